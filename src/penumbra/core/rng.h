@@ -1,0 +1,48 @@
+#pragma once
+// counter-based random numbers: every draw is a pure function of its keys, so
+// results never depend on thread count, scheduling or call order.
+//
+// hash: the 64-bit finaliser of SplitMix64 (Steele, Lea, Flood, "Fast splittable
+// pseudorandom number generators", OOPSLA 2014).
+
+#include <cstdint>
+
+namespace penumbra {
+
+/// SplitMix64 finaliser: a bijective 64-bit mix.
+constexpr uint64_t Mix64(uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+/// combines keys into one 64-bit stream id.
+constexpr uint64_t HashKeys(uint64_t a, uint64_t b) { return Mix64(a ^ Mix64(b)); }
+constexpr uint64_t HashKeys(uint64_t a, uint64_t b, uint64_t c) { return HashKeys(HashKeys(a, b), c); }
+constexpr uint64_t HashKeys(uint64_t a, uint64_t b, uint64_t c, uint64_t d) {
+  return HashKeys(HashKeys(a, b, c), d);
+}
+
+/// a small deterministic stream seeded by keys, e.g. Rng(HashKeys(seed, frame, pixel, sample)).
+class Rng {
+ public:
+  explicit constexpr Rng(uint64_t stream) : state_(stream) {}
+  /// next 64 random bits.
+  constexpr uint64_t NextU64() {
+    state_ += 0x9e3779b97f4a7c15ULL;
+    uint64_t z = state_;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  /// uniform float in [0, 1).
+  float Uniform() { return static_cast<float>(NextU64() >> 40) * 0x1.0p-24f; }
+  /// uniform double in [0, 1).
+  double UniformD() { return static_cast<double>(NextU64() >> 11) * 0x1.0p-53; }
+
+ private:
+  uint64_t state_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,3 @@
+#include "penumbra/app/cli.h"
+
+int main(int argc, char** argv) { return penumbra::RunCli(argc, argv); }

@@ -1,0 +1,32 @@
+#pragma once
+// settings that pick the render quality tier and the exposure / tone mapping.
+
+#include <cstdint>
+#include <string>
+
+namespace penumbra {
+
+/// render quality and image formation. both tiers share one code path (scene,
+/// materials, lights, camera); they differ in the light transport they simulate.
+struct RenderSettings {
+  enum class Tier {
+    kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1 sample/pixel
+    kPathtraced,  ///< unidirectional path tracing, NEE with MIS, N samples/pixel, denoised
+  };
+  Tier tier = Tier::kRealtime;
+  int samples_per_pixel = 16;  ///< pathtraced: samples per pixel (>= 1)
+  int max_bounces = 4;         ///< pathtraced: maximum path length in bounces (>= 1)
+  bool denoise = true;         ///< pathtraced: edge-aware denoiser guided by albedo/normal/depth
+  int threads = 0;             ///< render threads; 0 = all hardware threads
+  bool auto_exposure = true;   ///< per-frame exposure from the image's log-average luminance
+  double ev100 = 10;           ///< manual exposure value at ISO 100
+  double exposure_compensation_ev = 0;  ///< added to the (auto or manual) exposure, in stops
+  enum class ToneMap { kFilmic, kLinear };
+  ToneMap tone_map = ToneMap::kFilmic;  ///< filmic: ACES fit (Narkowicz 2015); linear: clamp
+  uint64_t seed = 0;           ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
+
+  /// throws ConfigError if a value is out of range.
+  void ValidateOrThrow() const;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,47 @@
+#pragma once
+// the renderer interface: turns a WorldSnapshot seen from one camera into images.
+// implementations never touch the physics engine, so a recorded run can be
+// re-rendered without it.
+
+#include <memory>
+
+#include "penumbra/core/image.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// what to render: a pinhole camera at a pose.
+struct CameraView {
+  Pose X_WO = Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in world
+  CameraIntrinsics intrinsics;
+  CameraOutputs outputs;
+  int64_t frame_index = 0;  ///< per-camera frame counter, keys the per-pixel random numbers
+  int camera_index = 0;     ///< index in SceneDescription::cameras, keys the random numbers too
+};
+
+/// images of one frame; the ones not requested are left empty.
+struct RenderedFrame {
+  ImageF radiance;   ///< (H x W x 3) float, linear scene radiance in cd/m^2 per channel, before exposure
+  ImageU8 rgb;       ///< (H x W x 3) uint8 sRGB after exposure and tone mapping
+  ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
+  ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background; never blended
+  double ev100 = 0;  ///< exposure value used for rgb
+};
+
+/// renders frames of one scene. not thread-safe: one Render at a time (each call is
+/// parallel inside).
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+  /// renders `view` of the world posed by `snapshot` into `out`.
+  /// @throws Error if the snapshot does not match the scene (body counts differ).
+  virtual void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) = 0;
+};
+
+/// Embree-backed ray tracer over `scene` (copied); see render/embree_renderer.h.
+/// @throws Error if Embree cannot be initialised; ConfigError for bad settings.
+std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene, const RenderSettings& settings);
+
+}  // namespace penumbra

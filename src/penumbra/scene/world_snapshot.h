@@ -1,0 +1,30 @@
+#pragma once
+// the moving part of a world at one instant: what the renderer and sensors need to
+// draw a frame, copied out of the physics state so that rendering can run on
+// another thread, or later from a recording, without the physics engine.
+
+#include <cstdint>
+#include <vector>
+
+#include "penumbra/core/pose.h"
+
+namespace penumbra {
+
+/// state of a world at one simulation step.
+struct WorldSnapshot {
+  double time_sec = 0.0;  ///< simulation time
+  int64_t step = 0;       ///< physics steps taken since the start
+  /// X_WB for every body of SceneDescription::bodies (index 0 = world = identity).
+  std::vector<Pose> X_WB;
+  /// X_W_mjcam: pose of every MJCF camera in MuJoCo's camera convention (x right,
+  /// y up, looking along -z), after tracking modes are applied, by MuJoCo camera id.
+  std::vector<Pose> X_W_mjcam;
+  /// position and direction (unit) of every MJCF light in the world frame, by MuJoCo light id.
+  std::vector<Eigen::Vector3d> light_position_W;
+  std::vector<Eigen::Vector3d> light_direction_W;
+  /// joint positions and velocities (MuJoCo qpos / qvel), for recording and replay.
+  std::vector<double> qpos;
+  std::vector<double> qvel;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,139 @@
+#pragma once
+// the world file: a YAML document that says which models make up a world, how it
+// is lit, which cameras watch it and for how long it runs. the full schema with
+// defaults and ranges is in README.md ("World file reference"); this header is
+// its in-memory form. every struct has defaults and ValidateOrThrow().
+
+#include <Eigen/Core>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/pose.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// where a model is placed: translation (m) and roll/pitch/yaw (deg, REP-103).
+struct PoseConfig {
+  Eigen::Vector3d xyz{0, 0, 0};
+  Eigen::Vector3d rpy_deg{0, 0, 0};
+  Pose ToPose() const { return PoseFromXyzRpyDeg(xyz, rpy_deg); }
+};
+
+/// a controller attached to a robot. `type` picks the implementation; `params`
+/// keeps the rest of the YAML map as text (a YAML/JSON snippet) for the controller
+/// to parse and validate itself at load, so controllers stay pluggable.
+struct ControllerConfig {
+  std::string type;    ///< e.g. "waypoint_follower"; empty = none
+  std::string params_yaml;  ///< the controller's mapping, re-emitted as YAML text
+  int line = 0;        ///< line of the controller block in the world file
+};
+
+/// one MJCF or URDF file placed in the world under a unique name.
+struct ModelConfig {
+  std::string name;   ///< unique; prefixes every MJCF name of the model as "<name>/"
+  std::string file;   ///< absolute path after loading (relative paths resolve against the world file)
+  PoseConfig pose;
+  bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
+  ControllerConfig controller;
+};
+
+/// a world-file light (see scene Light for units).
+struct LightConfig {
+  std::string name;
+  Light::Type type = Light::Type::kPoint;  ///< "sun"/"directional", "point", "spot"
+  std::string attach = "world";            ///< body name ("<model>/<body>") or "world"
+  Eigen::Vector3d position{0, 0, 3};       ///< m, in the attach frame (point, spot)
+  Eigen::Vector3d direction{0, 0, -1};     ///< direction the light travels (sun, spot)
+  Eigen::Vector3f color{1, 1, 1};
+  std::optional<double> illuminance_lux;   ///< sun / directional
+  std::optional<double> intensity_cd;      ///< point / spot
+  std::optional<double> power_w;           ///< point / spot, converted at 683 lm/W: I = 683 P / (4 pi)
+  double inner_angle_deg = 30, outer_angle_deg = 45;  ///< spot cone half-angles
+  double radius_m = 0;                     ///< emitter radius (soft shadows)
+  double angular_diameter_deg = 0.53;      ///< sun's apparent diameter (soft shadows)
+  bool cast_shadow = true;
+};
+
+/// sky: "uniform" (colour x luminance) or "daylight" (Preetham analytic sky).
+struct SkyConfig {
+  Sky::Type type = Sky::Type::kUniform;
+  Eigen::Vector3f color{0.6f, 0.7f, 0.8f};  ///< uniform: linear rgb tint
+  double luminance_cd_m2 = 1000;            ///< uniform: luminance of the sky
+  double turbidity = 3;                     ///< daylight
+  double sun_elevation_deg = 45, sun_azimuth_deg = 0;  ///< daylight; azimuth from +x towards +y
+  double zenith_luminance_cd_m2 = 8000;     ///< daylight
+};
+
+/// a world-file camera, or overrides for an MJCF camera of the same name.
+struct CameraConfig {
+  std::string name;
+  std::string attach = "world";  ///< body name ("<model>/<body>") or "world"
+  /// pose of the camera body frame (REP-103: x forward, y left, z up) in the attach
+  /// frame; the optical frame (OpenCV) is derived from it.
+  PoseConfig pose;
+  int width = 640, height = 480;
+  std::optional<double> fovy_deg;                        ///< default 60 when no intrinsics
+  std::optional<CameraIntrinsics> intrinsics;            ///< fx fy cx cy (px)
+  double rate_hz = 10;
+  CameraOutputs outputs;
+  bool is_mjcf_override = false;  ///< true: entry under `mjcf_cameras.overrides`
+  /// true: pose chosen at load to frame the whole model (bare-model runs)
+  bool auto_frame = false;
+};
+
+/// defaults applied to every camera that an MJCF model declares.
+struct MjcfCameraDefaults {
+  bool enabled = true;
+  int width = 640, height = 480;
+  double rate_hz = 10;
+  CameraOutputs outputs;
+  /// `mjcf_cameras.overrides`: per MJCF camera (prefixed name) width/height/fovy/
+  /// intrinsics/rate/outputs; entries have is_mjcf_override = true.
+  std::vector<CameraConfig> overrides;
+};
+
+/// world-file override of a material, by (prefixed) MJCF material name.
+struct MaterialOverride {
+  std::string name;
+  std::optional<Eigen::Vector3f> base_color;
+  std::optional<float> roughness, metallic, specular;
+  std::optional<Eigen::Vector3f> emission;  ///< cd/m^2 per channel
+};
+
+/// a whole world file.
+struct WorldConfig {
+  std::string file;             ///< path of the world file ("" for a bare model)
+  uint64_t seed = 0;
+  double duration_sec = 10;
+  std::optional<double> timestep_sec;  ///< overrides the MJCF <option timestep>
+  std::vector<ModelConfig> models;     ///< robots first, then static models, in file order
+  std::vector<LightConfig> lights;
+  bool default_lights = false;  ///< add a default sun + sky fill (bare-model runs)
+  SkyConfig sky;
+  std::vector<CameraConfig> cameras;
+  MjcfCameraDefaults mjcf_cameras;
+  std::vector<MaterialOverride> materials;
+  RenderSettings render;  ///< `render:` block (render/render_settings.h); seed copied from `seed`
+  std::string output_dir = "out";
+
+  /// throws ConfigError naming the file, key and the expected range.
+  void ValidateOrThrow() const;
+};
+
+/// reads and validates a world file. relative paths in it resolve against its folder.
+/// @throws ConfigError for unknown keys, wrong types, missing files, out-of-range values,
+///         naming the file, line, key path and what was expected.
+WorldConfig LoadWorldFile(const std::string& path);
+
+/// parses world-file text; `file_name` is used in messages and to resolve relative paths.
+WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name);
+
+/// a world around one bare MJCF or URDF file: a default camera framing the model,
+/// default lights and sky (penumbra run MODEL.xml).
+WorldConfig WorldForBareModel(const std::string& model_path);
+
+}  // namespace penumbra
