@@ -4,6 +4,7 @@
 // re-rendered without it.
 
 #include <memory>
+#include <string>
 
 #include "penumbra/core/image.h"
 #include "penumbra/render/render_settings.h"
@@ -28,6 +29,7 @@ struct RenderedFrame {
   ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
   ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background; never blended
   double ev100 = 0;  ///< exposure value used for rgb
+  int64_t rays = 0;  ///< rays traced for this frame (primary + shadow + secondary), for benchmarks
 };
 
 /// renders frames of one scene. not thread-safe: one Render at a time (each call is
@@ -42,6 +44,9 @@ class Renderer {
 
 /// Embree-backed ray tracer over `scene` (copied); see render/embree_renderer.h.
 /// @throws Error if Embree cannot be initialised; ConfigError for bad settings.
+/// Embree's version string, for run manifests.
+std::string EmbreeVersion();
+
 std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene, const RenderSettings& settings);
 
 }  // namespace penumbra
