@@ -4,7 +4,7 @@
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config git
-  libmujoco-dev libmujoco-samples
+  libmujoco-dev libmujoco-samples libqhull-dev
   libembree-dev
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libtinyxml2-dev libpng-dev nlohmann-json3-dev
