@@ -1,0 +1,347 @@
+#include "penumbra/render/sky_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// a diffuse ground of this albedo is seen below the horizon of a daylight sky.
+constexpr double kGroundAlbedo = 0.2;
+
+// sampling table: cells over the whole sphere in (theta from +z, phi from +x towards +y).
+constexpr int kSampleRows = 128;  // theta in [0, pi]
+constexpr int kSampleCols = 256;  // phi in [0, 2 pi)
+// irradiance quadrature: cells over the upper hemisphere only (the ground is analytic).
+constexpr int kQuadRows = 64;  // theta in [0, pi / 2]
+constexpr int kQuadCols = 128;
+// irradiance table: nodes over normal directions, bilinear in (theta, phi).
+constexpr int kIrrRows = 33;  // theta_i = i pi / (kIrrRows - 1), poles included
+constexpr int kIrrCols = 64;  // phi_j = 2 pi j / kIrrCols, wraps
+
+// Rec. 709 / sRGB luminance weights (row Y of the RGB -> XYZ matrix, D65 white), IEC 61966-2-1.
+double Luminance(const Eigen::Vector3d& rgb) {
+  return 0.2126729 * rgb.x() + 0.7151522 * rgb.y() + 0.0721750 * rgb.z();
+}
+
+Eigen::Vector3d DirectionFromAngles(double theta, double phi) {
+  const double s = std::sin(theta);
+  return {s * std::cos(phi), s * std::sin(phi), std::cos(theta)};
+}
+
+// piecewise-constant 1d distribution on [0, 1] (Pharr, Jakob, Humphreys, "Physically Based
+// Rendering", 3rd ed., sec. 13.3.1).
+class Distribution1D {
+ public:
+  explicit Distribution1D(std::vector<double> f) : func_(std::move(f)), cdf_(func_.size() + 1) {
+    const int n = static_cast<int>(func_.size());
+    cdf_[0] = 0;
+    for (int i = 0; i < n; ++i) cdf_[i + 1] = cdf_[i] + func_[i] / n;
+    integral_ = cdf_[n];
+    if (!(integral_ > 0)) {
+      // a zero function samples uniformly.
+      std::fill(func_.begin(), func_.end(), 1.0);
+      for (int i = 0; i <= n; ++i) cdf_[i] = static_cast<double>(i) / n;
+      integral_ = 1;
+    } else {
+      for (int i = 1; i <= n; ++i) cdf_[i] /= integral_;
+    }
+  }
+
+  int count() const { return static_cast<int>(func_.size()); }
+  double integral() const { return integral_; }
+  /// density on [0, 1] of cell i.
+  double Pdf(int i) const { return func_[i] / integral_; }
+
+  /// maps u in [0, 1) to x in [0, 1); writes the density at x and the cell index.
+  double Sample(double u, double* pdf, int* cell) const {
+    const int n = count();
+    // last cdf entry <= u.
+    int i = static_cast<int>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin()) - 1;
+    i = std::clamp(i, 0, n - 1);
+    // skip zero-width cells the search may land on.
+    while (i < n - 1 && func_[i] <= 0) ++i;
+    const double width = cdf_[i + 1] - cdf_[i];
+    double du = width > 0 ? (u - cdf_[i]) / width : 0.5;
+    du = std::clamp(du, 0.0, 1.0);
+    *pdf = Pdf(i);
+    *cell = i;
+    return std::min((i + du) / n, 1.0 - 1e-12);
+  }
+
+ private:
+  std::vector<double> func_;
+  std::vector<double> cdf_;
+  double integral_ = 0;
+};
+
+// Perez et al. 1993 sky luminance distribution with the five coefficients of one quantity.
+struct Perez {
+  double a, b, c, d, e;
+  /// F(theta, gamma): theta from the zenith, gamma from the sun.
+  double operator()(double cos_theta, double gamma, double cos_gamma) const {
+    const double ct = std::max(cos_theta, 1e-4);
+    return (1 + a * std::exp(b / ct)) * (1 + c * std::exp(d * gamma) + e * cos_gamma * cos_gamma);
+  }
+};
+
+}  // namespace
+
+struct SkyModel::Impl {
+  Sky::Type type = Sky::Type::kUniform;
+  Eigen::Vector3d uniform{0, 0, 0};
+  // daylight model state.
+  Eigen::Vector3d sun{0, 0, 1};
+  double theta_sun = 0;
+  Perez perez_y{}, perez_x{}, perez_yc{};
+  double y_scale = 0, x_scale = 0, yc_scale = 0;  // zenith value / F(0, theta_sun)
+  Eigen::Vector3d ground{0, 0, 0};
+
+  // sampling: marginal over rows (theta), conditionals per row over phi.
+  std::vector<Distribution1D> conditional;
+  std::unique_ptr<Distribution1D> marginal;
+  // irradiance table (kIrrRows x kIrrCols), per channel.
+  std::vector<Eigen::Vector3f> irradiance;
+
+  Eigen::Vector3d Upper(const Eigen::Vector3d& d) const;
+  Eigen::Vector3d Eval(const Eigen::Vector3d& d) const {
+    if (type == Sky::Type::kUniform) return uniform;
+    return d.z() < 0 ? ground : Upper(d);
+  }
+  void BuildSampling();
+  void BuildIrradiance();
+};
+
+// Preetham, Shirley, Smits 1999: Y, x, y each follow the Perez function normalised at the
+// zenith; xyY -> CIE XYZ -> linear sRGB (Rec. 709 primaries, D65 white, IEC 61966-2-1).
+Eigen::Vector3d SkyModel::Impl::Upper(const Eigen::Vector3d& d) const {
+  const double cos_theta = std::clamp(d.z(), 0.0, 1.0);
+  const double cos_gamma = std::clamp(d.dot(sun), -1.0, 1.0);
+  const double gamma = std::acos(cos_gamma);
+  const double lum = y_scale * perez_y(cos_theta, gamma, cos_gamma);
+  const double x = x_scale * perez_x(cos_theta, gamma, cos_gamma);
+  const double y = yc_scale * perez_yc(cos_theta, gamma, cos_gamma);
+  if (!(y > 1e-6) || !(lum > 0)) return {0, 0, 0};
+  const double cx = x / y * lum;
+  const double cz = (1 - x - y) / y * lum;
+  Eigen::Vector3d rgb(3.2404542 * cx - 1.5371385 * lum - 0.4985314 * cz,
+                      -0.9692660 * cx + 1.8760108 * lum + 0.0415560 * cz,
+                      0.0556434 * cx - 0.2040259 * lum + 1.0572252 * cz);
+  return rgb.cwiseMax(0.0);
+}
+
+void SkyModel::Impl::BuildSampling() {
+  // luminance x sin(theta) at cell centres: pbrt's environment-map sampling (sec. 14.2.4).
+  std::vector<double> lum(static_cast<size_t>(kSampleRows) * kSampleCols);
+  double max_lum = 0;
+  for (int r = 0; r < kSampleRows; ++r) {
+    const double theta = (r + 0.5) * kPi / kSampleRows;
+    for (int c = 0; c < kSampleCols; ++c) {
+      const double phi = (c + 0.5) * 2 * kPi / kSampleCols;
+      const double l = std::max(Luminance(Eval(DirectionFromAngles(theta, phi))), 0.0);
+      lum[static_cast<size_t>(r) * kSampleCols + c] = l;
+      max_lum = std::max(max_lum, l);
+    }
+  }
+  // a black sky samples the sphere (almost) uniformly so that Sample/Pdf stay valid.
+  if (!(max_lum > 0)) std::fill(lum.begin(), lum.end(), 1.0);
+  std::vector<double> row_integrals(kSampleRows);
+  conditional.reserve(kSampleRows);
+  for (int r = 0; r < kSampleRows; ++r) {
+    const double sin_theta = std::sin((r + 0.5) * kPi / kSampleRows);
+    std::vector<double> f(kSampleCols);
+    double sum = 0;
+    for (int c = 0; c < kSampleCols; ++c) {
+      f[c] = lum[static_cast<size_t>(r) * kSampleCols + c] * sin_theta;
+      sum += f[c];
+    }
+    row_integrals[r] = sum / kSampleCols;
+    conditional.emplace_back(std::move(f));
+  }
+  marginal = std::make_unique<Distribution1D>(std::move(row_integrals));
+}
+
+// irradiance E(n) = integral of L(w) max(0, n.w) dw, tabulated over normals. the upper
+// hemisphere is integrated by the midpoint rule on kQuadRows x kQuadCols cells; the ground
+// (constant radiance G over the lower hemisphere) contributes G pi (1 - n_z) / 2 exactly.
+void SkyModel::Impl::BuildIrradiance() {
+  const int cells = kQuadRows * kQuadCols;
+  std::vector<float> dx(cells), dy(cells), dz(cells), lr(cells), lg(cells), lb(cells);
+  const double dphi = 2 * kPi / kQuadCols;
+  for (int r = 0; r < kQuadRows; ++r) {
+    const double t0 = r * 0.5 * kPi / kQuadRows, t1 = (r + 1) * 0.5 * kPi / kQuadRows;
+    const double theta = 0.5 * (t0 + t1);
+    const double d_omega = dphi * (std::cos(t0) - std::cos(t1));
+    for (int c = 0; c < kQuadCols; ++c) {
+      const Eigen::Vector3d d = DirectionFromAngles(theta, (c + 0.5) * dphi);
+      const Eigen::Vector3d l = Eval(d) * d_omega;
+      const int i = r * kQuadCols + c;
+      dx[i] = static_cast<float>(d.x());
+      dy[i] = static_cast<float>(d.y());
+      dz[i] = static_cast<float>(d.z());
+      lr[i] = static_cast<float>(l.x());
+      lg[i] = static_cast<float>(l.y());
+      lb[i] = static_cast<float>(l.z());
+    }
+  }
+  const Eigen::Vector3d g = type == Sky::Type::kUniform ? uniform : ground;
+  irradiance.resize(static_cast<size_t>(kIrrRows) * kIrrCols);
+  for (int r = 0; r < kIrrRows; ++r) {
+    const double theta = r * kPi / (kIrrRows - 1);
+    for (int c = 0; c < kIrrCols; ++c) {
+      const Eigen::Vector3d n = DirectionFromAngles(theta, c * 2 * kPi / kIrrCols);
+      const float nx = static_cast<float>(n.x()), ny = static_cast<float>(n.y()),
+                  nz = static_cast<float>(n.z());
+      double er = 0, eg = 0, eb = 0;
+      for (int q = 0; q < kQuadRows; ++q) {
+        float sr = 0, sg = 0, sb = 0;
+        for (int k = q * kQuadCols; k < (q + 1) * kQuadCols; ++k) {
+          const float cosine = std::max(0.0f, nx * dx[k] + ny * dy[k] + nz * dz[k]);
+          sr += cosine * lr[k];
+          sg += cosine * lg[k];
+          sb += cosine * lb[k];
+        }
+        er += sr;
+        eg += sg;
+        eb += sb;
+      }
+      const Eigen::Vector3d e = Eigen::Vector3d(er, eg, eb) + g * (kPi * 0.5 * (1 - n.z()));
+      irradiance[static_cast<size_t>(r) * kIrrCols + c] = e.cast<float>();
+    }
+  }
+}
+
+SkyModel::SkyModel(const Sky& sky) {
+  auto impl = std::make_shared<Impl>();
+  impl->type = sky.type;
+  if (sky.type == Sky::Type::kUniform) {
+    if (!sky.radiance.allFinite() || sky.radiance.minCoeff() < 0)
+      throw ConfigError("", 0, "sky.radiance",
+                        "uniform sky radiance must be finite and >= 0 per channel");
+    impl->uniform = sky.radiance.cast<double>();
+  } else {
+    const double t = sky.turbidity;
+    if (!(t >= 1.7 && t <= 10))
+      throw ConfigError("", 0, "sky.turbidity",
+                        "got " + std::to_string(t) + "; expected a turbidity in [1.7, 10]");
+    const double norm = sky.sun_direction_W.norm();
+    if (!(norm > 1e-9) || !sky.sun_direction_W.allFinite())
+      throw ConfigError("", 0, "sky.sun_direction_W", "expected a non-zero finite direction");
+    if (!(sky.zenith_luminance >= 0) || !std::isfinite(sky.zenith_luminance))
+      throw ConfigError("", 0, "sky.zenith_luminance", "expected a finite luminance >= 0 cd/m^2");
+    // the model's fits hold for the sun above the horizon; a lower sun is moved up to it.
+    Eigen::Vector3d sun = sky.sun_direction_W / norm;
+    if (sun.z() < 0) {
+      sun.z() = 0;
+      sun = sun.norm() > 1e-9 ? Eigen::Vector3d(sun.normalized()) : Eigen::Vector3d(1, 0, 0);
+    }
+    impl->sun = sun;
+    const double ts = std::acos(std::clamp(sun.z(), 0.0, 1.0));
+    impl->theta_sun = ts;
+    // Perez coefficients as linear functions of turbidity (Preetham et al. 1999, appendix A.2).
+    impl->perez_y = {0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251,
+                     0.1206 * t - 2.5771, -0.0670 * t + 0.3703};
+    impl->perez_x = {-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125,
+                     -0.0641 * t - 0.8989, -0.0033 * t + 0.0452};
+    impl->perez_yc = {-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102,
+                      -0.0441 * t - 1.6537, -0.0109 * t + 0.0529};
+    // zenith chromaticity (appendix A.2): [T^2 T 1] M [ts^3 ts^2 ts 1]^T.
+    const double t_vec[3] = {t * t, t, 1};
+    const double s_vec[4] = {ts * ts * ts, ts * ts, ts, 1};
+    static constexpr double kMx[3][4] = {{0.00166, -0.00375, 0.00209, 0},
+                                         {-0.02903, 0.06377, -0.03202, 0.00394},
+                                         {0.11693, -0.21196, 0.06052, 0.25886}};
+    static constexpr double kMy[3][4] = {{0.00275, -0.00610, 0.00317, 0},
+                                         {-0.04214, 0.08970, -0.04153, 0.00516},
+                                         {0.15346, -0.26756, 0.06670, 0.26688}};
+    double xz = 0, yz = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 4; ++j) {
+        xz += t_vec[i] * kMx[i][j] * s_vec[j];
+        yz += t_vec[i] * kMy[i][j] * s_vec[j];
+      }
+    // the zenith luminance of the model, Yz = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192
+    // kcd/m^2, is replaced by the configured Sky::zenith_luminance (the overall scale of the
+    // model's luminance is only a fit; its angular distribution is kept).
+    const double cos_ts = std::cos(ts);
+    impl->y_scale = sky.zenith_luminance / impl->perez_y(1.0, ts, cos_ts);
+    impl->x_scale = xz / impl->perez_x(1.0, ts, cos_ts);
+    impl->yc_scale = yz / impl->perez_yc(1.0, ts, cos_ts);
+    // below the horizon: a Lambertian ground of albedo kGroundAlbedo lit by this sky alone
+    // (the sun is a separate Light; its bounce is not included), radiance
+    // G = albedo / pi * E_up, with E_up the sky irradiance on an upward-facing surface.
+    // constant over the lower hemisphere, it darkens the horizon value as a ground bounce.
+    double e_up[3] = {0, 0, 0};
+    const double dphi = 2 * kPi / kSampleCols;
+    for (int r = 0; r < kSampleRows; ++r) {
+      const double t0 = r * 0.5 * kPi / kSampleRows, t1 = (r + 1) * 0.5 * kPi / kSampleRows;
+      const double theta = 0.5 * (t0 + t1);
+      // integral of cos(theta) d omega over the cell.
+      const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
+      for (int c = 0; c < kSampleCols; ++c) {
+        const Eigen::Vector3d l = impl->Upper(DirectionFromAngles(theta, (c + 0.5) * dphi));
+        for (int k = 0; k < 3; ++k) e_up[k] += l[k] * w;
+      }
+    }
+    impl->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / kPi);
+  }
+  impl->BuildSampling();
+  impl->BuildIrradiance();
+  impl_ = std::move(impl);
+}
+
+Eigen::Vector3f SkyModel::Radiance(const Eigen::Vector3f& dir_W) const {
+  return impl_->Eval(dir_W.cast<double>()).cast<float>();
+}
+
+Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
+  const Impl& m = *impl_;
+  const double theta = std::acos(std::clamp(static_cast<double>(n_W.z()), -1.0, 1.0));
+  double phi = std::atan2(static_cast<double>(n_W.y()), static_cast<double>(n_W.x()));
+  if (phi < 0) phi += 2 * kPi;
+  const double ft = theta / kPi * (kIrrRows - 1);
+  const double fp = phi / (2 * kPi) * kIrrCols;
+  const int r0 = std::clamp(static_cast<int>(ft), 0, kIrrRows - 2);
+  const int c0 = std::clamp(static_cast<int>(fp), 0, kIrrCols - 1);
+  const int c1 = (c0 + 1) % kIrrCols;
+  const float a = static_cast<float>(std::clamp(ft - r0, 0.0, 1.0));
+  const float b = static_cast<float>(std::clamp(fp - c0, 0.0, 1.0));
+  auto at = [&](int r, int c) { return m.irradiance[static_cast<size_t>(r) * kIrrCols + c]; };
+  return (1 - a) * ((1 - b) * at(r0, c0) + b * at(r0, c1)) +
+         a * ((1 - b) * at(r0 + 1, c0) + b * at(r0 + 1, c1));
+}
+
+Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
+  const Impl& m = *impl_;
+  double pdf_v = 0, pdf_u = 0;
+  int row = 0, col = 0;
+  const double v = m.marginal->Sample(u2, &pdf_v, &row);
+  const double u = m.conditional[row].Sample(u1, &pdf_u, &col);
+  const double theta = v * kPi, phi = u * 2 * kPi;
+  const double sin_theta = std::sin(theta);
+  *pdf = sin_theta > 0 ? static_cast<float>(pdf_v * pdf_u / (2 * kPi * kPi * sin_theta)) : 0.0f;
+  return DirectionFromAngles(theta, phi).cast<float>();
+}
+
+float SkyModel::Pdf(const Eigen::Vector3f& dir_W) const {
+  const Impl& m = *impl_;
+  const Eigen::Vector3d d = dir_W.cast<double>().normalized();
+  const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
+  const double sin_theta = std::sin(theta);
+  if (!(sin_theta > 0)) return 0.0f;
+  double phi = std::atan2(d.y(), d.x());
+  if (phi < 0) phi += 2 * kPi;
+  const int row = std::clamp(static_cast<int>(theta / kPi * kSampleRows), 0, kSampleRows - 1);
+  const int col = std::clamp(static_cast<int>(phi / (2 * kPi) * kSampleCols), 0, kSampleCols - 1);
+  const double p = m.marginal->Pdf(row) * m.conditional[row].Pdf(col);
+  return static_cast<float>(p / (2 * kPi * kPi * sin_theta));
+}
+
+}  // namespace penumbra
