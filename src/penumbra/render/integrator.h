@@ -1,0 +1,79 @@
+#pragma once
+// the light-transport interface shared by both render tiers. the renderer
+// (render/embree_renderer) splits a frame into tiles, traces the pixel-centre camera ray
+// of every pixel of a tile once (those hits give the exact depth and segmentation
+// images), and hands them to an Integrator, which estimates the radiance of every pixel
+// of the tile. tiles never overlap, so integrators write their pixels without locks.
+//
+// determinism: an integrator draws random numbers only from Rng(ctx.PixelStream(u, v, s)),
+// so images do not depend on the thread count or tile order.
+
+#include <cstdint>
+
+#include "penumbra/core/image.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/material_eval.h"
+#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/render/sky_model.h"
+
+namespace penumbra {
+
+/// a rectangle of pixels: columns [x0, x0 + width), rows [y0, y0 + height).
+struct PixelTile {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
+/// what an integrator reads during one frame; all of it is immutable for the frame.
+struct FrameContext {
+  const RayScene* scene = nullptr;  ///< posed for this frame
+  const MaterialEvaluator* materials = nullptr;
+  const LightSampler* lights = nullptr;  ///< posed for this frame
+  const SkyModel* sky = nullptr;
+  const Camera* camera = nullptr;
+  const RenderSettings* settings = nullptr;
+  int camera_index = 0;     ///< CameraView::camera_index
+  int64_t frame_index = 0;  ///< CameraView::frame_index
+
+  /// stream id of pixel (u, v), sample s: HashKeys(HashKeys(seed, camera), frame, pixel, s)
+  /// with pixel = v * width + u.
+  uint64_t PixelStream(int u, int v, int s) const {
+    const uint64_t pixel = static_cast<uint64_t>(v) * static_cast<uint64_t>(camera->width()) +
+                           static_cast<uint64_t>(u);
+    return HashKeys(HashKeys(settings->seed, static_cast<uint64_t>(camera_index)),
+                    static_cast<uint64_t>(frame_index), pixel, static_cast<uint64_t>(s));
+  }
+};
+
+/// the pixel-centre camera rays of one tile and what they hit, row-major over the tile
+/// (index (v - y0) * width + (u - x0)). traced once by the renderer for every tier.
+struct PrimaryHits {
+  PixelTile tile;
+  const Ray* rays = nullptr;         ///< camera ray through the pixel centre (t = z-depth)
+  const SurfaceHit* hits = nullptr;  ///< valid where did_hit
+  const bool* did_hit = nullptr;
+};
+
+/// full-frame images an integrator writes its tile into.
+struct FrameBuffers {
+  ImageF* radiance = nullptr;  ///< (H x W x 3) linear radiance, cd/m^2 per channel; required
+  /// (H x W x 3) denoiser guides, or null when not wanted: albedo = base colour of the first
+  /// visible surface (0 for sky), normal = its unit shading normal in the world frame (0 for sky).
+  ImageF* albedo = nullptr;
+  ImageF* normal = nullptr;
+};
+
+/// estimates pixel radiance for one render tier.
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+
+  /// renders the pixels of primary.tile into `out`; returns the number of rays it traced
+  /// (the primary rays are counted by the renderer). called concurrently for different tiles.
+  virtual int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
+                             const FrameBuffers& out) const = 0;
+};
+
+}  // namespace penumbra

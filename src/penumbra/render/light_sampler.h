@@ -1,0 +1,77 @@
+#pragma once
+// the analytic lights of a scene (Light in scene_description.h) as seen from a shading
+// point: incident direction, distance and the illuminance they deliver. photometric:
+// light intensity is in candela and directional illuminance in lux, so a Lambertian
+// surface of albedo rho facing a source of illuminance E has radiance E rho / pi (cd/m^2).
+//
+//   directional: illuminance E = Light::intensity arriving along -direction; with a
+//                non-zero angular radius the direction is sampled uniformly in the cone of
+//                the sun disc (soft shadows), each sample carrying the full E.
+//   point:       E = I / d^2 (inverse-square law).
+//   spot:        E = I s(cos theta) / d^2, s the smoothstep from cos(outer) to cos(inner)
+//                (as in glTF KHR_lights_punctual / Filament, with a cubic smoothstep).
+//   radius > 0:  point and spot lights sample a point uniformly on the sphere of that
+//                radius (soft shadows); E = I / d^2 to the sampled point, which averages to
+//                the point-light value for d >> radius.
+//
+// these are delta lights for MIS purposes (no surface can be hit by a BSDF-sampled ray):
+// an estimator takes each sample with weight 1. light poses come from the snapshot: MJCF
+// lights (mjcf_light >= 0) from light_position_W / light_direction_W, others from the pose
+// of their body, X_WB position_B and R_WB direction_B.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// one light sample at a shading point.
+struct LightSample {
+  Eigen::Vector3f wi{0, 0, 1};  ///< unit direction from the shading point towards the light (world)
+  float distance = 0;           ///< distance to the sampled emitter point, m; +inf for directional
+  Eigen::Vector3f E{0, 0,
+                    0};  ///< illuminance (lux per channel) on a surface facing wi, colour included
+  bool cast_shadow = true;  ///< the light casts shadows (trace a shadow ray)
+};
+
+/// a light posed in the world for the current snapshot.
+struct PosedLight {
+  Light::Type type = Light::Type::kPoint;
+  Eigen::Vector3f position_W{0, 0, 0};     ///< point, spot
+  Eigen::Vector3f direction_W{0, 0, -1};   ///< unit, direction light travels (directional, spot)
+  Eigen::Vector3f intensity_rgb{0, 0, 0};  ///< color x intensity (cd or lux per channel)
+  float cos_inner = 1, cos_outer = 1;      ///< spot cone cosines
+  float radius_m = 0;
+  float cos_angular_radius = 1;  ///< directional: cosine of the sun disc's angular radius
+  bool cast_shadow = true;
+};
+
+/// lights of a scene, posed per snapshot. Sample is thread-safe between Update calls.
+class LightSampler {
+ public:
+  /// keeps the active lights of `scene` with non-zero intensity.
+  explicit LightSampler(const SceneDescription& scene);
+
+  /// poses every light from `snapshot`.
+  /// @throws Error if an MJCF light id or body index is out of the snapshot's range.
+  void Update(const WorldSnapshot& snapshot);
+
+  /// number of lights (active, non-zero).
+  int size() const { return static_cast<int>(lights_.size()); }
+  /// the posed lights (after Update).
+  const std::vector<PosedLight>& lights() const { return lights_; }
+
+  /// samples light `i` as seen from world point p_W with two uniform numbers in [0, 1)
+  /// (used only by lights with an extent). returns false when the light sends nothing to
+  /// p_W (outside a spot cone, or p_W inside the emitter).
+  bool Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2, LightSample* s) const;
+
+ private:
+  std::vector<Light> sources_;  // the kept lights of the scene
+  int num_bodies_ = 0;
+  std::vector<PosedLight> lights_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,119 @@
+#pragma once
+// the ray-traceable form of a SceneDescription, on Intel Embree 3.
+//
+// layout (two-level, as Embree's instancing tutorial): every body with visible geoms gets
+// one RTCScene holding all its geoms in the body frame, built once; a top-level scene
+// instances these body scenes with the body poses X_WB. Update() only rewrites the
+// instance transforms and recommits the top level, so moving bodies costs O(bodies).
+//
+// geom shapes: box, mesh and height field are triangle geometry (box faces are exact
+// planes; meshes carry vertex normals for smooth shading and texcoords); plane, sphere,
+// capsule, ellipsoid and cylinder are Embree user geometry intersected analytically in
+// double precision, so depths are exact up to float rounding of the ray (LiDAR ranges).
+// an infinite plane (MJCF half-size 0) is clipped to kInfinitePlaneHalfSize.
+//
+// visibility: geoms in MJCF groups > 2 (MuJoCo shows groups 0-2 by default) and geoms
+// whose material has alpha < 0.5 are left out.
+//
+// surfaces are two-sided and opaque: the normals of a SurfaceHit face the incoming ray.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// half-size (m) of the quad that stands in for an infinite MJCF plane.
+constexpr double kInfinitePlaneHalfSize = 1e4;
+
+/// a ray p(t) = o + t d, t in [tmin, tmax]. d need not be unit: t is then in units of |d|
+/// (camera rays use d with optical-frame z = 1 so that t is the z-depth).
+struct Ray {
+  Eigen::Vector3f o{0, 0, 0};  ///< origin, world frame, m
+  Eigen::Vector3f d{0, 0, 1};  ///< direction, world frame (non-zero)
+  float tmin = 0.0f;
+  float tmax = std::numeric_limits<float>::infinity();
+};
+
+/// the first surface a ray hits.
+struct SurfaceHit {
+  float t = 0;                   ///< ray parameter of the hit: p_W = o + t d
+  Eigen::Vector3f p_W{0, 0, 0};  ///< hit point, world frame, m
+  Eigen::Vector3f ng_W{0, 0,
+                       1};  ///< unit geometric normal, world frame, facing the ray (ng . d <= 0)
+  Eigen::Vector3f ns_W{0, 0,
+                       1};   ///< unit shading normal (interpolated for meshes), flipped with ng_W
+  Eigen::Vector2f uv{0, 0};  ///< mesh texcoords at the hit when the mesh has them, else (0, 0)
+  bool has_uv = false;       ///< uv came from mesh texcoords
+  bool front_face = true;    ///< the ray hit the outward side (before flipping the normals)
+  Eigen::Vector3f p_G{0, 0, 0};  ///< hit point in the geom frame, m (planar texture mapping)
+  Eigen::Vector3f n_G{0, 0, 1};  ///< unit outward geometric normal in the geom frame (not flipped)
+  int geom = -1;                 ///< index into SceneDescription::geoms
+  int material = -1;             ///< index into SceneDescription::materials, -1 = default material
+};
+
+/// scale of the offset that moves secondary-ray origins off a surface (relative to 1 + |p|_inf).
+constexpr float kRayOffsetScale = 5e-5f;
+
+/// a ray leaving `hit` in direction `d` (world), its origin pushed off the surface along the
+/// geometric normal on the side `d` goes to, so that it does not hit the surface it starts on.
+Ray SpawnRay(const SurfaceHit& hit, const Eigen::Vector3f& d);
+
+/// a shadow ray from `hit` towards the world point `p_W` that stops just short of it.
+Ray SpawnRayTo(const SurfaceHit& hit, const Eigen::Vector3f& p_W);
+
+/// Embree scenes of one SceneDescription. Intersect/Occluded are thread-safe between
+/// Update calls; Update must not run concurrently with them.
+class RayScene {
+ public:
+  /// builds the body scenes (and an identity pose for every body until Update). `scene` is
+  /// referenced, not copied: it must outlive this object.
+  /// @throws Error if Embree fails or a geom refers to a missing mesh / height field.
+  explicit RayScene(const SceneDescription& scene);
+  ~RayScene();
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  /// poses every body with snapshot.X_WB and recommits the top level if any pose changed.
+  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies.
+  void Update(const WorldSnapshot& snapshot);
+
+  /// closest hit along `ray` in [tmin, tmax]; fills `hit` and returns true, or returns false.
+  bool Intersect(const Ray& ray, SurfaceHit* hit) const;
+
+  /// true if anything blocks `ray` in [tmin, tmax].
+  bool Occluded(const Ray& ray) const;
+
+  /// closest hits of `n` rays traced together (Embree ray streams; `coherent` for rays of
+  /// neighbouring camera pixels). hit[i] is valid iff did_hit[i].
+  void IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits, bool* did_hit) const;
+
+  /// occlusion of `n` rays traced together; rays with active[i] == false are skipped and
+  /// get occluded[i] = false (active may be null = all).
+  void OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded) const;
+
+  /// the body poses currently in the scene (X_WB by body index).
+  const std::vector<Pose>& X_WB() const { return X_WB_; }
+
+  /// the scene this was built from.
+  const SceneDescription& scene() const { return scene_; }
+
+  /// how many geoms are ray traced (visible) and how many triangles they hold.
+  int num_visible_geoms() const { return num_visible_geoms_; }
+  int64_t num_triangles() const { return num_triangles_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  const SceneDescription& scene_;
+  std::vector<Pose> X_WB_;
+  int num_visible_geoms_ = 0;
+  int64_t num_triangles_ = 0;
+};
+
+}  // namespace penumbra
