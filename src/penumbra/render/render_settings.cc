@@ -1,0 +1,43 @@
+#include "penumbra/render/render_settings.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+namespace {
+
+std::string Num(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
+}
+
+// key paths are those of the world file's `render:` block.
+void CheckClosed(const char* key, double v, double lo, double hi) {
+  if (!std::isfinite(v) || v < lo || v > hi) {
+    throw ConfigError("", 0, std::string("render.") + key,
+                      "got " + Num(v) + "; expected [" + Num(lo) + ", " + Num(hi) + "]");
+  }
+}
+
+}  // namespace
+
+void RenderSettings::ValidateOrThrow() const {
+  if (tier != Tier::kRealtime && tier != Tier::kPathtraced) {
+    throw ConfigError("", 0, "render.tier", "unknown tier; expected one of: realtime, pathtraced");
+  }
+  CheckClosed("samples_per_pixel", samples_per_pixel, 1, 65536);
+  CheckClosed("max_bounces", max_bounces, 1, 64);
+  CheckClosed("threads", threads, 0, 256);
+  CheckClosed("exposure.ev100", ev100, -10, 30);
+  CheckClosed("exposure.compensation_ev", exposure_compensation_ev, -20, 20);
+  if (tone_map != ToneMap::kFilmic && tone_map != ToneMap::kLinear) {
+    throw ConfigError("", 0, "render.tone_map",
+                      "unknown tone map; expected one of: filmic, linear");
+  }
+}
+
+}  // namespace penumbra

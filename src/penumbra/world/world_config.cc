@@ -1,0 +1,412 @@
+#include "penumbra/world/world_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/world/world_validation.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace fs = std::filesystem;
+
+namespace penumbra {
+
+namespace {
+
+// reads one world-file document into a WorldConfig: structure, types and enum
+// values here; ranges and cross-field rules in ValidateWorld (world_validation.cc).
+class WorldParser {
+ public:
+  WorldParser(const std::string& file_name, LineTable* lines) : file_(file_name), lines_(lines) {
+    std::error_code ec;
+    fs::path abs = file_name.empty() ? fs::current_path(ec) / "world.yaml"
+                                     : fs::absolute(fs::path(file_name), ec);
+    base_dir_ = abs.parent_path();
+  }
+
+  WorldConfig Parse(const YAML::Node& root) {
+    YamlReader r(root, file_, lines_);
+    const std::vector<std::string_view> keys = {"seed",    "duration_sec", "physics",   "render",
+                                                "sky",     "robots",       "models",    "lights",
+                                                "cameras", "mjcf_cameras", "materials", "output"};
+    if (root.IsNull() || !root.IsDefined()) {
+      r.Fail("the world file is empty; expected a mapping with some of the keys: " +
+             JoinNames(keys));
+    }
+    r.ExpectMap(keys);
+
+    WorldConfig w;
+    w.file = file_;
+    if (r.Has("seed")) w.seed = r.Child("seed").Uint64();
+    if (r.Has("duration_sec")) w.duration_sec = r.Child("duration_sec").Double();
+    if (r.Has("physics")) {
+      YamlReader p = r.Child("physics");
+      p.ExpectMap({"timestep_sec"});
+      if (p.Has("timestep_sec")) w.timestep_sec = p.Child("timestep_sec").Double();
+    }
+    if (r.Has("render")) ReadRender(r.Child("render"), &w.render);
+    w.render.seed = w.seed;
+    if (r.Has("sky")) ReadSky(r.Child("sky"), &w.sky);
+    // robots first, then static models, each in file order
+    if (r.Has("robots")) {
+      for (const YamlReader& m : r.Child("robots").List()) w.models.push_back(ReadModel(m, true));
+    }
+    if (r.Has("models")) {
+      for (const YamlReader& m : r.Child("models").List()) w.models.push_back(ReadModel(m, false));
+    }
+    if (r.Has("lights")) {
+      for (const YamlReader& l : r.Child("lights").List()) w.lights.push_back(ReadLight(l));
+    }
+    if (r.Has("cameras")) {
+      for (const YamlReader& c : r.Child("cameras").List()) w.cameras.push_back(ReadCamera(c));
+    }
+    if (r.Has("mjcf_cameras")) ReadMjcfCameras(r.Child("mjcf_cameras"), &w.mjcf_cameras);
+    if (r.Has("materials")) {
+      for (auto& [name, m] : r.Child("materials").Entries())
+        w.materials.push_back(ReadMaterial(name, m));
+    }
+    if (r.Has("output")) {
+      YamlReader o = r.Child("output");
+      o.ExpectMap({"dir"});
+      if (o.Has("dir")) w.output_dir = o.Child("dir").String();
+    }
+    return w;
+  }
+
+ private:
+  // absolute, lexically normalised path; relative paths resolve against the world file's folder.
+  std::string Resolve(const std::string& path) const {
+    if (path.empty()) return path;
+    fs::path p(path);
+    if (p.is_relative()) p = base_dir_ / p;
+    return p.lexically_normal().string();
+  }
+
+  static void ReadPose(const YamlReader& r, PoseConfig* pose) {
+    r.ExpectMap({"xyz", "rpy_deg"});
+    if (r.Has("xyz")) pose->xyz = r.Child("xyz").Vector3();
+    if (r.Has("rpy_deg")) pose->rpy_deg = r.Child("rpy_deg").Vector3();
+  }
+
+  static Eigen::Vector3f Vector3f(const YamlReader& r) { return r.Vector3().cast<float>(); }
+
+  static void ReadRender(const YamlReader& r, RenderSettings* s) {
+    r.ExpectMap(
+        {"tier", "samples_per_pixel", "max_bounces", "denoise", "threads", "exposure", "tone_map"});
+    if (r.Has("tier")) {
+      s->tier = r.Child("tier").Enum({"realtime", "pathtraced"}) == "realtime"
+                    ? RenderSettings::Tier::kRealtime
+                    : RenderSettings::Tier::kPathtraced;
+    }
+    if (r.Has("samples_per_pixel")) s->samples_per_pixel = r.Child("samples_per_pixel").Int();
+    if (r.Has("max_bounces")) s->max_bounces = r.Child("max_bounces").Int();
+    if (r.Has("denoise")) s->denoise = r.Child("denoise").Bool();
+    if (r.Has("threads")) s->threads = r.Child("threads").Int();
+    if (r.Has("exposure")) {
+      YamlReader e = r.Child("exposure");
+      e.ExpectMap({"mode", "ev100", "compensation_ev"});
+      if (e.Has("mode")) s->auto_exposure = e.Child("mode").Enum({"auto", "manual"}) == "auto";
+      if (e.Has("ev100")) s->ev100 = e.Child("ev100").Double();
+      if (e.Has("compensation_ev")) {
+        s->exposure_compensation_ev = e.Child("compensation_ev").Double();
+      }
+    }
+    if (r.Has("tone_map")) {
+      s->tone_map = r.Child("tone_map").Enum({"filmic", "linear"}) == "filmic"
+                        ? RenderSettings::ToneMap::kFilmic
+                        : RenderSettings::ToneMap::kLinear;
+    }
+  }
+
+  static void ReadSky(const YamlReader& r, SkyConfig* s) {
+    r.ExpectMap({"type", "color", "luminance_cd_m2", "turbidity", "sun_elevation_deg",
+                 "sun_azimuth_deg", "zenith_luminance_cd_m2"});
+    if (r.Has("type")) {
+      s->type = r.Child("type").Enum({"uniform", "daylight"}) == "uniform" ? Sky::Type::kUniform
+                                                                           : Sky::Type::kDaylight;
+    }
+    if (r.Has("color")) s->color = Vector3f(r.Child("color"));
+    if (r.Has("luminance_cd_m2")) s->luminance_cd_m2 = r.Child("luminance_cd_m2").Double();
+    if (r.Has("turbidity")) s->turbidity = r.Child("turbidity").Double();
+    if (r.Has("sun_elevation_deg")) s->sun_elevation_deg = r.Child("sun_elevation_deg").Double();
+    if (r.Has("sun_azimuth_deg")) s->sun_azimuth_deg = r.Child("sun_azimuth_deg").Double();
+    if (r.Has("zenith_luminance_cd_m2")) {
+      s->zenith_luminance_cd_m2 = r.Child("zenith_luminance_cd_m2").Double();
+    }
+  }
+
+  ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
+    if (is_robot) {
+      r.ExpectMap({"name", "file", "pose", "controller"});
+    } else {
+      r.ExpectMap({"name", "file", "pose"});
+    }
+    ModelConfig m;
+    m.is_robot = is_robot;
+    m.name = r.Child("name").String();
+    m.file = Resolve(r.Child("file").String());
+    if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
+    if (r.Has("controller")) m.controller = ReadController(r.Child("controller"));
+    return m;
+  }
+
+  // `type` picks the controller; the rest of the mapping is kept as YAML text.
+  static ControllerConfig ReadController(const YamlReader& r) {
+    r.ExpectMapAnyKeys();
+    ControllerConfig c;
+    c.type = r.Child("type").String();
+    if (c.type.empty()) r.Child("type").Fail("empty; expected a controller type name");
+    c.line = r.line();
+    YAML::Emitter out;
+    out << YAML::BeginMap;
+    for (auto it = r.node().begin(); it != r.node().end(); ++it) {
+      if (it->first.Scalar() == "type") continue;
+      out << YAML::Key << it->first.Scalar() << YAML::Value << it->second;
+    }
+    out << YAML::EndMap;
+    c.params_yaml = out.c_str();
+    return c;
+  }
+
+  static LightConfig ReadLight(const YamlReader& r) {
+    r.ExpectMapAnyKeys();
+    LightConfig l;
+    const std::string type =
+        r.Has("type") ? r.Child("type").Enum({"sun", "directional", "point", "spot"}) : "point";
+    std::vector<std::string_view> keys = {"name", "type", "attach", "color", "cast_shadow"};
+    if (type == "sun") {
+      l.type = Light::Type::kDirectional;
+      keys.insert(keys.end(), {"direction", "illuminance_lux", "angular_diameter_deg"});
+    } else if (type == "directional") {
+      l.type = Light::Type::kDirectional;
+      l.angular_diameter_deg = 0;  // an ideal distant source: hard shadows
+      keys.insert(keys.end(), {"direction", "illuminance_lux"});
+    } else if (type == "point") {
+      l.type = Light::Type::kPoint;
+      keys.insert(keys.end(), {"position", "intensity_cd", "power_w", "radius_m"});
+    } else {
+      l.type = Light::Type::kSpot;
+      keys.insert(keys.end(), {"position", "direction", "intensity_cd", "power_w", "radius_m",
+                               "inner_angle_deg", "outer_angle_deg"});
+    }
+    // a key of another light type gets a more helpful message than "unknown key"
+    const std::vector<std::string_view> any_light_key = {
+        "position", "direction",       "illuminance_lux", "intensity_cd",        "power_w",
+        "radius_m", "inner_angle_deg", "outer_angle_deg", "angular_diameter_deg"};
+    for (auto& [key, child] : r.Entries()) {
+      const bool known =
+          std::find(any_light_key.begin(), any_light_key.end(), key) != any_light_key.end();
+      const bool allowed = std::find(keys.begin(), keys.end(), key) != keys.end();
+      if (known && !allowed) {
+        child.Fail("does not apply to a " + type + " light; expected one of: " + JoinNames(keys));
+      }
+    }
+    r.ExpectMap(keys);
+
+    l.name = r.Child("name").String();
+    if (r.Has("attach")) l.attach = r.Child("attach").String();
+    if (r.Has("position")) l.position = r.Child("position").Vector3();
+    if (r.Has("direction")) l.direction = r.Child("direction").Vector3();
+    if (r.Has("color")) l.color = Vector3f(r.Child("color"));
+    if (r.Has("illuminance_lux")) l.illuminance_lux = r.Child("illuminance_lux").Double();
+    if (r.Has("intensity_cd")) l.intensity_cd = r.Child("intensity_cd").Double();
+    if (r.Has("power_w")) l.power_w = r.Child("power_w").Double();
+    if (r.Has("inner_angle_deg")) l.inner_angle_deg = r.Child("inner_angle_deg").Double();
+    if (r.Has("outer_angle_deg")) l.outer_angle_deg = r.Child("outer_angle_deg").Double();
+    if (r.Has("radius_m")) l.radius_m = r.Child("radius_m").Double();
+    if (r.Has("angular_diameter_deg")) {
+      l.angular_diameter_deg = r.Child("angular_diameter_deg").Double();
+    }
+    if (r.Has("cast_shadow")) l.cast_shadow = r.Child("cast_shadow").Bool();
+    return l;
+  }
+
+  static CameraOutputs ReadOutputs(const YamlReader& r) {
+    CameraOutputs o{false, false, false};
+    for (const YamlReader& e : r.List()) {
+      const std::string v = e.Enum({"rgb", "depth", "segmentation"});
+      bool& flag = v == "rgb" ? o.rgb : v == "depth" ? o.depth : o.segmentation;
+      if (flag) e.Fail("'" + v + "' is listed twice; expected each output once");
+      flag = true;
+    }
+    return o;
+  }
+
+  // width, height, fovy_deg / intrinsics, rate_hz, outputs: shared by world cameras
+  // and MJCF camera overrides.
+  static void ReadCameraOptics(const YamlReader& r, CameraConfig* c) {
+    if (r.Has("width")) c->width = r.Child("width").Int();
+    if (r.Has("height")) c->height = r.Child("height").Int();
+    if (r.Has("fovy_deg")) c->fovy_deg = r.Child("fovy_deg").Double();
+    if (r.Has("intrinsics")) {
+      YamlReader k = r.Child("intrinsics");
+      if (c->fovy_deg) k.Fail("fovy_deg and intrinsics both given; expected one of them");
+      k.ExpectMap({"fx", "fy", "cx", "cy"});
+      CameraIntrinsics in;
+      in.width = c->width;
+      in.height = c->height;
+      in.fx = k.Child("fx").Double();
+      in.fy = k.Child("fy").Double();
+      // principal point defaults to the image centre (pixel centres at integers)
+      in.cx = k.Has("cx") ? k.Child("cx").Double() : 0.5 * (c->width - 1);
+      in.cy = k.Has("cy") ? k.Child("cy").Double() : 0.5 * (c->height - 1);
+      c->intrinsics = in;
+    }
+    if (r.Has("rate_hz")) c->rate_hz = r.Child("rate_hz").Double();
+    if (r.Has("outputs")) c->outputs = ReadOutputs(r.Child("outputs"));
+  }
+
+  static CameraConfig ReadCamera(const YamlReader& r) {
+    r.ExpectMap({"name", "attach", "pose", "width", "height", "fovy_deg", "intrinsics", "rate_hz",
+                 "outputs"});
+    CameraConfig c;
+    c.name = r.Child("name").String();
+    if (r.Has("attach")) c.attach = r.Child("attach").String();
+    if (r.Has("pose")) ReadPose(r.Child("pose"), &c.pose);
+    ReadCameraOptics(r, &c);
+    if (!c.fovy_deg && !c.intrinsics) c.fovy_deg = 60;
+    return c;
+  }
+
+  static void ReadMjcfCameras(const YamlReader& r, MjcfCameraDefaults* m) {
+    r.ExpectMap({"enabled", "width", "height", "rate_hz", "outputs", "overrides"});
+    if (r.Has("enabled")) m->enabled = r.Child("enabled").Bool();
+    if (r.Has("width")) m->width = r.Child("width").Int();
+    if (r.Has("height")) m->height = r.Child("height").Int();
+    if (r.Has("rate_hz")) m->rate_hz = r.Child("rate_hz").Double();
+    if (r.Has("outputs")) m->outputs = ReadOutputs(r.Child("outputs"));
+    if (!r.Has("overrides")) return;
+    for (auto& [name, o] : r.Child("overrides").Entries()) {
+      o.ExpectMap({"width", "height", "rate_hz", "outputs", "fovy_deg", "intrinsics"});
+      // unset fields inherit the mjcf_cameras defaults; an unset fovy keeps the MJCF one
+      CameraConfig c;
+      c.name = name;
+      c.is_mjcf_override = true;
+      c.width = m->width;
+      c.height = m->height;
+      c.rate_hz = m->rate_hz;
+      c.outputs = m->outputs;
+      ReadCameraOptics(o, &c);
+      m->overrides.push_back(c);
+    }
+  }
+
+  static MaterialOverride ReadMaterial(const std::string& name, const YamlReader& r) {
+    r.ExpectMap({"base_color", "roughness", "metallic", "specular", "emission"});
+    MaterialOverride m;
+    m.name = name;
+    if (r.Has("base_color")) m.base_color = Vector3f(r.Child("base_color"));
+    if (r.Has("roughness")) m.roughness = static_cast<float>(r.Child("roughness").Double());
+    if (r.Has("metallic")) m.metallic = static_cast<float>(r.Child("metallic").Double());
+    if (r.Has("specular")) m.specular = static_cast<float>(r.Child("specular").Double());
+    if (r.Has("emission")) m.emission = Vector3f(r.Child("emission"));
+    return m;
+  }
+
+  std::string file_;
+  LineTable* lines_;
+  fs::path base_dir_;
+};
+
+int MarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
+
+bool HasModelExtension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".xml" || ext == ".urdf";
+}
+
+}  // namespace
+
+WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name) {
+  LineTable lines;
+  WorldConfig w;
+  try {
+    YAML::Node root = YAML::Load(yaml_text);
+    w = WorldParser(file_name, &lines).Parse(root);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(file_name, MarkLine(e.mark), "", "YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    // any other yaml-cpp failure still names the file (and line when yaml-cpp knows it)
+    throw ConfigError(file_name, MarkLine(e.mark), "", "cannot read the YAML document: " + e.msg);
+  }
+  ValidateWorld(w, lines);
+  // directions are stored as unit vectors (ValidateWorld rejected zero vectors)
+  for (LightConfig& l : w.lights) {
+    if (l.type != Light::Type::kPoint) l.direction.normalize();
+  }
+  return w;
+}
+
+WorldConfig LoadWorldFile(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    throw ConfigError(
+        path, 0, "",
+        "world file not found: " + fs::absolute(path, ec).lexically_normal().string() +
+            "; expected an existing YAML file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) throw ConfigError(path, 0, "", "cannot read the world file; expected a readable file");
+  return ParseWorld(text.str(), path);
+}
+
+WorldConfig WorldForBareModel(const std::string& model_path) {
+  std::error_code ec;
+  const fs::path abs = fs::absolute(fs::path(model_path), ec).lexically_normal();
+  if (!HasModelExtension(abs)) {
+    throw ConfigError(model_path, 0, "",
+                      "unknown model file extension; expected an MJCF (.xml) or URDF (.urdf) file "
+                      "or a world file (.yaml)");
+  }
+  if (!fs::is_regular_file(abs, ec)) {
+    throw ConfigError(model_path, 0, "",
+                      "file not found: " + abs.string() + "; expected an existing model file");
+  }
+
+  WorldConfig w;
+  w.duration_sec = 10;
+  ModelConfig m;
+  // the name prefixes every MJCF name: keep [A-Za-z0-9_-] of the file stem
+  m.name = abs.stem().string();
+  for (char& ch : m.name) {
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_' && ch != '-') ch = '_';
+  }
+  if (m.name.empty()) m.name = "model";
+  m.file = abs.string();
+  m.is_robot = false;
+  w.models.push_back(m);
+
+  w.default_lights = true;
+  w.sky.type = Sky::Type::kDaylight;
+  w.sky.turbidity = 3;
+  w.sky.sun_elevation_deg = 45;
+  w.sky.sun_azimuth_deg = 30;
+  w.sky.zenith_luminance_cd_m2 = 8000;
+
+  CameraConfig cam;
+  cam.name = "default";
+  cam.attach = "world";
+  cam.auto_frame = true;
+  cam.width = 640;
+  cam.height = 480;
+  cam.fovy_deg = 45;
+  cam.rate_hz = 30;
+  cam.outputs = CameraOutputs{true, true, true};
+  w.cameras.push_back(cam);
+
+  w.mjcf_cameras.enabled = true;
+  w.render.seed = w.seed;
+  w.ValidateOrThrow();
+  return w;
+}
+
+}  // namespace penumbra
