@@ -1,0 +1,24 @@
+#pragma once
+// one rendered frame of one camera, as handed to the output writers.
+
+#include <cstdint>
+#include <string>
+
+#include "penumbra/core/image.h"
+#include "penumbra/core/pose.h"
+
+namespace penumbra {
+
+/// images and pose of one camera at one instant. images that the camera does not
+/// output are left empty.
+struct CameraFrame {
+  std::string camera;   ///< camera name, may contain '/' (e.g. "rover/head")
+  int64_t index = 0;    ///< per-camera frame counter, 0-based; names the files (NNNNNN.png)
+  double time_sec = 0;  ///< simulation time of the frame
+  Pose X_WO = Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in world
+  ImageU8 rgb;                   ///< (H x W x 3) uint8 sRGB
+  ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
+  ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background
+};
+
+}  // namespace penumbra

@@ -1,0 +1,215 @@
+#include "penumbra/output/camera_writer.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <system_error>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+void CreateFolder(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+}
+
+template <typename T>
+void CheckFrameImage(const Image<T>& image, int channels, const CameraIntrinsics& intr,
+                     const std::string& camera, int64_t index, const char* what) {
+  if (image.empty()) {
+    throw Error(fmt::format("camera '{}' frame {}: {} output requested but the image is empty",
+                            camera, index, what));
+  }
+  if (image.width != intr.width || image.height != intr.height || image.channels != channels ||
+      image.data.size() != static_cast<size_t>(image.width) * image.height * image.channels) {
+    throw Error(fmt::format(
+        "camera '{}' frame {}: {} image is {} x {} x {} ({} samples); expected {} x {} x {}",
+        camera, index, what, image.width, image.height, image.channels, image.data.size(),
+        intr.width, intr.height, channels));
+  }
+}
+
+}  // namespace
+
+ImageU16 DepthToMillimetres(const ImageF& depth_m) {
+  ImageU16 out(depth_m.width, depth_m.height, depth_m.channels);
+  for (size_t i = 0; i < depth_m.data.size(); ++i) {
+    const double d = depth_m.data[i];
+    uint16_t mm = 0;
+    if (std::isfinite(d) && d > 0) {
+      const double r = std::round(d * 1000.0);
+      mm = r >= 65535.0 ? uint16_t{65535} : r < 1.0 ? uint16_t{1} : static_cast<uint16_t>(r);
+    }
+    out.data[i] = mm;
+  }
+  return out;
+}
+
+ImageU16 SegmentationToU16(const ImageI32& geom_id) {
+  ImageU16 out(geom_id.width, geom_id.height, geom_id.channels);
+  for (size_t i = 0; i < geom_id.data.size(); ++i) {
+    const int32_t id = geom_id.data[i];
+    if (id < -1 || id >= 65535) {
+      throw Error(fmt::format(
+          "segmentation: geom id {} at sample {} does not fit a 16-bit PNG (expected -1..65534)",
+          id, i));
+    }
+    out.data[i] = static_cast<uint16_t>(id + 1);
+  }
+  return out;
+}
+
+fs::path CameraFolder(const std::string& camera) {
+  auto bad = [&](const std::string& why) {
+    return ConfigError("", 0, "cameras",
+                       "camera name '" + camera + "' cannot name an output folder: " + why +
+                           "; expected a relative name like \"front\" or \"rover/head\"");
+  };
+  if (camera.empty()) throw bad("it is empty");
+  if (camera.front() == '/') throw bad("it is an absolute path");
+  fs::path folder;
+  size_t start = 0;
+  while (start <= camera.size()) {
+    size_t end = camera.find('/', start);
+    if (end == std::string::npos) end = camera.size();
+    const std::string part = camera.substr(start, end - start);
+    if (part.empty()) throw bad("it has an empty path component");
+    if (part == "." || part == "..") throw bad("it has a '" + part + "' component");
+    for (unsigned char c : part) {
+      if (c == '\\') throw bad("it contains a backslash");
+      if (c < 0x20 || c == 0x7f) throw bad("it contains a control character");
+    }
+    folder /= part;
+    start = end + 1;
+  }
+  return folder;
+}
+
+std::string FrameFileName(int64_t index) { return fmt::format("{:06d}.png", index); }
+
+std::string FramesCsvRow(const CameraFrame& frame) {
+  Eigen::Quaterniond q(frame.X_WO.linear());
+  q.normalize();
+  // canonical sign: q and -q are the same rotation
+  bool flip = q.w() < 0;
+  if (q.w() == 0) {
+    const double first = q.x() != 0 ? q.x() : q.y() != 0 ? q.y() : q.z();
+    flip = first < 0;
+  }
+  if (flip) q.coeffs() = -q.coeffs();
+  const Eigen::Vector3d p = frame.X_WO.translation();
+  return fmt::format("{},{},{},{},{},{},{},{},{}\n", frame.index, frame.time_sec, p.x(), p.y(),
+                     p.z(), q.w(), q.x(), q.y(), q.z());
+}
+
+CameraWriter::CameraWriter(const std::string& output_dir, const std::string& camera,
+                           const CameraIntrinsics& intrinsics, const CameraOutputs& outputs,
+                           const PngEncodeOptions& png_options)
+    : camera_(camera),
+      folder_(fs::path(output_dir) / CameraFolder(camera)),
+      intrinsics_(intrinsics),
+      outputs_(outputs),
+      png_options_(png_options) {
+  png_options_.ValidateOrThrow();
+  if (intrinsics.width <= 0 || intrinsics.height <= 0) {
+    throw Error(fmt::format("camera '{}': image size {} x {} must be positive", camera,
+                            intrinsics.width, intrinsics.height));
+  }
+  CreateFolder(folder_);
+  if (outputs_.rgb) CreateFolder(folder_ / "rgb");
+  if (outputs_.depth) CreateFolder(folder_ / "depth");
+  if (outputs_.segmentation) CreateFolder(folder_ / "segmentation");
+
+  // ordered_json keeps the key order below
+  nlohmann::ordered_json j;
+  j["camera"] = camera;
+  j["width"] = intrinsics.width;
+  j["height"] = intrinsics.height;
+  j["fx"] = intrinsics.fx;
+  j["fy"] = intrinsics.fy;
+  j["cx"] = intrinsics.cx;
+  j["cy"] = intrinsics.cy;
+  j["model"] = "pinhole";
+  j["optical_frame"] = "opencv (x right, y down, z forward)";
+  nlohmann::ordered_json files = nlohmann::ordered_json::object();
+  if (outputs_.rgb) files["rgb"] = "rgb/NNNNNN.png: 8-bit sRGB";
+  if (outputs_.depth) {
+    files["depth"] =
+        "depth/NNNNNN.png: 16-bit z-depth in millimetres, 0 = no return, 65535 = 65.535 m or more";
+  }
+  if (outputs_.segmentation) {
+    files["segmentation"] = "segmentation/NNNNNN.png: 16-bit MuJoCo geom id + 1, 0 = background";
+  }
+  files["frames"] =
+      "frames.csv: pose of the optical frame in the world (m, unit quaternion, qw >= 0)";
+  j["files"] = files;
+  const fs::path json_path = folder_ / "intrinsics.json";
+  {
+    std::ofstream f(json_path, std::ios::binary | std::ios::trunc);
+    f << j.dump(2) << '\n';
+    if (!f) throw Error("cannot write '" + json_path.string() + "'");
+  }
+
+  const fs::path csv_path = folder_ / "frames.csv";
+  csv_.open(csv_path, std::ios::binary | std::ios::trunc);
+  csv_ << kFramesCsvHeader;
+  csv_.flush();
+  if (!csv_) throw Error("cannot write '" + csv_path.string() + "'");
+}
+
+void CameraWriter::WriteImages(const CameraFrame& frame) const {
+  if (frame.camera != camera_) {
+    throw Error("frame of camera '" + frame.camera + "' given to the writer of camera '" + camera_ +
+                "'");
+  }
+  if (frame.index < 0) {
+    throw Error(fmt::format("camera '{}': negative frame index {}", camera_, frame.index));
+  }
+  const std::string name = FrameFileName(frame.index);
+  if (outputs_.rgb) {
+    CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");
+    WritePngRgb8((folder_ / "rgb" / name).string(), frame.rgb, png_options_);
+  }
+  if (outputs_.depth) {
+    CheckFrameImage(frame.depth_m, 1, intrinsics_, camera_, frame.index, "depth");
+    WritePngGray16((folder_ / "depth" / name).string(), DepthToMillimetres(frame.depth_m),
+                   png_options_);
+  }
+  if (outputs_.segmentation) {
+    CheckFrameImage(frame.geom_id, 1, intrinsics_, camera_, frame.index, "segmentation");
+    ImageU16 seg;
+    try {
+      seg = SegmentationToU16(frame.geom_id);
+    } catch (const Error& e) {
+      throw Error(fmt::format("camera '{}' frame {}: {}", camera_, frame.index, e.what()));
+    }
+    WritePngGray16((folder_ / "segmentation" / name).string(), seg, png_options_);
+  }
+}
+
+void CameraWriter::AppendPose(const CameraFrame& frame) {
+  if (frame.index <= last_index_) {
+    throw Error(
+        fmt::format("camera '{}': frame {} appended after frame {}; expected increasing "
+                    "frame indices",
+                    camera_, frame.index, last_index_));
+  }
+  csv_ << FramesCsvRow(frame);
+  csv_.flush();
+  if (!csv_) throw Error("cannot write '" + (folder_ / "frames.csv").string() + "'");
+  last_index_ = frame.index;
+  ++frames_written_;
+}
+
+void CameraWriter::Write(const CameraFrame& frame) {
+  WriteImages(frame);
+  AppendPose(frame);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,99 @@
+#pragma once
+// files of one camera under an output folder:
+//
+//   DIR/<camera>/rgb/NNNNNN.png           8-bit sRGB colour
+//   DIR/<camera>/depth/NNNNNN.png         16-bit z-depth in millimetres (see DepthToMillimetres)
+//   DIR/<camera>/segmentation/NNNNNN.png  16-bit MuJoCo geom id + 1, 0 = background
+//   DIR/<camera>/frames.csv               frame,time_sec,x,y,z,qw,qx,qy,qz per frame
+//   DIR/<camera>/intrinsics.json          pinhole intrinsics (OpenCV convention)
+//
+// NNNNNN is the per-camera frame index, zero-padded to 6 digits (more digits past
+// 999999). a camera name with '/' maps to nested folders ("rover/head" ->
+// DIR/rover/head/).
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "penumbra/core/image.h"
+#include "penumbra/output/camera_frame.h"
+#include "penumbra/output/png_io.h"
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// z-depth (H x W x 1, metres) -> (H x W x 1) uint16 millimetres, rounded to nearest
+/// (halves away from zero). 0 = no return (depth <= 0 or not finite); a hit closer than
+/// 0.5 mm is stored as 1 so that it never reads as "no return"; depths of 65.535 m or
+/// more saturate to 65535.
+ImageU16 DepthToMillimetres(const ImageF& depth_m);
+
+/// MuJoCo geom ids (H x W x 1, -1 = background) -> (H x W x 1) uint16 id + 1, 0 = background.
+/// @throws Error for an id < -1 or >= 65535 (does not fit a 16-bit PNG).
+ImageU16 SegmentationToU16(const ImageI32& geom_id);
+
+/// folder of a camera relative to the output folder: the name split at '/' into nested folders.
+/// @throws ConfigError (key "cameras") for an empty name, an absolute path, an empty, "." or
+///         ".." component, a backslash or a control character.
+std::filesystem::path CameraFolder(const std::string& camera);
+
+/// image file name of a frame: index zero-padded to 6 digits + ".png".
+std::string FrameFileName(int64_t index);
+
+/// one frames.csv row (with '\n'): frame index, time_sec, then the pose X_WO of the optical
+/// frame in the world: position x y z (m) and unit quaternion qw qx qy qz with qw >= 0
+/// (for qw == 0 the first non-zero of qx, qy, qz is positive). numbers are printed in the
+/// shortest form that reads back to the same double (fmt "{}").
+std::string FramesCsvRow(const CameraFrame& frame);
+
+/// the frames.csv header line (with '\n').
+inline constexpr const char* kFramesCsvHeader = "frame,time_sec,x,y,z,qw,qx,qy,qz\n";
+
+/// writes the files of one camera. WriteImages may run on several threads at once for
+/// different frames; AppendPose must be called from one thread at a time, in frame order.
+class CameraWriter {
+ public:
+  /// creates DIR/<camera>/ and the folders of the requested outputs, writes
+  /// intrinsics.json and the frames.csv header (replacing existing ones).
+  /// @throws ConfigError for a bad camera name (see CameraFolder);
+  ///         Error naming the path if a folder or file cannot be created.
+  CameraWriter(const std::string& output_dir, const std::string& camera,
+               const CameraIntrinsics& intrinsics, const CameraOutputs& outputs,
+               const PngEncodeOptions& png_options = {});
+
+  CameraWriter(const CameraWriter&) = delete;
+  CameraWriter& operator=(const CameraWriter&) = delete;
+
+  /// encodes and writes the PNGs of the requested outputs (images of outputs that were
+  /// not requested are ignored).
+  /// @throws Error if frame.camera differs, the index is negative, a requested image is
+  ///         missing or its size/channels differ from the intrinsics, a geom id does not fit,
+  ///         or a file cannot be written (message names the path).
+  void WriteImages(const CameraFrame& frame) const;
+
+  /// appends the frame's frames.csv row and flushes it to the file.
+  /// @throws Error if the index is not greater than the previous one or the write fails.
+  void AppendPose(const CameraFrame& frame);
+
+  /// WriteImages then AppendPose.
+  void Write(const CameraFrame& frame);
+
+  const std::string& camera() const { return camera_; }
+  /// DIR/<camera>
+  const std::filesystem::path& folder() const { return folder_; }
+  /// rows appended to frames.csv so far.
+  int64_t frames_written() const { return frames_written_; }
+
+ private:
+  std::string camera_;
+  std::filesystem::path folder_;
+  CameraIntrinsics intrinsics_;
+  CameraOutputs outputs_;
+  PngEncodeOptions png_options_;
+  std::ofstream csv_;
+  int64_t last_index_ = -1;
+  int64_t frames_written_ = 0;
+};
+
+}  // namespace penumbra

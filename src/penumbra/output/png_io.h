@@ -1,0 +1,64 @@
+#pragma once
+// PNG files for camera outputs (libpng 1.6). encoding favours speed over size
+// (zlib level 1, one fixed row filter) because frames are written at video rates,
+// and the bytes are a pure function of the image: no time, text or other
+// metadata chunks are written.
+//
+// format: W3C "Portable Network Graphics (PNG) Specification (Third Edition)".
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/image.h"
+
+namespace penumbra {
+
+/// PNG encoder speed/size settings. defaults are tuned for rendered frames (see
+/// png_io.cc for the measurements behind them).
+struct PngEncodeOptions {
+  /// zlib level 0..9 (0 = store, 1 = Z_BEST_SPEED, 9 = smallest).
+  int compression_level = 1;
+  /// row filter for every row: one of "none", "sub", "up", "avg", "paeth".
+  std::string filter = "up";
+
+  /// @throws ConfigError for a level outside [0, 9] or an unknown filter name.
+  void ValidateOrThrow() const;
+};
+
+/// encodes an (H x W x 3) uint8 sRGB image as an 8-bit RGB PNG with an sRGB chunk.
+/// @throws Error if the image is empty, has channels != 3 or a data size that does not
+///         match width x height x channels, or if libpng fails.
+std::vector<uint8_t> EncodePngRgb8(const ImageU8& image, const PngEncodeOptions& options = {});
+
+/// encodes an (H x W x 1) uint16 image as a 16-bit greyscale PNG (values stored exactly).
+/// @throws Error as EncodePngRgb8 (channels must be 1).
+std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptions& options = {});
+
+/// writes EncodePngRgb8(image) to `path` (replacing an existing file).
+/// @throws Error naming `path` and the reason (bad image, cannot open, short write).
+void WritePngRgb8(const std::string& path, const ImageU8& image,
+                  const PngEncodeOptions& options = {});
+
+/// writes EncodePngGray16(image) to `path` (replacing an existing file).
+/// @throws Error naming `path` and the reason.
+void WritePngGray16(const std::string& path, const ImageU16& image,
+                    const PngEncodeOptions& options = {});
+
+/// a decoded PNG: samples as stored in the file (palette images are expanded to
+/// RGB, greyscale below 8 bits to 8 bits; 16-bit samples are kept exact).
+struct PngImage {
+  int width = 0;
+  int height = 0;
+  int channels = 0;   ///< 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA
+  int bit_depth = 0;  ///< 8 or 16
+  /// (height x width x channels) samples, row-major, channels interleaved, in
+  /// [0, 255] or [0, 65535] depending on bit_depth.
+  std::vector<uint16_t> samples;
+};
+
+/// reads a PNG file (used by tests and tools).
+/// @throws Error naming `path` and the reason (missing file, not a PNG, corrupt data).
+PngImage ReadPng(const std::string& path);
+
+}  // namespace penumbra

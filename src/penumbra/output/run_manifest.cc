@@ -1,0 +1,61 @@
+#include "penumbra/output/run_manifest.h"
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <system_error>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+std::string RunManifestJson(const RunManifest& m) {
+  // ordered_json keeps insertion order, so the key order is the struct's
+  nlohmann::ordered_json j;
+  j["world_file"] = m.world_file;
+  j["seed"] = m.seed;
+  j["penumbra_version"] = m.penumbra_version;
+  j["mujoco_version"] = m.mujoco_version;
+  j["embree_version"] = m.embree_version;
+  j["command_line"] = m.command_line;
+  j["sim_duration_sec"] = m.sim_duration_sec;
+  nlohmann::ordered_json frames = nlohmann::ordered_json::object();
+  for (const auto& [name, n] : m.frames_per_camera) frames[name] = n;
+  j["frames_per_camera"] = frames;
+  nlohmann::ordered_json timings = nlohmann::ordered_json::object();
+  for (const auto& [name, s] : m.timings_sec) timings[name] = s;
+  j["timings_sec"] = timings;
+  j["peak_resident_memory_mib"] = m.peak_resident_memory_mib;
+  return j.dump(2) + "\n";
+}
+
+void WriteRunManifest(const std::string& output_dir, const RunManifest& manifest) {
+  const std::filesystem::path dir(output_dir);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+  const std::filesystem::path path = dir / "run.json";
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  f << RunManifestJson(manifest);
+  f.close();
+  if (!f) throw Error("cannot write '" + path.string() + "'");
+}
+
+double PeakResidentMemoryMiB() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    // "VmHWM:     12345 kB"
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::istringstream in(line.substr(6));
+      double kib = 0;
+      std::string unit;
+      if (in >> kib >> unit && unit == "kB") return kib / 1024.0;
+      return 0;
+    }
+  }
+  return 0;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,101 @@
+#include "penumbra/output/progress.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+namespace {
+
+TEST(FormatProgressLine, MatchesTheDocumentedLayout) {
+  EXPECT_EQ(FormatProgressLine(4.5, 10.0, 123, 31.2, 10),
+            "[####      ]  45% sim 4.50/10.00 s  123 frames  31.2 fps");
+  EXPECT_EQ(FormatProgressLine(0.0, 10.0, 0, 0.0, 4),
+            "[    ]   0% sim 0.00/10.00 s  0 frames  0.0 fps");
+  EXPECT_EQ(FormatProgressLine(10.0, 10.0, 300, 30.0, 4),
+            "[####] 100% sim 10.00/10.00 s  300 frames  30.0 fps");
+  // past the end and zero durations clamp to 100 %
+  EXPECT_NE(FormatProgressLine(12.0, 10.0, 1, 1, 4).find("[####] 100%"), std::string::npos);
+  EXPECT_NE(FormatProgressLine(0.0, 0.0, 1, 1, 4).find("100%"), std::string::npos);
+}
+
+TEST(FormatProgressLine, PercentRoundsDown) {
+  // 99.96 % must not print as 100 % before the end
+  EXPECT_NE(FormatProgressLine(9.996, 10.0, 0, 0, 10).find(" 99%"), std::string::npos);
+}
+
+TEST(ProgressReporter, LogModeWritesOneLinePerTenPercent) {
+  std::vector<std::string> lines;
+  double now = 0;
+  ProgressOptions opt;
+  opt.mode = ProgressOptions::Mode::kLog;
+  opt.clock = [&] { return now; };
+  opt.log = [&](const std::string& s) { lines.push_back(s); };
+  {
+    ProgressReporter p(10.0, opt);
+    EXPECT_EQ(p.mode(), ProgressOptions::Mode::kLog);
+    for (int step = 1; step <= 1000; ++step) {  // 10 ms of sim per update, 1 ms wall
+      now = 0.001 * step;
+      p.Update(0.01 * step, step / 10);
+    }
+    p.Finish();
+    p.Finish();  // idempotent
+  }
+  ASSERT_EQ(lines.size(), 10u);
+  EXPECT_NE(lines[0].find(" 10% sim 1.00/10.00 s"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[9].find("100% sim 10.00/10.00 s  100 frames  100.0 fps"), std::string::npos)
+      << lines[9];
+}
+
+TEST(ProgressReporter, LogModeFinishReportsAnUnfinishedRun) {
+  std::vector<std::string> lines;
+  ProgressOptions opt;
+  opt.mode = ProgressOptions::Mode::kLog;
+  opt.clock = [] { return 0.0; };
+  opt.log = [&](const std::string& s) { lines.push_back(s); };
+  {
+    ProgressReporter p(10.0, opt);
+    p.Update(3.5, 7);
+  }  // destructor finishes
+  // crossing 10, 20 and 30 % in one update logs one line; Finish adds the final state
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_NE(lines[0].find(" 35% sim 3.50/10.00 s  7 frames"), std::string::npos) << lines[0];
+  EXPECT_EQ(lines[1], lines[0]);
+}
+
+TEST(ProgressReporter, BarModeRedrawsAtMostTenTimesPerSecond) {
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  double now = 100.0;
+  ProgressOptions opt;
+  opt.mode = ProgressOptions::Mode::kBar;
+  opt.stream = f;
+  opt.bar_width = 10;
+  opt.clock = [&] { return now; };
+  {
+    ProgressReporter p(10.0, opt);
+    for (int step = 1; step <= 1000; ++step) {  // 2 s of wall time in 2 ms steps
+      now = 100.0 + 0.002 * step;
+      p.Update(0.01 * step, step);
+    }
+  }
+  std::rewind(f);
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof(buf), f)) > 0) out.append(buf, n);
+  std::fclose(f);
+  const auto redraws = std::count(out.begin(), out.end(), '\r');
+  EXPECT_GE(redraws, 20);  // 2 s at 10 per second, plus the final draw
+  EXPECT_LE(redraws, 22);
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.back(), '\n');
+  const auto last = out.substr(out.rfind('\r') + 1);
+  EXPECT_EQ(last, "[##########] 100% sim 10.00/10.00 s  1000 frames  500.0 fps\n");
+}
+
+}  // namespace
+}  // namespace penumbra
