@@ -29,11 +29,12 @@ void RenderSettings::ValidateOrThrow() const {
   if (tier != Tier::kRealtime && tier != Tier::kPathtraced) {
     throw ConfigError("", 0, "render.tier", "unknown tier; expected one of: realtime, pathtraced");
   }
-  CheckClosed("samples_per_pixel", samples_per_pixel, 1, 65536);
-  CheckClosed("max_bounces", max_bounces, 1, 64);
-  CheckClosed("threads", threads, 0, 256);
-  CheckClosed("exposure.ev100", ev100, -10, 30);
-  CheckClosed("exposure.compensation_ev", exposure_compensation_ev, -20, 20);
+  CheckClosed("samples_per_pixel", samples_per_pixel, 1, kMaxSamplesPerPixel);
+  CheckClosed("max_bounces", max_bounces, 1, kMaxBounces);
+  CheckClosed("threads", threads, 0, kMaxThreads);
+  CheckClosed("exposure.ev100", ev100, kMinEv100, kMaxEv100);
+  CheckClosed("exposure.compensation_ev", exposure_compensation_ev, -kMaxCompensationEv,
+              kMaxCompensationEv);
   if (tone_map != ToneMap::kFilmic && tone_map != ToneMap::kLinear) {
     throw ConfigError("", 0, "render.tone_map",
                       "unknown tone map; expected one of: filmic, linear");

@@ -114,8 +114,9 @@ class Validator {
                      const std::string& what) const {
     size_t slash = name.find('/');
     if (slash == std::string::npos || slash == 0 || slash + 1 == name.size()) {
+      const std::string example = w_.models.empty() ? "rover" : w_.models.front().name;
       Fail(path, "'" + name + "' is not a prefixed name; expected \"<model>/<" + what +
-                     ">\", e.g. \"rover/" + what + "\"");
+                     ">\", e.g. \"" + example + "/" + what + "\"");
     }
     const std::string model = name.substr(0, slash);
     if (!HasModel(model)) {
@@ -144,16 +145,17 @@ class Validator {
     }
   }
 
+  // the same ranges as RenderSettings::ValidateOrThrow (render/), with world-file lines
   void CheckRender() const {
-    try {
-      w_.render.ValidateOrThrow();
-    } catch (const ConfigError& e) {
-      // re-throw with this file and the line of the key
-      const std::string prefix = std::string("<command line>: ") + e.key() + ": ";
-      std::string problem = e.what();
-      if (problem.rfind(prefix, 0) == 0) problem = problem.substr(prefix.size());
-      Fail(e.key(), problem);
-    }
+    using R = RenderSettings;
+    const R& r = w_.render;
+    Check("render.samples_per_pixel", r.samples_per_pixel,
+          Range::Closed(1, R::kMaxSamplesPerPixel));
+    Check("render.max_bounces", r.max_bounces, Range::Closed(1, R::kMaxBounces));
+    Check("render.threads", r.threads, Range::Closed(0, R::kMaxThreads));
+    Check("render.exposure.ev100", r.ev100, Range::Closed(R::kMinEv100, R::kMaxEv100));
+    Check("render.exposure.compensation_ev", r.exposure_compensation_ev,
+          Range::Closed(-R::kMaxCompensationEv, R::kMaxCompensationEv));
   }
 
   void CheckSky() const {

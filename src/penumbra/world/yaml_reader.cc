@@ -74,6 +74,7 @@ std::string YamlReader::Describe() const {
     case YAML::NodeType::Undefined:
       return "nothing";
     case YAML::NodeType::Scalar:
+      if (node_.Tag() == "!") return "the quoted string \"" + node_.Scalar() + "\"";
       return "'" + node_.Scalar() + "'";
     case YAML::NodeType::Sequence:
       return "a list";
@@ -84,6 +85,7 @@ std::string YamlReader::Describe() const {
 }
 
 void YamlReader::ExpectMapAnyKeys() const {
+  if (node_.IsNull()) return;  // "key:" with no value = an empty mapping
   if (!node_.IsMap()) Fail("expected a mapping (key: value pairs), got " + Describe());
   std::map<std::string, int> seen;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
@@ -119,6 +121,7 @@ void YamlReader::ExpectMap(const std::vector<std::string_view>& allowed) const {
 }
 
 void YamlReader::ExpectList() const {
+  if (node_.IsNull()) return;  // "key:" with no value = an empty list
   if (!node_.IsSequence()) Fail("expected a list, got " + Describe());
 }
 
@@ -156,6 +159,7 @@ YamlReader YamlReader::Element(size_t i) const {
 std::vector<std::pair<std::string, YamlReader>> YamlReader::Entries() const {
   ExpectMapAnyKeys();
   std::vector<std::pair<std::string, YamlReader>> out;
+  if (node_.IsNull()) return out;
   for (auto it = node_.begin(); it != node_.end(); ++it) {
     const std::string& key = it->first.Scalar();
     out.emplace_back(key, Child(key));
@@ -166,6 +170,7 @@ std::vector<std::pair<std::string, YamlReader>> YamlReader::Entries() const {
 std::vector<YamlReader> YamlReader::List() const {
   ExpectList();
   std::vector<YamlReader> out;
+  if (node_.IsNull()) return out;
   for (size_t i = 0; i < node_.size(); ++i) out.push_back(Element(i));
   return out;
 }

@@ -51,6 +51,7 @@ class YamlReader {
   [[noreturn]] void Fail(const std::string& problem) const;
 
   /// checks that the node is a mapping whose keys are unique scalars from `allowed`.
+  /// a null node ("key:" with no value) counts as an empty mapping.
   /// @throws ConfigError "expected a mapping", "unknown key 'k'; expected one of: ..."
   ///         (at the key's line), or "key 'k' appears twice".
   void ExpectMap(const std::vector<std::string_view>& allowed) const;
@@ -58,7 +59,8 @@ class YamlReader {
   /// checks that the node is a mapping with unique scalar keys (any names).
   void ExpectMapAnyKeys() const;
 
-  /// checks that the node is a sequence. @throws ConfigError "expected a list".
+  /// checks that the node is a sequence (a null node counts as an empty one).
+  /// @throws ConfigError "expected a list".
   void ExpectList() const;
 
   /// true if this (mapping) node has `key`.
