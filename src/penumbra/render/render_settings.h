@@ -10,8 +10,7 @@ namespace penumbra {
 /// materials, lights, camera); they differ in the light transport they simulate.
 struct RenderSettings {
   enum class Tier {
-    kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1
-                  ///< sample/pixel
+    kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1 sample/pixel
     kPathtraced,  ///< unidirectional path tracing, NEE with MIS, N samples/pixel, denoised
   };
   Tier tier = Tier::kRealtime;
@@ -24,7 +23,7 @@ struct RenderSettings {
   double exposure_compensation_ev = 0;  ///< added to the (auto or manual) exposure, in stops
   enum class ToneMap { kFilmic, kLinear };
   ToneMap tone_map = ToneMap::kFilmic;  ///< filmic: ACES fit (Narkowicz 2015); linear: clamp
-  uint64_t seed = 0;  ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
+  uint64_t seed = 0;           ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
 
   /// valid ranges (inclusive), checked by ValidateOrThrow and by the world-file loader
   /// (which links without the renderer).
