@@ -1,0 +1,29 @@
+#pragma once
+// builds controllers from world-file `controller:` blocks.
+//
+// types (the `type:` key):
+//   waypoint_follower   differential-drive waypoint follower (control/waypoint_follower.h)
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/control/controller.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// the controller described by `cfg` for robot `robot_name`, or nullptr when cfg.type is
+/// empty. robot-local model names in the parameters get the "<robot_name>/" prefix (none
+/// when robot_name is empty), matching the composer's naming. the result still has to be
+/// initialised against the model (Simulation::AddController does that).
+/// @throws ConfigError(world_file, cfg.line, "robots[<robot>].controller.<key>", ...) for an
+///         unknown type, unknown keys, missing keys or bad values.
+std::unique_ptr<Controller> MakeController(const ControllerConfig& cfg,
+                                           const std::string& robot_name,
+                                           const std::string& world_file);
+
+/// the controller types MakeController knows, sorted.
+std::vector<std::string> ControllerTypes();
+
+}  // namespace penumbra

@@ -1,0 +1,61 @@
+#pragma once
+// typed, validated access to a controller's YAML parameter map (the
+// `controller:` block of a robot in a world file). every error is a ConfigError
+// naming the world file, the block's line and the full key path, e.g.
+// "world.yaml:12: robots[rover].controller.speed_m_s: got -1; expected a number > 0".
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "penumbra/control/controller.h"
+
+namespace YAML {
+class Node;
+}
+
+namespace penumbra {
+
+/// reader over one controller's parameter map. keys read through it are marked as
+/// known; CheckNoUnknownKeys() then rejects anything else (typos fail loudly).
+class ControllerParams {
+ public:
+  /// parses `params_yaml` (a YAML mapping; the `type` key, if present, is ignored here).
+  /// @throws ConfigError if the text is not valid YAML or not a mapping.
+  ControllerParams(const std::string& params_yaml, ControllerContext context);
+  ~ControllerParams();
+  ControllerParams(const ControllerParams&) = delete;
+  ControllerParams& operator=(const ControllerParams&) = delete;
+
+  bool Has(const std::string& key) const;
+  /// required string. @throws ConfigError if missing, not a scalar or empty.
+  std::string String(const std::string& key);
+  /// finite number, required when `fallback` is empty; checked against [min, max]
+  /// (bounds inclusive unless `min_exclusive`). @throws ConfigError naming the range.
+  double Number(const std::string& key, std::optional<double> fallback, double min, double max,
+                bool min_exclusive = false);
+  /// boolean (true/false), with a default.
+  bool Bool(const std::string& key, bool fallback);
+  /// list of [x, y] pairs of finite numbers, at least `min_count`.
+  std::vector<Eigen::Vector2d> Points2(const std::string& key, size_t min_count);
+
+  /// @throws ConfigError listing the keys that were never read, and the allowed keys.
+  void CheckNoUnknownKeys() const;
+  /// @throws ConfigError for `key` (relative to the controller block) with `problem`.
+  [[noreturn]] void Fail(const std::string& key, const std::string& problem) const;
+
+  const ControllerContext& context() const { return context_; }
+
+ private:
+  const YAML::Node* Get(const std::string& key);
+
+  ControllerContext context_;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::set<std::string> known_;
+};
+
+}  // namespace penumbra

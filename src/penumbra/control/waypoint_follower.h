@@ -1,0 +1,104 @@
+#pragma once
+// differential-drive waypoint follower: steers a two-wheeled robot through a list
+// of world-frame (x, y) points.
+//
+// world-file block (robot-local names get the "<robot>/" prefix):
+//   controller:
+//     type: waypoint_follower
+//     base_body: chassis        # body whose x axis is the robot's forward direction
+//     left_actuator: left_wheel # velocity actuators: ctrl = wheel angular velocity (rad/s)
+//     right_actuator: right_wheel
+//     wheel_radius_m: 0.05      # > 0
+//     track_width_m: 0.3        # > 0, distance between the wheels' contact points
+//     speed_m_s: 0.5            # > 0, cruise speed (default 0.5)
+//     max_yaw_rate_deg_s: 90    # > 0 (default 90)
+//     waypoints: [[1.0, 0.0], [1.0, 1.0]]   # world x, y (m), at least 1
+//     loop: true                # after the last waypoint, start again (default true)
+//     tolerance_m: 0.15         # > 0, a waypoint counts as reached inside this radius (default
+//     0.15) rate_hz: 50               # > 0, control rate on sim time (default 50)
+//
+// wheel convention: a positive ctrl must drive its wheel forward, i.e. the wheel
+// hinge axes point to the robot's left (+y of the base body), as in REP-103.
+//
+// control law, at each update, with robot position p, heading psi (yaw of the
+// base body's x axis in the world xy plane) and target waypoint w:
+//   1. while |w - p| < tolerance_m: the waypoint is reached; advance to the next
+//      (wrapping when loop, otherwise stop for good after the last one).
+//   2. d = |w - p|, alpha = wrap(atan2(w - p) - psi) (heading error, in (-pi, pi]).
+//   3. |alpha| > 90 deg (target behind): turn in place, v = 0, omega = sign(alpha) omega_max.
+//      otherwise pure pursuit with the waypoint as goal point (R. C. Coulter,
+//      "Implementation of the Pure Pursuit Path Tracking Algorithm", CMU-RI-TR-92-01,
+//      1992): curvature kappa = 2 sin(alpha) / d, v = speed_m_s reduced until
+//      |v kappa| <= omega_max, omega = v kappa.
+//   4. differential-drive inverse kinematics (R. Siegwart, I. Nourbakhsh,
+//      D. Scaramuzza, "Introduction to Autonomous Mobile Robots", 2nd ed., 2011,
+//      sec. 3.2.1): wheel rates (v -/+ omega track/2) / wheel_radius (left/right).
+// if the base body's x axis points (nearly) straight up or down, the robot stops.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/control/controller.h"
+#include "penumbra/control/controller_params.h"
+
+namespace penumbra {
+
+/// parameters of a WaypointFollower (see the file comment for meanings and ranges).
+struct WaypointFollowerParams {
+  std::string base_body;       ///< full model name, e.g. "rover/chassis"
+  std::string left_actuator;   ///< full model name
+  std::string right_actuator;  ///< full model name
+  double wheel_radius_m = 0.05;
+  double track_width_m = 0.3;
+  double speed_m_s = 0.5;
+  double max_yaw_rate_deg_s = 90;
+  std::vector<Eigen::Vector2d> waypoints;  ///< world frame x, y (m)
+  bool loop = true;
+  double tolerance_m = 0.15;
+  double rate_hz = 50;
+
+  /// reads the keys above from `params`; local names get `name_prefix` ("rover/" or "").
+  /// @throws ConfigError for missing/unknown keys and out-of-range values.
+  static WaypointFollowerParams Parse(ControllerParams& params, const std::string& name_prefix);
+  /// @throws ConfigError (in `context`) if a value is out of range.
+  void ValidateOrThrow(const ControllerContext& context) const;
+};
+
+/// differential-drive waypoint follower (see the file comment).
+class WaypointFollower final : public Controller {
+ public:
+  /// @throws ConfigError if `params` are out of range.
+  WaypointFollower(WaypointFollowerParams params, ControllerContext context);
+
+  std::string type() const override { return "waypoint_follower"; }
+  double rate_hz() const override { return params_.rate_hz; }
+  std::vector<NameRequirement> RequiredNames() const override;
+  void Compute(const ControlInput& input, std::span<double> ctrl) override;
+
+  const WaypointFollowerParams& params() const { return params_; }
+  /// index of the waypoint being driven to.
+  int target_index() const { return target_; }
+  /// waypoints reached so far (counts every lap when looping).
+  int64_t waypoints_reached() const { return reached_; }
+  /// true once the last waypoint was reached and loop is false; the robot then stands still.
+  bool finished() const { return finished_; }
+  /// last commanded forward speed (m/s) and yaw rate (rad/s).
+  double commanded_speed_m_s() const { return v_; }
+  double commanded_yaw_rate() const { return omega_; }
+
+ protected:
+  void OnInitialize(const ModelInfo& model, const std::vector<int>& ids) override;
+
+ private:
+  WaypointFollowerParams params_;
+  int base_body_ = -1, left_ = -1, right_ = -1;
+  int target_ = 0;
+  int64_t reached_ = 0;
+  bool finished_ = false;
+  double v_ = 0, omega_ = 0;
+};
+
+}  // namespace penumbra

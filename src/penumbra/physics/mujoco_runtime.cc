@@ -1,0 +1,108 @@
+#include "penumbra/physics/mujoco_runtime.h"
+
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <regex>
+
+namespace penumbra {
+namespace {
+
+thread_local std::vector<std::string>* tls_warning_sink = nullptr;
+
+void ThrowingErrorHandler(const char* msg) { throw MujocoError(msg ? msg : "unknown error"); }
+
+void CapturingWarningHandler(const char* msg) {
+  if (tls_warning_sink) tls_warning_sink->emplace_back(msg ? msg : "");
+}
+
+std::string Trim(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ' || s.back() == '\'')) s.pop_back();
+  size_t b = 0;
+  while (b < s.size() && (s[b] == '\n' || s[b] == ' ')) ++b;
+  return s.substr(b);
+}
+
+// MuJoCo messages say "..., line 12" or "Element 'geom', line 3"
+int LineFromMessage(const std::string& msg) {
+  static const std::regex re("line ([0-9]+)");
+  std::smatch m;
+  if (std::regex_search(msg, m, re)) return std::stoi(m[1].str());
+  return 0;
+}
+
+std::string OneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n') c = ' ';
+  std::string out;
+  for (char c : s)
+    if (!(c == ' ' && !out.empty() && out.back() == ' ')) out += c;
+  return out;
+}
+
+}  // namespace
+
+void InstallMujocoHandlers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mju_user_error = ThrowingErrorHandler;
+    mju_user_warning = CapturingWarningHandler;
+  });
+}
+
+std::vector<std::string>* SetMujocoWarningSink(std::vector<std::string>* sink) {
+  std::vector<std::string>* old = tls_warning_sink;
+  tls_warning_sink = sink;
+  return old;
+}
+
+std::mutex& MujocoLoaderMutex() {
+  static std::mutex mu;
+  return mu;
+}
+
+mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* contents,
+                             const std::string& display_name, std::vector<std::string>* warnings) {
+  InstallMujocoHandlers();
+  if (!contents && !std::filesystem::exists(path))
+    throw ConfigError(display_name, 0, "", "model file not found; expected an MJCF or URDF file");
+  std::unique_ptr<mjVFS> vfs;
+  if (contents) {
+    vfs = std::make_unique<mjVFS>();
+    mj_defaultVFS(vfs.get());
+    const std::string name = std::filesystem::path(path).filename().string();
+    if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(contents->size())) != 0)
+      throw ConfigError(display_name, 0, "", "could not create an in-memory model file");
+    const int idx = mj_findFileVFS(vfs.get(), name.c_str());
+    std::memcpy(vfs->filedata[idx], contents->data(), contents->size());
+  }
+  char error[2048] = "";
+  std::vector<std::string> loader_warnings;
+  std::vector<std::string>* old_sink = SetMujocoWarningSink(&loader_warnings);
+  mjModel* m = nullptr;
+  try {
+    m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof(error));
+  } catch (const MujocoError& e) {
+    SetMujocoWarningSink(old_sink);
+    if (vfs) mj_deleteVFS(vfs.get());
+    throw ConfigError(display_name, 0, "",
+                      std::string("MuJoCo could not load the model: ") + e.what());
+  }
+  SetMujocoWarningSink(old_sink);
+  if (vfs) mj_deleteVFS(vfs.get());
+  const std::string msg = Trim(error);
+  if (!m) {
+    throw ConfigError(display_name, LineFromMessage(msg), "",
+                      "MuJoCo could not load the model: " + OneLine(msg));
+  }
+  if (warnings) {
+    if (!msg.empty())
+      warnings->push_back(display_name + ": MuJoCo compiler warning: " + OneLine(msg));
+    for (const auto& w : loader_warnings)
+      if (Trim(w) != msg)
+        warnings->push_back(display_name + ": MuJoCo warning while loading: " + OneLine(Trim(w)));
+  }
+  return m;
+}
+
+}  // namespace penumbra

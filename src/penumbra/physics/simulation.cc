@@ -1,0 +1,479 @@
+#include "penumbra/physics/simulation.h"
+
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "penumbra/core/error.h"
+#include "penumbra/physics/mujoco_runtime.h"
+#include "penumbra/physics/scene_extractor.h"
+
+namespace penumbra {
+namespace {
+
+// stored messages per warning type; later ones are only counted
+constexpr int kMaxMessagesPerWarning = 20;
+
+// ControlInput over live MuJoCo data, valid during one control update
+class MujocoControlInput final : public ControlInput {
+ public:
+  MujocoControlInput(const mjModel* m, mjData* d, const ModelInfo* info, std::vector<double>* jacp,
+                     std::vector<double>* jacr)
+      : m_(m), d_(d), info_(info), jacp_(jacp), jacr_(jacr) {}
+
+  double time_sec() const override { return d_->time; }
+  const ModelInfo& model() const override { return *info_; }
+  std::span<const double> qpos() const override { return {d_->qpos, static_cast<size_t>(m_->nq)}; }
+  std::span<const double> qvel() const override { return {d_->qvel, static_cast<size_t>(m_->nv)}; }
+  std::span<const double> sensordata() const override {
+    return {d_->sensordata, static_cast<size_t>(m_->nsensordata)};
+  }
+  Pose X_WB(int body) const override {
+    CheckBody(body, "X_WB");
+    return PoseFromPosQuat(d_->xpos + 3 * body, d_->xquat + 4 * body);
+  }
+  Twist V_WB(int body) const override {
+    CheckBody(body, "V_WB");
+    mjtNum v[6];
+    mj_objectVelocity(m_, d_, mjOBJ_XBODY, body, v, 0);
+    Twist t;
+    for (int i = 0; i < 6; ++i) t[i] = v[i];
+    return t;
+  }
+  void Jacobian(int body, const Eigen::Vector3d& p_W,
+                Eigen::Matrix<double, 6, Eigen::Dynamic>* J) const override {
+    CheckBody(body, "Jacobian");
+    const int nv = m_->nv;
+    const mjtNum point[3] = {p_W.x(), p_W.y(), p_W.z()};
+    mj_jac(m_, d_, jacp_->data(), jacr_->data(), point, body);
+    if (J->cols() != nv) J->resize(6, nv);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < nv; ++c) {
+        (*J)(r, c) = (*jacr_)[r * nv + c];
+        (*J)(r + 3, c) = (*jacp_)[r * nv + c];
+      }
+  }
+
+ private:
+  void CheckBody(int body, const char* what) const {
+    if (body < 0 || body >= m_->nbody)
+      throw Error(std::string("ControlInput::") + what + ": body index " + std::to_string(body) +
+                  " out of range [0, " + std::to_string(m_->nbody) + ")");
+  }
+  const mjModel* m_;
+  mjData* d_;
+  const ModelInfo* info_;
+  std::vector<double>* jacp_;
+  std::vector<double>* jacr_;
+};
+
+JointInfo::Type JointType(int t) {
+  switch (t) {
+    case mjJNT_FREE:
+      return JointInfo::Type::kFree;
+    case mjJNT_BALL:
+      return JointInfo::Type::kBall;
+    case mjJNT_SLIDE:
+      return JointInfo::Type::kSlide;
+    default:
+      return JointInfo::Type::kHinge;
+  }
+}
+
+std::string NameOr(const mjModel* m, int type, int id) {
+  const char* n = mj_id2name(m, type, id);
+  return n ? std::string(n) : std::string();
+}
+
+ModelInfo BuildModelInfo(const mjModel* m) {
+  ModelInfo info;
+  info.nq = m->nq;
+  info.nv = m->nv;
+  info.nu = m->nu;
+  info.nsensordata = m->nsensordata;
+  info.timestep_sec = m->opt.timestep;
+  for (int b = 0; b < m->nbody; ++b) {
+    info.body_names.push_back(NameOr(m, mjOBJ_BODY, b));
+    info.body_parent.push_back(b == 0 ? -1 : m->body_parentid[b]);
+  }
+  for (int s = 0; s < m->nsite; ++s) {
+    info.site_names.push_back(NameOr(m, mjOBJ_SITE, s));
+    info.site_body.push_back(m->site_bodyid[s]);
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    JointInfo ji;
+    ji.name = NameOr(m, mjOBJ_JOINT, j);
+    ji.type = JointType(m->jnt_type[j]);
+    ji.qpos_adr = m->jnt_qposadr[j];
+    ji.dof_adr = m->jnt_dofadr[j];
+    ji.body = m->jnt_bodyid[j];
+    ji.limited = m->jnt_limited[j] != 0;
+    ji.range[0] = m->jnt_range[2 * j];
+    ji.range[1] = m->jnt_range[2 * j + 1];
+    info.joints.push_back(ji);
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    ActuatorInfo ai;
+    ai.name = NameOr(m, mjOBJ_ACTUATOR, a);
+    const int trn = m->actuator_trntype[a];
+    ai.joint = (trn == mjTRN_JOINT || trn == mjTRN_JOINTINPARENT) ? m->actuator_trnid[2 * a] : -1;
+    ai.ctrl_limited = m->actuator_ctrllimited[a] != 0;
+    ai.ctrl_range[0] = m->actuator_ctrlrange[2 * a];
+    ai.ctrl_range[1] = m->actuator_ctrlrange[2 * a + 1];
+    info.actuators.push_back(ai);
+  }
+  for (int s = 0; s < m->nsensor; ++s)
+    info.sensors.push_back({NameOr(m, mjOBJ_SENSOR, s), m->sensor_adr[s], m->sensor_dim[s]});
+  return info;
+}
+
+// true if any value is NaN or infinite (x * 0 is NaN exactly for those)
+bool AnyNonFinite(const mjtNum* x, int n) {
+  double acc = 0;
+  for (int i = 0; i < n; ++i) acc += x[i] * 0.0;
+  return acc != acc;
+}
+
+}  // namespace
+
+struct Simulation::Impl {
+  struct Schedule {
+    double rate_hz = 0;
+    int64_t next = 0;  // index of the next update
+  };
+
+  std::string source;
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  SceneDescription scene;
+  ModelInfo info;
+  std::vector<std::unique_ptr<Controller>> controllers;
+  std::vector<Schedule> schedule;
+  std::vector<char> due;
+  int64_t steps = 0;
+  int seen_warnings[mjNWARNING] = {};
+  int warning_messages[mjNWARNING] = {};
+  int64_t dropped_warnings = 0;
+  std::vector<std::string> warnings;
+  std::vector<int> qpos_joint;  // (nq) joint owning each qpos entry
+  std::vector<double> jacp, jacr;
+  bool failed = false;
+  std::string failure;
+
+  ~Impl() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+
+  std::string BodyLabel(int body) const {
+    if (body < 0 || body >= m->nbody) return "body ?";
+    const std::string& n = info.body_names[body];
+    return n.empty() ? "body #" + std::to_string(body) + " (unnamed)" : "body '" + n + "'";
+  }
+  std::string JointLabel(int joint) const {
+    if (joint < 0 || joint >= m->njnt) return "";
+    const std::string& n = info.joints[joint].name;
+    return n.empty() ? "joint #" + std::to_string(joint) : "joint '" + n + "'";
+  }
+  // "dof 3 (joint 'j') of body 'b'"
+  std::string DofLabel(int dof) const {
+    if (dof < 0 || dof >= m->nv) return "dof " + std::to_string(dof);
+    return "dof " + std::to_string(dof) + " (" + JointLabel(m->dof_jntid[dof]) + ") of " +
+           BodyLabel(m->dof_bodyid[dof]);
+  }
+  std::string QposLabel(int i) const {
+    if (i < 0 || i >= m->nq) return "qpos[" + std::to_string(i) + "]";
+    const int j = qpos_joint[i];
+    return "qpos[" + std::to_string(i) + "] (" + JointLabel(j) + ") of " +
+           BodyLabel(m->jnt_bodyid[j]);
+  }
+  std::string ActuatorLabel(int a) const {
+    if (a < 0 || a >= m->nu) return "actuator " + std::to_string(a);
+    const std::string& n = info.actuators[a].name;
+    return n.empty() ? "actuator #" + std::to_string(a) : "actuator '" + n + "'";
+  }
+  std::string When(double t, int64_t step) const {
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "t = %.6g s (step %lld)", t, static_cast<long long>(step));
+    return source + ": " + buf;
+  }
+
+  [[noreturn]] void Fail(double t, int64_t step, const std::string& what) {
+    failed = true;
+    failure = When(t, step) + ": " + what;
+    throw PhysicsError(failure);
+  }
+
+  void RunControllers(double t, int64_t step) {
+    MujocoControlInput input(m, d, &info, &jacp, &jacr);
+    std::span<double> ctrl(d->ctrl, static_cast<size_t>(m->nu));
+    const double tol = 1e-6 * m->opt.timestep;
+    for (size_t i = 0; i < controllers.size(); ++i) {
+      if (!due[i]) continue;
+      controllers[i]->Compute(input, ctrl);
+      if (AnyNonFinite(d->ctrl, m->nu)) {
+        for (int a = 0; a < m->nu; ++a)
+          if (!std::isfinite(d->ctrl[a]))
+            Fail(t, step,
+                 "controller " + controllers[i]->label() + " wrote a non-finite ctrl (" +
+                     std::to_string(d->ctrl[a]) + ") to " + ActuatorLabel(a) + " (joint " +
+                     (info.actuators[a].joint >= 0
+                          ? JointLabel(info.actuators[a].joint) + " of " +
+                                BodyLabel(m->jnt_bodyid[info.actuators[a].joint])
+                          : std::string("none")) +
+                     ")");
+      }
+      Schedule& s = schedule[i];
+      if (s.rate_hz > 0) s.next = static_cast<int64_t>(std::floor((t + tol) * s.rate_hz)) + 1;
+    }
+  }
+
+  void CheckWarnings(double t, int64_t step) {
+    for (int w = 0; w < mjNWARNING; ++w) {
+      const int n = d->warning[w].number;
+      if (n == seen_warnings[w]) continue;
+      seen_warnings[w] = n;
+      const int info_i = d->warning[w].lastinfo;
+      const char* kDiverged =
+          "; MuJoCo reset the state. common causes: a timestep too large for stiff joints, "
+          "gains or contacts; huge actuator gear or ctrl; tiny masses or inertias";
+      switch (w) {
+        case mjWARN_BADQPOS:
+          Fail(t, step,
+               "physics diverged: NaN, Inf or |x| > 1e10 in " + QposLabel(info_i) + kDiverged);
+        case mjWARN_BADQVEL:
+          Fail(t, step,
+               "physics diverged: NaN, Inf or |x| > 1e10 in qvel at " + DofLabel(info_i) +
+                   kDiverged);
+        case mjWARN_BADQACC:
+          Fail(t, step,
+               "physics diverged: NaN, Inf or |x| > 1e10 in qacc at " + DofLabel(info_i) +
+                   kDiverged);
+        case mjWARN_BADCTRL:
+          Fail(t, step, "NaN, Inf or |x| > 1e10 in ctrl of " + ActuatorLabel(info_i));
+        default:
+          break;
+      }
+      if (warning_messages[w] >= kMaxMessagesPerWarning) {
+        ++dropped_warnings;
+        continue;
+      }
+      ++warning_messages[w];
+      std::string text = mju_warningText(w, info_i);
+      if (w == mjWARN_INERTIA) text += " (" + DofLabel(info_i) + ")";
+      warnings.push_back(When(t, step) + ": MuJoCo warning: " + text);
+    }
+  }
+
+  void CheckFinite(double t, int64_t step) {
+    const bool bad_pos = AnyNonFinite(d->qpos, m->nq);
+    const bool bad_vel = AnyNonFinite(d->qvel, m->nv);
+    const bool bad_acc = AnyNonFinite(d->qacc, m->nv);
+    if (!(bad_pos || bad_vel || bad_acc)) return;
+    for (int i = 0; i < m->nq; ++i)
+      if (!std::isfinite(d->qpos[i])) Fail(t, step, "physics diverged: non-finite " + QposLabel(i));
+    for (int i = 0; i < m->nv; ++i)
+      if (!std::isfinite(d->qvel[i]))
+        Fail(t, step, "physics diverged: non-finite qvel at " + DofLabel(i));
+    for (int i = 0; i < m->nv; ++i)
+      if (!std::isfinite(d->qacc[i]))
+        Fail(t, step, "physics diverged: non-finite qacc at " + DofLabel(i));
+  }
+};
+
+Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Simulation::Simulation(Simulation&&) noexcept = default;
+Simulation& Simulation::operator=(Simulation&&) noexcept = default;
+Simulation::~Simulation() = default;
+
+std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader_path,
+                                                       const std::string* contents,
+                                                       const std::string& source,
+                                                       std::optional<double> timestep_sec) {
+  if (timestep_sec && !(std::isfinite(*timestep_sec) && *timestep_sec > 0))
+    throw ConfigError(source, 0, "timestep_sec",
+                      "got " + std::to_string(*timestep_sec) + "; expected a number > 0 (s)");
+  InstallMujocoHandlers();
+  auto impl = std::make_unique<Simulation::Impl>();
+  impl->source = source;
+  {
+    std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
+    impl->m = LoadMujocoXmlLocked(loader_path, contents, source, &impl->warnings);
+  }
+  mjModel* m = impl->m;
+  if (timestep_sec) m->opt.timestep = *timestep_sec;
+  try {
+    impl->d = mj_makeData(m);
+  } catch (const MujocoError& e) {
+    throw PhysicsError(source + ": MuJoCo could not allocate the model's data: " + e.what());
+  }
+  if (!impl->d) throw PhysicsError(source + ": MuJoCo could not allocate the model's data");
+  mjData* d = impl->d;
+  // position-dependent quantities at qpos0 for the scene (no change to the dynamics state)
+  try {
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_camlight(m, d);
+  } catch (const MujocoError& e) {
+    throw PhysicsError(source + ": MuJoCo error at qpos0: " + e.what());
+  }
+  impl->scene = ExtractScene(m, d);
+  impl->info = BuildModelInfo(m);
+  impl->qpos_joint.assign(m->nq, 0);
+  for (int j = 0; j < m->njnt; ++j) {
+    const int adr = m->jnt_qposadr[j];
+    const int n = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
+    for (int k = adr; k < adr + n && k < m->nq; ++k) impl->qpos_joint[k] = j;
+  }
+  impl->jacp.assign(3 * static_cast<size_t>(m->nv), 0.0);
+  impl->jacr.assign(3 * static_cast<size_t>(m->nv), 0.0);
+  for (int w = 0; w < mjNWARNING; ++w) impl->seen_warnings[w] = d->warning[w].number;
+  return impl;
+}
+
+Simulation Simulation::LoadFromFile(const std::string& mjcf_path,
+                                    std::optional<double> timestep_sec) {
+  return Simulation(LoadImpl(mjcf_path, nullptr, mjcf_path, timestep_sec));
+}
+
+Simulation Simulation::LoadFromString(const std::string& mjcf_xml,
+                                      std::optional<double> timestep_sec,
+                                      const std::string& asset_dir) {
+  const std::filesystem::path dir =
+      asset_dir.empty() ? std::filesystem::current_path() : std::filesystem::path(asset_dir);
+  const std::string loader_path = (dir / "penumbra_inline_model.xml").string();
+  return Simulation(LoadImpl(loader_path, &mjcf_xml, "<string>", timestep_sec));
+}
+
+void Simulation::AddController(std::unique_ptr<Controller> controller) {
+  if (!controller) throw Error("Simulation::AddController: null controller");
+  controller->Initialize(impl_->info);
+  const double rate = controller->rate_hz();
+  if (!(std::isfinite(rate) && rate >= 0)) {
+    const ControllerContext& c = controller->context();
+    throw ConfigError(c.file, c.line, c.key,
+                      "controller rate " + std::to_string(rate) + " Hz; expected a number >= 0");
+  }
+  Impl::Schedule s;
+  s.rate_hz = rate;
+  s.next = 0;
+  // the first update runs at the first step at or after the current time
+  if (rate > 0) {
+    const double tol = 1e-6 * impl_->m->opt.timestep;
+    s.next = static_cast<int64_t>(std::ceil((impl_->d->time - tol) * rate));
+  }
+  impl_->controllers.push_back(std::move(controller));
+  impl_->schedule.push_back(s);
+  impl_->due.push_back(0);
+}
+
+void Simulation::Step() {
+  Impl& s = *impl_;
+  if (s.failed) throw PhysicsError(s.failure + " (the simulation cannot continue)");
+  const mjModel* m = s.m;
+  mjData* d = s.d;
+  const double t = d->time;
+  const int64_t step = s.steps + 1;
+  const double tol = 1e-6 * m->opt.timestep;
+  bool any_due = false;
+  for (size_t i = 0; i < s.controllers.size(); ++i) {
+    const Impl::Schedule& sc = s.schedule[i];
+    const bool due = sc.rate_hz <= 0 || t + tol >= static_cast<double>(sc.next) / sc.rate_hz;
+    s.due[i] = due;
+    any_due |= due;
+  }
+  try {
+    if (any_due) {
+      // position and velocity stages first, so controllers see a consistent state
+      mj_step1(m, d);
+      s.RunControllers(t, step);
+      if (m->opt.integrator == mjINT_RK4) {
+        mj_step(m, d);
+      } else {
+        mj_step2(m, d);
+      }
+    } else {
+      mj_step(m, d);
+    }
+  } catch (const MujocoError& e) {
+    s.Fail(t, step, std::string("MuJoCo error: ") + e.what());
+  }
+  s.steps = step;
+  s.CheckWarnings(t, step);
+  s.CheckFinite(t, step);
+}
+
+double Simulation::time() const { return impl_->d->time; }
+int64_t Simulation::step_count() const { return impl_->steps; }
+double Simulation::timestep() const { return impl_->m->opt.timestep; }
+
+WorldSnapshot Simulation::Snapshot() const {
+  WorldSnapshot out;
+  Snapshot(&out);
+  return out;
+}
+
+void Simulation::Snapshot(WorldSnapshot* out) const {
+  const mjModel* m = impl_->m;
+  mjData* d = impl_->d;
+  try {
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_camlight(m, d);
+  } catch (const MujocoError& e) {
+    throw PhysicsError(impl_->When(d->time, impl_->steps) + ": MuJoCo error: " + e.what());
+  }
+  out->time_sec = d->time;
+  out->step = impl_->steps;
+  out->X_WB.resize(m->nbody);
+  for (int b = 0; b < m->nbody; ++b)
+    out->X_WB[b] = PoseFromPosQuat(d->xpos + 3 * b, d->xquat + 4 * b);
+  out->X_W_mjcam.resize(m->ncam);
+  for (int c = 0; c < m->ncam; ++c) {
+    Pose X = Pose::Identity();
+    X.linear() =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->cam_xmat + 9 * c);
+    X.translation() =
+        Eigen::Vector3d(d->cam_xpos[3 * c], d->cam_xpos[3 * c + 1], d->cam_xpos[3 * c + 2]);
+    out->X_W_mjcam[c] = X;
+  }
+  out->light_position_W.resize(m->nlight);
+  out->light_direction_W.resize(m->nlight);
+  for (int l = 0; l < m->nlight; ++l) {
+    out->light_position_W[l] =
+        Eigen::Vector3d(d->light_xpos[3 * l], d->light_xpos[3 * l + 1], d->light_xpos[3 * l + 2]);
+    Eigen::Vector3d dir(d->light_xdir[3 * l], d->light_xdir[3 * l + 1], d->light_xdir[3 * l + 2]);
+    out->light_direction_W[l] = dir.norm() > 0 ? dir.normalized() : Eigen::Vector3d(0, 0, -1);
+  }
+  out->qpos.assign(d->qpos, d->qpos + m->nq);
+  out->qvel.assign(d->qvel, d->qvel + m->nv);
+}
+
+const SceneDescription& Simulation::scene() const { return impl_->scene; }
+const ModelInfo& Simulation::model_info() const { return impl_->info; }
+
+std::vector<std::string> Simulation::TakeWarnings() {
+  std::vector<std::string> out = std::move(impl_->warnings);
+  impl_->warnings.clear();
+  if (impl_->dropped_warnings > 0) {
+    out.push_back(impl_->source + ": " + std::to_string(impl_->dropped_warnings) +
+                  " more MuJoCo warnings of the same kinds (not listed)");
+    impl_->dropped_warnings = 0;
+  }
+  return out;
+}
+
+std::span<const double> Simulation::qpos() const {
+  return {impl_->d->qpos, static_cast<size_t>(impl_->m->nq)};
+}
+std::span<const double> Simulation::qvel() const {
+  return {impl_->d->qvel, static_cast<size_t>(impl_->m->nv)};
+}
+std::span<double> Simulation::ctrl() { return {impl_->d->ctrl, static_cast<size_t>(impl_->m->nu)}; }
+const std::string& Simulation::source() const { return impl_->source; }
+int Simulation::num_controllers() const { return static_cast<int>(impl_->controllers.size()); }
+const Controller& Simulation::controller(int i) const { return *impl_->controllers.at(i); }
+
+}  // namespace penumbra

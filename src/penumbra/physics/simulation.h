@@ -1,0 +1,109 @@
+#pragma once
+// one MuJoCo model and its state, stepped at a fixed timestep, with the
+// controllers that drive it. this is the only owner of mjModel/mjData; the rest
+// of penumbra sees the world through scene() (static) and Snapshot() (per step).
+//
+// determinism: Step() is a pure function of the model, the state and the
+// controllers' outputs (no wall clock, no randomness), so two simulations of the
+// same model with the same controllers give bit-identical trajectories.
+//
+// failures: MuJoCo errors (e.g. stack overflow) and divergence (MuJoCo's bad
+// qpos/qvel/qacc/ctrl warnings, or NaN/Inf in qpos/qvel/qacc) throw PhysicsError
+// naming the sim time, the step and the body involved; MuJoCo resets its state on
+// divergence, so after a PhysicsError the simulation refuses further steps.
+// non-fatal MuJoCo warnings (contact or constraint buffer full, near-singular
+// inertia) are collected for TakeWarnings().
+//
+// thread safety: one thread per Simulation; different Simulations may step on
+// different threads. loading is serialised internally (MuJoCo's loader has global state).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "penumbra/control/controller.h"
+#include "penumbra/control/model_info.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// a MuJoCo simulation with pluggable controllers.
+class Simulation {
+ public:
+  /// loads an MJCF (or URDF) file; `timestep_sec` overrides <option timestep>.
+  /// @throws ConfigError(mjcf_path, line, ...) with MuJoCo's message for a bad model, or
+  ///         for a timestep that is not finite and > 0; PhysicsError if MuJoCo fails
+  ///         to set up the model's data.
+  static Simulation LoadFromFile(const std::string& mjcf_path,
+                                 std::optional<double> timestep_sec = std::nullopt);
+  /// loads MJCF text; assets (meshes, textures, includes) resolve relative to `asset_dir`
+  /// ("" = the current directory). error messages name the model "<string>".
+  /// @throws as LoadFromFile.
+  static Simulation LoadFromString(const std::string& mjcf_xml,
+                                   std::optional<double> timestep_sec = std::nullopt,
+                                   const std::string& asset_dir = "");
+
+  Simulation(Simulation&&) noexcept;
+  Simulation& operator=(Simulation&&) noexcept;
+  ~Simulation();
+
+  /// takes ownership of `controller` and initialises it against the model.
+  /// @throws ConfigError from Controller::Initialize (lists every missing name).
+  void AddController(std::unique_ptr<Controller> controller);
+
+  /// advances one timestep: controllers that are due (on sim time, see
+  /// Controller::rate_hz) read the current state and write ctrl, then MuJoCo integrates.
+  /// no allocation in steady state.
+  /// @throws PhysicsError on a MuJoCo error, divergence, or a controller writing a
+  ///         non-finite ctrl; message: "<model>: t = <time> s (step <n>): ... body '<name>' ...".
+  void Step();
+
+  /// simulation time (s) and the number of steps taken since loading.
+  double time() const;
+  int64_t step_count() const;
+  /// the physics timestep (s).
+  double timestep() const;
+
+  /// the world at the current time: X_WB of every body, MJCF camera poses and light
+  /// positions/directions, qpos, qvel. MuJoCo's position-dependent quantities are
+  /// refreshed for the current qpos first (mj_kinematics, mj_comPos, mj_camlight), which
+  /// does not change the trajectory.
+  WorldSnapshot Snapshot() const;
+  /// as Snapshot(), reusing `out`'s storage.
+  void Snapshot(WorldSnapshot* out) const;
+
+  /// the static scene, extracted once at load (physics/scene_extractor.h).
+  const SceneDescription& scene() const;
+  /// names, sizes and index maps for controllers.
+  const ModelInfo& model_info() const;
+
+  /// non-fatal warnings since the last call (loader warnings first), each with sim time,
+  /// step and body where MuJoCo names one. clears the list.
+  std::vector<std::string> TakeWarnings();
+
+  /// (nq) / (nv) current joint positions and velocities.
+  std::span<const double> qpos() const;
+  std::span<const double> qvel() const;
+  /// (nu) MuJoCo ctrl vector; controllers write it, tools and tests may too.
+  std::span<double> ctrl();
+
+  /// the file the model came from ("<string>" for LoadFromString).
+  const std::string& source() const;
+  /// controllers added so far, in order.
+  int num_controllers() const;
+  const Controller& controller(int i) const;
+
+ private:
+  struct Impl;
+  explicit Simulation(std::unique_ptr<Impl> impl);
+  static std::unique_ptr<Impl> LoadImpl(const std::string& loader_path, const std::string* contents,
+                                        const std::string& source,
+                                        std::optional<double> timestep_sec);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace penumbra

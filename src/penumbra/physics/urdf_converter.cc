@@ -1,0 +1,82 @@
+#include "penumbra/physics/urdf_converter.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/physics/mujoco_runtime.h"
+
+namespace penumbra {
+namespace {
+
+// inserts <mujoco><compiler .../></mujoco> right after the <robot ...> tag unless the
+// URDF already has a <mujoco> element.
+std::string WithImportOptions(const std::string& urdf) {
+  if (urdf.find("<mujoco") != std::string::npos) return urdf;
+  size_t pos = urdf.find("<robot");
+  while (pos != std::string::npos) {
+    const char next = pos + 6 < urdf.size() ? urdf[pos + 6] : '\0';
+    if (next == ' ' || next == '>' || next == '\t' || next == '\n' || next == '\r') break;
+    pos = urdf.find("<robot", pos + 6);
+  }
+  if (pos == std::string::npos) return urdf;  // MuJoCo reports the missing element
+  char quote = 0;
+  for (size_t i = pos; i < urdf.size(); ++i) {
+    const char c = urdf[i];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      if (urdf[i - 1] == '/') return urdf;  // empty robot
+      return urdf.substr(0, i + 1) +
+             "<mujoco><compiler discardvisual=\"false\" fusestatic=\"false\"/></mujoco>" +
+             urdf.substr(i + 1);
+    }
+  }
+  return urdf;
+}
+
+}  // namespace
+
+std::string ConvertUrdfToMjcf(const std::string& urdf_path) {
+  std::ifstream in(urdf_path, std::ios::binary);
+  if (!in)
+    throw ConfigError(urdf_path, 0, "", "cannot read the URDF file; expected a readable file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string urdf = WithImportOptions(ss.str());
+
+  std::string tmpl = (std::filesystem::temp_directory_path() / "penumbra_urdf_XXXXXX").string();
+  std::string mjcf;
+  {
+    std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
+    mjModel* m = LoadMujocoXmlLocked(urdf_path, &urdf, urdf_path, nullptr);
+    const int fd = mkstemp(tmpl.data());
+    if (fd < 0) {
+      mj_deleteModel(m);
+      throw Error("ConvertUrdfToMjcf: cannot create a temporary file in " +
+                  std::filesystem::temp_directory_path().string());
+    }
+    close(fd);
+    char error[1024] = "";
+    const int ok = mj_saveLastXML(tmpl.c_str(), m, error, sizeof(error));
+    mj_deleteModel(m);
+    if (!ok) {
+      std::filesystem::remove(tmpl);
+      throw Error("ConvertUrdfToMjcf: MuJoCo could not save " + urdf_path + " as MJCF: " + error);
+    }
+  }
+  std::ifstream out(tmpl, std::ios::binary);
+  std::stringstream os;
+  os << out.rdbuf();
+  mjcf = os.str();
+  std::filesystem::remove(tmpl);
+  return mjcf;
+}
+
+}  // namespace penumbra
