@@ -1,0 +1,154 @@
+#include "penumbra/render/embree_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/realtime_integrator.h"
+
+namespace penumbra {
+namespace {
+
+// the integrator of a tier: the one place that maps tiers to light-transport algorithms.
+std::unique_ptr<Integrator> MakeIntegrator(const RenderSettings& settings) {
+  switch (settings.tier) {
+    case RenderSettings::Tier::kRealtime:
+      return std::make_unique<RealtimeIntegrator>();
+    case RenderSettings::Tier::kPathtraced:
+      throw Error("pathtraced tier not built");
+  }
+  throw Error("unknown render tier");
+}
+
+template <typename T>
+void Reshape(Image<T>* img, int w, int h, int c) {
+  if (img->width != w || img->height != h || img->channels != c) *img = Image<T>(w, h, c);
+}
+
+}  // namespace
+
+EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettings& settings)
+    : scene_(scene),
+      settings_((settings.ValidateOrThrow(), settings)),
+      ray_scene_(std::make_unique<RayScene>(scene_)),
+      materials_(scene_),
+      lights_(scene_),
+      sky_(scene_.sky),
+      film_(settings_),
+      pool_(settings_.threads),
+      integrator_(MakeIntegrator(settings_)) {
+  if (settings_.tier == RenderSettings::Tier::kPathtraced && settings_.denoise)
+    denoiser_ = std::make_unique<Denoiser>();
+}
+
+void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& view,
+                            RenderedFrame* out) {
+  if (snapshot.X_WB.size() != scene_.bodies.size())
+    throw Error("Render: snapshot has " + std::to_string(snapshot.X_WB.size()) +
+                " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
+  ray_scene_->Update(snapshot);
+  lights_.Update(snapshot);
+  const Camera camera(view.X_WO, view.intrinsics);
+  const int W = camera.width(), H = camera.height();
+  const CameraOutputs& want = view.outputs;
+  const bool denoise = want.rgb && denoiser_ != nullptr;
+
+  if (want.rgb) {
+    Reshape(&out->radiance, W, H, 3);
+  } else {
+    out->radiance = ImageF();
+    out->rgb = ImageU8();
+  }
+  ImageF* depth = nullptr;
+  if (want.depth) {
+    Reshape(&out->depth_m, W, H, 1);
+    depth = &out->depth_m;
+  } else {
+    out->depth_m = ImageF();
+    if (denoise) {
+      Reshape(&depth_, W, H, 1);
+      depth = &depth_;
+    }
+  }
+  if (want.segmentation) {
+    Reshape(&out->geom_id, W, H, 1);
+  } else {
+    out->geom_id = ImageI32();
+  }
+  FrameBuffers buffers;
+  if (want.rgb) {
+    buffers.radiance = &out->radiance;
+    if (denoise) {
+      Reshape(&albedo_, W, H, 3);
+      Reshape(&normal_, W, H, 3);
+      buffers.albedo = &albedo_;
+      buffers.normal = &normal_;
+    }
+  }
+
+  FrameContext ctx;
+  ctx.scene = ray_scene_.get();
+  ctx.materials = &materials_;
+  ctx.lights = &lights_;
+  ctx.sky = &sky_;
+  ctx.camera = &camera;
+  ctx.settings = &settings_;
+  ctx.camera_index = view.camera_index;
+  ctx.frame_index = view.frame_index;
+
+  const int tiles_x = (W + kTileSize - 1) / kTileSize;
+  const int tiles_y = (H + kTileSize - 1) / kTileSize;
+  std::atomic<int64_t> secondary_rays{0};
+  ImageI32* seg = want.segmentation ? &out->geom_id : nullptr;
+  pool_.ParallelFor(static_cast<int64_t>(tiles_x) * tiles_y, [&](int64_t k) {
+    constexpr int kMax = kTileSize * kTileSize;
+    Ray rays[kMax];
+    SurfaceHit hits[kMax];
+    bool did_hit[kMax];
+    PrimaryHits primary;
+    primary.tile.x0 = static_cast<int>(k % tiles_x) * kTileSize;
+    primary.tile.y0 = static_cast<int>(k / tiles_x) * kTileSize;
+    primary.tile.width = std::min(kTileSize, W - primary.tile.x0);
+    primary.tile.height = std::min(kTileSize, H - primary.tile.y0);
+    const PixelTile& t = primary.tile;
+    const int n = t.width * t.height;
+    for (int i = 0; i < n; ++i)
+      rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + i % t.width),
+                                   static_cast<float>(t.y0 + i / t.width));
+    ray_scene_->IntersectMany(rays, n, /*coherent=*/true, hits, did_hit);
+    for (int i = 0; i < n; ++i) {
+      const int u = t.x0 + i % t.width, v = t.y0 + i / t.width;
+      if (depth) *depth->at(u, v) = did_hit[i] ? hits[i].t : 0.0f;
+      if (seg) *seg->at(u, v) = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
+    }
+    if (buffers.radiance) {
+      primary.rays = rays;
+      primary.hits = hits;
+      primary.did_hit = did_hit;
+      secondary_rays.fetch_add(integrator_->RenderTile(ctx, primary, buffers),
+                               std::memory_order_relaxed);
+    }
+  });
+  out->rays = static_cast<int64_t>(W) * H + secondary_rays.load();
+
+  if (want.rgb) {
+    if (denoise) {
+      DenoiserGuides guides;
+      guides.albedo = &albedo_;
+      guides.normal = &normal_;
+      guides.depth = depth;
+      denoiser_->Denoise(out->radiance, guides, &pool_, &denoised_);
+      std::swap(out->radiance, denoised_);
+    }
+    out->ev100 = film_.Ev100(out->radiance, &pool_);
+    film_.Develop(out->radiance, out->ev100, &pool_, &out->rgb);
+  }
+}
+
+std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene,
+                                             const RenderSettings& settings) {
+  return std::make_unique<EmbreeRenderer>(scene, settings);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,58 @@
+#pragma once
+// the Embree ray tracer behind MakeEmbreeRenderer (renderer.h).
+//
+// per frame: pose the RayScene and the lights from the snapshot (the top-level BVH is
+// recommitted only when a body moved), split the image into kTileSize x kTileSize tiles spread
+// over a thread pool, trace the pixel-centre camera ray of every pixel of a tile as one
+// coherent Embree ray stream (these hits are the depth and segmentation images: exact, never
+// blended), then let the tier's Integrator estimate the tile's radiance. radiance is exposed,
+// tone mapped and encoded by Film. every output is independent of the thread count.
+
+#include <memory>
+
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/denoiser.h"
+#include "penumbra/render/film.h"
+#include "penumbra/render/integrator.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/material_eval.h"
+#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/render/sky_model.h"
+
+namespace penumbra {
+
+/// the Renderer of both tiers on Embree. one Render at a time (parallel inside).
+class EmbreeRenderer final : public Renderer {
+ public:
+  /// side of the square pixel tiles that threads work on.
+  static constexpr int kTileSize = 16;
+
+  /// copies `scene` and builds its ray scene.
+  /// @throws ConfigError for bad settings or sky; Error if Embree fails or the scene refers
+  /// to missing meshes, height fields, materials or textures.
+  EmbreeRenderer(const SceneDescription& scene, const RenderSettings& settings);
+
+  /// @throws Error if the snapshot does not match the scene (body counts) or a light /
+  /// MJCF light id is out of range; ConfigError for bad intrinsics.
+  void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) override;
+
+  const RayScene& ray_scene() const { return *ray_scene_; }
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  const SceneDescription scene_;  // owned copy; everything below refers to it
+  const RenderSettings settings_;
+  std::unique_ptr<RayScene> ray_scene_;
+  MaterialEvaluator materials_;
+  LightSampler lights_;
+  SkyModel sky_;
+  Film film_;
+  ThreadPool pool_;
+  std::unique_ptr<Integrator> integrator_;
+  std::unique_ptr<Denoiser> denoiser_;  // pathtraced with denoise only
+  // per-frame buffers kept between frames to avoid reallocation.
+  ImageF albedo_, normal_, depth_, denoised_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,62 @@
+#pragma once
+// image formation: exposure, tone mapping and sRGB encoding of a linear radiance image.
+//
+//   exposure  H = 1 / (1.2 2^EV100)  (saturation-based speed, Lagarde & de Rousiers, "Moving
+//             Frostbite to physically based rendering", SIGGRAPH 2014 course, eq. 12), so a
+//             pixel value is radiance x H.
+//   auto EV   the log-average luminance L_avg = exp(mean(log(max(L, kMinLuminance)))) is mapped
+//             to the key 0.18 (Reinhard et al., "Photographic tone reproduction", 2002):
+//             H = 0.18 / L_avg, i.e. EV100 = log2(L_avg / (0.18 x 1.2)).
+//   compensation  +c stops brighten the image: the EV100 used is EV100 - c.
+//   tone map  filmic: the ACES filmic fit of Narkowicz 2015 ("ACES filmic tone mapping
+//             curve"), per channel, without his 0.6 pre-scale; linear: clamp to [0, 1].
+//   encoding  sRGB OETF (IEC 61966-2-1) to 8 bits through a 65536-entry table (within 1 code
+//             value of the exact rounding).
+// luminance uses the Rec. 709 weights (0.2126, 0.7152, 0.0722). all sums run in a fixed order,
+// so results do not depend on the thread count.
+
+#include <cstdint>
+#include <vector>
+
+#include "penumbra/core/image.h"
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/render_settings.h"
+
+namespace penumbra {
+
+/// pixels darker than this (cd/m^2) count as this in the log-average (keeps black pixels from
+/// driving the exposure to infinity).
+constexpr double kMinLuminance = 1e-4;
+
+/// photometric exposure H for an exposure value at ISO 100: 1 / (1.2 2^ev100).
+double ExposureFromEv100(double ev100);
+
+/// ACES filmic fit (Narkowicz 2015) of a non-negative exposed value, in [0, 1].
+float AcesFilmic(float x);
+
+/// sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
+float SrgbOetf(float linear);
+
+/// turns radiance images into display images. immutable, thread-compatible.
+class Film {
+ public:
+  /// keeps the exposure / tone-mapping fields of `settings`.
+  explicit Film(const RenderSettings& settings);
+
+  /// log-average luminance of a (H x W x 3) radiance image (cd/m^2); kMinLuminance if empty.
+  double LogAverageLuminance(const ImageF& radiance, ThreadPool* pool) const;
+
+  /// the EV100 used for `radiance`: auto (from its log-average luminance) or manual, minus
+  /// the exposure compensation.
+  double Ev100(const ImageF& radiance, ThreadPool* pool) const;
+
+  /// exposes `radiance` ((H x W x 3) cd/m^2) with EV100 `ev100`, tone maps and encodes it
+  /// into `rgb` ((H x W x 3) uint8 sRGB, resized). rows are spread over `pool` (may be null).
+  void Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb) const;
+
+ private:
+  RenderSettings settings_;
+  std::vector<uint8_t> oetf_lut_;  // sRGB 8-bit code of i / (size - 1)
+};
+
+}  // namespace penumbra

@@ -1,0 +1,128 @@
+#include "penumbra/render/light_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// cubic smoothstep from e0 (0) to e1 (1); a hard step where e0 == e1.
+inline float SmoothStep(float e0, float e1, float x) {
+  if (e1 <= e0) return x >= e0 ? 1.0f : 0.0f;
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+// unit direction sampled uniformly in the cone of half-angle acos(cos_max) around unit axis
+// w (Pharr, Jakob, Humphreys, "Physically Based Rendering", 4th ed., sec. A.5.4).
+inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float u1, float u2) {
+  const float cos_t = 1.0f - u1 * (1.0f - cos_max);
+  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+  const float phi = static_cast<float>(2 * kPi) * u2;
+  // orthonormal basis around w (Duff et al., JCGT 2017).
+  const float sign = std::copysign(1.0f, w.z());
+  const float a = -1.0f / (sign + w.z());
+  const float b = w.x() * w.y() * a;
+  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
+  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
+  return (sin_t * std::cos(phi) * t + sin_t * std::sin(phi) * bt + cos_t * w).normalized();
+}
+
+}  // namespace
+
+LightSampler::LightSampler(const SceneDescription& scene)
+    : num_bodies_(static_cast<int>(scene.bodies.size())) {
+  for (const Light& l : scene.lights) {
+    if (!l.active || !(l.intensity > 0) || !(l.color.maxCoeff() > 0)) continue;
+    sources_.push_back(l);
+    PosedLight p;
+    p.type = l.type;
+    p.intensity_rgb = l.color.cwiseMax(0.0f) * l.intensity;
+    const float outer = std::clamp(l.spot_outer_deg, 0.0f, 180.0f);
+    const float inner = std::clamp(l.spot_inner_deg, 0.0f, outer);
+    p.cos_outer = static_cast<float>(std::cos(outer * kPi / 180.0));
+    p.cos_inner = static_cast<float>(std::cos(inner * kPi / 180.0));
+    p.radius_m = std::max(l.radius_m, 0.0f);
+    p.cos_angular_radius =
+        static_cast<float>(std::cos(std::clamp(l.angular_radius_deg, 0.0f, 90.0f) * kPi / 180.0));
+    p.cast_shadow = l.cast_shadow;
+    lights_.push_back(p);
+  }
+}
+
+void LightSampler::Update(const WorldSnapshot& snapshot) {
+  for (size_t i = 0; i < sources_.size(); ++i) {
+    const Light& l = sources_[i];
+    PosedLight& p = lights_[i];
+    Eigen::Vector3d pos, dir;
+    if (l.mjcf_light >= 0) {
+      if (l.mjcf_light >= static_cast<int>(snapshot.light_position_W.size()) ||
+          l.mjcf_light >= static_cast<int>(snapshot.light_direction_W.size()))
+        throw Error("LightSampler: light '" + l.name + "' is MJCF light " +
+                    std::to_string(l.mjcf_light) + " but the snapshot has " +
+                    std::to_string(snapshot.light_position_W.size()) + " lights");
+      pos = snapshot.light_position_W[l.mjcf_light];
+      dir = snapshot.light_direction_W[l.mjcf_light];
+    } else {
+      if (l.body < 0 || l.body >= static_cast<int>(snapshot.X_WB.size()))
+        throw Error("LightSampler: light '" + l.name + "' is attached to body " +
+                    std::to_string(l.body) + " but the snapshot has " +
+                    std::to_string(snapshot.X_WB.size()) + " bodies");
+      const Pose& X_WB = snapshot.X_WB[l.body];
+      pos = X_WB * l.position_B;
+      dir = X_WB.linear() * l.direction_B;
+    }
+    const double n = dir.norm();
+    p.position_W = pos.cast<float>();
+    p.direction_W = n > 0 ? Eigen::Vector3f((dir / n).cast<float>()) : Eigen::Vector3f(0, 0, -1);
+  }
+}
+
+bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
+                          LightSample* s) const {
+  const PosedLight& l = lights_[i];
+  s->cast_shadow = l.cast_shadow;
+  if (l.type == Light::Type::kDirectional) {
+    const Eigen::Vector3f to_light = -l.direction_W;
+    s->wi =
+        l.cos_angular_radius < 1.0f ? SampleCone(to_light, l.cos_angular_radius, u1, u2) : to_light;
+    s->distance = std::numeric_limits<float>::infinity();
+    s->E = l.intensity_rgb;
+    return true;
+  }
+  const Eigen::Vector3f to_light = l.position_W - p_W;
+  const float d2 = to_light.squaredNorm();
+  const float d = std::sqrt(d2);
+  if (!(d > l.radius_m)) return false;  // inside the emitter (or at a point light)
+  float atten = 1.0f;
+  if (l.type == Light::Type::kSpot) {
+    const float cos_axis = -to_light.dot(l.direction_W) / d;
+    atten = SmoothStep(l.cos_outer, l.cos_inner, cos_axis);
+    if (atten <= 0) return false;
+  }
+  s->E = l.intensity_rgb * (atten / d2);
+  const Eigen::Vector3f w = to_light / d;
+  if (l.radius_m > 0) {
+    // uniform direction in the cone the sphere subtends, ending on its near surface: for a
+    // sphere of uniform radiance I / (pi r^2) each direction carries the full I / d^2.
+    const float sin2 = (l.radius_m * l.radius_m) / d2;
+    const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sin2));
+    s->wi = SampleCone(w, cos_max, u1, u2);
+    // distance to the sphere along wi: the nearer root of |p + t wi - c|^2 = r^2.
+    const float b = s->wi.dot(to_light);
+    const float disc = std::max(0.0f, b * b - (d2 - l.radius_m * l.radius_m));
+    s->distance = std::max(b - std::sqrt(disc), 0.0f);
+  } else {
+    s->wi = w;
+    s->distance = d;
+  }
+  return true;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,32 @@
+#pragma once
+// the `realtime` tier: direct lighting with ray-traced shadows, one sample per pixel.
+//
+// per pixel, at the surface seen through the pixel centre:
+//   L = Le + sum over lights  f(wo, wi) |n . wi| E_i V_i  + ambient
+// with E_i the illuminance of one sample of light i (LightSampler; lights with an extent
+// are jittered per pixel for soft shadows), V_i its visibility from one shadow ray, f the
+// metallic-roughness BRDF (bsdf.h), and the unoccluded sky ambient
+//   ambient = Irradiance(n) / pi x (c_diff (1 - S) + S),   S = EnvBRDF(F0, n.v, roughness)
+// (SkyModel::Irradiance; S is Karis' analytic fit of the split-sum specular reflectance,
+// "Physically based shading on mobile", Unreal Engine blog 2014), exact for a uniform sky
+// and a Lambertian surface (S = 0). rays that miss see SkyModel::Radiance.
+//
+// shadow rays are skipped for lights that contribute less than kNegligibleLight of the
+// pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
+// Rng(ctx.PixelStream(u, v, 0)), two per light in light order.
+
+#include "penumbra/render/integrator.h"
+
+namespace penumbra {
+
+/// lights below this fraction of a pixel's unshadowed radiance get no shadow ray.
+constexpr float kNegligibleLight = 1e-3f;
+
+/// direct lighting + sky ambient, 1 sample per pixel. stateless, thread-safe.
+class RealtimeIntegrator final : public Integrator {
+ public:
+  int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
+                     const FrameBuffers& out) const override;
+};
+
+}  // namespace penumbra
