@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -661,6 +662,29 @@ TEST_F(WorldConfigTest, EmptyDocument) {
 TEST_F(WorldConfigTest, NonFiniteNumberRejected) {
   ExpectError("duration_sec: .inf\n", 1, "duration_sec", "expected a number");
   ExpectError("duration_sec: nan\n", 1, "duration_sec", "expected a finite number");
+}
+
+// the complete example of the reference must load as documented.
+TEST_F(WorldConfigTest, ReferenceExampleParses) {
+  std::ifstream in(std::string(PENUMBRA_SOURCE_DIR) + "/docs/world-file.md");
+  ASSERT_TRUE(in) << "docs/world-file.md not found";
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  const size_t heading = doc.find("### Complete example");
+  ASSERT_NE(heading, std::string::npos);
+  const size_t begin = doc.find("```yaml\n", heading);
+  ASSERT_NE(begin, std::string::npos);
+  const size_t end = doc.find("```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const WorldConfig w = ParseWorld(doc.substr(begin + 8, end - begin - 8), world_);
+  EXPECT_EQ(w.seed, 7u);
+  EXPECT_EQ(w.models.size(), 2u);
+  EXPECT_EQ(w.lights.size(), 3u);
+  EXPECT_EQ(w.cameras.size(), 2u);
+  EXPECT_EQ(w.mjcf_cameras.overrides.size(), 1u);
+  EXPECT_EQ(w.materials.size(), 1u);
+  EXPECT_EQ(w.models[0].controller.type, "waypoint_follower");
 }
 
 // ---- programmatic configs ----
