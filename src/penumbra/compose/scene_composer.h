@@ -1,0 +1,88 @@
+#pragma once
+// the scene composer: merges the MJCF and URDF models of a world into one MJCF
+// document that MuJoCo 2.2.2 loads (mj_loadXML) from any working directory.
+//
+// what it does to model M (name "M", see ModelConfig):
+//  - resolves <include file> recursively (relative to the including file, then to
+//    the main model file as MuJoCo 2.2.2 does) and makes every asset file path
+//    absolute (mesh/skin/hfield file, texture file and the six cube-face files),
+//    honouring compiler meshdir, texturedir, assetdir and strippath;
+//  - prefixes every name with "M/" (bodies, joints, geoms, sites, cameras, lights,
+//    assets, tendons, actuators, sensors, equalities, contact pairs/excludes,
+//    keyframes, custom numeric/text/tuple, default classes) and every reference
+//    to a name, using an explicit (section, element, attribute) -> kind table
+//    (mjcf_schema.h); a reference to an undefined name is an error. the world
+//    body "world" is never prefixed.
+//  - moves M's top-level <default> into a class "M/<root>" ("M/main" normally) under
+//    the composed root default, and sets childclass/class on M's top-level worldbody
+//    elements and class on its assets, tendons, actuators, equalities and pairs that
+//    had none, so M's defaults never reach another model;
+//  - rewrites every angle into radians and every euler into quat (using M's
+//    compiler angle and eulerseq), so the composed compiler is angle="radian" with
+//    the default eulerseq; slide joints and camera fovy / light cutoff (always
+//    degrees in MJCF) are not touched;
+//  - applies the model pose X_WM to the top-level worldbody elements (bodies keep
+//    their free joints at the top level): pos/quat, geom and site fromto, light
+//    pos/dir, composite offset;
+//  - URDF files (a .urdf file, or any file whose root element is <robot>) go through
+//    ComposeOptions::urdf_to_mjcf first and are then composed like MJCF.
+//
+// sections: <option>, <visual>, <statistic> come from the first model that has them
+// (later differing <option>/<statistic> give a warning); <size> is combined
+// (njmax/nconmax summed, nuser_* maximum, nuserdata maximum, nstack see .cc);
+// compiler attributes other than angle/eulerseq/paths must agree, except
+// autolimits (true wins, which is safe: a model valid without it is unchanged),
+// usethread (any) and inertiafromgeom true vs auto (reconciled by dropping the
+// <inertial> of the "true" model). keyframes: each key K of model M becomes "M/K"
+// with full-length vectors: M's slice from K (free-joint and mocap poses placed by
+// M's pose), every other model at its reference configuration (qpos0, zero
+// velocity, act and ctrl, placed mocap poses). keys are dropped with a warning when
+// the vector sizes cannot be derived from the XML (e.g. <composite>).
+//
+// MJCF semantics follow the MuJoCo 2.2.2 XML reference and its reader
+// (src/xml/xml_native_reader.cc, src/user/user_objects.cc, mjCAlternative::Set).
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// options of ComposeWorld.
+struct ComposeOptions {
+  /// converts a URDF file into MJCF text (MuJoCo's own converter: mj_loadXML on the URDF,
+  /// then mj_saveLastXML); provided by the physics module, which owns mujoco.h. the
+  /// returned text's relative asset paths resolve against the URDF's folder. may throw
+  /// ConfigError. required only when a model is URDF.
+  std::function<std::string(const std::string& urdf_path)> urdf_to_mjcf;
+  /// overrides <option timestep> of the composed model (s, > 0).
+  std::optional<double> timestep_sec;
+};
+
+/// the result of ComposeWorld.
+struct ComposedScene {
+  /// one self-contained MJCF document: absolute asset paths, no <include>,
+  /// compiler angle="radian".
+  std::string mjcf_xml;
+  /// the models' names in input order; model M's MJCF names start with "M/".
+  std::vector<std::string> model_names;
+  /// things that were composed with a compromise (dropped keyframes, conflicting
+  /// <option> or <statistic> of later models, ...), one line each.
+  std::vector<std::string> warnings;
+};
+
+/// merges `models` (in order) into one MJCF document.
+/// @throws ConfigError naming the model file, line (when known), element/attribute and
+///         what was expected: empty or duplicate model names, names containing '/',
+///         missing model/include/asset files, XML syntax errors, unsupported elements,
+///         undefined names, compiler attributes that differ and cannot be reconciled.
+ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const ComposeOptions& options);
+
+/// writes scene.mjcf_xml to `path` (e.g. "<output_dir>/composed.xml").
+/// @throws ConfigError when the file cannot be written.
+void WriteComposedScene(const ComposedScene& scene, const std::string& path);
+
+}  // namespace penumbra
