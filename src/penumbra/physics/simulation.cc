@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "penumbra/core/error.h"
@@ -147,6 +148,9 @@ struct Simulation::Impl {
   std::string source;
   mjModel* m = nullptr;
   mjData* d = nullptr;
+  // scratch data for snapshots: recomputing kinematics in `d` between steps would
+  // change later contact results in the last bits (MuJoCo reuses some derived data)
+  mjData* snap_d = nullptr;
   SceneDescription scene;
   ModelInfo info;
   std::vector<std::unique_ptr<Controller>> controllers;
@@ -163,6 +167,7 @@ struct Simulation::Impl {
   std::string failure;
 
   ~Impl() {
+    if (snap_d) mj_deleteData(snap_d);
     if (d) mj_deleteData(d);
     if (m) mj_deleteModel(m);
   }
@@ -306,12 +311,14 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   if (timestep_sec) m->opt.timestep = *timestep_sec;
   try {
     impl->d = mj_makeData(m);
+    impl->snap_d = mj_makeData(m);
   } catch (const MujocoError& e) {
     throw PhysicsError(source + ": MuJoCo could not allocate the model's data: " + e.what());
   }
-  if (!impl->d) throw PhysicsError(source + ": MuJoCo could not allocate the model's data");
-  mjData* d = impl->d;
-  // position-dependent quantities at qpos0 for the scene (no change to the dynamics state)
+  if (!impl->d || !impl->snap_d)
+    throw PhysicsError(source + ": MuJoCo could not allocate the model's data");
+  mjData* d = impl->snap_d;
+  // position-dependent quantities at qpos0 for the scene
   try {
     mj_kinematics(m, d);
     mj_comPos(m, d);
@@ -329,7 +336,7 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   }
   impl->jacp.assign(3 * static_cast<size_t>(m->nv), 0.0);
   impl->jacr.assign(3 * static_cast<size_t>(m->nv), 0.0);
-  for (int w = 0; w < mjNWARNING; ++w) impl->seen_warnings[w] = d->warning[w].number;
+  for (int w = 0; w < mjNWARNING; ++w) impl->seen_warnings[w] = impl->d->warning[w].number;
   return impl;
 }
 
@@ -417,15 +424,19 @@ WorldSnapshot Simulation::Snapshot() const {
 
 void Simulation::Snapshot(WorldSnapshot* out) const {
   const mjModel* m = impl_->m;
-  mjData* d = impl_->d;
+  const mjData* live = impl_->d;
+  mjData* d = impl_->snap_d;
+  std::memcpy(d->qpos, live->qpos, sizeof(mjtNum) * m->nq);
+  std::memcpy(d->mocap_pos, live->mocap_pos, sizeof(mjtNum) * 3 * m->nmocap);
+  std::memcpy(d->mocap_quat, live->mocap_quat, sizeof(mjtNum) * 4 * m->nmocap);
   try {
     mj_kinematics(m, d);
     mj_comPos(m, d);
     mj_camlight(m, d);
   } catch (const MujocoError& e) {
-    throw PhysicsError(impl_->When(d->time, impl_->steps) + ": MuJoCo error: " + e.what());
+    throw PhysicsError(impl_->When(live->time, impl_->steps) + ": MuJoCo error: " + e.what());
   }
-  out->time_sec = d->time;
+  out->time_sec = live->time;
   out->step = impl_->steps;
   out->X_WB.resize(m->nbody);
   for (int b = 0; b < m->nbody; ++b)
@@ -447,8 +458,8 @@ void Simulation::Snapshot(WorldSnapshot* out) const {
     Eigen::Vector3d dir(d->light_xdir[3 * l], d->light_xdir[3 * l + 1], d->light_xdir[3 * l + 2]);
     out->light_direction_W[l] = dir.norm() > 0 ? dir.normalized() : Eigen::Vector3d(0, 0, -1);
   }
-  out->qpos.assign(d->qpos, d->qpos + m->nq);
-  out->qvel.assign(d->qvel, d->qvel + m->nv);
+  out->qpos.assign(live->qpos, live->qpos + m->nq);
+  out->qvel.assign(live->qvel, live->qvel + m->nv);
 }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }

@@ -69,9 +69,9 @@ class Simulation {
   double timestep() const;
 
   /// the world at the current time: X_WB of every body, MJCF camera poses and light
-  /// positions/directions, qpos, qvel. MuJoCo's position-dependent quantities are
-  /// refreshed for the current qpos first (mj_kinematics, mj_comPos, mj_camlight), which
-  /// does not change the trajectory.
+  /// positions/directions, qpos, qvel. poses are computed for the current qpos (and mocap
+  /// poses) with mj_kinematics, mj_comPos and mj_camlight on a scratch copy, so taking
+  /// snapshots never changes the trajectory.
   WorldSnapshot Snapshot() const;
   /// as Snapshot(), reusing `out`'s storage.
   void Snapshot(WorldSnapshot* out) const;
