@@ -1,5 +1,6 @@
 #include "penumbra/render/bsdf.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 

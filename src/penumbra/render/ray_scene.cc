@@ -446,6 +446,7 @@ void RayScene::Update(const WorldSnapshot& snapshot) {
   }
   if (changed) {
     rtcCommitScene(m.top);
+    ++num_top_level_commits_;
     m.Check("updating body poses");
   }
 }

@@ -103,6 +103,10 @@ class RayScene {
   /// the scene this was built from.
   const SceneDescription& scene() const { return scene_; }
 
+  /// how many times Update recommitted the top-level scene (bodies moved); body scenes are
+  /// never rebuilt after construction.
+  int64_t num_top_level_commits() const { return num_top_level_commits_; }
+
   /// how many geoms are ray traced (visible) and how many triangles they hold.
   int num_visible_geoms() const { return num_visible_geoms_; }
   int64_t num_triangles() const { return num_triangles_; }
@@ -114,6 +118,7 @@ class RayScene {
   std::vector<Pose> X_WB_;
   int num_visible_geoms_ = 0;
   int64_t num_triangles_ = 0;
+  int64_t num_top_level_commits_ = 0;
 };
 
 }  // namespace penumbra
