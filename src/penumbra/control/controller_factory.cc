@@ -36,7 +36,9 @@ std::unique_ptr<Controller> MakeController(const ControllerConfig& cfg,
                                            const std::string& robot_name,
                                            const std::string& world_file) {
   if (cfg.type.empty()) return nullptr;
-  ControllerContext context{world_file, cfg.line, "robots[" + robot_name + "].controller"};
+  ControllerContext context{
+      world_file, cfg.line,
+      robot_name.empty() ? "controller" : "robots[" + robot_name + "].controller"};
   const auto it = Registry().find(cfg.type);
   if (it == Registry().end()) {
     std::string known;

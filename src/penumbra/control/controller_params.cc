@@ -18,7 +18,8 @@ namespace {
 
 std::string Repr(const YAML::Node& n) {
   if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list";
+  if (n.IsSequence())
+    return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
   if (n.IsMap()) return "a mapping";
   return "nothing";
 }

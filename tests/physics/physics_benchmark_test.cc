@@ -1,0 +1,31 @@
+// the physics benchmark runs both loops over the same number of steps (no timing
+// assertions: timings never decide pass/fail).
+
+#include "penumbra/physics/physics_benchmark.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+TEST(PhysicsBenchmark, RunsBothLoopsForTheRequestedSimTime) {
+  const std::string path = ::testing::TempDir() + "/bench_model.xml";
+  std::ofstream(path) << R"(<mujoco><option timestep="0.005"/><worldbody>
+    <geom type="plane" size="2 2 0.1"/>
+    <body pos="0 0 0.3"><freejoint/><geom type="box" size=".1 .1 .1"/></body>
+  </worldbody></mujoco>)";
+  const PhysicsBenchResult r = BenchmarkPhysics(path, 1.0);
+  EXPECT_EQ(r.steps, 200);
+  EXPECT_GT(r.penumbra_steps_per_sec, 0);
+  EXPECT_GT(r.bare_steps_per_sec, 0);
+  EXPECT_NEAR(r.ratio, r.penumbra_steps_per_sec / r.bare_steps_per_sec, 1e-12);
+  EXPECT_THROW(BenchmarkPhysics(path, 0), ConfigError);
+  EXPECT_THROW(BenchmarkPhysics("/nonexistent.xml", 1), ConfigError);
+}
+
+}  // namespace
+}  // namespace penumbra
