@@ -229,6 +229,15 @@ void ModelComposer::CollectNames() {
         composite_prefixes_.push_back(p ? p : "");
       }
       if (!spec.defines || *spec.defines == NameKind::kClass) return;
+      // an unnamed mesh, skin, hfield or texture is named after its file (MuJoCo 2.2.2)
+      if (section == "asset" && !e->Attribute("name") && e->Attribute("file") &&
+          (Is(e, "mesh") || Is(e, "skin") || Is(e, "hfield") || Is(e, "texture"))) {
+        std::string stem = StripPath(e->Attribute("file"));
+        if (const size_t dot = stem.find_last_of('.'); dot != std::string::npos) {
+          stem.resize(dot);
+        }
+        e->SetAttribute("name", stem.c_str());
+      }
       const char* name = e->Attribute(spec.name_attr);
       if (name == nullptr) return;
       auto& table = names_[static_cast<int>(*spec.defines)];
@@ -478,6 +487,7 @@ void ModelComposer::CountActuators() {
         dyn = tag == "intvelocity" || tag == "cylinder" || tag == "muscle";
       }
       if (dyn) ++sizes_.na;
+      sizes_.actuator_stateful.push_back(dyn);
     }
   }
 }
@@ -599,12 +609,8 @@ void ModelComposer::Rename() {
         section == "statistic") {
       continue;
     }
+    // references first, so that error messages show the names as written
     VisitSection(*src_, section, sec, [&](XMLElement* e, const ElementSpec& spec) {
-      if (spec.defines) {
-        if (const char* n = e->Attribute(spec.name_attr)) {
-          e->SetAttribute(spec.name_attr, (prefix_ + n).c_str());
-        }
-      }
       for (const auto& [attr, kind] : spec.refs) {
         if (const char* v = e->Attribute(attr)) {
           e->SetAttribute(attr, ResolveRef(e, Key(e, attr), kind, v).c_str());
@@ -629,6 +635,12 @@ void ModelComposer::Rename() {
       if (Is(e, "composite")) {
         const char* p = e->Attribute("prefix");
         e->SetAttribute("prefix", (prefix_ + (p ? p : "")).c_str());
+      }
+    });
+    VisitSection(*src_, section, sec, [&](XMLElement* e, const ElementSpec& spec) {
+      if (!spec.defines) return;
+      if (const char* n = e->Attribute(spec.name_attr)) {
+        e->SetAttribute(spec.name_attr, (prefix_ + n).c_str());
       }
     });
   }

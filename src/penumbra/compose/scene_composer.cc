@@ -402,18 +402,35 @@ void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root) {
   }
 }
 
-// appends the children of every model's `section` elements to one composed section
+// appends the children of every model's `section` elements to one composed section.
+// actuators: MuJoCo 2.2.2 requires stateless actuators before stateful ones, so all
+// models' stateless actuators come first, then all stateful ones (each in model order)
 void ComposeSection(const Models& models, const std::string& section, XMLDocument* doc,
                     XMLElement* root) {
   XMLElement* out = nullptr;
-  for (const auto& m : models) {
-    for (XMLElement* s : m->Sections(section)) {
-      for (XMLElement* c = s->FirstChildElement(); c; c = c->NextSiblingElement()) {
-        if (!out) out = root->InsertNewChildElement(section.c_str());
-        out->InsertEndChild(c->DeepClone(doc));
+  const bool actuators = section == "actuator";
+  for (int pass = 0; pass < (actuators ? 2 : 1); ++pass) {
+    for (const auto& m : models) {
+      size_t index = 0;
+      for (XMLElement* s : m->Sections(section)) {
+        for (XMLElement* c = s->FirstChildElement(); c; c = c->NextSiblingElement(), ++index) {
+          if (actuators && m->sizes().actuator_stateful.at(index) != (pass == 1)) continue;
+          if (!out) out = root->InsertNewChildElement(section.c_str());
+          out->InsertEndChild(c->DeepClone(doc));
+        }
       }
     }
   }
+}
+
+// splits a model's ctrl vector into its stateless and stateful parts
+std::pair<std::vector<double>, std::vector<double>> SplitCtrl(const std::vector<bool>& stateful,
+                                                              const std::vector<double>& ctrl) {
+  std::pair<std::vector<double>, std::vector<double>> out;
+  for (size_t i = 0; i < ctrl.size(); ++i) {
+    (stateful[i] ? out.second : out.first).push_back(ctrl[i]);
+  }
+  return out;
 }
 
 // keys: each model's key becomes "M/K" with the other models at their reference state
@@ -449,7 +466,7 @@ int ComposeKeys(const Models& models, XMLElement* root, std::vector<std::string>
         continue;
       }
       m.PlaceKey(&key);
-      std::vector<double> qpos, qvel, act, ctrl, mpos, mquat;
+      std::vector<double> qpos, qvel, act, ctrl, ctrl_stateful, mpos, mquat;
       for (size_t j = 0; j < models.size(); ++j) {
         const auto& s = models[j]->sizes();
         const bool own = j == mi;
@@ -459,10 +476,14 @@ int ComposeKeys(const Models& models, XMLElement* root, std::vector<std::string>
         append(&qpos, own && key.qpos ? *key.qpos : s.qpos0);
         append(&qvel, own && key.qvel ? *key.qvel : std::vector<double>(s.nv, 0.0));
         append(&act, own && key.act ? *key.act : std::vector<double>(s.na, 0.0));
-        append(&ctrl, own && key.ctrl ? *key.ctrl : std::vector<double>(s.nu, 0.0));
+        const auto [sl, sf] = SplitCtrl(
+            s.actuator_stateful, own && key.ctrl ? *key.ctrl : std::vector<double>(s.nu, 0.0));
+        append(&ctrl, sl);
+        append(&ctrl_stateful, sf);
         append(&mpos, own && key.mpos ? *key.mpos : s.mocap_pos);
         append(&mquat, own && key.mquat ? *key.mquat : s.mocap_quat);
       }
+      ctrl.insert(ctrl.end(), ctrl_stateful.begin(), ctrl_stateful.end());
       if (!section) section = root->InsertNewChildElement("keyframe");
       XMLElement* k = section->InsertNewChildElement("key");
       if (key.name) k->SetAttribute("name", (m.prefix() + *key.name).c_str());

@@ -33,7 +33,11 @@
 // compiler attributes other than angle/eulerseq/paths must agree, except
 // autolimits (true wins, which is safe: a model valid without it is unchanged),
 // usethread (any) and inertiafromgeom true vs auto (reconciled by dropping the
-// <inertial> of the "true" model). keyframes: each key K of model M becomes "M/K"
+// <inertial> of the "true" model).
+// actuators: MuJoCo 2.2.2 wants stateless actuators before stateful ones, so the
+// composed <actuator> lists every model's stateless actuators, then every model's
+// stateful ones (each group in model order); look actuators up by name.
+// keyframes: each key K of model M becomes "M/K"
 // with full-length vectors: M's slice from K (free-joint and mocap poses placed by
 // M's pose), every other model at its reference configuration (qpos0, zero
 // velocity, act and ctrl, placed mocap poses). keys are dropped with a warning when
