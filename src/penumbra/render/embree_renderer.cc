@@ -5,18 +5,20 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/path_integrator.h"
 #include "penumbra/render/realtime_integrator.h"
 
 namespace penumbra {
 namespace {
 
 // the integrator of a tier: the one place that maps tiers to light-transport algorithms.
-std::unique_ptr<Integrator> MakeIntegrator(const RenderSettings& settings) {
+std::unique_ptr<Integrator> MakeIntegrator(const RenderSettings& settings,
+                                           const SceneDescription& scene) {
   switch (settings.tier) {
     case RenderSettings::Tier::kRealtime:
       return std::make_unique<RealtimeIntegrator>();
     case RenderSettings::Tier::kPathtraced:
-      throw Error("pathtraced tier not built");
+      return std::make_unique<PathIntegrator>(scene);
   }
   throw Error("unknown render tier");
 }
@@ -37,7 +39,7 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       sky_(scene_.sky),
       film_(settings_),
       pool_(settings_.threads),
-      integrator_(MakeIntegrator(settings_)) {
+      integrator_(MakeIntegrator(settings_, scene_)) {
   if (settings_.tier == RenderSettings::Tier::kPathtraced && settings_.denoise)
     denoiser_ = std::make_unique<Denoiser>();
 }

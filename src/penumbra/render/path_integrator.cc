@@ -1,0 +1,350 @@
+#include "penumbra/render/path_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "penumbra/render/bsdf.h"
+
+namespace penumbra {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// shadow rays towards a point at distance d stop this fraction short of it.
+constexpr float kShadowShorten = 1e-4f;
+
+// power heuristic with beta = 2 (Veach 1997, eq. 9.13) for a sample drawn with density
+// pdf_a, the other strategy having density pdf_b.
+inline float PowerHeuristic(float pdf_a, float pdf_b) {
+  if (!(pdf_a > 0)) return 0.0f;
+  if (std::isinf(pdf_a)) return 1.0f;
+  const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+  if (std::isinf(b)) return 0.0f;
+  return a / (a + b);
+}
+
+// 1 - cos(theta_max) of the cone a sphere of radius r subtends at centre distance d > r.
+inline float OneMinusCosCone(float r, float d) {
+  const float sin2 = std::min(1.0f, (r * r) / (d * d));
+  return sin2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - sin2)));
+}
+
+// cubic smoothstep from e0 (0) to e1 (1), as LightSampler's spot factor.
+inline float SmoothStep(float e0, float e1, float x) {
+  if (e1 <= e0) return x >= e0 ? 1.0f : 0.0f;
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+// a point or spot light with a radius that casts shadows: a sphere that rays can hit.
+struct Lamp {
+  int light = -1;  // index into LightSampler::lights()
+  Eigen::Vector3f c{0, 0, 0};
+  float r = 0;
+  const PosedLight* posed = nullptr;
+
+  // radiance (cd/m^2) the sphere sends towards world point p: I s / (pi r^2).
+  Eigen::Vector3f RadianceTowards(const Eigen::Vector3f& p) const {
+    float atten = 1.0f;
+    if (posed->type == Light::Type::kSpot) {
+      const Eigen::Vector3f d = p - c;
+      const float n = d.norm();
+      if (!(n > 0)) return Eigen::Vector3f::Zero();
+      atten = SmoothStep(posed->cos_outer, posed->cos_inner, d.dot(posed->direction_W) / n);
+    }
+    return posed->intensity_rgb * (atten / (kPi * r * r));
+  }
+  // solid angle of the sphere seen from p (outside), 0 from inside.
+  float SolidAngle(const Eigen::Vector3f& p) const {
+    const float d = (c - p).norm();
+    if (!(d > r)) return 0.0f;
+    return 2 * kPi * OneMinusCosCone(r, d);
+  }
+  // nearest t in (tmin, tmax) where o + t d (d unit) meets the sphere from outside.
+  bool Intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmin, float tmax,
+                 float* t) const {
+    const Eigen::Vector3f oc = o - c;
+    const float c2 = oc.squaredNorm() - r * r;
+    if (c2 <= 0) return false;  // origin inside the lamp
+    const float b = oc.dot(d);
+    if (b >= 0) return false;  // sphere behind
+    // discriminant from the closest approach (Pharr, Jakob, Humphreys, PBR 4th ed., 6.8.1).
+    const Eigen::Vector3f q = oc - b * d;
+    const float disc = r * r - q.squaredNorm();
+    if (disc < 0) return false;
+    const float root = -b - std::sqrt(disc);
+    if (!(root > tmin && root < tmax)) return false;
+    *t = root;
+    return true;
+  }
+};
+
+// a directional light with an angular radius that casts shadows: a disc in the sky.
+struct SunDisc {
+  int light = -1;
+  Eigen::Vector3f to_sun{0, 0, 1};
+  float cos_max = 1;
+  float solid_angle = 0;
+  Eigen::Vector3f L{0, 0, 0};  // E / Omega, cd/m^2
+};
+
+// the frame's lights as this integrator sees them.
+struct FrameLights {
+  std::vector<Lamp> lamps;
+  std::vector<SunDisc> suns;
+  std::vector<int> lamp_of_light, sun_of_light;  // per light: index or -1
+  bool sky_active = false;
+
+  explicit FrameLights(const FrameContext& ctx) {
+    const std::vector<PosedLight>& pl = ctx.lights->lights();
+    lamp_of_light.assign(pl.size(), -1);
+    sun_of_light.assign(pl.size(), -1);
+    for (size_t i = 0; i < pl.size(); ++i) {
+      const PosedLight& l = pl[i];
+      if (!l.cast_shadow) continue;
+      if (l.type == Light::Type::kDirectional) {
+        if (!(l.cos_angular_radius < 1.0f)) continue;
+        SunDisc s;
+        s.light = static_cast<int>(i);
+        s.to_sun = -l.direction_W;
+        s.cos_max = l.cos_angular_radius;
+        s.solid_angle = 2 * kPi * (1.0f - l.cos_angular_radius);
+        if (!(s.solid_angle > 0)) continue;
+        s.L = l.intensity_rgb / s.solid_angle;
+        sun_of_light[i] = static_cast<int>(suns.size());
+        suns.push_back(s);
+      } else if (l.radius_m > 0) {
+        Lamp lamp;
+        lamp.light = static_cast<int>(i);
+        lamp.c = l.position_W;
+        lamp.r = l.radius_m;
+        lamp.posed = &l;
+        lamp_of_light[i] = static_cast<int>(lamps.size());
+        lamps.push_back(lamp);
+      }
+    }
+    const Eigen::Vector3f up = ctx.sky->Irradiance({0, 0, 1});
+    const Eigen::Vector3f down = ctx.sky->Irradiance({0, 0, -1});
+    sky_active = up.maxCoeff() > 0 || down.maxCoeff() > 0;
+  }
+
+  // the nearest lamp hit by o + t d (d unit) for t in (tmin, tmax), or -1.
+  int NearestLamp(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmin, float tmax,
+                  float* t_out, int skip = -1) const {
+    int best = -1;
+    float best_t = tmax;
+    for (size_t k = 0; k < lamps.size(); ++k) {
+      if (static_cast<int>(k) == skip) continue;
+      float t;
+      if (lamps[k].Intersect(o, d, tmin, best_t, &t)) best = static_cast<int>(k), best_t = t;
+    }
+    *t_out = best_t;
+    return best;
+  }
+  bool LampBlocks(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmax,
+                  int skip = -1) const {
+    float t;
+    return !lamps.empty() && NearestLamp(o, d, 0.0f, tmax, &t, skip) >= 0;
+  }
+};
+
+}  // namespace
+
+PathIntegrator::PathIntegrator(const SceneDescription& scene) : emitters_(scene) {}
+
+int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
+                                   const FrameBuffers& out) const {
+  const FrameLights fl(ctx);
+  const RayScene& scene = *ctx.scene;
+  const std::vector<Pose>& X_WB = scene.X_WB();
+  const int spp = std::max(1, ctx.settings->samples_per_pixel);
+  const int max_bounces = std::max(1, ctx.settings->max_bounces);
+  const int num_lights = ctx.lights->size();
+  const PixelTile& tile = primary.tile;
+  int64_t rays = 0;
+
+  for (int i = 0; i < tile.width * tile.height; ++i) {
+    const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+    double sum[3] = {0, 0, 0};
+    double albedo_sum[3] = {0, 0, 0};
+    int albedo_count = 0;
+
+    for (int s = 0; s < spp; ++s) {
+      Rng rng(ctx.PixelStream(u, v, s));
+      const float jx = rng.Uniform(), jy = rng.Uniform();
+      const Ray cam = ctx.camera->GenerateRay(static_cast<float>(u) + jx - 0.5f,
+                                              static_cast<float>(v) + jy - 0.5f);
+      Ray ray;
+      ray.o = cam.o;
+      ray.d = cam.d.normalized();
+
+      Eigen::Vector3f L(0, 0, 0), beta(1, 1, 1);
+      float prev_pdf = 0;  // BSDF density of the direction that led here
+      Eigen::Vector3f prev_p(0, 0, 0);
+      bool from_camera = true;
+
+      for (int vertex = 0;; ++vertex) {
+        SurfaceHit hit;
+        const bool found = scene.Intersect(ray, &hit);
+        ++rays;
+        const float t_surface = found ? hit.t : kInf;
+
+        // a lamp sphere in front of the surface ends the path.
+        float t_lamp;
+        const int lamp =
+            fl.lamps.empty() ? -1 : fl.NearestLamp(ray.o, ray.d, ray.tmin, t_surface, &t_lamp);
+        if (lamp >= 0) {
+          const Lamp& lp = fl.lamps[lamp];
+          float w = 1.0f;
+          if (!from_camera) {
+            const float omega = lp.SolidAngle(prev_p);
+            w = PowerHeuristic(prev_pdf, omega > 0 ? 1.0f / omega : 0.0f);
+          }
+          L += w * beta.cwiseProduct(lp.RadianceTowards(ray.o));
+          break;
+        }
+
+        if (!found) {
+          // the ray leaves the scene: sky and sun discs.
+          if (fl.sky_active) {
+            const float w = from_camera ? 1.0f : PowerHeuristic(prev_pdf, ctx.sky->Pdf(ray.d));
+            L += w * beta.cwiseProduct(ctx.sky->Radiance(ray.d));
+          }
+          for (const SunDisc& sun : fl.suns) {
+            if (ray.d.dot(sun.to_sun) < sun.cos_max) continue;
+            const float w = from_camera ? 1.0f : PowerHeuristic(prev_pdf, 1.0f / sun.solid_angle);
+            L += w * beta.cwiseProduct(sun.L);
+          }
+          break;
+        }
+
+        const SurfaceMaterial mat = ctx.materials->Evaluate(hit);
+        if (vertex == 0) {
+          for (int k = 0; k < 3; ++k) albedo_sum[k] += mat.pbr.base_color[k];
+          ++albedo_count;
+        }
+        if (mat.emission.maxCoeff() > 0) {
+          float w = 1.0f;
+          if (!from_camera)
+            w = PowerHeuristic(prev_pdf, emitters_.Pdf(X_WB, hit.geom, prev_p, hit.p_W, hit.ng_W));
+          L += w * beta.cwiseProduct(mat.emission);
+        }
+        if (vertex >= max_bounces) break;
+
+        const Eigen::Vector3f wo = -ray.d;
+        const Bsdf bsdf(mat.pbr, hit.ns_W, hit.ng_W, wo);
+
+        // next-event estimation: every analytic light.
+        for (int j = 0; j < num_lights; ++j) {
+          const float u1 = rng.Uniform(), u2 = rng.Uniform();
+          LightSample ls;
+          if (!ctx.lights->Sample(j, hit.p_W, u1, u2, &ls)) continue;
+          const Eigen::Vector3f f = bsdf.Eval(ls.wi);
+          if (!(f.maxCoeff() > 0)) continue;
+          Eigen::Vector3f c;
+          const int sun = fl.sun_of_light[j], lamp_j = fl.lamp_of_light[j];
+          if (sun >= 0) {
+            // uniform in the disc's cone: f E = f L Omega, weighted against BSDF sampling.
+            c = f.cwiseProduct(ls.E) *
+                PowerHeuristic(1.0f / fl.suns[sun].solid_angle, bsdf.Pdf(ls.wi));
+          } else if (lamp_j >= 0) {
+            const Lamp& lp = fl.lamps[lamp_j];
+            const float omega = lp.SolidAngle(hit.p_W);
+            if (!(omega > 0)) continue;
+            c = f.cwiseProduct(lp.RadianceTowards(hit.p_W)) *
+                (omega * PowerHeuristic(1.0f / omega, bsdf.Pdf(ls.wi)));
+          } else {
+            c = f.cwiseProduct(ls.E);
+          }
+          if (!(c.maxCoeff() > 0)) continue;
+          if (ls.cast_shadow) {
+            Ray sr = SpawnRay(hit, ls.wi);
+            sr.tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - kShadowShorten);
+            ++rays;
+            if (scene.Occluded(sr) || fl.LampBlocks(sr.o, sr.d, sr.tmax, lamp_j)) continue;
+          }
+          L += beta.cwiseProduct(c);
+        }
+
+        // next-event estimation: the sky.
+        if (fl.sky_active) {
+          const float u1 = rng.Uniform(), u2 = rng.Uniform();
+          float pdf = 0;
+          const Eigen::Vector3f wi = ctx.sky->Sample(u1, u2, &pdf);
+          if (pdf > 0) {
+            const Eigen::Vector3f f = bsdf.Eval(wi);
+            if (f.maxCoeff() > 0) {
+              const Ray sr = SpawnRay(hit, wi);
+              ++rays;
+              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, sr.d, kInf)) {
+                const float w = PowerHeuristic(pdf, bsdf.Pdf(wi));
+                L += (w / pdf) * beta.cwiseProduct(f.cwiseProduct(ctx.sky->Radiance(wi)));
+              }
+            }
+          }
+        }
+
+        // next-event estimation: one emissive geom.
+        if (!emitters_.empty()) {
+          const float u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+          EmitterSample es;
+          if (emitters_.Sample(X_WB, hit.p_W, u0, u1, u2, &es)) {
+            const Eigen::Vector3f f = bsdf.Eval(es.wi);
+            if (f.maxCoeff() > 0) {
+              const Ray sr = SpawnRayTo(hit, es.p_W);
+              ++rays;
+              const float dist = (es.p_W - sr.o).norm() * sr.tmax;
+              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, es.wi, dist)) {
+                const float w = PowerHeuristic(es.pdf, bsdf.Pdf(es.wi));
+                L += (w / es.pdf) * beta.cwiseProduct(f.cwiseProduct(es.Le));
+              }
+            }
+          }
+        }
+
+        // Russian roulette, then continue along a BSDF sample.
+        if (vertex >= kRussianRouletteStartVertex) {
+          const float q = std::min(1.0f, beta.maxCoeff());
+          if (!(rng.Uniform() < q)) break;
+          beta /= q;
+        }
+        const float ul = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+        BsdfSample bs;
+        if (!bsdf.Sample(ul, u1, u2, &bs)) break;
+        beta = beta.cwiseProduct(bs.f_cos) / bs.pdf;
+        if (!(beta.maxCoeff() > 0) || !beta.allFinite()) break;
+        prev_pdf = bs.pdf;
+        prev_p = hit.p_W;
+        from_camera = false;
+        ray = SpawnRay(hit, bs.wi);
+      }
+
+      if (!L.allFinite()) continue;  // dropped (see header)
+      for (int k = 0; k < 3; ++k) sum[k] += L[k];
+    }
+
+    float* px = out.radiance->at(u, v);
+    for (int k = 0; k < 3; ++k) px[k] = static_cast<float>(sum[k] / spp);
+    if (out.albedo) {
+      float* a = out.albedo->at(u, v);
+      for (int k = 0; k < 3; ++k)
+        a[k] = albedo_count > 0 ? static_cast<float>(albedo_sum[k] / albedo_count) : 0.0f;
+    }
+    if (out.normal) {
+      float* nn = out.normal->at(u, v);
+      if (primary.did_hit[i]) {
+        const SurfaceHit& h = primary.hits[i];
+        const Eigen::Vector3f wo = -primary.rays[i].d.normalized();
+        const Eigen::Vector3f n = h.ns_W.dot(wo) > 0 ? h.ns_W : h.ng_W;
+        nn[0] = n.x(), nn[1] = n.y(), nn[2] = n.z();
+      } else {
+        nn[0] = nn[1] = nn[2] = 0.0f;
+      }
+    }
+  }
+  return rays;
+}
+
+}  // namespace penumbra

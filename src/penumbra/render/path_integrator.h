@@ -1,0 +1,60 @@
+#pragma once
+// the `pathtraced` tier: unidirectional path tracing with next-event estimation and multiple
+// importance sampling (Veach, "Robust Monte Carlo methods for light transport simulation",
+// PhD thesis, Stanford 1997, ch. 9; power heuristic with beta = 2).
+//
+// per pixel, settings.samples_per_pixel paths, each from a camera ray jittered uniformly over
+// the pixel (box filter). at every surface vertex, up to settings.max_bounces of them:
+//   - emission Le of the surface (Material::emission, two-sided) is added: with weight 1 when
+//     seen by the camera ray, else MIS-weighted against the emitter sampling of the previous
+//     vertex (EmitterSampler::Pdf; weight 1 for shapes it does not sample);
+//   - next-event estimation, one sample per light, each with a shadow ray:
+//       point / spot / directional lights without extent, and lights that cast no shadow:
+//         delta lights, weight 1 (LightSampler);
+//       directional lights with an angular radius (sun disc, radiance E / Omega_cone) and
+//       point / spot lamps with a radius (spheres of radiance I s / (pi r^2), s the spot
+//       factor towards the shading point): uniform cone sampling (LightSampler), MIS-weighted;
+//       the sky (SkyModel::Sample), MIS-weighted; one emissive geom picked by power
+//       (EmitterSampler), MIS-weighted;
+//   - the BSDF (bsdf.h) samples the next direction; rays that leave the scene add the sky and
+//     any sun disc they point into, rays that meet a lamp sphere add its radiance and end,
+//     both MIS-weighted against the light sampling at the vertex they left (camera rays: 1).
+// lamp spheres and sun discs are thus visible to every ray in this tier (they are not in the
+// realtime tier); lamps also block shadow rays towards other lights. with max_bounces = b a
+// path gathers light that scattered at most b times (b = 1: direct lighting).
+// Russian roulette from the 4th vertex on (after 3 bounces): a path continues with probability
+// q = min(1, max channel of its throughput) and is reweighted by 1 / q (unbiased).
+//
+// outputs per pixel: the mean radiance; the denoiser guides (FrameBuffers): albedo = mean base
+// colour of the first surface over the samples that hit one, normal = shading normal of the
+// pixel-centre hit (consistent with the renderer's depth image). non-finite path values are
+// dropped (counted as zero).
+//
+// random numbers: every path draws from Rng(ctx.PixelStream(u, v, s)) only, so images are
+// bit-identical for any thread count and tile order.
+
+#include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/integrator.h"
+
+namespace penumbra {
+
+/// Russian roulette starts at this path vertex index (0 = first hit), i.e. after 3 bounces.
+constexpr int kRussianRouletteStartVertex = 3;
+
+/// unidirectional path tracer with NEE and MIS. immutable after construction, thread-safe.
+class PathIntegrator final : public Integrator {
+ public:
+  /// collects the emissive geoms of `scene` (which must outlive this object).
+  /// @throws Error if an emissive mesh geom refers to a missing mesh.
+  explicit PathIntegrator(const SceneDescription& scene);
+
+  int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
+                     const FrameBuffers& out) const override;
+
+  const EmitterSampler& emitters() const { return emitters_; }
+
+ private:
+  EmitterSampler emitters_;
+};
+
+}  // namespace penumbra
