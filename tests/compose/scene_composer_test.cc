@@ -78,9 +78,8 @@ std::string UrdfToMjcf(const std::string& urdf_path) {
   char err[1000] = "";
   mjModel* m = mj_loadXML(urdf_path.c_str(), nullptr, err, sizeof(err));
   if (!m) throw ConfigError(urdf_path, 0, "", std::string("MuJoCo: ") + err);
-  const std::string out = (fs::temp_directory_path() /
-                           ("penumbra_urdf_" + std::to_string(getpid()) + ".xml"))
-                              .string();
+  const std::string out =
+      (fs::temp_directory_path() / ("penumbra_urdf_" + std::to_string(getpid()) + ".xml")).string();
   const int ok = mj_saveLastXML(out.c_str(), m, err, sizeof(err));
   mj_deleteModel(m);
   if (!ok) throw ConfigError(urdf_path, 0, "", std::string("MuJoCo save: ") + err);
@@ -193,7 +192,8 @@ void ExpectSameModel(const mjModel* comp, const std::string& prefix, const mjMod
       ExpectNear3(V3(comp->geom_pos + 3 * cg), V3(alone->geom_pos + 3 * g), 1e-9, what);
       ExpectSameRotation(Q(comp->geom_quat + 4 * cg), Q(alone->geom_quat + 4 * g), what);
       ExpectNear3(V3(comp->geom_size + 3 * cg), V3(alone->geom_size + 3 * g), 1e-9, what);
-      for (int i = 0; i < 4; ++i) EXPECT_EQ(comp->geom_rgba[4 * cg + i], alone->geom_rgba[4 * g + i]);
+      for (int i = 0; i < 4; ++i)
+        EXPECT_EQ(comp->geom_rgba[4 * cg + i], alone->geom_rgba[4 * g + i]);
       EXPECT_EQ(comp->geom_contype[cg], alone->geom_contype[g]) << what;
       EXPECT_EQ(comp->geom_condim[cg], alone->geom_condim[g]) << what;
       EXPECT_EQ(comp->geom_friction[3 * cg], alone->geom_friction[3 * g]) << what;
@@ -355,7 +355,16 @@ constexpr const char* kRobot = R"(
   </contact>
   <equality>
     <joint name="couple" joint1="elbow" joint2="shoulder" polycoef="0 0.5 0 0 0" active="false"/>
+    <weld name="pin" body1="ball_link" body2="world" active="false"/>
   </equality>
+  <custom>
+    <numeric name="gains" data="1 2 3"/>
+    <text name="note" data="hello"/>
+    <tuple name="links">
+      <element objtype="body" objname="upper" prm="1"/>
+      <element objtype="joint" objname="elbow" prm="2"/>
+    </tuple>
+  </custom>
   <tendon>
     <fixed name="sum">
       <joint joint="shoulder" coef="1"/>
@@ -370,6 +379,7 @@ constexpr const char* kRobot = R"(
     <motor name="m_shoulder" joint="shoulder"/>
     <position name="p_elbow" joint="elbow" kp="10"/>
     <motor name="m_sum" tendon="sum" gear="2"/>
+    <general name="g_site" site="imu" refsite="anchor" gear="0 0 1 0 0 0"/>
     <general name="g_extend" joint="extend" dyntype="filter" dynprm="0.1"/>
   </actuator>
   <sensor>
@@ -379,9 +389,10 @@ constexpr const char* kRobot = R"(
     <tendonpos name="s_sum" tendon="sum"/>
     <actuatorfrc name="s_act" actuator="m_shoulder"/>
     <subtreecom name="s_com" body="base"/>
+    <framequat name="s_rel" objtype="site" objname="imu" reftype="body" refname="upper"/>
   </sensor>
   <keyframe>
-    <key name="home" qpos="0.3 0 0.6 1 0 0 0  0.2 -0.4 0.05  1 0 0 0" ctrl="0.1 0.2 0.3 0.4" act="0.5"/>
+    <key name="home" qpos="0.3 0 0.6 1 0 0 0  0.2 -0.4 0.05  1 0 0 0" ctrl="0.1 0.2 0.3 0.35 0.4" act="0.5"/>
   </keyframe>
 </mujoco>
 )";
@@ -403,8 +414,8 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
 
   const Pose X_b = PoseFromXyzRpyDeg({2, 1, 0}, {0, 0, 90});
   ComposedScene scene;
-  ModelPtr m = ComposeAndLoad(
-      {Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, dir, &scene);
+  ModelPtr m =
+      ComposeAndLoad({Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, dir, &scene);
   ASSERT_TRUE(m);
   EXPECT_EQ(scene.model_names, (std::vector<std::string>{"a", "b"}));
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
@@ -435,13 +446,23 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
     EXPECT_GE(Id(m.get(), mjOBJ_BODY, std::string("b/") + name), 0) << name;
     EXPECT_LT(Id(m.get(), mjOBJ_BODY, name), 0) << name;
   }
-  for (const auto& [type, name] : std::vector<std::pair<mjtObj, std::string>>{
-           {mjOBJ_JOINT, "shoulder"}, {mjOBJ_GEOM, "terrain"},      {mjOBJ_SITE, "imu"},
-           {mjOBJ_CAMERA, "wrist_cam"}, {mjOBJ_LIGHT, "lamp"},      {mjOBJ_MESH, "tetra"},
-           {mjOBJ_HFIELD, "ground"},  {mjOBJ_TEXTURE, "checker"},   {mjOBJ_MATERIAL, "mat"},
-           {mjOBJ_TENDON, "cable"},   {mjOBJ_ACTUATOR, "g_extend"}, {mjOBJ_SENSOR, "s_frame"},
-           {mjOBJ_EQUALITY, "couple"}, {mjOBJ_EXCLUDE, "no_self"},  {mjOBJ_PAIR, "p"},
-           {mjOBJ_KEY, "home"}}) {
+  for (const auto& [type, name] :
+       std::vector<std::pair<mjtObj, std::string>>{{mjOBJ_JOINT, "shoulder"},
+                                                   {mjOBJ_GEOM, "terrain"},
+                                                   {mjOBJ_SITE, "imu"},
+                                                   {mjOBJ_CAMERA, "wrist_cam"},
+                                                   {mjOBJ_LIGHT, "lamp"},
+                                                   {mjOBJ_MESH, "tetra"},
+                                                   {mjOBJ_HFIELD, "ground"},
+                                                   {mjOBJ_TEXTURE, "checker"},
+                                                   {mjOBJ_MATERIAL, "mat"},
+                                                   {mjOBJ_TENDON, "cable"},
+                                                   {mjOBJ_ACTUATOR, "g_extend"},
+                                                   {mjOBJ_SENSOR, "s_frame"},
+                                                   {mjOBJ_EQUALITY, "couple"},
+                                                   {mjOBJ_EXCLUDE, "no_self"},
+                                                   {mjOBJ_PAIR, "p"},
+                                                   {mjOBJ_KEY, "home"}}) {
     EXPECT_GE(Id(m.get(), type, "a/" + name), 0) << name;
     EXPECT_GE(Id(m.get(), type, "b/" + name), 0) << name;
   }
@@ -453,7 +474,9 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
   // b's actuators drive b's joints and tendons
   for (int a = 0; a < m->nu; ++a) {
     const std::string act = Name(m.get(), mjOBJ_ACTUATOR, a);
-    const mjtObj t = m->actuator_trntype[a] == mjTRN_TENDON ? mjOBJ_TENDON : mjOBJ_JOINT;
+    const mjtObj t = m->actuator_trntype[a] == mjTRN_TENDON ? mjOBJ_TENDON
+                     : m->actuator_trntype[a] == mjTRN_SITE ? mjOBJ_SITE
+                                                            : mjOBJ_JOINT;
     EXPECT_EQ(act.substr(0, 2), Name(m.get(), t, m->actuator_trnid[2 * a]).substr(0, 2)) << act;
   }
   // contact exclude and equality refer to the own copy
@@ -467,6 +490,23 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
   const int eq = Id(m.get(), mjOBJ_EQUALITY, "b/couple");
   EXPECT_EQ(m->eq_obj1id[eq], Id(m.get(), mjOBJ_JOINT, "b/elbow"));
   EXPECT_EQ(m->eq_obj2id[eq], Id(m.get(), mjOBJ_JOINT, "b/shoulder"));
+  // weld to the world body, sensor reference frame, site transmission, custom tuple
+  const int pin = Id(m.get(), mjOBJ_EQUALITY, "b/pin");
+  EXPECT_EQ(m->eq_obj1id[pin], Id(m.get(), mjOBJ_BODY, "b/ball_link"));
+  EXPECT_EQ(m->eq_obj2id[pin], 0);
+  const int rel = Id(m.get(), mjOBJ_SENSOR, "b/s_rel");
+  EXPECT_EQ(m->sensor_refid[rel], Id(m.get(), mjOBJ_BODY, "b/upper"));
+  const int gs = Id(m.get(), mjOBJ_ACTUATOR, "b/g_site");
+  EXPECT_EQ(m->actuator_trnid[2 * gs], Id(m.get(), mjOBJ_SITE, "b/imu"));
+  EXPECT_EQ(m->actuator_trnid[2 * gs + 1], Id(m.get(), mjOBJ_SITE, "b/anchor"));
+  EXPECT_EQ(m->nnumeric, 2);
+  EXPECT_EQ(m->ntext, 2);
+  const int tup = Id(m.get(), mjOBJ_TUPLE, "b/links");
+  ASSERT_GE(tup, 0);
+  EXPECT_EQ(m->tuple_objid[m->tuple_adr[tup]], Id(m.get(), mjOBJ_BODY, "b/upper"));
+  EXPECT_EQ(m->tuple_objid[m->tuple_adr[tup] + 1], Id(m.get(), mjOBJ_JOINT, "b/elbow"));
+  EXPECT_GE(Id(m.get(), mjOBJ_NUMERIC, "b/gains"), 0);
+  EXPECT_GE(Id(m.get(), mjOBJ_TEXT, "a/note"), 0);
   // top-level light direction is rotated with the model (90 deg about z keeps -z)
   const int lamp = Id(m.get(), mjOBJ_LIGHT, "b/lamp");
   ExpectNear3(V3(m->light_pos + 3 * lamp), X_b * Eigen::Vector3d(0, 0, 3), 1e-12, "lamp pos");
@@ -686,7 +726,8 @@ TEST(SceneComposerTest, IncludesAndMeshdirResolveFromTheirFiles) {
   EXPECT_EQ(m->nmesh, 2);
   EXPECT_GE(Id(m.get(), mjOBJ_GEOM, "y/arm_mesh"), 0);
   EXPECT_GE(Id(m.get(), mjOBJ_BODY, "y/hand"), 0);
-  EXPECT_EQ(m->geom_dataid[Id(m.get(), mjOBJ_GEOM, "y/arm_mesh")], Id(m.get(), mjOBJ_MESH, "y/tetra"));
+  EXPECT_EQ(m->geom_dataid[Id(m.get(), mjOBJ_GEOM, "y/arm_mesh")],
+            Id(m.get(), mjOBJ_MESH, "y/tetra"));
 
   // composed text: absolute mesh path, no include left
   const ComposedScene scene = ComposeWorld({Model("x", main)}, Options());
@@ -703,8 +744,8 @@ TEST(SceneComposerTest, HumanoidSampleComposesTwice) {
   ModelPtr alone = LoadFile(humanoid);
   ASSERT_TRUE(alone);
   const Pose X_b = PoseFromXyzRpyDeg({0, 3, 0.1}, {0, 0, 180});
-  ModelPtr m = ComposeAndLoad(
-      {Model("h1", humanoid), Model("h2", humanoid, {0, 3, 0.1}, {0, 0, 180})}, dir);
+  ModelPtr m =
+      ComposeAndLoad({Model("h1", humanoid), Model("h2", humanoid, {0, 3, 0.1}, {0, 0, 180})}, dir);
   ASSERT_TRUE(m);
   EXPECT_EQ(m->nbody, 2 * alone->nbody - 1);
   EXPECT_EQ(m->njnt, 2 * alone->njnt);
@@ -748,6 +789,25 @@ TEST(SceneComposerTest, MuJoCoSamplesComposeWithThemselves) {
     EXPECT_EQ(m->ntendon, 2 * alone->ntendon);
     EXPECT_EQ(m->nmesh, 2 * alone->nmesh);
   }
+}
+
+TEST(SceneComposerTest, KeyframesAreDroppedWithAWarningWhenSizesAreUnknown) {
+  const std::string rope = "/usr/share/mujoco/model/composite/rope.xml";
+  if (!fs::exists(rope)) GTEST_SKIP() << "MuJoCo samples not installed";
+  TempDir dir;
+  const std::string robot = WriteRobot(dir);
+  ComposedScene scene;
+  ModelPtr m = ComposeAndLoad({Model("robot", robot), Model("rope", rope, {3, 0, 0})}, dir, &scene);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(m->nkey, 0);
+  int dropped = 0;
+  for (const std::string& w : scene.warnings) {
+    if (w.find("keyframes dropped") == std::string::npos) continue;
+    ++dropped;
+    EXPECT_NE(w.find("composite"), std::string::npos) << w;
+    EXPECT_NE(w.find("rope.xml"), std::string::npos) << w;
+  }
+  EXPECT_EQ(dropped, 1);
 }
 
 TEST(SceneComposerTest, UrdfGoesThroughTheConverter) {
@@ -808,13 +868,15 @@ std::string ComposeError(const std::vector<ModelConfig>& models) {
 
 TEST(SceneComposerTest, ErrorsNameTheFileLineAndWhatWasExpected) {
   TempDir dir;
-  const std::string good = dir.Write("good.xml", "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>");
+  const std::string good =
+      dir.Write("good.xml", "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>");
 
   std::string e = ComposeError({Model("a", dir.path() + "/missing.xml")});
   EXPECT_NE(e.find("missing.xml"), std::string::npos) << e;
   EXPECT_NE(e.find("not found"), std::string::npos) << e;
 
-  const std::string broken = dir.Write("broken.xml", "<mujoco>\n<worldbody>\n<geom size='1'>\n</mujoco>\n");
+  const std::string broken =
+      dir.Write("broken.xml", "<mujoco>\n<worldbody>\n<geom size='1'>\n</mujoco>\n");
   e = ComposeError({Model("a", broken)});
   EXPECT_NE(e.find("broken.xml:"), std::string::npos) << e;
   EXPECT_NE(e.find("syntax"), std::string::npos) << e;
@@ -858,13 +920,21 @@ TEST(SceneComposerTest, ErrorsNameTheFileLineAndWhatWasExpected) {
   EXPECT_NE(e.find("gone.xml"), std::string::npos) << e;
 
   // an error inside an included file names the included file and its line
-  dir.Write("inc_bad.xml", "<mujoco>\n<worldbody>\n<geom size='1' material='nope'/>\n</worldbody>\n</mujoco>");
+  dir.Write("inc_bad.xml",
+            "<mujoco>\n<worldbody>\n<geom size='1' material='nope'/>\n</worldbody>\n</mujoco>");
   const std::string includes_bad = dir.Write("includes_bad.xml", R"(<mujoco>
   <include file="inc_bad.xml"/>
 </mujoco>)");
   e = ComposeError({Model("a", includes_bad)});
   EXPECT_NE(e.find("inc_bad.xml:3"), std::string::npos) << e;
   EXPECT_NE(e.find("unknown material 'nope'"), std::string::npos) << e;
+
+  const std::string cycle = dir.Write("cycle.xml", R"(<mujoco>
+  <include file="cycle.xml"/>
+</mujoco>)");
+  e = ComposeError({Model("a", cycle)});
+  EXPECT_NE(e.find("cycle.xml"), std::string::npos) << e;
+  EXPECT_NE(e.find("include cycle"), std::string::npos) << e;
 
   const std::string boundmass = dir.Write("bm.xml", R"(<mujoco>
   <compiler boundmass="0.01"/>
@@ -874,7 +944,8 @@ TEST(SceneComposerTest, ErrorsNameTheFileLineAndWhatWasExpected) {
   EXPECT_NE(e.find("bm.xml:2"), std::string::npos) << e;
   EXPECT_NE(e.find("compiler.boundmass"), std::string::npos) << e;
 
-  const std::string bad_elem = dir.Write("elem.xml", "<mujoco>\n<worldbody><body><gem/></body></worldbody></mujoco>");
+  const std::string bad_elem =
+      dir.Write("elem.xml", "<mujoco>\n<worldbody><body><gem/></body></worldbody></mujoco>");
   e = ComposeError({Model("a", bad_elem)});
   EXPECT_NE(e.find("elem.xml:2"), std::string::npos) << e;
   EXPECT_NE(e.find("<gem>"), std::string::npos) << e;

@@ -458,7 +458,6 @@ void ModelComposer::ProcessJoint(XMLElement* j, const Eigen::Vector3d& body_pos,
     sizes_.nq += 1;
     sizes_.nv += 1;
   }
-  sizes_.njoint_dofs_known = sizes_.nv;
 }
 
 void ModelComposer::StripDefaultOrientations() {

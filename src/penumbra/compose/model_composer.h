@@ -8,6 +8,7 @@
 #include <tinyxml2.h>
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <set>
@@ -46,10 +47,9 @@ struct ModelSizes {
   std::vector<double> mocap_pos;               ///< (3 nmocap) placed
   std::vector<double> mocap_quat;              ///< (4 nmocap) placed
   std::vector<std::pair<int, int>> free_dofs;  ///< (qpos address, qvel address) of free joints
-  std::vector<bool> actuator_stateful;  ///< (nu) actuator has activation dynamics
+  std::vector<bool> actuator_stateful;         ///< (nu) actuator has activation dynamics
   bool known = true;                           ///< false when the XML does not determine the sizes
   std::string why_unknown;
-  int njoint_dofs_known = 0;  ///< nv counted so far (for size heuristics even when !known)
 };
 
 /// one <key> of the model, vectors as written (before composition).

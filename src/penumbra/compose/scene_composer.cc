@@ -334,7 +334,7 @@ void ComposeSize(const Models& models, int composed_keys, XMLElement* root) {
   if (!out.empty()) ApplyAttrs(root->InsertNewChildElement("size"), out);
 }
 
-// first model that has the section decides; returns that model or nullptr
+// the first model that has a <visual> decides (sub-elements merged over its sections)
 void ComposeVisual(const Models& models, XMLElement* root) {
   for (const auto& m : models) {
     const auto sections = m->Sections("visual");
