@@ -1,5 +1,6 @@
 #include "penumbra/physics/physics_benchmark.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -32,7 +33,9 @@ PhysicsBenchResult BenchmarkPhysics(const std::string& mjcf_path, double sim_sec
 
   const double dt = sim.timestep();
   const int64_t total = std::max<int64_t>(1, static_cast<int64_t>(std::llround(sim_seconds / dt)));
-  constexpr int kBlocks = 10;
+  // short alternating blocks: frequency scaling and other load hit both sides alike
+  constexpr int64_t kBlockSteps = 250;
+  const int64_t blocks = (total + kBlockSteps - 1) / kBlockSteps;
   constexpr double kSnapshotHz = 30.0;
   WorldSnapshot snapshot;
   int64_t next_frame = 0;
@@ -58,8 +61,13 @@ PhysicsBenchResult BenchmarkPhysics(const std::string& mjcf_path, double sim_sec
     bare_wall += std::chrono::duration<double>(Clock::now() - t0).count();
   };
 
-  for (int b = 0; b < kBlocks; ++b) {
-    const int64_t n = total * (b + 1) / kBlocks - done;
+  // untimed warm-up of both (same number of steps, so both keep the same state)
+  const int64_t warmup = std::min<int64_t>(total, kBlockSteps);
+  run_sim(warmup);
+  run_bare(warmup);
+  sim_wall = bare_wall = 0;
+  for (int64_t b = 0; b < blocks; ++b) {
+    const int64_t n = std::min(kBlockSteps, total - done);
     done += n;
     if (b % 2 == 0) {
       run_sim(n);

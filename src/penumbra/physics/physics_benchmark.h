@@ -15,8 +15,9 @@ struct PhysicsBenchResult {
   int64_t steps = 0;                  ///< steps each side ran
 };
 
-/// runs `sim_seconds` of simulated time of the model at `mjcf_path` both ways, interleaved
-/// in 10 blocks (alternating which side goes first) so machine noise hits both alike.
+/// runs `sim_seconds` of simulated time of the model at `mjcf_path` both ways, after an
+/// untimed warm-up block, interleaved in blocks of 250 steps (alternating which side goes
+/// first) so machine noise hits both alike.
 /// no controllers are attached; snapshots are taken at 30 Hz of sim time, as the runner does.
 /// wall-clock time is measured with std::chrono::steady_clock (it never feeds the simulation).
 /// @throws ConfigError for a bad model or sim_seconds <= 0; PhysicsError if it diverges.
