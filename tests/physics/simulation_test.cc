@@ -324,8 +324,19 @@ TEST(Simulation, ControllersRunAtTheirRateOnSimTime) {
   }
 }
 
-TEST(Simulation, ControllersSeeCurrentStateAndDerivedQuantities) {
-  Simulation sim = Simulation::LoadFromString(kArmXml);
+class ControllerStateTest : public ::testing::TestWithParam<const char*> {};
+
+// every integrator: Euler and implicit split the step around the controllers (mj_step1 /
+// mj_step2), RK4 runs mj_step1 for them and then a full mj_step
+INSTANTIATE_TEST_SUITE_P(Integrators, ControllerStateTest,
+                         ::testing::Values("Euler", "implicit", "RK4"));
+
+TEST_P(ControllerStateTest, ControllersSeeCurrentStateAndDerivedQuantities) {
+  std::string xml = kArmXml;
+  const std::string opt = "<option timestep=\"0.002\"/>";
+  xml.replace(xml.find(opt), opt.size(),
+              std::string("<option timestep=\"0.002\" integrator=\"") + GetParam() + "\"/>");
+  Simulation sim = Simulation::LoadFromString(xml);
   int checks = 0;
   sim.AddController(std::make_unique<LambdaController>(
       0,

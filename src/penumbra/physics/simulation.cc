@@ -406,6 +406,11 @@ void Simulation::Step() {
     }
   } catch (const MujocoError& e) {
     s.Fail(t, step, std::string("MuJoCo error: ") + e.what());
+  } catch (const std::exception&) {
+    throw;  // controllers' own errors pass through unchanged
+  } catch (...) {
+    // MuJoCo's compiler swaps in its own throwing handler while another thread loads a model
+    s.Fail(t, step, "MuJoCo error (reported while another model was being loaded)");
   }
   s.steps = step;
   s.CheckWarnings(t, step);
