@@ -418,6 +418,10 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
       ComposeAndLoad({Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, dir, &scene);
   ASSERT_TRUE(m);
   EXPECT_EQ(scene.model_names, (std::vector<std::string>{"a", "b"}));
+  // deterministic text
+  EXPECT_EQ(ComposeWorld({Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, Options())
+                .mjcf_xml,
+            scene.mjcf_xml);
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
 
   // everything doubled

@@ -272,7 +272,7 @@ int SizeValue(const ModelComposer& m, const AttrList& size, const std::string& n
 
 void ComposeSize(const Models& models, int composed_keys, XMLElement* root) {
   AttrList out;
-  long long njmax = 0, nconmax = 0, nstack_explicit = 0, nv = 0;
+  long long njmax = 0, nconmax = 0, nstack = 0;
   int nuserdata = 0, nkey = 0;
   bool any_stack = false, any_userdata = false, any_nkey = false;
   std::vector<AttrList> sizes;
@@ -284,11 +284,15 @@ void ComposeSize(const Models& models, int composed_keys, XMLElement* root) {
     const int nc = SizeValue(m, s, "nconmax", kDefaultNconmax);
     njmax += nj > 0 ? nj : kDefaultNjmax;
     nconmax += nc > 0 ? nc : kDefaultNconmax;
-    nv += m.sizes().nv;
+    // stack: each model's explicit size, or an estimate of MuJoCo 2.2.2's automatic size
+    // for it (about 5 njmax^2 + 10 nv njmax, measured on the humanoid sample)
     const int ns = SizeValue(m, s, "nstack", -1);
+    const long long nj_eff = nj > 0 ? nj : kDefaultNjmax;
     if (ns > 0) {
       any_stack = true;
-      nstack_explicit += ns;
+      nstack += ns;
+    } else {
+      nstack += 5 * nj_eff * nj_eff + 10 * static_cast<long long>(m.sizes().nv) * nj_eff + 10000;
     }
     if (FindAttr(s, "nuserdata")) {
       any_userdata = true;
@@ -307,16 +311,8 @@ void ComposeSize(const Models& models, int composed_keys, XMLElement* root) {
   // constraint and contact buffers: the worlds' needs add up
   if (several || any_nj) SetAttr(&out, "njmax", std::to_string(njmax));
   if (several || any_nc) SetAttr(&out, "nconmax", std::to_string(nconmax));
-  if (any_stack) {
-    long long nstack = nstack_explicit;
-    if (several) {
-      // MuJoCo 2.2.2 sizes the stack automatically as about 5 njmax^2 + 10 nv njmax
-      // (measured on the humanoid sample); explicit stacks of single models do not add up
-      // because the solver's needs grow with the square of njmax
-      nstack = std::max(nstack, 5 * njmax * njmax + 10 * nv * njmax + 10000);
-    }
-    SetAttr(&out, "nstack", std::to_string(nstack));
-  }
+  // all automatic: MuJoCo sizes the composed stack itself; else the sum of the parts
+  if (any_stack) SetAttr(&out, "nstack", std::to_string(nstack));
   if (any_userdata) SetAttr(&out, "nuserdata", std::to_string(nuserdata));
   if (any_nkey) SetAttr(&out, "nkey", std::to_string(std::max(nkey, composed_keys)));
   // user data lengths: each model's explicit size or its longest user= (MuJoCo's -1)

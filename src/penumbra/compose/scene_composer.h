@@ -29,7 +29,10 @@
 //
 // sections: <option>, <visual>, <statistic> come from the first model that has them
 // (later differing <option>/<statistic> give a warning); <size> is combined
-// (njmax/nconmax summed, nuser_* maximum, nuserdata maximum, nstack see .cc);
+// (njmax/nconmax summed with MuJoCo's defaults 500/100 for models without them,
+// nuser_* and nuserdata maximum; nstack left automatic unless a model sets it, then
+// the sum of the explicit sizes and, for the other models, an estimate of MuJoCo
+// 2.2.2's automatic size 5 njmax^2 + 10 nv njmax + 10^4);
 // compiler attributes other than angle/eulerseq/paths must agree, except
 // autolimits (true wins, which is safe: a model valid without it is unchanged),
 // usethread (any) and inertiafromgeom true vs auto (reconciled by dropping the
