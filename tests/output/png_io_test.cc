@@ -85,7 +85,7 @@ TEST(PngIo, Gray16RoundTripIsExactIncludingExtremes) {
 TEST(PngIo, EveryFilterAndLevelRoundTrips) {
   TempDir dir;
   const ImageU8 img = TestRgb(40, 30, 3);
-  for (const char* filter : {"none", "sub", "up", "avg", "paeth"}) {
+  for (const char* filter : {"auto", "none", "sub", "up", "avg", "paeth"}) {
     for (int level : {0, 1, 6, 9}) {
       PngEncodeOptions opt;
       opt.filter = filter;

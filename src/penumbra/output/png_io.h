@@ -19,8 +19,9 @@ namespace penumbra {
 struct PngEncodeOptions {
   /// zlib level 0..9 (0 = store, 1 = Z_BEST_SPEED, 9 = smallest).
   int compression_level = 1;
-  /// row filter for every row: one of "none", "sub", "up", "avg", "paeth".
-  std::string filter = "up";
+  /// row filter used for every row: "none", "sub", "up", "avg", "paeth", or "auto" =
+  /// "sub" for 8-bit RGB and "up" for 16-bit greyscale.
+  std::string filter = "auto";
 
   /// @throws ConfigError for a level outside [0, 9] or an unknown filter name.
   void ValidateOrThrow() const;
