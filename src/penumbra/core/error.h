@@ -2,6 +2,7 @@
 // error types thrown across penumbra. every error names where it came from
 // (file, key path or line) and what was expected, so users can fix their input.
 
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -32,10 +33,12 @@ class ConfigError : public Error {
  private:
   static std::string Format(const std::string& file, int line, const std::string& key,
                             const std::string& problem) {
-    std::string s = file.empty() ? std::string("<command line>") : file;
-    if (line > 0) s += ":" + std::to_string(line);
-    if (!key.empty()) s += ": " + key;
-    return s + ": " + problem;
+    std::ostringstream s;
+    s << (file.empty() ? "<command line>" : file);
+    if (line > 0) s << ':' << line;
+    if (!key.empty()) s << ": " << key;
+    s << ": " << problem;
+    return s.str();
   }
   std::string file_;
   int line_ = 0;
