@@ -1,13 +1,103 @@
 #include "penumbra/app/cli.h"
 
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <filesystem>
+
+#include "penumbra/app/bench.h"
+#include "penumbra/app/runner.h"
+#include "penumbra/core/error.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/world/world_config.h"
 
 namespace penumbra {
+namespace {
+
+// a world file (.yaml/.yml) or a bare model (.xml MJCF, .urdf)
+WorldConfig LoadWorldOrModel(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".xml" || ext == ".urdf" || ext == ".mjcf") return WorldForBareModel(path);
+  if (ext == ".yaml" || ext == ".yml") return LoadWorldFile(path);
+  throw ConfigError(path, 0, "",
+                    "unknown file type '" + ext +
+                        "'; expected a world file (.yaml, .yml) or a model (.xml MJCF, .urdf)");
+}
+
+std::vector<std::string> Args(int argc, char** argv) { return std::vector<std::string>(argv, argv + argc); }
+
+}  // namespace
 
 int RunCli(int argc, char** argv) {
-  CLI::App app{"penumbra: robotics simulator with a physically based ray tracer"};
+  CLI::App app{"penumbra: robotics simulator with MuJoCo physics and a physically based ray tracer"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(PENUMBRA_VERSION));
+
+  // penumbra run
+  CLI::App* run = app.add_subcommand("run", "simulate a world file or a bare MJCF/URDF model and write outputs");
+  std::string world_path;
+  RunOptions run_options;
+  double duration = -1;
+  std::string tier;
+  int spp = 0, threads = -1;
+  int64_t seed = -1;
+  bool quiet = false;
+  run->add_option("world", world_path, "world file (.yaml) or model (.xml MJCF, .urdf)")->required();
+  run->add_option("--out,-o", run_options.out_dir, "output folder (default: the world's output.dir)");
+  run->add_option("--duration", duration, "simulated seconds (overrides duration_sec)")->check(CLI::PositiveNumber);
+  run->add_flag("--realtime", run_options.realtime, "pace physics to wall-clock time");
+  run->add_option("--tier", tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
+  run->add_option("--spp", spp, "samples per pixel (pathtraced)")->check(CLI::Range(1, 65536));
+  run->add_option("--threads", threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
+  run->add_option("--seed", seed, "world seed (overrides seed)")->check(CLI::NonNegativeNumber);
+  run->add_flag("--quiet,-q", quiet, "no progress output");
+
+  // penumbra bench render|physics
+  CLI::App* bench = app.add_subcommand("bench", "throughput benchmarks (not tests)");
+  bench->require_subcommand(1);
+  CLI::App* bench_render = bench->add_subcommand("render", "frames/s and Mrays/s at 640x480 and 800x800");
+  RenderBenchOptions render_bench;
+  bench_render->add_option("--world", render_bench.world_file, "world file (default: bundled default world)");
+  bench_render->add_option("--frames", render_bench.frames, "timed frames per resolution")->check(CLI::Range(1, 100000));
+  bench_render->add_option("--threads", render_bench.threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
+  bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
+  CLI::App* bench_physics = bench->add_subcommand("physics", "Penumbra physics steps/s vs a bare mj_step loop");
+  PhysicsBenchOptions physics_bench;
+  bench_physics->add_option("--world", physics_bench.world_file, "world file (default: bundled default world)");
+  bench_physics->add_option("--model", physics_bench.model_file, "bare MJCF model instead of a world");
+  bench_physics->add_option("--seconds", physics_bench.sim_seconds, "simulated seconds per side")->check(CLI::PositiveNumber);
+
   CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (*run) {
+      WorldConfig world = LoadWorldOrModel(world_path);
+      if (duration > 0) run_options.duration_sec = duration;
+      if (seed >= 0) world.seed = static_cast<uint64_t>(seed);
+      if (!tier.empty())
+        world.render.tier = tier == "pathtraced" ? RenderSettings::Tier::kPathtraced : RenderSettings::Tier::kRealtime;
+      if (spp > 0) world.render.samples_per_pixel = spp;
+      if (threads >= 0) world.render.threads = threads;
+      run_options.progress = !quiet;
+      run_options.command_line = Args(argc, argv);
+      const RunSummary s = RunWorld(world, run_options);
+      int64_t frames = 0;
+      for (const auto& [name, n] : s.frames_per_camera) frames += n;
+      spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
+                   s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
+      return 0;
+    }
+    if (*bench_render) return BenchRender(render_bench);
+    if (*bench_physics) return BenchPhysics(physics_bench);
+  } catch (const ConfigError& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
   return 0;
 }
 

@@ -1,0 +1,124 @@
+#include "penumbra/app/bench.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+
+#include "penumbra/app/scene_assembly.h"
+#include "penumbra/compose/scene_composer.h"
+#include "penumbra/control/controller_factory.h"
+#include "penumbra/core/error.h"
+#include "penumbra/physics/physics_benchmark.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/physics/urdf_converter.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// composes a world into a temporary folder and loads it with its controllers.
+Simulation LoadWorld(const WorldConfig& world, std::string* composed_path) {
+  ComposeOptions compose_options;
+  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
+  compose_options.timestep_sec = world.timestep_sec;
+  const ComposedScene composed = ComposeWorld(world.models, compose_options);
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  *composed_path = (dir / "composed.xml").string();
+  WriteComposedScene(composed, *composed_path);
+  Simulation sim = Simulation::LoadFromFile(*composed_path, world.timestep_sec);
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot && !m.controller.type.empty())
+      sim.AddController(MakeController(m.controller, m.name, world.file));
+  return sim;
+}
+
+}  // namespace
+
+std::string DefaultWorldPath() {
+  const std::filesystem::path installed = std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "default.yaml";
+  if (std::filesystem::exists(installed)) return installed.string();
+  return "worlds/default.yaml";
+}
+
+int BenchRender(const RenderBenchOptions& options) {
+  WorldConfig world = LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
+  world.render.seed = world.seed;
+  world.render.threads = options.threads;
+  world.render.tier = options.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
+                                                   : RenderSettings::Tier::kRealtime;
+  std::string composed_path;
+  Simulation sim = LoadWorld(world, &composed_path);
+  const SceneDescription scene = AssembleScene(sim.scene(), world);
+  if (scene.cameras.empty()) throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
+  const CameraSpec& cam = scene.cameras.front();
+  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
+  const double fovy_deg = 2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+
+  // let the robot get going so the frames show a moving world
+  const int steps_per_frame = std::max(1, static_cast<int>(std::lround(1.0 / 30.0 / sim.timestep())));
+  while (sim.time() < 1.0) sim.Step();
+
+  fmt::print("penumbra bench render: world {}\n", world.file);
+  fmt::print("camera '{}', tier {}, {} render threads requested (0 = all cores), {} timed frames\n",
+             cam.name, options.tier, options.threads, options.frames);
+  for (auto [w, h] : {std::pair{640, 480}, std::pair{800, 800}}) {
+    CameraView view;
+    view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
+    view.outputs.rgb = true;
+    view.outputs.depth = true;
+    view.outputs.segmentation = false;
+    view.camera_index = 0;
+    RenderedFrame frame;
+    double seconds = 0;
+    int64_t rays = 0;
+    for (int i = 0; i < options.warmup_frames + options.frames; ++i) {
+      for (int s = 0; s < steps_per_frame; ++s) sim.Step();
+      const WorldSnapshot snap = sim.Snapshot();
+      view.X_WO = CameraPoseInWorld(cam, snap);
+      view.frame_index = i;
+      const auto t0 = Clock::now();
+      renderer->Render(snap, view, &frame);
+      const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+      if (i >= options.warmup_frames) {
+        seconds += dt;
+        rays += frame.rays;
+      }
+    }
+    fmt::print("{}x{} rgb+depth {}: {:.1f} frames/s, {:.2f} ms/frame, {:.1f} Mrays/s\n", w, h,
+               options.tier, options.frames / seconds, 1e3 * seconds / options.frames,
+               rays / seconds * 1e-6);
+  }
+  fmt::print("target (2-core CI machine): >= 30 frames/s at 640x480 realtime\n");
+  return 0;
+}
+
+int BenchPhysics(const PhysicsBenchOptions& options) {
+  std::string model = options.model_file;
+  std::string label = model;
+  if (model.empty()) {
+    WorldConfig world = LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
+    ComposeOptions compose_options;
+    compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
+    compose_options.timestep_sec = world.timestep_sec;
+    const ComposedScene composed = ComposeWorld(world.models, compose_options);
+    const auto dir = std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
+    std::filesystem::create_directories(dir);
+    model = (dir / "composed.xml").string();
+    WriteComposedScene(composed, model);
+    label = world.file + " (composed, no controllers)";
+  }
+  const PhysicsBenchResult r = BenchmarkPhysics(model, options.sim_seconds);
+  fmt::print("penumbra bench physics: {}\n", label);
+  fmt::print("{} steps of {:.1f} s sim time each way\n", r.steps, options.sim_seconds);
+  fmt::print("penumbra Simulation::Step: {:.0f} steps/s\n", r.penumbra_steps_per_sec);
+  fmt::print("bare mj_step loop:         {:.0f} steps/s\n", r.bare_steps_per_sec);
+  fmt::print("ratio: {:.3f} (target >= 0.95)\n", r.ratio);
+  return 0;
+}
+
+}  // namespace penumbra

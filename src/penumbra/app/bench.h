@@ -1,0 +1,35 @@
+#pragma once
+// `penumbra bench render|physics`: throughput measurements on real worlds. these
+// are benchmarks, never pass/fail tests; they print numbers and targets.
+
+#include <string>
+
+namespace penumbra {
+
+/// options of `penumbra bench render`.
+struct RenderBenchOptions {
+  std::string world_file;   ///< world to render (default: the bundled default world)
+  int frames = 60;          ///< timed frames per resolution
+  int warmup_frames = 5;    ///< untimed frames first
+  int threads = 0;          ///< render threads, 0 = all cores
+  std::string tier = "realtime";
+};
+
+/// renders the world's first camera at 640x480 and 800x800 (RGB + depth) while the
+/// world moves, and prints frames/s and Mrays/s for each. returns 0.
+int BenchRender(const RenderBenchOptions& options);
+
+/// options of `penumbra bench physics`.
+struct PhysicsBenchOptions {
+  std::string world_file;  ///< world whose composed model is stepped (default world)
+  std::string model_file;  ///< or a bare MJCF file
+  double sim_seconds = 20;
+};
+
+/// prints Penumbra's physics steps/s against a bare mj_step loop on the same model. returns 0.
+int BenchPhysics(const PhysicsBenchOptions& options);
+
+/// the bundled default world (worlds/default.yaml in the source tree).
+std::string DefaultWorldPath();
+
+}  // namespace penumbra

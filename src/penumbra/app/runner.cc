@@ -1,0 +1,249 @@
+#include "penumbra/app/runner.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <thread>
+
+#include "penumbra/app/scene_assembly.h"
+#include "penumbra/compose/scene_composer.h"
+#include "penumbra/control/controller_factory.h"
+#include "penumbra/core/bounded_queue.h"
+#include "penumbra/core/error.h"
+#include "penumbra/output/async_frame_writer.h"
+#include "penumbra/output/progress.h"
+#include "penumbra/output/run_manifest.h"
+#include "penumbra/physics/mujoco_version.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/physics/urdf_converter.h"
+#include "penumbra/render/renderer.h"
+
+namespace penumbra {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// one unit of work from the physics thread: a snapshot and the cameras due at it.
+struct RenderJob {
+  WorldSnapshot snapshot;
+  std::vector<int> cameras;
+  std::vector<int64_t> frame_indices;
+  std::exception_ptr error;  // set on the last job if physics failed
+};
+
+// camera c fires its frame k at the first physics step whose time is >= k / rate_hz,
+// so frames never drift however the rate and timestep relate.
+class CameraSchedule {
+ public:
+  explicit CameraSchedule(const std::vector<CameraSpec>& cameras) : cameras_(cameras), next_(cameras.size(), 0) {}
+
+  void Due(double time_sec, std::vector<int>* cams, std::vector<int64_t>* frames) {
+    for (size_t c = 0; c < cameras_.size(); ++c) {
+      const double t_k = static_cast<double>(next_[c]) / cameras_[c].rate_hz;
+      if (time_sec >= t_k - 1e-9) {
+        cams->push_back(static_cast<int>(c));
+        frames->push_back(next_[c]);
+        // skip frames that fall inside one physics step (rate above the physics rate)
+        while (static_cast<double>(next_[c]) / cameras_[c].rate_hz <= time_sec + 1e-9) ++next_[c];
+      }
+    }
+  }
+
+ private:
+  const std::vector<CameraSpec>& cameras_;
+  std::vector<int64_t> next_;
+};
+
+void WriteTrajectoryHeader(std::ofstream& f, size_t nq) {
+  f << "step,time_sec";
+  for (size_t i = 0; i < nq; ++i) f << ",qpos" << i;
+  f << "\n";
+}
+
+void WriteTrajectoryRow(std::ofstream& f, const Simulation& sim) {
+  const std::span<const double> q = sim.qpos();
+  std::string row = fmt::format("{},{:.17g}", sim.step_count(), sim.time());
+  for (double v : q) fmt::format_to(std::back_inserter(row), ",{:.17g}", v);
+  row += '\n';
+  f << row;
+}
+
+}  // namespace
+
+RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
+  const auto t_start = Clock::now();
+  WorldConfig world = world_in;
+  if (options.duration_sec) world.duration_sec = *options.duration_sec;
+  if (!options.out_dir.empty()) world.output_dir = options.out_dir;
+  world.render.seed = world.seed;
+  world.ValidateOrThrow();
+
+  namespace fs = std::filesystem;
+  const fs::path out = world.output_dir;
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) throw ConfigError("", 0, "--out", "cannot create folder '" + out.string() + "': " + ec.message());
+
+  std::map<std::string, double> timings;
+
+  // compose every model into one MJCF and keep it next to the outputs
+  auto t0 = Clock::now();
+  ComposeOptions compose_options;
+  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
+  compose_options.timestep_sec = world.timestep_sec;
+  const ComposedScene composed = ComposeWorld(world.models, compose_options);
+  for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
+  const std::string composed_path = (out / "composed.xml").string();
+  WriteComposedScene(composed, composed_path);
+  timings["compose_sec"] = SecondsSince(t0);
+
+  // physics and controllers
+  t0 = Clock::now();
+  Simulation sim = Simulation::LoadFromFile(composed_path, world.timestep_sec);
+  for (const ModelConfig& m : world.models) {
+    if (!m.is_robot || m.controller.type.empty()) continue;
+    sim.AddController(MakeController(m.controller, m.name, world.file));
+  }
+  timings["load_sec"] = SecondsSince(t0);
+
+  // static scene for the renderer
+  t0 = Clock::now();
+  const SceneDescription scene = AssembleScene(sim.scene(), world);
+  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
+  timings["scene_build_sec"] = SecondsSince(t0);
+
+  // outputs
+  AsyncFrameWriter writer(out.string());
+  for (const CameraSpec& cam : scene.cameras) writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
+  std::ofstream trajectory(out / "trajectory.csv");
+  WriteTrajectoryHeader(trajectory, sim.qpos().size());
+
+  const double duration = world.duration_sec;
+  ProgressOptions progress_options;
+  progress_options.mode = options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
+  ProgressReporter progress(duration, progress_options);
+  spdlog::info("running {} for {:.3f} s of sim time, {} camera(s), timestep {:.6g} s, out {}",
+               world.file.empty() ? std::string("model") : world.file, duration,
+               scene.cameras.size(), sim.timestep(), out.string());
+
+  // physics on its own thread; it hands snapshots to the renderer through a bounded queue
+  BoundedQueue<RenderJob> jobs(4);
+  double physics_busy_sec = 0;
+  std::thread physics([&] {
+    CameraSchedule schedule(scene.cameras);
+    const auto wall0 = Clock::now();
+    try {
+      for (;;) {
+        RenderJob job;
+        schedule.Due(sim.time(), &job.cameras, &job.frame_indices);
+        if (!job.cameras.empty()) {
+          job.snapshot = sim.Snapshot();
+          if (!jobs.Push(std::move(job))) return;
+        }
+        if (sim.time() >= duration - 1e-9) break;
+        if (options.realtime) {
+          std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<Clock::duration>(
+                                                    std::chrono::duration<double>(sim.time())));
+        }
+        const auto ts = Clock::now();
+        sim.Step();
+        physics_busy_sec += SecondsSince(ts);
+        WriteTrajectoryRow(trajectory, sim);
+        for (const std::string& w : sim.TakeWarnings()) spdlog::warn("physics: {}", w);
+      }
+    } catch (...) {
+      RenderJob last;
+      last.error = std::current_exception();
+      jobs.Push(std::move(last));
+    }
+    jobs.Close();
+  });
+
+  // render and write on this thread, in arrival order (deterministic)
+  std::exception_ptr failure;
+  RunSummary summary;
+  double render_sec = 0;
+  int64_t total_frames = 0;
+  try {
+    while (std::optional<RenderJob> job = jobs.Pop()) {
+      if (job->error) {
+        failure = job->error;
+        break;
+      }
+      for (size_t i = 0; i < job->cameras.size(); ++i) {
+        const CameraSpec& cam = scene.cameras[job->cameras[i]];
+        CameraView view;
+        view.X_WO = CameraPoseInWorld(cam, job->snapshot);
+        view.intrinsics = cam.intrinsics;
+        view.outputs = cam.outputs;
+        view.frame_index = job->frame_indices[i];
+        view.camera_index = job->cameras[i];
+        RenderedFrame frame;
+        const auto tr = Clock::now();
+        renderer->Render(job->snapshot, view, &frame);
+        render_sec += SecondsSince(tr);
+        CameraFrame cf;
+        cf.camera = cam.name;
+        cf.index = view.frame_index;
+        cf.time_sec = job->snapshot.time_sec;
+        cf.X_WO = view.X_WO;
+        cf.rgb = std::move(frame.rgb);
+        cf.depth_m = std::move(frame.depth_m);
+        cf.geom_id = std::move(frame.geom_id);
+        writer.Submit(std::move(cf));
+        ++summary.frames_per_camera[cam.name];
+        ++total_frames;
+      }
+      progress.Update(job->snapshot.time_sec, total_frames);
+    }
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  jobs.Close();
+  physics.join();
+  progress.Finish();
+
+  std::exception_ptr write_failure;
+  try {
+    writer.Flush();
+  } catch (...) {
+    write_failure = std::current_exception();
+  }
+  trajectory.flush();
+
+  summary.out_dir = out.string();
+  summary.sim_time_sec = sim.time();
+  summary.physics_steps = sim.step_count();
+  summary.wall_time_sec = SecondsSince(t_start);
+  summary.peak_rss_mib = PeakResidentMemoryMiB();
+  timings["physics_sec"] = physics_busy_sec;
+  timings["render_sec"] = render_sec;
+  timings["total_sec"] = summary.wall_time_sec;
+
+  RunManifest manifest;
+  manifest.world_file = world.file;
+  manifest.seed = world.seed;
+  manifest.penumbra_version = PENUMBRA_VERSION;
+  manifest.mujoco_version = MujocoVersion();
+  manifest.embree_version = EmbreeVersion();
+  manifest.timings_sec = timings;
+  manifest.peak_resident_memory_mib = summary.peak_rss_mib;
+  manifest.frames_per_camera = summary.frames_per_camera;
+  manifest.sim_duration_sec = summary.sim_time_sec;
+  manifest.command_line = options.command_line;
+  WriteRunManifest(out.string(), manifest);
+
+  if (failure) std::rethrow_exception(failure);
+  if (write_failure) std::rethrow_exception(write_failure);
+  return summary;
+}
+
+}  // namespace penumbra

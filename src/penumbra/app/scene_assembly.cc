@@ -1,0 +1,210 @@
+#include "penumbra/app/scene_assembly.h"
+
+#include <cmath>
+#include <set>
+
+#include "penumbra/core/error.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+namespace {
+
+int BodyOrThrow(const SceneDescription& scene, const std::string& attach, const std::string& file,
+                const std::string& key) {
+  if (attach.empty() || attach == "world") return 0;
+  const int b = scene.FindBody(attach);
+  if (b < 0) {
+    std::string known;
+    for (size_t i = 1; i < scene.bodies.size() && i < 40; ++i) {
+      if (scene.bodies[i].name.empty()) continue;
+      known += (known.empty() ? "" : ", ") + scene.bodies[i].name;
+    }
+    throw ConfigError(file, 0, key,
+                      "no body named '" + attach + "'; expected \"world\" or one of: " + known);
+  }
+  return b;
+}
+
+Eigen::Vector3d DirectionFromElevationAzimuth(double elevation_deg, double azimuth_deg) {
+  const double el = elevation_deg * M_PI / 180.0, az = azimuth_deg * M_PI / 180.0;
+  return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+}
+
+void ApplyMaterialOverrides(SceneDescription& scene, const WorldConfig& world) {
+  for (size_t i = 0; i < world.materials.size(); ++i) {
+    const MaterialOverride& o = world.materials[i];
+    const int m = scene.FindMaterial(o.name);
+    if (m < 0)
+      throw ConfigError(world.file, 0, "materials." + o.name,
+                        "no MJCF material with that name; expected a prefixed material name such "
+                        "as '<model>/<material>'");
+    Material& mat = scene.materials[m];
+    if (o.base_color) mat.base_color = *o.base_color;
+    if (o.roughness) mat.roughness = *o.roughness;
+    if (o.metallic) mat.metallic = *o.metallic;
+    if (o.specular) mat.specular = *o.specular;
+    if (o.emission) mat.emission = *o.emission;
+  }
+}
+
+Light ToLight(const LightConfig& c, const SceneDescription& scene, const std::string& file,
+              size_t index) {
+  const std::string key = "lights[" + std::to_string(index) + "]";
+  Light l;
+  l.name = c.name;
+  l.body = BodyOrThrow(scene, c.attach, file, key + ".attach");
+  l.position_B = c.position;
+  l.direction_B = c.direction.normalized();
+  l.color = c.color;
+  l.cast_shadow = c.cast_shadow;
+  l.radius_m = static_cast<float>(c.radius_m);
+  switch (c.type) {
+    case Light::Type::kDirectional:
+      l.type = Light::Type::kDirectional;
+      l.intensity = static_cast<float>(c.illuminance_lux.value_or(10000.0));
+      l.angular_radius_deg = static_cast<float>(0.5 * c.angular_diameter_deg);
+      break;
+    case Light::Type::kPoint:
+    case Light::Type::kSpot:
+      l.type = c.type;
+      l.intensity = static_cast<float>(c.intensity_cd ? *c.intensity_cd
+                                                      : kLumensPerWatt * c.power_w.value_or(0.0) /
+                                                            (4.0 * M_PI));
+      l.spot_inner_deg = static_cast<float>(c.inner_angle_deg);
+      l.spot_outer_deg = static_cast<float>(c.outer_angle_deg);
+      break;
+  }
+  return l;
+}
+
+// a camera looking at the model's bounding sphere from the front-left, above.
+Pose AutoFramePose(const SceneDescription& scene, double fovy_deg) {
+  const double half = 0.5 * fovy_deg * M_PI / 180.0;
+  const double distance = std::max(0.1, 1.1 * scene.extent_m / std::sin(half));
+  const Eigen::Vector3d view_dir = Eigen::Vector3d(-1.0, -0.6, -0.45).normalized();
+  const Eigen::Vector3d eye = scene.center_W - distance * view_dir;
+  // optical frame: z forward, x right, y down
+  const Eigen::Vector3d z = view_dir;
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Pose X = Pose::Identity();
+  X.linear().col(0) = x;
+  X.linear().col(1) = y;
+  X.linear().col(2) = z;
+  X.translation() = eye;
+  return X;
+}
+
+CameraIntrinsics IntrinsicsFor(const CameraConfig& c, double fallback_fovy_deg) {
+  if (c.intrinsics) {
+    CameraIntrinsics k = *c.intrinsics;
+    k.width = c.width;
+    k.height = c.height;
+    return k;
+  }
+  return CameraIntrinsics::FromFovy(c.width, c.height, c.fovy_deg.value_or(fallback_fovy_deg));
+}
+
+double FovyOf(const CameraIntrinsics& k) {
+  return 2.0 * std::atan(0.5 * k.height / k.fy) * 180.0 / M_PI;
+}
+
+void AssembleCameras(SceneDescription& scene, const WorldConfig& world) {
+  std::vector<CameraSpec> cameras;
+  // mjcf cameras: defaults, then per-camera overrides
+  if (world.mjcf_cameras.enabled) {
+    for (CameraSpec cam : scene.cameras) {
+      const double fovy = FovyOf(cam.intrinsics);
+      cam.intrinsics =
+          CameraIntrinsics::FromFovy(world.mjcf_cameras.width, world.mjcf_cameras.height, fovy);
+      cam.rate_hz = world.mjcf_cameras.rate_hz;
+      cam.outputs = world.mjcf_cameras.outputs;
+      cameras.push_back(cam);
+    }
+  }
+  for (size_t i = 0; i < world.mjcf_cameras.overrides.size(); ++i) {
+    const CameraConfig& o = world.mjcf_cameras.overrides[i];
+    auto it = std::find_if(cameras.begin(), cameras.end(),
+                           [&](const CameraSpec& c) { return c.name == o.name; });
+    if (it == cameras.end()) {
+      std::string known;
+      for (const CameraSpec& c : scene.cameras) known += (known.empty() ? "" : ", ") + c.name;
+      throw ConfigError(world.file, 0, "mjcf_cameras.overrides." + o.name,
+                        world.mjcf_cameras.enabled
+                            ? "no MJCF camera with that name; expected one of: " +
+                                  (known.empty() ? std::string("(none)") : known)
+                            : "mjcf_cameras.enabled is false; expected no overrides");
+    }
+    it->intrinsics = IntrinsicsFor(o, o.fovy_deg.value_or(FovyOf(it->intrinsics)));
+    it->rate_hz = o.rate_hz;
+    it->outputs = o.outputs;
+  }
+  // world-file cameras
+  for (size_t i = 0; i < world.cameras.size(); ++i) {
+    const CameraConfig& c = world.cameras[i];
+    CameraSpec cam;
+    cam.name = c.name;
+    cam.intrinsics = IntrinsicsFor(c, 60.0);
+    cam.rate_hz = c.rate_hz;
+    cam.outputs = c.outputs;
+    if (c.auto_frame) {
+      cam.body = 0;
+      cam.X_BO = AutoFramePose(scene, FovyOf(cam.intrinsics));
+    } else {
+      cam.body = BodyOrThrow(scene, c.attach, world.file, "cameras[" + std::to_string(i) + "].attach");
+      Pose X_BodyOptical = Pose::Identity();
+      X_BodyOptical.linear() = RotationBodyFromOptical();
+      cam.X_BO = c.pose.ToPose() * X_BodyOptical;
+    }
+    cameras.push_back(cam);
+  }
+  std::set<std::string> names;
+  for (const CameraSpec& c : cameras)
+    if (!names.insert(c.name).second)
+      throw ConfigError(world.file, 0, "cameras",
+                        "two cameras are named '" + c.name +
+                            "'; expected unique names (MJCF cameras are named '<model>/<camera>')");
+  scene.cameras = std::move(cameras);
+}
+
+}  // namespace
+
+SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world) {
+  ApplyMaterialOverrides(scene, world);
+
+  for (size_t i = 0; i < world.lights.size(); ++i)
+    scene.lights.push_back(ToLight(world.lights[i], scene, world.file, i));
+
+  const SkyConfig& s = world.sky;
+  scene.sky.type = s.type;
+  scene.sky.radiance = s.color * static_cast<float>(s.luminance_cd_m2);
+  scene.sky.turbidity = static_cast<float>(s.turbidity);
+  scene.sky.zenith_luminance = static_cast<float>(s.zenith_luminance_cd_m2);
+  scene.sky.sun_direction_W = DirectionFromElevationAzimuth(s.sun_elevation_deg, s.sun_azimuth_deg);
+
+  if (world.default_lights) {
+    // a sun matching the sky's sun, plus a soft key light so bare models read well
+    Light sun;
+    sun.name = "default_sun";
+    sun.type = Light::Type::kDirectional;
+    sun.direction_B = -scene.sky.sun_direction_W;
+    sun.color = {1.0f, 0.96f, 0.9f};
+    sun.intensity = 50000.0f;
+    sun.angular_radius_deg = 0.2665f;
+    scene.lights.push_back(sun);
+  }
+
+  AssembleCameras(scene, world);
+  return scene;
+}
+
+Pose CameraPoseInWorld(const CameraSpec& camera, const WorldSnapshot& snapshot) {
+  if (camera.mjcf_camera >= 0) {
+    Pose X_OpticalInCam = Pose::Identity();
+    X_OpticalInCam.linear() = RotationMujocoCameraFromOptical();
+    return snapshot.X_W_mjcam.at(camera.mjcf_camera) * X_OpticalInCam;
+  }
+  return snapshot.X_WB.at(camera.body) * camera.X_BO;
+}
+
+}  // namespace penumbra
