@@ -15,6 +15,9 @@ namespace {
 constexpr float kKernel[5] = {1.0f / 16, 1.0f / 4, 3.0f / 8, 1.0f / 4, 1.0f / 16};
 // demodulation guard: irradiance = radiance / max(albedo, kAlbedoEps).
 constexpr float kAlbedoEps = 1e-3f;
+// depth test tolerances (times sigma_depth): of the inverse depth, and of its planar change.
+constexpr float kDepthRelativeTolerance = 0.01f;
+constexpr float kDepthSlopeTolerance = 0.1f;
 
 float Luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
@@ -86,8 +89,12 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
     for (int k = 0; k < 3; ++k)
       cur[i * 3 + k] = radiance.data[i * 3 + k] / std::max(albedo[i * 3 + k], kAlbedoEps);
   }
-  // screen-space depth gradient: the smaller one-sided difference towards a surface neighbour.
-  std::vector<float> dzdx(n, 0.0f), dzdy(n, 0.0f);
+  // inverse depth 1/z is affine in screen coordinates on a plane, so a plane through pixel p
+  // predicts it exactly at every neighbour. its screen-space gradient: the smaller one-sided
+  // difference towards a surface neighbour (so that it does not straddle an edge).
+  std::vector<float> inv_z(n, 0.0f), dwdx(n, 0.0f), dwdy(n, 0.0f);
+  for (size_t i = 0; i < n; ++i)
+    if (has_surface(i)) inv_z[i] = 1.0f / depth[i];
   RunRows(pool, h, [&](int64_t v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
@@ -100,14 +107,14 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
           if (uu < 0 || uu >= w || vv < 0 || vv >= h) continue;
           const size_t j = static_cast<size_t>(vv) * w + uu;
           if (!has_surface(j)) continue;
-          const float d = (depth[j] - depth[i]) * s;
+          const float d = (inv_z[j] - inv_z[i]) * s;
           if (!found || std::abs(d) < std::abs(best)) best = d;
           found = true;
         }
         return best;
       };
-      dzdx[i] = grad(1, 0);
-      dzdy[i] = grad(0, 1);
+      dwdx[i] = grad(1, 0);
+      dwdy[i] = grad(0, 1);
     }
   });
 
@@ -126,9 +133,14 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
     const float* nj = normal + j * 3;
     const float c = std::max(0.0f, ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2]);
     const float wn = sigma_n == 0 ? 1.0f : PowCos(c, sigma_n, squarings);
-    const float expected = std::abs(dzdx[i] * du + dzdy[i] * dv);
-    *depth_term = std::abs(depth[i] - depth[j]) /
-                  (settings_.sigma_depth * expected + 1e-3f * depth[i] + 1e-9f);
+    // deviation of the neighbour's inverse depth from the plane of pixel i, relative to a
+    // tolerance of 1% of the depth plus 10% of the plane's change over the offset.
+    const float slope_u = dwdx[i] * du, slope_v = dwdy[i] * dv;
+    const float deviation = std::abs(inv_z[j] - (inv_z[i] + slope_u + slope_v));
+    *depth_term = deviation / (settings_.sigma_depth *
+                                   (kDepthSlopeTolerance * (std::abs(slope_u) + std::abs(slope_v)) +
+                                    kDepthRelativeTolerance * inv_z[i]) +
+                               1e-12f);
     return wn;
   };
 

@@ -8,10 +8,13 @@
 // "Spatiotemporal variance-guided filtering" (SVGF), HPG 2017, eq. 3-5:
 //
 //   w_n = max(0, n_p . n_q)^sigma_normal                         (normals)
-//   w_z = exp(-|z_p - z_q| / (sigma_depth |grad z_p . (p - q)| + eps_z))   (depth)
+//   w_z = exp(-|iz_q - iz_p - grad iz_p . (q - p)| /
+//             (sigma_depth (0.1 |grad iz_p . (q - p)|_1 + 0.01 iz_p)))       (depth, iz = 1/z)
 //   w_l = exp(-|c_p - c_q| / sqrt(3) / (sigma_luminance sqrt(g3x3(var_p)) + eps_l))  (colour)
 //
-// with grad z the screen-space depth gradient (smaller one-sided difference, so that it does
+// with iz = 1/z the inverse depth, which is affine in screen space on a plane (so slanted planes
+// filter isotropically while depth steps stop the filter; SVGF compares z with its gradient
+// instead), grad iz its screen-space gradient (smaller one-sided difference, so that it does
 // not straddle edges), c the rgb of the filtered signal (SVGF compares luminance only; the rgb
 // distance / sqrt(3) equals the luminance difference for grey noise and also separates
 // colours of equal luminance) and var the variance of its luminance, which is
@@ -33,7 +36,7 @@ struct DenoiserSettings {
   int iterations = 5;            ///< a-trous passes (>= 1); footprint 1 + 4 (2^iterations - 1) px
   float sigma_luminance = 4.0f;  ///< luminance edge-stopping, in standard deviations (> 0)
   float sigma_normal = 128.0f;   ///< exponent of the normal cosine (>= 0)
-  float sigma_depth = 1.0f;      ///< depth edge-stopping, in units of the local depth change (> 0)
+  float sigma_depth = 1.0f;      ///< depth edge-stopping tolerance scale (> 0)
 
   /// @throws ConfigError if a value is out of range.
   void ValidateOrThrow() const;
