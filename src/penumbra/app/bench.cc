@@ -53,7 +53,7 @@ int BenchRender(const RenderBenchOptions& options) {
                                                    : RenderSettings::Tier::kRealtime;
   std::string composed_path;
   Simulation sim = LoadWorld(world, &composed_path);
-  const SceneDescription scene = AssembleScene(sim.scene(), world);
+  const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
   if (scene.cameras.empty()) throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
   const CameraSpec& cam = scene.cameras.front();
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);

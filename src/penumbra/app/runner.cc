@@ -116,7 +116,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
 
   // static scene for the renderer
   t0 = Clock::now();
-  const SceneDescription scene = AssembleScene(sim.scene(), world);
+  const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 
@@ -229,7 +229,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   timings["total_sec"] = summary.wall_time_sec;
 
   RunManifest manifest;
-  manifest.world_file = world.file;
+  manifest.world_file = world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
   manifest.seed = world.seed;
   manifest.penumbra_version = PENUMBRA_VERSION;
   manifest.mujoco_version = MujocoVersion();

@@ -77,12 +77,67 @@ Light ToLight(const LightConfig& c, const SceneDescription& scene, const std::st
   return l;
 }
 
+// radius of a sphere around the geom's origin that holds the geom (planes: none).
+double GeomBoundingRadius(const SceneDescription& scene, const Geom& g) {
+  switch (g.shape) {
+    case GeomShape::kPlane:
+      return -1;
+    case GeomShape::kSphere:
+      return g.size.x();
+    case GeomShape::kCapsule:
+      return g.size.x() + g.size.y();
+    case GeomShape::kCylinder:
+      return std::hypot(g.size.x(), g.size.y());
+    case GeomShape::kEllipsoid:
+      return g.size.maxCoeff();
+    case GeomShape::kBox:
+      return g.size.norm();
+    case GeomShape::kMesh: {
+      double r = 0;
+      for (const Eigen::Vector3f& v : scene.meshes.at(g.mesh).vertices) r = std::max(r, double(v.norm()));
+      return r;
+    }
+    case GeomShape::kHeightField: {
+      const HeightField& h = scene.hfields.at(g.hfield);
+      return std::sqrt(h.size_x * h.size_x + h.size_y * h.size_y + h.size_z * h.size_z);
+    }
+  }
+  return -1;
+}
+
+// bounding box of the geoms of moving bodies at `initial` (all finite geoms if none move).
+bool BoundsOfModel(const SceneDescription& scene, const WorldSnapshot& initial, Eigen::Vector3d* lo,
+                   Eigen::Vector3d* hi) {
+  for (bool moving_only : {true, false}) {
+    *lo = Eigen::Vector3d::Constant(1e300);
+    *hi = Eigen::Vector3d::Constant(-1e300);
+    bool any = false;
+    for (const Geom& g : scene.geoms) {
+      if (g.group > 2 || (moving_only && scene.bodies.at(g.body).is_static)) continue;
+      const double r = GeomBoundingRadius(scene, g);
+      if (r < 0 || static_cast<size_t>(g.body) >= initial.X_WB.size()) continue;
+      const Eigen::Vector3d c = initial.X_WB[g.body] * g.X_BG.translation();
+      *lo = lo->cwiseMin(c - Eigen::Vector3d::Constant(r));
+      *hi = hi->cwiseMax(c + Eigen::Vector3d::Constant(r));
+      any = true;
+    }
+    if (any) return true;
+  }
+  return false;
+}
+
 // a camera looking at the model's bounding sphere from the front-left, above.
-Pose AutoFramePose(const SceneDescription& scene, double fovy_deg) {
+Pose AutoFramePose(const SceneDescription& scene, const WorldSnapshot& initial, double fovy_deg) {
+  Eigen::Vector3d center = scene.center_W, lo, hi;
+  double radius = scene.extent_m;
+  if (BoundsOfModel(scene, initial, &lo, &hi)) {
+    center = 0.5 * (lo + hi);
+    radius = 0.5 * (hi - lo).norm();
+  }
   const double half = 0.5 * fovy_deg * M_PI / 180.0;
-  const double distance = std::max(0.1, 1.1 * scene.extent_m / std::sin(half));
+  const double distance = std::max(0.1, 1.6 * radius / std::sin(half));
   const Eigen::Vector3d view_dir = Eigen::Vector3d(-1.0, -0.6, -0.45).normalized();
-  const Eigen::Vector3d eye = scene.center_W - distance * view_dir;
+  const Eigen::Vector3d eye = center - distance * view_dir;
   // optical frame: z forward, x right, y down
   const Eigen::Vector3d z = view_dir;
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
@@ -109,7 +164,7 @@ double FovyOf(const CameraIntrinsics& k) {
   return 2.0 * std::atan(0.5 * k.height / k.fy) * 180.0 / M_PI;
 }
 
-void AssembleCameras(SceneDescription& scene, const WorldConfig& world) {
+void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const WorldSnapshot& initial) {
   std::vector<CameraSpec> cameras;
   // mjcf cameras: defaults, then per-camera overrides
   if (world.mjcf_cameras.enabled) {
@@ -149,7 +204,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world) {
     cam.outputs = c.outputs;
     if (c.auto_frame) {
       cam.body = 0;
-      cam.X_BO = AutoFramePose(scene, FovyOf(cam.intrinsics));
+      cam.X_BO = AutoFramePose(scene, initial, FovyOf(cam.intrinsics));
     } else {
       cam.body = BodyOrThrow(scene, c.attach, world.file, "cameras[" + std::to_string(i) + "].attach");
       Pose X_BodyOptical = Pose::Identity();
@@ -169,7 +224,8 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world) {
 
 }  // namespace
 
-SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world) {
+SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
+                               const WorldSnapshot& initial) {
   ApplyMaterialOverrides(scene, world);
 
   for (size_t i = 0; i < world.lights.size(); ++i)
@@ -194,7 +250,7 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world)
     scene.lights.push_back(sun);
   }
 
-  AssembleCameras(scene, world);
+  AssembleCameras(scene, world, initial);
   return scene;
 }
 

@@ -17,7 +17,10 @@ inline constexpr double kLumensPerWatt = 683.0;
 /// (or are removed when disabled); world-file cameras are attached to their body.
 /// @throws ConfigError naming the world file and key for unknown bodies, materials,
 ///         MJCF cameras and duplicate camera names.
-SceneDescription AssembleScene(SceneDescription extracted, const WorldConfig& world);
+/// `initial` is the world at the start (used to frame auto-framed cameras on the
+/// moving bodies).
+SceneDescription AssembleScene(SceneDescription extracted, const WorldConfig& world,
+                               const WorldSnapshot& initial);
 
 /// pose of a camera's optical frame in the world at `snapshot` (X_WO).
 Pose CameraPoseInWorld(const CameraSpec& camera, const WorldSnapshot& snapshot);
