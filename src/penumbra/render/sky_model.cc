@@ -37,48 +37,55 @@ Eigen::Vector3d DirectionFromAngles(double theta, double phi) {
 }
 
 // piecewise-constant 1d distribution on [0, 1] (Pharr, Jakob, Humphreys, "Physically Based
-// Rendering", 3rd ed., sec. 13.3.1).
+// Rendering", 3rd ed., sec. 13.3.1). built in double, stored in float (compact tables).
 class Distribution1D {
  public:
-  explicit Distribution1D(std::vector<double> f) : func_(std::move(f)), cdf_(func_.size() + 1) {
-    const int n = static_cast<int>(func_.size());
-    cdf_[0] = 0;
-    for (int i = 0; i < n; ++i) cdf_[i + 1] = cdf_[i] + func_[i] / n;
-    integral_ = cdf_[n];
+  explicit Distribution1D(std::vector<double> f) : pdf_(f.size()), cdf_(f.size() + 1) {
+    const int n = static_cast<int>(f.size());
+    std::vector<double> cdf(n + 1, 0.0);
+    for (int i = 0; i < n; ++i) cdf[i + 1] = cdf[i] + f[i] / n;
+    integral_ = cdf[n];
     if (!(integral_ > 0)) {
       // a zero function samples uniformly.
-      std::fill(func_.begin(), func_.end(), 1.0);
-      for (int i = 0; i <= n; ++i) cdf_[i] = static_cast<double>(i) / n;
+      std::fill(f.begin(), f.end(), 1.0);
+      for (int i = 0; i <= n; ++i) cdf[i] = static_cast<double>(i) / n;
       integral_ = 1;
     } else {
-      for (int i = 1; i <= n; ++i) cdf_[i] /= integral_;
+      for (int i = 1; i <= n; ++i) cdf[i] /= integral_;
     }
+    for (int i = 0; i < n; ++i) pdf_[i] = static_cast<float>(f[i] / integral_);
+    for (int i = 0; i <= n; ++i) cdf_[i] = static_cast<float>(cdf[i]);
+    cdf_[n] = 1.0f;
   }
 
-  int count() const { return static_cast<int>(func_.size()); }
+  int count() const { return static_cast<int>(pdf_.size()); }
   double integral() const { return integral_; }
-  /// density on [0, 1] of cell i.
-  double Pdf(int i) const { return func_[i] / integral_; }
+  /// samples keep this fraction of a cell away from its edges, so that float rounding of
+  /// the direction never moves Pdf() into a neighbouring cell; densities scale to match.
+  static constexpr float kCellMargin = 1e-4f;
+
+  /// density on [0, 1] in cell i.
+  float Pdf(int i) const { return pdf_[i] / (1 - 2 * kCellMargin); }
 
   /// maps u in [0, 1) to x in [0, 1); writes the density at x and the cell index.
-  double Sample(double u, double* pdf, int* cell) const {
+  float Sample(float u, float* pdf, int* cell) const {
     const int n = count();
     // last cdf entry <= u.
     int i = static_cast<int>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin()) - 1;
     i = std::clamp(i, 0, n - 1);
     // skip zero-width cells the search may land on.
-    while (i < n - 1 && func_[i] <= 0) ++i;
-    const double width = cdf_[i + 1] - cdf_[i];
-    double du = width > 0 ? (u - cdf_[i]) / width : 0.5;
-    du = std::clamp(du, 0.0, 1.0);
+    while (i < n - 1 && pdf_[i] <= 0) ++i;
+    const float width = cdf_[i + 1] - cdf_[i];
+    float du = width > 0 ? (u - cdf_[i]) / width : 0.5f;
+    du = kCellMargin + std::clamp(du, 0.0f, 1.0f) * (1 - 2 * kCellMargin);
     *pdf = Pdf(i);
     *cell = i;
-    return std::min((i + du) / n, 1.0 - 1e-12);
+    return (i + du) / n;
   }
 
  private:
-  std::vector<double> func_;
-  std::vector<double> cdf_;
+  std::vector<float> pdf_;
+  std::vector<float> cdf_;
   double integral_ = 0;
 };
 
@@ -320,28 +327,31 @@ Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
   const Impl& m = *impl_;
-  double pdf_v = 0, pdf_u = 0;
+  constexpr float kPiF = static_cast<float>(kPi);
+  float pdf_v = 0, pdf_u = 0;
   int row = 0, col = 0;
-  const double v = m.marginal->Sample(u2, &pdf_v, &row);
-  const double u = m.conditional[row].Sample(u1, &pdf_u, &col);
-  const double theta = v * kPi, phi = u * 2 * kPi;
-  const double sin_theta = std::sin(theta);
-  *pdf = sin_theta > 0 ? static_cast<float>(pdf_v * pdf_u / (2 * kPi * kPi * sin_theta)) : 0.0f;
-  return DirectionFromAngles(theta, phi).cast<float>();
+  const float v = m.marginal->Sample(u2, &pdf_v, &row);
+  const float u = m.conditional[row].Sample(u1, &pdf_u, &col);
+  const float theta = v * kPiF, phi = u * 2 * kPiF;
+  const float sin_theta = std::sin(theta);
+  *pdf = sin_theta > 0 ? pdf_v * pdf_u / (2 * kPiF * kPiF * sin_theta) : 0.0f;
+  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), std::cos(theta)};
 }
 
 float SkyModel::Pdf(const Eigen::Vector3f& dir_W) const {
   const Impl& m = *impl_;
-  const Eigen::Vector3d d = dir_W.cast<double>().normalized();
-  const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
-  const double sin_theta = std::sin(theta);
-  if (!(sin_theta > 0)) return 0.0f;
-  double phi = std::atan2(d.y(), d.x());
-  if (phi < 0) phi += 2 * kPi;
-  const int row = std::clamp(static_cast<int>(theta / kPi * kSampleRows), 0, kSampleRows - 1);
-  const int col = std::clamp(static_cast<int>(phi / (2 * kPi) * kSampleCols), 0, kSampleCols - 1);
-  const double p = m.marginal->Pdf(row) * m.conditional[row].Pdf(col);
-  return static_cast<float>(p / (2 * kPi * kPi * sin_theta));
+  constexpr float kPiF = static_cast<float>(kPi);
+  // theta and sin(theta) from atan2 / hypot stay accurate near the poles.
+  const float rho = std::hypot(dir_W.x(), dir_W.y());
+  const float len = std::hypot(rho, dir_W.z());
+  if (!(len > 0) || !(rho > 0)) return 0.0f;
+  const float theta = std::atan2(rho, dir_W.z());
+  const float sin_theta = rho / len;
+  float phi = std::atan2(dir_W.y(), dir_W.x());
+  if (phi < 0) phi += 2 * kPiF;
+  const int row = std::clamp(static_cast<int>(theta / kPiF * kSampleRows), 0, kSampleRows - 1);
+  const int col = std::clamp(static_cast<int>(phi / (2 * kPiF) * kSampleCols), 0, kSampleCols - 1);
+  return m.marginal->Pdf(row) * m.conditional[row].Pdf(col) / (2 * kPiF * kPiF * sin_theta);
 }
 
 }  // namespace penumbra
