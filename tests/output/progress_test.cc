@@ -99,3 +99,39 @@ TEST(ProgressReporter, BarModeRedrawsAtMostTenTimesPerSecond) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+TEST(ProgressReporter, AutoModeLogsWhenTheStreamIsNotATerminal) {
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  std::vector<std::string> lines;
+  ProgressOptions opt;
+  opt.stream = f;
+  opt.log = [&](const std::string& s) { lines.push_back(s); };
+  {
+    ProgressReporter p(1.0, opt);
+    EXPECT_EQ(p.mode(), ProgressOptions::Mode::kLog);
+    p.Update(1.0, 10);
+  }
+  EXPECT_EQ(lines.size(), 1u);
+  EXPECT_EQ(std::ftell(f), 0L) << "nothing drawn on a non-terminal";
+  std::fclose(f);
+}
+
+TEST(ProgressReporter, OffModeIsSilent) {
+  std::vector<std::string> lines;
+  ProgressOptions opt;
+  opt.mode = ProgressOptions::Mode::kOff;
+  opt.log = [&](const std::string& s) { lines.push_back(s); };
+  {
+    ProgressReporter p(1.0, opt);
+    p.Update(0.5, 1);
+    p.Update(1.0, 2);
+  }
+  EXPECT_TRUE(lines.empty());
+}
+
+}  // namespace
+}  // namespace penumbra
