@@ -56,6 +56,15 @@ class Distribution1D {
     for (int i = 0; i < n; ++i) pdf_[i] = static_cast<float>(f[i] / integral_);
     for (int i = 0; i <= n; ++i) cdf_[i] = static_cast<float>(cdf[i]);
     cdf_[n] = 1.0f;
+    // guide table (Chen and Asau 1974): the cell holding u = k / n, so that a search starts
+    // next to its answer.
+    guide_.resize(n);
+    int i = 0;
+    for (int k = 0; k < n; ++k) {
+      const float u = static_cast<float>(k) / n;
+      while (i < n - 1 && cdf_[i + 1] <= u) ++i;
+      guide_[k] = i;
+    }
   }
 
   int count() const { return static_cast<int>(pdf_.size()); }
@@ -70,9 +79,9 @@ class Distribution1D {
   /// maps u in [0, 1) to x in [0, 1); writes the density at x and the cell index.
   float Sample(float u, float* pdf, int* cell) const {
     const int n = count();
-    // last cdf entry <= u.
-    int i = static_cast<int>(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin()) - 1;
-    i = std::clamp(i, 0, n - 1);
+    // the cell with cdf[i] <= u < cdf[i + 1], searched forward from the guide entry.
+    int i = guide_[std::clamp(static_cast<int>(u * n), 0, n - 1)];
+    while (i < n - 1 && cdf_[i + 1] <= u) ++i;
     // skip zero-width cells the search may land on.
     while (i < n - 1 && pdf_[i] <= 0) ++i;
     const float width = cdf_[i + 1] - cdf_[i];
@@ -86,6 +95,7 @@ class Distribution1D {
  private:
   std::vector<float> pdf_;
   std::vector<float> cdf_;
+  std::vector<int> guide_;
   double integral_ = 0;
 };
 
