@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/core/pose.h"
+
 namespace penumbra {
 
 /// kind of named model object a controller can ask for.
@@ -33,6 +35,11 @@ struct ActuatorInfo {
   int joint = -1;  ///< joint it drives (joint transmission), else -1
   bool ctrl_limited = false;
   double ctrl_range[2] = {0, 0};  ///< clamp range of ctrl when ctrl_limited
+  int site = -1;  ///< site it acts on (site transmission, e.g. a rotor's thrust), else -1
+  /// actuator_gear: for a site transmission, the (force xyz, torque xyz) the actuator applies
+  /// per unit of its scalar force, in the site frame; for a joint transmission gear[0] is the
+  /// joint gear ratio.
+  double gear[6] = {1, 0, 0, 0, 0, 0};
 };
 
 /// a sensor (MuJoCo sensor_* arrays); its values are sensordata[adr .. adr + dim).
@@ -51,8 +58,15 @@ struct ModelInfo {
   double timestep_sec = 0.002;
   std::vector<std::string> body_names;  ///< (nbody)
   std::vector<int> body_parent;         ///< (nbody) parent body index, -1 for the world
+  /// (nbody) mass properties and rest frames (MuJoCo body_mass, body_inertia, body_pos /
+  /// body_quat, body_ipos / body_iquat); empty when the model info was built by hand.
+  std::vector<double> body_mass;              ///< kg
+  std::vector<Eigen::Vector3d> body_inertia;  ///< principal moments about the COM (kg m^2)
+  std::vector<Pose> body_X_PB;  ///< X_PB: body in its parent's frame at qpos0 (world: identity)
+  std::vector<Pose> body_X_BI;  ///< X_BI: inertial frame (origin at the COM, principal axes)
   std::vector<std::string> site_names;  ///< (nsite)
   std::vector<int> site_body;           ///< (nsite) body each site is fixed to
+  std::vector<Pose> site_X_BS;          ///< (nsite) X_BS: site in its body's frame (site_pos/quat)
   std::vector<JointInfo> joints;        ///< (njnt)
   std::vector<ActuatorInfo> actuators;  ///< (nu)
   std::vector<SensorInfo> sensors;      ///< (nsensor)

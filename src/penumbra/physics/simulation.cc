@@ -98,10 +98,16 @@ ModelInfo BuildModelInfo(const mjModel* m) {
   for (int b = 0; b < m->nbody; ++b) {
     info.body_names.push_back(NameOr(m, mjOBJ_BODY, b));
     info.body_parent.push_back(b == 0 ? -1 : m->body_parentid[b]);
+    info.body_mass.push_back(m->body_mass[b]);
+    info.body_inertia.emplace_back(m->body_inertia[3 * b], m->body_inertia[3 * b + 1],
+                                   m->body_inertia[3 * b + 2]);
+    info.body_X_PB.push_back(PoseFromPosQuat(m->body_pos + 3 * b, m->body_quat + 4 * b));
+    info.body_X_BI.push_back(PoseFromPosQuat(m->body_ipos + 3 * b, m->body_iquat + 4 * b));
   }
   for (int s = 0; s < m->nsite; ++s) {
     info.site_names.push_back(NameOr(m, mjOBJ_SITE, s));
     info.site_body.push_back(m->site_bodyid[s]);
+    info.site_X_BS.push_back(PoseFromPosQuat(m->site_pos + 3 * s, m->site_quat + 4 * s));
   }
   for (int j = 0; j < m->njnt; ++j) {
     JointInfo ji;
@@ -120,6 +126,8 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     ai.name = NameOr(m, mjOBJ_ACTUATOR, a);
     const int trn = m->actuator_trntype[a];
     ai.joint = (trn == mjTRN_JOINT || trn == mjTRN_JOINTINPARENT) ? m->actuator_trnid[2 * a] : -1;
+    ai.site = trn == mjTRN_SITE ? m->actuator_trnid[2 * a] : -1;
+    for (int k = 0; k < 6; ++k) ai.gear[k] = m->actuator_gear[6 * a + k];
     ai.ctrl_limited = m->actuator_ctrllimited[a] != 0;
     ai.ctrl_range[0] = m->actuator_ctrlrange[2 * a];
     ai.ctrl_range[1] = m->actuator_ctrlrange[2 * a + 1];
