@@ -42,6 +42,11 @@ class ControllerParams {
   /// list of [x, y] pairs of finite numbers, at least `min_count`.
   std::vector<Eigen::Vector2d> Points2(const std::string& key, size_t min_count);
 
+  /// the YAML node of `key`, for structured values the typed readers above don't cover
+  /// (lists of mappings, nested blocks); nullptr when absent. marks `key` as known. the
+  /// node lives as long as this object; report bad values with Fail("key[i].sub", ...).
+  const YAML::Node* Raw(const std::string& key) { return Get(key); }
+
   /// @throws ConfigError listing the keys that were never read, and the allowed keys.
   void CheckNoUnknownKeys() const;
   /// @throws ConfigError for `key` (relative to the controller block) with `problem`.
