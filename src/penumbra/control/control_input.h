@@ -35,6 +35,13 @@ class ControlInput {
   /// acceleration stage sensors, e.g. accelerometers, are from the previous step).
   virtual std::span<const double> sensordata() const = 0;
 
+  /// (nv) MuJoCo qfrc_bias = C(q, qdot) qdot + g(q): the Coriolis, centrifugal and gravity
+  /// generalized forces (N or N m per dof) at the current state, from MuJoCo's recursive
+  /// Newton-Euler pass (mj_rne, Featherstone, "Rigid Body Dynamics Algorithms", 2008). adding
+  /// it to joint torques compensates gravity and velocity-product terms. empty when the
+  /// input cannot provide it (the default, e.g. hand-made fakes in tests).
+  virtual std::span<const double> qfrc_bias() const { return {}; }
+
   /// X_WB: pose of body `body` (ModelInfo index) in the world frame.
   virtual Pose X_WB(int body) const = 0;
   /// V_WB: twist of body `body`'s frame in the world frame (see Twist).

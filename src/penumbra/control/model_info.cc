@@ -14,6 +14,8 @@ const char* ModelObjectName(ModelObject kind) {
       return "sensor";
     case ModelObject::kSite:
       return "site";
+    case ModelObject::kKey:
+      return "keyframe";
   }
   return "object";
 }
@@ -33,6 +35,9 @@ std::vector<std::string> ModelInfo::Names(ModelObject kind) const {
       break;
     case ModelObject::kSensor:
       for (const auto& s : sensors) out.push_back(s.name);
+      break;
+    case ModelObject::kKey:
+      for (const auto& k : keys) out.push_back(k.name);
       break;
   }
   return out;
@@ -58,6 +63,8 @@ int ModelInfo::Find(ModelObject kind, const std::string& name) const {
       return find(actuators, named);
     case ModelObject::kSensor:
       return find(sensors, named);
+    case ModelObject::kKey:
+      return find(keys, named);
   }
   return -1;
 }

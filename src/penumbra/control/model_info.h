@@ -12,7 +12,7 @@
 namespace penumbra {
 
 /// kind of named model object a controller can ask for.
-enum class ModelObject { kBody, kJoint, kActuator, kSensor, kSite };
+enum class ModelObject { kBody, kJoint, kActuator, kSensor, kSite, kKey };
 
 /// lowercase English name of a kind ("body", "joint", ...), for messages.
 const char* ModelObjectName(ModelObject kind);
@@ -49,6 +49,13 @@ struct SensorInfo {
   int dim = 0;
 };
 
+/// a keyframe (MuJoCo <key>, key_* arrays).
+struct KeyInfo {
+  std::string name;
+  double time_sec = 0;       ///< key_time
+  std::vector<double> qpos;  ///< (nq) key_qpos
+};
+
 /// the model as controllers see it. indices are MuJoCo ids; index 0 of bodies is the world.
 struct ModelInfo {
   int nq = 0;           ///< size of qpos
@@ -70,6 +77,7 @@ struct ModelInfo {
   std::vector<JointInfo> joints;        ///< (njnt)
   std::vector<ActuatorInfo> actuators;  ///< (nu)
   std::vector<SensorInfo> sensors;      ///< (nsensor)
+  std::vector<KeyInfo> keys;            ///< (nkey) keyframes; empty when built by hand
 
   /// index of the object of `kind` named `name` (exact match), or -1.
   int Find(ModelObject kind, const std::string& name) const;

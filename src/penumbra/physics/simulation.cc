@@ -31,6 +31,9 @@ class MujocoControlInput final : public ControlInput {
   std::span<const double> sensordata() const override {
     return {d_->sensordata, static_cast<size_t>(m_->nsensordata)};
   }
+  std::span<const double> qfrc_bias() const override {
+    return {d_->qfrc_bias, static_cast<size_t>(m_->nv)};
+  }
   Pose X_WB(int body) const override {
     CheckBody(body, "X_WB");
     return PoseFromPosQuat(d_->xpos + 3 * body, d_->xquat + 4 * body);
@@ -135,6 +138,14 @@ ModelInfo BuildModelInfo(const mjModel* m) {
   }
   for (int s = 0; s < m->nsensor; ++s)
     info.sensors.push_back({NameOr(m, mjOBJ_SENSOR, s), m->sensor_adr[s], m->sensor_dim[s]});
+  for (int k = 0; k < m->nkey; ++k) {
+    KeyInfo key;
+    key.name = NameOr(m, mjOBJ_KEY, k);
+    key.time_sec = m->key_time[k];
+    key.qpos.assign(m->key_qpos + static_cast<size_t>(k) * m->nq,
+                    m->key_qpos + static_cast<size_t>(k + 1) * m->nq);
+    info.keys.push_back(std::move(key));
+  }
   return info;
 }
 
