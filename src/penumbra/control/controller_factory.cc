@@ -4,6 +4,8 @@
 #include <map>
 
 #include "penumbra/control/controller_params.h"
+#include "penumbra/control/trot_gait.h"
+#include "penumbra/control/multirotor_pid.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
 
@@ -16,6 +18,14 @@ using Maker = std::function<std::unique_ptr<Controller>(ControllerParams&, const
 // every controller type; a new type adds one entry here.
 const std::map<std::string, Maker>& Registry() {
   static const std::map<std::string, Maker> registry = {
+      {"trot_gait",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<TrotGait>(TrotGaitParams::Parse(p, prefix), c);
+       }},
+      {"multirotor_pid",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<MultirotorPid>(MultirotorPidParams::Parse(p, prefix), c);
+       }},
       {"waypoint_follower",
        [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
          return std::make_unique<WaypointFollower>(WaypointFollowerParams::Parse(p, prefix), c);

@@ -2,6 +2,7 @@
 // builds controllers from world-file `controller:` blocks.
 //
 // types (the `type:` key):
+//   multirotor_pid      cascaded multirotor flight controller (control/multirotor_pid.h)
 //   waypoint_follower   differential-drive waypoint follower (control/waypoint_follower.h)
 
 #include <memory>
