@@ -4,6 +4,9 @@
 #include <map>
 
 #include "penumbra/control/controller_params.h"
+#include "penumbra/control/diff_ik.h"
+#include "penumbra/control/joint_controller.h"
+#include "penumbra/control/keyframe_playback.h"
 #include "penumbra/control/trot_gait.h"
 #include "penumbra/control/multirotor_pid.h"
 #include "penumbra/control/waypoint_follower.h"
@@ -18,6 +21,18 @@ using Maker = std::function<std::unique_ptr<Controller>(ControllerParams&, const
 // every controller type; a new type adds one entry here.
 const std::map<std::string, Maker>& Registry() {
   static const std::map<std::string, Maker> registry = {
+      {"joint_pd",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<JointPdController>(JointPdParams::Parse(p, prefix), c);
+       }},
+      {"diff_ik",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<DiffIkController>(DiffIkParams::Parse(p, prefix), c);
+       }},
+      {"keyframe_playback",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<KeyframePlayback>(KeyframePlaybackParams::Parse(p, prefix), c);
+       }},
       {"trot_gait",
        [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
          return std::make_unique<TrotGait>(TrotGaitParams::Parse(p, prefix), c);

@@ -1,0 +1,218 @@
+#include "penumbra/control/param_node.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+struct ParamNode::Impl {
+  YAML::Node node;
+  std::vector<std::pair<std::string, YAML::Node>> entries;  // in file order
+};
+
+namespace {
+
+std::string Repr(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  if (n.IsSequence())
+    return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
+  if (n.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+std::string FormatNumber(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+std::string RangeText(double min, double max, bool min_exclusive) {
+  std::string s = (min_exclusive ? "> " : ">= ") + FormatNumber(min);
+  if (!std::isinf(max)) s += " and <= " + FormatNumber(max);
+  if (std::isinf(min) && std::isinf(max)) s = "finite";
+  return s;
+}
+
+bool ToNumber(const YAML::Node& n, double* v) {
+  if (!n.IsScalar()) return false;
+  try {
+    *v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+  return std::isfinite(*v);
+}
+
+[[noreturn]] void FailAt(const ControllerContext& c, const std::string& key,
+                         const std::string& problem) {
+  throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
+}
+
+}  // namespace
+
+ParamNode::ParamNode(const YAML::Node& node, std::string path, ControllerContext context)
+    : impl_(std::make_unique<Impl>()), path_(std::move(path)), context_(std::move(context)) {
+  impl_->node = node;
+  if (node.IsMap())
+    for (const auto& kv : node) impl_->entries.emplace_back(kv.first.Scalar(), kv.second);
+}
+
+ParamNode::~ParamNode() = default;
+ParamNode::ParamNode(ParamNode&&) noexcept = default;
+
+std::string ParamNode::KeyPath(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void ParamNode::Fail(const std::string& key, const std::string& problem) const {
+  FailAt(context_, KeyPath(key), problem);
+}
+
+void ParamNode::FailHere(const std::string& problem) const { FailAt(context_, path_, problem); }
+
+bool ParamNode::Has(const std::string& key) const {
+  for (const auto& e : impl_->entries)
+    if (e.first == key) return true;
+  return false;
+}
+
+const YAML::Node* ParamNode::Get(const std::string& key) {
+  if (!impl_->node.IsMap()) FailHere("got " + Repr(impl_->node) + "; expected a mapping");
+  known_.insert(key);
+  for (const auto& e : impl_->entries)
+    if (e.first == key) return &e.second;
+  return nullptr;
+}
+
+const YAML::Node* ParamNode::Raw(const std::string& key) { return Get(key); }
+
+double ParamNode::Number(const std::string& key, std::optional<double> fallback, double min,
+                         double max) {
+  const YAML::Node* n = Get(key);
+  const std::string range = RangeText(min, max, false);
+  if (!n) {
+    if (fallback) return *fallback;
+    Fail(key, "missing; expected a number " + range);
+  }
+  double v = 0;
+  if (!ToNumber(*n, &v)) Fail(key, "got " + Repr(*n) + "; expected a number " + range);
+  if (v < min || v > max) Fail(key, "got " + FormatNumber(v) + "; expected a number " + range);
+  return v;
+}
+
+std::vector<double> ParamNode::Numbers(const std::string& key, size_t count, double min, double max,
+                                       const std::string& unit) {
+  const YAML::Node* n = Get(key);
+  const std::string expected =
+      "expected a list of " + std::to_string(count) + " numbers" +
+      (unit.empty() ? "" : " (" + unit + ")") +
+      (std::isinf(min) && std::isinf(max) ? "" : ", each " + RangeText(min, max, false));
+  if (!n) Fail(key, "missing; " + expected);
+  if (!n->IsSequence() || n->size() != count) Fail(key, "got " + Repr(*n) + "; " + expected);
+  std::vector<double> out(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (!ToNumber((*n)[i], &out[i]) || out[i] < min || out[i] > max)
+      Fail(key + "[" + std::to_string(i) + "]", "got " + Repr((*n)[i]) + "; " + expected);
+  }
+  return out;
+}
+
+std::string ParamNode::String(const std::string& key) {
+  const YAML::Node* n = Get(key);
+  if (!n) Fail(key, "missing; expected a name");
+  if (!n->IsScalar() || n->Scalar().empty()) Fail(key, "got " + Repr(*n) + "; expected a name");
+  return n->Scalar();
+}
+
+ParamNode ParamNode::Child(const std::string& key) {
+  const YAML::Node* n = Get(key);
+  if (!n) Fail(key, "missing; expected a mapping");
+  if (!n->IsMap()) Fail(key, "got " + Repr(*n) + "; expected a mapping");
+  return ParamNode(*n, KeyPath(key), context_);
+}
+
+void ParamNode::CheckNoUnknownKeys() const {
+  std::string first, unknown;
+  for (const auto& e : impl_->entries) {
+    if (known_.count(e.first)) continue;
+    if (first.empty()) first = e.first;
+    unknown += (unknown.empty() ? "'" : ", '") + e.first + "'";
+  }
+  if (unknown.empty()) return;
+  std::string allowed;
+  for (const auto& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
+  Fail(first, "unknown key(s) " + unknown + "; expected only: " + allowed);
+}
+
+std::vector<std::string> ReadNameList(ControllerParams& params, const std::string& key,
+                                      size_t min_count, const std::string& prefix) {
+  const YAML::Node* n = params.Raw(key);
+  const std::string expected =
+      "expected a list of at least " + std::to_string(min_count) + " names, e.g. [joint1, joint2]";
+  if (!n) params.Fail(key, "missing; " + expected);
+  if (!n->IsSequence()) params.Fail(key, "got " + Repr(*n) + "; " + expected);
+  std::vector<std::string> out;
+  for (size_t i = 0; i < n->size(); ++i) {
+    const YAML::Node item = (*n)[i];
+    const std::string item_key = key + "[" + std::to_string(i) + "]";
+    if (!item.IsScalar() || item.Scalar().empty())
+      params.Fail(item_key, "got " + Repr(item) + "; expected a name");
+    const std::string name = prefix + item.Scalar();
+    for (size_t k = 0; k < out.size(); ++k)
+      if (out[k] == name)
+        params.Fail(item_key, "'" + item.Scalar() + "' is listed twice (also at " + key + "[" +
+                                  std::to_string(k) + "]); expected distinct names");
+    out.push_back(name);
+  }
+  if (out.size() < min_count)
+    params.Fail(key, "got " + std::to_string(out.size()) + " names; " + expected);
+  return out;
+}
+
+std::vector<double> ReadPerJoint(ControllerParams& params, const std::string& key, size_t count,
+                                 std::optional<std::vector<double>> fallback, double min,
+                                 double max, bool min_exclusive) {
+  const std::string range = RangeText(min, max, min_exclusive);
+  const std::string expected = "expected a number " + range + " or a list of " +
+                               std::to_string(count) + " such numbers (one per joint)";
+  const YAML::Node* n = params.Raw(key);
+  if (!n) {
+    if (fallback) return *fallback;
+    params.Fail(key, "missing; " + expected);
+  }
+  auto check = [&](const YAML::Node& item, const std::string& item_key) {
+    double v = 0;
+    if (!ToNumber(item, &v) || v < min || v > max || (min_exclusive && v == min))
+      params.Fail(item_key, "got " + Repr(item) + "; " + expected);
+    return v;
+  };
+  if (n->IsScalar()) return std::vector<double>(count, check(*n, key));
+  if (!n->IsSequence() || n->size() != count) params.Fail(key, "got " + Repr(*n) + "; " + expected);
+  std::vector<double> out(count);
+  for (size_t i = 0; i < count; ++i) out[i] = check((*n)[i], key + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+std::optional<std::vector<double>> ReadOptionalNumbers(ControllerParams& params,
+                                                       const std::string& key, size_t count,
+                                                       double min, double max,
+                                                       const std::string& unit) {
+  const YAML::Node* n = params.Raw(key);
+  if (!n) return std::nullopt;
+  const std::string expected =
+      "expected a list of " + std::to_string(count) + " numbers" +
+      (unit.empty() ? "" : " (" + unit + ")") +
+      (std::isinf(min) && std::isinf(max) ? "" : ", each " + RangeText(min, max, false));
+  if (!n->IsSequence() || n->size() != count) params.Fail(key, "got " + Repr(*n) + "; " + expected);
+  std::vector<double> out(count);
+  for (size_t i = 0; i < count; ++i)
+    if (!ToNumber((*n)[i], &out[i]) || out[i] < min || out[i] > max)
+      params.Fail(key + "[" + std::to_string(i) + "]", "got " + Repr((*n)[i]) + "; " + expected);
+  return out;
+}
+
+}  // namespace penumbra
