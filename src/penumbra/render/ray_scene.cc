@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -14,50 +13,61 @@
 namespace penumbra {
 namespace {
 
-// rays per Embree stream call in IntersectMany / OccludedMany.
-constexpr int kStreamChunk = 64;
+// rays per Embree packet in IntersectMany / OccludedMany (rtcIntersect16 / rtcOccluded16).
+constexpr int kPacket = 16;
+
+// frames: G = geom, I = the frame of the instanced scene that holds the geom (the body frame
+// for a moving body, the world frame for the merged static bodies).
 
 // a geom traced as Embree user geometry; lives at a stable address (geometry user pointer).
 struct AnalyticGeom {
   AnalyticShape shape;
-  Eigen::Matrix3d R_GB;  // p_G = R_GB p_B + p_GB
-  Eigen::Vector3d p_GB;
-  Eigen::Matrix3f R_BG_f;  // for the body-frame Ng reported to Embree
+  Eigen::Matrix3d R_GI;  // p_G = R_GI p_I + p_GI
+  Eigen::Vector3d p_GI;
+  Eigen::Matrix3f R_IG_f;  // for the instance-frame Ng reported to Embree
 };
 
-// a geom traced as triangles, in the body frame. vertices carry one padding element at
+// a geom traced as triangles, in the instance frame. vertices carry one padding element at
 // the end: Embree reads vertex buffers with 16-byte loads.
 struct TriangleGeom {
-  std::vector<Eigen::Vector3f> vertices_B;
-  std::vector<Eigen::Vector3f> normals_B;
+  std::vector<Eigen::Vector3f> vertices_I;
+  std::vector<Eigen::Vector3f> normals_I;
   std::vector<Eigen::Vector2f> texcoords;
   std::vector<Eigen::Vector3i> faces;
-  Eigen::Matrix3f R_GB;  // p_G = R_GB p_B + p_GB
-  Eigen::Vector3f p_GB;
+  Eigen::Matrix3f R_GI;  // p_G = R_GI p_I + p_GI
+  Eigen::Vector3f p_GI;
 };
 
-// what an Embree (body scene, geomID) pair stands for.
+// what an Embree (instanced scene, geomID) pair stands for.
 struct GeomRecord {
   int geom = -1;
   int material = -1;
-  int analytic = -1;   // index into Impl::analytic, or -1
-  int triangles = -1;  // index into Impl::triangles, or -1
+  const AnalyticGeom* analytic = nullptr;  // exactly one of analytic / triangles is set
+  const TriangleGeom* triangles = nullptr;
 };
 
-struct BodyScene {
-  int body = -1;
+// one instanced scene: the geoms of one moving body, or of every static body merged.
+struct InstanceGroup {
+  bool is_static = false;
+  int body = -1;           // moving body; -1 for the static group
+  std::vector<int> geoms;  // indices into SceneDescription::geoms
   RTCScene scene = nullptr;
   RTCGeometry instance = nullptr;
-  std::vector<GeomRecord> geoms;  // by geomID in `scene`
+  std::vector<GeomRecord> records;  // by geomID in `scene`
+  std::vector<std::unique_ptr<AnalyticGeom>> analytic;
+  std::vector<std::unique_ptr<TriangleGeom>> triangles;
+  Pose X_WI = Pose::Identity();  // current instance pose (identity for the static group)
+  Eigen::Matrix3f R_WI_f = Eigen::Matrix3f::Identity();
+  int64_t num_triangles = 0;
 };
 
 void AnalyticBounds(const RTCBoundsFunctionArguments* args) {
   const auto* g = static_cast<const AnalyticGeom*>(args->geometryUserPtr);
   const Eigen::Vector3d h = AnalyticHalfExtents(g->shape);
-  // body-frame box of the rotated geom box: centre p_BG, half extents |R_BG| h.
-  const Eigen::Matrix3d R_BG = g->R_GB.transpose();
-  const Eigen::Vector3d c = -(R_BG * g->p_GB);
-  const Eigen::Vector3d e = R_BG.cwiseAbs() * h;
+  // instance-frame box of the rotated geom box: centre p_IG, half extents |R_IG| h.
+  const Eigen::Matrix3d R_IG = g->R_GI.transpose();
+  const Eigen::Vector3d c = -(R_IG * g->p_GI);
+  const Eigen::Vector3d e = R_IG.cwiseAbs() * h;
   // pad by a relative epsilon so that flat shapes (planes) have volume and float rounding
   // of the box never clips the surface.
   const Eigen::Vector3d pad =
@@ -71,15 +81,15 @@ void AnalyticBounds(const RTCBoundsFunctionArguments* args) {
   args->bounds_o->upper_z = static_cast<float>(hi.z());
 }
 
-// intersects ray i of an N-wide Embree ray (already in the body frame) with an analytic geom.
+// intersects ray i of an N-wide Embree ray (already in the instance frame) with an analytic geom.
 inline bool IntersectLane(const AnalyticGeom& g, RTCRayN* ray, unsigned N, unsigned i, double* t,
                           ShapePart* part) {
-  const Eigen::Vector3d o_B(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i),
+  const Eigen::Vector3d o_I(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i),
                             RTCRayN_org_z(ray, N, i));
-  const Eigen::Vector3d d_B(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i),
+  const Eigen::Vector3d d_I(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i),
                             RTCRayN_dir_z(ray, N, i));
-  const Eigen::Vector3d o_G = g.R_GB * o_B + g.p_GB;
-  const Eigen::Vector3d d_G = g.R_GB * d_B;
+  const Eigen::Vector3d o_G = g.R_GI * o_I + g.p_GI;
+  const Eigen::Vector3d d_G = g.R_GI * d_I;
   return IntersectAnalytic(g.shape, o_G, d_G, RTCRayN_tnear(ray, N, i), RTCRayN_tfar(ray, N, i), t,
                            part);
 }
@@ -96,16 +106,16 @@ void AnalyticIntersect(const RTCIntersectFunctionNArguments* args) {
     const float tf = static_cast<float>(t);
     if (!(tf < RTCRayN_tfar(ray, args->N, i))) continue;
     RTCRayN_tfar(ray, args->N, i) = tf;
-    // Ng: rough body-frame normal (RayScene recomputes the exact one in double).
-    const Eigen::Vector3d o_B(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
+    // Ng: rough instance-frame normal (RayScene recomputes the exact one in double).
+    const Eigen::Vector3d o_I(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
                               RTCRayN_org_z(ray, args->N, i));
-    const Eigen::Vector3d d_B(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
+    const Eigen::Vector3d d_I(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
                               RTCRayN_dir_z(ray, args->N, i));
-    const Eigen::Vector3d p_G = g->R_GB * (o_B + t * d_B) + g->p_GB;
-    const Eigen::Vector3f n_B = g->R_BG_f * AnalyticNormal(g->shape, p_G, part).cast<float>();
-    RTCHitN_Ng_x(hit, args->N, i) = n_B.x();
-    RTCHitN_Ng_y(hit, args->N, i) = n_B.y();
-    RTCHitN_Ng_z(hit, args->N, i) = n_B.z();
+    const Eigen::Vector3d p_G = g->R_GI * (o_I + t * d_I) + g->p_GI;
+    const Eigen::Vector3f n_I = g->R_IG_f * AnalyticNormal(g->shape, p_G, part).cast<float>();
+    RTCHitN_Ng_x(hit, args->N, i) = n_I.x();
+    RTCHitN_Ng_y(hit, args->N, i) = n_I.y();
+    RTCHitN_Ng_z(hit, args->N, i) = n_I.z();
     RTCHitN_u(hit, args->N, i) = static_cast<float>(static_cast<int>(part));
     RTCHitN_v(hit, args->N, i) = 0.0f;
     RTCHitN_primID(hit, args->N, i) = args->primID;
@@ -152,15 +162,12 @@ inline void ToEmbree(const Ray& r, RTCRay* e) {
 struct RayScene::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
-  std::string error;                        // first Embree error message
-  std::vector<BodyScene> bodies;            // bodies with visible geoms
-  std::vector<int> body_scene_of;           // body index -> index into bodies, or -1
-  std::vector<int> instance_to_body_scene;  // top-level geomID -> index into bodies
-  std::vector<std::unique_ptr<AnalyticGeom>> analytic;
-  std::vector<std::unique_ptr<TriangleGeom>> triangles;
-  // per body: R_WB, p_WB in float and double for hit reconstruction.
-  std::vector<Eigen::Matrix3f> R_WB_f;
-  std::vector<Eigen::Vector3f> p_WB_f;
+  std::string error;  // first Embree error message
+  const SceneDescription* scene = nullptr;
+  // groups[0] is the static group (may hold no geoms); then one per moving body with geoms.
+  std::vector<InstanceGroup> groups;
+  std::vector<int> group_of_instance;  // top-level geomID -> index into groups
+  std::vector<Pose> static_poses;      // X_WB of every body as the static group was built
 
   void Check(const char* what) const {
     if (!error.empty()) throw Error(std::string("RayScene: ") + what + ": " + error);
@@ -169,13 +176,128 @@ struct RayScene::Impl {
       throw Error(std::string("RayScene: ") + what + ": Embree error " + std::to_string(code));
   }
 
+  // adds geom `gi` to `group`'s scene with pose X_IG in the instance frame.
+  void AddGeom(InstanceGroup* group, int gi, const Pose& X_IG) {
+    const SceneDescription& sd = *scene;
+    const Geom& geom = sd.geoms[gi];
+    GeomRecord rec;
+    rec.geom = gi;
+    rec.material = geom.material;
+    const Pose X_GI = X_IG.inverse();
+    RTCGeometry eg = nullptr;
+    if (geom.shape == GeomShape::kBox || geom.shape == GeomShape::kMesh ||
+        geom.shape == GeomShape::kHeightField) {
+      TriangleShape shape;
+      if (geom.shape == GeomShape::kBox) {
+        shape = BoxTriangles(geom.size);
+      } else if (geom.shape == GeomShape::kMesh) {
+        shape = MeshTriangles(sd.meshes[geom.mesh]);
+      } else {
+        shape = HeightFieldTriangles(sd.hfields[geom.hfield]);
+      }
+      if (shape.faces.empty()) return;
+      auto tg = std::make_unique<TriangleGeom>();
+      const Eigen::Matrix3f R_IG = X_IG.linear().cast<float>();
+      const Eigen::Vector3f p_IG = X_IG.translation().cast<float>();
+      tg->vertices_I.reserve(shape.vertices.size() + 1);
+      for (const Eigen::Vector3f& v : shape.vertices) tg->vertices_I.push_back(R_IG * v + p_IG);
+      tg->vertices_I.push_back(Eigen::Vector3f::Zero());  // padding for Embree's 16-byte loads
+      for (const Eigen::Vector3f& n : shape.normals)
+        tg->normals_I.push_back((R_IG * n).normalized());
+      tg->texcoords = std::move(shape.texcoords);
+      tg->faces = std::move(shape.faces);
+      tg->R_GI = X_GI.linear().cast<float>();
+      tg->p_GI = X_GI.translation().cast<float>();
+      eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                 tg->vertices_I.data(), 0, sizeof(Eigen::Vector3f),
+                                 tg->vertices_I.size() - 1);
+      rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, tg->faces.data(),
+                                 0, sizeof(Eigen::Vector3i), tg->faces.size());
+      group->num_triangles += static_cast<int64_t>(tg->faces.size());
+      rec.triangles = tg.get();
+      group->triangles.push_back(std::move(tg));
+    } else {
+      auto ag = std::make_unique<AnalyticGeom>();
+      ag->shape = AnalyticShapeOf(geom);
+      ag->R_GI = X_GI.linear();
+      ag->p_GI = X_GI.translation();
+      ag->R_IG_f = X_IG.linear().cast<float>();
+      eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+      rtcSetGeometryUserPrimitiveCount(eg, 1);
+      rtcSetGeometryUserData(eg, ag.get());
+      rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
+      rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
+      rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
+      rec.analytic = ag.get();
+      group->analytic.push_back(std::move(ag));
+    }
+    rtcCommitGeometry(eg);
+    const unsigned id = rtcAttachGeometry(group->scene, eg);
+    rtcReleaseGeometry(eg);
+    if (group->records.size() <= id) group->records.resize(id + 1);
+    group->records[id] = rec;
+  }
+
+  // (re)builds the scene of `group`: a moving body's geoms in its body frame, or the static
+  // bodies' geoms in the world frame posed with X_WB.
+  void BuildGroup(InstanceGroup* group, const std::vector<Pose>& X_WB) {
+    if (group->scene) rtcReleaseScene(group->scene);
+    group->records.clear();
+    group->analytic.clear();
+    group->triangles.clear();
+    group->num_triangles = 0;
+    group->scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(group->scene, RTC_BUILD_QUALITY_HIGH);
+    for (int gi : group->geoms) {
+      const Geom& g = scene->geoms[gi];
+      AddGeom(group, gi, group->is_static ? Pose(X_WB[g.body] * g.X_BG) : g.X_BG);
+    }
+    rtcCommitScene(group->scene);
+  }
+
+  // sets the instance transform of `group` to X_WI.
+  void SetInstancePose(InstanceGroup* group, const Pose& X_WI) {
+    group->X_WI = X_WI;
+    group->R_WI_f = X_WI.linear().cast<float>();
+    float xfm[12];
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(X_WI.linear()(r, c));
+    for (int r = 0; r < 3; ++r) xfm[9 + r] = static_cast<float>(X_WI.translation()(r));
+    rtcSetGeometryTransform(group->instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(group->instance);
+  }
+
+  static AnalyticShape AnalyticShapeOf(const Geom& geom) {
+    AnalyticShape shape;
+    switch (geom.shape) {
+      case GeomShape::kPlane:
+        shape.kind = AnalyticKind::kPlane;
+        shape.size = {geom.size.x() > 0 ? geom.size.x() : kInfinitePlaneHalfSize,
+                      geom.size.y() > 0 ? geom.size.y() : kInfinitePlaneHalfSize, 0};
+        return shape;
+      case GeomShape::kSphere:
+        shape.kind = AnalyticKind::kSphere;
+        break;
+      case GeomShape::kCapsule:
+        shape.kind = AnalyticKind::kCapsule;
+        break;
+      case GeomShape::kEllipsoid:
+        shape.kind = AnalyticKind::kEllipsoid;
+        break;
+      default:
+        shape.kind = AnalyticKind::kCylinder;
+        break;
+    }
+    shape.size = geom.size;
+    return shape;
+  }
+
   // fills `hit` from Embree's hit of world ray `ray`: geom, exact surface point and
   // normals (analytic shapes in double from the world ray; triangles from barycentrics).
-  void FinishHit(const Ray& ray, const RTCRayHit& rh, const std::vector<Pose>& X_WB,
-                 SurfaceHit* hit) const {
-    const BodyScene& bs = bodies[instance_to_body_scene[rh.hit.instID[0]]];
-    const GeomRecord& rec = bs.geoms[rh.hit.geomID];
-    const int b = bs.body;
+  void FinishHit(const Ray& ray, const RTCRayHit& rh, SurfaceHit* hit) const {
+    const InstanceGroup& group = groups[group_of_instance[rh.hit.instID[0]]];
+    const GeomRecord& rec = group.records[rh.hit.geomID];
     const float t = rh.ray.tfar;
     hit->t = t;
     hit->p_W = ray.o + t * ray.d;
@@ -183,41 +305,40 @@ struct RayScene::Impl {
     hit->material = rec.material;
     hit->has_uv = false;
     hit->uv.setZero();
-    const Eigen::Matrix3f& R_WB = R_WB_f[b];
     Eigen::Vector3f ng_W, ns_W;
-    if (rec.analytic >= 0) {
-      const AnalyticGeom& g = *analytic[rec.analytic];
-      const Pose& X = X_WB[b];
+    if (rec.analytic) {
+      const AnalyticGeom& g = *rec.analytic;
+      const Pose& X = group.X_WI;
       const Eigen::Vector3d p_W =
           ray.o.cast<double>() + static_cast<double>(t) * ray.d.cast<double>();
-      const Eigen::Vector3d p_B = X.linear().transpose() * (p_W - X.translation());
-      const Eigen::Vector3d p_G = g.R_GB * p_B + g.p_GB;
+      const Eigen::Vector3d p_I = X.linear().transpose() * (p_W - X.translation());
+      const Eigen::Vector3d p_G = g.R_GI * p_I + g.p_GI;
       const Eigen::Vector3d n_G =
           AnalyticNormal(g.shape, p_G, static_cast<ShapePart>(static_cast<int>(rh.hit.u)));
       hit->p_G = p_G.cast<float>();
       hit->n_G = n_G.cast<float>();
-      ng_W = (X.linear() * (g.R_GB.transpose() * n_G)).cast<float>();
+      ng_W = (X.linear() * (g.R_GI.transpose() * n_G)).cast<float>();
       ns_W = ng_W;
     } else {
-      const TriangleGeom& g = *triangles[rec.triangles];
+      const TriangleGeom& g = *rec.triangles;
       const Eigen::Vector3i& f = g.faces[rh.hit.primID];
       const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-      const Eigen::Vector3f& v0 = g.vertices_B[f[0]];
-      const Eigen::Vector3f& v1 = g.vertices_B[f[1]];
-      const Eigen::Vector3f& v2 = g.vertices_B[f[2]];
-      Eigen::Vector3f n_B = (v1 - v0).cross(v2 - v0);
-      const float len = n_B.norm();
-      n_B = len > 0 ? Eigen::Vector3f(n_B / len) : Eigen::Vector3f::UnitZ();
-      const Eigen::Vector3f p_B = w * v0 + u * v1 + v * v2;
-      hit->p_G = g.R_GB * p_B + g.p_GB;
-      hit->n_G = g.R_GB * n_B;
-      ng_W = R_WB * n_B;
+      const Eigen::Vector3f& v0 = g.vertices_I[f[0]];
+      const Eigen::Vector3f& v1 = g.vertices_I[f[1]];
+      const Eigen::Vector3f& v2 = g.vertices_I[f[2]];
+      Eigen::Vector3f n_I = (v1 - v0).cross(v2 - v0);
+      const float len = n_I.norm();
+      n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
+      const Eigen::Vector3f p_I = w * v0 + u * v1 + v * v2;
+      hit->p_G = g.R_GI * p_I + g.p_GI;
+      hit->n_G = g.R_GI * n_I;
+      ng_W = group.R_WI_f * n_I;
       ns_W = ng_W;
-      if (!g.normals_B.empty()) {
-        const Eigen::Vector3f ns_B =
-            w * g.normals_B[f[0]] + u * g.normals_B[f[1]] + v * g.normals_B[f[2]];
-        const float ls = ns_B.norm();
-        if (ls > 0) ns_W = R_WB * (ns_B / ls);
+      if (!g.normals_I.empty()) {
+        const Eigen::Vector3f ns_I =
+            w * g.normals_I[f[0]] + u * g.normals_I[f[1]] + v * g.normals_I[f[2]];
+        const float ls = ns_I.norm();
+        if (ls > 0) ns_W = group.R_WI_f * (ns_I / ls);
       }
       if (!g.texcoords.empty()) {
         hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];
@@ -234,11 +355,11 @@ struct RayScene::Impl {
   }
 
   void Release() {
-    for (BodyScene& b : bodies) {
-      if (b.instance) rtcReleaseGeometry(b.instance);
-      if (b.scene) rtcReleaseScene(b.scene);
+    for (InstanceGroup& g : groups) {
+      if (g.instance) rtcReleaseGeometry(g.instance);
+      if (g.scene) rtcReleaseScene(g.scene);
     }
-    bodies.clear();
+    groups.clear();
     if (top) rtcReleaseScene(top);
     top = nullptr;
     if (device) rtcReleaseDevice(device);
@@ -261,157 +382,101 @@ Ray SpawnRayTo(const SurfaceHit& hit, const Eigen::Vector3f& p_W) {
   return r;
 }
 
+namespace {
+
+// checks the references and sizes of a visible geom.
+void ValidateGeom(const SceneDescription& scene, const Geom& geom) {
+  const std::string what = "RayScene: geom '" + geom.name + "' ";
+  if (geom.body < 0 || geom.body >= static_cast<int>(scene.bodies.size()))
+    throw Error(what + "refers to missing body " + std::to_string(geom.body));
+  switch (geom.shape) {
+    case GeomShape::kMesh:
+      if (geom.mesh < 0 || geom.mesh >= static_cast<int>(scene.meshes.size()))
+        throw Error(what + "refers to missing mesh " + std::to_string(geom.mesh));
+      break;
+    case GeomShape::kHeightField:
+      if (geom.hfield < 0 || geom.hfield >= static_cast<int>(scene.hfields.size()))
+        throw Error(what + "refers to missing height field " + std::to_string(geom.hfield));
+      break;
+    case GeomShape::kBox:
+      if (!(geom.size.minCoeff() > 0) || !geom.size.allFinite())
+        throw Error(what + "has a non-positive box size");
+      break;
+    case GeomShape::kPlane:
+      if (!(geom.size.x() >= 0 && geom.size.y() >= 0) || !geom.size.allFinite())
+        throw Error(what + "has a negative plane size");
+      break;
+    default: {
+      AnalyticShape shape;
+      shape.kind = geom.shape == GeomShape::kSphere      ? AnalyticKind::kSphere
+                   : geom.shape == GeomShape::kCapsule   ? AnalyticKind::kCapsule
+                   : geom.shape == GeomShape::kEllipsoid ? AnalyticKind::kEllipsoid
+                                                         : AnalyticKind::kCylinder;
+      shape.size = geom.size;
+      const Eigen::Vector3d h = AnalyticHalfExtents(shape);
+      if (!(h.minCoeff() > 0) || !h.allFinite())
+        throw Error(what + "has a non-positive size for its shape");
+    }
+  }
+}
+
+}  // namespace
+
 RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>()), scene_(scene) {
   Impl& m = *impl_;
+  m.scene = &scene;
+  const int num_bodies = static_cast<int>(scene.bodies.size());
+  X_WB_.assign(num_bodies, Pose::Identity());
+  m.static_poses = X_WB_;
+
+  // visible geoms, grouped: static bodies (the world body and Body::is_static) together,
+  // every other body on its own.
+  m.groups.resize(1);
+  m.groups[0].is_static = true;
+  std::vector<int> group_of_body(num_bodies, -1);
+  for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
+    const Geom& geom = scene.geoms[gi];
+    if (geom.group > 2) continue;
+    if (geom.material >= static_cast<int>(scene.materials.size()))
+      throw Error("RayScene: geom '" + geom.name + "' refers to missing material " +
+                  std::to_string(geom.material));
+    if (geom.material >= 0 && scene.materials[geom.material].alpha < 0.5f) continue;
+    ValidateGeom(scene, geom);
+    if (geom.body == 0 || scene.bodies[geom.body].is_static) {
+      m.groups[0].geoms.push_back(gi);
+    } else {
+      int& g = group_of_body[geom.body];
+      if (g < 0) {
+        g = static_cast<int>(m.groups.size());
+        m.groups.emplace_back();
+        m.groups.back().body = geom.body;
+      }
+      m.groups[g].geoms.push_back(gi);
+    }
+    ++num_visible_geoms_;
+  }
+
   m.device = rtcNewDevice(nullptr);
   if (!m.device) throw Error("RayScene: cannot create the Embree device (rtcNewDevice failed)");
   rtcSetDeviceErrorFunction(m.device, ErrorCallback, &m.error);
-
-  const int num_bodies = static_cast<int>(scene.bodies.size());
-  m.body_scene_of.assign(num_bodies, -1);
-  X_WB_.assign(num_bodies, Pose::Identity());
-  m.R_WB_f.assign(num_bodies, Eigen::Matrix3f::Identity());
-  m.p_WB_f.assign(num_bodies, Eigen::Vector3f::Zero());
-
   try {
-    for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
-      const Geom& geom = scene.geoms[gi];
-      if (geom.group > 2) continue;
-      if (geom.material >= static_cast<int>(scene.materials.size()))
-        throw Error("RayScene: geom '" + geom.name + "' refers to missing material " +
-                    std::to_string(geom.material));
-      if (geom.material >= 0 && scene.materials[geom.material].alpha < 0.5f) continue;
-      if (geom.body < 0 || geom.body >= num_bodies)
-        throw Error("RayScene: geom '" + geom.name + "' refers to missing body " +
-                    std::to_string(geom.body));
-
-      int& bs = m.body_scene_of[geom.body];
-      if (bs < 0) {
-        bs = static_cast<int>(m.bodies.size());
-        BodyScene b;
-        b.body = geom.body;
-        b.scene = rtcNewScene(m.device);
-        rtcSetSceneFlags(b.scene, RTC_SCENE_FLAG_ROBUST);
-        rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_HIGH);
-        m.bodies.push_back(b);
-      }
-      BodyScene& body = m.bodies[bs];
-      GeomRecord rec;
-      rec.geom = gi;
-      rec.material = geom.material;
-      const Pose& X_BG = geom.X_BG;
-      const Pose X_GB = X_BG.inverse();
-
-      RTCGeometry eg = nullptr;
-      if (geom.shape == GeomShape::kBox || geom.shape == GeomShape::kMesh ||
-          geom.shape == GeomShape::kHeightField) {
-        TriangleShape shape;
-        if (geom.shape == GeomShape::kBox) {
-          shape = BoxTriangles(geom.size);
-        } else if (geom.shape == GeomShape::kMesh) {
-          if (geom.mesh < 0 || geom.mesh >= static_cast<int>(scene.meshes.size()))
-            throw Error("RayScene: mesh geom '" + geom.name + "' refers to missing mesh " +
-                        std::to_string(geom.mesh));
-          shape = MeshTriangles(scene.meshes[geom.mesh]);
-        } else {
-          if (geom.hfield < 0 || geom.hfield >= static_cast<int>(scene.hfields.size()))
-            throw Error("RayScene: hfield geom '" + geom.name +
-                        "' refers to missing height field " + std::to_string(geom.hfield));
-          shape = HeightFieldTriangles(scene.hfields[geom.hfield]);
-        }
-        if (shape.faces.empty()) continue;
-        auto tg = std::make_unique<TriangleGeom>();
-        const Eigen::Matrix3f R_BG = X_BG.linear().cast<float>();
-        const Eigen::Vector3f p_BG = X_BG.translation().cast<float>();
-        tg->vertices_B.reserve(shape.vertices.size() + 1);
-        for (const Eigen::Vector3f& v : shape.vertices) tg->vertices_B.push_back(R_BG * v + p_BG);
-        tg->vertices_B.push_back(Eigen::Vector3f::Zero());  // padding for Embree's 16-byte loads
-        for (const Eigen::Vector3f& n : shape.normals)
-          tg->normals_B.push_back((R_BG * n).normalized());
-        tg->texcoords = std::move(shape.texcoords);
-        tg->faces = std::move(shape.faces);
-        tg->R_GB = X_GB.linear().cast<float>();
-        tg->p_GB = X_GB.translation().cast<float>();
-
-        eg = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                   tg->vertices_B.data(), 0, sizeof(Eigen::Vector3f),
-                                   tg->vertices_B.size() - 1);
-        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, tg->faces.data(),
-                                   0, sizeof(Eigen::Vector3i), tg->faces.size());
-        num_triangles_ += static_cast<int64_t>(tg->faces.size());
-        rec.triangles = static_cast<int>(m.triangles.size());
-        m.triangles.push_back(std::move(tg));
-      } else {
-        auto ag = std::make_unique<AnalyticGeom>();
-        switch (geom.shape) {
-          case GeomShape::kPlane: {
-            ag->shape.kind = AnalyticKind::kPlane;
-            const double hx = geom.size.x() > 0 ? geom.size.x() : kInfinitePlaneHalfSize;
-            const double hy = geom.size.y() > 0 ? geom.size.y() : kInfinitePlaneHalfSize;
-            ag->shape.size = {hx, hy, 0};
-            break;
-          }
-          case GeomShape::kSphere:
-            ag->shape.kind = AnalyticKind::kSphere;
-            break;
-          case GeomShape::kCapsule:
-            ag->shape.kind = AnalyticKind::kCapsule;
-            break;
-          case GeomShape::kEllipsoid:
-            ag->shape.kind = AnalyticKind::kEllipsoid;
-            break;
-          default:
-            ag->shape.kind = AnalyticKind::kCylinder;
-            break;
-        }
-        if (geom.shape != GeomShape::kPlane) ag->shape.size = geom.size;
-        const Eigen::Vector3d h = AnalyticHalfExtents(ag->shape);
-        const bool bad_size = (ag->shape.kind == AnalyticKind::kPlane)
-                                  ? !(h.x() > 0 && h.y() > 0)
-                                  : !(h.minCoeff() > 0) || !h.allFinite();
-        if (bad_size)
-          throw Error("RayScene: geom '" + geom.name + "' has a non-positive size for its shape");
-        ag->R_GB = X_GB.linear();
-        ag->p_GB = X_GB.translation();
-        ag->R_BG_f = X_BG.linear().cast<float>();
-        eg = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(eg, 1);
-        rtcSetGeometryUserData(eg, ag.get());
-        rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
-        rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
-        rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
-        rec.analytic = static_cast<int>(m.analytic.size());
-        m.analytic.push_back(std::move(ag));
-      }
-      rtcCommitGeometry(eg);
-      const unsigned id = rtcAttachGeometry(body.scene, eg);
-      rtcReleaseGeometry(eg);
-      if (body.geoms.size() <= id) body.geoms.resize(id + 1);
-      body.geoms[id] = rec;
-      ++num_visible_geoms_;
-    }
-    m.Check("building geometry");
-
     m.top = rtcNewScene(m.device);
-    rtcSetSceneFlags(m.top,
-                     static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST));
+    rtcSetSceneFlags(m.top, RTC_SCENE_FLAG_DYNAMIC);
     rtcSetSceneBuildQuality(m.top, RTC_BUILD_QUALITY_LOW);
-    for (int i = 0; i < static_cast<int>(m.bodies.size()); ++i) {
-      BodyScene& b = m.bodies[i];
-      rtcCommitScene(b.scene);
-      b.instance = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(b.instance, b.scene);
-      rtcSetGeometryTimeStepCount(b.instance, 1);
-      const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-      rtcSetGeometryTransform(b.instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
-      rtcCommitGeometry(b.instance);
-      const unsigned id = rtcAttachGeometry(m.top, b.instance);
-      if (m.instance_to_body_scene.size() <= id) m.instance_to_body_scene.resize(id + 1, -1);
-      m.instance_to_body_scene[id] = i;
+    for (int i = 0; i < static_cast<int>(m.groups.size()); ++i) {
+      InstanceGroup& g = m.groups[i];
+      m.BuildGroup(&g, X_WB_);
+      g.instance = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(g.instance, g.scene);
+      rtcSetGeometryTimeStepCount(g.instance, 1);
+      m.SetInstancePose(&g, Pose::Identity());
+      const unsigned id = rtcAttachGeometry(m.top, g.instance);
+      if (m.group_of_instance.size() <= id) m.group_of_instance.resize(id + 1, -1);
+      m.group_of_instance[id] = i;
+      num_triangles_ += g.num_triangles;
     }
     rtcCommitScene(m.top);
-    m.Check("committing scenes");
+    m.Check("building the scene");
   } catch (...) {
     m.Release();
     throw;
@@ -426,24 +491,31 @@ void RayScene::Update(const WorldSnapshot& snapshot) {
     throw Error("RayScene::Update: snapshot has " + std::to_string(snapshot.X_WB.size()) +
                 " body poses, scene has " + std::to_string(X_WB_.size()) + " bodies");
   bool changed = false;
-  for (const BodyScene& b : m.bodies) {
-    const Pose& X = snapshot.X_WB[b.body];
-    if (X.matrix() == X_WB_[b.body].matrix()) continue;
+  // static bodies do not move; their merged scene is rebuilt only if one did (normally only
+  // at the first Update, which brings their actual poses).
+  InstanceGroup& statics = m.groups[0];
+  bool static_moved = false;
+  for (int gi : statics.geoms) {
+    const int b = scene_.geoms[gi].body;
+    if (snapshot.X_WB[b].matrix() != m.static_poses[b].matrix()) static_moved = true;
+  }
+  if (static_moved) {
+    num_triangles_ -= statics.num_triangles;
+    m.static_poses = snapshot.X_WB;
+    m.BuildGroup(&statics, m.static_poses);
+    num_triangles_ += statics.num_triangles;
+    rtcSetGeometryInstancedScene(statics.instance, statics.scene);
+    rtcCommitGeometry(statics.instance);
     changed = true;
-    X_WB_[b.body] = X;
-    m.R_WB_f[b.body] = X.linear().cast<float>();
-    m.p_WB_f[b.body] = X.translation().cast<float>();
-    float xfm[12];
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(X.linear()(r, c));
-    for (int r = 0; r < 3; ++r) xfm[9 + r] = static_cast<float>(X.translation()(r));
-    rtcSetGeometryTransform(b.instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-    rtcCommitGeometry(b.instance);
   }
-  // bodies without visible geoms still report their pose.
-  for (size_t i = 0; i < X_WB_.size(); ++i) {
-    if (m.body_scene_of[i] < 0) X_WB_[i] = snapshot.X_WB[i];
+  for (size_t i = 1; i < m.groups.size(); ++i) {
+    InstanceGroup& g = m.groups[i];
+    const Pose& X = snapshot.X_WB[g.body];
+    if (X.matrix() == g.X_WI.matrix()) continue;
+    m.SetInstancePose(&g, X);
+    changed = true;
   }
+  X_WB_ = snapshot.X_WB;
   if (changed) {
     rtcCommitScene(m.top);
     ++num_top_level_commits_;
@@ -460,7 +532,7 @@ bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->top, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  impl_->FinishHit(ray, rh, X_WB_, hit);
+  impl_->FinishHit(ray, rh, hit);
   return true;
 }
 
@@ -473,48 +545,90 @@ bool RayScene::Occluded(const Ray& ray) const {
   return r.tfar < 0;
 }
 
+// packets of kPacket rays (rtcIntersect16 / rtcOccluded16) for coherent rays; incoherent rays
+// go one by one (rtcIntersect1), as Embree recommends. the packets are traced with an
+// incoherent context: Embree 3.13.5's coherent (frustum) packet traversal was seen to loop
+// forever on some packets of this renderer's scenes (instanced user geometry), and plain packet
+// traversal is as fast here.
 void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits,
                              bool* did_hit) const {
+  if (!coherent) {
+    for (int i = 0; i < n; ++i) did_hit[i] = Intersect(rays[i], &hits[i]);
+    return;
+  }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  ctx.flags =
-      coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  alignas(64) RTCRayHit rh[kStreamChunk];
-  for (int start = 0; start < n; start += kStreamChunk) {
-    const int m = std::min(kStreamChunk, n - start);
-    for (int i = 0; i < m; ++i) {
-      ToEmbree(rays[start + i], &rh[i].ray);
-      rh[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  alignas(64) RTCRayHit16 p;
+  alignas(64) int valid[kPacket];
+  for (int start = 0; start < n; start += kPacket) {
+    const int m = std::min(kPacket, n - start);
+    for (int i = 0; i < kPacket; ++i) {
+      valid[i] = i < m ? -1 : 0;
+      const Ray& r = rays[start + std::min(i, m - 1)];
+      p.ray.org_x[i] = r.o.x();
+      p.ray.org_y[i] = r.o.y();
+      p.ray.org_z[i] = r.o.z();
+      p.ray.dir_x[i] = r.d.x();
+      p.ray.dir_y[i] = r.d.y();
+      p.ray.dir_z[i] = r.d.z();
+      p.ray.tnear[i] = r.tmin;
+      p.ray.tfar[i] = r.tmax;
+      p.ray.time[i] = 0;
+      p.ray.mask[i] = 0xffffffffu;
+      p.ray.id[i] = 0;
+      p.ray.flags[i] = 0;
+      p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      p.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect1M(impl_->top, &ctx, rh, static_cast<unsigned>(m), sizeof(RTCRayHit));
+    rtcIntersect16(valid, impl_->top, &ctx, &p);
     for (int i = 0; i < m; ++i) {
-      did_hit[start + i] = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      if (did_hit[start + i]) impl_->FinishHit(rays[start + i], rh[i], X_WB_, &hits[start + i]);
+      did_hit[start + i] = p.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+      if (!did_hit[start + i]) continue;
+      RTCRayHit rh;
+      rh.ray.tfar = p.ray.tfar[i];
+      rh.hit.u = p.hit.u[i];
+      rh.hit.v = p.hit.v[i];
+      rh.hit.primID = p.hit.primID[i];
+      rh.hit.geomID = p.hit.geomID[i];
+      rh.hit.instID[0] = p.hit.instID[0][i];
+      impl_->FinishHit(rays[start + i], rh, &hits[start + i]);
     }
   }
 }
 
-void RayScene::OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded) const {
+void RayScene::OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded,
+                            bool coherent) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  alignas(64) RTCRay r[kStreamChunk];
-  int index[kStreamChunk];
-  int start = 0;
-  while (start < n) {
-    // gather up to kStreamChunk active rays.
-    int m = 0;
-    while (start < n && m < kStreamChunk) {
-      occluded[start] = false;
-      if (!active || active[start]) {
-        ToEmbree(rays[start], &r[m]);
-        index[m++] = start;
-      }
-      ++start;
+  if (!coherent) {
+    for (int i = 0; i < n; ++i) occluded[i] = (!active || active[i]) && Occluded(rays[i]);
+    return;
+  }
+  alignas(64) RTCRay16 p;
+  alignas(64) int valid[kPacket];
+  for (int start = 0; start < n; start += kPacket) {
+    const int m = std::min(kPacket, n - start);
+    bool any = false;
+    for (int i = 0; i < kPacket; ++i) {
+      const bool on = i < m && (!active || active[start + i]);
+      any |= on;
+      valid[i] = on ? -1 : 0;
+      const Ray& r = rays[start + std::min(i, m - 1)];
+      p.org_x[i] = r.o.x();
+      p.org_y[i] = r.o.y();
+      p.org_z[i] = r.o.z();
+      p.dir_x[i] = r.d.x();
+      p.dir_y[i] = r.d.y();
+      p.dir_z[i] = r.d.z();
+      p.tnear[i] = r.tmin;
+      p.tfar[i] = r.tmax;
+      p.time[i] = 0;
+      p.mask[i] = 0xffffffffu;
+      p.id[i] = 0;
+      p.flags[i] = 0;
     }
-    if (m == 0) continue;
-    rtcOccluded1M(impl_->top, &ctx, r, static_cast<unsigned>(m), sizeof(RTCRay));
-    for (int i = 0; i < m; ++i) occluded[index[i]] = r[i].tfar < 0;
+    if (any) rtcOccluded16(valid, impl_->top, &ctx, &p);
+    for (int i = 0; i < m; ++i) occluded[start + i] = valid[i] != 0 && p.tfar[i] < 0;
   }
 }
 

@@ -1,10 +1,13 @@
 #pragma once
 // the ray-traceable form of a SceneDescription, on Intel Embree 3.
 //
-// layout (two-level, as Embree's instancing tutorial): every body with visible geoms gets
-// one RTCScene holding all its geoms in the body frame, built once; a top-level scene
-// instances these body scenes with the body poses X_WB. Update() only rewrites the
-// instance transforms and recommits the top level, so moving bodies costs O(bodies).
+// layout (two-level, as Embree's instancing tutorial): the geoms of every moving body form
+// one RTCScene in the body frame, built once; the geoms of all static bodies (the world body
+// and bodies with Body::is_static) are merged into one RTCScene in the world frame. a top-level
+// scene instances these with the body poses X_WB (identity for the static scene). Update()
+// only rewrites the instance transforms of bodies that moved and recommits the top level, so
+// moving bodies costs O(bodies); the static scene is rebuilt only if a static body's pose
+// changes (normally once, at the first Update, which brings their actual poses).
 //
 // geom shapes: box, mesh and height field are triangle geometry (box faces are exact
 // planes; meshes carry vertex normals for smooth shading and texcoords); plane, sphere,
@@ -89,13 +92,15 @@ class RayScene {
   /// true if anything blocks `ray` in [tmin, tmax].
   bool Occluded(const Ray& ray) const;
 
-  /// closest hits of `n` rays traced together (Embree ray streams; `coherent` for rays of
-  /// neighbouring camera pixels). hit[i] is valid iff did_hit[i].
+  /// closest hits of `n` rays: `coherent` rays (e.g. camera rays of neighbouring pixels) are
+  /// traced in packets of 16, others one by one. hit[i] is valid iff did_hit[i].
   void IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits, bool* did_hit) const;
 
   /// occlusion of `n` rays traced together; rays with active[i] == false are skipped and
-  /// get occluded[i] = false (active may be null = all).
-  void OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded) const;
+  /// get occluded[i] = false (active may be null = all). `coherent` for rays with similar
+  /// origins and directions (e.g. shadow rays of neighbouring pixels towards one light).
+  void OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded,
+                    bool coherent = false) const;
 
   /// the body poses currently in the scene (X_WB by body index).
   const std::vector<Pose>& X_WB() const { return X_WB_; }
@@ -103,8 +108,8 @@ class RayScene {
   /// the scene this was built from.
   const SceneDescription& scene() const { return scene_; }
 
-  /// how many times Update recommitted the top-level scene (bodies moved); body scenes are
-  /// never rebuilt after construction.
+  /// how many times Update recommitted the top-level scene (bodies moved); moving bodies'
+  /// scenes are never rebuilt after construction.
   int64_t num_top_level_commits() const { return num_top_level_commits_; }
 
   /// how many geoms are ray traced (visible) and how many triangles they hold.

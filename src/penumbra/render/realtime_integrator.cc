@@ -34,10 +34,15 @@ struct PendingShadow {
   Eigen::Vector3f value;  // added if unoccluded
 };
 
-// per-thread scratch, grown once and reused across tiles and frames.
-struct Scratch {
+// shadow rays of one tile towards one light.
+struct ShadowBatch {
   std::vector<Ray> rays;
   std::vector<PendingShadow> pending;
+};
+
+// per-thread scratch, grown once and reused across tiles and frames.
+struct Scratch {
+  std::vector<ShadowBatch> batches;  // per light
   std::unique_ptr<bool[]> occluded;
   int occluded_capacity = 0;
   std::vector<Eigen::Vector3f> contrib;
@@ -53,8 +58,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
   const int num_lights = ctx.lights->size();
-  scratch.rays.clear();
-  scratch.pending.clear();
+  if (static_cast<int>(scratch.batches.size()) < num_lights) scratch.batches.resize(num_lights);
+  for (int j = 0; j < num_lights; ++j) {
+    scratch.batches[j].rays.clear();
+    scratch.batches[j].pending.clear();
+  }
   scratch.contrib.resize(num_lights);
   scratch.samples.resize(num_lights);
   scratch.valid.resize(num_lights);
@@ -107,8 +115,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       Ray r = SpawnRay(hit, s.wi);
       r.tmax = std::isinf(s.distance) ? s.distance : s.distance * (1.0f - 1e-4f);
-      scratch.rays.push_back(r);
-      scratch.pending.push_back({i, scratch.contrib[j]});
+      scratch.batches[j].rays.push_back(r);
+      scratch.batches[j].pending.push_back({i, scratch.contrib[j]});
     }
     L[0] = radiance.x(), L[1] = radiance.y(), L[2] = radiance.z();
     if (out.albedo) {
@@ -121,22 +129,28 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     }
   }
 
-  // all shadow rays of the tile in one stream; contributions are added back in the order
-  // they were queued (pixel-major, light order), so sums are deterministic.
-  const int m = static_cast<int>(scratch.rays.size());
-  if (m == 0) return 0;
-  if (scratch.occluded_capacity < m) {
-    scratch.occluded = std::make_unique<bool[]>(m);
-    scratch.occluded_capacity = m;
+  // the tile's shadow rays towards each light as one coherent stream; contributions are added
+  // in light order, so each pixel's sum is independent of scheduling.
+  int64_t traced = 0;
+  for (int j = 0; j < num_lights; ++j) {
+    ShadowBatch& batch = scratch.batches[j];
+    const int m = static_cast<int>(batch.rays.size());
+    if (m == 0) continue;
+    if (scratch.occluded_capacity < m) {
+      scratch.occluded = std::make_unique<bool[]>(m);
+      scratch.occluded_capacity = m;
+    }
+    ctx.scene->OccludedMany(batch.rays.data(), m, nullptr, scratch.occluded.get(),
+                            /*coherent=*/true);
+    for (int k = 0; k < m; ++k) {
+      if (scratch.occluded[k]) continue;
+      const PendingShadow& p = batch.pending[k];
+      float* L = out.radiance->at(tile.x0 + p.pixel % tile.width, tile.y0 + p.pixel / tile.width);
+      L[0] += p.value.x(), L[1] += p.value.y(), L[2] += p.value.z();
+    }
+    traced += m;
   }
-  ctx.scene->OccludedMany(scratch.rays.data(), m, nullptr, scratch.occluded.get());
-  for (int k = 0; k < m; ++k) {
-    if (scratch.occluded[k]) continue;
-    const PendingShadow& p = scratch.pending[k];
-    float* L = out.radiance->at(tile.x0 + p.pixel % tile.width, tile.y0 + p.pixel / tile.width);
-    L[0] += p.value.x(), L[1] += p.value.y(), L[2] += p.value.z();
-  }
-  return m;
+  return traced;
 }
 
 }  // namespace penumbra
