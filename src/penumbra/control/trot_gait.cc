@@ -1,0 +1,597 @@
+#include "penumbra/control/trot_gait.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "penumbra/control/quadruped_swing_trajectory.h"
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kGravity = 9.81;
+// reference heading / position may lead the robot by at most this much (anti-windup)
+constexpr double kMaxHeadingLead = 0.3;
+constexpr double kMaxPositionLead = 0.1;
+// swing targets end this far below the estimated ground, so the foot surely lands
+constexpr double kTouchdownDepth = 0.005;
+// phase offsets of FR, FL, RR, RL: the diagonals FR+RL and FL+RR alternate
+constexpr std::array<double, 4> kPhaseOffset = {0.0, 0.5, 0.5, 0.0};
+
+double WrapAngle(double a) {
+  a = std::remainder(a, 2 * M_PI);
+  return a <= -M_PI ? a + 2 * M_PI : a;
+}
+
+std::string Describe(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
+  if (n.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+// finite number from a YAML scalar, or Fail(key).
+double NumberAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
+                const std::string& expected) {
+  double v = 0;
+  bool ok = n.IsScalar();
+  if (ok) {
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      ok = false;
+    }
+  }
+  if (!ok || !std::isfinite(v)) p.Fail(key, "got " + Describe(n) + "; expected " + expected);
+  return v;
+}
+
+std::string NameAt(ControllerParams& p, const YAML::Node& n, const std::string& key) {
+  if (!n.IsScalar() || n.Scalar().empty()) p.Fail(key, "got " + Describe(n) + "; expected a name");
+  return n.Scalar();
+}
+
+// X_AB for body b below ancestor a, composed from the rest frames (qpos0), or nullopt when
+// a is not an ancestor of b.
+std::optional<Pose> RestFrame(const ModelInfo& m, int a, int b) {
+  Pose X = Pose::Identity();
+  while (b != a) {
+    if (b <= 0) return std::nullopt;
+    X = m.body_X_PB[b] * X;
+    b = m.body_parent[b];
+  }
+  return X;
+}
+
+}  // namespace
+
+TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& prefix) {
+  TrotGaitParams g;
+  g.base_body = prefix + p.String("base_body");
+
+  // legs: exactly FR, FL, RR, RL, each a mapping of names and conventions
+  const YAML::Node* legs = p.Raw("legs");
+  const std::string legs_expected =
+      "expected a mapping with the legs FR, FL, RR, RL, each {hip, thigh, calf, foot, "
+      "signs, offsets_rad, actuators}";
+  if (!legs) p.Fail("legs", "missing; " + legs_expected);
+  if (!legs->IsMap()) p.Fail("legs", "got " + Describe(*legs) + "; " + legs_expected);
+  for (const auto& kv : *legs) {
+    const std::string k = kv.first.Scalar();
+    if (std::find_if(kLegNames.begin(), kLegNames.end(), [&](const char* n) { return k == n; }) ==
+        kLegNames.end())
+      p.Fail("legs." + k, "unknown leg '" + k + "'; expected only FR, FL, RR, RL");
+  }
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = std::string("legs.") + kLegNames[i];
+    const YAML::Node n = (*legs)[kLegNames[i]];
+    if (!n) p.Fail(key, "missing; " + legs_expected);
+    if (!n.IsMap()) p.Fail(key, "got " + Describe(n) + "; expected {hip, thigh, calf, foot, ...}");
+    static const std::set<std::string> kKeys = {"hip",   "thigh",       "calf",     "foot",
+                                                "signs", "offsets_rad", "actuators"};
+    for (const auto& kv : n)
+      if (!kKeys.count(kv.first.Scalar()))
+        p.Fail(key + "." + kv.first.Scalar(),
+               "unknown key; expected only hip, thigh, calf, foot, signs, offsets_rad, actuators");
+    TrotLegConfig& leg = g.legs[i];
+    auto name = [&](const char* k) {
+      if (!n[k]) p.Fail(key + "." + k, "missing; expected a name");
+      return prefix + NameAt(p, n[k], key + "." + k);
+    };
+    leg.hip = name("hip");
+    leg.thigh = name("thigh");
+    leg.calf = name("calf");
+    leg.foot = name("foot");
+    leg.actuators = {leg.hip, leg.thigh, leg.calf};
+    if (n["actuators"]) {
+      const YAML::Node a = n["actuators"];
+      if (!a.IsSequence() || a.size() != 3)
+        p.Fail(key + ".actuators", "got " + Describe(a) + "; expected [hip, thigh, calf] names");
+      for (int k = 0; k < 3; ++k)
+        leg.actuators[k] = prefix + NameAt(p, a[k], key + ".actuators[" + std::to_string(k) + "]");
+    }
+    if (n["signs"]) {
+      const YAML::Node s = n["signs"];
+      if (!s.IsSequence() || s.size() != 3)
+        p.Fail(key + ".signs",
+               "got " + Describe(s) + "; expected [s_hip, s_thigh, s_calf], each 1 or -1");
+      for (int k = 0; k < 3; ++k) {
+        const std::string sk = key + ".signs[" + std::to_string(k) + "]";
+        const double v = NumberAt(p, s[k], sk, "1 or -1");
+        if (v != 1 && v != -1) p.Fail(sk, "got " + s[k].Scalar() + "; expected 1 or -1");
+        leg.signs[k] = v;
+      }
+    }
+    if (n["offsets_rad"]) {
+      const YAML::Node o = n["offsets_rad"];
+      if (!o.IsSequence() || o.size() != 3)
+        p.Fail(key + ".offsets_rad", "got " + Describe(o) + "; expected 3 angles (rad)");
+      for (int k = 0; k < 3; ++k)
+        leg.offsets_rad[k] = NumberAt(p, o[k], key + ".offsets_rad[" + std::to_string(k) + "]",
+                                      "a finite angle (rad)");
+    }
+  }
+
+  // commands: a list of {t, vx, vy, yaw_rate}, t strictly increasing
+  if (const YAML::Node* cmds = p.Raw("commands")) {
+    if (!cmds->IsSequence())
+      p.Fail("commands", "got " + Describe(*cmds) +
+                             "; expected a list of {t, vx, vy, yaw_rate} with increasing t");
+    for (size_t i = 0; i < cmds->size(); ++i) {
+      const std::string key = "commands[" + std::to_string(i) + "]";
+      const YAML::Node c = (*cmds)[i];
+      if (!c.IsMap()) p.Fail(key, "got " + Describe(c) + "; expected {t, vx, vy, yaw_rate}");
+      for (const auto& kv : c) {
+        const std::string k = kv.first.Scalar();
+        if (k != "t" && k != "vx" && k != "vy" && k != "yaw_rate")
+          p.Fail(key + "." + k, "unknown key; expected only t, vx, vy, yaw_rate");
+      }
+      if (!c["t"]) p.Fail(key + ".t", "missing; expected a time >= 0 (s)");
+      TimedTrotCommand tc;
+      tc.t_sec = NumberAt(p, c["t"], key + ".t", "a time >= 0 (s)");
+      if (tc.t_sec < 0) p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time >= 0 (s)");
+      if (!g.commands.empty() && tc.t_sec <= g.commands.back().t_sec)
+        p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time > the previous entry's");
+      if (c["vx"]) tc.command.vx = NumberAt(p, c["vx"], key + ".vx", "a speed (m/s)");
+      if (c["vy"]) tc.command.vy = NumberAt(p, c["vy"], key + ".vy", "a speed (m/s)");
+      if (c["yaw_rate"])
+        tc.command.yaw_rate = NumberAt(p, c["yaw_rate"], key + ".yaw_rate", "a rate (rad/s)");
+      g.commands.push_back(tc);
+    }
+  }
+
+  g.period_sec = p.Number("period_sec", 0.36, 0.05, 5, false);
+  g.duty = p.Number("duty", 0.5, 0.3, 0.8);
+  g.swing_height_m = p.Number("swing_height_m", 0.08, 0, 1);
+  if (p.Has("body_height_m"))
+    g.body_height_m = p.Number("body_height_m", std::nullopt, 0, kInf, true);
+  if (p.Has("raibert_gain")) g.raibert_gain = p.Number("raibert_gain", std::nullopt, 0, 10);
+  if (p.Has("max_step_m")) g.max_step_m = p.Number("max_step_m", std::nullopt, 0, kInf, true);
+  g.max_accel_m_s2 = p.Number("max_accel_m_s2", 1.5, 0, kInf, true);
+  g.max_yaw_accel_rad_s2 = p.Number("max_yaw_accel_rad_s2", 3, 0, kInf, true);
+  g.kp_xy = p.Number("kp_xy", 25, 0, kInf);
+  g.kd_xy = p.Number("kd_xy", 8, 0, kInf);
+  g.kp_z = p.Number("kp_z", 400, 0, kInf);
+  g.kd_z = p.Number("kd_z", 40, 0, kInf);
+  g.kp_tilt = p.Number("kp_tilt", 400, 0, kInf);
+  g.kd_tilt = p.Number("kd_tilt", 40, 0, kInf);
+  g.kp_yaw = p.Number("kp_yaw", 150, 0, kInf);
+  g.kd_yaw = p.Number("kd_yaw", 25, 0, kInf);
+  g.swing_kp = p.Number("swing_kp", 60, 0, kInf);
+  g.swing_kd = p.Number("swing_kd", 1.5, 0, kInf);
+  g.stance_kd = p.Number("stance_kd", 0.5, 0, kInf);
+  g.friction = p.Number("friction", 0.6, 0, 5, true);
+  if (const YAML::Node* hold = p.Raw("hold")) {
+    if (!hold->IsMap())
+      p.Fail("hold", "got " + Describe(*hold) + "; expected a mapping {actuator: ctrl}");
+    for (const auto& kv : *hold) {
+      const std::string k = kv.first.Scalar();
+      g.hold.emplace_back(prefix + k, NumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
+    }
+  }
+  g.rate_hz = p.Number("rate_hz", 500, 0, kInf, true);
+  p.CheckNoUnknownKeys();
+  return g;
+}
+
+void TrotGaitParams::ValidateOrThrow(const ControllerContext& c) const {
+  auto fail = [&](const std::string& key, const std::string& problem) {
+    throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
+  };
+  auto positive = [&](const char* key, double v) {
+    if (!(std::isfinite(v) && v > 0))
+      fail(key, "got " + std::to_string(v) + "; expected a number > 0");
+  };
+  auto non_negative = [&](const char* key, double v) {
+    if (!(std::isfinite(v) && v >= 0))
+      fail(key, "got " + std::to_string(v) + "; expected a number >= 0");
+  };
+  if (base_body.empty()) fail("base_body", "missing; expected a body name");
+  std::set<std::string> joints;
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = std::string("legs.") + kLegNames[i];
+    const TrotLegConfig& l = legs[i];
+    if (l.hip.empty() || l.thigh.empty() || l.calf.empty() || l.foot.empty())
+      fail(key, "missing names; expected hip, thigh, calf and foot");
+    for (const std::string* j : {&l.hip, &l.thigh, &l.calf})
+      if (!joints.insert(*j).second)
+        fail(key, "joint '" + *j + "' is used twice; expected 12 different joints");
+    for (int k = 0; k < 3; ++k) {
+      if (l.signs[k] != 1 && l.signs[k] != -1)
+        fail(key + ".signs", "got " + std::to_string(l.signs[k]) + "; expected 1 or -1");
+      if (!std::isfinite(l.offsets_rad[k])) fail(key + ".offsets_rad", "expected finite angles");
+      if (l.actuators[k].empty()) fail(key + ".actuators", "expected 3 actuator names");
+    }
+  }
+  for (size_t i = 0; i < commands.size(); ++i) {
+    const TimedTrotCommand& tc = commands[i];
+    if (!(std::isfinite(tc.t_sec) && tc.t_sec >= 0) ||
+        (i > 0 && !(tc.t_sec > commands[i - 1].t_sec)))
+      fail("commands[" + std::to_string(i) + "].t", "expected increasing times >= 0 (s)");
+    if (!std::isfinite(tc.command.vx) || !std::isfinite(tc.command.vy) ||
+        !std::isfinite(tc.command.yaw_rate))
+      fail("commands[" + std::to_string(i) + "]", "expected finite vx, vy, yaw_rate");
+  }
+  positive("period_sec", period_sec);
+  if (!(duty >= 0.3 && duty <= 0.8))
+    fail("duty", "got " + std::to_string(duty) + "; expected a number >= 0.3 and <= 0.8");
+  non_negative("swing_height_m", swing_height_m);
+  if (body_height_m) positive("body_height_m", *body_height_m);
+  if (raibert_gain) non_negative("raibert_gain", *raibert_gain);
+  if (max_step_m) positive("max_step_m", *max_step_m);
+  positive("max_accel_m_s2", max_accel_m_s2);
+  positive("max_yaw_accel_rad_s2", max_yaw_accel_rad_s2);
+  non_negative("kp_xy", kp_xy);
+  non_negative("kd_xy", kd_xy);
+  non_negative("kp_z", kp_z);
+  non_negative("kd_z", kd_z);
+  non_negative("kp_tilt", kp_tilt);
+  non_negative("kd_tilt", kd_tilt);
+  non_negative("kp_yaw", kp_yaw);
+  non_negative("kd_yaw", kd_yaw);
+  non_negative("swing_kp", swing_kp);
+  non_negative("swing_kd", swing_kd);
+  non_negative("stance_kd", stance_kd);
+  positive("friction", friction);
+  for (const auto& [name, v] : hold)
+    if (!std::isfinite(v)) fail("hold." + name, "expected a finite ctrl value");
+  positive("rate_hz", rate_hz);
+}
+
+TrotGait::TrotGait(TrotGaitParams params, ControllerContext context)
+    : Controller(std::move(context)), params_(std::move(params)) {
+  params_.ValidateOrThrow(this->context());
+  for (auto& f : forces_) f.setZero();
+}
+
+std::vector<NameRequirement> TrotGait::RequiredNames() const {
+  std::vector<NameRequirement> r;
+  r.push_back({ModelObject::kBody, params_.base_body, "base_body"});
+  for (int i = 0; i < 4; ++i) {
+    const TrotLegConfig& l = params_.legs[i];
+    const std::string key = std::string("legs.") + TrotGaitParams::kLegNames[i];
+    r.push_back({ModelObject::kJoint, l.hip, key + ".hip"});
+    r.push_back({ModelObject::kJoint, l.thigh, key + ".thigh"});
+    r.push_back({ModelObject::kJoint, l.calf, key + ".calf"});
+    r.push_back({ModelObject::kSite, l.foot, key + ".foot"});
+    for (int k = 0; k < 3; ++k)
+      r.push_back(
+          {ModelObject::kActuator, l.actuators[k], key + ".actuators[" + std::to_string(k) + "]"});
+  }
+  for (const auto& [name, v] : params_.hold)
+    r.push_back({ModelObject::kActuator, name, "hold." + name});
+  return r;
+}
+
+void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids) {
+  const ControllerContext& c = context();
+  auto fail = [&](const std::string& key, const std::string& problem) {
+    throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
+  };
+  if (model.body_X_PB.size() != model.body_names.size() ||
+      model.body_mass.size() != model.body_names.size() ||
+      model.site_X_BS.size() != model.site_names.size())
+    fail("base_body",
+         "the model information lacks body frames or masses; expected a model "
+         "loaded by the simulation");
+  base_ = ids[0];
+  size_t k = 1;
+  for (int i = 0; i < 4; ++i) {
+    const TrotLegConfig& cfg = params_.legs[i];
+    const std::string key = std::string("legs.") + TrotGaitParams::kLegNames[i];
+    Leg& leg = legs_[i];
+    std::array<int, 3> joint{};
+    for (int j = 0; j < 3; ++j) {
+      joint[j] = ids[k++];
+      const JointInfo& ji = model.joints[joint[j]];
+      if (ji.type != JointInfo::Type::kHinge)
+        fail(key, "joint '" + ji.name + "' is not a hinge; expected hinge joints");
+      leg.qpos[j] = ji.qpos_adr;
+      leg.dof[j] = ji.dof_adr;
+      const double s = cfg.signs[j], o = cfg.offsets_rad[j];
+      if (ji.limited) {
+        const double a = s * ji.range[0] + o, b = s * ji.range[1] + o;
+        leg.q_lo[j] = std::min(a, b);
+        leg.q_hi[j] = std::max(a, b);
+      } else {
+        leg.q_lo[j] = -kInf;
+        leg.q_hi[j] = kInf;
+      }
+    }
+    const int foot_site = ids[k++];
+    for (int j = 0; j < 3; ++j) {
+      const int a = ids[k++];
+      const ActuatorInfo& ai = model.actuators[a];
+      if (ai.joint != joint[j])
+        fail(key + ".actuators[" + std::to_string(j) + "]",
+             "actuator '" + ai.name + "' does not drive joint '" + model.joints[joint[j]].name +
+                 "'; expected a torque motor on that joint");
+      if (ai.gear[0] == 0) fail(key + ".actuators", "actuator '" + ai.name + "' has gear 0");
+      leg.act[j] = a;
+      leg.gear[j] = ai.gear[0];
+      leg.lo[j] = ai.ctrl_limited ? ai.ctrl_range[0] : -kInf;
+      leg.hi[j] = ai.ctrl_limited ? ai.ctrl_range[1] : kInf;
+    }
+    // geometry from the rest frames
+    const int hip_b = model.joints[joint[0]].body, thigh_b = model.joints[joint[1]].body,
+              calf_b = model.joints[joint[2]].body;
+    const auto X_base_hip = RestFrame(model, base_, hip_b);
+    const auto X_hip_thigh = RestFrame(model, hip_b, thigh_b);
+    const auto X_thigh_calf = RestFrame(model, thigh_b, calf_b);
+    const int site_b = model.site_body[foot_site];
+    const auto X_calf_site = RestFrame(model, calf_b, site_b);
+    if (!X_base_hip || !X_hip_thigh || !X_thigh_calf || hip_b == thigh_b || thigh_b == calf_b)
+      fail(key,
+           "the hip, thigh and calf joints must move a chain of bodies below base_body "
+           "(hip body, its descendant thigh body, its descendant calf body)");
+    if (!X_calf_site)
+      fail(key + ".foot", "site '" + cfg.foot + "' is not on the calf body or below it");
+    const Eigen::Vector3d t_thigh = X_hip_thigh->translation();
+    hip_B_[i] =
+        X_base_hip->translation() + X_base_hip->linear() * Eigen::Vector3d(t_thigh.x(), 0, 0);
+    const double l1 = std::copysign(std::hypot(t_thigh.y(), t_thigh.z()), t_thigh.y());
+    leg.calf_body = calf_b;
+    leg.foot_C = (*X_calf_site * model.site_X_BS[foot_site]).translation();
+    geometry_[i] = LegGeometry{l1, X_thigh_calf->translation().norm(), leg.foot_C.norm()};
+    if (geometry_[i].thigh_m <= 0 || geometry_[i].calf_m <= 0)
+      fail(key,
+           "zero thigh or calf length; expected the calf body and the foot site away "
+           "from the thigh and calf joint axes");
+  }
+  hold_.clear();
+  for (const auto& [name, v] : params_.hold) hold_.emplace_back(ids[k++], v);
+
+  // mass properties of the base subtree (rest configuration for the inertia)
+  bodies_.clear();
+  body_mass_.clear();
+  body_com_B_.clear();
+  mass_ = 0;
+  Eigen::Vector3d com0 = Eigen::Vector3d::Zero();
+  std::vector<Pose> X_base_b;
+  for (int b = 1; b < static_cast<int>(model.body_names.size()); ++b) {
+    const auto X = RestFrame(model, base_, b);
+    if (!X || model.body_mass[b] <= 0) continue;
+    bodies_.push_back(b);
+    body_mass_.push_back(model.body_mass[b]);
+    body_com_B_.push_back(model.body_X_BI[b].translation());
+    X_base_b.push_back(*X);
+    mass_ += model.body_mass[b];
+    com0 += model.body_mass[b] * (*X * model.body_X_BI[b].translation());
+  }
+  if (mass_ <= 0) fail("base_body", "the robot has no mass; expected bodies with mass");
+  com0 /= mass_;
+  inertia_B_.setZero();
+  for (size_t i = 0; i < bodies_.size(); ++i) {
+    const int b = bodies_[i];
+    const Eigen::Matrix3d R = X_base_b[i].linear() * model.body_X_BI[b].linear();
+    const Eigen::Vector3d r = X_base_b[i] * body_com_B_[i] - com0;
+    inertia_B_ +=
+        R * model.body_inertia[b].asDiagonal() * R.transpose() +
+        body_mass_[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+  }
+  double reach = 0;
+  for (const auto& g : geometry_) reach += (g.thigh_m + g.calf_m) / 4;
+  step_limit_ = params_.max_step_m.value_or(0.4 * reach);
+  limits_.mu = params_.friction;
+  limits_.min_normal_n = 0.01 * mass_ * kGravity;
+  limits_.max_normal_n = 2.0 * mass_ * kGravity;
+  started_ = false;
+  h_ref_ = 0;
+  k_raibert_ = 0;
+}
+
+TrotCommand TrotGait::ScriptedCommand(double t) const {
+  TrotCommand cmd;
+  for (const auto& tc : params_.commands) {
+    if (tc.t_sec > t + 1e-9) break;
+    cmd = tc.command;
+  }
+  return cmd;
+}
+
+void TrotGait::FirstUpdate(const ControlInput& in, const Eigen::Vector3d& com,
+                           const std::array<Eigen::Vector3d, 4>& feet) {
+  for (int i = 0; i < 4; ++i) {
+    legs_[i].p_ground = feet[i];
+    legs_[i].p_lift = feet[i];
+    legs_[i].in_swing = false;
+  }
+  const Pose X = in.X_WB(base_);
+  psi_ref_ = std::atan2(X.linear()(1, 0), X.linear()(0, 0));
+  p_ref_ = com.head<2>();
+  reference_ = TrotCommand{};
+  last_t_ = in.time_sec();
+  started_ = true;
+}
+
+void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
+  const double t = in.time_sec();
+  const Pose X_WB = in.X_WB(base_);
+  const Eigen::Matrix3d R = X_WB.linear();
+  const Eigen::Vector3d p = X_WB.translation();
+  const Twist V = in.V_WB(base_);
+  const Eigen::Vector3d w = V.head<3>(), v_base = V.tail<3>();
+  const auto qpos = in.qpos();
+  const auto qvel = in.qvel();
+
+  // centre of mass and its velocity (rigid-body approximation)
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < bodies_.size(); ++i)
+    com += body_mass_[i] * (in.X_WB(bodies_[i]) * body_com_B_[i]);
+  com /= mass_;
+  const Eigen::Vector3d v_com = v_base + w.cross(com - p);
+
+  std::array<Eigen::Vector3d, 4> feet;
+  for (int i = 0; i < 4; ++i) feet[i] = in.X_WB(legs_[i].calf_body) * legs_[i].foot_C;
+  if (!started_) FirstUpdate(in, com, feet);
+  const double dt = std::max(0.0, t - last_t_);
+  last_t_ = t;
+
+  // 1. command and references
+  command_ = override_ ? *override_ : ScriptedCommand(t);
+  auto slew = [dt](double from, double to, double rate) {
+    return from + std::clamp(to - from, -rate * dt, rate * dt);
+  };
+  reference_.vx = slew(reference_.vx, command_.vx, params_.max_accel_m_s2);
+  reference_.vy = slew(reference_.vy, command_.vy, params_.max_accel_m_s2);
+  reference_.yaw_rate = slew(reference_.yaw_rate, command_.yaw_rate, params_.max_yaw_accel_rad_s2);
+  const double psi = std::atan2(R(1, 0), R(0, 0));
+  psi_ref_ = psi + std::clamp(WrapAngle(psi_ref_ + reference_.yaw_rate * dt - psi),
+                              -kMaxHeadingLead, kMaxHeadingLead);
+  const double cp = std::cos(psi), sp = std::sin(psi);
+  const Eigen::Vector2d v_ref_xy(cp * reference_.vx - sp * reference_.vy,
+                                 sp * reference_.vx + cp * reference_.vy);
+  p_ref_ += v_ref_xy * dt;
+  Eigen::Vector2d lead = p_ref_ - com.head<2>();
+  if (lead.norm() > kMaxPositionLead) lead *= kMaxPositionLead / lead.norm();
+  p_ref_ = com.head<2>() + lead;
+
+  // 2. gait schedule
+  const double T = params_.period_sec, D = params_.duty;
+  const double T_st = D * T, T_sw = (1 - D) * T;
+  const double phase = std::fmod(t / T, 1.0);
+  std::array<double, 4> s_swing{};
+  for (int i = 0; i < 4; ++i) {
+    const double lp = std::fmod(phase - kPhaseOffset[i] + 1.0, 1.0);
+    stance_[i] = lp < D;
+    s_swing[i] = stance_[i] ? 0.0 : (lp - D) / (1 - D);
+    Leg& leg = legs_[i];
+    if (stance_[i]) {
+      leg.in_swing = false;
+      leg.p_ground = feet[i];
+    } else if (!leg.in_swing) {
+      leg.in_swing = true;
+      leg.p_lift = feet[i];
+    }
+  }
+
+  // ground plane z = a + b x + c y through the feet's last stance positions (least squares,
+  // slopes lightly regularised so that collinear feet still give a plane)
+  {
+    Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (const Leg& leg : legs_) {
+      const Eigen::Vector3d row(1, leg.p_ground.x() - com.x(), leg.p_ground.y() - com.y());
+      N += row * row.transpose();
+      rhs += row * leg.p_ground.z();
+    }
+    N(1, 1) += 1e-4;
+    N(2, 2) += 1e-4;
+    const Eigen::Vector3d sol = N.inverse() * rhs;  // about the COM's xy
+    const double b = std::clamp(sol[1], -0.6, 0.6), c = std::clamp(sol[2], -0.6, 0.6);
+    plane_ = Eigen::Vector3d(sol[0] - b * com.x() - c * com.y(), b, c);
+  }
+  auto ground_z = [&](double x, double y) { return plane_[0] + plane_[1] * x + plane_[2] * y; };
+  const Eigen::Vector3d normal = Eigen::Vector3d(-plane_[1], -plane_[2], 1).normalized();
+  const double h = com.z() - ground_z(com.x(), com.y());
+  if (h_ref_ <= 0) h_ref_ = params_.body_height_m.value_or(h);
+  if (k_raibert_ <= 0) k_raibert_ = params_.raibert_gain.value_or(std::sqrt(h_ref_ / kGravity));
+
+  // 3. stance: desired wrench on the COM, distributed over the stance feet
+  const double v_ref_z = plane_[1] * v_ref_xy.x() + plane_[2] * v_ref_xy.y();
+  Eigen::Vector3d acc;
+  acc.head<2>() =
+      params_.kp_xy * (p_ref_ - com.head<2>()) + params_.kd_xy * (v_ref_xy - v_com.head<2>());
+  acc.z() = params_.kp_z * (h_ref_ - h) + params_.kd_z * (v_ref_z - v_com.z());
+  Eigen::Matrix3d R_ref;
+  {
+    const Eigen::Vector3d x_h(std::cos(psi_ref_), std::sin(psi_ref_), 0);
+    const Eigen::Vector3d x_ref = (x_h - x_h.dot(normal) * normal).normalized();
+    R_ref.col(0) = x_ref;
+    R_ref.col(1) = normal.cross(x_ref);
+    R_ref.col(2) = normal;
+  }
+  const Eigen::AngleAxisd err(R_ref * R.transpose());
+  const Eigen::Vector3d e_B = R.transpose() * (err.angle() * err.axis());
+  const Eigen::Vector3d w_err_B = R.transpose() * (Eigen::Vector3d(0, 0, reference_.yaw_rate) - w);
+  const Eigen::Vector3d alpha_B(params_.kp_tilt * e_B.x() + params_.kd_tilt * w_err_B.x(),
+                                params_.kp_tilt * e_B.y() + params_.kd_tilt * w_err_B.y(),
+                                params_.kp_yaw * e_B.z() + params_.kd_yaw * w_err_B.z());
+  Eigen::Matrix<double, 6, 1> wrench;
+  wrench.head<3>() = mass_ * (acc + Eigen::Vector3d(0, 0, kGravity));
+  wrench.tail<3>() = R * (inertia_B_ * alpha_B);
+  std::array<Eigen::Vector3d, 4> r;
+  for (int i = 0; i < 4; ++i) r[i] = feet[i] - com;
+  DistributeStanceForces(r, stance_, wrench, normal, limits_, &forces_);
+
+  auto write = [&](const Leg& leg, int j, double tau) {
+    ctrl[leg.act[j]] = std::clamp(tau / leg.gear[j], leg.lo[j], leg.hi[j]);
+  };
+  for (int i = 0; i < 4; ++i) {
+    Leg& leg = legs_[i];
+    const TrotLegConfig& cfg = params_.legs[i];
+    if (stance_[i]) {
+      in.Jacobian(leg.calf_body, feet[i], &jac_);
+      for (int j = 0; j < 3; ++j) {
+        const double tau =
+            -jac_.block<3, 1>(3, leg.dof[j]).dot(forces_[i]) - params_.stance_kd * qvel[leg.dof[j]];
+        write(leg, j, tau);
+      }
+      continue;
+    }
+    // 4. swing: Raibert touch-down point, cycloid, IK and joint PD
+    const double t_rem = (1 - s_swing[i]) * T_sw;
+    const Eigen::Vector3d nominal_B = hip_B_[i] + Eigen::Vector3d(0, geometry_[i].abduction_m, 0);
+    const Eigen::Vector3d nominal_W = p + R * nominal_B;
+    const Eigen::Vector2d arm = (nominal_W - com).head<2>();
+    const Eigen::Vector2d v_nom_ref =
+        v_ref_xy + reference_.yaw_rate * Eigen::Vector2d(-arm.y(), arm.x());
+    const Eigen::Vector2d hip_td = nominal_W.head<2>() + v_nom_ref * t_rem;
+    Eigen::Vector2d step =
+        v_ref_xy * (T_st / 2) + k_raibert_ * (v_com.head<2>() - v_ref_xy) +
+        (h_ref_ / (2 * kGravity)) * reference_.yaw_rate * Eigen::Vector2d(v_com.y(), -v_com.x());
+    if (step.norm() > step_limit_) step *= step_limit_ / step.norm();
+    Eigen::Vector3d p_td;
+    p_td.head<2>() = hip_td + step;
+    p_td.z() = ground_z(p_td.x(), p_td.y()) - kTouchdownDepth;
+    const SwingSample target =
+        CycloidSwing(leg.p_lift, p_td, params_.swing_height_m, s_swing[i], T_sw);
+    const Eigen::Vector3d p_H = R.transpose() * (target.p - p) - hip_B_[i];
+    const Eigen::Vector3d v_H = R.transpose() * (target.v - v_base - w.cross(target.p - p));
+    Eigen::Vector3d q_can;
+    LegInverseKinematics(geometry_[i], p_H, &q_can);
+    const Eigen::Matrix3d J = LegJacobian(geometry_[i], q_can);
+    const Eigen::Vector3d qd_can =
+        (J.transpose() * J + 1e-4 * Eigen::Matrix3d::Identity()).ldlt().solve(J.transpose() * v_H);
+    for (int j = 0; j < 3; ++j) {
+      const double q_des_can = std::clamp(q_can[j], leg.q_lo[j], leg.q_hi[j]);
+      const double s = cfg.signs[j];
+      const double q_des = s * (q_des_can - cfg.offsets_rad[j]);
+      const double qd_des = s * qd_can[j];
+      const double tau = params_.swing_kp * (q_des - qpos[leg.qpos[j]]) +
+                         params_.swing_kd * (qd_des - qvel[leg.dof[j]]);
+      write(leg, j, tau);
+    }
+  }
+  for (const auto& [a, v] : hold_) ctrl[a] = v;
+}
+
+}  // namespace penumbra
