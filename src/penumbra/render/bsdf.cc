@@ -23,16 +23,17 @@ inline Eigen::Vector3f Schlick(const Eigen::Vector3f& f0, float cos_theta) {
   return f0 + (Eigen::Vector3f::Ones() - f0) * m5;
 }
 
-// GGX normal distribution D(h) for cos_h = n.h (Walter et al. 2007, eq. 33).
-inline float GgxD(float cos_h, float a2) {
-  const float k = cos_h * cos_h * (a2 - 1.0f) + 1.0f;
+// GGX normal distribution D(h) for a unit half vector h in the shading frame (Walter et al.
+// 2007, eq. 33, written as a2 / (pi (sin^2 + a2 cos^2)^2) with sin^2 = h.x^2 + h.y^2, which
+// keeps its precision for very smooth surfaces, unlike 1 - cos^2).
+inline float GgxD(const Eigen::Vector3f& h, float a2) {
+  const float k = (h.x() * h.x() + h.y() * h.y()) + a2 * h.z() * h.z();
   return a2 / (kPi * k * k);
 }
 
-// Smith Lambda for GGX (Heitz 2014, eq. 72), for a direction at cos_theta to the normal.
-inline float GgxLambda(float cos_theta, float a2) {
-  const float c2 = cos_theta * cos_theta;
-  const float tan2 = std::max(0.0f, 1.0f - c2) / c2;
+// Smith Lambda for GGX (Heitz 2014, eq. 72) of a unit direction w in the shading frame.
+inline float GgxLambda(const Eigen::Vector3f& w, float a2) {
+  const float tan2 = (w.x() * w.x() + w.y() * w.y()) / (w.z() * w.z());
   return 0.5f * (-1.0f + std::sqrt(1.0f + a2 * tan2));
 }
 
@@ -98,7 +99,7 @@ Eigen::Vector3f Bsdf::EvalLocal(const Eigen::Vector3f& wi, bool with_specular) c
   Eigen::Vector3f f = (Eigen::Vector3f::Ones() - F).cwiseProduct(c_diff_) * kInvPi;
   if (with_specular) {
     const float a2 = alpha_ * alpha_;
-    f += F * (GgxD(h.z(), a2) * SmithVisibility(n_v, n_l, a2));
+    f += F * (GgxD(h, a2) * SmithVisibility(n_v, n_l, a2));
   }
   return f * n_l;
 }
@@ -114,8 +115,8 @@ float Bsdf::PdfLocal(const Eigen::Vector3f& wi) const {
       const float a2 = alpha_ * alpha_;
       // visible-normal density reflected about h: D(h) G1(wo) / (4 wo.z) (Heitz 2018, eq. 17 and 1
       // / (4 wo.h)).
-      const float g1 = 1.0f / (1.0f + GgxLambda(wo_.z(), a2));
-      pdf += p_spec_ * GgxD(h.z(), a2) * g1 / (4.0f * wo_.z());
+      const float g1 = 1.0f / (1.0f + GgxLambda(wo_, a2));
+      pdf += p_spec_ * GgxD(h, a2) * g1 / (4.0f * wo_.z());
     }
   }
   return pdf;
@@ -167,11 +168,13 @@ bool Bsdf::Sample(float u_lobe, float u1, float u2, BsdfSample* s) const {
         Eigen::Vector3f(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1)));
   }
   if (wi.z() <= 0) return false;
+  // value and density of the returned (world, unit) direction itself, so that Sample agrees
+  // with Eval and Pdf to the last bit.
   const Eigen::Vector3f wi_W = FromLocal(wi).normalized();
   if (wi_W.dot(ng_) <= 0) return false;
   s->wi = wi_W;
-  s->f_cos = EvalLocal(wi, true);
-  s->pdf = PdfLocal(wi);
+  s->f_cos = Eval(wi_W);
+  s->pdf = Pdf(wi_W);
   return s->pdf > 0;
 }
 

@@ -1,0 +1,165 @@
+// textures and materials at surface points.
+
+#include "penumbra/render/material_eval.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+// a 2 x 2 texture: (0,0) black, (1,0) white, (0,1) red, (1,1) green (sRGB codes).
+Texture Quad() {
+  Texture t;
+  t.name = "quad";
+  t.width = t.height = 2;
+  t.rgb_srgb = {0, 0, 0, 255, 255, 255, 255, 0, 0, 0, 255, 0};
+  return t;
+}
+
+// a cube texture with one solid colour per face, code 10 (face + 1) in red.
+Texture Cube() {
+  Texture t;
+  t.name = "cube";
+  t.kind = Texture::Kind::kCube;
+  t.width = 4;
+  t.height = 24;
+  for (int f = 0; f < 6; ++f)
+    for (int i = 0; i < 16; ++i)
+      t.rgb_srgb.insert(t.rgb_srgb.end(), {static_cast<uint8_t>(10 * (f + 1)), 0, 0});
+  return t;
+}
+
+double Srgb(int code) {
+  const double c = code / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+SceneDescription OneGeom(GeomShape shape, Eigen::Vector3d size, Texture tex) {
+  SceneDescription s;
+  s.bodies.push_back({"world", -1, true});
+  s.textures.push_back(tex);
+  Material m;
+  m.base_color = {1, 1, 1};
+  m.texture = 0;
+  s.materials.push_back(m);
+  Geom g;
+  g.shape = shape;
+  g.size = size;
+  g.material = 0;
+  s.geoms.push_back(g);
+  return s;
+}
+
+SurfaceHit HitAt(Eigen::Vector3f p_G, Eigen::Vector3f n_G) {
+  SurfaceHit h;
+  h.geom = 0;
+  h.material = 0;
+  h.p_G = p_G;
+  h.n_G = n_G;
+  return h;
+}
+
+TEST(MaterialEvalTest, Sample2DIsBilinearInLinearSpaceAndWraps) {
+  const SceneDescription s = OneGeom(GeomShape::kPlane, {1, 1, 0}, Quad());
+  const MaterialEvaluator me(s);
+  // texel centres give the decoded texel.
+  EXPECT_NEAR(me.Sample2D(0, 0.75f, 0.25f).x(), 1.0, 1e-6);
+  EXPECT_NEAR(me.Sample2D(0, 0.25f, 0.75f).x(), 1.0, 1e-6);
+  EXPECT_NEAR(me.Sample2D(0, 0.25f, 0.75f).y(), 0.0, 1e-6);
+  EXPECT_NEAR(me.Sample2D(0, 0.75f, 0.75f).y(), 1.0, 1e-6);
+  // halfway between black and white: mean of the linear values, not of the codes.
+  EXPECT_NEAR(me.Sample2D(0, 0.5f, 0.25f).x(), 0.5, 1e-6);
+  // wrapping: s = 1.75 is s = 0.75; s = 0 blends the first and last columns.
+  EXPECT_EQ(me.Sample2D(0, 1.75f, 0.25f), me.Sample2D(0, 0.75f, 0.25f));
+  EXPECT_NEAR(me.Sample2D(0, 0.0f, 0.25f).x(), 0.5, 1e-6);
+}
+
+TEST(MaterialEvalTest, PlaneTexrepeatAndTexuniform) {
+  SceneDescription s = OneGeom(GeomShape::kPlane, {2, 2, 0}, Quad());
+  s.materials[0].texrepeat = {1, 1};
+  {
+    // not uniform: the image spans the plane once; (+x, +y) quarter = image top right = white.
+    const MaterialEvaluator me(s);
+    EXPECT_NEAR(me.Evaluate(HitAt({1, 1, 0}, {0, 0, 1})).pbr.base_color.x(), 1.0, 1e-6);
+    EXPECT_NEAR(me.Evaluate(HitAt({-1, -1, 0}, {0, 0, 1})).pbr.base_color.x(), 1.0, 1e-6);  // red
+    EXPECT_NEAR(me.Evaluate(HitAt({-1, -1, 0}, {0, 0, 1})).pbr.base_color.y(), 0.0, 1e-6);
+    EXPECT_NEAR(me.Evaluate(HitAt({-1, 1, 0}, {0, 0, 1})).pbr.base_color.norm(), 0.0,
+                1e-6);  // black
+  }
+  s.materials[0].texuniform = true;
+  s.materials[0].texrepeat = {2, 2};  // two repeats per metre: 0.5 m per image
+  {
+    const MaterialEvaluator me(s);
+    const Eigen::Vector3f a = me.Evaluate(HitAt({0.375f, -0.125f, 0}, {0, 0, 1})).pbr.base_color;
+    const Eigen::Vector3f b = me.Evaluate(HitAt({0.875f, 0.375f, 0}, {0, 0, 1})).pbr.base_color;
+    EXPECT_NEAR((a - b).norm(), 0.0, 1e-6);  // one period (0.5 m) apart in x and y
+    // (0.375, -0.125): s = 0.75, t = 0.25 -> texel (1, 0) = white.
+    EXPECT_NEAR(a.x(), 1.0, 1e-6);
+    EXPECT_NEAR(a.z(), 1.0, 1e-6);
+  }
+}
+
+TEST(MaterialEvalTest, CubeTextureShowsOneFacePerBoxFace) {
+  const SceneDescription s = OneGeom(GeomShape::kBox, {0.5, 1, 2}, Cube());
+  const MaterialEvaluator me(s);
+  const struct {
+    Eigen::Vector3f p, n;
+    int face;
+  } cases[] = {{{0.5f, 0.3f, -1}, {1, 0, 0}, 0}, {{-0.5f, 0.9f, 1.5f}, {-1, 0, 0}, 1},
+               {{0.2f, 1, 0.1f}, {0, 1, 0}, 2},  {{0.4f, -1, -1.9f}, {0, -1, 0}, 3},
+               {{-0.4f, 0.8f, 2}, {0, 0, 1}, 4}, {{0.1f, 0.1f, -2}, {0, 0, -1}, 5}};
+  for (const auto& c : cases)
+    EXPECT_NEAR(me.Evaluate(HitAt(c.p, c.n)).pbr.base_color.x(), Srgb(10 * (c.face + 1)), 1e-6)
+        << c.face;
+}
+
+TEST(MaterialEvalTest, MeshTexcoordsAreUsed) {
+  SceneDescription s = OneGeom(GeomShape::kMesh, {0, 0, 0}, Quad());
+  s.meshes.push_back(TriangleMesh{});
+  s.geoms[0].mesh = 0;
+  const MaterialEvaluator me(s);
+  SurfaceHit h = HitAt({0, 0, 0}, {0, 0, 1});
+  h.has_uv = true;
+  h.uv = {0.75f, 0.75f};  // texel (1, 1): green
+  const Eigen::Vector3f c = me.Evaluate(h).pbr.base_color;
+  EXPECT_NEAR(c.y(), 1.0, 1e-6);
+  EXPECT_NEAR(c.x(), 0.0, 1e-6);
+}
+
+TEST(MaterialEvalTest, MaterialFieldsAndDefaults) {
+  SceneDescription s = OneGeom(GeomShape::kSphere, {1, 0, 0}, Quad());
+  s.materials[0].texture = -1;
+  s.materials[0].base_color = {0.1f, 0.2f, 0.3f};
+  s.materials[0].roughness = 0.25f;
+  s.materials[0].metallic = 0.75f;
+  s.materials[0].emission = {5, 6, 7};
+  const MaterialEvaluator me(s);
+  const SurfaceMaterial m = me.Evaluate(HitAt({1, 0, 0}, {1, 0, 0}));
+  EXPECT_EQ(m.pbr.base_color, Eigen::Vector3f(0.1f, 0.2f, 0.3f));
+  EXPECT_EQ(m.pbr.roughness, 0.25f);
+  EXPECT_EQ(m.pbr.metallic, 0.75f);
+  EXPECT_EQ(m.emission, Eigen::Vector3f(5, 6, 7));
+  SurfaceHit h = HitAt({1, 0, 0}, {1, 0, 0});
+  h.material = -1;
+  EXPECT_EQ(me.Evaluate(h).pbr.base_color, Material{}.base_color);
+}
+
+TEST(MaterialEvalTest, BadTexturesThrow) {
+  SceneDescription s = OneGeom(GeomShape::kPlane, {1, 1, 0}, Quad());
+  s.materials[0].texture = 3;
+  EXPECT_THROW(MaterialEvaluator{s}, Error);
+  SceneDescription t = OneGeom(GeomShape::kPlane, {1, 1, 0}, Quad());
+  t.textures[0].rgb_srgb.pop_back();
+  EXPECT_THROW(MaterialEvaluator{t}, Error);
+  SceneDescription c = OneGeom(GeomShape::kBox, {1, 1, 1}, Cube());
+  c.textures[0].height = 20;
+  c.textures[0].rgb_srgb.resize(4 * 20 * 3);
+  EXPECT_THROW(MaterialEvaluator{c}, Error);
+}
+
+}  // namespace
+}  // namespace penumbra
