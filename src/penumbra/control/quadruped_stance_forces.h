@@ -6,7 +6,8 @@
 //
 //   A f = w,   A = [ I       I     ... ],   w = (F, tau)   (world frame, about the COM)
 //                  [ [r_1]x  [r_2]x ... ]
-//   f* = argmin |A f - w|^2_S + alpha |f|^2 = (A^T S A + alpha I)^-1 A^T S w,
+//   f* = argmin |A f - w|^2_S + alpha |f|^2 = (A^T S A + alpha I)^-1 A^T S w
+//      = A^T S^1/2 (alpha I + S^1/2 A A^T S^1/2)^-1 S^1/2 w     (a 6 x 6 solve),
 //   S = diag(1, 1, 1, s_tau, s_tau, s_tau),
 //
 // with r_i the foot positions relative to the COM and swing feet's forces fixed at zero;

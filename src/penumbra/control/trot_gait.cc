@@ -441,6 +441,7 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   const Eigen::Vector3d w = V.head<3>(), v_base = V.tail<3>();
   const auto qpos = in.qpos();
   const auto qvel = in.qvel();
+  const auto bias = in.qfrc_bias();
 
   // centre of mass and its velocity (rigid-body approximation)
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
@@ -579,15 +580,16 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
     Eigen::Vector3d q_can;
     LegInverseKinematics(geometry_[i], p_H, &q_can);
     const Eigen::Matrix3d J = LegJacobian(geometry_[i], q_can);
-    const Eigen::Vector3d qd_can =
-        (J.transpose() * J + 1e-4 * Eigen::Matrix3d::Identity()).ldlt().solve(J.transpose() * v_H);
+    const Eigen::Matrix3d JtJ = J.transpose() * J + 1e-4 * Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d qd_can = JtJ.inverse() * (J.transpose() * v_H);
     for (int j = 0; j < 3; ++j) {
       const double q_des_can = std::clamp(q_can[j], leg.q_lo[j], leg.q_hi[j]);
       const double s = cfg.signs[j];
       const double q_des = s * (q_des_can - cfg.offsets_rad[j]);
       const double qd_des = s * qd_can[j];
       const double tau = params_.swing_kp * (q_des - qpos[leg.qpos[j]]) +
-                         params_.swing_kd * (qd_des - qvel[leg.dof[j]]);
+                         params_.swing_kd * (qd_des - qvel[leg.dof[j]]) +
+                         (bias.empty() ? 0.0 : bias[leg.dof[j]]);
       write(leg, j, tau);
     }
   }
