@@ -123,10 +123,11 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
   d.speed_m_s = p.Number("speed_m_s", 0.25, 0, kInf, true);
   d.angular_speed_rad_s = p.Number("angular_speed_deg_s", 90, 0, kInf, true) * kDegToRad;
   d.posture = ReadOptionalNumbers(p, "posture", n, -kInf, kInf, "rad or m, one per joint");
-  d.posture_gain = p.Number("posture_gain", 1.0, 0, kInf);
+  d.posture_gain = p.Number("posture_gain", 0.3, 0, kInf);
   d.limit_zone = p.Number("limit_zone", 0.2, 0, kInf, true);
   d.limit_gain = p.Number("limit_gain", 5.0, 0, kInf);
   d.max_tracking_error = p.Number("max_tracking_error", 0.2, 0, kInf, true);
+  d.limit_velocity_gain = p.Number("limit_velocity_gain", 5, 0, kInf, true);
   if (p.Has("gripper_actuator")) {
     d.gripper_actuator = prefix + p.String("gripper_actuator");
     if (p.Has("gripper_open")) d.gripper_open = p.Number("gripper_open", std::nullopt, -kInf, kInf);
@@ -210,6 +211,7 @@ void DiffIkParams::ValidateOrThrow(const ControllerContext& c) const {
   positive("limit_zone", limit_zone);
   non_negative("limit_gain", limit_gain);
   positive("max_tracking_error", max_tracking_error);
+  positive("limit_velocity_gain", limit_velocity_gain);
   non_negative("rate_hz", rate_hz);
   if (posture && posture->size() != servo.joints.size())
     fail("posture", "got " + std::to_string(posture->size()) + " values; expected " +
@@ -430,17 +432,21 @@ void DiffIkController::SolveDls(double dt) {
     for (int i = 0; i < n; ++i)
       if (clamped_[i]) qdot_[i] = dq_fixed_[i];
     if (dt <= 0) break;
+    // velocity damper: towards a bound at most beta times the distance left (and never
+    // past it within this step)
+    const double beta = std::min(params_.limit_velocity_gain, 1.0 / dt);
     bool again = false;
     for (int i = 0; i < n; ++i) {
       if (clamped_[i]) continue;
-      const double next = q_ref_[i] + qdot_[i] * dt;
-      if (next > hi[i] && qdot_[i] > 0) {
+      const double up = beta * std::max(0.0, hi[i] - q_ref_[i]);
+      const double down = beta * std::min(0.0, lo[i] - q_ref_[i]);
+      if (qdot_[i] > up) {
         clamped_[i] = 1;
-        dq_fixed_[i] = std::max(0.0, (hi[i] - q_ref_[i]) / dt);
+        dq_fixed_[i] = up;
         again = true;
-      } else if (next < lo[i] && qdot_[i] < 0) {
+      } else if (qdot_[i] < down) {
         clamped_[i] = 1;
-        dq_fixed_[i] = std::min(0.0, (lo[i] - q_ref_[i]) / dt);
+        dq_fixed_[i] = down;
         again = true;
       }
     }

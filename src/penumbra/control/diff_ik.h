@@ -25,10 +25,11 @@
 //     angular_speed_deg_s: 90          # > 0, default peak angular speed
 //     posture: [...]            # null-space posture (rad or m, one per joint); default: the
 //                               # configuration at the first update
-//     posture_gain: 1.0         # 1/s >= 0
+//     posture_gain: 0.3         # 1/s >= 0
 //     limit_zone: 0.2           # rad (m) > 0: the limit-avoidance gradient acts this close
 //                               # to the (margin-shrunk) joint ranges
 //     limit_gain: 5.0           # 1/s >= 0
+//     limit_velocity_gain: 5    # 1/s > 0: speed towards a range bound <= this x distance
 //     max_tracking_error: 0.2   # rad (m) > 0: the reference stays this close to the joints
 //     gripper_actuator: gripper # optional actuator; ctrl = gripper_open / gripper_closed
 //     gripper_open: 0.04        # default: the actuator's ctrlrange maximum
@@ -68,10 +69,12 @@
 //      limit_gain g(q_r), where g pushes joints out of the limit zone (g_i = q_min,i +
 //      zone - q_r,i below it, q_max,i - zone - q_r,i above it, else 0): the gradient
 //      projection method (A. Liegeois, IEEE SMC 7(12), 1977).
-//   5. joint limits by clamping: a joint whose reference would leave [q_min, q_max] is
-//      held at the bound, its Jacobian column removed and the rest re-solved for the
-//      remaining task (P. Baerlocher and R. Boulic, The Visual Computer 20, 2004); repeated
-//      until no joint leaves its range.
+//   5. joint limits by clamping: a joint whose velocity towards a bound of [q_min, q_max]
+//      exceeds limit_velocity_gain times the distance left (a velocity damper, B. Faverjon
+//      and P. Tournassoud, IEEE ICRA 1987; it also never crosses the bound within a step)
+//      is held at that velocity, its Jacobian column removed and the rest re-solved for the
+//      remaining task (clamping, P. Baerlocher and R. Boulic, The Visual Computer 20,
+//      2004); repeated until no joint exceeds its bound.
 //   6. qdot scaled by one factor so that |qdot_i| <= max_velocity_i; q_r += qdot dt,
 //      clamped into the ranges and to within max_tracking_error of q; the servo tracks
 //      (q_r, qdot) with gravity compensation.
@@ -134,10 +137,11 @@ struct DiffIkParams {
   double speed_m_s = 0.25;
   double angular_speed_rad_s = M_PI / 2;
   std::optional<std::vector<double>> posture;
-  double posture_gain = 1.0;
+  double posture_gain = 0.3;
   double limit_zone = 0.2;
   double limit_gain = 5.0;
   double max_tracking_error = 0.2;
+  double limit_velocity_gain = 5;
   std::string gripper_actuator;  ///< full model name, "" = none
   std::optional<double> gripper_open, gripper_closed;
   ArmCommand gripper_initial = ArmCommand::Gripper(ArmCommand::GripperAction::kOpen);
