@@ -57,21 +57,27 @@ inline void Basis(const Eigen::Vector3f& n, Eigen::Vector3f* t, Eigen::Vector3f*
 
 }  // namespace
 
-Bsdf::Bsdf(const PbrParams& params, const Eigen::Vector3f& ns_W, const Eigen::Vector3f& ng_W,
-           const Eigen::Vector3f& wo_W)
-    : ng_(ng_W) {
+BrdfCoefficients BrdfCoefficients::From(const PbrParams& params) {
+  BrdfCoefficients c;
   const float metallic = std::clamp(params.metallic, 0.0f, 1.0f);
   const Eigen::Vector3f base = params.base_color.cwiseMax(0.0f).cwiseMin(1.0f);
   const float r = std::clamp(params.roughness, 0.0f, 1.0f);
-  alpha_ = std::max(r * r, kMinAlpha);
+  c.alpha = std::max(r * r, kMinAlpha);
   const Eigen::Vector3f f0_dielectric =
       Eigen::Vector3f::Constant(0.08f * std::clamp(params.specular, 0.0f, 1.0f));
-  f0_ = f0_dielectric + (base - f0_dielectric) * metallic;
-  c_diff_ = base * (1.0f - metallic);
+  c.f0 = f0_dielectric + (base - f0_dielectric) * metallic;
+  c.c_diff = base * (1.0f - metallic);
+  return c;
+}
 
-  // a shading normal that faces away from the viewer would make the surface black; fall
-  // back to the geometric normal there.
-  n_ = ns_W.dot(wo_W) > 0 ? ns_W : ng_W;
+Bsdf::Bsdf(const PbrParams& params, const Eigen::Vector3f& ns_W, const Eigen::Vector3f& ng_W,
+           const Eigen::Vector3f& wo_W)
+    : ng_(ng_W) {
+  const BrdfCoefficients c = BrdfCoefficients::From(params);
+  alpha_ = c.alpha;
+  f0_ = c.f0;
+  c_diff_ = c.c_diff;
+  n_ = UsableShadingNormal(ns_W, ng_W, wo_W);
   Basis(n_, &t_, &b_);
   wo_ = ToLocal(wo_W);
 

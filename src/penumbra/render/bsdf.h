@@ -43,6 +43,22 @@ struct BsdfSample {
   float pdf = 0;                   ///< solid-angle density of wi (mixture of both lobes)
 };
 
+/// the coefficients of the BRDF formula above, derived from PbrParams (clamped to range).
+struct BrdfCoefficients {
+  Eigen::Vector3f c_diff{0, 0, 0};  ///< base_color (1 - metallic)
+  Eigen::Vector3f f0{0, 0, 0};      ///< mix(0.08 specular, base_color, metallic)
+  float alpha = 0.25f;              ///< max(roughness^2, kMinAlpha)
+
+  static BrdfCoefficients From(const PbrParams& params);
+};
+
+/// the shading normal used for a view direction: ns_W, or ng_W where wo_W is not above ns_W
+/// (a shading normal that faces away from the viewer would make the surface black).
+inline Eigen::Vector3f UsableShadingNormal(const Eigen::Vector3f& ns_W, const Eigen::Vector3f& ng_W,
+                                           const Eigen::Vector3f& wo_W) {
+  return ns_W.dot(wo_W) > 0 ? ns_W : ng_W;
+}
+
 /// the BRDF of one shading point, with its shading frame.
 class Bsdf {
  public:

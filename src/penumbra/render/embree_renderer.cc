@@ -104,10 +104,11 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   std::atomic<int64_t> secondary_rays{0};
   ImageI32* seg = want.segmentation ? &out->geom_id : nullptr;
   pool_.ParallelFor(static_cast<int64_t>(tiles_x) * tiles_y, [&](int64_t k) {
+    // per-thread buffers of one tile, allocated once (no per-tile initialisation).
     constexpr int kMax = kTileSize * kTileSize;
-    Ray rays[kMax];
-    SurfaceHit hits[kMax];
-    bool did_hit[kMax];
+    thread_local std::unique_ptr<Ray[]> rays(new Ray[kMax]);
+    thread_local std::unique_ptr<SurfaceHit[]> hits(new SurfaceHit[kMax]);
+    thread_local std::unique_ptr<bool[]> did_hit(new bool[kMax]);
     PrimaryHits primary;
     primary.tile.x0 = static_cast<int>(k % tiles_x) * kTileSize;
     primary.tile.y0 = static_cast<int>(k / tiles_x) * kTileSize;
@@ -118,16 +119,16 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
     for (int i = 0; i < n; ++i)
       rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + i % t.width),
                                    static_cast<float>(t.y0 + i / t.width));
-    ray_scene_->IntersectMany(rays, n, /*coherent=*/true, hits, did_hit);
+    ray_scene_->IntersectMany(rays.get(), n, /*coherent=*/true, hits.get(), did_hit.get());
     for (int i = 0; i < n; ++i) {
       const int u = t.x0 + i % t.width, v = t.y0 + i / t.width;
       if (depth) *depth->at(u, v) = did_hit[i] ? hits[i].t : 0.0f;
       if (seg) *seg->at(u, v) = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
     }
     if (buffers.radiance) {
-      primary.rays = rays;
-      primary.hits = hits;
-      primary.did_hit = did_hit;
+      primary.rays = rays.get();
+      primary.hits = hits.get();
+      primary.did_hit = did_hit.get();
       secondary_rays.fetch_add(integrator_->RenderTile(ctx, primary, buffers),
                                std::memory_order_relaxed);
     }

@@ -24,14 +24,35 @@ inline float SmoothStep(float e0, float e1, float x) {
 inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float u1, float u2) {
   const float cos_t = 1.0f - u1 * (1.0f - cos_max);
   const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-  const float phi = static_cast<float>(2 * kPi) * u2;
+  float sp, cp;
+  SinCos2Pi(u2, &sp, &cp);
   // orthonormal basis around w (Duff et al., JCGT 2017).
-  const float sign = std::copysign(1.0f, w.z());
+  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
   const float a = -1.0f / (sign + w.z());
   const float b = w.x() * w.y() * a;
   const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
   const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
-  return (sin_t * std::cos(phi) * t + sin_t * std::sin(phi) * bt + cos_t * w).normalized();
+  return (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
+}
+
+// SampleCone for every lane (same arithmetic).
+inline Vec3Lanes SampleConeLanes(const Vec3Lanes& w, const Lanes& cos_max, const Lanes& u1,
+                                 const Lanes& u2) {
+  const Lanes cos_t = 1.0f - u1 * (1.0f - cos_max);
+  const Lanes sin_t = (1.0f - cos_t * cos_t).max(0.0f).sqrt();
+  Lanes sp, cp;
+  SinCos2Pi(u2, &sp, &cp);
+  Lanes sign;
+  for (int k = 0; k < kLanes; ++k) sign[k] = w.z[k] >= 0 ? 1.0f : -1.0f;
+  const Lanes a = -1.0f / (sign + w.z);
+  const Lanes b = w.x * w.y * a;
+  const Vec3Lanes t{1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x};
+  const Vec3Lanes bt{b, sign + w.y * w.y * a, -w.y};
+  const Lanes sc = sin_t * cp, ss = sin_t * sp;
+  Vec3Lanes d{sc * t.x + ss * bt.x + cos_t * w.x, sc * t.y + ss * bt.y + cos_t * w.y,
+              sc * t.z + ss * bt.z + cos_t * w.z};
+  const Lanes inv = 1.0f / d.Dot(d).sqrt();
+  return d * inv;
 }
 
 }  // namespace
@@ -107,7 +128,7 @@ bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
     if (atten <= 0) return false;
   }
   s->E = l.intensity_rgb * (atten / d2);
-  const Eigen::Vector3f w = to_light / d;
+  const Eigen::Vector3f w = to_light * (1.0f / d);
   if (l.radius_m > 0) {
     // uniform direction in the cone the sphere subtends, ending on its near surface: for a
     // sphere of uniform radiance I / (pi r^2) each direction carries the full I / d^2.
@@ -123,6 +144,57 @@ bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
     s->distance = d;
   }
   return true;
+}
+
+void LightSampler::SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, const Lanes& u2,
+                               LightSampleLanes* s) const {
+  const PosedLight& l = lights_[i];
+  if (l.type == Light::Type::kDirectional) {
+    const Eigen::Vector3f to_light = -l.direction_W;
+    const Vec3Lanes axis{Lanes::Constant(to_light.x()), Lanes::Constant(to_light.y()),
+                         Lanes::Constant(to_light.z())};
+    s->wi = l.cos_angular_radius < 1.0f
+                ? SampleConeLanes(axis, Lanes::Constant(l.cos_angular_radius), u1, u2)
+                : axis;
+    s->distance = Lanes::Constant(std::numeric_limits<float>::infinity());
+    s->E = {Lanes::Constant(l.intensity_rgb.x()), Lanes::Constant(l.intensity_rgb.y()),
+            Lanes::Constant(l.intensity_rgb.z())};
+    s->valid = LaneMask::Constant(true);
+    return;
+  }
+  const Vec3Lanes to_light{l.position_W.x() - p_W.x, l.position_W.y() - p_W.y,
+                           l.position_W.z() - p_W.z};
+  const Lanes d2 = to_light.Dot(to_light);
+  const Lanes d = d2.sqrt();
+  s->valid = d > l.radius_m;
+  Lanes atten = Lanes::Ones();
+  if (l.type == Light::Type::kSpot) {
+    const Lanes cos_axis = -(to_light.x * l.direction_W.x() + to_light.y * l.direction_W.y() +
+                             to_light.z * l.direction_W.z()) /
+                           d;
+    if (l.cos_inner <= l.cos_outer) {
+      for (int k = 0; k < kLanes; ++k) atten[k] = cos_axis[k] >= l.cos_outer ? 1.0f : 0.0f;
+    } else {
+      const Lanes t = ((cos_axis - l.cos_outer) / (l.cos_inner - l.cos_outer)).max(0.0f).min(1.0f);
+      atten = t * t * (3.0f - 2.0f * t);
+    }
+    s->valid = s->valid && (atten > 0.0f);
+  }
+  const Lanes scale = atten / d2;
+  s->E = {l.intensity_rgb.x() * scale, l.intensity_rgb.y() * scale, l.intensity_rgb.z() * scale};
+  const Lanes inv_d = 1.0f / d;
+  const Vec3Lanes w = to_light * inv_d;
+  if (l.radius_m > 0) {
+    const Lanes sin2 = (l.radius_m * l.radius_m) / d2;
+    const Lanes cos_max = (1.0f - sin2).max(0.0f).sqrt();
+    s->wi = SampleConeLanes(w, cos_max, u1, u2);
+    const Lanes b = s->wi.Dot(to_light);
+    const Lanes disc = (b * b - (d2 - l.radius_m * l.radius_m)).max(0.0f);
+    s->distance = (b - disc.sqrt()).max(0.0f);
+  } else {
+    s->wi = w;
+    s->distance = d;
+  }
 }
 
 }  // namespace penumbra

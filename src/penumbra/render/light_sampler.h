@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -34,6 +35,15 @@ struct LightSample {
   Eigen::Vector3f E{0, 0,
                     0};  ///< illuminance (lux per channel) on a surface facing wi, colour included
   bool cast_shadow = true;  ///< the light casts shadows (trace a shadow ray)
+};
+
+/// samples of one light for kLanes shading points (see LightSampler::SampleLanes).
+struct LightSampleLanes {
+  Vec3Lanes wi;    ///< unit directions towards the light
+  Lanes distance;  ///< m; +inf for directional lights
+  Vec3Lanes E;     ///< illuminance per channel (x = r, y = g, z = b), lux
+  LaneMask
+      valid;  ///< false where Sample() would return false (the other fields are then unspecified)
 };
 
 /// a light posed in the world for the current snapshot.
@@ -67,6 +77,11 @@ class LightSampler {
   /// (used only by lights with an extent). returns false when the light sends nothing to
   /// p_W (outside a spot cone, or p_W inside the emitter).
   bool Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2, LightSample* s) const;
+
+  /// Sample() for kLanes shading points at once, lane k with (p_W, u1, u2) lane k: the same
+  /// model, random-number use and arithmetic, so it agrees with Sample() to float rounding.
+  void SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, const Lanes& u2,
+                   LightSampleLanes* s) const;
 
  private:
   std::vector<Light> sources_;  // the kept lights of the scene

@@ -6,14 +6,15 @@
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
+#include "penumbra/render/bsdf_lanes.h"
 
 namespace penumbra {
 namespace {
 
 constexpr float kInvPi = 0.318309886183790671538f;
 
-inline float Luminance(const Eigen::Vector3f& c) {
-  return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z();
+inline Lanes LuminanceLanes(const Vec3Lanes& c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
 }
 
 // split-sum specular reflectance, analytic fit (Karis 2014, "Physically based shading on mobile").
@@ -28,26 +29,11 @@ inline Eigen::Vector3f EnvBrdfApprox(const Eigen::Vector3f& f0, float n_v, float
   return (f0 * a + Eigen::Vector3f::Constant(b)).cwiseMax(0.0f).cwiseMin(1.0f);
 }
 
-// a light contribution waiting for its shadow ray.
-struct PendingShadow {
-  int pixel;              // index within the tile
-  Eigen::Vector3f value;  // added if unoccluded
-};
-
-// shadow rays of one tile towards one light.
-struct ShadowBatch {
-  std::vector<Ray> rays;
-  std::vector<PendingShadow> pending;
-};
-
-// per-thread scratch, grown once and reused across tiles and frames.
+// per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
-  std::vector<ShadowBatch> batches;  // per light
-  std::unique_ptr<bool[]> occluded;
-  int occluded_capacity = 0;
-  std::vector<Eigen::Vector3f> contrib;
-  std::vector<LightSample> samples;
-  std::vector<uint8_t> valid;
+  std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
+  std::vector<LightSampleLanes> samples;  // per light
+  std::vector<Vec3Lanes> contrib;         // per light: unshadowed f cos E
 };
 
 }  // namespace
@@ -58,97 +44,130 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
   const int num_lights = ctx.lights->size();
-  if (static_cast<int>(scratch.batches.size()) < num_lights) scratch.batches.resize(num_lights);
-  for (int j = 0; j < num_lights; ++j) {
-    scratch.batches[j].rays.clear();
-    scratch.batches[j].pending.clear();
-  }
-  scratch.contrib.resize(num_lights);
+  scratch.u1.resize(num_lights);
+  scratch.u2.resize(num_lights);
   scratch.samples.resize(num_lights);
-  scratch.valid.resize(num_lights);
+  scratch.contrib.resize(num_lights);
+  int64_t traced = 0;
 
-  for (int i = 0; i < n; ++i) {
-    const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
-    float* L = out.radiance->at(u, v);
-    const Ray& ray = primary.rays[i];
-    if (!primary.did_hit[i]) {
-      const Eigen::Vector3f sky = ctx.sky->Radiance(ray.d.normalized());
-      L[0] = sky.x(), L[1] = sky.y(), L[2] = sky.z();
-      if (out.albedo) std::fill_n(out.albedo->at(u, v), 3, 0.0f);
-      if (out.normal) std::fill_n(out.normal->at(u, v), 3, 0.0f);
-      continue;
-    }
-    const SurfaceHit& hit = primary.hits[i];
-    const SurfaceMaterial mat = ctx.materials->Evaluate(hit);
-    const Eigen::Vector3f wo = -ray.d.normalized();
-    const Bsdf bsdf(mat.pbr, hit.ns_W, hit.ng_W, wo);
-    const Eigen::Vector3f& n_s = bsdf.shading_normal();
-
-    // emission and unoccluded sky ambient.
-    const Eigen::Vector3f spec =
-        EnvBrdfApprox(bsdf.f0(), std::max(n_s.dot(wo), 0.0f), mat.pbr.roughness);
-    const Eigen::Vector3f reflect =
-        bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-    Eigen::Vector3f radiance =
-        mat.emission + (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect);
-
-    // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
-    Rng rng(ctx.PixelStream(u, v, 0));
-    float total = Luminance(radiance);
-    for (int j = 0; j < num_lights; ++j) {
-      const float u1 = rng.Uniform(), u2 = rng.Uniform();
-      LightSample& s = scratch.samples[j];
-      scratch.valid[j] = 0;
-      if (!ctx.lights->Sample(j, hit.p_W, u1, u2, &s)) continue;
-      const Eigen::Vector3f f = bsdf.Eval(s.wi);
-      if (!(f.maxCoeff() > 0)) continue;
-      scratch.contrib[j] = f.cwiseProduct(s.E);
-      scratch.valid[j] = 1;
-      total += Luminance(scratch.contrib[j]);
-    }
-    for (int j = 0; j < num_lights; ++j) {
-      if (!scratch.valid[j]) continue;
-      const LightSample& s = scratch.samples[j];
-      if (!s.cast_shadow || Luminance(scratch.contrib[j]) < kNegligibleLight * total) {
-        radiance += scratch.contrib[j];
+  // rows of kLanes pixels (a tile row is kLanes wide): per-pixel set-up, then every light for
+  // all lanes at once, its shadow rays as one Embree packet.
+  for (int i0 = 0; i0 < n; i0 += kLanes) {
+    const int m = std::min(kLanes, n - i0);
+    LaneMask hit = LaneMask::Constant(false);
+    BsdfLanes bsdf;
+    Vec3Lanes p, origin, L;
+    for (int k = 0; k < kLanes; ++k) {
+      const int i = i0 + k;
+      const bool lane_hit = k < m && primary.did_hit[i];
+      hit[k] = lane_hit;
+      if (!lane_hit) {
+        // harmless values for idle lanes: every lane computes every light.
+        const Eigen::Vector3f z = Eigen::Vector3f::UnitZ();
+        p.Set(k, Eigen::Vector3f::Zero());
+        origin.Set(k, Eigen::Vector3f::Zero());
+        L.Set(k, Eigen::Vector3f::Zero());
+        bsdf.n.Set(k, z), bsdf.ng.Set(k, z), bsdf.wo.Set(k, z);
+        bsdf.n_v[k] = 1, bsdf.a2[k] = 1;
+        bsdf.c_diff.Set(k, Eigen::Vector3f::Zero()), bsdf.f0.Set(k, Eigen::Vector3f::Zero());
+        for (int j = 0; j < num_lights; ++j) scratch.u1[j][k] = scratch.u2[j][k] = 0.5f;
+        if (k < m) {
+          const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+          const Eigen::Vector3f sky = ctx.sky->Radiance(primary.rays[i].d.normalized());
+          float* Lp = out.radiance->at(u, v);
+          Lp[0] = sky.x(), Lp[1] = sky.y(), Lp[2] = sky.z();
+          if (out.albedo) std::fill_n(out.albedo->at(u, v), 3, 0.0f);
+          if (out.normal) std::fill_n(out.normal->at(u, v), 3, 0.0f);
+        }
         continue;
       }
-      Ray r = SpawnRay(hit, s.wi);
-      r.tmax = std::isinf(s.distance) ? s.distance : s.distance * (1.0f - 1e-4f);
-      scratch.batches[j].rays.push_back(r);
-      scratch.batches[j].pending.push_back({i, scratch.contrib[j]});
-    }
-    L[0] = radiance.x(), L[1] = radiance.y(), L[2] = radiance.z();
-    if (out.albedo) {
-      float* a = out.albedo->at(u, v);
-      a[0] = mat.pbr.base_color.x(), a[1] = mat.pbr.base_color.y(), a[2] = mat.pbr.base_color.z();
-    }
-    if (out.normal) {
-      float* nn = out.normal->at(u, v);
-      nn[0] = n_s.x(), nn[1] = n_s.y(), nn[2] = n_s.z();
-    }
-  }
+      const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+      const SurfaceHit& h = primary.hits[i];
+      const SurfaceMaterial mat = ctx.materials->Evaluate(h);
+      const Eigen::Vector3f wo = -primary.rays[i].d.normalized();
+      const BrdfCoefficients coef = BrdfCoefficients::From(mat.pbr);
+      bsdf.Set(k, coef, h.ns_W, h.ng_W, wo);
+      const Eigen::Vector3f n_s = bsdf.n.Lane(k);
+      p.Set(k, h.p_W);
+      // shadow rays start off the surface on the lit side (lights behind it contribute 0).
+      origin.Set(k, SpawnRay(h, h.ng_W).o);
 
-  // the tile's shadow rays towards each light as one coherent stream; contributions are added
-  // in light order, so each pixel's sum is independent of scheduling.
-  int64_t traced = 0;
-  for (int j = 0; j < num_lights; ++j) {
-    ShadowBatch& batch = scratch.batches[j];
-    const int m = static_cast<int>(batch.rays.size());
-    if (m == 0) continue;
-    if (scratch.occluded_capacity < m) {
-      scratch.occluded = std::make_unique<bool[]>(m);
-      scratch.occluded_capacity = m;
+      // emission and unoccluded sky ambient.
+      const Eigen::Vector3f spec =
+          EnvBrdfApprox(coef.f0, std::max(bsdf.n_v[k], 0.0f), mat.pbr.roughness);
+      const Eigen::Vector3f reflect =
+          coef.c_diff.cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
+      L.Set(k, mat.emission + (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect));
+
+      Rng rng(ctx.PixelStream(u, v, 0));
+      for (int j = 0; j < num_lights; ++j) {
+        scratch.u1[j][k] = rng.Uniform();
+        scratch.u2[j][k] = rng.Uniform();
+      }
+      if (out.albedo) {
+        float* a = out.albedo->at(u, v);
+        a[0] = mat.pbr.base_color.x(), a[1] = mat.pbr.base_color.y(), a[2] = mat.pbr.base_color.z();
+      }
+      if (out.normal) {
+        float* nn = out.normal->at(u, v);
+        nn[0] = n_s.x(), nn[1] = n_s.y(), nn[2] = n_s.z();
+      }
     }
-    ctx.scene->OccludedMany(batch.rays.data(), m, nullptr, scratch.occluded.get(),
-                            /*coherent=*/true);
+    if (!hit.any()) continue;
+
+    // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+    Lanes total = LuminanceLanes(L);
+    for (int j = 0; j < num_lights; ++j) {
+      LightSampleLanes& s = scratch.samples[j];
+      ctx.lights->SampleLanes(j, p, scratch.u1[j], scratch.u2[j], &s);
+      const Vec3Lanes f = bsdf.Eval(s.wi);
+      Vec3Lanes& c = scratch.contrib[j];
+      for (int k = 0; k < kLanes; ++k) {
+        const bool on = hit[k] && s.valid[k];
+        c.x[k] = on ? f.x[k] * s.E.x[k] : 0.0f;
+        c.y[k] = on ? f.y[k] * s.E.y[k] : 0.0f;
+        c.z[k] = on ? f.z[k] * s.E.z[k] : 0.0f;
+      }
+      total += LuminanceLanes(c);
+    }
+    // lights in order: negligible or shadowless contributions are added as they are, the
+    // others after one packet of shadow rays.
+    for (int j = 0; j < num_lights; ++j) {
+      const Vec3Lanes& c = scratch.contrib[j];
+      const LaneMask lit = LuminanceLanes(c) > 0.0f;
+      if (!lit.any()) continue;
+      const LaneMask shadowed =
+          ctx.lights->lights()[j].cast_shadow
+              ? LaneMask(lit && (LuminanceLanes(c) >= kNegligibleLight * total))
+              : LaneMask::Constant(false);
+      for (int k = 0; k < kLanes; ++k) {
+        if (!lit[k] || shadowed[k]) continue;
+        L.x[k] += c.x[k], L.y[k] += c.y[k], L.z[k] += c.z[k];
+      }
+      if (!shadowed.any()) continue;
+      const LightSampleLanes& s = scratch.samples[j];
+      Ray rays[kLanes];
+      bool active[kLanes], occluded[kLanes];
+      for (int k = 0; k < kLanes; ++k) {
+        active[k] = shadowed[k];
+        rays[k].o = origin.Lane(k);
+        rays[k].d = s.wi.Lane(k);
+        rays[k].tmax = std::isinf(s.distance[k]) ? s.distance[k] : s.distance[k] * (1.0f - 1e-4f);
+      }
+      ctx.scene->OccludedMany(rays, kLanes, active, occluded, /*coherent=*/true);
+      for (int k = 0; k < kLanes; ++k) {
+        if (!active[k]) continue;
+        ++traced;
+        if (occluded[k]) continue;
+        L.x[k] += c.x[k], L.y[k] += c.y[k], L.z[k] += c.z[k];
+      }
+    }
     for (int k = 0; k < m; ++k) {
-      if (scratch.occluded[k]) continue;
-      const PendingShadow& p = batch.pending[k];
-      float* L = out.radiance->at(tile.x0 + p.pixel % tile.width, tile.y0 + p.pixel / tile.width);
-      L[0] += p.value.x(), L[1] += p.value.y(), L[2] += p.value.z();
+      if (!hit[k]) continue;
+      const int i = i0 + k;
+      float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+      Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
     }
-    traced += m;
   }
   return traced;
 }

@@ -1,0 +1,47 @@
+#include "penumbra/render/bsdf_lanes.h"
+
+namespace penumbra {
+namespace {
+constexpr float kPi = 3.14159265358979323846f;
+}  // namespace
+
+void BsdfLanes::Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_W,
+                    const Eigen::Vector3f& ng_W, const Eigen::Vector3f& wo_W) {
+  const Eigen::Vector3f n_s = UsableShadingNormal(ns_W, ng_W, wo_W);
+  n.Set(k, n_s);
+  ng.Set(k, ng_W);
+  wo.Set(k, wo_W);
+  n_v[k] = n_s.dot(wo_W);
+  c_diff.Set(k, c.c_diff);
+  f0.Set(k, c.f0);
+  a2[k] = c.alpha * c.alpha;
+}
+
+Vec3Lanes BsdfLanes::Eval(const Vec3Lanes& wi) const {
+  const Lanes n_l = n.Dot(wi);
+  const LaneMask valid = (n_l > 0.0f) && (ng.Dot(wi) > 0.0f) && (n_v > 0.0f);
+  Vec3Lanes h = wo + wi;
+  h = h * (1.0f / h.Dot(h).max(1e-30f).sqrt());
+  const Lanes v_h = wo.Dot(h).max(0.0f);
+  const Lanes n_h = n.Dot(h);
+  // sin^2 of the half vector's angle to n: |h x n|^2.
+  const Lanes cx = h.y * n.z - h.z * n.y, cy = h.z * n.x - h.x * n.z, cz = h.x * n.y - h.y * n.x;
+  const Lanes k = (cx * cx + cy * cy + cz * cz) + a2 * n_h * n_h;
+  const Lanes D = a2 / (kPi * k * k);
+  // height-correlated Smith visibility G2 / (4 n.l n.v), as Bsdf.
+  const Lanes gv = n_l * (n_v * n_v * (1.0f - a2) + a2).sqrt();
+  const Lanes gl = n_v * (n_l * n_l * (1.0f - a2) + a2).sqrt();
+  const Lanes DV = D * (0.5f / (gv + gl));
+  const Lanes m = (1.0f - v_h).max(0.0f).min(1.0f);
+  const Lanes m2 = m * m;
+  const Lanes m5 = m2 * m2 * m;
+  auto channel = [&](const Lanes& f0c, const Lanes& cdc) -> Lanes {
+    const Lanes F = f0c + (1.0f - f0c) * m5;
+    Lanes f = ((1.0f - F) * cdc * (1.0f / kPi) + F * DV) * n_l;
+    for (int k = 0; k < kLanes; ++k) f[k] = valid[k] ? f[k] : 0.0f;
+    return f;
+  };
+  return {channel(f0.x, c_diff.x), channel(f0.y, c_diff.y), channel(f0.z, c_diff.z)};
+}
+
+}  // namespace penumbra

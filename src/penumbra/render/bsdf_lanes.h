@@ -1,0 +1,30 @@
+#pragma once
+// the BRDF of bsdf.h (glTF 2.0 metallic-roughness: Lambert + GGX, Smith height-correlated,
+// Schlick) evaluated for kLanes shading points at once, in the world frame. used by the
+// realtime tier; agrees with Bsdf::Eval to float rounding (same formulas; sin^2 of the half
+// vector from |h x n|^2 as Bsdf takes it from the local frame).
+
+#include "penumbra/render/bsdf.h"
+#include "penumbra/render/shading_lanes.h"
+
+namespace penumbra {
+
+/// kLanes shading points: frame, view direction and BRDF parameters per lane.
+struct BsdfLanes {
+  Vec3Lanes n;           ///< unit shading normal actually used (Bsdf::shading_normal())
+  Vec3Lanes ng;          ///< unit geometric normal on the viewer's side
+  Vec3Lanes wo;          ///< unit direction towards the viewer
+  Lanes n_v;             ///< n . wo
+  Vec3Lanes c_diff, f0;  ///< Bsdf::diffuse_color(), Bsdf::f0() (x = r, y = g, z = b)
+  Lanes a2;              ///< Bsdf::alpha()^2
+
+  /// sets lane k to the BRDF that Bsdf(c, ns_W, ng_W, wo_W) has, for coefficients c.
+  void Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_W,
+           const Eigen::Vector3f& ng_W, const Eigen::Vector3f& wo_W);
+
+  /// f(wo, wi) |n . wi| per lane (x = r, y = g, z = b) for unit directions wi; 0 where wi or
+  /// wo is below the shading or geometric surface (as Bsdf::Eval).
+  Vec3Lanes Eval(const Vec3Lanes& wi) const;
+};
+
+}  // namespace penumbra
