@@ -26,15 +26,16 @@ inline const std::vector<std::string> kJoints = {"joint1", "joint2", "joint3", "
 
 // the servo part of a controller block for the Panda-class arm (robot-local names):
 // Franka's joint impedance example gains, the datasheet speed limits.
-inline std::string ServoBlock() {
-  return "joints: [joint1, joint2, joint3, joint4, joint5, joint6, joint7]\n"
-         "actuators: [actuator1, actuator2, actuator3, actuator4, actuator5, actuator6, "
-         "actuator7]\n"
-         "output: torque\n"
-         "kp: [600, 600, 600, 600, 250, 150, 50]\n"
-         "kd: [50, 50, 50, 50, 30, 25, 15]\n"
-         "gravity_compensation: true\n"
-         "max_velocity: [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61]\n";
+inline std::string ServoBlock(bool gravity_compensation = true) {
+  return std::string(
+             "joints: [joint1, joint2, joint3, joint4, joint5, joint6, joint7]\n"
+             "actuators: [actuator1, actuator2, actuator3, actuator4, actuator5, actuator6, "
+             "actuator7]\n"
+             "output: torque\n"
+             "kp: [600, 600, 600, 600, 250, 150, 50]\n"
+             "kd: [50, 50, 50, 50, 30, 25, 15]\n"
+             "max_velocity: [2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61]\n") +
+         "gravity_compensation: " + (gravity_compensation ? "true" : "false") + "\n";
 }
 
 inline ControllerConfig Block(const std::string& type, const std::string& body, int line = 7) {

@@ -105,7 +105,7 @@ ArmCommand ArmCommand::Gripper(GripperAction action, double value) {
 
 DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix) {
   DiffIkParams d;
-  d.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0);
+  d.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0, 10.0);
   const size_t n = d.servo.joints.size();
   d.site = prefix + p.String("site");
   if (p.Has("base_body")) {

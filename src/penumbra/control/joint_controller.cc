@@ -27,7 +27,7 @@ const char* ModeKey(JointCommand::Mode m) {
 
 JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefix) {
   JointPdParams j;
-  j.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0);
+  j.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0, 10.0);
   const size_t n = j.servo.joints.size();
   j.target = ReadOptionalNumbers(p, "target", n, -kInf, kInf, "rad or m, one per joint");
   j.commands = ParseCommandScript<JointCommand>(p, "commands", [n](ParamNode& item) {
@@ -144,20 +144,10 @@ void JointPdController::Compute(const ControlInput& input, std::span<double> ctr
   last_time_ = t;
 
   switch (active_.mode) {
-    case JointCommand::Mode::kPosition: {
-      // straight line in joint space, one speed factor for all joints
-      const Eigen::VectorXd delta = target_ - q_ref_;
-      double scale = 1;
-      for (int i = 0; i < n; ++i) {
-        const double step_max = servo_.qd_max()[i] * dt;
-        if (std::abs(delta[i]) > step_max) scale = std::min(scale, step_max / std::abs(delta[i]));
-      }
-      const Eigen::VectorXd step = scale * delta;
-      q_ref_ += step;
-      qd_ref_ = dt > 0 ? Eigen::VectorXd(step / dt) : Eigen::VectorXd::Zero(n);
+    case JointCommand::Mode::kPosition:
+      servo_.StepTowards(target_, {}, dt, &q_ref_, &qd_ref_);
       servo_.Write(input, q_ref_, qd_ref_, {}, ctrl);
       break;
-    }
     case JointCommand::Mode::kVelocity: {
       for (int i = 0; i < n; ++i) {
         double v = std::clamp(values_[i], -servo_.qd_max()[i], servo_.qd_max()[i]);

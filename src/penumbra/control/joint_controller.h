@@ -10,7 +10,7 @@
 //     joints: [joint1, joint2]         # the JointServo keys (joint_servo.h): joints,
 //     actuators: [actuator1, actuator2]  # actuators, output, kp, kd, gravity_compensation,
 //     kp: [600, 600]                   # max_velocity, max_effort, limit_margin
-//     kd: [50, 50]
+//     kd: [50, 50]                     # (max_acceleration: 10 rad/s^2 by default)
 //     target: [0.0, -0.5]              # initial position target (rad or m); default: the
 //                                      # configuration at the first update (hold still)
 //     commands:                        # timed commands (control/command_script.h), each with
@@ -21,9 +21,10 @@
 //
 // reference generation, at each update with dt = time since the previous update:
 //   position: the reference q_r moves towards the target along a straight line in joint
-//     space, at most max_velocity_i dt per joint (all joints scaled by one factor so they
-//     arrive together); qd_r = (q_r,new - q_r,old) / dt. targets are clamped into the
-//     joint ranges shrunk by limit_margin.
+//     space with a trapezoidal velocity profile within max_velocity and max_acceleration
+//     (JointServo::StepTowards; all joints scaled by one factor so they arrive together);
+//     qd_r = (q_r,new - q_r,old) / dt. targets are clamped into the joint ranges shrunk
+//     by limit_margin.
 //   velocity: qd_r = the commanded velocity clamped to +-max_velocity; q_r += qd_r dt,
 //     stopping (qd_r = 0) at the range bounds.
 //   effort: tau = command (+ qfrc_bias with gravity_compensation), clamped to max_effort.

@@ -21,7 +21,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 JointServoParams JointServoParams::Parse(ControllerParams& p, const std::string& prefix,
                                          double default_kp, double default_kd,
-                                         double default_max_velocity) {
+                                         double default_max_velocity,
+                                         double default_max_acceleration) {
   JointServoParams s;
   s.joints = ReadNameList(p, "joints", 1, prefix);
   s.actuators = ReadNameList(p, "actuators", 1, prefix);
@@ -54,6 +55,8 @@ JointServoParams JointServoParams::Parse(ControllerParams& p, const std::string&
   s.gravity_compensation = p.Bool("gravity_compensation", true);
   s.max_velocity =
       ReadPerJoint(p, "max_velocity", n, fallback(default_max_velocity), 0, kInf, true);
+  s.max_acceleration =
+      ReadPerJoint(p, "max_acceleration", n, fallback(default_max_acceleration), 0, kInf, true);
   if (p.Has("max_effort")) s.max_effort = ReadPerJoint(p, "max_effort", n, {}, 0, kInf, true);
   s.limit_margin = p.Number("limit_margin", 0.01, 0, kInf);
   return s;
@@ -79,6 +82,7 @@ void JointServoParams::ValidateOrThrow(const ControllerContext& c) const {
   check("kp", kp, false, false);
   check("kd", kd, false, false);
   check("max_velocity", max_velocity, false, true);
+  check("max_acceleration", max_acceleration, false, true);
   check("max_effort", max_effort, true, true);
   if (!(std::isfinite(limit_margin) && limit_margin >= 0))
     Fail(c, "limit_margin", "got " + std::to_string(limit_margin) + "; expected a number >= 0");
@@ -167,6 +171,33 @@ void JointServo::ReadState(const ControlInput& input, Eigen::VectorXd* q,
 
 Eigen::VectorXd JointServo::ClampPosition(const Eigen::VectorXd& q) const {
   return q.cwiseMax(q_min_).cwiseMin(q_max_);
+}
+
+void JointServo::StepTowards(const Eigen::VectorXd& target, const Eigen::VectorXd& target_velocity,
+                             double dt, Eigen::VectorXd* q_ref, Eigen::VectorXd* qd_ref) const {
+  const int n = size();
+  if (qd_ref->size() != n) qd_ref->setZero(n);
+  if (dt <= 0) {
+    qd_ref->setZero();
+    return;
+  }
+  delta_.resize(n);
+  double scale = 1;
+  for (int i = 0; i < n; ++i) {
+    delta_[i] = std::clamp(target[i], q_min_[i], q_max_[i]) - (*q_ref)[i];
+    const double d = std::abs(delta_[i]);
+    if (d <= 0) continue;
+    const double a = params_.max_acceleration[i];
+    const double v_target = target_velocity.size() == n ? std::abs(target_velocity[i]) : 0.0;
+    const double v =
+        std::min({qd_max_[i], std::abs((*qd_ref)[i]) + a * dt, v_target + std::sqrt(2 * a * d)});
+    scale = std::min(scale, v * dt / d);
+  }
+  for (int i = 0; i < n; ++i) {
+    const double step = scale * delta_[i];
+    (*q_ref)[i] += step;
+    (*qd_ref)[i] = step / dt;
+  }
 }
 
 double JointServo::Bias(const ControlInput& input, int i) const {

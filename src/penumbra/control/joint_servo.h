@@ -12,6 +12,8 @@
 //   kd: 50                 # N m s/rad (N s/m), one number or one per joint (torque output)
 //   gravity_compensation: true   # add MuJoCo's qfrc_bias (torque output)
 //   max_velocity: 2.0      # rad/s (m/s), > 0, one or per joint: the reference moves no faster
+//   max_acceleration: 10   # rad/s^2 (m/s^2), > 0, one or per joint: position references
+//                          # speed up and slow down no harder (StepTowards)
 //   max_effort: 87         # N m (N), > 0, one or per joint (default: the actuator's ctrlrange x
 //   gear) limit_margin: 0.01     # rad (m) >= 0: position references stay this far inside joint
 //   ranges
@@ -46,19 +48,22 @@ struct JointServoParams {
   std::vector<std::string> joints;     ///< full model names
   std::vector<std::string> actuators;  ///< full model names, actuators[i] drives joints[i]
   ServoOutput output = ServoOutput::kTorque;
-  std::vector<double> kp;            ///< (n) N m/rad or N/m
-  std::vector<double> kd;            ///< (n) N m s/rad or N s/m
-  bool gravity_compensation = true;  ///< torque output: add qfrc_bias
-  std::vector<double> max_velocity;  ///< (n) rad/s or m/s
-  std::vector<double> max_effort;    ///< (n) N m or N; empty = from the actuators' ctrlrange
-  double limit_margin = 0.01;        ///< rad or m
+  std::vector<double> kp;                ///< (n) N m/rad or N/m
+  std::vector<double> kd;                ///< (n) N m s/rad or N s/m
+  bool gravity_compensation = true;      ///< torque output: add qfrc_bias
+  std::vector<double> max_velocity;      ///< (n) rad/s or m/s
+  std::vector<double> max_acceleration;  ///< (n) rad/s^2 or m/s^2
+  std::vector<double> max_effort;        ///< (n) N m or N; empty = from the actuators' ctrlrange
+  double limit_margin = 0.01;            ///< rad or m
 
-  /// reads the keys of the file comment; names get `name_prefix`. `default_kp`, `default_kd`
-  /// and `default_max_velocity` apply when a key is absent (empty: the key is required).
+  /// reads the keys of the file comment; names get `name_prefix`. `default_kp`, `default_kd`,
+  /// `default_max_velocity` and `default_max_acceleration` apply when a key is absent
+  /// (negative: the key is required).
   /// @throws ConfigError for missing/bad keys and joints/actuators lists of unequal length.
   static JointServoParams Parse(ControllerParams& params, const std::string& name_prefix,
                                 double default_kp = -1, double default_kd = -1,
-                                double default_max_velocity = 2.0);
+                                double default_max_velocity = 2.0,
+                                double default_max_acceleration = 10.0);
   /// @throws ConfigError (in `context`) for sizes that disagree or values out of range.
   void ValidateOrThrow(const ControllerContext& context) const;
 };
@@ -92,6 +97,18 @@ class JointServo {
   void ReadState(const ControlInput& input, Eigen::VectorXd* q, Eigen::VectorXd* qd) const;
   /// `q` clamped into [q_min, q_max].
   Eigen::VectorXd ClampPosition(const Eigen::VectorXd& q) const;
+  /// moves the reference `q_ref` one step of `dt` towards `target` (clamped into the
+  /// ranges) along a straight line in joint space, and sets `qd_ref` to the step / dt.
+  /// per joint i the speed is at most
+  ///   min(max_velocity_i, |qd_ref_i| + max_acceleration_i dt,
+  ///       |target_velocity_i| + sqrt(2 max_acceleration_i |distance left_i|)):
+  /// a trapezoidal profile that speeds up and brakes within the limits, and that follows a
+  /// target moving at target_velocity ((n), or empty for a fixed target) without lag when
+  /// the target's own motion is within the limits. one factor scales all joints, so they
+  /// arrive together and the reference never passes the target. dt <= 0 leaves q_ref and
+  /// zeroes qd_ref.
+  void StepTowards(const Eigen::VectorXd& target, const Eigen::VectorXd& target_velocity, double dt,
+                   Eigen::VectorXd* q_ref, Eigen::VectorXd* qd_ref) const;
 
   /// writes the servo's actuators in `ctrl` for the reference (q_ref, qd_ref) with
   /// feed-forward effort `tau_ff` ((n) each); `tau_ff` may be empty (zero).
@@ -112,6 +129,7 @@ class JointServo {
   std::vector<int> qpos_adr_, dof_adr_, actuator_;
   std::vector<double> gear_;
   Eigen::VectorXd q_min_, q_max_, qd_max_, effort_max_;
+  mutable Eigen::VectorXd delta_;
   mutable Eigen::VectorXd last_effort_;
 };
 

@@ -134,7 +134,7 @@ std::vector<PlaybackFrame> ReadJointCsv(const std::string& path,
 KeyframePlaybackParams KeyframePlaybackParams::Parse(ControllerParams& p,
                                                      const std::string& prefix) {
   KeyframePlaybackParams k;
-  k.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0);
+  k.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0, 10.0);
   const size_t n = k.servo.joints.size();
   if (p.Has("gripper_actuator") || p.Has("gripper_joint")) {
     k.gripper_actuator = prefix + p.String("gripper_actuator");
@@ -294,7 +294,7 @@ void KeyframePlayback::OnInitialize(const ModelInfo& model, const std::vector<in
 }
 
 void KeyframePlayback::Evaluate(double t_rel, const Eigen::VectorXd& q_start, double gripper_start,
-                                Eigen::VectorXd* q, double* gripper) const {
+                                Eigen::VectorXd* q, Eigen::VectorXd* qd, double* gripper) const {
   const double t_last = times_.back();
   const Eigen::VectorXd* first_from = &q_start;
   double g_from = gripper_start;
@@ -308,16 +308,19 @@ void KeyframePlayback::Evaluate(double t_rel, const Eigen::VectorXd& q_start, do
   if (t <= times_[0]) {
     if (times_[0] <= 0) {
       *q = qs_[0];
+      qd->setZero(q->size());
       *gripper = grippers_[0];
     } else {
       const double a = std::max(0.0, t) / times_[0];
       *q = *first_from + a * (qs_[0] - *first_from);
+      *qd = (qs_[0] - *first_from) / times_[0];
       *gripper = g_from + a * (grippers_[0] - g_from);
     }
     return;
   }
   if (t >= t_last) {
     *q = qs_.back();
+    qd->setZero(q->size());
     *gripper = grippers_.back();
     return;
   }
@@ -325,12 +328,12 @@ void KeyframePlayback::Evaluate(double t_rel, const Eigen::VectorXd& q_start, do
       static_cast<size_t>(std::upper_bound(times_.begin(), times_.end(), t) - times_.begin()) - 1;
   const double a = (t - times_[i]) / (times_[i + 1] - times_[i]);
   *q = qs_[i] + a * (qs_[i + 1] - qs_[i]);
+  *qd = (qs_[i + 1] - qs_[i]) / (times_[i + 1] - times_[i]);
   *gripper = grippers_[i] + a * (grippers_[i + 1] - grippers_[i]);
 }
 
 void KeyframePlayback::Compute(const ControlInput& input, std::span<double> ctrl) {
   const double t = input.time_sec();
-  const int n = servo_.size();
   servo_.ReadState(input, &q_, &qd_);
   if (!started_) {
     started_ = true;
@@ -343,22 +346,11 @@ void KeyframePlayback::Compute(const ControlInput& input, std::span<double> ctrl
   last_time_ = t;
   const double t_rel = t - start_time_;
   double gripper = 0;
-  Evaluate(t_rel, q_start_, gripper_start_, &target_, &gripper);
+  Evaluate(t_rel, q_start_, gripper_start_, &target_, &target_velocity_, &gripper);
   target_ = servo_.ClampPosition(target_);
   finished_ = !params_.loop && t_rel >= times_.back();
 
-  // rate-limited reference, one factor for all joints
-  double scale = 1;
-  for (int i = 0; i < n; ++i) {
-    const double delta = std::abs(target_[i] - q_ref_[i]);
-    const double step_max = servo_.qd_max()[i] * dt;
-    if (delta > step_max) scale = std::min(scale, step_max / delta);
-  }
-  for (int i = 0; i < n; ++i) {
-    const double step = scale * (target_[i] - q_ref_[i]);
-    q_ref_[i] += step;
-    qd_ref_[i] = dt > 0 ? step / dt : 0;
-  }
+  servo_.StepTowards(target_, target_velocity_, dt, &q_ref_, &qd_ref_);
   servo_.Write(input, q_ref_, qd_ref_, {}, ctrl);
   if (gripper_actuator_ >= 0) ctrl[gripper_actuator_] = gripper;
 }

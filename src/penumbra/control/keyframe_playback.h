@@ -31,8 +31,9 @@
 //   q(t) = q_i + (t - t_i) / (t_{i+1} - t_i) (q_{i+1} - q_i)
 // and after the last frame it holds (or, with loop, the timeline repeats with period
 // t_last, and the first frame's segment then starts from the last frame). the servo
-// reference follows q(t) within the joint limits and at most max_velocity (one scale
-// factor for all joints), with qd_ref = its rate of change.
+// reference follows q(t) through JointServo::StepTowards: exactly while q(t) moves within
+// max_velocity and max_acceleration, otherwise (jumps, corners between segments) along a
+// trapezoidal velocity profile within those limits; qd_ref = its rate of change.
 
 #include <Eigen/Core>
 #include <optional>
@@ -99,11 +100,11 @@ class KeyframePlayback final : public Controller {
   /// true once the last frame's time has passed (never with loop).
   bool finished() const { return finished_; }
 
-  /// the target at playback time `t_rel` (s since the first update) for a timeline whose
-  /// implicit start configuration is `q_start`/`gripper_start`; exposed for tests.
-  /// valid after Initialize.
+  /// the target `q` and its rate of change `qd` ((n) each) and the gripper value at
+  /// playback time `t_rel` (s since the first update), for a timeline whose implicit start
+  /// configuration is `q_start` / `gripper_start`; exposed for tests. valid after Initialize.
   void Evaluate(double t_rel, const Eigen::VectorXd& q_start, double gripper_start,
-                Eigen::VectorXd* q, double* gripper) const;
+                Eigen::VectorXd* q, Eigen::VectorXd* qd, double* gripper) const;
 
  protected:
   void OnInitialize(const ModelInfo& model, const std::vector<int>& ids) override;
@@ -118,7 +119,7 @@ class KeyframePlayback final : public Controller {
   int gripper_actuator_ = -1, gripper_qpos_adr_ = -1;
   bool started_ = false, finished_ = false;
   double start_time_ = 0, last_time_ = 0, gripper_start_ = 0;
-  Eigen::VectorXd q_, qd_, q_start_, target_, q_ref_, qd_ref_;
+  Eigen::VectorXd q_, qd_, q_start_, target_, target_velocity_, q_ref_, qd_ref_;
 };
 
 }  // namespace penumbra
