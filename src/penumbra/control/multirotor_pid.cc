@@ -14,6 +14,10 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDegToRad = M_PI / 180.0;
+// velocity integrator: input clipped to this error (m/s), and frozen while the thrust axis is
+// more than this far from its setpoint (rad), so an upset or a large step does not wind it up
+constexpr double kIntegratorErrorClip = 0.5;
+constexpr double kIntegratorMaxTiltError = 20 * kDegToRad;
 
 double WrapAngle(double a) {
   a = std::remainder(a, 2 * M_PI);  // in [-pi, pi]
@@ -97,6 +101,8 @@ std::vector<std::string> ModeKeys(MultirotorCommand::Mode mode) {
       return {"waypoints", "speed_m_s", "yaw_deg", "face_path"};
     case M::kVelocity:
       return {"velocity_m_s", "yaw_rate_deg_s", "frame"};
+    case M::kLand:
+      return {};
   }
   return {};
 }
@@ -112,17 +118,18 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
   if (!n["t"]) p.Fail(key + ".t", "missing; expected the start time in s (sim time, >= 0)");
   tc.t_sec = NodeNumber(p, n["t"], key + ".t", 0, kInf);
   if (!n["mode"])
-    p.Fail(key + ".mode", "missing; expected one of idle, takeoff, hover, waypoints, velocity");
+    p.Fail(key + ".mode",
+           "missing; expected one of idle, takeoff, hover, waypoints, velocity, land");
   const std::string mode = NodeName(p, n["mode"], key + ".mode");
   bool known = false;
-  for (M m : {M::kIdle, M::kTakeoff, M::kHover, M::kWaypoints, M::kVelocity})
+  for (M m : {M::kIdle, M::kTakeoff, M::kHover, M::kWaypoints, M::kVelocity, M::kLand})
     if (mode == MultirotorCommand::ModeName(m)) {
       c.mode = m;
       known = true;
     }
   if (!known)
     p.Fail(key + ".mode",
-           "got '" + mode + "'; expected one of idle, takeoff, hover, waypoints, velocity");
+           "got '" + mode + "'; expected one of idle, takeoff, hover, waypoints, velocity, land");
 
   const std::vector<std::string> allowed = ModeKeys(c.mode);
   for (const auto& kv : n) {
@@ -139,6 +146,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
   if (n["yaw_deg"]) c.yaw_deg = NodeNumber(p, n["yaw_deg"], key + ".yaw_deg", -kInf, kInf);
   switch (c.mode) {
     case M::kIdle:
+    case M::kLand:
       break;
     case M::kTakeoff:
       if (!n["altitude_m"])
@@ -202,6 +210,8 @@ const char* MultirotorCommand::ModeName(Mode mode) {
       return "waypoints";
     case Mode::kVelocity:
       return "velocity";
+    case Mode::kLand:
+      return "land";
   }
   return "unknown";
 }
@@ -259,11 +269,13 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
   m.max_climb_m_s = pos("max_climb_m_s", m.max_climb_m_s);
   m.max_descent_m_s = pos("max_descent_m_s", m.max_descent_m_s);
   m.max_accel_m_s2 = pos("max_accel_m_s2", m.max_accel_m_s2);
+  m.max_jerk_m_s3 = pos("max_jerk_m_s3", m.max_jerk_m_s3);
   m.max_tilt_deg = p.Number("max_tilt_deg", m.max_tilt_deg, 0, 80, true);
   m.max_roll_pitch_rate_deg_s = pos("max_roll_pitch_rate_deg_s", m.max_roll_pitch_rate_deg_s);
   m.max_yaw_rate_deg_s = pos("max_yaw_rate_deg_s", m.max_yaw_rate_deg_s);
   m.yaw_speed_deg_s = pos("yaw_speed_deg_s", m.yaw_speed_deg_s);
   m.leash_m = pos("leash_m", m.leash_m);
+  m.land_speed_m_s = pos("land_speed_m_s", m.land_speed_m_s);
   m.position_p_xy = pos("position_p_xy", m.position_p_xy);
   m.position_p_z = pos("position_p_z", m.position_p_z);
   m.velocity_p_xy = pos("velocity_p_xy", m.velocity_p_xy);
@@ -330,12 +342,14 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
   check("max_climb_m_s", max_climb_m_s, true);
   check("max_descent_m_s", max_descent_m_s, true);
   check("max_accel_m_s2", max_accel_m_s2, true);
+  check("max_jerk_m_s3", max_jerk_m_s3, true);
   check("max_tilt_deg", max_tilt_deg, true);
   if (max_tilt_deg > 80) fail("max_tilt_deg", "got " + Fmt(max_tilt_deg) + "; expected <= 80");
   check("max_roll_pitch_rate_deg_s", max_roll_pitch_rate_deg_s, true);
   check("max_yaw_rate_deg_s", max_yaw_rate_deg_s, true);
   check("yaw_speed_deg_s", yaw_speed_deg_s, true);
   check("leash_m", leash_m, true);
+  check("land_speed_m_s", land_speed_m_s, true);
   check("position_p_xy", position_p_xy, true);
   check("position_p_z", position_p_z, true);
   check("velocity_p_xy", velocity_p_xy, true);
@@ -421,9 +435,11 @@ void MultirotorPid::ResetState() {
   wdot_filt_.setZero();
   v_ff_.setZero();
   a_ff_.setZero();
+  j_ff_.setZero();
   yaw_rate_ff_ = 0;
   have_prev_ = false;
   xy_limited_ = false;
+  tilt_error_ = 0;
   mix_ = MixResult();
 }
 
@@ -470,24 +486,35 @@ void MultirotorPid::ApplyCommand(const MultirotorCommand& cmd, const Eigen::Vect
                      params_.max_yaw_rate_deg_s * kDegToRad);
       frame_ = cmd.frame;
       break;
+    case M::kLand:
+      path_ = MultirotorPath(start, {}, 1, accel);
+      v_cmd_ = Eigen::Vector3d(0, 0, -std::min(params_.land_speed_m_s, params_.max_descent_m_s));
+      yaw_rate_cmd_ = 0;
+      frame_ = MultirotorCommand::Frame::kWorld;
+      touchdown_sec_ = 0;
+      break;
   }
 }
 
 void MultirotorPid::UpdateReference(double dt, const Eigen::Vector3d& p) {
   using M = MultirotorCommand::Mode;
-  if (mode_ == M::kVelocity) {
-    // velocity command, slewed at max_accel, integrated into the position reference
+  if (mode_ == M::kVelocity || mode_ == M::kLand) {
+    // velocity command, smoothed, integrated into the position reference
     Eigen::Vector3d target = v_cmd_;
     if (frame_ == MultirotorCommand::Frame::kHeading)
       target.head<2>() = Eigen::Rotation2Dd(yaw_ref_) * v_cmd_.head<2>();
     const double sxy = target.head<2>().norm();
     if (sxy > params_.max_speed_xy_m_s) target.head<2>() *= params_.max_speed_xy_m_s / sxy;
     target.z() = std::clamp(target.z(), -params_.max_descent_m_s, params_.max_climb_m_s);
-    Eigen::Vector3d dv = target - v_ff_;
-    const double max_dv = params_.max_accel_m_s2 * dt;
-    if (dv.norm() > max_dv) dv *= max_dv / dv.norm();
-    v_ff_ += dv;
-    a_ff_ = dv / dt;
+    // first-order approach (time constant 0.25 s) with acceleration and jerk limits
+    Eigen::Vector3d a_des = 4.0 * (target - v_ff_);
+    if (a_des.norm() > params_.max_accel_m_s2) a_des *= params_.max_accel_m_s2 / a_des.norm();
+    Eigen::Vector3d da = a_des - a_ff_;
+    const double max_da = params_.max_jerk_m_s3 * dt;
+    if (da.norm() > max_da) da *= max_da / da.norm();
+    a_ff_ += da;
+    j_ff_ = da / dt;
+    v_ff_ += a_ff_ * dt;
     p_ref_ += v_ff_ * dt;
     const Eigen::Vector3d lead = p_ref_ - p;
     if (lead.norm() > params_.leash_m) p_ref_ = p + lead * (params_.leash_m / lead.norm());
@@ -505,6 +532,7 @@ void MultirotorPid::UpdateReference(double dt, const Eigen::Vector3d& p) {
   p_ref_ = s.position;
   v_ff_ = rate * s.velocity;
   a_ff_ = rate * s.acceleration;
+  j_ff_ = rate * s.jerk;
 
   if (face_path_) {
     const auto& v = path_.vertices();
@@ -561,6 +589,19 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   }
 
   UpdateReference(dt, p);
+  if (mode_ == M::kLand) {
+    // touchdown: resting on something while the reference keeps sinking
+    const bool resting = p.z() - p_ref_.z() > 0.3 && std::abs(v.z()) < 0.1;
+    touchdown_sec_ = resting ? touchdown_sec_ + dt : 0;
+    if (touchdown_sec_ >= 0.3) {
+      mode_ = M::kIdle;
+      for (size_t i = 0; i < rotors_.size(); ++i) {
+        thrust_[i] = airframe_.min_thrust_n[i];
+        ctrl[rotors_[i]] = thrust_[i];
+      }
+      return;
+    }
+  }
 
   // position P -> velocity setpoint
   Eigen::Vector3d v_sp = v_ff_;
@@ -583,12 +624,15 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   const Eigen::Vector3d kp_v(params_.velocity_p_xy, params_.velocity_p_xy, params_.velocity_p_z);
   const Eigen::Vector3d ki_v(params_.velocity_i_xy, params_.velocity_i_xy, params_.velocity_i_z);
   const Eigen::Vector3d kd_v(params_.velocity_d_xy, params_.velocity_d_xy, params_.velocity_d_z);
-  // integrate unless the output saturated on that axis at the last update
-  if (!xy_limited_ && mix_.roll_pitch_scale >= 1)
-    vel_int_.head<2>() += ki_v.head<2>().cwiseProduct(e_v.head<2>()) * dt;
+  // integrate the clipped error unless the output saturated on that axis at the last update
+  // or the thrust direction is far from its setpoint (the translational loop is open then)
+  const Eigen::Vector3d e_i = e_v.cwiseMax(-kIntegratorErrorClip).cwiseMin(kIntegratorErrorClip);
+  const bool attitude_ok = tilt_error_ < kIntegratorMaxTiltError;
+  if (attitude_ok && !xy_limited_ && mix_.roll_pitch_scale >= 1)
+    vel_int_.head<2>() += ki_v.head<2>().cwiseProduct(e_i.head<2>()) * dt;
   const bool z_blocked =
       mix_.collective_limited && ((mix_.collective_n < last_collective_request_) == (e_v.z() > 0));
-  if (!z_blocked) vel_int_.z() += ki_v.z() * e_v.z() * dt;
+  if (attitude_ok && !z_blocked) vel_int_.z() += ki_v.z() * e_i.z() * dt;
   const double ilim = params_.velocity_i_limit_m_s2;
   vel_int_ = vel_int_.cwiseMax(-ilim).cwiseMin(ilim);
   const Eigen::Vector3d a_sp =
@@ -603,6 +647,7 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   xy_limited_ = fxy > fxy_max;
   if (xy_limited_) F.head<2>() *= fxy_max / fxy;
   const Eigen::Vector3d b3 = F.normalized();
+  tilt_error_ = std::acos(std::clamp(b3.dot(R.col(2)), -1.0, 1.0));
   const double collective = std::max(F.dot(R.col(2)), 0.0);
 
   // attitude setpoint: thrust direction b3 and reference yaw
@@ -633,6 +678,8 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   if (q_e.w() < 0) q_e.coeffs() *= -1;
   Eigen::Vector3d w_sp = 2 * params_.attitude_p_roll_pitch * q_e.vec();
   w_sp += R.transpose().col(2) * yaw_rate_ff_;  // world yaw rate in body axes
+  const Eigen::Vector3d b3_dot = (m / F.norm()) * (j_ff_ - j_ff_.dot(b3) * b3);
+  w_sp += R.transpose() * b3.cross(b3_dot);
   const double rp_max = params_.max_roll_pitch_rate_deg_s * kDegToRad;
   const double yaw_max = params_.max_yaw_rate_deg_s * kDegToRad;
   w_sp.x() = std::clamp(w_sp.x(), -rp_max, rp_max);

@@ -26,9 +26,13 @@
 //              (MultirotorPath), then hold the last point.
 //   velocity   velocity_m_s [vx, vy, vz] (default 0), yaw_rate_deg_s (default 0), frame
 //              (world | heading; heading = level frame turned by the reference yaw, x
-//              forward, as ROS cmd_vel for a multirotor): the position reference integrates
-//              the velocity (it holds position once the velocity is zero) and is kept within
-//              leash_m of the vehicle.
+//              forward, as ROS cmd_vel for a multirotor): the reference velocity approaches
+//              the command with a 0.25 s time constant, limited to max_accel_m_s2 and
+//              max_jerk_m_s3; the position reference integrates it (so it holds position once
+//              the velocity is zero) and is kept within leash_m of the vehicle.
+//   land       descend vertically at land_speed_m_s (as a velocity command); touchdown is
+//              when the vehicle stays more than 0.3 m above its sinking reference with
+//              |v_z| < 0.1 m/s for 0.3 s: then the rotors stop (mode idle).
 //   yaw_deg, when given, turns the reference heading at yaw_speed_deg_s; otherwise the
 //   heading holds. a command applies at the first control update at or after its t.
 //   SetCommand() (programmatic) replaces the current command at the next update; the next
@@ -42,8 +46,10 @@
 //   position P  v_sp = v_ff + Kp_pos (p_r - p), |v_sp,xy| <= max_speed_xy_m_s,
 //               -max_descent_m_s <= v_sp,z <= max_climb_m_s.
 //   velocity    a_sp = a_ff + Kp_vel e_v + I_vel - Kd_vel dv/dt,  e_v = v_sp - v,
-//   PID         I_vel += Ki_vel e_v dt (|I| <= velocity_i_limit_m_s2; frozen on an axis while
-//               the output on it saturates), dv/dt low-passed at derivative_cutoff_hz.
+//   PID         I_vel += Ki_vel clip(e_v, +-0.5 m/s) dt, |I| <= velocity_i_limit_m_s2; frozen
+//               on an axis while the output on it saturates (tilt limit, mixer) and while the
+//               thrust axis is > 20 deg from its setpoint (anti-windup: upsets and large
+//               steps leave it alone); dv/dt low-passed at derivative_cutoff_hz.
 //   thrust      F = m (a_sp + g e_z), F_z >= 0.1 m g, |F_xy| <= F_z tan(max_tilt_deg);
 //   vector      collective T = F . R e_z (thrust along the current body z; T. Lee, M. Leok,
 //               N. H. McClamroch, "Geometric tracking control of a quadrotor UAV on SE(3)",
@@ -57,7 +63,10 @@
 //               q_e = q^-1 q_d' (D. Brescianini, M. Hehn, R. D'Andrea, "Nonlinear quadrocopter
 //               attitude control", ETH Zurich tech. report, 2013; the PX4 multicopter
 //               attitude controller), plus the yaw-rate feed-forward; each axis limited to
-//               max_roll_pitch_rate_deg_s / max_yaw_rate_deg_s.
+//               max_roll_pitch_rate_deg_s / max_yaw_rate_deg_s. the rate feed-forward
+//               turns the thrust direction as the reference's jerk j_ff demands
+//               (differential flatness, Mellinger and Kumar 2011, eq. 7-8):
+//               w_ff = R^T (b3 x (m / |F|) (j_ff - (j_ff . b3) b3)).
 //   rate PID    alpha = Kp_rate e_w + I_rate - Kd_rate dw/dt, e_w = w_sp - w, I frozen on
 //               axes whose torque the mixer had to cut; torque tau = J alpha + w x J w.
 //   mixer       per-rotor thrusts from (T, tau) with roll/pitch > collective > yaw priority
@@ -87,7 +96,7 @@ namespace penumbra {
 
 /// what the multirotor should do (see the file comment for each mode's meaning).
 struct MultirotorCommand {
-  enum class Mode { kIdle, kTakeoff, kHover, kWaypoints, kVelocity };
+  enum class Mode { kIdle, kTakeoff, kHover, kWaypoints, kVelocity, kLand };
   enum class Frame { kWorld, kHeading };
 
   Mode mode = Mode::kHover;
@@ -126,17 +135,19 @@ struct MultirotorPidParams {
   double max_climb_m_s = 2;
   double max_descent_m_s = 1.5;
   double max_accel_m_s2 = 2;  ///< path and velocity-command acceleration
+  double max_jerk_m_s3 = 10;  ///< velocity-command (and land) jerk
   double max_tilt_deg = 35;
   double max_roll_pitch_rate_deg_s = 220;
   double max_yaw_rate_deg_s = 150;
   double yaw_speed_deg_s = 60;  ///< heading slew for yaw_deg / face_path
   double leash_m = 1.0;         ///< farthest the reference may run ahead of the vehicle
+  double land_speed_m_s = 0.5;  ///< descent speed of the land mode
 
   // gains (position: 1/s; velocity P: 1/s, I: 1/s^2, D: -; attitude: 1/s;
   // rate P: 1/s, I: 1/s^2, D: -)
-  double position_p_xy = 1.0, position_p_z = 1.2;
-  double velocity_p_xy = 2.5, velocity_i_xy = 1.0, velocity_d_xy = 0.0;
-  double velocity_p_z = 4.0, velocity_i_z = 2.0, velocity_d_z = 0.0;
+  double position_p_xy = 1.5, position_p_z = 1.5;
+  double velocity_p_xy = 3.5, velocity_i_xy = 2.0, velocity_d_xy = 0.0;
+  double velocity_p_z = 5.0, velocity_i_z = 3.0, velocity_d_z = 0.0;
   double velocity_i_limit_m_s2 = 3.0;
   double attitude_p_roll_pitch = 8.0, attitude_p_yaw = 3.0;
   double rate_p_roll_pitch = 25.0, rate_i_roll_pitch = 10.0, rate_d_roll_pitch = 0.0;
@@ -214,12 +225,14 @@ class MultirotorPid final : public Controller {
   bool face_path_ = false;
   Eigen::Vector3d v_cmd_ = Eigen::Vector3d::Zero();
   double yaw_rate_cmd_ = 0;
+  double touchdown_sec_ = 0;  ///< how long the land mode has seen the vehicle resting
   MultirotorCommand::Frame frame_ = MultirotorCommand::Frame::kWorld;
 
   // reference
   Eigen::Vector3d p_ref_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_ff_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d a_ff_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d j_ff_ = Eigen::Vector3d::Zero();
   double yaw_ref_ = 0, yaw_target_ = 0, yaw_rate_ff_ = 0;
 
   // loop state
@@ -231,6 +244,7 @@ class MultirotorPid final : public Controller {
   Eigen::Vector3d w_prev_ = Eigen::Vector3d::Zero(), wdot_filt_ = Eigen::Vector3d::Zero();
   bool have_prev_ = false;
   bool xy_limited_ = false;
+  double tilt_error_ = 0;  ///< angle between the thrust axis and its setpoint (rad)
   double last_collective_request_ = 0;
   MixResult mix_;
   std::vector<double> thrust_;
