@@ -139,29 +139,33 @@ void JointPdController::Compute(const ControlInput& input, std::span<double> ctr
             : q_ref_;
     active_ = JointCommand::Position(std::vector<double>(target_.data(), target_.data() + n));
   }
-  commands_.Poll(t, [&](const JointCommand& c) { Apply(c, q_); });
   const double dt = std::max(0.0, t - last_time_);
   last_time_ = t;
+  // a velocity reference integrates over (t - dt, t] the velocity that was commanded then
+  if (active_.mode == JointCommand::Mode::kVelocity) {
+    for (int i = 0; i < n; ++i) {
+      const double v = std::clamp(values_[i], -servo_.qd_max()[i], servo_.qd_max()[i]);
+      q_ref_[i] = std::clamp(q_ref_[i] + v * dt, servo_.q_min()[i], servo_.q_max()[i]);
+    }
+  }
+  commands_.Poll(t, [&](const JointCommand& c) { Apply(c, q_); });
 
   switch (active_.mode) {
     case JointCommand::Mode::kPosition:
       servo_.StepTowards(target_, {}, dt, &q_ref_, &qd_ref_);
       servo_.Write(input, q_ref_, qd_ref_, {}, ctrl);
       break;
-    case JointCommand::Mode::kVelocity: {
+    case JointCommand::Mode::kVelocity:
+      // feed-forward the commanded velocity, except where the reference sits at a bound
+      // and the command pushes outwards
       for (int i = 0; i < n; ++i) {
-        double v = std::clamp(values_[i], -servo_.qd_max()[i], servo_.qd_max()[i]);
-        double next = q_ref_[i] + v * dt;
-        if (next > servo_.q_max()[i] || next < servo_.q_min()[i]) {
-          next = std::clamp(next, servo_.q_min()[i], servo_.q_max()[i]);
-          v = 0;
-        }
-        q_ref_[i] = next;
-        qd_ref_[i] = v;
+        const double v = std::clamp(values_[i], -servo_.qd_max()[i], servo_.qd_max()[i]);
+        const bool stopped =
+            (v > 0 && q_ref_[i] >= servo_.q_max()[i]) || (v < 0 && q_ref_[i] <= servo_.q_min()[i]);
+        qd_ref_[i] = stopped ? 0 : v;
       }
       servo_.Write(input, q_ref_, qd_ref_, {}, ctrl);
       break;
-    }
     case JointCommand::Mode::kEffort:
       q_ref_ = q_;
       qd_ref_ = qd_;

@@ -25,8 +25,9 @@
 //     (JointServo::StepTowards; all joints scaled by one factor so they arrive together);
 //     qd_r = (q_r,new - q_r,old) / dt. targets are clamped into the joint ranges shrunk
 //     by limit_margin.
-//   velocity: qd_r = the commanded velocity clamped to +-max_velocity; q_r += qd_r dt,
-//     stopping (qd_r = 0) at the range bounds.
+//   velocity: qd_r = the commanded velocity clamped to +-max_velocity; q_r integrates it
+//     (over each interval, the velocity commanded during that interval), stopping
+//     (qd_r = 0) at the range bounds.
 //   effort: tau = command (+ qfrc_bias with gravity_compensation), clamped to max_effort.
 // switching to position or velocity from effort restarts the reference at the measured q.
 

@@ -189,8 +189,10 @@ void JointServo::StepTowards(const Eigen::VectorXd& target, const Eigen::VectorX
     if (d <= 0) continue;
     const double a = params_.max_acceleration[i];
     const double v_target = target_velocity.size() == n ? std::abs(target_velocity[i]) : 0.0;
-    const double v =
-        std::min({qd_max_[i], std::abs((*qd_ref)[i]) + a * dt, v_target + std::sqrt(2 * a * d)});
+    // fastest speed from which steps slowing by a dt each still stop within d: the
+    // discrete form of sqrt(2 a d)
+    const double v_brake = a * dt * (std::sqrt(0.25 + 2 * d / (a * dt * dt)) - 0.5);
+    const double v = std::min({qd_max_[i], std::abs((*qd_ref)[i]) + a * dt, v_target + v_brake});
     scale = std::min(scale, v * dt / d);
   }
   for (int i = 0; i < n; ++i) {

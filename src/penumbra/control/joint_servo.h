@@ -101,7 +101,9 @@ class JointServo {
   /// ranges) along a straight line in joint space, and sets `qd_ref` to the step / dt.
   /// per joint i the speed is at most
   ///   min(max_velocity_i, |qd_ref_i| + max_acceleration_i dt,
-  ///       |target_velocity_i| + sqrt(2 max_acceleration_i |distance left_i|)):
+  ///       |target_velocity_i| + v_brake(|distance left_i|)),
+  /// with v_brake(d) = a dt (sqrt(1/4 + 2 d / (a dt^2)) - 1/2), the speed from which steps
+  /// slowing by a dt each stop within d (sqrt(2 a d) as dt -> 0):
   /// a trapezoidal profile that speeds up and brakes within the limits, and that follows a
   /// target moving at target_velocity ((n), or empty for a fixed target) without lag when
   /// the target's own motion is within the limits. one factor scales all joints, so they
