@@ -32,39 +32,48 @@ MultirotorMixer::MultirotorMixer(const Eigen::Matrix<double, 4, Eigen::Dynamic>&
         "MultirotorMixer: allocation has rank < 4; expected independent thrust and "
         "torques");
   pinv_ = allocation_.transpose() * lu.inverse();
-  for (int i = 0; i < n_; ++i)
+  for (int i = 0; i < n_; ++i) {
     if (!(pinv_(i, 0) > 0))
       throw Error("MultirotorMixer: rotor " + std::to_string(i) +
                   " takes no share of the collective thrust; expected every rotor to lift");
+    inv_d_.push_back(1.0 / pinv_(i, 0));
+  }
 }
 
 MixResult MultirotorMixer::Mix(double collective_n, const Eigen::Vector3d& torque,
                                std::span<double> out) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::array<double, kMaxRotors> d, u, y;
+  std::array<double, kMaxRotors> u, y;
   for (int i = 0; i < n_; ++i) {
-    d[i] = pinv_(i, 0);
     u[i] = pinv_(i, 1) * torque.x() + pinv_(i, 2) * torque.y();
     y[i] = pinv_(i, 3) * torque.z();
   }
 
-  // a. roll/pitch scale: every pair (i, j) needs lo_i(k) <= hi_j(k)
-  double k = 1;
-  for (int i = 0; i < n_; ++i)
-    for (int j = 0; j < n_; ++j) {
-      const double coef = u[j] / d[j] - u[i] / d[i];
-      if (coef <= 0) continue;
-      const double rhs = max_[j] / d[j] - min_[i] / d[i];
-      k = std::min(k, rhs / coef);
+  // collective interval that fits k u + c d inside the limits
+  auto interval = [&](double k, double* lo, double* hi) {
+    *lo = -kInf;
+    *hi = kInf;
+    for (int i = 0; i < n_; ++i) {
+      *lo = std::max(*lo, (min_[i] - k * u[i]) * inv_d_[i]);
+      *hi = std::min(*hi, (max_[i] - k * u[i]) * inv_d_[i]);
     }
-  k = std::max(k, 0.0);
+  };
+  double lo, hi, k = 1;
+  interval(1, &lo, &hi);
+  if (lo > hi) {
+    // a. roll/pitch scale: every pair (i, j) needs lo_i(k) <= hi_j(k), i.e.
+    //    k (u_j/d_j - u_i/d_i) <= max_j/d_j - min_i/d_i
+    for (int i = 0; i < n_; ++i)
+      for (int j = 0; j < n_; ++j) {
+        const double coef = u[j] * inv_d_[j] - u[i] * inv_d_[i];
+        if (coef <= 0) continue;
+        k = std::min(k, (max_[j] * inv_d_[j] - min_[i] * inv_d_[i]) / coef);
+      }
+    k = std::max(k, 0.0);
+    interval(k, &lo, &hi);
+  }
 
   // b. collective within the feasible interval at scale k
-  double lo = -kInf, hi = kInf;
-  for (int i = 0; i < n_; ++i) {
-    lo = std::max(lo, (min_[i] - k * u[i]) / d[i]);
-    hi = std::min(hi, (max_[i] - k * u[i]) / d[i]);
-  }
   double c = collective_n;
   if (lo > hi) {
     c = 0.5 * (lo + hi);  // only through rounding, or limits no collective can satisfy
@@ -75,7 +84,7 @@ MixResult MultirotorMixer::Mix(double collective_n, const Eigen::Vector3d& torqu
   // c. yaw gets the headroom that is left
   double s = 1;
   for (int i = 0; i < n_; ++i) {
-    const double base = k * u[i] + c * d[i];
+    const double base = k * u[i] + c * pinv_(i, 0);
     if (y[i] > 0) {
       s = std::min(s, (max_[i] - base) / y[i]);
     } else if (y[i] < 0) {
@@ -85,7 +94,7 @@ MixResult MultirotorMixer::Mix(double collective_n, const Eigen::Vector3d& torqu
   s = std::max(s, 0.0);
 
   for (int i = 0; i < n_; ++i)
-    out[i] = std::clamp(k * u[i] + c * d[i] + s * y[i], min_[i], max_[i]);
+    out[i] = std::clamp(k * u[i] + c * pinv_(i, 0) + s * y[i], min_[i], max_[i]);
 
   MixResult r;
   r.roll_pitch_scale = k;

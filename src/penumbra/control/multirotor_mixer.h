@@ -69,6 +69,7 @@ class MultirotorMixer {
   Eigen::Matrix<double, 4, Eigen::Dynamic> allocation_;
   Eigen::Matrix<double, Eigen::Dynamic, 4> pinv_;
   std::vector<double> min_, max_;
+  std::vector<double> inv_d_;  ///< 1 / (B^+ e_T)_i
 };
 
 }  // namespace penumbra

@@ -17,7 +17,7 @@ constexpr double kDegToRad = M_PI / 180.0;
 // velocity integrator: input clipped to this error (m/s), and frozen while the thrust axis is
 // more than this far from its setpoint (rad), so an upset or a large step does not wind it up
 constexpr double kIntegratorErrorClip = 0.5;
-constexpr double kIntegratorMaxTiltError = 20 * kDegToRad;
+const double kCosIntegratorMaxTiltError = std::cos(20 * kDegToRad);
 
 double WrapAngle(double a) {
   a = std::remainder(a, 2 * M_PI);  // in [-pi, pi]
@@ -382,6 +382,7 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
 MultirotorPid::MultirotorPid(MultirotorPidParams params, ControllerContext context)
     : Controller(std::move(context)), params_(std::move(params)) {
   params_.ValidateOrThrow(this->context());
+  tan_max_tilt_ = std::tan(params_.max_tilt_deg * kDegToRad);
 }
 
 std::vector<NameRequirement> MultirotorPid::RequiredNames() const {
@@ -439,7 +440,7 @@ void MultirotorPid::ResetState() {
   yaw_rate_ff_ = 0;
   have_prev_ = false;
   xy_limited_ = false;
-  tilt_error_ = 0;
+  tilt_error_large_ = false;
   mix_ = MixResult();
 }
 
@@ -560,12 +561,12 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   const Eigen::Matrix3d R = X_WB.linear();
   const Eigen::Vector3d v = V_WB.tail<3>();
   const Eigen::Vector3d w = R.transpose() * V_WB.head<3>();  // body rates
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  auto yaw = [&R] { return std::atan2(R(1, 0), R(0, 0)); };  // only needed on mode changes
 
   // commands that are due: scripted first, then a programmatic one
   while (next_scripted_ < params_.commands.size() &&
          params_.commands[next_scripted_].t_sec <= t + 1e-9) {
-    ApplyCommand(params_.commands[next_scripted_].command, p, yaw);
+    ApplyCommand(params_.commands[next_scripted_].command, p, yaw());
     ++next_scripted_;
   }
   if (has_pending_.load(std::memory_order_acquire)) {
@@ -575,7 +576,7 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
       cmd = pending_;
       has_pending_.store(false, std::memory_order_relaxed);
     }
-    ApplyCommand(cmd, p, yaw);
+    ApplyCommand(cmd, p, yaw());
   }
 
   if (mode_ == M::kIdle) {
@@ -584,7 +585,7 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
       ctrl[rotors_[i]] = thrust_[i];
     }
     p_ref_ = p;
-    yaw_ref_ = yaw;
+    yaw_ref_ = yaw();
     return;
   }
 
@@ -612,7 +613,11 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   v_sp.z() = std::clamp(v_sp.z(), -params_.max_descent_m_s, params_.max_climb_m_s);
 
   // velocity PID -> acceleration setpoint (derivative on the measured velocity)
-  const double alpha = LowPassAlpha(dt, params_.derivative_cutoff_hz);
+  if (dt != alpha_dt_) {
+    alpha_dt_ = dt;
+    alpha_ = LowPassAlpha(dt, params_.derivative_cutoff_hz);
+  }
+  const double alpha = alpha_;
   if (have_prev_) {
     acc_filt_ += alpha * ((v - v_prev_) / dt - acc_filt_);
     wdot_filt_ += alpha * ((w - w_prev_) / dt - wdot_filt_);
@@ -627,7 +632,7 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   // integrate the clipped error unless the output saturated on that axis at the last update
   // or the thrust direction is far from its setpoint (the translational loop is open then)
   const Eigen::Vector3d e_i = e_v.cwiseMax(-kIntegratorErrorClip).cwiseMin(kIntegratorErrorClip);
-  const bool attitude_ok = tilt_error_ < kIntegratorMaxTiltError;
+  const bool attitude_ok = !tilt_error_large_;
   if (attitude_ok && !xy_limited_ && mix_.roll_pitch_scale >= 1)
     vel_int_.head<2>() += ki_v.head<2>().cwiseProduct(e_i.head<2>()) * dt;
   const bool z_blocked =
@@ -643,15 +648,19 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   Eigen::Vector3d F = m * (a_sp + Eigen::Vector3d(0, 0, g));
   F.z() = std::max(F.z(), 0.1 * m * g);
   const double fxy = F.head<2>().norm();
-  const double fxy_max = F.z() * std::tan(params_.max_tilt_deg * kDegToRad);
+  const double fxy_max = F.z() * tan_max_tilt_;
   xy_limited_ = fxy > fxy_max;
   if (xy_limited_) F.head<2>() *= fxy_max / fxy;
   const Eigen::Vector3d b3 = F.normalized();
-  tilt_error_ = std::acos(std::clamp(b3.dot(R.col(2)), -1.0, 1.0));
+  tilt_error_large_ = b3.dot(R.col(2)) < kCosIntegratorMaxTiltError;
   const double collective = std::max(F.dot(R.col(2)), 0.0);
 
   // attitude setpoint: thrust direction b3 and reference yaw
-  const Eigen::Vector3d heading(std::cos(yaw_ref_), std::sin(yaw_ref_), 0);
+  if (yaw_ref_ != heading_yaw_) {
+    heading_yaw_ = yaw_ref_;
+    heading_ = Eigen::Vector3d(std::cos(yaw_ref_), std::sin(yaw_ref_), 0);
+  }
+  const Eigen::Vector3d& heading = heading_;
   Eigen::Vector3d b2 = b3.cross(heading);
   if (b2.norm() < 1e-6)
     b2 = b3.cross(R.col(0));  // heading along the thrust (not reachable

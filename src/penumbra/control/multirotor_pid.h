@@ -81,6 +81,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <atomic>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -244,7 +245,12 @@ class MultirotorPid final : public Controller {
   Eigen::Vector3d w_prev_ = Eigen::Vector3d::Zero(), wdot_filt_ = Eigen::Vector3d::Zero();
   bool have_prev_ = false;
   bool xy_limited_ = false;
-  double tilt_error_ = 0;  ///< angle between the thrust axis and its setpoint (rad)
+  bool tilt_error_large_ = false;  ///< thrust axis > 20 deg from its setpoint
+  // cached per-update constants
+  double tan_max_tilt_ = 0;
+  double alpha_dt_ = -1, alpha_ = 0;
+  double heading_yaw_ = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Vector3d heading_ = Eigen::Vector3d::UnitX();
   double last_collective_request_ = 0;
   MixResult mix_;
   std::vector<double> thrust_;
