@@ -42,8 +42,16 @@ struct FrameContext {
   uint64_t PixelStream(int u, int v, int s) const {
     const uint64_t pixel = static_cast<uint64_t>(v) * static_cast<uint64_t>(camera->width()) +
                            static_cast<uint64_t>(u);
+    return PixelStream(FrameKey(), pixel, s);
+  }
+  /// the per-frame part of PixelStream, to hoist out of pixel loops:
+  /// PixelStream(u, v, s) == PixelStream(FrameKey(), v * width + u, s).
+  uint64_t FrameKey() const {
     return HashKeys(HashKeys(settings->seed, static_cast<uint64_t>(camera_index)),
-                    static_cast<uint64_t>(frame_index), pixel, static_cast<uint64_t>(s));
+                    static_cast<uint64_t>(frame_index));
+  }
+  static uint64_t PixelStream(uint64_t frame_key, uint64_t pixel, int s) {
+    return HashKeys(HashKeys(frame_key, pixel), static_cast<uint64_t>(s));
   }
 };
 

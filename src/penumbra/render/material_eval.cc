@@ -45,11 +45,6 @@ Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g) {
   return Eigen::Vector3f::Ones();
 }
 
-inline int Wrap(int i, int n) {
-  const int r = i % n;
-  return r < 0 ? r + n : r;
-}
-
 }  // namespace
 
 MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene) : scene_(scene) {
@@ -80,8 +75,13 @@ Eigen::Vector3f MaterialEvaluator::Sample2D(int tex, float s, float t) const {
   const float y = (t - std::floor(t)) * h - 0.5f;
   const float x0f = std::floor(x), y0f = std::floor(y);
   const float fx = x - x0f, fy = y - y0f;
-  const int x0 = Wrap(static_cast<int>(x0f), w), x1 = Wrap(static_cast<int>(x0f) + 1, w);
-  const int y0 = Wrap(static_cast<int>(y0f), h), y1 = Wrap(static_cast<int>(y0f) + 1, h);
+  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
+  int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  int x1 = x0 + 1, y1 = y0 + 1;
+  x0 = x0 < 0 ? x0 + w : x0;
+  y0 = y0 < 0 ? y0 + h : y0;
+  x1 = x1 >= w ? x1 - w : x1;
+  y1 = y1 >= h ? y1 - h : y1;
   const uint8_t* p = T.rgb_srgb.data();
   auto texel = [&](int xi, int yi) {
     const uint8_t* q = p + (static_cast<size_t>(yi) * w + xi) * 3;

@@ -632,4 +632,30 @@ void RayScene::OccludedMany(const Ray* rays, int n, const bool* active, bool* oc
   }
 }
 
+void RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
+                             const LaneMask& active, LaneMask* occluded) const {
+  static_assert(kLanes == kPacket, "one Embree packet per lane batch");
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  alignas(64) RTCRay16 p;
+  alignas(64) int valid[kPacket];
+  for (int k = 0; k < kPacket; ++k) {
+    valid[k] = active[k] ? -1 : 0;
+    p.org_x[k] = o.x[k];
+    p.org_y[k] = o.y[k];
+    p.org_z[k] = o.z[k];
+    p.dir_x[k] = d.x[k];
+    p.dir_y[k] = d.y[k];
+    p.dir_z[k] = d.z[k];
+    p.tnear[k] = 0;
+    p.tfar[k] = tmax[k];
+    p.time[k] = 0;
+    p.mask[k] = 0xffffffffu;
+    p.id[k] = 0;
+    p.flags[k] = 0;
+  }
+  rtcOccluded16(valid, impl_->top, &ctx, &p);
+  for (int k = 0; k < kPacket; ++k) (*occluded)[k] = active[k] && p.tfar[k] < 0;
+}
+
 }  // namespace penumbra

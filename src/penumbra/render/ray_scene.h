@@ -26,6 +26,7 @@
 #include <memory>
 #include <vector>
 
+#include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -101,6 +102,11 @@ class RayScene {
   /// origins and directions (e.g. shadow rays of neighbouring pixels towards one light).
   void OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded,
                     bool coherent = false) const;
+
+  /// occlusion of one packet of kLanes rays o + t d, t in [0, tmax], given as lanes (the
+  /// realtime tier's shadow rays); lanes with active[k] == false get occluded[k] = false.
+  void OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
+                     const LaneMask& active, LaneMask* occluded) const;
 
   /// the body poses currently in the scene (X_WB by body index).
   const std::vector<Pose>& X_WB() const { return X_WB_; }

@@ -49,6 +49,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   scratch.samples.resize(num_lights);
   scratch.contrib.resize(num_lights);
   int64_t traced = 0;
+  const uint64_t frame_key = ctx.FrameKey();
+  const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
 
   // rows of kLanes pixels (a tile row is kLanes wide): per-pixel set-up, then every light for
   // all lanes at once, its shadow rays as one Embree packet.
@@ -89,8 +91,9 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       bsdf.Set(k, coef, h.ns_W, h.ng_W, wo);
       const Eigen::Vector3f n_s = bsdf.n.Lane(k);
       p.Set(k, h.p_W);
-      // shadow rays start off the surface on the lit side (lights behind it contribute 0).
-      origin.Set(k, SpawnRay(h, h.ng_W).o);
+      // shadow rays start off the surface on the lit side (lights behind it contribute 0), as
+      // SpawnRay.
+      origin.Set(k, h.p_W + (kRayOffsetScale * (1.0f + h.p_W.cwiseAbs().maxCoeff())) * h.ng_W);
 
       // emission and unoccluded sky ambient.
       const Eigen::Vector3f spec =
@@ -99,7 +102,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
           coef.c_diff.cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
       L.Set(k, mat.emission + (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect));
 
-      Rng rng(ctx.PixelStream(u, v, 0));
+      Rng rng(FrameContext::PixelStream(frame_key, static_cast<uint64_t>(v) * width + u, 0));
       for (int j = 0; j < num_lights; ++j) {
         scratch.u1[j][k] = rng.Uniform();
         scratch.u2[j][k] = rng.Uniform();
@@ -146,17 +149,13 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       if (!shadowed.any()) continue;
       const LightSampleLanes& s = scratch.samples[j];
-      Ray rays[kLanes];
-      bool active[kLanes], occluded[kLanes];
+      Lanes tmax;
+      for (int k = 0; k < kLanes; ++k)
+        tmax[k] = std::isinf(s.distance[k]) ? s.distance[k] : s.distance[k] * (1.0f - 1e-4f);
+      LaneMask occluded;
+      ctx.scene->OccludedLanes(origin, s.wi, tmax, shadowed, &occluded);
       for (int k = 0; k < kLanes; ++k) {
-        active[k] = shadowed[k];
-        rays[k].o = origin.Lane(k);
-        rays[k].d = s.wi.Lane(k);
-        rays[k].tmax = std::isinf(s.distance[k]) ? s.distance[k] : s.distance[k] * (1.0f - 1e-4f);
-      }
-      ctx.scene->OccludedMany(rays, kLanes, active, occluded, /*coherent=*/true);
-      for (int k = 0; k < kLanes; ++k) {
-        if (!active[k]) continue;
+        if (!shadowed[k]) continue;
         ++traced;
         if (occluded[k]) continue;
         L.x[k] += c.x[k], L.y[k] += c.y[k], L.z[k] += c.z[k];
