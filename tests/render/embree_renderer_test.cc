@@ -419,6 +419,39 @@ TEST(EmbreeRendererTest, OnlyRequestedOutputsAreFilled) {
   EXPECT_EQ(f.rays, 16 * 12);
 }
 
+TEST(EmbreeRendererTest, StaticBodiesArePosedBySnapshot) {
+  // static bodies are merged into one world-frame scene built from the snapshot's poses, and
+  // rebuilt if a static pose ever changes.
+  SceneDescription s = EmptyScene();
+  const int shelf = AddBody(&s, "shelf", /*is_static=*/true);
+  const int g = AddGeom(&s, GeomShape::kBox, {0.1, 0.5, 0.5}, Translation(0.5, 0, 0), shelf);
+  EmbreeRenderer r(s, TestSettings());
+  WorldSnapshot snap = IdentitySnapshot(s);
+  RenderedFrame f;
+  const CameraView view = MakeView(CameraLookingAlongX(), 21, 21, 30);
+  for (double x : {2.0, 3.0}) {
+    snap.X_WB[shelf] = Translation(x, 0, 0);
+    r.Render(snap, view, &f);
+    EXPECT_EQ(*f.geom_id.at(10, 10), s.geoms[g].id);
+    EXPECT_NEAR(*f.depth_m.at(10, 10), x + 0.4, 1e-4);
+  }
+}
+
+TEST(EmbreeRendererTest, EmptySceneShowsTheSky) {
+  SceneDescription s = EmptyScene();
+  AddBody(&s, "empty");
+  s.sky.radiance = {1, 2, 3};
+  auto r = MakeEmbreeRenderer(s, TestSettings());
+  RenderedFrame f;
+  r->Render(IdentitySnapshot(s), MakeView(CameraLookingAlongX(), 8, 6, 60), &f);
+  for (int v = 0; v < 6; ++v)
+    for (int u = 0; u < 8; ++u) {
+      EXPECT_EQ(*f.geom_id.at(u, v), -1);
+      EXPECT_EQ(*f.depth_m.at(u, v), 0.0f);
+      EXPECT_FLOAT_EQ(f.radiance.at(u, v)[2], 3.0f);
+    }
+}
+
 TEST(EmbreeRendererTest, MismatchedSnapshotThrows) {
   SceneDescription s = WallAt(2);
   auto r = MakeEmbreeRenderer(s, TestSettings());

@@ -14,6 +14,10 @@
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
 // Rng(ctx.PixelStream(u, v, 0)), two per light in light order.
+//
+// speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
+// LightSampler::SampleLanes) and its shadow rays towards one light form one Embree packet
+// (RayScene::OccludedLanes); materials, textures and the sky are evaluated per pixel.
 
 #include "penumbra/render/integrator.h"
 
