@@ -24,7 +24,6 @@ struct AnalyticGeom {
   AnalyticShape shape;
   Eigen::Matrix3d R_GI;  // p_G = R_GI p_I + p_GI
   Eigen::Vector3d p_GI;
-  Eigen::Matrix3f R_IG_f;  // for the instance-frame Ng reported to Embree
 };
 
 // a geom traced as triangles, in the instance frame. vertices carry one padding element at
@@ -68,10 +67,10 @@ void AnalyticBounds(const RTCBoundsFunctionArguments* args) {
   const Eigen::Matrix3d R_IG = g->R_GI.transpose();
   const Eigen::Vector3d c = -(R_IG * g->p_GI);
   const Eigen::Vector3d e = R_IG.cwiseAbs() * h;
-  // pad by a relative epsilon so that flat shapes (planes) have volume and float rounding
-  // of the box never clips the surface.
-  const Eigen::Vector3d pad =
-      Eigen::Vector3d::Constant(1e-5 * (1.0 + e.maxCoeff() + c.cwiseAbs().maxCoeff()));
+  // pad each axis by a relative epsilon, so that float rounding of the box never clips the
+  // surface and flat shapes have volume, while rays leaving a flat shape (shadow rays from a
+  // floor) stay out of its box.
+  const Eigen::Vector3d pad = 1e-6 * (Eigen::Vector3d::Ones() + c.cwiseAbs() + e);
   const Eigen::Vector3d lo = c - e - pad, hi = c + e + pad;
   args->bounds_o->lower_x = static_cast<float>(lo.x());
   args->bounds_o->lower_y = static_cast<float>(lo.y());
@@ -106,16 +105,7 @@ void AnalyticIntersect(const RTCIntersectFunctionNArguments* args) {
     const float tf = static_cast<float>(t);
     if (!(tf < RTCRayN_tfar(ray, args->N, i))) continue;
     RTCRayN_tfar(ray, args->N, i) = tf;
-    // Ng: rough instance-frame normal (RayScene recomputes the exact one in double).
-    const Eigen::Vector3d o_I(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i),
-                              RTCRayN_org_z(ray, args->N, i));
-    const Eigen::Vector3d d_I(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i),
-                              RTCRayN_dir_z(ray, args->N, i));
-    const Eigen::Vector3d p_G = g->R_GI * (o_I + t * d_I) + g->p_GI;
-    const Eigen::Vector3f n_I = g->R_IG_f * AnalyticNormal(g->shape, p_G, part).cast<float>();
-    RTCHitN_Ng_x(hit, args->N, i) = n_I.x();
-    RTCHitN_Ng_y(hit, args->N, i) = n_I.y();
-    RTCHitN_Ng_z(hit, args->N, i) = n_I.z();
+    // Ng is left unset: FinishHit computes the exact normal from the part hit (in u).
     RTCHitN_u(hit, args->N, i) = static_cast<float>(static_cast<int>(part));
     RTCHitN_v(hit, args->N, i) = 0.0f;
     RTCHitN_primID(hit, args->N, i) = args->primID;
@@ -222,7 +212,6 @@ struct RayScene::Impl {
       ag->shape = AnalyticShapeOf(geom);
       ag->R_GI = X_GI.linear();
       ag->p_GI = X_GI.translation();
-      ag->R_IG_f = X_IG.linear().cast<float>();
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(eg, 1);
       rtcSetGeometryUserData(eg, ag.get());

@@ -48,13 +48,13 @@ struct Ray {
 struct SurfaceHit {
   float t = 0;                   ///< ray parameter of the hit: p_W = o + t d
   Eigen::Vector3f p_W{0, 0, 0};  ///< hit point, world frame, m
-  Eigen::Vector3f ng_W{0, 0,
-                       1};  ///< unit geometric normal, world frame, facing the ray (ng . d <= 0)
-  Eigen::Vector3f ns_W{0, 0,
-                       1};   ///< unit shading normal (interpolated for meshes), flipped with ng_W
-  Eigen::Vector2f uv{0, 0};  ///< mesh texcoords at the hit when the mesh has them, else (0, 0)
-  bool has_uv = false;       ///< uv came from mesh texcoords
-  bool front_face = true;    ///< the ray hit the outward side (before flipping the normals)
+  /// unit geometric normal, world frame, facing the ray (ng . d <= 0).
+  Eigen::Vector3f ng_W{0, 0, 1};
+  /// unit shading normal (interpolated for meshes), flipped together with ng_W.
+  Eigen::Vector3f ns_W{0, 0, 1};
+  Eigen::Vector2f uv{0, 0};      ///< mesh texcoords at the hit when the mesh has them, else (0, 0)
+  bool has_uv = false;           ///< uv came from mesh texcoords
+  bool front_face = true;        ///< the ray hit the outward side (before flipping the normals)
   Eigen::Vector3f p_G{0, 0, 0};  ///< hit point in the geom frame, m (planar texture mapping)
   Eigen::Vector3f n_G{0, 0, 1};  ///< unit outward geometric normal in the geom frame (not flipped)
   int geom = -1;                 ///< index into SceneDescription::geoms
@@ -77,7 +77,8 @@ class RayScene {
  public:
   /// builds the body scenes (and an identity pose for every body until Update). `scene` is
   /// referenced, not copied: it must outlive this object.
-  /// @throws Error if Embree fails or a geom refers to a missing mesh / height field.
+  /// @throws Error if Embree fails, or a visible geom refers to a missing body, material, mesh
+  /// or height field, or has a non-positive size for its shape.
   explicit RayScene(const SceneDescription& scene);
   ~RayScene();
   RayScene(const RayScene&) = delete;
