@@ -87,14 +87,12 @@ class FakeInput final : public ControlInput {
     if (jacobian_.cols() == model_.nv) *J = jacobian_;
   }
 
+  const ModelInfo& model_;
   double t_ = 0;
   std::vector<double> q_, qd_, bias_;
   bool with_bias_ = true;
   Pose X_ee_ = Pose::Identity();
   Eigen::Matrix<double, 6, Eigen::Dynamic> jacobian_;
-
- private:
-  const ModelInfo& model_;
 };
 
 inline ControllerConfig Block(const std::string& type, const std::string& body) {

@@ -347,7 +347,6 @@ void KeyframePlayback::Compute(const ControlInput& input, std::span<double> ctrl
   const double t_rel = t - start_time_;
   double gripper = 0;
   Evaluate(t_rel, q_start_, gripper_start_, &target_, &target_velocity_, &gripper);
-  target_ = servo_.ClampPosition(target_);
   finished_ = !params_.loop && t_rel >= times_.back();
 
   servo_.StepTowards(target_, target_velocity_, dt, &q_ref_, &qd_ref_);

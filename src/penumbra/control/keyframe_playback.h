@@ -94,7 +94,8 @@ class KeyframePlayback final : public Controller {
 
   const KeyframePlaybackParams& params() const { return params_; }
   const JointServo& servo() const { return servo_; }
-  /// (n) the interpolated target and the servo reference of the last update.
+  /// (n) the interpolated target (the servo clamps it into the joint ranges) and the servo
+  /// reference of the last update.
   const Eigen::VectorXd& target() const { return target_; }
   const Eigen::VectorXd& q_ref() const { return q_ref_; }
   /// true once the last frame's time has passed (never with loop).
