@@ -181,7 +181,12 @@ void BM_RenderRoom(benchmark::State& state) {
   state.counters["Mrays/s"] = benchmark::Counter(rays * 1e-6, benchmark::Counter::kIsRate);
   state.counters["geoms"] = static_cast<double>(scene.geoms.size());
 }
-BENCHMARK(BM_RenderRoom)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderRoom)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()  // CPU column: all threads, comparable on a busy machine
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace penumbra
