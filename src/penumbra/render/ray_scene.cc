@@ -13,7 +13,7 @@
 namespace penumbra {
 namespace {
 
-// rays per Embree packet in IntersectMany / OccludedMany (rtcIntersect16 / rtcOccluded16).
+// rays per Embree packet in IntersectMany / OccludedLanes (rtcIntersect16 / rtcOccluded16).
 constexpr int kPacket = 16;
 
 // frames: G = geom, I = the frame of the instanced scene that holds the geom (the body frame
@@ -534,11 +534,11 @@ bool RayScene::Occluded(const Ray& ray) const {
   return r.tfar < 0;
 }
 
-// packets of kPacket rays (rtcIntersect16 / rtcOccluded16) for coherent rays; incoherent rays
-// go one by one (rtcIntersect1), as Embree recommends. the packets are traced with an
-// incoherent context: Embree 3.13.5's coherent (frustum) packet traversal was seen to loop
-// forever on some packets of this renderer's scenes (instanced user geometry), and plain packet
-// traversal is as fast here.
+// packets of kPacket rays (rtcIntersect16) for coherent rays; incoherent rays go one by one
+// (rtcIntersect1), as Embree recommends. the packets are traced with an incoherent context:
+// with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, Embree 3.13.5 was seen to loop forever inside
+// rtcIntersect16 / rtcOccluded16 (and rtcOccluded1M) on some packets of this renderer's scenes
+// (instanced user geometry; reproduced by the realtime lighting tests), so that flag is not used.
 void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits,
                              bool* did_hit) const {
   if (!coherent) {
@@ -582,42 +582,6 @@ void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* 
       rh.hit.instID[0] = p.hit.instID[0][i];
       impl_->FinishHit(rays[start + i], rh, &hits[start + i]);
     }
-  }
-}
-
-void RayScene::OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded,
-                            bool coherent) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  if (!coherent) {
-    for (int i = 0; i < n; ++i) occluded[i] = (!active || active[i]) && Occluded(rays[i]);
-    return;
-  }
-  alignas(64) RTCRay16 p;
-  alignas(64) int valid[kPacket];
-  for (int start = 0; start < n; start += kPacket) {
-    const int m = std::min(kPacket, n - start);
-    bool any = false;
-    for (int i = 0; i < kPacket; ++i) {
-      const bool on = i < m && (!active || active[start + i]);
-      any |= on;
-      valid[i] = on ? -1 : 0;
-      const Ray& r = rays[start + std::min(i, m - 1)];
-      p.org_x[i] = r.o.x();
-      p.org_y[i] = r.o.y();
-      p.org_z[i] = r.o.z();
-      p.dir_x[i] = r.d.x();
-      p.dir_y[i] = r.d.y();
-      p.dir_z[i] = r.d.z();
-      p.tnear[i] = r.tmin;
-      p.tfar[i] = r.tmax;
-      p.time[i] = 0;
-      p.mask[i] = 0xffffffffu;
-      p.id[i] = 0;
-      p.flags[i] = 0;
-    }
-    if (any) rtcOccluded16(valid, impl_->top, &ctx, &p);
-    for (int i = 0; i < m; ++i) occluded[start + i] = valid[i] != 0 && p.tfar[i] < 0;
   }
 }
 

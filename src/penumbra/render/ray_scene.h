@@ -98,12 +98,6 @@ class RayScene {
   /// traced in packets of 16, others one by one. hit[i] is valid iff did_hit[i].
   void IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits, bool* did_hit) const;
 
-  /// occlusion of `n` rays traced together; rays with active[i] == false are skipped and
-  /// get occluded[i] = false (active may be null = all). `coherent` for rays with similar
-  /// origins and directions (e.g. shadow rays of neighbouring pixels towards one light).
-  void OccludedMany(const Ray* rays, int n, const bool* active, bool* occluded,
-                    bool coherent = false) const;
-
   /// occlusion of one packet of kLanes rays o + t d, t in [0, tmax], given as lanes (the
   /// realtime tier's shadow rays); lanes with active[k] == false get occluded[k] = false.
   void OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,

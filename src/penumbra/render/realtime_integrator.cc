@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
@@ -52,7 +51,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
 
-  // rows of kLanes pixels (a tile row is kLanes wide): per-pixel set-up, then every light for
+  // runs of kLanes pixels (a full tile row): per-pixel set-up, then every light for
   // all lanes at once, its shadow rays as one Embree packet.
   for (int i0 = 0; i0 < n; i0 += kLanes) {
     const int m = std::min(kLanes, n - i0);
