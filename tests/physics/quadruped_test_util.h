@@ -4,6 +4,7 @@
 // criteria need (trunk contact, trajectory).
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -11,6 +12,7 @@
 
 #include "penumbra/control/controller.h"
 #include "penumbra/control/controller_factory.h"
+#include "penumbra/control/quadruped_leg_kinematics.h"
 #include "penumbra/control/trot_gait.h"
 #include "penumbra/physics/simulation.h"
 
@@ -82,6 +84,59 @@ class Probe final : public Controller {
  private:
   int touch_adr_ = 0;
   int trunk_ = 0;
+};
+
+/// compares, at every step, the trot_gait leg model (analytic FK and Jacobian of
+/// control/quadruped_leg_kinematics.h with the geometry TrotGait read from the model) with
+/// MuJoCo's kinematics: foot positions (calf body pose and foot offset) and MuJoCo's
+/// translational Jacobian of the foot point (columns of the leg's three joints).
+class LegModelCheck final : public Controller {
+ public:
+  explicit LegModelCheck(const TrotGait* gait) : Controller(ControllerContext{}), gait_(gait) {}
+  std::string type() const override { return "leg_model_check"; }
+  double rate_hz() const override { return 0; }
+  std::vector<NameRequirement> RequiredNames() const override {
+    std::vector<NameRequirement> r = {{ModelObject::kBody, "trunk", ""}};
+    for (const char* leg : {"FR", "FL", "RR", "RL"})
+      for (const char* j : {"_hip", "_thigh", "_calf"})
+        r.push_back({ModelObject::kJoint, std::string(leg) + j, ""});
+    return r;
+  }
+  void Compute(const ControlInput& in, std::span<double>) override {
+    const Pose X_WT = in.X_WB(trunk_);
+    for (int i = 0; i < 4; ++i) {
+      Eigen::Vector3d q;
+      for (int j = 0; j < 3; ++j) q[j] = in.qpos()[joints_[i][j].qpos_adr];
+      const LegGeometry& g = gait_->leg_geometry()[i];
+      const Eigen::Vector3d foot_W = X_WT * (gait_->hip_offsets()[i] + LegForwardKinematics(g, q));
+      const Eigen::Vector3d foot_mj =
+          in.X_WB(joints_[i][2].body) * Eigen::Vector3d(0, 0, -g.calf_m);
+      max_position_error_m = std::max(max_position_error_m, (foot_W - foot_mj).norm());
+      in.Jacobian(joints_[i][2].body, foot_mj, &jac_);
+      const Eigen::Matrix3d J = X_WT.linear() * LegJacobian(g, q);
+      for (int j = 0; j < 3; ++j)
+        max_jacobian_error = std::max(
+            max_jacobian_error, (jac_.block<3, 1>(3, joints_[i][j].dof_adr) - J.col(j)).norm());
+    }
+    ++checks;
+  }
+
+  double max_position_error_m = 0;  ///< largest foot position difference (m)
+  double max_jacobian_error = 0;    ///< largest Jacobian column difference (m/rad)
+  int checks = 0;
+
+ protected:
+  void OnInitialize(const ModelInfo& m, const std::vector<int>& ids) override {
+    trunk_ = ids[0];
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 3; ++j) joints_[i][j] = m.joints[ids[1 + 3 * i + j]];
+  }
+
+ private:
+  const TrotGait* gait_;
+  int trunk_ = 0;
+  std::array<std::array<JointInfo, 3>, 4> joints_;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> jac_;
 };
 
 /// a loaded scene with a trot_gait controller and a probe.

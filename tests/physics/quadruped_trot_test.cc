@@ -55,6 +55,21 @@ TEST(QuadrupedTrot, ModelGeometryAndMassAreReadFromTheModel) {
   EXPECT_LT(rig.gait->body_height_m(), 0.265);  // below the trunk origin (0.265 above them)
 }
 
+// the controller's analytic leg model (FK, Jacobian used for the stance torques) agrees with
+// MuJoCo's kinematics of the bundled model while it walks and turns.
+TEST(QuadrupedTrot, LegModelMatchesMujocoKinematics) {
+  for (const char* robot : {"quadruped", "quadruped_arm"}) {
+    Rig rig = MakeRig(robot, Ground::kFlat, Config("[{t: 0, vx: 0.4, vy: 0.1, yaw_rate: 0.4}]"));
+    auto check = std::make_unique<LegModelCheck>(rig.gait);
+    LegModelCheck* c = check.get();
+    rig.sim.AddController(std::move(check));
+    RunUntil(&rig, 1.0);
+    EXPECT_EQ(c->checks, 500);
+    EXPECT_LT(c->max_position_error_m, 1e-12) << robot;
+    EXPECT_LT(c->max_jacobian_error, 1e-12) << robot;
+  }
+}
+
 // acceptance: from standing, 0.5 m/s forward for 6 s travels 3.0 +- 0.3 m with lateral
 // drift < 0.3 m and the trunk never touching the ground; then it stops.
 TEST(QuadrupedTrot, WalksForwardThreeMetresInSixSecondsAndStops) {

@@ -34,20 +34,22 @@ bool LegInverseKinematics(const LegGeometry& leg, const Eigen::Vector3d& p_H, Ei
   const double l1 = leg.abduction_m, l2 = leg.thigh_m, l3 = leg.calf_m;
   bool reachable = true;
   // abduction: the foot lies on a circle of radius sqrt(l1^2 + z'^2) about the x axis
-  const double r_yz2 = p_H.y() * p_H.y() + p_H.z() * p_H.z();
+  const double py = p_H.y(), pz = p_H.z();
   const double min_leg = std::max(std::abs(l2 - l3), 0.05 * (l2 + l3));
-  double d2 = r_yz2 - l1 * l1;
+  double d2 = py * py + pz * pz - l1 * l1;
   if (d2 < min_leg * min_leg) {
     d2 = min_leg * min_leg;
     reachable = false;
   }
   const double zp = -std::sqrt(d2);
-  const double q1 = std::atan2(p_H.z(), p_H.y()) - std::atan2(zp, l1);
+  // q1 = atan2(pz, py) - atan2(z', l1), as one atan2 of the angle between the vectors
+  const double q1 = std::atan2(l1 * pz - zp * py, l1 * py + zp * pz);
   // sagittal plane: two-link arm from the thigh axis to the foot at (x, z')
   double x = p_H.x(), z = zp;
-  double r = std::hypot(x, z);
+  double r2 = x * x + z * z;
   const double r_max = (l2 + l3) * (1 - 1e-9), r_min = std::max(std::abs(l2 - l3), 1e-6) + 1e-9;
-  if (r > r_max || r < r_min) {
+  if (r2 > r_max * r_max || r2 < r_min * r_min) {
+    const double r = std::sqrt(r2);
     const double rc = std::clamp(r, r_min, r_max);
     if (r < 1e-12) {
       x = 0;
@@ -56,13 +58,16 @@ bool LegInverseKinematics(const LegGeometry& leg, const Eigen::Vector3d& p_H, Ei
       x *= rc / r;
       z *= rc / r;
     }
-    r = rc;
+    r2 = rc * rc;
     reachable = false;
   }
-  const double c3 = std::clamp((r * r - l2 * l2 - l3 * l3) / (2 * l2 * l3), -1.0, 1.0);
+  const double c3 = std::clamp((r2 - l2 * l2 - l3 * l3) / (2 * l2 * l3), -1.0, 1.0);
   const double q3 = -std::acos(c3);
-  const double q2 = std::atan2(-x, -z) - std::atan2(l3 * std::sin(q3), l2 + l3 * std::cos(q3));
-  *q = Eigen::Vector3d(std::remainder(q1, 2 * M_PI), std::remainder(q2, 2 * M_PI), q3);
+  const double s3 = -std::sqrt(std::max(0.0, 1 - c3 * c3));  // sin(q3), q3 <= 0
+  // q2 = atan2(-x, -z') - atan2(l3 s3, l2 + l3 c3), again as one atan2
+  const double wx = l2 + l3 * c3, wy = l3 * s3;
+  const double q2 = std::atan2(-x * wx + z * wy, -z * wx - x * wy);
+  *q = Eigen::Vector3d(q1, q2, q3);
   return reachable;
 }
 

@@ -26,10 +26,8 @@ constexpr double kTouchdownDepth = 0.005;
 // phase offsets of FR, FL, RR, RL: the diagonals FR+RL and FL+RR alternate
 constexpr std::array<double, 4> kPhaseOffset = {0.0, 0.5, 0.5, 0.0};
 
-double WrapAngle(double a) {
-  a = std::remainder(a, 2 * M_PI);
-  return a <= -M_PI ? a + 2 * M_PI : a;
-}
+// a wrapped into [-pi, pi)
+double WrapAngle(double a) { return a - 2 * M_PI * std::floor((a + M_PI) / (2 * M_PI)); }
 
 std::string Describe(const YAML::Node& n) {
   if (n.IsScalar()) return "'" + n.Scalar() + "'";
@@ -197,7 +195,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
       g.hold.emplace_back(prefix + k, NumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
     }
   }
-  g.rate_hz = p.Number("rate_hz", 500, 0, kInf, true);
+  g.rate_hz = p.Number("rate_hz", 250, 0, kInf, true);
   p.CheckNoUnknownKeys();
   return g;
 }
@@ -478,10 +476,11 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   // 2. gait schedule
   const double T = params_.period_sec, D = params_.duty;
   const double T_st = D * T, T_sw = (1 - D) * T;
-  const double phase = std::fmod(t / T, 1.0);
+  const double phase = t / T - std::floor(t / T);
   std::array<double, 4> s_swing{};
   for (int i = 0; i < 4; ++i) {
-    const double lp = std::fmod(phase - kPhaseOffset[i] + 1.0, 1.0);
+    double lp = phase - kPhaseOffset[i];
+    if (lp < 0) lp += 1.0;
     stance_[i] = lp < D;
     s_swing[i] = stance_[i] ? 0.0 : (lp - D) / (1 - D);
     Leg& leg = legs_[i];
@@ -530,8 +529,12 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
     R_ref.col(1) = normal.cross(x_ref);
     R_ref.col(2) = normal;
   }
-  const Eigen::AngleAxisd err(R_ref * R.transpose());
-  const Eigen::Vector3d e_B = R.transpose() * (err.angle() * err.axis());
+  // attitude error on SO(3) in the base frame (T. Lee, M. Leok, N. H. McClamroch, "Geometric
+  // tracking control of a quadrotor UAV on SE(3)", CDC 2010): e = 1/2 (R^T R_ref - R_ref^T R)^v,
+  // the rotation vector from R to R_ref for small errors
+  const Eigen::Matrix3d E = R.transpose() * R_ref;
+  const Eigen::Vector3d e_B =
+      0.5 * Eigen::Vector3d(E(2, 1) - E(1, 2), E(0, 2) - E(2, 0), E(1, 0) - E(0, 1));
   const Eigen::Vector3d w_err_B = R.transpose() * (Eigen::Vector3d(0, 0, reference_.yaw_rate) - w);
   const Eigen::Vector3d alpha_B(params_.kp_tilt * e_B.x() + params_.kd_tilt * w_err_B.x(),
                                 params_.kp_tilt * e_B.y() + params_.kd_tilt * w_err_B.y(),
@@ -550,12 +553,14 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
     Leg& leg = legs_[i];
     const TrotLegConfig& cfg = params_.legs[i];
     if (stance_[i]) {
-      in.Jacobian(leg.calf_body, feet[i], &jac_);
-      for (int j = 0; j < 3; ++j) {
-        const double tau =
-            -jac_.block<3, 1>(3, leg.dof[j]).dot(forces_[i]) - params_.stance_kd * qvel[leg.dof[j]];
-        write(leg, j, tau);
-      }
+      // tau = S J^T R^T (-f): J the leg's analytic Jacobian in the base frame at the
+      // measured angles, S the sign map
+      Eigen::Vector3d q_can;
+      for (int j = 0; j < 3; ++j) q_can[j] = cfg.signs[j] * qpos[leg.qpos[j]] + cfg.offsets_rad[j];
+      const Eigen::Vector3d tau_can =
+          LegJacobian(geometry_[i], q_can).transpose() * (R.transpose() * -forces_[i]);
+      for (int j = 0; j < 3; ++j)
+        write(leg, j, cfg.signs[j] * tau_can[j] - params_.stance_kd * qvel[leg.dof[j]]);
       continue;
     }
     // 4. swing: Raibert touch-down point, cycloid, IK and joint PD

@@ -34,7 +34,7 @@
 //     stance_kd: 0.5                 # stance-leg joint damping (N m s/rad)
 //     friction: 0.6                  # friction coefficient assumed for the force cones
 //     hold: {arm_joint2: 1.2}        # other actuators held at a constant ctrl (optional)
-//     rate_hz: 500                   # control rate on sim time (default 500)
+//     rate_hz: 250                   # control rate on sim time (default 250: every 2nd 2 ms step)
 // the gains in 1/s^2 and 1/s multiply the robot's mass (kg) and its composite rotational
 // inertia at qpos0 (kg m^2), both taken from the model, so one set suits robots of any size.
 //
@@ -61,11 +61,15 @@
 //   3. stance: desired COM acceleration
 //        a = kp_xy (p_ref - c)_xy + kd_xy (v_ref - v)_xy,
 //        a_z = kp_z (h_ref - h) + kd_z (v_ref,z - v_z)  (h above the ground plane),
-//      desired angular acceleration from the attitude error e = log(R_ref R^T) (R_ref:
-//      heading psi_ref, z axis along the ground normal) with per-axis gains in the base
-//      frame; wrench w = (m (a + g), I alpha) distributed over the stance feet
-//      (control/quadruped_stance_forces.h); joint torques tau = -J_foot^T f (J: MuJoCo's
-//      translational Jacobian of the foot point) - stance_kd qdot.
+//      desired angular acceleration from the attitude error e = 1/2 (R^T R_ref -
+//      R_ref^T R)^v in the base frame (T. Lee et al., "Geometric tracking control of a
+//      quadrotor UAV on SE(3)", CDC 2010; R_ref: heading psi_ref, z axis along the ground
+//      normal) with per-axis gains; wrench w = (m (a + g), I alpha) distributed over the
+//      stance feet (control/quadruped_stance_forces.h); joint torques
+//      tau = S J^T R^T (-f) - stance_kd qdot, with J the leg's analytic Jacobian at the
+//      measured angles (control/quadruped_leg_kinematics.h; for a model in the canonical
+//      convention it equals MuJoCo's translational Jacobian of the foot site, and it
+//      costs a fraction of mj_jac) and S = diag(signs).
 //   4. swing: touch-down point by the Raibert heuristic (M. H. Raibert, "Legged Robots
 //      That Balance", MIT Press, 1986) with capture-point style velocity feedback
 //      (J. Pratt et al., "Capture Point: A Step toward Humanoid Push Recovery", 2006):
@@ -137,7 +141,7 @@ struct TrotGaitParams {
   double stance_kd = 0.5;
   double friction = 0.6;
   std::vector<std::pair<std::string, double>> hold;  ///< actuator (full name) -> ctrl
-  double rate_hz = 500;
+  double rate_hz = 250;
 
   /// leg keys in the order of `legs`.
   static constexpr std::array<const char*, 4> kLegNames = {"FR", "FL", "RR", "RL"};
@@ -227,7 +231,6 @@ class TrotGait final : public Controller {
   Eigen::Vector3d plane_{0, 0, 0};  ///< ground z = a + b x + c y
   std::array<bool, 4> stance_{true, true, true, true};
   std::array<Eigen::Vector3d, 4> forces_;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> jac_;
 };
 
 }  // namespace penumbra
