@@ -357,9 +357,8 @@ struct RayScene::Impl {
 };
 
 Ray SpawnRay(const SurfaceHit& hit, const Eigen::Vector3f& d) {
-  const float eps = kRayOffsetScale * (1.0f + hit.p_W.cwiseAbs().maxCoeff());
   Ray r;
-  r.o = hit.p_W + (d.dot(hit.ng_W) >= 0 ? eps : -eps) * hit.ng_W;
+  r.o = OffsetRayOrigin(hit.p_W, d.dot(hit.ng_W) >= 0 ? hit.ng_W : Eigen::Vector3f(-hit.ng_W));
   r.d = d;
   return r;
 }

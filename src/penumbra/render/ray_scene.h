@@ -64,6 +64,12 @@ struct SurfaceHit {
 /// scale of the offset that moves secondary-ray origins off a surface (relative to 1 + |p|_inf).
 constexpr float kRayOffsetScale = 5e-5f;
 
+/// p_W moved off its surface along the unit normal n_W (to the side n_W points to) by
+/// kRayOffsetScale (1 + |p_W|_inf): the origin of rays leaving that side.
+inline Eigen::Vector3f OffsetRayOrigin(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W) {
+  return p_W + (kRayOffsetScale * (1.0f + p_W.cwiseAbs().maxCoeff())) * n_W;
+}
+
 /// a ray leaving `hit` in direction `d` (world), its origin pushed off the surface along the
 /// geometric normal on the side `d` goes to, so that it does not hit the surface it starts on.
 Ray SpawnRay(const SurfaceHit& hit, const Eigen::Vector3f& d);

@@ -90,9 +90,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       bsdf.Set(k, coef, h.ns_W, h.ng_W, wo);
       const Eigen::Vector3f n_s = bsdf.n.Lane(k);
       p.Set(k, h.p_W);
-      // shadow rays start off the surface on the lit side (lights behind it contribute 0), as
-      // SpawnRay.
-      origin.Set(k, h.p_W + (kRayOffsetScale * (1.0f + h.p_W.cwiseAbs().maxCoeff())) * h.ng_W);
+      // shadow rays start off the surface on the lit side (lights behind it contribute 0).
+      origin.Set(k, OffsetRayOrigin(h.p_W, h.ng_W));
 
       // emission and unoccluded sky ambient.
       const Eigen::Vector3f spec =
