@@ -170,6 +170,28 @@ TEST(QuadrupedTrot, SurvivesTwentyNewtonSecondLateralPush) {
   EXPECT_LT(std::abs(Yaw(X)), 10 * M_PI / 180);
 }
 
+// the programmatic command source (for the middleware) overrides the script until cleared.
+TEST(QuadrupedTrot, SetCommandOverridesTheScript) {
+  Rig rig = MakeRig("quadruped", Ground::kFlat, Config("[{t: 0, vx: 0}]"));
+  const Eigen::Vector3d p0 = Trunk(rig).translation();
+  RunUntil(&rig, 0.5);
+  rig.gait->SetCommand({0.0, -0.3, 0.0});  // sideways to the right
+  RunUntil(&rig, 3.5);
+  EXPECT_EQ(rig.gait->command().vy, -0.3);
+  const Eigen::Vector3d p1 = Trunk(rig).translation();
+  std::printf("[ measured ] SetCommand vy = -0.3 m/s for 3 s: dy = %.3f m, dx = %.3f m\n",
+              p1.y() - p0.y(), p1.x() - p0.x());
+  EXPECT_NEAR(p1.y() - p0.y(), -0.9, 0.15);
+  EXPECT_LT(std::abs(p1.x() - p0.x()), 0.1);
+  rig.gait->ClearCommand();  // back to the script: stand (trot in place)
+  RunUntil(&rig, 4.5);
+  EXPECT_EQ(rig.gait->command().vy, 0.0);
+  const Eigen::Vector3d p2 = Trunk(rig).translation();
+  RunUntil(&rig, 5.0);
+  EXPECT_LT((Trunk(rig).translation() - p2).head<2>().norm(), 0.025);
+  EXPECT_EQ(rig.probe->max_trunk_touch_n, 0.0);
+}
+
 // two runs of the same world are bit-identical at every step.
 TEST(QuadrupedTrot, TwoRunsAreBitIdentical) {
   const std::string cfg = Config("[{t: 0, vx: 0.4, vy: 0.1, yaw_rate: 0.3}, {t: 1.5, vx: -0.2}]");

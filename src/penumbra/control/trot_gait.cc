@@ -397,6 +397,7 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
   }
   double reach = 0;
   for (const auto& g : geometry_) reach += (g.thigh_m + g.calf_m) / 4;
+  leg_length_ = reach;
   step_limit_ = params_.max_step_m.value_or(0.4 * reach);
   limits_.mu = params_.friction;
   limits_.min_normal_n = 0.01 * mass_ * kGravity;
@@ -512,7 +513,8 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   auto ground_z = [&](double x, double y) { return plane_[0] + plane_[1] * x + plane_[2] * y; };
   const Eigen::Vector3d normal = Eigen::Vector3d(-plane_[1], -plane_[2], 1).normalized();
   const double h = com.z() - ground_z(com.x(), com.y());
-  if (h_ref_ <= 0) h_ref_ = params_.body_height_m.value_or(h);
+  // a robot that starts crouched or lying still gets a sensible target
+  if (h_ref_ <= 0) h_ref_ = params_.body_height_m.value_or(std::max(h, 0.3 * leg_length_));
   if (k_raibert_ <= 0) k_raibert_ = params_.raibert_gain.value_or(std::sqrt(h_ref_ / kGravity));
 
   // 3. stance: desired wrench on the COM, distributed over the stance feet

@@ -20,8 +20,9 @@
 //     period_sec: 0.36               # gait cycle (> 0, default 0.36)
 //     duty: 0.5                      # stance fraction of the cycle (0.3 .. 0.8, default 0.5)
 //     swing_height_m: 0.08           # apex of the foot above the line lift-off -> touch-down
-//     body_height_m: 0.28            # COM above the plane of the stance feet's centres
-//                                    # (default: the height at the first update)
+//     body_height_m: 0.25            # COM above the plane of the stance feet's centres
+//                                    # (default: the height at the first update, at least
+//                                    # 0.3 (l2 + l3))
 //     raibert_gain: 0.17             # k of the velocity feedback (s; default sqrt(h / g))
 //     max_step_m: 0.17               # |touch-down - nominal| limit (default 0.4 (l2 + l3))
 //     max_accel_m_s2: 1.5            # command slew limits (defaults 1.5 and 3)
@@ -78,7 +79,9 @@
 //      twist until touch-down, |p_td - p_hip(t_td)| <= max_step_m, on the ground plane;
 //      the foot follows a cycloid (control/quadruped_swing_trajectory.h) from its lift-off
 //      point, tracked by joint PD on the analytic IK of the target, with the desired joint
-//      velocity from the analytic leg Jacobian.
+//      velocity from the analytic leg Jacobian, plus MuJoCo's bias forces qfrc_bias
+//      (gravity and velocity products) of the leg's joints as feed-forward:
+//        tau = swing_kp (q_des - q) + swing_kd (qd_des - qd) + qfrc_bias.
 //   5. torques are clamped to the actuators' ctrl ranges (ctrl = torque / gear).
 // sources for the whole scheme: the MIT Cheetah 3 balance controller (G. Bledt et al.,
 // IROS 2018) and its convex-MPC successor (J. Di Carlo et al., IROS 2018), of which this is
@@ -86,7 +89,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -219,6 +221,7 @@ class TrotGait final : public Controller {
   Eigen::Matrix3d inertia_B_ = Eigen::Matrix3d::Identity();  ///< about the COM, base axes
   std::vector<std::pair<int, double>> hold_;                 ///< actuator index, ctrl
   StanceForceLimits limits_;
+  double leg_length_ = 0.426;  ///< mean thigh + calf length (m)
   double step_limit_ = 0.17;
 
   std::optional<TrotCommand> override_;
