@@ -9,6 +9,7 @@
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
+#include "penumbra/physics/controller_cost_benchmark.h"
 #include "penumbra/physics/physics_benchmark.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
@@ -118,6 +119,40 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
   fmt::print("penumbra Simulation::Step: {:.0f} steps/s\n", r.penumbra_steps_per_sec);
   fmt::print("bare mj_step loop:         {:.0f} steps/s\n", r.bare_steps_per_sec);
   fmt::print("ratio: {:.3f} (target >= 0.95)\n", r.ratio);
+
+  // controller cost on every bundled world with controllers
+  if (options.controllers) {
+    fmt::print("\ncontroller cost: steps/s with the world's controllers vs the same episode\n"
+               "replayed from its recorded ctrl without them (thread CPU time; target >= 0.9)\n");
+    const std::filesystem::path worlds = std::filesystem::path(DefaultWorldPath()).parent_path();
+    for (const char* name : {"default", "rover", "quadruped", "quadruped_arm", "quadrotor", "arm"}) {
+      const std::filesystem::path file = worlds / (std::string(name) + ".yaml");
+      if (!std::filesystem::exists(file)) continue;
+      const WorldConfig world = LoadWorldFile(file.string());
+      std::string composed_path;
+      double timestep = 0;
+      {
+        Simulation probe = LoadWorld(world, &composed_path);
+        if (probe.num_controllers() == 0) continue;
+        timestep = probe.timestep();
+      }
+      const int64_t steps = std::max<int64_t>(1, std::llround(options.controller_seconds / timestep));
+      const ControllerCostResult c = BenchmarkControllerCost(
+          composed_path,
+          [&](Simulation& sim) {
+            for (const ModelConfig& m : world.models)
+              if (m.is_robot && !m.controller.type.empty())
+                sim.AddController(MakeController(m.controller, m.name, world.file));
+          },
+          steps);
+      std::string types;
+      for (const ModelConfig& m : world.models)
+        if (m.is_robot && !m.controller.type.empty()) types += (types.empty() ? "" : ", ") + m.controller.type;
+      fmt::print("  {:<14} {:<20} {:>9.0f} vs {:>9.0f} steps/s  ratio {:.3f}{}\n", name, types,
+                 c.controlled_steps_per_sec, c.replay_steps_per_sec, c.ratio,
+                 c.replay_identical ? "" : "  (replay diverges from the controlled run: controller slower than physics rate)");
+    }
+  }
   return 0;
 }
 

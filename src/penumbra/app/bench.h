@@ -24,6 +24,8 @@ struct PhysicsBenchOptions {
   std::string world_file;  ///< world whose composed model is stepped (default world)
   std::string model_file;  ///< or a bare MJCF file
   double sim_seconds = 20;
+  bool controllers = true;         ///< also report controller cost on the bundled robot worlds
+  double controller_seconds = 10;  ///< simulated seconds per controller-cost episode
 };
 
 /// prints Penumbra's physics steps/s against a bare mj_step loop on the same model. returns 0.

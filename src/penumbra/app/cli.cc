@@ -68,6 +68,8 @@ int RunCli(int argc, char** argv) {
   bench_physics->add_option("--world", physics_bench.world_file, "world file (default: bundled default world)");
   bench_physics->add_option("--model", physics_bench.model_file, "bare MJCF model instead of a world");
   bench_physics->add_option("--seconds", physics_bench.sim_seconds, "simulated seconds per side")->check(CLI::PositiveNumber);
+  bool no_controllers = false;
+  bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
 
   CLI11_PARSE(app, argc, argv);
 
@@ -90,7 +92,10 @@ int RunCli(int argc, char** argv) {
       return 0;
     }
     if (*bench_render) return BenchRender(render_bench);
-    if (*bench_physics) return BenchPhysics(physics_bench);
+    if (*bench_physics) {
+      physics_bench.controllers = !no_controllers;
+      return BenchPhysics(physics_bench);
+    }
   } catch (const ConfigError& e) {
     spdlog::error("{}", e.what());
     return 2;
