@@ -13,36 +13,13 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
-#include <time.h>
 
-#include <algorithm>
-#include <cstdlib>
-#include <cstring>
-#include <filesystem>
-#include <stdexcept>
 #include <string>
-#include <vector>
 
-#include "penumbra/control/controller_factory.h"
-#include "penumbra/physics/simulation.h"
+#include "controller_cost_harness.h"
 
 namespace penumbra {
 namespace {
-
-std::string ModelsDir() {
-  if (const char* env = std::getenv("PENUMBRA_MODELS_DIR")) return env;
-  std::filesystem::path p = std::filesystem::canonical("/proc/self/exe").parent_path();
-  for (; !p.empty() && p != p.parent_path(); p = p.parent_path())
-    if (std::filesystem::exists(p / "worlds/models/table_scene.xml"))
-      return (p / "worlds/models").string();
-  throw std::runtime_error("worlds/models not found; set PENUMBRA_MODELS_DIR");
-}
-
-double ThreadCpuSec() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 // the Panda-class arm's servo block (as in worlds/arm.yaml)
 const char* kServo =
@@ -73,58 +50,10 @@ const char* kKeyframes =
 
 void BM_ArmControllerCost(benchmark::State& state, const std::string& type,
                           const std::string& block) {
-  constexpr int kSteps = 3000;
-  const std::string xml = ModelsDir() + "/table_scene.xml";
-  const ControllerConfig cfg{type, std::string(kServo) + block, 0};
-  auto controlled = [&]() {
-    Simulation sim = Simulation::LoadFromFile(xml);
-    sim.AddController(MakeController(cfg, "", "bench"));
-    return sim;
-  };
-  // the episode's ctrl, recorded once (the runs are deterministic)
-  std::vector<double> log;
-  {
-    Simulation sim = controlled();
-    for (int i = 0; i < kSteps; ++i) {
-      sim.Step();
-      log.insert(log.end(), sim.ctrl().begin(), sim.ctrl().end());
-    }
-  }
-  double t_ctrl = 0, t_replay = 0;
-  int64_t episodes = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    Simulation a = controlled();
-    Simulation b = Simulation::LoadFromFile(xml);
-    const size_t nu = b.ctrl().size();
-    state.ResumeTiming();
-    auto run_a = [&] {
-      const double t0 = ThreadCpuSec();
-      for (int i = 0; i < kSteps; ++i) a.Step();
-      t_ctrl += ThreadCpuSec() - t0;
-    };
-    auto run_b = [&] {
-      const double t0 = ThreadCpuSec();
-      for (int i = 0; i < kSteps; ++i) {
-        std::copy(log.begin() + i * nu, log.begin() + (i + 1) * nu, b.ctrl().begin());
-        b.Step();
-      }
-      t_replay += ThreadCpuSec() - t0;
-    };
-    if (episodes % 2 == 0) {
-      run_a();
-      run_b();
-    } else {
-      run_b();
-      run_a();
-    }
-    if (std::memcmp(a.qpos().data(), b.qpos().data(), a.qpos().size() * sizeof(double)) != 0)
-      state.SkipWithError("replay diverged from the controlled run");
-    ++episodes;
-  }
-  state.counters["controlled_steps_per_s"] = static_cast<double>(episodes * kSteps) / t_ctrl;
-  state.counters["replay_steps_per_s"] = static_cast<double>(episodes * kSteps) / t_replay;
-  state.counters["ratio"] = t_replay / t_ctrl;
+  const std::string xml = bench::ModelsDir("table_scene.xml") + "/table_scene.xml";
+  bench::MeasureControllerCost(state, {.steps = 3000,
+                                       .load = [&] { return Simulation::LoadFromFile(xml); },
+                                       .controller = {type, std::string(kServo) + block, 0}});
 }
 
 BENCHMARK_CAPTURE(BM_ArmControllerCost, diff_ik, std::string("diff_ik"), std::string(kDiffIk))

@@ -11,39 +11,18 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
-#include <time.h>
 
-#include <algorithm>
-#include <cstdlib>
-#include <filesystem>
-#include <stdexcept>
+#include <optional>
 #include <string>
-#include <vector>
 
-#include "penumbra/control/controller_factory.h"
-#include "penumbra/physics/simulation.h"
+#include "controller_cost_harness.h"
 
 namespace penumbra {
 namespace {
 
-std::string QuadrotorModelsDir() {
-  if (const char* env = std::getenv("PENUMBRA_MODELS_DIR")) return env;
-  std::filesystem::path p = std::filesystem::canonical("/proc/self/exe").parent_path();
-  for (; !p.empty() && p != p.parent_path(); p = p.parent_path())
-    if (std::filesystem::exists(p / "worlds/models/quadrotor.xml"))
-      return (p / "worlds/models").string();
-  throw std::runtime_error("worlds/models not found; set PENUMBRA_MODELS_DIR");
-}
-
-double QuadrotorThreadCpuSec() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 void BM_MultirotorPidCost(benchmark::State& state) {
   constexpr int kSteps = 5000;  // 10 s: takeoff, then the first two and a half sides
-  const std::string dir = QuadrotorModelsDir();
+  const std::string dir = bench::ModelsDir("quadrotor.xml");
   const std::string xml =
       "<mujoco><worldbody><geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\"/></worldbody>"
       "<include file=\"quadrotor.xml\"/></mujoco>";
@@ -56,55 +35,10 @@ void BM_MultirotorPidCost(benchmark::State& state) {
       "  - {t: 3, mode: waypoints, speed_m_s: 1.0,\n"
       "     waypoints: [[4, 0, 1.5], [4, 4, 1.5], [0, 4, 1.5], [0, 0, 1.5]]}\n",
       0};
-  auto controlled = [&]() {
-    Simulation sim = Simulation::LoadFromString(xml, std::nullopt, dir);
-    sim.AddController(MakeController(cfg, "", "bench"));
-    return sim;
-  };
-  // the episode's ctrl, recorded once (the runs are deterministic)
-  std::vector<double> log;
-  {
-    Simulation sim = controlled();
-    for (int i = 0; i < kSteps; ++i) {
-      sim.Step();
-      log.insert(log.end(), sim.ctrl().begin(), sim.ctrl().end());
-    }
-  }
-  double t_ctrl = 0, t_replay = 0;
-  int64_t episodes = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    Simulation a = controlled();
-    Simulation b = Simulation::LoadFromString(xml, std::nullopt, dir);
-    const size_t nu = b.ctrl().size();
-    state.ResumeTiming();
-    auto run_a = [&] {
-      const double t0 = QuadrotorThreadCpuSec();
-      for (int i = 0; i < kSteps; ++i) a.Step();
-      t_ctrl += QuadrotorThreadCpuSec() - t0;
-    };
-    auto run_b = [&] {
-      const double t0 = QuadrotorThreadCpuSec();
-      for (int i = 0; i < kSteps; ++i) {
-        std::copy(log.begin() + i * nu, log.begin() + (i + 1) * nu, b.ctrl().begin());
-        b.Step();
-      }
-      t_replay += QuadrotorThreadCpuSec() - t0;
-    };
-    if (episodes % 2 == 0) {
-      run_a();
-      run_b();
-    } else {
-      run_b();
-      run_a();
-    }
-    if (!std::equal(a.qpos().begin(), a.qpos().end(), b.qpos().begin()))
-      state.SkipWithError("replay diverged from the controlled run");
-    ++episodes;
-  }
-  state.counters["controlled_steps_per_s"] = static_cast<double>(episodes * kSteps) / t_ctrl;
-  state.counters["replay_steps_per_s"] = static_cast<double>(episodes * kSteps) / t_replay;
-  state.counters["ratio"] = t_replay / t_ctrl;
+  bench::MeasureControllerCost(
+      state, {.steps = kSteps,
+              .load = [&] { return Simulation::LoadFromString(xml, std::nullopt, dir); },
+              .controller = cfg});
 }
 
 BENCHMARK(BM_MultirotorPidCost)->Unit(benchmark::kMillisecond)->MinTime(3.0);
