@@ -2,35 +2,17 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cmath>
-#include <sstream>
-
+#include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 
 struct ControllerParams::Impl {
   YAML::Node root;
-  std::vector<std::pair<std::string, YAML::Node>> entries;  // in file order
+  ParamMapping keys;
 };
 
-namespace {
-
-std::string Repr(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence())
-    return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-std::string FormatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-}  // namespace
+using param::Repr;
 
 ControllerParams::ControllerParams(const std::string& params_yaml, ControllerContext context)
     : context_(std::move(context)), impl_(std::make_unique<Impl>()) {
@@ -45,8 +27,8 @@ ControllerParams::ControllerParams(const std::string& params_yaml, ControllerCon
     throw ConfigError(context_.file, context_.line, context_.key,
                       "got " + Repr(impl_->root) + "; expected a mapping of controller parameters");
   }
-  known_.insert("type");
-  for (const auto& kv : impl_->root) impl_->entries.emplace_back(kv.first.Scalar(), kv.second);
+  impl_->keys.MarkKnown("type");
+  impl_->keys.Load(impl_->root);
 }
 
 ControllerParams::~ControllerParams() = default;
@@ -56,47 +38,22 @@ void ControllerParams::Fail(const std::string& key, const std::string& problem) 
                     context_.key.empty() ? key : context_.key + "." + key, problem);
 }
 
-bool ControllerParams::Has(const std::string& key) const {
-  for (const auto& e : impl_->entries)
-    if (e.first == key) return true;
-  return false;
-}
+bool ControllerParams::Has(const std::string& key) const { return impl_->keys.Has(key); }
 
-const YAML::Node* ControllerParams::Get(const std::string& key) {
-  known_.insert(key);
-  for (const auto& e : impl_->entries)
-    if (e.first == key) return &e.second;
-  return nullptr;
-}
+const YAML::Node* ControllerParams::Get(const std::string& key) { return impl_->keys.Get(key); }
 
 std::string ControllerParams::String(const std::string& key) {
   const YAML::Node* n = Get(key);
-  if (!n) Fail(key, "missing; expected a name");
-  if (!n->IsScalar() || n->Scalar().empty()) Fail(key, "got " + Repr(*n) + "; expected a name");
+  if (const auto problem = param::NameProblem(n)) Fail(key, *problem);
   return n->Scalar();
 }
 
 double ControllerParams::Number(const std::string& key, std::optional<double> fallback, double min,
                                 double max, bool min_exclusive) {
-  const std::string range = std::string(min_exclusive ? "> " : ">= ") + FormatNumber(min) +
-                            (std::isinf(max) ? "" : " and <= " + FormatNumber(max));
-  const YAML::Node* n = Get(key);
-  if (!n) {
-    if (fallback) return *fallback;
-    Fail(key, "missing; expected a number " + range);
-  }
-  double v = 0;
-  bool ok = n->IsScalar();
-  if (ok) {
-    try {
-      v = n->as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v)) Fail(key, "got " + Repr(*n) + "; expected a number " + range);
-  if (v < min || (min_exclusive && v == min) || v > max)
-    Fail(key, "got " + FormatNumber(v) + "; expected a number " + range);
+  std::string problem;
+  const double v = param::ReadNumber(Get(key), fallback, min, max, min_exclusive,
+                                     param::RangeText(min, max, min_exclusive), &problem);
+  if (!problem.empty()) Fail(key, problem);
   return v;
 }
 
@@ -125,15 +82,7 @@ std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, s
     if (!p.IsSequence() || p.size() != 2) Fail(item_key, "got " + Repr(p) + "; expected [x, y]");
     Eigen::Vector2d v;
     for (int k = 0; k < 2; ++k) {
-      bool ok = p[k].IsScalar();
-      if (ok) {
-        try {
-          v[k] = p[k].as<double>();
-        } catch (const YAML::Exception&) {
-          ok = false;
-        }
-      }
-      if (!ok || !std::isfinite(v[k]))
+      if (!param::ToNumber(p[k], &v[k]))
         Fail(item_key, "got " + Repr(p[k]) + " as coordinate " + std::to_string(k) +
                            "; expected a finite number (m)");
     }
@@ -145,16 +94,7 @@ std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, s
 }
 
 void ControllerParams::CheckNoUnknownKeys() const {
-  std::string first, unknown;
-  for (const auto& e : impl_->entries) {
-    if (known_.count(e.first)) continue;
-    if (first.empty()) first = e.first;
-    unknown += (unknown.empty() ? "'" : ", '") + e.first + "'";
-  }
-  if (unknown.empty()) return;
-  std::string allowed;
-  for (const auto& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
-  Fail(first, "unknown key(s) " + unknown + "; expected only: " + allowed);
+  if (const auto unknown = impl_->keys.UnknownKeys()) Fail(unknown->first, unknown->second);
 }
 
 }  // namespace penumbra

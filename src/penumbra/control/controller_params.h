@@ -7,7 +7,6 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -60,7 +59,6 @@ class ControllerParams {
   ControllerContext context_;
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  std::set<std::string> known_;
 };
 
 }  // namespace penumbra

@@ -3,48 +3,26 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <sstream>
 
+#include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 
 struct ParamNode::Impl {
   YAML::Node node;
-  std::vector<std::pair<std::string, YAML::Node>> entries;  // in file order
+  ParamMapping keys;
 };
 
 namespace {
 
-std::string Repr(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence())
-    return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
+using param::Repr;
+using param::ToNumber;
 
-std::string FormatNumber(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
+// as param::RangeText, but "finite" when both bounds are infinite
 std::string RangeText(double min, double max, bool min_exclusive) {
-  std::string s = (min_exclusive ? "> " : ">= ") + FormatNumber(min);
-  if (!std::isinf(max)) s += " and <= " + FormatNumber(max);
-  if (std::isinf(min) && std::isinf(max)) s = "finite";
-  return s;
-}
-
-bool ToNumber(const YAML::Node& n, double* v) {
-  if (!n.IsScalar()) return false;
-  try {
-    *v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-  return std::isfinite(*v);
+  if (std::isinf(min) && std::isinf(max)) return "finite";
+  return param::RangeText(min, max, min_exclusive);
 }
 
 [[noreturn]] void FailAt(const ControllerContext& c, const std::string& key,
@@ -57,8 +35,7 @@ bool ToNumber(const YAML::Node& n, double* v) {
 ParamNode::ParamNode(const YAML::Node& node, std::string path, ControllerContext context)
     : impl_(std::make_unique<Impl>()), path_(std::move(path)), context_(std::move(context)) {
   impl_->node = node;
-  if (node.IsMap())
-    for (const auto& kv : node) impl_->entries.emplace_back(kv.first.Scalar(), kv.second);
+  impl_->keys.Load(node);
 }
 
 ParamNode::~ParamNode() = default;
@@ -74,18 +51,11 @@ void ParamNode::Fail(const std::string& key, const std::string& problem) const {
 
 void ParamNode::FailHere(const std::string& problem) const { FailAt(context_, path_, problem); }
 
-bool ParamNode::Has(const std::string& key) const {
-  for (const auto& e : impl_->entries)
-    if (e.first == key) return true;
-  return false;
-}
+bool ParamNode::Has(const std::string& key) const { return impl_->keys.Has(key); }
 
 const YAML::Node* ParamNode::Get(const std::string& key) {
   if (!impl_->node.IsMap()) FailHere("got " + Repr(impl_->node) + "; expected a mapping");
-  known_.insert(key);
-  for (const auto& e : impl_->entries)
-    if (e.first == key) return &e.second;
-  return nullptr;
+  return impl_->keys.Get(key);
 }
 
 const YAML::Node* ParamNode::Raw(const std::string& key) { return Get(key); }
@@ -93,14 +63,10 @@ const YAML::Node* ParamNode::Raw(const std::string& key) { return Get(key); }
 double ParamNode::Number(const std::string& key, std::optional<double> fallback, double min,
                          double max) {
   const YAML::Node* n = Get(key);
-  const std::string range = RangeText(min, max, false);
-  if (!n) {
-    if (fallback) return *fallback;
-    Fail(key, "missing; expected a number " + range);
-  }
-  double v = 0;
-  if (!ToNumber(*n, &v)) Fail(key, "got " + Repr(*n) + "; expected a number " + range);
-  if (v < min || v > max) Fail(key, "got " + FormatNumber(v) + "; expected a number " + range);
+  std::string problem;
+  const double v =
+      param::ReadNumber(n, fallback, min, max, false, RangeText(min, max, false), &problem);
+  if (!problem.empty()) Fail(key, problem);
   return v;
 }
 
@@ -123,8 +89,7 @@ std::vector<double> ParamNode::Numbers(const std::string& key, size_t count, dou
 
 std::string ParamNode::String(const std::string& key) {
   const YAML::Node* n = Get(key);
-  if (!n) Fail(key, "missing; expected a name");
-  if (!n->IsScalar() || n->Scalar().empty()) Fail(key, "got " + Repr(*n) + "; expected a name");
+  if (const auto problem = param::NameProblem(n)) Fail(key, *problem);
   return n->Scalar();
 }
 
@@ -136,16 +101,7 @@ ParamNode ParamNode::Child(const std::string& key) {
 }
 
 void ParamNode::CheckNoUnknownKeys() const {
-  std::string first, unknown;
-  for (const auto& e : impl_->entries) {
-    if (known_.count(e.first)) continue;
-    if (first.empty()) first = e.first;
-    unknown += (unknown.empty() ? "'" : ", '") + e.first + "'";
-  }
-  if (unknown.empty()) return;
-  std::string allowed;
-  for (const auto& k : known_) allowed += (allowed.empty() ? "" : ", ") + k;
-  Fail(first, "unknown key(s) " + unknown + "; expected only: " + allowed);
+  if (const auto unknown = impl_->keys.UnknownKeys()) Fail(unknown->first, unknown->second);
 }
 
 std::vector<std::string> ReadNameList(ControllerParams& params, const std::string& key,

@@ -7,7 +7,6 @@
 
 #include <memory>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -66,7 +65,6 @@ class ParamNode {
   std::unique_ptr<Impl> impl_;
   std::string path_;
   ControllerContext context_;
-  std::set<std::string> known_;
 };
 
 /// `key`: a list of at least `min_count` distinct non-empty names, each given `prefix`
