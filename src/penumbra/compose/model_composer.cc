@@ -27,16 +27,6 @@ const std::vector<std::string>& CarriedCompilerAttrs() {
   return attrs;
 }
 
-void SetAttr(AttrList* list, const std::string& name, const std::string& value) {
-  for (auto& [n, v] : *list) {
-    if (n == name) {
-      v = value;
-      return;
-    }
-  }
-  list->emplace_back(name, value);
-}
-
 // calls f(elem, spec) for every element below `section_elem`, parents before children
 void VisitSection(const MjcfSource& src, const std::string& section, XMLElement* section_elem,
                   const std::function<void(XMLElement*, const ElementSpec&)>& f) {
@@ -76,6 +66,23 @@ int CountTokens(const char* text) {
 }
 
 }  // namespace
+
+void SetAttr(AttrList* list, const std::string& name, const std::string& value) {
+  for (auto& [n, v] : *list) {
+    if (n == name) {
+      v = value;
+      return;
+    }
+  }
+  list->emplace_back(name, value);
+}
+
+const std::string* FindAttr(const AttrList& list, const std::string& name) {
+  for (const auto& [n, v] : list) {
+    if (n == name) return &v;
+  }
+  return nullptr;
+}
 
 ModelComposer::ModelComposer(const ModelConfig& config,
                              const std::function<std::string(const std::string&)>& urdf_to_mjcf)

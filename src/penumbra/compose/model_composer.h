@@ -28,6 +28,12 @@ namespace penumbra::compose {
 /// ordered attribute list (name, value).
 using AttrList = std::vector<std::pair<std::string, std::string>>;
 
+/// sets `name` to `value` in place when present, else appends it (keeps first-seen order).
+void SetAttr(AttrList* list, const std::string& name, const std::string& value);
+
+/// the value of `name` in `list`, or nullptr when absent.
+const std::string* FindAttr(const AttrList& list, const std::string& name);
+
 /// the merged <compiler> settings of one model.
 struct CompilerInfo {
   bool degree = true;  ///< angle="degree" (MJCF default)

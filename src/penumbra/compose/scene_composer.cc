@@ -15,9 +15,11 @@ namespace penumbra {
 namespace {
 
 using compose::AttrList;
+using compose::FindAttr;
 using compose::FormatNumbers;
 using compose::ModelComposer;
 using compose::ParseNumbers;
+using compose::SetAttr;
 using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
@@ -37,23 +39,6 @@ const AttrList& CompilerDefaults() {
 // MuJoCo 2.2.2 default sizes (measured: mj_loadXML of a model without <size>)
 constexpr int kDefaultNjmax = 500;
 constexpr int kDefaultNconmax = 100;
-
-const std::string* FindAttr(const AttrList& list, const std::string& name) {
-  for (const auto& [n, v] : list) {
-    if (n == name) return &v;
-  }
-  return nullptr;
-}
-
-void SetAttr(AttrList* list, const std::string& name, const std::string& value) {
-  for (auto& [n, v] : *list) {
-    if (n == name) {
-      v = value;
-      return;
-    }
-  }
-  list->emplace_back(name, value);
-}
 
 // equal as numbers when both read as numbers, else as text
 bool SameValue(const std::string& a, const std::string& b) {
