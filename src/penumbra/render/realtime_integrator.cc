@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
@@ -11,6 +12,7 @@ namespace penumbra {
 namespace {
 
 constexpr float kInvPi = 0.318309886183790671538f;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 inline Lanes LuminanceLanes(const Vec3Lanes& c) {
   return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
@@ -28,6 +30,41 @@ inline Eigen::Vector3f EnvBrdfApprox(const Eigen::Vector3f& f0, float n_v, float
   return (f0 * a + Eigen::Vector3f::Constant(b)).cwiseMax(0.0f).cwiseMin(1.0f);
 }
 
+// key of the frame's interleaved-sampling pattern (HashKeys(frame key, kSkyPatternKey)).
+constexpr uint64_t kSkyPatternKey = 0x5c1e5ca1ab1eull;
+// the plane-distance tolerance of the sky filter, in pixel footprints.
+constexpr float kPlaneTolerancePixels = 2.0f;
+
+// an orthonormal basis (t, b, n) around unit n without branches on a threshold (Duff et al.,
+// "Building an orthonormal basis, revisited", JCGT 2017).
+inline void Basis(const Eigen::Vector3f& n, Eigen::Vector3f* t, Eigen::Vector3f* b) {
+  const float sign = std::copysign(1.0f, n.z());
+  const float a = -1.0f / (sign + n.z());
+  const float c = n.x() * n.y() * a;
+  *t = {1.0f + sign * n.x() * n.x() * a, sign * c, -sign * n.x()};
+  *b = {c, sign + n.y() * n.y() * a, -n.y()};
+}
+
+// interleaved sampling over kSkyBlock x kSkyBlock pixel blocks: kSkyBlock^2 strata.
+constexpr int kSkyBlock = 8;
+// the sky filter: a tent of 2 kSkyRadius + 1 taps per axis, weight kSkyBlock - |offset|, so
+// that every residue mod kSkyBlock (every stratum column / row) gets the same total weight.
+constexpr int kSkyRadius = kSkyBlock - 1;
+constexpr float TapWeight(int k) {
+  return static_cast<float>(kSkyBlock - (k < kSkyRadius ? kSkyRadius - k : k - kSkyRadius));
+}
+
+// geometry weight of tap j for centre i: (n_i . n_j)^4 times a tent in the distance of p_j
+// from the tangent plane of p_i; 0 for taps without a surface.
+inline float GeometryWeight(const RealtimeIntegrator::SkyTap& i,
+                            const RealtimeIntegrator::SkyTap& j) {
+  if (!(j.tol > 0)) return 0.0f;
+  const float c = std::max(i.n.dot(j.n), 0.0f);
+  const float c2 = c * c;
+  const float dist = std::abs(i.n.dot(j.p - i.p));
+  return c2 * c2 * std::max(1.0f - dist / i.tol, 0.0f);
+}
+
 // per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
   std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
@@ -36,6 +73,61 @@ struct Scratch {
 };
 
 }  // namespace
+
+void RealtimeIntegrator::BeginFrame(const FrameContext& ctx) {
+  width_ = ctx.camera->width();
+  height_ = ctx.camera->height();
+  const size_t n = static_cast<size_t>(width_) * height_;
+  if (taps_.size() != n) {
+    taps_.assign(n, SkyTap());
+    rows_.assign(n, Eigen::Vector2f::Zero());
+  }
+}
+
+void RealtimeIntegrator::EndFrame(const FrameContext& ctx, const FrameBuffers& out,
+                                  ThreadPool* pool) {
+  (void)ctx;
+  const int W = width_, H = height_;
+  // horizontal pass: rows_ = sum over the row's taps, weighted for the centre's geometry.
+  pool->ParallelFor(H, [&](int64_t vv) {
+    const int v = static_cast<int>(vv);
+    const SkyTap* row = taps_.data() + static_cast<size_t>(v) * W;
+    Eigen::Vector2f* dst = rows_.data() + static_cast<size_t>(v) * W;
+    for (int u = 0; u < W; ++u) {
+      const SkyTap& c = row[u];
+      if (!(c.tol > 0)) continue;
+      float num = 0, den = 0;
+      for (int k = 0; k <= 2 * kSkyRadius; ++k) {
+        const int x = u + k - kSkyRadius;
+        if (x < 0 || x >= W) continue;
+        const float w = TapWeight(k) * GeometryWeight(c, row[x]);
+        num += w * row[x].num;
+        den += w * row[x].den;
+      }
+      dst[u] = {num, den};
+    }
+  });
+  // vertical pass: the ratio of the column sums, times the unoccluded sky ambient.
+  pool->ParallelFor(H, [&](int64_t vv) {
+    const int v = static_cast<int>(vv);
+    for (int u = 0; u < W; ++u) {
+      const SkyTap& c = taps_[static_cast<size_t>(v) * W + u];
+      if (!(c.tol > 0) || c.weight == Eigen::Vector3f::Zero()) continue;
+      float num = 0, den = 0;
+      for (int k = 0; k <= 2 * kSkyRadius; ++k) {
+        const int y = v + k - kSkyRadius;
+        if (y < 0 || y >= H) continue;
+        const size_t j = static_cast<size_t>(y) * W + u;
+        const float w = TapWeight(k) * GeometryWeight(c, taps_[j]);
+        num += w * rows_[j].x();
+        den += w * rows_[j].y();
+      }
+      const float vis = den > 0 ? std::min(num / den, 1.0f) : 0.0f;
+      float* L = out.radiance->at(u, v);
+      L[0] += c.weight.x() * vis, L[1] += c.weight.y() * vis, L[2] += c.weight.z() * vis;
+    }
+  });
+}
 
 int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
                                        const FrameBuffers& out) const {
@@ -50,6 +142,13 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   int64_t traced = 0;
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
+  // the frame's interleaved-sampling pattern: a permutation of the strata (xor with a key)
+  // and a toroidal shift of the grid.
+  constexpr int kStrata = kSkyBlock * kSkyBlock;
+  Rng pattern_rng(HashKeys(frame_key, kSkyPatternKey));
+  const int stratum_xor = static_cast<int>(pattern_rng.Uniform() * kStrata) & (kStrata - 1);
+  const float shift1 = pattern_rng.Uniform(), shift2 = pattern_rng.Uniform();
+  const float inv_fx = 1.0f / static_cast<float>(ctx.camera->intrinsics().fx);
 
   // runs of kLanes pixels (a full tile row): per-pixel set-up, then every light for
   // all lanes at once, its shadow rays as one Embree packet.
@@ -57,7 +156,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     const int m = std::min(kLanes, n - i0);
     LaneMask hit = LaneMask::Constant(false);
     BsdfLanes bsdf;
-    Vec3Lanes p, origin, L;
+    Vec3Lanes p, origin, L, sky_dir;
+    LaneMask sky_ray = LaneMask::Constant(false);
     for (int k = 0; k < kLanes; ++k) {
       const int i = i0 + k;
       const bool lane_hit = k < m && primary.did_hit[i];
@@ -72,8 +172,10 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         bsdf.n_v[k] = 1, bsdf.a2[k] = 1;
         bsdf.c_diff.Set(k, Eigen::Vector3f::Zero()), bsdf.f0.Set(k, Eigen::Vector3f::Zero());
         for (int j = 0; j < num_lights; ++j) scratch.u1[j][k] = scratch.u2[j][k] = 0.5f;
+        sky_dir.Set(k, z);
         if (k < m) {
           const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+          taps_[static_cast<size_t>(v) * width + u] = SkyTap();
           const Eigen::Vector3f sky = ctx.sky->Radiance(primary.rays[i].d.normalized());
           float* Lp = out.radiance->at(u, v);
           Lp[0] = sky.x(), Lp[1] = sky.y(), Lp[2] = sky.z();
@@ -98,9 +200,39 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
           EnvBrdfApprox(coef.f0, std::max(bsdf.n_v[k], 0.0f), mat.pbr.roughness);
       const Eigen::Vector3f reflect =
           coef.c_diff.cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-      L.Set(k, mat.emission + (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect));
+      const Eigen::Vector3f sky_weight = (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect);
+      L.Set(k, mat.emission);
 
-      Rng rng(FrameContext::PixelStream(frame_key, static_cast<uint64_t>(v) * width + u, 0));
+      // the sky ray: stratum of the pixel within its 4 x 4 block, jittered, cosine-weighted.
+      const uint64_t pixel = static_cast<uint64_t>(v) * width + u;
+      SkyTap& tap = taps_[pixel];
+      tap.n = n_s;
+      tap.p = h.p_W;
+      tap.tol = kPlaneTolerancePixels * std::max(h.t, 1e-6f) * inv_fx;
+      tap.weight = sky_weight;
+      tap.num = tap.den = 0;
+      sky_dir.Set(k, n_s);
+      if (sky_weight != Eigen::Vector3f::Zero()) {
+        const int stratum = ((u % kSkyBlock) + kSkyBlock * (v % kSkyBlock)) ^ stratum_xor;
+        constexpr float kInvBlock = 1.0f / kSkyBlock;
+        float s1 = (stratum % kSkyBlock) * kInvBlock + shift1;
+        float s2 = (stratum / kSkyBlock) * kInvBlock + shift2;
+        s1 -= std::floor(s1), s2 -= std::floor(s2);
+        float sn, cs;
+        SinCos2Pi(std::min(s2, 0.99999994f), &sn, &cs);
+        const float r = std::sqrt(s1);
+        Eigen::Vector3f t, b;
+        Basis(n_s, &t, &b);
+        const Eigen::Vector3f d =
+            (t * (r * cs) + b * (r * sn) + n_s * std::sqrt(std::max(1.0f - s1, 0.0f))).normalized();
+        tap.den = ctx.sky->LuminanceLookup(d);
+        if (d.dot(h.ng_W) > 0 && tap.den > 0) {
+          sky_dir.Set(k, d);
+          sky_ray[k] = true;
+        }
+      }
+
+      Rng rng(FrameContext::PixelStream(frame_key, pixel, 0));
       for (int j = 0; j < num_lights; ++j) {
         scratch.u1[j][k] = rng.Uniform();
         scratch.u2[j][k] = rng.Uniform();
@@ -116,8 +248,30 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     }
     if (!hit.any()) continue;
 
-    // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+    // the sky rays of the run, as one packet.
+    if (sky_ray.any()) {
+      LaneMask occluded;
+      ctx.scene->OccludedLanes(origin, sky_dir, Lanes::Constant(kInfinity), sky_ray, &occluded);
+      for (int k = 0; k < m; ++k) {
+        if (!sky_ray[k]) continue;
+        ++traced;
+        const int i = i0 + k;
+        SkyTap& tap =
+            taps_[static_cast<size_t>(tile.y0 + i / tile.width) * width + tile.x0 + i % tile.width];
+        if (!occluded[k]) tap.num = tap.den;
+      }
+    }
+
+    // one sample per light; the unshadowed total (with the unoccluded sky) decides which
+    // shadow rays are worth tracing.
     Lanes total = LuminanceLanes(L);
+    for (int k = 0; k < m; ++k) {
+      if (!hit[k]) continue;
+      const int i = i0 + k;
+      const SkyTap& tap =
+          taps_[static_cast<size_t>(tile.y0 + i / tile.width) * width + tile.x0 + i % tile.width];
+      total[k] += 0.2126f * tap.weight.x() + 0.7152f * tap.weight.y() + 0.0722f * tap.weight.z();
+    }
     for (int j = 0; j < num_lights; ++j) {
       LightSampleLanes& s = scratch.samples[j];
       ctx.lights->SampleLanes(j, p, scratch.u1[j], scratch.u2[j], &s);
