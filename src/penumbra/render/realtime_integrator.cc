@@ -54,15 +54,23 @@ constexpr float TapWeight(int k) {
   return static_cast<float>(kSkyBlock - (k < kSkyRadius ? kSkyRadius - k : k - kSkyRadius));
 }
 
-// geometry weight of tap j for centre i: (n_i . n_j)^4 times a tent in the distance of p_j
-// from the tangent plane of p_i; 0 for taps without a surface.
-inline float GeometryWeight(const RealtimeIntegrator::SkyTap& i,
-                            const RealtimeIntegrator::SkyTap& j) {
-  if (!(j.tol > 0)) return 0.0f;
-  const float c = std::max(i.n.dot(j.n), 0.0f);
-  const float c2 = c * c;
-  const float dist = std::abs(i.n.dot(j.p - i.p));
-  return c2 * c2 * std::max(1.0f - dist / i.tol, 0.0f);
+// the sky filter's planes: structure-of-arrays fields of a padded frame (kSkyRadius rows and
+// columns of zeros around it, width rounded up to kLanes), so that the passes run over
+// kLanes pixels at once without bounds checks. a zero normal marks "no surface" (weight 0).
+enum SkyField { kNx, kNy, kNz, kPx, kPy, kPz, kInvTol, kNum, kDen, kHNum, kHDen, kNumFields };
+
+// geometry weights of kLanes taps j for kLanes centres i: (n_i . n_j)^4 (0 if negative) times
+// a tent in the distance of p_j from the tangent plane of p_i, in units of i's tolerance.
+inline Lanes GeometryWeight(const float* const* f, size_t i, size_t j) {
+  using Map = Eigen::Map<const Lanes, Eigen::Unaligned>;
+  const Map nx(f[kNx] + i), ny(f[kNy] + i), nz(f[kNz] + i);
+  const Lanes c = (nx * Map(f[kNx] + j) + ny * Map(f[kNy] + j) + nz * Map(f[kNz] + j)).max(0.0f);
+  const Lanes dist = (nx * (Map(f[kPx] + j) - Map(f[kPx] + i)) +
+                      ny * (Map(f[kPy] + j) - Map(f[kPy] + i)) +
+                      nz * (Map(f[kPz] + j) - Map(f[kPz] + i)))
+                         .abs();
+  const Lanes c2 = c * c;
+  return c2 * c2 * (1.0f - dist * Map(f[kInvTol] + i)).max(0.0f);
 }
 
 // per-thread scratch, sized once per light count and reused across tiles and frames.
@@ -75,56 +83,78 @@ struct Scratch {
 }  // namespace
 
 void RealtimeIntegrator::BeginFrame(const FrameContext& ctx) {
+  if (width_ == ctx.camera->width() && height_ == ctx.camera->height()) return;
   width_ = ctx.camera->width();
   height_ = ctx.camera->height();
-  const size_t n = static_cast<size_t>(width_) * height_;
-  if (taps_.size() != n) {
-    taps_.assign(n, SkyTap());
-    rows_.assign(n, Eigen::Vector2f::Zero());
+  {
+    taps_.assign(static_cast<size_t>(width_) * height_, SkyTap());
+    padded_width_ = (width_ + kLanes - 1) / kLanes * kLanes + 2 * kSkyRadius;
+    padded_size_ = static_cast<size_t>(padded_width_) * (height_ + 2 * kSkyRadius);
+    planes_.assign(kNumFields * padded_size_, 0.0f);
   }
 }
 
 void RealtimeIntegrator::EndFrame(const FrameContext& ctx, const FrameBuffers& out,
                                   ThreadPool* pool) {
   (void)ctx;
-  const int W = width_, H = height_;
-  // horizontal pass: rows_ = sum over the row's taps, weighted for the centre's geometry.
+  const int W = width_, H = height_, PW = padded_width_;
+  const float* f[kNumFields];
+  float* fw[kNumFields];
+  for (int k = 0; k < kNumFields; ++k) f[k] = fw[k] = planes_.data() + k * padded_size_;
+  auto padded = [&](int u, int v) {
+    return static_cast<size_t>(v + kSkyRadius) * PW + static_cast<size_t>(u + kSkyRadius);
+  };
+  // structure-of-arrays copy of the taps (the padding stays zero).
   pool->ParallelFor(H, [&](int64_t vv) {
     const int v = static_cast<int>(vv);
-    const SkyTap* row = taps_.data() + static_cast<size_t>(v) * W;
-    Eigen::Vector2f* dst = rows_.data() + static_cast<size_t>(v) * W;
     for (int u = 0; u < W; ++u) {
-      const SkyTap& c = row[u];
-      if (!(c.tol > 0)) continue;
-      float num = 0, den = 0;
+      const SkyTap& t = taps_[static_cast<size_t>(v) * W + u];
+      const size_t i = padded(u, v);
+      const bool ok = t.tol > 0;
+      fw[kNx][i] = ok ? t.n.x() : 0.0f, fw[kNy][i] = ok ? t.n.y() : 0.0f;
+      fw[kNz][i] = ok ? t.n.z() : 0.0f;
+      fw[kPx][i] = t.p.x(), fw[kPy][i] = t.p.y(), fw[kPz][i] = t.p.z();
+      fw[kInvTol][i] = ok ? 1.0f / t.tol : 0.0f;
+      fw[kNum][i] = t.num, fw[kDen][i] = t.den;
+    }
+  });
+  using Map = Eigen::Map<const Lanes, Eigen::Unaligned>;
+  // horizontal pass: (HNum, HDen) = sums over the row's taps, weighted for the centre.
+  pool->ParallelFor(H, [&](int64_t vv) {
+    const int v = static_cast<int>(vv);
+    for (int u0 = 0; u0 < W; u0 += kLanes) {
+      const size_t i = padded(u0, v);
+      Lanes num = Lanes::Zero(), den = Lanes::Zero();
       for (int k = 0; k <= 2 * kSkyRadius; ++k) {
-        const int x = u + k - kSkyRadius;
-        if (x < 0 || x >= W) continue;
-        const float w = TapWeight(k) * GeometryWeight(c, row[x]);
-        num += w * row[x].num;
-        den += w * row[x].den;
+        const size_t j = i + k - kSkyRadius;
+        const Lanes w = TapWeight(k) * GeometryWeight(f, i, j);
+        num += w * Map(f[kNum] + j);
+        den += w * Map(f[kDen] + j);
       }
-      dst[u] = {num, den};
+      Eigen::Map<Lanes, Eigen::Unaligned>(fw[kHNum] + i) = num;
+      Eigen::Map<Lanes, Eigen::Unaligned>(fw[kHDen] + i) = den;
     }
   });
   // vertical pass: the ratio of the column sums, times the unoccluded sky ambient.
   pool->ParallelFor(H, [&](int64_t vv) {
     const int v = static_cast<int>(vv);
-    for (int u = 0; u < W; ++u) {
-      const SkyTap& c = taps_[static_cast<size_t>(v) * W + u];
-      if (!(c.tol > 0) || c.weight == Eigen::Vector3f::Zero()) continue;
-      float num = 0, den = 0;
+    for (int u0 = 0; u0 < W; u0 += kLanes) {
+      const size_t i = padded(u0, v);
+      Lanes num = Lanes::Zero(), den = Lanes::Zero();
       for (int k = 0; k <= 2 * kSkyRadius; ++k) {
-        const int y = v + k - kSkyRadius;
-        if (y < 0 || y >= H) continue;
-        const size_t j = static_cast<size_t>(y) * W + u;
-        const float w = TapWeight(k) * GeometryWeight(c, taps_[j]);
-        num += w * rows_[j].x();
-        den += w * rows_[j].y();
+        const size_t j = i + (static_cast<size_t>(k) - kSkyRadius) * PW;
+        const Lanes w = TapWeight(k) * GeometryWeight(f, i, j);
+        num += w * Map(f[kHNum] + j);
+        den += w * Map(f[kHDen] + j);
       }
-      const float vis = den > 0 ? std::min(num / den, 1.0f) : 0.0f;
-      float* L = out.radiance->at(u, v);
-      L[0] += c.weight.x() * vis, L[1] += c.weight.y() * vis, L[2] += c.weight.z() * vis;
+      const Lanes vis = (den > 0.0f).select((num / den.max(1e-30f)).min(1.0f), 0.0f);
+      const int m = std::min(kLanes, W - u0);
+      for (int k = 0; k < m; ++k) {
+        const SkyTap& c = taps_[static_cast<size_t>(v) * W + u0 + k];
+        if (!(c.tol > 0)) continue;
+        float* L = out.radiance->at(u0 + k, v);
+        L[0] += c.weight.x() * vis[k], L[1] += c.weight.y() * vis[k], L[2] += c.weight.z() * vis[k];
+      }
     }
   });
 }

@@ -70,7 +70,10 @@ class RealtimeIntegrator final : public Integrator {
  private:
   int width_ = 0, height_ = 0;
   mutable std::vector<SkyTap> taps_;   // (H x W), row-major; RenderTile writes its pixels
-  std::vector<Eigen::Vector2f> rows_;  // (H x W): horizontally filtered (num, den)
+  // the filter's fields, structure of arrays over a padded frame (realtime_integrator.cc).
+  int padded_width_ = 0;
+  size_t padded_size_ = 0;
+  std::vector<float> planes_;
 };
 
 }  // namespace penumbra
