@@ -65,10 +65,10 @@ inline Lanes GeometryWeight(const float* const* f, size_t i, size_t j) {
   using Map = Eigen::Map<const Lanes, Eigen::Unaligned>;
   const Map nx(f[kNx] + i), ny(f[kNy] + i), nz(f[kNz] + i);
   const Lanes c = (nx * Map(f[kNx] + j) + ny * Map(f[kNy] + j) + nz * Map(f[kNz] + j)).max(0.0f);
-  const Lanes dist = (nx * (Map(f[kPx] + j) - Map(f[kPx] + i)) +
-                      ny * (Map(f[kPy] + j) - Map(f[kPy] + i)) +
-                      nz * (Map(f[kPz] + j) - Map(f[kPz] + i)))
-                         .abs();
+  const Lanes dist =
+      (nx * (Map(f[kPx] + j) - Map(f[kPx] + i)) + ny * (Map(f[kPy] + j) - Map(f[kPy] + i)) +
+       nz * (Map(f[kPz] + j) - Map(f[kPz] + i)))
+          .abs();
   const Lanes c2 = c * c;
   return c2 * c2 * (1.0f - dist * Map(f[kInvTol] + i)).max(0.0f);
 }
@@ -186,8 +186,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     const int m = std::min(kLanes, n - i0);
     LaneMask hit = LaneMask::Constant(false);
     BsdfLanes bsdf;
-    Vec3Lanes p, origin, L, sky_dir;
-    LaneMask sky_ray = LaneMask::Constant(false);
+    Vec3Lanes p, origin, L, sky_dir, reflect_l;
+    LaneMask above = LaneMask::Constant(false);
     for (int k = 0; k < kLanes; ++k) {
       const int i = i0 + k;
       const bool lane_hit = k < m && primary.did_hit[i];
@@ -202,7 +202,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         bsdf.n_v[k] = 1, bsdf.a2[k] = 1;
         bsdf.c_diff.Set(k, Eigen::Vector3f::Zero()), bsdf.f0.Set(k, Eigen::Vector3f::Zero());
         for (int j = 0; j < num_lights; ++j) scratch.u1[j][k] = scratch.u2[j][k] = 0.5f;
-        sky_dir.Set(k, z);
+        sky_dir.Set(k, z), reflect_l.Set(k, Eigen::Vector3f::Zero());
         if (k < m) {
           const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
           taps_[static_cast<size_t>(v) * width + u] = SkyTap();
@@ -230,19 +230,17 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
           EnvBrdfApprox(coef.f0, std::max(bsdf.n_v[k], 0.0f), mat.pbr.roughness);
       const Eigen::Vector3f reflect =
           coef.c_diff.cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-      const Eigen::Vector3f sky_weight = (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect);
+      reflect_l.Set(k, reflect);
       L.Set(k, mat.emission);
 
-      // the sky ray: stratum of the pixel within its 4 x 4 block, jittered, cosine-weighted.
+      // the sky ray: the stratum of the pixel within its block, cosine-weighted about n_s
+      // (its sky luminance and the irradiance are looked up for the whole run below).
       const uint64_t pixel = static_cast<uint64_t>(v) * width + u;
       SkyTap& tap = taps_[pixel];
       tap.n = n_s;
       tap.p = h.p_W;
       tap.tol = kPlaneTolerancePixels * std::max(h.t, 1e-6f) * inv_fx;
-      tap.weight = sky_weight;
-      tap.num = tap.den = 0;
-      sky_dir.Set(k, n_s);
-      if (sky_weight != Eigen::Vector3f::Zero()) {
+      {
         const int stratum = ((u % kSkyBlock) + kSkyBlock * (v % kSkyBlock)) ^ stratum_xor;
         constexpr float kInvBlock = 1.0f / kSkyBlock;
         float s1 = (stratum % kSkyBlock) * kInvBlock + shift1;
@@ -255,11 +253,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         Basis(n_s, &t, &b);
         const Eigen::Vector3f d =
             (t * (r * cs) + b * (r * sn) + n_s * std::sqrt(std::max(1.0f - s1, 0.0f))).normalized();
-        tap.den = ctx.sky->LuminanceLookup(d);
-        if (d.dot(h.ng_W) > 0 && tap.den > 0) {
-          sky_dir.Set(k, d);
-          sky_ray[k] = true;
-        }
+        sky_dir.Set(k, d);
+        above[k] = d.dot(h.ng_W) > 0;
       }
 
       Rng rng(FrameContext::PixelStream(frame_key, pixel, 0));
@@ -277,6 +272,24 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     if (!hit.any()) continue;
+
+    // unoccluded sky ambient (the filter's weight at V = 1) and sky luminance of the rays; a
+    // ray is traced where both are non-zero and it leaves above the geometric surface.
+    Vec3Lanes E;
+    ctx.sky->IrradianceLanes(bsdf.n, &E);
+    const Lanes sky_y = ctx.sky->LuminanceLookupLanes(sky_dir);
+    LaneMask sky_ray = LaneMask::Constant(false);
+    for (int k = 0; k < m; ++k) {
+      if (!hit[k]) continue;
+      const int i = i0 + k;
+      SkyTap& tap =
+          taps_[static_cast<size_t>(tile.y0 + i / tile.width) * width + tile.x0 + i % tile.width];
+      tap.weight = (E.Lane(k) * kInvPi).cwiseProduct(reflect_l.Lane(k));
+      const bool lit = tap.weight != Eigen::Vector3f::Zero();
+      tap.num = 0;
+      tap.den = lit ? sky_y[k] : 0.0f;
+      sky_ray[k] = lit && above[k] && tap.den > 0;
+    }
 
     // the sky rays of the run, as one packet.
     if (sky_ray.any()) {

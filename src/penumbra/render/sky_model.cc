@@ -151,6 +151,28 @@ T OctLookup(const std::vector<T>& table, int side, const Eigen::Vector3f& d) {
   return (1 - a) * ((1 - b) * row0[0] + b * row0[1]) + a * ((1 - b) * row1[0] + b * row1[1]);
 }
 
+// OctLookup's cell and bilinear weights for kLanes directions: the octahedral map vectorised,
+// then per lane the four nodes. `fn(k, i00, a, b)` receives lane k, the index of its lower
+// node and the weights along rows (a) and columns (b).
+template <typename Fn>
+void OctLanes(const Vec3Lanes& d, int side, const Fn& fn) {
+  const Lanes inv = 1.0f / (d.x.abs() + d.y.abs() + d.z.abs());
+  const Lanes x0 = d.x * inv, y0 = d.y * inv;
+  const Lanes sx = (x0 >= 0.0f).select(Lanes::Ones(), -Lanes::Ones());
+  const Lanes sy = (y0 >= 0.0f).select(Lanes::Ones(), -Lanes::Ones());
+  const LaneMask lower = d.z < 0.0f;
+  const Lanes x = lower.select((1.0f - y0.abs()) * sx, x0);
+  const Lanes y = lower.select((1.0f - x0.abs()) * sy, y0);
+  const Lanes fs = (x * 0.5f + 0.5f) * static_cast<float>(side - 1);
+  const Lanes ft = (y * 0.5f + 0.5f) * static_cast<float>(side - 1);
+  for (int k = 0; k < kLanes; ++k) {
+    const int c0 = std::clamp(static_cast<int>(fs[k]), 0, side - 2);
+    const int r0 = std::clamp(static_cast<int>(ft[k]), 0, side - 2);
+    const float a = std::clamp(ft[k] - r0, 0.0f, 1.0f), b = std::clamp(fs[k] - c0, 0.0f, 1.0f);
+    fn(k, static_cast<size_t>(r0) * side + c0, a, b);
+  }
+}
+
 }  // namespace
 
 struct SkyModel::Impl {
@@ -374,6 +396,26 @@ Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
 
 float SkyModel::LuminanceLookup(const Eigen::Vector3f& dir_W) const {
   return std::max(OctLookup(impl_->luminance, kLumSide, dir_W), 0.0f);
+}
+
+void SkyModel::IrradianceLanes(const Vec3Lanes& n_W, Vec3Lanes* E) const {
+  const Eigen::Vector3f* t = impl_->irradiance.data();
+  OctLanes(n_W, kIrrSide, [&](int k, size_t i, float a, float b) {
+    const Eigen::Vector3f e = (1 - a) * ((1 - b) * t[i] + b * t[i + 1]) +
+                              a * ((1 - b) * t[i + kIrrSide] + b * t[i + kIrrSide + 1]);
+    E->Set(k, e);
+  });
+}
+
+Lanes SkyModel::LuminanceLookupLanes(const Vec3Lanes& dir_W) const {
+  const float* t = impl_->luminance.data();
+  Lanes y;
+  OctLanes(dir_W, kLumSide, [&](int k, size_t i, float a, float b) {
+    y[k] = std::max((1 - a) * ((1 - b) * t[i] + b * t[i + 1]) +
+                        a * ((1 - b) * t[i + kLumSide] + b * t[i + kLumSide + 1]),
+                    0.0f);
+  });
+  return y;
 }
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <memory>
 
+#include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -31,6 +32,12 @@ class SkyModel {
   /// approximate luminance (cd/m^2) of Radiance(dir_W) for a unit direction: bilinear in a
   /// 65 x 65 octahedral table (smooths the horizon edge). cheap; for weighting samples.
   float LuminanceLookup(const Eigen::Vector3f& dir_W) const;
+
+  /// Irradiance() of kLanes unit normals (x = r, y = g, z = b), the map's arithmetic vectorised.
+  void IrradianceLanes(const Vec3Lanes& n_W, Vec3Lanes* E) const;
+
+  /// LuminanceLookup() of kLanes unit directions.
+  Lanes LuminanceLookupLanes(const Vec3Lanes& dir_W) const;
 
   /// samples a direction with density roughly proportional to radiance from two
   /// uniform numbers in [0, 1); returns the direction and writes its solid-angle pdf.
