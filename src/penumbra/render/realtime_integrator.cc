@@ -59,18 +59,28 @@ constexpr float TapWeight(int k) {
 // kLanes pixels at once without bounds checks. a zero normal marks "no surface" (weight 0).
 enum SkyField { kNx, kNy, kNz, kPx, kPy, kPz, kInvTol, kNum, kDen, kHNum, kHDen, kNumFields };
 
-// geometry weights of kLanes taps j for kLanes centres i: (n_i . n_j)^4 (0 if negative) times
+// the filter's centre pixels: kLanes consecutive pixels starting at padded index i.
+struct Centre {
+  Lanes nx, ny, nz, px, py, pz, inv_tol;
+  Centre(const float* const* f, size_t i) {
+    using Map = Eigen::Map<const Lanes, Eigen::Unaligned>;
+    nx = Map(f[kNx] + i), ny = Map(f[kNy] + i), nz = Map(f[kNz] + i);
+    px = Map(f[kPx] + i), py = Map(f[kPy] + i), pz = Map(f[kPz] + i);
+    inv_tol = Map(f[kInvTol] + i);
+  }
+};
+
+// geometry weights of kLanes taps j for the centres c: (n_i . n_j)^4 (0 if negative) times
 // a tent in the distance of p_j from the tangent plane of p_i, in units of i's tolerance.
-inline Lanes GeometryWeight(const float* const* f, size_t i, size_t j) {
+inline Lanes GeometryWeight(const Centre& c, const float* const* f, size_t j) {
   using Map = Eigen::Map<const Lanes, Eigen::Unaligned>;
-  const Map nx(f[kNx] + i), ny(f[kNy] + i), nz(f[kNz] + i);
-  const Lanes c = (nx * Map(f[kNx] + j) + ny * Map(f[kNy] + j) + nz * Map(f[kNz] + j)).max(0.0f);
-  const Lanes dist =
-      (nx * (Map(f[kPx] + j) - Map(f[kPx] + i)) + ny * (Map(f[kPy] + j) - Map(f[kPy] + i)) +
-       nz * (Map(f[kPz] + j) - Map(f[kPz] + i)))
-          .abs();
-  const Lanes c2 = c * c;
-  return c2 * c2 * (1.0f - dist * Map(f[kInvTol] + i)).max(0.0f);
+  const Lanes cos =
+      (c.nx * Map(f[kNx] + j) + c.ny * Map(f[kNy] + j) + c.nz * Map(f[kNz] + j)).max(0.0f);
+  const Lanes dist = (c.nx * (Map(f[kPx] + j) - c.px) + c.ny * (Map(f[kPy] + j) - c.py) +
+                      c.nz * (Map(f[kPz] + j) - c.pz))
+                         .abs();
+  const Lanes c2 = cos * cos;
+  return c2 * c2 * (1.0f - dist * c.inv_tol).max(0.0f);
 }
 
 // per-thread scratch, sized once per light count and reused across tiles and frames.
@@ -124,10 +134,11 @@ void RealtimeIntegrator::EndFrame(const FrameContext& ctx, const FrameBuffers& o
     const int v = static_cast<int>(vv);
     for (int u0 = 0; u0 < W; u0 += kLanes) {
       const size_t i = padded(u0, v);
+      const Centre c(f, i);
       Lanes num = Lanes::Zero(), den = Lanes::Zero();
       for (int k = 0; k <= 2 * kSkyRadius; ++k) {
         const size_t j = i + k - kSkyRadius;
-        const Lanes w = TapWeight(k) * GeometryWeight(f, i, j);
+        const Lanes w = TapWeight(k) * GeometryWeight(c, f, j);
         num += w * Map(f[kNum] + j);
         den += w * Map(f[kDen] + j);
       }
@@ -140,10 +151,11 @@ void RealtimeIntegrator::EndFrame(const FrameContext& ctx, const FrameBuffers& o
     const int v = static_cast<int>(vv);
     for (int u0 = 0; u0 < W; u0 += kLanes) {
       const size_t i = padded(u0, v);
+      const Centre c(f, i);
       Lanes num = Lanes::Zero(), den = Lanes::Zero();
       for (int k = 0; k <= 2 * kSkyRadius; ++k) {
         const size_t j = i + (static_cast<size_t>(k) - kSkyRadius) * PW;
-        const Lanes w = TapWeight(k) * GeometryWeight(f, i, j);
+        const Lanes w = TapWeight(k) * GeometryWeight(c, f, j);
         num += w * Map(f[kHNum] + j);
         den += w * Map(f[kHDen] + j);
       }
