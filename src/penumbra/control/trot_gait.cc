@@ -10,6 +10,7 @@
 #include <limits>
 #include <set>
 
+#include "penumbra/control/pure_pursuit.h"
 #include "penumbra/control/quadruped_swing_trajectory.h"
 #include "penumbra/core/error.h"
 
@@ -166,6 +167,21 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     }
   }
 
+  // waypoint mode: the route keys only make sense with waypoints
+  if (p.Has("waypoints")) {
+    g.waypoints = p.Points2("waypoints", 1);
+    g.loop = p.Bool("loop", true);
+    g.speed_m_s = p.Number("speed_m_s", 0.5, 0, kInf, true);
+    g.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 60, 0, kInf, true);
+    g.tolerance_m = p.Number("tolerance_m", 0.15, 0, kInf, true);
+  } else {
+    for (const char* k : {"loop", "speed_m_s", "max_yaw_rate_deg_s", "tolerance_m"})
+      if (p.Has(k))
+        p.Fail(k,
+               "only valid in waypoint mode; expected also `waypoints: [[x, y], ...]` "
+               "(world frame, m)");
+  }
+
   g.period_sec = p.Number("period_sec", 0.36, 0.05, 5, false);
   g.duty = p.Number("duty", 0.5, 0.3, 0.8);
   g.swing_height_m = p.Number("swing_height_m", 0.08, 0, 1);
@@ -238,6 +254,13 @@ void TrotGaitParams::ValidateOrThrow(const ControllerContext& c) const {
         !std::isfinite(tc.command.yaw_rate))
       fail("commands[" + std::to_string(i) + "]", "expected finite vx, vy, yaw_rate");
   }
+  for (const Eigen::Vector2d& w : waypoints)
+    if (!w.allFinite()) fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
+  if (!waypoints.empty()) {
+    positive("speed_m_s", speed_m_s);
+    positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);
+    positive("tolerance_m", tolerance_m);
+  }
   positive("period_sec", period_sec);
   if (!(duty >= 0.3 && duty <= 0.8))
     fail("duty", "got " + std::to_string(duty) + "; expected a number >= 0.3 and <= 0.8");
@@ -268,6 +291,8 @@ TrotGait::TrotGait(TrotGaitParams params, ControllerContext context)
     : Controller(std::move(context)), params_(std::move(params)) {
   params_.ValidateOrThrow(this->context());
   for (auto& f : forces_) f.setZero();
+  if (!params_.waypoints.empty())
+    route_.emplace(params_.waypoints, params_.loop, params_.tolerance_m);
 }
 
 std::vector<NameRequirement> TrotGait::RequiredNames() const {
@@ -405,6 +430,7 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
   started_ = false;
   h_ref_ = 0;
   k_raibert_ = 0;
+  if (route_) route_->Reset();
 }
 
 TrotCommand TrotGait::ScriptedCommand(double t) const {
@@ -455,8 +481,19 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   const double dt = std::max(0.0, t - last_t_);
   last_t_ = t;
 
-  // 1. command and references
-  command_ = override_ ? *override_ : ScriptedCommand(t);
+  // 1. command (programmatic > waypoints > script) and references
+  if (override_) {
+    command_ = *override_;
+  } else {
+    if (route_) route_->Advance(p.head<2>());
+    if (route_ && !route_->finished()) {
+      const UnicycleCommand u = PurePursuit(
+          X_WB, route_->target(), {params_.speed_m_s, params_.max_yaw_rate_deg_s * M_PI / 180.0});
+      command_ = TrotCommand{u.v_m_s, 0.0, u.yaw_rate};
+    } else {
+      command_ = ScriptedCommand(t);
+    }
+  }
   auto slew = [dt](double from, double to, double rate) {
     return from + std::clamp(to - from, -rate * dt, rate * dt);
   };

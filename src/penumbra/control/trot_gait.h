@@ -17,6 +17,13 @@
 //     commands:                      # scripted twist, held from each t (s) to the next
 //       - {t: 0, vx: 0, vy: 0, yaw_rate: 0}
 //       - {t: 1, vx: 0.5}            # missing components are 0
+//     waypoints: [[1, 0], [1, 1]]    # waypoint mode: world x, y (m) of the base body's
+//                                    # origin, at least 1 (the next four keys only with it)
+//     loop: true                     # after the last waypoint, start again (default true)
+//     speed_m_s: 0.5                 # > 0, cruise speed along the route (default 0.5)
+//     max_yaw_rate_deg_s: 60         # > 0, yaw-rate limit of the route (default 60)
+//     tolerance_m: 0.15              # > 0, a waypoint counts as reached inside this
+//                                    # radius (default 0.15)
 //     period_sec: 0.36               # gait cycle (> 0, default 0.36)
 //     duty: 0.5                      # stance fraction of the cycle (0.3 .. 0.8, default 0.5)
 //     swing_height_m: 0.08           # apex of the foot above the line lift-off -> touch-down
@@ -52,8 +59,19 @@
 // fitted (least squares) to the last stance positions of the four feet.
 //
 // control law, at each update (time t, period T, duty D, T_st = D T, T_sw = T - T_st):
-//   1. command: the override from SetCommand() if set, else the scripted entry with the
-//      largest t_i <= t (zero before the first). the reference twist (v_ref, w_ref)
+//   1. command, from the first source in force (precedence: programmatic > waypoints >
+//      script):
+//      a. the override from SetCommand(), until ClearCommand();
+//      b. waypoint mode, while the route is not finished (a looping route never is): the
+//         waypoint progress of control/waypoint_route.h (goal w; a waypoint within
+//         tolerance_m of the base body's origin is reached), then the pure-pursuit law of
+//         control/pure_pursuit.h, shared with waypoint_follower (R. C. Coulter,
+//         CMU-RI-TR-92-01, 1992): vx = v, vy = 0, yaw_rate = omega, i.e. turn in place at
+//         the yaw-rate limit while w lies more than 90 deg off the heading, else follow
+//         the arc of curvature 2 sin(alpha) / |w - p| at speed_m_s, slowed until the
+//         yaw rate is within the limit; the route only advances while it is in force;
+//      c. the scripted entry with the largest t_i <= t (zero before the first and when
+//         there is no script, i.e. trot in place). the reference twist (v_ref, w_ref)
 //      follows it under the slew limits; the reference heading psi_ref and COM position
 //      p_ref integrate it (v_ref rotated by the heading), both kept within 0.3 rad /
 //      0.1 m of the robot (anti-windup, e.g. after a push).
@@ -97,6 +115,7 @@
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/quadruped_leg_kinematics.h"
 #include "penumbra/control/quadruped_stance_forces.h"
+#include "penumbra/control/waypoint_route.h"
 
 namespace penumbra {
 
@@ -127,6 +146,11 @@ struct TrotGaitParams {
   std::string base_body;
   std::array<TrotLegConfig, 4> legs;  ///< FR, FL, RR, RL
   std::vector<TimedTrotCommand> commands;
+  std::vector<Eigen::Vector2d> waypoints;  ///< world x, y (m); empty = no waypoint mode
+  bool loop = true;
+  double speed_m_s = 0.5;
+  double max_yaw_rate_deg_s = 60;
+  double tolerance_m = 0.15;
   double period_sec = 0.36;
   double duty = 0.5;
   double swing_height_m = 0.08;
@@ -167,15 +191,18 @@ class TrotGait final : public Controller {
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
 
   /// programmatic command source (e.g. a middleware's cmd_vel): from the next update on,
-  /// `command` replaces the scripted list until ClearCommand(). call it from the thread
-  /// that steps the simulation, between steps.
+  /// `command` replaces the waypoints and the scripted list until ClearCommand() (the
+  /// route pauses meanwhile). call it from the thread that steps the simulation, between
+  /// steps.
   void SetCommand(const TrotCommand& command) { override_ = command; }
-  /// returns to the scripted commands.
+  /// returns to the waypoints (if configured and not finished), else the script.
   void ClearCommand() { override_.reset(); }
 
   const TrotGaitParams& params() const { return params_; }
-  /// the command in force at the last update (scripted or set).
+  /// the command in force at the last update (set, from the waypoints or scripted).
   const TrotCommand& command() const { return command_; }
+  /// progress along the waypoints; nullptr without waypoint mode.
+  const WaypointRoute* route() const { return route_ ? &*route_ : nullptr; }
   /// the slew-limited reference twist at the last update.
   const TrotCommand& reference() const { return reference_; }
   /// leg geometry read from the model (FR, FL, RR, RL); valid after Initialize.
@@ -225,6 +252,7 @@ class TrotGait final : public Controller {
   double step_limit_ = 0.17;
 
   std::optional<TrotCommand> override_;
+  std::optional<WaypointRoute> route_;
   TrotCommand command_, reference_;
   bool started_ = false;
   double last_t_ = 0;

@@ -3,17 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "penumbra/control/pure_pursuit.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double WrapAngle(double a) {
-  a = std::remainder(a, 2 * M_PI);  // in [-pi, pi]
-  return a <= -M_PI ? a + 2 * M_PI : a;
-}
 
 }  // namespace
 
@@ -63,7 +59,9 @@ void WaypointFollowerParams::ValidateOrThrow(const ControllerContext& c) const {
 }
 
 WaypointFollower::WaypointFollower(WaypointFollowerParams params, ControllerContext context)
-    : Controller(std::move(context)), params_(std::move(params)) {
+    : Controller(std::move(context)),
+      params_(std::move(params)),
+      route_(params_.waypoints, params_.loop, params_.tolerance_m) {
   params_.ValidateOrThrow(this->context());
 }
 
@@ -87,53 +85,21 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
                             "' does not drive a hinge joint; expected a velocity actuator on a "
                             "wheel's hinge joint");
   }
-  target_ = 0;
-  reached_ = 0;
-  finished_ = false;
+  route_.Reset();
 }
 
 void WaypointFollower::Compute(const ControlInput& input, std::span<double> ctrl) {
   const Pose X_WB = input.X_WB(base_body_);
-  const Eigen::Vector2d p = X_WB.translation().head<2>();
-  const Eigen::Vector2d forward = X_WB.linear().col(0).head<2>();
-  const double omega_max = params_.max_yaw_rate_deg_s * M_PI / 180.0;
-  const int n = static_cast<int>(params_.waypoints.size());
-
-  // advance past reached waypoints (at most one lap per update)
-  for (int k = 0; k < n && !finished_; ++k) {
-    if ((params_.waypoints[target_] - p).norm() >= params_.tolerance_m) break;
-    ++reached_;
-    if (target_ + 1 < n) {
-      ++target_;
-    } else if (params_.loop) {
-      target_ = 0;
-    } else {
-      finished_ = true;
-    }
-  }
-
-  double v = 0, omega = 0;
-  if (!finished_ && forward.norm() > 1e-3) {
-    const Eigen::Vector2d to_target = params_.waypoints[target_] - p;
-    const double d = to_target.norm();
-    const double psi = std::atan2(forward.y(), forward.x());
-    const double alpha = WrapAngle(std::atan2(to_target.y(), to_target.x()) - psi);
-    if (std::abs(alpha) > 0.5 * M_PI) {
-      // target behind: turn in place
-      omega = alpha > 0 ? omega_max : -omega_max;
-    } else {
-      // pure pursuit towards the waypoint, speed capped by the yaw-rate limit
-      const double kappa = 2.0 * std::sin(alpha) / std::max(d, 1e-9);
-      v = params_.speed_m_s;
-      if (std::abs(v * kappa) > omega_max) v = omega_max / std::abs(kappa);
-      omega = v * kappa;
-    }
-  }
-  v_ = v;
-  omega_ = omega;
+  route_.Advance(X_WB.translation().head<2>());
+  UnicycleCommand cmd;
+  if (!route_.finished())
+    cmd = PurePursuit(X_WB, route_.target(),
+                      {params_.speed_m_s, params_.max_yaw_rate_deg_s * M_PI / 180.0});
+  v_ = cmd.v_m_s;
+  omega_ = cmd.yaw_rate;
   const double half_track = 0.5 * params_.track_width_m;
-  ctrl[left_] = (v - omega * half_track) / params_.wheel_radius_m;
-  ctrl[right_] = (v + omega * half_track) / params_.wheel_radius_m;
+  ctrl[left_] = (v_ - omega_ * half_track) / params_.wheel_radius_m;
+  ctrl[right_] = (v_ + omega_ * half_track) / params_.wheel_radius_m;
 }
 
 }  // namespace penumbra

@@ -14,22 +14,23 @@
 //     max_yaw_rate_deg_s: 90    # > 0 (default 90)
 //     waypoints: [[1.0, 0.0], [1.0, 1.0]]   # world x, y (m), at least 1
 //     loop: true                # after the last waypoint, start again (default true)
-//     tolerance_m: 0.15         # > 0, a waypoint counts as reached inside this radius (default
-//     0.15) rate_hz: 50               # > 0, control rate on sim time (default 50)
+//     tolerance_m: 0.15         # > 0, a waypoint counts as reached inside this radius
+//                               # (default 0.15)
+//     rate_hz: 50               # > 0, control rate on sim time (default 50)
 //
 // wheel convention: a positive ctrl must drive its wheel forward, i.e. the wheel
 // hinge axes point to the robot's left (+y of the base body), as in REP-103.
 //
-// control law, at each update, with robot position p, heading psi (yaw of the
-// base body's x axis in the world xy plane) and target waypoint w:
-//   1. while |w - p| < tolerance_m: the waypoint is reached; advance to the next
-//      (wrapping when loop, otherwise stop for good after the last one).
-//   2. d = |w - p|, alpha = wrap(atan2(w - p) - psi) (heading error, in (-pi, pi]).
-//   3. |alpha| > 90 deg (target behind): turn in place, v = 0, omega = sign(alpha) omega_max.
-//      otherwise pure pursuit with the waypoint as goal point (R. C. Coulter,
-//      "Implementation of the Pure Pursuit Path Tracking Algorithm", CMU-RI-TR-92-01,
-//      1992): curvature kappa = 2 sin(alpha) / d, v = speed_m_s reduced until
-//      |v kappa| <= omega_max, omega = v kappa.
+// control law, at each update, with robot position p (the base body's origin) and heading
+// psi (yaw of the base body's x axis in the world xy plane):
+//   1. the waypoint progress of control/waypoint_route.h: every waypoint within
+//      tolerance_m of p is reached and the goal w advances to the next (wrapping when
+//      loop, otherwise the robot stops for good after the last one).
+//   2.-3. the pure-pursuit law of control/pure_pursuit.h towards w: turn in place at
+//      omega_max while w lies more than 90 deg off the heading, otherwise drive the arc
+//      of curvature kappa = 2 sin(alpha) / |w - p| at speed_m_s, reduced until
+//      |v kappa| <= omega_max (R. C. Coulter, "Implementation of the Pure Pursuit Path
+//      Tracking Algorithm", CMU-RI-TR-92-01, 1992).
 //   4. differential-drive inverse kinematics (R. Siegwart, I. Nourbakhsh,
 //      D. Scaramuzza, "Introduction to Autonomous Mobile Robots", 2nd ed., 2011,
 //      sec. 3.2.1): wheel rates (v -/+ omega track/2) / wheel_radius (left/right).
@@ -43,6 +44,7 @@
 
 #include "penumbra/control/controller.h"
 #include "penumbra/control/controller_params.h"
+#include "penumbra/control/waypoint_route.h"
 
 namespace penumbra {
 
@@ -80,11 +82,11 @@ class WaypointFollower final : public Controller {
 
   const WaypointFollowerParams& params() const { return params_; }
   /// index of the waypoint being driven to.
-  int target_index() const { return target_; }
+  int target_index() const { return route_.target_index(); }
   /// waypoints reached so far (counts every lap when looping).
-  int64_t waypoints_reached() const { return reached_; }
+  int64_t waypoints_reached() const { return route_.reached(); }
   /// true once the last waypoint was reached and loop is false; the robot then stands still.
-  bool finished() const { return finished_; }
+  bool finished() const { return route_.finished(); }
   /// last commanded forward speed (m/s) and yaw rate (rad/s).
   double commanded_speed_m_s() const { return v_; }
   double commanded_yaw_rate() const { return omega_; }
@@ -95,9 +97,7 @@ class WaypointFollower final : public Controller {
  private:
   WaypointFollowerParams params_;
   int base_body_ = -1, left_ = -1, right_ = -1;
-  int target_ = 0;
-  int64_t reached_ = 0;
-  bool finished_ = false;
+  WaypointRoute route_;
   double v_ = 0, omega_ = 0;
 };
 
