@@ -169,59 +169,6 @@ TEST(RealtimeLightingTest, UniformSkyAmbientOnLambertianSurface) {
   EXPECT_NEAR(L.z(), 300 * rho, 0.02 * 300 * rho);
 }
 
-TEST(RealtimeLightingTest, ClosedBoxReceivesNoSkyLight) {
-  // a floor inside a closed box (camera inside, no lights): every sky ray is blocked.
-  SceneDescription s = Floor(0.5f);
-  s.sky.radiance = {100, 200, 300};
-  AddGeom(&s, GeomShape::kBox, {2, 2, 2}, Translation(0, 0, 1.5));
-  auto r = MakeEmbreeRenderer(s, TestSettings(2));
-  RenderedFrame f;
-  r->Render(IdentitySnapshot(s), MakeView(CameraLookingDown({0, 0, 2}), 64, 48, 90), &f);
-  float max_l = 0;
-  for (float x : f.radiance.data) max_l = std::max(max_l, x);
-  EXPECT_EQ(max_l, 0.0f);
-}
-
-TEST(RealtimeLightingTest, DiscRoofOccludesTheSkyByItsFormFactor) {
-  // a floor point below the centre of a disc of radius R at height h sees the sky with a
-  // cosine-weighted visible fraction 1 - R^2 / (R^2 + h^2) (form factor of a parallel coaxial
-  // disc); uniform sky radiance Ls and albedo rho give Ls rho (1 - R^2 / (R^2 + h^2)).
-  const float rho = 0.5f, Ls = 100.0f;
-  const double R = 1.0, h = 1.5;
-  SceneDescription s = Floor(rho);
-  s.sky.radiance = Eigen::Vector3f::Constant(Ls);
-  AddGeom(&s, GeomShape::kCylinder, {R, 0.005, 0}, Translation(0, 0, h));
-  auto r = MakeEmbreeRenderer(s, TestSettings(2));
-  // camera 0.5 m above the floor, below the disc; the 40 x 40 centre pixels see |x|, |y| < 4 cm.
-  const int size = 301;
-  RenderedFrame f;
-  const CameraView view = MakeView(CameraLookingDown({0, 0, 0.5}), size, size, 90);
-  double sum = 0;
-  int count = 0;
-  for (int frame = 0; frame < 4; ++frame) {
-    CameraView vf = view;
-    vf.frame_index = frame;
-    r->Render(IdentitySnapshot(s), vf, &f);
-    for (int v = size / 2 - 20; v < size / 2 + 20; ++v)
-      for (int u = size / 2 - 20; u < size / 2 + 20; ++u, ++count) sum += f.radiance.at(u, v)[1];
-  }
-  const double expected = Ls * rho * (1 - R * R / (R * R + h * h));
-  EXPECT_NEAR(sum / count, expected, 0.03 * expected);
-}
-
-TEST(RealtimeLightingTest, SkyVisibilityIsIndependentOfThreadCount) {
-  const float rho = 0.5f;
-  SceneDescription s = Floor(rho);
-  s.sky.radiance = {50, 60, 70};
-  AddGeom(&s, GeomShape::kCylinder, {0.6, 0.005, 0}, Translation(0.2, 0, 0.8));
-  AddGeom(&s, GeomShape::kSphere, {0.3, 0, 0}, Translation(-0.4, 0.3, 0.3));
-  RenderedFrame f1, f3;
-  const CameraView view = MakeView(CameraLookingDown({0, 0, 2}), 97, 61, 90);
-  MakeEmbreeRenderer(s, TestSettings(1))->Render(IdentitySnapshot(s), view, &f1);
-  MakeEmbreeRenderer(s, TestSettings(3))->Render(IdentitySnapshot(s), view, &f3);
-  EXPECT_EQ(f1.radiance.data, f3.radiance.data);
-}
-
 TEST(RealtimeLightingTest, MissesSeeTheSkyAndEmissionAdds) {
   SceneDescription s = EmptyScene();
   s.sky.radiance = {1, 2, 3};

@@ -128,33 +128,6 @@ TEST(SkyModelTest, DaylightIrradianceMatchesDenseQuadrature) {
   }
 }
 
-TEST(SkyModelTest, LaneLookupsAgreeWithScalarOnes) {
-  const SkyModel model(DaylightSky(25, -30, 4.0f));
-  Rng rng(HashKeys(3, 5));
-  for (int batch = 0; batch < 64; ++batch) {
-    Vec3Lanes d;
-    for (int k = 0; k < kLanes; ++k) {
-      Eigen::Vector3f w;
-      do {
-        w = Eigen::Vector3f(rng.Uniform(), rng.Uniform(), rng.Uniform()) * 2 -
-            Eigen::Vector3f::Ones();
-      } while (!(w.norm() > 0.1f && w.norm() < 1));
-      // include the poles and the equator of the octahedral map.
-      if (batch == 0 && k < 6) w = Eigen::Vector3f::Zero(), w[k / 2] = k % 2 ? -1.0f : 1.0f;
-      d.Set(k, w.normalized());
-    }
-    Vec3Lanes E;
-    model.IrradianceLanes(d, &E);
-    const Lanes y = model.LuminanceLookupLanes(d);
-    for (int k = 0; k < kLanes; ++k) {
-      const Eigen::Vector3f e = model.Irradiance(d.Lane(k));
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(E.Lane(k)[c], e[c], 1e-5f * e[c] + 1e-6f);
-      const float ys = model.LuminanceLookup(d.Lane(k));
-      EXPECT_NEAR(y[k], ys, 1e-5f * ys + 1e-6f);
-    }
-  }
-}
-
 TEST(SkyModelTest, SampleAndPdfAreConsistent) {
   for (const Sky& sky : {DaylightSky(50, 120), DaylightSky(5, 200, 8.0f)}) {
     const SkyModel model(sky);

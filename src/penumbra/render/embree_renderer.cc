@@ -99,7 +99,6 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   ctx.camera_index = view.camera_index;
   ctx.frame_index = view.frame_index;
 
-  if (buffers.radiance) integrator_->BeginFrame(ctx);
   const int tiles_x = (W + kTileSize - 1) / kTileSize;
   const int tiles_y = (H + kTileSize - 1) / kTileSize;
   std::atomic<int64_t> secondary_rays{0};
@@ -134,7 +133,6 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
                                std::memory_order_relaxed);
     }
   });
-  if (buffers.radiance) integrator_->EndFrame(ctx, buffers, &pool_);
   out->rays = static_cast<int64_t>(W) * H + secondary_rays.load();
 
   if (want.rgb) {

@@ -12,7 +12,6 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
@@ -79,20 +78,10 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
 
-  /// called once per frame before any RenderTile (e.g. to size per-frame buffers).
-  virtual void BeginFrame(const FrameContext& ctx) { (void)ctx; }
-
   /// renders the pixels of primary.tile into `out`; returns the number of rays it traced
   /// (the primary rays are counted by the renderer). called concurrently for different tiles.
   virtual int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
                              const FrameBuffers& out) const = 0;
-
-  /// called once per frame after every tile is rendered: passes over the whole frame (e.g.
-  /// filters that read neighbouring tiles) may finish `out`, spread over `pool`. must give
-  /// the same result for any thread count.
-  virtual void EndFrame(const FrameContext& ctx, const FrameBuffers& out, ThreadPool* pool) {
-    (void)ctx, (void)out, (void)pool;
-  }
 };
 
 }  // namespace penumbra

@@ -8,7 +8,6 @@
 #include <Eigen/Core>
 #include <memory>
 
-#include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -25,19 +24,8 @@ class SkyModel {
   Eigen::Vector3f Radiance(const Eigen::Vector3f& dir_W) const;
 
   /// irradiance (lux per channel) on a surface with unit normal n_W from the whole sky,
-  /// ignoring occlusion: integral of Radiance(w) max(0, n.w) dw. precomputed on an octahedral
-  /// grid of normals, bilinear between nodes (no trigonometry; within 1% of the integral).
+  /// ignoring occlusion: integral of Radiance(w) max(0, n.w) dw. precomputed, cheap.
   Eigen::Vector3f Irradiance(const Eigen::Vector3f& n_W) const;
-
-  /// approximate luminance (cd/m^2) of Radiance(dir_W) for a unit direction: bilinear in a
-  /// 65 x 65 octahedral table (smooths the horizon edge). cheap; for weighting samples.
-  float LuminanceLookup(const Eigen::Vector3f& dir_W) const;
-
-  /// Irradiance() of kLanes unit normals (x = r, y = g, z = b), the map's arithmetic vectorised.
-  void IrradianceLanes(const Vec3Lanes& n_W, Vec3Lanes* E) const;
-
-  /// LuminanceLookup() of kLanes unit directions.
-  Lanes LuminanceLookupLanes(const Vec3Lanes& dir_W) const;
 
   /// samples a direction with density roughly proportional to radiance from two
   /// uniform numbers in [0, 1); returns the direction and writes its solid-angle pdf.
