@@ -1,3 +1,4 @@
+#include "penumbra/control/param_check.h"
 #include "penumbra/control/diff_ik.h"
 
 #include <yaml-cpp/yaml.h>
@@ -185,40 +186,30 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
 
 void DiffIkParams::ValidateOrThrow(const ControllerContext& c) const {
   servo.ValidateOrThrow(c);
-  auto fail = [&](const std::string& key, const std::string& problem) {
-    throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
-  };
-  auto positive = [&](const char* key, double v) {
-    if (!(std::isfinite(v) && v > 0))
-      fail(key, "got " + std::to_string(v) + "; expected a number > 0");
-  };
-  auto non_negative = [&](const char* key, double v) {
-    if (!(std::isfinite(v) && v >= 0))
-      fail(key, "got " + std::to_string(v) + "; expected a number >= 0");
-  };
-  if (site.empty()) fail("site", "missing; expected a site name");
-  positive("position_gain", position_gain);
-  positive("orientation_gain", orientation_gain);
-  non_negative("damping", damping);
+  const ParamCheck check(c);
+  if (site.empty()) check.Fail("site", "missing; expected a site name");
+  check.Positive("position_gain", position_gain);
+  check.Positive("orientation_gain", orientation_gain);
+  check.NonNegative("damping", damping);
   if (!(std::isfinite(damping_max) && damping_max >= damping))
-    fail("damping_max", "got " + std::to_string(damping_max) + "; expected a number >= damping");
-  positive("manipulability_threshold", manipulability_threshold);
-  positive("max_linear_speed_m_s", max_linear_speed_m_s);
-  positive("max_angular_speed_deg_s", max_angular_speed_rad_s);
-  positive("speed_m_s", speed_m_s);
-  positive("angular_speed_deg_s", angular_speed_rad_s);
-  non_negative("posture_gain", posture_gain);
-  positive("limit_zone", limit_zone);
-  non_negative("limit_gain", limit_gain);
-  positive("max_tracking_error", max_tracking_error);
-  positive("limit_velocity_gain", limit_velocity_gain);
-  non_negative("rate_hz", rate_hz);
+    check.Fail("damping_max", "got " + std::to_string(damping_max) + "; expected a number >= damping");
+  check.Positive("manipulability_threshold", manipulability_threshold);
+  check.Positive("max_linear_speed_m_s", max_linear_speed_m_s);
+  check.Positive("max_angular_speed_deg_s", max_angular_speed_rad_s);
+  check.Positive("speed_m_s", speed_m_s);
+  check.Positive("angular_speed_deg_s", angular_speed_rad_s);
+  check.NonNegative("posture_gain", posture_gain);
+  check.Positive("limit_zone", limit_zone);
+  check.NonNegative("limit_gain", limit_gain);
+  check.Positive("max_tracking_error", max_tracking_error);
+  check.Positive("limit_velocity_gain", limit_velocity_gain);
+  check.NonNegative("rate_hz", rate_hz);
   if (posture && posture->size() != servo.joints.size())
-    fail("posture", "got " + std::to_string(posture->size()) + " values; expected " +
+    check.Fail("posture", "got " + std::to_string(posture->size()) + " values; expected " +
                         std::to_string(servo.joints.size()));
   for (size_t i = 0; i < commands.size(); ++i)
     if (commands[i].command.kind == ArmCommand::Kind::kGripper && gripper_actuator.empty())
-      fail("commands[" + std::to_string(i) + "].gripper",
+      check.Fail("commands[" + std::to_string(i) + "].gripper",
            "a gripper command, but no gripper_actuator is configured");
 }
 

@@ -1,3 +1,4 @@
+#include "penumbra/control/param_check.h"
 #include "penumbra/control/trot_gait.h"
 
 #include <yaml-cpp/yaml.h>
@@ -217,74 +218,64 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
 }
 
 void TrotGaitParams::ValidateOrThrow(const ControllerContext& c) const {
-  auto fail = [&](const std::string& key, const std::string& problem) {
-    throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
-  };
-  auto positive = [&](const char* key, double v) {
-    if (!(std::isfinite(v) && v > 0))
-      fail(key, "got " + std::to_string(v) + "; expected a number > 0");
-  };
-  auto non_negative = [&](const char* key, double v) {
-    if (!(std::isfinite(v) && v >= 0))
-      fail(key, "got " + std::to_string(v) + "; expected a number >= 0");
-  };
-  if (base_body.empty()) fail("base_body", "missing; expected a body name");
+  const ParamCheck check(c);
+  if (base_body.empty()) check.Fail("base_body", "missing; expected a body name");
   std::set<std::string> joints;
   for (int i = 0; i < 4; ++i) {
     const std::string key = std::string("legs.") + kLegNames[i];
     const TrotLegConfig& l = legs[i];
     if (l.hip.empty() || l.thigh.empty() || l.calf.empty() || l.foot.empty())
-      fail(key, "missing names; expected hip, thigh, calf and foot");
+      check.Fail(key, "missing names; expected hip, thigh, calf and foot");
     for (const std::string* j : {&l.hip, &l.thigh, &l.calf})
       if (!joints.insert(*j).second)
-        fail(key, "joint '" + *j + "' is used twice; expected 12 different joints");
+        check.Fail(key, "joint '" + *j + "' is used twice; expected 12 different joints");
     for (int k = 0; k < 3; ++k) {
       if (l.signs[k] != 1 && l.signs[k] != -1)
-        fail(key + ".signs", "got " + std::to_string(l.signs[k]) + "; expected 1 or -1");
-      if (!std::isfinite(l.offsets_rad[k])) fail(key + ".offsets_rad", "expected finite angles");
-      if (l.actuators[k].empty()) fail(key + ".actuators", "expected 3 actuator names");
+        check.Fail(key + ".signs", "got " + std::to_string(l.signs[k]) + "; expected 1 or -1");
+      if (!std::isfinite(l.offsets_rad[k])) check.Fail(key + ".offsets_rad", "expected finite angles");
+      if (l.actuators[k].empty()) check.Fail(key + ".actuators", "expected 3 actuator names");
     }
   }
   for (size_t i = 0; i < commands.size(); ++i) {
     const TimedTrotCommand& tc = commands[i];
     if (!(std::isfinite(tc.t_sec) && tc.t_sec >= 0) ||
         (i > 0 && !(tc.t_sec > commands[i - 1].t_sec)))
-      fail("commands[" + std::to_string(i) + "].t", "expected increasing times >= 0 (s)");
+      check.Fail("commands[" + std::to_string(i) + "].t", "expected increasing times >= 0 (s)");
     if (!std::isfinite(tc.command.vx) || !std::isfinite(tc.command.vy) ||
         !std::isfinite(tc.command.yaw_rate))
-      fail("commands[" + std::to_string(i) + "]", "expected finite vx, vy, yaw_rate");
+      check.Fail("commands[" + std::to_string(i) + "]", "expected finite vx, vy, yaw_rate");
   }
   for (const Eigen::Vector2d& w : waypoints)
-    if (!w.allFinite()) fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
+    if (!w.allFinite()) check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
   if (!waypoints.empty()) {
-    positive("speed_m_s", speed_m_s);
-    positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);
-    positive("tolerance_m", tolerance_m);
+    check.Positive("speed_m_s", speed_m_s);
+    check.Positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);
+    check.Positive("tolerance_m", tolerance_m);
   }
-  positive("period_sec", period_sec);
+  check.Positive("period_sec", period_sec);
   if (!(duty >= 0.3 && duty <= 0.8))
-    fail("duty", "got " + std::to_string(duty) + "; expected a number >= 0.3 and <= 0.8");
-  non_negative("swing_height_m", swing_height_m);
-  if (body_height_m) positive("body_height_m", *body_height_m);
-  if (raibert_gain) non_negative("raibert_gain", *raibert_gain);
-  if (max_step_m) positive("max_step_m", *max_step_m);
-  positive("max_accel_m_s2", max_accel_m_s2);
-  positive("max_yaw_accel_rad_s2", max_yaw_accel_rad_s2);
-  non_negative("kp_xy", kp_xy);
-  non_negative("kd_xy", kd_xy);
-  non_negative("kp_z", kp_z);
-  non_negative("kd_z", kd_z);
-  non_negative("kp_tilt", kp_tilt);
-  non_negative("kd_tilt", kd_tilt);
-  non_negative("kp_yaw", kp_yaw);
-  non_negative("kd_yaw", kd_yaw);
-  non_negative("swing_kp", swing_kp);
-  non_negative("swing_kd", swing_kd);
-  non_negative("stance_kd", stance_kd);
-  positive("friction", friction);
+    check.Fail("duty", "got " + std::to_string(duty) + "; expected a number >= 0.3 and <= 0.8");
+  check.NonNegative("swing_height_m", swing_height_m);
+  if (body_height_m) check.Positive("body_height_m", *body_height_m);
+  if (raibert_gain) check.NonNegative("raibert_gain", *raibert_gain);
+  if (max_step_m) check.Positive("max_step_m", *max_step_m);
+  check.Positive("max_accel_m_s2", max_accel_m_s2);
+  check.Positive("max_yaw_accel_rad_s2", max_yaw_accel_rad_s2);
+  check.NonNegative("kp_xy", kp_xy);
+  check.NonNegative("kd_xy", kd_xy);
+  check.NonNegative("kp_z", kp_z);
+  check.NonNegative("kd_z", kd_z);
+  check.NonNegative("kp_tilt", kp_tilt);
+  check.NonNegative("kd_tilt", kd_tilt);
+  check.NonNegative("kp_yaw", kp_yaw);
+  check.NonNegative("kd_yaw", kd_yaw);
+  check.NonNegative("swing_kp", swing_kp);
+  check.NonNegative("swing_kd", swing_kd);
+  check.NonNegative("stance_kd", stance_kd);
+  check.Positive("friction", friction);
   for (const auto& [name, v] : hold)
-    if (!std::isfinite(v)) fail("hold." + name, "expected a finite ctrl value");
-  positive("rate_hz", rate_hz);
+    if (!std::isfinite(v)) check.Fail("hold." + name, "expected a finite ctrl value");
+  check.Positive("rate_hz", rate_hz);
 }
 
 TrotGait::TrotGait(TrotGaitParams params, ControllerContext context)

@@ -1,3 +1,4 @@
+#include "penumbra/control/param_check.h"
 #include "penumbra/control/waypoint_follower.h"
 
 #include <algorithm>
@@ -35,27 +36,21 @@ WaypointFollowerParams WaypointFollowerParams::Parse(ControllerParams& p,
 }
 
 void WaypointFollowerParams::ValidateOrThrow(const ControllerContext& c) const {
-  auto fail = [&](const std::string& key, const std::string& problem) {
-    throw ConfigError(c.file, c.line, c.key.empty() ? key : c.key + "." + key, problem);
-  };
-  auto positive = [&](const char* key, double v) {
-    if (!(std::isfinite(v) && v > 0))
-      fail(key, "got " + std::to_string(v) + "; expected a number > 0");
-  };
-  if (base_body.empty()) fail("base_body", "missing; expected a body name");
-  if (left_actuator.empty()) fail("left_actuator", "missing; expected an actuator name");
-  if (right_actuator.empty()) fail("right_actuator", "missing; expected an actuator name");
+  const ParamCheck check(c);
+  if (base_body.empty()) check.Fail("base_body", "missing; expected a body name");
+  if (left_actuator.empty()) check.Fail("left_actuator", "missing; expected an actuator name");
+  if (right_actuator.empty()) check.Fail("right_actuator", "missing; expected an actuator name");
   if (left_actuator == right_actuator)
-    fail("right_actuator", "same actuator as left_actuator; expected two different actuators");
-  positive("wheel_radius_m", wheel_radius_m);
-  positive("track_width_m", track_width_m);
-  positive("speed_m_s", speed_m_s);
-  positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);
-  positive("tolerance_m", tolerance_m);
-  positive("rate_hz", rate_hz);
-  if (waypoints.empty()) fail("waypoints", "empty; expected at least 1 [x, y] point");
+    check.Fail("right_actuator", "same actuator as left_actuator; expected two different actuators");
+  check.Positive("wheel_radius_m", wheel_radius_m);
+  check.Positive("track_width_m", track_width_m);
+  check.Positive("speed_m_s", speed_m_s);
+  check.Positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);
+  check.Positive("tolerance_m", tolerance_m);
+  check.Positive("rate_hz", rate_hz);
+  if (waypoints.empty()) check.Fail("waypoints", "empty; expected at least 1 [x, y] point");
   for (const auto& w : waypoints)
-    if (!w.allFinite()) fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
+    if (!w.allFinite()) check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
 }
 
 WaypointFollower::WaypointFollower(WaypointFollowerParams params, ControllerContext context)
