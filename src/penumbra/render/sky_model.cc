@@ -22,9 +22,11 @@ constexpr int kSampleCols = 256;  // phi in [0, 2 pi)
 // irradiance quadrature: cells over the upper hemisphere only (the ground is analytic).
 constexpr int kQuadRows = 64;  // theta in [0, pi / 2]
 constexpr int kQuadCols = 128;
-// irradiance table: nodes over normal directions, bilinear in (theta, phi).
-constexpr int kIrrRows = 33;  // theta_i = i pi / (kIrrRows - 1), poles included
-constexpr int kIrrCols = 64;  // phi_j = 2 pi j / kIrrCols, wraps
+// irradiance table: nodes over directions on an octahedral map (Praun and
+// Hoppe, "Spherical parametrization and remeshing", SIGGRAPH 2003; Cigolle et al., "A survey
+// of efficient representations for independent unit vectors", JCGT 2014), bilinear between
+// nodes: looking up a direction needs no trigonometry.
+constexpr int kIrrSide = 49;  // irradiance nodes per side (odd: the axes are nodes)
 
 // Rec. 709 / sRGB luminance weights (row Y of the RGB -> XYZ matrix, D65 white), IEC 61966-2-1.
 double Luminance(const Eigen::Vector3d& rgb) {
@@ -109,6 +111,45 @@ struct Perez {
   }
 };
 
+// octahedral map of a unit direction to [0, 1]^2 (continuous over the sphere).
+inline void OctEncode(const Eigen::Vector3f& d, float* s, float* t) {
+  const float inv = 1.0f / (std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z()));
+  float x = d.x() * inv, y = d.y() * inv;
+  if (d.z() < 0) {
+    const float fx = (1 - std::abs(y)) * (x >= 0 ? 1.0f : -1.0f);
+    const float fy = (1 - std::abs(x)) * (y >= 0 ? 1.0f : -1.0f);
+    x = fx, y = fy;
+  }
+  *s = x * 0.5f + 0.5f;
+  *t = y * 0.5f + 0.5f;
+}
+
+// inverse of OctEncode: the unit direction of (s, t) in [0, 1]^2.
+Eigen::Vector3d OctDecode(double s, double t) {
+  double x = 2 * s - 1, y = 2 * t - 1;
+  const double z = 1 - std::abs(x) - std::abs(y);
+  if (z < 0) {
+    const double fx = (1 - std::abs(y)) * (x >= 0 ? 1.0 : -1.0);
+    const double fy = (1 - std::abs(x)) * (y >= 0 ? 1.0 : -1.0);
+    x = fx, y = fy;
+  }
+  return Eigen::Vector3d(x, y, z).normalized();
+}
+
+// bilinear interpolation of a (side x side) node table at the octahedral coordinates of d.
+template <typename T>
+T OctLookup(const std::vector<T>& table, int side, const Eigen::Vector3f& d) {
+  float s, t;
+  OctEncode(d, &s, &t);
+  const float fs = s * (side - 1), ft = t * (side - 1);
+  const int c0 = std::clamp(static_cast<int>(fs), 0, side - 2);
+  const int r0 = std::clamp(static_cast<int>(ft), 0, side - 2);
+  const float a = std::clamp(ft - r0, 0.0f, 1.0f), b = std::clamp(fs - c0, 0.0f, 1.0f);
+  const T* row0 = table.data() + static_cast<size_t>(r0) * side + c0;
+  const T* row1 = row0 + side;
+  return (1 - a) * ((1 - b) * row0[0] + b * row0[1]) + a * ((1 - b) * row1[0] + b * row1[1]);
+}
+
 }  // namespace
 
 struct SkyModel::Impl {
@@ -124,7 +165,7 @@ struct SkyModel::Impl {
   // sampling: marginal over rows (theta), conditionals per row over phi.
   std::vector<Distribution1D> conditional;
   std::unique_ptr<Distribution1D> marginal;
-  // irradiance table (kIrrRows x kIrrCols), per channel.
+  // irradiance table (kIrrSide x kIrrSide octahedral nodes), per channel.
   std::vector<Eigen::Vector3f> irradiance;
 
   Eigen::Vector3d Upper(const Eigen::Vector3d& d) const;
@@ -209,11 +250,11 @@ void SkyModel::Impl::BuildIrradiance() {
     }
   }
   const Eigen::Vector3d g = type == Sky::Type::kUniform ? uniform : ground;
-  irradiance.resize(static_cast<size_t>(kIrrRows) * kIrrCols);
-  for (int r = 0; r < kIrrRows; ++r) {
-    const double theta = r * kPi / (kIrrRows - 1);
-    for (int c = 0; c < kIrrCols; ++c) {
-      const Eigen::Vector3d n = DirectionFromAngles(theta, c * 2 * kPi / kIrrCols);
+  irradiance.resize(static_cast<size_t>(kIrrSide) * kIrrSide);
+  for (int r = 0; r < kIrrSide; ++r) {
+    for (int c = 0; c < kIrrSide; ++c) {
+      const Eigen::Vector3d n = OctDecode(static_cast<double>(c) / (kIrrSide - 1),
+                                          static_cast<double>(r) / (kIrrSide - 1));
       const float nx = static_cast<float>(n.x()), ny = static_cast<float>(n.y()),
                   nz = static_cast<float>(n.z());
       double er = 0, eg = 0, eb = 0;
@@ -230,7 +271,7 @@ void SkyModel::Impl::BuildIrradiance() {
         eb += sb;
       }
       const Eigen::Vector3d e = Eigen::Vector3d(er, eg, eb) + g * (kPi * 0.5 * (1 - n.z()));
-      irradiance[static_cast<size_t>(r) * kIrrCols + c] = e.cast<float>();
+      irradiance[static_cast<size_t>(r) * kIrrSide + c] = e.cast<float>();
     }
   }
 }
@@ -319,20 +360,7 @@ Eigen::Vector3f SkyModel::Radiance(const Eigen::Vector3f& dir_W) const {
 }
 
 Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
-  const Impl& m = *impl_;
-  const double theta = std::acos(std::clamp(static_cast<double>(n_W.z()), -1.0, 1.0));
-  double phi = std::atan2(static_cast<double>(n_W.y()), static_cast<double>(n_W.x()));
-  if (phi < 0) phi += 2 * kPi;
-  const double ft = theta / kPi * (kIrrRows - 1);
-  const double fp = phi / (2 * kPi) * kIrrCols;
-  const int r0 = std::clamp(static_cast<int>(ft), 0, kIrrRows - 2);
-  const int c0 = std::clamp(static_cast<int>(fp), 0, kIrrCols - 1);
-  const int c1 = (c0 + 1) % kIrrCols;
-  const float a = static_cast<float>(std::clamp(ft - r0, 0.0, 1.0));
-  const float b = static_cast<float>(std::clamp(fp - c0, 0.0, 1.0));
-  auto at = [&](int r, int c) { return m.irradiance[static_cast<size_t>(r) * kIrrCols + c]; };
-  return (1 - a) * ((1 - b) * at(r0, c0) + b * at(r0, c1)) +
-         a * ((1 - b) * at(r0 + 1, c0) + b * at(r0 + 1, c1));
+  return OctLookup(impl_->irradiance, kIrrSide, n_W);
 }
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {

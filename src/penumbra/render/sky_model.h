@@ -24,7 +24,8 @@ class SkyModel {
   Eigen::Vector3f Radiance(const Eigen::Vector3f& dir_W) const;
 
   /// irradiance (lux per channel) on a surface with unit normal n_W from the whole sky,
-  /// ignoring occlusion: integral of Radiance(w) max(0, n.w) dw. precomputed, cheap.
+  /// ignoring occlusion: integral of Radiance(w) max(0, n.w) dw. precomputed on an octahedral
+  /// grid of normals, bilinear between nodes (no trigonometry; within 1% of the integral).
   Eigen::Vector3f Irradiance(const Eigen::Vector3f& n_W) const;
 
   /// samples a direction with density roughly proportional to radiance from two
