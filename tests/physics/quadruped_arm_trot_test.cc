@@ -26,12 +26,6 @@ std::string Config(const std::string& commands) {
          "\nswing_kp: 200\nswing_kd: 4\nswing_height_m: 0.1\n" + hold;
 }
 
-Pose Trunk(const Rig& rig) {
-  WorldSnapshot snap;
-  rig.sim.Snapshot(&snap);
-  return snap.X_WB[rig.trunk];
-}
-
 // largest deviation (rad) of the arm joints from the held pose from `t_from` until `t_to`
 double RunTracking(Rig* rig, double t_from, double t_to) {
   std::vector<int> adr;

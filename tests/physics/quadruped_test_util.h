@@ -166,6 +166,18 @@ inline Rig MakeRig(const std::string& robot, Ground ground, const std::string& c
   return rig;
 }
 
+/// X_W_trunk: the trunk's pose at the simulation's current state.
+inline Pose Trunk(const Rig& rig) {
+  WorldSnapshot snap;
+  rig.sim.Snapshot(&snap);
+  return snap.X_WB[rig.trunk];
+}
+
+/// steps the rig's simulation until its time reaches t_sec.
+inline void RunUntil(Rig* rig, double t_sec) {
+  while (rig->sim.time() < t_sec - 1e-9) rig->sim.Step();
+}
+
 /// yaw of the trunk (rad) from a pose.
 inline double Yaw(const Pose& X) { return std::atan2(X.linear()(1, 0), X.linear()(0, 0)); }
 

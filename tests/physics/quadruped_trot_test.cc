@@ -24,16 +24,6 @@ std::string Config(const std::string& commands, const std::string& legs = LegsYa
   return "base_body: trunk\n" + legs + "commands: " + commands + "\n";
 }
 
-Pose Trunk(const Rig& rig) {
-  WorldSnapshot snap;
-  rig.sim.Snapshot(&snap);
-  return snap.X_WB[rig.trunk];
-}
-
-void RunUntil(Rig* rig, double t_sec) {
-  while (rig->sim.time() < t_sec - 1e-9) rig->sim.Step();
-}
-
 TEST(QuadrupedTrot, ModelGeometryAndMassAreReadFromTheModel) {
   Rig rig = MakeRig("quadruped", Ground::kFlat, Config("[]"));
   EXPECT_NEAR(rig.gait->mass_kg(), 12.316, 1e-9);

@@ -25,16 +25,6 @@ std::string WaypointConfig(const std::string& waypoints, bool loop, const std::s
          "\n" + extra;
 }
 
-Pose Trunk(const Rig& rig) {
-  WorldSnapshot snap;
-  rig.sim.Snapshot(&snap);
-  return snap.X_WB[rig.trunk];
-}
-
-void RunUntil(Rig* rig, double t_sec) {
-  while (rig->sim.time() < t_sec - 1e-9) rig->sim.Step();
-}
-
 // a 1.5 m square counter-clockwise from the start (origin, heading +x): each waypoint is
 // reached in order, within the tolerance, in bounded time; the trunk never touches the
 // ground; after the last one the (script-less) robot trots in place there. pure pursuit with
