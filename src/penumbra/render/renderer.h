@@ -20,6 +20,7 @@ struct CameraView {
   CameraOutputs outputs;
   int64_t frame_index = 0;  ///< per-camera frame counter, keys the per-pixel random numbers
   int camera_index = 0;     ///< index in SceneDescription::cameras, keys the random numbers too
+  double exposure_time_sec = 0.01;  ///< shutter open time from the snapshot's time (streaks, blur)
 };
 
 /// images of one frame; the ones not requested are left empty.

@@ -155,6 +155,7 @@ struct CameraSpec {
   Pose X_BO = Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in the body frame
   CameraIntrinsics intrinsics;
   double rate_hz = 10.0;    ///< frames per second of simulated time
+  double exposure_time_sec = 0.01;  ///< shutter open time (motion blur, particle streaks)
   CameraOutputs outputs;
 };
 

@@ -4,9 +4,11 @@
 // another thread, or later from a recording, without the physics engine.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
 
@@ -25,6 +27,10 @@ struct WorldSnapshot {
   /// joint positions and velocities (MuJoCo qpos / qvel), for recording and replay.
   std::vector<double> qpos;
   std::vector<double> qvel;
+  /// adverse conditions at this instant (media, particles, lighting changes), filled by the
+  /// effects stage after physics; null = clear conditions. shared so that queued snapshots
+  /// do not copy voxel grids.
+  std::shared_ptr<const EffectsFrame> effects;
 };
 
 }  // namespace penumbra
