@@ -99,6 +99,7 @@ class Checker {
     In(p + ".dissipation_per_s", f.dissipation_per_s, Range::AtLeast(0));
     In(p + ".cooling_per_s", f.cooling_per_s, Range::AtLeast(0));
     In(p + ".ambient_temperature_k", f.ambient_temperature_k, Range::Closed(200, 400));
+    In(p + ".turbulence_m_s", f.turbulence_m_s, Range::Closed(0, 20));
     if (f.emitters.empty()) {
       Fail(p + ".emitters", "no emitters; expected a list of at least one emitter");
     }

@@ -98,7 +98,10 @@ struct FluidParams {
   double dissipation_per_s = 0.1;         ///< density decay rate k (d rho/dt = -k rho), >= 0
   double cooling_per_s = 1.5;             ///< temperature excess decay rate, >= 0
   double ambient_temperature_k = 293.15;  ///< [200, 400]
-  std::vector<PlumeEmitter> emitters;     ///< at least one
+  /// random horizontal velocity kick per step at each emitter, uniform in [-t, t] m/s per
+  /// axis from the seed (breaks the symmetry, makes flames flicker), [0, 20].
+  double turbulence_m_s = 0.5;
+  std::vector<PlumeEmitter> emitters;  ///< at least one
 };
 
 /// smoke: `noise` = fBm value noise translated by the wind (stateless), `plume` = grid fluid.
@@ -137,7 +140,10 @@ struct VdbSmokeParams {
 /// BlackbodyLinearSrgb(T), L_bb = blackbody luminance (blackbody.h); extinction
 /// sigma_t = density_scale_per_m * density (soot). the glow is also added as a point
 /// light in extra_lights at the emission centroid with intensity
-///   I = sum_voxels j_Y dV  (cd)   (optically thin: luminous flux 4 pi sum j_Y dV over 4 pi sr).
+///   I = sum_voxels j_Y dV  (cd)   (optically thin: luminous flux 4 pi sum j_Y dV over 4 pi sr),
+/// coloured by the emission-weighted mean colour c (max component 1), stored as
+/// Light::intensity = I / Y(c) since the renderer multiplies intensity by the tint. the
+/// light follows the fire's emitted power, so it flickers with the flame.
 struct FireParams {
   FluidParams fluid;
   double density_scale_per_m = 1.0;         ///< soot extinction at density 1, > 0
@@ -187,8 +193,9 @@ struct SnowParams {
 
 /// sparks: embers born at rate_per_s at `position_W` (or at the first emitter of the fire
 /// named `fire`), with initial speed speed_m_s in a cone of spread_deg around +z, moving
-/// ballistically under gravity minus buoyancy and drag-free; each lives lifetime_sec and
-/// cools from temperature_k (emission colour = blackbody, luminance halves per half-life).
+/// ballistically (drag-free) under gravity_m_s2 (gravity minus buoyancy); each lives
+/// lifetime_sec and its radius shrinks linearly to 0 as it burns out. emission: the
+/// blackbody colour of temperature_k times luminance_cd_m2 (0 = the blackbody luminance).
 struct SparksParams {
   std::string fire;                     ///< name of a fire effect to sit on, or ""
   Eigen::Vector3d position_W{0, 0, 0};  ///< used when fire is ""
@@ -202,8 +209,8 @@ struct SparksParams {
   double luminance_cd_m2 = 0;           ///< 0 = blackbody luminance of temperature_k, else > 0
 };
 
-/// light_event: changes the intensity multiplier of scene lights named `light` ("*" =
-/// every light of the scene; also scales the sky for "blackout" of "*").
+/// light_event: changes the intensity multiplier of the scene light named `light` ("*" =
+/// every light of the scene); several events on one light multiply.
 ///  flicker: s = 1 - depth * n(t), n = smooth value noise in [0, 1] at frequency_hz.
 ///  failing: time is cut into slots of 1 / frequency_hz; a slot is off (s = min_scale)
 ///           with probability failure_probability, else s = 1 - 0.5 depth n(t).

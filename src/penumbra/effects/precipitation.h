@@ -1,0 +1,56 @@
+#pragma once
+// rain and snow particles around a viewer (models and citations in effect_config.h,
+// RainParams / SnowParams).
+//
+// sampling: particle i of an effect draws its size, its position in a periodic cell and its
+// drift phases from Rng(HashKeys(seed, effect key, i)). the cell (the box around the
+// viewer, size 2 x half extents) tiles space periodically; a particle's world position at
+// time t is its start position + displacement(t), wrapped into the box centred on the
+// viewer. the number density is therefore the same at every time and viewer position, and
+// a particle keeps its identity while it falls (no popping) unless it wraps around.
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "penumbra/effects/effect_config.h"
+#include "penumbra/scene/effects_frame.h"
+
+namespace penumbra {
+
+/// Marshall-Palmer slope Lambda = 4.1 R^-0.21, 1/mm, for R in mm/h (> 0).
+double MarshallPalmerLambda(double rate_mm_h);
+
+/// Marshall-Palmer intercept N0 = 8000 m^-3 mm^-1.
+constexpr double kMarshallPalmerN0 = 8000.0;
+
+/// number of drops per m^3 with diameter in [d_min_mm, d_max_mm]:
+/// integral of N0 exp(-Lambda D) dD = N0 / Lambda (exp(-Lambda d_min) - exp(-Lambda d_max)).
+double RainNumberDensity(double rate_mm_h, double d_min_mm, double d_max_mm);
+
+/// terminal fall speed of a raindrop of diameter d_mm, m/s: Atlas et al. 1973 fit to Gunn &
+/// Kinzer 1949, v = max(0, 9.65 - 10.3 exp(-0.6 D)).
+double RainTerminalVelocity(double d_mm);
+
+/// fall speed of a snow aggregate of diameter d_mm, m/s: Locatelli & Hobbs 1974,
+/// v = 0.81 D^0.16.
+double SnowFallSpeed(double d_mm);
+
+/// snowflakes per m^3 for a water-equivalent rate and nominal flake size (SnowParams).
+double SnowNumberDensity(const SnowParams& p);
+
+/// box half extents actually used: `half` shrunk uniformly so that density x volume stays
+/// <= max_particles.
+Eigen::Vector3d EffectiveHalfExtents(const Eigen::Vector3d& half, double density_per_m3,
+                                     int max_particles);
+
+/// rain drops at time t (sim seconds) around viewer_W. `weight` in [0, 1] thins the drops
+/// (drop i is kept when its own uniform draw is < weight); `region` (may be null) keeps only
+/// drops inside it. radius = D / 2, velocity = (wind_x, wind_y, -v(D)).
+ParticleSet SampleRain(const RainParams& p, double t, const Eigen::Vector3d& viewer_W,
+                       double weight, const BoxRegion* region, uint64_t seed, uint64_t effect_key);
+
+/// snowflakes at time t (see SnowParams for the drift model).
+ParticleSet SampleSnow(const SnowParams& p, double t, const Eigen::Vector3d& viewer_W,
+                       double weight, const BoxRegion* region, uint64_t seed, uint64_t effect_key);
+
+}  // namespace penumbra
