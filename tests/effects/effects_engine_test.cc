@@ -1,0 +1,265 @@
+// EffectsEngine: media, fire glow, smoke determinism, flashlight, sun, wetness, config errors.
+#include "penumbra/effects/effects_engine.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "penumbra/core/error.h"
+#include "penumbra/effects/blackbody.h"
+
+namespace penumbra {
+namespace {
+
+EffectConfig Fog() {
+  EffectConfig e;
+  e.name = "fog";
+  e.type = EffectType::kFog;
+  e.fog.extinction.mor_m = 50;
+  e.start_sec = 1;
+  e.stop_sec = 9;
+  e.fade_in_sec = 2;
+  return e;
+}
+
+TEST(EffectsEngineTest, EmptyConfigGivesAnEmptyFrame) {
+  EffectsEngine engine({}, 1, SceneDescription{});
+  auto f = engine.Evaluate(3.0, {0, 0, 0});
+  EXPECT_TRUE(f->empty());
+  EXPECT_EQ(f->time_sec, 3.0);
+}
+
+TEST(EffectsEngineTest, FogFromMorWithFadeIn) {
+  EffectsEngine engine({Fog()}, 1, SceneDescription{});
+  EXPECT_TRUE(engine.Evaluate(0.5, {0, 0, 0})->homogeneous_media.empty());
+  auto f = engine.Evaluate(2.0, {0, 0, 0});  // halfway through the fade
+  ASSERT_EQ(f->homogeneous_media.size(), 1u);
+  // Koschmieder: sigma_t = -ln(0.05) / MOR
+  EXPECT_NEAR(f->homogeneous_media[0].sigma_t_per_m.x(), 0.5 * 2.9957 / 50, 1e-5);
+  auto g = engine.Evaluate(5.0, {0, 0, 0});
+  EXPECT_NEAR(g->homogeneous_media[0].sigma_t_per_m.x(), 2.9957 / 50, 1e-5);
+  EXPECT_FLOAT_EQ(g->homogeneous_media[0].g, 0.8f);
+}
+
+EffectConfig Smoke(SmokeParams::Mode mode) {
+  EffectConfig e;
+  e.name = "smoke";
+  e.type = EffectType::kSmoke;
+  e.region = BoxRegion{{-1, -1, 0}, {1, 1, 2}};
+  e.smoke.mode = mode;
+  e.smoke.noise_resolution = 16;
+  e.smoke.fluid.resolution = 16;
+  PlumeEmitter em;
+  em.position_W = {0, 0, 0.3};
+  e.smoke.fluid.emitters = {em};
+  e.smoke.wind_m_s =
+      mode == SmokeParams::Mode::kPlume ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5, 0, 0);
+  return e;
+}
+
+TEST(EffectsEngineTest, SmokeIsDeterministicPerSeedAndRestartsWhenTimeGoesBack) {
+  for (auto mode : {SmokeParams::Mode::kNoise, SmokeParams::Mode::kPlume}) {
+    EffectsEngine a({Smoke(mode)}, 10, SceneDescription{});
+    EffectsEngine b({Smoke(mode)}, 10, SceneDescription{});
+    EffectsEngine c({Smoke(mode)}, 11, SceneDescription{});
+    std::vector<float> da, db, dc;
+    for (double t : {0.2, 0.5, 1.0}) {
+      da = *a.Evaluate(t, {0, 0, 0})->grid_media.at(0).density;
+      db = *b.Evaluate(t, {0, 0, 0})->grid_media.at(0).density;
+      dc = *c.Evaluate(t, {0, 0, 0})->grid_media.at(0).density;
+    }
+    EXPECT_EQ(da, db);
+    EXPECT_NE(da, dc);
+    for (float d : da) ASSERT_GE(d, 0.0f);
+    // b jumps straight to 1.0 after going back to 0.3: same state as a at 1.0
+    EffectsEngine d({Smoke(mode)}, 10, SceneDescription{});
+    d.Evaluate(1.0, {0, 0, 0});
+    d.Evaluate(0.3, {0, 0, 0});
+    EXPECT_EQ(*d.Evaluate(1.0, {0, 0, 0})->grid_media.at(0).density, da);
+  }
+}
+
+TEST(EffectsEngineTest, FireEmitsBlackbodyLightAndItsGlowMatchesTheEmittedPower) {
+  EffectConfig e;
+  e.name = "fire";
+  e.type = EffectType::kFire;
+  e.region = BoxRegion{{-0.5, -0.5, 0}, {0.5, 0.5, 1.5}};
+  e.fire.fluid.resolution = 16;
+  PlumeEmitter em;
+  em.position_W = {0, 0, 0.15};
+  em.radius_m = 0.15;
+  em.rate = 0.3;
+  em.temperature_k = 1500;
+  e.fire.fluid.emitters = {em};
+  EffectsEngine engine({e}, 3, SceneDescription{});
+  std::vector<float> intensities;
+  for (double t = 0.5; t <= 2.0; t += 0.25) {
+    auto f = engine.Evaluate(t, {0, 0, 0});
+    ASSERT_EQ(f->grid_media.size(), 1u);
+    const GridMedium& g = f->grid_media[0];
+    ASSERT_TRUE(g.emission);
+    ASSERT_EQ(f->extra_lights.size(), 1u);
+    const Light& l = f->extra_lights[0];
+    // documented relation: Y(colour) x intensity = sum of emitted luminance x voxel volume
+    const double dv = (2 * g.half_extents_m).prod() / (g.nx * g.ny * g.nz);
+    double sum_y = 0;
+    Eigen::Vector3d sum_rgb = Eigen::Vector3d::Zero();
+    for (size_t v = 0; v < g.emission->size() / 3; ++v) {
+      const Eigen::Vector3d c((*g.emission)[3 * v], (*g.emission)[3 * v + 1],
+                              (*g.emission)[3 * v + 2]);
+      sum_y += LinearSrgbLuminance(c) * dv;
+      sum_rgb += c;
+    }
+    EXPECT_NEAR(l.intensity * LinearSrgbLuminance(l.color.cast<double>()), sum_y, 1e-3 * sum_y);
+    // flame colours: red > green > blue
+    EXPECT_GT(sum_rgb.x(), sum_rgb.y());
+    EXPECT_GT(sum_rgb.y(), sum_rgb.z());
+    EXPECT_GT(l.position_B.z(), 0.1);
+    intensities.push_back(l.intensity);
+  }
+  // it flickers: the glow changes from frame to frame
+  const auto [lo, hi] = std::minmax_element(intensities.begin(), intensities.end());
+  EXPECT_GT(*hi, *lo * 1.01);
+}
+
+TEST(EffectsEngineTest, FlashlightFollowsWaypointsOrItsBody) {
+  EffectConfig e;
+  e.name = "torch";
+  e.type = EffectType::kFlashlight;
+  e.flashlight.waypoints = {{0, {0, 0, 1}, {1, 0, 0}}, {2, {2, 0, 1}, {0, 1, 0}}};
+  EffectsEngine engine({e}, 1, SceneDescription{});
+  auto f = engine.Evaluate(1.0, {0, 0, 0});
+  ASSERT_EQ(f->extra_lights.size(), 1u);
+  const Light& l = f->extra_lights[0];
+  EXPECT_EQ(l.type, Light::Type::kSpot);
+  EXPECT_NEAR((l.position_B - Eigen::Vector3d(1, 0, 1)).norm(), 0, 1e-12);
+  EXPECT_NEAR((l.direction_B - Eigen::Vector3d(1, 1, 0).normalized()).norm(), 0, 1e-12);
+  EXPECT_FLOAT_EQ(l.intensity, 300.0f);
+
+  SceneDescription scene;
+  scene.bodies.resize(2);
+  scene.bodies[1].name = "robot/base";
+  EffectConfig a;
+  a.name = "head";
+  a.type = EffectType::kFlashlight;
+  a.flashlight.attach = "robot/base";
+  a.flashlight.position_B = {0.2, 0, 0.1};
+  a.flashlight.direction_B = {1, 0, 0};
+  EffectsEngine attached({a}, 1, scene);
+  std::vector<Pose> X_WB(2, Pose::Identity());
+  X_WB[1] = PoseFromXyzRpyDeg({1, 2, 0}, {0, 0, 90});
+  auto g = attached.Evaluate(0.0, {0, 0, 0}, &X_WB);
+  EXPECT_NEAR((g->extra_lights[0].position_B - Eigen::Vector3d(1, 2.2, 0.1)).norm(), 0, 1e-12);
+  EXPECT_NEAR((g->extra_lights[0].direction_B - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-12);
+  EXPECT_THROW(attached.Evaluate(0.0, {0, 0, 0}), Error);
+  a.flashlight.attach = "robot/arm";
+  EXPECT_THROW(EffectsEngine({a}, 1, scene), ConfigError);
+}
+
+TEST(EffectsEngineTest, SunSetsDirectionAndDimsTheSkyAtNight) {
+  EffectConfig e;
+  e.name = "sun";
+  e.type = EffectType::kSun;
+  e.sun.latitude_deg = 48.14;
+  e.sun.longitude_deg = 11.58;
+  e.sun.year = 2024;
+  e.sun.month = 6;
+  e.sun.day = 21;
+  e.sun.time_utc_h = 11.0;  // about local solar noon in Munich
+  e.sun.time_scale = 3600;  // one hour per sim second
+  EffectsEngine engine({e}, 1, SceneDescription{});
+  auto noon = engine.Evaluate(0.0, {0, 0, 0});
+  ASSERT_TRUE(noon->sun_direction_W);
+  // noon elevation = 90 - lat + declination (23.44) ~ 65.3 deg, sun due south
+  EXPECT_NEAR(std::asin(noon->sun_direction_W->z()) * 180 / M_PI, 65.3, 0.5);
+  EXPECT_LT(noon->sun_direction_W->y(), 0);
+  EXPECT_EQ(noon->sky_luminance_scale, 1.0f);
+  auto night = engine.Evaluate(12.0, {0, 0, 0});  // 23:00 UTC
+  EXPECT_LT(night->sun_direction_W->z(), 0);
+  EXPECT_LT(night->sky_luminance_scale, 0.01f);
+}
+
+TEST(EffectsEngineTest, WetnessFollowsRain) {
+  EffectConfig rain;
+  rain.name = "rain";
+  rain.type = EffectType::kRain;
+  rain.start_sec = 10;
+  rain.stop_sec = 70;
+  rain.rain.box_half_extents_m = {1, 1, 1};
+  EffectConfig wet;
+  wet.name = "wet";
+  wet.type = EffectType::kWetness;
+  wet.wetness.wetting_time_sec = 20;
+  wet.wetness.drying_time_sec = 100;
+  EffectsEngine engine({rain, wet}, 1, SceneDescription{});
+  EXPECT_EQ(engine.Evaluate(5, {0, 0, 0})->surface_wetness, 0.0f);
+  auto during = engine.Evaluate(30, {0, 0, 0});
+  EXPECT_NEAR(during->surface_wetness, 1 - std::exp(-1.0), 1e-6);
+  EXPECT_EQ(during->particles.size(), 1u);
+  const double at_stop = 1 - std::exp(-3.0);
+  auto after = engine.Evaluate(170, {0, 0, 0});
+  EXPECT_NEAR(after->surface_wetness, at_stop * std::exp(-1.0), 1e-6);
+  EXPECT_TRUE(after->particles.empty());
+}
+
+TEST(EffectConfigTest, ErrorsNameEffectKeyAndRange) {
+  EffectConfig e = Fog();
+  e.fog.extinction.mor_m = 0.0;
+  try {
+    e.ValidateOrThrow("effects[4]");
+    FAIL();
+  } catch (const ConfigError& err) {
+    EXPECT_EQ(err.key(), "effects[4].fog.mor_m");
+    EXPECT_NE(std::string(err.what()).find("effect 'fog' (fog)"), std::string::npos);
+    EXPECT_NE(std::string(err.what()).find(">= 0.001"), std::string::npos) << err.what();
+  }
+  EffectConfig r;
+  r.name = "r";
+  r.type = EffectType::kRain;
+  r.rain.rate_mm_h = -1;
+  EXPECT_EQ(r.Validate()->key, "rain.rate_mm_h");
+  r.rain.rate_mm_h = 5;
+  r.region = BoxRegion{{0, 0, 0}, {1, -1, 1}};
+  EXPECT_EQ(r.Validate()->key, "region.min");
+  r.region.reset();
+  EXPECT_FALSE(r.Validate());
+  EffectConfig s = Smoke(SmokeParams::Mode::kPlume);
+  s.smoke.fluid.emitters[0].position_W = {5, 0, 0};
+  EXPECT_EQ(s.Validate()->key, "smoke.emitters[0].position");
+  // duplicate names and dangling references
+  EXPECT_THROW(ValidateEffectsOrThrow({Fog(), Fog()}), ConfigError);
+  EffectConfig w;
+  w.name = "w";
+  w.type = EffectType::kWetness;
+  try {
+    ValidateEffectsOrThrow({Fog(), w}, "world.yaml", [](const std::string&) { return 12; });
+    FAIL();
+  } catch (const ConfigError& err) {
+    EXPECT_EQ(err.key(), "effects[1].wetness.rain");
+    EXPECT_EQ(err.line(), 12);
+    EXPECT_EQ(err.file(), "world.yaml");
+  }
+}
+
+TEST(EffectsEngineTest, SparksRiseFromTheirSourceAndFallBack) {
+  EffectConfig e;
+  e.name = "sparks";
+  e.type = EffectType::kSparks;
+  e.sparks.position_W = {1, 1, 0.5};
+  e.sparks.rate_per_s = 100;
+  e.sparks.lifetime_sec = 1;
+  EffectsEngine engine({e}, 1, SceneDescription{});
+  auto f = engine.Evaluate(3.0, {0, 0, 0});
+  ASSERT_EQ(f->particles.size(), 1u);
+  const ParticleSet& s = f->particles[0];
+  EXPECT_EQ(s.kind, ParticleKind::kSpark);
+  EXPECT_NEAR(static_cast<double>(s.position_W.size()), 100.0, 1.0);
+  EXPECT_GT(s.emission.x(), s.emission.z());
+  for (size_t i = 0; i < s.position_W.size(); ++i) {
+    ASSERT_LE(s.radius_m[i], 0.004f);
+    ASSERT_LT((s.position_W[i] - Eigen::Vector3f(1, 1, 0.5)).norm(), 2.6f);
+  }
+}
+
+}  // namespace
+}  // namespace penumbra
