@@ -27,6 +27,11 @@ std::string RunManifestJson(const RunManifest& m) {
   for (const auto& [name, s] : m.timings_sec) timings[name] = s;
   j["timings_sec"] = timings;
   j["peak_resident_memory_mib"] = m.peak_resident_memory_mib;
+  if (!m.adversity.empty() || !m.effects.empty() || !m.agents.empty()) {
+    j["adversity"] = m.adversity;
+    j["effects"] = m.effects;
+    j["agents"] = m.agents;
+  }
   return j.dump(2) + "\n";
 }
 

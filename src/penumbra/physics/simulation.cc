@@ -10,6 +10,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/physics/mujoco_runtime.h"
 #include "penumbra/physics/scene_extractor.h"
+#include "penumbra/physics/sensor_snapshot.h"
 
 namespace penumbra {
 namespace {
@@ -182,6 +183,12 @@ struct Simulation::Impl {
   std::vector<std::string> warnings;
   std::vector<int> qpos_joint;  // (nq) joint owning each qpos entry
   std::vector<double> jacp, jacr;
+  std::vector<MujocoSensorInfo> sensor_info;
+  struct MocapDriver {
+    int mocap_id = -1;
+    std::function<Pose(double)> X_WB;
+  };
+  std::vector<MocapDriver> mocap_drivers;
   bool failed = false;
   std::string failure;
 
@@ -251,6 +258,19 @@ struct Simulation::Impl {
       }
       Schedule& s = schedule[i];
       if (s.rate_hz > 0) s.next = static_cast<int64_t>(std::floor((t + tol) * s.rate_hz)) + 1;
+    }
+  }
+
+  // poses every driven mocap body for sim time t
+  void ApplyMocapDrivers(double t) {
+    for (const MocapDriver& md : mocap_drivers) {
+      const Pose X = md.X_WB(t);
+      const Eigen::Quaterniond q(X.linear());
+      for (int k = 0; k < 3; ++k) d->mocap_pos[3 * md.mocap_id + k] = X.translation()[k];
+      d->mocap_quat[4 * md.mocap_id + 0] = q.w();
+      d->mocap_quat[4 * md.mocap_id + 1] = q.x();
+      d->mocap_quat[4 * md.mocap_id + 2] = q.y();
+      d->mocap_quat[4 * md.mocap_id + 3] = q.z();
     }
   }
 
@@ -347,6 +367,7 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   }
   impl->scene = ExtractScene(m, d);
   impl->info = BuildModelInfo(m);
+  impl->sensor_info = DescribeMujocoSensors(m);
   impl->qpos_joint.assign(m->nq, 0);
   for (int j = 0; j < m->njnt; ++j) {
     const int adr = m->jnt_qposadr[j];
@@ -395,6 +416,24 @@ void Simulation::AddController(std::unique_ptr<Controller> controller) {
   impl_->due.push_back(0);
 }
 
+void Simulation::AddMocapDriver(const std::string& body_name,
+                                std::function<Pose(double time_sec)> X_WB) {
+  const mjModel* m = impl_->m;
+  const int body = mj_name2id(m, mjOBJ_BODY, body_name.c_str());
+  if (body < 0)
+    throw ConfigError("", 0, "mocap driver",
+                      "no body named '" + body_name + "' in " + impl_->source +
+                          "; expected the name of a mocap body");
+  const int mocap = m->body_mocapid[body];
+  if (mocap < 0)
+    throw ConfigError("", 0, "mocap driver",
+                      "body '" + body_name + "' is not a mocap body; expected a body with "
+                      "mocap=\"true\"");
+  if (!X_WB) throw Error("Simulation::AddMocapDriver: empty pose function for '" + body_name + "'");
+  impl_->mocap_drivers.push_back({mocap, std::move(X_WB)});
+  impl_->ApplyMocapDrivers(impl_->d->time);
+}
+
 void Simulation::Step() {
   Impl& s = *impl_;
   if (s.failed) throw PhysicsError(s.failure + " (the simulation cannot continue)");
@@ -434,6 +473,7 @@ void Simulation::Step() {
   s.steps = step;
   s.CheckWarnings(t, step);
   s.CheckFinite(t, step);
+  if (!s.mocap_drivers.empty()) s.ApplyMocapDrivers(d->time);
 }
 
 double Simulation::time() const { return impl_->d->time; }
@@ -454,9 +494,10 @@ void Simulation::Snapshot(WorldSnapshot* out) const {
   std::memcpy(d->mocap_pos, live->mocap_pos, sizeof(mjtNum) * 3 * m->nmocap);
   std::memcpy(d->mocap_quat, live->mocap_quat, sizeof(mjtNum) * 4 * m->nmocap);
   try {
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_camlight(m, d);
+    // the whole forward pass on the scratch copy of the state: sensors, body velocities and
+    // contacts for this instant (mj_step's own sensordata belong to the previous step)
+    CopyStateForForward(m, live, d);
+    mj_forward(m, d);
   } catch (const MujocoError& e) {
     throw PhysicsError(impl_->When(live->time, impl_->steps) + ": MuJoCo error: " + e.what());
   }
@@ -484,6 +525,11 @@ void Simulation::Snapshot(WorldSnapshot* out) const {
   }
   out->qpos.assign(live->qpos, live->qpos + m->nq);
   out->qvel.assign(live->qvel, live->qvel + m->nv);
+  FillSensorGroundTruth(m, d, out);
+}
+
+const std::vector<MujocoSensorInfo>& Simulation::sensor_info() const {
+  return impl_->sensor_info;
 }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }

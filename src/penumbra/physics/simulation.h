@@ -18,6 +18,7 @@
 // different threads. loading is serialised internally (MuJoCo's loader has global state).
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -26,6 +27,7 @@
 
 #include "penumbra/control/controller.h"
 #include "penumbra/control/model_info.h"
+#include "penumbra/physics/sensor_readout.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -55,6 +57,16 @@ class Simulation {
   /// @throws ConfigError from Controller::Initialize (lists every missing name).
   void AddController(std::unique_ptr<Controller> controller);
 
+  /// drives the mocap body `body_name` kinematically (NPC agents, effects/agent_path.h):
+  /// its mocap_pos / mocap_quat are set to X_WB(t) now (t = time()) and after every
+  /// Step() for the new time, so the body's pose always matches the sim time, for the
+  /// controllers, the contacts of the next step and Snapshot(). coupling is one-way:
+  /// other bodies collide with it and are pushed; it ignores contact. X_WB must be a pure
+  /// function of t (determinism). drivers apply in the order they were added.
+  /// @throws ConfigError("", 0, "mocap driver", ...) naming the body if no body has that
+  ///         name or it is not a mocap body (MJCF mocap="true").
+  void AddMocapDriver(const std::string& body_name, std::function<Pose(double time_sec)> X_WB);
+
   /// advances one timestep: controllers that are due (on sim time, see
   /// Controller::rate_hz) read the current state and write ctrl, then MuJoCo integrates.
   /// no allocation in steady state.
@@ -75,6 +87,10 @@ class Simulation {
   WorldSnapshot Snapshot() const;
   /// as Snapshot(), reusing `out`'s storage.
   void Snapshot(WorldSnapshot* out) const;
+
+  /// the model's MuJoCo sensors (name, type, dimension, unit, object), by sensor id; their
+  /// values are WorldSnapshot::sensordata (physics/sensor_readout.h).
+  const std::vector<MujocoSensorInfo>& sensor_info() const;
 
   /// the static scene, extracted once at load (physics/scene_extractor.h).
   const SceneDescription& scene() const;

@@ -9,6 +9,9 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/world/adversity_preset.h"
+#include "penumbra/world/agents_reader.h"
+#include "penumbra/world/camera_config_reader.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -33,7 +36,8 @@ class WorldParser {
     YamlReader r(root, file_, lines_);
     const std::vector<std::string_view> keys = {"seed",    "duration_sec", "physics",   "render",
                                                 "sky",     "robots",       "models",    "lights",
-                                                "cameras", "mjcf_cameras", "materials", "output"};
+                                                "cameras", "mjcf_cameras", "materials", "output",
+                                                "agents",  "adversity", "semantic_classes"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -74,6 +78,13 @@ class WorldParser {
       YamlReader o = r.Child("output");
       o.ExpectMap({"dir"});
       if (o.Has("dir")) w.output_dir = o.Child("dir").String();
+    }
+    if (r.Has("semantic_classes")) w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
+    if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
+    if (r.Has("adversity")) {
+      const YamlReader a = r.Child("adversity");
+      w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());
+      w.adversity_line = a.line();
     }
     return w;
   }
@@ -229,8 +240,15 @@ class WorldParser {
   static CameraOutputs ReadOutputs(const YamlReader& r) {
     CameraOutputs o{false, false, false};
     for (const YamlReader& e : r.List()) {
-      const std::string v = e.Enum({"rgb", "depth", "segmentation"});
-      bool& flag = v == "rgb" ? o.rgb : v == "depth" ? o.depth : o.segmentation;
+      const std::string v = e.Enum({"rgb", "depth", "segmentation", "range", "normals",
+                                    "instance_segmentation", "semantic_segmentation"});
+      bool& flag = v == "rgb"                     ? o.rgb
+                   : v == "depth"                 ? o.depth
+                   : v == "segmentation"          ? o.segmentation
+                   : v == "range"                 ? o.range
+                   : v == "normals"               ? o.normals
+                   : v == "instance_segmentation" ? o.instance_segmentation
+                                                  : o.semantic_segmentation;
       if (flag) e.Fail("'" + v + "' is listed twice; expected each output once");
       flag = true;
     }
@@ -262,14 +280,17 @@ class WorldParser {
   }
 
   static CameraConfig ReadCamera(const YamlReader& r) {
-    r.ExpectMap({"name", "attach", "pose", "width", "height", "fovy_deg", "intrinsics", "rate_hz",
-                 "outputs"});
+    std::vector<std::string_view> keys = {"name",     "attach",     "pose",    "width", "height",
+                                          "fovy_deg", "intrinsics", "rate_hz", "outputs"};
+    keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());
+    r.ExpectMap(keys);
     CameraConfig c;
     c.name = r.Child("name").String();
     if (r.Has("attach")) c.attach = r.Child("attach").String();
     if (r.Has("pose")) ReadPose(r.Child("pose"), &c.pose);
     ReadCameraOptics(r, &c);
     if (!c.fovy_deg && !c.intrinsics) c.fovy_deg = 60;
+    ReadCameraSensorKeys(r, &c);
     return c;
   }
 

@@ -11,8 +11,11 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/effects/agent_path.h"
+#include "penumbra/effects/effect_config.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
+#include "penumbra/sensors/camera_sensor_config.h"
 
 namespace penumbra {
 
@@ -83,6 +86,19 @@ struct CameraConfig {
   bool is_mjcf_override = false;  ///< true: entry under `mjcf_cameras.overrides`
   /// true: pose chosen at load to frame the whole model (bare-model runs)
   bool auto_frame = false;
+  /// `distortion:` Brown-Conrady k1 k2 p1 p2 k3 (OpenCV order; see CameraIntrinsics)
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+  /// exposure, motion blur, rolling shutter, noise, JPEG, droplets, depth noise, stereo
+  CameraSensorConfig sensor;
+};
+
+/// `semantic_classes:` entry: geoms whose name, body name or material name matches one of the
+/// glob patterns ('*' any run, '?' one character; MJCF names are "<model>/<name>") get class `id`.
+/// the first matching entry in file order wins.
+struct SemanticClassConfig {
+  std::string name;  ///< class name (documentation, label files)
+  int id = 0;        ///< 1..65535 (0 = unlabelled)
+  std::vector<std::string> bodies, geoms, materials;  ///< glob patterns
 };
 
 /// defaults applied to every camera that an MJCF model declares.
@@ -117,8 +133,17 @@ struct WorldConfig {
   std::vector<CameraConfig> cameras;
   MjcfCameraDefaults mjcf_cameras;
   std::vector<MaterialOverride> materials;
+  std::vector<SemanticClassConfig> semantic_classes;  ///< `semantic_classes:` in file order
   RenderSettings render;  ///< `render:` block (render/render_settings.h); seed copied from `seed`
   std::string output_dir = "out";
+  /// `effects:` adverse conditions (effects/effect_config.h; parsed by world/effects_reader.h).
+  std::vector<EffectConfig> effects;
+  /// `agents:` NPC people and vehicles on waypoint paths (effects/agent_path.h).
+  std::vector<AgentConfig> agents;
+  /// `adversity:` preset spec: a bundled preset name (worlds/adversity/presets.yaml) or a
+  /// preset file path (absolute after loading), "" = none (world/adversity_preset.h).
+  std::string adversity;
+  int adversity_line = 0;  ///< line of the `adversity` key (0 = unknown / command line)
 
   /// throws ConfigError naming the file, key and the expected range.
   void ValidateOrThrow() const;

@@ -1,0 +1,199 @@
+#include "penumbra/world/adversity_preset.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/world/yaml_reader.h"
+
+#ifndef PENUMBRA_SOURCE_DIR
+#define PENUMBRA_SOURCE_DIR "."
+#endif
+
+namespace fs = std::filesystem;
+
+namespace penumbra {
+namespace {
+
+bool IsFileSpec(const std::string& spec) {
+  const std::string path = spec.substr(0, spec.find('#'));
+  const std::string ext = fs::path(path).extension().string();
+  return ext == ".yaml" || ext == ".yml";
+}
+
+// reads a number and checks lo < v <= hi (open_lo) or lo <= v <= hi
+double Ranged(const YamlReader& r, double lo, double hi, bool open_lo, const char* unit) {
+  const double v = r.Double();
+  if (open_lo ? !(v > lo && v <= hi) : !(v >= lo && v <= hi))
+    r.Fail("got " + FormatNumber(v) + "; expected " + (open_lo ? "(" : "[") + FormatNumber(lo) +
+           ", " + FormatNumber(hi) + "]" + (*unit ? std::string(" ") + unit : std::string()));
+  return v;
+}
+
+int RangedInt(const YamlReader& r, int lo, int hi) {
+  const int v = r.Int();
+  if (v < lo || v > hi)
+    r.Fail("got " + std::to_string(v) + "; expected an integer in [" + std::to_string(lo) + ", " +
+           std::to_string(hi) + "]");
+  return v;
+}
+
+AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const std::string& file) {
+  static const std::regex kName("[A-Za-z0-9_-]+");
+  if (!std::regex_match(name, kName))
+    r.Fail("preset name '" + name + "' is not valid; expected letters, digits, '_' and '-'");
+  r.ExpectMap({"description", "fog", "dust", "smoke", "rain", "snow", "lights", "npcs"});
+  AdversityPreset p;
+  p.name = name;
+  p.file = file;
+  if (r.Has("description")) p.description = r.Child("description").String();
+  if (r.Has("fog")) {
+    const YamlReader f = r.Child("fog");
+    f.ExpectMap({"mor_m", "height_falloff_per_m"});
+    p.fog_mor_m = Ranged(f.Child("mor_m"), 0, 1e5, true, "m");
+    if (f.Has("height_falloff_per_m"))
+      p.fog_height_falloff_per_m = Ranged(f.Child("height_falloff_per_m"), 0, 10, false, "1/m");
+  }
+  if (r.Has("dust")) {
+    const YamlReader f = r.Child("dust");
+    f.ExpectMap({"mor_m"});
+    p.dust_mor_m = Ranged(f.Child("mor_m"), 0, 1e5, true, "m");
+  }
+  if (r.Has("smoke")) {
+    const YamlReader s = r.Child("smoke");
+    s.ExpectMap({"sigma_t_per_m", "coverage", "extent_fraction", "height_m"});
+    p.smoke_sigma_t_per_m = Ranged(s.Child("sigma_t_per_m"), 0, 100, true, "1/m");
+    if (s.Has("coverage")) p.smoke_coverage = Ranged(s.Child("coverage"), 0, 1, false, "");
+    if (s.Has("extent_fraction"))
+      p.smoke_extent_fraction = Ranged(s.Child("extent_fraction"), 0, 1, true, "");
+    if (s.Has("height_m")) p.smoke_height_m = Ranged(s.Child("height_m"), 0, 100, true, "m");
+  }
+  if (r.Has("rain")) {
+    const YamlReader s = r.Child("rain");
+    s.ExpectMap({"rate_mm_h"});
+    p.rain_rate_mm_h = Ranged(s.Child("rate_mm_h"), 0, 500, true, "mm/h");
+  }
+  if (r.Has("snow")) {
+    const YamlReader s = r.Child("snow");
+    s.ExpectMap({"rate_mm_h"});
+    p.snow_rate_mm_h = Ranged(s.Child("rate_mm_h"), 0, 100, true, "mm/h");
+  }
+  if (r.Has("lights")) {
+    const YamlReader s = r.Child("lights");
+    s.ExpectMap({"scale", "flicker_depth", "flicker_hz"});
+    if (s.Has("scale")) p.light_scale = Ranged(s.Child("scale"), 0, 1, false, "");
+    if (s.Has("flicker_depth")) p.flicker_depth = Ranged(s.Child("flicker_depth"), 0, 1, false, "");
+    if (s.Has("flicker_hz")) p.flicker_hz = Ranged(s.Child("flicker_hz"), 0, 100, true, "Hz");
+  }
+  if (r.Has("npcs")) {
+    const YamlReader s = r.Child("npcs");
+    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec"});
+    if (s.Has("people")) p.npc_people = RangedInt(s.Child("people"), 0, 100);
+    if (s.Has("vehicles")) p.npc_vehicles = RangedInt(s.Child("vehicles"), 0, 20);
+    if (s.Has("speed_m_s")) p.npc_speed_m_s = Ranged(s.Child("speed_m_s"), 0, 5, true, "m/s");
+    if (s.Has("pause_sec")) p.npc_pause_sec = Ranged(s.Child("pause_sec"), 0, 60, false, "s");
+  }
+  return p;
+}
+
+std::string Names(const std::vector<AdversityPreset>& presets) {
+  std::string s;
+  for (const AdversityPreset& p : presets) s += (s.empty() ? "" : ", ") + p.name;
+  return s;
+}
+
+}  // namespace
+
+bool AdversityPreset::empty() const {
+  return !fog_mor_m && !dust_mor_m && !smoke_sigma_t_per_m && !rain_rate_mm_h && !snow_rate_mm_h &&
+         light_scale == 1.0 && flicker_depth == 0.0 && npc_people == 0 && npc_vehicles == 0;
+}
+
+std::string BundledAdversityPresetsPath() {
+  return (fs::path(PENUMBRA_SOURCE_DIR) / "worlds" / "adversity" / "presets.yaml").string();
+}
+
+std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw ConfigError(path, 0, "",
+                      "adversity preset file not found; expected an existing YAML file");
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::vector<AdversityPreset> out;
+  try {
+    const YAML::Node root = YAML::Load(text.str());
+    YamlReader r(root, path, nullptr);
+    r.ExpectMap({"presets"});
+    const YamlReader presets = r.Child("presets");
+    for (const auto& [name, p] : presets.Entries()) out.push_back(ReadPreset(name, p, path));
+    if (out.empty()) presets.Fail("no presets; expected a mapping of preset names to presets");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                      "YAML syntax error: " + e.msg);
+  }
+  return out;
+}
+
+std::vector<std::string> BundledAdversityPresetNames() {
+  std::vector<std::string> names;
+  for (const AdversityPreset& p : LoadAdversityPresetFile(BundledAdversityPresetsPath()))
+    names.push_back(p.name);
+  return names;
+}
+
+std::string ResolveAdversitySpec(const std::string& spec, const std::string& base_dir,
+                                 const std::string& file, int line) {
+  std::string resolved = spec;
+  if (IsFileSpec(spec)) {
+    const size_t hash = spec.find('#');
+    fs::path p(spec.substr(0, hash));
+    if (p.is_relative()) p = (base_dir.empty() ? fs::current_path() : fs::path(base_dir)) / p;
+    resolved = p.lexically_normal().string() + (hash == std::string::npos ? "" : spec.substr(hash));
+  }
+  LoadAdversityPreset(resolved, file, line);  // checks it
+  return resolved;
+}
+
+AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& file, int line) {
+  if (IsFileSpec(spec)) {
+    const size_t hash = spec.find('#');
+    const std::string path = spec.substr(0, hash);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec))
+      throw ConfigError(file, line, "adversity",
+                        "preset file not found: " + path +
+                            " (relative paths resolve against the world file's folder); expected "
+                            "an existing preset file (.yaml)");
+    const std::vector<AdversityPreset> presets = LoadAdversityPresetFile(path);
+    if (hash == std::string::npos) {
+      if (presets.size() != 1)
+        throw ConfigError(
+            file, line, "adversity",
+            path + " holds " + std::to_string(presets.size()) +
+                " presets; expected FILE.yaml#NAME with NAME one of: " + Names(presets));
+      return presets.front();
+    }
+    const std::string name = spec.substr(hash + 1);
+    for (const AdversityPreset& p : presets)
+      if (p.name == name) return p;
+    throw ConfigError(
+        file, line, "adversity",
+        "unknown preset '" + name + "' in " + path + "; expected one of: " + Names(presets));
+  }
+  const std::vector<AdversityPreset> bundled =
+      LoadAdversityPresetFile(BundledAdversityPresetsPath());
+  for (const AdversityPreset& p : bundled)
+    if (p.name == spec) return p;
+  throw ConfigError(file, line, "adversity",
+                    "unknown preset '" + spec + "'; expected one of: " + Names(bundled) +
+                        ", or a preset file (FILE.yaml or FILE.yaml#NAME)");
+}
+
+}  // namespace penumbra

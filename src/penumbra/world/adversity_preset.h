@@ -1,0 +1,86 @@
+#pragma once
+// adversity presets: named sets of physical parameters (visibility, smoke, precipitation,
+// lighting, NPC traffic) that turn any world into an adverse-condition variant of itself.
+// bundled presets `none`, `minor`, `major` live in worlds/adversity/presets.yaml; users
+// write their own files in the same format. a preset is applied relative to the world at
+// run time (app/effects_stage.h): regions come from the scene's bounds around the robots,
+// NPC paths are drawn from the world seed inside the free floor area.
+//
+// file format (YAML):
+//   presets:
+//     <name>:                          # [A-Za-z0-9_-]+
+//       description: <text>
+//       fog:    {mor_m: M, height_falloff_per_m: H}     # homogeneous fog everywhere
+//       dust:   {mor_m: M}                              # brown absorbing haze everywhere
+//       smoke:  {sigma_t_per_m: S, coverage: C, extent_fraction: F, height_m: Z}
+//       rain:   {rate_mm_h: R}
+//       snow:   {rate_mm_h: R}
+//       lights: {scale: K, flicker_depth: D, flicker_hz: F}
+//       npcs:   {people: N, vehicles: V, speed_m_s: S, pause_sec: P}
+// every block is optional; MOR is the meteorological optical range (WMO No. 8, 2018;
+// sigma_t = 2.996 / MOR, Koschmieder), rain and snow rates are water-equivalent mm/h.
+//
+// spec strings (world-file key `adversity`, command line --adversity):
+//   NAME            a preset of the bundled file
+//   FILE.yaml       the only preset of a user file (relative to the world file's folder)
+//   FILE.yaml#NAME  preset NAME of a user file
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// one adversity preset (units SI; see the file header for the meaning of each block).
+struct AdversityPreset {
+  std::string name;
+  std::string description;
+  std::string file;  ///< the file it came from
+
+  std::optional<double> fog_mor_m;            ///< fog MOR, (0, 1e5] m
+  double fog_height_falloff_per_m = 0;        ///< [0, 10] 1/m; 0 = uniform
+  std::optional<double> dust_mor_m;           ///< dust MOR, (0, 1e5] m
+  std::optional<double> smoke_sigma_t_per_m;  ///< smoke extinction at density 1, (0, 100] 1/m
+  double smoke_coverage = 0.5;                ///< fraction of the smoke box with smoke, [0, 1]
+  /// horizontal size of the smoke box as a fraction of the robots' area box, (0, 1]
+  double smoke_extent_fraction = 1.0;
+  double smoke_height_m = 2.5;           ///< smoke box height above the floor, (0, 100] m
+  std::optional<double> rain_rate_mm_h;  ///< (0, 500]
+  std::optional<double> snow_rate_mm_h;  ///< (0, 100]
+  double light_scale = 1.0;              ///< multiplier on every scene light and the sky, [0, 1]
+  double flicker_depth = 0.0;            ///< light flicker depth, [0, 1]; 0 = steady
+  double flicker_hz = 4.0;               ///< (0, 100]
+  int npc_people = 0;                    ///< walking people, [0, 100]
+  int npc_vehicles = 0;                  ///< forklifts, [0, 20]
+  double npc_speed_m_s = 1.2;            ///< people's speed, (0, 5]; vehicles drive at 1.5x
+  double npc_pause_sec = 1.0;            ///< pause at each waypoint, [0, 60]
+
+  /// true when the preset changes nothing (e.g. `none`).
+  bool empty() const;
+};
+
+/// worlds/adversity/presets.yaml of the source tree.
+std::string BundledAdversityPresetsPath();
+
+/// every preset of a preset file, in file order.
+/// @throws ConfigError(file, line, "presets.<name>.<key>", ...) for a missing/unreadable
+///         file, unknown keys, wrong types and out-of-range values.
+std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path);
+
+/// the names of the bundled presets ("none", "minor", "major").
+std::vector<std::string> BundledAdversityPresetNames();
+
+/// checks a spec (see the file header) and returns it with a relative file path made
+/// absolute against `base_dir` ("" = the current folder); bundled names stay as they are.
+/// @param file, line where the spec was written (for errors; "" = command line)
+/// @throws ConfigError(file, line, "adversity", "unknown preset 'x'; expected one of: none,
+///         minor, major, or a preset file (.yaml)") and the errors of LoadAdversityPresetFile.
+std::string ResolveAdversitySpec(const std::string& spec, const std::string& base_dir,
+                                 const std::string& file = "", int line = 0);
+
+/// the preset named by a resolved spec.
+/// @throws ConfigError as ResolveAdversitySpec.
+AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& file = "",
+                                    int line = 0);
+
+}  // namespace penumbra

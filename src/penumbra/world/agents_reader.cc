@@ -1,0 +1,72 @@
+#include "penumbra/world/agents_reader.h"
+
+#include <map>
+#include <set>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+Eigen::Vector2d ReadPoint(const YamlReader& r) {
+  if (!r.node().IsSequence() || r.size() != 2)
+    r.Fail("expected a floor point [x, y] (2 numbers, m)");
+  return {r.Element(0).Double(), r.Element(1).Double()};
+}
+
+}  // namespace
+
+std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& file) {
+  std::vector<AgentConfig> agents;
+  std::map<std::string, int> lines;  // key path -> line, for validation messages
+  const auto note = [&](const YamlReader& r) {
+    lines[r.path()] = r.line();
+    return r;
+  };
+  for (const YamlReader& r : list.List()) {
+    note(r);
+    r.ExpectMap({"name", "type", "waypoints", "speed_m_s", "pause_sec", "start_delay_sec", "route",
+                 "floor_z", "height_m"});
+    AgentConfig a;
+    a.line = r.line();
+    a.name = note(r.Child("name")).String();
+    if (r.Has("type")) {
+      const std::string t = note(r.Child("type")).Enum({"person", "forklift", "cart"});
+      a.kind = t == "person"     ? AgentKind::kPerson
+               : t == "forklift" ? AgentKind::kForklift
+                                 : AgentKind::kCart;
+    }
+    const YamlReader w = note(r.Child("waypoints"));
+    for (const YamlReader& p : w.List()) a.waypoints.push_back(ReadPoint(note(p)));
+    if (r.Has("speed_m_s")) a.speed_m_s = note(r.Child("speed_m_s")).Double();
+    if (r.Has("pause_sec")) a.pause_sec = note(r.Child("pause_sec")).Double();
+    if (r.Has("start_delay_sec")) a.start_delay_sec = note(r.Child("start_delay_sec")).Double();
+    if (r.Has("route")) {
+      const std::string t = note(r.Child("route")).Enum({"loop", "pingpong", "once"});
+      a.route = t == "loop"       ? AgentRoute::kLoop
+                : t == "pingpong" ? AgentRoute::kPingPong
+                                  : AgentRoute::kOnce;
+    }
+    if (r.Has("floor_z")) a.floor_z = note(r.Child("floor_z")).Double();
+    if (r.Has("height_m")) a.height_m = note(r.Child("height_m")).Double();
+    a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
+      auto it = lines.find(key);
+      return it == lines.end() ? 0 : it->second;
+    });
+    agents.push_back(std::move(a));
+  }
+  std::map<std::string, size_t> seen;
+  for (size_t i = 0; i < agents.size(); ++i) {
+    auto [it, fresh] = seen.emplace(agents[i].name, i);
+    if (!fresh) {
+      const std::string key = "agents[" + std::to_string(i) + "].name";
+      throw ConfigError(file, lines.count(key) ? lines[key] : agents[i].line, key,
+                        "duplicate agent name '" + agents[i].name + "' (also agents[" +
+                            std::to_string(it->second) +
+                            "].name); expected names unique among agents");
+    }
+  }
+  return agents;
+}
+
+}  // namespace penumbra
