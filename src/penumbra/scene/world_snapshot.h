@@ -27,6 +27,25 @@ struct WorldSnapshot {
   /// joint positions and velocities (MuJoCo qpos / qvel), for recording and replay.
   std::vector<double> qpos;
   std::vector<double> qvel;
+  /// MuJoCo sensordata at this instant (Simulation::Snapshot evaluates the model's sensors
+  /// for the snapshot's own state on a scratch copy); index with the adr/dim of
+  /// physics/sensor_readout.h. empty if the model has no sensors.
+  std::vector<double> sensordata;
+  /// V_WB of every body (index as X_WB): (angular rad/s; linear m/s) velocity of the body
+  /// frame's origin, both in world-frame axes (MuJoCo mj_objectVelocity, flg_local = 0).
+  std::vector<Eigen::Matrix<double, 6, 1>> V_WB;
+  /// one active contact (MuJoCo d->contact and mj_contactForce).
+  struct Contact {
+    int geom1 = -1, geom2 = -1;  ///< MuJoCo geom ids
+    int body1 = -1, body2 = -1;  ///< body indices
+    Eigen::Vector3d p_W{0, 0, 0};       ///< contact point, m
+    Eigen::Vector3d normal_W{0, 0, 1};  ///< unit normal, from geom1 towards geom2
+    double distance_m = 0;              ///< signed distance (< 0 = penetration)
+    /// force in the contact frame (normal, tangent 1, tangent 2), N; normal >= 0 pushes apart.
+    Eigen::Vector3d force_N{0, 0, 0};
+  };
+  /// active contacts at this instant (ground truth for evaluation).
+  std::vector<Contact> contacts;
   /// adverse conditions at this instant (media, particles, lighting changes), filled by the
   /// effects stage after physics; null = clear conditions. shared so that queued snapshots
   /// do not copy voxel grids.
