@@ -37,6 +37,7 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       materials_(scene_),
       lights_(scene_),
       sky_(scene_.sky),
+      effects_(scene_),
       film_(settings_),
       pool_(settings_.threads),
       integrator_(MakeIntegrator(settings_, scene_)) {
@@ -52,6 +53,9 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   ray_scene_->Update(snapshot);
   lights_.Update(snapshot);
   const Camera camera(view.X_WO, view.intrinsics);
+  // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
+  effects_.Prepare(snapshot, camera, view.exposure_time_sec, settings_, lights_, *ray_scene_, sky_,
+                   &pool_);
   const int W = camera.width(), H = camera.height();
   const CameraOutputs& want = view.outputs;
   const bool denoise = want.rgb && denoiser_ != nullptr;
@@ -93,7 +97,8 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   ctx.scene = ray_scene_.get();
   ctx.materials = &materials_;
   ctx.lights = &lights_;
-  ctx.sky = &sky_;
+  ctx.sky = effects_.sky();
+  ctx.effects = effects_.active() ? &effects_ : nullptr;
   ctx.camera = &camera;
   ctx.settings = &settings_;
   ctx.camera_index = view.camera_index;

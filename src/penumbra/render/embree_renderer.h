@@ -47,6 +47,7 @@ class EmbreeRenderer final : public Renderer {
   MaterialEvaluator materials_;
   LightSampler lights_;
   SkyModel sky_;
+  MediaFrame effects_;  // per-frame effects state (render/media_frame.h)
   Film film_;
   ThreadPool pool_;
   std::unique_ptr<Integrator> integrator_;

@@ -15,6 +15,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
+#include "penumbra/render/media_frame.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/sky_model.h"
@@ -36,6 +37,10 @@ struct FrameContext {
   const RenderSettings* settings = nullptr;
   int camera_index = 0;     ///< CameraView::camera_index
   int64_t frame_index = 0;  ///< CameraView::frame_index
+  /// adverse conditions of this frame (media, particles, wetness; render/media_frame.h), or
+  /// null in clear conditions (then both tiers render exactly as without effects). `sky`
+  /// already is the effects' sky and `lights` carry the effects' light changes.
+  const MediaFrame* effects = nullptr;
 
   /// stream id of pixel (u, v), sample s: HashKeys(HashKeys(seed, camera), frame, pixel, s)
   /// with pixel = v * width + u.

@@ -55,29 +55,65 @@ inline Vec3Lanes SampleConeLanes(const Vec3Lanes& w, const Lanes& cos_max, const
   return d * inv;
 }
 
+// the pose-independent part of a light.
+PosedLight Unposed(const Light& l) {
+  PosedLight p;
+  p.type = l.type;
+  p.intensity_rgb = l.color.cwiseMax(0.0f) * l.intensity;
+  const float outer = std::clamp(l.spot_outer_deg, 0.0f, 180.0f);
+  const float inner = std::clamp(l.spot_inner_deg, 0.0f, outer);
+  p.cos_outer = static_cast<float>(std::cos(outer * kPi / 180.0));
+  p.cos_inner = static_cast<float>(std::cos(inner * kPi / 180.0));
+  p.radius_m = std::max(l.radius_m, 0.0f);
+  p.cos_angular_radius =
+      static_cast<float>(std::cos(std::clamp(l.angular_radius_deg, 0.0f, 90.0f) * kPi / 180.0));
+  p.cast_shadow = l.cast_shadow;
+  return p;
+}
+
 }  // namespace
 
 LightSampler::LightSampler(const SceneDescription& scene)
     : num_bodies_(static_cast<int>(scene.bodies.size())) {
-  for (const Light& l : scene.lights) {
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
     if (!l.active || !(l.intensity > 0) || !(l.color.maxCoeff() > 0)) continue;
     sources_.push_back(l);
-    PosedLight p;
-    p.type = l.type;
-    p.intensity_rgb = l.color.cwiseMax(0.0f) * l.intensity;
-    const float outer = std::clamp(l.spot_outer_deg, 0.0f, 180.0f);
-    const float inner = std::clamp(l.spot_inner_deg, 0.0f, outer);
-    p.cos_outer = static_cast<float>(std::cos(outer * kPi / 180.0));
-    p.cos_inner = static_cast<float>(std::cos(inner * kPi / 180.0));
-    p.radius_m = std::max(l.radius_m, 0.0f);
-    p.cos_angular_radius =
-        static_cast<float>(std::cos(std::clamp(l.angular_radius_deg, 0.0f, 90.0f) * kPi / 180.0));
-    p.cast_shadow = l.cast_shadow;
-    lights_.push_back(p);
+    scene_index_.push_back(static_cast<int>(i));
+    lights_.push_back(Unposed(l));
+    base_intensity_rgb_.push_back(lights_.back().intensity_rgb);
   }
 }
 
 void LightSampler::Update(const WorldSnapshot& snapshot) {
+  const EffectsFrame* fx = snapshot.effects.get();
+  lights_.resize(sources_.size());
+  for (size_t i = 0; i < sources_.size(); ++i) {
+    lights_[i].intensity_rgb = base_intensity_rgb_[i];
+    if (fx == nullptr || fx->light_intensity_scale.empty()) continue;
+    const int k = scene_index_[i];
+    if (k >= static_cast<int>(fx->light_intensity_scale.size())) continue;
+    const float s = fx->light_intensity_scale[k];
+    if (!(s >= 0) || !std::isfinite(s))
+      throw ConfigError("", 0, "effects.light_intensity_scale[" + std::to_string(k) + "]",
+                        "expected a finite value >= 0");
+    lights_[i].intensity_rgb = base_intensity_rgb_[i] * s;
+  }
+  if (fx != nullptr) {
+    for (const Light& l : fx->extra_lights) {
+      if (!l.active || !(l.intensity > 0) || !(l.color.maxCoeff() > 0)) continue;
+      PosedLight p = Unposed(l);
+      Eigen::Vector3d pos = l.position_B, dir = l.direction_B;
+      if (l.body > 0 && l.body < static_cast<int>(snapshot.X_WB.size())) {
+        pos = snapshot.X_WB[l.body] * l.position_B;
+        dir = snapshot.X_WB[l.body].linear() * l.direction_B;
+      }
+      const double n = dir.norm();
+      p.position_W = pos.cast<float>();
+      p.direction_W = n > 0 ? Eigen::Vector3f((dir / n).cast<float>()) : Eigen::Vector3f(0, 0, -1);
+      lights_.push_back(p);
+    }
+  }
   for (size_t i = 0; i < sources_.size(); ++i) {
     const Light& l = sources_[i];
     PosedLight& p = lights_[i];

@@ -18,6 +18,12 @@
 // an estimator takes each sample with weight 1. light poses come from the snapshot: MJCF
 // lights (mjcf_light >= 0) from light_position_W / light_direction_W, others from the pose
 // of their body, X_WB position_B and R_WB direction_B.
+//
+// effects (WorldSnapshot::effects, scene/effects_frame.h): Update multiplies the intensity of
+// scene light i by EffectsFrame::light_intensity_scale[i] and appends EffectsFrame::extra_lights
+// (world frame, or posed by their body) after the scene's lights, so light indices
+// [0, num_scene_lights()) keep their meaning. without effects the lights are exactly the
+// scene's.
 
 #include <Eigen/Core>
 #include <vector>
@@ -64,12 +70,16 @@ class LightSampler {
   /// keeps the active lights of `scene` with non-zero intensity.
   explicit LightSampler(const SceneDescription& scene);
 
-  /// poses every light from `snapshot`.
-  /// @throws Error if an MJCF light id or body index is out of the snapshot's range.
+  /// poses every light from `snapshot` and applies its effects (see above).
+  /// @throws Error if an MJCF light id or body index is out of the snapshot's range;
+  /// ConfigError for a negative or non-finite intensity scale
+  /// (effects.light_intensity_scale[i]); scales beyond the scene's lights are ignored.
   void Update(const WorldSnapshot& snapshot);
 
-  /// number of lights (active, non-zero).
+  /// number of lights (active, non-zero), extra lights of the effects included.
   int size() const { return static_cast<int>(lights_.size()); }
+  /// number of lights that come from the scene (the first ones).
+  int num_scene_lights() const { return static_cast<int>(sources_.size()); }
   /// the posed lights (after Update).
   const std::vector<PosedLight>& lights() const { return lights_; }
 
@@ -84,7 +94,9 @@ class LightSampler {
                    LightSampleLanes* s) const;
 
  private:
-  std::vector<Light> sources_;  // the kept lights of the scene
+  std::vector<Light> sources_;    // the kept lights of the scene
+  std::vector<int> scene_index_;  // per kept light: index in SceneDescription::lights
+  std::vector<Eigen::Vector3f> base_intensity_rgb_;  // per kept light, before effects
   int num_bodies_ = 0;
   std::vector<PosedLight> lights_;
 };

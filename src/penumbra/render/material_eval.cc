@@ -131,6 +131,17 @@ Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q)
          fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
 }
 
+void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr) {
+  const float facing = std::clamp((n_W.z() - 0.3f) / 0.4f, 0.0f, 1.0f);
+  const float w = std::clamp(wetness, 0.0f, 1.0f) * facing;
+  if (!(w > 0)) return;
+  const float darken = 1.0f + (0.3f - 1.0f) * w;
+  const float m = std::clamp(pbr->metallic, 0.0f, 1.0f);
+  pbr->base_color *= (1.0f - m) * darken + m;
+  const float gloss = std::min(1.0f, (1.0f - pbr->roughness) * (1.0f + 1.5f * w));
+  pbr->roughness = 1.0f - gloss;
+}
+
 SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit) const {
   const Material& m = hit.material >= 0 ? scene_.materials[hit.material] : default_material_;
   SurfaceMaterial out;

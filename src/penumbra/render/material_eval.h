@@ -32,6 +32,15 @@ struct SurfaceMaterial {
   Eigen::Vector3f emission{0, 0, 0};  ///< emitted radiance, cd/m^2 per channel
 };
 
+/// darkens and smooths an upward-facing surface for rain wetness w in [0, 1] (Lagarde, "Water
+/// drop 2a - Dynamic rain and its effects" and "Water drop 2b", 2013: wet porous surfaces
+/// absorb more light, diffuse albedo x lerp(1, 0.3, w'), and a water film makes them glossier,
+/// gloss = 1 - roughness x lerp(1, 2.5, w') capped at 1). w' = w s, with s the facing weight
+/// clamp((n_z - 0.3) / 0.4, 0, 1) of the unit shading normal n_W (world z up): vertical and
+/// downward-facing surfaces stay dry. metals keep their albedo (only their gloss changes).
+/// whether a surface is sheltered from the rain is not tested.
+void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr);
+
 /// evaluates materials and textures of a scene. immutable after construction, thread-safe.
 class MaterialEvaluator {
  public:

@@ -163,6 +163,10 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
   const int max_bounces = std::max(1, ctx.settings->max_bounces);
   const int num_lights = ctx.lights->size();
   const PixelTile& tile = primary.tile;
+  const MediaFrame* fx = ctx.effects;
+  const MediaScene* media = fx != nullptr ? fx->media() : nullptr;
+  const ParticleScene* particles = fx != nullptr ? fx->particles() : nullptr;
+  const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
   int64_t rays = 0;
 
   for (int i = 0; i < tile.width * tile.height; ++i) {
@@ -181,9 +185,100 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
       ray.d = cam.d.normalized();
 
       Eigen::Vector3f L(0, 0, 0), beta(1, 1, 1);
-      float prev_pdf = 0;  // BSDF density of the direction that led here
+      float prev_pdf = 0;  // BSDF or phase density of the direction that led here
       Eigen::Vector3f prev_p(0, 0, 0);
       bool from_camera = true;
+
+      // transmittance of the media along a shadow ray o + t d (d unit), t in [0, dist].
+      auto media_T = [&](const Eigen::Vector3f& o, const Eigen::Vector3f& d, float dist) {
+        return media->Transmittance(o, d, 0.0f, dist, &rng);
+      };
+
+      // next-event estimation at a surface or medium vertex at p: `eval(wi, &f, &pdf)` gives
+      // the BSDF / phase value (times |cos| at surfaces) and its sampling density, `spawn(wi)`
+      // the shadow ray in direction wi, `spawn_to(q)` the one towards point q.
+      auto next_event = [&](const Eigen::Vector3f& p, auto&& eval, auto&& spawn, auto&& spawn_to) {
+        // every analytic light.
+        for (int j = 0; j < num_lights; ++j) {
+          const float u1 = rng.Uniform(), u2 = rng.Uniform();
+          LightSample ls;
+          if (!ctx.lights->Sample(j, p, u1, u2, &ls)) continue;
+          Eigen::Vector3f f;
+          float f_pdf;
+          eval(ls.wi, &f, &f_pdf);
+          if (!(f.maxCoeff() > 0)) continue;
+          Eigen::Vector3f c;
+          const int sun = fl.sun_of_light[j], lamp_j = fl.lamp_of_light[j];
+          if (sun >= 0) {
+            // uniform in the disc's cone: f E = f L Omega, weighted against BSDF sampling.
+            c = f.cwiseProduct(ls.E) * PowerHeuristic(1.0f / fl.suns[sun].solid_angle, f_pdf);
+          } else if (lamp_j >= 0) {
+            const Lamp& lp = fl.lamps[lamp_j];
+            const float omega = lp.SolidAngle(p);
+            if (!(omega > 0)) continue;
+            c = f.cwiseProduct(lp.RadianceTowards(p)) *
+                (omega * PowerHeuristic(1.0f / omega, f_pdf));
+          } else {
+            c = f.cwiseProduct(ls.E);
+          }
+          if (!(c.maxCoeff() > 0)) continue;
+          if (ls.cast_shadow) {
+            Ray sr = spawn(ls.wi);
+            sr.tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - kShadowShorten);
+            ++rays;
+            if (scene.Occluded(sr) || fl.LampBlocks(sr.o, sr.d, sr.tmax, lamp_j)) continue;
+            if (media != nullptr) c = c.cwiseProduct(media_T(sr.o, sr.d, sr.tmax));
+          } else if (media != nullptr) {
+            c = c.cwiseProduct(media_T(p, ls.wi, ls.distance));
+          }
+          L += beta.cwiseProduct(c);
+        }
+
+        // the sky.
+        if (fl.sky_active) {
+          const float u1 = rng.Uniform(), u2 = rng.Uniform();
+          float pdf = 0;
+          const Eigen::Vector3f wi = ctx.sky->Sample(u1, u2, &pdf);
+          if (pdf > 0) {
+            Eigen::Vector3f f;
+            float f_pdf;
+            eval(wi, &f, &f_pdf);
+            if (f.maxCoeff() > 0) {
+              const Ray sr = spawn(wi);
+              ++rays;
+              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, sr.d, kInf)) {
+                const float w = PowerHeuristic(pdf, f_pdf);
+                Eigen::Vector3f c =
+                    (w / pdf) * beta.cwiseProduct(f.cwiseProduct(ctx.sky->Radiance(wi)));
+                if (media != nullptr) c = c.cwiseProduct(media_T(sr.o, sr.d, kInf));
+                L += c;
+              }
+            }
+          }
+        }
+
+        // one emissive geom.
+        if (!emitters_.empty()) {
+          const float u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+          EmitterSample es;
+          if (emitters_.Sample(X_WB, p, u0, u1, u2, &es)) {
+            Eigen::Vector3f f;
+            float f_pdf;
+            eval(es.wi, &f, &f_pdf);
+            if (f.maxCoeff() > 0) {
+              const Ray sr = spawn_to(es.p_W);
+              ++rays;
+              const float dist = (es.p_W - sr.o).norm() * sr.tmax;
+              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, es.wi, dist)) {
+                const float w = PowerHeuristic(es.pdf, f_pdf);
+                Eigen::Vector3f c = (w / es.pdf) * beta.cwiseProduct(f.cwiseProduct(es.Le));
+                if (media != nullptr) c = c.cwiseProduct(media_T(sr.o, es.wi, dist));
+                L += c;
+              }
+            }
+          }
+        }
+      };
 
       for (int vertex = 0;; ++vertex) {
         SurfaceHit hit;
@@ -195,6 +290,70 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
         float t_lamp;
         const int lamp =
             fl.lamps.empty() ? -1 : fl.NearestLamp(ray.o, ray.d, ray.tmin, t_surface, &t_lamp);
+
+        if (fx != nullptr) {
+          const float t_end = lamp >= 0 ? t_lamp : t_surface;
+          // camera rays see particle streaks, each covering the pixel with probability alpha.
+          ParticleHit ph;
+          const bool particle = particles != nullptr && from_camera &&
+                                particles->Intersect(ray, t_end, &ph) && rng.Uniform() < ph.alpha;
+          const float t_stop = particle ? ph.t : t_end;
+          if (media != nullptr) {
+            float t_scatter;
+            MediumPoint mp;
+            const TrackEvent ev =
+                media->Track(ray.o, ray.d, ray.tmin, t_stop, &rng, &beta, &L, &t_scatter, &mp);
+            if (ev == TrackEvent::kAbsorb) break;
+            if (ev == TrackEvent::kScatter) {
+              if (vertex >= max_bounces) break;
+              const Eigen::Vector3f p = ray.o + t_scatter * ray.d;
+              const Eigen::Vector3f wo = -ray.d;
+              next_event(
+                  p,
+                  [&](const Eigen::Vector3f& wi, Eigen::Vector3f* f, float* pdf) {
+                    *pdf = mp.Phase(wo.dot(wi));
+                    *f = Eigen::Vector3f::Constant(*pdf);
+                  },
+                  [&](const Eigen::Vector3f& wi) {
+                    Ray r;
+                    r.o = p;
+                    r.d = wi;
+                    return r;
+                  },
+                  [&](const Eigen::Vector3f& q) {
+                    Ray r;
+                    r.o = p;
+                    r.d = q - p;
+                    r.tmax = 1.0f - 1e-4f;
+                    return r;
+                  });
+              if (vertex >= kRussianRouletteStartVertex) {
+                const float q = std::min(1.0f, beta.maxCoeff());
+                if (!(rng.Uniform() < q)) break;
+                beta /= q;
+              }
+              const float u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+              float pdf;
+              const Eigen::Vector3f wi = mp.SamplePhase(wo, u0, u1, u2, &pdf);
+              if (!(pdf > 0) || !(beta.maxCoeff() > 0) || !beta.allFinite()) break;
+              // phase sampling is exact: f / pdf = 1.
+              prev_pdf = pdf;
+              prev_p = p;
+              from_camera = false;
+              ray.o = p;
+              ray.d = wi;
+              ray.tmin = 0.0f;
+              ray.tmax = kInf;
+              continue;
+            }
+          }
+          if (particle) {
+            const Eigen::Vector3f p = ray.o + ph.t * ray.d;
+            L += beta.cwiseProduct(particles->Shade(ph, p, *ctx.lights, fx->sky_ambient()));
+            break;
+          }
+        }
+
         if (lamp >= 0) {
           const Lamp& lp = fl.lamps[lamp];
           float w = 1.0f;
@@ -220,7 +379,8 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
           break;
         }
 
-        const SurfaceMaterial mat = ctx.materials->Evaluate(hit);
+        SurfaceMaterial mat = ctx.materials->Evaluate(hit);
+        if (wetness > 0) ApplySurfaceWetness(wetness, hit.ns_W, &mat.pbr);
         if (vertex == 0) {
           for (int k = 0; k < 3; ++k) albedo_sum[k] += mat.pbr.base_color[k];
           ++albedo_count;
@@ -235,74 +395,14 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
 
         const Eigen::Vector3f wo = -ray.d;
         const Bsdf bsdf(mat.pbr, hit.ns_W, hit.ng_W, wo);
-
-        // next-event estimation: every analytic light.
-        for (int j = 0; j < num_lights; ++j) {
-          const float u1 = rng.Uniform(), u2 = rng.Uniform();
-          LightSample ls;
-          if (!ctx.lights->Sample(j, hit.p_W, u1, u2, &ls)) continue;
-          const Eigen::Vector3f f = bsdf.Eval(ls.wi);
-          if (!(f.maxCoeff() > 0)) continue;
-          Eigen::Vector3f c;
-          const int sun = fl.sun_of_light[j], lamp_j = fl.lamp_of_light[j];
-          if (sun >= 0) {
-            // uniform in the disc's cone: f E = f L Omega, weighted against BSDF sampling.
-            c = f.cwiseProduct(ls.E) *
-                PowerHeuristic(1.0f / fl.suns[sun].solid_angle, bsdf.Pdf(ls.wi));
-          } else if (lamp_j >= 0) {
-            const Lamp& lp = fl.lamps[lamp_j];
-            const float omega = lp.SolidAngle(hit.p_W);
-            if (!(omega > 0)) continue;
-            c = f.cwiseProduct(lp.RadianceTowards(hit.p_W)) *
-                (omega * PowerHeuristic(1.0f / omega, bsdf.Pdf(ls.wi)));
-          } else {
-            c = f.cwiseProduct(ls.E);
-          }
-          if (!(c.maxCoeff() > 0)) continue;
-          if (ls.cast_shadow) {
-            Ray sr = SpawnRay(hit, ls.wi);
-            sr.tmax = std::isinf(ls.distance) ? kInf : ls.distance * (1.0f - kShadowShorten);
-            ++rays;
-            if (scene.Occluded(sr) || fl.LampBlocks(sr.o, sr.d, sr.tmax, lamp_j)) continue;
-          }
-          L += beta.cwiseProduct(c);
-        }
-
-        // next-event estimation: the sky.
-        if (fl.sky_active) {
-          const float u1 = rng.Uniform(), u2 = rng.Uniform();
-          float pdf = 0;
-          const Eigen::Vector3f wi = ctx.sky->Sample(u1, u2, &pdf);
-          if (pdf > 0) {
-            const Eigen::Vector3f f = bsdf.Eval(wi);
-            if (f.maxCoeff() > 0) {
-              const Ray sr = SpawnRay(hit, wi);
-              ++rays;
-              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, sr.d, kInf)) {
-                const float w = PowerHeuristic(pdf, bsdf.Pdf(wi));
-                L += (w / pdf) * beta.cwiseProduct(f.cwiseProduct(ctx.sky->Radiance(wi)));
-              }
-            }
-          }
-        }
-
-        // next-event estimation: one emissive geom.
-        if (!emitters_.empty()) {
-          const float u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
-          EmitterSample es;
-          if (emitters_.Sample(X_WB, hit.p_W, u0, u1, u2, &es)) {
-            const Eigen::Vector3f f = bsdf.Eval(es.wi);
-            if (f.maxCoeff() > 0) {
-              const Ray sr = SpawnRayTo(hit, es.p_W);
-              ++rays;
-              const float dist = (es.p_W - sr.o).norm() * sr.tmax;
-              if (!scene.Occluded(sr) && !fl.LampBlocks(sr.o, es.wi, dist)) {
-                const float w = PowerHeuristic(es.pdf, bsdf.Pdf(es.wi));
-                L += (w / es.pdf) * beta.cwiseProduct(f.cwiseProduct(es.Le));
-              }
-            }
-          }
-        }
+        next_event(
+            hit.p_W,
+            [&](const Eigen::Vector3f& wi, Eigen::Vector3f* f, float* pdf) {
+              *f = bsdf.Eval(wi);
+              *pdf = f->maxCoeff() > 0 ? bsdf.Pdf(wi) : 0.0f;
+            },
+            [&](const Eigen::Vector3f& wi) { return SpawnRay(hit, wi); },
+            [&](const Eigen::Vector3f& q) { return SpawnRayTo(hit, q); });
 
         // Russian roulette, then continue along a BSDF sample.
         if (vertex >= kRussianRouletteStartVertex) {

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/bsdf_lanes.h"
+#include "penumbra/render/media_common.h"
 
 namespace penumbra {
 namespace {
@@ -35,6 +37,44 @@ struct Scratch {
   std::vector<Vec3Lanes> contrib;         // per light: unshadowed f cos E
 };
 
+// what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
+// the nearest particle streak alpha-composited over it, both attenuated and in-scattered by
+// the media along the ray (render/media_realtime.h, render/particle_scene.h). random numbers
+// from the pixel's stream 1 (stream 0 holds the light samples).
+Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
+                                 uint64_t frame_key, uint64_t pixel, Eigen::Vector3f L) {
+  const MediaFrame& fx = *ctx.effects;
+  const RealtimeMedia* rm = fx.realtime_media();
+  const ParticleScene* parts = fx.particles();
+  if (rm == nullptr && parts == nullptr) return L;
+  Rng rng(FrameContext::PixelStream(frame_key, pixel, 1));
+  const float d_len = ray.d.norm();
+  const Eigen::Vector3f d = ray.d / d_len;
+  const float inf = std::numeric_limits<float>::infinity();
+  const float t_end = hit ? t_hit * d_len : inf;
+  ParticleHit ph;
+  if (parts != nullptr && parts->Intersect(ray, hit ? t_hit : inf, &ph)) {
+    const float t_p = ph.t * d_len;
+    const Eigen::Vector3f p = ray.o + t_p * d;
+    const Eigen::Vector3f Lp = parts->Shade(ph, p, *ctx.lights, fx.sky_ambient());
+    if (rm != nullptr) {
+      const MediaSegment behind = rm->IntegrateView(*ctx.lights, p, d, t_end - t_p, &rng);
+      L = behind.T.cwiseProduct(L) + behind.L_add;
+    }
+    L = ph.alpha * Lp + (1.0f - ph.alpha) * L;
+    if (rm != nullptr) {
+      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, &rng);
+      L = front.T.cwiseProduct(L) + front.L_add;
+    }
+    return L;
+  }
+  if (rm != nullptr) {
+    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, &rng);
+    L = seg.T.cwiseProduct(L) + seg.L_add;
+  }
+  return L;
+}
+
 }  // namespace
 
 int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
@@ -50,6 +90,22 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   int64_t traced = 0;
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
+  const MediaFrame* fx = ctx.effects;
+  const RealtimeMedia* rm = fx != nullptr ? fx->realtime_media() : nullptr;
+  const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
+  // the effects on the pixels of a run whose surface radiance is final (misses hold the sky).
+  auto finish_run = [&](int i0, int m, const LaneMask& hit, const Vec3Lanes& L) {
+    for (int k = 0; k < m; ++k) {
+      const int i = i0 + k;
+      const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+      float* Lp = out.radiance->at(u, v);
+      const Eigen::Vector3f Ls = hit[k] ? L.Lane(k) : Eigen::Vector3f(Lp[0], Lp[1], Lp[2]);
+      const Eigen::Vector3f Lf =
+          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, frame_key,
+                           static_cast<uint64_t>(v) * width + u, Ls);
+      Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
+    }
+  };
 
   // runs of kLanes pixels (a full tile row): per-pixel set-up, then every light for
   // all lanes at once, its shadow rays as one Embree packet.
@@ -84,7 +140,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
       const SurfaceHit& h = primary.hits[i];
-      const SurfaceMaterial mat = ctx.materials->Evaluate(h);
+      SurfaceMaterial mat = ctx.materials->Evaluate(h);
+      if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
       const Eigen::Vector3f wo = -primary.rays[i].d.normalized();
       const BrdfCoefficients coef = BrdfCoefficients::From(mat.pbr);
       bsdf.Set(k, coef, h.ns_W, h.ng_W, wo);
@@ -114,7 +171,10 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         nn[0] = n_s.x(), nn[1] = n_s.y(), nn[2] = n_s.z();
       }
     }
-    if (!hit.any()) continue;
+    if (!hit.any()) {
+      if (fx != nullptr) finish_run(i0, m, hit, L);
+      continue;
+    }
 
     // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
     Lanes total = LuminanceLanes(L);
@@ -128,6 +188,15 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         c.x[k] = on ? f.x[k] * s.E.x[k] : 0.0f;
         c.y[k] = on ? f.y[k] * s.E.y[k] : 0.0f;
         c.z[k] = on ? f.z[k] * s.E.z[k] : 0.0f;
+      }
+      if (rm != nullptr) {
+        // attenuation of the light by the media between the surface and the light.
+        for (int k = 0; k < kLanes; ++k) {
+          if (!(hit[k] && s.valid[k])) continue;
+          const Eigen::Vector3f T =
+              rm->LightTransmittance(j, p.Lane(k), s.wi.Lane(k), s.distance[k]);
+          c.x[k] *= T.x(), c.y[k] *= T.y(), c.z[k] *= T.z();
+        }
       }
       total += LuminanceLanes(c);
     }
@@ -165,6 +234,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
       Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
     }
+    if (fx != nullptr) finish_run(i0, m, hit, L);
   }
   return traced;
 }

@@ -1,0 +1,69 @@
+#pragma once
+// small shared pieces of participating-media rendering: the meteorological optical range
+// (MOR) to extinction conversion and the Henyey-Greenstein phase function.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "penumbra/render/shading_lanes.h"
+
+namespace penumbra {
+
+/// 1 / (4 pi).
+constexpr float kInv4Pi = 0.0795774715459476679f;
+
+/// extinction coefficient sigma_t (1/m) of a homogeneous medium whose meteorological optical
+/// range is mor_m (m): MOR is the distance at which the transmittance of a collimated beam
+/// falls to 5 % (WMO, "Guide to Instruments and Methods of Observation", WMO-No. 8, vol. I,
+/// ch. 9, 2018; Koschmieder's law with a 5 % contrast threshold), so
+/// sigma_t = -ln(0.05) / MOR = ln(20) / MOR (about 2.996 / MOR).
+/// returns 0 for mor_m = +inf; mor_m must be > 0.
+inline double SigmaTFromMorM(double mor_m) { return std::log(20.0) / mor_m; }
+
+/// the MOR (m) of extinction sigma_t (1/m), the inverse of SigmaTFromMorM (+inf for 0).
+inline double MorMFromSigmaT(double sigma_t_per_m) { return std::log(20.0) / sigma_t_per_m; }
+
+/// Henyey-Greenstein phase function (Henyey and Greenstein, "Diffuse radiation in the
+/// galaxy", ApJ 93, 1941; Pharr, Jakob, Humphreys, PBR 4th ed., sec. 11.3.1), normalised
+/// over the sphere (1/sr): p(cos_theta) = (1 - g^2) / (4 pi (1 + g^2 + 2 g cos_theta)^1.5),
+/// where cos_theta = dot(wo, wi) with wo pointing back along the incoming ray (PBRT's
+/// convention), so g > 0 scatters forward.
+inline float HenyeyGreenstein(float cos_theta, float g) {
+  const float denom = 1.0f + g * g + 2.0f * g * cos_theta;
+  return kInv4Pi * (1.0f - g * g) / (denom * std::sqrt(std::max(denom, 1e-12f)));
+}
+
+/// samples wi from the Henyey-Greenstein distribution around wo (unit, pointing back along the
+/// incoming ray) with two uniform numbers in [0, 1); the pdf of wi is HenyeyGreenstein(dot(wo,
+/// wi), g) (PBR 4th ed., eq. 11.17 and SampleHenyeyGreenstein).
+inline Eigen::Vector3f SampleHenyeyGreenstein(const Eigen::Vector3f& wo, float g, float u1,
+                                              float u2, float* pdf) {
+  // cos of the angle between wi and -wo (the propagation direction).
+  float cos_t;
+  if (std::abs(g) < 1e-3f) {
+    cos_t = 1.0f - 2.0f * u1;
+  } else {
+    const float s = (1.0f - g * g) / (1.0f + g - 2.0f * g * u1);
+    cos_t = (1.0f + g * g - s * s) / (2.0f * g);
+  }
+  cos_t = std::clamp(cos_t, -1.0f, 1.0f);
+  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+  float sp, cp;
+  SinCos2Pi(u2, &sp, &cp);
+  const Eigen::Vector3f w = -wo;
+  // orthonormal basis around w (Duff et al., JCGT 2017).
+  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
+  const float a = -1.0f / (sign + w.z());
+  const float b = w.x() * w.y() * a;
+  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
+  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
+  const Eigen::Vector3f wi = (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
+  *pdf = HenyeyGreenstein(wo.dot(wi), g);
+  return wi;
+}
+
+/// mean of the three channels.
+inline float Mean3(const Eigen::Vector3f& v) { return (v.x() + v.y() + v.z()) * (1.0f / 3.0f); }
+
+}  // namespace penumbra

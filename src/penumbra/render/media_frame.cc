@@ -1,0 +1,79 @@
+#include "penumbra/render/media_frame.h"
+
+#include <cmath>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3f n = Eigen::Vector3f::Zero();
+    n[k] = 1;
+    sum += sky.Irradiance(n) + sky.Irradiance(-n);
+  }
+  return sum * static_cast<float>(1.0 / (6.0 * M_PI));
+}
+
+MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
+
+void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
+                         double exposure_time_sec, const RenderSettings& settings,
+                         const LightSampler& lights, const RayScene& rays, const SkyModel& base_sky,
+                         ThreadPool* pool) {
+  const EffectsFrame* fx =
+      snapshot.effects && !snapshot.effects->empty() ? snapshot.effects.get() : nullptr;
+  active_ = fx != nullptr;
+  sky_ = &base_sky;
+  realtime_ok_ = false;
+  wetness_ = 0;
+  if (!active_) {
+    media_.Build(nullptr);
+    particles_.Build(nullptr, camera, 0);
+    return;
+  }
+  if (!(fx->sky_luminance_scale >= 0) || !std::isfinite(fx->sky_luminance_scale))
+    throw ConfigError("", 0, "effects.sky_luminance_scale", "expected a finite value >= 0");
+  if (!(fx->surface_wetness >= 0 && fx->surface_wetness <= 1))
+    throw ConfigError("", 0, "effects.surface_wetness", "expected a value in [0, 1]");
+  wetness_ = fx->surface_wetness;
+
+  // sky: moved sun and luminance scale.
+  const bool sky_changed = fx->sun_direction_W.has_value() || fx->sky_luminance_scale != 1.0f;
+  if (sky_changed) {
+    bool rebuild = !effects_sky_ || effects_sky_scale_ != fx->sky_luminance_scale ||
+                   effects_sky_sun_.has_value() != fx->sun_direction_W.has_value();
+    if (!rebuild && fx->sun_direction_W) {
+      const double c = effects_sky_sun_->normalized().dot(fx->sun_direction_W->normalized());
+      rebuild = c < std::cos(kSkyRebuildDeg * M_PI / 180.0);
+    }
+    if (rebuild) {
+      Sky sky = scene_.sky;
+      if (fx->sun_direction_W) sky.sun_direction_W = *fx->sun_direction_W;
+      sky.radiance *= fx->sky_luminance_scale;
+      sky.zenith_luminance *= fx->sky_luminance_scale;
+      effects_sky_ = std::make_unique<SkyModel>(sky);
+      effects_sky_sun_ = fx->sun_direction_W;
+      effects_sky_scale_ = fx->sky_luminance_scale;
+    }
+    sky_ = effects_sky_.get();
+    sky_ambient_ = SkyAmbientRadiance(*sky_);
+  } else {
+    if (base_sky_seen_ != &base_sky) {
+      base_sky_ambient_ = SkyAmbientRadiance(base_sky);
+      base_sky_seen_ = &base_sky;
+    }
+    sky_ambient_ = base_sky_ambient_;
+  }
+
+  media_.Build(fx);
+  if (!media_.empty() && settings.tier == RenderSettings::Tier::kRealtime) {
+    realtime_.Build(media_, lights, rays, scene_.center_W.cast<float>(), scene_.extent_m,
+                    sky_ambient_, pool);
+    realtime_ok_ = true;
+  }
+  particles_.Build(fx, camera, exposure_time_sec);
+}
+
+}  // namespace penumbra

@@ -1,0 +1,85 @@
+#pragma once
+// everything of a frame's EffectsFrame (scene/effects_frame.h) that the renderer draws,
+// prepared once per frame by EmbreeRenderer and handed to the integrators through
+// FrameContext::effects (null in clear conditions, so a frame without effects renders exactly
+// as before):
+//  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
+//  - particle streaks for the frame's camera and exposure (ParticleScene);
+//  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
+//    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
+//    the scale changed (SkyModel's tables cost about a millisecond; the sun moves slowly);
+//  - surface wetness (ApplySurfaceWetness, material_eval.h).
+// light intensity scales and extra lights are applied by LightSampler::Update.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/media_scene.h"
+#include "penumbra/render/particle_scene.h"
+#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/render/sky_model.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// the sun must move by more than this (degrees) before the sky tables are rebuilt.
+constexpr double kSkyRebuildDeg = 0.1;
+
+/// sphere-average radiance of a sky (cd/m^2 per channel): the mean of its irradiance on the
+/// six axis-aligned normals divided by pi (exact for radiance that is linear in direction).
+Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
+
+/// per-frame effects state of one renderer. not thread-safe; the accessors are, after Prepare.
+class MediaFrame {
+ public:
+  /// `scene` (the renderer's copy) must outlive this object.
+  explicit MediaFrame(const SceneDescription& scene);
+
+  /// prepares the effects of `snapshot` (none when snapshot.effects is null or empty) for a
+  /// frame seen by `camera` with the given exposure. `lights` must already be posed for the
+  /// snapshot and `rays` updated. realtime light volumes are built only for that tier.
+  /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
+  void Prepare(const WorldSnapshot& snapshot, const Camera& camera, double exposure_time_sec,
+               const RenderSettings& settings, const LightSampler& lights, const RayScene& rays,
+               const SkyModel& base_sky, ThreadPool* pool);
+
+  /// any effect is active this frame.
+  bool active() const { return active_; }
+  /// the sky to use this frame (base_sky of Prepare unless the effects change it).
+  const SkyModel* sky() const { return sky_; }
+  /// sphere-average radiance of sky().
+  const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
+  /// media, or null when there are none.
+  const MediaScene* media() const { return media_.empty() ? nullptr : &media_; }
+  /// realtime light volumes, or null (no media, or the pathtraced tier).
+  const RealtimeMedia* realtime_media() const { return realtime_ok_ ? &realtime_ : nullptr; }
+  /// particle streaks, or null when there are none.
+  const ParticleScene* particles() const { return particles_.empty() ? nullptr : &particles_; }
+  /// EffectsFrame::surface_wetness (0 when inactive).
+  float surface_wetness() const { return wetness_; }
+
+ private:
+  const SceneDescription& scene_;
+  bool active_ = false;
+  const SkyModel* sky_ = nullptr;
+  Eigen::Vector3f sky_ambient_{0, 0, 0};
+  Eigen::Vector3f base_sky_ambient_{0, 0, 0};
+  const SkyModel* base_sky_seen_ = nullptr;
+  std::unique_ptr<SkyModel> effects_sky_;
+  std::optional<Eigen::Vector3d> effects_sky_sun_;
+  float effects_sky_scale_ = 1.0f;
+  MediaScene media_;
+  RealtimeMedia realtime_;
+  bool realtime_ok_ = false;
+  ParticleScene particles_;
+  float wetness_ = 0;
+};
+
+}  // namespace penumbra
