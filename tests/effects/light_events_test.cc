@@ -107,7 +107,7 @@ TEST(LightEventTest, EngineScalesOnlyTheNamedLight) {
     EffectsEngine bad({e}, 7, scene);
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& err) {
-    EXPECT_EQ(err.key(), "effects[0].light_event.light");
+    EXPECT_EQ(err.key(), "effects[0].light");
     EXPECT_NE(std::string(err.what()).find("lamp2"), std::string::npos) << err.what();
   }
 }

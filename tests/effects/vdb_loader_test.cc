@@ -77,7 +77,7 @@ TEST(VdbLoaderTest, FileWithoutDensityGridIsAConfigError) {
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
     const std::string what = e.what();
-    EXPECT_EQ(e.key(), "effects[0].vdb_smoke.grid");
+    EXPECT_EQ(e.key(), "effects[0].grid");
     EXPECT_NE(what.find("'plume'"), std::string::npos) << what;
     EXPECT_NE(what.find("temperature"), std::string::npos) << what;
     EXPECT_NE(what.find("expected a float grid named 'density'"), std::string::npos) << what;
@@ -95,7 +95,7 @@ TEST(VdbLoaderTest, MissingOrBrokenFileIsAConfigError) {
     EffectsEngine engine({VdbEffect(junk)}, 1, SceneDescription{});
     FAIL() << "expected ConfigError";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(e.key(), "effects[0].vdb_smoke.file");
+    EXPECT_EQ(e.key(), "effects[0].file");
   }
 }
 

@@ -358,7 +358,11 @@ std::optional<EffectConfig::Problem> EffectConfig::Validate() const {
       c.In("wetness.max_wetness", wetness.max_wetness, Range::Closed(0, 1));
       break;
   }
-  return c.problem();
+  // keys name the world-file key: the type's parameters sit next to name and type
+  std::optional<Problem> p = c.problem();
+  const std::string type_prefix = std::string(EffectTypeName(type)) + ".";
+  if (p && p->key.rfind(type_prefix, 0) == 0) p->key = p->key.substr(type_prefix.size());
+  return p;
 }
 
 namespace {
@@ -409,7 +413,7 @@ void ValidateEffectsOrThrow(const std::vector<EffectConfig>& effects, const std:
                              [](const EffectConfig& o) { return o.type == EffectType::kRain; })
               : !find(e.wetness.rain, EffectType::kRain)) {
         ThrowProblem(e, prefix,
-                     {"wetness.rain", "no rain effect '" + e.wetness.rain +
+                     {"rain", "no rain effect '" + e.wetness.rain +
                                           "'; expected the name of a rain effect of this world"},
                      file, line_of);
       }
@@ -417,7 +421,7 @@ void ValidateEffectsOrThrow(const std::vector<EffectConfig>& effects, const std:
     if (e.type == EffectType::kSparks && !e.sparks.fire.empty() &&
         !find(e.sparks.fire, EffectType::kFire)) {
       ThrowProblem(e, prefix,
-                   {"sparks.fire", "no fire effect '" + e.sparks.fire +
+                   {"fire", "no fire effect '" + e.sparks.fire +
                                        "'; expected the name of a fire effect of this world"},
                    file, line_of);
     }

@@ -303,8 +303,9 @@ struct EffectConfig {
   /// weight w(t) in [0, 1] of the time window and fades (see the file header).
   double Weight(double time_sec) const;
 
-  /// a problem found by Validate(): key relative to the effect ("rain.rate_mm_h",
-  /// "region.min", "fog.mor_m") and the message with the valid range.
+  /// a problem found by Validate(): the world-file key relative to the effect entry
+  /// ("rate_mm_h", "region.min", "emitters[0].position"; a type's parameters sit next to
+  /// name and type) and the message with the valid range.
   struct Problem {
     std::string key;
     std::string message;

@@ -113,7 +113,7 @@ EffectsEngine::EffectsEngine(const std::vector<EffectConfig>& effects, uint64_t 
           names += (names.empty() ? "" : ", ") + scene.lights[l].name;
         }
         if (rt->lights.empty() && e.light_event.light != "*") {
-          throw ConfigError("", 0, prefix + ".light_event.light",
+          throw ConfigError("", 0, prefix + ".light",
                             who + "no scene light named '" + e.light_event.light +
                                 "' (lights: " + (names.empty() ? "none" : names) +
                                 "); expected a light name of the scene or \"*\"");
@@ -126,7 +126,7 @@ EffectsEngine::EffectsEngine(const std::vector<EffectConfig>& effects, uint64_t 
           rt->body = scene.FindBody(e.flashlight.attach);
           if (rt->body < 0) {
             throw ConfigError(
-                "", 0, prefix + ".flashlight.attach",
+                "", 0, prefix + ".attach",
                 who + "no body named '" + e.flashlight.attach +
                     "'; expected a body name of the composed model (\"<model>/<body>\")");
           }

@@ -14,8 +14,8 @@ namespace penumbra {
 GridMedium LoadVdbDensity(const VdbSmokeParams& p, const std::optional<BoxRegion>& region,
                           const std::string& key_prefix, const std::string& effect_name) {
   const std::string who = "effect '" + effect_name + "' (vdb_smoke): ";
-  const std::string file_key = key_prefix + ".vdb_smoke.file";
-  const std::string grid_key = key_prefix + ".vdb_smoke.grid";
+  const std::string file_key = key_prefix + ".file";
+  const std::string grid_key = key_prefix + ".grid";
   std::error_code ec;
   if (!std::filesystem::is_regular_file(p.file, ec)) {
     throw ConfigError("", 0, file_key,

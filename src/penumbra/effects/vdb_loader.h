@@ -19,8 +19,8 @@ namespace penumbra {
 /// (sigma_t = density_scale_per_m per channel, albedo, g); density values are clamped to >= 0.
 /// @param key_prefix key path of the effect in errors, e.g. "effects[3]"
 /// @param effect_name named in error messages
-/// @throws ConfigError("", 0, "<prefix>.vdb_smoke.file", ...) when the file cannot be opened
-///         or is not a VDB file, and ("<prefix>.vdb_smoke.grid", ...) when it has no float grid
+/// @throws ConfigError("", 0, "<prefix>.file", ...) when the file cannot be opened
+///         or is not a VDB file, and ("<prefix>.grid", ...) when it has no float grid
 ///         of that name (the message lists the grids it has) or the grid has no active voxels.
 GridMedium LoadVdbDensity(const VdbSmokeParams& p, const std::optional<BoxRegion>& region,
                           const std::string& key_prefix, const std::string& effect_name);

@@ -12,6 +12,7 @@
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
+#include "penumbra/world/effects_reader.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -37,7 +38,7 @@ class WorldParser {
     const std::vector<std::string_view> keys = {"seed",    "duration_sec", "physics",   "render",
                                                 "sky",     "robots",       "models",    "lights",
                                                 "cameras", "mjcf_cameras", "materials", "output",
-                                                "agents",  "adversity", "semantic_classes"};
+                                                "agents",  "adversity", "semantic_classes", "effects"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -81,6 +82,7 @@ class WorldParser {
     }
     if (r.Has("semantic_classes")) w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
     if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
+    if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
     if (r.Has("adversity")) {
       const YamlReader a = r.Child("adversity");
       w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());
