@@ -67,6 +67,7 @@ class EffectRuntime {
   int body = -1;                       // attached flashlight
   const EffectConfig* rain = nullptr;  // wetness
   Eigen::Vector3d spark_origin{0, 0, 0};
+  std::optional<PrecipitationTable> precipitation;  // rain, snow: drawn on first use
 
   // advances the fluid to floor(t / dt) steps (restarting when t went backwards).
   void AdvanceFluid(double t) {
@@ -299,15 +300,14 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
         break;
       }
       case EffectType::kRain:
-        if (w > 0) {
-          frame->particles.push_back(
-              SampleRain(e.rain, t, viewer_W, w, e.region ? &*e.region : nullptr, rt.key, 1));
-        }
-        break;
       case EffectType::kSnow:
         if (w > 0) {
+          if (!rt.precipitation) {
+            rt.precipitation = e.type == EffectType::kRain ? BuildRainTable(e.rain, rt.key, 1)
+                                                           : BuildSnowTable(e.snow, rt.key, 2);
+          }
           frame->particles.push_back(
-              SampleSnow(e.snow, t, viewer_W, w, e.region ? &*e.region : nullptr, rt.key, 2));
+              PlaceParticles(*rt.precipitation, t, viewer_W, w, e.region ? &*e.region : nullptr));
         }
         break;
       case EffectType::kSparks: {

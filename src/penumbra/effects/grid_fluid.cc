@@ -67,41 +67,46 @@ void GridFluid::SetBoundary(int b, std::vector<float>& x) const {
     }
 }
 
-// trilinear sample at grid coordinates (x, y, z) where interior voxel centres sit at
-// 1..n. closed: clamped to [0.5, n + 0.5]; open: 0 outside that range (clean air).
-float GridFluid::Sample(const std::vector<float>& f, double x, double y, double z,
-                        bool open) const {
-  if (open && (x < 0.5 || x > nx_ + 0.5 || y < 0.5 || y > ny_ + 0.5 || z < 0.5 || z > nz_ + 0.5)) {
-    return 0.0f;
-  }
-  x = std::clamp(x, 0.5, nx_ + 0.5);
-  y = std::clamp(y, 0.5, ny_ + 0.5);
-  z = std::clamp(z, 0.5, nz_ + 0.5);
-  const int i0 = std::min(static_cast<int>(x), nx_), j0 = std::min(static_cast<int>(y), ny_),
-            k0 = std::min(static_cast<int>(z), nz_);
-  const float s = static_cast<float>(x - i0), t = static_cast<float>(y - j0),
-              r = static_cast<float>(z - k0);
-  auto lerp = [](float a, float b, float f) { return a + (b - a) * f; };
-  const float c00 = lerp(f[Ix(i0, j0, k0)], f[Ix(i0 + 1, j0, k0)], s);
-  const float c10 = lerp(f[Ix(i0, j0 + 1, k0)], f[Ix(i0 + 1, j0 + 1, k0)], s);
-  const float c01 = lerp(f[Ix(i0, j0, k0 + 1)], f[Ix(i0 + 1, j0, k0 + 1)], s);
-  const float c11 = lerp(f[Ix(i0, j0 + 1, k0 + 1)], f[Ix(i0 + 1, j0 + 1, k0 + 1)], s);
-  return lerp(lerp(c00, c10, t), lerp(c01, c11, t), r);
-}
-
-void GridFluid::Advect(int b, std::vector<float>& dst, const std::vector<float>& src,
-                       const Eigen::Vector3d& extra, bool open) const {
-  const double dt = params_.dt_sec;
+// advects `count` fields along one backtrace per voxel: the semi-Lagrangian step of Stam
+// 1999 with trilinear interpolation at grid coordinates where interior voxel centres sit at
+// 1..n. closed: the departure point is clamped to [0.5, n + 0.5]; open: outside that range
+// the value is 0 (clean air flows in).
+void GridFluid::Advect(int count, const int* b, std::vector<float>* const* dst,
+                       const std::vector<float>* const* src, const Eigen::Vector3d& extra,
+                       bool open) const {
+  const double cx = params_.dt_sec / h_.x(), cy = params_.dt_sec / h_.y(),
+               cz = params_.dt_sec / h_.z();
+  const size_t sy = nx_ + 2, sz = static_cast<size_t>(nx_ + 2) * (ny_ + 2);
   for (int k = 1; k <= nz_; ++k)
     for (int j = 1; j <= ny_; ++j)
       for (int i = 1; i <= nx_; ++i) {
         const size_t c = Ix(i, j, k);
-        const double x = i - dt * (u_[c] + extra.x()) / h_.x();
-        const double y = j - dt * (v_[c] + extra.y()) / h_.y();
-        const double z = k - dt * (w_[c] + extra.z()) / h_.z();
-        dst[c] = Sample(src, x, y, z, open);
+        double x = i - cx * (u_[c] + extra.x());
+        double y = j - cy * (v_[c] + extra.y());
+        double z = k - cz * (w_[c] + extra.z());
+        if (open &&
+            (x < 0.5 || x > nx_ + 0.5 || y < 0.5 || y > ny_ + 0.5 || z < 0.5 || z > nz_ + 0.5)) {
+          for (int f = 0; f < count; ++f) (*dst[f])[c] = 0.0f;
+          continue;
+        }
+        x = std::clamp(x, 0.5, nx_ + 0.5);
+        y = std::clamp(y, 0.5, ny_ + 0.5);
+        z = std::clamp(z, 0.5, nz_ + 0.5);
+        const int i0 = std::min(static_cast<int>(x), nx_), j0 = std::min(static_cast<int>(y), ny_),
+                  k0 = std::min(static_cast<int>(z), nz_);
+        const float s1 = static_cast<float>(x - i0), t1 = static_cast<float>(y - j0),
+                    r1 = static_cast<float>(z - k0);
+        const float s0 = 1 - s1, t0 = 1 - t1, r0 = 1 - r1;
+        const size_t o = Ix(i0, j0, k0);
+        for (int f = 0; f < count; ++f) {
+          const float* q = src[f]->data() + o;
+          const float lo = t0 * (s0 * q[0] + s1 * q[1]) + t1 * (s0 * q[sy] + s1 * q[sy + 1]);
+          const float hi =
+              t0 * (s0 * q[sz] + s1 * q[sz + 1]) + t1 * (s0 * q[sz + sy] + s1 * q[sz + sy + 1]);
+          (*dst[f])[c] = r0 * lo + r1 * hi;
+        }
       }
-  SetBoundary(b, dst);
+  for (int f = 0; f < count; ++f) SetBoundary(b[f], *dst[f]);
 }
 
 void GridFluid::Project() {
@@ -118,15 +123,22 @@ void GridFluid::Project() {
       }
   SetBoundary(0, div_);
   std::fill(p_.begin(), p_.end(), 0.0f);
+  // Jacobi sweeps over rows with fixed strides (x, y, z neighbours at 1, sy, sz)
+  const float fx = static_cast<float>(ix2 / diag), fy = static_cast<float>(iy2 / diag),
+              fz = static_cast<float>(iz2 / diag), fd = static_cast<float>(1.0 / diag);
+  const ptrdiff_t sy = nx_ + 2, sz = static_cast<ptrdiff_t>(nx_ + 2) * (ny_ + 2);
   for (int it = 0; it < params_.jacobi_iterations; ++it) {
     for (int k = 1; k <= nz_; ++k)
-      for (int j = 1; j <= ny_; ++j)
-        for (int i = 1; i <= nx_; ++i) {
-          const double s = (p_[Ix(i + 1, j, k)] + p_[Ix(i - 1, j, k)]) * ix2 +
-                           (p_[Ix(i, j + 1, k)] + p_[Ix(i, j - 1, k)]) * iy2 +
-                           (p_[Ix(i, j, k + 1)] + p_[Ix(i, j, k - 1)]) * iz2;
-          tmp_[Ix(i, j, k)] = static_cast<float>((s - div_[Ix(i, j, k)]) / diag);
+      for (int j = 1; j <= ny_; ++j) {
+        const size_t row = Ix(1, j, k);
+        const float* p = p_.data() + row;
+        const float* d = div_.data() + row;
+        float* out = tmp_.data() + row;
+        for (int i = 0; i < nx_; ++i) {
+          out[i] = (p[i + 1] + p[i - 1]) * fx + (p[i + sy] + p[i - sy]) * fy +
+                   (p[i + sz] + p[i - sz]) * fz - d[i] * fd;
         }
+      }
     SetBoundary(0, tmp_);
     std::swap(p_, tmp_);
   }
@@ -176,25 +188,30 @@ void GridFluid::Step(double weight) {
   SetBoundary(2, v_);
   SetBoundary(3, w_);
   Project();
-  // velocity self-advection (from copies, so all components use the old field)
+  // velocity self-advection: all three components along the same backtrace of the old field
   {
-    std::vector<float> u0 = u_, v0 = v_, w0 = w_;
     std::vector<float> un(u_.size()), vn(v_.size()), wn(w_.size());
-    Advect(1, un, u0, Eigen::Vector3d::Zero(), false);
-    Advect(2, vn, v0, Eigen::Vector3d::Zero(), false);
-    Advect(3, wn, w0, Eigen::Vector3d::Zero(), false);
+    const int b[3] = {1, 2, 3};
+    std::vector<float>* dst[3] = {&un, &vn, &wn};
+    const std::vector<float>* src[3] = {&u_, &v_, &w_};
+    Advect(3, b, dst, src, Eigen::Vector3d::Zero(), false);
     u_.swap(un);
     v_.swap(vn);
     w_.swap(wn);
   }
   Project();
-  // scalars
+  // scalars, moved by velocity + wind
   const bool open = wind_.squaredNorm() > 0;
   const double mass_before = TotalMass();
-  Advect(0, tmp_, rho_, wind_, open);
-  std::swap(rho_, tmp_);
-  Advect(0, tmp_, theta_, wind_, open);
-  std::swap(theta_, tmp_);
+  {
+    std::vector<float> rn(rho_.size());
+    const int b[2] = {0, 0};
+    std::vector<float>* dst[2] = {&rn, &tmp_};
+    const std::vector<float>* src[2] = {&rho_, &theta_};
+    Advect(2, b, dst, src, wind_, open);
+    rho_.swap(rn);
+    std::swap(theta_, tmp_);
+  }
   if (!open) {
     const double mass_after = TotalMass();
     if (mass_after > 0) {

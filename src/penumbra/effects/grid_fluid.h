@@ -66,9 +66,10 @@ class GridFluid {
     return (static_cast<size_t>(k) * (ny_ + 2) + j) * (nx_ + 2) + i;
   }
   void SetBoundary(int b, std::vector<float>& x) const;
-  float Sample(const std::vector<float>& f, double x, double y, double z, bool open) const;
-  void Advect(int b, std::vector<float>& dst, const std::vector<float>& src,
-              const Eigen::Vector3d& extra_velocity, bool open) const;
+  // advects `count` fields (boundary kinds b) along the velocity + extra_velocity.
+  void Advect(int count, const int* b, std::vector<float>* const* dst,
+              const std::vector<float>* const* src, const Eigen::Vector3d& extra_velocity,
+              bool open) const;
   void Project();
 
   FluidParams params_;

@@ -13,9 +13,10 @@ constexpr double kPi = 3.14159265358979323846;
 
 // x wrapped into [lo, lo + len)
 double Wrap(double x, double lo, double len) {
-  double r = std::fmod(x - lo, len);
-  if (r < 0) r += len;
-  return lo + r;
+  const double r = x - lo;
+  double m = r - len * std::floor(r / len);
+  if (m >= len) m = 0;  // rounding at the upper edge
+  return lo + m;
 }
 
 bool Inside(const BoxRegion* region, const Eigen::Vector3d& p) {
@@ -54,80 +55,109 @@ Eigen::Vector3d EffectiveHalfExtents(const Eigen::Vector3d& half, double density
   return half * std::cbrt(max_particles / count);
 }
 
-ParticleSet SampleRain(const RainParams& p, double t, const Eigen::Vector3d& viewer_W,
-                       double weight, const BoxRegion* region, uint64_t seed, uint64_t effect_key) {
-  ParticleSet set;
-  set.kind = ParticleKind::kRain;
-  set.color = p.color.cast<float>();
+PrecipitationTable BuildRainTable(const RainParams& p, uint64_t seed, uint64_t effect_key) {
+  PrecipitationTable tab;
+  tab.kind = ParticleKind::kRain;
+  tab.color = p.color.cast<float>();
   const double n = RainNumberDensity(p.rate_mm_h, p.min_diameter_mm, p.max_diameter_mm);
-  const Eigen::Vector3d half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
-  const Eigen::Vector3d size = 2.0 * half;
-  const Eigen::Vector3d lo = viewer_W - half;
-  const long long count = std::llround(n * 8.0 * half.prod());
+  tab.half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
+  const Eigen::Vector3d size = 2.0 * tab.half;
+  const size_t count = static_cast<size_t>(std::llround(n * 8.0 * tab.half.prod()));
   const double lam = MarshallPalmerLambda(p.rate_mm_h);
   const double cdf_span = 1.0 - std::exp(-lam * (p.max_diameter_mm - p.min_diameter_mm));
-  set.position_W.reserve(count);
-  set.velocity_W.reserve(count);
-  set.radius_m.reserve(count);
-  for (long long i = 0; i < count; ++i) {
+  tab.q0.resize(count);
+  tab.velocity.resize(count);
+  tab.radius_m.resize(count);
+  tab.keep.resize(count);
+  for (size_t i = 0; i < count; ++i) {
     Rng rng(HashKeys(seed, effect_key, static_cast<uint64_t>(i)));
-    const double u_keep = rng.UniformD();
+    tab.keep[i] = static_cast<float>(rng.UniformD());
     // diameter from the truncated exponential by inverting its CDF
-    const double u_d = rng.UniformD();
-    const double d_mm = p.min_diameter_mm - std::log(1.0 - u_d * cdf_span) / lam;
-    const Eigen::Vector3d q0(rng.UniformD() * size.x(), rng.UniformD() * size.y(),
-                             rng.UniformD() * size.z());
-    if (u_keep >= weight) continue;
-    const Eigen::Vector3d v(p.wind_m_s.x(), p.wind_m_s.y(), -RainTerminalVelocity(d_mm));
-    const Eigen::Vector3d q = q0 + v * t;
+    const double d_mm = p.min_diameter_mm - std::log(1.0 - rng.UniformD() * cdf_span) / lam;
+    tab.q0[i] = Eigen::Vector3d(rng.UniformD() * size.x(), rng.UniformD() * size.y(),
+                                rng.UniformD() * size.z());
+    tab.velocity[i] = Eigen::Vector3d(p.wind_m_s.x(), p.wind_m_s.y(), -RainTerminalVelocity(d_mm));
+    tab.radius_m[i] = static_cast<float>(0.5e-3 * d_mm);
+  }
+  return tab;
+}
+
+PrecipitationTable BuildSnowTable(const SnowParams& p, uint64_t seed, uint64_t effect_key) {
+  PrecipitationTable tab;
+  tab.kind = ParticleKind::kSnow;
+  tab.color = p.color.cast<float>();
+  const double n = SnowNumberDensity(p);
+  tab.half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
+  const Eigen::Vector3d size = 2.0 * tab.half;
+  const size_t count = static_cast<size_t>(std::llround(n * 8.0 * tab.half.prod()));
+  tab.drift_amplitude_m_s =
+      Eigen::Vector3d(p.turbulence_m_s, p.turbulence_m_s, 0.3 * p.turbulence_m_s);
+  tab.q0.resize(count);
+  tab.velocity.resize(count);
+  tab.radius_m.resize(count);
+  tab.keep.resize(count);
+  tab.omega.resize(count);
+  tab.phase.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    Rng rng(HashKeys(seed, effect_key, static_cast<uint64_t>(i)));
+    tab.keep[i] = static_cast<float>(rng.UniformD());
+    const double d_mm = p.flake_diameter_mm * (0.7 + 0.6 * rng.UniformD());
+    tab.q0[i] = Eigen::Vector3d(rng.UniformD() * size.x(), rng.UniformD() * size.y(),
+                                rng.UniformD() * size.z());
+    tab.omega[i] = 2 * kPi * p.drift_frequency_hz * (0.5 + rng.UniformD());
+    tab.phase[i] = Eigen::Vector3d(2 * kPi * rng.UniformD(), 2 * kPi * rng.UniformD(),
+                                   2 * kPi * rng.UniformD());
+    tab.velocity[i] = Eigen::Vector3d(p.wind_m_s.x(), p.wind_m_s.y(), -SnowFallSpeed(d_mm));
+    tab.radius_m[i] = static_cast<float>(0.5e-3 * d_mm);
+  }
+  return tab;
+}
+
+ParticleSet PlaceParticles(const PrecipitationTable& tab, double t, const Eigen::Vector3d& viewer_W,
+                           double weight, const BoxRegion* region) {
+  ParticleSet set;
+  set.kind = tab.kind;
+  set.color = tab.color;
+  const Eigen::Vector3d size = 2.0 * tab.half;
+  const Eigen::Vector3d lo = viewer_W - tab.half;
+  const bool drift = !tab.omega.empty();
+  const size_t count = tab.q0.size();
+  const size_t expect = static_cast<size_t>(std::min(1.0, std::max(0.0, weight)) * count) + 16;
+  set.position_W.reserve(expect);
+  set.velocity_W.reserve(expect);
+  set.radius_m.reserve(expect);
+  for (size_t i = 0; i < count; ++i) {
+    if (tab.keep[i] >= weight) continue;
+    Eigen::Vector3d q = tab.q0[i] + tab.velocity[i] * t;
+    Eigen::Vector3d v = tab.velocity[i];
+    if (drift) {
+      const double w = tab.omega[i];
+      for (int a = 0; a < 3; ++a) {
+        const double amp = tab.drift_amplitude_m_s[a];
+        const double ph = tab.phase[i][a];
+        // integral of amp sin(w s + ph) ds over [0, t]
+        q[a] += amp / w * (std::cos(ph) - std::cos(w * t + ph));
+        v[a] += amp * std::sin(w * t + ph);
+      }
+    }
     const Eigen::Vector3d pos(Wrap(q.x(), lo.x(), size.x()), Wrap(q.y(), lo.y(), size.y()),
                               Wrap(q.z(), lo.z(), size.z()));
     if (!Inside(region, pos)) continue;
     set.position_W.push_back(pos.cast<float>());
     set.velocity_W.push_back(v.cast<float>());
-    set.radius_m.push_back(static_cast<float>(0.5e-3 * d_mm));
+    set.radius_m.push_back(tab.radius_m[i]);
   }
   return set;
 }
 
+ParticleSet SampleRain(const RainParams& p, double t, const Eigen::Vector3d& viewer_W,
+                       double weight, const BoxRegion* region, uint64_t seed, uint64_t effect_key) {
+  return PlaceParticles(BuildRainTable(p, seed, effect_key), t, viewer_W, weight, region);
+}
+
 ParticleSet SampleSnow(const SnowParams& p, double t, const Eigen::Vector3d& viewer_W,
                        double weight, const BoxRegion* region, uint64_t seed, uint64_t effect_key) {
-  ParticleSet set;
-  set.kind = ParticleKind::kSnow;
-  set.color = p.color.cast<float>();
-  const double n = SnowNumberDensity(p);
-  const Eigen::Vector3d half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
-  const Eigen::Vector3d size = 2.0 * half;
-  const Eigen::Vector3d lo = viewer_W - half;
-  const long long count = std::llround(n * 8.0 * half.prod());
-  for (long long i = 0; i < count; ++i) {
-    Rng rng(HashKeys(seed, effect_key, static_cast<uint64_t>(i)));
-    const double u_keep = rng.UniformD();
-    const double d_mm = p.flake_diameter_mm * (0.7 + 0.6 * rng.UniformD());
-    const Eigen::Vector3d q0(rng.UniformD() * size.x(), rng.UniformD() * size.y(),
-                             rng.UniformD() * size.z());
-    const double f = p.drift_frequency_hz * (0.5 + rng.UniformD());
-    const Eigen::Vector3d phase(2 * kPi * rng.UniformD(), 2 * kPi * rng.UniformD(),
-                                2 * kPi * rng.UniformD());
-    if (u_keep >= weight) continue;
-    const double w = 2 * kPi * f;
-    const Eigen::Vector3d amp(p.turbulence_m_s, p.turbulence_m_s, 0.3 * p.turbulence_m_s);
-    const Eigen::Vector3d mean_v(p.wind_m_s.x(), p.wind_m_s.y(), -SnowFallSpeed(d_mm));
-    Eigen::Vector3d drift, v;
-    for (int a = 0; a < 3; ++a) {
-      // integral of amp sin(w s + phase) ds over [0, t]
-      drift[a] = amp[a] / w * (std::cos(phase[a]) - std::cos(w * t + phase[a]));
-      v[a] = mean_v[a] + amp[a] * std::sin(w * t + phase[a]);
-    }
-    const Eigen::Vector3d q = q0 + mean_v * t + drift;
-    const Eigen::Vector3d pos(Wrap(q.x(), lo.x(), size.x()), Wrap(q.y(), lo.y(), size.y()),
-                              Wrap(q.z(), lo.z(), size.z()));
-    if (!Inside(region, pos)) continue;
-    set.position_W.push_back(pos.cast<float>());
-    set.velocity_W.push_back(v.cast<float>());
-    set.radius_m.push_back(static_cast<float>(0.5e-3 * d_mm));
-  }
-  return set;
+  return PlaceParticles(BuildSnowTable(p, seed, effect_key), t, viewer_W, weight, region);
 }
 
 }  // namespace penumbra

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <vector>
 
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/scene/effects_frame.h"
@@ -42,6 +43,31 @@ double SnowNumberDensity(const SnowParams& p);
 /// <= max_particles.
 Eigen::Vector3d EffectiveHalfExtents(const Eigen::Vector3d& half, double density_per_m3,
                                      int max_particles);
+
+/// the fixed per-particle draws of a rain or snow effect (sizes, places in the periodic
+/// cell, velocities, drift), drawn once; PlaceParticles() moves them to a time and viewer.
+struct PrecipitationTable {
+  ParticleKind kind = ParticleKind::kRain;
+  Eigen::Vector3d half{1, 1, 1};          ///< half extents of the periodic box, m
+  std::vector<Eigen::Vector3d> q0;        ///< (N) place in the cell [0, 2 half)^3 at t = 0
+  std::vector<Eigen::Vector3d> velocity;  ///< (N) mean velocity, m/s
+  std::vector<float> radius_m;            ///< (N)
+  std::vector<float> keep;                ///< (N) uniform draw for thinning by the weight
+  // snow drift: amplitude per axis, angular frequency and phases per flake
+  Eigen::Vector3d drift_amplitude_m_s{0, 0, 0};
+  std::vector<double> omega;           ///< (N) rad/s, empty for rain
+  std::vector<Eigen::Vector3d> phase;  ///< (N) rad
+  Eigen::Vector3f color{1, 1, 1};
+};
+
+/// the drops of a rain effect (see SampleRain).
+PrecipitationTable BuildRainTable(const RainParams& p, uint64_t seed, uint64_t effect_key);
+/// the flakes of a snow effect (see SampleSnow).
+PrecipitationTable BuildSnowTable(const SnowParams& p, uint64_t seed, uint64_t effect_key);
+/// the particles of a table at time t around viewer_W, thinned to `weight` and clipped to
+/// `region` (may be null).
+ParticleSet PlaceParticles(const PrecipitationTable& table, double t,
+                           const Eigen::Vector3d& viewer_W, double weight, const BoxRegion* region);
 
 /// rain drops at time t (sim seconds) around viewer_W. `weight` in [0, 1] thins the drops
 /// (drop i is kept when its own uniform draw is < weight); `region` (may be null) keeps only

@@ -13,8 +13,12 @@ double Fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 }  // namespace
 
 double LatticeValue(uint64_t key, int64_t i, int64_t j, int64_t k) {
-  const uint64_t h =
-      HashKeys(key, static_cast<uint64_t>(i), static_cast<uint64_t>(j), static_cast<uint64_t>(k));
+  // one linear combination of the lattice index with odd 64-bit constants, then two rounds
+  // of the SplitMix64 finaliser keyed by `key`
+  const uint64_t lin = static_cast<uint64_t>(i) * 0x9e3779b97f4a7c15ULL +
+                       static_cast<uint64_t>(j) * 0xc2b2ae3d27d4eb4fULL +
+                       static_cast<uint64_t>(k) * 0x165667b19e3779f9ULL;
+  const uint64_t h = Mix64(key ^ Mix64(lin));
   return static_cast<double>(h >> 11) * 0x1.0p-53;
 }
 
