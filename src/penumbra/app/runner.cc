@@ -9,6 +9,7 @@
 #include <fstream>
 #include <thread>
 
+#include "penumbra/app/camera_stage.h"
 #include "penumbra/app/scene_assembly.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
@@ -123,6 +124,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   // outputs
   AsyncFrameWriter writer(out.string());
   for (const CameraSpec& cam : scene.cameras) writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
+  CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
   std::ofstream trajectory(out / "trajectory.csv");
   WriteTrajectoryHeader(trajectory, sim.qpos().size());
 
@@ -139,13 +141,15 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   double physics_busy_sec = 0;
   std::thread physics([&] {
     CameraSchedule schedule(scene.cameras);
+    ShutterSchedule shutters(scene, world);  // end-of-exposure snapshots (motion blur)
     const auto wall0 = Clock::now();
     try {
       for (;;) {
         RenderJob job;
         schedule.Due(sim.time(), &job.cameras, &job.frame_indices);
-        if (!job.cameras.empty()) {
+        if (shutters.Due(sim.time()) || !job.cameras.empty()) {
           job.snapshot = sim.Snapshot();
+          shutters.Add(job.snapshot.time_sec, job.cameras);
           if (!jobs.Push(std::move(job))) return;
         }
         if (sim.time() >= duration - 1e-9) break;
@@ -172,44 +176,28 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   RunSummary summary;
   double render_sec = 0;
   int64_t total_frames = 0;
+  const CameraStage::Submit submit = [&](CameraFrame&& cf) {
+    ++summary.frames_per_camera[cf.camera];
+    ++total_frames;
+    writer.Submit(std::move(cf));
+  };
   try {
     while (std::optional<RenderJob> job = jobs.Pop()) {
       if (job->error) {
         failure = job->error;
         break;
       }
-      for (size_t i = 0; i < job->cameras.size(); ++i) {
-        const CameraSpec& cam = scene.cameras[job->cameras[i]];
-        CameraView view;
-        view.X_WO = CameraPoseInWorld(cam, job->snapshot);
-        view.intrinsics = cam.intrinsics;
-        view.outputs = cam.outputs;
-        view.frame_index = job->frame_indices[i];
-        view.camera_index = job->cameras[i];
-        RenderedFrame frame;
-        const auto tr = Clock::now();
-        renderer->Render(job->snapshot, view, &frame);
-        render_sec += SecondsSince(tr);
-        CameraFrame cf;
-        cf.camera = cam.name;
-        cf.index = view.frame_index;
-        cf.time_sec = job->snapshot.time_sec;
-        cf.X_WO = view.X_WO;
-        cf.rgb = std::move(frame.rgb);
-        cf.depth_m = std::move(frame.depth_m);
-        cf.geom_id = std::move(frame.geom_id);
-        writer.Submit(std::move(cf));
-        ++summary.frames_per_camera[cam.name];
-        ++total_frames;
-      }
+      camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, {}, submit);
       progress.Update(job->snapshot.time_sec, total_frames);
     }
+    if (!failure) camera_stage.Finish(submit);
   } catch (...) {
     failure = std::current_exception();
   }
   jobs.Close();
   physics.join();
   progress.Finish();
+  render_sec = camera_stage.render_sec();
 
   std::exception_ptr write_failure;
   try {

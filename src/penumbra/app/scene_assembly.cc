@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 
+#include "penumbra/app/camera_specs.h"
 #include "penumbra/core/error.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -211,7 +212,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
       X_BodyOptical.linear() = RotationBodyFromOptical();
       cam.X_BO = c.pose.ToPose() * X_BodyOptical;
     }
-    cameras.push_back(cam);
+    AppendWorldCamera(c, cam, &cameras);
   }
   std::set<std::string> names;
   for (const CameraSpec& c : cameras)
@@ -251,6 +252,7 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
   }
 
   AssembleCameras(scene, world, initial);
+  ApplySemanticClasses(world.semantic_classes, &scene);
   return scene;
 }
 

@@ -3,11 +3,12 @@
 #include <cmath>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/camera_distortion.h"
 
 namespace penumbra {
 
-Camera::Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics)
-    : X_WO_(X_WO), intrinsics_(intrinsics) {
+Camera::Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics, const CameraMotion& motion)
+    : X_WO_(X_WO), intrinsics_(intrinsics), motion_(motion) {
   const CameraIntrinsics& k = intrinsics;
   if (k.width < 1 || k.height < 1)
     throw ConfigError("", 0, "camera.intrinsics",
@@ -17,6 +18,15 @@ Camera::Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics)
       !std::isfinite(k.cx) || !std::isfinite(k.cy))
     throw ConfigError("", 0, "camera.intrinsics",
                       "fx, fy must be positive and fx, fy, cx, cy finite");
+  if (auto problem = FindDistortionProblem(k))
+    throw ConfigError("", 0, "camera.intrinsics",
+                      *problem +
+                          "; expected a distortion that is "
+                          "one-to-one over the image");
+  if (!(motion.end_sec >= 0) || !std::isfinite(motion.end_sec) || !std::isfinite(motion.time_sec) ||
+      !(motion.line_time_sec >= 0) || !std::isfinite(motion.line_time_sec))
+    throw ConfigError("", 0, "camera.motion",
+                      "end_sec and line_time_sec must be finite and >= 0, time_sec finite");
   const Eigen::Matrix3d R = X_WO.linear();
   o_W_ = X_WO.translation().cast<float>();
   ex_W_ = R.col(0).cast<float>();
@@ -26,13 +36,50 @@ Camera::Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics)
   cy_ = static_cast<float>(k.cy);
   inv_fx_ = static_cast<float>(1.0 / k.fx);
   inv_fy_ = static_cast<float>(1.0 / k.fy);
+  q0_ = Eigen::Quaterniond(R);
+  q1_ = Eigen::Quaterniond(motion.X_WO_end.linear());
+  slow_ = k.has_distortion() || motion.moving();
+}
+
+Eigen::Vector2d Camera::Unproject(double u, double v) const {
+  const CameraIntrinsics& k = intrinsics_;
+  const double xd = (u - k.cx) / k.fx, yd = (v - k.cy) / k.fy;
+  if (!k.has_distortion()) return {xd, yd};
+  double x, y;
+  UndistortNormalized(k, xd, yd, &x, &y);  // converges: checked over the image at construction
+  return {x, y};
+}
+
+Pose Camera::PoseAtRow(double v) const {
+  if (!motion_.moving()) return X_WO_;
+  const double s = motion_.time_sec + motion_.line_time_sec * v;
+  const double a = s / motion_.end_sec;
+  Pose X = Pose::Identity();
+  X.linear() = q0_.slerp(a, q1_).toRotationMatrix();
+  X.translation() = (1.0 - a) * X_WO_.translation() + a * motion_.X_WO_end.translation();
+  return X;
+}
+
+Ray Camera::GenerateRaySlow(float u, float v) const {
+  const Eigen::Vector2d xy = Unproject(u, v);
+  Ray r;
+  if (!motion_.moving()) {
+    r.o = o_W_;
+    r.d = static_cast<float>(xy.x()) * ex_W_ + static_cast<float>(xy.y()) * ey_W_ + ez_W_;
+    return r;
+  }
+  const Pose X = PoseAtRow(v);
+  r.o = X.translation().cast<float>();
+  r.d = (X.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0)).cast<float>();
+  return r;
 }
 
 bool Camera::Project(const Eigen::Vector3d& p_W, Eigen::Vector2d* uv, double* z) const {
   const Eigen::Vector3d p_O = X_WO_.inverse() * p_W;
   if (!(p_O.z() > 0)) return false;
-  *uv = Eigen::Vector2d(intrinsics_.fx * p_O.x() / p_O.z() + intrinsics_.cx,
-                        intrinsics_.fy * p_O.y() / p_O.z() + intrinsics_.cy);
+  double xd = p_O.x() / p_O.z(), yd = p_O.y() / p_O.z();
+  if (intrinsics_.has_distortion()) DistortNormalized(intrinsics_, xd, yd, &xd, &yd);
+  *uv = Eigen::Vector2d(intrinsics_.fx * xd + intrinsics_.cx, intrinsics_.fy * yd + intrinsics_.cy);
   *z = p_O.z();
   return true;
 }

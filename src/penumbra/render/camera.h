@@ -1,10 +1,21 @@
 #pragma once
-// pinhole camera rays in the OpenCV convention: pixel centres at integer coordinates,
-// the ray through pixel (u, v) has direction ((u - cx) / fx, (v - cy) / fy, 1) in the
-// optical frame (x right, y down, z forward), so a hit at ray parameter t lies at
-// z-depth t along the optical axis (depth images are z, not range).
+// camera rays in the OpenCV convention: pixel centres at integer coordinates, optical frame
+// x right, y down, z forward. the ray through pixel (u, v) has optical-frame direction
+// (x, y, 1), where (x, y) are the undistorted normalised coordinates of the pixel: for a
+// pinhole (x, y) = ((u - cx) / fx, (v - cy) / fy); with Brown-Conrady distortion
+// (CameraIntrinsics k1 k2 p1 p2 k3, render/camera_distortion.h) (x, y) is the exact Newton
+// inverse of the distortion map, so a hit at ray parameter t lies at z-depth t along the
+// optical axis (depth images are z, range is t |d|).
+//
+// motion (CameraMotion): the optical frame may move during the exposure. the pose at time s
+// after the frame's time is interpolated between X_WO (s = 0) and X_WO_end (s = end_sec):
+// position linearly, rotation by quaternion slerp. a pixel in row v is seen at time
+// s = time_sec + line_time_sec * v (rolling shutter: rows are read out top to bottom; a
+// global shutter has line_time_sec = 0). motion blur over the exposure is made by rendering
+// sub-frames at several time_sec and averaging them (sensors/camera_imager.h).
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "penumbra/core/pose.h"
 #include "penumbra/render/ray_scene.h"
@@ -12,16 +23,31 @@
 
 namespace penumbra {
 
-/// a posed pinhole camera. immutable, thread-safe.
+/// motion of the optical frame around one frame (see the file comment).
+struct CameraMotion {
+  Pose X_WO_end = Pose::Identity();  ///< optical frame in the world at time end_sec
+  double end_sec = 0;                ///< time of X_WO_end after the frame's time, s; 0 = no motion
+  double time_sec = 0;               ///< time at which row 0 is seen, s after the frame's time
+  double line_time_sec = 0;  ///< rolling shutter: delay between consecutive rows, s (0 = global)
+
+  /// true if rays depend on time (the camera moves between X_WO and X_WO_end).
+  bool moving() const { return end_sec > 0; }
+};
+
+/// a posed camera. immutable, thread-safe.
 class Camera {
  public:
-  /// @param X_WO  pose of the optical frame in the world
-  /// @throws ConfigError if width/height < 1 or fx/fy are not positive and finite.
-  Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics);
+  /// @param X_WO  pose of the optical frame in the world at the frame's time
+  /// @throws ConfigError (key "camera.intrinsics") if width/height < 1, fx/fy are not positive
+  ///         and finite, or the distortion folds the image (see FindDistortionProblem);
+  ///         ConfigError (key "camera.motion") for a negative or non-finite motion time.
+  Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics, const CameraMotion& motion = {});
 
   /// world ray through pixel coordinates (u, v) (column, row; pixel centres are integers).
-  /// the origin is the optical centre; d has optical-frame z = 1 (t = z-depth).
+  /// the origin is the optical centre (at the row's time); d has optical-frame z = 1
+  /// (t = z-depth).
   Ray GenerateRay(float u, float v) const {
+    if (slow_) return GenerateRaySlow(u, v);
     const float x = (u - cx_) * inv_fx_;
     const float y = (v - cy_) * inv_fy_;
     Ray r;
@@ -30,20 +56,34 @@ class Camera {
     return r;
   }
 
-  /// projects world point p_W: pixel coordinates (u, v) and z-depth in the optical frame.
-  /// returns false (outputs untouched) for points at or behind the camera plane (z <= 0).
+  /// undistorted normalised coordinates (x, y) of pixel (u, v) (the optical-frame ray
+  /// direction is (x, y, 1)); exact to 1e-12 with distortion.
+  Eigen::Vector2d Unproject(double u, double v) const;
+
+  /// optical frame in the world at the time row v is seen (X_WO when the camera does not move).
+  Pose PoseAtRow(double v) const;
+
+  /// projects world point p_W (with the frame pose X_WO and the distortion): pixel
+  /// coordinates (u, v) and z-depth in the optical frame. returns false (outputs untouched)
+  /// for points at or behind the camera plane (z <= 0).
   bool Project(const Eigen::Vector3d& p_W, Eigen::Vector2d* uv, double* z) const;
 
   int width() const { return intrinsics_.width; }
   int height() const { return intrinsics_.height; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
   const Pose& X_WO() const { return X_WO_; }
+  const CameraMotion& motion() const { return motion_; }
 
  private:
+  Ray GenerateRaySlow(float u, float v) const;
+
   Pose X_WO_;
   CameraIntrinsics intrinsics_;
+  CameraMotion motion_;
+  bool slow_ = false;                         // distortion or motion
   Eigen::Vector3f o_W_, ex_W_, ey_W_, ez_W_;  // optical centre and optical axes in the world
   float cx_, cy_, inv_fx_, inv_fy_;
+  Eigen::Quaterniond q0_, q1_;  // rotations at s = 0 and s = end_sec
 };
 
 }  // namespace penumbra

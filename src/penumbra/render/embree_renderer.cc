@@ -5,6 +5,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/camera_ground_truth.h"
 #include "penumbra/render/path_integrator.h"
 #include "penumbra/render/realtime_integrator.h"
 
@@ -52,7 +53,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
                 " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
   ray_scene_->Update(snapshot);
   lights_.Update(snapshot);
-  const Camera camera(view.X_WO, view.intrinsics);
+  const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
   effects_.Prepare(snapshot, camera, view.exposure_time_sec, settings_, lights_, *ray_scene_, sky_,
                    &pool_);
@@ -82,6 +83,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   } else {
     out->geom_id = ImageI32();
   }
+  const GroundTruthImages truth = PrepareGroundTruth(want, W, H, out);
   FrameBuffers buffers;
   if (want.rgb) {
     buffers.radiance = &out->radiance;
@@ -129,6 +131,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
       const int u = t.x0 + i % t.width, v = t.y0 + i / t.width;
       if (depth) *depth->at(u, v) = did_hit[i] ? hits[i].t : 0.0f;
       if (seg) *seg->at(u, v) = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
+      if (truth.any) WriteGroundTruth(truth, camera, scene_, rays[i], did_hit[i], hits[i], u, v);
     }
     if (buffers.radiance) {
       primary.rays = rays.get();

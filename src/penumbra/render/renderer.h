@@ -7,6 +7,7 @@
 #include <string>
 
 #include "penumbra/core/image.h"
+#include "penumbra/render/camera.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -21,6 +22,9 @@ struct CameraView {
   int64_t frame_index = 0;  ///< per-camera frame counter, keys the per-pixel random numbers
   int camera_index = 0;     ///< index in SceneDescription::cameras, keys the random numbers too
   double exposure_time_sec = 0.01;  ///< shutter open time from the snapshot's time (streaks, blur)
+  /// optical-frame motion for this render (rolling shutter, motion-blur sub-frames); default
+  /// = a camera fixed at X_WO (render/camera.h).
+  CameraMotion motion;
 };
 
 /// images of one frame; the ones not requested are left empty.
@@ -29,6 +33,11 @@ struct RenderedFrame {
   ImageU8 rgb;       ///< (H x W x 3) uint8 sRGB after exposure and tone mapping
   ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
   ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background; never blended
+  /// the images below come from the same pixel-centre ray as depth_m (never blended).
+  ImageF range_m;    ///< (H x W x 1) float distance optical centre -> hit along the ray, m; 0 = no hit
+  ImageF normal_O;   ///< (H x W x 3) float unit geometric normal facing the camera, optical frame; 0 = no hit
+  ImageI32 body_id;  ///< (H x W x 1) SceneDescription body index of the hit geom, -1 = background
+  ImageI32 semantic_class;  ///< (H x W x 1) Geom::semantic_class of the hit geom, 0 = background
   double ev100 = 0;  ///< exposure value used for rgb
   int64_t rays = 0;  ///< rays traced for this frame (primary + shadow + secondary), for benchmarks
 };

@@ -135,6 +135,15 @@ struct CameraIntrinsics {
   int width = 640;
   int height = 480;
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pixels
+  /// Brown-Conrady lens distortion in OpenCV's order and names (plumb_bob: k1 k2 p1 p2 k3), on
+  /// normalised coordinates (x, y) = (X/Z, Y/Z): r2 = x^2 + y^2,
+  /// x_d = x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2),
+  /// y_d = y (1 + k1 r2 + k2 r2^2 + k3 r2^3) + p1 (r2 + 2 y^2) + 2 p2 x y, then
+  /// (u, v) = (fx x_d + cx, fy y_d + cy). all 0 = ideal pinhole (render/camera.h traces it exactly).
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+
+  /// true if any distortion coefficient is non-zero.
+  bool has_distortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
 
   /// square pixels, principal point at the image centre, vertical field of view fovy_deg.
   static CameraIntrinsics FromFovy(int width, int height, double fovy_deg);
@@ -145,6 +154,10 @@ struct CameraOutputs {
   bool rgb = true;
   bool depth = false;         ///< z-depth in metres along the optical axis
   bool segmentation = false;  ///< geom id + 1 per pixel, 0 = background
+  bool range = false;         ///< distance from the optical centre to the hit along the ray, m
+  bool normals = false;       ///< unit surface normal (facing the camera) in the optical frame
+  bool instance_segmentation = false;  ///< body index + 1 per pixel, 0 = background
+  bool semantic_segmentation = false;  ///< Geom::semantic_class per pixel, 0 = background/unlabelled
 };
 
 /// a camera: rigidly attached to a body, or an MJCF camera posed by the snapshot.

@@ -140,8 +140,11 @@ class Validator {
   }
 
   void CheckOutputs(const std::string& path, const CameraOutputs& o) const {
-    if (!o.rgb && !o.depth && !o.segmentation) {
-      Fail(path, "no output selected; expected a non-empty list of: rgb, depth, segmentation");
+    if (!o.rgb && !o.depth && !o.segmentation && !o.range && !o.normals &&
+        !o.instance_segmentation && !o.semantic_segmentation) {
+      Fail(path,
+           "no output selected; expected a non-empty list of: rgb, depth, segmentation, range, "
+           "normals, instance_segmentation, semantic_segmentation");
     }
   }
 

@@ -1,0 +1,233 @@
+#include "penumbra/sensors/camera_imager.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/sensors/camera_lens_droplets.h"
+#include "penumbra/sensors/image_noise.h"
+
+namespace penumbra {
+namespace {
+
+Pose Interpolate(const Pose& a, const Pose& b, double t) {
+  Pose X = Pose::Identity();
+  X.linear() =
+      Eigen::Quaterniond(a.linear()).slerp(t, Eigen::Quaterniond(b.linear())).toRotationMatrix();
+  X.translation() = (1.0 - t) * a.translation() + t * b.translation();
+  return X;
+}
+
+// the world at fraction t between start and end: body poses, MJCF cameras and light positions
+// interpolated; everything else (effects, joint state) from start.
+WorldSnapshot InterpolateSnapshot(const WorldSnapshot& a, const WorldSnapshot& b, double t) {
+  WorldSnapshot s = a;
+  s.time_sec = a.time_sec + t * (b.time_sec - a.time_sec);
+  for (size_t i = 0; i < s.X_WB.size() && i < b.X_WB.size(); ++i)
+    s.X_WB[i] = Interpolate(a.X_WB[i], b.X_WB[i], t);
+  for (size_t i = 0; i < s.X_W_mjcam.size() && i < b.X_W_mjcam.size(); ++i)
+    s.X_W_mjcam[i] = Interpolate(a.X_W_mjcam[i], b.X_W_mjcam[i], t);
+  for (size_t i = 0; i < s.light_position_W.size() && i < b.light_position_W.size(); ++i)
+    s.light_position_W[i] = (1.0 - t) * a.light_position_W[i] + t * b.light_position_W[i];
+  return s;
+}
+
+void RoundTripJpeg(int quality, ImageU8* rgb) {
+  cv::Mat img(rgb->height, rgb->width, CV_8UC3, rgb->data.data());
+  cv::Mat bgr;
+  cv::cvtColor(img, bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> buf;
+  cv::imencode(".jpg", bgr, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
+  const cv::Mat dec = cv::imdecode(buf, cv::IMREAD_COLOR);
+  cv::cvtColor(dec, img, cv::COLOR_BGR2RGB);  // writes into rgb's buffer (same size and type)
+}
+
+}  // namespace
+
+double FrameSpanSec(const CameraSensorConfig& c, int height) {
+  return c.exposure_time_sec + std::max(0, height - 1) * c.rolling_shutter_line_time_sec;
+}
+
+void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string& key_prefix) {
+  auto fail = [&](const std::string& key, const std::string& problem) {
+    throw ConfigError("", 0, key_prefix + "." + key, problem);
+  };
+  if (!(c.exposure_time_sec >= 0) || !std::isfinite(c.exposure_time_sec))
+    fail("exposure_time_sec", "got " + std::to_string(c.exposure_time_sec) +
+                                  "; expected a finite number >= 0 (seconds)");
+  if (c.motion_blur_samples < 1 || c.motion_blur_samples > 64)
+    fail("motion_blur_samples",
+         "got " + std::to_string(c.motion_blur_samples) + "; expected an integer in [1, 64]");
+  if (!(c.rolling_shutter_line_time_sec >= 0) || !std::isfinite(c.rolling_shutter_line_time_sec))
+    fail("rolling_shutter_line_time_sec", "expected a finite number >= 0 (seconds per row)");
+  if (!(c.auto_exposure_time_constant_sec >= 0) ||
+      !std::isfinite(c.auto_exposure_time_constant_sec))
+    fail("auto_exposure_time_constant_sec", "expected a finite number >= 0 (seconds)");
+  if (c.jpeg_quality < 0 || c.jpeg_quality > 100)
+    fail("jpeg_quality", "got " + std::to_string(c.jpeg_quality) +
+                             "; expected 0 (lossless) or a JPEG quality in [1, 100]");
+  if (c.lens_droplet_count < 0 || c.lens_droplet_count > 1000)
+    fail("lens_droplets.count", "expected an integer in [0, 1000]");
+  if (c.stereo_baseline_m && (!(*c.stereo_baseline_m > 0) || !std::isfinite(*c.stereo_baseline_m)))
+    fail("stereo.baseline_m", "expected a finite baseline > 0 (m)");
+  ValidateImageNoiseOrThrow(c.noise, key_prefix + ".noise");
+  if (!c.depth_noise.preset.empty()) DepthNoisePreset(c.depth_noise, key_prefix + ".depth_noise");
+}
+
+CameraImager::CameraImager(const CameraSpec& spec, const CameraSensorConfig& config,
+                           const RenderSettings& render_settings, int camera_index,
+                           const SceneDescription& scene)
+    : spec_(spec),
+      config_(config),
+      settings_(render_settings),
+      film_(render_settings),
+      camera_index_(camera_index),
+      scene_(scene) {
+  const std::string key = "cameras[" + spec.name + "]";
+  ValidateCameraSensorOrThrow(config, key);
+  if (!config.depth_noise.preset.empty())
+    depth_model_ = DepthNoisePreset(config.depth_noise, key + ".depth_noise");
+}
+
+void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const Pose& X_WO_start,
+                           const WorldSnapshot* end, const Pose& X_WO_end, int64_t frame_index,
+                           CameraImages* out) {
+  const CameraSensorConfig& c = config_;
+  const int W = spec_.intrinsics.width, H = spec_.intrinsics.height;
+  const double T = c.exposure_time_sec;
+  const bool moving = end != nullptr && end->time_sec > start.time_sec;
+  const double span = moving ? end->time_sec - start.time_sec : 0.0;
+  const int n = moving ? c.motion_blur_samples : 1;
+  const int truth_k = n / 2;
+
+  CameraOutputs internal = spec_.outputs;
+  if (depth_model_) {
+    internal.depth = internal.normals = internal.segmentation = true;
+  }
+  const bool want_rgb = spec_.outputs.rgb;
+  if (want_rgb) {
+    if (accum_.width != W || accum_.height != H || accum_.channels != 3) accum_ = ImageF(W, H, 3);
+    std::fill(accum_.data.begin(), accum_.data.end(), 0.0f);
+  }
+  RenderedFrame sub;
+  for (int k = 0; k < n; ++k) {
+    const double s = (k + 0.5) * T / n;
+    CameraView view;
+    view.X_WO = X_WO_start;
+    view.intrinsics = spec_.intrinsics;
+    view.frame_index = frame_index * n + k;
+    view.camera_index = camera_index_;
+    view.exposure_time_sec = T;
+    view.outputs = internal;
+    if (k != truth_k) {
+      view.outputs = CameraOutputs{want_rgb, false, false};
+    }
+    if (moving) {
+      view.motion.X_WO_end = X_WO_end;
+      view.motion.end_sec = span;
+      view.motion.time_sec = s;
+      view.motion.line_time_sec = c.rolling_shutter_line_time_sec;
+    }
+    const WorldSnapshot* snap = &start;
+    WorldSnapshot interp;
+    if (moving) {
+      interp = InterpolateSnapshot(start, *end, s / span);
+      snap = &interp;
+    }
+    RenderedFrame* target = k == truth_k ? &out->truth : &sub;
+    renderer->Render(*snap, view, target);
+    if (want_rgb) {
+      const std::vector<float>& r = target->radiance.data;
+      for (size_t i = 0; i < r.size(); ++i) accum_.data[i] += r[i];
+    }
+    if (k == truth_k) {
+      out->mid_exposure_time_sec = moving ? start.time_sec + s : start.time_sec;
+      out->X_WO =
+          moving ? Camera(X_WO_start, spec_.intrinsics, view.motion).PoseAtRow(0) : X_WO_start;
+    }
+  }
+  out->time_sec = start.time_sec;
+
+  if (want_rgb) {
+    for (float& v : accum_.data) v /= static_cast<float>(n);
+    // exposure with adaptation over sim time
+    double ev = film_.Ev100(accum_, nullptr);
+    if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
+      const double dt = std::max(0.0, start.time_sec - *last_time_);
+      ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
+    }
+    last_ev_ = ev;
+    last_time_ = start.time_sec;
+    out->ev100 = ev;
+    if (c.noise.enabled) {
+      const float h = static_cast<float>(ExposureFromEv100(ev));
+      if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
+        exposed_ = ImageF(W, H, 3);
+      for (size_t i = 0; i < accum_.data.size(); ++i) exposed_.data[i] = accum_.data[i] * h;
+      ApplyImageNoise(exposed_, c.noise, HashKeys(settings_.seed, camera_index_, frame_index, 1),
+                      &dn_);
+      const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
+      for (float& v : dn_.data) v *= inv_max;
+      film_.Develop(dn_, -std::log2(1.2), nullptr, &out->rgb);  // exposure H = 1
+    } else {
+      film_.Develop(accum_, ev, nullptr, &out->rgb);
+    }
+    if (c.lens_droplets && IsRaining(start.effects.get()))
+      ApplyLensDroplets(c.lens_droplet_count, start.time_sec,
+                        HashKeys(settings_.seed, camera_index_, 3), &out->rgb);
+    if (c.jpeg_quality > 0) RoundTripJpeg(c.jpeg_quality, &out->rgb);
+  } else {
+    out->rgb = ImageU8();
+  }
+
+  if (depth_model_) {
+    DepthNoiseInputs in;
+    in.normal_O = &out->truth.normal_O;
+    in.fx = spec_.intrinsics.fx;
+    in.fy = spec_.intrinsics.fy;
+    in.cx = spec_.intrinsics.cx;
+    in.cy = spec_.intrinsics.cy;
+    // IR reflectance from the hit geom's material: base colour luminance, -1 for mirror-like
+    ImageF reflectance(W, H, 1, 1.0f);
+    std::map<int, float> by_id;
+    for (const Geom& g : scene_.geoms) {
+      float r = 1.0f;
+      if (g.material >= 0 && g.material < static_cast<int>(scene_.materials.size())) {
+        const Material& m = scene_.materials[g.material];
+        r = 0.2126f * m.base_color.x() + 0.7152f * m.base_color.y() + 0.0722f * m.base_color.z();
+        if (m.metallic > 0.5f && m.roughness < 0.2f) r = -1.0f;
+      }
+      by_id[g.id] = r;
+    }
+    for (size_t i = 0; i < reflectance.data.size(); ++i) {
+      auto it = by_id.find(out->truth.geom_id.data[i]);
+      if (it != by_id.end()) reflectance.data[i] = it->second;
+    }
+    in.reflectance = &reflectance;
+    ImageF transmittance;
+    if (start.effects && !start.effects->homogeneous_media.empty()) {
+      CameraMotion m;
+      if (moving) {
+        m.X_WO_end = X_WO_end;
+        m.end_sec = span;
+        m.time_sec = (truth_k + 0.5) * T / n;
+        m.line_time_sec = c.rolling_shutter_line_time_sec;
+      }
+      transmittance = DepthTransmittance(out->truth.depth_m,
+                                         Camera(X_WO_start, spec_.intrinsics, m), *start.effects);
+      in.transmittance = &transmittance;
+    }
+    ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,
+                    HashKeys(settings_.seed, camera_index_, frame_index, 2), &out->depth_m);
+  } else {
+    out->depth_m = out->truth.depth_m;
+  }
+}
+
+}  // namespace penumbra

@@ -1,0 +1,97 @@
+#pragma once
+// image formation of one camera over a run: motion blur and rolling shutter from two world
+// snapshots, auto-exposure adaptation, sensor noise, lens droplets, JPEG and depth noise.
+//
+// timeline of a frame captured at snapshot time t0 with exposure T, n = motion_blur_samples and
+// rolling-shutter line time l (sensors/camera_sensor_config.h):
+//   - the frame spans D = T + (H - 1) l. `end` is a snapshot at t1 >= t0 + D (the first physics
+//     step after it); everything that moves is interpolated between `start` and `end` at
+//     a = s / (t1 - t0): the camera pose (position linear, rotation slerp; render/camera.h) per
+//     pixel row, and every body pose X_WB per sub-frame (so moving bodies blur too, but are not
+//     skewed by the rolling shutter: their poses do not change within one sub-frame).
+//   - sub-frame k (k < n) is rendered at s_k = (k + 0.5) T / n with row v seen at s_k + v l; the
+//     sub-frames' radiance images are averaged (box shutter). without `end` nothing moves.
+//   - ground-truth images (depth, range, normals, segmentations) come from the pixel-centre rays
+//     of sub-frame n / 2 (s = T / 2 for odd n): exact, never blended.
+// particle streaks (rain, snow, sparks) are drawn by the renderer over the exposure of each
+// sub-frame from the capture snapshot's effects.
+//
+// exposure: the renderer's auto or manual EV100 (render/film.h) of the averaged radiance is the
+// target; with auto_exposure_time_constant_sec = tau > 0 the EV used adapts as
+// EV_k = EV_target + (EV_{k-1} - EV_target) exp(-(t_k - t_{k-1}) / tau) (state per camera; the
+// first frame uses its target). the exposed values x = radiance * H(EV) go through the sensor
+// model (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "penumbra/core/image.h"
+#include "penumbra/render/film.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/sensors/camera_sensor_config.h"
+#include "penumbra/sensors/depth_noise.h"
+
+namespace penumbra {
+
+/// images of one captured frame.
+struct CameraImages {
+  RenderedFrame truth;  ///< renderer images: ground truth (depth_m exact z-depth) and radiance
+  ImageU8 rgb;          ///< (H x W x 3) uint8 sRGB after exposure, noise, droplets and JPEG
+  ImageF depth_m;       ///< (H x W x 1) z-depth in m after depth noise (= truth.depth_m without)
+  double ev100 = 0;     ///< exposure value used
+  double time_sec = 0;  ///< capture time t0 (exposure starts)
+  double mid_exposure_time_sec = 0;  ///< time of the ground-truth images, t0 + s_{n/2}
+  Pose X_WO = Pose::Identity();      ///< optical frame at mid_exposure_time_sec (row 0)
+};
+
+/// checks the ranges of `c` (see CameraSensorConfig).
+/// @throws ConfigError with key `key_prefix`.<field> naming the bad value and the valid range.
+void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string& key_prefix);
+
+/// the span D = T + (H - 1) l of a frame: the end snapshot must be at least this late.
+double FrameSpanSec(const CameraSensorConfig& c, int height);
+
+/// stateful image formation of one camera (auto-exposure state). not thread-safe.
+class CameraImager {
+ public:
+  /// @param camera_index  index in SceneDescription::cameras (keys the random numbers)
+  /// @throws ConfigError for bad settings (ValidateCameraSensorOrThrow; unknown depth preset).
+  /// @param scene  the rendered scene (materials give the depth sensor's IR reflectance);
+  ///                referenced, must outlive this object
+  CameraImager(const CameraSpec& spec, const CameraSensorConfig& config,
+               const RenderSettings& render_settings, int camera_index,
+               const SceneDescription& scene);
+
+  /// renders and forms frame `frame_index` captured at `start`. `X_WO_start` / `X_WO_end` are
+  /// the optical frame at `start` and at `end`; `end` = null (or not later than start) means
+  /// nothing moves during the exposure.
+  /// @throws Error from the renderer.
+  void Capture(Renderer* renderer, const WorldSnapshot& start, const Pose& X_WO_start,
+               const WorldSnapshot* end, const Pose& X_WO_end, int64_t frame_index,
+               CameraImages* out);
+
+  const CameraSpec& spec() const { return spec_; }
+  const CameraSensorConfig& config() const { return config_; }
+
+ private:
+  CameraSpec spec_;
+  CameraSensorConfig config_;
+  RenderSettings settings_;
+  Film film_;
+  int camera_index_;
+  const SceneDescription& scene_;
+  std::optional<DepthNoiseModel> depth_model_;
+  std::optional<double> last_ev_, last_time_;
+  ImageF accum_, exposed_, dn_;
+};
+
+/// frames per second of CameraImager::Capture for a small scene (a box room, 320 x 240, realtime
+/// tier) with each noise option in turn: "none", "shot_read", "motion_blur_4", "rolling_shutter",
+/// "jpeg_q80", "lens_droplets", "depth_realsense_d435", "all". for `penumbra bench sensors`.
+/// returns (option name, frames per second) in that order; `frames` frames each.
+std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames = 20);
+
+}  // namespace penumbra

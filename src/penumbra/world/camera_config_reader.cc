@@ -1,0 +1,165 @@
+#include "penumbra/world/camera_config_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "penumbra/render/camera_distortion.h"
+
+namespace penumbra {
+namespace {
+
+// "cameras[2] ('front')" for messages.
+std::string Who(const CameraConfig& c) { return "camera '" + c.name + "': "; }
+
+double NonNegative(const YamlReader& r, const CameraConfig& c, const std::string& unit) {
+  const double v = r.Double();
+  if (!(v >= 0))
+    r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected a number >= 0 (" + unit + ")");
+  return v;
+}
+
+double Positive(const YamlReader& r, const CameraConfig& c, const std::string& unit) {
+  const double v = r.Double();
+  if (!(v > 0))
+    r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected a number > 0 (" + unit + ")");
+  return v;
+}
+
+int IntIn(const YamlReader& r, const CameraConfig& c, int lo, int hi) {
+  const int v = r.Int();
+  if (v < lo || v > hi)
+    r.Fail(Who(c) + "got " + std::to_string(v) + "; expected an integer in [" + std::to_string(lo) +
+           ", " + std::to_string(hi) + "]");
+  return v;
+}
+
+// the camera's intrinsics as scene assembly will build them (for the fold check).
+CameraIntrinsics IntrinsicsOf(const CameraConfig& c) {
+  CameraIntrinsics k = c.intrinsics
+                           ? *c.intrinsics
+                           : CameraIntrinsics::FromFovy(c.width, c.height, c.fovy_deg.value_or(60));
+  k.width = c.width;
+  k.height = c.height;
+  k.k1 = c.k1, k.k2 = c.k2, k.p1 = c.p1, k.p2 = c.p2, k.k3 = c.k3;
+  return k;
+}
+
+}  // namespace
+
+const std::vector<std::string_view>& CameraSensorKeys() {
+  static const std::vector<std::string_view> keys = {"distortion",
+                                                     "exposure_time_sec",
+                                                     "motion_blur_samples",
+                                                     "rolling_shutter_line_time_sec",
+                                                     "auto_exposure_time_constant_sec",
+                                                     "noise",
+                                                     "jpeg_quality",
+                                                     "lens_droplets",
+                                                     "depth_noise",
+                                                     "stereo"};
+  return keys;
+}
+
+void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
+  CameraSensorConfig& s = c->sensor;
+  if (r.Has("distortion")) {
+    const YamlReader d = r.Child("distortion");
+    d.ExpectMap({"k1", "k2", "p1", "p2", "k3"});
+    double* field[] = {&c->k1, &c->k2, &c->p1, &c->p2, &c->k3};
+    const char* name[] = {"k1", "k2", "p1", "p2", "k3"};
+    for (int i = 0; i < 5; ++i)
+      if (d.Has(name[i])) *field[i] = d.Child(name[i]).Double();
+    const CameraIntrinsics k = IntrinsicsOf(*c);
+    if (k.fx > 0 && k.fy > 0 && k.width > 0 && k.height > 0) {
+      if (auto problem = FindDistortionProblem(k))
+        d.Fail(Who(*c) + *problem +
+               "; expected k1 k2 p1 p2 k3 that map the image one-to-one "
+               "(smaller coefficients or a narrower field of view)");
+    }
+  }
+  if (r.Has("exposure_time_sec"))
+    s.exposure_time_sec = NonNegative(r.Child("exposure_time_sec"), *c, "seconds");
+  if (r.Has("motion_blur_samples"))
+    s.motion_blur_samples = IntIn(r.Child("motion_blur_samples"), *c, 1, 64);
+  if (r.Has("rolling_shutter_line_time_sec"))
+    s.rolling_shutter_line_time_sec =
+        NonNegative(r.Child("rolling_shutter_line_time_sec"), *c, "seconds per row");
+  if (r.Has("auto_exposure_time_constant_sec"))
+    s.auto_exposure_time_constant_sec =
+        NonNegative(r.Child("auto_exposure_time_constant_sec"), *c, "seconds");
+  if (r.Has("noise")) {
+    const YamlReader n = r.Child("noise");
+    n.ExpectMap({"enabled", "full_well_e", "read_noise_e", "iso", "base_iso", "adc_bits"});
+    s.noise.enabled = n.Has("enabled") ? n.Child("enabled").Bool() : true;
+    if (n.Has("full_well_e"))
+      s.noise.full_well_e = Positive(n.Child("full_well_e"), *c, "electrons");
+    if (n.Has("read_noise_e"))
+      s.noise.read_noise_e = NonNegative(n.Child("read_noise_e"), *c, "electrons");
+    if (n.Has("iso")) s.noise.iso = Positive(n.Child("iso"), *c, "ISO");
+    if (n.Has("base_iso")) s.noise.base_iso = Positive(n.Child("base_iso"), *c, "ISO");
+    if (n.Has("adc_bits")) s.noise.adc_bits = IntIn(n.Child("adc_bits"), *c, 1, 16);
+  }
+  if (r.Has("jpeg_quality")) s.jpeg_quality = IntIn(r.Child("jpeg_quality"), *c, 0, 100);
+  if (r.Has("lens_droplets")) {
+    const YamlReader l = r.Child("lens_droplets");
+    l.ExpectMap({"enabled", "count"});
+    if (l.Has("enabled")) s.lens_droplets = l.Child("enabled").Bool();
+    if (l.Has("count")) s.lens_droplet_count = IntIn(l.Child("count"), *c, 0, 1000);
+  }
+  if (r.Has("depth_noise")) {
+    const YamlReader d = r.Child("depth_noise");
+    d.ExpectMap({"preset", "min_range_m", "max_range_m"});
+    std::vector<std::string_view> presets(std::begin(kDepthNoisePresets),
+                                          std::end(kDepthNoisePresets));
+    const YamlReader p = d.Child("preset");
+    s.depth_noise.preset = p.String();
+    if (std::find(presets.begin(), presets.end(), s.depth_noise.preset) == presets.end())
+      p.Fail(Who(*c) + "unknown depth noise preset '" + s.depth_noise.preset +
+             "'; expected one of: " + JoinNames(presets));
+    if (d.Has("min_range_m"))
+      s.depth_noise.min_range_m = NonNegative(d.Child("min_range_m"), *c, "m");
+    if (d.Has("max_range_m")) s.depth_noise.max_range_m = Positive(d.Child("max_range_m"), *c, "m");
+    if (s.depth_noise.min_range_m && s.depth_noise.max_range_m &&
+        !(*s.depth_noise.max_range_m > *s.depth_noise.min_range_m))
+      d.Child("max_range_m").Fail(Who(*c) + "expected max_range_m > min_range_m");
+  }
+  if (r.Has("stereo")) {
+    const YamlReader st = r.Child("stereo");
+    st.ExpectMap({"baseline_m"});
+    s.stereo_baseline_m = Positive(st.Child("baseline_m"), *c, "m");
+  }
+}
+
+std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r) {
+  std::vector<SemanticClassConfig> out;
+  std::set<std::string> names;
+  std::set<int> ids;
+  for (const YamlReader& e : r.List()) {
+    e.ExpectMap({"name", "id", "bodies", "geoms", "materials"});
+    SemanticClassConfig c;
+    c.name = e.Child("name").String();
+    const YamlReader id = e.Child("id");
+    c.id = id.Int();
+    if (c.id < 1 || c.id > 65535)
+      id.Fail("class '" + c.name + "': got " + std::to_string(c.id) +
+              "; expected an integer in [1, 65535] (0 = unlabelled)");
+    if (!names.insert(c.name).second)
+      e.Child("name").Fail("class '" + c.name + "' is listed twice; expected unique names");
+    if (!ids.insert(c.id).second)
+      id.Fail("class id " + std::to_string(c.id) + " is used twice; expected unique ids");
+    auto patterns = [&](const char* key, std::vector<std::string>* v) {
+      if (!e.Has(key)) return;
+      for (const YamlReader& p : e.Child(key).List()) v->push_back(p.String());
+    };
+    patterns("bodies", &c.bodies);
+    patterns("geoms", &c.geoms);
+    patterns("materials", &c.materials);
+    if (c.bodies.empty() && c.geoms.empty() && c.materials.empty())
+      e.Fail("class '" + c.name + "' has no patterns; expected some of bodies, geoms, materials");
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace penumbra

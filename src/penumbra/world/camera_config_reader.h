@@ -1,0 +1,37 @@
+#pragma once
+// world-file keys of camera sensors and semantic classes (README "World file reference"):
+//
+//   cameras[i]:
+//     distortion: {k1, k2, p1, p2, k3}     Brown-Conrady, OpenCV names; rejected if it folds
+//                                           the image (render/camera_distortion.h)
+//     exposure_time_sec: 0.01              shutter time T (>= 0)
+//     motion_blur_samples: 1               sub-frames over T (1..64)
+//     rolling_shutter_line_time_sec: 0     per-row readout delay (>= 0; 0 = global shutter)
+//     auto_exposure_time_constant_sec: 0   EV adaptation time constant (>= 0; 0 = instant)
+//     noise: {full_well_e, read_noise_e, iso, base_iso, adc_bits}   present = enabled
+//     jpeg_quality: 0                      0 = lossless PNG; 1..100 JPEG round trip
+//     lens_droplets: {enabled, count}      drops on the lens while it rains (default on, 6)
+//     depth_noise: {preset, min_range_m, max_range_m}   realsense_d435 | kinect_v1 | kinect_v2
+//     stereo: {baseline_m}                 two cameras <name>/left and <name>/right
+//   semantic_classes:
+//     - {name: robot, id: 1, bodies: ["rover/*"], geoms: [...], materials: [...]}
+
+#include <vector>
+
+#include "penumbra/world/world_config.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace penumbra {
+
+/// the camera keys handled here (for the caller's ExpectMap list).
+const std::vector<std::string_view>& CameraSensorKeys();
+
+/// reads the sensor keys of camera entry `r` into `c` (after width/height/fovy/intrinsics) and
+/// checks them, including that the distortion does not fold the image.
+/// @throws ConfigError naming the file, line, key path and the camera.
+void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c);
+
+/// reads the `semantic_classes:` list. @throws ConfigError for bad ids, duplicate names/ids.
+std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r);
+
+}  // namespace penumbra
