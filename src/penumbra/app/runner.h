@@ -18,6 +18,8 @@ struct RunOptions {
   bool realtime = false;               ///< pace physics to wall-clock time (default: as fast as possible)
   bool progress = true;                ///< progress bar on a terminal / log lines otherwise
   std::vector<std::string> command_line;  ///< argv, recorded in run.json
+  /// adversity preset spec (--adversity; world/adversity_preset.h), "" = the world's own
+  std::string adversity;
 };
 
 /// what a run produced.

@@ -1,0 +1,260 @@
+#include "penumbra/app/effects_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "penumbra/app/floor_map.h"
+#include "penumbra/compose/agent_bodies.h"
+#include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace penumbra {
+namespace {
+
+// key of every draw of the preset planner (core/rng.h streams)
+constexpr uint64_t kNpcStream = 0x4E5043A9E1ULL;
+
+std::vector<Eigen::Vector3d> RobotStarts(const WorldConfig& world) {
+  std::vector<Eigen::Vector3d> out;
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) out.push_back(m.pose.xyz);
+  return out;
+}
+
+// a closed loop of 3-4 waypoints for one NPC, or nothing after 200 draws
+std::optional<std::vector<Eigen::Vector2d>> DrawLoop(const FloorMap& map, uint64_t stream,
+                                                     double clearance,
+                                                     const std::vector<Eigen::Vector3d>& robots) {
+  Rng rng(stream);
+  const auto away_from_robots = [&](const Eigen::Vector2d& p) {
+    for (const Eigen::Vector3d& r : robots)
+      if ((p - r.head<2>()).norm() < 1.5) return false;
+    return true;
+  };
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    const int n = 3 + static_cast<int>(rng.NextU64() % 2);
+    std::vector<Eigen::Vector2d> pts;
+    bool ok = true;
+    for (int i = 0; i < n && ok; ++i) {
+      Eigen::Vector2d p;
+      ok =
+          map.RandomFreePoint(rng.NextU64(), &p) && away_from_robots(p) && map.IsFree(p, clearance);
+      if (ok && !pts.empty())
+        ok = (p - pts.back()).norm() > 1.0 && map.SegmentFree(pts.back(), p, clearance);
+      if (ok) pts.push_back(p);
+    }
+    if (ok && map.SegmentFree(pts.back(), pts.front(), clearance)) return pts;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
+                         const std::vector<Pose>& X_WB,
+                         const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents) {
+  double floor_z = 0;
+  Eigen::Vector2d centre(0, 0);
+  if (!robot_starts.empty()) {
+    floor_z = robot_starts.front().z();
+    for (const Eigen::Vector3d& r : robot_starts) {
+      floor_z = std::min(floor_z, r.z());
+      centre += r.head<2>() / static_cast<double>(robot_starts.size());
+    }
+  }
+  FloorMap map(scene, X_WB, floor_z, centre);
+
+  if (preset.fog_mor_m) {
+    EffectConfig e;
+    e.name = "adversity_fog";
+    e.type = EffectType::kFog;
+    e.fog.extinction.mor_m = *preset.fog_mor_m;
+    e.fog.height_falloff_per_m = preset.fog_height_falloff_per_m;
+    e.fog.base_height_m = floor_z + 1.0;
+    effects->push_back(e);
+  }
+  if (preset.dust_mor_m) {
+    EffectConfig e;
+    e.name = "adversity_dust";
+    e.type = EffectType::kDust;
+    e.dust.extinction.mor_m = *preset.dust_mor_m;
+    effects->push_back(e);
+  }
+  if (preset.smoke_sigma_t_per_m) {
+    EffectConfig e;
+    e.name = "adversity_smoke";
+    e.type = EffectType::kSmoke;
+    e.smoke.mode = SmokeParams::Mode::kNoise;
+    e.smoke.density_scale_per_m = *preset.smoke_sigma_t_per_m;
+    e.smoke.coverage = preset.smoke_coverage;
+    e.smoke.wind_m_s = Eigen::Vector3d(0.3, 0, 0);
+    const Eigen::Vector2d mid = 0.5 * (map.min_W() + map.max_W());
+    const Eigen::Vector2d half = 0.5 * preset.smoke_extent_fraction * (map.max_W() - map.min_W());
+    BoxRegion box;
+    box.min_W = Eigen::Vector3d(mid.x() - half.x(), mid.y() - half.y(), floor_z);
+    box.max_W =
+        Eigen::Vector3d(mid.x() + half.x(), mid.y() + half.y(), floor_z + preset.smoke_height_m);
+    e.region = box;
+    effects->push_back(e);
+  }
+  if (preset.rain_rate_mm_h) {
+    EffectConfig e;
+    e.name = "adversity_rain";
+    e.type = EffectType::kRain;
+    e.rain.rate_mm_h = *preset.rain_rate_mm_h;
+    effects->push_back(e);
+  }
+  if (preset.snow_rate_mm_h) {
+    EffectConfig e;
+    e.name = "adversity_snow";
+    e.type = EffectType::kSnow;
+    e.snow.rate_mm_h = *preset.snow_rate_mm_h;
+    effects->push_back(e);
+  }
+  if (preset.light_scale != 1.0) {
+    EffectConfig e;
+    e.name = "adversity_dim";
+    e.type = EffectType::kLightEvent;
+    e.light_event.light = "*";
+    e.light_event.mode = LightEventParams::Mode::kBlackout;
+    e.light_event.min_scale = std::min(preset.light_scale, 0.999);
+    e.light_event.recovery_sec = 0;
+    effects->push_back(e);
+  }
+  if (preset.flicker_depth > 0) {
+    EffectConfig e;
+    e.name = "adversity_flicker";
+    e.type = EffectType::kLightEvent;
+    e.light_event.light = "*";
+    e.light_event.mode = LightEventParams::Mode::kFlicker;
+    e.light_event.depth = preset.flicker_depth;
+    e.light_event.frequency_hz = preset.flicker_hz;
+    effects->push_back(e);
+  }
+
+  // NPCs: people first, then vehicles; each on its own random stream
+  const Eigen::Vector2d flood_seed =
+      robot_starts.empty() ? centre : Eigen::Vector2d(robot_starts.front().head<2>());
+  for (int kind = 0; kind < 2; ++kind) {
+    const int count = kind == 0 ? preset.npc_people : preset.npc_vehicles;
+    if (count == 0) continue;
+    const double clearance = kind == 0 ? 0.4 : 1.2;
+    map.Flood(flood_seed, clearance);
+    for (int i = 0; i < count; ++i) {
+      const std::string name =
+          std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
+      const auto loop = DrawLoop(map, HashKeys(seed, kNpcStream, kind, i), clearance, robot_starts);
+      if (!loop) {
+        spdlog::warn("adversity preset '{}': no free path found for {}; left out", preset.name,
+                     name);
+        continue;
+      }
+      AgentConfig a;
+      a.name = name;
+      a.kind = kind == 0 ? AgentKind::kPerson : AgentKind::kForklift;
+      a.waypoints = *loop;
+      a.speed_m_s = preset.npc_speed_m_s * (kind == 0 ? 1.0 : 1.5);
+      a.pause_sec = preset.npc_pause_sec;
+      a.route = AgentRoute::kLoop;
+      a.floor_z = floor_z;
+      agents->push_back(a);
+    }
+  }
+}
+
+EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
+                           const std::string& adversity_override)
+    : effects_(world.effects), agents_(world.agents), seed_(world.seed) {
+  ValidateAgentsOrThrow(agents_, world.file);
+  std::string spec = world.adversity;
+  std::string spec_file = world.file;
+  int spec_line = world.adversity_line;
+  if (!adversity_override.empty()) {
+    spec = ResolveAdversitySpec(adversity_override, "", "", 0);
+    spec_file.clear();
+    spec_line = 0;
+  }
+  if (!spec.empty()) preset_ = LoadAdversityPreset(spec, spec_file, spec_line);
+
+  // the scene at the start, for the preset's regions and NPC paths and the agent bounds
+  const bool need_scene = !agents_.empty() || (preset_ && !preset_->empty());
+  if (need_scene) {
+    Simulation probe = Simulation::LoadFromString(composed->mjcf_xml, world.timestep_sec);
+    const WorldSnapshot start = probe.Snapshot();
+    const std::vector<Eigen::Vector3d> robots = RobotStarts(world);
+    // user agents must walk inside the world
+    Eigen::Vector2d centre(0, 0);
+    for (const Eigen::Vector3d& r : robots)
+      centre += r.head<2>() / static_cast<double>(robots.size());
+    const FloorMap map(probe.scene(), start.X_WB, 0.0, centre);
+    if (map.has_static_bounds()) {
+      const Eigen::Vector2d lo = map.min_W() - Eigen::Vector2d(1, 1);
+      const Eigen::Vector2d hi = map.max_W() + Eigen::Vector2d(1, 1);
+      for (size_t i = 0; i < agents_.size(); ++i)
+        for (size_t j = 0; j < agents_[i].waypoints.size(); ++j) {
+          const Eigen::Vector2d& p = agents_[i].waypoints[j];
+          if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any())
+            throw ConfigError(
+                world.file, agents_[i].line,
+                "agents[" + std::to_string(i) + "].waypoints[" + std::to_string(j) + "]",
+                "[" + FormatNumber(p.x()) + ", " + FormatNumber(p.y()) +
+                    "] lies outside the world; expected x in [" + FormatNumber(lo.x()) + ", " +
+                    FormatNumber(hi.x()) + "], y in [" + FormatNumber(lo.y()) + ", " +
+                    FormatNumber(hi.y()) + "] m (the static geometry's extent + 1 m)");
+        }
+    }
+    if (preset_ && !preset_->empty())
+      PlanAdversityPreset(*preset_, probe.scene(), start.X_WB, robots, world.seed, &effects_,
+                          &agents_);
+  }
+  ValidateEffectsOrThrow(effects_, world.file);
+  AddAgentBodies(agents_, world.file, composed);
+}
+
+EffectsStage::~EffectsStage() = default;
+
+void EffectsStage::Attach(Simulation* sim) const {
+  for (const AgentConfig& a : agents_) {
+    auto path = std::make_shared<const AgentPath>(a);
+    sim->AddMocapDriver(AgentBodyName(a.name), [path](double t) { return path->X_WA(t); });
+  }
+}
+
+SceneDescription EffectsStage::Bind(SceneDescription scene) {
+  for (const AgentConfig& a : agents_) {
+    const int body = scene.FindBody(AgentBodyName(a.name));
+    for (Geom& g : scene.geoms)
+      if (body >= 0 && g.body == body) g.semantic_class = AgentSemanticClass(a.kind);
+  }
+  if (!effects_.empty()) engine_ = std::make_unique<EffectsEngine>(effects_, seed_, scene);
+  return scene;
+}
+
+std::shared_ptr<const EffectsFrame> EffectsStage::Evaluate(const WorldSnapshot& snapshot,
+                                                           const Eigen::Vector3d& viewer_W) {
+  if (!engine_) return nullptr;
+  return engine_->Evaluate(snapshot.time_sec, viewer_W, &snapshot.X_WB);
+}
+
+std::vector<std::string> EffectsStage::EffectLabels() const {
+  std::vector<std::string> out;
+  for (const EffectConfig& e : effects_) out.push_back(e.name + ": " + EffectTypeName(e.type));
+  return out;
+}
+
+std::vector<std::string> EffectsStage::AgentLabels() const {
+  std::vector<std::string> out;
+  for (const AgentConfig& a : agents_) out.push_back(a.name + ": " + AgentKindName(a.kind));
+  return out;
+}
+
+std::string EffectsStage::PresetLabel() const {
+  return preset_ ? preset_->name + " (" + preset_->file + ")" : std::string();
+}
+
+}  // namespace penumbra

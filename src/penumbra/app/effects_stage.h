@@ -1,0 +1,104 @@
+#pragma once
+// the adverse-condition stage of a run (issue 4): the world's `effects:`, its NPC
+// `agents:` and an adversity preset (world key `adversity`, or --adversity) put together.
+//
+// order in a run (app/runner.cc):
+//   1. compose the models, then EffectsStage(world, &composed, ...) plans the preset
+//      (regions and NPC paths need the scene: it loads the composed model once to read
+//      the static geometry) and adds one mocap body per agent to `composed`;
+//   2. load the simulation, Attach(&sim): every agent body is driven from its path;
+//   3. Bind(scene): labels agent geoms (Geom::semantic_class, effects/agent_path.h) and
+//      builds the EffectsEngine on the final scene;
+//   4. per rendered frame, after physics: Evaluate(snapshot, camera position) -> the
+//      EffectsFrame for WorldSnapshot::effects. effects never feed back into physics.
+//
+// how a preset (world/adversity_preset.h) is placed in a world:
+//   floor      z of the lowest robot's root pose (0 when there are no robots)
+//   area       the plan-view box of the static geometry, clipped to 15 m around the
+//              robots' mean start position (FloorMap); with no static geometry, +-5 m
+//   fog, dust  everywhere (no region); fog base height = floor + 1 m for height falloff
+//   smoke      noise smoke in a box centred on the area, extent_fraction of its size,
+//              from the floor to floor + height_m, drifting at 0.3 m/s along +x
+//   rain, snow around the viewer (effect defaults), at the preset rate
+//   lights     a `blackout` light event on "*" at min_scale = lights.scale for the whole
+//              run, plus a `flicker` event when flicker_depth > 0
+//   npcs       people (and forklifts at 1.5x speed) on closed loops of 3-4 waypoints drawn
+//              from the world seed among the free floor cells reachable from the first
+//              robot (clearance 0.4 m for people, 1.2 m for forklifts; every leg straight
+//              and clear; no waypoint within 1.5 m of a robot's start). an NPC for which no
+//              such path is found within 200 draws is left out (logged).
+// preset effects and agents are named "adversity_<what>" and follow the world's own.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/compose/scene_composer.h"
+#include "penumbra/effects/agent_path.h"
+#include "penumbra/effects/effect_config.h"
+#include "penumbra/effects/effects_engine.h"
+#include "penumbra/scene/effects_frame.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+#include "penumbra/world/adversity_preset.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+class Simulation;
+
+/// the effects, agents and preset of one run.
+class EffectsStage {
+ public:
+  /// plans the run's effects and agents and adds the agents' bodies to `composed`.
+  /// @param adversity_override a preset spec from the command line (--adversity), or ""
+  ///        for the world's own `adversity` key
+  /// @throws ConfigError for an unknown preset, invalid agents, an agent waypoint outside
+  ///         the world (the static geometry's plan-view box + 1 m), or invalid effects.
+  EffectsStage(const WorldConfig& world, ComposedScene* composed,
+               const std::string& adversity_override = "");
+  ~EffectsStage();
+
+  /// drives every agent's mocap body from its path (Simulation::AddMocapDriver).
+  void Attach(Simulation* sim) const;
+
+  /// `scene` with every agent geom labelled with its semantic class; builds the effects
+  /// engine on it. call once, before Evaluate.
+  /// @throws ConfigError from the EffectsEngine (unknown light or body names, bad .vdb).
+  SceneDescription Bind(SceneDescription scene);
+
+  /// the effects at the snapshot's time for a viewer at viewer_W; null when the run has
+  /// no effects (clear conditions). deterministic.
+  std::shared_ptr<const EffectsFrame> Evaluate(const WorldSnapshot& snapshot,
+                                               const Eigen::Vector3d& viewer_W);
+
+  /// all effects (the world's, then the preset's) and all agents.
+  const std::vector<EffectConfig>& effects() const { return effects_; }
+  const std::vector<AgentConfig>& agents() const { return agents_; }
+  /// the preset applied, if any (`none` counts as applied).
+  const std::optional<AdversityPreset>& preset() const { return preset_; }
+
+  /// run.json entries: "name: type" per effect, "name: kind" per agent, preset "name (file)".
+  std::vector<std::string> EffectLabels() const;
+  std::vector<std::string> AgentLabels() const;
+  std::string PresetLabel() const;
+
+ private:
+  std::vector<EffectConfig> effects_;
+  std::vector<AgentConfig> agents_;
+  std::optional<AdversityPreset> preset_;
+  uint64_t seed_ = 0;
+  std::unique_ptr<EffectsEngine> engine_;
+};
+
+/// the preset's effects and agents for a world whose scene at the start is (scene, X_WB),
+/// as described in the file header. pure and deterministic in (preset, world, seed).
+/// @param robot_starts start positions (world xy) of the robots' root bodies
+void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
+                         const std::vector<Pose>& X_WB,
+                         const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents);
+
+}  // namespace penumbra

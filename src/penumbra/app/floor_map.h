@@ -1,0 +1,58 @@
+#pragma once
+// plan-view occupancy of a world's floor, for placing adversity-preset regions and NPC
+// paths (app/effects_stage.h). built from the static geoms of the scene at the start.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "penumbra/core/pose.h"
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// a 2-d grid over the floor (world xy) marking cells blocked by static geometry.
+class FloorMap {
+ public:
+  /// grid cell size, m.
+  static constexpr double kCellM = 0.1;
+
+  /// @param scene    the static scene
+  /// @param X_WB     pose of every scene body at the start (WorldSnapshot::X_WB)
+  /// @param floor_z  height of the floor, m; geoms whose world bounding box overlaps
+  ///                 [floor_z + 0.05, floor_z + 2.0] block the cells under them (planes never do)
+  /// @param centre_W the grid covers the static geoms' bounding box (xy), clipped to
+  ///                 centre_W +- 15 m; with no static geoms, centre_W +- 5 m
+  FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
+           const Eigen::Vector2d& centre_W);
+
+  /// lower / upper corner (xy) of the mapped area, m.
+  const Eigen::Vector2d& min_W() const { return min_; }
+  const Eigen::Vector2d& max_W() const { return max_; }
+  /// true if the static geoms' bounds were used (false: the area is a default box).
+  bool has_static_bounds() const { return has_bounds_; }
+  double floor_z() const { return floor_z_; }
+
+  /// true if a disc of radius `clearance_m` at p lies inside the map and touches no blocked cell.
+  bool IsFree(const Eigen::Vector2d& p, double clearance_m) const;
+  /// true if every point of the segment a-b (sampled every 0.05 m) is IsFree.
+  bool SegmentFree(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const;
+  /// marks the free cells (at clearance_m) connected to `seed` (4-neighbours); cells of
+  /// Reachable() are then the only ones RandomFreePoint draws from. if the seed cell is
+  /// blocked, every free cell counts as reachable.
+  void Flood(const Eigen::Vector2d& seed, double clearance_m);
+  /// a uniformly drawn reachable free point (cell centre), from the 64-bit draw `u`;
+  /// false if there is none.
+  bool RandomFreePoint(uint64_t u, Eigen::Vector2d* p) const;
+
+ private:
+  int Index(int ix, int iy) const { return iy * nx_ + ix; }
+  Eigen::Vector2d min_, max_;
+  int nx_ = 0, ny_ = 0;
+  double floor_z_ = 0;
+  bool has_bounds_ = false;
+  std::vector<uint8_t> blocked_;  // (ny x nx)
+  std::vector<int> reachable_;    // indices of reachable free cells
+};
+
+}  // namespace penumbra

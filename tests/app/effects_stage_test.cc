@@ -1,0 +1,123 @@
+// adversity presets placed in the default world (app/effects_stage.h).
+#include "penumbra/app/effects_stage.h"
+
+#include <gtest/gtest.h>
+
+#include "penumbra/app/floor_map.h"
+#include "penumbra/compose/scene_composer.h"
+#include "penumbra/core/error.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/physics/urdf_converter.h"
+
+namespace penumbra {
+namespace {
+
+const std::string kDefaultWorld = std::string(PENUMBRA_SOURCE_DIR) + "/worlds/default.yaml";
+
+struct Planned {
+  std::vector<EffectConfig> effects;
+  std::vector<AgentConfig> agents;
+};
+
+Planned Plan(const std::string& preset, uint64_t seed) {
+  WorldConfig world = LoadWorldFile(kDefaultWorld);
+  world.seed = seed;
+  ComposeOptions opts;
+  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
+  ComposedScene composed = ComposeWorld(world.models, opts);
+  EffectsStage stage(world, &composed, preset);
+  return {stage.effects(), stage.agents()};
+}
+
+std::vector<std::string> Names(const Planned& p) {
+  std::vector<std::string> out;
+  for (const EffectConfig& e : p.effects) out.push_back(e.name);
+  for (const AgentConfig& a : p.agents) out.push_back(a.name);
+  return out;
+}
+
+TEST(AdversityPlan, NoneAddsNothingMinorAndMajorAddTheirParts) {
+  EXPECT_TRUE(Names(Plan("none", 7)).empty());
+  const Planned minor = Plan("minor", 7);
+  EXPECT_EQ(Names(minor),
+            (std::vector<std::string>{"adversity_fog", "adversity_smoke", "adversity_rain",
+                                      "adversity_dim", "adversity_person0", "adversity_person1"}));
+  const Planned major = Plan("major", 7);
+  EXPECT_EQ(major.agents.size(), 5u);
+  EXPECT_EQ(major.agents.back().kind, AgentKind::kForklift);
+  // fog extinction from the MOR of the preset: 2.996 / 12 m
+  EXPECT_NEAR(major.effects[0].fog.extinction.SigmaT(), -std::log(0.05) / 12.0, 1e-9);
+  // smoke box inside the room (x in [-4, 4], y in [-3, 3] plus walls), floor to 2.5 m
+  const BoxRegion& smoke = *major.effects[1].region;
+  EXPECT_GE(smoke.min_W.x(), -4.5);
+  EXPECT_LE(smoke.max_W.x(), 4.5);
+  EXPECT_EQ(smoke.min_W.z(), 0.0);
+  EXPECT_EQ(smoke.max_W.z(), 2.5);
+}
+
+TEST(AdversityPlan, NpcPathsAreClearOfFurnitureAndTheRobotAndDependOnTheSeed) {
+  const Planned a = Plan("major", 7);
+  const Planned b = Plan("major", 7);
+  const Planned c = Plan("major", 8);
+  ASSERT_EQ(a.agents.size(), b.agents.size());
+  for (size_t i = 0; i < a.agents.size(); ++i)
+    EXPECT_EQ(a.agents[i].waypoints, b.agents[i].waypoints);
+  EXPECT_NE(a.agents[0].waypoints, c.agents[0].waypoints);
+
+  // an independent check of the legs against the room's static geoms
+  WorldConfig world = LoadWorldFile(kDefaultWorld);
+  ComposeOptions opts;
+  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
+  const ComposedScene composed = ComposeWorld(world.models, opts);
+  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  const FloorMap map(sim.scene(), sim.Snapshot().X_WB, 0.0, Eigen::Vector2d(-0.2, -1.45));
+  for (const AgentConfig& agent : a.agents) {
+    const double clearance = agent.kind == AgentKind::kPerson ? 0.4 : 1.2;
+    const auto& w = agent.waypoints;
+    for (size_t i = 0; i < w.size(); ++i) {
+      EXPECT_TRUE(map.SegmentFree(w[i], w[(i + 1) % w.size()], clearance - 0.01)) << agent.name;
+      EXPECT_GE((w[i] - Eigen::Vector2d(-0.2, -1.45)).norm(), 1.5) << agent.name;
+      // inside the room's interior
+      EXPECT_GT(w[i].x(), -4.0);
+      EXPECT_LT(w[i].x(), 4.0);
+      EXPECT_GT(w[i].y(), -3.0);
+      EXPECT_LT(w[i].y(), 3.0);
+    }
+  }
+}
+
+TEST(AdversityPlan, UnknownPresetListsTheValidNames) {
+  try {
+    Plan("apocalypse", 7);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "<command line>: adversity: unknown preset 'apocalypse'; expected one of: none, "
+              "minor, major, or a preset file (FILE.yaml or FILE.yaml#NAME)");
+  }
+}
+
+TEST(AdversityPlan, EffectsAreEvaluatedDeterministically) {
+  WorldConfig world = LoadWorldFile(kDefaultWorld);
+  ComposeOptions opts;
+  opts.urdf_to_mjcf = ConvertUrdfToMjcf;
+  ComposedScene composed = ComposeWorld(world.models, opts);
+  EffectsStage stage(world, &composed, "major");
+  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  stage.Attach(&sim);
+  const SceneDescription scene = stage.Bind(sim.scene());
+  const WorldSnapshot snap = sim.Snapshot();
+  const auto f1 = stage.Evaluate(snap, Eigen::Vector3d(0, 0, 0.4));
+  ASSERT_TRUE(f1);
+  EXPECT_EQ(f1->homogeneous_media.size(), 1u);  // fog
+  EXPECT_EQ(f1->grid_media.size(), 1u);         // smoke
+  EXPECT_EQ(f1->particles.size(), 1u);          // rain
+  ASSERT_EQ(f1->light_intensity_scale.size(), scene.lights.size());
+  for (float s : f1->light_intensity_scale) EXPECT_LE(s, 0.25f + 1e-6f);
+  const auto f2 = stage.Evaluate(snap, Eigen::Vector3d(0, 0, 0.4));
+  EXPECT_EQ(f1->particles[0].position_W, f2->particles[0].position_W);
+  EXPECT_EQ(*f1->grid_media[0].density, *f2->grid_media[0].density);
+}
+
+}  // namespace
+}  // namespace penumbra
