@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
@@ -70,6 +71,11 @@ int RunCli(int argc, char** argv) {
   bench_physics->add_option("--seconds", physics_bench.sim_seconds, "simulated seconds per side")->check(CLI::PositiveNumber);
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
+  CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
+  SensorBenchOptions sensor_bench;
+  bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
+  bench_sensors->add_option("--scans", sensor_bench.scans, "timed scans per LiDAR preset")->check(CLI::Range(1, 100000));
+  bench_sensors->add_option("--seconds", sensor_bench.seconds, "simulated seconds for the sensor overhead")->check(CLI::PositiveNumber);
 
   CLI11_PARSE(app, argc, argv);
 
@@ -92,6 +98,7 @@ int RunCli(int argc, char** argv) {
       return 0;
     }
     if (*bench_render) return BenchRender(render_bench);
+    if (*bench_sensors) return BenchSensors(sensor_bench);
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

@@ -10,7 +10,10 @@
 #include <thread>
 
 #include "penumbra/app/camera_stage.h"
+#include "penumbra/app/effects_stage.h"
 #include "penumbra/app/scene_assembly.h"
+#include "penumbra/app/sensor_stage.h"
+#include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/bounded_queue.h"
@@ -37,6 +40,7 @@ struct RenderJob {
   WorldSnapshot snapshot;
   std::vector<int> cameras;
   std::vector<int64_t> frame_indices;
+  std::vector<std::shared_ptr<const EffectsFrame>> effects;  // per camera (app/effects_stage.h)
   std::exception_ptr error;  // set on the last job if physics failed
 };
 
@@ -100,7 +104,9 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   ComposeOptions compose_options;
   compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
   compose_options.timestep_sec = world.timestep_sec;
-  const ComposedScene composed = ComposeWorld(world.models, compose_options);
+  ComposedScene composed = ComposeWorld(world.models, compose_options);
+  AddImuSensors(world.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
+  EffectsStage effects(world, &composed, options.adversity);  // + agent bodies
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   const std::string composed_path = (out / "composed.xml").string();
   WriteComposedScene(composed, composed_path);
@@ -113,11 +119,12 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
     if (!m.is_robot || m.controller.type.empty()) continue;
     sim.AddController(MakeController(m.controller, m.name, world.file));
   }
+  effects.Attach(&sim);
   timings["load_sec"] = SecondsSince(t0);
 
   // static scene for the renderer
   t0 = Clock::now();
-  const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
+  const SceneDescription scene = effects.Bind(AssembleScene(sim.scene(), world, sim.Snapshot()));
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 
@@ -125,6 +132,10 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   AsyncFrameWriter writer(out.string());
   for (const CameraSpec& cam : scene.cameras) writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
   CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
+  SensorStage sensor_stage(world, sim, scene, out.string(),  // app/sensor_stage.h
+                           [&](const WorldSnapshot& s, const Eigen::Vector3d& p) {
+                             return effects.Evaluate(s, p);
+                           });
   std::ofstream trajectory(out / "trajectory.csv");
   WriteTrajectoryHeader(trajectory, sim.qpos().size());
 
@@ -147,9 +158,17 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
       for (;;) {
         RenderJob job;
         schedule.Due(sim.time(), &job.cameras, &job.frame_indices);
-        if (shutters.Due(sim.time()) || !job.cameras.empty()) {
+        const bool sensors_due = sensor_stage.Due(sim.time());  // same snapshot as cameras
+        const bool shutter_due = shutters.Due(sim.time());
+        if (sensors_due && !shutter_due && job.cameras.empty())
+          sensor_stage.Process(sim.Snapshot());
+        if (shutter_due || !job.cameras.empty()) {
           job.snapshot = sim.Snapshot();
+          if (sensors_due) sensor_stage.Process(job.snapshot);
           shutters.Add(job.snapshot.time_sec, job.cameras);
+          for (int c : job.cameras)
+            job.effects.push_back(effects.Evaluate(
+                job.snapshot, CameraPoseInWorld(scene.cameras[c], job.snapshot).translation()));
           if (!jobs.Push(std::move(job))) return;
         }
         if (sim.time() >= duration - 1e-9) break;
@@ -187,7 +206,8 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
         failure = job->error;
         break;
       }
-      camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, {}, submit);
+      // per-camera effects (app/effects_stage.h) ride along with each capture
+      camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, job->effects, submit);
       progress.Update(job->snapshot.time_sec, total_frames);
     }
     if (!failure) camera_stage.Finish(submit);
@@ -196,6 +216,8 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   }
   jobs.Close();
   physics.join();
+  sensor_stage.Finish();
+  for (const auto& [kind, sec] : sensor_stage.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
   progress.Finish();
   render_sec = camera_stage.render_sec();
 
@@ -227,6 +249,9 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   manifest.frames_per_camera = summary.frames_per_camera;
   manifest.sim_duration_sec = summary.sim_time_sec;
   manifest.command_line = options.command_line;
+  manifest.adversity = effects.PresetLabel();
+  manifest.effects = effects.EffectLabels();
+  manifest.agents = effects.AgentLabels();
   WriteRunManifest(out.string(), manifest);
 
   if (failure) std::rethrow_exception(failure);

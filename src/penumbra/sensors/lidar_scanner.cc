@@ -271,12 +271,13 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
     for (int j = 0; j < m; ++j) {
       const int i = start + j;
       const LidarBeam& beam = pat.beams[i];
+      // draws in a fixed order, each only when its model is on (a noise-free beam costs none)
       Rng rng(HashKeys(seed_, static_cast<uint64_t>(scan_index), static_cast<uint64_t>(i)));
-      const double u_drop = rng.UniformD();
-      const double n_range = StandardNormal(&rng);
-      const double n_hard = StandardNormal(&rng);
-      const double n_soft = StandardNormal(&rng);
-      const double n_part = StandardNormal(&rng);
+      const double u_drop = config_.dropout_probability > 0 ? rng.UniformD() : 1.0;
+      const double n_range = config_.range_noise_stddev_m > 0 ? StandardNormal(&rng) : 0.0;
+      const double n_hard = sigma_n > 0 ? StandardNormal(&rng) : 0.0;
+      const double n_soft = sigma_n > 0 ? StandardNormal(&rng) : 0.0;
+      const double n_part = sigma_n > 0 ? StandardNormal(&rng) : 0.0;
       const Ray& ray = rays[j];
       const Eigen::Vector3d o = ray.o.cast<double>(), d = ray.d.cast<double>();
 

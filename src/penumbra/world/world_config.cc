@@ -38,7 +38,8 @@ class WorldParser {
     const std::vector<std::string_view> keys = {"seed",    "duration_sec", "physics",   "render",
                                                 "sky",     "robots",       "models",    "lights",
                                                 "cameras", "mjcf_cameras", "materials", "output",
-                                                "agents",  "adversity", "semantic_classes", "effects"};
+                                                "agents",  "adversity", "semantic_classes", "effects",
+                                                "sensors"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -64,6 +65,15 @@ class WorldParser {
     if (r.Has("models")) {
       for (const YamlReader& m : r.Child("models").List()) w.models.push_back(ReadModel(m, false));
     }
+    if (r.Has("sensors")) w.sensors = ReadSensors(r.Child("sensors"), file_, "");
+    if (r.Has("robots")) {
+      for (const YamlReader& m : r.Child("robots").List())
+        if (m.Has("sensors")) {
+          const auto robot = ReadSensors(m.Child("sensors"), file_, m.Child("name").String());
+          w.sensors.insert(w.sensors.end(), robot.begin(), robot.end());
+        }
+    }
+    ValidateSensorNames(w.sensors);
     if (r.Has("lights")) {
       for (const YamlReader& l : r.Child("lights").List()) w.lights.push_back(ReadLight(l));
     }
@@ -155,7 +165,7 @@ class WorldParser {
 
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
     if (is_robot) {
-      r.ExpectMap({"name", "file", "pose", "controller"});
+      r.ExpectMap({"name", "file", "pose", "controller", "sensors"});
     } else {
       r.ExpectMap({"name", "file", "pose"});
     }

@@ -16,6 +16,7 @@
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/sensors/camera_sensor_config.h"
+#include "penumbra/world/sensors_reader.h"
 
 namespace penumbra {
 
@@ -135,6 +136,9 @@ struct WorldConfig {
   std::vector<MaterialOverride> materials;
   std::vector<SemanticClassConfig> semantic_classes;  ///< `semantic_classes:` in file order
   RenderSettings render;  ///< `render:` block (render/render_settings.h); seed copied from `seed`
+  /// `sensors:` (LiDAR, IMU, MuJoCo sensors, ground truth; world/sensors_reader.h), top-level
+  /// entries first, then each robot's own list in robot order.
+  std::vector<SensorConfig> sensors;
   std::string output_dir = "out";
   /// `effects:` adverse conditions (effects/effect_config.h; parsed by world/effects_reader.h).
   std::vector<EffectConfig> effects;

@@ -1,0 +1,392 @@
+#include "penumbra/app/sensor_stage.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "penumbra/compose/imu_injection.h"
+#include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/ray_scene.h"
+#include "penumbra/sensors/imu_model.h"
+#include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/sensors/mujoco_sensors.h"
+#include "penumbra/sensors/pcd_writer.h"
+#include "penumbra/sensors/sensor_noise.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::ofstream OpenCsv(const fs::path& path) {
+  std::error_code ec;
+  fs::create_directories(path.parent_path(), ec);
+  std::ofstream f(path, std::ios::trunc);
+  if (!f) throw ConfigError("", 0, "--out", "cannot create '" + path.string() + "'");
+  return f;
+}
+
+ConfigError SensorError(const SensorConfig& s, const std::string& key, const std::string& what) {
+  return ConfigError(s.file, s.line, s.key + (key.empty() ? "" : "." + key),
+                     "sensor '" + s.name + "': " + what);
+}
+
+// a sensor frame fixed to a body: X_WS = X_WB[body] * X_BS
+struct Mount {
+  int body = 0;
+  Pose X_BS = Pose::Identity();
+  Pose X_WS(const WorldSnapshot& s) const { return s.X_WB.at(body) * X_BS; }
+};
+
+Mount ResolveMount(const SensorConfig& s, const ModelInfo& info) {
+  Mount m;
+  if (!s.site.empty()) {
+    int site = -1;
+    for (size_t i = 0; i < info.site_names.size(); ++i)
+      if (info.site_names[i] == s.site) site = static_cast<int>(i);
+    if (site < 0)
+      throw SensorError(
+          s, "site",
+          "no site named '" + s.site + "' in the composed model; expected \"<model>/<site>\"");
+    m.body = info.site_body[site];
+    m.X_BS = info.site_X_BS[site] * s.X_AS();
+    return m;
+  }
+  const std::string body = s.body.empty() ? "world" : s.body;
+  if (body == "world") {
+    m.body = 0;
+  } else {
+    m.body = -1;
+    for (size_t i = 0; i < info.body_names.size(); ++i)
+      if (info.body_names[i] == body) m.body = static_cast<int>(i);
+    if (m.body < 0)
+      throw SensorError(s, "body",
+                        "no body named '" + body +
+                            "' in the composed model; expected \"<model>/<body>\" "
+                            "or world");
+  }
+  m.X_BS = s.X_AS();
+  return m;
+}
+
+}  // namespace
+
+struct SensorStage::Impl {
+  struct Lidar {
+    const SensorConfig* cfg = nullptr;
+    std::unique_ptr<LidarScanner> scanner;
+    Mount mount;
+    fs::path dir;
+    std::ofstream index;
+    bool pending = false;
+    SensorFiring start_firing;
+    WorldSnapshot start;
+    int64_t written = 0;
+  };
+  struct Imu {
+    const SensorConfig* cfg = nullptr;
+    std::unique_ptr<ImuNoiseModel> noise;
+    MujocoSensorInfo accel, gyro;
+    std::ofstream csv;
+    int64_t written = 0;
+  };
+  struct Mujoco {
+    const SensorConfig* cfg = nullptr;
+    std::unique_ptr<MujocoSensorSet> set;
+    double stddev = 0;
+    uint64_t stream = 0;
+    std::ofstream csv;
+    std::vector<double> values;
+    int64_t written = 0;
+  };
+  struct GroundTruth {
+    const SensorConfig* cfg = nullptr;
+    std::vector<int> bodies;
+    bool contacts = true;
+    std::ofstream csv, contacts_csv;
+    int64_t written = 0;
+  };
+  // what each schedule id stands for
+  struct Entry {
+    int kind = 0;  // 0 lidar, 1 imu, 2 mujoco, 3 ground truth
+    int index = 0;
+  };
+
+  std::vector<SensorConfig> configs;
+  const SceneDescription* scene = nullptr;
+  SensorEffectsAt effects_at;
+  SensorSchedule schedule;
+  std::vector<Entry> entries;
+  std::vector<Lidar> lidars;
+  std::vector<Imu> imus;
+  std::vector<Mujoco> mujocos;
+  std::vector<GroundTruth> truths;
+  std::vector<std::string> body_names;
+  std::unique_ptr<RayScene> ray_scene;
+  std::vector<SensorFiring> due;
+  std::map<std::string, double> busy;
+
+  void TraceScan(Lidar& l, const WorldSnapshot& end) {
+    const auto t0 = Clock::now();
+    const WorldSnapshot& start = l.start;
+    ray_scene->Update(start);
+    const Pose X0 = l.mount.X_WS(start), X1 = l.mount.X_WS(end);
+    const double span = end.time_sec - start.time_sec;
+    const SensorPoseAt pose = [&](double t) {
+      return span > 0 ? InterpolatePose(X0, X1, std::min(1.0, t / span)) : X0;
+    };
+    std::shared_ptr<const EffectsFrame> fx =
+        effects_at ? effects_at(start, X0.translation()) : start.effects;
+    LidarScan scan;
+    l.scanner->Scan(*ray_scene, fx.get(), pose, l.start_firing.index, &scan);
+    const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
+    WritePcd((l.dir / file).string(), scan.points);
+    l.index << fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
+                           l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec, file,
+                           scan.points.size(), scan.medium_returns, scan.particle_returns);
+    ++l.written;
+    busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+};
+
+SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
+                         const SceneDescription& scene, const std::string& out_dir,
+                         SensorEffectsAt effects_at)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.configs = world.sensors;
+  s.scene = &scene;
+  s.effects_at = std::move(effects_at);
+  const ModelInfo& info = sim.model_info();
+  s.body_names = info.body_names;
+  const fs::path out(out_dir);
+  for (const SensorConfig& c : s.configs) {
+    const uint64_t stream = SensorStreamSeed(world.seed, c.name);
+    double rate = c.rate_hz.value_or(c.type == "imu" ? 200.0 : 100.0);
+    if (c.type == "lidar") {
+      Impl::Lidar l;
+      l.cfg = &c;
+      l.mount = ResolveMount(c, info);
+      LidarConfig lc;
+      LidarPatternOptions po;
+      po.columns = static_cast<int>(c.Param("columns", 0));
+      po.rate_hz = c.rate_hz.value_or(0);
+      po.max_range_m = c.Param("max_range_m", 0);
+      po.min_range_m = c.Param("min_range_m", -1);
+      try {
+        lc.pattern = MakeLidarPattern(c.preset, po);
+        if (c.params.count("beam_divergence_mrad"))
+          lc.pattern.beam_divergence_rad = c.Param("beam_divergence_mrad", 0) * 1e-3;
+        lc.range_noise_stddev_m = c.Param("noise.range_stddev_m", 0);
+        lc.dropout_probability = c.Param("noise.dropout_probability", 0);
+        lc.min_intensity = c.Param("noise.min_intensity", 0);
+        lc.receiver_noise = c.Param("noise.receiver_noise", 0);
+        lc.reference_reflectivity = c.Param("reference_reflectivity", 0.1);
+        lc.intensity_range_normalized = c.Param("intensity_range_normalized", 1) != 0;
+        lc.media = c.Param("media", 1) != 0;
+        l.scanner = std::make_unique<LidarScanner>(lc, stream);
+      } catch (const ConfigError&) {
+        throw;
+      } catch (const Error& e) {
+        throw SensorError(c, "preset", e.what());
+      }
+      rate = lc.pattern.rate_hz;
+      l.dir = out / "lidar" / c.name;
+      l.index = OpenCsv(l.dir / "index.csv");
+      l.index << "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
+                 "particle_returns\n";
+      s.entries.push_back({0, static_cast<int>(s.lidars.size())});
+      s.lidars.push_back(std::move(l));
+    } else if (c.type == "imu") {
+      Impl::Imu m;
+      m.cfg = &c;
+      const auto [acc, gyr] = ImuSensorNames(c.name);
+      const int ia = FindMujocoSensor(sim.sensor_info(), acc);
+      const int ig = FindMujocoSensor(sim.sensor_info(), gyr);
+      if (ia < 0 || ig < 0)
+        throw SensorError(c, "",
+                          "the composed model has no accelerometer/gyro '" + acc +
+                              "' (AddImuSensors was not applied)");
+      m.accel = sim.sensor_info()[ia];
+      m.gyro = sim.sensor_info()[ig];
+      ImuNoiseConfig nc = ImuPreset(c.preset);
+      nc.accel_noise_density = c.Param("noise.accel_noise_density", nc.accel_noise_density);
+      nc.accel_random_walk = c.Param("noise.accel_random_walk", nc.accel_random_walk);
+      nc.gyro_noise_density = c.Param("noise.gyro_noise_density", nc.gyro_noise_density);
+      nc.gyro_random_walk = c.Param("noise.gyro_random_walk", nc.gyro_random_walk);
+      m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
+      m.csv = OpenCsv(out / "imu" / (c.name + ".csv"));
+      m.csv << "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
+               "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n";
+      s.entries.push_back({1, static_cast<int>(s.imus.size())});
+      s.imus.push_back(std::move(m));
+    } else if (c.type == "mujoco") {
+      Impl::Mujoco m;
+      m.cfg = &c;
+      try {
+        m.set = std::make_unique<MujocoSensorSet>(sim.sensor_info(), c.names);
+      } catch (const Error& e) {
+        throw SensorError(c, "sensors", e.what());
+      }
+      m.stddev = c.Param("noise.stddev", 0);
+      m.stream = stream;
+      m.csv = OpenCsv(out / "sensors" / (c.name + ".csv"));
+      m.csv << "sample,capture_time_sec,delivery_time_sec";
+      for (const std::string& col : m.set->ColumnNames()) m.csv << "," << col;
+      m.csv << "\n";
+      s.entries.push_back({2, static_cast<int>(s.mujocos.size())});
+      s.mujocos.push_back(std::move(m));
+    } else {
+      Impl::GroundTruth g;
+      g.cfg = &c;
+      if (c.names.empty()) {
+        for (size_t b = 1; b < info.body_names.size(); ++b)
+          if (!info.body_names[b].empty()) g.bodies.push_back(static_cast<int>(b));
+      } else {
+        for (const std::string& n : c.names) {
+          int found = -1;
+          for (size_t b = 0; b < info.body_names.size(); ++b)
+            if (info.body_names[b] == n) found = static_cast<int>(b);
+          if (found < 0)
+            throw SensorError(c, "bodies", "no body named '" + n + "' in the composed model");
+          g.bodies.push_back(found);
+        }
+      }
+      g.contacts = c.Param("contacts", 1) != 0;
+      g.csv = OpenCsv(out / "ground_truth" / (c.name + ".csv"));
+      g.csv << "sample,time_sec";
+      for (int b : g.bodies) {
+        const std::string& n = info.body_names[b];
+        for (const char* k : {"x_m", "y_m", "z_m", "qw", "qx", "qy", "qz", "wx_rad_s", "wy_rad_s",
+                              "wz_rad_s", "vx_m_s", "vy_m_s", "vz_m_s"})
+          g.csv << "," << n << "_" << k;
+      }
+      g.csv << "\n";
+      if (g.contacts) {
+        g.contacts_csv = OpenCsv(out / "ground_truth" / (c.name + "_contacts.csv"));
+        g.contacts_csv << "sample,time_sec,geom1,geom2,body1,body2,px_m,py_m,pz_m,nx,ny,nz,"
+                          "distance_m,fn_N,ft1_N,ft2_N\n";
+      }
+      s.entries.push_back({3, static_cast<int>(s.truths.size())});
+      s.truths.push_back(std::move(g));
+    }
+    try {
+      s.schedule.Add(c.name, rate, c.latency_sec);
+    } catch (const Error& e) {
+      throw SensorError(c, "rate_hz", e.what());
+    }
+  }
+  if (!s.lidars.empty()) s.ray_scene = std::make_unique<RayScene>(scene);
+}
+
+SensorStage::~SensorStage() = default;
+
+bool SensorStage::empty() const { return impl_->configs.empty(); }
+
+bool SensorStage::Due(double time_sec) {
+  impl_->due.clear();
+  impl_->schedule.Due(time_sec, &impl_->due);
+  return !impl_->due.empty();
+}
+
+void SensorStage::Process(const WorldSnapshot& snap) {
+  Impl& s = *impl_;
+  for (const SensorFiring& f : s.due) {
+    const Impl::Entry e = s.entries[f.sensor];
+    const auto t0 = Clock::now();
+    if (e.kind == 0) {
+      Impl::Lidar& l = s.lidars[e.index];
+      if (l.pending) s.TraceScan(l, snap);
+      l.pending = true;
+      l.start_firing = f;
+      l.start = snap;
+      continue;
+    }
+    if (e.kind == 1) {
+      Impl::Imu& m = s.imus[e.index];
+      const auto a = MujocoSensorValues(snap, m.accel);
+      const auto w = MujocoSensorValues(snap, m.gyro);
+      ImuSample truth;
+      truth.accel_m_s2 = {a[0], a[1], a[2]};
+      truth.gyro_rad_s = {w[0], w[1], w[2]};
+      const ImuSample o = m.noise->Apply(f.index, truth);
+      m.csv << fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
+                           f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
+                           o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(),
+                           o.gyro_rad_s.z());
+      ++m.written;
+      s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
+    } else if (e.kind == 2) {
+      Impl::Mujoco& m = s.mujocos[e.index];
+      m.values.clear();
+      m.set->Read(snap, &m.values);
+      std::string row =
+          fmt::format("{},{:.9f},{:.9f}", f.index, f.capture_time_sec, f.delivery_time_sec);
+      Rng rng(HashKeys(m.stream, static_cast<uint64_t>(f.index)));
+      for (double v : m.values) {
+        if (m.stddev > 0) v += m.stddev * StandardNormal(&rng);
+        fmt::format_to(std::back_inserter(row), ",{:.9g}", v);
+      }
+      row += '\n';
+      m.csv << row;
+      ++m.written;
+      s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
+    } else {
+      Impl::GroundTruth& g = s.truths[e.index];
+      std::string row = fmt::format("{},{:.9f}", f.index, snap.time_sec);
+      for (int b : g.bodies) {
+        const Pose& X = snap.X_WB.at(b);
+        const Eigen::Quaterniond q(X.linear());
+        const Eigen::Matrix<double, 6, 1> V = b < static_cast<int>(snap.V_WB.size())
+                                                  ? snap.V_WB[b]
+                                                  : Eigen::Matrix<double, 6, 1>::Zero();
+        fmt::format_to(std::back_inserter(row),
+                       ",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
+                       "{:.9g},{:.9g},{:.9g}",
+                       X.translation().x(), X.translation().y(), X.translation().z(), q.w(), q.x(),
+                       q.y(), q.z(), V[0], V[1], V[2], V[3], V[4], V[5]);
+      }
+      row += '\n';
+      g.csv << row;
+      if (g.contacts) {
+        for (const WorldSnapshot::Contact& c : snap.contacts)
+          g.contacts_csv << fmt::format(
+              "{},{:.9f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
+              "{:.9g},{:.9g}\n",
+              f.index, snap.time_sec, c.geom1, c.geom2, c.body1, c.body2, c.p_W.x(), c.p_W.y(),
+              c.p_W.z(), c.normal_W.x(), c.normal_W.y(), c.normal_W.z(), c.distance_m,
+              c.force_N.x(), c.force_N.y(), c.force_N.z());
+      }
+      ++g.written;
+      s.busy["ground_truth"] += std::chrono::duration<double>(Clock::now() - t0).count();
+    }
+  }
+}
+
+void SensorStage::Finish() {
+  Impl& s = *impl_;
+  for (auto& l : s.lidars) l.index.flush();
+  for (auto& m : s.imus) m.csv.flush();
+  for (auto& m : s.mujocos) m.csv.flush();
+  for (auto& g : s.truths) {
+    g.csv.flush();
+    if (g.contacts) g.contacts_csv.flush();
+  }
+}
+
+std::map<std::string, int64_t> SensorStage::samples() const {
+  std::map<std::string, int64_t> out;
+  for (const auto& l : impl_->lidars) out[l.cfg->name] = l.written;
+  for (const auto& m : impl_->imus) out[m.cfg->name] = m.written;
+  for (const auto& m : impl_->mujocos) out[m.cfg->name] = m.written;
+  for (const auto& g : impl_->truths) out[g.cfg->name] = g.written;
+  return out;
+}
+
+std::map<std::string, double> SensorStage::busy_sec() const { return impl_->busy; }
+
+}  // namespace penumbra

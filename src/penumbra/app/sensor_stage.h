@@ -1,0 +1,80 @@
+#pragma once
+// the run's sensor stage: every world-file sensor (`sensors:`, world/sensors_reader.h) on its
+// own schedule (sensors/sensor_schedule.h), fed with physics snapshots, writing its outputs:
+//
+//   <out>/lidar/<name>/scan_<k>.pcd   binary PCD v0.7, fields x y z intensity ring time,
+//                                     sensor frame (REP-103) at each beam's firing time
+//   <out>/lidar/<name>/index.csv      scan,capture_time_sec,delivery_time_sec,file,points,
+//                                     medium_returns,particle_returns
+//   <out>/imu/<name>.csv              sample,capture_time_sec,delivery_time_sec,
+//                                     accel_{x,y,z}_m_s2,gyro_{x,y,z}_rad_s (IMU site frame)
+//   <out>/sensors/<name>.csv          sample,capture_time_sec,delivery_time_sec, one column per
+//                                     MuJoCo sensor value named with its unit
+//   <out>/ground_truth/<name>.csv     sample,time_sec, per body <body>_{x,y,z}_m,
+//                                     _q{w,x,y,z}, _w{x,y,z}_rad_s, _v{x,y,z}_m_s (X_WB, V_WB)
+//   <out>/ground_truth/<name>_contacts.csv  sample,time_sec,geom1,geom2,body1,body2,
+//                                     p{x,y,z}_m,n{x,y,z},distance_m,f{n,t1,t2}_N
+//
+// stamps: capture_time_sec is the sim time of the physics step the sample was taken at,
+// delivery_time_sec = capture + latency_sec. rows are written in capture order, which for
+// one sensor (constant latency) is also its delivery order; both stamps are in every row.
+// a LiDAR scan k covers [capture_k, capture_{k+1}): it is traced when scan k + 1's snapshot
+// arrives, with the sensor pose interpolated between the two snapshots (motion distortion);
+// the scan still open when the run ends is not written.
+//
+// determinism: each sensor draws noise from its own stream SensorStreamSeed(seed, name);
+// everything runs on the physics thread in step order.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/physics/simulation.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+#include "penumbra/sensors/sensor_schedule.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// the effects seen by a sensor at world position p_W (e.g. EffectsStage::Evaluate); may
+/// return null for clear conditions.
+using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
+    const WorldSnapshot& snapshot, const Eigen::Vector3d& p_W)>;
+
+/// all world-file sensors of one run.
+class SensorStage {
+ public:
+  /// resolves every sensor against the composed model (IMUs need compose/imu_injection.h's
+  /// AddImuSensors applied to the model first) and opens the output files under `out_dir`.
+  /// `scene` must outlive the stage (LiDARs ray trace it).
+  /// @throws ConfigError naming the sensor's file, line and key (e.g. sensors[1].body) for a
+  ///         body, site, MuJoCo sensor or preset setting that does not resolve.
+  SensorStage(const WorldConfig& world, const Simulation& sim, const SceneDescription& scene,
+              const std::string& out_dir, SensorEffectsAt effects_at = {});
+  ~SensorStage();
+
+  /// true when the world has no sensors.
+  bool empty() const;
+  /// advances the schedules to the physics step at `time_sec` (call once per step, before
+  /// stepping); true if any sensor is due (then call Process with that step's snapshot).
+  bool Due(double time_sec);
+  /// runs the sensors found due by the last Due() on `snapshot` and writes their records.
+  void Process(const WorldSnapshot& snapshot);
+  /// flushes and closes the files.
+  void Finish();
+
+  /// samples (scans) written per sensor.
+  std::map<std::string, int64_t> samples() const;
+  /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s.
+  std::map<std::string, double> busy_sec() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace penumbra
