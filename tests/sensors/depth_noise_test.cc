@@ -143,7 +143,7 @@ TEST(DepthNoiseTest, FogDropsReturnsWithRoundTripTransmittance) {
   const CameraIntrinsics k = CameraIntrinsics::FromFovy(100, 100, 1);  // near-parallel rays
   const Camera cam(testing::LookingAlongX(Eigen::Vector3d::Zero()), k);
   const ImageF depth(100, 100, 1, 2.0f);
-  const ImageF t = DepthTransmittance(depth, cam, fx);
+  const ImageF t = DepthTransmittance(depth, cam, fx, 1);
   EXPECT_NEAR(*t.at(50, 50), std::exp(-0.4), 1e-4);
   DepthNoiseConfig cfg;
   cfg.preset = "realsense_d435";
@@ -160,10 +160,29 @@ TEST(DepthNoiseTest, FogDropsReturnsWithRoundTripTransmittance) {
   // thick smoke: below the threshold every return is lost
   fog.sigma_t_per_m = Eigen::Vector3f(2, 2, 2);
   fx.homogeneous_media = {fog};
-  const ImageF t2 = DepthTransmittance(depth, cam, fx);
+  const ImageF t2 = DepthTransmittance(depth, cam, fx, 1);
   in.transmittance = &t2;
   ApplyDepthNoise(depth, in, m, 9, &out);
   for (float d : out.data) EXPECT_EQ(d, 0.0f);
+}
+
+TEST(DepthNoiseTest, SmokeGridTransmittanceByRatioTracking) {
+  // a 1 m smoke box of density 1, sigma_t 0.5 / m across the rays: mean T = exp(-0.5)
+  EffectsFrame fx;
+  GridMedium g;
+  g.X_WG.translation() = Eigen::Vector3d(1.5, 0, 0);
+  g.half_extents_m = Eigen::Vector3d(0.5, 2, 2);
+  g.nx = g.ny = g.nz = 4;
+  g.density = std::make_shared<const std::vector<float>>(64, 1.0f);
+  g.max_density = 1.0f;
+  g.sigma_t_per_m = Eigen::Vector3f(0.5f, 0.5f, 0.5f);
+  fx.grid_media.push_back(g);
+  const CameraIntrinsics k = CameraIntrinsics::FromFovy(100, 100, 1);
+  const Camera cam(testing::LookingAlongX(Eigen::Vector3d::Zero()), k);
+  const ImageF t = DepthTransmittance(ImageF(100, 100, 1, 3.0f), cam, fx, 5);
+  double mean = 0;
+  for (float v : t.data) mean += v / 1e4;
+  EXPECT_NEAR(mean, std::exp(-0.5), 0.01);
 }
 
 TEST(DepthNoiseTest, LateralNoiseJagsEdges) {

@@ -175,6 +175,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
       const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
       for (float& v : dn_.data) v *= inv_max;
       film_.Develop(dn_, -std::log2(1.2), nullptr, &out->rgb);  // exposure H = 1
+    } else if (n == 1 && ev == out->truth.ev100 && !out->truth.rgb.empty()) {
+      out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV
     } else {
       film_.Develop(accum_, ev, nullptr, &out->rgb);
     }
@@ -193,6 +195,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     in.fy = spec_.intrinsics.fy;
     in.cx = spec_.intrinsics.cx;
     in.cy = spec_.intrinsics.cy;
+    const Camera depth_camera(X_WO_start, spec_.intrinsics);  // rays in the optical frame only
+    in.camera = &depth_camera;
     // IR reflectance from the hit geom's material: base colour luminance, -1 for mirror-like
     ImageF reflectance(W, H, 1, 1.0f);
     std::map<int, float> by_id;
@@ -211,7 +215,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     }
     in.reflectance = &reflectance;
     ImageF transmittance;
-    if (start.effects && !start.effects->homogeneous_media.empty()) {
+    if (start.effects &&
+        (!start.effects->homogeneous_media.empty() || !start.effects->grid_media.empty())) {
       CameraMotion m;
       if (moving) {
         m.X_WO_end = X_WO_end;
@@ -220,7 +225,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
         m.line_time_sec = c.rolling_shutter_line_time_sec;
       }
       transmittance = DepthTransmittance(out->truth.depth_m,
-                                         Camera(X_WO_start, spec_.intrinsics, m), *start.effects);
+                                         Camera(X_WO_start, spec_.intrinsics, m), *start.effects,
+                                         HashKeys(settings_.seed, camera_index_, frame_index, 4));
       in.transmittance = &transmittance;
     }
     ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,

@@ -6,6 +6,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/render/media_scene.h"
 #include "penumbra/sensors/image_noise.h"
 
 namespace penumbra {
@@ -84,7 +85,10 @@ void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
       double cos_theta = 1.0;
       if (in.normal_O && !in.normal_O->empty()) {
         const float* n = in.normal_O->at(u, v);
-        const Eigen::Vector3d ray((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0);
+        const Eigen::Vector2d xy = in.camera
+                                       ? in.camera->Unproject(u, v)
+                                       : Eigen::Vector2d((u - in.cx) / in.fx, (v - in.cy) / in.fy);
+        const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
         cos_theta = std::abs(Eigen::Vector3d(n[0], n[1], n[2]).dot(ray)) / ray.norm();
       }
       const double theta = std::acos(std::clamp(cos_theta, 0.0, 1.0));
@@ -147,21 +151,23 @@ double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vec
   return sigma * len * sum / kSteps;
 }
 
-ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera,
-                          const EffectsFrame& effects) {
+ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const EffectsFrame& effects,
+                          uint64_t key) {
   ImageF t(depth_z.width, depth_z.height, 1, 1.0f);
-  if (effects.homogeneous_media.empty()) return t;
+  if (effects.homogeneous_media.empty() && effects.grid_media.empty()) return t;
+  MediaScene media;
+  media.Build(&effects);
+  if (media.empty()) return t;
   for (int v = 0; v < depth_z.height; ++v) {
     for (int u = 0; u < depth_z.width; ++u) {
       const double z = *depth_z.at(u, v);
       if (!(z > 0)) continue;
       const Ray r = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
-      const Eigen::Vector3d a = r.o.cast<double>();
-      const Eigen::Vector3d b = a + z * r.d.cast<double>();
-      double tau = 0.0;
-      for (const HomogeneousMedium& m : effects.homogeneous_media)
-        tau += HomogeneousOpticalDepth(m, a, b);
-      *t.at(u, v) = static_cast<float>(std::exp(-tau));
+      const float len = r.d.norm();
+      Rng rng(HashKeys(key, static_cast<uint64_t>(v) * static_cast<uint64_t>(depth_z.width) + u));
+      const Eigen::Vector3f tr =
+          media.Transmittance(r.o, r.d / len, 0.0f, static_cast<float>(z) * len, &rng);
+      *t.at(u, v) = std::clamp(tr.mean(), 0.0f, 1.0f);
     }
   }
   return t;

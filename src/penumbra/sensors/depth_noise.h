@@ -78,6 +78,8 @@ struct DepthNoiseInputs {
   const ImageF* transmittance =
       nullptr;  ///< (H x W x 1) one-way transmittance to the hit in [0, 1]
   double fx = 500, fy = 500, cx = 0, cy = 0;  ///< intrinsics of the depth image (px)
+  /// the depth camera, for exact (distorted) pixel rays; null = pinhole rays from fx fy cx cy.
+  const Camera* camera = nullptr;
 };
 
 /// applies `model` to `depth_z` ((H x W x 1) z-depth in m, 0 = no hit) into `out` (same shape,
@@ -91,9 +93,13 @@ void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
 double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vector3d& a_W,
                                const Eigen::Vector3d& b_W);
 
-/// one-way transmittance exp(-tau) from the camera to the hit of every pixel of `depth_z`
-/// ((H x W x 1) z-depth, 0 = no hit -> 1) through the homogeneous media of `effects` (grid media
-/// are not included). the pixel ray comes from `camera` (distortion and rolling shutter aware).
-ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const EffectsFrame& effects);
+/// one-way transmittance T from the camera to the hit of every pixel of `depth_z`
+/// ((H x W x 1) z-depth, 0 = no hit -> 1) through all media of `effects`: homogeneous media in
+/// closed form, voxel grids (smoke, steam) by ratio tracking (render/media_scene.h,
+/// MediaScene::Transmittance; an unbiased per-pixel estimate, seeded by Rng(HashKeys(key,
+/// pixel))); channel mean (near-infrared sensors see roughly grey media). the pixel ray comes
+/// from `camera` (distortion and rolling shutter aware).
+ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const EffectsFrame& effects,
+                          uint64_t key);
 
 }  // namespace penumbra

@@ -1,0 +1,78 @@
+#include "penumbra/app/camera_specs.h"
+
+#include <gtest/gtest.h>
+
+namespace penumbra {
+namespace {
+
+TEST(CameraSpecsTest, GlobMatch) {
+  EXPECT_TRUE(GlobMatch("rover/*", "rover/chassis"));
+  EXPECT_TRUE(GlobMatch("*", ""));
+  EXPECT_TRUE(GlobMatch("*wheel?", "rover/wheel3"));
+  EXPECT_TRUE(GlobMatch("a*b*c", "axxbyyc"));
+  EXPECT_FALSE(GlobMatch("rover/*", "arm/link"));
+  EXPECT_FALSE(GlobMatch("*wheel?", "rover/wheel"));
+  EXPECT_FALSE(GlobMatch("abc", "abcd"));
+}
+
+TEST(CameraSpecsTest, SemanticClassesFirstMatchWins) {
+  SceneDescription s;
+  s.bodies = {{"world", -1, true}, {"rover/chassis", 0, false}, {"arm/link", 0, false}};
+  Material concrete, steel;
+  concrete.name = "room/concrete_floor";
+  steel.name = "steel";
+  s.materials = {concrete, steel};
+  auto geom = [&](const std::string& name, int body, int material) {
+    Geom g;
+    g.name = name;
+    g.body = body;
+    g.material = material;
+    s.geoms.push_back(g);
+  };
+  geom("floor", 0, 0);
+  geom("rover/wheel", 1, 1);
+  geom("arm/gripper", 2, 1);
+  geom("", 0, 1);
+  std::vector<SemanticClassConfig> classes(3);
+  classes[0] = {"robot", 1, {"rover/*"}, {}, {}};
+  classes[1] = {"floor", 7, {}, {}, {"*concrete*"}};
+  classes[2] = {"gripper", 9, {}, {"*gripper", "rover/*"}, {}};
+  ApplySemanticClasses(classes, &s);
+  EXPECT_EQ(s.geoms[0].semantic_class, 7);
+  EXPECT_EQ(s.geoms[1].semantic_class, 1);  // class 'robot' comes first
+  EXPECT_EQ(s.geoms[2].semantic_class, 9);
+  EXPECT_EQ(s.geoms[3].semantic_class, 0);
+}
+
+TEST(CameraSpecsTest, StereoCameraBecomesTwoWithBaselineAlongOpticalX) {
+  CameraConfig c;
+  c.name = "head";
+  c.k1 = -0.1;
+  c.sensor.exposure_time_sec = 0.004;
+  c.sensor.stereo_baseline_m = 0.1;
+  CameraSpec cam;
+  cam.name = "head";
+  cam.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
+  cam.X_BO.linear() = RotationBodyFromOptical();
+  cam.X_BO.translation() = Eigen::Vector3d(0.2, 0, 0.5);
+  std::vector<CameraSpec> out;
+  AppendWorldCamera(c, cam, &out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].name, "head/left");
+  EXPECT_EQ(out[1].name, "head/right");
+  EXPECT_EQ(out[0].intrinsics.k1, -0.1);
+  EXPECT_EQ(out[1].exposure_time_sec, 0.004);
+  // optical x = body -y: the right camera sits 0.1 m towards body -y
+  EXPECT_TRUE(out[1].X_BO.translation().isApprox(Eigen::Vector3d(0.2, -0.1, 0.5)));
+  EXPECT_TRUE(out[1].X_BO.linear().isApprox(out[0].X_BO.linear()));
+  WorldConfig w;
+  w.cameras.push_back(c);
+  SceneDescription s;
+  s.cameras = out;
+  const std::vector<CameraSensorConfig> cfg = SensorConfigsFor(s, w);
+  ASSERT_EQ(cfg.size(), 2u);
+  EXPECT_EQ(cfg[1].exposure_time_sec, 0.004);
+}
+
+}  // namespace
+}  // namespace penumbra
