@@ -3,9 +3,9 @@
 // each drop is a disc on the image (radius 3-8 % of the smaller image side); a drop on the front
 // glass is far out of focus and acts as a small ball lens, so inside the disc the image shows a
 // blurred, inverted, minified view of its surroundings: pixel p at distance d from the drop
-// centre c shows the average of 9 samples (a 3 x 3 pattern of spacing 0.2 r) around
-// c - 0.6 (p - c), blended in with a smooth edge over the outer 20 % of the radius and darkened
-// by 10 % at the rim (total internal reflection at the drop's edge). drops are drawn for an
+// centre c shows the image, Gaussian-blurred with sigma = 2 % of the smaller image side, at
+// c - 0.6 (p - c) (bilinear), blended in with a smooth edge over the outer 20 % of the radius and
+// darkened by 10 % at the rim (total internal reflection at the drop's edge). drops are drawn for an
 // epoch of kDropletLifetimeSec of sim time (they appear, stay and run off together), seeded by
 // Rng(HashKeys(key, epoch, drop)).
 
