@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "penumbra/app/effects_bench.h"
 #include "penumbra/app/scene_assembly.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
@@ -95,6 +96,7 @@ int BenchRender(const RenderBenchOptions& options) {
                rays / seconds * 1e-6);
   }
   fmt::print("target (2-core CI machine): >= 30 frames/s at 640x480 realtime\n");
+  if (options.adversity) BenchRenderAdversity(options);  // app/effects_bench.h
   return 0;
 }
 

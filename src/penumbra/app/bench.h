@@ -13,6 +13,7 @@ struct RenderBenchOptions {
   int warmup_frames = 5;    ///< untimed frames first
   int threads = 0;          ///< render threads, 0 = all cores
   std::string tier = "realtime";
+  bool adversity = true;    ///< also time the presets none/minor/major (app/effects_bench.h)
 };
 
 /// renders the world's first camera at 640x480 and 800x800 (RGB + depth) while the

@@ -7,6 +7,8 @@
 #include <filesystem>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/contact_sheet.h"
+#include "penumbra/app/vdb_tool.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
@@ -54,6 +56,9 @@ int RunCli(int argc, char** argv) {
   run->add_option("--threads", threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
   run->add_option("--seed", seed, "world seed (overrides seed)")->check(CLI::NonNegativeNumber);
   run->add_flag("--quiet,-q", quiet, "no progress output");
+  run->add_option("--adversity", run_options.adversity,
+                  "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
+                  "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
 
   // penumbra bench render|physics
   CLI::App* bench = app.add_subcommand("bench", "throughput benchmarks (not tests)");
@@ -64,6 +69,26 @@ int RunCli(int argc, char** argv) {
   bench_render->add_option("--frames", render_bench.frames, "timed frames per resolution")->check(CLI::Range(1, 100000));
   bench_render->add_option("--threads", render_bench.threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
   bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
+  bool no_adversity = false;
+  bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
+  // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
+  CLI::App* sheet = app.add_subcommand("contact-sheet", "one instant of a world under adversity presets, side by side, as a PNG");
+  ContactSheetOptions sheet_options;
+  sheet->add_option("--world", sheet_options.world_file, "world file (default: bundled default world)");
+  sheet->add_option("--presets", sheet_options.presets, "presets, left to right")->delimiter(',');
+  sheet->add_option("--time", sheet_options.time_sec, "sim time of the frames, s")->check(CLI::NonNegativeNumber);
+  sheet->add_option("--width", sheet_options.width, "frame width")->check(CLI::Range(16, 4096));
+  sheet->add_option("--height", sheet_options.height, "frame height")->check(CLI::Range(16, 4096));
+  sheet->add_option("--out,-o", sheet_options.out, "output PNG (default docs/effects.png)");
+  sheet->add_option("--threads", sheet_options.threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
+  CLI::App* make_vdb = app.add_subcommand("make-vdb", "write a procedural smoke cloud as an OpenVDB file (float grid 'density')");
+  std::string vdb_path;
+  SmokeVdbOptions vdb_options;
+  make_vdb->add_option("file", vdb_path, "output .vdb file")->required();
+  make_vdb->add_option("--seed", vdb_options.seed, "blob layout seed");
+  make_vdb->add_option("--voxel", vdb_options.voxel_m, "voxel size, m");
+  make_vdb->add_option("--radius", vdb_options.radius_m, "cloud radius, m");
+  make_vdb->add_option("--blobs", vdb_options.blobs, "Gaussian puffs");
   CLI::App* bench_physics = bench->add_subcommand("physics", "Penumbra physics steps/s vs a bare mj_step loop");
   PhysicsBenchOptions physics_bench;
   bench_physics->add_option("--world", physics_bench.world_file, "world file (default: bundled default world)");
@@ -97,7 +122,15 @@ int RunCli(int argc, char** argv) {
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
       return 0;
     }
-    if (*bench_render) return BenchRender(render_bench);
+    if (*bench_render) {
+      render_bench.adversity = !no_adversity;
+      return BenchRender(render_bench);
+    }
+    if (*sheet) return MakeContactSheet(sheet_options);
+    if (*make_vdb) {
+      MakeSmokeVdb(vdb_path, vdb_options);
+      return 0;
+    }
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
