@@ -26,13 +26,31 @@ double NonNegative(const YamlReader& r, const std::string& unit) {
   return v;
 }
 
+SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s);
+
+// every error after the name names the sensor: "sensor '<name>': <problem>"
 SensorConfig ReadSensor(const YamlReader& r, const std::string& robot) {
   r.ExpectMapAnyKeys();
   SensorConfig s;
+  s.name = r.Child("name").String();
+  const std::string name = s.name;
+  try {
+    return ReadSensorFields(r, robot, std::move(s));
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    const std::string tag = "sensor '" + name + "'";
+    if (what.find(tag) != std::string::npos) throw;
+    const size_t at = e.key().empty() ? std::string::npos : what.find(e.key() + ": ");
+    const std::string problem =
+        at == std::string::npos ? what : what.substr(at + e.key().size() + 2);
+    throw ConfigError(e.file(), e.line(), e.key(), tag + ": " + problem);
+  }
+}
+
+SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s) {
   s.line = r.line();
   s.key = r.path();
   s.robot = robot;
-  s.name = r.Child("name").String();
   if (s.name.empty() || s.name.find_first_of("/\\ \t") != std::string::npos)
     r.Child("name").Fail("'" + s.name +
                          "' is not a valid sensor name; expected a non-empty "

@@ -1,0 +1,157 @@
+// end-to-end sensors: world file `sensors:` -> composed IMU sensors -> SensorStage -> PCD and
+// CSV files; post-composition errors name the sensor and key.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "penumbra/app/runner.h"
+#include "penumbra/core/error.h"
+#include "penumbra/sensors/pcd_writer.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+// a box resting on the floor, a ball falling from 20 m (no contact within 1 s), walls.
+constexpr char kModel[] = R"(
+<mujoco model="drop">
+  <option timestep="0.002"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="10 10 0.1"/>
+    <geom name="wall" type="box" pos="5 0 1" size="0.1 5 1"/>
+    <body name="box" pos="0 0 0.1">
+      <freejoint/>
+      <geom name="box" type="box" size="0.1 0.1 0.1" mass="1"/>
+      <site name="imu_site" pos="0 0 0.05"/>
+      <site name="pad" type="box" size="0.11 0.11 0.02" pos="0 0 -0.1"/>
+    </body>
+    <body name="ball" pos="0 3 20">
+      <freejoint/>
+      <geom name="ball" type="sphere" size="0.1" mass="1"/>
+    </body>
+  </worldbody>
+  <sensor><touch name="box_touch" site="pad"/></sensor>
+</mujoco>)";
+
+class SensorRunTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("penumbra_sensor_run_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(dir_ / "drop.xml") << kModel;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  WorldConfig World(const std::string& sensors) {
+    std::ofstream(dir_ / "world.yaml")
+        << "duration_sec: 1\nmjcf_cameras: {enabled: false}\nrobots:\n"
+           "  - name: m\n    file: drop.xml\n"
+        << sensors;
+    return LoadWorldFile((dir_ / "world.yaml").string());
+  }
+  static std::vector<std::vector<std::string>> Csv(const fs::path& p) {
+    std::ifstream f(p);
+    std::vector<std::vector<std::string>> rows;
+    std::string line;
+    while (std::getline(f, line)) {
+      std::vector<std::string> row;
+      std::stringstream ss(line);
+      std::string cell;
+      while (std::getline(ss, cell, ',')) row.push_back(cell);
+      rows.push_back(row);
+    }
+    return rows;
+  }
+  fs::path dir_;
+};
+
+TEST_F(SensorRunTest, WritesScansImuMujocoAndGroundTruth) {
+  const WorldConfig world = World(R"(    sensors:
+      - {name: rest_imu, type: imu, site: imu_site, preset: ideal, rate_hz: 200, latency_sec: 0.01}
+      - {name: fall_imu, type: imu, body: ball, preset: ideal, rate_hz: 200}
+sensors:
+  - name: lidar
+    type: lidar
+    preset: velodyne_vlp16
+    body: world
+    pose: {xyz: [0, 0, 1], rpy_deg: [0, 0, 0]}
+  - {name: touch, type: mujoco, sensors: [m/box_touch], rate_hz: 50}
+  - {name: truth, type: ground_truth, bodies: [m/box, m/ball], rate_hz: 10}
+)");
+  RunOptions opt;
+  opt.out_dir = (dir_ / "out").string();
+  opt.progress = false;
+  RunWorld(world, opt);
+  const fs::path out = dir_ / "out";
+  // lidar: scans 0..9 (scan 10 at t = 1 s is still open at the end)
+  const auto index = Csv(out / "lidar" / "lidar" / "index.csv");
+  ASSERT_EQ(index.size(), 11u);
+  EXPECT_EQ(index[0][0], "scan");
+  const std::vector<LidarPoint> pts =
+      ReadPcd((out / "lidar" / "lidar" / "scan_000003.pcd").string());
+  EXPECT_EQ(std::to_string(pts.size()), index[4][4]);
+  // the wall at x = 4.9 (front face) is seen straight ahead by the horizontal-most rings
+  int wall = 0;
+  for (const LidarPoint& p : pts)
+    if (std::abs(p.x - 4.9) < 1e-3 && std::abs(p.y) < 0.5 && p.z > -1 && p.z < 1) ++wall;
+  EXPECT_GT(wall, 10);
+  // imu: 200 Hz over [0, 1] s = 201 samples; resting one reads +g up, falling one ~0
+  const auto rest = Csv(out / "imu" / "rest_imu.csv");
+  const auto fall = Csv(out / "imu" / "fall_imu.csv");
+  ASSERT_EQ(rest.size(), 202u);
+  ASSERT_EQ(fall.size(), 202u);
+  EXPECT_EQ(rest[0][3], "accel_x_m_s2");
+  EXPECT_NEAR(std::stod(rest[150][2]) - std::stod(rest[150][1]), 0.01, 1e-9);  // latency
+  EXPECT_NEAR(std::stod(rest[150][5]), 9.81, 0.01);
+  for (int k = 1; k <= 3; ++k) EXPECT_LT(std::abs(std::stod(fall[150][2 + k])), 1e-6);
+  // mujoco touch: 50 Hz, weight of the 1 kg box
+  const auto touch = Csv(out / "sensors" / "touch.csv");
+  ASSERT_EQ(touch.size(), 52u);
+  EXPECT_EQ(touch[0][3], "m/box_touch_N");
+  EXPECT_NEAR(std::stod(touch[40][3]), 9.81, 0.05);
+  // ground truth: ball falls freely: z = 20 - g t^2 / 2, vz = -g t
+  const auto truth = Csv(out / "ground_truth" / "truth.csv");
+  ASSERT_EQ(truth.size(), 12u);
+  EXPECT_EQ(truth[0][2 + 13 + 2], "m/ball_z_m");
+  const double t = std::stod(truth[11][1]);
+  EXPECT_NEAR(std::stod(truth[11][2 + 13 + 2]), 20 - 0.5 * 9.81 * t * t, 0.01);
+  EXPECT_NEAR(std::stod(truth[11][2 + 13 + 12]), -9.81 * t, 0.01);
+  EXPECT_TRUE(fs::exists(out / "ground_truth" / "truth_contacts.csv"));
+}
+
+TEST_F(SensorRunTest, MissingBodyOrSiteNamesTheSensorAndKey) {
+  const auto expect_error = [&](const std::string& sensors, const std::string& key) {
+    const WorldConfig world = World(sensors);
+    RunOptions opt;
+    opt.out_dir = (dir_ / "out").string();
+    opt.progress = false;
+    try {
+      RunWorld(world, opt);
+      ADD_FAILURE() << "no error for " << key;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("'bad'"), std::string::npos) << e.what();
+    }
+  };
+  expect_error("sensors:\n  - {name: bad, type: imu, body: m/nobody}\n", "sensors[0].body");
+  expect_error("sensors:\n  - {name: bad, type: imu, site: m/nosite}\n", "sensors[0].site");
+  expect_error("sensors:\n  - {name: bad, type: lidar, preset: velodyne_vlp16, body: m/nobody}\n",
+               "sensors[0].body");
+  expect_error(
+      "    sensors:\n      - {name: bad, type: lidar, preset: livox_mid40, site: nosite}\n",
+      "robots[0].sensors[0].site");
+  expect_error("sensors:\n  - {name: bad, type: mujoco, sensors: [m/none]}\n",
+               "sensors[0].sensors");
+}
+
+}  // namespace
+}  // namespace penumbra
