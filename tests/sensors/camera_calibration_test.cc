@@ -1,6 +1,15 @@
 // lens distortion end to end: a checkerboard rendered through a Brown-Conrady camera, its corners
 // detected with OpenCV (findChessboardCorners + cornerSubPix) and cv::calibrateCamera must give
 // back the intrinsics and distortion the renderer used.
+//
+// what "within 1 %" means here: k1 (the dominant term) within 1 % relative; the whole recovered
+// distortion model within 1 % of the largest distortion displacement (124 px), as the largest
+// pixel difference between the true and recovered models over the image radius the detected
+// corners cover. k2, k3, p1 and p2 are printed, not asserted to 1 % each: with ~0.15 px corner
+// detection noise they trade off against each other (k2/k3 are strongly correlated, p2 moves
+// pixels by < 0.5 px), so per-coefficient relative errors are not identifiable from any real
+// corner detections; ExactCornerProjectionsRecoverEveryCoefficient checks each one without
+// detection noise.
 
 #include <gtest/gtest.h>
 
@@ -18,7 +27,9 @@ namespace {
 
 constexpr int kSquaresX = 10, kSquaresY = 7;  // 9 x 6 inner corners (asymmetric: unambiguous)
 constexpr double kSquare = 0.07;              // m
-constexpr double kTopZ = 0.001;               // black tiles' top face: the board plane
+// black tiles are 20 um thick boxes on the white backing: their top faces are the board plane
+// (thin, so that their side walls do not widen the black squares seen from oblique views)
+constexpr double kTopZ = 2e-5;
 
 CameraIntrinsics TrueIntrinsics() {
   CameraIntrinsics k;
@@ -328,6 +339,8 @@ TEST(CameraCalibrationTest, DetectedCornersRecoverTheDistortion) {
   EXPECT_LT(c.rms, 0.5);
   EXPECT_NEAR(c.k.fx, truth.fx, 0.01 * truth.fx);
   EXPECT_NEAR(c.k.fy, truth.fy, 0.01 * truth.fy);
+  EXPECT_NEAR(c.k.cx, truth.cx, 1.0);
+  EXPECT_NEAR(c.k.cy, truth.cy, 1.0);
   EXPECT_NEAR(c.k.k1, truth.k1, 0.01 * std::abs(truth.k1));
   EXPECT_LT(model_error_px, 0.01 * distortion_px);
 }
