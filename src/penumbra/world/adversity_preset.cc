@@ -115,7 +115,10 @@ bool AdversityPreset::empty() const {
 }
 
 std::string BundledAdversityPresetsPath() {
-  return (fs::path(PENUMBRA_SOURCE_DIR) / "worlds" / "adversity" / "presets.yaml").string();
+  const fs::path source = fs::path(PENUMBRA_SOURCE_DIR) / "worlds" / "adversity" / "presets.yaml";
+  std::error_code ec;
+  if (fs::is_regular_file(source, ec)) return source.string();
+  return "worlds/adversity/presets.yaml";  // a build moved away from its source tree
 }
 
 std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path) {

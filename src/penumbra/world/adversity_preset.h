@@ -59,7 +59,8 @@ struct AdversityPreset {
   bool empty() const;
 };
 
-/// worlds/adversity/presets.yaml of the source tree.
+/// worlds/adversity/presets.yaml of the source tree (or, when the binary runs away from
+/// its source tree, relative to the current folder).
 std::string BundledAdversityPresetsPath();
 
 /// every preset of a preset file, in file order.
