@@ -156,6 +156,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
 
   if (want_rgb) {
     for (float& v : accum_.data) v /= static_cast<float>(n);
+    out->radiance = accum_;
     // exposure with adaptation over sim time
     double ev = film_.Ev100(accum_, nullptr);
     if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
@@ -186,6 +187,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     if (c.jpeg_quality > 0) RoundTripJpeg(c.jpeg_quality, &out->rgb);
   } else {
     out->rgb = ImageU8();
+    out->radiance = ImageF();
   }
 
   if (depth_model_) {

@@ -39,6 +39,7 @@ namespace penumbra {
 /// images of one captured frame.
 struct CameraImages {
   RenderedFrame truth;  ///< renderer images: ground truth (depth_m exact z-depth) and radiance
+  ImageF radiance;      ///< (H x W x 3) linear radiance averaged over the sub-frames, cd/m^2
   ImageU8 rgb;          ///< (H x W x 3) uint8 sRGB after exposure, noise, droplets and JPEG
   ImageF depth_m;       ///< (H x W x 1) z-depth in m after depth noise (= truth.depth_m without)
   double ev100 = 0;     ///< exposure value used
