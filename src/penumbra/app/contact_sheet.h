@@ -11,7 +11,7 @@ namespace penumbra {
 struct ContactSheetOptions {
   std::string world_file;  ///< default: the bundled default world
   std::vector<std::string> presets = {"none", "minor", "major"};
-  double time_sec = 6.0;          ///< sim time of the frames
+  double time_sec = 1.0;          ///< sim time of the frames
   int width = 640, height = 480;  ///< size of each frame (the world camera's field of view)
   std::string out = "docs/effects.png";
   int threads = 0;  ///< render threads, 0 = all cores
