@@ -48,5 +48,36 @@ TEST(EffectsKoschmiederTest, ContrastFallsExponentiallyWithDistance) {
   }
 }
 
+// single scattering of a point light in a bounded fog: the realtime tier's froxel in-scatter
+// against the pathtraced tier limited to one scattering event (max_bounces = 1).
+TEST(EffectsKoschmiederTest, LightInScatterTiersAgree) {
+  SceneDescription s = EmptyScene();
+  s.extent_m = 10;
+  Light l;
+  l.type = Light::Type::kPoint;
+  l.position_B = Eigen::Vector3d(3, 0, 2.0);  // above the view: no singular glow in it
+  l.intensity = 100;
+  s.lights.push_back(l);
+  EffectsFrame fx;
+  HomogeneousMedium fog = Fog(0.1f, 1.0f, 0.3f);
+  fog.region = BoxRegion{{0.5, -4, -4}, {8, 4, 4}};
+  fx.homogeneous_media.push_back(fog);
+  const CameraView view = MakeView(CameraLookingAlongX(), 96, 64, 30, true, false, false);
+  double mean[2];
+  int k = 0;
+  for (RenderSettings::Tier tier :
+       {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
+    RenderSettings rs = TierSettings(tier, 32);
+    rs.max_bounces = 1;
+    auto r = MakeEmbreeRenderer(s, rs);
+    RenderedFrame f;
+    r->Render(SnapshotWith(s, fx), view, &f);
+    mean[k++] = MeanRadiance(f.radiance, 0, 96, 0, 64);
+  }
+  EXPECT_GT(mean[1], 0.0);
+  EXPECT_NEAR(mean[0], mean[1], 0.1 * mean[1]);
+  RecordProperty("realtime_over_pathtraced", std::to_string(mean[0] / mean[1]));
+}
+
 }  // namespace
 }  // namespace penumbra

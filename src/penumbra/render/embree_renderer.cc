@@ -55,8 +55,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   lights_.Update(snapshot);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
-  effects_.Prepare(snapshot, camera, view.exposure_time_sec, settings_, lights_, *ray_scene_, sky_,
-                   &pool_);
+  effects_.Prepare(snapshot, camera, view, settings_, lights_, *ray_scene_, sky_, &pool_);
   const int W = camera.width(), H = camera.height();
   const CameraOutputs& want = view.outputs;
   const bool denoise = want.rgb && denoiser_ != nullptr;

@@ -19,7 +19,7 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
 MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
 
 void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
-                         double exposure_time_sec, const RenderSettings& settings,
+                         const CameraView& view, const RenderSettings& settings,
                          const LightSampler& lights, const RayScene& rays, const SkyModel& base_sky,
                          ThreadPool* pool) {
   const EffectsFrame* fx =
@@ -30,7 +30,7 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
   wetness_ = 0;
   if (!active_) {
     media_.Build(nullptr);
-    particles_.Build(nullptr, camera, 0);
+    particles_.Build(nullptr, camera, 0, false);
     return;
   }
   if (!(fx->sky_luminance_scale >= 0) || !std::isfinite(fx->sky_luminance_scale))
@@ -69,11 +69,15 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
 
   media_.Build(fx);
   if (!media_.empty() && settings.tier == RenderSettings::Tier::kRealtime) {
-    realtime_.Build(media_, lights, rays, scene_.center_W.cast<float>(), scene_.extent_m,
-                    sky_ambient_, pool);
+    const uint64_t frame_key =
+        HashKeys(HashKeys(settings.seed, static_cast<uint64_t>(view.camera_index)),
+                 static_cast<uint64_t>(view.frame_index));
+    realtime_.Build(media_, lights, rays, camera, frame_key, scene_.center_W.cast<float>(),
+                    scene_.extent_m, sky_ambient_, pool);
     realtime_ok_ = true;
   }
-  particles_.Build(fx, camera, exposure_time_sec);
+  particles_.Build(fx, camera, view.exposure_time_sec,
+                   settings.tier == RenderSettings::Tier::kRealtime);
 }
 
 }  // namespace penumbra

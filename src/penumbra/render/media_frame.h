@@ -23,6 +23,7 @@
 #include "penumbra/render/particle_scene.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/render/render_settings.h"
+#include "penumbra/render/renderer.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -42,11 +43,12 @@ class MediaFrame {
   /// `scene` (the renderer's copy) must outlive this object.
   explicit MediaFrame(const SceneDescription& scene);
 
-  /// prepares the effects of `snapshot` (none when snapshot.effects is null or empty) for a
-  /// frame seen by `camera` with the given exposure. `lights` must already be posed for the
-  /// snapshot and `rays` updated. realtime light volumes are built only for that tier.
+  /// prepares the effects of `snapshot` (none when snapshot.effects is null or empty) for
+  /// `view` (its exposure time, camera and frame index) seen through `camera`. `lights` must
+  /// already be posed for the snapshot and `rays` updated. realtime light volumes are built only
+  /// for that tier.
   /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
-  void Prepare(const WorldSnapshot& snapshot, const Camera& camera, double exposure_time_sec,
+  void Prepare(const WorldSnapshot& snapshot, const Camera& camera, const CameraView& view,
                const RenderSettings& settings, const LightSampler& lights, const RayScene& rays,
                const SkyModel& base_sky, ThreadPool* pool);
 

@@ -43,9 +43,9 @@ bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
 }  // namespace
 
 void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
-                          const RayScene& scene, const Eigen::Vector3f& bounds_center_W,
-                          double bounds_extent_m, const Eigen::Vector3f& sky_ambient,
-                          ThreadPool* pool) {
+                          const RayScene& scene, const Camera& camera, uint64_t frame_key,
+                          const Eigen::Vector3f& bounds_center_W, double bounds_extent_m,
+                          const Eigen::Vector3f& sky_ambient, ThreadPool* pool) {
   media_ = &media;
   sky_ambient_ = sky_ambient;
   num_lights_ = std::min(lights.size(), kMaxVolumeLights);
@@ -57,6 +57,15 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       for (int64_t i = 0; i < n; ++i) fn(i);
     }
   };
+  // geometric visibility of light l from p (one shadow ray).
+  auto visible = [&](const Eigen::Vector3f& p, const LightSample& ls) {
+    if (!ls.cast_shadow) return true;
+    Ray sr;
+    sr.o = p;
+    sr.d = ls.wi;
+    sr.tmax = std::isinf(ls.distance) ? kInfF : ls.distance * (1.0f - 1e-4f);
+    return !scene.Occluded(sr);
+  };
 
   // grid light volumes.
   grid_light_.assign(media.grids().size(), GridLight());
@@ -64,9 +73,11 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     const GridVolume& v = media.grids()[g];
     GridLight& gl = grid_light_[g];
     const int n[3] = {v.nx, v.ny, v.nz};
+    const Eigen::Vector3f size = 2 * v.half;
+    const float cell = std::cbrt(size.prod() / kGridLightCells);
     for (int k = 0; k < 3; ++k) {
-      gl.r[k] = std::min(n[k], kGridLightRes);
-      gl.cells_per_m[k] = gl.r[k] / (2 * v.half[k]);
+      gl.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, n[k]);
+      gl.cells_per_m[k] = gl.r[k] / size[k];
     }
     gl.cell_m = (1.0f / gl.cells_per_m.array()).minCoeff();
     const int cells = gl.r[0] * gl.r[1] * gl.r[2];
@@ -90,7 +101,8 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
         }
         float a, b, Tg = 1.0f;
         if (v.Interval(p, ls.wi, 0.0f, ls.distance, &a, &b)) {
-          const int steps = std::max(1, static_cast<int>(std::ceil((b - a) / gl.cell_m)));
+          const int steps =
+              std::clamp(static_cast<int>(std::ceil((b - a) / gl.cell_m)), 1, kGridLightSteps);
           const float ds = (b - a) / steps;
           const Eigen::Vector3f o_G = v.ToGrid(p), d_G = v.R_GW * ls.wi;
           float tau = 0;
@@ -98,28 +110,21 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
           Tg = std::exp(-tau * sigma * ds);
         }
         gl.T[static_cast<size_t>(l) * cells + c] = Tg;
-        float V = 1.0f;
-        if (ls.cast_shadow) {
-          Ray sr;
-          sr.o = p;
-          sr.d = ls.wi;
-          sr.tmax = std::isinf(ls.distance) ? kInfF : ls.distance * (1.0f - 1e-4f);
-          if (scene.Occluded(sr)) V = 0.0f;
-        }
-        if (!(V > 0)) continue;
+        if (!(Tg > 1e-4f) || !visible(p, ls)) continue;
         const float Th =
             media.analytic().empty()
                 ? 1.0f
                 : std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
-        src += ls.E * (V * Tg * Th * kInv4Pi);
+        src += ls.E * (Tg * Th * kInv4Pi);
       }
       gl.source[c] = src;
     });
   }
 
-  // visibility volume of the homogeneous media.
-  fog_ = FogVolume();
-  if (!media.analytic().empty() && nl > 0) {
+  // world light volume: transmittance to every light (all media), and for homogeneous media
+  // also times the geometric visibility (their in-scatter).
+  vol_ = LightVolume();
+  if (nl > 0) {
     Eigen::Vector3f lo = bounds_center_W - Eigen::Vector3f::Constant(bounds_extent_m);
     Eigen::Vector3f hi = bounds_center_W + Eigen::Vector3f::Constant(bounds_extent_m);
     bool all_bounded = true;
@@ -132,53 +137,275 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       ulo = ulo.cwiseMin(m.box_min);
       uhi = uhi.cwiseMax(m.box_max);
     }
-    if (all_bounded) {
+    if (all_bounded && !media.analytic().empty()) {
       lo = lo.cwiseMax(ulo);
       hi = hi.cwiseMin(uhi);
     }
     const Eigen::Vector3f size = hi - lo;
     if ((size.array() > 0).all()) {
-      fog_.active = true;
-      fog_.lo = lo;
-      fog_.hi = hi;
-      const float cell = std::cbrt(size.prod() / kFogCells);
+      vol_.active = true;
+      vol_.with_visibility = !media.analytic().empty();
+      vol_.lo = lo;
+      vol_.hi = hi;
+      const float cell = std::cbrt(size.prod() / kLightVolumeCells);
       for (int k = 0; k < 3; ++k) {
-        fog_.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, 128);
-        fog_.cells_per_m[k] = fog_.r[k] / size[k];
+        vol_.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, 128);
+        vol_.cells_per_m[k] = vol_.r[k] / size[k];
       }
-      const int cells = fog_.r[0] * fog_.r[1] * fog_.r[2];
-      fog_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
+      const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
+      vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
+      if (vol_.with_visibility) vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
       parallel(cells, [&](int64_t c) {
-        const int i = static_cast<int>(c % fog_.r[0]);
-        const int j = static_cast<int>((c / fog_.r[0]) % fog_.r[1]);
-        const int k = static_cast<int>(c / (static_cast<int64_t>(fog_.r[0]) * fog_.r[1]));
+        const int i = static_cast<int>(c % vol_.r[0]);
+        const int j = static_cast<int>((c / vol_.r[0]) % vol_.r[1]);
+        const int k = static_cast<int>(c / (static_cast<int64_t>(vol_.r[0]) * vol_.r[1]));
         const Eigen::Vector3f p =
-            lo + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(fog_.cells_per_m);
+            lo + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(vol_.cells_per_m);
         for (int l = 0; l < nl; ++l) {
-          float& out = fog_.vis[static_cast<size_t>(l) * cells + c];
+          const size_t at = static_cast<size_t>(l) * cells + c;
           LightSample ls;
           if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
-            out = 0.0f;
+            vol_.trans[at] = 0.0f;
+            if (vol_.with_visibility) vol_.vis[at] = 0.0f;
             continue;
           }
-          if (ls.cast_shadow) {
-            Ray sr;
-            sr.o = p;
-            sr.d = ls.wi;
-            sr.tmax = std::isinf(ls.distance) ? kInfF : ls.distance * (1.0f - 1e-4f);
-            if (scene.Occluded(sr)) {
-              out = 0.0f;
-              continue;
-            }
-          }
-          float T = std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
+          float T = media.analytic().empty()
+                        ? 1.0f
+                        : std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
           for (size_t g = 0; g < grid_light_.size(); ++g)
             T *= GridLightT(static_cast<int>(g), l, p, ls.wi, ls.distance);
-          out = T;
+          vol_.trans[at] = T;
+          if (vol_.with_visibility) vol_.vis[at] = T > 1e-4f && visible(p, ls) ? T : 0.0f;
         }
       });
     }
   }
+  BuildFroxels(lights, camera, frame_key, pool);
+  BuildFogFroxels(lights, camera, frame_key, pool);
+}
+
+void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camera,
+                                 uint64_t frame_key, ThreadPool* pool) {
+  froxels_ = Froxels();
+  const MediaScene& media = *media_;
+  if (media.grids().empty()) return;
+  const int W = camera.width(), H = camera.height();
+  Froxels& fr = froxels_;
+  fr.nx = (W + kFroxelBlock - 1) / kFroxelBlock;
+  fr.ny = (H + kFroxelBlock - 1) / kFroxelBlock;
+  const int columns = fr.nx * fr.ny;
+  constexpr int Z = kFroxelSlices;
+  fr.t0.assign(columns, 0.0f);
+  fr.t1.assign(columns, 0.0f);
+  fr.records.assign(static_cast<size_t>(columns) * (Z + 1),
+                    FroxelRecord{Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()});
+  const bool analytic = !media.analytic().empty();
+  auto column = [&](int64_t c) {
+    const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
+    const int uc = std::min(cx * kFroxelBlock + kFroxelBlock / 2, W - 1);
+    const int vc = std::min(cy * kFroxelBlock + kFroxelBlock / 2, H - 1);
+    const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
+    const Eigen::Vector3f o = r.o, d = r.d.normalized();
+    float a = kInfF, b = -kInfF;
+    for (const GridVolume& v : media.grids()) {
+      float ga, gb;
+      if (!v.Interval(o, d, 0.0f, kInfF, &ga, &gb)) continue;
+      a = std::min(a, ga);
+      b = std::max(b, gb);
+    }
+    if (!(a < b)) return;
+    fr.t0[c] = a;
+    fr.t1[c] = b;
+    // jitter of the slice samples from the column's centre pixel stream 2.
+    const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
+    Rng rng(HashKeys(HashKeys(frame_key, pixel), 2));
+    const float jitter = rng.Uniform();
+    const float ds = (b - a) / Z;
+    FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
+    Eigen::Vector3f S = Eigen::Vector3f::Zero(), T = Eigen::Vector3f::Ones();
+    for (int k = 0; k < Z; ++k) {
+      const float t = a + (k + jitter) * ds;
+      const Eigen::Vector3f p = o + t * d;
+      Eigen::Vector3f sig_t = Eigen::Vector3f::Zero(), src = Eigen::Vector3f::Zero();
+      for (size_t g = 0; g < media.grids().size(); ++g) {
+        const GridVolume& v = media.grids()[g];
+        const Eigen::Vector3f x = v.ToGrid(p);
+        const float dens = v.DensityAt(x);
+        if (dens > 0) {
+          const GridLight& gl = grid_light_[g];
+          const Eigen::Vector3f f =
+              (x + v.half).cwiseProduct(gl.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+          sig_t += dens * v.sigma_t;
+          src += (dens * v.sigma_s).cwiseProduct(Trilinear(gl.source.data(), gl.r, f));
+        }
+        if (v.emission) src += v.EmissionAt(x);
+      }
+      if (sig_t.maxCoeff() > 0 || src.maxCoeff() > 0) {
+        if (analytic) src = src.cwiseProduct(Exp(-media.AnalyticOpticalDepth(o, d, 0, t)));
+        const Eigen::Vector3f step_T = Exp(-sig_t * ds);
+        Eigen::Vector3f factor;
+        for (int ch = 0; ch < 3; ++ch)
+          factor[ch] = sig_t[ch] * ds > 1e-5f ? (1.0f - step_T[ch]) / sig_t[ch] : ds;
+        S += T.cwiseProduct(src).cwiseProduct(factor);
+        T = T.cwiseProduct(step_T);
+      }
+      rec[k + 1] = FroxelRecord{S, T};
+    }
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(columns, column);
+  } else {
+    for (int64_t c = 0; c < columns; ++c) column(c);
+  }
+}
+
+RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
+                                                         float* t_enter) const {
+  const Froxels& fr = froxels_;
+  constexpr int Z = kFroxelSlices;
+  const float fx = std::clamp((u - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock), 0.0f,
+                              static_cast<float>(fr.nx - 1));
+  const float fy = std::clamp((v - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock), 0.0f,
+                              static_cast<float>(fr.ny - 1));
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
+  const float wx = fx - x0, wy = fy - y0;
+  FroxelRecord out{Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+  *t_enter = kInfF;
+  const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+  const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+  for (int q = 0; q < 4; ++q) {
+    const int c = cols[q];
+    const float a = fr.t0[c], b = fr.t1[c];
+    if (!(a < b)) {
+      out.T += w[q] * Eigen::Vector3f::Ones();
+      continue;
+    }
+    *t_enter = std::min(*t_enter, a);
+    const float s = std::clamp((t - a) / (b - a), 0.0f, 1.0f) * Z;
+    const int k = std::min(static_cast<int>(s), Z - 1);
+    const float f = s - k;
+    const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
+    out.S += w[q] * ((1 - f) * rec[k].S + f * rec[k + 1].S);
+    out.T += w[q] * ((1 - f) * rec[k].T + f * rec[k + 1].T);
+  }
+  return out;
+}
+
+namespace {
+
+// slice coordinate in [0, Z] of distance t for exponentially spaced boundaries
+// 0, near, ..., t_far (boundary k >= 1 at near (t_far / near)^((k - 1) / (Z - 1))).
+float FogSlice(float t, float t_far) {
+  constexpr int Z = kFogFroxelSlices;
+  if (!(t > 0)) return 0.0f;
+  if (t < kFogFroxelNear) return t / kFogFroxelNear;
+  const float s = 1.0f + (Z - 1) * std::log(t / kFogFroxelNear) / std::log(t_far / kFogFroxelNear);
+  return std::min(s, static_cast<float>(Z));
+}
+
+float FogBoundary(int k, float t_far) {
+  if (k == 0) return 0.0f;
+  return kFogFroxelNear *
+         std::pow(t_far / kFogFroxelNear, static_cast<float>(k - 1) / (kFogFroxelSlices - 1));
+}
+
+}  // namespace
+
+void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& camera,
+                                    uint64_t frame_key, ThreadPool* pool) {
+  fog_froxels_ = FogFroxels();
+  const MediaScene& media = *media_;
+  if (media.analytic().empty() || lights.size() == 0) return;
+  const int W = camera.width(), H = camera.height();
+  FogFroxels& fr = fog_froxels_;
+  fr.nx = (W + kFogFroxelBlock - 1) / kFogFroxelBlock;
+  fr.ny = (H + kFogFroxelBlock - 1) / kFogFroxelBlock;
+  const int columns = fr.nx * fr.ny;
+  constexpr int Z = kFogFroxelSlices;
+  fr.t_far.assign(columns, 2 * kFogFroxelNear);
+  fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Vector3f::Zero());
+  const int nm = static_cast<int>(media.analytic().size());
+  auto column = [&](int64_t c) {
+    const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
+    const int uc = std::min(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
+    const int vc = std::min(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
+    const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
+    const Eigen::Vector3f o = r.o, d = r.d.normalized();
+    // the slices reach where the media's transmittance falls to 1 % (or they end).
+    float t_far = 2 * kFogFroxelNear;
+    for (const AnalyticMedium& m : media.analytic()) {
+      float a, b;
+      if (!m.Interval(o, d, 0.0f, kInfF, &a, &b)) continue;
+      const double tt = m.InvertDensityIntegral(o.z(), d.z(), a, b, 4.6 / Mean3(m.sigma_t));
+      t_far = std::max(t_far, static_cast<float>(std::min(std::isfinite(tt) ? tt : b, 2000.0)));
+    }
+    t_far = std::min(t_far, 2000.0f);
+    fr.t_far[c] = t_far;
+    const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
+    Rng rng(HashKeys(HashKeys(frame_key, pixel), 3));
+    const float jitter = rng.Uniform();
+    const Eigen::Vector3f wo = -d;
+    Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
+    Eigen::Vector3f S = Eigen::Vector3f::Zero();
+    for (int k = 0; k < Z; ++k) {
+      const float lo = FogBoundary(k, t_far), hi = FogBoundary(k + 1, t_far);
+      const float t = lo + jitter * (hi - lo);
+      const Eigen::Vector3f x = o + t * d;
+      Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
+      for (int j = 0; j < lights.size(); ++j) {
+        LightSample ls;
+        if (!lights.Sample(j, x, 0.5f, 0.5f, &ls)) continue;
+        const float vis = FogVisibility(j, x, ls.wi, ls.distance);
+        if (!(vis > 0)) continue;
+        const float cos_t = wo.dot(ls.wi);
+        Eigen::Vector3f ph = Eigen::Vector3f::Zero();
+        for (int i = 0; i < nm; ++i) {
+          const AnalyticMedium& m = media.analytic()[i];
+          if (!Inside(m, x)) continue;
+          ph += m.sigma_s * (m.Density(x.z()) * HenyeyGreenstein(cos_t, m.g));
+        }
+        Ls += ls.E.cwiseProduct(ph) * vis;
+      }
+      if (Ls.maxCoeff() > 0) {
+        float unused;
+        Eigen::Vector3f T_cam = Exp(-media.AnalyticOpticalDepth(o, d, 0, t));
+        if (!froxels_.records.empty())
+          T_cam = T_cam.cwiseProduct(LookupFroxels(uc, vc, t, &unused).T);
+        S += T_cam.cwiseProduct(Ls) * (hi - lo);
+      }
+      rec[k + 1] = S;
+    }
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(columns, column);
+  } else {
+    for (int64_t c = 0; c < columns; ++c) column(c);
+  }
+}
+
+Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
+  const FogFroxels& fr = fog_froxels_;
+  constexpr int Z = kFogFroxelSlices;
+  const float fx = std::clamp((u - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
+                              static_cast<float>(fr.nx - 1));
+  const float fy = std::clamp((v - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
+                              static_cast<float>(fr.ny - 1));
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
+  const float wx = fx - x0, wy = fy - y0;
+  const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+  const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+  Eigen::Vector3f out = Eigen::Vector3f::Zero();
+  for (int q = 0; q < 4; ++q) {
+    const int c = cols[q];
+    const float s = FogSlice(t, fr.t_far[c]);
+    const int k = std::min(static_cast<int>(s), Z - 1);
+    const float f = s - k;
+    const Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
+    out += w[q] * ((1 - f) * rec[k] + f * rec[k + 1]);
+  }
+  return out;
 }
 
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -196,12 +423,12 @@ float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const 
 
 float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                    float dist) const {
-  if (fog_.active && j < num_lights_ && (p_W.array() >= fog_.lo.array()).all() &&
-      (p_W.array() <= fog_.hi.array()).all()) {
+  if (vol_.with_visibility && j < num_lights_ && (p_W.array() >= vol_.lo.array()).all() &&
+      (p_W.array() <= vol_.hi.array()).all()) {
     const Eigen::Vector3f f =
-        (p_W - fog_.lo).cwiseProduct(fog_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-    const size_t cells = static_cast<size_t>(fog_.r[0]) * fog_.r[1] * fog_.r[2];
-    return Trilinear(fog_.vis.data() + j * cells, fog_.r, f);
+        (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+    const size_t cells = static_cast<size_t>(vol_.r[0]) * vol_.r[1] * vol_.r[2];
+    return Trilinear(vol_.vis.data() + j * cells, vol_.r, f);
   }
   float T = std::exp(-Mean3(media_->AnalyticOpticalDepth(p_W, wi, 0, dist)));
   for (size_t g = 0; g < grid_light_.size(); ++g)
@@ -211,6 +438,13 @@ float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eige
 
 Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& p_W,
                                                   const Eigen::Vector3f& wi, float dist) const {
+  if (vol_.active && j < num_lights_ && (p_W.array() >= vol_.lo.array()).all() &&
+      (p_W.array() <= vol_.hi.array()).all()) {
+    const Eigen::Vector3f f =
+        (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+    const size_t cells = static_cast<size_t>(vol_.r[0]) * vol_.r[1] * vol_.r[2];
+    return Eigen::Vector3f::Constant(Trilinear(vol_.trans.data() + j * cells, vol_.r, f));
+  }
   Eigen::Vector3f T = media_->analytic().empty()
                           ? Eigen::Vector3f::Ones()
                           : Exp(-media_->AnalyticOpticalDepth(p_W, wi, 0, dist));
@@ -220,70 +454,21 @@ Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& 
 }
 
 MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                                          const Eigen::Vector3f& d, float t_end, Rng* rng) const {
+                                          const Eigen::Vector3f& d, float t_end, int u, int v,
+                                          Rng* rng) const {
   MediaSegment out;
   const MediaScene& media = *media_;
   const bool analytic = !media.analytic().empty();
 
-  // grids: march the overlap with each box.
-  constexpr int kMaxSegs = 8;
-  float seg_a[kMaxSegs], seg_b[kMaxSegs];
-  Eigen::Vector3f seg_T[kMaxSegs];
-  int nseg = 0;
+  // grids: the froxel volume at the pixel's distance.
   Eigen::Vector3f Tg = Eigen::Vector3f::Ones();
   float first_a = kInfF;
-  for (size_t g = 0; g < media.grids().size(); ++g) {
-    const GridVolume& v = media.grids()[g];
-    float a, b;
-    if (!v.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
-    const GridLight& gl = grid_light_[g];
-    const int n = std::clamp(static_cast<int>(std::ceil((b - a) / gl.cell_m)), 1, kMaxGridSteps);
-    const float ds = (b - a) / n;
-    const float jitter = rng->Uniform();
-    const Eigen::Vector3f o_G = v.ToGrid(o), d_G = v.R_GW * d;
-    Eigen::Vector3f Tacc = Eigen::Vector3f::Ones(), Lg = Eigen::Vector3f::Zero();
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3f x = o_G + (a + (i + jitter) * ds) * d_G;
-      const float dens = v.DensityAt(x);
-      const Eigen::Vector3f em = v.emission ? v.EmissionAt(x) : Eigen::Vector3f::Zero();
-      if (!(dens > 0) && !(em.maxCoeff() > 0)) continue;
-      const Eigen::Vector3f sig_t = dens * v.sigma_t;
-      const Eigen::Vector3f step_T = Exp(-sig_t * ds);
-      Eigen::Vector3f factor;
-      for (int c = 0; c < 3; ++c)
-        factor[c] = sig_t[c] * ds > 1e-5f ? (1.0f - step_T[c]) / sig_t[c] : ds;
-      const Eigen::Vector3f f =
-          (x + v.half).cwiseProduct(gl.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-      const Eigen::Vector3f src =
-          (dens * v.sigma_s).cwiseProduct(Trilinear(gl.source.data(), gl.r, f)) + em;
-      Lg += Tacc.cwiseProduct(src).cwiseProduct(factor);
-      Tacc = Tacc.cwiseProduct(step_T);
-    }
-    const Eigen::Vector3f Th_mid = analytic
-                                       ? Exp(-media.AnalyticOpticalDepth(o, d, 0, 0.5f * (a + b)))
-                                       : Eigen::Vector3f::Ones();
-    out.L_add += Tg.cwiseProduct(Th_mid).cwiseProduct(Lg);
-    Tg = Tg.cwiseProduct(Tacc);
-    first_a = std::min(first_a, a);
-    if (nseg < kMaxSegs) {
-      seg_a[nseg] = a, seg_b[nseg] = b, seg_T[nseg] = Tacc;
-      ++nseg;
-    }
+  const bool grids = !froxels_.records.empty();
+  if (grids) {
+    const FroxelRecord r = LookupFroxels(u, v, std::min(t_end, 1e30f), &first_a);
+    out.L_add += r.S;
+    Tg = r.T;
   }
-  // grid transmittance from the camera to distance t (linear inside a box).
-  auto grid_T = [&](float t) {
-    Eigen::Vector3f T = Eigen::Vector3f::Ones();
-    for (int s = 0; s < nseg; ++s) {
-      if (t <= seg_a[s]) continue;
-      if (t >= seg_b[s]) {
-        T = T.cwiseProduct(seg_T[s]);
-      } else {
-        const float w = (t - seg_a[s]) / (seg_b[s] - seg_a[s]);
-        T = T.cwiseProduct(Eigen::Vector3f::Ones() * (1 - w) + seg_T[s] * w);
-      }
-    }
-    return T;
-  };
 
   if (!analytic) {
     out.T = Tg;
@@ -309,70 +494,15 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
   for (int c = 0; c < 3; ++c)
     albedo[c] = tau_t[c] > 0 ? static_cast<float>(tau_s[c] / tau_t[c]) : 0;
   Eigen::Vector3f sky_w = Eigen::Vector3f::Ones() - Th_end;
-  if (nseg > 0) {
+  if (first_a < t_end) {
     const Eigen::Vector3f Th_a = Exp(-media.AnalyticOpticalDepth(o, d, 0, first_a));
     sky_w = (Eigen::Vector3f::Ones() - Th_a) + (Th_a - Th_end).cwiseProduct(Tg);
   }
   out.L_add += albedo.cwiseProduct(sky_w).cwiseProduct(sky_ambient_);
   out.T = Th_end.cwiseProduct(Tg);
 
-  // light in-scatter: distances drawn from a mixture over the media, each medium's lobe
-  // proportional to its mean-channel sigma_t T along its own overlap.
-  if (lights.size() == 0) return out;
-  double P[kMaxMedia], P_sum = 0;
-  for (int i = 0; i < nm && i < kMaxMedia; ++i) {
-    const double sm = Mean3(media.analytic()[i].sigma_t);
-    P[i] = I[i] > 0 ? -std::expm1(-sm * I[i]) : 0.0;
-    P_sum += P[i];
-  }
-  if (!(P_sum > 0)) return out;
-  const Eigen::Vector3f wo = -d;
-  for (int k = 0; k < kFogLightSamples; ++k) {
-    const double u = (k + rng->UniformD()) / kFogLightSamples;
-    // pick a medium with probability P_i / P_sum, then a distance within it.
-    double acc = 0, u_pick = rng->UniformD() * P_sum;
-    int pick = 0;
-    for (int i = 0; i < nm && i < kMaxMedia; ++i) {
-      acc += P[i];
-      pick = i;
-      if (u_pick < acc && P[i] > 0) break;
-    }
-    const AnalyticMedium& mp = media.analytic()[pick];
-    const double smp = Mean3(mp.sigma_t);
-    const double tau_target = -std::log1p(-u * P[pick]) / smp;
-    const double t = mp.InvertDensityIntegral(o.z(), d.z(), ma[pick], mb[pick], tau_target);
-    if (!std::isfinite(t)) continue;
-    const Eigen::Vector3f x = o + static_cast<float>(t) * d;
-    // mixture pdf at t.
-    double pdf = 0;
-    for (int i = 0; i < nm && i < kMaxMedia; ++i) {
-      if (!(P[i] > 0) || t < ma[i] || t > mb[i]) continue;
-      const AnalyticMedium& m = media.analytic()[i];
-      const double sm = Mean3(m.sigma_t);
-      const double Ii = m.DensityIntegral(o.z(), d.z(), ma[i], t);
-      pdf += (P[i] / P_sum) * sm * m.Density(x.z()) * std::exp(-sm * Ii) / P[i];
-    }
-    if (!(pdf > 0)) continue;
-    Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
-    for (int j = 0; j < lights.size(); ++j) {
-      LightSample ls;
-      const float u1 = rng->Uniform(), u2 = rng->Uniform();
-      if (!lights.Sample(j, x, u1, u2, &ls)) continue;
-      const float vis = FogVisibility(j, x, ls.wi, ls.distance);
-      if (!(vis > 0)) continue;
-      const float cos_t = wo.dot(ls.wi);
-      Eigen::Vector3f ph = Eigen::Vector3f::Zero();
-      for (int i = 0; i < nm && i < kMaxMedia; ++i) {
-        const AnalyticMedium& m = media.analytic()[i];
-        if (!Inside(m, x)) continue;
-        ph += m.sigma_s * (m.Density(x.z()) * HenyeyGreenstein(cos_t, m.g));
-      }
-      Ls += ls.E.cwiseProduct(ph) * vis;
-    }
-    const Eigen::Vector3f T_cam = Exp(-media.AnalyticOpticalDepth(o, d, 0, static_cast<float>(t)))
-                                      .cwiseProduct(grid_T(static_cast<float>(t)));
-    out.L_add += T_cam.cwiseProduct(Ls) * static_cast<float>(1.0 / (pdf * kFogLightSamples));
-  }
+  // light in-scatter from the froxel columns.
+  if (!fog_froxels_.S.empty()) out.L_add += LookupFogFroxels(u, v, t_end);
   return out;
 }
 

@@ -3,30 +3,42 @@
 // per-frame precomputed light volumes instead of shadow rays per step.
 //
 // per frame (Build):
-//  - every grid medium gets a coarse light volume (at most kGridLightRes^3 cells on its box):
-//    per light j the transmittance T_j through the grid from the cell centre to the light
-//    (midpoint-rule march of the full-resolution density, one step per coarse cell), and an
-//    isotropic in-scatter source S = sum_j E_j V_j T_j Th_j / (4 pi) + L_sky, with V_j one
-//    shadow ray per cell and light and Th_j the homogeneous media's transmittance to the
-//    light. the grid's own phase function is treated as isotropic in this tier.
-//  - homogeneous media get a world-aligned visibility volume (at most kFogCells cells) over
-//    the scene's bounding box (SceneDescription::center_W, extent_m) clipped to the media
-//    boxes: per light V_j Th_j T_grid,j (channel mean). beyond it lights are unshadowed.
+//  - every grid medium gets a coarse light volume (about kGridLightCells cells on its box, at
+//    most the grid's resolution): per light j the transmittance T_j through the grid from the
+//    cell centre to the light (midpoint-rule march of the full-resolution density, at most
+//    kGridLightSteps steps), and an isotropic in-scatter source S = sum_j E_j V_j T_j Th_j /
+//    (4 pi) + L_sky, with V_j one shadow ray per cell and light and Th_j the homogeneous
+//    media's transmittance to the light. the grid's phase function is isotropic in this tier.
+//  - a world light volume (kLightVolumeCells cells) over the scene's bounding box
+//    (SceneDescription::center_W, extent_m; clipped to the media boxes when every homogeneous
+//    medium is boxed) stores per light the channel-mean transmittance Th T_grid to the light,
+//    and with homogeneous media also V Th T_grid (one shadow ray per cell and light). outside
+//    it lights are unshadowed in media and transmittances are computed exactly.
+//    nothing is cached between frames (moving bodies would make frames depend on history).
 // per camera ray (IntegrateView), over [0, t_end] (t_end = surface distance or +inf):
 //  - homogeneous media: closed-form transmittance (media_scene.h); the sky in-scatter
 //    albedo (1 - T) L_sky in closed form, with L_sky the sphere-average sky radiance treated
 //    as an isotropic source that reaches every point of the medium unoccluded and
 //    unattenuated (Koschmieder's setting; the sky is not shadowed by walls in this tier);
-//    light in-scatter from kFogLightSamples stratified distances drawn in proportion to
-//    sigma_t T (one lobe of a one-sample mixture per medium), each summing over the lights
-//    p_HG(theta) E_j times the visibility volume.
-//  - grid media: the ray's overlap with the box is marched in at most kMaxGridSteps jittered
-//    steps (step >= one coarse cell); each step adds T (sigma_s S + emission) (1 - e^-x) /
-//    sigma_t with exact per-step transmittance e^-x, x = sigma_t ds.
-//  - homogeneous in-scatter behind a grid is attenuated by the grid's full transmittance,
-//    grid in-scatter by the homogeneous transmittance at the middle of the grid overlap.
-// surfaces: each light's contribution is multiplied by LightTransmittance (closed form for
-// the homogeneous media, the light volume looked up at the shadow ray's entry into a grid).
+//    light in-scatter from a second, coarser froxel volume (one column per kFogFroxelBlock^2
+//    pixels, kFogFroxelSlices slices spaced exponentially from kFogFroxelNear to where the
+//    media's transmittance falls to 1 %, jittered per column from the centre pixel stream 3):
+//    per slice sum_j p_HG(theta) E_j times the visibility volume, times the transmittance
+//    from the camera (media and grids), accumulated and looked up like the grid froxels.
+//  - grid media: a camera-aligned froxel volume (Wronski, "Volumetric fog", SIGGRAPH 2014;
+//    Hillaire, "Physically based and unified volumetric rendering in Frostbite", SIGGRAPH
+//    2015), built per frame: one column ray per kFroxelBlock x kFroxelBlock pixels, marched
+//    in kFroxelSlices slices (midpoints jittered per column from the column's centre pixel
+//    stream 2) over the column's overlap with the grid boxes; each slice adds T (sigma_s S Th +
+//    emission Th) (1 - e^-x) / sigma_t with exact per-slice transmittance e^-x, x = sigma_t
+//    ds, Th the homogeneous media's transmittance from the camera, and the accumulated
+//    in-scatter and transmittance are stored at every slice boundary. a pixel looks them up
+//    at its own distance (linear between slice boundaries, bilinear between columns).
+//  - homogeneous in-scatter behind a grid is attenuated by the grid's transmittance.
+// every camera segment starts at the camera (particle compositing uses two of them).
+// surfaces: each light's contribution is multiplied by LightTransmittance (the world light
+// volume; outside it: closed form for the homogeneous media times the grid's light volume at
+// the shadow ray's entry into the grid box).
 // random numbers: the caller's Rng (the pixel's stream), deterministic per pixel.
 
 #include <Eigen/Core>
@@ -34,20 +46,29 @@
 
 #include "penumbra/core/rng.h"
 #include "penumbra/core/thread_pool.h"
+#include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/ray_scene.h"
 
 namespace penumbra {
 
-/// largest light-volume resolution per axis of a grid medium.
-constexpr int kGridLightRes = 24;
-/// most cells of the homogeneous media's visibility volume.
-constexpr int kFogCells = 12288;
-/// most march steps through one grid box per camera ray.
-constexpr int kMaxGridSteps = 24;
-/// in-scatter samples per camera ray for the homogeneous media.
-constexpr int kFogLightSamples = 2;
+/// cells of a grid medium's light volume (at most the grid's own resolution per axis).
+constexpr int kGridLightCells = 2048;
+/// most march steps from a light-volume cell to a light through its grid.
+constexpr int kGridLightSteps = 16;
+/// cells of the world light volume.
+constexpr int kLightVolumeCells = 4096;
+/// pixels per side of the square pixel block of one froxel column.
+constexpr int kFroxelBlock = 8;
+/// depth slices of a froxel column.
+constexpr int kFroxelSlices = 32;
+/// pixels per side of the block of one light in-scatter column of the homogeneous media.
+constexpr int kFogFroxelBlock = 16;
+/// slices of a light in-scatter column of the homogeneous media.
+constexpr int kFogFroxelSlices = 48;
+/// distance (m) of the first exponentially spaced slice boundary.
+constexpr float kFogFroxelNear = 0.25f;
 /// lights with light volumes; further lights are unshadowed in media and unattenuated by grids.
 constexpr int kMaxVolumeLights = 16;
 
@@ -63,18 +84,20 @@ class RealtimeMedia {
   /// precomputes the light volumes of `media` (which must outlive this object until the next
   /// Build) for the posed `lights`; `sky_ambient` is the sphere-average sky radiance (cd/m^2).
   /// shadow rays go through `scene`; the cells are spread over `pool` (may be null).
+  /// the froxel volume is built for `camera`; `frame_key` is FrameContext::FrameKey().
   void Build(const MediaScene& media, const LightSampler& lights, const RayScene& scene,
-             const Eigen::Vector3f& bounds_center_W, double bounds_extent_m,
-             const Eigen::Vector3f& sky_ambient, ThreadPool* pool);
+             const Camera& camera, uint64_t frame_key, const Eigen::Vector3f& bounds_center_W,
+             double bounds_extent_m, const Eigen::Vector3f& sky_ambient, ThreadPool* pool);
 
   /// rgb transmittance from p_W towards light j (unit direction wi, distance dist, +inf for
   /// directional lights) through every medium.
   Eigen::Vector3f LightTransmittance(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                      float dist) const;
 
-  /// single scattering along the camera ray o + t d (d unit), t in [0, t_end].
+  /// single scattering along the camera ray o + t d (d unit, o the camera centre) of pixel
+  /// (u, v), t in [0, t_end].
   MediaSegment IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                             const Eigen::Vector3f& d, float t_end, Rng* rng) const;
+                             const Eigen::Vector3f& d, float t_end, int u, int v, Rng* rng) const;
 
   const MediaScene* media() const { return media_; }
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
@@ -87,12 +110,37 @@ class RealtimeMedia {
     std::vector<float> T;                 // [light][cell] grid transmittance to the light
     std::vector<Eigen::Vector3f> source;  // [cell] isotropic in-scatter source, cd/m^2
   };
-  struct FogVolume {
+  struct LightVolume {
     bool active = false;
+    bool with_visibility = false;  // vis is filled (homogeneous media present)
     Eigen::Vector3f lo{0, 0, 0}, hi{0, 0, 0}, cells_per_m{1, 1, 1};
     int r[3] = {1, 1, 1};
-    std::vector<float> vis;  // [light][cell] V Th Tgrid (channel mean)
+    std::vector<float> trans;  // [light][cell] Th Tgrid (channel mean)
+    std::vector<float> vis;    // [light][cell] V Th Tgrid
   };
+  struct FroxelRecord {
+    Eigen::Vector3f S, T;  // in-scatter and transmittance from the camera to a slice boundary
+  };
+  struct Froxels {
+    int nx = 0, ny = 0;
+    std::vector<float> t0, t1;          // [column] overlap of the column ray with the grids
+    std::vector<FroxelRecord> records;  // [column][slice boundary 0..kFroxelSlices]
+  };
+  /// grid in-scatter and transmittance from the camera to distance t for pixel (u, v);
+  /// writes the smallest column entry distance to *t_enter.
+  FroxelRecord LookupFroxels(int u, int v, float t, float* t_enter) const;
+  struct FogFroxels {
+    int nx = 0, ny = 0;
+    std::vector<float> t_far;        // [column] last slice boundary, m
+    std::vector<Eigen::Vector3f> S;  // [column][slice boundary 0..kFogFroxelSlices]
+  };
+  /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v).
+  Eigen::Vector3f LookupFogFroxels(int u, int v, float t) const;
+  void BuildFogFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
+                       ThreadPool* pool);
+  void BuildFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
+                    ThreadPool* pool);
+
   float GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                    float dist) const;
   float FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -102,7 +150,9 @@ class RealtimeMedia {
   Eigen::Vector3f sky_ambient_{0, 0, 0};
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;
-  FogVolume fog_;
+  LightVolume vol_;
+  Froxels froxels_;
+  FogFroxels fog_froxels_;
 };
 
 }  // namespace penumbra

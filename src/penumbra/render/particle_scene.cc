@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -23,11 +24,15 @@ struct ParticleScene::Impl {
 ParticleScene::ParticleScene() : impl_(std::make_unique<Impl>()) {}
 ParticleScene::~ParticleScene() = default;
 
-void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec) {
+void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
+                          bool pixel_hits) {
   fx_ = fx;
   count_ = 0;
   alpha_.clear();
   set_.clear();
+  ends_.clear();
+  pixel_t_.clear();
+  pixel_prim_.clear();
   if (impl_->scene) {
     rtcReleaseScene(impl_->scene);
     impl_->scene = nullptr;
@@ -51,22 +56,12 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     }
   }
   if (total == 0) return;
-  if (!impl_->device) {
-    impl_->device = rtcNewDevice(nullptr);
-    if (!impl_->device) throw Error("ParticleScene: cannot create the Embree device");
-  }
   const float T = static_cast<float>(std::max(0.0, exposure_time_sec));
   const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
   const float fx_px = static_cast<float>(camera.intrinsics().fx);
-
-  RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-  auto* verts = static_cast<float*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * total));
-  auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), total));
   alpha_.reserve(total);
   set_.reserve(total);
-  size_t n = 0;
+  ends_.reserve(2 * total);
   for (size_t s = 0; s < fx->particles.size(); ++s) {
     const ParticleSet& ps = fx->particles[s];
     for (size_t i = 0; i < ps.position_W.size(); ++i) {
@@ -84,15 +79,31 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
       const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
       const float dist = (p + w * seg - cam_o).norm();
       const float r_wide = std::max(r, 0.5f * dist / fx_px);
-      const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
-      float* vp = verts + 8 * n;
-      vp[0] = p.x(), vp[1] = p.y(), vp[2] = p.z(), vp[3] = r_wide;
-      vp[4] = q.x(), vp[5] = q.y(), vp[6] = q.z(), vp[7] = r_wide;
-      index[n] = static_cast<unsigned>(2 * n);
-      alpha_.push_back(alpha);
+      alpha_.push_back(std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide));
       set_.push_back(static_cast<int>(s));
-      ++n;
+      ends_.push_back(Eigen::Vector4f(p.x(), p.y(), p.z(), r_wide));
+      ends_.push_back(Eigen::Vector4f(q.x(), q.y(), q.z(), r_wide));
     }
+  }
+  count_ = static_cast<int>(alpha_.size());
+  if (count_ == 0) return;
+  if (pixel_hits) {
+    BuildPixelHits(camera);
+    return;
+  }
+  if (!impl_->device) {
+    impl_->device = rtcNewDevice(nullptr);
+    if (!impl_->device) throw Error("ParticleScene: cannot create the Embree device");
+  }
+  RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+  auto* verts = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * count_));
+  auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), count_));
+  for (int n = 0; n < count_; ++n) {
+    for (int e = 0; e < 2; ++e)
+      for (int k = 0; k < 4; ++k) verts[8 * n + 4 * e + k] = ends_[2 * n + e][k];
+    index[n] = static_cast<unsigned>(2 * n);
   }
   rtcCommitGeometry(geom);
   impl_->scene = rtcNewScene(impl_->device);
@@ -100,7 +111,105 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   rtcAttachGeometry(impl_->scene, geom);
   rtcReleaseGeometry(geom);
   rtcCommitScene(impl_->scene);
-  count_ = static_cast<int>(n);
+}
+
+namespace {
+
+// nearest t > 0 where the ray o + t d (d unit) meets the capsule around [a, b] of radius r, or
+// -1 (Quilez, "Capsule - intersection", 2014: cylinder body, then the nearer end sphere).
+float IntersectCapsule(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Eigen::Vector3f& a,
+                       const Eigen::Vector3f& b, float r) {
+  const Eigen::Vector3f ba = b - a, oa = o - a;
+  const float baba = ba.dot(ba), bard = ba.dot(d), baoa = ba.dot(oa), rdoa = d.dot(oa),
+              oaoa = oa.dot(oa);
+  const float qa = baba - bard * bard;
+  const float qb = baba * rdoa - baoa * bard;
+  const float qc = baba * oaoa - baoa * baoa - r * r * baba;
+  float h = qb * qb - qa * qc;
+  float y;
+  if (qa > 1e-12f) {
+    if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
+    const float t = (-qb - std::sqrt(h)) / qa;
+    y = baoa + t * bard;
+    if (y > 0 && y < baba) return t > 0 ? t : -1.0f;
+  } else {
+    y = bard > 0 ? -1.0f : baba + 1.0f;  // along the axis: the nearer end
+  }
+  const Eigen::Vector3f oc = y <= 0 ? oa : Eigen::Vector3f(o - b);
+  const float sb = d.dot(oc), sc = oc.dot(oc) - r * r;
+  h = sb * sb - sc;
+  if (h <= 0) return -1.0f;
+  const float t = -sb - std::sqrt(h);
+  return t > 0 ? t : -1.0f;
+}
+
+}  // namespace
+
+void ParticleScene::BuildPixelHits(const Camera& camera) {
+  const int W = camera.width(), H = camera.height();
+  pixel_w_ = W;
+  pixel_t_.assign(static_cast<size_t>(W) * H, std::numeric_limits<float>::infinity());
+  pixel_prim_.assign(static_cast<size_t>(W) * H, -1);
+  const CameraIntrinsics& k = camera.intrinsics();
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+  constexpr float kNear = 0.01f;
+  for (int n = 0; n < count_; ++n) {
+    const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
+    const float r = ends_[2 * n].w();
+    // the segment in the optical frame, clipped to z >= kNear + r.
+    Eigen::Vector3f ao = R_OW * a + p_OW, bo = R_OW * b + p_OW;
+    const float zmin = kNear + r;
+    if (ao.z() < zmin && bo.z() < zmin) continue;
+    if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
+    if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
+    // pixel box of the projected capsule (pinhole; a margin of 2 px for lens distortion).
+    const float z_near = std::min(ao.z(), bo.z()) - r;
+    const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 2.0f;
+    const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
+    const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
+    const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
+    const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
+    const int u0 = std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp)));
+    const int u1 = std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp)));
+    const int v0 = std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp)));
+    const int v1 = std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp)));
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+        const float len = ray.d.norm();
+        const float t = IntersectCapsule(ray.o, ray.d / len, a, b, r);
+        if (!(t > 0)) continue;
+        const size_t at = static_cast<size_t>(v) * W + u;
+        const float t_ray = t / len;
+        if (t_ray < pixel_t_[at]) {
+          pixel_t_[at] = t_ray;
+          pixel_prim_[at] = n;
+        }
+      }
+  }
+}
+
+bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const {
+  if (pixel_prim_.empty()) return false;
+  const size_t at = static_cast<size_t>(v) * pixel_w_ + u;
+  const int n = pixel_prim_[at];
+  if (n < 0 || !(pixel_t_[at] <= tmax)) return false;
+  hit->t = pixel_t_[at];
+  const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
+  const Eigen::Vector3f p = ray.o + hit->t * ray.d;
+  const Eigen::Vector3f ba = b - a;
+  const float w = std::clamp((p - a).dot(ba) / std::max(ba.squaredNorm(), 1e-20f), 0.0f, 1.0f);
+  Eigen::Vector3f nrm = p - (a + w * ba);
+  const float nn = nrm.norm();
+  nrm = nn > 0 ? Eigen::Vector3f(nrm / nn) : Eigen::Vector3f(-ray.d.normalized());
+  if (nrm.dot(ray.d) > 0) nrm = -nrm;
+  hit->ng_W = nrm;
+  hit->alpha = alpha_[n];
+  hit->set = set_[n];
+  hit->kind = fx_->particles[hit->set].kind;
+  return true;
 }
 
 bool ParticleScene::Intersect(const Ray& ray, float tmax, ParticleHit* hit) const {

@@ -2,9 +2,13 @@
 // particles (EffectsFrame::particles) as motion streaks seen by one camera exposure.
 //
 // geometry: a particle of radius r moving at v during the exposure time T sweeps the capsule
-// around the segment p + [0, T] v; every particle of the frame is one Embree round linear
-// curve (a capsule: cone segment with spherical ends) in this class's own RTCScene, built per
-// frame (BVH over all streaks) and intersected by camera rays alongside the main scene.
+// around the segment p + [0, T] v. for the pathtraced tier (jittered camera rays) every
+// particle of the frame is one Embree round linear curve (a capsule: cone segment with
+// spherical ends) in this class's own RTCScene, built per frame (BVH over all streaks). for the
+// realtime tier (pixel-centre camera rays) the streaks are splatted instead: each capsule's
+// projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
+// (Quilez's ray-capsule test), keeping the nearest streak per pixel (ties: lower index), which
+// costs the streaks' screen area rather than a BVH traversal per pixel.
 // streaks thinner than half a pixel at their distance are widened to half a pixel (radius
 // 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel drops keep
 // their average contribution instead of aliasing away with one ray per pixel.
@@ -55,12 +59,20 @@ class ParticleScene {
   /// exposure_time_sec (>= 0). the frame must outlive this object until the next Build.
   /// @throws ConfigError if a set's arrays differ in length or hold non-finite values
   /// (key effects.particles[i]).
-  void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec);
+  /// pixel_hits: build the per-pixel nearest streaks of the camera's pixel-centre rays
+  /// (PixelHit) instead of the Embree scene (Intersect).
+  void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
+             bool pixel_hits);
 
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
 
-  /// nearest streak along `ray` within [ray.tmin, tmax]; false if none.
+  /// the nearest streak of the pixel-centre camera ray `ray` of pixel (u, v) within (0, tmax]
+  /// (Build with pixel_hits); false if none.
+  bool PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const;
+
+  /// nearest streak along `ray` within [ray.tmin, tmax] (Build without pixel_hits); false if
+  /// none.
   bool Intersect(const Ray& ray, float tmax, ParticleHit* hit) const;
 
   /// radiance (cd/m^2) of the streak at `hit`, point p_W, seen from direction wo (unit,
@@ -73,8 +85,14 @@ class ParticleScene {
   std::unique_ptr<Impl> impl_;
   const EffectsFrame* fx_ = nullptr;
   int count_ = 0;
-  std::vector<float> alpha_;  // per primitive
-  std::vector<int> set_;      // per primitive
+  std::vector<float> alpha_;           // per primitive
+  std::vector<int> set_;               // per primitive
+  std::vector<Eigen::Vector4f> ends_;  // per primitive: both ends (x, y, z, widened radius)
+  int pixel_w_ = 0;
+  std::vector<float> pixel_t_;   // per pixel: nearest streak t (ray units), +inf none
+  std::vector<int> pixel_prim_;  // per pixel: its primitive, -1 none
+
+  void BuildPixelHits(const Camera& camera);
 };
 
 }  // namespace penumbra

@@ -38,11 +38,12 @@ struct Scratch {
 };
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
-// the nearest particle streak alpha-composited over it, both attenuated and in-scattered by
-// the media along the ray (render/media_realtime.h, render/particle_scene.h). random numbers
+// the media along the ray attenuate and add to it, and the nearest particle streak is
+// alpha-composited over it (render/media_realtime.h, render/particle_scene.h). random numbers
 // from the pixel's stream 1 (stream 0 holds the light samples).
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
-                                 uint64_t frame_key, uint64_t pixel, Eigen::Vector3f L) {
+                                 int u, int v, uint64_t frame_key, uint64_t pixel,
+                                 Eigen::Vector3f L) {
   const MediaFrame& fx = *ctx.effects;
   const RealtimeMedia* rm = fx.realtime_media();
   const ParticleScene* parts = fx.particles();
@@ -52,25 +53,21 @@ Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool h
   const Eigen::Vector3f d = ray.d / d_len;
   const float inf = std::numeric_limits<float>::infinity();
   const float t_end = hit ? t_hit * d_len : inf;
+  if (rm != nullptr) {
+    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, u, v, &rng);
+    L = seg.T.cwiseProduct(L) + seg.L_add;
+  }
   ParticleHit ph;
-  if (parts != nullptr && parts->Intersect(ray, hit ? t_hit : inf, &ph)) {
+  if (parts != nullptr && parts->PixelHit(ray, u, v, hit ? t_hit : inf, &ph)) {
+    // the streak over what lies behind it: alpha (media to the streak, then the streak) +
+    // (1 - alpha) (media to the end, then the surface); equal to compositing at the streak.
     const float t_p = ph.t * d_len;
-    const Eigen::Vector3f p = ray.o + t_p * d;
-    const Eigen::Vector3f Lp = parts->Shade(ph, p, *ctx.lights, fx.sky_ambient());
+    Eigen::Vector3f Lp = parts->Shade(ph, ray.o + t_p * d, *ctx.lights, fx.sky_ambient());
     if (rm != nullptr) {
-      const MediaSegment behind = rm->IntegrateView(*ctx.lights, p, d, t_end - t_p, &rng);
-      L = behind.T.cwiseProduct(L) + behind.L_add;
+      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v, &rng);
+      Lp = front.T.cwiseProduct(Lp) + front.L_add;
     }
     L = ph.alpha * Lp + (1.0f - ph.alpha) * L;
-    if (rm != nullptr) {
-      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, &rng);
-      L = front.T.cwiseProduct(L) + front.L_add;
-    }
-    return L;
-  }
-  if (rm != nullptr) {
-    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, &rng);
-    L = seg.T.cwiseProduct(L) + seg.L_add;
   }
   return L;
 }
@@ -101,7 +98,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       float* Lp = out.radiance->at(u, v);
       const Eigen::Vector3f Ls = hit[k] ? L.Lane(k) : Eigen::Vector3f(Lp[0], Lp[1], Lp[2]);
       const Eigen::Vector3f Lf =
-          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, frame_key,
+          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, u, v, frame_key,
                            static_cast<uint64_t>(v) * width + u, Ls);
       Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
     }
