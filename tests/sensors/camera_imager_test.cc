@@ -242,6 +242,36 @@ TEST(CameraImagerTest, NoiseJpegAndDropletsAreSeededAndLocal) {
   EXPECT_EQ(capture(drops, dry, 0).data, base.data);
 }
 
+TEST(CameraImagerTest, ThreadCountDoesNotChangeTheImages) {
+  SceneDescription scene = BlackScene();
+  scene.sky.radiance = Eigen::Vector3f(0.2f, 0.1f, 0.05f);
+  const int m =
+      AddMaterial(&scene, Eigen::Vector3f(0.5f, 0.5f, 0.5f), Eigen::Vector3f(0.3f, 0.2f, 0.1f));
+  AddGeom(&scene, GeomShape::kSphere, Eigen::Vector3d(0.8, 0, 0), Eigen::Vector3d(3, 0, 0), m);
+  CameraSensorConfig cfg;
+  cfg.noise.enabled = true;
+  cfg.motion_blur_samples = 3;
+  cfg.rolling_shutter_line_time_sec = 1e-4;
+  cfg.depth_noise.preset = "kinect_v2";
+  CameraSpec spec = Spec(64, 48, 50);
+  spec.outputs.depth = true;
+  const Pose X0 = LookingAlongX(Eigen::Vector3d::Zero());
+  const Pose X1 = LookingAlongX(Eigen::Vector3d(0, -0.05, 0.01));
+  auto run = [&](int threads) {
+    RenderSettings rs = Realtime();
+    rs.threads = threads;
+    auto renderer = MakeEmbreeRenderer(scene, rs);
+    CameraImager imager(spec, cfg, rs, 2, scene);
+    const WorldSnapshot a = Snapshot(scene, 0), b = Snapshot(scene, 0.02);
+    CameraImages im;
+    imager.Capture(renderer.get(), a, X0, &b, X1, 4, &im);
+    return im;
+  };
+  const CameraImages one = run(1), two = run(2);
+  EXPECT_EQ(one.rgb.data, two.rgb.data);
+  EXPECT_EQ(one.depth_m.data, two.depth_m.data);
+}
+
 TEST(CameraImagerTest, BadSettingsNameCameraAndKey) {
   CameraSensorConfig cfg;
   cfg.exposure_time_sec = -1;

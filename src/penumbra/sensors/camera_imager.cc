@@ -93,6 +93,8 @@ CameraImager::CameraImager(const CameraSpec& spec, const CameraSensorConfig& con
   ValidateCameraSensorOrThrow(config, key);
   if (!config.depth_noise.preset.empty())
     depth_model_ = DepthNoisePreset(config.depth_noise, key + ".depth_noise");
+  if (config.noise.enabled || depth_model_ || config.motion_blur_samples > 1)
+    pool_ = std::make_unique<ThreadPool>(render_settings.threads);
 }
 
 void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const Pose& X_WO_start,
@@ -158,7 +160,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     for (float& v : accum_.data) v /= static_cast<float>(n);
     out->radiance = accum_;
     // exposure with adaptation over sim time
-    double ev = film_.Ev100(accum_, nullptr);
+    double ev = film_.Ev100(accum_, pool_.get());
     if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
       const double dt = std::max(0.0, start.time_sec - *last_time_);
       ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
@@ -172,14 +174,14 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
         exposed_ = ImageF(W, H, 3);
       for (size_t i = 0; i < accum_.data.size(); ++i) exposed_.data[i] = accum_.data[i] * h;
       ApplyImageNoise(exposed_, c.noise, HashKeys(settings_.seed, camera_index_, frame_index, 1),
-                      &dn_);
+                      &dn_, pool_.get());
       const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
       for (float& v : dn_.data) v *= inv_max;
-      film_.Develop(dn_, -std::log2(1.2), nullptr, &out->rgb);  // exposure H = 1
+      film_.Develop(dn_, -std::log2(1.2), pool_.get(), &out->rgb);  // exposure H = 1
     } else if (n == 1 && ev == out->truth.ev100 && !out->truth.rgb.empty()) {
       out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV
     } else {
-      film_.Develop(accum_, ev, nullptr, &out->rgb);
+      film_.Develop(accum_, ev, pool_.get(), &out->rgb);
     }
     if (c.lens_droplets && IsRaining(start.effects.get()))
       ApplyLensDroplets(c.lens_droplet_count, start.time_sec,
@@ -226,13 +228,14 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
         m.time_sec = (truth_k + 0.5) * T / n;
         m.line_time_sec = c.rolling_shutter_line_time_sec;
       }
-      transmittance = DepthTransmittance(out->truth.depth_m,
-                                         Camera(X_WO_start, spec_.intrinsics, m), *start.effects,
-                                         HashKeys(settings_.seed, camera_index_, frame_index, 4));
+      transmittance = DepthTransmittance(
+          out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *start.effects,
+          HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
       in.transmittance = &transmittance;
     }
     ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,
-                    HashKeys(settings_.seed, camera_index_, frame_index, 2), &out->depth_m);
+                    HashKeys(settings_.seed, camera_index_, frame_index, 2), &out->depth_m,
+                    pool_.get());
   } else {
     out->depth_m = out->truth.depth_m;
   }

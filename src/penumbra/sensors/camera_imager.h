@@ -23,12 +23,14 @@
 // model (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "penumbra/core/image.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/sensors/camera_sensor_config.h"
@@ -86,6 +88,7 @@ class CameraImager {
   const SceneDescription& scene_;
   std::optional<DepthNoiseModel> depth_model_;
   std::optional<double> last_ev_, last_time_;
+  std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;
 };
 

@@ -18,6 +18,16 @@ double AngleTerm(double theta) {
   return theta * theta / (d * d);
 }
 
+// fn(v) for every row v, over `pool` when given.
+template <typename Fn>
+void ForRows(int rows, ThreadPool* pool, const Fn& fn) {
+  if (pool) {
+    pool->ParallelFor(rows, [&](int64_t v) { fn(static_cast<int>(v)); });
+  } else {
+    for (int v = 0; v < rows; ++v) fn(v);
+  }
+}
+
 }  // namespace
 
 double DepthNoiseModel::AxialSigma(double z, double theta, double fx_px) const {
@@ -74,11 +84,11 @@ DepthNoiseModel DepthNoisePreset(const DepthNoiseConfig& config, const std::stri
 }
 
 void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
-                     const DepthNoiseModel& model, uint64_t key, ImageF* out) {
+                     const DepthNoiseModel& model, uint64_t key, ImageF* out, ThreadPool* pool) {
   const int W = depth_z.width, H = depth_z.height;
   *out = ImageF(W, H, 1);
   const double cos_max = std::cos(model.max_incidence_deg * M_PI / 180.0);
-  for (int v = 0; v < H; ++v) {
+  ForRows(H, pool, [&](int v) {
     for (int u = 0; u < W; ++u) {
       Rng rng(HashKeys(key, static_cast<uint64_t>(v) * static_cast<uint64_t>(W) + u));
       // incidence angle from the normal and the pixel ray (x, y, 1)
@@ -116,7 +126,7 @@ void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
       }
       o = static_cast<float>(z + model.AxialSigma(z, theta, in.fx) * axial_n);
     }
-  }
+  });
 }
 
 double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vector3d& a_W,
@@ -152,13 +162,13 @@ double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vec
 }
 
 ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const EffectsFrame& effects,
-                          uint64_t key) {
+                          uint64_t key, ThreadPool* pool) {
   ImageF t(depth_z.width, depth_z.height, 1, 1.0f);
   if (effects.homogeneous_media.empty() && effects.grid_media.empty()) return t;
   MediaScene media;
   media.Build(&effects);
   if (media.empty()) return t;
-  for (int v = 0; v < depth_z.height; ++v) {
+  ForRows(depth_z.height, pool, [&](int v) {
     for (int u = 0; u < depth_z.width; ++u) {
       const double z = *depth_z.at(u, v);
       if (!(z > 0)) continue;
@@ -169,7 +179,7 @@ ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const Eff
           media.Transmittance(r.o, r.d / len, 0.0f, static_cast<float>(z) * len, &rng);
       *t.at(u, v) = std::clamp(tr.mean(), 0.0f, 1.0f);
     }
-  }
+  });
   return t;
 }
 

@@ -39,6 +39,7 @@
 #include <string>
 
 #include "penumbra/core/image.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/sensors/camera_sensor_config.h"
@@ -83,9 +84,11 @@ struct DepthNoiseInputs {
 };
 
 /// applies `model` to `depth_z` ((H x W x 1) z-depth in m, 0 = no hit) into `out` (same shape,
-/// 0 = no return). `key` seeds the noise (e.g. HashKeys(seed, camera, frame)).
+/// 0 = no return). `key` seeds the noise (e.g. HashKeys(seed, camera, frame)); rows are spread
+/// over `pool` when given (results do not depend on it).
 void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
-                     const DepthNoiseModel& model, uint64_t key, ImageF* out);
+                     const DepthNoiseModel& model, uint64_t key, ImageF* out,
+                     ThreadPool* pool = nullptr);
 
 /// optical depth tau = integral of sigma_t along the segment a_W -> b_W through one homogeneous
 /// medium (channel mean of sigma_t_per_m; near-infrared sensors see roughly grey fog), clipped
@@ -100,6 +103,6 @@ double HomogeneousOpticalDepth(const HomogeneousMedium& medium, const Eigen::Vec
 /// pixel))); channel mean (near-infrared sensors see roughly grey media). the pixel ray comes
 /// from `camera` (distortion and rolling shutter aware).
 ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const EffectsFrame& effects,
-                          uint64_t key);
+                          uint64_t key, ThreadPool* pool = nullptr);
 
 }  // namespace penumbra

@@ -67,24 +67,32 @@ double GainDnPerElectron(const ImageNoiseConfig& c) {
   return (std::ldexp(1.0, c.adc_bits) - 1.0) / c.full_well_e * c.iso / c.base_iso;
 }
 
-void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t key, ImageF* dn) {
+void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t key, ImageF* dn,
+                     ThreadPool* pool) {
   if (dn->width != exposed.width || dn->height != exposed.height ||
       dn->channels != exposed.channels)
     *dn = ImageF(exposed.width, exposed.height, exposed.channels);
   const double gain = GainDnPerElectron(c);
   const double max_dn = std::ldexp(1.0, c.adc_bits) - 1.0;
   const double e_per_x = c.full_well_e * c.base_iso / c.iso;
-  const size_t n = exposed.data.size();
-  for (size_t i = 0; i < n; ++i) {
-    const double x = std::max(0.0f, exposed.data[i]);
-    double e = std::isfinite(x) ? x * e_per_x : c.full_well_e;
-    if (c.enabled) {
-      Rng rng(HashKeys(key, static_cast<uint64_t>(i)));
-      e = static_cast<double>(SamplePoisson(std::min(e, 4.0 * c.full_well_e), &rng));
-      e += c.read_noise_e * SampleStandardNormal(&rng);
+  const size_t row = static_cast<size_t>(exposed.width) * exposed.channels;
+  auto do_row = [&](int64_t v) {
+    for (size_t i = v * row; i < (v + 1) * row; ++i) {
+      const double x = std::max(0.0f, exposed.data[i]);
+      double e = std::isfinite(x) ? x * e_per_x : c.full_well_e;
+      if (c.enabled) {
+        Rng rng(HashKeys(key, static_cast<uint64_t>(i)));
+        e = static_cast<double>(SamplePoisson(std::min(e, 4.0 * c.full_well_e), &rng));
+        e += c.read_noise_e * SampleStandardNormal(&rng);
+      }
+      e = std::clamp(e, 0.0, c.full_well_e);
+      dn->data[i] = static_cast<float>(std::min(max_dn, std::round(e * gain)));
     }
-    e = std::clamp(e, 0.0, c.full_well_e);
-    dn->data[i] = static_cast<float>(std::min(max_dn, std::round(e * gain)));
+  };
+  if (pool) {
+    pool->ParallelFor(exposed.height, do_row);
+  } else {
+    for (int v = 0; v < exposed.height; ++v) do_row(v);
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/sensors/camera_sensor_config.h"
 
 namespace penumbra {
@@ -32,6 +33,8 @@ double GainDnPerElectron(const ImageNoiseConfig& c);
 /// well at base ISO) and writes `dn` ((H x W x C) float holding integer DN in
 /// [0, 2^adc_bits - 1]). `key` seeds the noise (e.g. HashKeys(seed, camera, frame)).
 /// with c.enabled == false only the gain and quantisation are applied.
-void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t key, ImageF* dn);
+/// rows are spread over `pool` when given (results do not depend on it).
+void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t key, ImageF* dn,
+                     ThreadPool* pool = nullptr);
 
 }  // namespace penumbra
