@@ -10,6 +10,8 @@
 
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
+#include "penumbra/sensors/imu_model.h"
+#include "penumbra/sensors/lidar_pattern.h"
 #include "penumbra/sensors/pcd_writer.h"
 #include "penumbra/world/world_config.h"
 
@@ -151,6 +153,46 @@ TEST_F(SensorRunTest, MissingBodyOrSiteNamesTheSensorAndKey) {
       "robots[0].sensors[0].site");
   expect_error("sensors:\n  - {name: bad, type: mujoco, sensors: [m/none]}\n",
                "sensors[0].sensors");
+}
+
+TEST_F(SensorRunTest, SameSeedSameBytesAndWorldPresetNamesMatchTheSensorModels) {
+  const std::string sensors = R"(sensors:
+  - {name: l, type: lidar, preset: ouster_os1_64, body: m/box, pose: {xyz: [0, 0, 0.5]},
+     noise: {range_stddev_m: 0.02, dropout_probability: 0.1, receiver_noise: 0.2}}
+  - {name: i, type: imu, body: m/ball, preset: consumer_mems}
+)";
+  std::string first_pcd, first_imu;
+  for (int run = 0; run < 2; ++run) {
+    const WorldConfig world = World(sensors);
+    RunOptions opt;
+    opt.out_dir = (dir_ / ("out" + std::to_string(run))).string();
+    opt.progress = false;
+    opt.duration_sec = 0.3;
+    RunWorld(world, opt);
+    std::ifstream p(fs::path(opt.out_dir) / "lidar" / "l" / "scan_000001.pcd", std::ios::binary);
+    std::ifstream i(fs::path(opt.out_dir) / "imu" / "i.csv");
+    std::stringstream ps, is;
+    ps << p.rdbuf();
+    is << i.rdbuf();
+    if (run == 0) {
+      first_pcd = ps.str();
+      first_imu = is.str();
+      EXPECT_GT(first_pcd.size(), 1000u);
+    } else {
+      EXPECT_TRUE(ps.str() == first_pcd);
+      EXPECT_TRUE(is.str() == first_imu);
+    }
+  }
+  // every preset the world file accepts builds in the sensor models
+  for (const std::string& p : LidarPresetNames()) {
+    EXPECT_NO_THROW(World("sensors:\n  - {name: x, type: lidar, preset: " + p + "}\n")) << p;
+    EXPECT_NO_THROW(MakeLidarPattern(p)) << p;
+  }
+  for (const std::string& p : ImuPresetNames()) {
+    EXPECT_NO_THROW(World("sensors:\n  - {name: x, type: imu, body: m/box, preset: " + p + "}\n"))
+        << p;
+    EXPECT_NO_THROW(ImuPreset(p)) << p;
+  }
 }
 
 }  // namespace

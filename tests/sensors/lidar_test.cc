@@ -101,6 +101,8 @@ TEST(LidarTest, NoiseFreeRangesMatchAnalyticSceneAndDetectionThreshold) {
     max_err = std::max(max_err, std::abs(Eigen::Vector3d(p.x, p.y, p.z).norm() - expected));
   }
   EXPECT_LT(max_err, 1e-3);
+  std::printf("analytic scene: %zu points, max |range error| %.3g m\n", scan.points.size(),
+              max_err);
   // detection: a beam returns iff its analytic power clears the threshold (1 % margin)
   int checked = 0;
   for (int i = 0; i < scan.rays; ++i) {
@@ -163,6 +165,8 @@ TEST(LidarTest, RingAndAzimuthOfEveryPointMatchTheAngleTable) {
       double diff = std::remainder(az - az_expected, 360.0);
       max_az = std::max(max_az, std::abs(diff));
     }
+    std::printf("%s: max elevation error %.3g deg, max azimuth error %.3g deg\n", preset.c_str(),
+                max_el, max_az);
     EXPECT_LT(max_el, 1e-3) << preset;
     EXPECT_LT(max_az, 1e-3) << preset;
   }
@@ -200,6 +204,8 @@ TEST(LidarTest, MotionDistortionShiftsLateColumnsByVelocityTimesTime) {
     if (p.time == t_last) x_last = std::max(x_last, static_cast<double>(p.x));
   }
   EXPECT_NEAR(x_first - x_last, v * t_last, 1e-3);
+  std::printf("motion: max |x - (10 - v t)| %.3g m, first-last column shift %.5f m (v t %.5f)\n",
+              max_err, x_first - x_last, v * t_last);
 }
 
 double NormalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
@@ -247,6 +253,8 @@ TEST(LidarTest, FogReturnFractionFollowsAttenuationAndReceiverNoise) {
     const double expected = NormalCdf(x);
     // binomial stddev sqrt(p (1-p) / 65536) <= 0.002; tolerance 5 sigma
     EXPECT_NEAR(fraction, expected, 0.01) << "sigma_t " << sigma;
+    std::printf("fog sigma_t %.4f 1/m at r = %.0f m: return fraction %.4f, model %.4f\n", sigma, r,
+                fraction, expected);
     EXPECT_EQ(scan.medium_returns, 0);
     for (const LidarPoint& p : scan.points)
       ASSERT_NEAR(std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z), r, 1e-3);
@@ -335,6 +343,52 @@ TEST(LidarTest, SnowflakeOnABeamReturnsAtItsSurface) {
     EXPECT_EQ(p.beam, 8);  // column 0
     EXPECT_NEAR(std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z), 3.0 - 0.01, 1e-3);
   }
+}
+
+TEST(LidarTest, ParticlesAreFoundWhileTheSensorTurnsAndMoves) {
+  // the sensor turns 90 deg and moves 0.5 m during the scan; every beam whose ray (from its own
+  // firing pose) passes through a flake must return from it
+  const SceneDescription scene = AnalyticScene(false, false, false);
+  RayScene rs(scene);
+  rs.Update(StaticSnapshot());
+  LidarConfig cfg;
+  cfg.pattern = MakeLidarPattern("velodyne_vlp16");
+  cfg.pattern.beam_divergence_rad = 0;
+  LidarScanner lidar(cfg, 1);
+  const Pose a = PoseFromXyzRpyDeg({0, 0, 1}, {0, 0, 0});
+  const Pose b = PoseFromXyzRpyDeg({0.5, 0, 1}, {0, 0, 90});
+  const SensorPoseAt pose = [&](double t) { return InterpolatePose(a, b, t / 0.1); };
+  EffectsFrame fx;
+  ParticleSet snow;
+  snow.kind = ParticleKind::kSnow;
+  for (int k = 0; k < 12; ++k) {
+    const double ang = k * 30.0 * kPi / 180;
+    snow.position_W.emplace_back(static_cast<float>(4 * std::cos(ang)),
+                                 static_cast<float>(4 * std::sin(ang)), 1.07f);
+    snow.velocity_W.emplace_back(0, 0, 0);
+    snow.radius_m.push_back(0.06f);
+  }
+  fx.particles.push_back(snow);
+  LidarScan scan;
+  lidar.Scan(rs, &fx, pose, 0, &scan);
+  int expected = 0;
+  for (int i = 0; i < scan.rays; ++i) {
+    const Pose X = pose(cfg.pattern.beams[i].time_sec);
+    float x, y, z;
+    cfg.pattern.Direction(i, &x, &y, &z);
+    const Eigen::Vector3d o = X.translation(), d = X.linear() * Eigen::Vector3d(x, y, z);
+    for (const Eigen::Vector3f& c : snow.position_W) {
+      const Eigen::Vector3d q = c.cast<double>();
+      const double tc = (q - o).dot(d);
+      if (tc > 0 && (q - o - tc * d).norm() < 0.06 - 1e-4) {
+        ++expected;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(expected, 20);
+  EXPECT_GE(scan.particle_returns, expected);
+  EXPECT_LE(scan.particle_returns, expected + 12);  // grazing beams within 0.1 mm of the rim
 }
 
 TEST(LidarTest, NoiseAndDropoutAreSeededAndStatisticallyRight) {

@@ -213,23 +213,43 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
   std::vector<int> cand_start;
   std::vector<ParticleCandidate> cands;
   if (config_.media && effects && !effects->particles.empty()) {
-    const Pose X_SW = X_WS(0.0).inverse();
-    const double pad_deg = 1.0;  // motion within the scan and the bin granularity
+    // the particle's direction in the sensor frame at 5 instants over the scan (the sensor
+    // may move and turn while scanning); the candidate bins cover all of them
+    constexpr int kKeys = 5;
+    const double period = 1.0 / pat.rate_hz;
+    Pose X_SW[kKeys];
+    for (int k = 0; k < kKeys; ++k) X_SW[k] = X_WS(period * k / (kKeys - 1)).inverse();
+    const double pad_deg = 0.25;  // float rounding and the exact beam test's margin
     for (int s = 0; s < static_cast<int>(effects->particles.size()); ++s) {
       const ParticleSet& ps = effects->particles[s];
       for (int i = 0; i < static_cast<int>(ps.position_W.size()); ++i) {
-        const Eigen::Vector3d p_S = X_SW * ps.position_W[i].cast<double>();
-        const double dist = p_S.norm();
-        if (dist < pat.min_range_m || dist > pat.max_range_m) continue;
+        const Eigen::Vector3d p_W = ps.position_W[i].cast<double>();
         const double rp = i < static_cast<int>(ps.radius_m.size()) ? ps.radius_m[i] : 0.0;
-        const double ang =
-            std::asin(std::min(1.0, (rp + dist * tan_half_div) / dist)) * 180 / kPi + pad_deg;
-        const double az = std::atan2(p_S.y(), p_S.x()) * 180 / kPi + 180;
-        const double el = std::asin(std::clamp(p_S.z() / dist, -1.0, 1.0)) * 180 / kPi + 90;
-        const int e0 = std::max(0, static_cast<int>((el - ang) / kBinDeg));
-        const int e1 = std::min(n_el_ - 1, static_cast<int>((el + ang) / kBinDeg));
-        const int a0 = static_cast<int>(std::floor((az - ang) / kBinDeg));
-        const int a1 = static_cast<int>(std::floor((az + ang) / kBinDeg));
+        double az_lo = 1e9, az_hi = -1e9, el_lo = 1e9, el_hi = -1e9, ang = 0, az_ref = 0;
+        bool in_range = false;
+        for (int k = 0; k < kKeys; ++k) {
+          const Eigen::Vector3d p_S = X_SW[k] * p_W;
+          const double dist = p_S.norm();
+          if (dist < pat.min_range_m - rp || dist > pat.max_range_m + rp || dist <= 0) continue;
+          in_range = true;
+          ang = std::max(ang,
+                         std::asin(std::min(1.0, (rp + dist * tan_half_div) / dist)) * 180 / kPi);
+          double az = std::atan2(p_S.y(), p_S.x()) * 180 / kPi + 180;
+          if (az_lo > az_hi) az_ref = az;
+          az = az_ref + std::remainder(az - az_ref, 360.0);  // unwrap around the first key
+          const double el = std::asin(std::clamp(p_S.z() / dist, -1.0, 1.0)) * 180 / kPi + 90;
+          az_lo = std::min(az_lo, az);
+          az_hi = std::max(az_hi, az);
+          el_lo = std::min(el_lo, el);
+          el_hi = std::max(el_hi, el);
+        }
+        if (!in_range) continue;
+        ang += pad_deg;
+        const int e0 = std::max(0, static_cast<int>((el_lo - ang) / kBinDeg));
+        const int e1 = std::min(n_el_ - 1, static_cast<int>((el_hi + ang) / kBinDeg));
+        const int a0 = static_cast<int>(std::floor((az_lo - ang) / kBinDeg));
+        const int a1 =
+            std::min(a0 + n_az_ - 1, static_cast<int>(std::floor((az_hi + ang) / kBinDeg)));
         for (int a = a0; a <= a1; ++a) {
           const int aw = ((a % n_az_) + n_az_) % n_az_;
           for (int e = e0; e <= e1; ++e) {
