@@ -177,5 +177,27 @@ TEST(AgentsInPhysics, AWaypointOutsideTheWorldIsAConfigError) {
   }
 }
 
+TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
+  const auto dir = std::filesystem::temp_directory_path() / "penumbra_agents_sim_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "target.xml";
+  std::ofstream(path) << R"(<mujoco model="target">
+  <worldbody>
+    <body name="target" mocap="true" pos="1 0 1"><geom type="sphere" size="0.1"/></body>
+  </worldbody>
+  <keyframe><key name="up" mpos="1 0 2" mquat="1 0 0 0"/></keyframe>
+</mujoco>)";
+  ModelConfig m;
+  m.name = "t";
+  m.file = path.string();
+  ComposedScene composed = ComposeWorld({m}, ComposeOptions{});
+  AgentConfig a = Walker();
+  a.waypoints = {{3, 1}, {4, 1}};
+  AddAgentBodies({a}, "", &composed);
+  EXPECT_NE(composed.mjcf_xml.find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.mjcf_xml;
+  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  EXPECT_EQ(sim.model_info().keys.size(), 1u);
+}
+
 }  // namespace
 }  // namespace penumbra
