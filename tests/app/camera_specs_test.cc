@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "penumbra/core/error.h"
+
 namespace penumbra {
 namespace {
 
@@ -72,6 +74,34 @@ TEST(CameraSpecsTest, StereoCameraBecomesTwoWithBaselineAlongOpticalX) {
   const std::vector<CameraSensorConfig> cfg = SensorConfigsFor(s, w);
   ASSERT_EQ(cfg.size(), 2u);
   EXPECT_EQ(cfg[1].exposure_time_sec, 0.004);
+}
+
+TEST(CameraSpecsTest, FoldingDistortionOnTheFinalIntrinsicsIsAConfigError) {
+  // an MJCF camera's fovy is known only after compilation: the check runs at assembly
+  CameraConfig c;
+  c.name = "rover/head";
+  c.k1 = -0.5;
+  CameraSpec cam;
+  cam.name = c.name;
+  cam.intrinsics = CameraIntrinsics::FromFovy(640, 480, 100);
+  try {
+    ApplyCameraConfig(c, &cam, "w.yaml", "mjcf_cameras.overrides.rover/head");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "mjcf_cameras.overrides.rover/head.distortion");
+    EXPECT_NE(std::string(e.what()).find("camera 'rover/head'"), std::string::npos);
+  }
+  cam.intrinsics = CameraIntrinsics::FromFovy(640, 480, 30);
+  ApplyCameraConfig(c, &cam, "w.yaml", "k");
+  EXPECT_EQ(cam.intrinsics.k1, -0.5);
+  // the override's sensor settings reach the MJCF camera
+  c.sensor.motion_blur_samples = 5;
+  WorldConfig w;
+  w.mjcf_cameras.overrides.push_back(c);
+  SceneDescription s;
+  cam.mjcf_camera = 0;
+  s.cameras = {cam};
+  EXPECT_EQ(SensorConfigsFor(s, w)[0].motion_blur_samples, 5);
 }
 
 }  // namespace

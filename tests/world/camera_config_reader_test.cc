@@ -109,6 +109,28 @@ TEST(CameraConfigReaderTest, BadValuesNameCameraAndKey) {
   }
 }
 
+TEST(CameraConfigReaderTest, MjcfCameraOverridesTakeSensorKeysButNotStereo) {
+  const std::string models = std::string("robots:\n  - {name: rover, file: ") +
+                             PENUMBRA_SOURCE_DIR + "/worlds/models/rover.xml}\n";
+  const WorldConfig w = ParseWorld(models +
+                                       "mjcf_cameras:\n  overrides:\n    rover/head:\n"
+                                       "      distortion: {k1: -0.1}\n"
+                                       "      motion_blur_samples: 3\n      noise: {iso: 200}\n",
+                                   "w.yaml");
+  ASSERT_EQ(w.mjcf_cameras.overrides.size(), 1u);
+  EXPECT_EQ(w.mjcf_cameras.overrides[0].k1, -0.1);
+  EXPECT_EQ(w.mjcf_cameras.overrides[0].sensor.motion_blur_samples, 3);
+  EXPECT_TRUE(w.mjcf_cameras.overrides[0].sensor.noise.enabled);
+  try {
+    ParseWorld(
+        models + "mjcf_cameras:\n  overrides:\n    rover/head:\n      stereo: {baseline_m: 0.1}\n",
+        "w.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "mjcf_cameras.overrides.rover/head.stereo");
+  }
+}
+
 TEST(CameraConfigReaderTest, BadSemanticClassesAreRejected) {
   EXPECT_THROW(ParseWorld("semantic_classes:\n  - {name: a, id: 0, bodies: [x]}\n", "w.yaml"),
                ConfigError);

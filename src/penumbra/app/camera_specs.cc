@@ -1,14 +1,27 @@
 #include "penumbra/app/camera_specs.h"
 
+#include "penumbra/core/error.h"
+#include "penumbra/render/camera_distortion.h"
+
 namespace penumbra {
 
-void AppendWorldCamera(const CameraConfig& c, CameraSpec cam, std::vector<CameraSpec>* cameras) {
-  cam.intrinsics.k1 = c.k1;
-  cam.intrinsics.k2 = c.k2;
-  cam.intrinsics.p1 = c.p1;
-  cam.intrinsics.p2 = c.p2;
-  cam.intrinsics.k3 = c.k3;
-  cam.exposure_time_sec = c.sensor.exposure_time_sec;
+void ApplyCameraConfig(const CameraConfig& c, CameraSpec* cam, const std::string& file,
+                       const std::string& key) {
+  cam->intrinsics.k1 = c.k1;
+  cam->intrinsics.k2 = c.k2;
+  cam->intrinsics.p1 = c.p1;
+  cam->intrinsics.p2 = c.p2;
+  cam->intrinsics.k3 = c.k3;
+  cam->exposure_time_sec = c.sensor.exposure_time_sec;
+  if (auto problem = FindDistortionProblem(cam->intrinsics))
+    throw ConfigError(file, 0, key + ".distortion",
+                      "camera '" + c.name + "': " + *problem +
+                          "; expected k1 k2 p1 p2 k3 that map the image one-to-one");
+}
+
+void AppendWorldCamera(const CameraConfig& c, CameraSpec cam, std::vector<CameraSpec>* cameras,
+                       const std::string& file, const std::string& key) {
+  ApplyCameraConfig(c, &cam, file, key);
   if (!c.sensor.stereo_baseline_m) {
     cameras->push_back(cam);
     return;
@@ -29,6 +42,9 @@ std::vector<CameraSensorConfig> SensorConfigsFor(const SceneDescription& scene,
   for (const CameraSpec& spec : scene.cameras) {
     CameraSensorConfig cfg;
     cfg.exposure_time_sec = spec.exposure_time_sec;
+    for (const CameraConfig& c : world.mjcf_cameras.overrides) {
+      if (spec.mjcf_camera >= 0 && spec.name == c.name) cfg = c.sensor;
+    }
     for (const CameraConfig& c : world.cameras) {
       if (spec.mjcf_camera >= 0) break;
       const bool stereo = c.sensor.stereo_baseline_m.has_value();

@@ -194,6 +194,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
     it->intrinsics = IntrinsicsFor(o, o.fovy_deg.value_or(FovyOf(it->intrinsics)));
     it->rate_hz = o.rate_hz;
     it->outputs = o.outputs;
+    ApplyCameraConfig(o, &*it, world.file, "mjcf_cameras.overrides." + o.name);
   }
   // world-file cameras
   for (size_t i = 0; i < world.cameras.size(); ++i) {
@@ -212,7 +213,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
       X_BodyOptical.linear() = RotationBodyFromOptical();
       cam.X_BO = c.pose.ToPose() * X_BodyOptical;
     }
-    AppendWorldCamera(c, cam, &cameras);
+    AppendWorldCamera(c, cam, &cameras, world.file, "cameras[" + std::to_string(i) + "]");
   }
   std::set<std::string> names;
   for (const CameraSpec& c : cameras)

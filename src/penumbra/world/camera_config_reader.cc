@@ -70,8 +70,11 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
     const char* name[] = {"k1", "k2", "p1", "p2", "k3"};
     for (int i = 0; i < 5; ++i)
       if (d.Has(name[i])) *field[i] = d.Child(name[i]).Double();
+    // an MJCF camera override without fovy_deg / intrinsics keeps the MJCF fovy, known only
+    // after compilation: scene assembly checks it then (app/camera_specs.h)
+    const bool optics_known = c->fovy_deg || c->intrinsics;
     const CameraIntrinsics k = IntrinsicsOf(*c);
-    if (k.fx > 0 && k.fy > 0 && k.width > 0 && k.height > 0) {
+    if (optics_known && k.fx > 0 && k.fy > 0 && k.width > 0 && k.height > 0) {
       if (auto problem = FindDistortionProblem(k))
         d.Fail(Who(*c) + *problem +
                "; expected k1 k2 p1 p2 k3 that map the image one-to-one "
@@ -126,6 +129,10 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
   }
   if (r.Has("stereo")) {
     const YamlReader st = r.Child("stereo");
+    if (c->is_mjcf_override)
+      st.Fail(Who(*c) +
+              "MJCF cameras cannot be made stereo pairs; expected a world-file camera "
+              "(under cameras:) for a stereo pair");
     st.ExpectMap({"baseline_m"});
     s.stereo_baseline_m = Positive(st.Child("baseline_m"), *c, "m");
   }

@@ -27,7 +27,9 @@ namespace penumbra {
 const std::vector<std::string_view>& CameraSensorKeys();
 
 /// reads the sensor keys of camera entry `r` into `c` (after width/height/fovy/intrinsics) and
-/// checks them, including that the distortion does not fold the image.
+/// checks them, including that the distortion does not fold the image (when the field of view is
+/// known at load; MJCF camera overrides without one are checked at scene assembly). `stereo` is
+/// rejected for MJCF camera overrides.
 /// @throws ConfigError naming the file, line, key path and the camera.
 void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c);
 

@@ -315,7 +315,10 @@ class WorldParser {
     if (r.Has("outputs")) m->outputs = ReadOutputs(r.Child("outputs"));
     if (!r.Has("overrides")) return;
     for (auto& [name, o] : r.Child("overrides").Entries()) {
-      o.ExpectMap({"width", "height", "rate_hz", "outputs", "fovy_deg", "intrinsics"});
+      std::vector<std::string_view> keys = {"width",   "height",   "rate_hz",
+                                            "outputs", "fovy_deg", "intrinsics"};
+      keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());
+      o.ExpectMap(keys);
       // unset fields inherit the mjcf_cameras defaults; an unset fovy keeps the MJCF one
       CameraConfig c;
       c.name = name;
@@ -325,6 +328,7 @@ class WorldParser {
       c.rate_hz = m->rate_hz;
       c.outputs = m->outputs;
       ReadCameraOptics(o, &c);
+      ReadCameraSensorKeys(o, &c);
       m->overrides.push_back(c);
     }
   }
