@@ -229,7 +229,8 @@ SceneDescription EffectsStage::Bind(SceneDescription scene) {
   for (const AgentConfig& a : agents_) {
     const int body = scene.FindBody(AgentBodyName(a.name));
     for (Geom& g : scene.geoms)
-      if (body >= 0 && g.body == body) g.semantic_class = AgentSemanticClass(a.kind);
+      if (body >= 0 && g.body == body && g.semantic_class == 0)
+        g.semantic_class = AgentSemanticClass(a.kind);
   }
   if (!effects_.empty()) engine_ = std::make_unique<EffectsEngine>(effects_, seed_, scene);
   return scene;

@@ -64,7 +64,8 @@ class EffectsStage {
   /// drives every agent's mocap body from its path (Simulation::AddMocapDriver).
   void Attach(Simulation* sim) const;
 
-  /// `scene` with every agent geom labelled with its semantic class; builds the effects
+  /// `scene` with every agent geom that has no class yet (a world-file `semantic_classes`
+  /// entry wins) labelled with its agent class (effects/agent_path.h); builds the effects
   /// engine on it. call once, before Evaluate.
   /// @throws ConfigError from the EffectsEngine (unknown light or body names, bad .vdb).
   SceneDescription Bind(SceneDescription scene);
