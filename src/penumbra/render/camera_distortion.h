@@ -85,17 +85,17 @@ inline std::optional<std::string> FindDistortionProblem(const CameraIntrinsics& 
   auto check_pixel = [&](double u, double v, bool border) -> std::optional<std::string> {
     const double xd = (u - k.cx) / k.fx, yd = (v - k.cy) / k.fy;
     double x, y;
-    const std::string at = "pixel (" + std::to_string(u) + ", " + std::to_string(v) + ")";
+    auto at = [&] { return "pixel (" + std::to_string(u) + ", " + std::to_string(v) + ")"; };
     if (!UndistortNormalized(k, xd, yd, &x, &y))
-      return "the distortion cannot be inverted at " + at + " (it folds the image)";
+      return "the distortion cannot be inverted at " + at() + " (it folds the image)";
     if (!(DistortionJacobianDet(k, x, y) > 0))
-      return "the distortion folds the image at " + at + " (Jacobian determinant <= 0)";
+      return "the distortion folds the image at " + at() + " (Jacobian determinant <= 0)";
     if (border) {
       for (int s = 1; s <= 64; ++s) {
         const double a = s / 64.0;
         const double px = x0 + a * (x - x0), py = y0 + a * (y - y0);
         if (!(DistortionJacobianDet(k, px, py) > 0))
-          return "the distortion folds the image between the principal point and " + at +
+          return "the distortion folds the image between the principal point and " + at() +
                  " (Jacobian determinant <= 0)";
       }
     }
