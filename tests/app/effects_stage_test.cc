@@ -3,7 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "penumbra/app/cli.h"
 #include "penumbra/app/floor_map.h"
+#include "penumbra/app/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
@@ -95,6 +101,29 @@ TEST(AdversityPlan, UnknownPresetListsTheValidNames) {
               "<command line>: adversity: unknown preset 'apocalypse'; expected one of: none, "
               "minor, major, or a preset file (FILE.yaml or FILE.yaml#NAME)");
   }
+}
+
+TEST(AdversityPlan, CliRunWithAnUnknownPresetExitsWith2AndAKnownOneRecordsIt) {
+  const std::string out =
+      (std::filesystem::temp_directory_path() / "penumbra_adversity_cli").string();
+  const char* bad[] = {"penumbra",  "run",     kDefaultWorld.c_str(), "--out",
+                       out.c_str(), "--quiet", "--adversity",         "apocalypse"};
+  EXPECT_EQ(RunCli(8, const_cast<char**>(bad)), 2);
+  WorldConfig world = LoadWorldFile(kDefaultWorld);
+  world.duration_sec = 0.05;
+  world.cameras.at(0).width = 32;
+  world.cameras.at(0).height = 24;
+  RunOptions options;
+  options.out_dir = out;
+  options.progress = false;
+  options.adversity = "major";
+  RunWorld(world, options);
+  std::ifstream f(std::filesystem::path(out) / "run.json");
+  std::stringstream text;
+  text << f.rdbuf();
+  EXPECT_NE(text.str().find("\"adversity\": \"major ("), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"adversity_forklift0: forklift\""), std::string::npos);
+  EXPECT_NE(text.str().find("\"adversity_smoke: smoke\""), std::string::npos);
 }
 
 TEST(AdversityPlan, EffectsAreEvaluatedDeterministically) {
