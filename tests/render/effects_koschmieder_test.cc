@@ -62,17 +62,17 @@ TEST(EffectsKoschmiederTest, LightInScatterTiersAgree) {
   HomogeneousMedium fog = Fog(0.1f, 1.0f, 0.3f);
   fog.region = BoxRegion{{0.5, -4, -4}, {8, 4, 4}};
   fx.homogeneous_media.push_back(fog);
-  const CameraView view = MakeView(CameraLookingAlongX(), 96, 64, 30, true, false, false);
+  const CameraView view = MakeView(CameraLookingAlongX(), 144, 96, 30, true, false, false);
   double mean[2];
   int k = 0;
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    RenderSettings rs = TierSettings(tier, 32);
+    RenderSettings rs = TierSettings(tier, 16);
     rs.max_bounces = 1;
     auto r = MakeEmbreeRenderer(s, rs);
     RenderedFrame f;
     r->Render(SnapshotWith(s, fx), view, &f);
-    mean[k++] = MeanRadiance(f.radiance, 0, 96, 0, 64);
+    mean[k++] = MeanRadiance(f.radiance, 0, 144, 0, 96);
   }
   EXPECT_GT(mean[1], 0.0);
   EXPECT_NEAR(mean[0], mean[1], 0.1 * mean[1]);

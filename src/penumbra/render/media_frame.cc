@@ -77,7 +77,8 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
     realtime_ok_ = true;
   }
   particles_.Build(fx, camera, view.exposure_time_sec,
-                   settings.tier == RenderSettings::Tier::kRealtime);
+                   settings.tier == RenderSettings::Tier::kRealtime, pool);
+  if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, pool);
 }
 
 }  // namespace penumbra

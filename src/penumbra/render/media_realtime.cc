@@ -296,11 +296,12 @@ namespace {
 
 // slice coordinate in [0, Z] of distance t for exponentially spaced boundaries
 // 0, near, ..., t_far (boundary k >= 1 at near (t_far / near)^((k - 1) / (Z - 1))).
-float FogSlice(float t, float t_far) {
+// log_t = log(t / near) (shared by the columns of a lookup), inv_log_far = 1 / log(t_far / near).
+float FogSlice(float t, float log_t, float inv_log_far) {
   constexpr int Z = kFogFroxelSlices;
   if (!(t > 0)) return 0.0f;
   if (t < kFogFroxelNear) return t / kFogFroxelNear;
-  const float s = 1.0f + (Z - 1) * std::log(t / kFogFroxelNear) / std::log(t_far / kFogFroxelNear);
+  const float s = 1.0f + (Z - 1) * log_t * inv_log_far;
   return std::min(s, static_cast<float>(Z));
 }
 
@@ -323,7 +324,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   fr.ny = (H + kFogFroxelBlock - 1) / kFogFroxelBlock;
   const int columns = fr.nx * fr.ny;
   constexpr int Z = kFogFroxelSlices;
-  fr.t_far.assign(columns, 2 * kFogFroxelNear);
+  fr.inv_log_far.assign(columns, 1.0f / std::log(2.0f));
   fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Vector3f::Zero());
   const int nm = static_cast<int>(media.analytic().size());
   auto column = [&](int64_t c) {
@@ -341,7 +342,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
       t_far = std::max(t_far, static_cast<float>(std::min(std::isfinite(tt) ? tt : b, 2000.0)));
     }
     t_far = std::min(t_far, 2000.0f);
-    fr.t_far[c] = t_far;
+    fr.inv_log_far[c] = 1.0f / std::log(t_far / kFogFroxelNear);
     const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
     Rng rng(HashKeys(HashKeys(frame_key, pixel), 3));
     const float jitter = rng.Uniform();
@@ -397,9 +398,10 @@ Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
   const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
   Eigen::Vector3f out = Eigen::Vector3f::Zero();
+  const float log_t = t > kFogFroxelNear ? std::log(t / kFogFroxelNear) : 0.0f;
   for (int q = 0; q < 4; ++q) {
     const int c = cols[q];
-    const float s = FogSlice(t, fr.t_far[c]);
+    const float s = FogSlice(t, log_t, fr.inv_log_far[c]);
     const int k = std::min(static_cast<int>(s), Z - 1);
     const float f = s - k;
     const Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
@@ -436,6 +438,36 @@ float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eige
   return T;
 }
 
+bool RealtimeMedia::Locate(const Eigen::Vector3f& p_W, LightVolumeSample* out) const {
+  if (!vol_.active || (p_W.array() < vol_.lo.array()).any() ||
+      (p_W.array() > vol_.hi.array()).any())
+    return false;
+  const Eigen::Vector3f f =
+      (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+  int i0[3], i1[3];
+  float w[3];
+  for (int k = 0; k < 3; ++k) {
+    const float c = std::clamp(f[k], 0.0f, static_cast<float>(vol_.r[k] - 1));
+    i0[k] = std::min(static_cast<int>(c), std::max(vol_.r[k] - 2, 0));
+    i1[k] = std::min(i0[k] + 1, vol_.r[k] - 1);
+    w[k] = c - static_cast<float>(i0[k]);
+  }
+  for (int q = 0; q < 8; ++q) {
+    const int i = q & 1 ? i1[0] : i0[0], j = q & 2 ? i1[1] : i0[1], k = q & 4 ? i1[2] : i0[2];
+    out->index[q] = (k * vol_.r[1] + j) * vol_.r[0] + i;
+    out->weight[q] =
+        (q & 1 ? w[0] : 1 - w[0]) * (q & 2 ? w[1] : 1 - w[1]) * (q & 4 ? w[2] : 1 - w[2]);
+  }
+  return true;
+}
+
+float RealtimeMedia::LightTransmittance(int j, const LightVolumeSample& at) const {
+  const float* T = vol_.trans.data() + static_cast<size_t>(j) * vol_.r[0] * vol_.r[1] * vol_.r[2];
+  float sum = 0;
+  for (int q = 0; q < 8; ++q) sum += at.weight[q] * T[at.index[q]];
+  return sum;
+}
+
 Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& p_W,
                                                   const Eigen::Vector3f& wi, float dist) const {
   if (vol_.active && j < num_lights_ && (p_W.array() >= vol_.lo.array()).all() &&
@@ -454,8 +486,8 @@ Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& 
 }
 
 MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                                          const Eigen::Vector3f& d, float t_end, int u, int v,
-                                          Rng* rng) const {
+                                          const Eigen::Vector3f& d, float t_end, int u,
+                                          int v) const {
   MediaSegment out;
   const MediaScene& media = *media_;
   const bool analytic = !media.analytic().empty();
@@ -476,20 +508,20 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
   }
 
   // homogeneous media: closed-form transmittance and sky in-scatter.
-  const int nm = static_cast<int>(media.analytic().size());
-  constexpr int kMaxMedia = 16;
-  double I[kMaxMedia];  // density integral of each medium over the ray
-  float ma[kMaxMedia], mb[kMaxMedia];
   Eigen::Vector3d tau_t = Eigen::Vector3d::Zero(), tau_s = Eigen::Vector3d::Zero();
-  for (int i = 0; i < nm && i < kMaxMedia; ++i) {
-    const AnalyticMedium& m = media.analytic()[i];
-    I[i] = 0;
-    if (!m.Interval(o, d, 0.0f, t_end, &ma[i], &mb[i])) continue;
-    I[i] = std::min(m.DensityIntegral(o.z(), d.z(), ma[i], mb[i]), 1e30);
-    tau_t += m.sigma_t.cast<double>() * I[i];
-    tau_s += m.sigma_s.cast<double>() * I[i];
+  for (const AnalyticMedium& m : media.analytic()) {
+    float a, b;
+    if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
+    const double I = std::min(m.DensityIntegral(o.z(), d.z(), a, b), 1e30);
+    tau_t += m.sigma_t.cast<double>() * I;
+    tau_s += m.sigma_s.cast<double>() * I;
   }
-  const Eigen::Vector3f Th_end = (-tau_t).array().exp().matrix().cast<float>();
+  Eigen::Vector3f Th_end;
+  if (tau_t.x() == tau_t.y() && tau_t.y() == tau_t.z()) {
+    Th_end.setConstant(std::exp(-static_cast<float>(tau_t.x())));  // grey: one exponential
+  } else {
+    Th_end = Exp(-tau_t.cast<float>());
+  }
   Eigen::Vector3f albedo;
   for (int c = 0; c < 3; ++c)
     albedo[c] = tau_t[c] > 0 ? static_cast<float>(tau_s[c] / tau_t[c]) : 0;

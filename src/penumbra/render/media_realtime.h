@@ -39,7 +39,7 @@
 // surfaces: each light's contribution is multiplied by LightTransmittance (the world light
 // volume; outside it: closed form for the homogeneous media times the grid's light volume at
 // the shadow ray's entry into the grid box).
-// random numbers: the caller's Rng (the pixel's stream), deterministic per pixel.
+// random numbers: the froxel columns' jitter, from their centre pixels' streams 2 and 3.
 
 #include <Eigen/Core>
 #include <vector>
@@ -54,19 +54,19 @@
 namespace penumbra {
 
 /// cells of a grid medium's light volume (at most the grid's own resolution per axis).
-constexpr int kGridLightCells = 2048;
+constexpr int kGridLightCells = 1024;
 /// most march steps from a light-volume cell to a light through its grid.
 constexpr int kGridLightSteps = 16;
 /// cells of the world light volume.
 constexpr int kLightVolumeCells = 4096;
 /// pixels per side of the square pixel block of one froxel column.
-constexpr int kFroxelBlock = 8;
+constexpr int kFroxelBlock = 12;
 /// depth slices of a froxel column.
-constexpr int kFroxelSlices = 32;
+constexpr int kFroxelSlices = 24;
 /// pixels per side of the block of one light in-scatter column of the homogeneous media.
-constexpr int kFogFroxelBlock = 16;
+constexpr int kFogFroxelBlock = 24;
 /// slices of a light in-scatter column of the homogeneous media.
-constexpr int kFogFroxelSlices = 48;
+constexpr int kFogFroxelSlices = 40;
 /// distance (m) of the first exponentially spaced slice boundary.
 constexpr float kFogFroxelNear = 0.25f;
 /// lights with light volumes; further lights are unshadowed in media and unattenuated by grids.
@@ -76,6 +76,13 @@ constexpr int kMaxVolumeLights = 16;
 struct MediaSegment {
   Eigen::Vector3f T{1, 1, 1};
   Eigen::Vector3f L_add{0, 0, 0};
+};
+
+/// where a point lies in the world light volume (RealtimeMedia::Locate): the eight cells of
+/// its trilinear lookup and their weights, shared by every light.
+struct LightVolumeSample {
+  int index[8];
+  float weight[8];
 };
 
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
@@ -94,10 +101,18 @@ class RealtimeMedia {
   Eigen::Vector3f LightTransmittance(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                      float dist) const;
 
+  /// locates p_W in the world light volume; false outside it (use LightTransmittance(j, p,
+  /// wi, dist) there).
+  bool Locate(const Eigen::Vector3f& p_W, LightVolumeSample* at) const;
+  /// number of lights that have light volumes (the first ones).
+  int num_volume_lights() const { return num_lights_; }
+  /// channel-mean transmittance to light j (< num_volume_lights()) at a located point.
+  float LightTransmittance(int j, const LightVolumeSample& at) const;
+
   /// single scattering along the camera ray o + t d (d unit, o the camera centre) of pixel
   /// (u, v), t in [0, t_end].
   MediaSegment IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                             const Eigen::Vector3f& d, float t_end, int u, int v, Rng* rng) const;
+                             const Eigen::Vector3f& d, float t_end, int u, int v) const;
 
   const MediaScene* media() const { return media_; }
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
@@ -131,7 +146,7 @@ class RealtimeMedia {
   FroxelRecord LookupFroxels(int u, int v, float t, float* t_enter) const;
   struct FogFroxels {
     int nx = 0, ny = 0;
-    std::vector<float> t_far;        // [column] last slice boundary, m
+    std::vector<float> inv_log_far;  // [column] 1 / log(last slice boundary / near)
     std::vector<Eigen::Vector3f> S;  // [column][slice boundary 0..kFogFroxelSlices]
   };
   /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v).

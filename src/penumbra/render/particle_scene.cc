@@ -25,12 +25,13 @@ ParticleScene::ParticleScene() : impl_(std::make_unique<Impl>()) {}
 ParticleScene::~ParticleScene() = default;
 
 void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-                          bool pixel_hits) {
+                          bool pixel_hits, ThreadPool* pool) {
   fx_ = fx;
   count_ = 0;
   alpha_.clear();
   set_.clear();
   ends_.clear();
+  rain_radiance_.clear();
   pixel_t_.clear();
   pixel_prim_.clear();
   if (impl_->scene) {
@@ -88,7 +89,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   count_ = static_cast<int>(alpha_.size());
   if (count_ == 0) return;
   if (pixel_hits) {
-    BuildPixelHits(camera);
+    BuildPixelHits(camera, pool);
     return;
   }
   if (!impl_->device) {
@@ -145,7 +146,7 @@ float IntersectCapsule(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const
 
 }  // namespace
 
-void ParticleScene::BuildPixelHits(const Camera& camera) {
+void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const int W = camera.width(), H = camera.height();
   pixel_w_ = W;
   pixel_t_.assign(static_cast<size_t>(W) * H, std::numeric_limits<float>::infinity());
@@ -155,39 +156,60 @@ void ParticleScene::BuildPixelHits(const Camera& camera) {
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   constexpr float kNear = 0.01f;
+  // pixel box of every streak (empty when behind the camera).
+  std::vector<Eigen::Vector4i> box(count_, Eigen::Vector4i(0, -1, 0, -1));
   for (int n = 0; n < count_; ++n) {
-    const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
     const float r = ends_[2 * n].w();
     // the segment in the optical frame, clipped to z >= kNear + r.
-    Eigen::Vector3f ao = R_OW * a + p_OW, bo = R_OW * b + p_OW;
+    Eigen::Vector3f ao = R_OW * ends_[2 * n].head<3>() + p_OW;
+    Eigen::Vector3f bo = R_OW * ends_[2 * n + 1].head<3>() + p_OW;
     const float zmin = kNear + r;
     if (ao.z() < zmin && bo.z() < zmin) continue;
     if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
     if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
-    // pixel box of the projected capsule (pinhole; a margin of 2 px for lens distortion).
+    // pinhole projection with a margin of 2 px (lens distortion, rounding).
     const float z_near = std::min(ao.z(), bo.z()) - r;
     const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 2.0f;
     const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
     const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
     const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
     const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
-    const int u0 = std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp)));
-    const int u1 = std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp)));
-    const int v0 = std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp)));
-    const int v1 = std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp)));
-    for (int v = v0; v <= v1; ++v)
-      for (int u = u0; u <= u1; ++u) {
-        const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
-        const float len = ray.d.norm();
-        const float t = IntersectCapsule(ray.o, ray.d / len, a, b, r);
-        if (!(t > 0)) continue;
-        const size_t at = static_cast<size_t>(v) * W + u;
-        const float t_ray = t / len;
-        if (t_ray < pixel_t_[at]) {
-          pixel_t_[at] = t_ray;
-          pixel_prim_[at] = n;
+    box[n] = Eigen::Vector4i(std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp))),
+                             std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp))),
+                             std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp))),
+                             std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp))));
+  }
+  // bands of rows in parallel; within a band streaks in index order (nearest wins, ties keep
+  // the lower index), so the result does not depend on the thread count.
+  constexpr int kBand = 16;
+  const int bands = (H + kBand - 1) / kBand;
+  auto band = [&](int64_t bi) {
+    const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
+    for (int n = 0; n < count_; ++n) {
+      const Eigen::Vector4i& bx = box[n];
+      const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
+      if (v0 > v1 || bx[0] > bx[1]) continue;
+      const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
+      const float r = ends_[2 * n].w();
+      for (int v = v0; v <= v1; ++v)
+        for (int u = bx[0]; u <= bx[1]; ++u) {
+          const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+          const float len = ray.d.norm();
+          const float t = IntersectCapsule(ray.o, ray.d / len, a, b, r);
+          if (!(t > 0)) continue;
+          const size_t at = static_cast<size_t>(v) * W + u;
+          const float t_ray = t / len;
+          if (t_ray < pixel_t_[at]) {
+            pixel_t_[at] = t_ray;
+            pixel_prim_[at] = n;
+          }
         }
-      }
+    }
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(bands, band);
+  } else {
+    for (int64_t bi = 0; bi < bands; ++bi) band(bi);
   }
 }
 
@@ -207,6 +229,7 @@ bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleH
   if (nrm.dot(ray.d) > 0) nrm = -nrm;
   hit->ng_W = nrm;
   hit->alpha = alpha_[n];
+  hit->prim = n;
   hit->set = set_[n];
   hit->kind = fx_->particles[hit->set].kind;
   return true;
@@ -237,9 +260,35 @@ bool ParticleScene::Intersect(const Ray& ray, float tmax, ParticleHit* hit) cons
   if (n.dot(ray.d) > 0) n = -n;
   hit->ng_W = n;
   hit->alpha = alpha_[prim];
+  hit->prim = static_cast<int>(prim);
   hit->set = set_[prim];
   hit->kind = fx_->particles[hit->set].kind;
   return true;
+}
+
+void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
+                                   ThreadPool* pool) {
+  rain_radiance_.clear();
+  bool any = false;
+  for (int n = 0; n < count_ && !any; ++n)
+    any = fx_->particles[set_[n]].kind == ParticleKind::kRain;
+  if (!any) return;
+  std::vector<Eigen::Vector3f> L(count_, Eigen::Vector3f::Zero());
+  auto one = [&](int64_t n) {
+    if (fx_->particles[set_[n]].kind != ParticleKind::kRain) return;
+    ParticleHit h;
+    h.kind = ParticleKind::kRain;
+    h.set = set_[n];
+    h.prim = -1;
+    const Eigen::Vector3f c = 0.5f * (ends_[2 * n].head<3>() + ends_[2 * n + 1].head<3>());
+    L[n] = Shade(h, c, lights, sky_ambient);
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(count_, one);
+  } else {
+    for (int64_t n = 0; n < count_; ++n) one(n);
+  }
+  rain_radiance_ = std::move(L);
 }
 
 Eigen::Vector3f ParticleScene::Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
@@ -247,6 +296,9 @@ Eigen::Vector3f ParticleScene::Shade(const ParticleHit& hit, const Eigen::Vector
                                      const Eigen::Vector3f& sky_ambient) const {
   const ParticleSet& ps = fx_->particles[hit.set];
   if (hit.kind == ParticleKind::kSpark) return ps.emission;
+  if (hit.kind == ParticleKind::kRain && hit.prim >= 0 &&
+      hit.prim < static_cast<int>(rain_radiance_.size()))
+    return rain_radiance_[hit.prim];
   Eigen::Vector3f E = Eigen::Vector3f::Zero();
   for (int j = 0; j < lights.size(); ++j) {
     LightSample ls;

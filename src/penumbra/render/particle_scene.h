@@ -32,6 +32,7 @@
 #include <memory>
 #include <vector>
 
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/scene/effects_frame.h"
@@ -44,7 +45,8 @@ struct ParticleHit {
   Eigen::Vector3f ng_W{0, 0, 1};  ///< unit normal of the capsule, facing the ray
   float alpha = 0;                ///< coverage in (0, 1]
   ParticleKind kind = ParticleKind::kRain;
-  int set = 0;  ///< index into EffectsFrame::particles
+  int set = 0;    ///< index into EffectsFrame::particles
+  int prim = -1;  ///< streak index in the ParticleScene
 };
 
 /// the streak scene of one frame and camera. Build, then Intersect is thread-safe.
@@ -60,9 +62,10 @@ class ParticleScene {
   /// @throws ConfigError if a set's arrays differ in length or hold non-finite values
   /// (key effects.particles[i]).
   /// pixel_hits: build the per-pixel nearest streaks of the camera's pixel-centre rays
-  /// (PixelHit) instead of the Embree scene (Intersect).
+  /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
+  /// null).
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits);
+             bool pixel_hits, ThreadPool* pool = nullptr);
 
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
@@ -74,6 +77,11 @@ class ParticleScene {
   /// nearest streak along `ray` within [ray.tmin, tmax] (Build without pixel_hits); false if
   /// none.
   bool Intersect(const Ray& ray, float tmax, ParticleHit* hit) const;
+
+  /// evaluates every rain streak's radiance once, at its centre (rain shading does not depend
+  /// on the hit point's normal), so that Shade looks it up; spread over `pool` (may be null).
+  void PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
+                      ThreadPool* pool);
 
   /// radiance (cd/m^2) of the streak at `hit`, point p_W, seen from direction wo (unit,
   /// towards the viewer); `sky_ambient` is the sphere-average sky radiance.
@@ -91,8 +99,9 @@ class ParticleScene {
   int pixel_w_ = 0;
   std::vector<float> pixel_t_;   // per pixel: nearest streak t (ray units), +inf none
   std::vector<int> pixel_prim_;  // per pixel: its primitive, -1 none
+  std::vector<Eigen::Vector3f> rain_radiance_;  // per primitive (PrecomputeRain), or empty
 
-  void BuildPixelHits(const Camera& camera);
+  void BuildPixelHits(const Camera& camera, ThreadPool* pool);
 };
 
 }  // namespace penumbra

@@ -39,22 +39,20 @@ struct Scratch {
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
-// alpha-composited over it (render/media_realtime.h, render/particle_scene.h). random numbers
-// from the pixel's stream 1 (stream 0 holds the light samples).
+// alpha-composited over it (render/media_realtime.h, render/particle_scene.h). no random
+// numbers here (the froxel volumes are jittered per column when they are built).
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
-                                 int u, int v, uint64_t frame_key, uint64_t pixel,
-                                 Eigen::Vector3f L) {
+                                 int u, int v, Eigen::Vector3f L) {
   const MediaFrame& fx = *ctx.effects;
   const RealtimeMedia* rm = fx.realtime_media();
   const ParticleScene* parts = fx.particles();
   if (rm == nullptr && parts == nullptr) return L;
-  Rng rng(FrameContext::PixelStream(frame_key, pixel, 1));
   const float d_len = ray.d.norm();
   const Eigen::Vector3f d = ray.d / d_len;
   const float inf = std::numeric_limits<float>::infinity();
   const float t_end = hit ? t_hit * d_len : inf;
   if (rm != nullptr) {
-    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, u, v, &rng);
+    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, u, v);
     L = seg.T.cwiseProduct(L) + seg.L_add;
   }
   ParticleHit ph;
@@ -64,7 +62,7 @@ Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool h
     const float t_p = ph.t * d_len;
     Eigen::Vector3f Lp = parts->Shade(ph, ray.o + t_p * d, *ctx.lights, fx.sky_ambient());
     if (rm != nullptr) {
-      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v, &rng);
+      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v);
       Lp = front.T.cwiseProduct(Lp) + front.L_add;
     }
     L = ph.alpha * Lp + (1.0f - ph.alpha) * L;
@@ -98,8 +96,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       float* Lp = out.radiance->at(u, v);
       const Eigen::Vector3f Ls = hit[k] ? L.Lane(k) : Eigen::Vector3f(Lp[0], Lp[1], Lp[2]);
       const Eigen::Vector3f Lf =
-          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, u, v, frame_key,
-                           static_cast<uint64_t>(v) * width + u, Ls);
+          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, u, v, Ls);
       Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
     }
   };
@@ -173,6 +170,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       continue;
     }
 
+    // where the surface points lie in the media's light volume (shared by all lights).
+    LightVolumeSample vol_at[kLanes];
+    bool located[kLanes] = {};
+    if (rm != nullptr)
+      for (int k = 0; k < kLanes; ++k) located[k] = hit[k] && rm->Locate(p.Lane(k), &vol_at[k]);
     // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
     Lanes total = LuminanceLanes(L);
     for (int j = 0; j < num_lights; ++j) {
@@ -190,6 +192,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         // attenuation of the light by the media between the surface and the light.
         for (int k = 0; k < kLanes; ++k) {
           if (!(hit[k] && s.valid[k])) continue;
+          if (located[k] && j < rm->num_volume_lights()) {
+            const float T = rm->LightTransmittance(j, vol_at[k]);
+            c.x[k] *= T, c.y[k] *= T, c.z[k] *= T;
+            continue;
+          }
           const Eigen::Vector3f T =
               rm->LightTransmittance(j, p.Lane(k), s.wi.Lane(k), s.distance[k]);
           c.x[k] *= T.x(), c.y[k] *= T.y(), c.z[k] *= T.z();
