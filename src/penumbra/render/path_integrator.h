@@ -25,6 +25,22 @@
 // Russian roulette from the 4th vertex on (after 3 bounces): a path continues with probability
 // q = min(1, max channel of its throughput) and is reweighted by 1 / q (unbiased).
 //
+// adverse conditions (FrameContext::effects, render/media_frame.h), when present:
+//   - participating media (render/media_scene.h): every ray segment is tracked from its origin
+//     to the surface, lamp or infinity by spectral delta tracking; a real scattering event is
+//     a path vertex (counted against max_bounces, Russian roulette as at surfaces) with the
+//     same next-event estimation as a surface but the media's Henyey-Greenstein phase mixture
+//     in place of the BSDF (MIS weights use the phase density), and continues along a phase
+//     sample; absorption ends the path; grid emission is gathered at every tentative
+//     collision. every shadow ray (surface and medium vertices) is weighted by the media's
+//     transmittance (exact for homogeneous media, ratio tracking in grids), so the sky behind
+//     an unbounded fog is never reached.
+//   - particles (render/particle_scene.h): a camera ray that meets a streak stops there with
+//     probability alpha (coverage), drawing the streak's radiance attenuated by the media in
+//     front of it; secondary rays do not see particles.
+//   - surface wetness (ApplySurfaceWetness) changes the material of upward-facing surfaces.
+// without effects the tier renders exactly as before (no extra random numbers are drawn).
+//
 // outputs per pixel: the mean radiance; the denoiser guides (FrameBuffers): albedo = mean base
 // colour of the first surface over the samples that hit one, normal = shading normal of the
 // pixel-centre hit (consistent with the renderer's depth image). non-finite path values are
