@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 
 #include "penumbra/app/bench.h"
@@ -119,7 +120,15 @@ int BenchSensors(const SensorBenchOptions& options) {
       options.scans);
   fmt::print("{:<16} {:>7} {:>12} {:>10} {:>8} {:>8} {:>12} {:>8}\n", "preset", "rays",
              "wall mean ms", "median ms", "max ms", "cpu ms", "cpu Mrays/s", "points");
-  for (const char* preset : {"ouster_os1_64", "velodyne_vlp16", "ouster_os1_128", "livox_mid40"}) {
+  // homogeneous fog of meteorological optical range 30 m (sigma_t = ln 20 / MOR)
+  auto fog = std::make_shared<EffectsFrame>();
+  HomogeneousMedium medium;
+  medium.sigma_t_per_m = Eigen::Vector3f::Constant(static_cast<float>(std::log(20.0) / 30.0));
+  fog->homogeneous_media.push_back(medium);
+  for (const char* row :
+       {"ouster_os1_64", "velodyne_vlp16", "ouster_os1_128", "livox_mid40", "os1_64 fog 30m"}) {
+    const bool foggy = std::string(row) == "os1_64 fog 30m";
+    const char* preset = foggy ? "ouster_os1_64" : row;
     LidarConfig cfg;
     cfg.pattern = MakeLidarPattern(preset);
     LidarScanner scanner(cfg, 1);
@@ -136,8 +145,8 @@ int BenchSensors(const SensorBenchOptions& options) {
       const double c0 = ThreadCpuSec();
       rs.Update(a);
       scanner.Scan(
-          rs, nullptr, [&](double t) { return InterpolatePose(X0, X1, std::min(1.0, t / span)); },
-          k, &scan);
+          rs, foggy ? fog.get() : nullptr,
+          [&](double t) { return InterpolatePose(X0, X1, std::min(1.0, t / span)); }, k, &scan);
       cpu += ThreadCpuSec() - c0;
       wall.push_back(Since(t0));
       points += static_cast<int64_t>(scan.points.size());
@@ -146,7 +155,7 @@ int BenchSensors(const SensorBenchOptions& options) {
     std::sort(sorted.begin(), sorted.end());
     double mean = 0;
     for (double w : wall) mean += w / wall.size();
-    fmt::print("{:<16} {:>7} {:>12.2f} {:>10.2f} {:>8.2f} {:>8.2f} {:>12.2f} {:>8}\n", preset,
+    fmt::print("{:<16} {:>7} {:>12.2f} {:>10.2f} {:>8.2f} {:>8.2f} {:>12.2f} {:>8}\n", row,
                scan.rays, 1e3 * mean, 1e3 * sorted[sorted.size() / 2], 1e3 * sorted.back(),
                1e3 * cpu / options.scans, scan.rays / (cpu / options.scans) * 1e-6,
                points / options.scans);

@@ -1,6 +1,7 @@
 #include "penumbra/app/sensor_stage.h"
 
 #include <fmt/format.h>
+#include <time.h>
 
 #include <chrono>
 #include <filesystem>
@@ -28,6 +29,12 @@ std::ofstream OpenCsv(const fs::path& path) {
   std::ofstream f(path, std::ios::trunc);
   if (!f) throw ConfigError("", 0, "--out", "cannot create '" + path.string() + "'");
   return f;
+}
+
+double ThreadCpuSec() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 ConfigError SensorError(const SensorConfig& s, const std::string& key, const std::string& what) {
@@ -132,6 +139,7 @@ struct SensorStage::Impl {
 
   void TraceScan(Lidar& l, const WorldSnapshot& end) {
     const auto t0 = Clock::now();
+    const double c0 = ThreadCpuSec();
     const WorldSnapshot& start = l.start;
     ray_scene->Update(start);
     const Pose X0 = l.mount.X_WS(start), X1 = l.mount.X_WS(end);
@@ -139,8 +147,10 @@ struct SensorStage::Impl {
     const SensorPoseAt pose = [&](double t) {
       return span > 0 ? InterpolatePose(X0, X1, std::min(1.0, t / span)) : X0;
     };
+    const auto te = Clock::now();
     std::shared_ptr<const EffectsFrame> fx =
         effects_at ? effects_at(start, X0.translation()) : start.effects;
+    busy["lidar_effects"] += std::chrono::duration<double>(Clock::now() - te).count();
     LidarScan scan;
     l.scanner->Scan(*ray_scene, fx.get(), pose, l.start_firing.index, &scan);
     const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
@@ -150,6 +160,7 @@ struct SensorStage::Impl {
                            scan.points.size(), scan.medium_returns, scan.particle_returns);
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
+    busy["lidar_cpu"] += ThreadCpuSec() - c0;
   }
 };
 

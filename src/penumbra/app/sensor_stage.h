@@ -69,7 +69,9 @@ class SensorStage {
 
   /// samples (scans) written per sensor.
   std::map<std::string, int64_t> samples() const;
-  /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s.
+  /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s; also
+  /// "lidar_effects" (evaluating the effects a LiDAR sees, part of "lidar") and "lidar_cpu"
+  /// (thread CPU time of the LiDAR work).
   std::map<std::string, double> busy_sec() const;
 
  private:

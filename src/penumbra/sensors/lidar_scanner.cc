@@ -12,7 +12,7 @@ namespace penumbra {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kBinDeg = 1.0;
+constexpr double kBinDeg = 0.5;  // angular bins of beams for the particle lookup
 constexpr int kChunk = 256;
 constexpr int kSoftSamples = 48;
 constexpr double kSpeedOfLight = 299792458.0;
@@ -46,7 +46,10 @@ bool ClipToBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::
 // extinction (1/m) and backscatter (1/(m sr)) of the media of one EffectsFrame, channel 0.
 class MediaView {
  public:
-  explicit MediaView(const EffectsFrame* fx) : fx_(fx) {}
+  explicit MediaView(const EffectsFrame* fx) : fx_(fx) {
+    if (fx_)
+      for (const GridMedium& g : fx_->grid_media) X_GW_.push_back(g.X_WG.inverse());
+  }
   bool empty() const { return !fx_ || (fx_->homogeneous_media.empty() && fx_->grid_media.empty()); }
 
   // sigma_t and beta at p_W
@@ -63,8 +66,9 @@ class MediaView {
       *sigma += s;
       *beta += s * m.albedo[0] * kBetaPerSigma;
     }
-    for (const GridMedium& g : fx_->grid_media) {
-      const double d = GridDensity(g, p);
+    for (size_t gi = 0; gi < fx_->grid_media.size(); ++gi) {
+      const GridMedium& g = fx_->grid_media[gi];
+      const double d = GridDensityLocal(g, X_GW_[gi] * p);
       if (d <= 0) continue;
       *sigma += d * g.sigma_t_per_m[0];
       *beta += d * g.sigma_t_per_m[0] * g.albedo[0] * kBetaPerSigma;
@@ -90,15 +94,16 @@ class MediaView {
                std::exp(-m.height_falloff_per_m * std::max(0.0, z - m.base_height_m)) * h;
       }
     }
-    for (const GridMedium& g : fx_->grid_media) {
-      const Eigen::Vector3d o_G = g.X_WG.inverse() * o;
+    for (size_t gi = 0; gi < fx_->grid_media.size(); ++gi) {
+      const GridMedium& g = fx_->grid_media[gi];
+      const Eigen::Vector3d o_G = X_GW_[gi] * o;
       const Eigen::Vector3d d_G = g.X_WG.linear().transpose() * d;
       double t0, t1;
       if (!ClipToBox(o_G, d_G, -g.half_extents_m, g.half_extents_m, r, &t0, &t1)) continue;
       const double voxel = std::min({2 * g.half_extents_m.x() / std::max(g.nx, 1),
                                      2 * g.half_extents_m.y() / std::max(g.ny, 1),
                                      2 * g.half_extents_m.z() / std::max(g.nz, 1)});
-      const int n = std::clamp(static_cast<int>(std::ceil((t1 - t0) / (0.5 * voxel))), 1, 256);
+      const int n = std::clamp(static_cast<int>(std::ceil((t1 - t0) / voxel)), 1, 128);
       const double h = (t1 - t0) / n;
       double acc = 0;
       for (int i = 0; i < n; ++i) acc += GridDensityLocal(g, o_G + (t0 + (i + 0.5) * h) * d_G);
@@ -108,9 +113,6 @@ class MediaView {
   }
 
  private:
-  static double GridDensity(const GridMedium& g, const Eigen::Vector3d& p_W) {
-    return GridDensityLocal(g, g.X_WG.inverse() * p_W);
-  }
   // nearest-voxel density at a point in the grid frame
   static double GridDensityLocal(const GridMedium& g, const Eigen::Vector3d& p) {
     if (!g.density || g.nx <= 0 || g.ny <= 0 || g.nz <= 0) return 0;
@@ -122,6 +124,7 @@ class MediaView {
     return (*g.density)[(static_cast<size_t>(k) * g.ny + j) * g.nx + i];
   }
   const EffectsFrame* fx_;
+  std::vector<Pose> X_GW_;  // inverse grid poses
 };
 
 struct ParticleCandidate {
@@ -186,6 +189,13 @@ LidarScanner::LidarScanner(LidarConfig config, uint64_t stream_seed)
     bin[i] = a * n_el_ + e;
     ++count[bin[i] + 1];
   }
+  el_min_deg_ = 90;
+  el_max_deg_ = -90;
+  for (int i = 0; i < n; ++i) {
+    const double el = std::asin(std::clamp(dir_S_[i].z(), -1.0f, 1.0f)) * 180 / kPi;
+    el_min_deg_ = std::min(el_min_deg_, el);
+    el_max_deg_ = std::max(el_max_deg_, el);
+  }
   for (size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
   bin_start_ = count;
   bin_beams_.resize(n);
@@ -208,23 +218,45 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
   const double sigma_n = config_.receiver_noise * p_th_;
   const double pulse_len = kSpeedOfLight * config_.pulse_half_power_width_ns * 1e-9 / 2;
   const double r1 = config_.overlap_start_m, r2 = config_.overlap_full_m;
+  // the weakest power that can still be detected (receiver noise up to 5 sigma), and the
+  // largest backscatter-per-range-squared numerator any return can have (for early exits)
+  const double floor_power = std::max(0.0, p_th_ - 5 * sigma_n);
+  double beta_max = 0;
+  if (has_media) {
+    for (const HomogeneousMedium& m : effects->homogeneous_media)
+      beta_max += m.sigma_t_per_m[0] * m.albedo[0] * kBetaPerSigma;
+    for (const GridMedium& g : effects->grid_media)
+      beta_max += g.max_density * g.sigma_t_per_m[0] * g.albedo[0] * kBetaPerSigma;
+  }
+  const double bound_numerator = std::max(beta_max * pulse_len, 1.0 / kPi);
 
   // particle candidates per beam (CSR by beam), from the scan-start pose
   std::vector<int> cand_start;
   std::vector<ParticleCandidate> cands;
   if (config_.media && effects && !effects->particles.empty()) {
-    // the particle's direction in the sensor frame at 5 instants over the scan (the sensor
+    // the particle's direction in the sensor frame at 3 instants over the scan (the sensor
     // may move and turn while scanning); the candidate bins cover all of them
-    constexpr int kKeys = 5;
+    constexpr int kKeys = 3;
     const double period = 1.0 / pat.rate_hz;
     Pose X_SW[kKeys];
     for (int k = 0; k < kKeys; ++k) X_SW[k] = X_WS(period * k / (kKeys - 1)).inverse();
-    const double pad_deg = 0.25;  // float rounding and the exact beam test's margin
+    const double pad_deg = 0.1;  // float rounding and the motion between the key poses
+    std::vector<double> rho_of_set;
+    for (const ParticleSet& ps : effects->particles)
+      rho_of_set.push_back(ps.kind == ParticleKind::kRain ? 0.02 : Luminance(ps.color));
     for (int s = 0; s < static_cast<int>(effects->particles.size()); ++s) {
       const ParticleSet& ps = effects->particles[s];
       for (int i = 0; i < static_cast<int>(ps.position_W.size()); ++i) {
         const Eigen::Vector3d p_W = ps.position_W[i].cast<double>();
         const double rp = i < static_cast<int>(ps.radius_m.size()) ? ps.radius_m[i] : 0.0;
+        {
+          // skip particles too faint to be detected anywhere in the scan: the most they can
+          // return (full transmittance) is rho_p / pi min(1, (r_p / r_beam)^2) / R^2
+          const double R = std::max((X_SW[0] * p_W).norm() - 1.0, pat.min_range_m);
+          const double r_beam = R * tan_half_div;
+          const double cover = r_beam > rp ? (rp * rp) / (r_beam * r_beam) : 1.0;
+          if (rho_of_set[s] / kPi * cover / (R * R) + 5 * sigma_n < p_th_) continue;
+        }
         double az_lo = 1e9, az_hi = -1e9, el_lo = 1e9, el_hi = -1e9, ang = 0, az_ref = 0;
         bool in_range = false;
         for (int k = 0; k < kKeys; ++k) {
@@ -245,6 +277,8 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
         }
         if (!in_range) continue;
         ang += pad_deg;
+        // outside the pattern's elevation span: no beam can reach it
+        if (el_hi + ang < el_min_deg_ + 90 || el_lo - ang > el_max_deg_ + 90) continue;
         const int e0 = std::max(0, static_cast<int>((el_lo - ang) / kBinDeg));
         const int e1 = std::min(n_el_ - 1, static_cast<int>((el_hi + ang) / kBinDeg));
         const int a0 = static_cast<int>(std::floor((az_lo - ang) / kBinDeg));
@@ -260,11 +294,13 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
         }
       }
     }
-    std::sort(cands.begin(), cands.end(),
-              [](const ParticleCandidate& x, const ParticleCandidate& y) {
-                return x.beam != y.beam ? x.beam < y.beam
-                                        : (x.set != y.set ? x.set < y.set : x.index < y.index);
-              });
+    // group by beam (counting sort; within a beam, particle order = set, index as collected)
+    std::vector<int> count(n + 1, 0);
+    for (const ParticleCandidate& c : cands) ++count[c.beam + 1];
+    for (int k = 0; k < n; ++k) count[k + 1] += count[k];
+    std::vector<ParticleCandidate> sorted(cands.size());
+    for (const ParticleCandidate& c : cands) sorted[count[c.beam]++] = c;
+    cands.swap(sorted);
   }
   size_t cand_pos = 0;
 
@@ -305,24 +341,11 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
       double best_p = -std::numeric_limits<double>::infinity(), best_r = 0;
       LidarReturnKind best_kind = LidarReturnKind::kSurface;
       const double r_end = did_hit[j] ? hits[j].t : pat.max_range_m;
-      if (did_hit[j]) {
-        const SurfaceHit& h = hits[j];
-        const double r = h.t;
-        const float rho = h.material >= 0 && h.material < static_cast<int>(desc.materials.size())
-                              ? Luminance(desc.materials[h.material].base_color)
-                              : 0.8f;
-        const double cos_t = std::abs(static_cast<double>(h.ng_W.dot(ray.d)));
-        double p = rho * cos_t / kPi / (r * r);
-        if (has_media) p *= std::exp(-2 * media.OpticalDepth(o, d, r));
-        p += sigma_n * n_hard;
-        if (r >= pat.min_range_m) {
-          best_p = p;
-          best_r = r;
-          best_kind = LidarReturnKind::kSurface;
-        }
-      }
+      // soft target first: P_soft(R) sampled on [R1, R_end], stopping where nothing beyond
+      // can reach the detection floor (the most any later return can bring is
+      // e^{-2 tau} max(beta_max L, 1 / pi) / R^2)
+      double tau_stop = 0, r_stop = r_end, tau_end = -1;
       if (has_media) {
-        // soft target: P_soft(R) sampled on [R1, R_end]
         const double a = std::max(r1, pat.min_range_m), b = r_end;
         if (b > a) {
           const double h = (b - a) / kSoftSamples;
@@ -330,6 +353,12 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
           double soft_best = 0, soft_r = 0;
           for (int k = 0; k < kSoftSamples; ++k) {
             const double R = a + (k + 0.5) * h;
+            const double bound = std::exp(-2 * tau) * bound_numerator / (R * R);
+            if (bound < std::max(soft_best, floor_power)) {
+              tau_stop = tau;
+              r_stop = R;
+              break;
+            }
             double sigma, beta;
             media.At(o + R * d, &sigma, &beta);
             const double tau_mid = tau + sigma * 0.5 * h;
@@ -341,6 +370,7 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
               soft_r = R;
             }
           }
+          if (r_stop == r_end) tau_end = tau;  // marched to the target: its optical depth
           if (soft_best > 0) {
             const double ps = soft_best + sigma_n * n_soft;
             if (ps > best_p) {
@@ -349,6 +379,31 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
               best_kind = LidarReturnKind::kMedium;
             }
           }
+        }
+      }
+      if (did_hit[j]) {
+        const SurfaceHit& h = hits[j];
+        const double r = h.t;
+        const float rho = h.material >= 0 && h.material < static_cast<int>(desc.materials.size())
+                              ? Luminance(desc.materials[h.material].base_color)
+                              : 0.8f;
+        const double cos_t = std::abs(static_cast<double>(h.ng_W.dot(ray.d)));
+        double p = rho * cos_t / kPi / (r * r);
+        if (has_media) {
+          // zero if the soft-target march already showed it undetectable; else T^2 from the
+          // march's optical depth (exact for uniform media: the initial segment is exact and
+          // the midpoint sum of a constant is exact; 48 midpoint samples for height fog and
+          // grids), or from OpticalDepth when the march did not run
+          if (r_stop < r_end && p * std::exp(-2 * tau_stop) < floor_power)
+            p = 0;
+          else
+            p *= std::exp(-2 * (tau_end >= 0 ? tau_end : media.OpticalDepth(o, d, r)));
+        }
+        p += sigma_n * n_hard;
+        if (r >= pat.min_range_m && p > best_p) {
+          best_p = p;
+          best_r = r;
+          best_kind = LidarReturnKind::kSurface;
         }
       }
       if (!cands.empty()) {

@@ -28,7 +28,10 @@
 //    target or max range) and its maximum taken; media extinction uses the rgb channel 0
 //    (red, closest to the 905 nm NIR; fog droplets scatter nearly independently of
 //    wavelength). as in Hahner et al., when the soft peak beats the hard target the point is
-//    replaced by a false return at the peak's range;
+//    replaced by a false return at the peak's range. the hard target's T^2 reuses the
+//    march's optical depth (midpoint rule: exact for uniform media; height fog and voxel
+//    grids are sampled at the 48 points, grids at the nearest voxel); the march stops early
+//    where nothing beyond can reach the detection floor (the result is then unchanged);
 //  - particles (EffectsFrame rain/snow/sparks): a sphere within the beam cone (divergence)
 //    returns P_p = (rho_p / pi) min(1, (r_p / r_beam)^2) T^2 / R^2, r_beam = R tan(div / 2);
 //    rho_p = 0.02 for rain (Fresnel reflectance of water at normal incidence), the colour's
@@ -123,6 +126,7 @@ class LidarScanner {
   // angular buckets of beams (azimuth x elevation, kBinDeg), for particle lookup
   int n_az_ = 0, n_el_ = 0;
   std::vector<int> bin_start_, bin_beams_;
+  double el_min_deg_ = -90, el_max_deg_ = 90;  // elevation span of the beams
 };
 
 }  // namespace penumbra
