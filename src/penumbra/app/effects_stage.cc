@@ -58,16 +58,33 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
                          const std::vector<Pose>& X_WB,
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents) {
-  double floor_z = 0;
+  double lowest = 0;
   Eigen::Vector2d centre(0, 0);
   if (!robot_starts.empty()) {
-    floor_z = robot_starts.front().z();
+    lowest = robot_starts.front().z();
     for (const Eigen::Vector3d& r : robot_starts) {
-      floor_z = std::min(floor_z, r.z());
+      lowest = std::min(lowest, r.z());
       centre += r.head<2>() / static_cast<double>(robot_starts.size());
     }
   }
+  // the floor: the highest static upward plane at or below the lowest robot, else its z
+  double floor_z = -1e300;
+  for (const Geom& g : scene.geoms) {
+    if (g.shape != GeomShape::kPlane || !scene.bodies[g.body].is_static) continue;
+    const Pose X_WG =
+        (g.body < static_cast<int>(X_WB.size()) ? X_WB[g.body] : Pose::Identity()) * g.X_BG;
+    if (X_WG.linear()(2, 2) < 0.99) continue;
+    const double z = X_WG.translation().z();
+    if (z <= lowest + 0.05) floor_z = std::max(floor_z, z);
+  }
+  if (floor_z == -1e300) floor_z = lowest;
   FloorMap map(scene, X_WB, floor_z, centre);
+  const Eigen::Vector2d flood_seed =
+      robot_starts.empty() ? centre : Eigen::Vector2d(robot_starts.front().head<2>());
+  // the robots' area: the free floor reachable from the first robot
+  map.Flood(flood_seed, 0.4);
+  Eigen::Vector2d area_lo = map.min_W(), area_hi = map.max_W();
+  map.ReachableBounds(&area_lo, &area_hi);
 
   if (preset.fog_mor_m) {
     EffectConfig e;
@@ -93,8 +110,8 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
     e.smoke.density_scale_per_m = *preset.smoke_sigma_t_per_m;
     e.smoke.coverage = preset.smoke_coverage;
     e.smoke.wind_m_s = Eigen::Vector3d(0.3, 0, 0);
-    const Eigen::Vector2d mid = 0.5 * (map.min_W() + map.max_W());
-    const Eigen::Vector2d half = 0.5 * preset.smoke_extent_fraction * (map.max_W() - map.min_W());
+    const Eigen::Vector2d mid = 0.5 * (area_lo + area_hi);
+    const Eigen::Vector2d half = 0.5 * preset.smoke_extent_fraction * (area_hi - area_lo);
     BoxRegion box;
     box.min_W = Eigen::Vector3d(mid.x() - half.x(), mid.y() - half.y(), floor_z);
     box.max_W =
@@ -138,8 +155,6 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   }
 
   // NPCs: people first, then vehicles; each on its own random stream
-  const Eigen::Vector2d flood_seed =
-      robot_starts.empty() ? centre : Eigen::Vector2d(robot_starts.front().head<2>());
   for (int kind = 0; kind < 2; ++kind) {
     const int count = kind == 0 ? preset.npc_people : preset.npc_vehicles;
     if (count == 0) continue;
@@ -193,8 +208,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
       centre += r.head<2>() / static_cast<double>(robots.size());
     const FloorMap map(probe.scene(), start.X_WB, 0.0, centre);
     if (map.has_static_bounds()) {
-      const Eigen::Vector2d lo = map.min_W() - Eigen::Vector2d(1, 1);
-      const Eigen::Vector2d hi = map.max_W() + Eigen::Vector2d(1, 1);
+      const Eigen::Vector2d lo = map.static_min_W() - Eigen::Vector2d(1, 1);
+      const Eigen::Vector2d hi = map.static_max_W() + Eigen::Vector2d(1, 1);
       for (size_t i = 0; i < agents_.size(); ++i)
         for (size_t j = 0; j < agents_[i].waypoints.size(); ++j) {
           const Eigen::Vector2d& p = agents_[i].waypoints[j];

@@ -13,9 +13,13 @@
 //      EffectsFrame for WorldSnapshot::effects. effects never feed back into physics.
 //
 // how a preset (world/adversity_preset.h) is placed in a world:
-//   floor      z of the lowest robot's root pose (0 when there are no robots)
-//   area       the plan-view box of the static geometry, clipped to 15 m around the
-//              robots' mean start position (FloorMap); with no static geometry, +-5 m
+//   floor      the highest static upward-facing plane at or below the lowest robot's root
+//              pose (else that pose's z; 0 without robots)
+//   area       the bounding box of the free floor (0.1 m cells, 0.4 m clearance from static
+//              geometry between 0.05 and 2 m above the floor) reachable from the first
+//              robot, within the static geometry's plan-view box joined with +-5 m around the
+//              robots' mean start, clipped to +-15 m (FloorMap): a room's interior, or +-5 m
+//              in the open
 //   fog, dust  everywhere (no region); fog base height = floor + 1 m for height falloff
 //   smoke      noise smoke in a box centred on the area, extent_fraction of its size,
 //              from the floor to floor + height_m, drifting at 0.3 m/s along +x

@@ -71,17 +71,14 @@ FloorMap::FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB,
     if (cw.z() + ew.z() < floor_z + 0.05 || cw.z() - ew.z() > floor_z + 2.0) continue;
     blockers.push_back({(cw - ew).head<2>(), (cw + ew).head<2>()});
   }
-  const Eigen::Vector2d reach(has_bounds_ ? 15.0 : 5.0, has_bounds_ ? 15.0 : 5.0);
+  const Eigen::Vector2d near(5.0, 5.0), reach(15.0, 15.0);
+  min_ = centre_W - near;
+  max_ = centre_W + near;
   if (has_bounds_) {
-    min_ = lo.cwiseMax(centre_W - reach);
-    max_ = hi.cwiseMin(centre_W + reach);
-    if ((max_ - min_).minCoeff() < kCellM) {
-      min_ = centre_W - reach;
-      max_ = centre_W + reach;
-    }
-  } else {
-    min_ = centre_W - reach;
-    max_ = centre_W + reach;
+    static_min_ = lo;
+    static_max_ = hi;
+    min_ = min_.cwiseMin(lo).cwiseMax(centre_W - reach);
+    max_ = max_.cwiseMax(hi).cwiseMin(centre_W + reach);
   }
   nx_ = std::max(1, static_cast<int>(std::ceil((max_.x() - min_.x()) / kCellM)));
   ny_ = std::max(1, static_cast<int>(std::ceil((max_.y() - min_.y()) / kCellM)));
@@ -159,6 +156,18 @@ void FloorMap::Flood(const Eigen::Vector2d& seed, double clearance_m) {
     }
   }
   std::sort(reachable_.begin(), reachable_.end());
+}
+
+bool FloorMap::ReachableBounds(Eigen::Vector2d* lo, Eigen::Vector2d* hi) const {
+  if (reachable_.empty()) return false;
+  *lo = Eigen::Vector2d(1e300, 1e300);
+  *hi = -*lo;
+  for (int i : reachable_) {
+    const Eigen::Vector2d c(min_.x() + (i % nx_) * kCellM, min_.y() + (i / nx_) * kCellM);
+    *lo = lo->cwiseMin(c);
+    *hi = hi->cwiseMax(c + Eigen::Vector2d::Constant(kCellM));
+  }
+  return true;
 }
 
 bool FloorMap::RandomFreePoint(uint64_t u, Eigen::Vector2d* p) const {

@@ -21,16 +21,19 @@ class FloorMap {
   /// @param X_WB     pose of every scene body at the start (WorldSnapshot::X_WB)
   /// @param floor_z  height of the floor, m; geoms whose world bounding box overlaps
   ///                 [floor_z + 0.05, floor_z + 2.0] block the cells under them (planes never do)
-  /// @param centre_W the grid covers the static geoms' bounding box (xy), clipped to
-  ///                 centre_W +- 15 m; with no static geoms, centre_W +- 5 m
+  /// @param centre_W the grid covers the static geoms' bounding box (xy) joined with
+  ///                 centre_W +- 5 m, clipped to centre_W +- 15 m
   FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
            const Eigen::Vector2d& centre_W);
 
   /// lower / upper corner (xy) of the mapped area, m.
   const Eigen::Vector2d& min_W() const { return min_; }
   const Eigen::Vector2d& max_W() const { return max_; }
-  /// true if the static geoms' bounds were used (false: the area is a default box).
+  /// true if the scene has static geoms other than planes and height fields.
   bool has_static_bounds() const { return has_bounds_; }
+  /// plan-view bounding box of those static geoms (when has_static_bounds()), m.
+  const Eigen::Vector2d& static_min_W() const { return static_min_; }
+  const Eigen::Vector2d& static_max_W() const { return static_max_; }
   double floor_z() const { return floor_z_; }
 
   /// true if a disc of radius `clearance_m` at p lies inside the map and touches no blocked cell.
@@ -41,6 +44,9 @@ class FloorMap {
   /// Reachable() are then the only ones RandomFreePoint draws from. if the seed cell is
   /// blocked, every free cell counts as reachable.
   void Flood(const Eigen::Vector2d& seed, double clearance_m);
+  /// bounding box (xy) of the reachable cells (after Flood; every free cell before); false
+  /// if there is none.
+  bool ReachableBounds(Eigen::Vector2d* lo, Eigen::Vector2d* hi) const;
   /// a uniformly drawn reachable free point (cell centre), from the 64-bit draw `u`;
   /// false if there is none.
   bool RandomFreePoint(uint64_t u, Eigen::Vector2d* p) const;
@@ -48,6 +54,7 @@ class FloorMap {
  private:
   int Index(int ix, int iy) const { return iy * nx_ + ix; }
   Eigen::Vector2d min_, max_;
+  Eigen::Vector2d static_min_{0, 0}, static_max_{0, 0};
   int nx_ = 0, ny_ = 0;
   double floor_z_ = 0;
   bool has_bounds_ = false;
