@@ -167,9 +167,10 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
     if (ao.z() < zmin && bo.z() < zmin) continue;
     if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
     if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
-    // pinhole projection with a margin of 2 px (lens distortion, rounding).
+    // pinhole projection with a margin of 1 px (rounding; lens distortion moves pixels by more only
+    // far from the centre, where a streak may then be clipped).
     const float z_near = std::min(ao.z(), bo.z()) - r;
-    const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 2.0f;
+    const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 1.0f;
     const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
     const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
     const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
