@@ -104,6 +104,9 @@ TEST_F(CameraRunTest, WritesEveryCameraOutputDeterministically) {
   EXPECT_NEAR(info["rig/right"]["P"][3].get<double>(),
               -0.1 * info["rig/right"]["K"][0].get<double>(), 1e-9);
   EXPECT_TRUE(fs::exists(out / "camera_info.yaml"));
+  const nlohmann::json labels = nlohmann::json::parse(ReadAll(out / "semantic_classes.json"));
+  EXPECT_EQ(labels["ball"], 2);
+  EXPECT_EQ(labels["ground"], 9);
   // semantic classes: the ball (2) and the concrete floor (9) are both in view, nothing else
   const PngImage sem = ReadPng((out / "rig/left/semantic_segmentation/000000.png").string());
   std::set<int> classes(sem.samples.begin(), sem.samples.end());

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "penumbra/app/camera_specs.h"
 #include "penumbra/app/scene_assembly.h"
@@ -74,6 +76,16 @@ CameraStage::CameraStage(const SceneDescription& scene, const WorldConfig& world
     }
   }
   WriteCameraInfo(output_dir, CameraInfosFor(scene.cameras));
+  if (!world.semantic_classes.empty()) {
+    // the labels of the semantic_segmentation ids, in file order
+    nlohmann::ordered_json classes = nlohmann::ordered_json::object();
+    for (const SemanticClassConfig& c : world.semantic_classes) classes[c.name] = c.id;
+    const std::filesystem::path path = std::filesystem::path(output_dir) / "semantic_classes.json";
+    std::ofstream f(path, std::ios::trunc);
+    f << classes.dump(2) << "\n";
+    f.flush();
+    if (!f) throw Error("cannot write '" + path.string() + "'");
+  }
 }
 
 void CameraStage::OnSnapshot(const WorldSnapshot& snapshot, const std::vector<int>& cameras,

@@ -3,13 +3,13 @@
 // shutter; sensors/camera_imager.h), image formation per camera, and the camera outputs beyond
 // rgb/depth/segmentation:
 //
-//   DIR/camera_info.yaml, DIR/camera_info.json      ROS CameraInfo per camera
-//   (output/camera_info.h) DIR/<camera>/range/NNNNNN.png                   16-bit range along the
-//   pixel ray, mm DIR/<camera>/normals/NNNNNN.png                 8-bit rgb = (n_O + 1) / 2 * 255,
-//   unit normal
-//                                                   facing the camera in the optical frame
-//   DIR/<camera>/instance_segmentation/NNNNNN.png   16-bit body index + 1, 0 = background
-//   DIR/<camera>/semantic_segmentation/NNNNNN.png   16-bit semantic class id, 0 = none
+// - DIR/camera_info.yaml, DIR/camera_info.json: ROS CameraInfo per camera (output/camera_info.h)
+// - DIR/semantic_classes.json: {class name: id} of the world file's `semantic_classes:`
+// - DIR/<camera>/range/NNNNNN.png: 16-bit range along the pixel ray, mm, 0 = no hit
+// - DIR/<camera>/normals/NNNNNN.png: 8-bit rgb (n_O + 1) / 2 * 255 of the unit normal facing the
+//   camera in the optical frame
+// - DIR/<camera>/instance_segmentation/NNNNNN.png: 16-bit body index + 1, 0 = background
+// - DIR/<camera>/semantic_segmentation/NNNNNN.png: 16-bit semantic class id, 0 = none
 //
 // depth/ holds the depth sensor's measurement (with depth_noise) or the exact z-depth; all other
 // images are exact. frames.csv time/pose: the capture instant, or mid-exposure (sub-frame n/2)
@@ -50,7 +50,7 @@ class ShutterSchedule {
 class CameraStage {
  public:
   using Submit = std::function<void(CameraFrame&&)>;
-  /// writes camera_info.yaml/json and makes the extra output folders.
+  /// writes camera_info.yaml/json (and semantic_classes.json) and makes the extra output folders.
   /// @throws ConfigError for bad camera sensor settings; Error if files cannot be written.
   CameraStage(const SceneDescription& scene, const WorldConfig& world, Renderer* renderer,
               const std::string& output_dir);

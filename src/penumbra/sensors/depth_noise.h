@@ -6,9 +6,10 @@
 //   2. holes: incidence angle theta (between the pixel ray and the surface normal) above
 //      max_incidence_deg -> no return; IR reflectance below min_reflectance -> no return;
 //      specular surfaces (mirror-like: reflectance image flags them) -> no return.
-//   3. participating media (smoke, fog): with one-way transmittance T along the pixel ray to the
-//      surface, the return survives with probability T^2 = exp(-2 tau) (the emitted pattern and
-//      its reflection both cross the medium), and never below min_round_trip_transmittance.
+//   3. participating media (fog, smoke; homogeneous and voxel grids): with one-way transmittance
+//      T along the pixel ray to the surface (DepthTransmittance), the return survives with
+//      probability T^2 = exp(-2 tau) (the emitted pattern and its reflection both cross the
+//      medium), and never when T^2 < min_round_trip_transmittance.
 //   4. lateral noise: the depth is read from the pixel displaced by N(0, sigma_L^2) in u and v
 //      (rounded to the nearest pixel), which jags depth edges; flat surfaces are unaffected.
 //   5. axial noise: z + N(0, sigma_z(z, theta)^2).
@@ -23,7 +24,8 @@
 //   kinect_v2       Fankhauser et al., "Kinect v2 for mobile robot navigation: evaluation and
 //                   modeling", ICAR 2015: sigma_z = 1.5 - 0.5 z + 0.3 z^2 + 0.1 z^1.5 theta^2 /
 //                   (pi/2 - theta)^2 mm, lateral sigma_L = 1.6 px (their reported ~constant
-//                   lateral noise, rounded); range 0.5-4.5 m (Microsoft spec).
+//                   lateral noise, rounded); range 0.5-4.5 m (Microsoft spec). the constants are
+//                   quoted from memory of the paper and should be checked against it.
 //   realsense_d435  Intel, "Tuning depth cameras for best performance" (Grunnet-Jepsen, Sweetser,
 //                   Woodfill, Intel RealSense white paper, 2018), depth RMS error =
 //                   z^2 subpixel / (f baseline) with subpixel = 0.08, baseline = 50 mm (D435
