@@ -162,6 +162,39 @@ TEST(MediaTransmittanceTest, TiersAgreeBehindDensityRamp) {
   RecordProperty("realtime_over_pathtraced", std::to_string(mean[0] / mean[1]));
 }
 
+TEST(MediaTransmittanceTest, GridEmissionIntegratesAlongTheRay) {
+  // a uniform emissive, absorbing grid (fire) in front of a black background: a ray crossing
+  // length l of it gains emission (1 - exp(-sigma_t l)) / sigma_t.
+  const SceneDescription s = EmptyScene();
+  GridMedium g = RampGrid({2, 0, 0}, {1, 3, 3}, 4, 0.5f, 0.0f, 1.0f, 0.0f);
+  auto e = std::make_shared<std::vector<float>>(4 * 2 * 2 * 3);
+  for (size_t i = 0; i < e->size(); i += 3) (*e)[i] = 2.0f, (*e)[i + 1] = 1.0f, (*e)[i + 2] = 0.5f;
+  g.emission = e;
+  EffectsFrame fx;
+  fx.grid_media.push_back(g);
+  const CameraView view = MakeView(CameraLookingAlongX(), kW, kH, kFovy, true, false, false);
+  double expected = 0;
+  for (int v = 0; v < kH; ++v)
+    for (int u = 0; u < kW; ++u) {
+      const double l = RangeOfPixel(view.intrinsics, u, v, 2.0);  // 2 m of grid along x
+      expected += 1.0 * (1 - std::exp(-0.5 * l)) / 0.5;
+    }
+  expected /= kW * kH;
+  for (RenderSettings::Tier tier :
+       {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
+    auto r = MakeEmbreeRenderer(s, TierSettings(tier, 128));
+    RenderedFrame f;
+    r->Render(SnapshotWith(s, fx), view, &f);
+    const double got = MeanRadiance(f.radiance, 0, kW, 0, kH, 1);
+    EXPECT_NEAR(got, expected, 0.02 * expected) << static_cast<int>(tier);
+    // the channels keep the emission's colour.
+    EXPECT_NEAR(MeanRadiance(f.radiance, 0, kW, 0, kH, 0), 2 * got, 0.02 * 2 * got);
+    RecordProperty(std::string("emission_ratio_") +
+                       (tier == RenderSettings::Tier::kRealtime ? "realtime" : "pathtraced"),
+                   std::to_string(got / expected));
+  }
+}
+
 TEST(MediaTransmittanceTest, MalformedGridThrowsConfigError) {
   EffectsFrame fx;
   GridMedium g = RampGrid({0, 0, 0}, {1, 1, 1}, 4, 1, 0, 1, 0);
