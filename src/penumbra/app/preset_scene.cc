@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 
 #include "penumbra/app/scene_assembly.h"
 #include "penumbra/compose/scene_composer.h"
@@ -10,6 +11,19 @@
 #include "penumbra/physics/urdf_converter.h"
 
 namespace penumbra {
+namespace {
+
+double CpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+double WallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
 
 PresetScene LoadPresetScene(const WorldConfig& world_in, const std::string& adversity) {
   WorldConfig world = world_in;
@@ -37,7 +51,7 @@ void PresetScene::StepTo(double t_sec) {
   while (sim->time() < t_sec - 1e-9) sim->Step();
 }
 
-RenderedFrame PresetScene::Render(int camera, int width, int height, double* effects_sec) {
+RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTiming* timing) {
   const CameraSpec& cam = scene.cameras.at(camera);
   WorldSnapshot snap = sim->Snapshot();
   CameraView view;
@@ -53,12 +67,17 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, double* eff
   view.exposure_time_sec = cam.exposure_time_sec;
   view.frame_index = snap.step;
   view.camera_index = camera;
-  const auto t0 = std::chrono::steady_clock::now();
+  RenderTiming t;
+  double w0 = WallSeconds(), c0 = CpuSeconds();
   snap.effects = effects->Evaluate(snap, view.X_WO.translation());
-  if (effects_sec)
-    *effects_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  double w1 = WallSeconds(), c1 = CpuSeconds();
+  t.effects_wall = w1 - w0;
+  t.effects_cpu = c1 - c0;
   RenderedFrame frame;
   renderer->Render(snap, view, &frame);
+  t.render_wall = WallSeconds() - w1;
+  t.render_cpu = CpuSeconds() - c1;
+  if (timing) *timing = t;
   return frame;
 }
 

@@ -13,6 +13,12 @@
 
 namespace penumbra {
 
+/// wall-clock and process CPU time (all threads) of one PresetScene::Render, s.
+struct RenderTiming {
+  double effects_wall = 0, effects_cpu = 0;  ///< EffectsStage::Evaluate
+  double render_wall = 0, render_cpu = 0;    ///< Renderer::Render
+};
+
 /// everything needed to step a world and render its cameras with effects.
 struct PresetScene {
   std::unique_ptr<EffectsStage> effects;
@@ -24,8 +30,8 @@ struct PresetScene {
   void StepTo(double t_sec);
   /// renders scene camera `camera` (its intrinsics unless width/height > 0, then the same
   /// vertical field of view at that size) at the current time, effects included.
-  /// @param effects_sec if not null, receives the time spent evaluating effects (s)
-  RenderedFrame Render(int camera, int width = 0, int height = 0, double* effects_sec = nullptr);
+  /// @param timing if not null, receives the times of the effects and of the render
+  RenderedFrame Render(int camera, int width = 0, int height = 0, RenderTiming* timing = nullptr);
 };
 
 /// loads `world` with the preset spec `adversity` ("" = the world's own).
