@@ -11,9 +11,10 @@
 // contype or conaffinity has bit 0 set (all bundled robots); condim 3, friction 0.8.
 //
 // shapes (agent frame A: origin on the floor, x forward, y left, z up; AgentKind):
-//   person    legs and arms capsules (r 0.07 / 0.05 m), torso box 0.22 x 0.38 x 0.56 m,
+//   person    legs and arms capsules (r 0.07 / 0.05 m), torso box 0.22 x 0.38 x 0.5 m,
 //             pelvis box, head sphere r 0.11 m; all heights scale with height_m / 1.75.
-//   forklift  chassis 1.6 x 1.1 x 0.7 m, counterweight, four wheels (cylinders r 0.25 m),
+//   forklift  about 2.75 x 1.1 x 2.1 m overall: chassis 1.6 x 1.1 x 0.7 m, counterweight, four
+//   wheels (cylinders r 0.25 m),
 //             mast (two 2.0 m uprights), overhead guard at 2.1 m on four posts, two forks
 //             1.1 m long in front (x = 0.8 ... 1.9 m) 0.1 m above the floor.
 //   cart      deck 1.0 x 0.6 m at 0.3 m, four wheels (r 0.1 m), push handle 1.0 m high.

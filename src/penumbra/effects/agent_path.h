@@ -28,7 +28,8 @@ namespace penumbra {
 /// what an agent looks like (its MJCF body, compose/agent_bodies.h) and its segmentation class.
 enum class AgentKind {
   kPerson,    ///< "person": a 1.75 m (height_m) figure of capsules and boxes
-  kForklift,  ///< "forklift": a counterbalance forklift of boxes, 2.6 x 1.1 x 2.1 m with forks
+  kForklift,  ///< "forklift": a counterbalance forklift of boxes, about 2.75 x 1.1 x 2.1 m with
+              ///< forks
   kCart,      ///< "cart": a hand cart, 1.0 x 0.6 x 1.0 m
 };
 
