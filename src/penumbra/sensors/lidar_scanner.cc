@@ -350,10 +350,11 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
         if (b > a) {
           const double h = (b - a) / kSoftSamples;
           double tau = media.OpticalDepth(o, d, a);
+          double trans = std::exp(-2 * tau);  // T^2 at the start of the current step
           double soft_best = 0, soft_r = 0;
           for (int k = 0; k < kSoftSamples; ++k) {
             const double R = a + (k + 0.5) * h;
-            const double bound = std::exp(-2 * tau) * bound_numerator / (R * R);
+            const double bound = trans * bound_numerator / (R * R);
             if (bound < std::max(soft_best, floor_power)) {
               tau_stop = tau;
               r_stop = R;
@@ -361,10 +362,14 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
             }
             double sigma, beta;
             media.At(o + R * d, &sigma, &beta);
-            const double tau_mid = tau + sigma * 0.5 * h;
+            // T^2 over half a step: e^{-sigma h} (one exp per sample)
+            const double half = sigma > 0 ? std::exp(-sigma * h) : 1.0;
+            const double trans_mid = trans * half;
+            trans = trans_mid * half;
             tau += sigma * h;
+            if (beta <= 0) continue;
             const double xi = std::clamp((R - r1) / (r2 - r1), 0.0, 1.0);
-            const double ps = beta * pulse_len * xi * std::exp(-2 * tau_mid) / (R * R);
+            const double ps = beta * pulse_len * xi * trans_mid / (R * R);
             if (ps > soft_best) {
               soft_best = ps;
               soft_r = R;
