@@ -80,6 +80,7 @@ TEST_F(SensorRunTest, WritesScansImuMujocoAndGroundTruth) {
   const WorldConfig world = World(R"(    sensors:
       - {name: rest_imu, type: imu, site: imu_site, preset: ideal, rate_hz: 200, latency_sec: 0.01}
       - {name: fall_imu, type: imu, body: ball, preset: ideal, rate_hz: 200}
+      - {name: rot_imu, type: imu, site: imu_site, pose: {rpy_deg: [90, 0, 0]}, preset: ideal}
 sensors:
   - name: lidar
     type: lidar
@@ -115,6 +116,11 @@ sensors:
   EXPECT_NEAR(std::stod(rest[150][2]) - std::stod(rest[150][1]), 0.01, 1e-9);  // latency
   EXPECT_NEAR(std::stod(rest[150][5]), 9.81, 0.01);
   for (int k = 1; k <= 3; ++k) EXPECT_LT(std::abs(std::stod(fall[150][2 + k])), 1e-6);
+  // rolled 90 deg about x relative to the site: world up is the IMU's +y
+  const auto rot = Csv(out / "imu" / "rot_imu.csv");
+  ASSERT_GT(rot.size(), 150u);
+  EXPECT_NEAR(std::stod(rot[150][4]), 9.81, 0.01);
+  EXPECT_NEAR(std::stod(rot[150][5]), 0.0, 0.01);
   // mujoco touch: 50 Hz, weight of the 1 kg box
   const auto touch = Csv(out / "sensors" / "touch.csv");
   ASSERT_EQ(touch.size(), 52u);
