@@ -92,6 +92,14 @@ TEST(AdversityPresets, BundledNoneMinorMajorWithIncreasingSeverity) {
   EXPECT_GT(major.npc_people + major.npc_vehicles, minor.npc_people + minor.npc_vehicles);
 }
 
+TEST(AdversityPresets, TheExampleUserFileLoads) {
+  const std::string file = std::string(PENUMBRA_SOURCE_DIR) + "/worlds/adversity/night_shift.yaml";
+  const AdversityPreset p = LoadAdversityPreset(file + "#night_shift");
+  EXPECT_EQ(p.npc_vehicles, 2);
+  EXPECT_EQ(*p.dust_mor_m, 20);
+  EXPECT_EQ(*LoadAdversityPreset(file + "#blizzard").snow_rate_mm_h, 8);
+}
+
 TEST(AdversityPresets, WorldKeyAndErrors) {
   EXPECT_EQ(ParseWorld("adversity: major\n", "w.yaml").adversity, "major");
   EXPECT_EQ(ErrorOf("duration_sec: 2\nadversity: extreme\n"),
