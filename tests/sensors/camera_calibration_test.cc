@@ -1,21 +1,29 @@
 // lens distortion end to end: a checkerboard rendered through a Brown-Conrady camera, its corners
 // detected with OpenCV (findChessboardCorners + cornerSubPix) and cv::calibrateCamera must give
-// back the intrinsics and distortion the renderer used.
+// back the intrinsics and every distortion coefficient (k1 k2 p1 p2 k3) within 1 % relative, with
+// a reprojection rms below 0.5 px (issue 5 acceptance).
 //
-// what "within 1 %" means here: k1 (the dominant term) within 1 % relative; the whole recovered
-// distortion model within 1 % of the largest distortion displacement (124 px), as the largest
-// pixel difference between the true and recovered models over the image radius the detected
-// corners cover. k2, k3, p1 and p2 are printed, not asserted to 1 % each: with ~0.15 px corner
-// detection noise they trade off against each other (k2/k3 are strongly correlated, p2 moves
-// pixels by < 0.5 px), so per-coefficient relative errors are not identifiable from any real
-// corner detections; ExactCornerProjectionsRecoverEveryCoefficient checks each one without
-// detection noise.
+// what makes the coefficients identifiable from detected corners (~0.08 px rms detection error):
+// - the lens: a decentred wide-angle lens (90 deg horizontal field of view at 1280 x 960) whose
+//   every term moves the outer image by many pixels (at the image corner k2 ~ 300 px, k3 ~ 150 px,
+//   p1, p2 ~ 4-8 px), so that an absolute error of ~1e-3 on k3 and ~2e-5 on p1/p2 is < 1 %. With a
+//   mild lens (k3 -0.01, p1 1e-3, p2 -5e-4 at 640 x 480) the same detection error gave k3 +57 %.
+// - the views: 18 views with the 16 x 12 board (165 inner corners) as large as fits in the frame,
+//   tilted 30-50 deg about varied axes, its centre placed in the middle, at the four edges and at
+//   the four corners of the image, so that corners reach 92 % of the image's corner radius
+//   (k2/k3 and p1/p2 are determined by the outer image region).
+// - the image: 1280 x 960, 2 x 2 supersampled, an emissive white backing with black tiles and no
+//   lighting (radiance exactly 1 or 0), cornerSubPix on the float supersampled image with a 15 x 15
+//   window.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <utility>
 #include <vector>
 
 #include "penumbra/render/camera.h"
@@ -25,25 +33,27 @@
 namespace penumbra {
 namespace {
 
-constexpr int kSquaresX = 10, kSquaresY = 7;  // 9 x 6 inner corners (asymmetric: unambiguous)
-constexpr double kSquare = 0.07;              // m
+constexpr int kSquaresX = 16, kSquaresY = 12;  // 15 x 11 inner corners (asymmetric: unambiguous)
+constexpr double kSquare = 0.04;               // m
 // black tiles are 20 um thick boxes on the white backing: their top faces are the board plane
 // (thin, so that their side walls do not widen the black squares seen from oblique views)
 constexpr double kTopZ = 2e-5;
 
 CameraIntrinsics TrueIntrinsics() {
   CameraIntrinsics k;
-  k.width = 640;
-  k.height = 480;
-  k.fx = 500;
-  k.fy = 502;
-  k.cx = 322.5;
-  k.cy = 237.5;
-  k.k1 = -0.28;
-  k.k2 = 0.07;
-  k.p1 = 1e-3;
-  k.p2 = -5e-4;
-  k.k3 = -0.01;
+  // a wide-angle (90 deg horizontal) lens with strong barrel distortion and a decentring
+  // (tangential) component; passes the fold check (FindDistortionProblem) over the whole image.
+  k.width = 1280;
+  k.height = 960;
+  k.fx = 1000;
+  k.fy = 1004;
+  k.cx = 643.5;
+  k.cy = 475.5;
+  k.k1 = -0.35;
+  k.k2 = 0.3;
+  k.p1 = 4e-3;
+  k.p2 = -3.5e-3;
+  k.k3 = -0.15;
   return k;
 }
 
@@ -102,32 +112,80 @@ Pose LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eig
   return X;
 }
 
-// 12 views: the board (about 390 x 270 px from 0.9 m) placed at the centre, the four edges and
-// the four corners of the image (so corners reach the largest radii), plus three tilted views.
-std::vector<Pose> Views() {
-  std::vector<Pose> v;
-  int n = 0;
-  for (double dy : {-0.17, 0.0, 0.17}) {
-    for (double dx : {-0.22, 0.0, 0.22}) {
-      const double a = 0.7 * n++;
-      const Eigen::Vector3d eye(0.08 * std::cos(a), 0.08 * std::sin(a), 0.9);
-      const double roll = 0.12 * std::sin(1.7 * a);
-      v.push_back(LookAt(eye, Eigen::Vector3d(dx, dy, 0),
-                         Eigen::Vector3d(std::sin(roll), std::cos(roll), 0)));
+// true when the whole checker area of the board projects inside the image, `margin_px` from its
+// border (findChessboardCorners needs the full pattern), and no part of it lies beyond the
+// undistorted radius of the image corners (where the forward model is not one-to-one).
+bool BoardFits(const Pose& X_WO, const CameraIntrinsics& k, double margin_px) {
+  const Camera cam(X_WO, k);
+  double r_max = 0;
+  for (const auto& [u, v] : {std::pair<double, double>{0, 0},
+                             {k.width - 1.0, k.height - 1.0},
+                             {0, k.height - 1.0},
+                             {k.width - 1.0, 0}}) {
+    double x, y;
+    UndistortNormalized(k, (u - k.cx) / k.fx, (v - k.cy) / k.fy, &x, &y);
+    r_max = std::max(r_max, std::hypot(x, y));
+  }
+  const Pose X_OW = X_WO.inverse();
+  const double bx = kSquaresX * kSquare / 2, by = kSquaresY * kSquare / 2;
+  constexpr int kSteps = 40;
+  for (int t = 0; t <= kSteps; ++t) {
+    const double s = -1 + 2.0 * t / kSteps;
+    for (const Eigen::Vector3d& p :
+         {Eigen::Vector3d(s * bx, -by, 0), Eigen::Vector3d(s * bx, by, 0),
+          Eigen::Vector3d(-bx, s * by, 0), Eigen::Vector3d(bx, s * by, 0)}) {
+      const Eigen::Vector3d p_O = X_OW * p;
+      if (p_O.z() <= 0 || std::hypot(p_O.x() / p_O.z(), p_O.y() / p_O.z()) > r_max) return false;
+      Eigen::Vector2d uv;
+      double z;
+      if (!cam.Project(p, &uv, &z)) return false;
+      if (uv.x() < margin_px || uv.y() < margin_px || uv.x() > k.width - 1 - margin_px ||
+          uv.y() > k.height - 1 - margin_px)
+        return false;
     }
   }
-  v.push_back(LookAt(Eigen::Vector3d(0.35, 0.0, 0.8), Eigen::Vector3d(0.02, 0, 0),
-                     Eigen::Vector3d(0, 1, 0)));
-  v.push_back(LookAt(Eigen::Vector3d(-0.1, 0.35, 0.75), Eigen::Vector3d(0, 0.03, 0),
-                     Eigen::Vector3d(0.2, 1, 0)));
-  v.push_back(LookAt(Eigen::Vector3d(-0.3, -0.25, 0.8), Eigen::Vector3d(-0.03, -0.02, 0),
-                     Eigen::Vector3d(-0.1, 1, 0)));
+  return true;
+}
+
+// 18 views: view i looks at the board from a direction tilted 30-50 deg from its normal (tilt
+// and azimuth from golden-ratio sequences), rolled up to +-17 deg, with the board centre aimed at
+// the image centre, one of the four image corners or one of the four edge midpoints (70 % of the
+// way out), from the smallest distance at which the whole board still fits in the image.
+std::vector<Pose> Views() {
+  const CameraIntrinsics k = TrueIntrinsics();
+  constexpr double kAim[9][2] = {{0, 0},  {-1, -1}, {1, -1}, {1, 1}, {-1, 1},
+                                 {0, -1}, {1, 0},   {0, 1},  {-1, 0}};
+  constexpr double kPi = 3.14159265358979323846;
+  std::vector<Pose> v;
+  for (int i = 0; i < 18; ++i) {
+    const double tilt = (30 + 20 * std::fmod(0.618034 * i, 1.0)) * kPi / 180;
+    const double azimuth = 2 * kPi * std::fmod(0.381966 * i + 0.1, 1.0);
+    const double roll = 0.3 * std::sin(2.3 * i);
+    const Eigen::Vector3d dir(std::sin(tilt) * std::cos(azimuth),
+                              std::sin(tilt) * std::sin(azimuth), std::cos(tilt));
+    // rotate the optical frame so that the board centre lands at the aimed image position
+    const double ax = std::atan(kAim[i % 9][0] * 0.7 * (k.width / 2) / k.fx);
+    const double ay = std::atan(kAim[i % 9][1] * 0.7 * (k.height / 2) / k.fy);
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(-ax, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(ay, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+    for (double d = 0.3; d < 6; d *= 1.01) {
+      Pose X = LookAt(d * dir, Eigen::Vector3d::Zero(),
+                      Eigen::Vector3d(std::sin(roll), std::cos(roll), 0.3));
+      X.linear() = X.linear() * R;
+      if (BoardFits(X, k, 8)) {
+        v.push_back(X);
+        break;
+      }
+    }
+  }
   return v;
 }
 
-// a 2 x 2 supersampled render: each pass shifts the principal point by a sub-pixel offset, so
-// pixel (u, v) of the pass sees the true camera's ray through (u + du, v + dv).
-cv::Mat RenderGray(Renderer* r, const SceneDescription& s, const Pose& X_WO) {
+// a 2 x 2 supersampled render ((H x W) float, 0..255): each pass shifts the principal point by a
+// sub-pixel offset, so pixel (u, v) of the pass sees the true camera's ray through (u + du, v +
+// dv).
+cv::Mat RenderSupersampled(Renderer* r, const SceneDescription& s, const Pose& X_WO) {
   const CameraIntrinsics k = TrueIntrinsics();
   WorldSnapshot snap;
   snap.X_WB.assign(s.bodies.size(), Pose::Identity());
@@ -147,9 +205,8 @@ cv::Mat RenderGray(Renderer* r, const SceneDescription& s, const Pose& X_WO) {
         for (int u = 0; u < k.width; ++u) acc.at<float>(v, u) += f.radiance.at(u, v)[1];
     }
   }
-  cv::Mat gray;
-  acc.convertTo(gray, CV_8U, 255.0 / (S * S));
-  return gray;
+  acc *= 255.0 / (S * S);
+  return acc;
 }
 
 // largest pixel displacement difference between two distortion models over the pixels within
@@ -181,7 +238,7 @@ Calibration Calibrate(const std::vector<std::vector<cv::Point3f>>& obj,
   cv::Mat K, D;
   std::vector<cv::Mat> rv, tv;
   const double rms = cv::calibrateCamera(
-      obj, img, cv::Size(640, 480), K, D, rv, tv, 0,
+      obj, img, cv::Size(TrueIntrinsics().width, TrueIntrinsics().height), K, D, rv, tv, 0,
       cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-12));
   Calibration c;
   c.rms = rms;
@@ -280,15 +337,17 @@ TEST(CameraCalibrationTest, DetectedCornersRecoverTheDistortion) {
   double sum_sq_detection_error = 0, max_radius = 0;
   int n_corners = 0;
   for (const Pose& X_WO : Views()) {
-    const cv::Mat gray = RenderGray(renderer.get(), scene, X_WO);
+    const cv::Mat image = RenderSupersampled(renderer.get(), scene, X_WO);
+    cv::Mat gray;
+    image.convertTo(gray, CV_8U);
     std::vector<cv::Point2f> corners;
     if (!cv::findChessboardCorners(gray, cv::Size(kSquaresX - 1, kSquaresY - 1), corners,
                                    cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE)) {
       std::printf("board not found in a view\n");
       continue;
     }
-    cv::cornerSubPix(gray, corners, cv::Size(5, 5), cv::Size(-1, -1),
-                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 1e-4));
+    cv::cornerSubPix(image, corners, cv::Size(7, 7), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 1e-6));
     // label each detection with its board corner: the nearest true projection (labels only)
     const Camera cam(X_WO, truth);
     std::vector<cv::Point3f> o;
@@ -313,7 +372,7 @@ TEST(CameraCalibrationTest, DetectedCornersRecoverTheDistortion) {
     obj.push_back(o);
     det.push_back(d);
   }
-  ASSERT_GE(obj.size(), 11u) << "the board was found in too few views";
+  ASSERT_GE(obj.size(), 17u) << "the board was found in too few views";
   const Calibration c = Calibrate(obj, det);
   const double detection_rms = std::sqrt(sum_sq_detection_error / n_corners);
   const double distortion_px = MaxModelDifferencePx(truth, [&] {
@@ -341,7 +400,12 @@ TEST(CameraCalibrationTest, DetectedCornersRecoverTheDistortion) {
   EXPECT_NEAR(c.k.fy, truth.fy, 0.01 * truth.fy);
   EXPECT_NEAR(c.k.cx, truth.cx, 1.0);
   EXPECT_NEAR(c.k.cy, truth.cy, 1.0);
+  EXPECT_LT(detection_rms, 0.15);
   EXPECT_NEAR(c.k.k1, truth.k1, 0.01 * std::abs(truth.k1));
+  EXPECT_NEAR(c.k.k2, truth.k2, 0.01 * std::abs(truth.k2));
+  EXPECT_NEAR(c.k.p1, truth.p1, 0.01 * std::abs(truth.p1));
+  EXPECT_NEAR(c.k.p2, truth.p2, 0.01 * std::abs(truth.p2));
+  EXPECT_NEAR(c.k.k3, truth.k3, 0.01 * std::abs(truth.k3));
   EXPECT_LT(model_error_px, 0.01 * distortion_px);
 }
 
