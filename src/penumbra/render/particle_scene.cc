@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -32,6 +33,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   set_.clear();
   ends_.clear();
   rain_radiance_.clear();
+  visible_.clear();
   pixel_t_.clear();
   pixel_prim_.clear();
   if (impl_->scene) {
@@ -156,44 +158,80 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   constexpr float kNear = 0.01f;
-  // pixel box of every streak (empty when behind the camera).
+  // pixel box and projected segment (ua, va, ub, vb, rp) of every streak, in parallel chunks
+  // (empty box when behind the camera or outside the image).
   std::vector<Eigen::Vector4i> box(count_, Eigen::Vector4i(0, -1, 0, -1));
-  for (int n = 0; n < count_; ++n) {
+  std::vector<std::array<float, 5>> seg2(count_);
+  auto project = [&](int n) {
     const float r = ends_[2 * n].w();
     // the segment in the optical frame, clipped to z >= kNear + r.
     Eigen::Vector3f ao = R_OW * ends_[2 * n].head<3>() + p_OW;
     Eigen::Vector3f bo = R_OW * ends_[2 * n + 1].head<3>() + p_OW;
     const float zmin = kNear + r;
-    if (ao.z() < zmin && bo.z() < zmin) continue;
+    if (ao.z() < zmin && bo.z() < zmin) return;
     if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
     if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
-    // pinhole projection with a margin of 1 px (rounding; lens distortion moves pixels by more only
-    // far from the centre, where a streak may then be clipped).
+    // pinhole projection with a margin of 1 px (rounding; lens distortion moves pixels by more
+    // only far from the centre, where a streak may then be clipped).
     const float z_near = std::min(ao.z(), bo.z()) - r;
     const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 1.0f;
     const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
     const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
     const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
     const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
+    seg2[n] = {ua, va, ub, vb, rp};
     box[n] = Eigen::Vector4i(std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp))),
                              std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp))),
                              std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp))),
                              std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp))));
+  };
+  constexpr int kChunk = 4096;
+  const int chunks = (count_ + kChunk - 1) / kChunk;
+  auto chunk = [&](int64_t c) {
+    const int n1 = std::min(count_, static_cast<int>(c + 1) * kChunk);
+    for (int n = static_cast<int>(c) * kChunk; n < n1; ++n) project(n);
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(chunks, chunk);
+  } else {
+    for (int64_t c = 0; c < chunks; ++c) chunk(c);
   }
   // bands of rows in parallel; within a band streaks in index order (nearest wins, ties keep
   // the lower index), so the result does not depend on the thread count.
   constexpr int kBand = 16;
   const int bands = (H + kBand - 1) / kBand;
+  // the streaks of every band, in index order; streaks outside the image are culled.
+  std::vector<std::vector<int>> in_band(bands);
+  visible_.assign(count_, 0);
+  for (int n = 0; n < count_; ++n) {
+    const Eigen::Vector4i& bx = box[n];
+    if (bx[0] > bx[1] || bx[2] > bx[3]) continue;
+    visible_[n] = 1;
+    for (int bi = bx[2] / kBand; bi <= bx[3] / kBand; ++bi) in_band[bi].push_back(n);
+  }
   auto band = [&](int64_t bi) {
     const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
-    for (int n = 0; n < count_; ++n) {
+    for (int n : in_band[bi]) {
       const Eigen::Vector4i& bx = box[n];
       const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
       if (v0 > v1 || bx[0] > bx[1]) continue;
       const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
       const float r = ends_[2 * n].w();
-      for (int v = v0; v <= v1; ++v)
-        for (int u = bx[0]; u <= bx[1]; ++u) {
+      const auto& [ua, va, ub, vb, rp] = seg2[n];
+      const float du = ub - ua, dv = vb - va;
+      for (int v = v0; v <= v1; ++v) {
+        // the columns within rp of the projected segment's part near this row.
+        float s0 = 0, s1 = 1;
+        if (std::abs(dv) > 1e-6f) {
+          s0 = std::clamp((v - rp - va) / dv, 0.0f, 1.0f);
+          s1 = std::clamp((v + rp - va) / dv, 0.0f, 1.0f);
+          if (s0 > s1) std::swap(s0, s1);
+        }
+        const float ul = std::min(ua + s0 * du, ua + s1 * du) - rp;
+        const float uh = std::max(ua + s0 * du, ua + s1 * du) + rp;
+        const int c0 = std::max(bx[0], static_cast<int>(std::floor(ul)));
+        const int c1 = std::min(bx[1], static_cast<int>(std::ceil(uh)));
+        for (int u = c0; u <= c1; ++u) {
           const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
           const float len = ray.d.norm();
           const float t = IntersectCapsule(ray.o, ray.d / len, a, b, r);
@@ -205,6 +243,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
             pixel_prim_[at] = n;
           }
         }
+      }
     }
   };
   if (pool != nullptr) {
@@ -271,12 +310,13 @@ void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vect
                                    ThreadPool* pool) {
   rain_radiance_.clear();
   bool any = false;
+  const bool culled = !visible_.empty();  // realtime: only streaks in the image are drawn
   for (int n = 0; n < count_ && !any; ++n)
     any = fx_->particles[set_[n]].kind == ParticleKind::kRain;
   if (!any) return;
   std::vector<Eigen::Vector3f> L(count_, Eigen::Vector3f::Zero());
   auto one = [&](int64_t n) {
-    if (fx_->particles[set_[n]].kind != ParticleKind::kRain) return;
+    if (fx_->particles[set_[n]].kind != ParticleKind::kRain || (culled && !visible_[n])) return;
     ParticleHit h;
     h.kind = ParticleKind::kRain;
     h.set = set_[n];

@@ -29,6 +29,7 @@
 // they do not change the depth or segmentation images.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -100,6 +101,7 @@ class ParticleScene {
   std::vector<float> pixel_t_;   // per pixel: nearest streak t (ray units), +inf none
   std::vector<int> pixel_prim_;  // per pixel: its primitive, -1 none
   std::vector<Eigen::Vector3f> rain_radiance_;  // per primitive (PrecomputeRain), or empty
+  std::vector<uint8_t> visible_;  // per primitive: in the image (BuildPixelHits), or empty
 
   void BuildPixelHits(const Camera& camera, ThreadPool* pool);
 };
