@@ -7,6 +7,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/effects/blackbody.h"
+#include "penumbra/effects/sun.h"
 
 namespace penumbra {
 namespace {
@@ -177,6 +178,51 @@ TEST(EffectsEngineTest, SunSetsDirectionAndDimsTheSkyAtNight) {
   auto night = engine.Evaluate(12.0, {0, 0, 0});  // 23:00 UTC
   EXPECT_LT(night->sun_direction_W->z(), 0);
   EXPECT_LT(night->sky_luminance_scale, 0.01f);
+}
+
+TEST(EffectsEngineTest, SunMovesTheSceneSunLight) {
+  SceneDescription scene;
+  Light lamp;
+  lamp.name = "lamp";
+  lamp.type = Light::Type::kPoint;
+  Light sun;
+  sun.name = "sun";
+  sun.type = Light::Type::kDirectional;
+  sun.direction_B = Eigen::Vector3d(0, 0, -1);
+  sun.intensity = 100000;
+  scene.lights = {lamp, sun};
+  EffectConfig e;
+  e.name = "day";
+  e.type = EffectType::kSun;
+  e.sun.time_utc_h = 11.0;
+  e.sun.time_scale = 3600;
+  EffectsEngine engine({e}, 1, scene);
+  auto noon = engine.Evaluate(0.0, {0, 0, 0});
+  ASSERT_EQ(noon->light_intensity_scale.size(), 2u);
+  EXPECT_EQ(noon->light_intensity_scale[0], 1.0f);  // the lamp is left alone
+  EXPECT_EQ(noon->light_intensity_scale[1], 0.0f);  // the configured sun is replaced
+  ASSERT_EQ(noon->extra_lights.size(), 1u);
+  const Light& moved = noon->extra_lights[0];
+  EXPECT_EQ(moved.type, Light::Type::kDirectional);
+  EXPECT_NEAR((moved.direction_B + *noon->sun_direction_W).norm(), 0, 1e-12);
+  // at ~65 deg elevation the beam is a few percent weaker than at the zenith
+  const double elevation = std::asin(noon->sun_direction_W->z()) * 180 / M_PI;
+  EXPECT_NEAR(moved.intensity, 100000 * DirectSunAttenuation(elevation), 1.0);
+  EXPECT_GT(moved.intensity, 90000);
+  EXPECT_LT(moved.intensity, 100000);
+  // at night the sun is gone
+  auto night = engine.Evaluate(12.0, {0, 0, 0});
+  EXPECT_EQ(night->light_intensity_scale[1], 0.0f);
+  EXPECT_TRUE(night->extra_lights.empty());
+}
+
+TEST(EffectsEngineTest, DirectSunAttenuationFollowsAirMass) {
+  EXPECT_NEAR(DirectSunAttenuation(90), 1.0, 1e-3);  // Kasten-Young AM(90 deg) = 0.9997
+  EXPECT_EQ(DirectSunAttenuation(0), 0.0);
+  EXPECT_EQ(DirectSunAttenuation(-5), 0.0);
+  // AM(30 deg) is just under the flat-earth 1 / sin(30 deg) = 2 (1.9943 by the formula)
+  EXPECT_NEAR(DirectSunAttenuation(30), std::pow(0.7, std::pow(1.9942, 0.678)) / 0.7, 1e-3);
+  EXPECT_NEAR(DirectSunAttenuation(0.01), 0.021, 0.001);  // AM ~ 38 at the horizon
 }
 
 TEST(EffectsEngineTest, WetnessFollowsRain) {

@@ -133,6 +133,9 @@ EffectsEngine::EffectsEngine(const std::vector<EffectConfig>& effects, uint64_t 
           }
         }
         break;
+      case EffectType::kSun:
+        any_sun_ = true;
+        break;
       case EffectType::kSparks:
         rt->spark_origin = e.sparks.position_W;
         for (const EffectConfig& o : effects) {
@@ -145,6 +148,11 @@ EffectsEngine::EffectsEngine(const std::vector<EffectConfig>& effects, uint64_t 
         break;
     }
     runtimes_.push_back(std::move(rt));
+  }
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    if (scene.lights[l].type == Light::Type::kDirectional) {
+      directional_lights_.emplace_back(static_cast<int>(l), scene.lights[l]);
+    }
   }
   // wetness refers to its rain by pointer into the runtimes (stable: unique_ptr)
   for (auto& rt : runtimes_) {
@@ -166,7 +174,7 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
                                                             const std::vector<Pose>* X_WB) {
   auto frame = std::make_shared<EffectsFrame>();
   frame->time_sec = t;
-  if (any_light_event_) frame->light_intensity_scale.assign(num_scene_lights_, 1.0f);
+  if (any_light_event_ || any_sun_) frame->light_intensity_scale.assign(num_scene_lights_, 1.0f);
 
   for (auto& rt_ptr : runtimes_) {
     EffectRuntime& rt = *rt_ptr;
@@ -404,6 +412,18 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
         frame->sun_direction_W = SunDirectionEnu(pos);
         frame->sky_luminance_scale *=
             static_cast<float>(TwilightSkyScale(pos.geometric_elevation_deg));
+        // the scene's suns follow: same light, new direction, air-mass attenuated
+        const double direct = DirectSunAttenuation(pos.elevation_deg);
+        for (const auto& [index, light] : directional_lights_) {
+          frame->light_intensity_scale[index] = 0.0f;
+          if (direct <= 0) continue;
+          Light sun = light;
+          sun.body = 0;
+          sun.mjcf_light = -1;
+          sun.direction_B = -*frame->sun_direction_W;
+          sun.intensity = static_cast<float>(light.intensity * direct);
+          frame->extra_lights.push_back(sun);
+        }
         break;
       }
       case EffectType::kWetness: {

@@ -46,7 +46,11 @@ class EffectsEngine {
   /// `viewer_W` (position of the viewer in the world, m), and for attached flashlights on
   /// `X_WB` (pose of every SceneDescription::bodies entry, as WorldSnapshot::X_WB; may be
   /// null when no flashlight is attached).
-  /// light_intensity_scale has one entry per scene light when any light event exists.
+  /// light_intensity_scale has one entry per scene light when any light event or sun effect
+  /// exists. a sun effect also moves the scene's directional lights: each is switched off
+  /// (scale 0) and re-emitted in extra_lights pointing along -sun_direction_W with its
+  /// configured illuminance taken as the illuminance at the zenith, times
+  /// DirectSunAttenuation(apparent elevation) (0 below the horizon).
   /// @throws Error when an attached flashlight needs X_WB and it is null or too short.
   std::shared_ptr<const EffectsFrame> Evaluate(double time_sec, const Eigen::Vector3d& viewer_W,
                                                const std::vector<Pose>* X_WB = nullptr);
@@ -58,6 +62,9 @@ class EffectsEngine {
   std::vector<std::unique_ptr<EffectRuntime>> runtimes_;
   size_t num_scene_lights_ = 0;
   bool any_light_event_ = false;
+  bool any_sun_ = false;
+  /// the scene's directional lights (index, light), moved by a sun effect.
+  std::vector<std::pair<int, Light>> directional_lights_;
 };
 
 }  // namespace penumbra

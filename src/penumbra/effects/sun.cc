@@ -111,4 +111,12 @@ double TwilightSkyScale(double h) {
   return std::pow(10.0, kLog[i] + f * (kLog[i + 1] - kLog[i]));
 }
 
+double DirectSunAttenuation(double elevation_deg) {
+  if (elevation_deg <= 0) return 0.0;
+  const double h_rad = Rad(elevation_deg);
+  const double air_mass =
+      1.0 / (std::sin(h_rad) + 0.50572 * std::pow(elevation_deg + 6.07995, -1.6364));
+  return std::pow(0.7, std::pow(air_mass, 0.678)) / 0.7;
+}
+
 }  // namespace penumbra

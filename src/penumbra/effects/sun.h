@@ -40,4 +40,12 @@ Eigen::Vector3d SunDirectionEnu(const SunPosition& p);
 /// above 0 deg, 8.5e-3 at -6 deg, 2e-5 at -12 deg, 2.5e-6 at and below -18 deg.
 double TwilightSkyScale(double geometric_elevation_deg);
 
+/// direct (beam) sunlight relative to the sun at the zenith, for an apparent elevation in
+/// degrees: 0.7^(AM^0.678) / 0.7 with the relative air mass AM of Kasten and Young, "Revised
+/// optical air mass tables and approximation formula", Applied Optics 28(22), 1989:
+/// AM = 1 / (sin h + 0.50572 (h + 6.07995 deg)^-1.6364), and the clear-sky beam attenuation
+/// of Meinel and Meinel, "Applied Solar Energy", 1976. 1 at the zenith, about 0.02 at the
+/// horizon, 0 below it.
+double DirectSunAttenuation(double elevation_deg);
+
 }  // namespace penumbra
