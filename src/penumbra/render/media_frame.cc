@@ -77,7 +77,8 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
     realtime_ok_ = true;
   }
   particles_.Build(fx, camera, view.exposure_time_sec,
-                   settings.tier == RenderSettings::Tier::kRealtime, pool);
+                   settings.tier == RenderSettings::Tier::kRealtime, pool,
+                   media_.empty() ? nullptr : &media_);
   if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, pool);
 }
 

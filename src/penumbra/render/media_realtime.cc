@@ -273,22 +273,33 @@ RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
   FroxelRecord out{Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
   *t_enter = kInfF;
   const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+  // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
+  for (int q = 0; q < 4; ++q)
+    if (fr.t0[cols[q]] < fr.t1[cols[q]]) *t_enter = std::min(*t_enter, fr.t0[cols[q]]);
+  if (!(t > *t_enter)) return FroxelRecord{Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()};
   const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+  // columns of weight 0 (pixels on a column's centre row or column) are skipped.
+  float S[3] = {0, 0, 0}, T[3] = {0, 0, 0};
   for (int q = 0; q < 4; ++q) {
+    if (!(w[q] > 0)) continue;
     const int c = cols[q];
     const float a = fr.t0[c], b = fr.t1[c];
     if (!(a < b)) {
-      out.T += w[q] * Eigen::Vector3f::Ones();
+      T[0] += w[q], T[1] += w[q], T[2] += w[q];
       continue;
     }
-    *t_enter = std::min(*t_enter, a);
     const float s = std::clamp((t - a) / (b - a), 0.0f, 1.0f) * Z;
     const int k = std::min(static_cast<int>(s), Z - 1);
     const float f = s - k;
-    const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
-    out.S += w[q] * ((1 - f) * rec[k].S + f * rec[k + 1].S);
-    out.T += w[q] * ((1 - f) * rec[k].T + f * rec[k + 1].T);
+    const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1) + k;
+    const float w0 = w[q] * (1 - f), w1 = w[q] * f;
+    for (int ch = 0; ch < 3; ++ch) {
+      S[ch] += w0 * rec[0].S[ch] + w1 * rec[1].S[ch];
+      T[ch] += w0 * rec[0].T[ch] + w1 * rec[1].T[ch];
+    }
   }
+  out.S = Eigen::Vector3f(S[0], S[1], S[2]);
+  out.T = Eigen::Vector3f(T[0], T[1], T[2]);
   return out;
 }
 
@@ -397,17 +408,19 @@ Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const float wx = fx - x0, wy = fy - y0;
   const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
   const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
-  Eigen::Vector3f out = Eigen::Vector3f::Zero();
+  float out[3] = {0, 0, 0};
   const float log_t = t > kFogFroxelNear ? std::log(t / kFogFroxelNear) : 0.0f;
   for (int q = 0; q < 4; ++q) {
+    if (!(w[q] > 0)) continue;  // as in LookupFroxels
     const int c = cols[q];
     const float s = FogSlice(t, log_t, fr.inv_log_far[c]);
     const int k = std::min(static_cast<int>(s), Z - 1);
     const float f = s - k;
-    const Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
-    out += w[q] * ((1 - f) * rec[k] + f * rec[k + 1]);
+    const Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1) + k;
+    const float w0 = w[q] * (1 - f), w1 = w[q] * f;
+    for (int ch = 0; ch < 3; ++ch) out[ch] += w0 * rec[0][ch] + w1 * rec[1][ch];
   }
-  return out;
+  return Eigen::Vector3f(out[0], out[1], out[2]);
 }
 
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -527,7 +540,10 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
     albedo[c] = tau_t[c] > 0 ? static_cast<float>(tau_s[c] / tau_t[c]) : 0;
   Eigen::Vector3f sky_w = Eigen::Vector3f::Ones() - Th_end;
   if (first_a < t_end) {
-    const Eigen::Vector3f Th_a = Exp(-media.AnalyticOpticalDepth(o, d, 0, first_a));
+    const Eigen::Vector3f tau_a = media.AnalyticOpticalDepth(o, d, 0, first_a);
+    const Eigen::Vector3f Th_a = tau_a.x() == tau_a.y() && tau_a.y() == tau_a.z()
+                                     ? Eigen::Vector3f::Constant(std::exp(-tau_a.x()))
+                                     : Exp(-tau_a);
     sky_w = (Eigen::Vector3f::Ones() - Th_a) + (Th_a - Th_end).cwiseProduct(Tg);
   }
   out.L_add += albedo.cwiseProduct(sky_w).cwiseProduct(sky_ambient_);

@@ -25,6 +25,20 @@
 //  - snow: Lambertian of albedo `color` on the capsule's normal, lit by every light
 //    (unshadowed) and the sphere-average sky radiance.
 //  - sparks: emit ParticleSet::emission.
+// culling (realtime tier only, rain only): a rain streak is not drawn when its coverage times
+// an upper bound of the homogeneous media's transmittance from the camera to the streak's
+// nearest point (smallest sigma_t channel, smallest density of the segment's ends, media that
+// hold the whole segment; grid media ignored) is below kRainCullContrast. the streak's radiance
+// (the mean environment radiance, see shading) and what lies behind it are both within the
+// displayed range for most pixels, so their difference after exposure is at most display white and
+// the streak changes the display-linear pixel value by less than one 8-bit step (1/255). this is an
+// approximation: against a background or drop brighter than white the bound does not hold
+// (both clip, so the change is small there too), and the sRGB curve magnifies display-linear
+// steps near black (slope up to 12.92), so a culled streak over a very dark pixel could have
+// changed it by a few codes; a culled streak also no longer hides the streaks behind it.
+// culling concerns sub-pixel drops far from the lens (coverage falls with distance as
+// r^2 fx / (d |v| T) once widened to half a pixel) and drops deep in fog; drops near the lens
+// have coverage near 1 and are always drawn. sparks (emissive) and snow are never culled.
 // particles cast no shadows and are not seen by secondary rays (reflections, shadow rays);
 // they do not change the depth or segmentation images.
 
@@ -36,9 +50,14 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_scene.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
+
+/// rain streaks whose coverage times media transmittance from the camera is below this are
+/// not drawn in the realtime tier (one 8-bit step of display-linear contrast; see above).
+constexpr float kRainCullContrast = 1.0f / 255.0f;
 
 /// the nearest streak along a ray.
 struct ParticleHit {
@@ -64,12 +83,15 @@ class ParticleScene {
   /// (key effects.particles[i]).
   /// pixel_hits: build the per-pixel nearest streaks of the camera's pixel-centre rays
   /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
-  /// null).
+  /// null). with pixel_hits, invisible rain streaks are culled (kRainCullContrast) using the
+  /// homogeneous media of `media` (may be null: coverage alone).
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits, ThreadPool* pool = nullptr);
+             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr);
 
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
+  /// rain streaks culled as invisible by the last Build.
+  int culled() const { return culled_; }
 
   /// the nearest streak of the pixel-centre camera ray `ray` of pixel (u, v) within (0, tmax]
   /// (Build with pixel_hits); false if none.
@@ -94,6 +116,7 @@ class ParticleScene {
   std::unique_ptr<Impl> impl_;
   const EffectsFrame* fx_ = nullptr;
   int count_ = 0;
+  int culled_ = 0;
   std::vector<float> alpha_;           // per primitive
   std::vector<int> set_;               // per primitive
   std::vector<Eigen::Vector4f> ends_;  // per primitive: both ends (x, y, z, widened radius)

@@ -191,7 +191,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       if (rm != nullptr) {
         // attenuation of the light by the media between the surface and the light.
         for (int k = 0; k < kLanes; ++k) {
-          if (!(hit[k] && s.valid[k])) continue;
+          // lanes the light does not reach (behind the surface, outside its cone) stay 0.
+          if (!(hit[k] && s.valid[k]) || (c.x[k] == 0 && c.y[k] == 0 && c.z[k] == 0)) continue;
           if (located[k] && j < rm->num_volume_lights()) {
             const float T = rm->LightTransmittance(j, vol_at[k]);
             c.x[k] *= T, c.y[k] *= T, c.z[k] *= T;
