@@ -12,6 +12,11 @@ root = pathlib.Path(__file__).resolve().parent.parent
 readme = root / "README.md"
 
 
+def readme_links(text):
+    """links between docs (`](effects.md)`) point into docs/ from the README."""
+    return re.sub(r"\]\((?![a-z]+:|/|#|docs/)([^)]+\.(?:md|png))", r"](docs/\1", text)
+
+
 def demote(text):
     return re.sub(r"^(#+) ", lambda m: "#" + m.group(1) + " ", text, flags=re.M)
 
@@ -21,11 +26,11 @@ parts = []
 for name in robots:
     p = root / "docs" / "robots" / f"{name}.md"
     if p.exists():
-        parts.append(demote(p.read_text().strip()))
+        parts.append(readme_links(demote(p.read_text().strip())))
 blocks = {
     "robots": "## Robots\n\nEach bundled robot has a model in `worlds/models/`, an example world in "
     "`worlds/`, and a controller configured in that world.\n\n" + "\n\n".join(parts),
-    "world-file": (root / "docs" / "world-file.md").read_text().strip(),
+    "world-file": readme_links((root / "docs" / "world-file.md").read_text().strip()),
 }
 text = readme.read_text()
 for key, body in blocks.items():
