@@ -37,6 +37,22 @@ bool ParseVec(const char* text, int n, double* out) {
   return true;
 }
 
+// adds site "penumbra_imu/<imu_name>" to `body` at X_BS (pose in the body frame), in the
+// invisible group 5; returns its name.
+std::string AddImuSite(XMLElement* body, const std::string& imu_name, const Pose& X_BS) {
+  const std::string name = "penumbra_imu/" + imu_name;
+  XMLElement* site = body->InsertNewChildElement("site");
+  site->SetAttribute("name", name.c_str());
+  const Eigen::Quaterniond q(X_BS.linear());
+  const Eigen::Vector3d p = X_BS.translation();
+  site->SetAttribute("pos", (Num(p.x()) + " " + Num(p.y()) + " " + Num(p.z())).c_str());
+  site->SetAttribute("quat",
+                     (Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) + " " + Num(q.z())).c_str());
+  site->SetAttribute("size", "0.005");
+  site->SetAttribute("group", "5");
+  return name;
+}
+
 }  // namespace
 
 std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name) {
@@ -82,17 +98,7 @@ void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scen
         Pose X_BA = PoseFromPosQuat(pos, q);
         XMLElement* body = site->Parent()->ToElement();
         const Pose X_BS = X_BA * X_AS;
-        site_name = "penumbra_imu/" + s.name;
-        XMLElement* ns = body->InsertNewChildElement("site");
-        ns->SetAttribute("name", site_name.c_str());
-        const Eigen::Quaterniond qq(X_BS.linear());
-        const Eigen::Vector3d p = X_BS.translation();
-        ns->SetAttribute("pos", (Num(p.x()) + " " + Num(p.y()) + " " + Num(p.z())).c_str());
-        ns->SetAttribute(
-            "quat",
-            (Num(qq.w()) + " " + Num(qq.x()) + " " + Num(qq.y()) + " " + Num(qq.z())).c_str());
-        ns->SetAttribute("size", "0.005");
-        ns->SetAttribute("group", "5");
+        site_name = AddImuSite(body, s.name, X_BS);
       }
     } else {
       XMLElement* body = s.body == "world" ? worldbody : FindNamed(worldbody, "body", s.body);
@@ -101,17 +107,7 @@ void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scen
                           "sensor '" + s.name + "': no body named '" + s.body +
                               "' in the composed model; expected a body name (\"<model>/<body>\")"
                               " or world");
-      site_name = "penumbra_imu/" + s.name;
-      XMLElement* ns = body->InsertNewChildElement("site");
-      ns->SetAttribute("name", site_name.c_str());
-      const Eigen::Quaterniond qq(X_AS.linear());
-      const Eigen::Vector3d p = X_AS.translation();
-      ns->SetAttribute("pos", (Num(p.x()) + " " + Num(p.y()) + " " + Num(p.z())).c_str());
-      ns->SetAttribute(
-          "quat",
-          (Num(qq.w()) + " " + Num(qq.x()) + " " + Num(qq.y()) + " " + Num(qq.z())).c_str());
-      ns->SetAttribute("size", "0.005");
-      ns->SetAttribute("group", "5");
+      site_name = AddImuSite(body, s.name, X_AS);
     }
     const auto [acc, gyr] = ImuSensorNames(s.name);
     XMLElement* a = sensor_section->InsertNewChildElement("accelerometer");
