@@ -197,6 +197,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   constexpr int Z = kFroxelSlices;
   fr.t0.assign(columns, 0.0f);
   fr.t1.assign(columns, 0.0f);
+  fr.slices_per_m.assign(columns, 0.0f);
   fr.records.assign(static_cast<size_t>(columns) * (Z + 1),
                     FroxelRecord{Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()});
   const bool analytic = !media.analytic().empty();
@@ -216,6 +217,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
     if (!(a < b)) return;
     fr.t0[c] = a;
     fr.t1[c] = b;
+    fr.slices_per_m[c] = std::min(Z / (b - a), 1e30f);
     // jitter of the slice samples from the column's centre pixel stream 2.
     const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
     Rng rng(HashKeys(HashKeys(frame_key, pixel), 2));
@@ -288,7 +290,7 @@ RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
       T[0] += w[q], T[1] += w[q], T[2] += w[q];
       continue;
     }
-    const float s = std::clamp((t - a) / (b - a), 0.0f, 1.0f) * Z;
+    const float s = std::clamp((t - a) * fr.slices_per_m[c], 0.0f, static_cast<float>(Z));
     const int k = std::min(static_cast<int>(s), Z - 1);
     const float f = s - k;
     const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1) + k;

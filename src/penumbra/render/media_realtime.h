@@ -139,6 +139,7 @@ class RealtimeMedia {
   struct Froxels {
     int nx = 0, ny = 0;
     std::vector<float> t0, t1;          // [column] overlap of the column ray with the grids
+    std::vector<float> slices_per_m;    // [column] kFroxelSlices / (t1 - t0), 0 without overlap
     std::vector<FroxelRecord> records;  // [column][slice boundary 0..kFroxelSlices]
   };
   /// grid in-scatter and transmittance from the camera to distance t for pixel (u, v);
