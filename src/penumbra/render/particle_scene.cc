@@ -360,10 +360,17 @@ void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vect
     const Eigen::Vector3f c = 0.5f * (ends_[2 * n].head<3>() + ends_[2 * n + 1].head<3>());
     L[n] = Shade(h, c, lights, sky_ambient);
   };
+  // chunks of streaks per task (one task per streak costs more in scheduling than shading).
+  constexpr int kChunk = 1024;
+  const int chunks = (count_ + kChunk - 1) / kChunk;
+  auto chunk = [&](int64_t c) {
+    const int64_t n1 = std::min<int64_t>(count_, (c + 1) * kChunk);
+    for (int64_t n = c * kChunk; n < n1; ++n) one(n);
+  };
   if (pool != nullptr) {
-    pool->ParallelFor(count_, one);
+    pool->ParallelFor(chunks, chunk);
   } else {
-    for (int64_t n = 0; n < count_; ++n) one(n);
+    for (int64_t c = 0; c < chunks; ++c) chunk(c);
   }
   rain_radiance_ = std::move(L);
 }
