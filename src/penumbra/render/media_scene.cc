@@ -120,20 +120,25 @@ double AnalyticMedium::InvertDensityIntegral(double oz, double dz, double a, dou
   return kInfD;
 }
 
-float GridVolume::DensityAt(const Eigen::Vector3f& x_G) const {
+bool GridVolume::TrilinearCell(const Eigen::Vector3f& x_G, int i0[3], int i1[3], float w[3]) const {
   if (std::abs(x_G.x()) > half.x() || std::abs(x_G.y()) > half.y() || std::abs(x_G.z()) > half.z())
-    return 0.0f;
+    return false;
   const Eigen::Vector3f f =
       (x_G + half).cwiseProduct(voxels_per_m) - Eigen::Vector3f::Constant(0.5f);
   const int n[3] = {nx, ny, nz};
-  int i0[3], i1[3];
-  float w[3];
   for (int k = 0; k < 3; ++k) {
     const float c = std::clamp(f[k], 0.0f, static_cast<float>(n[k] - 1));
     i0[k] = std::min(static_cast<int>(c), std::max(n[k] - 2, 0));
     i1[k] = std::min(i0[k] + 1, n[k] - 1);
     w[k] = c - static_cast<float>(i0[k]);
   }
+  return true;
+}
+
+float GridVolume::DensityAt(const Eigen::Vector3f& x_G) const {
+  int i0[3], i1[3];
+  float w[3];
+  if (!TrilinearCell(x_G, i0, i1, w)) return 0.0f;
   const float* D = density->data();
   auto at = [&](int i, int j, int k) { return D[(static_cast<size_t>(k) * ny + j) * nx + i]; };
   const float c00 = at(i0[0], i0[1], i0[2]) * (1 - w[0]) + at(i1[0], i0[1], i0[2]) * w[0];
@@ -147,19 +152,9 @@ float GridVolume::DensityAt(const Eigen::Vector3f& x_G) const {
 
 Eigen::Vector3f GridVolume::EmissionAt(const Eigen::Vector3f& x_G) const {
   if (!emission) return Eigen::Vector3f::Zero();
-  if (std::abs(x_G.x()) > half.x() || std::abs(x_G.y()) > half.y() || std::abs(x_G.z()) > half.z())
-    return Eigen::Vector3f::Zero();
-  const Eigen::Vector3f f =
-      (x_G + half).cwiseProduct(voxels_per_m) - Eigen::Vector3f::Constant(0.5f);
-  const int n[3] = {nx, ny, nz};
   int i0[3], i1[3];
   float w[3];
-  for (int k = 0; k < 3; ++k) {
-    const float c = std::clamp(f[k], 0.0f, static_cast<float>(n[k] - 1));
-    i0[k] = std::min(static_cast<int>(c), std::max(n[k] - 2, 0));
-    i1[k] = std::min(i0[k] + 1, n[k] - 1);
-    w[k] = c - static_cast<float>(i0[k]);
-  }
+  if (!TrilinearCell(x_G, i0, i1, w)) return Eigen::Vector3f::Zero();
   const float* E = emission->data();
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   for (int c = 0; c < 8; ++c) {

@@ -80,6 +80,9 @@ struct GridVolume {
   /// trilinear density at grid-frame point x_G (clamped to the outermost voxel centres inside
   /// the box, 0 outside it).
   float DensityAt(const Eigen::Vector3f& x_G) const;
+  /// the voxel-centre cell around x_G: lower/upper voxel indices per axis and the trilinear
+  /// weights of the upper ones; false outside the box.
+  bool TrilinearCell(const Eigen::Vector3f& x_G, int i0[3], int i1[3], float w[3]) const;
   /// trilinear emission (cd/m^2 per m) at x_G, 0 outside the box or without emission.
   Eigen::Vector3f EmissionAt(const Eigen::Vector3f& x_G) const;
   /// the part [a, b] of [t0, t1] where o + t d (world) is inside the box; false if empty.
