@@ -117,8 +117,9 @@ int BenchSensors(const SensorBenchOptions& options) {
 
   RayScene rs(scene);
   fmt::print(
-      "\nLiDAR (single thread, Embree packets of 16, motion-interpolated pose, {} "
-      "scans each; target: OS1-64 < 10 ms/scan = 10 % of one core at 10 Hz)\n",
+      "\nLiDAR (single thread, Embree packets of 16, motion-interpolated pose, scene posed per "
+      "scan, {} scans each after one untimed warm-up scan; target: OS1-64 < 10 ms/scan = 10 % of "
+      "one core at 10 Hz)\n",
       options.scans);
   fmt::print("{:<16} {:>7} {:>12} {:>10} {:>8} {:>8} {:>12} {:>8}\n", "preset", "rays",
              "wall mean ms", "median ms", "max ms", "cpu ms", "cpu Mrays/s", "points");
@@ -138,6 +139,14 @@ int BenchSensors(const SensorBenchOptions& options) {
     double cpu = 0;
     int64_t points = 0;
     LidarScan scan;
+    // one untimed scan first: Embree builds its BVHs lazily on the first trace, and the
+    // first preset row would otherwise pay for it
+    {
+      const Pose X0 = snaps[0].X_WB[mount_body] * X_BS;
+      rs.Update(snaps[0]);
+      scanner.Scan(
+          rs, foggy ? fog.get() : nullptr, [&](double) { return X0; }, 0, &scan);
+    }
     for (int k = 0; k < options.scans; ++k) {
       const WorldSnapshot& a = snaps[k];
       const WorldSnapshot& b = snaps[k + 1];
