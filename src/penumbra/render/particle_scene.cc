@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -91,37 +92,73 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   const float T = static_cast<float>(std::max(0.0, exposure_time_sec));
   const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
   const float fx_px = static_cast<float>(camera.intrinsics().fx);
+  // every drop's streak and cull flag in parallel chunks (each drop only reads its own input and
+  // writes its own slot), then compacted serially in (set, index) order, so the output does not
+  // depend on the thread count.
+  std::vector<size_t> first(fx->particles.size() + 1, 0);
+  for (size_t s = 0; s < fx->particles.size(); ++s)
+    first[s + 1] = first[s] + fx->particles[s].position_W.size();
+  const size_t n_all = first.back();
+  // per drop: 0 = no streak (radius <= 0), 1 = culled, 2 = kept.
+  std::vector<uint8_t> state(n_all, 0);
+  std::vector<float> alpha_all(n_all);
+  std::vector<Eigen::Vector4f> ends_all(2 * n_all);
+  auto drop = [&](size_t s, size_t i, size_t g) {
+    const ParticleSet& ps = fx->particles[s];
+    const Eigen::Vector3f& p = ps.position_W[i];
+    const Eigen::Vector3f& v = ps.velocity_W[i];
+    const float r = ps.radius_m[i];
+    if (!(r > 0)) return;
+    Eigen::Vector3f q = p + T * v;
+    // a still particle: a capsule of negligible length (Embree needs two distinct ends).
+    if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
+    const float len = T * v.norm();  // the motion, not the widened capsule
+    // widen to half a pixel at the streak's nearest distance to the camera.
+    const Eigen::Vector3f seg = q - p;
+    const float l2 = seg.squaredNorm();
+    const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
+    const float dist = (p + w * seg - cam_o).norm();
+    const float r_wide = std::max(r, 0.5f * dist / fx_px);
+    const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
+    // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
+    if (pixel_hits && ps.kind == ParticleKind::kRain &&
+        RainInvisible(alpha, cam_o, p + w * seg, media)) {
+      state[g] = 1;
+      return;
+    }
+    state[g] = 2;
+    alpha_all[g] = alpha;
+    ends_all[2 * g] = Eigen::Vector4f(p.x(), p.y(), p.z(), r_wide);
+    ends_all[2 * g + 1] = Eigen::Vector4f(q.x(), q.y(), q.z(), r_wide);
+  };
+  constexpr size_t kDropChunk = 4096;
+  const size_t drop_chunks = (n_all + kDropChunk - 1) / kDropChunk;
+  auto drop_chunk = [&](int64_t c) {
+    const size_t g0 = static_cast<size_t>(c) * kDropChunk;
+    const size_t g1 = std::min(n_all, g0 + kDropChunk);
+    size_t s =
+        static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g0) - first.begin()) - 1;
+    for (size_t g = g0; g < g1; ++g) {
+      while (g >= first[s + 1]) ++s;
+      drop(s, g - first[s], g);
+    }
+  };
+  if (pool != nullptr) {
+    pool->ParallelFor(static_cast<int64_t>(drop_chunks), drop_chunk);
+  } else {
+    for (size_t c = 0; c < drop_chunks; ++c) drop_chunk(static_cast<int64_t>(c));
+  }
   alpha_.reserve(total);
   set_.reserve(total);
   ends_.reserve(2 * total);
   for (size_t s = 0; s < fx->particles.size(); ++s) {
-    const ParticleSet& ps = fx->particles[s];
-    for (size_t i = 0; i < ps.position_W.size(); ++i) {
-      const Eigen::Vector3f& p = ps.position_W[i];
-      const Eigen::Vector3f& v = ps.velocity_W[i];
-      const float r = ps.radius_m[i];
-      if (!(r > 0)) continue;
-      Eigen::Vector3f q = p + T * v;
-      // a still particle: a capsule of negligible length (Embree needs two distinct ends).
-      if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
-      const float len = T * v.norm();  // the motion, not the widened capsule
-      // widen to half a pixel at the streak's nearest distance to the camera.
-      const Eigen::Vector3f seg = q - p;
-      const float l2 = seg.squaredNorm();
-      const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
-      const float dist = (p + w * seg - cam_o).norm();
-      const float r_wide = std::max(r, 0.5f * dist / fx_px);
-      const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
-      // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
-      if (pixel_hits && ps.kind == ParticleKind::kRain &&
-          RainInvisible(alpha, cam_o, p + w * seg, media)) {
-        ++culled_;
-        continue;
-      }
-      alpha_.push_back(alpha);
+    for (size_t g = first[s]; g < first[s + 1]; ++g) {
+      if (state[g] == 1) ++culled_;
+      if (state[g] != 2) continue;
+      alpha_.push_back(alpha_all[g]);
       set_.push_back(static_cast<int>(s));
-      ends_.push_back(Eigen::Vector4f(p.x(), p.y(), p.z(), r_wide));
-      ends_.push_back(Eigen::Vector4f(q.x(), q.y(), q.z(), r_wide));
+      ends_.push_back(ends_all[2 * g]);
+      ends_.push_back(ends_all[2 * g + 1]);
     }
   }
   count_ = static_cast<int>(alpha_.size());
