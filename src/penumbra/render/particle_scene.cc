@@ -27,6 +27,29 @@ ParticleScene::ParticleScene() : impl_(std::make_unique<Impl>()) {}
 
 namespace {
 
+// per frame, per homogeneous medium: what RainInvisible needs of it that does not depend on
+// the streak.
+struct RainCullMedium {
+  bool bounded;       // has a box
+  bool cam_in;        // the camera is in its box (or it is unbounded)
+  float sigma_t_min;  // smallest channel of sigma_t, 1/m
+  float cam_density;  // density at the camera's height
+  Eigen::Vector3f box_min, box_max;
+  const AnalyticMedium* m;
+};
+
+std::vector<RainCullMedium> RainCullMedia(const Eigen::Vector3f& cam_o, const MediaScene* media) {
+  std::vector<RainCullMedium> out;
+  if (media == nullptr) return out;
+  for (const AnalyticMedium& m : media->analytic()) {
+    const bool cam_in = !m.bounded || ((cam_o.array() >= m.box_min.array()).all() &&
+                                       (cam_o.array() <= m.box_max.array()).all());
+    out.push_back(RainCullMedium{m.bounded, cam_in, m.sigma_t.minCoeff(), m.Density(cam_o.z()),
+                                 m.box_min, m.box_max, &m});
+  }
+  return out;
+}
+
 // true when a rain streak of coverage alpha whose nearest point to the camera is p_W cannot
 // change a displayed pixel by kRainCullContrast (particle_scene.h): alpha times an upper bound
 // of the transmittance of the homogeneous media between the camera and p_W. the bound uses a
@@ -34,19 +57,18 @@ namespace {
 // ends in its box, which is convex), its smallest channel of sigma_t times the length times the
 // smaller density of the two ends (the density is monotonic in height, so along a segment its
 // minimum is at an end). grid media are ignored. both only keep more streaks than exact.
+// media: RainCullMedia(cam_o, ...) of this frame.
 bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vector3f& p_W,
-                   const MediaScene* media) {
+                   const std::vector<RainCullMedium>& media) {
   if (alpha < kRainCullContrast) return true;
-  if (media == nullptr || media->analytic().empty()) return false;
+  if (media.empty()) return false;
   const float dist = (p_W - cam_o).norm();
   float tau = 0;
-  for (const AnalyticMedium& m : media->analytic()) {
-    if (m.bounded &&
-        !((cam_o.array() >= m.box_min.array()).all() &&
-          (cam_o.array() <= m.box_max.array()).all() && (p_W.array() >= m.box_min.array()).all() &&
-          (p_W.array() <= m.box_max.array()).all()))
+  for (const RainCullMedium& m : media) {
+    if (m.bounded && !(m.cam_in && (p_W.array() >= m.box_min.array()).all() &&
+                       (p_W.array() <= m.box_max.array()).all()))
       continue;
-    tau += m.sigma_t.minCoeff() * dist * std::min(m.Density(cam_o.z()), m.Density(p_W.z()));
+    tau += m.sigma_t_min * dist * std::min(m.cam_density, m.m->Density(p_W.z()));
   }
   return alpha * std::exp(-tau) < kRainCullContrast;
 }
@@ -103,6 +125,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   std::vector<uint8_t> state(n_all, 0);
   std::vector<float> alpha_all(n_all);
   std::vector<Eigen::Vector4f> ends_all(2 * n_all);
+  const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
   auto drop = [&](size_t s, size_t i, size_t g) {
     const ParticleSet& ps = fx->particles[s];
     const Eigen::Vector3f& p = ps.position_W[i];
@@ -122,7 +145,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
     // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
     if (pixel_hits && ps.kind == ParticleKind::kRain &&
-        RainInvisible(alpha, cam_o, p + w * seg, media)) {
+        RainInvisible(alpha, cam_o, p + w * seg, cull_media)) {
       state[g] = 1;
       return;
     }
