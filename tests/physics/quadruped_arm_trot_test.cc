@@ -149,14 +149,7 @@ TEST(QuadrupedArmTrot, TwoRunsAreBitIdentical) {
   const std::string cfg = Config("[{t: 0, vx: 0.3, yaw_rate: -0.3}, {t: 1, vy: 0.2}]");
   Rig a = MakeRig("quadruped_arm", Ground::kFlat, cfg);
   Rig b = MakeRig("quadruped_arm", Ground::kFlat, cfg);
-  for (int i = 0; i < 1000; ++i) {
-    a.sim.Step();
-    b.sim.Step();
-    const auto qa = a.sim.qpos(), qb = b.sim.qpos();
-    const auto va = a.sim.qvel(), vb = b.sim.qvel();
-    ASSERT_TRUE(std::equal(qa.begin(), qa.end(), qb.begin())) << "qpos differs at step " << i;
-    ASSERT_TRUE(std::equal(va.begin(), va.end(), vb.begin())) << "qvel differs at step " << i;
-  }
+  ASSERT_TRUE(StepInLockstep(a.sim, b.sim, 1000));
   EXPECT_GT(std::abs(a.sim.qpos()[0]) + std::abs(a.sim.qpos()[1]), 0.1);
 }
 

@@ -3,7 +3,10 @@
 // trot_gait configs of the bundled robots, and a probe that records what the acceptance
 // criteria need (trunk contact, trajectory).
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -180,5 +183,21 @@ inline void RunUntil(Rig* rig, double t_sec) {
 
 /// yaw of the trunk (rad) from a pose.
 inline double Yaw(const Pose& X) { return std::atan2(X.linear()(1, 0), X.linear()(0, 0)); }
+
+/// steps `a` and `b` together for `steps` steps; fails at the first step where their qpos or
+/// qvel differ in any bit.
+inline ::testing::AssertionResult StepInLockstep(Simulation& a, Simulation& b, int steps) {
+  for (int i = 0; i < steps; ++i) {
+    a.Step();
+    b.Step();
+    const auto qa = a.qpos(), qb = b.qpos();
+    const auto va = a.qvel(), vb = b.qvel();
+    if (!std::equal(qa.begin(), qa.end(), qb.begin()))
+      return ::testing::AssertionFailure() << "qpos differs at step " << i;
+    if (!std::equal(va.begin(), va.end(), vb.begin()))
+      return ::testing::AssertionFailure() << "qvel differs at step " << i;
+  }
+  return ::testing::AssertionSuccess();
+}
 
 }  // namespace penumbra::quadruped_test

@@ -187,14 +187,7 @@ TEST(QuadrupedTrot, TwoRunsAreBitIdentical) {
   const std::string cfg = Config("[{t: 0, vx: 0.4, vy: 0.1, yaw_rate: 0.3}, {t: 1.5, vx: -0.2}]");
   Rig a = MakeRig("quadruped", Ground::kFlat, cfg);
   Rig b = MakeRig("quadruped", Ground::kFlat, cfg);
-  for (int i = 0; i < 1250; ++i) {
-    a.sim.Step();
-    b.sim.Step();
-    const auto qa = a.sim.qpos(), qb = b.sim.qpos();
-    const auto va = a.sim.qvel(), vb = b.sim.qvel();
-    ASSERT_TRUE(std::equal(qa.begin(), qa.end(), qb.begin())) << "qpos differs at step " << i;
-    ASSERT_TRUE(std::equal(va.begin(), va.end(), vb.begin())) << "qvel differs at step " << i;
-  }
+  ASSERT_TRUE(StepInLockstep(a.sim, b.sim, 1250));
   // and it did move
   EXPECT_GT(std::abs(a.sim.qpos()[0]) + std::abs(a.sim.qpos()[1]), 0.2);
 }

@@ -106,14 +106,7 @@ TEST(QuadrupedWaypoints, TwoRunsAreBitIdentical) {
   const std::string cfg = WaypointConfig("[[0.6, 0.4], [0, 0.8]]", true);
   Rig a = MakeRig("quadruped", Ground::kFlat, cfg);
   Rig b = MakeRig("quadruped", Ground::kFlat, cfg);
-  for (int i = 0; i < 1500; ++i) {
-    a.sim.Step();
-    b.sim.Step();
-    const auto qa = a.sim.qpos(), qb = b.sim.qpos();
-    const auto va = a.sim.qvel(), vb = b.sim.qvel();
-    ASSERT_TRUE(std::equal(qa.begin(), qa.end(), qb.begin())) << "qpos differs at step " << i;
-    ASSERT_TRUE(std::equal(va.begin(), va.end(), vb.begin())) << "qvel differs at step " << i;
-  }
+  ASSERT_TRUE(StepInLockstep(a.sim, b.sim, 1500));
   EXPECT_GT(std::hypot(a.sim.qpos()[0], a.sim.qpos()[1]), 0.5);  // and it did walk
 }
 
