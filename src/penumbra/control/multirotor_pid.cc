@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -30,13 +31,7 @@ std::string Fmt(double v) {
   return s.str();
 }
 
-std::string Repr(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence())
-    return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
+using param::Repr;
 
 std::string RangeText(double min, double max, bool min_exclusive) {
   return std::string(min_exclusive ? "> " : ">= ") + Fmt(min) +
