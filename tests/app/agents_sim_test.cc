@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/effects_stage.h"
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/compose/scene_composer.h"
@@ -29,7 +30,7 @@ const char* kArena = R"(<mujoco model="arena">
 </mujoco>)";
 
 std::string ArenaFile() {
-  const auto dir = std::filesystem::temp_directory_path() / "penumbra_agents_sim_test";
+  const auto dir = std::filesystem::path(penumbra::testing::ProcessTempDir());
   std::filesystem::create_directories(dir);
   const auto path = dir / "arena.xml";
   std::ofstream(path) << kArena;
@@ -178,7 +179,7 @@ TEST(AgentsInPhysics, AWaypointOutsideTheWorldIsAConfigError) {
 }
 
 TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
-  const auto dir = std::filesystem::temp_directory_path() / "penumbra_agents_sim_test";
+  const auto dir = std::filesystem::path(penumbra::testing::ProcessTempDir());
   std::filesystem::create_directories(dir);
   const auto path = dir / "target.xml";
   std::ofstream(path) << R"(<mujoco model="target">

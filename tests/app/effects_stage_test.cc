@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
 #include "penumbra/app/floor_map.h"
 #include "penumbra/app/runner.h"
@@ -104,8 +105,7 @@ TEST(AdversityPlan, UnknownPresetListsTheValidNames) {
 }
 
 TEST(AdversityPlan, CliRunWithAnUnknownPresetExitsWith2AndAKnownOneRecordsIt) {
-  const std::string out =
-      (std::filesystem::temp_directory_path() / "penumbra_adversity_cli").string();
+  const std::string out = penumbra::testing::ProcessTempDir() + "/adversity_cli";
   const char* bad[] = {"penumbra",  "run",     kDefaultWorld.c_str(), "--out",
                        out.c_str(), "--quiet", "--adversity",         "apocalypse"};
   EXPECT_EQ(RunCli(8, const_cast<char**>(bad)), 2);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/world/world_config.h"
 
@@ -27,7 +28,7 @@ std::vector<std::string> Trajectory(const std::string& tag,
   world.cameras.at(0).height = 60;
   world.effects = effects;
   world.agents = agents;
-  const fs::path out = fs::temp_directory_path() / ("penumbra_invariance_" + tag);
+  const fs::path out = fs::path(penumbra::testing::ProcessTempDir()) / ("invariance_" + tag);
   fs::remove_all(out);
   RunOptions options;
   options.out_dir = out.string();

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/pose.h"
 
@@ -33,28 +34,7 @@ struct DataDeleter {
 using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "penumbra_compose_XXXXXX").string();
-    path_ = mkdtemp(tmpl.data());
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-  // writes `text` to <dir>/<rel> (creating folders) and returns the absolute path
-  std::string Write(const std::string& rel, const std::string& text) const {
-    const fs::path p = fs::path(path_) / rel;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-
- private:
-  std::string path_;
-};
+using penumbra::testing::TempDir;
 
 // changes the working directory for the lifetime of the object
 class ScopedCwd {
@@ -111,7 +91,7 @@ ComposeOptions Options() {
 ModelPtr ComposeAndLoad(const std::vector<ModelConfig>& models, const TempDir& dir,
                         ComposedScene* scene_out = nullptr, ComposeOptions opt = Options()) {
   const ComposedScene scene = ComposeWorld(models, opt);
-  const std::string path = dir.path() + "/composed.xml";
+  const std::string path = dir.str() + "/composed.xml";
   WriteComposedScene(scene, path);
   std::string err;
   ModelPtr m = LoadFile(path, &err);
@@ -518,9 +498,9 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
 
   // the composed file has no relative asset paths and loads from another folder
   TempDir elsewhere;
-  const std::string moved = elsewhere.path() + "/scene.xml";
+  const std::string moved = elsewhere.str() + "/scene.xml";
   WriteComposedScene(scene, moved);
-  ScopedCwd cwd(elsewhere.path());
+  ScopedCwd cwd(elsewhere.str());
   std::string err;
   EXPECT_TRUE(LoadFile("scene.xml", &err)) << err;
 }
@@ -736,7 +716,7 @@ TEST(SceneComposerTest, IncludesAndMeshdirResolveFromTheirFiles) {
   // composed text: absolute mesh path, no include left
   const ComposedScene scene = ComposeWorld({Model("x", main)}, Options());
   EXPECT_EQ(scene.mjcf_xml.find("<include"), std::string::npos);
-  EXPECT_NE(scene.mjcf_xml.find(fs::canonical(dir.path()).string() + "/proj/meshes/tetra.obj"),
+  EXPECT_NE(scene.mjcf_xml.find(fs::canonical(dir.str()).string() + "/proj/meshes/tetra.obj"),
             std::string::npos)
       << scene.mjcf_xml;
 }
@@ -875,7 +855,7 @@ TEST(SceneComposerTest, ErrorsNameTheFileLineAndWhatWasExpected) {
   const std::string good =
       dir.Write("good.xml", "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>");
 
-  std::string e = ComposeError({Model("a", dir.path() + "/missing.xml")});
+  std::string e = ComposeError({Model("a", dir.str() + "/missing.xml")});
   EXPECT_NE(e.find("missing.xml"), std::string::npos) << e;
   EXPECT_NE(e.find("not found"), std::string::npos) << e;
 

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/effects/effects_engine.h"
 
@@ -23,7 +24,8 @@ std::string WriteVdb(const std::string& name, const std::string& grid_name) {
   for (int k = 0; k < 8; ++k)
     for (int j = 0; j < 6; ++j)
       for (int i = 0; i < 4; ++i) acc.setValue(openvdb::Coord(i, j, k), Value(i, j, k));
-  const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+  const std::string path =
+      (std::filesystem::path(penumbra::testing::ProcessTempDir()) / name).string();
   openvdb::io::File file(path);
   openvdb::GridPtrVec grids{grid};
   file.write(grids);
@@ -87,7 +89,8 @@ TEST(VdbLoaderTest, FileWithoutDensityGridIsAConfigError) {
 TEST(VdbLoaderTest, MissingOrBrokenFileIsAConfigError) {
   EXPECT_THROW(EffectsEngine({VdbEffect("/nonexistent/x.vdb")}, 1, SceneDescription{}),
                ConfigError);
-  const std::string junk = (std::filesystem::path(::testing::TempDir()) / "junk.vdb").string();
+  const std::string junk =
+      (std::filesystem::path(penumbra::testing::ProcessTempDir()) / "junk.vdb").string();
   FILE* fp = std::fopen(junk.c_str(), "wb");
   std::fputs("not a vdb file", fp);
   std::fclose(fp);

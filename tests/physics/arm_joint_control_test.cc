@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "arm_test_util.h"
+#include "common/temp_dir.h"
 #include "penumbra/control/joint_controller.h"
 #include "penumbra/control/keyframe_playback.h"
 #include "penumbra/core/error.h"
@@ -150,8 +151,7 @@ TEST(ArmKeyframePlayback, PlaysMjcfKeysWithLinearInterpolation) {
 }
 
 TEST(ArmKeyframePlayback, PlaysACsvRelativeToTheWorldFile) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "penumbra_arm_keyframe_test";
+  const std::filesystem::path dir = std::filesystem::path(penumbra::testing::ProcessTempDir());
   std::filesystem::create_directories(dir / "motions");
   {
     std::ofstream csv(dir / "motions" / "wave.csv");

@@ -7,13 +7,14 @@
 
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
 
 TEST(PhysicsBenchmark, RunsBothLoopsForTheRequestedSimTime) {
-  const std::string path = ::testing::TempDir() + "/bench_model.xml";
+  const std::string path = penumbra::testing::ProcessTempDir() + "/bench_model.xml";
   std::ofstream(path) << R"(<mujoco><option timestep="0.005"/><worldbody>
     <geom type="plane" size="2 2 0.1"/>
     <body pos="0 0 0.3"><freejoint/><geom type="box" size=".1 .1 .1"/></body>

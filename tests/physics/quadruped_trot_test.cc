@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "quadruped_test_util.h"
 
@@ -239,7 +240,7 @@ TEST(QuadrupedTrot, JointSignsMapReversedAxes) {
                         R"(qpos="0 0 0.285 1 0 0 0 0 0.9 1.8 0 0.9 1.8 0 0.9 1.8 0 0.9 1.8")"),
             1);
   // the model has no asset files, so it loads from a scratch folder
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = penumbra::testing::ProcessTempDir();
   {
     std::ofstream out(dir + "/quadruped_reversed_knees.xml");
     out << xml;

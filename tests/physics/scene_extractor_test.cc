@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/physics/simulation.h"
 
 namespace penumbra {
@@ -53,7 +54,7 @@ constexpr const char* kSceneXml = R"(
 
 // MuJoCo's binary height field: int32 nrow, int32 ncol, float32 data (row-major)
 std::string WriteTerrain() {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = penumbra::testing::ProcessTempDir();
   std::ofstream f(dir + "/terrain.bin", std::ios::binary);
   const int32_t size[2] = {3, 4};
   f.write(reinterpret_cast<const char*>(size), sizeof(size));

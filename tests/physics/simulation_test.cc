@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -80,7 +81,7 @@ TEST(Simulation, SnapshotPosesMatchMujocoKinematics) {
 
   char err[512] = "";
   // ground truth: MuJoCo's own kinematics for the same qpos
-  const std::string path = ::testing::TempDir() + "/arm.xml";
+  const std::string path = penumbra::testing::ProcessTempDir() + "/arm.xml";
   std::ofstream(path) << kArmXml;
   mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof(err));
   ASSERT_NE(m, nullptr) << err;
@@ -109,7 +110,7 @@ TEST(Simulation, SnapshotPosesMatchMujocoKinematics) {
 }
 
 TEST(Simulation, MatchesBareMjStepBitForBitAndIsDeterministic) {
-  const std::string path = ::testing::TempDir() + "/arm_bare.xml";
+  const std::string path = penumbra::testing::ProcessTempDir() + "/arm_bare.xml";
   std::ofstream(path) << kArmXml;
   char err[512] = "";
   mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof(err));
@@ -177,7 +178,7 @@ TEST(Simulation, LoaderErrorsNameFileAndLine) {
     EXPECT_EQ(e.file(), "<string>");
     EXPECT_NE(std::string(e.what()).find("sizze"), std::string::npos) << e.what();
   }
-  const std::string path = ::testing::TempDir() + "/bad_model.xml";
+  const std::string path = penumbra::testing::ProcessTempDir() + "/bad_model.xml";
   std::ofstream(path) << bad;
   try {
     Simulation::LoadFromFile(path);

@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 
@@ -32,7 +33,7 @@ constexpr const char* kUrdf = R"(<?xml version="1.0"?>
 )";
 
 std::string Write(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = penumbra::testing::ProcessTempDir() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/world_config.h"
@@ -106,7 +107,7 @@ TEST(AdversityPresets, WorldKeyAndErrors) {
             "w.yaml:2: adversity: unknown preset 'extreme'; expected one of: none, minor, major, "
             "or a preset file (FILE.yaml or FILE.yaml#NAME)");
   // a user file, relative to the world file
-  const auto dir = std::filesystem::temp_directory_path() / "penumbra_adversity_test";
+  const auto dir = std::filesystem::path(penumbra::testing::ProcessTempDir());
   std::filesystem::create_directories(dir);
   {
     std::ofstream f(dir / "mine.yaml");
