@@ -1,0 +1,425 @@
+#include "penumbra/render/sky_irradiance_volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/ray_scene.h"
+
+namespace penumbra {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kNumSh = 9;  // real SH up to l = 2
+constexpr int kShFloats = kNumSh * 3;
+
+// real spherical harmonics y_lm of a unit vector, l <= 2, in the order (0,0), (1,-1), (1,0),
+// (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) (Ramamoorthi and Hanrahan 2001, eq. 3).
+template <typename T>
+inline void ShBasis(T x, T y, T z, T* out) {
+  out[0] = T(0.282094791773878);
+  out[1] = T(0.488602511902920) * y;
+  out[2] = T(0.488602511902920) * z;
+  out[3] = T(0.488602511902920) * x;
+  out[4] = T(1.092548430592079) * x * y;
+  out[5] = T(1.092548430592079) * y * z;
+  out[6] = T(0.315391565252520) * (T(3) * z * z - T(1));
+  out[7] = T(1.092548430592079) * x * z;
+  out[8] = T(0.546274215296040) * (x * x - y * y);
+}
+
+// clamped-cosine convolution weight of band l (Ramamoorthi and Hanrahan 2001, eq. 8-9).
+constexpr double kBandWeight[kNumSh] = {kPi,     2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                                        kPi / 4, kPi / 4,     kPi / 4,     kPi / 4};
+
+// octahedral map: (u, v) in [-1, 1]^2 to a direction of L1 norm 1 (not unit): the upper
+// hemisphere is the diamond |u| + |v| <= 1, the lower one folded into the corners.
+inline Eigen::Vector3d OctDecode(double u, double v) {
+  double x = u, y = v;
+  const double z = 1 - std::abs(u) - std::abs(v);
+  if (z < 0) {
+    x = (1 - std::abs(v)) * std::copysign(1.0, u);
+    y = (1 - std::abs(u)) * std::copysign(1.0, v);
+  }
+  return {x, y, z};
+}
+
+// axis-aligned half extents of a geom's shape in its own frame; false for planes.
+bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
+                      Eigen::Vector3d* hi) {
+  const Eigen::Vector3d& s = g.size;
+  Eigen::Vector3d h = Eigen::Vector3d::Zero();
+  switch (g.shape) {
+    case GeomShape::kPlane:
+      return false;
+    case GeomShape::kSphere:
+      h = Eigen::Vector3d::Constant(s.x());
+      break;
+    case GeomShape::kCapsule:
+      h = {s.x(), s.x(), s.y() + s.x()};
+      break;
+    case GeomShape::kEllipsoid:
+    case GeomShape::kBox:
+      h = s;
+      break;
+    case GeomShape::kCylinder:
+      h = {s.x(), s.x(), s.y()};
+      break;
+    case GeomShape::kMesh: {
+      if (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())) return false;
+      const TriangleMesh& m = scene.meshes[g.mesh];
+      if (m.vertices.empty()) return false;
+      Eigen::Vector3f a = m.vertices[0], b = m.vertices[0];
+      for (const Eigen::Vector3f& v : m.vertices) a = a.cwiseMin(v), b = b.cwiseMax(v);
+      *lo = a.cast<double>();
+      *hi = b.cast<double>();
+      return true;
+    }
+    case GeomShape::kHeightField: {
+      if (g.hfield < 0 || g.hfield >= static_cast<int>(scene.hfields.size())) return false;
+      const HeightField& f = scene.hfields[g.hfield];
+      *lo = {-f.size_x, -f.size_y, -f.size_base};
+      *hi = {f.size_x, f.size_y, f.size_z};
+      return true;
+    }
+  }
+  *lo = -h;
+  *hi = h;
+  return true;
+}
+
+// the geoms RayScene traces (render/ray_scene.h: groups <= 2, alpha >= 0.5) of static bodies.
+bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
+  if (g.group > 2) return false;
+  if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&
+      scene.materials[g.material].alpha < 0.5f)
+    return false;
+  return g.body == 0 || (g.body > 0 && g.body < static_cast<int>(scene.bodies.size()) &&
+                         scene.bodies[g.body].is_static);
+}
+
+bool IsStaticBody(const SceneDescription& scene, int b) {
+  return b == 0 || scene.bodies[b].is_static;
+}
+
+// the fixed ray directions shared by every probe (unit) and the texel of each.
+struct ProbeDirections {
+  std::vector<Eigen::Vector3f> dir;
+  std::vector<int> texel;
+};
+
+const ProbeDirections& Directions() {
+  static const ProbeDirections dirs = [] {
+    constexpr int K = SkyIrradianceVolume::kOctSide;
+    constexpr int R = SkyIrradianceVolume::kRaysPerTexel;
+    ProbeDirections d;
+    for (int t = 0; t < K * K; ++t) {
+      const int ix = t % K, iy = t / K;
+      for (int r = 0; r < R; ++r) {
+        // stratified along u within the texel, jittered.
+        Rng rng(HashKeys(SkyIrradianceVolume::kDirectionSeed, static_cast<uint64_t>(t),
+                         static_cast<uint64_t>(r)));
+        const double ju = (r + rng.UniformD()) / R, jv = rng.UniformD();
+        const double u = -1 + 2 * (ix + ju) / K, v = -1 + 2 * (iy + jv) / K;
+        d.dir.push_back(OctDecode(u, v).normalized().cast<float>());
+        d.texel.push_back(t);
+      }
+    }
+    return d;
+  }();
+  return dirs;
+}
+
+}  // namespace
+
+int SkyIrradianceVolume::TexelOf(const Eigen::Vector3f& w) {
+  const float inv_l1 = 1.0f / (std::abs(w.x()) + std::abs(w.y()) + std::abs(w.z()));
+  float u = w.x() * inv_l1, v = w.y() * inv_l1;
+  if (w.z() < 0) {
+    const float au = std::abs(u), av = std::abs(v);
+    u = std::copysign(1.0f - av, w.x());
+    v = std::copysign(1.0f - au, w.y());
+  }
+  const int ix = std::clamp(static_cast<int>((u + 1.0f) * (0.5f * kOctSide)), 0, kOctSide - 1);
+  const int iy = std::clamp(static_cast<int>((v + 1.0f) * (0.5f * kOctSide)), 0, kOctSide - 1);
+  return ix + kOctSide * iy;
+}
+
+Eigen::Vector3f SkyIrradianceVolume::ProbePosition(int probe) const {
+  const int i = probe % dims_[0], j = (probe / dims_[0]) % dims_[1],
+            k = probe / (dims_[0] * dims_[1]);
+  return origin_ + spacing_ * Eigen::Vector3f(static_cast<float>(i), static_cast<float>(j),
+                                              static_cast<float>(k));
+}
+
+int SkyIrradianceVolume::num_valid_probes() const {
+  return static_cast<int>(std::count(valid_.begin(), valid_.end(), uint8_t{1}));
+}
+
+void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector<Pose>& X_WB,
+                                ThreadPool* pool, int max_probes) {
+  if (X_WB.size() != scene.bodies.size())
+    throw Error("SkyIrradianceVolume::Build: " + std::to_string(X_WB.size()) +
+                " body poses, scene has " + std::to_string(scene.bodies.size()) + " bodies");
+  max_probes = std::clamp(max_probes, 8, 65536);
+  built_ = true;
+  built_static_poses_ = X_WB;
+  lit_sky_ = nullptr;
+  dims_ = {0, 0, 0};
+  valid_.clear();
+  position_.clear();
+  escaped_.clear();
+  depth_.clear();
+  sh_.clear();
+
+  // the static geoms and the bounds of the finite ones, world frame.
+  SceneDescription statics = scene;
+  statics.geoms.clear();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Geom& g : scene.geoms) {
+    if (!IsStaticVisible(scene, g)) continue;
+    statics.geoms.push_back(g);
+    Eigen::Vector3d a, b;
+    if (!LocalHalfExtents(scene, g, &a, &b)) continue;
+    const Pose X_WG = X_WB[g.body] * g.X_BG;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? b.x() : a.x(), (c & 2) ? b.y() : a.y(),
+                                   (c & 4) ? b.z() : a.z());
+      const Eigen::Vector3d p = X_WG * corner;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  if (!(lo.array() <= hi.array()).all()) return;  // no finite static geometry
+
+  // the grid: smallest spacing >= kMinSpacingM (in steps of 5%) with <= max_probes probes,
+  // padded by half a spacing and centred on the bounds.
+  double s = kMinSpacingM;
+  std::array<int, 3> n{};
+  for (;;) {
+    int64_t count = 1;
+    for (int a = 0; a < 3; ++a) {
+      n[a] = std::max(2, static_cast<int>(std::ceil((hi[a] - lo[a] + 1.4 * s) / s - 1e-9)) + 1);
+      count *= n[a];
+    }
+    if (count <= max_probes) break;
+    s *= 1.05;
+  }
+  dims_ = n;
+  spacing_ = static_cast<float>(s);
+  inv_spacing_ = static_cast<float>(1.0 / s);
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  // shifted by a fixed fraction of a spacing, so that probes rarely lie exactly on the faces of
+  // axis-aligned geometry that is symmetric about the centre of the bounds.
+  constexpr double kShift[3] = {0.113, 0.137, 0.171};
+  for (int a = 0; a < 3; ++a)
+    origin_[a] = static_cast<float>(centre[a] - 0.5 * s * (n[a] - 1) + kShift[a] * s);
+
+  // trace the probes against the static geoms only.
+  RayScene rays(statics);
+  WorldSnapshot snap;
+  snap.X_WB = X_WB;
+  rays.Update(snap);
+  const ProbeDirections& dirs = Directions();
+  const int num = num_probes();
+  valid_.assign(num, 0);
+  escaped_.assign(static_cast<size_t>(num) * kNumTexels, 0);
+  depth_.assign(static_cast<size_t>(num) * kNumTexels, Moments{});
+  position_.resize(num);
+  const float far = 2.0f * spacing_;
+  // traces one probe at x into its texels; returns the number of back-face hits and writes
+  // the closest back-face hit (distance, direction).
+  auto trace_probe = [&](const Eigen::Vector3f& x, Moments* m, uint8_t* esc, float* t_back,
+                         Eigen::Vector3f* d_back) {
+    std::fill_n(m, kNumTexels, Moments{});
+    std::fill_n(esc, kNumTexels, uint8_t{0});
+    *t_back = std::numeric_limits<float>::infinity();
+    Ray ray;
+    ray.o = x;
+    int backfaces = 0;
+    for (int r = 0; r < kRaysPerProbe; ++r) {
+      ray.d = dirs.dir[r];
+      SurfaceHit hit;
+      float t = far;
+      if (rays.Intersect(ray, &hit)) {
+        if (!hit.front_face) {
+          ++backfaces;
+          if (hit.t < *t_back) *t_back = hit.t, *d_back = ray.d;
+        }
+        t = std::min(hit.t, far);
+      } else {
+        ++esc[dirs.texel[r]];
+      }
+      m[dirs.texel[r]].mean += t * (1.0f / kRaysPerTexel);
+      m[dirs.texel[r]].mean2 += t * t * (1.0f / kRaysPerTexel);
+    }
+    return backfaces;
+  };
+  constexpr int kChunk = 16;
+  auto trace = [&](int64_t chunk) {
+    const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
+    for (int p = p0; p < p1; ++p) {
+      Moments* m = &depth_[static_cast<size_t>(p) * kNumTexels];
+      uint8_t* esc = &escaped_[static_cast<size_t>(p) * kNumTexels];
+      const Eigen::Vector3f x = ProbePosition(p);
+      position_[p] = x;
+      float t_back;
+      Eigen::Vector3f d_back;
+      const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
+      if (trace_probe(x, m, esc, &t_back, &d_back) <= max_back) {
+        valid_[p] = 1;
+        continue;
+      }
+      // inside geometry: relocate just past the closest back face when that is within half a
+      // spacing (Majercik et al. 2021, "Scaling probe-based real-time dynamic global
+      // illumination for production", sec. 5), and keep the probe if it is outside there.
+      if (!(t_back < 0.5f * spacing_)) continue;
+      const Eigen::Vector3f y = x + (t_back + kRelocateMargin * spacing_) * d_back;
+      float t2;
+      Eigen::Vector3f d2;
+      if (trace_probe(y, m, esc, &t2, &d2) <= max_back) {
+        valid_[p] = 1;
+        position_[p] = y;
+      }
+    }
+  };
+  const int64_t chunks = (num + kChunk - 1) / kChunk;
+  if (pool != nullptr) {
+    pool->ParallelFor(chunks, trace);
+  } else {
+    for (int64_t c = 0; c < chunks; ++c) trace(c);
+  }
+}
+
+void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
+  lit_sky_ = &sky;
+  if (empty()) return;
+  // per texel: the integral of sky radiance x y_lm over the texel's solid angle, times the
+  // band's convolution weight (so that a probe's irradiance SH is a sum over texels).
+  constexpr int K = kOctSide, S = kSubSide;
+  std::vector<double> texel_sh(static_cast<size_t>(kNumTexels) * kShFloats, 0.0);
+  const double du = 2.0 / (K * S);
+  for (int t = 0; t < kNumTexels; ++t) {
+    const int ix = t % K, iy = t / K;
+    double* acc = &texel_sh[static_cast<size_t>(t) * kShFloats];
+    for (int a = 0; a < S; ++a)
+      for (int b = 0; b < S; ++b) {
+        const double u = -1 + (ix * S + a + 0.5) * du, v = -1 + (iy * S + b + 0.5) * du;
+        const Eigen::Vector3d x = OctDecode(u, v);
+        const double len = x.norm();
+        const double dw = du * du / (len * len * len);  // solid angle of the sub-sample
+        const Eigen::Vector3d w = x / len;
+        const Eigen::Vector3d L = sky.Radiance(w.cast<float>()).cast<double>();
+        double y[kNumSh];
+        ShBasis(w.x(), w.y(), w.z(), y);
+        for (int k = 0; k < kNumSh; ++k)
+          for (int c = 0; c < 3; ++c) acc[k * 3 + c] += L[c] * y[k] * dw * kBandWeight[k];
+      }
+  }
+  const int num = num_probes();
+  sh_.assign(static_cast<size_t>(num) * kShFloats, 0.0f);
+  constexpr int kChunk = 64;
+  auto light = [&](int64_t chunk) {
+    const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
+    for (int p = p0; p < p1; ++p) {
+      double acc[kShFloats] = {};
+      const uint8_t* esc = &escaped_[static_cast<size_t>(p) * kNumTexels];
+      for (int t = 0; t < kNumTexels; ++t) {
+        if (esc[t] == 0) continue;
+        const double f = static_cast<double>(esc[t]) / kRaysPerTexel;
+        const double* ts = &texel_sh[static_cast<size_t>(t) * kShFloats];
+        for (int i = 0; i < kShFloats; ++i) acc[i] += f * ts[i];
+      }
+      float* out = &sh_[static_cast<size_t>(p) * kShFloats];
+      for (int i = 0; i < kShFloats; ++i) out[i] = static_cast<float>(acc[i]);
+    }
+  };
+  const int64_t chunks = (num + kChunk - 1) / kChunk;
+  if (pool != nullptr) {
+    pool->ParallelFor(chunks, light);
+  } else {
+    for (int64_t c = 0; c < chunks; ++c) light(c);
+  }
+}
+
+void SkyIrradianceVolume::Update(const SceneDescription& scene, const WorldSnapshot& snapshot,
+                                 const SkyModel& sky, ThreadPool* pool) {
+  bool rebuild = !built_ || snapshot.X_WB.size() != built_static_poses_.size();
+  for (size_t b = 0; !rebuild && b < snapshot.X_WB.size(); ++b)
+    rebuild = IsStaticBody(scene, static_cast<int>(b)) &&
+              snapshot.X_WB[b].matrix() != built_static_poses_[b].matrix();
+  if (rebuild) Build(scene, snapshot.X_WB, pool);
+  if (rebuild || lit_sky_ != &sky) Relight(sky, pool);
+}
+
+Eigen::Vector3f SkyIrradianceVolume::ProbeIrradiance(int probe, const Eigen::Vector3f& n_W) const {
+  float y[kNumSh];
+  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  const float* c = &sh_[static_cast<size_t>(probe) * kShFloats];
+  Eigen::Vector3f e = Eigen::Vector3f::Zero();
+  for (int k = 0; k < kNumSh; ++k)
+    e += y[k] * Eigen::Vector3f(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
+  return e;
+}
+
+Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
+                                                const Eigen::Vector3f& n_W,
+                                                const SkyModel& sky) const {
+  if (empty()) return sky.Irradiance(n_W);
+  const Eigen::Vector3f q = p_W + (kNormalBias * spacing_) * n_W;
+  const Eigen::Vector3f g = (q - origin_) * inv_spacing_;
+  const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
+  if (!(g.x() >= 0 && g.y() >= 0 && g.z() >= 0 && g.x() <= nx - 1 && g.y() <= ny - 1 &&
+        g.z() <= nz - 1))
+    return sky.Irradiance(n_W);
+  const int i0 = std::min(static_cast<int>(g.x()), nx - 2);
+  const int j0 = std::min(static_cast<int>(g.y()), ny - 2);
+  const int k0 = std::min(static_cast<int>(g.z()), nz - 2);
+  const float fx = g.x() - i0, fy = g.y() - j0, fz = g.z() - k0;
+  float y[kNumSh];
+  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  const float var_floor = 4e-4f * spacing_ * spacing_;
+  const int base = ProbeIndex(i0, j0, k0);
+  float e0 = 0, e1 = 0, e2 = 0, wsum = 0;
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+    const int idx = base + dx + nx * (dy + ny * dz);
+    if (!valid_[idx]) continue;
+    const float tri = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+    // from q to the (possibly relocated) probe.
+    const Eigen::Vector3f d = position_[idx] - q;
+    const float r = d.norm();
+    const float inv_r = r > 1e-6f ? 1.0f / r : 0.0f;
+    const float back = 0.5f * (1.0f + d.dot(n_W) * inv_r);
+    float w = tri * (back * back + 0.2f);
+    if (r > 1e-6f) {
+      // Chebyshev bound on the probe seeing q (the probe's depth moments towards q).
+      const Moments& m = depth_[static_cast<size_t>(idx) * kNumTexels + TexelOf(-d)];
+      if (r > m.mean) {
+        const float var = std::max(m.mean2 - m.mean * m.mean, var_floor);
+        const float delta = r - m.mean;
+        const float cheb = var / (var + delta * delta);
+        w *= cheb * cheb * cheb;
+      }
+    }
+    const float* sh = &sh_[static_cast<size_t>(idx) * kShFloats];
+    float a0 = 0, a1 = 0, a2 = 0;
+    for (int k = 0; k < kNumSh; ++k) {
+      a0 += y[k] * sh[3 * k];
+      a1 += y[k] * sh[3 * k + 1];
+      a2 += y[k] * sh[3 * k + 2];
+    }
+    e0 += w * a0, e1 += w * a1, e2 += w * a2;
+    wsum += w;
+  }
+  if (!(wsum > 0)) return Eigen::Vector3f::Zero();
+  const float inv = 1.0f / wsum;
+  return Eigen::Vector3f(std::max(e0 * inv, 0.0f), std::max(e1 * inv, 0.0f),
+                         std::max(e2 * inv, 0.0f));
+}
+
+}  // namespace penumbra

@@ -1,0 +1,144 @@
+#pragma once
+// occluded sky irradiance for the realtime tier: a precomputed irradiance volume of the static
+// geometry (Greger, Shirley, Hubbard, Greenberg, "The Irradiance Volume", IEEE CG&A 1998), lit
+// by the SkyModel, with probe visibility weights after Majercik, Guertin, Nowrouzezahrai,
+// McGuire, "Dynamic Diffuse Global Illumination with Ray-Traced Irradiance Fields", JCGT 2019.
+//
+// build (once per static scene): a regular 3d grid of probes over the bounds of the finite
+// static geometry (planes, finite or not, are left out of the bounds: they are floors and
+// ground that would stretch the grid over the whole terrain), padded by half a spacing. the
+// spacing is the smallest multiple of 1.05 of kMinSpacingM whose grid holds <= max_probes
+// probes. every probe traces the same kRaysPerProbe directions against the static geoms only
+// (the world body and Body::is_static; moving bodies are not baked): kRaysPerTexel jittered
+// directions in each texel of a kOctSide x kOctSide octahedral map of the sphere (Cigolle et
+// al., "A survey of efficient representations for independent unit vectors", JCGT 2014),
+// jitter from Rng(HashKeys(kDirectionSeed, texel, ray)), identical for every probe. per probe
+// and texel it keeps the number of rays that escaped (hit nothing) and the first two moments of
+// the hit distance clamped to 2 spacings (for the visibility test). a probe whose rays hit back
+// faces more than kMaxBackfaceFraction of the time is inside geometry and invalid.
+//
+// lighting (whenever the sky changes): the sky radiance is projected onto real spherical
+// harmonics up to l = 2 texel by texel (kSubSide^2 sub-samples of each texel, weighted by the
+// octahedral map's solid angle du dv / |x|^3), so a probe's radiance SH is the sum over texels
+// of (escaped fraction) x (texel's sky SH); the irradiance SH is that times the clamped-cosine
+// convolution weights A0 = pi, A1 = 2 pi / 3, A2 = pi / 4 (Ramamoorthi and Hanrahan, "An
+// efficient representation for irradiance environment maps", SIGGRAPH 2001). rays that hit
+// geometry contribute no sky light (no bounce off the static surfaces).
+//
+// lookup at a surface point p with unit normal n (Majercik et al. 2019, sec. 4.2): the point
+// is moved off the surface, p' = p + kNormalBias spacing n; of the 8 probes of the grid cell
+// around p', invalid ones are skipped and each valid one is weighted by
+//   trilinear weight x ((1 + n . d) / 2)^2 + 0.2 (backface weight; d unit from p' to the probe)
+//   x Chebyshev visibility max(0, var / (var + (r - mean)^2))^3 when r > mean,
+// where r = |probe - p'| and mean, var are the probe's hit-distance moments in the texel of the
+// direction towards p' (a wall between the probe and p' makes mean << r: the probe's light
+// does not leak through the wall). the weights are renormalised; the irradiance is the
+// weighted mean of the probes' L2 irradiance at n, clamped to >= 0. a cell with no valid probe
+// gives 0 (inside thick geometry); outside the grid the unoccluded SkyModel::Irradiance(n).
+//
+// thread-safety: Irradiance is const and thread-safe; Build/Relight/Update are not.
+// determinism: every probe is computed on its own from fixed directions, so the volume is
+// bit-identical whatever the thread count.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "penumbra/core/pose.h"
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/sky_model.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// occluded sky irradiance of the static scene on a probe grid (see the file comment).
+class SkyIrradianceVolume {
+ public:
+  static constexpr int kOctSide = 8;       ///< octahedral texels per side (64 texels)
+  static constexpr int kRaysPerTexel = 2;  ///< rays per texel
+  static constexpr int kNumTexels = kOctSide * kOctSide;
+  static constexpr int kRaysPerProbe = kNumTexels * kRaysPerTexel;  ///< 128
+  static constexpr int kSubSide = 8;              ///< sky sub-samples per texel side when lighting
+  static constexpr double kMinSpacingM = 0.25;    ///< smallest probe spacing, m
+  static constexpr int kDefaultMaxProbes = 4096;  ///< default cap on the probe count
+  static constexpr float kMaxBackfaceFraction = 0.25f;
+  static constexpr float kNormalBias = 0.25f;  ///< lookup offset along n, in spacings
+  /// a relocated probe is put this far (in spacings) past the back face it left through.
+  static constexpr float kRelocateMargin = 0.05f;
+  static constexpr uint64_t kDirectionSeed = 0x5ca1ab1e5c1e5ULL;
+
+  SkyIrradianceVolume() = default;
+
+  /// traces the probes of the static geoms of `scene` posed by X_WB (one pose per body; only
+  /// the static bodies' are used). with no finite static geometry the volume stays empty.
+  /// the probe count is <= max_probes (clamped to [8, 65536]). clears the lighting: call
+  /// Relight before Irradiance.
+  /// @throws Error if X_WB.size() != scene.bodies.size() or Embree fails.
+  void Build(const SceneDescription& scene, const std::vector<Pose>& X_WB, ThreadPool* pool,
+             int max_probes = kDefaultMaxProbes);
+
+  /// projects `sky` onto every probe's SH (a few ms for 4k probes). `sky` is only read here.
+  void Relight(const SkyModel& sky, ThreadPool* pool);
+
+  /// for the renderer, once per frame: Build when the static bodies' poses in `snapshot`
+  /// differ from those of the last build (or on the first call), Relight when `sky` is not the
+  /// object lit last (SkyModels are compared by address: a renderer keeps its base sky, and
+  /// the effects build a new object whenever they change the sky).
+  /// @throws as Build.
+  void Update(const SceneDescription& scene, const WorldSnapshot& snapshot, const SkyModel& sky,
+              ThreadPool* pool);
+
+  /// true when there are no probes (no finite static geometry): Irradiance is then the
+  /// unoccluded sky.
+  bool empty() const { return num_probes() == 0; }
+
+  /// sky irradiance (lux per channel) on a surface at world point p_W with unit normal n_W,
+  /// occluded by the static geometry (lookup scheme in the file comment); outside the grid,
+  /// or when empty, `sky`.Irradiance(n_W). requires Relight after Build.
+  Eigen::Vector3f Irradiance(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
+                             const SkyModel& sky) const;
+
+  /// irradiance SH of one probe evaluated at unit normal n (no interpolation, no clamping).
+  Eigen::Vector3f ProbeIrradiance(int probe, const Eigen::Vector3f& n_W) const;
+
+  int num_probes() const { return dims_[0] * dims_[1] * dims_[2]; }
+  int num_valid_probes() const;
+  /// probes along x, y, z.
+  const std::array<int, 3>& dims() const { return dims_; }
+  /// probe spacing, m.
+  float spacing() const { return spacing_; }
+  /// world position of probe (i, j, k) = origin + spacing (i, j, k).
+  const Eigen::Vector3f& origin() const { return origin_; }
+  /// index of probe (i, j, k): i + nx (j + ny k).
+  int ProbeIndex(int i, int j, int k) const { return i + dims_[0] * (j + dims_[1] * k); }
+  Eigen::Vector3f ProbePosition(int probe) const;
+  /// where probe `probe` was traced: its grid node, or where it was relocated to.
+  const Eigen::Vector3f& probe_position(int probe) const { return position_[probe]; }
+  bool probe_valid(int probe) const { return valid_[probe] != 0; }
+  /// escaped rays of texel t of a probe (0..kRaysPerTexel), for tests and tools.
+  int escaped(int probe, int texel) const { return escaped_[probe * kNumTexels + texel]; }
+
+  /// the octahedral texel of unit direction w, in [0, kNumTexels).
+  static int TexelOf(const Eigen::Vector3f& w);
+
+ private:
+  struct Moments {
+    float mean = 0, mean2 = 0;
+  };
+  std::array<int, 3> dims_{0, 0, 0};
+  float spacing_ = 0;
+  float inv_spacing_ = 0;
+  Eigen::Vector3f origin_{0, 0, 0};
+  std::vector<uint8_t> valid_;             // per probe
+  std::vector<Eigen::Vector3f> position_;  // per probe: grid node or relocated, world
+  std::vector<uint8_t> escaped_;           // per probe and texel
+  std::vector<Moments> depth_;             // per probe and texel
+  std::vector<float> sh_;                  // per probe: 9 (l, m) x 3 channels, irradiance
+  std::vector<Pose> built_static_poses_;   // X_WB of the last Build (static bodies only)
+  bool built_ = false;
+  const SkyModel* lit_sky_ = nullptr;
+};
+
+}  // namespace penumbra
