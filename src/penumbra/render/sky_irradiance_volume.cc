@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -116,8 +117,11 @@ const ProbeDirections& Directions() {
     constexpr int K = SkyIrradianceVolume::kOctSide;
     constexpr int R = SkyIrradianceVolume::kRaysPerTexel;
     ProbeDirections d;
-    for (int t = 0; t < K * K; ++t) {
-      const int ix = t % K, iy = t / K;
+    // texels in 4 x 4 blocks, so that consecutive rays are coherent.
+    for (int b = 0; b < K * K; ++b) {
+      const int block = b / 16, in = b % 16;
+      const int ix = (block % (K / 4)) * 4 + in % 4, iy = (block / (K / 4)) * 4 + in / 4;
+      const int t = ix + K * iy;
       for (int r = 0; r < R; ++r) {
         // stratified along u within the texel, jittered.
         Rng rng(HashKeys(SkyIrradianceVolume::kDirectionSeed, static_cast<uint64_t>(t),
@@ -170,6 +174,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   lit_sky_ = nullptr;
   dims_ = {0, 0, 0};
   valid_.clear();
+  links_.clear();
   position_.clear();
   escaped_.clear();
   depth_.clear();
@@ -228,34 +233,38 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   const int num = num_probes();
   valid_.assign(num, 0);
   escaped_.assign(static_cast<size_t>(num) * kNumTexels, 0);
-  depth_.assign(static_cast<size_t>(num) * kNumTexels, Moments{});
+  depth_.assign(static_cast<size_t>(num) * kNumTexels, 0.0f);
   position_.resize(num);
   const float far = 2.0f * spacing_;
   // traces one probe at x into its texels; returns the number of back-face hits and writes
   // the closest back-face hit (distance, direction).
-  auto trace_probe = [&](const Eigen::Vector3f& x, Moments* m, uint8_t* esc, float* t_back,
+  auto trace_probe = [&](const Eigen::Vector3f& x, float* m, uint8_t* esc, float* t_back,
                          Eigen::Vector3f* d_back) {
-    std::fill_n(m, kNumTexels, Moments{});
+    std::fill_n(m, kNumTexels, far);
     std::fill_n(esc, kNumTexels, uint8_t{0});
     *t_back = std::numeric_limits<float>::infinity();
-    Ray ray;
-    ray.o = x;
+    // one probe's rays as Embree packets of 16 (4 x 4 neighbouring texels share a packet).
+    thread_local std::vector<Ray> ray(kRaysPerProbe);
+    thread_local std::vector<SurfaceHit> hit(kRaysPerProbe);
+    thread_local std::unique_ptr<bool[]> did_hit(new bool[kRaysPerProbe]);
+    for (int r = 0; r < kRaysPerProbe; ++r) {
+      ray[r].o = x;
+      ray[r].d = dirs.dir[r];
+    }
+    rays.IntersectMany(ray.data(), kRaysPerProbe, /*coherent=*/true, hit.data(), did_hit.get());
     int backfaces = 0;
     for (int r = 0; r < kRaysPerProbe; ++r) {
-      ray.d = dirs.dir[r];
-      SurfaceHit hit;
       float t = far;
-      if (rays.Intersect(ray, &hit)) {
-        if (!hit.front_face) {
+      if (did_hit[r]) {
+        if (!hit[r].front_face) {
           ++backfaces;
-          if (hit.t < *t_back) *t_back = hit.t, *d_back = ray.d;
+          if (hit[r].t < *t_back) *t_back = hit[r].t, *d_back = ray[r].d;
         }
-        t = std::min(hit.t, far);
+        t = std::min(hit[r].t, far);
       } else {
         ++esc[dirs.texel[r]];
       }
-      m[dirs.texel[r]].mean += t * (1.0f / kRaysPerTexel);
-      m[dirs.texel[r]].mean2 += t * t * (1.0f / kRaysPerTexel);
+      m[dirs.texel[r]] = std::min(m[dirs.texel[r]], t);
     }
     return backfaces;
   };
@@ -263,7 +272,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   auto trace = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
     for (int p = p0; p < p1; ++p) {
-      Moments* m = &depth_[static_cast<size_t>(p) * kNumTexels];
+      float* m = &depth_[static_cast<size_t>(p) * kNumTexels];
       uint8_t* esc = &escaped_[static_cast<size_t>(p) * kNumTexels];
       const Eigen::Vector3f x = ProbePosition(p);
       position_[p] = x;
@@ -292,6 +301,27 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     pool->ParallelFor(chunks, trace);
   } else {
     for (int64_t c = 0; c < chunks; ++c) trace(c);
+  }
+
+  // links between valid neighbours along the grid axes that see each other (each one's ray
+  // towards the other goes at least as far as the other probe), for the smoothing in Relight.
+  links_.assign(num, 0);
+  for (int p = 0; p < num; ++p) {
+    if (!valid_[p]) continue;
+    const int c[3] = {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])};
+    const int stride[3] = {1, n[0], n[0] * n[1]};
+    for (int a = 0; a < 3; ++a) {
+      if (c[a] + 1 >= n[a]) continue;
+      const int q = p + stride[a];
+      if (!valid_[q]) continue;
+      const Eigen::Vector3f d = position_[q] - position_[p];
+      const float dist = d.norm();
+      if (depth_[static_cast<size_t>(p) * kNumTexels + TexelOf(d)] < dist ||
+          depth_[static_cast<size_t>(q) * kNumTexels + TexelOf(-d)] < dist)
+        continue;
+      links_[p] |= static_cast<uint8_t>(1u << (2 * a));      // p -> +a neighbour
+      links_[q] |= static_cast<uint8_t>(1u << (2 * a + 1));  // q -> -a neighbour
+    }
   }
 }
 
@@ -344,6 +374,28 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
   } else {
     for (int64_t c = 0; c < chunks; ++c) light(c);
   }
+  // smoothing: a [1 2 1] filter along x, then y, then z over linked neighbours (renormalised),
+  // which spreads the quantisation of small sky openings (a window seen by a few texels) over
+  // the neighbourhood without mixing probes on the two sides of a wall.
+  std::vector<float> prev;
+  const int stride[3] = {1, dims_[0], dims_[0] * dims_[1]};
+  for (int a = 0; a < 3; ++a) {
+    prev = sh_;
+    for (int p = 0; p < num; ++p) {
+      if (!valid_[p]) continue;
+      float* out = &sh_[static_cast<size_t>(p) * kShFloats];
+      float w = 2;
+      for (int i = 0; i < kShFloats; ++i) out[i] *= 2;
+      for (int side = 0; side < 2; ++side) {
+        if (!(links_[p] & (1u << (2 * a + side)))) continue;
+        const int q = side == 0 ? p + stride[a] : p - stride[a];
+        const float* in = &prev[static_cast<size_t>(q) * kShFloats];
+        for (int i = 0; i < kShFloats; ++i) out[i] += in[i];
+        w += 1;
+      }
+      for (int i = 0; i < kShFloats; ++i) out[i] /= w;
+    }
+  }
 }
 
 void SkyIrradianceVolume::Update(const SceneDescription& scene, const WorldSnapshot& snapshot,
@@ -382,9 +434,12 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const float fx = g.x() - i0, fy = g.y() - j0, fz = g.z() - k0;
   float y[kNumSh];
   ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
-  const float var_floor = 4e-4f * spacing_ * spacing_;
+  const float tol = kVisibilityTolerance * spacing_;
+  const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
   float e0 = 0, e1 = 0, e2 = 0, wsum = 0;
+  float dark_lum = std::numeric_limits<float>::infinity();
+  Eigen::Vector3f dark = Eigen::Vector3f::Zero();
   for (int c = 0; c < 8; ++c) {
     const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
     const int idx = base + dx + nx * (dy + ny * dz);
@@ -394,17 +449,16 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     const Eigen::Vector3f d = position_[idx] - q;
     const float r = d.norm();
     const float inv_r = r > 1e-6f ? 1.0f / r : 0.0f;
-    const float back = 0.5f * (1.0f + d.dot(n_W) * inv_r);
-    float w = tri * (back * back + 0.2f);
+    // probes behind the surface's tangent plane at p never light it.
+    const float d_n = d.dot(n_W);
+    if (d_n + kNormalBias * spacing_ <= 0) continue;
+    const float back = 0.5f * (1.0f + d_n * inv_r);
+    float w = tri * back * back;
     if (r > 1e-6f) {
-      // Chebyshev bound on the probe seeing q (the probe's depth moments towards q).
-      const Moments& m = depth_[static_cast<size_t>(idx) * kNumTexels + TexelOf(-d)];
-      if (r > m.mean) {
-        const float var = std::max(m.mean2 - m.mean * m.mean, var_floor);
-        const float delta = r - m.mean;
-        const float cheb = var / (var + delta * delta);
-        w *= cheb * cheb * cheb;
-      }
+      // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
+      // ramps down to 0 over tol beyond that.
+      const float depth = depth_[static_cast<size_t>(idx) * kNumTexels + TexelOf(-d)];
+      w *= std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
     }
     const float* sh = &sh_[static_cast<size_t>(idx) * kShFloats];
     float a0 = 0, a1 = 0, a2 = 0;
@@ -415,8 +469,11 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     }
     e0 += w * a0, e1 += w * a1, e2 += w * a2;
     wsum += w;
+    // the darkest valid probe in front of the surface, in case none is visible.
+    const float lum = 0.2126f * a0 + 0.7152f * a1 + 0.0722f * a2;
+    if (lum < dark_lum) dark_lum = lum, dark = Eigen::Vector3f(a0, a1, a2);
   }
-  if (!(wsum > 0)) return Eigen::Vector3f::Zero();
+  if (!(wsum > 0)) return dark.cwiseMax(0.0f);
   const float inv = 1.0f / wsum;
   return Eigen::Vector3f(std::max(e0 * inv, 0.0f), std::max(e1 * inv, 0.0f),
                          std::max(e2 * inv, 0.0f));

@@ -6,35 +6,44 @@
 //
 // build (once per static scene): a regular 3d grid of probes over the bounds of the finite
 // static geometry (planes, finite or not, are left out of the bounds: they are floors and
-// ground that would stretch the grid over the whole terrain), padded by half a spacing. the
-// spacing is the smallest multiple of 1.05 of kMinSpacingM whose grid holds <= max_probes
+// ground that would stretch the grid over the whole terrain), padded by 0.7 spacing and shifted
+// by a fixed fraction of a spacing (so that probes rarely sit exactly on axis-aligned faces).
+// the spacing is the smallest multiple of 1.05 of kMinSpacingM whose grid holds <= max_probes
 // probes. every probe traces the same kRaysPerProbe directions against the static geoms only
-// (the world body and Body::is_static; moving bodies are not baked): kRaysPerTexel jittered
-// directions in each texel of a kOctSide x kOctSide octahedral map of the sphere (Cigolle et
-// al., "A survey of efficient representations for independent unit vectors", JCGT 2014),
-// jitter from Rng(HashKeys(kDirectionSeed, texel, ray)), identical for every probe. per probe
-// and texel it keeps the number of rays that escaped (hit nothing) and the first two moments of
-// the hit distance clamped to 2 spacings (for the visibility test). a probe whose rays hit back
-// faces more than kMaxBackfaceFraction of the time is inside geometry and invalid.
+// (the world body and Body::is_static; moving bodies are not baked), as Embree packets: one
+// jittered direction in each texel of a kOctSide x kOctSide octahedral map of the sphere
+// (Cigolle et al., "A survey of efficient representations for independent unit vectors", JCGT
+// 2014), jitter from Rng(HashKeys(kDirectionSeed, texel, ray)). per probe and texel it keeps
+// whether the ray escaped (hit nothing) and its hit distance clamped to 2 spacings. a probe
+// whose rays hit back faces more than kMaxBackfaceFraction of the time is inside geometry: it
+// is moved just past the closest back face when that is within half a spacing and traced again
+// (probe relocation, Majercik et al. 2021, "Scaling probe-based real-time dynamic global
+// illumination for production", JCGT), else it is invalid. neighbours along the grid axes that
+// see each other are linked.
 //
 // lighting (whenever the sky changes): the sky radiance is projected onto real spherical
 // harmonics up to l = 2 texel by texel (kSubSide^2 sub-samples of each texel, weighted by the
-// octahedral map's solid angle du dv / |x|^3), so a probe's radiance SH is the sum over texels
-// of (escaped fraction) x (texel's sky SH); the irradiance SH is that times the clamped-cosine
+// octahedral map's solid angle du dv / |x|^3), so a probe's radiance SH is the sum over its
+// escaped texels of the texel's sky SH; the irradiance SH is that times the clamped-cosine
 // convolution weights A0 = pi, A1 = 2 pi / 3, A2 = pi / 4 (Ramamoorthi and Hanrahan, "An
-// efficient representation for irradiance environment maps", SIGGRAPH 2001). rays that hit
-// geometry contribute no sky light (no bounce off the static surfaces).
+// efficient representation for irradiance environment maps", SIGGRAPH 2001). then a [1 2 1]
+// filter along each axis over linked neighbours smooths the quantisation of small openings
+// (a window 5 m away covers about 2 texels) without mixing the two sides of a wall. rays that
+// hit geometry contribute no sky light (no bounce off the static surfaces).
 //
-// lookup at a surface point p with unit normal n (Majercik et al. 2019, sec. 4.2): the point
-// is moved off the surface, p' = p + kNormalBias spacing n; of the 8 probes of the grid cell
-// around p', invalid ones are skipped and each valid one is weighted by
-//   trilinear weight x ((1 + n . d) / 2)^2 + 0.2 (backface weight; d unit from p' to the probe)
-//   x Chebyshev visibility max(0, var / (var + (r - mean)^2))^3 when r > mean,
-// where r = |probe - p'| and mean, var are the probe's hit-distance moments in the texel of the
-// direction towards p' (a wall between the probe and p' makes mean << r: the probe's light
-// does not leak through the wall). the weights are renormalised; the irradiance is the
-// weighted mean of the probes' L2 irradiance at n, clamped to >= 0. a cell with no valid probe
-// gives 0 (inside thick geometry); outside the grid the unoccluded SkyModel::Irradiance(n).
+// lookup at a surface point p with unit normal n (after Majercik et al. 2019, sec. 4.2): the
+// point is moved off the surface, q = p + kNormalBias spacing n; of the 8 probes of the grid
+// cell around q, invalid ones and those behind the tangent plane at p are skipped and each
+// other one is weighted by
+//   trilinear weight x ((1 + n . d) / 2)^2 (d unit from q to the probe)
+//   x clamp((depth + tol - r) / tol, 0, 1),  tol = kVisibilityTolerance spacing,
+// where r = |probe - q| and depth is the hit distance of the probe's ray in the texel of the
+// direction towards q: a wall between the probe and q makes depth < r, so an outdoor probe's
+// light does not leak through the wall (a conservative test: it rather drops probes that do see
+// q than keep ones that do not). the weights are renormalised; the irradiance is the weighted
+// mean of the probes' L2 irradiance at n, clamped to >= 0. when no probe passes, the darkest
+// valid probe in front of the surface is used, and 0 when there is none (inside thick
+// geometry); outside the grid it is the unoccluded SkyModel::Irradiance(n).
 //
 // thread-safety: Irradiance is const and thread-safe; Build/Relight/Update are not.
 // determinism: every probe is computed on its own from fixed directions, so the volume is
@@ -56,14 +65,17 @@ namespace penumbra {
 /// occluded sky irradiance of the static scene on a probe grid (see the file comment).
 class SkyIrradianceVolume {
  public:
-  static constexpr int kOctSide = 8;       ///< octahedral texels per side (64 texels)
-  static constexpr int kRaysPerTexel = 2;  ///< rays per texel
+  static constexpr int kOctSide =
+      16;  // a multiple of 4      ///< octahedral texels per side (256 texels)
+  static constexpr int kRaysPerTexel = 1;  ///< rays per texel
   static constexpr int kNumTexels = kOctSide * kOctSide;
-  static constexpr int kRaysPerProbe = kNumTexels * kRaysPerTexel;  ///< 128
-  static constexpr int kSubSide = 8;              ///< sky sub-samples per texel side when lighting
+  static constexpr int kRaysPerProbe = kNumTexels * kRaysPerTexel;  ///< 256
+  static constexpr int kSubSide = 4;              ///< sky sub-samples per texel side when lighting
   static constexpr double kMinSpacingM = 0.25;    ///< smallest probe spacing, m
   static constexpr int kDefaultMaxProbes = 4096;  ///< default cap on the probe count
   static constexpr float kMaxBackfaceFraction = 0.25f;
+  /// a probe's visibility weight falls from 1 to 0 over this many spacings beyond its depth.
+  static constexpr float kVisibilityTolerance = 0.1f;
   static constexpr float kNormalBias = 0.25f;  ///< lookup offset along n, in spacings
   /// a relocated probe is put this far (in spacings) past the back face it left through.
   static constexpr float kRelocateMargin = 0.05f;
@@ -124,17 +136,15 @@ class SkyIrradianceVolume {
   static int TexelOf(const Eigen::Vector3f& w);
 
  private:
-  struct Moments {
-    float mean = 0, mean2 = 0;
-  };
   std::array<int, 3> dims_{0, 0, 0};
   float spacing_ = 0;
   float inv_spacing_ = 0;
   Eigen::Vector3f origin_{0, 0, 0};
   std::vector<uint8_t> valid_;             // per probe
+  std::vector<uint8_t> links_;             // per probe: bit 2a (+a) / 2a+1 (-a) neighbour linked
   std::vector<Eigen::Vector3f> position_;  // per probe: grid node or relocated, world
   std::vector<uint8_t> escaped_;           // per probe and texel
-  std::vector<Moments> depth_;             // per probe and texel
+  std::vector<float> depth_;               // per probe and texel
   std::vector<float> sh_;                  // per probe: 9 (l, m) x 3 channels, irradiance
   std::vector<Pose> built_static_poses_;   // X_WB of the last Build (static bodies only)
   bool built_ = false;
