@@ -222,6 +222,7 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
           const uint64_t k1 =
               HashKeys(rt.key, static_cast<uint64_t>(static_cast<int64_t>(slice) + 1));
           const double threshold = 1.0 - s.coverage;
+          Fbm3Sampler fbm0(k0, s.octaves), fbm1(k1, s.octaves);  // = Fbm3(k0 / k1, q, octaves)
           float max_d = 0;
           for (int k = 0; k < nz; ++k)
             for (int j = 0; j < ny; ++j)
@@ -231,8 +232,7 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
                                                       (j + 0.5) * ext.y() / ny,
                                                       (k + 0.5) * ext.z() / nz);
                 const Eigen::Vector3d q = (p - s.wind_m_s * t) / s.noise_scale_m;
-                const double n =
-                    (1 - blend) * Fbm3(k0, q, s.octaves) + blend * Fbm3(k1, q, s.octaves);
+                const double n = (1 - blend) * fbm0(q) + blend * fbm1(q);
                 const double d = s.coverage > 0
                                      ? std::max(0.0, n - threshold) / std::max(s.coverage, 1e-6) * w
                                      : 0;

@@ -1,5 +1,6 @@
 #include "penumbra/effects/value_noise.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "penumbra/core/rng.h"
@@ -51,6 +52,43 @@ double Fbm3(uint64_t key, const Eigen::Vector3d& p, int octaves) {
   double sum = 0, amp = 1, norm = 0, freq = 1;
   for (int o = 0; o < octaves; ++o) {
     sum += amp * ValueNoise3(HashKeys(key, static_cast<uint64_t>(o)), p * freq);
+    norm += amp;
+    amp *= 0.5;
+    freq *= 2.0;
+  }
+  return sum / norm;
+}
+
+Fbm3Sampler::Fbm3Sampler(uint64_t key, int octaves) : octaves_(std::max(octaves, 0)) {
+  for (int o = 0; o < octaves; ++o) octaves_[o].key = HashKeys(key, static_cast<uint64_t>(o));
+}
+
+double Fbm3Sampler::operator()(const Eigen::Vector3d& p) {
+  // the arithmetic of Fbm3 and ValueNoise3, with the lattice values of the cell memoised.
+  double sum = 0, amp = 1, norm = 0, freq = 1;
+  for (Octave& oc : octaves_) {
+    const Eigen::Vector3d x = p * freq;
+    const Eigen::Vector3d fl(std::floor(x.x()), std::floor(x.y()), std::floor(x.z()));
+    const int64_t i = static_cast<int64_t>(fl.x()), j = static_cast<int64_t>(fl.y()),
+                  k = static_cast<int64_t>(fl.z());
+    if (!oc.valid || i != oc.i || j != oc.j || k != oc.k) {
+      for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx)
+            oc.v[dz][dy][dx] = LatticeValue(oc.key, i + dx, j + dy, k + dz);
+      oc.valid = true;
+      oc.i = i, oc.j = j, oc.k = k;
+    }
+    const double fx = Fade(x.x() - fl.x()), fy = Fade(x.y() - fl.y()), fz = Fade(x.z() - fl.z());
+    double c[2][2];
+    for (int dz = 0; dz < 2; ++dz)
+      for (int dy = 0; dy < 2; ++dy) {
+        const double a = oc.v[dz][dy][0], b = oc.v[dz][dy][1];
+        c[dz][dy] = a + (b - a) * fx;
+      }
+    const double y0 = c[0][0] + (c[0][1] - c[0][0]) * fy;
+    const double y1 = c[1][0] + (c[1][1] - c[1][0]) * fy;
+    sum += amp * (y0 + (y1 - y0) * fz);
     norm += amp;
     amp *= 0.5;
     freq *= 2.0;

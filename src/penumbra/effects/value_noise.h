@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <vector>
 
 namespace penumbra {
 
@@ -21,5 +22,25 @@ double ValueNoise3(uint64_t key, const Eigen::Vector3d& p);
 /// fractal sum of `octaves` ValueNoise3 octaves (frequency x2, amplitude x0.5 per octave),
 /// normalised to [0, 1].
 double Fbm3(uint64_t key, const Eigen::Vector3d& p, int octaves);
+
+/// Fbm3 for a sequence of nearby points (a voxel grid row by row): equal to Fbm3(key, p,
+/// octaves) bit for bit, but each octave keeps the eight lattice values of the last cell it
+/// used, so consecutive points in the same lattice cell do not hash them again. one object per
+/// thread (it has state).
+class Fbm3Sampler {
+ public:
+  Fbm3Sampler(uint64_t key, int octaves);
+  /// Fbm3(key, p, octaves).
+  double operator()(const Eigen::Vector3d& p);
+
+ private:
+  struct Octave {
+    uint64_t key = 0;
+    bool valid = false;
+    int64_t i = 0, j = 0, k = 0;
+    double v[2][2][2] = {};  // [dz][dy][dx]
+  };
+  std::vector<Octave> octaves_;
+};
 
 }  // namespace penumbra

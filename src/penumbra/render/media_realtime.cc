@@ -35,6 +35,38 @@ T Trilinear(const T* a, const int r[3], const Eigen::Vector3f& f) {
 
 Eigen::Vector3f Exp(const Eigen::Vector3f& x) { return x.array().exp().matrix(); }
 
+// rgb in lanes 0..2 of a 4-lane array (lane 3 = 0), for vectorised lookups.
+Eigen::Array4f To4(const Eigen::Vector3f& v) { return Eigen::Array4f(v.x(), v.y(), v.z(), 0.0f); }
+
+// AnalyticMedium::DensityIntegral in single precision for camera rays (the same pieces below and
+// above the base height, closed form per piece): the integral of h(z(t)) dt over [a, b] for
+// z(t) = oz + dz t (d unit); b may be +inf. float keeps the relative error near 1e-6 (the
+// optical depths it yields are used as exp(-tau) for display radiance).
+float DensityIntegralF(const AnalyticMedium& m, float oz, float dz, float a, float b) {
+  if (!(a < b)) return 0.0f;
+  auto piece = [](float s, float e, float h_s, float rate) {
+    const float len = e - s;
+    if (rate == 0.0f || std::abs(rate) * len < 1e-6f) return h_s * len;
+    if (std::isinf(len)) return rate > 0 ? h_s / rate : kInfF;
+    return h_s * -std::expm1(-rate * len) / rate;
+  };
+  const float k = m.falloff, zb = m.base;
+  auto h = [&](float t) { return std::exp(-k * std::max(0.0f, oz + dz * t - zb)); };
+  if (k <= 0 || std::abs(dz) < 1e-9f) return piece(a, b, k <= 0 ? 1.0f : h(a), 0.0f);
+  const float tc = (zb - oz) / dz;  // where z crosses the base
+  float sum = 0.0f;
+  if (dz > 0) {
+    if (a < tc) sum += piece(a, std::min(b, tc), 1.0f, 0.0f);
+    const float s = std::max(a, tc);
+    if (s < b) sum += piece(s, b, h(s), k * dz);
+  } else {
+    if (a < tc) sum += piece(a, std::min(b, tc), h(a), k * dz);
+    const float s = std::max(a, tc);
+    if (s < b) sum += piece(s, b, 1.0f, 0.0f);
+  }
+  return sum;
+}
+
 bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
   return !m.bounded ||
          ((p.array() >= m.box_min.array()).all() && (p.array() <= m.box_max.array()).all());
@@ -48,6 +80,13 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
                           const Eigen::Vector3f& sky_ambient, ThreadPool* pool) {
   media_ = &media;
   sky_ambient_ = sky_ambient;
+  sky_ambient4_ = To4(sky_ambient);
+  sigma_t4_.clear();
+  sigma_s4_.clear();
+  for (const AnalyticMedium& m : media.analytic()) {
+    sigma_t4_.push_back(To4(m.sigma_t));
+    sigma_s4_.push_back(To4(m.sigma_s));
+  }
   num_lights_ = std::min(lights.size(), kMaxVolumeLights);
   const int nl = num_lights_;
   auto parallel = [&](int64_t n, const std::function<void(int64_t)>& fn) {
@@ -178,6 +217,13 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
           if (vol_.with_visibility) vol_.vis[at] = T > 1e-4f && visible(p, ls) ? T : 0.0f;
         }
       });
+      // the same values with the lights of a cell adjacent (LightTransmittances).
+      vol_.stride = (nl + 3) / 4 * 4;
+      vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+      for (int l = 0; l < nl; ++l)
+        for (int c = 0; c < cells; ++c)
+          vol_.trans_cl[static_cast<size_t>(c) * vol_.stride + l] =
+              vol_.trans[static_cast<size_t>(l) * cells + c];
     }
   }
   BuildFroxels(lights, camera, frame_key, pool);
@@ -199,7 +245,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   fr.t1.assign(columns, 0.0f);
   fr.slices_per_m.assign(columns, 0.0f);
   fr.records.assign(static_cast<size_t>(columns) * (Z + 1),
-                    FroxelRecord{Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()});
+                    FroxelRecord{To4(Eigen::Vector3f::Zero()), To4(Eigen::Vector3f::Ones())});
   const bool analytic = !media.analytic().empty();
   auto column = [&](int64_t c) {
     const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
@@ -251,7 +297,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
         S += T.cwiseProduct(src).cwiseProduct(factor);
         T = T.cwiseProduct(step_T);
       }
-      rec[k + 1] = FroxelRecord{S, T};
+      rec[k + 1] = FroxelRecord{To4(S), To4(T)};
     }
   };
   if (pool != nullptr) {
@@ -261,8 +307,8 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   }
 }
 
-RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
-                                                         float* t_enter) const {
+float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
+                                   Eigen::Array4f* T) const {
   const Froxels& fr = froxels_;
   constexpr int Z = kFroxelSlices;
   const float fx = std::clamp((u - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock), 0.0f,
@@ -272,22 +318,25 @@ RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
   const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
   const float wx = fx - x0, wy = fy - y0;
-  FroxelRecord out{Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
-  *t_enter = kInfF;
   const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
   // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
+  float t_enter = kInfF;
   for (int q = 0; q < 4; ++q)
-    if (fr.t0[cols[q]] < fr.t1[cols[q]]) *t_enter = std::min(*t_enter, fr.t0[cols[q]]);
-  if (!(t > *t_enter)) return FroxelRecord{Eigen::Vector3f::Zero(), Eigen::Vector3f::Ones()};
+    if (fr.t0[cols[q]] < fr.t1[cols[q]]) t_enter = std::min(t_enter, fr.t0[cols[q]]);
+  S->setZero();
+  if (!(t > t_enter)) {
+    *T = Eigen::Array4f(1, 1, 1, 0);
+    return t_enter;
+  }
+  T->setZero();
   const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
   // columns of weight 0 (pixels on a column's centre row or column) are skipped.
-  float S[3] = {0, 0, 0}, T[3] = {0, 0, 0};
   for (int q = 0; q < 4; ++q) {
     if (!(w[q] > 0)) continue;
     const int c = cols[q];
     const float a = fr.t0[c], b = fr.t1[c];
     if (!(a < b)) {
-      T[0] += w[q], T[1] += w[q], T[2] += w[q];
+      *T += Eigen::Array4f::Constant(w[q]);  // lane 3 is unused
       continue;
     }
     const float s = std::clamp((t - a) * fr.slices_per_m[c], 0.0f, static_cast<float>(Z));
@@ -295,14 +344,10 @@ RealtimeMedia::FroxelRecord RealtimeMedia::LookupFroxels(int u, int v, float t,
     const float f = s - k;
     const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1) + k;
     const float w0 = w[q] * (1 - f), w1 = w[q] * f;
-    for (int ch = 0; ch < 3; ++ch) {
-      S[ch] += w0 * rec[0].S[ch] + w1 * rec[1].S[ch];
-      T[ch] += w0 * rec[0].T[ch] + w1 * rec[1].T[ch];
-    }
+    *S += w0 * rec[0].S + w1 * rec[1].S;
+    *T += w0 * rec[0].T + w1 * rec[1].T;
   }
-  out.S = Eigen::Vector3f(S[0], S[1], S[2]);
-  out.T = Eigen::Vector3f(T[0], T[1], T[2]);
-  return out;
+  return t_enter;
 }
 
 namespace {
@@ -338,7 +383,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   const int columns = fr.nx * fr.ny;
   constexpr int Z = kFogFroxelSlices;
   fr.inv_log_far.assign(columns, 1.0f / std::log(2.0f));
-  fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Vector3f::Zero());
+  fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Array4f::Zero());
   const int nm = static_cast<int>(media.analytic().size());
   auto column = [&](int64_t c) {
     const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
@@ -360,7 +405,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
     Rng rng(HashKeys(HashKeys(frame_key, pixel), 3));
     const float jitter = rng.Uniform();
     const Eigen::Vector3f wo = -d;
-    Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
+    Eigen::Array4f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
     Eigen::Vector3f S = Eigen::Vector3f::Zero();
     for (int k = 0; k < Z; ++k) {
       const float lo = FogBoundary(k, t_far), hi = FogBoundary(k + 1, t_far);
@@ -382,13 +427,15 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
         Ls += ls.E.cwiseProduct(ph) * vis;
       }
       if (Ls.maxCoeff() > 0) {
-        float unused;
         Eigen::Vector3f T_cam = Exp(-media.AnalyticOpticalDepth(o, d, 0, t));
-        if (!froxels_.records.empty())
-          T_cam = T_cam.cwiseProduct(LookupFroxels(uc, vc, t, &unused).T);
+        if (!froxels_.records.empty()) {
+          Eigen::Array4f S_g, T_g;
+          LookupFroxels(uc, vc, t, &S_g, &T_g);
+          T_cam = T_cam.cwiseProduct(T_g.head<3>().matrix());
+        }
         S += T_cam.cwiseProduct(Ls) * (hi - lo);
       }
-      rec[k + 1] = S;
+      rec[k + 1] = To4(S);
     }
   };
   if (pool != nullptr) {
@@ -398,7 +445,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   }
 }
 
-Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
+Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const FogFroxels& fr = fog_froxels_;
   constexpr int Z = kFogFroxelSlices;
   const float fx = std::clamp((u - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
@@ -410,7 +457,7 @@ Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const float wx = fx - x0, wy = fy - y0;
   const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
   const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
-  float out[3] = {0, 0, 0};
+  Eigen::Array4f out = Eigen::Array4f::Zero();
   const float log_t = t > kFogFroxelNear ? std::log(t / kFogFroxelNear) : 0.0f;
   for (int q = 0; q < 4; ++q) {
     if (!(w[q] > 0)) continue;  // as in LookupFroxels
@@ -418,11 +465,11 @@ Eigen::Vector3f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
     const float s = FogSlice(t, log_t, fr.inv_log_far[c]);
     const int k = std::min(static_cast<int>(s), Z - 1);
     const float f = s - k;
-    const Eigen::Vector3f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1) + k;
+    const Eigen::Array4f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1) + k;
     const float w0 = w[q] * (1 - f), w1 = w[q] * f;
-    for (int ch = 0; ch < 3; ++ch) out[ch] += w0 * rec[0][ch] + w1 * rec[1][ch];
+    out += w0 * rec[0] + w1 * rec[1];
   }
-  return Eigen::Vector3f(out[0], out[1], out[2]);
+  return out;
 }
 
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -453,34 +500,45 @@ float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eige
   return T;
 }
 
-bool RealtimeMedia::Locate(const Eigen::Vector3f& p_W, LightVolumeSample* out) const {
-  if (!vol_.active || (p_W.array() < vol_.lo.array()).any() ||
-      (p_W.array() > vol_.hi.array()).any())
-    return false;
-  const Eigen::Vector3f f =
-      (p_W - vol_.lo).cwiseProduct(vol_.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-  int i0[3], i1[3];
+bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) const {
+  if (!vol_.active) return false;
+  int base[3], step[3];
   float w[3];
   for (int k = 0; k < 3; ++k) {
-    const float c = std::clamp(f[k], 0.0f, static_cast<float>(vol_.r[k] - 1));
-    i0[k] = std::min(static_cast<int>(c), std::max(vol_.r[k] - 2, 0));
-    i1[k] = std::min(i0[k] + 1, vol_.r[k] - 1);
-    w[k] = c - static_cast<float>(i0[k]);
+    const float x = p_W[k];
+    if (!(x >= vol_.lo[k] && x <= vol_.hi[k])) return false;
+    const int r = vol_.r[k];
+    const float c =
+        std::clamp((x - vol_.lo[k]) * vol_.cells_per_m[k] - 0.5f, 0.0f, static_cast<float>(r - 1));
+    const int i0 = std::min(static_cast<int>(c), std::max(r - 2, 0));
+    step[k] = std::min(i0 + 1, r - 1) - i0;
+    base[k] = i0;
+    w[k] = c - static_cast<float>(i0);
   }
-  for (int q = 0; q < 8; ++q) {
-    const int i = q & 1 ? i1[0] : i0[0], j = q & 2 ? i1[1] : i0[1], k = q & 4 ? i1[2] : i0[2];
-    out->index[q] = (k * vol_.r[1] + j) * vol_.r[0] + i;
-    out->weight[q] =
-        (q & 1 ? w[0] : 1 - w[0]) * (q & 2 ? w[1] : 1 - w[1]) * (q & 4 ? w[2] : 1 - w[2]);
+  // the eight corners (+1 along x, y, z for bits 0, 1, 2 of the corner index) and their
+  // trilinear weights, summed in corner order; lights adjacent per cell.
+  const size_t S = static_cast<size_t>(vol_.stride);
+  const size_t nx = static_cast<size_t>(vol_.r[0]), nxy = nx * static_cast<size_t>(vol_.r[1]);
+  const float* c0 = vol_.trans_cl.data() + (base[2] * nxy + base[1] * nx + base[0]) * S;
+  const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
+  const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
+  const float w0 = ux * uy * uz, w1 = w[0] * uy * uz, w2 = ux * w[1] * uz, w3 = w[0] * w[1] * uz;
+  const float w4 = ux * uy * w[2], w5 = w[0] * uy * w[2], w6 = ux * w[1] * w[2],
+              w7 = w[0] * w[1] * w[2];
+  using A4 = Eigen::Map<const Eigen::Array4f>;
+  for (size_t j0 = 0; j0 < S; j0 += 4) {
+    const float* c = c0 + j0;
+    Eigen::Array4f sum = w0 * A4(c);
+    sum += w1 * A4(c + ox);
+    sum += w2 * A4(c + oy);
+    sum += w3 * A4(c + ox + oy);
+    sum += w4 * A4(c + oz);
+    sum += w5 * A4(c + ox + oz);
+    sum += w6 * A4(c + oy + oz);
+    sum += w7 * A4(c + ox + oy + oz);
+    Eigen::Map<Eigen::Array4f>(T + j0) = sum;
   }
   return true;
-}
-
-float RealtimeMedia::LightTransmittance(int j, const LightVolumeSample& at) const {
-  const float* T = vol_.trans.data() + static_cast<size_t>(j) * vol_.r[0] * vol_.r[1] * vol_.r[2];
-  float sum = 0;
-  for (int q = 0; q < 8; ++q) sum += at.weight[q] * T[at.index[q]];
-  return sum;
 }
 
 Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& p_W,
@@ -503,56 +561,54 @@ Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& 
 MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
                                           const Eigen::Vector3f& d, float t_end, int u,
                                           int v) const {
-  MediaSegment out;
   const MediaScene& media = *media_;
   const bool analytic = !media.analytic().empty();
 
   // grids: the froxel volume at the pixel's distance.
-  Eigen::Vector3f Tg = Eigen::Vector3f::Ones();
+  Eigen::Array4f L_add = Eigen::Array4f::Zero(), Tg(1, 1, 1, 0);
   float first_a = kInfF;
-  const bool grids = !froxels_.records.empty();
-  if (grids) {
-    const FroxelRecord r = LookupFroxels(u, v, std::min(t_end, 1e30f), &first_a);
-    out.L_add += r.S;
-    Tg = r.T;
-  }
+  if (!froxels_.records.empty()) first_a = LookupFroxels(u, v, std::min(t_end, 1e30f), &L_add, &Tg);
 
+  MediaSegment out;
   if (!analytic) {
-    out.T = Tg;
+    out.T = Tg.head<3>().matrix();
+    out.L_add = L_add.head<3>().matrix();
     return out;
   }
 
-  // homogeneous media: closed-form transmittance and sky in-scatter.
-  Eigen::Vector3d tau_t = Eigen::Vector3d::Zero(), tau_s = Eigen::Vector3d::Zero();
-  for (const AnalyticMedium& m : media.analytic()) {
+  // homogeneous media: closed-form transmittance and sky in-scatter (single precision), to the
+  // end and, when the ray enters a grid before it, to the grid's entry.
+  const bool to_grid = first_a < t_end;
+  Eigen::Array4f tau_t = Eigen::Array4f::Zero(), tau_s = Eigen::Array4f::Zero();
+  Eigen::Array4f tau_a = Eigen::Array4f::Zero();
+  for (size_t i = 0; i < media.analytic().size(); ++i) {
+    const AnalyticMedium& m = media.analytic()[i];
     float a, b;
     if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
-    const double I = std::min(m.DensityIntegral(o.z(), d.z(), a, b), 1e30);
-    tau_t += m.sigma_t.cast<double>() * I;
-    tau_s += m.sigma_s.cast<double>() * I;
+    const float I = std::min(DensityIntegralF(m, o.z(), d.z(), a, b), 1e30f);
+    const Eigen::Array4f& st = sigma_t4_[i];
+    tau_t += st * I;
+    tau_s += sigma_s4_[i] * I;
+    if (to_grid && a < first_a)
+      tau_a += st * std::min(DensityIntegralF(m, o.z(), d.z(), a, std::min(b, first_a)), 1e30f);
   }
-  Eigen::Vector3f Th_end;
-  if (tau_t.x() == tau_t.y() && tau_t.y() == tau_t.z()) {
-    Th_end.setConstant(std::exp(-static_cast<float>(tau_t.x())));  // grey: one exponential
-  } else {
-    Th_end = Exp(-tau_t.cast<float>());
+  auto exp_neg = [](const Eigen::Array4f& tau) -> Eigen::Array4f {
+    if (tau[0] == tau[1] && tau[1] == tau[2])
+      return Eigen::Array4f::Constant(std::exp(-tau[0]));  // grey: one exponential
+    return Eigen::Array4f(std::exp(-tau[0]), std::exp(-tau[1]), std::exp(-tau[2]), 1.0f);
+  };
+  const Eigen::Array4f Th_end = exp_neg(tau_t);
+  const Eigen::Array4f albedo = (tau_t > 0.0f).select(tau_s / tau_t, 0.0f);
+  Eigen::Array4f sky_w = 1.0f - Th_end;
+  if (to_grid) {
+    const Eigen::Array4f Th_a = exp_neg(tau_a);
+    sky_w = (1.0f - Th_a) + (Th_a - Th_end) * Tg;
   }
-  Eigen::Vector3f albedo;
-  for (int c = 0; c < 3; ++c)
-    albedo[c] = tau_t[c] > 0 ? static_cast<float>(tau_s[c] / tau_t[c]) : 0;
-  Eigen::Vector3f sky_w = Eigen::Vector3f::Ones() - Th_end;
-  if (first_a < t_end) {
-    const Eigen::Vector3f tau_a = media.AnalyticOpticalDepth(o, d, 0, first_a);
-    const Eigen::Vector3f Th_a = tau_a.x() == tau_a.y() && tau_a.y() == tau_a.z()
-                                     ? Eigen::Vector3f::Constant(std::exp(-tau_a.x()))
-                                     : Exp(-tau_a);
-    sky_w = (Eigen::Vector3f::Ones() - Th_a) + (Th_a - Th_end).cwiseProduct(Tg);
-  }
-  out.L_add += albedo.cwiseProduct(sky_w).cwiseProduct(sky_ambient_);
-  out.T = Th_end.cwiseProduct(Tg);
-
+  L_add += albedo * sky_w * sky_ambient4_;
   // light in-scatter from the froxel columns.
-  if (!fog_froxels_.S.empty()) out.L_add += LookupFogFroxels(u, v, t_end);
+  if (!fog_froxels_.S.empty()) L_add += LookupFogFroxels(u, v, t_end);
+  out.T = (Th_end * Tg).head<3>().matrix();
+  out.L_add = L_add.head<3>().matrix();
   return out;
 }
 

@@ -78,13 +78,6 @@ struct MediaSegment {
   Eigen::Vector3f L_add{0, 0, 0};
 };
 
-/// where a point lies in the world light volume (RealtimeMedia::Locate): the eight cells of
-/// its trilinear lookup and their weights, shared by every light.
-struct LightVolumeSample {
-  int index[8];
-  float weight[8];
-};
-
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
 class RealtimeMedia {
  public:
@@ -101,13 +94,13 @@ class RealtimeMedia {
   Eigen::Vector3f LightTransmittance(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                      float dist) const;
 
-  /// locates p_W in the world light volume; false outside it (use LightTransmittance(j, p,
-  /// wi, dist) there).
-  bool Locate(const Eigen::Vector3f& p_W, LightVolumeSample* at) const;
+  /// channel-mean transmittance from p_W to every light that has a light volume: writes T[j]
+  /// for j < num_volume_lights() (T must hold kMaxVolumeLights floats; trilinear in the world
+  /// light volume, all lights in one pass). false outside the volume (T untouched; use
+  /// LightTransmittance(j, p, wi, dist) there).
+  bool LightTransmittances(const Eigen::Vector3f& p_W, float* T) const;
   /// number of lights that have light volumes (the first ones).
   int num_volume_lights() const { return num_lights_; }
-  /// channel-mean transmittance to light j (< num_volume_lights()) at a located point.
-  float LightTransmittance(int j, const LightVolumeSample& at) const;
 
   /// single scattering along the camera ray o + t d (d unit, o the camera centre) of pixel
   /// (u, v), t in [0, t_end].
@@ -130,11 +123,14 @@ class RealtimeMedia {
     bool with_visibility = false;  // vis is filled (homogeneous media present)
     Eigen::Vector3f lo{0, 0, 0}, hi{0, 0, 0}, cells_per_m{1, 1, 1};
     int r[3] = {1, 1, 1};
-    std::vector<float> trans;  // [light][cell] Th Tgrid (channel mean)
-    std::vector<float> vis;    // [light][cell] V Th Tgrid
+    std::vector<float> trans;     // [light][cell] Th Tgrid (channel mean)
+    std::vector<float> vis;       // [light][cell] V Th Tgrid
+    int stride = 0;               // lights per cell in trans_cl (num lights rounded up to 4)
+    std::vector<float> trans_cl;  // [cell][light] copy of trans (LightTransmittances)
   };
   struct FroxelRecord {
-    Eigen::Vector3f S, T;  // in-scatter and transmittance from the camera to a slice boundary
+    // in-scatter and transmittance (rgb, 4th lane 0) from the camera to a slice boundary.
+    Eigen::Array4f S, T;
   };
   struct Froxels {
     int nx = 0, ny = 0;
@@ -142,16 +138,18 @@ class RealtimeMedia {
     std::vector<float> slices_per_m;    // [column] kFroxelSlices / (t1 - t0), 0 without overlap
     std::vector<FroxelRecord> records;  // [column][slice boundary 0..kFroxelSlices]
   };
-  /// grid in-scatter and transmittance from the camera to distance t for pixel (u, v);
-  /// writes the smallest column entry distance to *t_enter.
-  FroxelRecord LookupFroxels(int u, int v, float t, float* t_enter) const;
+  /// grid in-scatter S and transmittance T from the camera to distance t for pixel (u, v)
+  /// (rgb in lanes 0..2); returns the smallest entry distance of the four columns (+inf if
+  /// none meets a grid; then S = 0, T = 1).
+  float LookupFroxels(int u, int v, float t, Eigen::Array4f* S, Eigen::Array4f* T) const;
   struct FogFroxels {
     int nx = 0, ny = 0;
     std::vector<float> inv_log_far;  // [column] 1 / log(last slice boundary / near)
-    std::vector<Eigen::Vector3f> S;  // [column][slice boundary 0..kFogFroxelSlices]
+    std::vector<Eigen::Array4f> S;   // [column][slice boundary 0..kFogFroxelSlices], rgb + 0
   };
-  /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v).
-  Eigen::Vector3f LookupFogFroxels(int u, int v, float t) const;
+  /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v)
+  /// (rgb in lanes 0..2).
+  Eigen::Array4f LookupFogFroxels(int u, int v, float t) const;
   void BuildFogFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
                        ThreadPool* pool);
   void BuildFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
@@ -164,6 +162,10 @@ class RealtimeMedia {
 
   const MediaScene* media_ = nullptr;
   Eigen::Vector3f sky_ambient_{0, 0, 0};
+  // per homogeneous medium sigma_t and sigma_s, and the sky ambient, as 4-lane arrays (rgb, 0)
+  // built once per frame (assembling them per pixel stalls on store forwarding).
+  std::vector<Eigen::Array4f> sigma_t4_, sigma_s4_;
+  Eigen::Array4f sky_ambient4_ = Eigen::Array4f::Zero();
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;
   LightVolume vol_;

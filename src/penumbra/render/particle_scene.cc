@@ -27,6 +27,9 @@ ParticleScene::ParticleScene() : impl_(std::make_unique<Impl>()) {}
 
 namespace {
 
+// near plane (m, optical-frame depth) of the realtime tier's streak splatting.
+constexpr float kPixelNear = 0.01f;
+
 // per frame, per homogeneous medium: what RainInvisible needs of it that does not depend on
 // the streak.
 struct RainCullMedium {
@@ -121,11 +124,19 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   for (size_t s = 0; s < fx->particles.size(); ++s)
     first[s + 1] = first[s] + fx->particles[s].position_W.size();
   const size_t n_all = first.back();
-  // per drop: 0 = no streak (radius <= 0), 1 = culled, 2 = kept.
+  // per drop: 0 = no streak (radius <= 0; realtime: wholly behind the near plane), 1 = culled,
+  // 2 = kept.
   std::vector<uint8_t> state(n_all, 0);
   std::vector<float> alpha_all(n_all);
   std::vector<Eigen::Vector4f> ends_all(2 * n_all);
   const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
+  // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
+  // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
+  // would give them an empty pixel box: it clips at kPixelNear + radius >= kPixelNear).
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+  auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
   auto drop = [&](size_t s, size_t i, size_t g) {
     const ParticleSet& ps = fx->particles[s];
     const Eigen::Vector3f& p = ps.position_W[i];
@@ -135,6 +146,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     Eigen::Vector3f q = p + T * v;
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
     if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
+    if (pixel_hits && depth(p) < kPixelNear && depth(q) < kPixelNear) return;  // never drawn
     const float len = T * v.norm();  // the motion, not the widened capsule
     // widen to half a pixel at the streak's nearest distance to the camera.
     const Eigen::Vector3f seg = q - p;
@@ -214,28 +226,42 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
 
 namespace {
 
-// nearest t > 0 where the ray o + t d (d unit) meets the capsule around [a, b] of radius r, or
-// -1 (Quilez, "Capsule - intersection", 2014: cylinder body, then the nearer end sphere).
-float IntersectCapsule(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Eigen::Vector3f& a,
-                       const Eigen::Vector3f& b, float r) {
-  const Eigen::Vector3f ba = b - a, oa = o - a;
-  const float baba = ba.dot(ba), bard = ba.dot(d), baoa = ba.dot(oa), rdoa = d.dot(oa),
-              oaoa = oa.dot(oa);
-  const float qa = baba - bard * bard;
-  const float qb = baba * rdoa - baoa * bard;
-  const float qc = baba * oaoa - baoa * baoa - r * r * baba;
-  float h = qb * qb - qa * qc;
+// what the ray-capsule test needs of a capsule around [a, b] of radius r and a ray origin o
+// that does not depend on the ray's direction (the realtime tier's pixel-centre rays share o
+// when the camera neither distorts nor moves).
+struct CapsuleOrigin {
+  Eigen::Vector3f ba, oa, ob;
+  float baba, baoa, qc, sc_a, sc_b;
+  CapsuleOrigin(const Eigen::Vector3f& o, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                float r)
+      : ba(b - a), oa(o - a), ob(o - b) {
+    baba = ba.dot(ba);
+    baoa = ba.dot(oa);
+    const float oaoa = oa.dot(oa);
+    qc = baba * oaoa - baoa * baoa - r * r * baba;
+    sc_a = oa.dot(oa) - r * r;
+    sc_b = ob.dot(ob) - r * r;
+  }
+};
+
+// nearest t > 0 where the ray o + t d (d unit, o that of `c`) meets the capsule, or -1 (Quilez,
+// "Capsule - intersection", 2014: cylinder body, then the nearer end sphere).
+float IntersectCapsule(const CapsuleOrigin& c, const Eigen::Vector3f& d) {
+  const float bard = c.ba.dot(d), rdoa = d.dot(c.oa);
+  const float qa = c.baba - bard * bard;
+  const float qb = c.baba * rdoa - c.baoa * bard;
+  float h = qb * qb - qa * c.qc;
   float y;
   if (qa > 1e-12f) {
     if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
     const float t = (-qb - std::sqrt(h)) / qa;
-    y = baoa + t * bard;
-    if (y > 0 && y < baba) return t > 0 ? t : -1.0f;
+    y = c.baoa + t * bard;
+    if (y > 0 && y < c.baba) return t > 0 ? t : -1.0f;
   } else {
-    y = bard > 0 ? -1.0f : baba + 1.0f;  // along the axis: the nearer end
+    y = bard > 0 ? -1.0f : c.baba + 1.0f;  // along the axis: the nearer end
   }
-  const Eigen::Vector3f oc = y <= 0 ? oa : Eigen::Vector3f(o - b);
-  const float sb = d.dot(oc), sc = oc.dot(oc) - r * r;
+  const bool at_a = y <= 0;
+  const float sb = d.dot(at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
   h = sb * sb - sc;
   if (h <= 0) return -1.0f;
   const float t = -sb - std::sqrt(h);
@@ -253,7 +279,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const Pose X_OW = camera.X_WO().inverse();
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
-  constexpr float kNear = 0.01f;
+  constexpr float kNear = kPixelNear;
   // pixel box and projected segment (ua, va, ub, vb, rp) of every streak, in parallel chunks
   // (empty box when behind the camera or outside the image).
   std::vector<Eigen::Vector4i> box(count_, Eigen::Vector4i(0, -1, 0, -1));
@@ -305,6 +331,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
     visible_[n] = 1;
     for (int bi = bx[2] / kBand; bi <= bx[3] / kBand; ++bi) in_band[bi].push_back(n);
   }
+  const Eigen::Vector3f o_shared = camera.GenerateRay(0.0f, 0.0f).o;
   auto band = [&](int64_t bi) {
     const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
     for (int n : in_band[bi]) {
@@ -313,6 +340,9 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
       if (v0 > v1 || bx[0] > bx[1]) continue;
       const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
       const float r = ends_[2 * n].w();
+      // the origin-dependent terms once per streak for the camera centre (every pixel's ray
+      // origin unless the camera moves during the exposure: then per pixel).
+      const CapsuleOrigin shared(o_shared, a, b, r);
       const auto& [ua, va, ub, vb, rp] = seg2[n];
       const float du = ub - ua, dv = vb - va;
       for (int v = v0; v <= v1; ++v) {
@@ -330,7 +360,9 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
         for (int u = c0; u <= c1; ++u) {
           const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
           const float len = ray.d.norm();
-          const float t = IntersectCapsule(ray.o, ray.d / len, a, b, r);
+          const float t = ray.o == o_shared
+                              ? IntersectCapsule(shared, ray.d / len)
+                              : IntersectCapsule(CapsuleOrigin(ray.o, a, b, r), ray.d / len);
           if (!(t > 0)) continue;
           const size_t at = static_cast<size_t>(v) * W + u;
           const float t_ray = t / len;

@@ -171,10 +171,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     }
 
     // where the surface points lie in the media's light volume (shared by all lights).
-    LightVolumeSample vol_at[kLanes];
+    float vol_T[kLanes][kMaxVolumeLights];
     bool located[kLanes] = {};
     if (rm != nullptr)
-      for (int k = 0; k < kLanes; ++k) located[k] = hit[k] && rm->Locate(p.Lane(k), &vol_at[k]);
+      for (int k = 0; k < kLanes; ++k)
+        located[k] = hit[k] && rm->LightTransmittances(p.Lane(k), vol_T[k]);
     // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
     Lanes total = LuminanceLanes(L);
     for (int j = 0; j < num_lights; ++j) {
@@ -194,7 +195,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
           // lanes the light does not reach (behind the surface, outside its cone) stay 0.
           if (!(hit[k] && s.valid[k]) || (c.x[k] == 0 && c.y[k] == 0 && c.z[k] == 0)) continue;
           if (located[k] && j < rm->num_volume_lights()) {
-            const float T = rm->LightTransmittance(j, vol_at[k]);
+            const float T = vol_T[k][j];
             c.x[k] *= T, c.y[k] *= T, c.z[k] *= T;
             continue;
           }
