@@ -56,6 +56,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
   effects_.Prepare(snapshot, camera, view, settings_, lights_, *ray_scene_, sky_, &pool_);
+  // realtime tier: sky light occluded by the static geometry, rebuilt only when the static
+  // bodies move and relit when the sky changes (render/sky_irradiance_volume.h).
+  if (settings_.tier == RenderSettings::Tier::kRealtime)
+    sky_volume_.Update(scene_, snapshot, *effects_.sky(), &pool_);
   const int W = camera.width(), H = camera.height();
   const CameraOutputs& want = view.outputs;
   const bool denoise = want.rgb && denoiser_ != nullptr;
@@ -99,6 +103,8 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   ctx.materials = &materials_;
   ctx.lights = &lights_;
   ctx.sky = effects_.sky();
+  if (settings_.tier == RenderSettings::Tier::kRealtime && !sky_volume_.empty())
+    ctx.sky_volume = &sky_volume_;
   ctx.effects = effects_.active() ? &effects_ : nullptr;
   ctx.camera = &camera;
   ctx.settings = &settings_;

@@ -18,6 +18,7 @@
 #include "penumbra/render/material_eval.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 
 namespace penumbra {
@@ -47,7 +48,8 @@ class EmbreeRenderer final : public Renderer {
   MaterialEvaluator materials_;
   LightSampler lights_;
   SkyModel sky_;
-  MediaFrame effects_;  // per-frame effects state (render/media_frame.h)
+  MediaFrame effects_;              // per-frame effects state (render/media_frame.h)
+  SkyIrradianceVolume sky_volume_;  // realtime tier: occluded sky light, built at the first frame
   Film film_;
   ThreadPool pool_;
   std::unique_ptr<Integrator> integrator_;

@@ -18,6 +18,7 @@
 #include "penumbra/render/media_frame.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/render/render_settings.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 
 namespace penumbra {
@@ -33,6 +34,9 @@ struct FrameContext {
   const MaterialEvaluator* materials = nullptr;
   const LightSampler* lights = nullptr;  ///< posed for this frame
   const SkyModel* sky = nullptr;
+  /// the realtime tier's sky light occluded by the static geometry, lit by `sky`
+  /// (render/sky_irradiance_volume.h), or null: then the sky irradiance is unoccluded.
+  const SkyIrradianceVolume* sky_volume = nullptr;
   const Camera* camera = nullptr;
   const RenderSettings* settings = nullptr;
   int camera_index = 0;     ///< CameraView::camera_index

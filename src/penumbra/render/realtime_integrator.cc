@@ -144,12 +144,15 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       // shadow rays start off the surface on the lit side (lights behind it contribute 0).
       origin.Set(k, OffsetRayOrigin(h.p_W, h.ng_W));
 
-      // emission and unoccluded sky ambient.
+      // emission and sky ambient (occluded by the static geometry when there is a sky volume).
       const Eigen::Vector3f spec =
           EnvBrdfApprox(coef.f0, std::max(bsdf.n_v[k], 0.0f), mat.pbr.roughness);
       const Eigen::Vector3f reflect =
           coef.c_diff.cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-      L.Set(k, mat.emission + (ctx.sky->Irradiance(n_s) * kInvPi).cwiseProduct(reflect));
+      const Eigen::Vector3f sky_E = ctx.sky_volume != nullptr
+                                        ? ctx.sky_volume->Irradiance(h.p_W, n_s, *ctx.sky)
+                                        : ctx.sky->Irradiance(n_s);
+      L.Set(k, mat.emission + (sky_E * kInvPi).cwiseProduct(reflect));
 
       Rng rng(FrameContext::PixelStream(frame_key, static_cast<uint64_t>(v) * width + u, 0));
       for (int j = 0; j < num_lights; ++j) {

@@ -437,46 +437,48 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const float tol = kVisibilityTolerance * spacing_;
   const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
-  float e0 = 0, e1 = 0, e2 = 0, wsum = 0;
-  float dark_lum = std::numeric_limits<float>::infinity();
-  Eigen::Vector3f dark = Eigen::Vector3f::Zero();
+  // the weighted sum of the probes' irradiance SH, evaluated once at the end.
+  float acc[kShFloats] = {};
+  float wsum = 0;
+  int in_front[8], num_in_front = 0;
   for (int c = 0; c < 8; ++c) {
     const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
     const int idx = base + dx + nx * (dy + ny * dz);
     if (!valid_[idx]) continue;
-    const float tri = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
     // from q to the (possibly relocated) probe.
     const Eigen::Vector3f d = position_[idx] - q;
-    const float r = d.norm();
-    const float inv_r = r > 1e-6f ? 1.0f / r : 0.0f;
     // probes behind the surface's tangent plane at p never light it.
     const float d_n = d.dot(n_W);
     if (d_n + kNormalBias * spacing_ <= 0) continue;
-    const float back = 0.5f * (1.0f + d_n * inv_r);
-    float w = tri * back * back;
+    in_front[num_in_front++] = idx;
+    const float r = d.norm();
+    float w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
     if (r > 1e-6f) {
+      const float back = 0.5f * (1.0f + d_n / r);
       // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
       // ramps down to 0 over tol beyond that.
       const float depth = depth_[static_cast<size_t>(idx) * kNumTexels + TexelOf(-d)];
-      w *= std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
+      w *= back * back * std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
     }
+    if (!(w > 0)) continue;
     const float* sh = &sh_[static_cast<size_t>(idx) * kShFloats];
-    float a0 = 0, a1 = 0, a2 = 0;
-    for (int k = 0; k < kNumSh; ++k) {
-      a0 += y[k] * sh[3 * k];
-      a1 += y[k] * sh[3 * k + 1];
-      a2 += y[k] * sh[3 * k + 2];
-    }
-    e0 += w * a0, e1 += w * a1, e2 += w * a2;
+    for (int i = 0; i < kShFloats; ++i) acc[i] += w * sh[i];
     wsum += w;
-    // the darkest valid probe in front of the surface, in case none is visible.
-    const float lum = 0.2126f * a0 + 0.7152f * a1 + 0.0722f * a2;
-    if (lum < dark_lum) dark_lum = lum, dark = Eigen::Vector3f(a0, a1, a2);
   }
-  if (!(wsum > 0)) return dark.cwiseMax(0.0f);
-  const float inv = 1.0f / wsum;
-  return Eigen::Vector3f(std::max(e0 * inv, 0.0f), std::max(e1 * inv, 0.0f),
-                         std::max(e2 * inv, 0.0f));
+  Eigen::Vector3f e = Eigen::Vector3f::Zero();
+  if (wsum > 0) {
+    for (int k = 0; k < kNumSh; ++k)
+      e += (y[k] / wsum) * Eigen::Vector3f(acc[3 * k], acc[3 * k + 1], acc[3 * k + 2]);
+  } else {
+    // no probe sees q: the darkest valid probe in front of the surface (0 if none).
+    float dark_lum = std::numeric_limits<float>::infinity();
+    for (int j = 0; j < num_in_front; ++j) {
+      const Eigen::Vector3f ej = ProbeIrradiance(in_front[j], n_W);
+      const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
+      if (lum < dark_lum) dark_lum = lum, e = ej;
+    }
+  }
+  return e.cwiseMax(0.0f);
 }
 
 }  // namespace penumbra
