@@ -38,6 +38,13 @@ class Rng {
   }
   /// uniform float in [0, 1).
   float Uniform() { return static_cast<float>(NextU64() >> 40) * 0x1.0p-24f; }
+  /// two uniform floats in [0, 1) from one 64-bit draw: *a from its top 24 bits (the value
+  /// Uniform() would return for that draw), *b from the 24 bits below them.
+  void Uniform2(float* a, float* b) {
+    const uint64_t z = NextU64();
+    *a = static_cast<float>(z >> 40) * 0x1.0p-24f;
+    *b = static_cast<float>((z >> 16) & 0xffffffULL) * 0x1.0p-24f;
+  }
   /// uniform double in [0, 1).
   double UniformD() { return static_cast<double>(NextU64() >> 11) * 0x1.0p-53; }
 

@@ -17,9 +17,25 @@ void BsdfLanes::Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_
   a2[k] = c.alpha * c.alpha;
 }
 
+void BsdfLanes::SetCoefficients(const PbrLanes& p) {
+  const Lanes metallic = p.metallic.max(0.0f).min(1.0f);
+  const Vec3Lanes base{p.base_color.x.max(0.0f).min(1.0f), p.base_color.y.max(0.0f).min(1.0f),
+                       p.base_color.z.max(0.0f).min(1.0f)};
+  const Lanes r = p.roughness.max(0.0f).min(1.0f);
+  const Lanes alpha = (r * r).max(kMinAlpha);
+  const Lanes f0_dielectric = 0.08f * p.specular.max(0.0f).min(1.0f);
+  f0 = {f0_dielectric + (base.x - f0_dielectric) * metallic,
+        f0_dielectric + (base.y - f0_dielectric) * metallic,
+        f0_dielectric + (base.z - f0_dielectric) * metallic};
+  const Lanes dielectric = 1.0f - metallic;
+  c_diff = {base.x * dielectric, base.y * dielectric, base.z * dielectric};
+  a2 = alpha * alpha;
+  n_v = n.Dot(wo);
+}
+
 Vec3Lanes BsdfLanes::Eval(const Vec3Lanes& wi) const {
   const Lanes n_l = n.Dot(wi);
-  const LaneMask valid = (n_l > 0.0f) && (ng.Dot(wi) > 0.0f) && (n_v > 0.0f);
+  const Lanes ng_l = ng.Dot(wi);
   Vec3Lanes h = wo + wi;
   h = h * (1.0f / h.Dot(h).max(1e-30f).sqrt());
   const Lanes v_h = wo.Dot(h).max(0.0f);
@@ -37,9 +53,8 @@ Vec3Lanes BsdfLanes::Eval(const Vec3Lanes& wi) const {
   const Lanes m5 = m2 * m2 * m;
   auto channel = [&](const Lanes& f0c, const Lanes& cdc) -> Lanes {
     const Lanes F = f0c + (1.0f - f0c) * m5;
-    Lanes f = ((1.0f - F) * cdc * (1.0f / kPi) + F * DV) * n_l;
-    for (int k = 0; k < kLanes; ++k) f[k] = valid[k] ? f[k] : 0.0f;
-    return f;
+    // valid where n.l, ng.l and n.v are all > 0.
+    return WhereAllPositive(n_l, ng_l, n_v, ((1.0f - F) * cdc * (1.0f / kPi) + F * DV) * n_l);
   };
   return {channel(f0.x, c_diff.x), channel(f0.y, c_diff.y), channel(f0.z, c_diff.z)};
 }

@@ -9,6 +9,20 @@
 
 namespace penumbra {
 
+/// the metallic-roughness parameters (PbrParams) of kLanes points, unclamped.
+struct PbrLanes {
+  Vec3Lanes base_color;                 ///< linear albedo (x = r, y = g, z = b)
+  Lanes roughness, metallic, specular;  ///< as PbrParams
+
+  /// sets lane k to `p`.
+  void Set(int k, const PbrParams& p) {
+    base_color.Set(k, p.base_color);
+    roughness[k] = p.roughness;
+    metallic[k] = p.metallic;
+    specular[k] = p.specular;
+  }
+};
+
 /// kLanes shading points: frame, view direction and BRDF parameters per lane.
 struct BsdfLanes {
   Vec3Lanes n;           ///< unit shading normal actually used (Bsdf::shading_normal())
@@ -21,6 +35,19 @@ struct BsdfLanes {
   /// sets lane k to the BRDF that Bsdf(c, ns_W, ng_W, wo_W) has, for coefficients c.
   void Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_W,
            const Eigen::Vector3f& ng_W, const Eigen::Vector3f& wo_W);
+
+  /// sets the frame of lane k: n = n_s (the usable shading normal, UsableShadingNormal(ns_W,
+  /// ng_W, wo_W)), ng = ng_W, wo = wo_W. n_v and the coefficients follow from SetCoefficients.
+  void SetFrame(int k, const Eigen::Vector3f& n_s, const Eigen::Vector3f& ng_W,
+                const Eigen::Vector3f& wo_W) {
+    n.Set(k, n_s);
+    ng.Set(k, ng_W);
+    wo.Set(k, wo_W);
+  }
+
+  /// for every lane: c_diff, f0 and a2 from `p` (the arithmetic of BrdfCoefficients::From,
+  /// so they equal Set's) and n_v = n . wo from the frame set by SetFrame.
+  void SetCoefficients(const PbrLanes& p);
 
   /// f(wo, wi) |n . wi| per lane (x = r, y = g, z = b) for unit directions wi; 0 where wi or
   /// wo is below the shading or geometric surface (as Bsdf::Eval).

@@ -55,6 +55,26 @@ inline Vec3Lanes SampleConeLanes(const Vec3Lanes& w, const Lanes& cos_max, const
   return d * inv;
 }
 
+// SampleConeLanes around one axis w shared by every lane (the sun): the basis is computed once,
+// with the same arithmetic, so the directions equal those of SampleConeLanes.
+inline Vec3Lanes SampleConeLanes(const Eigen::Vector3f& w, float cos_max, const Lanes& u1,
+                                 const Lanes& u2) {
+  const Lanes cos_t = 1.0f - u1 * (1.0f - cos_max);
+  const Lanes sin_t = (1.0f - cos_t * cos_t).max(0.0f).sqrt();
+  Lanes sp, cp;
+  SinCos2Pi(u2, &sp, &cp);
+  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
+  const float a = -1.0f / (sign + w.z());
+  const float b = w.x() * w.y() * a;
+  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
+  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
+  const Lanes sc = sin_t * cp, ss = sin_t * sp;
+  Vec3Lanes d{sc * t.x() + ss * bt.x() + cos_t * w.x(), sc * t.y() + ss * bt.y() + cos_t * w.y(),
+              sc * t.z() + ss * bt.z() + cos_t * w.z()};
+  const Lanes inv = 1.0f / d.Dot(d).sqrt();
+  return d * inv;
+}
+
 // the pose-independent part of a light.
 PosedLight Unposed(const Light& l) {
   PosedLight p;
@@ -187,11 +207,12 @@ void LightSampler::SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, con
   const PosedLight& l = lights_[i];
   if (l.type == Light::Type::kDirectional) {
     const Eigen::Vector3f to_light = -l.direction_W;
-    const Vec3Lanes axis{Lanes::Constant(to_light.x()), Lanes::Constant(to_light.y()),
-                         Lanes::Constant(to_light.z())};
-    s->wi = l.cos_angular_radius < 1.0f
-                ? SampleConeLanes(axis, Lanes::Constant(l.cos_angular_radius), u1, u2)
-                : axis;
+    if (l.cos_angular_radius < 1.0f) {
+      s->wi = SampleConeLanes(to_light, l.cos_angular_radius, u1, u2);
+    } else {
+      s->wi = {Lanes::Constant(to_light.x()), Lanes::Constant(to_light.y()),
+               Lanes::Constant(to_light.z())};
+    }
     s->distance = Lanes::Constant(std::numeric_limits<float>::infinity());
     s->E = {Lanes::Constant(l.intensity_rgb.x()), Lanes::Constant(l.intensity_rgb.y()),
             Lanes::Constant(l.intensity_rgb.z())};

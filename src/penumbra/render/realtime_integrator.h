@@ -13,7 +13,8 @@
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
-// Rng(ctx.PixelStream(u, v, 0)), two per light in light order.
+// Rng(ctx.PixelStream(u, v, 0)), one 64-bit draw per light in light order, split into the
+// light's two uniforms by Rng::Uniform2.
 //
 // adverse conditions (FrameContext::effects): surface wetness changes the material of
 // upward-facing surfaces; each light's contribution is attenuated by the media between the
