@@ -137,9 +137,9 @@ const ProbeDirections& Directions() {
   return dirs;
 }
 
-}  // namespace
-
-int SkyIrradianceVolume::TexelOf(const Eigen::Vector3f& w) {
+// octahedral texel of a non-zero direction (SkyIrradianceVolume::TexelOf), inlined into lookups.
+inline int OctTexel(const Eigen::Vector3f& w) {
+  constexpr int kOctSide = SkyIrradianceVolume::kOctSide;
   const float inv_l1 = 1.0f / (std::abs(w.x()) + std::abs(w.y()) + std::abs(w.z()));
   float u = w.x() * inv_l1, v = w.y() * inv_l1;
   if (w.z() < 0) {
@@ -151,6 +151,10 @@ int SkyIrradianceVolume::TexelOf(const Eigen::Vector3f& w) {
   const int iy = std::clamp(static_cast<int>((v + 1.0f) * (0.5f * kOctSide)), 0, kOctSide - 1);
   return ix + kOctSide * iy;
 }
+
+}  // namespace
+
+int SkyIrradianceVolume::TexelOf(const Eigen::Vector3f& w) { return OctTexel(w); }
 
 Eigen::Vector3f SkyIrradianceVolume::ProbePosition(int probe) const {
   const int i = probe % dims_[0], j = (probe / dims_[0]) % dims_[1],
@@ -457,7 +461,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
       const float back = 0.5f * (1.0f + d_n / r);
       // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
       // ramps down to 0 over tol beyond that.
-      const float depth = depth_[static_cast<size_t>(idx) * kNumTexels + TexelOf(-d)];
+      const float depth = depth_[static_cast<size_t>(idx) * kNumTexels + OctTexel(-d)];
       w *= back * back * std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
     }
     if (!(w > 0)) continue;
