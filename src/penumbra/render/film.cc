@@ -1,7 +1,14 @@
 #include "penumbra/render/film.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace penumbra {
 namespace {
@@ -17,6 +24,74 @@ void ForRows(int rows, ThreadPool* pool, const Fn& fn) {
   } else {
     for (int r = 0; r < rows; ++r) fn(r);
   }
+}
+
+// table index of a tone-mapped value x in [0, 1]: round(x (kLutSize - 1)); NaN-safe
+// (!(x > 0) maps to 0).
+inline int LutIndex(float x) {
+  const int k = x > 0 ? static_cast<int>(x * (kLutSize - 1) + 0.5f) : 0;
+  return std::min(k, kLutSize - 1);
+}
+
+// table indices of n exposed values src[i] * exposure, tone mapped (AcesFilmic or a clamp to
+// [0, 1]). with SSE2, four at a time, with the same IEEE operations in the same order and the
+// same NaN handling as the scalar form (min/max operand order as in std::clamp / std::max),
+// so the indices are identical.
+void ToneMapIndices(const float* src, int n, float exposure, bool filmic, int32_t* index) {
+  int i = 0;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), ex = _mm_set1_ps(exposure);
+  const __m128 a = _mm_set1_ps(2.51f), b = _mm_set1_ps(0.03f), c = _mm_set1_ps(2.43f),
+               d = _mm_set1_ps(0.59f), e = _mm_set1_ps(0.14f);
+  const __m128 scale = _mm_set1_ps(kLutSize - 1), half = _mm_set1_ps(0.5f);
+  for (; i + 4 <= n; i += 4) {
+    __m128 x = _mm_mul_ps(_mm_loadu_ps(src + i), ex);
+    if (filmic) {
+      x = _mm_max_ps(zero, x);  // std::max(x, 0): 0 > x ? 0 : x
+      const __m128 num = _mm_mul_ps(x, _mm_add_ps(_mm_mul_ps(a, x), b));
+      const __m128 den = _mm_add_ps(_mm_mul_ps(x, _mm_add_ps(_mm_mul_ps(c, x), d)), e);
+      x = _mm_div_ps(num, den);
+    }
+    x = _mm_min_ps(one, _mm_max_ps(zero, x));  // std::clamp(x, 0, 1)
+    // x > 0 ? x (kLutSize - 1) + 0.5 : 0, then the truncating conversion (x <= 1 here).
+    const __m128 k = _mm_and_ps(_mm_cmpgt_ps(x, zero), _mm_add_ps(_mm_mul_ps(x, scale), half));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(index + i), _mm_cvttps_epi32(k));
+  }
+#endif
+  for (; i < n; ++i) {
+    const float x = src[i] * exposure;
+    index[i] = LutIndex(filmic ? AcesFilmic(x) : std::clamp(x, 0.0f, 1.0f));
+  }
+}
+
+// sum over the n pixels of an RGB row of ln(max(L, kMinLuminance)), L the Rec. 709 luminance,
+// as the logarithm of their product: the product's binary exponent and mantissa are kept apart
+// (four interleaved partial products), and ln is taken once per row. exact but for the
+// rounding of the mantissa products (~1e-16 relative each).
+double SumLog(const float* rgb, int n) {
+  constexpr uint64_t kMantissaBits = 0x000fffffffffffffull, kOne = 0x3ff0000000000000ull;
+  double mantissa[4] = {1.0, 1.0, 1.0, 1.0};
+  double odd = 0.0;  // sum of the logs of non-finite luminances
+  int64_t exponent = 0;
+  // splits x > 0 (a normal double) into f in [1, 2) and its binary exponent.
+  auto split = [&](double x) {
+    const uint64_t bits = std::bit_cast<uint64_t>(x);
+    exponent += static_cast<int64_t>(bits >> 52) - 1023;
+    return std::bit_cast<double>((bits & kMantissaBits) | kOne);
+  };
+  for (int i = 0; i < n; ++i) {
+    const double L = std::max(static_cast<double>(Luminance(rgb + 3 * i)), kMinLuminance);
+    if (!(L < std::numeric_limits<double>::infinity())) {
+      odd += std::log(L);  // inf or NaN, as the per-pixel sum would have it
+      continue;
+    }
+    double& m = mantissa[i & 3];
+    m *= split(L);
+    // each partial product stays below 2^17: renormalised to [1, 2) every 16 factors < 2.
+    if ((i & 63) >= 60) m = split(m);
+  }
+  const double product = (mantissa[0] * mantissa[1]) * (mantissa[2] * mantissa[3]);
+  return std::log(product) + static_cast<double>(exponent) * std::log(2.0) + odd;
 }
 
 }  // namespace
@@ -46,12 +121,7 @@ double Film::LogAverageLuminance(const ImageF& radiance, ThreadPool* pool) const
   if (radiance.empty()) return kMinLuminance;
   const int w = radiance.width, h = radiance.height;
   std::vector<double> row_sum(h, 0.0);
-  ForRows(h, pool, [&](int v) {
-    double s = 0;
-    for (int u = 0; u < w; ++u)
-      s += std::log(std::max(static_cast<double>(Luminance(radiance.at(u, v))), kMinLuminance));
-    row_sum[v] = s;
-  });
+  ForRows(h, pool, [&](int v) { row_sum[v] = SumLog(radiance.at(0, v), w); });
   double total = 0;
   for (double s : row_sum) total += s;  // fixed order: independent of the thread count
   return std::exp(total / (static_cast<double>(w) * h));
@@ -73,12 +143,13 @@ void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, Image
   ForRows(h, pool, [&](int v) {
     const float* src = radiance.at(0, v);
     uint8_t* dst = rgb->at(0, v);
-    for (int i = 0; i < 3 * w; ++i) {
-      float x = src[i] * exposure;
-      x = filmic ? AcesFilmic(x) : std::clamp(x, 0.0f, 1.0f);
-      // NaN-safe: !(x > 0) maps to 0.
-      const int k = x > 0 ? static_cast<int>(x * (kLutSize - 1) + 0.5f) : 0;
-      dst[i] = lut[std::min(k, kLutSize - 1)];
+    // per chunk: the table indices (SIMD), then the table look-ups.
+    constexpr int kChunk = 240;
+    int32_t index[kChunk];
+    for (int i0 = 0; i0 < 3 * w; i0 += kChunk) {
+      const int m = std::min(kChunk, 3 * w - i0);
+      ToneMapIndices(src + i0, m, exposure, filmic, index);
+      for (int i = 0; i < m; ++i) dst[i0 + i] = lut[index[i]];
     }
   });
 }
