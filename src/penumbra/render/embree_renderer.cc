@@ -127,16 +127,20 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
     primary.tile.width = std::min(kTileSize, W - primary.tile.x0);
     primary.tile.height = std::min(kTileSize, H - primary.tile.y0);
     const PixelTile& t = primary.tile;
-    const int n = t.width * t.height;
-    for (int i = 0; i < n; ++i)
-      rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + i % t.width),
-                                   static_cast<float>(t.y0 + i / t.width));
-    ray_scene_->IntersectMany(rays.get(), n, /*coherent=*/true, hits.get(), did_hit.get());
-    for (int i = 0; i < n; ++i) {
-      const int u = t.x0 + i % t.width, v = t.y0 + i / t.width;
-      if (depth) *depth->at(u, v) = did_hit[i] ? hits[i].t : 0.0f;
-      if (seg) *seg->at(u, v) = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
-      if (truth.any) WriteGroundTruth(truth, camera, scene_, rays[i], did_hit[i], hits[i], u, v);
+    for (int y = 0, i = 0; y < t.height; ++y)
+      for (int x = 0; x < t.width; ++x, ++i)
+        rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + x), static_cast<float>(t.y0 + y));
+    ray_scene_->IntersectGrid(rays.get(), t.width, t.height, hits.get(), did_hit.get());
+    for (int y = 0, i = 0; y < t.height; ++y) {
+      const int v = t.y0 + y;
+      float* depth_row = depth ? depth->at(t.x0, v) : nullptr;
+      int32_t* seg_row = seg ? seg->at(t.x0, v) : nullptr;
+      for (int x = 0; x < t.width; ++x, ++i) {
+        if (depth_row) depth_row[x] = did_hit[i] ? hits[i].t : 0.0f;
+        if (seg_row) seg_row[x] = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
+        if (truth.any)
+          WriteGroundTruth(truth, camera, scene_, rays[i], did_hit[i], hits[i], t.x0 + x, v);
+      }
     }
     if (buffers.radiance) {
       primary.rays = rays.get();

@@ -24,6 +24,11 @@ struct AnalyticGeom {
   AnalyticShape shape;
   Eigen::Matrix3d R_GI;  // p_G = R_GI p_I + p_GI
   Eigen::Vector3d p_GI;
+  // the same with the instance pose folded in (set with the pose, for FinishHit):
+  // p_G = R_GW p_W + p_GW, n_W = R_WG n_G.
+  Eigen::Matrix3d R_GW = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_GW = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_WG = Eigen::Matrix3d::Identity();
 };
 
 // a geom traced as triangles, in the instance frame. vertices carry one padding element at
@@ -33,6 +38,12 @@ struct TriangleGeom {
   std::vector<Eigen::Vector3f> normals_I;
   std::vector<Eigen::Vector2f> texcoords;
   std::vector<Eigen::Vector3i> faces;
+  // per face: unit geometric normal in the instance frame (counter-clockwise) and in the geom
+  // frame, precomputed for FinishHit.
+  struct FaceNormal {
+    Eigen::Vector3f n_I, n_G;
+  };
+  std::vector<FaceNormal> face_normals;
   Eigen::Matrix3f R_GI;  // p_G = R_GI p_I + p_GI
   Eigen::Vector3f p_GI;
 };
@@ -198,6 +209,14 @@ struct RayScene::Impl {
       tg->faces = std::move(shape.faces);
       tg->R_GI = X_GI.linear().cast<float>();
       tg->p_GI = X_GI.translation().cast<float>();
+      tg->face_normals.reserve(tg->faces.size());
+      for (const Eigen::Vector3i& f : tg->faces) {
+        const Eigen::Vector3f& v0 = tg->vertices_I[f[0]];
+        Eigen::Vector3f n_I = (tg->vertices_I[f[1]] - v0).cross(tg->vertices_I[f[2]] - v0);
+        const float len = n_I.norm();
+        n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
+        tg->face_normals.push_back({n_I, tg->R_GI * n_I});
+      }
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
       rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                  tg->vertices_I.data(), 0, sizeof(Eigen::Vector3f),
@@ -242,13 +261,25 @@ struct RayScene::Impl {
       const Geom& g = scene->geoms[gi];
       AddGeom(group, gi, group->is_static ? Pose(X_WB[g.body] * g.X_BG) : g.X_BG);
     }
+    SetAnalyticWorldTransforms(group);
     rtcCommitScene(group->scene);
+  }
+
+  // folds the instance pose of `group` into its analytic geoms' transforms.
+  static void SetAnalyticWorldTransforms(InstanceGroup* group) {
+    const Eigen::Matrix3d R_IW = group->X_WI.linear().transpose();
+    for (const std::unique_ptr<AnalyticGeom>& g : group->analytic) {
+      g->R_GW = g->R_GI * R_IW;
+      g->p_GW = g->p_GI - g->R_GW * group->X_WI.translation();
+      g->R_WG = g->R_GW.transpose();
+    }
   }
 
   // sets the instance transform of `group` to X_WI.
   void SetInstancePose(InstanceGroup* group, const Pose& X_WI) {
     group->X_WI = X_WI;
     group->R_WI_f = X_WI.linear().cast<float>();
+    SetAnalyticWorldTransforms(group);
     float xfm[12];
     for (int c = 0; c < 3; ++c)
       for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(X_WI.linear()(r, c));
@@ -297,31 +328,25 @@ struct RayScene::Impl {
     Eigen::Vector3f ng_W, ns_W;
     if (rec.analytic) {
       const AnalyticGeom& g = *rec.analytic;
-      const Pose& X = group.X_WI;
       const Eigen::Vector3d p_W =
           ray.o.cast<double>() + static_cast<double>(t) * ray.d.cast<double>();
-      const Eigen::Vector3d p_I = X.linear().transpose() * (p_W - X.translation());
-      const Eigen::Vector3d p_G = g.R_GI * p_I + g.p_GI;
+      const Eigen::Vector3d p_G = g.R_GW * p_W + g.p_GW;
       const Eigen::Vector3d n_G =
           AnalyticNormal(g.shape, p_G, static_cast<ShapePart>(static_cast<int>(rh.hit.u)));
       hit->p_G = p_G.cast<float>();
       hit->n_G = n_G.cast<float>();
-      ng_W = (X.linear() * (g.R_GI.transpose() * n_G)).cast<float>();
+      ng_W = (g.R_WG * n_G).cast<float>();
       ns_W = ng_W;
     } else {
       const TriangleGeom& g = *rec.triangles;
       const Eigen::Vector3i& f = g.faces[rh.hit.primID];
+      const TriangleGeom::FaceNormal& fn = g.face_normals[rh.hit.primID];
       const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-      const Eigen::Vector3f& v0 = g.vertices_I[f[0]];
-      const Eigen::Vector3f& v1 = g.vertices_I[f[1]];
-      const Eigen::Vector3f& v2 = g.vertices_I[f[2]];
-      Eigen::Vector3f n_I = (v1 - v0).cross(v2 - v0);
-      const float len = n_I.norm();
-      n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
-      const Eigen::Vector3f p_I = w * v0 + u * v1 + v * v2;
+      const Eigen::Vector3f p_I =
+          w * g.vertices_I[f[0]] + u * g.vertices_I[f[1]] + v * g.vertices_I[f[2]];
       hit->p_G = g.R_GI * p_I + g.p_GI;
-      hit->n_G = g.R_GI * n_I;
-      ng_W = group.R_WI_f * n_I;
+      hit->n_G = fn.n_G;
+      ng_W = group.R_WI_f * fn.n_I;
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
@@ -341,6 +366,56 @@ struct RayScene::Impl {
     }
     hit->ng_W = ng_W;
     hit->ns_W = ns_W;
+  }
+
+  // traces rays[index[k]] for the lanes k with index[k] >= 0 as one Embree packet and
+  // writes hits[index[k]], did_hit[index[k]]. the packets are traced with an incoherent
+  // context: with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, Embree 3.13.5 was seen to loop forever
+  // inside rtcIntersect16 / rtcOccluded16 (and rtcOccluded1M) on some packets of this
+  // renderer's scenes (instanced user geometry; reproduced by the realtime lighting tests), so
+  // that flag is not used.
+  void IntersectPacket(const Ray* rays, const int* index, SurfaceHit* hits, bool* did_hit) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) RTCRayHit16 p;
+    alignas(64) int valid[kPacket];
+    int fill = -1;  // idle lanes repeat an active ray (harmless values)
+    for (int k = 0; k < kPacket; ++k)
+      if (index[k] >= 0) fill = index[k];
+    if (fill < 0) return;
+    for (int k = 0; k < kPacket; ++k) {
+      valid[k] = index[k] >= 0 ? -1 : 0;
+      const Ray& r = rays[index[k] >= 0 ? index[k] : fill];
+      p.ray.org_x[k] = r.o.x();
+      p.ray.org_y[k] = r.o.y();
+      p.ray.org_z[k] = r.o.z();
+      p.ray.dir_x[k] = r.d.x();
+      p.ray.dir_y[k] = r.d.y();
+      p.ray.dir_z[k] = r.d.z();
+      p.ray.tnear[k] = r.tmin;
+      p.ray.tfar[k] = r.tmax;
+      p.ray.time[k] = 0;
+      p.ray.mask[k] = 0xffffffffu;
+      p.ray.id[k] = 0;
+      p.ray.flags[k] = 0;
+      p.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      p.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, top, &ctx, &p);
+    for (int k = 0; k < kPacket; ++k) {
+      const int i = index[k];
+      if (i < 0) continue;
+      did_hit[i] = p.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
+      if (!did_hit[i]) continue;
+      RTCRayHit rh;
+      rh.ray.tfar = p.ray.tfar[k];
+      rh.hit.u = p.hit.u[k];
+      rh.hit.v = p.hit.v[k];
+      rh.hit.primID = p.hit.primID[k];
+      rh.hit.geomID = p.hit.geomID[k];
+      rh.hit.instID[0] = p.hit.instID[0][k];
+      FinishHit(rays[i], rh, &hits[i]);
+    }
   }
 
   void Release() {
@@ -533,53 +608,34 @@ bool RayScene::Occluded(const Ray& ray) const {
   return r.tfar < 0;
 }
 
-// packets of kPacket rays (rtcIntersect16) for coherent rays; incoherent rays go one by one
-// (rtcIntersect1), as Embree recommends. the packets are traced with an incoherent context:
-// with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, Embree 3.13.5 was seen to loop forever inside
-// rtcIntersect16 / rtcOccluded16 (and rtcOccluded1M) on some packets of this renderer's scenes
-// (instanced user geometry; reproduced by the realtime lighting tests), so that flag is not used.
+// packets of kPacket rays (rtcIntersect16, Impl::IntersectPacket) for coherent rays;
+// incoherent rays go one by one (rtcIntersect1), as Embree recommends.
 void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits,
                              bool* did_hit) const {
   if (!coherent) {
     for (int i = 0; i < n; ++i) did_hit[i] = Intersect(rays[i], &hits[i]);
     return;
   }
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  alignas(64) RTCRayHit16 p;
-  alignas(64) int valid[kPacket];
+  int index[kPacket];
   for (int start = 0; start < n; start += kPacket) {
     const int m = std::min(kPacket, n - start);
-    for (int i = 0; i < kPacket; ++i) {
-      valid[i] = i < m ? -1 : 0;
-      const Ray& r = rays[start + std::min(i, m - 1)];
-      p.ray.org_x[i] = r.o.x();
-      p.ray.org_y[i] = r.o.y();
-      p.ray.org_z[i] = r.o.z();
-      p.ray.dir_x[i] = r.d.x();
-      p.ray.dir_y[i] = r.d.y();
-      p.ray.dir_z[i] = r.d.z();
-      p.ray.tnear[i] = r.tmin;
-      p.ray.tfar[i] = r.tmax;
-      p.ray.time[i] = 0;
-      p.ray.mask[i] = 0xffffffffu;
-      p.ray.id[i] = 0;
-      p.ray.flags[i] = 0;
-      p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-      p.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-    }
-    rtcIntersect16(valid, impl_->top, &ctx, &p);
-    for (int i = 0; i < m; ++i) {
-      did_hit[start + i] = p.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-      if (!did_hit[start + i]) continue;
-      RTCRayHit rh;
-      rh.ray.tfar = p.ray.tfar[i];
-      rh.hit.u = p.hit.u[i];
-      rh.hit.v = p.hit.v[i];
-      rh.hit.primID = p.hit.primID[i];
-      rh.hit.geomID = p.hit.geomID[i];
-      rh.hit.instID[0] = p.hit.instID[0][i];
-      impl_->FinishHit(rays[start + i], rh, &hits[start + i]);
+    for (int k = 0; k < kPacket; ++k) index[k] = k < m ? start + k : -1;
+    impl_->IntersectPacket(rays, index, hits, did_hit);
+  }
+}
+
+void RayScene::IntersectGrid(const Ray* rays, int width, int height, SurfaceHit* hits,
+                             bool* did_hit) const {
+  constexpr int kSide = 4;  // kSide x kSide cells per packet
+  static_assert(kSide * kSide == kPacket, "one Embree packet per square of cells");
+  int index[kPacket];
+  for (int y0 = 0; y0 < height; y0 += kSide) {
+    for (int x0 = 0; x0 < width; x0 += kSide) {
+      for (int k = 0; k < kPacket; ++k) {
+        const int x = x0 + k % kSide, y = y0 + k / kSide;
+        index[k] = x < width && y < height ? y * width + x : -1;
+      }
+      impl_->IntersectPacket(rays, index, hits, did_hit);
     }
   }
 }
