@@ -16,6 +16,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kNumSh = 9;  // real SH up to l = 2
 constexpr int kShFloats = kNumSh * 3;
+// a probe's irradiance SH padded to 28 floats (7 SSE packets; 112 bytes keep every probe's
+// coefficients 16-byte aligned in the vector).
+constexpr int kShStride = 28;
+using ShArray = Eigen::Array<float, kShStride, 1>;
 
 // real spherical harmonics y_lm of a unit vector, l <= 2, in the order (0,0), (1,-1), (1,0),
 // (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) (Ramamoorthi and Hanrahan 2001, eq. 3).
@@ -355,7 +359,7 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
       }
   }
   const int num = num_probes();
-  sh_.assign(static_cast<size_t>(num) * kShFloats, 0.0f);
+  sh_.assign(static_cast<size_t>(num) * kShStride, 0.0f);
   constexpr int kChunk = 64;
   auto light = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
@@ -368,7 +372,7 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
         const double* ts = &texel_sh[static_cast<size_t>(t) * kShFloats];
         for (int i = 0; i < kShFloats; ++i) acc[i] += f * ts[i];
       }
-      float* out = &sh_[static_cast<size_t>(p) * kShFloats];
+      float* out = &sh_[static_cast<size_t>(p) * kShStride];
       for (int i = 0; i < kShFloats; ++i) out[i] = static_cast<float>(acc[i]);
     }
   };
@@ -387,13 +391,13 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
     prev = sh_;
     for (int p = 0; p < num; ++p) {
       if (!valid_[p]) continue;
-      float* out = &sh_[static_cast<size_t>(p) * kShFloats];
+      float* out = &sh_[static_cast<size_t>(p) * kShStride];
       float w = 2;
       for (int i = 0; i < kShFloats; ++i) out[i] *= 2;
       for (int side = 0; side < 2; ++side) {
         if (!(links_[p] & (1u << (2 * a + side)))) continue;
         const int q = side == 0 ? p + stride[a] : p - stride[a];
-        const float* in = &prev[static_cast<size_t>(q) * kShFloats];
+        const float* in = &prev[static_cast<size_t>(q) * kShStride];
         for (int i = 0; i < kShFloats; ++i) out[i] += in[i];
         w += 1;
       }
@@ -415,7 +419,7 @@ void SkyIrradianceVolume::Update(const SceneDescription& scene, const WorldSnaps
 Eigen::Vector3f SkyIrradianceVolume::ProbeIrradiance(int probe, const Eigen::Vector3f& n_W) const {
   float y[kNumSh];
   ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
-  const float* c = &sh_[static_cast<size_t>(probe) * kShFloats];
+  const float* c = &sh_[static_cast<size_t>(probe) * kShStride];
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   for (int k = 0; k < kNumSh; ++k)
     e += y[k] * Eigen::Vector3f(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
@@ -442,7 +446,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
   // the weighted sum of the probes' irradiance SH, evaluated once at the end.
-  float acc[kShFloats] = {};
+  ShArray acc = ShArray::Zero();
   float wsum = 0;
   int in_front[8], num_in_front = 0;
   for (int c = 0; c < 8; ++c) {
@@ -465,8 +469,9 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
       w *= back * back * std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
     }
     if (!(w > 0)) continue;
-    const float* sh = &sh_[static_cast<size_t>(idx) * kShFloats];
-    for (int i = 0; i < kShFloats; ++i) acc[i] += w * sh[i];
+    acc +=
+        w * Eigen::Map<const ShArray, Eigen::Aligned16>(&sh_[static_cast<size_t>(idx) * kShStride]);
+
     wsum += w;
   }
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
