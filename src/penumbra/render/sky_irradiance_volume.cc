@@ -186,6 +186,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   position_.clear();
   escaped_.clear();
   depth_.clear();
+  depth_q_.clear();
   sh_.clear();
 
   // the static geoms and the bounds of the finite ones, world frame.
@@ -285,7 +286,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       const Eigen::Vector3f x = ProbePosition(p);
       position_[p] = x;
       float t_back;
-      Eigen::Vector3f d_back;
+      Eigen::Vector3f d_back = Eigen::Vector3f::Zero();
       const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
       if (trace_probe(x, m, esc, &t_back, &d_back) <= max_back) {
         valid_[p] = 1;
@@ -331,6 +332,18 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       links_[q] |= static_cast<uint8_t>(1u << (2 * a + 1));  // q -> -a neighbour
     }
   }
+
+  // the lookups read the depths as bytes: 1 byte a texel keeps the table of the default
+  // world (3740 probes) at under 1 MB, so lookups hit the cache (4 MB of floats did not).
+  // rounding down makes a depth shorter by < far / 255 = 0.008 spacing, far below the
+  // visibility tolerance: a probe is dropped at most that much sooner.
+  depth_q_.resize(depth_.size());
+  const float to_q = 255.0f / far;
+  for (size_t i = 0; i < depth_.size(); ++i)
+    depth_q_[i] = static_cast<uint8_t>(std::clamp(depth_[i] * to_q, 0.0f, 255.0f));
+  depth_scale_ = far / 255.0f;
+  depth_.clear();
+  depth_.shrink_to_fit();
 }
 
 void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
@@ -465,7 +478,8 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
       const float back = 0.5f * (1.0f + d_n / r);
       // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
       // ramps down to 0 over tol beyond that.
-      const float depth = depth_[static_cast<size_t>(idx) * kNumTexels + OctTexel(-d)];
+      const float depth =
+          depth_scale_ * depth_q_[static_cast<size_t>(idx) * kNumTexels + OctTexel(-d)];
       w *= back * back * std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
     }
     if (!(w > 0)) continue;

@@ -144,7 +144,9 @@ class SkyIrradianceVolume {
   std::vector<uint8_t> links_;             // per probe: bit 2a (+a) / 2a+1 (-a) neighbour linked
   std::vector<Eigen::Vector3f> position_;  // per probe: grid node or relocated, world
   std::vector<uint8_t> escaped_;           // per probe and texel
-  std::vector<float> depth_;               // per probe and texel
+  std::vector<float> depth_;               // per probe and texel, m (Build only)
+  std::vector<uint8_t> depth_q_;           // per probe and texel, depth / depth_scale_
+  float depth_scale_ = 0;                  // m per depth_q_ step
   std::vector<float> sh_;                  // per probe: 9 (l, m) x 3 channels, irradiance
   std::vector<Pose> built_static_poses_;   // X_WB of the last Build (static bodies only)
   bool built_ = false;
