@@ -19,6 +19,16 @@ inline float SmoothStep(float e0, float e1, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
+// tangent t and bitangent bt completing unit w to an orthonormal basis (Duff et al., "Building
+// an orthonormal basis, revisited", JCGT 2017).
+inline void ConeBasis(const Eigen::Vector3f& w, Eigen::Vector3f* t, Eigen::Vector3f* bt) {
+  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
+  const float a = -1.0f / (sign + w.z());
+  const float b = w.x() * w.y() * a;
+  *t = Eigen::Vector3f(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
+  *bt = Eigen::Vector3f(b, sign + w.y() * w.y() * a, -w.y());
+}
+
 // unit direction sampled uniformly in the cone of half-angle acos(cos_max) around unit axis
 // w (Pharr, Jakob, Humphreys, "Physically Based Rendering", 4th ed., sec. A.5.4).
 inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float u1, float u2) {
@@ -26,12 +36,8 @@ inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float
   const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
   float sp, cp;
   SinCos2Pi(u2, &sp, &cp);
-  // orthonormal basis around w (Duff et al., JCGT 2017).
-  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
-  const float a = -1.0f / (sign + w.z());
-  const float b = w.x() * w.y() * a;
-  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
-  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
+  Eigen::Vector3f t, bt;
+  ConeBasis(w, &t, &bt);
   return (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
 }
 
@@ -63,11 +69,8 @@ inline Vec3Lanes SampleConeLanes(const Eigen::Vector3f& w, float cos_max, const 
   const Lanes sin_t = (1.0f - cos_t * cos_t).max(0.0f).sqrt();
   Lanes sp, cp;
   SinCos2Pi(u2, &sp, &cp);
-  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
-  const float a = -1.0f / (sign + w.z());
-  const float b = w.x() * w.y() * a;
-  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
-  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
+  Eigen::Vector3f t, bt;
+  ConeBasis(w, &t, &bt);
   const Lanes sc = sin_t * cp, ss = sin_t * sp;
   Vec3Lanes d{sc * t.x() + ss * bt.x() + cos_t * w.x(), sc * t.y() + ss * bt.y() + cos_t * w.y(),
               sc * t.z() + ss * bt.z() + cos_t * w.z()};
