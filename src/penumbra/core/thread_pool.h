@@ -44,4 +44,15 @@ class ThreadPool {
   std::exception_ptr error_;
 };
 
+/// calls fn(i) for every i in [0, count): over `pool` when it is given (ThreadPool::ParallelFor),
+/// else in index order on the calling thread.
+template <typename Fn>
+void ParallelForOrSerial(ThreadPool* pool, int64_t count, const Fn& fn) {
+  if (pool != nullptr) {
+    pool->ParallelFor(count, fn);
+  } else {
+    for (int64_t i = 0; i < count; ++i) fn(i);
+  }
+}
+
 }  // namespace penumbra

@@ -28,14 +28,6 @@ float PowCos(float x, float e, int squarings) {
   return x;
 }
 
-void RunRows(ThreadPool* pool, int rows, const std::function<void(int64_t)>& fn) {
-  if (pool) {
-    pool->ParallelFor(rows, fn);
-  } else {
-    for (int v = 0; v < rows; ++v) fn(v);
-  }
-}
-
 void CheckGuide(const ImageF* img, const char* name, int w, int h, int c) {
   if (!img) throw Error(std::string("Denoiser: guide '") + name + "' is missing");
   if (img->width != w || img->height != h || img->channels != c ||
@@ -95,7 +87,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
   std::vector<float> inv_z(n, 0.0f), dwdx(n, 0.0f), dwdy(n, 0.0f);
   for (size_t i = 0; i < n; ++i)
     if (has_surface(i)) inv_z[i] = 1.0f / depth[i];
-  RunRows(pool, h, [&](int64_t v) {
+  ParallelForOrSerial(pool, h, [&](int64_t v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
       if (!has_surface(i)) continue;
@@ -152,7 +144,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
       var[i] = std::max(0.0f, guides.variance->data[i]) / (a * a);
     }
   } else {
-    RunRows(pool, h, [&](int64_t v) {
+    ParallelForOrSerial(pool, h, [&](int64_t v) {
       for (int u = 0; u < w; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
         var[i] = 0;
@@ -180,7 +172,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
 
   for (int it = 0; it < settings_.iterations; ++it) {
     const int step = 1 << it;
-    RunRows(pool, h, [&](int64_t v) {
+    ParallelForOrSerial(pool, h, [&](int64_t v) {
       for (int u = 0; u < w; ++u) {
         const size_t i = static_cast<size_t>(v) * w + u;
         if (!has_surface(i)) {

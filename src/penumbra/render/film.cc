@@ -17,15 +17,6 @@ constexpr int kLutSize = 65536;
 
 inline float Luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
-template <typename Fn>
-void ForRows(int rows, ThreadPool* pool, const Fn& fn) {
-  if (pool) {
-    pool->ParallelFor(rows, [&](int64_t r) { fn(static_cast<int>(r)); });
-  } else {
-    for (int r = 0; r < rows; ++r) fn(r);
-  }
-}
-
 // table index of a tone-mapped value x in [0, 1]: round(x (kLutSize - 1)); NaN-safe
 // (!(x > 0) maps to 0).
 inline int LutIndex(float x) {
@@ -121,7 +112,7 @@ double Film::LogAverageLuminance(const ImageF& radiance, ThreadPool* pool) const
   if (radiance.empty()) return kMinLuminance;
   const int w = radiance.width, h = radiance.height;
   std::vector<double> row_sum(h, 0.0);
-  ForRows(h, pool, [&](int v) { row_sum[v] = SumLog(radiance.at(0, v), w); });
+  ParallelForOrSerial(pool, h, [&](int v) { row_sum[v] = SumLog(radiance.at(0, v), w); });
   double total = 0;
   for (double s : row_sum) total += s;  // fixed order: independent of the thread count
   return std::exp(total / (static_cast<double>(w) * h));
@@ -140,7 +131,7 @@ void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, Image
   const float exposure = static_cast<float>(ExposureFromEv100(ev100));
   const bool filmic = settings_.tone_map == RenderSettings::ToneMap::kFilmic;
   const uint8_t* lut = oetf_lut_.data();
-  ForRows(h, pool, [&](int v) {
+  ParallelForOrSerial(pool, h, [&](int v) {
     const float* src = radiance.at(0, v);
     uint8_t* dst = rgb->at(0, v);
     // per chunk: the table indices (SIMD), then the table look-ups.

@@ -89,13 +89,6 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   }
   num_lights_ = std::min(lights.size(), kMaxVolumeLights);
   const int nl = num_lights_;
-  auto parallel = [&](int64_t n, const std::function<void(int64_t)>& fn) {
-    if (pool != nullptr) {
-      pool->ParallelFor(n, fn);
-    } else {
-      for (int64_t i = 0; i < n; ++i) fn(i);
-    }
-  };
   // geometric visibility of light l from p (one shadow ray).
   auto visible = [&](const Eigen::Vector3f& p, const LightSample& ls) {
     if (!ls.cast_shadow) return true;
@@ -124,7 +117,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     gl.source.assign(cells, sky_ambient);
     const Eigen::Matrix3f R_WG = v.R_GW.transpose();
     const float sigma = Mean3(v.sigma_t);
-    parallel(cells, [&](int64_t c) {
+    ParallelForOrSerial(pool, cells, [&](int64_t c) {
       const int i = static_cast<int>(c % gl.r[0]);
       const int j = static_cast<int>((c / gl.r[0]) % gl.r[1]);
       const int k = static_cast<int>(c / (static_cast<int64_t>(gl.r[0]) * gl.r[1]));
@@ -194,7 +187,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
       vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
       if (vol_.with_visibility) vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
-      parallel(cells, [&](int64_t c) {
+      ParallelForOrSerial(pool, cells, [&](int64_t c) {
         const int i = static_cast<int>(c % vol_.r[0]);
         const int j = static_cast<int>((c / vol_.r[0]) % vol_.r[1]);
         const int k = static_cast<int>(c / (static_cast<int64_t>(vol_.r[0]) * vol_.r[1]));
@@ -300,11 +293,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
       rec[k + 1] = FroxelRecord{To4(S), To4(T)};
     }
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(columns, column);
-  } else {
-    for (int64_t c = 0; c < columns; ++c) column(c);
-  }
+  ParallelForOrSerial(pool, columns, column);
 }
 
 float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
@@ -438,11 +427,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
       rec[k + 1] = To4(S);
     }
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(columns, column);
-  } else {
-    for (int64_t c = 0; c < columns; ++c) column(c);
-  }
+  ParallelForOrSerial(pool, columns, column);
 }
 
 Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {

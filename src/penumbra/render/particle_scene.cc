@@ -178,11 +178,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
       drop(s, g - first[s], g);
     }
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(static_cast<int64_t>(drop_chunks), drop_chunk);
-  } else {
-    for (size_t c = 0; c < drop_chunks; ++c) drop_chunk(static_cast<int64_t>(c));
-  }
+  ParallelForOrSerial(pool, static_cast<int64_t>(drop_chunks), drop_chunk);
   alpha_.reserve(total);
   set_.reserve(total);
   ends_.reserve(2 * total);
@@ -313,11 +309,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
     const int n1 = std::min(count_, static_cast<int>(c + 1) * kChunk);
     for (int n = static_cast<int>(c) * kChunk; n < n1; ++n) project(n);
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(chunks, chunk);
-  } else {
-    for (int64_t c = 0; c < chunks; ++c) chunk(c);
-  }
+  ParallelForOrSerial(pool, chunks, chunk);
   // bands of rows in parallel; within a band streaks in index order (nearest wins, ties keep
   // the lower index), so the result does not depend on the thread count.
   constexpr int kBand = 16;
@@ -374,11 +366,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
       }
     }
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(bands, band);
-  } else {
-    for (int64_t bi = 0; bi < bands; ++bi) band(bi);
-  }
+  ParallelForOrSerial(pool, bands, band);
 }
 
 bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const {
@@ -459,11 +447,7 @@ void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vect
     const int64_t n1 = std::min<int64_t>(count_, (c + 1) * kChunk);
     for (int64_t n = c * kChunk; n < n1; ++n) one(n);
   };
-  if (pool != nullptr) {
-    pool->ParallelFor(chunks, chunk);
-  } else {
-    for (int64_t c = 0; c < chunks; ++c) chunk(c);
-  }
+  ParallelForOrSerial(pool, chunks, chunk);
   rain_radiance_ = std::move(L);
 }
 

@@ -306,11 +306,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     }
   };
   const int64_t chunks = (num + kChunk - 1) / kChunk;
-  if (pool != nullptr) {
-    pool->ParallelFor(chunks, trace);
-  } else {
-    for (int64_t c = 0; c < chunks; ++c) trace(c);
-  }
+  ParallelForOrSerial(pool, chunks, trace);
 
   // links between valid neighbours along the grid axes that see each other (each one's ray
   // towards the other goes at least as far as the other probe), for the smoothing in Relight.
@@ -390,11 +386,7 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
     }
   };
   const int64_t chunks = (num + kChunk - 1) / kChunk;
-  if (pool != nullptr) {
-    pool->ParallelFor(chunks, light);
-  } else {
-    for (int64_t c = 0; c < chunks; ++c) light(c);
-  }
+  ParallelForOrSerial(pool, chunks, light);
   // smoothing: a [1 2 1] filter along x, then y, then z over linked neighbours (renormalised),
   // which spreads the quantisation of small sky openings (a window seen by a few texels) over
   // the neighbourhood without mixing probes on the two sides of a wall.

@@ -18,16 +18,6 @@ double AngleTerm(double theta) {
   return theta * theta / (d * d);
 }
 
-// fn(v) for every row v, over `pool` when given.
-template <typename Fn>
-void ForRows(int rows, ThreadPool* pool, const Fn& fn) {
-  if (pool) {
-    pool->ParallelFor(rows, [&](int64_t v) { fn(static_cast<int>(v)); });
-  } else {
-    for (int v = 0; v < rows; ++v) fn(v);
-  }
-}
-
 }  // namespace
 
 double DepthNoiseModel::AxialSigma(double z, double theta, double fx_px) const {
@@ -88,7 +78,7 @@ void ApplyDepthNoise(const ImageF& depth_z, const DepthNoiseInputs& in,
   const int W = depth_z.width, H = depth_z.height;
   *out = ImageF(W, H, 1);
   const double cos_max = std::cos(model.max_incidence_deg * M_PI / 180.0);
-  ForRows(H, pool, [&](int v) {
+  ParallelForOrSerial(pool, H, [&](int v) {
     for (int u = 0; u < W; ++u) {
       Rng rng(HashKeys(key, static_cast<uint64_t>(v) * static_cast<uint64_t>(W) + u));
       // incidence angle from the normal and the pixel ray (x, y, 1)
@@ -168,7 +158,7 @@ ImageF DepthTransmittance(const ImageF& depth_z, const Camera& camera, const Eff
   MediaScene media;
   media.Build(&effects);
   if (media.empty()) return t;
-  ForRows(depth_z.height, pool, [&](int v) {
+  ParallelForOrSerial(pool, depth_z.height, [&](int v) {
     for (int u = 0; u < depth_z.width; ++u) {
       const double z = *depth_z.at(u, v);
       if (!(z > 0)) continue;

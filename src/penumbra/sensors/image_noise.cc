@@ -89,11 +89,7 @@ void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t 
       dn->data[i] = static_cast<float>(std::min(max_dn, std::round(e * gain)));
     }
   };
-  if (pool) {
-    pool->ParallelFor(exposed.height, do_row);
-  } else {
-    for (int v = 0; v < exposed.height; ++v) do_row(v);
-  }
+  ParallelForOrSerial(pool, exposed.height, do_row);
 }
 
 }  // namespace penumbra
