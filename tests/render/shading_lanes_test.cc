@@ -42,6 +42,7 @@ TEST(ShadingLanesTest, BsdfLanesAgreesWithBsdf) {
   Rng rng(21);
   for (int trial = 0; trial < 50; ++trial) {
     BsdfLanes lanes;
+    PbrLanes pbr;
     Vec3Lanes wi;
     Bsdf* ref[kLanes];
     Eigen::Vector3f wis[kLanes];
@@ -57,11 +58,14 @@ TEST(ShadingLanesTest, BsdfLanesAgreesWithBsdf) {
       Eigen::Vector3f wo = RandomDir(&rng);
       if (wo.dot(ng) < 0) wo = -wo;
       ref[k] = new (storage[k]) Bsdf(p, ns, ng, wo);
-      lanes.Set(k, BrdfCoefficients::From(p), ns, ng, wo);
+      // the realtime tier's path: frame per lane, then the coefficients of all lanes at once.
+      lanes.SetFrame(k, UsableShadingNormal(ns, ng, wo), ng, wo);
+      pbr.Set(k, p);
       wis[k] = RandomDir(&rng);
       if (rng.Uniform() < 0.7f && wis[k].dot(ng) < 0) wis[k] = -wis[k];
       wi.Set(k, wis[k]);
     }
+    lanes.SetCoefficients(pbr);
     const Vec3Lanes f = lanes.Eval(wi);
     for (int k = 0; k < kLanes; ++k) {
       const Eigen::Vector3f e = ref[k]->Eval(wis[k]);

@@ -5,18 +5,6 @@ namespace {
 constexpr float kPi = 3.14159265358979323846f;
 }  // namespace
 
-void BsdfLanes::Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_W,
-                    const Eigen::Vector3f& ng_W, const Eigen::Vector3f& wo_W) {
-  const Eigen::Vector3f n_s = UsableShadingNormal(ns_W, ng_W, wo_W);
-  n.Set(k, n_s);
-  ng.Set(k, ng_W);
-  wo.Set(k, wo_W);
-  n_v[k] = n_s.dot(wo_W);
-  c_diff.Set(k, c.c_diff);
-  f0.Set(k, c.f0);
-  a2[k] = c.alpha * c.alpha;
-}
-
 void BsdfLanes::SetCoefficients(const PbrLanes& p) {
   const Lanes metallic = p.metallic.max(0.0f).min(1.0f);
   const Vec3Lanes base{p.base_color.x.max(0.0f).min(1.0f), p.base_color.y.max(0.0f).min(1.0f),

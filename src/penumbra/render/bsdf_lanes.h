@@ -32,10 +32,6 @@ struct BsdfLanes {
   Vec3Lanes c_diff, f0;  ///< Bsdf::diffuse_color(), Bsdf::f0() (x = r, y = g, z = b)
   Lanes a2;              ///< Bsdf::alpha()^2
 
-  /// sets lane k to the BRDF that Bsdf(c, ns_W, ng_W, wo_W) has, for coefficients c.
-  void Set(int k, const BrdfCoefficients& c, const Eigen::Vector3f& ns_W,
-           const Eigen::Vector3f& ng_W, const Eigen::Vector3f& wo_W);
-
   /// sets the frame of lane k: n = n_s (the usable shading normal, UsableShadingNormal(ns_W,
   /// ng_W, wo_W)), ng = ng_W, wo = wo_W. n_v and the coefficients follow from SetCoefficients.
   void SetFrame(int k, const Eigen::Vector3f& n_s, const Eigen::Vector3f& ng_W,
@@ -46,7 +42,8 @@ struct BsdfLanes {
   }
 
   /// for every lane: c_diff, f0 and a2 from `p` (the arithmetic of BrdfCoefficients::From,
-  /// so they equal Set's) and n_v = n . wo from the frame set by SetFrame.
+  /// so a lane's BRDF is the one Bsdf(params, ns_W, ng_W, wo_W) has) and n_v = n . wo from the
+  /// frame set by SetFrame.
   void SetCoefficients(const PbrLanes& p);
 
   /// f(wo, wi) |n . wi| per lane (x = r, y = g, z = b) for unit directions wi; 0 where wi or
