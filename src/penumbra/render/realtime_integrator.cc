@@ -40,7 +40,72 @@ struct Scratch {
   std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
   std::vector<LightSampleLanes> samples;  // per light
   std::vector<Vec3Lanes> contrib;         // per light: unshadowed f cos E
+  std::vector<Eigen::Vector3f> n_s;       // per tile pixel: usable shading normal
+  std::vector<Eigen::Vector3f> sky_E;     // per tile pixel: sky irradiance on n_s
 };
+
+// the sky irradiance on the shading normal of every hit pixel of the tile (the ambient term),
+// and that normal. with a sky volume (occluded sky light), a 2x2 quad of pixels that all see
+// one flat face (one geom, bitwise equal normals, points on one plane within 1 mm and within a
+// quarter probe spacing of each other) shares one lookup at the quad's mean point: the volume
+// interpolates probes one spacing apart (0.43 m in the default world), so across a quad
+// it changes by far less than the 8-bit output resolves, and the lookup is the costliest
+// per-pixel term of the tier. other quads (edges, curved or smooth-shaded faces) look up
+// every pixel.
+void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scratch* scratch) {
+  const PixelTile& tile = primary.tile;
+  const int n = tile.width * tile.height;
+  scratch->n_s.resize(n);
+  scratch->sky_E.resize(n);
+  for (int i = 0; i < n; ++i) {
+    if (!primary.did_hit[i]) continue;
+    const SurfaceHit& h = primary.hits[i];
+    scratch->n_s[i] = UsableShadingNormal(h.ns_W, h.ng_W, -primary.rays[i].d.normalized());
+  }
+  const SkyIrradianceVolume* volume = ctx.sky_volume;
+  if (volume == nullptr) {
+    for (int i = 0; i < n; ++i)
+      if (primary.did_hit[i]) scratch->sky_E[i] = ctx.sky->Irradiance(scratch->n_s[i]);
+    return;
+  }
+  const float max_extent = 0.25f * volume->spacing();
+  constexpr float kPlaneTolM = 1e-3f;
+  for (int y = 0; y < tile.height; y += 2) {
+    for (int x = 0; x < tile.width; x += 2) {
+      const int i00 = y * tile.width + x;
+      const bool full = x + 1 < tile.width && y + 1 < tile.height;
+      const int quad[4] = {i00, i00 + 1, i00 + tile.width, i00 + tile.width + 1};
+      bool shared = full;
+      for (int c = 0; c < 4 && shared; ++c) {
+        const int i = quad[c];
+        shared = primary.did_hit[i] && primary.hits[i].geom == primary.hits[i00].geom &&
+                 scratch->n_s[i] == scratch->n_s[i00];
+      }
+      if (shared) {
+        const Eigen::Vector3f& n0 = scratch->n_s[i00];
+        const Eigen::Vector3f& p0 = primary.hits[i00].p_W;
+        Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+        for (int c = 0; c < 4 && shared; ++c) {
+          const Eigen::Vector3f dp = primary.hits[quad[c]].p_W - p0;
+          shared = std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent;
+          mean += 0.25f * primary.hits[quad[c]].p_W;
+        }
+        if (shared) {
+          const Eigen::Vector3f E = volume->Irradiance(mean, n0, *ctx.sky);
+          for (int c = 0; c < 4; ++c) scratch->sky_E[quad[c]] = E;
+          continue;
+        }
+      }
+      for (int c = 0; c < 4; ++c) {
+        const int dx = c & 1, dy = c >> 1;
+        if (x + dx >= tile.width || y + dy >= tile.height) continue;
+        const int i = quad[c];
+        if (primary.did_hit[i])
+          scratch->sky_E[i] = volume->Irradiance(primary.hits[i].p_W, scratch->n_s[i], *ctx.sky);
+      }
+    }
+  }
+}
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
@@ -87,6 +152,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   scratch.u2.resize(num_lights);
   scratch.samples.resize(num_lights);
   scratch.contrib.resize(num_lights);
+  TileSkyIrradiance(ctx, primary, &scratch);
   int64_t traced = 0;
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
@@ -143,18 +209,14 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       SurfaceMaterial mat = ctx.materials->Evaluate(h);
       if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
       const Eigen::Vector3f wo = -primary.rays[i].d.normalized();
-      const Eigen::Vector3f n_s = UsableShadingNormal(h.ns_W, h.ng_W, wo);
+      const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);
       pbr.Set(k, mat.pbr);
       emission.Set(k, mat.emission);
       p.Set(k, h.p_W);
       // shadow rays start off the surface on the lit side (lights behind it contribute 0).
       origin.Set(k, OffsetRayOrigin(h.p_W, h.ng_W));
-
-      // sky irradiance on the shading normal (the ambient term below), occluded by the static
-      // geometry when there is a sky volume.
-      sky_E.Set(k, ctx.sky_volume != nullptr ? ctx.sky_volume->Irradiance(h.p_W, n_s, *ctx.sky)
-                                             : ctx.sky->Irradiance(n_s));
+      sky_E.Set(k, scratch.sky_E[i]);
 
       // one 64-bit draw per light: (u1, u2) from its top 48 bits.
       Rng rng(FrameContext::PixelStream(frame_key, static_cast<uint64_t>(v) * width + u, 0));

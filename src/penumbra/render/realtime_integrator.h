@@ -5,11 +5,12 @@
 //   L = Le + sum over lights  f(wo, wi) |n . wi| E_i V_i  + ambient
 // with E_i the illuminance of one sample of light i (LightSampler; lights with an extent
 // are jittered per pixel for soft shadows), V_i its visibility from one shadow ray, f the
-// metallic-roughness BRDF (bsdf.h), and the unoccluded sky ambient
-//   ambient = Irradiance(n) / pi x (c_diff (1 - S) + S),   S = EnvBRDF(F0, n.v, roughness)
-// (SkyModel::Irradiance; S is Karis' analytic fit of the split-sum specular reflectance,
-// "Physically based shading on mobile", Unreal Engine blog 2014), exact for a uniform sky
-// and a Lambertian surface (S = 0). rays that miss see SkyModel::Radiance.
+// metallic-roughness BRDF (bsdf.h), and the sky ambient
+//   ambient = E_sky(p, n) / pi x (c_diff (1 - S) + S),   S = EnvBRDF(F0, n.v, roughness)
+// where E_sky is the sky irradiance occluded by the static geometry (SkyIrradianceVolume, when
+// the context has one; else the unoccluded SkyModel::Irradiance(n)) and S is Karis' analytic
+// fit of the split-sum specular reflectance ("Physically based shading on mobile", Unreal
+// Engine blog 2014); unoccluded, this is exact for a uniform sky and a Lambertian surface. rays that miss see SkyModel::Radiance.
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
@@ -25,7 +26,9 @@
 //
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
 // LightSampler::SampleLanes) and its shadow rays towards one light form one Embree packet
-// (RayScene::OccludedLanes); materials, textures and the sky are evaluated per pixel.
+// (RayScene::OccludedLanes); materials and textures are evaluated per pixel. the sky volume is
+// looked up once per 2x2 pixel quad that sees one flat face, at the quad's mean hit point (it
+// varies over a probe spacing, tens of pixels), else per pixel.
 
 #include "penumbra/render/integrator.h"
 
