@@ -457,6 +457,131 @@ Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   return out;
 }
 
+void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) const {
+  MediaQuad& q = *quad;
+  q = MediaQuad();
+  // grid froxels: the columns and weights of the quad's centre, then per column the slice that
+  // holds t and the distances where that stays so (constant before the column's entry and
+  // after its exit).
+  const Froxels& fr = froxels_;
+  if (!fr.records.empty()) {
+    constexpr int Z = kFroxelSlices;
+    const float t = std::min(t_c, 1e30f);
+    q.t_c = t;
+    const float fx = std::clamp((u0 + 0.5f - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock),
+                                0.0f, static_cast<float>(fr.nx - 1));
+    const float fy = std::clamp((v0 + 0.5f - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock),
+                                0.0f, static_cast<float>(fr.ny - 1));
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
+    const float wx = fx - x0, wy = fy - y0;
+    const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+    float t_enter = kInfF;
+    for (int k = 0; k < 4; ++k)
+      if (fr.t0[cols[k]] < fr.t1[cols[k]]) t_enter = std::min(t_enter, fr.t0[cols[k]]);
+    q.g_enter = t_enter;
+    if (t > t_enter) {
+      const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+      float lo = t_enter, hi = kInfF;
+      for (int k = 0; k < 4; ++k) {
+        if (!(w[k] > 0)) continue;
+        const int c = cols[k];
+        const float a = fr.t0[c], b = fr.t1[c];
+        if (!(a < b)) {
+          q.gT += Eigen::Array4f::Constant(w[k]);
+          continue;
+        }
+        const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
+        const float spm = fr.slices_per_m[c];
+        const float s = (t - a) * spm;
+        if (!(s > 0)) {  // before the column's entry: record 0
+          hi = std::min(hi, a);
+          q.gS += w[k] * rec[0].S;
+          q.gT += w[k] * rec[0].T;
+        } else if (!(s < Z)) {  // after its exit: record Z
+          lo = std::max(lo, b);
+          q.gS += w[k] * rec[Z].S;
+          q.gT += w[k] * rec[Z].T;
+        } else {
+          const int i = std::min(static_cast<int>(s), Z - 1);
+          const float f = s - i;
+          lo = std::max(lo, a + i / spm);
+          hi = std::min(hi, a + (i + 1) / spm);
+          q.gS += w[k] * ((1 - f) * rec[i].S + f * rec[i + 1].S);
+          q.gT += w[k] * ((1 - f) * rec[i].T + f * rec[i + 1].T);
+          q.gS_dt += (w[k] * spm) * (rec[i + 1].S - rec[i].S);
+          q.gT_dt += (w[k] * spm) * (rec[i + 1].T - rec[i].T);
+        }
+      }
+      q.g_lo = lo;
+      q.g_hi = hi;
+    }
+  }
+  // light in-scatter froxels: the same in log distance (slices are spaced exponentially),
+  // beyond the first slice boundary only.
+  const FogFroxels& ff = fog_froxels_;
+  if (!ff.S.empty() && t_c > kFogFroxelNear) {
+    constexpr int Z = kFogFroxelSlices;
+    const float fx =
+        std::clamp((u0 + 0.5f - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
+                   static_cast<float>(ff.nx - 1));
+    const float fy =
+        std::clamp((v0 + 0.5f - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
+                   static_cast<float>(ff.ny - 1));
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const int x1 = std::min(x0 + 1, ff.nx - 1), y1 = std::min(y0 + 1, ff.ny - 1);
+    const float wx = fx - x0, wy = fy - y0;
+    const int cols[4] = {y0 * ff.nx + x0, y0 * ff.nx + x1, y1 * ff.nx + x0, y1 * ff.nx + x1};
+    const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    const float log_t = std::log(t_c / kFogFroxelNear);
+    q.log_c = log_t;
+    float lo = 0.0f, hi = kInfF;
+    for (int k = 0; k < 4; ++k) {
+      if (!(w[k] > 0)) continue;
+      const int c = cols[k];
+      const float ilf = ff.inv_log_far[c];
+      const float s = 1.0f + (Z - 1) * log_t * ilf;
+      const Eigen::Array4f* rec = ff.S.data() + static_cast<size_t>(c) * (Z + 1);
+      if (!(s < Z)) {  // beyond the last boundary: record Z
+        lo = std::max(lo, 1.0f / ilf);
+        q.fS += w[k] * rec[Z];
+        continue;
+      }
+      const int i = std::min(static_cast<int>(s), Z - 1);
+      const float f = s - i;
+      const float per_slice = 1.0f / ((Z - 1) * ilf);  // log distance per slice
+      lo = std::max(lo, (i - 1) * per_slice);
+      hi = std::min(hi, i * per_slice);
+      q.fS += w[k] * ((1 - f) * rec[i] + f * rec[i + 1]);
+      q.fS_dlog += (w[k] * (Z - 1) * ilf) * (rec[i + 1] - rec[i]);
+    }
+    q.f_lo = lo;
+    q.f_hi = hi;
+  }
+}
+
+float RealtimeMedia::QuadFroxels(const MediaQuad& q, int u, int v, float t, Eigen::Array4f* S,
+                                 Eigen::Array4f* T) const {
+  if (!(t > q.g_enter)) {
+    S->setZero();
+    *T = Eigen::Array4f(1, 1, 1, 0);
+    return q.g_enter;
+  }
+  if (!(t >= q.g_lo && t <= q.g_hi)) return LookupFroxels(u, v, t, S, T);
+  const float dt = t == q.t_c ? 0.0f : t - q.t_c;
+  *S = q.gS + dt * q.gS_dt;
+  *T = q.gT + dt * q.gT_dt;
+  return q.g_enter;
+}
+
+Eigen::Array4f RealtimeMedia::QuadFogFroxels(const MediaQuad& q, int u, int v, float t) const {
+  if (!(t > kFogFroxelNear)) return LookupFogFroxels(u, v, t);
+  const float log_t = std::log(t / kFogFroxelNear);
+  if (!(log_t >= q.f_lo && log_t <= q.f_hi)) return LookupFogFroxels(u, v, t);
+  const float dl = log_t == q.log_c ? 0.0f : log_t - q.log_c;
+  return q.fS + dl * q.fS_dlog;
+}
+
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                 float dist) const {
   if (j >= num_lights_) return 1.0f;
@@ -544,15 +669,19 @@ Eigen::Vector3f RealtimeMedia::LightTransmittance(int j, const Eigen::Vector3f& 
 }
 
 MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                                          const Eigen::Vector3f& d, float t_end, int u,
-                                          int v) const {
+                                          const Eigen::Vector3f& d, float t_end, int u, int v,
+                                          const MediaQuad* quad) const {
   const MediaScene& media = *media_;
   const bool analytic = !media.analytic().empty();
 
   // grids: the froxel volume at the pixel's distance.
   Eigen::Array4f L_add = Eigen::Array4f::Zero(), Tg(1, 1, 1, 0);
   float first_a = kInfF;
-  if (!froxels_.records.empty()) first_a = LookupFroxels(u, v, std::min(t_end, 1e30f), &L_add, &Tg);
+  if (!froxels_.records.empty()) {
+    const float t = std::min(t_end, 1e30f);
+    first_a = quad != nullptr ? QuadFroxels(*quad, u, v, t, &L_add, &Tg)
+                              : LookupFroxels(u, v, t, &L_add, &Tg);
+  }
 
   MediaSegment out;
   if (!analytic) {
@@ -591,7 +720,8 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
   }
   L_add += albedo * sky_w * sky_ambient4_;
   // light in-scatter from the froxel columns.
-  if (!fog_froxels_.S.empty()) L_add += LookupFogFroxels(u, v, t_end);
+  if (!fog_froxels_.S.empty())
+    L_add += quad != nullptr ? QuadFogFroxels(*quad, u, v, t_end) : LookupFogFroxels(u, v, t_end);
   out.T = (Th_end * Tg).head<3>().matrix();
   out.L_add = L_add.head<3>().matrix();
   return out;

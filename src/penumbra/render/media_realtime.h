@@ -35,6 +35,11 @@
 //    in-scatter and transmittance are stored at every slice boundary. a pixel looks them up
 //    at its own distance (linear between slice boundaries, bilinear between columns).
 //  - homogeneous in-scatter behind a grid is attenuated by the grid's transmittance.
+//  - the realtime integrator looks the two froxel volumes up once per 2x2 pixel quad whose
+//    pixels all hit a surface or all see the sky (MediaQuad): at the quad's centre and mean
+//    distance, with the slices' slopes in distance for each pixel's own distance while it stays
+//    in the same slices (else the pixel looks them up itself). default world, major preset:
+//    8-bit output within 1 code of per-pixel lookups (mean 0.02 codes).
 // every camera segment starts at the camera (particle compositing uses two of them).
 // surfaces: each light's contribution is multiplied by LightTransmittance (the world light
 // volume; outside it: closed form for the homogeneous media times the grid's light volume at
@@ -78,6 +83,23 @@ struct MediaSegment {
   Eigen::Vector3f L_add{0, 0, 0};
 };
 
+/// the froxel lookups of one 2x2 pixel quad, made once (RealtimeMedia::PrepareQuad) and shared
+/// by its four pixels: both froxel volumes interpolated bilinearly at the quad's centre and
+/// linearly in distance (grid volume) or log distance (light in-scatter volume) from the quad's
+/// reference distance t_c, within the distance ranges where the lookups stay in one slice of
+/// every column; a pixel whose distance lies outside a range looks that volume up itself.
+struct MediaQuad {
+  float t_c = 0;             ///< reference distance of the grid values (m)
+  float g_enter = 0;         ///< grid: smallest entry distance of the columns (m)
+  float g_lo = 1, g_hi = 0;  ///< grid: distances (m) where gS, gT hold (empty: none)
+  Eigen::Array4f gS = Eigen::Array4f::Zero(), gT = Eigen::Array4f::Zero();        ///< at t_c
+  Eigen::Array4f gS_dt = Eigen::Array4f::Zero(), gT_dt = Eigen::Array4f::Zero();  ///< per m
+  float log_c = 0;                             ///< fog: log(t_c / kFogFroxelNear)
+  float f_lo = 1, f_hi = 0;                    ///< fog: log distances where fS holds (empty: none)
+  Eigen::Array4f fS = Eigen::Array4f::Zero();  ///< fog in-scatter at t_c
+  Eigen::Array4f fS_dlog = Eigen::Array4f::Zero();  ///< its change per unit of log distance
+};
+
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
 class RealtimeMedia {
  public:
@@ -103,9 +125,18 @@ class RealtimeMedia {
   int num_volume_lights() const { return num_lights_; }
 
   /// single scattering along the camera ray o + t d (d unit, o the camera centre) of pixel
-  /// (u, v), t in [0, t_end].
+  /// (u, v), t in [0, t_end]. with `quad` (PrepareQuad of the 2x2 quad holding the pixel; may
+  /// be null) the froxel volumes are read from it where it holds the pixel's distance: their
+  /// columns are then interpolated at the quad's centre instead of the pixel's (half a pixel
+  /// away, 1/24 of the grid and 1/48 of the in-scatter columns' spacing); the homogeneous
+  /// media's closed-form terms stay per pixel.
   MediaSegment IntegrateView(const LightSampler& lights, const Eigen::Vector3f& o,
-                             const Eigen::Vector3f& d, float t_end, int u, int v) const;
+                             const Eigen::Vector3f& d, float t_end, int u, int v,
+                             const MediaQuad* quad = nullptr) const;
+
+  /// the shared froxel lookups of the 2x2 quad of pixels (u0, v0) .. (u0 + 1, v0 + 1) at the
+  /// reference distance t_c (m; the mean of the pixels' distances, +inf for sky pixels).
+  void PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) const;
 
   const MediaScene* media() const { return media_; }
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
@@ -142,6 +173,11 @@ class RealtimeMedia {
   /// (rgb in lanes 0..2); returns the smallest entry distance of the four columns (+inf if
   /// none meets a grid; then S = 0, T = 1).
   float LookupFroxels(int u, int v, float t, Eigen::Array4f* S, Eigen::Array4f* T) const;
+  /// LookupFroxels from `quad` where it holds t, else per pixel.
+  float QuadFroxels(const MediaQuad& quad, int u, int v, float t, Eigen::Array4f* S,
+                    Eigen::Array4f* T) const;
+  /// LookupFogFroxels from `quad` where it holds t, else per pixel.
+  Eigen::Array4f QuadFogFroxels(const MediaQuad& quad, int u, int v, float t) const;
   struct FogFroxels {
     int nx = 0, ny = 0;
     std::vector<float> inv_log_far;  // [column] 1 / log(last slice boundary / near)
