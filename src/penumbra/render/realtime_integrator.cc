@@ -110,9 +110,10 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
 // alpha-composited over it (render/media_realtime.h, render/particle_scene.h). no random
-// numbers here (the froxel volumes are jittered per column when they are built).
+// numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
+// shared froxel lookups of the pixel's 2x2 quad, or null.
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
-                                 int u, int v, Eigen::Vector3f L) {
+                                 int u, int v, Eigen::Vector3f L, const MediaQuad* quad) {
   const MediaFrame& fx = *ctx.effects;
   const RealtimeMedia* rm = fx.realtime_media();
   const ParticleScene* parts = fx.particles();
@@ -122,7 +123,7 @@ Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool h
   const float inf = std::numeric_limits<float>::infinity();
   const float t_end = hit ? t_hit * d_len : inf;
   if (rm != nullptr) {
-    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, u, v);
+    const MediaSegment seg = rm->IntegrateView(*ctx.lights, ray.o, d, t_end, u, v, quad);
     L = seg.T.cwiseProduct(L) + seg.L_add;
   }
   ParticleHit ph;
@@ -132,12 +133,55 @@ Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool h
     const float t_p = ph.t * d_len;
     Eigen::Vector3f Lp = parts->Shade(ph, ray.o + t_p * d, *ctx.lights, fx.sky_ambient());
     if (rm != nullptr) {
-      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v);
+      const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v, quad);
       Lp = front.T.cwiseProduct(Lp) + front.L_add;
     }
     L = ph.alpha * Lp + (1.0f - ph.alpha) * L;
   }
   return L;
+}
+
+// the effects on every pixel of a tile whose radiance buffer holds its final surface or sky
+// radiance, per 2x2 quad: a full quad whose pixels all hit a surface or all see the sky shares
+// one set of froxel lookups (RealtimeMedia::PrepareQuad at the mean distance of its pixels);
+// other pixels look the froxels up themselves.
+void ApplyTileViewEffects(const FrameContext& ctx, const PrimaryHits& primary,
+                          const FrameBuffers& out) {
+  const PixelTile& tile = primary.tile;
+  const RealtimeMedia* rm = ctx.effects->realtime_media();
+  auto apply = [&](int i, const MediaQuad* quad) {
+    const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+    float* Lp = out.radiance->at(u, v);
+    const Eigen::Vector3f Lf =
+        ApplyViewEffects(ctx, primary.rays[i], primary.did_hit[i], primary.hits[i].t, u, v,
+                         Eigen::Vector3f(Lp[0], Lp[1], Lp[2]), quad);
+    Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
+  };
+  for (int y = 0; y < tile.height; y += 2) {
+    for (int x = 0; x < tile.width; x += 2) {
+      const int i00 = y * tile.width + x;
+      const int quad[4] = {i00, i00 + 1, i00 + tile.width, i00 + tile.width + 1};
+      bool shared = rm != nullptr && x + 1 < tile.width && y + 1 < tile.height;
+      for (int c = 1; c < 4 && shared; ++c)
+        shared = primary.did_hit[quad[c]] == primary.did_hit[i00];
+      if (shared) {
+        float t_c = std::numeric_limits<float>::infinity();
+        if (primary.did_hit[i00]) {
+          t_c = 0;
+          for (int c = 0; c < 4; ++c)
+            t_c += 0.25f * primary.hits[quad[c]].t * primary.rays[quad[c]].d.norm();
+        }
+        MediaQuad q;
+        rm->PrepareQuad(tile.x0 + x, tile.y0 + y, t_c, &q);
+        for (int c = 0; c < 4; ++c) apply(quad[c], &q);
+        continue;
+      }
+      for (int c = 0; c < 4; ++c) {
+        const int dx = c & 1, dy = c >> 1;
+        if (x + dx < tile.width && y + dy < tile.height) apply(quad[c], nullptr);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -159,18 +203,6 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const MediaFrame* fx = ctx.effects;
   const RealtimeMedia* rm = fx != nullptr ? fx->realtime_media() : nullptr;
   const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
-  // the effects on the pixels of a run whose surface radiance is final (misses hold the sky).
-  auto finish_run = [&](int i0, int m, const LaneMask& hit, const Vec3Lanes& L) {
-    for (int k = 0; k < m; ++k) {
-      const int i = i0 + k;
-      const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
-      float* Lp = out.radiance->at(u, v);
-      const Eigen::Vector3f Ls = hit[k] ? L.Lane(k) : Eigen::Vector3f(Lp[0], Lp[1], Lp[2]);
-      const Eigen::Vector3f Lf =
-          ApplyViewEffects(ctx, primary.rays[i], hit[k], primary.hits[i].t, u, v, Ls);
-      Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
-    }
-  };
 
   // runs of kLanes pixels (a full tile row): per-pixel set-up (materials, textures, sky,
   // random numbers), then the BRDF coefficients, the ambient term and every light for all
@@ -230,10 +262,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         nn[0] = n_s.x(), nn[1] = n_s.y(), nn[2] = n_s.z();
       }
     }
-    if (!hit.any()) {
-      if (fx != nullptr) finish_run(i0, m, hit, L);
-      continue;
-    }
+    if (!hit.any()) continue;
     bsdf.SetCoefficients(pbr);
 
     // emission and sky ambient, E_sky / pi (c_diff (1 - S) + S).
@@ -305,8 +334,9 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
       Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
     }
-    if (fx != nullptr) finish_run(i0, m, hit, L);
   }
+  // the effects once every pixel of the tile holds its surface or sky radiance.
+  if (fx != nullptr) ApplyTileViewEffects(ctx, primary, out);
   return traced;
 }
 
