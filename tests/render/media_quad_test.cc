@@ -74,10 +74,12 @@ TEST(MediaQuadTest, SharedQuadLookupsMatchPerPixelLookups) {
       rm.PrepareQuad(u0, v0, t_c, &q);
       for (int c = 0; c < 4; ++c) {
         const int u = u0 + (c & 1), v = v0 + (c >> 1);
-        // the surface, a point 3 % behind it (in the quad's slices where the distance
-        // slopes matter) and, as for a particle streak, a point half-way to it.
+        // the surface, points 1 % and 3 % behind the quad's mean distance and the surface
+        // (where the slices' slopes in distance matter) and, as for a particle streak, a point
+        // half-way to the surface.
         const bool sky = !std::isfinite(t[c]);
-        for (float te : {t[c], sky ? 2.0f : 1.03f * t[c], sky ? 3.0f : 0.5f * t[c]}) {
+        for (float te : {t[c], sky ? 1.0f : 1.01f * t_c, sky ? 2.0f : 1.03f * t[c],
+                         sky ? 3.0f : 0.5f * t[c]}) {
           const MediaSegment own = rm.IntegrateView(lights, o[c], d[c], te, u, v);
           const MediaSegment shared = rm.IntegrateView(lights, o[c], d[c], te, u, v, &q);
           const double dT = (shared.T - own.T).cwiseAbs().maxCoeff();
