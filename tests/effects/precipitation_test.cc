@@ -134,5 +134,33 @@ TEST(SnowTest, NumberDensityFromWaterEquivalentRate) {
   EXPECT_GT(vh, 0.05);  // turbulent drift
 }
 
+// PlaceParticles spreads chunks of the table over a pool: the particles and their order must
+// not depend on it (rain and drifting snow, thinned and clipped to a region).
+TEST(PlaceParticlesTest, PoolGivesTheSerialResultBitForBit) {
+  RainParams rain;
+  rain.rate_mm_h = 25;
+  rain.max_particles = 70000;
+  SnowParams snow;
+  snow.rate_mm_h = 5;
+  snow.max_particles = 40000;
+  const PrecipitationTable tables[2] = {BuildRainTable(rain, 9, 1), BuildSnowTable(snow, 9, 2)};
+  const BoxRegion region{{-3, -2, -1}, {2, 3, 1.5}};
+  ThreadPool pool2(2), pool3(3);
+  for (const PrecipitationTable& tab : tables) {
+    ASSERT_GT(tab.q0.size(), 30000u);  // several chunks
+    for (const BoxRegion* r : {static_cast<const BoxRegion*>(nullptr), &region}) {
+      const ParticleSet serial = PlaceParticles(tab, 2.5, {1, 2, 0.5}, 0.7, r);
+      ASSERT_GT(serial.position_W.size(), 1000u);
+      for (ThreadPool* pool : {&pool2, &pool3}) {
+        const ParticleSet par = PlaceParticles(tab, 2.5, {1, 2, 0.5}, 0.7, r, pool);
+        EXPECT_EQ(par.position_W, serial.position_W);
+        EXPECT_EQ(par.velocity_W, serial.velocity_W);
+        EXPECT_EQ(par.radius_m, serial.radius_m);
+        EXPECT_EQ(par.kind, serial.kind);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "media_test_util.h"
+#include "penumbra/core/error.h"
+#include "penumbra/render/camera.h"
 #include "penumbra/render/particle_scene.h"
 
 namespace penumbra {
@@ -109,6 +111,48 @@ TEST(ParticleStreakTest, RainAndSnowShading) {
     // irradiance table), over the sky behind it.
     EXPECT_NEAR(f.radiance.at(32, 23)[1], 0.8 * 0.5, 0.01) << static_cast<int>(kind);
   }
+}
+
+// the first non-finite particle in (set, index) order is reported, whatever the thread count
+// (the check runs in the parallel chunks of Build).
+TEST(ParticleSceneTest, FirstNonFiniteParticleIsReported) {
+  EffectsFrame fx;
+  for (int s = 0; s < 3; ++s) {
+    ParticleSet ps;
+    for (int i = 0; i < 9000; ++i) {
+      ps.position_W.emplace_back(5.0f + 0.001f * i, 0.1f * s, 0.0f);
+      ps.velocity_W.emplace_back(0.0f, 0.0f, -5.0f);
+      ps.radius_m.push_back(0.001f);
+    }
+    fx.particles.push_back(ps);
+  }
+  fx.particles[1].velocity_W[8500].y() = NAN;
+  fx.particles[1].radius_m[6000] = INFINITY;
+  fx.particles[2].position_W[10].x() = NAN;
+  const CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60.0);
+  const Camera camera(view.X_WO, view.intrinsics);
+  ThreadPool pool(2);
+  for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
+    for (bool pixel_hits : {false, true}) {
+      ParticleScene scene;
+      try {
+        scene.Build(&fx, camera, 0.01, pixel_hits, p);
+        ADD_FAILURE() << "expected a ConfigError";
+      } catch (const ConfigError& e) {
+        EXPECT_EQ(e.key(), "effects.particles[1]");
+        EXPECT_NE(std::string(e.what()).find("particle 6000 has a non-finite value"),
+                  std::string::npos)
+            << e.what();
+      }
+    }
+  }
+  // valid again: builds.
+  fx.particles[1].velocity_W[8500].y() = 0;
+  fx.particles[1].radius_m[6000] = 0.001f;
+  fx.particles[2].position_W[10].x() = 5;
+  ParticleScene scene;
+  scene.Build(&fx, camera, 0.01, true, &pool);
+  EXPECT_EQ(scene.size() + scene.culled(), 27000);
 }
 
 }  // namespace

@@ -169,6 +169,11 @@ EffectsEngine::EffectsEngine(const std::vector<EffectConfig>& effects, uint64_t 
 
 EffectsEngine::~EffectsEngine() = default;
 
+ThreadPool* EffectsEngine::Pool() {
+  if (!pool_) pool_ = std::make_unique<ThreadPool>(0);
+  return pool_.get();
+}
+
 std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
                                                             const Eigen::Vector3d& viewer_W,
                                                             const std::vector<Pose>* X_WB) {
@@ -222,23 +227,30 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
           const uint64_t k1 =
               HashKeys(rt.key, static_cast<uint64_t>(static_cast<int64_t>(slice) + 1));
           const double threshold = 1.0 - s.coverage;
-          Fbm3Sampler fbm0(k0, s.octaves), fbm1(k1, s.octaves);  // = Fbm3(k0 / k1, q, octaves)
+          // rows of voxels in parallel, each with its own samplers (their memo of the lattice
+          // cell does not change the values).
+          std::vector<float> row_max(static_cast<size_t>(ny) * nz, 0.0f);
+          auto row = [&](int64_t r) {
+            const int j = static_cast<int>(r % ny), k = static_cast<int>(r / ny);
+            Fbm3Sampler fbm0(k0, s.octaves), fbm1(k1, s.octaves);  // = Fbm3(k0 / k1, q, octaves)
+            float mx = 0;
+            for (int i = 0; i < nx; ++i) {
+              const Eigen::Vector3d p = e.region->min_W + Eigen::Vector3d((i + 0.5) * ext.x() / nx,
+                                                                          (j + 0.5) * ext.y() / ny,
+                                                                          (k + 0.5) * ext.z() / nz);
+              const Eigen::Vector3d q = (p - s.wind_m_s * t) / s.noise_scale_m;
+              const double n = (1 - blend) * fbm0(q) + blend * fbm1(q);
+              const double d = s.coverage > 0
+                                   ? std::max(0.0, n - threshold) / std::max(s.coverage, 1e-6) * w
+                                   : 0;
+              (*density)[(static_cast<size_t>(k) * ny + j) * nx + i] = static_cast<float>(d);
+              mx = std::max(mx, static_cast<float>(d));
+            }
+            row_max[r] = mx;
+          };
+          ParallelForOrSerial(Pool(), static_cast<int64_t>(row_max.size()), row);
           float max_d = 0;
-          for (int k = 0; k < nz; ++k)
-            for (int j = 0; j < ny; ++j)
-              for (int i = 0; i < nx; ++i) {
-                const Eigen::Vector3d p =
-                    e.region->min_W + Eigen::Vector3d((i + 0.5) * ext.x() / nx,
-                                                      (j + 0.5) * ext.y() / ny,
-                                                      (k + 0.5) * ext.z() / nz);
-                const Eigen::Vector3d q = (p - s.wind_m_s * t) / s.noise_scale_m;
-                const double n = (1 - blend) * fbm0(q) + blend * fbm1(q);
-                const double d = s.coverage > 0
-                                     ? std::max(0.0, n - threshold) / std::max(s.coverage, 1e-6) * w
-                                     : 0;
-                (*density)[(static_cast<size_t>(k) * ny + j) * nx + i] = static_cast<float>(d);
-                max_d = std::max(max_d, static_cast<float>(d));
-              }
+          for (float m : row_max) max_d = std::max(max_d, m);
           if (max_d <= 0) break;
           g.density = std::move(density);
           g.max_density = max_d;
@@ -314,8 +326,8 @@ std::shared_ptr<const EffectsFrame> EffectsEngine::Evaluate(double t,
             rt.precipitation = e.type == EffectType::kRain ? BuildRainTable(e.rain, rt.key, 1)
                                                            : BuildSnowTable(e.snow, rt.key, 2);
           }
-          frame->particles.push_back(
-              PlaceParticles(*rt.precipitation, t, viewer_W, w, e.region ? &*e.region : nullptr));
+          frame->particles.push_back(PlaceParticles(*rt.precipitation, t, viewer_W, w,
+                                                    e.region ? &*e.region : nullptr, Pool()));
         }
         break;
       case EffectType::kSparks: {

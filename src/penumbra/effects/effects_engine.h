@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
@@ -65,6 +66,10 @@ class EffectsEngine {
   bool any_sun_ = false;
   /// the scene's directional lights (index, light), moved by a sun effect.
   std::vector<std::pair<int, Light>> directional_lights_;
+  /// threads (hardware concurrency) for the noise smoke voxels and the precipitation
+  /// particles, made on first use; the results do not depend on the thread count.
+  std::unique_ptr<ThreadPool> pool_;
+  ThreadPool* Pool();
 };
 
 }  // namespace penumbra

@@ -114,7 +114,7 @@ PrecipitationTable BuildSnowTable(const SnowParams& p, uint64_t seed, uint64_t e
 }
 
 ParticleSet PlaceParticles(const PrecipitationTable& tab, double t, const Eigen::Vector3d& viewer_W,
-                           double weight, const BoxRegion* region) {
+                           double weight, const BoxRegion* region, ThreadPool* pool) {
   ParticleSet set;
   set.kind = tab.kind;
   set.color = tab.color;
@@ -122,30 +122,50 @@ ParticleSet PlaceParticles(const PrecipitationTable& tab, double t, const Eigen:
   const Eigen::Vector3d lo = viewer_W - tab.half;
   const bool drift = !tab.omega.empty();
   const size_t count = tab.q0.size();
-  const size_t expect = static_cast<size_t>(std::min(1.0, std::max(0.0, weight)) * count) + 16;
-  set.position_W.reserve(expect);
-  set.velocity_W.reserve(expect);
-  set.radius_m.reserve(expect);
-  for (size_t i = 0; i < count; ++i) {
-    if (tab.keep[i] >= weight) continue;
-    Eigen::Vector3d q = tab.q0[i] + tab.velocity[i] * t;
-    Eigen::Vector3d v = tab.velocity[i];
-    if (drift) {
-      const double w = tab.omega[i];
-      for (int a = 0; a < 3; ++a) {
-        const double amp = tab.drift_amplitude_m_s[a];
-        const double ph = tab.phase[i][a];
-        // integral of amp sin(w s + ph) ds over [0, t]
-        q[a] += amp / w * (std::cos(ph) - std::cos(w * t + ph));
-        v[a] += amp * std::sin(w * t + ph);
+  // chunks of the table in parallel, each into its own arrays, then joined in table order.
+  constexpr size_t kChunk = 16384;
+  const size_t chunks = (count + kChunk - 1) / kChunk;
+  std::vector<ParticleSet> part(chunks);
+  auto chunk = [&](int64_t c) {
+    const size_t i0 = static_cast<size_t>(c) * kChunk, i1 = std::min(count, i0 + kChunk);
+    ParticleSet& out = part[c];
+    const size_t expect =
+        static_cast<size_t>(std::min(1.0, std::max(0.0, weight)) * (i1 - i0)) + 16;
+    out.position_W.reserve(expect);
+    out.velocity_W.reserve(expect);
+    out.radius_m.reserve(expect);
+    for (size_t i = i0; i < i1; ++i) {
+      if (tab.keep[i] >= weight) continue;
+      Eigen::Vector3d q = tab.q0[i] + tab.velocity[i] * t;
+      Eigen::Vector3d v = tab.velocity[i];
+      if (drift) {
+        const double w = tab.omega[i];
+        for (int a = 0; a < 3; ++a) {
+          const double amp = tab.drift_amplitude_m_s[a];
+          const double ph = tab.phase[i][a];
+          // integral of amp sin(w s + ph) ds over [0, t]
+          q[a] += amp / w * (std::cos(ph) - std::cos(w * t + ph));
+          v[a] += amp * std::sin(w * t + ph);
+        }
       }
+      const Eigen::Vector3d pos(Wrap(q.x(), lo.x(), size.x()), Wrap(q.y(), lo.y(), size.y()),
+                                Wrap(q.z(), lo.z(), size.z()));
+      if (!Inside(region, pos)) continue;
+      out.position_W.push_back(pos.cast<float>());
+      out.velocity_W.push_back(v.cast<float>());
+      out.radius_m.push_back(tab.radius_m[i]);
     }
-    const Eigen::Vector3d pos(Wrap(q.x(), lo.x(), size.x()), Wrap(q.y(), lo.y(), size.y()),
-                              Wrap(q.z(), lo.z(), size.z()));
-    if (!Inside(region, pos)) continue;
-    set.position_W.push_back(pos.cast<float>());
-    set.velocity_W.push_back(v.cast<float>());
-    set.radius_m.push_back(tab.radius_m[i]);
+  };
+  ParallelForOrSerial(pool, static_cast<int64_t>(chunks), chunk);
+  size_t total = 0;
+  for (const ParticleSet& p : part) total += p.position_W.size();
+  set.position_W.reserve(total);
+  set.velocity_W.reserve(total);
+  set.radius_m.reserve(total);
+  for (const ParticleSet& p : part) {
+    set.position_W.insert(set.position_W.end(), p.position_W.begin(), p.position_W.end());
+    set.velocity_W.insert(set.velocity_W.end(), p.velocity_W.begin(), p.velocity_W.end());
+    set.radius_m.insert(set.radius_m.end(), p.radius_m.begin(), p.radius_m.end());
   }
   return set;
 }

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/scene/effects_frame.h"
 
@@ -65,9 +66,11 @@ PrecipitationTable BuildRainTable(const RainParams& p, uint64_t seed, uint64_t e
 /// the flakes of a snow effect (see SampleSnow).
 PrecipitationTable BuildSnowTable(const SnowParams& p, uint64_t seed, uint64_t effect_key);
 /// the particles of a table at time t around viewer_W, thinned to `weight` and clipped to
-/// `region` (may be null).
+/// `region` (may be null), in table order; chunks of the table are placed over `pool` (may be
+/// null; the result does not depend on it).
 ParticleSet PlaceParticles(const PrecipitationTable& table, double t,
-                           const Eigen::Vector3d& viewer_W, double weight, const BoxRegion* region);
+                           const Eigen::Vector3d& viewer_W, double weight, const BoxRegion* region,
+                           ThreadPool* pool = nullptr);
 
 /// rain drops at time t (sim seconds) around viewer_W. `weight` in [0, 1] thins the drops
 /// (drop i is kept when its own uniform draw is < weight); `region` (may be null) keeps only

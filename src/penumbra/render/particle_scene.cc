@@ -96,34 +96,27 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     impl_->scene = nullptr;
   }
   if (fx == nullptr) return;
-  size_t total = 0;
   for (size_t s = 0; s < fx->particles.size(); ++s) {
     const ParticleSet& ps = fx->particles[s];
-    const std::string key = "effects.particles[" + std::to_string(s) + "]";
     if (ps.velocity_W.size() != ps.position_W.size() || ps.radius_m.size() != ps.position_W.size())
-      throw ConfigError("", 0, key,
+      throw ConfigError("", 0, "effects.particles[" + std::to_string(s) + "]",
                         "expected position_W, velocity_W and radius_m of equal length (got " +
                             std::to_string(ps.position_W.size()) + ", " +
                             std::to_string(ps.velocity_W.size()) + ", " +
                             std::to_string(ps.radius_m.size()) + ")");
-    for (size_t i = 0; i < ps.position_W.size(); ++i) {
-      if (!ps.position_W[i].allFinite() || !ps.velocity_W[i].allFinite() ||
-          !std::isfinite(ps.radius_m[i]))
-        throw ConfigError("", 0, key, "particle " + std::to_string(i) + " has a non-finite value");
-      if (ps.radius_m[i] > 0) ++total;
-    }
   }
-  if (total == 0) return;
   const float T = static_cast<float>(std::max(0.0, exposure_time_sec));
   const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
   const float fx_px = static_cast<float>(camera.intrinsics().fx);
-  // every drop's streak and cull flag in parallel chunks (each drop only reads its own input and
-  // writes its own slot), then compacted serially in (set, index) order, so the output does not
-  // depend on the thread count.
+  // every drop's check for finite values, streak and cull flag in parallel chunks (each drop
+  // only reads its own input and writes its own slot), then compacted serially in (set, index)
+  // order, so the output (and the first non-finite particle reported) does not depend on the
+  // thread count.
   std::vector<size_t> first(fx->particles.size() + 1, 0);
   for (size_t s = 0; s < fx->particles.size(); ++s)
     first[s + 1] = first[s] + fx->particles[s].position_W.size();
   const size_t n_all = first.back();
+  if (n_all == 0) return;
   // per drop: 0 = no streak (radius <= 0; realtime: wholly behind the near plane), 1 = culled,
   // 2 = kept.
   std::vector<uint8_t> state(n_all, 0);
@@ -168,6 +161,8 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   };
   constexpr size_t kDropChunk = 4096;
   const size_t drop_chunks = (n_all + kDropChunk - 1) / kDropChunk;
+  // per chunk: its first non-finite particle (n_all: none).
+  std::vector<size_t> bad(drop_chunks, n_all);
   auto drop_chunk = [&](int64_t c) {
     const size_t g0 = static_cast<size_t>(c) * kDropChunk;
     const size_t g1 = std::min(n_all, g0 + kDropChunk);
@@ -175,10 +170,26 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
         static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g0) - first.begin()) - 1;
     for (size_t g = g0; g < g1; ++g) {
       while (g >= first[s + 1]) ++s;
-      drop(s, g - first[s], g);
+      const ParticleSet& ps = fx->particles[s];
+      const size_t i = g - first[s];
+      if (!ps.position_W[i].allFinite() || !ps.velocity_W[i].allFinite() ||
+          !std::isfinite(ps.radius_m[i])) {
+        bad[c] = g;
+        return;
+      }
+      drop(s, i, g);
     }
   };
   ParallelForOrSerial(pool, static_cast<int64_t>(drop_chunks), drop_chunk);
+  for (size_t g : bad) {
+    if (g == n_all) continue;
+    const size_t s =
+        static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g) - first.begin()) - 1;
+    throw ConfigError("", 0, "effects.particles[" + std::to_string(s) + "]",
+                      "particle " + std::to_string(g - first[s]) + " has a non-finite value");
+  }
+  size_t total = 0;
+  for (uint8_t st : state) total += st == 2 ? 1 : 0;
   alpha_.reserve(total);
   set_.reserve(total);
   ends_.reserve(2 * total);
