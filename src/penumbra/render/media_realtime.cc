@@ -213,10 +213,14 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       // the same values with the lights of a cell adjacent (LightTransmittances).
       vol_.stride = (nl + 3) / 4 * 4;
       vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
-      for (int l = 0; l < nl; ++l)
-        for (int c = 0; c < cells; ++c)
-          vol_.trans_cl[static_cast<size_t>(c) * vol_.stride + l] =
-              vol_.trans[static_cast<size_t>(l) * cells + c];
+      if (vol_.with_visibility) vol_.vis_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+      for (int l = 0; l < nl; ++l) {
+        for (int c = 0; c < cells; ++c) {
+          const size_t at = static_cast<size_t>(c) * vol_.stride + l;
+          vol_.trans_cl[at] = vol_.trans[static_cast<size_t>(l) * cells + c];
+          if (vol_.with_visibility) vol_.vis_cl[at] = vol_.vis[static_cast<size_t>(l) * cells + c];
+        }
+      }
     }
   }
   BuildFroxels(lights, camera, frame_key, pool);
@@ -401,10 +405,14 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
       const float t = lo + jitter * (hi - lo);
       const Eigen::Vector3f x = o + t * d;
       Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
+      // the visibility of every light with a volume in one lookup where x is in the volume.
+      float vis_all[kMaxVolumeLights];
+      const bool located = vol_.with_visibility && CellLightsLookup(vol_.vis_cl.data(), x, vis_all);
       for (int j = 0; j < lights.size(); ++j) {
         LightSample ls;
         if (!lights.Sample(j, x, 0.5f, 0.5f, &ls)) continue;
-        const float vis = FogVisibility(j, x, ls.wi, ls.distance);
+        const float vis =
+            located && j < num_lights_ ? vis_all[j] : FogVisibility(j, x, ls.wi, ls.distance);
         if (!(vis > 0)) continue;
         const float cos_t = wo.dot(ls.wi);
         Eigen::Vector3f ph = Eigen::Vector3f::Zero();
@@ -612,6 +620,10 @@ float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eige
 
 bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) const {
   if (!vol_.active) return false;
+  return CellLightsLookup(vol_.trans_cl.data(), p_W, T);
+}
+
+bool RealtimeMedia::CellLightsLookup(const float* cl, const Eigen::Vector3f& p_W, float* T) const {
   int base[3], step[3];
   float w[3];
   for (int k = 0; k < 3; ++k) {
@@ -629,7 +641,7 @@ bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) co
   // trilinear weights, summed in corner order; lights adjacent per cell.
   const size_t S = static_cast<size_t>(vol_.stride);
   const size_t nx = static_cast<size_t>(vol_.r[0]), nxy = nx * static_cast<size_t>(vol_.r[1]);
-  const float* c0 = vol_.trans_cl.data() + (base[2] * nxy + base[1] * nx + base[0]) * S;
+  const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
   const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
   const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
   const float w0 = ux * uy * uz, w1 = w[0] * uy * uz, w2 = ux * w[1] * uz, w3 = w[0] * w[1] * uz;

@@ -158,6 +158,7 @@ class RealtimeMedia {
     std::vector<float> vis;       // [light][cell] V Th Tgrid
     int stride = 0;               // lights per cell in trans_cl (num lights rounded up to 4)
     std::vector<float> trans_cl;  // [cell][light] copy of trans (LightTransmittances)
+    std::vector<float> vis_cl;    // [cell][light] copy of vis (BuildFogFroxels)
   };
   struct FroxelRecord {
     // in-scatter and transmittance (rgb, 4th lane 0) from the camera to a slice boundary.
@@ -191,6 +192,9 @@ class RealtimeMedia {
   void BuildFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
                     ThreadPool* pool);
 
+  /// trilinear lookup at p_W of every light's value in a [cell][light] array of the world light
+  /// volume (trans_cl or vis_cl) into out[0 .. stride); false outside the volume.
+  bool CellLightsLookup(const float* cl, const Eigen::Vector3f& p_W, float* out) const;
   float GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                    float dist) const;
   float FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
