@@ -116,5 +116,59 @@ TEST(RaySceneTest, AnalyticHitsFollowTheBodyPose) {
   }
 }
 
+TEST(RaySceneTest, FinitePlaneIsTheExactRectangleFromBothSides) {
+  // a finite plane on a tilted, shifted pose: every ray hits it exactly
+  // where the rectangle |x_G| <= 1.5, |y_G| <= 0.75, z_G = 0 is, at the analytic distance, with
+  // the geom-frame point and normal of the analytic plane; seen from below it is a back face.
+  SceneDescription scene = EmptyScene();
+  Pose X_WG = Translation(3, 0.2, -0.1);
+  X_WG.linear() = (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitY()))
+                      .toRotationMatrix();
+  AddGeom(&scene, GeomShape::kPlane, {1.5, 0.75, 0.1}, X_WG);
+  RayScene rs(scene);
+  rs.Update(testing::IdentitySnapshot(scene));
+  const Eigen::Vector3d n_W = X_WG.linear().col(2);
+  int hits = 0, misses = 0;
+  for (const Eigen::Vector3d& o : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(6, -0.5, 0.3)}) {
+    for (int i = -40; i <= 40; ++i)
+      for (int j = -40; j <= 40; ++j) {
+        const Eigen::Vector3d target =
+            X_WG * Eigen::Vector3d(2.0 * i / 40 + 0.0123, 1.0 * j / 40 + 0.0071, 0);
+        Ray ray;
+        ray.o = o.cast<float>();
+        ray.d = (target - o).normalized().cast<float>();
+        const Eigen::Vector3d d = ray.d.cast<double>();
+        // analytic: distance to z_G = 0 along the (float) ray, and the point there.
+        const Eigen::Vector3d o_G = X_WG.inverse() * ray.o.cast<double>();
+        const Eigen::Vector3d d_G = X_WG.linear().transpose() * d;
+        const double t = -o_G.z() / d_G.z();
+        const Eigen::Vector3d p_G = o_G + t * d_G;
+        const bool inside = std::abs(p_G.x()) <= 1.5 && std::abs(p_G.y()) <= 0.75;
+        // rays grazing the rectangle's border may go either way.
+        const bool border =
+            std::abs(std::abs(p_G.x()) - 1.5) < 1e-5 || std::abs(std::abs(p_G.y()) - 0.75) < 1e-5;
+        SurfaceHit hit;
+        const bool got = rs.Intersect(ray, &hit);
+        if (border) continue;
+        ASSERT_EQ(got, inside) << "i " << i << " j " << j << " o " << o.transpose();
+        if (!got) {
+          ++misses;
+          continue;
+        }
+        ++hits;
+        EXPECT_NEAR(hit.t, t, 1e-5 * t);
+        EXPECT_LT((hit.p_G.cast<double>() - p_G).norm(), 1e-5);
+        EXPECT_LT((hit.n_G.cast<double>() - Eigen::Vector3d::UnitZ()).norm(), 1e-6);
+        const bool from_front = d.dot(n_W) < 0;
+        EXPECT_EQ(hit.front_face, from_front);
+        EXPECT_LT((hit.ng_W.cast<double>() - (from_front ? n_W : -n_W)).norm(), 1e-5);
+        EXPECT_LT((hit.ns_W - hit.ng_W).norm(), 1e-6);
+      }
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(misses, 2000);
+}
+
 }  // namespace
 }  // namespace penumbra
