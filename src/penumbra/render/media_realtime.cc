@@ -11,6 +11,24 @@ namespace {
 
 constexpr float kInfF = std::numeric_limits<float>::infinity();
 
+// the four froxel columns around image position (x, y) in pixels (column centres at the centres
+// of blocks of `block` pixels, clamped to the nx x ny columns) and their bilinear weights.
+struct ColumnBilerp {
+  int cols[4];
+  float w[4];
+};
+ColumnBilerp ColumnsAt(float x, float y, int block, int nx, int ny) {
+  const float fx =
+      std::clamp((x - block / 2) / static_cast<float>(block), 0.0f, static_cast<float>(nx - 1));
+  const float fy =
+      std::clamp((y - block / 2) / static_cast<float>(block), 0.0f, static_cast<float>(ny - 1));
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int x1 = std::min(x0 + 1, nx - 1), y1 = std::min(y0 + 1, ny - 1);
+  const float wx = fx - x0, wy = fy - y0;
+  return {{y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1},
+          {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
+}
+
 // trilinear lookup in a cell-centred (r0 x r1 x r2) array at continuous index f (cell centre
 // i at f = i), clamped to the outermost centres.
 template <typename T>
@@ -304,14 +322,9 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
                                    Eigen::Array4f* T) const {
   const Froxels& fr = froxels_;
   constexpr int Z = kFroxelSlices;
-  const float fx = std::clamp((u - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock), 0.0f,
-                              static_cast<float>(fr.nx - 1));
-  const float fy = std::clamp((v - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock), 0.0f,
-                              static_cast<float>(fr.ny - 1));
-  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
-  const float wx = fx - x0, wy = fy - y0;
-  const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+  const ColumnBilerp cb =
+      ColumnsAt(static_cast<float>(u), static_cast<float>(v), kFroxelBlock, fr.nx, fr.ny);
+  const int* cols = cb.cols;
   // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
   float t_enter = kInfF;
   for (int q = 0; q < 4; ++q)
@@ -322,7 +335,7 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
     return t_enter;
   }
   T->setZero();
-  const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+  const float* w = cb.w;
   // columns of weight 0 (pixels on a column's centre row or column) are skipped.
   for (int q = 0; q < 4; ++q) {
     if (!(w[q] > 0)) continue;
@@ -441,15 +454,10 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
 Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const FogFroxels& fr = fog_froxels_;
   constexpr int Z = kFogFroxelSlices;
-  const float fx = std::clamp((u - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
-                              static_cast<float>(fr.nx - 1));
-  const float fy = std::clamp((v - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
-                              static_cast<float>(fr.ny - 1));
-  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
-  const float wx = fx - x0, wy = fy - y0;
-  const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
-  const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+  const ColumnBilerp cb =
+      ColumnsAt(static_cast<float>(u), static_cast<float>(v), kFogFroxelBlock, fr.nx, fr.ny);
+  const int* cols = cb.cols;
+  const float* w = cb.w;
   Eigen::Array4f out = Eigen::Array4f::Zero();
   const float log_t = t > kFogFroxelNear ? std::log(t / kFogFroxelNear) : 0.0f;
   for (int q = 0; q < 4; ++q) {
@@ -476,20 +484,14 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) cons
     constexpr int Z = kFroxelSlices;
     const float t = std::min(t_c, 1e30f);
     q.t_c = t;
-    const float fx = std::clamp((u0 + 0.5f - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock),
-                                0.0f, static_cast<float>(fr.nx - 1));
-    const float fy = std::clamp((v0 + 0.5f - kFroxelBlock / 2) / static_cast<float>(kFroxelBlock),
-                                0.0f, static_cast<float>(fr.ny - 1));
-    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-    const int x1 = std::min(x0 + 1, fr.nx - 1), y1 = std::min(y0 + 1, fr.ny - 1);
-    const float wx = fx - x0, wy = fy - y0;
-    const int cols[4] = {y0 * fr.nx + x0, y0 * fr.nx + x1, y1 * fr.nx + x0, y1 * fr.nx + x1};
+    const ColumnBilerp cb = ColumnsAt(u0 + 0.5f, v0 + 0.5f, kFroxelBlock, fr.nx, fr.ny);
+    const int* cols = cb.cols;
     float t_enter = kInfF;
     for (int k = 0; k < 4; ++k)
       if (fr.t0[cols[k]] < fr.t1[cols[k]]) t_enter = std::min(t_enter, fr.t0[cols[k]]);
     q.g_enter = t_enter;
     if (t > t_enter) {
-      const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+      const float* w = cb.w;
       float lo = t_enter, hi = kInfF;
       for (int k = 0; k < 4; ++k) {
         if (!(w[k] > 0)) continue;
@@ -530,17 +532,9 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) cons
   const FogFroxels& ff = fog_froxels_;
   if (!ff.S.empty() && t_c > kFogFroxelNear) {
     constexpr int Z = kFogFroxelSlices;
-    const float fx =
-        std::clamp((u0 + 0.5f - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
-                   static_cast<float>(ff.nx - 1));
-    const float fy =
-        std::clamp((v0 + 0.5f - kFogFroxelBlock / 2) / static_cast<float>(kFogFroxelBlock), 0.0f,
-                   static_cast<float>(ff.ny - 1));
-    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-    const int x1 = std::min(x0 + 1, ff.nx - 1), y1 = std::min(y0 + 1, ff.ny - 1);
-    const float wx = fx - x0, wy = fy - y0;
-    const int cols[4] = {y0 * ff.nx + x0, y0 * ff.nx + x1, y1 * ff.nx + x0, y1 * ff.nx + x1};
-    const float w[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+    const ColumnBilerp cb = ColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, ff.nx, ff.ny);
+    const int* cols = cb.cols;
+    const float* w = cb.w;
     const float log_t = std::log(t_c / kFogFroxelNear);
     q.log_c = log_t;
     float lo = 0.0f, hi = kInfF;
