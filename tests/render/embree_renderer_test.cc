@@ -45,6 +45,28 @@ TEST(EmbreeRendererTest, DepthOfBoxFaceIsExactZ) {
   }
 }
 
+TEST(EmbreeRendererTest, NearClipHidesOnlyWhatIsNearerThanNearM) {
+  // a wall 6 mm in front of the camera is clipped by the default near_m (1 cm), seen with
+  // near_m = 0 or 5 mm; with it clipped, the wall 2 m behind it shows (z-depth, every pixel).
+  SceneDescription s = WallAt(2.0);
+  AddGeom(&s, GeomShape::kBox, {0.0005, 1, 1}, Translation(0.0065, 0, 0));
+  auto r = MakeEmbreeRenderer(s, TestSettings());
+  CameraView view = MakeView(CameraLookingAlongX(), 32, 24, 70, false, true, false);
+  EXPECT_DOUBLE_EQ(view.near_m, 0.01);
+  for (double near_m : {0.01, 0.005, 0.0}) {
+    view.near_m = near_m;
+    RenderedFrame f;
+    r->Render(IdentitySnapshot(s), view, &f);
+    const double expected = near_m > 0.006 ? 2.0 : 0.006;
+    for (int v = 0; v < 24; ++v)
+      for (int u = 0; u < 32; ++u)
+        ASSERT_NEAR(*f.depth_m.at(u, v), expected, 1e-5) << "near_m " << near_m;
+  }
+  view.near_m = -0.001;
+  RenderedFrame f;
+  EXPECT_THROW(r->Render(IdentitySnapshot(s), view, &f), Error);
+}
+
 TEST(EmbreeRendererTest, DepthOfTiltedCameraIsZNotRange) {
   // camera yawed by 20 degrees towards the wall's normal: the wall plane x = d in the optical
   // frame has z(u, v) varying linearly across the image; check against the analytic value.

@@ -150,7 +150,7 @@ mjcf_cameras:
   rate_hz: 5
   outputs: [rgb, segmentation]
   overrides:
-    rover/head: {width: 320, height: 240, rate_hz: 30, outputs: [rgb, depth], fovy_deg: 70}
+    rover/head: {width: 320, height: 240, rate_hz: 30, outputs: [rgb, depth], fovy_deg: 70, near_m: 0.05}
     room/corner: {intrinsics: {fx: 500, fy: 500}}
 materials:
   room/floor: {base_color: [0.5, 0.4, 0.3], roughness: 0.6, metallic: 0, specular: 0.25, emission: [1, 2, 3]}
@@ -279,6 +279,7 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(mc.overrides[0].height, 240);
   EXPECT_EQ(mc.overrides[0].rate_hz, 30);
   EXPECT_EQ(mc.overrides[0].fovy_deg, 70);
+  EXPECT_EQ(mc.overrides[0].near_m, 0.05);
   EXPECT_TRUE(mc.overrides[0].outputs.rgb && mc.overrides[0].outputs.depth &&
               !mc.overrides[0].outputs.segmentation);
   EXPECT_EQ(mc.overrides[1].name, "room/corner");
@@ -368,6 +369,14 @@ TEST_F(WorldConfigTest, CameraDefaultsToFovy60AndRgb) {
   EXPECT_TRUE(w.cameras[0].outputs.rgb);
   EXPECT_FALSE(w.cameras[0].outputs.depth);
   EXPECT_EQ(w.cameras[0].attach, "world");
+  EXPECT_EQ(w.cameras[0].near_m, 0.01);
+}
+
+TEST_F(WorldConfigTest, CameraNearClip) {
+  const WorldConfig w = ParseWorld("cameras:\n  - {name: c, near_m: 0.2}\n", world_);
+  EXPECT_EQ(w.cameras[0].near_m, 0.2);
+  ExpectError("cameras:\n  - name: c\n    near_m: -0.01\n", 3, "cameras[0].near_m",
+              "got -0.01; expected [0, 10]");
 }
 
 TEST_F(WorldConfigTest, PathsResolveAgainstWorldFolder) {

@@ -28,7 +28,8 @@ Simulation LoadWorld(const WorldConfig& world, std::string* composed_path) {
   compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
   compose_options.timestep_sec = world.timestep_sec;
   const ComposedScene composed = ComposeWorld(world.models, compose_options);
-  const auto dir = std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
+  const auto dir =
+      std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
   std::filesystem::create_directories(dir);
   *composed_path = (dir / "composed.xml").string();
   WriteComposedScene(composed, *composed_path);
@@ -42,13 +43,15 @@ Simulation LoadWorld(const WorldConfig& world, std::string* composed_path) {
 }  // namespace
 
 std::string DefaultWorldPath() {
-  const std::filesystem::path installed = std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "default.yaml";
+  const std::filesystem::path installed =
+      std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "default.yaml";
   if (std::filesystem::exists(installed)) return installed.string();
   return "worlds/default.yaml";
 }
 
 int BenchRender(const RenderBenchOptions& options) {
-  WorldConfig world = LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
+  WorldConfig world =
+      LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
   world.render.seed = world.seed;
   world.render.threads = options.threads;
   world.render.tier = options.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
@@ -56,13 +59,16 @@ int BenchRender(const RenderBenchOptions& options) {
   std::string composed_path;
   Simulation sim = LoadWorld(world, &composed_path);
   const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
-  if (scene.cameras.empty()) throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
+  if (scene.cameras.empty())
+    throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
   const CameraSpec& cam = scene.cameras.front();
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
-  const double fovy_deg = 2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+  const double fovy_deg =
+      2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
 
   // let the robot get going so the frames show a moving world
-  const int steps_per_frame = std::max(1, static_cast<int>(std::lround(1.0 / 30.0 / sim.timestep())));
+  const int steps_per_frame =
+      std::max(1, static_cast<int>(std::lround(1.0 / 30.0 / sim.timestep())));
   while (sim.time() < 1.0) sim.Step();
 
   fmt::print("penumbra bench render: world {}\n", world.file);
@@ -75,6 +81,7 @@ int BenchRender(const RenderBenchOptions& options) {
     view.outputs.depth = true;
     view.outputs.segmentation = false;
     view.camera_index = 0;
+    view.near_m = cam.near_m;
     RenderedFrame frame;
     double seconds = 0;
     int64_t rays = 0;
@@ -104,12 +111,14 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
   std::string model = options.model_file;
   std::string label = model;
   if (model.empty()) {
-    WorldConfig world = LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
+    WorldConfig world =
+        LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
     ComposeOptions compose_options;
     compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
     compose_options.timestep_sec = world.timestep_sec;
     const ComposedScene composed = ComposeWorld(world.models, compose_options);
-    const auto dir = std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
+    const auto dir =
+        std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
     std::filesystem::create_directories(dir);
     model = (dir / "composed.xml").string();
     WriteComposedScene(composed, model);
@@ -124,10 +133,12 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
 
   // controller cost on every bundled world with controllers
   if (options.controllers) {
-    fmt::print("\ncontroller cost: steps/s with the world's controllers vs the same episode\n"
-               "replayed from its recorded ctrl without them (thread CPU time; target >= 0.9)\n");
+    fmt::print(
+        "\ncontroller cost: steps/s with the world's controllers vs the same episode\n"
+        "replayed from its recorded ctrl without them (thread CPU time; target >= 0.9)\n");
     const std::filesystem::path worlds = std::filesystem::path(DefaultWorldPath()).parent_path();
-    for (const char* name : {"default", "rover", "quadruped", "quadruped_arm", "quadrotor", "arm"}) {
+    for (const char* name :
+         {"default", "rover", "quadruped", "quadruped_arm", "quadrotor", "arm"}) {
       const std::filesystem::path file = worlds / (std::string(name) + ".yaml");
       if (!std::filesystem::exists(file)) continue;
       const WorldConfig world = LoadWorldFile(file.string());
@@ -138,7 +149,8 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
         if (probe.num_controllers() == 0) continue;
         timestep = probe.timestep();
       }
-      const int64_t steps = std::max<int64_t>(1, std::llround(options.controller_seconds / timestep));
+      const int64_t steps =
+          std::max<int64_t>(1, std::llround(options.controller_seconds / timestep));
       const ControllerCostResult c = BenchmarkControllerCost(
           composed_path,
           [&](Simulation& sim) {
@@ -149,10 +161,14 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
           steps);
       std::string types;
       for (const ModelConfig& m : world.models)
-        if (m.is_robot && !m.controller.type.empty()) types += (types.empty() ? "" : ", ") + m.controller.type;
-      fmt::print("  {:<14} {:<20} {:>9.0f} vs {:>9.0f} steps/s  ratio {:.3f}{}\n", name, types,
-                 c.controlled_steps_per_sec, c.replay_steps_per_sec, c.ratio,
-                 c.replay_identical ? "" : "  (replay diverges from the controlled run: controller slower than physics rate)");
+        if (m.is_robot && !m.controller.type.empty())
+          types += (types.empty() ? "" : ", ") + m.controller.type;
+      fmt::print(
+          "  {:<14} {:<20} {:>9.0f} vs {:>9.0f} steps/s  ratio {:.3f}{}\n", name, types,
+          c.controlled_steps_per_sec, c.replay_steps_per_sec, c.ratio,
+          c.replay_identical
+              ? ""
+              : "  (replay diverges from the controlled run: controller slower than physics rate)");
     }
   }
   return 0;

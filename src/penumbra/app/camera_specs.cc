@@ -13,6 +13,7 @@ void ApplyCameraConfig(const CameraConfig& c, CameraSpec* cam, const std::string
   cam->intrinsics.p2 = c.p2;
   cam->intrinsics.k3 = c.k3;
   cam->exposure_time_sec = c.sensor.exposure_time_sec;
+  cam->near_m = c.near_m;
   if (auto problem = FindDistortionProblem(cam->intrinsics))
     throw ConfigError(file, 0, key + ".distortion",
                       "camera '" + c.name + "': " + *problem +

@@ -65,6 +65,7 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTimin
   view.outputs.rgb = true;
   view.outputs.depth = true;
   view.exposure_time_sec = cam.exposure_time_sec;
+  view.near_m = cam.near_m;
   view.frame_index = snap.step;
   view.camera_index = camera;
   RenderTiming t;

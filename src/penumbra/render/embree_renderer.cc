@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -51,6 +52,9 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   if (snapshot.X_WB.size() != scene_.bodies.size())
     throw Error("Render: snapshot has " + std::to_string(snapshot.X_WB.size()) +
                 " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
+  if (!(view.near_m >= 0 && std::isfinite(view.near_m)))
+    throw Error("Render: camera near_m " + std::to_string(view.near_m) +
+                " is not a finite distance >= 0");
   ray_scene_->Update(snapshot);
   lights_.Update(snapshot);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
@@ -114,6 +118,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
   const int tiles_x = (W + kTileSize - 1) / kTileSize;
   const int tiles_y = (H + kTileSize - 1) / kTileSize;
   std::atomic<int64_t> secondary_rays{0};
+  const float near = static_cast<float>(view.near_m);
   ImageI32* seg = want.segmentation ? &out->geom_id : nullptr;
   pool_.ParallelFor(static_cast<int64_t>(tiles_x) * tiles_y, [&](int64_t k) {
     // per-thread buffers of one tile, allocated once (no per-tile initialisation).
@@ -128,8 +133,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
     primary.tile.height = std::min(kTileSize, H - primary.tile.y0);
     const PixelTile& t = primary.tile;
     for (int y = 0, i = 0; y < t.height; ++y)
-      for (int x = 0; x < t.width; ++x, ++i)
+      for (int x = 0; x < t.width; ++x, ++i) {
         rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + x), static_cast<float>(t.y0 + y));
+        rays[i].tmin = near;  // t is z-depth (optical-frame d.z = 1)
+      }
     ray_scene_->IntersectGrid(rays.get(), t.width, t.height, hits.get(), did_hit.get());
     for (int y = 0, i = 0; y < t.height; ++y) {
       const int v = t.y0 + y;

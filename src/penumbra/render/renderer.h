@@ -25,20 +25,29 @@ struct CameraView {
   /// optical-frame motion for this render (rolling shutter, motion-blur sub-frames); default
   /// = a camera fixed at X_WO (render/camera.h).
   CameraMotion motion;
+  /// near clipping distance, m, as z-depth along the optical axis: geometry nearer than this
+  /// is not seen (the role of MuJoCo's znear; no lens focuses this close). it also keeps the
+  /// camera's own housing, whose bounding box holds the optical centre, out of every primary
+  /// ray's traversal. >= 0.
+  double near_m = 0.01;
 };
 
 /// images of one frame; the ones not requested are left empty.
 struct RenderedFrame {
-  ImageF radiance;   ///< (H x W x 3) float, linear scene radiance in cd/m^2 per channel, before exposure
-  ImageU8 rgb;       ///< (H x W x 3) uint8 sRGB after exposure and tone mapping
-  ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
-  ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background; never blended
+  ImageF radiance;  ///< (H x W x 3) float, linear scene radiance in cd/m^2 per channel, before
+                    ///< exposure
+  ImageU8 rgb;      ///< (H x W x 3) uint8 sRGB after exposure and tone mapping
+  ImageF depth_m;   ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
+  ImageI32
+      geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background; never blended
   /// the images below come from the same pixel-centre ray as depth_m (never blended).
-  ImageF range_m;    ///< (H x W x 1) float distance optical centre -> hit along the ray, m; 0 = no hit
-  ImageF normal_O;   ///< (H x W x 3) float unit geometric normal facing the camera, optical frame; 0 = no hit
+  ImageF
+      range_m;  ///< (H x W x 1) float distance optical centre -> hit along the ray, m; 0 = no hit
+  ImageF normal_O;  ///< (H x W x 3) float unit geometric normal facing the camera, optical frame; 0
+                    ///< = no hit
   ImageI32 body_id;  ///< (H x W x 1) SceneDescription body index of the hit geom, -1 = background
   ImageI32 semantic_class;  ///< (H x W x 1) Geom::semantic_class of the hit geom, 0 = background
-  double ev100 = 0;  ///< exposure value used for rgb
+  double ev100 = 0;         ///< exposure value used for rgb
   int64_t rays = 0;  ///< rays traced for this frame (primary + shadow + secondary), for benchmarks
 };
 
@@ -49,7 +58,8 @@ class Renderer {
   virtual ~Renderer() = default;
   /// renders `view` of the world posed by `snapshot` into `out`.
   /// @throws Error if the snapshot does not match the scene (body counts differ).
-  virtual void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) = 0;
+  virtual void Render(const WorldSnapshot& snapshot, const CameraView& view,
+                      RenderedFrame* out) = 0;
 };
 
 /// Embree-backed ray tracer over `scene` (copied); see render/embree_renderer.h.
@@ -57,6 +67,7 @@ class Renderer {
 /// Embree's version string, for run manifests.
 std::string EmbreeVersion();
 
-std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene, const RenderSettings& settings);
+std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene,
+                                             const RenderSettings& settings);
 
 }  // namespace penumbra

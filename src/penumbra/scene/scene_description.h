@@ -18,12 +18,21 @@
 namespace penumbra {
 
 /// shape of a geom; sizes follow MuJoCo's geom_size convention (see Geom::size).
-enum class GeomShape { kPlane, kSphere, kCapsule, kEllipsoid, kCylinder, kBox, kMesh, kHeightField };
+enum class GeomShape {
+  kPlane,
+  kSphere,
+  kCapsule,
+  kEllipsoid,
+  kCylinder,
+  kBox,
+  kMesh,
+  kHeightField
+};
 
 /// a rigid body of the compiled model. index 0 is the world body.
 struct Body {
   std::string name;
-  int parent = -1;       ///< parent body index, -1 for the world body
+  int parent = -1;         ///< parent body index, -1 for the world body
   bool is_static = false;  ///< welded to the world (no joints up to the root, not mocap)
 };
 
@@ -41,9 +50,9 @@ struct TriangleMesh {
 /// [0, 1]), and a base box goes down to -size_base.
 struct HeightField {
   std::string name;
-  int rows = 0;                 ///< samples along y
-  int cols = 0;                 ///< samples along x
-  std::vector<float> elevation; ///< (rows x cols) row-major, row 0 at y = -size_y
+  int rows = 0;                  ///< samples along y
+  int cols = 0;                  ///< samples along x
+  std::vector<float> elevation;  ///< (rows x cols) row-major, row 0 at y = -size_y
   double size_x = 1, size_y = 1, size_z = 1, size_base = 0;
 };
 
@@ -71,25 +80,25 @@ struct Material {
   Eigen::Vector3f emission{0, 0, 0};             ///< emitted radiance, cd/m^2 (nits) per channel
   int texture = -1;                              ///< index into SceneDescription::textures, -1 none
   Eigen::Vector2f texrepeat{1, 1};               ///< MJCF texrepeat for 2d mapping
-  bool texuniform = false;                       ///< MJCF texuniform: repeat per metre, not per face
+  bool texuniform = false;  ///< MJCF texuniform: repeat per metre, not per face
 };
 
 /// one piece of geometry attached to a body.
 struct Geom {
-  std::string name;    ///< MJCF name ("" if unnamed)
-  int id = -1;         ///< MuJoCo geom id; segmentation stores id + 1
-  int body = 0;        ///< index into SceneDescription::bodies
+  std::string name;  ///< MJCF name ("" if unnamed)
+  int id = -1;       ///< MuJoCo geom id; segmentation stores id + 1
+  int body = 0;      ///< index into SceneDescription::bodies
   GeomShape shape = GeomShape::kBox;
   /// MuJoCo geom_size: plane (half x, half y, grid spacing; 0 half-size = infinite),
   /// sphere (r), capsule (r, half length), ellipsoid (rx, ry, rz), cylinder (r, half
   /// length), box (half x, half y, half z); unused for mesh and hfield.
   Eigen::Vector3d size{0, 0, 0};
   Pose X_BG = Pose::Identity();  ///< pose of the geom in its body frame
-  int material = -1;             ///< index into SceneDescription::materials (always valid after extraction)
-  int mesh = -1;                 ///< index into meshes for kMesh
-  int hfield = -1;               ///< index into hfields for kHeightField
-  int group = 0;                 ///< MJCF visibility group
-  int semantic_class = 0;        ///< class id for semantic segmentation (0 = unlabelled)
+  int material = -1;  ///< index into SceneDescription::materials (always valid after extraction)
+  int mesh = -1;      ///< index into meshes for kMesh
+  int hfield = -1;    ///< index into hfields for kHeightField
+  int group = 0;      ///< MJCF visibility group
+  int semantic_class = 0;  ///< class id for semantic segmentation (0 = unlabelled)
 };
 
 /// a light source. photometric units: the renderer works in luminance-like units
@@ -98,17 +107,18 @@ struct Light {
   enum class Type { kDirectional, kPoint, kSpot };
   std::string name;
   Type type = Type::kPoint;
-  int body = 0;                         ///< body the light is fixed to (0 = world)
-  int mjcf_light = -1;                  ///< MuJoCo light id if from MJCF (posed by the snapshot), else -1
+  int body = 0;         ///< body the light is fixed to (0 = world)
+  int mjcf_light = -1;  ///< MuJoCo light id if from MJCF (posed by the snapshot), else -1
   Eigen::Vector3d position_B{0, 0, 0};  ///< position in the body frame (point, spot)
-  Eigen::Vector3d direction_B{0, 0, -1};  ///< unit direction light travels, body frame (directional, spot)
-  Eigen::Vector3f color{1, 1, 1};       ///< linear rgb tint, max component 1
+  Eigen::Vector3d direction_B{
+      0, 0, -1};                   ///< unit direction light travels, body frame (directional, spot)
+  Eigen::Vector3f color{1, 1, 1};  ///< linear rgb tint, max component 1
   /// directional: illuminance in lux on a surface facing the light;
   /// point / spot: luminous intensity in candela (on the axis for spot).
   float intensity = 1.0f;
-  float spot_inner_deg = 30.0f;   ///< full intensity inside this half-angle (spot)
-  float spot_outer_deg = 45.0f;   ///< zero intensity outside this half-angle (spot)
-  float radius_m = 0.0f;          ///< emitter radius for soft shadows (point, spot); 0 = hard
+  float spot_inner_deg = 30.0f;     ///< full intensity inside this half-angle (spot)
+  float spot_outer_deg = 45.0f;     ///< zero intensity outside this half-angle (spot)
+  float radius_m = 0.0f;            ///< emitter radius for soft shadows (point, spot); 0 = hard
   float angular_radius_deg = 0.0f;  ///< angular radius of a directional source (sun: 0.2665)
   bool cast_shadow = true;
   bool active = true;
@@ -139,7 +149,8 @@ struct CameraIntrinsics {
   /// normalised coordinates (x, y) = (X/Z, Y/Z): r2 = x^2 + y^2,
   /// x_d = x (1 + k1 r2 + k2 r2^2 + k3 r2^3) + 2 p1 x y + p2 (r2 + 2 x^2),
   /// y_d = y (1 + k1 r2 + k2 r2^2 + k3 r2^3) + p1 (r2 + 2 y^2) + 2 p2 x y, then
-  /// (u, v) = (fx x_d + cx, fy y_d + cy). all 0 = ideal pinhole (render/camera.h traces it exactly).
+  /// (u, v) = (fx x_d + cx, fy y_d + cy). all 0 = ideal pinhole (render/camera.h traces it
+  /// exactly).
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
 
   /// true if any distortion coefficient is non-zero.
@@ -157,19 +168,22 @@ struct CameraOutputs {
   bool range = false;         ///< distance from the optical centre to the hit along the ray, m
   bool normals = false;       ///< unit surface normal (facing the camera) in the optical frame
   bool instance_segmentation = false;  ///< body index + 1 per pixel, 0 = background
-  bool semantic_segmentation = false;  ///< Geom::semantic_class per pixel, 0 = background/unlabelled
+  bool semantic_segmentation =
+      false;  ///< Geom::semantic_class per pixel, 0 = background/unlabelled
 };
 
 /// a camera: rigidly attached to a body, or an MJCF camera posed by the snapshot.
 struct CameraSpec {
   std::string name;
-  int body = 0;             ///< body it is fixed to (0 = world); ignored when mjcf_camera >= 0
-  int mjcf_camera = -1;     ///< MuJoCo camera id (posed by WorldSnapshot::X_W_mjcam), else -1
-  Pose X_BO = Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in the body frame
+  int body = 0;          ///< body it is fixed to (0 = world); ignored when mjcf_camera >= 0
+  int mjcf_camera = -1;  ///< MuJoCo camera id (posed by WorldSnapshot::X_W_mjcam), else -1
+  Pose X_BO =
+      Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in the body frame
   CameraIntrinsics intrinsics;
-  double rate_hz = 10.0;    ///< frames per second of simulated time
+  double rate_hz = 10.0;            ///< frames per second of simulated time
   double exposure_time_sec = 0.01;  ///< shutter open time (motion blur, particle streaks)
   CameraOutputs outputs;
+  double near_m = 0.01;  ///< near clipping distance, z-depth, m (render/renderer.h CameraView)
 };
 
 /// the static part of a scene, shared by every frame.

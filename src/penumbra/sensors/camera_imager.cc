@@ -123,6 +123,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     CameraView view;
     view.X_WO = X_WO_start;
     view.intrinsics = spec_.intrinsics;
+    view.near_m = spec_.near_m;
     view.frame_index = frame_index * n + k;
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;

@@ -35,11 +35,10 @@ class WorldParser {
 
   WorldConfig Parse(const YAML::Node& root) {
     YamlReader r(root, file_, lines_);
-    const std::vector<std::string_view> keys = {"seed",    "duration_sec", "physics",   "render",
-                                                "sky",     "robots",       "models",    "lights",
-                                                "cameras", "mjcf_cameras", "materials", "output",
-                                                "agents",  "adversity", "semantic_classes", "effects",
-                                                "sensors"};
+    const std::vector<std::string_view> keys = {
+        "seed",   "duration_sec", "physics",          "render",       "sky",       "robots",
+        "models", "lights",       "cameras",          "mjcf_cameras", "materials", "output",
+        "agents", "adversity",    "semantic_classes", "effects",      "sensors"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -90,7 +89,8 @@ class WorldParser {
       o.ExpectMap({"dir"});
       if (o.Has("dir")) w.output_dir = o.Child("dir").String();
     }
-    if (r.Has("semantic_classes")) w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
+    if (r.Has("semantic_classes"))
+      w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
     if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
     if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
     if (r.Has("adversity")) {
@@ -289,11 +289,12 @@ class WorldParser {
     }
     if (r.Has("rate_hz")) c->rate_hz = r.Child("rate_hz").Double();
     if (r.Has("outputs")) c->outputs = ReadOutputs(r.Child("outputs"));
+    if (r.Has("near_m")) c->near_m = r.Child("near_m").Double();
   }
 
   static CameraConfig ReadCamera(const YamlReader& r) {
-    std::vector<std::string_view> keys = {"name",     "attach",     "pose",    "width", "height",
-                                          "fovy_deg", "intrinsics", "rate_hz", "outputs"};
+    std::vector<std::string_view> keys = {"name",     "attach",     "pose",    "width",   "height",
+                                          "fovy_deg", "intrinsics", "rate_hz", "outputs", "near_m"};
     keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());
     r.ExpectMap(keys);
     CameraConfig c;
@@ -315,8 +316,8 @@ class WorldParser {
     if (r.Has("outputs")) m->outputs = ReadOutputs(r.Child("outputs"));
     if (!r.Has("overrides")) return;
     for (auto& [name, o] : r.Child("overrides").Entries()) {
-      std::vector<std::string_view> keys = {"width",   "height",   "rate_hz",
-                                            "outputs", "fovy_deg", "intrinsics"};
+      std::vector<std::string_view> keys = {"width",    "height",     "rate_hz", "outputs",
+                                            "fovy_deg", "intrinsics", "near_m"};
       keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());
       o.ExpectMap(keys);
       // unset fields inherit the mjcf_cameras defaults; an unset fovy keeps the MJCF one

@@ -31,15 +31,16 @@ struct PoseConfig {
 /// keeps the rest of the YAML map as text (a YAML/JSON snippet) for the controller
 /// to parse and validate itself at load, so controllers stay pluggable.
 struct ControllerConfig {
-  std::string type;    ///< e.g. "waypoint_follower"; empty = none
+  std::string type;         ///< e.g. "waypoint_follower"; empty = none
   std::string params_yaml;  ///< the controller's mapping, re-emitted as YAML text
-  int line = 0;        ///< line of the controller block in the world file
+  int line = 0;             ///< line of the controller block in the world file
 };
 
 /// one MJCF or URDF file placed in the world under a unique name.
 struct ModelConfig {
-  std::string name;   ///< unique; prefixes every MJCF name of the model as "<name>/"
-  std::string file;   ///< absolute path after loading (relative paths resolve against the world file)
+  std::string name;  ///< unique; prefixes every MJCF name of the model as "<name>/"
+  std::string
+      file;  ///< absolute path after loading (relative paths resolve against the world file)
   PoseConfig pose;
   bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
   ControllerConfig controller;
@@ -53,23 +54,23 @@ struct LightConfig {
   Eigen::Vector3d position{0, 0, 3};       ///< m, in the attach frame (point, spot)
   Eigen::Vector3d direction{0, 0, -1};     ///< direction the light travels (sun, spot)
   Eigen::Vector3f color{1, 1, 1};
-  std::optional<double> illuminance_lux;   ///< sun / directional
-  std::optional<double> intensity_cd;      ///< point / spot
-  std::optional<double> power_w;           ///< point / spot, converted at 683 lm/W: I = 683 P / (4 pi)
+  std::optional<double> illuminance_lux;  ///< sun / directional
+  std::optional<double> intensity_cd;     ///< point / spot
+  std::optional<double> power_w;  ///< point / spot, converted at 683 lm/W: I = 683 P / (4 pi)
   double inner_angle_deg = 30, outer_angle_deg = 45;  ///< spot cone half-angles
-  double radius_m = 0;                     ///< emitter radius (soft shadows)
-  double angular_diameter_deg = 0.53;      ///< sun's apparent diameter (soft shadows)
+  double radius_m = 0;                                ///< emitter radius (soft shadows)
+  double angular_diameter_deg = 0.53;                 ///< sun's apparent diameter (soft shadows)
   bool cast_shadow = true;
 };
 
 /// sky: "uniform" (colour x luminance) or "daylight" (Preetham analytic sky).
 struct SkyConfig {
   Sky::Type type = Sky::Type::kUniform;
-  Eigen::Vector3f color{0.6f, 0.7f, 0.8f};  ///< uniform: linear rgb tint
-  double luminance_cd_m2 = 1000;            ///< uniform: luminance of the sky
-  double turbidity = 3;                     ///< daylight
+  Eigen::Vector3f color{0.6f, 0.7f, 0.8f};             ///< uniform: linear rgb tint
+  double luminance_cd_m2 = 1000;                       ///< uniform: luminance of the sky
+  double turbidity = 3;                                ///< daylight
   double sun_elevation_deg = 45, sun_azimuth_deg = 0;  ///< daylight; azimuth from +x towards +y
-  double zenith_luminance_cd_m2 = 8000;     ///< daylight
+  double zenith_luminance_cd_m2 = 8000;                ///< daylight
 };
 
 /// a world-file camera, or overrides for an MJCF camera of the same name.
@@ -80,10 +81,12 @@ struct CameraConfig {
   /// frame; the optical frame (OpenCV) is derived from it.
   PoseConfig pose;
   int width = 640, height = 480;
-  std::optional<double> fovy_deg;                        ///< default 60 when no intrinsics
-  std::optional<CameraIntrinsics> intrinsics;            ///< fx fy cx cy (px)
+  std::optional<double> fovy_deg;              ///< default 60 when no intrinsics
+  std::optional<CameraIntrinsics> intrinsics;  ///< fx fy cx cy (px)
   double rate_hz = 10;
   CameraOutputs outputs;
+  /// near clipping distance (z-depth, m): nothing nearer is seen; [0, 10]
+  double near_m = 0.01;
   bool is_mjcf_override = false;  ///< true: entry under `mjcf_cameras.overrides`
   /// true: pose chosen at load to frame the whole model (bare-model runs)
   bool auto_frame = false;
@@ -97,8 +100,8 @@ struct CameraConfig {
 /// glob patterns ('*' any run, '?' one character; MJCF names are "<model>/<name>") get class `id`.
 /// the first matching entry in file order wins.
 struct SemanticClassConfig {
-  std::string name;  ///< class name (documentation, label files)
-  int id = 0;        ///< 1..65535 (0 = unlabelled)
+  std::string name;                                   ///< class name (documentation, label files)
+  int id = 0;                                         ///< 1..65535 (0 = unlabelled)
   std::vector<std::string> bodies, geoms, materials;  ///< glob patterns
 };
 
@@ -123,7 +126,7 @@ struct MaterialOverride {
 
 /// a whole world file.
 struct WorldConfig {
-  std::string file;             ///< path of the world file ("" for a bare model)
+  std::string file;  ///< path of the world file ("" for a bare model)
   uint64_t seed = 0;
   double duration_sec = 10;
   std::optional<double> timestep_sec;  ///< overrides the MJCF <option timestep>

@@ -43,6 +43,7 @@ struct Range {
 const Range kUnit = Range::Closed(0, 1);
 const Range kImageSize = Range::Closed(1, 16384);
 const Range kRate = Range::OpenClosed(0, 10000);
+const Range kNearClip = Range::Closed(0, 10);
 const Range kFovy = Range::Open(0, 179);
 
 bool EndsWithNoCase(const std::string& s, const std::string& suffix) {
@@ -289,6 +290,7 @@ class Validator {
       }
     }
     Check(path + ".rate_hz", c.rate_hz, kRate);
+    Check(path + ".near_m", c.near_m, kNearClip);
     CheckOutputs(path + ".outputs", c.outputs);
   }
 
