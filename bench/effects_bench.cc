@@ -1,4 +1,5 @@
-// cost of the effects stage (EffectsEngine::Evaluate, one core): rain at the default box
+// cost of the effects stage (EffectsEngine::Evaluate; noise smoke voxels and particle placement run
+// on its own pool of all cores, the fluids serially): rain at the default box
 // (200000 drops after the max_particles cap, 5 mm/h), noise smoke on a 4 x 4 x 2 m region at
 // noise_resolution 48, and one second of sim time (30 steps) of the plume and fire fluids at
 // resolution 48 and 32. counters: particles per frame; fluid steps per second of CPU time.
