@@ -33,8 +33,9 @@ TEST(BundledWorlds, EveryWorldLoadsBindsItsEffectsAndSteps) {
     const WorldConfig world = LoadWorldFile(file);
     if (file.find("/effects/") != std::string::npos) ++effect_worlds;
     PresetScene p = LoadPresetScene(world, "");
-    if (file.find("/effects/") != std::string::npos)
+    if (file.find("/effects/") != std::string::npos) {
       EXPECT_GT(p.effects->effects().size() + p.effects->agents().size(), 0u);
+    }
     for (int i = 0; i < 20; ++i) p.sim->Step();
     const WorldSnapshot snap = p.sim->Snapshot();
     const auto frame = p.effects->Evaluate(snap, Eigen::Vector3d(0, 0, 1));

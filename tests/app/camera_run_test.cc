@@ -115,8 +115,11 @@ TEST_F(CameraRunTest, WritesEveryCameraOutputDeterministically) {
   for (int c : classes) EXPECT_TRUE(c == 0 || c == 2 || c == 9) << c;
   // instance ids are body index + 1: the ball's pixels carry the same instance id
   const PngImage inst = ReadPng((out / "rig/left/instance_segmentation/000000.png").string());
-  for (size_t i = 0; i < sem.samples.size(); ++i)
-    if (sem.samples[i] == 2) EXPECT_GE(inst.samples[i], 2);
+  for (size_t i = 0; i < sem.samples.size(); ++i) {
+    if (sem.samples[i] == 2) {
+      EXPECT_GE(inst.samples[i], 2);
+    }
+  }
   // frames.csv: mid-exposure time (sub-frame 1 of 3 at T / 2 = 0.01 s)
   const std::string csv = ReadAll(out / "rig/left/frames.csv");
   const size_t row = csv.find("\n0,");

@@ -247,7 +247,9 @@ void ExpectSameModel(const mjModel* comp, const std::string& prefix, const mjMod
     EXPECT_EQ(comp->sensor_type[cs], alone->sensor_type[s]);
     const mjtObj t = static_cast<mjtObj>(alone->sensor_objtype[s]);
     const std::string obj = Name(alone, t, alone->sensor_objid[s]);
-    if (!obj.empty()) EXPECT_EQ(Name(comp, t, comp->sensor_objid[cs]), prefix + obj);
+    if (!obj.empty()) {
+      EXPECT_EQ(Name(comp, t, comp->sensor_objid[cs]), prefix + obj);
+    }
   }
   // cameras keep their field of view (always degrees in MJCF)
   for (int c = 0; c < alone->ncam; ++c) {

@@ -20,7 +20,7 @@ TEST(Fbm3SamplerTest, EqualsFbm3BitForBit) {
           ++checked;
         }
     // back to an earlier cell, then a far jump.
-    for (const Eigen::Vector3d q :
+    for (const Eigen::Vector3d& q :
          {Eigen::Vector3d(-3.0, -0.6, 2.0), Eigen::Vector3d(1e3, -2e3, 7.5)})
       EXPECT_EQ(sampler(q), Fbm3(1234, q, octaves));
     EXPECT_EQ(checked, 5 * 7 * 23);

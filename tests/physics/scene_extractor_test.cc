@@ -136,8 +136,8 @@ TEST_F(SceneExtractorTest, MeshAndHeightField) {
   // MuJoCo re-centres the mesh; X_BG puts the vertices back where the MJCF placed them
   std::vector<Eigen::Vector3d> placed;
   for (const auto& v : mesh.vertices) placed.push_back(rock.X_BG * v.cast<double>());
-  for (const Eigen::Vector3d want : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
-                                     Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
+  for (const Eigen::Vector3d& want : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
+                                      Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
     double best = 1e9;
     for (const auto& p : placed) best = std::min(best, (p - want).norm());
     EXPECT_LT(best, 1e-5) << want.transpose();

@@ -174,8 +174,8 @@ TEST(EmbreeRendererTest, MovingABodyMovesItsPixelsWithoutRebuild) {
   const CameraIntrinsics& k = view.intrinsics;
   WorldSnapshot snap = IdentitySnapshot(s);
   RenderedFrame f;
-  for (const Eigen::Vector3d p : {Eigen::Vector3d(3, 0, -0.05), Eigen::Vector3d(3, 0.5, 0.25),
-                                  Eigen::Vector3d(2, -0.4, -0.3)}) {
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(3, 0, -0.05), Eigen::Vector3d(3, 0.5, 0.25),
+                                   Eigen::Vector3d(2, -0.4, -0.3)}) {
     const int64_t commits = r.ray_scene().num_top_level_commits();
     snap.X_WB[body] = Translation(p.x(), p.y(), p.z());
     r.Render(snap, view, &f);

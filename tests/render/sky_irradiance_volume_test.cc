@@ -158,7 +158,7 @@ TEST(SkyIrradianceVolumeTest, OpenSceneMatchesTheSkyAboveTheFloor) {
     EXPECT_GE(vol.spacing(), SkyIrradianceVolume::kMinSpacingM - 1e-6);
     RayScene rays(s);
     rays.Update(IdentitySnapshot(s));
-    for (const Eigen::Vector3f p :
+    for (const Eigen::Vector3f& p :
          {Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(0.37f, -0.81f, 0),
           Eigen::Vector3f(1.1f, 0.4f, 0.6f), Eigen::Vector3f(-0.6f, 0.9f, 1.3f)}) {
       const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();

@@ -104,8 +104,9 @@ TEST(CameraConfigReaderTest, BadValuesNameCameraAndKey) {
     EXPECT_GT(e.line(), 1) << c.yaml;
     EXPECT_EQ(e.key(), c.key) << c.yaml << e.what();
     const std::string what = e.what();
-    if (std::string(c.key).find("k4") == std::string::npos)
+    if (std::string(c.key).find("k4") == std::string::npos) {
       EXPECT_NE(what.find("camera 'cam'"), std::string::npos) << what;
+    }
   }
 }
 
