@@ -40,9 +40,28 @@ struct Scratch {
   std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
   std::vector<LightSampleLanes> samples;  // per light
   std::vector<Vec3Lanes> contrib;         // per light: unshadowed f cos E
+  std::vector<Eigen::Vector3f> wo;        // per tile pixel: unit direction towards the camera
   std::vector<Eigen::Vector3f> n_s;       // per tile pixel: usable shading normal
   std::vector<Eigen::Vector3f> sky_E;     // per tile pixel: sky irradiance on n_s
 };
+
+// walks the tile by 2x2 pixel quads, row-major: shared(q) is offered every quad that lies fully
+// inside the tile (q = its 4 pixel indices, row-major) and returns whether it handled the quad;
+// single(i) is called for every pixel of the other quads, and of quads shared() declined.
+template <typename SharedFn, typename SingleFn>
+void ForEachQuad(const PixelTile& tile, SharedFn&& shared, SingleFn&& single) {
+  for (int y = 0; y < tile.height; y += 2) {
+    for (int x = 0; x < tile.width; x += 2) {
+      const int i00 = y * tile.width + x;
+      const int q[4] = {i00, i00 + 1, i00 + tile.width, i00 + tile.width + 1};
+      if (x + 1 < tile.width && y + 1 < tile.height && shared(x, y, q)) continue;
+      for (int c = 0; c < 4; ++c) {
+        const int dx = c & 1, dy = c >> 1;
+        if (x + dx < tile.width && y + dy < tile.height) single(q[c]);
+      }
+    }
+  }
+}
 
 // the sky irradiance on the shading normal of every hit pixel of the tile (the ambient term),
 // and that normal. with a sky volume (occluded sky light), a 2x2 quad of pixels that all see
@@ -55,12 +74,14 @@ struct Scratch {
 void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scratch* scratch) {
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
+  scratch->wo.resize(n);
   scratch->n_s.resize(n);
   scratch->sky_E.resize(n);
   for (int i = 0; i < n; ++i) {
     if (!primary.did_hit[i]) continue;
     const SurfaceHit& h = primary.hits[i];
-    scratch->n_s[i] = UsableShadingNormal(h.ns_W, h.ng_W, -primary.rays[i].d.normalized());
+    scratch->wo[i] = -primary.rays[i].d.normalized();
+    scratch->n_s[i] = UsableShadingNormal(h.ns_W, h.ng_W, scratch->wo[i]);
   }
   const SkyIrradianceVolume* volume = ctx.sky_volume;
   if (volume == nullptr) {
@@ -70,41 +91,32 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
   }
   const float max_extent = 0.25f * volume->spacing();
   constexpr float kPlaneTolM = 1e-3f;
-  for (int y = 0; y < tile.height; y += 2) {
-    for (int x = 0; x < tile.width; x += 2) {
-      const int i00 = y * tile.width + x;
-      const bool full = x + 1 < tile.width && y + 1 < tile.height;
-      const int quad[4] = {i00, i00 + 1, i00 + tile.width, i00 + tile.width + 1};
-      bool shared = full;
-      for (int c = 0; c < 4 && shared; ++c) {
-        const int i = quad[c];
-        shared = primary.did_hit[i] && primary.hits[i].geom == primary.hits[i00].geom &&
-                 scratch->n_s[i] == scratch->n_s[i00];
-      }
-      if (shared) {
-        const Eigen::Vector3f& n0 = scratch->n_s[i00];
-        const Eigen::Vector3f& p0 = primary.hits[i00].p_W;
-        Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-        for (int c = 0; c < 4 && shared; ++c) {
-          const Eigen::Vector3f dp = primary.hits[quad[c]].p_W - p0;
-          shared = std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent;
-          mean += 0.25f * primary.hits[quad[c]].p_W;
-        }
-        if (shared) {
-          const Eigen::Vector3f E = volume->Irradiance(mean, n0, *ctx.sky);
-          for (int c = 0; c < 4; ++c) scratch->sky_E[quad[c]] = E;
-          continue;
-        }
-      }
-      for (int c = 0; c < 4; ++c) {
-        const int dx = c & 1, dy = c >> 1;
-        if (x + dx >= tile.width || y + dy >= tile.height) continue;
-        const int i = quad[c];
-        if (primary.did_hit[i])
-          scratch->sky_E[i] = volume->Irradiance(primary.hits[i].p_W, scratch->n_s[i], *ctx.sky);
-      }
+  auto shared = [&](int, int, const int* quad) {
+    const int i00 = quad[0];
+    for (int c = 0; c < 4; ++c) {
+      const int i = quad[c];
+      if (!(primary.did_hit[i] && primary.hits[i].geom == primary.hits[i00].geom &&
+            scratch->n_s[i] == scratch->n_s[i00]))
+        return false;
     }
-  }
+    const Eigen::Vector3f& n0 = scratch->n_s[i00];
+    const Eigen::Vector3f& p0 = primary.hits[i00].p_W;
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector3f dp = primary.hits[quad[c]].p_W - p0;
+      if (!(std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent))
+        return false;
+      mean += 0.25f * primary.hits[quad[c]].p_W;
+    }
+    const Eigen::Vector3f E = volume->Irradiance(mean, n0, *ctx.sky);
+    for (int c = 0; c < 4; ++c) scratch->sky_E[quad[c]] = E;
+    return true;
+  };
+  auto single = [&](int i) {
+    if (primary.did_hit[i])
+      scratch->sky_E[i] = volume->Irradiance(primary.hits[i].p_W, scratch->n_s[i], *ctx.sky);
+  };
+  ForEachQuad(primary.tile, shared, single);
 }
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
@@ -157,31 +169,23 @@ void ApplyTileViewEffects(const FrameContext& ctx, const PrimaryHits& primary,
                          Eigen::Vector3f(Lp[0], Lp[1], Lp[2]), quad);
     Lp[0] = Lf.x(), Lp[1] = Lf.y(), Lp[2] = Lf.z();
   };
-  for (int y = 0; y < tile.height; y += 2) {
-    for (int x = 0; x < tile.width; x += 2) {
-      const int i00 = y * tile.width + x;
-      const int quad[4] = {i00, i00 + 1, i00 + tile.width, i00 + tile.width + 1};
-      bool shared = rm != nullptr && x + 1 < tile.width && y + 1 < tile.height;
-      for (int c = 1; c < 4 && shared; ++c)
-        shared = primary.did_hit[quad[c]] == primary.did_hit[i00];
-      if (shared) {
-        float t_c = std::numeric_limits<float>::infinity();
-        if (primary.did_hit[i00]) {
-          t_c = 0;
-          for (int c = 0; c < 4; ++c)
-            t_c += 0.25f * primary.hits[quad[c]].t * primary.rays[quad[c]].d.norm();
-        }
-        MediaQuad q;
-        rm->PrepareQuad(tile.x0 + x, tile.y0 + y, t_c, &q);
-        for (int c = 0; c < 4; ++c) apply(quad[c], &q);
-        continue;
-      }
-      for (int c = 0; c < 4; ++c) {
-        const int dx = c & 1, dy = c >> 1;
-        if (x + dx < tile.width && y + dy < tile.height) apply(quad[c], nullptr);
-      }
+  auto shared = [&](int x, int y, const int* quad) {
+    if (rm == nullptr) return false;
+    const int i00 = quad[0];
+    for (int c = 1; c < 4; ++c)
+      if (primary.did_hit[quad[c]] != primary.did_hit[i00]) return false;
+    float t_c = std::numeric_limits<float>::infinity();
+    if (primary.did_hit[i00]) {
+      t_c = 0;
+      for (int c = 0; c < 4; ++c)
+        t_c += 0.25f * primary.hits[quad[c]].t * primary.rays[quad[c]].d.norm();
     }
-  }
+    MediaQuad q;
+    rm->PrepareQuad(tile.x0 + x, tile.y0 + y, t_c, &q);
+    for (int c = 0; c < 4; ++c) apply(quad[c], &q);
+    return true;
+  };
+  ForEachQuad(tile, shared, [&](int i) { apply(i, nullptr); });
 }
 
 }  // namespace
@@ -240,7 +244,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const SurfaceHit& h = primary.hits[i];
       SurfaceMaterial mat = ctx.materials->Evaluate(h);
       if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
-      const Eigen::Vector3f wo = -primary.rays[i].d.normalized();
+      const Eigen::Vector3f& wo = scratch.wo[i];
       const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);
       pbr.Set(k, mat.pbr);
