@@ -1,7 +1,9 @@
 #include "penumbra/render/sky_irradiance_volume.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
@@ -10,16 +12,18 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/render/ray_scene.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace penumbra {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kNumSh = 9;  // real SH up to l = 2
 constexpr int kShFloats = kNumSh * 3;
-// a probe's irradiance SH padded to 28 floats (7 SSE packets; 112 bytes keep every probe's
-// coefficients 16-byte aligned in the vector).
+// a probe's irradiance SH padded to 28 floats (7 4-lane packets).
 constexpr int kShStride = 28;
-using ShArray = Eigen::Array<float, kShStride, 1>;
 
 // real spherical harmonics y_lm of a unit vector, l <= 2, in the order (0,0), (1,-1), (1,0),
 // (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) (Ramamoorthi and Hanrahan 2001, eq. 3).
@@ -141,6 +145,71 @@ const ProbeDirections& Directions() {
   return dirs;
 }
 
+// 4-lane math for the lookup's 8 corners (two halves), with GCC/Clang vector extensions: SSE2
+// registers in the portable build, VEX-encoded ones in the native build. every operation is
+// the IEEE one of the scalar code (no approximations), lane by lane.
+typedef float F4 __attribute__((vector_size(16)));
+typedef int32_t I4 __attribute__((vector_size(16)));
+
+inline F4 Splat4(float a) { return F4{a, a, a, a}; }
+inline F4 Load4(const float* p) {
+  F4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline I4 Load4(const int32_t* p) {
+  I4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void Store4(float* p, F4 v) { std::memcpy(p, &v, sizeof v); }
+inline void Store4(int32_t* p, I4 v) { std::memcpy(p, &v, sizeof v); }
+// bit k set where lane k of the comparison result m is true.
+inline unsigned MoveMask4(I4 m) {
+#if defined(__SSE2__)
+  return static_cast<unsigned>(_mm_movemask_ps(reinterpret_cast<__m128>(m)));
+#else
+  return (m[0] & 1u) | (m[1] & 2u) | (m[2] & 4u) | (m[3] & 8u);
+#endif
+}
+inline F4 Sqrt4(F4 a) {
+#if defined(__SSE2__)
+  return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+#else
+  return F4{std::sqrt(a[0]), std::sqrt(a[1]), std::sqrt(a[2]), std::sqrt(a[3])};
+#endif
+}
+inline I4 Bits4(F4 a) { return reinterpret_cast<I4>(a); }
+inline F4 Float4(I4 a) { return reinterpret_cast<F4>(a); }
+// m ? a : b per lane (m all-ones or all-zeros, from a comparison).
+inline F4 Select4(I4 m, F4 a, F4 b) { return Float4((Bits4(a) & m) | (Bits4(b) & ~m)); }
+inline F4 Abs4(F4 a) { return Float4(Bits4(a) & 0x7fffffff); }
+// std::copysign(mag, sgn) per lane.
+inline F4 CopySign4(F4 mag, F4 sgn) {
+  return Float4((Bits4(mag) & 0x7fffffff) | (Bits4(sgn) & static_cast<int32_t>(0x80000000u)));
+}
+// a < b ? a : b and a > b ? a : b per lane (MINPS / MAXPS: b where either is NaN).
+inline F4 Min4(F4 a, F4 b) {
+#if defined(__SSE2__)
+  return reinterpret_cast<F4>(_mm_min_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+#else
+  return Select4(a < b, a, b);
+#endif
+}
+inline F4 Max4(F4 a, F4 b) {
+#if defined(__SSE2__)
+  return reinterpret_cast<F4>(_mm_max_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+#else
+  return Select4(a > b, a, b);
+#endif
+}
+// std::clamp(static_cast<int>(t), 0, kOctSide - 1) per lane (clamping first in float gives the
+// same integers; NaN lanes give 0).
+inline I4 TexelIndex4(F4 t) {
+  constexpr float kMax = SkyIrradianceVolume::kOctSide - 1;
+  return __builtin_convertvector(Min4(Max4(t, Splat4(0.0f)), Splat4(kMax)), I4);
+}
+
 // octahedral texel of a non-zero direction (SkyIrradianceVolume::TexelOf), inlined into lookups.
 inline int OctTexel(const Eigen::Vector3f& w) {
   constexpr int kOctSide = SkyIrradianceVolume::kOctSide;
@@ -188,6 +257,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   depth_.clear();
   depth_q_.clear();
   sh_.clear();
+  cell_pos_.clear();
 
   // the static geoms and the bounds of the finite ones, world frame.
   SceneDescription statics = scene;
@@ -340,6 +410,19 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   depth_scale_ = far / 255.0f;
   depth_.clear();
   depth_.shrink_to_fit();
+
+  // the lookup's per-cell corner positions (see cell_pos_), NaN for invalid probes.
+  cell_pos_.assign(static_cast<size_t>(num) * 24, std::numeric_limits<float>::quiet_NaN());
+  for (int p = 0; p < num; ++p) {
+    const int i = p % n[0], j = (p / n[0]) % n[1], k = p / (n[0] * n[1]);
+    if (i + 1 >= n[0] || j + 1 >= n[1] || k + 1 >= n[2]) continue;
+    float* cell = &cell_pos_[static_cast<size_t>(p) * 24];
+    for (int c = 0; c < 8; ++c) {
+      const int idx = p + (c & 1) + n[0] * (((c >> 1) & 1) + n[1] * (c >> 2));
+      if (!valid_[idx]) continue;
+      for (int a = 0; a < 3; ++a) cell[8 * a + c] = position_[idx][a];
+    }
+  }
 }
 
 void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
@@ -445,50 +528,95 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const int j0 = std::min(static_cast<int>(g.y()), ny - 2);
   const int k0 = std::min(static_cast<int>(g.z()), nz - 2);
   const float fx = g.x() - i0, fy = g.y() - j0, fz = g.z() - k0;
-  float y[kNumSh];
-  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  const float bias = kNormalBias * spacing_;
   const float tol = kVisibilityTolerance * spacing_;
   const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
-  // the weighted sum of the probes' irradiance SH, evaluated once at the end.
-  ShArray acc = ShArray::Zero();
-  float wsum = 0;
-  int in_front[8], num_in_front = 0;
-  for (int c = 0; c < 8; ++c) {
-    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
-    const int idx = base + dx + nx * (dy + ny * dz);
-    if (!valid_[idx]) continue;
-    // from q to the (possibly relocated) probe.
-    const Eigen::Vector3f d = position_[idx] - q;
-    // probes behind the surface's tangent plane at p never light it.
-    const float d_n = d.dot(n_W);
-    if (d_n + kNormalBias * spacing_ <= 0) continue;
-    in_front[num_in_front++] = idx;
-    const float r = d.norm();
-    float w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
-    if (r > 1e-6f) {
-      const float back = 0.5f * (1.0f + d_n / r);
-      // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
-      // ramps down to 0 over tol beyond that.
-      const float depth =
-          depth_scale_ * depth_q_[static_cast<size_t>(idx) * kNumTexels + OctTexel(-d)];
-      w *= back * back * std::clamp((depth + tol - r) * inv_tol, 0.0f, 1.0f);
-    }
-    if (!(w > 0)) continue;
-    acc +=
-        w * Eigen::Map<const ShArray, Eigen::Aligned16>(&sh_[static_cast<size_t>(idx) * kShStride]);
+  // probe index of corner c = dx + 2 dy + 4 dz: base + corner[c].
+  const I4 corner_lo = {0, 1, nx, nx + 1};
+  alignas(16) int32_t corner[8];
+  Store4(corner, corner_lo);
+  Store4(corner + 4, corner_lo + nx * ny);
 
-    wsum += w;
+  // the 8 corners as two 4-lane halves (dz = 0, 1), every lane computing every branch; the
+  // same operations in the same order as the one-probe-at-a-time form in the file comment,
+  // so the result is bit for bit that of evaluating the corners one by one.
+  const float* cell = &cell_pos_[static_cast<size_t>(base) * 24];
+  const F4 qx = Splat4(q.x()), qy = Splat4(q.y()), qz = Splat4(q.z());
+  const F4 wx_tri = {1 - fx, fx, 1 - fx, fx}, wy_tri = {1 - fy, 1 - fy, fy, fy};
+  const F4 wxy_tri = wx_tri * wy_tri;
+  alignas(16) float w[8];
+  alignas(16) int32_t texel[8];
+  F4 r[2], d_n_r[2], tri[2];
+  unsigned front = 0;
+  for (int h = 0; h < 2; ++h) {
+    const F4 dx = Load4(cell + 4 * h) - qx, dy = Load4(cell + 8 + 4 * h) - qy,
+             dz = Load4(cell + 16 + 4 * h) - qz;
+    // probes behind the surface's tangent plane at p never light it (invalid probes sit at
+    // NaN, which fails the test too).
+    const F4 d_n = dx * n_W.x() + (dy * n_W.y() + dz * n_W.z());
+    front |= MoveMask4(d_n + bias > 0.0f) << (4 * h);
+    r[h] = Sqrt4(dx * dx + (dy * dy + dz * dz));
+    d_n_r[h] = d_n / r[h];
+    tri[h] = wxy_tri * (h ? fz : 1 - fz);
+    // the octahedral texel of -d (OctTexel without branches; NaN lanes land in texel 0).
+    const F4 ux = -dx, uy = -dy, uz = -dz;
+    const F4 inv_l1 = 1.0f / (Abs4(ux) + Abs4(uy) + Abs4(uz));
+    F4 u = ux * inv_l1, v = uy * inv_l1;
+    const I4 lower = uz < 0.0f;
+    const F4 u_fold = CopySign4(1.0f - Abs4(v), ux), v_fold = CopySign4(1.0f - Abs4(u), uy);
+    u = Select4(lower, u_fold, u);
+    v = Select4(lower, v_fold, v);
+    const I4 ix = TexelIndex4((u + 1.0f) * (0.5f * kOctSide));
+    const I4 iy = TexelIndex4((v + 1.0f) * (0.5f * kOctSide));
+    // offset of the texel in depth_q_ from the cell's first probe.
+    Store4(texel + 4 * h, (ix + kOctSide * iy) + kNumTexels * Load4(corner + 4 * h));
   }
+  if (front == 0) return Eigen::Vector3f::Zero();
+  // the depth of each probe's ray towards q.
+  const uint8_t* dq = &depth_q_[static_cast<size_t>(base) * kNumTexels];
+  alignas(16) int32_t depth_q[8];
+  for (int c = 0; c < 8; ++c) depth_q[c] = dq[texel[c]];
+  unsigned active = 0;
+  for (int h = 0; h < 2; ++h) {
+    // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
+    // ramps down to 0 over tol beyond that. r <= 1e-6: q on the probe, trilinear weight only.
+    const F4 back = 0.5f * (1.0f + d_n_r[h]);
+    const F4 depth = depth_scale_ * __builtin_convertvector(Load4(depth_q + 4 * h), F4);
+    // std::clamp(x, 0, 1) = Min4(1, Max4(0, x)), lane by lane (x for x = -0 or NaN too).
+    const F4 vis = Min4(Splat4(1.0f), Max4(Splat4(0.0f), ((depth + tol) - r[h]) * inv_tol));
+    const F4 wh = Select4(r[h] > 1e-6f, tri[h] * (back * back * vis), tri[h]);
+    Store4(w + 4 * h, wh);
+    active |= MoveMask4(wh > 0.0f) << (4 * h);
+  }
+  active &= front;
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
-  if (wsum > 0) {
-    for (int k = 0; k < kNumSh; ++k)
-      e += (y[k] / wsum) * Eigen::Vector3f(acc[3 * k], acc[3 * k + 1], acc[3 * k + 2]);
+  float y[kNumSh];
+  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  if (active != 0) {
+    // the weighted sum of the probes' irradiance SH, evaluated once at the end.
+    F4 acc[kShStride / 4];
+    for (int i = 0; i < kShStride / 4; ++i) acc[i] = Splat4(0.0f);
+    float wsum = 0;
+    const float* sh_base = &sh_[static_cast<size_t>(base) * kShStride];
+    for (unsigned bits = active; bits != 0; bits &= bits - 1) {
+      const int c = std::countr_zero(bits);
+      const float* sh = sh_base + corner[c] * kShStride;
+      const F4 wc = Splat4(w[c]);
+      for (int i = 0; i < kShStride / 4; ++i) acc[i] += wc * Load4(sh + 4 * i);
+      wsum += w[c];
+    }
+    alignas(16) float a[kShStride + 4];
+    for (int i = 0; i < kShStride / 4; ++i) Store4(a + 4 * i, acc[i]);
+    F4 sum = Splat4(0.0f);
+    for (int k = 0; k < kNumSh; ++k) sum += (y[k] / wsum) * Load4(a + 3 * k);
+    e = {sum[0], sum[1], sum[2]};
   } else {
-    // no probe sees q: the darkest valid probe in front of the surface (0 if none).
+    // no probe sees q: the darkest valid probe in front of the surface.
     float dark_lum = std::numeric_limits<float>::infinity();
-    for (int j = 0; j < num_in_front; ++j) {
-      const Eigen::Vector3f ej = ProbeIrradiance(in_front[j], n_W);
+    for (unsigned bits = front; bits != 0; bits &= bits - 1) {
+      const int c = std::countr_zero(bits);
+      const Eigen::Vector3f ej = ProbeIrradiance(base + corner[c], n_W);
       const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
       if (lum < dark_lum) dark_lum = lum, e = ej;
     }

@@ -148,7 +148,12 @@ class SkyIrradianceVolume {
   std::vector<uint8_t> depth_q_;           // per probe and texel, depth / depth_scale_
   float depth_scale_ = 0;                  // m per depth_q_ step
   std::vector<float> sh_;                  // per probe: 9 (l, m) x 3 channels, irradiance
-  std::vector<Pose> built_static_poses_;   // X_WB of the last Build (static bodies only)
+  // per cell (indexed by its corner probe (i, j, k) of lowest index, for i < nx - 1, j < ny - 1,
+  // k < nz - 1; the rest unused): x, y, z of its 8 corner probes (corner c = dx + 2 dy + 4 dz
+  // at (i + dx, j + dy, k + dz)) as 3 rows of 8 floats, NaN where the probe is invalid, so
+  // that Irradiance loads them as SIMD lanes.
+  std::vector<float> cell_pos_;
+  std::vector<Pose> built_static_poses_;  // X_WB of the last Build (static bodies only)
   bool built_ = false;
   const SkyModel* lit_sky_ = nullptr;
 };
