@@ -22,8 +22,13 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kNumSh = 9;  // real SH up to l = 2
 constexpr int kShFloats = kNumSh * 3;
-// a probe's irradiance SH padded to 28 floats (7 4-lane packets).
+// a probe's irradiance SH padded to 28 floats (7 4-lane packets): coefficient k (RGB) at floats
+// 3 kShSlot[k] .. 3 kShSlot[k] + 2. the order puts together the coefficients that do not
+// vanish for an axis-aligned normal (the basis at +-x is non-zero for k = 0, 3, 6, 8 only, at
+// +-z for 0, 2, 6, at +-y for 0, 1, 6, 8), so that a lookup on an axis-aligned face (most of
+// them indoors) accumulates 3 to 5 packets instead of 7.
 constexpr int kShStride = 28;
+constexpr int kShSlot[9] = {2, 5, 4, 0, 6, 7, 3, 8, 1};  // storage order 3 8 0 6 2 1 4 5 7
 
 // real spherical harmonics y_lm of a unit vector, l <= 2, in the order (0,0), (1,-1), (1,0),
 // (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) (Ramamoorthi and Hanrahan 2001, eq. 3).
@@ -208,6 +213,36 @@ inline F4 Max4(F4 a, F4 b) {
 inline I4 TexelIndex4(F4 t) {
   constexpr float kMax = SkyIrradianceVolume::kOctSide - 1;
   return __builtin_convertvector(Min4(Max4(t, Splat4(0.0f)), Splat4(kMax)), I4);
+}
+
+// the lookup's weighted mean of the probes' irradiance SH at the basis values y, for the
+// active corners (bits of `active`, in increasing order, weight w[c], probe base + corner[c])
+// and, of the 7 packets of a probe's SH, only packets kLo .. kHi - 1, which must hold every
+// coefficient k with y[k] != 0; kK... are those k in increasing order. the terms with y[k] = 0
+// that this leaves out would add an exact 0 to each channel, so the sum is bit for bit the
+// full one.
+template <int kLo, int kHi, int... kK>
+__attribute__((always_inline)) inline Eigen::Vector3f WeightedSh(const float* sh_base,
+                                                                 const int32_t* corner,
+                                                                 const float* w, unsigned active,
+                                                                 const float* y) {
+  F4 acc[kHi - kLo];
+  for (int i = 0; i < kHi - kLo; ++i) acc[i] = Splat4(0.0f);
+  float wsum = 0;
+  for (unsigned bits = active; bits != 0; bits &= bits - 1) {
+    const int c = std::countr_zero(bits);
+    const float* sh = sh_base + corner[c] * kShStride;
+    const F4 wc = Splat4(w[c]);
+    for (int i = 0; i < kHi - kLo; ++i) acc[i] += wc * Load4(sh + 4 * (kLo + i));
+    wsum += w[c];
+  }
+  // packets kLo .. kHi - 1 of the sum at their place, zeros around them (one lane beyond a
+  // coefficient is read).
+  alignas(16) float a[kShStride + 4] = {};
+  for (int i = 0; i < kHi - kLo; ++i) Store4(a + 4 * (kLo + i), acc[i]);
+  F4 sum = Splat4(0.0f);
+  ((sum += (y[kK] / wsum) * Load4(a + 3 * kShSlot[kK])), ...);
+  return {sum[0], sum[1], sum[2]};
 }
 
 // octahedral texel of a non-zero direction (SkyIrradianceVolume::TexelOf), inlined into lookups.
@@ -465,7 +500,8 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
         for (int i = 0; i < kShFloats; ++i) acc[i] += f * ts[i];
       }
       float* out = &sh_[static_cast<size_t>(p) * kShStride];
-      for (int i = 0; i < kShFloats; ++i) out[i] = static_cast<float>(acc[i]);
+      for (int k = 0; k < kNumSh; ++k)
+        for (int c = 0; c < 3; ++c) out[3 * kShSlot[k] + c] = static_cast<float>(acc[3 * k + c]);
     }
   };
   const int64_t chunks = (num + kChunk - 1) / kChunk;
@@ -510,7 +546,7 @@ Eigen::Vector3f SkyIrradianceVolume::ProbeIrradiance(int probe, const Eigen::Vec
   const float* c = &sh_[static_cast<size_t>(probe) * kShStride];
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   for (int k = 0; k < kNumSh; ++k)
-    e += y[k] * Eigen::Vector3f(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
+    e += y[k] * Eigen::Vector3f(c[3 * kShSlot[k]], c[3 * kShSlot[k] + 1], c[3 * kShSlot[k] + 2]);
   return e;
 }
 
@@ -594,23 +630,18 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   float y[kNumSh];
   ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
   if (active != 0) {
-    // the weighted sum of the probes' irradiance SH, evaluated once at the end.
-    F4 acc[kShStride / 4];
-    for (int i = 0; i < kShStride / 4; ++i) acc[i] = Splat4(0.0f);
-    float wsum = 0;
+    // the weighted sum of the probes' irradiance SH, evaluated once at the end. on a face
+    // whose normal is an axis (exact zeros in n), y[k] = 0 exactly for every k but 0, 3, 6, 8
+    // (x), 0, 2, 6 (z) or 0, 1, 6, 8 (y).
     const float* sh_base = &sh_[static_cast<size_t>(base) * kShStride];
-    for (unsigned bits = active; bits != 0; bits &= bits - 1) {
-      const int c = std::countr_zero(bits);
-      const float* sh = sh_base + corner[c] * kShStride;
-      const F4 wc = Splat4(w[c]);
-      for (int i = 0; i < kShStride / 4; ++i) acc[i] += wc * Load4(sh + 4 * i);
-      wsum += w[c];
-    }
-    alignas(16) float a[kShStride + 4];
-    for (int i = 0; i < kShStride / 4; ++i) Store4(a + 4 * i, acc[i]);
-    F4 sum = Splat4(0.0f);
-    for (int k = 0; k < kNumSh; ++k) sum += (y[k] / wsum) * Load4(a + 3 * k);
-    e = {sum[0], sum[1], sum[2]};
+    if (n_W.y() == 0 && n_W.z() == 0)
+      e = WeightedSh<0, 3, 0, 3, 6, 8>(sh_base, corner, w, active, y);
+    else if (n_W.x() == 0 && n_W.y() == 0)
+      e = WeightedSh<1, 4, 0, 2, 6>(sh_base, corner, w, active, y);
+    else if (n_W.x() == 0 && n_W.z() == 0)
+      e = WeightedSh<0, 5, 0, 1, 6, 8>(sh_base, corner, w, active, y);
+    else
+      e = WeightedSh<0, kShStride / 4, 0, 1, 2, 3, 4, 5, 6, 7, 8>(sh_base, corner, w, active, y);
   } else {
     // no probe sees q: the darkest valid probe in front of the surface.
     float dark_lum = std::numeric_limits<float>::infinity();
