@@ -447,6 +447,8 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   depth_.shrink_to_fit();
 
   // the lookup's per-cell corner positions (see cell_pos_), NaN for invalid probes.
+  for (int c = 0; c < 8; ++c)
+    corner_offset_[c] = (c & 1) + n[0] * (((c >> 1) & 1) + n[1] * (c >> 2));
   cell_pos_.assign(static_cast<size_t>(num) * 24, std::numeric_limits<float>::quiet_NaN());
   for (int p = 0; p < num; ++p) {
     const int i = p % n[0], j = (p / n[0]) % n[1], k = p / (n[0] * n[1]);
@@ -569,10 +571,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
   // probe index of corner c = dx + 2 dy + 4 dz: base + corner[c].
-  const I4 corner_lo = {0, 1, nx, nx + 1};
-  alignas(16) int32_t corner[8];
-  Store4(corner, corner_lo);
-  Store4(corner + 4, corner_lo + nx * ny);
+  const int32_t* corner = corner_offset_.data();
 
   // the 8 corners as two 4-lane halves (dz = 0, 1), every lane computing every branch; the
   // same operations in the same order as the one-probe-at-a-time form in the file comment,
@@ -612,7 +611,13 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   // the depth of each probe's ray towards q.
   const uint8_t* dq = &depth_q_[static_cast<size_t>(base) * kNumTexels];
   alignas(16) int32_t depth_q[8];
-  for (int c = 0; c < 8; ++c) depth_q[c] = dq[texel[c]];
+  for (int c = 0; c < 8; c += 2) {
+    // the offsets (>= 0) two at a time: one load instead of two lane extractions.
+    uint64_t pair;
+    std::memcpy(&pair, texel + c, sizeof pair);
+    depth_q[c] = dq[static_cast<uint32_t>(pair)];
+    depth_q[c + 1] = dq[pair >> 32];
+  }
   unsigned active = 0;
   for (int h = 0; h < 2; ++h) {
     // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight

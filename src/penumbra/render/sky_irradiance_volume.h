@@ -153,6 +153,8 @@ class SkyIrradianceVolume {
   // at (i + dx, j + dy, k + dz)) as 3 rows of 8 floats, NaN where the probe is invalid, so
   // that Irradiance loads them as SIMD lanes.
   std::vector<float> cell_pos_;
+  // probe index of a cell's corner c minus that of its corner 0: dx + nx (dy + ny dz).
+  alignas(16) std::array<int32_t, 8> corner_offset_{};
   std::vector<Pose> built_static_poses_;  // X_WB of the last Build (static bodies only)
   bool built_ = false;
   const SkyModel* lit_sky_ = nullptr;
