@@ -170,5 +170,133 @@ TEST(RaySceneTest, FinitePlaneIsTheExactRectangleFromBothSides) {
   EXPECT_GT(misses, 2000);
 }
 
+TEST(RaySceneTest, MovingBodyHitsMatchTheSameGeomsPlacedStatic) {
+  // the fixture's moving body (its own instanced scene, posed with X_WB) and the same geoms as
+  // static geoms at X_WB X_BG (merged world-frame scene) give the same hits up to float
+  // rounding of the instance transform and the world-frame vertices.
+  Fixture f;
+  RayScene moving(f.scene);
+  moving.Update(f.snapshot);
+  SceneDescription fixed = f.scene;
+  for (Geom& g : fixed.geoms) {
+    if (g.body == 0) continue;
+    g.X_BG = f.snapshot.X_WB[g.body] * g.X_BG;
+    g.body = 0;
+  }
+  RayScene still(fixed);
+  still.Update(testing::IdentitySnapshot(fixed));
+  const int w = 61, h = 47;
+  const Camera camera(testing::CameraLookingAlongX(), CameraIntrinsics::FromFovy(w, h, 70.0));
+  int moving_hits = 0;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      SCOPED_TRACE(u + w * v);
+      const Ray ray = camera.GenerateRay(u, v);
+      SurfaceHit a, b;
+      const bool got_a = moving.Intersect(ray, &a), got_b = still.Intersect(ray, &b);
+      ASSERT_EQ(got_a, got_b);
+      if (!got_a) continue;
+      // rays grazing a silhouette may pick the other geom; they are rare.
+      if (a.geom != b.geom) continue;
+      if (f.scene.geoms[a.geom].body != 0) ++moving_hits;
+      EXPECT_NEAR(a.t, b.t, 1e-5 * b.t);
+      EXPECT_LT((a.p_W - b.p_W).norm(), 1e-5);
+      EXPECT_LT((a.p_G - b.p_G).norm(), 1e-5);
+      EXPECT_LT((a.n_G - b.n_G).norm(), 1e-5);
+      EXPECT_LT((a.ng_W - b.ng_W).norm(), 1e-5);
+      EXPECT_LT((a.ns_W - b.ns_W).norm(), 1e-5);
+      EXPECT_EQ(a.front_face, b.front_face);
+      EXPECT_EQ(a.material, b.material);
+    }
+  EXPECT_GT(moving_hits, 100);
+}
+
+// a square plate of 2 n^2 triangles, side 1 m, in the z = 0 plane of its frame, facing +z.
+TriangleMesh Plate(int n) {
+  TriangleMesh mesh;
+  mesh.name = "plate";
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      mesh.vertices.emplace_back(static_cast<float>(i) / n - 0.5f, static_cast<float>(j) / n - 0.5f,
+                                 0.0f);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      mesh.faces.emplace_back(a, b, d);
+      mesh.faces.emplace_back(a, d, c);
+    }
+  return mesh;
+}
+
+TEST(RaySceneTest, BoxSphereAndMeshBodiesFollowTheirPoses) {
+  // a body of a box and a sphere and a body holding a 3200-triangle mesh. after every Update,
+  // rays find the box face, the sphere and the plate at their exact distances for the new
+  // poses, with the geom-frame points and normals of the geoms.
+  SceneDescription scene = EmptyScene();
+  const int robot = AddBody(&scene, "robot");
+  const int arm = AddBody(&scene, "arm");
+  const Eigen::Vector3d half(0.2, 0.3, 0.4);
+  const int box = AddGeom(&scene, GeomShape::kBox, half, Translation(0, 0, 0), robot);
+  const int sphere =
+      AddGeom(&scene, GeomShape::kSphere, {0.25, 0, 0}, Translation(0, 0, 1.0), robot);
+  scene.meshes.push_back(Plate(40));
+  const int plate = AddGeom(&scene, GeomShape::kMesh, {1, 1, 1}, Translation(0, 0, 0), arm);
+  scene.geoms[plate].mesh = 0;
+  RayScene rs(scene);
+  EXPECT_EQ(rs.num_triangles(), 12 + 2 * 40 * 40);
+  WorldSnapshot snap = testing::IdentitySnapshot(scene);
+  int commits = 0;
+  for (const double yaw : {0.0, 0.3, -0.5}) {
+    SCOPED_TRACE(yaw);
+    // robot at x = 3 turned by `yaw` about z, off to the side of the rays to the plate; the
+    // plate at x = 5, facing -x, shifted in y.
+    Pose X_WR = Translation(3, -1.0 + 0.2 * yaw, -0.5);
+    X_WR.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    Pose X_WA = Translation(5, -yaw, 0.1);
+    X_WA.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    snap.X_WB[robot] = X_WR;
+    snap.X_WB[arm] = X_WA;
+    rs.Update(snap);
+    EXPECT_EQ(rs.num_top_level_commits(), ++commits);
+    SurfaceHit hit;
+    // box: a ray from the origin towards its centre meets the face x_B = -half.x at
+    // t = ((R^T c).x - half.x) / (R^T d).x.
+    const Eigen::Vector3d c = X_WR.translation();
+    Ray ray;
+    ray.d = c.normalized().cast<float>();
+    ASSERT_TRUE(rs.Intersect(ray, &hit));
+    EXPECT_EQ(hit.geom, box);
+    const Eigen::Matrix3d R_BW = X_WR.linear().transpose();
+    const Eigen::Vector3d d = ray.d.cast<double>();
+    const double t_box = ((R_BW * c).x() - half.x()) / (R_BW * d).x();
+    EXPECT_NEAR(hit.t, t_box, 1e-5);
+    EXPECT_LT((hit.n_G - Eigen::Vector3f(-1, 0, 0)).norm(), 1e-6);
+    EXPECT_LT((hit.ng_W.cast<double>() + X_WR.linear().col(0)).norm(), 1e-6);
+    EXPECT_NEAR(hit.p_G.x(), -half.x(), 1e-5);
+    EXPECT_TRUE(hit.front_face);
+    // sphere (exact analytic shape): centre 1 m above the box centre, t = |c| - r.
+    const Eigen::Vector3d cs = X_WR * Eigen::Vector3d(0, 0, 1.0);
+    ray.d = cs.normalized().cast<float>();
+    ASSERT_TRUE(rs.Intersect(ray, &hit));
+    EXPECT_EQ(hit.geom, sphere);
+    const Eigen::Vector3d ds = ray.d.cast<double>();
+    const double b = ds.dot(cs), a = ds.squaredNorm();
+    EXPECT_NEAR(hit.t, (b - std::sqrt(b * b - a * (cs.squaredNorm() - 0.0625))) / a, 1e-6);
+    // plate: the plane x = 5, its normal -x in the world, +z in the geom frame.
+    const Eigen::Vector3d target(5, -yaw + 0.31, 0.1 - 0.27);
+    ray.d = target.normalized().cast<float>();
+    ASSERT_TRUE(rs.Intersect(ray, &hit));
+    EXPECT_EQ(hit.geom, plate);
+    EXPECT_NEAR(hit.t, 5.0 / ray.d.cast<double>().x(), 1e-5);
+    EXPECT_LT((hit.p_W.cast<double>() - target.normalized() * hit.t).norm(), 1e-5);
+    EXPECT_LT((hit.ng_W - Eigen::Vector3f(-1, 0, 0)).norm(), 1e-6);
+    EXPECT_LT((hit.n_G - Eigen::Vector3f(0, 0, 1)).norm(), 1e-6);
+    EXPECT_LT((hit.p_G.head<2>().cast<double>() - Eigen::Vector2d(-0.27, 0.31)).norm(), 1e-5);
+    // the same poses again commit nothing.
+    rs.Update(snap);
+    EXPECT_EQ(rs.num_top_level_commits(), commits);
+  }
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -44,8 +44,9 @@ struct TriangleGeom {
     Eigen::Vector3f n_I, n_G;
   };
   std::vector<FaceNormal> face_normals;
-  Eigen::Matrix3f R_GI;  // p_G = R_GI p_I + p_GI
-  Eigen::Vector3f p_GI;
+  std::vector<Eigen::Vector3f> vertices_G;  // the same vertices in the geom frame (FinishHit)
+  Eigen::Matrix3f R_WI = Eigen::Matrix3f::Identity();  // current instance rotation (FinishHit)
+  bool rotated = false;                                // R_WI is not the identity
 };
 
 // what an Embree (instanced scene, geomID) pair stands for.
@@ -207,15 +208,15 @@ struct RayScene::Impl {
         tg->normals_I.push_back((R_IG * n).normalized());
       tg->texcoords = std::move(shape.texcoords);
       tg->faces = std::move(shape.faces);
-      tg->R_GI = X_GI.linear().cast<float>();
-      tg->p_GI = X_GI.translation().cast<float>();
+      tg->vertices_G = std::move(shape.vertices);
+      const Eigen::Matrix3f R_GI = X_GI.linear().cast<float>();
       tg->face_normals.reserve(tg->faces.size());
       for (const Eigen::Vector3i& f : tg->faces) {
         const Eigen::Vector3f& v0 = tg->vertices_I[f[0]];
         Eigen::Vector3f n_I = (tg->vertices_I[f[1]] - v0).cross(tg->vertices_I[f[2]] - v0);
         const float len = n_I.norm();
         n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
-        tg->face_normals.push_back({n_I, tg->R_GI * n_I});
+        tg->face_normals.push_back({n_I, R_GI * n_I});
       }
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
       rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -265,13 +266,18 @@ struct RayScene::Impl {
     rtcCommitScene(group->scene);
   }
 
-  // folds the instance pose of `group` into its analytic geoms' transforms.
+  // folds the instance pose of `group` into its geoms' world transforms (for FinishHit).
   static void SetAnalyticWorldTransforms(InstanceGroup* group) {
     const Eigen::Matrix3d R_IW = group->X_WI.linear().transpose();
     for (const std::unique_ptr<AnalyticGeom>& g : group->analytic) {
       g->R_GW = g->R_GI * R_IW;
       g->p_GW = g->p_GI - g->R_GW * group->X_WI.translation();
       g->R_WG = g->R_GW.transpose();
+    }
+    const bool rotated = group->R_WI_f != Eigen::Matrix3f::Identity();
+    for (const std::unique_ptr<TriangleGeom>& g : group->triangles) {
+      g->R_WI = group->R_WI_f;
+      g->rotated = rotated;
     }
   }
 
@@ -342,17 +348,17 @@ struct RayScene::Impl {
       const Eigen::Vector3i& f = g.faces[rh.hit.primID];
       const TriangleGeom::FaceNormal& fn = g.face_normals[rh.hit.primID];
       const float u = rh.hit.u, v = rh.hit.v, w = 1.0f - u - v;
-      const Eigen::Vector3f p_I =
-          w * g.vertices_I[f[0]] + u * g.vertices_I[f[1]] + v * g.vertices_I[f[2]];
-      hit->p_G = g.R_GI * p_I + g.p_GI;
+      // p_G straight from the geom-frame vertices (no transform of p_I).
+      hit->p_G = w * g.vertices_G[f[0]] + u * g.vertices_G[f[1]] + v * g.vertices_G[f[2]];
       hit->n_G = fn.n_G;
-      ng_W = group.R_WI_f * fn.n_I;
+      // the static group's frame is the world frame: no rotation to apply.
+      ng_W = g.rotated ? Eigen::Vector3f(g.R_WI * fn.n_I) : fn.n_I;
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
             w * g.normals_I[f[0]] + u * g.normals_I[f[1]] + v * g.normals_I[f[2]];
         const float ls = ns_I.norm();
-        if (ls > 0) ns_W = group.R_WI_f * (ns_I / ls);
+        if (ls > 0) ns_W = g.rotated ? Eigen::Vector3f(g.R_WI * (ns_I / ls)) : ns_I / ls;
       }
       if (!g.texcoords.empty()) {
         hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];
