@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "penumbra/core/rng.h"
 #include "penumbra/render/bsdf_lanes.h"
@@ -17,6 +18,55 @@ Eigen::Vector3f RandomDir(Rng* rng) {
   const float z = 2 * rng->Uniform() - 1, phi = 6.2831853f * rng->Uniform();
   const float r = std::sqrt(std::max(0.0f, 1 - z * z));
   return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+// lane masks: comparisons per lane (NaN compares false), logic, counting, writes, selects.
+TEST(ShadingLanesTest, LaneMaskComparisonsAndSelects) {
+  Lanes a, b;
+  for (int k = 0; k < kLanes; ++k) {
+    a[k] = static_cast<float>(k % 5) - 2.0f;  // -2 .. 2
+    b[k] = static_cast<float>(k % 3) - 1.0f;  // -1 .. 1
+  }
+  a[7] = std::nanf("");
+  const LaneMask gt = GreaterThan(a, b), ge = GreaterEqual(a, b), pos = GreaterThan(a, 0.0f);
+  int n_gt = 0;
+  for (int k = 0; k < kLanes; ++k) {
+    EXPECT_EQ(gt[k], a[k] > b[k]) << k;
+    EXPECT_EQ(ge[k], a[k] >= b[k]) << k;
+    EXPECT_EQ(pos[k], a[k] > 0.0f) << k;
+    EXPECT_EQ((gt && pos)[k], a[k] > b[k] && a[k] > 0.0f) << k;
+    EXPECT_EQ((gt || pos)[k], a[k] > b[k] || a[k] > 0.0f) << k;
+    EXPECT_EQ((!gt)[k], !(a[k] > b[k])) << k;
+    n_gt += a[k] > b[k];
+  }
+  EXPECT_FALSE(gt[7]);
+  EXPECT_FALSE((!gt)[kLanes]);  // no lanes beyond kLanes
+  EXPECT_EQ(gt.count(), n_gt);
+  EXPECT_TRUE(LaneMask::Constant(true).all());
+  EXPECT_EQ(LaneMask::Constant(true).count(), kLanes);
+  EXPECT_FALSE(LaneMask().any());
+
+  LaneMask m;
+  m[3] = true;
+  m[kLanes - 1] = true;
+  m[3] = false;
+  m[5] = true;
+  EXPECT_EQ(m.count(), 2);
+  EXPECT_TRUE(m[5] && m[kLanes - 1] && !m[3]);
+
+  // selects keep the lane (inf and NaN included) or give +0.
+  Lanes v = Lanes::Constant(3.0f);
+  v[5] = std::numeric_limits<float>::infinity();
+  v[6] = std::nanf("");
+  const Lanes w = Where(m, v);
+  for (int k = 0; k < kLanes; ++k) {
+    if (m[k]) {
+      EXPECT_EQ(w[k], v[k]) << k;
+    } else {
+      EXPECT_EQ(w[k], 0.0f) << k;
+      EXPECT_FALSE(std::signbit(w[k])) << k;
+    }
+  }
 }
 
 TEST(ShadingLanesTest, SinCos2Pi) {

@@ -226,7 +226,7 @@ void LightSampler::SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, con
                            l.position_W.z() - p_W.z};
   const Lanes d2 = to_light.Dot(to_light);
   const Lanes d = d2.sqrt();
-  s->valid = d > l.radius_m;
+  s->valid = GreaterThan(d, l.radius_m);
   Lanes atten = Lanes::Ones();
   if (l.type == Light::Type::kSpot) {
     const Lanes cos_axis = -(to_light.x * l.direction_W.x() + to_light.y * l.direction_W.y() +
@@ -238,7 +238,7 @@ void LightSampler::SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, con
       const Lanes t = ((cos_axis - l.cos_outer) / (l.cos_inner - l.cos_outer)).max(0.0f).min(1.0f);
       atten = t * t * (3.0f - 2.0f * t);
     }
-    s->valid = s->valid && (atten > 0.0f);
+    s->valid = s->valid && GreaterThan(atten, 0.0f);
   }
   const Lanes scale = atten / d2;
   s->E = {l.intensity_rgb.x() * scale, l.intensity_rgb.y() * scale, l.intensity_rgb.z() * scale};

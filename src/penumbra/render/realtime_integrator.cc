@@ -229,7 +229,6 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         bsdf.SetFrame(k, z, z, z);
         pbr.base_color.Set(k, zero);
         pbr.roughness[k] = 1, pbr.metallic[k] = 0, pbr.specular[k] = 0;
-        for (int j = 0; j < num_lights; ++j) scratch.u1[j][k] = scratch.u2[j][k] = 0.5f;
         if (k < m) {
           const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
           const Eigen::Vector3f sky = ctx.sky->Radiance(primary.rays[i].d.normalized());
@@ -254,9 +253,6 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       origin.Set(k, OffsetRayOrigin(h.p_W, h.ng_W));
       sky_E.Set(k, scratch.sky_E[i]);
 
-      // one 64-bit draw per light: (u1, u2) from its top 48 bits.
-      Rng rng(FrameContext::PixelStream(frame_key, static_cast<uint64_t>(v) * width + u, 0));
-      for (int j = 0; j < num_lights; ++j) rng.Uniform2(&scratch.u1[j][k], &scratch.u2[j][k]);
       if (out.albedo) {
         float* a = out.albedo->at(u, v);
         a[0] = mat.pbr.base_color.x(), a[1] = mat.pbr.base_color.y(), a[2] = mat.pbr.base_color.z();
@@ -267,6 +263,30 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     if (!hit.any()) continue;
+    // random numbers: light j's (u1, u2) from the top 48 bits of draw j of the pixel's stream,
+    // as Rng::Uniform2 takes them; computed for every lane at once (idle lanes' values are
+    // never used).
+    {
+      alignas(64) uint64_t stream[kLanes];
+      const int x = i0 % tile.width, y = i0 / tile.width;
+      const uint64_t row0 = static_cast<uint64_t>(tile.y0 + y) * width + tile.x0 + x;
+      if (x + kLanes <= tile.width) {
+        for (int k = 0; k < kLanes; ++k) stream[k] = row0 + k;
+      } else {
+        for (int k = 0; k < kLanes; ++k) {
+          const int i = i0 + std::min(k, m - 1);
+          stream[k] =
+              static_cast<uint64_t>(tile.y0 + i / tile.width) * width + tile.x0 + i % tile.width;
+        }
+      }
+      for (int k = 0; k < kLanes; ++k)
+        stream[k] = FrameContext::PixelStream(frame_key, stream[k], 0);
+      for (int j = 0; j < num_lights; ++j) {
+        float* u1 = scratch.u1[j].data();
+        float* u2 = scratch.u2[j].data();
+        for (int k = 0; k < kLanes; ++k) Rng::Uniform2Of(Rng::DrawAt(stream[k], j), &u1[k], &u2[k]);
+      }
+    }
     bsdf.SetCoefficients(pbr);
 
     // emission and sky ambient, E_sky / pi (c_diff (1 - S) + S).
@@ -315,11 +335,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     // others after one packet of shadow rays.
     for (int j = 0; j < num_lights; ++j) {
       const Vec3Lanes& c = scratch.contrib[j];
-      const LaneMask lit = LuminanceLanes(c) > 0.0f;
+      const LaneMask lit = GreaterThan(LuminanceLanes(c), 0.0f);
       if (!lit.any()) continue;
       const LaneMask shadowed =
           ctx.lights->lights()[j].cast_shadow
-              ? LaneMask(lit && (LuminanceLanes(c) >= kNegligibleLight * total))
+              ? lit && GreaterEqual(LuminanceLanes(c), kNegligibleLight * total)
               : LaneMask::Constant(false);
       const LaneMask unshadowed = lit && !shadowed;
       L = L + Where(unshadowed, c);

@@ -1,14 +1,19 @@
 #pragma once
 // structure-of-arrays math for shading kLanes points at once (the realtime tier shades a row
 // of 16 pixels together, matching Embree's 16-wide ray packets). Eigen's fixed-size arrays
-// compile to SIMD instructions; masks are arrays of bool and every lane computes every branch.
+// compile to SIMD instructions; masks are bit sets (one bit per lane, as AVX-512 mask
+// registers) made by the lane comparisons below, and every lane computes every branch.
 //
 // SinCos2Pi is shared by the scalar and the lane code, so both sample the same directions.
 
 #include <Eigen/Core>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace penumbra {
 
@@ -17,8 +22,93 @@ constexpr int kLanes = 16;
 
 /// one float per lane.
 using Lanes = Eigen::Array<float, kLanes, 1>;
-/// one bool per lane.
-using LaneMask = Eigen::Array<bool, kLanes, 1>;
+/// one bool per lane, stored as bit k of a word.
+class LaneMask {
+ public:
+  /// every lane false.
+  constexpr LaneMask() = default;
+  /// lane k = bit k of `bits` (bits above kLanes are dropped).
+  constexpr explicit LaneMask(uint32_t bits) : bits_(bits & kAll) {}
+  /// every lane `b`.
+  static constexpr LaneMask Constant(bool b) { return LaneMask(b ? kAll : 0u); }
+
+  /// lane k.
+  constexpr bool operator[](int k) const { return ((bits_ >> k) & 1u) != 0; }
+  /// a writable lane k: `mask[k] = b`.
+  class LaneRef {
+   public:
+    constexpr LaneRef(uint32_t* bits, int k) : bits_(bits), k_(k) {}
+    constexpr LaneRef& operator=(bool b) {
+      *bits_ = (*bits_ & ~(1u << k_)) | (static_cast<uint32_t>(b) << k_);
+      return *this;
+    }
+    constexpr operator bool() const { return ((*bits_ >> k_) & 1u) != 0; }
+
+   private:
+    uint32_t* bits_;
+    int k_;
+  };
+  constexpr LaneRef operator[](int k) { return LaneRef(&bits_, k); }
+
+  constexpr bool any() const { return bits_ != 0; }
+  constexpr bool all() const { return bits_ == kAll; }
+  /// number of true lanes.
+  constexpr int count() const { return std::popcount(bits_); }
+  /// bit k = lane k.
+  constexpr uint32_t bits() const { return bits_; }
+
+  friend constexpr LaneMask operator&&(LaneMask a, LaneMask b) {
+    return LaneMask(a.bits_ & b.bits_);
+  }
+  friend constexpr LaneMask operator||(LaneMask a, LaneMask b) {
+    return LaneMask(a.bits_ | b.bits_);
+  }
+  constexpr LaneMask operator!() const { return LaneMask(~bits_); }
+  friend constexpr bool operator==(LaneMask a, LaneMask b) { return a.bits_ == b.bits_; }
+
+ private:
+  static_assert(kLanes <= 32, "a LaneMask holds at most 32 lanes");
+  static constexpr uint32_t kAll = kLanes == 32 ? ~0u : (1u << kLanes) - 1u;
+  uint32_t bits_ = 0;
+};
+
+// lane comparisons. ordered: a lane holding NaN compares false, as the scalar operators.
+namespace lanes_detail {
+enum class Cmp { kGt, kGe };
+template <Cmp kCmp>
+inline LaneMask Compare(const Lanes& a, const Lanes& b) {
+#if defined(__AVX512F__)
+  static_assert(kLanes == 16, "one AVX-512 register of lanes");
+  constexpr int kPred = kCmp == Cmp::kGt ? _CMP_GT_OQ : _CMP_GE_OQ;
+  return LaneMask(_mm512_cmp_ps_mask(_mm512_loadu_ps(a.data()), _mm512_loadu_ps(b.data()), kPred));
+#elif defined(__SSE2__)
+  static_assert(kLanes % 4 == 0, "lanes come in 4-float chunks");
+  uint32_t bits = 0;
+  for (int k = 0; k < kLanes; k += 4) {
+    const __m128 x = _mm_loadu_ps(a.data() + k), y = _mm_loadu_ps(b.data() + k);
+    const __m128 c = kCmp == Cmp::kGt ? _mm_cmpgt_ps(x, y) : _mm_cmpge_ps(x, y);
+    bits |= static_cast<uint32_t>(_mm_movemask_ps(c)) << k;
+  }
+  return LaneMask(bits);
+#else
+  uint32_t bits = 0;
+  for (int k = 0; k < kLanes; ++k)
+    bits |= static_cast<uint32_t>(kCmp == Cmp::kGt ? a[k] > b[k] : a[k] >= b[k]) << k;
+  return LaneMask(bits);
+#endif
+}
+}  // namespace lanes_detail
+
+/// a > b per lane.
+inline LaneMask GreaterThan(const Lanes& a, const Lanes& b) {
+  return lanes_detail::Compare<lanes_detail::Cmp::kGt>(a, b);
+}
+/// a > b per lane.
+inline LaneMask GreaterThan(const Lanes& a, float b) { return GreaterThan(a, Lanes::Constant(b)); }
+/// a >= b per lane.
+inline LaneMask GreaterEqual(const Lanes& a, const Lanes& b) {
+  return lanes_detail::Compare<lanes_detail::Cmp::kGe>(a, b);
+}
 
 /// a 3-vector per lane.
 struct Vec3Lanes {
@@ -48,8 +138,6 @@ namespace lanes_detail {
 typedef float Float4 __attribute__((vector_size(16)));
 typedef int32_t Int4 __attribute__((vector_size(16)));
 static_assert(kLanes % 4 == 0, "lanes come in 4-float chunks");
-static_assert(sizeof(bool) == 1, "LaneMask holds one byte per lane");
-static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "MaskOf4 reads bools as a word");
 
 inline Float4 Load4(const Lanes& a, int k) {
   Float4 v;
@@ -59,13 +147,10 @@ inline Float4 Load4(const Lanes& a, int k) {
 inline void Store4(Int4 bits, Lanes* out, int k) {
   std::memcpy(out->data() + k, &bits, sizeof bits);
 }
-// all-ones lanes where the bools m[k .. k + 3] are true: their four bytes as one
-// little-endian word, tested byte by byte.
+// all-ones lanes where the lanes k .. k + 3 of m are true.
 inline Int4 MaskOf4(const LaneMask& m, int k) {
-  int32_t w;
-  std::memcpy(&w, m.data() + k, sizeof w);
-  const Int4 bytes = {0xff, 0xff00, 0xff0000, static_cast<int32_t>(0xff000000u)};
-  return (Int4{w, w, w, w} & bytes) != 0;
+  const int32_t w = static_cast<int32_t>(m.bits() >> k);
+  return (Int4{w, w, w, w} & Int4{1, 2, 4, 8}) != 0;
 }
 inline Int4 Bits4(Float4 v) {
   Int4 r;
@@ -98,21 +183,17 @@ __attribute__((always_inline)) inline Lanes WhereAllPositive(const Lanes& c0, co
 __attribute__((always_inline)) inline Lanes Where(const LaneMask& m, const Lanes& a) {
   using namespace lanes_detail;
   Lanes out;
+#if defined(__AVX512F__)
+  _mm512_storeu_ps(out.data(), _mm512_maskz_mov_ps(m.bits(), _mm512_loadu_ps(a.data())));
+#else
   for (int k = 0; k < kLanes; k += 4) Store4(Bits4(Load4(a, k)) & MaskOf4(m, k), &out, k);
+#endif
   return out;
 }
 
 /// v where m, +0 elsewhere, per lane.
 __attribute__((always_inline)) inline Vec3Lanes Where(const LaneMask& m, const Vec3Lanes& v) {
-  using namespace lanes_detail;
-  Vec3Lanes out;
-  for (int k = 0; k < kLanes; k += 4) {
-    const Int4 mask = MaskOf4(m, k);
-    Store4(Bits4(Load4(v.x, k)) & mask, &out.x, k);
-    Store4(Bits4(Load4(v.y, k)) & mask, &out.y, k);
-    Store4(Bits4(Load4(v.z, k)) & mask, &out.z, k);
-  }
-  return out;
+  return {Where(m, v.x), Where(m, v.y), Where(m, v.z)};
 }
 #else
 inline Lanes WherePositive(const Lanes& c, const Lanes& a) {
