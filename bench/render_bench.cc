@@ -84,29 +84,31 @@ SceneDescription Room() {
                {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   s.meshes.push_back(oct);
 
-  // tables with chairs on a 4 x 3 grid; each table and chair is its own (movable) body.
+  // six tables on a 3 x 2 grid, each with a chair on either side (along x, backrests away from
+  // the table); each table and chair is its own static body, its geoms placed in the world.
   int n = 0;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 2; ++j, ++n) {
       const double x = -1.8 + 1.8 * i, y = -1.2 + 2.4 * j;
       s.bodies.push_back({"table" + std::to_string(n), 0, true});
       const int tb = static_cast<int>(s.bodies.size()) - 1;
-      Add(&s, tb, GeomShape::kBox, {0.4, 0.3, 0.02}, At(0, 0, 0.72), wood);
+      Add(&s, tb, GeomShape::kBox, {0.4, 0.3, 0.02}, At(x, y, 0.72), wood);
       for (int k = 0; k < 4; ++k)
         Add(&s, tb, GeomShape::kCylinder, {0.025, 0.35, 0},
-            At(k & 1 ? 0.35 : -0.35, k & 2 ? 0.25 : -0.25, 0.35), metal);
-      Add(&s, tb, GeomShape::kMesh, {0, 0, 0}, At(0.1, 0.05, 0.89), plastic);
+            At(x + (k & 1 ? 0.35 : -0.35), y + (k & 2 ? 0.25 : -0.25), 0.35), metal);
+      Add(&s, tb, GeomShape::kMesh, {0, 0, 0}, At(x + 0.1, y + 0.05, 0.89), plastic);
       s.geoms.back().mesh = 0;
-      Add(&s, tb, GeomShape::kSphere, {0.06, 0, 0}, At(-0.2, -0.1, 0.8), metal);
+      Add(&s, tb, GeomShape::kSphere, {0.06, 0, 0}, At(x - 0.2, y - 0.1, 0.8), metal);
       for (int c = 0; c < 2; ++c) {
         s.bodies.push_back({"chair" + std::to_string(2 * n + c), 0, true});
         const int cb = static_cast<int>(s.bodies.size()) - 1;
         const double side = c ? 1 : -1;
-        Add(&s, cb, GeomShape::kBox, {0.2, 0.2, 0.02}, At(0, 0, 0.45), fabric);
-        Add(&s, cb, GeomShape::kBox, {0.02, 0.2, 0.22}, At(side * 0.2, 0, 0.69), fabric);
+        const double cx = x + side * 0.6;
+        Add(&s, cb, GeomShape::kBox, {0.2, 0.2, 0.02}, At(cx, y, 0.45), fabric);
+        Add(&s, cb, GeomShape::kBox, {0.02, 0.2, 0.22}, At(cx + side * 0.2, y, 0.69), fabric);
         for (int k = 0; k < 4; ++k)
           Add(&s, cb, GeomShape::kCapsule, {0.015, 0.2, 0},
-              At(k & 1 ? 0.17 : -0.17, k & 2 ? 0.17 : -0.17, 0.22), metal);
+              At(cx + (k & 1 ? 0.17 : -0.17), y + (k & 2 ? 0.17 : -0.17), 0.22), metal);
       }
     }
   }
