@@ -9,13 +9,18 @@
 
 namespace penumbra {
 
-/// SplitMix64 finaliser: a bijective 64-bit mix.
-constexpr uint64_t Mix64(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
+namespace rng_detail {
+constexpr uint64_t kGamma = 0x9e3779b97f4a7c15ULL;  // SplitMix64's golden-ratio increment
+// SplitMix64's output mix of its state z.
+constexpr uint64_t Finalize(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
 }
+}  // namespace rng_detail
+
+/// SplitMix64 finaliser: a bijective 64-bit mix.
+constexpr uint64_t Mix64(uint64_t z) { return rng_detail::Finalize(z + rng_detail::kGamma); }
 
 /// combines keys into one 64-bit stream id.
 constexpr uint64_t HashKeys(uint64_t a, uint64_t b) { return Mix64(a ^ Mix64(b)); }
@@ -56,12 +61,8 @@ class Rng {
   double UniformD() { return static_cast<double>(NextU64() >> 11) * 0x1.0p-53; }
 
  private:
-  static constexpr uint64_t kGamma = 0x9e3779b97f4a7c15ULL;  // the golden-ratio increment
-  static constexpr uint64_t Finalize(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
+  static constexpr uint64_t kGamma = rng_detail::kGamma;
+  static constexpr uint64_t Finalize(uint64_t z) { return rng_detail::Finalize(z); }
   uint64_t state_;
 };
 

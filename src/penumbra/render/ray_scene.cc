@@ -45,8 +45,6 @@ struct TriangleGeom {
   };
   std::vector<FaceNormal> face_normals;
   std::vector<Eigen::Vector3f> vertices_G;  // the same vertices in the geom frame (FinishHit)
-  Eigen::Matrix3f R_WI = Eigen::Matrix3f::Identity();  // current instance rotation (FinishHit)
-  bool rotated = false;                                // R_WI is not the identity
 };
 
 // what an Embree (instanced scene, geomID) pair stands for.
@@ -69,6 +67,7 @@ struct InstanceGroup {
   std::vector<std::unique_ptr<TriangleGeom>> triangles;
   Pose X_WI = Pose::Identity();  // current instance pose (identity for the static group)
   Eigen::Matrix3f R_WI_f = Eigen::Matrix3f::Identity();
+  bool rotated = false;  // R_WI_f is not the identity (FinishHit skips it for the static group)
   int64_t num_triangles = 0;
 };
 
@@ -266,7 +265,7 @@ struct RayScene::Impl {
     rtcCommitScene(group->scene);
   }
 
-  // folds the instance pose of `group` into its geoms' world transforms (for FinishHit).
+  // folds the instance pose of `group` into its analytic geoms' transforms.
   static void SetAnalyticWorldTransforms(InstanceGroup* group) {
     const Eigen::Matrix3d R_IW = group->X_WI.linear().transpose();
     for (const std::unique_ptr<AnalyticGeom>& g : group->analytic) {
@@ -274,17 +273,13 @@ struct RayScene::Impl {
       g->p_GW = g->p_GI - g->R_GW * group->X_WI.translation();
       g->R_WG = g->R_GW.transpose();
     }
-    const bool rotated = group->R_WI_f != Eigen::Matrix3f::Identity();
-    for (const std::unique_ptr<TriangleGeom>& g : group->triangles) {
-      g->R_WI = group->R_WI_f;
-      g->rotated = rotated;
-    }
   }
 
   // sets the instance transform of `group` to X_WI.
   void SetInstancePose(InstanceGroup* group, const Pose& X_WI) {
     group->X_WI = X_WI;
     group->R_WI_f = X_WI.linear().cast<float>();
+    group->rotated = group->R_WI_f != Eigen::Matrix3f::Identity();
     SetAnalyticWorldTransforms(group);
     float xfm[12];
     for (int c = 0; c < 3; ++c)
@@ -352,13 +347,13 @@ struct RayScene::Impl {
       hit->p_G = w * g.vertices_G[f[0]] + u * g.vertices_G[f[1]] + v * g.vertices_G[f[2]];
       hit->n_G = fn.n_G;
       // the static group's frame is the world frame: no rotation to apply.
-      ng_W = g.rotated ? Eigen::Vector3f(g.R_WI * fn.n_I) : fn.n_I;
+      ng_W = group.rotated ? Eigen::Vector3f(group.R_WI_f * fn.n_I) : fn.n_I;
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
             w * g.normals_I[f[0]] + u * g.normals_I[f[1]] + v * g.normals_I[f[2]];
         const float ls = ns_I.norm();
-        if (ls > 0) ns_W = g.rotated ? Eigen::Vector3f(g.R_WI * (ns_I / ls)) : ns_I / ls;
+        if (ls > 0) ns_W = group.rotated ? Eigen::Vector3f(group.R_WI_f * (ns_I / ls)) : ns_I / ls;
       }
       if (!g.texcoords.empty()) {
         hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];

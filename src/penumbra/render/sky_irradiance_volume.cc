@@ -455,7 +455,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     if (i + 1 >= n[0] || j + 1 >= n[1] || k + 1 >= n[2]) continue;
     float* cell = &cell_pos_[static_cast<size_t>(p) * 24];
     for (int c = 0; c < 8; ++c) {
-      const int idx = p + (c & 1) + n[0] * (((c >> 1) & 1) + n[1] * (c >> 2));
+      const int idx = p + corner_offset_[c];
       if (!valid_[idx]) continue;
       for (int a = 0; a < 3; ++a) cell[8 * a + c] = position_[idx][a];
     }

@@ -147,7 +147,7 @@ class SkyIrradianceVolume {
   std::vector<float> depth_;               // per probe and texel, m (Build only)
   std::vector<uint8_t> depth_q_;           // per probe and texel, depth / depth_scale_
   float depth_scale_ = 0;                  // m per depth_q_ step
-  std::vector<float> sh_;                  // per probe: 9 (l, m) x 3 channels, irradiance
+  std::vector<float> sh_;  // per probe: 9 (l, m) x 3 channels, irradiance (slot order: .cc)
   // per cell (indexed by its corner probe (i, j, k) of lowest index, for i < nx - 1, j < ny - 1,
   // k < nz - 1; the rest unused): x, y, z of its 8 corner probes (corner c = dx + 2 dy + 4 dz
   // at (i + dx, j + dy, k + dz)) as 3 rows of 8 floats, NaN where the probe is invalid, so
