@@ -9,6 +9,7 @@
 #include <cmath>
 #include <vector>
 
+#include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/camera.h"
 #include "render_test_util.h"
 
@@ -209,6 +210,291 @@ TEST(RaySceneTest, MovingBodyHitsMatchTheSameGeomsPlacedStatic) {
       EXPECT_EQ(a.material, b.material);
     }
   EXPECT_GT(moving_hits, 100);
+}
+
+// ---- planes traced as Embree triangles (axis-aligned in their instance frame) ----
+
+// the analytic reference of a plane of half-size (sx, sy) posed at X_WG: IntersectAnalytic on
+// the float ray taken to the geom frame in double. returns false on a miss.
+bool ReferencePlaneHit(const Pose& X_WG, double sx, double sy, const Ray& ray, double* t,
+                       Eigen::Vector3d* p_G) {
+  AnalyticShape plane;
+  plane.kind = AnalyticKind::kPlane;
+  plane.size = {sx, sy, 0};
+  const Eigen::Matrix3d R_GW = X_WG.linear().transpose();
+  const Eigen::Vector3d o_G = R_GW * (ray.o.cast<double>() - X_WG.translation());
+  const Eigen::Vector3d d_G = R_GW * ray.d.cast<double>();
+  ShapePart part;
+  if (!IntersectAnalytic(plane, o_G, d_G, ray.tmin, ray.tmax, t, &part)) return false;
+  *p_G = o_G + *t * d_G;
+  return true;
+}
+
+// the hit matches the analytic plane: t to float rounding (1 ulp), the geom-frame point to
+// float rounding of the distance, the normals exactly +-n_W.
+void ExpectPlaneHit(const SurfaceHit& hit, const Ray& ray, const Pose& X_WG, double t,
+                    const Eigen::Vector3d& p_G) {
+  EXPECT_NEAR(hit.t, t, 1.2e-7 * t);
+  const double scale = t * ray.d.cast<double>().norm() + p_G.norm();
+  EXPECT_LT((hit.p_G.cast<double>() - p_G).norm(), 3e-7 * scale + 1e-9);
+  EXPECT_EQ(hit.n_G, Eigen::Vector3f(0, 0, 1));
+  const Eigen::Vector3d n_W = X_WG.linear().col(2);
+  const bool from_front = ray.d.cast<double>().dot(n_W) < 0;
+  EXPECT_EQ(hit.front_face, from_front);
+  EXPECT_LT((hit.ng_W.cast<double>() - (from_front ? n_W : -n_W)).norm(), 1e-7);
+  EXPECT_EQ(hit.ns_W, hit.ng_W);
+}
+
+Ray RayTo(const Eigen::Vector3d& o, const Eigen::Vector3d& target) {
+  Ray r;
+  r.o = o.cast<float>();
+  r.d = (target - o).cast<float>();
+  return r;
+}
+
+TEST(RaySceneTest, AxisAlignedFloorsMatchTheAnalyticPlaneAndAreWatertight) {
+  // the default world's floors: a finite 4 x 3 m floor at z = 0 and an infinite one (half-size
+  // kInfinitePlaneHalfSize) 2 cm below, seen from a low camera; every hit is the analytic one,
+  // rays aimed at the quad diagonals (where the two triangles meet) all hit, and rays 1e-5 m
+  // past the finite floor's edges go through to the infinite one.
+  SceneDescription scene = EmptyScene();
+  const Pose X_floor = Translation(0, 0, 0), X_ground = Translation(0, 0, -0.02);
+  const int floor = AddGeom(&scene, GeomShape::kPlane, {4, 3, 0.1}, X_floor);
+  const int ground = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_ground);
+  RayScene rs(scene);
+  rs.Update(testing::IdentitySnapshot(scene));
+  EXPECT_EQ(rs.num_triangles(), 0);
+  int checked = 0;
+  for (const Eigen::Vector3d& o :
+       {Eigen::Vector3d(0.4, -0.3, 0.355), Eigen::Vector3d(-3.1, 2.2, 1.7),
+        Eigen::Vector3d(2.0, 0.5, -0.5)}) {
+    for (int i = 0; i <= 200; ++i) {
+      const double s = -1 + 2.0 * i / 200;
+      for (const double off : {0.0, 1e-7, -1e-7, 1e-6, -1e-6, 3e-4}) {
+        // points on the diagonals y = +-3/4 x, moved by `off` normal to them.
+        for (const double sign : {1.0, -1.0}) {
+          const Eigen::Vector2d n = Eigen::Vector2d(-3 * sign, 4).normalized();
+          const Eigen::Vector2d q = Eigen::Vector2d(4 * s, 3 * s * sign) * 0.999 + off * n;
+          const Ray ray = RayTo(o, Eigen::Vector3d(q.x(), q.y(), 0));
+          double t;
+          Eigen::Vector3d p_G;
+          const bool from_below = o.z() < 0;
+          SurfaceHit hit;
+          ASSERT_TRUE(rs.Intersect(ray, &hit)) << o.transpose() << " s " << s << " off " << off;
+          // from below, the ground (2 cm below the floor) comes first.
+          const int expected = from_below ? ground : floor;
+          ASSERT_EQ(hit.geom, expected);
+          const Pose& X = from_below ? X_ground : X_floor;
+          const double half = from_below ? kInfinitePlaneHalfSize : 4.0;
+          ASSERT_TRUE(ReferencePlaneHit(X, half, from_below ? half : 3.0, ray, &t, &p_G));
+          ExpectPlaneHit(hit, ray, X, t, p_G);
+          EXPECT_FALSE(rs.Occluded(SpawnRay(hit, -ray.d)));
+          ++checked;
+        }
+      }
+      // just inside / just outside the edges x = +-4 and y = +-3 (from above).
+      if (o.z() < 0) continue;
+      for (const double eps : {1e-5, -1e-5}) {
+        for (const Eigen::Vector3d& q :
+             {Eigen::Vector3d(4 + eps, 2.9 * s, 0), Eigen::Vector3d(-4 - eps, 2.9 * s, 0),
+              Eigen::Vector3d(3.9 * s, 3 + eps, 0), Eigen::Vector3d(3.9 * s, -3 - eps, 0)}) {
+          SurfaceHit hit;
+          const Ray ray = RayTo(o, q);
+          ASSERT_TRUE(rs.Intersect(ray, &hit));
+          EXPECT_EQ(hit.geom, eps > 0 ? ground : floor) << q.transpose();
+          // a shadow ray ending 1 mm above the point is not blocked; 10 % longer, it crosses
+          // the floor or the ground.
+          Ray shadow = RayTo(o, q + Eigen::Vector3d(0, 0, 1e-3));
+          shadow.tmax = 1.0f;
+          EXPECT_FALSE(rs.Occluded(shadow));
+          shadow.tmax = 1.1f;  // goes on through the floor or the ground
+          EXPECT_TRUE(rs.Occluded(shadow));
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 7000);
+}
+
+TEST(RaySceneTest, InfinitePlanesAtGrazingAnglesKeepFloatDepths) {
+  // an infinite floor and an infinite wall (posed with a rotation whose matrix has rounding
+  // residues instead of zeros), seen at grazing angles out to 1e4 m: the depth is the
+  // analytic one to float rounding at every distance, and shadow rays leaving the hit point
+  // away from the surface are never blocked by it (no self-intersection).
+  SceneDescription scene = EmptyScene();
+  const Pose X_floor = Translation(0, 0, 0);
+  Pose X_wall = Translation(30, 0, 0);
+  X_wall.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  ASSERT_NE(X_wall.linear()(0, 0), 0.0);  // the residue the triangles must tolerate
+  const int floor = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_floor);
+  const int wall = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_wall);
+  RayScene rs(scene);
+  rs.Update(testing::IdentitySnapshot(scene));
+  const Eigen::Vector3d o(0.3, -0.2, 0.35);
+  int floor_hits = 0, wall_hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    // elevation from -0.5 rad down to -5e-5 rad (floor hits out to 7e3 m) and azimuths
+    // all around (rays towards +x meet the wall first).
+    const double el = -0.5 * std::pow(10.0, -4.0 * i / 399.0);
+    const double az = 2 * M_PI * i * 0.618034;
+    Ray ray;
+    ray.o = o.cast<float>();
+    ray.d = Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el))
+                .cast<float>();
+    SurfaceHit hit;
+    double t_floor, t_wall;
+    Eigen::Vector3d p_floor, p_wall;
+    const bool h_floor = ReferencePlaneHit(X_floor, kInfinitePlaneHalfSize, kInfinitePlaneHalfSize,
+                                           ray, &t_floor, &p_floor);
+    const bool h_wall = ReferencePlaneHit(X_wall, kInfinitePlaneHalfSize, kInfinitePlaneHalfSize,
+                                          ray, &t_wall, &p_wall);
+    if (!h_floor && !h_wall) {
+      EXPECT_FALSE(rs.Intersect(ray, &hit));
+      continue;
+    }
+    ASSERT_TRUE(rs.Intersect(ray, &hit)) << i;
+    const bool wall_first = h_wall && (!h_floor || t_wall < t_floor);
+    ASSERT_EQ(hit.geom, wall_first ? wall : floor) << i;
+    if (wall_first) {
+      ExpectPlaneHit(hit, ray, X_wall, t_wall, p_wall);
+      ++wall_hits;
+    } else {
+      ExpectPlaneHit(hit, ray, X_floor, t_floor, p_floor);
+      ++floor_hits;
+    }
+    // the hit point itself lies on the plane to float rounding of p_W.
+    const double dist = wall_first ? hit.p_W.x() - 30.0 : hit.p_W.z();
+    EXPECT_LT(std::abs(dist), 3e-7 * (hit.p_W.cwiseAbs().maxCoeff() + o.cwiseAbs().maxCoeff()));
+    // shadow rays towards the sky side never hit their own surface.
+    for (const Eigen::Vector3f& d :
+         {Eigen::Vector3f(hit.ng_W), Eigen::Vector3f(hit.ng_W + 0.3f * ray.d).normalized(),
+          Eigen::Vector3f(-ray.d)}) {
+      Ray shadow = SpawnRay(hit, d);
+      shadow.tmax = 1e-2f;
+      EXPECT_FALSE(rs.Occluded(shadow)) << i;
+    }
+  }
+  EXPECT_GT(floor_hits, 200);
+  EXPECT_GT(wall_hits, 30);
+}
+
+TEST(RaySceneTest, TiltedPlanesStayAnalytic) {
+  // a tilted infinite plane (30 deg about x and 20 deg about z) and a tilted finite one: the
+  // depth is the analytic one to float rounding of the ray, also 1e3 m away, and shadow rays
+  // from the hits leave the surface (float corners 1e4 m away would put the plane ~1e-3 m off).
+  SceneDescription scene = EmptyScene();
+  Pose X_big = Translation(0.5, 1.0, -1.0);
+  X_big.linear() = (Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()) *
+                    Eigen::AngleAxisd(0.52, Eigen::Vector3d::UnitX()))
+                       .toRotationMatrix();
+  const int big = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_big);
+  RayScene rs(scene);
+  rs.Update(testing::IdentitySnapshot(scene));
+  const Eigen::Vector3d n_W = X_big.linear().col(2);
+  int hits = 0;
+  for (int i = 0; i < 500; ++i) {
+    const double u = -1 + 2.0 * ((i * 37) % 500) / 500, v = -1 + 2.0 * i / 500;
+    // targets on the plane out to 1e3 m from its centre, and a ray origin above it.
+    const Eigen::Vector3d target = X_big * Eigen::Vector3d(1e3 * u * u * u, 1e3 * v * v * v, 0);
+    const Eigen::Vector3d o = X_big * Eigen::Vector3d(0.2, -0.1, 1.3);
+    const Ray ray = RayTo(o, target);
+    double t;
+    Eigen::Vector3d p_G;
+    ASSERT_TRUE(
+        ReferencePlaneHit(X_big, kInfinitePlaneHalfSize, kInfinitePlaneHalfSize, ray, &t, &p_G));
+    SurfaceHit hit;
+    ASSERT_TRUE(rs.Intersect(ray, &hit));
+    EXPECT_EQ(hit.geom, big);
+    ExpectPlaneHit(hit, ray, X_big, t, p_G);
+    Ray shadow = SpawnRay(hit, n_W.cast<float>());
+    EXPECT_FALSE(rs.Occluded(shadow));
+    ++hits;
+  }
+  EXPECT_EQ(hits, 500);
+}
+
+TEST(RaySceneTest, PlaneOnAMovingBodyMatchesTheAnalyticPlane) {
+  // a finite 0.6 x 0.4 m plate on a moving body (a robot's deck), posed with rotations; it is
+  // axis-aligned in the body frame (triangles there): hits match the analytic plane posed at
+  // X_WB X_BG, rays 1e-4 m past an edge miss, and packets (IntersectMany, OccludedLanes)
+  // agree with single rays.
+  SceneDescription scene = EmptyScene();
+  const int body = AddBody(&scene, "deck");
+  Pose X_BG = Translation(0.1, -0.05, 0.2);
+  X_BG.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const int plate = AddGeom(&scene, GeomShape::kPlane, {0.6, 0.4, 0.01}, X_BG, body);
+  RayScene rs(scene);
+  WorldSnapshot snap = testing::IdentitySnapshot(scene);
+  int hits = 0, misses = 0;
+  for (const double yaw : {0.0, 0.4, -2.2}) {
+    Pose X_WB = Translation(2.0, 0.3, 0.5);
+    X_WB.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(0.2 * yaw, Eigen::Vector3d::UnitY()))
+                        .toRotationMatrix();
+    snap.X_WB[body] = X_WB;
+    rs.Update(snap);
+    const Pose X_WG = X_WB * X_BG;
+    const Eigen::Vector3d o(0, 0, 0.4);
+    std::vector<Ray> rays;
+    std::vector<int> expect;  // 1 hit, 0 miss
+    for (int i = -12; i <= 12; ++i)
+      for (int j = -12; j <= 12; ++j) {
+        // a grid over the plate and its edges: targets at 0.9 of the half-size, and
+        // 1e-4 m beyond the edges.
+        const double x = i == 12 ? 0.6 + 1e-4 : i == -12 ? -0.6 - 1e-4 : 0.9 * 0.6 * i / 11;
+        const double y = j == 12 ? 0.4 + 1e-4 : j == -12 ? -0.4 - 1e-4 : 0.9 * 0.4 * j / 11;
+        rays.push_back(RayTo(o, X_WG * Eigen::Vector3d(x, y, 0)));
+        expect.push_back(std::abs(i) < 12 && std::abs(j) < 12);
+      }
+    const int n = static_cast<int>(rays.size());
+    std::vector<SurfaceHit> many(n);
+    std::unique_ptr<bool[]> got_many(new bool[n]);
+    rs.IntersectMany(rays.data(), n, /*coherent=*/true, many.data(), got_many.get());
+    for (int k = 0; k < n; ++k) {
+      SurfaceHit hit;
+      const bool got = rs.Intersect(rays[k], &hit);
+      ASSERT_EQ(got, expect[k] == 1) << "ray " << k << " yaw " << yaw;
+      ASSERT_EQ(got_many[k], got);
+      Ray shadow = rays[k];
+      shadow.tmax = 1.0f - 1e-3f;  // ends 0.1 % before the plate
+      EXPECT_FALSE(rs.Occluded(shadow));
+      shadow.tmax = 1.0f + 1e-3f;
+      EXPECT_EQ(rs.Occluded(shadow), got);
+      if (!got) {
+        ++misses;
+        continue;
+      }
+      ++hits;
+      EXPECT_EQ(hit.geom, plate);
+      ExpectSameHit(many[k], hit);
+      double t;
+      Eigen::Vector3d p_G;
+      ASSERT_TRUE(ReferencePlaneHit(X_WG, 0.6, 0.4, rays[k], &t, &p_G));
+      ExpectPlaneHit(hit, rays[k], X_WG, t, p_G);
+    }
+    // the same shadow rays as lanes.
+    for (int start = 0; start + kLanes <= n; start += kLanes) {
+      Vec3Lanes lo, ld;
+      Lanes tmax;
+      for (int k = 0; k < kLanes; ++k) {
+        const Ray& r = rays[start + k];
+        lo.x[k] = r.o.x();
+        lo.y[k] = r.o.y();
+        lo.z[k] = r.o.z();
+        ld.x[k] = r.d.x();
+        ld.y[k] = r.d.y();
+        ld.z[k] = r.d.z();
+        tmax[k] = k % 2 ? 1.0f + 1e-3f : 1.0f - 1e-3f;
+      }
+      const LaneMask active(0xbfffu);  // lane 14 idle
+      LaneMask occluded;
+      rs.OccludedLanes(lo, ld, tmax, active, &occluded);
+      for (int k = 0; k < kLanes; ++k)
+        EXPECT_EQ(occluded[k], k != 14 && k % 2 == 1 && expect[start + k] == 1) << start + k;
+    }
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_GT(misses, 250);
 }
 
 // a square plate of 2 n^2 triangles, side 1 m, in the z = 0 plane of its frame, facing +z.

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -29,7 +30,41 @@ struct AnalyticGeom {
   Eigen::Matrix3d R_GW = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_GW = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_WG = Eigen::Matrix3d::Identity();
+  // a plane traced as two Embree triangles (see ray_scene.h): its corners in the instance
+  // frame (one padding element for Embree's 16-byte loads) and the two faces, fanned from
+  // corner 0 so that Embree's edge test of the shared diagonal is the same in both (no crack).
+  bool plane_triangles = false;
+  std::array<Eigen::Vector3f, 5> corners_I;
+  std::array<Eigen::Vector3i, 2> faces{Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3)};
 };
+
+// how far (m) the corners of a plane may lie off the plane through its centre normal to the
+// instance-frame axis nearest its normal and still be traced as triangles in that plane: the
+// rounding residue of rotation matrices of axis-aligned poses (~1e-16 of the half-size).
+constexpr double kAxisAlignedPlaneTolerance = 1e-9;
+
+// the corners of `plane` (posed at X_IG in the instance frame) as float vertices that share one
+// coordinate exactly, if the plane is normal to an instance-frame axis to within
+// kAxisAlignedPlaneTolerance; false (corners untouched) if it is tilted.
+bool AxisAlignedPlaneCorners(const AnalyticShape& plane, const Pose& X_IG,
+                             std::array<Eigen::Vector3f, 5>* corners) {
+  const Eigen::Matrix3d& R_IG = X_IG.linear();
+  const Eigen::Vector3d& p_IG = X_IG.translation();
+  int axis;
+  R_IG.col(2).cwiseAbs().maxCoeff(&axis);
+  const double sx = plane.size.x(), sy = plane.size.y();
+  const Eigen::Vector3d c_G[4] = {{-sx, -sy, 0}, {sx, -sy, 0}, {sx, sy, 0}, {-sx, sy, 0}};
+  std::array<Eigen::Vector3f, 5> v;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d c_I = R_IG * c_G[k] + p_IG;
+    if (!(std::abs(c_I[axis] - p_IG[axis]) <= kAxisAlignedPlaneTolerance)) return false;
+    v[k] = c_I.cast<float>();
+    v[k][axis] = static_cast<float>(p_IG[axis]);
+  }
+  v[4].setZero();
+  *corners = v;
+  return true;
+}
 
 // a geom traced as triangles, in the instance frame. vertices carry one padding element at
 // the end: Embree reads vertex buffers with 16-byte loads.
@@ -231,12 +266,23 @@ struct RayScene::Impl {
       ag->shape = AnalyticShapeOf(geom);
       ag->R_GI = X_GI.linear();
       ag->p_GI = X_GI.translation();
-      eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-      rtcSetGeometryUserPrimitiveCount(eg, 1);
-      rtcSetGeometryUserData(eg, ag.get());
-      rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
-      rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
-      rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
+      ag->plane_triangles = ag->shape.kind == AnalyticKind::kPlane &&
+                            AxisAlignedPlaneCorners(ag->shape, X_IG, &ag->corners_I);
+      if (ag->plane_triangles) {
+        // Embree's own triangle test finds the hit; FinishHit recomputes it in double.
+        eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   ag->corners_I.data(), 0, sizeof(Eigen::Vector3f), 4);
+        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, ag->faces.data(),
+                                   0, sizeof(Eigen::Vector3i), 2);
+      } else {
+        eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(eg, 1);
+        rtcSetGeometryUserData(eg, ag.get());
+        rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
+        rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
+        rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
+      }
       rec.analytic = ag.get();
       group->analytic.push_back(std::move(ag));
     }
@@ -319,7 +365,18 @@ struct RayScene::Impl {
   void FinishHit(const Ray& ray, const RTCRayHit& rh, SurfaceHit* hit) const {
     const InstanceGroup& group = groups[group_of_instance[rh.hit.instID[0]]];
     const GeomRecord& rec = group.records[rh.hit.geomID];
-    const float t = rh.ray.tfar;
+    float t = rh.ray.tfar;
+    ShapePart part = static_cast<ShapePart>(static_cast<int>(rh.hit.u));
+    if (rec.analytic && rec.analytic->plane_triangles) {
+      // a plane found by Embree's float triangle test: its exact distance, in double, from
+      // the world ray (the formula of IntersectAnalytic), kept within the ray's range.
+      const AnalyticGeom& g = *rec.analytic;
+      const Eigen::Vector3d o_G = g.R_GW * ray.o.cast<double>() + g.p_GW;
+      const Eigen::Vector3d d_G = g.R_GW * ray.d.cast<double>();
+      const double tc = -o_G.z() / d_G.z();
+      if (std::isfinite(tc)) t = std::clamp(static_cast<float>(tc), ray.tmin, ray.tmax);
+      part = ShapePart::kMain;
+    }
     hit->t = t;
     hit->p_W = ray.o + t * ray.d;
     hit->geom = rec.geom;
@@ -332,8 +389,7 @@ struct RayScene::Impl {
       const Eigen::Vector3d p_W =
           ray.o.cast<double>() + static_cast<double>(t) * ray.d.cast<double>();
       const Eigen::Vector3d p_G = g.R_GW * p_W + g.p_GW;
-      const Eigen::Vector3d n_G =
-          AnalyticNormal(g.shape, p_G, static_cast<ShapePart>(static_cast<int>(rh.hit.u)));
+      const Eigen::Vector3d n_G = AnalyticNormal(g.shape, p_G, part);
       hit->p_G = p_G.cast<float>();
       hit->n_G = n_G.cast<float>();
       ng_W = (g.R_WG * n_G).cast<float>();

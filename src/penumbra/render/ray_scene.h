@@ -11,9 +11,21 @@
 //
 // geom shapes: box, mesh and height field are triangle geometry (box faces are exact
 // planes; meshes carry vertex normals for smooth shading and texcoords); plane, sphere,
-// capsule, ellipsoid and cylinder are Embree user geometry intersected analytically in
-// double precision, so depths are exact up to float rounding of the ray (LiDAR ranges).
-// an infinite plane (MJCF half-size 0) is clipped to kInfinitePlaneHalfSize.
+// capsule, ellipsoid and cylinder are intersected analytically in double precision, so
+// depths are exact up to float rounding of the ray (LiDAR ranges). sphere, capsule, ellipsoid
+// and cylinder are Embree user geometry. an infinite plane (MJCF half-size 0) is clipped to
+// kInfinitePlaneHalfSize.
+//
+// planes: a plane normal to an axis of its instance frame (the world frame for static bodies,
+// the body frame for moving ones; normal within kAxisAlignedPlaneTolerance in ray_scene.cc,
+// i.e. floors, walls and ceilings of any size and pose up to rounding) is two Embree
+// triangles, whose float corners then share that axis' coordinate exactly: Embree's float
+// test is exact in the normal direction (distance error of a few float ulps at any distance
+// or angle) and watertight on the shared diagonal, and Intersect* then recomputes the depth
+// in double from the world ray (the analytic formula), so the reported t, p_W, p_G and normal
+// are those of the analytic plane. the closest-hit choice between surfaces and Occluded use
+// Embree's t, a few ulps from the exact one. tilted planes stay user geometry (a float
+// triangle corner kInfinitePlaneHalfSize away would tilt the plane by its rounding, ~1e-3 m).
 //
 // visibility: geoms in MJCF groups > 2 (MuJoCo shows groups 0-2 by default) and geoms
 // whose material has alpha < 0.5 are left out.
@@ -125,7 +137,8 @@ class RayScene {
   /// scenes are never rebuilt after construction.
   int64_t num_top_level_commits() const { return num_top_level_commits_; }
 
-  /// how many geoms are ray traced (visible) and how many triangles they hold.
+  /// how many geoms are ray traced (visible) and how many triangles they hold (meshes, height
+  /// fields and boxes; not the two triangles of a plane, which is an analytic shape).
   int num_visible_geoms() const { return num_visible_geoms_; }
   int64_t num_triangles() const { return num_triangles_; }
 
