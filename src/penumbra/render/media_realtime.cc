@@ -1,5 +1,7 @@
 #include "penumbra/render/media_realtime.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -27,6 +29,49 @@ ColumnBilerp ColumnsAt(float x, float y, int block, int nx, int ny) {
   const float wx = fx - x0, wy = fy - y0;
   return {{y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1},
           {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
+}
+
+// ColumnsAt's per-axis part at every pixel centre u and every quad centre u + 0.5 of an axis of
+// n pixels (the same arithmetic, so ColumnsFrom gives ColumnsAt's result bit for bit).
+void BuildAxisTables(int n, int block, int columns, std::vector<RealtimeMedia::AxisBilerp>* at,
+                     std::vector<RealtimeMedia::AxisBilerp>* at_half) {
+  auto one = [&](float x) {
+    const float f = std::clamp((x - block / 2) / static_cast<float>(block), 0.0f,
+                               static_cast<float>(columns - 1));
+    const int i0 = static_cast<int>(f);
+    return RealtimeMedia::AxisBilerp{i0, std::min(i0 + 1, columns - 1), f - i0};
+  };
+  at->resize(n);
+  at_half->resize(n);
+  for (int u = 0; u < n; ++u) {
+    (*at)[u] = one(static_cast<float>(u));
+    (*at_half)[u] = one(u + 0.5f);
+  }
+}
+
+// ColumnsAt from the per-axis parts of x and y.
+ColumnBilerp ColumnsFrom(const RealtimeMedia::AxisBilerp& x, const RealtimeMedia::AxisBilerp& y,
+                         int nx) {
+  const float wx = x.w, wy = y.w;
+  return {{y.i0 * nx + x.i0, y.i0 * nx + x.i1, y.i1 * nx + x.i0, y.i1 * nx + x.i1},
+          {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
+}
+
+// ColumnsAt(u, v) of pixel (u, v) (from the tables inside the image).
+template <typename F>
+ColumnBilerp PixelColumns(const F& fr, int u, int v, int block) {
+  if (u >= 0 && v >= 0 && u < static_cast<int>(fr.ax.size()) && v < static_cast<int>(fr.ay.size()))
+    return ColumnsFrom(fr.ax[u], fr.ay[v], fr.nx);
+  return ColumnsAt(static_cast<float>(u), static_cast<float>(v), block, fr.nx, fr.ny);
+}
+
+// ColumnsAt(u0 + 0.5, v0 + 0.5) of the quad at (u0, v0).
+template <typename F>
+ColumnBilerp QuadColumns(const F& fr, int u0, int v0, int block) {
+  if (u0 >= 0 && v0 >= 0 && u0 < static_cast<int>(fr.ax_half.size()) &&
+      v0 < static_cast<int>(fr.ay_half.size()))
+    return ColumnsFrom(fr.ax_half[u0], fr.ay_half[v0], fr.nx);
+  return ColumnsAt(u0 + 0.5f, v0 + 0.5f, block, fr.nx, fr.ny);
 }
 
 // trilinear lookup in a cell-centred (r0 x r1 x r2) array at continuous index f (cell centre
@@ -60,7 +105,11 @@ Eigen::Array4f To4(const Eigen::Vector3f& v) { return Eigen::Array4f(v.x(), v.y(
 // above the base height, closed form per piece): the integral of h(z(t)) dt over [a, b] for
 // z(t) = oz + dz t (d unit); b may be +inf. float keeps the relative error near 1e-6 (the
 // optical depths it yields are used as exp(-tau) for display radiance).
-float DensityIntegralF(const AnalyticMedium& m, float oz, float dz, float a, float b) {
+// h_0: h(0) of this ray (the camera's h, RealtimeMedia::h_cam_) when oz is the camera's height,
+// else NaN (then computed here); h(+-0) does not depend on dz, so it is the same value bit for
+// bit.
+float DensityIntegralF(const AnalyticMedium& m, float oz, float dz, float a, float b,
+                       float h_0 = std::numeric_limits<float>::quiet_NaN()) {
   if (!(a < b)) return 0.0f;
   auto piece = [](float s, float e, float h_s, float rate) {
     const float len = e - s;
@@ -69,7 +118,10 @@ float DensityIntegralF(const AnalyticMedium& m, float oz, float dz, float a, flo
     return h_s * -std::expm1(-rate * len) / rate;
   };
   const float k = m.falloff, zb = m.base;
-  auto h = [&](float t) { return std::exp(-k * std::max(0.0f, oz + dz * t - zb)); };
+  auto h = [&](float t) {
+    if (t == 0.0f && h_0 == h_0) return h_0;
+    return std::exp(-k * std::max(0.0f, oz + dz * t - zb));
+  };
   if (k <= 0 || std::abs(dz) < 1e-9f) return piece(a, b, k <= 0 ? 1.0f : h(a), 0.0f);
   const float tc = (zb - oz) / dz;  // where z crosses the base
   float sum = 0.0f;
@@ -104,6 +156,15 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   for (const AnalyticMedium& m : media.analytic()) {
     sigma_t4_.push_back(To4(m.sigma_t));
     sigma_s4_.push_back(To4(m.sigma_s));
+  }
+  // the camera's h(0) per medium (DensityIntegralF), and whether every sigma_t is grey.
+  h_cam_oz_ = camera.GenerateRay(0.0f, 0.0f).o.z();
+  h_cam_.clear();
+  grey_t_ = true;
+  for (const AnalyticMedium& m : media.analytic()) {
+    const float k = m.falloff, zb = m.base;
+    h_cam_.push_back(std::exp(-k * std::max(0.0f, h_cam_oz_ + 0.0f * 0.0f - zb)));
+    grey_t_ = grey_t_ && m.sigma_t.x() == m.sigma_t.y() && m.sigma_t.y() == m.sigma_t.z();
   }
   num_lights_ = std::min(lights.size(), kMaxVolumeLights);
   const int nl = num_lights_;
@@ -202,6 +263,13 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
         vol_.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, 128);
         vol_.cells_per_m[k] = vol_.r[k] / size[k];
       }
+      for (int k = 0; k < 3; ++k) {
+        vol_.lo4[k] = vol_.lo[k];
+        vol_.hi4[k] = vol_.hi[k];
+        vol_.cpm4[k] = vol_.cells_per_m[k];
+        vol_.rmax4[k] = static_cast<float>(vol_.r[k] - 1);
+        vol_.imax4[k] = static_cast<float>(std::max(vol_.r[k] - 2, 0));
+      }
       const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
       vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
       if (vol_.with_visibility) vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
@@ -256,6 +324,8 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   fr.ny = (H + kFroxelBlock - 1) / kFroxelBlock;
   const int columns = fr.nx * fr.ny;
   constexpr int Z = kFroxelSlices;
+  BuildAxisTables(W, kFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
+  BuildAxisTables(H, kFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
   fr.t0.assign(columns, 0.0f);
   fr.t1.assign(columns, 0.0f);
   fr.slices_per_m.assign(columns, 0.0f);
@@ -322,8 +392,7 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
                                    Eigen::Array4f* T) const {
   const Froxels& fr = froxels_;
   constexpr int Z = kFroxelSlices;
-  const ColumnBilerp cb =
-      ColumnsAt(static_cast<float>(u), static_cast<float>(v), kFroxelBlock, fr.nx, fr.ny);
+  const ColumnBilerp cb = PixelColumns(fr, u, v, kFroxelBlock);
   const int* cols = cb.cols;
   // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
   float t_enter = kInfF;
@@ -388,9 +457,19 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   fr.ny = (H + kFogFroxelBlock - 1) / kFogFroxelBlock;
   const int columns = fr.nx * fr.ny;
   constexpr int Z = kFogFroxelSlices;
+  BuildAxisTables(W, kFogFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
+  BuildAxisTables(H, kFogFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
   fr.inv_log_far.assign(columns, 1.0f / std::log(2.0f));
   fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Array4f::Zero());
   const int nm = static_cast<int>(media.analytic().size());
+  // a directional light's sample (u1 = u2 = 0.5) is the same at every point: taken once.
+  const int nl = lights.size();
+  std::vector<uint8_t> directional(nl, 0);
+  std::vector<LightSample> sun_sample(nl);
+  for (int j = 0; j < nl; ++j) {
+    if (lights.lights()[j].type != Light::Type::kDirectional) continue;
+    directional[j] = lights.Sample(j, Eigen::Vector3f::Zero(), 0.5f, 0.5f, &sun_sample[j]) ? 1 : 0;
+  }
   auto column = [&](int64_t c) {
     const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
     const int uc = std::min(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
@@ -413,26 +492,43 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
     const Eigen::Vector3f wo = -d;
     Eigen::Array4f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
     Eigen::Vector3f S = Eigen::Vector3f::Zero();
+    float boundary[Z + 1];
+    for (int k = 0; k <= Z; ++k) boundary[k] = FogBoundary(k, t_far);
+    // per medium at the slice point: inside it, and its relative density (the same for every
+    // light).
+    std::vector<float> density(nm);
+    std::vector<uint8_t> inside(nm);
     for (int k = 0; k < Z; ++k) {
-      const float lo = FogBoundary(k, t_far), hi = FogBoundary(k + 1, t_far);
+      const float lo = boundary[k], hi = boundary[k + 1];
       const float t = lo + jitter * (hi - lo);
       const Eigen::Vector3f x = o + t * d;
+      for (int i = 0; i < nm; ++i) {
+        const AnalyticMedium& m = media.analytic()[i];
+        inside[i] = Inside(m, x);
+        if (inside[i]) density[i] = m.Density(x.z());
+      }
       Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
       // the visibility of every light with a volume in one lookup where x is in the volume.
       float vis_all[kMaxVolumeLights];
       const bool located = vol_.with_visibility && CellLightsLookup(vol_.vis_cl.data(), x, vis_all);
       for (int j = 0; j < lights.size(); ++j) {
+        // a light without visibility here adds nothing: skip its sample.
+        if (located && j < num_lights_ && !(vis_all[j] > 0)) continue;
         LightSample ls;
-        if (!lights.Sample(j, x, 0.5f, 0.5f, &ls)) continue;
+        if (directional[j]) {
+          ls = sun_sample[j];
+        } else if (!lights.Sample(j, x, 0.5f, 0.5f, &ls)) {
+          continue;
+        }
         const float vis =
             located && j < num_lights_ ? vis_all[j] : FogVisibility(j, x, ls.wi, ls.distance);
         if (!(vis > 0)) continue;
         const float cos_t = wo.dot(ls.wi);
         Eigen::Vector3f ph = Eigen::Vector3f::Zero();
         for (int i = 0; i < nm; ++i) {
+          if (!inside[i]) continue;
           const AnalyticMedium& m = media.analytic()[i];
-          if (!Inside(m, x)) continue;
-          ph += m.sigma_s * (m.Density(x.z()) * HenyeyGreenstein(cos_t, m.g));
+          ph += m.sigma_s * (density[i] * HenyeyGreenstein(cos_t, m.g));
         }
         Ls += ls.E.cwiseProduct(ph) * vis;
       }
@@ -454,8 +550,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
 Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const FogFroxels& fr = fog_froxels_;
   constexpr int Z = kFogFroxelSlices;
-  const ColumnBilerp cb =
-      ColumnsAt(static_cast<float>(u), static_cast<float>(v), kFogFroxelBlock, fr.nx, fr.ny);
+  const ColumnBilerp cb = PixelColumns(fr, u, v, kFogFroxelBlock);
   const int* cols = cb.cols;
   const float* w = cb.w;
   Eigen::Array4f out = Eigen::Array4f::Zero();
@@ -484,7 +579,7 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) cons
     constexpr int Z = kFroxelSlices;
     const float t = std::min(t_c, 1e30f);
     q.t_c = t;
-    const ColumnBilerp cb = ColumnsAt(u0 + 0.5f, v0 + 0.5f, kFroxelBlock, fr.nx, fr.ny);
+    const ColumnBilerp cb = QuadColumns(fr, u0, v0, kFroxelBlock);
     const int* cols = cb.cols;
     float t_enter = kInfF;
     for (int k = 0; k < 4; ++k)
@@ -532,7 +627,7 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) cons
   const FogFroxels& ff = fog_froxels_;
   if (!ff.S.empty() && t_c > kFogFroxelNear) {
     constexpr int Z = kFogFroxelSlices;
-    const ColumnBilerp cb = ColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, ff.nx, ff.ny);
+    const ColumnBilerp cb = QuadColumns(ff, u0, v0, kFogFroxelBlock);
     const int* cols = cb.cols;
     const float* w = cb.w;
     const float log_t = std::log(t_c / kFogFroxelNear);
@@ -618,18 +713,32 @@ bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) co
 }
 
 bool RealtimeMedia::CellLightsLookup(const float* cl, const Eigen::Vector3f& p_W, float* T) const {
+  // the three axes in SSE lanes 0..2 (lane 3 is a dummy inside [0, 0]): the same IEEE
+  // operations as the scalar form clamp((x - lo) cells_per_m - 0.5, 0, r - 1), i0 =
+  // min(trunc(c), max(r - 2, 0)), step = min(i0 + 1, r - 1) - i0, w = c - i0 (the clamp's input
+  // is never -0 or NaN here, where max/min and std::clamp agree).
+  const __m128 x = _mm_set_ps(0.0f, p_W.z(), p_W.y(), p_W.x());
+  const __m128 inside = _mm_and_ps(_mm_cmpge_ps(x, _mm_loadu_ps(vol_.lo4.data())),
+                                   _mm_cmple_ps(x, _mm_loadu_ps(vol_.hi4.data())));
+  if (_mm_movemask_ps(inside) != 0xF) return false;
+  const __m128 rmax = _mm_loadu_ps(vol_.rmax4.data());
+  __m128 c = _mm_sub_ps(
+      _mm_mul_ps(_mm_sub_ps(x, _mm_loadu_ps(vol_.lo4.data())), _mm_loadu_ps(vol_.cpm4.data())),
+      _mm_set1_ps(0.5f));
+  c = _mm_min_ps(_mm_max_ps(c, _mm_setzero_ps()), rmax);
+  const __m128 i0 =
+      _mm_min_ps(_mm_cvtepi32_ps(_mm_cvttps_epi32(c)), _mm_loadu_ps(vol_.imax4.data()));
+  alignas(16) float wv[4], iv[4], sv[4];
+  _mm_store_ps(wv, _mm_sub_ps(c, i0));
+  _mm_store_ps(iv, i0);
+  const __m128 one = _mm_set1_ps(1.0f);
+  _mm_store_ps(sv, _mm_and_ps(_mm_cmple_ps(_mm_add_ps(i0, one), rmax), one));
   int base[3], step[3];
   float w[3];
   for (int k = 0; k < 3; ++k) {
-    const float x = p_W[k];
-    if (!(x >= vol_.lo[k] && x <= vol_.hi[k])) return false;
-    const int r = vol_.r[k];
-    const float c =
-        std::clamp((x - vol_.lo[k]) * vol_.cells_per_m[k] - 0.5f, 0.0f, static_cast<float>(r - 1));
-    const int i0 = std::min(static_cast<int>(c), std::max(r - 2, 0));
-    step[k] = std::min(i0 + 1, r - 1) - i0;
-    base[k] = i0;
-    w[k] = c - static_cast<float>(i0);
+    base[k] = static_cast<int>(iv[k]);
+    step[k] = static_cast<int>(sv[k]);
+    w[k] = wv[k];
   }
   // the eight corners (+1 along x, y, z for bits 0, 1, 2 of the corner index) and their
   // trilinear weights, summed in corner order; lights adjacent per cell.
@@ -705,15 +814,20 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
     const AnalyticMedium& m = media.analytic()[i];
     float a, b;
     if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
-    const float I = std::min(DensityIntegralF(m, o.z(), d.z(), a, b), 1e30f);
+    const float h_0 = o.z() == h_cam_oz_ ? h_cam_[i] : std::numeric_limits<float>::quiet_NaN();
+    const float I = std::min(DensityIntegralF(m, o.z(), d.z(), a, b, h_0), 1e30f);
     const Eigen::Array4f& st = sigma_t4_[i];
     tau_t += st * I;
     tau_s += sigma_s4_[i] * I;
     if (to_grid && a < first_a)
-      tau_a += st * std::min(DensityIntegralF(m, o.z(), d.z(), a, std::min(b, first_a)), 1e30f);
+      tau_a +=
+          st * std::min(DensityIntegralF(m, o.z(), d.z(), a, std::min(b, first_a), h_0), 1e30f);
   }
-  auto exp_neg = [](const Eigen::Array4f& tau) -> Eigen::Array4f {
-    if (tau[0] == tau[1] && tau[1] == tau[2])
+  // grey media give equal channels (the same operations on equal values), so the test is
+  // skipped for them.
+  const bool grey = grey_t_;
+  auto exp_neg = [grey](const Eigen::Array4f& tau) -> Eigen::Array4f {
+    if (grey || (tau[0] == tau[1] && tau[1] == tau[2]))
       return Eigen::Array4f::Constant(std::exp(-tau[0]));  // grey: one exponential
     return Eigen::Array4f(std::exp(-tau[0]), std::exp(-tau[1]), std::exp(-tau[2]), 1.0f);
   };

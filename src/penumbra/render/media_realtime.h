@@ -47,6 +47,7 @@
 // random numbers: the froxel columns' jitter, from their centre pixels' streams 2 and 3.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "penumbra/core/rng.h"
@@ -141,6 +142,13 @@ class RealtimeMedia {
   const MediaScene* media() const { return media_; }
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
 
+  /// one axis of the bilinear interpolation between froxel columns at an image position:
+  /// columns i0 and i1 along the axis and the weight w of i1 (tables per frame).
+  struct AxisBilerp {
+    int i0 = 0, i1 = 0;
+    float w = 0;
+  };
+
  private:
   struct GridLight {
     int r[3] = {1, 1, 1};
@@ -159,6 +167,8 @@ class RealtimeMedia {
     int stride = 0;               // lights per cell in trans_cl (num lights rounded up to 4)
     std::vector<float> trans_cl;  // [cell][light] copy of trans (LightTransmittances)
     std::vector<float> vis_cl;    // [cell][light] copy of vis (BuildFogFroxels)
+    // lo, hi, cells_per_m, r - 1 and max(r - 2, 0) per axis, 4th lane 0 (CellLightsLookup).
+    std::array<float, 4> lo4{}, hi4{}, cpm4{}, rmax4{}, imax4{};
   };
   struct FroxelRecord {
     // in-scatter and transmittance (rgb, 4th lane 0) from the camera to a slice boundary.
@@ -169,6 +179,8 @@ class RealtimeMedia {
     std::vector<float> t0, t1;          // [column] overlap of the column ray with the grids
     std::vector<float> slices_per_m;    // [column] kFroxelSlices / (t1 - t0), 0 without overlap
     std::vector<FroxelRecord> records;  // [column][slice boundary 0..kFroxelSlices]
+    // the column interpolation per pixel column / row and per quad (pixel + 0.5).
+    std::vector<AxisBilerp> ax, ax_half, ay, ay_half;
   };
   /// grid in-scatter S and transmittance T from the camera to distance t for pixel (u, v)
   /// (rgb in lanes 0..2); returns the smallest entry distance of the four columns (+inf if
@@ -183,6 +195,7 @@ class RealtimeMedia {
     int nx = 0, ny = 0;
     std::vector<float> inv_log_far;  // [column] 1 / log(last slice boundary / near)
     std::vector<Eigen::Array4f> S;   // [column][slice boundary 0..kFogFroxelSlices], rgb + 0
+    std::vector<AxisBilerp> ax, ax_half, ay, ay_half;  // as in Froxels
   };
   /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v)
   /// (rgb in lanes 0..2).
@@ -206,6 +219,11 @@ class RealtimeMedia {
   // built once per frame (assembling them per pixel stalls on store forwarding).
   std::vector<Eigen::Array4f> sigma_t4_, sigma_s4_;
   Eigen::Array4f sky_ambient4_ = Eigen::Array4f::Zero();
+  // relative density h(0) per homogeneous medium for rays from height h_cam_oz_ (the camera's
+  // pixel rays), and whether every homogeneous medium's sigma_t is grey.
+  float h_cam_oz_ = 0;
+  std::vector<float> h_cam_;
+  bool grey_t_ = false;
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;
   LightVolume vol_;

@@ -89,8 +89,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   ends_.clear();
   rain_radiance_.clear();
   visible_.clear();
-  pixel_t_.clear();
-  pixel_prim_.clear();
+  pixel_hits_built_ = false;
   if (impl_->scene) {
     rtcReleaseScene(impl_->scene);
     impl_->scene = nullptr;
@@ -109,19 +108,14 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
   const float fx_px = static_cast<float>(camera.intrinsics().fx);
   // every drop's check for finite values, streak and cull flag in parallel chunks (each drop
-  // only reads its own input and writes its own slot), then compacted serially in (set, index)
-  // order, so the output (and the first non-finite particle reported) does not depend on the
-  // thread count.
+  // only reads its own input), each chunk keeping its drawn streaks in (set, index) order in its
+  // own buffers (reused between frames), which are then concatenated in chunk order, so the
+  // output (and the first non-finite particle reported) does not depend on the thread count.
   std::vector<size_t> first(fx->particles.size() + 1, 0);
   for (size_t s = 0; s < fx->particles.size(); ++s)
     first[s + 1] = first[s] + fx->particles[s].position_W.size();
   const size_t n_all = first.back();
   if (n_all == 0) return;
-  // per drop: 0 = no streak (radius <= 0; realtime: wholly behind the near plane), 1 = culled,
-  // 2 = kept.
-  std::vector<uint8_t> state(n_all, 0);
-  std::vector<float> alpha_all(n_all);
-  std::vector<Eigen::Vector4f> ends_all(2 * n_all);
   const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
   // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
   // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
@@ -130,7 +124,9 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
-  auto drop = [&](size_t s, size_t i, size_t g) {
+  // one drop: nothing (radius <= 0; realtime: wholly behind the near plane), culled (counted)
+  // or a streak appended to `out`.
+  auto drop = [&](size_t s, size_t i, DropChunk* out) {
     const ParticleSet& ps = fx->particles[s];
     const Eigen::Vector3f& p = ps.position_W[i];
     const Eigen::Vector3f& v = ps.velocity_W[i];
@@ -151,19 +147,24 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
     if (pixel_hits && ps.kind == ParticleKind::kRain &&
         RainInvisible(alpha, cam_o, p + w * seg, cull_media)) {
-      state[g] = 1;
+      ++out->culled;
       return;
     }
-    state[g] = 2;
-    alpha_all[g] = alpha;
-    ends_all[2 * g] = Eigen::Vector4f(p.x(), p.y(), p.z(), r_wide);
-    ends_all[2 * g + 1] = Eigen::Vector4f(q.x(), q.y(), q.z(), r_wide);
+    out->alpha.push_back(alpha);
+    out->set.push_back(static_cast<int>(s));
+    out->ends.emplace_back(p.x(), p.y(), p.z(), r_wide);
+    out->ends.emplace_back(q.x(), q.y(), q.z(), r_wide);
   };
   constexpr size_t kDropChunk = 4096;
   const size_t drop_chunks = (n_all + kDropChunk - 1) / kDropChunk;
-  // per chunk: its first non-finite particle (n_all: none).
-  std::vector<size_t> bad(drop_chunks, n_all);
+  if (drop_chunks_.size() < drop_chunks) drop_chunks_.resize(drop_chunks);
   auto drop_chunk = [&](int64_t c) {
+    DropChunk& out = drop_chunks_[c];
+    out.alpha.clear();
+    out.set.clear();
+    out.ends.clear();
+    out.culled = 0;
+    out.bad = n_all;
     const size_t g0 = static_cast<size_t>(c) * kDropChunk;
     const size_t g1 = std::min(n_all, g0 + kDropChunk);
     size_t s =
@@ -174,14 +175,15 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
       const size_t i = g - first[s];
       if (!ps.position_W[i].allFinite() || !ps.velocity_W[i].allFinite() ||
           !std::isfinite(ps.radius_m[i])) {
-        bad[c] = g;
+        out.bad = g;  // its first non-finite particle
         return;
       }
-      drop(s, i, g);
+      drop(s, i, &out);
     }
   };
   ParallelForOrSerial(pool, static_cast<int64_t>(drop_chunks), drop_chunk);
-  for (size_t g : bad) {
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    const size_t g = drop_chunks_[c].bad;
     if (g == n_all) continue;
     const size_t s =
         static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g) - first.begin()) - 1;
@@ -189,19 +191,18 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
                       "particle " + std::to_string(g - first[s]) + " has a non-finite value");
   }
   size_t total = 0;
-  for (uint8_t st : state) total += st == 2 ? 1 : 0;
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    total += drop_chunks_[c].alpha.size();
+    culled_ += drop_chunks_[c].culled;
+  }
   alpha_.reserve(total);
   set_.reserve(total);
   ends_.reserve(2 * total);
-  for (size_t s = 0; s < fx->particles.size(); ++s) {
-    for (size_t g = first[s]; g < first[s + 1]; ++g) {
-      if (state[g] == 1) ++culled_;
-      if (state[g] != 2) continue;
-      alpha_.push_back(alpha_all[g]);
-      set_.push_back(static_cast<int>(s));
-      ends_.push_back(ends_all[2 * g]);
-      ends_.push_back(ends_all[2 * g + 1]);
-    }
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    const DropChunk& dc = drop_chunks_[c];
+    alpha_.insert(alpha_.end(), dc.alpha.begin(), dc.alpha.end());
+    set_.insert(set_.end(), dc.set.begin(), dc.set.end());
+    ends_.insert(ends_.end(), dc.ends.begin(), dc.ends.end());
   }
   count_ = static_cast<int>(alpha_.size());
   if (count_ == 0) return;
@@ -280,8 +281,10 @@ float IntersectCapsule(const CapsuleOrigin& c, const Eigen::Vector3f& d) {
 void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const int W = camera.width(), H = camera.height();
   pixel_w_ = W;
-  pixel_t_.assign(static_cast<size_t>(W) * H, std::numeric_limits<float>::infinity());
-  pixel_prim_.assign(static_cast<size_t>(W) * H, -1);
+  // (filled band by band below, in parallel)
+  pixel_t_.resize(static_cast<size_t>(W) * H);
+  pixel_prim_.resize(static_cast<size_t>(W) * H);
+  pixel_hits_built_ = true;
   const CameraIntrinsics& k = camera.intrinsics();
   const Pose X_OW = camera.X_WO().inverse();
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
@@ -337,6 +340,9 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const Eigen::Vector3f o_shared = camera.GenerateRay(0.0f, 0.0f).o;
   auto band = [&](int64_t bi) {
     const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
+    const size_t p0 = static_cast<size_t>(r0) * W, p1 = static_cast<size_t>(r1 + 1) * W;
+    std::fill(pixel_t_.begin() + p0, pixel_t_.begin() + p1, std::numeric_limits<float>::infinity());
+    std::fill(pixel_prim_.begin() + p0, pixel_prim_.begin() + p1, -1);
     for (int n : in_band[bi]) {
       const Eigen::Vector4i& bx = box[n];
       const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
@@ -381,7 +387,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
 }
 
 bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const {
-  if (pixel_prim_.empty()) return false;
+  if (!pixel_hits_built_) return false;
   const size_t at = static_cast<size_t>(v) * pixel_w_ + u;
   const int n = pixel_prim_[at];
   if (n < 0 || !(pixel_t_[at] <= tmax)) return false;

@@ -124,7 +124,18 @@ class ParticleScene {
   std::vector<float> pixel_t_;   // per pixel: nearest streak t (ray units), +inf none
   std::vector<int> pixel_prim_;  // per pixel: its primitive, -1 none
   std::vector<Eigen::Vector3f> rain_radiance_;  // per primitive (PrecomputeRain), or empty
-  std::vector<uint8_t> visible_;  // per primitive: in the image (BuildPixelHits), or empty
+  std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
+  bool pixel_hits_built_ = false;  // pixel_t_ and pixel_prim_ hold this frame's hits
+  // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
+  // capacity).
+  struct DropChunk {
+    std::vector<float> alpha;
+    std::vector<int> set;
+    std::vector<Eigen::Vector4f> ends;  // both ends per streak
+    int culled = 0;
+    size_t bad = 0;  // index of the chunk's first non-finite particle, or the particle count
+  };
+  std::vector<DropChunk> drop_chunks_;
 
   void BuildPixelHits(const Camera& camera, ThreadPool* pool);
 };

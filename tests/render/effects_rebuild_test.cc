@@ -1,0 +1,215 @@
+// per-frame state of the realtime effects structures: RealtimeMedia and ParticleScene keep
+// tables and buffers between Build calls (for their capacity) and per-frame shortcuts (the
+// camera's relative fog density, pixel / quad column tables); a rebuilt object must answer
+// exactly as a freshly built one, and the shortcuts must give the values of the full formulas.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "media_test_util.h"
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/media_scene.h"
+#include "penumbra/render/particle_scene.h"
+#include "penumbra/render/ray_scene.h"
+
+namespace penumbra::testing {
+namespace {
+
+bool SameBits(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return std::memcmp(a.data(), b.data(), sizeof(float) * 3) == 0;
+}
+
+bool SameBits(const MediaSegment& a, const MediaSegment& b) {
+  return SameBits(a.T, b.T) && SameBits(a.L_add, b.L_add);
+}
+
+// a point light, height fog (coloured or grey) and optionally a smoke ramp; media of `fx`.
+struct MediaSetup {
+  SceneDescription scene;
+  EffectsFrame fx;
+  MediaSetup(bool grey, bool smoke) {
+    scene = EmptyScene();
+    Light l;
+    l.type = Light::Type::kPoint;
+    l.position_B = {4, 1.5, 2.5};
+    l.intensity = 200;
+    scene.lights.push_back(l);
+    HomogeneousMedium fog = Fog(0.25f, 0.9f, 0.3f);
+    if (!grey) fog.sigma_t_per_m = Eigen::Vector3f(0.2f, 0.25f, 0.3f);
+    fog.height_falloff_per_m = 0.1f;
+    fog.base_height_m = 0.5f;
+    fx.homogeneous_media.push_back(fog);
+    if (smoke)
+      fx.grid_media.push_back(RampGrid({5, 0, 1}, {3, 3, 1.5}, 24, 1.0f, 0.25f, 1.5f, 0.8f));
+  }
+};
+
+TEST(EffectsRebuildTest, RebuiltRealtimeMediaMatchesFreshOne) {
+  // frame 1: coloured fog, no smoke, a 96 x 64 camera low down; frame 2: grey fog and smoke,
+  // a 160 x 120 camera higher up. the object rebuilt for frame 2 answers as a fresh one.
+  MediaSetup a(false, false), b(true, true);
+  const WorldSnapshot snap = IdentitySnapshot(b.scene);
+  LightSampler lights(b.scene);
+  lights.Update(snap);
+  RayScene rays(b.scene);
+  rays.Update(snap);
+  const CameraView view_a = MakeView(CameraLookingAlongX({0, 0, 0.3}), 96, 64, 60.0);
+  const CameraView view_b = MakeView(CameraLookingAlongX({0, 0.2, 1.2}), 160, 120, 70.0);
+  const Camera cam_a(view_a.X_WO, view_a.intrinsics), cam_b(view_b.X_WO, view_b.intrinsics);
+  MediaScene media_a, media_b;
+  media_a.Build(&a.fx);
+  media_b.Build(&b.fx);
+  ThreadPool pool(2);
+  RealtimeMedia reused, fresh;
+  reused.Build(media_a, lights, rays, cam_a, 11, Eigen::Vector3f(5, 0, 1), 8.0,
+               Eigen::Vector3f::Constant(0.3f), &pool);
+  reused.Build(media_b, lights, rays, cam_b, 22, Eigen::Vector3f(5, 0, 1), 8.0,
+               Eigen::Vector3f::Constant(0.4f), &pool);
+  fresh.Build(media_b, lights, rays, cam_b, 22, Eigen::Vector3f(5, 0, 1), 8.0,
+              Eigen::Vector3f::Constant(0.4f), nullptr);
+  int compared = 0, with_light = 0;
+  for (int v = 0; v < 120; v += 3) {
+    for (int u = 0; u < 160; u += 3) {
+      const Ray r = cam_b.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+      const Eigen::Vector3f d = r.d.normalized();
+      for (float t : {0.1f, 2.0f, 6.5f, 40.0f, std::numeric_limits<float>::infinity()}) {
+        const MediaSegment x = reused.IntegrateView(lights, r.o, d, t, u, v);
+        const MediaSegment y = fresh.IntegrateView(lights, r.o, d, t, u, v);
+        EXPECT_TRUE(SameBits(x, y)) << u << " " << v << " " << t;
+        with_light += x.L_add.maxCoeff() > 0 ? 1 : 0;
+        if (u + 1 < 160 && v + 1 < 120) {
+          MediaQuad qx, qy;
+          reused.PrepareQuad(u, v, t, &qx);
+          fresh.PrepareQuad(u, v, t, &qy);
+          EXPECT_TRUE(SameBits(reused.IntegrateView(lights, r.o, d, t, u, v, &qx),
+                               fresh.IntegrateView(lights, r.o, d, t, u, v, &qy)))
+              << u << " " << v << " " << t;
+        }
+        ++compared;
+      }
+      float Tx[kMaxVolumeLights] = {}, Ty[kMaxVolumeLights] = {};
+      const Eigen::Vector3f p = r.o + 3.0f * d;
+      ASSERT_EQ(reused.LightTransmittances(p, Tx), fresh.LightTransmittances(p, Ty));
+      EXPECT_EQ(std::memcmp(Tx, Ty, sizeof(Tx)), 0);
+    }
+  }
+  EXPECT_GT(compared, 9000);
+  EXPECT_GT(with_light, compared / 2);  // the scenes do scatter light
+}
+
+TEST(EffectsRebuildTest, CameraDensityShortcutGivesTheFullFormula) {
+  // fog only, no lights (no froxel volumes): IntegrateView is then the closed form alone. one
+  // object is built for a camera at the rays' height (rays from there use the stored relative
+  // density at the camera), the other for a camera 1 m higher (they compute it). the rays start
+  // below, at and above the fog's base height (0.5 m) and look up, down and level.
+  for (bool grey : {true, false}) {
+    MediaSetup setup(grey, false);
+    setup.scene.lights.clear();
+    const WorldSnapshot snap = IdentitySnapshot(setup.scene);
+    LightSampler lights(setup.scene);
+    lights.Update(snap);
+    RayScene rays(setup.scene);
+    rays.Update(snap);
+    MediaScene media;
+    media.Build(&setup.fx);
+    for (double z : {0.2, 0.5, 1.7}) {
+      const CameraView at = MakeView(CameraLookingAlongX({0, 0, z}), 64, 48, 60.0);
+      const CameraView above = MakeView(CameraLookingAlongX({0, 0, z + 1.0}), 64, 48, 60.0);
+      const Camera cam_at(at.X_WO, at.intrinsics), cam_above(above.X_WO, above.intrinsics);
+      RealtimeMedia x, y;
+      x.Build(media, lights, rays, cam_at, 5, Eigen::Vector3f(5, 0, 1), 8.0,
+              Eigen::Vector3f::Constant(0.4f), nullptr);
+      y.Build(media, lights, rays, cam_above, 5, Eigen::Vector3f(5, 0, 1), 8.0,
+              Eigen::Vector3f::Constant(0.4f), nullptr);
+      const Eigen::Vector3f o = cam_at.GenerateRay(0, 0).o;
+      for (float dz : {-0.5f, -1e-3f, 0.0f, 1e-3f, 0.5f}) {
+        const Eigen::Vector3f d = Eigen::Vector3f(1.0f, 0.3f, dz).normalized();
+        for (float t : {0.5f, 3.0f, 30.0f, std::numeric_limits<float>::infinity()}) {
+          const MediaSegment sx = x.IntegrateView(lights, o, d, t, 10, 10);
+          const MediaSegment sy = y.IntegrateView(lights, o, d, t, 10, 10);
+          EXPECT_TRUE(SameBits(sx, sy)) << grey << " " << z << " " << dz << " " << t;
+          EXPECT_LT(sx.T.maxCoeff(), 1.0f);  // the fog attenuates
+        }
+      }
+    }
+  }
+}
+
+// rain drops on a jittered lattice in front of a camera looking along x.
+EffectsFrame Rain(int n, float x0, uint32_t seed) {
+  EffectsFrame fx;
+  ParticleSet rain;
+  rain.kind = ParticleKind::kRain;
+  uint32_t h = seed;
+  auto next = [&h]() {
+    h = h * 1664525u + 1013904223u;
+    return static_cast<float>(h >> 8) / 16777216.0f;
+  };
+  for (int i = 0; i < n; ++i) {
+    rain.position_W.emplace_back(x0 + 8.0f * next(), -3.0f + 6.0f * next(), -2.0f + 4.0f * next());
+    rain.velocity_W.emplace_back(0.0f, 0.3f, -6.0f - next());
+    rain.radius_m.push_back(0.0005f + 0.002f * next());
+  }
+  fx.particles.push_back(rain);
+  HomogeneousMedium fog = Fog(0.2f, 0.9f);
+  fx.homogeneous_media.push_back(fog);
+  return fx;
+}
+
+TEST(EffectsRebuildTest, RebuiltParticleSceneMatchesFreshOne) {
+  // a large frame, then a smaller one (the chunk buffers and pixel arrays shrink in use but
+  // keep their old contents beyond it), then an empty one.
+  const int W = 96, H = 72;
+  const CameraView view = MakeView(CameraLookingAlongX({0, 0, 0}), W, H, 60.0);
+  const Camera camera(view.X_WO, view.intrinsics);
+  const EffectsFrame big = Rain(30000, 0.5f, 1), small = Rain(5000, 1.0f, 2);
+  EffectsFrame none;
+  none.particles.push_back(ParticleSet());
+  MediaScene media_big, media_small;
+  media_big.Build(&big);
+  media_small.Build(&small);
+  ThreadPool pool(2);
+  ParticleScene reused;
+  reused.Build(&big, camera, 0.01, true, &pool, &media_big);
+  const int big_size = reused.size();
+  EXPECT_GT(big_size, 1000);
+  EXPECT_GT(reused.culled(), 0);
+  reused.Build(&small, camera, 0.01, true, &pool, &media_small);
+  for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
+    ParticleScene fresh;
+    fresh.Build(&small, camera, 0.01, true, p, &media_small);
+    EXPECT_EQ(reused.size(), fresh.size());
+    EXPECT_EQ(reused.culled(), fresh.culled());
+    EXPECT_EQ(reused.size() + reused.culled(), 5000);
+    int hits = 0;
+    for (int v = 0; v < H; ++v) {
+      for (int u = 0; u < W; ++u) {
+        const Ray r = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+        ParticleHit a, b;
+        const bool ha = reused.PixelHit(r, u, v, 1e30f, &a);
+        const bool hb = fresh.PixelHit(r, u, v, 1e30f, &b);
+        ASSERT_EQ(ha, hb) << u << " " << v;
+        if (!ha) continue;
+        ++hits;
+        EXPECT_EQ(a.prim, b.prim);
+        EXPECT_EQ(a.t, b.t);
+        EXPECT_EQ(a.alpha, b.alpha);
+        EXPECT_TRUE(SameBits(a.ng_W, b.ng_W));
+      }
+    }
+    EXPECT_GT(hits, 100);
+  }
+  reused.Build(&none, camera, 0.01, true, &pool, nullptr);
+  EXPECT_TRUE(reused.empty());
+  ParticleHit h;
+  EXPECT_FALSE(reused.PixelHit(camera.GenerateRay(40, 30), 40, 30, 1e30f, &h));
+}
+
+}  // namespace
+}  // namespace penumbra::testing
