@@ -124,8 +124,37 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
-  // one drop: nothing (radius <= 0; realtime: wholly behind the near plane), culled (counted)
-  // or a streak appended to `out`.
+  // realtime with a pinhole camera that does not move (every pixel ray leaves cam_o inside the
+  // pyramid of the pixel centres): the outward unit normals (world) of that pyramid's four side
+  // planes widened by half a pixel, to skip the drops no pixel ray can meet (Outside below).
+  const bool frustum =
+      pixel_hits && !camera.intrinsics().has_distortion() && !camera.motion().moving();
+  Eigen::Vector3f side_W[4];
+  if (frustum) {
+    const CameraIntrinsics& k = camera.intrinsics();
+    const double l = (-0.5 - k.cx) / k.fx, rt = (k.width - 0.5 - k.cx) / k.fx;
+    const double tp = (-0.5 - k.cy) / k.fy, bt = (k.height - 0.5 - k.cy) / k.fy;
+    // optical frame: x right, y down, z forward; outside the left side where x < l z, etc.
+    const Eigen::Vector3d side_O[4] = {{-1, 0, l}, {1, 0, -rt}, {0, -1, tp}, {0, 1, -bt}};
+    for (int i = 0; i < 4; ++i)
+      side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
+  }
+  const float four_fx2 = 4.0f * fx_px * fx_px;
+  // true when the capsule around [p, q] widened to r_wide = max(r, 0.5 dist / fx) (dist <= the
+  // larger distance D of p and q from the camera) lies wholly beyond one side plane: both ends
+  // farther than r and 0.5 D / fx from it, with 0.1 % to spare for rounding. then no pixel ray
+  // meets it (the renderer would not draw it either: its hits would be none).
+  auto outside = [&](const Eigen::Vector3f& p, const Eigen::Vector3f& q, float r) {
+    const Eigen::Vector3f dp = p - cam_o, dq = q - cam_o;
+    const float D2 = std::max(dp.squaredNorm(), dq.squaredNorm());
+    for (const Eigen::Vector3f& n : side_W) {
+      const float s = std::min(n.dot(dp), n.dot(dq));
+      if (s > 1.001f * r && four_fx2 * s * s > 1.002f * D2) return true;
+    }
+    return false;
+  };
+  // one drop: nothing (radius <= 0; realtime: wholly behind the near plane or outside the
+  // image), culled (counted) or a streak appended to `out`.
   auto drop = [&](size_t s, size_t i, DropChunk* out) {
     const ParticleSet& ps = fx->particles[s];
     const Eigen::Vector3f& p = ps.position_W[i];
@@ -136,6 +165,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
     if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
     if (pixel_hits && depth(p) < kPixelNear && depth(q) < kPixelNear) return;  // never drawn
+    if (frustum && outside(p, q, r)) return;                                   // never drawn
     const float len = T * v.norm();  // the motion, not the widened capsule
     // widen to half a pixel at the streak's nearest distance to the camera.
     const Eigen::Vector3f seg = q - p;
@@ -282,8 +312,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   const int W = camera.width(), H = camera.height();
   pixel_w_ = W;
   // (filled band by band below, in parallel)
-  pixel_t_.resize(static_cast<size_t>(W) * H);
-  pixel_prim_.resize(static_cast<size_t>(W) * H);
+  pixel_.resize(static_cast<size_t>(W) * H);
   pixel_hits_built_ = true;
   const CameraIntrinsics& k = camera.intrinsics();
   const Pose X_OW = camera.X_WO().inverse();
@@ -341,8 +370,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   auto band = [&](int64_t bi) {
     const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
     const size_t p0 = static_cast<size_t>(r0) * W, p1 = static_cast<size_t>(r1 + 1) * W;
-    std::fill(pixel_t_.begin() + p0, pixel_t_.begin() + p1, std::numeric_limits<float>::infinity());
-    std::fill(pixel_prim_.begin() + p0, pixel_prim_.begin() + p1, -1);
+    std::fill(pixel_.begin() + p0, pixel_.begin() + p1, PixelStreak());
     for (int n : in_band[bi]) {
       const Eigen::Vector4i& bx = box[n];
       const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
@@ -375,10 +403,7 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
           if (!(t > 0)) continue;
           const size_t at = static_cast<size_t>(v) * W + u;
           const float t_ray = t / len;
-          if (t_ray < pixel_t_[at]) {
-            pixel_t_[at] = t_ray;
-            pixel_prim_[at] = n;
-          }
+          if (t_ray < pixel_[at].t) pixel_[at] = PixelStreak{t_ray, n};
         }
       }
     }
@@ -389,9 +414,10 @@ void ParticleScene::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
 bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const {
   if (!pixel_hits_built_) return false;
   const size_t at = static_cast<size_t>(v) * pixel_w_ + u;
-  const int n = pixel_prim_[at];
-  if (n < 0 || !(pixel_t_[at] <= tmax)) return false;
-  hit->t = pixel_t_[at];
+  const PixelStreak px = pixel_[at];
+  const int n = px.prim;
+  if (n < 0 || !(px.t <= tmax)) return false;
+  hit->t = px.t;
   const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
   const Eigen::Vector3f p = ray.o + hit->t * ray.d;
   const Eigen::Vector3f ba = b - a;

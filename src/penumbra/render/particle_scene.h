@@ -8,7 +8,9 @@
 // realtime tier (pixel-centre camera rays) the streaks are splatted instead: each capsule's
 // projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
 // (Quilez's ray-capsule test), keeping the nearest streak per pixel (ties: lower index), which
-// costs the streaks' screen area rather than a BVH traversal per pixel.
+// costs the streaks' screen area rather than a BVH traversal per pixel. with a pinhole camera
+// that does not move, drops whose widened capsule lies wholly outside the pyramid of the pixel
+// rays are skipped first (no streak, not counted as culled; they could not be drawn).
 // streaks thinner than half a pixel at their distance are widened to half a pixel (radius
 // 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel drops keep
 // their average contribution instead of aliasing away with one ray per pixel.
@@ -44,6 +46,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -121,11 +124,14 @@ class ParticleScene {
   std::vector<int> set_;               // per primitive
   std::vector<Eigen::Vector4f> ends_;  // per primitive: both ends (x, y, z, widened radius)
   int pixel_w_ = 0;
-  std::vector<float> pixel_t_;   // per pixel: nearest streak t (ray units), +inf none
-  std::vector<int> pixel_prim_;  // per pixel: its primitive, -1 none
+  struct PixelStreak {
+    float t = std::numeric_limits<float>::infinity();  // nearest streak t (ray units), +inf none
+    int prim = -1;                                     // its primitive, -1 none
+  };
+  std::vector<PixelStreak> pixel_;              // per pixel (one load per PixelHit)
   std::vector<Eigen::Vector3f> rain_radiance_;  // per primitive (PrecomputeRain), or empty
   std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
-  bool pixel_hits_built_ = false;  // pixel_t_ and pixel_prim_ hold this frame's hits
+  bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
   // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
   // capacity).
   struct DropChunk {
