@@ -211,25 +211,39 @@ TEST(EffectsRebuildTest, RebuiltParticleSceneMatchesFreshOne) {
   EXPECT_FALSE(reused.PixelHit(camera.GenerateRay(40, 30), 40, 30, 1e30f, &h));
 }
 
-TEST(EffectsRebuildTest, DropsOutsideTheViewAreSkippedWithoutChangingHits) {
-  // drops all around the camera (a 4 m box): the scene of all of them and the scene of the
-  // subsequence near the view (centre within 20 degrees of the image, plus everything within
-  // 0.3 m of the camera) keep the same streaks (the others are skipped, not culled) and give
-  // the same hit in every pixel.
+// drops all around the camera (a 4 m box): the scene of all of them and the scene of the
+// subsequence near the view (centre within 20 degrees (moving: 50) of the image at X_WO, plus
+// everything within 0.3 m (moving: 0.8 m) of the camera) keep the same streaks (the others are
+// skipped, not culled) and give the same hit in every pixel.
+void ExpectSkippedDropsChangeNoHit(bool moving) {
   const int W = 80, H = 60;
   const CameraView view = MakeView(CameraLookingAlongX({0.3, -0.2, 1.0}), W, H, 50.0);
-  const Camera camera(view.X_WO, view.intrinsics);
+  CameraMotion motion;
+  if (moving) {
+    // 6 degrees of yaw and 0.15 m during the exposure, a rolling shutter reading row 59 at
+    // 1.2 x the exposure (the last rows extrapolate the motion).
+    motion.X_WO_end = view.X_WO;
+    motion.X_WO_end.linear() =
+        Eigen::AngleAxisd(6 * M_PI / 180, Eigen::Vector3d::UnitZ()) * view.X_WO.linear();
+    motion.X_WO_end.translation() += Eigen::Vector3d(0.1, 0.1, 0.05);
+    motion.end_sec = 0.01;
+    motion.time_sec = 0.002;
+    motion.line_time_sec = 0.01 / 60;
+  }
+  const Camera camera(view.X_WO, view.intrinsics, motion);
+  const double margin = (moving ? 50 : 20) * M_PI / 180;
+  const float close_m = moving ? 0.8f : 0.3f;
   const EffectsFrame all = Rain(40000, -4.0f, 7);
   EffectsFrame near = all;
   ParticleSet& ps = near.particles[0];
   ps.position_W.clear(), ps.velocity_W.clear(), ps.radius_m.clear();
   const CameraIntrinsics& k = view.intrinsics;
-  const double half_u = std::atan(0.5 * k.width / k.fx) + 20 * M_PI / 180;
-  const double half_v = std::atan(0.5 * k.height / k.fy) + 20 * M_PI / 180;
+  const double half_u = std::atan(0.5 * k.width / k.fx) + margin;
+  const double half_v = std::atan(0.5 * k.height / k.fy) + margin;
   const Eigen::Vector3f cam = view.X_WO.translation().cast<float>();
   for (size_t i = 0; i < all.particles[0].position_W.size(); ++i) {
     const Eigen::Vector3f p = all.particles[0].position_W[i] - cam;  // camera looks along +x
-    const bool close = p.norm() < 0.3f;
+    const bool close = p.norm() < close_m;
     const bool in_view = p.x() > 0 && std::abs(std::atan2(p.y(), p.x())) < half_u &&
                          std::abs(std::atan2(p.z(), p.x())) < half_v;
     if (!close && !in_view) continue;
@@ -260,6 +274,14 @@ TEST(EffectsRebuildTest, DropsOutsideTheViewAreSkippedWithoutChangingHits) {
     }
   }
   EXPECT_GT(hits, 50);
+}
+
+TEST(EffectsRebuildTest, DropsOutsideTheViewAreSkippedWithoutChangingHits) {
+  ExpectSkippedDropsChangeNoHit(false);
+}
+
+TEST(EffectsRebuildTest, DropsOutsideAMovingViewAreSkippedWithoutChangingHits) {
+  ExpectSkippedDropsChangeNoHit(true);
 }
 
 TEST(EffectsRebuildTest, DropJustOutsideTheImageStillCoversItsBorderPixels) {

@@ -124,12 +124,18 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
-  // realtime with a pinhole camera that does not move (every pixel ray leaves cam_o inside the
-  // pyramid of the pixel centres): the outward unit normals (world) of that pyramid's four side
-  // planes widened by half a pixel, to skip the drops no pixel ray can meet (Outside below).
-  const bool frustum =
-      pixel_hits && !camera.intrinsics().has_distortion() && !camera.motion().moving();
+  // realtime with a pinhole camera: the outward unit normals (world) of the four side planes of
+  // the pyramid of the pixel-centre rays widened by half a pixel (at the pose X_WO), to skip
+  // the drops no pixel ray can meet (`outside` below).
+  const bool frustum = pixel_hits && !camera.intrinsics().has_distortion();
   Eigen::Vector3f side_W[4];
+  // a moving camera (camera.h: pose slerped / lerped at a = (time_sec + line_time_sec v) /
+  // end_sec for row v) sees row v from o(a), turned by |a| theta from X_WO (theta the rotation
+  // from X_WO to X_WO_end): the planes then move by at most turn |x - cam_o| + shift at a
+  // point x, with turn and shift the largest |a| over the rows times theta and times the
+  // translation (1 % and 1e-6 to spare).
+  float turn = 0, shift = 0;
+  const bool moving = camera.motion().moving();
   if (frustum) {
     const CameraIntrinsics& k = camera.intrinsics();
     const double l = (-0.5 - k.cx) / k.fx, rt = (k.width - 0.5 - k.cx) / k.fx;
@@ -138,19 +144,39 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     const Eigen::Vector3d side_O[4] = {{-1, 0, l}, {1, 0, -rt}, {0, -1, tp}, {0, 1, -bt}};
     for (int i = 0; i < 4; ++i)
       side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
+    if (moving) {
+      const CameraMotion& m = camera.motion();
+      const double a_max =
+          std::max(std::abs(m.time_sec), std::abs(m.time_sec + m.line_time_sec * k.height)) /
+          m.end_sec;
+      const Eigen::Quaterniond q0(camera.X_WO().linear()), q1(m.X_WO_end.linear());
+      const double theta =
+          2.0 * std::acos(std::min(1.0, std::abs(q0.normalized().dot(q1.normalized()))));
+      const double move = (m.X_WO_end.translation() - camera.X_WO().translation()).norm();
+      turn = static_cast<float>(1.01 * a_max * theta + 1e-6);
+      shift = static_cast<float>(1.01 * a_max * move + 1e-6);
+    }
   }
   const float four_fx2 = 4.0f * fx_px * fx_px;
   // true when the capsule around [p, q] widened to r_wide = max(r, 0.5 dist / fx) (dist <= the
   // larger distance D of p and q from the camera) lies wholly beyond one side plane: both ends
-  // farther than r and 0.5 D / fx from it, with 0.1 % to spare for rounding. then no pixel ray
-  // meets it (the renderer would not draw it either: its hits would be none).
+  // farther than r and 0.5 D / fx from it (0.1 % to spare for rounding) and, for a moving
+  // camera, than the planes' motion. then no pixel ray meets it (its hits would be none).
   auto outside = [&](const Eigen::Vector3f& p, const Eigen::Vector3f& q, float r) {
     const Eigen::Vector3f dp = p - cam_o, dq = q - cam_o;
     const float D2 = std::max(dp.squaredNorm(), dq.squaredNorm());
-    for (const Eigen::Vector3f& n : side_W) {
-      const float s = std::min(n.dot(dp), n.dot(dq));
-      if (s > 1.001f * r && four_fx2 * s * s > 1.002f * D2) return true;
+    if (!moving) {
+      for (const Eigen::Vector3f& n : side_W) {
+        const float s = std::min(n.dot(dp), n.dot(dq));
+        if (s > 1.001f * r && four_fx2 * s * s > 1.002f * D2) return true;
+      }
+      return false;
     }
+    const float D = std::sqrt(D2);
+    const float R = 1.001f * std::max(r, 0.5f * D / fx_px);
+    const float margin = R + turn * (D + R) + shift;
+    for (const Eigen::Vector3f& n : side_W)
+      if (std::min(n.dot(dp), n.dot(dq)) > margin) return true;
     return false;
   };
   // one drop: nothing (radius <= 0; realtime: wholly behind the near plane or outside the
