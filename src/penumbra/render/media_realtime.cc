@@ -96,7 +96,11 @@ T Trilinear(const T* a, const int r[3], const Eigen::Vector3f& f) {
   return c0 * (1 - w[2]) + c1 * w[2];
 }
 
-Eigen::Vector3f Exp(const Eigen::Vector3f& x) { return x.array().exp().matrix(); }
+// e^x per channel; one exponential when the channels are equal (grey media).
+Eigen::Vector3f Exp(const Eigen::Vector3f& x) {
+  if (x.x() == x.y() && x.y() == x.z()) return Eigen::Vector3f::Constant(std::exp(x.x()));
+  return x.array().exp().matrix();
+}
 
 // rgb in lanes 0..2 of a 4-lane array (lane 3 = 0), for vectorised lookups.
 Eigen::Array4f To4(const Eigen::Vector3f& v) { return Eigen::Array4f(v.x(), v.y(), v.z(), 0.0f); }
