@@ -212,7 +212,7 @@ TEST(RaySceneTest, MovingBodyHitsMatchTheSameGeomsPlacedStatic) {
   EXPECT_GT(moving_hits, 100);
 }
 
-// ---- planes traced as Embree triangles (axis-aligned in their instance frame) ----
+// ---- analytic planes through RayScene: exact depths, edges, grazing angles, shadows ----
 
 // the analytic reference of a plane of half-size (sx, sy) posed at X_WG: IntersectAnalytic on
 // the float ray taken to the geom frame in double. returns false on a miss.
@@ -255,7 +255,7 @@ Ray RayTo(const Eigen::Vector3d& o, const Eigen::Vector3d& target) {
 TEST(RaySceneTest, AxisAlignedFloorsMatchTheAnalyticPlaneAndAreWatertight) {
   // the default world's floors: a finite 4 x 3 m floor at z = 0 and an infinite one (half-size
   // kInfinitePlaneHalfSize) 2 cm below, seen from a low camera; every hit is the analytic one,
-  // rays aimed at the quad diagonals (where the two triangles meet) all hit, and rays 1e-5 m
+  // rays aimed at the diagonals (where a two-triangle plane would crack) all hit, and rays 1e-5 m
   // past the finite floor's edges go through to the infinite one.
   SceneDescription scene = EmptyScene();
   const Pose X_floor = Translation(0, 0, 0), X_ground = Translation(0, 0, -0.02);
@@ -325,7 +325,7 @@ TEST(RaySceneTest, InfinitePlanesAtGrazingAnglesKeepFloatDepths) {
   const Pose X_floor = Translation(0, 0, 0);
   Pose X_wall = Translation(30, 0, 0);
   X_wall.linear() = Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  ASSERT_NE(X_wall.linear()(0, 0), 0.0);  // the residue the triangles must tolerate
+  ASSERT_NE(X_wall.linear()(0, 0), 0.0);  // a rotation with rounding residues
   const int floor = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_floor);
   const int wall = AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, X_wall);
   RayScene rs(scene);
@@ -381,7 +381,7 @@ TEST(RaySceneTest, InfinitePlanesAtGrazingAnglesKeepFloatDepths) {
 TEST(RaySceneTest, TiltedPlanesStayAnalytic) {
   // a tilted infinite plane (30 deg about x and 20 deg about z) and a tilted finite one: the
   // depth is the analytic one to float rounding of the ray, also 1e3 m away, and shadow rays
-  // from the hits leave the surface (float corners 1e4 m away would put the plane ~1e-3 m off).
+  // from the hits leave the surface (no self-intersection).
   SceneDescription scene = EmptyScene();
   Pose X_big = Translation(0.5, 1.0, -1.0);
   X_big.linear() = (Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()) *
@@ -415,7 +415,7 @@ TEST(RaySceneTest, TiltedPlanesStayAnalytic) {
 
 TEST(RaySceneTest, PlaneOnAMovingBodyMatchesTheAnalyticPlane) {
   // a finite 0.6 x 0.4 m plate on a moving body (a robot's deck), posed with rotations; it is
-  // axis-aligned in the body frame (triangles there): hits match the analytic plane posed at
+  // axis-aligned in the body frame: hits match the analytic plane posed at
   // X_WB X_BG, rays 1e-4 m past an edge miss, and packets (IntersectMany, OccludedLanes)
   // agree with single rays.
   SceneDescription scene = EmptyScene();

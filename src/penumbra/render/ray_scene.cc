@@ -3,11 +3,11 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/analytic_lanes.h"
 #include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/triangle_shapes.h"
 
@@ -30,41 +30,7 @@ struct AnalyticGeom {
   Eigen::Matrix3d R_GW = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_GW = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_WG = Eigen::Matrix3d::Identity();
-  // a plane traced as two Embree triangles (see ray_scene.h): its corners in the instance
-  // frame (one padding element for Embree's 16-byte loads) and the two faces, fanned from
-  // corner 0 so that Embree's edge test of the shared diagonal is the same in both (no crack).
-  bool plane_triangles = false;
-  std::array<Eigen::Vector3f, 5> corners_I;
-  std::array<Eigen::Vector3i, 2> faces{Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3)};
 };
-
-// how far (m) the corners of a plane may lie off the plane through its centre normal to the
-// instance-frame axis nearest its normal and still be traced as triangles in that plane: the
-// rounding residue of rotation matrices of axis-aligned poses (~1e-16 of the half-size).
-constexpr double kAxisAlignedPlaneTolerance = 1e-9;
-
-// the corners of `plane` (posed at X_IG in the instance frame) as float vertices that share one
-// coordinate exactly, if the plane is normal to an instance-frame axis to within
-// kAxisAlignedPlaneTolerance; false (corners untouched) if it is tilted.
-bool AxisAlignedPlaneCorners(const AnalyticShape& plane, const Pose& X_IG,
-                             std::array<Eigen::Vector3f, 5>* corners) {
-  const Eigen::Matrix3d& R_IG = X_IG.linear();
-  const Eigen::Vector3d& p_IG = X_IG.translation();
-  int axis;
-  R_IG.col(2).cwiseAbs().maxCoeff(&axis);
-  const double sx = plane.size.x(), sy = plane.size.y();
-  const Eigen::Vector3d c_G[4] = {{-sx, -sy, 0}, {sx, -sy, 0}, {sx, sy, 0}, {-sx, sy, 0}};
-  std::array<Eigen::Vector3f, 5> v;
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d c_I = R_IG * c_G[k] + p_IG;
-    if (!(std::abs(c_I[axis] - p_IG[axis]) <= kAxisAlignedPlaneTolerance)) return false;
-    v[k] = c_I.cast<float>();
-    v[k][axis] = static_cast<float>(p_IG[axis]);
-  }
-  v[4].setZero();
-  *corners = v;
-  return true;
-}
 
 // a geom traced as triangles, in the instance frame. vertices carry one padding element at
 // the end: Embree reads vertex buffers with 16-byte loads.
@@ -126,49 +92,81 @@ void AnalyticBounds(const RTCBoundsFunctionArguments* args) {
   args->bounds_o->upper_z = static_cast<float>(hi.z());
 }
 
-// intersects ray i of an N-wide Embree ray (already in the instance frame) with an analytic geom.
-inline bool IntersectLane(const AnalyticGeom& g, RTCRayN* ray, unsigned N, unsigned i, double* t,
-                          ShapePart* part) {
-  const Eigen::Vector3d o_I(RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i),
-                            RTCRayN_org_z(ray, N, i));
-  const Eigen::Vector3d d_I(RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i),
-                            RTCRayN_dir_z(ray, N, i));
-  const Eigen::Vector3d o_G = g.R_GI * o_I + g.p_GI;
-  const Eigen::Vector3d d_G = g.R_GI * d_I;
-  return IntersectAnalytic(g.shape, o_G, d_G, RTCRayN_tnear(ray, N, i), RTCRayN_tfar(ray, N, i), t,
-                           part);
+// lanes [base, base + n) of an N-wide Embree ray (already in the instance frame), n =
+// min(N - base, kAnalyticLanes), taken to an analytic geom's frame in double. all n lanes are
+// computed, active or not (inactive lanes hold harmless values; their results are ignored):
+// a packet's lanes are read in place when n is a lane width (Embree's 4, 8 and 16-wide
+// packets), else copied and padded with the last lane (single rays).
+inline int LoadLanes(const AnalyticGeom& g, RTCRayN* ray, unsigned N, unsigned base,
+                     AnalyticRayLanes* out) {
+  const int n = static_cast<int>(std::min<unsigned>(N - base, kAnalyticLanes));
+  const int w = AnalyticLaneWidth(n);
+  const float* ox = &RTCRayN_org_x(ray, N, base);
+  const float* oy = &RTCRayN_org_y(ray, N, base);
+  const float* oz = &RTCRayN_org_z(ray, N, base);
+  const float* dx = &RTCRayN_dir_x(ray, N, base);
+  const float* dy = &RTCRayN_dir_y(ray, N, base);
+  const float* dz = &RTCRayN_dir_z(ray, N, base);
+  const float* tnear = &RTCRayN_tnear(ray, N, base);
+  const float* tfar = &RTCRayN_tfar(ray, N, base);
+  alignas(64) float pad[8][kAnalyticLanes];
+  if (w != n) {
+    const float* src[8] = {ox, oy, oz, dx, dy, dz, tnear, tfar};
+    for (int a = 0; a < 8; ++a)
+      for (int k = 0; k < w; ++k) pad[a][k] = src[a][std::min(k, n - 1)];
+    ox = pad[0], oy = pad[1], oz = pad[2], dx = pad[3], dy = pad[4], dz = pad[5];
+    tnear = pad[6], tfar = pad[7];
+  }
+  for (int k = 0; k < w; ++k) {
+    out->tmin[k] = tnear[k];
+    out->tmax[k] = tfar[k];
+  }
+  TransformRayLanes(g.R_GI, g.p_GI, ox, oy, oz, dx, dy, dz, n, out);
+  return n;
 }
 
+// Embree's intersect callback of an analytic geom: the packet's lanes at once
+// (IntersectAnalyticLanes, in double), each hit of an active lane stored with its float t.
 void AnalyticIntersect(const RTCIntersectFunctionNArguments* args) {
   const auto* g = static_cast<const AnalyticGeom*>(args->geometryUserPtr);
-  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
-  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    double t;
-    ShapePart part;
-    if (!IntersectLane(*g, ray, args->N, i, &t, &part)) continue;
-    const float tf = static_cast<float>(t);
-    if (!(tf < RTCRayN_tfar(ray, args->N, i))) continue;
-    RTCRayN_tfar(ray, args->N, i) = tf;
-    // Ng is left unset: FinishHit computes the exact normal from the part hit (in u).
-    RTCHitN_u(hit, args->N, i) = static_cast<float>(static_cast<int>(part));
-    RTCHitN_v(hit, args->N, i) = 0.0f;
-    RTCHitN_primID(hit, args->N, i) = args->primID;
-    RTCHitN_geomID(hit, args->N, i) = args->geomID;
-    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  const unsigned N = args->N;
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, N);
+  AnalyticRayLanes lanes;
+  AnalyticHitLanes hits;
+  for (unsigned base = 0; base < N; base += kAnalyticLanes) {
+    const int n = LoadLanes(*g, ray, N, base, &lanes);
+    IntersectAnalyticLanes(g->shape, lanes, n, &hits);
+    for (int k = 0; k < n; ++k) {
+      const unsigned i = base + k;
+      if (args->valid[i] != -1 || !(hits.t[k] < std::numeric_limits<double>::infinity())) continue;
+      const float tf = static_cast<float>(hits.t[k]);
+      if (!(tf < RTCRayN_tfar(ray, N, i))) continue;
+      RTCRayN_tfar(ray, N, i) = tf;
+      // Ng is left unset: FinishHit computes the exact normal from the part hit (in u).
+      RTCHitN_u(hit, N, i) = static_cast<float>(hits.part[k]);
+      RTCHitN_v(hit, N, i) = 0.0f;
+      RTCHitN_primID(hit, N, i) = args->primID;
+      RTCHitN_geomID(hit, N, i) = args->geomID;
+      RTCHitN_instID(hit, N, i, 0) = args->context->instID[0];
+    }
   }
 }
 
 void AnalyticOccluded(const RTCOccludedFunctionNArguments* args) {
   const auto* g = static_cast<const AnalyticGeom*>(args->geometryUserPtr);
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    double t;
-    ShapePart part;
-    if (IntersectLane(*g, args->ray, args->N, i, &t, &part) &&
-        static_cast<float>(t) < RTCRayN_tfar(args->ray, args->N, i))
-      RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
+  const unsigned N = args->N;
+  AnalyticRayLanes lanes;
+  AnalyticHitLanes hits;
+  for (unsigned base = 0; base < N; base += kAnalyticLanes) {
+    const int n = LoadLanes(*g, args->ray, N, base, &lanes);
+    IntersectAnalyticLanes(g->shape, lanes, n, &hits);
+    for (int k = 0; k < n; ++k) {
+      const unsigned i = base + k;
+      if (args->valid[i] == -1 && hits.t[k] < std::numeric_limits<double>::infinity() &&
+          static_cast<float>(hits.t[k]) < RTCRayN_tfar(args->ray, N, i))
+        RTCRayN_tfar(args->ray, N, i) = -std::numeric_limits<float>::infinity();
+    }
   }
 }
 
@@ -266,23 +264,12 @@ struct RayScene::Impl {
       ag->shape = AnalyticShapeOf(geom);
       ag->R_GI = X_GI.linear();
       ag->p_GI = X_GI.translation();
-      ag->plane_triangles = ag->shape.kind == AnalyticKind::kPlane &&
-                            AxisAlignedPlaneCorners(ag->shape, X_IG, &ag->corners_I);
-      if (ag->plane_triangles) {
-        // Embree's own triangle test finds the hit; FinishHit recomputes it in double.
-        eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                   ag->corners_I.data(), 0, sizeof(Eigen::Vector3f), 4);
-        rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, ag->faces.data(),
-                                   0, sizeof(Eigen::Vector3i), 2);
-      } else {
-        eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-        rtcSetGeometryUserPrimitiveCount(eg, 1);
-        rtcSetGeometryUserData(eg, ag.get());
-        rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
-        rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
-        rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
-      }
+      eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+      rtcSetGeometryUserPrimitiveCount(eg, 1);
+      rtcSetGeometryUserData(eg, ag.get());
+      rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
+      rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
+      rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
       rec.analytic = ag.get();
       group->analytic.push_back(std::move(ag));
     }
@@ -365,18 +352,8 @@ struct RayScene::Impl {
   void FinishHit(const Ray& ray, const RTCRayHit& rh, SurfaceHit* hit) const {
     const InstanceGroup& group = groups[group_of_instance[rh.hit.instID[0]]];
     const GeomRecord& rec = group.records[rh.hit.geomID];
-    float t = rh.ray.tfar;
-    ShapePart part = static_cast<ShapePart>(static_cast<int>(rh.hit.u));
-    if (rec.analytic && rec.analytic->plane_triangles) {
-      // a plane found by Embree's float triangle test: its exact distance, in double, from
-      // the world ray (the formula of IntersectAnalytic), kept within the ray's range.
-      const AnalyticGeom& g = *rec.analytic;
-      const Eigen::Vector3d o_G = g.R_GW * ray.o.cast<double>() + g.p_GW;
-      const Eigen::Vector3d d_G = g.R_GW * ray.d.cast<double>();
-      const double tc = -o_G.z() / d_G.z();
-      if (std::isfinite(tc)) t = std::clamp(static_cast<float>(tc), ray.tmin, ray.tmax);
-      part = ShapePart::kMain;
-    }
+    const float t = rh.ray.tfar;
+    const ShapePart part = static_cast<ShapePart>(static_cast<int>(rh.hit.u));
     hit->t = t;
     hit->p_W = ray.o + t * ray.d;
     hit->geom = rec.geom;
