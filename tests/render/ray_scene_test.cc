@@ -7,10 +7,13 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
+#include <random>
 #include <vector>
 
 #include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/camera.h"
+#include "penumbra/render/ray_cone.h"
 #include "render_test_util.h"
 
 namespace penumbra {
@@ -582,6 +585,136 @@ TEST(RaySceneTest, BoxSphereAndMeshBodiesFollowTheirPoses) {
     rs.Update(snap);
     EXPECT_EQ(rs.num_top_level_commits(), commits);
   }
+}
+
+// a robot-mounted camera: a static room (floor, walls, a crate, a sphere), a robot body whose
+// camera sits 0.5 mm in front of its housing box, a leg body that reaches into the lower right
+// of the view, and a second robot walking through the view.
+struct RobotCameraFixture {
+  SceneDescription scene = EmptyScene();
+  WorldSnapshot snapshot;
+  int trunk, leg, walker;
+  Pose X_WO;  // camera optical frame
+  RobotCameraFixture() {
+    AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, Translation(0, 0, 0));
+    AddGeom(&scene, GeomShape::kBox, {0.1, 4, 1.5}, Translation(5, 0, 1.5));
+    AddGeom(&scene, GeomShape::kBox, {4, 0.1, 1.5}, Translation(1, 3, 1.5));
+    AddGeom(&scene, GeomShape::kBox, {0.3, 0.3, 0.3}, Translation(3, -1, 0.3));
+    AddGeom(&scene, GeomShape::kSphere, {0.4, 0, 0}, Translation(3.5, 1.2, 0.6));
+    trunk = AddBody(&scene, "trunk");
+    leg = AddBody(&scene, "leg");
+    scene.bodies[leg].parent = trunk;
+    walker = AddBody(&scene, "walker");
+    // trunk: a box 0.4 m long ending at x = 0.2145, the camera at x = 0.215 (body frame).
+    AddGeom(&scene, GeomShape::kBox, {0.19, 0.1, 0.06}, Translation(0.0245, 0, 0), trunk);
+    AddGeom(&scene, GeomShape::kCylinder, {0.007, 0.0015, 0}, Translation(0.2135, 0.03, 0.0),
+            trunk);
+    // leg: a capsule reaching forward and down in front of the trunk's right side.
+    Pose X_LG = Translation(0.4, -0.12, -0.15);
+    X_LG.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    AddGeom(&scene, GeomShape::kCapsule, {0.03, 0.12, 0}, X_LG, leg);
+    AddGeom(&scene, GeomShape::kBox, {0.2, 0.2, 0.8}, Translation(0, 0, 0.8), walker);
+    snapshot = testing::IdentitySnapshot(scene);
+    Pose X_WT = Translation(0.5, -0.2, 0.35);
+    X_WT.linear() = Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    snapshot.X_WB[trunk] = X_WT;
+    snapshot.X_WB[leg] = X_WT;
+    snapshot.X_WB[walker] = Translation(3.2, 0.5, 0);
+    X_WO = X_WT * testing::CameraLookingAlongX(Eigen::Vector3d(0.215, 0, 0));
+  }
+};
+
+TEST(RaySceneTest, RobotCameraTilesTracedStaticOnlyMatchSingleRays) {
+  RobotCameraFixture f;
+  RayScene rs(f.scene);
+  rs.Update(f.snapshot);
+  const Camera camera(f.X_WO, CameraIntrinsics::FromFovy(320, 240, 100));
+  ASSERT_TRUE(camera.projective());
+  int static_tiles = 0, full_tiles = 0, static_rays = 0;
+  std::vector<bool> seen(f.scene.geoms.size(), false);
+  for (int y0 = 0; y0 < 240; y0 += 16)
+    for (int x0 = 0; x0 < 320; x0 += 16) {
+      std::vector<Ray> rays;
+      for (int y = y0; y < y0 + 16; ++y)
+        for (int x = x0; x < x0 + 16; ++x) {
+          rays.push_back(camera.GenerateRay(x, y));
+          rays.back().tmin = 0.01f;
+        }
+      const RayCone cone =
+          RayCone::FromCorners(rays[0].o, {rays[0].d, rays[15].d, rays[255].d, rays[240].d}, 0.01f);
+      std::vector<SurfaceHit> single(256), grid(256), grid_rays(256);
+      bool hit_single[256], hit_grid[256], hit_grid_rays[256];
+      for (int i = 0; i < 256; ++i) hit_single[i] = rs.Intersect(rays[i], &single[i]);
+      const bool fast = rs.IntersectGrid(rays.data(), 16, 16, grid.data(), hit_grid, &cone);
+      // without a cone, RayScene bounds the rays itself (a looser cone: it may decide
+      // otherwise near the robot, never with other hits).
+      if (rs.IntersectGrid(rays.data(), 16, 16, grid_rays.data(), hit_grid_rays)) ++static_rays;
+      (fast ? static_tiles : full_tiles)++;
+      for (int i = 0; i < 256; ++i) {
+        SCOPED_TRACE(::testing::Message() << "tile " << x0 << " " << y0 << " ray " << i);
+        ASSERT_EQ(hit_grid[i], hit_single[i]);
+        ASSERT_EQ(hit_grid_rays[i], hit_single[i]);
+        if (!hit_single[i]) continue;
+        seen[single[i].geom] = true;
+        if (fast) EXPECT_EQ(f.scene.geoms[single[i].geom].body, 0);
+        ExpectSameHit(grid[i], single[i]);
+        ExpectSameHit(grid_rays[i], single[i]);
+      }
+    }
+  // most tiles miss the robot's own geoms and take the static path; the leg and the walker
+  // are seen (through the top level), the trunk and its lens never.
+  EXPECT_GT(static_tiles, 200);
+  EXPECT_GT(static_rays, 200);
+  EXPECT_GT(full_tiles, 5);
+  EXPECT_TRUE(seen[7]) << "leg";
+  EXPECT_TRUE(seen[8]) << "walker";
+  EXPECT_FALSE(seen[5]) << "trunk";
+  EXPECT_FALSE(seen[6]) << "lens";
+}
+
+TEST(RaySceneTest, ShadowPacketsTracedStaticOnlyMatchSingleRays) {
+  RobotCameraFixture f;
+  RayScene rs(f.scene);
+  rs.Update(f.snapshot);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0, 1);
+  const Eigen::Vector3f lamp(1.5f, 0.5f, 2.9f);
+  int static_packets = 0, full_packets = 0, occluded = 0, lit = 0;
+  for (int packet = 0; packet < 400; ++packet) {
+    // points on the floor and the walls towards a lamp (finite) or the sun (endless).
+    const bool sun = packet % 2 == 1;
+    Vec3Lanes o, d;
+    Lanes tmax;
+    const Eigen::Vector3f base(-0.5f + 5 * u(rng), -2.5f + 5 * u(rng), 0.001f);
+    for (int k = 0; k < kLanes; ++k) {
+      const Eigen::Vector3f p = base + Eigen::Vector3f(0.02f * k, 0.03f * u(rng), 0);
+      o.Set(k, p);
+      if (sun) {
+        d.Set(k, Eigen::Vector3f(-0.4f, 0.3f + 0.01f * u(rng), 0.8f));
+        tmax[k] = std::numeric_limits<float>::infinity();
+      } else {
+        d.Set(k, lamp - p);
+        tmax[k] = 1 - 1e-4f;
+      }
+    }
+    const LaneMask active(0xffffu & ~(1u << (packet % 16)));
+    LaneMask packet_occluded;
+    const bool fast = rs.OccludedLanes(o, d, tmax, active, &packet_occluded);
+    (fast ? static_packets : full_packets)++;
+    for (int k = 0; k < kLanes; ++k) {
+      Ray r;
+      r.o = o.Lane(k);
+      r.d = d.Lane(k);
+      r.tmax = tmax[k];
+      const bool expected = active[k] && rs.Occluded(r);
+      ASSERT_EQ(packet_occluded[k], expected) << "packet " << packet << " lane " << k;
+      if (active[k]) (expected ? occluded : lit)++;
+    }
+  }
+  EXPECT_GT(static_packets, 100);
+  EXPECT_GT(full_packets, 10);
+  EXPECT_GT(occluded, 500);
+  EXPECT_GT(lit, 500);
 }
 
 }  // namespace

@@ -68,6 +68,11 @@ class Camera {
   /// for points at or behind the camera plane (z <= 0).
   bool Project(const Eigen::Vector3d& p_W, Eigen::Vector2d* uv, double* z) const;
 
+  /// true for a pinhole without distortion or motion: every ray starts at the optical centre
+  /// and its direction is an affine function of (u, v), so the rays of a pixel rectangle lie
+  /// in the convex cone of its corner rays.
+  bool projective() const { return !slow_; }
+
   int width() const { return intrinsics_.width; }
   int height() const { return intrinsics_.height; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }

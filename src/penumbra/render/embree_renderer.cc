@@ -8,6 +8,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera_ground_truth.h"
 #include "penumbra/render/path_integrator.h"
+#include "penumbra/render/ray_cone.h"
 #include "penumbra/render/realtime_integrator.h"
 
 namespace penumbra {
@@ -137,7 +138,15 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
         rays[i] = camera.GenerateRay(static_cast<float>(t.x0 + x), static_cast<float>(t.y0 + y));
         rays[i].tmin = near;  // t is z-depth (optical-frame d.z = 1)
       }
-    ray_scene_->IntersectGrid(rays.get(), t.width, t.height, hits.get(), did_hit.get());
+    // a pinhole camera's tile: its rays lie in the cone of its corner rays (RayScene then
+    // needs no pass over the rays to bound them).
+    const int n = t.width * t.height;
+    RayCone cone;
+    if (camera.projective())
+      cone = RayCone::FromCorners(
+          rays[0].o, {rays[0].d, rays[t.width - 1].d, rays[n - 1].d, rays[n - t.width].d}, near);
+    ray_scene_->IntersectGrid(rays.get(), t.width, t.height, hits.get(), did_hit.get(),
+                              camera.projective() ? &cone : nullptr);
     for (int y = 0, i = 0; y < t.height; ++y) {
       const int v = t.y0 + y;
       float* depth_row = depth ? depth->at(t.x0, v) : nullptr;

@@ -9,6 +9,8 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_lanes.h"
 #include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/moving_bounds.h"
+#include "penumbra/render/ray_cone.h"
 #include "penumbra/render/triangle_shapes.h"
 
 namespace penumbra {
@@ -66,6 +68,9 @@ struct InstanceGroup {
   std::vector<GeomRecord> records;  // by geomID in `scene`
   std::vector<std::unique_ptr<AnalyticGeom>> analytic;
   std::vector<std::unique_ptr<TriangleGeom>> triangles;
+  // per geom, a box in the instance frame that holds it (MovingBounds): analytic shapes their
+  // half extents in the geom frame, triangle geoms the box of their geom-frame vertices.
+  std::vector<MovingBounds::Box> boxes_I;
   Pose X_WI = Pose::Identity();  // current instance pose (identity for the static group)
   Eigen::Matrix3f R_WI_f = Eigen::Matrix3f::Identity();
   bool rotated = false;  // R_WI_f is not the identity (FinishHit skips it for the static group)
@@ -202,12 +207,24 @@ struct RayScene::Impl {
   std::vector<InstanceGroup> groups;
   std::vector<int> group_of_instance;  // top-level geomID -> index into groups
   std::vector<Pose> static_poses;      // X_WB of every body as the static group was built
+  unsigned static_instance_id = 0;     // top-level geomID of the static group's instance
+  // bounds of the moving groups (group i >= 1 is body i - 1 here), for the static-only path.
+  MovingBounds moving;
 
   void Check(const char* what) const {
     if (!error.empty()) throw Error(std::string("RayScene: ") + what + ": " + error);
     const RTCError code = rtcGetDeviceError(device);
     if (code != RTC_ERROR_NONE)
       throw Error(std::string("RayScene: ") + what + ": Embree error " + std::to_string(code));
+  }
+
+  // the instance-frame box of a geom-frame box (centre c_G, half extents h_G) of a geom at X_IG.
+  static MovingBounds::Box BoxInInstance(const Pose& X_IG, const Eigen::Vector3f& c_G,
+                                         const Eigen::Vector3f& h_G) {
+    MovingBounds::Box b;
+    b.c = (X_IG * c_G.cast<double>()).cast<float>();
+    b.axes = (X_IG.linear() * h_G.cast<double>().asDiagonal()).cast<float>();
+    return b;
   }
 
   // adds geom `gi` to `group`'s scene with pose X_IG in the instance frame.
@@ -230,6 +247,9 @@ struct RayScene::Impl {
         shape = HeightFieldTriangles(sd.hfields[geom.hfield]);
       }
       if (shape.faces.empty()) return;
+      Eigen::Vector3f lo = shape.vertices.front(), hi = lo;
+      for (const Eigen::Vector3f& v : shape.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      group->boxes_I.push_back(BoxInInstance(X_IG, 0.5f * (lo + hi), 0.5f * (hi - lo)));
       auto tg = std::make_unique<TriangleGeom>();
       const Eigen::Matrix3f R_IG = X_IG.linear().cast<float>();
       const Eigen::Vector3f p_IG = X_IG.translation().cast<float>();
@@ -264,6 +284,8 @@ struct RayScene::Impl {
       ag->shape = AnalyticShapeOf(geom);
       ag->R_GI = X_GI.linear();
       ag->p_GI = X_GI.translation();
+      group->boxes_I.push_back(BoxInInstance(X_IG, Eigen::Vector3f::Zero(),
+                                             AnalyticHalfExtents(ag->shape).cast<float>()));
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
       rtcSetGeometryUserPrimitiveCount(eg, 1);
       rtcSetGeometryUserData(eg, ag.get());
@@ -287,6 +309,7 @@ struct RayScene::Impl {
     group->records.clear();
     group->analytic.clear();
     group->triangles.clear();
+    group->boxes_I.clear();
     group->num_triangles = 0;
     group->scene = rtcNewScene(device);
     rtcSetSceneBuildQuality(group->scene, RTC_BUILD_QUALITY_HIGH);
@@ -403,12 +426,15 @@ struct RayScene::Impl {
   }
 
   // traces rays[index[k]] for the lanes k with index[k] >= 0 as one Embree packet and
-  // writes hits[index[k]], did_hit[index[k]]. the packets are traced with an incoherent
-  // context: with RTC_INTERSECT_CONTEXT_FLAG_COHERENT, Embree 3.13.5 was seen to loop forever
-  // inside rtcIntersect16 / rtcOccluded16 (and rtcOccluded1M) on some packets of this
-  // renderer's scenes (instanced user geometry; reproduced by the realtime lighting tests), so
-  // that flag is not used.
-  void IntersectPacket(const Ray* rays, const int* index, SurfaceHit* hits, bool* did_hit) const {
+  // writes hits[index[k]], did_hit[index[k]]. static_only: against the static group's scene
+  // alone, not the top level (the caller has made sure that no ray can hit a moving geom; the
+  // hits are then those of the top level, whose static instance has the identity pose).
+  // the packets are traced with an incoherent context: with RTC_INTERSECT_CONTEXT_FLAG_COHERENT,
+  // Embree 3.13.5 was seen to loop forever inside rtcIntersect16 / rtcOccluded16 (and
+  // rtcOccluded1M) on some packets of this renderer's scenes (instanced user geometry;
+  // reproduced by the realtime lighting tests), so that flag is not used.
+  void IntersectPacket(const Ray* rays, const int* index, bool static_only, SurfaceHit* hits,
+                       bool* did_hit) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     alignas(64) RTCRayHit16 p;
@@ -435,7 +461,9 @@ struct RayScene::Impl {
       p.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       p.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect16(valid, top, &ctx, &p);
+    rtcIntersect16(valid, static_only ? groups[0].scene : top, &ctx, &p);
+    if (static_only)
+      for (int k = 0; k < kPacket; ++k) p.hit.instID[0][k] = static_instance_id;
     for (int k = 0; k < kPacket; ++k) {
       const int i = index[k];
       if (i < 0) continue;
@@ -570,6 +598,13 @@ RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>
       const unsigned id = rtcAttachGeometry(m.top, g.instance);
       if (m.group_of_instance.size() <= id) m.group_of_instance.resize(id + 1, -1);
       m.group_of_instance[id] = i;
+      if (i == 0) m.static_instance_id = id;
+      if (i > 0) {
+        // cluster: the root of the body's kinematic tree (the child of the world body).
+        int root = g.body;
+        while (scene.bodies[root].parent > 0) root = scene.bodies[root].parent;
+        m.moving.AddBody(g.boxes_I, root);
+      }
       num_triangles_ += g.num_triangles;
     }
     rtcCommitScene(m.top);
@@ -610,10 +645,12 @@ void RayScene::Update(const WorldSnapshot& snapshot) {
     const Pose& X = snapshot.X_WB[g.body];
     if (X.matrix() == g.X_WI.matrix()) continue;
     m.SetInstancePose(&g, X);
+    m.moving.SetPose(static_cast<int>(i) - 1, X);
     changed = true;
   }
   X_WB_ = snapshot.X_WB;
   if (changed) {
+    m.moving.CommitPoses();
     rtcCommitScene(m.top);
     ++num_top_level_commits_;
     m.Check("updating body poses");
@@ -654,14 +691,16 @@ void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* 
   for (int start = 0; start < n; start += kPacket) {
     const int m = std::min(kPacket, n - start);
     for (int k = 0; k < kPacket; ++k) index[k] = k < m ? start + k : -1;
-    impl_->IntersectPacket(rays, index, hits, did_hit);
+    impl_->IntersectPacket(rays, index, /*static_only=*/false, hits, did_hit);
   }
 }
 
-void RayScene::IntersectGrid(const Ray* rays, int width, int height, SurfaceHit* hits,
-                             bool* did_hit) const {
+bool RayScene::IntersectGrid(const Ray* rays, int width, int height, SurfaceHit* hits,
+                             bool* did_hit, const RayCone* cone) const {
   constexpr int kSide = 4;  // kSide x kSide cells per packet
   static_assert(kSide * kSide == kPacket, "one Embree packet per square of cells");
+  const bool static_only =
+      !impl_->moving.MayHit(cone != nullptr ? *cone : RayCone::FromRays(rays, width * height));
   int index[kPacket];
   for (int y0 = 0; y0 < height; y0 += kSide) {
     for (int x0 = 0; x0 < width; x0 += kSide) {
@@ -669,12 +708,13 @@ void RayScene::IntersectGrid(const Ray* rays, int width, int height, SurfaceHit*
         const int x = x0 + k % kSide, y = y0 + k / kSide;
         index[k] = x < width && y < height ? y * width + x : -1;
       }
-      impl_->IntersectPacket(rays, index, hits, did_hit);
+      impl_->IntersectPacket(rays, index, static_only, hits, did_hit);
     }
   }
+  return static_only;
 }
 
-void RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
+bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
                              const LaneMask& active, LaneMask* occluded) const {
   static_assert(kLanes == kPacket, "one Embree packet per lane batch");
   RTCIntersectContext ctx;
@@ -696,8 +736,10 @@ void RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
     p.id[k] = 0;
     p.flags[k] = 0;
   }
-  rtcOccluded16(valid, impl_->top, &ctx, &p);
+  const bool static_only = !impl_->moving.SegmentsMayHit(o, d, tmax, active).any();
+  rtcOccluded16(valid, static_only ? impl_->groups[0].scene : impl_->top, &ctx, &p);
   for (int k = 0; k < kPacket; ++k) (*occluded)[k] = active[k] && p.tfar[k] < 0;
+  return static_only;
 }
 
 }  // namespace penumbra

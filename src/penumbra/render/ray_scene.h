@@ -24,6 +24,14 @@
 // SSE build), and were slower in wall clock; tilted float triangles 1e4 m wide would also
 // move the plane by ~1e-3 m.
 
+// static-only fast path: rays that provably miss every moving geom (MovingBounds: boxes of the
+// moving geoms, posed by Update) are traced against the static scene directly, which skips the
+// top level and the instances of the moving bodies that the rays pass near (a camera on a
+// robot starts every ray inside its own robot's instance bounds). the hits are the same as
+// through the top level: the static instance has the identity pose, so Embree sees the same
+// ray (default world: images byte-identical). IntersectGrid tests a cone of the grid's rays,
+// OccludedLanes each shadow segment against the bodies' spheres.
+//
 // visibility: geoms in MJCF groups > 2 (MuJoCo shows groups 0-2 by default) and geoms
 // whose material has alpha < 0.5 are left out.
 //
@@ -40,6 +48,8 @@
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
+
+struct RayCone;
 
 /// half-size (m) of the quad that stands in for an infinite MJCF plane.
 constexpr double kInfinitePlaneHalfSize = 1e4;
@@ -116,12 +126,18 @@ class RayScene {
   /// closest hits of the rays of a width x height pixel grid stored row-major (ray of grid
   /// cell (x, y) at rays[y * width + x]; hits and did_hit likewise), e.g. the camera rays of a
   /// tile: traced in packets of 4 x 4 neighbouring cells, which are more coherent than rows.
-  /// the same hits as IntersectMany.
-  void IntersectGrid(const Ray* rays, int width, int height, SurfaceHit* hits, bool* did_hit) const;
+  /// the same hits as IntersectMany. `cone`, when given, must hold every ray (e.g.
+  /// RayCone::FromCorners for a pinhole camera's tile); else the rays' cone is computed here
+  /// (RayCone::FromRays, O(n)). when no ray of the cone can touch a moving geom, the grid is
+  /// traced against the static scene alone (file comment), and true is returned.
+  bool IntersectGrid(const Ray* rays, int width, int height, SurfaceHit* hits, bool* did_hit,
+                     const RayCone* cone = nullptr) const;
 
   /// occlusion of one packet of kLanes rays o + t d, t in [0, tmax], given as lanes (the
   /// realtime tier's shadow rays); lanes with active[k] == false get occluded[k] = false.
-  void OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
+  /// a packet whose segments all pass clear of the moving bodies' bounding spheres is traced
+  /// against the static scene alone (file comment), and true is returned.
+  bool OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes& tmax,
                      const LaneMask& active, LaneMask* occluded) const;
 
   /// the body poses currently in the scene (X_WB by body index).
