@@ -213,6 +213,16 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   // lanes at once, the shadow rays towards one light as one Embree packet.
   for (int i0 = 0; i0 < n; i0 += kLanes) {
     const int m = std::min(kLanes, n - i0);
+    // pixel coordinates of the lanes (idle lanes repeat the last pixel), stepped along the
+    // tile's rows: one division per run instead of one per pixel.
+    int lane_u[kLanes], lane_v[kLanes];
+    {
+      int x = i0 % tile.width, y = i0 / tile.width;
+      for (int k = 0; k < kLanes; ++k) {
+        lane_u[k] = tile.x0 + x, lane_v[k] = tile.y0 + y;
+        if (k + 1 < m && ++x == tile.width) x = 0, ++y;
+      }
+    }
     LaneMask hit = LaneMask::Constant(false);
     BsdfLanes bsdf;
     PbrLanes pbr;
@@ -230,7 +240,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         pbr.base_color.Set(k, zero);
         pbr.roughness[k] = 1, pbr.metallic[k] = 0, pbr.specular[k] = 0;
         if (k < m) {
-          const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+          const int u = lane_u[k], v = lane_v[k];
           const Eigen::Vector3f sky = ctx.sky->Radiance(primary.rays[i].d.normalized());
           float* Lp = out.radiance->at(u, v);
           Lp[0] = sky.x(), Lp[1] = sky.y(), Lp[2] = sky.z();
@@ -239,7 +249,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         }
         continue;
       }
-      const int u = tile.x0 + i % tile.width, v = tile.y0 + i / tile.width;
+      const int u = lane_u[k], v = lane_v[k];
       const SurfaceHit& h = primary.hits[i];
       SurfaceMaterial mat = ctx.materials->Evaluate(h);
       if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
@@ -268,17 +278,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     // never used).
     {
       alignas(64) uint64_t stream[kLanes];
-      const int x = i0 % tile.width, y = i0 / tile.width;
-      const uint64_t row0 = static_cast<uint64_t>(tile.y0 + y) * width + tile.x0 + x;
-      if (x + kLanes <= tile.width) {
-        for (int k = 0; k < kLanes; ++k) stream[k] = row0 + k;
-      } else {
-        for (int k = 0; k < kLanes; ++k) {
-          const int i = i0 + std::min(k, m - 1);
-          stream[k] =
-              static_cast<uint64_t>(tile.y0 + i / tile.width) * width + tile.x0 + i % tile.width;
-        }
-      }
+      for (int k = 0; k < kLanes; ++k)
+        stream[k] = static_cast<uint64_t>(lane_v[k]) * width + static_cast<uint64_t>(lane_u[k]);
       for (int k = 0; k < kLanes; ++k)
         stream[k] = FrameContext::PixelStream(frame_key, stream[k], 0);
       for (int j = 0; j < num_lights; ++j) {
@@ -354,8 +355,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     }
     for (int k = 0; k < m; ++k) {
       if (!hit[k]) continue;
-      const int i = i0 + k;
-      float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+      float* Lp = out.radiance->at(lane_u[k], lane_v[k]);
       Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
     }
   }
