@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <bitset>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -119,35 +120,69 @@ bool IsStaticBody(const SceneDescription& scene, int b) {
   return b == 0 || scene.bodies[b].is_static;
 }
 
-// the fixed ray directions shared by every probe (unit) and the texel of each.
+// the fixed ray directions shared by every probe (unit): the first pass (one per texel, with
+// the texel of each) and the refinement rays (one per sub-cell of each texel).
 struct ProbeDirections {
   std::vector<Eigen::Vector3f> dir;
   std::vector<int> texel;
+  std::vector<Eigen::Vector3f> sub;  // [texel * kSubRays + sub-cell]
 };
 
 const ProbeDirections& Directions() {
   static const ProbeDirections dirs = [] {
     constexpr int K = SkyIrradianceVolume::kOctSide;
-    constexpr int R = SkyIrradianceVolume::kRaysPerTexel;
+    constexpr int S = SkyIrradianceVolume::kSubSide;
     ProbeDirections d;
     // texels in 4 x 4 blocks, so that consecutive rays are coherent.
     for (int b = 0; b < K * K; ++b) {
       const int block = b / 16, in = b % 16;
       const int ix = (block % (K / 4)) * 4 + in % 4, iy = (block / (K / 4)) * 4 + in / 4;
       const int t = ix + K * iy;
-      for (int r = 0; r < R; ++r) {
-        // stratified along u within the texel, jittered.
-        Rng rng(HashKeys(SkyIrradianceVolume::kDirectionSeed, static_cast<uint64_t>(t),
-                         static_cast<uint64_t>(r)));
-        const double ju = (r + rng.UniformD()) / R, jv = rng.UniformD();
-        const double u = -1 + 2 * (ix + ju) / K, v = -1 + 2 * (iy + jv) / K;
-        d.dir.push_back(OctDecode(u, v).normalized().cast<float>());
-        d.texel.push_back(t);
-      }
+      Rng rng(HashKeys(SkyIrradianceVolume::kDirectionSeed, static_cast<uint64_t>(t), 0));
+      const double ju = rng.UniformD(), jv = rng.UniformD();
+      const double u = -1 + 2 * (ix + ju) / K, v = -1 + 2 * (iy + jv) / K;
+      d.dir.push_back(OctDecode(u, v).normalized().cast<float>());
+      d.texel.push_back(t);
     }
+    d.sub.resize(static_cast<size_t>(K * K) * S * S);
+    for (int t = 0; t < K * K; ++t)
+      for (int c = 0; c < S * S; ++c) {
+        Rng rng(HashKeys(SkyIrradianceVolume::kDirectionSeed, static_cast<uint64_t>(t),
+                         static_cast<uint64_t>(1 + c)));
+        const double ju = rng.UniformD(), jv = rng.UniformD();
+        const double u = -1 + 2 * ((t % K) * S + c % S + ju) / (K * S);
+        const double v = -1 + 2 * ((t / K) * S + c / S + jv) / (K * S);
+        d.sub[static_cast<size_t>(t) * S * S + c] = OctDecode(u, v).normalized().cast<float>();
+      }
     return d;
   }();
   return dirs;
+}
+
+// the texel next to texel (ix, iy) by (dx, dy) in [-1, 1]^2 on the sphere: across an edge of
+// the octahedral map the neighbour is mirrored (the map folds there: u = -1 - e is u = -1 + e
+// with v negated), across a corner it is the opposite corner.
+int NeighbourTexel(int ix, int iy, int dx, int dy) {
+  constexpr int K = SkyIrradianceVolume::kOctSide;
+  int x = ix + dx, y = iy + dy;
+  if (x < 0 || x >= K) x = x < 0 ? 0 : K - 1, y = K - 1 - y;
+  if (y < 0 || y >= K) y = y < 0 ? 0 : K - 1, x = K - 1 - x;
+  return x + K * y;
+}
+
+// one bit per texel.
+using TexelBits = std::bitset<SkyIrradianceVolume::kNumTexels>;
+
+// the texels whose 3 x 3 neighbourhood on the sphere (NeighbourTexel) holds an open texel
+// (*near_open) and a closed one (*near_closed), of one probe's first pass.
+void NearOpenClosed(const uint16_t* open, TexelBits* near_open, TexelBits* near_closed) {
+  constexpr int K = SkyIrradianceVolume::kOctSide;
+  near_open->reset();
+  near_closed->reset();
+  for (int t = 0; t < K * K; ++t)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        (open[NeighbourTexel(t % K, t / K, dx, dy)] != 0 ? *near_open : *near_closed).set(t);
 }
 
 // 4-lane math for the lookup's 8 corners (two halves), with GCC/Clang vector extensions: SSE2
@@ -288,7 +323,8 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   valid_.clear();
   links_.clear();
   position_.clear();
-  escaped_.clear();
+  open_.clear();
+  num_refined_ = 0;
   depth_.clear();
   depth_q_.clear();
   sh_.clear();
@@ -346,16 +382,16 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   const ProbeDirections& dirs = Directions();
   const int num = num_probes();
   valid_.assign(num, 0);
-  escaped_.assign(static_cast<size_t>(num) * kNumTexels, 0);
+  open_.assign(static_cast<size_t>(num) * kNumTexels, 0);
   depth_.assign(static_cast<size_t>(num) * kNumTexels, 0.0f);
   position_.resize(num);
   const float far = 2.0f * spacing_;
   // traces one probe at x into its texels; returns the number of back-face hits and writes
   // the closest back-face hit (distance, direction).
-  auto trace_probe = [&](const Eigen::Vector3f& x, float* m, uint8_t* esc, float* t_back,
+  auto trace_probe = [&](const Eigen::Vector3f& x, float* m, uint16_t* open, float* t_back,
                          Eigen::Vector3f* d_back) {
     std::fill_n(m, kNumTexels, far);
-    std::fill_n(esc, kNumTexels, uint8_t{0});
+    std::fill_n(open, kNumTexels, uint16_t{0});
     *t_back = std::numeric_limits<float>::infinity();
     // one probe's rays as Embree packets of 16 (4 x 4 neighbouring texels share a packet).
     thread_local std::vector<Ray> ray(kRaysPerProbe);
@@ -376,24 +412,55 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
         }
         t = std::min(hit[r].t, far);
       } else {
-        ++esc[dirs.texel[r]];
+        open[dirs.texel[r]] = kAllOpen;
       }
       m[dirs.texel[r]] = std::min(m[dirs.texel[r]], t);
     }
     return backfaces;
+  };
+  // refines the texels `refine` of a probe at x (see the file comment): one ray per sub-cell, a
+  // texel's kSubRays rays as one packet; returns the number of refined texels.
+  auto refine_probe = [&](const Eigen::Vector3f& x, const TexelBits& refine, uint16_t* open) {
+    thread_local std::vector<int> texels;
+    thread_local std::vector<Ray> ray;
+    thread_local std::vector<SurfaceHit> hit;
+    thread_local std::unique_ptr<bool[]> did_hit;
+    thread_local size_t capacity = 0;
+    texels.clear();
+    for (int t = 0; t < kNumTexels; ++t)
+      if (refine[t]) texels.push_back(t);
+    const size_t n_rays = texels.size() * kSubRays;
+    if (n_rays == 0) return 0;
+    ray.resize(n_rays);
+    hit.resize(n_rays);
+    if (capacity < n_rays) did_hit.reset(new bool[n_rays]), capacity = n_rays;
+    for (size_t i = 0; i < texels.size(); ++i)
+      for (int c = 0; c < kSubRays; ++c) {
+        ray[i * kSubRays + c].o = x;
+        ray[i * kSubRays + c].d = dirs.sub[static_cast<size_t>(texels[i]) * kSubRays + c];
+      }
+    rays.IntersectMany(ray.data(), static_cast<int>(n_rays), /*coherent=*/true, hit.data(),
+                       did_hit.get());
+    for (size_t i = 0; i < texels.size(); ++i) {
+      uint16_t mask = 0;
+      for (int c = 0; c < kSubRays; ++c)
+        if (!did_hit[i * kSubRays + c]) mask |= static_cast<uint16_t>(1u << c);
+      open[texels[i]] = mask;
+    }
+    return static_cast<int>(texels.size());
   };
   constexpr int kChunk = 16;
   auto trace = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
     for (int p = p0; p < p1; ++p) {
       float* m = &depth_[static_cast<size_t>(p) * kNumTexels];
-      uint8_t* esc = &escaped_[static_cast<size_t>(p) * kNumTexels];
+      uint16_t* open = &open_[static_cast<size_t>(p) * kNumTexels];
       const Eigen::Vector3f x = ProbePosition(p);
       position_[p] = x;
       float t_back;
       Eigen::Vector3f d_back = Eigen::Vector3f::Zero();
       const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
-      if (trace_probe(x, m, esc, &t_back, &d_back) <= max_back) {
+      if (trace_probe(x, m, open, &t_back, &d_back) <= max_back) {
         valid_[p] = 1;
         continue;
       }
@@ -404,7 +471,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       const Eigen::Vector3f y = x + (t_back + kRelocateMargin * spacing_) * d_back;
       float t2;
       Eigen::Vector3f d2;
-      if (trace_probe(y, m, esc, &t2, &d2) <= max_back) {
+      if (trace_probe(y, m, open, &t2, &d2) <= max_back) {
         valid_[p] = 1;
         position_[p] = y;
       }
@@ -412,6 +479,40 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   };
   const int64_t chunks = (num + kChunk - 1) / kChunk;
   ParallelForOrSerial(pool, chunks, trace);
+
+  // refinement: a texel is refined when, in the first pass of the probe or of a valid probe
+  // next to it (the 3 x 3 x 3 grid neighbourhood), its 3 x 3 texel neighbourhood holds both
+  // open sky and geometry. the neighbours matter: a window a few metres away is missed by every
+  // first-pass ray of some probes while the probes next to them see it.
+  std::vector<TexelBits> near_open(num), near_closed(num);
+  auto dilate = [&](int64_t p) {
+    if (valid_[p])
+      NearOpenClosed(&open_[static_cast<size_t>(p) * kNumTexels], &near_open[p], &near_closed[p]);
+  };
+  ParallelForOrSerial(pool, num, dilate);
+  std::vector<int> refined(num, 0);
+  auto refine = [&](int64_t chunk) {
+    const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
+    for (int p = p0; p < p1; ++p) {
+      if (!valid_[p]) continue;
+      const int c[3] = {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])};
+      TexelBits any_open, any_closed;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int i = c[0] + dx, j = c[1] + dy, k = c[2] + dz;
+            if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) continue;
+            const int q = ProbeIndex(i, j, k);
+            if (!valid_[q]) continue;
+            any_open |= near_open[q];
+            any_closed |= near_closed[q];
+          }
+      refined[p] = refine_probe(position_[p], any_open & any_closed,
+                                &open_[static_cast<size_t>(p) * kNumTexels]);
+    }
+  };
+  ParallelForOrSerial(pool, chunks, refine);
+  for (int r : refined) num_refined_ += r;
 
   // links between valid neighbours along the grid axes that see each other (each one's ray
   // towards the other goes at least as far as the other probe), for the smoothing in Relight.
@@ -465,27 +566,31 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
 void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
   lit_sky_ = &sky;
   if (empty()) return;
-  // per texel: the integral of sky radiance x y_lm over the texel's solid angle, times the
-  // band's convolution weight (so that a probe's irradiance SH is a sum over texels).
+  // per sub-cell of each texel: the integral of sky radiance x y_lm over its solid angle (one
+  // sample at its centre), times the band's convolution weight, so that a probe's irradiance SH
+  // is a sum over its open sub-cells; and per texel the sum over its sub-cells.
   constexpr int K = kOctSide, S = kSubSide;
+  std::vector<double> sub_sh(static_cast<size_t>(kNumTexels) * kSubRays * kShFloats, 0.0);
   std::vector<double> texel_sh(static_cast<size_t>(kNumTexels) * kShFloats, 0.0);
   const double du = 2.0 / (K * S);
   for (int t = 0; t < kNumTexels; ++t) {
     const int ix = t % K, iy = t / K;
     double* acc = &texel_sh[static_cast<size_t>(t) * kShFloats];
-    for (int a = 0; a < S; ++a)
-      for (int b = 0; b < S; ++b) {
-        const double u = -1 + (ix * S + a + 0.5) * du, v = -1 + (iy * S + b + 0.5) * du;
-        const Eigen::Vector3d x = OctDecode(u, v);
-        const double len = x.norm();
-        const double dw = du * du / (len * len * len);  // solid angle of the sub-sample
-        const Eigen::Vector3d w = x / len;
-        const Eigen::Vector3d L = sky.Radiance(w.cast<float>()).cast<double>();
-        double y[kNumSh];
-        ShBasis(w.x(), w.y(), w.z(), y);
-        for (int k = 0; k < kNumSh; ++k)
-          for (int c = 0; c < 3; ++c) acc[k * 3 + c] += L[c] * y[k] * dw * kBandWeight[k];
-      }
+    for (int c = 0; c < kSubRays; ++c) {
+      const int a = c % S, b = c / S;
+      const double u = -1 + (ix * S + a + 0.5) * du, v = -1 + (iy * S + b + 0.5) * du;
+      const Eigen::Vector3d x = OctDecode(u, v);
+      const double len = x.norm();
+      const double dw = du * du / (len * len * len);  // solid angle of the sub-cell
+      const Eigen::Vector3d w = x / len;
+      const Eigen::Vector3d L = sky.Radiance(w.cast<float>()).cast<double>();
+      double y[kNumSh];
+      ShBasis(w.x(), w.y(), w.z(), y);
+      double* sub = &sub_sh[(static_cast<size_t>(t) * kSubRays + c) * kShFloats];
+      for (int k = 0; k < kNumSh; ++k)
+        for (int ch = 0; ch < 3; ++ch) sub[k * 3 + ch] = L[ch] * y[k] * dw * kBandWeight[k];
+      for (int i = 0; i < kShFloats; ++i) acc[i] += sub[i];
+    }
   }
   const int num = num_probes();
   sh_.assign(static_cast<size_t>(num) * kShStride, 0.0f);
@@ -494,12 +599,19 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
     for (int p = p0; p < p1; ++p) {
       double acc[kShFloats] = {};
-      const uint8_t* esc = &escaped_[static_cast<size_t>(p) * kNumTexels];
+      const uint16_t* open = &open_[static_cast<size_t>(p) * kNumTexels];
       for (int t = 0; t < kNumTexels; ++t) {
-        if (esc[t] == 0) continue;
-        const double f = static_cast<double>(esc[t]) / kRaysPerTexel;
-        const double* ts = &texel_sh[static_cast<size_t>(t) * kShFloats];
-        for (int i = 0; i < kShFloats; ++i) acc[i] += f * ts[i];
+        if (open[t] == 0) continue;
+        if (open[t] == kAllOpen) {
+          const double* ts = &texel_sh[static_cast<size_t>(t) * kShFloats];
+          for (int i = 0; i < kShFloats; ++i) acc[i] += ts[i];
+          continue;
+        }
+        for (unsigned bits = open[t]; bits != 0; bits &= bits - 1) {
+          const double* ss =
+              &sub_sh[(static_cast<size_t>(t) * kSubRays + std::countr_zero(bits)) * kShFloats];
+          for (int i = 0; i < kShFloats; ++i) acc[i] += ss[i];
+        }
       }
       float* out = &sh_[static_cast<size_t>(p) * kShStride];
       for (int k = 0; k < kNumSh; ++k)
