@@ -109,6 +109,33 @@ TEST(Simulation, SnapshotPosesMatchMujocoKinematics) {
   mj_deleteModel(m);
 }
 
+// a pose snapshot (what cameras read) has the full snapshot's poses bit for bit and no
+// sensor ground truth; taking either kind never perturbs the trajectory (next test).
+TEST(Simulation, PoseSnapshotsHaveTheFullSnapshotsPoses) {
+  Simulation sim = Simulation::LoadFromString(kArmXml);
+  sim.ctrl()[0] = 0.5;
+  for (int i = 0; i < 500; ++i) sim.Step();  // 1 s: the box has landed
+  const WorldSnapshot full = sim.Snapshot(Simulation::SnapshotContent::kFull);
+  WorldSnapshot poses = full;  // reused storage: the sensor fields must be cleared
+  sim.Snapshot(&poses, Simulation::SnapshotContent::kPoses);
+  EXPECT_EQ(poses.time_sec, full.time_sec);
+  EXPECT_EQ(poses.step, full.step);
+  EXPECT_EQ(poses.qpos, full.qpos);
+  EXPECT_EQ(poses.qvel, full.qvel);
+  ASSERT_EQ(poses.X_WB.size(), full.X_WB.size());
+  for (size_t b = 0; b < full.X_WB.size(); ++b)
+    EXPECT_TRUE(poses.X_WB[b].matrix() == full.X_WB[b].matrix()) << b;
+  EXPECT_EQ(poses.light_position_W, full.light_position_W);
+  EXPECT_EQ(poses.light_direction_W, full.light_direction_W);
+  ASSERT_EQ(poses.X_W_mjcam.size(), full.X_W_mjcam.size());
+  EXPECT_FALSE(full.sensordata.empty());
+  EXPECT_FALSE(full.V_WB.empty());
+  EXPECT_FALSE(full.contacts.empty());  // the box rests on the floor
+  EXPECT_TRUE(poses.sensordata.empty());
+  EXPECT_TRUE(poses.V_WB.empty());
+  EXPECT_TRUE(poses.contacts.empty());
+}
+
 TEST(Simulation, MatchesBareMjStepBitForBitAndIsDeterministic) {
   const std::string path = penumbra::testing::ProcessTempDir() + "/arm_bare.xml";
   std::ofstream(path) << kArmXml;
@@ -127,7 +154,9 @@ TEST(Simulation, MatchesBareMjStepBitForBitAndIsDeterministic) {
     a.Step();
     b.Step();
     mj_step(m, d);
-    b.Snapshot(&scratch);  // snapshots must not perturb the trajectory
+    // snapshots of either kind must not perturb the trajectory
+    b.Snapshot(&scratch,
+               i % 2 ? Simulation::SnapshotContent::kFull : Simulation::SnapshotContent::kPoses);
     ASSERT_EQ(0, std::memcmp(a.qpos().data(), b.qpos().data(), sizeof(double) * m->nq)) << i;
     ASSERT_EQ(0, std::memcmp(a.qvel().data(), b.qvel().data(), sizeof(double) * m->nv)) << i;
     ASSERT_EQ(0, std::memcmp(a.qpos().data(), d->qpos, sizeof(double) * m->nq)) << i;

@@ -87,7 +87,7 @@ int BenchRender(const RenderBenchOptions& options) {
     int64_t rays = 0;
     for (int i = 0; i < options.warmup_frames + options.frames; ++i) {
       for (int s = 0; s < steps_per_frame; ++s) sim.Step();
-      const WorldSnapshot snap = sim.Snapshot();
+      const WorldSnapshot snap = sim.Snapshot(Simulation::SnapshotContent::kPoses);
       view.X_WO = CameraPoseInWorld(cam, snap);
       view.frame_index = i;
       const auto t0 = Clock::now();

@@ -1,11 +1,11 @@
 #include "penumbra/app/runner.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 #include <thread>
 
@@ -48,7 +48,8 @@ struct RenderJob {
 // so frames never drift however the rate and timestep relate.
 class CameraSchedule {
  public:
-  explicit CameraSchedule(const std::vector<CameraSpec>& cameras) : cameras_(cameras), next_(cameras.size(), 0) {}
+  explicit CameraSchedule(const std::vector<CameraSpec>& cameras)
+      : cameras_(cameras), next_(cameras.size(), 0) {}
 
   void Due(double time_sec, std::vector<int>* cams, std::vector<int64_t>* frames) {
     for (size_t c = 0; c < cameras_.size(); ++c) {
@@ -95,7 +96,9 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   const fs::path out = world.output_dir;
   std::error_code ec;
   fs::create_directories(out, ec);
-  if (ec) throw ConfigError("", 0, "--out", "cannot create folder '" + out.string() + "': " + ec.message());
+  if (ec)
+    throw ConfigError("", 0, "--out",
+                      "cannot create folder '" + out.string() + "': " + ec.message());
 
   std::map<std::string, double> timings;
 
@@ -130,18 +133,19 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
 
   // outputs
   AsyncFrameWriter writer(out.string());
-  for (const CameraSpec& cam : scene.cameras) writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
+  for (const CameraSpec& cam : scene.cameras)
+    writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
   CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
-  SensorStage sensor_stage(world, sim, scene, out.string(),  // app/sensor_stage.h
-                           [&](const WorldSnapshot& s, const Eigen::Vector3d& p) {
-                             return effects.Evaluate(s, p);
-                           });
+  SensorStage sensor_stage(
+      world, sim, scene, out.string(),  // app/sensor_stage.h
+      [&](const WorldSnapshot& s, const Eigen::Vector3d& p) { return effects.Evaluate(s, p); });
   std::ofstream trajectory(out / "trajectory.csv");
   WriteTrajectoryHeader(trajectory, sim.qpos().size());
 
   const double duration = world.duration_sec;
   ProgressOptions progress_options;
-  progress_options.mode = options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
+  progress_options.mode =
+      options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
   ProgressReporter progress(duration, progress_options);
   spdlog::info("running {} for {:.3f} s of sim time, {} camera(s), timestep {:.6g} s, out {}",
                world.file.empty() ? std::string("model") : world.file, duration,
@@ -163,7 +167,10 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
         if (sensors_due && !shutter_due && job.cameras.empty())
           sensor_stage.Process(sim.Snapshot());
         if (shutter_due || !job.cameras.empty()) {
-          job.snapshot = sim.Snapshot();
+          // cameras and effects read poses only: the full forward pass (sensordata, body
+          // velocities, contacts) only when the sensors read this snapshot too
+          job.snapshot = sim.Snapshot(sensors_due ? Simulation::SnapshotContent::kFull
+                                                  : Simulation::SnapshotContent::kPoses);
           if (sensors_due) sensor_stage.Process(job.snapshot);
           shutters.Add(job.snapshot.time_sec, job.cameras);
           for (int c : job.cameras)
@@ -207,7 +214,8 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
         break;
       }
       // per-camera effects (app/effects_stage.h) ride along with each capture
-      camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, job->effects, submit);
+      camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, job->effects,
+                              submit);
       progress.Update(job->snapshot.time_sec, total_frames);
     }
     if (!failure) camera_stage.Finish(submit);
@@ -239,7 +247,8 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   timings["total_sec"] = summary.wall_time_sec;
 
   RunManifest manifest;
-  manifest.world_file = world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
+  manifest.world_file =
+      world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
   manifest.seed = world.seed;
   manifest.penumbra_version = PENUMBRA_VERSION;
   manifest.mujoco_version = MujocoVersion();

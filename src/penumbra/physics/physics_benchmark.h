@@ -9,16 +9,18 @@ namespace penumbra {
 
 /// steps per wall-clock second of Simulation::Step and of a bare mj_step loop.
 struct PhysicsBenchResult {
-  double penumbra_steps_per_sec = 0;  ///< Simulation::Step + a Snapshot every 1/30 s of sim time
-  double bare_steps_per_sec = 0;      ///< mj_step on a separately loaded copy of the model
-  double ratio = 0;                   ///< penumbra / bare (1 = no overhead)
-  int64_t steps = 0;                  ///< steps each side ran
+  /// Simulation::Step + a pose snapshot (SnapshotContent::kPoses) every 1/30 s of sim time
+  double penumbra_steps_per_sec = 0;
+  double bare_steps_per_sec = 0;  ///< mj_step on a separately loaded copy of the model
+  double ratio = 0;               ///< penumbra / bare (1 = no overhead)
+  int64_t steps = 0;              ///< steps each side ran
 };
 
 /// runs `sim_seconds` of simulated time of the model at `mjcf_path` both ways, after an
 /// untimed warm-up block, interleaved in blocks of 250 steps (alternating which side goes
 /// first) so machine noise hits both alike.
-/// no controllers are attached; snapshots are taken at 30 Hz of sim time, as the runner does.
+/// no controllers are attached; pose snapshots are taken at 30 Hz of sim time, as the runner
+/// takes them for cameras (a world's sensors add full snapshots at their own rates).
 /// wall-clock time is measured with std::chrono::steady_clock (it never feeds the simulation).
 /// @throws ConfigError for a bad model or sim_seconds <= 0; PhysicsError if it diverges.
 PhysicsBenchResult BenchmarkPhysics(const std::string& mjcf_path, double sim_seconds);

@@ -427,8 +427,9 @@ void Simulation::AddMocapDriver(const std::string& body_name,
   const int mocap = m->body_mocapid[body];
   if (mocap < 0)
     throw ConfigError("", 0, "mocap driver",
-                      "body '" + body_name + "' is not a mocap body; expected a body with "
-                      "mocap=\"true\"");
+                      "body '" + body_name +
+                          "' is not a mocap body; expected a body with "
+                          "mocap=\"true\"");
   if (!X_WB) throw Error("Simulation::AddMocapDriver: empty pose function for '" + body_name + "'");
   impl_->mocap_drivers.push_back({mocap, std::move(X_WB)});
   impl_->ApplyMocapDrivers(impl_->d->time);
@@ -480,24 +481,28 @@ double Simulation::time() const { return impl_->d->time; }
 int64_t Simulation::step_count() const { return impl_->steps; }
 double Simulation::timestep() const { return impl_->m->opt.timestep; }
 
-WorldSnapshot Simulation::Snapshot() const {
+WorldSnapshot Simulation::Snapshot(SnapshotContent content) const {
   WorldSnapshot out;
-  Snapshot(&out);
+  Snapshot(&out, content);
   return out;
 }
 
-void Simulation::Snapshot(WorldSnapshot* out) const {
+void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   const mjModel* m = impl_->m;
   const mjData* live = impl_->d;
   mjData* d = impl_->snap_d;
-  std::memcpy(d->qpos, live->qpos, sizeof(mjtNum) * m->nq);
-  std::memcpy(d->mocap_pos, live->mocap_pos, sizeof(mjtNum) * 3 * m->nmocap);
-  std::memcpy(d->mocap_quat, live->mocap_quat, sizeof(mjtNum) * 4 * m->nmocap);
   try {
-    // the whole forward pass on the scratch copy of the state: sensors, body velocities and
-    // contacts for this instant (mj_step's own sensordata belong to the previous step)
     CopyStateForForward(m, live, d);
-    mj_forward(m, d);
+    if (content == SnapshotContent::kFull) {
+      // the whole forward pass: sensors, body velocities and contacts for this instant
+      // (mj_step's own sensordata belong to the previous step)
+      mj_forward(m, d);
+    } else {
+      // the position stage's first functions, as mj_forward calls them: the same poses
+      mj_kinematics(m, d);
+      mj_comPos(m, d);
+      mj_camlight(m, d);
+    }
   } catch (const MujocoError& e) {
     throw PhysicsError(impl_->When(live->time, impl_->steps) + ": MuJoCo error: " + e.what());
   }
@@ -525,12 +530,16 @@ void Simulation::Snapshot(WorldSnapshot* out) const {
   }
   out->qpos.assign(live->qpos, live->qpos + m->nq);
   out->qvel.assign(live->qvel, live->qvel + m->nv);
-  FillSensorGroundTruth(m, d, out);
+  if (content == SnapshotContent::kFull) {
+    FillSensorGroundTruth(m, d, out);
+  } else {
+    out->sensordata.clear();
+    out->V_WB.clear();
+    out->contacts.clear();
+  }
 }
 
-const std::vector<MujocoSensorInfo>& Simulation::sensor_info() const {
-  return impl_->sensor_info;
-}
+const std::vector<MujocoSensorInfo>& Simulation::sensor_info() const { return impl_->sensor_info; }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }
 const ModelInfo& Simulation::model_info() const { return impl_->info; }

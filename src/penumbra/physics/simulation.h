@@ -80,13 +80,23 @@ class Simulation {
   /// the physics timestep (s).
   double timestep() const;
 
-  /// the world at the current time: X_WB of every body, MJCF camera poses and light
-  /// positions/directions, qpos, qvel. poses are computed for the current qpos (and mocap
-  /// poses) with mj_kinematics, mj_comPos and mj_camlight on a scratch copy, so taking
-  /// snapshots never changes the trajectory.
-  WorldSnapshot Snapshot() const;
+  /// what a snapshot computes. both work on a scratch copy of the state, so taking snapshots
+  /// never changes the trajectory, and both give bit-identical poses.
+  enum class SnapshotContent {
+    /// time, X_WB of every body, MJCF camera poses, light positions/directions, qpos, qvel:
+    /// mj_kinematics, mj_comPos and mj_camlight for the current qpos and mocap poses (what
+    /// cameras and effects read; a small part of a step). sensordata, V_WB and contacts are
+    /// left empty.
+    kPoses,
+    /// kPoses plus sensordata, V_WB and contacts: the whole mj_forward for the current
+    /// state (collision, constraint forces, every sensor stage; about the cost of a step).
+    kFull,
+  };
+
+  /// the world at the current time (see SnapshotContent).
+  WorldSnapshot Snapshot(SnapshotContent content = SnapshotContent::kFull) const;
   /// as Snapshot(), reusing `out`'s storage.
-  void Snapshot(WorldSnapshot* out) const;
+  void Snapshot(WorldSnapshot* out, SnapshotContent content = SnapshotContent::kFull) const;
 
   /// the model's MuJoCo sensors (name, type, dimension, unit, object), by sensor id; their
   /// values are WorldSnapshot::sensordata (physics/sensor_readout.h).
