@@ -656,7 +656,9 @@ TEST(RaySceneTest, RobotCameraTilesTracedStaticOnlyMatchSingleRays) {
         ASSERT_EQ(hit_grid_rays[i], hit_single[i]);
         if (!hit_single[i]) continue;
         seen[single[i].geom] = true;
-        if (fast) EXPECT_EQ(f.scene.geoms[single[i].geom].body, 0);
+        if (fast) {
+          EXPECT_EQ(f.scene.geoms[single[i].geom].body, 0);
+        }
         ExpectSameHit(grid[i], single[i]);
         ExpectSameHit(grid_rays[i], single[i]);
       }
