@@ -157,6 +157,14 @@ bool AnyNonFinite(const mjtNum* x, int n) {
   return acc != acc;
 }
 
+// body, camera and light poses for d's qpos and mocap poses: the first functions of
+// mj_forward's position stage, in its order, so the poses are bit for bit mj_forward's.
+void ComputePoses(const mjModel* m, mjData* d) {
+  mj_kinematics(m, d);
+  mj_comPos(m, d);
+  mj_camlight(m, d);
+}
+
 }  // namespace
 
 struct Simulation::Impl {
@@ -359,9 +367,7 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   mjData* d = impl->snap_d;
   // position-dependent quantities at qpos0 for the scene
   try {
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_camlight(m, d);
+    ComputePoses(m, d);
   } catch (const MujocoError& e) {
     throw PhysicsError(source + ": MuJoCo error at qpos0: " + e.what());
   }
@@ -498,10 +504,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
       // (mj_step's own sensordata belong to the previous step)
       mj_forward(m, d);
     } else {
-      // the position stage's first functions, as mj_forward calls them: the same poses
-      mj_kinematics(m, d);
-      mj_comPos(m, d);
-      mj_camlight(m, d);
+      ComputePoses(m, d);
     }
   } catch (const MujocoError& e) {
     throw PhysicsError(impl_->When(live->time, impl_->steps) + ": MuJoCo error: " + e.what());

@@ -424,8 +424,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     thread_local std::vector<int> texels;
     thread_local std::vector<Ray> ray;
     thread_local std::vector<SurfaceHit> hit;
-    thread_local std::unique_ptr<bool[]> did_hit;
-    thread_local size_t capacity = 0;
+    thread_local std::unique_ptr<bool[]> did_hit(new bool[kNumTexels * kSubRays]);
     texels.clear();
     for (int t = 0; t < kNumTexels; ++t)
       if (refine[t]) texels.push_back(t);
@@ -433,7 +432,6 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     if (n_rays == 0) return 0;
     ray.resize(n_rays);
     hit.resize(n_rays);
-    if (capacity < n_rays) did_hit.reset(new bool[n_rays]), capacity = n_rays;
     for (size_t i = 0; i < texels.size(); ++i)
       for (int c = 0; c < kSubRays; ++c) {
         ray[i * kSubRays + c].o = x;
