@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/world_config.h"
 
@@ -54,7 +55,10 @@ std::string ErrorOf(const std::string& yaml, ConfigError* out = nullptr) {
 }
 
 TEST(WorldEffects, ParsesEveryType) {
-  const WorldConfig w = ParseWorld(kEffects, "/tmp/worlds/w.yaml");
+  // the .vdb file must exist at load (its grid is read when the effects are built)
+  const testing::TempDir dir;
+  const std::string vdb = dir.Write("assets/cloud.vdb", "");
+  const WorldConfig w = ParseWorld(kEffects, (dir.path() / "w.yaml").string());
   ASSERT_EQ(w.effects.size(), 12u);
   const auto& e = w.effects;
   EXPECT_EQ(e[0].type, EffectType::kFog);
@@ -67,7 +71,7 @@ TEST(WorldEffects, ParsesEveryType) {
   EXPECT_EQ(e[2].smoke.fluid.resolution, 32);
   ASSERT_EQ(e[2].smoke.fluid.emitters.size(), 1u);
   EXPECT_EQ(e[2].smoke.fluid.emitters[0].rate, 0.3);
-  EXPECT_EQ(e[3].vdb_smoke.file, "/tmp/worlds/assets/cloud.vdb");  // relative to the world file
+  EXPECT_EQ(e[3].vdb_smoke.file, vdb);  // relative to the world file
   EXPECT_EQ(e[4].fire.fluid.emitters[0].temperature_k, 1400);
   EXPECT_EQ(e[5].rain.rate_mm_h, 20);
   EXPECT_EQ(e[5].start_sec, 2);

@@ -769,3 +769,73 @@ TEST_F(WorldConfigTest, WorldForBareModelErrors) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// ---- issue 15 point 7: nothing in a world file is silently ignored, every error is placed ----
+
+TEST_F(WorldConfigTest, SecondYamlDocumentIsAnError) {
+  ExpectError("seed: 1\n---\nduration_sec: 5\n", 3, "", "a second YAML document");
+  // a trailing '---' with nothing after it is harmless
+  EXPECT_EQ(ParseWorld("seed: 3\n---\n", world_).seed, 3u);
+}
+
+TEST_F(WorldConfigTest, HugeValueIsEchoedShortened) {
+  const std::string name(10 * 1024 * 1024, 'n');
+  try {
+    ParseWorld("lights:\n  - name: " + name + "!\n    type: point\n    power_w: 1\n", world_);
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_LT(std::string(e.what()).size(), 2000u);
+    EXPECT_NE(std::string(e.what()).find("bytes elided"), std::string::npos);
+  }
+}
+
+TEST_F(WorldConfigTest, BinaryGarbageIsEscaped) {
+  try {
+    ParseWorld(std::string("seed: 1\n\x01\x02\xff\xfe: 3\n"), world_);
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    for (char c : what) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << what;
+  }
+}
+
+TEST_F(WorldConfigTest, LocateInWorldPlacesStageErrors) {
+  const std::string yaml =
+      "seed: 1\n"
+      "models:\n"
+      "  - {name: room, file: models/room.xml}\n"
+      "effects:\n"
+      "  - name: flicker\n"
+      "    type: light_event\n"
+      "    light: lamp\n"
+      "materials:\n"
+      "  room/floor: {roughness: 0.5}\n";
+  WorldConfig w = ParseWorld(yaml, world_);
+  w.file = world_;
+  // an error raised by a stage with no file, and one with the file but no line
+  const ConfigError a = LocateInWorld(w, ConfigError("", 0, "effects[0].light", "no such light"));
+  EXPECT_EQ(a.file(), world_);
+  EXPECT_EQ(a.line(), 7);
+  EXPECT_EQ(std::string(a.what()), world_ + ":7: effects[0].light: no such light");
+  const ConfigError b = LocateInWorld(w, ConfigError(world_, 0, "materials.room/floor", "x"));
+  EXPECT_EQ(b.line(), 9);
+  // command-line flags and errors in other files keep their origin
+  EXPECT_EQ(LocateInWorld(w, ConfigError("", 0, "--out", "x")).file(), "");
+  EXPECT_EQ(LocateInWorld(w, ConfigError("m.xml", 0, "geom", "x")).file(), "m.xml");
+  // a bare-model world (no file) changes nothing
+  WorldConfig bare;
+  EXPECT_EQ(LocateInWorld(bare, ConfigError("", 0, "effects[0].light", "x")).file(), "");
+}
+
+TEST_F(WorldConfigTest, MissingVdbFileIsFoundAtLoad) {
+  ExpectError(
+      "effects:\n  - name: v\n    type: vdb_smoke\n    file: nothere.vdb\n", 4,
+      "effects[0].file", "file not found");
+}
+
+}  // namespace
+}  // namespace penumbra

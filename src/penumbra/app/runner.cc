@@ -82,9 +82,22 @@ void WriteTrajectoryRow(std::ofstream& f, const Simulation& sim) {
   f << row;
 }
 
+RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options);
+
 }  // namespace
 
-RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
+RunSummary RunWorld(const WorldConfig& world, const RunOptions& options) {
+  // errors the stages raise after loading still name the world file's line
+  try {
+    return RunWorldUnlocated(world, options);
+  } catch (const ConfigError& e) {
+    throw LocateInWorld(world, e);
+  }
+}
+
+namespace {
+
+RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options) {
   const auto t_start = Clock::now();
   WorldConfig world = world_in;
   if (options.duration_sec) world.duration_sec = *options.duration_sec;
@@ -97,7 +110,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec)
-    throw ConfigError("", 0, "--out",
+    throw ConfigError("", 0, options.out_dir.empty() ? "output.dir" : "--out",
                       "cannot create folder '" + out.string() + "': " + ec.message());
 
   std::map<std::string, double> timings;
@@ -267,5 +280,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   if (write_failure) std::rethrow_exception(write_failure);
   return summary;
 }
+
+}  // namespace
 
 }  // namespace penumbra

@@ -65,9 +65,6 @@ std::string ModelLabel(const ModelComposer& m) {
 }
 
 void ValidateModels(const std::vector<ModelConfig>& models) {
-  if (models.empty()) {
-    throw ConfigError("", 0, "models", "no models to compose; expected at least one model");
-  }
   for (size_t i = 0; i < models.size(); ++i) {
     const ModelConfig& m = models[i];
     const std::string key = "models[" + std::to_string(i) + "].name";

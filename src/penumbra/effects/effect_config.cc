@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -223,6 +224,11 @@ std::optional<EffectConfig::Problem> EffectConfig::Validate() const {
     case EffectType::kVdbSmoke:
       if (vdb_smoke.file.empty())
         c.Fail("vdb_smoke.file", "no file; expected the path of a .vdb file");
+      // checked at load so the error names the world file's line (the grid is read later)
+      if (std::error_code ec; !std::filesystem::is_regular_file(vdb_smoke.file, ec))
+        c.Fail("vdb_smoke.file", "file not found: " + vdb_smoke.file +
+                                     " (relative paths resolve against the world file's "
+                                     "folder); expected an existing .vdb file");
       if (vdb_smoke.grid.empty())
         c.Fail("vdb_smoke.grid", "empty grid name; expected e.g. density");
       c.In("vdb_smoke.max_resolution", vdb_smoke.max_resolution, Range::Closed(4, 512));

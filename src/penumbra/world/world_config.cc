@@ -363,18 +363,27 @@ bool HasModelExtension(const fs::path& p) {
 }  // namespace
 
 WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name) {
-  LineTable lines;
+  auto lines = std::make_shared<LineTable>();
   WorldConfig w;
   try {
-    YAML::Node root = YAML::Load(yaml_text);
-    w = WorldParser(file_name, &lines).Parse(root);
+    // a world file is one YAML document: a second one would be silently ignored
+    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
+    for (size_t d = 1; d < docs.size(); ++d) {
+      if (docs[d].IsNull()) continue;
+      throw ConfigError(file_name, MarkLine(docs[d].Mark()), "",
+                        "a second YAML document (after '---'); expected the world in one "
+                        "document");
+    }
+    const YAML::Node root = docs.empty() ? YAML::Node() : docs.front();
+    w = WorldParser(file_name, lines.get()).Parse(root);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(file_name, MarkLine(e.mark), "", "YAML syntax error: " + e.msg);
   } catch (const YAML::Exception& e) {
     // any other yaml-cpp failure still names the file (and line when yaml-cpp knows it)
     throw ConfigError(file_name, MarkLine(e.mark), "", "cannot read the YAML document: " + e.msg);
   }
-  ValidateWorld(w, lines);
+  ValidateWorld(w, *lines);
+  w.lines = std::move(lines);
   // directions are stored as unit vectors (ValidateWorld rejected zero vectors)
   for (LightConfig& l : w.lights) {
     if (l.type != Light::Type::kPoint) l.direction.normalize();
@@ -395,6 +404,14 @@ WorldConfig LoadWorldFile(const std::string& path) {
   text << in.rdbuf();
   if (!in) throw ConfigError(path, 0, "", "cannot read the world file; expected a readable file");
   return ParseWorld(text.str(), path);
+}
+
+ConfigError LocateInWorld(const WorldConfig& world, const ConfigError& e) {
+  // errors a stage raised with no file, or with the world file but no line
+  const bool unplaced = e.file().empty() || (e.file() == world.file && e.line() == 0);
+  if (!unplaced || world.file.empty() || e.key().empty() || e.key().front() == '-') return e;
+  const int line = world.lines ? world.lines->Find(e.key()) : 0;
+  return ConfigError(world.file, line, e.key(), e.problem());
 }
 
 WorldConfig WorldForBareModel(const std::string& model_path) {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -124,6 +125,9 @@ struct MaterialOverride {
   std::optional<Eigen::Vector3f> emission;  ///< cd/m^2 per channel
 };
 
+class LineTable;
+class ConfigError;
+
 /// a whole world file.
 struct WorldConfig {
   std::string file;  ///< path of the world file ("" for a bare model)
@@ -151,6 +155,9 @@ struct WorldConfig {
   /// preset file path (absolute after loading), "" = none (world/adversity_preset.h).
   std::string adversity;
   int adversity_line = 0;  ///< line of the `adversity` key (0 = unknown / command line)
+  /// 1-based line of every key path of the world file (null for a bare model); lets errors
+  /// found after loading (by a stage) still name the line: see LocateInWorld.
+  std::shared_ptr<const LineTable> lines;
 
   /// throws ConfigError naming the file, key and the expected range.
   void ValidateOrThrow() const;
@@ -163,6 +170,12 @@ WorldConfig LoadWorldFile(const std::string& path);
 
 /// parses world-file text; `file_name` is used in messages and to resolve relative paths.
 WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name);
+
+/// `e` with the world file and the line of its key filled in, when `e` names no file (or the
+/// world file without a line) and its key is a world-file key path (e.g. "effects[2].light",
+/// raised by a stage after loading); otherwise `e` unchanged. errors about command-line flags (keys starting with '-') and
+/// errors of bare-model runs (no world file) keep their origin.
+ConfigError LocateInWorld(const WorldConfig& world, const ConfigError& e);
 
 /// a world around one bare MJCF or URDF file: a default camera framing the model,
 /// default lights and sky (penumbra run MODEL.xml).
