@@ -4,6 +4,7 @@
 // with an alarm, so a regression that hangs fails the test instead of stalling the suite.
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -55,9 +56,10 @@ struct CliResult {
 };
 
 // runs `penumbra run <target> --out <dir>/out --quiet <extra>` in a child process that is killed
-// after 60 s (a hang fails the test with code -SIGALRM).
+// after 60 s (a hang fails the test with code -SIGALRM); address_space_bytes > 0 limits the
+// child's address space (RLIMIT_AS).
 CliResult RunChild(const penumbra::testing::TempDir& dir, const std::string& target,
-                   std::vector<std::string> extra = {}) {
+                   std::vector<std::string> extra = {}, rlim_t address_space_bytes = 0) {
   const std::string log = (dir.path() / "cli.log").string();
   std::vector<std::string> args = {"penumbra",         "run",    target, "--out",
                                    dir.str() + "/out", "--quiet"};
@@ -65,6 +67,10 @@ CliResult RunChild(const penumbra::testing::TempDir& dir, const std::string& tar
   const pid_t pid = fork();
   if (pid == 0) {
     alarm(60);
+    if (address_space_bytes > 0) {
+      const rlimit limit{address_space_bytes, address_space_bytes};
+      if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(98);
+    }
     FILE* f = std::freopen(log.c_str(), "w", stdout);
     if (f == nullptr || dup2(fileno(stdout), 2) < 0) _exit(99);
     std::vector<char*> argv;
@@ -177,6 +183,24 @@ TEST(LimitsRun, LidarColumnsExit2WithTheKey) {
                                                       "    preset: velodyne_vlp16\n"
                                                       "    rate_hz: 1e-6\n"))),
               "expected at most 4194304 beams per scan");
+}
+
+// memory that runs out anyway (here: a 1 GiB address space for a 4096 x 4096 camera that the
+// estimate allows on a machine with more memory) ends with a message, not a bare
+// "std::bad_alloc".
+TEST(LimitsRun, OutOfMemoryIsReportedClearly) {
+  penumbra::testing::TempDir dir;
+  dir.Write("ball.xml", Ball());
+  const CliResult r =
+      RunChild(dir,
+               dir.Write("m.yaml",
+                         "duration_sec: 0.01\nmodels: [{name: m, file: ball.xml}]\n"
+                         "mjcf_cameras: {enabled: false}\n"
+                         "cameras: [{name: c, pose: {xyz: [-3, 0, 1]}, width: 4096, height: 4096,\n"
+                         "           rate_hz: 1}]\n"),
+               {}, rlim_t{1} << 30);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("out of memory; expected smaller images"), std::string::npos) << r.output;
 }
 
 // a world with one 640 x 480 world camera and the MJCF camera of kBall.
