@@ -420,7 +420,7 @@ TEST_F(WorldConfigTest, ErrorMessageFromDiskNamesFileAndLine) {
     LoadWorldFile(world_);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), world_ + ":2: duration_sec: got -3; expected > 0");
+    EXPECT_EQ(std::string(e.what()), world_ + ":2: duration_sec: got -3; expected (0, 1e+06]");
   }
 }
 
@@ -499,7 +499,7 @@ TEST_F(WorldConfigTest, RateOutOfRange) {
 
 TEST_F(WorldConfigTest, TimestepOutOfRange) {
   ExpectError("physics:\n  timestep_sec: 0.5\n", 2, "physics.timestep_sec",
-              "got 0.5; expected (0, 0.1]");
+              "got 0.5; expected [1e-06, 0.1]");
 }
 
 TEST_F(WorldConfigTest, RenderSamplesOutOfRangeNamesWorldFileAndLine) {

@@ -139,6 +139,11 @@ int RunCli(int argc, char** argv) {
   } catch (const ConfigError& e) {
     spdlog::error("{}", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    spdlog::error(
+        "out of memory; expected smaller images, fewer cameras or LiDAR columns "
+        "(docs/world-file.md \"Input limits\")");
+    return 1;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -11,6 +11,7 @@
 
 #include "penumbra/app/camera_stage.h"
 #include "penumbra/app/effects_stage.h"
+#include "penumbra/app/run_budget.h"
 #include "penumbra/app/scene_assembly.h"
 #include "penumbra/app/sensor_stage.h"
 #include "penumbra/compose/imu_injection.h"
@@ -141,6 +142,9 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // static scene for the renderer
   t0 = Clock::now();
   const SceneDescription scene = effects.Bind(AssembleScene(sim.scene(), world, sim.Snapshot()));
+  CheckRunMemory(world, scene, PhysicalMemoryBytes());  // app/run_budget.h: before allocating
+  if (auto work = DescribeRunWork(EstimateRunWork(world, scene, sim.timestep())))
+    spdlog::warn("{}", *work);
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 

@@ -1,10 +1,13 @@
 #include "penumbra/app/scene_assembly.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <set>
 
 #include "penumbra/app/camera_specs.h"
 #include "penumbra/core/error.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
@@ -24,6 +27,11 @@ int BodyOrThrow(const SceneDescription& scene, const std::string& attach, const 
                       "no body named '" + attach + "'; expected \"world\" or one of: " + known);
   }
   return b;
+}
+
+std::string FormatXyz(double v) { return fmt::format("{:g}", v); }
+std::string FormatXyz(const Eigen::Vector3d& v) {
+  return fmt::format("{:g}, {:g}, {:g}", v.x(), v.y(), v.z());
 }
 
 Eigen::Vector3d DirectionFromElevationAzimuth(double elevation_deg, double azimuth_deg) {
@@ -212,6 +220,16 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
       Pose X_BodyOptical = Pose::Identity();
       X_BodyOptical.linear() = RotationBodyFromOptical();
       cam.X_BO = c.pose.ToPose() * X_BodyOptical;
+      // the pose is in range (world validation); the body it hangs on may not be
+      if (static_cast<size_t>(cam.body) < initial.X_WB.size()) {
+        const Eigen::Vector3d p_W = (initial.X_WB[cam.body] * cam.X_BO).translation();
+        if (!(p_W.cwiseAbs().maxCoeff() <= kMaxPositionM))
+          throw ConfigError(world.file, 0, "cameras[" + std::to_string(i) + "].attach",
+                            "camera '" + c.name + "' starts at (" + FormatXyz(p_W) +
+                                ") m in the world (attached to '" + c.attach +
+                                "'); expected each coordinate in [-" + FormatXyz(kMaxPositionM) +
+                                ", " + FormatXyz(kMaxPositionM) + "] m");
+      }
     }
     AppendWorldCamera(c, cam, &cameras, world.file, "cameras[" + std::to_string(i) + "]");
   }
@@ -224,10 +242,36 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
   scene.cameras = std::move(cameras);
 }
 
+// the file of the world model whose MJCF names start with "<model>/" ("" if none does).
+std::string ModelFileOf(const WorldConfig& world, const std::string& name) {
+  for (const ModelConfig& m : world.models)
+    if (name.size() > m.name.size() && name.compare(0, m.name.size() + 1, m.name + "/") == 0)
+      return m.file;
+  return world.models.size() == 1 ? world.models.front().file : "";
+}
+
+// the compiled models' geoms, MJCF cameras and lights against scene/scene_limits.h, before
+// anything is sized or traced.
+void CheckSceneLimits(const SceneDescription& scene, const WorldConfig& world,
+                      const WorldSnapshot& initial) {
+  const std::optional<SceneLimitProblem> p =
+      FindSceneLimitProblem(scene, initial, world.mjcf_cameras.enabled);
+  if (!p) return;
+  const size_t quote = p->object.find('\'');
+  const std::string name = quote == std::string::npos
+                               ? p->body
+                               : p->object.substr(quote + 1, p->object.size() - quote - 2);
+  std::string file = ModelFileOf(world, name);
+  if (file.empty()) file = ModelFileOf(world, p->body);
+  throw ConfigError(file.empty() ? world.file : file, 0, p->object,
+                    (p->body.empty() ? "" : "in body '" + p->body + "': ") + p->problem);
+}
+
 }  // namespace
 
 SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
                                const WorldSnapshot& initial) {
+  CheckSceneLimits(scene, world, initial);
   ApplyMaterialOverrides(scene, world);
 
   for (size_t i = 0; i < world.lights.size(); ++i)

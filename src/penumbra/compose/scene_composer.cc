@@ -10,6 +10,7 @@
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/compose/model_composer.h"
 #include "penumbra/core/error.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -198,6 +199,22 @@ AttrList MergedAttrs(const ModelComposer& m, const std::string& section) {
   return out;
 }
 
+// the model's <option timestep> (the last one set, as MuJoCo reads them) against
+// kMinTimestepSec..kMaxTimestepSec, with its file and line.
+void CheckModelTimestep(const ModelComposer& m) {
+  XMLElement* where = nullptr;
+  for (XMLElement* s : m.Sections("option"))
+    if (s->Attribute("timestep")) where = s;
+  if (where == nullptr) return;
+  const std::string text = where->Attribute("timestep");
+  const auto v = ParseNumbers(text);
+  if (v && v->size() == 1 && (*v)[0] >= kMinTimestepSec && (*v)[0] <= kMaxTimestepSec) return;
+  m.source().Fail(where, "option.timestep",
+                  "'" + text + "' is not a usable physics timestep; expected seconds in [" +
+                      FormatNumbers({kMinTimestepSec}) + ", " + FormatNumbers({kMaxTimestepSec}) +
+                      "] (or set physics.timestep_sec in a world file, which overrides it)");
+}
+
 void ComposeOption(const Models& models, const ComposeOptions& options, XMLElement* root,
                    std::vector<std::string>* warnings) {
   // the first model that has an <option> decides; later explicit values that differ warn
@@ -234,6 +251,9 @@ void ComposeOption(const Models& models, const ComposeOptions& options, XMLEleme
                           "'s; the composed world uses the latter");
     }
   }
+  // the world file's physics.timestep_sec wins; else the deciding model's own timestep must be
+  // in the range that the world file's is held to (scene/scene_limits.h)
+  if (owner != nullptr && !options.timestep_sec) CheckModelTimestep(*owner);
   if (options.timestep_sec) SetAttr(&attrs, "timestep", FormatNumbers({*options.timestep_sec}));
   if (attrs.empty() && flags.empty()) return;
   XMLElement* opt = root->InsertNewChildElement("option");
@@ -486,10 +506,12 @@ int ComposeKeys(const Models& models, XMLElement* root, std::vector<std::string>
 ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const ComposeOptions& options) {
   ValidateModels(models);
   if (options.timestep_sec &&
-      !(std::isfinite(*options.timestep_sec) && *options.timestep_sec > 0)) {
+      !(*options.timestep_sec >= kMinTimestepSec && *options.timestep_sec <= kMaxTimestepSec)) {
     throw ConfigError("", 0, "timestep_sec",
-                      "timestep " + std::to_string(*options.timestep_sec) +
-                          " is not valid; expected a finite number > 0 (s)");
+                      "timestep " + FormatNumbers({*options.timestep_sec}) +
+                          " is not valid; expected seconds in [" +
+                          FormatNumbers({kMinTimestepSec}) + ", " +
+                          FormatNumbers({kMaxTimestepSec}) + "]");
   }
   ComposedScene scene;
   Models composers;

@@ -65,7 +65,9 @@ struct ComposeOptions {
   /// returned text's relative asset paths resolve against the URDF's folder. may throw
   /// ConfigError. required only when a model is URDF.
   std::function<std::string(const std::string& urdf_path)> urdf_to_mjcf;
-  /// overrides <option timestep> of the composed model (s, > 0).
+  /// overrides <option timestep> of the composed model (s, in [kMinTimestepSec,
+  /// kMaxTimestepSec] of scene/scene_limits.h). without it the first model with an <option>
+  /// decides, and its timestep must be in that range too.
   std::optional<double> timestep_sec;
 };
 

@@ -93,7 +93,7 @@ class Checker {
   void Phase(const std::string& key, double g) { In(key, g, Range::Open(-1, 1)); }
   void Fluid(const std::string& p, const FluidParams& f, const std::optional<BoxRegion>& region) {
     In(p + ".resolution", f.resolution, Range::Closed(8, 128));
-    In(p + ".dt_sec", f.dt_sec, Range::OpenClosed(0, 0.1));
+    In(p + ".dt_sec", f.dt_sec, Range::Closed(FluidParams::kMinDtSec, FluidParams::kMaxDtSec));
     In(p + ".jacobi_iterations", f.jacobi_iterations, Range::Closed(1, 200));
     In(p + ".buoyancy_m_s2", f.buoyancy_m_s2, Range::AtLeast(0));
     In(p + ".weight_m_s2", f.weight_m_s2, Range::AtLeast(0));

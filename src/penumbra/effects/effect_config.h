@@ -91,7 +91,11 @@ struct PlumeEmitter {
 /// - weight_m_s2 * density.
 struct FluidParams {
   int resolution = 48;                    ///< voxels along the longest region axis, [8, 128]
-  double dt_sec = 1.0 / 30.0;             ///< fixed internal step, (0, 0.1]
+  /// range of dt_sec: the state at time t takes floor(t / dt_sec) steps from t = 0, so the
+  /// lower end caps the work at 1000 steps per simulated second (13 ms each at resolution 48,
+  /// docs/effects.md) instead of letting a tiny step hang the run.
+  static constexpr double kMinDtSec = 1e-3, kMaxDtSec = 0.1;
+  double dt_sec = 1.0 / 30.0;             ///< fixed internal step, [kMinDtSec, kMaxDtSec]
   int jacobi_iterations = 20;             ///< pressure iterations per step, [1, 200]
   double buoyancy_m_s2 = 9.81;            ///< >= 0, thermal buoyancy scale
   double weight_m_s2 = 0.0;               ///< >= 0, downward pull per unit density

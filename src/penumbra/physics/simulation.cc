@@ -11,6 +11,7 @@
 #include "penumbra/physics/mujoco_runtime.h"
 #include "penumbra/physics/scene_extractor.h"
 #include "penumbra/physics/sensor_snapshot.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -148,6 +149,12 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     info.keys.push_back(std::move(key));
   }
   return info;
+}
+
+std::string FormatSeconds(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
 }
 
 // true if any value is NaN or infinite (x * 0 is NaN exactly for those)
@@ -344,9 +351,11 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
                                                        const std::string* contents,
                                                        const std::string& source,
                                                        std::optional<double> timestep_sec) {
-  if (timestep_sec && !(std::isfinite(*timestep_sec) && *timestep_sec > 0))
+  if (timestep_sec && !(*timestep_sec >= kMinTimestepSec && *timestep_sec <= kMaxTimestepSec))
     throw ConfigError(source, 0, "timestep_sec",
-                      "got " + std::to_string(*timestep_sec) + "; expected a number > 0 (s)");
+                      "got " + FormatSeconds(*timestep_sec) + "; expected seconds in [" +
+                          FormatSeconds(kMinTimestepSec) + ", " + FormatSeconds(kMaxTimestepSec) +
+                          "]");
   InstallMujocoHandlers();
   auto impl = std::make_unique<Simulation::Impl>();
   impl->source = source;
@@ -356,6 +365,12 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   }
   mjModel* m = impl->m;
   if (timestep_sec) m->opt.timestep = *timestep_sec;
+  // the model's own timestep (no override): 0 would never advance, < 0 runs backwards
+  if (!(m->opt.timestep >= kMinTimestepSec && m->opt.timestep <= kMaxTimestepSec))
+    throw ConfigError(source, 0, "option.timestep",
+                      "the model's timestep is " + FormatSeconds(m->opt.timestep) +
+                          " s; expected seconds in [" + FormatSeconds(kMinTimestepSec) + ", " +
+                          FormatSeconds(kMaxTimestepSec) + "]");
   try {
     impl->d = mj_makeData(m);
     impl->snap_d = mj_makeData(m);

@@ -36,10 +36,13 @@ namespace penumbra {
 /// a MuJoCo simulation with pluggable controllers.
 class Simulation {
  public:
-  /// loads an MJCF (or URDF) file; `timestep_sec` overrides <option timestep>.
+  /// loads an MJCF (or URDF) file; `timestep_sec` overrides <option timestep> (the override
+  /// wins, as physics.timestep_sec of a world file does).
   /// @throws ConfigError(mjcf_path, line, ...) with MuJoCo's message for a bad model, or
-  ///         for a timestep that is not finite and > 0; PhysicsError if MuJoCo fails
-  ///         to set up the model's data.
+  ///         when the timestep used (override, else the model's) is outside
+  ///         [kMinTimestepSec, kMaxTimestepSec] (scene/scene_limits.h: 0 would never advance,
+  ///         a negative one runs backwards); PhysicsError if MuJoCo fails to set up the
+  ///         model's data.
   static Simulation LoadFromFile(const std::string& mjcf_path,
                                  std::optional<double> timestep_sec = std::nullopt);
   /// loads MJCF text; assets (meshes, textures, includes) resolve relative to `asset_dir`

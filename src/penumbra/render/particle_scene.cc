@@ -11,6 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/ray_scene.h"
 
 namespace penumbra {
 
@@ -462,6 +463,10 @@ bool ParticleScene::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleH
 
 bool ParticleScene::Intersect(const Ray& ray, float tmax, ParticleHit* hit) const {
   if (count_ == 0) return false;
+  // a ray Embree would reject misses the particles (RayScene logs such rays)
+  if (!IsTraceableRay(ray.o.x(), ray.o.y(), ray.o.z(), ray.d.x(), ray.d.y(), ray.d.z(), ray.tmin,
+                      tmax))
+    return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;

@@ -1,8 +1,10 @@
 #include "penumbra/render/ray_scene.h"
 
 #include <embree3/rtcore.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -210,6 +212,18 @@ struct RayScene::Impl {
   unsigned static_instance_id = 0;     // top-level geomID of the static group's instance
   // bounds of the moving groups (group i >= 1 is body i - 1 here), for the static-only path.
   MovingBounds moving;
+  // rays refused by IsTraceableRay (never passed to Embree)
+  mutable std::atomic<int64_t> untraceable{0};
+
+  // counts a refused ray; the first one is logged.
+  void NoteUntraceable(float ox, float oy, float oz, float dx, float dy, float dz) const {
+    if (untraceable.fetch_add(1, std::memory_order_relaxed) == 0)
+      spdlog::warn(
+          "renderer: a ray with origin ({:g}, {:g}, {:g}) and direction ({:g}, {:g}, {:g}) is "
+          "NaN, infinite or beyond {:g} m and was treated as a miss; expected the scene within "
+          "the limits of docs/world-file.md (\"Input limits\")",
+          ox, oy, oz, dx, dy, dz, kMaxRayComponent);
+  }
 
   void Check(const char* what) const {
     if (!error.empty()) throw Error(std::string("RayScene: ") + what + ": " + error);
@@ -439,13 +453,32 @@ struct RayScene::Impl {
     rtcInitIntersectContext(&ctx);
     alignas(64) RTCRayHit16 p;
     alignas(64) int valid[kPacket];
-    int fill = -1;  // idle lanes repeat an active ray (harmless values)
-    for (int k = 0; k < kPacket; ++k)
-      if (index[k] >= 0) fill = index[k];
-    if (fill < 0) return;
+    int fill = -1;  // idle lanes repeat an active, traceable ray (harmless values)
+    int local_index[kPacket];
     for (int k = 0; k < kPacket; ++k) {
-      valid[k] = index[k] >= 0 ? -1 : 0;
-      const Ray& r = rays[index[k] >= 0 ? index[k] : fill];
+      local_index[k] = index[k];
+      if (index[k] >= 0 && IsTraceableRay(rays[index[k]])) fill = index[k];
+    }
+    if (fill < 0) {
+      for (int k = 0; k < kPacket; ++k) {
+        if (index[k] < 0) continue;
+        const Ray& r = rays[index[k]];
+        NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
+        did_hit[index[k]] = false;
+      }
+      return;
+    }
+    // untraceable rays are misses: their lanes stay inactive (filled with the active ray)
+    for (int k = 0; k < kPacket; ++k) {
+      if (index[k] < 0 || IsTraceableRay(rays[index[k]])) continue;
+      const Ray& r = rays[index[k]];
+      NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
+      did_hit[index[k]] = false;
+      local_index[k] = -1;
+    }
+    for (int k = 0; k < kPacket; ++k) {
+      valid[k] = local_index[k] >= 0 ? -1 : 0;
+      const Ray& r = rays[local_index[k] >= 0 ? local_index[k] : fill];
       p.ray.org_x[k] = r.o.x();
       p.ray.org_y[k] = r.o.y();
       p.ray.org_z[k] = r.o.z();
@@ -465,7 +498,7 @@ struct RayScene::Impl {
     if (static_only)
       for (int k = 0; k < kPacket; ++k) p.hit.instID[0][k] = static_instance_id;
     for (int k = 0; k < kPacket; ++k) {
-      const int i = index[k];
+      const int i = local_index[k];
       if (i < 0) continue;
       did_hit[i] = p.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID;
       if (!did_hit[i]) continue;
@@ -657,7 +690,15 @@ void RayScene::Update(const WorldSnapshot& snapshot) {
   }
 }
 
+int64_t RayScene::num_untraceable_rays() const {
+  return impl_->untraceable.load(std::memory_order_relaxed);
+}
+
 bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
+  if (!IsTraceableRay(ray)) {
+    impl_->NoteUntraceable(ray.o.x(), ray.o.y(), ray.o.z(), ray.d.x(), ray.d.y(), ray.d.z());
+    return false;
+  }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
@@ -671,6 +712,10 @@ bool RayScene::Intersect(const Ray& ray, SurfaceHit* hit) const {
 }
 
 bool RayScene::Occluded(const Ray& ray) const {
+  if (!IsTraceableRay(ray)) {
+    impl_->NoteUntraceable(ray.o.x(), ray.o.y(), ray.o.z(), ray.d.x(), ray.d.y(), ray.d.z());
+    return false;
+  }
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
@@ -721,8 +766,30 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
   rtcInitIntersectContext(&ctx);
   alignas(64) RTCRay16 p;
   alignas(64) int valid[kPacket];
+  LaneMask traced = active;
   for (int k = 0; k < kPacket; ++k) {
-    valid[k] = active[k] ? -1 : 0;
+    if (active[k] &&
+        !IsTraceableRay(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k], 0.0f, tmax[k])) {
+      impl_->NoteUntraceable(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k]);
+      traced[k] = false;
+    }
+  }
+  for (int k = 0; k < kPacket; ++k) {
+    // inactive lanes get a harmless ray: Embree may read them
+    const bool use = traced[k];
+    valid[k] = use ? -1 : 0;
+    if (!use) {
+      p.org_x[k] = p.org_y[k] = p.org_z[k] = 0;
+      p.dir_x[k] = p.dir_y[k] = 0;
+      p.dir_z[k] = 1;
+      p.tnear[k] = 0;
+      p.tfar[k] = 0;
+      p.time[k] = 0;
+      p.mask[k] = 0xffffffffu;
+      p.id[k] = 0;
+      p.flags[k] = 0;
+      continue;
+    }
     p.org_x[k] = o.x[k];
     p.org_y[k] = o.y[k];
     p.org_z[k] = o.z[k];
@@ -736,9 +803,9 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
     p.id[k] = 0;
     p.flags[k] = 0;
   }
-  const bool static_only = !impl_->moving.SegmentsMayHit(o, d, tmax, active).any();
+  const bool static_only = !impl_->moving.SegmentsMayHit(o, d, tmax, traced).any();
   rtcOccluded16(valid, static_only ? impl_->groups[0].scene : impl_->top, &ctx, &p);
-  for (int k = 0; k < kPacket; ++k) (*occluded)[k] = active[k] && p.tfar[k] < 0;
+  for (int k = 0; k < kPacket; ++k) (*occluded)[k] = traced[k] && p.tfar[k] < 0;
   return static_only;
 }
 

@@ -38,6 +38,7 @@
 // surfaces are two-sided and opaque: the normals of a SurfaceHit face the incoming ray.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -45,6 +46,7 @@
 
 #include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
@@ -95,6 +97,21 @@ Ray SpawnRay(const SurfaceHit& hit, const Eigen::Vector3f& d);
 
 /// a shadow ray from `hit` towards the world point `p_W` that stops just short of it.
 Ray SpawnRayTo(const SurfaceHit& hit, const Eigen::Vector3f& p_W);
+
+/// true if Embree may trace the ray o + t d, t in [tmin, tmax]: every component of o and d
+/// finite with |component| <= kMaxRayComponent (scene/scene_limits.h; Embree 3 asserts on
+/// larger ones) and tmin, tmax not NaN. RayScene and ParticleScene treat other rays as misses
+/// (not occluded) instead of passing them to Embree.
+inline bool IsTraceableRay(float ox, float oy, float oz, float dx, float dy, float dz, float tmin,
+                           float tmax) {
+  constexpr float m = kMaxRayComponent;
+  // written so that NaN fails every comparison
+  return std::abs(ox) <= m && std::abs(oy) <= m && std::abs(oz) <= m && std::abs(dx) <= m &&
+         std::abs(dy) <= m && std::abs(dz) <= m && tmin == tmin && tmax == tmax;
+}
+inline bool IsTraceableRay(const Ray& r) {
+  return IsTraceableRay(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z(), r.tmin, r.tmax);
+}
 
 /// Embree scenes of one SceneDescription. Intersect/Occluded are thread-safe between
 /// Update calls; Update must not run concurrently with them.
@@ -153,6 +170,10 @@ class RayScene {
   /// how many geoms are ray traced (visible) and how many triangles they hold.
   int num_visible_geoms() const { return num_visible_geoms_; }
   int64_t num_triangles() const { return num_triangles_; }
+
+  /// how many rays were not traced because IsTraceableRay was false (they count as misses);
+  /// the first one also logs a warning with its origin and direction.
+  int64_t num_untraceable_rays() const;
 
  private:
   struct Impl;

@@ -3,14 +3,36 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdint>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
+
+// columns per scan for `beams_per_second` at `rate_hz` (a preset's default), checked against
+// kMaxLidarBeamsPerScan before it is rounded to an int.
+int DefaultColumns(const std::string& preset, double beams_per_second, int rings, double rate_hz) {
+  const double cols = std::round(beams_per_second / rate_hz);
+  if (!(cols * rings <= kMaxLidarBeamsPerScan))
+    throw Error("lidar preset '" + preset + "': rate_hz " + std::to_string(rate_hz) + " gives " +
+                std::to_string(cols) + " columns x " + std::to_string(rings) +
+                " rings per scan; expected at most " + std::to_string(kMaxLidarBeamsPerScan) +
+                " beams per scan (raise rate_hz or set columns)");
+  return static_cast<int>(cols);
+}
+
+void CheckBeams(const std::string& name, double columns, int rings) {
+  if (!(columns * rings <= kMaxLidarBeamsPerScan))
+    throw Error("lidar '" + name + "': " + std::to_string(static_cast<int64_t>(columns)) +
+                " columns x " + std::to_string(rings) + " rings is " +
+                std::to_string(static_cast<int64_t>(columns * rings)) +
+                " beams per scan; expected at most " + std::to_string(kMaxLidarBeamsPerScan));
+}
 
 std::vector<double> Uniform(int n, double lo_deg, double hi_deg) {
   std::vector<double> v(n);
@@ -101,6 +123,7 @@ LidarPattern MakeSpinningPattern(const std::string& name, std::vector<double> el
   if (columns < 1) throw Error("lidar '" + name + "': columns must be >= 1");
   if (!(std::isfinite(rate_hz) && rate_hz > 0))
     throw Error("lidar '" + name + "': rate_hz must be > 0");
+  CheckBeams(name, columns, static_cast<int>(elevations_deg.size()));
   std::sort(elevations_deg.begin(), elevations_deg.end());
   LidarPattern p;
   p.name = name;
@@ -137,7 +160,7 @@ LidarPattern MakeLidarPattern(const std::string& preset, const LidarPatternOptio
   if (preset == "velodyne_vlp16") {
     const double rate = o.rate_hz > 0 ? o.rate_hz : 10.0;
     // 0.2 deg at 10 Hz; the azimuth step scales with the rate (VLP-16: 0.1-0.4 deg at 5-20 Hz)
-    const int cols = o.columns > 0 ? o.columns : static_cast<int>(std::lround(18000.0 / rate));
+    const int cols = o.columns > 0 ? o.columns : DefaultColumns(preset, 18000.0, 16, rate);
     p = MakeSpinningPattern(preset, Uniform(16, -15, 15), cols, rate);
     p.min_range_m = 0.5;
     p.max_range_m = 100;
@@ -160,7 +183,8 @@ LidarPattern MakeLidarPattern(const std::string& preset, const LidarPatternOptio
     p.beam_divergence_rad = 0.0016;  // 0.09 deg FWHM (OS1 datasheet)
   } else if (preset == "livox_mid40") {
     const double rate = o.rate_hz > 0 ? o.rate_hz : 10.0;
-    const int pts = o.columns > 0 ? o.columns : static_cast<int>(std::lround(100000.0 / rate));
+    const int pts = o.columns > 0 ? o.columns : DefaultColumns(preset, 100000.0, 1, rate);
+    CheckBeams(preset, pts, 1);
     p = Rosette(pts, rate);
   } else if (preset == "solid_state_raster") {
     if (o.columns > 0)

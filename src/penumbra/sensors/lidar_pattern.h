@@ -73,11 +73,15 @@ struct LidarPatternOptions {
 
 /// builds a preset pattern.
 /// @throws Error for an unknown preset (listing the names) or options out of range
-///         (columns < 1, rate <= 0, Ouster column counts other than 512/1024/2048).
+///         (columns < 1, rate <= 0, Ouster column counts other than 512/1024/2048, more than
+///         kMaxLidarBeamsPerScan beams per scan (scene/scene_limits.h), also when a preset's
+///         default column count, beams per second / rate_hz, would exceed it).
 LidarPattern MakeLidarPattern(const std::string& preset, const LidarPatternOptions& options = {});
 
 /// a spinning pattern from a table of ring elevations (deg, any order; rings are numbered
 /// in ascending elevation), `columns` per revolution at `rate_hz`.
+/// @throws Error for no rings, columns < 1, rate_hz <= 0 or more than kMaxLidarBeamsPerScan
+///         beams.
 LidarPattern MakeSpinningPattern(const std::string& name, std::vector<double> elevations_deg,
                                  int columns, double rate_hz);
 

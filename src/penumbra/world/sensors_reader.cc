@@ -4,6 +4,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
@@ -92,7 +93,14 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   if (r.Has("pose")) {
     const YamlReader p = r.Child("pose");
     p.ExpectMap({"xyz", "rpy_deg"});
-    if (p.Has("xyz")) s.xyz = p.Child("xyz").Vector3();
+    if (p.Has("xyz")) {
+      const YamlReader c = p.Child("xyz");
+      s.xyz = c.Vector3();
+      if (!(s.xyz.cwiseAbs().maxCoeff() <= kMaxPositionM))
+        c.Fail(sensor + "got [" + FormatNumber(s.xyz.x()) + ", " + FormatNumber(s.xyz.y()) + ", " +
+               FormatNumber(s.xyz.z()) + "]; expected each of the 3 numbers in [" +
+               FormatNumber(-kMaxPositionM) + ", " + FormatNumber(kMaxPositionM) + "] (m)");
+    }
     if (p.Has("rpy_deg")) s.rpy_deg = p.Child("rpy_deg").Vector3();
   }
   if (s.type == "lidar") {
@@ -103,7 +111,10 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   if (r.Has("columns")) {
     const YamlReader c = r.Child("columns");
     const int v = c.Int();
-    if (v < 1) c.Fail(sensor + "got " + std::to_string(v) + "; expected an integer >= 1");
+    if (v < 1 || v > kMaxLidarBeamsPerScan)
+      c.Fail(sensor + "got " + std::to_string(v) + "; expected an integer in [1, " +
+             std::to_string(kMaxLidarBeamsPerScan) + "] (rings x columns is at most " +
+             std::to_string(kMaxLidarBeamsPerScan) + " beams per scan)");
     s.params["columns"] = v;
   }
   for (const char* k : {"min_range_m", "max_range_m"})

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 
@@ -44,7 +45,9 @@ const Range kUnit = Range::Closed(0, 1);
 const Range kImageSize = Range::Closed(1, 16384);
 const Range kRate = Range::OpenClosed(0, 10000);
 const Range kNearClip = Range::Closed(0, 10);
-const Range kFovy = Range::Open(0, 179);
+const Range kFovy = Range::Open(0, kMaxFovyDeg);
+// positions given in the world file (scene/scene_limits.h: Embree's float precision)
+const Range kPosition = Range::Closed(-kMaxPositionM, kMaxPositionM);
 
 bool EndsWithNoCase(const std::string& s, const std::string& suffix) {
   if (s.size() < suffix.size()) return false;
@@ -60,8 +63,10 @@ class Validator {
   Validator(const WorldConfig& w, const LineTable& lines) : w_(w), lines_(lines) {}
 
   void Run() {
-    Check("duration_sec", w_.duration_sec, Range::Above(0));
-    if (w_.timestep_sec) Check("physics.timestep_sec", *w_.timestep_sec, Range::OpenClosed(0, 0.1));
+    Check("duration_sec", w_.duration_sec, Range::OpenClosed(0, kMaxDurationSec));
+    if (w_.timestep_sec)
+      Check("physics.timestep_sec", *w_.timestep_sec,
+            Range::Closed(kMinTimestepSec, kMaxTimestepSec));
     CheckRender();
     CheckSky();
     CheckModels();
@@ -136,7 +141,7 @@ class Validator {
   }
 
   void CheckPose(const std::string& path, const PoseConfig& p) const {
-    Check3(path + ".xyz", p.xyz, Range::Finite());
+    Check3(path + ".xyz", p.xyz, kPosition);
     Check3(path + ".rpy_deg", p.rpy_deg, Range::Finite());
   }
 
@@ -251,7 +256,7 @@ class Validator {
       if (l.intensity_cd) Check(path + ".intensity_cd", *l.intensity_cd, Range::Above(0));
       if (l.power_w) Check(path + ".power_w", *l.power_w, Range::Above(0));
       Check(path + ".radius_m", l.radius_m, Range::AtLeast(0));
-      Check3(path + ".position", l.position, Range::Finite());
+      Check3(path + ".position", l.position, kPosition);
     }
     if (l.type == Light::Type::kSpot) {
       Check(path + ".inner_angle_deg", l.inner_angle_deg, Range::OpenClosed(0, 90));
@@ -282,6 +287,10 @@ class Validator {
       Check(path + ".intrinsics.fy", k.fy, Range::Above(0));
       Check(path + ".intrinsics.cx", k.cx, Range::Finite());
       Check(path + ".intrinsics.cy", k.cy, Range::Finite());
+      CameraIntrinsics sized = k;
+      sized.width = c.width;
+      sized.height = c.height;
+      if (auto problem = FindIntrinsicsProblem(sized)) Fail(path + ".intrinsics", *problem);
       if (k.width != c.width || k.height != c.height) {
         Fail(path + ".intrinsics", "image size " + std::to_string(k.width) + "x" +
                                        std::to_string(k.height) + " differs from the camera's " +

@@ -1,0 +1,73 @@
+#pragma once
+// penumbra's limits on magnitudes and times, checked when a world is loaded so that absurd but
+// finite input (a pose of 1e19 m, a sphere of radius 1e30 m, a timestep of 1e-300 s) is refused
+// with a message instead of aborting in Embree or hanging. docs/world-file.md ("Input limits")
+// lists them with the reasons; world/world_validation.cc applies them to world files,
+// app/scene_assembly.cc to compiled MJCF models, and render/ray_scene.cc never traces a ray
+// outside kMaxRayComponent.
+//
+// why these values: Embree traces in 32-bit floats. the spacing of floats is 7.8 mm at
+// 1e5 m and 0.5 m at 1e7 m, so geometry much farther out than 1e5 m cannot be rendered
+// faithfully, and Embree's own ray check (|origin|, |direction| <= 1.844e18 per component)
+// is hit long before a double overflows. MuJoCo itself calls a state with |qpos| > 1e10
+// diverged.
+
+#include <optional>
+#include <string>
+
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// largest |coordinate| (m) of a position given at load: world-file poses and light positions,
+/// sensor mounts, and the centres of MJCF geoms, cameras and lights at qpos0.
+inline constexpr double kMaxPositionM = 1e5;
+/// range (m) of a primitive geom's size parameters (sphere radius, box half-sizes, ...), of
+/// |mesh vertex coordinates| and of height-field sizes. planes may also have size 0 (infinite).
+inline constexpr double kMinGeomSizeM = 1e-6;
+inline constexpr double kMaxGeomSizeM = 1e5;
+/// vertical field of view (deg) of a camera given by fovy (world file, MJCF) is in
+/// (0, kMaxFovyDeg); with explicit intrinsics every pixel's ray stays within kMaxFovyDeg / 2
+/// of the optical axis horizontally and vertically.
+inline constexpr double kMaxFovyDeg = 179;
+/// physics timestep range (s), for physics.timestep_sec and the MJCF <option timestep>.
+/// the lower end keeps 1 s of simulated time at <= 1e6 steps.
+inline constexpr double kMinTimestepSec = 1e-6;
+inline constexpr double kMaxTimestepSec = 0.1;
+/// largest run duration (s of simulated time): duration_sec and --duration (11.6 days).
+inline constexpr double kMaxDurationSec = 1e6;
+/// most LiDAR beams per scan (rings x columns; livox_mid40: points per scan): 128 rings x
+/// 32768 columns. a scan's buffers take about 100 bytes per beam (docs/sensors.md).
+inline constexpr int kMaxLidarBeamsPerScan = 1 << 22;
+/// largest |component| of a traced ray's origin and direction (Embree 3 asserts on
+/// components above FLT_LARGE = 1.844e18); rays beyond it, or with NaN/Inf, are misses.
+inline constexpr float kMaxRayComponent = 1e18f;
+
+/// what is wrong with pinhole intrinsics, or nothing: fx, fy finite and > 0, cx, cy finite,
+/// and every pixel centre's ray within kMaxFovyDeg / 2 of the optical axis, i.e.
+/// max(|0 - cx|, |width - 1 - cx|) / fx <= tan(kMaxFovyDeg / 2) and the same for y.
+/// the message names the failing value and the accepted range (px).
+std::optional<std::string> FindIntrinsicsProblem(const CameraIntrinsics& k);
+
+/// a value of a compiled scene outside the limits above.
+struct SceneLimitProblem {
+  std::string object;   ///< e.g. "geom 'rover/wheel'", "MJCF camera 'rover/head'"
+  std::string body;     ///< name of the body it belongs to ("" = world / unknown)
+  std::string problem;  ///< "size[0] is 1e+30 m; expected [1e-06, 100000] m"
+};
+
+/// checks a compiled MJCF scene (physics/scene_extractor.h) at its initial poses: every visible
+/// and invisible geom's size parameters (kMinGeomSizeM..kMaxGeomSizeM for the ones its shape
+/// uses; planes 0 or in range), mesh vertices and height-field sizes (<= kMaxGeomSizeM), geom
+/// centres, MJCF camera and light positions (|coordinate| <= kMaxPositionM) and MJCF camera
+/// fovy (in (0, kMaxFovyDeg), as world-file fovy_deg; read back from the extracted intrinsics,
+/// so call it before the cameras are resized).
+/// `initial` must hold X_WB for every body, X_W_mjcam and light_position_W for every MJCF
+/// camera and light (Simulation::Snapshot). `mjcf_cameras` false skips the MJCF cameras (a
+/// world that disables them). returns the first problem, or nothing.
+std::optional<SceneLimitProblem> FindSceneLimitProblem(const SceneDescription& scene,
+                                                       const WorldSnapshot& initial,
+                                                       bool mjcf_cameras = true);
+
+}  // namespace penumbra
