@@ -52,11 +52,12 @@ SceneDescription Room() {
   // checker floor texture, 8 x 8.
   Texture tex;
   tex.name = "checker";
-  tex.width = tex.height = 8;
+  std::vector<uint8_t> rgb;
   for (int i = 0; i < 64; ++i) {
     const uint8_t c = ((i % 8) + (i / 8)) % 2 ? 200 : 90;
-    tex.rgb_srgb.insert(tex.rgb_srgb.end(), {c, c, c});
+    rgb.insert(rgb.end(), {c, c, c});
   }
+  tex.image = std::make_shared<const TextureImage>(8, 8, 1, std::move(rgb));
   s.textures.push_back(tex);
   const int floor = AddMaterial(&s, {0.9f, 0.85f, 0.8f}, 0.7f, 0);
   s.materials[floor].texture = 0;

@@ -204,11 +204,12 @@ TEST_F(SceneExtractorTest, TexturesKeepMujocoPixels) {
   const Texture& c = tex[0];
   EXPECT_EQ(c.name, "checker");
   EXPECT_EQ(c.kind, Texture::Kind::k2D);
-  EXPECT_EQ(c.width, 8);
-  EXPECT_EQ(c.height, 8);
-  ASSERT_EQ(c.rgb_srgb.size(), 8u * 8u * 3u);
+  ASSERT_NE(c.image, nullptr);
+  EXPECT_EQ(c.image->width(), 8);
+  EXPECT_EQ(c.image->height(), 8);
+  ASSERT_EQ(c.image->rgb_srgb().size(), 8u * 8u * 3u);
   auto px = [&](int u, int v, int ch) {
-    return static_cast<int>(c.rgb_srgb[(v * 8 + u) * 3 + ch]);
+    return static_cast<int>(c.image->rgb_srgb()[(v * 8 + u) * 3 + ch]);
   };
   const float rgb1[3] = {.1f, .2f, .3f}, rgb2[3] = {.9f, .8f, .7f};
   // 2 x 2 checker: rgb1 in the top-left and bottom-right quadrants
@@ -219,12 +220,46 @@ TEST_F(SceneExtractorTest, TexturesKeepMujocoPixels) {
         EXPECT_NEAR(px(u, v, ch), 255.0f * (first ? rgb1[ch] : rgb2[ch]), 1.0) << u << "," << v;
     }
   EXPECT_EQ(tex[1].kind, Texture::Kind::kCube);
-  EXPECT_EQ(tex[1].width, 4);
-  EXPECT_EQ(tex[1].height, 24);  // six faces stacked
-  EXPECT_EQ(tex[1].rgb_srgb.size(), 4u * 24u * 3u);
-  EXPECT_NEAR(tex[1].rgb_srgb[0], 127.5, 1.0);
+  EXPECT_EQ(tex[1].image->width(), 4);
+  EXPECT_EQ(tex[1].image->height(), 24);  // six faces stacked
+  EXPECT_EQ(tex[1].image->faces(), 6);
+  EXPECT_EQ(tex[1].image->rgb_srgb().size(), 4u * 24u * 3u);
+  EXPECT_NEAR(tex[1].image->rgb_srgb()[0], 127.5, 1.0);
   EXPECT_EQ(tex[2].kind, Texture::Kind::kSkybox);
-  EXPECT_EQ(tex[2].height, 6 * tex[2].width);
+  EXPECT_EQ(tex[2].image->height(), 6 * tex[2].image->width());
+}
+
+// identical pixels are stored once: textures with the same image share one TextureImage (with
+// its mip levels, ~4 bytes per texel), and copies of the scene share it too.
+TEST(SceneExtractorTextures, IdenticalImagesAreStoredOnce) {
+  const Simulation sim = Simulation::LoadFromString(R"(
+<mujoco>
+  <asset>
+    <texture name="a" type="2d" builtin="checker" rgb1=".1 .2 .3" rgb2=".9 .8 .7" width="64" height="64"/>
+    <texture name="a_again" type="2d" builtin="checker" rgb1=".1 .2 .3" rgb2=".9 .8 .7" width="64" height="64"/>
+    <texture name="b" type="2d" builtin="checker" rgb1=".3 .2 .1" rgb2=".9 .8 .7" width="64" height="64"/>
+    <material name="ma" texture="a"/>
+    <material name="ma2" texture="a_again"/>
+    <material name="mb" texture="b"/>
+  </asset>
+  <worldbody>
+    <geom type="box" size=".1 .1 .1" material="ma"/>
+    <geom type="box" size=".1 .1 .1" pos="1 0 0" material="ma2"/>
+    <geom type="box" size=".1 .1 .1" pos="2 0 0" material="mb"/>
+  </worldbody>
+</mujoco>)");
+  const std::vector<Texture>& tex = sim.scene().textures;
+  ASSERT_EQ(tex.size(), 3u);
+  EXPECT_EQ(tex[0].image.get(), tex[1].image.get());
+  EXPECT_NE(tex[0].image.get(), tex[2].image.get());
+  const TextureMemory m = CountTextureMemory(tex);
+  EXPECT_EQ(m.textures, 3);
+  EXPECT_EQ(m.images, 2);
+  EXPECT_EQ(m.texels, 2u * 64 * 64);
+  // 8-bit RGB plus mip levels: 3 x 4/3 bytes per texel, not 16 (float RGBA).
+  EXPECT_LE(m.bytes_per_texel(), 4.01);
+  const SceneDescription copy = sim.scene();
+  EXPECT_EQ(copy.textures[2].image.get(), tex[2].image.get());
 }
 
 TEST_F(SceneExtractorTest, LightsArePhotometric) {

@@ -348,11 +348,12 @@ SceneDescription BusyScene() {
   s.sky.radiance = {0.3f, 0.35f, 0.4f};
   Texture tex;
   tex.name = "checker";
-  tex.width = tex.height = 4;
+  std::vector<uint8_t> rgb;
   for (int i = 0; i < 16; ++i) {
     const uint8_t c = ((i % 4) + (i / 4)) % 2 ? 230 : 40;
-    tex.rgb_srgb.insert(tex.rgb_srgb.end(), {c, c, static_cast<uint8_t>(c / 2)});
+    rgb.insert(rgb.end(), {c, c, static_cast<uint8_t>(c / 2)});
   }
+  tex.image = std::make_shared<const TextureImage>(4, 4, 1, std::move(rgb));
   s.textures.push_back(tex);
   const int floor = AddMaterial(&s, {0.8f, 0.8f, 0.8f}, 0.6f, 0.0f, 0.5f);
   s.materials[floor].texture = 0;

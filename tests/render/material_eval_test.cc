@@ -15,8 +15,8 @@ namespace {
 Texture Quad() {
   Texture t;
   t.name = "quad";
-  t.width = t.height = 2;
-  t.rgb_srgb = {0, 0, 0, 255, 255, 255, 255, 0, 0, 0, 255, 0};
+  t.image = std::make_shared<const TextureImage>(
+      2, 2, 1, std::vector<uint8_t>{0, 0, 0, 255, 255, 255, 255, 0, 0, 0, 255, 0});
   return t;
 }
 
@@ -25,11 +25,10 @@ Texture Cube() {
   Texture t;
   t.name = "cube";
   t.kind = Texture::Kind::kCube;
-  t.width = 4;
-  t.height = 24;
+  std::vector<uint8_t> rgb;
   for (int f = 0; f < 6; ++f)
-    for (int i = 0; i < 16; ++i)
-      t.rgb_srgb.insert(t.rgb_srgb.end(), {static_cast<uint8_t>(10 * (f + 1)), 0, 0});
+    for (int i = 0; i < 16; ++i) rgb.insert(rgb.end(), {static_cast<uint8_t>(10 * (f + 1)), 0, 0});
+  t.image = std::make_shared<const TextureImage>(4, 24, 6, std::move(rgb));
   return t;
 }
 
@@ -153,11 +152,12 @@ TEST(MaterialEvalTest, BadTexturesThrow) {
   s.materials[0].texture = 3;
   EXPECT_THROW(MaterialEvaluator{s}, Error);
   SceneDescription t = OneGeom(GeomShape::kPlane, {1, 1, 0}, Quad());
-  t.textures[0].rgb_srgb.pop_back();
+  t.textures[0].image = nullptr;
   EXPECT_THROW(MaterialEvaluator{t}, Error);
+  // a cube texture whose image is not six square faces.
   SceneDescription c = OneGeom(GeomShape::kBox, {1, 1, 1}, Cube());
-  c.textures[0].height = 20;
-  c.textures[0].rgb_srgb.resize(4 * 20 * 3);
+  c.textures[0].image =
+      std::make_shared<const TextureImage>(4, 20, 1, std::vector<uint8_t>(4 * 20 * 3, 0));
   EXPECT_THROW(MaterialEvaluator{c}, Error);
 }
 

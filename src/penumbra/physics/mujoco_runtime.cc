@@ -1,5 +1,7 @@
 #include "penumbra/physics/mujoco_runtime.h"
 
+#include <malloc.h>
+
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -103,6 +105,11 @@ mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* content
         warnings->push_back(display_name + ": MuJoCo warning while loading: " + OneLine(Trim(w)));
   }
   return m;
+}
+
+void FreeLastXmlLocked() {
+  mj_freeLastXML();
+  malloc_trim(0);
 }
 
 }  // namespace penumbra

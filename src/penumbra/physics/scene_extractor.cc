@@ -171,19 +171,25 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
     h.size_base = m->hfield_size[4 * i + 3];
   }
 
-  // textures
+  // textures: one shared image (with mip levels) per distinct set of pixels
   s.textures.resize(m->ntex);
+  std::vector<TextureSource> sources(m->ntex);
   for (int i = 0; i < m->ntex; ++i) {
     Texture& t = s.textures[i];
     t.name = Name(m, mjOBJ_TEXTURE, i);
     t.kind = m->tex_type[i] == mjTEXTURE_2D     ? Texture::Kind::k2D
              : m->tex_type[i] == mjTEXTURE_CUBE ? Texture::Kind::kCube
                                                 : Texture::Kind::kSkybox;
-    t.width = m->tex_width[i];
-    t.height = m->tex_height[i];
-    const mjtByte* rgb = m->tex_rgb + m->tex_adr[i];
-    t.rgb_srgb.assign(rgb, rgb + static_cast<size_t>(t.width) * t.height * 3);
+    TextureSource& src = sources[i];
+    src.width = m->tex_width[i];
+    src.height = m->tex_height[i];
+    src.faces = t.kind == Texture::Kind::k2D ? 1 : 6;
+    src.rgb_srgb = reinterpret_cast<const uint8_t*>(m->tex_rgb + m->tex_adr[i]);
+    src.size = static_cast<size_t>(src.width) * src.height * 3;
   }
+  TextureStore store;
+  const std::vector<std::shared_ptr<const TextureImage>> images = store.AddAll(sources);
+  for (int i = 0; i < m->ntex; ++i) s.textures[i].image = images[i];
 
   // MJCF materials keep their ids
   s.materials.reserve(m->nmat);

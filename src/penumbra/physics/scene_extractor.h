@@ -14,7 +14,9 @@
 //   specular    = specular (MuJoCo's default 0.5 is the glTF/Burley default, F0 = 0.04).
 //   metallic    = 0 (MJCF has no metal notion).
 //   emission    = emission * base_color * kMjcfEmissionLuminance (cd/m^2).
-//   texture     texture id, texrepeat and texuniform carried over unchanged.
+//   texture     texture id, texrepeat and texuniform carried over unchanged. the texture's
+//               pixels are kept as MuJoCo holds them (8-bit sRGB RGB) with mip levels, and
+//               textures with identical pixels share one image (scene/texture_image.h).
 //   every geom gets a material: MJCF materials keep their ids and names (index i = MuJoCo
 //   material i); a geom without a material gets one made from its rgba, named
 //   "rgba(r g b a)"; a geom whose rgba overrides its material's gets "<material>#rgba(r g b a)".

@@ -362,6 +362,7 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   {
     std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
     impl->m = LoadMujocoXmlLocked(loader_path, contents, source, &impl->warnings);
+    FreeLastXmlLocked();  // the simulation never saves the XML back
   }
   mjModel* m = impl->m;
   if (timestep_sec) m->opt.timestep = *timestep_sec;

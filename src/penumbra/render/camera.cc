@@ -47,6 +47,7 @@ Camera::Camera(const Pose& X_WO, const CameraIntrinsics& intrinsics, const Camer
   cy_ = static_cast<float>(k.cy);
   inv_fx_ = static_cast<float>(1.0 / k.fx);
   inv_fy_ = static_cast<float>(1.0 / k.fy);
+  pixel_spread_rad_ = static_cast<float>(1.0 / (std::sqrt(k.fx) * std::sqrt(k.fy)));
   q0_ = Eigen::Quaterniond(R);
   q1_ = Eigen::Quaterniond(motion.X_WO_end.linear());
   slow_ = k.has_distortion() || motion.moving();

@@ -73,6 +73,11 @@ class Camera {
   /// in the convex cone of its corner rays.
   bool projective() const { return !slow_; }
 
+  /// the spread angle of one pixel's cone of rays, rad: 1 / sqrt(fx fy), a pixel's angular
+  /// size at the principal point (the ray-cone texture level of detail, render/material_eval.h;
+  /// off-axis pixels and lens distortion change it, which the cone ignores).
+  float pixel_spread_rad() const { return pixel_spread_rad_; }
+
   int width() const { return intrinsics_.width; }
   int height() const { return intrinsics_.height; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
@@ -88,6 +93,7 @@ class Camera {
   bool slow_ = false;                         // distortion or motion
   Eigen::Vector3f o_W_, ex_W_, ey_W_, ez_W_;  // optical centre and optical axes in the world
   float cx_, cy_, inv_fx_, inv_fy_;
+  float pixel_spread_rad_ = 0;
   Eigen::Quaterniond q0_, q1_;  // rotations at s = 0 and s = end_sec
 };
 

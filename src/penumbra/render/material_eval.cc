@@ -5,13 +5,74 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
 namespace {
 
-// sRGB EOTF, IEC 61966-2-1: code value in [0, 1] to linear.
-double SrgbToLinear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+// the smallest |cos| of incidence the level of detail divides by (grazing rays).
+constexpr float kMinCosIncidence = 1e-4f;
+
+// bilinear lookup in one level, wrapped; (s, t) in images (1 = one image).
+Eigen::Vector3f BilinearWrap(const TextureLevel& L, const float* decode, float s, float t) {
+  const int w = L.width, h = L.height;
+  // texel centres at (i + 0.5) / w; wrap the integer part away first to keep precision.
+  const float x = (s - std::floor(s)) * w - 0.5f;
+  const float y = (t - std::floor(t)) * h - 0.5f;
+  const float x0f = std::floor(x), y0f = std::floor(y);
+  const float fx = x - x0f, fy = y - y0f;
+  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
+  int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  int x1 = x0 + 1, y1 = y0 + 1;
+  x0 = x0 < 0 ? x0 + w : x0;
+  y0 = y0 < 0 ? y0 + h : y0;
+  x1 = x1 >= w ? x1 - w : x1;
+  y1 = y1 >= h ? y1 - h : y1;
+  const uint8_t* p = L.rgb_srgb.data();
+  auto texel = [&](int xi, int yi) {
+    const uint8_t* q = p + (static_cast<size_t>(yi) * w + xi) * 3;
+    return Eigen::Vector3f(decode[q[0]], decode[q[1]], decode[q[2]]);
+  };
+  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
+         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+}
+
+// bilinear lookup in face `face` of one level, clamped to the face; (s, t) in [0, 1].
+Eigen::Vector3f BilinearFace(const TextureLevel& L, const float* decode, int face, float s,
+                             float t) {
+  const int w = L.width;
+  const float x = std::clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
+  const float y = std::clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, w - 1);
+  const float fx = x - x0, fy = y - y0;
+  const uint8_t* p = L.rgb_srgb.data() + static_cast<size_t>(face) * w * w * 3;
+  auto texel = [&](int xi, int yi) {
+    const uint8_t* c = p + (static_cast<size_t>(yi) * w + xi) * 3;
+    return Eigen::Vector3f(decode[c[0]], decode[c[1]], decode[c[2]]);
+  };
+  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
+         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+}
+
+// the mip level of a footprint on a mapping of rho texels per metre (file comment); 0 when the
+// footprint or rho is 0.
+float TextureLod(const TextureFootprint& f, float rho) {
+  if (!(f.width_m > 0) || !(rho > 0)) return 0;
+  return std::log2(f.width_m * rho / std::max(f.cos_incidence, kMinCosIncidence));
+}
+
+// trilinear: bilinear(level) in the two levels around `lod`, mixed by its fraction.
+template <typename BilinearFn>
+Eigen::Vector3f Trilinear(const TextureImage& image, float lod, const BilinearFn& bilinear) {
+  if (!(lod > 0)) return bilinear(image.level(0));
+  const int last = image.num_levels() - 1;
+  if (!(lod < static_cast<float>(last))) return bilinear(image.level(last));
+  const int l = static_cast<int>(lod);
+  const float f = lod - static_cast<float>(l);
+  const Eigen::Vector3f a = bilinear(image.level(l));
+  if (!(f > 0)) return a;
+  return (1 - f) * a + f * bilinear(image.level(l + 1));
 }
 
 // half extents of a geom's bounding box in its own frame (zero where a shape is flat).
@@ -47,19 +108,25 @@ Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g) {
 
 }  // namespace
 
-MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene) : scene_(scene) {
-  for (int i = 0; i < 256; ++i) srgb_to_linear_[i] = static_cast<float>(SrgbToLinear(i / 255.0));
+TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::Vector3f& d_unit,
+                               const SurfaceHit& hit) {
+  TextureFootprint f;
+  f.width_m = spread_rad * distance_m;
+  f.cos_incidence = std::min(1.0f, std::abs(hit.ng_W.dot(d_unit)));
+  return f;
+}
+
+MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene)
+    : scene_(scene), srgb_to_linear_(SrgbDecodeTable()) {
   for (const Material& m : scene.materials) {
     if (m.texture < 0) continue;
     if (m.texture >= static_cast<int>(scene.textures.size()))
       throw Error("material '" + m.name + "' refers to missing texture " +
                   std::to_string(m.texture));
     const Texture& t = scene.textures[m.texture];
-    const size_t expected = static_cast<size_t>(std::max(t.width, 0)) * std::max(t.height, 0) * 3;
-    if (t.width < 1 || t.height < 1 || t.rgb_srgb.size() != expected)
-      throw Error("texture '" + t.name +
-                  "': expected width, height >= 1 and width x height x 3 bytes");
-    if (t.kind != Texture::Kind::k2D && t.height != 6 * t.width)
+    if (!t.image) throw Error("texture '" + t.name + "': expected an image, got none");
+    if (t.kind != Texture::Kind::k2D &&
+        (t.image->faces() != 6 || t.image->height() != 6 * t.image->width()))
       throw Error("cube texture '" + t.name +
                   "': expected six square faces stacked vertically (height = 6 width)");
   }
@@ -67,33 +134,13 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene) : scene_(sce
   for (const Geom& g : scene.geoms) half_extent_G_.push_back(GeomHalfExtents(scene, g));
 }
 
-Eigen::Vector3f MaterialEvaluator::Sample2D(int tex, float s, float t) const {
-  const Texture& T = scene_.textures[tex];
-  const int w = T.width, h = T.height;
-  // texel centres at (i + 0.5) / w; wrap the integer part away first to keep precision.
-  const float x = (s - std::floor(s)) * w - 0.5f;
-  const float y = (t - std::floor(t)) * h - 0.5f;
-  const float x0f = std::floor(x), y0f = std::floor(y);
-  const float fx = x - x0f, fy = y - y0f;
-  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
-  int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
-  int x1 = x0 + 1, y1 = y0 + 1;
-  x0 = x0 < 0 ? x0 + w : x0;
-  y0 = y0 < 0 ? y0 + h : y0;
-  x1 = x1 >= w ? x1 - w : x1;
-  y1 = y1 >= h ? y1 - h : y1;
-  const uint8_t* p = T.rgb_srgb.data();
-  auto texel = [&](int xi, int yi) {
-    const uint8_t* q = p + (static_cast<size_t>(yi) * w + xi) * 3;
-    return Eigen::Vector3f(srgb_to_linear_[q[0]], srgb_to_linear_[q[1]], srgb_to_linear_[q[2]]);
-  };
-  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
-         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+Eigen::Vector3f MaterialEvaluator::Sample2D(int tex, float s, float t, float lod) const {
+  const float* decode = srgb_to_linear_;
+  return Trilinear(*scene_.textures[tex].image, lod,
+                   [&](const TextureLevel& L) { return BilinearWrap(L, decode, s, t); });
 }
 
-Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q) const {
-  const Texture& T = scene_.textures[tex];
-  const int w = T.width;
+Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q, float lod) const {
   const Eigen::Vector3f a = q.cwiseAbs();
   int face;
   float sc, tc, ma;
@@ -116,19 +163,9 @@ Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q)
   }
   if (!(ma > 0)) return Eigen::Vector3f::Ones();
   const float s = 0.5f * (sc / ma + 1.0f), t = 0.5f * (tc / ma + 1.0f);
-  // bilinear, clamped to the face.
-  const float x = std::clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const float y = std::clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, w - 1);
-  const float fx = x - x0, fy = y - y0;
-  const uint8_t* p = T.rgb_srgb.data() + static_cast<size_t>(face) * w * w * 3;
-  auto texel = [&](int xi, int yi) {
-    const uint8_t* c = p + (static_cast<size_t>(yi) * w + xi) * 3;
-    return Eigen::Vector3f(srgb_to_linear_[c[0]], srgb_to_linear_[c[1]], srgb_to_linear_[c[2]]);
-  };
-  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
-         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+  const float* decode = srgb_to_linear_;
+  return Trilinear(*scene_.textures[tex].image, lod,
+                   [&](const TextureLevel& L) { return BilinearFace(L, decode, face, s, t); });
 }
 
 void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr) {
@@ -142,7 +179,8 @@ void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* p
   pbr->roughness = 1.0f - gloss;
 }
 
-SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit) const {
+SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
+                                            const TextureFootprint& footprint) const {
   const Material& m = hit.material >= 0 ? scene_.materials[hit.material] : default_material_;
   SurfaceMaterial out;
   out.pbr.base_color = m.base_color;
@@ -153,13 +191,18 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit) const {
   if (m.texture < 0) return out;
 
   const Texture& tex = scene_.textures[m.texture];
+  const float w = static_cast<float>(tex.image->width());
   const Eigen::Vector3f& h = half_extent_G_[hit.geom];
+  // texels per metre of surface of the mapping at the hit (rho, file comment); 0 = unknown.
+  float rho = 0;
   Eigen::Vector3f c;
   if (tex.kind == Texture::Kind::k2D) {
+    const float th = static_cast<float>(tex.image->height());
     float s, t;
     if (hit.has_uv) {
       s = hit.uv.x();
       t = hit.uv.y();
+      rho = hit.uv_per_m * std::sqrt(w * th);
     } else {
       // planar projection along the dominant axis of the geom-frame normal: face axes
       // (a0, a1) = the next two axes in cyclic order, image rows along -a1.
@@ -171,18 +214,23 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit) const {
       if (m.texuniform || infinite_plane) {
         s = hit.p_G[a0] * m.texrepeat.x();
         t = -hit.p_G[a1] * m.texrepeat.y();
+        rho = std::sqrt(std::abs(m.texrepeat.x()) * w * std::abs(m.texrepeat.y()) * th);
       } else {
         const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;
         s = (0.5f * hit.p_G[a0] / h0 + 0.5f) * m.texrepeat.x();
         t = (0.5f - 0.5f * hit.p_G[a1] / h1) * m.texrepeat.y();
+        rho = std::sqrt(std::abs(m.texrepeat.x()) * w / (2 * h0) * std::abs(m.texrepeat.y()) * th /
+                        (2 * h1));
       }
     }
-    c = Sample2D(m.texture, s, t);
+    c = Sample2D(m.texture, s, t, TextureLod(footprint, rho));
   } else {
     const Eigen::Vector3f q(h.x() > 0 ? hit.p_G.x() / h.x() : hit.n_G.x(),
                             h.y() > 0 ? hit.p_G.y() / h.y() : hit.n_G.y(),
                             h.z() > 0 ? hit.p_G.z() / h.z() : hit.n_G.z());
-    c = SampleCube(m.texture, q);
+    const float h_max = h.maxCoeff();
+    rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
+    c = SampleCube(m.texture, q, TextureLod(footprint, rho));
   }
   out.pbr.base_color = out.pbr.base_color.cwiseProduct(c);
   return out;

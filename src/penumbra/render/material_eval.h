@@ -2,8 +2,9 @@
 // the material of a surface point: the geom's Material with its texture applied.
 //
 // texture mapping (chosen to match MuJoCo's OpenGL renderer where it is defined):
-//  - textures are sRGB-encoded (IEC 61966-2-1); texels are decoded to linear before
-//    bilinear filtering, and the filtered colour multiplies Material::base_color.
+//  - textures are sRGB-encoded 8-bit RGB with mip levels (scene/texture_image.h); texels are
+//    decoded to linear (256-entry table) before filtering, and the filtered colour multiplies
+//    Material::base_color.
 //  - 2d texture on a mesh with texcoords: (u, v) = texcoords (row 0 of the image at v = 0),
 //    wrapped (repeat).
 //  - 2d texture elsewhere: planar projection of the hit point in the geom frame onto the
@@ -16,6 +17,23 @@
 //    normal), with the face orientation of OpenGL cube maps (OpenGL 4.6 core spec, table 8.19)
 //    and the faces stacked in MuJoCo's order (+x, -x, +y, -y, +z, -z); clamped per face.
 //  - skybox textures on geoms are treated as cube textures.
+//
+// filtering (texture level of detail by ray cones: Akenine-Moller, Crassin, Boksansky, Belcour,
+// Panteleev, Wright, "Improved Shader and Texture Level of Detail Using Ray Cones", JCGT 10(1),
+// 2021): a pixel's rays form a cone of spread angle alpha (Camera::pixel_spread_rad); where it
+// meets a surface at distance d it is W = alpha d wide (TextureFootprint::width_m). the mip level
+//   lambda = log2(W rho / |n . v|)
+// with rho the texels per metre of surface of the mapping at the hit and n . v the cosine
+// between the ray and the geometric normal (the paper's isotropic level, its equation for
+// lambda with Delta_0 = log2 rho). rho: planar mapping, sqrt(rho_s rho_t) with rho_s =
+// texrepeat.x w (uniform) or texrepeat.x w / (2 h_a0) (per face), rho_t likewise with the
+// height; mesh texcoords, SurfaceHit::uv_per_m sqrt(w h) (the triangle's texcoord-to-surface
+// area ratio, the paper's t_a / p_a); cube textures, w / (2 max(h)). the colour is a trilinear
+// lookup: bilinear in levels floor(lambda) and floor(lambda) + 1, mixed by the fraction
+// (lambda <= 0: bilinear in level 0, beyond the last level: bilinear in the last level).
+// isotropic: at grazing angles the footprint is long and thin, and the level follows its long
+// axis (textures blur there rather than alias). the lookup depends on the hit and the cone only,
+// so images do not depend on the thread count.
 
 #include <Eigen/Core>
 #include <vector>
@@ -41,29 +59,46 @@ struct SurfaceMaterial {
 /// whether a surface is sheltered from the rain is not tested.
 void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr);
 
+/// where a ray cone meets a surface (file comment, "filtering").
+struct TextureFootprint {
+  /// width of the cone at the hit, m; 0 = an infinitely thin ray (bilinear in level 0).
+  float width_m = 0;
+  /// |cos| of the angle between the ray and the surface's geometric normal, in (0, 1].
+  float cos_incidence = 1;
+};
+
+/// the footprint at `hit` of a cone of spread angle `spread_rad` around a ray of unit direction
+/// `d_unit`, `distance_m` long from the cone's apex (or `distance_m` plus the width the cone had
+/// at its origin, see path_integrator): width spread_rad x distance_m.
+TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::Vector3f& d_unit,
+                               const SurfaceHit& hit);
+
 /// evaluates materials and textures of a scene. immutable after construction, thread-safe.
 class MaterialEvaluator {
  public:
   /// precomputes per-geom texture mapping data. `scene` must outlive this object.
-  /// @throws Error if a material refers to a missing texture or a texture's pixel buffer
-  /// does not match its size (cube textures: height = 6 width).
+  /// @throws Error if a material refers to a missing texture or a texture without an image,
+  /// or a cube or skybox texture whose image does not hold six square faces.
   explicit MaterialEvaluator(const SceneDescription& scene);
 
-  /// material at `hit` (default Material when hit.material < 0).
-  SurfaceMaterial Evaluate(const SurfaceHit& hit) const;
+  /// material at `hit` (default Material when hit.material < 0), its texture filtered over
+  /// `footprint` (file comment; the default footprint gives bilinear level-0 lookups).
+  SurfaceMaterial Evaluate(const SurfaceHit& hit, const TextureFootprint& footprint = {}) const;
 
-  /// linear rgb of texture `tex` at (s, t) in texture space (1 = one image), bilinear,
-  /// wrapped. exposed for tests.
-  Eigen::Vector3f Sample2D(int tex, float s, float t) const;
+  /// linear rgb of texture `tex` at (s, t) in texture space (1 = one image), wrapped,
+  /// trilinear at mip level `lod` (log2 of the footprint in level-0 texels; <= 0: bilinear in
+  /// level 0). exposed for tests.
+  Eigen::Vector3f Sample2D(int tex, float s, float t, float lod = 0) const;
 
-  /// linear rgb of cube texture `tex` in direction q (any length > 0), bilinear within a face.
-  Eigen::Vector3f SampleCube(int tex, const Eigen::Vector3f& q) const;
+  /// linear rgb of cube texture `tex` in direction q (any length > 0), clamped to the face,
+  /// trilinear at mip level `lod` as Sample2D.
+  Eigen::Vector3f SampleCube(int tex, const Eigen::Vector3f& q, float lod = 0) const;
 
  private:
   const SceneDescription& scene_;
   Material default_material_;
   std::vector<Eigen::Vector3f> half_extent_G_;  // per geom: local bounding-box half extents
-  float srgb_to_linear_[256];
+  const float* srgb_to_linear_;                 // 256 entries (SrgbDecodeTable)
 };
 
 }  // namespace penumbra

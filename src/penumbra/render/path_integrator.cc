@@ -167,6 +167,7 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
   const MediaScene* media = fx != nullptr ? fx->media() : nullptr;
   const ParticleScene* particles = fx != nullptr ? fx->particles() : nullptr;
   const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
+  const float spread = ctx.camera->pixel_spread_rad();
   int64_t rays = 0;
 
   for (int i = 0; i < tile.width * tile.height; ++i) {
@@ -188,6 +189,9 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
       float prev_pdf = 0;  // BSDF or phase density of the direction that led here
       Eigen::Vector3f prev_p(0, 0, 0);
       bool from_camera = true;
+      // length of the path from the camera to the current ray's origin, m: the pixel's ray
+      // cone is spread * that length wide there (texture level of detail, see header).
+      float path_m = 0;
 
       // transmittance of the media along a shadow ray o + t d (d unit), t in [0, dist].
       auto media_T = [&](const Eigen::Vector3f& o, const Eigen::Vector3f& d, float dist) {
@@ -340,6 +344,7 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
               prev_pdf = pdf;
               prev_p = p;
               from_camera = false;
+              path_m += t_scatter * ray.d.norm();
               ray.o = p;
               ray.d = wi;
               ray.tmin = 0.0f;
@@ -379,7 +384,10 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
           break;
         }
 
-        SurfaceMaterial mat = ctx.materials->Evaluate(hit);
+        const float d_len = ray.d.norm();
+        const float hit_path_m = path_m + hit.t * d_len;
+        SurfaceMaterial mat =
+            ctx.materials->Evaluate(hit, ConeFootprint(spread, hit_path_m, ray.d / d_len, hit));
         if (wetness > 0) ApplySurfaceWetness(wetness, hit.ns_W, &mat.pbr);
         if (vertex == 0) {
           for (int k = 0; k < 3; ++k) albedo_sum[k] += mat.pbr.base_color[k];
@@ -418,6 +426,7 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
         prev_pdf = bs.pdf;
         prev_p = hit.p_W;
         from_camera = false;
+        path_m = hit_path_m;
         ray = SpawnRay(hit, bs.wi);
       }
 

@@ -41,6 +41,12 @@
 //   - surface wetness (ApplySurfaceWetness) changes the material of upward-facing surfaces.
 // without effects the tier renders exactly as before (no extra random numbers are drawn).
 //
+// textures are filtered over the pixel's ray cone (render/material_eval.h): its spread angle is
+// Camera::pixel_spread_rad and its width at a vertex is that angle times the length of the path
+// from the camera to the vertex (the cone of a chain of flat mirrors; the paper's spread from
+// surface curvature and roughness is left out, so after rough bounces the footprint is
+// underestimated and textures are sampled sharper than the cone of the path would need).
+//
 // outputs per pixel: the mean radiance; the denoiser guides (FrameBuffers): albedo = mean base
 // colour of the first surface over the samples that hit one, normal = shading normal of the
 // pixel-centre hit (consistent with the renderer's depth image). non-finite path values are

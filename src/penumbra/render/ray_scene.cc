@@ -50,6 +50,9 @@ struct TriangleGeom {
   };
   std::vector<FaceNormal> face_normals;
   std::vector<Eigen::Vector3f> vertices_G;  // the same vertices in the geom frame (FinishHit)
+  // per face when there are texcoords: sqrt(texcoord area / surface area), texcoord units per
+  // metre (the ray-cone texture level of detail's triangle term, SurfaceHit::uv_per_m).
+  std::vector<float> uv_per_m;
 };
 
 // what an Embree (instanced scene, geomID) pair stands for.
@@ -284,6 +287,17 @@ struct RayScene::Impl {
         n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
         tg->face_normals.push_back({n_I, R_GI * n_I});
       }
+      if (!tg->texcoords.empty()) {
+        tg->uv_per_m.reserve(tg->faces.size());
+        for (const Eigen::Vector3i& f : tg->faces) {
+          const Eigen::Vector3f& p0 = tg->vertices_G[f[0]];
+          const float area = (tg->vertices_G[f[1]] - p0).cross(tg->vertices_G[f[2]] - p0).norm();
+          const Eigen::Vector2f& t0 = tg->texcoords[f[0]];
+          const Eigen::Vector2f e1 = tg->texcoords[f[1]] - t0, e2 = tg->texcoords[f[2]] - t0;
+          const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+          tg->uv_per_m.push_back(area > 0 ? std::sqrt(uv_area / area) : 0.0f);
+        }
+      }
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
       rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                  tg->vertices_I.data(), 0, sizeof(Eigen::Vector3f),
@@ -397,6 +411,7 @@ struct RayScene::Impl {
     hit->material = rec.material;
     hit->has_uv = false;
     hit->uv.setZero();
+    hit->uv_per_m = 0;
     Eigen::Vector3f ng_W, ns_W;
     if (rec.analytic) {
       const AnalyticGeom& g = *rec.analytic;
@@ -428,6 +443,7 @@ struct RayScene::Impl {
       if (!g.texcoords.empty()) {
         hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];
         hit->has_uv = true;
+        hit->uv_per_m = g.uv_per_m[rh.hit.primID];
       }
     }
     hit->front_face = ng_W.dot(ray.d) <= 0;

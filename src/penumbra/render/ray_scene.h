@@ -75,6 +75,9 @@ struct SurfaceHit {
   Eigen::Vector3f ns_W{0, 0, 1};
   Eigen::Vector2f uv{0, 0};      ///< mesh texcoords at the hit when the mesh has them, else (0, 0)
   bool has_uv = false;           ///< uv came from mesh texcoords
+  /// with has_uv: texcoord units per metre of surface on the hit triangle, sqrt(uv area / area)
+  /// (for texture level of detail); else 0.
+  float uv_per_m = 0;
   bool front_face = true;        ///< the ray hit the outward side (before flipping the normals)
   Eigen::Vector3f p_G{0, 0, 0};  ///< hit point in the geom frame, m (planar texture mapping)
   Eigen::Vector3f n_G{0, 0, 1};  ///< unit outward geometric normal in the geom frame (not flipped)

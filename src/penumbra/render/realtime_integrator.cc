@@ -207,6 +207,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const MediaFrame* fx = ctx.effects;
   const RealtimeMedia* rm = fx != nullptr ? fx->realtime_media() : nullptr;
   const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
+  const float spread = ctx.camera->pixel_spread_rad();
 
   // runs of kLanes pixels (a full tile row): per-pixel set-up (materials, textures, sky,
   // random numbers), then the BRDF coefficients, the ambient term and every light for all
@@ -251,9 +252,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       const int u = lane_u[k], v = lane_v[k];
       const SurfaceHit& h = primary.hits[i];
-      SurfaceMaterial mat = ctx.materials->Evaluate(h);
-      if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
       const Eigen::Vector3f& wo = scratch.wo[i];
+      // the texture is filtered over the pixel's ray cone where it meets the surface.
+      SurfaceMaterial mat =
+          ctx.materials->Evaluate(h, ConeFootprint(spread, h.t * primary.rays[i].d.norm(), -wo, h));
+      if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
       const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);
       pbr.Set(k, mat.pbr);

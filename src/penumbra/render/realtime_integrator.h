@@ -10,7 +10,8 @@
 // where E_sky is the sky irradiance occluded by the static geometry (SkyIrradianceVolume, when
 // the context has one; else the unoccluded SkyModel::Irradiance(n)) and S is Karis' analytic
 // fit of the split-sum specular reflectance ("Physically based shading on mobile", Unreal
-// Engine blog 2014); unoccluded, this is exact for a uniform sky and a Lambertian surface. rays that miss see SkyModel::Radiance.
+// Engine blog 2014); unoccluded, this is exact for a uniform sky and a Lambertian surface. rays
+// that miss see SkyModel::Radiance.
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
@@ -26,7 +27,8 @@
 //
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
 // LightSampler::SampleLanes) and its shadow rays towards one light form one Embree packet
-// (RayScene::OccludedLanes); materials and textures are evaluated per pixel. the sky volume is
+// (RayScene::OccludedLanes); materials and textures are evaluated per pixel, textures filtered
+// over the pixel's ray cone (render/material_eval.h, Camera::pixel_spread_rad). the sky volume is
 // looked up once per 2x2 pixel quad that sees one flat face, at the quad's mean hit point (it
 // varies over a probe spacing, tens of pixels), else per pixel.
 

@@ -1,6 +1,7 @@
 #include "penumbra/scene/scene_description.h"
 
 #include <cmath>
+#include <set>
 
 namespace penumbra {
 
@@ -27,5 +28,19 @@ int FindByName(const V& v, const std::string& name) {
 int SceneDescription::FindMaterial(const std::string& name) const { return FindByName(materials, name); }
 int SceneDescription::FindBody(const std::string& name) const { return FindByName(bodies, name); }
 int SceneDescription::FindCamera(const std::string& name) const { return FindByName(cameras, name); }
+
+TextureMemory CountTextureMemory(const std::vector<Texture>& textures) {
+  TextureMemory m;
+  std::set<const TextureImage*> seen;
+  for (const Texture& t : textures) {
+    if (!t.image) continue;
+    ++m.textures;
+    if (!seen.insert(t.image.get()).second) continue;
+    ++m.images;
+    m.texels += static_cast<size_t>(t.image->width()) * t.image->height();
+    m.bytes += t.image->bytes();
+  }
+  return m;
+}
 
 }  // namespace penumbra

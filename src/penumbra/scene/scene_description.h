@@ -10,10 +10,12 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
 
@@ -62,9 +64,10 @@ struct Texture {
   enum class Kind { k2D, kCube, kSkybox };
   std::string name;
   Kind kind = Kind::k2D;
-  int width = 0;
-  int height = 0;
-  std::vector<uint8_t> rgb_srgb;  ///< (height x width x 3) uint8, sRGB-encoded
+  /// the pixels (8-bit sRGB RGB) and their mip levels (scene/texture_image.h); immutable and
+  /// shared: by copies of the scene, and by textures whose pixels are identical. cube and
+  /// skybox textures have 6 faces, 2d textures 1.
+  std::shared_ptr<const TextureImage> image;
 };
 
 /// physically based material (metallic-roughness, as glTF 2.0 / Burley 2012).
@@ -206,5 +209,9 @@ struct SceneDescription {
   int FindBody(const std::string& name) const;
   int FindCamera(const std::string& name) const;
 };
+
+/// the memory of the texture images of `textures`, each distinct image counted once (textures
+/// without an image are not counted).
+TextureMemory CountTextureMemory(const std::vector<Texture>& textures);
 
 }  // namespace penumbra

@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""Measures texture aliasing on a far checker floor (docs/rendering.md, "Textures").
+
+Pure Python (zlib + struct). Writes a world into OUT_DIR: MuJoCo's standard Menagerie ground
+plane (a 300 x 300 checker with mark="edge", texrepeat 5 5, texuniform) and one 640 x 480
+camera 1.2 m above it, fovy 20 deg, pitched 2 deg down, looking along it; runs
+
+    PENUMBRA run OUT_DIR/world.yaml --out OUT_DIR/run
+
+for one frame, and prints, for the floor pixels whose range is in [15, 60] m:
+
+    far_residual_std   the standard deviation of luminance minus its local mean (9 x 9 box)
+
+and, for the floor pixels nearer than 8 m, near_residual_std (the near checker's contrast,
+which filtering must keep). Luminance is Rec. 709 luma of the 8-bit sRGB values in [0, 1]
+(as stored). Usage, from the repository root:
+
+    python3 scripts/measure_texture_aliasing.py OUT_DIR [--penumbra build/penumbra]
+                                                [--tier realtime|pathtraced] [--spp N]
+"""
+
+import argparse
+import json
+import os
+import struct
+import subprocess
+import sys
+import zlib
+
+FLOOR_XML = """<mujoco model="floor">
+  <asset>
+    <texture type="2d" name="groundplane" builtin="checker" mark="edge" rgb1="0.2 0.3 0.4"
+             rgb2="0.1 0.2 0.3" markrgb="0.8 0.8 0.8" width="300" height="300"/>
+    <material name="groundplane" texture="groundplane" texuniform="true" texrepeat="5 5"
+              reflectance="0.2"/>
+  </asset>
+  <worldbody>
+    <geom name="floor" size="0 0 0.05" type="plane" material="groundplane"/>
+  </worldbody>
+</mujoco>
+"""
+
+WORLD_YAML = """seed: 1
+duration_sec: 0.05
+physics: {timestep_sec: 0.002}
+render: {tier: %(tier)s, samples_per_pixel: %(spp)d, max_bounces: 2, denoise: false}
+sky: {type: daylight, turbidity: 3, sun_elevation_deg: 45, sun_azimuth_deg: 30}
+models:
+  - {name: floor, file: floor.xml}
+lights:
+  - {name: sun, type: sun, direction: [-0.5, -0.3, -0.8], illuminance_lux: 50000}
+cameras:
+  - name: far
+    pose: {xyz: [0, 0, 1.2], rpy_deg: [0, 2, 0]}
+    width: 640
+    height: 480
+    fovy_deg: 20
+    rate_hz: 10
+    outputs: [rgb, range]
+mjcf_cameras: {enabled: false}
+"""
+
+
+def read_png(path):
+    """(width, height, channels, bit depth, rows of samples) of an 8/16-bit grey or RGB PNG."""
+    with open(path, "rb") as f:
+        data = f.read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    pos, idat = 8, b""
+    while pos < len(data):
+        n, tag = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        if tag == b"IHDR":
+            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+        elif tag == b"IDAT":
+            idat += body
+        pos += 12 + n
+    ch = {0: 1, 2: 3}[ctype]
+    bpp = ch * depth // 8
+    raw = zlib.decompress(idat)
+    stride = w * bpp
+    rows, prev = [], bytearray(stride)
+    for y in range(h):
+        ft = raw[y * (stride + 1)]
+        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b = prev[i]
+            c = prev[i - bpp] if i >= bpp else 0
+            if ft == 1:
+                line[i] = (line[i] + a) & 0xFF
+            elif ft == 2:
+                line[i] = (line[i] + b) & 0xFF
+            elif ft == 3:
+                line[i] = (line[i] + (a + b) // 2) & 0xFF
+            elif ft == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 0xFF
+        prev = line
+        if depth == 16:
+            rows.append([(line[2 * i] << 8) | line[2 * i + 1] for i in range(w * ch)])
+        else:
+            rows.append(list(line))
+    return w, h, ch, rows
+
+
+def residual_std(lum, mask, w, h, r=4):
+    """std-dev of lum - (its (2r+1)^2 box mean) over the pixels where mask is set and the whole
+    box lies inside the image."""
+    integ = [[0.0] * (w + 1) for _ in range(h + 1)]
+    for y in range(h):
+        acc = 0.0
+        for x in range(w):
+            acc += lum[y][x]
+            integ[y + 1][x + 1] = integ[y][x + 1] + acc
+    vals = []
+    n = (2 * r + 1) ** 2
+    for y in range(r, h - r):
+        for x in range(r, w - r):
+            if not mask[y][x]:
+                continue
+            s = (integ[y + r + 1][x + r + 1] - integ[y - r][x + r + 1] - integ[y + r + 1][x - r] +
+                 integ[y - r][x - r])
+            vals.append(lum[y][x] - s / n)
+    if not vals:
+        return float("nan"), 0
+    m = sum(vals) / len(vals)
+    return (sum((v - m) ** 2 for v in vals) / len(vals)) ** 0.5, len(vals)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("out_dir")
+    ap.add_argument("--penumbra", default="build/penumbra")
+    ap.add_argument("--tier", default="realtime", choices=["realtime", "pathtraced"])
+    ap.add_argument("--spp", type=int, default=4)
+    a = ap.parse_args()
+    os.makedirs(a.out_dir, exist_ok=True)
+    with open(os.path.join(a.out_dir, "floor.xml"), "w") as f:
+        f.write(FLOOR_XML)
+    with open(os.path.join(a.out_dir, "world.yaml"), "w") as f:
+        f.write(WORLD_YAML % {"tier": a.tier, "spp": a.spp})
+    run = os.path.join(a.out_dir, "run")
+    subprocess.run([a.penumbra, "run", os.path.join(a.out_dir, "world.yaml"), "--out", run],
+                   check=True, stdout=subprocess.DEVNULL)
+    w, h, _, rgb = read_png(os.path.join(run, "far", "rgb", "000000.png"))
+    _, _, _, rng = read_png(os.path.join(run, "far", "range", "000000.png"))
+    lum = [[(0.2126 * row[3 * x] + 0.7152 * row[3 * x + 1] + 0.0722 * row[3 * x + 2]) / 255.0
+            for x in range(w)] for row in rgb]
+    far = [[15000 <= rng[y][x] <= 60000 for x in range(w)] for y in range(h)]
+    near = [[0 < rng[y][x] < 8000 for x in range(w)] for y in range(h)]
+    far_std, far_n = residual_std(lum, far, w, h)
+    near_std, near_n = residual_std(lum, near, w, h)
+    print(json.dumps({"tier": a.tier, "far_residual_std": round(far_std, 5), "far_pixels": far_n,
+                      "near_residual_std": round(near_std, 5), "near_pixels": near_n,
+                      "image": os.path.join(run, "far", "rgb", "000000.png")}))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
