@@ -56,7 +56,8 @@ TEST(RunManifest, KeyOrderIsStable) {
   const std::vector<std::string> expected = {"world_file",       "seed",
                                              "penumbra_version", "mujoco_version",
                                              "embree_version",   "command_line",
-                                             "sim_duration_sec", "frames_per_camera",
+                                             "sim_duration_sec", "interrupted",
+                                             "frames_per_camera",
                                              "timings_sec",      "peak_resident_memory_mib"};
   EXPECT_EQ(keys, expected);
   // maps are sorted by name whatever the insertion order

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -148,6 +150,41 @@ CLI::Option* AddDecimal(CLI::App* app, const std::string& name, std::function<vo
           range, ""));
 }
 
+// SIGINT / SIGTERM during `penumbra run`: the first asks the run to stop at the next physics
+// step boundary (RunOptions::stop_request), the second exits at once. async-signal-safe:
+// a lock-free atomic, write(2) and _exit(2) only.
+std::atomic<int> g_stop_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free);
+
+extern "C" void OnStopSignal(int sig) {
+  int expected = 0;
+  if (!g_stop_signal.compare_exchange_strong(expected, sig)) _exit(128 + sig);
+  static const char kMsg[] =
+      "\npenumbra: stopping at the next physics step and writing the outputs "
+      "(signal again to exit at once)\n";
+  const ssize_t ignored = write(STDERR_FILENO, kMsg, sizeof(kMsg) - 1);
+  (void)ignored;
+}
+
+// installs OnStopSignal for SIGINT and SIGTERM while it lives
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction sa = {};
+    sa.sa_handler = OnStopSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+
+ private:
+  struct sigaction old_int_ = {}, old_term_ = {};
+};
+
 // errors and logs go to stderr; stdout carries only what was asked for (--help, --version)
 void LogToStderr() {
   auto logger = std::make_shared<spdlog::logger>(
@@ -172,6 +209,7 @@ int RunCli(int argc, char** argv) {
   int spp = 0, threads = -1;
   std::optional<uint64_t> seed;
   bool quiet = false;
+  std::string outputs;
   run->add_option("world", world_path, "world file (.yaml) or model (.xml MJCF, .urdf)")->required();
   run->add_option("--out,-o", run_options.out_dir, "output folder (default: the world's output.dir)");
   AddDecimal(run, "--duration", [&](double v) { duration = v; }, 0, true,
@@ -182,6 +220,12 @@ int RunCli(int argc, char** argv) {
   AddInteger(run, "--threads", &threads, 0, 256, "render threads (0 = all cores)");
   AddUint64(run, "--seed", &seed, "world seed (overrides seed)");
   run->add_flag("--quiet,-q", quiet, "no progress output");
+  run->add_flag("--force", run_options.force,
+                "the output folder may hold an earlier run's outputs: remove them first "
+                "(anything else there is refused)");
+  run->add_option("--outputs", outputs,
+                  "images of every camera, comma-separated: rgb, depth, segmentation, range, "
+                  "normals, instance_segmentation, semantic_segmentation (overrides the world)");
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -253,11 +297,21 @@ int RunCli(int argc, char** argv) {
       if (threads >= 0) world.render.threads = threads;
       run_options.progress = !quiet;
       run_options.command_line = Args(argc, argv);
+      if (!outputs.empty() || run->count("--outputs")) run_options.outputs = ParseCameraOutputs(outputs);
+      g_stop_signal.store(0);
+      run_options.stop_request = &g_stop_signal;
+      const StopSignals stop_signals;
       const RunSummary s = RunWorld(world, run_options);
       int64_t frames = 0;
       for (const auto& [name, n] : s.frames_per_camera) frames += n;
       spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
+      if (s.interrupted) {
+        const int sig = g_stop_signal.load();
+        spdlog::warn("interrupted by {} at {:.6g} s of sim time; outputs and run.json written",
+                     sig == SIGTERM ? "SIGTERM" : "SIGINT", s.sim_time_sec);
+        return 128 + sig;
+      }
       return 0;
     }
     if (*bench_render) {

@@ -6,7 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <mutex>
 #include <thread>
 
 #include "penumbra/app/camera_stage.h"
@@ -18,7 +18,9 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/bounded_queue.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/async_frame_writer.h"
+#include "penumbra/output/output_folder.h"
 #include "penumbra/output/progress.h"
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/mujoco_version.h"
@@ -68,37 +70,101 @@ class CameraSchedule {
   std::vector<int64_t> next_;
 };
 
-void WriteTrajectoryHeader(std::ofstream& f, size_t nq) {
-  f << "step,time_sec";
-  for (size_t i = 0; i < nq; ++i) f << ",qpos" << i;
-  f << "\n";
+std::string TrajectoryHeader(size_t nq) {
+  std::string h = "step,time_sec";
+  for (size_t i = 0; i < nq; ++i) fmt::format_to(std::back_inserter(h), ",qpos{}", i);
+  return h + "\n";
 }
 
-void WriteTrajectoryRow(std::ofstream& f, const Simulation& sim) {
+std::string TrajectoryRow(const Simulation& sim) {
   const std::span<const double> q = sim.qpos();
   std::string row = fmt::format("{},{:.17g}", sim.step_count(), sim.time());
   for (double v : q) fmt::format_to(std::back_inserter(row), ",{:.17g}", v);
   row += '\n';
-  f << row;
+  return row;
+}
+
+// the first error of a run, from any thread (physics, render, writers)
+class FirstError {
+ public:
+  // keeps `e` if it is the first; returns true if it was
+  bool Record(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (first_) return false;
+    first_ = e;
+    return true;
+  }
+  std::exception_ptr get() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return first_;
+  }
+
+ private:
+  mutable std::mutex mu_;
+  std::exception_ptr first_;
+};
+
+std::string What(std::exception_ptr e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown error";
+  }
 }
 
 }  // namespace
+
+CameraOutputs ParseCameraOutputs(const std::string& list) {
+  static const std::vector<std::string> kValid = {"rgb",    "depth",   "segmentation",
+                                                  "range",  "normals", "instance_segmentation",
+                                                  "semantic_segmentation"};
+  std::string valid;
+  for (const std::string& v : kValid) valid += (valid.empty() ? "" : ", ") + v;
+  CameraOutputs o{false, false, false};
+  size_t start = 0, count = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    const std::string name = list.substr(start, end - start);
+    start = end + 1;
+    bool* flag = name == "rgb"                     ? &o.rgb
+                 : name == "depth"                 ? &o.depth
+                 : name == "segmentation"          ? &o.segmentation
+                 : name == "range"                 ? &o.range
+                 : name == "normals"               ? &o.normals
+                 : name == "instance_segmentation" ? &o.instance_segmentation
+                 : name == "semantic_segmentation" ? &o.semantic_segmentation
+                                                   : nullptr;
+    if (!flag)
+      throw ConfigError("", 0, "--outputs",
+                        "unknown output '" + name + "'; expected a comma-separated list of: " + valid);
+    if (*flag) throw ConfigError("", 0, "--outputs", "'" + name + "' is listed twice");
+    *flag = true;
+    ++count;
+  }
+  if (count == 0) throw ConfigError("", 0, "--outputs", "empty list; expected some of: " + valid);
+  return o;
+}
 
 RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   const auto t_start = Clock::now();
   WorldConfig world = world_in;
   if (options.duration_sec) world.duration_sec = *options.duration_sec;
   if (!options.out_dir.empty()) world.output_dir = options.out_dir;
+  if (options.outputs) {
+    for (CameraConfig& c : world.cameras) c.outputs = *options.outputs;
+    world.mjcf_cameras.outputs = *options.outputs;
+    for (CameraConfig& c : world.mjcf_cameras.overrides) c.outputs = *options.outputs;
+  }
   world.render.seed = world.seed;
   world.ValidateOrThrow();
 
   namespace fs = std::filesystem;
   const fs::path out = world.output_dir;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec)
-    throw ConfigError("", 0, "--out",
-                      "cannot create folder '" + out.string() + "': " + ec.message());
+  // empty or new, or (--force) holding only an earlier run's outputs (output/output_folder.h)
+  PrepareOutputFolder(out, options.force);
 
   std::map<std::string, double> timings;
 
@@ -131,16 +197,19 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 
-  // outputs
-  AsyncFrameWriter writer(out.string());
+  // outputs. the first error of any stage is the one reported (FirstError)
+  FirstError first_error;
+  AsyncFrameWriterOptions writer_options;
+  writer_options.on_error = [&](std::exception_ptr e) { first_error.Record(e); };
+  AsyncFrameWriter writer(out.string(), writer_options);
   for (const CameraSpec& cam : scene.cameras)
     writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
   CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
   SensorStage sensor_stage(
       world, sim, scene, out.string(),  // app/sensor_stage.h
       [&](const WorldSnapshot& s, const Eigen::Vector3d& p) { return effects.Evaluate(s, p); });
-  std::ofstream trajectory(out / "trajectory.csv");
-  WriteTrajectoryHeader(trajectory, sim.qpos().size());
+  LineFile trajectory(out / "trajectory.csv");  // whole rows only (core/output_file.h)
+  trajectory.Append(TrajectoryHeader(sim.qpos().size()));
 
   const double duration = world.duration_sec;
   ProgressOptions progress_options;
@@ -154,6 +223,8 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   // physics on its own thread; it hands snapshots to the renderer through a bounded queue
   BoundedQueue<RenderJob> jobs(4);
   double physics_busy_sec = 0;
+  double sim_time_reached = sim.time();
+  bool interrupted = false;
   std::thread physics([&] {
     CameraSchedule schedule(scene.cameras);
     ShutterSchedule shutters(scene, world);  // end-of-exposure snapshots (motion blur)
@@ -179,6 +250,11 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
           if (!jobs.Push(std::move(job))) return;
         }
         if (sim.time() >= duration - 1e-9) break;
+        // a stop request (SIGINT/SIGTERM) ends the run at this step boundary
+        if (options.stop_request && options.stop_request->load() != 0) {
+          interrupted = true;
+          break;
+        }
         if (options.realtime) {
           std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<Clock::duration>(
                                                     std::chrono::duration<double>(sim.time())));
@@ -186,10 +262,12 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
         const auto ts = Clock::now();
         sim.Step();
         physics_busy_sec += SecondsSince(ts);
-        WriteTrajectoryRow(trajectory, sim);
+        sim_time_reached = sim.time();
+        trajectory.Append(TrajectoryRow(sim));
         for (const std::string& w : sim.TakeWarnings()) spdlog::warn("physics: {}", w);
       }
     } catch (...) {
+      first_error.Record(std::current_exception());
       RenderJob last;
       last.error = std::current_exception();
       jobs.Push(std::move(last));
@@ -198,7 +276,6 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   });
 
   // render and write on this thread, in arrival order (deterministic)
-  std::exception_ptr failure;
   RunSummary summary;
   double render_sec = 0;
   int64_t total_frames = 0;
@@ -207,10 +284,11 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
     ++total_frames;
     writer.Submit(std::move(cf));
   };
+  bool failed = false;
   try {
     while (std::optional<RenderJob> job = jobs.Pop()) {
       if (job->error) {
-        failure = job->error;
+        failed = true;
         break;
       }
       // per-camera effects (app/effects_stage.h) ride along with each capture
@@ -218,34 +296,41 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
                               submit);
       progress.Update(job->snapshot.time_sec, total_frames);
     }
-    if (!failure) camera_stage.Finish(submit);
+    if (!failed) camera_stage.Finish(submit);
   } catch (...) {
-    failure = std::current_exception();
+    first_error.Record(std::current_exception());
   }
   jobs.Close();
   physics.join();
-  sensor_stage.Finish();
-  for (const auto& [kind, sec] : sensor_stage.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
   progress.Finish();
   render_sec = camera_stage.render_sec();
 
-  std::exception_ptr write_failure;
-  try {
-    writer.Flush();
-  } catch (...) {
-    write_failure = std::current_exception();
-  }
-  trajectory.flush();
+  // drain every writer; each reports its own error, the run reports the first one
+  auto drain = [&](auto&& f) {
+    try {
+      f();
+    } catch (...) {
+      first_error.Record(std::current_exception());
+    }
+  };
+  drain([&] { sensor_stage.Finish(); });
+  drain([&] { writer.Flush(); });
+  drain([&] { trajectory.Close(); });
+  for (const auto& [kind, sec] : sensor_stage.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
+  // frames.csv rows actually written (a frame whose files failed has none)
+  summary.frames_per_camera = writer.FramesWritten();
 
   summary.out_dir = out.string();
-  summary.sim_time_sec = sim.time();
+  summary.sim_time_sec = sim_time_reached;
   summary.physics_steps = sim.step_count();
+  summary.interrupted = interrupted;
   summary.wall_time_sec = SecondsSince(t_start);
   summary.peak_rss_mib = PeakResidentMemoryMiB();
   timings["physics_sec"] = physics_busy_sec;
   timings["render_sec"] = render_sec;
   timings["total_sec"] = summary.wall_time_sec;
 
+  const std::exception_ptr failure = first_error.get();
   RunManifest manifest;
   manifest.world_file =
       world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
@@ -257,14 +342,21 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   manifest.peak_resident_memory_mib = summary.peak_rss_mib;
   manifest.frames_per_camera = summary.frames_per_camera;
   manifest.sim_duration_sec = summary.sim_time_sec;
+  manifest.interrupted = interrupted;
+  if (failure) manifest.error = What(failure);
   manifest.command_line = options.command_line;
   manifest.adversity = effects.PresetLabel();
   manifest.effects = effects.EffectLabels();
   manifest.agents = effects.AgentLabels();
-  WriteRunManifest(out.string(), manifest);
+  try {
+    WriteRunManifest(out.string(), manifest);
+  } catch (...) {
+    // on a full disk run.json fails too; the error that came first is the one reported
+    if (!first_error.Record(std::current_exception()))
+      spdlog::error("also: {}", What(std::current_exception()));
+  }
 
-  if (failure) std::rethrow_exception(failure);
-  if (write_failure) std::rethrow_exception(write_failure);
+  if (const std::exception_ptr e = first_error.get()) std::rethrow_exception(e);
   return summary;
 }
 

@@ -64,7 +64,8 @@ class SensorStage {
   bool Due(double time_sec);
   /// runs the sensors found due by the last Due() on `snapshot` and writes their records.
   void Process(const WorldSnapshot& snapshot);
-  /// flushes and closes the files.
+  /// writes the buffered rows and closes the files.
+  /// @throws Error naming the first file that could not be written (all are closed).
   void Finish();
 
   /// samples (scans) written per sensor.

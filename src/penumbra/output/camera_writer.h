@@ -1,5 +1,6 @@
 #pragma once
-// files of one camera under an output folder:
+// files of one camera under an output folder (images and JSON are written whole under a
+// temporary name and renamed into place, core/output_file.h):
 //
 //   DIR/<camera>/rgb/NNNNNN.png           8-bit sRGB colour
 //   DIR/<camera>/depth/NNNNNN.png         16-bit z-depth in millimetres (see DepthToMillimetres)
@@ -17,6 +18,7 @@
 #include <string>
 
 #include "penumbra/core/image.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/camera_frame.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/scene/scene_description.h"
@@ -72,7 +74,8 @@ class CameraWriter {
   ///         or a file cannot be written (message names the path).
   void WriteImages(const CameraFrame& frame) const;
 
-  /// appends the frame's frames.csv row and flushes it to the file.
+  /// appends the frame's frames.csv row and writes it to the file (whole rows only; a row
+  /// that fails to write is cut off again, core/output_file.h).
   /// @throws Error if the index is not greater than the previous one or the write fails.
   void AppendPose(const CameraFrame& frame);
 
@@ -91,7 +94,7 @@ class CameraWriter {
   CameraIntrinsics intrinsics_;
   CameraOutputs outputs_;
   PngEncodeOptions png_options_;
-  std::ofstream csv_;
+  LineFile csv_;
   int64_t last_index_ = -1;
   int64_t frames_written_ = 0;
 };
