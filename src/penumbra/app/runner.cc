@@ -353,7 +353,7 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   } catch (...) {
     // on a full disk run.json fails too; the error that came first is the one reported
     if (!first_error.Record(std::current_exception()))
-      spdlog::error("also: {}", What(std::current_exception()));
+      spdlog::warn("after the first error, also: {}", What(std::current_exception()));
   }
 
   if (const std::exception_ptr e = first_error.get()) std::rethrow_exception(e);

@@ -156,7 +156,12 @@ void LineFile::Close() {
 void LineFile::WriteBuffer() {
   size_t done = 0;
   const int err = WriteAll(fd_, buffer_.data(), buffer_.size(), &done);
-  if (err != 0) Fail(err);
+  if (err != 0) {
+    // keep the complete rows that made it to the file
+    const size_t last_newline = std::string_view(buffer_.data(), done).rfind('\n');
+    if (last_newline != std::string_view::npos) written_ += last_newline + 1;
+    Fail(err);
+  }
   written_ += buffer_.size();
   buffer_.clear();
 }

@@ -39,7 +39,8 @@ void CreateOutputFolder(const std::filesystem::path& root, const std::filesystem
 /// a file written as whole lines (CSV rows): Append() buffers rows, which reach the kernel
 /// only as whole rows (one write(2) of complete rows at a time), so a killed process leaves
 /// complete rows at worst. a write that fails part-way (full disk) is cut back to the last
-/// complete row (ftruncate) and reported; a file that never got a complete row is removed.
+/// complete row that reached the file (ftruncate) and reported; a file that holds no
+/// complete row then is removed.
 class LineFile {
  public:
   LineFile() = default;

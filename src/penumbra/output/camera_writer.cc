@@ -162,14 +162,32 @@ void CameraWriter::WriteImages(const CameraFrame& frame) const {
     throw Error(fmt::format("camera '{}': negative frame index {}", camera_, frame.index));
   }
   const std::string name = FrameFileName(frame.index);
+  // a frame is written whole or not at all: if one image fails, the frame's images written
+  // before it are removed again (the frame gets no frames.csv row either)
+  std::vector<fs::path> written;
+  try {
+    WriteFrameImages(frame, name, &written);
+  } catch (...) {
+    for (const fs::path& p : written) {
+      std::error_code ec;
+      fs::remove(p, ec);
+    }
+    throw;
+  }
+}
+
+void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string& name,
+                                    std::vector<fs::path>* written) const {
   if (outputs_.rgb) {
     CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");
     WritePngRgb8((folder_ / "rgb" / name).string(), frame.rgb, png_options_);
+    written->push_back(folder_ / "rgb" / name);
   }
   if (outputs_.depth) {
     CheckFrameImage(frame.depth_m, 1, intrinsics_, camera_, frame.index, "depth");
     WritePngGray16((folder_ / "depth" / name).string(), DepthToMillimetres(frame.depth_m),
                    png_options_);
+    written->push_back(folder_ / "depth" / name);
   }
   if (outputs_.segmentation) {
     CheckFrameImage(frame.geom_id, 1, intrinsics_, camera_, frame.index, "segmentation");

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/output_file.h"
@@ -68,7 +69,8 @@ class CameraWriter {
   CameraWriter& operator=(const CameraWriter&) = delete;
 
   /// encodes and writes the PNGs of the requested outputs (images of outputs that were
-  /// not requested are ignored).
+  /// not requested are ignored). all or nothing: when one fails, the frame's images written
+  /// before it are removed.
   /// @throws Error if frame.camera differs, the index is negative, a requested image is
   ///         missing or its size/channels differ from the intrinsics, a geom id does not fit,
   ///         or a file cannot be written (message names the path).
@@ -89,6 +91,9 @@ class CameraWriter {
   int64_t frames_written() const { return frames_written_; }
 
  private:
+  void WriteFrameImages(const CameraFrame& frame, const std::string& name,
+                        std::vector<std::filesystem::path>* written) const;
+
   std::string camera_;
   std::filesystem::path folder_;
   CameraIntrinsics intrinsics_;
