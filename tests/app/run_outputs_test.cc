@@ -356,5 +356,54 @@ TEST_F(RunOutputsTest, FullDiskReportsTheFirstErrorAndLeavesNoPartialFile) {
   EXPECT_EQ(CountFiles(out / "cam" / "depth", ".png"), CsvRows(out / "cam" / "frames.csv"));
 }
 
+TEST_F(RunOutputsTest, FrameTimesAreAtLeastKOverRateAndFloorGivesTheFrame) {
+  const fs::path out = tmp_.path() / "out";
+  const ProcessResult r = RunPenumbra(
+      {"run", World("w.yaml", 8, 6, 10, "rgb", 4.0, "physics: {timestep_sec: 0.002}\n"), "--out",
+       out.string(), "-q"},
+      tmp_.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream csv(out / "cam" / "frames.csv");
+  std::string line;
+  std::getline(csv, line);
+  int64_t k = 0;
+  while (std::getline(csv, line)) {
+    const double t = std::strtod(line.c_str() + line.find(',') + 1, nullptr);
+    EXPECT_GE(t, static_cast<double>(k) / 10) << line;
+    EXPECT_EQ(static_cast<int64_t>(std::floor(t * 10)), k) << line;
+    ++k;
+  }
+  EXPECT_EQ(k, 41);
+}
+
+TEST_F(RunOutputsTest, DivergenceRecordsTheSimTimeReached) {
+  // a stiff spring that blows up after a few dozen steps of 10 ms
+  tmp_.Write("spring.xml", R"(<mujoco>
+  <option timestep="0.01" gravity="0 0 0"/>
+  <worldbody>
+    <body name="pendulum" pos="0 0 1">
+      <joint name="spring" type="hinge" axis="0 1 0" stiffness="1e6" springref="0.1"/>
+      <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.05"/>
+    </body>
+  </worldbody>
+</mujoco>)");
+  const std::string world = tmp_.Write(
+      "d.yaml",
+      "duration_sec: 10\nmodels: [{name: m, file: spring.xml}]\nmjcf_cameras: {enabled: false}\n"
+      "cameras: [{name: cam, attach: world, pose: {xyz: [-3, 0, 1]}, width: 8, height: 6, "
+      "rate_hz: 1}]\n");
+  const fs::path out = tmp_.path() / "out";
+  const ProcessResult r = RunPenumbra({"run", world, "--out", out.string(), "-q"}, tmp_.path());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const size_t at = r.err.find("t = ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const double t_diverged = std::strtod(r.err.c_str() + at + 4, nullptr);
+  EXPECT_GT(t_diverged, 0.02) << r.err;
+  const auto j = nlohmann::json::parse(ReadAll(out / "run.json"));
+  EXPECT_NEAR(j.at("sim_duration_sec").get<double>(), t_diverged, 1e-6 * t_diverged) << r.err;
+  EXPECT_NE(j.at("error").get<std::string>().find("diverged"), std::string::npos);
+  EXPECT_FALSE(j.at("interrupted").get<bool>());
+}
+
 }  // namespace
 }  // namespace penumbra

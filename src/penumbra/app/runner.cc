@@ -27,6 +27,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/sensors/sensor_schedule.h"
 
 namespace penumbra {
 namespace {
@@ -46,28 +47,34 @@ struct RenderJob {
   std::exception_ptr error;  // set on the last job if physics failed
 };
 
-// camera c fires its frame k at the first physics step whose time is >= k / rate_hz,
-// so frames never drift however the rate and timestep relate.
+// camera c fires its frame k at the first physics step whose time is >= k / rate_hz, on the
+// step count (sensors/sensor_schedule.h), so frames never drift however the rate and timestep
+// relate; a camera faster than physics renders once per step.
 class CameraSchedule {
  public:
-  explicit CameraSchedule(const std::vector<CameraSpec>& cameras)
-      : cameras_(cameras), next_(cameras.size(), 0) {}
+  CameraSchedule(const std::vector<CameraSpec>& cameras, double timestep_sec)
+      : schedule_(timestep_sec) {
+    for (const CameraSpec& c : cameras) {
+      const int id = schedule_.Add(c.name, c.rate_hz);
+      if (schedule_.exceeds_physics_rate(id))
+        spdlog::warn("camera '{}': rate_hz {:.6g} is faster than the physics rate ({:.6g} Hz); "
+                     "it renders one frame per physics step",
+                     c.name, c.rate_hz, schedule_.physics_rate_hz());
+    }
+  }
 
-  void Due(double time_sec, std::vector<int>* cams, std::vector<int64_t>* frames) {
-    for (size_t c = 0; c < cameras_.size(); ++c) {
-      const double t_k = static_cast<double>(next_[c]) / cameras_[c].rate_hz;
-      if (time_sec >= t_k - 1e-9) {
-        cams->push_back(static_cast<int>(c));
-        frames->push_back(next_[c]);
-        // skip frames that fall inside one physics step (rate above the physics rate)
-        while (static_cast<double>(next_[c]) / cameras_[c].rate_hz <= time_sec + 1e-9) ++next_[c];
-      }
+  void Due(int64_t step, std::vector<int>* cams, std::vector<int64_t>* frames) {
+    due_.clear();
+    schedule_.Due(step, &due_);
+    for (const SensorFiring& f : due_) {
+      cams->push_back(f.sensor);
+      frames->push_back(f.index);
     }
   }
 
  private:
-  const std::vector<CameraSpec>& cameras_;
-  std::vector<int64_t> next_;
+  SensorSchedule schedule_;
+  std::vector<SensorFiring> due_;
 };
 
 std::string TrajectoryHeader(size_t nq) {
@@ -226,14 +233,14 @@ RunSummary RunWorld(const WorldConfig& world_in, const RunOptions& options) {
   double sim_time_reached = sim.time();
   bool interrupted = false;
   std::thread physics([&] {
-    CameraSchedule schedule(scene.cameras);
+    CameraSchedule schedule(scene.cameras, sim.timestep());
     ShutterSchedule shutters(scene, world);  // end-of-exposure snapshots (motion blur)
     const auto wall0 = Clock::now();
     try {
       for (;;) {
         RenderJob job;
-        schedule.Due(sim.time(), &job.cameras, &job.frame_indices);
-        const bool sensors_due = sensor_stage.Due(sim.time());  // same snapshot as cameras
+        schedule.Due(sim.step_count(), &job.cameras, &job.frame_indices);
+        const bool sensors_due = sensor_stage.Due(sim.step_count());  // same snapshot as cameras
         const bool shutter_due = shutters.Due(sim.time());
         if (sensors_due && !shutter_due && job.cameras.empty())
           sensor_stage.Process(sim.Snapshot());

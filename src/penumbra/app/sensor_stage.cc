@@ -1,11 +1,12 @@
 #include "penumbra/app/sensor_stage.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <time.h>
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/core/error.h"
@@ -125,7 +126,7 @@ struct SensorStage::Impl {
   std::vector<SensorConfig> configs;
   const SceneDescription* scene = nullptr;
   SensorEffectsAt effects_at;
-  SensorSchedule schedule;
+  std::optional<SensorSchedule> schedule;
   std::vector<Entry> entries;
   std::vector<Lidar> lidars;
   std::vector<Imu> imus;
@@ -174,9 +175,18 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
   const ModelInfo& info = sim.model_info();
   s.body_names = info.body_names;
   const fs::path out(out_dir);
+  s.schedule.emplace(sim.timestep());
+  const double physics_rate = s.schedule->physics_rate_hz();
   for (const SensorConfig& c : s.configs) {
     const uint64_t stream = SensorStreamSeed(world.seed, c.name);
     double rate = c.rate_hz.value_or(c.type == "imu" ? 200.0 : 100.0);
+    // a rate above the physics rate fires once per step (sensors/sensor_schedule.h)
+    if (rate > physics_rate && c.type != "lidar") {
+      spdlog::warn("{}:{}: {}.rate_hz: sensor '{}' at {:.6g} Hz is faster than the physics "
+                   "rate ({:.6g} Hz); it records one sample per physics step",
+                   c.file, c.line, c.key, c.name, rate, physics_rate);
+      rate = physics_rate;
+    }
     if (c.type == "lidar") {
       Impl::Lidar l;
       l.cfg = &c;
@@ -288,7 +298,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       s.truths.push_back(std::move(g));
     }
     try {
-      s.schedule.Add(c.name, rate, c.latency_sec);
+      s.schedule->Add(c.name, rate, c.latency_sec);
     } catch (const Error& e) {
       throw SensorError(c, "rate_hz", e.what());
     }
@@ -300,9 +310,9 @@ SensorStage::~SensorStage() = default;
 
 bool SensorStage::empty() const { return impl_->configs.empty(); }
 
-bool SensorStage::Due(double time_sec) {
+bool SensorStage::Due(int64_t step) {
   impl_->due.clear();
-  impl_->schedule.Due(time_sec, &impl_->due);
+  impl_->schedule->Due(step, &impl_->due);
   return !impl_->due.empty();
 }
 
