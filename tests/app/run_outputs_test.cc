@@ -97,15 +97,14 @@ class RunOutputsTest : public ::testing::Test {
   std::string World(const std::string& name, int width, int height, double rate_hz,
                     const std::string& outputs, double duration_sec,
                     const std::string& extra = "") {
-    return tmp_.Write(name,
-                      "seed: 3\nduration_sec: " + std::to_string(duration_sec) +
-                          "\nmodels: [{name: scene, file: ball.xml}]\n"
-                          "mjcf_cameras: {enabled: false}\n"
-                          "cameras:\n  - {name: cam, attach: world, pose: {xyz: [-3, 0, 1.5], "
-                          "rpy_deg: [0, 20, 0]}, width: " +
-                          std::to_string(width) + ", height: " + std::to_string(height) +
-                          ", rate_hz: " + std::to_string(rate_hz) + ", outputs: [" + outputs +
-                          "]}\n" + extra);
+    return tmp_.Write(
+        name, "seed: 3\nduration_sec: " + std::to_string(duration_sec) +
+                  "\nmodels: [{name: scene, file: ball.xml}]\n"
+                  "mjcf_cameras: {enabled: false}\n"
+                  "cameras:\n  - {name: cam, attach: world, pose: {xyz: [-3, 0, 1.5], "
+                  "rpy_deg: [0, 20, 0]}, width: " +
+                  std::to_string(width) + ", height: " + std::to_string(height) + ", rate_hz: " +
+                  std::to_string(rate_hz) + ", outputs: [" + outputs + "]}\n" + extra);
   }
 
   // waits until `csv` has at least `rows` rows (max 30 s)
@@ -358,10 +357,10 @@ TEST_F(RunOutputsTest, FullDiskReportsTheFirstErrorAndLeavesNoPartialFile) {
 
 TEST_F(RunOutputsTest, FrameTimesAreAtLeastKOverRateAndFloorGivesTheFrame) {
   const fs::path out = tmp_.path() / "out";
-  const ProcessResult r = RunPenumbra(
-      {"run", World("w.yaml", 8, 6, 10, "rgb", 4.0, "physics: {timestep_sec: 0.002}\n"), "--out",
-       out.string(), "-q"},
-      tmp_.path());
+  const ProcessResult r =
+      RunPenumbra({"run", World("w.yaml", 8, 6, 10, "rgb", 4.0, "physics: {timestep_sec: 0.002}\n"),
+                   "--out", out.string(), "-q"},
+                  tmp_.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream csv(out / "cam" / "frames.csv");
   std::string line;
@@ -374,6 +373,24 @@ TEST_F(RunOutputsTest, FrameTimesAreAtLeastKOverRateAndFloorGivesTheFrame) {
     ++k;
   }
   EXPECT_EQ(k, 41);
+}
+
+TEST_F(RunOutputsTest, SensorRatesAbovePhysicsFireEveryStepWithAWarning) {
+  // rate_hz 1e12 looped once per skipped sample (hours); now one sample per 5 ms step
+  const fs::path out = tmp_.path() / "out";
+  const ProcessResult r =
+      RunPenumbra({"run",
+                   World("w.yaml", 8, 6, 10, "rgb", 0.1,
+                         "sensors:\n  - {name: imu, type: imu, body: scene/ball, rate_hz: 1e12}\n"
+                         "  - {name: gt, type: ground_truth, rate_hz: 1e12, contacts: false}\n"),
+                   "--out", out.string(), "-q"},
+                  tmp_.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("sensor 'imu' at 1e+12 Hz is faster than the physics rate (200 Hz)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(CsvRows(out / "imu" / "imu.csv"), 21);  // steps 0 .. 20
+  EXPECT_EQ(CsvRows(out / "ground_truth" / "gt.csv"), 21);
 }
 
 TEST_F(RunOutputsTest, DivergenceRecordsTheSimTimeReached) {

@@ -18,15 +18,27 @@ namespace fs = std::filesystem;
 
 // the files of an earlier run, as `penumbra run` writes them
 void WriteEarlierRun(const testing::TempDir& dir) {
-  for (const char* f :
-       {"out/run.json", "out/composed.xml", "out/trajectory.csv", "out/camera_info.yaml",
-        "out/camera_info.json", "out/semantic_classes.json", "out/cam/frames.csv",
-        "out/cam/intrinsics.json", "out/cam/rgb/000000.png", "out/cam/depth/000000.png",
-        "out/cam/segmentation/000000.png", "out/cam/normals/000001.png",
-        "out/scene/overhead/rgb/000002.png", "out/scene/overhead/frames.csv",
-        "out/lidar/top/index.csv", "out/lidar/top/scan_000003.pcd", "out/imu/imu.csv",
-        "out/sensors/joints.csv", "out/ground_truth/gt.csv", "out/ground_truth/gt_contacts.csv",
-        "out/cam/rgb/.000001.png.tmp-42-7"})
+  for (const char* f : {"out/run.json",
+                        "out/composed.xml",
+                        "out/trajectory.csv",
+                        "out/camera_info.yaml",
+                        "out/camera_info.json",
+                        "out/semantic_classes.json",
+                        "out/cam/frames.csv",
+                        "out/cam/intrinsics.json",
+                        "out/cam/rgb/000000.png",
+                        "out/cam/depth/000000.png",
+                        "out/cam/segmentation/000000.png",
+                        "out/cam/normals/000001.png",
+                        "out/scene/overhead/rgb/000002.png",
+                        "out/scene/overhead/frames.csv",
+                        "out/lidar/top/index.csv",
+                        "out/lidar/top/scan_000003.pcd",
+                        "out/imu/imu.csv",
+                        "out/sensors/joints.csv",
+                        "out/ground_truth/gt.csv",
+                        "out/ground_truth/gt_contacts.csv",
+                        "out/cam/rgb/.000001.png.tmp-42-7"})
     dir.Write(f, "x");
 }
 

@@ -1,9 +1,9 @@
 #include "penumbra/app/cli.h"
 
 #include <fmt/format.h>
+#include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <signal.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -17,9 +17,9 @@
 
 #include "penumbra/app/bench.h"
 #include "penumbra/app/contact_sheet.h"
-#include "penumbra/app/vdb_tool.h"
-#include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/runner.h"
+#include "penumbra/app/sensor_bench.h"
+#include "penumbra/app/vdb_tool.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
@@ -77,8 +77,7 @@ std::optional<double> ParseDecimal(std::string_view s) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
   double v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v))
-    return std::nullopt;
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
   return v;
 }
 
@@ -125,8 +124,7 @@ CLI::Option* AddUint64(CLI::App* app, const std::string& name, std::optional<uin
             if (!s.empty() && s.front() == '-')
               return "'" + s + "' is negative; expected an integer in [0, 2^64 - 1]";
             if (!ParseUnsigned(s))
-              return "'" + s +
-                     "' is not a decimal integer in [0, 2^64 - 1] (18446744073709551615)";
+              return "'" + s + "' is not a decimal integer in [0, 2^64 - 1] (18446744073709551615)";
             return "";
           },
           "UINT64", ""));
@@ -144,7 +142,8 @@ CLI::Option* AddDecimal(CLI::App* app, const std::string& name, std::function<vo
           [lo, lo_open, range](std::string& s) -> std::string {
             const std::optional<double> v = ParseDecimal(s);
             if (!v) return "'" + s + "' is not " + range;
-            if (lo_open ? !(*v > lo) : !(*v >= lo)) return "'" + s + "' is out of range; expected " + range;
+            if (lo_open ? !(*v > lo) : !(*v >= lo))
+              return "'" + s + "' is out of range; expected " + range;
             return "";
           },
           range, ""));
@@ -187,8 +186,8 @@ class StopSignals {
 
 // errors and logs go to stderr; stdout carries only what was asked for (--help, --version)
 void LogToStderr() {
-  auto logger = std::make_shared<spdlog::logger>(
-      "", std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
+  auto logger =
+      std::make_shared<spdlog::logger>("", std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
   spdlog::set_default_logger(std::move(logger));
 }
 
@@ -212,8 +211,9 @@ int RunCli(int argc, char** argv) {
   std::string outputs;
   run->add_option("world", world_path, "world file (.yaml) or model (.xml MJCF, .urdf)")->required();
   run->add_option("--out,-o", run_options.out_dir, "output folder (default: the world's output.dir)");
-  AddDecimal(run, "--duration", [&](double v) { duration = v; }, 0, true,
-             "simulated seconds (overrides duration_sec)");
+  AddDecimal(
+      run, "--duration", [&](double v) { duration = v; }, 0, true,
+      "simulated seconds (overrides duration_sec)");
   run->add_flag("--realtime", run_options.realtime, "pace physics to wall-clock time");
   run->add_option("--tier", tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
   AddInteger(run, "--spp", &spp, 1, 65536, "samples per pixel (pathtraced)");
@@ -236,8 +236,10 @@ int RunCli(int argc, char** argv) {
   CLI::App* bench_render = bench->add_subcommand("render", "frames/s and Mrays/s at 640x480 and 800x800");
   RenderBenchOptions render_bench;
   bench_render->add_option("--world", render_bench.world_file, "world file (default: bundled default world)");
-  AddInteger(bench_render, "--frames", &render_bench.frames, 1, 100000, "timed frames per resolution");
-  AddInteger(bench_render, "--threads", &render_bench.threads, 0, 256, "render threads (0 = all cores)");
+  AddInteger(bench_render, "--frames", &render_bench.frames, 1, 100000,
+             "timed frames per resolution");
+  AddInteger(bench_render, "--threads", &render_bench.threads, 0, 256,
+             "render threads (0 = all cores)");
   bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
@@ -246,8 +248,9 @@ int RunCli(int argc, char** argv) {
   ContactSheetOptions sheet_options;
   sheet->add_option("--world", sheet_options.world_file, "world file (default: bundled default world)");
   sheet->add_option("--presets", sheet_options.presets, "presets, left to right")->delimiter(',');
-  AddDecimal(sheet, "--time", [&](double v) { sheet_options.time_sec = v; }, 0, false,
-             "sim time of the frames, s");
+  AddDecimal(
+      sheet, "--time", [&](double v) { sheet_options.time_sec = v; }, 0, false,
+      "sim time of the frames, s");
   AddInteger(sheet, "--width", &sheet_options.width, 16, 4096, "frame width");
   AddInteger(sheet, "--height", &sheet_options.height, 16, 4096, "frame height");
   sheet->add_option("--out,-o", sheet_options.out, "output PNG (default docs/effects.png)");
@@ -258,23 +261,29 @@ int RunCli(int argc, char** argv) {
   std::optional<uint64_t> vdb_seed;
   make_vdb->add_option("file", vdb_path, "output .vdb file")->required();
   AddUint64(make_vdb, "--seed", &vdb_seed, "blob layout seed");
-  AddDecimal(make_vdb, "--voxel", [&](double v) { vdb_options.voxel_m = v; }, 0, true, "voxel size, m");
-  AddDecimal(make_vdb, "--radius", [&](double v) { vdb_options.radius_m = v; }, 0, true, "cloud radius, m");
+  AddDecimal(
+      make_vdb, "--voxel", [&](double v) { vdb_options.voxel_m = v; }, 0, true, "voxel size, m");
+  AddDecimal(
+      make_vdb, "--radius", [&](double v) { vdb_options.radius_m = v; }, 0, true,
+      "cloud radius, m");
   AddInteger(make_vdb, "--blobs", &vdb_options.blobs, 1, 64, "Gaussian puffs");
   CLI::App* bench_physics = bench->add_subcommand("physics", "Penumbra physics steps/s vs a bare mj_step loop");
   PhysicsBenchOptions physics_bench;
   bench_physics->add_option("--world", physics_bench.world_file, "world file (default: bundled default world)");
   bench_physics->add_option("--model", physics_bench.model_file, "bare MJCF model instead of a world");
-  AddDecimal(bench_physics, "--seconds", [&](double v) { physics_bench.sim_seconds = v; }, 0, true,
-             "simulated seconds per side");
+  AddDecimal(
+      bench_physics, "--seconds", [&](double v) { physics_bench.sim_seconds = v; }, 0, true,
+      "simulated seconds per side");
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
-  AddInteger(bench_sensors, "--scans", &sensor_bench.scans, 1, 100000, "timed scans per LiDAR preset");
-  AddDecimal(bench_sensors, "--seconds", [&](double v) { sensor_bench.seconds = v; }, 0, true,
-             "simulated seconds for the sensor overhead");
+  AddInteger(bench_sensors, "--scans", &sensor_bench.scans, 1, 100000,
+             "timed scans per LiDAR preset");
+  AddDecimal(
+      bench_sensors, "--seconds", [&](double v) { sensor_bench.seconds = v; }, 0, true,
+      "simulated seconds for the sensor overhead");
 
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
@@ -297,7 +306,8 @@ int RunCli(int argc, char** argv) {
       if (threads >= 0) world.render.threads = threads;
       run_options.progress = !quiet;
       run_options.command_line = Args(argc, argv);
-      if (!outputs.empty() || run->count("--outputs")) run_options.outputs = ParseCameraOutputs(outputs);
+      if (!outputs.empty() || run->count("--outputs"))
+        run_options.outputs = ParseCameraOutputs(outputs);
       g_stop_signal.store(0);
       run_options.stop_request = &g_stop_signal;
       const StopSignals stop_signals;

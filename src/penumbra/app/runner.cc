@@ -57,9 +57,10 @@ class CameraSchedule {
     for (const CameraSpec& c : cameras) {
       const int id = schedule_.Add(c.name, c.rate_hz);
       if (schedule_.exceeds_physics_rate(id))
-        spdlog::warn("camera '{}': rate_hz {:.6g} is faster than the physics rate ({:.6g} Hz); "
-                     "it renders one frame per physics step",
-                     c.name, c.rate_hz, schedule_.physics_rate_hz());
+        spdlog::warn(
+            "camera '{}': rate_hz {:.6g} is faster than the physics rate ({:.6g} Hz); "
+            "it renders one frame per physics step",
+            c.name, c.rate_hz, schedule_.physics_rate_hz());
     }
   }
 
@@ -124,8 +125,12 @@ std::string What(std::exception_ptr e) {
 }  // namespace
 
 CameraOutputs ParseCameraOutputs(const std::string& list) {
-  static const std::vector<std::string> kValid = {"rgb",    "depth",   "segmentation",
-                                                  "range",  "normals", "instance_segmentation",
+  static const std::vector<std::string> kValid = {"rgb",
+                                                  "depth",
+                                                  "segmentation",
+                                                  "range",
+                                                  "normals",
+                                                  "instance_segmentation",
                                                   "semantic_segmentation"};
   std::string valid;
   for (const std::string& v : kValid) valid += (valid.empty() ? "" : ", ") + v;
@@ -145,8 +150,9 @@ CameraOutputs ParseCameraOutputs(const std::string& list) {
                  : name == "semantic_segmentation" ? &o.semantic_segmentation
                                                    : nullptr;
     if (!flag)
-      throw ConfigError("", 0, "--outputs",
-                        "unknown output '" + name + "'; expected a comma-separated list of: " + valid);
+      throw ConfigError(
+          "", 0, "--outputs",
+          "unknown output '" + name + "'; expected a comma-separated list of: " + valid);
     if (*flag) throw ConfigError("", 0, "--outputs", "'" + name + "' is listed twice");
     *flag = true;
     ++count;

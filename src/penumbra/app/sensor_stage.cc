@@ -156,8 +156,9 @@ struct SensorStage::Impl {
     const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
     WritePcd((l.dir / file).string(), scan.points);
     l.index.Append(fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
-                           l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec, file,
-                           scan.points.size(), scan.medium_returns, scan.particle_returns));
+                               l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec,
+                               file, scan.points.size(), scan.medium_returns,
+                               scan.particle_returns));
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -182,9 +183,10 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
     double rate = c.rate_hz.value_or(c.type == "imu" ? 200.0 : 100.0);
     // a rate above the physics rate fires once per step (sensors/sensor_schedule.h)
     if (rate > physics_rate && c.type != "lidar") {
-      spdlog::warn("{}:{}: {}.rate_hz: sensor '{}' at {:.6g} Hz is faster than the physics "
-                   "rate ({:.6g} Hz); it records one sample per physics step",
-                   c.file, c.line, c.key, c.name, rate, physics_rate);
+      spdlog::warn(
+          "{}:{}: {}.rate_hz: sensor '{}' at {:.6g} Hz is faster than the physics "
+          "rate ({:.6g} Hz); it records one sample per physics step",
+          c.file, c.line, c.key, c.name, rate, physics_rate);
       rate = physics_rate;
     }
     if (c.type == "lidar") {

@@ -68,8 +68,8 @@ void CreateOutputFolder(const fs::path& root, const fs::path& rel) {
   fs::path p = root;
   for (const fs::path& part : rel) {
     if (part.empty() || part == "." || part == "..")
-      throw Error("output folder '" + (root / rel).string() + "': bad component '" +
-                  part.string() + "'");
+      throw Error("output folder '" + (root / rel).string() + "': bad component '" + part.string() +
+                  "'");
     p /= part;
     if (::mkdir(p.c_str(), 0755) == 0) continue;
     const int err = errno;
@@ -89,8 +89,8 @@ LineFile::LineFile(fs::path path, size_t buffer_bytes)
   fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     const int err = errno;
-    throw Error("cannot write '" + path_.string() + "': " +
-                (err == ELOOP ? std::string("it is a symbolic link") : Reason(err)));
+    throw Error("cannot write '" + path_.string() +
+                "': " + (err == ELOOP ? std::string("it is a symbolic link") : Reason(err)));
   }
 }
 

@@ -14,7 +14,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 template <typename T>
 void CheckFrameImage(const Image<T>& image, int channels, const CameraIntrinsics& intr,
                      const std::string& camera, int64_t index, const char* what) {

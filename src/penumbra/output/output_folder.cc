@@ -27,7 +27,8 @@ const std::set<std::string> kImageFolders = {"rgb",
                                              "semantic_segmentation"};
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 // NNNNNN.png: at least 6 digits
@@ -108,7 +109,7 @@ class Scanner {
       } else if (fs::is_regular_file(st)) {
         if (!kTopFiles.count(name) && !IsTemporaryOutputName(name)) Foreign(p, "");
       } else if (fs::is_directory(st)) {
-        Folder(p, name == "lidar"                ? Kind::kLidarFolder
+        Folder(p, name == "lidar"              ? Kind::kLidarFolder
                   : kSensorFolders.count(name) ? Kind::kSensorFolder
                                                : Kind::kCameraFolder);
       } else {

@@ -141,7 +141,8 @@ std::vector<uint8_t> Encode(png_uint_32 width, png_uint_32 height, int color_typ
 
 // whole file under a temporary name, then renamed into place (core/output_file.h)
 void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  WriteFileAtomic(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  WriteFileAtomic(path,
+                  std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 // plain-data state of the setjmp-guarded decoder.

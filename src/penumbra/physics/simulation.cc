@@ -3,10 +3,10 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include "penumbra/core/error.h"
 #include "penumbra/physics/mujoco_runtime.h"

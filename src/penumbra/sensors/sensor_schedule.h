@@ -54,7 +54,9 @@ class SensorSchedule {
   /// the rate it fires at: min(rate_hz, physics rate).
   double effective_rate_hz(int id) const;
   /// true if rate_hz is above the physics rate (it fires every step instead).
-  bool exceeds_physics_rate(int id) const { return entries_.at(id).every_step && entries_.at(id).above; }
+  bool exceeds_physics_rate(int id) const {
+    return entries_.at(id).every_step && entries_.at(id).above;
+  }
   double latency_sec(int id) const { return entries_.at(id).latency_sec; }
   /// samples skipped (several falling inside one step; only possible through rounding).
   int64_t skipped(int id) const { return entries_.at(id).skipped; }
