@@ -142,6 +142,7 @@ TEST_F(SensorRunTest, MissingBodyOrSiteNamesTheSensorAndKey) {
     RunOptions opt;
     opt.out_dir = (dir_ / "out").string();
     opt.progress = false;
+    opt.force = true;  // each failed attempt leaves composed.xml behind
     try {
       RunWorld(world, opt);
       ADD_FAILURE() << "no error for " << key;

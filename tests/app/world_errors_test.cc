@@ -43,7 +43,9 @@ class WorldErrorsTest : public ::testing::Test {
     options.progress = false;
     try {
       WorldConfig w = LoadWorldFile(world);
-      if (w.output_dir == "out") options.out_dir = (dir_.path() / "out").string();
+      // a fresh folder per run (a failed run may leave composed.xml behind)
+      if (w.output_dir == "out")
+        options.out_dir = (dir_.path() / ("out" + std::to_string(runs_++))).string();
       RunWorld(w, options);
     } catch (const ConfigError& e) {
       return e;
@@ -64,6 +66,7 @@ class WorldErrorsTest : public ::testing::Test {
   }
 
   testing::TempDir dir_;
+  int runs_ = 0;
 };
 
 TEST_F(WorldErrorsTest, UnknownLightOfALightEvent) {
@@ -91,7 +94,7 @@ TEST_F(WorldErrorsTest, UnknownMaterialAndMjcfCamera) {
 }
 
 TEST_F(WorldErrorsTest, OutputFolderThatCannotBeMade) {
-  ExpectPlaced("output:\n  dir: /dev/null/x\n", 5, "output.dir", "cannot create folder");
+  ExpectPlaced("output:\n  dir: /dev/null/x\n", 5, "output.dir", "cannot be created");
 }
 
 TEST_F(WorldErrorsTest, EmptyWorldRuns) {

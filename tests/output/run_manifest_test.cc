@@ -53,11 +53,10 @@ TEST(RunManifest, KeyOrderIsStable) {
   const auto j = nlohmann::ordered_json::parse(text);
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  const std::vector<std::string> expected = {"world_file",       "seed",
-                                             "penumbra_version", "mujoco_version",
-                                             "embree_version",   "command_line",
-                                             "sim_duration_sec", "frames_per_camera",
-                                             "timings_sec",      "peak_resident_memory_mib"};
+  const std::vector<std::string> expected = {
+      "world_file",        "seed",         "penumbra_version",        "mujoco_version",
+      "embree_version",    "command_line", "sim_duration_sec",        "interrupted",
+      "frames_per_camera", "timings_sec",  "peak_resident_memory_mib"};
   EXPECT_EQ(keys, expected);
   // maps are sorted by name whatever the insertion order
   std::vector<std::string> timing_keys;

@@ -248,8 +248,58 @@ TEST(Simulation, DivergenceThrowsWithTimeAndBody) {
   std::snprintf(expected_time, sizeof(expected_time), "t = %.6g s (step %d)", steps * 0.01,
                 steps + 1);
   EXPECT_NE(msg.find(expected_time), std::string::npos) << msg << " vs " << expected_time;
+  // time and step count stay at the last completed step (MuJoCo's reset set time to 0)
+  EXPECT_EQ(sim.step_count(), steps);
+  EXPECT_EQ(sim.time(), SimTimeOfStep(steps, 0.01));
   // the state was reset by MuJoCo: no silent continuation
   EXPECT_THROW(sim.Step(), PhysicsError);
+}
+
+TEST(SimTimeOfStep, IsTheSmallestDoubleAtOrAboveTheExactStepTime) {
+  for (double dt : {0.002, 0.005, 0.001, 0.01, 0.1, 0.003, 1.0 / 60.0, 0.0015}) {
+    const double rate = PhysicsRateHz(dt);
+    const bool integer_rate = rate == std::nearbyint(rate);
+    for (int64_t n = 0; n <= 200000; n += (n < 2000 ? 1 : 97)) {
+      const double t = SimTimeOfStep(n, dt);
+      const double nd = static_cast<double>(n);
+      // exact comparisons of t against n / R (or n dt) through fma
+      if (integer_rate) {
+        ASSERT_GE(std::fma(t, rate, -nd), 0) << dt << " " << n;
+        if (n > 0) ASSERT_LT(std::fma(std::nextafter(t, 0.0), rate, -nd), 0) << dt << " " << n;
+      } else {
+        ASSERT_GE(std::fma(-nd, dt, t), 0) << dt << " " << n;
+        if (n > 0) ASSERT_LT(std::fma(-nd, dt, std::nextafter(t, 0.0)), 0) << dt << " " << n;
+      }
+    }
+  }
+  EXPECT_EQ(PhysicsRateHz(0.002), 500.0);
+  EXPECT_EQ(SimTimeOfStep(0, 0.002), 0.0);
+  EXPECT_EQ(SimTimeOfStep(-3, 0.002), 0.0);
+}
+
+TEST(Simulation, TimeComesFromTheStepCount) {
+  const char* xml = R"(
+<mujoco>
+  <option timestep="0.002"/>
+  <worldbody>
+    <body pos="0 0 1"><freejoint/><geom type="sphere" size="0.1"/></body>
+  </worldbody>
+</mujoco>)";
+  Simulation sim = Simulation::LoadFromString(xml);
+  double controller_time = -1;
+  sim.AddController(std::make_unique<LambdaController>(
+      0, std::vector<NameRequirement>{},
+      [&](const ControlInput& in, std::span<double>) { controller_time = in.time_sec(); }));
+  for (int n = 1; n <= 5000; ++n) {
+    const double before = sim.time();
+    sim.Step();
+    ASSERT_EQ(controller_time, before);  // controllers see the same time
+    ASSERT_EQ(sim.time(), SimTimeOfStep(n, 0.002)) << n;
+    // a 10 Hz frame every 50 steps: floor(t * 10) is the frame index (summed time gave
+    // 3.999999999999781 at step 2000)
+    if (n % 50 == 0) ASSERT_EQ(static_cast<int64_t>(std::floor(sim.time() * 10)), n / 50) << n;
+  }
+  EXPECT_EQ(sim.Snapshot().time_sec, SimTimeOfStep(5000, 0.002));
 }
 
 TEST(Simulation, HugeGearDivergenceNamesBody) {

@@ -10,6 +10,7 @@
 #include "penumbra/app/camera_specs.h"
 #include "penumbra/app/scene_assembly.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/camera_info.h"
 #include "penumbra/output/camera_writer.h"
 #include "penumbra/output/png_io.h"
@@ -64,15 +65,11 @@ CameraStage::CameraStage(const SceneDescription& scene, const WorldConfig& world
     imagers_.emplace_back(scene.cameras[i], cfg[i], world.render, static_cast<int>(i), scene);
     span_.push_back(CaptureSpanSec(scene.cameras[i], cfg[i]));
     const CameraOutputs& o = scene.cameras[i].outputs;
-    namespace fs = std::filesystem;
-    const fs::path folder = fs::path(output_dir) / CameraFolder(scene.cameras[i].name);
-    std::error_code ec;
+    const std::filesystem::path folder = CameraFolder(scene.cameras[i].name);
     for (auto [want, name] : {std::pair{o.range, "range"}, std::pair{o.normals, "normals"},
                               std::pair{o.instance_segmentation, "instance_segmentation"},
                               std::pair{o.semantic_segmentation, "semantic_segmentation"}}) {
-      if (!want) continue;
-      fs::create_directories(folder / name, ec);
-      if (ec) throw Error("cannot create '" + (folder / name).string() + "': " + ec.message());
+      if (want) CreateOutputFolder(output_dir, folder / name);
     }
   }
   WriteCameraInfo(output_dir, CameraInfosFor(scene.cameras));
@@ -80,11 +77,8 @@ CameraStage::CameraStage(const SceneDescription& scene, const WorldConfig& world
     // the labels of the semantic_segmentation ids, in file order
     nlohmann::ordered_json classes = nlohmann::ordered_json::object();
     for (const SemanticClassConfig& c : world.semantic_classes) classes[c.name] = c.id;
-    const std::filesystem::path path = std::filesystem::path(output_dir) / "semantic_classes.json";
-    std::ofstream f(path, std::ios::trunc);
-    f << classes.dump(2) << "\n";
-    f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "'");
+    WriteFileAtomic(std::filesystem::path(output_dir) / "semantic_classes.json",
+                    classes.dump(2) + "\n");
   }
 }
 

@@ -1,16 +1,25 @@
 #include "penumbra/app/cli.h"
 
+#include <fmt/format.h>
+#include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
+#include <charconv>
+#include <cmath>
 #include <filesystem>
+#include <iostream>
+#include <limits>
+#include <optional>
 
 #include "penumbra/app/bench.h"
 #include "penumbra/app/contact_sheet.h"
-#include "penumbra/app/vdb_tool.h"
-#include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/runner.h"
+#include "penumbra/app/sensor_bench.h"
+#include "penumbra/app/vdb_tool.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
@@ -31,9 +40,161 @@ WorldConfig LoadWorldOrModel(const std::string& path) {
 
 std::vector<std::string> Args(int argc, char** argv) { return std::vector<std::string>(argv, argv + argc); }
 
+// strict command-line numbers: plain decimal only. CLI11's own conversion accepts hex
+// (0x10), octal and binary prefixes and nan/inf, and clamps out-of-range integers.
+
+// an unsigned decimal integer: digits only (a leading '+' is allowed)
+std::optional<uint64_t> ParseUnsigned(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty()) return std::nullopt;
+  for (char c : s)
+    if (c < '0' || c > '9') return std::nullopt;
+  uint64_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// a finite decimal number: [+-]digits[.digits][(e|E)[+-]digits], at least one digit
+std::optional<double> ParseDecimal(std::string_view s) {
+  std::string_view body = s;
+  if (!body.empty() && (body.front() == '+' || body.front() == '-')) body.remove_prefix(1);
+  size_t i = 0, digits = 0;
+  while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i, ++digits;
+  if (i < body.size() && body[i] == '.') {
+    ++i;
+    while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i, ++digits;
+  }
+  if (digits == 0) return std::nullopt;
+  if (i < body.size() && (body[i] == 'e' || body[i] == 'E')) {
+    ++i;
+    if (i < body.size() && (body[i] == '+' || body[i] == '-')) ++i;
+    const size_t exp_start = i;
+    while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i;
+    if (i == exp_start) return std::nullopt;
+  }
+  if (i != body.size()) return std::nullopt;
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+// a decimal integer that fits int64: [+-]digits
+std::optional<int64_t> ParseInteger(std::string_view s) {
+  std::string_view digits = s;
+  if (!digits.empty() && (digits.front() == '+' || digits.front() == '-')) digits.remove_prefix(1);
+  if (!ParseUnsigned(digits) || digits.front() == '+') return std::nullopt;
+  if (s.front() == '+') s.remove_prefix(1);
+  int64_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// integer option in [lo, hi]
+template <typename T>
+CLI::Option* AddInteger(CLI::App* app, const std::string& name, T* target, int64_t lo, int64_t hi,
+                        const std::string& help) {
+  const std::string range = fmt::format("an integer in [{}, {}]", lo, hi);
+  return app
+      ->add_option_function<std::string>(
+          name, [target](const std::string& s) { *target = static_cast<T>(*ParseInteger(s)); },
+          help)
+      ->type_name("INT")
+      ->check(CLI::Validator(
+          [lo, hi, range](std::string& s) -> std::string {
+            const std::optional<int64_t> v = ParseInteger(s);
+            if (!v || *v < lo || *v > hi) return "'" + s + "' is not " + range;
+            return "";
+          },
+          range, ""));
+}
+
+// any uint64 (seeds): 0 .. 18446744073709551615, recorded exactly
+CLI::Option* AddUint64(CLI::App* app, const std::string& name, std::optional<uint64_t>* target,
+                       const std::string& help) {
+  return app
+      ->add_option_function<std::string>(
+          name, [target](const std::string& s) { *target = *ParseUnsigned(s); }, help)
+      ->type_name("UINT64")
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            if (!s.empty() && s.front() == '-')
+              return "'" + s + "' is negative; expected an integer in [0, 2^64 - 1]";
+            if (!ParseUnsigned(s))
+              return "'" + s + "' is not a decimal integer in [0, 2^64 - 1] (18446744073709551615)";
+            return "";
+          },
+          "UINT64", ""));
+}
+
+// decimal number option: > lo (lo_open) or >= lo
+CLI::Option* AddDecimal(CLI::App* app, const std::string& name, std::function<void(double)> set,
+                        double lo, bool lo_open, const std::string& help) {
+  const std::string range = fmt::format("a finite decimal number {} {}", lo_open ? ">" : ">=", lo);
+  return app
+      ->add_option_function<std::string>(
+          name, [set](const std::string& s) { set(*ParseDecimal(s)); }, help)
+      ->type_name("NUM")
+      ->check(CLI::Validator(
+          [lo, lo_open, range](std::string& s) -> std::string {
+            const std::optional<double> v = ParseDecimal(s);
+            if (!v) return "'" + s + "' is not " + range;
+            if (lo_open ? !(*v > lo) : !(*v >= lo))
+              return "'" + s + "' is out of range; expected " + range;
+            return "";
+          },
+          range, ""));
+}
+
+// SIGINT / SIGTERM during `penumbra run`: the first asks the run to stop at the next physics
+// step boundary (RunOptions::stop_request), the second exits at once. async-signal-safe:
+// a lock-free atomic, write(2) and _exit(2) only.
+std::atomic<int> g_stop_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free);
+
+extern "C" void OnStopSignal(int sig) {
+  int expected = 0;
+  if (!g_stop_signal.compare_exchange_strong(expected, sig)) _exit(128 + sig);
+  static const char kMsg[] =
+      "\npenumbra: stopping at the next physics step and writing the outputs "
+      "(signal again to exit at once)\n";
+  const ssize_t ignored = write(STDERR_FILENO, kMsg, sizeof(kMsg) - 1);
+  (void)ignored;
+}
+
+// installs OnStopSignal for SIGINT and SIGTERM while it lives
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction sa = {};
+    sa.sa_handler = OnStopSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+
+ private:
+  struct sigaction old_int_ = {}, old_term_ = {};
+};
+
+// errors and logs go to stderr; stdout carries only what was asked for (--help, --version)
+void LogToStderr() {
+  auto logger =
+      std::make_shared<spdlog::logger>("", std::make_shared<spdlog::sinks::stderr_color_sink_mt>());
+  spdlog::set_default_logger(std::move(logger));
+}
+
 }  // namespace
 
 int RunCli(int argc, char** argv) {
+  LogToStderr();
   CLI::App app{"penumbra: robotics simulator with MuJoCo physics and a physically based ray tracer"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(PENUMBRA_VERSION));
@@ -42,20 +203,29 @@ int RunCli(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "simulate a world file or a bare MJCF/URDF model and write outputs");
   std::string world_path;
   RunOptions run_options;
-  double duration = -1;
+  std::optional<double> duration;
   std::string tier;
   int spp = 0, threads = -1;
-  int64_t seed = -1;
+  std::optional<uint64_t> seed;
   bool quiet = false;
+  std::string outputs;
   run->add_option("world", world_path, "world file (.yaml) or model (.xml MJCF, .urdf)")->required();
   run->add_option("--out,-o", run_options.out_dir, "output folder (default: the world's output.dir)");
-  run->add_option("--duration", duration, "simulated seconds (overrides duration_sec)")->check(CLI::PositiveNumber);
+  AddDecimal(
+      run, "--duration", [&](double v) { duration = v; }, 0, true,
+      "simulated seconds (overrides duration_sec)");
   run->add_flag("--realtime", run_options.realtime, "pace physics to wall-clock time");
   run->add_option("--tier", tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
-  run->add_option("--spp", spp, "samples per pixel (pathtraced)")->check(CLI::Range(1, 65536));
-  run->add_option("--threads", threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
-  run->add_option("--seed", seed, "world seed (overrides seed)")->check(CLI::NonNegativeNumber);
+  AddInteger(run, "--spp", &spp, 1, 65536, "samples per pixel (pathtraced)");
+  AddInteger(run, "--threads", &threads, 0, 256, "render threads (0 = all cores)");
+  AddUint64(run, "--seed", &seed, "world seed (overrides seed)");
   run->add_flag("--quiet,-q", quiet, "no progress output");
+  run->add_flag("--force", run_options.force,
+                "the output folder may hold an earlier run's outputs: remove them first "
+                "(anything else there is refused)");
+  run->add_option("--outputs", outputs,
+                  "images of every camera, comma-separated: rgb, depth, segmentation, range, "
+                  "normals, instance_segmentation, semantic_segmentation (overrides the world)");
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -66,8 +236,10 @@ int RunCli(int argc, char** argv) {
   CLI::App* bench_render = bench->add_subcommand("render", "frames/s and Mrays/s at 640x480 and 800x800");
   RenderBenchOptions render_bench;
   bench_render->add_option("--world", render_bench.world_file, "world file (default: bundled default world)");
-  bench_render->add_option("--frames", render_bench.frames, "timed frames per resolution")->check(CLI::Range(1, 100000));
-  bench_render->add_option("--threads", render_bench.threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
+  AddInteger(bench_render, "--frames", &render_bench.frames, 1, 100000,
+             "timed frames per resolution");
+  AddInteger(bench_render, "--threads", &render_bench.threads, 0, 256,
+             "render threads (0 = all cores)");
   bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
@@ -76,50 +248,80 @@ int RunCli(int argc, char** argv) {
   ContactSheetOptions sheet_options;
   sheet->add_option("--world", sheet_options.world_file, "world file (default: bundled default world)");
   sheet->add_option("--presets", sheet_options.presets, "presets, left to right")->delimiter(',');
-  sheet->add_option("--time", sheet_options.time_sec, "sim time of the frames, s")->check(CLI::NonNegativeNumber);
-  sheet->add_option("--width", sheet_options.width, "frame width")->check(CLI::Range(16, 4096));
-  sheet->add_option("--height", sheet_options.height, "frame height")->check(CLI::Range(16, 4096));
+  AddDecimal(
+      sheet, "--time", [&](double v) { sheet_options.time_sec = v; }, 0, false,
+      "sim time of the frames, s");
+  AddInteger(sheet, "--width", &sheet_options.width, 16, 4096, "frame width");
+  AddInteger(sheet, "--height", &sheet_options.height, 16, 4096, "frame height");
   sheet->add_option("--out,-o", sheet_options.out, "output PNG (default docs/effects.png)");
-  sheet->add_option("--threads", sheet_options.threads, "render threads (0 = all cores)")->check(CLI::Range(0, 256));
+  AddInteger(sheet, "--threads", &sheet_options.threads, 0, 256, "render threads (0 = all cores)");
   CLI::App* make_vdb = app.add_subcommand("make-vdb", "write a procedural smoke cloud as an OpenVDB file (float grid 'density')");
   std::string vdb_path;
   SmokeVdbOptions vdb_options;
+  std::optional<uint64_t> vdb_seed;
   make_vdb->add_option("file", vdb_path, "output .vdb file")->required();
-  make_vdb->add_option("--seed", vdb_options.seed, "blob layout seed");
-  make_vdb->add_option("--voxel", vdb_options.voxel_m, "voxel size, m");
-  make_vdb->add_option("--radius", vdb_options.radius_m, "cloud radius, m");
-  make_vdb->add_option("--blobs", vdb_options.blobs, "Gaussian puffs");
+  AddUint64(make_vdb, "--seed", &vdb_seed, "blob layout seed");
+  AddDecimal(
+      make_vdb, "--voxel", [&](double v) { vdb_options.voxel_m = v; }, 0, true, "voxel size, m");
+  AddDecimal(
+      make_vdb, "--radius", [&](double v) { vdb_options.radius_m = v; }, 0, true,
+      "cloud radius, m");
+  AddInteger(make_vdb, "--blobs", &vdb_options.blobs, 1, 64, "Gaussian puffs");
   CLI::App* bench_physics = bench->add_subcommand("physics", "Penumbra physics steps/s vs a bare mj_step loop");
   PhysicsBenchOptions physics_bench;
   bench_physics->add_option("--world", physics_bench.world_file, "world file (default: bundled default world)");
   bench_physics->add_option("--model", physics_bench.model_file, "bare MJCF model instead of a world");
-  bench_physics->add_option("--seconds", physics_bench.sim_seconds, "simulated seconds per side")->check(CLI::PositiveNumber);
+  AddDecimal(
+      bench_physics, "--seconds", [&](double v) { physics_bench.sim_seconds = v; }, 0, true,
+      "simulated seconds per side");
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
-  bench_sensors->add_option("--scans", sensor_bench.scans, "timed scans per LiDAR preset")->check(CLI::Range(1, 100000));
-  bench_sensors->add_option("--seconds", sensor_bench.seconds, "simulated seconds for the sensor overhead")->check(CLI::PositiveNumber);
+  AddInteger(bench_sensors, "--scans", &sensor_bench.scans, 1, 100000,
+             "timed scans per LiDAR preset");
+  AddDecimal(
+      bench_sensors, "--seconds", [&](double v) { sensor_bench.seconds = v; }, 0, true,
+      "simulated seconds for the sensor overhead");
 
-  CLI11_PARSE(app, argc, argv);
+  // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
+  // and exit 0
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e, std::cout, std::cerr);
+    return code == 0 ? 0 : 2;
+  }
+  if (vdb_seed) vdb_options.seed = *vdb_seed;
 
   try {
     if (*run) {
       WorldConfig world = LoadWorldOrModel(world_path);
-      if (duration > 0) run_options.duration_sec = duration;
-      if (seed >= 0) world.seed = static_cast<uint64_t>(seed);
+      if (duration) run_options.duration_sec = *duration;
+      if (seed) world.seed = *seed;
       if (!tier.empty())
         world.render.tier = tier == "pathtraced" ? RenderSettings::Tier::kPathtraced : RenderSettings::Tier::kRealtime;
       if (spp > 0) world.render.samples_per_pixel = spp;
       if (threads >= 0) world.render.threads = threads;
       run_options.progress = !quiet;
       run_options.command_line = Args(argc, argv);
+      if (!outputs.empty() || run->count("--outputs"))
+        run_options.outputs = ParseCameraOutputs(outputs);
+      g_stop_signal.store(0);
+      run_options.stop_request = &g_stop_signal;
+      const StopSignals stop_signals;
       const RunSummary s = RunWorld(world, run_options);
       int64_t frames = 0;
       for (const auto& [name, n] : s.frames_per_camera) frames += n;
       spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
+      if (s.interrupted) {
+        const int sig = g_stop_signal.load();
+        spdlog::warn("interrupted by {} at {:.6g} s of sim time; outputs and run.json written",
+                     sig == SIGTERM ? "SIGTERM" : "SIGINT", s.sim_time_sec);
+        return 128 + sig;
+      }
       return 0;
     }
     if (*bench_render) {

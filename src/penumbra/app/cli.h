@@ -3,8 +3,12 @@
 
 namespace penumbra {
 
-/// parses argv and runs the verb; returns the process exit code
-/// (0 ok, 1 runtime failure, 2 bad input). never throws.
+/// parses argv and runs the verb; returns the process exit code: 0 ok (also --help and
+/// --version, printed on stdout), 1 runtime failure, 2 bad input or usage (every CLI11 parse
+/// error; message on stderr), 128 + signal (130 SIGINT, 143 SIGTERM) for a `run` stopped by
+/// a signal after writing its outputs. logs and errors go to stderr. during `run`, SIGINT and
+/// SIGTERM handlers are installed (the first stops at the next physics step, a second exits
+/// at once). never throws.
 int RunCli(int argc, char** argv);
 
 }  // namespace penumbra

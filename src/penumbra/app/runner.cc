@@ -6,7 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <mutex>
 #include <thread>
 
 #include "penumbra/app/camera_stage.h"
@@ -19,13 +19,16 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/bounded_queue.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/async_frame_writer.h"
+#include "penumbra/output/output_folder.h"
 #include "penumbra/output/progress.h"
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/sensors/sensor_schedule.h"
 
 namespace penumbra {
 namespace {
@@ -45,47 +48,121 @@ struct RenderJob {
   std::exception_ptr error;  // set on the last job if physics failed
 };
 
-// camera c fires its frame k at the first physics step whose time is >= k / rate_hz,
-// so frames never drift however the rate and timestep relate.
+// camera c fires its frame k at the first physics step whose time is >= k / rate_hz, on the
+// step count (sensors/sensor_schedule.h), so frames never drift however the rate and timestep
+// relate; a camera faster than physics renders once per step.
 class CameraSchedule {
  public:
-  explicit CameraSchedule(const std::vector<CameraSpec>& cameras)
-      : cameras_(cameras), next_(cameras.size(), 0) {}
+  CameraSchedule(const std::vector<CameraSpec>& cameras, double timestep_sec)
+      : schedule_(timestep_sec) {
+    for (const CameraSpec& c : cameras) {
+      const int id = schedule_.Add(c.name, c.rate_hz);
+      if (schedule_.exceeds_physics_rate(id))
+        spdlog::warn(
+            "camera '{}': rate_hz {:.6g} is faster than the physics rate ({:.6g} Hz); "
+            "it renders one frame per physics step",
+            c.name, c.rate_hz, schedule_.physics_rate_hz());
+    }
+  }
 
-  void Due(double time_sec, std::vector<int>* cams, std::vector<int64_t>* frames) {
-    for (size_t c = 0; c < cameras_.size(); ++c) {
-      const double t_k = static_cast<double>(next_[c]) / cameras_[c].rate_hz;
-      if (time_sec >= t_k - 1e-9) {
-        cams->push_back(static_cast<int>(c));
-        frames->push_back(next_[c]);
-        // skip frames that fall inside one physics step (rate above the physics rate)
-        while (static_cast<double>(next_[c]) / cameras_[c].rate_hz <= time_sec + 1e-9) ++next_[c];
-      }
+  void Due(int64_t step, std::vector<int>* cams, std::vector<int64_t>* frames) {
+    due_.clear();
+    schedule_.Due(step, &due_);
+    for (const SensorFiring& f : due_) {
+      cams->push_back(f.sensor);
+      frames->push_back(f.index);
     }
   }
 
  private:
-  const std::vector<CameraSpec>& cameras_;
-  std::vector<int64_t> next_;
+  SensorSchedule schedule_;
+  std::vector<SensorFiring> due_;
 };
 
-void WriteTrajectoryHeader(std::ofstream& f, size_t nq) {
-  f << "step,time_sec";
-  for (size_t i = 0; i < nq; ++i) f << ",qpos" << i;
-  f << "\n";
+std::string TrajectoryHeader(size_t nq) {
+  std::string h = "step,time_sec";
+  for (size_t i = 0; i < nq; ++i) fmt::format_to(std::back_inserter(h), ",qpos{}", i);
+  return h + "\n";
 }
 
-void WriteTrajectoryRow(std::ofstream& f, const Simulation& sim) {
+std::string TrajectoryRow(const Simulation& sim) {
   const std::span<const double> q = sim.qpos();
   std::string row = fmt::format("{},{:.17g}", sim.step_count(), sim.time());
   for (double v : q) fmt::format_to(std::back_inserter(row), ",{:.17g}", v);
   row += '\n';
-  f << row;
+  return row;
+}
+
+// the first error of a run, from any thread (physics, render, writers)
+class FirstError {
+ public:
+  // keeps `e` if it is the first; returns true if it was
+  bool Record(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (first_) return false;
+    first_ = e;
+    return true;
+  }
+  std::exception_ptr get() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return first_;
+  }
+
+ private:
+  mutable std::mutex mu_;
+  std::exception_ptr first_;
+};
+
+std::string What(std::exception_ptr e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    return x.what();
+  } catch (...) {
+    return "unknown error";
+  }
 }
 
 RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options);
 
 }  // namespace
+
+CameraOutputs ParseCameraOutputs(const std::string& list) {
+  static const std::vector<std::string> kValid = {"rgb",
+                                                  "depth",
+                                                  "segmentation",
+                                                  "range",
+                                                  "normals",
+                                                  "instance_segmentation",
+                                                  "semantic_segmentation"};
+  std::string valid;
+  for (const std::string& v : kValid) valid += (valid.empty() ? "" : ", ") + v;
+  CameraOutputs o{false, false, false};
+  size_t start = 0, count = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    const std::string name = list.substr(start, end - start);
+    start = end + 1;
+    bool* flag = name == "rgb"                     ? &o.rgb
+                 : name == "depth"                 ? &o.depth
+                 : name == "segmentation"          ? &o.segmentation
+                 : name == "range"                 ? &o.range
+                 : name == "normals"               ? &o.normals
+                 : name == "instance_segmentation" ? &o.instance_segmentation
+                 : name == "semantic_segmentation" ? &o.semantic_segmentation
+                                                   : nullptr;
+    if (!flag)
+      throw ConfigError(
+          "", 0, "--outputs",
+          "unknown output '" + name + "'; expected a comma-separated list of: " + valid);
+    if (*flag) throw ConfigError("", 0, "--outputs", "'" + name + "' is listed twice");
+    *flag = true;
+    ++count;
+  }
+  if (count == 0) throw ConfigError("", 0, "--outputs", "empty list; expected some of: " + valid);
+  return o;
+}
 
 RunSummary RunWorld(const WorldConfig& world, const RunOptions& options) {
   // errors the stages raise after loading still name the world file's line
@@ -103,16 +180,18 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   WorldConfig world = world_in;
   if (options.duration_sec) world.duration_sec = *options.duration_sec;
   if (!options.out_dir.empty()) world.output_dir = options.out_dir;
+  if (options.outputs) {
+    for (CameraConfig& c : world.cameras) c.outputs = *options.outputs;
+    world.mjcf_cameras.outputs = *options.outputs;
+    for (CameraConfig& c : world.mjcf_cameras.overrides) c.outputs = *options.outputs;
+  }
   world.render.seed = world.seed;
   world.ValidateOrThrow();
 
   namespace fs = std::filesystem;
   const fs::path out = world.output_dir;
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  if (ec)
-    throw ConfigError("", 0, options.out_dir.empty() ? "output.dir" : "--out",
-                      "cannot create folder '" + out.string() + "': " + ec.message());
+  // empty or new, or (--force) holding only an earlier run's outputs (output/output_folder.h)
+  PrepareOutputFolder(out, options.force, options.out_dir.empty() ? "output.dir" : "--out");
 
   std::map<std::string, double> timings;
 
@@ -148,16 +227,19 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 
-  // outputs
-  AsyncFrameWriter writer(out.string());
+  // outputs. the first error of any stage is the one reported (FirstError)
+  FirstError first_error;
+  AsyncFrameWriterOptions writer_options;
+  writer_options.on_error = [&](std::exception_ptr e) { first_error.Record(e); };
+  AsyncFrameWriter writer(out.string(), writer_options);
   for (const CameraSpec& cam : scene.cameras)
     writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
   CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
   SensorStage sensor_stage(
       world, sim, scene, out.string(),  // app/sensor_stage.h
       [&](const WorldSnapshot& s, const Eigen::Vector3d& p) { return effects.Evaluate(s, p); });
-  std::ofstream trajectory(out / "trajectory.csv");
-  WriteTrajectoryHeader(trajectory, sim.qpos().size());
+  LineFile trajectory(out / "trajectory.csv");  // whole rows only (core/output_file.h)
+  trajectory.Append(TrajectoryHeader(sim.qpos().size()));
 
   const double duration = world.duration_sec;
   ProgressOptions progress_options;
@@ -171,15 +253,17 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // physics on its own thread; it hands snapshots to the renderer through a bounded queue
   BoundedQueue<RenderJob> jobs(4);
   double physics_busy_sec = 0;
+  double sim_time_reached = sim.time();
+  bool interrupted = false;
   std::thread physics([&] {
-    CameraSchedule schedule(scene.cameras);
+    CameraSchedule schedule(scene.cameras, sim.timestep());
     ShutterSchedule shutters(scene, world);  // end-of-exposure snapshots (motion blur)
     const auto wall0 = Clock::now();
     try {
       for (;;) {
         RenderJob job;
-        schedule.Due(sim.time(), &job.cameras, &job.frame_indices);
-        const bool sensors_due = sensor_stage.Due(sim.time());  // same snapshot as cameras
+        schedule.Due(sim.step_count(), &job.cameras, &job.frame_indices);
+        const bool sensors_due = sensor_stage.Due(sim.step_count());  // same snapshot as cameras
         const bool shutter_due = shutters.Due(sim.time());
         if (sensors_due && !shutter_due && job.cameras.empty())
           sensor_stage.Process(sim.Snapshot());
@@ -196,6 +280,11 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
           if (!jobs.Push(std::move(job))) return;
         }
         if (sim.time() >= duration - 1e-9) break;
+        // a stop request (SIGINT/SIGTERM) ends the run at this step boundary
+        if (options.stop_request && options.stop_request->load() != 0) {
+          interrupted = true;
+          break;
+        }
         if (options.realtime) {
           std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<Clock::duration>(
                                                     std::chrono::duration<double>(sim.time())));
@@ -203,10 +292,12 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
         const auto ts = Clock::now();
         sim.Step();
         physics_busy_sec += SecondsSince(ts);
-        WriteTrajectoryRow(trajectory, sim);
+        sim_time_reached = sim.time();
+        trajectory.Append(TrajectoryRow(sim));
         for (const std::string& w : sim.TakeWarnings()) spdlog::warn("physics: {}", w);
       }
     } catch (...) {
+      first_error.Record(std::current_exception());
       RenderJob last;
       last.error = std::current_exception();
       jobs.Push(std::move(last));
@@ -215,7 +306,6 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   });
 
   // render and write on this thread, in arrival order (deterministic)
-  std::exception_ptr failure;
   RunSummary summary;
   double render_sec = 0;
   int64_t total_frames = 0;
@@ -224,10 +314,11 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     ++total_frames;
     writer.Submit(std::move(cf));
   };
+  bool failed = false;
   try {
     while (std::optional<RenderJob> job = jobs.Pop()) {
       if (job->error) {
-        failure = job->error;
+        failed = true;
         break;
       }
       // per-camera effects (app/effects_stage.h) ride along with each capture
@@ -235,34 +326,41 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
                               submit);
       progress.Update(job->snapshot.time_sec, total_frames);
     }
-    if (!failure) camera_stage.Finish(submit);
+    if (!failed) camera_stage.Finish(submit);
   } catch (...) {
-    failure = std::current_exception();
+    first_error.Record(std::current_exception());
   }
   jobs.Close();
   physics.join();
-  sensor_stage.Finish();
-  for (const auto& [kind, sec] : sensor_stage.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
   progress.Finish();
   render_sec = camera_stage.render_sec();
 
-  std::exception_ptr write_failure;
-  try {
-    writer.Flush();
-  } catch (...) {
-    write_failure = std::current_exception();
-  }
-  trajectory.flush();
+  // drain every writer; each reports its own error, the run reports the first one
+  auto drain = [&](auto&& f) {
+    try {
+      f();
+    } catch (...) {
+      first_error.Record(std::current_exception());
+    }
+  };
+  drain([&] { sensor_stage.Finish(); });
+  drain([&] { writer.Flush(); });
+  drain([&] { trajectory.Close(); });
+  for (const auto& [kind, sec] : sensor_stage.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
+  // frames.csv rows actually written (a frame whose files failed has none)
+  summary.frames_per_camera = writer.FramesWritten();
 
   summary.out_dir = out.string();
-  summary.sim_time_sec = sim.time();
+  summary.sim_time_sec = sim_time_reached;
   summary.physics_steps = sim.step_count();
+  summary.interrupted = interrupted;
   summary.wall_time_sec = SecondsSince(t_start);
   summary.peak_rss_mib = PeakResidentMemoryMiB();
   timings["physics_sec"] = physics_busy_sec;
   timings["render_sec"] = render_sec;
   timings["total_sec"] = summary.wall_time_sec;
 
+  const std::exception_ptr failure = first_error.get();
   RunManifest manifest;
   manifest.world_file =
       world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
@@ -274,14 +372,21 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   manifest.peak_resident_memory_mib = summary.peak_rss_mib;
   manifest.frames_per_camera = summary.frames_per_camera;
   manifest.sim_duration_sec = summary.sim_time_sec;
+  manifest.interrupted = interrupted;
+  if (failure) manifest.error = What(failure);
   manifest.command_line = options.command_line;
   manifest.adversity = effects.PresetLabel();
   manifest.effects = effects.EffectLabels();
   manifest.agents = effects.AgentLabels();
-  WriteRunManifest(out.string(), manifest);
+  try {
+    WriteRunManifest(out.string(), manifest);
+  } catch (...) {
+    // on a full disk run.json fails too; the error that came first is the one reported
+    if (!first_error.Record(std::current_exception()))
+      spdlog::warn("after the first error, also: {}", What(std::current_exception()));
+  }
 
-  if (failure) std::rethrow_exception(failure);
-  if (write_failure) std::rethrow_exception(write_failure);
+  if (const std::exception_ptr e = first_error.get()) std::rethrow_exception(e);
   return summary;
 }
 

@@ -2,8 +2,10 @@
 // `penumbra run`: the whole pipeline for one world file. world file -> composer ->
 // physics on its own thread -> snapshots at camera times -> renderer -> outputs.
 
+#include <atomic>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,23 +22,47 @@ struct RunOptions {
   std::vector<std::string> command_line;  ///< argv, recorded in run.json
   /// adversity preset spec (--adversity; world/adversity_preset.h), "" = the world's own
   std::string adversity;
+  /// the output folder may hold the outputs of an earlier run, which are removed first
+  /// (--force; output/output_folder.h). without it the folder must be empty or new.
+  bool force = false;
+  /// --outputs: replaces the outputs of every camera (world-file and MJCF cameras).
+  std::optional<CameraOutputs> outputs;
+  /// a stop request (e.g. set by a SIGINT handler; nullptr = none): when it reads non-zero
+  /// the run stops at the next physics step boundary, renders and writes what was captured
+  /// up to there, writes run.json with "interrupted": true and returns normally with
+  /// RunSummary::interrupted set.
+  const std::atomic<int>* stop_request = nullptr;
 };
 
 /// what a run produced.
 struct RunSummary {
   std::string out_dir;
-  double sim_time_sec = 0;
+  double sim_time_sec = 0;  ///< sim time reached (time of the last completed step)
   int64_t physics_steps = 0;
   std::map<std::string, int64_t> frames_per_camera;
   double wall_time_sec = 0;
   double peak_rss_mib = 0;
+  bool interrupted = false;  ///< stopped early by RunOptions::stop_request
 };
+
+/// the camera outputs named in a comma-separated list ("rgb,depth,segmentation"); valid names:
+/// rgb, depth, segmentation, range, normals, instance_segmentation, semantic_segmentation.
+/// @throws ConfigError (key "--outputs") for an empty list, an unknown name (the message
+///         lists the valid ones) or a name given twice.
+CameraOutputs ParseCameraOutputs(const std::string& list);
 
 /// runs `world` and writes every output under the output folder (see README "Outputs").
 /// physics runs on its own thread; rendering and writing happen on the caller's thread
 /// and a writer pool. frames already written are kept if the run fails part-way.
-/// @throws ConfigError for bad input (before anything runs), PhysicsError if the
-///         simulation diverges (after flushing outputs and run.json).
+///
+/// failures: the first error of the run (physics divergence, or the first file that could
+/// not be written, e.g. on a full disk) is the one rethrown, after the outputs written so far
+/// are flushed and run.json (with an "error" entry) is written if possible; a later error
+/// (e.g. run.json on the same full disk) is only logged. files are never left partial
+/// (core/output_file.h).
+/// @throws ConfigError for bad input (before anything runs), including an output folder that
+///         is not empty without RunOptions::force (output/output_folder.h); PhysicsError if
+///         the simulation diverges; Error for a write failure.
 RunSummary RunWorld(const WorldConfig& world, const RunOptions& options);
 
 }  // namespace penumbra

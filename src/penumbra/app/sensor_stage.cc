@@ -1,14 +1,16 @@
 #include "penumbra/app/sensor_stage.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <time.h>
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/sensors/imu_model.h"
@@ -23,12 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-std::ofstream OpenCsv(const fs::path& path) {
-  std::error_code ec;
-  fs::create_directories(path.parent_path(), ec);
-  std::ofstream f(path, std::ios::trunc);
-  if (!f) throw ConfigError("", 0, "--out", "cannot create '" + path.string() + "'");
-  return f;
+// a streaming CSV under the output folder `out` (whole rows only, core/output_file.h)
+LineFile OpenCsv(const fs::path& out, const fs::path& rel) {
+  CreateOutputFolder(out, rel.parent_path());
+  return LineFile(out / rel);
 }
 
 double ThreadCpuSec() {
@@ -88,7 +88,7 @@ struct SensorStage::Impl {
     std::unique_ptr<LidarScanner> scanner;
     Mount mount;
     fs::path dir;
-    std::ofstream index;
+    LineFile index;
     bool pending = false;
     SensorFiring start_firing;
     WorldSnapshot start;
@@ -98,7 +98,7 @@ struct SensorStage::Impl {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
     MujocoSensorInfo accel, gyro;
-    std::ofstream csv;
+    LineFile csv;
     int64_t written = 0;
   };
   struct Mujoco {
@@ -106,7 +106,7 @@ struct SensorStage::Impl {
     std::unique_ptr<MujocoSensorSet> set;
     double stddev = 0;
     uint64_t stream = 0;
-    std::ofstream csv;
+    LineFile csv;
     std::vector<double> values;
     int64_t written = 0;
   };
@@ -114,7 +114,7 @@ struct SensorStage::Impl {
     const SensorConfig* cfg = nullptr;
     std::vector<int> bodies;
     bool contacts = true;
-    std::ofstream csv, contacts_csv;
+    LineFile csv, contacts_csv;
     int64_t written = 0;
   };
   // what each schedule id stands for
@@ -126,7 +126,7 @@ struct SensorStage::Impl {
   std::vector<SensorConfig> configs;
   const SceneDescription* scene = nullptr;
   SensorEffectsAt effects_at;
-  SensorSchedule schedule;
+  std::optional<SensorSchedule> schedule;
   std::vector<Entry> entries;
   std::vector<Lidar> lidars;
   std::vector<Imu> imus;
@@ -155,9 +155,10 @@ struct SensorStage::Impl {
     l.scanner->Scan(*ray_scene, fx.get(), pose, l.start_firing.index, &scan);
     const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
     WritePcd((l.dir / file).string(), scan.points);
-    l.index << fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
-                           l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec, file,
-                           scan.points.size(), scan.medium_returns, scan.particle_returns);
+    l.index.Append(fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
+                               l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec,
+                               file, scan.points.size(), scan.medium_returns,
+                               scan.particle_returns));
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -175,9 +176,19 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
   const ModelInfo& info = sim.model_info();
   s.body_names = info.body_names;
   const fs::path out(out_dir);
+  s.schedule.emplace(sim.timestep());
+  const double physics_rate = s.schedule->physics_rate_hz();
   for (const SensorConfig& c : s.configs) {
     const uint64_t stream = SensorStreamSeed(world.seed, c.name);
     double rate = c.rate_hz.value_or(c.type == "imu" ? 200.0 : 100.0);
+    // a rate above the physics rate fires once per step (sensors/sensor_schedule.h)
+    if (rate > physics_rate && c.type != "lidar") {
+      spdlog::warn(
+          "{}:{}: {}.rate_hz: sensor '{}' at {:.6g} Hz is faster than the physics "
+          "rate ({:.6g} Hz); it records one sample per physics step",
+          c.file, c.line, c.key, c.name, rate, physics_rate);
+      rate = physics_rate;
+    }
     if (c.type == "lidar") {
       Impl::Lidar l;
       l.cfg = &c;
@@ -207,9 +218,10 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       }
       rate = lc.pattern.rate_hz;
       l.dir = out / "lidar" / c.name;
-      l.index = OpenCsv(l.dir / "index.csv");
-      l.index << "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
-                 "particle_returns\n";
+      l.index = OpenCsv(out, fs::path("lidar") / c.name / "index.csv");
+      l.index.Append(
+          "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
+          "particle_returns\n");
       s.entries.push_back({0, static_cast<int>(s.lidars.size())});
       s.lidars.push_back(std::move(l));
     } else if (c.type == "imu") {
@@ -230,9 +242,10 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       nc.gyro_noise_density = c.Param("noise.gyro_noise_density", nc.gyro_noise_density);
       nc.gyro_random_walk = c.Param("noise.gyro_random_walk", nc.gyro_random_walk);
       m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
-      m.csv = OpenCsv(out / "imu" / (c.name + ".csv"));
-      m.csv << "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
-               "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n";
+      m.csv = OpenCsv(out, fs::path("imu") / (c.name + ".csv"));
+      m.csv.Append(
+          "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
+          "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n");
       s.entries.push_back({1, static_cast<int>(s.imus.size())});
       s.imus.push_back(std::move(m));
     } else if (c.type == "mujoco") {
@@ -245,10 +258,10 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       }
       m.stddev = c.Param("noise.stddev", 0);
       m.stream = stream;
-      m.csv = OpenCsv(out / "sensors" / (c.name + ".csv"));
-      m.csv << "sample,capture_time_sec,delivery_time_sec";
-      for (const std::string& col : m.set->ColumnNames()) m.csv << "," << col;
-      m.csv << "\n";
+      m.csv = OpenCsv(out, fs::path("sensors") / (c.name + ".csv"));
+      std::string header = "sample,capture_time_sec,delivery_time_sec";
+      for (const std::string& col : m.set->ColumnNames()) header += "," + col;
+      m.csv.Append(header + "\n");
       s.entries.push_back({2, static_cast<int>(s.mujocos.size())});
       s.mujocos.push_back(std::move(m));
     } else {
@@ -268,25 +281,26 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
         }
       }
       g.contacts = c.Param("contacts", 1) != 0;
-      g.csv = OpenCsv(out / "ground_truth" / (c.name + ".csv"));
-      g.csv << "sample,time_sec";
+      g.csv = OpenCsv(out, fs::path("ground_truth") / (c.name + ".csv"));
+      std::string header = "sample,time_sec";
       for (int b : g.bodies) {
         const std::string& n = info.body_names[b];
         for (const char* k : {"x_m", "y_m", "z_m", "qw", "qx", "qy", "qz", "wx_rad_s", "wy_rad_s",
                               "wz_rad_s", "vx_m_s", "vy_m_s", "vz_m_s"})
-          g.csv << "," << n << "_" << k;
+          header += "," + n + "_" + k;
       }
-      g.csv << "\n";
+      g.csv.Append(header + "\n");
       if (g.contacts) {
-        g.contacts_csv = OpenCsv(out / "ground_truth" / (c.name + "_contacts.csv"));
-        g.contacts_csv << "sample,time_sec,geom1,geom2,body1,body2,px_m,py_m,pz_m,nx,ny,nz,"
-                          "distance_m,fn_N,ft1_N,ft2_N\n";
+        g.contacts_csv = OpenCsv(out, fs::path("ground_truth") / (c.name + "_contacts.csv"));
+        g.contacts_csv.Append(
+            "sample,time_sec,geom1,geom2,body1,body2,px_m,py_m,pz_m,nx,ny,nz,"
+            "distance_m,fn_N,ft1_N,ft2_N\n");
       }
       s.entries.push_back({3, static_cast<int>(s.truths.size())});
       s.truths.push_back(std::move(g));
     }
     try {
-      s.schedule.Add(c.name, rate, c.latency_sec);
+      s.schedule->Add(c.name, rate, c.latency_sec);
     } catch (const Error& e) {
       throw SensorError(c, "rate_hz", e.what());
     }
@@ -298,9 +312,9 @@ SensorStage::~SensorStage() = default;
 
 bool SensorStage::empty() const { return impl_->configs.empty(); }
 
-bool SensorStage::Due(double time_sec) {
+bool SensorStage::Due(int64_t step) {
   impl_->due.clear();
-  impl_->schedule.Due(time_sec, &impl_->due);
+  impl_->schedule->Due(step, &impl_->due);
   return !impl_->due.empty();
 }
 
@@ -325,10 +339,10 @@ void SensorStage::Process(const WorldSnapshot& snap) {
       truth.accel_m_s2 = {a[0], a[1], a[2]};
       truth.gyro_rad_s = {w[0], w[1], w[2]};
       const ImuSample o = m.noise->Apply(f.index, truth);
-      m.csv << fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
-                           f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
-                           o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(),
-                           o.gyro_rad_s.z());
+      m.csv.Append(fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
+                               f.index, f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
+                               o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(),
+                               o.gyro_rad_s.y(), o.gyro_rad_s.z()));
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {
@@ -343,7 +357,7 @@ void SensorStage::Process(const WorldSnapshot& snap) {
         fmt::format_to(std::back_inserter(row), ",{:.9g}", v);
       }
       row += '\n';
-      m.csv << row;
+      m.csv.Append(row);
       ++m.written;
       s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else {
@@ -362,15 +376,15 @@ void SensorStage::Process(const WorldSnapshot& snap) {
                        q.y(), q.z(), V[0], V[1], V[2], V[3], V[4], V[5]);
       }
       row += '\n';
-      g.csv << row;
+      g.csv.Append(row);
       if (g.contacts) {
         for (const WorldSnapshot::Contact& c : snap.contacts)
-          g.contacts_csv << fmt::format(
+          g.contacts_csv.Append(fmt::format(
               "{},{:.9f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
               "{:.9g},{:.9g}\n",
               f.index, snap.time_sec, c.geom1, c.geom2, c.body1, c.body2, c.p_W.x(), c.p_W.y(),
               c.p_W.z(), c.normal_W.x(), c.normal_W.y(), c.normal_W.z(), c.distance_m,
-              c.force_N.x(), c.force_N.y(), c.force_N.z());
+              c.force_N.x(), c.force_N.y(), c.force_N.z()));
       }
       ++g.written;
       s.busy["ground_truth"] += std::chrono::duration<double>(Clock::now() - t0).count();
@@ -380,13 +394,23 @@ void SensorStage::Process(const WorldSnapshot& snap) {
 
 void SensorStage::Finish() {
   Impl& s = *impl_;
-  for (auto& l : s.lidars) l.index.flush();
-  for (auto& m : s.imus) m.csv.flush();
-  for (auto& m : s.mujocos) m.csv.flush();
+  // every file is closed (and its error, if any, seen); the first error is rethrown
+  std::exception_ptr first;
+  auto close = [&](LineFile& f) {
+    try {
+      f.Close();
+    } catch (...) {
+      if (!first) first = std::current_exception();
+    }
+  };
+  for (auto& l : s.lidars) close(l.index);
+  for (auto& m : s.imus) close(m.csv);
+  for (auto& m : s.mujocos) close(m.csv);
   for (auto& g : s.truths) {
-    g.csv.flush();
-    if (g.contacts) g.contacts_csv.flush();
+    close(g.csv);
+    close(g.contacts_csv);
   }
+  if (first) std::rethrow_exception(first);
 }
 
 std::map<std::string, int64_t> SensorStage::samples() const {

@@ -59,12 +59,14 @@ class SensorStage {
 
   /// true when the world has no sensors.
   bool empty() const;
-  /// advances the schedules to the physics step at `time_sec` (call once per step, before
-  /// stepping); true if any sensor is due (then call Process with that step's snapshot).
-  bool Due(double time_sec);
+  /// advances the schedules to physics step `step` (Simulation::step_count(); call once per
+  /// step, before stepping); true if any sensor is due (then call Process with that step's
+  /// snapshot).
+  bool Due(int64_t step);
   /// runs the sensors found due by the last Due() on `snapshot` and writes their records.
   void Process(const WorldSnapshot& snapshot);
-  /// flushes and closes the files.
+  /// writes the buffered rows and closes the files.
+  /// @throws Error naming the first file that could not be written (all are closed).
   void Finish();
 
   /// samples (scans) written per sensor.

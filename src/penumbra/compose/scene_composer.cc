@@ -10,6 +10,7 @@
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/compose/model_composer.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
@@ -566,13 +567,7 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
 }
 
 void WriteComposedScene(const ComposedScene& scene, const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    throw ConfigError(path, 0, "", "cannot open the file for writing the composed MJCF");
-  }
-  out << scene.mjcf_xml;
-  out.close();
-  if (!out) throw ConfigError(path, 0, "", "writing the composed MJCF failed");
+  WriteFileAtomic(path, scene.mjcf_xml);
 }
 
 }  // namespace penumbra

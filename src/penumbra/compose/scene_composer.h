@@ -90,8 +90,9 @@ struct ComposedScene {
 ///         undefined names, compiler attributes that differ and cannot be reconciled.
 ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const ComposeOptions& options);
 
-/// writes scene.mjcf_xml to `path` (e.g. "<output_dir>/composed.xml").
-/// @throws ConfigError when the file cannot be written.
+/// writes scene.mjcf_xml to `path` (e.g. "<output_dir>/composed.xml"), whole under a
+/// temporary name and then renamed into place (core/output_file.h).
+/// @throws Error naming the path when the file cannot be written.
 void WriteComposedScene(const ComposedScene& scene, const std::string& path);
 
 }  // namespace penumbra

@@ -142,6 +142,7 @@ void AsyncFrameWriter::AppendFinishedRows(CameraState* cam) {
 }
 
 void AsyncFrameWriter::RecordError(std::exception_ptr e) {
+  if (options_.on_error) options_.on_error(e);
   if (!error_) error_ = e;
   cv_space_.notify_all();
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -29,6 +30,10 @@ struct AsyncFrameWriterOptions {
   /// encoder/writer threads, 1..8.
   int num_threads = 2;
   PngEncodeOptions png;
+  /// called with each write error as it happens, on the worker thread (with the writer's
+  /// lock held: do not call back into the writer), before Submit/Flush rethrow it; lets a
+  /// caller order it against errors of other threads. may be empty.
+  std::function<void(std::exception_ptr)> on_error;
 
   /// @throws ConfigError for a capacity < 1 or a thread count outside 1..8.
   void ValidateOrThrow() const;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 namespace penumbra {
 namespace {
@@ -30,10 +31,7 @@ std::string List(const std::array<double, N>& v) {
 }
 
 void WriteText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
-  if (!f) throw Error("cannot write '" + path.string() + "'");
+  WriteFileAtomic(path, text);
 }
 
 }  // namespace

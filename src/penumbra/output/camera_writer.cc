@@ -7,17 +7,12 @@
 #include <system_error>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
-
-void CreateFolder(const fs::path& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
-}
 
 template <typename T>
 void CheckFrameImage(const Image<T>& image, int channels, const CameraIntrinsics& intr,
@@ -121,10 +116,11 @@ CameraWriter::CameraWriter(const std::string& output_dir, const std::string& cam
     throw Error(fmt::format("camera '{}': image size {} x {} must be positive", camera,
                             intrinsics.width, intrinsics.height));
   }
-  CreateFolder(folder_);
-  if (outputs_.rgb) CreateFolder(folder_ / "rgb");
-  if (outputs_.depth) CreateFolder(folder_ / "depth");
-  if (outputs_.segmentation) CreateFolder(folder_ / "segmentation");
+  const fs::path rel = CameraFolder(camera);
+  CreateOutputFolder(output_dir, rel);
+  if (outputs_.rgb) CreateOutputFolder(output_dir, rel / "rgb");
+  if (outputs_.depth) CreateOutputFolder(output_dir, rel / "depth");
+  if (outputs_.segmentation) CreateOutputFolder(output_dir, rel / "segmentation");
 
   // ordered_json keeps the key order below
   nlohmann::ordered_json j;
@@ -149,18 +145,11 @@ CameraWriter::CameraWriter(const std::string& output_dir, const std::string& cam
   files["frames"] =
       "frames.csv: pose of the optical frame in the world (m, unit quaternion, qw >= 0)";
   j["files"] = files;
-  const fs::path json_path = folder_ / "intrinsics.json";
-  {
-    std::ofstream f(json_path, std::ios::binary | std::ios::trunc);
-    f << j.dump(2) << '\n';
-    if (!f) throw Error("cannot write '" + json_path.string() + "'");
-  }
+  WriteFileAtomic(folder_ / "intrinsics.json", j.dump(2) + "\n");
 
-  const fs::path csv_path = folder_ / "frames.csv";
-  csv_.open(csv_path, std::ios::binary | std::ios::trunc);
-  csv_ << kFramesCsvHeader;
-  csv_.flush();
-  if (!csv_) throw Error("cannot write '" + csv_path.string() + "'");
+  // every row reaches the file at once (buffer 0): rows never lag the images on disk
+  csv_ = LineFile(folder_ / "frames.csv", 0);
+  csv_.Append(kFramesCsvHeader);
 }
 
 void CameraWriter::WriteImages(const CameraFrame& frame) const {
@@ -172,14 +161,32 @@ void CameraWriter::WriteImages(const CameraFrame& frame) const {
     throw Error(fmt::format("camera '{}': negative frame index {}", camera_, frame.index));
   }
   const std::string name = FrameFileName(frame.index);
+  // a frame is written whole or not at all: if one image fails, the frame's images written
+  // before it are removed again (the frame gets no frames.csv row either)
+  std::vector<fs::path> written;
+  try {
+    WriteFrameImages(frame, name, &written);
+  } catch (...) {
+    for (const fs::path& p : written) {
+      std::error_code ec;
+      fs::remove(p, ec);
+    }
+    throw;
+  }
+}
+
+void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string& name,
+                                    std::vector<fs::path>* written) const {
   if (outputs_.rgb) {
     CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");
     WritePngRgb8((folder_ / "rgb" / name).string(), frame.rgb, png_options_);
+    written->push_back(folder_ / "rgb" / name);
   }
   if (outputs_.depth) {
     CheckFrameImage(frame.depth_m, 1, intrinsics_, camera_, frame.index, "depth");
     WritePngGray16((folder_ / "depth" / name).string(), DepthToMillimetres(frame.depth_m),
                    png_options_);
+    written->push_back(folder_ / "depth" / name);
   }
   if (outputs_.segmentation) {
     CheckFrameImage(frame.geom_id, 1, intrinsics_, camera_, frame.index, "segmentation");
@@ -200,9 +207,7 @@ void CameraWriter::AppendPose(const CameraFrame& frame) {
                     "frame indices",
                     camera_, frame.index, last_index_));
   }
-  csv_ << FramesCsvRow(frame);
-  csv_.flush();
-  if (!csv_) throw Error("cannot write '" + (folder_ / "frames.csv").string() + "'");
+  csv_.Append(FramesCsvRow(frame));
   last_index_ = frame.index;
   ++frames_written_;
 }

@@ -1,5 +1,6 @@
 #pragma once
-// files of one camera under an output folder:
+// files of one camera under an output folder (images and JSON are written whole under a
+// temporary name and renamed into place, core/output_file.h):
 //
 //   DIR/<camera>/rgb/NNNNNN.png           8-bit sRGB colour
 //   DIR/<camera>/depth/NNNNNN.png         16-bit z-depth in millimetres (see DepthToMillimetres)
@@ -15,8 +16,10 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/image.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/camera_frame.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/scene/scene_description.h"
@@ -66,13 +69,15 @@ class CameraWriter {
   CameraWriter& operator=(const CameraWriter&) = delete;
 
   /// encodes and writes the PNGs of the requested outputs (images of outputs that were
-  /// not requested are ignored).
+  /// not requested are ignored). all or nothing: when one fails, the frame's images written
+  /// before it are removed.
   /// @throws Error if frame.camera differs, the index is negative, a requested image is
   ///         missing or its size/channels differ from the intrinsics, a geom id does not fit,
   ///         or a file cannot be written (message names the path).
   void WriteImages(const CameraFrame& frame) const;
 
-  /// appends the frame's frames.csv row and flushes it to the file.
+  /// appends the frame's frames.csv row and writes it to the file (whole rows only; a row
+  /// that fails to write is cut off again, core/output_file.h).
   /// @throws Error if the index is not greater than the previous one or the write fails.
   void AppendPose(const CameraFrame& frame);
 
@@ -86,12 +91,15 @@ class CameraWriter {
   int64_t frames_written() const { return frames_written_; }
 
  private:
+  void WriteFrameImages(const CameraFrame& frame, const std::string& name,
+                        std::vector<std::filesystem::path>* written) const;
+
   std::string camera_;
   std::filesystem::path folder_;
   CameraIntrinsics intrinsics_;
   CameraOutputs outputs_;
   PngEncodeOptions png_options_;
-  std::ofstream csv_;
+  LineFile csv_;
   int64_t last_index_ = -1;
   int64_t frames_written_ = 0;
 };

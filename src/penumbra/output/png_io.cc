@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 // speed settings, measured on 640 x 480 frames of worlds/default.yaml (realtime tier),
 // thread CPU time per image, zlib 1.2.13 / libpng 1.6.39:
@@ -138,18 +139,10 @@ std::vector<uint8_t> Encode(png_uint_32 width, png_uint_32 height, int color_typ
   return out;
 }
 
+// whole file under a temporary name, then renamed into place (core/output_file.h)
 void WriteFileBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) {
-    throw Error("cannot write PNG '" + path + "': " + std::strerror(errno));
-  }
-  const size_t n = std::fwrite(bytes.data(), 1, bytes.size(), f);
-  const int write_errno = errno;
-  const int close_rc = std::fclose(f);
-  if (n != bytes.size() || close_rc != 0) {
-    throw Error("cannot write PNG '" + path +
-                "': " + std::strerror(n != bytes.size() ? write_errno : errno));
-  }
+  WriteFileAtomic(path,
+                  std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 // plain-data state of the setjmp-guarded decoder.

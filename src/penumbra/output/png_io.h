@@ -36,12 +36,14 @@ std::vector<uint8_t> EncodePngRgb8(const ImageU8& image, const PngEncodeOptions&
 /// @throws Error as EncodePngRgb8 (channels must be 1).
 std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptions& options = {});
 
-/// writes EncodePngRgb8(image) to `path` (replacing an existing file).
+/// writes EncodePngRgb8(image) to `path` (replacing an existing file): whole under a
+/// temporary name, then renamed into place (core/output_file.h), so `path` is never a
+/// truncated PNG.
 /// @throws Error naming `path` and the reason (bad image, cannot open, short write).
 void WritePngRgb8(const std::string& path, const ImageU8& image,
                   const PngEncodeOptions& options = {});
 
-/// writes EncodePngGray16(image) to `path` (replacing an existing file).
+/// writes EncodePngGray16(image) to `path` as WritePngRgb8 does.
 /// @throws Error naming `path` and the reason.
 void WritePngGray16(const std::string& path, const ImageU16& image,
                     const PngEncodeOptions& options = {});

@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 namespace penumbra {
 
@@ -20,6 +21,7 @@ std::string RunManifestJson(const RunManifest& m) {
   j["embree_version"] = m.embree_version;
   j["command_line"] = m.command_line;
   j["sim_duration_sec"] = m.sim_duration_sec;
+  j["interrupted"] = m.interrupted;
   nlohmann::ordered_json frames = nlohmann::ordered_json::object();
   for (const auto& [name, n] : m.frames_per_camera) frames[name] = n;
   j["frames_per_camera"] = frames;
@@ -27,6 +29,7 @@ std::string RunManifestJson(const RunManifest& m) {
   for (const auto& [name, s] : m.timings_sec) timings[name] = s;
   j["timings_sec"] = timings;
   j["peak_resident_memory_mib"] = m.peak_resident_memory_mib;
+  if (!m.error.empty()) j["error"] = m.error;
   if (!m.adversity.empty() || !m.effects.empty() || !m.agents.empty()) {
     j["adversity"] = m.adversity;
     j["effects"] = m.effects;
@@ -37,14 +40,8 @@ std::string RunManifestJson(const RunManifest& m) {
 
 void WriteRunManifest(const std::string& output_dir, const RunManifest& manifest) {
   const std::filesystem::path dir(output_dir);
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
-  const std::filesystem::path path = dir / "run.json";
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << RunManifestJson(manifest);
-  f.close();
-  if (!f) throw Error("cannot write '" + path.string() + "'");
+  CreateOutputFolder(dir);
+  WriteFileAtomic(dir / "run.json", RunManifestJson(manifest));
 }
 
 double PeakResidentMemoryMiB() {

@@ -19,7 +19,9 @@ struct RunManifest {
   std::string mujoco_version;                        ///< e.g. "2.2.2" (mj_versionString)
   std::string embree_version;                        ///< e.g. "3.13.5"
   std::vector<std::string> command_line;             ///< argv, one entry per argument
-  double sim_duration_sec = 0;                       ///< simulated time covered by the run
+  double sim_duration_sec = 0;  ///< sim time reached: time of the last completed physics step
+  /// true when the run was stopped early (SIGINT / SIGTERM); written always
+  bool interrupted = false;
   std::map<std::string, int64_t> frames_per_camera;  ///< frames written per camera name
   std::map<std::string, double> timings_sec;         ///< wall-clock per stage, e.g. "render": 12.5
   double peak_resident_memory_mib = 0;  ///< usually PeakResidentMemoryMiB() at the end of the run
@@ -28,12 +30,16 @@ struct RunManifest {
   std::string adversity;
   std::vector<std::string> effects;
   std::vector<std::string> agents;
+  /// the run's first error (e.g. divergence, a file that could not be written); the key
+  /// "error" is written only when it is not empty, after "peak_resident_memory_mib".
+  std::string error;
 };
 
 /// the manifest as pretty-printed JSON text (2-space indent, trailing newline).
 std::string RunManifestJson(const RunManifest& manifest);
 
-/// writes RunManifestJson(manifest) to DIR/run.json, creating DIR if needed.
+/// writes RunManifestJson(manifest) to DIR/run.json, creating DIR if needed; whole under a
+/// temporary name, then renamed into place (core/output_file.h).
 /// @throws Error naming the path if it cannot be written.
 void WriteRunManifest(const std::string& output_dir, const RunManifest& manifest);
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include "penumbra/core/error.h"
 #include "penumbra/physics/mujoco_runtime.h"
@@ -248,6 +249,7 @@ struct Simulation::Impl {
 
   [[noreturn]] void Fail(double t, int64_t step, const std::string& what) {
     failed = true;
+    d->time = t;  // MuJoCo may have reset the state: keep the time reached
     failure = When(t, step) + ": " + what;
     throw PhysicsError(failure);
   }
@@ -341,6 +343,28 @@ struct Simulation::Impl {
         Fail(t, step, "physics diverged: non-finite qacc at " + DofLabel(i));
   }
 };
+
+double PhysicsRateHz(double timestep_sec) {
+  const double rate = 1.0 / timestep_sec;
+  const double r = std::nearbyint(rate);
+  return r >= 1 && std::abs(rate - r) <= 1e-9 * r ? r : rate;
+}
+
+double SimTimeOfStep(int64_t n, double timestep_sec) {
+  if (n <= 0) return 0.0;
+  const double nd = static_cast<double>(n);
+  const double rate = PhysicsRateHz(timestep_sec);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (rate == std::nearbyint(rate)) {
+    // n / R rounded up: fma gives the sign of q R - n exactly
+    double q = nd / rate;
+    if (std::fma(q, rate, -nd) < 0) q = std::nextafter(q, kInf);
+    return q;
+  }
+  double p = nd * timestep_sec;
+  if (std::fma(nd, timestep_sec, -p) > 0) p = std::nextafter(p, kInf);
+  return p;
+}
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Simulation::Simulation(Simulation&&) noexcept = default;
@@ -493,9 +517,11 @@ void Simulation::Step() {
     // MuJoCo's compiler swaps in its own throwing handler while another thread loads a model
     s.Fail(t, step, "MuJoCo error (reported while another model was being loaded)");
   }
-  s.steps = step;
   s.CheckWarnings(t, step);
   s.CheckFinite(t, step);
+  // time from the step count, not summed (SimTimeOfStep)
+  s.steps = step;
+  d->time = SimTimeOfStep(step, m->opt.timestep);
   if (!s.mocap_drivers.empty()) s.ApplyMocapDrivers(d->time);
 }
 

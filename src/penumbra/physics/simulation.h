@@ -33,6 +33,17 @@
 
 namespace penumbra {
 
+/// the physics rate 1 / timestep_sec (Hz), snapped to the nearest integer when it is within
+/// 1e-9 (relative) of one: 0.002 s -> exactly 500 Hz.
+double PhysicsRateHz(double timestep_sec);
+
+/// sim time of physics step n (s): the smallest double >= n / R, R = PhysicsRateHz(timestep)
+/// when that is an integer, else >= n * timestep (both exact, not summed). so for a rate r
+/// dividing R, the step of frame k = n r / R has time >= k / r exactly and
+/// floor(time * r) == k, and times never drift (MuJoCo's own time += timestep does, by up
+/// to ~1e-11 s over a minute). n <= 0 gives 0.
+double SimTimeOfStep(int64_t n, double timestep_sec);
+
 /// a MuJoCo simulation with pluggable controllers.
 class Simulation {
  public:
@@ -77,7 +88,10 @@ class Simulation {
   ///         non-finite ctrl; message: "<model>: t = <time> s (step <n>): ... body '<name>' ...".
   void Step();
 
-  /// simulation time (s) and the number of steps taken since loading.
+  /// simulation time (s) and the number of steps completed since loading. time() is
+  /// SimTimeOfStep(step_count(), timestep()) (MuJoCo's accumulated time is overwritten after
+  /// each step), also for controllers and snapshots. after a PhysicsError both stay at the
+  /// last completed step: the sim time reached.
   double time() const;
   int64_t step_count() const;
   /// the physics timestep (s).

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 namespace penumbra {
 namespace {
@@ -28,11 +29,7 @@ void WritePcd(const std::string& path, const std::vector<LidarPoint>& points) {
     std::memcpy(p + 18, &q.time, 4);
     p += kRecord;
   }
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << h.str();
-  f.write(data.data(), static_cast<std::streamsize>(data.size()));
-  f.close();
-  if (!f) throw Error("cannot write point cloud '" + path + "'");
+  WriteFileAtomic(path, h.str() + data);
 }
 
 std::vector<LidarPoint> ReadPcd(const std::string& path) {

@@ -1,0 +1,193 @@
+#include "penumbra/output/output_folder.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <set>
+#include <system_error>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::set<std::string> kTopFiles = {"run.json",         "composed.xml",
+                                         "trajectory.csv",   "camera_info.yaml",
+                                         "camera_info.json", "semantic_classes.json"};
+const std::set<std::string> kSensorFolders = {"imu", "sensors", "ground_truth"};
+const std::set<std::string> kImageFolders = {"rgb",
+                                             "depth",
+                                             "segmentation",
+                                             "range",
+                                             "normals",
+                                             "instance_segmentation",
+                                             "semantic_segmentation"};
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// NNNNNN.png: at least 6 digits
+bool IsFrameFile(const std::string& name) {
+  if (!EndsWith(name, ".png") || name.size() < 10) return false;
+  return std::all_of(name.begin(), name.end() - 4, [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// scan_NNNNNN.pcd
+bool IsScanFile(const std::string& name) {
+  if (name.rfind("scan_", 0) != 0 || !EndsWith(name, ".pcd") || name.size() < 15) return false;
+  return std::all_of(name.begin() + 5, name.end() - 4, [](char c) { return c >= '0' && c <= '9'; });
+}
+
+enum class Kind { kCameraFolder, kImageFolder, kLidarFolder, kSensorFolder };
+
+class Scanner {
+ public:
+  Scanner(const fs::path& root, size_t limit) : root_(root), limit_(limit) {}
+
+  // checks the entries of folder `dir` of kind `kind`
+  void Folder(const fs::path& dir, Kind kind) {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+      if (found.size() >= limit_) return;
+      const fs::path p = it->path();
+      const std::string name = p.filename().string();
+      const fs::file_status st = it->symlink_status(ec);
+      if (ec) break;
+      if (fs::is_symlink(st)) {
+        Foreign(p, " (a symbolic link)");
+        continue;
+      }
+      const bool dir_entry = fs::is_directory(st), file = fs::is_regular_file(st);
+      if (file && IsTemporaryOutputName(name)) continue;
+      switch (kind) {
+        case Kind::kCameraFolder:
+          if (file && (name == "intrinsics.json" || name == "frames.csv")) continue;
+          if (dir_entry) {
+            Folder(p, kImageFolders.count(name) ? Kind::kImageFolder : Kind::kCameraFolder);
+            continue;
+          }
+          break;
+        case Kind::kImageFolder:
+          if (file && IsFrameFile(name)) continue;
+          break;
+        case Kind::kLidarFolder:
+          if (file && (name == "index.csv" || IsScanFile(name))) continue;
+          if (dir_entry) {
+            Folder(p, Kind::kLidarFolder);
+            continue;
+          }
+          break;
+        case Kind::kSensorFolder:
+          if (file && EndsWith(name, ".csv")) continue;
+          if (dir_entry) {
+            Folder(p, Kind::kSensorFolder);
+            continue;
+          }
+          break;
+      }
+      Foreign(p, "");
+    }
+    if (ec) throw Error("cannot list '" + dir.string() + "': " + ec.message());
+  }
+
+  // the top level of the output folder
+  void Top() {
+    std::error_code ec;
+    for (fs::directory_iterator it(root_, ec), end; !ec && it != end; it.increment(ec)) {
+      if (found.size() >= limit_) return;
+      const fs::path p = it->path();
+      const std::string name = p.filename().string();
+      const fs::file_status st = it->symlink_status(ec);
+      if (ec) break;
+      if (fs::is_symlink(st)) {
+        Foreign(p, " (a symbolic link)");
+      } else if (fs::is_regular_file(st)) {
+        if (!kTopFiles.count(name) && !IsTemporaryOutputName(name)) Foreign(p, "");
+      } else if (fs::is_directory(st)) {
+        Folder(p, name == "lidar"              ? Kind::kLidarFolder
+                  : kSensorFolders.count(name) ? Kind::kSensorFolder
+                                               : Kind::kCameraFolder);
+      } else {
+        Foreign(p, " (not a file or folder)");
+      }
+    }
+    if (ec) throw Error("cannot list '" + root_.string() + "': " + ec.message());
+  }
+
+  std::vector<std::string> found;
+
+ private:
+  void Foreign(const fs::path& p, const std::string& why) {
+    found.push_back(p.lexically_relative(root_).string() + why);
+  }
+  fs::path root_;
+  size_t limit_;
+};
+
+std::string Quoted(const std::vector<std::string>& names) {
+  std::string s;
+  for (size_t i = 0; i < names.size(); ++i) s += (i ? ", '" : "'") + names[i] + "'";
+  return s;
+}
+
+}  // namespace
+
+std::vector<std::string> ForeignOutputEntries(const fs::path& out, size_t limit) {
+  Scanner s(out, limit);
+  s.Top();
+  std::sort(s.found.begin(), s.found.end());
+  return s.found;
+}
+
+void PrepareOutputFolder(const fs::path& out, bool force, const std::string& key) {
+  auto fail = [&](const std::string& what) {
+    return ConfigError("", 0, key, "output folder '" + out.string() + "' " + what);
+  };
+  std::error_code ec;
+  const fs::file_status st = fs::status(out, ec);
+  if (!fs::exists(st)) {
+    try {
+      CreateOutputFolder(out);
+    } catch (const Error& e) {
+      throw fail(std::string("cannot be created: ") + e.what());
+    }
+    return;
+  }
+  if (!fs::is_directory(st)) throw fail("exists and is not a folder");
+  std::vector<std::string> entries;
+  for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
+    entries.push_back(it->path().filename().string());
+  if (ec) throw fail("cannot be listed: " + ec.message());
+  if (entries.empty()) return;
+  if (!force) {
+    std::sort(entries.begin(), entries.end());
+    const size_t n = entries.size();
+    if (n > 5) entries.resize(5);
+    throw fail("is not empty (it holds " + Quoted(entries) + (n > 5 ? ", ..." : "") +
+               "); choose an empty or new folder, or pass --force to replace the outputs of an "
+               "earlier run");
+  }
+  const std::vector<std::string> foreign = ForeignOutputEntries(out, 10);
+  if (!foreign.empty()) {
+    throw fail("holds files that Penumbra did not write: " + Quoted(foreign) +
+               (foreign.size() == 10 ? ", ..." : "") +
+               "; --force removes only the outputs of an earlier run (README \"Outputs\"): move "
+               "these away or choose another folder");
+  }
+  // only Penumbra outputs and no links (checked above): remove them
+  std::vector<fs::path> top;
+  for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
+    top.push_back(it->path());
+  if (ec) throw fail("cannot be listed: " + ec.message());
+  for (const fs::path& p : top) {
+    fs::remove_all(p, ec);
+    if (ec) throw fail("cannot be cleared: '" + p.string() + "': " + ec.message());
+  }
+}
+
+}  // namespace penumbra

@@ -1,0 +1,34 @@
+#pragma once
+// the output folder of a run (--out): a run writes into an empty or new folder only, so
+// that no stale frame of an earlier run can sit next to this run's files. with `force`,
+// the outputs of an earlier Penumbra run are removed first, and nothing else: a file
+// Penumbra does not write, or any symbolic link, makes the run refuse (and is left alone).
+//
+// Penumbra's outputs (README "Outputs"): run.json, composed.xml, trajectory.csv,
+// camera_info.{yaml,json}, semantic_classes.json; lidar/**/{index.csv,scan_*.pcd};
+// imu/**, sensors/**, ground_truth/** *.csv; camera folders (any other folder, nested for
+// "<model>/<camera>") holding intrinsics.json, frames.csv and image folders rgb, depth,
+// segmentation, range, normals, instance_segmentation, semantic_segmentation of NNNNNN.png;
+// and the temporary files a killed run can leave (core/output_file.h).
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// paths (relative to `out`) under `out` that are not outputs of a Penumbra run, and
+/// symbolic links (never followed); at most `limit` of them.
+/// @throws Error if `out` cannot be listed.
+std::vector<std::string> ForeignOutputEntries(const std::filesystem::path& out, size_t limit = 10);
+
+/// makes `out` ready for a run: creates it if missing; an empty folder is used as is; a
+/// non-empty one is refused unless `force`, which removes the outputs of an earlier run
+/// when everything in it is one (ForeignOutputEntries is empty) and refuses otherwise.
+/// @param key  where `out` came from, named in errors: "--out" or the world file's "output.dir"
+/// @throws ConfigError (key `key`) if `out` is not a folder, cannot be created, is not
+///         empty without `force`, or holds anything but Penumbra outputs (named, up to 10).
+void PrepareOutputFolder(const std::filesystem::path& out, bool force,
+                         const std::string& key = "--out");
+
+}  // namespace penumbra

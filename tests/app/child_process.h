@@ -1,0 +1,96 @@
+#pragma once
+// runs the real `penumbra` binary (PENUMBRA_BINARY, set by CMake for app_tests) as a
+// child process: exit codes, signals and the stdout / stderr contract are tested on the
+// program users run, not on RunCli in-process.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace penumbra::testing {
+
+/// a started child process with stdout and stderr captured to files.
+class ChildProcess {
+ public:
+  /// starts PENUMBRA_BINARY with `args` (without argv[0]); stdout / stderr go to
+  /// `capture_dir`/stdout.txt and stderr.txt.
+  ChildProcess(const std::vector<std::string>& args, const std::filesystem::path& capture_dir)
+      : out_path_(capture_dir / "stdout.txt"), err_path_(capture_dir / "stderr.txt") {
+    std::vector<std::string> argv_s = {PENUMBRA_BINARY};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, err_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int rc = posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) throw std::runtime_error("posix_spawn " + argv_s[0] + " failed");
+  }
+  ~ChildProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  void Signal(int sig) const { kill(pid_, sig); }
+
+  /// waits for the exit; returns the exit code, or 128 + signal if a signal killed it.
+  int Wait() {
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+    return WEXITSTATUS(status);
+  }
+
+  std::string out() const { return Read(out_path_); }
+  std::string err() const { return Read(err_path_); }
+
+ private:
+  static std::string Read(const std::filesystem::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  }
+  pid_t pid_ = -1;
+  std::filesystem::path out_path_, err_path_;
+};
+
+/// the result of a finished run of the binary.
+struct ProcessResult {
+  int exit_code = -1;  ///< exit status, or 128 + signal
+  std::string out, err;
+};
+
+/// runs PENUMBRA_BINARY with `args` to completion.
+inline ProcessResult RunPenumbra(const std::vector<std::string>& args,
+                                 const std::filesystem::path& capture_dir) {
+  ChildProcess p(args, capture_dir);
+  ProcessResult r;
+  r.exit_code = p.Wait();
+  r.out = p.out();
+  r.err = p.err();
+  return r;
+}
+
+}  // namespace penumbra::testing
