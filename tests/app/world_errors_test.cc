@@ -97,6 +97,36 @@ TEST_F(WorldErrorsTest, OutputFolderThatCannotBeMade) {
   ExpectPlaced("output:\n  dir: /dev/null/x\n", 5, "output.dir", "cannot be created");
 }
 
+TEST_F(WorldErrorsTest, ARunRefusedDuringSetUpLeavesTheFolderAsItFoundIt) {
+  const std::string world = dir_.Write("world.yaml",
+                                       "duration_sec: 0.02\n"
+                                       "models:\n"
+                                       "  - {name: m, file: box.xml}\n"
+                                       "cameras:\n"
+                                       "  - {name: c, attach: m/nobody}\n");
+  RunOptions options;
+  options.progress = false;
+  // a new folder is removed again; an existing empty one is emptied again
+  for (const fs::path& out : {dir_.path() / "new_out", dir_.path() / "empty_out"}) {
+    if (out.filename() == "empty_out") fs::create_directories(out);
+    options.out_dir = out.string();
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      try {
+        RunWorld(LoadWorldFile(world), options);
+        ADD_FAILURE() << "expected a ConfigError";
+      } catch (const ConfigError& e) {
+        // the same error both times: not "is not empty" the second time
+        EXPECT_EQ(e.key(), "cameras[0].attach") << e.what();
+      }
+    }
+    if (out.filename() == "new_out") {
+      EXPECT_FALSE(fs::exists(out));
+    } else {
+      EXPECT_TRUE(fs::is_empty(out));
+    }
+  }
+}
+
 TEST_F(WorldErrorsTest, EmptyWorldRuns) {
   const std::string world = dir_.Write("empty.yaml", "{}\n");
   WorldConfig w = LoadWorldFile(world);

@@ -125,6 +125,37 @@ std::string What(std::exception_ptr e) {
 
 RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options);
 
+// a run refused while it sets up (bad input found once the model is composed: an unknown body,
+// a scene too large) leaves its output folder as it found it, empty or absent, so that the
+// corrected command runs without --force. everything in the folder is this run's: it was empty
+// or new when the run began (PrepareOutputFolder).
+class SetupRollback {
+ public:
+  SetupRollback(std::filesystem::path out, bool created)
+      : out_(std::move(out)), created_(created) {}
+  SetupRollback(const SetupRollback&) = delete;
+  SetupRollback& operator=(const SetupRollback&) = delete;
+  ~SetupRollback() {
+    if (done_) return;
+    std::error_code ec;
+    if (created_) {
+      std::filesystem::remove_all(out_, ec);
+      return;
+    }
+    std::vector<std::filesystem::path> entries;
+    for (std::filesystem::directory_iterator it(out_, ec), end; !ec && it != end; it.increment(ec))
+      entries.push_back(it->path());
+    for (const std::filesystem::path& p : entries) std::filesystem::remove_all(p, ec);
+  }
+  /// the run has started: from here on what it wrote is kept
+  void Dismiss() { done_ = true; }
+
+ private:
+  std::filesystem::path out_;
+  bool created_ = false;
+  bool done_ = false;
+};
+
 }  // namespace
 
 CameraOutputs ParseCameraOutputs(const std::string& list) {
@@ -191,7 +222,10 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   namespace fs = std::filesystem;
   const fs::path out = world.output_dir;
   // empty or new, or (--force) holding only an earlier run's outputs (output/output_folder.h)
+  std::error_code exists_ec;
+  const bool out_existed = fs::exists(fs::symlink_status(out, exists_ec));
   PrepareOutputFolder(out, options.force, options.out_dir.empty() ? "output.dir" : "--out");
+  SetupRollback rollback(out, !out_existed);
 
   std::map<std::string, double> timings;
 
@@ -255,6 +289,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   double physics_busy_sec = 0;
   double sim_time_reached = sim.time();
   bool interrupted = false;
+  rollback.Dismiss();
   std::thread physics([&] {
     CameraSchedule schedule(scene.cameras, sim.timestep());
     ShutterSchedule shutters(scene, world);  // end-of-exposure snapshots (motion blur)
