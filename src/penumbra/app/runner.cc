@@ -159,15 +159,9 @@ class SetupRollback {
 }  // namespace
 
 CameraOutputs ParseCameraOutputs(const std::string& list) {
-  static const std::vector<std::string> kValid = {"rgb",
-                                                  "depth",
-                                                  "segmentation",
-                                                  "range",
-                                                  "normals",
-                                                  "instance_segmentation",
-                                                  "semantic_segmentation"};
   std::string valid;
-  for (const std::string& v : kValid) valid += (valid.empty() ? "" : ", ") + v;
+  for (std::string_view v : CameraOutputs::kNames)
+    valid += (valid.empty() ? "" : ", ") + std::string(v);
   CameraOutputs o{false, false, false};
   size_t start = 0, count = 0;
   while (start <= list.size()) {
@@ -175,14 +169,7 @@ CameraOutputs ParseCameraOutputs(const std::string& list) {
     if (end == std::string::npos) end = list.size();
     const std::string name = list.substr(start, end - start);
     start = end + 1;
-    bool* flag = name == "rgb"                     ? &o.rgb
-                 : name == "depth"                 ? &o.depth
-                 : name == "segmentation"          ? &o.segmentation
-                 : name == "range"                 ? &o.range
-                 : name == "normals"               ? &o.normals
-                 : name == "instance_segmentation" ? &o.instance_segmentation
-                 : name == "semantic_segmentation" ? &o.semantic_segmentation
-                                                   : nullptr;
+    bool* flag = o.Flag(name);
     if (!flag)
       throw ConfigError(
           "", 0, "--outputs",

@@ -8,6 +8,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
 namespace {
@@ -18,13 +19,11 @@ const std::set<std::string> kTopFiles = {"run.json",         "composed.xml",
                                          "trajectory.csv",   "camera_info.yaml",
                                          "camera_info.json", "semantic_classes.json"};
 const std::set<std::string> kSensorFolders = {"imu", "sensors", "ground_truth"};
-const std::set<std::string> kImageFolders = {"rgb",
-                                             "depth",
-                                             "segmentation",
-                                             "range",
-                                             "normals",
-                                             "instance_segmentation",
-                                             "semantic_segmentation"};
+// image folders are named after the camera outputs
+bool IsImageFolder(const std::string& name) {
+  return std::find(CameraOutputs::kNames.begin(), CameraOutputs::kNames.end(), name) !=
+         CameraOutputs::kNames.end();
+}
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
@@ -68,7 +67,7 @@ class Scanner {
         case Kind::kCameraFolder:
           if (file && (name == "intrinsics.json" || name == "frames.csv")) continue;
           if (dir_entry) {
-            Folder(p, kImageFolders.count(name) ? Kind::kImageFolder : Kind::kCameraFolder);
+            Folder(p, IsImageFolder(name) ? Kind::kImageFolder : Kind::kCameraFolder);
             continue;
           }
           break;

@@ -9,9 +9,11 @@
 // Rec.709/sRGB primaries unless a name says srgb.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "penumbra/core/pose.h"
@@ -173,6 +175,14 @@ struct CameraOutputs {
   bool instance_segmentation = false;  ///< body index + 1 per pixel, 0 = background
   bool semantic_segmentation =
       false;  ///< Geom::semantic_class per pixel, 0 = background/unlabelled
+
+  /// the output names, in this order: they name the world file's `outputs` entries, the
+  /// `--outputs` flag's list and the image folders of a run.
+  static constexpr std::array<std::string_view, 7> kNames = {
+      "rgb",     "depth", "segmentation", "range", "normals", "instance_segmentation",
+      "semantic_segmentation"};
+  /// the flag of output `name` (one of kNames), or nullptr for any other name.
+  bool* Flag(std::string_view name);
 };
 
 /// a camera: rigidly attached to a body, or an MJCF camera posed by the snapshot.

@@ -251,16 +251,11 @@ class WorldParser {
 
   static CameraOutputs ReadOutputs(const YamlReader& r) {
     CameraOutputs o{false, false, false};
+    const std::vector<std::string_view> names(CameraOutputs::kNames.begin(),
+                                              CameraOutputs::kNames.end());
     for (const YamlReader& e : r.List()) {
-      const std::string v = e.Enum({"rgb", "depth", "segmentation", "range", "normals",
-                                    "instance_segmentation", "semantic_segmentation"});
-      bool& flag = v == "rgb"                     ? o.rgb
-                   : v == "depth"                 ? o.depth
-                   : v == "segmentation"          ? o.segmentation
-                   : v == "range"                 ? o.range
-                   : v == "normals"               ? o.normals
-                   : v == "instance_segmentation" ? o.instance_segmentation
-                                                  : o.semantic_segmentation;
+      const std::string v = e.Enum(names);
+      bool& flag = *o.Flag(v);
       if (flag) e.Fail("'" + v + "' is listed twice; expected each output once");
       flag = true;
     }
