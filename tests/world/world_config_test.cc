@@ -200,7 +200,7 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(w.models[0].pose.xyz, Eigen::Vector3d(0, 0, 0.05));
   EXPECT_EQ(w.models[0].pose.rpy_deg, Eigen::Vector3d(0, 0, 90));
   EXPECT_EQ(w.models[0].controller.type, "waypoint_follower");
-  EXPECT_EQ(w.models[0].controller.line, 24);
+  EXPECT_EQ(w.models[0].controller.line, 25);
   EXPECT_EQ(w.models[1].name, "arm");
   EXPECT_TRUE(w.models[1].is_robot);
   EXPECT_EQ(w.models[1].file, Abs("models/arm.urdf"));
