@@ -1,6 +1,8 @@
 // texture filtering by ray cones (render/material_eval.h): MuJoCo's standard checker ground plane
 // seen 15-60 m away must not alias (moire, bright dots from the edge marks), in both tiers and
-// at any thread count, while a near checker keeps its contrast.
+// at any thread count, while a near checker keeps its contrast and (anisotropic filtering, the
+// default max_anisotropy of RenderSettings) the grid lines running away from the camera keep
+// theirs.
 
 #include <gtest/gtest.h>
 
