@@ -12,11 +12,20 @@ for one frame, and prints, for the floor pixels whose range is in [15, 60] m:
     far_residual_std   the standard deviation of luminance minus its local mean (9 x 9 box)
 
 and, for the floor pixels nearer than 8 m, near_residual_std (the near checker's contrast,
-which filtering must keep). Luminance is Rec. 709 luma of the 8-bit sRGB values in [0, 1]
+which filtering must keep), and
+
+    line_contrast      the contrast of the edge-mark line y = 0, which runs away from the camera
+                       (the middle columns): per image row whose floor is 10-15 m away, the
+                       brightest luminance of the 7 columns around the middle over the median of
+                       the 25 around it (the next lines are >= 18 columns away), minus 1,
+                       averaged over those rows (0: the line is gone)
+
+Luminance is Rec. 709 luma of the 8-bit sRGB values in [0, 1]
 (as stored). Usage, from the repository root:
 
     python3 scripts/measure_texture_aliasing.py OUT_DIR [--penumbra build/penumbra]
                                                 [--tier realtime|pathtraced] [--spp N]
+                                                [--max-anisotropy N]
 """
 
 import argparse
@@ -43,7 +52,8 @@ FLOOR_XML = """<mujoco model="floor">
 WORLD_YAML = """seed: 1
 duration_sec: 0.05
 physics: {timestep_sec: 0.002}
-render: {tier: %(tier)s, samples_per_pixel: %(spp)d, max_bounces: 2, denoise: false}
+render: {tier: %(tier)s, samples_per_pixel: %(spp)d, max_bounces: 2, denoise: false,
+         max_anisotropy: %(aniso)d}
 sky: {type: daylight, turbidity: 3, sun_elevation_deg: 45, sun_azimuth_deg: 30}
 models:
   - {name: floor, file: floor.xml}
@@ -129,18 +139,32 @@ def residual_std(lum, mask, w, h, r=4):
     return (sum((v - m) ** 2 for v in vals) / len(vals)) ** 0.5, len(vals)
 
 
+def line_contrast(lum, rng, w, h):
+    """contrast of the line in the middle columns over the rows whose floor is 10-15 m away
+    (module docstring)."""
+    cu, vals = w // 2, []
+    for y in range(h):
+        if not 10000 <= rng[y][cu] <= 15000:
+            continue
+        win = sorted(lum[y][cu - 12:cu + 13])
+        peak = max(lum[y][cu - 3:cu + 4])
+        vals.append(peak / win[12] - 1 if win[12] > 0 else 0.0)
+    return (sum(vals) / len(vals) if vals else float("nan")), len(vals)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out_dir")
     ap.add_argument("--penumbra", default="build/penumbra")
     ap.add_argument("--tier", default="realtime", choices=["realtime", "pathtraced"])
     ap.add_argument("--spp", type=int, default=4)
+    ap.add_argument("--max-anisotropy", type=int, default=16)
     a = ap.parse_args()
     os.makedirs(a.out_dir, exist_ok=True)
     with open(os.path.join(a.out_dir, "floor.xml"), "w") as f:
         f.write(FLOOR_XML)
     with open(os.path.join(a.out_dir, "world.yaml"), "w") as f:
-        f.write(WORLD_YAML % {"tier": a.tier, "spp": a.spp})
+        f.write(WORLD_YAML % {"tier": a.tier, "spp": a.spp, "aniso": a.max_anisotropy})
     run = os.path.join(a.out_dir, "run")
     subprocess.run([a.penumbra, "run", os.path.join(a.out_dir, "world.yaml"), "--out", run],
                    check=True, stdout=subprocess.DEVNULL)
@@ -152,8 +176,11 @@ def main():
     near = [[0 < rng[y][x] < 8000 for x in range(w)] for y in range(h)]
     far_std, far_n = residual_std(lum, far, w, h)
     near_std, near_n = residual_std(lum, near, w, h)
-    print(json.dumps({"tier": a.tier, "far_residual_std": round(far_std, 5), "far_pixels": far_n,
+    contrast, contrast_rows = line_contrast(lum, rng, w, h)
+    print(json.dumps({"tier": a.tier, "max_anisotropy": a.max_anisotropy,
+                      "far_residual_std": round(far_std, 5), "far_pixels": far_n,
                       "near_residual_std": round(near_std, 5), "near_pixels": near_n,
+                      "line_contrast": round(contrast, 4), "line_rows": contrast_rows,
                       "image": os.path.join(run, "far", "rgb", "000000.png")}))
 
 

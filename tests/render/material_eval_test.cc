@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "penumbra/core/error.h"
 
@@ -127,6 +128,43 @@ TEST(MaterialEvalTest, MeshTexcoordsAreUsed) {
   const Eigen::Vector3f c = me.Evaluate(h).pbr.base_color;
   EXPECT_NEAR(c.y(), 1.0, 1e-6);
   EXPECT_NEAR(c.x(), 0.0, 1e-6);
+}
+
+// anisotropic filtering on mesh texcoords: stripes 8 texels wide across s (64 x 64 texels, one
+// texcoord unit per metre) seen at grazing incidence (|cos| 0.1, a footprint 2 x 20 texels).
+// with the footprint's long axis along the stripes (t) the taps stay on the white stripe; across
+// them (s), or with the isotropic lookup, the stripes average to grey.
+TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
+  std::vector<uint8_t> rgb;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const uint8_t c = (x / 8) % 2 ? 255 : 0;
+      rgb.insert(rgb.end(), {c, c, c});
+    }
+  Texture stripes;
+  stripes.name = "stripes";
+  stripes.image = std::make_shared<const TextureImage>(64, 64, 1, std::move(rgb));
+  SceneDescription s = OneGeom(GeomShape::kMesh, {0, 0, 0}, stripes);
+  s.meshes.push_back(TriangleMesh{});
+  s.geoms[0].mesh = 0;
+  SurfaceHit h = HitAt({0, 0, 0}, {0, 0, 1});
+  h.has_uv = true;
+  h.uv = {12.0f / 64, 0.5f};  // the middle of the white stripe of texels 8-15
+  h.uv_per_m = 1;
+  h.duv_dp_G << 1, 0, 0, 0, 1, 0;
+  TextureFootprint f;
+  f.width_m = 2.0f / 64;
+  f.cos_incidence = 0.1f;
+  const float sin = std::sqrt(1 - 0.1f * 0.1f);
+  auto grey = [&](const MaterialEvaluator& me, const Eigen::Vector3f& d_G) {
+    h.d_G = d_G;
+    return me.Evaluate(h, f).pbr.base_color.x();
+  };
+  const MaterialEvaluator iso(s, 1), aniso(s, 16);
+  const Eigen::Vector3f along_t(0, sin, -0.1f), along_s(sin, 0, -0.1f);
+  EXPECT_GT(grey(aniso, along_t), 0.9f);
+  EXPECT_NEAR(grey(aniso, along_s), 0.5f, 0.15f);
+  EXPECT_NEAR(grey(iso, along_t), 0.5f, 0.15f);
 }
 
 TEST(MaterialEvalTest, MaterialFieldsAndDefaults) {

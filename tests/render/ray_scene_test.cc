@@ -517,6 +517,56 @@ TriangleMesh Plate(int n) {
   return mesh;
 }
 
+// anisotropic texture filtering's inputs: a textured mesh on a turned body reports its
+// triangles' texcoord gradient in the geom frame and the ray direction in the geom frame, and an
+// analytic shape the ray direction in its frame.
+TEST(RaySceneTest, HitsCarryTexcoordGradientAndGeomFrameDirection) {
+  SceneDescription scene = EmptyScene();
+  const int body = AddBody(&scene, "arm");
+  TriangleMesh plate = Plate(4);
+  // u = 2 (x + 0.5), v = 3 (y + 0.5): du/dx = 2, dv/dy = 3.
+  for (const Eigen::Vector3f& p : plate.vertices)
+    plate.texcoords.emplace_back(2 * (p.x() + 0.5f), 3 * (p.y() + 0.5f));
+  scene.meshes.push_back(plate);
+  Pose X_BG = Translation(0, 0.1, 0);
+  X_BG.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const int mesh = AddGeom(&scene, GeomShape::kMesh, {1, 1, 1}, X_BG, body);
+  scene.geoms[mesh].mesh = 0;
+  const int sphere = AddGeom(&scene, GeomShape::kSphere, {0.2, 0, 0}, X_BG, body);
+  WorldSnapshot snap = testing::IdentitySnapshot(scene);
+  Pose X_WB = Translation(0.2, -0.1, 2);
+  X_WB.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  snap.X_WB[body] = X_WB;
+  RayScene rs(scene);
+  rs.Update(snap);
+  const Pose X_WG = X_WB * X_BG;
+  const Eigen::Matrix3f R_GW = X_WG.linear().transpose().cast<float>();
+  Ray ray;
+  // from below and to the side: the plate (z_G = 0, facing the ray's origin side) is met first
+  // at an oblique angle.
+  ray.o = Eigen::Vector3f(1.5f, 0.7f, 0.0f);
+  ray.d = (X_WG * Eigen::Vector3d(0.3, -0.2, 0) - ray.o.cast<double>()).cast<float>() * 2;
+  SurfaceHit hit;
+  ASSERT_TRUE(rs.Intersect(ray, &hit));
+  ASSERT_EQ(hit.geom, mesh);
+  ASSERT_TRUE(hit.has_uv);
+  Eigen::Matrix<float, 2, 3> J;
+  J << 2, 0, 0, 0, 3, 0;
+  EXPECT_LT((hit.duv_dp_G - J).cwiseAbs().maxCoeff(), 1e-4f) << hit.duv_dp_G;
+  EXPECT_LT((hit.d_G - R_GW * ray.d.normalized()).norm(), 1e-5f);
+  EXPECT_NEAR(hit.uv.x(), 2 * (0.3 + 0.5), 1e-4);
+  EXPECT_NEAR(hit.uv.y(), 3 * (-0.2 + 0.5), 1e-4);
+  // the sphere, seen from above (the plate is below its centre's ray).
+  Ray down;
+  down.o = (X_WG.translation() + Eigen::Vector3d(0.05, 0.02, 1)).cast<float>();
+  down.d = Eigen::Vector3f(0.1f, 0.05f, -1.0f);
+  ASSERT_TRUE(rs.Intersect(down, &hit));
+  ASSERT_EQ(hit.geom, sphere);
+  EXPECT_FALSE(hit.has_uv);
+  EXPECT_EQ(hit.duv_dp_G, (Eigen::Matrix<float, 2, 3>::Zero()));
+  EXPECT_LT((hit.d_G - R_GW * down.d.normalized()).norm(), 1e-5f);
+}
+
 TEST(RaySceneTest, BoxSphereAndMeshBodiesFollowTheirPoses) {
   // a body of a box and a sphere and a body holding a 3200-triangle mesh. after every Update,
   // rays find the box face, the sphere and the plate at their exact distances for the new

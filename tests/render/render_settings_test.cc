@@ -26,6 +26,8 @@ TEST(RenderSettingsTest, EachRangeIsChecked) {
        "expected [1, 65536]"},
       {[](RenderSettings* s) { s->max_bounces = 0; }, "render.max_bounces", "expected [1, 64]"},
       {[](RenderSettings* s) { s->threads = -1; }, "render.threads", "expected [0, 256]"},
+      {[](RenderSettings* s) { s->max_anisotropy = 65; }, "render.max_anisotropy",
+       "expected [1, 64]"},
       {[](RenderSettings* s) { s->ev100 = -11; }, "render.exposure.ev100", "expected [-10, 30]"},
       {[](RenderSettings* s) { s->exposure_compensation_ev = NAN; },
        "render.exposure.compensation_ev", "expected [-20, 20]"},
@@ -47,6 +49,7 @@ TEST(RenderSettingsTest, EachRangeIsChecked) {
   edge.samples_per_pixel = 65536;
   edge.max_bounces = 64;
   edge.threads = 256;
+  edge.max_anisotropy = 1;
   edge.ev100 = 30;
   EXPECT_NO_THROW(edge.ValidateOrThrow());
 }

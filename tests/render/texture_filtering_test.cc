@@ -1,6 +1,8 @@
 // texture filtering by ray cones (render/material_eval.h): MuJoCo's standard checker ground plane
 // seen 15-60 m away must not alias (moire, bright dots from the edge marks), in both tiers and
-// at any thread count, while a near checker keeps its contrast.
+// at any thread count, while a near checker keeps its contrast and (anisotropic filtering, the
+// default max_anisotropy of RenderSettings) the grid lines running away from the camera keep
+// theirs.
 
 #include <gtest/gtest.h>
 
@@ -189,6 +191,52 @@ TEST(TextureFilteringTest, NearCheckerStaysSharp) {
     // 10th percentile: a dark check; 60th: a bright one (the marks cover ~1 % of the floor).
     EXPECT_NEAR(hi / lo, y(kRgb1) / y(kRgb2), 0.05 * y(kRgb1) / y(kRgb2))
         << "tier " << static_cast<int>(settings.tier);
+  }
+}
+
+// the contrast of the checker's edge-mark line y = 0 (it runs along the view direction, so it
+// projects to the middle column) on the floor 10-15 m away: per image row there, the brightest
+// of the 5 columns around the middle over the median of the 13 around it (the next lines,
+// y = +-0.2 m, are >= 9 columns away), minus 1, averaged over the rows.
+double RunAwayLineContrast(const RenderedFrame& f, int* rows) {
+  const int cu = f.radiance.width / 2;
+  double sum = 0;
+  *rows = 0;
+  for (int v = 0; v < f.radiance.height; ++v) {
+    const float range = *f.range_m.at(cu, v);
+    if (!(range >= 10 && range <= 15)) continue;
+    std::vector<double> l;
+    double peak = 0;
+    for (int du = -6; du <= 6; ++du) {
+      l.push_back(Luminance(f.radiance.at(cu + du, v)));
+      if (std::abs(du) <= 2) peak = std::max(peak, l.back());
+    }
+    std::nth_element(l.begin(), l.begin() + 6, l.end());
+    sum += peak / l[6] - 1;
+    ++*rows;
+  }
+  return *rows > 0 ? sum / *rows : 0;
+}
+
+// anisotropic filtering keeps the grid lines that run away from the camera, which the isotropic
+// lookup (its level follows the footprint's long axis) blurs into the floor's mean, and the far
+// floor still does not alias, in both tiers.
+TEST(TextureFilteringTest, AnisotropicFilteringKeepsRunAwayLines) {
+  const SceneDescription s = CheckerFloor();
+  const CameraView view = FarView();
+  for (const RenderSettings& base : {TestSettings(1), PathSettings(1)}) {
+    RenderSettings iso = base, aniso = base;
+    iso.max_anisotropy = 1;
+    aniso.max_anisotropy = 16;
+    const RenderedFrame fi = RenderWith(s, iso, view), fa = RenderWith(s, aniso, view);
+    int rows = 0;
+    const double ci = RunAwayLineContrast(fi, &rows);
+    const double ca = RunAwayLineContrast(fa, &rows);
+    EXPECT_GT(rows, 10);
+    EXPECT_GT(ca, 0.2) << "tier " << static_cast<int>(base.tier) << ", isotropic " << ci;
+    EXPECT_GT(ca, 3 * ci) << "tier " << static_cast<int>(base.tier);
+    int n = 0;
+    EXPECT_LT(RelativeResidualStd(fa, 15, 60, &n), 0.1) << "tier " << static_cast<int>(base.tier);
   }
 }
 

@@ -82,6 +82,7 @@ render:
   max_bounces: 6
   denoise: false
   threads: 3
+  max_anisotropy: 4
   exposure: {mode: manual, ev100: 12.5, compensation_ev: -1}
   tone_map: linear
 sky:
@@ -174,6 +175,7 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(w.render.max_bounces, 6);
   EXPECT_FALSE(w.render.denoise);
   EXPECT_EQ(w.render.threads, 3);
+  EXPECT_EQ(w.render.max_anisotropy, 4);
   EXPECT_FALSE(w.render.auto_exposure);
   EXPECT_EQ(w.render.ev100, 12.5);
   EXPECT_EQ(w.render.exposure_compensation_ev, -1);
@@ -198,7 +200,7 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(w.models[0].pose.xyz, Eigen::Vector3d(0, 0, 0.05));
   EXPECT_EQ(w.models[0].pose.rpy_deg, Eigen::Vector3d(0, 0, 90));
   EXPECT_EQ(w.models[0].controller.type, "waypoint_follower");
-  EXPECT_EQ(w.models[0].controller.line, 24);
+  EXPECT_EQ(w.models[0].controller.line, 25);
   EXPECT_EQ(w.models[1].name, "arm");
   EXPECT_TRUE(w.models[1].is_robot);
   EXPECT_EQ(w.models[1].file, Abs("models/arm.urdf"));
@@ -505,6 +507,11 @@ TEST_F(WorldConfigTest, TimestepOutOfRange) {
 TEST_F(WorldConfigTest, RenderSamplesOutOfRangeNamesWorldFileAndLine) {
   ExpectError("seed: 3\nrender:\n  tier: pathtraced\n  samples_per_pixel: 0\n", 4,
               "render.samples_per_pixel", "got 0; expected [1, 65536]");
+}
+
+TEST_F(WorldConfigTest, MaxAnisotropyOutOfRange) {
+  ExpectError("render:\n  max_anisotropy: 0\n", 2, "render.max_anisotropy",
+              "got 0; expected [1, 64]");
 }
 
 TEST_F(WorldConfigTest, ManualEv100OutOfRange) {

@@ -37,7 +37,7 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
     : scene_(scene),
       settings_((settings.ValidateOrThrow(), settings)),
       ray_scene_(std::make_unique<RayScene>(scene_)),
-      materials_(scene_),
+      materials_(scene_, settings_.max_anisotropy),
       lights_(scene_),
       sky_(scene_.sky),
       effects_(scene_),

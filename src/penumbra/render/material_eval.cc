@@ -75,6 +75,44 @@ Eigen::Vector3f Trilinear(const TextureImage& image, float lod, const BilinearFn
   return (1 - f) * a + f * bilinear(image.level(l + 1));
 }
 
+// the footprint ellipse's axes on the surface, geom frame (file comment, "anisotropic
+// filtering"): major = t W / |n . v|, minor = b W. false when there is no width or the ray meets
+// the surface head-on (no direction to stretch along).
+bool FootprintAxes(const SurfaceHit& hit, const TextureFootprint& f, Eigen::Vector3f* major_G,
+                   Eigen::Vector3f* minor_G) {
+  if (!(f.width_m > 0)) return false;
+  const Eigen::Vector3f& n = hit.n_G;
+  const Eigen::Vector3f t = hit.d_G - hit.d_G.dot(n) * n;
+  const float len = t.norm();
+  if (!(len > 1e-4f)) return false;
+  const Eigen::Vector3f t_unit = t / len;
+  *major_G = t_unit * (f.width_m / std::max(f.cos_incidence, kMinCosIncidence));
+  *minor_G = n.cross(t_unit) * f.width_m;
+  return true;
+}
+
+// the taps of an anisotropic lookup for axis lengths (in level-0 texels) l_major, l_minor:
+// their number N and level.
+struct AnisoTaps {
+  int n = 1;
+  float lod = 0;
+};
+AnisoTaps TapsFor(float l_major, float l_minor, int max_anisotropy) {
+  if (l_minor > l_major) std::swap(l_major, l_minor);
+  AnisoTaps taps;
+  const float ratio = l_minor > 0 ? l_major / l_minor : static_cast<float>(max_anisotropy);
+  taps.n = static_cast<int>(std::min(static_cast<float>(max_anisotropy), std::ceil(ratio)));
+  taps.n = std::max(taps.n, 1);
+  const float l = std::max(l_minor, l_major / static_cast<float>(taps.n));
+  taps.lod = l > 0 ? std::log2(l) : 0.0f;
+  return taps;
+}
+
+// offset of tap k of n along the major axis, in units of the axis: ((k + 1/2) / n - 1/2).
+float TapOffset(int k, int n) {
+  return (static_cast<float>(k) + 0.5f) / static_cast<float>(n) - 0.5f;
+}
+
 // half extents of a geom's bounding box in its own frame (zero where a shape is flat).
 Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g) {
   const Eigen::Vector3d& s = g.size;
@@ -116,8 +154,10 @@ TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::
   return f;
 }
 
-MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene)
-    : scene_(scene), srgb_to_linear_(SrgbDecodeTable()) {
+MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anisotropy)
+    : scene_(scene),
+      srgb_to_linear_(SrgbDecodeTable()),
+      max_anisotropy_(std::max(1, max_anisotropy)) {
   for (const Material& m : scene.materials) {
     if (m.texture < 0) continue;
     if (m.texture >= static_cast<int>(scene.textures.size()))
@@ -195,14 +235,19 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
   const Eigen::Vector3f& h = half_extent_G_[hit.geom];
   // texels per metre of surface of the mapping at the hit (rho, file comment); 0 = unknown.
   float rho = 0;
+  Eigen::Vector3f major_G, minor_G;
+  const bool aniso = max_anisotropy_ > 1 && FootprintAxes(hit, footprint, &major_G, &minor_G);
   Eigen::Vector3f c;
   if (tex.kind == Texture::Kind::k2D) {
     const float th = static_cast<float>(tex.image->height());
     float s, t;
+    // texture units (1 = one image) per metre of geom-frame displacement (anisotropic path).
+    Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
     if (hit.has_uv) {
       s = hit.uv.x();
       t = hit.uv.y();
       rho = hit.uv_per_m * std::sqrt(w * th);
+      J = hit.duv_dp_G;
     } else {
       // planar projection along the dominant axis of the geom-frame normal: face axes
       // (a0, a1) = the next two axes in cyclic order, image rows along -a1.
@@ -215,22 +260,53 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
         s = hit.p_G[a0] * m.texrepeat.x();
         t = -hit.p_G[a1] * m.texrepeat.y();
         rho = std::sqrt(std::abs(m.texrepeat.x()) * w * std::abs(m.texrepeat.y()) * th);
+        J(0, a0) = m.texrepeat.x();
+        J(1, a1) = -m.texrepeat.y();
       } else {
         const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;
         s = (0.5f * hit.p_G[a0] / h0 + 0.5f) * m.texrepeat.x();
         t = (0.5f - 0.5f * hit.p_G[a1] / h1) * m.texrepeat.y();
         rho = std::sqrt(std::abs(m.texrepeat.x()) * w / (2 * h0) * std::abs(m.texrepeat.y()) * th /
                         (2 * h1));
+        J(0, a0) = 0.5f * m.texrepeat.x() / h0;
+        J(1, a1) = -0.5f * m.texrepeat.y() / h1;
       }
     }
-    c = Sample2D(m.texture, s, t, TextureLod(footprint, rho));
+    const Eigen::Vector2f major_st = J * major_G, minor_st = J * minor_G;
+    const Eigen::Vector2f texels(w, th);
+    const float l_major = major_st.cwiseProduct(texels).norm();
+    const float l_minor = minor_st.cwiseProduct(texels).norm();
+    if (aniso && l_major > 0) {
+      // the axis the taps spread along: the longer one in texels.
+      const bool swap = l_minor > l_major;
+      const Eigen::Vector2f axis = swap ? minor_st : major_st;
+      const AnisoTaps taps = TapsFor(l_major, l_minor, max_anisotropy_);
+      c.setZero();
+      for (int k = 0; k < taps.n; ++k) {
+        const float o = TapOffset(k, taps.n);
+        c += Sample2D(m.texture, s + o * axis.x(), t + o * axis.y(), taps.lod);
+      }
+      c /= static_cast<float>(taps.n);
+    } else {
+      c = Sample2D(m.texture, s, t, TextureLod(footprint, rho));
+    }
   } else {
-    const Eigen::Vector3f q(h.x() > 0 ? hit.p_G.x() / h.x() : hit.n_G.x(),
-                            h.y() > 0 ? hit.p_G.y() / h.y() : hit.n_G.y(),
-                            h.z() > 0 ? hit.p_G.z() / h.z() : hit.n_G.z());
+    auto q_of = [&](const Eigen::Vector3f& p_G) {
+      return Eigen::Vector3f(h.x() > 0 ? p_G.x() / h.x() : hit.n_G.x(),
+                             h.y() > 0 ? p_G.y() / h.y() : hit.n_G.y(),
+                             h.z() > 0 ? p_G.z() / h.z() : hit.n_G.z());
+    };
     const float h_max = h.maxCoeff();
     rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
-    c = SampleCube(m.texture, q, TextureLod(footprint, rho));
+    if (aniso && rho > 0) {
+      const AnisoTaps taps = TapsFor(major_G.norm() * rho, minor_G.norm() * rho, max_anisotropy_);
+      c.setZero();
+      for (int k = 0; k < taps.n; ++k)
+        c += SampleCube(m.texture, q_of(hit.p_G + TapOffset(k, taps.n) * major_G), taps.lod);
+      c /= static_cast<float>(taps.n);
+    } else {
+      c = SampleCube(m.texture, q_of(hit.p_G), TextureLod(footprint, rho));
+    }
   }
   out.pbr.base_color = out.pbr.base_color.cwiseProduct(c);
   return out;

@@ -31,9 +31,22 @@
 // area ratio, the paper's t_a / p_a); cube textures, w / (2 max(h)). the colour is a trilinear
 // lookup: bilinear in levels floor(lambda) and floor(lambda) + 1, mixed by the fraction
 // (lambda <= 0: bilinear in level 0, beyond the last level: bilinear in the last level).
-// isotropic: at grazing angles the footprint is long and thin, and the level follows its long
-// axis (textures blur there rather than alias). the lookup depends on the hit and the cone only,
-// so images do not depend on the thread count.
+// with max_anisotropy 1 this isotropic lookup is all: at grazing angles the footprint is long
+// and thin, and the level follows its long axis (textures blur there rather than alias).
+//
+// anisotropic filtering (max_anisotropy N_max > 1; the paper's anisotropic section and the
+// footprint assembly of Schilling, Knittel, Strasser, "Texram: A Smart Memory for Texturing",
+// IEEE CG&A 1996, as in EXT_texture_filter_anisotropic): the cone meets the surface in an
+// ellipse with minor axis W along b = n x t and major axis W / |n . v| along t, the ray
+// direction projected on the surface (n, t, b in the geom frame: SurfaceHit::n_G, d_G). both
+// axes are mapped to texels by the mapping's gradient (planar mapping: its per-axis scales;
+// mesh texcoords: SurfaceHit::duv_dp_G of the hit triangle, times the image size), giving
+// lengths L_maj >= L_min. N = min(N_max, ceil(L_maj / L_min)) trilinear taps at level
+// lambda = log2(max(L_min, L_maj / N)) are placed at offsets ((k + 1/2) / N - 1/2) of the major
+// axis, k = 0 .. N-1, and averaged with equal weights. cube textures: the taps are the cube
+// lookups of the displaced points, the lengths those of the isotropic rho. a footprint without
+// a width, or seen head-on, takes the isotropic lookup. deterministic: no random numbers; the
+// lookup depends on the hit and the cone only, so images do not depend on the thread count.
 
 #include <Eigen/Core>
 #include <vector>
@@ -79,7 +92,9 @@ class MaterialEvaluator {
   /// precomputes per-geom texture mapping data. `scene` must outlive this object.
   /// @throws Error if a material refers to a missing texture or a texture without an image,
   /// or a cube or skybox texture whose image does not hold six square faces.
-  explicit MaterialEvaluator(const SceneDescription& scene);
+  /// `max_anisotropy` (>= 1; 1 = isotropic) caps the taps of an anisotropic lookup (file
+  /// comment, "anisotropic filtering"); values below 1 count as 1.
+  explicit MaterialEvaluator(const SceneDescription& scene, int max_anisotropy = 1);
 
   /// material at `hit` (default Material when hit.material < 0), its texture filtered over
   /// `footprint` (file comment; the default footprint gives bilinear level-0 lookups).
@@ -99,6 +114,7 @@ class MaterialEvaluator {
   Material default_material_;
   std::vector<Eigen::Vector3f> half_extent_G_;  // per geom: local bounding-box half extents
   const float* srgb_to_linear_;                 // 256 entries (SrgbDecodeTable)
+  int max_anisotropy_ = 1;
 };
 
 }  // namespace penumbra

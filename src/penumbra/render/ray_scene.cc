@@ -53,6 +53,11 @@ struct TriangleGeom {
   // per face when there are texcoords: sqrt(texcoord area / surface area), texcoord units per
   // metre (the ray-cone texture level of detail's triangle term, SurfaceHit::uv_per_m).
   std::vector<float> uv_per_m;
+  // per face when there are texcoords: the texcoord gradient in the geom frame
+  // (SurfaceHit::duv_dp_G).
+  std::vector<Eigen::Matrix<float, 2, 3>> duv_dp_G;
+  // rotation from the instance frame to the geom frame (SurfaceHit::d_G).
+  Eigen::Matrix3f R_GI = Eigen::Matrix3f::Identity();
 };
 
 // what an Embree (instanced scene, geomID) pair stands for.
@@ -296,8 +301,23 @@ struct RayScene::Impl {
           const Eigen::Vector2f e1 = tg->texcoords[f[1]] - t0, e2 = tg->texcoords[f[2]] - t0;
           const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
           tg->uv_per_m.push_back(area > 0 ? std::sqrt(uv_area / area) : 0.0f);
+          // J with J e1 = duv1, J e2 = duv2, J n = 0: J = [duv1 duv2 0] [e1 e2 n]^-1.
+          const Eigen::Vector3f p1 = tg->vertices_G[f[1]] - p0, p2 = tg->vertices_G[f[2]] - p0;
+          const Eigen::Vector3f n = p1.cross(p2);
+          Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
+          if (area > 0 && uv_area > 0) {
+            Eigen::Matrix3f E;
+            E << p1, p2, n / area;
+            Eigen::Matrix<float, 2, 3> F = Eigen::Matrix<float, 2, 3>::Zero();
+            F.col(0) = e1;
+            F.col(1) = e2;
+            J = F * E.inverse();
+            if (!J.allFinite()) J.setZero();
+          }
+          tg->duv_dp_G.push_back(J);
         }
       }
+      tg->R_GI = R_GI;
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
       rtcSetSharedGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                  tg->vertices_I.data(), 0, sizeof(Eigen::Vector3f),
@@ -412,6 +432,7 @@ struct RayScene::Impl {
     hit->has_uv = false;
     hit->uv.setZero();
     hit->uv_per_m = 0;
+    hit->duv_dp_G.setZero();
     Eigen::Vector3f ng_W, ns_W;
     if (rec.analytic) {
       const AnalyticGeom& g = *rec.analytic;
@@ -421,6 +442,7 @@ struct RayScene::Impl {
       const Eigen::Vector3d n_G = AnalyticNormal(g.shape, p_G, part);
       hit->p_G = p_G.cast<float>();
       hit->n_G = n_G.cast<float>();
+      hit->d_G = (g.R_GW * ray.d.cast<double>()).normalized().cast<float>();
       ng_W = (g.R_WG * n_G).cast<float>();
       ns_W = ng_W;
     } else {
@@ -433,6 +455,9 @@ struct RayScene::Impl {
       hit->n_G = fn.n_G;
       // the static group's frame is the world frame: no rotation to apply.
       ng_W = group.rotated ? Eigen::Vector3f(group.R_WI_f * fn.n_I) : fn.n_I;
+      const Eigen::Vector3f d_I =
+          group.rotated ? Eigen::Vector3f(group.R_WI_f.transpose() * ray.d) : ray.d;
+      hit->d_G = (g.R_GI * d_I).normalized();
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
@@ -444,6 +469,7 @@ struct RayScene::Impl {
         hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];
         hit->has_uv = true;
         hit->uv_per_m = g.uv_per_m[rh.hit.primID];
+        hit->duv_dp_G = g.duv_dp_G[rh.hit.primID];
       }
     }
     hit->front_face = ng_W.dot(ray.d) <= 0;

@@ -78,6 +78,12 @@ struct SurfaceHit {
   /// with has_uv: texcoord units per metre of surface on the hit triangle, sqrt(uv area / area)
   /// (for texture level of detail); else 0.
   float uv_per_m = 0;
+  /// with has_uv: the hit triangle's texcoord gradient, texcoord units per metre of a
+  /// geom-frame displacement in its plane (duv = duv_dp_G dp_G; zero across the plane, and
+  /// all zero for a triangle whose vertices or texcoords are degenerate); else zero.
+  Eigen::Matrix<float, 2, 3> duv_dp_G = Eigen::Matrix<float, 2, 3>::Zero();
+  /// unit direction of the ray in the geom frame (anisotropic texture filtering).
+  Eigen::Vector3f d_G{0, 0, -1};
   bool front_face = true;        ///< the ray hit the outward side (before flipping the normals)
   Eigen::Vector3f p_G{0, 0, 0};  ///< hit point in the geom frame, m (planar texture mapping)
   Eigen::Vector3f n_G{0, 0, 1};  ///< unit outward geometric normal in the geom frame (not flipped)

@@ -32,6 +32,7 @@ void RenderSettings::ValidateOrThrow() const {
   CheckClosed("samples_per_pixel", samples_per_pixel, 1, kMaxSamplesPerPixel);
   CheckClosed("max_bounces", max_bounces, 1, kMaxBounces);
   CheckClosed("threads", threads, 0, kMaxThreads);
+  CheckClosed("max_anisotropy", max_anisotropy, 1, kMaxAnisotropy);
   CheckClosed("exposure.ev100", ev100, kMinEv100, kMaxEv100);
   CheckClosed("exposure.compensation_ev", exposure_compensation_ev, -kMaxCompensationEv,
               kMaxCompensationEv);

@@ -24,12 +24,16 @@ struct RenderSettings {
   enum class ToneMap { kFilmic, kLinear };
   ToneMap tone_map = ToneMap::kFilmic;  ///< filmic: ACES fit (Narkowicz 2015); linear: clamp
   uint64_t seed = 0;           ///< world seed; per-pixel randomness = f(seed, frame, pixel, sample)
+  /// most trilinear taps of an anisotropic texture lookup (render/material_eval.h,
+  /// "filtering"); 1 = isotropic trilinear filtering. both tiers.
+  int max_anisotropy = 16;
 
   /// valid ranges (inclusive), checked by ValidateOrThrow and by the world-file loader
   /// (which links without the renderer).
   static constexpr int kMaxSamplesPerPixel = 65536;
   static constexpr int kMaxBounces = 64;
   static constexpr int kMaxThreads = 256;
+  static constexpr int kMaxAnisotropy = 64;
   static constexpr double kMinEv100 = -10, kMaxEv100 = 30;
   static constexpr double kMaxCompensationEv = 20;  ///< |exposure_compensation_ev| <= this
 

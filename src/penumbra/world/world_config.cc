@@ -119,8 +119,8 @@ class WorldParser {
   static Eigen::Vector3f Vector3f(const YamlReader& r) { return r.Vector3().cast<float>(); }
 
   static void ReadRender(const YamlReader& r, RenderSettings* s) {
-    r.ExpectMap(
-        {"tier", "samples_per_pixel", "max_bounces", "denoise", "threads", "exposure", "tone_map"});
+    r.ExpectMap({"tier", "samples_per_pixel", "max_bounces", "denoise", "threads", "exposure",
+                 "tone_map", "max_anisotropy"});
     if (r.Has("tier")) {
       s->tier = r.Child("tier").Enum({"realtime", "pathtraced"}) == "realtime"
                     ? RenderSettings::Tier::kRealtime
@@ -130,6 +130,7 @@ class WorldParser {
     if (r.Has("max_bounces")) s->max_bounces = r.Child("max_bounces").Int();
     if (r.Has("denoise")) s->denoise = r.Child("denoise").Bool();
     if (r.Has("threads")) s->threads = r.Child("threads").Int();
+    if (r.Has("max_anisotropy")) s->max_anisotropy = r.Child("max_anisotropy").Int();
     if (r.Has("exposure")) {
       YamlReader e = r.Child("exposure");
       e.ExpectMap({"mode", "ev100", "compensation_ev"});

@@ -162,6 +162,7 @@ class Validator {
           Range::Closed(1, R::kMaxSamplesPerPixel));
     Check("render.max_bounces", r.max_bounces, Range::Closed(1, R::kMaxBounces));
     Check("render.threads", r.threads, Range::Closed(0, R::kMaxThreads));
+    Check("render.max_anisotropy", r.max_anisotropy, Range::Closed(1, R::kMaxAnisotropy));
     Check("render.exposure.ev100", r.ev100, Range::Closed(R::kMinEv100, R::kMaxEv100));
     Check("render.exposure.compensation_ev", r.exposure_compensation_ev,
           Range::Closed(-R::kMaxCompensationEv, R::kMaxCompensationEv));
