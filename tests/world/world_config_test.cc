@@ -839,9 +839,8 @@ TEST_F(WorldConfigTest, LocateInWorldPlacesStageErrors) {
 }
 
 TEST_F(WorldConfigTest, MissingVdbFileIsFoundAtLoad) {
-  ExpectError(
-      "effects:\n  - name: v\n    type: vdb_smoke\n    file: nothere.vdb\n", 4,
-      "effects[0].file", "file not found");
+  ExpectError("effects:\n  - name: v\n    type: vdb_smoke\n    file: nothere.vdb\n", 4,
+              "effects[0].file", "file not found");
 }
 
 }  // namespace

@@ -178,9 +178,13 @@ struct CameraOutputs {
 
   /// the output names, in this order: they name the world file's `outputs` entries, the
   /// `--outputs` flag's list and the image folders of a run.
-  static constexpr std::array<std::string_view, 7> kNames = {
-      "rgb",     "depth", "segmentation", "range", "normals", "instance_segmentation",
-      "semantic_segmentation"};
+  static constexpr std::array<std::string_view, 7> kNames = {"rgb",
+                                                             "depth",
+                                                             "segmentation",
+                                                             "range",
+                                                             "normals",
+                                                             "instance_segmentation",
+                                                             "semantic_segmentation"};
   /// the flag of output `name` (one of kNames), or nullptr for any other name.
   bool* Flag(std::string_view name);
 };

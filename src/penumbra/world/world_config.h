@@ -173,8 +173,8 @@ WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_nam
 
 /// `e` with the world file and the line of its key filled in, when `e` names no file (or the
 /// world file without a line) and its key is a world-file key path (e.g. "effects[2].light",
-/// raised by a stage after loading); otherwise `e` unchanged. errors about command-line flags (keys starting with '-') and
-/// errors of bare-model runs (no world file) keep their origin.
+/// raised by a stage after loading); otherwise `e` unchanged. errors about command-line flags (keys
+/// starting with '-') and errors of bare-model runs (no world file) keep their origin.
 ConfigError LocateInWorld(const WorldConfig& world, const ConfigError& e);
 
 /// a world around one bare MJCF or URDF file: a default camera framing the model,
