@@ -91,23 +91,31 @@ bool FootprintAxes(const SurfaceHit& hit, const TextureFootprint& f, Eigen::Vect
   return true;
 }
 
-// the taps of an anisotropic lookup for axis lengths (in level-0 texels) l_major, l_minor:
-// their number N and level. N = the axis ratio rounded to the nearest integer (below 1.5: one
-// tap), capped at max_anisotropy. one tap keeps the trilinear lookup at lambda; several taps
-// share the mip level nearest to lambda (an integer), each a bilinear lookup in that level only.
+// the taps of an anisotropic lookup for squared axis lengths (in level-0 texels^2) l2_major,
+// l2_minor: their number N and level. N = the axis ratio rounded to the nearest integer (below
+// 1.5: one tap), capped at max_anisotropy. one tap keeps the trilinear lookup at lambda = log2
+// of the longer axis; several taps share the mip level nearest to lambda = log2(max(L_min,
+// L_maj / N)), an integer, each a bilinear lookup in that level only. the squared lengths
+// spare the square roots, and the level of several taps comes from the float exponent:
+// round(lambda) = floor(log2(2 l^2) / 2) = floor(ilogb(2 l^2) / 2).
 struct AnisoTaps {
   int n = 1;
   float lod = 0;
 };
-AnisoTaps TapsFor(float l_major, float l_minor, int max_anisotropy) {
-  if (l_minor > l_major) std::swap(l_major, l_minor);
+inline AnisoTaps TapsFor(float l2_major, float l2_minor, int max_anisotropy) {
+  if (l2_minor > l2_major) std::swap(l2_major, l2_minor);
   AnisoTaps taps;
   const float cap = static_cast<float>(max_anisotropy);
-  const float ratio = l_minor > 0 ? std::min(cap, l_major / l_minor) : cap;
-  taps.n = std::max(1, static_cast<int>(std::floor(ratio + 0.5f)));
-  const float l = std::max(l_minor, l_major / static_cast<float>(taps.n));
-  taps.lod = l > 0 ? std::log2(l) : 0.0f;
-  if (taps.n > 1) taps.lod = std::max(0.0f, std::floor(taps.lod + 0.5f));
+  const float ratio = l2_minor > 0 ? std::min(cap, std::sqrt(l2_major / l2_minor)) : cap;
+  taps.n = std::max(1, static_cast<int>(ratio + 0.5f));
+  if (taps.n == 1) {
+    taps.lod = l2_major > 0 ? 0.5f * std::log2(l2_major) : 0.0f;
+    return taps;
+  }
+  const float nf = static_cast<float>(taps.n);
+  const float l2 = std::max(l2_minor, l2_major / (nf * nf));
+  // l2 >= 1/2 gives a level >= 0 (smaller footprints: level 0).
+  taps.lod = l2 >= 0.5f ? static_cast<float>(std::ilogb(2 * l2) / 2) : 0.0f;
   return taps;
 }
 
@@ -319,15 +327,21 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
         J(1, a1) = -0.5f * m.texrepeat.y() / h1;
       }
     }
-    const Eigen::Vector2f major_st = J * major_G, minor_st = J * minor_G;
-    const Eigen::Vector2f texels(w, th);
-    const float l_major = major_st.cwiseProduct(texels).norm();
-    const float l_minor = minor_st.cwiseProduct(texels).norm();
-    if (aniso && l_major > 0) {
+    // the axes in texture units and their squared lengths in level-0 texels.
+    Eigen::Vector2f major_st, minor_st;
+    float l2_major = 0, l2_minor = 0;
+    if (aniso) {
+      major_st = J * major_G;
+      minor_st = J * minor_G;
+      const Eigen::Vector2f texels(w, th);
+      l2_major = major_st.cwiseProduct(texels).squaredNorm();
+      l2_minor = minor_st.cwiseProduct(texels).squaredNorm();
+    }
+    if (aniso && l2_major > 0) {
       // the axis the taps spread along: the longer one in texels.
-      const bool swap = l_minor > l_major;
+      const bool swap = l2_minor > l2_major;
       const Eigen::Vector2f axis = swap ? minor_st : major_st;
-      const AnisoTaps taps = TapsFor(l_major, l_minor, max_anisotropy_);
+      const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
       if (taps.n == 1) {
         c = Sample2D(m.texture, s, t, taps.lod);
       } else {
@@ -347,7 +361,9 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     const float h_max = h.maxCoeff();
     rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
     if (aniso && rho > 0) {
-      const AnisoTaps taps = TapsFor(major_G.norm() * rho, minor_G.norm() * rho, max_anisotropy_);
+      const float rho2 = rho * rho;
+      const AnisoTaps taps =
+          TapsFor(major_G.squaredNorm() * rho2, minor_G.squaredNorm() * rho2, max_anisotropy_);
       c.setZero();
       for (int k = 0; k < taps.n; ++k)
         c += SampleCube(m.texture, q_of(hit.p_G + TapOffset(k, taps.n) * major_G), taps.lod);
