@@ -167,6 +167,54 @@ TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
   EXPECT_NEAR(grey(iso, along_t), 0.5f, 0.15f);
 }
 
+// the tap rule of the anisotropic lookup (material_eval.h, "anisotropic filtering"): N = the
+// axis ratio rounded (below 1.5: one trilinear tap at the major axis' level), several taps
+// bilinear in the one level nearest to log2(max(L_min, L_maj / N)).
+TEST(MaterialEvalTest, AnisotropicTapsRoundTheRatioAndShareOneLevel) {
+  std::vector<uint8_t> rgb;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const uint8_t c = (x / 8) % 2 ? 255 : 0;
+      rgb.insert(rgb.end(), {c, c, c});
+    }
+  Texture stripes;
+  stripes.name = "stripes";
+  stripes.image = std::make_shared<const TextureImage>(64, 64, 1, std::move(rgb));
+  SceneDescription sc = OneGeom(GeomShape::kMesh, {0, 0, 0}, stripes);
+  sc.meshes.push_back(TriangleMesh{});
+  sc.geoms[0].mesh = 0;
+  SurfaceHit h = HitAt({0, 0, 0}, {0, 0, 1});
+  h.has_uv = true;
+  const float s = 9.0f / 64, t = 0.5f;  // near the black-white edge at texel 8
+  h.uv = {s, t};
+  h.uv_per_m = 1;
+  h.duv_dp_G << 1, 0, 0, 0, 1, 0;
+  TextureFootprint f;
+  f.width_m = 2.6f / 64;  // minor axis 2.6 texels
+  const MaterialEvaluator me(sc, 16);
+  auto evaluate = [&](float cos) {
+    f.cos_incidence = cos;
+    h.d_G = Eigen::Vector3f(std::sqrt(1 - cos * cos), 0, -cos);  // major axis along s
+    return me.Evaluate(h, f).pbr.base_color.x();
+  };
+  // the mean of n taps along s over a major axis of `major_s` (texture units), each at `lod`.
+  auto taps = [&](int n, float major_s, float lod) {
+    float sum = 0;
+    for (int k = 0; k < n; ++k)
+      sum += me.Sample2D(0, s + ((k + 0.5f) / n - 0.5f) * major_s, t, lod).x();
+    return sum / n;
+  };
+  // ratio 4: 4 taps at lambda = log2(2.6) = 1.38 -> level 1 (not a trilinear mix of 1 and 2).
+  const float major4 = f.width_m / 0.25f;
+  EXPECT_NEAR(evaluate(0.25f), taps(4, major4, 1.0f), 1e-5f);
+  EXPECT_GT(std::abs(taps(4, major4, 1.0f) - taps(4, major4, std::log2(2.6f))), 1e-3f);
+  // ratio 1.3: one trilinear tap at the major axis' level log2(3.38) (not two taps).
+  const float cos13 = 1 / 1.3f, major13 = f.width_m / cos13;
+  EXPECT_NEAR(evaluate(cos13), taps(1, major13, std::log2(2.6f * 1.3f)), 1e-5f);
+  EXPECT_GT(std::abs(taps(1, major13, std::log2(2.6f * 1.3f)) - taps(2, major13, std::log2(2.6f))),
+            1e-3f);
+}
+
 TEST(MaterialEvalTest, MaterialFieldsAndDefaults) {
   SceneDescription s = OneGeom(GeomShape::kSphere, {1, 0, 0}, Quad());
   s.materials[0].texture = -1;

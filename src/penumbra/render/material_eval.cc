@@ -91,21 +91,76 @@ bool FootprintAxes(const SurfaceHit& hit, const TextureFootprint& f, Eigen::Vect
   return true;
 }
 
-// the taps of an anisotropic lookup for axis lengths (in level-0 texels) l_major, l_minor:
-// their number N and level.
+// the taps of an anisotropic lookup for squared axis lengths (in level-0 texels^2) l2_major,
+// l2_minor: their number N and level. N = the axis ratio rounded to the nearest integer (below
+// 1.5: one tap), capped at max_anisotropy. one tap keeps the trilinear lookup at lambda = log2
+// of the longer axis; several taps share the mip level nearest to lambda = log2(max(L_min,
+// L_maj / N)), an integer, each a bilinear lookup in that level only. the squared lengths
+// spare the square roots, and the level of several taps comes from the float exponent:
+// round(lambda) = floor(log2(2 l^2) / 2) = floor(ilogb(2 l^2) / 2).
 struct AnisoTaps {
   int n = 1;
   float lod = 0;
 };
-AnisoTaps TapsFor(float l_major, float l_minor, int max_anisotropy) {
-  if (l_minor > l_major) std::swap(l_major, l_minor);
+inline AnisoTaps TapsFor(float l2_major, float l2_minor, int max_anisotropy) {
+  if (l2_minor > l2_major) std::swap(l2_major, l2_minor);
   AnisoTaps taps;
-  const float ratio = l_minor > 0 ? l_major / l_minor : static_cast<float>(max_anisotropy);
-  taps.n = static_cast<int>(std::min(static_cast<float>(max_anisotropy), std::ceil(ratio)));
-  taps.n = std::max(taps.n, 1);
-  const float l = std::max(l_minor, l_major / static_cast<float>(taps.n));
-  taps.lod = l > 0 ? std::log2(l) : 0.0f;
+  const float cap = static_cast<float>(max_anisotropy);
+  const float ratio = l2_minor > 0 ? std::min(cap, std::sqrt(l2_major / l2_minor)) : cap;
+  taps.n = std::max(1, static_cast<int>(ratio + 0.5f));
+  if (taps.n == 1) {
+    taps.lod = l2_major > 0 ? 0.5f * std::log2(l2_major) : 0.0f;
+    return taps;
+  }
+  const float nf = static_cast<float>(taps.n);
+  const float l2 = std::max(l2_minor, l2_major / (nf * nf));
+  // l2 >= 1/2 gives a level >= 0 (smaller footprints: level 0).
+  taps.lod = l2 >= 0.5f ? static_cast<float>(std::ilogb(2 * l2) / 2) : 0.0f;
   return taps;
+}
+
+// the level index an integer lod (TapsFor, N > 1) selects, clamped to the image's levels.
+int TapLevel(const TextureImage& image, float lod) {
+  return std::min(static_cast<int>(lod), image.num_levels() - 1);
+}
+
+// mean of n bilinear lookups in one level (wrapped) at (s, t) + o_k (ds, dt), with the tap
+// offsets o_k = (k + 1/2) / n - 1/2 (footprint assembly along the major axis).
+Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, float s, float t,
+                                 float ds, float dt, int n) {
+  const int w = L.width, h = L.height;
+  const float fw = static_cast<float>(w), fh = static_cast<float>(h);
+  const uint8_t* p = L.rgb_srgb.data();
+  const float step = 1.0f / static_cast<float>(n);
+  const float o0 = 0.5f * step - 0.5f;
+  float r = 0, g = 0, b = 0;
+  for (int k = 0; k < n; ++k) {
+    const float o = o0 + static_cast<float>(k) * step;
+    const float u = s + o * ds, v = t + o * dt;
+    // texel centres at (i + 0.5) / w, as BilinearWrap.
+    const float x = (u - std::floor(u)) * fw - 0.5f;
+    const float y = (v - std::floor(v)) * fh - 0.5f;
+    const float x0f = std::floor(x), y0f = std::floor(y);
+    const float fx = x - x0f, fy = y - y0f;
+    int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+    int x1 = x0 + 1, y1 = y0 + 1;
+    x0 = x0 < 0 ? x0 + w : x0;
+    y0 = y0 < 0 ? y0 + h : y0;
+    x1 = x1 >= w ? x1 - w : x1;
+    y1 = y1 >= h ? y1 - h : y1;
+    const uint8_t* r0 = p + static_cast<size_t>(y0) * w * 3;
+    const uint8_t* r1 = p + static_cast<size_t>(y1) * w * 3;
+    const uint8_t* a = r0 + x0 * 3;
+    const uint8_t* bq = r0 + x1 * 3;
+    const uint8_t* c = r1 + x0 * 3;
+    const uint8_t* d = r1 + x1 * 3;
+    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy);
+    const float w01 = (1 - fx) * fy, w11 = fx * fy;
+    r += w00 * decode[a[0]] + w10 * decode[bq[0]] + w01 * decode[c[0]] + w11 * decode[d[0]];
+    g += w00 * decode[a[1]] + w10 * decode[bq[1]] + w01 * decode[c[1]] + w11 * decode[d[1]];
+    b += w00 * decode[a[2]] + w10 * decode[bq[2]] + w01 * decode[c[2]] + w11 * decode[d[2]];
+  }
+  return Eigen::Vector3f(r, g, b) * step;
 }
 
 // offset of tap k of n along the major axis, in units of the axis: ((k + 1/2) / n - 1/2).
@@ -272,21 +327,28 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
         J(1, a1) = -0.5f * m.texrepeat.y() / h1;
       }
     }
-    const Eigen::Vector2f major_st = J * major_G, minor_st = J * minor_G;
-    const Eigen::Vector2f texels(w, th);
-    const float l_major = major_st.cwiseProduct(texels).norm();
-    const float l_minor = minor_st.cwiseProduct(texels).norm();
-    if (aniso && l_major > 0) {
+    // the axes in texture units and their squared lengths in level-0 texels.
+    Eigen::Vector2f major_st, minor_st;
+    float l2_major = 0, l2_minor = 0;
+    if (aniso) {
+      major_st = J * major_G;
+      minor_st = J * minor_G;
+      const Eigen::Vector2f texels(w, th);
+      l2_major = major_st.cwiseProduct(texels).squaredNorm();
+      l2_minor = minor_st.cwiseProduct(texels).squaredNorm();
+    }
+    if (aniso && l2_major > 0) {
       // the axis the taps spread along: the longer one in texels.
-      const bool swap = l_minor > l_major;
+      const bool swap = l2_minor > l2_major;
       const Eigen::Vector2f axis = swap ? minor_st : major_st;
-      const AnisoTaps taps = TapsFor(l_major, l_minor, max_anisotropy_);
-      c.setZero();
-      for (int k = 0; k < taps.n; ++k) {
-        const float o = TapOffset(k, taps.n);
-        c += Sample2D(m.texture, s + o * axis.x(), t + o * axis.y(), taps.lod);
+      const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
+      if (taps.n == 1) {
+        c = Sample2D(m.texture, s, t, taps.lod);
+      } else {
+        const TextureImage& image = *tex.image;
+        c = BilinearWrapTaps(image.level(TapLevel(image, taps.lod)), srgb_to_linear_, s, t,
+                             axis.x(), axis.y(), taps.n);
       }
-      c /= static_cast<float>(taps.n);
     } else {
       c = Sample2D(m.texture, s, t, TextureLod(footprint, rho));
     }
@@ -299,7 +361,9 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     const float h_max = h.maxCoeff();
     rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
     if (aniso && rho > 0) {
-      const AnisoTaps taps = TapsFor(major_G.norm() * rho, minor_G.norm() * rho, max_anisotropy_);
+      const float rho2 = rho * rho;
+      const AnisoTaps taps =
+          TapsFor(major_G.squaredNorm() * rho2, minor_G.squaredNorm() * rho2, max_anisotropy_);
       c.setZero();
       for (int k = 0; k < taps.n; ++k)
         c += SampleCube(m.texture, q_of(hit.p_G + TapOffset(k, taps.n) * major_G), taps.lod);

@@ -41,12 +41,16 @@
 // direction projected on the surface (n, t, b in the geom frame: SurfaceHit::n_G, d_G). both
 // axes are mapped to texels by the mapping's gradient (planar mapping: its per-axis scales;
 // mesh texcoords: SurfaceHit::duv_dp_G of the hit triangle, times the image size), giving
-// lengths L_maj >= L_min. N = min(N_max, ceil(L_maj / L_min)) trilinear taps at level
-// lambda = log2(max(L_min, L_maj / N)) are placed at offsets ((k + 1/2) / N - 1/2) of the major
-// axis, k = 0 .. N-1, and averaged with equal weights. cube textures: the taps are the cube
-// lookups of the displaced points, the lengths those of the isotropic rho. a footprint without
-// a width, or seen head-on, takes the isotropic lookup. deterministic: no random numbers; the
-// lookup depends on the hit and the cone only, so images do not depend on the thread count.
+// lengths L_maj >= L_min. N = min(N_max, L_maj / L_min) rounded to the nearest integer (a
+// ratio below 1.5 gives N = 1: one trilinear lookup at lambda = log2(L_maj)); N > 1 taps are
+// placed at offsets ((k + 1/2) / N - 1/2) of the major axis, k = 0 .. N-1, each a bilinear
+// lookup in the one mip level nearest to lambda = log2(max(L_min, L_maj / N)) (round(lambda),
+// clamped to the levels; the taps already integrate along the major axis, so they skip the
+// second level of a trilinear lookup: half the texel reads), averaged with equal weights. cube
+// textures: the taps are the cube lookups of the displaced points, the lengths those of the
+// isotropic rho. a footprint without a width, or seen head-on, takes the isotropic lookup.
+// deterministic: no random numbers; the lookup depends on the hit and the cone only, so images
+// do not depend on the thread count.
 
 #include <Eigen/Core>
 #include <vector>
