@@ -495,28 +495,33 @@ struct RayScene::Impl {
     rtcInitIntersectContext(&ctx);
     alignas(64) RTCRayHit16 p;
     alignas(64) int valid[kPacket];
-    int fill = -1;  // idle lanes repeat an active, traceable ray (harmless values)
-    int local_index[kPacket];
+    // idle lanes repeat an active ray (harmless values). the common case, every active ray
+    // traceable, is checked in one branch-free pass; the rest only when one is not
+    int fill = -1;
+    bool all_traceable = true;
     for (int k = 0; k < kPacket; ++k) {
-      local_index[k] = index[k];
-      if (index[k] >= 0 && IsTraceableRay(rays[index[k]])) fill = index[k];
+      if (index[k] < 0) continue;
+      fill = index[k];
+      all_traceable &= IsTraceableRay(rays[index[k]]);
     }
-    if (fill < 0) {
+    if (fill < 0) return;
+    int local_index[kPacket];
+    for (int k = 0; k < kPacket; ++k) local_index[k] = index[k];
+    if (!all_traceable) {
+      // untraceable rays are misses: their lanes stay inactive (filled with a traceable ray)
+      fill = -1;
       for (int k = 0; k < kPacket; ++k) {
         if (index[k] < 0) continue;
+        if (IsTraceableRay(rays[index[k]])) {
+          fill = index[k];
+          continue;
+        }
         const Ray& r = rays[index[k]];
         NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
         did_hit[index[k]] = false;
+        local_index[k] = -1;
       }
-      return;
-    }
-    // untraceable rays are misses: their lanes stay inactive (filled with the active ray)
-    for (int k = 0; k < kPacket; ++k) {
-      if (index[k] < 0 || IsTraceableRay(rays[index[k]])) continue;
-      const Ray& r = rays[index[k]];
-      NoteUntraceable(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z());
-      did_hit[index[k]] = false;
-      local_index[k] = -1;
+      if (fill < 0) return;
     }
     for (int k = 0; k < kPacket; ++k) {
       valid[k] = local_index[k] >= 0 ? -1 : 0;
@@ -808,30 +813,26 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
   rtcInitIntersectContext(&ctx);
   alignas(64) RTCRay16 p;
   alignas(64) int valid[kPacket];
+  // untraceable rays (NaN, infinite, out of range) are not traced: a miss, not occluded. the
+  // common case, every active lane traceable, is one branch-free pass
   LaneMask traced = active;
+  bool all_traceable = true;
   for (int k = 0; k < kPacket; ++k) {
-    if (active[k] &&
-        !IsTraceableRay(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k], 0.0f, tmax[k])) {
-      impl_->NoteUntraceable(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k]);
-      traced[k] = false;
+    all_traceable &=
+        !active[k] | IsTraceableRay(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k], 0.0f, tmax[k]);
+  }
+  if (!all_traceable) {
+    for (int k = 0; k < kPacket; ++k) {
+      if (active[k] &&
+          !IsTraceableRay(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k], 0.0f, tmax[k])) {
+        impl_->NoteUntraceable(o.x[k], o.y[k], o.z[k], d.x[k], d.y[k], d.z[k]);
+        traced[k] = false;
+      }
     }
   }
+  // lanes that are not traced may hold any values: Embree reads only the valid ones
   for (int k = 0; k < kPacket; ++k) {
-    // inactive lanes get a harmless ray: Embree may read them
-    const bool use = traced[k];
-    valid[k] = use ? -1 : 0;
-    if (!use) {
-      p.org_x[k] = p.org_y[k] = p.org_z[k] = 0;
-      p.dir_x[k] = p.dir_y[k] = 0;
-      p.dir_z[k] = 1;
-      p.tnear[k] = 0;
-      p.tfar[k] = 0;
-      p.time[k] = 0;
-      p.mask[k] = 0xffffffffu;
-      p.id[k] = 0;
-      p.flags[k] = 0;
-      continue;
-    }
+    valid[k] = traced[k] ? -1 : 0;
     p.org_x[k] = o.x[k];
     p.org_y[k] = o.y[k];
     p.org_z[k] = o.z[k];

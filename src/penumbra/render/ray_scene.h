@@ -114,9 +114,10 @@ Ray SpawnRayTo(const SurfaceHit& hit, const Eigen::Vector3f& p_W);
 inline bool IsTraceableRay(float ox, float oy, float oz, float dx, float dy, float dz, float tmin,
                            float tmax) {
   constexpr float m = kMaxRayComponent;
-  // written so that NaN fails every comparison
-  return std::abs(ox) <= m && std::abs(oy) <= m && std::abs(oz) <= m && std::abs(dx) <= m &&
-         std::abs(dy) <= m && std::abs(dz) <= m && tmin == tmin && tmax == tmax;
+  // written so that NaN fails every comparison; `&` rather than `&&`: no branches, so that the
+  // check of a packet's lanes vectorises (it runs for every ray traced)
+  return (std::abs(ox) <= m) & (std::abs(oy) <= m) & (std::abs(oz) <= m) & (std::abs(dx) <= m) &
+         (std::abs(dy) <= m) & (std::abs(dz) <= m) & (tmin == tmin) & (tmax == tmax);
 }
 inline bool IsTraceableRay(const Ray& r) {
   return IsTraceableRay(r.o.x(), r.o.y(), r.o.z(), r.d.x(), r.d.y(), r.d.z(), r.tmin, r.tmax);
