@@ -82,7 +82,9 @@ void ExpectNothingPartial(const fs::path& out, bool allow_temporaries = false) {
       EXPECT_NO_THROW(ReadPng(e.path().string())) << e.path();
     } else if (e.path().extension() == ".csv") {
       const std::string text = ReadAll(e.path());
-      if (!text.empty()) EXPECT_EQ(text.back(), '\n') << e.path();
+      if (!text.empty()) {
+        EXPECT_EQ(text.back(), '\n') << e.path();
+      }
       continue;
     }
     EXPECT_GT(fs::file_size(e.path()), 0u) << "empty file: " << e.path();
@@ -230,7 +232,7 @@ TEST_F(RunOutputsTest, OutputsFlagForBareModelsAndWorlds) {
                                 tmp_.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // the default camera and the model's own camera both
-  for (const fs::path cam : {bare / "default", bare / "ball" / "overhead"}) {
+  for (const fs::path& cam : {bare / "default", bare / "ball" / "overhead"}) {
     EXPECT_GE(CountFiles(cam / "depth", ".png"), 1) << cam;
     EXPECT_GE(CountFiles(cam / "normals", ".png"), 1) << cam;
     EXPECT_FALSE(fs::exists(cam / "rgb")) << cam;

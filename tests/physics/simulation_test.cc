@@ -265,10 +265,14 @@ TEST(SimTimeOfStep, IsTheSmallestDoubleAtOrAboveTheExactStepTime) {
       // exact comparisons of t against n / R (or n dt) through fma
       if (integer_rate) {
         ASSERT_GE(std::fma(t, rate, -nd), 0) << dt << " " << n;
-        if (n > 0) ASSERT_LT(std::fma(std::nextafter(t, 0.0), rate, -nd), 0) << dt << " " << n;
+        if (n > 0) {
+          ASSERT_LT(std::fma(std::nextafter(t, 0.0), rate, -nd), 0) << dt << " " << n;
+        }
       } else {
         ASSERT_GE(std::fma(-nd, dt, t), 0) << dt << " " << n;
-        if (n > 0) ASSERT_LT(std::fma(-nd, dt, std::nextafter(t, 0.0)), 0) << dt << " " << n;
+        if (n > 0) {
+          ASSERT_LT(std::fma(-nd, dt, std::nextafter(t, 0.0)), 0) << dt << " " << n;
+        }
       }
     }
   }
@@ -297,7 +301,9 @@ TEST(Simulation, TimeComesFromTheStepCount) {
     ASSERT_EQ(sim.time(), SimTimeOfStep(n, 0.002)) << n;
     // a 10 Hz frame every 50 steps: floor(t * 10) is the frame index (summed time gave
     // 3.999999999999781 at step 2000)
-    if (n % 50 == 0) ASSERT_EQ(static_cast<int64_t>(std::floor(sim.time() * 10)), n / 50) << n;
+    if (n % 50 == 0) {
+      ASSERT_EQ(static_cast<int64_t>(std::floor(sim.time() * 10)), n / 50) << n;
+    }
   }
   EXPECT_EQ(sim.Snapshot().time_sec, SimTimeOfStep(5000, 0.002));
 }
