@@ -13,21 +13,36 @@ namespace {
 // the smallest |cos| of incidence the level of detail divides by (grazing rays).
 constexpr float kMinCosIncidence = 1e-4f;
 
+// the four texels around wrapped coordinates (s, t) (in images, 1 = one image) of a w x h
+// level, and the bilinear fractions between them.
+struct WrappedTexels {
+  int x0, y0, x1, y1;
+  float fx, fy;
+};
+inline WrappedTexels WrapTexels(float s, float t, int w, int h) {
+  // texel centres at (i + 0.5) / w; wrap the integer part away first to keep precision.
+  const float x = (s - std::floor(s)) * static_cast<float>(w) - 0.5f;
+  const float y = (t - std::floor(t)) * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(x), y0f = std::floor(y);
+  WrappedTexels q;
+  q.fx = x - x0f;
+  q.fy = y - y0f;
+  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
+  q.x0 = static_cast<int>(x0f);
+  q.y0 = static_cast<int>(y0f);
+  q.x1 = q.x0 + 1;
+  q.y1 = q.y0 + 1;
+  q.x0 = q.x0 < 0 ? q.x0 + w : q.x0;
+  q.y0 = q.y0 < 0 ? q.y0 + h : q.y0;
+  q.x1 = q.x1 >= w ? q.x1 - w : q.x1;
+  q.y1 = q.y1 >= h ? q.y1 - h : q.y1;
+  return q;
+}
+
 // bilinear lookup in one level, wrapped; (s, t) in images (1 = one image).
 Eigen::Vector3f BilinearWrap(const TextureLevel& L, const float* decode, float s, float t) {
   const int w = L.width, h = L.height;
-  // texel centres at (i + 0.5) / w; wrap the integer part away first to keep precision.
-  const float x = (s - std::floor(s)) * w - 0.5f;
-  const float y = (t - std::floor(t)) * h - 0.5f;
-  const float x0f = std::floor(x), y0f = std::floor(y);
-  const float fx = x - x0f, fy = y - y0f;
-  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
-  int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
-  int x1 = x0 + 1, y1 = y0 + 1;
-  x0 = x0 < 0 ? x0 + w : x0;
-  y0 = y0 < 0 ? y0 + h : y0;
-  x1 = x1 >= w ? x1 - w : x1;
-  y1 = y1 >= h ? y1 - h : y1;
+  const auto [x0, y0, x1, y1, fx, fy] = WrapTexels(s, t, w, h);
   const uint8_t* p = L.rgb_srgb.data();
   auto texel = [&](int xi, int yi) {
     const uint8_t* q = p + (static_cast<size_t>(yi) * w + xi) * 3;
@@ -129,7 +144,6 @@ int TapLevel(const TextureImage& image, float lod) {
 Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, float s, float t,
                                  float ds, float dt, int n) {
   const int w = L.width, h = L.height;
-  const float fw = static_cast<float>(w), fh = static_cast<float>(h);
   const uint8_t* p = L.rgb_srgb.data();
   const float step = 1.0f / static_cast<float>(n);
   const float o0 = 0.5f * step - 0.5f;
@@ -137,17 +151,7 @@ Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, flo
   for (int k = 0; k < n; ++k) {
     const float o = o0 + static_cast<float>(k) * step;
     const float u = s + o * ds, v = t + o * dt;
-    // texel centres at (i + 0.5) / w, as BilinearWrap.
-    const float x = (u - std::floor(u)) * fw - 0.5f;
-    const float y = (v - std::floor(v)) * fh - 0.5f;
-    const float x0f = std::floor(x), y0f = std::floor(y);
-    const float fx = x - x0f, fy = y - y0f;
-    int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
-    int x1 = x0 + 1, y1 = y0 + 1;
-    x0 = x0 < 0 ? x0 + w : x0;
-    y0 = y0 < 0 ? y0 + h : y0;
-    x1 = x1 >= w ? x1 - w : x1;
-    y1 = y1 >= h ? y1 - h : y1;
+    const auto [x0, y0, x1, y1, fx, fy] = WrapTexels(u, v, w, h);
     const uint8_t* r0 = p + static_cast<size_t>(y0) * w * 3;
     const uint8_t* r1 = p + static_cast<size_t>(y1) * w * 3;
     const uint8_t* a = r0 + x0 * 3;
