@@ -158,6 +158,36 @@ TEST_F(RunOutputsTest, SigintStopsAtAStepBoundaryWritesEverythingAndExits130) {
 
 TEST_F(RunOutputsTest, SigtermDoesTheSameAndExits143) { InterruptAndCheck(SIGTERM, 143); }
 
+TEST_F(RunOutputsTest, ASecondSignalExitsAtOnce) {
+  // frames that take seconds each (pathtraced, 4096 samples per pixel): after the first
+  // SIGINT the run would render the queued frames and then write run.json; the second SIGINT
+  // must end it before that, with 130 and no run.json
+  const fs::path out = tmp_.path() / "out";
+  const std::string world =
+      World("slow.yaml", 64, 48, 20, "rgb", 60,
+            "render: {tier: pathtraced, samples_per_pixel: 4096, denoise: false}\n");
+  ChildProcess p({"run", world, "--out", out.string(), "-q"}, tmp_.path());
+  // composed.xml is written once the run is set up, after the handlers are installed
+  bool set_up = false;
+  for (int i = 0; i < 3000 && !set_up; ++i) {
+    set_up = fs::exists(out / "composed.xml");
+    if (!set_up) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(set_up) << p.err();
+  p.Signal(SIGINT);
+  // the second signal only once the first was handled (two pending SIGINTs would merge)
+  bool handled = false;
+  for (int i = 0; i < 3000 && !handled; ++i) {
+    handled = p.err().find("signal again to exit at once") != std::string::npos;
+    if (!handled) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(handled) << p.err();
+  p.Signal(SIGINT);
+  EXPECT_EQ(p.Wait(), 130) << p.err();
+  EXPECT_FALSE(fs::exists(out / "run.json"));
+  EXPECT_EQ(CountFiles(out / "cam" / "rgb", ".png"), 0);
+}
+
 TEST_F(RunOutputsTest, SigkillLeavesNoTruncatedPngAndForceClearsTheRest) {
   const fs::path out = tmp_.path() / "out";
   const std::string world = World("w.yaml", 160, 120, 200, "rgb, depth, segmentation", 60);
