@@ -42,13 +42,13 @@ bool IsScanFile(const std::string& name) {
   return std::all_of(name.begin() + 5, name.end() - 4, [](char c) { return c >= '0' && c <= '9'; });
 }
 
-enum class Kind { kCameraFolder, kImageFolder, kLidarFolder, kSensorFolder };
+enum class Kind { kTop, kCameraFolder, kImageFolder, kLidarFolder, kSensorFolder };
 
 class Scanner {
  public:
   Scanner(const fs::path& root, size_t limit) : root_(root), limit_(limit) {}
 
-  // checks the entries of folder `dir` of kind `kind`
+  // checks the entries of folder `dir` of kind `kind` (root_ itself is kTop)
   void Folder(const fs::path& dir, Kind kind) {
     std::error_code ec;
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
@@ -64,6 +64,19 @@ class Scanner {
       const bool dir_entry = fs::is_directory(st), file = fs::is_regular_file(st);
       if (file && IsTemporaryOutputName(name)) continue;
       switch (kind) {
+        case Kind::kTop:
+          if (file && kTopFiles.count(name)) continue;
+          if (dir_entry) {
+            Folder(p, name == "lidar"              ? Kind::kLidarFolder
+                      : kSensorFolders.count(name) ? Kind::kSensorFolder
+                                                   : Kind::kCameraFolder);
+            continue;
+          }
+          if (!file) {
+            Foreign(p, " (not a file or folder)");
+            continue;
+          }
+          break;
         case Kind::kCameraFolder:
           if (file && (name == "intrinsics.json" || name == "frames.csv")) continue;
           if (dir_entry) {
@@ -95,28 +108,7 @@ class Scanner {
   }
 
   // the top level of the output folder
-  void Top() {
-    std::error_code ec;
-    for (fs::directory_iterator it(root_, ec), end; !ec && it != end; it.increment(ec)) {
-      if (found.size() >= limit_) return;
-      const fs::path p = it->path();
-      const std::string name = p.filename().string();
-      const fs::file_status st = it->symlink_status(ec);
-      if (ec) break;
-      if (fs::is_symlink(st)) {
-        Foreign(p, " (a symbolic link)");
-      } else if (fs::is_regular_file(st)) {
-        if (!kTopFiles.count(name) && !IsTemporaryOutputName(name)) Foreign(p, "");
-      } else if (fs::is_directory(st)) {
-        Folder(p, name == "lidar"              ? Kind::kLidarFolder
-                  : kSensorFolders.count(name) ? Kind::kSensorFolder
-                                               : Kind::kCameraFolder);
-      } else {
-        Foreign(p, " (not a file or folder)");
-      }
-    }
-    if (ec) throw Error("cannot list '" + root_.string() + "': " + ec.message());
-  }
+  void Top() { Folder(root_, Kind::kTop); }
 
   std::vector<std::string> found;
 
