@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
@@ -61,12 +62,7 @@ cameras:
     stereo: {baseline_m: 0.1}
 )";
 
-std::string ReadAll(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using testing::ReadAll;
 
 class CameraRunTest : public ::testing::Test {
  protected:

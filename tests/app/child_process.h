@@ -18,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include "common/temp_dir.h"
+
 extern char** environ;
 
 namespace penumbra::testing {
@@ -62,16 +64,10 @@ class ChildProcess {
     return WEXITSTATUS(status);
   }
 
-  std::string out() const { return Read(out_path_); }
-  std::string err() const { return Read(err_path_); }
+  std::string out() const { return ReadAll(out_path_); }
+  std::string err() const { return ReadAll(err_path_); }
 
  private:
-  static std::string Read(const std::filesystem::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-  }
   pid_t pid_ = -1;
   std::filesystem::path out_path_, err_path_;
 };

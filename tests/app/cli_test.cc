@@ -25,12 +25,7 @@ constexpr char kBoxMjcf[] = R"(<mujoco model="m">
   </worldbody>
 </mujoco>)";
 
-std::string ReadAll(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using testing::ReadAll;
 
 class CliTest : public ::testing::Test {
  protected:

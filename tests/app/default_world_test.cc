@@ -11,6 +11,7 @@
 #include <limits>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
@@ -26,12 +27,7 @@ namespace fs = std::filesystem;
 const char kDefaultWorld[] = PENUMBRA_SOURCE_DIR "/worlds/default.yaml";
 const std::string kRobot = "go1";
 
-std::string ReadAll(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using testing::ReadAll;
 
 // rows of trajectory.csv (step, time_sec, qpos...) as numbers
 std::vector<std::vector<double>> ReadTrajectory(const fs::path& csv) {

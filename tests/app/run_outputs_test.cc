@@ -45,12 +45,7 @@ constexpr char kBallMjcf[] = R"(<mujoco model="ball">
   </worldbody>
 </mujoco>)";
 
-std::string ReadAll(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using testing::ReadAll;
 
 int64_t CountFiles(const fs::path& dir, const std::string& ext) {
   if (!fs::exists(dir)) return 0;

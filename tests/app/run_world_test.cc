@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
@@ -37,12 +38,7 @@ constexpr char kBallMjcf[] = R"(
   </worldbody>
 </mujoco>)";
 
-std::string ReadAll(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+using testing::ReadAll;
 
 class RunWorldTest : public ::testing::Test {
  protected:

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -43,6 +44,14 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+/// the whole content of file `p` ("" when it cannot be read).
+inline std::string ReadAll(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
 
 /// a TempDir that lives as long as the test process: a drop-in for
 /// ::testing::TempDir() whose files no other test process can see.

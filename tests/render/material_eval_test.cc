@@ -130,11 +130,9 @@ TEST(MaterialEvalTest, MeshTexcoordsAreUsed) {
   EXPECT_NEAR(c.x(), 0.0, 1e-6);
 }
 
-// anisotropic filtering on mesh texcoords: stripes 8 texels wide across s (64 x 64 texels, one
-// texcoord unit per metre) seen at grazing incidence (|cos| 0.1, a footprint 2 x 20 texels).
-// with the footprint's long axis along the stripes (t) the taps stay on the white stripe; across
-// them (s), or with the isotropic lookup, the stripes average to grey.
-TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
+// one mesh geom with a 64 x 64 texture of vertical stripes 8 texels wide (black at texels
+// 0-7, white at 8-15, ...), for the anisotropic lookups below.
+SceneDescription StripedMesh() {
   std::vector<uint8_t> rgb;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
@@ -147,6 +145,15 @@ TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
   SceneDescription s = OneGeom(GeomShape::kMesh, {0, 0, 0}, stripes);
   s.meshes.push_back(TriangleMesh{});
   s.geoms[0].mesh = 0;
+  return s;
+}
+
+// anisotropic filtering on mesh texcoords: stripes 8 texels wide across s (64 x 64 texels, one
+// texcoord unit per metre) seen at grazing incidence (|cos| 0.1, a footprint 2 x 20 texels).
+// with the footprint's long axis along the stripes (t) the taps stay on the white stripe; across
+// them (s), or with the isotropic lookup, the stripes average to grey.
+TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
+  const SceneDescription s = StripedMesh();
   SurfaceHit h = HitAt({0, 0, 0}, {0, 0, 1});
   h.has_uv = true;
   h.uv = {12.0f / 64, 0.5f};  // the middle of the white stripe of texels 8-15
@@ -171,18 +178,7 @@ TEST(MaterialEvalTest, AnisotropicLookupFollowsTheTexcoordGradient) {
 // axis ratio rounded (below 1.5: one trilinear tap at the major axis' level), several taps
 // bilinear in the one level nearest to log2(max(L_min, L_maj / N)).
 TEST(MaterialEvalTest, AnisotropicTapsRoundTheRatioAndShareOneLevel) {
-  std::vector<uint8_t> rgb;
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 64; ++x) {
-      const uint8_t c = (x / 8) % 2 ? 255 : 0;
-      rgb.insert(rgb.end(), {c, c, c});
-    }
-  Texture stripes;
-  stripes.name = "stripes";
-  stripes.image = std::make_shared<const TextureImage>(64, 64, 1, std::move(rgb));
-  SceneDescription sc = OneGeom(GeomShape::kMesh, {0, 0, 0}, stripes);
-  sc.meshes.push_back(TriangleMesh{});
-  sc.geoms[0].mesh = 0;
+  const SceneDescription sc = StripedMesh();
   SurfaceHit h = HitAt({0, 0, 0}, {0, 0, 1});
   h.has_uv = true;
   const float s = 9.0f / 64, t = 0.5f;  // near the black-white edge at texel 8
