@@ -7,13 +7,13 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "penumbra/app/camera_specs.h"
-#include "penumbra/app/scene_assembly.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/camera_info.h"
 #include "penumbra/output/camera_writer.h"
 #include "penumbra/output/png_io.h"
+#include "penumbra/session/camera_specs.h"
+#include "penumbra/session/scene_assembly.h"
 
 namespace penumbra {
 namespace {

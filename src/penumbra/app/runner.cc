@@ -10,13 +10,7 @@
 #include <thread>
 
 #include "penumbra/app/camera_stage.h"
-#include "penumbra/app/effects_stage.h"
-#include "penumbra/app/run_budget.h"
-#include "penumbra/app/scene_assembly.h"
 #include "penumbra/app/sensor_stage.h"
-#include "penumbra/compose/imu_injection.h"
-#include "penumbra/compose/scene_composer.h"
-#include "penumbra/control/controller_factory.h"
 #include "penumbra/core/bounded_queue.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
@@ -26,9 +20,11 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/sensors/sensor_schedule.h"
+#include "penumbra/session/effects_stage.h"
+#include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
@@ -44,7 +40,7 @@ struct RenderJob {
   WorldSnapshot snapshot;
   std::vector<int> cameras;
   std::vector<int64_t> frame_indices;
-  std::vector<std::shared_ptr<const EffectsFrame>> effects;  // per camera (app/effects_stage.h)
+  std::vector<std::shared_ptr<const EffectsFrame>> effects;  // per camera (session/effects_stage.h)
   std::exception_ptr error;  // set on the last job if physics failed
 };
 
@@ -216,37 +212,20 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
 
   std::map<std::string, double> timings;
 
-  // compose every model into one MJCF and keep it next to the outputs
-  auto t0 = Clock::now();
-  ComposeOptions compose_options;
-  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
-  compose_options.timestep_sec = world.timestep_sec;
-  ComposedScene composed = ComposeWorld(world.models, compose_options);
-  AddImuSensors(world.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
-  EffectsStage effects(world, &composed, options.adversity);  // + agent bodies
-  for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
-  const std::string composed_path = (out / "composed.xml").string();
-  WriteComposedScene(composed, composed_path);
-  timings["compose_sec"] = SecondsSince(t0);
-
-  // physics and controllers
-  t0 = Clock::now();
-  Simulation sim = Simulation::LoadFromFile(composed_path, world.timestep_sec);
-  for (const ModelConfig& m : world.models) {
-    if (!m.is_robot || m.controller.type.empty()) continue;
-    sim.AddController(MakeController(m.controller, m.name, world.file));
-  }
-  effects.Attach(&sim);
-  timings["load_sec"] = SecondsSince(t0);
-
-  // static scene for the renderer
-  t0 = Clock::now();
-  const SceneDescription scene = effects.Bind(AssembleScene(sim.scene(), world, sim.Snapshot()));
-  CheckRunMemory(world, scene, PhysicalMemoryBytes());  // app/run_budget.h: before allocating
-  if (auto work = DescribeRunWork(EstimateRunWork(world, scene, sim.timestep())))
-    spdlog::warn("{}", *work);
-  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
-  timings["scene_build_sec"] = SecondsSince(t0);
+  // compose, load, scene, effects and renderer, once (session/session.h); composed.xml is
+  // kept next to the outputs
+  SessionOptions session_options;
+  session_options.adversity = options.adversity;
+  session_options.composed_xml_path = (out / "composed.xml").string();
+  session_options.check_run_budget = true;
+  Session session(world, session_options);
+  Simulation& sim = session.sim();
+  const SceneDescription& scene = session.scene();
+  EffectsStage& effects = session.effects();
+  Renderer* const renderer = session.renderer();
+  timings["compose_sec"] = session.timings().compose_sec;
+  timings["load_sec"] = session.timings().load_sec;
+  timings["scene_build_sec"] = session.timings().scene_build_sec;
 
   // outputs. the first error of any stage is the one reported (FirstError)
   FirstError first_error;
@@ -255,7 +234,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   AsyncFrameWriter writer(out.string(), writer_options);
   for (const CameraSpec& cam : scene.cameras)
     writer.AddCamera(cam.name, cam.intrinsics, cam.outputs);
-  CameraStage camera_stage(scene, world, renderer.get(), out.string());  // app/camera_stage.h
+  CameraStage camera_stage(scene, world, renderer, out.string());  // app/camera_stage.h
   SensorStage sensor_stage(
       world, sim, scene, out.string(),  // app/sensor_stage.h
       [&](const WorldSnapshot& s, const Eigen::Vector3d& p) { return effects.Evaluate(s, p); });
@@ -343,7 +322,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
         failed = true;
         break;
       }
-      // per-camera effects (app/effects_stage.h) ride along with each capture
+      // per-camera effects (session/effects_stage.h) ride along with each capture
       camera_stage.OnSnapshot(job->snapshot, job->cameras, job->frame_indices, job->effects,
                               submit);
       progress.Update(job->snapshot.time_sec, total_frames);
