@@ -4,10 +4,13 @@
 //   1. compose   every model into one MJCF document (compose/scene_composer.h), the world's
 //                IMUs added to it (compose/imu_injection.h), then the effects stage plans the
 //                world's effects, agents and adversity preset and adds one mocap body per agent
-//                (session/effects_stage.h); the document is printed to text once, written to
-//                SessionOptions::composed_xml_path when one is given;
-//   2. load      MuJoCo compiles the text once into the Simulation; the robots' controllers
-//                (control/controller_factory.h) and the agents' mocap drivers are added;
+//                (session/effects_stage.h), all on one tinyxml2 document, printed to text
+//                once and written to SessionOptions::composed_xml_path when one is given;
+//   2. load      MuJoCo compiles the text into the Simulation (the only compile, except for
+//                a world with an adversity preset, whose planner compiled a probe of the
+//                document without its NPCs in step 1); the world's agents are checked
+//                against the model and their mocap drivers added, then the robots'
+//                controllers (control/controller_factory.h);
 //   3. scene     the renderer's SceneDescription: the compiled model's scene joined with the
 //                world file's lights, sky, cameras and materials (session/scene_assembly.h),
 //                agent geoms labelled and the effects engine built on it (EffectsStage::Bind);
