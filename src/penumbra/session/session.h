@@ -17,8 +17,8 @@
 //                optionally the run's memory and work are checked (session/run_budget.h);
 //                then the renderer (render/renderer.h) is built for that scene.
 // a Session is then stepped and rendered by its user (app/runner.cc, app/bench.cc, ...); it
-// owns everything it built and is neither copied nor moved (the renderer and the effects
-// stage refer to the scene it holds).
+// owns everything it built and is neither copied nor moved (what it hands out by reference
+// stays valid for its lifetime).
 
 #include <memory>
 #include <string>
