@@ -13,7 +13,6 @@
 namespace penumbra {
 namespace {
 
-using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
 std::string Nums(std::initializer_list<double> v) {
@@ -150,11 +149,7 @@ void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& w
       throw ConfigError(world_file, 0, "models",
                         "a model is named 'agents', which is reserved for the bodies of the "
                         "world's agents; expected another model name");
-  XMLDocument doc;
-  if (doc.Parse(scene->mjcf_xml.c_str()) != tinyxml2::XML_SUCCESS)
-    throw ConfigError(world_file, 0, "agents",
-                      std::string("cannot parse the composed MJCF: ") + doc.ErrorStr());
-  XMLElement* root = doc.FirstChildElement("mujoco");
+  XMLElement* root = scene->document->FirstChildElement("mujoco");
   if (!root) throw ConfigError(world_file, 0, "agents", "composed MJCF has no <mujoco> root");
   XMLElement* worldbody = root->FirstChildElement("worldbody");
   if (!worldbody) worldbody = root->InsertNewChildElement("worldbody");
@@ -200,9 +195,6 @@ void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& w
       }
     }
   }
-  tinyxml2::XMLPrinter printer;
-  doc.Print(&printer);
-  scene->mjcf_xml = printer.CStr();
 }
 
 }  // namespace penumbra

@@ -30,11 +30,11 @@ namespace penumbra {
 /// MJCF body name of agent `agent_name` ("agents/<name>").
 std::string AgentBodyName(const std::string& agent_name);
 
-/// adds one mocap body per agent (placed at its path pose at t = 0) to scene->mjcf_xml,
-/// and extends every keyframe's mpos / mquat by the agents' initial poses.
+/// adds one mocap body per agent (placed at its path pose at t = 0) to scene->document (in
+/// place), and extends every keyframe's mpos / mquat by the agents' initial poses.
 /// @throws ConfigError if an agent is invalid (AgentConfig::ValidateOrThrow, key
 ///         "agents[i]"), if a model is named "agents" (its names would clash), or if the
-///         composed XML cannot be parsed.
+///         composed document has no <mujoco> root.
 void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& world_file,
                     ComposedScene* scene);
 
