@@ -194,7 +194,7 @@ TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
   ComposedScene composed = ComposeWorld({m}, ComposeOptions{});
   AgentConfig a = Walker();
   a.waypoints = {{3, 1}, {4, 1}};
-  AddAgentBodies({a}, "", &composed);
+  AddAgentBodies(AgentBodySpecs({a}), "", &composed);
   EXPECT_NE(composed.mjcf_xml.find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.mjcf_xml;
   Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
   EXPECT_EQ(sim.model_info().keys.size(), 1u);

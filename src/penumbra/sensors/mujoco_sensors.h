@@ -1,6 +1,7 @@
 #pragma once
 // reading MuJoCo-native sensors by name from a WorldSnapshot (values from
-// WorldSnapshot::sensordata, metadata from Simulation::sensor_info()), with optional
+// WorldSnapshot::sensordata, metadata: the engine-neutral SensorInfo of scene/sensor_info.h,
+// which the physics module fills: Simulation::sensor_info()), with optional
 // per-sensor Gaussian noise, and CSV column names that carry the unit
 // (e.g. "box/acc_x_m_s2", "arm/shoulder_pos_rad", "range_m").
 
@@ -9,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/physics/sensor_readout.h"
+#include "penumbra/scene/sensor_info.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
@@ -19,15 +20,14 @@ std::string UnitSuffix(const std::string& unit);
 
 /// the values of sensor `s` in `snapshot` (a view into snapshot.sensordata).
 /// @throws Error if the snapshot holds fewer values than the sensor's adr + dim.
-std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot,
-                                           const MujocoSensorInfo& s);
+std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot, const SensorInfo& s);
 
 /// a chosen set of MuJoCo sensors, read together.
 class MujocoSensorSet {
  public:
   /// `names` = MJCF sensor names (composed, "<model>/<name>"), or empty for every sensor.
   /// @throws Error naming the first unknown sensor and listing the model's sensors.
-  MujocoSensorSet(const std::vector<MujocoSensorInfo>& all, const std::vector<std::string>& names);
+  MujocoSensorSet(const std::vector<SensorInfo>& all, const std::vector<std::string>& names);
 
   /// column names, one per value: "<sensor>[_<component>][_<unit suffix>]".
   std::vector<std::string> ColumnNames() const;
@@ -35,10 +35,10 @@ class MujocoSensorSet {
   void Read(const WorldSnapshot& snapshot, std::vector<double>* out) const;
   /// number of values.
   int size() const { return size_; }
-  const std::vector<MujocoSensorInfo>& sensors() const { return sensors_; }
+  const std::vector<SensorInfo>& sensors() const { return sensors_; }
 
  private:
-  std::vector<MujocoSensorInfo> sensors_;
+  std::vector<SensorInfo> sensors_;
   int size_ = 0;
 };
 
