@@ -65,7 +65,7 @@ TEST(MujocoSensorsTest, EverySensorReadableByNameWithDimensionUnitAndValue) {
   Simulation sim = Simulation::LoadFromString(kModel);
   for (int i = 0; i < 1000; ++i) sim.Step();  // 2 s: box settled, arm hanging still
   const WorldSnapshot snap = sim.Snapshot();
-  const std::vector<SensorInfo>& info = sim.sensor_info();
+  const std::vector<SensorDescription>& info = sim.sensor_info();
   ASSERT_EQ(info.size(), 14u);
   struct Expect {
     const char* name;

@@ -97,7 +97,7 @@ struct SensorStage::Impl {
   struct Imu {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
-    SensorInfo accel, gyro;
+    SensorDescription accel, gyro;
     LineFile csv;
     int64_t written = 0;
   };

@@ -196,11 +196,11 @@ std::string Name(const mjModel* m, int type, int id) {
 
 }  // namespace
 
-std::vector<SensorInfo> DescribeMujocoSensors(const mjModel_* mm) {
+std::vector<SensorDescription> DescribeMujocoSensors(const mjModel_* mm) {
   const mjModel* m = mm;
-  std::vector<SensorInfo> out;
+  std::vector<SensorDescription> out;
   for (int s = 0; s < m->nsensor; ++s) {
-    SensorInfo i;
+    SensorDescription i;
     i.name = Name(m, mjOBJ_SENSOR, s);
     i.id = s;
     i.type = TypeName(m->sensor_type[s]);

@@ -1,7 +1,7 @@
 #pragma once
 // metadata of a model's MuJoCo-native sensors (<sensor> elements of the MJCF) as the
-// engine-neutral SensorInfo of scene/sensor_info.h: name, type, dimension, unit and the object
-// each one is attached to, so that every sensor can be read by name from
+// engine-neutral SensorDescription of scene/sensor_description.h: name, type, dimension, unit and
+// the object each one is attached to, so that every sensor can be read by name from
 // WorldSnapshot::sensordata (Simulation::Snapshot fills it for the snapshot's own instant).
 //
 // units follow the MuJoCo 2.2.2 XML reference ("sensor" section): touch N (normal force
@@ -17,13 +17,13 @@
 
 #include <vector>
 
-#include "penumbra/scene/sensor_info.h"
+#include "penumbra/scene/sensor_description.h"
 
 struct mjModel_;
 
 namespace penumbra {
 
-/// every sensor of the model, by id, as engine-neutral SensorInfo (units as listed above).
-std::vector<SensorInfo> DescribeMujocoSensors(const mjModel_* m);
+/// every sensor of the model, by id, as engine-neutral SensorDescription (units as listed above).
+std::vector<SensorDescription> DescribeMujocoSensors(const mjModel_* m);
 
 }  // namespace penumbra

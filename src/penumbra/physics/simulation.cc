@@ -199,7 +199,7 @@ struct Simulation::Impl {
   std::vector<std::string> warnings;
   std::vector<int> qpos_joint;  // (nq) joint owning each qpos entry
   std::vector<double> jacp, jacr;
-  std::vector<SensorInfo> sensor_info;
+  std::vector<SensorDescription> sensor_info;
   struct MocapDriver {
     int mocap_id = -1;
     std::function<Pose(double)> X_WB;
@@ -562,7 +562,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   }
 }
 
-const std::vector<SensorInfo>& Simulation::sensor_info() const { return impl_->sensor_info; }
+const std::vector<SensorDescription>& Simulation::sensor_info() const { return impl_->sensor_info; }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }
 const ModelInfo& Simulation::model_info() const { return impl_->info; }

@@ -109,7 +109,7 @@ class Simulation {
 
   /// the model's MuJoCo sensors (name, type, dimension, unit, object), by sensor id; their
   /// values are WorldSnapshot::sensordata (physics/sensor_readout.h).
-  const std::vector<SensorInfo>& sensor_info() const;
+  const std::vector<SensorDescription>& sensor_info() const;
 
   /// the static scene, extracted once at load (physics/scene_extractor.h).
   const SceneDescription& scene() const;

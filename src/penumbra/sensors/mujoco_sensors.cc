@@ -22,7 +22,8 @@ std::string UnitSuffix(const std::string& unit) {
   return out;
 }
 
-std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot, const SensorInfo& s) {
+std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot,
+                                           const SensorDescription& s) {
   if (s.adr < 0 || static_cast<size_t>(s.adr + s.dim) > snapshot.sensordata.size())
     throw Error("MuJoCo sensor '" + s.name + "': the snapshot holds " +
                 std::to_string(snapshot.sensordata.size()) + " sensor values; expected at least " +
@@ -30,7 +31,7 @@ std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot, const 
   return {snapshot.sensordata.data() + s.adr, static_cast<size_t>(s.dim)};
 }
 
-MujocoSensorSet::MujocoSensorSet(const std::vector<SensorInfo>& all,
+MujocoSensorSet::MujocoSensorSet(const std::vector<SensorDescription>& all,
                                  const std::vector<std::string>& names) {
   if (names.empty()) {
     sensors_ = all;
@@ -39,19 +40,19 @@ MujocoSensorSet::MujocoSensorSet(const std::vector<SensorInfo>& all,
       const int i = FindSensor(all, n);
       if (i < 0) {
         std::string list;
-        for (const SensorInfo& s : all) list += (list.empty() ? "" : ", ") + s.name;
+        for (const SensorDescription& s : all) list += (list.empty() ? "" : ", ") + s.name;
         throw Error("no MuJoCo sensor named '" + n +
                     "'; the model has: " + (list.empty() ? std::string("none") : list));
       }
       sensors_.push_back(all[i]);
     }
   }
-  for (const SensorInfo& s : sensors_) size_ += s.dim;
+  for (const SensorDescription& s : sensors_) size_ += s.dim;
 }
 
 std::vector<std::string> MujocoSensorSet::ColumnNames() const {
   std::vector<std::string> cols;
-  for (const SensorInfo& s : sensors_) {
+  for (const SensorDescription& s : sensors_) {
     const std::string unit = UnitSuffix(s.unit);
     for (int k = 0; k < s.dim; ++k) {
       std::string c = SensorValueLabel(s, k);
@@ -64,7 +65,7 @@ std::vector<std::string> MujocoSensorSet::ColumnNames() const {
 }
 
 void MujocoSensorSet::Read(const WorldSnapshot& snapshot, std::vector<double>* out) const {
-  for (const SensorInfo& s : sensors_) {
+  for (const SensorDescription& s : sensors_) {
     const std::span<const double> v = MujocoSensorValues(snapshot, s);
     out->insert(out->end(), v.begin(), v.end());
   }

@@ -11,7 +11,7 @@
 namespace penumbra {
 
 /// one engine-native sensor (an MJCF <sensor> element for MuJoCo).
-struct SensorInfo {
+struct SensorDescription {
   std::string name;  ///< model name (composed: "<model>/<name>"); "" if unnamed
   int id = -1;       ///< the engine's sensor id (MuJoCo sensor id)
   std::string type;  ///< MJCF element name: "touch", "accelerometer", "framequat", ...
@@ -29,10 +29,10 @@ struct SensorInfo {
 };
 
 /// index of the sensor named `name` in `sensors`, or -1.
-int FindSensor(const std::vector<SensorInfo>& sensors, const std::string& name);
+int FindSensor(const std::vector<SensorDescription>& sensors, const std::string& name);
 
 /// the column label of value k of a sensor: "<name>" for scalars, "<name>_x" etc. for vectors.
 /// @throws std::out_of_range if k is not in [0, components.size()).
-std::string SensorValueLabel(const SensorInfo& s, int k);
+std::string SensorValueLabel(const SensorDescription& s, int k);
 
 }  // namespace penumbra
