@@ -196,7 +196,7 @@ TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
   ComposedScene composed = ComposeWorld({m}, ComposeOptions{});
   AgentConfig a = Walker();
   a.waypoints = {{3, 1}, {4, 1}};
-  AddAgentBodies({a}, "", &composed);
+  AddAgentBodies(AgentBodySpecs({a}), "", &composed);
   EXPECT_NE(composed.Xml().find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.Xml();
   Simulation sim = Simulation::LoadFromString(composed.Xml());
   EXPECT_EQ(sim.model_info().keys.size(), 1u);

@@ -97,7 +97,7 @@ struct SensorStage::Impl {
   struct Imu {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
-    MujocoSensorInfo accel, gyro;
+    SensorDescription accel, gyro;
     LineFile csv;
     int64_t written = 0;
   };
@@ -228,8 +228,8 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       Impl::Imu m;
       m.cfg = &c;
       const auto [acc, gyr] = ImuSensorNames(c.name);
-      const int ia = FindMujocoSensor(sim.sensor_info(), acc);
-      const int ig = FindMujocoSensor(sim.sensor_info(), gyr);
+      const int ia = FindSensor(sim.sensor_info(), acc);
+      const int ig = FindSensor(sim.sensor_info(), gyr);
       if (ia < 0 || ig < 0)
         throw SensorError(c, "",
                           "the composed model has no accelerometer/gyro '" + acc +

@@ -199,7 +199,7 @@ struct Simulation::Impl {
   std::vector<std::string> warnings;
   std::vector<int> qpos_joint;  // (nq) joint owning each qpos entry
   std::vector<double> jacp, jacr;
-  std::vector<MujocoSensorInfo> sensor_info;
+  std::vector<SensorDescription> sensor_info;
   struct MocapDriver {
     int mocap_id = -1;
     std::function<Pose(double)> X_WB;
@@ -343,28 +343,6 @@ struct Simulation::Impl {
         Fail(t, step, "physics diverged: non-finite qacc at " + DofLabel(i));
   }
 };
-
-double PhysicsRateHz(double timestep_sec) {
-  const double rate = 1.0 / timestep_sec;
-  const double r = std::nearbyint(rate);
-  return r >= 1 && std::abs(rate - r) <= 1e-9 * r ? r : rate;
-}
-
-double SimTimeOfStep(int64_t n, double timestep_sec) {
-  if (n <= 0) return 0.0;
-  const double nd = static_cast<double>(n);
-  const double rate = PhysicsRateHz(timestep_sec);
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (rate == std::nearbyint(rate)) {
-    // n / R rounded up: fma gives the sign of q R - n exactly
-    double q = nd / rate;
-    if (std::fma(q, rate, -nd) < 0) q = std::nextafter(q, kInf);
-    return q;
-  }
-  double p = nd * timestep_sec;
-  if (std::fma(nd, timestep_sec, -p) > 0) p = std::nextafter(p, kInf);
-  return p;
-}
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Simulation::Simulation(Simulation&&) noexcept = default;
@@ -650,7 +628,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   }
 }
 
-const std::vector<MujocoSensorInfo>& Simulation::sensor_info() const { return impl_->sensor_info; }
+const std::vector<SensorDescription>& Simulation::sensor_info() const { return impl_->sensor_info; }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }
 const ModelInfo& Simulation::model_info() const { return impl_->info; }

@@ -29,20 +29,12 @@
 #include "penumbra/control/model_info.h"
 #include "penumbra/physics/sensor_readout.h"
 #include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/sim_time.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
 
-/// the physics rate 1 / timestep_sec (Hz), snapped to the nearest integer when it is within
-/// 1e-9 (relative) of one: 0.002 s -> exactly 500 Hz.
-double PhysicsRateHz(double timestep_sec);
-
-/// sim time of physics step n (s): the smallest double >= n / R, R = PhysicsRateHz(timestep)
-/// when that is an integer, else >= n * timestep (both exact, not summed). so for a rate r
-/// dividing R, the step of frame k = n r / R has time >= k / r exactly and
-/// floor(time * r) == k, and times never drift (MuJoCo's own time += timestep does, by up
-/// to ~1e-11 s over a minute). n <= 0 gives 0.
-double SimTimeOfStep(int64_t n, double timestep_sec);
+// PhysicsRateHz and SimTimeOfStep (the time of each step): scene/sim_time.h.
 
 /// everything a bit-exact restart of a Simulation needs (Simulation::GetState / SetState),
 /// for MuJoCo 2.2.2: mj_step is a function of exactly these mjData fields (the set MuJoCo 3
@@ -159,7 +151,7 @@ class Simulation {
 
   /// the model's MuJoCo sensors (name, type, dimension, unit, object), by sensor id; their
   /// values are WorldSnapshot::sensordata (physics/sensor_readout.h).
-  const std::vector<MujocoSensorInfo>& sensor_info() const;
+  const std::vector<SensorDescription>& sensor_info() const;
 
   /// the static scene, extracted once at load (physics/scene_extractor.h).
   const SceneDescription& scene() const;

@@ -212,10 +212,34 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
                         &effects_, &agents_);
   }
   ValidateEffectsOrThrow(effects_, world.file);
-  AddAgentBodies(agents_, world.file, composed);
+  ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
+  AddAgentBodies(AgentBodySpecs(agents_), world.file, composed);
 }
 
 EffectsStage::~EffectsStage() = default;
+
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents) {
+  std::vector<MocapBodySpec> specs;
+  for (const AgentConfig& a : agents) {
+    MocapBodySpec s;
+    s.name = a.name;
+    switch (a.kind) {
+      case AgentKind::kPerson:
+        s.shape = MocapBodySpec::Shape::kPerson;
+        break;
+      case AgentKind::kForklift:
+        s.shape = MocapBodySpec::Shape::kForklift;
+        break;
+      case AgentKind::kCart:
+        s.shape = MocapBodySpec::Shape::kCart;
+        break;
+    }
+    s.height_m = a.height_m;
+    s.X_WB = AgentPath(a).X_WA(0.0);
+    specs.push_back(std::move(s));
+  }
+  return specs;
+}
 
 void EffectsStage::Attach(Simulation* sim) const {
   // the world's agents must walk inside the world: the static geometry's plan-view box + 1 m

@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/compose/mocap_body_spec.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/effects/agent_path.h"
 #include "penumbra/effects/effect_config.h"
@@ -113,5 +114,10 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
                          const std::vector<Pose>& X_WB,
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents);
+
+/// the mocap body of each agent for compose/agent_bodies.h, in the same order: name, shape of
+/// its kind, height and its path's pose at t = 0 (AgentPath::X_WA(0)).
+/// @throws ConfigError if an agent is invalid (as AgentPath's constructor).
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents);
 
 }  // namespace penumbra
