@@ -15,8 +15,8 @@
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
-#include "penumbra/render/particle_scene.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/particle_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 namespace penumbra::testing {
 namespace {

@@ -13,7 +13,7 @@
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 namespace penumbra::testing {
 namespace {

@@ -8,7 +8,7 @@
 #include "media_test_util.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/particle_scene.h"
+#include "penumbra/render/embree/particle_scene.h"
 
 namespace penumbra {
 namespace {

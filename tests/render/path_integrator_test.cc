@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "penumbra/render/bsdf.h"
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 #include "render_test_util.h"
 
 namespace penumbra {

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 #include "render_test_util.h"
 
 namespace penumbra {

@@ -13,8 +13,8 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/embree_renderer.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/embree_renderer.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/sky_model.h"
 #include "render_test_util.h"
 

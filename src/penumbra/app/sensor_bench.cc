@@ -16,7 +16,7 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
 

@@ -12,7 +12,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"

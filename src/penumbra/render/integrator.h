@@ -16,7 +16,7 @@
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
 #include "penumbra/render/media_frame.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"

@@ -31,7 +31,7 @@
 
 #include "penumbra/core/pose.h"
 #include "penumbra/render/ray_cone.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {

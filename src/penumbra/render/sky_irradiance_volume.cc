@@ -11,7 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -106,7 +106,7 @@ bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vecto
   return true;
 }
 
-// the geoms RayScene traces (render/ray_scene.h: groups <= 2, alpha >= 0.5) of static bodies.
+// the geoms RayScene traces (render/embree/ray_scene.h: groups <= 2, alpha >= 0.5) of static bodies.
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
   if (g.group > 2) return false;
   if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&

@@ -1,6 +1,6 @@
 #pragma once
 // ray-traced LiDAR: one scan of a LidarPattern against the Embree scene the cameras see
-// (render/ray_scene.h), with per-beam timestamps, motion distortion, intensity, range noise,
+// (render/embree/ray_scene.h), with per-beam timestamps, motion distortion, intensity, range noise,
 // dropout and adverse media (attenuation, fog/smoke false returns, rain/snow returns).
 //
 // frames and motion: the caller gives X_WS(t), the sensor pose in the world for t in
@@ -52,7 +52,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/sensors/lidar_pattern.h"
 

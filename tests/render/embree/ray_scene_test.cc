@@ -1,7 +1,7 @@
 // RayScene's batched tracing: IntersectGrid (4 x 4 packets) and IntersectMany give exactly the
 // hits of tracing every ray alone.
 
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/ray_cone.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {

@@ -1,4 +1,4 @@
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 
 #include <algorithm>
 #include <atomic>

@@ -16,7 +16,7 @@
 #include "penumbra/render/integrator.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"

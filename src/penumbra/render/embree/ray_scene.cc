@@ -1,4 +1,4 @@
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 #include <embree3/rtcore.h>
 #include <spdlog/spdlog.h>
