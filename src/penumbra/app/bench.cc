@@ -15,6 +15,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -62,7 +63,7 @@ int BenchRender(const RenderBenchOptions& options) {
   if (scene.cameras.empty())
     throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
   const CameraSpec& cam = scene.cameras.front();
-  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
+  std::unique_ptr<Renderer> renderer = MakeRenderer(scene, world.render);
   const double fovy_deg =
       2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
 

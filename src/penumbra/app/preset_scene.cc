@@ -9,6 +9,7 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/urdf_converter.h"
+#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {
@@ -43,7 +44,7 @@ PresetScene LoadPresetScene(const WorldConfig& world_in, const std::string& adve
   p.scene = p.effects->Bind(AssembleScene(p.sim->scene(), world, p.sim->Snapshot()));
   if (p.scene.cameras.empty())
     throw ConfigError(world.file, 0, "cameras", "the world has no camera");
-  p.renderer = MakeEmbreeRenderer(p.scene, world.render);
+  p.renderer = MakeRenderer(p.scene, world.render);
   return p;
 }
 

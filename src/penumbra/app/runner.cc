@@ -28,6 +28,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/sensor_schedule.h"
 
 namespace penumbra {
@@ -245,7 +246,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   CheckRunMemory(world, scene, PhysicalMemoryBytes());  // app/run_budget.h: before allocating
   if (auto work = DescribeRunWork(EstimateRunWork(world, scene, sim.timestep())))
     spdlog::warn("{}", *work);
-  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
+  std::unique_ptr<Renderer> renderer = MakeRenderer(scene, world.render);
   timings["scene_build_sec"] = SecondsSince(t0);
 
   // outputs. the first error of any stage is the one reported (FirstError)
@@ -389,7 +390,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   manifest.seed = world.seed;
   manifest.penumbra_version = PENUMBRA_VERSION;
   manifest.mujoco_version = MujocoVersion();
-  manifest.embree_version = EmbreeVersion();
+  manifest.embree_version = RendererVersion(world.render.backend);
   manifest.timings_sec = timings;
   manifest.peak_resident_memory_mib = summary.peak_rss_mib;
   manifest.frames_per_camera = summary.frames_per_camera;

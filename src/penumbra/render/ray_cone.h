@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 
-#include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/ray.h"
 
 namespace penumbra {
 

@@ -11,7 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/media_common.h"
-#include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/ray.h"
 
 namespace penumbra {
 
