@@ -20,6 +20,7 @@
 #include "penumbra/render/renderer.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -122,7 +123,7 @@ void BM_MediaRealtime(benchmark::State& state) {
   rs.tier = RenderSettings::Tier::kRealtime;
   rs.threads = 2;
   rs.seed = 7;
-  auto r = MakeEmbreeRenderer(w.scene, rs);
+  auto r = MakeRenderer(w.scene, rs);
   WorldSnapshot snap = w.snapshot;
   const int parts = static_cast<int>(state.range(0));
   if (parts != 0) snap.effects = MajorLike(parts, w.view.X_WO);

@@ -11,6 +11,7 @@
 
 #include "penumbra/core/pose.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {
@@ -155,7 +156,7 @@ void BM_RenderRoom(benchmark::State& state) {
   RenderSettings settings;
   settings.tier = RenderSettings::Tier::kRealtime;
   settings.threads = static_cast<int>(state.range(0));
-  auto renderer = MakeEmbreeRenderer(scene, settings);
+  auto renderer = MakeRenderer(scene, settings);
   WorldSnapshot snap;
   snap.X_WB.assign(scene.bodies.size(), Pose::Identity());
   const int robot = scene.FindBody("robot_base");

@@ -66,7 +66,7 @@ RenderedFrame Render(const SceneDescription& s, const WorldSnapshot& snap,
                      RenderSettings::Tier tier, int threads, uint64_t seed) {
   RenderSettings rs = TierSettings(tier, 4, threads);
   rs.seed = seed;
-  auto r = MakeEmbreeRenderer(s, rs);
+  auto r = MakeRenderer(s, rs);
   CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60, true, true, true);
   view.exposure_time_sec = 0.02;
   RenderedFrame f;

@@ -26,7 +26,7 @@ TEST(EffectsKoschmiederTest, ContrastFallsExponentiallyWithDistance) {
     AddGeom(&s, GeomShape::kBox, {0.05, 0.2, 0.2}, Translation(d + 0.05, 0, 0), 0, black);
     EffectsFrame fx;
     fx.homogeneous_media.push_back(Fog(sigma, 1.0f, 0.0f));
-    auto r = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+    auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
     // the target fills the centre pixels; the corners see the horizon.
     const double fovy = 2 * std::atan(0.6 / d) * 180 / M_PI;
     const CameraView view = MakeView(CameraLookingAlongX(), 33, 33, fovy, true, false, true);
@@ -69,7 +69,7 @@ TEST(EffectsKoschmiederTest, LightInScatterTiersAgree) {
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
     RenderSettings rs = TierSettings(tier, 16);
     rs.max_bounces = 1;
-    auto r = MakeEmbreeRenderer(s, rs);
+    auto r = MakeRenderer(s, rs);
     RenderedFrame f;
     r->Render(SnapshotWith(s, fx), view, &f);
     mean[k++] = MeanRadiance(f.radiance, 0, 144, 0, 96);

@@ -29,7 +29,7 @@ SceneDescription SunFloor() {
 
 double CentreRadiance(const SceneDescription& s, const WorldSnapshot& snap,
                       RenderSettings::Tier tier = RenderSettings::Tier::kRealtime) {
-  auto r = MakeEmbreeRenderer(s, TierSettings(tier, 16));
+  auto r = MakeRenderer(s, TierSettings(tier, 16));
   const CameraView view = MakeView(CameraLookingDown({0, 0, 2}), 9, 9, 20, true, false, false);
   RenderedFrame f;
   r->Render(snap, view, &f);
@@ -80,7 +80,7 @@ TEST(EffectsLightingTest, SkyScaleAndMovedSun) {
   s.sky.type = Sky::Type::kDaylight;
   s.sky.sun_direction_W = Eigen::Vector3d(0.3, 0.2, 0.93);
   // look at the horizon towards +x.
-  auto r = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+  auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   const CameraView view = MakeView(CameraLookingAlongX(), 9, 9, 10, true, false, false);
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);

@@ -25,7 +25,7 @@ double RenderedOverExpected(RenderSettings::Tier tier, double distance, float si
   const SceneDescription s = EmissiveWallScene(distance, Le);
   EffectsFrame fx;
   fx.homogeneous_media.push_back(Fog(sigma_t, 0.0f));
-  auto r = MakeEmbreeRenderer(s, TierSettings(tier, spp));
+  auto r = MakeRenderer(s, TierSettings(tier, spp));
   const CameraView view = MakeView(CameraLookingAlongX(), kW, kH, kFovy, true, true, false);
   RenderedFrame f;
   r->Render(SnapshotWith(s, fx), view, &f);
@@ -65,7 +65,7 @@ TEST(MediaTransmittanceTest, MorGivesFivePercentTransmittance) {
   const SceneDescription s = EmissiveWallScene(mor, Le);
   EffectsFrame fx;
   fx.homogeneous_media.push_back(Fog(static_cast<float>(SigmaTFromMorM(mor)), 0.0f));
-  auto r = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+  auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   const CameraView view = MakeView(CameraLookingAlongX(), 9, 9, 2, true, false, false);
   RenderedFrame f;
   r->Render(SnapshotWith(s, fx), view, &f);
@@ -150,7 +150,7 @@ TEST(MediaTransmittanceTest, TiersAgreeBehindDensityRamp) {
   int k = 0;
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    auto r = MakeEmbreeRenderer(s, TierSettings(tier, 256));
+    auto r = MakeRenderer(s, TierSettings(tier, 256));
     RenderedFrame f;
     r->Render(SnapshotWith(s, fx), view, &f);
     mean[k++] = MeanRadiance(f.radiance, 0, kW, 0, kH);
@@ -182,7 +182,7 @@ TEST(MediaTransmittanceTest, GridEmissionIntegratesAlongTheRay) {
   expected /= kW * kH;
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    auto r = MakeEmbreeRenderer(s, TierSettings(tier, 128));
+    auto r = MakeRenderer(s, TierSettings(tier, 128));
     RenderedFrame f;
     r->Render(SnapshotWith(s, fx), view, &f);
     const double got = MeanRadiance(f.radiance, 0, kW, 0, kH, 1);

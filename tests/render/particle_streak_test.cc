@@ -8,7 +8,7 @@
 #include "media_test_util.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/particle_scene.h"
+#include "penumbra/render/embree/particle_scene.h"
 
 namespace penumbra {
 namespace {
@@ -37,7 +37,7 @@ int StreakSpan(double depth, double speed, double exposure, int row, double* exp
   sparks.velocity_W.emplace_back(0, -speed, 0);
   sparks.radius_m.push_back(1e-5f);  // far below a pixel: widened to half a pixel
   fx.particles.push_back(sparks);
-  auto r = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+  auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   static RenderedFrame f;
   r->Render(SnapshotWith(s, fx), view, &f);
   if (img_out) *img_out = &f.radiance;
@@ -77,7 +77,7 @@ TEST(ParticleStreakTest, CoverageFollowsExposureFraction) {
   sparks.velocity_W.emplace_back(0, -v, 0);  // through the centre of the view
   sparks.radius_m.push_back(r);
   fx.particles.push_back(sparks);
-  auto rr = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+  auto rr = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   RenderedFrame f;
   rr->Render(SnapshotWith(s, fx), view, &f);
   const double alpha = 2 * r / (v * 0.01 + 2 * r);
@@ -104,7 +104,7 @@ TEST(ParticleStreakTest, RainAndSnowShading) {
     p.velocity_W.emplace_back(0, 0, -5);
     p.radius_m.push_back(0.05f);
     fx.particles.push_back(p);
-    auto rr = MakeEmbreeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
+    auto rr = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
     RenderedFrame f;
     rr->Render(SnapshotWith(s, fx), view, &f);
     // no lights: colour x sphere-average sky radiance (uniform sky, within the 1 % of the

@@ -11,7 +11,7 @@
 #include <limits>
 
 #include "penumbra/render/bsdf.h"
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "render_test_util.h"
 
 namespace penumbra {
@@ -32,7 +32,7 @@ RenderSettings PathSettings(int spp, int max_bounces, int threads = 1) {
 
 RenderedFrame Render(const SceneDescription& s, const RenderSettings& settings,
                      const CameraView& view) {
-  auto r = MakeEmbreeRenderer(s, settings);
+  auto r = MakeRenderer(s, settings);
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);
   return f;

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "render_test_util.h"
 
 namespace penumbra {
@@ -27,7 +27,7 @@ SceneDescription Floor(float rho) {
 class FloorProbe {
  public:
   explicit FloorProbe(const SceneDescription& s, int size = 101)
-      : scene_(s), r_(MakeEmbreeRenderer(scene_, TestSettings())), size_(size) {}
+      : scene_(s), r_(MakeRenderer(scene_, TestSettings())), size_(size) {}
   const RenderedFrame& Render() {
     view_ = MakeView(CameraLookingDown({0, 0, 2}), size_, size_, 90, true, true, true);
     r_->Render(IdentitySnapshot(scene_), view_, &f_);
@@ -175,7 +175,7 @@ TEST(RealtimeLightingTest, MissesSeeTheSkyAndEmissionAdds) {
   const int m = AddMaterial(&s, Eigen::Vector3f::Zero());
   s.materials[m].emission = {50, 60, 70};
   AddGeom(&s, GeomShape::kSphere, {0.3, 0, 0}, Translation(2, 0, 0), 0, m);
-  auto r = MakeEmbreeRenderer(s, TestSettings());
+  auto r = MakeRenderer(s, TestSettings());
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), MakeView(CameraLookingAlongX(), 31, 31, 60), &f);
   const float* sky = f.radiance.at(0, 0);
@@ -198,7 +198,7 @@ TEST(RealtimeLightingTest, SoftShadowPenumbraIsBetweenLitAndDark) {
   sun.angular_radius_deg = 10;
   s.lights.push_back(sun);
   AddGeom(&s, GeomShape::kBox, {0.5, 0.5, 0.01}, Translation(-0.5, 0, 0.5));  // edge at x = 0
-  auto r = MakeEmbreeRenderer(s, TestSettings());
+  auto r = MakeRenderer(s, TestSettings());
   CameraView view = MakeView(CameraLookingDown({0.0, 0, 0.2}), 201, 61, 60);
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);

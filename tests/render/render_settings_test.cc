@@ -31,6 +31,8 @@ TEST(RenderSettingsTest, EachRangeIsChecked) {
       {[](RenderSettings* s) { s->ev100 = -11; }, "render.exposure.ev100", "expected [-10, 30]"},
       {[](RenderSettings* s) { s->exposure_compensation_ev = NAN; },
        "render.exposure.compensation_ev", "expected [-20, 20]"},
+      {[](RenderSettings* s) { s->backend = static_cast<RenderSettings::Backend>(7); },
+       "render.backend", "unknown backend; expected one of: embree"},
   };
   for (const Case& c : cases) {
     RenderSettings s;

@@ -111,7 +111,7 @@ double RelativeResidualStd(const RenderedFrame& f, double lo, double hi, int* co
 }
 
 RenderedFrame RenderWith(const SceneDescription& s, RenderSettings settings, const CameraView& v) {
-  auto r = MakeEmbreeRenderer(s, settings);
+  auto r = MakeRenderer(s, settings);
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), v, &f);
   return f;

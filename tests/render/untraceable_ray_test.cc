@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "render_test_util.h"
 
 namespace penumbra {

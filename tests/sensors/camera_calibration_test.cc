@@ -33,6 +33,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/camera_distortion.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {
@@ -326,7 +327,7 @@ TEST(CameraCalibrationTest, DetectedCornersRecoverTheDistortion) {
   const SceneDescription scene = Checkerboard();
   RenderSettings settings;
   settings.tier = RenderSettings::Tier::kRealtime;
-  auto renderer = MakeEmbreeRenderer(scene, settings);
+  auto renderer = MakeRenderer(scene, settings);
   const CameraIntrinsics truth = TrueIntrinsics();
   std::vector<cv::Point3f> board,
       board_plane;  // world corners; the same in the board frame (z = 0)

@@ -8,6 +8,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera_distortion.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_lens_droplets.h"
 
 namespace penumbra {
@@ -70,7 +71,7 @@ TEST(CameraImagerTest, MotionBlurSmearsByVelocityTimesExposure) {
   const double speed = 2.0, T = 0.04, f = 400;
   const double expected_px = speed * T * f / kZ;
   const SceneDescription scene = Bar(2.0 * kZ / f);  // 2 px wide
-  auto renderer = MakeEmbreeRenderer(scene, Realtime());
+  auto renderer = MakeRenderer(scene, Realtime());
   CameraSensorConfig cfg;
   cfg.exposure_time_sec = T;
   cfg.motion_blur_samples = 64;
@@ -106,7 +107,7 @@ TEST(CameraImagerTest, MovingBodiesBlurToo) {
   SceneDescription scene = Bar(2.0 * kZ / f);
   scene.bodies.push_back({"bar", 0, false});
   scene.geoms[0].body = 1;
-  auto renderer = MakeEmbreeRenderer(scene, Realtime());
+  auto renderer = MakeRenderer(scene, Realtime());
   CameraSensorConfig cfg;
   cfg.exposure_time_sec = T;
   cfg.motion_blur_samples = 64;
@@ -132,7 +133,7 @@ TEST(CameraImagerTest, RollingShutterSkewsAVerticalEdge) {
   const double per_row = speed * line * f / kZ;
   // a wide bar right of the image centre: its left edge (world y = -0.1) is a vertical edge
   const SceneDescription scene = Bar(0.5, -0.35);
-  auto renderer = MakeEmbreeRenderer(scene, Realtime());
+  auto renderer = MakeRenderer(scene, Realtime());
   CameraSensorConfig cfg;
   cfg.exposure_time_sec = 0;
   cfg.rolling_shutter_line_time_sec = line;
@@ -169,8 +170,8 @@ TEST(CameraImagerTest, AutoExposureAdaptsWithTimeConstant) {
   bright.sky.radiance = Eigen::Vector3f::Constant(160.0f);
   RenderSettings rs = Realtime();
   rs.auto_exposure = true;
-  auto r_dim = MakeEmbreeRenderer(dim, rs);
-  auto r_bright = MakeEmbreeRenderer(bright, rs);
+  auto r_dim = MakeRenderer(dim, rs);
+  auto r_bright = MakeRenderer(bright, rs);
   CameraSensorConfig cfg;
   cfg.auto_exposure_time_constant_sec = 0.5;
   CameraImager imager(Spec(32, 24, 30), cfg, rs, 0, dim);
@@ -193,7 +194,7 @@ TEST(CameraImagerTest, NoiseJpegAndDropletsAreSeededAndLocal) {
   AddGeom(&scene, GeomShape::kSphere, Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(3, 0, 0), m);
   RenderSettings rs = Realtime();
   rs.ev100 = std::log2(0.3 / (0.18 * 1.2));
-  auto renderer = MakeEmbreeRenderer(scene, rs);
+  auto renderer = MakeRenderer(scene, rs);
   const Pose X = LookingAlongX(Eigen::Vector3d::Zero());
   auto capture = [&](const CameraSensorConfig& cfg, const WorldSnapshot& snap, int64_t frame) {
     CameraImager imager(Spec(96, 64, 80), cfg, rs, 1, scene);
@@ -260,7 +261,7 @@ TEST(CameraImagerTest, ThreadCountDoesNotChangeTheImages) {
   auto run = [&](int threads) {
     RenderSettings rs = Realtime();
     rs.threads = threads;
-    auto renderer = MakeEmbreeRenderer(scene, rs);
+    auto renderer = MakeRenderer(scene, rs);
     CameraImager imager(spec, cfg, rs, 2, scene);
     const WorldSnapshot a = Snapshot(scene, 0), b = Snapshot(scene, 0.02);
     CameraImages im;

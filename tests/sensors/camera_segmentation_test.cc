@@ -10,6 +10,7 @@
 #include "camera_sensor_test_util.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {
@@ -77,7 +78,7 @@ TEST(CameraSegmentationTest, IdsClassesRangeAndNormalsAreExactPerPixel) {
   s.geoms[g2].semantic_class = 7;
   RenderSettings rs;
   rs.tier = RenderSettings::Tier::kRealtime;
-  auto renderer = MakeEmbreeRenderer(s, rs);
+  auto renderer = MakeRenderer(s, rs);
 
   CameraView view;
   view.X_WO = testing::LookingAlongX(Eigen::Vector3d(0, 0, 0.05));

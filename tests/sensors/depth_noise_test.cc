@@ -7,6 +7,7 @@
 #include "camera_sensor_test_util.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 
 namespace penumbra {
@@ -33,7 +34,7 @@ DepthStats MeasureWall(const std::string& preset, double z) {
   const SceneDescription scene = Wall(z);
   RenderSettings rs;
   rs.tier = RenderSettings::Tier::kRealtime;
-  auto renderer = MakeEmbreeRenderer(scene, rs);
+  auto renderer = MakeRenderer(scene, rs);
   CameraSpec spec;
   spec.name = "rgbd";
   spec.intrinsics = CameraIntrinsics::FromFovy(160, 120, 40);

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/sensors/lidar_scanner.h"
 
 namespace penumbra {

@@ -347,10 +347,16 @@ TEST_F(WorldConfigTest, EmptyMappingGivesDefaults) {
   EXPECT_TRUE(w.cameras.empty());
   EXPECT_EQ(w.sky.type, Sky::Type::kUniform);
   EXPECT_EQ(w.render.tier, RenderSettings::Tier::kRealtime);
+  EXPECT_EQ(w.render.backend, RenderSettings::Backend::kEmbree);
   EXPECT_EQ(w.render.samples_per_pixel, 16);
   EXPECT_TRUE(w.render.auto_exposure);
   EXPECT_TRUE(w.mjcf_cameras.enabled);
   EXPECT_EQ(w.output_dir, "out");
+}
+
+TEST_F(WorldConfigTest, RenderBackendIsRead) {
+  const WorldConfig w = ParseWorld("render:\n  backend: embree\n", world_);
+  EXPECT_EQ(w.render.backend, RenderSettings::Backend::kEmbree);
 }
 
 TEST_F(WorldConfigTest, KeysWithoutValueMeanEmptyListOrMapping) {
@@ -629,6 +635,8 @@ TEST_F(WorldConfigTest, ControllerNotAllowedOnStaticModel) {
 TEST_F(WorldConfigTest, UnknownEnumValueListsValidOnes) {
   ExpectError("render:\n  tier: fast\n", 2, "render.tier",
               "unknown value 'fast'; expected one of: realtime, pathtraced");
+  ExpectError("render:\n  backend: optix\n", 2, "render.backend",
+              "unknown value 'optix'; expected one of: embree");
   ExpectError("lights:\n  - name: a\n    type: area\n", 3, "lights[0].type",
               "expected one of: sun, directional, point, spot");
 }

@@ -21,6 +21,7 @@
 #include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/sensor_schedule.h"
 #include "penumbra/session/effects_stage.h"
 #include "penumbra/session/scene_assembly.h"
@@ -368,7 +369,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   manifest.seed = world.seed;
   manifest.penumbra_version = PENUMBRA_VERSION;
   manifest.mujoco_version = MujocoVersion();
-  manifest.embree_version = EmbreeVersion();
+  manifest.embree_version = RendererVersion(world.render.backend);
   manifest.timings_sec = timings;
   manifest.peak_resident_memory_mib = summary.peak_rss_mib;
   manifest.frames_per_camera = summary.frames_per_camera;

@@ -11,7 +11,7 @@
 #include "penumbra/app/bench.h"
 #include "penumbra/app/sensor_stage.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/session/session.h"
@@ -106,7 +106,8 @@ int BenchSensors(const SensorBenchOptions& options) {
     if (sim.model_info().body_names[b] == mount) mount_body = static_cast<int>(b);
   const Pose X_BS = PoseFromXyzRpyDeg({0.1, 0, 0.12}, {0, 0, 0});
 
-  RayScene rs(scene);
+  const std::unique_ptr<RayQuery> query = MakeRayQuery(scene, world.render.backend);
+  RayQuery& rs = *query;
   fmt::print(
       "\nLiDAR (single thread, Embree packets of 16, motion-interpolated pose, scene posed per "
       "scan, {} scans each after one untimed warm-up scan; target: OS1-64 < 10 ms/scan = 10 % of "

@@ -12,7 +12,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"
@@ -133,7 +133,7 @@ struct SensorStage::Impl {
   std::vector<Mujoco> mujocos;
   std::vector<GroundTruth> truths;
   std::vector<std::string> body_names;
-  std::unique_ptr<RayScene> ray_scene;
+  std::unique_ptr<RayQuery> ray_scene;
   std::vector<SensorFiring> due;
   std::map<std::string, double> busy;
 
@@ -305,7 +305,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       throw SensorError(c, "rate_hz", e.what());
     }
   }
-  if (!s.lidars.empty()) s.ray_scene = std::make_unique<RayScene>(scene);
+  if (!s.lidars.empty()) s.ray_scene = MakeRayQuery(scene, world.render.backend);
 }
 
 SensorStage::~SensorStage() = default;

@@ -18,7 +18,7 @@
 #include <Eigen/Geometry>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {

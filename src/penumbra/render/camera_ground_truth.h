@@ -5,7 +5,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {

@@ -56,7 +56,7 @@
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {

@@ -53,9 +53,9 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
-#include "penumbra/render/ray_scene.h"
 
 namespace penumbra {
 

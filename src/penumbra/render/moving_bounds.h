@@ -30,8 +30,8 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/render/ray.h"
 #include "penumbra/render/ray_cone.h"
-#include "penumbra/render/ray_scene.h"
 #include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {

@@ -35,7 +35,7 @@
 //     collision. every shadow ray (surface and medium vertices) is weighted by the media's
 //     transmittance (exact for homogeneous media, ratio tracking in grids), so the sky behind
 //     an unbounded fog is never reached.
-//   - particles (render/particle_scene.h): a camera ray that meets a streak stops there with
+//   - particles (render/embree/particle_scene.h): a camera ray that meets a streak stops there with
 //     probability alpha (coverage), drawing the streak's radiance attenuated by the media in
 //     front of it; secondary rays do not see particles.
 //   - surface wetness (ApplySurfaceWetness) changes the material of upward-facing surfaces.

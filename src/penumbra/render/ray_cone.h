@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray.h"
 
 namespace penumbra {
 

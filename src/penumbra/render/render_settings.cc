@@ -26,6 +26,9 @@ void CheckClosed(const char* key, double v, double lo, double hi) {
 }  // namespace
 
 void RenderSettings::ValidateOrThrow() const {
+  if (backend != Backend::kEmbree) {
+    throw ConfigError("", 0, "render.backend", "unknown backend; expected one of: embree");
+  }
   if (tier != Tier::kRealtime && tier != Tier::kPathtraced) {
     throw ConfigError("", 0, "render.tier", "unknown tier; expected one of: realtime, pathtraced");
   }

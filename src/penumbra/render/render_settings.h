@@ -9,6 +9,12 @@ namespace penumbra {
 /// render quality and image formation. both tiers share one code path (scene,
 /// materials, lights, camera); they differ in the light transport they simulate.
 struct RenderSettings {
+  /// the ray-tracing backend: MakeRenderer and MakeRayQuery (render/renderer_factory.h) build
+  /// its Renderer and RayQuery.
+  enum class Backend {
+    kEmbree,  ///< Intel Embree 3 on the CPU (render/embree/)
+  };
+  Backend backend = Backend::kEmbree;
   enum class Tier {
     kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1 sample/pixel
     kPathtraced,  ///< unidirectional path tracing, NEE with MIS, N samples/pixel, denoised

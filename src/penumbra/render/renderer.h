@@ -1,7 +1,8 @@
 #pragma once
 // the renderer interface: turns a WorldSnapshot seen from one camera into images.
 // implementations never touch the physics engine, so a recorded run can be
-// re-rendered without it.
+// re-rendered without it. MakeRenderer (render/renderer_factory.h) builds the one of
+// RenderSettings::backend (Embree: render/embree/embree_renderer.h).
 
 #include <memory>
 #include <string>
@@ -61,13 +62,5 @@ class Renderer {
   virtual void Render(const WorldSnapshot& snapshot, const CameraView& view,
                       RenderedFrame* out) = 0;
 };
-
-/// Embree-backed ray tracer over `scene` (copied); see render/embree_renderer.h.
-/// @throws Error if Embree cannot be initialised; ConfigError for bad settings.
-/// Embree's version string, for run manifests.
-std::string EmbreeVersion();
-
-std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene,
-                                             const RenderSettings& settings);
 
 }  // namespace penumbra

@@ -7,11 +7,12 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
+#include <utility>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
-#include "penumbra/render/ray_scene.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -106,7 +107,7 @@ bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vecto
   return true;
 }
 
-// the geoms RayScene traces (render/ray_scene.h: groups <= 2, alpha >= 0.5) of static bodies.
+// the geoms a RayQuery traces (render/ray_query.h: groups <= 2, alpha >= 0.5) of static bodies.
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
   if (g.group > 2) return false;
   if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&
@@ -310,6 +311,11 @@ int SkyIrradianceVolume::num_valid_probes() const {
   return static_cast<int>(std::count(valid_.begin(), valid_.end(), uint8_t{1}));
 }
 
+SkyIrradianceVolume::SkyIrradianceVolume(RayQueryFactory make_query)
+    : make_query_(std::move(make_query)) {
+  if (!make_query_) throw Error("SkyIrradianceVolume: no RayQueryFactory");
+}
+
 void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector<Pose>& X_WB,
                                 ThreadPool* pool, int max_probes) {
   if (X_WB.size() != scene.bodies.size())
@@ -375,10 +381,10 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     origin_[a] = static_cast<float>(centre[a] - 0.5 * s * (n[a] - 1) + kShift[a] * s);
 
   // trace the probes against the static geoms only.
-  RayScene rays(statics);
+  const std::unique_ptr<RayQuery> rays = make_query_(statics);
   WorldSnapshot snap;
   snap.X_WB = X_WB;
-  rays.Update(snap);
+  rays->Update(snap);
   const ProbeDirections& dirs = Directions();
   const int num = num_probes();
   valid_.assign(num, 0);
@@ -393,7 +399,8 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     std::fill_n(m, kNumTexels, far);
     std::fill_n(open, kNumTexels, uint16_t{0});
     *t_back = std::numeric_limits<float>::infinity();
-    // one probe's rays as Embree packets of 16 (4 x 4 neighbouring texels share a packet).
+    // one probe's rays as one batch, neighbouring texels next to each other (Embree: packets of
+    // 16, 4 x 4 neighbouring texels share one).
     thread_local std::vector<Ray> ray(kRaysPerProbe);
     thread_local std::vector<SurfaceHit> hit(kRaysPerProbe);
     thread_local std::unique_ptr<bool[]> did_hit(new bool[kRaysPerProbe]);
@@ -401,7 +408,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       ray[r].o = x;
       ray[r].d = dirs.dir[r];
     }
-    rays.IntersectMany(ray.data(), kRaysPerProbe, /*coherent=*/true, hit.data(), did_hit.get());
+    rays->Intersect(ray, hit, std::span<bool>(did_hit.get(), kRaysPerProbe));
     int backfaces = 0;
     for (int r = 0; r < kRaysPerProbe; ++r) {
       float t = far;
@@ -437,8 +444,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
         ray[i * kSubRays + c].o = x;
         ray[i * kSubRays + c].d = dirs.sub[static_cast<size_t>(texels[i]) * kSubRays + c];
       }
-    rays.IntersectMany(ray.data(), static_cast<int>(n_rays), /*coherent=*/true, hit.data(),
-                       did_hit.get());
+    rays->Intersect(ray, hit, std::span<bool>(did_hit.get(), n_rays));
     for (size_t i = 0; i < texels.size(); ++i) {
       uint16_t mask = 0;
       for (int c = 0; c < kSubRays; ++c)

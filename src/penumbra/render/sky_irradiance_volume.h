@@ -10,7 +10,8 @@
 // by a fixed fraction of a spacing (so that probes rarely sit exactly on axis-aligned faces).
 // the spacing is the smallest multiple of 1.05 of kMinSpacingM whose grid holds <= max_probes
 // probes. every probe traces the same kRaysPerProbe directions against the static geoms only
-// (the world body and Body::is_static; moving bodies are not baked), as Embree packets: one
+// (the world body and Body::is_static; moving bodies are not baked) through a RayQuery
+// (render/ray_query.h) of those geoms, built by the volume's RayQueryFactory, in batches: one
 // jittered direction in each texel of a kOctSide x kOctSide octahedral map of the sphere
 // (Cigolle et al., "A survey of efficient representations for independent unit vectors", JCGT
 // 2014), jitter from Rng(HashKeys(kDirectionSeed, texel, 0)). per probe and texel it keeps
@@ -67,6 +68,7 @@
 
 #include "penumbra/core/pose.h"
 #include "penumbra/core/thread_pool.h"
+#include "penumbra/render/ray_query.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -94,13 +96,16 @@ class SkyIrradianceVolume {
   static constexpr float kRelocateMargin = 0.05f;
   static constexpr uint64_t kDirectionSeed = 0x5ca1ab1e5c1e5ULL;
 
-  SkyIrradianceVolume() = default;
+  /// an empty volume whose Build traces through queries from `make_query` (e.g. the renderer
+  /// backend's; called once per Build, with a scene of the static geoms).
+  /// @throws Error if make_query is empty.
+  explicit SkyIrradianceVolume(RayQueryFactory make_query);
 
   /// traces the probes of the static geoms of `scene` posed by X_WB (one pose per body; only
   /// the static bodies' are used). with no finite static geometry the volume stays empty.
   /// the probe count is <= max_probes (clamped to [8, 65536]). clears the lighting: call
   /// Relight before Irradiance.
-  /// @throws Error if X_WB.size() != scene.bodies.size() or Embree fails.
+  /// @throws Error if X_WB.size() != scene.bodies.size(), or as the RayQueryFactory.
   void Build(const SceneDescription& scene, const std::vector<Pose>& X_WB, ThreadPool* pool,
              int max_probes = kDefaultMaxProbes);
 
@@ -154,6 +159,7 @@ class SkyIrradianceVolume {
   static int TexelOf(const Eigen::Vector3f& w);
 
  private:
+  RayQueryFactory make_query_;
   std::array<int, 3> dims_{0, 0, 0};
   float spacing_ = 0;
   float inv_spacing_ = 0;

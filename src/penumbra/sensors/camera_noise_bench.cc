@@ -1,6 +1,7 @@
 #include <chrono>
 #include <memory>
 
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 
 namespace penumbra {
@@ -35,7 +36,7 @@ std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames) {
   scene.lights.push_back(sun);
   RenderSettings rs;
   rs.tier = RenderSettings::Tier::kRealtime;
-  auto renderer = MakeEmbreeRenderer(scene, rs);
+  auto renderer = MakeRenderer(scene, rs);
   CameraSpec spec;
   spec.name = "bench";
   spec.intrinsics = CameraIntrinsics::FromFovy(320, 240, 60);

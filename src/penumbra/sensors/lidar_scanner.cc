@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
@@ -203,7 +204,7 @@ LidarScanner::LidarScanner(LidarConfig config, uint64_t stream_seed)
   for (int i = 0; i < n; ++i) bin_beams_[fill[bin[i]]++] = i;
 }
 
-void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
+void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
                         const SensorPoseAt& X_WS, int64_t scan_index, LidarScan* out) const {
   const LidarPattern& pat = config_.pattern;
   const SceneDescription& desc = scene.scene();
@@ -323,7 +324,8 @@ void LidarScanner::Scan(const RayScene& scene, const EffectsFrame* effects,
       r.tmin = 0.0f;
       r.tmax = static_cast<float>(pat.max_range_m);
     }
-    scene.IntersectMany(rays.data(), m, true, hits.data(), did_hit);
+    scene.Intersect(std::span<const Ray>(rays.data(), m), std::span<SurfaceHit>(hits.data(), m),
+                    std::span<bool>(did_hit, m));
     for (int j = 0; j < m; ++j) {
       const int i = start + j;
       const LidarBeam& beam = pat.beams[i];

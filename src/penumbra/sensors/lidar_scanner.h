@@ -1,14 +1,15 @@
 #pragma once
-// ray-traced LiDAR: one scan of a LidarPattern against the Embree scene the cameras see
-// (render/ray_scene.h), with per-beam timestamps, motion distortion, intensity, range noise,
-// dropout and adverse media (attenuation, fog/smoke false returns, rain/snow returns).
+// ray-traced LiDAR: one scan of a LidarPattern against the geometry the cameras see, through the
+// backend-neutral RayQuery (render/ray_query.h; beams traced in batches of neighbours), with
+// per-beam timestamps, motion distortion, intensity, range noise, dropout and adverse media
+// (attenuation, fog/smoke false returns, rain/snow returns).
 //
 // frames and motion: the caller gives X_WS(t), the sensor pose in the world for t in
 // [0, scan period] after the scan start (e.g. interpolated between the scan-start and the
 // scan-end snapshots with InterpolatePose). every beam is traced from the pose at its firing
 // time; its point is range * direction in the sensor frame at that time (what a driver
 // reports without motion compensation), so a moving sensor's scan is motion-distorted. the
-// rest of the world is posed once (the RayScene as the caller updated it, normally from the
+// rest of the world is posed once (the RayQuery as the caller updated it, normally from the
 // scan-start snapshot) and particles are frozen at their EffectsFrame positions.
 //
 // return model (single return, "strongest" mode), in one normalised power unit: the power
@@ -52,7 +53,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray_query.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/sensors/lidar_pattern.h"
 
@@ -111,7 +112,7 @@ class LidarScanner {
 
   /// traces scan `scan_index` in `scene` (already posed by the caller) with media and
   /// particles from `effects` (null = clear); `X_WS` gives the sensor pose over the scan.
-  void Scan(const RayScene& scene, const EffectsFrame* effects, const SensorPoseAt& X_WS,
+  void Scan(const RayQuery& scene, const EffectsFrame* effects, const SensorPoseAt& X_WS,
             int64_t scan_index, LidarScan* out) const;
 
   const LidarConfig& config() const { return config_; }

@@ -66,7 +66,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
     if (auto work = DescribeRunWork(EstimateRunWork(world_, scene_, sim_->timestep())))
       spdlog::warn("{}", *work);
   }
-  if (options.build_renderer) renderer_ = MakeEmbreeRenderer(scene_, world_.render);
+  if (options.build_renderer) renderer_ = MakeRenderer(scene_, world_.render);
   timings_.scene_build_sec = SecondsSince(t0);
 }
 

@@ -119,8 +119,11 @@ class WorldParser {
   static Eigen::Vector3f Vector3f(const YamlReader& r) { return r.Vector3().cast<float>(); }
 
   static void ReadRender(const YamlReader& r, RenderSettings* s) {
-    r.ExpectMap({"tier", "samples_per_pixel", "max_bounces", "denoise", "threads", "exposure",
-                 "tone_map", "max_anisotropy"});
+    r.ExpectMap({"backend", "tier", "samples_per_pixel", "max_bounces", "denoise", "threads",
+                 "exposure", "tone_map", "max_anisotropy"});
+    // one backend so far: Enum names it in the error for any other value
+    if (r.Has("backend") && r.Child("backend").Enum({"embree"}) == "embree")
+      s->backend = RenderSettings::Backend::kEmbree;
     if (r.Has("tier")) {
       s->tier = r.Child("tier").Enum({"realtime", "pathtraced"}) == "realtime"
                     ? RenderSettings::Tier::kRealtime

@@ -1,7 +1,7 @@
 // geometry of rendered images: exact depth, projection, segmentation, instancing,
 // all geom shapes, determinism across thread counts.
 
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {

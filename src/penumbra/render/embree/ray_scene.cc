@@ -1,4 +1,4 @@
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 #include <embree3/rtcore.h>
 #include <spdlog/spdlog.h>
@@ -14,6 +14,7 @@
 #include "penumbra/render/moving_bounds.h"
 #include "penumbra/render/ray_cone.h"
 #include "penumbra/render/triangle_shapes.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -573,20 +574,6 @@ struct RayScene::Impl {
   }
 };
 
-Ray SpawnRay(const SurfaceHit& hit, const Eigen::Vector3f& d) {
-  Ray r;
-  r.o = OffsetRayOrigin(hit.p_W, d.dot(hit.ng_W) >= 0 ? hit.ng_W : Eigen::Vector3f(-hit.ng_W));
-  r.d = d;
-  return r;
-}
-
-Ray SpawnRayTo(const SurfaceHit& hit, const Eigen::Vector3f& p_W) {
-  Ray r = SpawnRay(hit, p_W - hit.p_W);
-  r.d = p_W - r.o;
-  r.tmax = 1.0f - 1e-4f;
-  return r;
-}
-
 namespace {
 
 // checks the references and sizes of a visible geom.
@@ -773,6 +760,17 @@ bool RayScene::Occluded(const Ray& ray) const {
 
 // packets of kPacket rays (rtcIntersect16, Impl::IntersectPacket) for coherent rays;
 // incoherent rays go one by one (rtcIntersect1), as Embree recommends.
+void RayScene::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                              std::span<bool> did_hit) const {
+  // IntersectMany counts rays in int: batches of 2^30 rays (a multiple of the packet size, so
+  // the packets are those of one call)
+  constexpr size_t kMaxBatch = size_t{1} << 30;
+  for (size_t i = 0; i < rays.size(); i += kMaxBatch) {
+    const int n = static_cast<int>(std::min(kMaxBatch, rays.size() - i));
+    IntersectMany(rays.data() + i, n, /*coherent=*/true, hits.data() + i, did_hit.data() + i);
+  }
+}
+
 void RayScene::IntersectMany(const Ray* rays, int n, bool coherent, SurfaceHit* hits,
                              bool* did_hit) const {
   if (!coherent) {

@@ -1,6 +1,6 @@
 #include <embree3/rtcore.h>
 
-#include "penumbra/render/renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 
 namespace penumbra {
 

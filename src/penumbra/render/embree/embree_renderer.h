@@ -1,5 +1,6 @@
 #pragma once
-// the Embree ray tracer behind MakeEmbreeRenderer (renderer.h).
+// the Embree ray tracer: the Renderer of RenderSettings::Backend::kEmbree (MakeRenderer,
+// render/renderer_factory.h).
 //
 // per frame: pose the RayScene and the lights from the snapshot (the top-level BVH is
 // recommitted only when a body moved), split the image into kTileSize x kTileSize tiles spread
@@ -9,14 +10,15 @@
 // tone mapped and encoded by Film. every output is independent of the thread count.
 
 #include <memory>
+#include <string>
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/denoiser.h"
+#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/integrator.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
-#include "penumbra/render/ray_scene.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
@@ -57,5 +59,13 @@ class EmbreeRenderer final : public Renderer {
   // per-frame buffers kept between frames to avoid reallocation.
   ImageF albedo_, normal_, depth_, denoised_;
 };
+
+/// the EmbreeRenderer of `scene` (copied) with `settings`.
+/// @throws as the EmbreeRenderer constructor.
+std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene,
+                                             const RenderSettings& settings);
+
+/// the version of the Embree library built against (RTC_VERSION_STRING, e.g. "3.13.5").
+std::string EmbreeVersion();
 
 }  // namespace penumbra

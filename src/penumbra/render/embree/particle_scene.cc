@@ -1,4 +1,4 @@
-#include "penumbra/render/particle_scene.h"
+#include "penumbra/render/embree/particle_scene.h"
 
 #include <embree3/rtcore.h>
 
@@ -11,7 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/media_common.h"
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/ray.h"
 
 namespace penumbra {
 

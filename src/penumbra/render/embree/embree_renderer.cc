@@ -1,4 +1,4 @@
-#include "penumbra/render/embree_renderer.h"
+#include "penumbra/render/embree/embree_renderer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -41,6 +41,9 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       lights_(scene_),
       sky_(scene_.sky),
       effects_(scene_),
+      sky_volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+        return std::make_unique<RayScene>(statics);
+      }),
       film_(settings_),
       pool_(settings_.threads),
       integrator_(MakeIntegrator(settings_, scene_)) {

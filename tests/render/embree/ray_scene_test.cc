@@ -1,7 +1,7 @@
 // RayScene's batched tracing: IntersectGrid (4 x 4 packets) and IntersectMany give exactly the
 // hits of tracing every ray alone.
 
-#include "penumbra/render/ray_scene.h"
+#include "penumbra/render/embree/ray_scene.h"
 
 #include <gtest/gtest.h>
 
@@ -9,12 +9,14 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <span>
 #include <vector>
 
+#include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/ray_cone.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {
@@ -61,9 +63,10 @@ void ExpectSameHit(const SurfaceHit& a, const SurfaceHit& b) {
   EXPECT_EQ(a.has_uv, b.has_uv);
 }
 
-TEST(RaySceneTest, GridAndManyMatchSingleRays) {
+TEST(RaySceneTest, GridManyAndRayQueryBatchesMatchSingleRays) {
   Fixture f;
   RayScene rs(f.scene);
+  const RayQuery& query = rs;  // the backend-neutral batch interface (LiDAR, sky volume)
   rs.Update(f.snapshot);
   // a grid whose sides are not multiples of 4 (partial packets at the right and bottom).
   const int w = 37, h = 23;
@@ -72,27 +75,44 @@ TEST(RaySceneTest, GridAndManyMatchSingleRays) {
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) rays.push_back(camera.GenerateRay(u, v));
   const int n = w * h;
-  std::vector<SurfaceHit> single(n), grid(n), many(n);
-  std::unique_ptr<bool[]> hit_single(new bool[n]), hit_grid(new bool[n]), hit_many(new bool[n]);
+  std::vector<SurfaceHit> single(n), grid(n), many(n), batch(n);
+  std::unique_ptr<bool[]> hit_single(new bool[n]), hit_grid(new bool[n]), hit_many(new bool[n]),
+      hit_batch(new bool[n]);
   for (int i = 0; i < n; ++i) hit_single[i] = rs.Intersect(rays[i], &single[i]);
   rs.IntersectGrid(rays.data(), w, h, grid.data(), hit_grid.get());
   rs.IntersectMany(rays.data(), n, /*coherent=*/true, many.data(), hit_many.get());
+  query.Intersect(rays, batch, {hit_batch.get(), static_cast<size_t>(n)});
   int hits = 0;
   std::vector<bool> geom_seen(f.scene.geoms.size(), false);
   for (int i = 0; i < n; ++i) {
     SCOPED_TRACE(i);
     ASSERT_EQ(hit_grid[i], hit_single[i]);
     ASSERT_EQ(hit_many[i], hit_single[i]);
+    ASSERT_EQ(hit_batch[i], hit_single[i]);
     if (!hit_single[i]) continue;
     ++hits;
     geom_seen[single[i].geom] = true;
     ExpectSameHit(grid[i], single[i]);
     ExpectSameHit(many[i], single[i]);
+    ExpectSameHit(batch[i], single[i]);
   }
   // the test sees most of the scene: misses and hits, and every geom.
   EXPECT_GT(hits, n / 4);
   EXPECT_LT(hits, n);
   for (size_t g = 0; g < geom_seen.size(); ++g) EXPECT_TRUE(geom_seen[g]) << "geom " << g;
+}
+
+TEST(RaySceneTest, RayQueryBatchNeedsRoomForEveryHit) {
+  Fixture f;
+  RayScene rs(f.scene);
+  const RayQuery& query = rs;
+  std::vector<Ray> rays(5);
+  std::vector<SurfaceHit> hits(5);
+  bool did_hit[5];
+  EXPECT_THROW(query.Intersect(rays, std::span(hits).first(4), did_hit), Error);
+  EXPECT_THROW(query.Intersect(rays, hits, std::span(did_hit).first(4)), Error);
+  EXPECT_NO_THROW(query.Intersect(rays, hits, did_hit));
+  EXPECT_NO_THROW(query.Intersect({}, {}, {}));
 }
 
 TEST(RaySceneTest, AnalyticHitsFollowTheBodyPose) {

@@ -1,0 +1,61 @@
+#pragma once
+// the backend-neutral ray-query interface: closest hits of batches of rays against the
+// geometry the cameras see, posed from a WorldSnapshot. the LiDAR (sensors/lidar_scanner.h) and
+// the sky irradiance volume (render/sky_irradiance_volume.h) trace only through it, so that a
+// new backend (e.g. a GPU ray tracer) implements RayQuery next to its Renderer and the sensors
+// stay untouched. the shape follows pbrt-v4's Primitive::Intersect, batched as wavefront and
+// GPU tracers consume rays; it holds only what its users call (closest hits of ray batches,
+// posing, the scene), and grows when a user needs more (e.g. batched occlusion).
+//
+// implementations: RayScene (Embree 3, render/embree/ray_scene.h). MakeRayQuery
+// (render/renderer_factory.h) builds the one RenderSettings::backend names.
+//
+// contract of every backend:
+//  - traced geoms: those in MJCF groups <= 2 whose material has alpha >= 0.5;
+//  - surfaces are two-sided and opaque: the normals of a SurfaceHit face the incoming ray;
+//  - a ray that is not IsTraceableRay (render/ray.h) is a miss;
+//  - a ray's hit does not depend on the batch it is traced in, its position there or the
+//    thread count (bit-identical).
+
+#include <functional>
+#include <memory>
+#include <span>
+
+#include "penumbra/render/ray.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra {
+
+/// closest-hit queries of one SceneDescription (see the file comment). Intersect is
+/// thread-safe between Update calls; Update must not run concurrently with it.
+class RayQuery {
+ public:
+  virtual ~RayQuery() = default;
+
+  /// the scene traced: SurfaceHit::geom and SurfaceHit::material index its geoms and materials.
+  virtual const SceneDescription& scene() const = 0;
+
+  /// poses every body with snapshot.X_WB (world frame); until the first Update every body has
+  /// the identity pose.
+  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies.
+  virtual void Update(const WorldSnapshot& snapshot) = 0;
+
+  /// closest hits of `rays`, each within its [tmin, tmax]: did_hit[i] is whether rays[i] hit
+  /// something, and hits[i] is then that hit (otherwise unspecified). neighbouring rays of a
+  /// batch should be coherent (nearby origins, similar directions, e.g. a scan line or a probe's
+  /// neighbouring directions): backends trace neighbours together (Embree: packets of 16).
+  /// @throws Error if hits or did_hit is shorter than rays.
+  void Intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                 std::span<bool> did_hit) const;
+
+ protected:
+  /// Intersect after its size check: hits and did_hit hold at least rays.size() elements.
+  virtual void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                              std::span<bool> did_hit) const = 0;
+};
+
+/// builds a RayQuery over `scene`, which is referenced, not copied: it must outlive the query.
+using RayQueryFactory = std::function<std::unique_ptr<RayQuery>(const SceneDescription& scene)>;
+
+}  // namespace penumbra

@@ -1,0 +1,36 @@
+#pragma once
+// the one place that knows the rendering backends: builds the Renderer and the RayQuery of the
+// backend RenderSettings::backend names. a new backend adds its enum value
+// (render/render_settings.h), a sub-folder next to render/embree/ with its Renderer and
+// RayQuery, and a case in each function below; the sensors (LiDAR) and the sky irradiance
+// volume only see RayQuery (render/ray_query.h), the rest of the pipeline only Renderer.
+
+#include <memory>
+#include <string>
+
+#include "penumbra/render/ray_query.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// the Renderer of settings.backend over `scene` (copied) with `settings`.
+/// @throws ConfigError for bad settings (settings.ValidateOrThrow); Error if the backend
+/// cannot be initialised or the scene refers to missing meshes, height fields, materials or
+/// textures.
+std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,
+                                       const RenderSettings& settings);
+
+/// the RayQuery of `backend` over `scene`, which is referenced, not copied: it must outlive the
+/// query (e.g. the LiDAR's scene, posed by the caller with RayQuery::Update).
+/// @throws ConfigError for an unknown backend; Error as the backend's constructor.
+std::unique_ptr<RayQuery> MakeRayQuery(const SceneDescription& scene,
+                                       RenderSettings::Backend backend);
+
+/// the version of `backend`'s ray-tracing library, for run manifests (Embree: its
+/// RTC_VERSION_STRING, e.g. "3.13.5").
+/// @throws ConfigError for an unknown backend.
+std::string RendererVersion(RenderSettings::Backend backend);
+
+}  // namespace penumbra
