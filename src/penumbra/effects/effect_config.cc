@@ -30,7 +30,14 @@ std::string EffectChecker::Num(double v) {
 }
 
 std::string EffectChecker::Vec(const Eigen::Vector3d& v) {
-  return "[" + Num(v[0]) + ", " + Num(v[1]) + ", " + Num(v[2]) + "]";
+  std::string s = "[";
+  s += Num(v[0]);
+  s += ", ";
+  s += Num(v[1]);
+  s += ", ";
+  s += Num(v[2]);
+  s += "]";
+  return s;
 }
 
 void EffectChecker::Fail(const std::string& key, const std::string& message) {
