@@ -113,7 +113,8 @@ std::optional<double> EffectFluidDtSec(const EffectConfig& e);
 std::unique_ptr<EffectInstance> BindEffect(const EffectConfig& e, const EffectBindContext& ctx);
 
 /// validates every effect (keys "effects[i].<key>") and the cross-effect rules: unique
-/// names, wetness.rain and sparks.fire naming effects of that type.
+/// names, and each type's CheckReferences (wetness.rain and sparks.fire naming effects of
+/// that type).
 /// @param file     file named in errors ("" = none)
 /// @param line_of  optional: 1-based line of a key path, or 0 when unknown
 /// @throws ConfigError(file, line_of(key), key, problem) on the first violation.
