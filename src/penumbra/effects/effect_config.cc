@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <concepts>
 #include <map>
 #include <utility>
 
@@ -59,10 +60,24 @@ void EffectChecker::In3(const std::string& key, const Eigen::Vector3d& v, Effect
 
 namespace {
 
+// the hooks every effect type must have (effect_type.h); a type without them fails here with
+// the name of the missing one rather than deep inside std::visit.
+template <class P>
+concept EffectTypeParams = requires(P p, const P& cp, const EffectParamReader& r,
+                                    const EffectConfig& e, EffectChecker* c,
+                                    const EffectBindContext& ctx) {
+  { P::kTypeName } -> std::convertible_to<std::string_view>;
+  { P::Keys() } -> std::same_as<std::vector<std::string_view>>;
+  p.Read(r);
+  cp.Validate(e, c);
+  { cp.Bind(e, ctx) } -> std::same_as<std::unique_ptr<EffectInstance>>;
+};
+
 // the registry entry of alternative I of EffectParams, made from the type's hooks.
 template <size_t I>
 EffectTypeInfo MakeTypeInfo() {
   using P = std::variant_alternative_t<I, EffectParams>;
+  static_assert(EffectTypeParams<P>, "an effect type lacks a hook of effects/effect_type.h");
   EffectTypeInfo info;
   info.name = std::string(P::kTypeName);
   info.index = I;
