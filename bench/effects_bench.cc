@@ -14,29 +14,35 @@ namespace {
 EffectConfig Rain() {
   EffectConfig e;
   e.name = "rain";
-  e.type = EffectType::kRain;
+  e.params = RainParams{};
   return e;
 }
 
 EffectConfig NoiseSmoke() {
   EffectConfig e;
   e.name = "smoke";
-  e.type = EffectType::kSmoke;
+  e.params = SmokeParams{};
   e.region = BoxRegion{{-2, -2, 0}, {2, 2, 2}};
   return e;
 }
 
-EffectConfig Plume(EffectType type, int resolution) {
+EffectConfig Plume(bool fire, int resolution) {
   EffectConfig e;
   e.name = "plume";
-  e.type = type;
   e.region = BoxRegion{{-1, -1, 0}, {1, 1, 2}};
   PlumeEmitter em;
   em.position_W = {0, 0, 0.3};
-  FluidParams& f = type == EffectType::kFire ? e.fire.fluid : e.smoke.fluid;
-  if (type == EffectType::kFire) em.temperature_k = 1500;
-  e.smoke.mode = SmokeParams::Mode::kPlume;
-  e.smoke.wind_m_s.setZero();
+  FluidParams* fluid;
+  if (fire) {
+    fluid = &e.params.emplace<FireParams>().fluid;
+    em.temperature_k = 1500;
+  } else {
+    SmokeParams& s = e.params.emplace<SmokeParams>();
+    s.mode = SmokeParams::Mode::kPlume;
+    s.wind_m_s.setZero();
+    fluid = &s.fluid;
+  }
+  FluidParams& f = *fluid;
   f.resolution = resolution;
   f.emitters = {em};
   return e;
@@ -67,10 +73,10 @@ BENCHMARK(BM_EffectsNoiseSmokeFrame)->Unit(benchmark::kMillisecond);
 
 // one second of sim time: 30 fluid steps plus one frame
 void BM_EffectsFluidSecond(benchmark::State& state) {
-  const EffectType type = state.range(0) ? EffectType::kFire : EffectType::kSmoke;
+  const bool fire = state.range(0) != 0;
   const int resolution = static_cast<int>(state.range(1));
   for (auto _ : state) {
-    EffectsEngine engine({Plume(type, resolution)}, 1, SceneDescription{});
+    EffectsEngine engine({Plume(fire, resolution)}, 1, SceneDescription{});
     benchmark::DoNotOptimize(engine.Evaluate(1.0, {0, 0, 0}));
   }
   state.counters["steps_per_s"] =

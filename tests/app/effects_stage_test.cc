@@ -53,7 +53,7 @@ TEST(AdversityPlan, NoneAddsNothingMinorAndMajorAddTheirParts) {
   EXPECT_EQ(major.agents.size(), 5u);
   EXPECT_EQ(major.agents.back().kind, AgentKind::kForklift);
   // fog extinction from the MOR of the preset: 2.996 / 12 m
-  EXPECT_NEAR(major.effects[0].fog.extinction.SigmaT(), -std::log(0.05) / 12.0, 1e-9);
+  EXPECT_NEAR(major.effects[0].Get<FogParams>().extinction.SigmaT(), -std::log(0.05) / 12.0, 1e-9);
   // smoke box inside the room (x in [-4, 4], y in [-3, 3] plus walls), floor to 2.5 m
   const BoxRegion& smoke = *major.effects[1].region;
   EXPECT_GE(smoke.min_W.x(), -4.5);

@@ -43,17 +43,17 @@ std::vector<std::string> Trajectory(const std::string& tag,
 std::vector<EffectConfig> Weather() {
   EffectConfig fog;
   fog.name = "fog";
-  fog.type = EffectType::kFog;
-  fog.fog.extinction.mor_m = 15;
+  fog.params = FogParams{};
+  fog.Get<FogParams>().extinction.mor_m = 15;
   EffectConfig smoke;
   smoke.name = "smoke";
-  smoke.type = EffectType::kSmoke;
-  smoke.smoke.density_scale_per_m = 1.5;
+  smoke.params = SmokeParams{};
+  smoke.Get<SmokeParams>().density_scale_per_m = 1.5;
   smoke.region = BoxRegion{Eigen::Vector3d(-2, -2, 0), Eigen::Vector3d(2, 2, 2.5)};
   EffectConfig rain;
   rain.name = "rain";
-  rain.type = EffectType::kRain;
-  rain.rain.rate_mm_h = 20;
+  rain.params = RainParams{};
+  rain.Get<RainParams>().rate_mm_h = 20;
   return {fog, smoke, rain};
 }
 

@@ -15,8 +15,8 @@ namespace {
 EffectConfig Fog() {
   EffectConfig e;
   e.name = "fog";
-  e.type = EffectType::kFog;
-  e.fog.extinction.mor_m = 50;
+  e.params = FogParams{};
+  e.Get<FogParams>().extinction.mor_m = 50;
   e.start_sec = 1;
   e.stop_sec = 9;
   e.fade_in_sec = 2;
@@ -45,15 +45,15 @@ TEST(EffectsEngineTest, FogFromMorWithFadeIn) {
 EffectConfig Smoke(SmokeParams::Mode mode) {
   EffectConfig e;
   e.name = "smoke";
-  e.type = EffectType::kSmoke;
+  e.params = SmokeParams{};
   e.region = BoxRegion{{-1, -1, 0}, {1, 1, 2}};
-  e.smoke.mode = mode;
-  e.smoke.noise_resolution = 16;
-  e.smoke.fluid.resolution = 16;
+  e.Get<SmokeParams>().mode = mode;
+  e.Get<SmokeParams>().noise_resolution = 16;
+  e.Get<SmokeParams>().fluid.resolution = 16;
   PlumeEmitter em;
   em.position_W = {0, 0, 0.3};
-  e.smoke.fluid.emitters = {em};
-  e.smoke.wind_m_s =
+  e.Get<SmokeParams>().fluid.emitters = {em};
+  e.Get<SmokeParams>().wind_m_s =
       mode == SmokeParams::Mode::kPlume ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0.5, 0, 0);
   return e;
 }
@@ -83,15 +83,15 @@ TEST(EffectsEngineTest, SmokeIsDeterministicPerSeedAndRestartsWhenTimeGoesBack) 
 TEST(EffectsEngineTest, FireEmitsBlackbodyLightAndItsGlowMatchesTheEmittedPower) {
   EffectConfig e;
   e.name = "fire";
-  e.type = EffectType::kFire;
+  e.params = FireParams{};
   e.region = BoxRegion{{-0.5, -0.5, 0}, {0.5, 0.5, 1.5}};
-  e.fire.fluid.resolution = 16;
+  e.Get<FireParams>().fluid.resolution = 16;
   PlumeEmitter em;
   em.position_W = {0, 0, 0.15};
   em.radius_m = 0.15;
   em.rate = 0.3;
   em.temperature_k = 1500;
-  e.fire.fluid.emitters = {em};
+  e.Get<FireParams>().fluid.emitters = {em};
   EffectsEngine engine({e}, 3, SceneDescription{});
   std::vector<float> intensities;
   for (double t = 0.5; t <= 2.0; t += 0.25) {
@@ -126,8 +126,8 @@ TEST(EffectsEngineTest, FireEmitsBlackbodyLightAndItsGlowMatchesTheEmittedPower)
 TEST(EffectsEngineTest, FlashlightFollowsWaypointsOrItsBody) {
   EffectConfig e;
   e.name = "torch";
-  e.type = EffectType::kFlashlight;
-  e.flashlight.waypoints = {{0, {0, 0, 1}, {1, 0, 0}}, {2, {2, 0, 1}, {0, 1, 0}}};
+  e.params = FlashlightParams{};
+  e.Get<FlashlightParams>().waypoints = {{0, {0, 0, 1}, {1, 0, 0}}, {2, {2, 0, 1}, {0, 1, 0}}};
   EffectsEngine engine({e}, 1, SceneDescription{});
   auto f = engine.Evaluate(1.0, {0, 0, 0});
   ASSERT_EQ(f->extra_lights.size(), 1u);
@@ -142,10 +142,10 @@ TEST(EffectsEngineTest, FlashlightFollowsWaypointsOrItsBody) {
   scene.bodies[1].name = "robot/base";
   EffectConfig a;
   a.name = "head";
-  a.type = EffectType::kFlashlight;
-  a.flashlight.attach = "robot/base";
-  a.flashlight.position_B = {0.2, 0, 0.1};
-  a.flashlight.direction_B = {1, 0, 0};
+  a.params = FlashlightParams{};
+  a.Get<FlashlightParams>().attach = "robot/base";
+  a.Get<FlashlightParams>().position_B = {0.2, 0, 0.1};
+  a.Get<FlashlightParams>().direction_B = {1, 0, 0};
   EffectsEngine attached({a}, 1, scene);
   std::vector<Pose> X_WB(2, Pose::Identity());
   X_WB[1] = PoseFromXyzRpyDeg({1, 2, 0}, {0, 0, 90});
@@ -153,21 +153,21 @@ TEST(EffectsEngineTest, FlashlightFollowsWaypointsOrItsBody) {
   EXPECT_NEAR((g->extra_lights[0].position_B - Eigen::Vector3d(1, 2.2, 0.1)).norm(), 0, 1e-12);
   EXPECT_NEAR((g->extra_lights[0].direction_B - Eigen::Vector3d(0, 1, 0)).norm(), 0, 1e-12);
   EXPECT_THROW(attached.Evaluate(0.0, {0, 0, 0}), Error);
-  a.flashlight.attach = "robot/arm";
+  a.Get<FlashlightParams>().attach = "robot/arm";
   EXPECT_THROW(EffectsEngine({a}, 1, scene), ConfigError);
 }
 
 TEST(EffectsEngineTest, SunSetsDirectionAndDimsTheSkyAtNight) {
   EffectConfig e;
   e.name = "sun";
-  e.type = EffectType::kSun;
-  e.sun.latitude_deg = 48.14;
-  e.sun.longitude_deg = 11.58;
-  e.sun.year = 2024;
-  e.sun.month = 6;
-  e.sun.day = 21;
-  e.sun.time_utc_h = 11.0;  // about local solar noon in Munich
-  e.sun.time_scale = 3600;  // one hour per sim second
+  e.params = SunParams{};
+  e.Get<SunParams>().latitude_deg = 48.14;
+  e.Get<SunParams>().longitude_deg = 11.58;
+  e.Get<SunParams>().year = 2024;
+  e.Get<SunParams>().month = 6;
+  e.Get<SunParams>().day = 21;
+  e.Get<SunParams>().time_utc_h = 11.0;  // about local solar noon in Munich
+  e.Get<SunParams>().time_scale = 3600;  // one hour per sim second
   EffectsEngine engine({e}, 1, SceneDescription{});
   auto noon = engine.Evaluate(0.0, {0, 0, 0});
   ASSERT_TRUE(noon->sun_direction_W);
@@ -193,9 +193,9 @@ TEST(EffectsEngineTest, SunMovesTheSceneSunLight) {
   scene.lights = {lamp, sun};
   EffectConfig e;
   e.name = "day";
-  e.type = EffectType::kSun;
-  e.sun.time_utc_h = 11.0;
-  e.sun.time_scale = 3600;
+  e.params = SunParams{};
+  e.Get<SunParams>().time_utc_h = 11.0;
+  e.Get<SunParams>().time_scale = 3600;
   EffectsEngine engine({e}, 1, scene);
   auto noon = engine.Evaluate(0.0, {0, 0, 0});
   ASSERT_EQ(noon->light_intensity_scale.size(), 2u);
@@ -228,15 +228,15 @@ TEST(EffectsEngineTest, DirectSunAttenuationFollowsAirMass) {
 TEST(EffectsEngineTest, WetnessFollowsRain) {
   EffectConfig rain;
   rain.name = "rain";
-  rain.type = EffectType::kRain;
+  rain.params = RainParams{};
   rain.start_sec = 10;
   rain.stop_sec = 70;
-  rain.rain.box_half_extents_m = {1, 1, 1};
+  rain.Get<RainParams>().box_half_extents_m = {1, 1, 1};
   EffectConfig wet;
   wet.name = "wet";
-  wet.type = EffectType::kWetness;
-  wet.wetness.wetting_time_sec = 20;
-  wet.wetness.drying_time_sec = 100;
+  wet.params = WetnessParams{};
+  wet.Get<WetnessParams>().wetting_time_sec = 20;
+  wet.Get<WetnessParams>().drying_time_sec = 100;
   EffectsEngine engine({rain, wet}, 1, SceneDescription{});
   EXPECT_EQ(engine.Evaluate(5, {0, 0, 0})->surface_wetness, 0.0f);
   auto during = engine.Evaluate(30, {0, 0, 0});
@@ -250,7 +250,7 @@ TEST(EffectsEngineTest, WetnessFollowsRain) {
 
 TEST(EffectConfigTest, ErrorsNameEffectKeyAndRange) {
   EffectConfig e = Fog();
-  e.fog.extinction.mor_m = 0.0;
+  e.Get<FogParams>().extinction.mor_m = 0.0;
   try {
     e.ValidateOrThrow("effects[4]");
     FAIL();
@@ -261,22 +261,22 @@ TEST(EffectConfigTest, ErrorsNameEffectKeyAndRange) {
   }
   EffectConfig r;
   r.name = "r";
-  r.type = EffectType::kRain;
-  r.rain.rate_mm_h = -1;
+  r.params = RainParams{};
+  r.Get<RainParams>().rate_mm_h = -1;
   EXPECT_EQ(r.Validate()->key, "rate_mm_h");
-  r.rain.rate_mm_h = 5;
+  r.Get<RainParams>().rate_mm_h = 5;
   r.region = BoxRegion{{0, 0, 0}, {1, -1, 1}};
   EXPECT_EQ(r.Validate()->key, "region.min");
   r.region.reset();
   EXPECT_FALSE(r.Validate());
   EffectConfig s = Smoke(SmokeParams::Mode::kPlume);
-  s.smoke.fluid.emitters[0].position_W = {5, 0, 0};
+  s.Get<SmokeParams>().fluid.emitters[0].position_W = {5, 0, 0};
   EXPECT_EQ(s.Validate()->key, "emitters[0].position");
   // duplicate names and dangling references
   EXPECT_THROW(ValidateEffectsOrThrow({Fog(), Fog()}), ConfigError);
   EffectConfig w;
   w.name = "w";
-  w.type = EffectType::kWetness;
+  w.params = WetnessParams{};
   try {
     ValidateEffectsOrThrow({Fog(), w}, "world.yaml", [](const std::string&) { return 12; });
     FAIL();
@@ -290,10 +290,10 @@ TEST(EffectConfigTest, ErrorsNameEffectKeyAndRange) {
 TEST(EffectsEngineTest, SparksRiseFromTheirSourceAndFallBack) {
   EffectConfig e;
   e.name = "sparks";
-  e.type = EffectType::kSparks;
-  e.sparks.position_W = {1, 1, 0.5};
-  e.sparks.rate_per_s = 100;
-  e.sparks.lifetime_sec = 1;
+  e.params = SparksParams{};
+  e.Get<SparksParams>().position_W = {1, 1, 0.5};
+  e.Get<SparksParams>().rate_per_s = 100;
+  e.Get<SparksParams>().lifetime_sec = 1;
   EffectsEngine engine({e}, 1, SceneDescription{});
   auto f = engine.Evaluate(3.0, {0, 0, 0});
   ASSERT_EQ(f->particles.size(), 1u);

@@ -14,9 +14,9 @@ namespace {
 EffectConfig Event(LightEventParams::Mode mode) {
   EffectConfig e;
   e.name = "ev";
-  e.type = EffectType::kLightEvent;
-  e.light_event.light = "lamp";
-  e.light_event.mode = mode;
+  e.params = LightEventParams{};
+  e.Get<LightEventParams>().light = "lamp";
+  e.Get<LightEventParams>().mode = mode;
   return e;
 }
 
@@ -24,9 +24,9 @@ TEST(LightEventTest, StrobeFollowsFrequencyAndDutyCycle) {
   EffectConfig e = Event(LightEventParams::Mode::kStrobe);
   e.start_sec = 1.0;
   e.stop_sec = 10.0;
-  e.light_event.frequency_hz = 2.0;
-  e.light_event.duty_cycle = 0.25;
-  e.light_event.min_scale = 0.1;
+  e.Get<LightEventParams>().frequency_hz = 2.0;
+  e.Get<LightEventParams>().duty_cycle = 0.25;
+  e.Get<LightEventParams>().min_scale = 0.1;
   EXPECT_DOUBLE_EQ(LightEventScale(e, 0.5, 1), 1.0);   // before start
   EXPECT_DOUBLE_EQ(LightEventScale(e, 1.05, 1), 1.0);  // phase 0.1 < 0.25: on
   EXPECT_DOUBLE_EQ(LightEventScale(e, 1.2, 1), 0.1);   // phase 0.4: off
@@ -42,8 +42,8 @@ TEST(LightEventTest, StrobeFollowsFrequencyAndDutyCycle) {
 
 TEST(LightEventTest, FlickerStaysWithinDepthAndIsSmooth) {
   EffectConfig e = Event(LightEventParams::Mode::kFlicker);
-  e.light_event.frequency_hz = 10;
-  e.light_event.depth = 0.4;
+  e.Get<LightEventParams>().frequency_hz = 10;
+  e.Get<LightEventParams>().depth = 0.4;
   double lo = 1, hi = 0, prev = LightEventScale(e, 0, 3), max_step = 0;
   for (int i = 1; i <= 20000; ++i) {
     const double s = LightEventScale(e, i * 1e-4, 3);
@@ -61,9 +61,9 @@ TEST(LightEventTest, FlickerStaysWithinDepthAndIsSmooth) {
 
 TEST(LightEventTest, FailingDropsOutWithItsProbability) {
   EffectConfig e = Event(LightEventParams::Mode::kFailing);
-  e.light_event.frequency_hz = 5;
-  e.light_event.failure_probability = 0.3;
-  e.light_event.min_scale = 0.0;
+  e.Get<LightEventParams>().frequency_hz = 5;
+  e.Get<LightEventParams>().failure_probability = 0.3;
+  e.Get<LightEventParams>().min_scale = 0.0;
   int off = 0;
   const int slots = 4000;
   for (int i = 0; i < slots; ++i) off += LightEventScale(e, (i + 0.5) / 5.0, 9) == 0.0;
@@ -74,8 +74,8 @@ TEST(LightEventTest, BlackoutThenLinearRecovery) {
   EffectConfig e = Event(LightEventParams::Mode::kBlackout);
   e.start_sec = 2;
   e.stop_sec = 5;
-  e.light_event.recovery_sec = 2;
-  e.light_event.min_scale = 0;
+  e.Get<LightEventParams>().recovery_sec = 2;
+  e.Get<LightEventParams>().min_scale = 0;
   EXPECT_DOUBLE_EQ(LightEventScale(e, 1.0, 1), 1.0);
   EXPECT_DOUBLE_EQ(LightEventScale(e, 2.0, 1), 0.0);
   EXPECT_DOUBLE_EQ(LightEventScale(e, 4.9, 1), 0.0);
@@ -102,7 +102,7 @@ TEST(LightEventTest, EngineScalesOnlyTheNamedLight) {
   EXPECT_EQ(f->light_intensity_scale[2], 1.0f);
   EXPECT_FALSE(f->empty());
 
-  e.light_event.light = "nope";
+  e.Get<LightEventParams>().light = "nope";
   try {
     EffectsEngine bad({e}, 7, scene);
     FAIL() << "expected ConfigError";

@@ -36,8 +36,8 @@ std::string WriteVdb(const std::string& name, const std::string& grid_name) {
 EffectConfig VdbEffect(const std::string& path) {
   EffectConfig e;
   e.name = "plume";
-  e.type = EffectType::kVdbSmoke;
-  e.vdb_smoke.file = path;
+  e.params = VdbSmokeParams{};
+  e.Get<VdbSmokeParams>().file = path;
   return e;
 }
 

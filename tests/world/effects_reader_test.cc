@@ -61,28 +61,28 @@ TEST(WorldEffects, ParsesEveryType) {
   const WorldConfig w = ParseWorld(kEffects, (dir.path() / "w.yaml").string());
   ASSERT_EQ(w.effects.size(), 12u);
   const auto& e = w.effects;
-  EXPECT_EQ(e[0].type, EffectType::kFog);
-  EXPECT_NEAR(e[0].fog.extinction.SigmaT(), 2.9957 / 80, 1e-5);
-  EXPECT_EQ(e[0].fog.height_falloff_per_m, 0.3);
-  EXPECT_EQ(e[1].dust.color, Eigen::Vector3d(0.8, 0.6, 0.4));
+  EXPECT_TRUE(e[0].Is<FogParams>());
+  EXPECT_NEAR(e[0].Get<FogParams>().extinction.SigmaT(), 2.9957 / 80, 1e-5);
+  EXPECT_EQ(e[0].Get<FogParams>().height_falloff_per_m, 0.3);
+  EXPECT_EQ(e[1].Get<DustParams>().color, Eigen::Vector3d(0.8, 0.6, 0.4));
   ASSERT_TRUE(e[1].region);
   EXPECT_EQ(e[1].region->max_W, Eigen::Vector3d(5, 5, 3));
-  EXPECT_EQ(e[2].smoke.mode, SmokeParams::Mode::kPlume);
-  EXPECT_EQ(e[2].smoke.fluid.resolution, 32);
-  ASSERT_EQ(e[2].smoke.fluid.emitters.size(), 1u);
-  EXPECT_EQ(e[2].smoke.fluid.emitters[0].rate, 0.3);
-  EXPECT_EQ(e[3].vdb_smoke.file, vdb);  // relative to the world file
-  EXPECT_EQ(e[4].fire.fluid.emitters[0].temperature_k, 1400);
-  EXPECT_EQ(e[5].rain.rate_mm_h, 20);
+  EXPECT_EQ(e[2].Get<SmokeParams>().mode, SmokeParams::Mode::kPlume);
+  EXPECT_EQ(e[2].Get<SmokeParams>().fluid.resolution, 32);
+  ASSERT_EQ(e[2].Get<SmokeParams>().fluid.emitters.size(), 1u);
+  EXPECT_EQ(e[2].Get<SmokeParams>().fluid.emitters[0].rate, 0.3);
+  EXPECT_EQ(e[3].Get<VdbSmokeParams>().file, vdb);  // relative to the world file
+  EXPECT_EQ(e[4].Get<FireParams>().fluid.emitters[0].temperature_k, 1400);
+  EXPECT_EQ(e[5].Get<RainParams>().rate_mm_h, 20);
   EXPECT_EQ(e[5].start_sec, 2);
   EXPECT_TRUE(std::isinf(e[5].stop_sec));
-  EXPECT_EQ(e[6].snow.flake_diameter_mm, 6);
-  EXPECT_EQ(e[7].sparks.fire, "campfire");
-  EXPECT_EQ(e[8].light_event.mode, LightEventParams::Mode::kStrobe);
-  ASSERT_EQ(e[9].flashlight.waypoints.size(), 2u);
-  EXPECT_EQ(e[9].flashlight.waypoints[1].position_W, Eigen::Vector3d(4, 0, 1.5));
-  EXPECT_EQ(e[10].sun.month, 12);
-  EXPECT_EQ(e[11].wetness.rain, "storm");
+  EXPECT_EQ(e[6].Get<SnowParams>().flake_diameter_mm, 6);
+  EXPECT_EQ(e[7].Get<SparksParams>().fire, "campfire");
+  EXPECT_EQ(e[8].Get<LightEventParams>().mode, LightEventParams::Mode::kStrobe);
+  ASSERT_EQ(e[9].Get<FlashlightParams>().waypoints.size(), 2u);
+  EXPECT_EQ(e[9].Get<FlashlightParams>().waypoints[1].position_W, Eigen::Vector3d(4, 0, 1.5));
+  EXPECT_EQ(e[10].Get<SunParams>().month, 12);
+  EXPECT_EQ(e[11].Get<WetnessParams>().rain, "storm");
 }
 
 struct BadCase {
@@ -150,6 +150,33 @@ TEST(WorldEffects, MissingNameOrTypeIsAnError) {
             std::string::npos);
   EXPECT_NE(ErrorOf("effects:\n  - {name: x}\n").find("effects[0].type"), std::string::npos);
   EXPECT_NE(ErrorOf("effects: {a: 1}\n").find("expected a list"), std::string::npos);
+}
+
+TEST(WorldEffects, UnknownTypeListsEveryRegisteredType) {
+  ConfigError err("", 0, "", "");
+  const std::string what = ErrorOf("effects:\n  - {name: x, type: hail}\n", &err);
+  std::string names;
+  for (const std::string& n : EffectTypeNames()) names += (names.empty() ? "" : ", ") + n;
+  EXPECT_EQ(err.key(), "effects[0].type") << what;
+  EXPECT_EQ(err.line(), 2) << what;
+  EXPECT_NE(what.find("unknown value 'hail'; expected one of: " + names), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("fog, dust, smoke, vdb_smoke, fire, rain, snow, sparks, light_event, "
+                      "flashlight, sun, wetness"),
+            std::string::npos)
+      << what;
+}
+
+TEST(WorldEffects, EachTypeAcceptsOnlyItsOwnKeys) {
+  // a key of another type is unknown: "mor_m" belongs to fog and dust, not rain
+  ConfigError err("", 0, "", "");
+  const std::string what = ErrorOf("effects:\n  - {name: r, type: rain, mor_m: 3}\n", &err);
+  EXPECT_EQ(err.key(), "effects[0].mor_m") << what;
+  EXPECT_NE(what.find("unknown key 'mor_m'"), std::string::npos) << what;
+  // the message lists the common keys, then the type's own keys (its registry entry)
+  std::string keys = "name, type, start_sec, stop_sec, fade_in_sec, fade_out_sec, region";
+  for (std::string_view k : FindEffectType("rain")->keys) keys += ", " + std::string(k);
+  EXPECT_NE(what.find(keys), std::string::npos) << what;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 #pragma once
-// NPC agents (issue 4): people and vehicles that walk or drive a waypoint path in the
+// NPC agents: people and vehicles that walk or drive a waypoint path in the
 // world. an agent is a kinematic (mocap) body in the composed MJCF
 // (compose/agent_bodies.h), posed every physics step from AgentPath::X_WA(sim time)
 // (physics Simulation::AddMocapDriver). coupling is one-way: robots and free bodies

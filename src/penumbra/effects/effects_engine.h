@@ -1,7 +1,9 @@
 #pragma once
 // the effects stage: turns the world's effect configs, its seed and the sim time into an
 // EffectsFrame (scene/effects_frame.h) for the renderer. models and units per effect type
-// are documented in effect_config.h and docs/effects.md.
+// are documented in effects/types/<type>.h and docs/effects.md; the engine itself knows no
+// type: it binds each effect through the registry (effect_types.h) and evaluates the
+// instances in the order of the list.
 //
 // determinism: every random draw comes from core/rng.h keyed by (seed, effect index,
 // particle / voxel / slot index); nothing depends on wall-clock time, call order of
@@ -25,8 +27,6 @@
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
-
-class EffectRuntime;  // one per effect (effects_engine.cc)
 
 /// evaluates all effects of a world at given sim times.
 class EffectsEngine {
@@ -57,15 +57,14 @@ class EffectsEngine {
                                                const std::vector<Pose>* X_WB = nullptr);
 
   /// number of effects.
-  size_t size() const { return runtimes_.size(); }
+  size_t size() const { return instances_.size(); }
 
  private:
-  std::vector<std::unique_ptr<EffectRuntime>> runtimes_;
+  /// the configs the instances refer to (never resized after construction).
+  const std::vector<EffectConfig> effects_;
+  std::vector<std::unique_ptr<EffectInstance>> instances_;  ///< one per effect, same order
   size_t num_scene_lights_ = 0;
-  bool any_light_event_ = false;
-  bool any_sun_ = false;
-  /// the scene's directional lights (index, light), moved by a sun effect.
-  std::vector<std::pair<int, Light>> directional_lights_;
+  bool scales_scene_lights_ = false;  ///< any instance ScalesSceneLights()
   /// threads (hardware concurrency) for the noise smoke voxels and the precipitation
   /// particles, made on first use; the results do not depend on the thread count.
   std::unique_ptr<ThreadPool> pool_;

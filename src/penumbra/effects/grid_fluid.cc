@@ -37,6 +37,24 @@ GridFluid::GridFluid(const FluidParams& params, const BoxRegion& region,
   Reset();
 }
 
+void GridFluid::AdvanceTo(double t_sec, const std::function<double(double)>& emission_weight_at) {
+  const double dt = params_.dt_sec;
+  const int target = static_cast<int>(std::floor(t_sec / dt + 1e-9));
+  if (target < steps_) Reset();
+  while (steps_ < target) Step(emission_weight_at(steps_ * dt));
+}
+
+GridMedium RegionGridMedium(const BoxRegion& r, int nx, int ny, int nz) {
+  GridMedium g;
+  g.X_WG = Pose::Identity();
+  g.X_WG.translation() = 0.5 * (r.min_W + r.max_W);
+  g.half_extents_m = 0.5 * (r.max_W - r.min_W);
+  g.nx = nx;
+  g.ny = ny;
+  g.nz = nz;
+  return g;
+}
+
 void GridFluid::Reset() {
   const size_t n = static_cast<size_t>(nx_ + 2) * (ny_ + 2) * (nz_ + 2);
   for (auto* f : {&rho_, &theta_, &u_, &v_, &w_, &tmp_, &p_, &div_}) f->assign(n, 0.0f);

@@ -19,9 +19,11 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
-#include "penumbra/effects/effect_config.h"
+#include "penumbra/effects/types/fluid_params.h"
+#include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
 
@@ -36,6 +38,10 @@ class GridFluid {
   void Reset();
   /// advances one dt; `emission_weight` in [0, 1] scales the emitters (the effect's weight).
   void Step(double emission_weight);
+
+  /// steps (from Reset() when t went backwards) until steps() = floor(t_sec / dt_sec),
+  /// each step k with emission weight emission_weight_at(k * dt_sec).
+  void AdvanceTo(double t_sec, const std::function<double(double)>& emission_weight_at);
 
   int steps() const { return steps_; }
   int nx() const { return nx_; }
@@ -84,5 +90,9 @@ class GridFluid {
   std::vector<float> rho_, theta_, u_, v_, w_, tmp_, p_, div_;
   std::vector<std::vector<size_t>> emitter_cells_;
 };
+
+/// a GridMedium on the axis-aligned box `region` with nx x ny x nz voxels (the GridFluid
+/// layout); density, coefficients and emission left empty.
+GridMedium RegionGridMedium(const BoxRegion& region, int nx, int ny, int nz);
 
 }  // namespace penumbra

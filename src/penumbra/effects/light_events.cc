@@ -9,7 +9,7 @@
 namespace penumbra {
 
 double LightEventScale(const EffectConfig& e, double t, uint64_t key) {
-  const LightEventParams& p = e.light_event;
+  const LightEventParams& p = e.Get<LightEventParams>();
   if (p.mode == LightEventParams::Mode::kBlackout) {
     if (t < e.start_sec) return 1.0;
     if (t <= e.stop_sec) {

@@ -1,5 +1,5 @@
 #pragma once
-// intensity multipliers of light events (definitions in effect_config.h, LightEventParams).
+// intensity multipliers of light events (definitions in types/light_event.h, LightEventParams).
 
 #include <cstdint>
 

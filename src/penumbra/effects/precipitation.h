@@ -1,6 +1,6 @@
 #pragma once
-// rain and snow particles around a viewer (models and citations in effect_config.h,
-// RainParams / SnowParams).
+// rain and snow particles around a viewer (models and citations in types/rain.h and
+// types/snow.h, RainParams / SnowParams).
 //
 // sampling: particle i of an effect draws its size, its position in a periodic cell and its
 // drift phases from Rng(HashKeys(seed, effect key, i)). the cell (the box around the
@@ -14,7 +14,8 @@
 #include <vector>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/effects/effect_config.h"
+#include "penumbra/effects/types/rain.h"
+#include "penumbra/effects/types/snow.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "penumbra/effects/effect_config.h"
+#include "penumbra/effects/types/vdb_smoke.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {

@@ -25,7 +25,7 @@ struct RunManifest {
   std::map<std::string, int64_t> frames_per_camera;  ///< frames written per camera name
   std::map<std::string, double> timings_sec;         ///< wall-clock per stage, e.g. "render": 12.5
   double peak_resident_memory_mib = 0;  ///< usually PeakResidentMemoryMiB() at the end of the run
-  /// adverse conditions (issue 4), written only when any is set: the adversity preset
+  /// adverse conditions, written only when any is set: the adversity preset
   /// ("name (file)"), the effects ("name: type") and the NPC agents ("name: kind") in order.
   std::string adversity;
   std::vector<std::string> effects;

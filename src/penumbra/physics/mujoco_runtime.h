@@ -43,7 +43,7 @@ mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* content
                              const std::string& display_name, std::vector<std::string>* warnings);
 
 /// frees the "last loaded XML" that mj_loadXML keeps for mj_saveLastXML (MuJoCo's whole
-/// compiler model: every mesh and texture a second time, ~280 MB for 19 textures of 2048 x 2048)
+/// compiler model: every mesh and texture a second time; sizes in docs/performance.md)
 /// and returns the freed heap to the system (glibc malloc_trim). for loads that will not be
 /// saved back; the caller must hold MujocoLoaderMutex().
 void FreeLastXmlLocked();

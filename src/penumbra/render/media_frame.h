@@ -1,13 +1,14 @@
 #pragma once
 // everything of a frame's EffectsFrame (scene/effects_frame.h) that the renderer draws,
 // prepared once per frame by EmbreeRenderer and handed to the integrators through
-// FrameContext::effects (null in clear conditions, so a frame without effects renders exactly
-// as before):
+// FrameContext::effects (null in clear conditions, so a frame without effects takes none of
+// the effects code paths):
 //  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
 //  - particle streaks for the frame's camera and exposure (ParticleScene);
 //  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
 //    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
-//    the scale changed (SkyModel's tables cost about a millisecond; the sun moves slowly);
+//    the scale changed (building SkyModel's tables is not free, docs/performance.md; the sun
+//    moves slowly);
 //  - surface wetness (ApplySurfaceWetness, material_eval.h).
 // light intensity scales and extra lights are applied by LightSampler::Update.
 

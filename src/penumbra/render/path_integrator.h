@@ -39,7 +39,8 @@
 //     probability alpha (coverage), drawing the streak's radiance attenuated by the media in
 //     front of it; secondary rays do not see particles.
 //   - surface wetness (ApplySurfaceWetness) changes the material of upward-facing surfaces.
-// without effects the tier renders exactly as before (no extra random numbers are drawn).
+// without effects the tier draws no extra random numbers: its images do not depend on the
+// effects code.
 //
 // textures are filtered over the pixel's ray cone (render/material_eval.h): its spread angle is
 // Camera::pixel_spread_rad and its width at a vertex is that angle times the length of the path

@@ -30,8 +30,8 @@
 // texel neighbourhood (across the map's folded edges too) holds both an escaped and a blocked
 // first-pass ray in the probe itself or in a valid probe of its 3 x 3 x 3 grid neighbourhood
 // (some probes' first passes miss a window that their neighbours see); those rays say which
-// sub-cells of the texel are open. hit distances stay those of the first pass. default world:
-// the volume's build goes from about 0.2 s to about 0.45 s on 2 cores (docs/rendering.md).
+// sub-cells of the texel are open. hit distances stay those of the first pass (its cost:
+// docs/rendering.md).
 //
 // lighting (whenever the sky changes): the sky radiance is projected onto real spherical
 // harmonics up to l = 2 per sub-cell of each texel (one sample at the sub-cell's centre,

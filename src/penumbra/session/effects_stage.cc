@@ -89,27 +89,27 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   if (preset.fog_mor_m) {
     EffectConfig e;
     e.name = "adversity_fog";
-    e.type = EffectType::kFog;
-    e.fog.extinction.mor_m = *preset.fog_mor_m;
-    e.fog.height_falloff_per_m = preset.fog_height_falloff_per_m;
-    e.fog.base_height_m = floor_z + 1.0;
+    FogParams& p = e.params.emplace<FogParams>();
+    p.extinction.mor_m = *preset.fog_mor_m;
+    p.height_falloff_per_m = preset.fog_height_falloff_per_m;
+    p.base_height_m = floor_z + 1.0;
     effects->push_back(e);
   }
   if (preset.dust_mor_m) {
     EffectConfig e;
     e.name = "adversity_dust";
-    e.type = EffectType::kDust;
-    e.dust.extinction.mor_m = *preset.dust_mor_m;
+    DustParams& p = e.params.emplace<DustParams>();
+    p.extinction.mor_m = *preset.dust_mor_m;
     effects->push_back(e);
   }
   if (preset.smoke_sigma_t_per_m) {
     EffectConfig e;
     e.name = "adversity_smoke";
-    e.type = EffectType::kSmoke;
-    e.smoke.mode = SmokeParams::Mode::kNoise;
-    e.smoke.density_scale_per_m = *preset.smoke_sigma_t_per_m;
-    e.smoke.coverage = preset.smoke_coverage;
-    e.smoke.wind_m_s = Eigen::Vector3d(0.3, 0, 0);
+    SmokeParams& p = e.params.emplace<SmokeParams>();
+    p.mode = SmokeParams::Mode::kNoise;
+    p.density_scale_per_m = *preset.smoke_sigma_t_per_m;
+    p.coverage = preset.smoke_coverage;
+    p.wind_m_s = Eigen::Vector3d(0.3, 0, 0);
     const Eigen::Vector2d mid = 0.5 * (area_lo + area_hi);
     const Eigen::Vector2d half = 0.5 * preset.smoke_extent_fraction * (area_hi - area_lo);
     BoxRegion box;
@@ -122,35 +122,35 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   if (preset.rain_rate_mm_h) {
     EffectConfig e;
     e.name = "adversity_rain";
-    e.type = EffectType::kRain;
-    e.rain.rate_mm_h = *preset.rain_rate_mm_h;
+    RainParams& p = e.params.emplace<RainParams>();
+    p.rate_mm_h = *preset.rain_rate_mm_h;
     effects->push_back(e);
   }
   if (preset.snow_rate_mm_h) {
     EffectConfig e;
     e.name = "adversity_snow";
-    e.type = EffectType::kSnow;
-    e.snow.rate_mm_h = *preset.snow_rate_mm_h;
+    SnowParams& p = e.params.emplace<SnowParams>();
+    p.rate_mm_h = *preset.snow_rate_mm_h;
     effects->push_back(e);
   }
   if (preset.light_scale != 1.0) {
     EffectConfig e;
     e.name = "adversity_dim";
-    e.type = EffectType::kLightEvent;
-    e.light_event.light = "*";
-    e.light_event.mode = LightEventParams::Mode::kBlackout;
-    e.light_event.min_scale = std::min(preset.light_scale, 0.999);
-    e.light_event.recovery_sec = 0;
+    LightEventParams& p = e.params.emplace<LightEventParams>();
+    p.light = "*";
+    p.mode = LightEventParams::Mode::kBlackout;
+    p.min_scale = std::min(preset.light_scale, 0.999);
+    p.recovery_sec = 0;
     effects->push_back(e);
   }
   if (preset.flicker_depth > 0) {
     EffectConfig e;
     e.name = "adversity_flicker";
-    e.type = EffectType::kLightEvent;
-    e.light_event.light = "*";
-    e.light_event.mode = LightEventParams::Mode::kFlicker;
-    e.light_event.depth = preset.flicker_depth;
-    e.light_event.frequency_hz = preset.flicker_hz;
+    LightEventParams& p = e.params.emplace<LightEventParams>();
+    p.light = "*";
+    p.mode = LightEventParams::Mode::kFlicker;
+    p.depth = preset.flicker_depth;
+    p.frequency_hz = preset.flicker_hz;
     effects->push_back(e);
   }
 
@@ -292,7 +292,7 @@ std::shared_ptr<const EffectsFrame> EffectsStage::Evaluate(const WorldSnapshot& 
 
 std::vector<std::string> EffectsStage::EffectLabels() const {
   std::vector<std::string> out;
-  for (const EffectConfig& e : effects_) out.push_back(e.name + ": " + EffectTypeName(e.type));
+  for (const EffectConfig& e : effects_) out.push_back(e.name + ": " + e.type_name());
   return out;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// the adverse-condition stage of a run (issue 4): the world's `effects:`, its NPC
+// the adverse-condition stage of a run: the world's `effects:`, its NPC
 // `agents:` and an adversity preset (world key `adversity`, or --adversity) put together.
 //
 // order in a run (app/runner.cc):

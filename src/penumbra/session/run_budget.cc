@@ -121,11 +121,8 @@ RunWork EstimateRunWork(const WorldConfig& world, const SceneDescription& scene,
   }
   for (const SensorConfig& s : world.sensors)
     if (const auto beams = LidarBeams(s)) w.lidar_rays += beams->first * (t * beams->second + 1);
-  for (const EffectConfig& e : world.effects) {
-    if (e.type == EffectType::kFire) w.fluid_steps += t / e.fire.fluid.dt_sec;
-    if (e.type == EffectType::kSmoke && e.smoke.mode == SmokeParams::Mode::kPlume)
-      w.fluid_steps += t / e.smoke.fluid.dt_sec;
-  }
+  for (const EffectConfig& e : world.effects)
+    if (const std::optional<double> dt = EffectFluidDtSec(e)) w.fluid_steps += t / *dt;
   return w;
 }
 

@@ -2,7 +2,8 @@
 // what a run will cost, estimated before anything big is allocated: memory per camera and
 // LiDAR (refused above the machine's physical memory, exit 2) and the total work (physics
 // steps, frames, image bytes, LiDAR rays, fluid steps; a warning above stated thresholds).
-// docs/world-file.md ("Input limits") gives the figures and how they were measured.
+// docs/world-file.md ("Input limits") gives the figures; docs/performance.md the measurements
+// behind the constants below.
 
 #include <cstdint>
 #include <optional>
@@ -14,18 +15,16 @@
 namespace penumbra {
 
 /// resident memory (bytes per pixel) that one camera adds to a run: the peak RSS difference
-/// of one-frame runs at 1024 x 1024 and 2048 x 2048 (run.json peak_resident_memory_mib,
-/// docs/world-file.md "Input limits"). realtime tier, rgb only (131.9 -> 258.3 MiB: 42.2 B/px):
+/// of one-frame runs at 1024 x 1024 and 2048 x 2048 (run.json peak_resident_memory_mib;
+/// figures in docs/performance.md). realtime tier, rgb only:
 inline constexpr double kCameraBytesPerPixelRealtime = 42;
-/// pathtraced tier (1 spp), rgb only (198.5 -> 522.5 MiB: 108.0 B/px):
+/// pathtraced tier (1 spp), rgb only:
 inline constexpr double kCameraBytesPerPixelPathtraced = 108;
-/// added per output image beyond the first (realtime, all 7 outputs: 172.8 -> 418.6 MiB,
-/// 81.9 B/px, i.e. 6.6 B/px for each of the 6 extra outputs):
+/// added per output image beyond the first (realtime tier, from a run with all 7 outputs):
 inline constexpr double kCameraBytesPerPixelPerOutput = 7;
 /// resident memory (bytes) per beam of a LiDAR scan: the pattern, the scanner's per-beam
-/// buffers, the scan's points and the PCD text being written. measured: 60 B per beam
-/// (velodyne_vlp16 at 1800 -> 131072 columns, 23 % of the beams returning: 94.8 -> 212.3 MiB);
-/// 100 leaves room for scans where every beam returns.
+/// buffers, the scan's points and the PCD text being written; rounded up from the measured
+/// value (docs/performance.md) to leave room for scans where every beam returns.
 inline constexpr double kLidarBytesPerBeam = 100;
 
 /// work above which a run gets a warning (EstimateRunWork / DescribeRunWork).

@@ -1,9 +1,10 @@
 #pragma once
 // the world file's `effects:` list: adverse conditions (effects/effect_config.h). each
-// entry has name (required, unique), type (required: fog | dust | smoke | vdb_smoke | fire |
-// rain | snow | sparks | light_event | flashlight | sun | wetness), start_sec, stop_sec,
-// fade_in_sec, fade_out_sec, region {min: [x, y, z], max: [x, y, z]} and the parameters of
-// its type next to them; every key, unit, default and range is in docs/effects.md.
+// entry has name (required, unique), type (required: a name of the effects registry,
+// effects/effect_types.h: fog | dust | smoke | vdb_smoke | fire | rain | snow | sparks |
+// light_event | flashlight | sun | wetness), start_sec, stop_sec, fade_in_sec, fade_out_sec,
+// region {min: [x, y, z], max: [x, y, z]} and the parameters of its type next to them (read
+// by the type's own reader); every key, unit, default and range is in docs/effects.md.
 //
 // example:
 //   effects:

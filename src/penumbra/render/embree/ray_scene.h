@@ -18,11 +18,9 @@
 // lanes, bit-identical results without FMA). an infinite plane (MJCF half-size 0) is clipped
 // to kInfinitePlaneHalfSize.
 //
-// planes stay user geometry: traced as two Embree triangles (exact for axis-aligned planes
-// with the depth recomputed in double), the default world's floors cost Embree ~1.0 G more
-// instructions per 2 bench frames than the user-geometry callbacks they replaced (callgrind,
-// SSE build), and were slower in wall clock; tilted float triangles 1e4 m wide would also
-// move the plane by ~1e-3 m.
+// planes stay user geometry: as two Embree triangles (exact for axis-aligned planes with the
+// depth recomputed in double) they cost more (docs/performance.md), and tilted float
+// triangles 1e4 m wide would move the plane by ~1e-3 m.
 
 // static-only fast path: rays that provably miss every moving geom (MovingBounds: boxes of the
 // moving geoms, posed by Update) are traced against the static scene directly, which skips the

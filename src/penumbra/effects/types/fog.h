@@ -1,0 +1,32 @@
+#pragma once
+// the `fog` effect type: a homogeneous scattering medium with optional height falloff.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "penumbra/effects/effect_type.h"
+#include "penumbra/effects/types/homogeneous.h"
+
+namespace penumbra {
+
+/// fog: sigma_t(p) = sigma_t * exp(-height_falloff_per_m * max(0, p.z - base_height_m)).
+struct FogParams {
+  static constexpr std::string_view kTypeName = "fog";
+
+  ExtinctionSpec extinction;                 ///< required (sigma_t_per_m or mor_m)
+  Eigen::Vector3d albedo{0.95, 0.95, 0.95};  ///< single-scattering albedo per channel, [0, 1]
+  double g = 0.8;  ///< Henyey-Greenstein asymmetry, (-1, 1); water fog is strongly forward (~0.8)
+  double height_falloff_per_m = 0;  ///< >= 0, 0 = uniform
+  double base_height_m = 0;         ///< finite; full density below this height
+
+  /// effect-type hooks (effects/effect_type.h).
+  static std::vector<std::string_view> Keys();
+  void Read(const EffectParamReader& r);
+  void Validate(const EffectConfig& e, EffectChecker* c) const;
+  /// one HomogeneousMedium in the effect's region while the weight is > 0.
+  std::unique_ptr<EffectInstance> Bind(const EffectConfig& e, const EffectBindContext& ctx) const;
+};
+
+}  // namespace penumbra

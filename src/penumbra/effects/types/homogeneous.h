@@ -1,0 +1,36 @@
+#pragma once
+// parts shared by the homogeneous media (fog, dust): the extinction given directly or as
+// meteorological optical range, and the HomogeneousMedium they evaluate to.
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "penumbra/effects/effect_type.h"
+
+namespace penumbra {
+
+/// extinction given either directly or as meteorological optical range (MOR, WMO No. 8,
+/// 2018: distance at which the contrast of a black object falls to 5%):
+///   sigma_t = -ln(0.05) / MOR = 2.996 / MOR  (Koschmieder's law).
+/// exactly one of the two must be set.
+struct ExtinctionSpec {
+  std::optional<double> sigma_t_per_m;  ///< extinction coefficient, 1/m, > 0 (<= 1e3)
+  std::optional<double> mor_m;          ///< MOR, m, > 0 (>= 1e-3)
+  /// sigma_t in 1/m (throws nothing; call after validation).
+  double SigmaT() const;
+};
+
+/// reads the keys sigma_t_per_m and mor_m of an effect entry (whichever are present).
+void ReadExtinction(const EffectParamReader& r, ExtinctionSpec* e);
+
+/// exactly one of the two set, in range; problems at "sigma_t_per_m" / "mor_m".
+void CheckExtinction(const ExtinctionSpec& e, EffectChecker* c);
+
+/// the medium of a fog / dust effect at weight w: sigma_t * w per channel, the given
+/// albedo, g, height falloff (1/m) and base height (m), inside `region` (nullopt = everywhere).
+HomogeneousMedium MakeHomogeneousMedium(double sigma_t_per_m, const Eigen::Vector3d& albedo,
+                                        double g, double height_falloff_per_m, double base_height_m,
+                                        const std::optional<BoxRegion>& region, double w);
+
+}  // namespace penumbra
