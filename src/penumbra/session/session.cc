@@ -9,6 +9,7 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/physics/urdf_converter.h"
+#include "penumbra/render/renderer_factory.h"
 #include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
 
