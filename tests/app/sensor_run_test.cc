@@ -1,4 +1,4 @@
-// end-to-end sensors: world file `sensors:` -> composed IMU sensors -> SensorStage -> PCD and
+// end-to-end sensors: world file `sensors:` -> composed IMU sensors -> SensorSink -> PCD and
 // CSV files; post-composition errors name the sensor and key.
 
 #include <gtest/gtest.h>

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "penumbra/app/effects_bench.h"
-#include "penumbra/app/scene_assembly.h"
+#include "penumbra/session/scene_assembly.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"

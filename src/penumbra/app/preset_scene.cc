@@ -4,7 +4,7 @@
 #include <cmath>
 #include <ctime>
 
-#include "penumbra/app/scene_assembly.h"
+#include "penumbra/session/scene_assembly.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
@@ -53,7 +53,7 @@ void PresetScene::StepTo(double t_sec) {
 
 RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTiming* timing) {
   const CameraSpec& cam = scene.cameras.at(camera);
-  WorldSnapshot snap = sim->Snapshot();
+  const WorldSnapshot snap = sim->Snapshot();
   CameraView view;
   view.X_WO = CameraPoseInWorld(cam, snap);
   view.intrinsics = cam.intrinsics;
@@ -70,12 +70,12 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTimin
   view.camera_index = camera;
   RenderTiming t;
   double w0 = WallSeconds(), c0 = CpuSeconds();
-  snap.effects = effects->Evaluate(snap, view.X_WO.translation());
+  const std::shared_ptr<const EffectsFrame> fx = effects->Evaluate(snap, view.X_WO.translation());
   double w1 = WallSeconds(), c1 = CpuSeconds();
   t.effects_wall = w1 - w0;
   t.effects_cpu = c1 - c0;
   RenderedFrame frame;
-  renderer->Render(snap, view, &frame);
+  renderer->Render(snap, fx.get(), view, &frame);
   t.render_wall = WallSeconds() - w1;
   t.render_cpu = CpuSeconds() - c1;
   if (timing) *timing = t;

@@ -43,7 +43,7 @@ double PhysicalMemoryBytes();
 
 /// refuses a run whose cameras and LiDARs would need more than `limit_bytes` of memory
 /// (e.g. PhysicalMemoryBytes(); <= 0 = no limit), before the renderer allocates anything.
-/// `scene` is the assembled scene (app/scene_assembly.h): its cameras have their final sizes.
+/// `scene` is the assembled scene (session/scene_assembly.h): its cameras have their final sizes.
 /// @throws ConfigError naming the world file and the camera's key (cameras[i].width,
 ///         mjcf_cameras.width, mjcf_cameras.overrides.<name>.width) or the LiDAR's
 ///         (sensors[...].columns), with the estimate and the limit.

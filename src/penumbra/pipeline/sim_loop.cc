@@ -93,6 +93,8 @@ void SimLoop::Loop() {
     } catch (...) {
       ReportError(std::current_exception());
     }
+    // later sinks (e.g. the manifest) see the errors of the earlier ones' OnFinish
+    finish_.error = errors_.get();
   }
   finish_.error = errors_.get();
 }

@@ -43,8 +43,9 @@ struct LoopFinish {
   LoopEndReason reason = LoopEndReason::kEndTime;
   int64_t step = 0;     ///< the source's last position
   double time_sec = 0;  ///< the source's time at its last position, s
-  /// the first error: in OnFinish, recorded before the sinks finish; from SimLoop::Wait,
-  /// including errors thrown by OnFinish. null if none.
+  /// the first error of the run, or null: in OnFinish, the one recorded so far (including
+  /// errors thrown by the OnFinish of sinks registered earlier); from SimLoop::Wait, the final
+  /// one.
   std::exception_ptr error;
 };
 

@@ -3,7 +3,7 @@
 // finite input (a pose of 1e19 m, a sphere of radius 1e30 m, a timestep of 1e-300 s) is refused
 // with a message instead of aborting in Embree or hanging. docs/world-file.md ("Input limits")
 // lists them with the reasons; world/world_validation.cc applies them to world files,
-// app/scene_assembly.cc to compiled MJCF models, and render/ray_scene.cc never traces a ray
+// session/scene_assembly.cc to compiled MJCF models, and render/ray_scene.cc never traces a ray
 // outside kMaxRayComponent.
 //
 // why these values: Embree traces in 32-bit floats. the spacing of floats is 7.8 mm at

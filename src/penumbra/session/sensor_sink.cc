@@ -1,4 +1,4 @@
-#include "penumbra/app/sensor_stage.h"
+#include "penumbra/session/sensor_sink.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -12,6 +12,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/pipeline/sink_worker.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
@@ -82,7 +83,7 @@ Mount ResolveMount(const SensorConfig& s, const ModelInfo& info) {
 
 }  // namespace
 
-struct SensorStage::Impl {
+struct SensorSink::Impl {
   struct Lidar {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<LidarScanner> scanner;
@@ -91,7 +92,8 @@ struct SensorStage::Impl {
     LineFile index;
     bool pending = false;
     SensorFiring start_firing;
-    WorldSnapshot start;
+    std::shared_ptr<const WorldSnapshot> start;
+    std::shared_ptr<const EffectsFrame> start_effects;  // seen at the scan's start
     int64_t written = 0;
   };
   struct Imu {
@@ -134,25 +136,32 @@ struct SensorStage::Impl {
   std::vector<GroundTruth> truths;
   std::vector<std::string> body_names;
   std::unique_ptr<RayScene> ray_scene;
+  // loop thread
   std::vector<SensorFiring> due;
+  int64_t due_step = -1;
+  double effects_sec = 0;
+  // sink thread
   std::map<std::string, double> busy;
+  SinkWorker worker{8};
+
+  // the sensors `due` read `snap`; on the sink thread, in step order. `scan_effects`: per
+  // entry of `due`, the effects a LiDAR starting a scan sees (null otherwise).
+  void Process(const std::shared_ptr<const WorldSnapshot>& snap,
+               const std::vector<SensorFiring>& due,
+               const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects);
 
   void TraceScan(Lidar& l, const WorldSnapshot& end) {
     const auto t0 = Clock::now();
     const double c0 = ThreadCpuSec();
-    const WorldSnapshot& start = l.start;
+    const WorldSnapshot& start = *l.start;
     ray_scene->Update(start);
     const Pose X0 = l.mount.X_WS(start), X1 = l.mount.X_WS(end);
     const double span = end.time_sec - start.time_sec;
     const SensorPoseAt pose = [&](double t) {
       return span > 0 ? InterpolatePose(X0, X1, std::min(1.0, t / span)) : X0;
     };
-    const auto te = Clock::now();
-    std::shared_ptr<const EffectsFrame> fx =
-        effects_at ? effects_at(start, X0.translation()) : start.effects;
-    busy["lidar_effects"] += std::chrono::duration<double>(Clock::now() - te).count();
     LidarScan scan;
-    l.scanner->Scan(*ray_scene, fx.get(), pose, l.start_firing.index, &scan);
+    l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
     const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
     WritePcd((l.dir / file).string(), scan.points);
     l.index.Append(fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
@@ -165,9 +174,9 @@ struct SensorStage::Impl {
   }
 };
 
-SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
-                         const SceneDescription& scene, const std::string& out_dir,
-                         SensorEffectsAt effects_at)
+SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
+                       const SceneDescription& scene, const std::string& out_dir,
+                       SensorEffectsAt effects_at)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.configs = world.sensors;
@@ -308,19 +317,48 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
   if (!s.lidars.empty()) s.ray_scene = std::make_unique<RayScene>(scene);
 }
 
-SensorStage::~SensorStage() = default;
+SensorSink::~SensorSink() { impl_->worker.Finish(); }
 
-bool SensorStage::empty() const { return impl_->configs.empty(); }
+bool SensorSink::empty() const { return impl_->configs.empty(); }
 
-bool SensorStage::Due(int64_t step) {
-  impl_->due.clear();
-  impl_->schedule->Due(step, &impl_->due);
-  return !impl_->due.empty();
+void SensorSink::OnStart(const LoopStart& start) { impl_->worker.Start(start.report_error); }
+
+SnapshotContent SensorSink::Wants(int64_t step, double) {
+  Impl& s = *impl_;
+  s.due.clear();
+  s.schedule->Due(step, &s.due);
+  s.due_step = s.due.empty() ? -1 : step;
+  return s.due.empty() ? SnapshotContent::kNone : SnapshotContent::kFull;
 }
 
-void SensorStage::Process(const WorldSnapshot& snap) {
+void SensorSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) {
   Impl& s = *impl_;
-  for (const SensorFiring& f : s.due) {
+  if (s.due_step < 0 || snapshot->step != s.due_step) return;
+  s.due_step = -1;
+  // the effects a LiDAR sees over a scan are those at its start, for its start position
+  std::vector<std::shared_ptr<const EffectsFrame>> scan_effects(s.due.size());
+  if (s.effects_at) {
+    const auto t0 = Clock::now();
+    for (size_t i = 0; i < s.due.size(); ++i) {
+      const Impl::Entry e = s.entries[s.due[i].sensor];
+      if (e.kind != 0) continue;
+      const Pose X0 = s.lidars[e.index].mount.X_WS(*snapshot);
+      scan_effects[i] = s.effects_at(*snapshot, X0.translation());
+    }
+    s.effects_sec += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  s.worker.Post([&s, snapshot, due = s.due, scan_effects = std::move(scan_effects)] {
+    s.Process(snapshot, due, scan_effects);
+  });
+}
+
+void SensorSink::Impl::Process(const std::shared_ptr<const WorldSnapshot>& snap_ptr,
+                               const std::vector<SensorFiring>& due,
+                               const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
+  Impl& s = *this;
+  const WorldSnapshot& snap = *snap_ptr;
+  for (size_t i = 0; i < due.size(); ++i) {
+    const SensorFiring& f = due[i];
     const Impl::Entry e = s.entries[f.sensor];
     const auto t0 = Clock::now();
     if (e.kind == 0) {
@@ -328,7 +366,8 @@ void SensorStage::Process(const WorldSnapshot& snap) {
       if (l.pending) s.TraceScan(l, snap);
       l.pending = true;
       l.start_firing = f;
-      l.start = snap;
+      l.start = snap_ptr;
+      l.start_effects = scan_effects[i];
       continue;
     }
     if (e.kind == 1) {
@@ -392,8 +431,11 @@ void SensorStage::Process(const WorldSnapshot& snap) {
   }
 }
 
-void SensorStage::Finish() {
+void SensorSink::OnFinish(const LoopFinish&) {
   Impl& s = *impl_;
+  s.worker.Finish();
+  s.busy["lidar_effects"] += s.effects_sec;
+  if (!s.lidars.empty()) s.busy["lidar"] += s.effects_sec;
   // every file is closed (and its error, if any, seen); the first error is rethrown
   std::exception_ptr first;
   auto close = [&](LineFile& f) {
@@ -413,7 +455,7 @@ void SensorStage::Finish() {
   if (first) std::rethrow_exception(first);
 }
 
-std::map<std::string, int64_t> SensorStage::samples() const {
+std::map<std::string, int64_t> SensorSink::samples() const {
   std::map<std::string, int64_t> out;
   for (const auto& l : impl_->lidars) out[l.cfg->name] = l.written;
   for (const auto& m : impl_->imus) out[m.cfg->name] = m.written;
@@ -422,6 +464,6 @@ std::map<std::string, int64_t> SensorStage::samples() const {
   return out;
 }
 
-std::map<std::string, double> SensorStage::busy_sec() const { return impl_->busy; }
+std::map<std::string, double> SensorSink::busy_sec() const { return impl_->busy; }
 
 }  // namespace penumbra

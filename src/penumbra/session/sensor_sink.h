@@ -1,6 +1,7 @@
 #pragma once
-// the run's sensor stage: every world-file sensor (`sensors:`, world/sensors_reader.h) on its
-// own schedule (sensors/sensor_schedule.h), fed with physics snapshots, writing its outputs:
+// the run's sensors as a pipeline sink (pipeline/sink.h): every world-file sensor (`sensors:`,
+// world/sensors_reader.h) on its own schedule (sensors/sensor_schedule.h), fed with physics
+// snapshots, writing its outputs:
 //
 //   <out>/lidar/<name>/scan_<k>.pcd   binary PCD v0.7, fields x y z intensity ring time,
 //                                     sensor frame (REP-103) at each beam's firing time
@@ -22,8 +23,12 @@
 // arrives, with the sensor pose interpolated between the two snapshots (motion distortion);
 // the scan still open when the run ends is not written.
 //
-// determinism: each sensor draws noise from its own stream SensorStreamSeed(seed, name);
-// everything runs on the physics thread in step order.
+// threading and determinism: the loop thread only decides which steps need a snapshot and
+// evaluates the effects a LiDAR sees at the start of each scan (in step order, as the effects
+// engine wants); the sensor models, the LiDAR ray tracing and every file write run on the
+// sink's own thread (pipeline/sink_worker.h), one snapshot after the other in step order. each
+// sensor draws noise from its own stream SensorStreamSeed(seed, name), so the outputs do not
+// depend on thread timing.
 
 #include <cstdint>
 #include <functional>
@@ -33,6 +38,7 @@
 #include <vector>
 
 #include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/sink.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 #include "penumbra/sensors/sensor_schedule.h"
@@ -41,39 +47,41 @@
 namespace penumbra {
 
 /// the effects seen by a sensor at world position p_W (e.g. EffectsStage::Evaluate); may
-/// return null for clear conditions.
+/// return null for clear conditions. called on the loop thread only.
 using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
     const WorldSnapshot& snapshot, const Eigen::Vector3d& p_W)>;
 
 /// all world-file sensors of one run.
-class SensorStage {
+class SensorSink : public Sink {
  public:
   /// resolves every sensor against the composed model (IMUs need compose/imu_injection.h's
   /// AddImuSensors applied to the model first) and opens the output files under `out_dir`.
   /// `scene` must outlive the stage (LiDARs ray trace it).
   /// @throws ConfigError naming the sensor's file, line and key (e.g. sensors[1].body) for a
   ///         body, site, MuJoCo sensor or preset setting that does not resolve.
-  SensorStage(const WorldConfig& world, const Simulation& sim, const SceneDescription& scene,
-              const std::string& out_dir, SensorEffectsAt effects_at = {});
-  ~SensorStage();
+  SensorSink(const WorldConfig& world, const Simulation& sim, const SceneDescription& scene,
+             const std::string& out_dir, SensorEffectsAt effects_at = {});
+  ~SensorSink() override;
 
   /// true when the world has no sensors.
   bool empty() const;
-  /// advances the schedules to physics step `step` (Simulation::step_count(); call once per
-  /// step, before stepping); true if any sensor is due (then call Process with that step's
-  /// snapshot).
-  bool Due(int64_t step);
-  /// runs the sensors found due by the last Due() on `snapshot` and writes their records.
-  void Process(const WorldSnapshot& snapshot);
-  /// writes the buffered rows and closes the files.
-  /// @throws Error naming the first file that could not be written (all are closed).
-  void Finish();
 
-  /// samples (scans) written per sensor.
+  /// starts the sink's thread.
+  void OnStart(const LoopStart& start) override;
+  /// advances the schedules to `step` (once per step, in order); kFull if any sensor is due.
+  SnapshotContent Wants(int64_t step, double time_sec) override;
+  /// the snapshot of a step Wants found sensors due at: queued for the sensors due (other
+  /// snapshots are ignored).
+  void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override;
+  /// waits for the queued work, writes the buffered rows and closes the files.
+  /// @throws Error naming the first file that could not be written (all are closed).
+  void OnFinish(const LoopFinish& finish) override;
+
+  /// samples (scans) written per sensor (read after OnFinish).
   std::map<std::string, int64_t> samples() const;
   /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s; also
-  /// "lidar_effects" (evaluating the effects a LiDAR sees, part of "lidar") and "lidar_cpu"
-  /// (thread CPU time of the LiDAR work).
+  /// "lidar_effects" (evaluating the effects a LiDAR sees, on the loop thread, part of "lidar")
+  /// and "lidar_cpu" (thread CPU time of the LiDAR work). read after OnFinish.
   std::map<std::string, double> busy_sec() const;
 
  private:

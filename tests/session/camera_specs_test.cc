@@ -1,4 +1,4 @@
-#include "penumbra/app/camera_specs.h"
+#include "penumbra/session/camera_specs.h"
 
 #include <gtest/gtest.h>
 

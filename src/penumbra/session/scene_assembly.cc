@@ -1,11 +1,11 @@
-#include "penumbra/app/scene_assembly.h"
+#include "penumbra/session/scene_assembly.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
 #include <set>
 
-#include "penumbra/app/camera_specs.h"
+#include "penumbra/session/camera_specs.h"
 #include "penumbra/core/error.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"

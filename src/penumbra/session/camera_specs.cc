@@ -1,4 +1,4 @@
-#include "penumbra/app/camera_specs.h"
+#include "penumbra/session/camera_specs.h"
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera_distortion.h"

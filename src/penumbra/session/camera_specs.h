@@ -1,5 +1,5 @@
 #pragma once
-// scene-assembly helpers for cameras and semantic classes (called from app/scene_assembly.cc).
+// scene-assembly helpers for cameras and semantic classes (called from session/scene_assembly.cc).
 
 #include <string>
 #include <vector>
