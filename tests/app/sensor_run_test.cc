@@ -12,7 +12,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_pattern.h"
-#include "penumbra/sensors/pcd_writer.h"
+#include "penumbra/output/pcd_writer.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -3,18 +3,12 @@
 // world/sensors_reader.h) on its own schedule (sensors/sensor_schedule.h), fed with physics
 // snapshots, writing its outputs:
 //
-//   <out>/lidar/<name>/scan_<k>.pcd   binary PCD v0.7, fields x y z intensity ring time,
-//                                     sensor frame (REP-103) at each beam's firing time
-//   <out>/lidar/<name>/index.csv      scan,capture_time_sec,delivery_time_sec,file,points,
-//                                     medium_returns,particle_returns
-//   <out>/imu/<name>.csv              sample,capture_time_sec,delivery_time_sec,
-//                                     accel_{x,y,z}_m_s2,gyro_{x,y,z}_rad_s (IMU site frame)
-//   <out>/sensors/<name>.csv          sample,capture_time_sec,delivery_time_sec, one column per
-//                                     MuJoCo sensor value named with its unit
-//   <out>/ground_truth/<name>.csv     sample,time_sec, per body <body>_{x,y,z}_m,
-//                                     _q{w,x,y,z}, _w{x,y,z}_rad_s, _v{x,y,z}_m_s (X_WB, V_WB)
-//   <out>/ground_truth/<name>_contacts.csv  sample,time_sec,geom1,geom2,body1,body2,
-//                                     p{x,y,z}_m,n{x,y,z},distance_m,f{n,t1,t2}_N
+//   <out>/lidar/<name>/scan_<k>.pcd and index.csv, <out>/imu/<name>.csv,
+//   <out>/sensors/<name>.csv, <out>/ground_truth/<name>.csv and <name>_contacts.csv
+//
+// the sensor models (sensors/) return records (a LidarScan, an ImuSample, MuJoCo sensor values,
+// the snapshot's poses and contacts); output/sensor_writers.h writes them (columns, units and
+// number formats are documented there).
 //
 // stamps: capture_time_sec is the sim time of the physics step the sample was taken at,
 // delivery_time_sec = capture + latency_sec. rows are written in capture order, which for
