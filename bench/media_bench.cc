@@ -15,12 +15,11 @@
 #include <filesystem>
 #include <memory>
 
-#include "penumbra/session/scene_assembly.h"
-#include "penumbra/compose/scene_composer.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/media_common.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -35,19 +34,14 @@ struct World {
 const World& DefaultWorld() {
   static const World* w = [] {
     auto* out = new World;
-    WorldConfig world = LoadWorldFile("worlds/default.yaml");  // run from the repository root
-    ComposeOptions co;
-    co.urdf_to_mjcf = ConvertUrdfToMjcf;
-    co.timestep_sec = world.timestep_sec;
-    const ComposedScene composed = ComposeWorld(world.models, co);
-    const auto dir = std::filesystem::temp_directory_path() / "penumbra_media_bench";
-    std::filesystem::create_directories(dir);
-    const std::string path = (dir / "composed.xml").string();
-    WriteComposedScene(composed, path);
-    Simulation sim = Simulation::LoadFromFile(path, world.timestep_sec);
+    // run from the repository root; the benchmark builds its own renderers
+    SessionOptions options;
+    options.build_renderer = false;
+    Session session(LoadWorldFile("worlds/default.yaml"), options);  // session/session.h
+    Simulation& sim = session.sim();
     while (sim.time() < 1.0) sim.Step();
     out->snapshot = sim.Snapshot();
-    out->scene = AssembleScene(sim.scene(), world, out->snapshot);
+    out->scene = session.scene();
     const CameraSpec& cam = out->scene.cameras.front();
     const double fovy =
         2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180 / M_PI;

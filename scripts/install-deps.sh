@@ -11,6 +11,7 @@ pkgs=(
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  python3
 )
 missing=()
 for p in "${pkgs[@]}"; do

@@ -6,11 +6,11 @@
 #include <fstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/effects_stage.h"
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/session/effects_stage.h"
 
 namespace penumbra {
 namespace {

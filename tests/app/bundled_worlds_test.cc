@@ -34,12 +34,12 @@ TEST(BundledWorlds, EveryWorldLoadsBindsItsEffectsAndSteps) {
     if (file.find("/effects/") != std::string::npos) ++effect_worlds;
     PresetScene p = LoadPresetScene(world, "");
     if (file.find("/effects/") != std::string::npos) {
-      EXPECT_GT(p.effects->effects().size() + p.effects->agents().size(), 0u);
+      EXPECT_GT(p.session->effects().effects().size() + p.session->effects().agents().size(), 0u);
     }
-    for (int i = 0; i < 20; ++i) p.sim->Step();
-    const WorldSnapshot snap = p.sim->Snapshot();
-    const auto frame = p.effects->Evaluate(snap, Eigen::Vector3d(0, 0, 1));
-    EXPECT_EQ(frame != nullptr, !p.effects->effects().empty());
+    for (int i = 0; i < 20; ++i) p.session->sim().Step();
+    const WorldSnapshot snap = p.session->sim().Snapshot();
+    const auto frame = p.session->effects().Evaluate(snap, Eigen::Vector3d(0, 0, 1));
+    EXPECT_EQ(frame != nullptr, !p.session->effects().effects().empty());
   }
   EXPECT_GE(effect_worlds, 13);
 }

@@ -1,5 +1,5 @@
-// adversity presets placed in the default world (app/effects_stage.h).
-#include "penumbra/app/effects_stage.h"
+// adversity presets placed in the default world (session/effects_stage.h).
+#include "penumbra/session/effects_stage.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/app/floor_map.h"
+#include "penumbra/session/floor_map.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"

@@ -16,9 +16,9 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/app/run_budget.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
+#include "penumbra/session/run_budget.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

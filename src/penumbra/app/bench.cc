@@ -6,15 +6,13 @@
 #include <filesystem>
 
 #include "penumbra/app/effects_bench.h"
-#include "penumbra/session/scene_assembly.h"
-#include "penumbra/compose/scene_composer.h"
-#include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/controller_cost_benchmark.h"
 #include "penumbra/physics/physics_benchmark.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -22,22 +20,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// composes a world into a temporary folder and loads it with its controllers.
-Simulation LoadWorld(const WorldConfig& world, std::string* composed_path) {
-  ComposeOptions compose_options;
-  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
-  compose_options.timestep_sec = world.timestep_sec;
-  const ComposedScene composed = ComposeWorld(world.models, compose_options);
+// where the physics benchmarks keep the composed model they load (a temporary folder).
+std::string BenchComposedPath() {
   const auto dir =
       std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
   std::filesystem::create_directories(dir);
-  *composed_path = (dir / "composed.xml").string();
-  WriteComposedScene(composed, *composed_path);
-  Simulation sim = Simulation::LoadFromFile(*composed_path, world.timestep_sec);
-  for (const ModelConfig& m : world.models)
-    if (m.is_robot && !m.controller.type.empty())
-      sim.AddController(MakeController(m.controller, m.name, world.file));
-  return sim;
+  return (dir / "composed.xml").string();
 }
 
 }  // namespace
@@ -56,13 +44,13 @@ int BenchRender(const RenderBenchOptions& options) {
   world.render.threads = options.threads;
   world.render.tier = options.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
                                                    : RenderSettings::Tier::kRealtime;
-  std::string composed_path;
-  Simulation sim = LoadWorld(world, &composed_path);
-  const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
+  Session session(world);  // session/session.h
+  Simulation& sim = session.sim();
+  const SceneDescription& scene = session.scene();
   if (scene.cameras.empty())
     throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
   const CameraSpec& cam = scene.cameras.front();
-  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
+  Renderer* const renderer = session.renderer();
   const double fovy_deg =
       2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
 
@@ -113,15 +101,12 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
   if (model.empty()) {
     WorldConfig world =
         LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
-    ComposeOptions compose_options;
-    compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
-    compose_options.timestep_sec = world.timestep_sec;
-    const ComposedScene composed = ComposeWorld(world.models, compose_options);
-    const auto dir =
-        std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
-    std::filesystem::create_directories(dir);
-    model = (dir / "composed.xml").string();
-    WriteComposedScene(composed, model);
+    SessionOptions session_options;
+    session_options.composed_xml_path = BenchComposedPath();
+    session_options.add_controllers = false;
+    session_options.build_renderer = false;
+    const Session session(world, session_options);  // writes the composed model
+    model = session_options.composed_xml_path;
     label = world.file + " (composed, no controllers)";
   }
   const PhysicsBenchResult r = BenchmarkPhysics(model, options.sim_seconds);
@@ -142,23 +127,20 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
       const std::filesystem::path file = worlds / (std::string(name) + ".yaml");
       if (!std::filesystem::exists(file)) continue;
       const WorldConfig world = LoadWorldFile(file.string());
-      std::string composed_path;
+      SessionOptions session_options;
+      session_options.composed_xml_path = BenchComposedPath();
+      session_options.build_renderer = false;
+      const std::string& composed_path = session_options.composed_xml_path;
       double timestep = 0;
       {
-        Simulation probe = LoadWorld(world, &composed_path);
-        if (probe.num_controllers() == 0) continue;
-        timestep = probe.timestep();
+        const Session probe(world, session_options);  // writes the composed model
+        if (probe.sim().num_controllers() == 0) continue;
+        timestep = probe.sim().timestep();
       }
       const int64_t steps =
           std::max<int64_t>(1, std::llround(options.controller_seconds / timestep));
       const ControllerCostResult c = BenchmarkControllerCost(
-          composed_path,
-          [&](Simulation& sim) {
-            for (const ModelConfig& m : world.models)
-              if (m.is_robot && !m.controller.type.empty())
-                sim.AddController(MakeController(m.controller, m.name, world.file));
-          },
-          steps);
+          composed_path, [&](Simulation& sim) { AddWorldControllers(world, &sim); }, steps);
       std::string types;
       for (const ModelConfig& m : world.models)
         if (m.is_robot && !m.controller.type.empty())

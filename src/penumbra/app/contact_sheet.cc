@@ -64,8 +64,8 @@ int MakeContactSheet(const ContactSheetOptions& o) {
         for (int c = 0; c < 3; ++c) sheet.at(x0 + x, kBar + y)[c] = f.rgb.at(x, y)[c];
     const std::string label = o.presets[i];
     DrawText(&sheet, x0 + (o.width - static_cast<int>(label.size()) * 18) / 2, 3, label, 3);
-    fmt::print("{}: t = {:.3f} s, {} effects, {} agents\n", label, p.sim->time(),
-               p.effects->effects().size(), p.effects->agents().size());
+    fmt::print("{}: t = {:.3f} s, {} effects, {} agents\n", label, p.session->sim().time(),
+               p.session->effects().effects().size(), p.session->effects().agents().size());
   }
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());

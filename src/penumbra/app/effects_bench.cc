@@ -20,7 +20,7 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
     RenderTiming sum;
     int64_t rays = 0;
     for (int i = 0; i < options.warmup_frames + options.frames; ++i) {
-      p.StepTo(p.sim->time() + 1.0 / 30.0);
+      p.StepTo(p.session->sim().time() + 1.0 / 30.0);
       RenderTiming t;
       const RenderedFrame f = p.Render(0, 640, 480, &t);
       if (i >= options.warmup_frames) {
@@ -37,7 +37,7 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
         "({} effects, {} agents)\n",
         preset, n / sum.render_wall, 1e3 * sum.render_wall / n, rays / sum.render_wall * 1e-6,
         1e3 * sum.render_cpu / n, 2.0 * n / sum.render_cpu, 1e3 * sum.effects_wall / n,
-        p.effects->effects().size(), p.effects->agents().size());
+        p.session->effects().effects().size(), p.session->effects().agents().size());
   }
   fmt::print("target (2-core CI machine): major >= 10 frames/s at 640x480 realtime\n");
 }

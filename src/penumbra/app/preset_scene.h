@@ -1,14 +1,14 @@
 #pragma once
 // a world loaded with an adversity preset for single-frame work (contact sheet, bench
-// render): composed models + agents, simulation with controllers and agent drivers, the
-// renderer's scene and the effects stage (app/effects_stage.h), without a full run.
+// render): a Session (session/session.h: composed models + agents, simulation with
+// controllers and agent drivers, the renderer's scene, the effects stage and the renderer),
+// stepped and rendered one frame at a time, without a full run.
 
 #include <memory>
 #include <string>
 
-#include "penumbra/app/effects_stage.h"
-#include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -21,10 +21,8 @@ struct RenderTiming {
 
 /// everything needed to step a world and render its cameras with effects.
 struct PresetScene {
-  std::unique_ptr<EffectsStage> effects;
-  std::unique_ptr<Simulation> sim;
-  SceneDescription scene;
-  std::unique_ptr<Renderer> renderer;
+  /// the loaded world (never null after LoadPresetScene).
+  std::unique_ptr<Session> session;
 
   /// steps the simulation until its time is >= t_sec (never backwards).
   void StepTo(double t_sec);
@@ -35,7 +33,8 @@ struct PresetScene {
 };
 
 /// loads `world` with the preset spec `adversity` ("" = the world's own).
-/// @throws ConfigError for bad input (as RunWorld).
+/// @throws ConfigError for bad input (as RunWorld), and naming the key "cameras" when the
+///         world has no camera.
 PresetScene LoadPresetScene(const WorldConfig& world, const std::string& adversity);
 
 }  // namespace penumbra

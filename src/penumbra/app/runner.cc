@@ -8,11 +8,6 @@
 #include <filesystem>
 #include <initializer_list>
 
-#include "penumbra/app/effects_stage.h"
-#include "penumbra/app/run_budget.h"
-#include "penumbra/compose/imu_injection.h"
-#include "penumbra/compose/scene_composer.h"
-#include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/manifest_sink.h"
@@ -22,13 +17,14 @@
 #include "penumbra/output/trajectory_sink.h"
 #include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/session/camera_sink.h"
+#include "penumbra/session/effects_stage.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/sensor_sink.h"
+#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
@@ -132,37 +128,20 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
 
   std::map<std::string, double> timings;
 
-  // compose every model into one MJCF and keep it next to the outputs
-  auto t0 = Clock::now();
-  ComposeOptions compose_options;
-  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
-  compose_options.timestep_sec = world.timestep_sec;
-  ComposedScene composed = ComposeWorld(world.models, compose_options);
-  AddImuSensors(world.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
-  EffectsStage effects(world, &composed, options.adversity);  // + agent bodies
-  for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
-  const std::string composed_path = (out / "composed.xml").string();
-  WriteComposedScene(composed, composed_path);
-  timings["compose_sec"] = SecondsSince(t0);
-
-  // physics and controllers
-  t0 = Clock::now();
-  Simulation sim = Simulation::LoadFromFile(composed_path, world.timestep_sec);
-  for (const ModelConfig& m : world.models) {
-    if (!m.is_robot || m.controller.type.empty()) continue;
-    sim.AddController(MakeController(m.controller, m.name, world.file));
-  }
-  effects.Attach(&sim);
-  timings["load_sec"] = SecondsSince(t0);
-
-  // static scene for the renderer
-  t0 = Clock::now();
-  const SceneDescription scene = effects.Bind(AssembleScene(sim.scene(), world, sim.Snapshot()));
-  CheckRunMemory(world, scene, PhysicalMemoryBytes());  // app/run_budget.h: before allocating
-  if (auto work = DescribeRunWork(EstimateRunWork(world, scene, sim.timestep())))
-    spdlog::warn("{}", *work);
-  std::unique_ptr<Renderer> renderer = MakeEmbreeRenderer(scene, world.render);
-  timings["scene_build_sec"] = SecondsSince(t0);
+  // compose, load, scene, effects and renderer, once (session/session.h); composed.xml is
+  // kept next to the outputs
+  SessionOptions session_options;
+  session_options.adversity = options.adversity;
+  session_options.composed_xml_path = (out / "composed.xml").string();
+  session_options.check_run_budget = true;
+  Session session(world, session_options);
+  Simulation& sim = session.sim();
+  const SceneDescription& scene = session.scene();
+  EffectsStage& effects = session.effects();
+  Renderer* const renderer = session.renderer();
+  timings["compose_sec"] = session.timings().compose_sec;
+  timings["load_sec"] = session.timings().load_sec;
+  timings["scene_build_sec"] = session.timings().scene_build_sec;
 
   // the pipeline (docs/architecture.md): physics -> SimLoop -> sinks. every output file is
   // written by a sink on its own thread; the first error of any of them is the one reported.
@@ -176,7 +155,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   ProgressReporter progress(duration, progress_options);
   CameraSinkOptions camera_options;
   camera_options.on_rendered = [&](double t, int64_t frames) { progress.Update(t, frames); };
-  CameraSink cameras(scene, world, sim.timestep(), renderer.get(), out.string(), viewer_effects,
+  CameraSink cameras(scene, world, sim.timestep(), renderer, out.string(), viewer_effects,
                      camera_options);
   SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
   TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());

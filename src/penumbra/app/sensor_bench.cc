@@ -11,16 +11,12 @@
 #include "penumbra/app/bench.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/physics_source.h"
-#include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/sensor_sink.h"
-#include "penumbra/compose/imu_injection.h"
-#include "penumbra/compose/scene_composer.h"
-#include "penumbra/control/controller_factory.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
@@ -37,17 +33,11 @@ double Since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-Simulation LoadWithSensors(const WorldConfig& world) {
-  ComposeOptions co;
-  co.urdf_to_mjcf = ConvertUrdfToMjcf;
-  co.timestep_sec = world.timestep_sec;
-  ComposedScene composed = ComposeWorld(world.models, co);
-  AddImuSensors(world.sensors, &composed);
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml, world.timestep_sec);
-  for (const ModelConfig& m : world.models)
-    if (m.is_robot && !m.controller.type.empty())
-      sim.AddController(MakeController(m.controller, m.name, world.file));
-  return sim;
+// the world loaded for physics and sensors only (no renderer)
+std::unique_ptr<Session> LoadWithSensors(const WorldConfig& world) {
+  SessionOptions options;
+  options.build_renderer = false;
+  return std::make_unique<Session>(world, options);
 }
 
 // the first robot's root body (the mount for the benchmark's sensors), or world
@@ -80,8 +70,8 @@ int BenchSensors(const SensorBenchOptions& options) {
   // a first load to find the robot's root body
   std::string mount;
   {
-    Simulation probe = LoadWithSensors(world);
-    mount = MountBody(probe, world);
+    const std::unique_ptr<Session> probe = LoadWithSensors(world);
+    mount = MountBody(probe->sim(), world);
   }
   SensorConfig imu;
   imu.name = "bench_imu";
@@ -98,8 +88,9 @@ int BenchSensors(const SensorBenchOptions& options) {
   gt.type = "ground_truth";
   gt.rate_hz = 100;
   world.sensors = {imu, mj, gt};
-  Simulation sim = LoadWithSensors(world);
-  const SceneDescription scene = AssembleScene(sim.scene(), world, sim.Snapshot());
+  const std::unique_ptr<Session> session = LoadWithSensors(world);
+  Simulation& sim = session->sim();
+  const SceneDescription& scene = session->scene();
   fmt::print(
       "penumbra bench sensors: world {}, mount body '{}', timestep {:.4g} s, {} MuJoCo "
       "sensors\n",
@@ -177,7 +168,8 @@ int BenchSensors(const SensorBenchOptions& options) {
   // IMU / MuJoCo sensors / ground truth: physics with and without the sensor sink, through the
   // run's pipeline (pipeline/sim_loop.h); the wall time includes writing the sensor files
   const auto run = [&](bool with_sensors, double* snapshot_us) {
-    Simulation s = LoadWithSensors(world);
+    const std::unique_ptr<Session> loaded = LoadWithSensors(world);
+    Simulation& s = loaded->sim();
     const std::string dir =
         (std::filesystem::temp_directory_path() / "penumbra_bench_sensors").string();
     // times the snapshots the sensors ask for (Simulation::Snapshot, kFull)

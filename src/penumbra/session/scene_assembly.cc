@@ -5,10 +5,10 @@
 #include <cmath>
 #include <set>
 
-#include "penumbra/session/camera_specs.h"
 #include "penumbra/core/error.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
+#include "penumbra/session/camera_specs.h"
 
 namespace penumbra {
 namespace {

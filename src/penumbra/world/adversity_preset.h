@@ -3,7 +3,7 @@
 // lighting, NPC traffic) that turn any world into an adverse-condition variant of itself.
 // bundled presets `none`, `minor`, `major` live in worlds/adversity/presets.yaml; users
 // write their own files in the same format. a preset is applied relative to the world at
-// run time (app/effects_stage.h): regions come from the scene's bounds around the robots,
+// run time (session/effects_stage.h): regions come from the scene's bounds around the robots,
 // NPC paths are drawn from the world seed inside the free floor area.
 //
 // file format (YAML):

@@ -1,4 +1,4 @@
-#include "penumbra/app/floor_map.h"
+#include "penumbra/session/floor_map.h"
 
 #include <gtest/gtest.h>
 

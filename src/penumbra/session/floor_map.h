@@ -1,6 +1,6 @@
 #pragma once
 // plan-view occupancy of a world's floor, for placing adversity-preset regions and NPC
-// paths (app/effects_stage.h). built from the static geoms of the scene at the start.
+// paths (session/effects_stage.h). built from the static geoms of the scene at the start.
 
 #include <Eigen/Core>
 #include <cstdint>

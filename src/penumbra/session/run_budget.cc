@@ -1,4 +1,4 @@
-#include "penumbra/app/run_budget.h"
+#include "penumbra/session/run_budget.h"
 
 #include <fmt/format.h>
 #include <unistd.h>

@@ -1,15 +1,15 @@
-#include "penumbra/app/effects_stage.h"
+#include "penumbra/session/effects_stage.h"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "penumbra/app/floor_map.h"
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/session/floor_map.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {

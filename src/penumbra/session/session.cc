@@ -1,0 +1,71 @@
+#include "penumbra/session/session.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "penumbra/compose/imu_injection.h"
+#include "penumbra/compose/scene_composer.h"
+#include "penumbra/control/controller_factory.h"
+#include "penumbra/physics/urdf_converter.h"
+#include "penumbra/session/run_budget.h"
+#include "penumbra/session/scene_assembly.h"
+
+namespace penumbra {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+void AddWorldControllers(const WorldConfig& world, Simulation* sim) {
+  for (const ModelConfig& m : world.models) {
+    if (!m.is_robot || m.controller.type.empty()) continue;
+    sim->AddController(MakeController(m.controller, m.name, world.file));
+  }
+}
+
+Session::Session(const WorldConfig& world, const SessionOptions& options) : world_(world) {
+  world_.render.seed = world_.seed;
+
+  // compose every model into one MJCF, with the world's IMUs and the agents' bodies
+  auto t0 = Clock::now();
+  ComposeOptions compose_options;
+  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
+  compose_options.timestep_sec = world_.timestep_sec;
+  ComposedScene composed = ComposeWorld(world_.models, compose_options);
+  AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
+  effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
+  for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
+  if (!options.composed_xml_path.empty()) WriteComposedScene(composed, options.composed_xml_path);
+  timings_.compose_sec = SecondsSince(t0);
+
+  // physics, controllers and agent drivers
+  t0 = Clock::now();
+  sim_ = std::make_unique<Simulation>(
+      options.composed_xml_path.empty()
+          ? Simulation::LoadFromString(composed.mjcf_xml, world_.timestep_sec)
+          : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
+  if (options.add_controllers) AddWorldControllers(world_, sim_.get());
+  effects_->Attach(sim_.get());
+  timings_.load_sec = SecondsSince(t0);
+
+  // the renderer's static scene, the effects engine on it, and the renderer
+  t0 = Clock::now();
+  scene_ = effects_->Bind(AssembleScene(sim_->scene(), world_, sim_->Snapshot()));
+  if (options.check_run_budget) {
+    CheckRunMemory(world_, scene_, PhysicalMemoryBytes());  // before allocating
+    if (auto work = DescribeRunWork(EstimateRunWork(world_, scene_, sim_->timestep())))
+      spdlog::warn("{}", *work);
+  }
+  if (options.build_renderer) renderer_ = MakeEmbreeRenderer(scene_, world_.render);
+  timings_.scene_build_sec = SecondsSince(t0);
+}
+
+Session::~Session() = default;
+
+}  // namespace penumbra

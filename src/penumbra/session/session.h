@@ -1,0 +1,103 @@
+#pragma once
+// a world loaded once: the one set-up sequence shared by `penumbra run`, the benchmarks, the
+// contact sheet and the tests. in order (each step's errors stop it; nothing is retried):
+//   1. compose   every model into one MJCF document (compose/scene_composer.h), the world's
+//                IMUs added to it (compose/imu_injection.h), then the effects stage plans the
+//                world's effects, agents and adversity preset and adds one mocap body per agent
+//                (session/effects_stage.h); the document is printed to text once, written to
+//                SessionOptions::composed_xml_path when one is given;
+//   2. load      MuJoCo compiles the text once into the Simulation; the robots' controllers
+//                (control/controller_factory.h) and the agents' mocap drivers are added;
+//   3. scene     the renderer's SceneDescription: the compiled model's scene joined with the
+//                world file's lights, sky, cameras and materials (session/scene_assembly.h),
+//                agent geoms labelled and the effects engine built on it (EffectsStage::Bind);
+//                optionally the run's memory and work are checked (session/run_budget.h);
+//                then the renderer (render/renderer.h) is built for that scene.
+// a Session is then stepped and rendered by its user (app/runner.cc, app/bench.cc, ...); it
+// owns everything it built and is neither copied nor moved (the renderer and the effects
+// stage refer to the scene it holds).
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/physics/simulation.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/session/effects_stage.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// how a Session is set up; the defaults load a world to be stepped and rendered.
+struct SessionOptions {
+  /// an adversity preset spec from the command line (--adversity, world/adversity_preset.h), or
+  /// "" for the world's own `adversity` key.
+  std::string adversity;
+  /// where to keep the composed MJCF (e.g. "<output_dir>/composed.xml"); MuJoCo then loads
+  /// that file, so its messages (and PhysicsError's) name it. "" = loaded from memory
+  /// (messages name "<string>"), nothing written.
+  std::string composed_xml_path;
+  /// add the controllers of the world's robots (AddWorldControllers).
+  bool add_controllers = true;
+  /// before the renderer is built: refuse a run whose cameras and LiDARs would not fit in the
+  /// machine's physical memory (CheckRunMemory) and warn about a large amount of work
+  /// (DescribeRunWork), as `penumbra run` does.
+  bool check_run_budget = false;
+  /// build the renderer (MakeEmbreeRenderer with the world's render settings); off for
+  /// physics- or sensor-only work and for callers with their own render settings.
+  bool build_renderer = true;
+};
+
+/// wall-clock seconds of the set-up steps (run.json timings_sec: compose_sec, load_sec,
+/// scene_build_sec).
+struct SessionTimings {
+  double compose_sec = 0;      ///< compose, IMUs, effects planning and agents, composed.xml
+  double load_sec = 0;         ///< MuJoCo compile, controllers, mocap drivers
+  double scene_build_sec = 0;  ///< scene assembly, effects engine, run budget, renderer
+};
+
+/// adds a controller (control/controller_factory.h: MakeController) for every robot of
+/// `world` that has one, in world order.
+/// @throws ConfigError from the factory or Controller::Initialize (unknown type, bad
+///         parameter, a name missing from the model), naming the world file.
+void AddWorldControllers(const WorldConfig& world, Simulation* sim);
+
+/// a world composed, compiled and made ready to step and render, once.
+class Session {
+ public:
+  /// sets `world` up as the file header describes. world.render.seed is set to world.seed.
+  /// @throws ConfigError for bad input found on the way (composer, IMUs, effects, agents,
+  ///         preset, MuJoCo, controllers, scene assembly, effects engine, run budget; each
+  ///         names its file, line and key as the stage that finds it does); Error when
+  ///         composed_xml_path cannot be written; PhysicsError if MuJoCo fails to set up.
+  explicit Session(const WorldConfig& world, const SessionOptions& options = {});
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// the world as set up (render.seed = seed).
+  const WorldConfig& world() const { return world_; }
+  /// the simulation, with its controllers and agent drivers, at time 0 until stepped.
+  Simulation& sim() { return *sim_; }
+  const Simulation& sim() const { return *sim_; }
+  /// the renderer's static scene (cameras with their final sizes).
+  const SceneDescription& scene() const { return scene_; }
+  /// the renderer for scene(); null when SessionOptions::build_renderer is off.
+  Renderer* renderer() const { return renderer_.get(); }
+  /// the run's effects, agents and preset; Evaluate gives the effects per viewer.
+  EffectsStage& effects() { return *effects_; }
+  const EffectsStage& effects() const { return *effects_; }
+  /// seconds each set-up step took.
+  const SessionTimings& timings() const { return timings_; }
+
+ private:
+  WorldConfig world_;
+  std::unique_ptr<EffectsStage> effects_;
+  std::unique_ptr<Simulation> sim_;
+  SceneDescription scene_;
+  std::unique_ptr<Renderer> renderer_;
+  SessionTimings timings_;
+};
+
+}  // namespace penumbra
