@@ -105,8 +105,8 @@ RunSummary RunWorld(const WorldConfig& world, const RunOptions& options) {
 
 namespace {
 
-RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options) {
-  const auto t_start = Clock::now();
+// the world with the command line's overrides applied, validated
+WorldConfig WithRunOptions(const WorldConfig& world_in, const RunOptions& options) {
   WorldConfig world = world_in;
   if (options.duration_sec) world.duration_sec = *options.duration_sec;
   if (!options.out_dir.empty()) world.output_dir = options.out_dir;
@@ -117,6 +117,35 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   }
   world.render.seed = world.seed;
   world.ValidateOrThrow();
+  return world;
+}
+
+// run.json of a finished run (the error is added by the ManifestSink)
+RunManifest DescribeRun(const WorldConfig& world, const RunOptions& options,
+                        const EffectsStage& effects, const RunSummary& summary,
+                        const std::map<std::string, double>& timings) {
+  RunManifest m;
+  m.world_file =
+      world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
+  m.seed = world.seed;
+  m.penumbra_version = PENUMBRA_VERSION;
+  m.mujoco_version = MujocoVersion();
+  m.embree_version = EmbreeVersion();
+  m.timings_sec = timings;
+  m.peak_resident_memory_mib = summary.peak_rss_mib;
+  m.frames_per_camera = summary.frames_per_camera;
+  m.sim_duration_sec = summary.sim_time_sec;
+  m.interrupted = summary.interrupted;
+  m.command_line = options.command_line;
+  m.adversity = effects.PresetLabel();
+  m.effects = effects.EffectLabels();
+  m.agents = effects.AgentLabels();
+  return m;
+}
+
+RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options) {
+  const auto t_start = Clock::now();
+  const WorldConfig world = WithRunOptions(world_in, options);
 
   namespace fs = std::filesystem;
   const fs::path out = world.output_dir;
@@ -182,23 +211,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     timings["physics_sec"] = physics.busy_sec();
     timings["render_sec"] = cameras.render_sec();
     timings["total_sec"] = summary.wall_time_sec;
-    RunManifest m;
-    m.world_file =
-        world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
-    m.seed = world.seed;
-    m.penumbra_version = PENUMBRA_VERSION;
-    m.mujoco_version = MujocoVersion();
-    m.embree_version = EmbreeVersion();
-    m.timings_sec = timings;
-    m.peak_resident_memory_mib = summary.peak_rss_mib;
-    m.frames_per_camera = summary.frames_per_camera;
-    m.sim_duration_sec = summary.sim_time_sec;
-    m.interrupted = summary.interrupted;
-    m.command_line = options.command_line;
-    m.adversity = effects.PresetLabel();
-    m.effects = effects.EffectLabels();
-    m.agents = effects.AgentLabels();
-    return m;
+    return DescribeRun(world, options, effects, summary, timings);
   });
   for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, &manifest})
     loop.AddSink(sink);
