@@ -10,9 +10,9 @@
 
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
+#include "penumbra/output/pcd_writer.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_pattern.h"
-#include "penumbra/output/pcd_writer.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -90,7 +90,8 @@ TEST(SensorWritersTest, GroundTruthRowsAndContacts) {
   EXPECT_EQ(rows.substr(rows.find('\n') + 1), "2,0.500000000,1,2,3,1,0,0,0,0,0,0,0,0,0\n");
   EXPECT_EQ(rows.substr(0, rows.find(',', 20)), "sample,time_sec,box_x_m");
   const std::string contacts = ReadText(dir.path() / "ground_truth" / "gt_contacts.csv");
-  EXPECT_EQ(contacts.substr(contacts.find('\n') + 1), "2,0.500000000,0,4,0,1,0,0,0,0,0,1,0,10,0,0\n");
+  EXPECT_EQ(contacts.substr(contacts.find('\n') + 1),
+            "2,0.500000000,0,4,0,1,0,0,0,0,0,1,0,10,0,0\n");
 }
 
 }  // namespace

@@ -9,13 +9,13 @@
 #include <filesystem>
 
 #include "penumbra/app/bench.h"
-#include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/sensor_sink.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/session/physics_source.h"
+#include "penumbra/session/sensor_sink.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

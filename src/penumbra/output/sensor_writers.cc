@@ -94,9 +94,8 @@ void GroundTruthCsvWriter::Write(int64_t sample, const WorldSnapshot& snap) {
   for (int b : bodies_) {
     const Pose& X = snap.X_WB.at(b);
     const Eigen::Quaterniond q(X.linear());
-    const Eigen::Matrix<double, 6, 1> V = b < static_cast<int>(snap.V_WB.size())
-                                              ? snap.V_WB[b]
-                                              : Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::Matrix<double, 6, 1> V =
+        b < static_cast<int>(snap.V_WB.size()) ? snap.V_WB[b] : Eigen::Matrix<double, 6, 1>::Zero();
     fmt::format_to(std::back_inserter(row),
                    ",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
                    "{:.9g},{:.9g},{:.9g}",
@@ -107,12 +106,12 @@ void GroundTruthCsvWriter::Write(int64_t sample, const WorldSnapshot& snap) {
   csv_.Append(row);
   if (!contacts_) return;
   for (const WorldSnapshot::Contact& c : snap.contacts)
-    contacts_csv_.Append(fmt::format(
-        "{},{:.9f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
-        "{:.9g},{:.9g}\n",
-        sample, snap.time_sec, c.geom1, c.geom2, c.body1, c.body2, c.p_W.x(), c.p_W.y(),
-        c.p_W.z(), c.normal_W.x(), c.normal_W.y(), c.normal_W.z(), c.distance_m, c.force_N.x(),
-        c.force_N.y(), c.force_N.z()));
+    contacts_csv_.Append(
+        fmt::format("{},{:.9f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
+                    "{:.9g},{:.9g}\n",
+                    sample, snap.time_sec, c.geom1, c.geom2, c.body1, c.body2, c.p_W.x(), c.p_W.y(),
+                    c.p_W.z(), c.normal_W.x(), c.normal_W.y(), c.normal_W.z(), c.distance_m,
+                    c.force_N.x(), c.force_N.y(), c.force_N.z()));
 }
 
 void GroundTruthCsvWriter::Close() {

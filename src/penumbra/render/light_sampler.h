@@ -19,18 +19,18 @@
 // lights (mjcf_light >= 0) from light_position_W / light_direction_W, others from the pose
 // of their body, X_WB position_B and R_WB direction_B.
 //
-// effects (the EffectsFrame given to Update, scene/effects_frame.h): Update multiplies the intensity of
-// scene light i by EffectsFrame::light_intensity_scale[i] and appends EffectsFrame::extra_lights
-// (world frame, or posed by their body) after the scene's lights, so light indices
-// [0, num_scene_lights()) keep their meaning. without effects the lights are exactly the
-// scene's.
+// effects (the EffectsFrame given to Update, scene/effects_frame.h): Update multiplies the
+// intensity of scene light i by EffectsFrame::light_intensity_scale[i] and appends
+// EffectsFrame::extra_lights (world frame, or posed by their body) after the scene's lights, so
+// light indices [0, num_scene_lights()) keep their meaning. without effects the lights are exactly
+// the scene's.
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "penumbra/render/shading_lanes.h"
-#include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/effects_frame.h"
+#include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {

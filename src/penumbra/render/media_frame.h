@@ -48,9 +48,9 @@ class MediaFrame {
   /// already be posed for the snapshot and `rays` updated. realtime light volumes are built only
   /// for that tier.
   /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
-  void Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects, const Camera& camera, const CameraView& view,
-               const RenderSettings& settings, const LightSampler& lights, const RayScene& rays,
-               const SkyModel& base_sky, ThreadPool* pool);
+  void Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects, const Camera& camera,
+               const CameraView& view, const RenderSettings& settings, const LightSampler& lights,
+               const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool);
 
   /// any effect is active this frame.
   bool active() const { return active_; }

@@ -6,11 +6,11 @@
 // viewer sees beyond it (media, particles, light changes: scene/effects_frame.h) depends on the
 // viewer and travels beside it.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
 #include "penumbra/core/pose.h"
-#include <Eigen/Core>
 
 namespace penumbra {
 

@@ -229,9 +229,9 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
         m.time_sec = (truth_k + 0.5) * T / n;
         m.line_time_sec = c.rolling_shutter_line_time_sec;
       }
-      transmittance = DepthTransmittance(
-          out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *effects,
-          HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
+      transmittance =
+          DepthTransmittance(out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *effects,
+                             HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
       in.transmittance = &transmittance;
     }
     ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,

@@ -74,9 +74,8 @@ class CameraImager {
   /// `end` = null (or not later than start) means nothing moves during the exposure.
   /// @throws Error from the renderer.
   void Capture(Renderer* renderer, const WorldSnapshot& start, const EffectsFrame* effects,
-               const Pose& X_WO_start,
-               const WorldSnapshot* end, const Pose& X_WO_end, int64_t frame_index,
-               CameraImages* out);
+               const Pose& X_WO_start, const WorldSnapshot* end, const Pose& X_WO_end,
+               int64_t frame_index, CameraImages* out);
 
   const CameraSpec& spec() const { return spec_; }
   const CameraSensorConfig& config() const { return config_; }

@@ -40,9 +40,9 @@ void ShutterSchedule::Add(double time_sec, const std::vector<int>& cameras) {
     if (span_[c] > 0) ends_.insert(time_sec + span_[c]);
 }
 
-CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world,
-                       double timestep_sec, Renderer* renderer, const std::string& output_dir,
-                       ViewerEffects effects, CameraSinkOptions options)
+CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, double timestep_sec,
+                       Renderer* renderer, const std::string& output_dir, ViewerEffects effects,
+                       CameraSinkOptions options)
     : scene_(scene),
       renderer_(renderer),
       effects_(std::move(effects)),

@@ -12,12 +12,12 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/output/sensor_writers.h"
 #include "penumbra/pipeline/sink_worker.h"
 #include "penumbra/render/ray_scene.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"
-#include "penumbra/output/sensor_writers.h"
 #include "penumbra/sensors/sensor_noise.h"
 
 namespace penumbra {
@@ -316,9 +316,9 @@ void SensorSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot
   });
 }
 
-void SensorSink::Impl::Process(const std::shared_ptr<const WorldSnapshot>& snap_ptr,
-                               const std::vector<SensorFiring>& due,
-                               const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
+void SensorSink::Impl::Process(
+    const std::shared_ptr<const WorldSnapshot>& snap_ptr, const std::vector<SensorFiring>& due,
+    const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
   Impl& s = *this;
   const WorldSnapshot& snap = *snap_ptr;
   for (size_t i = 0; i < due.size(); ++i) {
