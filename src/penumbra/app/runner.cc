@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
@@ -178,16 +179,17 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     return effects.Evaluate(s, p_W);  // per viewer, beside the snapshot
   };
   const double duration = world.duration_sec;
-  ProgressOptions progress_options;
-  progress_options.mode =
-      options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
-  ProgressReporter progress(duration, progress_options);
+  std::optional<ProgressReporter> progress;  // made once the sinks are set up
   CameraSinkOptions camera_options;
-  camera_options.on_rendered = [&](double t, int64_t frames) { progress.Update(t, frames); };
+  camera_options.on_rendered = [&](double t, int64_t frames) { progress->Update(t, frames); };
   CameraSink cameras(scene, world, sim.timestep(), renderer, out.string(), viewer_effects,
                      camera_options);
   SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
   TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());
+  ProgressOptions progress_options;
+  progress_options.mode =
+      options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
+  progress.emplace(duration, progress_options);
   spdlog::info("running {} for {:.3f} s of sim time, {} camera(s), timestep {:.6g} s, out {}",
                world.file.empty() ? std::string("model") : world.file, duration,
                scene.cameras.size(), sim.timestep(), out.string());
@@ -199,7 +201,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   SimLoop loop(&physics, loop_options);
   RunSummary summary;
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {
-    progress.Finish();
+    progress->Finish();
     for (const auto& [kind, sec] : sensors.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
     summary.out_dir = out.string();
     summary.sim_time_sec = f.time_sec;
