@@ -51,9 +51,10 @@ const char* kKeyframes =
 void BM_ArmControllerCost(benchmark::State& state, const std::string& type,
                           const std::string& block) {
   const std::string xml = bench::ModelsDir("table_scene.xml") + "/table_scene.xml";
-  bench::MeasureControllerCost(state, {.steps = 3000,
-                                       .load = [&] { return Simulation::LoadFromFile(xml); },
-                                       .controller = {type, std::string(kServo) + block, 0}});
+  bench::MeasureControllerCost(state,
+                               {.steps = 3000,
+                                .load = [&] { return Simulation::LoadFromFile(xml); },
+                                .controller = {type, YAML::Load(std::string(kServo) + block), 0}});
 }
 
 BENCHMARK_CAPTURE(BM_ArmControllerCost, diff_ik, std::string("diff_ik"), std::string(kDiffIk))

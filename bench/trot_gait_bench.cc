@@ -41,7 +41,7 @@ void BM_TrotGaitCost(benchmark::State& state, const std::string& robot, double s
   constexpr int kSteps = 2000;
   const std::string dir = bench::ModelsDir("quadruped.xml");
   const std::string xml = SceneXml(robot);
-  const ControllerConfig cfg{"trot_gait", GaitYaml(speed, extra), 0};
+  const ControllerConfig cfg{"trot_gait", YAML::Load(GaitYaml(speed, extra)), 0};
   bench::MeasureControllerCost(
       state, {.steps = kSteps,
               .load = [&] { return Simulation::LoadFromString(xml, std::nullopt, dir); },

@@ -11,7 +11,7 @@ pkgs=(
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3
+  python3  # scripts/, the module dependency check and outputs_thread_invariance (standard library only)
 )
 missing=()
 for p in "${pkgs[@]}"; do

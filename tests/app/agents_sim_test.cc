@@ -53,7 +53,7 @@ SimRun Simulate(const std::vector<AgentConfig>& agents, double seconds) {
   ComposeOptions opts;
   ComposedScene composed = ComposeWorld(world.models, opts);
   EffectsStage stage(world, &composed);
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   stage.Attach(&sim);
   const int body = agents.empty() ? -1 : sim.scene().FindBody(AgentBodyName(agents[0].name));
   SimRun run;
@@ -129,7 +129,7 @@ TEST(AgentsInPhysics, AgentBodiesAreMocapWithCollidingGeomsAndSemanticClass) {
   world.agents = {Walker(), lift};
   ComposedScene composed = ComposeWorld(world.models, ComposeOptions{});
   EffectsStage stage(world, &composed);
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   const SceneDescription scene = stage.Bind(sim.scene());
   const int person = scene.FindBody("agents/walker");
   const int forklift = scene.FindBody("agents/lift");
@@ -167,8 +167,10 @@ TEST(AgentsInPhysics, AWaypointOutsideTheWorldIsAConfigError) {
   a.waypoints[1] = Eigen::Vector2d(40, 0);
   world.agents = {a};
   ComposedScene composed = ComposeWorld(world.models, ComposeOptions{});
+  EffectsStage stage(world, &composed);
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   try {
-    EffectsStage stage(world, &composed);
+    stage.Attach(&sim);  // checked against the compiled model's static geometry
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "agents[0].waypoints[1]");
@@ -194,9 +196,9 @@ TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
   ComposedScene composed = ComposeWorld({m}, ComposeOptions{});
   AgentConfig a = Walker();
   a.waypoints = {{3, 1}, {4, 1}};
-  AddAgentBodies({a}, "", &composed);
-  EXPECT_NE(composed.mjcf_xml.find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.mjcf_xml;
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  AddAgentBodies(AgentBodySpecs({a}), "", &composed);
+  EXPECT_NE(composed.Xml().find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.Xml();
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   EXPECT_EQ(sim.model_info().keys.size(), 1u);
 }
 

@@ -225,7 +225,7 @@ TEST(DefaultWorldTest, TheLoopKeepsClearOfTheFurniture) {
   ComposeOptions compose;
   compose.timestep_sec = world.timestep_sec;
   const ComposedScene composed = ComposeWorld(world.models, compose);
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml, world.timestep_sec);
+  Simulation sim = Simulation::LoadFromString(composed.Xml(), world.timestep_sec);
   const ModelConfig& robot = RobotConfig(world);
   std::unique_ptr<Controller> c = MakeController(robot.controller, robot.name, world.file);
   const TrotGait* gait = dynamic_cast<const TrotGait*>(c.get());

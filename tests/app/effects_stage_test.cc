@@ -9,12 +9,12 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/session/floor_map.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
+#include "penumbra/session/floor_map.h"
 
 namespace penumbra {
 namespace {
@@ -76,7 +76,7 @@ TEST(AdversityPlan, NpcPathsAreClearOfFurnitureAndTheRobotAndDependOnTheSeed) {
   ComposeOptions opts;
   opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   const ComposedScene composed = ComposeWorld(world.models, opts);
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   const FloorMap map(sim.scene(), sim.Snapshot().X_WB, 0.0, Eigen::Vector2d(-0.2, -1.45));
   for (const AgentConfig& agent : a.agents) {
     const double clearance = agent.kind == AgentKind::kPerson ? 0.4 : 1.2;
@@ -132,7 +132,7 @@ TEST(AdversityPlan, EffectsAreEvaluatedDeterministically) {
   opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   ComposedScene composed = ComposeWorld(world.models, opts);
   EffectsStage stage(world, &composed, "major");
-  Simulation sim = Simulation::LoadFromString(composed.mjcf_xml);
+  Simulation sim = Simulation::LoadFromString(composed.Xml());
   stage.Attach(&sim);
   const SceneDescription scene = stage.Bind(sim.scene());
   const WorldSnapshot snap = sim.Snapshot();

@@ -95,7 +95,7 @@ ModelPtr ComposeAndLoad(const std::vector<ModelConfig>& models, const TempDir& d
   WriteComposedScene(scene, path);
   std::string err;
   ModelPtr m = LoadFile(path, &err);
-  EXPECT_TRUE(m) << "MuJoCo rejected the composed model: " << err << "\n" << scene.mjcf_xml;
+  EXPECT_TRUE(m) << "MuJoCo rejected the composed model: " << err << "\n" << scene.Xml();
   if (scene_out) *scene_out = scene;
   return m;
 }
@@ -401,9 +401,9 @@ TEST(SceneComposerTest, TwoCopiesOfARobotComposeAndMatchTheRobotAlone) {
   ASSERT_TRUE(m);
   EXPECT_EQ(scene.model_names, (std::vector<std::string>{"a", "b"}));
   // deterministic text
-  EXPECT_EQ(ComposeWorld({Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, Options())
-                .mjcf_xml,
-            scene.mjcf_xml);
+  EXPECT_EQ(
+      ComposeWorld({Model("a", robot), Model("b", robot, {2, 1, 0}, {0, 0, 90})}, Options()).Xml(),
+      scene.Xml());
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
 
   // everything doubled
@@ -717,10 +717,10 @@ TEST(SceneComposerTest, IncludesAndMeshdirResolveFromTheirFiles) {
 
   // composed text: absolute mesh path, no include left
   const ComposedScene scene = ComposeWorld({Model("x", main)}, Options());
-  EXPECT_EQ(scene.mjcf_xml.find("<include"), std::string::npos);
-  EXPECT_NE(scene.mjcf_xml.find(fs::canonical(dir.str()).string() + "/proj/meshes/tetra.obj"),
+  EXPECT_EQ(scene.Xml().find("<include"), std::string::npos);
+  EXPECT_NE(scene.Xml().find(fs::canonical(dir.str()).string() + "/proj/meshes/tetra.obj"),
             std::string::npos)
-      << scene.mjcf_xml;
+      << scene.Xml();
 }
 
 TEST(SceneComposerTest, HumanoidSampleComposesTwice) {

@@ -45,7 +45,7 @@ TEST(TimestepOption, ModelTimestepIsCheckedWithItsFileAndLine) {
   const std::string good = dir.Write("good.xml", Mjcf("0.004"));
   const std::string later = dir.Write("later.xml", Mjcf("0"));
   const ComposedScene s = ComposeWorld({Model("a", good), Model("b", later)}, {});
-  EXPECT_NE(s.mjcf_xml.find("timestep=\"0.004\""), std::string::npos);
+  EXPECT_NE(s.Xml().find("timestep=\"0.004\""), std::string::npos);
 }
 
 TEST(TimestepOption, WorldTimestepWins) {
@@ -54,7 +54,7 @@ TEST(TimestepOption, WorldTimestepWins) {
   ComposeOptions o;
   o.timestep_sec = 0.002;
   const ComposedScene s = ComposeWorld({Model("m", file)}, o);
-  EXPECT_NE(s.mjcf_xml.find("timestep=\"0.002\""), std::string::npos);
+  EXPECT_NE(s.Xml().find("timestep=\"0.002\""), std::string::npos);
   o.timestep_sec = 1e-300;
   EXPECT_THROW(ComposeWorld({Model("m", file)}, o), ConfigError);
 }

@@ -99,7 +99,7 @@ inline ControllerConfig Block(const std::string& type, const std::string& body) 
   ControllerConfig cfg;
   cfg.type = type;
   cfg.line = 30;
-  cfg.params_yaml = "type: " + type + "\n" + body;
+  cfg.params = YAML::Load("type: " + type + "\n" + body);
   return cfg;
 }
 

@@ -27,7 +27,7 @@ tolerance_m: 0.15
 ControllerConfig Config(const std::string& yaml, const std::string& type = "waypoint_follower") {
   ControllerConfig c;
   c.type = type;
-  c.params_yaml = yaml;
+  c.params = YAML::Load(yaml);
   c.line = 21;
   return c;
 }
@@ -93,6 +93,27 @@ TEST(ControllerFactory, EmptyTypeMeansNoController) {
   EXPECT_EQ(MakeController(Config("", ""), "rover", "w.yaml"), nullptr);
 }
 
+TEST(ControllerFactory, ParamsMustBeAMappingOrNothing) {
+  // a list or a scalar in place of the block's mapping
+  EXPECT_EQ(std::string(ErrorFor("[a, b]").what()),
+            "worlds/w.yaml:21: robots[rover].controller: got a list of 2 items; expected a "
+            "mapping of controller parameters");
+  EXPECT_EQ(std::string(ErrorFor("fast").what()),
+            "worlds/w.yaml:21: robots[rover].controller: got 'fast'; expected a mapping of "
+            "controller parameters");
+  // no parameters at all (a null node): the required keys are reported missing
+  ControllerConfig none;
+  none.type = "waypoint_follower";
+  none.line = 4;
+  try {
+    MakeController(none, "rover", "w.yaml");
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "w.yaml:4: robots[rover].controller.base_body: missing; expected a name");
+  }
+}
+
 TEST(ControllerFactory, UnknownTypeNamesKnownTypes) {
   const ConfigError e = ErrorFor(kGood, "teleport");
   EXPECT_EQ(e.file(), "worlds/w.yaml");
@@ -136,11 +157,6 @@ TEST(ControllerFactory, BadValuesNameKeyAndExpectation) {
     EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << c.to << ": " << e.what();
     EXPECT_EQ(e.line(), 21);
   }
-}
-
-TEST(ControllerFactory, NonMappingAndInvalidYaml) {
-  EXPECT_EQ(ErrorFor("[1, 2]").key(), "robots[rover].controller");
-  EXPECT_EQ(ErrorFor("a: [1, 2").key(), "robots[rover].controller");
 }
 
 }  // namespace

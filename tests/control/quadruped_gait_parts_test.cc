@@ -169,7 +169,7 @@ std::string Legs() {
 }
 
 std::string Error(const std::string& yaml) {
-  ControllerConfig cfg{"trot_gait", yaml, 12};
+  ControllerConfig cfg{"trot_gait", YAML::Load(yaml), 12};
   try {
     MakeController(cfg, "dog", "world.yaml");
   } catch (const ConfigError& e) {
@@ -180,9 +180,9 @@ std::string Error(const std::string& yaml) {
 
 TEST(TrotGaitParams, ParsesPrefixedNamesCommandsAndHold) {
   ControllerConfig cfg{"trot_gait",
-                       "base_body: trunk\n" + Legs() +
-                           "commands: [{t: 0}, {t: 1.5, vx: 0.5, yaw_rate: -0.2}]\n"
-                           "period_sec: 0.4\nduty: 0.6\nhold: {arm: 0.5}\n",
+                       YAML::Load("base_body: trunk\n" + Legs() +
+                                  "commands: [{t: 0}, {t: 1.5, vx: 0.5, yaw_rate: -0.2}]\n"
+                                  "period_sec: 0.4\nduty: 0.6\nhold: {arm: 0.5}\n"),
                        3};
   std::unique_ptr<Controller> c = MakeController(cfg, "dog", "world.yaml");
   auto* g = dynamic_cast<TrotGait*>(c.get());

@@ -44,7 +44,7 @@ MultirotorPid* AddPid(Simulation* sim, const std::string& extra_yaml) {
   ControllerConfig cfg;
   cfg.type = "multirotor_pid";
   cfg.line = 20;
-  cfg.params_yaml = std::string(kBaseParams) + extra_yaml;
+  cfg.params = YAML::Load(std::string(kBaseParams) + extra_yaml);
   std::unique_ptr<Controller> c = MakeController(cfg, "", "quadrotor.yaml");
   auto* pid = dynamic_cast<MultirotorPid*>(c.get());
   sim->AddController(std::move(c));
@@ -172,10 +172,10 @@ TEST(QuadrotorFlight, WrongRotorNamesFailAtLoadListingThem) {
   ControllerConfig cfg;
   cfg.type = "multirotor_pid";
   cfg.line = 14;
-  cfg.params_yaml = R"(base_body: base
+  cfg.params = YAML::Load(R"(base_body: base
 rotor_actuators: [thrust_fr, motor_rl, thrust_fl, motor_rr]
 commands: [{t: 0, mode: takeoff, altitude_m: 1.5}]
-)";
+)");
   std::unique_ptr<Controller> c = MakeController(cfg, "", "quadrotor.yaml");
   try {
     sim.AddController(std::move(c));
@@ -196,7 +196,8 @@ TEST(QuadrotorFlight, BadCommandsFailAtParseNamingTheKey) {
     ControllerConfig cfg;
     cfg.type = "multirotor_pid";
     cfg.line = 9;
-    cfg.params_yaml = (base ? std::string(kBaseParams) : std::string("base_body: base\n")) + extra;
+    cfg.params =
+        YAML::Load((base ? std::string(kBaseParams) : std::string("base_body: base\n")) + extra);
     try {
       MakeController(cfg, "drone", "w.yaml");
     } catch (const ConfigError& e) {

@@ -157,7 +157,7 @@ inline Rig MakeRig(const std::string& robot, Ground ground, const std::string& c
   ControllerConfig cfg;
   cfg.type = "trot_gait";
   cfg.line = 1;
-  cfg.params_yaml = config_yaml;
+  cfg.params = YAML::Load(config_yaml);
   std::unique_ptr<Controller> c = MakeController(cfg, "", "test.yaml");
   rig.gait = dynamic_cast<TrotGait*>(c.get());
   rig.sim.AddController(std::move(c));

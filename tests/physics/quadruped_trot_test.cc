@@ -199,7 +199,7 @@ TEST(QuadrupedTrot, MissingNamesFailAtLoadListingAll) {
   legs.replace(legs.find("RL_foot,"), 8, "RL_toe,");
   Simulation sim =
       Simulation::LoadFromString(SceneXml("quadruped", Ground::kFlat), std::nullopt, kModelsDir);
-  ControllerConfig cfg{"trot_gait", "base_body: body\n" + legs, 7};
+  ControllerConfig cfg{"trot_gait", YAML::Load("base_body: body\n" + legs), 7};
   try {
     sim.AddController(MakeController(cfg, "", "world.yaml"));
     FAIL() << "expected a ConfigError";
@@ -255,7 +255,7 @@ TEST(QuadrupedTrot, JointSignsMapReversedAxes) {
   auto walk = [&](const std::string& model_xml, const std::string& asset_dir,
                   const std::string& legs_yaml) {
     Rig rig{Simulation::LoadFromString(model_xml, std::nullopt, asset_dir)};
-    ControllerConfig cfg{"trot_gait", Config("[{t: 0, vx: 0.5}]", legs_yaml), 1};
+    ControllerConfig cfg{"trot_gait", YAML::Load(Config("[{t: 0, vx: 0.5}]", legs_yaml)), 1};
     rig.sim.AddController(MakeController(cfg, "", "test.yaml"));
     rig.trunk = rig.sim.scene().FindBody("trunk");
     const double x0 = Trunk(rig).translation().x();

@@ -149,7 +149,7 @@ TEST(QuadrupedWaypoints, CommandSourcesKeepTheirPrecedence) {
 TEST(QuadrupedWaypoints, BadWaypointConfigFailsNamingTheKey) {
   auto error_of = [](const std::string& yaml) -> std::string {
     try {
-      MakeController(ControllerConfig{"trot_gait", yaml, 4}, "", "world.yaml");
+      MakeController(ControllerConfig{"trot_gait", YAML::Load(yaml), 4}, "", "world.yaml");
     } catch (const ConfigError& e) {
       return e.what();
     }

@@ -45,7 +45,7 @@ ControllerConfig SquareConfig(bool loop) {
   ControllerConfig cfg;
   cfg.type = "waypoint_follower";
   cfg.line = 12;
-  cfg.params_yaml = std::string(R"(type: waypoint_follower
+  cfg.params = YAML::Load(std::string(R"(type: waypoint_follower
 base_body: chassis
 left_actuator: left_wheel
 right_actuator: right_wheel
@@ -56,7 +56,7 @@ max_yaw_rate_deg_s: 90
 waypoints: [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0]]
 tolerance_m: 0.15
 loop: )") + (loop ? "true" : "false") +
-                    "\n";
+                          "\n");
   return cfg;
 }
 
@@ -109,13 +109,13 @@ TEST(WaypointFollowerSim, LoopKeepsGoing) {
 
 TEST(WaypointFollowerSim, MissingNamesFailAtLoadListingAll) {
   ControllerConfig cfg = SquareConfig(false);
-  cfg.params_yaml = R"(base_body: hull_link
+  cfg.params = YAML::Load(R"(base_body: hull_link
 left_actuator: left_wheel
 right_actuator: right_motor
 wheel_radius_m: 0.05
 track_width_m: 0.3
 waypoints: [[1, 0]]
-)";
+)");
   Simulation sim = Simulation::LoadFromString(kRoverXml);
   try {
     sim.AddController(MakeController(cfg, "rover", "world.yaml"));

@@ -142,7 +142,7 @@ TEST(ImuTest, FreeFallReadsZeroSpecificForceAndRestReadsGravityUp) {
   for (bool floor : {false, true}) {
     Simulation sim = Simulation::LoadFromString(ImuModel(floor));
     const auto& info = sim.sensor_info();
-    const int acc = FindMujocoSensor(info, "acc"), gyr = FindMujocoSensor(info, "gyr");
+    const int acc = FindSensor(info, "acc"), gyr = FindSensor(info, "gyr");
     ASSERT_GE(acc, 0);
     ASSERT_GE(gyr, 0);
     for (int i = 0; i < 500; ++i) sim.Step();  // 1 s

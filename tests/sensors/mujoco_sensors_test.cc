@@ -65,7 +65,7 @@ TEST(MujocoSensorsTest, EverySensorReadableByNameWithDimensionUnitAndValue) {
   Simulation sim = Simulation::LoadFromString(kModel);
   for (int i = 0; i < 1000; ++i) sim.Step();  // 2 s: box settled, arm hanging still
   const WorldSnapshot snap = sim.Snapshot();
-  const std::vector<MujocoSensorInfo>& info = sim.sensor_info();
+  const std::vector<SensorDescription>& info = sim.sensor_info();
   ASSERT_EQ(info.size(), 14u);
   struct Expect {
     const char* name;
@@ -89,7 +89,7 @@ TEST(MujocoSensorsTest, EverySensorReadableByNameWithDimensionUnitAndValue) {
                            {"arm_com", "subtreecom", 3, "m", "arm"},
                            {"clock", "clock", 1, "s", ""}};
   for (const Expect& e : expect) {
-    const int i = FindMujocoSensor(info, e.name);
+    const int i = FindSensor(info, e.name);
     ASSERT_GE(i, 0) << e.name;
     EXPECT_EQ(info[i].type, e.type) << e.name;
     EXPECT_EQ(info[i].dim, e.dim) << e.name;
@@ -97,7 +97,7 @@ TEST(MujocoSensorsTest, EverySensorReadableByNameWithDimensionUnitAndValue) {
     EXPECT_EQ(info[i].object_name, e.object) << e.name;
   }
   const auto v = [&](const char* name) {
-    return MujocoSensorValues(snap, info[FindMujocoSensor(info, name)]);
+    return MujocoSensorValues(snap, info[FindSensor(info, name)]);
   };
   const double g = 9.81;
   EXPECT_NEAR(v("touch")[0], 2 * g, 0.02);  // the resting box's weight

@@ -311,7 +311,8 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
 
 TEST_F(WorldConfigTest, ControllerParamsKeptAsYaml) {
   const WorldConfig w = ParseWorld(kFullWorld, world_);
-  const YAML::Node p = YAML::Load(w.models[0].controller.params_yaml);
+  const YAML::Node& p = w.models[0].controller.params;
+  EXPECT_EQ(w.models[0].controller.line, 25);
   ASSERT_TRUE(p.IsMap());
   EXPECT_EQ(p.size(), 2u);  // type is not repeated
   EXPECT_FALSE(p["type"]);
@@ -319,6 +320,10 @@ TEST_F(WorldConfigTest, ControllerParamsKeptAsYaml) {
   ASSERT_TRUE(p["waypoints"].IsSequence());
   ASSERT_EQ(p["waypoints"].size(), 2u);
   EXPECT_EQ(p["waypoints"][1][1].as<double>(), 1.0);
+  // the world file's own nodes, not a re-parsed copy: they keep their place in the file
+  // (yaml-cpp marks are 0-based)
+  EXPECT_EQ(p["speed_m_s"].Mark().line + 1, 27);
+  EXPECT_EQ(p["waypoints"].Mark().line + 1, 28);
 }
 
 TEST_F(WorldConfigTest, ControllerWithOnlyTypeHasEmptyMapParams) {
@@ -326,7 +331,7 @@ TEST_F(WorldConfigTest, ControllerWithOnlyTypeHasEmptyMapParams) {
       "robots:\n  - name: r\n    file: models/rover.xml\n    controller: {type: idle}\n", world_);
   EXPECT_EQ(w.models[0].controller.type, "idle");
   EXPECT_EQ(w.models[0].controller.line, 4);
-  const YAML::Node p = YAML::Load(w.models[0].controller.params_yaml);
+  const YAML::Node& p = w.models[0].controller.params;
   EXPECT_TRUE(p.IsMap());
   EXPECT_EQ(p.size(), 0u);
 }
@@ -401,7 +406,7 @@ TEST_F(WorldConfigTest, LoadWorldFileReadsFromDisk) {
   EXPECT_EQ(a.file, world_);
   ASSERT_EQ(a.models.size(), b.models.size());
   for (size_t i = 0; i < a.models.size(); ++i) EXPECT_EQ(a.models[i].file, b.models[i].file);
-  EXPECT_EQ(a.models[0].controller.params_yaml, b.models[0].controller.params_yaml);
+  EXPECT_EQ(YAML::Dump(a.models[0].controller.params), YAML::Dump(b.models[0].controller.params));
   EXPECT_EQ(a.lights.size(), 4u);
 }
 

@@ -13,7 +13,6 @@
 namespace penumbra {
 namespace {
 
-using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
 std::string Nums(std::initializer_list<double> v) {
@@ -141,45 +140,40 @@ void AddCart(BodyWriter* w) {
 
 std::string AgentBodyName(const std::string& agent_name) { return "agents/" + agent_name; }
 
-void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& world_file,
+void AddAgentBodies(const std::vector<MocapBodySpec>& bodies, const std::string& world_file,
                     ComposedScene* scene) {
-  if (agents.empty()) return;
-  ValidateAgentsOrThrow(agents, world_file);
+  if (bodies.empty()) return;
+  ValidateMocapBodySpecsOrThrow(bodies);
   for (const std::string& m : scene->model_names)
     if (m == "agents")
       throw ConfigError(world_file, 0, "models",
                         "a model is named 'agents', which is reserved for the bodies of the "
                         "world's agents; expected another model name");
-  XMLDocument doc;
-  if (doc.Parse(scene->mjcf_xml.c_str()) != tinyxml2::XML_SUCCESS)
-    throw ConfigError(world_file, 0, "agents",
-                      std::string("cannot parse the composed MJCF: ") + doc.ErrorStr());
-  XMLElement* root = doc.FirstChildElement("mujoco");
+  XMLElement* root = scene->document->FirstChildElement("mujoco");
   if (!root) throw ConfigError(world_file, 0, "agents", "composed MJCF has no <mujoco> root");
   XMLElement* worldbody = root->FirstChildElement("worldbody");
   if (!worldbody) worldbody = root->InsertNewChildElement("worldbody");
 
   std::vector<double> mpos, mquat;
-  for (size_t i = 0; i < agents.size(); ++i) {
-    const AgentConfig& a = agents[i];
-    const Pose X = AgentPath(a).X_WA(0.0);
-    const Eigen::Quaterniond q(X.linear());
-    const Eigen::Vector3d p = X.translation();
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    const MocapBodySpec& spec = bodies[i];
+    const Eigen::Quaterniond q(spec.X_WB.linear());
+    const Eigen::Vector3d p = spec.X_WB.translation();
     XMLElement* body = worldbody->InsertNewChildElement("body");
-    const std::string name = AgentBodyName(a.name);
+    const std::string name = AgentBodyName(spec.name);
     body->SetAttribute("name", name.c_str());
     body->SetAttribute("mocap", "true");
     body->SetAttribute("pos", Nums({p.x(), p.y(), p.z()}).c_str());
     body->SetAttribute("quat", Nums({q.w(), q.x(), q.y(), q.z()}).c_str());
     BodyWriter w(body, name);
-    switch (a.kind) {
-      case AgentKind::kPerson:
-        AddPerson(&w, a.height_m, kShirts[HashKeys(0xA6E7, i) % kShirts.size()]);
+    switch (spec.shape) {
+      case MocapBodySpec::Shape::kPerson:
+        AddPerson(&w, spec.height_m, kShirts[HashKeys(0xA6E7, i) % kShirts.size()]);
         break;
-      case AgentKind::kForklift:
+      case MocapBodySpec::Shape::kForklift:
         AddForklift(&w);
         break;
-      case AgentKind::kCart:
+      case MocapBodySpec::Shape::kCart:
         AddCart(&w);
         break;
     }
@@ -200,9 +194,6 @@ void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& w
       }
     }
   }
-  tinyxml2::XMLPrinter printer;
-  doc.Print(&printer);
-  scene->mjcf_xml = printer.CStr();
 }
 
 }  // namespace penumbra

@@ -1,6 +1,7 @@
 #pragma once
-// MJCF bodies for NPC agents (effects/agent_path.h): one mocap body per agent, added to
-// a composed scene after ComposeWorld. the bodies are kinematic (MuJoCo mocap: no joints,
+// MJCF bodies for NPC agents: one mocap body per MocapBodySpec (compose/mocap_body_spec.h; the
+// effects module's agents are converted to specs by app/effects_stage.cc), added to a composed
+// scene after ComposeWorld. the bodies are kinematic (MuJoCo mocap: no joints,
 // posed through mocap_pos / mocap_quat by physics Simulation::AddMocapDriver), so robots
 // and free bodies collide with them and are pushed, while agents never react to contact.
 // MuJoCo filters contacts between bodies welded to the world, so agents pass through
@@ -10,7 +11,7 @@
 // contype = conaffinity = 1 (MuJoCo's default), so they collide with every geom whose
 // contype or conaffinity has bit 0 set (all bundled robots); condim 3, friction 0.8.
 //
-// shapes (agent frame A: origin on the floor, x forward, y left, z up; AgentKind):
+// shapes (body frame B: origin on the floor, x forward, y left, z up; MocapBodySpec::Shape):
 //   person    legs and arms capsules (r 0.07 / 0.05 m), torso box 0.22 x 0.38 x 0.5 m,
 //             pelvis box, head sphere r 0.11 m; all heights scale with height_m / 1.75.
 //   forklift  about 2.75 x 1.1 x 2.1 m overall: chassis 1.6 x 1.1 x 0.7 m, counterweight, four
@@ -22,20 +23,21 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/compose/mocap_body_spec.h"
 #include "penumbra/compose/scene_composer.h"
-#include "penumbra/effects/agent_path.h"
 
 namespace penumbra {
 
 /// MJCF body name of agent `agent_name` ("agents/<name>").
 std::string AgentBodyName(const std::string& agent_name);
 
-/// adds one mocap body per agent (placed at its path pose at t = 0) to scene->mjcf_xml,
-/// and extends every keyframe's mpos / mquat by the agents' initial poses.
-/// @throws ConfigError if an agent is invalid (AgentConfig::ValidateOrThrow, key
-///         "agents[i]"), if a model is named "agents" (its names would clash), or if the
-///         composed XML cannot be parsed.
-void AddAgentBodies(const std::vector<AgentConfig>& agents, const std::string& world_file,
+/// adds one mocap body per spec (placed at its X_WB) to scene->document (in place), and extends
+/// every keyframe's mpos / mquat by the bodies' initial poses. a person's shirt colour is picked
+/// from a fixed palette by the spec's index in `bodies`.
+/// @throws Error if a spec is invalid (ValidateMocapBodySpecsOrThrow); ConfigError(world_file,
+///         0, "models") if a model is named "agents" (its names would clash), or
+///         ConfigError(world_file, 0, "agents") if the composed document has no <mujoco> root.
+void AddAgentBodies(const std::vector<MocapBodySpec>& bodies, const std::string& world_file,
                     ComposedScene* scene);
 
 }  // namespace penumbra

@@ -63,10 +63,8 @@ void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scen
   bool any = false;
   for (const SensorConfig& s : sensors) any = any || s.type == "imu";
   if (!any) return;
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(scene->mjcf_xml.c_str()) != tinyxml2::XML_SUCCESS)
-    throw Error("AddImuSensors: the composed MJCF does not parse: " + std::string(doc.ErrorStr()));
-  XMLElement* root = doc.RootElement();
+  XMLElement* root = scene->document->RootElement();
+  if (!root) throw Error("AddImuSensors: the composed MJCF has no <mujoco> root");
   XMLElement* worldbody = root->FirstChildElement("worldbody");
   if (!worldbody) worldbody = root->InsertNewChildElement("worldbody");
   XMLElement* sensor_section = root->FirstChildElement("sensor");
@@ -117,9 +115,6 @@ void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scen
     g->SetAttribute("name", gyr.c_str());
     g->SetAttribute("site", site_name.c_str());
   }
-  tinyxml2::XMLPrinter printer;
-  doc.Print(&printer);
-  scene->mjcf_xml = printer.CStr();
 }
 
 }  // namespace penumbra

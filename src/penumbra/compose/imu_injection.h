@@ -20,7 +20,7 @@ namespace penumbra {
 std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name);
 
 /// adds the IMU sites and sensors of `sensors` (entries of other types are ignored) to
-/// scene->mjcf_xml.
+/// scene->document (in place).
 /// @throws ConfigError(file, line, "<entry key>.body" / ".site", ...) naming the sensor when
 ///         the body or site does not exist in the composed model, or when a non-identity
 ///         pose is combined with a site oriented by anything other than pos/quat.

@@ -525,7 +525,7 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
     composers[i]->Prepare(compiler.strip_inertials[i], &scene.warnings);
   }
 
-  XMLDocument doc;
+  XMLDocument& doc = *scene.document;
   std::string comment = " composed by penumbra from:";
   for (const auto& m : composers) {
     comment += " " + m->config().name + " (" + m->source().file() + ")";
@@ -560,14 +560,36 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
     root->InsertAfterChild(size_anchor, size->DeepClone(&doc));
   }
 
-  tinyxml2::XMLPrinter printer;
-  doc.Print(&printer);
-  scene.mjcf_xml = printer.CStr();
   return scene;
 }
 
+ComposedScene::ComposedScene() : document(std::make_unique<XMLDocument>()) {}
+ComposedScene::ComposedScene(const ComposedScene& other)
+    : document(std::make_unique<XMLDocument>()),
+      model_names(other.model_names),
+      warnings(other.warnings) {
+  other.document->DeepCopy(document.get());
+}
+ComposedScene& ComposedScene::operator=(const ComposedScene& other) {
+  if (this != &other) {
+    other.document->DeepCopy(document.get());
+    model_names = other.model_names;
+    warnings = other.warnings;
+  }
+  return *this;
+}
+ComposedScene::ComposedScene(ComposedScene&&) noexcept = default;
+ComposedScene& ComposedScene::operator=(ComposedScene&&) noexcept = default;
+ComposedScene::~ComposedScene() = default;
+
+std::string ComposedScene::Xml() const {
+  tinyxml2::XMLPrinter printer;
+  document->Print(&printer);
+  return printer.CStr();
+}
+
 void WriteComposedScene(const ComposedScene& scene, const std::string& path) {
-  WriteFileAtomic(path, scene.mjcf_xml);
+  WriteFileAtomic(path, scene.Xml());
 }
 
 }  // namespace penumbra

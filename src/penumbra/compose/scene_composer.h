@@ -50,11 +50,16 @@
 // (src/xml/xml_native_reader.cc, src/user/user_objects.cc, mjCAlternative::Set).
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "penumbra/world/world_config.h"
+
+namespace tinyxml2 {
+class XMLDocument;
+}
 
 namespace penumbra {
 
@@ -71,16 +76,28 @@ struct ComposeOptions {
   std::optional<double> timestep_sec;
 };
 
-/// the result of ComposeWorld.
+/// the result of ComposeWorld: one MJCF document, kept as a tinyxml2 document so that the
+/// later composition steps (compose/imu_injection.h, compose/agent_bodies.h) edit it in place;
+/// it becomes text once, with Xml(), when it is written or compiled. copies are deep.
 struct ComposedScene {
+  ComposedScene();
+  ComposedScene(const ComposedScene& other);
+  ComposedScene& operator=(const ComposedScene& other);
+  ComposedScene(ComposedScene&&) noexcept;
+  ComposedScene& operator=(ComposedScene&&) noexcept;
+  ~ComposedScene();
+
   /// one self-contained MJCF document: absolute asset paths, no <include>,
-  /// compiler angle="radian".
-  std::string mjcf_xml;
+  /// compiler angle="radian". never null.
+  std::unique_ptr<tinyxml2::XMLDocument> document;
   /// the models' names in input order; model M's MJCF names start with "M/".
   std::vector<std::string> model_names;
   /// things that were composed with a compromise (dropped keyframes, conflicting
   /// <option> or <statistic> of later models, ...), one line each.
   std::vector<std::string> warnings;
+
+  /// the document as MJCF text (tinyxml2's indented printing).
+  std::string Xml() const;
 };
 
 /// merges `models` (in order) into one MJCF document.
@@ -90,7 +107,7 @@ struct ComposedScene {
 ///         undefined names, compiler attributes that differ and cannot be reconciled.
 ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const ComposeOptions& options);
 
-/// writes scene.mjcf_xml to `path` (e.g. "<output_dir>/composed.xml"), whole under a
+/// writes scene.Xml() to `path` (e.g. "<output_dir>/composed.xml"), whole under a
 /// temporary name and then renamed into place (core/output_file.h).
 /// @throws Error naming the path when the file cannot be written.
 void WriteComposedScene(const ComposedScene& scene, const std::string& path);

@@ -71,7 +71,7 @@ std::unique_ptr<Controller> MakeController(const ControllerConfig& cfg,
     throw ConfigError(world_file, cfg.line, context.key + ".type",
                       "unknown controller type '" + cfg.type + "'; expected one of: " + known);
   }
-  ControllerParams params(cfg.params_yaml, context);
+  ControllerParams params(cfg.params, context);
   const std::string prefix = robot_name.empty() ? "" : robot_name + "/";
   return it->second(params, prefix, context);
 }

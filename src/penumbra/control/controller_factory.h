@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "penumbra/control/controller.h"
-#include "penumbra/world/world_config.h"
+#include "penumbra/control/controller_config.h"
 
 namespace penumbra {
 
@@ -23,8 +23,8 @@ namespace penumbra {
 /// when robot_name is empty), matching the composer's naming. the result still has to be
 /// initialised against the model (Simulation::AddController does that).
 /// @throws ConfigError(world_file, cfg.line, "robots[<robot>].controller.<key>", ...) for an
-///         unknown type, unknown keys, missing keys or bad values ("controller.<key>" when
-///         robot_name is empty).
+///         unknown type, params that are not a mapping, unknown keys, missing keys or bad
+///         values ("controller.<key>" when robot_name is empty).
 std::unique_ptr<Controller> MakeController(const ControllerConfig& cfg,
                                            const std::string& robot_name,
                                            const std::string& world_file);

@@ -14,14 +14,9 @@ struct ControllerParams::Impl {
 
 using param::Repr;
 
-ControllerParams::ControllerParams(const std::string& params_yaml, ControllerContext context)
+ControllerParams::ControllerParams(const YAML::Node& params, ControllerContext context)
     : context_(std::move(context)), impl_(std::make_unique<Impl>()) {
-  try {
-    impl_->root = YAML::Load(params_yaml);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(context_.file, context_.line, context_.key,
-                      std::string("invalid YAML in the controller block: ") + e.what());
-  }
+  impl_->root = params;
   if (impl_->root.IsNull()) return;  // an empty block: no parameters
   if (!impl_->root.IsMap()) {
     throw ConfigError(context_.file, context_.line, context_.key,

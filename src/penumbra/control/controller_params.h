@@ -22,9 +22,10 @@ namespace penumbra {
 /// known; CheckNoUnknownKeys() then rejects anything else (typos fail loudly).
 class ControllerParams {
  public:
-  /// parses `params_yaml` (a YAML mapping; the `type` key, if present, is ignored here).
-  /// @throws ConfigError if the text is not valid YAML or not a mapping.
-  ControllerParams(const std::string& params_yaml, ControllerContext context);
+  /// reads `params` (a YAML mapping, or a null node for no parameters; the `type` key, if
+  /// present, is ignored here). the nodes are shared, not copied; they are only read.
+  /// @throws ConfigError if `params` is neither null nor a mapping.
+  ControllerParams(const YAML::Node& params, ControllerContext context);
   ~ControllerParams();
   ControllerParams(const ControllerParams&) = delete;
   ControllerParams& operator=(const ControllerParams&) = delete;

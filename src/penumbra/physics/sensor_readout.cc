@@ -196,11 +196,11 @@ std::string Name(const mjModel* m, int type, int id) {
 
 }  // namespace
 
-std::vector<MujocoSensorInfo> DescribeMujocoSensors(const mjModel_* mm) {
+std::vector<SensorDescription> DescribeMujocoSensors(const mjModel_* mm) {
   const mjModel* m = mm;
-  std::vector<MujocoSensorInfo> out;
+  std::vector<SensorDescription> out;
   for (int s = 0; s < m->nsensor; ++s) {
-    MujocoSensorInfo i;
+    SensorDescription i;
     i.name = Name(m, mjOBJ_SENSOR, s);
     i.id = s;
     i.type = TypeName(m->sensor_type[s]);
@@ -226,17 +226,6 @@ std::vector<MujocoSensorInfo> DescribeMujocoSensors(const mjModel_* mm) {
     out.push_back(std::move(i));
   }
   return out;
-}
-
-int FindMujocoSensor(const std::vector<MujocoSensorInfo>& sensors, const std::string& name) {
-  for (size_t i = 0; i < sensors.size(); ++i)
-    if (sensors[i].name == name) return static_cast<int>(i);
-  return -1;
-}
-
-std::string SensorValueLabel(const MujocoSensorInfo& s, int k) {
-  const std::string& c = s.components.at(k);
-  return c.empty() ? s.name : s.name + "_" + c;
 }
 
 }  // namespace penumbra

@@ -199,7 +199,7 @@ struct Simulation::Impl {
   std::vector<std::string> warnings;
   std::vector<int> qpos_joint;  // (nq) joint owning each qpos entry
   std::vector<double> jacp, jacr;
-  std::vector<MujocoSensorInfo> sensor_info;
+  std::vector<SensorDescription> sensor_info;
   struct MocapDriver {
     int mocap_id = -1;
     std::function<Pose(double)> X_WB;
@@ -343,28 +343,6 @@ struct Simulation::Impl {
         Fail(t, step, "physics diverged: non-finite qacc at " + DofLabel(i));
   }
 };
-
-double PhysicsRateHz(double timestep_sec) {
-  const double rate = 1.0 / timestep_sec;
-  const double r = std::nearbyint(rate);
-  return r >= 1 && std::abs(rate - r) <= 1e-9 * r ? r : rate;
-}
-
-double SimTimeOfStep(int64_t n, double timestep_sec) {
-  if (n <= 0) return 0.0;
-  const double nd = static_cast<double>(n);
-  const double rate = PhysicsRateHz(timestep_sec);
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (rate == std::nearbyint(rate)) {
-    // n / R rounded up: fma gives the sign of q R - n exactly
-    double q = nd / rate;
-    if (std::fma(q, rate, -nd) < 0) q = std::nextafter(q, kInf);
-    return q;
-  }
-  double p = nd * timestep_sec;
-  if (std::fma(nd, timestep_sec, -p) > 0) p = std::nextafter(p, kInf);
-  return p;
-}
 
 Simulation::Simulation(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Simulation::Simulation(Simulation&&) noexcept = default;
@@ -525,6 +503,72 @@ void Simulation::Step() {
   if (!s.mocap_drivers.empty()) s.ApplyMocapDrivers(d->time);
 }
 
+SimState Simulation::GetState() const {
+  const mjModel* m = impl_->m;
+  const mjData* d = impl_->d;
+  const auto copy = [](const mjtNum* x, int n) { return std::vector<double>(x, x + n); };
+  SimState s;
+  s.step_count = impl_->steps;
+  s.time_sec = d->time;
+  s.qpos = copy(d->qpos, m->nq);
+  s.qvel = copy(d->qvel, m->nv);
+  s.act = copy(d->act, m->na);
+  s.ctrl = copy(d->ctrl, m->nu);
+  s.qacc_warmstart = copy(d->qacc_warmstart, m->nv);
+  s.qfrc_applied = copy(d->qfrc_applied, m->nv);
+  s.xfrc_applied = copy(d->xfrc_applied, 6 * m->nbody);
+  s.mocap_pos = copy(d->mocap_pos, 3 * m->nmocap);
+  s.mocap_quat = copy(d->mocap_quat, 4 * m->nmocap);
+  s.userdata = copy(d->userdata, m->nuserdata);
+  for (const Impl::Schedule& sc : impl_->schedule) s.controller_next_update.push_back(sc.next);
+  return s;
+}
+
+void Simulation::SetState(const SimState& s) {
+  Impl& impl = *impl_;
+  const mjModel* m = impl.m;
+  mjData* d = impl.d;
+  const auto check = [&](const char* field, size_t got, size_t expected) {
+    if (got != expected)
+      throw Error(impl.source + ": SetState: " + field + " has " + std::to_string(got) +
+                  " entries; expected " + std::to_string(expected) + " for this model");
+  };
+  check("qpos", s.qpos.size(), m->nq);
+  check("qvel", s.qvel.size(), m->nv);
+  check("act", s.act.size(), m->na);
+  check("ctrl", s.ctrl.size(), m->nu);
+  check("qacc_warmstart", s.qacc_warmstart.size(), m->nv);
+  check("qfrc_applied", s.qfrc_applied.size(), m->nv);
+  check("xfrc_applied", s.xfrc_applied.size(), 6 * static_cast<size_t>(m->nbody));
+  check("mocap_pos", s.mocap_pos.size(), 3 * static_cast<size_t>(m->nmocap));
+  check("mocap_quat", s.mocap_quat.size(), 4 * static_cast<size_t>(m->nmocap));
+  check("userdata", s.userdata.size(), m->nuserdata);
+  check("controller_next_update", s.controller_next_update.size(), impl.schedule.size());
+  if (s.step_count < 0 || s.time_sec != SimTimeOfStep(s.step_count, m->opt.timestep))
+    throw Error(impl.source + ": SetState: time_sec " + FormatSeconds(s.time_sec) +
+                " is not the time of step " + std::to_string(s.step_count) + " (" +
+                FormatSeconds(SimTimeOfStep(s.step_count, m->opt.timestep)) + " s)");
+  const auto put = [](const std::vector<double>& x, mjtNum* out) {
+    if (!x.empty()) std::memcpy(out, x.data(), sizeof(mjtNum) * x.size());
+  };
+  d->time = s.time_sec;
+  put(s.qpos, d->qpos);
+  put(s.qvel, d->qvel);
+  put(s.act, d->act);
+  put(s.ctrl, d->ctrl);
+  put(s.qacc_warmstart, d->qacc_warmstart);
+  put(s.qfrc_applied, d->qfrc_applied);
+  put(s.xfrc_applied, d->xfrc_applied);
+  put(s.mocap_pos, d->mocap_pos);
+  put(s.mocap_quat, d->mocap_quat);
+  put(s.userdata, d->userdata);
+  for (size_t i = 0; i < impl.schedule.size(); ++i)
+    impl.schedule[i].next = s.controller_next_update[i];
+  impl.steps = s.step_count;
+  impl.failed = false;
+  impl.failure.clear();
+}
+
 double Simulation::time() const { return impl_->d->time; }
 int64_t Simulation::step_count() const { return impl_->steps; }
 double Simulation::timestep() const { return impl_->m->opt.timestep; }
@@ -584,7 +628,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   }
 }
 
-const std::vector<MujocoSensorInfo>& Simulation::sensor_info() const { return impl_->sensor_info; }
+const std::vector<SensorDescription>& Simulation::sensor_info() const { return impl_->sensor_info; }
 
 const SceneDescription& Simulation::scene() const { return impl_->scene; }
 const ModelInfo& Simulation::model_info() const { return impl_->info; }

@@ -29,20 +29,44 @@
 #include "penumbra/control/model_info.h"
 #include "penumbra/physics/sensor_readout.h"
 #include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/sim_time.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
 
-/// the physics rate 1 / timestep_sec (Hz), snapped to the nearest integer when it is within
-/// 1e-9 (relative) of one: 0.002 s -> exactly 500 Hz.
-double PhysicsRateHz(double timestep_sec);
+// PhysicsRateHz and SimTimeOfStep (the time of each step): scene/sim_time.h.
 
-/// sim time of physics step n (s): the smallest double >= n / R, R = PhysicsRateHz(timestep)
-/// when that is an integer, else >= n * timestep (both exact, not summed). so for a rate r
-/// dividing R, the step of frame k = n r / R has time >= k / r exactly and
-/// floor(time * r) == k, and times never drift (MuJoCo's own time += timestep does, by up
-/// to ~1e-11 s over a minute). n <= 0 gives 0.
-double SimTimeOfStep(int64_t n, double timestep_sec);
+/// everything a bit-exact restart of a Simulation needs (Simulation::GetState / SetState),
+/// for MuJoCo 2.2.2: mj_step is a function of exactly these mjData fields (the set MuJoCo 3
+/// later named mjSTATE_INTEGRATION, less eq_active and plugin_state, which 2.2.2's mjData does
+/// not have) and of the model; every other mjData field is recomputed from them by the next
+/// step's mj_forward. qacc_warmstart is the constraint solver's starting point: without it the
+/// next contact solve starts elsewhere and the trajectory differs in the last bits.
+/// plus penumbra's own: the step count (time is SimTimeOfStep(step_count)) and each
+/// controller's next update (its schedule on sim time).
+///
+/// NOT included: the controllers' own memory (waypoint index, gait phase, integrators, ...).
+/// SetState restores physics and the controllers' schedule only; a restart is bit-exact for a
+/// simulation whose controllers keep no state between updates, or that has none. mocap
+/// drivers (AddMocapDriver) are pure functions of time and need nothing.
+/// vectors are MuJoCo's, in its order and units (sizes from the model: nq, nv, na, nu, nmocap,
+/// nuserdata, nbody).
+struct SimState {
+  int64_t step_count = 0;              ///< steps completed since loading
+  double time_sec = 0;                 ///< mjData time (SimTimeOfStep(step_count, timestep))
+  std::vector<double> qpos;            ///< (nq) joint positions
+  std::vector<double> qvel;            ///< (nv) joint velocities
+  std::vector<double> act;             ///< (na) actuator activations
+  std::vector<double> ctrl;            ///< (nu) controls
+  std::vector<double> qacc_warmstart;  ///< (nv) constraint solver warm start
+  std::vector<double> qfrc_applied;    ///< (nv) applied generalized forces
+  std::vector<double> xfrc_applied;    ///< (6 nbody) applied Cartesian wrenches
+  std::vector<double> mocap_pos;       ///< (3 nmocap) mocap body positions, m, world frame
+  std::vector<double> mocap_quat;      ///< (4 nmocap) mocap body orientations (w, x, y, z)
+  std::vector<double> userdata;        ///< (nuserdata) user data
+  /// (number of controllers) index of each controller's next update (see Controller::rate_hz)
+  std::vector<int64_t> controller_next_update;
+};
 
 /// a MuJoCo simulation with pluggable controllers.
 class Simulation {
@@ -88,6 +112,16 @@ class Simulation {
   ///         non-finite ctrl; message: "<model>: t = <time> s (step <n>): ... body '<name>' ...".
   void Step();
 
+  /// the current state (SimState: physics, step count, controller schedule).
+  SimState GetState() const;
+  /// restores a state taken with GetState from a Simulation of the same model with the same
+  /// number of controllers: the following steps are bit-identical to those that followed
+  /// GetState (with stateless controllers; see SimState). also clears a PhysicsError, so a
+  /// simulation can be restarted from a state before it failed.
+  /// @throws Error naming the first field whose size does not match this model, or when
+  ///         time_sec is not SimTimeOfStep(step_count, timestep()); the state is unchanged then.
+  void SetState(const SimState& state);
+
   /// simulation time (s) and the number of steps completed since loading. time() is
   /// SimTimeOfStep(step_count(), timestep()) (MuJoCo's accumulated time is overwritten after
   /// each step), also for controllers and snapshots. after a PhysicsError both stay at the
@@ -117,7 +151,7 @@ class Simulation {
 
   /// the model's MuJoCo sensors (name, type, dimension, unit, object), by sensor id; their
   /// values are WorldSnapshot::sensordata (physics/sensor_readout.h).
-  const std::vector<MujocoSensorInfo>& sensor_info() const;
+  const std::vector<SensorDescription>& sensor_info() const;
 
   /// the static scene, extracted once at load (physics/scene_extractor.h).
   const SceneDescription& scene() const;

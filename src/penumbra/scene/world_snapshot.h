@@ -31,7 +31,7 @@ struct WorldSnapshot {
   std::vector<double> qvel;
   /// MuJoCo sensordata at this instant (Simulation::Snapshot evaluates the model's sensors
   /// for the snapshot's own state on a scratch copy); index with the adr/dim of
-  /// physics/sensor_readout.h. empty if the model has no sensors.
+  /// scene/sensor_description.h. empty if the model has no sensors.
   std::vector<double> sensordata;
   /// V_WB of every body (index as X_WB): (angular rad/s; linear m/s) velocity of the body
   /// frame's origin, both in world-frame axes (MuJoCo mj_objectVelocity, flg_local = 0).

@@ -23,7 +23,7 @@ std::string UnitSuffix(const std::string& unit) {
 }
 
 std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot,
-                                           const MujocoSensorInfo& s) {
+                                           const SensorDescription& s) {
   if (s.adr < 0 || static_cast<size_t>(s.adr + s.dim) > snapshot.sensordata.size())
     throw Error("MuJoCo sensor '" + s.name + "': the snapshot holds " +
                 std::to_string(snapshot.sensordata.size()) + " sensor values; expected at least " +
@@ -31,28 +31,28 @@ std::span<const double> MujocoSensorValues(const WorldSnapshot& snapshot,
   return {snapshot.sensordata.data() + s.adr, static_cast<size_t>(s.dim)};
 }
 
-MujocoSensorSet::MujocoSensorSet(const std::vector<MujocoSensorInfo>& all,
+MujocoSensorSet::MujocoSensorSet(const std::vector<SensorDescription>& all,
                                  const std::vector<std::string>& names) {
   if (names.empty()) {
     sensors_ = all;
   } else {
     for (const std::string& n : names) {
-      const int i = FindMujocoSensor(all, n);
+      const int i = FindSensor(all, n);
       if (i < 0) {
         std::string list;
-        for (const MujocoSensorInfo& s : all) list += (list.empty() ? "" : ", ") + s.name;
+        for (const SensorDescription& s : all) list += (list.empty() ? "" : ", ") + s.name;
         throw Error("no MuJoCo sensor named '" + n +
                     "'; the model has: " + (list.empty() ? std::string("none") : list));
       }
       sensors_.push_back(all[i]);
     }
   }
-  for (const MujocoSensorInfo& s : sensors_) size_ += s.dim;
+  for (const SensorDescription& s : sensors_) size_ += s.dim;
 }
 
 std::vector<std::string> MujocoSensorSet::ColumnNames() const {
   std::vector<std::string> cols;
-  for (const MujocoSensorInfo& s : sensors_) {
+  for (const SensorDescription& s : sensors_) {
     const std::string unit = UnitSuffix(s.unit);
     for (int k = 0; k < s.dim; ++k) {
       std::string c = SensorValueLabel(s, k);
@@ -65,7 +65,7 @@ std::vector<std::string> MujocoSensorSet::ColumnNames() const {
 }
 
 void MujocoSensorSet::Read(const WorldSnapshot& snapshot, std::vector<double>* out) const {
-  for (const MujocoSensorInfo& s : sensors_) {
+  for (const SensorDescription& s : sensors_) {
     const std::span<const double> v = MujocoSensorValues(snapshot, s);
     out->insert(out->end(), v.begin(), v.end());
   }

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "penumbra/core/error.h"
-#include "penumbra/physics/simulation.h"
+#include "penumbra/scene/sim_time.h"
 
 namespace penumbra {
 namespace {

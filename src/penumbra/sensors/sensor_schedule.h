@@ -1,7 +1,7 @@
 #pragma once
 // when sensors (and cameras) fire, on the physics step count. sample k of a sensor with
 // rate f is captured at the first physics step n whose time t_n = SimTimeOfStep(n, timestep)
-// (physics/simulation.h) is >= k / f, compared exactly (t_n f >= k): no tolerance and no
+// (scene/sim_time.h) is >= k / f, compared exactly (t_n f >= k): no tolerance and no
 // drift, whatever the ratio of rate and timestep. when f divides the physics rate the step's
 // time is >= k / f and floor(t_n f) == k for every sample.
 //

@@ -184,7 +184,12 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
 
 EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
                            const std::string& adversity_override)
-    : effects_(world.effects), agents_(world.agents), seed_(world.seed) {
+    : effects_(world.effects),
+      agents_(world.agents),
+      seed_(world.seed),
+      world_file_(world.file),
+      world_agents_(world.agents.size()),
+      robot_starts_(RobotStarts(world)) {
   ValidateAgentsOrThrow(agents_, world.file);
   std::string spec = world.adversity;
   std::string spec_file = world.file;
@@ -196,26 +201,64 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   }
   if (!spec.empty()) preset_ = LoadAdversityPreset(spec, spec_file, spec_line);
 
-  // the scene at the start, for the preset's regions and NPC paths and the agent bounds
-  const bool need_scene = !agents_.empty() || (preset_ && !preset_->empty());
-  if (need_scene) {
-    Simulation probe = Simulation::LoadFromString(composed->mjcf_xml, world.timestep_sec);
-    const WorldSnapshot start = probe.Snapshot();
-    const std::vector<Eigen::Vector3d> robots = RobotStarts(world);
-    // user agents must walk inside the world
+  // the preset's regions and NPC paths need the static scene at the start, before the NPCs'
+  // bodies exist: MuJoCo 2.2.2 cannot add bodies to a compiled model, so a world with a
+  // preset compiles its composed document twice, here (a probe, without agents) and for the
+  // run. without a preset it compiles once; the world's own agents are checked against
+  // the run's model in Attach.
+  if (preset_ && !preset_->empty()) {
+    const Simulation probe = Simulation::LoadFromString(composed->Xml(), world.timestep_sec);
+    PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, world.seed,
+                        &effects_, &agents_);
+  }
+  ValidateEffectsOrThrow(effects_, world.file);
+  ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
+  AddAgentBodies(AgentBodySpecs(agents_), world.file, composed);
+}
+
+EffectsStage::~EffectsStage() = default;
+
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents) {
+  std::vector<MocapBodySpec> specs;
+  for (const AgentConfig& a : agents) {
+    MocapBodySpec s;
+    s.name = a.name;
+    switch (a.kind) {
+      case AgentKind::kPerson:
+        s.shape = MocapBodySpec::Shape::kPerson;
+        break;
+      case AgentKind::kForklift:
+        s.shape = MocapBodySpec::Shape::kForklift;
+        break;
+      case AgentKind::kCart:
+        s.shape = MocapBodySpec::Shape::kCart;
+        break;
+    }
+    s.height_m = a.height_m;
+    s.X_WB = AgentPath(a).X_WA(0.0);
+    specs.push_back(std::move(s));
+  }
+  return specs;
+}
+
+void EffectsStage::Attach(Simulation* sim) const {
+  // the world's agents must walk inside the world: the static geometry's plan-view box + 1 m
+  // (agent bodies are mocap, never static, so they do not widen it)
+  if (world_agents_ > 0) {
     Eigen::Vector2d centre(0, 0);
-    for (const Eigen::Vector3d& r : robots)
-      centre += r.head<2>() / static_cast<double>(robots.size());
-    const FloorMap map(probe.scene(), start.X_WB, 0.0, centre);
+    for (const Eigen::Vector3d& r : robot_starts_)
+      centre += r.head<2>() / static_cast<double>(robot_starts_.size());
+    const FloorMap map(sim->scene(), sim->Snapshot(Simulation::SnapshotContent::kPoses).X_WB, 0.0,
+                       centre);
     if (map.has_static_bounds()) {
       const Eigen::Vector2d lo = map.static_min_W() - Eigen::Vector2d(1, 1);
       const Eigen::Vector2d hi = map.static_max_W() + Eigen::Vector2d(1, 1);
-      for (size_t i = 0; i < agents_.size(); ++i)
+      for (size_t i = 0; i < world_agents_; ++i)
         for (size_t j = 0; j < agents_[i].waypoints.size(); ++j) {
           const Eigen::Vector2d& p = agents_[i].waypoints[j];
           if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any())
             throw ConfigError(
-                world.file, agents_[i].line,
+                world_file_, agents_[i].line,
                 "agents[" + std::to_string(i) + "].waypoints[" + std::to_string(j) + "]",
                 "[" + FormatNumber(p.x()) + ", " + FormatNumber(p.y()) +
                     "] lies outside the world; expected x in [" + FormatNumber(lo.x()) + ", " +
@@ -223,17 +266,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
                     FormatNumber(hi.y()) + "] m (the static geometry's extent + 1 m)");
         }
     }
-    if (preset_ && !preset_->empty())
-      PlanAdversityPreset(*preset_, probe.scene(), start.X_WB, robots, world.seed, &effects_,
-                          &agents_);
   }
-  ValidateEffectsOrThrow(effects_, world.file);
-  AddAgentBodies(agents_, world.file, composed);
-}
-
-EffectsStage::~EffectsStage() = default;
-
-void EffectsStage::Attach(Simulation* sim) const {
   for (const AgentConfig& a : agents_) {
     auto path = std::make_shared<const AgentPath>(a);
     sim->AddMocapDriver(AgentBodyName(a.name), [path](double t) { return path->X_WA(t); });

@@ -4,9 +4,11 @@
 //
 // order in a run (app/runner.cc):
 //   1. compose the models, then EffectsStage(world, &composed, ...) plans the preset
-//      (regions and NPC paths need the scene: it loads the composed model once to read
-//      the static geometry) and adds one mocap body per agent to `composed`;
-//   2. load the simulation, Attach(&sim): every agent body is driven from its path;
+//      (regions and NPC paths need the scene: with a preset it compiles the composed
+//      document once more to read the static geometry) and adds one mocap body per agent
+//      to `composed`;
+//   2. load the simulation, Attach(&sim): the world's agents are checked against the
+//      world's extent, then every agent body is driven from its path;
 //   3. Bind(scene): labels agent geoms (Geom::semantic_class, effects/agent_path.h) and
 //      builds the EffectsEngine on the final scene;
 //   4. per rendered frame, after physics: Evaluate(snapshot, camera position) -> the
@@ -40,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/compose/mocap_body_spec.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/effects/agent_path.h"
 #include "penumbra/effects/effect_config.h"
@@ -60,13 +63,16 @@ class EffectsStage {
   /// plans the run's effects and agents and adds the agents' bodies to `composed`.
   /// @param adversity_override a preset spec from the command line (--adversity), or ""
   ///        for the world's own `adversity` key
-  /// @throws ConfigError for an unknown preset, invalid agents, an agent waypoint outside
-  ///         the world (the static geometry's plan-view box + 1 m), or invalid effects.
+  /// @throws ConfigError for an unknown preset, invalid agents or invalid effects.
   EffectsStage(const WorldConfig& world, ComposedScene* composed,
                const std::string& adversity_override = "");
   ~EffectsStage();
 
-  /// drives every agent's mocap body from its path (Simulation::AddMocapDriver).
+  /// checks the world's agents against `sim`'s static geometry, then drives every agent's
+  /// mocap body from its path (Simulation::AddMocapDriver). `sim` is the composed model
+  /// loaded, before its first step.
+  /// @throws ConfigError for a waypoint of a world agent outside the world (the static
+  ///         geometry's plan-view box + 1 m), naming agents[i].waypoints[j].
   void Attach(Simulation* sim) const;
 
   /// `scene` with every agent geom that has no class yet (a world-file `semantic_classes`
@@ -96,6 +102,9 @@ class EffectsStage {
   std::vector<AgentConfig> agents_;
   std::optional<AdversityPreset> preset_;
   uint64_t seed_ = 0;
+  std::string world_file_;
+  size_t world_agents_ = 0;  // agents_[0, world_agents_) are the world's, then the preset's
+  std::vector<Eigen::Vector3d> robot_starts_;
   std::unique_ptr<EffectsEngine> engine_;
 };
 
@@ -106,5 +115,10 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
                          const std::vector<Pose>& X_WB,
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents);
+
+/// the mocap body of each agent for compose/agent_bodies.h, in the same order: name, shape of
+/// its kind, height and its path's pose at t = 0 (AgentPath::X_WA(0)).
+/// @throws ConfigError if an agent is invalid (as AgentPath's constructor).
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents);
 
 }  // namespace penumbra

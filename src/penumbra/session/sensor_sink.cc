@@ -92,7 +92,7 @@ struct SensorSink::Impl {
   struct Imu {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
-    MujocoSensorInfo accel, gyro;
+    SensorDescription accel, gyro;
     ImuCsvWriter out;
     int64_t written = 0;
   };
@@ -221,8 +221,8 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       Impl::Imu m;
       m.cfg = &c;
       const auto [acc, gyr] = ImuSensorNames(c.name);
-      const int ia = FindMujocoSensor(sim.sensor_info(), acc);
-      const int ig = FindMujocoSensor(sim.sensor_info(), gyr);
+      const int ia = FindSensor(sim.sensor_info(), acc);
+      const int ig = FindSensor(sim.sensor_info(), gyr);
       if (ia < 0 || ig < 0)
         throw SensorError(c, "",
                           "the composed model has no accelerometer/gyro '" + acc +

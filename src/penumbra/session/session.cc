@@ -7,6 +7,7 @@
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
@@ -41,17 +42,20 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
-  if (!options.composed_xml_path.empty()) WriteComposedScene(composed, options.composed_xml_path);
+  // the document becomes text once: the file kept and what MuJoCo compiles
+  const std::string xml = composed.Xml();
+  if (!options.composed_xml_path.empty()) WriteFileAtomic(options.composed_xml_path, xml);
   timings_.compose_sec = SecondsSince(t0);
 
-  // physics, controllers and agent drivers
+  // physics (compiled once; a second, earlier compile only for an adversity preset's
+  // planning, session/effects_stage.h), agent drivers and controllers
   t0 = Clock::now();
   sim_ = std::make_unique<Simulation>(
       options.composed_xml_path.empty()
-          ? Simulation::LoadFromString(composed.mjcf_xml, world_.timestep_sec)
+          ? Simulation::LoadFromString(xml, world_.timestep_sec)
           : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
+  effects_->Attach(sim_.get());  // checks the world's agents against the model
   if (options.add_controllers) AddWorldControllers(world_, sim_.get());
-  effects_->Attach(sim_.get());
   timings_.load_sec = SecondsSince(t0);
 
   // the renderer's static scene, the effects engine on it, and the renderer

@@ -4,18 +4,21 @@
 //   1. compose   every model into one MJCF document (compose/scene_composer.h), the world's
 //                IMUs added to it (compose/imu_injection.h), then the effects stage plans the
 //                world's effects, agents and adversity preset and adds one mocap body per agent
-//                (session/effects_stage.h); the document is printed to text once, written to
-//                SessionOptions::composed_xml_path when one is given;
-//   2. load      MuJoCo compiles the text once into the Simulation; the robots' controllers
-//                (control/controller_factory.h) and the agents' mocap drivers are added;
+//                (session/effects_stage.h), all on one tinyxml2 document, printed to text
+//                once and written to SessionOptions::composed_xml_path when one is given;
+//   2. load      MuJoCo compiles the text into the Simulation (the only compile, except for
+//                a world with an adversity preset, whose planner compiled a probe of the
+//                document without its NPCs in step 1); the world's agents are checked
+//                against the model and their mocap drivers added, then the robots'
+//                controllers (control/controller_factory.h);
 //   3. scene     the renderer's SceneDescription: the compiled model's scene joined with the
 //                world file's lights, sky, cameras and materials (session/scene_assembly.h),
 //                agent geoms labelled and the effects engine built on it (EffectsStage::Bind);
 //                optionally the run's memory and work are checked (session/run_budget.h);
 //                then the renderer (render/renderer.h) is built for that scene.
 // a Session is then stepped and rendered by its user (app/runner.cc, app/bench.cc, ...); it
-// owns everything it built and is neither copied nor moved (the renderer and the effects
-// stage refer to the scene it holds).
+// owns everything it built and is neither copied nor moved (what it hands out by reference
+// stays valid for its lifetime).
 
 #include <memory>
 #include <string>

@@ -179,21 +179,16 @@ class WorldParser {
     return m;
   }
 
-  // `type` picks the controller; the rest of the mapping is kept as YAML text.
+  // `type` picks the controller; the rest of the mapping stays YAML nodes for it.
   static ControllerConfig ReadController(const YamlReader& r) {
     r.ExpectMapAnyKeys();
     ControllerConfig c;
     c.type = r.Child("type").String();
     if (c.type.empty()) r.Child("type").Fail("empty; expected a controller type name");
     c.line = r.line();
-    YAML::Emitter out;
-    out << YAML::BeginMap;
-    for (auto it = r.node().begin(); it != r.node().end(); ++it) {
-      if (it->first.Scalar() == "type") continue;
-      out << YAML::Key << it->first.Scalar() << YAML::Value << it->second;
-    }
-    out << YAML::EndMap;
-    c.params_yaml = out.c_str();
+    c.params = YAML::Node(YAML::NodeType::Map);
+    for (auto it = r.node().begin(); it != r.node().end(); ++it)
+      if (it->first.Scalar() != "type") c.params.force_insert(it->first, it->second);
     return c;
   }
 

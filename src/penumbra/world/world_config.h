@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/control/controller_config.h"
 #include "penumbra/core/pose.h"
 #include "penumbra/effects/agent_path.h"
 #include "penumbra/effects/effect_config.h"
@@ -28,15 +29,6 @@ struct PoseConfig {
   Pose ToPose() const { return PoseFromXyzRpyDeg(xyz, rpy_deg); }
 };
 
-/// a controller attached to a robot. `type` picks the implementation; `params`
-/// keeps the rest of the YAML map as text (a YAML/JSON snippet) for the controller
-/// to parse and validate itself at load, so controllers stay pluggable.
-struct ControllerConfig {
-  std::string type;         ///< e.g. "waypoint_follower"; empty = none
-  std::string params_yaml;  ///< the controller's mapping, re-emitted as YAML text
-  int line = 0;             ///< line of the controller block in the world file
-};
-
 /// one MJCF or URDF file placed in the world under a unique name.
 struct ModelConfig {
   std::string name;  ///< unique; prefixes every MJCF name of the model as "<name>/"
@@ -44,7 +36,7 @@ struct ModelConfig {
       file;  ///< absolute path after loading (relative paths resolve against the world file)
   PoseConfig pose;
   bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
-  ControllerConfig controller;
+  ControllerConfig controller;  ///< control/controller_config.h; type "" = none
 };
 
 /// a world-file light (see scene Light for units).

@@ -1,0 +1,132 @@
+// Simulation::GetState / SetState: a restart from a saved state is bit-exact (SimState).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/physics/simulation.h"
+
+namespace penumbra {
+namespace {
+
+// the bundled Go1 quadruped (12 torque motors, a free trunk) on a floor plane: it walks its
+// joints through a PD controller and its feet keep touching the floor (contacts)
+std::string QuadrupedOnFloorXml() {
+  const std::filesystem::path file =
+      std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "models" / "quadruped.xml";
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string xml = text.str();
+  const size_t at = xml.find("<worldbody>");
+  EXPECT_NE(at, std::string::npos);
+  xml.insert(at + std::string("<worldbody>").size(),
+             R"(<geom name="floor" type="plane" size="5 5 0.1"/>)");
+  return xml;
+}
+
+// a controller that keeps no memory: torques from the current state and sim time only
+class StatelessPd final : public Controller {
+ public:
+  StatelessPd() : Controller({"", 0, "test"}) {}
+  std::string type() const override { return "stateless_pd"; }
+  double rate_hz() const override { return 100; }  // every 5th step at 2 ms
+  std::vector<NameRequirement> RequiredNames() const override { return {}; }
+  void Compute(const ControlInput& in, std::span<double> ctrl) override {
+    const ModelInfo& info = in.model();
+    for (size_t a = 0; a < info.actuators.size(); ++a) {
+      const JointInfo& j = info.joints.at(info.actuators[a].joint);
+      const double target = info.keys.at(0).qpos[j.qpos_adr] +
+                            0.3 * std::sin(2 * M_PI * 1.5 * in.time_sec() + static_cast<double>(a));
+      ctrl[a] = 20.0 * (target - in.qpos()[j.qpos_adr]) - 0.5 * in.qvel()[j.dof_adr];
+    }
+  }
+
+ protected:
+  void OnInitialize(const ModelInfo&, const std::vector<int>&) override {}
+};
+
+Simulation LoadQuadruped() {
+  Simulation sim = Simulation::LoadFromString(QuadrupedOnFloorXml(), 0.002);
+  sim.AddController(std::make_unique<StatelessPd>());
+  return sim;
+}
+
+struct Trace {
+  std::vector<std::vector<double>> qpos, qvel;
+  size_t max_contacts = 0;
+};
+
+Trace StepAndRecord(Simulation* sim, int steps) {
+  Trace t;
+  for (int i = 0; i < steps; ++i) {
+    sim->Step();
+    t.qpos.emplace_back(sim->qpos().begin(), sim->qpos().end());
+    t.qvel.emplace_back(sim->qvel().begin(), sim->qvel().end());
+    if (i % 50 == 0) t.max_contacts = std::max(t.max_contacts, sim->Snapshot().contacts.size());
+  }
+  return t;
+}
+
+// EXPECT_EQ on every double: bit-identical, not close
+void ExpectIdentical(const Trace& a, const Trace& b) {
+  ASSERT_EQ(a.qpos.size(), b.qpos.size());
+  for (size_t i = 0; i < a.qpos.size(); ++i) {
+    for (size_t k = 0; k < a.qpos[i].size(); ++k)
+      ASSERT_EQ(a.qpos[i][k], b.qpos[i][k]) << "step " << i << " qpos[" << k << "]";
+    for (size_t k = 0; k < a.qvel[i].size(); ++k)
+      ASSERT_EQ(a.qvel[i][k], b.qvel[i][k]) << "step " << i << " qvel[" << k << "]";
+  }
+}
+
+TEST(SimulationState, RestoringMidRunRepeatsTheFollowingStepsBitForBit) {
+  Simulation sim = LoadQuadruped();
+  StepAndRecord(&sim, 301);  // lands, mid-way between two controller updates
+  const SimState saved = sim.GetState();
+  EXPECT_EQ(saved.step_count, 301);
+  EXPECT_EQ(saved.time_sec, sim.time());
+  const Trace first = StepAndRecord(&sim, 400);
+  ASSERT_GT(first.max_contacts, 0u);  // the feet touch the floor
+  // the run moved on: restoring has something to undo
+  ASSERT_NE(first.qpos.back(), std::vector<double>(saved.qpos));
+
+  sim.SetState(saved);
+  EXPECT_EQ(sim.step_count(), 301);
+  EXPECT_EQ(sim.time(), saved.time_sec);
+  ExpectIdentical(first, StepAndRecord(&sim, 400));
+}
+
+TEST(SimulationState, AFreshSimulationOfTheSameModelContinuesIdentically) {
+  Simulation a = LoadQuadruped();
+  StepAndRecord(&a, 257);
+  const SimState saved = a.GetState();
+  const Trace rest = StepAndRecord(&a, 300);
+
+  Simulation b = LoadQuadruped();
+  b.SetState(saved);
+  ExpectIdentical(rest, StepAndRecord(&b, 300));
+}
+
+TEST(SimulationState, AStateOfAnotherModelIsRefusedNamingTheField) {
+  Simulation sim = LoadQuadruped();
+  SimState s = sim.GetState();
+  s.qvel.pop_back();
+  try {
+    sim.SetState(s);
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("qvel has 17 entries; expected 18"), std::string::npos)
+        << e.what();
+  }
+  s = sim.GetState();
+  s.step_count = 10;  // time_sec is that of step 0
+  EXPECT_THROW(sim.SetState(s), Error);
+  s.controller_next_update.clear();
+  EXPECT_THROW(sim.SetState(s), Error);
+}
+
+}  // namespace
+}  // namespace penumbra
