@@ -124,18 +124,19 @@ void BM_MediaRealtime(benchmark::State& state) {
   rs.threads = 2;
   rs.seed = 7;
   auto r = MakeRenderer(w.scene, rs);
-  WorldSnapshot snap = w.snapshot;
+  const WorldSnapshot& snap = w.snapshot;
   const int parts = static_cast<int>(state.range(0));
-  if (parts != 0) snap.effects = MajorLike(parts, w.view.X_WO);
+  std::shared_ptr<const EffectsFrame> fx;
+  if (parts != 0) fx = MajorLike(parts, w.view.X_WO);
   CameraView view = w.view;
   RenderedFrame f;
-  for (int i = 0; i < 3; ++i) r->Render(snap, view, &f);  // warm-up
+  for (int i = 0; i < 3; ++i) r->Render(snap, fx.get(), view, &f);  // warm-up
   int64_t frame = 0;
   // process CPU time (all threads): on a shared, loaded machine the wall time is not the work.
   const std::clock_t c0 = std::clock();
   for (auto _ : state) {
     view.frame_index = frame++;
-    r->Render(snap, view, &f);
+    r->Render(snap, fx.get(), view, &f);
   }
   const double cpu_ms = 1e3 * static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC / frame;
   state.counters["frames_per_s"] =

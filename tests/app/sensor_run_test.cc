@@ -1,4 +1,4 @@
-// end-to-end sensors: world file `sensors:` -> composed IMU sensors -> SensorStage -> PCD and
+// end-to-end sensors: world file `sensors:` -> composed IMU sensors -> SensorSink -> PCD and
 // CSV files; post-composition errors name the sensor and key.
 
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
+#include "penumbra/output/pcd_writer.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_pattern.h"
-#include "penumbra/sensors/pcd_writer.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

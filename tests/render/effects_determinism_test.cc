@@ -62,35 +62,36 @@ EffectsFrame Adverse() {
   return fx;
 }
 
-RenderedFrame Render(const SceneDescription& s, const WorldSnapshot& snap,
-                     RenderSettings::Tier tier, int threads, uint64_t seed) {
+RenderedFrame Render(const SceneDescription& s, const EffectsFrame* fx, RenderSettings::Tier tier,
+                     int threads, uint64_t seed) {
   RenderSettings rs = TierSettings(tier, 4, threads);
   rs.seed = seed;
   auto r = MakeRenderer(s, rs);
   CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60, true, true, true);
   view.exposure_time_sec = 0.02;
   RenderedFrame f;
-  r->Render(snap, view, &f);
+  r->Render(IdentitySnapshot(s), fx, view, &f);
   return f;
 }
 
 TEST(EffectsDeterminismTest, SameEffectsSameImageAnyThreadCount) {
   const SceneDescription s = LitScene();
-  const WorldSnapshot snap = SnapshotWith(s, Adverse());
+  const EffectsFrame adverse = Adverse();
+  const EffectsFrame* fx = &adverse;
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    const RenderedFrame a = Render(s, snap, tier, 1, 3);
-    const RenderedFrame b = Render(s, snap, tier, 1, 3);
-    const RenderedFrame c = Render(s, snap, tier, 3, 3);
+    const RenderedFrame a = Render(s, fx, tier, 1, 3);
+    const RenderedFrame b = Render(s, fx, tier, 1, 3);
+    const RenderedFrame c = Render(s, fx, tier, 3, 3);
     EXPECT_EQ(a.radiance.data, b.radiance.data);
     EXPECT_EQ(a.radiance.data, c.radiance.data);
     EXPECT_EQ(a.rgb.data, c.rgb.data);
     for (float x : a.radiance.data) ASSERT_TRUE(std::isfinite(x));
     // a different seed gives a different image (media are sampled per pixel stream).
-    const RenderedFrame d = Render(s, snap, tier, 1, 4);
+    const RenderedFrame d = Render(s, fx, tier, 1, 4);
     EXPECT_NE(a.radiance.data, d.radiance.data);
     // and the effects change the image at all.
-    const RenderedFrame clear = Render(s, IdentitySnapshot(s), tier, 1, 3);
+    const RenderedFrame clear = Render(s, nullptr, tier, 1, 3);
     EXPECT_NE(a.radiance.data, clear.radiance.data);
   }
 }
@@ -99,11 +100,12 @@ TEST(EffectsDeterminismTest, NullOrEmptyEffectsLeaveImagesUnchanged) {
   const SceneDescription s = LitScene();
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    const RenderedFrame none = Render(s, IdentitySnapshot(s), tier, 2, 1);
-    const RenderedFrame empty = Render(s, SnapshotWith(s, EffectsFrame()), tier, 2, 1);
+    const EffectsFrame empty_fx;
+    const RenderedFrame none = Render(s, nullptr, tier, 2, 1);
+    const RenderedFrame empty = Render(s, &empty_fx, tier, 2, 1);
     EffectsFrame no_particles;  // a particle set without particles: active, draws nothing
     no_particles.particles.emplace_back();
-    const RenderedFrame hollow = Render(s, SnapshotWith(s, no_particles), tier, 2, 1);
+    const RenderedFrame hollow = Render(s, &no_particles, tier, 2, 1);
     EXPECT_EQ(none.radiance.data, empty.radiance.data);
     EXPECT_EQ(none.rgb.data, empty.rgb.data);
     EXPECT_EQ(none.radiance.data, hollow.radiance.data);

@@ -31,7 +31,7 @@ TEST(EffectsKoschmiederTest, ContrastFallsExponentiallyWithDistance) {
     const double fovy = 2 * std::atan(0.6 / d) * 180 / M_PI;
     const CameraView view = MakeView(CameraLookingAlongX(), 33, 33, fovy, true, false, true);
     RenderedFrame f;
-    r->Render(SnapshotWith(s, fx), view, &f);
+    r->Render(IdentitySnapshot(s), &fx, view, &f);
     ASSERT_NE(*f.geom_id.at(16, 16), -1);
     ASSERT_EQ(*f.geom_id.at(0, 0), -1);
     for (int c = 0; c < 3; ++c) {
@@ -71,7 +71,7 @@ TEST(EffectsKoschmiederTest, LightInScatterTiersAgree) {
     rs.max_bounces = 1;
     auto r = MakeRenderer(s, rs);
     RenderedFrame f;
-    r->Render(SnapshotWith(s, fx), view, &f);
+    r->Render(IdentitySnapshot(s), &fx, view, &f);
     mean[k++] = MeanRadiance(f.radiance, 0, 144, 0, 96);
   }
   EXPECT_GT(mean[1], 0.0);

@@ -27,22 +27,22 @@ SceneDescription SunFloor() {
   return s;
 }
 
-double CentreRadiance(const SceneDescription& s, const WorldSnapshot& snap,
+double CentreRadiance(const SceneDescription& s, const EffectsFrame* fx,
                       RenderSettings::Tier tier = RenderSettings::Tier::kRealtime) {
   auto r = MakeRenderer(s, TierSettings(tier, 16));
   const CameraView view = MakeView(CameraLookingDown({0, 0, 2}), 9, 9, 20, true, false, false);
   RenderedFrame f;
-  r->Render(snap, view, &f);
+  r->Render(IdentitySnapshot(s), fx, view, &f);
   return f.radiance.at(4, 4)[1];
 }
 
 TEST(EffectsLightingTest, IntensityScaleAndExtraLights) {
   const SceneDescription s = SunFloor();
-  const double base = CentreRadiance(s, IdentitySnapshot(s));
+  const double base = CentreRadiance(s, nullptr);
   EXPECT_NEAR(base, 1000 * 0.5 / M_PI, 0.01 * base);
   EffectsFrame fx;
   fx.light_intensity_scale = {0.25f};
-  EXPECT_NEAR(CentreRadiance(s, SnapshotWith(s, fx)), 0.25 * base, 1e-3 * base);
+  EXPECT_NEAR(CentreRadiance(s, &fx), 0.25 * base, 1e-3 * base);
   // blackout plus a flashlight: a spot 1 m above the floor pointing down, 200 cd on its axis.
   fx.light_intensity_scale = {0.0f};
   Light spot;
@@ -53,18 +53,18 @@ TEST(EffectsLightingTest, IntensityScaleAndExtraLights) {
   fx.extra_lights.push_back(spot);
   for (RenderSettings::Tier tier :
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
-    const double L = CentreRadiance(s, SnapshotWith(s, fx), tier);
+    const double L = CentreRadiance(s, &fx, tier);
     EXPECT_NEAR(L, 200 * 0.5 / M_PI, 0.02 * 200 * 0.5 / M_PI);
   }
 }
 
 TEST(EffectsLightingTest, WetnessDarkensUpwardSurfaces) {
   const SceneDescription s = SunFloor();
-  const double dry = CentreRadiance(s, IdentitySnapshot(s));
+  const double dry = CentreRadiance(s, nullptr);
   EffectsFrame fx;
   fx.surface_wetness = 1.0f;
   // fully rough: only the albedo changes (x 0.3).
-  EXPECT_NEAR(CentreRadiance(s, SnapshotWith(s, fx)), 0.3 * dry, 1e-3 * dry);
+  EXPECT_NEAR(CentreRadiance(s, &fx), 0.3 * dry, 1e-3 * dry);
   PbrParams p;
   p.base_color = Eigen::Vector3f::Constant(0.5f);
   p.roughness = 0.6f;
@@ -87,12 +87,12 @@ TEST(EffectsLightingTest, SkyScaleAndMovedSun) {
   const double base = f.radiance.at(4, 4)[1];
   EffectsFrame fx;
   fx.sky_luminance_scale = 0.1f;
-  r->Render(SnapshotWith(s, fx), view, &f);
+  r->Render(IdentitySnapshot(s), &fx, view, &f);
   EXPECT_NEAR(f.radiance.at(4, 4)[1], 0.1 * base, 1e-3 * base);
   // the sun moves to just above the horizon in +x: the sky there brightens as the model says.
   fx.sky_luminance_scale = 1.0f;
   fx.sun_direction_W = Eigen::Vector3d(1, 0, 0.2).normalized();
-  r->Render(SnapshotWith(s, fx), view, &f);
+  r->Render(IdentitySnapshot(s), &fx, view, &f);
   Sky moved = s.sky;
   moved.sun_direction_W = *fx.sun_direction_W;
   const Eigen::Vector3f expected = SkyModel(moved).Radiance(Eigen::Vector3f(1, 0, 0));

@@ -40,13 +40,6 @@ inline HomogeneousMedium Fog(float sigma_t, float albedo, float g = 0.0f) {
   return m;
 }
 
-/// snapshot of `s` with `fx` as its effects.
-inline WorldSnapshot SnapshotWith(const SceneDescription& s, const EffectsFrame& fx) {
-  WorldSnapshot snap = IdentitySnapshot(s);
-  snap.effects = std::make_shared<const EffectsFrame>(fx);
-  return snap;
-}
-
 /// mean of channel c of the radiance over the pixels [u0, u1) x [v0, v1).
 inline double MeanRadiance(const ImageF& img, int u0, int u1, int v0, int v1, int c = 1) {
   double sum = 0;

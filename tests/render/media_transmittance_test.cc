@@ -28,7 +28,7 @@ double RenderedOverExpected(RenderSettings::Tier tier, double distance, float si
   auto r = MakeRenderer(s, TierSettings(tier, spp));
   const CameraView view = MakeView(CameraLookingAlongX(), kW, kH, kFovy, true, true, false);
   RenderedFrame f;
-  r->Render(SnapshotWith(s, fx), view, &f);
+  r->Render(IdentitySnapshot(s), &fx, view, &f);
   double got = 0, want = 0;
   for (int v = 0; v < kH; ++v)
     for (int u = 0; u < kW; ++u) {
@@ -68,7 +68,7 @@ TEST(MediaTransmittanceTest, MorGivesFivePercentTransmittance) {
   auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   const CameraView view = MakeView(CameraLookingAlongX(), 9, 9, 2, true, false, false);
   RenderedFrame f;
-  r->Render(SnapshotWith(s, fx), view, &f);
+  r->Render(IdentitySnapshot(s), &fx, view, &f);
   EXPECT_NEAR(f.radiance.at(4, 4)[1] / Le, 0.05, 0.05 * 0.01);
 }
 
@@ -152,7 +152,7 @@ TEST(MediaTransmittanceTest, TiersAgreeBehindDensityRamp) {
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
     auto r = MakeRenderer(s, TierSettings(tier, 256));
     RenderedFrame f;
-    r->Render(SnapshotWith(s, fx), view, &f);
+    r->Render(IdentitySnapshot(s), &fx, view, &f);
     mean[k++] = MeanRadiance(f.radiance, 0, kW, 0, kH);
   }
   // reference for the centre ray (off-axis rays are up to 2.7 % longer in the box).
@@ -184,7 +184,7 @@ TEST(MediaTransmittanceTest, GridEmissionIntegratesAlongTheRay) {
        {RenderSettings::Tier::kRealtime, RenderSettings::Tier::kPathtraced}) {
     auto r = MakeRenderer(s, TierSettings(tier, 128));
     RenderedFrame f;
-    r->Render(SnapshotWith(s, fx), view, &f);
+    r->Render(IdentitySnapshot(s), &fx, view, &f);
     const double got = MeanRadiance(f.radiance, 0, kW, 0, kH, 1);
     EXPECT_NEAR(got, expected, 0.02 * expected) << static_cast<int>(tier);
     // the channels keep the emission's colour.

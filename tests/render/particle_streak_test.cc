@@ -39,7 +39,7 @@ int StreakSpan(double depth, double speed, double exposure, int row, double* exp
   fx.particles.push_back(sparks);
   auto r = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   static RenderedFrame f;
-  r->Render(SnapshotWith(s, fx), view, &f);
+  r->Render(IdentitySnapshot(s), &fx, view, &f);
   if (img_out) *img_out = &f.radiance;
   *expected_px = k.fx * speed * exposure / depth;
   int first = -1, last = -1;
@@ -79,14 +79,14 @@ TEST(ParticleStreakTest, CoverageFollowsExposureFraction) {
   fx.particles.push_back(sparks);
   auto rr = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
   RenderedFrame f;
-  rr->Render(SnapshotWith(s, fx), view, &f);
+  rr->Render(IdentitySnapshot(s), &fx, view, &f);
   const double alpha = 2 * r / (v * 0.01 + 2 * r);
   EXPECT_NEAR(f.radiance.at(32, 23)[1], 4 * alpha, 1e-4);
   // a still particle covers fully.
   fx.particles[0].velocity_W[0].setZero();
   fx.particles[0].position_W[0] = Eigen::Vector3f(3, 0, 0);
   fx.particles[0].radius_m[0] = 0.05f;
-  rr->Render(SnapshotWith(s, fx), view, &f);
+  rr->Render(IdentitySnapshot(s), &fx, view, &f);
   EXPECT_NEAR(f.radiance.at(32, 23)[1], 4.0, 1e-4);
 }
 
@@ -106,7 +106,7 @@ TEST(ParticleStreakTest, RainAndSnowShading) {
     fx.particles.push_back(p);
     auto rr = MakeRenderer(s, TierSettings(RenderSettings::Tier::kRealtime));
     RenderedFrame f;
-    rr->Render(SnapshotWith(s, fx), view, &f);
+    rr->Render(IdentitySnapshot(s), &fx, view, &f);
     // no lights: colour x sphere-average sky radiance (uniform sky, within the 1 % of the
     // irradiance table), over the sky behind it.
     EXPECT_NEAR(f.radiance.at(32, 23)[1], 0.8 * 0.5, 0.01) << static_cast<int>(kind);

@@ -44,8 +44,8 @@ DepthStats MeasureWall(const std::string& preset, double z) {
   CameraImager imager(spec, cfg, rs, 0, scene);
   const WorldSnapshot snap = testing::Snapshot(scene, 0);
   CameraImages img;
-  imager.Capture(renderer.get(), snap, testing::LookingAlongX(Eigen::Vector3d::Zero()), nullptr,
-                 Pose::Identity(), 3, &img);
+  imager.Capture(renderer.get(), snap, nullptr, testing::LookingAlongX(Eigen::Vector3d::Zero()),
+                 nullptr, Pose::Identity(), 3, &img);
   const DepthNoiseModel model = DepthNoisePreset(cfg.depth_noise, "d");
   DepthStats st;
   double s = 0, s2 = 0, m2 = 0;

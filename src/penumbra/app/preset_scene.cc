@@ -39,7 +39,7 @@ void PresetScene::StepTo(double t_sec) {
 
 RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTiming* timing) {
   const CameraSpec& cam = session->scene().cameras.at(camera);
-  WorldSnapshot snap = session->sim().Snapshot();
+  const WorldSnapshot snap = session->sim().Snapshot();
   CameraView view;
   view.X_WO = CameraPoseInWorld(cam, snap);
   view.intrinsics = cam.intrinsics;
@@ -56,12 +56,13 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTimin
   view.camera_index = camera;
   RenderTiming t;
   double w0 = WallSeconds(), c0 = CpuSeconds();
-  snap.effects = session->effects().Evaluate(snap, view.X_WO.translation());
+  const std::shared_ptr<const EffectsFrame> fx =
+      session->effects().Evaluate(snap, view.X_WO.translation());
   double w1 = WallSeconds(), c1 = CpuSeconds();
   t.effects_wall = w1 - w0;
   t.effects_cpu = c1 - c0;
   RenderedFrame frame;
-  session->renderer()->Render(snap, view, &frame);
+  session->renderer()->Render(snap, fx.get(), view, &frame);
   t.render_wall = WallSeconds() - w1;
   t.render_cpu = CpuSeconds() - c1;
   if (timing) *timing = t;

@@ -9,11 +9,13 @@
 #include <filesystem>
 
 #include "penumbra/app/bench.h"
-#include "penumbra/app/sensor_stage.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/session/physics_source.h"
+#include "penumbra/session/sensor_sink.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -164,30 +166,38 @@ int BenchSensors(const SensorBenchOptions& options) {
                points / options.scans);
   }
 
-  // IMU / MuJoCo sensors / ground truth: physics with and without the sensor stage
+  // IMU / MuJoCo sensors / ground truth: physics with and without the sensor sink, through the
+  // run's pipeline (pipeline/sim_loop.h); the wall time includes writing the sensor files
   const auto run = [&](bool with_sensors, double* snapshot_us) {
     const std::unique_ptr<Session> loaded = LoadWithSensors(world);
     Simulation& s = loaded->sim();
     const std::string dir =
         (std::filesystem::temp_directory_path() / "penumbra_bench_sensors").string();
-    std::unique_ptr<SensorStage> stage;
-    if (with_sensors) stage = std::make_unique<SensorStage>(world, s, scene, dir);
-    int64_t snaps_taken = 0;
-    double snap_sec = 0;
-    const auto t0 = Clock::now();
-    while (s.time() < options.seconds - 1e-9) {
-      if (stage && stage->Due(s.time())) {
-        const auto ts = Clock::now();
-        const WorldSnapshot snap = s.Snapshot();
-        snap_sec += Since(ts);
-        ++snaps_taken;
-        stage->Process(snap);
+    // times the snapshots the sensors ask for (Simulation::Snapshot, kFull)
+    class TimedSource : public PhysicsSource {
+     public:
+      using PhysicsSource::PhysicsSource;
+      std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override {
+        const auto ts = std::chrono::steady_clock::now();
+        auto snap = PhysicsSource::Snapshot(content);
+        sec += Since(ts);
+        ++taken;
+        return snap;
       }
-      s.Step();
-    }
+      double sec = 0;
+      int64_t taken = 0;
+    } source(&s);
+    std::unique_ptr<SensorSink> sink;
+    if (with_sensors) sink = std::make_unique<SensorSink>(world, s, scene, dir);
+    SimLoopOptions loop_options;
+    loop_options.end_time_sec = options.seconds;
+    SimLoop loop(&source, loop_options);
+    if (sink) loop.AddSink(sink.get());
+    const auto t0 = Clock::now();
+    const LoopFinish finish = loop.Run();
     const double wall = Since(t0);
-    if (stage) stage->Finish();
-    if (snapshot_us) *snapshot_us = snaps_taken ? 1e6 * snap_sec / snaps_taken : 0;
+    if (finish.error) std::rethrow_exception(finish.error);
+    if (snapshot_us) *snapshot_us = source.taken ? 1e6 * source.sec / source.taken : 0;
     std::filesystem::remove_all(dir);
     return wall;
   };

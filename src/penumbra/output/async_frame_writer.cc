@@ -112,6 +112,10 @@ void AsyncFrameWriter::WorkerLoop() {
     job.frame.rgb = {};
     job.frame.depth_m = {};
     job.frame.geom_id = {};
+    job.frame.range_m = {};
+    job.frame.normal_O = {};
+    job.frame.body_id = {};
+    job.frame.semantic_class = {};
 
     lock.lock();
     if (failure) {

@@ -19,6 +19,11 @@ struct CameraFrame {
   ImageU8 rgb;                   ///< (H x W x 3) uint8 sRGB
   ImageF depth_m;    ///< (H x W x 1) float z-depth along the optical axis in m, 0 = no hit
   ImageI32 geom_id;  ///< (H x W x 1) MuJoCo geom id of the first hit, -1 = background
+  /// ground truth from the pixel-centre rays (render/renderer.h RenderedFrame):
+  ImageF range_m;    ///< (H x W x 1) distance optical centre -> hit along the ray, m; 0 = no hit
+  ImageF normal_O;   ///< (H x W x 3) unit normal facing the camera, optical frame; 0 = no hit
+  ImageI32 body_id;  ///< (H x W x 1) body index of the hit, -1 = background
+  ImageI32 semantic_class;  ///< (H x W x 1) semantic class id of the hit, 0 = none
 };
 
 }  // namespace penumbra

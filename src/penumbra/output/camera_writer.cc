@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <system_error>
@@ -86,6 +87,26 @@ fs::path CameraFolder(const std::string& camera) {
   return folder;
 }
 
+ImageU8 NormalsToRgb8(const ImageF& n) {
+  ImageU8 rgb(n.width, n.height, 3);
+  for (size_t i = 0; i < n.data.size(); ++i) {
+    const float v = std::clamp((n.data[i] + 1.0f) * 0.5f * 255.0f, 0.0f, 255.0f);
+    rgb.data[i] = static_cast<uint8_t>(std::lround(v));
+  }
+  return rgb;
+}
+
+ImageU16 IdsToU16(const ImageI32& ids, int offset, const std::string& what) {
+  ImageU16 out(ids.width, ids.height, 1);
+  for (size_t i = 0; i < ids.data.size(); ++i) {
+    const int64_t v = static_cast<int64_t>(ids.data[i]) + offset;
+    if (v < 0 || v > 65535)
+      throw Error(what + " id " + std::to_string(ids.data[i]) + " does not fit a 16-bit PNG");
+    out.data[i] = static_cast<uint16_t>(v);
+  }
+  return out;
+}
+
 std::string FrameFileName(int64_t index) { return fmt::format("{:06d}.png", index); }
 
 std::string FramesCsvRow(const CameraFrame& frame) {
@@ -121,6 +142,10 @@ CameraWriter::CameraWriter(const std::string& output_dir, const std::string& cam
   if (outputs_.rgb) CreateOutputFolder(output_dir, rel / "rgb");
   if (outputs_.depth) CreateOutputFolder(output_dir, rel / "depth");
   if (outputs_.segmentation) CreateOutputFolder(output_dir, rel / "segmentation");
+  if (outputs_.range) CreateOutputFolder(output_dir, rel / "range");
+  if (outputs_.normals) CreateOutputFolder(output_dir, rel / "normals");
+  if (outputs_.instance_segmentation) CreateOutputFolder(output_dir, rel / "instance_segmentation");
+  if (outputs_.semantic_segmentation) CreateOutputFolder(output_dir, rel / "semantic_segmentation");
 
   // ordered_json keeps the key order below
   nlohmann::ordered_json j;
@@ -197,6 +222,31 @@ void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string&
       throw Error(fmt::format("camera '{}' frame {}: {}", camera_, frame.index, e.what()));
     }
     WritePngGray16((folder_ / "segmentation" / name).string(), seg, png_options_);
+    written->push_back(folder_ / "segmentation" / name);
+  }
+  // ground truth beyond the geom ids (the same pixel-centre rays)
+  auto write16 = [&](const char* kind, const ImageU16& img) {
+    WritePngGray16((folder_ / kind / name).string(), img, png_options_);
+    written->push_back(folder_ / kind / name);
+  };
+  if (outputs_.range) {
+    CheckFrameImage(frame.range_m, 1, intrinsics_, camera_, frame.index, "range");
+    write16("range", DepthToMillimetres(frame.range_m));
+  }
+  if (outputs_.normals) {
+    CheckFrameImage(frame.normal_O, 3, intrinsics_, camera_, frame.index, "normals");
+    WritePngRgb8((folder_ / "normals" / name).string(), NormalsToRgb8(frame.normal_O),
+                 png_options_);
+    written->push_back(folder_ / "normals" / name);
+  }
+  if (outputs_.instance_segmentation) {
+    CheckFrameImage(frame.body_id, 1, intrinsics_, camera_, frame.index, "instance_segmentation");
+    write16("instance_segmentation", IdsToU16(frame.body_id, 1, "body"));
+  }
+  if (outputs_.semantic_segmentation) {
+    CheckFrameImage(frame.semantic_class, 1, intrinsics_, camera_, frame.index,
+                    "semantic_segmentation");
+    write16("semantic_segmentation", IdsToU16(frame.semantic_class, 0, "semantic class"));
   }
 }
 

@@ -5,6 +5,12 @@
 //   DIR/<camera>/rgb/NNNNNN.png           8-bit sRGB colour
 //   DIR/<camera>/depth/NNNNNN.png         16-bit z-depth in millimetres (see DepthToMillimetres)
 //   DIR/<camera>/segmentation/NNNNNN.png  16-bit MuJoCo geom id + 1, 0 = background
+//   DIR/<camera>/range/NNNNNN.png         16-bit range along the pixel ray in millimetres
+//                                         (as depth), 0 = no hit
+//   DIR/<camera>/normals/NNNNNN.png       8-bit rgb round((n_O + 1) / 2 * 255) of the unit normal
+//                                         facing the camera in the optical frame
+//   DIR/<camera>/instance_segmentation/NNNNNN.png  16-bit body index + 1, 0 = background
+//   DIR/<camera>/semantic_segmentation/NNNNNN.png  16-bit semantic class id, 0 = none
 //   DIR/<camera>/frames.csv               frame,time_sec,x,y,z,qw,qx,qy,qz per frame
 //   DIR/<camera>/intrinsics.json          pinhole intrinsics (OpenCV convention)
 //
@@ -49,6 +55,13 @@ std::string FrameFileName(int64_t index);
 /// (for qw == 0 the first non-zero of qx, qy, qz is positive). numbers are printed in the
 /// shortest form that reads back to the same double (fmt "{}").
 std::string FramesCsvRow(const CameraFrame& frame);
+
+/// (H x W x 3) unit normals in [-1, 1] -> (H x W x 3) uint8 round((n + 1) / 2 * 255), clamped.
+ImageU8 NormalsToRgb8(const ImageF& normal_O);
+
+/// integer ids (H x W x 1) -> (H x W x 1) uint16 id + offset.
+/// @throws Error "<what> id <id> does not fit a 16-bit PNG" when id + offset is outside 0..65535.
+ImageU16 IdsToU16(const ImageI32& ids, int offset, const std::string& what);
 
 /// the frames.csv header line (with '\n').
 inline constexpr const char* kFramesCsvHeader = "frame,time_sec,x,y,z,qw,qx,qy,qz\n";

@@ -108,8 +108,8 @@ LightSampler::LightSampler(const SceneDescription& scene)
   }
 }
 
-void LightSampler::Update(const WorldSnapshot& snapshot) {
-  const EffectsFrame* fx = snapshot.effects.get();
+void LightSampler::Update(const WorldSnapshot& snapshot, const EffectsFrame* effects) {
+  const EffectsFrame* fx = effects;
   lights_.resize(sources_.size());
   for (size_t i = 0; i < sources_.size(); ++i) {
     lights_[i].intensity_rgb = base_intensity_rgb_[i];

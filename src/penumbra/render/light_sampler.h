@@ -19,16 +19,17 @@
 // lights (mjcf_light >= 0) from light_position_W / light_direction_W, others from the pose
 // of their body, X_WB position_B and R_WB direction_B.
 //
-// effects (WorldSnapshot::effects, scene/effects_frame.h): Update multiplies the intensity of
-// scene light i by EffectsFrame::light_intensity_scale[i] and appends EffectsFrame::extra_lights
-// (world frame, or posed by their body) after the scene's lights, so light indices
-// [0, num_scene_lights()) keep their meaning. without effects the lights are exactly the
-// scene's.
+// effects (the EffectsFrame given to Update, scene/effects_frame.h): Update multiplies the
+// intensity of scene light i by EffectsFrame::light_intensity_scale[i] and appends
+// EffectsFrame::extra_lights (world frame, or posed by their body) after the scene's lights, so
+// light indices [0, num_scene_lights()) keep their meaning. without effects the lights are exactly
+// the scene's.
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "penumbra/render/shading_lanes.h"
+#include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -70,11 +71,11 @@ class LightSampler {
   /// keeps the active lights of `scene` with non-zero intensity.
   explicit LightSampler(const SceneDescription& scene);
 
-  /// poses every light from `snapshot` and applies its effects (see above).
+  /// poses every light from `snapshot` and applies `effects` (see above; null = none).
   /// @throws Error if an MJCF light id or body index is out of the snapshot's range;
   /// ConfigError for a negative or non-finite intensity scale
   /// (effects.light_intensity_scale[i]); scales beyond the scene's lights are ignored.
-  void Update(const WorldSnapshot& snapshot);
+  void Update(const WorldSnapshot& snapshot, const EffectsFrame* effects = nullptr);
 
   /// number of lights (active, non-zero), extra lights of the effects included.
   int size() const { return static_cast<int>(lights_.size()); }

@@ -18,12 +18,11 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
 
 MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
 
-void MediaFrame::Prepare(const WorldSnapshot& snapshot, const Camera& camera,
-                         const CameraView& view, const RenderSettings& settings,
-                         const LightSampler& lights, const RayScene& rays, const SkyModel& base_sky,
-                         ThreadPool* pool) {
-  const EffectsFrame* fx =
-      snapshot.effects && !snapshot.effects->empty() ? snapshot.effects.get() : nullptr;
+void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                         const Camera& camera, const CameraView& view,
+                         const RenderSettings& settings, const LightSampler& lights,
+                         const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool) {
+  const EffectsFrame* fx = effects && !effects->empty() ? effects : nullptr;
   active_ = fx != nullptr;
   sky_ = &base_sky;
   realtime_ok_ = false;

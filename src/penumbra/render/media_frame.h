@@ -44,14 +44,14 @@ class MediaFrame {
   /// `scene` (the renderer's copy) must outlive this object.
   explicit MediaFrame(const SceneDescription& scene);
 
-  /// prepares the effects of `snapshot` (none when snapshot.effects is null or empty) for
+  /// prepares `effects` at `snapshot` (none when `effects` is null or empty) for
   /// `view` (its exposure time, camera and frame index) seen through `camera`. `lights` must
   /// already be posed for the snapshot and `rays` updated. realtime light volumes are built only
   /// for that tier.
   /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
-  void Prepare(const WorldSnapshot& snapshot, const Camera& camera, const CameraView& view,
-               const RenderSettings& settings, const LightSampler& lights, const RayScene& rays,
-               const SkyModel& base_sky, ThreadPool* pool);
+  void Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects, const Camera& camera,
+               const CameraView& view, const RenderSettings& settings, const LightSampler& lights,
+               const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool);
 
   /// any effect is active this frame.
   bool active() const { return active_; }

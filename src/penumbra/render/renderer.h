@@ -10,6 +10,7 @@
 #include "penumbra/core/image.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/render_settings.h"
+#include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -57,10 +58,17 @@ struct RenderedFrame {
 class Renderer {
  public:
   virtual ~Renderer() = default;
-  /// renders `view` of the world posed by `snapshot` into `out`.
-  /// @throws Error if the snapshot does not match the scene (body counts differ).
-  virtual void Render(const WorldSnapshot& snapshot, const CameraView& view,
-                      RenderedFrame* out) = 0;
+  /// renders `view` of the world posed by `snapshot` under `effects` into `out`. `effects`
+  /// are the adverse conditions this viewer sees at the snapshot's time (media, particles,
+  /// light changes; scene/effects_frame.h), null or empty = clear conditions.
+  /// @throws Error if the snapshot does not match the scene (body counts differ);
+  ///         ConfigError for effects out of range (e.g. a negative light scale).
+  virtual void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                      const CameraView& view, RenderedFrame* out) = 0;
+  /// Render under clear conditions (no effects).
+  void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) {
+    Render(snapshot, nullptr, view, out);
+  }
 };
 
 }  // namespace penumbra

@@ -1,14 +1,16 @@
 #pragma once
 // the moving part of a world at one instant: what the renderer and sensors need to
 // draw a frame, copied out of the physics state so that rendering can run on
-// another thread, or later from a recording, without the physics engine.
+// another thread, or later from a recording, without the physics engine. a snapshot is never
+// changed once made (shared as std::shared_ptr<const WorldSnapshot> between threads); what a
+// viewer sees beyond it (media, particles, light changes: scene/effects_frame.h) depends on the
+// viewer and travels beside it.
 
+#include <Eigen/Core>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
 
@@ -46,10 +48,6 @@ struct WorldSnapshot {
   };
   /// active contacts at this instant (ground truth for evaluation).
   std::vector<Contact> contacts;
-  /// adverse conditions at this instant (media, particles, lighting changes), filled by the
-  /// effects stage after physics; null = clear conditions. shared so that queued snapshots
-  /// do not copy voxel grids.
-  std::shared_ptr<const EffectsFrame> effects;
 };
 
 }  // namespace penumbra

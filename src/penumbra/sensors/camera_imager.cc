@@ -97,7 +97,8 @@ CameraImager::CameraImager(const CameraSpec& spec, const CameraSensorConfig& con
     pool_ = std::make_unique<ThreadPool>(render_settings.threads);
 }
 
-void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const Pose& X_WO_start,
+void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
+                           const EffectsFrame* effects, const Pose& X_WO_start,
                            const WorldSnapshot* end, const Pose& X_WO_end, int64_t frame_index,
                            CameraImages* out) {
   const CameraSensorConfig& c = config_;
@@ -144,7 +145,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
       snap = &interp;
     }
     RenderedFrame* target = k == truth_k ? &out->truth : &sub;
-    renderer->Render(*snap, view, target);
+    renderer->Render(*snap, effects, view, target);
     if (want_rgb) {
       const std::vector<float>& r = target->radiance.data;
       for (size_t i = 0; i < r.size(); ++i) accum_.data[i] += r[i];
@@ -184,7 +185,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     } else {
       film_.Develop(accum_, ev, pool_.get(), &out->rgb);
     }
-    if (c.lens_droplets && IsRaining(start.effects.get()))
+    if (c.lens_droplets && IsRaining(effects))
       ApplyLensDroplets(c.lens_droplet_count, start.time_sec,
                         HashKeys(settings_.seed, camera_index_, 3), &out->rgb);
     if (c.jpeg_quality > 0) RoundTripJpeg(c.jpeg_quality, &out->rgb);
@@ -220,8 +221,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
     }
     in.reflectance = &reflectance;
     ImageF transmittance;
-    if (start.effects &&
-        (!start.effects->homogeneous_media.empty() || !start.effects->grid_media.empty())) {
+    if (effects && (!effects->homogeneous_media.empty() || !effects->grid_media.empty())) {
       CameraMotion m;
       if (moving) {
         m.X_WO_end = X_WO_end;
@@ -229,9 +229,9 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start, const
         m.time_sec = (truth_k + 0.5) * T / n;
         m.line_time_sec = c.rolling_shutter_line_time_sec;
       }
-      transmittance = DepthTransmittance(
-          out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *start.effects,
-          HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
+      transmittance =
+          DepthTransmittance(out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *effects,
+                             HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
       in.transmittance = &transmittance;
     }
     ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,

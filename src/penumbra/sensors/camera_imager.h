@@ -14,7 +14,7 @@
 //   - ground-truth images (depth, range, normals, segmentations) come from the pixel-centre rays
 //     of sub-frame n / 2 (s = T / 2 for odd n): exact, never blended.
 // particle streaks (rain, snow, sparks) are drawn by the renderer over the exposure of each
-// sub-frame from the capture snapshot's effects.
+// sub-frame from the effects given to Capture (those of the capture instant).
 //
 // exposure: the renderer's auto or manual EV100 (render/film.h) of the averaged radiance is the
 // target; with auto_exposure_time_constant_sec = tau > 0 the EV used adapts as
@@ -68,13 +68,14 @@ class CameraImager {
                const RenderSettings& render_settings, int camera_index,
                const SceneDescription& scene);
 
-  /// renders and forms frame `frame_index` captured at `start`. `X_WO_start` / `X_WO_end` are
-  /// the optical frame at `start` and at `end`; `end` = null (or not later than start) means
-  /// nothing moves during the exposure.
+  /// renders and forms frame `frame_index` captured at `start`. `effects` are what this camera
+  /// sees at `start` (scene/effects_frame.h; null = clear conditions), used for every
+  /// sub-frame. `X_WO_start` / `X_WO_end` are the optical frame at `start` and at `end`;
+  /// `end` = null (or not later than start) means nothing moves during the exposure.
   /// @throws Error from the renderer.
-  void Capture(Renderer* renderer, const WorldSnapshot& start, const Pose& X_WO_start,
-               const WorldSnapshot* end, const Pose& X_WO_end, int64_t frame_index,
-               CameraImages* out);
+  void Capture(Renderer* renderer, const WorldSnapshot& start, const EffectsFrame* effects,
+               const Pose& X_WO_start, const WorldSnapshot* end, const Pose& X_WO_end,
+               int64_t frame_index, CameraImages* out);
 
   const CameraSpec& spec() const { return spec_; }
   const CameraSensorConfig& config() const { return config_; }

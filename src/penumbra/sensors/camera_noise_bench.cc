@@ -88,13 +88,12 @@ std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames) {
   std::vector<std::pair<std::string, double>> out;
   for (auto& [name, cfg] : options) {
     CameraImager imager(spec, cfg, rs, 0, scene);
-    WorldSnapshot start = a;
-    if (name == "lens_droplets" || name == "all") start.effects = wet;
+    const EffectsFrame* fx = name == "lens_droplets" || name == "all" ? wet.get() : nullptr;
     const bool moving = cfg.motion_blur_samples > 1 || cfg.rolling_shutter_line_time_sec > 0;
     CameraImages img;
     const auto t0 = std::chrono::steady_clock::now();
     for (int f = 0; f < frames; ++f)
-      imager.Capture(renderer.get(), start, X0, moving ? &b : nullptr, X1, f, &img);
+      imager.Capture(renderer.get(), a, fx, X0, moving ? &b : nullptr, X1, f, &img);
     const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.emplace_back(name, frames / std::max(sec, 1e-9));
   }

@@ -12,7 +12,8 @@
 //   3. Bind(scene): labels agent geoms (Geom::semantic_class, effects/agent_path.h) and
 //      builds the EffectsEngine on the final scene;
 //   4. per rendered frame, after physics: Evaluate(snapshot, camera position) -> the
-//      EffectsFrame for WorldSnapshot::effects. effects never feed back into physics.
+//      EffectsFrame that camera sees, passed beside the (immutable) snapshot to
+//      Renderer::Render. effects never feed back into physics.
 //
 // how a preset (world/adversity_preset.h) is placed in a world:
 //   floor      the highest static upward-facing plane at or below the lowest robot's root

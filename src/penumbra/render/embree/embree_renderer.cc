@@ -51,8 +51,8 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
     denoiser_ = std::make_unique<Denoiser>();
 }
 
-void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& view,
-                            RenderedFrame* out) {
+void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                            const CameraView& view, RenderedFrame* out) {
   if (snapshot.X_WB.size() != scene_.bodies.size())
     throw Error("Render: snapshot has " + std::to_string(snapshot.X_WB.size()) +
                 " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
@@ -60,10 +60,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const CameraView& vie
     throw Error("Render: camera near_m " + std::to_string(view.near_m) +
                 " is not a finite distance >= 0");
   ray_scene_->Update(snapshot);
-  lights_.Update(snapshot);
+  lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
-  effects_.Prepare(snapshot, camera, view, settings_, lights_, *ray_scene_, sky_, &pool_);
+  effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_, &pool_);
   // realtime tier: sky light occluded by the static geometry, rebuilt only when the static
   // bodies move and relit when the sky changes (render/sky_irradiance_volume.h).
   if (settings_.tier == RenderSettings::Tier::kRealtime)

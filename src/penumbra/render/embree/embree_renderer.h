@@ -38,7 +38,9 @@ class EmbreeRenderer final : public Renderer {
 
   /// @throws Error if the snapshot does not match the scene (body counts) or a light /
   /// MJCF light id is out of range; ConfigError for bad intrinsics.
-  void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) override;
+  void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
+              RenderedFrame* out) override;
+  using Renderer::Render;
 
   const RayScene& ray_scene() const { return *ray_scene_; }
   const RenderSettings& settings() const { return settings_; }

@@ -1,4 +1,4 @@
-#include "penumbra/sensors/pcd_writer.h"
+#include "penumbra/output/pcd_writer.h"
 
 #include <cstring>
 #include <fstream>

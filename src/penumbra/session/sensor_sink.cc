@@ -1,4 +1,4 @@
-#include "penumbra/app/sensor_stage.h"
+#include "penumbra/session/sensor_sink.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -12,11 +12,12 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/output/sensor_writers.h"
+#include "penumbra/pipeline/sink_worker.h"
 #include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"
-#include "penumbra/sensors/pcd_writer.h"
 #include "penumbra/sensors/sensor_noise.h"
 
 namespace penumbra {
@@ -24,12 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-// a streaming CSV under the output folder `out` (whole rows only, core/output_file.h)
-LineFile OpenCsv(const fs::path& out, const fs::path& rel) {
-  CreateOutputFolder(out, rel.parent_path());
-  return LineFile(out / rel);
-}
 
 double ThreadCpuSec() {
   timespec ts;
@@ -82,23 +77,23 @@ Mount ResolveMount(const SensorConfig& s, const ModelInfo& info) {
 
 }  // namespace
 
-struct SensorStage::Impl {
+struct SensorSink::Impl {
   struct Lidar {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<LidarScanner> scanner;
     Mount mount;
-    fs::path dir;
-    LineFile index;
+    LidarScanWriter out;
     bool pending = false;
     SensorFiring start_firing;
-    WorldSnapshot start;
+    std::shared_ptr<const WorldSnapshot> start;
+    std::shared_ptr<const EffectsFrame> start_effects;  // seen at the scan's start
     int64_t written = 0;
   };
   struct Imu {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
     SensorDescription accel, gyro;
-    LineFile csv;
+    ImuCsvWriter out;
     int64_t written = 0;
   };
   struct Mujoco {
@@ -106,7 +101,7 @@ struct SensorStage::Impl {
     std::unique_ptr<MujocoSensorSet> set;
     double stddev = 0;
     uint64_t stream = 0;
-    LineFile csv;
+    MujocoSensorCsvWriter out;
     std::vector<double> values;
     int64_t written = 0;
   };
@@ -114,7 +109,7 @@ struct SensorStage::Impl {
     const SensorConfig* cfg = nullptr;
     std::vector<int> bodies;
     bool contacts = true;
-    LineFile csv, contacts_csv;
+    GroundTruthCsvWriter out;
     int64_t written = 0;
   };
   // what each schedule id stands for
@@ -134,40 +129,42 @@ struct SensorStage::Impl {
   std::vector<GroundTruth> truths;
   std::vector<std::string> body_names;
   std::unique_ptr<RayQuery> ray_scene;
+  // loop thread
   std::vector<SensorFiring> due;
+  int64_t due_step = -1;
+  double effects_sec = 0;
+  // sink thread
   std::map<std::string, double> busy;
+  SinkWorker worker{8};
+
+  // the sensors `due` read `snap`; on the sink thread, in step order. `scan_effects`: per
+  // entry of `due`, the effects a LiDAR starting a scan sees (null otherwise).
+  void Process(const std::shared_ptr<const WorldSnapshot>& snap,
+               const std::vector<SensorFiring>& due,
+               const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects);
 
   void TraceScan(Lidar& l, const WorldSnapshot& end) {
     const auto t0 = Clock::now();
     const double c0 = ThreadCpuSec();
-    const WorldSnapshot& start = l.start;
+    const WorldSnapshot& start = *l.start;
     ray_scene->Update(start);
     const Pose X0 = l.mount.X_WS(start), X1 = l.mount.X_WS(end);
     const double span = end.time_sec - start.time_sec;
     const SensorPoseAt pose = [&](double t) {
       return span > 0 ? InterpolatePose(X0, X1, std::min(1.0, t / span)) : X0;
     };
-    const auto te = Clock::now();
-    std::shared_ptr<const EffectsFrame> fx =
-        effects_at ? effects_at(start, X0.translation()) : start.effects;
-    busy["lidar_effects"] += std::chrono::duration<double>(Clock::now() - te).count();
     LidarScan scan;
-    l.scanner->Scan(*ray_scene, fx.get(), pose, l.start_firing.index, &scan);
-    const std::string file = fmt::format("scan_{:06d}.pcd", l.start_firing.index);
-    WritePcd((l.dir / file).string(), scan.points);
-    l.index.Append(fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", l.start_firing.index,
-                               l.start_firing.capture_time_sec, l.start_firing.delivery_time_sec,
-                               file, scan.points.size(), scan.medium_returns,
-                               scan.particle_returns));
+    l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
+    l.out.Write(l.start_firing, scan);
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
   }
 };
 
-SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
-                         const SceneDescription& scene, const std::string& out_dir,
-                         SensorEffectsAt effects_at)
+SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
+                       const SceneDescription& scene, const std::string& out_dir,
+                       SensorEffectsAt effects_at)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.configs = world.sensors;
@@ -217,11 +214,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
         throw SensorError(c, "preset", e.what());
       }
       rate = lc.pattern.rate_hz;
-      l.dir = out / "lidar" / c.name;
-      l.index = OpenCsv(out, fs::path("lidar") / c.name / "index.csv");
-      l.index.Append(
-          "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
-          "particle_returns\n");
+      l.out = LidarScanWriter(out, c.name);
       s.entries.push_back({0, static_cast<int>(s.lidars.size())});
       s.lidars.push_back(std::move(l));
     } else if (c.type == "imu") {
@@ -242,10 +235,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       nc.gyro_noise_density = c.Param("noise.gyro_noise_density", nc.gyro_noise_density);
       nc.gyro_random_walk = c.Param("noise.gyro_random_walk", nc.gyro_random_walk);
       m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
-      m.csv = OpenCsv(out, fs::path("imu") / (c.name + ".csv"));
-      m.csv.Append(
-          "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
-          "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n");
+      m.out = ImuCsvWriter(out, c.name);
       s.entries.push_back({1, static_cast<int>(s.imus.size())});
       s.imus.push_back(std::move(m));
     } else if (c.type == "mujoco") {
@@ -258,10 +248,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
       }
       m.stddev = c.Param("noise.stddev", 0);
       m.stream = stream;
-      m.csv = OpenCsv(out, fs::path("sensors") / (c.name + ".csv"));
-      std::string header = "sample,capture_time_sec,delivery_time_sec";
-      for (const std::string& col : m.set->ColumnNames()) header += "," + col;
-      m.csv.Append(header + "\n");
+      m.out = MujocoSensorCsvWriter(out, c.name, m.set->ColumnNames());
       s.entries.push_back({2, static_cast<int>(s.mujocos.size())});
       s.mujocos.push_back(std::move(m));
     } else {
@@ -281,21 +268,7 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
         }
       }
       g.contacts = c.Param("contacts", 1) != 0;
-      g.csv = OpenCsv(out, fs::path("ground_truth") / (c.name + ".csv"));
-      std::string header = "sample,time_sec";
-      for (int b : g.bodies) {
-        const std::string& n = info.body_names[b];
-        for (const char* k : {"x_m", "y_m", "z_m", "qw", "qx", "qy", "qz", "wx_rad_s", "wy_rad_s",
-                              "wz_rad_s", "vx_m_s", "vy_m_s", "vz_m_s"})
-          header += "," + n + "_" + k;
-      }
-      g.csv.Append(header + "\n");
-      if (g.contacts) {
-        g.contacts_csv = OpenCsv(out, fs::path("ground_truth") / (c.name + "_contacts.csv"));
-        g.contacts_csv.Append(
-            "sample,time_sec,geom1,geom2,body1,body2,px_m,py_m,pz_m,nx,ny,nz,"
-            "distance_m,fn_N,ft1_N,ft2_N\n");
-      }
+      g.out = GroundTruthCsvWriter(out, c.name, g.bodies, info.body_names, g.contacts);
       s.entries.push_back({3, static_cast<int>(s.truths.size())});
       s.truths.push_back(std::move(g));
     }
@@ -308,19 +281,48 @@ SensorStage::SensorStage(const WorldConfig& world, const Simulation& sim,
   if (!s.lidars.empty()) s.ray_scene = MakeRayQuery(scene, world.render.backend);
 }
 
-SensorStage::~SensorStage() = default;
+SensorSink::~SensorSink() { impl_->worker.Finish(); }
 
-bool SensorStage::empty() const { return impl_->configs.empty(); }
+bool SensorSink::empty() const { return impl_->configs.empty(); }
 
-bool SensorStage::Due(int64_t step) {
-  impl_->due.clear();
-  impl_->schedule->Due(step, &impl_->due);
-  return !impl_->due.empty();
+void SensorSink::OnStart(const LoopStart& start) { impl_->worker.Start(start.report_error); }
+
+SnapshotContent SensorSink::Wants(int64_t step, double) {
+  Impl& s = *impl_;
+  s.due.clear();
+  s.schedule->Due(step, &s.due);
+  s.due_step = s.due.empty() ? -1 : step;
+  return s.due.empty() ? SnapshotContent::kNone : SnapshotContent::kFull;
 }
 
-void SensorStage::Process(const WorldSnapshot& snap) {
+void SensorSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) {
   Impl& s = *impl_;
-  for (const SensorFiring& f : s.due) {
+  if (s.due_step < 0 || snapshot->step != s.due_step) return;
+  s.due_step = -1;
+  // the effects a LiDAR sees over a scan are those at its start, for its start position
+  std::vector<std::shared_ptr<const EffectsFrame>> scan_effects(s.due.size());
+  if (s.effects_at) {
+    const auto t0 = Clock::now();
+    for (size_t i = 0; i < s.due.size(); ++i) {
+      const Impl::Entry e = s.entries[s.due[i].sensor];
+      if (e.kind != 0) continue;
+      const Pose X0 = s.lidars[e.index].mount.X_WS(*snapshot);
+      scan_effects[i] = s.effects_at(*snapshot, X0.translation());
+    }
+    s.effects_sec += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  s.worker.Post([&s, snapshot, due = s.due, scan_effects = std::move(scan_effects)] {
+    s.Process(snapshot, due, scan_effects);
+  });
+}
+
+void SensorSink::Impl::Process(
+    const std::shared_ptr<const WorldSnapshot>& snap_ptr, const std::vector<SensorFiring>& due,
+    const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
+  Impl& s = *this;
+  const WorldSnapshot& snap = *snap_ptr;
+  for (size_t i = 0; i < due.size(); ++i) {
+    const SensorFiring& f = due[i];
     const Impl::Entry e = s.entries[f.sensor];
     const auto t0 = Clock::now();
     if (e.kind == 0) {
@@ -328,7 +330,8 @@ void SensorStage::Process(const WorldSnapshot& snap) {
       if (l.pending) s.TraceScan(l, snap);
       l.pending = true;
       l.start_firing = f;
-      l.start = snap;
+      l.start = snap_ptr;
+      l.start_effects = scan_effects[i];
       continue;
     }
     if (e.kind == 1) {
@@ -338,82 +341,50 @@ void SensorStage::Process(const WorldSnapshot& snap) {
       ImuSample truth;
       truth.accel_m_s2 = {a[0], a[1], a[2]};
       truth.gyro_rad_s = {w[0], w[1], w[2]};
-      const ImuSample o = m.noise->Apply(f.index, truth);
-      m.csv.Append(fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
-                               f.index, f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
-                               o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(),
-                               o.gyro_rad_s.y(), o.gyro_rad_s.z()));
+      m.out.Write(f, m.noise->Apply(f.index, truth));
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {
       Impl::Mujoco& m = s.mujocos[e.index];
       m.values.clear();
       m.set->Read(snap, &m.values);
-      std::string row =
-          fmt::format("{},{:.9f},{:.9f}", f.index, f.capture_time_sec, f.delivery_time_sec);
       Rng rng(HashKeys(m.stream, static_cast<uint64_t>(f.index)));
-      for (double v : m.values) {
-        if (m.stddev > 0) v += m.stddev * StandardNormal(&rng);
-        fmt::format_to(std::back_inserter(row), ",{:.9g}", v);
-      }
-      row += '\n';
-      m.csv.Append(row);
+      if (m.stddev > 0)
+        for (double& v : m.values) v += m.stddev * StandardNormal(&rng);
+      m.out.Write(f, m.values);
       ++m.written;
       s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else {
       Impl::GroundTruth& g = s.truths[e.index];
-      std::string row = fmt::format("{},{:.9f}", f.index, snap.time_sec);
-      for (int b : g.bodies) {
-        const Pose& X = snap.X_WB.at(b);
-        const Eigen::Quaterniond q(X.linear());
-        const Eigen::Matrix<double, 6, 1> V = b < static_cast<int>(snap.V_WB.size())
-                                                  ? snap.V_WB[b]
-                                                  : Eigen::Matrix<double, 6, 1>::Zero();
-        fmt::format_to(std::back_inserter(row),
-                       ",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
-                       "{:.9g},{:.9g},{:.9g}",
-                       X.translation().x(), X.translation().y(), X.translation().z(), q.w(), q.x(),
-                       q.y(), q.z(), V[0], V[1], V[2], V[3], V[4], V[5]);
-      }
-      row += '\n';
-      g.csv.Append(row);
-      if (g.contacts) {
-        for (const WorldSnapshot::Contact& c : snap.contacts)
-          g.contacts_csv.Append(fmt::format(
-              "{},{:.9f},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
-              "{:.9g},{:.9g}\n",
-              f.index, snap.time_sec, c.geom1, c.geom2, c.body1, c.body2, c.p_W.x(), c.p_W.y(),
-              c.p_W.z(), c.normal_W.x(), c.normal_W.y(), c.normal_W.z(), c.distance_m,
-              c.force_N.x(), c.force_N.y(), c.force_N.z()));
-      }
+      g.out.Write(f.index, snap);
       ++g.written;
       s.busy["ground_truth"] += std::chrono::duration<double>(Clock::now() - t0).count();
     }
   }
 }
 
-void SensorStage::Finish() {
+void SensorSink::OnFinish(const LoopFinish&) {
   Impl& s = *impl_;
+  s.worker.Finish();
+  s.busy["lidar_effects"] += s.effects_sec;
+  if (!s.lidars.empty()) s.busy["lidar"] += s.effects_sec;
   // every file is closed (and its error, if any, seen); the first error is rethrown
   std::exception_ptr first;
-  auto close = [&](LineFile& f) {
+  auto close = [&](auto& writer) {
     try {
-      f.Close();
+      writer.Close();
     } catch (...) {
       if (!first) first = std::current_exception();
     }
   };
-  for (auto& l : s.lidars) close(l.index);
-  for (auto& m : s.imus) close(m.csv);
-  for (auto& m : s.mujocos) close(m.csv);
-  for (auto& g : s.truths) {
-    close(g.csv);
-    close(g.contacts_csv);
-  }
+  for (auto& l : s.lidars) close(l.out);
+  for (auto& m : s.imus) close(m.out);
+  for (auto& m : s.mujocos) close(m.out);
+  for (auto& g : s.truths) close(g.out);
   if (first) std::rethrow_exception(first);
 }
 
-std::map<std::string, int64_t> SensorStage::samples() const {
+std::map<std::string, int64_t> SensorSink::samples() const {
   std::map<std::string, int64_t> out;
   for (const auto& l : impl_->lidars) out[l.cfg->name] = l.written;
   for (const auto& m : impl_->imus) out[m.cfg->name] = m.written;
@@ -422,6 +393,6 @@ std::map<std::string, int64_t> SensorStage::samples() const {
   return out;
 }
 
-std::map<std::string, double> SensorStage::busy_sec() const { return impl_->busy; }
+std::map<std::string, double> SensorSink::busy_sec() const { return impl_->busy; }
 
 }  // namespace penumbra

@@ -1,0 +1,152 @@
+#pragma once
+// the cameras of a run as a pipeline sink (pipeline/sink.h): which steps each camera captures
+// (sensors/sensor_schedule.h), exposures that need a later snapshot (motion blur, rolling
+// shutter; sensors/camera_imager.h), image formation per camera on the sink's render thread,
+// and every image file through the asynchronous frame writer (output/async_frame_writer.h):
+//
+// - DIR/<camera>/{rgb,depth,segmentation}/NNNNNN.png, frames.csv, intrinsics.json
+//   (output/camera_writer.h)
+// - DIR/<camera>/range/NNNNNN.png: 16-bit range along the pixel ray, mm, 0 = no hit
+// - DIR/<camera>/normals/NNNNNN.png: 8-bit rgb (n_O + 1) / 2 * 255 of the unit normal facing the
+//   camera in the optical frame
+// - DIR/<camera>/instance_segmentation/NNNNNN.png: 16-bit body index + 1, 0 = background
+// - DIR/<camera>/semantic_segmentation/NNNNNN.png: 16-bit semantic class id, 0 = none
+// - DIR/camera_info.yaml, DIR/camera_info.json: ROS CameraInfo per camera (output/camera_info.h)
+// - DIR/semantic_classes.json: {class name: id} of the world file's `semantic_classes:`
+//
+// depth/ holds the depth sensor's measurement (with depth_noise) or the exact z-depth; all other
+// images are exact. frames.csv time/pose: the capture instant, or mid-exposure (sub-frame n/2)
+// when the frame uses motion blur or a rolling shutter.
+//
+// timing: camera c fires its frame k at the first physics step whose time is >= k / rate_hz, on
+// the step count, so frames never drift however the rate and timestep relate; a camera faster
+// than physics renders once per step. the effects a camera sees (scene/effects_frame.h) are
+// evaluated on the loop thread when its frame is captured (in step order, as the effects
+// engine wants) and travel beside the snapshot; rendering runs on the sink's own thread in
+// capture order, so the images do not depend on thread timing.
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "penumbra/output/async_frame_writer.h"
+#include "penumbra/pipeline/sink.h"
+#include "penumbra/pipeline/sink_worker.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/scene/effects_frame.h"
+#include "penumbra/sensors/camera_imager.h"
+#include "penumbra/sensors/sensor_schedule.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// the effects a viewer at `p_W` (world frame, m) sees at `snapshot` (e.g.
+/// EffectsStage::Evaluate); null = clear conditions. called on the loop thread only.
+using ViewerEffects = std::function<std::shared_ptr<const EffectsFrame>(
+    const WorldSnapshot& snapshot, const Eigen::Vector3d& p_W)>;
+
+/// the span of sim time camera `spec`'s frames need after their capture (0: rendered at once).
+double CaptureSpanSec(const CameraSpec& spec, const CameraSensorConfig& config);
+
+/// which steps must be handed over as end-of-exposure snapshots.
+class ShutterSchedule {
+ public:
+  ShutterSchedule(const SceneDescription& scene, const WorldConfig& world);
+  /// true if an exposure started earlier ends at or before `time_sec` (consumes those ends).
+  bool Due(double time_sec);
+  /// records the exposures of `cameras` starting at `time_sec`.
+  void Add(double time_sec, const std::vector<int>& cameras);
+
+ private:
+  std::vector<double> span_;
+  std::multiset<double> ends_;
+};
+
+/// settings of a CameraSink.
+struct CameraSinkOptions {
+  /// captured snapshots waiting for the render thread before the loop blocks, >= 1.
+  int render_queue = 4;
+  /// the frame writer's queue and threads.
+  AsyncFrameWriterOptions writer;
+  /// called on the render thread after each captured snapshot is rendered with its sim time
+  /// and the frames rendered so far (e.g. a progress bar); may be empty.
+  std::function<void(double time_sec, int64_t frames)> on_rendered;
+};
+
+/// every camera of `scene`. the render thread is the only user of `renderer`.
+class CameraSink : public Sink {
+ public:
+  /// registers every camera with the frame writer (folders, intrinsics.json, frames.csv
+  /// header), makes the extra output folders and writes camera_info.yaml/json and
+  /// semantic_classes.json. `timestep_sec` is the physics timestep (the schedules count
+  /// steps). `scene`, `renderer` must outlive the sink; `effects` may be empty (clear
+  /// conditions).
+  /// @throws ConfigError for bad camera names or sensor settings; Error if files cannot be
+  ///         written.
+  CameraSink(const SceneDescription& scene, const WorldConfig& world, double timestep_sec,
+             Renderer* renderer, const std::string& output_dir, ViewerEffects effects,
+             CameraSinkOptions options = {});
+  ~CameraSink() override;
+
+  void OnStart(const LoopStart& start) override;
+  /// kPoses at steps where a camera fires or an exposure ends.
+  SnapshotContent Wants(int64_t step, double time_sec) override;
+  /// hands the snapshots this sink asked for (with each capturing camera's effects) to the
+  /// render thread; others are ignored.
+  void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override;
+  /// completes the pending exposures with the last snapshot (not after an error), waits for
+  /// the render thread and the writer. @throws Error the first write error not yet reported.
+  void OnFinish(const LoopFinish& finish) override;
+
+  /// frames.csv rows written per camera (read after OnFinish).
+  std::map<std::string, int64_t> FramesWritten() const { return writer_.FramesWritten(); }
+  /// wall time spent rendering and forming images, s (read after OnFinish).
+  double render_sec() const { return render_sec_; }
+
+ private:
+  struct Pending {
+    int camera;
+    int64_t frame;
+    std::shared_ptr<const WorldSnapshot> start;
+    std::shared_ptr<const EffectsFrame> effects;
+    double end_time;
+  };
+  struct Capture {
+    int64_t step = -1;
+    std::vector<int> cameras;
+    std::vector<int64_t> frames;
+  };
+  // render thread
+  void Render(const std::shared_ptr<const WorldSnapshot>& snapshot, const Capture& capture,
+              const std::vector<std::shared_ptr<const EffectsFrame>>& effects);
+  void CompletePending(bool with_last);
+  void Complete(const Pending& p, const WorldSnapshot* end);
+
+  const SceneDescription& scene_;
+  Renderer* renderer_;
+  ViewerEffects effects_;
+  CameraSinkOptions options_;
+  std::function<void(std::exception_ptr)> report_error_;
+  AsyncFrameWriter writer_;
+  // loop thread
+  SensorSchedule schedule_;
+  ShutterSchedule shutters_;
+  std::vector<SensorFiring> due_;
+  std::optional<Capture> capture_;
+  // render thread
+  std::vector<CameraImager> imagers_;
+  std::vector<double> span_;
+  std::deque<Pending> pending_;
+  std::shared_ptr<const WorldSnapshot> last_;
+  double render_sec_ = 0;
+  int64_t frames_ = 0;
+  SinkWorker worker_;
+};
+
+}  // namespace penumbra

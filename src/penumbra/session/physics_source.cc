@@ -1,0 +1,42 @@
+#include "penumbra/session/physics_source.h"
+
+#include <spdlog/spdlog.h>
+
+#include <thread>
+
+namespace penumbra {
+
+PhysicsSource::PhysicsSource(Simulation* sim, PhysicsSourceOptions options)
+    : sim_(sim), options_(options), step_(sim->step_count()), time_sec_(sim->time()) {}
+
+std::shared_ptr<const WorldSnapshot> PhysicsSource::Snapshot(SnapshotContent content) {
+  auto s = std::make_shared<WorldSnapshot>();
+  if (content == SnapshotContent::kState || content == SnapshotContent::kNone) {
+    s->time_sec = sim_->time();
+    s->step = sim_->step_count();
+    s->qpos.assign(sim_->qpos().begin(), sim_->qpos().end());
+    s->qvel.assign(sim_->qvel().begin(), sim_->qvel().end());
+  } else {
+    sim_->Snapshot(s.get(), content == SnapshotContent::kFull
+                                ? Simulation::SnapshotContent::kFull
+                                : Simulation::SnapshotContent::kPoses);
+  }
+  return s;
+}
+
+bool PhysicsSource::Advance() {
+  if (!wall0_) wall0_ = Clock::now();
+  if (options_.realtime) {
+    std::this_thread::sleep_until(*wall0_ + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(sim_->time())));
+  }
+  const auto t0 = Clock::now();
+  sim_->Step();
+  busy_sec_ += std::chrono::duration<double>(Clock::now() - t0).count();
+  step_ = sim_->step_count();
+  time_sec_ = sim_->time();
+  for (const std::string& w : sim_->TakeWarnings()) spdlog::warn("physics: {}", w);
+  return true;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,52 @@
+#pragma once
+// live physics as a pipeline source (pipeline/source.h): a Simulation stepped one timestep per
+// Advance, optionally paced to wall-clock time, with snapshots of the requested content.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/source.h"
+
+namespace penumbra {
+
+/// settings of a PhysicsSource.
+struct PhysicsSourceOptions {
+  /// pace the steps to wall-clock time: step n is not taken before n * timestep seconds of
+  /// wall time have passed since the first Advance (default: as fast as possible). the
+  /// trajectory does not depend on it.
+  bool realtime = false;
+};
+
+/// a Simulation as a Source. not thread-safe (one loop thread; the simulation must not be used
+/// elsewhere while the loop runs).
+class PhysicsSource : public Source {
+ public:
+  /// `sim` must outlive the source.
+  explicit PhysicsSource(Simulation* sim, PhysicsSourceOptions options = {});
+
+  /// the step and time of the last step completed (after a PhysicsError: the step before it).
+  int64_t step() const override { return step_; }
+  double time_sec() const override { return time_sec_; }
+  /// kState: time, step, qpos, qvel only; kPoses / kFull: Simulation::Snapshot's kPoses / kFull.
+  std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override;
+  /// one Simulation::Step (after the realtime wait); logs the simulation's warnings. always
+  /// true. @throws PhysicsError when the simulation diverges.
+  bool Advance() override;
+
+  /// wall time spent inside Simulation::Step so far, s.
+  double busy_sec() const { return busy_sec_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  Simulation* sim_;
+  PhysicsSourceOptions options_;
+  int64_t step_ = 0;
+  double time_sec_ = 0;
+  std::optional<Clock::time_point> wall0_;
+  double busy_sec_ = 0;
+};
+
+}  // namespace penumbra

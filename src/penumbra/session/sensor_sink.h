@@ -1,0 +1,86 @@
+#pragma once
+// the run's sensors as a pipeline sink (pipeline/sink.h): every world-file sensor (`sensors:`,
+// world/sensors_reader.h) on its own schedule (sensors/sensor_schedule.h), fed with physics
+// snapshots, writing its outputs:
+//
+//   <out>/lidar/<name>/scan_<k>.pcd and index.csv, <out>/imu/<name>.csv,
+//   <out>/sensors/<name>.csv, <out>/ground_truth/<name>.csv and <name>_contacts.csv
+//
+// the sensor models (sensors/) return records (a LidarScan, an ImuSample, MuJoCo sensor values,
+// the snapshot's poses and contacts); output/sensor_writers.h writes them (columns, units and
+// number formats are documented there).
+//
+// stamps: capture_time_sec is the sim time of the physics step the sample was taken at,
+// delivery_time_sec = capture + latency_sec. rows are written in capture order, which for
+// one sensor (constant latency) is also its delivery order; both stamps are in every row.
+// a LiDAR scan k covers [capture_k, capture_{k+1}): it is traced when scan k + 1's snapshot
+// arrives, with the sensor pose interpolated between the two snapshots (motion distortion);
+// the scan still open when the run ends is not written.
+//
+// threading and determinism: the loop thread only decides which steps need a snapshot and
+// evaluates the effects a LiDAR sees at the start of each scan (in step order, as the effects
+// engine wants); the sensor models, the LiDAR ray tracing and every file write run on the
+// sink's own thread (pipeline/sink_worker.h), one snapshot after the other in step order. each
+// sensor draws noise from its own stream SensorStreamSeed(seed, name), so the outputs do not
+// depend on thread timing.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/sink.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+#include "penumbra/sensors/sensor_schedule.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// the effects seen by a sensor at world position p_W (e.g. EffectsStage::Evaluate); may
+/// return null for clear conditions. called on the loop thread only.
+using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
+    const WorldSnapshot& snapshot, const Eigen::Vector3d& p_W)>;
+
+/// all world-file sensors of one run.
+class SensorSink : public Sink {
+ public:
+  /// resolves every sensor against the composed model (IMUs need compose/imu_injection.h's
+  /// AddImuSensors applied to the model first) and opens the output files under `out_dir`.
+  /// `scene` must outlive the stage (LiDARs ray trace it).
+  /// @throws ConfigError naming the sensor's file, line and key (e.g. sensors[1].body) for a
+  ///         body, site, MuJoCo sensor or preset setting that does not resolve.
+  SensorSink(const WorldConfig& world, const Simulation& sim, const SceneDescription& scene,
+             const std::string& out_dir, SensorEffectsAt effects_at = {});
+  ~SensorSink() override;
+
+  /// true when the world has no sensors.
+  bool empty() const;
+
+  /// starts the sink's thread.
+  void OnStart(const LoopStart& start) override;
+  /// advances the schedules to `step` (once per step, in order); kFull if any sensor is due.
+  SnapshotContent Wants(int64_t step, double time_sec) override;
+  /// the snapshot of a step Wants found sensors due at: queued for the sensors due (other
+  /// snapshots are ignored).
+  void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override;
+  /// waits for the queued work, writes the buffered rows and closes the files.
+  /// @throws Error naming the first file that could not be written (all are closed).
+  void OnFinish(const LoopFinish& finish) override;
+
+  /// samples (scans) written per sensor (read after OnFinish).
+  std::map<std::string, int64_t> samples() const;
+  /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s; also
+  /// "lidar_effects" (evaluating the effects a LiDAR sees, on the loop thread, part of "lidar")
+  /// and "lidar_cpu" (thread CPU time of the LiDAR work). read after OnFinish.
+  std::map<std::string, double> busy_sec() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace penumbra
