@@ -3,8 +3,8 @@
 // finite input (a pose of 1e19 m, a sphere of radius 1e30 m, a timestep of 1e-300 s) is refused
 // with a message instead of aborting in Embree or hanging. docs/world-file.md ("Input limits")
 // lists them with the reasons; world/world_validation.cc applies them to world files,
-// session/scene_assembly.cc to compiled MJCF models, and render/embree/ray_scene.cc never traces a ray
-// outside kMaxRayComponent.
+// session/scene_assembly.cc to compiled MJCF models, and render/embree/ray_scene.cc never traces a
+// ray outside kMaxRayComponent.
 //
 // why these values: Embree traces in 32-bit floats. the spacing of floats is 7.8 mm at
 // 1e5 m and 0.5 m at 1e7 m, so geometry much farther out than 1e5 m cannot be rendered
