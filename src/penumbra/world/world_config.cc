@@ -435,7 +435,9 @@ WorldConfig WorldForBareModel(const std::string& model_path) {
   w.sky.type = Sky::Type::kDaylight;
   w.sky.turbidity = 3;
   w.sky.sun_elevation_deg = 45;
-  w.sky.sun_azimuth_deg = 30;
+  // 90 deg to the left of the auto-framed camera (azimuth 31 deg, session/scene_assembly.h):
+  // shadows fall beside the model, in view.
+  w.sky.sun_azimuth_deg = -59;
   w.sky.zenith_luminance_cd_m2 = 8000;
 
   CameraConfig cam;
