@@ -19,9 +19,9 @@ inline constexpr double kAutoFrameFill = 0.7;
 
 /// direction (world frame, not unit) along which an auto-framed camera looks: from the model's
 /// front-left (+x, +y), 21 deg above the horizon; azimuth of the camera seen from the model
-/// atan2(0.6, 1) = 31 deg. a bare model's sun stands at azimuth 31 - 90 = -59 deg
-/// (world/world_config.cc, WorldForBareModel): on the camera's left, so shadows fall to the
-/// right of the model in the image instead of behind it.
+/// atan2(0.6, 1) = 31 deg. a bare model's sun stands at azimuth 31 - 60 = -29 deg
+/// (world/world_config.cc, WorldForBareModel): 60 deg to the camera's left, so the model is
+/// lit from the front-left and its shadow falls to its right in the image, not behind it.
 inline const Eigen::Vector3d kAutoFrameView{-1.0, -0.6, -0.45};
 
 /// returns `extracted` with the world file's material overrides, lights, sky and
