@@ -166,7 +166,8 @@ TEST_F(SceneExtractorTest, MaterialsFollowTheDocumentedMapping) {
   EXPECT_NEAR(m.base_color.y(), 0.0331048f, 1e-6);
   EXPECT_NEAR(m.base_color.z(), 0.04f / 12.92f, 1e-7);
   EXPECT_NEAR(m.alpha, 0.9f, 1e-7);
-  EXPECT_NEAR(m.roughness, (1 - 0.8f) * (1 - 0.5f), 1e-6);
+  EXPECT_NEAR(m.roughness, 1 - 0.8f, 1e-6);
+  EXPECT_NEAR(m.reflectance, 0.5f, 1e-6);
   EXPECT_NEAR(m.specular, 0.3f, 1e-7);
   EXPECT_EQ(m.metallic, 0.0f);
   EXPECT_TRUE(m.emission.isApprox(m.base_color * float(2 * kMjcfEmissionLuminance), 1e-5));
@@ -193,7 +194,8 @@ TEST_F(SceneExtractorTest, MaterialsFollowTheDocumentedMapping) {
   EXPECT_EQ(green.name, "shiny#rgba(0 1 0 1)");
   EXPECT_EQ(green.base_color, Eigen::Vector3f(0, 1, 0));
   EXPECT_NEAR(green.specular, 0.3f, 1e-7);
-  EXPECT_NEAR(green.roughness, 0.1f, 1e-6);
+  EXPECT_NEAR(green.roughness, 0.2f, 1e-6);
+  EXPECT_NEAR(green.reflectance, 0.5f, 1e-6);
   // invisible geoms are kept, marked by alpha
   EXPECT_EQ(mats[geom("ghost").material].alpha, 0.0f);
 }

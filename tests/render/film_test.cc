@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace penumbra {
 namespace {
@@ -69,6 +71,69 @@ TEST(FilmTest, DevelopEncodesWithinOneCodeOfExactRounding) {
   EXPECT_GT(exact, 990);
   EXPECT_EQ(rgb.at(0, 0)[0], 0);
   EXPECT_EQ(rgb.at(1000, 0)[0], 255);
+}
+
+// HSV hue (degrees) of an 8-bit RGB pixel.
+double HueDeg(const uint8_t* p) {
+  const double r = p[0], g = p[1], b = p[2];
+  const double mx = std::max({r, g, b}), mn = std::min({r, g, b});
+  if (mx == mn) return 0;
+  double h = 0;
+  if (mx == r) {
+    h = 60 * (g - b) / (mx - mn);
+  } else if (mx == g) {
+    h = 60 * (2 + (b - r) / (mx - mn));
+  } else {
+    h = 60 * (4 + (r - g) / (mx - mn));
+  }
+  return h < 0 ? h + 360 : h;
+}
+
+// issue 17: a per-channel curve turned a saturated orange yellow when over-exposed and red when
+// dim. the filmic map keeps the hue of the material colour from 1/4 to 4x of the exposure at
+// which the linear colour itself is the exposed value.
+TEST(FilmTest, FilmicKeepsTheHueOfSaturatedColours) {
+  const Film film(Manual(0, RenderSettings::ToneMap::kFilmic));
+  struct Case {
+    const char* name;
+    float srgb[3];
+  };
+  for (const Case& col : {Case{"orange", {1.0f, 0.5f, 0.0f}}, Case{"blue", {0.1f, 0.3f, 1.0f}}}) {
+    ImageF radiance(1, 1, 3);
+    for (int c = 0; c < 3; ++c) {
+      const float v = col.srgb[c];  // sRGB decode (IEC 61966-2-1)
+      radiance.at(0, 0)[c] = v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+    }
+    uint8_t code[3];
+    for (int c = 0; c < 3; ++c) code[c] = static_cast<uint8_t>(std::lround(255 * col.srgb[c]));
+    const double material_hue = HueDeg(code);
+    for (double stops = -2; stops <= 2; stops += 0.5) {
+      // exposure H = 2^stops: EV100 = log2(1 / (1.2 H)).
+      ImageU8 rgb;
+      film.Develop(radiance, std::log2(1.0 / 1.2) - stops, nullptr, &rgb);
+      EXPECT_NEAR(HueDeg(rgb.at(0, 0)), material_hue, 3.0)
+          << col.name << " at " << stops << " stops: " << int(rgb.at(0, 0)[0]) << " "
+          << int(rgb.at(0, 0)[1]) << " " << int(rgb.at(0, 0)[2]);
+    }
+  }
+}
+
+TEST(FilmTest, FilmicMapsGreyThroughTheAcesCurve) {
+  const Film film(Manual(std::log2(1.0 / 1.2), RenderSettings::ToneMap::kFilmic));
+  ImageF ramp(200, 1, 3);
+  for (int u = 0; u < 200; ++u)
+    for (int c = 0; c < 3; ++c) ramp.at(u, 0)[c] = u / 20.0f;
+  ImageU8 rgb;
+  film.Develop(ramp, std::log2(1.0 / 1.2), nullptr, &rgb);
+  for (int u = 0; u < 200; ++u) {
+    const int expected = static_cast<int>(std::lround(255.0 * SrgbOetf(AcesFilmic(u / 20.0f))));
+    for (int c = 0; c < 3; ++c) EXPECT_LE(std::abs(rgb.at(u, 0)[c] - expected), 1) << u;
+  }
+  float x[3] = {4.0f, 1.0f, std::nanf("")}, y[3];
+  HuePreservingFilmic(x, y);
+  EXPECT_FLOAT_EQ(y[0], AcesFilmic(4.0f));
+  EXPECT_FLOAT_EQ(y[1], AcesFilmic(4.0f) / 4);
+  EXPECT_TRUE(std::isnan(y[2]));
 }
 
 TEST(FilmTest, AutoExposureMapsTheLogAverageToMiddleGrey) {

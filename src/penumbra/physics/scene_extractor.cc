@@ -105,8 +105,8 @@ Material MaterialFromMjcf(const std::string& name, const float rgba[4], float em
   mat.base_color =
       Eigen::Vector3f(SrgbToLinear(rgba[0]), SrgbToLinear(rgba[1]), SrgbToLinear(rgba[2]));
   mat.alpha = std::clamp(rgba[3], 0.0f, 1.0f);
-  const float smooth = std::clamp(1.0f - shininess, kMjcfMinRoughness, 1.0f);
-  mat.roughness = smooth * (1.0f - std::clamp(reflectance, 0.0f, 1.0f));
+  mat.roughness = std::clamp(1.0f - shininess, kMjcfMinRoughness, 1.0f);
+  mat.reflectance = std::clamp(reflectance, 0.0f, 1.0f);
   mat.metallic = 0.0f;
   mat.specular = std::clamp(specular, 0.0f, 1.0f);
   mat.emission =

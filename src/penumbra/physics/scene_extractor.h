@@ -8,9 +8,10 @@
 //               61966-2-1 transfer function), alpha = a. a geom's rgba wins over its
 //               material's rgba when it differs from MuJoCo's default (0.5 0.5 0.5 1),
 //               as in MuJoCo's renderer.
-//   roughness   = clamp(1 - shininess, 0.05, 1) * (1 - reflectance): MuJoCo's Phong
-//               shininess maps to smoothness, and reflectance (MuJoCo's mirror-like
-//               reflection) pulls the surface towards a mirror (roughness 0 at 1).
+//   roughness   = clamp(1 - shininess, 0.05, 1): MuJoCo's Phong shininess maps to smoothness.
+//   reflectance = clamp(reflectance, 0, 1): the weight of a mirror layer that both render tiers
+//               draw on planes and the +z faces of boxes, where MuJoCo draws its reflections
+//               (render/material_eval.h, SurfaceMaterial::mirror).
 //   specular    = specular (MuJoCo's default 0.5 is the glTF/Burley default, F0 = 0.04).
 //   metallic    = 0 (MJCF has no metal notion).
 //   emission    = emission * base_color * kMjcfEmissionLuminance (cd/m^2).
@@ -54,7 +55,7 @@ inline constexpr double kMjcfDirectionalLux = 10000.0;
 inline constexpr double kMjcfEmissionLuminance = kMjcfDirectionalLux / 3.14159265358979323846;
 /// lower bound (m) of the distance used to size MJCF spot/point light intensities.
 inline constexpr double kMjcfLampMinDistance = 1.0;
-/// roughness bounds of the shininess mapping (before the reflectance factor).
+/// lower roughness bound of the shininess mapping.
 inline constexpr float kMjcfMinRoughness = 0.05f;
 
 /// IEC 61966-2-1 sRGB decoding of one channel in [0, 1] to linear.

@@ -24,34 +24,34 @@ inline int LutIndex(float x) {
   return std::min(k, kLutSize - 1);
 }
 
-// table indices of n exposed values src[i] * exposure, tone mapped (AcesFilmic or a clamp to
-// [0, 1]). with SSE2, four at a time, with the same IEEE operations in the same order and the
-// same NaN handling as the scalar form (min/max operand order as in std::clamp / std::max),
-// so the indices are identical.
-void ToneMapIndices(const float* src, int n, float exposure, bool filmic, int32_t* index) {
+// table indices of n exposed values src[i] * exposure clamped to [0, 1] (the linear tone map).
+// with SSE2, four at a time, with the same IEEE operations in the same order and the same NaN
+// handling as the scalar form (min/max operand order as in std::clamp), so the indices are
+// identical.
+void ClampIndices(const float* src, int n, float exposure, int32_t* index) {
   int i = 0;
 #if defined(__SSE2__)
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), ex = _mm_set1_ps(exposure);
-  const __m128 a = _mm_set1_ps(2.51f), b = _mm_set1_ps(0.03f), c = _mm_set1_ps(2.43f),
-               d = _mm_set1_ps(0.59f), e = _mm_set1_ps(0.14f);
   const __m128 scale = _mm_set1_ps(kLutSize - 1), half = _mm_set1_ps(0.5f);
   for (; i + 4 <= n; i += 4) {
     __m128 x = _mm_mul_ps(_mm_loadu_ps(src + i), ex);
-    if (filmic) {
-      x = _mm_max_ps(zero, x);  // std::max(x, 0): 0 > x ? 0 : x
-      const __m128 num = _mm_mul_ps(x, _mm_add_ps(_mm_mul_ps(a, x), b));
-      const __m128 den = _mm_add_ps(_mm_mul_ps(x, _mm_add_ps(_mm_mul_ps(c, x), d)), e);
-      x = _mm_div_ps(num, den);
-    }
     x = _mm_min_ps(one, _mm_max_ps(zero, x));  // std::clamp(x, 0, 1)
     // x > 0 ? x (kLutSize - 1) + 0.5 : 0, then the truncating conversion (x <= 1 here).
     const __m128 k = _mm_and_ps(_mm_cmpgt_ps(x, zero), _mm_add_ps(_mm_mul_ps(x, scale), half));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(index + i), _mm_cvttps_epi32(k));
   }
 #endif
-  for (; i < n; ++i) {
-    const float x = src[i] * exposure;
-    index[i] = LutIndex(filmic ? AcesFilmic(x) : std::clamp(x, 0.0f, 1.0f));
+  for (; i < n; ++i) index[i] = LutIndex(std::clamp(src[i] * exposure, 0.0f, 1.0f));
+}
+
+// table indices of n / 3 exposed RGB pixels src * exposure through the hue-preserving filmic
+// map (HuePreservingFilmic).
+void FilmicIndices(const float* src, int n, float exposure, int32_t* index) {
+  for (int i = 0; i + 3 <= n; i += 3) {
+    const float x[3] = {src[i] * exposure, src[i + 1] * exposure, src[i + 2] * exposure};
+    float y[3];
+    HuePreservingFilmic(x, y);
+    for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(y[c]);
   }
 }
 
@@ -95,6 +95,16 @@ float AcesFilmic(float x) {
   return std::clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0f, 1.0f);
 }
 
+void HuePreservingFilmic(const float x[3], float y[3]) {
+  // the largest channel; NaN channels never win, so they stay NaN (and encode as 0).
+  float m = 0.0f;
+  for (int c = 0; c < 3; ++c)
+    if (x[c] > m) m = x[c];
+  // m = +inf gives NaN (black), as the per-channel curve did.
+  const float ratio = m > 0.0f ? AcesFilmic(m) / m : 0.0f;
+  for (int c = 0; c < 3; ++c) y[c] = std::clamp(std::max(x[c], 0.0f) * ratio, 0.0f, 1.0f);
+}
+
 float SrgbOetf(float linear) {
   const float v = std::clamp(linear, 0.0f, 1.0f);
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
@@ -135,11 +145,15 @@ void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, Image
     const float* src = radiance.at(0, v);
     uint8_t* dst = rgb->at(0, v);
     // per chunk: the table indices (SIMD), then the table look-ups.
-    constexpr int kChunk = 240;
+    constexpr int kChunk = 240;  // a multiple of 3: whole pixels
     int32_t index[kChunk];
     for (int i0 = 0; i0 < 3 * w; i0 += kChunk) {
       const int m = std::min(kChunk, 3 * w - i0);
-      ToneMapIndices(src + i0, m, exposure, filmic, index);
+      if (filmic) {
+        FilmicIndices(src + i0, m, exposure, index);
+      } else {
+        ClampIndices(src + i0, m, exposure, index);
+      }
       for (int i = 0; i < m; ++i) dst[i0 + i] = lut[index[i]];
     }
   });

@@ -9,7 +9,15 @@
 //             H = 0.18 / L_avg, i.e. EV100 = log2(L_avg / (0.18 x 1.2)).
 //   compensation  +c stops brighten the image: the EV100 used is EV100 - c.
 //   tone map  filmic: the ACES filmic fit of Narkowicz 2015 ("ACES filmic tone mapping
-//             curve"), per channel, without his 0.6 pre-scale; linear: clamp to [0, 1].
+//             curve"), without his 0.6 pre-scale, applied to the largest channel m of the exposed
+//             linear RGB, and all three channels scaled by AcesFilmic(m) / m. scaling keeps the
+//             ratios of the channels, hence the hue (and saturation) of every pixel, and the
+//             result never leaves [0, 1]^3: the hue-preserving "max-RGB" scaling of Naik and
+//             Murthy ("Hue-preserving color image enhancement without gamut problem", IEEE
+//             Trans. Image Processing 12(12), 2003). a per-channel curve compresses the largest
+//             channel most, so bright saturated colours drift towards the nearest secondary
+//             (orange to yellow, blue to cyan) and wash out. grey pixels get exactly the
+//             per-channel curve. linear: clamp to [0, 1], per channel.
 //   encoding  sRGB OETF (IEC 61966-2-1) to 8 bits through a 65536-entry table (within 1 code
 //             value of the exact rounding).
 // luminance uses the Rec. 709 weights (0.2126, 0.7152, 0.0722). all sums run in a fixed order,
@@ -33,6 +41,10 @@ double ExposureFromEv100(double ev100);
 
 /// ACES filmic fit (Narkowicz 2015) of a non-negative exposed value, in [0, 1].
 float AcesFilmic(float x);
+
+/// hue-preserving filmic map of an exposed linear RGB value x (>= 0; NaN channels stay NaN):
+/// y = x AcesFilmic(m) / m, m = max(x), each y in [0, 1]; all 0 when m <= 0.
+void HuePreservingFilmic(const float x[3], float y[3]);
 
 /// sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
 float SrgbOetf(float linear);

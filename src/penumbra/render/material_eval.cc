@@ -287,6 +287,11 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
   out.pbr.metallic = m.metallic;
   out.pbr.specular = m.specular;
   out.emission = m.emission;
+  if (m.reflectance > 0 && hit.geom >= 0) {
+    const GeomShape shape = scene_.geoms[hit.geom].shape;
+    if (shape == GeomShape::kPlane || (shape == GeomShape::kBox && hit.n_G.z() > 0.5f))
+      out.mirror = std::min(m.reflectance, 1.0f);
+  }
   if (m.texture < 0) return out;
 
   const Texture& tex = scene_.textures[m.texture];

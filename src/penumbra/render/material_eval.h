@@ -65,6 +65,15 @@ namespace penumbra {
 struct SurfaceMaterial {
   PbrParams pbr;                      ///< BRDF parameters, base colour textured
   Eigen::Vector3f emission{0, 0, 0};  ///< emitted radiance, cd/m^2 per channel
+  /// weight r in [0, 1] of a perfect mirror layered over the BRDF: the point's radiance is
+  /// (1 - r) L_brdf + r L_mirror, L_mirror the radiance arriving along the mirrored view ray.
+  /// this is how MuJoCo's renderer blends its planar reflection with weight `reflectance`
+  /// (MuJoCo XML reference, material/reflectance: "If the value is larger than 0, and the
+  /// material is applied to a plane or a box geom, the renderer will simulate reflection ...
+  /// For boxes, only the face in the direction of the local +Z axis is reflective"), so it is
+  /// Material::reflectance on planes and on box faces whose geom-frame normal is +z, else 0.
+  /// a constant weight (no Fresnel rise at grazing angles), as MuJoCo's.
+  float mirror = 0;
 };
 
 /// darkens and smooths an upward-facing surface for rain wetness w in [0, 1] (Lagarde, "Water

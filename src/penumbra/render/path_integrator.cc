@@ -401,6 +401,23 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
         }
         if (vertex >= max_bounces) break;
 
+        // the mirror layer (weight r = mat.mirror), picked with probability r: the path goes on
+        // along the mirrored ray with its throughput unchanged (r L_mirror / r), or goes on
+        // through the BRDF below ((1 - r) L_brdf / (1 - r)). a delta direction: the next
+        // vertex's emitters count with weight 1 (prev_pdf = inf). no draw without a mirror, so
+        // other materials keep their random numbers.
+        if (mat.mirror > 0 && rng.Uniform() < mat.mirror) {
+          const Eigen::Vector3f d = ray.d / d_len;
+          const Eigen::Vector3f n = hit.ng_W;  // faces the ray
+          const Eigen::Vector3f wi = d - 2.0f * d.dot(n) * n;
+          prev_pdf = kInf;
+          prev_p = hit.p_W;
+          from_camera = false;
+          path_m = hit_path_m;
+          ray = SpawnRay(hit, wi);
+          continue;
+        }
+
         const Eigen::Vector3f wo = -ray.d;
         const Bsdf bsdf(mat.pbr, hit.ns_W, hit.ng_W, wo);
         next_event(

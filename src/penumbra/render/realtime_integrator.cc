@@ -35,6 +35,62 @@ inline Vec3Lanes EnvBrdfApprox(const Vec3Lanes& f0, const Lanes& n_v, const Lane
           (f0.z * a + b).max(0.0f).min(1.0f)};
 }
 
+// EnvBrdfApprox for one shading point (the same formula, scalar exp2).
+inline Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
+  const float r0 = 1.0f - roughness, r1 = 0.0425f - 0.0275f * roughness;
+  const float a004 = std::min(r0 * r0, std::exp2(-9.28f * n_v)) * r0 + r1;
+  const float a = -1.04f * a004 + 1.04f - 0.572f * roughness;
+  const float b = 1.04f * a004 - 0.04f + 0.022f * roughness;
+  return (f0 * a + Eigen::Vector3f::Constant(b)).cwiseMax(0.0f).cwiseMin(1.0f);
+}
+
+// radiance arriving along a mirrored ray `ray` (the mirror layer, SurfaceMaterial::mirror):
+// the sky where it escapes, else the surface it hits shaded as the tier shades what the camera
+// sees (emission, sky ambient, one sample of every light with a shadow ray), the light samples'
+// numbers from draws first_draw ... of the pixel's `stream`. one reflection: a mirror seen in a
+// mirror shows its BRDF only. `path_m`: the camera-to-mirror distance (texture level of detail);
+// no media or particles along the mirrored ray.
+Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float path_m, float wetness,
+                               uint64_t stream, uint64_t first_draw, int64_t* traced) {
+  SurfaceHit h;
+  ++*traced;
+  const Eigen::Vector3f d = ray.d.normalized();
+  if (!ctx.scene->Intersect(ray, &h)) return ctx.sky->Radiance(d);
+  const Eigen::Vector3f wo = -d;
+  SurfaceMaterial mat = ctx.materials->Evaluate(
+      h, ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h));
+  if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
+  const Bsdf bsdf(mat.pbr, h.ns_W, h.ng_W, wo);
+  const Eigen::Vector3f& n = bsdf.shading_normal();
+  const Eigen::Vector3f sky_E = ctx.sky_volume != nullptr
+                                    ? ctx.sky_volume->Irradiance(h.p_W, n, *ctx.sky)
+                                    : ctx.sky->Irradiance(n);
+  const Eigen::Vector3f spec = EnvBrdfApproxScalar(bsdf.f0(), std::max(n.dot(wo), 0.0f),
+                                                   std::clamp(mat.pbr.roughness, 0.0f, 1.0f));
+  const Eigen::Vector3f reflect =
+      bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
+  Eigen::Vector3f L = mat.emission + (sky_E * kInvPi).cwiseProduct(reflect);
+  const Eigen::Vector3f origin = OffsetRayOrigin(h.p_W, h.ng_W);
+  for (int j = 0; j < ctx.lights->size(); ++j) {
+    float u1, u2;
+    Rng::Uniform2Of(Rng::DrawAt(stream, first_draw + j), &u1, &u2);
+    LightSample s;
+    if (!ctx.lights->Sample(j, h.p_W, u1, u2, &s)) continue;
+    const Eigen::Vector3f c = bsdf.Eval(s.wi).cwiseProduct(s.E);
+    if (!(c.maxCoeff() > 0)) continue;
+    if (s.cast_shadow) {
+      Ray sr;
+      sr.o = origin;
+      sr.d = s.wi;
+      sr.tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
+      ++*traced;
+      if (ctx.scene->Occluded(sr)) continue;
+    }
+    L += c;
+  }
+  return L;
+}
+
 // per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
   std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
@@ -225,6 +281,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     LaneMask hit = LaneMask::Constant(false);
+    float mirror[kLanes] = {};  // SurfaceMaterial::mirror of every lane
     BsdfLanes bsdf;
     PbrLanes pbr;
     Vec3Lanes p, origin, L, emission, sky_E;
@@ -260,6 +317,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);
       pbr.Set(k, mat.pbr);
+      mirror[k] = mat.mirror;
       emission.Set(k, mat.emission);
       p.Set(k, h.p_W);
       // shadow rays start off the surface on the lit side (lights behind it contribute 0).
@@ -358,8 +416,23 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     }
     for (int k = 0; k < m; ++k) {
       if (!hit[k]) continue;
+      Eigen::Vector3f Lk(L.x[k], L.y[k], L.z[k]);
+      if (mirror[k] > 0) {
+        // the mirror layer: (1 - r) L + r L_mirror, its light samples after this pixel's.
+        const int i = i0 + k;
+        const SurfaceHit& h = primary.hits[i];
+        const Eigen::Vector3f d = primary.rays[i].d.normalized();
+        const Eigen::Vector3f wi = d - 2.0f * d.dot(h.ng_W) * h.ng_W;
+        const uint64_t stream = FrameContext::PixelStream(
+            frame_key, static_cast<uint64_t>(lane_v[k]) * width + static_cast<uint64_t>(lane_u[k]),
+            0);
+        const Eigen::Vector3f Lm =
+            MirrorRadiance(ctx, SpawnRay(h, wi), h.t * primary.rays[i].d.norm(), wetness, stream,
+                           static_cast<uint64_t>(num_lights), &traced);
+        Lk = (1.0f - mirror[k]) * Lk + mirror[k] * Lm;
+      }
       float* Lp = out.radiance->at(lane_u[k], lane_v[k]);
-      Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
+      Lp[0] = Lk.x(), Lp[1] = Lk.y(), Lp[2] = Lk.z();
     }
   }
   // the effects once every pixel of the tile holds its surface or sky radiance.

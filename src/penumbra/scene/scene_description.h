@@ -82,6 +82,9 @@ struct Material {
   float roughness = 0.5f;                        ///< perceptual roughness in [0, 1]
   float metallic = 0.0f;                         ///< [0, 1]
   float specular = 0.5f;                         ///< dielectric specular scale, 0.5 -> F0 = 0.04
+  /// MuJoCo's `reflectance` in [0, 1]: weight of a mirror layer over the surface, on planes
+  /// and the local +z faces of boxes only, as MuJoCo draws it (render/material_eval.h).
+  float reflectance = 0.0f;
   Eigen::Vector3f emission{0, 0, 0};             ///< emitted radiance, cd/m^2 (nits) per channel
   int texture = -1;                              ///< index into SceneDescription::textures, -1 none
   Eigen::Vector2f texrepeat{1, 1};               ///< MJCF texrepeat for 2d mapping

@@ -86,75 +86,124 @@ Light ToLight(const LightConfig& c, const SceneDescription& scene, const std::st
   return l;
 }
 
-// radius of a sphere around the geom's origin that holds the geom (planes: none).
-double GeomBoundingRadius(const SceneDescription& scene, const Geom& g) {
+// half extents of a box in the geom frame, centred on the geom's origin, that holds the geom
+// (planes: none; meshes: see GeomCornersInWorld).
+bool GeomHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* h) {
+  const Eigen::Vector3d& s = g.size;
   switch (g.shape) {
     case GeomShape::kPlane:
-      return -1;
+    case GeomShape::kMesh:
+      return false;
     case GeomShape::kSphere:
-      return g.size.x();
+      *h = Eigen::Vector3d::Constant(s.x());
+      return true;
     case GeomShape::kCapsule:
-      return g.size.x() + g.size.y();
+      *h = Eigen::Vector3d(s.x(), s.x(), s.y() + s.x());
+      return true;
     case GeomShape::kCylinder:
-      return std::hypot(g.size.x(), g.size.y());
+      *h = Eigen::Vector3d(s.x(), s.x(), s.y());
+      return true;
     case GeomShape::kEllipsoid:
-      return g.size.maxCoeff();
     case GeomShape::kBox:
-      return g.size.norm();
-    case GeomShape::kMesh: {
-      double r = 0;
-      for (const Eigen::Vector3f& v : scene.meshes.at(g.mesh).vertices) r = std::max(r, double(v.norm()));
-      return r;
-    }
+      *h = s;
+      return true;
     case GeomShape::kHeightField: {
-      const HeightField& h = scene.hfields.at(g.hfield);
-      return std::sqrt(h.size_x * h.size_x + h.size_y * h.size_y + h.size_z * h.size_z);
+      const HeightField& f = scene.hfields.at(g.hfield);
+      *h = Eigen::Vector3d::Constant(
+          std::sqrt(f.size_x * f.size_x + f.size_y * f.size_y + f.size_z * f.size_z));
+      return true;
     }
   }
-  return -1;
+  return false;
 }
 
-// bounding box of the geoms of moving bodies at `initial` (all finite geoms if none move).
+// bounding box of the geoms of moving bodies at `initial` (all finite geoms if none move):
+// meshes by their vertices, other shapes by the corners of their local bounding boxes, posed.
 bool BoundsOfModel(const SceneDescription& scene, const WorldSnapshot& initial, Eigen::Vector3d* lo,
                    Eigen::Vector3d* hi) {
   for (bool moving_only : {true, false}) {
     *lo = Eigen::Vector3d::Constant(1e300);
     *hi = Eigen::Vector3d::Constant(-1e300);
     bool any = false;
+    auto add = [&](const Eigen::Vector3d& p_W) {
+      *lo = lo->cwiseMin(p_W);
+      *hi = hi->cwiseMax(p_W);
+      any = true;
+    };
     for (const Geom& g : scene.geoms) {
       if (g.group > 2 || (moving_only && scene.bodies.at(g.body).is_static)) continue;
-      const double r = GeomBoundingRadius(scene, g);
-      if (r < 0 || static_cast<size_t>(g.body) >= initial.X_WB.size()) continue;
-      const Eigen::Vector3d c = initial.X_WB[g.body] * g.X_BG.translation();
-      *lo = lo->cwiseMin(c - Eigen::Vector3d::Constant(r));
-      *hi = hi->cwiseMax(c + Eigen::Vector3d::Constant(r));
-      any = true;
+      if (static_cast<size_t>(g.body) >= initial.X_WB.size()) continue;
+      const Pose X_WG = initial.X_WB[g.body] * g.X_BG;
+      Eigen::Vector3d h;
+      if (g.shape == GeomShape::kMesh) {
+        for (const Eigen::Vector3f& v : scene.meshes.at(g.mesh).vertices)
+          add(X_WG * v.cast<double>());
+      } else if (GeomHalfExtents(scene, g, &h)) {
+        for (int c = 0; c < 8; ++c)
+          add(X_WG * Eigen::Vector3d(c & 1 ? h.x() : -h.x(), c & 2 ? h.y() : -h.y(),
+                                     c & 4 ? h.z() : -h.z()));
+      }
     }
     if (any) return true;
   }
   return false;
 }
 
-// a camera looking at the model's bounding sphere from the front-left, above.
-Pose AutoFramePose(const SceneDescription& scene, const WorldSnapshot& initial, double fovy_deg) {
-  Eigen::Vector3d center = scene.center_W, lo, hi;
-  double radius = scene.extent_m;
-  if (BoundsOfModel(scene, initial, &lo, &hi)) {
-    center = 0.5 * (lo + hi);
-    radius = 0.5 * (hi - lo).norm();
+// the auto-framed camera (docs/cameras.md, "Bare models"): it looks along kAutoFrameView (from
+// the front-left, above) and stands where the model's bounding box, centred in the image,
+// spans kAutoFrameFill of the image width or height, whichever it reaches first. the position
+// is found by fixed-point steps: shift sideways by the box's off-centre offset, move along the
+// view by depth x (1 - fill / kAutoFrameFill); every step keeps the box in front of the camera.
+Pose AutoFramePose(const SceneDescription& scene, const WorldSnapshot& initial,
+                   const CameraIntrinsics& k) {
+  Eigen::Vector3d lo, hi;
+  if (!BoundsOfModel(scene, initial, &lo, &hi)) {
+    lo = scene.center_W - Eigen::Vector3d::Constant(scene.extent_m);
+    hi = scene.center_W + Eigen::Vector3d::Constant(scene.extent_m);
   }
-  const double half = 0.5 * fovy_deg * M_PI / 180.0;
-  const double distance = std::max(0.1, 1.6 * radius / std::sin(half));
-  const Eigen::Vector3d view_dir = Eigen::Vector3d(-1.0, -0.6, -0.45).normalized();
-  const Eigen::Vector3d eye = center - distance * view_dir;
+  const Eigen::Vector3d center = 0.5 * (lo + hi);
+  const double radius = std::max(1e-3, 0.5 * (hi - lo).norm());
   // optical frame: z forward, x right, y down
-  const Eigen::Vector3d z = view_dir;
+  const Eigen::Vector3d z = kAutoFrameView.normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
   const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = y;
+  R.col(2) = z;
+  // tangents of the half angles of view (the principal point taken as the image centre).
+  const double tan_x = 0.5 * k.width / k.fx, tan_y = 0.5 * k.height / k.fy;
+  const double half = std::atan(std::min(tan_x, tan_y));
+  // start: the box's bounding sphere inside the view, so every corner is in front.
+  Eigen::Vector3d eye = center - z * std::max(0.1, radius / std::sin(half));
+  for (int step = 0; step < 100; ++step) {
+    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
+    bool in_front = true;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d p(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(),
+                              c & 4 ? hi.z() : lo.z());
+      const Eigen::Vector3d q = R.transpose() * (p - eye);
+      if (!(q.z() > 1e-3 * radius)) {
+        in_front = false;
+        break;
+      }
+      u_lo = std::min(u_lo, q.x() / q.z()), u_hi = std::max(u_hi, q.x() / q.z());
+      v_lo = std::min(v_lo, q.y() / q.z()), v_hi = std::max(v_hi, q.y() / q.z());
+    }
+    const double depth = z.dot(center - eye);
+    if (!in_front) {
+      eye -= z * radius;  // not reached from the start above; a guard
+      continue;
+    }
+    const double fill = std::max((u_hi - u_lo) / (2 * tan_x), (v_hi - v_lo) / (2 * tan_y));
+    const double du = 0.5 * (u_lo + u_hi), dv = 0.5 * (v_lo + v_hi);
+    if (std::abs(fill - kAutoFrameFill) < 1e-5 && std::abs(du) < 1e-6 && std::abs(dv) < 1e-6) break;
+    // never closer than a tenth of the depth per step (thin boxes seen edge-on).
+    const double forward = depth * std::min(0.9, 1.0 - fill / kAutoFrameFill);
+    eye += R * Eigen::Vector3d(du * depth, dv * depth, forward);
+  }
   Pose X = Pose::Identity();
-  X.linear().col(0) = x;
-  X.linear().col(1) = y;
-  X.linear().col(2) = z;
+  X.linear() = R;
   X.translation() = eye;
   return X;
 }
@@ -214,7 +263,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
     cam.outputs = c.outputs;
     if (c.auto_frame) {
       cam.body = 0;
-      cam.X_BO = AutoFramePose(scene, initial, FovyOf(cam.intrinsics));
+      cam.X_BO = AutoFramePose(scene, initial, cam.intrinsics);
     } else {
       cam.body = BodyOrThrow(scene, c.attach, world.file, "cameras[" + std::to_string(i) + "].attach");
       Pose X_BodyOptical = Pose::Identity();

@@ -438,7 +438,9 @@ WorldConfig WorldForBareModel(const std::string& model_path) {
   w.sky.type = Sky::Type::kDaylight;
   w.sky.turbidity = 3;
   w.sky.sun_elevation_deg = 45;
-  w.sky.sun_azimuth_deg = 30;
+  // 60 deg to the left of the auto-framed camera (azimuth 31 deg, session/scene_assembly.h):
+  // the model is lit from the front-left and its shadow falls to its right, in view.
+  w.sky.sun_azimuth_deg = -29;
   w.sky.zenith_luminance_cd_m2 = 8000;
 
   CameraConfig cam;
