@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 
+#include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/core/error.h"
 
@@ -33,9 +34,11 @@ void VisitSection(const MjcfSource& src, const std::string& section, XMLElement*
   for (XMLElement* e = section_elem->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const ElementSpec* spec = FindElementSpec(section, section_elem->Name(), e->Name());
     if (spec == nullptr) {
+      const auto newer = NewerElementHint(e->Name());
       src.Fail(e, section + "." + e->Name(),
                std::string("unsupported element <") + e->Name() + "> inside <" +
-                   section_elem->Name() + ">; expected an MJCF 2.2.2 element");
+                   section_elem->Name() + ">; expected an MJCF 2.2.2 element" +
+                   (newer ? " (" + *newer + ")" : ""));
     }
     f(e, *spec);
     VisitSection(src, section, e, f);
@@ -88,6 +91,7 @@ ModelComposer::ModelComposer(const ModelConfig& config,
                              const std::function<std::string(const std::string&)>& urdf_to_mjcf)
     : config_(config), prefix_(config.name + "/") {
   src_ = MjcfSource::Load(config.file, urdf_to_mjcf);
+  DowngradeMjcf3(*src_, &compat_warnings_);
   X_WM_ = config.pose.ToPose();
   q_WM_ = Eigen::Quaterniond(X_WM_.linear()).normalized();
   CollectSections();
@@ -206,6 +210,7 @@ void ModelComposer::ReadCompiler() {
 }
 
 void ModelComposer::Prepare(bool strip_inertials, std::vector<std::string>* warnings) {
+  warnings->insert(warnings->end(), compat_warnings_.begin(), compat_warnings_.end());
   defaults_ = DefaultTree::Build(*src_);
   CollectNames();
   for (XMLElement* wb : Sections("worldbody")) {

@@ -53,15 +53,26 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "penumbra/world/world_config.h"
 
 namespace tinyxml2 {
 class XMLDocument;
-}
+class XMLElement;
+}  // namespace tinyxml2
 
 namespace penumbra {
+
+class ConfigError;
+
+/// where an element of the composed document was written: a model file (or a file it
+/// includes) and the 1-based line of the element's start tag there.
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+};
 
 /// options of ComposeWorld.
 struct ComposeOptions {
@@ -93,12 +104,29 @@ struct ComposedScene {
   /// the models' names in input order; model M's MJCF names start with "M/".
   std::vector<std::string> model_names;
   /// things that were composed with a compromise (dropped keyframes, conflicting
-  /// <option> or <statistic> of later models, ...), one line each.
+  /// <option> or <statistic> of later models, MuJoCo-3 keywords rewritten for 2.2.2, ...),
+  /// one line each.
   std::vector<std::string> warnings;
+  /// the source map: for each element of `document` that came from a model file, where it
+  /// was written (elements added later, e.g. injected IMU sites, have no entry). copies
+  /// map their own elements.
+  std::unordered_map<const tinyxml2::XMLElement*, SourceLocation> sources;
 
   /// the document as MJCF text (tinyxml2's indented printing).
   std::string Xml() const;
+
+  /// where the element that starts on 1-based line `xml_line` of Xml() (or, when none
+  /// starts there, the last one that starts before it) was written; nullopt when that
+  /// element was not copied from a model file or the line is out of range.
+  std::optional<SourceLocation> SourceOfLine(int xml_line) const;
 };
+
+/// `error` of MuJoCo loading Xml() (its line is a line of the composed text) restated for
+/// the user: file and line of the model element that the line came from (the composed
+/// line is kept in the message, "composed.xml line N"), plus a hint when MuJoCo rejected a
+/// keyword that is newer than MuJoCo 2.2.2. an error without a line, or whose line has no
+/// source, keeps its file and line and only gets the hint.
+ConfigError LocateComposedError(const ComposedScene& scene, const ConfigError& error);
 
 /// merges `models` (in order) into one MJCF document.
 /// @throws ConfigError naming the model file, line (when known), element/attribute and
