@@ -255,6 +255,17 @@ void CheckModelTimestep(const ModelComposer& m) {
 
 void ComposeOption(const Models& models, const ComposeOptions& options, XMLElement* root,
                    Sources* sources, std::vector<std::string>* warnings) {
+  // the world file's physics options, as <option> attributes
+  AttrList overrides;
+  if (options.timestep_sec) SetAttr(&overrides, "timestep", FormatNumbers({*options.timestep_sec}));
+  const PhysicsOptions& p = options.physics;
+  if (p.integrator) SetAttr(&overrides, "integrator", *p.integrator);
+  if (p.gravity_mps2) {
+    SetAttr(&overrides, "gravity",
+            FormatNumbers({p.gravity_mps2->x(), p.gravity_mps2->y(), p.gravity_mps2->z()}));
+  }
+  if (p.solver_iterations) SetAttr(&overrides, "iterations", std::to_string(*p.solver_iterations));
+  if (p.cone) SetAttr(&overrides, "cone", *p.cone);
   // the first model that has an <option> decides; later explicit values that differ warn
   AttrList attrs, flags;
   const ModelComposer* owner = nullptr;
@@ -277,22 +288,32 @@ void ComposeOption(const Models& models, const ComposeOptions& options, XMLEleme
       flags = f;
       continue;
     }
-    const auto differs = [](const AttrList& mine, const AttrList& used) {
+    // the differing attributes the world file does not decide
+    std::vector<std::string> names;
+    const auto differs = [&](const AttrList& mine, const AttrList& used, const char* prefix) {
       for (const auto& [n, v] : mine) {
         const std::string* u = FindAttr(used, n);
-        if (u == nullptr || !SameValue(*u, v)) return true;
+        const bool decided = std::any_of(overrides.begin(), overrides.end(),
+                                         [&](const auto& o) { return o.first == n; });
+        if (!decided && (u == nullptr || !SameValue(*u, v))) names.push_back(prefix + n);
       }
-      return false;
     };
-    if (differs(a, attrs) || differs(f, flags)) {
+    differs(a, attrs, "");
+    differs(f, flags, "flag ");
+    if (!names.empty()) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
       warnings->push_back(ModelLabel(*m) + ": its <option> differs from " + ModelLabel(*owner) +
-                          "'s; the composed world uses the latter");
+                          "'s (" + list +
+                          "); the composed world uses the latter. the world file's physics "
+                          "section decides timestep_sec, integrator, gravity_mps2, "
+                          "solver_iterations and cone (docs/world-file.md)");
     }
   }
   // the world file's physics.timestep_sec wins; else the deciding model's own timestep must be
   // in the range that the world file's is held to (scene/scene_limits.h)
   if (owner != nullptr && !options.timestep_sec) CheckModelTimestep(*owner);
-  if (options.timestep_sec) SetAttr(&attrs, "timestep", FormatNumbers({*options.timestep_sec}));
+  for (const auto& [n, v] : overrides) SetAttr(&attrs, n, v);
   if (attrs.empty() && flags.empty()) return;
   XMLElement* opt = root->InsertNewChildElement("option");
   ApplyAttrs(opt, attrs);

@@ -28,7 +28,8 @@
 //    ComposeOptions::urdf_to_mjcf first and are then composed like MJCF.
 //
 // sections: <option>, <visual>, <statistic> come from the first model that has them
-// (later differing <option>/<statistic> give a warning); <size> is combined
+// (later differing <option>/<statistic> give a warning naming the attributes; the world
+// file's physics options override and silence those they cover); <size> is combined
 // (njmax/nconmax summed with MuJoCo's defaults 500/100 for models without them,
 // nuser_* and nuserdata maximum; nstack left automatic unless a model sets it, then
 // the sum of the explicit sizes and, for the other models, an estimate of MuJoCo
@@ -85,6 +86,10 @@ struct ComposeOptions {
   /// kMaxTimestepSec] of scene/scene_limits.h). without it the first model with an <option>
   /// decides, and its timestep must be in that range too.
   std::optional<double> timestep_sec;
+  /// the world file's physics options (world/world_config.h): each one set overrides the
+  /// composed <option>'s integrator, gravity, iterations or cone, and later models'
+  /// differing values of it no longer warn.
+  PhysicsOptions physics;
 };
 
 /// the result of ComposeWorld: one MJCF document, kept as a tinyxml2 document so that the

@@ -39,6 +39,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   ComposeOptions compose_options;
   compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
   compose_options.timestep_sec = world_.timestep_sec;
+  compose_options.physics = world_.physics;
   ComposedScene composed = ComposeWorld(world_.models, compose_options);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);

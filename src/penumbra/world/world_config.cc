@@ -51,8 +51,22 @@ class WorldParser {
     if (r.Has("duration_sec")) w.duration_sec = r.Child("duration_sec").Double();
     if (r.Has("physics")) {
       YamlReader p = r.Child("physics");
-      p.ExpectMap({"timestep_sec"});
+      p.ExpectMap({"timestep_sec", "integrator", "gravity_mps2", "solver_iterations", "cone"});
       if (p.Has("timestep_sec")) w.timestep_sec = p.Child("timestep_sec").Double();
+      if (p.Has("integrator")) {
+        const YamlReader i = p.Child("integrator");
+        if (i.String() == "implicitfast") {
+          i.Fail(
+              "'implicitfast' is newer than MuJoCo 2.2.2 (Penumbra's physics); expected one of: "
+              "Euler, RK4, implicit (implicit is implicitfast with the Coriolis terms kept)");
+        }
+        w.physics.integrator = i.Enum({"Euler", "RK4", "implicit"});
+      }
+      if (p.Has("gravity_mps2")) w.physics.gravity_mps2 = p.Child("gravity_mps2").Vector3();
+      if (p.Has("solver_iterations")) {
+        w.physics.solver_iterations = p.Child("solver_iterations").Int();
+      }
+      if (p.Has("cone")) w.physics.cone = p.Child("cone").Enum({"pyramidal", "elliptic"});
     }
     if (r.Has("render")) ReadRender(r.Child("render"), &w.render);
     w.render.seed = w.seed;

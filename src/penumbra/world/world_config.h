@@ -39,6 +39,22 @@ struct ModelConfig {
   ControllerConfig controller;  ///< control/controller_config.h; type "" = none
 };
 
+/// world-file `physics:` options besides timestep_sec. each one that is set overrides the
+/// composed MJCF's <option> attribute of the same meaning (MuJoCo 2.2.2 XML reference,
+/// <option>); unset ones keep the first model's <option> (compose/scene_composer.h).
+struct PhysicsOptions {
+  /// <option integrator>: "Euler", "RK4" or "implicit" (MuJoCo 2.2.2's integrators).
+  std::optional<std::string> integrator;
+  /// <option gravity>, m/s^2 in the world frame W (z up); each component in [-1000, 1000].
+  std::optional<Eigen::Vector3d> gravity_mps2;
+  /// <option iterations>: the constraint solver's maximum iterations, in [1, 10000].
+  std::optional<int> solver_iterations;
+  /// <option cone>: the friction cone, "pyramidal" or "elliptic".
+  std::optional<std::string> cone;
+
+  bool empty() const { return !integrator && !gravity_mps2 && !solver_iterations && !cone; }
+};
+
 /// a world-file light (see scene Light for units).
 struct LightConfig {
   std::string name;
@@ -126,6 +142,7 @@ struct WorldConfig {
   uint64_t seed = 0;
   double duration_sec = 10;
   std::optional<double> timestep_sec;  ///< overrides the MJCF <option timestep>
+  PhysicsOptions physics;              ///< `physics:` integrator, gravity, iterations, cone
   std::vector<ModelConfig> models;     ///< robots first, then static models, in file order
   std::vector<LightConfig> lights;
   bool default_lights = false;  ///< add a default sun + sky fill (bare-model runs)
