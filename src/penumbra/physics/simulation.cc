@@ -94,6 +94,46 @@ std::string NameOr(const mjModel* m, int type, int id) {
   return n ? std::string(n) : std::string();
 }
 
+// which MJCF shortcut actuator a's gain/bias/dynamics amount to (MuJoCo 2.2.2
+// user_objects.cc mjCActuator and xml_native_reader.cc: <motor> gain [1] no bias,
+// <position kp> gain [kp] bias [0 -kp 0], <velocity kv> gain [kv] bias [0 0 -kv]; a <general>
+// with bias [0 -kp -kv] is a position servo with damping)
+void ClassifyDrive(const mjModel* m, int a, ActuatorInfo* ai) {
+  const mjtNum* g = m->actuator_gainprm + static_cast<size_t>(a) * mjNGAIN;
+  const mjtNum* b = m->actuator_biasprm + static_cast<size_t>(a) * mjNBIAS;
+  ai->drive = ActuatorDrive::kOther;
+  if (m->actuator_dyntype[a] != mjDYN_NONE) {
+    ai->drive_detail = "dyntype " + std::to_string(m->actuator_dyntype[a]) +
+                       ": activation dynamics (integrator/filter/muscle/user)";
+    return;
+  }
+  if (m->actuator_gaintype[a] != mjGAIN_FIXED) {
+    ai->drive_detail = "gaintype " + std::to_string(m->actuator_gaintype[a]) + ": not fixed";
+    return;
+  }
+  ai->gain = g[0];
+  if (m->actuator_biastype[a] == mjBIAS_NONE) {
+    ai->drive = ActuatorDrive::kMotor;
+    return;
+  }
+  if (m->actuator_biastype[a] == mjBIAS_AFFINE && b[0] == 0) {
+    if (b[1] < 0 && b[1] == -g[0] && b[2] <= 0) {
+      ai->drive = ActuatorDrive::kPositionServo;
+      ai->kp = g[0];
+      ai->kv = -b[2];
+      return;
+    }
+    if (b[1] == 0 && b[2] < 0 && b[2] == -g[0]) {
+      ai->drive = ActuatorDrive::kVelocityServo;
+      ai->kv = g[0];
+      return;
+    }
+  }
+  ai->drive_detail = "biastype " + std::to_string(m->actuator_biastype[a]) + ", biasprm " +
+                     std::to_string(b[0]) + " " + std::to_string(b[1]) + " " +
+                     std::to_string(b[2]) + " for gain " + std::to_string(g[0]);
+}
+
 ModelInfo BuildModelInfo(const mjModel* m) {
   ModelInfo info;
   info.nq = m->nq;
@@ -137,6 +177,10 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     ai.ctrl_limited = m->actuator_ctrllimited[a] != 0;
     ai.ctrl_range[0] = m->actuator_ctrlrange[2 * a];
     ai.ctrl_range[1] = m->actuator_ctrlrange[2 * a + 1];
+    ai.force_limited = m->actuator_forcelimited[a] != 0;
+    ai.force_range[0] = m->actuator_forcerange[2 * a];
+    ai.force_range[1] = m->actuator_forcerange[2 * a + 1];
+    ClassifyDrive(m, a, &ai);
     info.actuators.push_back(ai);
   }
   for (int s = 0; s < m->nsensor; ++s)
