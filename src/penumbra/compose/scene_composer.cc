@@ -11,6 +11,7 @@
 #include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/compose/model_composer.h"
+#include "penumbra/compose/world_sites.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/scene/scene_limits.h"
@@ -614,6 +615,7 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
        {"custom", "asset", "worldbody", "contact", "equality", "tendon", "actuator", "sensor"}) {
     ComposeSection(composers, section, &doc, root, &scene.sources);
   }
+  compose::AddWorldSites(models, root);  // the world file's sites: (compose/world_sites.h)
   const int nkeys = ComposeKeys(composers, root, &scene.sources, &scene.warnings);
   // <size> needs the key count; put it after <option> as MuJoCo's writer does
   XMLDocument size_doc;

@@ -24,6 +24,8 @@
 //  - applies the model pose X_WM to the top-level worldbody elements (bodies keep
 //    their free joints at the top level): pos/quat, geom and site fromto, light
 //    pos/dir, composite offset;
+//  - adds the world file's sites of M (ModelConfig::sites, compose/world_sites.h) to M's
+//    bodies as "M/<site>";
 //  - URDF files (a .urdf file, or any file whose root element is <robot>) go through
 //    ComposeOptions::urdf_to_mjcf first and are then composed like MJCF.
 //

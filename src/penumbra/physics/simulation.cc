@@ -613,6 +613,62 @@ void Simulation::SetState(const SimState& s) {
   impl.failure.clear();
 }
 
+void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix,
+                               const std::string& error_key) {
+  const mjModel* m = impl_->m;
+  mjData* d = impl_->d;
+  const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
+  if (k < 0) {
+    std::string keys;
+    for (int i = 0; i < m->nkey; ++i) {
+      const std::string name = NameOr(m, mjOBJ_KEY, i);
+      if (name.rfind(prefix, 0) == 0)
+        keys += (keys.empty() ? "" : ", ") + name.substr(prefix.size());
+    }
+    throw ConfigError(
+        "", 0, error_key,
+        "no keyframe '" + key.substr(std::min(key.size(), prefix.size())) + "' in model '" +
+            prefix.substr(0, prefix.size() - 1) +
+            "'; expected one of its <key> names: " + (keys.empty() ? "(it has none)" : keys));
+  }
+  const auto mine = [&](mjtObj type, int id) {
+    const char* name = mj_id2name(m, type, id);
+    return name != nullptr && std::string(name).rfind(prefix, 0) == 0;
+  };
+  for (int j = 0; j < m->njnt; ++j) {
+    if (!mine(mjOBJ_JOINT, j)) continue;
+    const int type = m->jnt_type[j];
+    const int nq = type == mjJNT_FREE ? 7 : type == mjJNT_BALL ? 4 : 1;
+    const int nv = type == mjJNT_FREE ? 6 : type == mjJNT_BALL ? 3 : 1;
+    for (int i = 0; i < nq; ++i) {
+      const int a = m->jnt_qposadr[j] + i;
+      d->qpos[a] = m->key_qpos[static_cast<size_t>(k) * m->nq + a];
+    }
+    for (int i = 0; i < nv; ++i) {
+      const int a = m->jnt_dofadr[j] + i;
+      d->qvel[a] = m->key_qvel[static_cast<size_t>(k) * m->nv + a];
+    }
+  }
+  // stateful actuators come last (MuJoCo 2.2.2), act[i] belongs to actuator nu - na + i
+  for (int a = 0; a < m->nu; ++a) {
+    if (!mine(mjOBJ_ACTUATOR, a)) continue;
+    d->ctrl[a] = m->key_ctrl[static_cast<size_t>(k) * m->nu + a];
+    const int act = a - (m->nu - m->na);
+    if (act >= 0) d->act[act] = m->key_act[static_cast<size_t>(k) * m->na + act];
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    const int mocap = m->body_mocapid[b];
+    if (mocap < 0 || !mine(mjOBJ_BODY, b)) continue;
+    for (int i = 0; i < 3; ++i)
+      d->mocap_pos[3 * mocap + i] =
+          m->key_mpos[static_cast<size_t>(k) * 3 * m->nmocap + 3 * mocap + i];
+    for (int i = 0; i < 4; ++i)
+      d->mocap_quat[4 * mocap + i] =
+          m->key_mquat[static_cast<size_t>(k) * 4 * m->nmocap + 4 * mocap + i];
+  }
+  mj_forward(m, d);
+}
+
 double Simulation::time() const { return impl_->d->time; }
 int64_t Simulation::step_count() const { return impl_->steps; }
 double Simulation::timestep() const { return impl_->m->opt.timestep; }

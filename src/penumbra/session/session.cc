@@ -61,6 +61,12 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
     // MuJoCo names a line of the composed text: name the model file and line instead
     throw LocateComposedError(composed, e);
   }
+  // the world file's initial_keyframe of each model, before anything reads the state
+  for (const ModelConfig& m : world_.models) {
+    if (m.initial_keyframe.empty()) continue;
+    sim_->ApplyKeyframe(m.name + "/" + m.initial_keyframe, m.name + "/",
+                        (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".initial_keyframe");
+  }
   effects_->Attach(sim_.get());  // checks the world's agents against the model
   if (options.add_controllers) AddWorldControllers(world_, sim_.get());
   timings_.load_sec = SecondsSince(t0);

@@ -29,6 +29,17 @@ struct PoseConfig {
   Pose ToPose() const { return PoseFromXyzRpyDeg(xyz, rpy_deg); }
 };
 
+/// a site the world file adds to a model (`sites:` of a robot or model entry), e.g. a foot
+/// point or tool centre point the model lacks. its MJCF name is "<model>/<name>".
+struct SiteConfig {
+  std::string name;  ///< model-local, unique among the model's sites
+  std::string body;  ///< model-local parent body ("world" = the world body); or
+  std::string geom;  ///< model-local geom: the site goes on its body, at its centre
+  /// X_PS: the site in the parent body's frame (body), or offset from the geom's centre
+  /// along the body's axes (geom).
+  PoseConfig pose;
+};
+
 /// one MJCF or URDF file placed in the world under a unique name.
 struct ModelConfig {
   std::string name;  ///< unique; prefixes every MJCF name of the model as "<name>/"
@@ -37,6 +48,13 @@ struct ModelConfig {
   PoseConfig pose;
   bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
   ControllerConfig controller;  ///< control/controller_config.h; type "" = none
+  std::vector<SiteConfig> sites;  ///< `sites:` added to the model when composing
+  /// `initial_keyframe:` a <key> of the model (its local name) the run starts from ("" =
+  /// MuJoCo's reference configuration qpos0).
+  std::string initial_keyframe;
+  /// key path of the entry in the world file ("robots[1]"), for errors found later; "" for
+  /// models not from a world file.
+  std::string key;
 };
 
 /// world-file `physics:` options besides timestep_sec. each one that is set overrides the
