@@ -2,7 +2,8 @@
 // position-servo actuators and no foot sites (the bundled quadruped with its motors replaced
 // by <position> servos and its foot sites and touch sensors removed) trots with trot_gait,
 // its feet added by the world file's `sites:` (at foot geoms, or on the calf bodies with an
-// offset), starting from its `stand` key via `initial_keyframe`.
+// offset), starting from its `stand` key via `initial_keyframe`; and a Panda-class arm with
+// servos and no TCP site moved by diff_ik to a target for a world-file TCP site.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -108,6 +109,69 @@ TEST(ForeignRobotWorld, AnUnknownInitialKeyframeNamesTheKeyAndTheModelsKeys) {
               std::string::npos)
         << e.what();
   }
+}
+
+// the arm half: a Panda-class arm without a TCP site whose joints have Menagerie-Panda style
+// servos (<general gainprm=kp biasprm="0 -kp -kv">), moved by diff_ik (output: position) to a
+// target given for a TCP that the world file adds on the hand body
+std::string ForeignArm() {
+  std::ifstream f(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/models/arm/panda_arm.xml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  std::string xml = ss.str();
+  xml = std::regex_replace(xml, std::regex("<site name=\"ee\"[^>]*/>"), "");
+  xml = std::regex_replace(
+      xml,
+      std::regex("<motor (name=\"actuator[1-7]\" class=\"panda\" joint=\"joint[1-7]\") "
+                 "ctrlrange=\"[^\"]*\"/>"),
+      "<general $1 gainprm=\"2000\" biastype=\"affine\" biasprm=\"0 -2000 -100\" "
+      "ctrlrange=\"-3.1 3.1\"/>");
+  EXPECT_EQ(xml.find("name=\"ee\""), std::string::npos);
+  EXPECT_EQ(xml.find("<motor name=\"actuator"), std::string::npos);
+  return xml;
+}
+
+TEST(ForeignRobotWorld, ServoArmWithoutATcpSiteMovesWithDiffIkFromTheWorldFile) {
+  penumbra::testing::TempDir dir;
+  dir.Write("arm/panda.xml", ForeignArm());
+  const std::string world = dir.Write(
+      "world.yaml",
+      // as Menagerie's Panda (implicitfast): implicit integrates the servo damping stably
+      "physics: {integrator: implicit}\n"
+      "robots:\n"
+      "  - name: arm\n"
+      "    file: arm/panda.xml\n"
+      "    sites:\n"
+      "      - {name: tcp, body: hand, pose: {xyz: [0, 0, 0.1034]}}\n"
+      "    controller:\n"
+      "      type: diff_ik\n"
+      "      site: tcp\n"
+      "      base_body: link0\n"
+      "      joints: [joint1, joint2, joint3, joint4, joint5, joint6, joint7]\n"
+      "      actuators: [actuator1, actuator2, actuator3, actuator4, actuator5, actuator6, "
+      "actuator7]\n"
+      "      output: position\n"
+      "      commands:\n"
+      "        - {t: 0, move_to: {xyz: [0.45, 0.15, 0.35], rpy_deg: [180, 0, 0]}}\n");
+  SessionOptions options;
+  options.build_renderer = false;
+  Session session(LoadWorldFile(world), options);
+  Simulation& sim = session.sim();
+  const auto& names = sim.model_info().body_names;
+  const int hand =
+      static_cast<int>(std::find(names.begin(), names.end(), "arm/hand") - names.begin());
+  ASSERT_LT(hand, static_cast<int>(names.size()));
+  const auto tcp = [&] {
+    return Eigen::Vector3d(sim.Snapshot().X_WB[hand] * Eigen::Vector3d(0, 0, 0.1034));
+  };
+  const Eigen::Vector3d start = tcp();
+  while (sim.time() < 4.0 - 1e-9) sim.Step();
+  const Eigen::Vector3d end = tcp();
+  const Eigen::Vector3d target(0.45, 0.15, 0.35);
+  std::printf("[ measured ] TCP from (%.3f, %.3f, %.3f) to (%.4f, %.4f, %.4f), error %.4f m\n",
+              start.x(), start.y(), start.z(), end.x(), end.y(), end.z(), (end - target).norm());
+  EXPECT_GT((start - target).norm(), 0.1);
+  EXPECT_LT((end - target).norm(), 0.01);
 }
 
 }  // namespace
