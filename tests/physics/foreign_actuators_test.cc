@@ -63,7 +63,7 @@ TEST(ForeignActuators, TrotGaitDrivesPositionServosLikeMotors) {
   // Menagerie Go1 style: <position kp> (ctrl = joint target), force-limited like the motors,
   // and a <general> servo with damping (biasprm 0 -kp -kv)
   const std::string dir = penumbra::testing::ProcessTempDir();
-  for (const std::string servo :
+  for (const std::string& servo :
        {std::string("<position kp=\"100\""),
         std::string("<general gainprm=\"80\" biastype=\"affine\" biasprm=\"0 -80 -2\"")}) {
     Rig rig = LoadRig(ModelWithActuators(servo, dir), config);

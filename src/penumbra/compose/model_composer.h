@@ -100,6 +100,7 @@ class ModelComposer {
   int MaxUserLength(const std::string& tag_kind) const;
 
  private:
+  void AddFloatingBase();
   void CollectSections();
   void ReadCompiler();
   void CollectNames();

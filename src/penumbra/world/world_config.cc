@@ -180,9 +180,10 @@ class WorldParser {
 
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
     if (is_robot) {
-      r.ExpectMap({"name", "file", "pose", "controller", "sensors", "sites", "initial_keyframe"});
+      r.ExpectMap({"name", "file", "pose", "controller", "sensors", "sites", "initial_keyframe",
+                   "floating_base"});
     } else {
-      r.ExpectMap({"name", "file", "pose", "sites", "initial_keyframe"});
+      r.ExpectMap({"name", "file", "pose", "sites", "initial_keyframe", "floating_base"});
     }
     ModelConfig m;
     m.is_robot = is_robot;
@@ -190,6 +191,7 @@ class WorldParser {
     m.name = r.Child("name").String();
     m.file = Resolve(r.Child("file").String());
     if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
+    if (r.Has("floating_base")) m.floating_base = r.Child("floating_base").Bool();
     if (r.Has("initial_keyframe")) {
       m.initial_keyframe = r.Child("initial_keyframe").String();
       if (m.initial_keyframe.empty())

@@ -52,6 +52,9 @@ struct ModelConfig {
   /// `initial_keyframe:` a <key> of the model (its local name) the run starts from ("" =
   /// MuJoCo's reference configuration qpos0).
   std::string initial_keyframe;
+  /// `floating_base:` (URDF only) the URDF's root link becomes a free body (joint
+  /// "<model>/floating_base") instead of being welded to the world, as MuJoCo's importer does.
+  bool floating_base = false;
   /// key path of the entry in the world file ("robots[1]"), for errors found later; "" for
   /// models not from a world file.
   std::string key;
