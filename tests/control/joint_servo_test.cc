@@ -202,3 +202,30 @@ TEST(JointPd, ConfigErrors) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+using namespace arm_fake;  // NOLINT(build/namespaces)
+
+// issue 17 point 7: torque output on a position servo (a Menagerie arm's <position>) would
+// write efforts as joint targets; it is refused naming the actuator and its type
+TEST(JointServo, TorqueOutputRefusesServoActuators) {
+  ModelInfo m = ArmModel();
+  m.actuators[2].drive = ActuatorDrive::kPositionServo;
+  m.actuators[2].kp = 100;
+  try {
+    MakePd(m, "");
+    ADD_FAILURE() << "torque output accepted a position servo";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("actuators[2]: actuator '" + m.actuators[2].name +
+                        "' is a position servo; expected a motor for output: torque"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_NE(MakePd(m, "output: position\n"), nullptr);
+}
+
+}  // namespace
+}  // namespace penumbra

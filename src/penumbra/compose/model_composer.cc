@@ -1,8 +1,11 @@
 #include "penumbra/compose/model_composer.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <functional>
+#include <set>
 
+#include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/core/error.h"
 
@@ -33,9 +36,11 @@ void VisitSection(const MjcfSource& src, const std::string& section, XMLElement*
   for (XMLElement* e = section_elem->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const ElementSpec* spec = FindElementSpec(section, section_elem->Name(), e->Name());
     if (spec == nullptr) {
+      const auto newer = NewerElementHint(e->Name());
       src.Fail(e, section + "." + e->Name(),
                std::string("unsupported element <") + e->Name() + "> inside <" +
-                   section_elem->Name() + ">; expected an MJCF 2.2.2 element");
+                   section_elem->Name() + ">; expected an MJCF 2.2.2 element" +
+                   (newer ? " (" + *newer + ")" : ""));
     }
     f(e, *spec);
     VisitSection(src, section, e, f);
@@ -88,10 +93,100 @@ ModelComposer::ModelComposer(const ModelConfig& config,
                              const std::function<std::string(const std::string&)>& urdf_to_mjcf)
     : config_(config), prefix_(config.name + "/") {
   src_ = MjcfSource::Load(config.file, urdf_to_mjcf);
+  DowngradeMjcf3(*src_, &compat_warnings_);
+  if (config.floating_base) AddFloatingBase();
   X_WM_ = config.pose.ToPose();
   q_WM_ = Eigen::Quaterniond(X_WM_.linear()).normalized();
   CollectSections();
   ReadCompiler();
+}
+
+// floating_base: the root link (the URDF link that is no joint's child) gets a free joint.
+// with Penumbra's converter it is a top-level body; MuJoCo's importer with link fusing on
+// (a URDF's own <mujoco> extension) puts its geoms straight into the world body and drops
+// its <inertial>: then they are wrapped into a body named after the root link, with the
+// root link's inertial from the URDF (origin xyz / rpy: fixed-axis roll, pitch, yaw as URDF
+// defines them; inertia about the link's inertial frame).
+void ModelComposer::AddFloatingBase() {
+  const std::string key =
+      (config_.key.empty() ? "models[" + config_.name + "]" : config_.key) + ".floating_base";
+  if (!src_->from_urdf()) {
+    throw ConfigError("", 0, key,
+                      "model '" + config_.name +
+                          "' is MJCF; expected floating_base only for URDF models (give an MJCF "
+                          "body a <freejoint/> in its file)");
+  }
+  tinyxml2::XMLDocument urdf;
+  if (urdf.LoadFile(config_.file.c_str()) != tinyxml2::XML_SUCCESS || !urdf.RootElement()) {
+    throw ConfigError(config_.file, 0, key, "cannot read the URDF again to find its root link");
+  }
+  std::set<std::string> children;
+  for (const XMLElement* j = urdf.RootElement()->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
+    if (const XMLElement* c = j->FirstChildElement("child"); c && c->Attribute("link"))
+      children.insert(c->Attribute("link"));
+  }
+  const XMLElement* root_link = nullptr;
+  for (const XMLElement* l = urdf.RootElement()->FirstChildElement("link"); l;
+       l = l->NextSiblingElement("link")) {
+    if (l->Attribute("name") && !children.count(l->Attribute("name"))) root_link = l;
+  }
+  if (root_link == nullptr) throw ConfigError(config_.file, 0, key, "the URDF has no root link");
+  XMLElement* world = src_->root()->FirstChildElement("worldbody");
+  if (world == nullptr) world = src_->root()->InsertNewChildElement("worldbody");
+  // physics/urdf_converter.h keeps every link a body (fusestatic off): the root link is a
+  // top-level body with its inertial, which only needs the free joint
+  for (XMLElement* e = world->FirstChildElement("body"); e; e = e->NextSiblingElement("body")) {
+    if (e->Attribute("name", root_link->Attribute("name"))) {
+      e->InsertNewChildElement("freejoint")->SetAttribute("name", "floating_base");
+      e->InsertFirstChild(e->LastChild());
+      return;
+    }
+  }
+  XMLElement* body = src_->doc()->NewElement("body");
+  body->SetAttribute("name", root_link->Attribute("name"));
+  while (XMLElement* e = world->FirstChildElement()) body->InsertEndChild(e);
+  XMLElement* joint = src_->doc()->NewElement("freejoint");
+  joint->SetAttribute("name", "floating_base");
+  body->InsertFirstChild(joint);
+  if (const XMLElement* in = root_link->FirstChildElement("inertial")) {
+    const auto numbers = [&](const XMLElement* e, const char* attr, size_t n) {
+      std::vector<double> out(n, 0.0);
+      if (e != nullptr && e->Attribute(attr)) {
+        const auto v = ParseNumbers(e->Attribute(attr));
+        if (!v || v->size() != n) {
+          throw ConfigError(config_.file, e->GetLineNum(), key,
+                            std::string("root link inertial: '") + e->Attribute(attr) +
+                                "' is not " + std::to_string(n) + " numbers");
+        }
+        out = *v;
+      }
+      return out;
+    };
+    const XMLElement* origin = in->FirstChildElement("origin");
+    const std::vector<double> xyz = numbers(origin, "xyz", 3);
+    const std::vector<double> rpy = numbers(origin, "rpy", 3);
+    const XMLElement* I = in->FirstChildElement("inertia");
+    const XMLElement* mass = in->FirstChildElement("mass");
+    XMLElement* inertial = src_->doc()->NewElement("inertial");
+    inertial->SetAttribute("pos", FormatNumbers(xyz).c_str());
+    const Eigen::Quaterniond q = Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX());
+    inertial->SetAttribute("mass", FormatNumbers(numbers(mass, "value", 1)).c_str());
+    // MJCF fullinertia excludes an orientation: the tensor goes into the body frame instead,
+    // I_B = R I_L R^T
+    const auto v = [&](const char* a) { return numbers(I, a, 1)[0]; };
+    Eigen::Matrix3d I_L;
+    I_L << v("ixx"), v("ixy"), v("ixz"), v("ixy"), v("iyy"), v("iyz"), v("ixz"), v("iyz"), v("izz");
+    const Eigen::Matrix3d R = q.toRotationMatrix();
+    const Eigen::Matrix3d I_B = R * I_L * R.transpose();
+    inertial->SetAttribute(
+        "fullinertia",
+        FormatNumbers({I_B(0, 0), I_B(1, 1), I_B(2, 2), I_B(0, 1), I_B(0, 2), I_B(1, 2)}).c_str());
+    body->InsertAfterChild(joint, inertial);
+  }
+  world->InsertEndChild(body);
 }
 
 std::string ModelComposer::Key(const XMLElement* elem, const char* attr) const {
@@ -206,6 +301,7 @@ void ModelComposer::ReadCompiler() {
 }
 
 void ModelComposer::Prepare(bool strip_inertials, std::vector<std::string>* warnings) {
+  warnings->insert(warnings->end(), compat_warnings_.begin(), compat_warnings_.end());
   defaults_ = DefaultTree::Build(*src_);
   CollectNames();
   for (XMLElement* wb : Sections("worldbody")) {

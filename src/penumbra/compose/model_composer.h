@@ -68,7 +68,9 @@ struct KeyData {
 
 class ModelComposer {
  public:
-  /// loads the model file (URDF through `urdf_to_mjcf`) and reads its compiler settings.
+  /// loads the model file (URDF through `urdf_to_mjcf`), rewrites or rejects its MuJoCo-3
+  /// keywords (mjcf_compat.h; the warnings are reported by Prepare) and reads its compiler
+  /// settings.
   ModelComposer(const ModelConfig& config,
                 const std::function<std::string(const std::string&)>& urdf_to_mjcf);
 
@@ -98,6 +100,7 @@ class ModelComposer {
   int MaxUserLength(const std::string& tag_kind) const;
 
  private:
+  void AddFloatingBase();
   void CollectSections();
   void ReadCompiler();
   void CollectNames();
@@ -134,6 +137,7 @@ class ModelComposer {
   Eigen::Quaterniond q_WM_ = Eigen::Quaterniond::Identity();
   ModelSizes sizes_;
   std::vector<KeyData> keys_;
+  std::vector<std::string> compat_warnings_;  ///< MuJoCo-3 keywords rewritten (mjcf_compat.h)
 };
 
 }  // namespace penumbra::compose

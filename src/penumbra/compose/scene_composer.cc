@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <memory>
 
+#include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/compose/model_composer.h"
+#include "penumbra/compose/world_sites.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/scene/scene_limits.h"
@@ -26,6 +29,41 @@ using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
 using Models = std::vector<std::unique_ptr<ModelComposer>>;
+using Sources = std::unordered_map<const XMLElement*, SourceLocation>;
+
+// records where `copy` (and its subtree) came from: `original` of model `m`, same shape
+void Record(const ModelComposer& m, const XMLElement* original, const XMLElement* copy,
+            Sources* sources) {
+  const compose::Origin o = m.source().Where(original);
+  if (o.line > 0) (*sources)[copy] = {o.file, o.line};
+  const XMLElement* a = original->FirstChildElement();
+  const XMLElement* b = copy->FirstChildElement();
+  for (; a && b; a = a->NextSiblingElement(), b = b->NextSiblingElement()) {
+    Record(m, a, b, sources);
+  }
+}
+
+// calls f(a, b) for the elements of two documents of the same shape, in document order
+void WalkPair(const tinyxml2::XMLNode* a, const tinyxml2::XMLNode* b,
+              const std::function<void(const XMLElement*, const XMLElement*)>& f) {
+  const XMLElement* x = a->FirstChildElement();
+  const XMLElement* y = b->FirstChildElement();
+  for (; x && y; x = x->NextSiblingElement(), y = y->NextSiblingElement()) {
+    f(x, y);
+    WalkPair(x, y, f);
+  }
+}
+
+// the source map of `from` (elements of `from_doc`) for the deep copy `to_doc`
+Sources CopySources(const Sources& from, const XMLDocument& from_doc, const XMLDocument& to_doc) {
+  Sources out;
+  if (from.empty()) return out;
+  WalkPair(&from_doc, &to_doc, [&](const XMLElement* a, const XMLElement* b) {
+    const auto it = from.find(a);
+    if (it != from.end()) out[b] = it->second;
+  });
+  return out;
+}
 
 // MuJoCo 2.2.2 defaults of the compiler attributes the composer carries over
 const AttrList& CompilerDefaults() {
@@ -217,7 +255,18 @@ void CheckModelTimestep(const ModelComposer& m) {
 }
 
 void ComposeOption(const Models& models, const ComposeOptions& options, XMLElement* root,
-                   std::vector<std::string>* warnings) {
+                   Sources* sources, std::vector<std::string>* warnings) {
+  // the world file's physics options, as <option> attributes
+  AttrList overrides;
+  if (options.timestep_sec) SetAttr(&overrides, "timestep", FormatNumbers({*options.timestep_sec}));
+  const PhysicsOptions& p = options.physics;
+  if (p.integrator) SetAttr(&overrides, "integrator", *p.integrator);
+  if (p.gravity_mps2) {
+    SetAttr(&overrides, "gravity",
+            FormatNumbers({p.gravity_mps2->x(), p.gravity_mps2->y(), p.gravity_mps2->z()}));
+  }
+  if (p.solver_iterations) SetAttr(&overrides, "iterations", std::to_string(*p.solver_iterations));
+  if (p.cone) SetAttr(&overrides, "cone", *p.cone);
   // the first model that has an <option> decides; later explicit values that differ warn
   AttrList attrs, flags;
   const ModelComposer* owner = nullptr;
@@ -240,25 +289,39 @@ void ComposeOption(const Models& models, const ComposeOptions& options, XMLEleme
       flags = f;
       continue;
     }
-    const auto differs = [](const AttrList& mine, const AttrList& used) {
+    // the differing attributes the world file does not decide
+    std::vector<std::string> names;
+    const auto differs = [&](const AttrList& mine, const AttrList& used, const char* prefix) {
       for (const auto& [n, v] : mine) {
         const std::string* u = FindAttr(used, n);
-        if (u == nullptr || !SameValue(*u, v)) return true;
+        const bool decided = std::any_of(overrides.begin(), overrides.end(),
+                                         [&](const auto& o) { return o.first == n; });
+        if (!decided && (u == nullptr || !SameValue(*u, v))) names.push_back(prefix + n);
       }
-      return false;
     };
-    if (differs(a, attrs) || differs(f, flags)) {
+    differs(a, attrs, "");
+    differs(f, flags, "flag ");
+    if (!names.empty()) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
       warnings->push_back(ModelLabel(*m) + ": its <option> differs from " + ModelLabel(*owner) +
-                          "'s; the composed world uses the latter");
+                          "'s (" + list +
+                          "); the composed world uses the latter. the world file's physics "
+                          "section decides timestep_sec, integrator, gravity_mps2, "
+                          "solver_iterations and cone (docs/world-file.md)");
     }
   }
   // the world file's physics.timestep_sec wins; else the deciding model's own timestep must be
   // in the range that the world file's is held to (scene/scene_limits.h)
   if (owner != nullptr && !options.timestep_sec) CheckModelTimestep(*owner);
-  if (options.timestep_sec) SetAttr(&attrs, "timestep", FormatNumbers({*options.timestep_sec}));
+  for (const auto& [n, v] : overrides) SetAttr(&attrs, n, v);
   if (attrs.empty() && flags.empty()) return;
   XMLElement* opt = root->InsertNewChildElement("option");
   ApplyAttrs(opt, attrs);
+  if (owner != nullptr) {
+    const compose::Origin o = owner->source().Where(owner->Sections("option").front());
+    if (o.line > 0) (*sources)[opt] = {o.file, o.line};
+  }
   if (!flags.empty()) ApplyAttrs(opt->InsertNewChildElement("flag"), flags);
 }
 
@@ -373,7 +436,7 @@ void ComposeStatistic(const Models& models, XMLElement* root, std::vector<std::s
   if (owner) ApplyAttrs(root->InsertNewChildElement("statistic"), used);
 }
 
-void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root) {
+void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root, Sources* sources) {
   XMLElement* top = nullptr;
   for (const auto& m : models) {
     if (!top) top = root->InsertNewChildElement("default");
@@ -382,7 +445,7 @@ void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root) {
     for (XMLElement* s : m->defaults().root_sections()) {
       for (XMLElement* c = s->FirstChildElement(); c; c = c->NextSiblingElement()) {
         if (std::string(c->Name()) == "default") {
-          cls->InsertEndChild(c->DeepClone(doc));
+          Record(*m, c, cls->InsertEndChild(c->DeepClone(doc))->ToElement(), sources);
           continue;
         }
         // several top-level <default> sections all write into the root class
@@ -394,7 +457,7 @@ void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root) {
         if (same) {
           ApplyAttrs(same, Attributes(c));
         } else {
-          cls->InsertEndChild(c->DeepClone(doc));
+          Record(*m, c, cls->InsertEndChild(c->DeepClone(doc))->ToElement(), sources);
         }
       }
     }
@@ -405,7 +468,7 @@ void ComposeDefaults(const Models& models, XMLDocument* doc, XMLElement* root) {
 // actuators: MuJoCo 2.2.2 requires stateless actuators before stateful ones, so all
 // models' stateless actuators come first, then all stateful ones (each in model order)
 void ComposeSection(const Models& models, const std::string& section, XMLDocument* doc,
-                    XMLElement* root) {
+                    XMLElement* root, Sources* sources) {
   XMLElement* out = nullptr;
   const bool actuators = section == "actuator";
   for (int pass = 0; pass < (actuators ? 2 : 1); ++pass) {
@@ -415,7 +478,7 @@ void ComposeSection(const Models& models, const std::string& section, XMLDocumen
         for (XMLElement* c = s->FirstChildElement(); c; c = c->NextSiblingElement(), ++index) {
           if (actuators && m->sizes().actuator_stateful.at(index) != (pass == 1)) continue;
           if (!out) out = root->InsertNewChildElement(section.c_str());
-          out->InsertEndChild(c->DeepClone(doc));
+          Record(*m, c, out->InsertEndChild(c->DeepClone(doc))->ToElement(), sources);
         }
       }
     }
@@ -433,7 +496,8 @@ std::pair<std::vector<double>, std::vector<double>> SplitCtrl(const std::vector<
 }
 
 // keys: each model's key becomes "M/K" with the other models at their reference state
-int ComposeKeys(const Models& models, XMLElement* root, std::vector<std::string>* warnings) {
+int ComposeKeys(const Models& models, XMLElement* root, Sources* sources,
+                std::vector<std::string>* warnings) {
   bool any = false;
   for (const auto& m : models) any = any || !m->keys().empty();
   if (!any) return 0;
@@ -485,6 +549,7 @@ int ComposeKeys(const Models& models, XMLElement* root, std::vector<std::string>
       ctrl.insert(ctrl.end(), ctrl_stateful.begin(), ctrl_stateful.end());
       if (!section) section = root->InsertNewChildElement("keyframe");
       XMLElement* k = section->InsertNewChildElement("key");
+      if (key.elem != nullptr) Record(m, key.elem, k, sources);
       if (key.name) k->SetAttribute("name", (m.prefix() + *key.name).c_str());
       if (key.time) k->SetAttribute("time", FormatNumbers({*key.time}).c_str());
       for (const auto& [attr, v] :
@@ -541,16 +606,17 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
   if (!compiler.lengthrange.empty()) {
     ApplyAttrs(comp->InsertNewChildElement("lengthrange"), compiler.lengthrange);
   }
-  ComposeOption(composers, options, root, &scene.warnings);
+  ComposeOption(composers, options, root, &scene.sources, &scene.warnings);
   XMLElement* size_anchor = root->LastChildElement();
   ComposeVisual(composers, root);
   ComposeStatistic(composers, root, &scene.warnings);
-  ComposeDefaults(composers, &doc, root);
+  ComposeDefaults(composers, &doc, root, &scene.sources);
   for (const char* section :
        {"custom", "asset", "worldbody", "contact", "equality", "tendon", "actuator", "sensor"}) {
-    ComposeSection(composers, section, &doc, root);
+    ComposeSection(composers, section, &doc, root, &scene.sources);
   }
-  const int nkeys = ComposeKeys(composers, root, &scene.warnings);
+  compose::AddWorldSites(models, root);  // the world file's sites: (compose/world_sites.h)
+  const int nkeys = ComposeKeys(composers, root, &scene.sources, &scene.warnings);
   // <size> needs the key count; put it after <option> as MuJoCo's writer does
   XMLDocument size_doc;
   XMLElement* size_root = size_doc.NewElement("mujoco");
@@ -569,12 +635,14 @@ ComposedScene::ComposedScene(const ComposedScene& other)
       model_names(other.model_names),
       warnings(other.warnings) {
   other.document->DeepCopy(document.get());
+  sources = CopySources(other.sources, *other.document, *document);
 }
 ComposedScene& ComposedScene::operator=(const ComposedScene& other) {
   if (this != &other) {
     other.document->DeepCopy(document.get());
     model_names = other.model_names;
     warnings = other.warnings;
+    sources = CopySources(other.sources, *other.document, *document);
   }
   return *this;
 }
@@ -586,6 +654,41 @@ std::string ComposedScene::Xml() const {
   tinyxml2::XMLPrinter printer;
   document->Print(&printer);
   return printer.CStr();
+}
+
+std::optional<SourceLocation> ComposedScene::SourceOfLine(int xml_line) const {
+  // the printed text parsed again has the line numbers MuJoCo's tinyxml2 reports
+  XMLDocument printed;
+  const std::string xml = Xml();
+  if (xml_line <= 0 || printed.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
+    return std::nullopt;
+  }
+  const XMLElement* best = nullptr;
+  int best_line = 0;
+  WalkPair(document.get(), &printed, [&](const XMLElement* mine, const XMLElement* parsed) {
+    const int line = parsed->GetLineNum();
+    if (line <= xml_line && line > best_line) {
+      best = mine;
+      best_line = line;
+    }
+  });
+  if (best == nullptr) return std::nullopt;
+  const auto it = sources.find(best);
+  if (it == sources.end()) return std::nullopt;
+  return it->second;
+}
+
+ConfigError LocateComposedError(const ComposedScene& scene, const ConfigError& error) {
+  const auto hint = compose::HintForMujocoError(error.problem());
+  std::string problem = error.problem();
+  if (hint) problem += " (" + *hint + ")";
+  if (error.line() > 0) {
+    if (const auto src = scene.SourceOfLine(error.line())) {
+      problem += " [composed.xml line " + std::to_string(error.line()) + "]";
+      return ConfigError(src->file, src->line, error.key(), problem);
+    }
+  }
+  return ConfigError(error.file(), error.line(), error.key(), problem);
 }
 
 void WriteComposedScene(const ComposedScene& scene, const std::string& path) {

@@ -24,11 +24,14 @@
 //  - applies the model pose X_WM to the top-level worldbody elements (bodies keep
 //    their free joints at the top level): pos/quat, geom and site fromto, light
 //    pos/dir, composite offset;
+//  - adds the world file's sites of M (ModelConfig::sites, compose/world_sites.h) to M's
+//    bodies as "M/<site>";
 //  - URDF files (a .urdf file, or any file whose root element is <robot>) go through
 //    ComposeOptions::urdf_to_mjcf first and are then composed like MJCF.
 //
 // sections: <option>, <visual>, <statistic> come from the first model that has them
-// (later differing <option>/<statistic> give a warning); <size> is combined
+// (later differing <option>/<statistic> give a warning naming the attributes; the world
+// file's physics options override and silence those they cover); <size> is combined
 // (njmax/nconmax summed with MuJoCo's defaults 500/100 for models without them,
 // nuser_* and nuserdata maximum; nstack left automatic unless a model sets it, then
 // the sum of the explicit sizes and, for the other models, an estimate of MuJoCo
@@ -53,15 +56,26 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "penumbra/world/world_config.h"
 
 namespace tinyxml2 {
 class XMLDocument;
-}
+class XMLElement;
+}  // namespace tinyxml2
 
 namespace penumbra {
+
+class ConfigError;
+
+/// where an element of the composed document was written: a model file (or a file it
+/// includes) and the 1-based line of the element's start tag there.
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+};
 
 /// options of ComposeWorld.
 struct ComposeOptions {
@@ -74,6 +88,10 @@ struct ComposeOptions {
   /// kMaxTimestepSec] of scene/scene_limits.h). without it the first model with an <option>
   /// decides, and its timestep must be in that range too.
   std::optional<double> timestep_sec;
+  /// the world file's physics options (world/world_config.h): each one set overrides the
+  /// composed <option>'s integrator, gravity, iterations or cone, and later models'
+  /// differing values of it no longer warn.
+  PhysicsOptions physics;
 };
 
 /// the result of ComposeWorld: one MJCF document, kept as a tinyxml2 document so that the
@@ -93,12 +111,29 @@ struct ComposedScene {
   /// the models' names in input order; model M's MJCF names start with "M/".
   std::vector<std::string> model_names;
   /// things that were composed with a compromise (dropped keyframes, conflicting
-  /// <option> or <statistic> of later models, ...), one line each.
+  /// <option> or <statistic> of later models, MuJoCo-3 keywords rewritten for 2.2.2, ...),
+  /// one line each.
   std::vector<std::string> warnings;
+  /// the source map: for each element of `document` that came from a model file, where it
+  /// was written (elements added later, e.g. injected IMU sites, have no entry). copies
+  /// map their own elements.
+  std::unordered_map<const tinyxml2::XMLElement*, SourceLocation> sources;
 
   /// the document as MJCF text (tinyxml2's indented printing).
   std::string Xml() const;
+
+  /// where the element that starts on 1-based line `xml_line` of Xml() (or, when none
+  /// starts there, the last one that starts before it) was written; nullopt when that
+  /// element was not copied from a model file or the line is out of range.
+  std::optional<SourceLocation> SourceOfLine(int xml_line) const;
 };
+
+/// `error` of MuJoCo loading Xml() (its line is a line of the composed text) restated for
+/// the user: file and line of the model element that the line came from (the composed
+/// line is kept in the message, "composed.xml line N"), plus a hint when MuJoCo rejected a
+/// keyword that is newer than MuJoCo 2.2.2. an error without a line, or whose line has no
+/// source, keeps its file and line and only gets the hint.
+ConfigError LocateComposedError(const ComposedScene& scene, const ConfigError& error);
 
 /// merges `models` (in order) into one MJCF document.
 /// @throws ConfigError naming the model file, line (when known), element/attribute and

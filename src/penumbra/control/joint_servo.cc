@@ -130,6 +130,12 @@ void JointServo::Bind(const ModelInfo& model, std::span<const int> ids,
                "); expected actuators[i] to drive joints[i] through a joint transmission");
     if (!(std::abs(act.gear[0]) > 0))
       Fail(c, akey, "actuator '" + act.name + "' has gear 0; expected a non-zero gear");
+    // torque output writes efforts: a servo would read them as targets (issue 17)
+    if (params_.output == ServoOutput::kTorque && act.drive != ActuatorDrive::kMotor)
+      Fail(c, akey,
+           "actuator '" + act.name + "' is a " + ActuatorDriveName(act.drive) +
+               (act.drive_detail.empty() ? "" : " (" + act.drive_detail + ")") +
+               "; expected a motor for output: torque (for position servos set output: position)");
     qpos_adr_[i] = joint.qpos_adr;
     dof_adr_[i] = joint.dof_adr;
     actuator_[i] = a;

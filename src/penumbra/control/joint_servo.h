@@ -6,7 +6,8 @@
 // world-file keys it reads (inside the controller block; names are robot-local):
 //   joints: [joint1, ..., joint7]          # hinge or slide joints, in the controller's order
 //   actuators: [actuator1, ..., actuator7] # one per joint, each driving that joint
-//   output: torque         # torque: motor actuators, ctrl = effort / gear (N m or N)
+//   output: torque         # torque: motor actuators, ctrl = effort / gear (N m or N); any
+//                          # other actuator (a position servo, ...) is refused at Initialize
 //                          # position: position servos, ctrl = gear * position reference
 //   kp: 600                # N m/rad (N/m), one number or one per joint (torque output)
 //   kd: 50                 # N m s/rad (N s/m), one number or one per joint (torque output)

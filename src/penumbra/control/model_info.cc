@@ -2,6 +2,20 @@
 
 namespace penumbra {
 
+const char* ActuatorDriveName(ActuatorDrive drive) {
+  switch (drive) {
+    case ActuatorDrive::kMotor:
+      return "motor";
+    case ActuatorDrive::kPositionServo:
+      return "position servo";
+    case ActuatorDrive::kVelocityServo:
+      return "velocity servo";
+    case ActuatorDrive::kOther:
+      break;
+  }
+  return "general actuator";
+}
+
 const char* ModelObjectName(ModelObject kind) {
   switch (kind) {
     case ModelObject::kBody:

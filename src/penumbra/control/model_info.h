@@ -29,6 +29,19 @@ struct JointInfo {
   double range[2] = {0, 0};  ///< limits (m or rad) when limited
 };
 
+/// how an actuator turns its ctrl u into its scalar force f (MuJoCo's gain/bias model,
+/// f = gain u + b0 + b1 L + b2 Ldot with L the actuator length = gear q for a joint
+/// transmission; XML reference "actuator"): which of MJCF's shortcut actuators it is.
+enum class ActuatorDrive {
+  kMotor,          ///< <motor> / fixed gain, no bias, no dynamics: f = gain u
+  kPositionServo,  ///< <position>: f = kp (u - L) - kv Ldot (kv from a <general> bias)
+  kVelocityServo,  ///< <velocity>: f = kv (u - Ldot)
+  kOther,          ///< activation dynamics, muscle/user gain or bias, any other bias
+};
+
+/// lowercase description of a drive ("motor", "position servo", ...), for messages.
+const char* ActuatorDriveName(ActuatorDrive drive);
+
 /// an actuator (MuJoCo actuator_* arrays); its control is ctrl[index].
 struct ActuatorInfo {
   std::string name;
@@ -40,6 +53,13 @@ struct ActuatorInfo {
   /// per unit of its scalar force, in the site frame; for a joint transmission gear[0] is the
   /// joint gear ratio.
   double gear[6] = {1, 0, 0, 0, 0, 0};
+  ActuatorDrive drive = ActuatorDrive::kMotor;
+  double gain = 1;        ///< motor: force per unit ctrl (gainprm[0])
+  double kp = 0, kv = 0;  ///< servo gains (N/m or N m/rad; N s/m or N m s/rad per unit length)
+  /// MuJoCo's words for what makes the drive kOther, e.g. "dyntype filter", for messages.
+  std::string drive_detail;
+  bool force_limited = false;
+  double force_range[2] = {0, 0};  ///< clamp range of the force when force_limited
 };
 
 /// a sensor (MuJoCo sensor_* arrays); its values are sensordata[adr .. adr + dim).

@@ -1,4 +1,3 @@
-#include "penumbra/control/param_check.h"
 #include "penumbra/control/trot_gait.h"
 
 #include <yaml-cpp/yaml.h>
@@ -11,6 +10,8 @@
 #include <limits>
 #include <set>
 
+#include "penumbra/control/actuator_drive.h"
+#include "penumbra/control/param_check.h"
 #include "penumbra/control/pure_pursuit.h"
 #include "penumbra/control/quadruped_swing_trajectory.h"
 #include "penumbra/core/error.h"
@@ -347,12 +348,13 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
       if (ai.joint != joint[j])
         fail(key + ".actuators[" + std::to_string(j) + "]",
              "actuator '" + ai.name + "' does not drive joint '" + model.joints[joint[j]].name +
-                 "'; expected a torque motor on that joint");
-      if (ai.gear[0] == 0) fail(key + ".actuators", "actuator '" + ai.name + "' has gear 0");
+                 "'; expected a motor or position/velocity servo on that joint");
+      // torques go through the actuator's own force law (control/actuator_drive.h); an
+      // actuator whose force cannot be set is refused rather than misread
+      if (const auto problem = EffortDriveProblem(ai))
+        fail(key + ".actuators[" + std::to_string(j) + "]", *problem);
       leg.act[j] = a;
-      leg.gear[j] = ai.gear[0];
-      leg.lo[j] = ai.ctrl_limited ? ai.ctrl_range[0] : -kInf;
-      leg.hi[j] = ai.ctrl_limited ? ai.ctrl_range[1] : kInf;
+      leg.actuator[j] = ai;
     }
     // geometry from the rest frames
     const int hip_b = model.joints[joint[0]].body, thigh_b = model.joints[joint[1]].body,
@@ -577,7 +579,7 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   DistributeStanceForces(r, stance_, wrench, normal, limits_, &forces_);
 
   auto write = [&](const Leg& leg, int j, double tau) {
-    ctrl[leg.act[j]] = std::clamp(tau / leg.gear[j], leg.lo[j], leg.hi[j]);
+    ctrl[leg.act[j]] = CtrlForEffort(leg.actuator[j], tau, qpos[leg.qpos[j]], qvel[leg.dof[j]]);
   };
   for (int i = 0; i < 4; ++i) {
     Leg& leg = legs_[i];

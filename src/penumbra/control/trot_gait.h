@@ -10,7 +10,8 @@
 //       FR: {hip: FR_hip, thigh: FR_thigh, calf: FR_calf, foot: FR_foot,
 //            signs: [1, 1, 1],         # model joint direction vs the canonical one (+-1)
 //            offsets_rad: [0, 0, 0],   # q_canonical = sign q_model + offset (default 0)
-//            actuators: [FR_hip, FR_thigh, FR_calf]}  # torque motors (default: joint names)
+//            actuators: [FR_hip, FR_thigh, FR_calf]}  # motors or position/velocity servos
+//                                                     # (default: the joint names)
 //       FL: {...}
 //       RR: {...}
 //       RL: {...}
@@ -100,7 +101,12 @@
 //      velocity from the analytic leg Jacobian, plus MuJoCo's bias forces qfrc_bias
 //      (gravity and velocity products) of the leg's joints as feed-forward:
 //        tau = swing_kp (q_des - q) + swing_kd (qd_des - qd) + qfrc_bias.
-//   5. torques are clamped to the actuators' ctrl ranges (ctrl = torque / gear).
+//   5. each torque becomes its actuator's ctrl by the actuator's force law
+//      (control/actuator_drive.h): motors ctrl = torque / (gear gain); position servos
+//      (Menagerie's <position>) ctrl = gear q + (torque / gear + kv gear qdot) / kp; velocity
+//      servos ctrl = gear qdot + torque / (gear kv); clamped to forcerange, then ctrlrange.
+//      actuators with activation dynamics or other gain/bias laws are refused at
+//      Initialize with an error naming the actuator and its type.
 // sources for the whole scheme: the MIT Cheetah 3 balance controller (G. Bledt et al.,
 // IROS 2018) and its convex-MPC successor (J. Di Carlo et al., IROS 2018), of which this is
 // the QP-free variant.
@@ -136,7 +142,7 @@ struct TimedTrotCommand {
 struct TrotLegConfig {
   std::string hip, thigh, calf;                   ///< hinge joints
   std::string foot;                               ///< site at the foot point
-  std::array<std::string, 3> actuators;           ///< torque actuators (hip, thigh, calf)
+  std::array<std::string, 3> actuators;  ///< motors or position/velocity servos (hip, thigh, calf)
   std::array<double, 3> signs = {1, 1, 1};        ///< +-1
   std::array<double, 3> offsets_rad = {0, 0, 0};  ///< q_canonical = sign q + offset
 };
@@ -224,7 +230,8 @@ class TrotGait final : public Controller {
  private:
   struct Leg {
     std::array<int, 3> qpos{}, dof{}, act{};
-    std::array<double, 3> gear{1, 1, 1}, lo{}, hi{}, q_lo{}, q_hi{};
+    std::array<ActuatorInfo, 3> actuator{};  ///< hip, thigh, calf drives (actuator_drive.h)
+    std::array<double, 3> q_lo{}, q_hi{};
     int calf_body = -1;
     Eigen::Vector3d foot_C = Eigen::Vector3d::Zero();    ///< foot point in the calf body frame
     Eigen::Vector3d p_lift = Eigen::Vector3d::Zero();    ///< world, at lift-off

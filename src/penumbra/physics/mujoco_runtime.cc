@@ -25,9 +25,10 @@ std::string Trim(std::string s) {
   return s.substr(b);
 }
 
-// MuJoCo messages say "..., line 12" or "Element 'geom', line 3"
+// MuJoCo messages say "..., line 12", "Element 'geom', line 3" (XML errors) or
+// "Object name = j, id = 0, line = 5, column = -1" (compiler errors)
 int LineFromMessage(const std::string& msg) {
-  static const std::regex re("line ([0-9]+)");
+  static const std::regex re("line (?:= )?([0-9]+)");
   std::smatch m;
   if (std::regex_search(msg, m, re)) return std::stoi(m[1].str());
   return 0;

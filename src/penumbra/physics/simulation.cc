@@ -94,6 +94,46 @@ std::string NameOr(const mjModel* m, int type, int id) {
   return n ? std::string(n) : std::string();
 }
 
+// which MJCF shortcut actuator a's gain/bias/dynamics amount to (MuJoCo 2.2.2
+// user_objects.cc mjCActuator and xml_native_reader.cc: <motor> gain [1] no bias,
+// <position kp> gain [kp] bias [0 -kp 0], <velocity kv> gain [kv] bias [0 0 -kv]; a <general>
+// with bias [0 -kp -kv] is a position servo with damping)
+void ClassifyDrive(const mjModel* m, int a, ActuatorInfo* ai) {
+  const mjtNum* g = m->actuator_gainprm + static_cast<size_t>(a) * mjNGAIN;
+  const mjtNum* b = m->actuator_biasprm + static_cast<size_t>(a) * mjNBIAS;
+  ai->drive = ActuatorDrive::kOther;
+  if (m->actuator_dyntype[a] != mjDYN_NONE) {
+    ai->drive_detail = "dyntype " + std::to_string(m->actuator_dyntype[a]) +
+                       ": activation dynamics (integrator/filter/muscle/user)";
+    return;
+  }
+  if (m->actuator_gaintype[a] != mjGAIN_FIXED) {
+    ai->drive_detail = "gaintype " + std::to_string(m->actuator_gaintype[a]) + ": not fixed";
+    return;
+  }
+  ai->gain = g[0];
+  if (m->actuator_biastype[a] == mjBIAS_NONE) {
+    ai->drive = ActuatorDrive::kMotor;
+    return;
+  }
+  if (m->actuator_biastype[a] == mjBIAS_AFFINE && b[0] == 0) {
+    if (b[1] < 0 && b[1] == -g[0] && b[2] <= 0) {
+      ai->drive = ActuatorDrive::kPositionServo;
+      ai->kp = g[0];
+      ai->kv = -b[2];
+      return;
+    }
+    if (b[1] == 0 && b[2] < 0 && b[2] == -g[0]) {
+      ai->drive = ActuatorDrive::kVelocityServo;
+      ai->kv = g[0];
+      return;
+    }
+  }
+  ai->drive_detail = "biastype " + std::to_string(m->actuator_biastype[a]) + ", biasprm " +
+                     std::to_string(b[0]) + " " + std::to_string(b[1]) + " " +
+                     std::to_string(b[2]) + " for gain " + std::to_string(g[0]);
+}
+
 ModelInfo BuildModelInfo(const mjModel* m) {
   ModelInfo info;
   info.nq = m->nq;
@@ -137,6 +177,10 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     ai.ctrl_limited = m->actuator_ctrllimited[a] != 0;
     ai.ctrl_range[0] = m->actuator_ctrlrange[2 * a];
     ai.ctrl_range[1] = m->actuator_ctrlrange[2 * a + 1];
+    ai.force_limited = m->actuator_forcelimited[a] != 0;
+    ai.force_range[0] = m->actuator_forcerange[2 * a];
+    ai.force_range[1] = m->actuator_forcerange[2 * a + 1];
+    ClassifyDrive(m, a, &ai);
     info.actuators.push_back(ai);
   }
   for (int s = 0; s < m->nsensor; ++s)
@@ -567,6 +611,62 @@ void Simulation::SetState(const SimState& s) {
   impl.steps = s.step_count;
   impl.failed = false;
   impl.failure.clear();
+}
+
+void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix,
+                               const std::string& error_key) {
+  const mjModel* m = impl_->m;
+  mjData* d = impl_->d;
+  const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
+  if (k < 0) {
+    std::string keys;
+    for (int i = 0; i < m->nkey; ++i) {
+      const std::string name = NameOr(m, mjOBJ_KEY, i);
+      if (name.rfind(prefix, 0) == 0)
+        keys += (keys.empty() ? "" : ", ") + name.substr(prefix.size());
+    }
+    throw ConfigError(
+        "", 0, error_key,
+        "no keyframe '" + key.substr(std::min(key.size(), prefix.size())) + "' in model '" +
+            prefix.substr(0, prefix.size() - 1) +
+            "'; expected one of its <key> names: " + (keys.empty() ? "(it has none)" : keys));
+  }
+  const auto mine = [&](mjtObj type, int id) {
+    const char* name = mj_id2name(m, type, id);
+    return name != nullptr && std::string(name).rfind(prefix, 0) == 0;
+  };
+  for (int j = 0; j < m->njnt; ++j) {
+    if (!mine(mjOBJ_JOINT, j)) continue;
+    const int type = m->jnt_type[j];
+    const int nq = type == mjJNT_FREE ? 7 : type == mjJNT_BALL ? 4 : 1;
+    const int nv = type == mjJNT_FREE ? 6 : type == mjJNT_BALL ? 3 : 1;
+    for (int i = 0; i < nq; ++i) {
+      const int a = m->jnt_qposadr[j] + i;
+      d->qpos[a] = m->key_qpos[static_cast<size_t>(k) * m->nq + a];
+    }
+    for (int i = 0; i < nv; ++i) {
+      const int a = m->jnt_dofadr[j] + i;
+      d->qvel[a] = m->key_qvel[static_cast<size_t>(k) * m->nv + a];
+    }
+  }
+  // stateful actuators come last (MuJoCo 2.2.2), act[i] belongs to actuator nu - na + i
+  for (int a = 0; a < m->nu; ++a) {
+    if (!mine(mjOBJ_ACTUATOR, a)) continue;
+    d->ctrl[a] = m->key_ctrl[static_cast<size_t>(k) * m->nu + a];
+    const int act = a - (m->nu - m->na);
+    if (act >= 0) d->act[act] = m->key_act[static_cast<size_t>(k) * m->na + act];
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    const int mocap = m->body_mocapid[b];
+    if (mocap < 0 || !mine(mjOBJ_BODY, b)) continue;
+    for (int i = 0; i < 3; ++i)
+      d->mocap_pos[3 * mocap + i] =
+          m->key_mpos[static_cast<size_t>(k) * 3 * m->nmocap + 3 * mocap + i];
+    for (int i = 0; i < 4; ++i)
+      d->mocap_quat[4 * mocap + i] =
+          m->key_mquat[static_cast<size_t>(k) * 4 * m->nmocap + 4 * mocap + i];
+  }
+  mj_forward(m, d);
 }
 
 double Simulation::time() const { return impl_->d->time; }

@@ -122,6 +122,17 @@ class Simulation {
   ///         time_sec is not SimTimeOfStep(step_count, timestep()); the state is unchanged then.
   void SetState(const SimState& state);
 
+  /// sets the state of one composed model from one of its keyframes: for the MJCF key named
+  /// `key` (e.g. "go1/home"), the qpos and qvel of every joint, the ctrl (and act) of every
+  /// actuator and the mocap pose of every mocap body whose name starts with `prefix` (e.g.
+  /// "go1/") are copied from the key; everything else is left as it is. then the derived
+  /// quantities are recomputed (mj_forward). call before the first Step(), e.g. for the world
+  /// file's `initial_keyframe`.
+  /// @throws ConfigError("", 0, `error_key`, ...) when the model has no key `key`, naming the
+  ///         keys that `prefix` has.
+  void ApplyKeyframe(const std::string& key, const std::string& prefix,
+                     const std::string& error_key);
+
   /// simulation time (s) and the number of steps completed since loading. time() is
   /// SimTimeOfStep(step_count(), timestep()) (MuJoCo's accumulated time is overwritten after
   /// each step), also for controllers and snapshots. after a PhysicsError both stay at the

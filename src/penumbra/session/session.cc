@@ -7,6 +7,7 @@
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
+#include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer_factory.h"
@@ -39,6 +40,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   ComposeOptions compose_options;
   compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
   compose_options.timestep_sec = world_.timestep_sec;
+  compose_options.physics = world_.physics;
   ComposedScene composed = ComposeWorld(world_.models, compose_options);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
@@ -51,10 +53,21 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   // physics (compiled once; a second, earlier compile only for an adversity preset's
   // planning, session/effects_stage.h), agent drivers and controllers
   t0 = Clock::now();
-  sim_ = std::make_unique<Simulation>(
-      options.composed_xml_path.empty()
-          ? Simulation::LoadFromString(xml, world_.timestep_sec)
-          : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
+  try {
+    sim_ = std::make_unique<Simulation>(
+        options.composed_xml_path.empty()
+            ? Simulation::LoadFromString(xml, world_.timestep_sec)
+            : Simulation::LoadFromFile(options.composed_xml_path, world_.timestep_sec));
+  } catch (const ConfigError& e) {
+    // MuJoCo names a line of the composed text: name the model file and line instead
+    throw LocateComposedError(composed, e);
+  }
+  // the world file's initial_keyframe of each model, before anything reads the state
+  for (const ModelConfig& m : world_.models) {
+    if (m.initial_keyframe.empty()) continue;
+    sim_->ApplyKeyframe(m.name + "/" + m.initial_keyframe, m.name + "/",
+                        (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".initial_keyframe");
+  }
   effects_->Attach(sim_.get());  // checks the world's agents against the model
   if (options.add_controllers) AddWorldControllers(world_, sim_.get());
   timings_.load_sec = SecondsSince(t0);

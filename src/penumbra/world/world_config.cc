@@ -51,8 +51,22 @@ class WorldParser {
     if (r.Has("duration_sec")) w.duration_sec = r.Child("duration_sec").Double();
     if (r.Has("physics")) {
       YamlReader p = r.Child("physics");
-      p.ExpectMap({"timestep_sec"});
+      p.ExpectMap({"timestep_sec", "integrator", "gravity_mps2", "solver_iterations", "cone"});
       if (p.Has("timestep_sec")) w.timestep_sec = p.Child("timestep_sec").Double();
+      if (p.Has("integrator")) {
+        const YamlReader i = p.Child("integrator");
+        if (i.String() == "implicitfast") {
+          i.Fail(
+              "'implicitfast' is newer than MuJoCo 2.2.2 (Penumbra's physics); expected one of: "
+              "Euler, RK4, implicit (implicit is implicitfast with the Coriolis terms kept)");
+        }
+        w.physics.integrator = i.Enum({"Euler", "RK4", "implicit"});
+      }
+      if (p.Has("gravity_mps2")) w.physics.gravity_mps2 = p.Child("gravity_mps2").Vector3();
+      if (p.Has("solver_iterations")) {
+        w.physics.solver_iterations = p.Child("solver_iterations").Int();
+      }
+      if (p.Has("cone")) w.physics.cone = p.Child("cone").Enum({"pyramidal", "elliptic"});
     }
     if (r.Has("render")) ReadRender(r.Child("render"), &w.render);
     w.render.seed = w.seed;
@@ -169,15 +183,43 @@ class WorldParser {
 
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
     if (is_robot) {
-      r.ExpectMap({"name", "file", "pose", "controller", "sensors"});
+      r.ExpectMap({"name", "file", "pose", "controller", "sensors", "sites", "initial_keyframe",
+                   "floating_base"});
     } else {
-      r.ExpectMap({"name", "file", "pose"});
+      r.ExpectMap({"name", "file", "pose", "sites", "initial_keyframe", "floating_base"});
     }
     ModelConfig m;
     m.is_robot = is_robot;
+    m.key = r.path();
     m.name = r.Child("name").String();
     m.file = Resolve(r.Child("file").String());
     if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
+    if (r.Has("floating_base")) m.floating_base = r.Child("floating_base").Bool();
+    if (r.Has("initial_keyframe")) {
+      m.initial_keyframe = r.Child("initial_keyframe").String();
+      if (m.initial_keyframe.empty())
+        r.Child("initial_keyframe").Fail("empty; expected the name of one of the model's <key>s");
+    }
+    if (r.Has("sites")) {
+      for (const YamlReader& s : r.Child("sites").List()) {
+        s.ExpectMap({"name", "body", "geom", "pose"});
+        SiteConfig site;
+        site.name = s.Child("name").String();
+        if (site.name.empty() || site.name.find('/') != std::string::npos)
+          s.Child("name").Fail("'" + site.name + "'; expected a non-empty name without '/'");
+        if (s.Has("body") == s.Has("geom"))
+          s.Fail(
+              "expected exactly one of body (the parent body) and geom (a geom whose centre "
+              "the site marks)");
+        if (s.Has("body")) site.body = s.Child("body").String();
+        if (s.Has("geom")) site.geom = s.Child("geom").String();
+        if (s.Has("pose")) ReadPose(s.Child("pose"), &site.pose);
+        for (const SiteConfig& other : m.sites)
+          if (other.name == site.name)
+            s.Child("name").Fail("duplicate site '" + site.name + "'; expected unique names");
+        m.sites.push_back(site);
+      }
+    }
     if (r.Has("controller")) m.controller = ReadController(r.Child("controller"));
     return m;
   }

@@ -29,6 +29,17 @@ struct PoseConfig {
   Pose ToPose() const { return PoseFromXyzRpyDeg(xyz, rpy_deg); }
 };
 
+/// a site the world file adds to a model (`sites:` of a robot or model entry), e.g. a foot
+/// point or tool centre point the model lacks. its MJCF name is "<model>/<name>".
+struct SiteConfig {
+  std::string name;  ///< model-local, unique among the model's sites
+  std::string body;  ///< model-local parent body ("world" = the world body); or
+  std::string geom;  ///< model-local geom: the site goes on its body, at its centre
+  /// X_PS: the site in the parent body's frame (body), or offset from the geom's centre
+  /// along the body's axes (geom).
+  PoseConfig pose;
+};
+
 /// one MJCF or URDF file placed in the world under a unique name.
 struct ModelConfig {
   std::string name;  ///< unique; prefixes every MJCF name of the model as "<name>/"
@@ -37,6 +48,32 @@ struct ModelConfig {
   PoseConfig pose;
   bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
   ControllerConfig controller;  ///< control/controller_config.h; type "" = none
+  std::vector<SiteConfig> sites;  ///< `sites:` added to the model when composing
+  /// `initial_keyframe:` a <key> of the model (its local name) the run starts from ("" =
+  /// MuJoCo's reference configuration qpos0).
+  std::string initial_keyframe;
+  /// `floating_base:` (URDF only) the URDF's root link becomes a free body (joint
+  /// "<model>/floating_base") instead of being welded to the world, as MuJoCo's importer does.
+  bool floating_base = false;
+  /// key path of the entry in the world file ("robots[1]"), for errors found later; "" for
+  /// models not from a world file.
+  std::string key;
+};
+
+/// world-file `physics:` options besides timestep_sec. each one that is set overrides the
+/// composed MJCF's <option> attribute of the same meaning (MuJoCo 2.2.2 XML reference,
+/// <option>); unset ones keep the first model's <option> (compose/scene_composer.h).
+struct PhysicsOptions {
+  /// <option integrator>: "Euler", "RK4" or "implicit" (MuJoCo 2.2.2's integrators).
+  std::optional<std::string> integrator;
+  /// <option gravity>, m/s^2 in the world frame W (z up); each component in [-1000, 1000].
+  std::optional<Eigen::Vector3d> gravity_mps2;
+  /// <option iterations>: the constraint solver's maximum iterations, in [1, 10000].
+  std::optional<int> solver_iterations;
+  /// <option cone>: the friction cone, "pyramidal" or "elliptic".
+  std::optional<std::string> cone;
+
+  bool empty() const { return !integrator && !gravity_mps2 && !solver_iterations && !cone; }
 };
 
 /// a world-file light (see scene Light for units).
@@ -126,6 +163,7 @@ struct WorldConfig {
   uint64_t seed = 0;
   double duration_sec = 10;
   std::optional<double> timestep_sec;  ///< overrides the MJCF <option timestep>
+  PhysicsOptions physics;              ///< `physics:` integrator, gravity, iterations, cone
   std::vector<ModelConfig> models;     ///< robots first, then static models, in file order
   std::vector<LightConfig> lights;
   bool default_lights = false;  ///< add a default sun + sky fill (bare-model runs)

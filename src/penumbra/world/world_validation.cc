@@ -67,6 +67,17 @@ class Validator {
     if (w_.timestep_sec)
       Check("physics.timestep_sec", *w_.timestep_sec,
             Range::Closed(kMinTimestepSec, kMaxTimestepSec));
+    if (w_.physics.gravity_mps2)
+      Check3("physics.gravity_mps2", *w_.physics.gravity_mps2, Range::Closed(-1000, 1000));
+    if (w_.physics.solver_iterations)
+      Check("physics.solver_iterations", *w_.physics.solver_iterations, Range::Closed(1, 10000));
+    if (w_.physics.integrator && *w_.physics.integrator != "Euler" &&
+        *w_.physics.integrator != "RK4" && *w_.physics.integrator != "implicit")
+      Fail("physics.integrator",
+           "unknown value '" + *w_.physics.integrator + "'; expected one of: Euler, RK4, implicit");
+    if (w_.physics.cone && *w_.physics.cone != "pyramidal" && *w_.physics.cone != "elliptic")
+      Fail("physics.cone",
+           "unknown value '" + *w_.physics.cone + "'; expected one of: pyramidal, elliptic");
     CheckRender();
     CheckSky();
     CheckModels();
