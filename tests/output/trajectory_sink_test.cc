@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/pipeline/sim_loop.h"
 
@@ -36,11 +37,7 @@ TEST(TrajectorySinkTest, OneRowPerStepAfterTheFirstWithFullPrecision) {
   TempDir dir;
   Steps source;
   TrajectorySink sink(dir.path() / "trajectory.csv", 2);
-  SimLoopOptions o;
-  o.end_time_sec = 0.3;
-  SimLoop loop(&source, o);
-  loop.AddSink(&sink);
-  const LoopFinish f = loop.Run();
+  const LoopFinish f = testing::RunLoop(&source, {&sink}, 0.3);
   ASSERT_FALSE(f.error);
   EXPECT_EQ(ReadAll(dir.path() / "trajectory.csv"),
             "step,time_sec,qpos0,qpos1\n"
