@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
@@ -118,12 +116,10 @@ TEST(AdversityPlan, CliRunWithAnUnknownPresetExitsWith2AndAKnownOneRecordsIt) {
   options.progress = false;
   options.adversity = "major";
   RunWorld(world, options);
-  std::ifstream f(std::filesystem::path(out) / "run.json");
-  std::stringstream text;
-  text << f.rdbuf();
-  EXPECT_NE(text.str().find("\"adversity\": \"major ("), std::string::npos) << text.str();
-  EXPECT_NE(text.str().find("\"adversity_forklift0: forklift\""), std::string::npos);
-  EXPECT_NE(text.str().find("\"adversity_smoke: smoke\""), std::string::npos);
+  const std::string text = testing::ReadAll(std::filesystem::path(out) / "run.json");
+  EXPECT_NE(text.find("\"adversity\": \"major ("), std::string::npos) << text;
+  EXPECT_NE(text.find("\"adversity_forklift0: forklift\""), std::string::npos);
+  EXPECT_NE(text.find("\"adversity_smoke: smoke\""), std::string::npos);
 }
 
 TEST(AdversityPlan, EffectsAreEvaluatedDeterministically) {

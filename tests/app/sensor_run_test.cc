@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/pcd_writer.h"
@@ -176,18 +177,16 @@ TEST_F(SensorRunTest, SameSeedSameBytesAndWorldPresetNamesMatchTheSensorModels) 
     opt.progress = false;
     opt.duration_sec = 0.3;
     RunWorld(world, opt);
-    std::ifstream p(fs::path(opt.out_dir) / "lidar" / "l" / "scan_000001.pcd", std::ios::binary);
-    std::ifstream i(fs::path(opt.out_dir) / "imu" / "i.csv");
-    std::stringstream ps, is;
-    ps << p.rdbuf();
-    is << i.rdbuf();
+    const std::string pcd =
+        testing::ReadAll(fs::path(opt.out_dir) / "lidar" / "l" / "scan_000001.pcd");
+    const std::string imu = testing::ReadAll(fs::path(opt.out_dir) / "imu" / "i.csv");
     if (run == 0) {
-      first_pcd = ps.str();
-      first_imu = is.str();
+      first_pcd = pcd;
+      first_imu = imu;
       EXPECT_GT(first_pcd.size(), 1000u);
     } else {
-      EXPECT_TRUE(ps.str() == first_pcd);
-      EXPECT_TRUE(is.str() == first_imu);
+      EXPECT_TRUE(pcd == first_pcd);
+      EXPECT_TRUE(imu == first_imu);
     }
   }
   // every preset the world file accepts builds in the sensor models

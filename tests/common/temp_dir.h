@@ -1,16 +1,19 @@
 #pragma once
-// a fresh, uniquely named scratch folder for one test. ctest runs every test
-// case as its own process, in parallel, so a fixed name under
-// ::testing::TempDir() is shared between processes and races.
+// a fresh, uniquely named scratch folder for one test, and reading back the files a
+// test wrote. ctest runs every test case as its own process, in parallel, so a fixed
+// name under ::testing::TempDir() is shared between processes and races.
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace penumbra::testing {
 
@@ -51,6 +54,12 @@ inline std::string ReadAll(const std::filesystem::path& p) {
   std::stringstream ss;
   ss << f.rdbuf();
   return ss.str();
+}
+
+/// the bytes of file `p` (empty when it cannot be read).
+inline std::vector<uint8_t> ReadBytes(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
 /// a TempDir that lives as long as the test process: a drop-in for

@@ -3,12 +3,12 @@
 // the engine find types only through it.
 #include <gtest/gtest.h>
 
-#include <fstream>
+#include <filesystem>
 #include <regex>
 #include <set>
-#include <sstream>
 #include <string>
 
+#include "common/temp_dir.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/effects_engine.h"
 
@@ -16,10 +16,7 @@ namespace penumbra {
 namespace {
 
 std::string ReadDoc(const std::string& name) {
-  std::ifstream in(std::string(PENUMBRA_SOURCE_DIR) + "/docs/" + name);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return testing::ReadAll(std::filesystem::path(PENUMBRA_SOURCE_DIR) / "docs" / name);
 }
 
 // the type names of the "### `<type>`" sections of docs/effects.md, in document order.

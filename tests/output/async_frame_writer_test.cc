@@ -4,13 +4,13 @@
 
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {
 
-using testing::ReadText;
+using testing::ReadAll;
 using testing::TempDir;
 
 CameraFrame Frame(const std::string& camera, int64_t index, int w, int h) {
@@ -32,7 +32,7 @@ CameraFrame Frame(const std::string& camera, int64_t index, int w, int h) {
 
 std::vector<std::string> CsvLines(const std::filesystem::path& p) {
   std::vector<std::string> lines;
-  std::istringstream in(ReadText(p));
+  std::istringstream in(ReadAll(p));
   std::string line;
   while (std::getline(in, line)) lines.push_back(line);
   return lines;

@@ -5,11 +5,11 @@
 
 #include <filesystem>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/async_frame_writer.h"
 #include "penumbra/output/camera_writer.h"
 #include "penumbra/output/png_io.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {

@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {
 
-using testing::ReadText;
+using testing::ReadAll;
 using testing::TempDir;
 
 std::vector<std::string> Lines(const std::string& text) {
@@ -201,7 +201,7 @@ TEST(CameraWriter, WritesImagesPosesAndIntrinsics) {
   }
 
   // frames.csv
-  const auto lines = Lines(ReadText(folder / "frames.csv"));
+  const auto lines = Lines(ReadAll(folder / "frames.csv"));
   ASSERT_EQ(lines.size(), 4u);
   EXPECT_EQ(lines[0], "frame,time_sec,x,y,z,qw,qx,qy,qz");
   for (int i = 0; i < 3; ++i) {
@@ -213,7 +213,7 @@ TEST(CameraWriter, WritesImagesPosesAndIntrinsics) {
   }
 
   // intrinsics.json
-  const auto j = nlohmann::json::parse(ReadText(folder / "intrinsics.json"));
+  const auto j = nlohmann::json::parse(ReadAll(folder / "intrinsics.json"));
   EXPECT_EQ(j.at("width"), 8);
   EXPECT_EQ(j.at("height"), 6);
   EXPECT_DOUBLE_EQ(j.at("fx").get<double>(), intr.fx);

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {

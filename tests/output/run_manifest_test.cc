@@ -4,13 +4,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {
 
-using testing::ReadText;
+using testing::ReadAll;
 using testing::TempDir;
 
 RunManifest Example() {
@@ -31,7 +31,7 @@ RunManifest Example() {
 TEST(RunManifest, WritesEveryField) {
   TempDir dir;
   WriteRunManifest((dir.path() / "sub").string(), Example());
-  const auto j = nlohmann::json::parse(ReadText(dir.path() / "sub" / "run.json"));
+  const auto j = nlohmann::json::parse(ReadAll(dir.path() / "sub" / "run.json"));
   EXPECT_EQ(j.at("world_file"), "worlds/default.yaml");
   EXPECT_EQ(j.at("seed").get<uint64_t>(), 18446744073709551615ULL);
   EXPECT_EQ(j.at("penumbra_version"), "0.1.0");

@@ -2,14 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "common/temp_dir.h"
 #include "penumbra/output/pcd_writer.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::ReadText;
+using testing::ReadAll;
 using testing::TempDir;
 
 SensorFiring Firing(int64_t k, double t, double latency) {
@@ -28,7 +28,7 @@ TEST(SensorWritersTest, ImuRowsHaveTheDocumentedColumnsAndPrecision) {
   s.gyro_rad_s = {0, 2e-7, -1};
   w.Write(Firing(3, 0.015, 0.002), s);
   w.Close();
-  EXPECT_EQ(ReadText(dir.path() / "imu" / "imu0.csv"),
+  EXPECT_EQ(ReadAll(dir.path() / "imu" / "imu0.csv"),
             "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,accel_z_m_s2,"
             "gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n"
             "3,0.015000000,0.017000000,0.1,-9.80665,0.333333333,0,2e-07,-1\n");
@@ -39,7 +39,7 @@ TEST(SensorWritersTest, MujocoSensorRowsFollowTheColumns) {
   MujocoSensorCsvWriter w(dir.path(), "joints", {"a_rad", "b_m"});
   w.Write(Firing(0, 0, 0), {1.5, -2});
   w.Close();
-  EXPECT_EQ(ReadText(dir.path() / "sensors" / "joints.csv"),
+  EXPECT_EQ(ReadAll(dir.path() / "sensors" / "joints.csv"),
             "sample,capture_time_sec,delivery_time_sec,a_rad,b_m\n"
             "0,0.000000000,0.000000000,1.5,-2\n");
 }
@@ -59,7 +59,7 @@ TEST(SensorWritersTest, LidarScansGoToPcdFilesListedInTheIndex) {
   scan.medium_returns = 1;
   w.Write(Firing(12, 1.2, 0.1), scan);
   w.Close();
-  EXPECT_EQ(ReadText(dir.path() / "lidar" / "top" / "index.csv"),
+  EXPECT_EQ(ReadAll(dir.path() / "lidar" / "top" / "index.csv"),
             "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
             "particle_returns\n"
             "12,1.200000000,1.300000000,scan_000012.pcd,2,1,0\n");
@@ -86,10 +86,10 @@ TEST(SensorWritersTest, GroundTruthRowsAndContacts) {
   s.contacts = {c};
   w.Write(2, s);
   w.Close();
-  const std::string rows = ReadText(dir.path() / "ground_truth" / "gt.csv");
+  const std::string rows = ReadAll(dir.path() / "ground_truth" / "gt.csv");
   EXPECT_EQ(rows.substr(rows.find('\n') + 1), "2,0.500000000,1,2,3,1,0,0,0,0,0,0,0,0,0\n");
   EXPECT_EQ(rows.substr(0, rows.find(',', 20)), "sample,time_sec,box_x_m");
-  const std::string contacts = ReadText(dir.path() / "ground_truth" / "gt_contacts.csv");
+  const std::string contacts = ReadAll(dir.path() / "ground_truth" / "gt_contacts.csv");
   EXPECT_EQ(contacts.substr(contacts.find('\n') + 1),
             "2,0.500000000,0,4,0,1,0,0,0,0,0,1,0,10,0,0\n");
 }

@@ -2,13 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "common/run_loop.h"
+#include "common/temp_dir.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "test_util.h"
 
 namespace penumbra {
 namespace {
 
-using testing::ReadText;
+using testing::ReadAll;
 using testing::TempDir;
 
 // steps of 0.1 s; qpos = {step, -step / 3}
@@ -36,13 +37,9 @@ TEST(TrajectorySinkTest, OneRowPerStepAfterTheFirstWithFullPrecision) {
   TempDir dir;
   Steps source;
   TrajectorySink sink(dir.path() / "trajectory.csv", 2);
-  SimLoopOptions o;
-  o.end_time_sec = 0.3;
-  SimLoop loop(&source, o);
-  loop.AddSink(&sink);
-  const LoopFinish f = loop.Run();
+  const LoopFinish f = testing::RunLoop(&source, {&sink}, 0.3);
   ASSERT_FALSE(f.error);
-  EXPECT_EQ(ReadText(dir.path() / "trajectory.csv"),
+  EXPECT_EQ(ReadAll(dir.path() / "trajectory.csv"),
             "step,time_sec,qpos0,qpos1\n"
             "1,0.10000000000000001,1,-0.33333333333333331\n"
             "2,0.20000000000000001,2,-0.66666666666666663\n"

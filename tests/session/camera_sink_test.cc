@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/pipeline/sim_loop.h"
@@ -85,11 +86,7 @@ TEST(CameraSinkTest, EffectsTravelBesideTheSnapshotAndEveryImageKindIsWritten) {
   CameraSink sink(scene, s.world, s.session->sim().timestep(), &renderer, dir.path().string(),
                   effects);
   PhysicsSource source(&s.session->sim());
-  SimLoopOptions o;
-  o.end_time_sec = 0.3;
-  SimLoop loop(&source, o);
-  loop.AddSink(&sink);
-  const LoopFinish f = loop.Run();
+  const LoopFinish f = testing::RunLoop(&source, {&sink}, 0.3);
   ASSERT_FALSE(f.error) << ErrorMessage(f.error);
 
   // frames at 0, 0.05, ..., 0.3 s; each rendered with the effects evaluated for its own
@@ -119,11 +116,7 @@ TEST(CameraSinkTest, ARenderErrorEndsTheRunAndIsTheErrorReported) {
   CameraSink sink(s.session->scene(), s.world, s.session->sim().timestep(), &renderer,
                   dir.path().string(), {});
   PhysicsSource source(&s.session->sim());
-  SimLoopOptions o;
-  o.end_time_sec = 5.0;
-  SimLoop loop(&source, o);
-  loop.AddSink(&sink);
-  const LoopFinish f = loop.Run();
+  const LoopFinish f = testing::RunLoop(&source, {&sink}, 5.0);
   EXPECT_EQ(f.reason, LoopEndReason::kError);
   EXPECT_EQ(ErrorMessage(f.error), "renderer failed");
   EXPECT_LT(f.time_sec, 5.0) << "the loop stopped early";

@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "common/run_loop.h"
 #include "penumbra/pipeline/sim_loop.h"
 
 namespace penumbra {
@@ -35,11 +36,7 @@ TEST(PhysicsSourceTest, StepsTheSimulationAndHandsOutItsStatePerStep) {
   Simulation reference = Simulation::LoadFromString(kBoxXml);
   PhysicsSource source(&sim);
   Collect state(SnapshotContent::kState);
-  SimLoopOptions o;
-  o.end_time_sec = 0.5;
-  SimLoop loop(&source, o);
-  loop.AddSink(&state);
-  const LoopFinish f = loop.Run();
+  const LoopFinish f = testing::RunLoop(&source, {&state}, 0.5);
   ASSERT_FALSE(f.error);
   EXPECT_EQ(f.step, 50);
   ASSERT_EQ(state.got.size(), 51u);

@@ -202,16 +202,22 @@ void CameraWriter::WriteImages(const CameraFrame& frame) const {
 
 void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string& name,
                                     std::vector<fs::path>* written) const {
+  // one PNG per image kind, at <folder>/<kind>/<name>, recorded in `written`
+  auto write8 = [&](const char* kind, const ImageU8& img) {
+    WritePngRgb8((folder_ / kind / name).string(), img, png_options_);
+    written->push_back(folder_ / kind / name);
+  };
+  auto write16 = [&](const char* kind, const ImageU16& img) {
+    WritePngGray16((folder_ / kind / name).string(), img, png_options_);
+    written->push_back(folder_ / kind / name);
+  };
   if (outputs_.rgb) {
     CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");
-    WritePngRgb8((folder_ / "rgb" / name).string(), frame.rgb, png_options_);
-    written->push_back(folder_ / "rgb" / name);
+    write8("rgb", frame.rgb);
   }
   if (outputs_.depth) {
     CheckFrameImage(frame.depth_m, 1, intrinsics_, camera_, frame.index, "depth");
-    WritePngGray16((folder_ / "depth" / name).string(), DepthToMillimetres(frame.depth_m),
-                   png_options_);
-    written->push_back(folder_ / "depth" / name);
+    write16("depth", DepthToMillimetres(frame.depth_m));
   }
   if (outputs_.segmentation) {
     CheckFrameImage(frame.geom_id, 1, intrinsics_, camera_, frame.index, "segmentation");
@@ -221,23 +227,16 @@ void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string&
     } catch (const Error& e) {
       throw Error(fmt::format("camera '{}' frame {}: {}", camera_, frame.index, e.what()));
     }
-    WritePngGray16((folder_ / "segmentation" / name).string(), seg, png_options_);
-    written->push_back(folder_ / "segmentation" / name);
+    write16("segmentation", seg);
   }
   // ground truth beyond the geom ids (the same pixel-centre rays)
-  auto write16 = [&](const char* kind, const ImageU16& img) {
-    WritePngGray16((folder_ / kind / name).string(), img, png_options_);
-    written->push_back(folder_ / kind / name);
-  };
   if (outputs_.range) {
     CheckFrameImage(frame.range_m, 1, intrinsics_, camera_, frame.index, "range");
     write16("range", DepthToMillimetres(frame.range_m));
   }
   if (outputs_.normals) {
     CheckFrameImage(frame.normal_O, 3, intrinsics_, camera_, frame.index, "normals");
-    WritePngRgb8((folder_ / "normals" / name).string(), NormalsToRgb8(frame.normal_O),
-                 png_options_);
-    written->push_back(folder_ / "normals" / name);
+    write8("normals", NormalsToRgb8(frame.normal_O));
   }
   if (outputs_.instance_segmentation) {
     CheckFrameImage(frame.body_id, 1, intrinsics_, camera_, frame.index, "instance_segmentation");

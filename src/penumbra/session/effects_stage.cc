@@ -52,6 +52,15 @@ std::optional<std::vector<Eigen::Vector2d>> DrawLoop(const FloorMap& map, uint64
   return std::nullopt;
 }
 
+// appends an effect named `name` of type P (default parameters, no region) to `effects`;
+// returns its parameters (valid until the next append).
+template <typename P>
+P& AppendEffect(std::vector<EffectConfig>* effects, std::string name) {
+  EffectConfig& e = effects->emplace_back();
+  e.name = std::move(name);
+  return e.params.emplace<P>();
+}
+
 }  // namespace
 
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
@@ -87,25 +96,17 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   map.ReachableBounds(&area_lo, &area_hi);
 
   if (preset.fog_mor_m) {
-    EffectConfig e;
-    e.name = "adversity_fog";
-    FogParams& p = e.params.emplace<FogParams>();
+    FogParams& p = AppendEffect<FogParams>(effects, "adversity_fog");
     p.extinction.mor_m = *preset.fog_mor_m;
     p.height_falloff_per_m = preset.fog_height_falloff_per_m;
     p.base_height_m = floor_z + 1.0;
-    effects->push_back(e);
   }
   if (preset.dust_mor_m) {
-    EffectConfig e;
-    e.name = "adversity_dust";
-    DustParams& p = e.params.emplace<DustParams>();
+    DustParams& p = AppendEffect<DustParams>(effects, "adversity_dust");
     p.extinction.mor_m = *preset.dust_mor_m;
-    effects->push_back(e);
   }
   if (preset.smoke_sigma_t_per_m) {
-    EffectConfig e;
-    e.name = "adversity_smoke";
-    SmokeParams& p = e.params.emplace<SmokeParams>();
+    SmokeParams& p = AppendEffect<SmokeParams>(effects, "adversity_smoke");
     p.mode = SmokeParams::Mode::kNoise;
     p.density_scale_per_m = *preset.smoke_sigma_t_per_m;
     p.coverage = preset.smoke_coverage;
@@ -116,42 +117,29 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
     box.min_W = Eigen::Vector3d(mid.x() - half.x(), mid.y() - half.y(), floor_z);
     box.max_W =
         Eigen::Vector3d(mid.x() + half.x(), mid.y() + half.y(), floor_z + preset.smoke_height_m);
-    e.region = box;
-    effects->push_back(e);
+    effects->back().region = box;
   }
   if (preset.rain_rate_mm_h) {
-    EffectConfig e;
-    e.name = "adversity_rain";
-    RainParams& p = e.params.emplace<RainParams>();
+    RainParams& p = AppendEffect<RainParams>(effects, "adversity_rain");
     p.rate_mm_h = *preset.rain_rate_mm_h;
-    effects->push_back(e);
   }
   if (preset.snow_rate_mm_h) {
-    EffectConfig e;
-    e.name = "adversity_snow";
-    SnowParams& p = e.params.emplace<SnowParams>();
+    SnowParams& p = AppendEffect<SnowParams>(effects, "adversity_snow");
     p.rate_mm_h = *preset.snow_rate_mm_h;
-    effects->push_back(e);
   }
   if (preset.light_scale != 1.0) {
-    EffectConfig e;
-    e.name = "adversity_dim";
-    LightEventParams& p = e.params.emplace<LightEventParams>();
+    LightEventParams& p = AppendEffect<LightEventParams>(effects, "adversity_dim");
     p.light = "*";
     p.mode = LightEventParams::Mode::kBlackout;
     p.min_scale = std::min(preset.light_scale, 0.999);
     p.recovery_sec = 0;
-    effects->push_back(e);
   }
   if (preset.flicker_depth > 0) {
-    EffectConfig e;
-    e.name = "adversity_flicker";
-    LightEventParams& p = e.params.emplace<LightEventParams>();
+    LightEventParams& p = AppendEffect<LightEventParams>(effects, "adversity_flicker");
     p.light = "*";
     p.mode = LightEventParams::Mode::kFlicker;
     p.depth = preset.flicker_depth;
     p.frequency_hz = preset.flicker_hz;
-    effects->push_back(e);
   }
 
   // NPCs: people first, then vehicles; each on its own random stream

@@ -2,9 +2,7 @@
 // the `dust` effect type: a coloured, absorbing homogeneous haze.
 
 #include <Eigen/Core>
-#include <memory>
 #include <string_view>
-#include <vector>
 
 #include "penumbra/effects/effect_type.h"
 #include "penumbra/effects/types/homogeneous.h"
@@ -14,7 +12,7 @@ namespace penumbra {
 /// dust: a coloured, absorbing haze. the colour is the single-scattering albedo per
 /// channel (blue absorbed more than red gives the brown cast of mineral dust). density
 /// falls off with height as for fog.
-struct DustParams {
+struct DustParams : HomogeneousMediumType<DustParams> {
   static constexpr std::string_view kTypeName = "dust";
 
   ExtinctionSpec extinction;                ///< required
@@ -23,12 +21,9 @@ struct DustParams {
   double height_falloff_per_m = 0;          ///< >= 0
   double base_height_m = 0;                 ///< finite
 
-  /// effect-type hooks (effects/effect_type.h).
-  static std::vector<std::string_view> Keys();
-  void Read(const EffectParamReader& r);
-  void Validate(const EffectConfig& e, EffectChecker* c) const;
-  /// one HomogeneousMedium in the effect's region while the weight is > 0.
-  std::unique_ptr<EffectInstance> Bind(const EffectConfig& e, const EffectBindContext& ctx) const;
+  /// the albedo's world-file key and field; the hooks are HomogeneousMediumType's.
+  static constexpr std::string_view kAlbedoKey = "color";
+  static constexpr Eigen::Vector3d DustParams::*kAlbedo = &DustParams::color;
 };
 
 }  // namespace penumbra

@@ -2,9 +2,7 @@
 // the `fog` effect type: a homogeneous scattering medium with optional height falloff.
 
 #include <Eigen/Core>
-#include <memory>
 #include <string_view>
-#include <vector>
 
 #include "penumbra/effects/effect_type.h"
 #include "penumbra/effects/types/homogeneous.h"
@@ -12,7 +10,7 @@
 namespace penumbra {
 
 /// fog: sigma_t(p) = sigma_t * exp(-height_falloff_per_m * max(0, p.z - base_height_m)).
-struct FogParams {
+struct FogParams : HomogeneousMediumType<FogParams> {
   static constexpr std::string_view kTypeName = "fog";
 
   ExtinctionSpec extinction;                 ///< required (sigma_t_per_m or mor_m)
@@ -21,12 +19,9 @@ struct FogParams {
   double height_falloff_per_m = 0;  ///< >= 0, 0 = uniform
   double base_height_m = 0;         ///< finite; full density below this height
 
-  /// effect-type hooks (effects/effect_type.h).
-  static std::vector<std::string_view> Keys();
-  void Read(const EffectParamReader& r);
-  void Validate(const EffectConfig& e, EffectChecker* c) const;
-  /// one HomogeneousMedium in the effect's region while the weight is > 0.
-  std::unique_ptr<EffectInstance> Bind(const EffectConfig& e, const EffectBindContext& ctx) const;
+  /// the albedo's world-file key and field; the hooks are HomogeneousMediumType's.
+  static constexpr std::string_view kAlbedoKey = "albedo";
+  static constexpr Eigen::Vector3d FogParams::*kAlbedo = &FogParams::albedo;
 };
 
 }  // namespace penumbra

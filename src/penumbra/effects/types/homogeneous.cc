@@ -2,6 +2,10 @@
 
 #include <cmath>
 
+#include "penumbra/effects/effect_config.h"
+#include "penumbra/effects/types/dust.h"
+#include "penumbra/effects/types/fog.h"
+
 namespace penumbra {
 
 double ExtinctionSpec::SigmaT() const {
@@ -41,5 +45,59 @@ HomogeneousMedium MakeHomogeneousMedium(double sigma_t_per_m, const Eigen::Vecto
   m.region = region;
   return m;
 }
+
+namespace {
+
+template <typename P>
+class HomogeneousMediumInstance : public EffectInstance {
+ public:
+  explicit HomogeneousMediumInstance(const EffectConfig& e) : e_(e), p_(e.Get<P>()) {}
+  void Evaluate(const EffectEvalContext& ctx, EffectsFrame* frame) override {
+    if (ctx.weight <= 0) return;
+    frame->homogeneous_media.push_back(
+        MakeHomogeneousMedium(p_.extinction.SigmaT(), p_.*P::kAlbedo, p_.g, p_.height_falloff_per_m,
+                              p_.base_height_m, e_.region, ctx.weight));
+  }
+
+ private:
+  const EffectConfig& e_;
+  const P& p_;
+};
+
+}  // namespace
+
+template <typename P>
+std::vector<std::string_view> HomogeneousMediumType<P>::Keys() {
+  return {"sigma_t_per_m", "mor_m", P::kAlbedoKey, "g", "height_falloff_per_m", "base_height_m"};
+}
+
+template <typename P>
+void HomogeneousMediumType<P>::Read(const EffectParamReader& r) {
+  P& p = static_cast<P&>(*this);
+  ReadExtinction(r, &p.extinction);
+  r.Vec(P::kAlbedoKey, &(p.*P::kAlbedo));
+  r.Num("g", &p.g);
+  r.Num("height_falloff_per_m", &p.height_falloff_per_m);
+  r.Num("base_height_m", &p.base_height_m);
+}
+
+template <typename P>
+void HomogeneousMediumType<P>::Validate(const EffectConfig&, EffectChecker* c) const {
+  const P& p = static_cast<const P&>(*this);
+  CheckExtinction(p.extinction, c);
+  c->In3(std::string(P::kAlbedoKey), p.*P::kAlbedo, EffectRange::Closed(0, 1));
+  c->Phase("g", p.g);
+  c->In("height_falloff_per_m", p.height_falloff_per_m, EffectRange::AtLeast(0));
+  c->In("base_height_m", p.base_height_m, EffectRange::Finite());
+}
+
+template <typename P>
+std::unique_ptr<EffectInstance> HomogeneousMediumType<P>::Bind(const EffectConfig& e,
+                                                               const EffectBindContext&) const {
+  return std::make_unique<HomogeneousMediumInstance<P>>(e);
+}
+
+template struct HomogeneousMediumType<FogParams>;
+template struct HomogeneousMediumType<DustParams>;
 
 }  // namespace penumbra

@@ -3,8 +3,11 @@
 // meteorological optical range, and the HomogeneousMedium they evaluate to.
 
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "penumbra/effects/effect_type.h"
 
@@ -32,5 +35,24 @@ void CheckExtinction(const ExtinctionSpec& e, EffectChecker* c);
 HomogeneousMedium MakeHomogeneousMedium(double sigma_t_per_m, const Eigen::Vector3d& albedo,
                                         double g, double height_falloff_per_m, double base_height_m,
                                         const std::optional<BoxRegion>& region, double w);
+
+/// the effect-type hooks (effects/effect_type.h) of a homogeneous medium (fog, dust): the
+/// two types differ only in their defaults and in the name of the albedo key. P derives
+/// from HomogeneousMediumType<P> and has the fields `ExtinctionSpec extinction`, `double g`
+/// (Henyey-Greenstein asymmetry), `double height_falloff_per_m`, `double base_height_m`, and
+/// the albedo per channel (Eigen::Vector3d) at the pointer to member P::kAlbedo, read from
+/// the key P::kAlbedoKey. instantiated for FogParams and DustParams (homogeneous.cc).
+template <typename P>
+struct HomogeneousMediumType {
+  /// sigma_t_per_m, mor_m, the albedo key, g, height_falloff_per_m, base_height_m.
+  static std::vector<std::string_view> Keys();
+  /// reads the keys that are present.
+  void Read(const EffectParamReader& r);
+  /// extinction as CheckExtinction, albedo in [0, 1], g in (-1, 1), falloff >= 0, base finite.
+  void Validate(const EffectConfig& e, EffectChecker* c) const;
+  /// one HomogeneousMedium (MakeHomogeneousMedium) in the effect's region while the weight is
+  /// > 0.
+  std::unique_ptr<EffectInstance> Bind(const EffectConfig& e, const EffectBindContext& ctx) const;
+};
 
 }  // namespace penumbra
