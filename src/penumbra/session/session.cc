@@ -49,6 +49,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   };
   compose_options.timestep_sec = world_.timestep_sec;
   compose_options.physics = world_.physics;
+  compose_options.ground_plane = world_.ground_plane;
   ComposedScene composed = ComposeWorld(world_.models, compose_options);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
