@@ -8,6 +8,7 @@ pkgs=(
   libembree-dev
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libtinyxml2-dev libpng-dev nlohmann-json3-dev
+  libassimp-dev  # URDF meshes MuJoCo 2.2.2 cannot read (DAE, ...) become STL at compose time
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev

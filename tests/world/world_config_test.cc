@@ -769,8 +769,11 @@ TEST_F(WorldConfigTest, WorldForBareModel) {
   EXPECT_EQ(c.rate_hz, 30);
   EXPECT_TRUE(c.outputs.rgb && c.outputs.depth && c.outputs.segmentation);
 
+  EXPECT_FALSE(w.ground_plane);  // an MJCF brings its own floor (or floats on purpose)
+
   const WorldConfig u = WorldForBareModel((dir_ / "models" / "arm.urdf").string());
   EXPECT_EQ(u.models[0].name, "arm");
+  EXPECT_TRUE(u.ground_plane);  // a URDF has none
 }
 
 TEST_F(WorldConfigTest, WorldForBareModelErrors) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <string_view>
 
 #include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
@@ -569,6 +570,56 @@ int ComposeKeys(const Models& models, XMLElement* root, Sources* sources,
 
 }  // namespace
 
+// true if `e` or an element below it is a <geom type="plane">
+bool HasPlane(const XMLElement* e) {
+  if (e == nullptr) return false;
+  if (std::string_view(e->Name()) == "geom" && e->Attribute("type", "plane")) return true;
+  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    if (HasPlane(c)) return true;
+  }
+  return false;
+}
+
+// ComposeOptions::ground_plane: an infinite plane at z = 0 with a 1 m grey checker (the
+// look of worlds/models/ramp.xml's floor), added when no model has a plane
+void AddGroundPlane(XMLDocument* doc, XMLElement* root) {
+  XMLElement* worldbody = root->FirstChildElement("worldbody");
+  if (HasPlane(worldbody)) return;
+  if (worldbody == nullptr) worldbody = root->InsertNewChildElement("worldbody");
+  XMLElement* asset = root->FirstChildElement("asset");
+  if (asset == nullptr) {
+    asset = doc->NewElement("asset");
+    if (XMLElement* before = worldbody->PreviousSiblingElement()) {
+      root->InsertAfterChild(before, asset);
+    } else {
+      root->InsertFirstChild(asset);
+    }
+  }
+  XMLElement* tex = asset->InsertNewChildElement("texture");
+  tex->SetAttribute("name", "ground_grid");
+  tex->SetAttribute("type", "2d");
+  tex->SetAttribute("builtin", "checker");
+  tex->SetAttribute("rgb1", "0.46 0.47 0.48");
+  tex->SetAttribute("rgb2", "0.40 0.41 0.42");
+  tex->SetAttribute("width", "256");
+  tex->SetAttribute("height", "256");
+  tex->SetAttribute("mark", "edge");
+  tex->SetAttribute("markrgb", "0.3 0.3 0.32");
+  XMLElement* mat = asset->InsertNewChildElement("material");
+  mat->SetAttribute("name", "ground");
+  mat->SetAttribute("texture", "ground_grid");
+  mat->SetAttribute("texrepeat", "1 1");
+  mat->SetAttribute("texuniform", "true");
+  mat->SetAttribute("specular", "0.2");
+  mat->SetAttribute("shininess", "0.1");
+  XMLElement* geom = doc->NewElement("geom");
+  geom->SetAttribute("name", "ground");
+  geom->SetAttribute("type", "plane");
+  geom->SetAttribute("size", "0 0 0.05");
+  geom->SetAttribute("material", "ground");
+  worldbody->InsertFirstChild(geom);
+}
+
 ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const ComposeOptions& options) {
   ValidateModels(models);
   if (options.timestep_sec &&
@@ -615,6 +666,7 @@ ComposedScene ComposeWorld(const std::vector<ModelConfig>& models, const Compose
        {"custom", "asset", "worldbody", "contact", "equality", "tendon", "actuator", "sensor"}) {
     ComposeSection(composers, section, &doc, root, &scene.sources);
   }
+  if (options.ground_plane) AddGroundPlane(&doc, root);
   compose::AddWorldSites(models, root);  // the world file's sites: (compose/world_sites.h)
   const int nkeys = ComposeKeys(composers, root, &scene.sources, &scene.warnings);
   // <size> needs the key count; put it after <option> as MuJoCo's writer does

@@ -92,6 +92,10 @@ struct ComposeOptions {
   /// composed <option>'s integrator, gravity, iterations or cone, and later models'
   /// differing values of it no longer warn.
   PhysicsOptions physics;
+  /// adds a ground: an infinite plane at z = 0 (geom "ground", material "ground", texture
+  /// "ground_grid": a 1 m grey checker) unless a model already has a plane somewhere in its
+  /// worldbody. WorldConfig::ground_plane (bare URDF runs) sets it.
+  bool ground_plane = false;
 };
 
 /// the result of ComposeWorld: one MJCF document, kept as a tinyxml2 document so that the

@@ -65,7 +65,8 @@ std::mutex& MujocoLoaderMutex() {
 }
 
 mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* contents,
-                             const std::string& display_name, std::vector<std::string>* warnings) {
+                             const std::string& display_name, std::vector<std::string>* warnings,
+                             const std::vector<std::pair<std::string, std::string>>* extra_files) {
   InstallMujocoHandlers();
   if (!contents && !std::filesystem::exists(path))
     throw ConfigError(display_name, 0, "", "model file not found; expected an MJCF or URDF file");
@@ -73,11 +74,20 @@ mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* content
   if (contents) {
     vfs = std::make_unique<mjVFS>();
     mj_defaultVFS(vfs.get());
-    const std::string name = std::filesystem::path(path).filename().string();
-    if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(contents->size())) != 0)
-      throw ConfigError(display_name, 0, "", "could not create an in-memory model file");
-    const int idx = mj_findFileVFS(vfs.get(), name.c_str());
-    std::memcpy(vfs->filedata[idx], contents->data(), contents->size());
+    std::vector<std::pair<std::string, std::string>> files;
+    files.emplace_back(std::filesystem::path(path).filename().string(), std::string());
+    if (extra_files) files.insert(files.end(), extra_files->begin(), extra_files->end());
+    for (size_t i = 0; i < files.size(); ++i) {
+      const std::string& name = files[i].first;
+      const std::string& bytes = i == 0 ? *contents : files[i].second;
+      if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(bytes.size())) != 0) {
+        mj_deleteVFS(vfs.get());
+        throw ConfigError(display_name, 0, "",
+                          "could not create the in-memory file '" + name + "' for MuJoCo");
+      }
+      const int idx = mj_findFileVFS(vfs.get(), name.c_str());
+      std::memcpy(vfs->filedata[idx], bytes.data(), bytes.size());
+    }
   }
   char error[2048] = "";
   std::vector<std::string> loader_warnings;

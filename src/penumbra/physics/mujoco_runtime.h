@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "penumbra/core/error.h"
@@ -38,9 +39,13 @@ std::mutex& MujocoLoaderMutex();
 /// used instead of the file's (through a MuJoCo VFS), but assets still resolve
 /// relative to `path`'s folder. the caller must hold MujocoLoaderMutex().
 /// compiler warnings are appended to `warnings`. messages name the model `display_name`.
+/// `extra_files` (name, bytes) join that in-memory file system (only with `contents`): an
+/// asset whose file name (path stripped) is one of them is read from there.
 /// @throws ConfigError(display_name, line from MuJoCo's message, "", MuJoCo's message).
-mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* contents,
-                             const std::string& display_name, std::vector<std::string>* warnings);
+mjModel* LoadMujocoXmlLocked(
+    const std::string& path, const std::string* contents, const std::string& display_name,
+    std::vector<std::string>* warnings,
+    const std::vector<std::pair<std::string, std::string>>* extra_files = nullptr);
 
 /// frees the "last loaded XML" that mj_loadXML keeps for mj_saveLastXML (MuJoCo's whole
 /// compiler model: every mesh and texture a second time; sizes in docs/performance.md)

@@ -8,7 +8,9 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/physics/mujoco_runtime.h"
+#include "penumbra/physics/urdf_meshes.h"
 
 namespace penumbra {
 namespace {
@@ -43,19 +45,31 @@ std::string WithImportOptions(const std::string& urdf) {
 
 }  // namespace
 
-std::string ConvertUrdfToMjcf(const std::string& urdf_path) {
+std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::string& mesh_dir) {
   std::ifstream in(urdf_path, std::ios::binary);
   if (!in)
     throw ConfigError(urdf_path, 0, "", "cannot read the URDF file; expected a readable file");
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string urdf = WithImportOptions(ss.str());
+  // meshes MuJoCo cannot read become STL files: in memory for this load, on disk for the
+  // composed model
+  const UrdfMeshConversion meshes = ConvertUrdfMeshes(urdf_path, ss.str());
+  const std::string urdf = WithImportOptions(meshes.urdf);
+  const std::filesystem::path dir =
+      mesh_dir.empty() ? std::filesystem::temp_directory_path() / "penumbra-urdf-meshes"
+                       : std::filesystem::path(mesh_dir);
+  for (const auto& [name, bytes] : meshes.files) {
+    const std::filesystem::path file = std::filesystem::absolute(dir / name);
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    WriteFileAtomic(file, bytes);
+  }
 
   std::string tmpl = (std::filesystem::temp_directory_path() / "penumbra_urdf_XXXXXX").string();
   std::string mjcf;
   {
     std::lock_guard<std::mutex> lock(MujocoLoaderMutex());
-    mjModel* m = LoadMujocoXmlLocked(urdf_path, &urdf, urdf_path, nullptr);
+    mjModel* m = LoadMujocoXmlLocked(urdf_path, &urdf, urdf_path, nullptr, &meshes.files);
     const int fd = mkstemp(tmpl.data());
     if (fd < 0) {
       mj_deleteModel(m);
@@ -76,7 +90,18 @@ std::string ConvertUrdfToMjcf(const std::string& urdf_path) {
   os << out.rdbuf();
   mjcf = os.str();
   std::filesystem::remove(tmpl);
+  for (const auto& [name, bytes] : meshes.files) {
+    const std::string from = "file=\"" + name + "\"";
+    const std::string to = "file=\"" + std::filesystem::absolute(dir / name).string() + "\"";
+    for (size_t pos = mjcf.find(from); pos != std::string::npos;
+         pos = mjcf.find(from, pos + to.size()))
+      mjcf.replace(pos, from.size(), to);
+  }
   return mjcf;
+}
+
+std::string ConvertUrdfToMjcf(const std::string& urdf_path) {
+  return ConvertUrdfToMjcfInto(urdf_path, "");
 }
 
 }  // namespace penumbra

@@ -13,8 +13,17 @@ namespace penumbra {
 /// (fusestatic="false"), so links named in world files still exist. mesh file names
 /// in the result are as MuJoCo stores them (path stripped) and resolve against the
 /// URDF's folder. a root link without a joint is welded to the world, as in MuJoCo.
+/// meshes MuJoCo 2.2.2 cannot read (DAE and the other formats assimp reads) are converted
+/// to binary STL first (physics/urdf_meshes.h): each is written to `mesh_dir` (created if
+/// missing; empty: the folder "penumbra-urdf-meshes" in the system's temporary folder) and
+/// the result's <mesh file> names it by its absolute path. the files' names come from their
+/// content, so the same URDF gives the same text and bytes every time.
 /// @throws ConfigError(urdf_path, line, "", MuJoCo's message) if MuJoCo cannot load it;
-///         Error if the converted text cannot be written.
+///         ConfigError(urdf_path, mesh line, "", ...) naming link and mesh if a mesh cannot
+///         be found or converted; Error if the converted text or meshes cannot be written.
+std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::string& mesh_dir);
+
+/// ConvertUrdfToMjcfInto(urdf_path, ""): converted meshes go to the temporary folder.
 std::string ConvertUrdfToMjcf(const std::string& urdf_path);
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <filesystem>
 
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
@@ -38,9 +39,17 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   // compose every model into one MJCF, with the world's IMUs and the agents' bodies
   auto t0 = Clock::now();
   ComposeOptions compose_options;
-  compose_options.urdf_to_mjcf = ConvertUrdfToMjcf;
+  // URDF meshes MuJoCo cannot read become STL files next to the composed model (a "meshes"
+  // folder beside composed.xml), or in the temporary folder when none is written
+  std::string mesh_dir;
+  if (!options.composed_xml_path.empty())
+    mesh_dir = (std::filesystem::path(options.composed_xml_path).parent_path() / "meshes").string();
+  compose_options.urdf_to_mjcf = [mesh_dir](const std::string& urdf_path) {
+    return ConvertUrdfToMjcfInto(urdf_path, mesh_dir);
+  };
   compose_options.timestep_sec = world_.timestep_sec;
   compose_options.physics = world_.physics;
+  compose_options.ground_plane = world_.ground_plane;
   ComposedScene composed = ComposeWorld(world_.models, compose_options);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);

@@ -39,7 +39,9 @@ struct SessionOptions {
   std::string adversity;
   /// where to keep the composed MJCF (e.g. "<output_dir>/composed.xml"); MuJoCo then loads
   /// that file, so its messages (and PhysicsError's) name it. "" = loaded from memory
-  /// (messages name "<string>"), nothing written.
+  /// (messages name "<string>"), nothing written. URDF meshes MuJoCo 2.2.2 cannot read
+  /// (DAE, ...) are converted to STL files in "meshes/" beside it ("" = in the temporary
+  /// folder's "penumbra-urdf-meshes"; physics/urdf_converter.h).
   std::string composed_xml_path;
   /// add the controllers of the world's robots (AddWorldControllers).
   bool add_controllers = true;

@@ -389,10 +389,15 @@ class WorldParser {
 
 int MarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
-bool HasModelExtension(const fs::path& p) {
+std::string LowerExtension(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext;
+}
+
+bool HasModelExtension(const fs::path& p) {
+  const std::string ext = LowerExtension(p);
   return ext == ".xml" || ext == ".urdf";
 }
 
@@ -477,6 +482,8 @@ WorldConfig WorldForBareModel(const std::string& model_path) {
   w.models.push_back(m);
 
   w.default_lights = true;
+  // a URDF has no floor: give it one (a bare MJCF brings its own, or floats on purpose)
+  w.ground_plane = LowerExtension(abs) == ".urdf";
   w.sky.type = Sky::Type::kDaylight;
   w.sky.turbidity = 3;
   w.sky.sun_elevation_deg = 45;

@@ -167,6 +167,9 @@ struct WorldConfig {
   std::vector<ModelConfig> models;     ///< robots first, then static models, in file order
   std::vector<LightConfig> lights;
   bool default_lights = false;  ///< add a default sun + sky fill (bare-model runs)
+  /// add a ground plane at z = 0 when no model has a plane (bare URDF runs: a URDF has no
+  /// floor of its own; compose/scene_composer.h, ComposeOptions::ground_plane).
+  bool ground_plane = false;
   SkyConfig sky;
   std::vector<CameraConfig> cameras;
   MjcfCameraDefaults mjcf_cameras;
