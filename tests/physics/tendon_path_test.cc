@@ -64,8 +64,8 @@ TEST(TendonPathTest, SceneListsVisibleSpatialTendonsWithWidthAndColour) {
 
 TEST(TendonPathTest, SnapshotsCarryTheWrapPointsInTheWorldFrame) {
   Simulation sim = Simulation::LoadFromString(kTendonXml);
-  for (const auto content : {Simulation::SnapshotContent::kPoses,
-                             Simulation::SnapshotContent::kFull}) {
+  for (const auto content :
+       {Simulation::SnapshotContent::kPoses, Simulation::SnapshotContent::kFull}) {
     const WorldSnapshot snap = sim.Snapshot(content);
     // rope: one run anchor -> hook; pulleyed: two runs split at the pulley
     ASSERT_EQ(snap.tendon_paths.size(), 3u);

@@ -64,7 +64,8 @@ TEST(TendonRenderTest, TendonIsDrawnAtItsPathInBothTiers) {
     // the midpoints of both segments show the tendon's colour; beside it, the black floor/sky
     for (const Eigen::Vector3d& p : {Eigen::Vector3d(3, 0, 0.4), Eigen::Vector3d(3, 0.15, 0.8)}) {
       const Eigen::Vector2i px = PixelOf(view, p);
-      EXPECT_NEAR(f.radiance.at(px.x(), px.y())[1], kEmission, 1e-3) << name << " at " << p.transpose();
+      EXPECT_NEAR(f.radiance.at(px.x(), px.y())[1], kEmission, 1e-3)
+          << name << " at " << p.transpose();
       EXPECT_EQ(f.geom_id.at(px.x(), px.y())[0], -1) << name;
       // the capsule's near side: 3 m minus its radius along the optical axis (x)
       EXPECT_NEAR(f.depth_m.at(px.x(), px.y())[0], 3.0 - 0.05, 0.01) << name;

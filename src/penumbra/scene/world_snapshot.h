@@ -30,7 +30,7 @@ struct WorldSnapshot {
   /// a tendon is drawn as capsules between consecutive points; a pulley splits a tendon's path
   /// into several runs.
   struct TendonPath {
-    int tendon = 0;                      ///< index into SceneDescription::tendons
+    int tendon = 0;                    ///< index into SceneDescription::tendons
     std::vector<Eigen::Vector3d> p_W;  ///< at least two points
   };
   /// the paths of SceneDescription::tendons at this instant (empty if the model has none).
