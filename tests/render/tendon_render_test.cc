@@ -60,28 +60,32 @@ TEST(TendonRenderTest, TendonIsDrawnAtItsPathInBothTiers) {
     const CameraView view = MakeView(CameraLookingAlongX({0, 0, 0.6}), 96, 96, 60);
     RenderedFrame f;
     renderer->Render(WithPath(s, path), view, &f);
-    const char* name = tier == RenderSettings::Tier::kRealtime ? "realtime" : "pathtraced";
+    const bool realtime = tier == RenderSettings::Tier::kRealtime;
+    const char* name = realtime ? "realtime" : "pathtraced";
+    // the pathtraced tier adds the glossy reflections of the tendon in itself and the floor
+    const float tol = realtime ? 1e-3f : 0.02f * kEmission;
     // the midpoints of both segments show the tendon's colour; beside it, the black floor/sky
     for (const Eigen::Vector3d& p : {Eigen::Vector3d(3, 0, 0.4), Eigen::Vector3d(3, 0.15, 0.8)}) {
       const Eigen::Vector2i px = PixelOf(view, p);
-      EXPECT_NEAR(f.radiance.at(px.x(), px.y())[1], kEmission, 1e-3)
+      EXPECT_NEAR(f.radiance.at(px.x(), px.y())[1], kEmission, tol)
           << name << " at " << p.transpose();
       EXPECT_EQ(f.geom_id.at(px.x(), px.y())[0], -1) << name;
-      // the capsule's near side: 3 m minus its radius along the optical axis (x)
-      EXPECT_NEAR(f.depth_m.at(px.x(), px.y())[0], 3.0 - 0.05, 0.01) << name;
+      // the capsule's near side: within its radius in front of the axis at x = 3 m
+      EXPECT_GE(f.depth_m.at(px.x(), px.y())[0], 3.0f - 0.05f) << name;
+      EXPECT_LE(f.depth_m.at(px.x(), px.y())[0], 3.0f) << name;
     }
     const Eigen::Vector2i beside = PixelOf(view, {3, -0.4, 0.4});
-    EXPECT_EQ(f.radiance.at(beside.x(), beside.y())[1], 0.0f) << name;
+    EXPECT_LT(f.radiance.at(beside.x(), beside.y())[1], tol) << name;
 
     // the next snapshot moves the tendon: the old midpoint is clear, the new one drawn
     renderer->Render(WithPath(s, {{3, -0.4, 0.2}, {3, -0.4, 0.6}}), view, &f);
     const Eigen::Vector2i old_px = PixelOf(view, {3, 0, 0.4});
-    EXPECT_EQ(f.radiance.at(old_px.x(), old_px.y())[1], 0.0f) << name;
-    EXPECT_NEAR(f.radiance.at(beside.x(), beside.y())[1], kEmission, 1e-3) << name;
+    EXPECT_LT(f.radiance.at(old_px.x(), old_px.y())[1], tol) << name;
+    EXPECT_NEAR(f.radiance.at(beside.x(), beside.y())[1], kEmission, tol) << name;
 
     // no paths: nothing drawn
     renderer->Render(IdentitySnapshot(s), view, &f);
-    EXPECT_EQ(f.radiance.at(beside.x(), beside.y())[1], 0.0f) << name;
+    EXPECT_LT(f.radiance.at(beside.x(), beside.y())[1], tol) << name;
   }
 }
 
