@@ -116,8 +116,9 @@ TEST(TendonRenderTest, TendonCastsAShadow) {
   EXPECT_GT(lit_g, 0.0f);
   EXPECT_LT(f.radiance.at(shadow.x(), shadow.y())[1], 0.01f * lit_g);
   const Eigen::Vector2i top = PixelOf(view, {0.5, 0, 1.1});
-  EXPECT_GT(f.radiance.at(top.x(), top.y())[0], 0.0f);
-  EXPECT_EQ(f.radiance.at(top.x(), top.y())[1], 0.0f);  // red tendon seen from above
+  const float top_r = f.radiance.at(top.x(), top.y())[0];
+  EXPECT_GT(top_r, 0.0f);
+  EXPECT_LT(f.radiance.at(top.x(), top.y())[1], 1e-3f * top_r);  // the red tendon, from above
 }
 
 }  // namespace
