@@ -200,27 +200,10 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
                          m->mat_texid[i], m->mat_texrepeat + 2 * i, m->mat_texuniform[i] != 0));
   }
 
-  // geoms, with generated materials deduplicated by (material id, rgba)
+  // geoms (and tendons), with generated materials deduplicated by (material id, rgba)
   std::map<std::tuple<int, float, float, float, float>, int> generated;
-  s.geoms.resize(m->ngeom);
-  for (int g = 0; g < m->ngeom; ++g) {
-    Geom& geom = s.geoms[g];
-    geom.name = Name(m, mjOBJ_GEOM, g);
-    geom.id = g;
-    geom.body = m->geom_bodyid[g];
-    geom.shape = ShapeFromMujoco(m->geom_type[g]);
-    geom.size =
-        Eigen::Vector3d(m->geom_size[3 * g], m->geom_size[3 * g + 1], m->geom_size[3 * g + 2]);
-    geom.X_BG = PoseFromPosQuat(m->geom_pos + 3 * g, m->geom_quat + 4 * g);
-    geom.group = m->geom_group[g];
-    if (geom.shape == GeomShape::kMesh) geom.mesh = m->geom_dataid[g];
-    if (geom.shape == GeomShape::kHeightField) geom.hfield = m->geom_dataid[g];
-    const int mat = m->geom_matid[g];
-    const float* rgba = m->geom_rgba + 4 * g;
-    if (mat >= 0 && IsDefaultRgba(rgba)) {
-      geom.material = mat;
-      continue;
-    }
+  const auto material_of = [&](int mat, const float* rgba) {
+    if (mat >= 0 && IsDefaultRgba(rgba)) return mat;
     const auto key = std::make_tuple(mat, rgba[0], rgba[1], rgba[2], rgba[3]);
     auto it = generated.find(key);
     if (it == generated.end()) {
@@ -238,7 +221,36 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
       it = generated.emplace(key, static_cast<int>(s.materials.size())).first;
       s.materials.push_back(std::move(made));
     }
-    geom.material = it->second;
+    return it->second;
+  };
+  s.geoms.resize(m->ngeom);
+  for (int g = 0; g < m->ngeom; ++g) {
+    Geom& geom = s.geoms[g];
+    geom.name = Name(m, mjOBJ_GEOM, g);
+    geom.id = g;
+    geom.body = m->geom_bodyid[g];
+    geom.shape = ShapeFromMujoco(m->geom_type[g]);
+    geom.size =
+        Eigen::Vector3d(m->geom_size[3 * g], m->geom_size[3 * g + 1], m->geom_size[3 * g + 2]);
+    geom.X_BG = PoseFromPosQuat(m->geom_pos + 3 * g, m->geom_quat + 4 * g);
+    geom.group = m->geom_group[g];
+    if (geom.shape == GeomShape::kMesh) geom.mesh = m->geom_dataid[g];
+    if (geom.shape == GeomShape::kHeightField) geom.hfield = m->geom_dataid[g];
+    geom.material = material_of(m->geom_matid[g], m->geom_rgba + 4 * g);
+  }
+
+  // spatial tendons that MuJoCo shows (groups 0-2, a width, not transparent); fixed tendons
+  // (joint wraps) have no path
+  for (int t = 0; t < m->ntendon; ++t) {
+    if (m->tendon_num[t] < 2 || m->wrap_type[m->tendon_adr[t]] == mjWRAP_JOINT) continue;
+    if (m->tendon_group[t] > 2 || !(m->tendon_width[t] > 0)) continue;
+    Tendon tendon;
+    tendon.name = Name(m, mjOBJ_TENDON, t);
+    tendon.id = t;
+    tendon.width_m = m->tendon_width[t];
+    tendon.material = material_of(m->tendon_matid[t], m->tendon_rgba + 4 * t);
+    if (s.materials[tendon.material].alpha < 0.5f) continue;
+    s.tendons.push_back(std::move(tendon));
   }
 
   // lights

@@ -217,6 +217,31 @@ void ComputePoses(const mjModel* m, mjData* d) {
   mj_camlight(m, d);
 }
 
+// the runs of wrap points of `tendons` in `d` (after mj_tendon), split at pulleys (wrap_obj
+// -2), as MuJoCo's mjv_addGeoms draws them.
+void FillTendonPaths(const mjModel* m, const mjData* d, const std::vector<Tendon>& tendons,
+                     std::vector<WorldSnapshot::TendonPath>* out) {
+  out->clear();
+  for (int i = 0; i < static_cast<int>(tendons.size()); ++i) {
+    const int t = tendons[i].id;
+    const int begin = d->ten_wrapadr[t], end = begin + d->ten_wrapnum[t];
+    WorldSnapshot::TendonPath run;
+    run.tendon = i;
+    const auto flush = [&] {
+      if (run.p_W.size() >= 2) out->push_back(run);
+      run.p_W.clear();
+    };
+    for (int j = begin; j < end; ++j) {
+      if (d->wrap_obj[j] == -2) {
+        flush();
+        continue;
+      }
+      run.p_W.emplace_back(d->wrap_xpos[3 * j], d->wrap_xpos[3 * j + 1], d->wrap_xpos[3 * j + 2]);
+    }
+    flush();
+  }
+}
+
 }  // namespace
 
 struct Simulation::Impl {
@@ -691,6 +716,8 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
       mj_forward(m, d);
     } else {
       ComputePoses(m, d);
+      // the tendons' wrap points (mj_forward computes them for kFull)
+      if (!impl_->scene.tendons.empty()) mj_tendon(m, d);
     }
   } catch (const MujocoError& e) {
     throw PhysicsError(impl_->When(live->time, impl_->steps) + ": MuJoCo error: " + e.what());
@@ -717,6 +744,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
     Eigen::Vector3d dir(d->light_xdir[3 * l], d->light_xdir[3 * l + 1], d->light_xdir[3 * l + 2]);
     out->light_direction_W[l] = dir.norm() > 0 ? dir.normalized() : Eigen::Vector3d(0, 0, -1);
   }
+  FillTendonPaths(m, d, impl_->scene.tendons, &out->tendon_paths);
   out->qpos.assign(live->qpos, live->qpos + m->nq);
   out->qvel.assign(live->qvel, live->qvel + m->nv);
   if (content == SnapshotContent::kFull) {

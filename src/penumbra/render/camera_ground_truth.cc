@@ -43,7 +43,7 @@ void WriteGroundTruth(const GroundTruthImages& img, const Camera& camera,
       n[0] = n[1] = n[2] = 0.0f;
     }
   }
-  const Geom* g = did_hit ? &scene.geoms[hit.geom] : nullptr;
+  const Geom* g = did_hit && hit.geom >= 0 ? &scene.geoms[hit.geom] : nullptr;
   if (img.body_id) *img.body_id->at(u, v) = g ? g->body : -1;
   if (img.semantic_class) *img.semantic_class->at(u, v) = g ? g->semantic_class : 0;
 }

@@ -292,7 +292,8 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     if (shape == GeomShape::kPlane || (shape == GeomShape::kBox && hit.n_G.z() > 0.5f))
       out.mirror = std::min(m.reflectance, 1.0f);
   }
-  if (m.texture < 0) return out;
+  // tendons (geom -1) are drawn untextured
+  if (m.texture < 0 || hit.geom < 0) return out;
 
   const Texture& tex = scene_.textures[m.texture];
   const float w = static_cast<float>(tex.image->width());

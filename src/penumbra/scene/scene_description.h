@@ -109,6 +109,19 @@ struct Geom {
   int semantic_class = 0;  ///< class id for semantic segmentation (0 = unlabelled)
 };
 
+/// a visible spatial tendon (MJCF <spatial>), drawn as MuJoCo draws it: a capsule of radius
+/// width_m around each segment between consecutive wrap points, except segments that touch a
+/// pulley. the wrap points move with the model: WorldSnapshot::tendon_paths carries them.
+/// tendons in MJCF groups > 2 and tendons whose material has alpha < 0.5 are not listed.
+struct Tendon {
+  std::string name;    ///< MJCF name ("" if unnamed)
+  int id = -1;         ///< MuJoCo tendon id
+  double width_m = 0;  ///< capsule radius (MuJoCo tendon_width), m, > 0
+  /// index into SceneDescription::materials: the tendon's MJCF material if it has one, else one
+  /// made from its rgba (as geoms, physics/scene_extractor.h).
+  int material = -1;
+};
+
 /// a light source. photometric units: the renderer works in luminance-like units
 /// (cd/m^2 per channel), so illuminance is lux and intensity is candela.
 struct Light {
@@ -210,6 +223,8 @@ struct CameraSpec {
 struct SceneDescription {
   std::vector<Body> bodies;
   std::vector<Geom> geoms;
+  /// visible spatial tendons; hits on them report geom -1 (segmentation: background id).
+  std::vector<Tendon> tendons;
   std::vector<TriangleMesh> meshes;
   std::vector<HeightField> hfields;
   std::vector<Texture> textures;

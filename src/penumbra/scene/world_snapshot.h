@@ -26,6 +26,15 @@ struct WorldSnapshot {
   /// position and direction (unit) of every MJCF light in the world frame, by MuJoCo light id.
   std::vector<Eigen::Vector3d> light_position_W;
   std::vector<Eigen::Vector3d> light_direction_W;
+  /// one unbroken run of a tendon's wrap points (MuJoCo wrap_xpos), in the world frame, m:
+  /// a tendon is drawn as capsules between consecutive points; a pulley splits a tendon's path
+  /// into several runs.
+  struct TendonPath {
+    int tendon = 0;                    ///< index into SceneDescription::tendons
+    std::vector<Eigen::Vector3d> p_W;  ///< at least two points
+  };
+  /// the paths of SceneDescription::tendons at this instant (empty if the model has none).
+  std::vector<TendonPath> tendon_paths;
   /// joint positions and velocities (MuJoCo qpos / qvel), for recording and replay.
   std::vector<double> qpos;
   std::vector<double> qvel;

@@ -156,7 +156,8 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       int32_t* seg_row = seg ? seg->at(t.x0, v) : nullptr;
       for (int x = 0; x < t.width; ++x, ++i) {
         if (depth_row) depth_row[x] = did_hit[i] ? hits[i].t : 0.0f;
-        if (seg_row) seg_row[x] = did_hit[i] ? scene_.geoms[hits[i].geom].id : -1;
+        if (seg_row)
+          seg_row[x] = did_hit[i] && hits[i].geom >= 0 ? scene_.geoms[hits[i].geom].id : -1;
         if (truth.any)
           WriteGroundTruth(truth, camera, scene_, rays[i], did_hit[i], hits[i], t.x0 + x, v);
       }

@@ -221,6 +221,10 @@ struct RayScene::Impl {
   unsigned static_instance_id = 0;     // top-level geomID of the static group's instance
   // bounds of the moving groups (group i >= 1 is body i - 1 here), for the static-only path.
   MovingBounds moving;
+  // the group of the tendons' capsules (world frame, rebuilt when the paths change; the last
+  // group), or -1 if the scene has no tendons. with tendons the static-only path is not taken.
+  int tendon_group = -1;
+  std::vector<WorldSnapshot::TendonPath> tendon_paths;  // as the tendon group was built
   // rays refused by IsTraceableRay (never passed to Embree)
   mutable std::atomic<int64_t> untraceable{0};
 
@@ -368,6 +372,63 @@ struct RayScene::Impl {
     }
     SetAnalyticWorldTransforms(group);
     rtcCommitScene(group->scene);
+  }
+
+  // rebuilds the tendon group's scene: a capsule around every segment of `paths` (world frame;
+  // a segment shorter than 1e-9 m is a sphere).
+  void BuildTendonGroup(const std::vector<WorldSnapshot::TendonPath>& paths) {
+    InstanceGroup* group = &groups[tendon_group];
+    if (group->scene) rtcReleaseScene(group->scene);
+    group->records.clear();
+    group->analytic.clear();
+    group->scene = rtcNewScene(device);
+    for (const WorldSnapshot::TendonPath& path : paths) {
+      if (path.tendon < 0 || path.tendon >= static_cast<int>(scene->tendons.size()))
+        throw Error("RayScene::Update: a tendon path refers to missing tendon " +
+                    std::to_string(path.tendon));
+      const Tendon& tendon = scene->tendons[path.tendon];
+      for (size_t k = 0; k + 1 < path.p_W.size(); ++k) {
+        const Eigen::Vector3d& a = path.p_W[k];
+        const Eigen::Vector3d& b = path.p_W[k + 1];
+        if (!a.allFinite() || !b.allFinite()) continue;
+        const double length = (b - a).norm();
+        auto ag = std::make_unique<AnalyticGeom>();
+        ag->shape.kind = length > 1e-9 ? AnalyticKind::kCapsule : AnalyticKind::kSphere;
+        ag->shape.size = {tendon.width_m, 0.5 * length, 0};
+        // geom frame: origin at the segment's midpoint, z along it
+        Eigen::Matrix3d R_WG = Eigen::Matrix3d::Identity();
+        if (length > 1e-9) {
+          const Eigen::Vector3d z = (b - a) / length;
+          const Eigen::Vector3d x = z.unitOrthogonal();
+          R_WG.col(0) = x;
+          R_WG.col(1) = z.cross(x);
+          R_WG.col(2) = z;
+        }
+        ag->R_GI = R_WG.transpose();
+        ag->p_GI = -(ag->R_GI * (0.5 * (a + b)));
+        RTCGeometry eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(eg, 1);
+        rtcSetGeometryUserData(eg, ag.get());
+        rtcSetGeometryBoundsFunction(eg, AnalyticBounds, nullptr);
+        rtcSetGeometryIntersectFunction(eg, AnalyticIntersect);
+        rtcSetGeometryOccludedFunction(eg, AnalyticOccluded);
+        rtcCommitGeometry(eg);
+        const unsigned id = rtcAttachGeometry(group->scene, eg);
+        rtcReleaseGeometry(eg);
+        GeomRecord rec;
+        rec.geom = -1;
+        rec.material = tendon.material;
+        rec.analytic = ag.get();
+        if (group->records.size() <= id) group->records.resize(id + 1);
+        group->records[id] = rec;
+        group->analytic.push_back(std::move(ag));
+      }
+    }
+    SetAnalyticWorldTransforms(group);
+    rtcCommitScene(group->scene);
+    rtcSetGeometryInstancedScene(group->instance, group->scene);
+    rtcCommitGeometry(group->instance);
+    tendon_paths = paths;
   }
 
   // folds the instance pose of `group` into its analytic geoms' transforms.
@@ -648,6 +709,19 @@ RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>
     ++num_visible_geoms_;
   }
 
+  // the tendons' capsules: one group of their own, rebuilt by Update
+  for (const Tendon& tendon : scene.tendons) {
+    if (tendon.material < 0 || tendon.material >= static_cast<int>(scene.materials.size()))
+      throw Error("RayScene: tendon '" + tendon.name + "' refers to missing material " +
+                  std::to_string(tendon.material));
+    if (!(tendon.width_m > 0) || !std::isfinite(tendon.width_m))
+      throw Error("RayScene: tendon '" + tendon.name + "' has a non-positive width");
+  }
+  if (!scene.tendons.empty()) {
+    m.tendon_group = static_cast<int>(m.groups.size());
+    m.groups.emplace_back();
+  }
+
   m.device = rtcNewDevice(nullptr);
   if (!m.device) throw Error("RayScene: cannot create the Embree device (rtcNewDevice failed)");
   rtcSetDeviceErrorFunction(m.device, ErrorCallback, &m.error);
@@ -666,7 +740,7 @@ RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>
       if (m.group_of_instance.size() <= id) m.group_of_instance.resize(id + 1, -1);
       m.group_of_instance[id] = i;
       if (i == 0) m.static_instance_id = id;
-      if (i > 0) {
+      if (i > 0 && i != m.tendon_group) {
         // cluster: the root of the body's kinematic tree (the child of the world body).
         int root = g.body;
         while (scene.bodies[root].parent > 0) root = scene.bodies[root].parent;
@@ -708,12 +782,23 @@ void RayScene::Update(const WorldSnapshot& snapshot) {
     changed = true;
   }
   for (size_t i = 1; i < m.groups.size(); ++i) {
+    if (static_cast<int>(i) == m.tendon_group) continue;
     InstanceGroup& g = m.groups[i];
     const Pose& X = snapshot.X_WB[g.body];
     if (X.matrix() == g.X_WI.matrix()) continue;
     m.SetInstancePose(&g, X);
     m.moving.SetPose(static_cast<int>(i) - 1, X);
     changed = true;
+  }
+  if (m.tendon_group >= 0) {
+    bool same = snapshot.tendon_paths.size() == m.tendon_paths.size();
+    for (size_t k = 0; same && k < m.tendon_paths.size(); ++k)
+      same = snapshot.tendon_paths[k].tendon == m.tendon_paths[k].tendon &&
+             snapshot.tendon_paths[k].p_W == m.tendon_paths[k].p_W;
+    if (!same) {
+      m.BuildTendonGroup(snapshot.tendon_paths);
+      changed = true;
+    }
   }
   X_WB_ = snapshot.X_WB;
   if (changed) {
@@ -790,6 +875,7 @@ bool RayScene::IntersectGrid(const Ray* rays, int width, int height, SurfaceHit*
   constexpr int kSide = 4;  // kSide x kSide cells per packet
   static_assert(kSide * kSide == kPacket, "one Embree packet per square of cells");
   const bool static_only =
+      impl_->tendon_group < 0 &&
       !impl_->moving.MayHit(cone != nullptr ? *cone : RayCone::FromRays(rays, width * height));
   int index[kPacket];
   for (int y0 = 0; y0 < height; y0 += kSide) {
@@ -844,7 +930,8 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
     p.id[k] = 0;
     p.flags[k] = 0;
   }
-  const bool static_only = !impl_->moving.SegmentsMayHit(o, d, tmax, traced).any();
+  const bool static_only =
+      impl_->tendon_group < 0 && !impl_->moving.SegmentsMayHit(o, d, tmax, traced).any();
   rtcOccluded16(valid, static_only ? impl_->groups[0].scene : impl_->top, &ctx, &p);
   for (int k = 0; k < kPacket; ++k) (*occluded)[k] = traced[k] && p.tfar[k] < 0;
   return static_only;

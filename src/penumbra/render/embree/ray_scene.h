@@ -30,6 +30,12 @@
 // ray (default world: images byte-identical). IntersectGrid tests a cone of the grid's rays,
 // OccludedLanes each shadow segment against the bodies' spheres.
 //
+// tendons (SceneDescription::tendons): one more instanced scene, in the world frame, holds a
+// capsule (user geometry, as analytic geoms) around every segment of the snapshot's tendon
+// paths; Update rebuilds it when the paths change. hits on it report geom -1 and the tendon's
+// material. a scene with tendons never takes the static-only fast path (the capsules have no
+// MovingBounds); scenes without tendons are traced as before.
+//
 // visibility: geoms in MJCF groups > 2 (MuJoCo shows groups 0-2 by default) and geoms
 // whose material has alpha < 0.5 are left out.
 //
@@ -64,14 +70,17 @@ class RayScene final : public RayQuery {
   /// builds the body scenes (and an identity pose for every body until Update). `scene` is
   /// referenced, not copied: it must outlive this object.
   /// @throws Error if Embree fails, or a visible geom refers to a missing body, material, mesh
-  /// or height field, or has a non-positive size for its shape.
+  /// or height field, or has a non-positive size for its shape, or a tendon refers to a missing
+  /// material or has a non-positive width.
   explicit RayScene(const SceneDescription& scene);
   ~RayScene();
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;
 
-  /// poses every body with snapshot.X_WB and recommits the top level if any pose changed.
-  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies.
+  /// poses every body with snapshot.X_WB, rebuilds the tendon capsules if
+  /// snapshot.tendon_paths changed, and recommits the top level if anything changed.
+  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies, or a tendon path
+  /// refers to a missing tendon.
   void Update(const WorldSnapshot& snapshot) override;
 
   /// RayQuery's batched closest hits (IntersectMany with coherent rays).
