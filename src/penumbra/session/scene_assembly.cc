@@ -222,7 +222,8 @@ double FovyOf(const CameraIntrinsics& k) {
   return 2.0 * std::atan(0.5 * k.height / k.fy) * 180.0 / M_PI;
 }
 
-void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const WorldSnapshot& initial) {
+void AssembleCameras(SceneDescription& scene, const WorldConfig& world,
+                     const WorldSnapshot& initial) {
   std::vector<CameraSpec> cameras;
   // mjcf cameras: defaults, then per-camera overrides
   if (world.mjcf_cameras.enabled) {
@@ -265,7 +266,8 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world, const Wo
       cam.body = 0;
       cam.X_BO = AutoFramePose(scene, initial, cam.intrinsics);
     } else {
-      cam.body = BodyOrThrow(scene, c.attach, world.file, "cameras[" + std::to_string(i) + "].attach");
+      cam.body =
+          BodyOrThrow(scene, c.attach, world.file, "cameras[" + std::to_string(i) + "].attach");
       Pose X_BodyOptical = Pose::Identity();
       X_BodyOptical.linear() = RotationBodyFromOptical();
       cam.X_BO = c.pose.ToPose() * X_BodyOptical;

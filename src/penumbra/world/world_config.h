@@ -47,7 +47,7 @@ struct ModelConfig {
       file;  ///< absolute path after loading (relative paths resolve against the world file)
   PoseConfig pose;
   bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
-  ControllerConfig controller;  ///< control/controller_config.h; type "" = none
+  ControllerConfig controller;    ///< control/controller_config.h; type "" = none
   std::vector<SiteConfig> sites;  ///< `sites:` added to the model when composing
   /// `initial_keyframe:` a <key> of the model (its local name) the run starts from ("" =
   /// MuJoCo's reference configuration qpos0).
