@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <optional>
+
+#include "penumbra/session/geom_extents.h"
 
 namespace penumbra {
 namespace {
@@ -11,38 +14,24 @@ namespace {
 // and height fields (never blocking)
 bool LocalBox(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* c,
               Eigen::Vector3d* e) {
-  const Eigen::Vector3d& s = g.size;
   *c = Eigen::Vector3d::Zero();
-  switch (g.shape) {
-    case GeomShape::kSphere:
-      *e = Eigen::Vector3d::Constant(s[0]);
-      return true;
-    case GeomShape::kCapsule:
-      *e = Eigen::Vector3d(s[0], s[0], s[0] + s[1]);
-      return true;
-    case GeomShape::kCylinder:
-      *e = Eigen::Vector3d(s[0], s[0], s[1]);
-      return true;
-    case GeomShape::kEllipsoid:
-    case GeomShape::kBox:
-      *e = s;
-      return true;
-    case GeomShape::kMesh: {
-      if (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())) return false;
-      const auto& v = scene.meshes[g.mesh].vertices;
-      if (v.empty()) return false;
-      Eigen::Vector3f lo = v[0], hi = v[0];
-      for (const Eigen::Vector3f& p : v) {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-      }
-      *c = (0.5f * (lo + hi)).cast<double>();
-      *e = (0.5f * (hi - lo)).cast<double>();
-      return true;
-    }
-    default:
-      return false;
+  if (const std::optional<Eigen::Vector3d> h = PrimitiveHalfExtents(g)) {
+    *e = *h;
+    return true;
   }
+  // meshes: the box of their vertices
+  if (g.shape != GeomShape::kMesh || g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size()))
+    return false;
+  const auto& v = scene.meshes[g.mesh].vertices;
+  if (v.empty()) return false;
+  Eigen::Vector3f lo = v[0], hi = v[0];
+  for (const Eigen::Vector3f& p : v) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  *c = (0.5f * (lo + hi)).cast<double>();
+  *e = (0.5f * (hi - lo)).cast<double>();
+  return true;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
 #include "penumbra/session/camera_specs.h"
+#include "penumbra/session/geom_extents.h"
 
 namespace penumbra {
 namespace {
@@ -89,32 +90,15 @@ Light ToLight(const LightConfig& c, const SceneDescription& scene, const std::st
 // half extents of a box in the geom frame, centred on the geom's origin, that holds the geom
 // (planes: none; meshes: see GeomCornersInWorld).
 bool GeomHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* h) {
-  const Eigen::Vector3d& s = g.size;
-  switch (g.shape) {
-    case GeomShape::kPlane:
-    case GeomShape::kMesh:
-      return false;
-    case GeomShape::kSphere:
-      *h = Eigen::Vector3d::Constant(s.x());
-      return true;
-    case GeomShape::kCapsule:
-      *h = Eigen::Vector3d(s.x(), s.x(), s.y() + s.x());
-      return true;
-    case GeomShape::kCylinder:
-      *h = Eigen::Vector3d(s.x(), s.x(), s.y());
-      return true;
-    case GeomShape::kEllipsoid:
-    case GeomShape::kBox:
-      *h = s;
-      return true;
-    case GeomShape::kHeightField: {
-      const HeightField& f = scene.hfields.at(g.hfield);
-      *h = Eigen::Vector3d::Constant(
-          std::sqrt(f.size_x * f.size_x + f.size_y * f.size_y + f.size_z * f.size_z));
-      return true;
-    }
+  if (const std::optional<Eigen::Vector3d> p = PrimitiveHalfExtents(g)) {
+    *h = *p;
+    return true;
   }
-  return false;
+  if (g.shape != GeomShape::kHeightField) return false;  // planes; meshes by their vertices
+  const HeightField& f = scene.hfields.at(g.hfield);
+  *h = Eigen::Vector3d::Constant(
+      std::sqrt(f.size_x * f.size_x + f.size_y * f.size_y + f.size_z * f.size_z));
+  return true;
 }
 
 // bounding box of the geoms of moving bodies at `initial` (all finite geoms if none move):
