@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "common/model_config.h"
 #include "common/temp_dir.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
@@ -15,12 +16,7 @@
 namespace penumbra {
 namespace {
 
-ModelConfig Model(const std::string& name, const std::string& file) {
-  ModelConfig m;
-  m.name = name;
-  m.file = file;
-  return m;
-}
+using testing::Model;
 
 // MuJoCo 2.2.2's verdict on `xml` (written to `dir`): "" when it loads, else its error
 std::string MujocoError(const penumbra::testing::TempDir& dir, const std::string& xml) {

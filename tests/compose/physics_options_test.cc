@@ -7,18 +7,14 @@
 
 #include <string>
 
+#include "common/model_config.h"
 #include "common/temp_dir.h"
 #include "penumbra/compose/scene_composer.h"
 
 namespace penumbra {
 namespace {
 
-ModelConfig Model(const std::string& name, const std::string& file) {
-  ModelConfig m;
-  m.name = name;
-  m.file = file;
-  return m;
-}
+using testing::Model;
 
 std::string Mjcf(const std::string& option) {
   return "<mujoco>\n  <option " + option +

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "common/model_config.h"
 #include "common/temp_dir.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
@@ -13,12 +14,7 @@
 namespace penumbra {
 namespace {
 
-ModelConfig Model(const std::string& name, const std::string& file) {
-  ModelConfig m;
-  m.name = name;
-  m.file = file;
-  return m;
-}
+using testing::Model;
 
 std::string Mjcf(const std::string& timestep) {
   return "<mujoco>\n  <option timestep=\"" + timestep +
