@@ -99,6 +99,7 @@ TEST_F(EvalCommandTest, RpeJsonWithDeltaInFramesAndSeconds) {
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["metric"], "rpe");
     EXPECT_EQ(j["rpe"]["delta"], 2.0);
+    EXPECT_EQ(j["rpe"]["delta"].is_number_integer(), delta[0] == "--delta");
     EXPECT_EQ(j["rpe"]["delta_unit"], delta[0] == "--delta" ? "frames" : "s");
     EXPECT_EQ(j["rpe"]["translation_m"]["count"], 1);
     EXPECT_NEAR(j["rpe"]["translation_m"]["rmse"].get<double>(), std::sqrt(5.0), 1e-12);

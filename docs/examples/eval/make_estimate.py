@@ -5,7 +5,7 @@ the example in docs/evaluation.md (not the output of any real estimator).
 what it does to the ground truth, so that `penumbra eval` has something to find:
 - expresses it in another frame at half scale (a monocular estimate): p_V = 0.5 R^T (p_W - t)
   with R = Rz(40 deg) Rx(5 deg), t = (1, -2, 0.3) m; orientations R^T R_WB;
-- adds a drift of 1 cm/s along the estimate's x axis, Gaussian noise of 1 cm per axis and 0.5 deg
+- adds a drift of 1 cm/s along the estimate's x axis, Gaussian noise of 4 mm per axis and 0.5 deg
   per axis on the orientation;
 - drops the poses from 8 s to 10 s (a tracking loss);
 - stamps each pose 0 .. 4 ms late (uniform).
@@ -66,7 +66,7 @@ def main():
         p_v = rotate(qconj(q_R), [p[i] - t[i] for i in range(3)])
         p_v = [scale * c for c in p_v]
         p_v[0] += 0.01 * (time - t0)
-        p_v = [c + rng.gauss(0, 0.01) for c in p_v]
+        p_v = [c + rng.gauss(0, 0.004) for c in p_v]
         noise = qmul(qmul(qaxis((1, 0, 0), math.radians(rng.gauss(0, 0.5))),
                           qaxis((0, 1, 0), math.radians(rng.gauss(0, 0.5)))),
                      qaxis((0, 0, 1), math.radians(rng.gauss(0, 0.5))))

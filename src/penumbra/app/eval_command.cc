@@ -186,11 +186,11 @@ Json EvalCommand::State::ToJson(bool ate_verb, const TrajectoryEvaluation& r) co
                          {"total_sec", r.tracked.total_sec},
                          {"max_gap_sec", r.tracked.max_gap_sec}};
   } else {
-    j["rpe"] = {{"delta", r.rpe_delta.seconds ? *r.rpe_delta.seconds
-                                              : static_cast<double>(r.rpe_delta.frames)},
-                {"delta_unit", r.rpe_delta.seconds ? "s" : "frames"},
-                {"translation_m", StatsJson(r.rpe_translation_m)},
-                {"rotation_deg", StatsJson(r.rpe_rotation_deg)}};
+    j["rpe"] = {
+        {"delta", r.rpe_delta.seconds ? Json(*r.rpe_delta.seconds) : Json(r.rpe_delta.frames)},
+        {"delta_unit", r.rpe_delta.seconds ? "s" : "frames"},
+        {"translation_m", StatsJson(r.rpe_translation_m)},
+        {"rotation_deg", StatsJson(r.rpe_rotation_deg)}};
   }
   return j;
 }

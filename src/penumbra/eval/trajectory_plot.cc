@@ -172,7 +172,7 @@ std::vector<uint8_t> RenderTrajectoryPlotPng(const TrajectoryPlot& plot) {
 
   cv::Mat img(plot.height, plot.width, CV_8UC3, kWhite);
   const int half = plot.width / 2;
-  constexpr int kLeft = 80, kRight = 30, kTop = 70, kBottom = 70;
+  constexpr int kLeft = 80, kRight = 30, kTop = 70, kBottom = 84;
 
   // title
   const cv::Size ts = TextSize(plot.title, kTitleFontScale);
@@ -203,7 +203,7 @@ std::vector<uint8_t> RenderTrajectoryPlotPng(const TrajectoryPlot& plot) {
   if (!ex.empty())
     cv::circle(img, SubPixel(top.ToPixel(ex[0], ey[0])), 5 << kShift, kEstimate, 1, cv::LINE_AA,
                kShift);
-  const int legend_y = top.area.y + top.area.height + 62;
+  const int legend_y = top.area.y + top.area.height + 70;
   LegendEntry(img, {top.area.x, legend_y}, kGroundTruth, "ground truth");
   LegendEntry(img, {top.area.x + 170, legend_y}, kEstimate, plot.estimate_label);
 
@@ -230,7 +230,7 @@ std::vector<uint8_t> RenderTrajectoryPlotPng(const TrajectoryPlot& plot) {
   LegendEntry(img, {err.area.x, legend_y}, kError, "error");
 
   std::vector<uint8_t> png;
-  Check(cv::imencode(".png", img, png), "PNG encoding failed");
+  Check(cv::imencode(".png", img, png, {cv::IMWRITE_PNG_COMPRESSION, 9}), "PNG encoding failed");
   return png;
 }
 
