@@ -115,6 +115,16 @@ TEST_F(EvalCommandTest, RpeJsonWithDeltaInFramesAndSeconds) {
       << text.out;
 }
 
+TEST_F(EvalCommandTest, NegativeOffsetAssociatesALaterClock) {
+  const std::string late = tmp_.Write("late.txt", "100 0 0 0 0 0 0 1\n101 1 0 0 0 0 0 1\n");
+  const ProcessResult r = Run({"eval", "ate", gt_, late, "--offset", "-100", "--format", "json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["association"]["pairs"], 2);
+  EXPECT_EQ(j["association"]["offset_sec"], -100.0);
+  EXPECT_EQ(j["association"]["unmatched_ground_truth"], 2);
+}
+
 TEST_F(EvalCommandTest, PlotIsAPng) {
   for (const char* verb : {"ate", "rpe"}) {
     const std::string png = (tmp_.path() / (std::string(verb) + ".png")).string();
@@ -144,6 +154,7 @@ TEST_F(EvalCommandTest, BadInputExits2WithTheMessageOnStderr) {
       {{"eval", "ate", gt_, est_, "--max-dt", "0"}, "--max-dt: '0' is out of range"},
       {{"eval", "ate", gt_, est_, "--max-dt", "nan"}, "--max-dt: 'nan' is not a finite decimal"},
       {{"eval", "ate", gt_, est_, "--offset", "0x10"}, "--offset: '0x10' is not a finite decimal"},
+      {{"eval", "ate", gt_, est_, "--offset", "+-1"}, "--offset: '+-1' is not a finite decimal"},
       {{"eval", "ate", gt_, est_, "--align", "affine"}, "--align: affine not in {se3,sim3,none}"},
       {{"eval", "ate", gt_, est_, "--format", "xml"}, "--format"},
       {{"eval", "rpe", gt_, est_, "--delta", "0"},

@@ -87,6 +87,8 @@ TEST(TumTrajectory, MalformedLinesNameFileLineAndWhatWasExpected) {
       {ok + "1 inf 0 0 0 0 0 1\n", 3, "field 2 (tx) 'inf' is not a finite"},
       {ok + "1 0x10 0 0 0 0 0 1\n", 3, "field 2 (tx) '0x10'"},
       {ok + "1 1e999 0 0 0 0 0 1\n", 3, "field 2 (tx) '1e999'"},
+      {ok + "1 +-1 0 0 0 0 0 1\n", 3, "field 2 (tx) '+-1'"},
+      {ok + "1 0 0 0 0 0 0 1e\n", 3, "field 8 (qw) '1e'"},
       {ok + "1 0 0 0 0 0 0 0\n", 3,
        "est.txt:3: quaternion (qx qy qz qw) = (0 0 0 0) has norm 0; expected a unit quaternion"},
       {ok + "1 0 0 0 1 0 0 1\n", 3, "has norm 1.41421; expected a unit quaternion"},

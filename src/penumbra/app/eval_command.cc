@@ -26,8 +26,11 @@ using Json = nlohmann::ordered_json;
 
 // a finite decimal number ([+-]digits[.digits][e[+-]digits]; no hex, inf or nan)
 std::optional<double> ParseFinite(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty() || s.front() == '+') return std::nullopt;
+  if (!s.empty() && s.front() == '+') {
+    s.remove_prefix(1);
+    if (!s.empty() && (s.front() == '+' || s.front() == '-')) return std::nullopt;
+  }
+  if (s.empty()) return std::nullopt;
   double v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;

@@ -39,7 +39,10 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
 // a finite decimal number ([+-]digits[.digits][e[+-]digits], as numpy's float() reads TUM
 // files, without inf / nan / hex)
 std::optional<double> ParseNumber(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (!s.empty() && s.front() == '+') {
+    s.remove_prefix(1);
+    if (!s.empty() && (s.front() == '+' || s.front() == '-')) return std::nullopt;
+  }
   if (s.empty()) return std::nullopt;
   double v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
