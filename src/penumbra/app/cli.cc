@@ -17,6 +17,7 @@
 
 #include "penumbra/app/bench.h"
 #include "penumbra/app/contact_sheet.h"
+#include "penumbra/app/eval_command.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
@@ -285,6 +286,9 @@ int RunCli(int argc, char** argv) {
       bench_sensors, "--seconds", [&](double v) { sensor_bench.seconds = v; }, 0, true,
       "simulated seconds for the sensor overhead");
 
+  // penumbra eval ate|rpe (app/eval_command.h)
+  const EvalCommand eval = AddEvalCommand(app);
+
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
   try {
@@ -334,6 +338,7 @@ int RunCli(int argc, char** argv) {
       return 0;
     }
     if (*bench_sensors) return BenchSensors(sensor_bench);
+    if (eval.Selected()) return eval.Run();
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

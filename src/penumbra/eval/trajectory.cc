@@ -1,0 +1,146 @@
+#include "penumbra/eval/trajectory.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+constexpr std::array<const char*, 8> kFieldNames = {"timestamp", "tx", "ty", "tz",
+                                                    "qx",        "qy", "qz", "qw"};
+constexpr char kExpectedLine[] =
+    "expected 8 numbers 'timestamp tx ty tz qx qy qz qw' separated by spaces, tabs or commas";
+
+bool IsSeparator(char c) { return c == ' ' || c == '\t' || c == ',' || c == '\r'; }
+
+// the fields of one line, split at runs of separators
+std::vector<std::string_view> SplitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && IsSeparator(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !IsSeparator(line[i])) ++i;
+    if (i > start) fields.push_back(line.substr(start, i - start));
+  }
+  return fields;
+}
+
+// a finite decimal number ([+-]digits[.digits][e[+-]digits], as numpy's float() reads TUM
+// files, without inf / nan / hex)
+std::optional<double> ParseNumber(std::string_view s) {
+  if (!s.empty() && s.front() == '+') {
+    s.remove_prefix(1);
+    if (!s.empty() && (s.front() == '+' || s.front() == '-')) return std::nullopt;
+  }
+  if (s.empty()) return std::nullopt;
+  double v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
+Eigen::Matrix3Xd Trajectory::Positions() const {
+  Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(X_WB.size()));
+  for (size_t i = 0; i < X_WB.size(); ++i)
+    p.col(static_cast<Eigen::Index>(i)) = X_WB[i].translation();
+  return p;
+}
+
+Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) {
+  Trajectory t;
+  int line_number = 0;
+  int previous_line = 0;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    const size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_number;
+    const std::vector<std::string_view> fields = SplitFields(line);
+    if (fields.empty() || fields.front().front() == '#') continue;
+    if (fields.size() != kFieldNames.size())
+      throw ConfigError(source, line_number, "",
+                        fmt::format("{} field{}; {}", fields.size(), fields.size() == 1 ? "" : "s",
+                                    kExpectedLine));
+    std::array<double, 8> v{};
+    for (size_t k = 0; k < fields.size(); ++k) {
+      const std::optional<double> x = ParseNumber(fields[k]);
+      if (!x)
+        throw ConfigError(
+            source, line_number, "",
+            fmt::format("field {} ({}) '{}' is not a finite decimal number; {}", k + 1,
+                        kFieldNames[k], SanitizeForMessage(fields[k], 64), kExpectedLine));
+      v[k] = *x;
+    }
+    // quaternion: file order x y z w
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    const double norm = q.norm();
+    if (!(std::abs(norm - 1.0) <= kTumQuaternionNormTolerance))
+      throw ConfigError(source, line_number, "",
+                        fmt::format("quaternion (qx qy qz qw) = ({} {} {} {}) has norm {:.6g}; "
+                                    "expected a unit quaternion (norm within {} of 1), the scalar "
+                                    "qw last",
+                                    v[4], v[5], v[6], v[7], norm, kTumQuaternionNormTolerance));
+    if (!t.empty() && !(v[0] > t.time_sec.back()))
+      throw ConfigError(source, line_number, "",
+                        fmt::format("timestamp {} is not after the previous pose's {} (line {}); "
+                                    "expected strictly increasing timestamps",
+                                    v[0], t.time_sec.back(), previous_line));
+    Pose X = Pose::Identity();
+    X.linear() = q.normalized().toRotationMatrix();
+    X.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    t.time_sec.push_back(v[0]);
+    t.X_WB.push_back(X);
+    previous_line = line_number;
+  }
+  if (t.empty())
+    throw ConfigError(source, 0, "",
+                      fmt::format("no poses ({} line{}, all blank or comments); expected lines "
+                                  "'timestamp tx ty tz qx qy qz qw'",
+                                  line_number, line_number == 1 ? "" : "s"));
+  return t;
+}
+
+Trajectory ReadTumTrajectory(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(
+        path.string(), 0, "",
+        "is a folder; expected a TUM trajectory file (timestamp tx ty tz qx qy qz qw)");
+  std::ifstream f(path, std::ios::binary);
+  if (!f)
+    throw ConfigError(
+        path.string(), 0, "",
+        fmt::format("cannot be read ({}); expected a TUM trajectory file", std::strerror(errno)));
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  if (f.bad())
+    throw ConfigError(path.string(), 0, "", "read failed; expected a TUM trajectory file");
+  return ParseTumTrajectory(ss.str(), path.string());
+}
+
+std::string FormatTumTrajectory(const Trajectory& trajectory) {
+  std::string out = "# timestamp tx ty tz qx qy qz qw\n";
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    const Eigen::Vector3d p = trajectory.X_WB[i].translation();
+    const Eigen::Quaterniond q(trajectory.X_WB[i].linear());
+    out += fmt::format("{} {} {} {} {} {} {} {}\n", trajectory.time_sec[i], p.x(), p.y(), p.z(),
+                       q.x(), q.y(), q.z(), q.w());
+  }
+  return out;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,84 @@
+#pragma once
+// one evaluation of an estimated trajectory against ground truth, as `penumbra eval ate|rpe`
+// runs it (docs/evaluation.md):
+//   1. associate timestamps (association.h, TUM's associate.py rule);
+//   2. align the associated estimated positions onto the ground truth (umeyama.h: se3, sim3
+//      or none); the transform applies to the whole estimate (positions c R p + t,
+//      orientations R R_WB);
+//   3. ATE, RPE (trajectory_metrics.h) and the benchmark figures of the URLab paper:
+//      coverage = ground-truth path length / aligned estimated path length, both over the
+//      associated poses in ground-truth time order; scaled ATE = ATE RMSE / coverage;
+//      fraction of ground-truth time tracked (ComputeTrackedTime).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/eval/association.h"
+#include "penumbra/eval/trajectory.h"
+#include "penumbra/eval/trajectory_metrics.h"
+#include "penumbra/eval/umeyama.h"
+
+namespace penumbra {
+
+/// what EvaluateTrajectory does; defaults are those of `penumbra eval`.
+struct EvaluationOptions {
+  AssociationOptions association;
+  AlignmentModel alignment = AlignmentModel::kSe3;
+  RpeDelta rpe_delta;
+  /// the longest interval between consecutive associated poses that counts as tracked, s;
+  /// unset: 3 x the larger of the two files' median sample periods (MedianPeriod)
+  std::optional<double> max_gap_sec;
+
+  /// @throws ConfigError naming the key (max_dt_sec, offset_sec, delta, delta_sec,
+  ///         max_gap_sec) of a value out of range.
+  void ValidateOrThrow() const;
+};
+
+/// the results. positions in the ground truth's world frame W, m; times s.
+struct TrajectoryEvaluation {
+  size_t ground_truth_poses = 0, estimate_poses = 0;
+  double ground_truth_start_sec = 0, ground_truth_end_sec = 0;
+  double estimate_start_sec = 0, estimate_end_sec = 0;
+  Association association;
+  /// X_WV: the estimate's frame V into W (identity for AlignmentModel::kNone)
+  Similarity3 alignment;
+  AlignmentModel alignment_model = AlignmentModel::kSe3;
+
+  /// per associated pair, in ground-truth time order
+  std::vector<double> pair_time_sec;  ///< ground-truth timestamp
+  Eigen::Matrix3Xd ground_truth_positions;
+  Eigen::Matrix3Xd aligned_estimate_positions;
+  std::vector<double> ate_errors_m;
+  ErrorStats ate_m;
+
+  /// the whole estimate (every pose, associated or not) after alignment, for plots
+  Eigen::Matrix3Xd aligned_estimate_all_positions;
+
+  RpeDelta rpe_delta;
+  std::vector<RelativePoseError> rpe;
+  ErrorStats rpe_translation_m, rpe_rotation_deg;
+
+  double ground_truth_path_m = 0;  ///< over the associated poses
+  double estimate_path_m = 0;      ///< aligned, over the associated poses
+  /// ground_truth_path_m / estimate_path_m; NaN (undefined) when the aligned estimate does
+  /// not move (estimate_path_m = 0)
+  double coverage = 0;
+  double scaled_ate_m = 0;  ///< ate_m.rmse / coverage; NaN when coverage is NaN or 0
+  TrackedTime tracked;
+};
+
+/// evaluates `estimate` against `ground_truth` (steps 1-3 above). `ground_truth_name` and
+/// `estimate_name` (file paths) name the inputs in errors.
+/// @throws ConfigError from options.ValidateOrThrow(); naming the estimate when fewer than 2
+///         poses associate (with both time spans and a hint at --max-dt / --offset), and when
+///         sim3 alignment meets associated estimated positions that all coincide.
+TrajectoryEvaluation EvaluateTrajectory(const Trajectory& ground_truth, const Trajectory& estimate,
+                                        const EvaluationOptions& options,
+                                        const std::string& ground_truth_name,
+                                        const std::string& estimate_name);
+
+/// "none", "se3" or "sim3".
+const char* AlignmentModelName(AlignmentModel model);
+
+}  // namespace penumbra
