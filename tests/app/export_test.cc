@@ -34,7 +34,7 @@ constexpr char kMjcf[] = R"(
     <geom name="near" type="box" pos="1.55 0 1" size="0.05 3 3" rgba="0.7 0.7 0.7 1"/>
     <geom name="far" type="box" pos="-2.3 0 1" size="0.05 3 3" rgba="0.4 0.5 0.7 1"/>
     <body name="rig" pos="0 0 1">
-      <geom name="box" type="box" size="0.02 0.02 0.02" contype="0" conaffinity="0"/>
+      <geom name="box" type="box" pos="0 0 -0.2" size="0.02 0.02 0.02" contype="0" conaffinity="0"/>
       <body name="arm" pos="0 0.3 0">
         <joint name="swivel" type="hinge" axis="0 0 1"/>
         <geom name="arm" type="box" size="0.02 0.02 0.02" contype="0" conaffinity="0"/>

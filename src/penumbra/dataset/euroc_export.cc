@@ -19,7 +19,7 @@ std::string MatrixYaml(const Pose& X) {
   for (int r = 0; r < 4; ++r) {
     if (r > 0) s += ",\n         ";
     for (int c = 0; c < 4; ++c)
-      s += fmt::format("{}{:.17g}", c ? ", " : "", M(r, c) == 0 ? 0.0 : M(r, c));
+      s += fmt::format("{}{}", c ? ", " : "", M(r, c) == 0 ? 0.0 : M(r, c));
   }
   return s + "]\n";
 }
