@@ -26,7 +26,8 @@ using testing::RunPenumbra;
 
 // walls: the front face of "near" at x = 1.5 m, of "far" at x = -2.25 m; the rig body (no
 // joint: welded to the world) at (0, 0, 1) holds both cameras and the IMU; a third camera sits
-// on "tip", welded to "arm", which turns on a hinge
+// on "tip", welded to "arm", which turns on a vertical hinge at 2 rad/s (keyframe "spin"; no
+// gravity torque, no damping, no contact), with a second IMU "spin" 0.05 m beyond the tip, 0.15 m from the axis
 constexpr char kMjcf[] = R"(
 <mujoco model="walls">
   <option timestep="0.005"/>
@@ -44,12 +45,13 @@ constexpr char kMjcf[] = R"(
       </body>
     </body>
   </worldbody>
+  <keyframe><key name="spin" qvel="2"/></keyframe>
 </mujoco>)";
 
 constexpr char kWorld[] = R"(seed: 3
 duration_sec: 0.5
 models:
-  - {name: scene, file: walls.xml}
+  - {name: scene, file: walls.xml, initial_keyframe: spin}
 lights:
   - {name: sun, type: sun, direction: [0.3, 0.4, -1], illuminance_lux: 20000}
 mjcf_cameras: {enabled: false}
@@ -83,6 +85,12 @@ sensors:
     body: scene/rig
     pose: {xyz: [0.1, 0, -0.05], rpy_deg: [0, 0, 90]}
     preset: consumer_mems
+    rate_hz: 100
+  - name: spin
+    type: imu
+    body: scene/tip
+    pose: {xyz: [0.05, 0, 0], rpy_deg: [0, 0, 0]}
+    preset: ideal
     rate_hz: 100
 )";
 
@@ -150,6 +158,22 @@ TEST_F(ExportCommandTest, RunWritesRigAndImuTruth) {
   EXPECT_NEAR(v[5], std::cos(M_PI / 4), 1e-8);  // qw
   EXPECT_NEAR(v[8], std::sin(M_PI / 4), 1e-8);  // qz
   for (int i = 9; i < 12; ++i) EXPECT_NEAR(v[i], 0, 1e-9);
+  // the spinning IMU: velocity of its own origin, 0.15 m from the axis at 2 rad/s: 0.3 m/s,
+  // horizontal, perpendicular to the radius (its body's origin, 0.1 m out, moves at 0.2 m/s)
+  const auto spin = Lines(run() / "imu" / "spin_truth.csv");
+  ASSERT_GT(spin.size(), 40u);
+  for (size_t k = 1; k < spin.size(); k += 7) {
+    std::istringstream in(spin[k]);
+    std::vector<double> s;
+    for (std::string f; std::getline(in, f, ',');) s.push_back(std::stod(f));
+    ASSERT_EQ(s.size(), 18u);
+    const Eigen::Vector3d radius(s[2] - 0, s[3] - 0.3, s[4] - 1);
+    const Eigen::Vector3d vel(s[9], s[10], s[11]);
+    EXPECT_NEAR(radius.norm(), 0.15, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.norm(), 0.3, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.dot(radius), 0, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.z(), 0, 1e-9) << spin[k];
+  }
 }
 
 TEST_F(ExportCommandTest, TumDepthIs5000PerMetreAtAKnownWallDistance) {
@@ -172,7 +196,8 @@ TEST_F(ExportCommandTest, TumDepthIs5000PerMetreAtAKnownWallDistance) {
 
 TEST_F(ExportCommandTest, EurocExtrinsicsAndGroundTruthFromTheRun) {
   const fs::path out = out_.path() / "euroc";
-  const testing::ProcessResult r = Export("euroc", out, {"--camera", "front", "--camera2", "back"});
+  const testing::ProcessResult r =
+      Export("euroc", out, {"--camera", "front", "--camera2", "back", "--imu", "imu"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // T_BS of cam0: the optical frame of "front" in the IMU frame
   Pose X_RI = PoseFromXyzRpyDeg({0.1, 0, -0.05}, {0, 0, 90});
@@ -240,8 +265,12 @@ TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
   r = Export("tum", out_.path() / "full", {"--camera", "front"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("not empty"), std::string::npos) << r.err;
+  // EuRoC with two IMUs and none named
+  r = Export("euroc", out_.path() / "e", {"--camera", "front"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--imu"), std::string::npos) << r.err;
   // EuRoC: a camera that moves relative to the IMU has no constant T_BS
-  r = Export("euroc", out_.path() / "d", {"--camera", "arm_cam"});
+  r = Export("euroc", out_.path() / "d", {"--camera", "arm_cam", "--imu", "imu"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("move relative to each other"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out_.path() / "d"));
