@@ -27,7 +27,8 @@ using testing::RunPenumbra;
 // walls: the front face of "near" at x = 1.5 m, of "far" at x = -2.25 m; the rig body (no
 // joint: welded to the world) at (0, 0, 1) holds both cameras and the IMU; a third camera sits
 // on "tip", welded to "arm", which turns on a vertical hinge at 2 rad/s (keyframe "spin"; no
-// gravity torque, no damping, no contact), with a second IMU "spin" 0.05 m beyond the tip, 0.15 m from the axis
+// gravity torque, no damping, no contact), with a second IMU "spin" 0.05 m beyond the tip, 0.15 m
+// from the axis
 constexpr char kMjcf[] = R"(
 <mujoco model="walls">
   <option timestep="0.005"/>
@@ -91,6 +92,7 @@ sensors:
     body: scene/tip
     pose: {xyz: [0.05, 0, 0], rpy_deg: [0, 0, 0]}
     preset: ideal
+    noise: {gyro_random_walk: 0.01, accel_random_walk: 0.01}
     rate_hz: 100
 )";
 
@@ -174,6 +176,23 @@ TEST_F(ExportCommandTest, RunWritesRigAndImuTruth) {
     EXPECT_NEAR(vel.dot(radius), 0, 1e-6) << spin[k];
     EXPECT_NEAR(vel.z(), 0, 1e-9) << spin[k];
   }
+  // its noise is bias only (random walk, no white noise): each sample is the true value plus
+  // the bias its truth row gives; the gyro's true value is (0, 0, 2) rad/s
+  const auto spin_samples = Lines(run() / "imu" / "spin.csv");
+  ASSERT_EQ(spin_samples.size(), spin.size());
+  double largest_bias = 0;
+  for (size_t k = 1; k < spin.size(); ++k) {
+    std::istringstream a(spin_samples[k]), b(spin[k]);
+    std::vector<double> m, t;
+    for (std::string f; std::getline(a, f, ',');) m.push_back(std::stod(f));
+    for (std::string f; std::getline(b, f, ',');) t.push_back(std::stod(f));
+    ASSERT_EQ(m.size(), 9u);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(m[6 + i] - t[12 + i], i == 2 ? 2.0 : 0.0, 1e-6) << "sample " << k;
+      largest_bias = std::max(largest_bias, std::abs(t[12 + i]));
+    }
+  }
+  EXPECT_GT(largest_bias, 1e-3);
 }
 
 TEST_F(ExportCommandTest, TumDepthIs5000PerMetreAtAKnownWallDistance) {
