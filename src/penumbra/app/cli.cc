@@ -18,6 +18,7 @@
 #include "penumbra/app/bench.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
+#include "penumbra/app/export_command.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
@@ -288,6 +289,8 @@ int RunCli(int argc, char** argv) {
 
   // penumbra eval ate|rpe (app/eval_command.h)
   const EvalCommand eval = AddEvalCommand(app);
+  // penumbra export (app/export_command.h)
+  const ExportCommand export_command = AddExportCommand(app);
 
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
@@ -333,6 +336,7 @@ int RunCli(int argc, char** argv) {
       return BenchRender(render_bench);
     }
     if (*sheet) return MakeContactSheet(sheet_options);
+    if (export_command.selected()) return export_command.Run();
     if (*make_vdb) {
       MakeSmokeVdb(vdb_path, vdb_options);
       return 0;

@@ -50,6 +50,25 @@ void ImuCsvWriter::Write(const SensorFiring& f, const ImuSample& o) {
                           o.gyro_rad_s.z()));
 }
 
+ImuTruthCsvWriter::ImuTruthCsvWriter(const fs::path& out, const std::string& name)
+    : csv_(OpenCsv(out, fs::path("imu") / (name + "_truth.csv"))) {
+  csv_.Append(
+      "sample,capture_time_sec,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,bgx_rad_s,"
+      "bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2\n");
+}
+
+void ImuTruthCsvWriter::Write(const SensorFiring& f, const ImuTruth& t) {
+  const Eigen::Vector3d& p = t.X_WS.translation();
+  Eigen::Quaterniond q(t.X_WS.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  csv_.Append(fmt::format(
+      "{},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},"
+      "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
+      f.index, f.capture_time_sec, p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), t.v_WS.x(),
+      t.v_WS.y(), t.v_WS.z(), t.gyro_bias.x(), t.gyro_bias.y(), t.gyro_bias.z(), t.accel_bias.x(),
+      t.accel_bias.y(), t.accel_bias.z()));
+}
+
 MujocoSensorCsvWriter::MujocoSensorCsvWriter(const fs::path& out, const std::string& name,
                                              const std::vector<std::string>& columns)
     : csv_(OpenCsv(out, fs::path("sensors") / (name + ".csv"))) {

@@ -7,6 +7,11 @@
 //                                     medium_returns,particle_returns
 //   <out>/imu/<name>.csv              sample,capture_time_sec,delivery_time_sec,
 //                                     accel_{x,y,z}_m_s2,gyro_{x,y,z}_rad_s
+//   <out>/imu/<name>_truth.csv        sample,capture_time_sec, the true state of the IMU frame S
+//                                     at the sample: x_m,y_m,z_m,qw,qx,qy,qz (X_WS),
+//                                     vx_m_s,vy_m_s,vz_m_s (velocity of S's origin, world axes),
+//                                     bg{x,y,z}_rad_s, ba{x,y,z}_m_s2 (the noise model's gyro
+//                                     and accelerometer biases added to this sample, S axes)
 //   <out>/sensors/<name>.csv          sample,capture_time_sec,delivery_time_sec, one column per
 //                                     MuJoCo sensor value
 //   <out>/ground_truth/<name>.csv     sample,time_sec, per body <body>_{x,y,z}_m,
@@ -56,6 +61,28 @@ class ImuCsvWriter {
   ImuCsvWriter(const std::filesystem::path& out, const std::string& name);
   /// appends the row of sample `firing.index`. @throws Error if the write fails.
   void Write(const SensorFiring& firing, const ImuSample& sample);
+  void Close() { csv_.Close(); }
+
+ private:
+  LineFile csv_;
+};
+
+/// the true state of one IMU at its samples (what the noisy samples of ImuCsvWriter measure).
+struct ImuTruth {
+  Pose X_WS = Pose::Identity();         ///< IMU frame in the world
+  Eigen::Vector3d v_WS{0, 0, 0};        ///< velocity of S's origin in the world, world axes, m/s
+  Eigen::Vector3d gyro_bias{0, 0, 0};   ///< gyro bias in this sample, S axes, rad/s
+  Eigen::Vector3d accel_bias{0, 0, 0};  ///< accelerometer bias in this sample, S axes, m/s^2
+};
+
+/// the true state of one IMU at its samples.
+class ImuTruthCsvWriter {
+ public:
+  ImuTruthCsvWriter() = default;
+  /// creates <out>/imu/<name>_truth.csv with its header. @throws Error as LidarScanWriter.
+  ImuTruthCsvWriter(const std::filesystem::path& out, const std::string& name);
+  /// appends the row of sample `firing.index`. @throws Error if the write fails.
+  void Write(const SensorFiring& firing, const ImuTruth& truth);
   void Close() { csv_.Close(); }
 
  private:

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "penumbra/compose/imu_injection.h"
@@ -75,6 +76,43 @@ Mount ResolveMount(const SensorConfig& s, const ModelInfo& info) {
   return m;
 }
 
+// the rigid part a mounted frame moves with: from its body, up through the bodies welded to
+// their parent (no joint of their own), to the first body with a joint or the world.
+// returns that body and the frame's pose in it (X_RS = X_RB * X_BS).
+std::pair<int, Pose> RigidMount(const ModelInfo& info, int body, const Pose& X_BS) {
+  Pose X_RS = X_BS;
+  if (info.body_X_PB.size() != info.body_names.size()) return {body, X_RS};
+  while (body > 0) {
+    bool has_joint = false;
+    for (const JointInfo& j : info.joints) has_joint = has_joint || j.body == body;
+    if (has_joint) break;
+    X_RS = info.body_X_PB[body] * X_RS;
+    body = info.body_parent[body] < 0 ? 0 : info.body_parent[body];
+  }
+  return {body, X_RS};
+}
+
+nlohmann::ordered_json PoseJson(const Pose& X) {
+  Eigen::Quaterniond q(X.linear());
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const Eigen::Vector3d& p = X.translation();
+  return {{"xyz", {p.x(), p.y(), p.z()}}, {"qwxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+std::string BodyName(const ModelInfo& info, int body) {
+  return body == 0 ? std::string("world") : info.body_names.at(body);
+}
+
+nlohmann::ordered_json MountJson(const ModelInfo& info, int body, const Pose& X_BS) {
+  const auto [root, X_RS] = RigidMount(info, body, X_BS);
+  nlohmann::ordered_json j;
+  j["body"] = BodyName(info, body);
+  j["X_BS"] = PoseJson(X_BS);
+  j["rigid_body"] = BodyName(info, root);
+  j["X_RS"] = PoseJson(X_RS);
+  return j;
+}
+
 }  // namespace
 
 struct SensorSink::Impl {
@@ -93,7 +131,9 @@ struct SensorSink::Impl {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
     SensorDescription accel, gyro;
+    Mount mount;
     ImuCsvWriter out;
+    ImuTruthCsvWriter truth_out;
     int64_t written = 0;
   };
   struct Mujoco {
@@ -173,6 +213,19 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
   const ModelInfo& info = sim.model_info();
   s.body_names = info.body_names;
   const fs::path out(out_dir);
+  // rig.json: where every camera, IMU and LiDAR is mounted (dataset export needs the static
+  // extrinsics between them)
+  nlohmann::ordered_json rig;
+  rig["frames"] =
+      "X_BS: sensor frame S in its body B; X_RS: S in the rigid body R it moves with (B or the "
+      "first ancestor of B with a joint, or the world); xyz in m, unit quaternion qwxyz; "
+      "cameras: S = the OpenCV optical frame (x right, y down, z forward); MJCF cameras are "
+      "not listed";
+  rig["cameras"] = nlohmann::ordered_json::object();
+  for (const CameraSpec& c : scene.cameras)
+    if (c.mjcf_camera < 0) rig["cameras"][c.name] = MountJson(info, c.body, c.X_BO);
+  rig["imus"] = nlohmann::ordered_json::object();
+  rig["lidars"] = nlohmann::ordered_json::object();
   s.schedule.emplace(sim.timestep());
   const double physics_rate = s.schedule->physics_rate_hz();
   for (const SensorConfig& c : s.configs) {
@@ -215,6 +268,7 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       }
       rate = lc.pattern.rate_hz;
       l.out = LidarScanWriter(out, c.name);
+      rig["lidars"][c.name] = MountJson(info, l.mount.body, l.mount.X_BS);
       s.entries.push_back({0, static_cast<int>(s.lidars.size())});
       s.lidars.push_back(std::move(l));
     } else if (c.type == "imu") {
@@ -235,7 +289,16 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       nc.gyro_noise_density = c.Param("noise.gyro_noise_density", nc.gyro_noise_density);
       nc.gyro_random_walk = c.Param("noise.gyro_random_walk", nc.gyro_random_walk);
       m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
+      m.mount = ResolveMount(c, info);
       m.out = ImuCsvWriter(out, c.name);
+      m.truth_out = ImuTruthCsvWriter(out, c.name);
+      nlohmann::ordered_json j = MountJson(info, m.mount.body, m.mount.X_BS);
+      j["rate_hz"] = rate;
+      j["gyroscope_noise_density"] = nc.gyro_noise_density;
+      j["gyroscope_random_walk"] = nc.gyro_random_walk;
+      j["accelerometer_noise_density"] = nc.accel_noise_density;
+      j["accelerometer_random_walk"] = nc.accel_random_walk;
+      rig["imus"][c.name] = j;
       s.entries.push_back({1, static_cast<int>(s.imus.size())});
       s.imus.push_back(std::move(m));
     } else if (c.type == "mujoco") {
@@ -279,6 +342,7 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
     }
   }
   if (!s.lidars.empty()) s.ray_scene = MakeRayQuery(scene, world.render.backend);
+  WriteFileAtomic(out / "rig.json", rig.dump(2) + "\n");
 }
 
 SensorSink::~SensorSink() { impl_->worker.Finish(); }
@@ -341,7 +405,19 @@ void SensorSink::Impl::Process(
       ImuSample truth;
       truth.accel_m_s2 = {a[0], a[1], a[2]};
       truth.gyro_rad_s = {w[0], w[1], w[2]};
+      // the true state: pose and velocity of the IMU frame, and the biases this sample gets
+      ImuTruth state;
+      state.X_WS = m.mount.X_WS(snap);
+      const Eigen::Matrix<double, 6, 1> V = m.mount.body < static_cast<int>(snap.V_WB.size())
+                                                ? snap.V_WB[m.mount.body]
+                                                : Eigen::Matrix<double, 6, 1>::Zero();
+      const Eigen::Vector3d p_BS_W =
+          state.X_WS.translation() - snap.X_WB.at(m.mount.body).translation();
+      state.v_WS = V.tail<3>() + V.head<3>().cross(p_BS_W);
+      state.gyro_bias = m.noise->gyro_bias();
+      state.accel_bias = m.noise->accel_bias();
       m.out.Write(f, m.noise->Apply(f.index, truth));
+      m.truth_out.Write(f, state);
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {
@@ -378,7 +454,10 @@ void SensorSink::OnFinish(const LoopFinish&) {
     }
   };
   for (auto& l : s.lidars) close(l.out);
-  for (auto& m : s.imus) close(m.out);
+  for (auto& m : s.imus) {
+    close(m.out);
+    close(m.truth_out);
+  }
   for (auto& m : s.mujocos) close(m.out);
   for (auto& g : s.truths) close(g.out);
   if (first) std::rethrow_exception(first);

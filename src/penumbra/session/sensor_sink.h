@@ -3,8 +3,15 @@
 // world/sensors_reader.h) on its own schedule (sensors/sensor_schedule.h), fed with physics
 // snapshots, writing its outputs:
 //
-//   <out>/lidar/<name>/scan_<k>.pcd and index.csv, <out>/imu/<name>.csv,
+//   <out>/lidar/<name>/scan_<k>.pcd and index.csv, <out>/imu/<name>.csv and <name>_truth.csv,
 //   <out>/sensors/<name>.csv, <out>/ground_truth/<name>.csv and <name>_contacts.csv
+//   <out>/rig.json: the mount of every camera (not MJCF cameras), IMU and LiDAR, written at
+//   construction: {"cameras"|"imus"|"lidars": {name: {"body", "X_BS", "rigid_body", "X_RS"}}}
+//   with X_BS the sensor frame S in its body B, X_RS the same frame in the rigid body R it moves
+//   with (B, or the first ancestor of B that has a joint, or "world"), each as {"xyz": [m],
+//   "qwxyz": unit quaternion}; cameras' S is the OpenCV optical frame; IMUs also carry rate_hz
+//   and their noise parameters (Kalibr names: gyroscope_noise_density, ..._random_walk,
+//   accelerometer_noise_density, ..._random_walk).
 //
 // the sensor models (sensors/) return records (a LidarScan, an ImuSample, MuJoCo sensor values,
 // the snapshot's poses and contacts); output/sensor_writers.h writes them (columns, units and

@@ -1,0 +1,32 @@
+#pragma once
+// `penumbra export RUN_DIR --format tum|euroc|kitti --out DIR [--camera NAME]
+// [--camera2 NAME] [--imu NAME] [--sequence NN]`: a run's output folder in a public dataset
+// layout (dataset/dataset_export.h, docs/datasets.md).
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+namespace penumbra {
+
+/// the `export` verb: its options, filled by CLI11 while parsing.
+class ExportCommand {
+ public:
+  /// true when the command line chose `export`.
+  bool selected() const;
+  /// runs the export; returns the exit code (0).
+  /// @throws ConfigError for bad input (a missing run folder, an unknown camera, a non-empty
+  ///         --out, ...: exit code 2 in cli.cc); Error if a file cannot be written.
+  int Run() const;
+
+ private:
+  friend ExportCommand AddExportCommand(CLI::App& app);
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+/// adds the `export` subcommand to `app`; the returned command reads its options after
+/// app.parse().
+ExportCommand AddExportCommand(CLI::App& app);
+
+}  // namespace penumbra

@@ -1,0 +1,59 @@
+#pragma once
+// `penumbra export`: a run's output folder (dataset/run_folder.h) written in a public dataset
+// layout: TUM RGB-D (dataset/tum_export.h), EuRoC/ASL (dataset/euroc_export.h) or KITTI
+// odometry (dataset/kitti_export.h). docs/datasets.md states each format's frames and
+// timestamps and how Penumbra's map to them.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "penumbra/dataset/run_folder.h"
+
+namespace penumbra {
+
+enum class DatasetFormat { kTum, kEuroc, kKitti };
+
+/// "tum", "euroc", "kitti" -> the format.
+/// @throws ConfigError (key "--format") for any other name, listing the names.
+DatasetFormat ParseDatasetFormat(const std::string& name);
+
+/// what to export and where.
+struct DatasetExportOptions {
+  DatasetFormat format = DatasetFormat::kTum;
+  /// output folder: created if missing; an existing one must be empty.
+  std::filesystem::path out_dir;
+  /// camera (cam0 / image_0 / the TUM camera); empty = the run's only camera.
+  std::string camera;
+  /// second camera (EuRoC cam1, KITTI image_1); empty = none. not used by TUM.
+  std::string camera2;
+  /// IMU (EuRoC imu0); empty = the run's only IMU. used by EuRoC only.
+  std::string imu;
+  /// KITTI sequence name: two digits.
+  std::string sequence = "00";
+
+  /// @throws ConfigError naming the option (--out, --camera2, --imu, --sequence) for an empty
+  ///         output folder, a second camera with TUM or equal to the first, an IMU without
+  ///         EuRoC, or a sequence that is not two digits.
+  void ValidateOrThrow() const;
+};
+
+/// what was exported.
+struct DatasetExportSummary {
+  std::string camera, camera2, imu;  ///< the sensors used ("" = none)
+  int64_t frames = 0;                ///< images per camera
+  int64_t imu_samples = 0;           ///< EuRoC only
+  int64_t depth_beyond_range = 0;    ///< TUM only: depth pixels beyond 13.107 m, written as 0
+};
+
+/// makes `out` ready: creates it if missing; an existing one must be an empty folder.
+/// @throws ConfigError (key "--out") if it is a file, not empty, or cannot be created.
+void PrepareExportFolder(const std::filesystem::path& out);
+
+/// exports `run` as `options` says (options.ValidateOrThrow() first, then PrepareExportFolder).
+/// @throws ConfigError for a camera or IMU the run does not have (listing those it has), a
+///         run with several cameras or IMUs and none named, and the format's own errors
+///         (see the format headers); Error if a file cannot be written.
+DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOptions& options);
+
+}  // namespace penumbra

@@ -1,0 +1,307 @@
+// `penumbra export` end to end on a short run of a small world: a camera looking at a wall at
+// a known distance (TUM depth = 5000 per metre at the centre pixel, within 1 unit), a second
+// camera at another wall, an IMU on the same rigid body (EuRoC T_BS and ground truth from the
+// run's rig.json and imu/<name>_truth.csv), KITTI poses of a static camera; bad input exits 2.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "app/child_process.h"
+#include "common/temp_dir.h"
+#include "penumbra/core/pose.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadAll;
+using testing::RunPenumbra;
+
+// walls: the front face of "near" at x = 1.5 m, of "far" at x = -2.25 m; the rig body (no
+// joint: welded to the world) at (0, 0, 1) holds both cameras and the IMU; a third camera sits
+// on "tip", welded to "arm", which turns on a vertical hinge at 2 rad/s (keyframe "spin"; no
+// gravity torque, no damping, no contact), with a second IMU "spin" 0.05 m beyond the tip, 0.15 m
+// from the axis
+constexpr char kMjcf[] = R"(
+<mujoco model="walls">
+  <option timestep="0.005"/>
+  <worldbody>
+    <geom name="near" type="box" pos="1.55 0 1" size="0.05 3 3" rgba="0.7 0.7 0.7 1"/>
+    <geom name="far" type="box" pos="-2.3 0 1" size="0.05 3 3" rgba="0.4 0.5 0.7 1"/>
+    <body name="rig" pos="0 0 1">
+      <geom name="box" type="box" pos="0 0 -0.2" size="0.02 0.02 0.02" contype="0" conaffinity="0"/>
+      <body name="arm" pos="0 0.3 0">
+        <joint name="swivel" type="hinge" axis="0 0 1"/>
+        <geom name="arm" type="box" size="0.02 0.02 0.02" contype="0" conaffinity="0"/>
+        <body name="tip" pos="0.1 0 0">
+          <geom name="tip" type="sphere" size="0.01" contype="0" conaffinity="0"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <keyframe><key name="spin" qvel="2"/></keyframe>
+</mujoco>)";
+
+constexpr char kWorld[] = R"(seed: 3
+duration_sec: 0.5
+models:
+  - {name: scene, file: walls.xml, initial_keyframe: spin}
+lights:
+  - {name: sun, type: sun, direction: [0.3, 0.4, -1], illuminance_lux: 20000}
+mjcf_cameras: {enabled: false}
+cameras:
+  - name: front
+    attach: scene/rig
+    pose: {xyz: [0, 0, 0], rpy_deg: [0, 0, 0]}
+    width: 32
+    height: 24
+    fovy_deg: 60
+    rate_hz: 10
+    outputs: [rgb, depth]
+  - name: back
+    attach: scene/rig
+    pose: {xyz: [0, 0, 0], rpy_deg: [0, 0, 180]}
+    width: 32
+    height: 24
+    fovy_deg: 60
+    rate_hz: 10
+    outputs: [rgb, depth]
+  - name: arm_cam
+    attach: scene/tip
+    pose: {xyz: [0, 0, 0.05], rpy_deg: [0, 0, 0]}
+    width: 16
+    height: 12
+    rate_hz: 10
+    outputs: [rgb]
+sensors:
+  - name: imu
+    type: imu
+    body: scene/rig
+    pose: {xyz: [0.1, 0, -0.05], rpy_deg: [0, 0, 90]}
+    preset: consumer_mems
+    rate_hz: 100
+  - name: spin
+    type: imu
+    body: scene/tip
+    pose: {xyz: [0.05, 0, 0], rpy_deg: [0, 0, 0]}
+    preset: ideal
+    noise: {gyro_random_walk: 0.01, accel_random_walk: 0.01}
+    rate_hz: 100
+)";
+
+std::vector<std::string> Lines(const fs::path& p) {
+  std::istringstream in(ReadAll(p));
+  std::vector<std::string> out;
+  std::string line;
+  while (std::getline(in, line)) out.push_back(line);
+  return out;
+}
+
+class ExportCommandTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::TempDir();
+    dir_->Write("walls.xml", kMjcf);
+    const std::string world = dir_->Write("world.yaml", kWorld);
+    const testing::ProcessResult r = RunPenumbra(
+        {"run", world, "--out", (dir_->path() / "run").string(), "--quiet"}, dir_->path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  testing::ProcessResult Export(const std::string& format, const fs::path& out,
+                                std::vector<std::string> extra = {}) {
+    std::vector<std::string> args = {"export", run().string(), "--format",
+                                     format,   "--out",        out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunPenumbra(args, dir_->path());
+  }
+  static fs::path run() { return dir_->path() / "run"; }
+  static testing::TempDir* dir_;
+  testing::TempDir out_;
+};
+testing::TempDir* ExportCommandTest::dir_ = nullptr;
+
+TEST_F(ExportCommandTest, RunWritesRigAndImuTruth) {
+  const nlohmann::json rig = nlohmann::json::parse(ReadAll(run() / "rig.json"));
+  EXPECT_EQ(rig["cameras"]["front"]["body"], "scene/rig");
+  EXPECT_EQ(rig["cameras"]["front"]["rigid_body"], "world");  // the rig has no joint
+  EXPECT_EQ(rig["imus"]["imu"]["rigid_body"], "world");
+  // a camera on a body welded to a jointed one moves with the jointed one
+  EXPECT_EQ(rig["cameras"]["arm_cam"]["body"], "scene/tip");
+  EXPECT_EQ(rig["cameras"]["arm_cam"]["rigid_body"], "scene/arm");
+  const std::vector<double> arm_xyz = rig["cameras"]["arm_cam"]["X_RS"]["xyz"];
+  EXPECT_NEAR(arm_xyz[0], 0.1, 1e-12);
+  EXPECT_NEAR(arm_xyz[2], 0.05, 1e-12);
+  EXPECT_EQ(rig["imus"]["imu"]["rate_hz"], 100.0);
+  const std::vector<double> xyz = rig["imus"]["imu"]["X_RS"]["xyz"];
+  EXPECT_NEAR(xyz[0], 0.1, 1e-12);
+  EXPECT_NEAR(xyz[2], 1 - 0.05, 1e-12);
+  const auto samples = Lines(run() / "imu" / "imu.csv");
+  const auto truth = Lines(run() / "imu" / "imu_truth.csv");
+  ASSERT_GT(samples.size(), 40u);
+  ASSERT_EQ(truth.size(), samples.size());
+  // the static IMU: at (0.1, 0, 0.95), yawed 90 deg, not moving
+  std::istringstream row(truth[5]);
+  std::vector<double> v;
+  for (std::string f; std::getline(row, f, ',');) v.push_back(std::stod(f));
+  ASSERT_EQ(v.size(), 18u);
+  EXPECT_NEAR(v[2], 0.1, 1e-9);
+  EXPECT_NEAR(v[4], 0.95, 1e-9);
+  EXPECT_NEAR(v[5], std::cos(M_PI / 4), 1e-8);  // qw
+  EXPECT_NEAR(v[8], std::sin(M_PI / 4), 1e-8);  // qz
+  for (int i = 9; i < 12; ++i) EXPECT_NEAR(v[i], 0, 1e-9);
+  // the spinning IMU: velocity of its own origin, 0.15 m from the axis at 2 rad/s: 0.3 m/s,
+  // horizontal, perpendicular to the radius (its body's origin, 0.1 m out, moves at 0.2 m/s)
+  const auto spin = Lines(run() / "imu" / "spin_truth.csv");
+  ASSERT_GT(spin.size(), 40u);
+  for (size_t k = 1; k < spin.size(); k += 7) {
+    std::istringstream in(spin[k]);
+    std::vector<double> s;
+    for (std::string f; std::getline(in, f, ',');) s.push_back(std::stod(f));
+    ASSERT_EQ(s.size(), 18u);
+    const Eigen::Vector3d radius(s[2] - 0, s[3] - 0.3, s[4] - 1);
+    const Eigen::Vector3d vel(s[9], s[10], s[11]);
+    EXPECT_NEAR(radius.norm(), 0.15, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.norm(), 0.3, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.dot(radius), 0, 1e-6) << spin[k];
+    EXPECT_NEAR(vel.z(), 0, 1e-9) << spin[k];
+  }
+  // its noise is bias only (random walk, no white noise): each sample is the true value plus
+  // the bias its truth row gives; the gyro's true value is (0, 0, 2) rad/s
+  const auto spin_samples = Lines(run() / "imu" / "spin.csv");
+  ASSERT_EQ(spin_samples.size(), spin.size());
+  double largest_bias = 0;
+  for (size_t k = 1; k < spin.size(); ++k) {
+    std::istringstream a(spin_samples[k]), b(spin[k]);
+    std::vector<double> m, t;
+    for (std::string f; std::getline(a, f, ',');) m.push_back(std::stod(f));
+    for (std::string f; std::getline(b, f, ',');) t.push_back(std::stod(f));
+    ASSERT_EQ(m.size(), 9u);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(m[6 + i] - t[12 + i], i == 2 ? 2.0 : 0.0, 1e-6) << "sample " << k;
+      largest_bias = std::max(largest_bias, std::abs(t[12 + i]));
+    }
+  }
+  EXPECT_GT(largest_bias, 1e-3);
+}
+
+TEST_F(ExportCommandTest, TumDepthIs5000PerMetreAtAKnownWallDistance) {
+  const fs::path out = out_.path() / "tum";
+  for (const auto& [camera, d] : {std::pair<std::string, double>{"front", 1.5}, {"back", 2.25}}) {
+    const fs::path o = out / camera;
+    const testing::ProcessResult r = Export("tum", o, {"--camera", camera});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto lines = Lines(o / "depth.txt");
+    ASSERT_GE(lines.size(), 3u + 5u);  // 5 or 6 frames in 0.5 s at 10 Hz
+    for (size_t i = 3; i < lines.size(); ++i) {
+      const std::string file = lines[i].substr(lines[i].find(' ') + 1);
+      const cv::Mat depth = cv::imread((o / file).string(), cv::IMREAD_UNCHANGED);
+      ASSERT_EQ(depth.type(), CV_16UC1) << file;
+      const double v = depth.at<uint16_t>(depth.rows / 2, depth.cols / 2);
+      EXPECT_NEAR(v, 5000 * d, 1.0) << camera << " " << file;
+    }
+  }
+}
+
+TEST_F(ExportCommandTest, EurocExtrinsicsAndGroundTruthFromTheRun) {
+  const fs::path out = out_.path() / "euroc";
+  const testing::ProcessResult r =
+      Export("euroc", out, {"--camera", "front", "--camera2", "back", "--imu", "imu"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // T_BS of cam0: the optical frame of "front" in the IMU frame
+  Pose X_RI = PoseFromXyzRpyDeg({0.1, 0, -0.05}, {0, 0, 90});
+  Pose X_RC = Pose::Identity();
+  X_RC.linear() = RotationBodyFromOptical();
+  const Eigen::Matrix4d expected = (X_RI.inverse() * X_RC).matrix();
+  const std::string yaml = ReadAll(out / "mav0/cam0/sensor.yaml");
+  std::string data = yaml.substr(yaml.find("data: [") + 7);
+  data = data.substr(0, data.find(']'));
+  for (char& c : data)
+    if (c == ',') c = ' ';
+  std::istringstream in(data);
+  for (int i = 0; i < 16; ++i) {
+    double v = 0;
+    ASSERT_TRUE(in >> v) << yaml;
+    EXPECT_NEAR(v, expected(i / 4, i % 4), 1e-9) << i;
+  }
+  EXPECT_NE(yaml.find("rate_hz: 10\n"), std::string::npos) << yaml;
+  EXPECT_TRUE(fs::exists(out / "mav0/cam1/data.csv"));
+  // ground truth: the IMU at (0.1, 0, 0.95), at rest; as many rows as IMU samples
+  const auto gt = Lines(out / "mav0/state_groundtruth_estimate0/data.csv");
+  const auto imu = Lines(out / "mav0/imu0/data.csv");
+  EXPECT_EQ(gt.size(), imu.size());
+  EXPECT_EQ(imu.size(), Lines(run() / "imu" / "imu.csv").size());
+  std::istringstream row(gt[3]);
+  std::vector<double> v;
+  for (std::string f; std::getline(row, f, ',');) v.push_back(std::stod(f));
+  ASSERT_EQ(v.size(), 17u);
+  EXPECT_NEAR(v[1], 0.1, 1e-9);
+  EXPECT_NEAR(v[3], 0.95, 1e-9);
+  // the accelerometer of a resting IMU reads +g along its z (noise and bias are small)
+  std::istringstream s(imu[3]);
+  std::vector<double> a;
+  for (std::string f; std::getline(s, f, ',');) a.push_back(std::stod(f));
+  ASSERT_EQ(a.size(), 7u);
+  EXPECT_NEAR(a[6], 9.81, 0.05);
+}
+
+TEST_F(ExportCommandTest, KittiPosesOfAStaticCameraAreIdentity) {
+  const fs::path out = out_.path() / "kitti";
+  const testing::ProcessResult r =
+      Export("kitti", out, {"--camera", "front", "--camera2", "back", "--sequence", "07"});
+  // "back" looks the other way: not KITTI's parallel pair, but a rigid one (P1 with a rotation)
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto poses = Lines(out / "poses/07.txt");
+  ASSERT_GE(poses.size(), 5u);
+  for (const std::string& line : poses) {
+    std::istringstream in(line);
+    std::vector<double> v;
+    for (double x; in >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 12u);
+    for (int i = 0; i < 12; ++i) EXPECT_NEAR(v[i], (i == 0 || i == 5 || i == 10) ? 1 : 0, 1e-9);
+  }
+  EXPECT_EQ(Lines(out / "sequences/07/times.txt").size(), poses.size());
+}
+
+TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
+  // several cameras, none named
+  testing::ProcessResult r = Export("tum", out_.path() / "a");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--camera"), std::string::npos) << r.err;
+  // a non-empty output folder
+  fs::create_directories(out_.path() / "full");
+  std::ofstream(out_.path() / "full" / "x") << "x";
+  r = Export("tum", out_.path() / "full", {"--camera", "front"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("not empty"), std::string::npos) << r.err;
+  // EuRoC with two IMUs and none named
+  r = Export("euroc", out_.path() / "e", {"--camera", "front"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--imu"), std::string::npos) << r.err;
+  // EuRoC: a camera that moves relative to the IMU has no constant T_BS
+  r = Export("euroc", out_.path() / "d", {"--camera", "arm_cam", "--imu", "imu"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("move relative to each other"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out_.path() / "d"));
+  // an unknown format (CLI usage error) and a run log
+  r = Export("rosbag", out_.path() / "b");
+  EXPECT_EQ(r.exit_code, 2);
+  r = RunPenumbra({"export", (out_.path() / "x.plog").string(), "--format", "tum", "--out",
+                   (out_.path() / "c").string()},
+                  out_.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("replay it first"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace penumbra
