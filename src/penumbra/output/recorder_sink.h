@@ -43,6 +43,7 @@ class RecorderSink : public Sink {
  private:
   std::unique_ptr<RunLogWriter> writer_;
   int64_t last_step_ = -1;
+  StepRecord scratch_;  // the record appended, storage reused from step to step
 };
 
 }  // namespace penumbra
