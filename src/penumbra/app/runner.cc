@@ -251,7 +251,13 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     RunLogHeader header = MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
     header.has_sensor_records = world.record.sensors;
     recorder = std::make_unique<RecorderSink>(record_path, header);
-    if (world.record.sensors) sensor_log = &recorder->writer();
+    if (world.record.sensors) {
+      sensor_log = &recorder->writer();
+      sensors.set_on_output([log = sensor_log](const std::string& sensor, const std::string& kind,
+                                               int64_t step, double time_sec, std::string bytes) {
+        log->RecordSensor(SensorRecord{step, time_sec, sensor, kind, std::move(bytes)});
+      });
+    }
     spdlog::info("recording the run to {}", record_path);
   }
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {

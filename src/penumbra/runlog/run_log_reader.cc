@@ -1,7 +1,6 @@
 #include "penumbra/runlog/run_log_reader.h"
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cstring>
@@ -311,7 +310,6 @@ void RunLogReader::Impl::ScanChunks() {
   const std::string msg =
       fmt::format("log ends at chunk {} ({}): {}", chunks.back().index, step, why);
   if (mode == RunLogReadMode::kStrict) throw RunLogError(fmt::format("{}: {}", path, msg));
-  spdlog::warn("run log {}: {}; reading up to there", path, msg);
   damage = msg;
 }
 
