@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+#include "penumbra/runlog/run_log_writer.h"
+
 namespace CLI {
 class App;
 }
@@ -20,6 +22,7 @@ struct BenchRecordOptions {
   int rounds = 3;               ///< A/B pairs (recording off, then on), >= 1
   double size_seconds = 60;     ///< simulated seconds of the log whose size is reported
   std::string log_dir;          ///< where the logs go ("" = the temporary folder); removed after
+  int zstd_level = RunLogWriterOptions{}.zstd_level;  ///< the writer's compression level
 };
 
 /// the verb as registered on `penumbra bench`.
