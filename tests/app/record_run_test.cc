@@ -101,9 +101,9 @@ TEST_F(RecordRunTest, RecordsEveryStepAndLeavesTheOtherOutputsUnchanged) {
 TEST_F(RecordRunTest, SigkillLeavesALogReadableToItsLastCompleteChunk) {
   const std::string world = World("", 60);
   const std::string log = (tmp_.path() / "killed.plog").string();
-  ChildProcess p({"run", world, "--out", (tmp_.path() / "out").string(), "-q", "--realtime",
-                  "--record", log},
-                 tmp_.path());
+  ChildProcess p(
+      {"run", world, "--out", (tmp_.path() / "out").string(), "-q", "--realtime", "--record", log},
+      tmp_.path());
   // two chunks of 256 steps are on disk, then the recorder dies mid-run
   ASSERT_TRUE(WaitForStep(log, 511)) << p.err();
   p.Signal(SIGKILL);
@@ -164,9 +164,9 @@ TEST_F(RecordRunTest, RecordSensorsStoresTheBytesOfEveryImageAndSensorRow) {
       0.2);
   const fs::path out = tmp_.path() / "out";
   const std::string log = (tmp_.path() / "s.plog").string();
-  auto a = RunPenumbra({"run", world, "--out", out.string(), "-q", "--record", log,
-                        "--record-sensors"},
-                       tmp_.path());
+  auto a =
+      RunPenumbra({"run", world, "--out", out.string(), "-q", "--record", log, "--record-sensors"},
+                  tmp_.path());
   ASSERT_EQ(a.exit_code, 0) << a.err;
   RunLogReader r = RunLogReader::Open(log);
   EXPECT_TRUE(r.header().has_sensor_records);
@@ -200,8 +200,7 @@ TEST_F(RecordRunTest, RecordSensorsStoresTheBytesOfEveryImageAndSensorRow) {
   EXPECT_EQ(imu, 21);
   const std::string csv = ReadAll(out / "imu" / "imu0.csv");
   EXPECT_EQ(csv.substr(csv.find('\n') + 1), imu_rows);
-  EXPECT_EQ(nlohmann::json::parse(ReadAll(out / "run.json")).at("record").at("sensor_records"),
-            31);
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(out / "run.json")).at("record").at("sensor_records"), 31);
 }
 
 TEST_F(RecordRunTest, WorldFileRecordSectionWritesIntoTheOutputFolder) {
@@ -228,9 +227,9 @@ TEST_F(RecordRunTest, BadRecordSettingsAreRefusedNamingTheirSource) {
   EXPECT_EQ(b.exit_code, 2);
   EXPECT_NE(b.err.find("w.yaml:7: record.file"), std::string::npos) << b.err;
 
-  auto c = RunPenumbra({"run", World(), "--out", (tmp_.path() / "o3").string(), "-q",
-                        "--record-sensors"},
-                       tmp_.path());
+  auto c = RunPenumbra(
+      {"run", World(), "--out", (tmp_.path() / "o3").string(), "-q", "--record-sensors"},
+      tmp_.path());
   EXPECT_EQ(c.exit_code, 2);
   EXPECT_NE(c.err.find("--record-sensors"), std::string::npos) << c.err;
 }

@@ -25,8 +25,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Round {
-  double steps_per_sec = 0;      // wall clock
-  double cpu_us_per_step = 0;    // CPU time of the whole process (loop + writer threads)
+  double steps_per_sec = 0;    // wall clock
+  double cpu_us_per_step = 0;  // CPU time of the whole process (loop + writer threads)
   int64_t steps = 0;
   uint64_t log_bytes = 0;
 };
@@ -102,10 +102,10 @@ int BenchRecord(const BenchRecordOptions& options) {
       LoadWorldFile(options.world_file.empty() ? DefaultWorldPath() : options.world_file);
   world.render.seed = world.seed;
   namespace fs = std::filesystem;
-  const fs::path dir = options.log_dir.empty()
-                           ? fs::temp_directory_path() / fmt::format("penumbra_bench_record_{}",
-                                                                     ::getpid())
-                           : fs::path(options.log_dir);
+  const fs::path dir =
+      options.log_dir.empty()
+          ? fs::temp_directory_path() / fmt::format("penumbra_bench_record_{}", ::getpid())
+          : fs::path(options.log_dir);
   fs::create_directories(dir);
   const std::string log = (dir / "bench.plog").string();
 
@@ -126,8 +126,8 @@ int BenchRecord(const BenchRecordOptions& options) {
         b.steps_per_sec / a.steps_per_sec);
   }
   const double m_off = Median(off), m_on = Median(on);
-  fmt::print("median: off {:.0f} steps/s, on {:.0f} steps/s, ratio {:.3f} (target >= 0.9)\n",
-             m_off, m_on, m_on / m_off);
+  fmt::print("median: off {:.0f} steps/s, on {:.0f} steps/s, ratio {:.3f} (target >= 0.9)\n", m_off,
+             m_on, m_on / m_off);
   // the CPU time of the process (loop and writer threads): the ratio a single free core
   // would see, independent of other load on the machine
   const double c_off = Median(cpu_off), c_on = Median(cpu_on);

@@ -46,10 +46,10 @@ ImuCsvWriter::ImuCsvWriter(const fs::path& out, const std::string& name)
 }
 
 std::string ImuCsvWriter::Write(const SensorFiring& f, const ImuSample& o) {
-  std::string row = fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
-                          f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
-                          o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(),
-                          o.gyro_rad_s.z());
+  std::string row =
+      fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
+                  f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(), o.accel_m_s2.y(),
+                  o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(), o.gyro_rad_s.z());
   csv_.Append(row);
   return row;
 }

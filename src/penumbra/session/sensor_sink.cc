@@ -157,8 +157,7 @@ struct SensorSink::Impl {
     LidarScan scan;
     l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
     std::string pcd = l.out.Write(l.start_firing, scan);
-    if (on_output)
-      on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
+    if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -349,7 +348,8 @@ void SensorSink::Impl::Process(
       truth.accel_m_s2 = {a[0], a[1], a[2]};
       truth.gyro_rad_s = {w[0], w[1], w[2]};
       std::string row = m.out.Write(f, m.noise->Apply(f.index, truth));
-      if (s.on_output) s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
+      if (s.on_output)
+        s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {

@@ -50,9 +50,8 @@ using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
 /// and sim time of its capture, and the bytes written (the PCD file, the CSV row with '\n').
 /// called on the sensor sink's thread, in step order. ground truth is not passed on (it is a
 /// function of the simulation state).
-using SensorOutputCallback = std::function<void(const std::string& sensor,
-                                                const std::string& kind, int64_t step,
-                                                double time_sec, std::string bytes)>;
+using SensorOutputCallback = std::function<void(const std::string& sensor, const std::string& kind,
+                                                int64_t step, double time_sec, std::string bytes)>;
 
 /// all world-file sensors of one run.
 class SensorSink : public Sink {
