@@ -9,6 +9,7 @@ pkgs=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libtinyxml2-dev libpng-dev nlohmann-json3-dev
   libassimp-dev  # URDF meshes MuJoCo 2.2.2 cannot read (DAE, ...) become STL at compose time
+  libzstd-dev zlib1g-dev libssl-dev  # run logs (.plog): zstd chunks, CRC32, SHA-256 asset hashes
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev

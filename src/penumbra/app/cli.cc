@@ -16,6 +16,7 @@
 #include <optional>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/bench_record.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -228,6 +229,10 @@ int RunCli(int argc, char** argv) {
   run->add_option("--outputs", outputs,
                   "images of every camera, comma-separated: rgb, depth, segmentation, range, "
                   "normals, instance_segmentation, semantic_segmentation (overrides the world)");
+  run->add_option("--record", run_options.record_file,
+                  "write a run log of every physics step to FILE.plog (docs/run-log.md)");
+  run->add_flag("--record-sensors", run_options.record_sensors,
+                "the run log also holds every camera image and sensor output");
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -278,6 +283,7 @@ int RunCli(int argc, char** argv) {
       "simulated seconds per side");
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
+  const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -343,6 +349,7 @@ int RunCli(int argc, char** argv) {
     }
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (eval.Selected()) return eval.Run();
+    if (*bench_record->app) return bench_record->Run();
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

@@ -14,6 +14,7 @@
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/progress.h"
+#include "penumbra/output/recorder_sink.h"
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/output/trajectory_sink.h"
 #include "penumbra/physics/mujoco_version.h"
@@ -24,6 +25,7 @@
 #include "penumbra/session/camera_sink.h"
 #include "penumbra/session/effects_stage.h"
 #include "penumbra/session/physics_source.h"
+#include "penumbra/session/run_log_header.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/sensor_sink.h"
 #include "penumbra/session/session.h"
@@ -117,9 +119,37 @@ WorldConfig WithRunOptions(const WorldConfig& world_in, const RunOptions& option
     world.mjcf_cameras.outputs = *options.outputs;
     for (CameraConfig& c : world.mjcf_cameras.overrides) c.outputs = *options.outputs;
   }
+  if (!options.record_file.empty()) world.record.file = options.record_file;
+  if (options.record_sensors) world.record.sensors = true;
   world.render.seed = world.seed;
-  world.ValidateOrThrow();
+  try {
+    world.ValidateOrThrow();
+  } catch (const ConfigError& e) {
+    // a bad --record / --record-sensors is the command line's, not the world file's
+    if (e.key().rfind("record.", 0) == 0 && !options.record_file.empty())
+      throw ConfigError("", 0, "--record", e.problem());
+    if (e.key() == "record.sensors" && options.record_sensors)
+      throw ConfigError("", 0, "--record-sensors",
+                        "needs --record FILE.plog (or world-file record.file)");
+    throw;
+  }
   return world;
+}
+
+// where the run log goes: --record is relative to the current folder, the world file's
+// record.file to the output folder
+std::string RecordPath(const WorldConfig& world, const RunOptions& options) {
+  if (world.record.file.empty()) return "";
+  std::filesystem::path p(world.record.file);
+  if (options.record_file.empty() && p.is_relative())
+    p = std::filesystem::path(world.output_dir) / p;
+  return p.lexically_normal().string();
+}
+
+std::string JoinArgs(const std::vector<std::string>& args) {
+  std::string s;
+  for (const std::string& a : args) s += (s.empty() ? "" : " ") + a;
+  return s;
 }
 
 // run.json of a finished run (the error is added by the ManifestSink)
@@ -142,6 +172,9 @@ RunManifest DescribeRun(const WorldConfig& world, const RunOptions& options,
   m.adversity = effects.PresetLabel();
   m.effects = effects.EffectLabels();
   m.agents = effects.AgentLabels();
+  m.record_file = summary.record_file;
+  m.record_bytes = summary.record_bytes;
+  m.record_steps = summary.record_steps;
   return m;
 }
 
@@ -183,6 +216,17 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   std::optional<ProgressReporter> progress;  // made once the sinks are set up
   CameraSinkOptions camera_options;
   camera_options.on_rendered = [&](double t, int64_t frames) { progress->Update(t, frames); };
+  // --record-sensors: every image file the cameras write also goes into the run log (set
+  // once the log is open, before the loop starts)
+  RunLogWriter* sensor_log = nullptr;
+  if (world.record.sensors) {
+    camera_options.writer.on_image = [&sensor_log](const CameraFrame& f, const std::string& kind,
+                                                   const std::vector<uint8_t>& png) {
+      if (!sensor_log) return;
+      sensor_log->RecordSensor(SensorRecord{f.step, f.time_sec, f.camera, kind + ".png",
+                                            std::string(png.begin(), png.end())});
+    };
+  }
   CameraSink cameras(scene, world, sim.timestep(), renderer, out.string(), viewer_effects,
                      camera_options);
   SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
@@ -201,6 +245,24 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   loop_options.stop_request = options.stop_request;
   SimLoop loop(&physics, loop_options);
   RunSummary summary;
+  // the run log (--record): every step's state from the loop thread, closed (complete) at the
+  // end of the run, also after Ctrl-C or an error; opened last so that a setup error leaves none
+  std::unique_ptr<RecorderSink> recorder;
+  const std::string record_path = RecordPath(world, options);
+  if (!record_path.empty()) {
+    RunLogHeader header =
+        MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
+    header.has_sensor_records = world.record.sensors;
+    recorder = std::make_unique<RecorderSink>(record_path, header);
+    if (world.record.sensors) {
+      sensor_log = &recorder->writer();
+      sensors.set_on_output([log = sensor_log](const std::string& sensor, const std::string& kind,
+                                               int64_t step, double time_sec, std::string bytes) {
+        log->RecordSensor(SensorRecord{step, time_sec, sensor, kind, std::move(bytes)});
+      });
+    }
+    spdlog::info("recording the run to {}", record_path);
+  }
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {
     progress->Finish();
     for (const auto& [kind, sec] : sensors.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
@@ -214,10 +276,28 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     timings["physics_sec"] = physics.busy_sec();
     timings["render_sec"] = cameras.render_sec();
     timings["total_sec"] = summary.wall_time_sec;
-    return DescribeRun(world, options, effects, summary, timings);
+    if (recorder) {
+      const RunLogWriterStats st = recorder->stats();
+      summary.record_file = record_path;
+      summary.record_bytes = st.file_bytes;
+      summary.record_steps = st.steps;
+    }
+    RunManifest m = DescribeRun(world, options, effects, summary, timings);
+    if (recorder) {
+      const RunLogWriterStats st = recorder->stats();
+      m.record_first_step = st.first_step;
+      m.record_last_step = st.last_step;
+      m.record_events = st.events;
+      m.record_sensor_records = st.sensor_records;
+    }
+    return m;
   });
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, &manifest})
+  // the recorder after the cameras and sensors (their sensor records reach it before it
+  // closes) and before the manifest (which reports its size)
+  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory})
     loop.AddSink(sink);
+  if (recorder) loop.AddSink(recorder.get());
+  loop.AddSink(&manifest);
   rollback.Dismiss();
   const LoopFinish finish = loop.Run();
   if (finish.error) std::rethrow_exception(finish.error);

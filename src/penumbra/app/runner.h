@@ -25,6 +25,11 @@ struct RunOptions {
   /// the output folder may hold the outputs of an earlier run, which are removed first
   /// (--force; output/output_folder.h). without it the folder must be empty or new.
   bool force = false;
+  /// --record FILE.plog: write a run log (docs/run-log.md); overrides the world's `record:`
+  /// file. relative to the current folder. "" = the world's `record:` (if any).
+  std::string record_file;
+  /// --record-sensors: the log also holds the cameras' images and the other sensors' outputs.
+  bool record_sensors = false;
   /// --outputs: replaces the outputs of every camera (world-file and MJCF cameras).
   std::optional<CameraOutputs> outputs;
   /// a stop request (e.g. set by a SIGINT handler; nullptr = none): when it reads non-zero
@@ -43,6 +48,10 @@ struct RunSummary {
   double wall_time_sec = 0;
   double peak_rss_mib = 0;
   bool interrupted = false;  ///< stopped early by RunOptions::stop_request
+  /// the run log written ("" = none), its size and its step records.
+  std::string record_file;
+  uint64_t record_bytes = 0;
+  int64_t record_steps = 0;
 };
 
 /// the camera outputs named in a comma-separated list ("rgb,depth,segmentation"); valid names:

@@ -55,6 +55,7 @@ void AsyncFrameWriter::AddCamera(const std::string& camera, const CameraIntrinsi
   auto state = std::make_unique<CameraState>();
   state->writer =
       std::make_unique<CameraWriter>(output_dir_, camera, intrinsics, outputs, options_.png);
+  if (options_.on_image) state->writer->set_on_image(options_.on_image);
   std::lock_guard<std::mutex> lock(mu_);
   cameras_.emplace(camera, std::move(state));
 }

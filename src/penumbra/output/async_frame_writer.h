@@ -34,6 +34,9 @@ struct AsyncFrameWriterOptions {
   /// lock held: do not call back into the writer), before Submit/Flush rethrow it; lets a
   /// caller order it against errors of other threads. may be empty.
   std::function<void(std::exception_ptr)> on_error;
+  /// receives every image file written (output/camera_frame.h), on the worker threads; may
+  /// be empty.
+  CameraImageCallback on_image;
 
   /// @throws ConfigError for a capacity < 1 or a thread count outside 1..8.
   void ValidateOrThrow() const;

@@ -2,7 +2,9 @@
 // one rendered frame of one camera, as handed to the output writers.
 
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/pose.h"
@@ -14,6 +16,7 @@ namespace penumbra {
 struct CameraFrame {
   std::string camera;   ///< camera name, may contain '/' (e.g. "rover/head")
   int64_t index = 0;    ///< per-camera frame counter, 0-based; names the files (NNNNNN.png)
+  int64_t step = -1;    ///< physics step of the capture (start of the exposure); -1 = unknown
   double time_sec = 0;  ///< simulation time of the frame
   Pose X_WO = Pose::Identity();  ///< optical frame (OpenCV: x right, y down, z forward) in world
   ImageU8 rgb;                   ///< (H x W x 3) uint8 sRGB
@@ -25,5 +28,11 @@ struct CameraFrame {
   ImageI32 body_id;  ///< (H x W x 1) body index of the hit, -1 = background
   ImageI32 semantic_class;  ///< (H x W x 1) semantic class id of the hit, 0 = none
 };
+
+/// receives each image file a camera writer wrote: the frame (camera, index, step, time), the
+/// output kind ("rgb", "depth", "segmentation", ...) and the PNG bytes (the file's content).
+/// called on the frame writer's threads, possibly several at once.
+using CameraImageCallback = std::function<void(const CameraFrame& frame, const std::string& kind,
+                                               const std::vector<uint8_t>& png)>;
 
 }  // namespace penumbra

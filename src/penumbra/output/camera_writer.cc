@@ -204,12 +204,16 @@ void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string&
                                     std::vector<fs::path>* written) const {
   // one PNG per image kind, at <folder>/<kind>/<name>, recorded in `written`
   auto write8 = [&](const char* kind, const ImageU8& img) {
-    WritePngRgb8((folder_ / kind / name).string(), img, png_options_);
+    const std::vector<uint8_t> bytes =
+        WritePngRgb8((folder_ / kind / name).string(), img, png_options_);
     written->push_back(folder_ / kind / name);
+    if (on_image_) on_image_(frame, kind, bytes);
   };
   auto write16 = [&](const char* kind, const ImageU16& img) {
-    WritePngGray16((folder_ / kind / name).string(), img, png_options_);
+    const std::vector<uint8_t> bytes =
+        WritePngGray16((folder_ / kind / name).string(), img, png_options_);
     written->push_back(folder_ / kind / name);
+    if (on_image_) on_image_(frame, kind, bytes);
   };
   if (outputs_.rgb) {
     CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");

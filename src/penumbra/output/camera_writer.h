@@ -97,6 +97,10 @@ class CameraWriter {
   /// WriteImages then AppendPose.
   void Write(const CameraFrame& frame);
 
+  /// `on_image` receives every image file WriteImages writes, after it is written (e.g. a run
+  /// log's sensor records); empty = none.
+  void set_on_image(CameraImageCallback on_image) { on_image_ = std::move(on_image); }
+
   const std::string& camera() const { return camera_; }
   /// DIR/<camera>
   const std::filesystem::path& folder() const { return folder_; }
@@ -115,6 +119,7 @@ class CameraWriter {
   LineFile csv_;
   int64_t last_index_ = -1;
   int64_t frames_written_ = 0;
+  CameraImageCallback on_image_;
 };
 
 }  // namespace penumbra

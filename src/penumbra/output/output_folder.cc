@@ -66,6 +66,7 @@ class Scanner {
       switch (kind) {
         case Kind::kTop:
           if (file && kTopFiles.count(name)) continue;
+          if (file && EndsWith(name, ".plog")) continue;  // a run log (--record)
           if (dir_entry) {
             Folder(p, name == "lidar"              ? Kind::kLidarFolder
                       : kSensorFolders.count(name) ? Kind::kSensorFolder

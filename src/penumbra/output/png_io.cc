@@ -215,7 +215,8 @@ std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptio
                 options, PNG_FILTER_UP);
 }
 
-void WritePngRgb8(const std::string& path, const ImageU8& image, const PngEncodeOptions& options) {
+std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
+                                  const PngEncodeOptions& options) {
   std::vector<uint8_t> bytes;
   try {
     bytes = EncodePngRgb8(image, options);
@@ -223,10 +224,11 @@ void WritePngRgb8(const std::string& path, const ImageU8& image, const PngEncode
     throw Error("cannot write PNG '" + path + "': " + e.what());
   }
   WriteFileBytes(path, bytes);
+  return bytes;
 }
 
-void WritePngGray16(const std::string& path, const ImageU16& image,
-                    const PngEncodeOptions& options) {
+std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
+                                    const PngEncodeOptions& options) {
   std::vector<uint8_t> bytes;
   try {
     bytes = EncodePngGray16(image, options);
@@ -234,6 +236,7 @@ void WritePngGray16(const std::string& path, const ImageU16& image,
     throw Error("cannot write PNG '" + path + "': " + e.what());
   }
   WriteFileBytes(path, bytes);
+  return bytes;
 }
 
 PngImage ReadPng(const std::string& path) {

@@ -38,15 +38,15 @@ std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptio
 
 /// writes EncodePngRgb8(image) to `path` (replacing an existing file): whole under a
 /// temporary name, then renamed into place (core/output_file.h), so `path` is never a
-/// truncated PNG.
+/// truncated PNG. returns the bytes written.
 /// @throws Error naming `path` and the reason (bad image, cannot open, short write).
-void WritePngRgb8(const std::string& path, const ImageU8& image,
-                  const PngEncodeOptions& options = {});
+std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
+                                  const PngEncodeOptions& options = {});
 
-/// writes EncodePngGray16(image) to `path` as WritePngRgb8 does.
+/// writes EncodePngGray16(image) to `path` as WritePngRgb8 does; returns the bytes written.
 /// @throws Error naming `path` and the reason.
-void WritePngGray16(const std::string& path, const ImageU16& image,
-                    const PngEncodeOptions& options = {});
+std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
+                                    const PngEncodeOptions& options = {});
 
 /// a decoded PNG: samples as stored in the file (palette images are expanded to
 /// RGB, greyscale below 8 bits to 8 bits; 16-bit samples are kept exact).

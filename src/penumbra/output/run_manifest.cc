@@ -35,6 +35,17 @@ std::string RunManifestJson(const RunManifest& m) {
     j["effects"] = m.effects;
     j["agents"] = m.agents;
   }
+  if (!m.record_file.empty()) {
+    nlohmann::ordered_json r;
+    r["file"] = m.record_file;
+    r["bytes"] = m.record_bytes;
+    r["steps"] = m.record_steps;
+    r["first_step"] = m.record_first_step;
+    r["last_step"] = m.record_last_step;
+    r["events"] = m.record_events;
+    r["sensor_records"] = m.record_sensor_records;
+    j["record"] = r;
+  }
   return j.dump(2) + "\n";
 }
 

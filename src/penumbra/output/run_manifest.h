@@ -30,6 +30,15 @@ struct RunManifest {
   std::string adversity;
   std::vector<std::string> effects;
   std::vector<std::string> agents;
+  /// the run log (--record, world `record:`), written only when record_file is not empty:
+  /// "record": {"file", "bytes", "steps", "first_step", "last_step", "events",
+  /// "sensor_records"} after "agents".
+  std::string record_file;
+  uint64_t record_bytes = 0;  ///< size of the log file
+  int64_t record_steps = 0;   ///< step records in the log
+  int64_t record_first_step = -1, record_last_step = -1;
+  int64_t record_events = 0;
+  int64_t record_sensor_records = 0;
   /// the run's first error (e.g. divergence, a file that could not be written); the key
   /// "error" is written only when it is not empty, after "peak_resident_memory_mib".
   std::string error;

@@ -593,6 +593,36 @@ SimState Simulation::GetState() const {
   return s;
 }
 
+std::vector<std::string> Simulation::MocapBodyNames() const {
+  const mjModel* m = impl_->m;
+  std::vector<std::string> names(m->nmocap);
+  for (int b = 0; b < m->nbody; ++b) {
+    const int id = m->body_mocapid[b];
+    if (id >= 0) names[id] = mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "";
+  }
+  return names;
+}
+
+void Simulation::SnapshotState(WorldSnapshot* out) const {
+  const mjModel* m = impl_->m;
+  const mjData* d = impl_->d;
+  out->time_sec = d->time;
+  out->step = impl_->steps;
+  out->qpos.assign(d->qpos, d->qpos + m->nq);
+  out->qvel.assign(d->qvel, d->qvel + m->nv);
+  out->act.assign(d->act, d->act + m->na);
+  out->ctrl.assign(d->ctrl, d->ctrl + m->nu);
+  out->qacc_warmstart.assign(d->qacc_warmstart, d->qacc_warmstart + m->nv);
+  out->qfrc_applied.assign(d->qfrc_applied, d->qfrc_applied + m->nv);
+  out->xfrc_applied.assign(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody);
+  out->mocap_pos.assign(d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
+  out->mocap_quat.assign(d->mocap_quat, d->mocap_quat + 4 * m->nmocap);
+  out->userdata.assign(d->userdata, d->userdata + m->nuserdata);
+  out->controller_next_update.resize(impl_->schedule.size());
+  for (size_t i = 0; i < impl_->schedule.size(); ++i)
+    out->controller_next_update[i] = impl_->schedule[i].next;
+}
+
 void Simulation::SetState(const SimState& s) {
   Impl& impl = *impl_;
   const mjModel* m = impl.m;
@@ -745,8 +775,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
     out->light_direction_W[l] = dir.norm() > 0 ? dir.normalized() : Eigen::Vector3d(0, 0, -1);
   }
   FillTendonPaths(m, d, impl_->scene.tendons, &out->tendon_paths);
-  out->qpos.assign(live->qpos, live->qpos + m->nq);
-  out->qvel.assign(live->qvel, live->qvel + m->nv);
+  SnapshotState(out);
   if (content == SnapshotContent::kFull) {
     FillSensorGroundTruth(m, d, out);
   } else {

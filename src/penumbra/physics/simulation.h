@@ -145,7 +145,8 @@ class Simulation {
   /// what a snapshot computes. both work on a scratch copy of the state, so taking snapshots
   /// never changes the trajectory, and both give bit-identical poses.
   enum class SnapshotContent {
-    /// time, X_WB of every body, MJCF camera poses, light positions/directions, qpos, qvel:
+    /// time, X_WB of every body, MJCF camera poses, light positions/directions, the state
+    /// (SnapshotState: qpos, qvel, act, ctrl, ...):
     /// mj_kinematics, mj_comPos and mj_camlight for the current qpos and mocap poses (what
     /// cameras and effects read; a small part of a step). sensordata, V_WB and contacts are
     /// left empty.
@@ -154,6 +155,12 @@ class Simulation {
     /// state (collision, constraint forces, every sensor stage; about the cost of a step).
     kFull,
   };
+
+  /// copies the current state into `out`'s state fields (time_sec, step, qpos, qvel, act,
+  /// ctrl, qacc_warmstart, qfrc_applied, xfrc_applied, mocap_pos, mocap_quat, userdata,
+  /// controller_next_update: the content of GetState), reusing their storage; other fields
+  /// are left as they are. Snapshot() does this too.
+  void SnapshotState(WorldSnapshot* out) const;
 
   /// the world at the current time (see SnapshotContent).
   WorldSnapshot Snapshot(SnapshotContent content = SnapshotContent::kFull) const;
@@ -178,6 +185,9 @@ class Simulation {
   std::span<const double> qvel() const;
   /// (nu) MuJoCo ctrl vector; controllers write it, tools and tests may too.
   std::span<double> ctrl();
+
+  /// the names of the mocap bodies by mocap id (the order of SimState::mocap_pos / mocap_quat).
+  std::vector<std::string> MocapBodyNames() const;
 
   /// the file the model came from ("<string>" for LoadFromString).
   const std::string& source() const;

@@ -14,8 +14,11 @@ namespace penumbra {
 /// how much of a WorldSnapshot a consumer reads; ordered from least to most (a richer content
 /// holds everything of a poorer one).
 enum class SnapshotContent {
-  kNone = 0,   ///< no snapshot at this step
-  kState = 1,  ///< time_sec, step, qpos, qvel (trajectory rows, recorders)
+  kNone = 0,  ///< no snapshot at this step
+  /// time_sec, step, qpos, qvel and, from live physics, the rest of the simulation state
+  /// (act, ctrl, qacc_warmstart, applied forces, mocap poses, userdata, controllers' schedule:
+  /// WorldSnapshot) (trajectory rows, recorders)
+  kState = 1,
   kPoses = 2,  ///< kState plus X_WB, X_W_mjcam, light poses (cameras, effects)
   kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts (sensors, ground truth)
 };

@@ -170,6 +170,7 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   CameraFrame cf;
   cf.camera = spec.name;
   cf.index = p.frame;
+  cf.step = p.start->step;
   cf.time_sec = img.mid_exposure_time_sec;
   cf.X_WO = img.X_WO;
   cf.rgb = std::move(img.rgb);

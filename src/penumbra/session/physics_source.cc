@@ -12,10 +12,7 @@ PhysicsSource::PhysicsSource(Simulation* sim, PhysicsSourceOptions options)
 std::shared_ptr<const WorldSnapshot> PhysicsSource::Snapshot(SnapshotContent content) {
   auto s = std::make_shared<WorldSnapshot>();
   if (content == SnapshotContent::kState || content == SnapshotContent::kNone) {
-    s->time_sec = sim_->time();
-    s->step = sim_->step_count();
-    s->qpos.assign(sim_->qpos().begin(), sim_->qpos().end());
-    s->qvel.assign(sim_->qvel().begin(), sim_->qvel().end());
+    sim_->SnapshotState(s.get());
   } else {
     sim_->Snapshot(s.get(), content == SnapshotContent::kFull
                                 ? Simulation::SnapshotContent::kFull

@@ -30,7 +30,8 @@ class PhysicsSource : public Source {
   /// the step and time of the last step completed (after a PhysicsError: the step before it).
   int64_t step() const override { return step_; }
   double time_sec() const override { return time_sec_; }
-  /// kState: time, step, qpos, qvel only; kPoses / kFull: Simulation::Snapshot's kPoses / kFull.
+  /// kState: the state only (Simulation::SnapshotState: time, step, qpos, qvel, act, ctrl,
+  /// ...); kPoses / kFull: Simulation::Snapshot's kPoses / kFull (which include the state).
   std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override;
   /// one Simulation::Step (after the realtime wait); logs the simulation's warnings. always
   /// true. @throws PhysicsError when the simulation diverges.

@@ -169,6 +169,7 @@ struct SensorSink::Impl {
   std::vector<GroundTruth> truths;
   std::vector<std::string> body_names;
   std::unique_ptr<RayQuery> ray_scene;
+  SensorOutputCallback on_output;
   // loop thread
   std::vector<SensorFiring> due;
   int64_t due_step = -1;
@@ -195,7 +196,8 @@ struct SensorSink::Impl {
     };
     LidarScan scan;
     l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
-    l.out.Write(l.start_firing, scan);
+    std::string pcd = l.out.Write(l.start_firing, scan);
+    if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -349,6 +351,10 @@ SensorSink::~SensorSink() { impl_->worker.Finish(); }
 
 bool SensorSink::empty() const { return impl_->configs.empty(); }
 
+void SensorSink::set_on_output(SensorOutputCallback on_output) {
+  impl_->on_output = std::move(on_output);
+}
+
 void SensorSink::OnStart(const LoopStart& start) { impl_->worker.Start(start.report_error); }
 
 SnapshotContent SensorSink::Wants(int64_t step, double) {
@@ -416,8 +422,10 @@ void SensorSink::Impl::Process(
       state.v_WS = V.tail<3>() + V.head<3>().cross(p_BS_W);
       state.gyro_bias = m.noise->gyro_bias();
       state.accel_bias = m.noise->accel_bias();
-      m.out.Write(f, m.noise->Apply(f.index, truth));
+      std::string row = m.out.Write(f, m.noise->Apply(f.index, truth));
       m.truth_out.Write(f, state);
+      if (s.on_output)
+        s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {
@@ -427,7 +435,9 @@ void SensorSink::Impl::Process(
       Rng rng(HashKeys(m.stream, static_cast<uint64_t>(f.index)));
       if (m.stddev > 0)
         for (double& v : m.values) v += m.stddev * StandardNormal(&rng);
-      m.out.Write(f, m.values);
+      std::string row = m.out.Write(f, m.values);
+      if (s.on_output)
+        s.on_output(m.cfg->name, "sensor.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
       s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else {

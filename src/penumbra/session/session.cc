@@ -55,7 +55,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   // the document becomes text once: the file kept and what MuJoCo compiles
-  const std::string xml = composed.Xml();
+  composed_xml_ = composed.Xml();
+  const std::string& xml = composed_xml_;
   if (!options.composed_xml_path.empty()) WriteFileAtomic(options.composed_xml_path, xml);
   timings_.compose_sec = SecondsSince(t0);
 

@@ -94,6 +94,8 @@ class Session {
   /// the run's effects, agents and preset; Evaluate gives the effects per viewer.
   EffectsStage& effects() { return *effects_; }
   const EffectsStage& effects() const { return *effects_; }
+  /// the composed MJCF text MuJoCo compiled (what composed.xml holds).
+  const std::string& composed_xml() const { return composed_xml_; }
   /// seconds each set-up step took.
   const SessionTimings& timings() const { return timings_; }
 
@@ -104,6 +106,7 @@ class Session {
   SceneDescription scene_;
   std::unique_ptr<Renderer> renderer_;
   SessionTimings timings_;
+  std::string composed_xml_;
 };
 
 }  // namespace penumbra

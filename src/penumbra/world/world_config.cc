@@ -38,7 +38,7 @@ class WorldParser {
     const std::vector<std::string_view> keys = {
         "seed",   "duration_sec", "physics",          "render",       "sky",       "robots",
         "models", "lights",       "cameras",          "mjcf_cameras", "materials", "output",
-        "agents", "adversity",    "semantic_classes", "effects",      "sensors"};
+        "agents", "adversity",    "semantic_classes", "effects",      "sensors",   "record"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -102,6 +102,13 @@ class WorldParser {
       YamlReader o = r.Child("output");
       o.ExpectMap({"dir"});
       if (o.Has("dir")) w.output_dir = o.Child("dir").String();
+    }
+    if (r.Has("record")) {
+      YamlReader rec = r.Child("record");
+      rec.ExpectMap({"file", "sensors"});
+      if (!rec.Has("file")) rec.Fail("no 'file'; expected record: {file: NAME.plog}");
+      w.record.file = rec.Child("file").String();
+      if (rec.Has("sensors")) w.record.sensors = rec.Child("sensors").Bool();
     }
     if (r.Has("semantic_classes"))
       w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));

@@ -154,6 +154,15 @@ struct MaterialOverride {
   std::optional<Eigen::Vector3f> emission;  ///< cd/m^2 per channel
 };
 
+/// world-file `record:`: write a run log of the run (runlog/, docs/run-log.md).
+struct RecordConfig {
+  /// the log file, ending in ".plog"; "" = no log. a relative path is relative to the
+  /// run's output folder (`record: {file: run.plog}` writes <output.dir>/run.plog).
+  std::string file;
+  /// also record each camera image, LiDAR scan and IMU / sensor row (--record-sensors).
+  bool sensors = false;
+};
+
 class LineTable;
 class ConfigError;
 
@@ -180,6 +189,8 @@ struct WorldConfig {
   /// entries first, then each robot's own list in robot order.
   std::vector<SensorConfig> sensors;
   std::string output_dir = "out";
+  /// `record:` the run log (--record overrides it).
+  RecordConfig record;
   /// `effects:` adverse conditions (effects/effect_config.h; parsed by world/effects_reader.h).
   std::vector<EffectConfig> effects;
   /// `agents:` NPC people and vehicles on waypoint paths (effects/agent_path.h).

@@ -86,9 +86,22 @@ class Validator {
     CheckMjcfCameras();
     CheckMaterials();
     if (w_.output_dir.empty()) Fail("output.dir", "empty; expected a folder name");
+    CheckRecord();
   }
 
  private:
+  // `record:` (a run log): a .plog file name, or nothing recorded
+  void CheckRecord() const {
+    const std::string& f = w_.record.file;
+    if (f.empty()) {
+      if (w_.record.sensors)
+        Fail("record.sensors", "true without record.file; expected record: {file: NAME.plog}");
+      return;
+    }
+    if (f.size() <= 5 || f.compare(f.size() - 5, 5, ".plog") != 0 || f.back() == '/')
+      Fail("record.file", "'" + f + "'; expected a file name ending in .plog");
+  }
+
   [[noreturn]] void Fail(const std::string& path, const std::string& problem) const {
     throw ConfigError(w_.file, lines_.Find(path), path, problem);
   }

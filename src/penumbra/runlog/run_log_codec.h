@@ -1,0 +1,131 @@
+#pragma once
+// the byte-level pieces of the run log format shared by the writer and the reader
+// (docs/run-log.md): the preamble, the 64-byte chunk header, record bodies, CRC32 and zstd.
+// every integer and double is little-endian; doubles are IEEE 754 binary64 bit patterns.
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "penumbra/runlog/run_log_format.h"
+
+namespace penumbra::runlog_codec {
+
+static_assert(std::endian::native == std::endian::little,
+              "the run log codec writes the host's bytes; it assumes a little-endian host");
+
+/// bytes of the preamble: magic (8), format version (u32), reserved (u32, 0).
+inline constexpr size_t kPreambleBytes = 16;
+/// bytes of a chunk header; its last 4 are the CRC32 of the first 60.
+inline constexpr size_t kChunkHeaderBytes = 64;
+/// bytes of the CRC32 that follows each chunk body.
+inline constexpr size_t kChunkTrailerBytes = 4;
+/// the 4 bytes that open every chunk header.
+inline constexpr char kChunkMagic[4] = {'P', 'C', 'H', 'K'};
+/// body codecs.
+inline constexpr uint32_t kCodecNone = 0;
+inline constexpr uint32_t kCodecZstd = 1;
+/// field encodings of a step record (docs/run-log.md "Steps chunk").
+inline constexpr uint8_t kFieldZero = 0;   ///< n entries, all +0.0 (or 0); no data follows
+inline constexpr uint8_t kFieldXor = 1;    ///< n words, each XORed with the previous record's
+inline constexpr uint8_t kFieldPlain = 2;  ///< n words as they are
+
+/// a chunk header as stored (RunLogChunkInfo less the file offset, plus the codec).
+struct ChunkHeader {
+  RunLogChunkKind kind = RunLogChunkKind::kSteps;
+  uint64_t index = 0;
+  uint32_t record_count = 0;
+  uint32_t codec = kCodecNone;
+  int64_t first_step = 0;
+  int64_t last_step = 0;
+  uint64_t raw_size = 0;
+  uint64_t stored_size = 0;
+};
+
+/// the 16-byte preamble for `version`.
+std::string EncodePreamble(uint32_t version);
+/// the 64-byte header of `h` (with its CRC).
+std::string EncodeChunkHeader(const ChunkHeader& h);
+/// parses 64 bytes; returns "" and fills `out`, or the reason they are not a valid chunk
+/// header ("bad chunk magic", "header CRC mismatch", "unknown chunk kind 9", ...).
+std::string DecodeChunkHeader(const uint8_t* bytes, ChunkHeader* out);
+
+/// CRC-32 (ISO-HDLC, zlib crc32) of `n` bytes.
+uint32_t Crc32(const void* data, size_t n);
+
+/// zstd at `level`. @throws RunLogError with zstd's message.
+std::string ZstdCompress(std::string_view raw, int level);
+/// zstd decompression of a frame whose content is `raw_size` bytes.
+/// @throws RunLogError when the data is not such a frame.
+std::string ZstdDecompress(std::string_view stored, uint64_t raw_size);
+
+/// appends little-endian values to a buffer.
+inline void PutU8(std::string* b, uint8_t v) { b->push_back(static_cast<char>(v)); }
+inline void PutU32(std::string* b, uint32_t v) { b->append(reinterpret_cast<const char*>(&v), 4); }
+inline void PutU64(std::string* b, uint64_t v) { b->append(reinterpret_cast<const char*>(&v), 8); }
+inline void PutI64(std::string* b, int64_t v) { b->append(reinterpret_cast<const char*>(&v), 8); }
+inline void PutF64(std::string* b, double v) { b->append(reinterpret_cast<const char*>(&v), 8); }
+/// u32 length, then the bytes.
+inline void PutString(std::string* b, std::string_view s) {
+  PutU32(b, static_cast<uint32_t>(s.size()));
+  b->append(s.data(), s.size());
+}
+/// u64 length, then the bytes.
+inline void PutBlob(std::string* b, std::string_view s) {
+  PutU64(b, s.size());
+  b->append(s.data(), s.size());
+}
+
+/// reads little-endian values from a body; every read past the end throws RunLogError with
+/// `what` and the offset.
+class BodyReader {
+ public:
+  BodyReader(std::string_view data, std::string what) : data_(data), what_(std::move(what)) {}
+  bool done() const { return pos_ == data_.size(); }
+  size_t pos() const { return pos_; }
+  uint8_t U8() { return Take<uint8_t>(); }
+  uint32_t U32() { return Take<uint32_t>(); }
+  uint64_t U64() { return Take<uint64_t>(); }
+  int64_t I64() { return Take<int64_t>(); }
+  double F64() { return Take<double>(); }
+  std::string_view Bytes(uint64_t n);
+  std::string String() { return std::string(Bytes(U32())); }
+  std::string Blob() { return std::string(Bytes(U64())); }
+  /// throws RunLogError "<what>: <problem> at byte <pos>".
+  [[noreturn]] void Fail(const std::string& problem) const;
+
+ private:
+  template <typename T>
+  T Take() {
+    T v;
+    std::memcpy(&v, Bytes(sizeof(T)).data(), sizeof(T));
+    return v;
+  }
+  std::string_view data_;
+  std::string what_;
+  size_t pos_ = 0;
+};
+
+/// appends `r` to a steps body; `prev` is the previous record of the same chunk (null for
+/// the chunk's first), against which fields of equal size are XORed.
+void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body);
+/// reads one step record; `prev` as for EncodeStep. @throws RunLogError on malformed data.
+void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out);
+
+/// appends an event / sensor record to a body.
+void EncodeEvent(const EventRecord& e, std::string* body);
+void EncodeSensor(const SensorRecord& s, std::string* body);
+/// reads one event / sensor record. @throws RunLogError on malformed data.
+EventRecord DecodeEvent(BodyReader* in);
+SensorRecord DecodeSensor(BodyReader* in);
+
+/// the header as the JSON text of a header chunk.
+std::string HeaderToJson(const RunLogHeader& h);
+/// parses a header chunk's JSON. @throws RunLogError naming a missing or mistyped key.
+RunLogHeader HeaderFromJson(std::string_view json);
+
+}  // namespace penumbra::runlog_codec

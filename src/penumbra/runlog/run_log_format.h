@@ -1,0 +1,176 @@
+#pragma once
+// the run log (.plog): a versioned, chunked binary record of one `penumbra run` (issue 18):
+// a header (versions, the world and composed model texts, asset hashes, seed, command line,
+// timestep and the state layout with names), then per physics step the state MuJoCo 2.2.2
+// needs to continue bit for bit, plus events (commands, effect changes, notes) and optional
+// sensor outputs. the byte layout is specified in docs/run-log.md; this file holds the
+// in-memory types the writer (runlog/run_log_writer.h) takes and the reader
+// (runlog/run_log_reader.h) returns, and the format constants.
+//
+// this module depends on core only: it knows nothing of MuJoCo, the pipeline or snapshots.
+// the vectors of a StepRecord are MuJoCo's, in its order and units; their sizes are those of
+// RunLogLayout (the same content as physics/simulation.h SimState).
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+/// the first 8 bytes of every run log: 0x89 'P' 'L' 'O' 'G' '\r' '\n' 0x1a (a high byte
+/// first, so that no text tool mistakes a log for text; CR LF catches newline conversion).
+inline constexpr std::array<uint8_t, 8> kRunLogMagic = {0x89, 'P', 'L', 'O', 'G', '\r', '\n', 0x1a};
+
+/// the format version this build writes (u32 after the magic).
+inline constexpr uint32_t kRunLogFormatVersion = 1;
+/// the format versions this build reads.
+inline constexpr std::array<uint32_t, 1> kRunLogReadableVersions = {1};
+
+/// a run log could not be written or read: I/O failure, not a run log, another format version,
+/// truncation or damage. messages name the file and, for damage, the chunk index and step.
+class RunLogError : public Error {
+ public:
+  explicit RunLogError(const std::string& what) : Error(what) {}
+};
+
+/// one joint of the recorded model and where its coordinates are in qpos / qvel.
+struct RunLogJoint {
+  std::string name;    ///< MJCF name ("" for an unnamed joint)
+  std::string type;    ///< "free", "ball", "slide" or "hinge"
+  int qpos_adr = 0;    ///< first index in qpos
+  int qpos_width = 0;  ///< entries in qpos (free 7, ball 4, slide/hinge 1)
+  int qvel_adr = 0;    ///< first index in qvel (and qacc_warmstart, qfrc_applied)
+  int qvel_width = 0;  ///< entries in qvel (free 6, ball 3, slide/hinge 1)
+};
+
+/// the shape of the recorded state and the names that map it, so that a reader can find a
+/// joint's, actuator's or body's values by name without the model.
+struct RunLogLayout {
+  int nq = 0;               ///< size of qpos
+  int nv = 0;               ///< size of qvel, qacc_warmstart, qfrc_applied
+  int na = 0;               ///< size of act
+  int nu = 0;               ///< size of ctrl
+  int nmocap = 0;           ///< mocap bodies (mocap_pos has 3 nmocap entries, mocap_quat 4 nmocap)
+  int nuserdata = 0;        ///< size of userdata
+  int nbody = 0;            ///< bodies including the world (xfrc_applied has 6 nbody entries)
+  int num_controllers = 0;  ///< size of controller_next_update
+  std::vector<RunLogJoint> joints;            ///< (njnt) by MuJoCo joint id
+  std::vector<std::string> actuator_names;    ///< (nu) by actuator id = index into ctrl
+  std::vector<std::string> mocap_body_names;  ///< (nmocap) by mocap id
+  std::vector<std::string> body_names;        ///< (nbody) by body id (0 = "world")
+  std::vector<std::string> controller_names;  ///< (num_controllers) e.g. "go1: trot_gait"
+};
+
+/// a file the run read and its content hash (lowercase hex SHA-256 of its bytes).
+struct RunLogAsset {
+  std::string role;    ///< "world", "model", "mesh", "texture", "hfield", "include", ...
+  std::string path;    ///< as the world or model names it, made absolute
+  std::string sha256;  ///< 64 lowercase hex digits; "" when the file could not be read
+  uint64_t size_bytes = 0;
+};
+
+/// everything known before the first step (the header chunk; JSON in the file).
+struct RunLogHeader {
+  /// the format version of the file (kRunLogFormatVersion when writing; set by the writer).
+  uint32_t format_version = kRunLogFormatVersion;
+  std::string penumbra_version;  ///< of the writer, e.g. "0.1.0"
+  std::string mujoco_version;    ///< e.g. "2.2.2"
+  /// the world file (absolute path) and its text; both "" for a bare model run
+  /// (`penumbra run model.xml`), which then has model_file / model_text.
+  std::string world_file;
+  std::string world_text;
+  /// for a bare model: the model file run (absolute path) and its text; else "".
+  std::string model_file;
+  std::string model_text;
+  /// the composed MJCF the simulation compiled (composed.xml).
+  std::string composed_mjcf;
+  /// every file read to build the run: the world file, the model files and the meshes,
+  /// textures and height fields the composed MJCF references.
+  std::vector<RunLogAsset> assets;
+  uint64_t seed = 0;
+  std::string command_line;  ///< as typed, arguments joined by spaces
+  double timestep_sec = 0;   ///< physics timestep; step n is at SimTimeOfStep(n, timestep_sec)
+  RunLogLayout layout;
+  bool has_sensor_records = false;  ///< the writer was asked for sensor records
+  /// the adversity label of the run ("" = none), for information.
+  std::string adversity;
+};
+
+/// the simulation state after `step` steps (physics/simulation.h SimState): vectors in
+/// MuJoCo's order and units, sizes from RunLogLayout (n = 0 entries allowed for an empty
+/// model part).
+struct StepRecord {
+  int64_t step = 0;                    ///< steps completed since loading (0 = initial state)
+  double time_sec = 0;                 ///< sim time, s
+  std::vector<double> qpos;            ///< (nq)
+  std::vector<double> qvel;            ///< (nv)
+  std::vector<double> act;             ///< (na)
+  std::vector<double> ctrl;            ///< (nu)
+  std::vector<double> qacc_warmstart;  ///< (nv)
+  std::vector<double> qfrc_applied;    ///< (nv) N or N m per dof
+  std::vector<double> xfrc_applied;    ///< (6 nbody) torque, force per body, world frame
+  std::vector<double> mocap_pos;       ///< (3 nmocap) m, world frame
+  std::vector<double> mocap_quat;      ///< (4 nmocap) w, x, y, z
+  std::vector<double> userdata;        ///< (nuserdata)
+  std::vector<int64_t> controller_next_update;  ///< (num_controllers) step of next update
+};
+
+/// something that happened at a step besides the state: a command a bridge received, an
+/// effect parameter change, a note. kind is free text ("command", "effect", "note", ...);
+/// payload is JSON text (not checked by the log).
+struct EventRecord {
+  int64_t step = 0;
+  double time_sec = 0;
+  std::string kind;
+  std::string payload;
+};
+
+/// one sensor output at a step (--record-sensors): a camera image, a LiDAR scan, IMU rows.
+struct SensorRecord {
+  int64_t step = 0;
+  double time_sec = 0;
+  std::string sensor;  ///< the sensor's name, e.g. "front" or "lidar0"
+  /// what the payload is, e.g. "rgb.png", "depth.png", "segmentation.png", "points.pcd",
+  /// "imu.csv" (the bytes the run's own writer produces for that output).
+  std::string kind;
+  std::string payload;  ///< bytes (binary)
+};
+
+/// one record of a log, in the order it was written within its stream.
+using RunLogRecord = std::variant<StepRecord, EventRecord, SensorRecord>;
+
+/// chunk kinds (u32 in the chunk header).
+enum class RunLogChunkKind : uint32_t {
+  kHeader = 1,   ///< the RunLogHeader as JSON (always chunk 0)
+  kSteps = 2,    ///< StepRecords, steps increasing
+  kEvents = 3,   ///< EventRecords
+  kSensors = 4,  ///< SensorRecords
+  kEnd = 5,      ///< the last chunk of a log closed cleanly (body: JSON summary)
+};
+
+/// lowercase name of a chunk kind ("header", "steps", ...), for messages.
+std::string_view RunLogChunkKindName(RunLogChunkKind kind);
+
+/// what a chunk header says (docs/run-log.md "Chunk"), plus where the chunk is in the file.
+struct RunLogChunkInfo {
+  RunLogChunkKind kind = RunLogChunkKind::kSteps;
+  uint64_t index = 0;            ///< 0 for the header chunk, then 1, 2, ... in file order
+  uint32_t record_count = 0;     ///< records in the body
+  int64_t first_step = 0;        ///< smallest step of the records (0 if none)
+  int64_t last_step = 0;         ///< largest step of the records (0 if none)
+  uint64_t raw_size = 0;         ///< body bytes before compression
+  uint64_t compressed_size = 0;  ///< body bytes in the file
+  uint64_t file_offset = 0;      ///< offset of the chunk header in the file
+};
+
+/// lowercase hex SHA-256 of `bytes` (OpenSSL).
+std::string Sha256Hex(std::string_view bytes);
+/// lowercase hex SHA-256 of a file's bytes. @throws RunLogError naming the file if unreadable.
+std::string Sha256OfFile(const std::string& path, uint64_t* size_bytes = nullptr);
+
+}  // namespace penumbra

@@ -1,0 +1,115 @@
+#include "penumbra/session/run_log_header.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "penumbra/compose/mjcf_assets.h"
+#include "penumbra/physics/mujoco_version.h"
+
+namespace penumbra {
+namespace {
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot be read for the run log header");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string Absolute(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::absolute(path, ec);
+  return ec ? path : p.lexically_normal().string();
+}
+
+const char* JointTypeName(JointInfo::Type t) {
+  switch (t) {
+    case JointInfo::Type::kFree:
+      return "free";
+    case JointInfo::Type::kBall:
+      return "ball";
+    case JointInfo::Type::kSlide:
+      return "slide";
+    case JointInfo::Type::kHinge:
+      return "hinge";
+  }
+  return "hinge";
+}
+
+}  // namespace
+
+RunLogHeader MakeRunLogHeader(const Session& session, const std::string& penumbra_version,
+                              const std::string& command_line) {
+  const WorldConfig& world = session.world();
+  const Simulation& sim = session.sim();
+  RunLogHeader h;
+  h.penumbra_version = penumbra_version;
+  h.mujoco_version = MujocoVersion();
+  if (!world.file.empty()) {
+    h.world_file = Absolute(world.file);
+    h.world_text = ReadText(world.file);
+  } else if (!world.models.empty()) {
+    h.model_file = Absolute(world.models.front().file);
+    h.model_text = ReadText(world.models.front().file);
+  }
+  h.composed_mjcf = session.composed_xml();
+  h.seed = world.seed;
+  h.command_line = command_line;
+  h.timestep_sec = sim.timestep();
+  h.adversity = session.effects().PresetLabel();
+
+  // every file read, each once
+  std::set<std::string> seen;
+  const auto hash = [&](const std::string& role, const std::string& path) {
+    const std::string abs = Absolute(path);
+    if (!seen.insert(abs).second) return;
+    RunLogAsset a;
+    a.role = role;
+    a.path = abs;
+    try {
+      a.sha256 = Sha256OfFile(abs, &a.size_bytes);
+    } catch (const RunLogError&) {
+      a.sha256.clear();
+    }
+    h.assets.push_back(std::move(a));
+  };
+  if (!world.file.empty()) hash("world", world.file);
+  for (const ModelConfig& m : world.models) hash("model", m.file);
+  if (!world.adversity.empty() && std::filesystem::is_regular_file(world.adversity))
+    hash("adversity", world.adversity);
+  for (const MjcfAssetFile& f : MjcfAssetFiles(session.composed_xml())) hash(f.role, f.path);
+
+  // the state layout (SimState sizes) and its names
+  const ModelInfo& info = sim.model_info();
+  const SimState state = sim.GetState();
+  RunLogLayout& l = h.layout;
+  l.nq = static_cast<int>(state.qpos.size());
+  l.nv = static_cast<int>(state.qvel.size());
+  l.na = static_cast<int>(state.act.size());
+  l.nu = static_cast<int>(state.ctrl.size());
+  l.nmocap = static_cast<int>(state.mocap_pos.size() / 3);
+  l.nuserdata = static_cast<int>(state.userdata.size());
+  l.nbody = static_cast<int>(state.xfrc_applied.size() / 6);
+  l.num_controllers = static_cast<int>(state.controller_next_update.size());
+  for (const JointInfo& j : info.joints) {
+    RunLogJoint x;
+    x.name = j.name;
+    x.type = JointTypeName(j.type);
+    x.qpos_adr = j.qpos_adr;
+    x.qvel_adr = j.dof_adr;
+    x.qpos_width = j.type == JointInfo::Type::kFree ? 7 : j.type == JointInfo::Type::kBall ? 4 : 1;
+    x.qvel_width = j.type == JointInfo::Type::kFree ? 6 : j.type == JointInfo::Type::kBall ? 3 : 1;
+    l.joints.push_back(std::move(x));
+  }
+  for (const ActuatorInfo& a : info.actuators) l.actuator_names.push_back(a.name);
+  l.mocap_body_names = sim.MocapBodyNames();
+  l.body_names = info.body_names;
+  for (int i = 0; i < sim.num_controllers(); ++i)
+    l.controller_names.push_back(sim.controller(i).type());
+  return h;
+}
+
+}  // namespace penumbra
