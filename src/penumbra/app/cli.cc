@@ -18,6 +18,7 @@
 #include "penumbra/app/bench.h"
 #include "penumbra/app/bench_record.h"
 #include "penumbra/app/contact_sheet.h"
+#include "penumbra/app/replay_command.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
@@ -291,6 +292,9 @@ int RunCli(int argc, char** argv) {
       bench_sensors, "--seconds", [&](double v) { sensor_bench.seconds = v; }, 0, true,
       "simulated seconds for the sensor overhead");
 
+  // penumbra replay (app/replay_command.h)
+  const ReplayCommand replay = AddReplayCommand(app);
+
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
   try {
@@ -329,6 +333,11 @@ int RunCli(int argc, char** argv) {
         return 128 + sig;
       }
       return 0;
+    }
+    if (replay.Selected()) {
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return replay.Run(Args(argc, argv), &g_stop_signal);
     }
     if (*bench_render) {
       render_bench.adversity = !no_adversity;

@@ -285,7 +285,10 @@ SensorSink::~SensorSink() { impl_->worker.Finish(); }
 
 bool SensorSink::empty() const { return impl_->configs.empty(); }
 
-void SensorSink::OnStart(const LoopStart& start) { impl_->worker.Start(start.report_error); }
+void SensorSink::OnStart(const LoopStart& start) {
+  impl_->schedule->StartAt(start.step);  // a loop from a later step (a replay): same indices
+  impl_->worker.Start(start.report_error);
+}
 
 SnapshotContent SensorSink::Wants(int64_t step, double) {
   Impl& s = *impl_;
