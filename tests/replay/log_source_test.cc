@@ -181,6 +181,7 @@ TEST_F(LogSourceTest, AnotherTimestepOrAMissingJointIsRefused) {
   // the rover left out: its joints are missing
   world = RecordedWorld(reader.header());
   world.models.erase(world.models.begin());
+  world.cameras.erase(world.cameras.begin());  // `front` rides on the rover
   Session no_rover(world, Replaying());
   try {
     LogSource source(&reader, &no_rover.sim());

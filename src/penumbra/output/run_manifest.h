@@ -14,8 +14,8 @@ namespace penumbra {
 /// what a replay (`penumbra replay`, replay/replay_runner.h) rendered, and how: run.json's
 /// "replay" object.
 struct ReplayManifest {
-  std::string log;   ///< the run log replayed, as given on the command line
-  std::string mode;  ///< "kinematic" (the log's states, no physics)
+  std::string log;                        ///< the run log replayed, as given on the command line
+  std::string mode;                       ///< "kinematic" (the log's states, no physics)
   int64_t first_step = 0, last_step = 0;  ///< the logged steps replayed
   /// the changes to the recorded conditions: the --world override file ("" = none) and the
   /// keys it replaced, --adversity ("" = as recorded), --tier ("" = as recorded), --cameras

@@ -73,8 +73,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
   std::vector<CameraSpec> selected;
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     if (!selected_[i]) continue;
-    writer_.AddCamera(scene.cameras[i].name, scene.cameras[i].intrinsics,
-                      scene.cameras[i].outputs);
+    writer_.AddCamera(scene.cameras[i].name, scene.cameras[i].intrinsics, scene.cameras[i].outputs);
     selected.push_back(scene.cameras[i]);
   }
   const std::vector<CameraSensorConfig> cfg = SensorConfigsFor(scene, world);
