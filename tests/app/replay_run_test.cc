@@ -198,14 +198,14 @@ TEST(ReplayRunTest, AnOverrideChangesAResolutionAndAddsACameraAlongTheLoggedPath
   testing::TempDir tmp;
   tmp.Write("ball.xml", R"(<mujoco model="ball"><option timestep="0.002"/><worldbody>
     <geom name="floor" type="plane" size="5 5 0.1"/>
-    <body name="ball" pos="0 0 1"><freejoint/><geom type="sphere" size="0.2"/></body>
+    <body name="ball" pos="0 0 1"><freejoint name="j"/><geom type="sphere" size="0.2"/></body>
     </worldbody><keyframe><key name="throw" qpos="0 0 1 1 0 0 0" qvel="1.5 0.5 2 0 3 1"/></keyframe></mujoco>)");
   const std::string world =
       tmp.Write("w.yaml",
                 "duration_sec: 1\n"
                 "models: [{name: s, file: ball.xml, initial_keyframe: throw}]\n"
                 "mjcf_cameras: {enabled: false}\n"
-                "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1]}]\n"
+                "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1], illuminance_lux: 50000}]\n"
                 "cameras:\n"
                 "  - {name: cam, attach: s/ball, width: 32, height: 24, rate_hz: 20}\n");
   const std::string log = (tmp.path() / "ball.plog").string();
@@ -219,7 +219,7 @@ TEST(ReplayRunTest, AnOverrideChangesAResolutionAndAddsACameraAlongTheLoggedPath
                 "  - {name: cam, attach: s/ball, width: 64, height: 48, rate_hz: 20}\n"
                 "  - {name: back, attach: s/ball, pose: {rpy_deg: [0, 0, 180]}, width: 40,\n"
                 "     height: 30, rate_hz: 10, outputs: [rgb, depth]}\n");
-  const fs::path out = tmp.path() / "rig";
+  const fs::path out = tmp.path() / "replayed";
   r = RunPenumbra({"replay", log, "--out", out.string(), "-q", "--world", rig}, tmp.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
 
