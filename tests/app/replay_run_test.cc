@@ -249,6 +249,18 @@ TEST(ReplayRunTest, AnOverrideChangesAResolutionAndAddsACameraAlongTheLoggedPath
   const std::string manifest = ReadAll(out / "run.json");
   EXPECT_NE(manifest.find("\"override_keys\": [\n      \"cameras\"\n    ]"), std::string::npos)
       << manifest;
+
+  // --cameras: only `back` is rendered, with the same frames as beside `cam`
+  const fs::path only = tmp.path() / "only_back";
+  r = RunPenumbra(
+      {"replay", log, "--out", only.string(), "-q", "--world", rig, "--cameras", "back"},
+      tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(only / "cam"));
+  EXPECT_EQ(ReadAll(only / "camera_info.json").find("\"cam\""), std::string::npos);
+  EXPECT_EQ(ReadAll(only / "back" / "frames.csv"), ReadAll(out / "back" / "frames.csv"));
+  for (const auto& [frame, row] : back)
+    EXPECT_TRUE(Png(only / "back", "rgb", frame) == Png(out / "back", "rgb", frame)) << frame;
 }
 
 TEST(ReplayRunTest, BadOptionsAndOverridesAreRefusedNamingThem) {
