@@ -101,9 +101,9 @@ TEST_F(RecordRunTest, RecordsEveryStepAndLeavesTheOtherOutputsUnchanged) {
 TEST_F(RecordRunTest, SigkillLeavesALogReadableToItsLastCompleteChunk) {
   const std::string world = World("", 60);
   const std::string log = (tmp_.path() / "killed.plog").string();
-  ChildProcess p({"run", world, "--out", (tmp_.path() / "out").string(), "-q", "--realtime",
-                  "--record", log},
-                 tmp_.path());
+  ChildProcess p(
+      {"run", world, "--out", (tmp_.path() / "out").string(), "-q", "--realtime", "--record", log},
+      tmp_.path());
   // two chunks of 256 steps are on disk, then the recorder dies mid-run
   ASSERT_TRUE(WaitForStep(log, 511)) << p.err();
   p.Signal(SIGKILL);
@@ -158,6 +158,51 @@ TEST_F(RecordRunTest, CtrlCClosesTheLogCompletely) {
   EXPECT_EQ(std::stoll(last.substr(0, last.find(','))), r.last_step());
 }
 
+TEST_F(RecordRunTest, RecordSensorsStoresTheBytesOfEveryImageAndSensorRow) {
+  const std::string world = World(
+      "sensors:\n  - {name: imu0, type: imu, body: scene/ball, preset: ideal, rate_hz: 100}\n",
+      0.2);
+  const fs::path out = tmp_.path() / "out";
+  const std::string log = (tmp_.path() / "s.plog").string();
+  auto a =
+      RunPenumbra({"run", world, "--out", out.string(), "-q", "--record", log, "--record-sensors"},
+                  tmp_.path());
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  RunLogReader r = RunLogReader::Open(log);
+  EXPECT_TRUE(r.header().has_sensor_records);
+  const std::vector<SensorRecord> recs = r.SensorRecords();
+  // camera at 20 Hz over [0, 0.2] s: frames 0..4, rgb and depth each; IMU at 100 Hz: 21 rows
+  int rgb = 0, depth = 0, imu = 0;
+  std::string imu_rows;
+  for (const SensorRecord& s : recs) {
+    if (s.sensor == "cam") {
+      const int64_t frame = s.step / 50;  // 1 ms steps, a frame every 50
+      EXPECT_EQ(s.step % 50, 0) << s.step;
+      char name[16];
+      std::snprintf(name, sizeof(name), "%06lld.png", static_cast<long long>(frame));
+      if (s.kind == "rgb.png") {
+        ++rgb;
+        EXPECT_EQ(s.payload, ReadAll(out / "cam" / "rgb" / name)) << name;
+      } else {
+        EXPECT_EQ(s.kind, "depth.png");
+        ++depth;
+        EXPECT_EQ(s.payload, ReadAll(out / "cam" / "depth" / name)) << name;
+      }
+    } else {
+      EXPECT_EQ(s.sensor, "imu0");
+      EXPECT_EQ(s.kind, "imu.csv");
+      ++imu;
+      imu_rows += s.payload;
+    }
+  }
+  EXPECT_EQ(rgb, 5);
+  EXPECT_EQ(depth, 5);
+  EXPECT_EQ(imu, 21);
+  const std::string csv = ReadAll(out / "imu" / "imu0.csv");
+  EXPECT_EQ(csv.substr(csv.find('\n') + 1), imu_rows);
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(out / "run.json")).at("record").at("sensor_records"), 31);
+}
+
 TEST_F(RecordRunTest, WorldFileRecordSectionWritesIntoTheOutputFolder) {
   const std::string world = World("record: {file: run.plog}\n");
   const fs::path out = tmp_.path() / "out";
@@ -182,9 +227,9 @@ TEST_F(RecordRunTest, BadRecordSettingsAreRefusedNamingTheirSource) {
   EXPECT_EQ(b.exit_code, 2);
   EXPECT_NE(b.err.find("w.yaml:7: record.file"), std::string::npos) << b.err;
 
-  auto c = RunPenumbra({"run", World(), "--out", (tmp_.path() / "o3").string(), "-q",
-                        "--record-sensors"},
-                       tmp_.path());
+  auto c = RunPenumbra(
+      {"run", World(), "--out", (tmp_.path() / "o3").string(), "-q", "--record-sensors"},
+      tmp_.path());
   EXPECT_EQ(c.exit_code, 2);
   EXPECT_NE(c.err.find("--record-sensors"), std::string::npos) << c.err;
 }

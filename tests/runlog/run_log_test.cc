@@ -400,8 +400,7 @@ TEST(RunLogTest, WriteErrorsAreReportedNotSwallowed) {
     RunLogWriter w("/dev/full", TestHeader());
     FAIL() << "writing to a full disk succeeded";
   } catch (const RunLogError& e) {
-    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
   }
   testing::TempDir tmp;
   EXPECT_THROW(RunLogWriter((tmp.path() / "no" / "such" / "x.plog").string(), TestHeader()),

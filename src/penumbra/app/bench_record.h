@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+#include "penumbra/runlog/run_log_writer.h"
+
 namespace CLI {
 class App;
 }
@@ -15,11 +17,12 @@ namespace penumbra {
 
 /// options of `penumbra bench record`.
 struct BenchRecordOptions {
-  std::string world_file;       ///< world to step (default: the bundled default world)
-  double round_seconds = 10;    ///< simulated seconds per timed round
-  int rounds = 3;               ///< A/B pairs (recording off, then on), >= 1
-  double size_seconds = 60;     ///< simulated seconds of the log whose size is reported
-  std::string log_dir;          ///< where the logs go ("" = the temporary folder); removed after
+  std::string world_file;     ///< world to step (default: the bundled default world)
+  double round_seconds = 10;  ///< simulated seconds per timed round
+  int rounds = 3;             ///< A/B pairs (recording off, then on), >= 1
+  double size_seconds = 60;   ///< simulated seconds of the log whose size is reported
+  std::string log_dir;        ///< where the logs go ("" = the temporary folder); removed after
+  int zstd_level = RunLogWriterOptions{}.zstd_level;  ///< the writer's compression level
 };
 
 /// the verb as registered on `penumbra bench`.

@@ -129,7 +129,8 @@ WorldConfig WithRunOptions(const WorldConfig& world_in, const RunOptions& option
     if (e.key().rfind("record.", 0) == 0 && !options.record_file.empty())
       throw ConfigError("", 0, "--record", e.problem());
     if (e.key() == "record.sensors" && options.record_sensors)
-      throw ConfigError("", 0, "--record-sensors", "needs --record FILE.plog (or world-file record.file)");
+      throw ConfigError("", 0, "--record-sensors",
+                        "needs --record FILE.plog (or world-file record.file)");
     throw;
   }
   return world;
@@ -140,7 +141,8 @@ WorldConfig WithRunOptions(const WorldConfig& world_in, const RunOptions& option
 std::string RecordPath(const WorldConfig& world, const RunOptions& options) {
   if (world.record.file.empty()) return "";
   std::filesystem::path p(world.record.file);
-  if (options.record_file.empty() && p.is_relative()) p = std::filesystem::path(world.output_dir) / p;
+  if (options.record_file.empty() && p.is_relative())
+    p = std::filesystem::path(world.output_dir) / p;
   return p.lexically_normal().string();
 }
 
@@ -248,10 +250,17 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   std::unique_ptr<RecorderSink> recorder;
   const std::string record_path = RecordPath(world, options);
   if (!record_path.empty()) {
-    RunLogHeader header = MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
+    RunLogHeader header =
+        MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
     header.has_sensor_records = world.record.sensors;
     recorder = std::make_unique<RecorderSink>(record_path, header);
-    if (world.record.sensors) sensor_log = &recorder->writer();
+    if (world.record.sensors) {
+      sensor_log = &recorder->writer();
+      sensors.set_on_output([log = sensor_log](const std::string& sensor, const std::string& kind,
+                                               int64_t step, double time_sec, std::string bytes) {
+        log->RecordSensor(SensorRecord{step, time_sec, sensor, kind, std::move(bytes)});
+      });
+    }
     spdlog::info("recording the run to {}", record_path);
   }
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {

@@ -27,8 +27,7 @@ std::vector<MjcfAssetFile> MjcfAssetFiles(const std::string& mjcf_text,
   if (root == nullptr) return out;
   for (const tinyxml2::XMLElement* sec = root->FirstChildElement("asset"); sec;
        sec = sec->NextSiblingElement("asset")) {
-    for (const tinyxml2::XMLElement* a = sec->FirstChildElement(); a;
-         a = a->NextSiblingElement()) {
+    for (const tinyxml2::XMLElement* a = sec->FirstChildElement(); a; a = a->NextSiblingElement()) {
       const std::string tag = a->Name();
       if (tag == "mesh" || tag == "skin" || tag == "hfield") {
         add(a->Name(), a->Attribute("file"));

@@ -5,11 +5,11 @@
 // Penumbra does not write, or any symbolic link, makes the run refuse (and is left alone).
 //
 // Penumbra's outputs (README "Outputs"): run.json, composed.xml, trajectory.csv,
-// camera_info.{yaml,json}, semantic_classes.json, run logs *.plog (--record); lidar/**/{index.csv,scan_*.pcd};
-// imu/**, sensors/**, ground_truth/** *.csv; camera folders (any other folder, nested for
-// "<model>/<camera>") holding intrinsics.json, frames.csv and image folders rgb, depth,
-// segmentation, range, normals, instance_segmentation, semantic_segmentation of NNNNNN.png;
-// and the temporary files a killed run can leave (core/output_file.h).
+// camera_info.{yaml,json}, semantic_classes.json, run logs *.plog (--record);
+// lidar/**/{index.csv,scan_*.pcd}; imu/**, sensors/**, ground_truth/** *.csv; camera folders
+// (any other folder, nested for "<model>/<camera>") holding intrinsics.json, frames.csv and image
+// folders rgb, depth, segmentation, range, normals, instance_segmentation, semantic_segmentation of
+// NNNNNN.png; and the temporary files a killed run can leave (core/output_file.h).
 
 #include <filesystem>
 #include <string>

@@ -12,7 +12,7 @@ namespace {
 constexpr size_t kRecord = 4 * 4 + 2 + 4;  // x y z intensity ring time
 }
 
-void WritePcd(const std::string& path, const std::vector<LidarPoint>& points) {
+std::string EncodePcd(const std::vector<LidarPoint>& points) {
   std::ostringstream h;
   h << "# .PCD v0.7 - Point Cloud Data file format\n"
     << "VERSION 0.7\nFIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\n"
@@ -29,7 +29,11 @@ void WritePcd(const std::string& path, const std::vector<LidarPoint>& points) {
     std::memcpy(p + 18, &q.time, 4);
     p += kRecord;
   }
-  WriteFileAtomic(path, h.str() + data);
+  return h.str() + data;
+}
+
+void WritePcd(const std::string& path, const std::vector<LidarPoint>& points) {
+  WriteFileAtomic(path, EncodePcd(points));
 }
 
 std::vector<LidarPoint> ReadPcd(const std::string& path) {

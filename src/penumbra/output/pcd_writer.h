@@ -10,6 +10,9 @@
 
 namespace penumbra {
 
+/// the bytes of a binary PCD v0.7 file of `points` (the format WritePcd writes).
+std::string EncodePcd(const std::vector<LidarPoint>& points);
+
 /// writes `points` as binary PCD v0.7 with fields x y z intensity (float32), ring (uint16),
 /// time (float32, s since the scan start); WIDTH = number of points, HEIGHT = 1.
 /// @throws Error if the file cannot be written.

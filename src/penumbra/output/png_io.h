@@ -41,12 +41,12 @@ std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptio
 /// truncated PNG. returns the bytes written.
 /// @throws Error naming `path` and the reason (bad image, cannot open, short write).
 std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
-                  const PngEncodeOptions& options = {});
+                                  const PngEncodeOptions& options = {});
 
 /// writes EncodePngGray16(image) to `path` as WritePngRgb8 does; returns the bytes written.
 /// @throws Error naming `path` and the reason.
 std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
-                    const PngEncodeOptions& options = {});
+                                    const PngEncodeOptions& options = {});
 
 /// a decoded PNG: samples as stored in the file (palette images are expanded to
 /// RGB, greyscale below 8 bits to 8 bits; 16-bit samples are kept exact).

@@ -28,12 +28,14 @@ LidarScanWriter::LidarScanWriter(const fs::path& out, const std::string& name)
       "particle_returns\n");
 }
 
-void LidarScanWriter::Write(const SensorFiring& f, const LidarScan& scan) {
+std::string LidarScanWriter::Write(const SensorFiring& f, const LidarScan& scan) {
   const std::string file = fmt::format("scan_{:06d}.pcd", f.index);
-  WritePcd((dir_ / file).string(), scan.points);
+  std::string pcd = EncodePcd(scan.points);
+  WriteFileAtomic(dir_ / file, pcd);
   index_.Append(fmt::format("{},{:.9f},{:.9f},{},{},{},{}\n", f.index, f.capture_time_sec,
                             f.delivery_time_sec, file, scan.points.size(), scan.medium_returns,
                             scan.particle_returns));
+  return pcd;
 }
 
 ImuCsvWriter::ImuCsvWriter(const fs::path& out, const std::string& name)
@@ -43,11 +45,13 @@ ImuCsvWriter::ImuCsvWriter(const fs::path& out, const std::string& name)
       "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n");
 }
 
-void ImuCsvWriter::Write(const SensorFiring& f, const ImuSample& o) {
-  csv_.Append(fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
-                          f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(),
-                          o.accel_m_s2.y(), o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(),
-                          o.gyro_rad_s.z()));
+std::string ImuCsvWriter::Write(const SensorFiring& f, const ImuSample& o) {
+  std::string row =
+      fmt::format("{},{:.9f},{:.9f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", f.index,
+                  f.capture_time_sec, f.delivery_time_sec, o.accel_m_s2.x(), o.accel_m_s2.y(),
+                  o.accel_m_s2.z(), o.gyro_rad_s.x(), o.gyro_rad_s.y(), o.gyro_rad_s.z());
+  csv_.Append(row);
+  return row;
 }
 
 MujocoSensorCsvWriter::MujocoSensorCsvWriter(const fs::path& out, const std::string& name,
@@ -58,12 +62,13 @@ MujocoSensorCsvWriter::MujocoSensorCsvWriter(const fs::path& out, const std::str
   csv_.Append(header + "\n");
 }
 
-void MujocoSensorCsvWriter::Write(const SensorFiring& f, const std::vector<double>& values) {
+std::string MujocoSensorCsvWriter::Write(const SensorFiring& f, const std::vector<double>& values) {
   std::string row =
       fmt::format("{},{:.9f},{:.9f}", f.index, f.capture_time_sec, f.delivery_time_sec);
   for (double v : values) fmt::format_to(std::back_inserter(row), ",{:.9g}", v);
   row += '\n';
   csv_.Append(row);
+  return row;
 }
 
 GroundTruthCsvWriter::GroundTruthCsvWriter(const fs::path& out, const std::string& name,

@@ -37,9 +37,9 @@ class LidarScanWriter {
   /// creates <out>/lidar/<name>/ and its index.csv header.
   /// @throws Error naming the path if it cannot be created.
   LidarScanWriter(const std::filesystem::path& out, const std::string& name);
-  /// writes scan_<firing.index>.pcd and its index.csv row.
+  /// writes scan_<firing.index>.pcd and its index.csv row; returns the PCD file's bytes.
   /// @throws Error naming the file that could not be written.
-  void Write(const SensorFiring& firing, const LidarScan& scan);
+  std::string Write(const SensorFiring& firing, const LidarScan& scan);
   /// writes the buffered rows and closes index.csv. @throws Error as Write.
   void Close() { index_.Close(); }
 
@@ -54,8 +54,9 @@ class ImuCsvWriter {
   ImuCsvWriter() = default;
   /// creates <out>/imu/<name>.csv with its header. @throws Error as LidarScanWriter.
   ImuCsvWriter(const std::filesystem::path& out, const std::string& name);
-  /// appends the row of sample `firing.index`. @throws Error if the write fails.
-  void Write(const SensorFiring& firing, const ImuSample& sample);
+  /// appends the row of sample `firing.index`; returns the row (with '\n').
+  /// @throws Error if the write fails.
+  std::string Write(const SensorFiring& firing, const ImuSample& sample);
   void Close() { csv_.Close(); }
 
  private:
@@ -70,9 +71,9 @@ class MujocoSensorCsvWriter {
   /// @throws Error as LidarScanWriter.
   MujocoSensorCsvWriter(const std::filesystem::path& out, const std::string& name,
                         const std::vector<std::string>& columns);
-  /// appends the row of sample `firing.index` (one value per column).
-  /// @throws Error if the write fails.
-  void Write(const SensorFiring& firing, const std::vector<double>& values);
+  /// appends the row of sample `firing.index` (one value per column); returns the row (with
+  /// '\n'). @throws Error if the write fails.
+  std::string Write(const SensorFiring& firing, const std::vector<double>& values);
   void Close() { csv_.Close(); }
 
  private:

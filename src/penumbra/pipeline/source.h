@@ -14,7 +14,7 @@ namespace penumbra {
 /// how much of a WorldSnapshot a consumer reads; ordered from least to most (a richer content
 /// holds everything of a poorer one).
 enum class SnapshotContent {
-  kNone = 0,   ///< no snapshot at this step
+  kNone = 0,  ///< no snapshot at this step
   /// time_sec, step, qpos, qvel and, from live physics, the rest of the simulation state
   /// (act, ctrl, qacc_warmstart, applied forces, mocap poses, userdata, controllers' schedule:
   /// WorldSnapshot) (trajectory rows, recorders)

@@ -62,8 +62,8 @@ void DecodeField(BodyReader* in, const std::vector<T>* prev, const char* name,
   if (enc != kFieldXor && enc != kFieldPlain)
     in->Fail(fmt::format("field {}: unknown encoding {}", name, enc));
   if (enc == kFieldXor && (!prev || prev->size() != n))
-    in->Fail(fmt::format("field {}: XOR encoding without a previous record of {} entries", name,
-                         n));
+    in->Fail(
+        fmt::format("field {}: XOR encoding without a previous record of {} entries", name, n));
   const std::string_view data = in->Bytes(uint64_t{8} * n);
   out->resize(n);
   for (size_t i = 0; i < n; ++i) {
@@ -146,8 +146,8 @@ std::string ZstdDecompress(std::string_view stored, uint64_t raw_size) {
   const unsigned long long content = ZSTD_getFrameContentSize(stored.data(), stored.size());
   if (content == ZSTD_CONTENTSIZE_ERROR) throw RunLogError("body is not a zstd frame");
   if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != raw_size)
-    throw RunLogError(fmt::format("zstd frame holds {} bytes, the chunk header says {}", content,
-                                  raw_size));
+    throw RunLogError(
+        fmt::format("zstd frame holds {} bytes, the chunk header says {}", content, raw_size));
   std::string out(raw_size, '\0');
   const size_t n = ZSTD_decompress(out.data(), out.size(), stored.data(), stored.size());
   if (ZSTD_isError(n))

@@ -30,9 +30,9 @@ inline constexpr char kChunkMagic[4] = {'P', 'C', 'H', 'K'};
 inline constexpr uint32_t kCodecNone = 0;
 inline constexpr uint32_t kCodecZstd = 1;
 /// field encodings of a step record (docs/run-log.md "Steps chunk").
-inline constexpr uint8_t kFieldZero = 0;  ///< n entries, all +0.0 (or 0); no data follows
-inline constexpr uint8_t kFieldXor = 1;   ///< n words, each XORed with the previous record's
-inline constexpr uint8_t kFieldPlain = 2; ///< n words as they are
+inline constexpr uint8_t kFieldZero = 0;   ///< n entries, all +0.0 (or 0); no data follows
+inline constexpr uint8_t kFieldXor = 1;    ///< n words, each XORed with the previous record's
+inline constexpr uint8_t kFieldPlain = 2;  ///< n words as they are
 
 /// a chunk header as stored (RunLogChunkInfo less the file offset, plus the codec).
 struct ChunkHeader {

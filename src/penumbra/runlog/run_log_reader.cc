@@ -1,7 +1,6 @@
 #include "penumbra/runlog/run_log_reader.h"
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cstring>
@@ -40,8 +39,8 @@ struct RunLogReader::Impl {
   uint64_t file_size = 0;
   RunLogHeader header;
   std::vector<RunLogChunkInfo> chunks;
-  std::vector<uint32_t> codecs;       // by position in chunks
-  std::vector<size_t> step_chunks;    // positions in chunks of the steps chunks
+  std::vector<uint32_t> codecs;     // by position in chunks
+  std::vector<size_t> step_chunks;  // positions in chunks of the steps chunks
   bool complete = false;
   std::optional<std::string> damage;
   int64_t num_steps = 0, first_step = -1, last_step = -1;
@@ -80,10 +79,9 @@ struct RunLogReader::Impl {
   std::string Body(size_t pos) {
     const RunLogChunkInfo& c = chunks[pos];
     std::string stored;
-    if (!ReadAt(c.file_offset + kChunkHeaderBytes, c.compressed_size + kChunkTrailerBytes,
-                &stored))
-      throw RunLogError(fmt::format("{}: {} can no longer be read (the file shrank)", path,
-                                    ChunkName(c)));
+    if (!ReadAt(c.file_offset + kChunkHeaderBytes, c.compressed_size + kChunkTrailerBytes, &stored))
+      throw RunLogError(
+          fmt::format("{}: {} can no longer be read (the file shrank)", path, ChunkName(c)));
     uint32_t crc;
     std::memcpy(&crc, stored.data() + c.compressed_size, 4);
     stored.resize(c.compressed_size);
@@ -159,9 +157,8 @@ void RunLogReader::Impl::ReadPreambleAndHeader() {
                                 file_size - kPreambleBytes, kChunkHeaderBytes));
   ChunkHeader h;
   const std::string bad = DecodeChunkHeader(reinterpret_cast<const uint8_t*>(hb.data()), &h);
-  const bool readable =
-      std::find(kRunLogReadableVersions.begin(), kRunLogReadableVersions.end(), version) !=
-      kRunLogReadableVersions.end();
+  const bool readable = std::find(kRunLogReadableVersions.begin(), kRunLogReadableVersions.end(),
+                                  version) != kRunLogReadableVersions.end();
   std::string text;
   std::string header_error = bad;
   if (header_error.empty() && (h.kind != RunLogChunkKind::kHeader || h.index != 0))
@@ -230,8 +227,8 @@ void RunLogReader::Impl::ReadPreambleAndHeader() {
 }
 
 void RunLogReader::Impl::ScanChunks() {
-  uint64_t offset = chunks[0].file_offset + kChunkHeaderBytes + chunks[0].compressed_size +
-                    kChunkTrailerBytes;
+  uint64_t offset =
+      chunks[0].file_offset + kChunkHeaderBytes + chunks[0].compressed_size + kChunkTrailerBytes;
   uint64_t expected = 1;
   bool end_seen = false;
   std::string why;
@@ -272,8 +269,8 @@ void RunLogReader::Impl::ScanChunks() {
     const uint64_t need = h.stored_size + kChunkTrailerBytes;
     const uint64_t left = file_size - offset - kChunkHeaderBytes;
     if (need > left) {
-      why = fmt::format("{} is cut off: the file ends {} bytes into its {}-byte body and CRC",
-                        name, left, need);
+      why = fmt::format("{} is cut off: the file ends {} bytes into its {}-byte body and CRC", name,
+                        left, need);
       break;
     }
     ReadAt(offset + kChunkHeaderBytes, need, &body);
@@ -311,7 +308,6 @@ void RunLogReader::Impl::ScanChunks() {
   const std::string msg =
       fmt::format("log ends at chunk {} ({}): {}", chunks.back().index, step, why);
   if (mode == RunLogReadMode::kStrict) throw RunLogError(fmt::format("{}: {}", path, msg));
-  spdlog::warn("run log {}: {}; reading up to there", path, msg);
   damage = msg;
 }
 
@@ -346,9 +342,9 @@ int64_t RunLogReader::last_step() const { return impl_->last_step; }
 bool RunLogReader::SeekStep(int64_t step) {
   Impl& m = *impl_;
   // the first steps chunk whose last step is >= step
-  const auto it = std::lower_bound(
-      m.step_chunks.begin(), m.step_chunks.end(), step,
-      [&](size_t pos, int64_t s) { return m.chunks[pos].last_step < s; });
+  const auto it =
+      std::lower_bound(m.step_chunks.begin(), m.step_chunks.end(), step,
+                       [&](size_t pos, int64_t s) { return m.chunks[pos].last_step < s; });
   m.step_chunk = static_cast<size_t>(it - m.step_chunks.begin());
   m.steps.clear();
   m.step_pos = 0;

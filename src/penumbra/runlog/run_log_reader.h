@@ -24,7 +24,7 @@ enum class RunLogReadMode {
   /// chunk index.
   kStrict,
   /// the log is read up to the last complete, CRC-valid chunk; damage() describes the rest
-  /// (replay uses this and warns).
+  /// (the reader logs nothing: its user warns with damage(), as replay does).
   kRecover,
 };
 

@@ -55,12 +55,11 @@ struct OpenChunk {
   }
 };
 
-void CheckSize(const std::string& path, int64_t step, const char* field, size_t got,
-               int expected) {
+void CheckSize(const std::string& path, int64_t step, const char* field, size_t got, int expected) {
   if (got != static_cast<size_t>(expected))
-    throw RunLogError(fmt::format(
-        "run log {}: step {}: {} has {} entries; the header's layout says {}", path, step, field,
-        got, expected));
+    throw RunLogError(
+        fmt::format("run log {}: step {}: {} has {} entries; the header's layout says {}", path,
+                    step, field, got, expected));
 }
 
 }  // namespace
@@ -71,8 +70,7 @@ void RunLogWriterOptions::ValidateOrThrow() const {
                       fmt::format("{} is not a step count; expected >= 1", chunk_steps));
   if (chunk_bytes < 1) throw ConfigError("", 0, "record.chunk_bytes", "0; expected >= 1");
   if (zstd_level < 1 || zstd_level > 19)
-    throw ConfigError("", 0, "record.zstd_level",
-                      fmt::format("{}; expected 1 to 19", zstd_level));
+    throw ConfigError("", 0, "record.zstd_level", fmt::format("{}; expected 1 to 19", zstd_level));
   if (max_pending_chunks < 1)
     throw ConfigError("", 0, "record.max_pending_chunks", "0; expected >= 1");
 }

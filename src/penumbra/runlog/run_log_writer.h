@@ -23,7 +23,7 @@ struct RunLogWriterOptions {
   /// time, so a killed process loses at most the records since the last steps chunk.
   size_t chunk_bytes = size_t{1} << 20;
   /// zstd compression level (1..19).
-  int zstd_level = 3;
+  int zstd_level = 1;
   /// chunks waiting for the writer thread before Append blocks (back-pressure), >= 1.
   size_t max_pending_chunks = 16;
 

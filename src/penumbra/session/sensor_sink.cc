@@ -129,6 +129,7 @@ struct SensorSink::Impl {
   std::vector<GroundTruth> truths;
   std::vector<std::string> body_names;
   std::unique_ptr<RayQuery> ray_scene;
+  SensorOutputCallback on_output;
   // loop thread
   std::vector<SensorFiring> due;
   int64_t due_step = -1;
@@ -155,7 +156,8 @@ struct SensorSink::Impl {
     };
     LidarScan scan;
     l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
-    l.out.Write(l.start_firing, scan);
+    std::string pcd = l.out.Write(l.start_firing, scan);
+    if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -285,6 +287,10 @@ SensorSink::~SensorSink() { impl_->worker.Finish(); }
 
 bool SensorSink::empty() const { return impl_->configs.empty(); }
 
+void SensorSink::set_on_output(SensorOutputCallback on_output) {
+  impl_->on_output = std::move(on_output);
+}
+
 void SensorSink::OnStart(const LoopStart& start) {
   impl_->schedule->StartAt(start.step);  // a loop from a later step (a replay): same indices
   impl_->worker.Start(start.report_error);
@@ -344,7 +350,9 @@ void SensorSink::Impl::Process(
       ImuSample truth;
       truth.accel_m_s2 = {a[0], a[1], a[2]};
       truth.gyro_rad_s = {w[0], w[1], w[2]};
-      m.out.Write(f, m.noise->Apply(f.index, truth));
+      std::string row = m.out.Write(f, m.noise->Apply(f.index, truth));
+      if (s.on_output)
+        s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
       s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else if (e.kind == 2) {
@@ -354,7 +362,9 @@ void SensorSink::Impl::Process(
       Rng rng(HashKeys(m.stream, static_cast<uint64_t>(f.index)));
       if (m.stddev > 0)
         for (double& v : m.values) v += m.stddev * StandardNormal(&rng);
-      m.out.Write(f, m.values);
+      std::string row = m.out.Write(f, m.values);
+      if (s.on_output)
+        s.on_output(m.cfg->name, "sensor.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
       s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
     } else {

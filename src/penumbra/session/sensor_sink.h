@@ -45,6 +45,14 @@ namespace penumbra {
 using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
     const WorldSnapshot& snapshot, const Eigen::Vector3d& p_W)>;
 
+/// receives each output a sensor wrote: the sensor's name, the kind ("points.pcd" for a LiDAR
+/// scan, "imu.csv" / "sensor.csv" for a row of an IMU / MuJoCo sensor stream), the physics step
+/// and sim time of its capture, and the bytes written (the PCD file, the CSV row with '\n').
+/// called on the sensor sink's thread, in step order. ground truth is not passed on (it is a
+/// function of the simulation state).
+using SensorOutputCallback = std::function<void(const std::string& sensor, const std::string& kind,
+                                                int64_t step, double time_sec, std::string bytes)>;
+
 /// all world-file sensors of one run.
 class SensorSink : public Sink {
  public:
@@ -56,6 +64,10 @@ class SensorSink : public Sink {
   SensorSink(const WorldConfig& world, const Simulation& sim, const SceneDescription& scene,
              const std::string& out_dir, SensorEffectsAt effects_at = {});
   ~SensorSink() override;
+
+  /// `on_output` receives every sensor output written from now on (set before the loop
+  /// starts; e.g. a run log's sensor records); empty = none. the files do not change.
+  void set_on_output(SensorOutputCallback on_output);
 
   /// true when the world has no sensors.
   bool empty() const;
