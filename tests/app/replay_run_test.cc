@@ -299,6 +299,11 @@ TEST(ReplayRunTest, BadOptionsAndOverridesAreRefusedNamingThem) {
   r = RunPenumbra({"replay", log, "--resimulate", "--out", out.string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--out: does not apply to --resimulate"), std::string::npos) << r.err;
+  // the output folder of the recording holds the log: --force would remove it
+  r = RunPenumbra({"replay", log, "--out", tmp.str(), "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("holds the log being replayed"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(log));
   r = RunPenumbra({"replay", world, "--out", out.string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(world), std::string::npos) << r.err;

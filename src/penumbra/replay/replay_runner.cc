@@ -91,6 +91,17 @@ ReplaySummary ReplayLog(const ReplayOptions& options) {
                       fmt::format("{:.6g} s is not before --to {:.6g} s; expected from < to",
                                   *options.from_sec, *options.to_sec));
 
+  {
+    // --force empties the output folder: never the one that holds the log being replayed
+    std::error_code ec;
+    const fs::path log = fs::weakly_canonical(options.log_path, ec);
+    const fs::path out = fs::weakly_canonical(options.out_dir, ec);
+    const std::string rel = log.lexically_relative(out).string();
+    if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
+      throw ConfigError("", 0, "--out",
+                        "'" + options.out_dir + "' holds the log being replayed (" +
+                            options.log_path + "); expected another output folder");
+  }
   RunLogReader reader = RunLogReader::Open(options.log_path, RunLogReadMode::kRecover);
   const RunLogHeader& header = reader.header();
   std::vector<std::string> warnings;
