@@ -200,14 +200,14 @@ TEST(ReplayRunTest, AnOverrideChangesAResolutionAndAddsACameraAlongTheLoggedPath
     <geom name="floor" type="plane" size="5 5 0.1"/>
     <body name="ball" pos="0 0 1"><freejoint name="j"/><geom type="sphere" size="0.2"/></body>
     </worldbody><keyframe><key name="throw" qpos="0 0 1 1 0 0 0" qvel="1.5 0.5 2 0 3 1"/></keyframe></mujoco>)");
-  const std::string world =
-      tmp.Write("w.yaml",
-                "duration_sec: 1\n"
-                "models: [{name: s, file: ball.xml, initial_keyframe: throw}]\n"
-                "mjcf_cameras: {enabled: false}\n"
-                "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1], illuminance_lux: 50000}]\n"
-                "cameras:\n"
-                "  - {name: cam, attach: s/ball, width: 32, height: 24, rate_hz: 20}\n");
+  const std::string world = tmp.Write(
+      "w.yaml",
+      "duration_sec: 1\n"
+      "models: [{name: s, file: ball.xml, initial_keyframe: throw}]\n"
+      "mjcf_cameras: {enabled: false}\n"
+      "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1], illuminance_lux: 50000}]\n"
+      "cameras:\n"
+      "  - {name: cam, attach: s/ball, width: 32, height: 24, rate_hz: 20}\n");
   const std::string log = (tmp.path() / "ball.plog").string();
   const fs::path run = tmp.path() / "run";
   auto r = RunPenumbra({"run", world, "--out", run.string(), "-q", "--record", log}, tmp.path());
@@ -307,6 +307,40 @@ TEST(ReplayRunTest, BadOptionsAndOverridesAreRefusedNamingThem) {
   r = RunPenumbra({"replay", world, "--out", out.string()}, tmp.path());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(world), std::string::npos) << r.err;
+}
+
+// a log cut short (as by SIGKILL of the recorder) replays up to its last complete chunk, with a
+// warning naming where it ends, also in run.json
+TEST(ReplayRunTest, ACutLogReplaysToItsLastCompleteChunk) {
+  testing::TempDir tmp;
+  tmp.Write("ball.xml", R"(<mujoco><worldbody><geom type="plane" size="2 2 0.1"/>
+    <body pos="0 0 1"><freejoint/><geom type="sphere" size="0.1"/></body></worldbody></mujoco>)");
+  const std::string world =
+      tmp.Write("w.yaml",
+                "duration_sec: 2\nmodels: [{name: s, file: ball.xml}]\n"
+                "cameras: [{name: cam, pose: {xyz: [-2, 0, 0.5]}, width: 16, height: 12, "
+                "rate_hz: 10}]\nmjcf_cameras: {enabled: false}\n");
+  const std::string log = (tmp.path() / "b.plog").string();
+  const fs::path run = tmp.path() / "run";
+  auto r = RunPenumbra({"run", world, "--out", run.string(), "-q", "--record", log}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // the last 40 % of the file gone: the steps of its last chunks with it
+  fs::resize_file(log, fs::file_size(log) * 6 / 10);
+  const fs::path out = tmp.path() / "cut";
+  r = RunPenumbra({"replay", log, "--out", out.string(), "-q"}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("log ends at chunk "), std::string::npos) << r.err;
+  const std::map<int64_t, std::string> recorded = FramesCsv(run / "cam");
+  const std::map<int64_t, std::string> replayed = FramesCsv(out / "cam");
+  ASSERT_EQ(recorded.size(), 21u);
+  ASSERT_GT(replayed.size(), 0u);
+  EXPECT_LT(replayed.size(), recorded.size());
+  for (const auto& [frame, row] : replayed) {
+    EXPECT_EQ(row, recorded.at(frame));
+    EXPECT_TRUE(Png(out / "cam", "rgb", frame) == Png(run / "cam", "rgb", frame)) << frame;
+  }
+  const std::string manifest = ReadAll(out / "run.json");
+  EXPECT_NE(manifest.find("log ends at chunk "), std::string::npos) << manifest;
 }
 
 }  // namespace
