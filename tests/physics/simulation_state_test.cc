@@ -130,3 +130,43 @@ TEST(SimulationState, AStateOfAnotherModelIsRefusedNamingTheField) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// two mocap bodies, one of them driven: the kinematic replay's tools (SetState of a recorded
+// state, then ApplyMocapDrivers for the driven bodies the recording lacks)
+TEST(SimulationState, ApplyMocapDriversPosesOnlyTheListedDrivenBodies) {
+  Simulation sim = Simulation::LoadFromString(R"(
+    <mujoco><worldbody>
+      <body name="a" mocap="true" pos="1 0 0"><geom size="0.1"/></body>
+      <body name="b" mocap="true" pos="2 0 0"><geom size="0.1"/></body>
+      <body><freejoint/><geom size="0.1"/></body>
+    </worldbody></mujoco>)");
+  EXPECT_EQ(sim.MocapBodyNames(), (std::vector<std::string>{"a", "b"}));
+  sim.AddMocapDriver("b", [](double t) {
+    Pose X = Pose::Identity();
+    X.translation() = Eigen::Vector3d(5 + t, 0, 0);
+    return X;
+  });
+  SimState s = sim.GetState();
+  s.step_count = 100;
+  s.time_sec = SimTimeOfStep(100, sim.timestep());
+  s.mocap_pos = {7, 7, 7, 8, 8, 8};
+  sim.SetState(s);
+  // SetState alone keeps the given poses
+  EXPECT_EQ(sim.GetState().mocap_pos, (std::vector<double>{7, 7, 7, 8, 8, 8}));
+  // "a" has no driver: listed or not it keeps its pose; "b" is posed for t only when listed
+  const std::vector<int> only_a = {0};
+  sim.ApplyMocapDrivers(only_a);
+  EXPECT_EQ(sim.GetState().mocap_pos, (std::vector<double>{7, 7, 7, 8, 8, 8}));
+  const std::vector<int> both = {0, 1};
+  sim.ApplyMocapDrivers(both);
+  EXPECT_EQ(sim.GetState().mocap_pos, (std::vector<double>{7, 7, 7, 5 + sim.time(), 0, 0}));
+  EXPECT_EQ(sim.Snapshot().X_WB[2].translation(), Eigen::Vector3d(5 + sim.time(), 0, 0));
+  const std::vector<int> bad = {2};
+  EXPECT_THROW(sim.ApplyMocapDrivers(bad), Error);
+}
+
+}  // namespace
+}  // namespace penumbra

@@ -127,5 +127,45 @@ TEST(SensorScheduleTest, AJumpOverManyStepsSkipsArithmetically) {
   EXPECT_EQ(due[0].index, 250000001);
 }
 
+// a loop that starts at a later step (a replay from --from) fires what a run from step 0 fires
+// from that step on, with the same indices and capture times
+TEST(SensorScheduleTest, StartAtFiresAsARunFromStepZeroFromThatStepOn) {
+  for (double dt : {0.002, 0.0015, 0.003}) {
+    const double rates[] = {10, 30, 7.3, 1000};  // 1000 Hz: above the physics rate (every step)
+    for (int64_t start : {int64_t{1}, int64_t{9000}, int64_t{4567}, int64_t{6001}}) {
+      SensorSchedule full(dt), late(dt);
+      for (double r : rates) {
+        full.Add("s", r);
+        late.Add("s", r);
+      }
+      late.StartAt(start);
+      std::vector<SensorFiring> a, b;
+      for (int64_t n = 0; n < start + 800; ++n) {
+        std::vector<SensorFiring> due;
+        full.Due(n, &due);
+        if (n >= start) a.insert(a.end(), due.begin(), due.end());
+        if (n >= start) late.Due(n, &b);
+      }
+      ASSERT_EQ(a.size(), b.size()) << "dt " << dt << " start " << start;
+      ASSERT_FALSE(a.empty());
+      for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].sensor, b[i].sensor);
+        EXPECT_EQ(a[i].index, b[i].index);
+        EXPECT_EQ(a[i].capture_time_sec, b[i].capture_time_sec);
+        EXPECT_EQ(a[i].nominal_time_sec, b[i].nominal_time_sec);
+      }
+    }
+  }
+  // StartAt(0) leaves a fresh schedule as it is; a negative step is refused
+  SensorSchedule s(0.002);
+  s.Add("s", 10);
+  s.StartAt(0);
+  std::vector<SensorFiring> due;
+  s.Due(0, &due);
+  ASSERT_EQ(due.size(), 1u);
+  EXPECT_EQ(due[0].index, 0);
+  EXPECT_THROW(s.StartAt(-1), Error);
+}
+
 }  // namespace
 }  // namespace penumbra

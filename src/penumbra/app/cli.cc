@@ -20,6 +20,7 @@
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
+#include "penumbra/app/replay_command.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
@@ -297,6 +298,8 @@ int RunCli(int argc, char** argv) {
   const EvalCommand eval = AddEvalCommand(app);
   // penumbra export (app/export_command.h)
   const ExportCommand export_command = AddExportCommand(app);
+  // penumbra replay (app/replay_command.h)
+  const ReplayCommand replay = AddReplayCommand(app);
 
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
@@ -336,6 +339,11 @@ int RunCli(int argc, char** argv) {
         return 128 + sig;
       }
       return 0;
+    }
+    if (replay.Selected()) {
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return replay.Run(Args(argc, argv), &g_stop_signal);
     }
     if (*bench_render) {
       render_bench.adversity = !no_adversity;

@@ -46,6 +46,22 @@ std::string RunManifestJson(const RunManifest& m) {
     r["sensor_records"] = m.record_sensor_records;
     j["record"] = r;
   }
+  if (m.replay) {
+    const ReplayManifest& r = *m.replay;
+    nlohmann::ordered_json rj;
+    rj["log"] = r.log;
+    rj["mode"] = r.mode;
+    rj["first_step"] = r.first_step;
+    rj["last_step"] = r.last_step;
+    rj["world_override"] = r.world_override;
+    rj["override_keys"] = r.override_keys;
+    rj["adversity"] = r.adversity;
+    rj["tier"] = r.tier;
+    rj["cameras"] = r.cameras;
+    rj["outputs"] = r.outputs;
+    rj["warnings"] = r.warnings;
+    j["replay"] = rj;
+  }
   return j.dump(2) + "\n";
 }
 

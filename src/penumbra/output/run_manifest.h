@@ -5,10 +5,31 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace penumbra {
+
+/// what a replay (`penumbra replay`, replay/replay_runner.h) rendered, and how: run.json's
+/// "replay" object.
+struct ReplayManifest {
+  std::string log;                        ///< the run log replayed, as given on the command line
+  std::string mode;                       ///< "kinematic" (the log's states, no physics)
+  int64_t first_step = 0, last_step = 0;  ///< the logged steps replayed
+  /// the changes to the recorded conditions: the --world override file ("" = none) and the
+  /// keys it replaced, --adversity ("" = as recorded), --tier ("" = as recorded), --cameras
+  /// (empty = all), --outputs ("" = as recorded).
+  std::string world_override;
+  std::vector<std::string> override_keys;
+  std::string adversity;
+  std::string tier;
+  std::vector<std::string> cameras;
+  std::string outputs;
+  /// warnings about the log or its assets (a damaged log, a model file changed since it was
+  /// recorded), in the order they were found.
+  std::vector<std::string> warnings;
+};
 
 /// contents of run.json. the file lists the keys in this order (stable across runs);
 /// maps are sorted by key.
@@ -42,6 +63,8 @@ struct RunManifest {
   /// the run's first error (e.g. divergence, a file that could not be written); the key
   /// "error" is written only when it is not empty, after "peak_resident_memory_mib".
   std::string error;
+  /// set for a replay: the key "replay" is written last, only then.
+  std::optional<ReplayManifest> replay;
 };
 
 /// the manifest as pretty-printed JSON text (2-space indent, trailing newline).

@@ -349,15 +349,16 @@ struct Simulation::Impl {
 
   // poses every driven mocap body for sim time t
   void ApplyMocapDrivers(double t) {
-    for (const MocapDriver& md : mocap_drivers) {
-      const Pose X = md.X_WB(t);
-      const Eigen::Quaterniond q(X.linear());
-      for (int k = 0; k < 3; ++k) d->mocap_pos[3 * md.mocap_id + k] = X.translation()[k];
-      d->mocap_quat[4 * md.mocap_id + 0] = q.w();
-      d->mocap_quat[4 * md.mocap_id + 1] = q.x();
-      d->mocap_quat[4 * md.mocap_id + 2] = q.y();
-      d->mocap_quat[4 * md.mocap_id + 3] = q.z();
-    }
+    for (const MocapDriver& md : mocap_drivers) ApplyMocapDriver(md, t);
+  }
+  void ApplyMocapDriver(const MocapDriver& md, double t) {
+    const Pose X = md.X_WB(t);
+    const Eigen::Quaterniond q(X.linear());
+    for (int k = 0; k < 3; ++k) d->mocap_pos[3 * md.mocap_id + k] = X.translation()[k];
+    d->mocap_quat[4 * md.mocap_id + 0] = q.w();
+    d->mocap_quat[4 * md.mocap_id + 1] = q.x();
+    d->mocap_quat[4 * md.mocap_id + 2] = q.y();
+    d->mocap_quat[4 * md.mocap_id + 3] = q.z();
   }
 
   void CheckWarnings(double t, int64_t step) {
@@ -666,6 +667,18 @@ void Simulation::SetState(const SimState& s) {
   impl.steps = s.step_count;
   impl.failed = false;
   impl.failure.clear();
+}
+
+void Simulation::ApplyMocapDrivers(std::span<const int> mocap_ids) {
+  Impl& impl = *impl_;
+  const double t = impl.d->time;
+  for (const int id : mocap_ids) {
+    if (id < 0 || id >= impl.m->nmocap)
+      throw Error(impl.source + ": ApplyMocapDrivers: mocap id " + std::to_string(id) +
+                  " is outside [0, " + std::to_string(impl.m->nmocap) + ")");
+    for (const Impl::MocapDriver& md : impl.mocap_drivers)
+      if (md.mocap_id == id) impl.ApplyMocapDriver(md, t);
+  }
 }
 
 void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix,

@@ -122,6 +122,13 @@ class Simulation {
   ///         time_sec is not SimTimeOfStep(step_count, timestep()); the state is unchanged then.
   void SetState(const SimState& state);
 
+  /// poses the mocap bodies among `mocap_ids` (mocap ids, see MocapBodyNames) that have a
+  /// driver (AddMocapDriver) for the current time(), as Step() does for all of them; ids
+  /// without a driver are left alone. a kinematic replay uses it after SetState of a recorded
+  /// state to move the driven bodies the recording does not hold.
+  /// @throws Error for an id outside [0, number of mocap bodies).
+  void ApplyMocapDrivers(std::span<const int> mocap_ids);
+
   /// sets the state of one composed model from one of its keyframes: for the MJCF key named
   /// `key` (e.g. "go1/home"), the qpos and qvel of every joint, the ctrl (and act) of every
   /// actuator and the mocap pose of every mocap body whose name starts with `prefix` (e.g.

@@ -44,6 +44,23 @@ double SensorSchedule::effective_rate_hz(int id) const {
   return e.every_step ? physics_rate_hz_ : e.rate_hz;
 }
 
+void SensorSchedule::StartAt(int64_t step) {
+  if (step < 0) throw Error("sensor schedule: start step " + std::to_string(step) + " < 0");
+  if (step == 0) return;
+  // after the step before: the first k with k > t f (as Due leaves it after any firing)
+  const double t = SimTimeOfStep(step - 1, timestep_sec_);
+  for (Entry& e : entries_) {
+    if (e.every_step) {
+      e.next = step;
+      continue;
+    }
+    int64_t k = static_cast<int64_t>(std::floor(t * e.rate_hz)) + 1;
+    while (k > 0 && !AtOrAfter(t, e.rate_hz, k - 1)) --k;
+    while (AtOrAfter(t, e.rate_hz, k)) ++k;
+    e.next = k;
+  }
+}
+
 double SensorSchedule::NominalTime(int id, int64_t k) const {
   return static_cast<double>(k) / entries_.at(id).rate_hz;
 }

@@ -44,6 +44,14 @@ class SensorSchedule {
   /// (steps without a call count as passed).
   void Due(int64_t step, std::vector<SensorFiring>* out);
 
+  /// positions every schedule added so far as if Due had been called for the steps 0 .. step - 1:
+  /// the next sample of each sensor is the first one due at or after `step` (its index as in a
+  /// run from step 0), and a sensor at or above the physics rate continues with index `step`.
+  /// for a run that starts at a later step (a replay from --from); StartAt(0) changes nothing
+  /// of a fresh schedule. call before the first Due.
+  /// @throws Error if step < 0.
+  void StartAt(int64_t step);
+
   /// sim time of sample k of sensor `id` (k / rate_hz).
   double NominalTime(int id, int64_t k) const;
 

@@ -59,15 +59,30 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
       schedule_(timestep_sec),
       shutters_(scene, world),
       worker_(static_cast<size_t>(std::max(1, options_.render_queue))) {
-  for (const CameraSpec& cam : scene.cameras)
-    writer_.AddCamera(cam.name, cam.intrinsics, cam.outputs);
+  selected_.assign(scene.cameras.size(), options_.cameras.empty() ? 1 : 0);
+  for (const std::string& name : options_.cameras) {
+    const int c = scene.FindCamera(name);
+    if (c < 0) {
+      std::string names;
+      for (const CameraSpec& cam : scene.cameras) names += (names.empty() ? "" : ", ") + cam.name;
+      throw ConfigError("", 0, "--cameras",
+                        "no camera named '" + name + "'; expected some of: " + names);
+    }
+    selected_[c] = 1;
+  }
+  std::vector<CameraSpec> selected;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    if (!selected_[i]) continue;
+    writer_.AddCamera(scene.cameras[i].name, scene.cameras[i].intrinsics, scene.cameras[i].outputs);
+    selected.push_back(scene.cameras[i]);
+  }
   const std::vector<CameraSensorConfig> cfg = SensorConfigsFor(scene, world);
   imagers_.reserve(scene.cameras.size());
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     imagers_.emplace_back(scene.cameras[i], cfg[i], world.render, static_cast<int>(i), scene);
     span_.push_back(CaptureSpanSec(scene.cameras[i], cfg[i]));
   }
-  WriteCameraInfo(output_dir, CameraInfosFor(scene.cameras));
+  WriteCameraInfo(output_dir, CameraInfosFor(selected));
   if (!world.semantic_classes.empty()) {
     // the labels of the semantic_segmentation ids, in file order
     nlohmann::ordered_json classes = nlohmann::ordered_json::object();
@@ -89,6 +104,7 @@ CameraSink::~CameraSink() { worker_.Finish(); }
 
 void CameraSink::OnStart(const LoopStart& start) {
   report_error_ = start.report_error;
+  schedule_.StartAt(start.step);  // a loop from a later step (a replay) keeps the frame indices
   worker_.Start(start.report_error);
 }
 
@@ -98,6 +114,7 @@ SnapshotContent CameraSink::Wants(int64_t step, double time_sec) {
   due_.clear();
   schedule_.Due(step, &due_);
   for (const SensorFiring& f : due_) {
+    if (!selected_[f.sensor]) continue;
     c.cameras.push_back(f.sensor);
     c.frames.push_back(f.index);
   }

@@ -77,6 +77,11 @@ struct CameraSinkOptions {
   /// called on the render thread after each captured snapshot is rendered with its sim time
   /// and the frames rendered so far (e.g. a progress bar); may be empty.
   std::function<void(double time_sec, int64_t frames)> on_rendered;
+  /// the names of the cameras to render (empty = every camera of the scene). the others are
+  /// neither rendered nor written (no folder, no camera_info entry); every camera keeps its
+  /// index in the scene (its noise streams), so a selected camera's frames do not depend on
+  /// the selection.
+  std::vector<std::string> cameras;
 };
 
 /// every camera of `scene`. the render thread is the only user of `renderer`.
@@ -87,13 +92,16 @@ class CameraSink : public Sink {
   /// semantic_classes.json. `timestep_sec` is the physics timestep (the schedules count
   /// steps). `scene`, `renderer` must outlive the sink; `effects` may be empty (clear
   /// conditions).
-  /// @throws ConfigError for bad camera names or sensor settings; Error if files cannot be
-  ///         written.
+  /// @throws ConfigError for bad camera names or sensor settings, or (key "--cameras") a name
+  ///         in CameraSinkOptions::cameras that is not a camera of the scene; Error if files
+  ///         cannot be written.
   CameraSink(const SceneDescription& scene, const WorldConfig& world, double timestep_sec,
              Renderer* renderer, const std::string& output_dir, ViewerEffects effects,
              CameraSinkOptions options = {});
   ~CameraSink() override;
 
+  /// starts the render thread. a loop that starts at a later step (a replay from --from)
+  /// captures the frames a run from step 0 captures from that step on, with the same indices.
   void OnStart(const LoopStart& start) override;
   /// kPoses at steps where a camera fires or an exposure ends.
   SnapshotContent Wants(int64_t step, double time_sec) override;
@@ -138,6 +146,7 @@ class CameraSink : public Sink {
   SensorSchedule schedule_;
   ShutterSchedule shutters_;
   std::vector<SensorFiring> due_;
+  std::vector<char> selected_;  // per scene camera: rendered (CameraSinkOptions::cameras)
   std::optional<Capture> capture_;
   // render thread
   std::vector<CameraImager> imagers_;

@@ -41,6 +41,37 @@ const char* JointTypeName(JointInfo::Type t) {
 
 }  // namespace
 
+RunLogLayout RunLogLayoutOf(const Simulation& sim) {
+  // the SimState sizes and the names that map them
+  const ModelInfo& info = sim.model_info();
+  const SimState state = sim.GetState();
+  RunLogLayout l;
+  l.nq = static_cast<int>(state.qpos.size());
+  l.nv = static_cast<int>(state.qvel.size());
+  l.na = static_cast<int>(state.act.size());
+  l.nu = static_cast<int>(state.ctrl.size());
+  l.nmocap = static_cast<int>(state.mocap_pos.size() / 3);
+  l.nuserdata = static_cast<int>(state.userdata.size());
+  l.nbody = static_cast<int>(state.xfrc_applied.size() / 6);
+  l.num_controllers = static_cast<int>(state.controller_next_update.size());
+  for (const JointInfo& j : info.joints) {
+    RunLogJoint x;
+    x.name = j.name;
+    x.type = JointTypeName(j.type);
+    x.qpos_adr = j.qpos_adr;
+    x.qvel_adr = j.dof_adr;
+    x.qpos_width = j.type == JointInfo::Type::kFree ? 7 : j.type == JointInfo::Type::kBall ? 4 : 1;
+    x.qvel_width = j.type == JointInfo::Type::kFree ? 6 : j.type == JointInfo::Type::kBall ? 3 : 1;
+    l.joints.push_back(std::move(x));
+  }
+  for (const ActuatorInfo& a : info.actuators) l.actuator_names.push_back(a.name);
+  l.mocap_body_names = sim.MocapBodyNames();
+  l.body_names = info.body_names;
+  for (int i = 0; i < sim.num_controllers(); ++i)
+    l.controller_names.push_back(sim.controller(i).type());
+  return l;
+}
+
 RunLogHeader MakeRunLogHeader(const Session& session, const std::string& penumbra_version,
                               const std::string& command_line) {
   const WorldConfig& world = session.world();
@@ -82,33 +113,7 @@ RunLogHeader MakeRunLogHeader(const Session& session, const std::string& penumbr
     hash("adversity", world.adversity);
   for (const MjcfAssetFile& f : MjcfAssetFiles(session.composed_xml())) hash(f.role, f.path);
 
-  // the state layout (SimState sizes) and its names
-  const ModelInfo& info = sim.model_info();
-  const SimState state = sim.GetState();
-  RunLogLayout& l = h.layout;
-  l.nq = static_cast<int>(state.qpos.size());
-  l.nv = static_cast<int>(state.qvel.size());
-  l.na = static_cast<int>(state.act.size());
-  l.nu = static_cast<int>(state.ctrl.size());
-  l.nmocap = static_cast<int>(state.mocap_pos.size() / 3);
-  l.nuserdata = static_cast<int>(state.userdata.size());
-  l.nbody = static_cast<int>(state.xfrc_applied.size() / 6);
-  l.num_controllers = static_cast<int>(state.controller_next_update.size());
-  for (const JointInfo& j : info.joints) {
-    RunLogJoint x;
-    x.name = j.name;
-    x.type = JointTypeName(j.type);
-    x.qpos_adr = j.qpos_adr;
-    x.qvel_adr = j.dof_adr;
-    x.qpos_width = j.type == JointInfo::Type::kFree ? 7 : j.type == JointInfo::Type::kBall ? 4 : 1;
-    x.qvel_width = j.type == JointInfo::Type::kFree ? 6 : j.type == JointInfo::Type::kBall ? 3 : 1;
-    l.joints.push_back(std::move(x));
-  }
-  for (const ActuatorInfo& a : info.actuators) l.actuator_names.push_back(a.name);
-  l.mocap_body_names = sim.MocapBodyNames();
-  l.body_names = info.body_names;
-  for (int i = 0; i < sim.num_controllers(); ++i)
-    l.controller_names.push_back(sim.controller(i).type());
+  h.layout = RunLogLayoutOf(sim);
   return h;
 }
 

@@ -10,6 +10,11 @@
 
 namespace penumbra {
 
+/// the state layout of `sim`'s model (RunLogLayout: SimState sizes, the joints with their qpos
+/// and qvel addresses and widths, actuators, mocap bodies, bodies and controllers by name): the
+/// header's layout, and what a replay maps a logged state onto (replay/state_map.h).
+RunLogLayout RunLogLayoutOf(const Simulation& sim);
+
 /// the header of a log of `session`'s run. the files hashed: the world file (role "world"),
 /// every model file ("model"), the adversity preset file when the world names one by path
 /// ("adversity"), and every mesh, skin, height field and texture file of the composed MJCF

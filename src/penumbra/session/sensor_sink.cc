@@ -355,7 +355,10 @@ void SensorSink::set_on_output(SensorOutputCallback on_output) {
   impl_->on_output = std::move(on_output);
 }
 
-void SensorSink::OnStart(const LoopStart& start) { impl_->worker.Start(start.report_error); }
+void SensorSink::OnStart(const LoopStart& start) {
+  impl_->schedule->StartAt(start.step);  // a loop from a later step (a replay): same indices
+  impl_->worker.Start(start.report_error);
+}
 
 SnapshotContent SensorSink::Wants(int64_t step, double) {
   Impl& s = *impl_;

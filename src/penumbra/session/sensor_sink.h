@@ -79,7 +79,8 @@ class SensorSink : public Sink {
   /// true when the world has no sensors.
   bool empty() const;
 
-  /// starts the sink's thread.
+  /// starts the sink's thread. a loop that starts at a later step (a replay from --from)
+  /// samples what a run from step 0 samples from that step on, with the same indices.
   void OnStart(const LoopStart& start) override;
   /// advances the schedules to `step` (once per step, in order); kFull if any sensor is due.
   SnapshotContent Wants(int64_t step, double time_sec) override;

@@ -1,0 +1,155 @@
+#include "penumbra/app/replay_command.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <charconv>
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "penumbra/app/runner.h"
+#include "penumbra/core/error.h"
+#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/resimulate.h"
+
+namespace penumbra {
+
+struct ReplayCommand::State {
+  CLI::App* verb = nullptr;
+  ReplayOptions options;
+  std::string tier, outputs, resimulate;
+  CLI::Option* resimulate_option = nullptr;
+  std::optional<double> from_sec, to_sec;
+  bool quiet = false;
+  int threads = -1;
+};
+
+namespace {
+
+// a finite decimal number >= 0 (no hex, nan or inf, which CLI11's own conversion accepts)
+std::optional<double> ParseSeconds(const std::string& s) {
+  double v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v,
+                                 std::chars_format::fixed | std::chars_format::scientific);
+  if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v) ||
+      v < 0)
+    return std::nullopt;
+  return v;
+}
+
+void AddSeconds(CLI::App* app, const std::string& name, std::optional<double>* target,
+                const std::string& help) {
+  app->add_option_function<std::string>(
+         name, [target](const std::string& s) { *target = *ParseSeconds(s); }, help)
+      ->type_name("SEC")
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            return ParseSeconds(s) ? "" : "'" + s + "' is not a finite decimal number >= 0";
+          },
+          "SEC >= 0", ""));
+}
+
+}  // namespace
+
+ReplayCommand::ReplayCommand(CLI::App& app) : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  CLI::App* r = app.add_subcommand(
+      "replay",
+      "render a recorded run (.plog, run --record) again under other visual conditions, or "
+      "re-run its physics and check it against the log (--resimulate)");
+  s.verb = r;
+  ReplayOptions& o = s.options;
+  r->add_option("log", o.log_path, "run log (.plog) written by penumbra run --record")->required();
+  r->add_option("--out,-o", o.out_dir, "output folder (required for a kinematic replay)");
+  r->add_flag("--force", o.force,
+              "the output folder may hold an earlier run's outputs: remove them first");
+  r->add_option("--adversity", o.adversity,
+                "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME (default: as "
+                "recorded); its NPCs are seen but push nothing");
+  r->add_option("--world", o.world_override,
+                "world-file fragment replacing visual keys of the recorded world (cameras, "
+                "lights, sky, materials, render, effects, ...; docs/replay.md)");
+  r->add_option("--tier", s.tier, "render tier (default: as recorded)")
+      ->check(CLI::IsMember({"realtime", "pathtraced"}));
+  r->add_option("--cameras", o.cameras, "cameras to render, comma-separated (default: all)")
+      ->delimiter(',');
+  AddSeconds(r, "--from", &s.from_sec, "first sim time replayed, s (default: the log's start)");
+  AddSeconds(r, "--to", &s.to_sec, "last sim time replayed, s (default: the log's end)");
+  r->add_option("--threads", s.threads, "render threads (0 = all cores; default: as recorded)")
+      ->check(CLI::Range(0, 256));
+  r->add_option("--outputs", s.outputs,
+                "images of every camera, comma-separated: rgb, depth, segmentation, range, "
+                "normals, instance_segmentation, semantic_segmentation (default: as recorded)");
+  r->add_flag("--quiet,-q", s.quiet, "no progress output");
+  s.resimulate_option =
+      r->add_option("--resimulate", s.resimulate,
+                    "re-run physics from the log and check every step: `--resimulate` runs the "
+                    "world's controllers again, `--resimulate ctrl` applies the logged ctrl")
+          ->expected(0, 1)
+          ->check(CLI::IsMember({"controllers", "ctrl"}));
+}
+
+ReplayCommand::~ReplayCommand() = default;
+ReplayCommand::ReplayCommand(ReplayCommand&&) noexcept = default;
+ReplayCommand& ReplayCommand::operator=(ReplayCommand&&) noexcept = default;
+
+bool ReplayCommand::Selected() const { return state_->verb->parsed(); }
+
+int ReplayCommand::Run(const std::vector<std::string>& command_line,
+                       const std::atomic<int>* stop_request) const {
+  const State& s = *state_;
+  CLI::App* r = s.verb;
+  if (s.resimulate_option->count() > 0) {
+    // physics only: the options that change what is seen do not apply
+    for (const char* flag : {"--out", "--force", "--adversity", "--world", "--tier", "--cameras",
+                             "--from", "--to", "--threads", "--outputs"})
+      if (r->count(flag) > 0)
+        throw ConfigError("", 0, flag,
+                          "does not apply to --resimulate, which re-runs the recorded physics "
+                          "and writes no outputs; expected it without --resimulate");
+    ResimulateOptions o;
+    o.log_path = s.options.log_path;
+    o.mode = s.resimulate == "ctrl" ? ResimulateMode::kCtrl : ResimulateMode::kControllers;
+    o.stop_request = stop_request;
+    const ResimulateReport report = ResimulateLog(o);
+    std::cout << report.Describe() << std::endl;
+    if (report.divergence) return 3;
+    if (report.interrupted && stop_request) return 128 + stop_request->load();
+    return 0;
+  }
+
+  ReplayOptions o = s.options;
+  if (o.out_dir.empty())
+    throw ConfigError("", 0, "--out", "required; expected the replay's output folder");
+  if (!s.tier.empty())
+    o.tier = s.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
+                                    : RenderSettings::Tier::kRealtime;
+  if (r->count("--outputs") > 0) {
+    o.outputs = ParseCameraOutputs(s.outputs);
+    o.outputs_text = s.outputs;
+  }
+  o.from_sec = s.from_sec;
+  o.to_sec = s.to_sec;
+  o.threads = s.threads;
+  o.progress = !s.quiet;
+  o.stop_request = stop_request;
+  o.command_line = command_line;
+  const ReplaySummary summary = ReplayLog(o);
+  int64_t frames = 0;
+  for (const auto& [name, n] : summary.frames_per_camera) frames += n;
+  spdlog::info("done: steps {} to {} ({:.3f} s sim time), {} frames in {:.2f} s wall -> {}",
+               summary.first_step, summary.last_step, summary.sim_time_sec, frames,
+               summary.wall_time_sec, summary.out_dir);
+  if (summary.interrupted) {
+    spdlog::warn("interrupted at {:.6g} s of sim time; outputs and run.json written",
+                 summary.sim_time_sec);
+    return stop_request ? 128 + stop_request->load() : 130;
+  }
+  return 0;
+}
+
+ReplayCommand AddReplayCommand(CLI::App& app) { return ReplayCommand(app); }
+
+}  // namespace penumbra

@@ -1,0 +1,53 @@
+#include "penumbra/replay/log_source.h"
+
+#include <fmt/format.h>
+
+#include "penumbra/core/error.h"
+#include "penumbra/session/run_log_header.h"
+
+namespace penumbra {
+
+LogSource::LogSource(RunLogReader* reader, Simulation* sim, LogSourceOptions options)
+    : reader_(reader),
+      sim_(sim),
+      map_(reader->header().layout, RunLogLayoutOf(*sim), reader->path()),
+      state_(sim->GetState()) {
+  const double logged_dt = reader_->header().timestep_sec;
+  if (logged_dt != sim_->timestep())
+    throw ConfigError(reader_->path(), 0, "",
+                      fmt::format("the replay model's timestep is {:.17g} s; the log was recorded "
+                                  "at {:.17g} s; expected the recorded physics unchanged",
+                                  sim_->timestep(), logged_dt));
+  if (!reader_->SeekStep(options.first_step) || !reader_->NextStep(&current_))
+    throw RunLogError(fmt::format("{}: no step at or after step {} (the log's steps are {} to {})",
+                                  reader_->path(), options.first_step, reader_->first_step(),
+                                  reader_->last_step()));
+}
+
+std::shared_ptr<const WorldSnapshot> LogSource::Snapshot(SnapshotContent content) {
+  if (applied_step_ != current_.step) {
+    map_.Apply(current_, &state_);
+    sim_->SetState(state_);
+    sim_->ApplyMocapDrivers(map_.unlogged_mocap());
+    applied_step_ = current_.step;
+  }
+  auto s = std::make_shared<WorldSnapshot>();
+  if (content == SnapshotContent::kState || content == SnapshotContent::kNone) {
+    sim_->SnapshotState(s.get());
+  } else {
+    sim_->Snapshot(s.get(), content == SnapshotContent::kFull
+                                ? Simulation::SnapshotContent::kFull
+                                : Simulation::SnapshotContent::kPoses);
+  }
+  // the controllers' schedule as logged (the replay runs none)
+  s->controller_next_update = current_.controller_next_update;
+  return s;
+}
+
+bool LogSource::Advance() {
+  if (!reader_->NextStep(&next_)) return false;
+  std::swap(current_, next_);
+  return true;
+}
+
+}  // namespace penumbra

@@ -1,0 +1,80 @@
+#pragma once
+// `penumbra replay FILE.plog --out DIR`: a recorded run rendered again with no physics. the
+// recorded world (replay/recorded_world.h) is set up as `run` sets it up (session/session.h),
+// without controllers, with the replay's changes to what is seen (--world override,
+// replay/world_override.h; --adversity; --tier; --cameras; --outputs); a LogSource
+// (replay/log_source.h) walks the log's states through the SimLoop into the SAME sinks as
+// `penumbra run` (cameras, sensors, trajectory.csv, run.json), so the output folder has the
+// layout of a run's (README "Outputs") plus a "replay" object in run.json.
+//
+// with the recorded conditions the frames are those of the run, byte for byte (same steps,
+// same snapshots, same sinks); --from / --to render the frames of that window only, with the
+// indices (file names) of the run's.
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/render/render_settings.h"
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// what `penumbra replay` (kinematic) is asked for.
+struct ReplayOptions {
+  std::string log_path;  ///< the .plog
+  std::string out_dir;   ///< output folder (required)
+  /// the output folder may hold an earlier run's outputs, removed first (as run --force).
+  bool force = false;
+  /// adversity preset spec (world/adversity_preset.h); "" = as recorded.
+  std::string adversity;
+  /// world-file fragment replacing visual keys (replay/world_override.h); "" = none.
+  std::string world_override;
+  std::optional<RenderSettings::Tier> tier;  ///< --tier; nullopt = as recorded
+  int threads = -1;                          ///< render threads, -1 = as recorded (0 = all cores)
+  /// --outputs: replaces the outputs of every camera; nullopt = as recorded. outputs_text is
+  /// the list as given, for run.json.
+  std::optional<CameraOutputs> outputs;
+  std::string outputs_text;
+  /// --cameras: the cameras to render, by name (empty = all).
+  std::vector<std::string> cameras;
+  /// the window of sim time replayed: from the first logged step at or after from_sec, to the
+  /// first at or after to_sec (inclusive); nullopt = the log's first / last step.
+  std::optional<double> from_sec, to_sec;
+  bool progress = true;                   ///< progress bar / log lines
+  std::vector<std::string> command_line;  ///< argv, for run.json
+  /// a stop request (SIGINT): the replay stops at the next step, writes what it rendered and
+  /// run.json ("interrupted": true).
+  const std::atomic<int>* stop_request = nullptr;
+};
+
+/// what a replay produced.
+struct ReplaySummary {
+  std::string out_dir;
+  int64_t first_step = 0, last_step = 0;  ///< the logged steps replayed
+  double sim_time_sec = 0;                ///< time of the last step replayed
+  std::map<std::string, int64_t> frames_per_camera;
+  double wall_time_sec = 0;
+  bool interrupted = false;
+  /// warnings (damaged log, changed assets, dropped mocap bodies), also logged and in run.json.
+  std::vector<std::string> warnings;
+};
+
+/// the first step whose time (SimTimeOfStep) is >= time_sec - 1e-9 s (the SimLoop's end rule).
+int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec);
+
+/// replays the log as the file header describes. the log is read in recovery mode: a damaged
+/// or cut log replays up to its last complete chunk, with a warning naming it.
+/// @throws RunLogError for a file that is not a readable run log (bad magic, other format
+///         version, truncated header); ConfigError for bad options (from >= to, a window
+///         outside the log, unknown camera names, an override key that changes physics, an
+///         output folder that is not empty without force) or a replay model that does not
+///         match the log (a joint missing or changed), naming the file, line and key where one
+///         applies; Error for a write failure (after what was rendered is flushed and run.json
+///         written, as in `run`).
+ReplaySummary ReplayLog(const ReplayOptions& options);
+
+}  // namespace penumbra

@@ -1,0 +1,70 @@
+#pragma once
+// `penumbra replay FILE.plog --resimulate`: the recorded run simulated again from its recorded
+// world (replay/recorded_world.h, set up as `run` sets it up) and checked against the log at
+// EVERY step: step count, time, qpos, qvel, act, ctrl, qacc_warmstart, qfrc_applied,
+// xfrc_applied, mocap_pos, mocap_quat, userdata and (with controllers) controller_next_update,
+// compared bit for bit (the logged step 0 against the initial state too). it reports
+// "bit-exact (N steps)" or the first divergent step, field and index with both values.
+//
+// modes:
+//   kControllers  the world's controllers run again and compute ctrl (the default). commands
+//                 logged as events would have to be re-injected; none exist yet (bridges,
+//                 issue 19), so a log that holds "command" events is refused in this mode.
+//   kCtrl         no controllers: before each step the ctrl the log holds after that step is
+//                 applied (what the controllers wrote), so physics alone is checked.
+// MuJoCo 2.2.2 computes a step from exactly the state the log holds (physics/simulation.h
+// SimState), so a run is bit-exact as long as the model, the world and the binary's floating
+// point are those of the recording (changed model files are warned about).
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// how a resimulation computes ctrl.
+enum class ResimulateMode {
+  kControllers,  ///< the world's controllers run again
+  kCtrl,         ///< the logged ctrl is applied, controllers off
+};
+
+/// settings of a resimulation.
+struct ResimulateOptions {
+  std::string log_path;
+  ResimulateMode mode = ResimulateMode::kControllers;
+  /// a stop request (SIGINT): checking stops at the next step; the report says how far it got.
+  const std::atomic<int>* stop_request = nullptr;
+};
+
+/// the first difference between the log and the resimulation.
+struct Divergence {
+  int64_t step = 0;     ///< logged step where it differs
+  double time_sec = 0;  ///< its time, s
+  std::string field;    ///< "qpos", "qvel", ..., "step", "time_sec", "size of qpos"
+  int64_t index = 0;    ///< entry of the field (0 for scalars)
+  std::string what;     ///< what the entry belongs to, e.g. "joint 'go1/FR_calf'" ("" if none)
+  double logged = 0, simulated = 0;  ///< both values
+};
+
+/// how a resimulation went.
+struct ResimulateReport {
+  int64_t steps_checked = 0;  ///< logged steps compared (step 0 included)
+  int64_t last_step = 0;      ///< the last logged step compared
+  std::optional<Divergence> divergence;
+  bool interrupted = false;           ///< stopped by the stop request before the log's end
+  std::vector<std::string> warnings;  ///< damaged log, changed assets
+  /// "bit-exact (N steps)", or "diverged at step S (t = T s): FIELD[I] (WHAT): logged L,
+  /// simulated M" with 17 significant digits; "stopped after N steps (bit-exact so far)".
+  std::string Describe() const;
+};
+
+/// resimulates the log (see the file header).
+/// @throws RunLogError for a file that is not a readable run log; ConfigError naming the log
+///         when it holds command events in kControllers mode, when its model does not match
+///         the recorded world's (state sizes) or its first step is not 0; PhysicsError when
+///         the simulation fails where the recording did not.
+ResimulateReport ResimulateLog(const ResimulateOptions& options);
+
+}  // namespace penumbra

@@ -1,0 +1,205 @@
+#include "penumbra/replay/state_map.h"
+
+#include <algorithm>
+#include <map>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace {
+
+std::string Quoted(const std::string& name, const char* kind, size_t index) {
+  return name.empty() ? "unnamed " + std::string(kind) + " #" + std::to_string(index)
+                      : std::string(kind) + " '" + name + "'";
+}
+
+bool SameJoints(const std::vector<RunLogJoint>& a, const std::vector<RunLogJoint>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].name != b[i].name || a[i].type != b[i].type || a[i].qpos_adr != b[i].qpos_adr ||
+        a[i].qpos_width != b[i].qpos_width || a[i].qvel_adr != b[i].qvel_adr ||
+        a[i].qvel_width != b[i].qvel_width)
+      return false;
+  }
+  return true;
+}
+
+bool SameLayout(const RunLogLayout& a, const RunLogLayout& b) {
+  return a.nq == b.nq && a.nv == b.nv && a.na == b.na && a.nu == b.nu && a.nmocap == b.nmocap &&
+         a.nuserdata == b.nuserdata && a.nbody == b.nbody && SameJoints(a.joints, b.joints) &&
+         a.actuator_names == b.actuator_names && a.mocap_body_names == b.mocap_body_names &&
+         a.body_names == b.body_names;
+}
+
+template <typename T>
+void CheckSize(const char* field, const std::vector<T>& v, size_t expected, const char* side) {
+  if (v.size() != expected)
+    throw Error("replay state map: " + std::string(side) + " " + field + " has " +
+                std::to_string(v.size()) + " entries; expected " + std::to_string(expected));
+}
+
+}  // namespace
+
+std::vector<int> MatchNames(const std::vector<std::string>& log,
+                            const std::vector<std::string>& model) {
+  std::map<std::string, int> by_name;
+  std::vector<int> unnamed;
+  for (size_t i = 0; i < model.size(); ++i) {
+    if (model[i].empty())
+      unnamed.push_back(static_cast<int>(i));
+    else
+      by_name.emplace(model[i], static_cast<int>(i));
+  }
+  std::vector<int> out(log.size(), -1);
+  size_t next_unnamed = 0;
+  for (size_t i = 0; i < log.size(); ++i) {
+    if (log[i].empty()) {
+      if (next_unnamed < unnamed.size()) out[i] = unnamed[next_unnamed++];
+      continue;
+    }
+    auto it = by_name.find(log[i]);
+    if (it != by_name.end()) out[i] = it->second;
+  }
+  return out;
+}
+
+void StateMap::AddSpan(std::vector<Span>* spans, int src, int dst, int length) {
+  if (length <= 0) return;
+  // consecutive entries in both vectors become one copy
+  if (!spans->empty()) {
+    Span& last = spans->back();
+    if (last.src + last.length == src && last.dst + last.length == dst) {
+      last.length += length;
+      return;
+    }
+  }
+  spans->push_back({src, dst, length});
+}
+
+StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std::string& log_name)
+    : log_(log), model_(model), identity_(SameLayout(log, model)) {
+  const auto fail = [&](const std::string& problem) {
+    throw ConfigError(log_name, 0, "", problem);
+  };
+  const std::string kFixed =
+      "; expected the recorded robots and models unchanged (a replay may change only what is "
+      "seen: docs/replay.md)";
+
+  // joints: both ways, same type and widths
+  std::vector<std::string> log_joints, model_joints;
+  for (const RunLogJoint& j : log.joints) log_joints.push_back(j.name);
+  for (const RunLogJoint& j : model.joints) model_joints.push_back(j.name);
+  const std::vector<int> joint_to = MatchNames(log_joints, model_joints);
+  std::vector<char> model_joint_seen(model.joints.size(), 0);
+  for (size_t i = 0; i < log.joints.size(); ++i) {
+    const RunLogJoint& a = log.joints[i];
+    if (joint_to[i] < 0)
+      fail("the replay model has no " + Quoted(a.name, "joint", i) + " (" + a.type +
+           ", qpos width " + std::to_string(a.qpos_width) + ") that the log records" + kFixed);
+    const RunLogJoint& b = model.joints[joint_to[i]];
+    model_joint_seen[joint_to[i]] = 1;
+    if (a.type != b.type || a.qpos_width != b.qpos_width || a.qvel_width != b.qvel_width)
+      fail("the replay model's " + Quoted(a.name, "joint", i) + " is " + b.type +
+           " with qpos width " + std::to_string(b.qpos_width) + " and qvel width " +
+           std::to_string(b.qvel_width) + "; the log records it as " + a.type +
+           " with qpos width " + std::to_string(a.qpos_width) + " and qvel width " +
+           std::to_string(a.qvel_width) + kFixed);
+    AddSpan(&qpos_, a.qpos_adr, b.qpos_adr, a.qpos_width);
+    AddSpan(&qvel_, a.qvel_adr, b.qvel_adr, a.qvel_width);
+  }
+  for (size_t j = 0; j < model.joints.size(); ++j)
+    if (!model_joint_seen[j])
+      fail("the replay model has " + Quoted(model.joints[j].name, "joint", j) +
+           ", which the log does not record" + kFixed);
+
+  // actuators: ctrl, and act of the stateful ones (the last na actuators)
+  const std::vector<int> act_to = MatchNames(log.actuator_names, model.actuator_names);
+  std::vector<char> model_act_seen(model.actuator_names.size(), 0);
+  for (size_t i = 0; i < log.actuator_names.size(); ++i) {
+    if (act_to[i] < 0)
+      fail("the replay model has no " + Quoted(log.actuator_names[i], "actuator", i) +
+           " that the log records" + kFixed);
+    const int b = act_to[i];
+    model_act_seen[b] = 1;
+    AddSpan(&ctrl_, static_cast<int>(i), b, 1);
+    const int log_act = static_cast<int>(i) - (log.nu - log.na);
+    const int model_act = b - (model.nu - model.na);
+    if ((log_act >= 0) != (model_act >= 0))
+      fail("the replay model's " + Quoted(log.actuator_names[i], "actuator", i) +
+           (model_act >= 0 ? " has" : " has no") + " activation state; the log records it " +
+           (log_act >= 0 ? "with" : "without") + " one" + kFixed);
+    if (log_act >= 0) AddSpan(&act_, log_act, model_act, 1);
+  }
+  for (size_t a = 0; a < model.actuator_names.size(); ++a)
+    if (!model_act_seen[a])
+      fail("the replay model has " + Quoted(model.actuator_names[a], "actuator", a) +
+           ", which the log does not record" + kFixed);
+
+  if (log.nuserdata != model.nuserdata)
+    fail("the replay model has " + std::to_string(model.nuserdata) +
+         " userdata entries; the log records " + std::to_string(log.nuserdata) + kFixed);
+
+  // mocap bodies: logged ones follow the log, the model's others keep their drivers
+  const std::vector<int> mocap_to = MatchNames(log.mocap_body_names, model.mocap_body_names);
+  std::vector<char> model_mocap_seen(model.mocap_body_names.size(), 0);
+  for (size_t i = 0; i < log.mocap_body_names.size(); ++i) {
+    const int b = mocap_to[i];
+    if (b < 0) {
+      dropped_mocap_.push_back(log.mocap_body_names[i]);
+      continue;
+    }
+    model_mocap_seen[b] = 1;
+    AddSpan(&mocap_pos_, 3 * static_cast<int>(i), 3 * b, 3);
+    AddSpan(&mocap_quat_, 4 * static_cast<int>(i), 4 * b, 4);
+  }
+  for (size_t b = 0; b < model.mocap_body_names.size(); ++b)
+    if (!model_mocap_seen[b]) unlogged_mocap_.push_back(static_cast<int>(b));
+
+  // applied wrenches per body
+  const std::vector<int> body_to = MatchNames(log.body_names, model.body_names);
+  for (size_t i = 0; i < log.body_names.size(); ++i)
+    if (body_to[i] >= 0) AddSpan(&xfrc_, 6 * static_cast<int>(i), 6 * body_to[i], 6);
+}
+
+void StateMap::Apply(const StepRecord& r, SimState* s) const {
+  CheckSize("qpos", r.qpos, log_.nq, "logged");
+  CheckSize("qvel", r.qvel, log_.nv, "logged");
+  CheckSize("act", r.act, log_.na, "logged");
+  CheckSize("ctrl", r.ctrl, log_.nu, "logged");
+  CheckSize("qacc_warmstart", r.qacc_warmstart, log_.nv, "logged");
+  CheckSize("qfrc_applied", r.qfrc_applied, log_.nv, "logged");
+  CheckSize("xfrc_applied", r.xfrc_applied, 6 * static_cast<size_t>(log_.nbody), "logged");
+  CheckSize("mocap_pos", r.mocap_pos, 3 * static_cast<size_t>(log_.nmocap), "logged");
+  CheckSize("mocap_quat", r.mocap_quat, 4 * static_cast<size_t>(log_.nmocap), "logged");
+  CheckSize("userdata", r.userdata, log_.nuserdata, "logged");
+  CheckSize("qpos", s->qpos, model_.nq, "replay");
+  CheckSize("qvel", s->qvel, model_.nv, "replay");
+  CheckSize("act", s->act, model_.na, "replay");
+  CheckSize("ctrl", s->ctrl, model_.nu, "replay");
+  CheckSize("qacc_warmstart", s->qacc_warmstart, model_.nv, "replay");
+  CheckSize("qfrc_applied", s->qfrc_applied, model_.nv, "replay");
+  CheckSize("xfrc_applied", s->xfrc_applied, 6 * static_cast<size_t>(model_.nbody), "replay");
+  CheckSize("mocap_pos", s->mocap_pos, 3 * static_cast<size_t>(model_.nmocap), "replay");
+  CheckSize("mocap_quat", s->mocap_quat, 4 * static_cast<size_t>(model_.nmocap), "replay");
+  CheckSize("userdata", s->userdata, model_.nuserdata, "replay");
+
+  const auto copy = [](const std::vector<Span>& spans, const std::vector<double>& src,
+                       std::vector<double>* dst) {
+    for (const Span& sp : spans)
+      std::copy_n(src.begin() + sp.src, sp.length, dst->begin() + sp.dst);
+  };
+  s->step_count = r.step;
+  s->time_sec = r.time_sec;
+  copy(qpos_, r.qpos, &s->qpos);
+  copy(qvel_, r.qvel, &s->qvel);
+  copy(qvel_, r.qacc_warmstart, &s->qacc_warmstart);
+  copy(qvel_, r.qfrc_applied, &s->qfrc_applied);
+  copy(ctrl_, r.ctrl, &s->ctrl);
+  copy(act_, r.act, &s->act);
+  copy(xfrc_, r.xfrc_applied, &s->xfrc_applied);
+  copy(mocap_pos_, r.mocap_pos, &s->mocap_pos);
+  copy(mocap_quat_, r.mocap_quat, &s->mocap_quat);
+  s->userdata = r.userdata;
+}
+
+}  // namespace penumbra
