@@ -11,6 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/progress.h"
@@ -187,6 +188,8 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
                      camera_options);
   SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
   TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());
+  const std::unique_ptr<MetricsSink> metrics =
+      MakeMetricsSink(world, sim, out.string(), MetricsMode::kDynamics);
   ProgressOptions progress_options;
   progress_options.mode =
       options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
@@ -214,10 +217,13 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     timings["physics_sec"] = physics.busy_sec();
     timings["render_sec"] = cameras.render_sec();
     timings["total_sec"] = summary.wall_time_sec;
-    return DescribeRun(world, options, effects, summary, timings);
+    RunManifest m = DescribeRun(world, options, effects, summary, timings);
+    if (metrics) m.metrics_json = metrics->SummaryJson();  // its OnFinish ran before
+    return m;
   });
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, &manifest})
-    loop.AddSink(sink);
+  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, metrics.get(),
+                                                 &manifest})
+    if (sink) loop.AddSink(sink);
   rollback.Dismiss();
   const LoopFinish finish = loop.Run();
   if (finish.error) std::rethrow_exception(finish.error);

@@ -35,6 +35,7 @@ std::string RunManifestJson(const RunManifest& m) {
     j["effects"] = m.effects;
     j["agents"] = m.agents;
   }
+  if (!m.metrics_json.empty()) j["metrics"] = nlohmann::ordered_json::parse(m.metrics_json);
   return j.dump(2) + "\n";
 }
 

@@ -30,6 +30,9 @@ struct RunManifest {
   std::string adversity;
   std::vector<std::string> effects;
   std::vector<std::string> agents;
+  /// the world file's `metrics:` summaries (metrics/metrics_sink.h, MetricsSink::SummaryJson):
+  /// a JSON object as text, written as the key "metrics" (last) only when not empty.
+  std::string metrics_json;
   /// the run's first error (e.g. divergence, a file that could not be written); the key
   /// "error" is written only when it is not empty, after "peak_resident_memory_mib".
   std::string error;

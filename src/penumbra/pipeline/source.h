@@ -17,7 +17,7 @@ enum class SnapshotContent {
   kNone = 0,   ///< no snapshot at this step
   kState = 1,  ///< time_sec, step, qpos, qvel (trajectory rows, recorders)
   kPoses = 2,  ///< kState plus X_WB, X_W_mjcam, light poses (cameras, effects)
-  kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts (sensors, ground truth)
+  kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts, qfrc_actuator, tracking_error
 };
 
 /// the richer of two contents.
