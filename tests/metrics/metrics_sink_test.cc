@@ -53,7 +53,8 @@ physics: {timestep_sec: 0.002}
 mjcf_cameras: {enabled: false}
 robots:
   - name: rover
-    file: )") + PENUMBRA_SOURCE_DIR + R"(/worlds/models/rover.xml
+    file: )") +
+         PENUMBRA_SOURCE_DIR + R"(/worlds/models/rover.xml
     controller:
       type: waypoint_follower
       base_body: chassis
@@ -123,8 +124,7 @@ TEST(MetricsSinkTest, RoverDrivenIntoAWallIsOneCollisionAndTheFloorIsExcluded) {
   ASSERT_EQ(episodes.size(), 2u) << ReadText(metrics / "bumps_episodes.csv");
   EXPECT_EQ(episodes[0], "episode,a,b,start_sec,end_sec,peak_force_N");
   double start = 0, end = 0;
-  ASSERT_EQ(std::sscanf(episodes[1].c_str(), "1,rover/chassis,arena/wall,%lf,%lf", &start, &end),
-            2)
+  ASSERT_EQ(std::sscanf(episodes[1].c_str(), "1,rover/chassis,arena/wall,%lf,%lf", &start, &end), 2)
       << episodes[1];
   EXPECT_GT(start, 1.5);
   EXPECT_LT(start, 3.0);
@@ -133,8 +133,9 @@ TEST(MetricsSinkTest, RoverDrivenIntoAWallIsOneCollisionAndTheFloorIsExcluded) {
   // rows at 20 Hz from t = 0 (81 rows in 4 s), columns with units
   const std::vector<std::string> rows = Lines(ReadText(metrics / "bumps.csv"));
   ASSERT_EQ(rows.size(), 82u);
-  EXPECT_EQ(rows[0], "step,time_sec,contacts,pairs_in_collision,normal_force_N,max_pair_force_N,"
-                     "collisions");
+  EXPECT_EQ(rows[0],
+            "step,time_sec,contacts,pairs_in_collision,normal_force_N,max_pair_force_N,"
+            "collisions");
   EXPECT_EQ(rows[1].substr(0, 4), "0,0,");
   EXPECT_EQ(rows.back().substr(rows.back().rfind(',') + 1), "1");
   EXPECT_EQ(Lines(ReadText(metrics / "chassis.csv"))[0],
@@ -190,8 +191,9 @@ TEST(MetricsSinkTest, KinematicModeRecordsPosesAndTwistsFromTheStateAlone) {
 TEST(MetricsSinkTest, NamesThatMatchNothingAreConfigErrorsWithTheirLine) {
   testing::TempDir dir;
   std::ofstream(dir.path() / "arena.xml") << kArena;
-  const std::string text = CollisionWorld("    - {name: legs, type: joint_velocity, joints: "
-                                          "[rover/left_wheel, \"go1/*\"]}\n");
+  const std::string text = CollisionWorld(
+      "    - {name: legs, type: joint_velocity, joints: "
+      "[rover/left_wheel, \"go1/*\"]}\n");
   const WorldConfig world = ParseWorld(text, (dir.path() / "world.yaml").string());
   SessionOptions options;
   options.build_renderer = false;

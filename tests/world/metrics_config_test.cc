@@ -129,8 +129,8 @@ TEST_F(MetricsConfigTest, ErrorsNameFileLineAndKey) {
   EXPECT_NE(rate.find(file + ":9: metrics.series[0].rate_hz: got 0; expected (0, 10000] Hz"),
             std::string::npos)
       << rate;
-  const std::string force = Error(
-      "metrics:\n  series:\n    - {name: c, type: contacts, min_force_N: -1}\n");
+  const std::string force =
+      Error("metrics:\n  series:\n    - {name: c, type: contacts, min_force_N: -1}\n");
   EXPECT_NE(force.find("metrics.series[0].min_force_N: got -1; expected a number >= 0"),
             std::string::npos)
       << force;

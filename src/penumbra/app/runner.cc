@@ -221,8 +221,8 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     if (metrics) m.metrics_json = metrics->SummaryJson();  // its OnFinish ran before
     return m;
   });
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, metrics.get(),
-                                                 &manifest})
+  for (Sink* sink :
+       std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, metrics.get(), &manifest})
     if (sink) loop.AddSink(sink);
   rollback.Dismiss();
   const LoopFinish finish = loop.Run();

@@ -92,7 +92,7 @@ void WaypointFollower::Compute(const ControlInput& input, std::span<double> ctrl
   {
     const auto& w = route_.waypoints();
     const int k = route_.target_index();
-    const Eigen::Vector2d a = k > 0                                  ? w[k - 1]
+    const Eigen::Vector2d a = k > 0                                    ? w[k - 1]
                               : (params_.loop && route_.reached() > 0) ? w.back()
                                                                        : *start_;
     const Eigen::Vector2d ab = route_.target() - a;

@@ -39,9 +39,9 @@
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
-#include <optional>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -111,7 +111,7 @@ class WaypointFollower final : public Controller {
   int base_body_ = -1, left_ = -1, right_ = -1;
   WaypointRoute route_;
   double v_ = 0, omega_ = 0;
-  std::optional<Eigen::Vector2d> start_;  ///< base origin at the first update (world xy, m)
+  std::optional<Eigen::Vector2d> start_;         ///< base origin at the first update (world xy, m)
   std::array<double, 2> tracking_ = {NAN, NAN};  ///< see tracking_error_labels()
 };
 

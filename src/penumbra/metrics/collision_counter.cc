@@ -14,7 +14,8 @@ void CollisionCounter::Update(double t, const std::map<ContactPairKey, double>& 
     if (!(force >= min_force_N_)) continue;
     auto it = open_.find(pair);
     // back after a gap of at least the debounce time (between two detection instants)
-    if (it != open_.end() && !it->second.active && t - it->second.episode.end_sec >= debounce_sec_) {
+    if (it != open_.end() && !it->second.active &&
+        t - it->second.episode.end_sec >= debounce_sec_) {
       closed_.push_back(it->second.episode);
       open_.erase(it);
       it = open_.end();

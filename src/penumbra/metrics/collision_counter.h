@@ -15,7 +15,7 @@
 
 namespace penumbra {
 
-/// a pair of contact sides (ids chosen by the caller, e.g. body indices), smaller id first.
+/// a pair of contact sides (ids and their order chosen by the caller, e.g. body indices).
 using ContactPairKey = std::pair<int, int>;
 
 /// one collision episode of a pair.

@@ -218,8 +218,8 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
               cols.push_back(n + suffix);
             continue;
           }
-          for (const char* suffix : {"_wx_rad_s", "_wy_rad_s", "_wz_rad_s", "_vx_m_s", "_vy_m_s",
-                                     "_vz_m_s"})
+          for (const char* suffix :
+               {"_wx_rad_s", "_wy_rad_s", "_wz_rad_s", "_vx_m_s", "_vy_m_s", "_vz_m_s"})
             cols.push_back(n + suffix);
           int dof = -1;
           for (const JointInfo& j : model_.joints)
@@ -239,8 +239,8 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
         std::vector<std::string> names;
         for (const JointInfo& j : model_.joints) names.push_back(j.name);
         const std::vector<int> joints = Resolve(c.joints, names, s->key + ".joints", "joint");
-        s->row_content = c.kind == MetricKind::kJointTorque ? SnapshotContent::kFull
-                                                            : SnapshotContent::kState;
+        s->row_content =
+            c.kind == MetricKind::kJointTorque ? SnapshotContent::kFull : SnapshotContent::kState;
         for (int ji : joints) {
           const JointInfo& j = model_.joints[ji];
           std::vector<const char*> sfx;
@@ -284,7 +284,8 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
         for (int si : Resolve(c.sensors, names, s->key + ".sensors", "MJCF sensor")) {
           const SensorDescription& d = model_.sensors[si];
           s->ranges.push_back({d.adr, d.dim});
-          for (int k = 0; k < d.dim; ++k) cols.push_back(SensorValueLabel(d, k) + UnitSuffix(d.unit));
+          for (int k = 0; k < d.dim; ++k)
+            cols.push_back(SensorValueLabel(d, k) + UnitSuffix(d.unit));
         }
         s->row_content = SnapshotContent::kFull;
         break;
@@ -462,8 +463,7 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
         for (const WorldSnapshot::Contact& ct : snap.contacts) {
           const int g1 = ct.geom1, g2 = ct.geom2;
           if (g1 < 0 || g2 < 0 || g1 >= ng || g2 >= ng) continue;
-          if (!c.self_contacts && !s.geom_model[g1].empty() &&
-              s.geom_model[g1] == s.geom_model[g2])
+          if (!c.self_contacts && !s.geom_model[g1].empty() && s.geom_model[g1] == s.geom_model[g2])
             continue;
           auto pair_in = [&](const std::vector<std::vector<uint8_t>>& a,
                              const std::vector<std::vector<uint8_t>>& b) {
@@ -479,9 +479,12 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
             const int b = model_.geom_body[g];
             return b > 0 ? b : -(g + 1);
           };
-          const int a = side(g1), b = side(g2);
+          // pairs list moving sides first (robots are composed first), world geoms last
+          auto fixed = [&](int id) { return c.geom_pairs ? model_.geom_body[id] == 0 : id < 0; };
+          int a = side(g1), b = side(g2);
+          if (fixed(a) != fixed(b) ? fixed(a) : a > b) std::swap(a, b);
           const double fn = std::max(0.0, ct.force_N.x());
-          pair_force[{std::min(a, b), std::max(a, b)}] += fn;
+          pair_force[{a, b}] += fn;
           total += fn;
           ++n;
         }

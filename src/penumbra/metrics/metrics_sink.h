@@ -47,10 +47,10 @@ enum class MetricsMode {
 
 /// what the sink needs to know about the composed model: names and index maps.
 struct MetricsModel {
-  std::vector<std::string> body_names;  ///< by body index (0 = world)
-  std::vector<std::string> geom_names;  ///< by MuJoCo geom id ("" if unnamed)
-  std::vector<int> geom_body;           ///< body index of each geom
-  std::vector<JointInfo> joints;        ///< by MuJoCo joint id (control/model_info.h)
+  std::vector<std::string> body_names;     ///< by body index (0 = world)
+  std::vector<std::string> geom_names;     ///< by MuJoCo geom id ("" if unnamed)
+  std::vector<int> geom_body;              ///< body index of each geom
+  std::vector<JointInfo> joints;           ///< by MuJoCo joint id (control/model_info.h)
   std::vector<SensorDescription> sensors;  ///< by MuJoCo sensor id
   /// the simulation's controllers in order: the robot each drives and the labels of its
   /// tracking error (Controller::tracking_error_labels); WorldSnapshot::tracking_error holds

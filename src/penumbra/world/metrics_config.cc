@@ -16,10 +16,14 @@ struct KindEntry {
   std::string_view name;
 };
 constexpr KindEntry kKinds[] = {
-    {MetricKind::kBodyPose, "body_pose"},         {MetricKind::kBodyTwist, "body_twist"},
-    {MetricKind::kJointPosition, "joint_position"}, {MetricKind::kJointVelocity, "joint_velocity"},
-    {MetricKind::kJointTorque, "joint_torque"},   {MetricKind::kDistance, "distance"},
-    {MetricKind::kSensor, "sensor"},              {MetricKind::kTrackingError, "tracking_error"},
+    {MetricKind::kBodyPose, "body_pose"},
+    {MetricKind::kBodyTwist, "body_twist"},
+    {MetricKind::kJointPosition, "joint_position"},
+    {MetricKind::kJointVelocity, "joint_velocity"},
+    {MetricKind::kJointTorque, "joint_torque"},
+    {MetricKind::kDistance, "distance"},
+    {MetricKind::kSensor, "sensor"},
+    {MetricKind::kTrackingError, "tracking_error"},
     {MetricKind::kContacts, "contacts"},
 };
 
@@ -46,8 +50,8 @@ std::vector<std::string_view> KindKeys(MetricKind kind) {
     case MetricKind::kTrackingError:
       return {"robot"};
     case MetricKind::kContacts:
-      return {"min_force_N", "debounce_sec", "between", "exclude",
-              "self_contacts", "pair", "detect_hz"};
+      return {"min_force_N",   "debounce_sec", "between",  "exclude",
+              "self_contacts", "pair",         "detect_hz"};
   }
   return {};
 }
@@ -125,8 +129,7 @@ MetricConfig ReadEntry(const YamlReader& r) {
   throw ConfigError("", 0, key, problem);
 }
 
-void CheckNames(const std::string& key, const std::vector<std::string>& names,
-                const char* what) {
+void CheckNames(const std::string& key, const std::vector<std::string>& names, const char* what) {
   if (names.empty()) Fail(key, std::string("empty list; expected at least one ") + what);
   for (size_t i = 0; i < names.size(); ++i)
     if (names[i].empty())

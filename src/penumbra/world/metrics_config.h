@@ -67,7 +67,7 @@ struct ContactPairRule {
 struct MetricConfig {
   std::string name;  ///< [A-Za-z0-9_-]+, unique; names the CSV file
   MetricKind kind = MetricKind::kBodyPose;
-  std::optional<double> rate_hz;  ///< rows per second of sim time; nullopt = MetricsConfig's
+  std::optional<double> rate_hz;     ///< rows per second of sim time; nullopt = MetricsConfig's
   std::vector<std::string> bodies;   ///< body_pose, body_twist: name globs, >= 1
   std::vector<std::string> joints;   ///< joint_*: name globs, >= 1
   std::vector<std::string> sensors;  ///< sensor: MJCF sensor name globs, >= 1
@@ -76,13 +76,13 @@ struct MetricConfig {
   std::optional<Eigen::Vector3d> to_point_m;  ///< distance: to this point, world frame, m
   std::string robot;                          ///< tracking_error: the robot (its model name)
   // contacts
-  double min_force_N = 1.0;    ///< >= 0: an episode needs a pair's normal force >= this
-  double debounce_sec = 0.1;   ///< >= 0: a pair's episodes less than this apart merge
+  double min_force_N = 1.0;              ///< >= 0: an episode needs a pair's normal force >= this
+  double debounce_sec = 0.1;             ///< >= 0: a pair's episodes less than this apart merge
   std::vector<ContactPairRule> between;  ///< pairs counted; empty = every pair
   std::vector<ContactPairRule> exclude;  ///< pairs never counted (after `between`)
-  bool self_contacts = false;  ///< count contacts between two bodies of the same model
-  bool geom_pairs = false;     ///< pair: geom (true) or body (false)
-  double detect_hz = 0;        ///< >= 0; 0 = every physics step
+  bool self_contacts = false;            ///< count contacts between two bodies of the same model
+  bool geom_pairs = false;               ///< pair: geom (true) or body (false)
+  double detect_hz = 0;                  ///< >= 0; 0 = every physics step
 };
 
 /// the `metrics:` section.

@@ -38,8 +38,7 @@ class WorldParser {
     const std::vector<std::string_view> keys = {
         "seed",   "duration_sec", "physics",          "render",       "sky",       "robots",
         "models", "lights",       "cameras",          "mjcf_cameras", "materials", "output",
-        "agents", "adversity",    "semantic_classes", "effects",      "sensors",
-        "metrics"};
+        "agents", "adversity",    "semantic_classes", "effects",      "sensors",   "metrics"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
