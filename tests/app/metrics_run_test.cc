@@ -53,45 +53,45 @@ class MetricsRunTest : public ::testing::Test {
         << metrics;
     return LoadWorldFile((dir_ / "world.yaml").string());
   }
-  nlohmann::json Run(const WorldConfig& world, const std::string& out) {
+  nlohmann::ordered_json Run(const WorldConfig& world, const std::string& out) {
     RunOptions options;
     options.out_dir = (dir_ / out).string();
     options.progress = false;
     RunWorld(world, options);
     std::ifstream in(dir_ / out / "run.json");
-    return nlohmann::json::parse(in);
+    return nlohmann::ordered_json::parse(in);
   }
   fs::path dir_;
 };
 
 TEST_F(MetricsRunTest, SummariesAreTheLastKeyOfRunJson) {
-  const nlohmann::json j = Run(World(R"(metrics:
+  const nlohmann::ordered_json j = Run(World(R"(metrics:
   series:
     - {name: ball, type: body_pose, bodies: [scene/ball], rate_hz: 10}
     - {name: height, type: distance, body: scene/ball, to_point: [0, 0, 0]}
     - {name: landing, type: contacts, min_force_N: 0.5}
 )"),
-                               "out");
+                                       "out");
   ASSERT_TRUE(j.contains("metrics"));
   EXPECT_EQ(j.items().begin().key(), "world_file");
   std::string last;
   for (const auto& item : j.items()) last = item.key();
   EXPECT_EQ(last, "metrics");
-  const nlohmann::json& m = j.at("metrics");
+  const nlohmann::ordered_json& m = j.at("metrics");
   EXPECT_EQ(m.at("ball").at("rows"), 11);
-  const nlohmann::json& z = m.at("ball").at("columns").at("scene/ball_z_m");
+  const nlohmann::ordered_json& z = m.at("ball").at("columns").at("scene/ball_z_m");
   EXPECT_NEAR(z.at("max").get<double>(), 0.5, 1e-9) << "starts at 0.5 m";
-  EXPECT_NEAR(z.at("min").get<double>(), 0.1, 0.01) << "rests on the floor";
-  EXPECT_NEAR(m.at("height").at("final_distance_m").get<double>(), 0.1, 0.01);
+  EXPECT_NEAR(z.at("min").get<double>(), 0.1, 0.03) << "lands on the floor (soft contact)";
+  EXPECT_NEAR(m.at("height").at("final_distance_m").get<double>(), 0.1, 0.03);
   EXPECT_EQ(m.at("landing").at("collisions"), 1);
   EXPECT_EQ(m.at("landing").at("collisions_by_pair"),
-            nlohmann::json({{"scene/ball | scene/floor", 1}}));
+            nlohmann::ordered_json({{"scene/ball | scene/floor", 1}}));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / "metrics" / "ball.csv"));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / "metrics" / "landing_episodes.csv"));
 }
 
 TEST_F(MetricsRunTest, WithoutTheSectionNothingChanges) {
-  const nlohmann::json j = Run(World(""), "out");
+  const nlohmann::ordered_json j = Run(World(""), "out");
   EXPECT_FALSE(j.contains("metrics"));
   EXPECT_FALSE(fs::exists(dir_ / "out" / "metrics"));
 }

@@ -144,7 +144,7 @@ struct MetricsSink::Series {
   // contacts
   std::unique_ptr<CollisionCounter> counter;
   std::vector<std::vector<uint8_t>> between_a, between_b, exclude_a, exclude_b;  // per geom
-  std::vector<std::string> geom_model;  // per geom: the model its side belongs to
+  std::vector<std::string> geom_model;  // per geom: the model of its body ("" for the world's)
   std::string episodes_name;
   LineFile episodes;
   int64_t episode_rows = 0;
@@ -340,7 +340,8 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
         s->geom_model.resize(ng);
         for (size_t g = 0; g < ng; ++g) {
           const int b = model_.geom_body[g];
-          s->geom_model[g] = b > 0 ? ModelOf(model_.body_names[b]) : ModelOf(model_.geom_names[g]);
+          // geoms of the world body (floors, walls) belong to no model: never a self contact
+          s->geom_model[g] = b > 0 ? ModelOf(model_.body_names[b]) : "";
         }
         s->row_content = SnapshotContent::kFull;
         cols = {"contacts", "pairs_in_collision", "normal_force_N", "max_pair_force_N",

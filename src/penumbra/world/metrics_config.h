@@ -80,9 +80,11 @@ struct MetricConfig {
   double debounce_sec = 0.1;             ///< >= 0: a pair's episodes less than this apart merge
   std::vector<ContactPairRule> between;  ///< pairs counted; empty = every pair
   std::vector<ContactPairRule> exclude;  ///< pairs never counted (after `between`)
-  bool self_contacts = false;            ///< count contacts between two bodies of the same model
-  bool geom_pairs = false;               ///< pair: geom (true) or body (false)
-  double detect_hz = 0;                  ///< >= 0; 0 = every physics step
+  /// count contacts between two bodies of the same model ("<model>/" prefix; geoms of the
+  /// world body belong to none)
+  bool self_contacts = false;
+  bool geom_pairs = false;  ///< pair: geom (true) or body (false)
+  double detect_hz = 0;     ///< >= 0; 0 = every physics step
 };
 
 /// the `metrics:` section.
