@@ -88,11 +88,12 @@ metrics:
 
 // runs `world_text` (in `dir`) for its duration with one metrics sink in `mode`
 std::string RunMetrics(const testing::TempDir& dir, const std::string& world_text,
-                       const std::string& out, MetricsMode mode) {
+                       const std::string& out, MetricsMode mode, bool controllers = true) {
   std::ofstream(dir.path() / "arena.xml") << kArena;
   const WorldConfig world = ParseWorld(world_text, (dir.path() / "world.yaml").string());
   SessionOptions options;
   options.build_renderer = false;
+  options.add_controllers = controllers;
   Session session(world, options);
   std::unique_ptr<MetricsSink> sink =
       MakeMetricsSink(world, session.sim(), (dir.path() / out).string(), mode);
@@ -186,6 +187,18 @@ TEST(MetricsSinkTest, KinematicModeRecordsPosesAndTwistsFromTheStateAlone) {
   }
   EXPECT_EQ(kin.at("twist").at("columns").size(), 6u);
   EXPECT_EQ(dyn.at("chassis"), kin.at("chassis"));
+}
+
+TEST(MetricsSinkTest, WithoutControllersTheTrackingErrorIsUnavailable) {
+  // a replay runs no controllers: the rover stands still, its contacts are still counted
+  testing::TempDir dir;
+  const json j = json::parse(
+      RunMetrics(dir, CollisionWorld(), "out", MetricsMode::kDynamics, /*controllers=*/false));
+  EXPECT_EQ(j.at("track").at("unavailable"),
+            "the simulation runs no controllers (a replay without them)");
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "metrics" / "track.csv"));
+  EXPECT_EQ(j.at("bumps").at("collisions"), 0);
+  EXPECT_NEAR(j.at("wall").at("final_distance_m").get<double>(), 1.15, 0.01) << "stood still";
 }
 
 TEST(MetricsSinkTest, NamesThatMatchNothingAreConfigErrorsWithTheirLine) {

@@ -174,7 +174,8 @@ MetricsModel MetricsModel::FromSimulation(const WorldConfig& world, const Simula
   std::vector<const ModelConfig*> driven;
   for (const ModelConfig& mc : world.models)
     if (mc.is_robot && !mc.controller.type.empty()) driven.push_back(&mc);
-  if (static_cast<int>(driven.size()) == sim.num_controllers()) {
+  m.has_controllers = static_cast<int>(driven.size()) == sim.num_controllers();
+  if (m.has_controllers) {
     for (int i = 0; i < sim.num_controllers(); ++i) {
       const Controller& c = sim.controller(i);
       m.controllers.push_back({driven[i]->name, c.type(), c.tracking_error_labels()});
@@ -196,9 +197,12 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
     s->config = c;
     s->key = "metrics.series[" + std::to_string(i) + "]";
     s->rate_hz = config.RateOf(c);
-    if (!dynamics && NeedsDynamics(c.kind)) {
+    if (!dynamics && NeedsDynamics(c.kind))
       s->unavailable = "needs physics (" + std::string(MetricKindName(c.kind)) +
                        "); a kinematic replay only moves the bodies";
+    else if (c.kind == MetricKind::kTrackingError && !model_.has_controllers)
+      s->unavailable = "the simulation runs no controllers (a replay without them)";
+    if (!s->unavailable.empty()) {
       spdlog::warn("metric '{}' ({}) is not recorded: {}", c.name, MetricKindName(c.kind),
                    s->unavailable);
       series_.push_back(std::move(s));

@@ -61,6 +61,9 @@ struct MetricsModel {
     std::vector<std::string> labels;
   };
   std::vector<ControllerTracking> controllers;
+  /// false when the simulation runs none of the world's controllers (a replay without them):
+  /// tracking_error metrics are then unavailable, not an error.
+  bool has_controllers = true;
 
   /// from a composed, loaded world: scene bodies and geoms, joints, sensors, and the
   /// controllers of `world`'s robots (in Session's order: robots with a controller, in file
