@@ -158,6 +158,30 @@ TEST_F(WaypointFollowerTest, AdvancesStopsAndLoops) {
   EXPECT_EQ(tiny->waypoints_reached(), 2);
 }
 
+TEST_F(WaypointFollowerTest, TrackingErrorIsTheDistanceFromTheSegmentFollowed) {
+  auto f = Make({{2, 0}, {2, 2}}, false);
+  ASSERT_EQ(f->tracking_error_labels(),
+            (std::vector<std::string>{"cross_track_m", "goal_distance_m"}));
+  std::vector<double> e;
+  f->AppendTrackingError(&e);
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_TRUE(std::isnan(e[0])) << "no update yet";
+  // the first segment runs from the start position (0, 0) to (2, 0)
+  Run(*f, 0, 0, 0);
+  Run(*f, 1, 0.3, 0);
+  e.clear();
+  f->AppendTrackingError(&e);
+  EXPECT_NEAR(e[0], 0.3, 1e-12);
+  EXPECT_NEAR(e[1], std::hypot(1.0, 0.3), 1e-12);
+  // past the first waypoint: the segment (2, 0) -> (2, 2)
+  Run(*f, 1.95, 0.05, 90);
+  Run(*f, 1.6, 1.0, 90);
+  e.clear();
+  f->AppendTrackingError(&e);
+  EXPECT_NEAR(e[0], 0.4, 1e-12);
+  EXPECT_NEAR(e[1], std::hypot(0.4, 1.0), 1e-12);
+}
+
 TEST_F(WaypointFollowerTest, InitializeListsAllMissingNames) {
   WaypointFollowerParams p = Params({{1, 0}}, false);
   p.base_body = "r/base";

@@ -11,6 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/progress.h"
@@ -231,6 +232,8 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
                      camera_options);
   SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
   TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());
+  const std::unique_ptr<MetricsSink> metrics =
+      MakeMetricsSink(world, sim, out.string(), MetricsMode::kDynamics);
   ProgressOptions progress_options;
   progress_options.mode =
       options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
@@ -290,12 +293,13 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
       m.record_events = st.events;
       m.record_sensor_records = st.sensor_records;
     }
+    if (metrics) m.metrics_json = metrics->SummaryJson();  // its OnFinish ran before
     return m;
   });
   // the recorder after the cameras and sensors (their sensor records reach it before it
   // closes) and before the manifest (which reports its size)
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory})
-    loop.AddSink(sink);
+  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, metrics.get()})
+    if (sink) loop.AddSink(sink);
   if (recorder) loop.AddSink(recorder.get());
   loop.AddSink(&manifest);
   rollback.Dismiss();

@@ -60,6 +60,14 @@ class Controller {
   /// must write finite values (the simulation throws PhysicsError otherwise).
   virtual void Compute(const ControlInput& input, std::span<double> ctrl) = 0;
 
+  /// names of the values AppendTrackingError reports, each ending in its unit (e.g.
+  /// "cross_track_m", "vx_error_m_s"), for the world file's `tracking_error` metric
+  /// (world/metrics_config.h). empty (the default): the controller reports no tracking error.
+  virtual std::vector<std::string> tracking_error_labels() const { return {}; }
+  /// appends one value per tracking_error_labels() entry to `out`: the tracking error at the
+  /// last control update (NaN before the first one). the default appends nothing.
+  virtual void AppendTrackingError(std::vector<double>* out) const {}
+
   /// where the controller was configured.
   const ControllerContext& context() const { return context_; }
   /// "type (key)" for messages, e.g. "waypoint_follower (robots[rover].controller)".

@@ -499,6 +499,8 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   const double cp = std::cos(psi), sp = std::sin(psi);
   const Eigen::Vector2d v_ref_xy(cp * reference_.vx - sp * reference_.vy,
                                  sp * reference_.vx + cp * reference_.vy);
+  tracking_ = {reference_.vx - (cp * v_com.x() + sp * v_com.y()),
+               reference_.vy - (-sp * v_com.x() + cp * v_com.y()), reference_.yaw_rate - w.z()};
   p_ref_ += v_ref_xy * dt;
   Eigen::Vector2d lead = p_ref_ - com.head<2>();
   if (lead.norm() > kMaxPositionLead) lead *= kMaxPositionLead / lead.norm();

@@ -113,6 +113,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -195,6 +196,15 @@ class TrotGait final : public Controller {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// twist tracking at the last update: the slew-limited reference() minus the measured
+  /// velocity of the centre of mass (heading frame: x forward, y left, m/s) and the trunk's yaw
+  /// rate (rad/s): "vx_error_m_s", "vy_error_m_s", "yaw_rate_error_rad_s".
+  std::vector<std::string> tracking_error_labels() const override {
+    return {"vx_error_m_s", "vy_error_m_s", "yaw_rate_error_rad_s"};
+  }
+  void AppendTrackingError(std::vector<double>* out) const override {
+    out->insert(out->end(), tracking_.begin(), tracking_.end());
+  }
 
   /// programmatic command source (e.g. a middleware's cmd_vel): from the next update on,
   /// `command` replaces the waypoints and the scripted list until ClearCommand() (the
@@ -257,6 +267,7 @@ class TrotGait final : public Controller {
   StanceForceLimits limits_;
   double leg_length_ = 0.426;  ///< mean thigh + calf length (m)
   double step_limit_ = 0.17;
+  std::array<double, 3> tracking_ = {NAN, NAN, NAN};  ///< see tracking_error_labels()
 
   std::optional<TrotCommand> override_;
   std::optional<WaypointRoute> route_;

@@ -85,7 +85,21 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
 
 void WaypointFollower::Compute(const ControlInput& input, std::span<double> ctrl) {
   const Pose X_WB = input.X_WB(base_body_);
-  route_.Advance(X_WB.translation().head<2>());
+  const Eigen::Vector2d p = X_WB.translation().head<2>();
+  if (!start_) start_ = p;
+  route_.Advance(p);
+  // tracking error: distance from the segment (previous waypoint or start) -> goal
+  {
+    const auto& w = route_.waypoints();
+    const int k = route_.target_index();
+    const Eigen::Vector2d a = k > 0                                    ? w[k - 1]
+                              : (params_.loop && route_.reached() > 0) ? w.back()
+                                                                       : *start_;
+    const Eigen::Vector2d ab = route_.target() - a;
+    const double len2 = ab.squaredNorm();
+    const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    tracking_ = {(a + s * ab - p).norm(), (route_.target() - p).norm()};
+  }
   UnicycleCommand cmd;
   if (!route_.finished())
     cmd = PurePursuit(X_WB, route_.target(),

@@ -37,8 +37,11 @@
 // if the base body's x axis points (nearly) straight up or down, the robot stops.
 
 #include <Eigen/Core>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +82,15 @@ class WaypointFollower final : public Controller {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// "cross_track_m": distance of the base body's origin (world xy) from the path segment
+  /// being followed (the previous waypoint, or the start position before the first one is
+  /// reached, to the current goal); "goal_distance_m": its distance to the current goal.
+  std::vector<std::string> tracking_error_labels() const override {
+    return {"cross_track_m", "goal_distance_m"};
+  }
+  void AppendTrackingError(std::vector<double>* out) const override {
+    out->insert(out->end(), tracking_.begin(), tracking_.end());
+  }
 
   const WaypointFollowerParams& params() const { return params_; }
   /// index of the waypoint being driven to.
@@ -99,6 +111,8 @@ class WaypointFollower final : public Controller {
   int base_body_ = -1, left_ = -1, right_ = -1;
   WaypointRoute route_;
   double v_ = 0, omega_ = 0;
+  std::optional<Eigen::Vector2d> start_;         ///< base origin at the first update (world xy, m)
+  std::array<double, 2> tracking_ = {NAN, NAN};  ///< see tracking_error_labels()
 };
 
 }  // namespace penumbra

@@ -62,6 +62,7 @@ std::string RunManifestJson(const RunManifest& m) {
     rj["warnings"] = r.warnings;
     j["replay"] = rj;
   }
+  if (!m.metrics_json.empty()) j["metrics"] = nlohmann::ordered_json::parse(m.metrics_json);
   return j.dump(2) + "\n";
 }
 

@@ -60,6 +60,9 @@ struct RunManifest {
   int64_t record_first_step = -1, record_last_step = -1;
   int64_t record_events = 0;
   int64_t record_sensor_records = 0;
+  /// the world file's `metrics:` summaries (metrics/metrics_sink.h, MetricsSink::SummaryJson):
+  /// a JSON object as text, written as the key "metrics" (last) only when not empty.
+  std::string metrics_json;
   /// the run's first error (e.g. divergence, a file that could not be written); the key
   /// "error" is written only when it is not empty, after "peak_resident_memory_mib".
   std::string error;

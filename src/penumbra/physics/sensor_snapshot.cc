@@ -26,6 +26,7 @@ void FillSensorGroundTruth(const mjModel* m, const mjData* d, WorldSnapshot* out
     mj_objectVelocity(m, d, mjOBJ_XBODY, b, v, 0);
     for (int k = 0; k < 6; ++k) out->V_WB[b][k] = v[k];
   }
+  out->qfrc_actuator.assign(d->qfrc_actuator, d->qfrc_actuator + m->nv);
   out->contacts.resize(d->ncon);
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];

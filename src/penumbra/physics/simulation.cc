@@ -789,12 +789,15 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   }
   FillTendonPaths(m, d, impl_->scene.tendons, &out->tendon_paths);
   SnapshotState(out);
+  out->tracking_error.clear();
   if (content == SnapshotContent::kFull) {
     FillSensorGroundTruth(m, d, out);
+    for (const auto& c : impl_->controllers) c->AppendTrackingError(&out->tracking_error);
   } else {
     out->sensordata.clear();
     out->V_WB.clear();
     out->contacts.clear();
+    out->qfrc_actuator.clear();
   }
 }
 

@@ -155,11 +155,12 @@ class Simulation {
     /// time, X_WB of every body, MJCF camera poses, light positions/directions, the state
     /// (SnapshotState: qpos, qvel, act, ctrl, ...):
     /// mj_kinematics, mj_comPos and mj_camlight for the current qpos and mocap poses (what
-    /// cameras and effects read; a small part of a step). sensordata, V_WB and contacts are
-    /// left empty.
+    /// cameras and effects read; a small part of a step). sensordata, V_WB, contacts,
+    /// qfrc_actuator and tracking_error are left empty.
     kPoses,
-    /// kPoses plus sensordata, V_WB and contacts: the whole mj_forward for the current
-    /// state (collision, constraint forces, every sensor stage; about the cost of a step).
+    /// kPoses plus sensordata, V_WB, contacts, qfrc_actuator and the controllers' tracking
+    /// errors: the whole mj_forward for the current state (collision, constraint forces,
+    /// every sensor stage; about the cost of a step).
     kFull,
   };
 

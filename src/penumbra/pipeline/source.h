@@ -20,7 +20,7 @@ enum class SnapshotContent {
   /// WorldSnapshot) (trajectory rows, recorders)
   kState = 1,
   kPoses = 2,  ///< kState plus X_WB, X_W_mjcam, light poses (cameras, effects)
-  kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts (sensors, ground truth)
+  kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts, qfrc_actuator, tracking_error
 };
 
 /// the richer of two contents.

@@ -71,6 +71,13 @@ struct WorldSnapshot {
   };
   /// active contacts at this instant (ground truth for evaluation).
   std::vector<Contact> contacts;
+  /// (nv) MuJoCo qfrc_actuator: the generalized force the actuators apply at each degree of
+  /// freedom (N m at hinge dofs, N at slide dofs), index as qvel. filled with contacts.
+  std::vector<double> qfrc_actuator;
+  /// every controller's tracking error at its last update (control/controller.h,
+  /// Controller::AppendTrackingError), concatenated in the simulation's controller order;
+  /// filled with contacts.
+  std::vector<double> tracking_error;
 };
 
 }  // namespace penumbra

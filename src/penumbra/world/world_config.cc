@@ -38,7 +38,8 @@ class WorldParser {
     const std::vector<std::string_view> keys = {
         "seed",   "duration_sec", "physics",          "render",       "sky",       "robots",
         "models", "lights",       "cameras",          "mjcf_cameras", "materials", "output",
-        "agents", "adversity",    "semantic_classes", "effects",      "sensors",   "record"};
+        "agents", "adversity",    "semantic_classes", "effects",      "sensors",   "record",
+        "metrics"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -114,6 +115,7 @@ class WorldParser {
       w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
     if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
     if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
+    if (r.Has("metrics")) w.metrics = ReadMetrics(r.Child("metrics"));
     if (r.Has("adversity")) {
       const YamlReader a = r.Child("adversity");
       w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());

@@ -18,6 +18,7 @@
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/sensors/camera_sensor_config.h"
+#include "penumbra/world/metrics_config.h"
 #include "penumbra/world/sensors_reader.h"
 
 namespace penumbra {
@@ -199,6 +200,8 @@ struct WorldConfig {
   /// preset file path (absolute after loading), "" = none (world/adversity_preset.h).
   std::string adversity;
   int adversity_line = 0;  ///< line of the `adversity` key (0 = unknown / command line)
+  /// `metrics:` time series recorded while the world runs (world/metrics_config.h).
+  MetricsConfig metrics;
   /// 1-based line of every key path of the world file (null for a bare model); lets errors
   /// found after loading (by a stage) still name the line: see LocateInWorld.
   std::shared_ptr<const LineTable> lines;

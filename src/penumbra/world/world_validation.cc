@@ -87,6 +87,12 @@ class Validator {
     CheckMaterials();
     if (w_.output_dir.empty()) Fail("output.dir", "empty; expected a folder name");
     CheckRecord();
+    // metrics: keys of the section's own checks get the file and line here
+    try {
+      w_.metrics.ValidateOrThrow();
+    } catch (const ConfigError& e) {
+      Fail(e.key(), e.problem());
+    }
   }
 
  private:
