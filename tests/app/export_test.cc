@@ -111,7 +111,9 @@ class ExportCommandTest : public ::testing::Test {
     dir_->Write("walls.xml", kMjcf);
     const std::string world = dir_->Write("world.yaml", kWorld);
     const testing::ProcessResult r = RunPenumbra(
-        {"run", world, "--out", (dir_->path() / "run").string(), "--quiet"}, dir_->path());
+        {"run", world, "--out", (dir_->path() / "run").string(), "--record",
+         (dir_->path() / "run.plog").string(), "--quiet"},
+        dir_->path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   static void TearDownTestSuite() {
@@ -300,7 +302,42 @@ TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
                    (out_.path() / "c").string()},
                   out_.path());
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("replay it first"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no such run log"), std::string::npos) << r.err;
+  // --world only for a run log
+  r = Export("tum", out_.path() / "w", {"--camera", "front", "--world", "x.yaml"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("only for a run log"), std::string::npos) << r.err;
+}
+
+// a run log is replayed with the recorded conditions and exported: the dataset is the one the
+// run's own folder gives, file for file, and the temporary replay folder is gone
+TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
+  ASSERT_EQ(Export("tum", out_.path() / "from_run", {"--camera", "front"}).exit_code, 0);
+  const testing::ProcessResult r =
+      RunPenumbra({"export", (dir_->path() / "run.plog").string(), "--format", "tum", "--out",
+                   (out_.path() / "from_log").string(), "--camera", "front"},
+                  dir_->path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_run")) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), out_.path() / "from_run");
+    names.push_back(rel.string());
+    // the lists name their source: the run folder, or the log
+    std::string a = ReadAll(e.path()), b = ReadAll(out_.path() / "from_log" / rel);
+    const std::string run_line = "# file: '" + run().string() + "'\n";
+    const std::string log_line = "# file: '" + (dir_->path() / "run.plog").string() + "'\n";
+    if (const size_t at = a.find(run_line); at != std::string::npos) {
+      a.replace(at, run_line.size(), log_line);
+    }
+    EXPECT_EQ(a, b) << rel;
+  }
+  EXPECT_GT(names.size(), 10u);  // 6 rgb + 6 depth + 4 lists
+  size_t log_files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_log"))
+    log_files += e.is_regular_file();
+  EXPECT_EQ(log_files, names.size());
+  EXPECT_FALSE(fs::exists(out_.path() / "from_log.replay-tmp"));
 }
 
 }  // namespace

@@ -3,10 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <optional>
 
 #include "penumbra/core/error.h"
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/run_folder.h"
+#include "penumbra/replay/replay_runner.h"
 
 namespace penumbra {
 
@@ -16,7 +18,29 @@ struct ExportCommand::State {
   std::string format;
   DatasetExportOptions options;
   std::string out;
+  std::string replay_world;  // --world for a .plog input
+  std::string replay_adversity;
 };
+
+namespace {
+
+// a temporary folder that is removed with everything in it when it goes out of scope
+class TempFolder {
+ public:
+  explicit TempFolder(std::filesystem::path path) : path_(std::move(path)) {}
+  TempFolder(const TempFolder&) = delete;
+  TempFolder& operator=(const TempFolder&) = delete;
+  ~TempFolder() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace
 
 bool ExportCommand::selected() const {
   return state_ && state_->command && static_cast<bool>(*state_->command);
@@ -29,14 +53,35 @@ int ExportCommand::Run() const {
   options.out_dir = s.out;
   namespace fs = std::filesystem;
   const fs::path input(s.input);
-  // a run log is first replayed into a temporary run folder, then exported from there. the
-  // replay verb (issue 18 point 2) plugs in here: replay `input` into a temp folder and pass
-  // that folder to RunFolder below.
-  if (input.extension() == ".plog")
-    throw ConfigError(s.input, 0, "",
-                      "a run log; export reads a run folder: replay it first "
-                      "(penumbra replay FILE.plog --out DIR), then penumbra export DIR");
-  const RunFolder run(input);
+  // a run log is first replayed (replay/replay_runner.h, with the recorded conditions or the
+  // given --world / --adversity) into a temporary run folder beside --out, exported from there
+  std::optional<TempFolder> replayed;
+  fs::path run_dir = input;
+  if (input.extension() == ".plog") {
+    if (!fs::is_regular_file(input))
+      throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
+    if (fs::exists(options.out_dir) && !fs::is_empty(options.out_dir))
+      throw ConfigError("", 0, "--out",
+                        "'" + options.out_dir.string() + "' is not empty; expected a new or empty folder");
+    const fs::path parent = fs::absolute(options.out_dir).parent_path();
+    fs::create_directories(parent);
+    replayed.emplace(parent / (fs::absolute(options.out_dir).filename().string() + ".replay-tmp"));
+    ReplayOptions replay;
+    replay.log_path = s.input;
+    replay.out_dir = replayed->path().string();
+    replay.force = true;
+    replay.world_override = s.replay_world;
+    replay.adversity = s.replay_adversity;
+    replay.progress = false;
+    spdlog::info("replaying {} into {} for the export", s.input, replay.out_dir);
+    ReplayLog(replay);
+    run_dir = replayed->path();
+    options.source_label = fs::absolute(input).lexically_normal().string();
+  } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
+    throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
+                      "only for a run log (.plog) input, which is replayed first");
+  }
+  const RunFolder run(run_dir);
   const DatasetExportSummary summary = ExportDataset(run, options);
   std::string sensors = "camera '" + summary.camera + "'";
   if (!summary.camera2.empty()) sensors += ", camera '" + summary.camera2 + "'";
@@ -57,7 +102,14 @@ ExportCommand AddExportCommand(CLI::App& app) {
   ExportCommand::State& s = *c.state_;
   s.command = app.add_subcommand(
       "export", "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset");
-  s.command->add_option("run", s.input, "output folder of `penumbra run`")->required();
+  s.command->add_option("run", s.input,
+                        "output folder of `penumbra run`, or a run log (.plog), replayed first")
+      ->required();
+  s.command->add_option("--world", s.replay_world,
+                        "for a .plog: world-file override of the replay (replay --world), e.g. "
+                        "to add depth to a camera");
+  s.command->add_option("--adversity", s.replay_adversity,
+                        "for a .plog: adversity preset of the replay (replay --adversity)");
   s.command->add_option("--format,-f", s.format, "dataset layout")
       ->required()
       ->check(CLI::IsMember({"tum", "euroc", "kitti"}));

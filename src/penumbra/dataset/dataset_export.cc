@@ -120,7 +120,9 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
   }
   // every input is read before the output folder is touched; a failed export removes what it
   // wrote (the folder too when it made it)
-  const std::string source = fs::absolute(run.dir()).lexically_normal().string();
+  const std::string source = options.source_label.empty()
+                                 ? fs::absolute(run.dir()).lexically_normal().string()
+                                 : options.source_label;
   std::error_code ec;
   const bool out_existed = fs::exists(fs::symlink_status(options.out_dir, ec));
   bool prepared = false;

@@ -31,6 +31,9 @@ struct DatasetExportOptions {
   std::string imu;
   /// KITTI sequence name: two digits.
   std::string sequence = "00";
+  /// what the TUM lists' "# file:" line names as the source; "" = the run folder (absolute).
+  /// (a run log exported through a temporary replay folder names the log.)
+  std::string source_label;
 
   /// @throws ConfigError naming the option (--out, --camera2, --imu, --sequence) for an empty
   ///         output folder, a second camera with TUM or equal to the first, an IMU without
