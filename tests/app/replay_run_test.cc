@@ -296,9 +296,22 @@ TEST(ReplayRunTest, BadOptionsAndOverridesAreRefusedNamingThem) {
                   tmp.path());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--from"), std::string::npos) << r.err;
-  r = RunPenumbra({"replay", log, "--resimulate", "--out", out.string()}, tmp.path());
+  r = RunPenumbra({"replay", log, "--resimulate", "--cameras", "cam"}, tmp.path());
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--out: does not apply to --resimulate"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--cameras: does not apply to --resimulate"), std::string::npos) << r.err;
+  r = RunPenumbra({"replay", log, "--resimulate", "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--force: needs --out DIR"), std::string::npos) << r.err;
+  // --resimulate --out: the verdict on stdout, run.json beside; the log's folder is refused
+  r = RunPenumbra({"replay", log, "--resimulate", "--out", out.string()}, tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "bit-exact (101 steps)\n");
+  EXPECT_NE(ReadAll(out / "run.json").find("\"verdict\": \"bit-exact (101 steps)\""),
+            std::string::npos);
+  fs::remove_all(out);
+  r = RunPenumbra({"replay", log, "--resimulate", "--out", tmp.str(), "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("holds the log being replayed"), std::string::npos) << r.err;
   // the output folder of the recording holds the log: --force would remove it
   r = RunPenumbra({"replay", log, "--out", tmp.str(), "--force"}, tmp.path());
   EXPECT_EQ(r.exit_code, 2);

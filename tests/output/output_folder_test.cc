@@ -113,5 +113,31 @@ TEST(OutputFolderTest, LinksAreNeverFollowedOrRemoved) {
   EXPECT_TRUE(fs::exists(dir.path() / "victim" / "000000.png"));
 }
 
+// a set-up that fails leaves the folder as it found it: a created one is removed, an empty
+// one emptied; once dismissed, what the run wrote stays
+TEST(OutputFolderTest, SetupRollbackLeavesTheFolderAsFoundUnlessDismissed) {
+  testing::TempDir dir;
+  const fs::path created = dir.path() / "new";
+  const fs::path existing = dir.path() / "old";
+  fs::create_directories(existing);
+  PrepareOutputFolder(created, false);
+  PrepareOutputFolder(existing, false);
+  {
+    SetupRollback a(created, true), b(existing, false);
+    std::ofstream(created / "run.json") << "{}";
+    fs::create_directories(existing / "cam" / "rgb");
+    std::ofstream(existing / "composed.xml") << "<mujoco/>";
+  }
+  EXPECT_FALSE(fs::exists(created));
+  ASSERT_TRUE(fs::is_directory(existing));
+  EXPECT_TRUE(fs::is_empty(existing));
+  {
+    SetupRollback kept(existing, false);
+    std::ofstream(existing / "run.json") << "{}";
+    kept.Dismiss();
+  }
+  EXPECT_TRUE(fs::is_regular_file(existing / "run.json"));
+}
+
 }  // namespace
 }  // namespace penumbra

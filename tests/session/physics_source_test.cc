@@ -74,5 +74,27 @@ TEST(PhysicsSourceTest, FullSnapshotsMatchTheSimulationsOwn) {
   EXPECT_TRUE(poses->contacts.empty());
 }
 
+// before_step runs before every step with the simulation about to step: what it sets (here
+// ctrl-like xfrc_applied) is in the step, and returning false ends the source there
+TEST(PhysicsSourceTest, BeforeStepRunsBeforeEachStepAndCanEndTheSource) {
+  Simulation sim = Simulation::LoadFromString(kBoxXml);
+  std::vector<int64_t> called_at;
+  PhysicsSourceOptions options;
+  options.before_step = [&](Simulation& s) {
+    called_at.push_back(s.step_count());
+    return s.step_count() < 20;
+  };
+  PhysicsSource source(&sim, options);
+  Collect state(SnapshotContent::kState);
+  const LoopFinish f = testing::RunLoop(&source, {&state}, 0.5);
+  ASSERT_FALSE(f.error);
+  EXPECT_EQ(f.reason, LoopEndReason::kSourceEnded);
+  EXPECT_EQ(f.step, 20);
+  EXPECT_EQ(sim.step_count(), 20);
+  ASSERT_EQ(called_at.size(), 21u);
+  for (size_t i = 0; i < called_at.size(); ++i) EXPECT_EQ(called_at[i], static_cast<int64_t>(i));
+  EXPECT_EQ(state.got.size(), 21u);
+}
+
 }  // namespace
 }  // namespace penumbra

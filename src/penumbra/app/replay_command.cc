@@ -62,7 +62,9 @@ ReplayCommand::ReplayCommand(CLI::App& app) : state_(std::make_unique<State>()) 
   s.verb = r;
   ReplayOptions& o = s.options;
   r->add_option("log", o.log_path, "run log (.plog) written by penumbra run --record")->required();
-  r->add_option("--out,-o", o.out_dir, "output folder (required for a kinematic replay)");
+  r->add_option("--out,-o", o.out_dir,
+                "output folder (required for a kinematic replay; with --resimulate: the "
+                "metrics and run.json)");
   r->add_flag("--force", o.force,
               "the output folder may hold an earlier run's outputs: remove them first");
   r->add_option("--adversity", o.adversity,
@@ -103,14 +105,19 @@ int ReplayCommand::Run(const std::vector<std::string>& command_line,
   CLI::App* r = s.verb;
   if (s.resimulate_option->count() > 0) {
     // physics only: the options that change what is seen do not apply
-    for (const char* flag : {"--out", "--force", "--adversity", "--world", "--tier", "--cameras",
-                             "--from", "--to", "--threads", "--outputs"})
+    for (const char* flag : {"--adversity", "--world", "--tier", "--cameras", "--from", "--to",
+                             "--threads", "--outputs"})
       if (r->count(flag) > 0)
         throw ConfigError("", 0, flag,
                           "does not apply to --resimulate, which re-runs the recorded physics "
-                          "and writes no outputs; expected it without --resimulate");
+                          "and renders nothing; expected it without --resimulate");
+    if (r->count("--force") > 0 && s.options.out_dir.empty())
+      throw ConfigError("", 0, "--force", "needs --out DIR; expected it with --out");
     ResimulateOptions o;
     o.log_path = s.options.log_path;
+    o.out_dir = s.options.out_dir;
+    o.force = s.options.force;
+    o.command_line = command_line;
     o.mode = s.resimulate == "ctrl" ? ResimulateMode::kCtrl : ResimulateMode::kControllers;
     o.stop_request = stop_request;
     const ResimulateReport report = ResimulateLog(o);

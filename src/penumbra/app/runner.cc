@@ -6,29 +6,19 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <initializer_list>
-#include <optional>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
-#include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
-#include "penumbra/output/progress.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/output/run_manifest.h"
-#include "penumbra/output/trajectory_sink.h"
-#include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
-#include "penumbra/session/camera_sink.h"
-#include "penumbra/session/effects_stage.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
+#include "penumbra/session/run_outputs.h"
 #include "penumbra/session/scene_assembly.h"
-#include "penumbra/session/sensor_sink.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -41,37 +31,6 @@ double SecondsSince(Clock::time_point t0) {
 }
 
 RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options);
-
-// a run refused while it sets up (bad input found once the model is composed: an unknown body,
-// a scene too large) leaves its output folder as it found it, empty or absent, so that the
-// corrected command runs without --force. everything in the folder is this run's: it was empty
-// or new when the run began (PrepareOutputFolder).
-class SetupRollback {
- public:
-  SetupRollback(std::filesystem::path out, bool created)
-      : out_(std::move(out)), created_(created) {}
-  SetupRollback(const SetupRollback&) = delete;
-  SetupRollback& operator=(const SetupRollback&) = delete;
-  ~SetupRollback() {
-    if (done_) return;
-    std::error_code ec;
-    if (created_) {
-      std::filesystem::remove_all(out_, ec);
-      return;
-    }
-    std::vector<std::filesystem::path> entries;
-    for (std::filesystem::directory_iterator it(out_, ec), end; !ec && it != end; it.increment(ec))
-      entries.push_back(it->path());
-    for (const std::filesystem::path& p : entries) std::filesystem::remove_all(p, ec);
-  }
-  /// the run has started: from here on what it wrote is kept
-  void Dismiss() { done_ = true; }
-
- private:
-  std::filesystem::path out_;
-  bool created_ = false;
-  bool done_ = false;
-};
 
 }  // namespace
 
@@ -153,32 +112,6 @@ std::string JoinArgs(const std::vector<std::string>& args) {
   return s;
 }
 
-// run.json of a finished run (the error is added by the ManifestSink)
-RunManifest DescribeRun(const WorldConfig& world, const RunOptions& options,
-                        const EffectsStage& effects, const RunSummary& summary,
-                        const std::map<std::string, double>& timings) {
-  RunManifest m;
-  m.world_file =
-      world.file.empty() && !world.models.empty() ? world.models.front().file : world.file;
-  m.seed = world.seed;
-  m.penumbra_version = PENUMBRA_VERSION;
-  m.mujoco_version = MujocoVersion();
-  m.embree_version = RendererVersion(world.render.backend);
-  m.timings_sec = timings;
-  m.peak_resident_memory_mib = summary.peak_rss_mib;
-  m.frames_per_camera = summary.frames_per_camera;
-  m.sim_duration_sec = summary.sim_time_sec;
-  m.interrupted = summary.interrupted;
-  m.command_line = options.command_line;
-  m.adversity = effects.PresetLabel();
-  m.effects = effects.EffectLabels();
-  m.agents = effects.AgentLabels();
-  m.record_file = summary.record_file;
-  m.record_bytes = summary.record_bytes;
-  m.record_steps = summary.record_steps;
-  return m;
-}
-
 RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& options) {
   const auto t_start = Clock::now();
   const WorldConfig world = WithRunOptions(world_in, options);
@@ -202,47 +135,36 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   Session session(world, session_options);
   Simulation& sim = session.sim();
   const SceneDescription& scene = session.scene();
-  EffectsStage& effects = session.effects();
-  Renderer* const renderer = session.renderer();
   timings["compose_sec"] = session.timings().compose_sec;
   timings["load_sec"] = session.timings().load_sec;
   timings["scene_build_sec"] = session.timings().scene_build_sec;
 
   // the pipeline (docs/architecture.md): physics -> SimLoop -> sinks. every output file is
   // written by a sink on its own thread; the first error of any of them is the one reported.
-  const ViewerEffects viewer_effects = [&](const WorldSnapshot& s, const Eigen::Vector3d& p_W) {
-    return effects.Evaluate(s, p_W);  // per viewer, beside the snapshot
-  };
   const double duration = world.duration_sec;
-  std::optional<ProgressReporter> progress;  // made once the sinks are set up
-  CameraSinkOptions camera_options;
-  camera_options.on_rendered = [&](double t, int64_t frames) { progress->Update(t, frames); };
+  RunOutputsOptions outputs_options;
+  outputs_options.end_time_sec = duration;
+  outputs_options.progress = options.progress;
+  outputs_options.metrics_mode = MetricsMode::kDynamics;
   // --record-sensors: every image file the cameras write also goes into the run log (set
   // once the log is open, before the loop starts)
   RunLogWriter* sensor_log = nullptr;
   if (world.record.sensors) {
-    camera_options.writer.on_image = [&sensor_log](const CameraFrame& f, const std::string& kind,
-                                                   const std::vector<uint8_t>& png) {
+    outputs_options.on_image = [&sensor_log](const CameraFrame& f, const std::string& kind,
+                                             const std::vector<uint8_t>& png) {
       if (!sensor_log) return;
       sensor_log->RecordSensor(SensorRecord{f.step, f.time_sec, f.camera, kind + ".png",
                                             std::string(png.begin(), png.end())});
     };
   }
-  CameraSink cameras(scene, world, sim.timestep(), renderer, out.string(), viewer_effects,
-                     camera_options);
-  SensorSink sensors(world, sim, scene, out.string(), viewer_effects);
-  TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());
-  const std::unique_ptr<MetricsSink> metrics =
-      MakeMetricsSink(world, sim, out.string(), MetricsMode::kDynamics);
-  ProgressOptions progress_options;
-  progress_options.mode =
-      options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
-  progress.emplace(duration, progress_options);
+  RunOutputs outputs(session, world, out, outputs_options);
   spdlog::info("running {} for {:.3f} s of sim time, {} camera(s), timestep {:.6g} s, out {}",
                world.file.empty() ? std::string("model") : world.file, duration,
                scene.cameras.size(), sim.timestep(), out.string());
 
-  PhysicsSource physics(&sim, PhysicsSourceOptions{options.realtime});
+  PhysicsSourceOptions physics_options;
+  physics_options.realtime = options.realtime;
+  PhysicsSource physics(&sim, physics_options);
   SimLoopOptions loop_options;
   loop_options.end_time_sec = duration;
   loop_options.stop_request = options.stop_request;
@@ -259,47 +181,47 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     recorder = std::make_unique<RecorderSink>(record_path, header);
     if (world.record.sensors) {
       sensor_log = &recorder->writer();
-      sensors.set_on_output([log = sensor_log](const std::string& sensor, const std::string& kind,
-                                               int64_t step, double time_sec, std::string bytes) {
+      outputs.sensors().set_on_output([log = sensor_log](const std::string& sensor,
+                                                         const std::string& kind, int64_t step,
+                                                         double time_sec, std::string bytes) {
         log->RecordSensor(SensorRecord{step, time_sec, sensor, kind, std::move(bytes)});
       });
     }
     spdlog::info("recording the run to {}", record_path);
   }
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {
-    progress->Finish();
-    for (const auto& [kind, sec] : sensors.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
+    outputs.Finish(&timings);
     summary.out_dir = out.string();
     summary.sim_time_sec = f.time_sec;
     summary.physics_steps = sim.step_count();
     summary.interrupted = f.reason == LoopEndReason::kStopRequested;
-    summary.frames_per_camera = cameras.FramesWritten();  // frames.csv rows actually written
+    summary.frames_per_camera = outputs.cameras().FramesWritten();  // frames.csv rows written
     summary.wall_time_sec = SecondsSince(t_start);
     summary.peak_rss_mib = PeakResidentMemoryMiB();
     timings["physics_sec"] = physics.busy_sec();
-    timings["render_sec"] = cameras.render_sec();
     timings["total_sec"] = summary.wall_time_sec;
+    RunManifest m = outputs.Describe(
+        world.file.empty() && !world.models.empty() ? world.models.front().file : world.file,
+        options.command_line, summary.sim_time_sec, summary.interrupted, timings,
+        summary.peak_rss_mib);
     if (recorder) {
       const RunLogWriterStats st = recorder->stats();
       summary.record_file = record_path;
       summary.record_bytes = st.file_bytes;
       summary.record_steps = st.steps;
-    }
-    RunManifest m = DescribeRun(world, options, effects, summary, timings);
-    if (recorder) {
-      const RunLogWriterStats st = recorder->stats();
+      m.record_file = summary.record_file;
+      m.record_bytes = summary.record_bytes;
+      m.record_steps = summary.record_steps;
       m.record_first_step = st.first_step;
       m.record_last_step = st.last_step;
       m.record_events = st.events;
       m.record_sensor_records = st.sensor_records;
     }
-    if (metrics) m.metrics_json = metrics->SummaryJson();  // its OnFinish ran before
     return m;
   });
-  // the recorder after the cameras and sensors (their sensor records reach it before it
-  // closes) and before the manifest (which reports its size)
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, metrics.get()})
-    if (sink) loop.AddSink(sink);
+  // the recorder after the cameras, sensors and metrics (their sensor records reach it
+  // before it closes) and before the manifest (which reports its size)
+  outputs.AddTo(&loop);
   if (recorder) loop.AddSink(recorder.get());
   loop.AddSink(&manifest);
   rollback.Dismiss();

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <set>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
@@ -180,6 +182,22 @@ void PrepareOutputFolder(const fs::path& out, bool force, const std::string& key
     fs::remove_all(p, ec);
     if (ec) throw fail("cannot be cleared: '" + p.string() + "': " + ec.message());
   }
+}
+
+SetupRollback::SetupRollback(std::filesystem::path out, bool created)
+    : out_(std::move(out)), created_(created) {}
+
+SetupRollback::~SetupRollback() {
+  if (done_) return;
+  std::error_code ec;
+  if (created_) {
+    std::filesystem::remove_all(out_, ec);
+    return;
+  }
+  std::vector<std::filesystem::path> entries;
+  for (std::filesystem::directory_iterator it(out_, ec), end; !ec && it != end; it.increment(ec))
+    entries.push_back(it->path());
+  for (const std::filesystem::path& p : entries) std::filesystem::remove_all(p, ec);
 }
 
 }  // namespace penumbra

@@ -31,4 +31,25 @@ std::vector<std::string> ForeignOutputEntries(const std::filesystem::path& out, 
 void PrepareOutputFolder(const std::filesystem::path& out, bool force,
                          const std::string& key = "--out");
 
+/// a run refused while it sets up (bad input found once the model is composed: an unknown
+/// body, a scene too large) leaves its output folder as it found it, empty or absent, so that
+/// the corrected command runs without --force. everything in the folder is the run's own: it
+/// was empty or new when the run began (PrepareOutputFolder). unless Dismiss() was called, the
+/// destructor removes the folder (`created`) or everything in it; errors are ignored.
+class SetupRollback {
+ public:
+  /// `out`: the output folder; `created`: PrepareOutputFolder created it (it did not exist).
+  SetupRollback(std::filesystem::path out, bool created);
+  SetupRollback(const SetupRollback&) = delete;
+  SetupRollback& operator=(const SetupRollback&) = delete;
+  ~SetupRollback();
+  /// the run has started: from here on what it wrote is kept.
+  void Dismiss() { done_ = true; }
+
+ private:
+  std::filesystem::path out_;
+  bool created_ = false;
+  bool done_ = false;
+};
+
 }  // namespace penumbra

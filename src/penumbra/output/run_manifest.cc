@@ -60,6 +60,7 @@ std::string RunManifestJson(const RunManifest& m) {
     rj["cameras"] = r.cameras;
     rj["outputs"] = r.outputs;
     rj["warnings"] = r.warnings;
+    if (!r.verdict.empty()) rj["verdict"] = r.verdict;
     j["replay"] = rj;
   }
   if (!m.metrics_json.empty()) j["metrics"] = nlohmann::ordered_json::parse(m.metrics_json);

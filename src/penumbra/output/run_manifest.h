@@ -15,7 +15,9 @@ namespace penumbra {
 /// "replay" object.
 struct ReplayManifest {
   std::string log;                        ///< the run log replayed, as given on the command line
-  std::string mode;                       ///< "kinematic" (the log's states, no physics)
+  /// "kinematic" (the log's states, no physics), "resimulate" (physics again, the world's
+  /// controllers) or "resimulate ctrl" (physics again, the logged ctrl)
+  std::string mode;
   int64_t first_step = 0, last_step = 0;  ///< the logged steps replayed
   /// the changes to the recorded conditions: the --world override file ("" = none) and the
   /// keys it replaced, --adversity ("" = as recorded), --tier ("" = as recorded), --cameras
@@ -29,6 +31,9 @@ struct ReplayManifest {
   /// warnings about the log or its assets (a damaged log, a model file changed since it was
   /// recorded), in the order they were found.
   std::vector<std::string> warnings;
+  /// a resimulation's verdict (ResimulateReport::Describe: "bit-exact (N steps)", "diverged
+  /// at step ..."); "" (and no key) for a kinematic replay.
+  std::string verdict;
 };
 
 /// contents of run.json. the file lists the keys in this order (stable across runs);

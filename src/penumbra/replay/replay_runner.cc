@@ -7,24 +7,18 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <initializer_list>
 
 #include "penumbra/core/error.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
-#include "penumbra/output/progress.h"
 #include "penumbra/output/run_manifest.h"
-#include "penumbra/output/trajectory_sink.h"
-#include "penumbra/physics/mujoco_version.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/replay/log_source.h"
 #include "penumbra/replay/recorded_world.h"
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
-#include "penumbra/session/camera_sink.h"
-#include "penumbra/session/sensor_sink.h"
+#include "penumbra/session/run_outputs.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -36,33 +30,6 @@ using Clock = std::chrono::steady_clock;
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-
-// a replay refused while it sets up leaves its output folder as it found it (empty or absent),
-// as `penumbra run` does
-class SetupRollback {
- public:
-  SetupRollback(fs::path out, bool created) : out_(std::move(out)), created_(created) {}
-  SetupRollback(const SetupRollback&) = delete;
-  SetupRollback& operator=(const SetupRollback&) = delete;
-  ~SetupRollback() {
-    if (done_) return;
-    std::error_code ec;
-    if (created_) {
-      fs::remove_all(out_, ec);
-      return;
-    }
-    std::vector<fs::path> entries;
-    for (fs::directory_iterator it(out_, ec), end; !ec && it != end; it.increment(ec))
-      entries.push_back(it->path());
-    for (const fs::path& p : entries) fs::remove_all(p, ec);
-  }
-  void Dismiss() { done_ = true; }
-
- private:
-  fs::path out_;
-  bool created_ = false;
-  bool done_ = false;
-};
 
 void Warn(std::vector<std::string>* warnings, const std::string& w) {
   spdlog::warn("replay: {}", w);
@@ -83,6 +50,18 @@ int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec) {
   return n;
 }
 
+void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path) {
+  // --force empties the output folder: never the one that holds the log being replayed
+  std::error_code ec;
+  const fs::path log = fs::weakly_canonical(log_path, ec);
+  const fs::path out = fs::weakly_canonical(out_dir, ec);
+  const std::string rel = log.lexically_relative(out).string();
+  if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
+    throw ConfigError("", 0, "--out",
+                      "'" + out_dir + "' holds the log being replayed (" + log_path +
+                          "); expected another output folder");
+}
+
 ReplaySummary ReplayLog(const ReplayOptions& options) {
   if (options.out_dir.empty())
     throw ConfigError("", 0, "--out", "required; expected the replay's output folder");
@@ -91,17 +70,7 @@ ReplaySummary ReplayLog(const ReplayOptions& options) {
                       fmt::format("{:.6g} s is not before --to {:.6g} s; expected from < to",
                                   *options.from_sec, *options.to_sec));
 
-  {
-    // --force empties the output folder: never the one that holds the log being replayed
-    std::error_code ec;
-    const fs::path log = fs::weakly_canonical(options.log_path, ec);
-    const fs::path out = fs::weakly_canonical(options.out_dir, ec);
-    const std::string rel = log.lexically_relative(out).string();
-    if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
-      throw ConfigError("", 0, "--out",
-                        "'" + options.out_dir + "' holds the log being replayed (" +
-                            options.log_path + "); expected another output folder");
-  }
+  RefuseOutputFolderHoldingLog(options.out_dir, options.log_path);
   RunLogReader reader = RunLogReader::Open(options.log_path, RunLogReadMode::kRecover);
   const RunLogHeader& header = reader.header();
   std::vector<std::string> warnings;
@@ -165,7 +134,6 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   session_options.check_run_budget = true;
   Session session(world, session_options);
   Simulation& sim = session.sim();
-  EffectsStage& effects = session.effects();
 
   // the window
   const double dt = sim.timestep();
@@ -186,24 +154,14 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   timings["load_sec"] = session.timings().load_sec;
   timings["scene_build_sec"] = session.timings().scene_build_sec;
 
-  // the sinks of `penumbra run` (app/runner.cc), fed by the log
-  const ViewerEffects viewer_effects = [&](const WorldSnapshot& s, const Eigen::Vector3d& p_W) {
-    return effects.Evaluate(s, p_W);
-  };
-  std::optional<ProgressReporter> progress;
-  CameraSinkOptions camera_options;
-  camera_options.on_rendered = [&](double t, int64_t frames) { progress->Update(t, frames); };
-  camera_options.cameras = options.cameras;
-  CameraSink cameras(session.scene(), world, dt, session.renderer(), out.string(), viewer_effects,
-                     camera_options);
-  SensorSink sensors(world, sim, session.scene(), out.string(), viewer_effects);
-  TrajectorySink trajectory(out / "trajectory.csv", sim.qpos().size());
-  // sinks that also run in a replay are added here, before the manifest (e.g. the world's
-  // `metrics:` sink, on the kinematic quantities of the snapshots)
-  ProgressOptions progress_options;
-  progress_options.mode =
-      options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
-  progress.emplace(end_time, progress_options);
+  // the sinks of `penumbra run` (session/run_outputs.h), fed by the log; the world's
+  // `metrics:` on the kinematic quantities of the snapshots
+  RunOutputsOptions outputs_options;
+  outputs_options.end_time_sec = end_time;
+  outputs_options.progress = options.progress;
+  outputs_options.metrics_mode = MetricsMode::kKinematic;
+  outputs_options.cameras = options.cameras;
+  RunOutputs outputs(session, world, out, outputs_options);
   spdlog::info("replaying {} from {:.3f} s (step {}) to {:.3f} s, {} camera(s), out {}",
                options.log_path, source.time_sec(), source.step(), end_time,
                options.cameras.empty() ? session.scene().cameras.size() : options.cameras.size(),
@@ -216,32 +174,18 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   ReplaySummary summary;
   summary.first_step = source.step();
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {
-    progress->Finish();
-    for (const auto& [kind, sec] : sensors.busy_sec()) timings["sensors_" + kind + "_sec"] = sec;
+    outputs.Finish(&timings);
     summary.out_dir = out.string();
     summary.last_step = f.step;
     summary.sim_time_sec = f.time_sec;
     summary.interrupted = f.reason == LoopEndReason::kStopRequested;
-    summary.frames_per_camera = cameras.FramesWritten();
+    summary.frames_per_camera = outputs.cameras().FramesWritten();
     summary.wall_time_sec = SecondsSince(t_start);
     summary.warnings = warnings;
-    timings["render_sec"] = cameras.render_sec();
     timings["total_sec"] = summary.wall_time_sec;
-    RunManifest m;
-    m.world_file = header.world_file.empty() ? header.model_file : header.world_file;
-    m.seed = world.seed;
-    m.penumbra_version = PENUMBRA_VERSION;
-    m.mujoco_version = MujocoVersion();
-    m.embree_version = RendererVersion(world.render.backend);
-    m.timings_sec = timings;
-    m.peak_resident_memory_mib = PeakResidentMemoryMiB();
-    m.frames_per_camera = summary.frames_per_camera;
-    m.sim_duration_sec = f.time_sec;
-    m.interrupted = summary.interrupted;
-    m.command_line = options.command_line;
-    m.adversity = effects.PresetLabel();
-    m.effects = effects.EffectLabels();
-    m.agents = effects.AgentLabels();
+    RunManifest m = outputs.Describe(
+        header.world_file.empty() ? header.model_file : header.world_file, options.command_line,
+        f.time_sec, summary.interrupted, timings, PeakResidentMemoryMiB());
     ReplayManifest r;
     r.log = options.log_path;
     r.mode = "kinematic";
@@ -258,8 +202,8 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     m.replay = std::move(r);
     return m;
   });
-  for (Sink* sink : std::initializer_list<Sink*>{&sensors, &cameras, &trajectory, &manifest})
-    loop.AddSink(sink);
+  outputs.AddTo(&loop);
+  loop.AddSink(&manifest);
   rollback.Dismiss();
   const LoopFinish finish = loop.Run();
   if (finish.error) std::rethrow_exception(finish.error);

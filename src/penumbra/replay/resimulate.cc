@@ -4,13 +4,26 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
 
 #include "penumbra/core/error.h"
+#include "penumbra/metrics/metrics_sink.h"
+#include "penumbra/output/manifest_sink.h"
+#include "penumbra/output/output_folder.h"
+#include "penumbra/output/run_manifest.h"
+#include "penumbra/physics/mujoco_version.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/replay/recorded_world.h"
+#include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
+#include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/session.h"
 
@@ -107,6 +120,76 @@ std::optional<Divergence> Compare(const StepRecord& r, const SimState& s, const 
   return std::nullopt;
 }
 
+// the simulated state a snapshot carries (PhysicsSource fills every state field)
+SimState StateOf(const WorldSnapshot& s) {
+  SimState st;
+  st.step_count = s.step;
+  st.time_sec = s.time_sec;
+  st.qpos = s.qpos;
+  st.qvel = s.qvel;
+  st.act = s.act;
+  st.ctrl = s.ctrl;
+  st.qacc_warmstart = s.qacc_warmstart;
+  st.qfrc_applied = s.qfrc_applied;
+  st.xfrc_applied = s.xfrc_applied;
+  st.mocap_pos = s.mocap_pos;
+  st.mocap_quat = s.mocap_quat;
+  st.userdata = s.userdata;
+  st.controller_next_update = s.controller_next_update;
+  return st;
+}
+
+// the log read in step with the simulation: before each step the record of that step is read
+// (its ctrl applied in kCtrl mode; PhysicsSourceOptions::before_step), and as a sink every
+// step's snapshot is compared with it. the first divergence, or the log's end, ends the source.
+class LogCheck : public Sink {
+ public:
+  LogCheck(RunLogReader* reader, const RunLogLayout& layout, bool controllers, std::string log_path,
+           StepRecord first, ResimulateReport* report)
+      : reader_(reader),
+        layout_(layout),
+        controllers_(controllers),
+        log_path_(std::move(log_path)),
+        record_(std::move(first)),
+        report_(report) {}
+
+  bool BeforeStep(Simulation& sim) {
+    if (report_->divergence || !reader_->NextStep(&record_)) return false;
+    if (record_.step != sim.step_count() + 1)
+      throw ConfigError(log_path_, 0, "",
+                        fmt::format("the log skips from step {} to step {}; expected every step",
+                                    sim.step_count(), record_.step));
+    if (!controllers_) {
+      // the ctrl the controllers wrote during this step, as logged after it
+      std::span<double> ctrl = sim.ctrl();
+      if (record_.ctrl.size() != ctrl.size())
+        throw ConfigError(log_path_, 0, "", "logged ctrl has another size than the model's");
+      std::copy(record_.ctrl.begin(), record_.ctrl.end(), ctrl.begin());
+    }
+    return true;
+  }
+
+  SnapshotContent Wants(int64_t step, double) override {
+    return step > last_checked_ ? SnapshotContent::kState : SnapshotContent::kNone;
+  }
+  void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override {
+    if (snapshot->step <= last_checked_) return;
+    last_checked_ = snapshot->step;
+    report_->divergence = Compare(record_, StateOf(*snapshot), layout_, controllers_);
+    ++report_->steps_checked;
+    report_->last_step = record_.step;
+  }
+
+ private:
+  RunLogReader* reader_;
+  const RunLogLayout& layout_;
+  bool controllers_;
+  std::string log_path_;
+  StepRecord record_;  // of the step the simulation takes next, or has just taken
+  ResimulateReport* report_;
+  int64_t last_checked_ = -1;
+};
+
 }  // namespace
 
 std::string ResimulateReport::Describe() const {
@@ -127,6 +210,7 @@ std::string ResimulateReport::Describe() const {
 }
 
 ResimulateReport ResimulateLog(const ResimulateOptions& options) {
+  const auto t_start = std::chrono::steady_clock::now();
   RunLogReader reader = RunLogReader::Open(options.log_path, RunLogReadMode::kRecover);
   const RunLogHeader& header = reader.header();
   ResimulateReport report;
@@ -154,6 +238,19 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
                                     commands, first));
   }
 
+  // the output folder, as `run` prepares its own; left as found if the set-up fails
+  namespace fs = std::filesystem;
+  const bool write = !options.out_dir.empty();
+  const fs::path out = options.out_dir;
+  std::optional<SetupRollback> rollback;
+  if (write) {
+    RefuseOutputFolderHoldingLog(options.out_dir, options.log_path);
+    std::error_code exists_ec;
+    const bool out_existed = fs::exists(fs::symlink_status(out, exists_ec));
+    PrepareOutputFolder(out, options.force, "--out");
+    rollback.emplace(out, !out_existed);
+  }
+
   // the recorded world as `run` set it up (its adversity preset's NPCs included)
   const WorldConfig world = RecordedWorld(header);
   SessionOptions session_options;
@@ -161,6 +258,13 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   session_options.add_controllers = controllers;
   session_options.build_renderer = false;
   Session session(world, session_options);
+  std::unique_ptr<MetricsSink> metrics;
+  try {
+    if (write)
+      metrics = MakeMetricsSink(world, session.sim(), out.string(), MetricsMode::kDynamics);
+  } catch (const ConfigError& e) {
+    throw LocateInWorld(world, e);  // the recorded world's `metrics:` line
+  }
   Simulation& sim = session.sim();
   const RunLogLayout& layout = header.layout;
   const StateMap map(layout, RunLogLayoutOf(sim), options.log_path);
@@ -175,38 +279,66 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
                                   "records {}",
                                   sim.num_controllers(), layout.num_controllers));
 
-  StepRecord r;
-  if (!reader.NextStep(&r))
+  StepRecord first;
+  if (!reader.NextStep(&first))
     throw ConfigError(options.log_path, 0, "", "the log holds no step; expected step 0 first");
-  if (r.step != 0)
+  if (first.step != 0)
     throw ConfigError(options.log_path, 0, "",
                       fmt::format("the log's first step is {}; expected step 0 (the initial "
                                   "state) to resimulate from",
-                                  r.step));
-  report.divergence = Compare(r, sim.GetState(), layout, controllers);
-  report.steps_checked = 1;
-  report.last_step = r.step;
-  while (!report.divergence && reader.NextStep(&r)) {
-    if (options.stop_request && options.stop_request->load() != 0) {
-      report.interrupted = true;
-      break;
-    }
-    if (r.step != sim.step_count() + 1)
-      throw ConfigError(options.log_path, 0, "",
-                        fmt::format("the log skips from step {} to step {}; expected every step",
-                                    sim.step_count(), r.step));
-    if (!controllers) {
-      // the ctrl the controllers wrote during this step, as logged after it
-      std::span<double> ctrl = sim.ctrl();
-      if (r.ctrl.size() != ctrl.size())
-        throw ConfigError(options.log_path, 0, "", "logged ctrl has another size than the model's");
-      std::copy(r.ctrl.begin(), r.ctrl.end(), ctrl.begin());
-    }
-    sim.Step();
-    report.divergence = Compare(r, sim.GetState(), layout, controllers);
-    ++report.steps_checked;
-    report.last_step = r.step;
+                                  first.step));
+
+  // the pipeline: physics -> SimLoop -> the check (+ the metrics and run.json)
+  LogCheck check(&reader, layout, controllers, options.log_path, std::move(first), &report);
+  PhysicsSourceOptions physics_options;
+  physics_options.before_step = [&check](Simulation& s) { return check.BeforeStep(s); };
+  PhysicsSource physics(&sim, physics_options);
+  SimLoopOptions loop_options;
+  loop_options.stop_request = options.stop_request;
+  SimLoop loop(&physics, loop_options);
+  loop.AddSink(&check);
+  if (metrics) loop.AddSink(metrics.get());
+  std::optional<ManifestSink> manifest;
+  if (write) {
+    manifest.emplace(out.string(), [&](const LoopFinish& f) {
+      std::map<std::string, double> timings;
+      timings["compose_sec"] = session.timings().compose_sec;
+      timings["load_sec"] = session.timings().load_sec;
+      timings["scene_build_sec"] = session.timings().scene_build_sec;
+      timings["physics_sec"] = physics.busy_sec();
+      timings["total_sec"] =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+      RunManifest m;
+      m.world_file = header.world_file.empty() ? header.model_file : header.world_file;
+      m.seed = world.seed;
+      m.penumbra_version = PENUMBRA_VERSION;
+      m.mujoco_version = MujocoVersion();
+      m.command_line = options.command_line;
+      m.sim_duration_sec = f.time_sec;
+      m.interrupted = f.reason == LoopEndReason::kStopRequested;
+      m.timings_sec = timings;
+      m.peak_resident_memory_mib = PeakResidentMemoryMiB();
+      m.adversity = session.effects().PresetLabel();
+      m.effects = session.effects().EffectLabels();
+      m.agents = session.effects().AgentLabels();
+      ReplayManifest r;
+      r.log = options.log_path;
+      r.mode = controllers ? "resimulate" : "resimulate ctrl";
+      r.first_step = 0;
+      r.last_step = report.last_step;
+      r.warnings = report.warnings;
+      report.interrupted = m.interrupted;
+      r.verdict = report.Describe();
+      m.replay = std::move(r);
+      if (metrics) m.metrics_json = metrics->SummaryJson();  // its OnFinish ran before
+      return m;
+    });
+    loop.AddSink(&*manifest);
   }
+  if (rollback) rollback->Dismiss();
+  const LoopFinish finish = loop.Run();
+  if (finish.error) std::rethrow_exception(finish.error);
+  report.interrupted = finish.reason == LoopEndReason::kStopRequested;
   return report;
 }
 

@@ -12,6 +12,12 @@
 //                 issue 19), so a log that holds "command" events is refused in this mode.
 //   kCtrl         no controllers: before each step the ctrl the log holds after that step is
 //                 applied (what the controllers wrote), so physics alone is checked.
+// it runs as a pipeline (docs/architecture.md): PhysicsSource -> SimLoop -> a checking sink
+// that compares every step's snapshot with the log (the first divergence ends the loop) and,
+// with an output folder (ResimulateOptions::out_dir), the world's `metrics:` sink with every
+// quantity (metrics/metrics_sink.h MetricsMode::kDynamics) and run.json (its "replay" object
+// has mode "resimulate" and the verdict). without an output folder nothing is written.
+//
 // MuJoCo 2.2.2 computes a step from exactly the state the log holds (physics/simulation.h
 // SimState), so a run is bit-exact as long as the model, the world and the binary's floating
 // point are those of the recording (changed model files are warned about).
@@ -36,6 +42,12 @@ struct ResimulateOptions {
   ResimulateMode mode = ResimulateMode::kControllers;
   /// a stop request (SIGINT): checking stops at the next step; the report says how far it got.
   const std::atomic<int>* stop_request = nullptr;
+  /// the output folder of the metrics and run.json ("" = write nothing); prepared as `run`
+  /// prepares its own (output/output_folder.h: empty or new, or `force`).
+  std::string out_dir;
+  bool force = false;
+  /// argv, for run.json.
+  std::vector<std::string> command_line;
 };
 
 /// the first difference between the log and the resimulation.
@@ -63,8 +75,11 @@ struct ResimulateReport {
 /// resimulates the log (see the file header).
 /// @throws RunLogError for a file that is not a readable run log; ConfigError naming the log
 ///         when it holds command events in kControllers mode, when its model does not match
-///         the recorded world's (state sizes) or its first step is not 0; PhysicsError when
-///         the simulation fails where the recording did not.
+///         the recorded world's (state sizes), its first step is not 0 or it skips a step;
+///         ConfigError("--out") for an output folder PrepareOutputFolder refuses, and the
+///         metrics sink's for a bad `metrics:` (located in the recorded world); PhysicsError
+///         when the simulation fails where the recording did not; Error if an output cannot
+///         be written.
 ResimulateReport ResimulateLog(const ResimulateOptions& options);
 
 }  // namespace penumbra

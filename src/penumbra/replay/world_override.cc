@@ -39,8 +39,8 @@ bool IsTopLevel(const SensorConfig& s) { return s.robot.empty(); }
 
 const std::vector<std::string_view>& ReplaceableWorldKeys() {
   static const std::vector<std::string_view> kKeys = {
-      "cameras",          "mjcf_cameras", "lights",    "sky",    "materials", "render", "effects",
-      "semantic_classes", "output",       "adversity", "agents", "seed",      "sensors"};
+      "cameras",          "mjcf_cameras", "lights",    "sky",    "materials", "render",  "effects",
+      "semantic_classes", "output",       "adversity", "agents", "seed",      "sensors", "metrics"};
   return kKeys;
 }
 
@@ -118,6 +118,7 @@ WorldConfig ApplyWorldOverride(const WorldConfig& recorded, const std::string& p
       w.adversity_line = 0;  // a line of the override, not of the recorded world
     }
     if (key == "seed") w.seed = o.seed;
+    if (key == "metrics") w.metrics = o.metrics;
     if (key == "sensors") {
       std::vector<SensorConfig> sensors;
       for (const SensorConfig& s : o.sensors)

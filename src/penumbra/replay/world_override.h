@@ -6,6 +6,8 @@
 //   (visual)              semantic_classes, output, adversity, agents, seed, and the top-level
 //                         `sensors` list (the sensors listed under a robot stay: `robots` cannot
 //                         change)
+//   replaced whole        metrics: what is measured along the logged motion (a replay records
+//   (measured)            the kinematic quantities only; metrics/metrics_sink.h)
 //   refused (physics)     robots, models, physics: they change the model or its dynamics, which
 //                         the log records; duration_sec: a replay's span is the log's (use
 //                         --from / --to); any other key of the world file (e.g. record) is

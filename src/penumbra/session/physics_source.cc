@@ -27,6 +27,7 @@ bool PhysicsSource::Advance() {
     std::this_thread::sleep_until(*wall0_ + std::chrono::duration_cast<Clock::duration>(
                                                 std::chrono::duration<double>(sim_->time())));
   }
+  if (options_.before_step && !options_.before_step(*sim_)) return false;
   const auto t0 = Clock::now();
   sim_->Step();
   busy_sec_ += std::chrono::duration<double>(Clock::now() - t0).count();

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -18,6 +19,11 @@ struct PhysicsSourceOptions {
   /// wall time have passed since the first Advance (default: as fast as possible). the
   /// trajectory does not depend on it.
   bool realtime = false;
+  /// called by Advance before each Simulation::Step with the simulation about to step (e.g.
+  /// to set its ctrl: replay/resimulate.h applies the logged ctrl); returning false ends the
+  /// source there (Advance returns false without stepping). empty = none.
+  /// @throws anything: Advance throws it, and the loop ends with that error.
+  std::function<bool(Simulation& sim)> before_step;
 };
 
 /// a Simulation as a Source. not thread-safe (one loop thread; the simulation must not be used
@@ -33,8 +39,9 @@ class PhysicsSource : public Source {
   /// kState: the state only (Simulation::SnapshotState: time, step, qpos, qvel, act, ctrl,
   /// ...); kPoses / kFull: Simulation::Snapshot's kPoses / kFull (which include the state).
   std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override;
-  /// one Simulation::Step (after the realtime wait); logs the simulation's warnings. always
-  /// true. @throws PhysicsError when the simulation diverges.
+  /// one Simulation::Step (after the realtime wait and PhysicsSourceOptions::before_step);
+  /// logs the simulation's warnings. true, or false when before_step returned false.
+  /// @throws PhysicsError when the simulation diverges; what before_step throws.
   bool Advance() override;
 
   /// wall time spent inside Simulation::Step so far, s.
