@@ -7,15 +7,6 @@
 namespace penumbra {
 namespace {
 
-TEST(CameraSpecsTest, GlobMatch) {
-  EXPECT_TRUE(GlobMatch("rover/*", "rover/chassis"));
-  EXPECT_TRUE(GlobMatch("*", ""));
-  EXPECT_TRUE(GlobMatch("*wheel?", "rover/wheel3"));
-  EXPECT_TRUE(GlobMatch("a*b*c", "axxbyyc"));
-  EXPECT_FALSE(GlobMatch("rover/*", "arm/link"));
-  EXPECT_FALSE(GlobMatch("*wheel?", "rover/wheel"));
-  EXPECT_FALSE(GlobMatch("abc", "abcd"));
-}
 
 TEST(CameraSpecsTest, SemanticClassesFirstMatchWins) {
   SceneDescription s;

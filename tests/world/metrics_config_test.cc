@@ -152,14 +152,6 @@ TEST_F(MetricsConfigTest, ErrorsNameFileLineAndKey) {
       << pair;
 }
 
-TEST(MetricGlobMatchTest, StarsAndQuestionMarks) {
-  EXPECT_TRUE(MetricGlobMatch("go1/*_foot", "go1/FR_foot"));
-  EXPECT_FALSE(MetricGlobMatch("go1/*_foot", "go1/FR_calf"));
-  EXPECT_TRUE(MetricGlobMatch("*", ""));
-  EXPECT_TRUE(MetricGlobMatch("r?v*", "rover/chassis"));
-  EXPECT_FALSE(MetricGlobMatch("room/floor", "room/floor2"));
-  EXPECT_TRUE(MetricGlobMatch("*a*b*", "xxaxxbxx"));
-}
 
 }  // namespace
 }  // namespace penumbra

@@ -25,6 +25,7 @@
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/world/world_config.h"
@@ -56,32 +57,6 @@ std::optional<uint64_t> ParseUnsigned(std::string_view s) {
   uint64_t v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
-  return v;
-}
-
-// a finite decimal number: [+-]digits[.digits][(e|E)[+-]digits], at least one digit
-std::optional<double> ParseDecimal(std::string_view s) {
-  std::string_view body = s;
-  if (!body.empty() && (body.front() == '+' || body.front() == '-')) body.remove_prefix(1);
-  size_t i = 0, digits = 0;
-  while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i, ++digits;
-  if (i < body.size() && body[i] == '.') {
-    ++i;
-    while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i, ++digits;
-  }
-  if (digits == 0) return std::nullopt;
-  if (i < body.size() && (body[i] == 'e' || body[i] == 'E')) {
-    ++i;
-    if (i < body.size() && (body[i] == '+' || body[i] == '-')) ++i;
-    const size_t exp_start = i;
-    while (i < body.size() && body[i] >= '0' && body[i] <= '9') ++i;
-    if (i == exp_start) return std::nullopt;
-  }
-  if (i != body.size()) return std::nullopt;
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
   return v;
 }
 

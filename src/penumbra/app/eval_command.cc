@@ -14,6 +14,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"
@@ -24,18 +25,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// a finite decimal number ([+-]digits[.digits][e[+-]digits]; no hex, inf or nan)
-std::optional<double> ParseFinite(std::string_view s) {
-  if (!s.empty() && s.front() == '+') {
-    s.remove_prefix(1);
-    if (!s.empty() && (s.front() == '+' || s.front() == '-')) return std::nullopt;
-  }
-  if (s.empty()) return std::nullopt;
-  double v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 // a decimal option: any finite number (positive_only = false) or one > 0
 CLI::Option* AddNumber(CLI::App* app, const std::string& name, std::optional<double>* target,
@@ -44,11 +33,11 @@ CLI::Option* AddNumber(CLI::App* app, const std::string& name, std::optional<dou
       positive_only ? "a finite decimal number > 0" : "a finite decimal number";
   return app
       ->add_option_function<std::string>(
-          name, [target](const std::string& s) { *target = *ParseFinite(s); }, help)
+          name, [target](const std::string& s) { *target = *ParseDecimal(s); }, help)
       ->type_name("SEC")
       ->check(CLI::Validator(
           [positive_only, expected](std::string& s) -> std::string {
-            const std::optional<double> v = ParseFinite(s);
+            const std::optional<double> v = ParseDecimal(s);
             if (!v) return "'" + s + "' is not " + expected;
             if (positive_only && !(*v > 0))
               return "'" + s + "' is out of range; expected " + expected;

@@ -11,6 +11,7 @@
 
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/resimulate.h"
 
@@ -28,14 +29,11 @@ struct ReplayCommand::State {
 
 namespace {
 
-// a finite decimal number >= 0 (no hex, nan or inf, which CLI11's own conversion accepts)
+// a finite decimal number >= 0 (core/text_match.h; no hex, nan or inf, which CLI11's own
+// conversion accepts)
 std::optional<double> ParseSeconds(const std::string& s) {
-  double v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v,
-                                 std::chars_format::fixed | std::chars_format::scientific);
-  if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v) ||
-      v < 0)
-    return std::nullopt;
+  const std::optional<double> v = ParseDecimal(s);
+  if (!v || *v < 0) return std::nullopt;
   return v;
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 
 namespace penumbra {
 namespace {
@@ -36,19 +37,6 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   return fields;
 }
 
-// a finite decimal number ([+-]digits[.digits][e[+-]digits], as numpy's float() reads TUM
-// files, without inf / nan / hex)
-std::optional<double> ParseNumber(std::string_view s) {
-  if (!s.empty() && s.front() == '+') {
-    s.remove_prefix(1);
-    if (!s.empty() && (s.front() == '+' || s.front() == '-')) return std::nullopt;
-  }
-  if (s.empty()) return std::nullopt;
-  double v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 }  // namespace
 
@@ -77,7 +65,7 @@ Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) 
                                     kExpectedLine));
     std::array<double, 8> v{};
     for (size_t k = 0; k < fields.size(); ++k) {
-      const std::optional<double> x = ParseNumber(fields[k]);
+      const std::optional<double> x = ParseDecimal(fields[k]);
       if (!x)
         throw ConfigError(
             source, line_number, "",

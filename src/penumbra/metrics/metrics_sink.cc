@@ -13,6 +13,7 @@
 #include "penumbra/control/controller.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/metrics/collision_counter.h"
 #include "penumbra/physics/simulation.h"
 
@@ -69,7 +70,7 @@ std::vector<int> Resolve(const std::vector<std::string>& patterns,
   for (size_t p = 0; p < patterns.size(); ++p) {
     bool any = false;
     for (size_t i = 0; i < names.size(); ++i) {
-      if (names[i].empty() || !MetricGlobMatch(patterns[p], names[i])) continue;
+      if (names[i].empty() || !GlobMatch(patterns[p], names[i])) continue;
       hit[i] = 1;
       any = true;
     }
@@ -327,9 +328,9 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
           std::vector<uint8_t> m(ng, 0);
           for (size_t g = 0; g < ng; ++g) {
             const int b = model_.geom_body[g];
-            m[g] = MetricGlobMatch(pattern, model_.geom_names[g]) ||
+            m[g] = GlobMatch(pattern, model_.geom_names[g]) ||
                    (b >= 0 && b < static_cast<int>(model_.body_names.size()) &&
-                    MetricGlobMatch(pattern, model_.body_names[b]));
+                    GlobMatch(pattern, model_.body_names[b]));
           }
           return m;
         };

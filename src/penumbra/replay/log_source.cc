@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "penumbra/core/error.h"
+#include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 
 namespace penumbra {
@@ -31,14 +32,7 @@ std::shared_ptr<const WorldSnapshot> LogSource::Snapshot(SnapshotContent content
     sim_->ApplyMocapDrivers(map_.unlogged_mocap());
     applied_step_ = current_.step;
   }
-  auto s = std::make_shared<WorldSnapshot>();
-  if (content == SnapshotContent::kState || content == SnapshotContent::kNone) {
-    sim_->SnapshotState(s.get());
-  } else {
-    sim_->Snapshot(s.get(), content == SnapshotContent::kFull
-                                ? Simulation::SnapshotContent::kFull
-                                : Simulation::SnapshotContent::kPoses);
-  }
+  const std::shared_ptr<WorldSnapshot> s = TakeSnapshot(*sim_, content);
   // the controllers' schedule as logged (the replay runs none)
   s->controller_next_update = current_.controller_next_update;
   return s;

@@ -1,6 +1,7 @@
 #include "penumbra/session/camera_specs.h"
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
 
 namespace penumbra {
@@ -58,27 +59,6 @@ std::vector<CameraSensorConfig> SensorConfigsFor(const SceneDescription& scene,
     out.push_back(cfg);
   }
   return out;
-}
-
-bool GlobMatch(std::string_view p, std::string_view t) {
-  // iterative matcher with backtracking to the last '*'
-  size_t pi = 0, ti = 0, star = std::string_view::npos, mark = 0;
-  while (ti < t.size()) {
-    if (pi < p.size() && (p[pi] == '?' || p[pi] == t[ti])) {
-      ++pi;
-      ++ti;
-    } else if (pi < p.size() && p[pi] == '*') {
-      star = pi++;
-      mark = ti;
-    } else if (star != std::string_view::npos) {
-      pi = star + 1;
-      ti = ++mark;
-    } else {
-      return false;
-    }
-  }
-  while (pi < p.size() && p[pi] == '*') ++pi;
-  return pi == p.size();
 }
 
 void ApplySemanticClasses(const std::vector<SemanticClassConfig>& classes,

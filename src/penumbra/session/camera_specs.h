@@ -29,9 +29,6 @@ void AppendWorldCamera(const CameraConfig& c, CameraSpec cam, std::vector<Camera
 std::vector<CameraSensorConfig> SensorConfigsFor(const SceneDescription& scene,
                                                  const WorldConfig& world);
 
-/// glob match: '*' matches any run of characters (also none), '?' one character.
-bool GlobMatch(std::string_view pattern, std::string_view text);
-
 /// sets Geom::semantic_class of every geom from the first class (in file order) with a pattern
 /// matching the geom's name, its body's name or its material's name; others keep 0.
 void ApplySemanticClasses(const std::vector<SemanticClassConfig>& classes, SceneDescription* scene);

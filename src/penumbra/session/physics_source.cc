@@ -9,16 +9,19 @@ namespace penumbra {
 PhysicsSource::PhysicsSource(Simulation* sim, PhysicsSourceOptions options)
     : sim_(sim), options_(options), step_(sim->step_count()), time_sec_(sim->time()) {}
 
-std::shared_ptr<const WorldSnapshot> PhysicsSource::Snapshot(SnapshotContent content) {
+std::shared_ptr<WorldSnapshot> TakeSnapshot(const Simulation& sim, SnapshotContent content) {
   auto s = std::make_shared<WorldSnapshot>();
   if (content == SnapshotContent::kState || content == SnapshotContent::kNone) {
-    sim_->SnapshotState(s.get());
+    sim.SnapshotState(s.get());
   } else {
-    sim_->Snapshot(s.get(), content == SnapshotContent::kFull
-                                ? Simulation::SnapshotContent::kFull
-                                : Simulation::SnapshotContent::kPoses);
+    sim.Snapshot(s.get(), content == SnapshotContent::kFull ? Simulation::SnapshotContent::kFull
+                                                            : Simulation::SnapshotContent::kPoses);
   }
   return s;
+}
+
+std::shared_ptr<const WorldSnapshot> PhysicsSource::Snapshot(SnapshotContent content) {
+  return TakeSnapshot(*sim_, content);
 }
 
 bool PhysicsSource::Advance() {

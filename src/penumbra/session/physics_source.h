@@ -13,6 +13,12 @@
 
 namespace penumbra {
 
+/// a new snapshot of `sim`'s current state with `content` (pipeline/source.h): kState (and
+/// kNone) the state only (Simulation::SnapshotState: time, step, the SimState vectors);
+/// kPoses / kFull Simulation::Snapshot's kPoses / kFull. for sources that hold a Simulation
+/// (live physics, a replayed log set into one).
+std::shared_ptr<WorldSnapshot> TakeSnapshot(const Simulation& sim, SnapshotContent content);
+
 /// settings of a PhysicsSource.
 struct PhysicsSourceOptions {
   /// pace the steps to wall-clock time: step n is not taken before n * timestep seconds of

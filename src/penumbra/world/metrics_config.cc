@@ -144,27 +144,6 @@ std::string_view MetricKindName(MetricKind kind) {
   return "?";
 }
 
-bool MetricGlobMatch(std::string_view p, std::string_view t) {
-  // iterative matcher with one backtrack point for the last '*'
-  size_t pi = 0, ti = 0, star = std::string_view::npos, mark = 0;
-  while (ti < t.size()) {
-    if (pi < p.size() && (p[pi] == '?' || p[pi] == t[ti])) {
-      ++pi;
-      ++ti;
-    } else if (pi < p.size() && p[pi] == '*') {
-      star = pi++;
-      mark = ti;
-    } else if (star != std::string_view::npos) {
-      pi = star + 1;
-      ti = ++mark;
-    } else {
-      return false;
-    }
-  }
-  while (pi < p.size() && p[pi] == '*') ++pi;
-  return pi == p.size();
-}
-
 void MetricsConfig::ValidateOrThrow() const {
   auto rate_ok = [](double v) { return std::isfinite(v) && v > 0 && v <= 10000; };
   if (!rate_ok(rate_hz))

@@ -109,7 +109,4 @@ struct MetricsConfig {
 ///         out-of-range values, duplicate names.
 MetricsConfig ReadMetrics(const YamlReader& r);
 
-/// true if `text` matches the glob `pattern` ('*' any run, '?' one character).
-bool MetricGlobMatch(std::string_view pattern, std::string_view text);
-
 }  // namespace penumbra
