@@ -110,10 +110,10 @@ class ExportCommandTest : public ::testing::Test {
     dir_ = new testing::TempDir();
     dir_->Write("walls.xml", kMjcf);
     const std::string world = dir_->Write("world.yaml", kWorld);
-    const testing::ProcessResult r = RunPenumbra(
-        {"run", world, "--out", (dir_->path() / "run").string(), "--record",
-         (dir_->path() / "run.plog").string(), "--quiet"},
-        dir_->path());
+    const testing::ProcessResult r =
+        RunPenumbra({"run", world, "--out", (dir_->path() / "run").string(), "--record",
+                     (dir_->path() / "run.plog").string(), "--quiet"},
+                    dir_->path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   static void TearDownTestSuite() {

@@ -29,14 +29,14 @@ class ResimulateTest : public ::testing::Test {
  protected:
   void SetUp() override {
     model_ = tmp_.Write("m.xml", kModel);
-    const std::string world = tmp_.Write(
-        "w.yaml",
-        "robots:\n"
-        "  - name: r\n"
-        "    file: m.xml\n"
-        "    controller: {type: joint_pd, joints: [hinge], actuators: [m], kp: [20],\n"
-        "                 kd: [1], target: [0.8]}\n"
-        "mjcf_cameras: {enabled: false}\n");
+    const std::string world =
+        tmp_.Write("w.yaml",
+                   "robots:\n"
+                   "  - name: r\n"
+                   "    file: m.xml\n"
+                   "    controller: {type: joint_pd, joints: [hinge], actuators: [m], kp: [20],\n"
+                   "                 kd: [1], target: [0.8]}\n"
+                   "mjcf_cameras: {enabled: false}\n");
     log_ = (tmp_.path() / "r.plog").string();
     SessionOptions o;
     o.build_renderer = false;

@@ -7,7 +7,6 @@
 namespace penumbra {
 namespace {
 
-
 TEST(CameraSpecsTest, SemanticClassesFirstMatchWins) {
   SceneDescription s;
   s.bodies = {{"world", -1, true}, {"rover/chassis", 0, false}, {"arm/link", 0, false}};

@@ -152,6 +152,5 @@ TEST_F(MetricsConfigTest, ErrorsNameFileLineAndKey) {
       << pair;
 }
 
-
 }  // namespace
 }  // namespace penumbra

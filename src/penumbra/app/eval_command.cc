@@ -14,8 +14,8 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/core/text_match.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"
 #include "penumbra/eval/trajectory_plot.h"
@@ -24,7 +24,6 @@ namespace penumbra {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
 
 // a decimal option: any finite number (positive_only = false) or one > 0
 CLI::Option* AddNumber(CLI::App* app, const std::string& name, std::optional<double>* target,

@@ -61,8 +61,9 @@ int ExportCommand::Run() const {
     if (!fs::is_regular_file(input))
       throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
     if (fs::exists(options.out_dir) && !fs::is_empty(options.out_dir))
-      throw ConfigError("", 0, "--out",
-                        "'" + options.out_dir.string() + "' is not empty; expected a new or empty folder");
+      throw ConfigError(
+          "", 0, "--out",
+          "'" + options.out_dir.string() + "' is not empty; expected a new or empty folder");
     const fs::path parent = fs::absolute(options.out_dir).parent_path();
     fs::create_directories(parent);
     replayed.emplace(parent / (fs::absolute(options.out_dir).filename().string() + ".replay-tmp"));
@@ -102,8 +103,9 @@ ExportCommand AddExportCommand(CLI::App& app) {
   ExportCommand::State& s = *c.state_;
   s.command = app.add_subcommand(
       "export", "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset");
-  s.command->add_option("run", s.input,
-                        "output folder of `penumbra run`, or a run log (.plog), replayed first")
+  s.command
+      ->add_option("run", s.input,
+                   "output folder of `penumbra run`, or a run log (.plog), replayed first")
       ->required();
   s.command->add_option("--world", s.replay_world,
                         "for a .plog: world-file override of the replay (replay --world), e.g. "

@@ -37,7 +37,6 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   return fields;
 }
 
-
 }  // namespace
 
 Eigen::Matrix3Xd Trajectory::Positions() const {

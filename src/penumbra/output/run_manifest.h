@@ -14,7 +14,7 @@ namespace penumbra {
 /// what a replay (`penumbra replay`, replay/replay_runner.h) rendered, and how: run.json's
 /// "replay" object.
 struct ReplayManifest {
-  std::string log;                        ///< the run log replayed, as given on the command line
+  std::string log;  ///< the run log replayed, as given on the command line
   /// "kinematic" (the log's states, no physics), "resimulate" (physics again, the world's
   /// controllers) or "resimulate ctrl" (physics again, the logged ctrl)
   std::string mode;

@@ -36,10 +36,10 @@ class WorldParser {
   WorldConfig Parse(const YAML::Node& root) {
     YamlReader r(root, file_, lines_);
     const std::vector<std::string_view> keys = {
-        "seed",   "duration_sec", "physics",          "render",       "sky",       "robots",
-        "models", "lights",       "cameras",          "mjcf_cameras", "materials", "output",
-        "agents", "adversity",    "semantic_classes", "effects",      "sensors",   "record",
-        "metrics"};
+        "seed",      "duration_sec", "physics", "render",    "sky",
+        "robots",    "models",       "lights",  "cameras",   "mjcf_cameras",
+        "materials", "output",       "agents",  "adversity", "semantic_classes",
+        "effects",   "sensors",      "record",  "metrics"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
