@@ -178,7 +178,7 @@ TEST_F(RecordRunTest, RecordSensorsStoresTheBytesOfEveryImageAndSensorRow) {
     if (s.sensor == "cam") {
       const int64_t frame = s.step / 50;  // 1 ms steps, a frame every 50
       EXPECT_EQ(s.step % 50, 0) << s.step;
-      char name[16];
+      char name[32];
       std::snprintf(name, sizeof(name), "%06lld.png", static_cast<long long>(frame));
       if (s.kind == "rgb.png") {
         ++rgb;

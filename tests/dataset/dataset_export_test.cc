@@ -320,7 +320,9 @@ TEST_F(DatasetExportTest, KittiPosesCalibTimesAndImages) {
     const Pose T = PoseFromKittiRow(f);
     const Pose expected = X_W0.inverse() * testing::FakeCameraPose(static_cast<int>(i));
     EXPECT_LT((T.matrix() - expected.matrix()).cwiseAbs().maxCoeff(), 1e-8) << i;
-    if (i == 0) EXPECT_TRUE(T.matrix().isIdentity(0));
+    if (i == 0) {
+      EXPECT_TRUE(T.matrix().isIdentity(0));
+    }
   }
   // times: one per frame, strictly increasing, seconds
   const auto times = Lines(seq / "times.txt");
