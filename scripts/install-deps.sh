@@ -14,6 +14,16 @@ pkgs=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3  # scripts/, the module dependency check and outputs_thread_invariance (standard library only)
+  cppzmq-dev libzmq3-dev libmsgpack-cxx-dev  # ZeroMQ bridge (command/ + zmq/)
+  python3-zmq python3-msgpack python3-numpy  # python/penumbra_client and its tests
+  ros-base-dev libroscpp-dev librosbag-dev libtf2-ros-dev libsensor-msgs-dev libnav-msgs-dev
+  libgeometry-msgs-dev libstd-srvs-dev libtf2-msgs-dev  # ROS 1 bridge and rosbag export
+  rosout rosbash python3-rosbag python3-rostopic  # roscore, rostopic, rosbag tools for the ROS tests
+  libboost-dev libturbojpeg0-dev libjs-three  # browser viewer: Boost.Beast, JPEG frames, three.js
+  chromium chromium-driver python3-websocket python3-selenium  # viewer tests drive a real headless Chromium
+  libcgal-dev  # convex decomposition (CoACD) clipping and hulls
+  libopencv-contrib-dev libopen3d-dev  # bundled SLAM methods (cv::rgbd, cv::kinfu, Open3D odometry)
+  slurm-wlm munge  # benchmark sweeps on Slurm, tested on a single-node cluster
 )
 missing=()
 for p in "${pkgs[@]}"; do
