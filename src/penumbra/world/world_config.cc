@@ -39,7 +39,7 @@ class WorldParser {
         "seed",      "duration_sec", "physics", "render",    "sky",
         "robots",    "models",       "lights",  "cameras",   "mjcf_cameras",
         "materials", "output",       "agents",  "adversity", "semantic_classes",
-        "effects",   "sensors",      "record",  "metrics"};
+        "effects",   "sensors",      "record",  "metrics",   "ros"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -116,6 +116,7 @@ class WorldParser {
     if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
     if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
     if (r.Has("metrics")) w.metrics = ReadMetrics(r.Child("metrics"));
+    if (r.Has("ros")) w.ros = ReadRosConfig(r.Child("ros"));
     if (r.Has("adversity")) {
       const YamlReader a = r.Child("adversity");
       w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());
