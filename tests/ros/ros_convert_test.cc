@@ -1,4 +1,6 @@
 // Penumbra data as ROS messages (ros/ros_convert.h): encodings, units, layouts and frames.
+#include "penumbra/ros/ros_convert.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +8,6 @@
 #include <limits>
 
 #include "penumbra/core/pose.h"
-#include "penumbra/ros/ros_convert.h"
 
 namespace penumbra {
 namespace {

@@ -1,5 +1,7 @@
 // ROS names of a world (ros/ros_graph.h): derived topics and frames, overrides, tf parents,
 // rigid mounts and clashes.
+#include "penumbra/ros/ros_graph.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -7,7 +9,7 @@
 #include <fstream>
 
 #include "penumbra/core/error.h"
-#include "penumbra/ros/ros_graph.h"
+#include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -62,9 +64,15 @@ class RosGraphTest : public ::testing::Test {
                                      "<geom size=\"0.1\"/></body></worldbody></mujoco>";
   }
   void TearDown() override { fs::remove_all(dir_); }
+  // the world file (written, so that LoadRosConfig reads its `ros:` again)
   WorldConfig World(const std::string& robots, const std::string& extra = "") {
-    return ParseWorld(robots + "models:\n  - {name: box, file: m.xml}\n" + extra,
-                      (dir_ / "world.yaml").string());
+    std::ofstream(dir_ / "world.yaml") << robots << "models:\n  - {name: box, file: m.xml}\n"
+                                       << extra;
+    return LoadWorldFile((dir_ / "world.yaml").string());
+  }
+  RosGraph Build(const WorldConfig& w, const std::vector<RosSensorMount>& sensors,
+                 const std::vector<std::string>& mocap = {}) {
+    return BuildRosGraph(w, LoadRosConfig(w), Model(), sensors, mocap);
   }
   fs::path dir_;
 };
@@ -81,10 +89,9 @@ TEST_F(RosGraphTest, DerivesNamesForOneRobot) {
   lidar.name = "roof";
   lidar.kind = RosSensorKind::kLidar;
   lidar.body = 5;
-  const RosGraph g = BuildRosGraph(World(kOneRobot), Model(),
-                                   {Camera("front", 2), Camera("leg_cam", 3), Camera("side", 0),
-                                    imu, lidar},
-                                   {"box/base"});
+  const RosGraph g = Build(
+      World(kOneRobot), {Camera("front", 2), Camera("leg_cam", 3), Camera("side", 0), imu, lidar},
+      {"box/base"});
   ASSERT_EQ(g.robots.size(), 1u);
   const RosRobotGraph& r = g.robots[0];
   EXPECT_EQ(r.base_body, 1);  // the model's first body (no controller)
@@ -103,7 +110,7 @@ TEST_F(RosGraphTest, DerivesNamesForOneRobot) {
   EXPECT_EQ(front->depth_image_topic, "/r/front/depth/image_raw");
   EXPECT_EQ(front->frame_id, "front/optical");
   EXPECT_EQ(front->parent_frame, "base_link");
-  EXPECT_TRUE(front->rigid_to_parent);  // the mount is welded to the trunk
+  EXPECT_TRUE(front->rigid_to_parent);                     // the mount is welded to the trunk
   EXPECT_FALSE(g.FindSensor("leg_cam")->rigid_to_parent);  // behind the knee
   const RosSensorGraph* side = g.FindSensor("side");
   EXPECT_EQ(side->robot, -1);
@@ -121,8 +128,7 @@ TEST_F(RosGraphTest, DerivesNamesForOneRobot) {
 }
 
 TEST_F(RosGraphTest, SeveralRobotsPrefixFrames) {
-  const RosGraph g =
-      BuildRosGraph(World(kTwoRobots), Model(), {Camera("front", 2), Camera("qcam", 4)});
+  const RosGraph g = Build(World(kTwoRobots), {Camera("front", 2), Camera("qcam", 4)});
   ASSERT_EQ(g.robots.size(), 2u);
   EXPECT_EQ(g.robots[0].base_frame, "r/base_link");
   EXPECT_EQ(g.robots[1].odom_frame, "q/odom");
@@ -138,7 +144,7 @@ TEST_F(RosGraphTest, OverridesFromTheWorldFile) {
                               "  robots:\n    r: {base_body: mount, base_frame: body, "
                               "odom_frame: r_odom, namespace: dog}\n"
                               "  sensors:\n    front: {topic: /camera, frame_id: cam}\n");
-  const RosGraph g = BuildRosGraph(w, Model(), {Camera("front", 2), Camera("side", 0)});
+  const RosGraph g = Build(w, {Camera("front", 2), Camera("side", 0)});
   EXPECT_EQ(g.map_frame, "world");
   EXPECT_EQ(g.robots[0].base_body, 2);
   EXPECT_EQ(g.robots[0].base_frame, "body");
@@ -152,7 +158,7 @@ TEST_F(RosGraphTest, OverridesFromTheWorldFile) {
 TEST_F(RosGraphTest, ErrorsNameTheKey) {
   const WorldConfig bad_body = World(kOneRobot, "ros:\n  robots:\n    r: {base_body: tail}\n");
   try {
-    BuildRosGraph(bad_body, Model(), {});
+    Build(bad_body, {});
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "ros.robots.r.base_body");
@@ -164,7 +170,7 @@ TEST_F(RosGraphTest, ErrorsNameTheKey) {
                                   "  - {name: b, attach: world}\n"
                                   "ros:\n  sensors:\n    b: {topic: a}\n");
   try {
-    BuildRosGraph(clash, Model(), {Camera("a", 0), Camera("b", 0)});
+    Build(clash, {Camera("a", 0), Camera("b", 0)});
     FAIL() << "no error";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("topic '/a/image_raw' is used by both sensor 'a' and "
@@ -174,7 +180,7 @@ TEST_F(RosGraphTest, ErrorsNameTheKey) {
   }
   // an MJCF camera override the model lacks
   const WorldConfig mjcf = World(kOneRobot, "ros:\n  sensors:\n    r/head: {topic: head}\n");
-  EXPECT_THROW(BuildRosGraph(mjcf, Model(), {}), ConfigError);
+  EXPECT_THROW(Build(mjcf, {}), ConfigError);
 }
 
 TEST(RosNameOf, MakesValidNames) {

@@ -1,4 +1,6 @@
 // the world file's `ros:` section (world/ros_config.h): reading, validation and error lines.
+#include "penumbra/world/ros_config.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -6,7 +8,6 @@
 #include <fstream>
 
 #include "penumbra/core/error.h"
-#include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -25,9 +26,10 @@ class RosConfigTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
   // lines 1-3: the robot, 4-5: a camera; `text` starts on line 6
   WorldConfig Parse(const std::string& text) {
-    return ParseWorld(
-        "robots:\n  - name: r\n    file: m.xml\ncameras:\n  - {name: cam, attach: r/b}\n" + text,
-        (dir_ / "world.yaml").string());
+    std::ofstream(dir_ / "world.yaml")
+        << "robots:\n  - name: r\n    file: m.xml\ncameras:\n  - {name: cam, attach: r/b}\n"
+        << text;
+    return LoadWorldFile((dir_ / "world.yaml").string());
   }
   std::string Error(const std::string& text) {
     try {
@@ -41,36 +43,37 @@ class RosConfigTest : public ::testing::Test {
 };
 
 TEST_F(RosConfigTest, DefaultsWithoutSection) {
-  const WorldConfig w = Parse("");
-  EXPECT_EQ(w.ros.ns, "");
-  EXPECT_EQ(w.ros.map_frame, "map");
-  EXPECT_DOUBLE_EQ(w.ros.state_rate_hz, 50);
-  EXPECT_TRUE(w.ros.robots.empty());
-  EXPECT_TRUE(w.ros.sensors.empty());
+  const RosConfig ros = LoadRosConfig(Parse(""));
+  EXPECT_EQ(ros.ns, "");
+  EXPECT_EQ(ros.map_frame, "map");
+  EXPECT_DOUBLE_EQ(ros.state_rate_hz, 50);
+  EXPECT_TRUE(ros.robots.empty());
+  EXPECT_TRUE(ros.sensors.empty());
+  EXPECT_EQ(LoadRosConfig(WorldConfig{}).map_frame, "map");
 }
 
 TEST_F(RosConfigTest, ReadsEveryKey) {
-  const WorldConfig w = Parse(
-      "ros:\n"
-      "  namespace: /sim\n"
-      "  map_frame: world\n"
-      "  state_rate_hz: 100\n"
-      "  robots:\n"
-      "    r: {base_body: b, base_frame: r_base, odom_frame: r_odom, namespace: robot1}\n"
-      "  sensors:\n"
-      "    cam: {topic: camera, frame_id: cam_optical}\n");
-  EXPECT_EQ(w.ros.ns, "/sim");
-  EXPECT_EQ(w.ros.map_frame, "world");
-  EXPECT_DOUBLE_EQ(w.ros.state_rate_hz, 100);
-  ASSERT_EQ(w.ros.robots.size(), 1u);
-  EXPECT_EQ(w.ros.robots[0].robot, "r");
-  EXPECT_EQ(w.ros.robots[0].base_body, "b");
-  EXPECT_EQ(w.ros.robots[0].base_frame, "r_base");
-  EXPECT_EQ(w.ros.robots[0].odom_frame, "r_odom");
-  EXPECT_EQ(w.ros.robots[0].ns, "robot1");
-  ASSERT_EQ(w.ros.sensors.size(), 1u);
-  EXPECT_EQ(w.ros.sensors[0].topic, "camera");
-  EXPECT_EQ(w.ros.sensors[0].frame_id, "cam_optical");
+  const RosConfig ros = LoadRosConfig(
+      Parse("ros:\n"
+            "  namespace: /sim\n"
+            "  map_frame: world\n"
+            "  state_rate_hz: 100\n"
+            "  robots:\n"
+            "    r: {base_body: b, base_frame: r_base, odom_frame: r_odom, namespace: robot1}\n"
+            "  sensors:\n"
+            "    cam: {topic: camera, frame_id: cam_optical}\n"));
+  EXPECT_EQ(ros.ns, "/sim");
+  EXPECT_EQ(ros.map_frame, "world");
+  EXPECT_DOUBLE_EQ(ros.state_rate_hz, 100);
+  ASSERT_EQ(ros.robots.size(), 1u);
+  EXPECT_EQ(ros.robots[0].robot, "r");
+  EXPECT_EQ(ros.robots[0].base_body, "b");
+  EXPECT_EQ(ros.robots[0].base_frame, "r_base");
+  EXPECT_EQ(ros.robots[0].odom_frame, "r_odom");
+  EXPECT_EQ(ros.robots[0].ns, "robot1");
+  ASSERT_EQ(ros.sensors.size(), 1u);
+  EXPECT_EQ(ros.sensors[0].topic, "camera");
+  EXPECT_EQ(ros.sensors[0].frame_id, "cam_optical");
 }
 
 TEST_F(RosConfigTest, ErrorsNameLineAndKey) {

@@ -105,7 +105,10 @@ int ExportCommand::RunRosbag() const {
   const fs::path input(s.input);
   const fs::path bag(s.out);
   if (!s.options.camera.empty() || !s.options.camera2.empty() || !s.options.imu.empty())
-    throw ConfigError("", 0, !s.options.camera.empty() ? "--camera" : (!s.options.camera2.empty() ? "--camera2" : "--imu"),
+    throw ConfigError("", 0,
+                      !s.options.camera.empty()
+                          ? "--camera"
+                          : (!s.options.camera2.empty() ? "--camera2" : "--imu"),
                       "a rosbag holds every camera, LiDAR and IMU of the run; expected no sensor "
                       "selection with --format rosbag");
   // a run log is replayed into a temporary run folder beside the bag first

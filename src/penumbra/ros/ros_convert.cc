@@ -106,9 +106,9 @@ RosPointCloud2 PointsToRos(const std::vector<LidarPoint>& points, const RosHeade
   m.header = header;
   m.height = 1;
   m.width = static_cast<uint32_t>(points.size());
-  m.fields = {{"x", 0, kRosFloat32, 1},         {"y", 4, kRosFloat32, 1},
-              {"z", 8, kRosFloat32, 1},         {"intensity", 12, kRosFloat32, 1},
-              {"ring", 16, kRosUint16, 1},      {"time", 20, kRosFloat32, 1}};
+  m.fields = {{"x", 0, kRosFloat32, 1},    {"y", 4, kRosFloat32, 1},
+              {"z", 8, kRosFloat32, 1},    {"intensity", 12, kRosFloat32, 1},
+              {"ring", 16, kRosUint16, 1}, {"time", 20, kRosFloat32, 1}};
   m.point_step = 24;
   m.row_step = m.point_step * m.width;
   m.data.assign(static_cast<size_t>(m.row_step), 0);
@@ -186,9 +186,8 @@ RosJointState JointStateToRos(const ModelInfo& model, const std::vector<int>& jo
     if (!qvel.empty())
       m.velocity.push_back(ji.dof_adr < static_cast<int>(qvel.size()) ? qvel[ji.dof_adr] : 0.0);
     if (!qfrc_actuator.empty())
-      m.effort.push_back(ji.dof_adr < static_cast<int>(qfrc_actuator.size())
-                             ? qfrc_actuator[ji.dof_adr]
-                             : 0.0);
+      m.effort.push_back(
+          ji.dof_adr < static_cast<int>(qfrc_actuator.size()) ? qfrc_actuator[ji.dof_adr] : 0.0);
   }
   return m;
 }

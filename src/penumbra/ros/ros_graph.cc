@@ -8,6 +8,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/sensors/imu_model.h"
+#include "penumbra/world/ros_config.h"
 
 namespace penumbra {
 
@@ -71,8 +72,8 @@ int RigidBodyOf(const ModelInfo& model, int b, const std::vector<std::string>& m
   while (b > 0) {
     const bool jointed = std::any_of(model.joints.begin(), model.joints.end(),
                                      [b](const JointInfo& j) { return j.body == b; });
-    const bool mocap = std::find(mocap_bodies.begin(), mocap_bodies.end(),
-                                 model.body_names[b]) != mocap_bodies.end();
+    const bool mocap = std::find(mocap_bodies.begin(), mocap_bodies.end(), model.body_names[b]) !=
+                       mocap_bodies.end();
     if (jointed || mocap) return b;
     b = model.body_parent[b];
   }
@@ -115,10 +116,9 @@ std::vector<std::string> RosGraph::PublishedTopics() const {
   return t;
 }
 
-RosGraph BuildRosGraph(const WorldConfig& world, const ModelInfo& model,
+RosGraph BuildRosGraph(const WorldConfig& world, const RosConfig& cfg, const ModelInfo& model,
                        const std::vector<RosSensorMount>& sensors,
                        const std::vector<std::string>& mocap_bodies) {
-  const RosConfig& cfg = world.ros;
   RosGraph g;
   g.map_frame = cfg.map_frame;
   g.state_rate_hz = cfg.state_rate_hz;
@@ -176,9 +176,9 @@ RosGraph BuildRosGraph(const WorldConfig& world, const ModelInfo& model,
   for (const RosSensorMount& mount : sensors) {
     RosSensorGraph s;
     s.mount = mount;
-    const std::string owner =
-        mount.body < 0 ? ModelOf(mount.name)
-                       : (mount.body == 0 ? "" : ModelOf(model.body_names[mount.body]));
+    const std::string owner = mount.body < 0
+                                  ? ModelOf(mount.name)
+                                  : (mount.body == 0 ? "" : ModelOf(model.body_names[mount.body]));
     if (auto it = robot_index.find(owner); it != robot_index.end()) s.robot = it->second;
     const RosSensorConfig* sc = FindSensorConfig(cfg, mount.name);
     std::string base_ns = ns;
@@ -196,9 +196,9 @@ RosGraph BuildRosGraph(const WorldConfig& world, const ModelInfo& model,
     s.parent_frame = s.robot >= 0 ? g.robots[s.robot].base_frame : g.map_frame;
     if (mount.body >= 0) {
       const int rigid = RigidBodyOf(model, mount.body, mocap_bodies);
-      s.rigid_to_parent = s.robot >= 0
-                              ? rigid == RigidBodyOf(model, g.robots[s.robot].base_body, mocap_bodies)
-                              : rigid == 0;
+      s.rigid_to_parent =
+          s.robot >= 0 ? rigid == RigidBodyOf(model, g.robots[s.robot].base_body, mocap_bodies)
+                       : rigid == 0;
     }
     switch (mount.kind) {
       case RosSensorKind::kCamera:
@@ -222,7 +222,8 @@ RosGraph BuildRosGraph(const WorldConfig& world, const ModelInfo& model,
       std::string names;
       for (const RosSensorGraph& s : g.sensors) names += (names.empty() ? "" : ", ") + s.mount.name;
       throw ConfigError("", 0, "ros.sensors." + sc.sensor,
-                        "'" + sc.sensor + "' is not a camera, LiDAR or IMU of the world; expected one of: " +
+                        "'" + sc.sensor +
+                            "' is not a camera, LiDAR or IMU of the world; expected one of: " +
                             (names.empty() ? std::string("(none)") : names));
     }
   for (const std::string& body : mocap_bodies) {

@@ -34,6 +34,7 @@
 #include "penumbra/control/model_info.h"
 #include "penumbra/core/pose.h"
 #include "penumbra/scene/scene_description.h"
+#include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -48,10 +49,10 @@ struct RosSensorMount {
   /// body index (ModelInfo::body_names) the sensor is fixed to, 0 = the world; -1 = an MJCF
   /// camera, posed per frame by the snapshot (WorldSnapshot::X_W_mjcam[mjcf_camera]).
   int body = 0;
-  int mjcf_camera = -1;  ///< MuJoCo camera id of an MJCF camera, else -1
-  Pose X_BS = Pose::Identity();  ///< sensor frame in the body (cameras: the optical frame)
-  CameraIntrinsics intrinsics;   ///< cameras
-  double baseline_m = 0;         ///< cameras: > 0 for the right camera of a stereo pair
+  int mjcf_camera = -1;             ///< MuJoCo camera id of an MJCF camera, else -1
+  Pose X_BS = Pose::Identity();     ///< sensor frame in the body (cameras: the optical frame)
+  CameraIntrinsics intrinsics;      ///< cameras
+  double baseline_m = 0;            ///< cameras: > 0 for the right camera of a stereo pair
   bool rgb = false, depth = false;  ///< cameras: which images it makes
   /// IMUs: white-noise densities (Kalibr names), for the message covariances, and the rate
   double gyro_noise_density = 0, accel_noise_density = 0, rate_hz = 0;
@@ -59,8 +60,8 @@ struct RosSensorMount {
 
 /// a robot's names.
 struct RosRobotGraph {
-  std::string robot;      ///< model name
-  int base_body = 0;      ///< body index of base_link
+  std::string robot;  ///< model name
+  int base_body = 0;  ///< body index of base_link
   std::string base_frame, odom_frame;
   std::string odom_topic, joint_states_topic, cmd_vel_topic, joint_commands_topic;
   /// hinge and slide joints of the robot (ModelInfo::joints indices), in model order; their
@@ -106,12 +107,13 @@ std::string RosNameOf(const std::string& world_name);
 /// absolute and kept).
 std::string JoinRosName(const std::string& ns, const std::string& name);
 
-/// derives the names of `world`'s robots and of `sensors` on the composed model `model`.
+/// derives the names of `world`'s robots and of `sensors` on the composed model `model`, with
+/// the overrides of `ros` (the world's `ros:` section: world/ros_config.h LoadRosConfig).
 /// `mocap_bodies` are the model's mocap bodies (composed names).
 /// @throws ConfigError (key "ros.robots.<r>.base_body" / "ros.sensors.<s>") for a base body
 ///         the robot does not have or an override naming an MJCF camera the model lacks; or
 ///         (key "ros") when two topics or two frames come out equal, naming both owners.
-RosGraph BuildRosGraph(const WorldConfig& world, const ModelInfo& model,
+RosGraph BuildRosGraph(const WorldConfig& world, const RosConfig& ros, const ModelInfo& model,
                        const std::vector<RosSensorMount>& sensors,
                        const std::vector<std::string>& mocap_bodies = {});
 

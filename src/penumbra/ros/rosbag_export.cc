@@ -19,6 +19,7 @@
 #include "penumbra/ros/ros_graph.h"
 #include "penumbra/ros/rosbag_writer.h"
 #include "penumbra/scene/sim_time.h"
+#include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -59,13 +60,13 @@ std::vector<std::string> SplitComma(const std::string& line) {
 
 CsvRows ReadCsvRows(const fs::path& path, const std::string& first_columns) {
   std::ifstream in(path);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+  if (!in)
+    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
   CsvRows csv;
   csv.path = path;
   std::string line;
   if (!std::getline(in, line) || line.rfind(first_columns, 0) != 0)
-    throw ConfigError(path.string(), 1, "",
-                      "header does not start with '" + first_columns + "'");
+    throw ConfigError(path.string(), 1, "", "header does not start with '" + first_columns + "'");
   csv.header = SplitComma(line);
   int n = 1;
   while (std::getline(in, line)) {
@@ -79,7 +80,8 @@ CsvRows ReadCsvRows(const fs::path& path, const std::string& first_columns) {
 
 nlohmann::json ReadJsonFile(const fs::path& path) {
   std::ifstream in(path);
-  if (!in) throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+  if (!in)
+    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
   try {
     return nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
@@ -113,8 +115,9 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
                       "'" + bag_path.string() + "'; expected a bag file name ending in .bag");
   std::error_code ec;
   if (fs::exists(fs::symlink_status(bag_path, ec)))
-    throw ConfigError("", 0, "--out",
-                      "'" + bag_path.string() + "' exists; expected a new file (never overwritten)");
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + bag_path.string() + "' exists; expected a new file (never overwritten)");
   const RunFolder run(run_dir);
   RosbagExportSummary summary;
   const WorldConfig world = RunWorld(run_dir, &summary.world_file);
@@ -161,15 +164,17 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
         if (c.name == name) m.mjcf_camera = c.mjcf_camera;
       if (m.mjcf_camera < 0)
         throw ConfigError((run_dir / "camera_info.json").string(), 0, name,
-                          "camera '" + name + "' has no mount in rig.json and is no MJCF camera "
-                          "of composed.xml");
+                          "camera '" + name +
+                              "' has no mount in rig.json and is no MJCF camera "
+                              "of composed.xml");
     }
     mounts.push_back(m);
     cameras.push_back(std::move(cam));
   }
   SceneDescription no_cameras;  // world cameras came from the run folder above
   for (RosSensorMount& m : SensorMountsOf(world, model, no_cameras)) mounts.push_back(m);
-  const RosGraph graph = BuildRosGraph(world, model, mounts, sim.MocapBodyNames());
+  const RosGraph graph =
+      BuildRosGraph(world, LoadRosConfig(world), model, mounts, sim.MocapBodyNames());
 
   fs::create_directories(fs::absolute(bag_path).parent_path(), ec);
   bool done = false;
@@ -227,7 +232,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     if (sc.type == "lidar") {
       const fs::path dir = run_dir / "lidar" / sc.name;
       if (!fs::is_directory(dir, ec)) continue;
-      const CsvRows index = ReadCsvRows(dir / "index.csv", "scan,capture_time_sec,delivery_time_sec,file");
+      const CsvRows index =
+          ReadCsvRows(dir / "index.csv", "scan,capture_time_sec,delivery_time_sec,file");
       for (size_t r = 0; r < index.rows.size(); ++r) {
         const double capture = index.Number(r, 1), delivery = index.Number(r, 2);
         const std::vector<LidarPoint> points = ReadPcd((dir / index.rows[r].at(3)).string());
@@ -261,9 +267,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
       state.time_sec = SimTimeOfStep(step, dt);
       if (traj.rows[row].size() != 2 + nq)
         throw ConfigError(trajectory.string(), traj.lines[row], "",
-                          std::to_string(traj.rows[row].size() - 2) +
-                              " qpos values; expected " + std::to_string(nq) +
-                              " (the nq of composed.xml)");
+                          std::to_string(traj.rows[row].size() - 2) + " qpos values; expected " +
+                              std::to_string(nq) + " (the nq of composed.xml)");
       for (size_t i = 0; i < nq; ++i) state.qpos[i] = traj.Number(row, 2 + i);
       sim.SetState(state);
       return sim.Snapshot(Simulation::SnapshotContent::kPoses);

@@ -1,5 +1,7 @@
 #include "penumbra/world/ros_config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cctype>
 #include <cmath>
 #include <set>
@@ -104,8 +106,8 @@ void RosConfig::ValidateOrThrow() const {
     if (!seen.insert(r.robot).second) Fail(key, "listed twice; expected one entry per robot");
     if (r.base_body.find('/') != std::string::npos)
       Fail(key + ".base_body", "'" + r.base_body +
-                                   "'; expected the model-local body name (without \"" +
-                                   r.robot + "/\")");
+                                   "'; expected the model-local body name (without \"" + r.robot +
+                                   "/\")");
     CheckFrame(key + ".base_frame", r.base_frame, false);
     CheckFrame(key + ".odom_frame", r.odom_frame, false);
     CheckTopic(key + ".namespace", r.ns);
@@ -119,7 +121,7 @@ void RosConfig::ValidateOrThrow() const {
   }
 }
 
-void ValidateRosReferences(const WorldConfig& world) {
+void ValidateRosReferences(const RosConfig& ros, const WorldConfig& world) {
   std::string robots, sensors;
   std::set<std::string> robot_names, sensor_names;
   for (const ModelConfig& m : world.models)
@@ -136,16 +138,38 @@ void ValidateRosReferences(const WorldConfig& world) {
       sensor_names.insert(s.name);
       sensors += (sensors.empty() ? "" : ", ") + s.name;
     }
-  for (const RosRobotConfig& r : world.ros.robots)
+  for (const RosRobotConfig& r : ros.robots)
     if (!robot_names.count(r.robot))
-      Fail("ros.robots." + r.robot, "'" + r.robot + "' is not a robot of the world; expected one of: " +
+      Fail("ros.robots." + r.robot, "'" + r.robot +
+                                        "' is not a robot of the world; expected one of: " +
                                         (robots.empty() ? std::string("(none)") : robots));
-  for (const RosSensorConfig& s : world.ros.sensors)
+  for (const RosSensorConfig& s : ros.sensors)
     if (s.sensor.find('/') == std::string::npos && !sensor_names.count(s.sensor))
       Fail("ros.sensors." + s.sensor,
            "'" + s.sensor + "' is not a camera, LiDAR or IMU of the world; expected one of: " +
                (sensors.empty() ? std::string("(none)") : sensors) +
                " (or an MJCF camera \"<model>/<camera>\")");
+}
+
+RosConfig LoadRosConfig(const WorldConfig& world) {
+  if (world.file.empty()) return RosConfig{};
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(world.file);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(world.file, e.mark.line + 1, "", std::string("cannot read: ") + e.what());
+  }
+  if (!root.IsMap() || !root["ros"]) return RosConfig{};
+  LineTable lines;
+  const YamlReader r(root, world.file, &lines);
+  const RosConfig c = ReadRosConfig(r.Child("ros"));
+  try {
+    c.ValidateOrThrow();
+    ValidateRosReferences(c, world);
+  } catch (const ConfigError& e) {
+    throw ConfigError(world.file, lines.Find(e.key()), e.key(), e.problem());
+  }
+  return c;
 }
 
 }  // namespace penumbra

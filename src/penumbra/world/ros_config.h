@@ -14,9 +14,14 @@
 //                                 # base_body, else the model's first body)
 //         base_frame: base_link   # default "base_link" (one robot) or "<robot>/base_link"
 //         odom_frame: odom        # default "odom" (one robot) or "<robot>/odom"
-//         namespace: go1          # topic namespace of the robot and its sensors (default: its name)
+//         namespace: go1          # topic namespace of the robot and its sensors (default: its
+//         name)
 //     sensors:                    # per camera, LiDAR or IMU, by its name
 //       front: {topic: front_cam, frame_id: front_optical}
+//
+// the section is read and checked when the world file loads (LoadWorldFile / ParseWorld: keys,
+// types, names, that the robots and sensors exist; errors name the line and key); the ROS
+// module reads it again from the world file with LoadRosConfig when it needs the names.
 //
 // topic names follow ROS 1 graph-name rules (letters, digits, '_' and '/'; a segment starts with
 // a letter; relative names are resolved under the namespaces above). frame ids are tf2 frame
@@ -64,12 +69,17 @@ struct RosConfig {
 /// @throws ConfigError naming file, line and key path.
 RosConfig ReadRosConfig(const YamlReader& r);
 
-/// checks that every robot of `world.ros.robots` is a robot of the world and every sensor of
-/// `world.ros.sensors` is a world-file camera or sensor (a name with '/', an MJCF camera, is
-/// checked once the model is composed).
+/// checks that every robot of `ros.robots` is a robot of `world` and every sensor of
+/// `ros.sensors` is a world-file camera, LiDAR or IMU (a name with '/', an MJCF camera, is
+/// checked once the model is composed: ros/ros_graph.h).
 /// @throws ConfigError (no file; key "ros.robots.<name>" / "ros.sensors.<name>") listing the
 ///         names the world has.
-void ValidateRosReferences(const WorldConfig& world);
+void ValidateRosReferences(const RosConfig& ros, const WorldConfig& world);
+
+/// the `ros:` section of `world`'s world file (defaults when the world has no file or no
+/// section), read and checked again (ReadRosConfig, ValidateOrThrow, ValidateRosReferences).
+/// @throws ConfigError naming the world file, line and key.
+RosConfig LoadRosConfig(const WorldConfig& world);
 
 /// true if `name` is a valid ROS 1 graph name (absolute "/a/b", relative "a/b" or "~a"): segments
 /// of letters, digits and '_' starting with a letter, separated by single '/'; no trailing '/'.

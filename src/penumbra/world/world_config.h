@@ -19,7 +19,6 @@
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/sensors/camera_sensor_config.h"
 #include "penumbra/world/metrics_config.h"
-#include "penumbra/world/ros_config.h"
 #include "penumbra/world/sensors_reader.h"
 
 namespace penumbra {
@@ -203,8 +202,6 @@ struct WorldConfig {
   int adversity_line = 0;  ///< line of the `adversity` key (0 = unknown / command line)
   /// `metrics:` time series recorded while the world runs (world/metrics_config.h).
   MetricsConfig metrics;
-  /// `ros:` topic and frame names of the ROS bridge and rosbag export (world/ros_config.h).
-  RosConfig ros;
   /// 1-based line of every key path of the world file (null for a bare model); lets errors
   /// found after loading (by a stage) still name the line: see LocateInWorld.
   std::shared_ptr<const LineTable> lines;

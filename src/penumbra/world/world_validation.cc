@@ -93,12 +93,6 @@ class Validator {
     } catch (const ConfigError& e) {
       Fail(e.key(), e.problem());
     }
-    try {
-      w_.ros.ValidateOrThrow();
-      ValidateRosReferences(w_);
-    } catch (const ConfigError& e) {
-      Fail(e.key(), e.problem());
-    }
   }
 
  private:
