@@ -11,7 +11,12 @@
 # the headers it needs are found by hand.
 set(PENUMBRA_ROS1_FOUND OFF)
 if(NOT PENUMBRA_WITH_ROS STREQUAL "OFF")
+  # roscpp's config adds -DROS_PACKAGE_NAME and -DROSCONSOLE_BACKEND_LOG4CXX to every target of
+  # the directory (add_definitions); they are kept off the other modules (whose compile lines,
+  # and so their ccache entries, stay as without ROS) and given to the ROS files alone below
+  get_directory_property(_penumbra_defs_before COMPILE_DEFINITIONS)
   find_package(roscpp CONFIG QUIET)
+  set_directory_properties(PROPERTIES COMPILE_DEFINITIONS "${_penumbra_defs_before}")
   find_path(PENUMBRA_ROSBAG_INCLUDE_DIR rosbag/bag.h)
   find_path(PENUMBRA_PLUGINLIB_INCLUDE_DIR pluginlib/class_loader.hpp PATH_SUFFIXES pluginlib)
   find_path(PENUMBRA_CLASS_LOADER_INCLUDE_DIR class_loader/class_loader.hpp

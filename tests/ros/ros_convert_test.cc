@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 
+#include "penumbra/core/error.h"
 #include "penumbra/core/pose.h"
 
 namespace penumbra {

@@ -77,10 +77,10 @@ TEST_F(RosConfigTest, ReadsEveryKey) {
 }
 
 TEST_F(RosConfigTest, ErrorsNameLineAndKey) {
-  EXPECT_NE(Error("ros:\n  nspace: /x\n").find("line 7"), std::string::npos);
+  EXPECT_NE(Error("ros:\n  nspace: /x\n").find("world.yaml:7: "), std::string::npos);
   EXPECT_NE(Error("ros:\n  nspace: /x\n").find("unknown key 'nspace'"), std::string::npos);
   const std::string bad_topic = Error("ros:\n  sensors:\n    cam: {topic: 'a b'}\n");
-  EXPECT_NE(bad_topic.find("line 8"), std::string::npos) << bad_topic;
+  EXPECT_NE(bad_topic.find("world.yaml:8: ros.sensors.cam.topic"), std::string::npos) << bad_topic;
   EXPECT_NE(bad_topic.find("ros.sensors.cam.topic"), std::string::npos) << bad_topic;
   EXPECT_NE(bad_topic.find("not a ROS graph name"), std::string::npos) << bad_topic;
   const std::string rate = Error("ros:\n  state_rate_hz: 0\n");

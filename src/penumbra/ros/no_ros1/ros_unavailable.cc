@@ -2,6 +2,7 @@
 // of the ROS-linked files (ros/ros1/) refuses with an error that says how to get them.
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros1_node.h"
+#include "penumbra/ros/ros_bench.h"
 #include "penumbra/ros/rosbag_writer.h"
 
 namespace penumbra {
@@ -28,6 +29,8 @@ void RosbagWriter::Write(const std::string&, int64_t, const RosJointState&) {}
 void RosbagWriter::Write(const std::string&, int64_t, const RosOdometry&) {}
 void RosbagWriter::Write(const std::string&, int64_t, const RosTransform&) {}
 void RosbagWriter::Close() {}
+
+RosBenchResult RunRosBench(const RosBenchOptions&) { NoRos("penumbra bench ros"); }
 
 struct Ros1Node::Impl {};
 Ros1Node::Ros1Node(const Options&) { NoRos("the ROS bridge (--ros)"); }
