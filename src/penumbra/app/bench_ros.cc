@@ -17,12 +17,12 @@ int BenchRosCommand::Run() const {
                                 "ms, p99 {:.3f} ms\n",
                                 options.trips, r.trip_median_ms, r.trip_p99_ms)
                         .c_str());
-  std::printf("%s", fmt::format("  free-running, {:.1f} s: {} frames published, {} received = "
-                                "{:.1f} frames/s ({:.0f} MB/s)   target >= 100 frames/s: {}\n",
-                                options.seconds, r.frames_sent, r.frames_received,
-                                r.received_per_sec, r.megabytes_per_sec,
-                                r.received_per_sec >= 100 ? "met" : "NOT met")
-                        .c_str());
+  std::printf("%s",
+              fmt::format("  free-running, {:.1f} s: {} frames published, {} received = "
+                          "{:.1f} frames/s ({:.0f} MB/s)   target >= 100 frames/s: {}\n",
+                          options.seconds, r.frames_sent, r.frames_received, r.received_per_sec,
+                          r.megabytes_per_sec, r.received_per_sec >= 100 ? "met" : "NOT met")
+                  .c_str());
   return 0;
 }
 
@@ -34,8 +34,7 @@ std::unique_ptr<BenchRosCommand> AddBenchRosCommand(CLI::App& bench) {
       ->check(CLI::Range(0.5, 600.0));
   c->app->add_option("--trips", c->options.trips, "round trips timed")
       ->check(CLI::Range(10, 100000));
-  c->app->add_option("--master", c->options.master_uri,
-                     "ROS master URI (default $ROS_MASTER_URI)");
+  c->app->add_option("--master", c->options.master_uri, "ROS master URI (default $ROS_MASTER_URI)");
   return c;
 }
 

@@ -26,10 +26,10 @@ struct RosBenchOptions {
 /// what the benchmark measured.
 struct RosBenchResult {
   double trip_median_ms = 0, trip_p99_ms = 0;
-  int64_t frames_sent = 0;         ///< throughput phase, published
-  int64_t frames_received = 0;     ///< throughput phase, received by the subscriber
-  double received_per_sec = 0;     ///< received frames / subscriber's receive span
-  double megabytes_per_sec = 0;    ///< received image bytes / s, MB (1e6)
+  int64_t frames_sent = 0;       ///< throughput phase, published
+  int64_t frames_received = 0;   ///< throughput phase, received by the subscriber
+  double received_per_sec = 0;   ///< received frames / subscriber's receive span
+  double megabytes_per_sec = 0;  ///< received image bytes / s, MB (1e6)
 };
 
 /// runs the benchmark. must be called before anything else in the process starts ROS (it

@@ -147,7 +147,8 @@ RosBenchResult RunRosBench(const RosBenchOptions& o) {
     const Clock::time_point t0 = Clock::now();
     pub.publish(frame);
     std::unique_lock<std::mutex> lock(mutex);
-    if (!cv.wait_for(lock, std::chrono::seconds(5), [&] { return acked == static_cast<uint64_t>(i); }))
+    if (!cv.wait_for(lock, std::chrono::seconds(5),
+                     [&] { return acked == static_cast<uint64_t>(i); }))
       throw Error("bench ros: no answer to frame " + std::to_string(i) + " within 5 s");
     trips.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
@@ -157,9 +158,8 @@ RosBenchResult RunRosBench(const RosBenchOptions& o) {
 
   // 2. throughput
   frame.header.frame_id = "flood";
-  const Clock::time_point end =
-      Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                         std::chrono::duration<double>(o.seconds));
+  const Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(o.seconds));
   while (Clock::now() < end) {
     frame.header.stamp.fromNSec(static_cast<uint64_t>(1000000 + r.frames_sent));
     pub.publish(frame);
