@@ -164,7 +164,7 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
   refused([&] { fx.SetEffect("haze", nullptr); }, "effects.haze", "no such effect");
   refused([&] { fx.SetEffect("fog", 3); }, "effects.fog", "expected an object or null");
   refused([&] { fx.SetEffect("dimmer", {{"type", "light_event"}, {"light", "no_such_lamp"}}); },
-          "effects[1].light", "no_such_lamp");
+          "effects.dimmer.light", "no_such_lamp");
   EXPECT_EQ(fx.pending(), 0u);
   EXPECT_EQ(session.effects().effects().size(), 1u);
 

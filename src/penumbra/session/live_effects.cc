@@ -90,12 +90,22 @@ LiveEffects::Change LiveEffects::Plan(const State& s) const {
                             "expected at most those (" +
                             std::to_string(bodies.size() - session_.world().agents.size()) +
                             " NPCs)");
-  ValidateEffectsOrThrow(c.effects);
   ValidateAgentsOrThrow(c.agents, "");
-  // bound here, so that an unknown light or body name fails the request, not the loop
-  if (!c.effects.empty())
-    c.engine = std::make_unique<EffectsEngine>(c.effects, session_.effects().seed(),
-                                               session_.scene());
+  try {
+    ValidateEffectsOrThrow(c.effects);
+    // bound here, so that an unknown light or body name fails the request, not the loop
+    if (!c.effects.empty())
+      c.engine = std::make_unique<EffectsEngine>(c.effects, session_.effects().seed(),
+                                                 session_.scene());
+  } catch (const ConfigError& e) {
+    // "effects[3].light" -> "effects.<name>.light": a live request names effects by name
+    const std::string& key = e.key();
+    const size_t close = key.find(']');
+    if (key.rfind("effects[", 0) != 0 || close == std::string::npos) throw;
+    const size_t i = std::stoul(key.substr(8, close - 8));
+    if (i >= c.effects.size()) throw;
+    throw ConfigError("", 0, "effects." + c.effects[i].name + key.substr(close + 1), e.problem());
+  }
   return c;
 }
 
