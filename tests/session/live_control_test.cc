@@ -3,6 +3,8 @@
 // requests are refused naming the field before anything changes; the NPCs of the preset a run
 // started with move onto the new preset's paths or park, and no more can be added.
 
+#include "penumbra/session/live_control.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +17,6 @@
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/live_control.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_outputs.h"
 #include "penumbra/session/session.h"
@@ -106,11 +107,11 @@ TEST(LiveControlTest, AFogChangeAtStepKChangesTheFramesAfterKAndNoneBefore) {
   // 0.6 s: frames 0..6 at steps 0, 50, ..., 300; the fog is asked for during step 120, so it
   // shows from step 121: frames 3..6 change, frames 0..2 do not
   const auto clear = RunWithChange(SmallDefaultWorld(tmp.path() / "clear", 0.6), 120, nullptr);
-  const auto foggy = RunWithChange(SmallDefaultWorld(tmp.path() / "foggy", 0.6), 120,
-                                   [](LiveControl& live) {
-                                     live.effects().SetEffect("fog", {{"mor_m", 1.5}});
-                                     EXPECT_EQ(live.effects().pending(), 1u);
-                                   });
+  const auto foggy =
+      RunWithChange(SmallDefaultWorld(tmp.path() / "foggy", 0.6), 120, [](LiveControl& live) {
+        live.effects().SetEffect("fog", {{"mor_m", 1.5}});
+        EXPECT_EQ(live.effects().pending(), 1u);
+      });
   ASSERT_EQ(clear.size(), 7u);
   ASSERT_EQ(foggy.size(), 7u);
   for (int i = 0; i <= 2; ++i)
@@ -144,27 +145,45 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
   refused([&] { fx.SetAdversity("minor"); }, "npcs", "cannot add bodies");
   refused([&] { fx.SetEffect("npcs", {{"people", 1}}); }, "npcs", "cannot add bodies");
   // the world's own effect `fog`: world-file keys, checked as the world file's
-  refused([&] { fx.SetEffect("fog", {{"mor_m", "thick"}}); }, "effects.fog.mor_m",
-          "expected a number");
+  refused(
+      [&] {
+        fx.SetEffect("fog", {{"mor_m", "thick"}});
+      },
+      "effects.fog.mor_m", "expected a number");
   refused([&] { fx.SetEffect("fog", {{"mor_m", -2}}); }, "effects.fog.mor_m", "expected >= 0.001");
-  refused([&] { fx.SetEffect("fog", {{"visibility", 3}}); }, "effects.fog.visibility",
-          "unknown key 'visibility'");
+  refused(
+      [&] {
+        fx.SetEffect("fog", {{"visibility", 3}});
+      },
+      "effects.fog.visibility", "unknown key 'visibility'");
   refused([&] { fx.SetEffect("fog", {{"type", "rain"}}); }, "effects.fog.type", "keeps its type");
   // preset blocks: the preset file's keys and ranges
-  refused([&] { fx.SetEffect("rain", {{"rate_mm_h", 900}}); }, "rain.rate_mm_h",
-          "expected (0, 500] mm/h");
+  refused(
+      [&] {
+        fx.SetEffect("rain", {{"rate_mm_h", 900}});
+      },
+      "rain.rate_mm_h", "expected (0, 500] mm/h");
   refused([&] { fx.SetEffect("smoke", {{"coverage", 0.5}}); }, "smoke.sigma_t_per_m", "");
   refused([&] { fx.SetEffect("lights", {{"scale", 2}}); }, "lights.scale", "expected [0, 1]");
-  refused([&] { fx.SetEffect("adversity_fog", {{"mor_m", 3}}); }, "effects.adversity_fog",
-          "planned from the adversity preset");
+  refused(
+      [&] {
+        fx.SetEffect("adversity_fog", {{"mor_m", 3}});
+      },
+      "effects.adversity_fog", "planned from the adversity preset");
   // new effects need a type; removals need an effect
   refused([&] { fx.SetEffect("haze", {{"mor_m", 5}}); }, "effects.haze.type", "missing");
-  refused([&] { fx.SetEffect("haze", {{"type", "mist"}}); }, "effects.haze.type",
-          "unknown value 'mist'");
+  refused(
+      [&] {
+        fx.SetEffect("haze", {{"type", "mist"}});
+      },
+      "effects.haze.type", "unknown value 'mist'");
   refused([&] { fx.SetEffect("haze", nullptr); }, "effects.haze", "no such effect");
   refused([&] { fx.SetEffect("fog", 3); }, "effects.fog", "expected an object or null");
-  refused([&] { fx.SetEffect("dimmer", {{"type", "light_event"}, {"light", "no_such_lamp"}}); },
-          "effects.dimmer.light", "no_such_lamp");
+  refused(
+      [&] {
+        fx.SetEffect("dimmer", {{"type", "light_event"}, {"light", "no_such_lamp"}});
+      },
+      "effects.dimmer.light", "no_such_lamp");
   EXPECT_EQ(fx.pending(), 0u);
   EXPECT_EQ(session.effects().effects().size(), 1u);
 

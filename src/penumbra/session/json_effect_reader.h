@@ -4,9 +4,8 @@
 // types of the world file's `effects:` entries (docs/effects.md), with errors naming the key
 // path and what was expected.
 
-#include <nlohmann/json.hpp>
-
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>

@@ -95,8 +95,8 @@ LiveEffects::Change LiveEffects::Plan(const State& s) const {
     ValidateEffectsOrThrow(c.effects);
     // bound here, so that an unknown light or body name fails the request, not the loop
     if (!c.effects.empty())
-      c.engine = std::make_unique<EffectsEngine>(c.effects, session_.effects().seed(),
-                                                 session_.scene());
+      c.engine =
+          std::make_unique<EffectsEngine>(c.effects, session_.effects().seed(), session_.scene());
   } catch (const ConfigError& e) {
     // "effects[3].light" -> "effects.<name>.light": a live request names effects by name
     const std::string& key = e.key();

@@ -27,14 +27,13 @@
 // replay schedules the recorded changes at their steps (ScheduleRecorded), which gives the
 // same effects frame for frame.
 
-#include <nlohmann/json.hpp>
-
 #include <atomic>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>

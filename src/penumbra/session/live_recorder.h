@@ -11,12 +11,11 @@
 // sinks; a stop at once, between two steps (the loop thread appends under the same lock), so
 // in lockstep a log started and stopped between the same requests holds the same steps.
 
-#include <nlohmann/json.hpp>
-
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -28,9 +27,9 @@ namespace penumbra {
 
 /// a finished live recording.
 struct LiveRecording {
-  std::string path;    ///< the .plog written
-  uint64_t bytes = 0;  ///< its size
-  int64_t steps = 0;   ///< step records in it
+  std::string path;                         ///< the .plog written
+  uint64_t bytes = 0;                       ///< its size
+  int64_t steps = 0;                        ///< step records in it
   int64_t first_step = -1, last_step = -1;  ///< its first and last step (-1: none)
 };
 
@@ -96,7 +95,7 @@ class LiveRecorder : public Sink {
   bool started_ = false;  // the first step was appended (with the earlier changes)
   int64_t first_step_ = -1;
   int64_t last_step_ = -1;
-  std::string error_;  // a write error that ended the recording
+  std::string error_;                    // a write error that ended the recording
   std::vector<nlohmann::json> history_;  // every change applied so far, with its step
   LiveRecording at_finish_;
 };
