@@ -149,10 +149,10 @@ LiveEffects::State LiveEffects::EditEffect(const std::string& name,
   }
   if (IsBlock(name)) {
     AdversityPreset base;
-    if (s.preset) {
+    if (s.preset && !s.preset->empty()) {
       base = *s.preset;
     } else {
-      base.name = "live";
+      base.name = "live";  // run.json's adversity label: "live ((live))"
       base.file = "(live)";
     }
     s.preset = EditAdversityPreset(base, name, params.dump());
