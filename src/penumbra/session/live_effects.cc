@@ -152,7 +152,7 @@ LiveEffects::State LiveEffects::EditEffect(const std::string& name,
     if (s.preset && !s.preset->empty()) {
       base = *s.preset;
     } else {
-      base.name = "live";  // run.json's adversity label: "live ((live))"
+X
       base.file = "(live)";
     }
     s.preset = EditAdversityPreset(base, name, params.dump());
