@@ -152,8 +152,8 @@ LiveEffects::State LiveEffects::EditEffect(const std::string& name,
     if (s.preset && !s.preset->empty()) {
       base = *s.preset;
     } else {
-X
-      base.file = "(live)";
+      base.name = "live";  // run.json's adversity label: "live (live changes)"
+      base.file = "live changes";
     }
     s.preset = EditAdversityPreset(base, name, params.dump());
     return s;
