@@ -47,6 +47,7 @@ WorldConfig SmallDefaultWorld(const fs::path& out, double duration) {
   WorldConfig w = LoadWorldFile((kWorlds / "default.yaml").string());
   w.duration_sec = duration;
   w.output_dir = out.string();
+  fs::create_directories(out);
   w.cameras.resize(1);
   w.cameras[0].width = 48;
   w.cameras[0].height = 36;
