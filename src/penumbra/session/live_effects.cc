@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <utility>
 #include <variant>
 
 #include "penumbra/compose/agent_bodies.h"
@@ -21,8 +22,21 @@ bool IsBlock(const std::string& name) {
   return std::find(blocks.begin(), blocks.end(), name) != blocks.end();
 }
 
-// the common keys and the type's keys of `params` read into `e` (keys not given keep theirs)
-void ReadInto(const nlohmann::json& params, const std::string& path, EffectConfig* e) {
+// default parameters of the effect type at `index` of EffectParams
+template <size_t... I>
+EffectParams DefaultParams(size_t index, std::index_sequence<I...>) {
+  EffectParams p;
+  ((I == index ? (void)p.template emplace<I>() : (void)0), ...);
+  return p;
+}
+
+// the common keys and the type's keys of `params_in` read into `e` (keys not given keep theirs)
+void ReadInto(const nlohmann::json& params_in, const std::string& path, EffectConfig* e) {
+  nlohmann::json params = params_in;
+  // light_event's `light` is required by its reader: a change keeps the light it names
+  if (const auto* ev = std::get_if<LightEventParams>(&e->params);
+      ev && !ev->light.empty() && !params.contains("light"))
+    params["light"] = ev->light;
   JsonEffectReader r(params, path);
   std::vector<std::string_view> keys = kCommonKeys;
   keys.insert(keys.end(), e->type().keys.begin(), e->type().keys.end());
@@ -173,7 +187,8 @@ LiveEffects::State LiveEffects::EditEffect(const std::string& name,
   std::vector<std::string_view> types;
   for (const std::string& t : EffectTypeNames()) types.push_back(t);
   const std::string type = JsonEffectReader(params, path).Enum("type", types);
-  FindEffectType(type)->read(JsonEffectReader(nlohmann::json::object(), path), &e);
+  e.params = DefaultParams(FindEffectType(type)->index,
+                           std::make_index_sequence<std::variant_size_v<EffectParams>>());
   ReadInto(params, path, &e);
   e.ValidateOrThrow(path);
   s.own.push_back(std::move(e));
