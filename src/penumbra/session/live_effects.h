@@ -44,7 +44,7 @@
 #include "penumbra/effects/effects_engine.h"
 #include "penumbra/pipeline/sink.h"
 #include "penumbra/session/session.h"
-#include "penumbra/world/adversity_preset.h"
+#include "penumbra/world/adversity_edit.h"
 
 namespace penumbra {
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/world/adversity_edit.h"
 #include "penumbra/world/yaml_reader.h"
 
 #ifndef PENUMBRA_SOURCE_DIR

@@ -79,21 +79,6 @@ std::vector<std::string> BundledAdversityPresetNames();
 std::string ResolveAdversitySpec(const std::string& spec, const std::string& base_dir,
                                  const std::string& file = "", int line = 0);
 
-/// the blocks of a preset (the keys of a preset file's entry besides `description`), in file
-/// order: fog, dust, smoke, rain, snow, lights, npcs.
-const std::vector<std::string>& AdversityPresetBlocks();
-
-/// `base` with one block changed, as a live change sets it (session/live_effects.h): the keys
-/// of `block_yaml` (a YAML or JSON mapping, e.g. `{"mor_m": 20}`) replace those of the block
-/// and the block's other keys keep their values (a block the preset lacks starts from its
-/// defaults; fog, dust, smoke, rain and snow then need their required key); `block_yaml` "null"
-/// removes the block. the result is checked as a preset file's block is; name, description
-/// and file are kept.
-/// @throws ConfigError("", 0, "<block>.<key>", ...) for an unknown block (naming the valid
-///         ones), unknown keys, wrong types and out-of-range values, before anything changes.
-AdversityPreset EditAdversityPreset(const AdversityPreset& base, const std::string& block,
-                                    const std::string& block_yaml);
-
 /// the preset named by a resolved spec.
 /// @throws ConfigError as ResolveAdversitySpec.
 AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& file = "",
