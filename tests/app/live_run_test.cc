@@ -50,11 +50,22 @@ void WaitForStep(const LiveControl& live, int64_t step) {
 
 TEST(LiveRunTest, AMidRunRecordingReplaysFromItsFirstStepWithTheLiveRunsImages) {
   testing::TempDir tmp;
-  WorldConfig world = LoadWorldFile((kWorlds / "default.yaml").string());
-  world.cameras.resize(1);
-  world.cameras[0].width = 40;
-  world.cameras[0].height = 30;
-  world.cameras[0].outputs = CameraOutputs{true, false, false};
+  // the default world with its camera at 40 x 30, rgb only, in a file (a replay rebuilds the
+  // world from the text the log holds)
+  std::string text = Bytes(kWorlds / "default.yaml");
+  const auto replace = [&text](const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  replace("    width: 640\n    height: 480\n", "    width: 40\n    height: 30\n");
+  replace("outputs: [rgb, depth, segmentation]", "outputs: [rgb]");
+  for (size_t at = text.find("file: models/"); at != std::string::npos;
+       at = text.find("file: models/", at + 1))
+    text.replace(at, 13, "file: " + (kWorlds / "models").string() + "/");
+  const WorldConfig world = LoadWorldFile(tmp.Write("default.yaml", text));
+  ASSERT_EQ(world.cameras.size(), 1u);
+  ASSERT_EQ(world.cameras[0].width, 40);
   const fs::path run = tmp.path() / "run";
   const std::string full_log = (tmp.path() / "full.plog").string();
   const std::string live_log = (tmp.path() / "live.plog").string();
