@@ -10,7 +10,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "python"))
 import penumbra_client as pc  # noqa: E402
-from penumbra_client.messages import LIDAR_POINT_DTYPE, Message, ModelInfo, State, StepResult  # noqa: E402
+from penumbra_client.messages import (LIDAR_POINT_DTYPE, Message, ModelInfo, State,  # noqa: E402
+                                     StepResult)
 from penumbra_client.protocol import decode_reply, encode_request  # noqa: E402
 
 

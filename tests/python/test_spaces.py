@@ -47,7 +47,8 @@ class BoxTest(unittest.TestCase):
 
 class DictTest(unittest.TestCase):
     def test_contains_and_sample(self):
-        space = Dict({"qpos": Box(-np.inf, np.inf, shape=(2,)), "rgb": Box(0, 255, (2, 2, 3), np.uint8)})
+        space = Dict({"qpos": Box(-np.inf, np.inf, shape=(2,)),
+                      "rgb": Box(0, 255, (2, 2, 3), np.uint8)})
         x = space.sample(np.random.default_rng(0))
         self.assertEqual(set(x), {"qpos", "rgb"})
         self.assertTrue(space.contains(x))
