@@ -104,6 +104,12 @@ class PenumbraServer:
         client.timeout_sec = timeout_sec
         return client
 
+    def wait(self, timeout_sec=60):
+        """Waits for the process to exit by itself (e.g. after a `stop` request); returns the
+        exit code. Raises subprocess.TimeoutExpired when it does not."""
+        self.returncode = self.proc.wait(timeout_sec)
+        return self.returncode
+
     def stop(self, timeout_sec=60):
         """SIGINT (as Ctrl-C) and wait; returns the exit code."""
         if self.proc is not None and self.proc.poll() is None:
