@@ -1,0 +1,60 @@
+"""PenumbraEnv (Gymnasium-style reset/step) over a real lockstep `penumbra run --zmq`."""
+
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(__file__))
+from penumbra_server import PenumbraServer  # noqa: E402
+
+import penumbra_client as pc  # noqa: E402
+
+
+class PenumbraEnvTest(unittest.TestCase):
+    def test_reset_step_spaces(self):
+        with PenumbraServer("worlds/quadruped_target.yaml", lockstep=True) as server:
+            client = server.connect(timeout_sec=60)
+            # the target's red pixels: the reward is the count of them in view
+            reward = lambda obs, info: float(((obs["rgb"][..., 0] > 100) &  # noqa: E731
+                                              (obs["rgb"][..., 1] < 50)).sum())
+            env = pc.PenumbraEnv(client=client, outputs=("rgb", "depth"), reward_fn=reward,
+                                 max_episode_steps=15)
+            self.assertEqual(env.action_space.shape, (3,))
+            self.assertEqual(env.observation_space["rgb"].shape, (60, 80, 3))
+            self.assertEqual(env.observation_space["depth"].dtype, np.float32)
+            self.assertEqual(env.observation_space["qpos"].shape, (client.model_info().nq,))
+            self.assertEqual(env.steps_per_action, 50)  # 10 Hz camera, 2 ms steps
+
+            obs, info = env.reset(seed=client.model_info().seed)
+            self.assertTrue(env.observation_space.contains(obs), obs.keys())
+            x0 = obs["qpos"][:2].copy()
+            self.assertLess(np.linalg.norm(x0), 0.05)
+            t0 = info["time_sec"]
+            done, n, rewards = False, 0, []
+            while not done:
+                obs, r, terminated, truncated, info = env.step([0.5, 0.0, 0.0])
+                self.assertTrue(env.observation_space.contains(obs))
+                rewards.append(r)
+                n += 1
+                done = terminated or truncated
+            self.assertEqual(n, 15)
+            self.assertAlmostEqual(info["time_sec"] - t0, 15 * 0.1, places=9)
+            # walking forward at up to 0.5 m/s for 1.5 s
+            self.assertGreater(obs["qpos"][0] - x0[0], 0.3)
+            self.assertGreater(max(rewards), 0)  # the red target is in view
+            # an action outside the box is clipped, not refused
+            env.step([10.0, 0.0, 0.0])
+            # a reset goes back to the start pose
+            obs, _ = env.reset()
+            self.assertLess(np.linalg.norm(obs["qpos"][:2] - x0), 0.05)
+            with self.assertRaises(ValueError):
+                env.reset(seed=client.model_info().seed + 1)
+            self.assertEqual(env.render().shape, (60, 80, 3))
+            env.close()
+            client.close()
+
+
+if __name__ == "__main__":
+    unittest.main()
