@@ -16,6 +16,7 @@
 #include <optional>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/bench_bridge.h"
 #include "penumbra/app/bench_record.h"
 #include "penumbra/app/bridge_flags.h"
 #include "penumbra/app/contact_sheet.h"
@@ -263,6 +264,7 @@ int RunCli(int argc, char** argv) {
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
+  const std::unique_ptr<BenchBridgeCommand> bench_bridge = AddBenchBridgeCommand(*bench);
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -343,6 +345,7 @@ int RunCli(int argc, char** argv) {
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (eval.Selected()) return eval.Run();
     if (*bench_record->app) return bench_record->Run();
+    if (*bench_bridge->app) return bench_bridge->Run();
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

@@ -113,6 +113,18 @@ nlohmann::ordered_json MountJson(const ModelInfo& info, int body, const Pose& X_
   return j;
 }
 
+// a sample of `sensor` for SensorSink's on_sample
+SensorSample MakeSample(const std::string& sensor, const char* type, int64_t index, int64_t step,
+                        double time_sec) {
+  SensorSample s;
+  s.sensor = sensor;
+  s.type = type;
+  s.index = index;
+  s.step = step;
+  s.time_sec = time_sec;
+  return s;
+}
+
 }  // namespace
 
 struct SensorSink::Impl {
@@ -202,7 +214,8 @@ struct SensorSink::Impl {
     std::string pcd = l.out.Write(l.start_firing, scan);
     if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     if (on_sample) {
-      SensorSample sample{l.cfg->name, "lidar", l.start_firing.index, start.step, start.time_sec};
+      SensorSample sample =
+          MakeSample(l.cfg->name, "lidar", l.start_firing.index, start.step, start.time_sec);
       sample.scan = std::move(scan_ptr);
       on_sample(sample);
     }
@@ -443,10 +456,9 @@ void SensorSink::Impl::Process(
       std::string row = m.out.Write(f, measured);
       m.truth_out.Write(f, state);
       if (s.on_sample) {
-        SensorSample sample{m.cfg->name, "imu", f.index, snap.step, snap.time_sec};
-        sample.values = {measured.accel_m_s2.x(), measured.accel_m_s2.y(),
-                         measured.accel_m_s2.z(), measured.gyro_rad_s.x(),
-                         measured.gyro_rad_s.y(),  measured.gyro_rad_s.z()};
+        SensorSample sample = MakeSample(m.cfg->name, "imu", f.index, snap.step, snap.time_sec);
+        sample.values = {measured.accel_m_s2.x(), measured.accel_m_s2.y(), measured.accel_m_s2.z(),
+                         measured.gyro_rad_s.x(), measured.gyro_rad_s.y(), measured.gyro_rad_s.z()};
         s.on_sample(sample);
       }
       if (s.on_output)
@@ -464,7 +476,7 @@ void SensorSink::Impl::Process(
       if (s.on_sample) {
         if (!m.columns)
           m.columns = std::make_shared<const std::vector<std::string>>(m.set->ColumnNames());
-        SensorSample sample{m.cfg->name, "mujoco", f.index, snap.step, snap.time_sec};
+        SensorSample sample = MakeSample(m.cfg->name, "mujoco", f.index, snap.step, snap.time_sec);
         sample.values = m.values;
         sample.columns = m.columns;
         s.on_sample(sample);
