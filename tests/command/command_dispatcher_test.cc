@@ -44,9 +44,9 @@ class LiveLoop {
     RunControlOptions co;
     co.start_paused = true;
     control_ = std::make_unique<RunControl>(&session_->sim(), co);
-    dispatcher_ = std::make_unique<CommandDispatcher>(
-        *session_, session_->world(), control_.get(),
-        DescribeRun(*session_, session_->world()), true);
+    dispatcher_ =
+        std::make_unique<CommandDispatcher>(*session_, session_->world(), control_.get(),
+                                            DescribeRun(*session_, session_->world()), true);
     PhysicsSourceOptions po;
     po.before_step = [this](Simulation& sim) { return control_->BeforeStep(sim); };
     source_ = std::make_unique<PhysicsSource>(&session_->sim(), po);
@@ -85,8 +85,7 @@ class CommandDispatcherTest : public ::testing::Test {
   std::string world_;
 };
 
-void ExpectError(LiveLoop& live, const json& request, const std::string& code,
-                 const json& field) {
+void ExpectError(LiveLoop& live, const json& request, const std::string& code, const json& field) {
   const json r = live.Call(request);
   ASSERT_FALSE(r.at("ok").get<bool>()) << r.dump();
   EXPECT_EQ(r.at("error").at("code"), code) << r.dump();
@@ -116,10 +115,10 @@ TEST_F(CommandDispatcherTest, BadRequestsGetErrorsNamingTheField) {
               "body");
   ExpectError(live, {{"cmd", "set_mocap"}, {"body", "a/target"}, {"xyz", {0, 0}}}, "bad_field",
               "xyz");
-  ExpectError(live,
-              {{"cmd", "set_mocap"}, {"body", "a/target"}, {"xyz", {0, 0, 1}},
-               {"qwxyz", {0, 0, 0, 0}}},
-              "bad_field", "qwxyz");
+  ExpectError(
+      live,
+      {{"cmd", "set_mocap"}, {"body", "a/target"}, {"xyz", {0, 0, 1}}, {"qwxyz", {0, 0, 0, 0}}},
+      "bad_field", "qwxyz");
   ExpectError(live, {{"cmd", "reset"}, {"keyframe", "away"}}, "bad_field", "keyframe");
   ExpectError(live, {{"cmd", "reset"}, {"seed", 9}}, "bad_field", "seed");
   ExpectError(live, {{"cmd", "hello"}, {"protocol", 7}}, "version_mismatch", "protocol");

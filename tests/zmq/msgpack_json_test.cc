@@ -44,10 +44,10 @@ TEST(MsgpackJson, RejectsHostileInput) {
   ExpectRejected(map.substr(0, map.size() - 1), "truncated");
   ExpectRejected(map + "\x01", "after the msgpack value");
   ExpectRejected(std::string(40, '\x91') + "\x00", "nested deeper");
-  ExpectRejected(std::string("\x81\x01\x02", 3), "not a string");           // {1: 2}
-  ExpectRejected(std::string("\xd4\x01\x00", 3), "ext");                    // fixext 1
-  ExpectRejected(std::string("\xdd\xff\xff\xff\xff", 5), "");               // 4e9-entry array
-  ExpectRejected(std::string("\xdb\xff\xff\xff\xff", 5), "");               // 4 GB string
+  ExpectRejected(std::string("\x81\x01\x02", 3), "not a string");  // {1: 2}
+  ExpectRejected(std::string("\xd4\x01\x00", 3), "ext");           // fixext 1
+  ExpectRejected(std::string("\xdd\xff\xff\xff\xff", 5), "");      // 4e9-entry array
+  ExpectRejected(std::string("\xdb\xff\xff\xff\xff", 5), "");      // 4 GB string
 }
 
 }  // namespace

@@ -329,6 +329,8 @@ def test_errors(binary, source):
             for key in ("qpos", "qvel", "act", "mocap_pos", "mocap_quat"):
                 assert after[key] == state0[key], f"{key} after reset differs from step 0"
             c.ok("pause")
+            # running free at 5 % of real time (the run must not reach its end meanwhile)
+            assert c.ok("set_realtime_factor", factor=0.05)["factor"] == 0.05
             r = c.ok("resume")
             assert r["paused"] is False
             r = c.call("step", n=1)

@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
-#include <vector>
 #include <thread>
+#include <vector>
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
@@ -236,9 +236,9 @@ std::unique_ptr<BenchBridgeCommand> AddBenchBridgeCommand(CLI::App& bench) {
 
 int BenchBridgeCommand::Run() const {
   const BenchBridgeOptions& o = options;
-  WorldConfig world = LoadWorldFile(
-      o.world_file.empty() ? std::string(PENUMBRA_SOURCE_DIR) + "/worlds/quadruped.yaml"
-                           : o.world_file);
+  WorldConfig world = LoadWorldFile(o.world_file.empty() ? std::string(PENUMBRA_SOURCE_DIR) +
+                                                               "/worlds/quadruped.yaml"
+                                                         : o.world_file);
   world.render.seed = world.seed;
   world.duration_sec = 1e6;
   constexpr int kWidth = 640, kHeight = 480;
@@ -355,8 +355,9 @@ int BenchBridgeCommand::Run() const {
     on.push_back(b.steps_per_sec);
     cpu_off.push_back(a.cpu_us_per_step);
     cpu_on.push_back(b.cpu_us_per_step);
-    fmt::print("  round {}: no bridge {:7.0f} steps/s   bridge idle {:7.0f} steps/s   ratio {:.3f}\n",
-               i + 1, a.steps_per_sec, b.steps_per_sec, b.steps_per_sec / a.steps_per_sec);
+    fmt::print(
+        "  round {}: no bridge {:7.0f} steps/s   bridge idle {:7.0f} steps/s   ratio {:.3f}\n",
+        i + 1, a.steps_per_sec, b.steps_per_sec, b.steps_per_sec / a.steps_per_sec);
   }
   fmt::print(
       "physics with the bridge idle: median {:.0f} vs {:.0f} steps/s, ratio {:.3f} (target >= "

@@ -15,8 +15,7 @@ int64_t ParseCount(const std::string& flag, const std::string& s, int64_t lo, in
   int64_t v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || v < lo || v > hi)
-    throw ConfigError("", 0, flag,
-                      fmt::format("'{}' is not an integer in [{}, {}]", s, lo, hi));
+    throw ConfigError("", 0, flag, fmt::format("'{}' is not an integer in [{}, {}]", s, lo, hi));
   return v;
 }
 
@@ -29,13 +28,11 @@ void BridgeFlags::Add(CLI::App* run) {
       ->expected(0, 1)
       ->type_name("[ENDPOINT]");
   run->add_option("--zmq-pub", zmq_pub, "ZeroMQ publish endpoint (default: command port + 1)");
-  run->add_option("--bind", bind,
-                  "host the bridges bind to instead of loopback (e.g. 0.0.0.0)");
+  run->add_option("--bind", bind, "host the bridges bind to instead of loopback (e.g. 0.0.0.0)");
   run->add_flag("--lockstep", lockstep,
                 "with --zmq: start paused; the run advances only by `step` requests");
   run->add_option("--zmq-hwm", hwm, "ZeroMQ send high-water mark per subscriber (default 1000)");
-  run->add_option("--zmq-max-request", max_request,
-                  "largest request in bytes (default 1048576)");
+  run->add_option("--zmq-max-request", max_request, "largest request in bytes (default 1048576)");
   run->add_option("--zmq-state-hz", state_hz,
                   "rate of the clock/joint_states/ground_truth/contacts topics, Hz of sim time "
                   "(default 0: every physics step)");
@@ -43,8 +40,8 @@ void BridgeFlags::Add(CLI::App* run) {
 
 void BridgeFlags::Apply(const CLI::App& run, RunOptions* options) const {
   const bool zmq = run.count("--zmq") > 0;
-  for (const char* flag : {"--zmq-pub", "--bind", "--lockstep", "--zmq-hwm", "--zmq-max-request",
-                           "--zmq-state-hz"})
+  for (const char* flag :
+       {"--zmq-pub", "--bind", "--lockstep", "--zmq-hwm", "--zmq-max-request", "--zmq-state-hz"})
     if (run.count(flag) > 0 && !zmq)
       throw ConfigError("", 0, flag, "needs --zmq (a bridge to serve the run)");
   if (!zmq) return;

@@ -314,9 +314,10 @@ int RunCli(int argc, char** argv) {
       spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
       if (s.interrupted && g_stop_signal.load() == 0) {
-        spdlog::info("stopped by a client's `stop` at {:.6g} s of sim time; outputs and run.json "
-                     "written",
-                     s.sim_time_sec);
+        spdlog::info(
+            "stopped by a client's `stop` at {:.6g} s of sim time; outputs and run.json "
+            "written",
+            s.sim_time_sec);
         return 0;
       }
       if (s.interrupted) {

@@ -34,11 +34,10 @@ json StepTime(const Simulation& sim) {
 const std::vector<std::string>& Names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n = {
-        "hello",          "model_info",     "get_state",           "step",
-        "set_ctrl",       "twist",          "joint_targets",       "waypoints",
-        "set_mocap",      "reset",          "pause",               "resume",
-        "set_realtime_factor", "stop",      "set_adversity",       "set_effect",
-        "start_recording", "stop_recording"};
+        "hello",      "model_info",      "get_state",           "step",      "set_ctrl",
+        "twist",      "joint_targets",   "waypoints",           "set_mocap", "reset",
+        "pause",      "resume",          "set_realtime_factor", "stop",      "set_adversity",
+        "set_effect", "start_recording", "stop_recording"};
     std::sort(n.begin(), n.end());
     return n;
   }();
@@ -103,9 +102,9 @@ void CommandDispatcher::Dispatch(const json& request, Done done) {
     const std::string name = it->get<std::string>();
     const auto& names = Names();
     if (!std::binary_search(names.begin(), names.end(), name))
-      throw CommandError(command_code::kUnknownCommand, "cmd",
-                         fmt::format("unknown command '{}'; expected one of: {}", name,
-                                     JoinNames(names)));
+      throw CommandError(
+          command_code::kUnknownCommand, "cmd",
+          fmt::format("unknown command '{}'; expected one of: {}", name, JoinNames(names)));
     cmd = name;
     RequestReader rd(request);
     // replies from the loop thread get "cmd" and "id" too (the lambda owns copies)
@@ -118,8 +117,7 @@ void CommandDispatcher::Dispatch(const json& request, Done done) {
   } catch (const CommandError& e) {
     finish({{"ok", false}, {"error", e.ToJson()}});
   } catch (const std::exception& e) {
-    finish({{"ok", false},
-            {"error", CommandError(command_code::kFailed, "", e.what()).ToJson()}});
+    finish({{"ok", false}, {"error", CommandError(command_code::kFailed, "", e.what()).ToJson()}});
   }
 }
 
@@ -134,18 +132,18 @@ const CommandDispatcher::Target& CommandDispatcher::FindTarget(RequestReader& rd
     robots.push_back(t.robot);
   }
   if (accepting.empty())
-    throw CommandError(command_code::kNotAvailable, "",
-                       fmt::format("no controller of this world accepts '{}' (it needs a robot "
-                                   "with a {} controller)",
-                                   command,
-                                   command == "joint_targets" ? "joint_pd"
-                                                              : "trot_gait or waypoint_follower"));
+    throw CommandError(
+        command_code::kNotAvailable, "",
+        fmt::format("no controller of this world accepts '{}' (it needs a robot "
+                    "with a {} controller)",
+                    command,
+                    command == "joint_targets" ? "joint_pd" : "trot_gait or waypoint_follower"));
   const std::string robot = rd.String("robot", "");
   if (robot.empty()) {
     if (accepting.size() > 1)
       throw CommandError(command_code::kMissingField, "robot",
-                         fmt::format("several robots accept '{}'; name one in 'robot': {}",
-                                     command, JoinNames(robots)));
+                         fmt::format("several robots accept '{}'; name one in 'robot': {}", command,
+                                     JoinNames(robots)));
     return *accepting.front();
   }
   for (const Target* t : accepting)
@@ -211,9 +209,9 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     const int nu = static_cast<int>(actuator_names_.size());
     if (v.is_array()) {
       if (static_cast<int>(v.size()) != nu)
-        throw CommandError(command_code::kBadField, "ctrl",
-                           fmt::format("'ctrl' has {} values; the model has {} actuators (nu)",
-                                       v.size(), nu));
+        throw CommandError(
+            command_code::kBadField, "ctrl",
+            fmt::format("'ctrl' has {} values; the model has {} actuators (nu)", v.size(), nu));
       for (int i = 0; i < nu; ++i)
         values.emplace_back(i, RequestReader::RealValue(v[i], fmt::format("ctrl[{}]", i)));
     } else if (v.is_object()) {
@@ -246,9 +244,9 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     if (clear) {
       for (const char* f : {"vx", "vy", "yaw_rate"})
         if (rd.Has(f))
-          throw CommandError(command_code::kBadField, f,
-                             fmt::format("'{}' given with 'clear': true; clear takes no values",
-                                         f));
+          throw CommandError(
+              command_code::kBadField, f,
+              fmt::format("'{}' given with 'clear': true; clear takes no values", f));
     } else {
       vx = rd.Real("vx", -kMaxSpeed, kMaxSpeed, 0.0);
       vy = rd.Real("vy", -kMaxSpeed, kMaxSpeed, 0.0);
@@ -289,9 +287,9 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     else if (mode == "effort")
       m = JointCommand::Mode::kEffort;
     else
-      throw CommandError(command_code::kBadField, "mode",
-                         fmt::format("unknown mode '{}'; expected position, velocity or effort",
-                                     mode));
+      throw CommandError(
+          command_code::kBadField, "mode",
+          fmt::format("unknown mode '{}'; expected position, velocity or effort", mode));
     std::vector<double> values = rd.Reals("values", t.joints);
     queue([t, m, values = std::move(values)](Simulation& sim) {
       auto* pd = dynamic_cast<JointPdController*>(&sim.mutable_controller(t.index));
@@ -338,9 +336,9 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     const std::string body = rd.String("body");
     const auto found = std::find(mocap_names_.begin(), mocap_names_.end(), body);
     if (found == mocap_names_.end())
-      throw CommandError(command_code::kBadField, "body",
-                         fmt::format("'{}' is not a mocap body; mocap bodies: {}", body,
-                                     JoinNames(mocap_names_)));
+      throw CommandError(
+          command_code::kBadField, "body",
+          fmt::format("'{}' is not a mocap body; mocap bodies: {}", body, JoinNames(mocap_names_)));
     const int id = static_cast<int>(found - mocap_names_.begin());
     if (mocap_driven_[id])
       throw CommandError(command_code::kBadField, "body",
@@ -381,8 +379,8 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
       throw CommandError(command_code::kBadField, "keyframe",
                          fmt::format("the model has no keyframe '{}'; keyframes: {}", keyframe,
                                      JoinNames(key_names_)));
-    const int64_t seed = rd.Int("seed", 0, std::numeric_limits<int64_t>::max(),
-                                static_cast<int64_t>(world_.seed));
+    const int64_t seed =
+        rd.Int("seed", 0, std::numeric_limits<int64_t>::max(), static_cast<int64_t>(world_.seed));
     if (static_cast<uint64_t>(seed) != world_.seed)
       throw CommandError(command_code::kBadField, "seed",
                          fmt::format("seed {} differs from the run's seed {}: noise streams and "

@@ -70,8 +70,9 @@ int64_t RequestReader::Int(const std::string& field, int64_t lo, int64_t hi,
                                    JsonTypeName(*v), lo, hi));
   }
   if (x < lo || x > hi)
-    throw CommandError(command_code::kBadField, field,
-                       fmt::format("'{}' is {}; expected an integer in [{}, {}]", field, x, lo, hi));
+    throw CommandError(
+        command_code::kBadField, field,
+        fmt::format("'{}' is {}; expected an integer in [{}, {}]", field, x, lo, hi));
   return x;
 }
 
@@ -118,16 +119,16 @@ std::string RequestReader::String(const std::string& field, std::optional<std::s
 std::vector<double> RequestReader::Reals(const std::string& field, int size, int min_size) {
   const nlohmann::json& v = *Find(field, true);
   if (!v.is_array())
-    throw CommandError(command_code::kBadField, field,
-                       fmt::format("'{}' is a {}; expected an array of numbers", field,
-                                   JsonTypeName(v)));
+    throw CommandError(
+        command_code::kBadField, field,
+        fmt::format("'{}' is a {}; expected an array of numbers", field, JsonTypeName(v)));
   if (size >= 0 && static_cast<int>(v.size()) != size)
     throw CommandError(command_code::kBadField, field,
                        fmt::format("'{}' has {} values; expected {}", field, v.size(), size));
   if (size < 0 && static_cast<int>(v.size()) < min_size)
-    throw CommandError(command_code::kBadField, field,
-                       fmt::format("'{}' has {} values; expected at least {}", field, v.size(),
-                                   min_size));
+    throw CommandError(
+        command_code::kBadField, field,
+        fmt::format("'{}' has {} values; expected at least {}", field, v.size(), min_size));
   std::vector<double> out;
   out.reserve(v.size());
   for (size_t i = 0; i < v.size(); ++i)

@@ -16,8 +16,7 @@ nlohmann::json ErrorOnly(const CommandError& e) { return {{"ok", false}, {"error
 
 }  // namespace
 
-RunControl::RunControl(Simulation* sim, RunControlOptions options)
-    : sim_(sim), options_(options) {
+RunControl::RunControl(Simulation* sim, RunControlOptions options) : sim_(sim), options_(options) {
   if (!(options_.realtime_factor >= 0))
     throw Error(fmt::format("realtime factor {} must be >= 0", options_.realtime_factor));
   factor_.store(options_.realtime_factor);
@@ -90,19 +89,22 @@ void RunControl::Reanchor(const Simulation& sim) {
 nlohmann::json RunControl::StateJson(const Simulation& sim) const {
   const SimState s = sim.GetState();
   const WorldSnapshot snap = sim.Snapshot(Simulation::SnapshotContent::kFull);
-  return {{"step", s.step_count},   {"time_sec", s.time_sec},
-          {"qpos", s.qpos},         {"qvel", s.qvel},
-          {"act", s.act},           {"ctrl", s.ctrl},
-          {"mocap_pos", s.mocap_pos}, {"mocap_quat", s.mocap_quat},
-          {"sensordata", snap.sensordata}, {"paused", paused_.load()}};
+  return {{"step", s.step_count},
+          {"time_sec", s.time_sec},
+          {"qpos", s.qpos},
+          {"qvel", s.qvel},
+          {"act", s.act},
+          {"ctrl", s.ctrl},
+          {"mocap_pos", s.mocap_pos},
+          {"mocap_quat", s.mocap_quat},
+          {"sensordata", snap.sensordata},
+          {"paused", paused_.load()}};
 }
 
 void RunControl::CompleteSteps(Simulation& sim, bool ended) {
   RunDrains();
-  nlohmann::json r = {{"ok", true},
-                      {"step", sim.step_count()},
-                      {"time_sec", sim.time()},
-                      {"ended", ended}};
+  nlohmann::json r = {
+      {"ok", true}, {"step", sim.step_count()}, {"time_sec", sim.time()}, {"ended", ended}};
   if (active_->with_state) {
     for (auto& [k, v] : StateJson(sim).items()) r[k] = v;
   }
@@ -180,9 +182,9 @@ bool RunControl::Gate(Simulation& sim, bool at_start) {
       if (f <= 0) return true;
       if (!anchored_ || factor_changed_.exchange(false)) Reanchor(sim);
       const auto deadline =
-          anchor_wall_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                             static_cast<double>(sim.step_count() - anchor_step_) *
-                             sim.timestep() / f));
+          anchor_wall_ +
+          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+              static_cast<double>(sim.step_count() - anchor_step_) * sim.timestep() / f));
       const auto now = Clock::now();
       if (now >= deadline) return true;
       cv_.wait_until(lock, std::min(deadline, now + kPollInterval), woken);
@@ -214,10 +216,8 @@ void RunControl::OnFinish(const LoopFinish&) {
   if (active_) CompleteSteps(*sim_, true);
   for (Work& w : left) {
     if (w.steps > 0) {
-      nlohmann::json r = {{"ok", true},
-                          {"step", sim_->step_count()},
-                          {"time_sec", sim_->time()},
-                          {"ended", true}};
+      nlohmann::json r = {
+          {"ok", true}, {"step", sim_->step_count()}, {"time_sec", sim_->time()}, {"ended", true}};
       if (w.with_state)
         for (auto& [k, v] : StateJson(*sim_).items()) r[k] = v;
       w.done(std::move(r));

@@ -110,8 +110,8 @@ class RunControl : public Sink {
 
  private:
   struct Work {
-    Action action;        // set for an action
-    int64_t steps = 0;    // > 0 for a step request
+    Action action;      // set for an action
+    int64_t steps = 0;  // > 0 for a step request
     bool with_state = false;
     Done done;
   };

@@ -92,9 +92,8 @@ nlohmann::json DescribeRun(Session& session, const WorldConfig& world) {
   json mocap = json::array();
   const std::vector<std::string> mocap_names = sim.MocapBodyNames();
   for (size_t i = 0; i < mocap_names.size(); ++i)
-    mocap.push_back({{"id", i},
-                     {"name", mocap_names[i]},
-                     {"driven", sim.MocapDriven(static_cast<int>(i))}});
+    mocap.push_back(
+        {{"id", i}, {"name", mocap_names[i]}, {"driven", sim.MocapDriven(static_cast<int>(i))}});
   j["nmocap"] = mocap_names.size();
   j["mocap_bodies"] = std::move(mocap);
 
@@ -132,12 +131,12 @@ nlohmann::json DescribeRun(Session& session, const WorldConfig& world) {
       rate = 200.0;
     else if (s.type != "lidar")
       rate = 100.0;
-    world_sensors.push_back({{"name", s.name},
-                             {"type", s.type},
-                             {"rate_hz", rate},
-                             {"frame_id", s.type == "mujoco" || s.type == "ground_truth"
-                                              ? std::string("world")
-                                              : s.name}});
+    world_sensors.push_back(
+        {{"name", s.name},
+         {"type", s.type},
+         {"rate_hz", rate},
+         {"frame_id",
+          s.type == "mujoco" || s.type == "ground_truth" ? std::string("world") : s.name}});
   }
   j["sensors"] = std::move(world_sensors);
 

@@ -23,9 +23,9 @@ nlohmann::json ToJson(const msgpack::object& o) {
     case msgpack::type::STR:
       return std::string(o.via.str.ptr, o.via.str.size);
     case msgpack::type::BIN:
-      return json::binary(std::vector<uint8_t>(
-          reinterpret_cast<const uint8_t*>(o.via.bin.ptr),
-          reinterpret_cast<const uint8_t*>(o.via.bin.ptr) + o.via.bin.size));
+      return json::binary(
+          std::vector<uint8_t>(reinterpret_cast<const uint8_t*>(o.via.bin.ptr),
+                               reinterpret_cast<const uint8_t*>(o.via.bin.ptr) + o.via.bin.size));
     case msgpack::type::ARRAY: {
       json a = json::array();
       for (uint32_t i = 0; i < o.via.array.size; ++i) a.push_back(ToJson(o.via.array.ptr[i]));
@@ -103,8 +103,7 @@ nlohmann::json DecodeMsgpack(const void* data, size_t size, const MsgpackLimits&
   try {
     h = msgpack::unpack(static_cast<const char*>(data), size, off, nullptr, nullptr, limit);
   } catch (const msgpack::depth_size_overflow&) {
-    throw std::runtime_error("nested deeper than " + std::to_string(limits.max_depth) +
-                             " levels");
+    throw std::runtime_error("nested deeper than " + std::to_string(limits.max_depth) + " levels");
   } catch (const msgpack::size_overflow& e) {
     throw std::runtime_error(std::string("a value exceeds the size limits (") + e.what() + ")");
   } catch (const msgpack::insufficient_bytes&) {

@@ -13,9 +13,9 @@ namespace penumbra {
 
 /// limits of DecodeMsgpack.
 struct MsgpackLimits {
-  size_t max_depth = 32;           ///< nesting of arrays and maps
-  size_t max_elements = 1 << 20;   ///< entries of one array or map
-  size_t max_bytes = 64u << 20;    ///< one string or bin
+  size_t max_depth = 32;          ///< nesting of arrays and maps
+  size_t max_elements = 1 << 20;  ///< entries of one array or map
+  size_t max_bytes = 64u << 20;   ///< one string or bin
 };
 
 /// the value in `size` bytes at `data`: nil, bool, integers, floats, str (as UTF-8 text, not

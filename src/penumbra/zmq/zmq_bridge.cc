@@ -27,7 +27,7 @@ namespace {
 using json = nlohmann::json;
 
 constexpr int64_t kHardMessageLimit = 64ll << 20;  // ZMQ_MAXMSGSIZE: peers above it are dropped
-constexpr size_t kMaxRequestFrames = 4;             // frames kept of one request (rest dropped)
+constexpr size_t kMaxRequestFrames = 4;            // frames kept of one request (rest dropped)
 
 json PoseJson(const Pose& X) {
   const Eigen::Quaterniond q(X.linear());
@@ -87,8 +87,8 @@ class ZmqBridge final : public RunBridge {
   void Wake();
   void Shutdown();
   json Topics() const;
-  void PublishImage(const std::string& topic, const CameraFrame& f, const char* encoding,
-                    int width, int height, int bytes_per_pixel, zmq::message_t payload);
+  void PublishImage(const std::string& topic, const CameraFrame& f, const char* encoding, int width,
+                    int height, int bytes_per_pixel, zmq::message_t payload);
 
   RunControl& control_;
   CommandDispatcher& dispatcher_;
@@ -172,14 +172,14 @@ ZmqBridge::ZmqBridge(const RunBridgeContext& context, ZmqBridgeOptions options)
   try {
     router_.bind(endpoint_);
   } catch (const zmq::error_t& e) {
-    throw Error(fmt::format("cannot bind the ZeroMQ command socket to {}: {}", endpoint_,
-                            e.what()));
+    throw Error(
+        fmt::format("cannot bind the ZeroMQ command socket to {}: {}", endpoint_, e.what()));
   }
   try {
     xpub_.bind(pub_endpoint_);
   } catch (const zmq::error_t& e) {
-    throw Error(fmt::format("cannot bind the ZeroMQ publish socket to {}: {}", pub_endpoint_,
-                            e.what()));
+    throw Error(
+        fmt::format("cannot bind the ZeroMQ publish socket to {}: {}", pub_endpoint_, e.what()));
   }
   wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) throw Error("eventfd failed for the ZeroMQ bridge");
@@ -244,9 +244,8 @@ void ZmqBridge::Publish(const std::string& topic, const json& header, zmq::messa
     if (pending_publications_ >= options_.queue_capacity) {
       if (control_.paused()) {
         // lockstep: nothing is dropped; the producer waits for the I/O thread
-        out_cv_.wait(lock, [&] {
-          return pending_publications_ < options_.queue_capacity || closing_;
-        });
+        out_cv_.wait(lock,
+                     [&] { return pending_publications_ < options_.queue_capacity || closing_; });
         if (closing_) return;
       } else {
         ++dropped_;
@@ -514,17 +513,10 @@ void ZmqBridge::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot)
 
 void ZmqBridge::PublishImage(const std::string& topic, const CameraFrame& f, const char* encoding,
                              int width, int height, int bytes_per_pixel, zmq::message_t payload) {
-  json h = {{"stamp", f.time_sec},
-            {"sim_step", f.step},
-            {"frame_id", f.camera + "/optical"},
-            {"camera", f.camera},
-            {"index", f.index},
-            {"encoding", encoding},
-            {"width", width},
-            {"height", height},
-            {"step", width * bytes_per_pixel},
-            {"is_bigendian", false},
-            {"X_WO", PoseJson(f.X_WO)}};
+  json h = {{"stamp", f.time_sec},   {"sim_step", f.step},      {"frame_id", f.camera + "/optical"},
+            {"camera", f.camera},    {"index", f.index},        {"encoding", encoding},
+            {"width", width},        {"height", height},        {"step", width * bytes_per_pixel},
+            {"is_bigendian", false}, {"X_WO", PoseJson(f.X_WO)}};
   auto it = intrinsics_.find(f.camera);
   if (it != intrinsics_.end())
     for (auto& [k, v] : it->second.items()) h[k] = v;
@@ -637,11 +629,12 @@ void ZmqBridge::OnFinish(const LoopFinish& finish) {
 
 void ZmqBridgeOptions::ValidateOrThrow() const {
   if (hwm < 1)
-    throw ConfigError("", 0, "--zmq-hwm", fmt::format("{} is below 1; expected messages >= 1", hwm));
+    throw ConfigError("", 0, "--zmq-hwm",
+                      fmt::format("{} is below 1; expected messages >= 1", hwm));
   if (max_request_bytes < 64 || max_request_bytes > kHardMessageLimit)
-    throw ConfigError("", 0, "--zmq-max-request",
-                      fmt::format("{} bytes is outside [64, {}]", max_request_bytes,
-                                  kHardMessageLimit));
+    throw ConfigError(
+        "", 0, "--zmq-max-request",
+        fmt::format("{} bytes is outside [64, {}]", max_request_bytes, kHardMessageLimit));
   if (!(state_hz >= 0) || !std::isfinite(state_hz))
     throw ConfigError("", 0, "--zmq-state-hz",
                       fmt::format("{} is not a rate; expected Hz >= 0 (0 = every step)", state_hz));
