@@ -86,7 +86,6 @@ class ZmqBridge final : public RunBridge {
   bool Subscribed(const std::string& topic) const;
   void Wake();
   void Shutdown();
-  json Topics() const;
   void PublishImage(const std::string& topic, const CameraFrame& f, const char* encoding, int width,
                     int height, int bytes_per_pixel, zmq::message_t payload);
 
@@ -271,8 +270,6 @@ void ZmqBridge::SendReply(const std::vector<std::string>& envelope, json reply) 
   }
   Wake();
 }
-
-json ZmqBridge::Topics() const { return topics_; }
 
 void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_frames) {
   if (frames.empty()) return;
