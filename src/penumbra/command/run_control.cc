@@ -106,7 +106,8 @@ void RunControl::CompleteSteps(Simulation& sim, bool ended) {
   nlohmann::json r = {
       {"ok", true}, {"step", sim.step_count()}, {"time_sec", sim.time()}, {"ended", ended}};
   if (active_->with_state) {
-    for (auto& [k, v] : StateJson(sim).items()) r[k] = v;
+    const nlohmann::json state = StateJson(sim);
+    for (auto& [k, v] : state.items()) r[k] = v;
   }
   Done done = std::move(active_->done);
   active_.reset();
@@ -218,8 +219,10 @@ void RunControl::OnFinish(const LoopFinish&) {
     if (w.steps > 0) {
       nlohmann::json r = {
           {"ok", true}, {"step", sim_->step_count()}, {"time_sec", sim_->time()}, {"ended", true}};
-      if (w.with_state)
-        for (auto& [k, v] : StateJson(*sim_).items()) r[k] = v;
+      if (w.with_state) {
+        const nlohmann::json state = StateJson(*sim_);
+        for (auto& [k, v] : state.items()) r[k] = v;
+      }
       w.done(std::move(r));
     } else {
       w.done(ErrorOnly(CommandError(command_code::kRunEnded, "", "the run has ended")));
