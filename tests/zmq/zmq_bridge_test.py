@@ -45,7 +45,7 @@ def free_port_pair():
 
 def write_world(folder, source, duration=2.0):
     """the quadruped on the ramp, one small camera (rgb + depth at 10 Hz) and a 100 Hz IMU."""
-    models = os.path.join(source, "worlds", "models")
+    models = os.path.join(os.path.abspath(source), "worlds", "models")
     text = f"""
 seed: 5
 duration_sec: {duration}
@@ -94,7 +94,8 @@ class Server:
     def __init__(self, binary, world, out, extra):
         self.port = free_port_pair()
         self.endpoint = f"tcp://127.0.0.1:{self.port}"
-        self.log = open(out + ".log", "w")
+        self.log_path = out + ".log"
+        self.log = open(self.log_path, "w")
         self.proc = subprocess.Popen(
             [binary, "run", world, "--out", out, "-q", "--zmq", self.endpoint] + extra,
             stdout=self.log, stderr=subprocess.STDOUT)
@@ -113,7 +114,9 @@ class Server:
 class Client:
     """REQ + SUB client of one server."""
 
-    def __init__(self, endpoint, topics=(b"camera/", b"imu/", b"clock")):
+    def __init__(self, server, topics=(b"camera/", b"imu/", b"clock")):
+        self.server = server
+        endpoint = server.endpoint
         self.ctx = zmq.Context()
         self.req = self.ctx.socket(zmq.REQ)
         self.req.setsockopt(zmq.RCVTIMEO, TIMEOUT_MS)
@@ -144,6 +147,13 @@ class Client:
 
     def raw(self, body):
         self.req.send(body)
+        deadline = time.time() + TIMEOUT_MS / 1000
+        while not self.req.poll(500):
+            rc = self.server.proc.poll()
+            if rc is not None:
+                with open(self.server.log_path) as f:
+                    raise AssertionError(f"penumbra exited with {rc}:\n{f.read()}")
+            assert time.time() < deadline, "no reply within the timeout"
         return msgpack.unpackb(self.req.recv(), raw=False)
 
     def call(self, cmd, **fields):
@@ -178,7 +188,7 @@ def lockstep_session(binary, source, tmp, name):
     world = write_world(tmp, source)
     server = Server(binary, world, os.path.join(tmp, name), ["--lockstep"])
     try:
-        c = Client(server.endpoint)
+        c = Client(server)
         assert c.hello["mode"] == "lockstep" and c.hello["paused"], c.hello
         info = c.ok("model_info")
         assert [cam["name"] for cam in info["cameras"]] == ["front"], info["cameras"]
@@ -269,7 +279,7 @@ def test_errors(binary, source):
         world = write_world(tmp, source)
         server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
         try:
-            c = Client(server.endpoint, topics=())
+            c = Client(server, topics=())
             state0 = c.ok("get_state")
             assert state0["step"] == 0, state0
             c.ok("step", n=1)
@@ -349,7 +359,7 @@ def test_stop(binary, source):
         out = os.path.join(tmp, "out")
         server = Server(binary, world, out, ["--lockstep"])
         try:
-            c = Client(server.endpoint, topics=())
+            c = Client(server, topics=())
             c.ok("step", n=20)
             server.proc.send_signal(signal.SIGINT)
             rc = server.wait()
@@ -368,7 +378,7 @@ def test_free(binary, source):
         world = write_world(tmp, source, duration=3.0)
         server = Server(binary, world, os.path.join(tmp, "out"), ["--realtime"])
         try:
-            c = Client(server.endpoint, topics=(b"camera/front/rgb",))
+            c = Client(server, topics=(b"camera/front/rgb",))
             assert c.hello["mode"] == "free" and not c.hello["paused"]
             r = c.call("step", n=1)
             assert not r["ok"] and r["error"]["code"] == "conflict", r
