@@ -22,11 +22,11 @@ namespace penumbra {
 
 /// options of `penumbra bench bridge`.
 struct BenchBridgeOptions {
-  std::string world_file;    ///< world to step (default: worlds/quadruped.yaml)
-  int trips = 500;           ///< lockstep round trips timed, >= 10
-  double seconds = 3;        ///< wall seconds of the free-running measurement
-  double round_seconds = 5;  ///< simulated seconds per physics A/B round
-  int rounds = 3;            ///< A/B round pairs, >= 1
+  std::string world_file;     ///< world to step (default: worlds/quadruped.yaml)
+  int trips = 500;            ///< lockstep round trips timed, >= 10
+  double seconds = 3;         ///< wall seconds of the free-running measurement
+  double round_seconds = 60;  ///< simulated seconds per physics A/B round
+  int rounds = 5;             ///< A/B round pairs, >= 1
 };
 
 /// the verb as registered on `penumbra bench`.
