@@ -49,6 +49,7 @@ function connect() {
     if (m.type === 'scene') return onScene(m);
     if (m.type === 'state') return onState(m);
     if (m.type === 'lidar') return onLidar(m);
+    if (m.type === 'status') return onStatus(m);
     if (m.type === 'error' || m.ok === false) {
       const text = m.error && m.error.message ? `${m.cmd}: ${m.error.message}` : String(m.error);
       viewer.errors.push(m);
@@ -81,14 +82,10 @@ function onHello(h) {
   buildEffectSliders(h.effect_sliders || []);
   buildJointSliders(h.joint_controls || []);
   $('teleop').style.display = (h.teleop_robots || []).length ? '' : 'none';
-  const sig = $('plotSignal');
-  sig.innerHTML = '';
-  for (const s of h.signals || []) sig.add(new Option(s, s));
   $('record').disabled = !h.record_available;
   if (!h.record_available) $('recordState').textContent = 'no live recorder in this build';
   if (!document.querySelector('.cam-panel') && h.model && h.model.cameras.length) addCameraPanel();
   for (const p of panels) p.fillCameras();
-  if (plots.length === 0 && (h.signals || []).length) addPlot(h.signals[0]);
   subscribe();
 }
 
@@ -387,6 +384,16 @@ function onState(m) {
   if (m.signals) pushSignals(m.time_sec, m.signals);
 }
 
+// a change of the run's state at a step boundary (pause, resume, step, reset, end)
+function onStatus(m) {
+  viewer.status = m;
+  if (m.time_sec !== undefined) $('simTime').textContent = m.time_sec.toFixed(3);
+  if (m.step !== undefined) $('simStep').textContent = m.step;
+  if (m.realtime_factor !== undefined && document.activeElement !== $('rtf')) $('rtf').value = m.realtime_factor;
+  if (m.ended) setBadge('runState', 'ended', 'off');
+  else if (m.paused !== undefined) setBadge('runState', m.paused ? 'paused' : 'running', m.paused ? 'off' : 'on');
+}
+
 function updateFrustum(h) {
   if (!h.X_WO) return;
   let f = frusta.get(h.camera);
@@ -455,11 +462,19 @@ const history = new Map();  // signal -> [[t, v], ...]
 
 function pushSignals(t, signals) {
   for (const [k, v] of Object.entries(signals)) {
-    if (!history.has(k)) history.set(k, []);
+    if (!history.has(k)) {
+      history.set(k, []);
+      $('plotSignal').add(new Option(k, k));
+    }
     const h = history.get(k);
     if (h.length && t < h[h.length - 1][0]) h.length = 0;  // reset or a new run
     h.push([t, v]);
     while (h.length && h[0][0] < t - 10) h.shift();
+  }
+  if (plots.length === 0) {
+    const keys = Object.keys(signals);
+    const first = keys.find((k) => k.startsWith('imu/')) || keys.find((k) => k.startsWith('contacts/normal'));
+    if (first) addPlot(first);
   }
 }
 

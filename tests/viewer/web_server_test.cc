@@ -217,6 +217,17 @@ TEST(WebServerTest, FiveClientsEachGetEveryMessageTheyAreSent) {
   EXPECT_EQ(f.closed.load(), 1);
   f.server->Publish("status", WebMessage::Text(json{{"k", 99}}.dump()));
   for (auto& c : clients) EXPECT_EQ(json::parse(c->Read())["k"], 99);
+  // a message for some clients only: client ids are 1..5 in connection order, 1 left
+  f.server->PublishTo({3, 42}, "camera/x/rgb", WebMessage::Text(json{{"only", 3}}.dump()));
+  f.server->Publish("status", WebMessage::Text(json{{"k", 100}}.dump()));
+  for (size_t i = 0; i < clients.size(); ++i) {
+    json first = json::parse(clients[i]->Read());
+    if (i == 1) {  // the third client to connect
+      EXPECT_EQ(first["only"], 3);
+      first = json::parse(clients[i]->Read());
+    }
+    EXPECT_EQ(first["k"], 100) << i;
+  }
 }
 
 TEST(WebServerTest, SlowClientGetsTheLatestFrameAndNeverBlocksThePublisher) {

@@ -443,6 +443,14 @@ void WebServer::Publish(const std::string& channel, WebMessage message) {
   });
 }
 
+void WebServer::PublishTo(const std::vector<int>& clients, const std::string& channel,
+                          WebMessage message) {
+  net::post(impl_->ioc_, [impl = impl_, clients, channel, message = std::move(message)] {
+    for (int id : clients)
+      if (auto s = impl->Find(id)) s->Offer(channel, message);
+  });
+}
+
 void WebServer::Send(int client, WebMessage message) {
   net::post(impl_->ioc_, [impl = impl_, client, message = std::move(message)]() mutable {
     if (auto s = impl->Find(client)) s->Reply(std::move(message));

@@ -92,6 +92,8 @@ class WebServer {
   /// offers `message` to every client on `channel`; replaces a message of that channel a
   /// client has not been sent yet. returns at once.
   void Publish(const std::string& channel, WebMessage message);
+  /// Publish to the listed clients only (those gone are skipped).
+  void PublishTo(const std::vector<int>& clients, const std::string& channel, WebMessage message);
   /// queues a reply for one client (never replaced); no-op if it is gone. returns at once.
   void Send(int client, WebMessage message);
   /// the counters now.
