@@ -332,7 +332,14 @@ function geomObject(g, s) {
 }
 
 function onScene(s) {
+  const first = !viewer.scene;
   viewer.scene = s;
+  if (first && s.center) {
+    const [cx, cy, cz] = s.center, e = Math.max(1, s.extent || 5);
+    orbit.target.set(cx, cy, Math.max(0, cz - 0.3 * e));
+    camera3.position.set(cx - 0.9 * e, cy - 1.1 * e, cz + 0.9 * e);
+    orbit.update();
+  }
   for (const n of bodyNodes) scene3.remove(n);
   bodyNodes = s.bodies.map(() => new THREE.Group());
   for (const n of bodyNodes) scene3.add(n);
