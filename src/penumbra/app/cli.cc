@@ -16,7 +16,9 @@
 #include <optional>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/bench_bridge.h"
 #include "penumbra/app/bench_record.h"
+#include "penumbra/app/bridge_flags.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -209,6 +211,8 @@ int RunCli(int argc, char** argv) {
                   "write a run log of every physics step to FILE.plog (docs/run-log.md)");
   run->add_flag("--record-sensors", run_options.record_sensors,
                 "the run log also holds every camera image and sensor output");
+  BridgeFlags bridge_flags;
+  bridge_flags.Add(run);
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -260,6 +264,7 @@ int RunCli(int argc, char** argv) {
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
+  const std::unique_ptr<BenchBridgeCommand> bench_bridge = AddBenchBridgeCommand(*bench);
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -299,6 +304,7 @@ int RunCli(int argc, char** argv) {
       run_options.command_line = Args(argc, argv);
       if (!outputs.empty() || run->count("--outputs"))
         run_options.outputs = ParseCameraOutputs(outputs);
+      bridge_flags.Apply(*run, &run_options);
       g_stop_signal.store(0);
       run_options.stop_request = &g_stop_signal;
       const StopSignals stop_signals;
@@ -307,6 +313,13 @@ int RunCli(int argc, char** argv) {
       for (const auto& [name, n] : s.frames_per_camera) frames += n;
       spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
+      if (s.interrupted && g_stop_signal.load() == 0) {
+        spdlog::info(
+            "stopped by a client's `stop` at {:.6g} s of sim time; outputs and run.json "
+            "written",
+            s.sim_time_sec);
+        return 0;
+      }
       if (s.interrupted) {
         const int sig = g_stop_signal.load();
         spdlog::warn("interrupted by {} at {:.6g} s of sim time; outputs and run.json written",
@@ -333,6 +346,7 @@ int RunCli(int argc, char** argv) {
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (eval.Selected()) return eval.Run();
     if (*bench_record->app) return bench_record->Run();
+    if (*bench_bridge->app) return bench_bridge->Run();
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/command/run_bridge.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -37,6 +38,12 @@ struct RunOptions {
   /// up to there, writes run.json with "interrupted": true and returns normally with
   /// RunSummary::interrupted set.
   const std::atomic<int>* stop_request = nullptr;
+  /// middleware bridges attached to the run (command/run_bridge.h, e.g. --zmq's). with any,
+  /// the run is live: its commands go through one CommandDispatcher, its steps through a
+  /// RunControl (command/bridge_set.h), which also does the --realtime pacing.
+  std::vector<RunBridgeFactory> bridges;
+  /// with bridges: the run starts paused and advances only by `step` requests (--lockstep).
+  bool lockstep = false;
 };
 
 /// what a run produced.
