@@ -40,11 +40,19 @@ void BridgeFlags::Add(CLI::App* run) {
 
 void BridgeFlags::Apply(const CLI::App& run, RunOptions* options) const {
   const bool zmq = run.count("--zmq") > 0;
+  // the live viewer (app/viewer_commands.h) is a bridge too: --lockstep works with it
+  const CLI::Option* viewer_flag = run.get_option_no_throw("--viewer");
+  const bool viewer = viewer_flag && viewer_flag->count() > 0;
+  if (run.count("--lockstep") > 0 && !zmq && !viewer)
+    throw ConfigError("", 0, "--lockstep", "needs --zmq or --viewer (a bridge to serve the run)");
   for (const char* flag :
-       {"--zmq-pub", "--bind", "--lockstep", "--zmq-hwm", "--zmq-max-request", "--zmq-state-hz"})
+       {"--zmq-pub", "--bind", "--zmq-hwm", "--zmq-max-request", "--zmq-state-hz"})
     if (run.count(flag) > 0 && !zmq)
       throw ConfigError("", 0, flag, "needs --zmq (a bridge to serve the run)");
-  if (!zmq) return;
+  if (!zmq) {
+    options->lockstep = lockstep;
+    return;
+  }
   ZmqBridgeOptions o;
   if (!zmq_endpoint.empty()) o.endpoint = zmq_endpoint;
   o.pub_endpoint = zmq_pub;

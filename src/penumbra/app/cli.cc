@@ -19,6 +19,7 @@
 #include "penumbra/app/bench_bridge.h"
 #include "penumbra/app/bench_record.h"
 #include "penumbra/app/bridge_flags.h"
+#include "penumbra/app/viewer_commands.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -213,6 +214,8 @@ int RunCli(int argc, char** argv) {
                 "the run log also holds every camera image and sensor output");
   BridgeFlags bridge_flags;
   bridge_flags.Add(run);
+  ViewerFlag viewer_flag;
+  viewer_flag.Add(run);
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -265,6 +268,39 @@ int RunCli(int argc, char** argv) {
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
   const std::unique_ptr<BenchBridgeCommand> bench_bridge = AddBenchBridgeCommand(*bench);
+  // penumbra bench viewer / penumbra view (app/viewer_commands.h, docs/viewer.md)
+  CLI::App* bench_viewer = bench->add_subcommand(
+      "viewer", "live viewer: frames/s delivered, input-to-photon latency, steps/s with a viewer");
+  BenchViewerOptions viewer_bench;
+  bench_viewer->add_option("--world", viewer_bench.world_file,
+                           "world file (default: bundled default world)");
+  AddDecimal(
+      bench_viewer, "--seconds", [&](double v) { viewer_bench.seconds = v; }, 0, true,
+      "simulated seconds per timed run");
+  AddInteger(bench_viewer, "--rounds", &viewer_bench.rounds, 1, 100, "A/B pairs");
+  AddDecimal(
+      bench_viewer, "--camera-hz", [&](double v) { viewer_bench.camera_hz = v; }, 0, true,
+      "rate of the streamed camera, Hz");
+  AddInteger(bench_viewer, "--latency-samples", &viewer_bench.latency_samples, 0, 1000,
+             "teleop commands timed at real-time pacing (0 = none)");
+  CLI::App* view = app.add_subcommand(
+      "view", "a world served live to browsers: real time, paused at the start (docs/viewer.md)");
+  std::string view_world;
+  ViewOptions view_options;
+  view->add_option("world", view_world, "world file (.yaml) or model (.xml MJCF, .urdf)")
+      ->required();
+  view->add_option("--viewer", view_options.address,
+                   "HOST:PORT to serve on (default 127.0.0.1:8080; loopback unless told)");
+  view->add_option("--out,-o", view_options.out_dir,
+                   "keep the camera outputs in this folder (default: a temporary folder, removed "
+                   "at exit)");
+  AddDecimal(
+      view, "--duration", [&](double v) { view_options.duration_sec = v; }, 0, true,
+      "simulated seconds (default: the world's duration_sec)");
+  view->add_option("--adversity", view_options.adversity,
+                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME");
+  view->add_flag("--running", view_options.running, "start running instead of paused");
+  view->add_flag("--force", view_options.force, "--out may hold an earlier run's outputs");
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -305,6 +341,7 @@ int RunCli(int argc, char** argv) {
       if (!outputs.empty() || run->count("--outputs"))
         run_options.outputs = ParseCameraOutputs(outputs);
       bridge_flags.Apply(*run, &run_options);
+      viewer_flag.Apply(*run, &run_options);
       g_stop_signal.store(0);
       run_options.stop_request = &g_stop_signal;
       const StopSignals stop_signals;
@@ -347,6 +384,14 @@ int RunCli(int argc, char** argv) {
     if (eval.Selected()) return eval.Run();
     if (*bench_record->app) return bench_record->Run();
     if (*bench_bridge->app) return bench_bridge->Run();
+    if (*bench_viewer) return BenchViewer(viewer_bench);
+    if (*view) {
+      const WorldConfig world = LoadWorldOrModel(view_world);
+      view_options.command_line = Args(argc, argv);
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return RunView(world, view_options, &g_stop_signal);
+    }
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

@@ -40,6 +40,42 @@ void ViewerFlag::Apply(const CLI::App& run, RunOptions* options) const {
   options->bridges.push_back(MakeViewerBridgeFactory(v));
 }
 
+int RunView(const WorldConfig& world, const ViewOptions& options,
+            const std::atomic<int>* stop_request) {
+  namespace fs = std::filesystem;
+  ViewerOptions v;
+  ParseViewerAddress(options.address, &v);
+  RunOptions o;
+  o.realtime = true;
+  o.lockstep = !options.running;
+  o.progress = false;
+  o.force = options.force;
+  o.duration_sec = options.duration_sec;
+  o.adversity = options.adversity;
+  o.command_line = options.command_line;
+  o.stop_request = stop_request;
+  // the cameras render for the page; their files go to a folder removed at exit unless --out
+  const bool temporary = options.out_dir.empty();
+  o.out_dir = temporary ? (fs::temp_directory_path() / fmt::format("penumbra_view_{}", ::getpid()))
+                              .string()
+                        : options.out_dir;
+  if (temporary) fs::remove_all(o.out_dir);
+  o.bridges.push_back(MakeViewerBridgeFactory(v));
+  spdlog::info("penumbra view: {} {}; Ctrl-C ends it", world.file.empty() ? "model" : world.file,
+               options.running ? "running in real time" : "paused: press play in the page");
+  try {
+    const RunSummary s = RunWorld(world, o);
+    spdlog::info("view ended at {:.3f} s of sim time ({} steps)", s.sim_time_sec, s.physics_steps);
+  } catch (...) {
+    std::error_code ec;
+    if (temporary) fs::remove_all(o.out_dir, ec);
+    throw;
+  }
+  std::error_code ec;
+  if (temporary) fs::remove_all(o.out_dir, ec);
+  return 0;
+}
+
 namespace {
 
 namespace beast = boost::beast;

@@ -6,8 +6,11 @@
 //   penumbra bench viewer                     frames/s delivered, input-to-photon latency,
 //                                             physics steps/s with and without a viewer
 
+#include <atomic>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "penumbra/app/runner.h"
 
@@ -26,6 +29,24 @@ struct ViewerFlag {
   /// @throws ConfigError("", 0, "--viewer", ...) for a bad address or a missing web folder.
   void Apply(const CLI::App& run, RunOptions* options) const;
 };
+
+/// options of `penumbra view`.
+struct ViewOptions {
+  std::string address;  ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
+  std::string out_dir;  ///< --out: keep the outputs here ("" = a temporary folder, removed)
+  bool running = false;  ///< --running: start running instead of paused
+  bool force = false;    ///< --force: --out may hold an earlier run's outputs
+  std::optional<double> duration_sec;  ///< --duration (default: the world's)
+  std::string adversity;               ///< --adversity preset spec
+  std::vector<std::string> command_line;
+};
+
+/// `penumbra view`: runs `world` with the viewer at real-time pacing, paused at the start
+/// unless options.running, until its duration ends or `stop_request` reads non-zero (Ctrl-C).
+/// returns 0 (also when stopped by a signal: that is how a view ends).
+/// @throws ConfigError for a bad address, world or output folder; Error when the port is in use.
+int RunView(const WorldConfig& world, const ViewOptions& options,
+            const std::atomic<int>* stop_request);
 
 /// options of `penumbra bench viewer`.
 struct BenchViewerOptions {
