@@ -241,7 +241,9 @@ function decodeNext(stream) {
   decoding[stream] = true;
   createImageBitmap(jpeg).then((bitmap) => {
     for (const p of panels) if (p.stream() === stream) p.draw(header, bitmap);
+    bitmap.close();
     viewer.framesDrawn++;
+    viewer.lastHeader = header;
     viewer.lastFrame[stream] = { time_sec: header.time_sec, step: header.step, index: header.index, drawn_ms: performance.now() };
     if (header.stream.endsWith('/rgb')) updateFrustum(header);
   }).catch((e) => log('frame: ' + e.message)).finally(() => {
