@@ -172,8 +172,8 @@ def main():
         js = driver.execute_script
         driver.get(url)
         log("page loaded")
-        wait_for("hello, scene and state", lambda: js(
-            "const v = window.penumbraViewer; return v.hello && v.scene && v.state && true;"))
+        wait_for("hello and scene", lambda: js(
+            "const v = window.penumbraViewer; return v.hello && v.scene && true;"))
         hello = js("return window.penumbraViewer.hello;")
         period = hello["control_period_sec"]
         dt = hello["timestep_sec"]
@@ -183,7 +183,7 @@ def main():
 
         # play: time runs, frames arrive and are drawn
         driver.find_element("id", "play").click()
-        wait_for("sim time > 0.6 s", lambda: js("return window.penumbraViewer.state.time_sec") > 0.6,
+        wait_for("sim time > 0.6 s", lambda: js("const s = window.penumbraViewer.state; return s ? s.time_sec : 0;") > 0.6,
                  timeout=40)
         wait_for("a drawn camera frame after t = 0", lambda: js(
             "const f = window.penumbraViewer.lastFrame['camera/front/rgb']; return f && f.time_sec > 0;"))
