@@ -222,14 +222,17 @@ def main():
                 r2 = driver.execute_async_script(COMPARE_PNG, base64.b64encode(f.read()).decode())
             check(r2["mad"] > r["mad"], f"an earlier frame differs more ({r2['mad']:.2f})")
 
-        # one step = one control period
-        s0 = js("return [window.penumbraViewer.state.step, window.penumbraViewer.state.time_sec];")
+        # one step = one control period: from the pause's boundary to the step's
+        p0 = js("return window.penumbraViewer.replies.filter(r => r.cmd === 'pause' && r.ok).pop();")
         driver.find_element("id", "step").click()
         n = max(1, round(period / dt))
-        wait_for("the step's state", lambda: js("return window.penumbraViewer.state.step;") == s0[0] + n)
-        s1 = js("return [window.penumbraViewer.state.step, window.penumbraViewer.state.time_sec];")
-        check(abs((s1[1] - s0[1]) - period) < 1e-9,
-              f"step advances exactly one control period ({n} steps, {s1[1] - s0[1]:.6f} s = {period} s)")
+        r1 = wait_for("the step reply", lambda: js(
+            "return window.penumbraViewer.replies.find(r => r.cmd === 'step' && r.ok);"))
+        check(r1["step"] - p0["step"] == n and abs((r1["time_sec"] - p0["time_sec"]) - period) < 1e-9,
+              f"step advances exactly one control period ({r1['step'] - p0['step']} steps, "
+              f"{r1['time_sec'] - p0['time_sec']:.6f} s; period {period} s)")
+        wait_for("the page's state at the step", lambda: js(
+            "const s = window.penumbraViewer.state; return s && s.step;") == r1["step"])
 
         # fog: the next frames lose contrast
         before = js(CANVAS_STATS)
