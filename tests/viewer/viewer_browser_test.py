@@ -313,8 +313,10 @@ def main():
         end = time.monotonic() + 10
         while time.monotonic() < end and closed is None:
             try:
-                op, data = c.recv_data(control_frame=True)
-            except websocket.WebSocketConnectionClosedException:
+                frame = c.recv_frame()  # raw frames: no automatic close reply to a gone peer
+                op, data = frame.opcode, frame.data
+            except (websocket.WebSocketConnectionClosedException, ConnectionResetError,
+                    BrokenPipeError):
                 closed = -1
                 break
             if op == websocket.ABNF.OPCODE_CLOSE:
