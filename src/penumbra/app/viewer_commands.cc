@@ -87,24 +87,30 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
+// what TimingBridge measured (outlives the bridge, which ends with the run)
+struct LoopTiming {
+  double wall_sec = 0;
+  int64_t steps = 0;
+  double steps_per_sec() const { return wall_sec > 0 ? steps / wall_sec : 0; }
+};
+
 // times the loop: from its start to its end, and the steps taken
 class TimingBridge : public RunBridge {
  public:
+  explicit TimingBridge(LoopTiming* out) : out_(out) {}
   void OnStart(const LoopStart& s) override {
     t0_ = Clock::now();
     step0_ = s.step;
   }
   void OnFinish(const LoopFinish& f) override {
-    wall_sec_ = Seconds(Clock::now() - t0_);
-    steps_ = f.step - step0_;
+    out_->wall_sec = Seconds(Clock::now() - t0_);
+    out_->steps = f.step - step0_;
   }
-  double steps_per_sec() const { return wall_sec_ > 0 ? steps_ / wall_sec_ : 0; }
-  double wall_sec() const { return wall_sec_; }
 
  private:
+  LoopTiming* out_;
   Clock::time_point t0_;
-  int64_t step0_ = 0, steps_ = 0;
-  double wall_sec_ = 0;
+  int64_t step0_ = 0;
 };
 
 // a page stand-in: one WebSocket client that subscribes to a stream, counts the frames it is
@@ -211,11 +217,9 @@ ViewerRound RunViewerRound(const WorldConfig& world, double seconds, bool viewer
   o.duration_sec = seconds;
   o.progress = false;
   o.realtime = realtime;
-  TimingBridge* timing = nullptr;
-  o.bridges.push_back([&timing](const RunBridgeContext&) {
-    auto t = std::make_unique<TimingBridge>();
-    timing = t.get();
-    return t;
+  LoopTiming timing;
+  o.bridges.push_back([&timing](const RunBridgeContext&) -> std::unique_ptr<RunBridge> {
+    return std::make_unique<TimingBridge>(&timing);
   });
   BenchPage page;
   page.stream = "camera/" + world.cameras.front().name + "/rgb";
@@ -230,7 +234,7 @@ ViewerRound RunViewerRound(const WorldConfig& world, double seconds, bool viewer
   RunWorld(world, o);  // the viewer (and its server) is gone once it returns
   if (page.thread.joinable()) page.thread.join();
   std::filesystem::remove_all(out);
-  r.steps_per_sec = timing ? timing->steps_per_sec() : 0;
+  r.steps_per_sec = timing.steps_per_sec();
   r.frames_per_sec = page.FramesPerSec();
   r.kbytes_per_frame = page.frames ? page.bytes.load() / 1e3 / page.frames.load() : 0;
   r.latencies_ms = page.latencies_ms;
