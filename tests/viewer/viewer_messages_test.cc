@@ -53,7 +53,7 @@ TEST(ViewerMessagesTest, SceneHoldsTheVisibleGeomsOnce) {
   EXPECT_TRUE(j["bodies"][1]["trail"]);   // moving root body
   EXPECT_FALSE(j["bodies"][2]["trail"]);  // child
   EXPECT_FALSE(j["bodies"][0]["trail"]);  // world
-  ASSERT_EQ(j["geoms"].size(), 3u);  // the ghost (alpha 0.2) and group 3 are left out
+  ASSERT_EQ(j["geoms"].size(), 3u);       // the ghost (alpha 0.2) and group 3 are left out
   const json& b = j["geoms"][0];
   EXPECT_EQ(b["shape"], "box");
   EXPECT_EQ(b["size"], json({0.1, 0.2, 0.3}));

@@ -22,7 +22,8 @@ TEST(ViewerOptionsTest, ParsesAddresses) {
   ParseViewerAddress("[::1]:8082", &o);
   EXPECT_EQ(o.host, "::1");
   EXPECT_EQ(o.port, 8082);
-  for (const char* bad : {"host:", "host:http", "1.2.3.4:65536", "-1", "[::1]8080", "[::1", "a:1x"}) {
+  for (const char* bad :
+       {"host:", "host:http", "1.2.3.4:65536", "-1", "[::1]8080", "[::1", "a:1x"}) {
     ViewerOptions p;
     try {
       ParseViewerAddress(bad, &p);

@@ -1,7 +1,6 @@
 #include "penumbra/viewer/web_server.h"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <boost/asio/connect.hpp>
@@ -13,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "penumbra/core/error.h"
@@ -30,8 +30,8 @@ using nlohmann::json;
 // a web root with an index page and a script in a sub-folder
 std::string MakeWebRoot() {
   namespace fs = std::filesystem;
-  const fs::path root = fs::temp_directory_path() /
-                        ("penumbra_web_test_" + std::to_string(::getpid()));
+  const fs::path root =
+      fs::temp_directory_path() / ("penumbra_web_test_" + std::to_string(::getpid()));
   fs::create_directories(root / "js");
   std::ofstream(root / "index.html") << "<html>viewer</html>";
   std::ofstream(root / "js" / "app.js") << "console.log(1);";
@@ -150,8 +150,7 @@ TEST(WebServerTest, RejectsBadOptions) {
     WebServer second(o, {});
     ADD_FAILURE() << "bound a port in use";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("127.0.0.1:" + std::to_string(o.port)),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("127.0.0.1:" + std::to_string(o.port)), std::string::npos)
         << e.what();
   }
 }

@@ -1,8 +1,8 @@
 #include "penumbra/app/viewer_commands.h"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -14,8 +14,8 @@
 #include <chrono>
 #include <filesystem>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <thread>
-#include <unistd.h>
 
 #include "penumbra/app/bench.h"
 #include "penumbra/core/error.h"
@@ -56,9 +56,9 @@ int RunView(const WorldConfig& world, const ViewOptions& options,
   o.stop_request = stop_request;
   // the cameras render for the page; their files go to a folder removed at exit unless --out
   const bool temporary = options.out_dir.empty();
-  o.out_dir = temporary ? (fs::temp_directory_path() / fmt::format("penumbra_view_{}", ::getpid()))
-                              .string()
-                        : options.out_dir;
+  o.out_dir =
+      temporary ? (fs::temp_directory_path() / fmt::format("penumbra_view_{}", ::getpid())).string()
+                : options.out_dir;
   if (temporary) fs::remove_all(o.out_dir);
   o.bridges.push_back(MakeViewerBridgeFactory(v));
   spdlog::info("penumbra view: {} {}; Ctrl-C ends it", world.file.empty() ? "model" : world.file,
@@ -208,9 +208,9 @@ struct ViewerRound {
 ViewerRound RunViewerRound(const WorldConfig& world, double seconds, bool viewer, bool realtime,
                            int latency_samples) {
   ViewerRound r;
-  const std::string out = (std::filesystem::temp_directory_path() /
-                           fmt::format("penumbra_bench_viewer_{}", ::getpid()))
-                              .string();
+  const std::string out =
+      (std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_viewer_{}", ::getpid()))
+          .string();
   std::filesystem::remove_all(out);
   RunOptions o;
   o.out_dir = out;
@@ -262,30 +262,34 @@ int BenchViewer(const BenchViewerOptions& options) {
   world.mjcf_cameras.enabled = false;
   world.sensors.clear();
   const auto& cam = world.cameras[0];
-  fmt::print("penumbra bench viewer: {} camera '{}' {}x{} rgb at {} Hz, {} s per run, {} round(s), "
-             "{} core(s)\n",
-             world.file, cam.name, cam.width, cam.height, options.camera_hz,
-             options.seconds, options.rounds, std::thread::hardware_concurrency());
+  fmt::print(
+      "penumbra bench viewer: {} camera '{}' {}x{} rgb at {} Hz, {} s per run, {} round(s), "
+      "{} core(s)\n",
+      world.file, cam.name, cam.width, cam.height, options.camera_hz, options.seconds,
+      options.rounds, std::thread::hardware_concurrency());
   std::vector<double> without, with, fps, kb;
   for (int i = 0; i < options.rounds; ++i) {
     const ViewerRound a = RunViewerRound(world, options.seconds, false, false, 0);
     const ViewerRound b = RunViewerRound(world, options.seconds, true, false, 0);
-    fmt::print("  round {}: steps/s without viewer {:.0f}, with a page attached {:.0f} (ratio "
-               "{:.3f}); frames delivered {:.1f}/s, {:.0f} kB/frame\n",
-               i + 1, a.steps_per_sec, b.steps_per_sec, b.steps_per_sec / a.steps_per_sec,
-               b.frames_per_sec, b.kbytes_per_frame);
+    fmt::print(
+        "  round {}: steps/s without viewer {:.0f}, with a page attached {:.0f} (ratio "
+        "{:.3f}); frames delivered {:.1f}/s, {:.0f} kB/frame\n",
+        i + 1, a.steps_per_sec, b.steps_per_sec, b.steps_per_sec / a.steps_per_sec,
+        b.frames_per_sec, b.kbytes_per_frame);
     without.push_back(a.steps_per_sec);
     with.push_back(b.steps_per_sec);
     fps.push_back(b.frames_per_sec);
     kb.push_back(b.kbytes_per_frame);
   }
   const double ratio = Median(with) / Median(without);
-  fmt::print("physics steps/s (as fast as possible, median): without viewer {:.0f}, with viewer "
-             "and one page {:.0f}: ratio {:.3f} (target >= 0.95)\n",
-             Median(without), Median(with), ratio);
-  fmt::print("frames/s delivered to the page, {}x{} camera (median): {:.1f} (target >= 20; the "
-             "renderer's rate is the limit), {:.0f} kB/frame\n",
-             cam.width, cam.height, Median(fps), Median(kb));
+  fmt::print(
+      "physics steps/s (as fast as possible, median): without viewer {:.0f}, with viewer "
+      "and one page {:.0f}: ratio {:.3f} (target >= 0.95)\n",
+      Median(without), Median(with), ratio);
+  fmt::print(
+      "frames/s delivered to the page, {}x{} camera (median): {:.1f} (target >= 20; the "
+      "renderer's rate is the limit), {:.0f} kB/frame\n",
+      cam.width, cam.height, Median(fps), Median(kb));
   if (options.latency_samples > 0) {
     const double seconds = std::max(options.seconds, 0.6 * options.latency_samples + 2);
     const ViewerRound rt = RunViewerRound(world, seconds, true, true, options.latency_samples);
@@ -294,10 +298,11 @@ int BenchViewer(const BenchViewerOptions& options) {
     if (l.empty()) {
       fmt::print("input-to-photon latency: no sample (no frame arrived after a command)\n");
     } else {
-      fmt::print("input-to-photon latency at real-time pacing (teleop twist sent -> first frame "
-                 "captured after it received), {} samples: median {:.0f} ms, min {:.0f}, max "
-                 "{:.0f} (target < 150 ms); frames {:.1f}/s\n",
-                 l.size(), Median(l), l.front(), l.back(), rt.frames_per_sec);
+      fmt::print(
+          "input-to-photon latency at real-time pacing (teleop twist sent -> first frame "
+          "captured after it received), {} samples: median {:.0f} ms, min {:.0f}, max "
+          "{:.0f} (target < 150 ms); frames {:.1f}/s\n",
+          l.size(), Median(l), l.front(), l.back(), rt.frames_per_sec);
     }
   }
   return 0;

@@ -32,8 +32,8 @@ struct ViewerFlag {
 
 /// options of `penumbra view`.
 struct ViewOptions {
-  std::string address;  ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
-  std::string out_dir;  ///< --out: keep the outputs here ("" = a temporary folder, removed)
+  std::string address;   ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
+  std::string out_dir;   ///< --out: keep the outputs here ("" = a temporary folder, removed)
   bool running = false;  ///< --running: start running instead of paused
   bool force = false;    ///< --force: --out may hold an earlier run's outputs
   std::optional<double> duration_sec;  ///< --duration (default: the world's)

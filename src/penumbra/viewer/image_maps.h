@@ -15,9 +15,9 @@ std::array<uint8_t, 3> TurboColor(double x);
 
 /// a depth image drawn with TurboColor: near_m -> 0 (dark blue), far_m -> 1 (dark red).
 struct DepthColorMap {
-  ImageU8 image;       ///< (H x W x 3) sRGB; pixels without a hit (depth 0) are black
-  double near_m = 0;   ///< depth of colour 0, m
-  double far_m = 0;    ///< depth of colour 1, m
+  ImageU8 image;      ///< (H x W x 3) sRGB; pixels without a hit (depth 0) are black
+  double near_m = 0;  ///< depth of colour 0, m
+  double far_m = 0;   ///< depth of colour 1, m
 };
 
 /// colours `depth_m` (H x W x 1, m, 0 = no hit). the range is the 1st..99th percentile of the

@@ -21,17 +21,17 @@ std::string JpegEncoder::Encode(const ImageU8& image, int quality) {
   if (image.empty() || image.width <= 0 || image.height <= 0)
     throw Error("JPEG encoder: empty image");
   if (image.channels != 1 && image.channels != 3)
-    throw Error(fmt::format("JPEG encoder: {} channels; expected 1 (grey) or 3 (RGB)",
-                            image.channels));
+    throw Error(
+        fmt::format("JPEG encoder: {} channels; expected 1 (grey) or 3 (RGB)", image.channels));
   if (image.data.size() != static_cast<size_t>(image.width) * image.height * image.channels)
     throw Error("JPEG encoder: image buffer does not match its size");
   quality = std::clamp(quality, 1, 100);
   unsigned char* out = nullptr;
   unsigned long size = 0;
-  const int rc = tjCompress2(static_cast<tjhandle>(handle_), image.data.data(), image.width, 0,
-                             image.height, image.channels == 3 ? TJPF_RGB : TJPF_GRAY, &out,
-                             &size, image.channels == 3 ? TJSAMP_420 : TJSAMP_GRAY, quality,
-                             TJFLAG_FASTDCT);
+  const int rc =
+      tjCompress2(static_cast<tjhandle>(handle_), image.data.data(), image.width, 0, image.height,
+                  image.channels == 3 ? TJPF_RGB : TJPF_GRAY, &out, &size,
+                  image.channels == 3 ? TJSAMP_420 : TJSAMP_GRAY, quality, TJFLAG_FASTDCT);
   if (rc != 0) {
     const std::string why = tjGetErrorStr2(static_cast<tjhandle>(handle_));
     tjFree(out);
@@ -53,8 +53,8 @@ ImageU8 DecodeJpeg(const std::string& jpeg) {
     throw Error("JPEG decoder: " + why);
   }
   ImageU8 img(w, hgt, 3);
-  if (tjDecompress2(h, src, jpeg.size(), img.data.data(), w, 0, hgt, TJPF_RGB, TJFLAG_ACCURATEDCT) !=
-      0) {
+  if (tjDecompress2(h, src, jpeg.size(), img.data.data(), w, 0, hgt, TJPF_RGB,
+                    TJFLAG_ACCURATEDCT) != 0) {
     const std::string why = tjGetErrorStr2(h);
     tjDestroy(h);
     throw Error("JPEG decoder: " + why);
@@ -76,9 +76,9 @@ void AdaptiveJpegOptions::ValidateOrThrow() const {
     throw ConfigError("", 0, "viewer.jpeg.min_quality",
                       fmt::format("{} is above max_quality {}", min_quality, max_quality));
   if (initial_quality < min_quality || initial_quality > max_quality)
-    throw ConfigError("", 0, "viewer.jpeg.initial_quality",
-                      fmt::format("{}; expected {}..{}", initial_quality, min_quality,
-                                  max_quality));
+    throw ConfigError(
+        "", 0, "viewer.jpeg.initial_quality",
+        fmt::format("{}; expected {}..{}", initial_quality, min_quality, max_quality));
   if (!(target_bytes_per_sec > 0))
     throw ConfigError("", 0, "viewer.jpeg.target_bytes_per_sec", "expected a positive rate");
 }
@@ -88,8 +88,7 @@ AdaptiveJpegQuality::AdaptiveJpegQuality(const AdaptiveJpegOptions& options)
   options_.ValidateOrThrow();
 }
 
-void AdaptiveJpegQuality::Update(size_t frame_bytes, double interval_sec,
-                                 int64_t frames_replaced) {
+void AdaptiveJpegQuality::Update(size_t frame_bytes, double interval_sec, int64_t frames_replaced) {
   int q = quality_;
   if (frames_replaced > 0) {
     q -= 10;

@@ -17,12 +17,12 @@
 #include "penumbra/control/joint_controller.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/session/session.h"
 #include "penumbra/viewer/image_maps.h"
 #include "penumbra/viewer/viewer_messages.h"
 #include "penumbra/viewer/web_root.h"
 #include "penumbra/viewer/web_server.h"
-#include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/world/adversity_preset.h"
 
 namespace penumbra {
@@ -45,8 +45,9 @@ void ParseViewerAddress(const std::string& spec, ViewerOptions* options) {
   if (spec.front() == '[') {  // [v6]:port
     const size_t close = spec.find(']');
     if (close == std::string::npos || close + 1 >= spec.size() || spec[close + 1] != ':')
-      throw ConfigError("", 0, "--viewer",
-                        "'" + spec + "' is not [IPv6]:PORT; expected HOST:PORT, e.g. 127.0.0.1:8080");
+      throw ConfigError(
+          "", 0, "--viewer",
+          "'" + spec + "' is not [IPv6]:PORT; expected HOST:PORT, e.g. 127.0.0.1:8080");
     host = spec.substr(1, close - 1);
     port_text = spec.substr(close + 2);
   } else if (const size_t colon = spec.rfind(':'); colon != std::string::npos) {
@@ -57,9 +58,10 @@ void ParseViewerAddress(const std::string& spec, ViewerOptions* options) {
   const auto r = std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
   if (port_text.empty() || r.ec != std::errc() || r.ptr != port_text.data() + port_text.size() ||
       port < 0 || port > 65535)
-    throw ConfigError("", 0, "--viewer",
-                      "'" + spec + "': port '" + port_text +
-                          "' is not an integer in 0..65535; expected HOST:PORT, e.g. 127.0.0.1:8080");
+    throw ConfigError(
+        "", 0, "--viewer",
+        "'" + spec + "': port '" + port_text +
+            "' is not an integer in 0..65535; expected HOST:PORT, e.g. 127.0.0.1:8080");
   if (host.empty()) throw ConfigError("", 0, "--viewer", "'" + spec + "': empty host");
   options->host = host;
   options->port = port;
@@ -190,8 +192,7 @@ class ViewerBridge : public RunBridge {
     if (clients_.load() == 0) return;
     std::lock_guard<std::mutex> lock(sig_mu_);
     if (s.type == "imu" && s.values.size() >= 6) {
-      static const char* kAxes[6] = {"accel_x", "accel_y", "accel_z",
-                                     "gyro_x",  "gyro_y",  "gyro_z"};
+      static const char* kAxes[6] = {"accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"};
       for (int k = 0; k < 6; ++k) sensor_signals_["imu/" + s.sensor + "/" + kAxes[k]] = s.values[k];
     } else if (s.type == "mujoco" && s.columns) {
       for (size_t k = 0; k < s.values.size() && k < s.columns->size(); ++k)
@@ -238,8 +239,13 @@ class ViewerBridge : public RunBridge {
         value.push_back(0.0);
       }
       if (!names.empty())
-        joint_controls.push_back({{"kind", "ctrl"}, {"robot", ""}, {"names", names},
-                                  {"min", lo}, {"max", hi}, {"value", value}, {"unit", ""}});
+        joint_controls.push_back({{"kind", "ctrl"},
+                                  {"robot", ""},
+                                  {"names", names},
+                                  {"min", lo},
+                                  {"max", hi},
+                                  {"value", value},
+                                  {"unit", ""}});
     }
     control_period_sec_ = period;
     json colormap = json::array();
@@ -289,8 +295,8 @@ class ViewerBridge : public RunBridge {
       hi.push_back(b);
       value.push_back(std::clamp(q0, a, b));
     }
-    return {{"kind", "joint_targets"}, {"robot", robot}, {"names", names}, {"min", lo},
-            {"max", hi},           {"value", value}, {"unit", "rad"}};
+    return {{"kind", "joint_targets"}, {"robot", robot}, {"names", names}, {"min", lo}, {"max", hi},
+            {"value", value},          {"unit", "rad"}};
   }
 
   json EffectSliders() const {
@@ -305,22 +311,22 @@ class ViewerBridge : public RunBridge {
     auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
     auto slider = [](const char* block, const char* key, const char* label, const char* unit,
                      double min, double max, double step, double off, json value) {
-      return json{{"block", block}, {"key", key}, {"label", label}, {"unit", unit},
-                  {"min", min},     {"max", max}, {"step", step},   {"off", off},
+      return json{{"block", block}, {"key", key},      {"label", label}, {"unit", unit},
+                  {"min", min},     {"max", max},      {"step", step},   {"off", off},
                   {"value", value}, {"integer", false}};
     };
     json s = json::array();
     s.push_back(slider("fog", "mor_m", "fog MOR", "m", 2, 300, 1, 300, opt(p.fog_mor_m)));
     s.push_back(slider("smoke", "sigma_t_per_m", "smoke extinction", "1/m", 0, 3, 0.05, 0,
                        opt(p.smoke_sigma_t_per_m)));
-    s.push_back(slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0,
-                       opt(p.rain_rate_mm_h)));
-    s.push_back(slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0,
-                       opt(p.snow_rate_mm_h)));
+    s.push_back(
+        slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0, opt(p.rain_rate_mm_h)));
+    s.push_back(
+        slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0, opt(p.snow_rate_mm_h)));
     s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1, p.light_scale));
     // MuJoCo cannot add bodies to a loaded model: the run has the NPCs it started with
-    json npcs = slider("npcs", "people", "NPC count", "", 0, std::max(p.npc_people, 0), 1, 0,
-                       p.npc_people);
+    json npcs =
+        slider("npcs", "people", "NPC count", "", 0, std::max(p.npc_people, 0), 1, 0, p.npc_people);
     npcs["integer"] = true;
     s.push_back(npcs);
     return s;
@@ -359,13 +365,13 @@ class ViewerBridge : public RunBridge {
                                "expected a JSON object {\"cmd\": NAME, ...}")
           .dump();
     if (request.contains("cmd") && request["cmd"] == "subscribe") return Subscribe(client, request);
-    const std::string cmd = request.value("cmd", json()).is_string() ? request["cmd"].get<std::string>() : "";
+    const std::string cmd =
+        request.value("cmd", json()).is_string() ? request["cmd"].get<std::string>() : "";
     dispatcher_.Dispatch(request, [this, client, cmd](json reply) {
       server_->Send(client, WebMessage::Text(reply.dump()));
       // the run's state changed at a boundary: every page learns it at once
-      if (reply.value("ok", false) &&
-          (cmd == "pause" || cmd == "resume" || cmd == "step" || cmd == "reset" ||
-           cmd == "set_realtime_factor")) {
+      if (reply.value("ok", false) && (cmd == "pause" || cmd == "resume" || cmd == "step" ||
+                                       cmd == "reset" || cmd == "set_realtime_factor")) {
         json status = {{"paused", control_.paused()},
                        {"realtime_factor", control_.realtime_factor()}};
         if (reply.contains("step")) status["step"] = reply["step"];
@@ -398,18 +404,20 @@ class ViewerBridge : public RunBridge {
     for (size_t i = 0; i < streams.size(); ++i) {
       const std::string field = fmt::format("streams[{}]", i);
       if (!streams[i].is_string())
-        return CommandErrorReply(cmd, id, command_code::kBadField, field, "expected a string").dump();
+        return CommandErrorReply(cmd, id, command_code::kBadField, field, "expected a string")
+            .dump();
       const std::string s = streams[i];
       const size_t slash = s.rfind('/');
-      const std::string camera = s.rfind("camera/", 0) == 0 && slash > 7 ? s.substr(7, slash - 7) : "";
+      const std::string camera =
+          s.rfind("camera/", 0) == 0 && slash > 7 ? s.substr(7, slash - 7) : "";
       const std::string kind = slash == std::string::npos ? "" : s.substr(slash + 1);
       const CameraSpec* spec = nullptr;
       for (const CameraSpec& c : session_.scene().cameras)
         if (c.name == camera) spec = &c;
-      const bool kind_ok = spec && ((kind == "rgb" && spec->outputs.rgb) ||
-                                    (kind == "depth" && spec->outputs.depth) ||
-                                    (kind == "segmentation" && spec->outputs.rgb &&
-                                     spec->outputs.segmentation));
+      const bool kind_ok =
+          spec &&
+          ((kind == "rgb" && spec->outputs.rgb) || (kind == "depth" && spec->outputs.depth) ||
+           (kind == "segmentation" && spec->outputs.rgb && spec->outputs.segmentation));
       if (!kind_ok)
         return CommandErrorReply(
                    cmd, id, command_code::kBadField, field,
@@ -534,10 +542,18 @@ class ViewerBridge : public RunBridge {
     for (const char* kind : {"rgb", "depth", "segmentation"}) {
       const std::string stream = "camera/" + f.camera + "/" + kind;
       if (!streams.count(stream) || !FrameHas(f, kind)) continue;
-      json header = {{"type", "frame"},        {"stream", stream},    {"camera", f.camera},
-                     {"kind", kind},           {"time_sec", f.time_sec}, {"step", f.step},
-                     {"index", f.index},       {"fx", K.fx},          {"fy", K.fy},
-                     {"cx", K.cx},             {"cy", K.cy},          {"X_WO", PoseJson(f.X_WO)}};
+      json header = {{"type", "frame"},
+                     {"stream", stream},
+                     {"camera", f.camera},
+                     {"kind", kind},
+                     {"time_sec", f.time_sec},
+                     {"step", f.step},
+                     {"index", f.index},
+                     {"fx", K.fx},
+                     {"fy", K.fy},
+                     {"cx", K.cx},
+                     {"cy", K.cy},
+                     {"X_WO", PoseJson(f.X_WO)}};
       ImageU8 image;
       const ImageU8* src = &f.rgb;
       if (std::string_view(kind) == "depth") {
@@ -611,7 +627,9 @@ class ViewerBridge : public RunBridge {
         const Eigen::Vector3d w = *X_WS * Eigen::Vector3d(p.x, p.y, p.z);
         for (int k = 0; k < 3; ++k) pts.push_back(std::round(w[k] * 1e3) / 1e3);
       }
-      json m = {{"type", "lidar"}, {"sensor", name}, {"time_sec", s.time_sec},
+      json m = {{"type", "lidar"},
+                {"sensor", name},
+                {"time_sec", s.time_sec},
                 {"points", std::move(pts)}};
       server_->Publish("lidar/" + name, WebMessage::Text(m.dump()));
     }

@@ -15,14 +15,22 @@ double Round(double v, double scale) { return std::round(v * scale) / scale; }
 
 const char* ShapeName(GeomShape s) {
   switch (s) {
-    case GeomShape::kPlane: return "plane";
-    case GeomShape::kSphere: return "sphere";
-    case GeomShape::kCapsule: return "capsule";
-    case GeomShape::kEllipsoid: return "ellipsoid";
-    case GeomShape::kCylinder: return "cylinder";
-    case GeomShape::kBox: return "box";
-    case GeomShape::kMesh: return "mesh";
-    case GeomShape::kHeightField: return "hfield";
+    case GeomShape::kPlane:
+      return "plane";
+    case GeomShape::kSphere:
+      return "sphere";
+    case GeomShape::kCapsule:
+      return "capsule";
+    case GeomShape::kEllipsoid:
+      return "ellipsoid";
+    case GeomShape::kCylinder:
+      return "cylinder";
+    case GeomShape::kBox:
+      return "box";
+    case GeomShape::kMesh:
+      return "mesh";
+    case GeomShape::kHeightField:
+      return "hfield";
   }
   return "box";
 }
@@ -48,8 +56,8 @@ json SceneJson(const SceneDescription& scene) {
     const Body& b = scene.bodies[i];
     // a robot's root: a moving body hanging from the world
     const bool trail = i > 0 && b.parent == 0 && !b.is_static;
-    bodies.push_back({{"name", b.name}, {"parent", b.parent}, {"static", b.is_static},
-                      {"trail", trail}});
+    bodies.push_back(
+        {{"name", b.name}, {"parent", b.parent}, {"static", b.is_static}, {"trail", trail}});
   }
   json geoms = json::array();
   std::vector<int> mesh_index(scene.meshes.size(), -1), hfield_index(scene.hfields.size(), -1);
@@ -74,7 +82,8 @@ json SceneJson(const SceneDescription& scene) {
     const json pose = PoseJson(g.X_BG);
     jg["pos"] = {pose[0], pose[1], pose[2]};
     jg["quat"] = {pose[3], pose[4], pose[5], pose[6]};
-    if (g.shape == GeomShape::kMesh && g.mesh >= 0 && g.mesh < static_cast<int>(scene.meshes.size())) {
+    if (g.shape == GeomShape::kMesh && g.mesh >= 0 &&
+        g.mesh < static_cast<int>(scene.meshes.size())) {
       if (mesh_index[g.mesh] < 0) {
         const TriangleMesh& m = scene.meshes[g.mesh];
         json v = json::array(), f = json::array();

@@ -4,7 +4,6 @@
 // binary messages. all JSON; poses as [x, y, z, qw, qx, qy, qz] (m, unit quaternion w first).
 
 #include <nlohmann/json.hpp>
-
 #include <string>
 
 #include "penumbra/core/pose.h"

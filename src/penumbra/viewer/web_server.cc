@@ -1,7 +1,6 @@
 #include "penumbra/viewer/web_server.h"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -15,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -121,7 +121,8 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   void Accept(http::request<http::string_body> req) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     ws_.read_message_max(server_->options_.max_message_bytes);
-    ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) { self->OnAccept(ec); });
+    ws_.async_accept(req,
+                     [self = shared_from_this()](beast::error_code ec) { self->OnAccept(ec); });
   }
 
   void Offer(const std::string& channel, const WebMessage& m) {
@@ -176,9 +177,8 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
   }
 
   void Read() {
-    ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, size_t) {
-      self->OnRead(ec);
-    });
+    ws_.async_read(buffer_,
+                   [self = shared_from_this()](beast::error_code ec, size_t) { self->OnRead(ec); });
   }
 
   void OnRead(beast::error_code ec) {
@@ -223,9 +223,8 @@ class WebSocketSession : public std::enable_shared_from_this<WebSocketSession> {
     writing_ = true;
     ws_.binary(next.binary);
     ws_.async_write(net::buffer(*next.bytes),
-                    [self = shared_from_this(), bytes = next.bytes](beast::error_code ec, size_t n) {
-                      self->OnWrite(ec, n);
-                    });
+                    [self = shared_from_this(), bytes = next.bytes](
+                        beast::error_code ec, size_t n) { self->OnWrite(ec, n); });
   }
 
   void OnWrite(beast::error_code ec, size_t n) {
@@ -276,8 +275,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     parser_->header_limit(16 * 1024);
     parser_->body_limit(server_->options_.max_message_bytes);
     stream_.expires_after(std::chrono::seconds(30));
-    http::async_read(stream_, buffer_, *parser_,
-                     [self = shared_from_this()](beast::error_code ec, size_t) { self->OnRead(ec); });
+    http::async_read(
+        stream_, buffer_, *parser_,
+        [self = shared_from_this()](beast::error_code ec, size_t) { self->OnRead(ec); });
   }
 
  private:
@@ -285,17 +285,18 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (ec == http::error::end_of_stream) return Shutdown();
     if (ec) {
       if (ec == http::error::body_limit || ec == http::error::header_limit)
-        return Respond(ErrorResponse(http::status::payload_too_large, "request too large", 11, false));
+        return Respond(
+            ErrorResponse(http::status::payload_too_large, "request too large", 11, false));
       return;  // malformed or cut off: drop the connection
     }
     http::request<http::string_body> req = parser_->release();
     if (websocket::is_upgrade(req)) {
       if (req.target() != "/ws")
-        return Respond(ErrorResponse(http::status::not_found, "WebSocket endpoint is /ws", req.version(),
-                             false));
+        return Respond(ErrorResponse(http::status::not_found, "WebSocket endpoint is /ws",
+                                     req.version(), false));
       if (server_->clients_.load() >= server_->options_.max_clients)
         return Respond(ErrorResponse(http::status::service_unavailable, "too many viewers",
-                             req.version(), false));
+                                     req.version(), false));
       stream_.expires_never();
       const int id = server_->next_id_++;
       std::make_shared<WebSocketSession>(stream_.release_socket(), server_, id)
@@ -307,7 +308,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   static http::response<http::string_body> ErrorResponse(http::status status, std::string_view what,
-                                                 unsigned version, bool keep_alive) {
+                                                         unsigned version, bool keep_alive) {
     http::response<http::string_body> res{status, version};
     res.set(http::field::content_type, "text/plain; charset=utf-8");
     res.keep_alive(keep_alive);
@@ -319,10 +320,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   http::response<http::string_body> Serve(const http::request<http::string_body>& req) {
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return ErrorResponse(http::status::method_not_allowed, "only GET and HEAD", req.version(),
-                   req.keep_alive());
-    const std::string path =
-        ResolveWebPath(server_->options_.web_root, std::string_view(req.target().data(),
-                                                                    req.target().size()));
+                           req.keep_alive());
+    const std::string path = ResolveWebPath(
+        server_->options_.web_root, std::string_view(req.target().data(), req.target().size()));
     if (path.empty())
       return ErrorResponse(http::status::bad_request, "bad path", req.version(), req.keep_alive());
     std::ifstream in(path, std::ios::binary);
@@ -387,16 +387,16 @@ void WebServerImpl::Start() {
 }
 
 void WebServerImpl::Accept() {
-  acceptor_.async_accept(net::make_strand(ioc_), [self = shared_from_this()](
-                                                     beast::error_code ec, tcp::socket socket) {
-    if (ec) {
-      if (ec == net::error::operation_aborted) return;
-    } else {
-      socket.set_option(tcp::no_delay(true), ec);
-      std::make_shared<HttpSession>(std::move(socket), self)->Read();
-    }
-    self->Accept();
-  });
+  acceptor_.async_accept(net::make_strand(ioc_),
+                         [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
+                           if (ec) {
+                             if (ec == net::error::operation_aborted) return;
+                           } else {
+                             socket.set_option(tcp::no_delay(true), ec);
+                             std::make_shared<HttpSession>(std::move(socket), self)->Read();
+                           }
+                           self->Accept();
+                         });
 }
 
 void WebServerImpl::Unregister(int id) { sessions_.erase(id); }

@@ -27,9 +27,9 @@ namespace penumbra {
 
 /// where and how the server listens.
 struct WebServerOptions {
-  std::string host = "127.0.0.1";  ///< numeric IPv4/IPv6 address to bind; loopback by default
-  int port = 8080;                 ///< TCP port; 0 = any free port (see WebServer::port)
-  std::string web_root;            ///< folder of the static files ("/" serves index.html)
+  std::string host = "127.0.0.1";        ///< numeric IPv4/IPv6 address to bind; loopback by default
+  int port = 8080;                       ///< TCP port; 0 = any free port (see WebServer::port)
+  std::string web_root;                  ///< folder of the static files ("/" serves index.html)
   size_t max_message_bytes = 64 * 1024;  ///< largest WebSocket message accepted from a client
   size_t max_pending_replies = 256;      ///< replies queued for one client before it is dropped
   int max_clients = 64;                  ///< WebSocket clients at once; more are refused (503)
@@ -65,12 +65,12 @@ struct WebServerHandlers {
 
 /// counters since the server started (read from any thread).
 struct WebServerStats {
-  int clients = 0;                  ///< WebSocket clients connected now
-  int64_t messages_received = 0;    ///< WebSocket messages read from clients
-  int64_t messages_sent = 0;        ///< WebSocket messages written to clients
-  int64_t messages_replaced = 0;    ///< published messages replaced before being sent
-  int64_t bytes_sent = 0;           ///< WebSocket payload bytes written
-  int64_t http_requests = 0;        ///< plain HTTP requests answered
+  int clients = 0;                ///< WebSocket clients connected now
+  int64_t messages_received = 0;  ///< WebSocket messages read from clients
+  int64_t messages_sent = 0;      ///< WebSocket messages written to clients
+  int64_t messages_replaced = 0;  ///< published messages replaced before being sent
+  int64_t bytes_sent = 0;         ///< WebSocket payload bytes written
+  int64_t http_requests = 0;      ///< plain HTTP requests answered
 };
 
 /// the server; listening from construction to destruction.
