@@ -182,8 +182,14 @@ TEST(WebServerTest, RepliesAndSurvivesMalformedMessages) {
   beast::flat_buffer b;
   beast::error_code ec;
   c.ws.read(b, ec);
-  EXPECT_EQ(ec, websocket::error::closed);
-  EXPECT_EQ(c.ws.reason().code, websocket::close_code::too_big);
+  // the close frame with 1009, or, when the server's close overtook the client's answer to
+  // it, a broken pipe / reset: either way the connection is gone
+  if (ec == websocket::error::closed)
+    EXPECT_EQ(c.ws.reason().code, websocket::close_code::too_big);
+  else
+    EXPECT_TRUE(ec == net::error::broken_pipe || ec == net::error::connection_reset ||
+                ec == net::error::eof)
+        << ec.message();
   Client d(f.server->port());
   EXPECT_EQ(json::parse(d.Read())["type"], "hello");
   d.Write(R"({"cmd":"ping"})");
