@@ -17,6 +17,7 @@
 
 #include "penumbra/app/bench.h"
 #include "penumbra/app/bench_record.h"
+#include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -275,6 +276,8 @@ int RunCli(int argc, char** argv) {
   const ExportCommand export_command = AddExportCommand(app);
   // penumbra replay (app/replay_command.h)
   const ReplayCommand replay = AddReplayCommand(app);
+  // penumbra benchmark / slam (app/benchmark_command.h)
+  const BenchmarkCommands benchmark_commands(app);
 
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
@@ -319,6 +322,11 @@ int RunCli(int argc, char** argv) {
       g_stop_signal.store(0);
       const StopSignals stop_signals;
       return replay.Run(Args(argc, argv), &g_stop_signal);
+    }
+    if (benchmark_commands.Selected()) {
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return benchmark_commands.Run(&g_stop_signal);
     }
     if (*bench_render) {
       render_bench.adversity = !no_adversity;
