@@ -277,11 +277,8 @@ int RunBenchmark(const BenchmarkOptions& o) {
   const int workers = o.workers > 0 ? o.workers : spec.workers;
   const std::vector<std::string> failed =
       o.slurm ? RunSlurm(o, spec, jobs, start) : RunLocal(o, spec, jobs, workers, start);
-  if (o.stop_request && o.stop_request->load() != 0) {
-    spdlog::warn("interrupted; finished jobs are kept: run the same command again to resume");
-    return 130;
-  }
-  // 3. the results of every finished job
+  const bool interrupted = o.stop_request && o.stop_request->load() != 0;
+  // 3. the results of every finished job (also after an interruption)
   std::vector<BenchmarkRow> rows;
   for (const BenchmarkJob& j : jobs)
     if (Finished(o.out_dir, j))
@@ -289,6 +286,10 @@ int RunBenchmark(const BenchmarkOptions& o) {
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   WriteBenchmarkReport(spec, o.out_dir, rows, wall);
   spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", rows.size(), o.out_dir, Hms(wall));
+  if (interrupted) {
+    spdlog::warn("interrupted; the finished jobs are kept and reported: the same command resumes");
+    return 130;
+  }
   if (!failed.empty()) {
     spdlog::error("{} job(s) failed in the harness (not a method's failure): their rows are missing", failed.size());
     return 1;
