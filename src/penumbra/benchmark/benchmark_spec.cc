@@ -8,9 +8,13 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include "penumbra/core/error.h"
+#include "penumbra/replay/world_override.h"
 #include "penumbra/world/adversity_preset.h"
+#include "penumbra/world/world_config.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
@@ -69,6 +73,8 @@ void CheckTemplate(const YamlReader& r, const std::string& text) {
   }
 }
 
+void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera);
+
 BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   r.ExpectMap({"name", "file", "duration_sec", "camera"});
   BenchmarkWorld w;
@@ -94,6 +100,7 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   YAML::Emitter out;
   out << YAML::Flow << node;
   w.camera_yaml = out.c_str();
+  CheckCamera(w, cam);
   return w;
 }
 
@@ -145,6 +152,31 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
   if (r.Has("timeout_sec")) m.timeout_sec = Positive(r.Child("timeout_sec"), 7 * 24 * 3600.0);
   if (r.Has("align")) m.align = Align(r.Child("align"));
   return m;
+}
+
+// the camera as a replay will take it: the world file loaded and the override the jobs write
+// applied (world-file camera rules: keys, ranges, attach bodies); errors point at the spec
+void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera) {
+  WorldConfig world = LoadWorldFile(w.file);
+  std::string tmpl = (fs::temp_directory_path() / "penumbra_benchmark_camera_XXXXXX.yaml").string();
+  const int fd = mkstemps(tmpl.data(), 5);
+  if (fd < 0) throw Error("cannot create a temporary file in " + fs::temp_directory_path().string());
+  close(fd);
+  {
+    std::ofstream out(tmpl, std::ios::binary | std::ios::trunc);
+    out << "cameras:\n  - " << w.camera_yaml << "\n";
+  }
+  try {
+    ApplyWorldOverride(world, tmpl);
+  } catch (const ConfigError& e) {
+    std::error_code ec;
+    fs::remove(tmpl, ec);
+    std::string key = e.key();
+    if (key.rfind("cameras[0]", 0) == 0) key = key.substr(10);
+    camera.Fail((key.empty() ? "" : key.substr(key[0] == '.' ? 1 : 0) + ": ") + e.problem());
+  }
+  std::error_code ec;
+  fs::remove(tmpl, ec);
 }
 
 }  // namespace
