@@ -7,18 +7,18 @@
 //   penumbra-slam-open3d DATASET OUT FX FY CX CY MIN_DEPTH_M MAX_DEPTH_M
 //
 // exit codes: 0 written, 2 bad input, 3 no frame tracked after the first, 1 other failures.
-#include <cmath>
-#include <cstring>
 #include <open3d/camera/PinholeCameraIntrinsic.h>
 #include <open3d/geometry/Image.h>
 #include <open3d/geometry/RGBDImage.h>
 #include <open3d/pipelines/odometry/Odometry.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iostream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <fstream>
-#include <iostream>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
@@ -107,7 +107,8 @@ int main(int argc, char** argv) {
     double v[6];
     for (int i = 0; i < 6; ++i) {
       const std::optional<double> d = ParseDecimal(argv[3 + i]);
-      if (!d) throw ConfigError("", 0, "argument " + std::to_string(3 + i), "expected a decimal number");
+      if (!d)
+        throw ConfigError("", 0, "argument " + std::to_string(3 + i), "expected a decimal number");
       v[i] = *d;
     }
     RgbdOdometryOptions options;
@@ -116,15 +117,15 @@ int main(int argc, char** argv) {
     options.max_depth_m = v[5];
     const RgbdOdometryResult r = RunOpen3dRgbdOdometry(ReadTumRgbdSequence(argv[1]), options);
     if (r.trajectory.size() < 2) {
-      std::cerr << "open3d_rgbd tracked no frame after the first (" << r.frames << " frames, " << r.lost
-                << " lost); no trajectory written\n";
+      std::cerr << "open3d_rgbd tracked no frame after the first (" << r.frames << " frames, "
+                << r.lost << " lost); no trajectory written\n";
       return 3;
     }
     std::ofstream out(argv[2], std::ios::binary | std::ios::trunc);
     out << FormatTumTrajectory(r.trajectory);
     if (!out.flush()) throw Error(std::string("cannot write ") + argv[2]);
-    std::cerr << "open3d_rgbd over " << r.frames << " frames: " << r.trajectory.size() << " tracked, " << r.lost
-              << " lost -> " << argv[2] << "\n";
+    std::cerr << "open3d_rgbd over " << r.frames << " frames: " << r.trajectory.size()
+              << " tracked, " << r.lost << " lost -> " << argv[2] << "\n";
     return 0;
   } catch (const ConfigError& e) {
     std::cerr << "penumbra-slam-open3d: " << e.what() << "\n";

@@ -30,11 +30,13 @@ std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
     std::string cur;
     bool quoted = false;
     for (char c : line) {
-      if (c == '"') quoted = !quoted;
+      if (c == '"')
+        quoted = !quoted;
       else if (c == ',' && !quoted) {
         f.push_back(cur);
         cur.clear();
-      } else cur += c;
+      } else
+        cur += c;
     }
     f.push_back(cur);
     rows.push_back(f);
@@ -50,7 +52,8 @@ int RunBenchmarkCli(const std::string& args) {
 std::string ShortSpec() {
   return std::string("name: short\nworlds:\n  - name: room\n    file: ") + PENUMBRA_SOURCE_DIR +
          "/worlds/default.yaml\n    duration_sec: 1.5\n"
-         "    camera: {name: cam, attach: go1/camera_mount, width: 160, height: 120, fovy_deg: 70, rate_hz: 10}\n"
+         "    camera: {name: cam, attach: go1/camera_mount, width: 160, height: 120, fovy_deg: 70, "
+         "rate_hz: 10}\n"
          "conditions: [none, major]\ntrials: 2\nmethods:\n"
          "  - {name: rgbd, bundled: opencv_rgbd}\n"
          "  - {name: crash, command: \"kill -SEGV $$\"}\n"
@@ -63,7 +66,9 @@ TEST(BenchmarkEndToEnd, ShortSlamSpecRowsStatusesAndSharedGroundTruth) {
   TempDir dir;
   const std::string spec = dir.Write("spec.yaml", ShortSpec());
   const fs::path out = dir.path() / "out";
-  ASSERT_EQ(RunBenchmarkCli(spec + " --out " + out.string() + " --quiet 2>" + (dir.path() / "err.txt").string()), 0)
+  ASSERT_EQ(RunBenchmarkCli(spec + " --out " + out.string() + " --quiet 2>" +
+                            (dir.path() / "err.txt").string()),
+            0)
       << ReadAll(dir.path() / "err.txt");
   const auto rows = ParseCsv(ReadAll(out / "results.csv"));
   ASSERT_EQ(rows.size(), 1u + 2 * 2 * 4);
@@ -79,7 +84,8 @@ TEST(BenchmarkEndToEnd, ShortSlamSpecRowsStatusesAndSharedGroundTruth) {
       ASSERT_EQ(status, "ok") << row[col["detail"]];
       const double ate = std::stod(row[col["ate_rmse_m"]]);
       EXPECT_GT(ate, 0);
-      if (row[col["condition"]] == "none") EXPECT_LT(ate, 0.05) << "frame-to-frame odometry over 0.7 m of trot";
+      if (row[col["condition"]] == "none")
+        EXPECT_LT(ate, 0.05) << "frame-to-frame odometry over 0.7 m of trot";
       const double tracked = std::stod(row[col["tracked_fraction"]]);
       EXPECT_GT(tracked, 0);
       EXPECT_LE(tracked, 1);
@@ -104,8 +110,10 @@ TEST(BenchmarkEndToEnd, ShortSlamSpecRowsStatusesAndSharedGroundTruth) {
   EXPECT_TRUE(fs::is_regular_file(out / "report.md"));
   EXPECT_TRUE(fs::is_regular_file(out / "plots" / "room_ate.png"));
   EXPECT_TRUE(fs::is_regular_file(out / "plots" / "traj_room__none__rgbd.png"));
-  EXPECT_NE(ReadAll(out / "summary.md").find("| none | rgbd | 2/2 |"), std::string::npos) << ReadAll(out / "summary.md");
-  EXPECT_FALSE(fs::exists(out / "jobs" / "room__none__t1" / "replay")) << "datasets removed unless keep_datasets";
+  EXPECT_NE(ReadAll(out / "summary.md").find("| none | rgbd | 2/2 |"), std::string::npos)
+      << ReadAll(out / "summary.md");
+  EXPECT_FALSE(fs::exists(out / "jobs" / "room__none__t1" / "replay"))
+      << "datasets removed unless keep_datasets";
 
   // a second run resumes: every job is finished, nothing runs again, the rows are the same
   const std::string before = ReadAll(out / "results.csv");

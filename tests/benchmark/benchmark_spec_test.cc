@@ -12,10 +12,13 @@ namespace {
 
 using testing::TempDir;
 
-std::string Spec(const std::string& extra, const std::string& methods = "  - {name: rgbd, bundled: opencv_rgbd}\n") {
+std::string Spec(const std::string& extra,
+                 const std::string& methods = "  - {name: rgbd, bundled: opencv_rgbd}\n") {
   return std::string("name: t\nworlds:\n  - name: room\n    file: ") + PENUMBRA_SOURCE_DIR +
-         "/worlds/default.yaml\n    duration_sec: 1\n    camera: {name: cam, attach: go1/camera_mount, width: 160, "
-         "height: 120, fovy_deg: 70, rate_hz: 10}\nconditions: [none, major]\ntrials: 2\nmethods:\n" +
+         "/worlds/default.yaml\n    duration_sec: 1\n    camera: {name: cam, attach: "
+         "go1/camera_mount, width: 160, "
+         "height: 120, fovy_deg: 70, rate_hz: 10}\nconditions: [none, major]\ntrials: "
+         "2\nmethods:\n" +
          methods + extra;
 }
 
@@ -36,8 +39,10 @@ TEST(BenchmarkSpec, LoadsWithDefaults) {
   ASSERT_EQ(s.worlds.size(), 1u);
   EXPECT_EQ(s.worlds[0].camera_name, "cam");
   // the benchmark camera writes rgb and depth through the RealSense D435 model
-  EXPECT_NE(s.worlds[0].camera_yaml.find("outputs: [rgb, depth]"), std::string::npos) << s.worlds[0].camera_yaml;
-  EXPECT_NE(s.worlds[0].camera_yaml.find("realsense_d435"), std::string::npos) << s.worlds[0].camera_yaml;
+  EXPECT_NE(s.worlds[0].camera_yaml.find("outputs: [rgb, depth]"), std::string::npos)
+      << s.worlds[0].camera_yaml;
+  EXPECT_NE(s.worlds[0].camera_yaml.find("realsense_d435"), std::string::npos)
+      << s.worlds[0].camera_yaml;
   ASSERT_EQ(s.conditions.size(), 2u);
   EXPECT_EQ(s.conditions[1].name, "major");
   EXPECT_EQ(s.seeds, (std::vector<uint64_t>{1, 2}));
@@ -59,7 +64,8 @@ TEST(BenchmarkSpec, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("exactly one of 'bundled'"), std::string::npos) << e;
   e = ErrorOf(Spec("workers: 0\n"));
   EXPECT_NE(e.find("workers"), std::string::npos) << e;
-  e = ErrorOf(Spec("", "  - {name: a, bundled: opencv_rgbd}\n  - {name: a, bundled: opencv_icp}\n"));
+  e = ErrorOf(
+      Spec("", "  - {name: a, bundled: opencv_rgbd}\n  - {name: a, bundled: opencv_icp}\n"));
   EXPECT_NE(e.find("appears twice"), std::string::npos) << e;
   std::string text = Spec("");
   text.replace(text.find("[none, major]"), 13, "[none, heavy]");
@@ -126,13 +132,14 @@ TEST(BenchmarkReport, SummaryIsMeanAndSampleStdOverOkTrials) {
   EXPECT_EQ(lines[0].ok, 2);
   EXPECT_NEAR(lines[0].ate_rmse_m.mean, 0.15, 1e-12);
   EXPECT_NEAR(lines[0].ate_rmse_m.std, std::sqrt(0.005), 1e-12);  // (0.05^2 * 2) / (2 - 1)
-  EXPECT_NEAR(lines[0].tracked_fraction.mean, 2.0 / 3.0, 1e-12);   // the failed trial counts 0
+  EXPECT_NEAR(lines[0].tracked_fraction.mean, 2.0 / 3.0, 1e-12);  // the failed trial counts 0
   EXPECT_EQ(lines[1].trials, 0);
   const std::string csv = BenchmarkCsv(rows);
-  EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "world,condition,method,trial,seed,status,frames,poses,ate_rmse_m,ate_mean_m,ate_max_m,"
-            "rpe_trans_rmse_m,rpe_rot_rmse_deg,coverage,scaled_ate_m,tracked_fraction,scale,replay_sec,"
-            "export_sec,method_sec,eval_sec,detail");
+  EXPECT_EQ(
+      csv.substr(0, csv.find('\n')),
+      "world,condition,method,trial,seed,status,frames,poses,ate_rmse_m,ate_mean_m,ate_max_m,"
+      "rpe_trans_rmse_m,rpe_rot_rmse_deg,coverage,scaled_ate_m,tracked_fraction,scale,replay_sec,"
+      "export_sec,method_sec,eval_sec,detail");
   EXPECT_NE(csv.find("room,none,rgbd,3,0,failed,0,0,,,,"), std::string::npos) << csv;
 }
 

@@ -43,7 +43,8 @@ TEST(RgbdSequence, BadLinesNameFileAndLine) {
 TEST(RgbdSequence, IntrinsicsFromCameraInfo) {
   TempDir dir;
   const std::string file = dir.Write(
-      "camera_info.json", R"({"front": {"width": 160, "height": 120, "K": [100, 0, 80, 0, 101, 60, 0, 0, 1]}})");
+      "camera_info.json",
+      R"({"front": {"width": 160, "height": 120, "K": [100, 0, 80, 0, 101, 60, 0, 0, 1]}})");
   const PinholeIntrinsics k = ReadCameraInfoIntrinsics(file, "");
   EXPECT_EQ(k.fx, 100);
   EXPECT_EQ(k.fy, 101);

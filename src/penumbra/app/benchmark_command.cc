@@ -64,11 +64,15 @@ PinholeIntrinsics ParseIntrinsics(const std::string& text) {
   while (pos <= text.size()) {
     const size_t end = std::min(text.find(',', pos), text.size());
     const std::optional<double> d = ParseDecimal(text.substr(pos, end - pos));
-    if (!d) throw ConfigError("", 0, "--intrinsics", "'" + text + "' is not 4 comma-separated numbers fx,fy,cx,cy");
+    if (!d)
+      throw ConfigError("", 0, "--intrinsics",
+                        "'" + text + "' is not 4 comma-separated numbers fx,fy,cx,cy");
     v.push_back(*d);
     pos = end + 1;
   }
-  if (v.size() != 4) throw ConfigError("", 0, "--intrinsics", "'" + text + "' is not 4 comma-separated numbers fx,fy,cx,cy");
+  if (v.size() != 4)
+    throw ConfigError("", 0, "--intrinsics",
+                      "'" + text + "' is not 4 comma-separated numbers fx,fy,cx,cy");
   PinholeIntrinsics k{v[0], v[1], v[2], v[3]};
   k.ValidateOrThrow();
   return k;
@@ -78,27 +82,44 @@ PinholeIntrinsics ParseIntrinsics(const std::string& text) {
 
 BenchmarkCommands::BenchmarkCommands(CLI::App& app) : state_(std::make_unique<State>()) {
   State& s = *state_;
-  s.benchmark = app.add_subcommand("benchmark", "SLAM benchmark: routes replayed under adversity conditions, methods "
-                                                "run and evaluated (docs/benchmarks.md)");
+  s.benchmark =
+      app.add_subcommand("benchmark",
+                         "SLAM benchmark: routes replayed under adversity conditions, methods "
+                         "run and evaluated (docs/benchmarks.md)");
   s.benchmark->add_option("spec", s.spec, "benchmark spec (.yaml)")->required();
-  s.benchmark->add_option("--out,-o", s.out, "output folder (results.csv, report.md, ...)")->required();
-  s.benchmark->add_option("--workers", s.workers, "local worker processes (default: the spec's `workers`)")
+  s.benchmark->add_option("--out,-o", s.out, "output folder (results.csv, report.md, ...)")
+      ->required();
+  s.benchmark
+      ->add_option("--workers", s.workers, "local worker processes (default: the spec's `workers`)")
       ->check(CLI::Range(1, 256));
-  s.benchmark->add_flag("--slurm", s.slurm, "submit the jobs as a Slurm job array and wait for them");
-  s.benchmark->add_flag("--force", s.force, "remove an earlier benchmark's outputs from --out first");
+  s.benchmark->add_flag("--slurm", s.slurm,
+                        "submit the jobs as a Slurm job array and wait for them");
+  s.benchmark->add_flag("--force", s.force,
+                        "remove an earlier benchmark's outputs from --out first");
   s.benchmark->add_flag("--quiet,-q", s.quiet, "no progress output");
-  s.benchmark->add_option("--job", s.job, "run only job K (the worker side; used by local workers and Slurm)")
+  s.benchmark
+      ->add_option("--job", s.job,
+                   "run only job K (the worker side; used by local workers and Slurm)")
       ->check(CLI::Range(0, 1000000));
 
-  s.slam = app.add_subcommand("slam", "run a bundled RGB-D odometry method over a TUM RGB-D folder");
-  s.slam->add_option("method", s.method, "opencv_rgbd | opencv_icp | opencv_rgbd_icp | open3d_rgbd")->required();
-  s.slam->add_option("dataset", s.dataset, "TUM RGB-D folder (penumbra export --format tum)")->required();
-  s.slam->add_option("out", s.trajectory, "output trajectory file (TUM: timestamp tx ty tz qx qy qz qw)")->required();
+  s.slam =
+      app.add_subcommand("slam", "run a bundled RGB-D odometry method over a TUM RGB-D folder");
+  s.slam->add_option("method", s.method, "opencv_rgbd | opencv_icp | opencv_rgbd_icp | open3d_rgbd")
+      ->required();
+  s.slam->add_option("dataset", s.dataset, "TUM RGB-D folder (penumbra export --format tum)")
+      ->required();
+  s.slam
+      ->add_option("out", s.trajectory,
+                   "output trajectory file (TUM: timestamp tx ty tz qx qy qz qw)")
+      ->required();
   s.slam->add_option("--intrinsics", s.intrinsics, "fx,fy,cx,cy in pixels");
-  s.slam->add_option("--camera-info", s.camera_info, "a run's camera_info.json (instead of --intrinsics)");
+  s.slam->add_option("--camera-info", s.camera_info,
+                     "a run's camera_info.json (instead of --intrinsics)");
   s.slam->add_option("--camera", s.camera, "the camera in --camera-info (default: its only one)");
-  s.slam->add_option("--min-depth", s.min_depth_m, "depth below is ignored, m")->check(CLI::Range(0.0, 100.0));
-  s.slam->add_option("--max-depth", s.max_depth_m, "depth above is ignored, m")->check(CLI::Range(0.01, 100.0));
+  s.slam->add_option("--min-depth", s.min_depth_m, "depth below is ignored, m")
+      ->check(CLI::Range(0.0, 100.0));
+  s.slam->add_option("--max-depth", s.max_depth_m, "depth above is ignored, m")
+      ->check(CLI::Range(0.01, 100.0));
   s.slam->add_flag("--quiet,-q", s.quiet, "no progress output");
 }
 
@@ -112,7 +133,8 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
   const State& s = *state_;
   if (*s.benchmark) {
     if (s.job >= 0) {
-      if (s.slurm) throw ConfigError("", 0, "--job", "not with --slurm (a worker runs one job here)");
+      if (s.slurm)
+        throw ConfigError("", 0, "--job", "not with --slurm (a worker runs one job here)");
       RunBenchmarkWorker(s.spec, s.out, s.job, SelfExecutable(), stop_request);
       return 0;
     }
@@ -130,9 +152,11 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
   }
   // slam
   if (s.intrinsics.empty() == s.camera_info.empty())
-    throw ConfigError("", 0, "--intrinsics", "expected exactly one of --intrinsics fx,fy,cx,cy and --camera-info FILE");
+    throw ConfigError("", 0, "--intrinsics",
+                      "expected exactly one of --intrinsics fx,fy,cx,cy and --camera-info FILE");
   RgbdOdometryOptions options;
-  options.intrinsics = s.intrinsics.empty() ? ReadCameraInfoIntrinsics(s.camera_info, s.camera) : ParseIntrinsics(s.intrinsics);
+  options.intrinsics = s.intrinsics.empty() ? ReadCameraInfoIntrinsics(s.camera_info, s.camera)
+                                            : ParseIntrinsics(s.intrinsics);
   options.min_depth_m = s.min_depth_m;
   options.max_depth_m = s.max_depth_m;
   if (!s.quiet)
@@ -141,10 +165,17 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
     };
   if (s.method == "open3d_rgbd") {
     // the Open3D method is its own executable beside this one (tools/slam_open3d.cc)
-    const std::string helper = (fs::path(SelfExecutable()).parent_path() / "penumbra-slam-open3d").string();
+    const std::string helper =
+        (fs::path(SelfExecutable()).parent_path() / "penumbra-slam-open3d").string();
     const PinholeIntrinsics& k = options.intrinsics;
-    const std::vector<std::string> args = {helper, s.dataset, s.trajectory, FormatNumber(k.fx), FormatNumber(k.fy),
-                                           FormatNumber(k.cx), FormatNumber(k.cy), FormatNumber(options.min_depth_m),
+    const std::vector<std::string> args = {helper,
+                                           s.dataset,
+                                           s.trajectory,
+                                           FormatNumber(k.fx),
+                                           FormatNumber(k.fy),
+                                           FormatNumber(k.cx),
+                                           FormatNumber(k.cy),
+                                           FormatNumber(options.min_depth_m),
                                            FormatNumber(options.max_depth_m)};
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -155,15 +186,16 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
   const std::vector<RgbdFrameFiles> frames = ReadTumRgbdSequence(s.dataset);
   const RgbdOdometryResult r = RunRgbdOdometry(s.method, frames, options);
   if (r.trajectory.size() < 2) {
-    spdlog::error("slam: {} tracked no frame after the first ({} frames, {} lost); no trajectory written", s.method,
-                  r.frames, r.lost);
+    spdlog::error(
+        "slam: {} tracked no frame after the first ({} frames, {} lost); no trajectory written",
+        s.method, r.frames, r.lost);
     return 3;
   }
   std::ofstream out(s.trajectory, std::ios::binary | std::ios::trunc);
   out << FormatTumTrajectory(r.trajectory);
   if (!out.flush()) throw Error("cannot write " + s.trajectory);
-  spdlog::info("slam: {} over {} frames: {} tracked, {} lost -> {}", s.method, r.frames, r.trajectory.size(), r.lost,
-               s.trajectory);
+  spdlog::info("slam: {} over {} frames: {} tracked, {} lost -> {}", s.method, r.frames,
+               r.trajectory.size(), r.lost, s.trajectory);
   return 0;
 }
 

@@ -41,7 +41,9 @@ void WriteText(const fs::path& p, const std::string& text) {
   if (!out.flush()) throw Error("cannot write " + p.string());
 }
 
-nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json Num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 double NumOf(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : NAN; }
 
 nlohmann::json RowJson(const BenchmarkRow& r) {
@@ -159,7 +161,8 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
   replay.force = true;
   replay.adversity = condition.adversity;
   replay.world_override = override_file.string();
-  replay.tier = spec.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced : RenderSettings::Tier::kRealtime;
+  replay.tier = spec.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
+                                          : RenderSettings::Tier::kRealtime;
   replay.threads = spec.render_threads;
   replay.cameras = {world.camera_name};
   replay.progress = false;
@@ -179,7 +182,8 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
     ex.format = ParseDatasetFormat(m.dataset);
     ex.out_dir = dir / ("dataset_" + m.dataset);
     ex.camera = world.camera_name;
-    ex.source_label = replay.log_path + " (" + condition.name + ", seed " + std::to_string(job.seed) + ")";
+    ex.source_label =
+        replay.log_path + " (" + condition.name + ", seed " + std::to_string(job.seed) + ")";
     exported[m.dataset] = ExportDataset(run, ex);
   }
   fs::copy_file(fs::path(replay.out_dir) / "camera_info.json", dir / "camera_info.json",
@@ -224,7 +228,8 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
         {"seed", std::to_string(job.seed)}};
     const std::string command = FillTemplate(m.command, values);
     WriteText(workdir / "command.sh", command + "\n");
-    const ProcessOutcome outcome = RunShellCommand(command, workdir.string(), m.timeout_sec, context.stop_request);
+    const ProcessOutcome outcome =
+        RunShellCommand(command, workdir.string(), m.timeout_sec, context.stop_request);
     if (outcome.stopped) throw Error("job " + job.id + ": interrupted");
     row.method_sec = outcome.wall_sec;
     row.detail = outcome.Describe();

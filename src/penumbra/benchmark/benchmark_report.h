@@ -20,7 +20,7 @@ std::string BenchmarkCsv(const std::vector<BenchmarkRow>& rows);
 
 /// mean +- std of one metric over the trials of one (world, condition, method).
 struct SummaryCell {
-  int n = 0;  ///< trials that contribute (status ok)
+  int n = 0;                     ///< trials that contribute (status ok)
   double mean = NAN, std = NAN;  ///< std: sample (n - 1) standard deviation, 0 for n = 1
 };
 
@@ -34,7 +34,8 @@ struct SummaryLine {
 };
 
 /// the summary lines in spec order (world, condition, method).
-std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec, const std::vector<BenchmarkRow>& rows);
+std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
+                                   const std::vector<BenchmarkRow>& rows);
 
 /// the summary as a Markdown table (one per world).
 std::string SummaryMarkdown(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines);

@@ -56,7 +56,8 @@ bool Finished(const std::string& out, const BenchmarkJob& j) {
 }
 
 // one line of progress: done / all, elapsed, ETA from the mean time of the jobs done here
-void Progress(bool on, size_t done, size_t all, size_t done_here, size_t failed, Clock::time_point start) {
+void Progress(bool on, size_t done, size_t all, size_t done_here, size_t failed,
+              Clock::time_point start) {
   if (!on) return;
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
   const std::string eta =
@@ -64,8 +65,8 @@ void Progress(bool on, size_t done, size_t all, size_t done_here, size_t failed,
   const int width = 30;
   const int filled = all ? static_cast<int>(width * done / all) : width;
   spdlog::info("benchmark [{}{}] {}/{} jobs{}, {} elapsed{}", std::string(filled, '#'),
-               std::string(width - filled, '.'), done, all, failed ? fmt::format(" ({} failed)", failed) : "",
-               Hms(elapsed), eta);
+               std::string(width - filled, '.'), done, all,
+               failed ? fmt::format(" ({} failed)", failed) : "", Hms(elapsed), eta);
 }
 
 // `command` through popen; its stdout (or nullopt when it cannot run / exits non-zero)
@@ -95,8 +96,9 @@ pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const
     dup2(fd, 1);
     dup2(fd, 2);
     const std::string index = std::to_string(j.index);
-    execl(o.penumbra_binary.c_str(), o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(), "--out",
-          o.out_dir.c_str(), "--job", index.c_str(), "--quiet", static_cast<char*>(nullptr));
+    execl(o.penumbra_binary.c_str(), o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(),
+          "--out", o.out_dir.c_str(), "--job", index.c_str(), "--quiet",
+          static_cast<char*>(nullptr));
     _exit(127);
   }
   return pid;
@@ -105,7 +107,8 @@ pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const
 // runs the unfinished jobs as local worker processes; returns the ids of jobs whose worker
 // failed
 std::vector<std::string> RunLocal(const BenchmarkOptions& o, const BenchmarkSpec& spec,
-                                  const std::vector<BenchmarkJob>& jobs, int workers, Clock::time_point start) {
+                                  const std::vector<BenchmarkJob>& jobs, int workers,
+                                  Clock::time_point start) {
   std::vector<const BenchmarkJob*> pending;
   size_t done = 0;
   for (const BenchmarkJob& j : jobs)
@@ -161,32 +164,40 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
   for (const BenchmarkJob& j : jobs)
     if (!Finished(o.out_dir, j)) pending.push_back(j.index);
   if (pending.size() < jobs.size())
-    spdlog::info("{} of {} jobs finished earlier: not submitted", jobs.size() - pending.size(), jobs.size());
+    spdlog::info("{} of {} jobs finished earlier: not submitted", jobs.size() - pending.size(),
+                 jobs.size());
   if (pending.empty()) return {};
   if (!Capture("command -v sbatch"))
-    throw ConfigError("", 0, "--slurm", "sbatch not found; expected Slurm's client commands (slurm-client) on PATH");
+    throw ConfigError("", 0, "--slurm",
+                      "sbatch not found; expected Slurm's client commands (slurm-client) on PATH");
   const fs::path dir = fs::path(o.out_dir) / "slurm";
   fs::create_directories(dir);
   const fs::path script = dir / "array.sbatch";
   WriteText(script, SlurmBatchScript(spec, o.out_dir, o.penumbra_binary, pending));
   int code = 0;
-  const std::optional<std::string> submitted = Capture("sbatch --parsable " + ShellQuote(script.string()) + " 2>&1", &code);
-  if (!submitted) throw Error("sbatch " + script.string() + " failed (exit " + std::to_string(code) + ")");
+  const std::optional<std::string> submitted =
+      Capture("sbatch --parsable " + ShellQuote(script.string()) + " 2>&1", &code);
+  if (!submitted)
+    throw Error("sbatch " + script.string() + " failed (exit " + std::to_string(code) + ")");
   const std::string job_id = submitted->substr(0, submitted->find_first_of(";\n"));
-  spdlog::info("submitted Slurm job array {} ({} tasks): {}", job_id, pending.size(), script.string());
+  spdlog::info("submitted Slurm job array {} ({} tasks): {}", job_id, pending.size(),
+               script.string());
   size_t last = SIZE_MAX;
   for (;;) {
     if (o.stop_request && o.stop_request->load() != 0) {
       Capture("scancel " + job_id);
       throw Error("interrupted: Slurm job " + job_id + " cancelled; run again to resume");
     }
-    const std::optional<std::string> queued = Capture("squeue -h -j " + job_id + " -o %i 2>/dev/null");
+    const std::optional<std::string> queued =
+        Capture("squeue -h -j " + job_id + " -o %i 2>/dev/null");
     size_t done = 0;
     for (const BenchmarkJob& j : jobs) done += Finished(o.out_dir, j) ? 1 : 0;
-    if (done != last) Progress(o.progress, done, jobs.size(), done - (jobs.size() - pending.size()), 0, start);
+    if (done != last)
+      Progress(o.progress, done, jobs.size(), done - (jobs.size() - pending.size()), 0, start);
     last = done;
     if (queued && queued->find_first_not_of(" \n") == std::string::npos) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(spec.slurm_poll_sec * 1000)));
+    std::this_thread::sleep_for(
+        std::chrono::milliseconds(static_cast<int>(spec.slurm_poll_sec * 1000)));
   }
   std::vector<std::string> failed;
   for (int i : pending)
@@ -209,11 +220,12 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
   s += "#SBATCH --job-name=penumbra-" + spec.name + "\n";
   s += "#SBATCH --array=" + array + "\n";
   s += "#SBATCH --output=" + out + "/slurm/%A_%a.out\n";
-  s += "#SBATCH --cpus-per-task=" + std::to_string(spec.render_threads > 0 ? spec.render_threads : 1) + "\n";
+  s += "#SBATCH --cpus-per-task=" +
+       std::to_string(spec.render_threads > 0 ? spec.render_threads : 1) + "\n";
   for (const std::string& l : spec.sbatch_lines) s += l + "\n";
   s += "# one benchmark job (world x condition x trial) per array task; docs/benchmarks.md\n";
-  s += "exec " + ShellQuote(penumbra_binary) + " benchmark " + ShellQuote(spec.file) + " --out " + ShellQuote(out) +
-       " --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n";
+  s += "exec " + ShellQuote(penumbra_binary) + " benchmark " + ShellQuote(spec.file) + " --out " +
+       ShellQuote(out) + " --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n";
   return s;
 }
 
@@ -224,20 +236,22 @@ void RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir
   std::error_code ec;
   if (!fs::is_regular_file(copy, ec) || ReadText(copy) != ReadText(spec.file))
     throw ConfigError(spec.file, 0, "",
-                      "differs from " + copy.string() + " (or that is missing); expected the spec the benchmark in '" +
-                          out_dir + "' was started with");
+                      "differs from " + copy.string() +
+                          " (or that is missing); expected the spec the benchmark in '" + out_dir +
+                          "' was started with");
   const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(spec);
   if (index < 0 || index >= static_cast<int>(jobs.size()))
-    throw ConfigError("", 0, "--job", "index " + std::to_string(index) + " out of range; expected 0.." +
-                                          std::to_string(jobs.size() - 1));
+    throw ConfigError("", 0, "--job",
+                      "index " + std::to_string(index) + " out of range; expected 0.." +
+                          std::to_string(jobs.size() - 1));
   BenchmarkJobContext context;
   context.out_dir = out_dir;
   context.penumbra_binary = penumbra_binary;
   context.stop_request = stop_request;
   const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, jobs[index], context);
   for (const BenchmarkRow& r : rows)
-    spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial, r.status, r.detail,
-                 r.ate_rmse_m);
+    spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial,
+                 r.status, r.detail, r.ate_rmse_m);
 }
 
 int RunBenchmark(const BenchmarkOptions& o) {
@@ -248,21 +262,27 @@ int RunBenchmark(const BenchmarkOptions& o) {
   const fs::path copy = out / "spec.yaml";
   std::error_code ec;
   if (o.force)
-    for (const char* p : {"spec.yaml", "recordings", "jobs", "logs", "slurm", "plots", "results.csv", "summary.md",
-                          "summary.csv", "report.md"})
+    for (const char* p : {"spec.yaml", "recordings", "jobs", "logs", "slurm", "plots",
+                          "results.csv", "summary.md", "summary.csv", "report.md"})
       fs::remove_all(out / p);
   if (fs::is_regular_file(copy, ec) && ReadText(copy) != ReadText(spec.file))
-    throw ConfigError("", 0, "--out",
-                      "'" + o.out_dir + "' holds the results of another spec (its spec.yaml differs from " + spec.file +
-                          "); expected the same spec to resume, --force to start again, or another folder");
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + o.out_dir + "' holds the results of another spec (its spec.yaml differs from " +
+            spec.file +
+            "); expected the same spec to resume, --force to start again, or another folder");
   if (!fs::exists(copy, ec) && fs::exists(out, ec) && !fs::is_empty(out, ec))
-    throw ConfigError("", 0, "--out", "'" + o.out_dir + "' is not empty and holds no benchmark; expected a new or empty folder");
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + o.out_dir + "' is not empty and holds no benchmark; expected a new or empty folder");
   fs::create_directories(out / "recordings");
   WriteText(copy, ReadText(spec.file));
 
   const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(spec);
-  spdlog::info("benchmark '{}': {} world(s) x {} condition(s) x {} trial(s) = {} jobs, {} method(s)", spec.name,
-               spec.worlds.size(), spec.conditions.size(), spec.seeds.size(), jobs.size(), spec.methods.size());
+  spdlog::info(
+      "benchmark '{}': {} world(s) x {} condition(s) x {} trial(s) = {} jobs, {} method(s)",
+      spec.name, spec.worlds.size(), spec.conditions.size(), spec.seeds.size(), jobs.size(),
+      spec.methods.size());
   // 1. the routes, recorded once
   for (const BenchmarkWorld& w : spec.worlds) {
     const std::string plog = RecordingPath(o.out_dir, w);
@@ -282,7 +302,8 @@ int RunBenchmark(const BenchmarkOptions& o) {
   std::vector<BenchmarkRow> rows;
   for (const BenchmarkJob& j : jobs)
     if (Finished(o.out_dir, j))
-      for (BenchmarkRow& r : ReadJobResult(JobResultPath(o.out_dir, j))) rows.push_back(std::move(r));
+      for (BenchmarkRow& r : ReadJobResult(JobResultPath(o.out_dir, j)))
+        rows.push_back(std::move(r));
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   WriteBenchmarkReport(spec, o.out_dir, rows, wall);
   spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", rows.size(), o.out_dir, Hms(wall));
@@ -291,7 +312,9 @@ int RunBenchmark(const BenchmarkOptions& o) {
     return 130;
   }
   if (!failed.empty()) {
-    spdlog::error("{} job(s) failed in the harness (not a method's failure): their rows are missing", failed.size());
+    spdlog::error(
+        "{} job(s) failed in the harness (not a method's failure): their rows are missing",
+        failed.size());
     return 1;
   }
   return 0;

@@ -18,7 +18,8 @@
 namespace penumbra {
 
 /// records `world`'s route into the run log `plog_path` (penumbra run --record, no cameras).
-using RecordRouteFn = std::function<void(const BenchmarkWorld& world, const std::string& plog_path)>;
+using RecordRouteFn =
+    std::function<void(const BenchmarkWorld& world, const std::string& plog_path)>;
 
 /// what `penumbra benchmark` is asked for.
 struct BenchmarkOptions {

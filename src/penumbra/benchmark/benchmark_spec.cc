@@ -1,5 +1,7 @@
 #include "penumbra/benchmark/benchmark_spec.h"
 
+#include <stdlib.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -8,8 +10,6 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <stdlib.h>
-#include <unistd.h>
 
 #include "penumbra/core/error.h"
 #include "penumbra/replay/world_override.h"
@@ -38,13 +38,16 @@ std::string Name(const YamlReader& r) {
 
 double Positive(const YamlReader& r, double hi) {
   const double v = r.Double();
-  if (!(v > 0 && v <= hi)) r.Fail("out of range; expected a number in (0, " + FormatNumber(hi) + "]");
+  if (!(v > 0 && v <= hi))
+    r.Fail("out of range; expected a number in (0, " + FormatNumber(hi) + "]");
   return v;
 }
 
 AlignmentModel Align(const YamlReader& r) {
   const std::string s = r.Enum({"se3", "sim3", "none"});
-  return s == "sim3" ? AlignmentModel::kSim3 : s == "none" ? AlignmentModel::kNone : AlignmentModel::kSe3;
+  return s == "sim3"   ? AlignmentModel::kSim3
+         : s == "none" ? AlignmentModel::kNone
+                       : AlignmentModel::kSe3;
 }
 
 // checks that every {placeholder} of a template is known; `{{` and `}}` are literal braces
@@ -59,15 +62,18 @@ void CheckTemplate(const YamlReader& r, const std::string& text) {
       ++i;
       continue;
     }
-    if (text[i] == '}') r.Fail("unmatched '}' at column " + std::to_string(i + 1) + "; write '}}' for a brace");
+    if (text[i] == '}')
+      r.Fail("unmatched '}' at column " + std::to_string(i + 1) + "; write '}}' for a brace");
     if (text[i] != '{') continue;
     const size_t end = text.find('}', i);
-    if (end == std::string::npos) r.Fail("unmatched '{' at column " + std::to_string(i + 1) + "; write '{{' for a brace");
+    if (end == std::string::npos)
+      r.Fail("unmatched '{' at column " + std::to_string(i + 1) + "; write '{{' for a brace");
     const std::string key = text.substr(i + 1, end - i - 1);
     if (std::find(known.begin(), known.end(), key) == known.end()) {
       std::string names;
       for (const std::string& k : known) names += (names.empty() ? "{" : ", {") + k + "}";
-      r.Fail("unknown placeholder '{" + SanitizeForMessage(key, 40) + "}'; expected one of: " + names);
+      r.Fail("unknown placeholder '{" + SanitizeForMessage(key, 40) +
+             "}'; expected one of: " + names);
     }
     i = end;
   }
@@ -84,12 +90,14 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   fs::path p = file.String();
   if (p.is_relative()) p = fs::path(dir) / p;
   std::error_code ec;
-  if (!fs::is_regular_file(p, ec)) file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
+  if (!fs::is_regular_file(p, ec))
+    file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
   w.file = fs::weakly_canonical(p).string();
   if (r.Has("duration_sec")) w.duration_sec = Positive(r.Child("duration_sec"), 3600);
   const YamlReader cam = r.Child("camera");
   cam.ExpectMapAnyKeys();
-  if (!cam.Has("name")) cam.Fail("no 'name'; expected a world-file camera with a name (docs/world-file.md)");
+  if (!cam.Has("name"))
+    cam.Fail("no 'name'; expected a world-file camera with a name (docs/world-file.md)");
   const YamlReader cam_name = cam.Child("name");
   w.camera_name = cam_name.String();
   if (w.camera_name.empty() || w.camera_name.find_first_of(" \t\n{}[],:#") != std::string::npos)
@@ -104,7 +112,8 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   return w;
 }
 
-BenchmarkCondition ReadCondition(const YamlReader& r, const std::string& dir, const std::string& file) {
+BenchmarkCondition ReadCondition(const YamlReader& r, const std::string& dir,
+                                 const std::string& file) {
   BenchmarkCondition c;
   if (r.node().IsScalar()) {
     const std::string spec = r.String();
@@ -112,7 +121,8 @@ BenchmarkCondition ReadCondition(const YamlReader& r, const std::string& dir, co
     std::string stem = fs::path(spec.substr(0, spec.find('#'))).stem().string();
     if (spec.find('#') != std::string::npos) stem = spec.substr(spec.find('#') + 1);
     c.name = spec.find(".y") == std::string::npos ? spec : stem;
-    if (!ValidName(c.name)) r.Fail("cannot name the condition '" + spec + "'; write {name: NAME, adversity: SPEC}");
+    if (!ValidName(c.name))
+      r.Fail("cannot name the condition '" + spec + "'; write {name: NAME, adversity: SPEC}");
     return c;
   }
   r.ExpectMap({"name", "adversity"});
@@ -124,28 +134,34 @@ BenchmarkCondition ReadCondition(const YamlReader& r, const std::string& dir, co
 }
 
 BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics) {
-  r.ExpectMap({"name", "bundled", "dataset", "command", "trajectory", "format", "timeout_sec", "align"});
+  r.ExpectMap(
+      {"name", "bundled", "dataset", "command", "trajectory", "format", "timeout_sec", "align"});
   BenchmarkMethod m;
   m.name = Name(r.Child("name"));
   m.align = metrics.align;
   if (r.Has("bundled") == r.Has("command"))
     r.Fail("expected exactly one of 'bundled' (a penumbra slam method) and 'command' (a template)");
   if (r.Has("bundled")) {
-    m.bundled = r.Child("bundled").Enum({"opencv_rgbd", "opencv_icp", "opencv_rgbd_icp", "open3d_rgbd"});
+    m.bundled =
+        r.Child("bundled").Enum({"opencv_rgbd", "opencv_icp", "opencv_rgbd_icp", "open3d_rgbd"});
     for (const char* k : {"dataset", "trajectory", "format"})
-      if (r.Has(k)) r.Child(k).Fail("not allowed with 'bundled' (a bundled method reads TUM and writes TUM)");
-    m.command = "{penumbra} slam " + m.bundled + " {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}";
+      if (r.Has(k))
+        r.Child(k).Fail("not allowed with 'bundled' (a bundled method reads TUM and writes TUM)");
+    m.command =
+        "{penumbra} slam " + m.bundled + " {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}";
   } else {
     const YamlReader c = r.Child("command");
     m.command = c.String();
-    if (m.command.find_first_not_of(" \t") == std::string::npos) c.Fail("empty; expected a command line");
+    if (m.command.find_first_not_of(" \t") == std::string::npos)
+      c.Fail("empty; expected a command line");
     CheckTemplate(c, m.command);
   }
   if (r.Has("dataset")) m.dataset = r.Child("dataset").Enum({"tum", "euroc"});
   if (r.Has("trajectory")) {
     const YamlReader t = r.Child("trajectory");
     m.trajectory = t.String();
-    if (m.trajectory.empty() || fs::path(m.trajectory).is_absolute() || m.trajectory.find("..") != std::string::npos)
+    if (m.trajectory.empty() || fs::path(m.trajectory).is_absolute() ||
+        m.trajectory.find("..") != std::string::npos)
       t.Fail("expected a file name relative to the method's work folder");
   }
   if (r.Has("format")) m.format = r.Child("format").Enum({"tum", "tum_ns"});
@@ -160,7 +176,8 @@ void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera) {
   WorldConfig world = LoadWorldFile(w.file);
   std::string tmpl = (fs::temp_directory_path() / "penumbra_benchmark_camera_XXXXXX.yaml").string();
   const int fd = mkstemps(tmpl.data(), 5);
-  if (fd < 0) throw Error("cannot create a temporary file in " + fs::temp_directory_path().string());
+  if (fd < 0)
+    throw Error("cannot create a temporary file in " + fs::temp_directory_path().string());
   close(fd);
   {
     std::ofstream out(tmpl, std::ios::binary | std::ios::trunc);
@@ -182,8 +199,9 @@ void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera) {
 }  // namespace
 
 const std::vector<std::string>& MethodPlaceholders() {
-  static const std::vector<std::string> kKeys = {"penumbra", "dataset", "output", "workdir", "fx",   "fy",
-                                                 "cx",       "cy",      "width",  "height",  "camera_info", "seed"};
+  static const std::vector<std::string> kKeys = {"penumbra", "dataset", "output",      "workdir",
+                                                 "fx",       "fy",      "cx",          "cy",
+                                                 "width",    "height",  "camera_info", "seed"};
   return kKeys;
 }
 
@@ -200,31 +218,36 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
   try {
     const YAML::Node root = YAML::Load(text.str());
     YamlReader r(root, s.file, nullptr);
-    r.ExpectMap({"name", "worlds", "conditions", "trials", "seeds", "methods", "metrics", "render", "workers",
-                 "keep_datasets", "slurm"});
+    r.ExpectMap({"name", "worlds", "conditions", "trials", "seeds", "methods", "metrics", "render",
+                 "workers", "keep_datasets", "slurm"});
     s.name = r.Has("name") ? Name(r.Child("name")) : fs::path(s.file).stem().string();
     if (r.Has("metrics")) {
       const YamlReader m = r.Child("metrics");
       m.ExpectMap({"align", "rpe_delta_sec", "max_dt_sec"});
       if (m.Has("align")) s.metrics.align = Align(m.Child("align"));
-      if (m.Has("rpe_delta_sec")) s.metrics.rpe_delta_sec = Positive(m.Child("rpe_delta_sec"), 3600);
+      if (m.Has("rpe_delta_sec"))
+        s.metrics.rpe_delta_sec = Positive(m.Child("rpe_delta_sec"), 3600);
       if (m.Has("max_dt_sec")) s.metrics.max_dt_sec = Positive(m.Child("max_dt_sec"), 10);
     }
     std::set<std::string> names;
     const YamlReader worlds = r.Child("worlds");
     for (const YamlReader& w : worlds.List()) {
       s.worlds.push_back(ReadWorld(w, s.dir));
-      if (!names.insert(s.worlds.back().name).second) w.Child("name").Fail("world name appears twice; expected unique names");
+      if (!names.insert(s.worlds.back().name).second)
+        w.Child("name").Fail("world name appears twice; expected unique names");
     }
     if (s.worlds.empty()) worlds.Fail("no worlds; expected at least one");
     names.clear();
     const YamlReader conditions = r.Child("conditions");
     for (const YamlReader& c : conditions.List()) {
       s.conditions.push_back(ReadCondition(c, s.dir, s.file));
-      if (!names.insert(s.conditions.back().name).second) c.Fail("condition name '" + s.conditions.back().name + "' appears twice; expected unique names");
+      if (!names.insert(s.conditions.back().name).second)
+        c.Fail("condition name '" + s.conditions.back().name +
+               "' appears twice; expected unique names");
     }
     if (s.conditions.empty()) conditions.Fail("no conditions; expected at least one");
-    if (r.Has("trials") == r.Has("seeds")) r.Fail("expected exactly one of 'trials' (N: seeds 1..N) and 'seeds' (a list)");
+    if (r.Has("trials") == r.Has("seeds"))
+      r.Fail("expected exactly one of 'trials' (N: seeds 1..N) and 'seeds' (a list)");
     if (r.Has("trials")) {
       const YamlReader t = r.Child("trials");
       const int n = t.Int();
@@ -235,7 +258,8 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       std::set<uint64_t> seen;
       for (const YamlReader& e : seeds.List()) {
         s.seeds.push_back(e.Uint64());
-        if (!seen.insert(s.seeds.back()).second) e.Fail("seed appears twice; expected distinct seeds");
+        if (!seen.insert(s.seeds.back()).second)
+          e.Fail("seed appears twice; expected distinct seeds");
       }
       if (s.seeds.empty()) seeds.Fail("no seeds; expected at least one");
     }
@@ -243,7 +267,8 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
     const YamlReader methods = r.Child("methods");
     for (const YamlReader& m : methods.List()) {
       s.methods.push_back(ReadMethod(m, s.metrics));
-      if (!names.insert(s.methods.back().name).second) m.Child("name").Fail("method name appears twice; expected unique names");
+      if (!names.insert(s.methods.back().name).second)
+        m.Child("name").Fail("method name appears twice; expected unique names");
     }
     if (s.methods.empty()) methods.Fail("no methods; expected at least one");
     if (r.Has("render")) {
@@ -251,13 +276,15 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       rr.ExpectMap({"threads", "tier"});
       if (rr.Has("threads")) {
         s.render_threads = rr.Child("threads").Int();
-        if (s.render_threads < 0 || s.render_threads > 256) rr.Child("threads").Fail("out of range; expected an integer in [0, 256] (0 = all cores)");
+        if (s.render_threads < 0 || s.render_threads > 256)
+          rr.Child("threads").Fail("out of range; expected an integer in [0, 256] (0 = all cores)");
       }
       if (rr.Has("tier")) s.tier = rr.Child("tier").Enum({"realtime", "pathtraced"});
     }
     if (r.Has("workers")) {
       s.workers = r.Child("workers").Int();
-      if (s.workers < 1 || s.workers > 256) r.Child("workers").Fail("out of range; expected an integer in [1, 256]");
+      if (s.workers < 1 || s.workers > 256)
+        r.Child("workers").Fail("out of range; expected an integer in [1, 256]");
     }
     if (r.Has("keep_datasets")) s.keep_datasets = r.Child("keep_datasets").Bool();
     if (r.Has("slurm")) {
@@ -273,7 +300,8 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       if (sl.Has("poll_sec")) s.slurm_poll_sec = Positive(sl.Child("poll_sec"), 600);
     }
   } catch (const YAML::Exception& e) {
-    throw ConfigError(s.file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "YAML syntax error: " + e.msg);
+    throw ConfigError(s.file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
+                      "YAML syntax error: " + e.msg);
   }
   return s;
 }

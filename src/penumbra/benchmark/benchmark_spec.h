@@ -48,11 +48,11 @@ namespace penumbra {
 /// one world (one recorded route).
 struct BenchmarkWorld {
   std::string name;
-  std::string file;           ///< world file, absolute
-  double duration_sec = 0;    ///< 0 = the world's own duration
-  std::string camera_name;    ///< the benchmark camera
-  std::string camera_yaml;    ///< the camera as a one-line YAML mapping (outputs, depth_noise set)
-  int line = 0;               ///< line of the entry in the spec
+  std::string file;         ///< world file, absolute
+  double duration_sec = 0;  ///< 0 = the world's own duration
+  std::string camera_name;  ///< the benchmark camera
+  std::string camera_yaml;  ///< the camera as a one-line YAML mapping (outputs, depth_noise set)
+  int line = 0;             ///< line of the entry in the spec
 };
 
 /// one adversity condition.
@@ -64,13 +64,13 @@ struct BenchmarkCondition {
 /// one SLAM method: a command template over an exported dataset.
 struct BenchmarkMethod {
   std::string name;
-  std::string dataset = "tum";           ///< tum | euroc
-  std::string command;                   ///< template (see the file header)
+  std::string dataset = "tum";                ///< tum | euroc
+  std::string command;                        ///< template (see the file header)
   std::string trajectory = "trajectory.txt";  ///< relative to the method's work folder
-  std::string format = "tum";            ///< tum | tum_ns
+  std::string format = "tum";                 ///< tum | tum_ns
   double timeout_sec = 600;
   AlignmentModel align = AlignmentModel::kSe3;
-  std::string bundled;                   ///< the `penumbra slam` method, "" for a command
+  std::string bundled;  ///< the `penumbra slam` method, "" for a command
 };
 
 /// evaluation settings (docs/evaluation.md).
@@ -90,8 +90,8 @@ struct BenchmarkSpec {
   std::vector<uint64_t> seeds;
   std::vector<BenchmarkMethod> methods;
   BenchmarkMetrics metrics;
-  int render_threads = 1;             ///< per job (0 = all cores)
-  std::string tier = "realtime";      ///< realtime | pathtraced
+  int render_threads = 1;         ///< per job (0 = all cores)
+  std::string tier = "realtime";  ///< realtime | pathtraced
   int workers = 1;
   bool keep_datasets = false;
   std::vector<std::string> sbatch_lines;  ///< extra lines of the Slurm batch script header

@@ -24,7 +24,8 @@ std::string ProcessOutcome::Describe() const {
   return "exit " + std::to_string(exit_code);
 }
 
-std::string FillTemplate(const std::string& text, const std::map<std::string, std::string>& values) {
+std::string FillTemplate(const std::string& text,
+                         const std::map<std::string, std::string>& values) {
   std::string out;
   for (size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
@@ -97,7 +98,8 @@ ProcessOutcome RunShellCommand(const std::string& command, const std::string& wo
     std::this_thread::sleep_for(std::chrono::milliseconds(elapsed < 1 ? 5 : 50));
   }
   kill(-pid, SIGKILL);  // leftovers of the group (a daemonised child)
-  outcome.wall_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  outcome.wall_sec =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
   return outcome;

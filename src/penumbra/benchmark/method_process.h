@@ -13,9 +13,9 @@ namespace penumbra {
 /// how the process ended.
 struct ProcessOutcome {
   bool timed_out = false;
-  bool stopped = false;    ///< killed because of a stop request
-  int exit_code = -1;      ///< when it exited normally
-  int signal = 0;          ///< when a signal ended it (0 = none)
+  bool stopped = false;  ///< killed because of a stop request
+  int exit_code = -1;    ///< when it exited normally
+  int signal = 0;        ///< when a signal ended it (0 = none)
   double wall_sec = 0;
   /// "exit 0", "exit 3", "signal 11 (SIGSEGV)", "timeout after 600 s", ...
   std::string Describe() const;

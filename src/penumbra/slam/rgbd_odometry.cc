@@ -72,8 +72,8 @@ RgbdOdometryResult RunRgbdOdometry(const std::string& method,
                       "OPENCV_ENABLE_NONFREE, so cv::kinfu::KinFu::create refuses to run; "
                       "expected one of: opencv_rgbd, opencv_icp, opencv_rgbd_icp, open3d_rgbd");
   const PinholeIntrinsics& k = options.intrinsics;
-  const cv::Mat camera = (cv::Mat_<float>(3, 3) << float(k.fx), 0.f, float(k.cx), 0.f,
-                          float(k.fy), float(k.cy), 0.f, 0.f, 1.f);
+  const cv::Mat camera = (cv::Mat_<float>(3, 3) << float(k.fx), 0.f, float(k.cx), 0.f, float(k.fy),
+                          float(k.cy), 0.f, 0.f, 1.f);
   const float min_d = float(options.min_depth_m), max_d = float(options.max_depth_m),
               max_diff = float(options.max_depth_diff_m);
   cv::Ptr<cv::rgbd::Odometry> odometry;
@@ -86,7 +86,8 @@ RgbdOdometryResult RunRgbdOdometry(const std::string& method,
   else {
     std::string names;
     for (const std::string& n : RgbdOdometryMethodNames()) names += (names.empty() ? "" : ", ") + n;
-    throw ConfigError("", 0, "method", "unknown method '" + method + "'; expected one of: " + names);
+    throw ConfigError("", 0, "method",
+                      "unknown method '" + method + "'; expected one of: " + names);
   }
 
   RgbdOdometryResult result;
@@ -102,8 +103,8 @@ RgbdOdometryResult RunRgbdOdometry(const std::string& method,
       cv::Mat rt;
       try {
         // src = current, dst = previous: Rt = X_prev_cur (dst_p = Rt src_p)
-        tracked = odometry->compute(cur.gray, cur.depth, cv::Mat(), prev.gray, prev.depth,
-                                    cv::Mat(), rt);
+        tracked =
+            odometry->compute(cur.gray, cur.depth, cv::Mat(), prev.gray, prev.depth, cv::Mat(), rt);
       } catch (const cv::Exception&) {
         tracked = false;  // too few valid pixels etc.: a lost frame
       }

@@ -35,9 +35,9 @@ namespace penumbra {
 /// settings shared by the methods (SI units).
 struct RgbdOdometryOptions {
   PinholeIntrinsics intrinsics;
-  double min_depth_m = 0.2;         ///< depth below is ignored
-  double max_depth_m = 6.0;         ///< depth above is ignored
-  double max_depth_diff_m = 0.07;   ///< OpenCV: largest depth change of a correspondence
+  double min_depth_m = 0.2;        ///< depth below is ignored
+  double max_depth_m = 6.0;        ///< depth above is ignored
+  double max_depth_diff_m = 0.07;  ///< OpenCV: largest depth change of a correspondence
   /// called after each frame with (frames done, frames in all); may be empty.
   std::function<void(int64_t, int64_t)> progress;
   /// @throws ConfigError naming the key for bad intrinsics or depth limits.
@@ -56,8 +56,9 @@ const std::vector<std::string>& RgbdOdometryMethodNames();
 
 /// runs `method` over `frames`.
 /// @throws ConfigError for an unknown method (listing the names), open3d_rgbd (pointing to
-///         penumbra-slam-open3d), opencv_kinfu (naming the OpenCV build gap), or an image that cannot be read or has another size than the
-///         first (naming the file); Error for a failure inside the library.
+///         penumbra-slam-open3d), opencv_kinfu (naming the OpenCV build gap), or an image that
+///         cannot be read or has another size than the first (naming the file); Error for a failure
+///         inside the library.
 RgbdOdometryResult RunRgbdOdometry(const std::string& method,
                                    const std::vector<RgbdFrameFiles>& frames,
                                    const RgbdOdometryOptions& options);

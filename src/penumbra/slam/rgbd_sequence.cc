@@ -40,8 +40,9 @@ std::vector<RgbdFrameFiles> ReadTumRgbdSequence(const std::filesystem::path& fol
     if (!t || !ParseDecimal(t_depth))
       throw ConfigError(list.string(), line_no, "", "a timestamp is not a finite decimal number");
     if (!frames.empty() && !(*t > frames.back().time_sec))
-      throw ConfigError(list.string(), line_no, "",
-                        "timestamp " + t_rgb + " does not increase; expected strictly increasing times");
+      throw ConfigError(
+          list.string(), line_no, "",
+          "timestamp " + t_rgb + " does not increase; expected strictly increasing times");
     frames.push_back({*t, folder / rgb, folder / depth});
   }
   if (frames.empty()) throw ConfigError(list.string(), 0, "", "no frame; expected at least one");
@@ -63,8 +64,7 @@ PinholeIntrinsics ReadCameraInfoIntrinsics(const std::filesystem::path& camera_i
     throw ConfigError(file, 0, "", "expected an object of cameras");
   std::string name = camera;
   if (name.empty()) {
-    if (doc.size() != 1)
-      throw ConfigError(file, 0, "", "several cameras; name one (--camera)");
+    if (doc.size() != 1) throw ConfigError(file, 0, "", "several cameras; name one (--camera)");
     name = doc.begin().key();
   }
   if (!doc.contains(name)) {
