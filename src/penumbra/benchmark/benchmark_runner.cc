@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -214,18 +215,19 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
 std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_dir,
                              const std::string& penumbra_binary, const std::vector<int>& indices) {
   std::string array;
-  for (int i : indices) array += (array.empty() ? "" : ",") + std::to_string(i);
+  for (int i : indices) {
+    if (!array.empty()) array += ',';
+    array += std::to_string(i);
+  }
   const std::string out = fs::absolute(out_dir).lexically_normal().string();
-  std::string s = "#!/bin/bash\n";
-  s += "#SBATCH --job-name=penumbra-" + spec.name + "\n";
-  s += "#SBATCH --array=" + array + "\n";
-  s += "#SBATCH --output=" + out + "/slurm/%A_%a.out\n";
-  s += "#SBATCH --cpus-per-task=" +
-       std::to_string(spec.render_threads > 0 ? spec.render_threads : 1) + "\n";
-  for (const std::string& l : spec.sbatch_lines) s += l + "\n";
+  std::string s = fmt::format(
+      "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH --output={}/slurm/%A_%a.out\n"
+      "#SBATCH --cpus-per-task={}\n",
+      spec.name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
+  for (const std::string& l : spec.sbatch_lines) s += fmt::format("{}\n", l);
   s += "# one benchmark job (world x condition x trial) per array task; docs/benchmarks.md\n";
-  s += "exec " + ShellQuote(penumbra_binary) + " benchmark " + ShellQuote(spec.file) + " --out " +
-       ShellQuote(out) + " --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n";
+  s += fmt::format("exec {} benchmark {} --out {} --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n",
+                   ShellQuote(penumbra_binary), ShellQuote(spec.file), ShellQuote(out));
   return s;
 }
 
