@@ -80,7 +80,11 @@ RgbdOdometryResult RunOpen3dRgbdOdometry(const std::vector<RgbdFrameFiles>& fram
           *cur, *prev, intrinsic, Eigen::Matrix4d::Identity(),
           open3d::pipelines::odometry::RGBDOdometryJacobianFromHybridTerm(), option);
       tracked = ok && T.allFinite();
-      if (tracked) X_C0_prev = X_C0_prev * Pose(T);
+      if (tracked) {
+        Pose X_prev_cur = Pose::Identity();
+        X_prev_cur.matrix() = T;
+        X_C0_prev = X_C0_prev * X_prev_cur;
+      }
     }
     if (tracked) {
       result.trajectory.time_sec.push_back(frames[i].time_sec);

@@ -80,12 +80,17 @@ TEST(BenchmarkEndToEnd, ShortSlamSpecRowsStatusesAndSharedGroundTruth) {
     ASSERT_EQ(row.size(), rows[0].size());
     const std::string method = row[col["method"]], status = row[col["status"]];
     EXPECT_EQ(row[col["frames"]], "16") << "1.5 s at 10 Hz, frames at 0 .. 1.5 s";
-    if (method == "rgbd") {
+    if (method == "rgbd" && row[col["condition"]] == "major" && status != "ok") {
+      // major adversity may break the odometry: recorded as such, never dropped
+      EXPECT_TRUE(status == "failed" || status == "lost") << status;
+      EXPECT_EQ(row[col["ate_rmse_m"]], "");
+    } else if (method == "rgbd") {
       ASSERT_EQ(status, "ok") << row[col["detail"]];
       const double ate = std::stod(row[col["ate_rmse_m"]]);
       EXPECT_GT(ate, 0);
-      if (row[col["condition"]] == "none")
+      if (row[col["condition"]] == "none") {
         EXPECT_LT(ate, 0.05) << "frame-to-frame odometry over 0.7 m of trot";
+      }
       const double tracked = std::stod(row[col["tracked_fraction"]]);
       EXPECT_GT(tracked, 0);
       EXPECT_LE(tracked, 1);
@@ -104,7 +109,7 @@ TEST(BenchmarkEndToEnd, ShortSlamSpecRowsStatusesAndSharedGroundTruth) {
   ASSERT_GT(gt.size(), 100u);
   for (const char* job : {"room__none__t2", "room__major__t1", "room__major__t2"})
     EXPECT_EQ(ReadAll(out / "jobs" / job / "groundtruth.txt"), gt) << job;
-  // the two conditions rendered different images: the estimates differ
+  // the two conditions rendered different images: the estimates differ (or major lost track)
   EXPECT_NE(ReadAll(out / "jobs" / "room__none__t1" / "rgbd" / "estimate.txt"),
             ReadAll(out / "jobs" / "room__major__t1" / "rgbd" / "estimate.txt"));
   EXPECT_TRUE(fs::is_regular_file(out / "report.md"));

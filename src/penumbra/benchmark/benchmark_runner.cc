@@ -290,7 +290,7 @@ int RunBenchmark(const BenchmarkOptions& o) {
     const std::string plog = RecordingPath(o.out_dir, w);
     if (fs::is_regular_file(plog, ec)) continue;
     spdlog::info("recording the route of world '{}' ({})", w.name, w.file);
-    const std::string tmp = plog + ".tmp";
+    const std::string tmp = plog.substr(0, plog.size() - 5) + ".partial.plog";
     fs::remove(tmp, ec);
     o.record(w, tmp);
     fs::rename(tmp, plog);
