@@ -82,10 +82,6 @@ TEST(BenchmarkSpec, ErrorsNameFileLineAndKey) {
   e = ErrorOf(text);
   EXPECT_NE(e.find("spec.yaml:6: worlds[0].camera"), std::string::npos) << e;
   EXPECT_NE(e.find("width"), std::string::npos) << e;
-  text = Spec("");
-  text.replace(text.find("go1/camera_mount"), 16, "go1/nose");
-  e = ErrorOf(text);
-  EXPECT_NE(e.find("worlds[0].camera"), std::string::npos) << e;
   e = ErrorOf("worlds: [\n");
   EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
 }
