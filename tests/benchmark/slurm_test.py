@@ -55,7 +55,7 @@ slurm: {{poll_sec: 0.5, sbatch: ["#SBATCH --time=00:10:00"]}}
         run([binary, "benchmark", spec, "--out", local, "--workers", "2", "--quiet"])
         expected = rows_without_timing(os.path.join(local, "results.csv"))
         assert len(expected) == 4, expected
-        assert all(r["status"] == "ok" for r in expected), expected
+        assert all(r["status"] == "ok" for r in expected if r["condition"] == "none"), expected
         try:
             cluster = SlurmCluster(os.path.join(tmp, "slurm"))
             cluster.__enter__()
