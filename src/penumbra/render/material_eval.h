@@ -74,6 +74,9 @@ struct SurfaceMaterial {
   /// Material::reflectance on planes and on box faces whose geom-frame normal is +z, else 0.
   /// a constant weight (no Fresnel rise at grazing angles), as MuJoCo's.
   float mirror = 0;
+  /// ambient occlusion in [0, 1] from Material::occlusion_texture (1 without): the realtime
+  /// tier multiplies the sky light by it.
+  float occlusion = 1;
 };
 
 /// darkens and smooths an upward-facing surface for rain wetness w in [0, 1] (Lagarde, "Water
@@ -113,6 +116,19 @@ class MaterialEvaluator {
   /// `footprint` (file comment; the default footprint gives bilinear level-0 lookups).
   SurfaceMaterial Evaluate(const SurfaceHit& hit, const TextureFootprint& footprint = {}) const;
 
+  /// true when some material has a normal map (Material::normal_texture).
+  bool has_normal_maps() const { return has_normal_maps_; }
+
+  /// normal mapping: replaces hit->ns_W by the material's normal map (Material::normal_texture)
+  /// at the hit, filtered over `footprint` as the base colour is; no change without a normal
+  /// map. tangent frame (geom frame, then rotated by hit->R_WG): mesh texcoords, t = dp/du and
+  /// b = -dp/dv of the hit triangle (the pseudo-inverse of SurfaceHit::duv_dp_G), Gram-Schmidt
+  /// against the interpolated normal; planar mapping, the mapping's face axes. the mapped
+  /// normal n = normalize(x t + y b + z n_s) with (x, y, z) = (2 c - 1) (scale, scale, 1), on
+  /// the side of the geometric normal (flipped with it; a mapped normal that would face away
+  /// from the viewer is bent back to the surface by UsableShadingNormal in the BSDF).
+  void ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& footprint = {}) const;
+
   /// linear rgb of texture `tex` at (s, t) in texture space (1 = one image), wrapped,
   /// trilinear at mip level `lod` (log2 of the footprint in level-0 texels; <= 0: bilinear in
   /// level 0). exposed for tests.
@@ -123,11 +139,20 @@ class MaterialEvaluator {
   Eigen::Vector3f SampleCube(int tex, const Eigen::Vector3f& q, float lod = 0) const;
 
  private:
+  struct Mapping2D;
+  Mapping2D MapAt(const SurfaceHit& hit, const Material& m) const;
+  const float* DecodeFor(const TextureImage& image) const;
+  Eigen::Vector3f Filter2D(const TextureImage& image, const Mapping2D& map, bool aniso,
+                           const Eigen::Vector3f& major_G, const Eigen::Vector3f& minor_G,
+                           const TextureFootprint& footprint) const;
+
   const SceneDescription& scene_;
   Material default_material_;
   std::vector<Eigen::Vector3f> half_extent_G_;  // per geom: local bounding-box half extents
   const float* srgb_to_linear_;                 // 256 entries (SrgbDecodeTable)
+  float linear_decode_[256];                    // c / 255 (TextureImage::Encoding::kLinear)
   int max_anisotropy_ = 1;
+  bool has_normal_maps_ = false;
 };
 
 }  // namespace penumbra

@@ -230,11 +230,14 @@ class Validator {
       }
       if (m.file.empty())
         Fail(path + ".file", "required; expected an MJCF (.xml) or URDF (.urdf) file");
-      if (!EndsWithNoCase(m.file, ".xml") && !EndsWithNoCase(m.file, ".urdf")) {
+      if (!EndsWithNoCase(m.file, ".xml") && !EndsWithNoCase(m.file, ".urdf") &&
+          !IsMeshModelFile(m.file)) {
         Fail(path + ".file", "'" + m.file +
                                  "' has an unknown extension; expected an MJCF (.xml) "
-                                 "or URDF (.urdf) file");
+                                 "or URDF (.urdf) file, or a mesh (.obj, .gltf, .glb, .fbx, "
+                                 ".dae, .stl, .ply)");
       }
+      m.mesh.ValidateOrThrow(w_.file, path);
       std::error_code ec;
       if (!std::filesystem::is_regular_file(m.file, ec)) {
         Fail(path + ".file", "file not found: " + m.file +
@@ -379,6 +382,7 @@ class Validator {
       if (m.metallic) Check(path + ".metallic", *m.metallic, kUnit);
       if (m.specular) Check(path + ".specular", *m.specular, kUnit);
       if (m.emission) Check3(path + ".emission", *m.emission, Range::AtLeast(0));
+      if (m.procedural) m.procedural->ValidateOrThrow(w_.file, m.line, path + ".procedural");
     }
   }
 

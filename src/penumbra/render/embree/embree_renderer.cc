@@ -163,6 +163,17 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       }
     }
     if (buffers.radiance) {
+      // normal maps bend the shading normals the integrators see (after the ground truth,
+      // whose normals stay the surfaces')
+      if (materials_.has_normal_maps()) {
+        for (int i = 0; i < n; ++i) {
+          if (!did_hit[i]) continue;
+          const float d_len = rays[i].d.norm();
+          materials_.ApplyNormalMap(
+              &hits[i], ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
+                                      rays[i].d / d_len, hits[i]));
+        }
+      }
       primary.rays = rays.get();
       primary.hits = hits.get();
       primary.did_hit = did_hit.get();

@@ -1,0 +1,41 @@
+#pragma once
+// the world-file `procedural:` key of a `materials:` entry: a physically based material whose
+// albedo, roughness and normal maps Penumbra generates from a seed (assets/procedural_material.h,
+// docs/assets.md "Procedural materials").
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace penumbra {
+
+class YamlReader;
+
+/// what to generate. the maps tile every `size_m` metres (one image); on primitives (planes,
+/// boxes, ...) they are laid out per metre (texuniform), on meshes with texcoords one image
+/// per texcoord unit.
+struct ProceduralMaterialConfig {
+  /// wood, tiles, concrete, plaster, painted_metal, cardboard, fabric (ProceduralTypes()).
+  std::string type;
+  uint64_t seed = 0;  ///< same seed, same maps (bit-identical)
+  double size_m = 0;  ///< side of one image, m, in (0, 100]; 0 = the type's default
+  int resolution = 512;  ///< texels per side, 16 ... 4096
+  /// linear base colour of the type's palette (tiles, painted_metal, fabric: the colour; the
+  /// others: a tint multiplying their natural colours); unset = the type's default.
+  std::optional<Eigen::Vector3f> color;
+
+  /// @throws ConfigError(file, line, key + ...) for an unknown type or out-of-range value.
+  void ValidateOrThrow(const std::string& file, int line, const std::string& key) const;
+};
+
+/// the procedural types, in documentation order.
+const std::vector<std::string_view>& ProceduralTypes();
+
+/// reads a `procedural:` mapping (type, seed, size_m, resolution, color).
+/// @throws ConfigError naming the line and key for unknown keys, types and bad values.
+ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r);
+
+}  // namespace penumbra
