@@ -191,9 +191,9 @@ class WorldParser {
   }
 
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
-    std::vector<std::string_view> keys = {"name", "file", "pose", "sites", "initial_keyframe",
-                                          "floating_base"};
+    std::vector<std::string_view> keys = {"name", "file", "pose"};
     if (is_robot) keys.insert(keys.end(), {"controller", "sensors"});
+    keys.insert(keys.end(), {"sites", "initial_keyframe", "floating_base"});
     keys.insert(keys.end(), MeshImportKeys().begin(), MeshImportKeys().end());
     r.ExpectMap(keys);
     ModelConfig m;
