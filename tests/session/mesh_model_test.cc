@@ -231,6 +231,26 @@ TEST(MeshModel, ObjInCentimetresWithYUpLandsInMetresWithZUp) {
   EXPECT_NEAR(hi.z(), 2.0, 1e-5);
 }
 
+TEST(MeshModel, FlatMeshesLoad) {
+  // a floor tile: MuJoCo's qhull cannot hull a flat point set, nor its compiler give a flat
+  // mesh in a body an inertia; the generated model keeps it loadable
+  TempDir dir;
+  dir.Write("tile.obj", "v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3 4\n");
+  const WorldConfig world = LoadWorldFile(dir.Write(
+      "world.yaml", "duration_sec: 0.01\nmodels:\n  - {name: tile, file: tile.obj, up_axis: z}\n"));
+  SessionOptions options;
+  options.build_renderer = false;
+  options.add_controllers = false;
+  Session session(world, options);
+  int meshes = 0;
+  for (const Geom& g : session.scene().geoms) {
+    if (g.shape != GeomShape::kMesh) continue;
+    ++meshes;
+    EXPECT_EQ(session.scene().meshes[g.mesh].faces.size(), 2u);
+  }
+  EXPECT_EQ(meshes, 1);
+}
+
 TEST(MeshModel, MalformedMeshFailsNamingTheWorldEntryAndTheFile) {
   TempDir dir;
   const std::string bad = dir.Write("chair.glb", "glTF\x02\x00\x00\x00 not really");

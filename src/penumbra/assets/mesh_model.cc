@@ -77,6 +77,33 @@ std::string MshBytes(const TriangleMesh& mesh) {
   std::vector<Eigen::Vector3f> v = mesh.vertices;
   std::vector<Eigen::Vector3f> n = mesh.normals;
   std::vector<Eigen::Vector2f> t = mesh.texcoords;
+  // a flat mesh (a label, a floor tile): one unreferenced vertex off its plane, or qhull
+  // cannot build MuJoCo's convex hull
+  if (!v.empty() && !mesh.faces.empty()) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero(), area_n = Eigen::Vector3d::Zero();
+    Eigen::Vector3d lo = v[0].cast<double>(), hi = lo;
+    for (const Eigen::Vector3f& p : v) {
+      c += p.cast<double>();
+      lo = lo.cwiseMin(p.cast<double>());
+      hi = hi.cwiseMax(p.cast<double>());
+    }
+    c /= static_cast<double>(v.size());
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      const Eigen::Vector3d a = v[f[0]].cast<double>();
+      area_n += (v[f[1]].cast<double>() - a).cross(v[f[2]].cast<double>() - a);
+    }
+    const double extent = (hi - lo).norm();
+    if (area_n.norm() > 0 && extent > 0) {
+      const Eigen::Vector3d nn = area_n.normalized();
+      double off = 0;
+      for (const Eigen::Vector3f& p : v) off = std::max(off, std::abs((p.cast<double>() - c).dot(nn)));
+      if (off < 1e-6 * extent) {
+        v.push_back((c - 1e-4 * extent * nn).cast<float>());
+        if (!n.empty()) n.push_back(nn.cast<float>());
+        if (!t.empty()) t.push_back(Eigen::Vector2f::Zero());
+      }
+    }
+  }
   while (!v.empty() && v.size() < 4) {
     v.push_back(v.front());
     if (!n.empty()) n.push_back(n.front());
@@ -110,11 +137,12 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
                      XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
                      LinearToSrgb(c.z()));
   }
-  x += "  </asset>\n  <worldbody>\n    <body name=\"root\">\n";
+  // geoms of the world body: MuJoCo computes no inertia for them, so open and flat meshes load
+  x += "  </asset>\n  <worldbody>\n";
   for (const ImportedMesh& m : asset.meshes)
-    x += fmt::format("      <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"/>\n",
+    x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"/>\n",
                      XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name));
-  x += "    </body>\n  </worldbody>\n</mujoco>\n";
+  x += "  </worldbody>\n</mujoco>\n";
   return x;
 }
 

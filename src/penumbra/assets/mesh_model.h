@@ -3,12 +3,13 @@
 // compiles, plus the imported materials that the renderer's scene gets after extraction
 // (docs/assets.md).
 //
-// the generated MJCF (written next to the meshes, "<stem>-<hash>.xml"): one static body
-// "root" at the model origin holding one mesh geom per imported mesh ("<i>_<mesh name>",
-// MuJoCo binary .msh files with positions, normals and texcoords in metres, z up), each with
-// the material "<material name>" (rgba = the base colour factor, sRGB). the geoms collide
-// with MuJoCo's default (the convex hull of each mesh) and are in group 0. as every model,
-// the composer prefixes the names with "<model>/" and places the body at the model pose.
+// the generated MJCF (written next to the meshes, "<stem>-<hash>.xml"): one mesh geom of the
+// world body per imported mesh ("<i>_<mesh name>", MuJoCo binary .msh files with positions,
+// normals and texcoords in metres, z up), each with the material "<material name>" (rgba =
+// the base colour factor, sRGB): static geometry, for which MuJoCo 2.2.2 computes no inertia,
+// so open and flat meshes load (it refuses "mesh volume is too small" in a body). the geoms
+// collide with MuJoCo's default (the convex hull of each mesh) and are in group 0. as every
+// model, the composer prefixes the names with "<model>/" and places the geoms at the model pose.
 // ApplyImportedMaterials then gives the scene's "<model>/<material name>" materials the
 // imported factors and texture images.
 
@@ -30,7 +31,9 @@ struct ImportedModel {
 
 /// MuJoCo 2.2.2's binary .msh bytes of `mesh` (4 int32 counts nvertex, nnormal, ntexcoord,
 /// nface, then float32 positions, normals, texcoords and int32 faces, little-endian). meshes
-/// with fewer than 4 vertices get copies of their first vertex (MuJoCo's minimum).
+/// with fewer than 4 vertices get copies of their first vertex (MuJoCo's minimum); a flat mesh
+/// (all vertices within 1e-6 of its extent from one plane) gets one vertex no face uses,
+/// 1e-4 of its extent behind the plane, so that qhull can build MuJoCo's convex hull.
 std::string MshBytes(const TriangleMesh& mesh);
 
 /// the MJCF text of `asset` (file comment) whose <mesh file>s are `msh_files` (absolute paths,
