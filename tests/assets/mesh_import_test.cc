@@ -158,12 +158,14 @@ TEST(MeshImport, GltfMaterialsBringTheirMapsAndFactors) {
   ASSERT_TRUE(m.base_color && m.normal && m.metallic_roughness);
   EXPECT_EQ(m.base_color->width(), 8);
   EXPECT_EQ(m.base_color->height(), 4);
-  EXPECT_EQ(m.base_color->encoding(), TextureImage::Encoding::kSrgb);
+  // colour codes as in the file
   EXPECT_EQ(m.base_color->rgb_srgb()[0], 200);
   EXPECT_EQ(m.base_color->rgb_srgb()[1], 100);
-  EXPECT_EQ(m.normal->encoding(), TextureImage::Encoding::kLinear);
-  EXPECT_EQ(m.metallic_roughness->encoding(), TextureImage::Encoding::kLinear);
-  EXPECT_FLOAT_EQ(m.normal_scale, 0.5f);
+  // data maps: the decoded value is the file's code / 255 (normal x, y scaled by 0.5 about 0.5)
+  const float* decode = SrgbDecodeTable();
+  EXPECT_NEAR(decode[m.metallic_roughness->rgb_srgb()[1]], 128 / 255.0f, 0.005f);
+  EXPECT_NEAR(decode[m.metallic_roughness->rgb_srgb()[2]], 1.0f, 0.005f);
+  EXPECT_NEAR(decode[m.normal->rgb_srgb()[2]], 1.0f, 0.005f);
   EXPECT_FLOAT_EQ(m.factors.metallic, 0.25f);
   EXPECT_FLOAT_EQ(m.factors.roughness, 0.75f);
   EXPECT_FALSE(m.occlusion);
@@ -198,15 +200,26 @@ TEST(MeshImport, MshBytesFollowMujocosLayout) {
   EXPECT_EQ(b.size(), 16u + 4 * 12 + 4 * 8 + 12);
 }
 
-TEST(MeshImport, LinearTexturesAverageCodesNotLight) {
-  // a 2 x 1 normal-map-like image of codes 0 and 255: its 1 x 1 level is the code mean (128),
-  // where an sRGB image's level is the mean light (188)
-  const TextureImage lin(2, 1, 1, {0, 0, 0, 255, 255, 255}, TextureImage::Encoding::kLinear);
-  const TextureImage srgb(2, 1, 1, {0, 0, 0, 255, 255, 255});
-  ASSERT_EQ(lin.num_levels(), 2);
-  EXPECT_EQ(lin.level(1).rgb_srgb[0], 128);
-  EXPECT_EQ(srgb.level(1).rgb_srgb[0], 188);
-  EXPECT_NE(lin.content_hash(), srgb.content_hash());
+TEST(MeshImport, DataMapsStoreTheirValuesSoThatMipsAverageThem) {
+  // a normal map texel tilted along x (code 255, 128, 128 -> n = (1, 0, 0)) next to a flat one
+  // (128, 128, 255): stored, their 1 x 1 mip level decodes to the mean of the values
+  std::vector<uint8_t> rgb = {255, 128, 128, 128, 128, 255};
+  StoreTexels(TextureMap::kNormal, 1.0f, &rgb);
+  const TextureImage image(2, 1, 1, rgb);
+  const float* decode = SrgbDecodeTable();
+  EXPECT_NEAR(decode[image.level(0).rgb_srgb[0]], 1.0f, 0.005f);
+  EXPECT_NEAR(decode[image.level(0).rgb_srgb[3]], 128 / 255.0f, 0.005f);
+  ASSERT_EQ(image.num_levels(), 2);
+  EXPECT_NEAR(decode[image.level(1).rgb_srgb[0]], 0.5f * (1.0f + 128 / 255.0f), 0.005f);
+  EXPECT_NEAR(decode[image.level(1).rgb_srgb[2]], 0.5f * (128 / 255.0f + 1.0f), 0.005f);
+  // the normal scale halves x and y about 0.5; occlusion strength 0.25 lifts R towards 1
+  std::vector<uint8_t> n = {255, 0, 255};
+  StoreTexels(TextureMap::kNormal, 0.5f, &n);
+  EXPECT_NEAR(decode[n[0]], 0.75f, 0.005f);
+  EXPECT_NEAR(decode[n[1]], 0.25f, 0.005f);
+  std::vector<uint8_t> o = {0, 0, 0};
+  StoreTexels(TextureMap::kOcclusion, 0.25f, &o);
+  EXPECT_NEAR(decode[o[0]], 0.75f, 0.005f);
 }
 
 }  // namespace

@@ -28,9 +28,6 @@ TEST(ProceduralMaterial, SameSeedSameMapsOtherSeedOtherMaps) {
     EXPECT_EQ(a.metal_roughness->rgb_srgb(), b.metal_roughness->rgb_srgb());
     EXPECT_EQ(a.normal->rgb_srgb(), b.normal->rgb_srgb());
     EXPECT_NE(a.albedo->rgb_srgb(), c.albedo->rgb_srgb());
-    EXPECT_EQ(a.albedo->encoding(), TextureImage::Encoding::kSrgb);
-    EXPECT_EQ(a.normal->encoding(), TextureImage::Encoding::kLinear);
-    EXPECT_EQ(a.metal_roughness->encoding(), TextureImage::Encoding::kLinear);
     EXPECT_DOUBLE_EQ(a.size_m, ProceduralDefaultSize(std::string(type)));
   }
 }
@@ -44,17 +41,19 @@ TEST(ProceduralMaterial, MapsVaryAndStayPlausible) {
     const std::vector<uint8_t>& a = m.albedo->rgb_srgb();
     const std::vector<uint8_t>& n = m.normal->rgb_srgb();
     const std::vector<uint8_t>& r = m.metal_roughness->rgb_srgb();
-    double mean = 0, sq = 0;
-    int lo_r = 255, hi_r = 0, tilted = 0;
+    // data maps hold sRGB-encoded values (render/material_eval.h, "PBR maps")
+    const float* decode = SrgbDecodeTable();
+    double mean = 0, sq = 0, lo_r = 1, hi_r = 0;
+    int tilted = 0;
     const size_t texels = a.size() / 3;
     for (size_t i = 0; i < texels; ++i) {
       const double l = (a[3 * i] + a[3 * i + 1] + a[3 * i + 2]) / 3.0;
       mean += l;
       sq += l * l;
-      lo_r = std::min<int>(lo_r, r[3 * i + 1]);
-      hi_r = std::max<int>(hi_r, r[3 * i + 1]);
-      const double nx = 2 * n[3 * i] / 255.0 - 1, ny = 2 * n[3 * i + 1] / 255.0 - 1,
-                   nz = 2 * n[3 * i + 2] / 255.0 - 1;
+      lo_r = std::min<double>(lo_r, decode[r[3 * i + 1]]);
+      hi_r = std::max<double>(hi_r, decode[r[3 * i + 1]]);
+      const double nx = 2 * decode[n[3 * i]] - 1, ny = 2 * decode[n[3 * i + 1]] - 1,
+                   nz = 2 * decode[n[3 * i + 2]] - 1;
       EXPECT_GT(nz, 0.3);
       if (std::hypot(nx, ny) > 0.02) ++tilted;
     }
@@ -62,8 +61,8 @@ TEST(ProceduralMaterial, MapsVaryAndStayPlausible) {
     const double sd = std::sqrt(std::max(0.0, sq / texels - mean * mean));
     EXPECT_GT(sd, 1.0) << "albedo has no variation";
     EXPECT_GT(tilted, static_cast<int>(texels / 50)) << "normal map has no relief";
-    EXPECT_GT(hi_r - lo_r, 5) << "roughness has no variation";
-    EXPECT_GE(lo_r, static_cast<int>(0.1 * 255)) << "rougher than a polished surface";
+    EXPECT_GT(hi_r - lo_r, 0.02) << "roughness has no variation";
+    EXPECT_GE(lo_r, 0.1) << "rougher than a polished surface";
   }
 }
 
@@ -75,12 +74,14 @@ TEST(ProceduralMaterial, TileGroutSitsAtTheTileSize) {
   const std::vector<uint8_t>& a = m.albedo->rgb_srgb();
   const std::vector<uint8_t>& r = m.metal_roughness->rgb_srgb();
   auto lum = [&](int x, int y) { return a[3 * (static_cast<size_t>(y) * n + x)]; };
-  auto rough = [&](int x, int y) { return r[3 * (static_cast<size_t>(y) * n + x) + 1]; };
+  auto rough = [&](int x, int y) {
+    return SrgbDecodeTable()[r[3 * (static_cast<size_t>(y) * n + x) + 1]];
+  };
   for (const int y : {n / 4, 3 * n / 4}) {
     EXPECT_LT(lum(0, y) + 50, lum(n / 4, y));      // grout column at x = 0
     EXPECT_LT(lum(n / 2, y) + 50, lum(n / 4, y));  // and at x = 0.3 m
-    EXPECT_GT(rough(n / 2, y), 200);
-    EXPECT_LT(rough(3 * n / 4, y), 80);
+    EXPECT_GT(rough(n / 2, y), 0.8f);
+    EXPECT_LT(rough(3 * n / 4, y), 0.3f);
   }
   // 10 texels (25 mm) from a grout line is tile again
   EXPECT_GT(lum(n / 2 + 10, n / 4), 150);
@@ -91,17 +92,19 @@ TEST(ProceduralMaterial, ApplyNamesMissingMaterials) {
   Material floor;
   floor.name = "room/floor";
   scene.materials.push_back(floor);
-  MaterialOverride o;
-  o.name = "room/floor";
-  o.procedural = Config("wood", 2, 64);
+  ProceduralMaterialEntry o;
+  o.material = "room/floor";
+  o.config = Config("wood", 2, 64);
   ApplyProceduralMaterials({o}, "w.yaml", &scene);
   const Material& m = scene.materials[0];
   ASSERT_GE(m.texture, 0);
-  ASSERT_GE(m.normal_texture, 0);
-  ASSERT_GE(m.metallic_roughness_texture, 0);
+  EXPECT_EQ(scene.textures[m.texture].name, "room/floor/albedo");
+  ASSERT_EQ(scene.textures.size(), 3u);
+  EXPECT_EQ(scene.textures[1].name, "room/floor/metallic_roughness");
+  EXPECT_EQ(scene.textures[2].name, "room/floor/normal");
   EXPECT_TRUE(m.texuniform);
   EXPECT_NEAR(m.texrepeat.x(), 1 / 1.2, 1e-6);
-  o.name = "room/wall";
+  o.material = "room/wall";
   o.line = 12;
   try {
     ApplyProceduralMaterials({o}, "w.yaml", &scene);

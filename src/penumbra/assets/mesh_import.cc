@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
+#include <tuple>
 
 #include "penumbra/core/error.h"
 
@@ -88,20 +89,20 @@ class TextureLoader {
 
   // texture `type` slot 0 of `mat`, or null when it has none.
   std::shared_ptr<const TextureImage> Load(const aiMaterial* mat, aiTextureType type,
-                                           TextureImage::Encoding encoding,
+                                           TextureMap encoding, float param,
                                            const std::string& material_name) {
     aiString path;
     if (mat->GetTextureCount(type) == 0 || mat->GetTexture(type, 0, &path) != aiReturn_SUCCESS)
       return nullptr;
     const std::string p = path.C_Str();
     if (p.empty()) return nullptr;
-    const auto key = std::make_pair(p, encoding);
+    const auto key = std::make_tuple(p, encoding, param);
     if (auto it = cache_.find(key); it != cache_.end()) return it->second;
     const std::string what = "texture '" + p + "' of material '" + material_name + "'";
     std::shared_ptr<const TextureImage> image;
     try {
       if (const aiTexture* embedded = scene_->GetEmbeddedTexture(p.c_str())) {
-        image = FromEmbedded(*embedded, encoding, what);
+        image = FromEmbedded(*embedded, encoding, param, what);
       } else {
         fs::path tp = fs::path(p);
         if (tp.is_relative()) tp = fs::path(file_).parent_path() / tp;
@@ -109,7 +110,8 @@ class TextureLoader {
         if (!fs::is_regular_file(tp, ec))
           throw Error(what + ": file not found: " + tp.string() +
                       " (relative paths resolve against the mesh file's folder)");
-        image = DecodeTextureImage(ReadFileBytes(tp), encoding, what + " (" + tp.string() + ")");
+        image = DecodeTextureImage(ReadFileBytes(tp), encoding, param,
+                                   what + " (" + tp.string() + ")");
       }
     } catch (const ConfigError&) {
       throw;
@@ -121,12 +123,12 @@ class TextureLoader {
   }
 
  private:
-  static std::shared_ptr<const TextureImage> FromEmbedded(const aiTexture& t,
-                                                          TextureImage::Encoding encoding,
-                                                          const std::string& what) {
+  static std::shared_ptr<const TextureImage> FromEmbedded(const aiTexture& t, TextureMap encoding,
+                                                          float param, const std::string& what) {
     if (t.mHeight == 0) {  // compressed (PNG / JPEG bytes)
       const auto* b = reinterpret_cast<const unsigned char*>(t.pcData);
-      return DecodeTextureImage(std::vector<unsigned char>(b, b + t.mWidth), encoding, what);
+      return DecodeTextureImage(std::vector<unsigned char>(b, b + t.mWidth), encoding, param,
+                                what);
     }
     // raw ARGB8888 texels (aiTexel: b g r a)
     std::vector<uint8_t> rgb(static_cast<size_t>(t.mWidth) * t.mHeight * 3);
@@ -135,15 +137,14 @@ class TextureLoader {
       rgb[3 * i + 1] = t.pcData[i].g;
       rgb[3 * i + 2] = t.pcData[i].b;
     }
+    StoreTexels(encoding, param, &rgb);
     return std::make_shared<const TextureImage>(static_cast<int>(t.mWidth),
-                                                static_cast<int>(t.mHeight), 1, std::move(rgb),
-                                                encoding);
+                                                static_cast<int>(t.mHeight), 1, std::move(rgb));
   }
 
   const aiScene* scene_;
   std::string file_;
-  std::map<std::pair<std::string, TextureImage::Encoding>, std::shared_ptr<const TextureImage>>
-      cache_;
+  std::map<std::tuple<std::string, TextureMap, float>, std::shared_ptr<const TextureImage>> cache_;
 };
 
 ImportedMaterial ReadMaterial(const aiMaterial* mat, bool gltf, const MeshImportConfig& config,
@@ -176,33 +177,52 @@ ImportedMaterial ReadMaterial(const aiMaterial* mat, bool gltf, const MeshImport
     f.emission = Eigen::Vector3f(e.r, e.g, e.b).cwiseMax(0.0f) * strength *
                  static_cast<float>(config.emissive_cd_m2);
   }
-  using Enc = TextureImage::Encoding;
-  out.base_color = textures->Load(mat, aiTextureType_BASE_COLOR, Enc::kSrgb, name);
-  if (!out.base_color) out.base_color = textures->Load(mat, aiTextureType_DIFFUSE, Enc::kSrgb, name);
-  out.normal = textures->Load(mat, aiTextureType_NORMALS, Enc::kLinear, name);
+  out.base_color = textures->Load(mat, aiTextureType_BASE_COLOR, TextureMap::kColour, 0, name);
+  if (!out.base_color)
+    out.base_color = textures->Load(mat, aiTextureType_DIFFUSE, TextureMap::kColour, 0, name);
+  float normal_scale = 1;
+  if (gltf &&
+      mat->Get(AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0), v) == aiReturn_SUCCESS)
+    normal_scale = v;
+  out.normal = textures->Load(mat, aiTextureType_NORMALS, TextureMap::kNormal, normal_scale, name);
   if (gltf) {
     // assimp 5.2's glTF importer: metallicRoughnessTexture in the UNKNOWN slot (also METALNESS)
-    out.metallic_roughness = textures->Load(mat, aiTextureType_UNKNOWN, Enc::kLinear, name);
+    out.metallic_roughness =
+        textures->Load(mat, aiTextureType_UNKNOWN, TextureMap::kData, 0, name);
     if (!out.metallic_roughness)
-      out.metallic_roughness = textures->Load(mat, aiTextureType_METALNESS, Enc::kLinear, name);
-    out.occlusion = textures->Load(mat, aiTextureType_LIGHTMAP, Enc::kLinear, name);
+      out.metallic_roughness =
+          textures->Load(mat, aiTextureType_METALNESS, TextureMap::kData, 0, name);
+    float strength = 1;
+    if (mat->Get(AI_MATKEY_GLTF_TEXTURE_STRENGTH(aiTextureType_LIGHTMAP, 0), v) == aiReturn_SUCCESS)
+      strength = std::clamp(v, 0.0f, 1.0f);
+    out.occlusion =
+        textures->Load(mat, aiTextureType_LIGHTMAP, TextureMap::kOcclusion, strength, name);
     if (!out.occlusion)
-      out.occlusion = textures->Load(mat, aiTextureType_AMBIENT_OCCLUSION, Enc::kLinear, name);
-    if (out.normal && mat->Get(AI_MATKEY_GLTF_TEXTURE_SCALE(aiTextureType_NORMALS, 0), v) ==
-                          aiReturn_SUCCESS)
-      out.normal_scale = v;
-    if (out.occlusion && mat->Get(AI_MATKEY_GLTF_TEXTURE_STRENGTH(aiTextureType_LIGHTMAP, 0), v) ==
-                             aiReturn_SUCCESS)
-      out.occlusion_strength = std::clamp(v, 0.0f, 1.0f);
+      out.occlusion = textures->Load(mat, aiTextureType_AMBIENT_OCCLUSION, TextureMap::kOcclusion,
+                                     strength, name);
   }
-  out.emissive = textures->Load(mat, aiTextureType_EMISSIVE, Enc::kSrgb, name);
+  out.emissive = textures->Load(mat, aiTextureType_EMISSIVE, TextureMap::kColour, 0, name);
   return out;
 }
 
 }  // namespace
 
+void StoreTexels(TextureMap map, float param, std::vector<uint8_t>* rgb) {
+  if (map == TextureMap::kColour) return;
+  std::vector<uint8_t>& p = *rgb;
+  for (size_t i = 0; i + 2 < p.size(); i += 3) {
+    float v[3] = {p[i] / 255.0f, p[i + 1] / 255.0f, p[i + 2] / 255.0f};
+    if (map == TextureMap::kNormal) {
+      for (int c = 0; c < 2; ++c) v[c] = std::clamp(0.5f + (v[c] - 0.5f) * param, 0.0f, 1.0f);
+    } else if (map == TextureMap::kOcclusion) {
+      v[0] = std::clamp(1.0f + param * (v[0] - 1.0f), 0.0f, 1.0f);
+    }
+    for (int c = 0; c < 3; ++c) p[i + c] = EncodeSrgb8(v[c]);
+  }
+}
+
 std::shared_ptr<const TextureImage> DecodeTextureImage(const std::vector<unsigned char>& bytes,
-                                                       TextureImage::Encoding encoding,
+                                                       TextureMap map, float param,
                                                        const std::string& what) {
   cv::Mat img;
   if (!bytes.empty()) img = cv::imdecode(bytes, cv::IMREAD_COLOR);
@@ -215,7 +235,8 @@ std::shared_ptr<const TextureImage> DecodeTextureImage(const std::vector<unsigne
   for (int y = 0; y < rgb.rows; ++y)
     std::copy_n(rgb.ptr<uint8_t>(y), static_cast<size_t>(rgb.cols) * 3,
                 data.data() + static_cast<size_t>(y) * rgb.cols * 3);
-  return std::make_shared<const TextureImage>(rgb.cols, rgb.rows, 1, std::move(data), encoding);
+  StoreTexels(map, param, &data);
+  return std::make_shared<const TextureImage>(rgb.cols, rgb.rows, 1, std::move(data));
 }
 
 ImportedAsset ImportMeshFile(const std::string& path, const MeshImportConfig& config) {

@@ -24,7 +24,11 @@
 //  - emission in cd/m^2: the emissive colour times MeshImportConfig::emissive_cd_m2.
 // texture images: PNG or JPEG, external (relative to the mesh file) or embedded (.glb, FBX),
 // decoded with OpenCV imgcodecs to 8-bit RGB; alpha is dropped (alpha modes are not
-// supported: every surface is opaque).
+// supported: every surface is opaque). data maps (normal, metallic-roughness, occlusion) are
+// stored as the renderer keeps every map (render/material_eval.h, "PBR maps"): each value
+// v = code / 255 sRGB-encoded (EncodeSrgb8), so that mip levels average the values; the
+// normal scale (x and y of 2 v - 1 times it) and the occlusion strength (1 + s (o - 1)) are
+// applied to the texels here.
 
 #include <memory>
 #include <string>
@@ -42,13 +46,11 @@ struct ImportedMaterial {
   /// made unique by a suffix "_<index>" when needed; "default" when unnamed.
   std::string name;
   /// the constant factors: base_color (linear), roughness, metallic, emission (cd/m^2).
-  /// the texture indices of this Material are not used (the images are below).
+  /// the texture index of this Material is not used (the images are below).
   Material factors;
-  /// 8-bit images or null: base colour and emissive sRGB-encoded, the rest linear
-  /// (TextureImage::Encoding).
+  /// images or null (file comment: the data maps hold sRGB-encoded values, with the normal
+  /// scale and occlusion strength applied).
   std::shared_ptr<const TextureImage> base_color, normal, metallic_roughness, occlusion, emissive;
-  float normal_scale = 1;        ///< glTF normalTexture.scale: xy of the tangent normal times it
-  float occlusion_strength = 1;  ///< glTF occlusionTexture.strength
 };
 
 /// a triangle mesh of an imported file, in the model frame (metres, z up).
@@ -73,10 +75,22 @@ struct ImportedAsset {
 ///         or not a readable image (naming the texture), or when a coordinate is not finite.
 ImportedAsset ImportMeshFile(const std::string& path, const MeshImportConfig& config);
 
-/// decodes a PNG or JPEG file's bytes into an 8-bit RGB TextureImage of `encoding`.
+/// how the texels of a decoded image are stored (file comment).
+enum class TextureMap {
+  kColour,  ///< base colour, emissive: the sRGB codes as they are
+  kData,    ///< metallic-roughness: each value v = code / 255, sRGB-encoded
+  kNormal,  ///< data; x and y of n = 2 v - 1 scaled by `param` (glTF normalTexture.scale)
+  kOcclusion,  ///< data; R becomes 1 + param (R - 1) (glTF occlusionTexture.strength)
+};
+
+/// decodes a PNG or JPEG file's bytes into an 8-bit RGB TextureImage stored as `map` says.
 /// @throws Error naming `what` when the bytes are not a readable image.
 std::shared_ptr<const TextureImage> DecodeTextureImage(const std::vector<unsigned char>& bytes,
-                                                       TextureImage::Encoding encoding,
+                                                       TextureMap map, float param,
                                                        const std::string& what);
+
+/// RGB codes (3 per texel) of map kind `map` as stored (the colour codes unchanged, data
+/// values sRGB-encoded, see TextureMap), in place.
+void StoreTexels(TextureMap map, float param, std::vector<uint8_t>* rgb);
 
 }  // namespace penumbra

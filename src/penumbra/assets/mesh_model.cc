@@ -165,12 +165,13 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
     const std::string key = (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".file";
     ImportedModel im;
     im.model = m.name;
+    const MeshImportConfig config = MeshImportConfigOf(world_file, m.key);
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      im.asset = ImportMeshFile(m.file, m.mesh);
+      im.asset = ImportMeshFile(m.file, config);
     } catch (const ConfigError& e) {
       // name the world-file entry; the problem names the mesh file
-      throw ConfigError(world_file, m.mesh.line, key,
+      throw ConfigError(world_file, config.line, key,
                         "cannot import mesh file " + e.file() + ": " + e.problem());
     }
     im.import_sec =
@@ -211,13 +212,12 @@ void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescr
         scene->textures.push_back(std::move(t));
         return static_cast<int>(scene->textures.size()) - 1;
       };
+      // the maps by name (render/material_eval.h, "PBR maps")
       m.texture = add(mat.base_color, "base_color");
-      m.normal_texture = add(mat.normal, "normal");
-      m.normal_scale = mat.normal_scale;
-      m.metallic_roughness_texture = add(mat.metallic_roughness, "metallic_roughness");
-      m.occlusion_texture = add(mat.occlusion, "occlusion");
-      m.occlusion_strength = mat.occlusion_strength;
-      m.emissive_texture = add(mat.emissive, "emissive");
+      add(mat.normal, "normal");
+      add(mat.metallic_roughness, "metallic_roughness");
+      add(mat.occlusion, "occlusion");
+      add(mat.emissive, "emissive");
     }
   }
 }

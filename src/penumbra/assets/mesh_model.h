@@ -40,10 +40,11 @@ std::string MshBytes(const TriangleMesh& mesh);
 /// one per asset.meshes entry).
 std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files);
 
-/// imports every model of `models` whose file is a mesh (IsMeshModelFile) and points its
-/// `file` at the generated MJCF in `dir` (created if missing; "" = the folder
-/// "penumbra-mesh-models" in the system's temporary folder). files are named by a hash of
-/// their content, so a second import writes nothing new. other models are left alone.
+/// imports every model of `models` whose file is a mesh (IsMeshModelFile), with the mesh keys
+/// of its world-file entry (MeshImportConfigOf(world_file, key)), and points its `file` at the
+/// generated MJCF in `dir` (created if missing; "" = the folder "penumbra-mesh-models" in the
+/// system's temporary folder). files are named by a hash of their content, so a second
+/// import writes nothing new. other models are left alone.
 /// @throws ConfigError naming the world file `world_file`, the entry's line and key when the
 ///         mesh cannot be imported (the message names the mesh file), or Error when a file
 ///         cannot be written.
@@ -52,9 +53,9 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
                                             const std::string& world_file);
 
 /// gives every material "<model>/<name>" of `scene` that an imported model defines its
-/// factors and images: base_color, roughness, metallic, emission, and the base colour,
-/// normal, metallic-roughness, occlusion and emissive textures (added to scene->textures as
-/// 2d textures named "<model>/<name>/<map>").
+/// factors and images: base_color, roughness, metallic, emission, the base colour texture
+/// (Material::texture), and the normal, metallic-roughness, occlusion and emissive maps as 2d
+/// textures named "<model>/<name>/normal", ... (render/material_eval.h, "PBR maps").
 /// @throws Error when such a material is missing from the scene (a composer bug).
 void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescription* scene);
 

@@ -259,9 +259,8 @@ Eigen::Vector3f DefaultColour(const std::string& type) {
   return {1, 1, 1};  // wood: its own palette, untinted
 }
 
-std::shared_ptr<const TextureImage> MakeImage(int n, std::vector<uint8_t> bytes,
-                                              TextureImage::Encoding e) {
-  return std::make_shared<const TextureImage>(n, n, 1, std::move(bytes), e);
+std::shared_ptr<const TextureImage> MakeImage(int n, std::vector<uint8_t> bytes) {
+  return std::make_shared<const TextureImage>(n, n, 1, std::move(bytes));
 }
 
 }  // namespace
@@ -300,9 +299,10 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
       const Texel tx = (gen.*fn)((x + 0.5f) / n, (y + 0.5f) / n);
       const size_t i = static_cast<size_t>(y) * n + x;
       for (int c = 0; c < 3; ++c) albedo[3 * i + c] = EncodeSrgb8(tx.albedo[c]);
+      // data maps hold sRGB-encoded values (render/material_eval.h, "PBR maps")
       mr[3 * i] = 0;
-      mr[3 * i + 1] = static_cast<uint8_t>(std::lround(std::clamp(tx.roughness, 0.0f, 1.0f) * 255));
-      mr[3 * i + 2] = static_cast<uint8_t>(std::lround(std::clamp(tx.metallic, 0.0f, 1.0f) * 255));
+      mr[3 * i + 1] = EncodeSrgb8(tx.roughness);
+      mr[3 * i + 2] = EncodeSrgb8(tx.metallic);
       height[i] = tx.height_m;
     }
   // normals by central differences (wrapped), x along +u, y towards the top row
@@ -315,29 +315,26 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
       Eigen::Vector3f nn(-dhdx, -dhdy, 1);
       nn.normalize();
       const size_t i = static_cast<size_t>(y) * n + x;
-      for (int c = 0; c < 3; ++c)
-        normal[3 * i + c] =
-            static_cast<uint8_t>(std::lround(std::clamp((nn[c] + 1) * 0.5f, 0.0f, 1.0f) * 255));
+      for (int c = 0; c < 3; ++c) normal[3 * i + c] = EncodeSrgb8((nn[c] + 1) * 0.5f);
     }
-  out.albedo = MakeImage(n, std::move(albedo), TextureImage::Encoding::kSrgb);
-  out.metal_roughness = MakeImage(n, std::move(mr), TextureImage::Encoding::kLinear);
-  out.normal = MakeImage(n, std::move(normal), TextureImage::Encoding::kLinear);
+  out.albedo = MakeImage(n, std::move(albedo));
+  out.metal_roughness = MakeImage(n, std::move(mr));
+  out.normal = MakeImage(n, std::move(normal));
   return out;
 }
 
-void ApplyProceduralMaterials(const std::vector<MaterialOverride>& overrides,
+void ApplyProceduralMaterials(const std::vector<ProceduralMaterialEntry>& entries,
                               const std::string& world_file, SceneDescription* scene) {
-  for (const MaterialOverride& o : overrides) {
-    if (!o.procedural) continue;
-    const int k = scene->FindMaterial(o.name);
+  for (const ProceduralMaterialEntry& o : entries) {
+    const int k = scene->FindMaterial(o.material);
     if (k < 0)
-      throw ConfigError(world_file, o.line, "materials." + o.name,
+      throw ConfigError(world_file, o.line, "materials." + o.material,
                         "no material with that name; expected a prefixed material name such as "
                         "'<model>/<material>'");
-    const ProceduralMaps maps = GenerateProceduralMaterial(*o.procedural);
+    const ProceduralMaps maps = GenerateProceduralMaterial(o.config);
     auto add = [&](const std::shared_ptr<const TextureImage>& image, const char* map) {
       Texture t;
-      t.name = o.name + "/" + map;
+      t.name = o.material + "/" + map;
       t.kind = Texture::Kind::k2D;
       t.image = image;
       scene->textures.push_back(std::move(t));
@@ -345,9 +342,8 @@ void ApplyProceduralMaterials(const std::vector<MaterialOverride>& overrides,
     };
     Material& m = scene->materials[k];
     m.texture = add(maps.albedo, "albedo");
-    m.metallic_roughness_texture = add(maps.metal_roughness, "metallic_roughness");
-    m.normal_texture = add(maps.normal, "normal");
-    m.normal_scale = 1;
+    add(maps.metal_roughness, "metallic_roughness");
+    add(maps.normal, "normal");
     m.base_color = Eigen::Vector3f::Ones();
     m.roughness = 1;
     m.metallic = 1;

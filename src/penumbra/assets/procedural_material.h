@@ -24,15 +24,15 @@
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/texture_image.h"
 #include "penumbra/world/procedural_material_config.h"
-#include "penumbra/world/world_config.h"
 
 namespace penumbra {
 
-/// the maps of one procedural material and the image side they tile with.
+/// the maps of one procedural material and the image side they tile with. the data maps hold
+/// sRGB-encoded values (render/material_eval.h, "PBR maps").
 struct ProceduralMaps {
-  std::shared_ptr<const TextureImage> albedo;           ///< sRGB
-  std::shared_ptr<const TextureImage> metal_roughness;  ///< linear: G roughness, B metallic
-  std::shared_ptr<const TextureImage> normal;           ///< linear tangent-space normals
+  std::shared_ptr<const TextureImage> albedo;           ///< sRGB colour
+  std::shared_ptr<const TextureImage> metal_roughness;  ///< G roughness, B metallic
+  std::shared_ptr<const TextureImage> normal;           ///< tangent-space normals, (n + 1) / 2
   double size_m = 1;                                    ///< metres per image side
 };
 
@@ -43,15 +43,16 @@ double ProceduralDefaultSize(const std::string& type);
 /// @throws Error for an unknown type.
 ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config);
 
-/// for every `materials:` entry of `overrides` with `procedural:`, generates its maps and makes
-/// them the scene material's: texture (albedo), metallic_roughness_texture and normal_texture
-/// (added to scene->textures as "<material>/albedo" ...), base_color 1, roughness and metallic
+/// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps and makes
+/// them the scene material's: texture (albedo, "<material>/albedo"), and the maps
+/// "<material>/metallic_roughness" and "<material>/normal" (render/material_eval.h, "PBR
+/// maps"), added to scene->textures; base_color 1, roughness and metallic
 /// factors 1 (the maps hold them), texuniform on with texrepeat 1 / size_m (one image per
 /// size_m metres on planes and boxes). the entry's own base_color / roughness / ... (applied
 /// after this by the scene assembly) then scale the maps.
 /// @throws ConfigError(world_file, entry line, "materials.<name>", ...) when the scene has no
 ///         material of that name.
-void ApplyProceduralMaterials(const std::vector<MaterialOverride>& overrides,
+void ApplyProceduralMaterials(const std::vector<ProceduralMaterialEntry>& entries,
                               const std::string& world_file, SceneDescription* scene);
 
 }  // namespace penumbra

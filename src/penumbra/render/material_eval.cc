@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 
 #include "penumbra/core/error.h"
 #include "penumbra/scene/texture_image.h"
@@ -217,17 +218,26 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
     : scene_(scene),
       srgb_to_linear_(SrgbDecodeTable()),
       max_anisotropy_(std::max(1, max_anisotropy)) {
-  for (int c = 0; c < 256; ++c) linear_decode_[c] = static_cast<float>(c) / 255.0f;
+  // the PBR maps by name (file comment): "<material>/<map>"
+  std::unordered_map<std::string, int> by_name;
+  for (size_t t = 0; t < scene.textures.size(); ++t)
+    if (scene.textures[t].kind == Texture::Kind::k2D && scene.textures[t].image)
+      by_name.emplace(scene.textures[t].name, static_cast<int>(t));
+  maps_.resize(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const std::string& name = scene.materials[i].name;
+    if (name.empty() || by_name.empty()) continue;
+    auto find = [&](const char* map) {
+      const auto it = by_name.find(name + "/" + map);
+      return it == by_name.end() ? -1 : it->second;
+    };
+    maps_[i].normal = find("normal");
+    maps_[i].metallic_roughness = find("metallic_roughness");
+    maps_[i].occlusion = find("occlusion");
+    maps_[i].emissive = find("emissive");
+    has_normal_maps_ |= maps_[i].normal >= 0;
+  }
   for (const Material& m : scene.materials) {
-    for (const int map : {m.normal_texture, m.metallic_roughness_texture, m.occlusion_texture,
-                          m.emissive_texture}) {
-      if (map < 0) continue;
-      if (map >= static_cast<int>(scene.textures.size()) || !scene.textures[map].image ||
-          scene.textures[map].kind != Texture::Kind::k2D)
-        throw Error("material '" + m.name + "' refers to texture " + std::to_string(map) +
-                    "; expected a 2d texture with an image for its PBR maps");
-    }
-    if (m.normal_texture >= 0) has_normal_maps_ = true;
     if (m.texture < 0) continue;
     if (m.texture >= static_cast<int>(scene.textures.size()))
       throw Error("material '" + m.name + "' refers to missing texture " +
@@ -244,7 +254,7 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
 }
 
 Eigen::Vector3f MaterialEvaluator::Sample2D(int tex, float s, float t, float lod) const {
-  const float* decode = DecodeFor(*scene_.textures[tex].image);
+  const float* decode = srgb_to_linear_;
   return Trilinear(*scene_.textures[tex].image, lod,
                    [&](const TextureLevel& L) { return BilinearWrap(L, decode, s, t); });
 }
@@ -272,7 +282,7 @@ Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q,
   }
   if (!(ma > 0)) return Eigen::Vector3f::Ones();
   const float s = 0.5f * (sc / ma + 1.0f), t = 0.5f * (tc / ma + 1.0f);
-  const float* decode = DecodeFor(*scene_.textures[tex].image);
+  const float* decode = srgb_to_linear_;
   return Trilinear(*scene_.textures[tex].image, lod,
                    [&](const TextureLevel& L) { return BilinearFace(L, decode, face, s, t); });
 }
@@ -357,17 +367,13 @@ MaterialEvaluator::Mapping2D MaterialEvaluator::MapAt(const SurfaceHit& hit,
   return map;
 }
 
-const float* MaterialEvaluator::DecodeFor(const TextureImage& image) const {
-  return image.encoding() == TextureImage::Encoding::kLinear ? linear_decode_ : srgb_to_linear_;
-}
-
 Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Mapping2D& map,
                                             bool aniso, const Eigen::Vector3f& major_G,
                                             const Eigen::Vector3f& minor_G,
                                             const TextureFootprint& footprint) const {
   const float w = static_cast<float>(image.width());
   const float th = static_cast<float>(image.height());
-  const float* decode = DecodeFor(image);
+  const float* decode = srgb_to_linear_;
   auto trilinear = [&](float lod) {
     return Trilinear(image, lod,
                      [&](const TextureLevel& L) { return BilinearWrap(L, decode, map.s, map.t); });
@@ -408,8 +414,9 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     if (shape == GeomShape::kPlane || (shape == GeomShape::kBox && hit.n_G.z() > 0.5f))
       out.mirror = std::min(m.reflectance, 1.0f);
   }
-  const bool pbr_maps =
-      m.metallic_roughness_texture >= 0 || m.occlusion_texture >= 0 || m.emissive_texture >= 0;
+  static const PbrMaps kNoMaps;
+  const PbrMaps& maps = hit.material >= 0 ? maps_[hit.material] : kNoMaps;
+  const bool pbr_maps = maps.metallic_roughness >= 0 || maps.occlusion >= 0 || maps.emissive >= 0;
   // tendons (geom -1) are drawn untextured
   if ((m.texture < 0 && !pbr_maps) || hit.geom < 0) return out;
 
@@ -454,23 +461,22 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
   auto sample = [&](int tex) {
     return Filter2D(*scene_.textures[tex].image, mapping(), aniso, major_G, minor_G, footprint);
   };
-  if (m.metallic_roughness_texture >= 0) {
-    const Eigen::Vector3f c = sample(m.metallic_roughness_texture);
+  if (maps.metallic_roughness >= 0) {
+    const Eigen::Vector3f c = sample(maps.metallic_roughness);
     out.pbr.roughness *= c.y();
     out.pbr.metallic *= c.z();
   }
-  if (m.occlusion_texture >= 0) {
-    const float o = sample(m.occlusion_texture).x();
-    out.occlusion = std::clamp(1.0f + m.occlusion_strength * (o - 1.0f), 0.0f, 1.0f);
-  }
-  if (m.emissive_texture >= 0) out.emission = out.emission.cwiseProduct(sample(m.emissive_texture));
+  if (maps.occlusion >= 0) out.occlusion = std::clamp(sample(maps.occlusion).x(), 0.0f, 1.0f);
+  if (maps.emissive >= 0) out.emission = out.emission.cwiseProduct(sample(maps.emissive));
   return out;
 }
 
 void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& footprint) const {
-  if (hit->material < 0 || hit->geom < 0) return;
+  if (hit->material < 0 || hit->geom < 0 || hit->geom >= static_cast<int>(R_WG_.size())) return;
+  const int normal_map = maps_[hit->material].normal;
+  if (normal_map < 0) return;
   const Material& m = scene_.materials[hit->material];
-  if (m.normal_texture < 0) return;
+  const Eigen::Matrix3f& R_WG = R_WG_[hit->geom];
   const Mapping2D map = MapAt(*hit, m);
   // tangent t (increasing s) and bitangent b (towards the image's top row: decreasing t), geom
   // frame: the columns of the pseudo-inverse of J restricted to the surface.
@@ -491,17 +497,16 @@ void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& 
   Eigen::Vector3f major_G, minor_G;
   const bool aniso = max_anisotropy_ > 1 && FootprintAxes(*hit, footprint, &major_G, &minor_G);
   const Eigen::Vector3f c =
-      Filter2D(*scene_.textures[m.normal_texture].image, map, aniso, major_G, minor_G, footprint);
-  const Eigen::Vector3f tn((2 * c.x() - 1) * m.normal_scale, (2 * c.y() - 1) * m.normal_scale,
-                           2 * c.z() - 1);
+      Filter2D(*scene_.textures[normal_map].image, map, aniso, major_G, minor_G, footprint);
+  const Eigen::Vector3f tn(2 * c.x() - 1, 2 * c.y() - 1, 2 * c.z() - 1);
   // outward shading normal, and the tangent frame around it (Gram-Schmidt), world frame.
   const Eigen::Vector3f n = hit->front_face ? hit->ns_W : Eigen::Vector3f(-hit->ns_W);
-  Eigen::Vector3f t = hit->R_WG * t_G;
+  Eigen::Vector3f t = R_WG * t_G;
   t -= t.dot(n) * n;
   const float lt = t.norm();
   if (!(lt > 0)) return;
   t /= lt;
-  Eigen::Vector3f b = hit->R_WG * b_G;
+  Eigen::Vector3f b = R_WG * b_G;
   b -= b.dot(n) * n + b.dot(t) * t;
   const float lb = b.norm();
   if (!(lb > 0)) return;

@@ -42,9 +42,6 @@ struct SurfaceHit {
   bool front_face = true;        ///< the ray hit the outward side (before flipping the normals)
   Eigen::Vector3f p_G{0, 0, 0};  ///< hit point in the geom frame, m (planar texture mapping)
   Eigen::Vector3f n_G{0, 0, 1};  ///< unit outward geometric normal in the geom frame (not flipped)
-  /// rotation of the geom frame into the world frame (normal mapping: tangents are found in
-  /// the geom frame).
-  Eigen::Matrix3f R_WG = Eigen::Matrix3f::Identity();
   int geom = -1;                 ///< index into SceneDescription::geoms
   int material = -1;             ///< index into SceneDescription::materials, -1 = default material
 };

@@ -89,19 +89,6 @@ struct Material {
   int texture = -1;                              ///< index into SceneDescription::textures, -1 none
   Eigen::Vector2f texrepeat{1, 1};               ///< MJCF texrepeat for 2d mapping
   bool texuniform = false;  ///< MJCF texuniform: repeat per metre, not per face
-  /// glTF 2.0 maps (section 3.9), 2d textures mapped as `texture` is (mesh texcoords, else
-  /// the planar mapping with texrepeat / texuniform); -1 = none. see render/material_eval.h.
-  /// tangent-space normal map (TextureImage::Encoding::kLinear): n = 2 c - 1 with x along
-  /// increasing u, y towards the image's top row (decreasing v), z along the surface normal.
-  int normal_texture = -1;
-  float normal_scale = 1;  ///< x and y of the tangent-space normal are multiplied by it
-  /// linear; G multiplies roughness, B multiplies metallic.
-  int metallic_roughness_texture = -1;
-  /// linear; R is the ambient occlusion o: the realtime tier's sky light is multiplied by
-  /// 1 + strength (o - 1). the pathtraced tier traces occlusion and ignores it.
-  int occlusion_texture = -1;
-  float occlusion_strength = 1;
-  int emissive_texture = -1;  ///< sRGB; multiplies `emission`
 };
 
 /// one piece of geometry attached to a body.

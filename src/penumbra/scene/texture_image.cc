@@ -124,7 +124,7 @@ uint8_t EncodeSrgb8(float linear) {
 }
 
 uint64_t TextureImage::HashOf(int width, int height, int faces, const uint8_t* rgb_srgb,
-                              size_t size, Encoding encoding) {
+                              size_t size) {
   // a multiply-xorshift hash over 8-byte words (the bytes are compared as well before two
   // images are taken as equal, so this only has to spread well and be fast).
   constexpr uint64_t kMul = 0x9e3779b97f4a7c15ull;
@@ -137,7 +137,6 @@ uint64_t TextureImage::HashOf(int width, int height, int faces, const uint8_t* r
       mix(mix(0x243f6a8885a308d3ull, static_cast<uint64_t>(width)), static_cast<uint64_t>(height)),
       static_cast<uint64_t>(faces));
   h = mix(h, size);
-  if (encoding == Encoding::kLinear) h = mix(h, 0x6c696e656172ull);  // "linear"
   size_t i = 0;
   for (; i + 8 <= size; i += 8) {
     uint64_t v;
@@ -152,9 +151,8 @@ uint64_t TextureImage::HashOf(int width, int height, int faces, const uint8_t* r
   return h ^ (h >> 32);
 }
 
-TextureImage::TextureImage(int width, int height, int faces, std::vector<uint8_t> rgb_srgb,
-                           Encoding encoding)
-    : encoding_(encoding), faces_(faces) {
+TextureImage::TextureImage(int width, int height, int faces, std::vector<uint8_t> rgb_srgb)
+    : faces_(faces) {
   if (width < 1 || height < 1 || faces < 1 || height % faces != 0)
     throw Error("texture image: expected width, height >= 1 and height a multiple of the " +
                 std::to_string(faces) + " faces; got " + std::to_string(width) + " x " +
@@ -163,21 +161,14 @@ TextureImage::TextureImage(int width, int height, int faces, std::vector<uint8_t
   if (rgb_srgb.size() != expected)
     throw Error("texture image: expected width x height x 3 = " + std::to_string(expected) +
                 " bytes; got " + std::to_string(rgb_srgb.size()));
-  hash_ = HashOf(width, height, faces, rgb_srgb.data(), rgb_srgb.size(), encoding);
+  hash_ = HashOf(width, height, faces, rgb_srgb.data(), rgb_srgb.size());
   TextureLevel base;
   base.width = width;
   base.height = height / faces;
   base.rgb_srgb = std::move(rgb_srgb);
   levels_.push_back(std::move(base));
 
-  std::array<float, 256> linear_decode;
-  for (int c = 0; c < 256; ++c) linear_decode[c] = static_cast<float>(c) / 255.0f;
-  const bool srgb = encoding == Encoding::kSrgb;
-  const float* decode = srgb ? SrgbDecodeTable() : linear_decode.data();
-  auto encode = [srgb](float v) {
-    if (srgb) return EncodeSrgb8(v);
-    return static_cast<uint8_t>(std::clamp(std::lround(v * 255.0f), 0l, 255l));
-  };
+  const float* decode = SrgbDecodeTable();
   // per face: level 1 straight from the bytes, each further level from the floats above.
   std::vector<FloatFace> prev(faces);
   for (int l = 1;; ++l) {
@@ -205,7 +196,7 @@ TextureImage::TextureImage(int width, int height, int faces, std::vector<uint8_t
                      [&](int y) { return &src.rgb[static_cast<size_t>(y) * src.w * 3]; });
       }
       uint8_t* out = next.rgb_srgb.data() + f * face_bytes;
-      for (size_t k = 0; k < face_bytes; ++k) out[k] = encode(cur.rgb[k]);
+      for (size_t k = 0; k < face_bytes; ++k) out[k] = EncodeSrgb8(cur.rgb[k]);
       prev[f] = std::move(cur);
     }
     levels_.push_back(std::move(next));
@@ -232,7 +223,7 @@ std::vector<std::shared_ptr<const TextureImage>> TextureStore::AddAll(
     for (auto it = first; it != last; ++it) {
       const TextureImage& im = *it->second;
       if (im.width() == src.width && im.height() == src.height && im.faces() == src.faces &&
-          im.encoding() == src.encoding && im.rgb_srgb().size() == src.size &&
+          im.rgb_srgb().size() == src.size &&
           std::memcmp(im.rgb_srgb().data(), src.rgb_srgb, src.size) == 0)
         return it->second;
     }
@@ -240,7 +231,6 @@ std::vector<std::shared_ptr<const TextureImage>> TextureStore::AddAll(
   };
   auto same = [](const TextureSource& a, const TextureSource& b) {
     return a.width == b.width && a.height == b.height && a.faces == b.faces && a.size == b.size &&
-           a.encoding == b.encoding &&
            std::memcmp(a.rgb_srgb, b.rgb_srgb, a.size) == 0;
   };
   // serially: stored images, and for the others the first source with the same pixels.
@@ -249,8 +239,7 @@ std::vector<std::shared_ptr<const TextureImage>> TextureStore::AddAll(
   std::vector<int> build;  // sources whose image is new
   for (int i = 0; i < n; ++i) {
     const TextureSource& src = sources[i];
-    hash[i] =
-        TextureImage::HashOf(src.width, src.height, src.faces, src.rgb_srgb, src.size, src.encoding);
+    hash[i] = TextureImage::HashOf(src.width, src.height, src.faces, src.rgb_srgb, src.size);
     if ((out[i] = find(src, hash[i]))) continue;
     for (int j : build)
       if (hash[j] == hash[i] && same(sources[j], src)) {
@@ -266,7 +255,7 @@ std::vector<std::shared_ptr<const TextureImage>> TextureStore::AddAll(
     const TextureSource& src = sources[build[k]];
     out[build[k]] = std::make_shared<const TextureImage>(
         src.width, src.height, src.faces,
-        std::vector<uint8_t>(src.rgb_srgb, src.rgb_srgb + src.size), src.encoding);
+        std::vector<uint8_t>(src.rgb_srgb, src.rgb_srgb + src.size));
   };
   if (num_threads == 1 || build.size() < 2) {
     for (size_t k = 0; k < build.size(); ++k) make(static_cast<int64_t>(k));

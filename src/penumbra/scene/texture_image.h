@@ -40,20 +40,12 @@ struct TextureLevel {
 /// an immutable 8-bit sRGB RGB image with its mip levels (file comment).
 class TextureImage {
  public:
-  /// what the 8-bit codes mean. kSrgb: colour, sRGB-encoded (mip levels averaged in linear
-  /// light, as the file comment says). kLinear: data stored linearly, code c = value c / 255
-  /// (normal, metallic-roughness and occlusion maps, glTF 2.0 section 3.9): mip levels are
-  /// the plain means of the codes, rounded to the nearest code; the samplers read c / 255.
-  enum class Encoding { kSrgb, kLinear };
-
   /// builds the image and its mip chain from `rgb_srgb` ((height x width x 3) bytes, row-major;
   /// `faces` images of width x (height / faces) stacked vertically).
   /// @throws Error if width or height < 1, faces < 1, height is not a multiple of faces, or
   ///         rgb_srgb does not hold width x height x 3 bytes.
-  TextureImage(int width, int height, int faces, std::vector<uint8_t> rgb_srgb,
-               Encoding encoding = Encoding::kSrgb);
+  TextureImage(int width, int height, int faces, std::vector<uint8_t> rgb_srgb);
 
-  Encoding encoding() const { return encoding_; }
   int width() const { return levels_[0].width; }
   /// total rows of level 0 (all faces).
   int height() const { return levels_[0].height * faces_; }
@@ -69,11 +61,9 @@ class TextureImage {
   size_t bytes() const;
 
   /// the content hash of an image given as its level-0 data, without building it.
-  static uint64_t HashOf(int width, int height, int faces, const uint8_t* rgb_srgb, size_t size,
-                         Encoding encoding = Encoding::kSrgb);
+  static uint64_t HashOf(int width, int height, int faces, const uint8_t* rgb_srgb, size_t size);
 
  private:
-  Encoding encoding_ = Encoding::kSrgb;
   int faces_ = 1;
   uint64_t hash_ = 0;
   std::vector<TextureLevel> levels_;
@@ -87,7 +77,6 @@ struct TextureSource {
   int faces = 1;
   const uint8_t* rgb_srgb = nullptr;
   size_t size = 0;
-  TextureImage::Encoding encoding = TextureImage::Encoding::kSrgb;
 };
 
 /// hands out one shared TextureImage per distinct image: textures with the same size, faces

@@ -99,7 +99,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   t0 = Clock::now();
   SceneDescription extracted = sim_->scene();
   ApplyImportedMaterials(imported, &extracted);
-  ApplyProceduralMaterials(world_.materials, world_.file, &extracted);
+  ApplyProceduralMaterials(ProceduralMaterialsOf(world_.file), world_.file, &extracted);
   scene_ = effects_->Bind(AssembleScene(std::move(extracted), world_, sim_->Snapshot()));
   if (options.check_run_budget) {
     CheckRunMemory(world_, scene_, PhysicalMemoryBytes());  // before allocating

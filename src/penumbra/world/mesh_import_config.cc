@@ -1,5 +1,7 @@
 #include "penumbra/world/mesh_import_config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -71,6 +73,32 @@ void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out
     if (!(out->emissive_cd_m2 >= 0 && out->emissive_cd_m2 <= 1e9))
       r.Child("emissive_cd_m2").Fail("expected a luminance in [0, 1e9] cd/m^2");
   }
+}
+
+MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::string& key) {
+  MeshImportConfig out;
+  if (world_file.empty() || key.empty()) return out;
+  // key: "<list>[<index>]"
+  const size_t open = key.find('['), close = key.find(']');
+  if (open == std::string::npos || close == std::string::npos || close < open) return out;
+  const std::string list = key.substr(0, open);
+  const size_t index = std::stoul(key.substr(open + 1, close - open - 1));
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(world_file);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(world_file, 0, key, std::string("cannot read the world file again: ") + e.what());
+  }
+  const YamlReader doc(root, world_file, nullptr);
+  doc.ExpectMapAnyKeys();
+  if (!doc.Has(list)) return out;
+  const YamlReader entries = doc.Child(list);
+  if (index >= entries.size()) return out;
+  const YamlReader entry = entries.Element(index);
+  entry.ExpectMapAnyKeys();
+  const std::string file = entry.Has("file") ? entry.Child("file").String() : "";
+  ReadMeshImportKeys(entry, IsMeshModelFile(file), &out);
+  return out;
 }
 
 }  // namespace penumbra

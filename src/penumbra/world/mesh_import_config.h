@@ -40,6 +40,13 @@ bool IsMeshModelFile(const std::string& path);
 /// handedness, emissive_cd_m2.
 const std::vector<std::string_view>& MeshImportKeys();
 
+/// the mesh keys of the model entry at key path `key` ("models[0]", "robots[1]": ModelConfig::key)
+/// of the world file `world_file`, read from the file again (the world file's reader checks
+/// them at load; ModelConfig does not carry them). defaults when `world_file` or `key` is empty
+/// (bare models, worlds built in code) or the entry has none of the keys.
+/// @throws ConfigError as ReadMeshImportKeys, or naming the file when it cannot be read.
+MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::string& key);
+
 /// reads the mesh keys of model entry `r` (any of MeshImportKeys()) into `out`.
 /// @throws ConfigError naming the line and key: both `units` and `scale`, an unknown unit,
 ///         axis or handedness, a non-positive scale, or mesh keys on a model whose file is not

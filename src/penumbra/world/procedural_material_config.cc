@@ -1,5 +1,7 @@
 #include "penumbra/world/procedural_material_config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -47,6 +49,31 @@ ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r) {
     c.color = v.cast<float>();
   }
   return c;
+}
+
+std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& world_file) {
+  std::vector<ProceduralMaterialEntry> out;
+  if (world_file.empty()) return out;
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(world_file);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(world_file, 0, "materials",
+                      std::string("cannot read the world file again: ") + e.what());
+  }
+  const YamlReader doc(root, world_file, nullptr);
+  doc.ExpectMapAnyKeys();
+  if (!doc.Has("materials")) return out;
+  for (auto& [name, entry] : doc.Child("materials").Entries()) {
+    entry.ExpectMapAnyKeys();
+    if (!entry.Has("procedural")) continue;
+    ProceduralMaterialEntry e;
+    e.material = name;
+    e.line = entry.line();
+    e.config = ReadProceduralMaterial(entry.Child("procedural"));
+    out.push_back(std::move(e));
+  }
+  return out;
 }
 
 }  // namespace penumbra

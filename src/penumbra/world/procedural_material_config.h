@@ -34,6 +34,19 @@ struct ProceduralMaterialConfig {
 /// the procedural types, in documentation order.
 const std::vector<std::string_view>& ProceduralTypes();
 
+/// a `materials:` entry with `procedural:`.
+struct ProceduralMaterialEntry {
+  std::string material;  ///< the prefixed material name (the entry's key)
+  int line = 0;          ///< 1-based line of the entry in the world file
+  ProceduralMaterialConfig config;
+};
+
+/// the `materials:` entries with `procedural:` of the world file `world_file`, in file order,
+/// read from the file again (the world file's reader checks them at load; MaterialOverride
+/// does not carry them). empty when `world_file` is "".
+/// @throws ConfigError as ReadProceduralMaterial, or naming the file when it cannot be read.
+std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& world_file);
+
 /// reads a `procedural:` mapping (type, seed, size_m, resolution, color).
 /// @throws ConfigError naming the line and key for unknown keys, types and bad values.
 ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r);

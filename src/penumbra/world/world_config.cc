@@ -12,6 +12,8 @@
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
+#include "penumbra/world/mesh_import_config.h"
+#include "penumbra/world/procedural_material_config.h"
 #include "penumbra/world/effects_reader.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
@@ -201,7 +203,9 @@ class WorldParser {
     m.key = r.path();
     m.name = r.Child("name").String();
     m.file = Resolve(r.Child("file").String());
-    ReadMeshImportKeys(r, IsMeshModelFile(m.file), &m.mesh);
+    // checked here, read again by the session (world/mesh_import_config.h)
+    MeshImportConfig mesh;
+    ReadMeshImportKeys(r, IsMeshModelFile(m.file), &mesh);
     if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
     if (r.Has("floating_base")) m.floating_base = r.Child("floating_base").Bool();
     if (r.Has("initial_keyframe")) {
@@ -383,8 +387,8 @@ class WorldParser {
     r.ExpectMap({"base_color", "roughness", "metallic", "specular", "emission", "procedural"});
     MaterialOverride m;
     m.name = name;
-    m.line = r.line();
-    if (r.Has("procedural")) m.procedural = ReadProceduralMaterial(r.Child("procedural"));
+    // checked here, read again by the session (world/procedural_material_config.h)
+    if (r.Has("procedural")) ReadProceduralMaterial(r.Child("procedural"));
     if (r.Has("base_color")) m.base_color = Vector3f(r.Child("base_color"));
     if (r.Has("roughness")) m.roughness = static_cast<float>(r.Child("roughness").Double());
     if (r.Has("metallic")) m.metallic = static_cast<float>(r.Child("metallic").Double());

@@ -18,9 +18,7 @@
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/sensors/camera_sensor_config.h"
-#include "penumbra/world/mesh_import_config.h"
 #include "penumbra/world/metrics_config.h"
-#include "penumbra/world/procedural_material_config.h"
 #include "penumbra/world/sensors_reader.h"
 
 namespace penumbra {
@@ -61,8 +59,6 @@ struct ModelConfig {
   /// key path of the entry in the world file ("robots[1]"), for errors found later; "" for
   /// models not from a world file.
   std::string key;
-  /// mesh files (IsMeshModelFile): units, up axis, handedness (world/mesh_import_config.h).
-  MeshImportConfig mesh;
 };
 
 /// world-file `physics:` options besides timestep_sec. each one that is set overrides the
@@ -157,9 +153,6 @@ struct MaterialOverride {
   std::optional<Eigen::Vector3f> base_color;
   std::optional<float> roughness, metallic, specular;
   std::optional<Eigen::Vector3f> emission;  ///< cd/m^2 per channel
-  /// `procedural:` generated albedo, roughness and normal maps (world/procedural_material_config.h)
-  std::optional<ProceduralMaterialConfig> procedural;
-  int line = 0;  ///< 1-based world-file line of the entry (0 = unknown)
 };
 
 /// world-file `record:`: write a run log of the run (runlog/, docs/run-log.md).

@@ -10,6 +10,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/scene/scene_limits.h"
+#include "penumbra/world/mesh_import_config.h"
 
 namespace penumbra {
 
@@ -237,7 +238,6 @@ class Validator {
                                  "or URDF (.urdf) file, or a mesh (.obj, .gltf, .glb, .fbx, "
                                  ".dae, .stl, .ply)");
       }
-      m.mesh.ValidateOrThrow(w_.file, path);
       std::error_code ec;
       if (!std::filesystem::is_regular_file(m.file, ec)) {
         Fail(path + ".file", "file not found: " + m.file +
@@ -382,7 +382,6 @@ class Validator {
       if (m.metallic) Check(path + ".metallic", *m.metallic, kUnit);
       if (m.specular) Check(path + ".specular", *m.specular, kUnit);
       if (m.emission) Check3(path + ".emission", *m.emission, Range::AtLeast(0));
-      if (m.procedural) m.procedural->ValidateOrThrow(w_.file, m.line, path + ".procedural");
     }
   }
 

@@ -60,6 +60,15 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     throw Error("Render: camera near_m " + std::to_string(view.near_m) +
                 " is not a finite distance >= 0");
   ray_scene_->Update(snapshot);
+  if (materials_.has_normal_maps()) {
+    // normal maps find their tangent frames in the geom frame: every geom's rotation now
+    std::vector<Eigen::Matrix3f> R_WG(scene_.geoms.size());
+    for (size_t g = 0; g < scene_.geoms.size(); ++g) {
+      const Geom& geom = scene_.geoms[g];
+      R_WG[g] = (snapshot.X_WB[geom.body].linear() * geom.X_BG.linear()).cast<float>();
+    }
+    materials_.SetGeomRotations(std::move(R_WG));
+  }
   lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.

@@ -505,7 +505,6 @@ struct RayScene::Impl {
       hit->p_G = p_G.cast<float>();
       hit->n_G = n_G.cast<float>();
       hit->d_G = (g.R_GW * ray.d.cast<double>()).normalized().cast<float>();
-      hit->R_WG = g.R_WG.cast<float>();
       ng_W = (g.R_WG * n_G).cast<float>();
       ns_W = ng_W;
     } else {
@@ -521,8 +520,6 @@ struct RayScene::Impl {
       const Eigen::Vector3f d_I =
           group.rotated ? Eigen::Vector3f(group.R_WI_f.transpose() * ray.d) : ray.d;
       hit->d_G = (g.R_GI * d_I).normalized();
-      hit->R_WG = group.rotated ? Eigen::Matrix3f(group.R_WI_f * g.R_GI.transpose())
-                                : Eigen::Matrix3f(g.R_GI.transpose());
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
