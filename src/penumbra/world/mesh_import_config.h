@@ -43,8 +43,9 @@ const std::vector<std::string_view>& MeshImportKeys();
 /// the mesh keys of the model entry at key path `key` ("models[0]", "robots[1]": ModelConfig::key)
 /// of the world file `world_file`, read from the file again (the world file's reader checks
 /// them at load; ModelConfig does not carry them). defaults when `world_file` or `key` is empty
-/// (bare models, worlds built in code) or the entry has none of the keys.
-/// @throws ConfigError as ReadMeshImportKeys, or naming the file when it cannot be read.
+/// (bare models, worlds built in code), the file cannot be read (a replay of a world whose file
+/// is gone) or the entry has none of the keys.
+/// @throws ConfigError as ReadMeshImportKeys.
 MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::string& key);
 
 /// reads the mesh keys of model entry `r` (any of MeshImportKeys()) into `out`.

@@ -54,12 +54,12 @@ ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r) {
 std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& world_file) {
   std::vector<ProceduralMaterialEntry> out;
   if (world_file.empty()) return out;
+  // a world whose file is gone (a replay's recorded world): none
   YAML::Node root;
   try {
     root = YAML::LoadFile(world_file);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(world_file, 0, "materials",
-                      std::string("cannot read the world file again: ") + e.what());
+  } catch (const YAML::Exception&) {
+    return out;
   }
   const YamlReader doc(root, world_file, nullptr);
   doc.ExpectMapAnyKeys();

@@ -43,8 +43,9 @@ struct ProceduralMaterialEntry {
 
 /// the `materials:` entries with `procedural:` of the world file `world_file`, in file order,
 /// read from the file again (the world file's reader checks them at load; MaterialOverride
-/// does not carry them). empty when `world_file` is "".
-/// @throws ConfigError as ReadProceduralMaterial, or naming the file when it cannot be read.
+/// does not carry them). empty when `world_file` is "" or cannot be read (a replay of a world
+/// whose file is gone).
+/// @throws ConfigError as ReadProceduralMaterial.
 std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& world_file);
 
 /// reads a `procedural:` mapping (type, seed, size_m, resolution, color).
