@@ -63,8 +63,7 @@ TEST(MeshImport, ObjInCentimetresYUpLandsInMetresZUp) {
   for (const ImportedMesh& m : a.meshes)
     for (const Eigen::Vector3i& f : m.mesh.faces) {
       const Eigen::Vector3f& p0 = m.mesh.vertices[f[0]];
-      const Eigen::Vector3f n =
-          (m.mesh.vertices[f[1]] - p0).cross(m.mesh.vertices[f[2]] - p0);
+      const Eigen::Vector3f n = (m.mesh.vertices[f[1]] - p0).cross(m.mesh.vertices[f[2]] - p0);
       EXPECT_GT(n.dot(p0 - centre), 0.0f);
     }
   ASSERT_EQ(a.materials.size(), 1u);
@@ -94,15 +93,15 @@ TEST(MeshImport, LeftHandedFilesAreMirroredAndKeepOutwardFaces) {
   for (const ImportedMesh& m : a.meshes)
     for (const Eigen::Vector3i& f : m.mesh.faces) {
       const Eigen::Vector3f& p0 = m.mesh.vertices[f[0]];
-      const Eigen::Vector3f n =
-          (m.mesh.vertices[f[1]] - p0).cross(m.mesh.vertices[f[2]] - p0);
+      const Eigen::Vector3f n = (m.mesh.vertices[f[1]] - p0).cross(m.mesh.vertices[f[2]] - p0);
       EXPECT_GT(n.dot(p0 - centre), 0.0f);
     }
 }
 
 TEST(MeshImport, MalformedMeshNamesTheFile) {
   TempDir dir;
-  const std::string bad = dir.Write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
+  const std::string bad =
+      dir.Write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
   try {
     ImportMeshFile(bad, {});
     FAIL() << "expected a ConfigError";

@@ -81,7 +81,8 @@ inline std::string WriteGltfSlab(const TempDir& dir, const std::string& stem, co
     face(c, n, true);
   }
   {
-    const float c[4][3] = {{-0.5f, -h, 0.5f}, {0.5f, -h, 0.5f}, {0.5f, -h, -0.5f}, {-0.5f, -h, -0.5f}};
+    const float c[4][3] = {
+        {-0.5f, -h, 0.5f}, {0.5f, -h, 0.5f}, {0.5f, -h, -0.5f}, {-0.5f, -h, -0.5f}};
     const float n[3] = {0, -1, 0};
     face(c, n, false);
   }
@@ -91,7 +92,8 @@ inline std::string WriteGltfSlab(const TempDir& dir, const std::string& stem, co
     face(c, n, false);
   }
   {
-    const float c[4][3] = {{0.5f, 0, -0.5f}, {-0.5f, 0, -0.5f}, {-0.5f, -h, -0.5f}, {0.5f, -h, -0.5f}};
+    const float c[4][3] = {
+        {0.5f, 0, -0.5f}, {-0.5f, 0, -0.5f}, {-0.5f, -h, -0.5f}, {0.5f, -h, -0.5f}};
     const float n[3] = {0, 0, -1};
     face(c, n, false);
   }
@@ -101,7 +103,8 @@ inline std::string WriteGltfSlab(const TempDir& dir, const std::string& stem, co
     face(c, n, false);
   }
   {
-    const float c[4][3] = {{-0.5f, 0, -0.5f}, {-0.5f, 0, 0.5f}, {-0.5f, -h, 0.5f}, {-0.5f, -h, -0.5f}};
+    const float c[4][3] = {
+        {-0.5f, 0, -0.5f}, {-0.5f, 0, 0.5f}, {-0.5f, -h, 0.5f}, {-0.5f, -h, -0.5f}};
     const float n[3] = {-1, 0, 0};
     face(c, n, false);
   }
@@ -148,8 +151,8 @@ inline std::string WriteGltfSlab(const TempDir& dir, const std::string& stem, co
       "\"materials\":[" +
       material + "],";
   if (count > 0) json += "\"textures\":[" + textures + "],\"images\":[" + images + "],";
-  json += "\"buffers\":[{\"uri\":\"" + stem + ".bin\",\"byteLength\":" +
-          std::to_string(bin.size()) +
+  json += "\"buffers\":[{\"uri\":\"" + stem +
+          ".bin\",\"byteLength\":" + std::to_string(bin.size()) +
           "}],"
           "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":" +
           std::to_string(nrm_off) +

@@ -35,8 +35,8 @@ std::string LowerExtension(const std::string& path) {
 std::string Sanitize(const std::string& name) {
   std::string out;
   for (const char c : name)
-    out += (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.') ? c
-                                                                                            : '_';
+    out +=
+        (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.') ? c : '_';
   return out;
 }
 
@@ -110,8 +110,8 @@ class TextureLoader {
         if (!fs::is_regular_file(tp, ec))
           throw Error(what + ": file not found: " + tp.string() +
                       " (relative paths resolve against the mesh file's folder)");
-        image = DecodeTextureImage(ReadFileBytes(tp), encoding, param,
-                                   what + " (" + tp.string() + ")");
+        image =
+            DecodeTextureImage(ReadFileBytes(tp), encoding, param, what + " (" + tp.string() + ")");
       }
     } catch (const ConfigError&) {
       throw;
@@ -127,8 +127,7 @@ class TextureLoader {
                                                           float param, const std::string& what) {
     if (t.mHeight == 0) {  // compressed (PNG / JPEG bytes)
       const auto* b = reinterpret_cast<const unsigned char*>(t.pcData);
-      return DecodeTextureImage(std::vector<unsigned char>(b, b + t.mWidth), encoding, param,
-                                what);
+      return DecodeTextureImage(std::vector<unsigned char>(b, b + t.mWidth), encoding, param, what);
     }
     // raw ARGB8888 texels (aiTexel: b g r a)
     std::vector<uint8_t> rgb(static_cast<size_t>(t.mWidth) * t.mHeight * 3);
@@ -187,8 +186,7 @@ ImportedMaterial ReadMaterial(const aiMaterial* mat, bool gltf, const MeshImport
   out.normal = textures->Load(mat, aiTextureType_NORMALS, TextureMap::kNormal, normal_scale, name);
   if (gltf) {
     // assimp 5.2's glTF importer: metallicRoughnessTexture in the UNKNOWN slot (also METALNESS)
-    out.metallic_roughness =
-        textures->Load(mat, aiTextureType_UNKNOWN, TextureMap::kData, 0, name);
+    out.metallic_roughness = textures->Load(mat, aiTextureType_UNKNOWN, TextureMap::kData, 0, name);
     if (!out.metallic_roughness)
       out.metallic_roughness =
           textures->Load(mat, aiTextureType_METALNESS, TextureMap::kData, 0, name);
@@ -250,15 +248,18 @@ ImportedAsset ImportMeshFile(const std::string& path, const MeshImportConfig& co
 
   Assimp::Importer importer;
   // points and lines are dropped; polygons become triangles
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE, 80.0f);
   const aiScene* scene = importer.ReadFile(
       asset.file, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                       aiProcess_PreTransformVertices | aiProcess_GenSmoothNormals |
                       aiProcess_SortByPType | aiProcess_FlipUVs | aiProcess_ValidateDataStructure);
-  if (scene == nullptr || scene->mRootNode == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
+  if (scene == nullptr || scene->mRootNode == nullptr ||
+      (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE))
     throw ConfigError(asset.file, 0, "",
-                      std::string("not a readable mesh file: assimp: ") + importer.GetErrorString() +
+                      std::string("not a readable mesh file: assimp: ") +
+                          importer.GetErrorString() +
                           "; expected a valid OBJ, glTF 2.0, FBX, COLLADA, STL or PLY file");
 
   // units and up axis: the config, else the format's convention

@@ -77,9 +77,9 @@ ImportedAsset ImportMeshFile(const std::string& path, const MeshImportConfig& co
 
 /// how the texels of a decoded image are stored (file comment).
 enum class TextureMap {
-  kColour,  ///< base colour, emissive: the sRGB codes as they are
-  kData,    ///< metallic-roughness: each value v = code / 255, sRGB-encoded
-  kNormal,  ///< data; x and y of n = 2 v - 1 scaled by `param` (glTF normalTexture.scale)
+  kColour,     ///< base colour, emissive: the sRGB codes as they are
+  kData,       ///< metallic-roughness: each value v = code / 255, sRGB-encoded
+  kNormal,     ///< data; x and y of n = 2 v - 1 scaled by `param` (glTF normalTexture.scale)
   kOcclusion,  ///< data; R becomes 1 + param (R - 1) (glTF occlusionTexture.strength)
 };
 

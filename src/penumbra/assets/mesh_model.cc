@@ -96,7 +96,8 @@ std::string MshBytes(const TriangleMesh& mesh) {
     if (area_n.norm() > 0 && extent > 0) {
       const Eigen::Vector3d nn = area_n.normalized();
       double off = 0;
-      for (const Eigen::Vector3f& p : v) off = std::max(off, std::abs((p.cast<double>() - c).dot(nn)));
+      for (const Eigen::Vector3f& p : v)
+        off = std::max(off, std::abs((p.cast<double>() - c).dot(nn)));
       if (off < 1e-6 * extent) {
         v.push_back((c - 1e-4 * extent * nn).cast<float>());
         if (!n.empty()) n.push_back(nn.cast<float>());
@@ -147,10 +148,10 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
 }
 
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
-                                            const std::string& dir,
-                                            const std::string& world_file) {
+                                            const std::string& dir, const std::string& world_file) {
   std::vector<ImportedModel> out;
-  fs::path folder = dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
+  fs::path folder =
+      dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
   bool made = false;
   for (size_t i = 0; i < models->size(); ++i) {
     ModelConfig& m = (*models)[i];
@@ -158,8 +159,8 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
     if (!made) {
       std::error_code ec;
       fs::create_directories(folder, ec);
-      if (ec) throw Error("cannot create the mesh model folder " + folder.string() + ": " +
-                          ec.message());
+      if (ec)
+        throw Error("cannot create the mesh model folder " + folder.string() + ": " + ec.message());
       made = true;
     }
     const std::string key = (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".file";
@@ -174,8 +175,7 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
       throw ConfigError(world_file, config.line, key,
                         "cannot import mesh file " + e.file() + ": " + e.problem());
     }
-    im.import_sec =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    im.import_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string stem = fs::path(m.file).stem().string();
     std::vector<std::string> msh_files;
     for (const ImportedMesh& mesh : im.asset.meshes) {

@@ -49,8 +49,7 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
 ///         mesh cannot be imported (the message names the mesh file), or Error when a file
 ///         cannot be written.
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
-                                            const std::string& dir,
-                                            const std::string& world_file);
+                                            const std::string& dir, const std::string& world_file);
 
 /// gives every material "<model>/<name>" of `scene` that an imported model defines its
 /// factors and images: base_color, roughness, metallic, emission, the base colour texture

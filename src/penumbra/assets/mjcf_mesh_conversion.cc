@@ -47,7 +47,8 @@ TriangleMesh Merge(const ImportedAsset& asset) {
   for (const ImportedMesh& m : asset.meshes) {
     const int base = static_cast<int>(out.vertices.size());
     out.vertices.insert(out.vertices.end(), m.mesh.vertices.begin(), m.mesh.vertices.end());
-    if (normals) out.normals.insert(out.normals.end(), m.mesh.normals.begin(), m.mesh.normals.end());
+    if (normals)
+      out.normals.insert(out.normals.end(), m.mesh.normals.begin(), m.mesh.normals.end());
     if (texcoords)
       out.texcoords.insert(out.texcoords.end(), m.mesh.texcoords.begin(), m.mesh.texcoords.end());
     for (const Eigen::Vector3i& f : m.mesh.faces)
@@ -65,8 +66,7 @@ void Visit(tinyxml2::XMLElement* e, const std::function<void(tinyxml2::XMLElemen
 
 }  // namespace
 
-std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed,
-                                                  const std::string& dir) {
+std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed, const std::string& dir) {
   std::vector<std::string> converted;
   const fs::path folder =
       dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);

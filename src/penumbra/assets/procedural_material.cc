@@ -96,8 +96,9 @@ struct Generator {
     // plank tone and grain: streaks stretched along the plank (x), rings across it
     const float tone = Hash01(seed, plank, 1, 12);
     const float streak = Fbm(seed, 13 + plank, u, v, per_row * 3, rows * 24, 4);
-    const float rings = 0.5f + 0.5f * std::sin(2 * kPi * (y / pw * 3.0f + 4.0f * streak +
-                                                           Hash01(seed, plank, 2, 14) * 10));
+    const float rings =
+        0.5f + 0.5f * std::sin(2 * kPi *
+                               (y / pw * 3.0f + 4.0f * streak + Hash01(seed, plank, 2, 14) * 10));
     const float fine = Fbm(seed, 15, u, v, 64, rows * 64, 2);
     const Eigen::Vector3f dark = Eigen::Vector3f(0.20f, 0.095f, 0.038f).cwiseProduct(tint);
     const Eigen::Vector3f light = Eigen::Vector3f(0.46f, 0.26f, 0.12f).cwiseProduct(tint);
@@ -119,7 +120,8 @@ struct Generator {
     const int n = std::max(1, static_cast<int>(std::lround(size / 0.3f)));
     const float tile = size / n;
     const float x = u * size, y = v * size;
-    const int i = std::min(n - 1, static_cast<int>(x / tile)), j = std::min(n - 1, static_cast<int>(y / tile));
+    const int i = std::min(n - 1, static_cast<int>(x / tile)),
+              j = std::min(n - 1, static_cast<int>(y / tile));
     const float d = std::min(LineDistance(x, tile), LineDistance(y, tile));
     const float g = Groove(d, 0.002f, 0.0015f);  // 4 mm grout, 2 mm deep
     const float shade = 0.93f + 0.14f * Hash01(seed, i, j, 21);
@@ -309,7 +311,9 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
   const float texel_m = static_cast<float>(out.size_m) / n;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
-      auto h = [&](int xi, int yi) { return height[static_cast<size_t>(Wrap(yi, n)) * n + Wrap(xi, n)]; };
+      auto h = [&](int xi, int yi) {
+        return height[static_cast<size_t>(Wrap(yi, n)) * n + Wrap(xi, n)];
+      };
       const float dhdx = (h(x + 1, y) - h(x - 1, y)) / (2 * texel_m);
       const float dhdy = (h(x, y - 1) - h(x, y + 1)) / (2 * texel_m);
       Eigen::Vector3f nn(-dhdx, -dhdy, 1);

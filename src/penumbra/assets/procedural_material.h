@@ -43,8 +43,8 @@ double ProceduralDefaultSize(const std::string& type);
 /// @throws Error for an unknown type.
 ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config);
 
-/// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps and makes
-/// them the scene material's: texture (albedo, "<material>/albedo"), and the maps
+/// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps and
+/// makes them the scene material's: texture (albedo, "<material>/albedo"), and the maps
 /// "<material>/metallic_roughness" and "<material>/normal" (render/material_eval.h, "PBR
 /// maps"), added to scene->textures; base_color 1, roughness and metallic
 /// factors 1 (the maps hold them), texuniform on with texrepeat 1 / size_m (one image per

@@ -306,10 +306,10 @@ struct MaterialEvaluator::Mapping2D {
   Kind kind = Kind::kTexcoords;
   float s = 0, t = 0;
   Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
-  float uv_per_m = 0;          // kTexcoords
-  float rx = 1, ry = 1;        // texrepeat
-  float h0 = 1, h1 = 1;        // kPerFace: half sizes of the face
-  int a0 = -1, a1 = -1;        // planar: the face axes (image rows along -a1)
+  float uv_per_m = 0;    // kTexcoords
+  float rx = 1, ry = 1;  // texrepeat
+  float h0 = 1, h1 = 1;  // kPerFace: half sizes of the face
+  int a0 = -1, a1 = -1;  // planar: the face axes (image rows along -a1)
 
   // texels per metre of surface for a w x h image (the expressions of the isotropic lookup).
   float Rho(float w, float th) const {

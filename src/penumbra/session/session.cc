@@ -57,8 +57,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   std::vector<ModelConfig> models = world_.models;
   const std::vector<ImportedModel> imported = ImportMeshModels(&models, mesh_dir, world_.file);
   for (const ImportedModel& im : imported)
-    spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s",
-                 im.model, im.asset.file, im.asset.meshes.size(), im.asset.triangles,
+    spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s", im.model,
+                 im.asset.file, im.asset.meshes.size(), im.asset.triangles,
                  im.asset.materials.size(), im.import_sec);
   ComposedScene composed = ComposeWorld(models, compose_options);
   // MJCF <mesh> files MuJoCo 2.2.2 cannot read (glTF, FBX, COLLADA, PLY) become .msh files

@@ -58,7 +58,11 @@ void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out
     r.Child("scale").Fail("given together with units; expected one of units and scale");
   if (r.Has("units")) {
     const std::string u = r.Child("units").Enum({"m", "cm", "mm", "in", "ft"});
-    out->scale = u == "m" ? 1.0 : u == "cm" ? 0.01 : u == "mm" ? 0.001 : u == "in" ? 0.0254 : 0.3048;
+    out->scale = u == "m"    ? 1.0
+                 : u == "cm" ? 0.01
+                 : u == "mm" ? 0.001
+                 : u == "in" ? 0.0254
+                             : 0.3048;
   }
   if (r.Has("scale")) {
     out->scale = r.Child("scale").Double();

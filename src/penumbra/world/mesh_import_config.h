@@ -23,7 +23,8 @@ struct MeshImportConfig {
   /// `handedness: left`: the file is left-handed; its x axis is negated (and triangle winding
   /// reversed) before the up-axis rotation.
   bool left_handed = false;
-  /// luminance, cd/m^2, of an emissive factor of 1 (glTF emissiveFactor / MTL Ke) (`emissive_cd_m2:`).
+  /// luminance, cd/m^2, of an emissive factor of 1 (glTF emissiveFactor / MTL Ke)
+  /// (`emissive_cd_m2:`).
   double emissive_cd_m2 = 100;
   /// 1-based world-file line of the entry (0 = unknown), for errors found at import.
   int line = 0;

@@ -20,8 +20,8 @@ class YamlReader;
 struct ProceduralMaterialConfig {
   /// wood, tiles, concrete, plaster, painted_metal, cardboard, fabric (ProceduralTypes()).
   std::string type;
-  uint64_t seed = 0;  ///< same seed, same maps (bit-identical)
-  double size_m = 0;  ///< side of one image, m, in (0, 100]; 0 = the type's default
+  uint64_t seed = 0;     ///< same seed, same maps (bit-identical)
+  double size_m = 0;     ///< side of one image, m, in (0, 100]; 0 = the type's default
   int resolution = 512;  ///< texels per side, 16 ... 4096
   /// linear base colour of the type's palette (tiles, painted_metal, fabric: the colour; the
   /// others: a tint multiplying their natural colours); unset = the type's default.

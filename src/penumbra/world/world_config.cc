@@ -12,9 +12,9 @@
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
+#include "penumbra/world/effects_reader.h"
 #include "penumbra/world/mesh_import_config.h"
 #include "penumbra/world/procedural_material_config.h"
-#include "penumbra/world/effects_reader.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
 

@@ -178,9 +178,9 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
         for (int i = 0; i < n; ++i) {
           if (!did_hit[i]) continue;
           const float d_len = rays[i].d.norm();
-          materials_.ApplyNormalMap(
-              &hits[i], ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
-                                      rays[i].d / d_len, hits[i]));
+          materials_.ApplyNormalMap(&hits[i],
+                                    ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
+                                                  rays[i].d / d_len, hits[i]));
         }
       }
       primary.rays = rays.get();
