@@ -15,6 +15,7 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/session/live_control.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/run_outputs.h"
@@ -149,14 +150,16 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // --record-sensors: every image file the cameras write also goes into the run log (set
   // once the log is open, before the loop starts)
   RunLogWriter* sensor_log = nullptr;
-  if (world.record.sensors) {
-    outputs_options.on_image = [&sensor_log](const CameraFrame& f, const std::string& kind,
-                                             const std::vector<uint8_t>& png) {
-      if (!sensor_log) return;
-      sensor_log->RecordSensor(SensorRecord{f.step, f.time_sec, f.camera, kind + ".png",
-                                            std::string(png.begin(), png.end())});
-    };
-  }
+  // the live controls (session/live_control.h); their recordings take sensor records too
+  LiveControl live(session, JoinArgs(options.command_line));
+  outputs_options.on_image = [&sensor_log, &live](const CameraFrame& f, const std::string& kind,
+                                                  const std::vector<uint8_t>& png) {
+    if (!sensor_log && !live.recorder().wants_sensor_records()) return;
+    const SensorRecord r{f.step, f.time_sec, f.camera, kind + ".png",
+                         std::string(png.begin(), png.end())};
+    if (sensor_log) sensor_log->RecordSensor(r);
+    live.recorder().RecordSensor(r);
+  };
   RunOutputs outputs(session, world, out, outputs_options);
   spdlog::info("running {} for {:.3f} s of sim time, {} camera(s), timestep {:.6g} s, out {}",
                world.file.empty() ? std::string("model") : world.file, duration,
@@ -179,16 +182,18 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
         MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
     header.has_sensor_records = world.record.sensors;
     recorder = std::make_unique<RecorderSink>(record_path, header);
-    if (world.record.sensors) {
-      sensor_log = &recorder->writer();
-      outputs.sensors().set_on_output([log = sensor_log](const std::string& sensor,
-                                                         const std::string& kind, int64_t step,
-                                                         double time_sec, std::string bytes) {
-        log->RecordSensor(SensorRecord{step, time_sec, sensor, kind, std::move(bytes)});
-      });
-    }
+    if (world.record.sensors) sensor_log = &recorder->writer();
+    live.RecordChangesTo(&recorder->writer());
     spdlog::info("recording the run to {}", record_path);
   }
+  outputs.sensors().set_on_output([&sensor_log, &live](const std::string& sensor,
+                                                       const std::string& kind, int64_t step,
+                                                       double time_sec, std::string bytes) {
+    if (!sensor_log && !live.recorder().wants_sensor_records()) return;
+    const SensorRecord r{step, time_sec, sensor, kind, std::move(bytes)};
+    if (sensor_log) sensor_log->RecordSensor(r);
+    live.recorder().RecordSensor(r);
+  });
   ManifestSink manifest(out.string(), [&](const LoopFinish& f) {
     outputs.Finish(&timings);
     summary.out_dir = out.string();
@@ -221,10 +226,13 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   });
   // the recorder after the cameras, sensors and metrics (their sensor records reach it
   // before it closes) and before the manifest (which reports its size)
+  live.AddFirst(&loop);
   outputs.AddTo(&loop);
   if (recorder) loop.AddSink(recorder.get());
+  live.AddAfterOutputs(&loop);
   loop.AddSink(&manifest);
   rollback.Dismiss();
+  if (options.on_live) options.on_live(live);
   const LoopFinish finish = loop.Run();
   if (finish.error) std::rethrow_exception(finish.error);
   return summary;

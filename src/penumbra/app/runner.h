@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -12,6 +13,8 @@
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
+
+class LiveControl;
 
 /// options given on the command line that are not part of the world file.
 struct RunOptions {
@@ -37,6 +40,11 @@ struct RunOptions {
   /// up to there, writes run.json with "interrupted": true and returns normally with
   /// RunSummary::interrupted set.
   const std::atomic<int>* stop_request = nullptr;
+  /// called once the run is set up, before its first step, on the caller's thread, with the
+  /// run's live controls (session/live_control.h: adversity and effect changes, start/stop
+  /// recording; thread-safe). the LiveControl lives until RunWorld returns: stop using it
+  /// before then (e.g. in a sink's OnFinish). may be empty.
+  std::function<void(LiveControl&)> on_live;
 };
 
 /// what a run produced.

@@ -18,6 +18,7 @@
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
+#include "penumbra/session/live_effects.h"
 #include "penumbra/session/run_outputs.h"
 #include "penumbra/session/session.h"
 
@@ -135,6 +136,27 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   Session session(world, session_options);
   Simulation& sim = session.sim();
 
+  // the live changes of the run (session/live_effects.h), applied at their steps as the run
+  // applied them; a replay under --adversity shows its own conditions instead
+  LiveEffects live(session);
+  int64_t live_changes = 0;
+  for (const EventRecord& e : reader->Events()) {
+    if (e.kind != "live") continue;
+    ++live_changes;
+    if (!options.adversity.empty()) continue;
+    nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
+    if (change.is_discarded())
+      throw ConfigError(options.log_path, 0, "live",
+                        fmt::format("the live change at step {} is not JSON; expected the "
+                                    "payload docs/run-log.md describes",
+                                    e.step));
+    live.ScheduleRecorded(e.step, change);
+  }
+  if (live_changes > 0 && !options.adversity.empty())
+    Warn(&warnings, fmt::format("--adversity replaces the recorded conditions: the log's {} live "
+                                "change(s) are not applied",
+                                live_changes));
+
   // the window
   const double dt = sim.timestep();
   const int64_t first_step = options.from_sec ? FirstStepAtOrAfter(*options.from_sec, dt) : 0;
@@ -202,6 +224,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     m.replay = std::move(r);
     return m;
   });
+  loop.AddSink(&live);  // first: a change applies before any sink sees its step
   outputs.AddTo(&loop);
   loop.AddSink(&manifest);
   rollback.Dismiss();

@@ -23,6 +23,7 @@
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
+#include "penumbra/session/live_effects.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/session.h"
@@ -288,6 +289,20 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
                                   "state) to resimulate from",
                                   first.step));
 
+  // the live changes of the run (session/live_effects.h) at their steps: those that moved or
+  // parked NPCs changed the physics from there
+  LiveEffects live(session);
+  for (const EventRecord& e : reader.Events()) {
+    if (e.kind != "live") continue;
+    const nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
+    if (change.is_discarded())
+      throw ConfigError(options.log_path, 0, "live",
+                        fmt::format("the live change at step {} is not JSON; expected the "
+                                    "payload docs/run-log.md describes",
+                                    e.step));
+    live.ScheduleRecorded(e.step, change);
+  }
+
   // the pipeline: physics -> SimLoop -> the check (+ the metrics and run.json)
   LogCheck check(&reader, layout, controllers, options.log_path, std::move(first), &report);
   PhysicsSourceOptions physics_options;
@@ -296,6 +311,7 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   SimLoopOptions loop_options;
   loop_options.stop_request = options.stop_request;
   SimLoop loop(&physics, loop_options);
+  loop.AddSink(&live);  // first: a change applies before the check sees its step
   loop.AddSink(&check);
   if (metrics) loop.AddSink(metrics.get());
   std::optional<ManifestSink> manifest;

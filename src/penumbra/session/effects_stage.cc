@@ -229,7 +229,13 @@ std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents
   return specs;
 }
 
-void EffectsStage::Attach(Simulation* sim) const {
+Pose AgentParkedPose(const AgentConfig& agent) {
+  Pose X = AgentPath(agent).X_WA(0.0);
+  X.translation().z() -= 100.0;
+  return X;
+}
+
+void EffectsStage::Attach(Simulation* sim) {
   // the world's agents must walk inside the world: the static geometry's plan-view box + 1 m
   // (agent bodies are mocap, never static, so they do not widen it)
   if (world_agents_ > 0) {
@@ -256,9 +262,36 @@ void EffectsStage::Attach(Simulation* sim) const {
     }
   }
   for (const AgentConfig& a : agents_) {
-    auto path = std::make_shared<const AgentPath>(a);
-    sim->AddMocapDriver(AgentBodyName(a.name), [path](double t) { return path->X_WA(t); });
+    auto slot = std::make_shared<AgentSlot>();
+    slot->path = std::make_shared<const AgentPath>(a);
+    slot->parked = AgentParkedPose(a);
+    sim->AddMocapDriver(AgentBodyName(a.name), [slot](double t) {
+      return slot->path ? slot->path->X_WA(t) : slot->parked;
+    });
+    body_names_.push_back(a.name);
+    slots_.push_back(std::move(slot));
   }
+}
+
+void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
+                           std::optional<AdversityPreset> preset,
+                           std::unique_ptr<EffectsEngine> engine) {
+  std::vector<std::shared_ptr<const AgentPath>> paths(slots_.size());
+  for (const AgentConfig& a : agents) {
+    const auto it = std::find(body_names_.begin(), body_names_.end(), a.name);
+    if (it == body_names_.end())
+      throw ConfigError("", 0, "npcs",
+                        "agent '" + a.name +
+                            "' has no body in this run (MuJoCo 2.2.2 cannot add bodies to a "
+                            "loaded model); expected at most the NPCs the run started with");
+    paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
+  }
+  for (size_t i = 0; i < slots_.size(); ++i) slots_[i]->path = paths[i];
+  std::lock_guard<std::mutex> lock(mu_);
+  effects_ = std::move(effects);
+  agents_ = std::move(agents);
+  preset_ = std::move(preset);
+  engine_ = std::move(engine);
 }
 
 SceneDescription EffectsStage::Bind(SceneDescription scene) {
@@ -279,18 +312,21 @@ std::shared_ptr<const EffectsFrame> EffectsStage::Evaluate(const WorldSnapshot& 
 }
 
 std::vector<std::string> EffectsStage::EffectLabels() const {
+  std::lock_guard<std::mutex> lock(mu_);
   std::vector<std::string> out;
   for (const EffectConfig& e : effects_) out.push_back(e.name + ": " + e.type_name());
   return out;
 }
 
 std::vector<std::string> EffectsStage::AgentLabels() const {
+  std::lock_guard<std::mutex> lock(mu_);
   std::vector<std::string> out;
   for (const AgentConfig& a : agents_) out.push_back(a.name + ": " + AgentKindName(a.kind));
   return out;
 }
 
 std::string EffectsStage::PresetLabel() const {
+  std::lock_guard<std::mutex> lock(mu_);
   return preset_ ? preset_->name + " (" + preset_->file + ")" : std::string();
 }
 

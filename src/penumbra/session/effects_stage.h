@@ -38,6 +38,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,7 +74,7 @@ class EffectsStage {
   /// loaded, before its first step.
   /// @throws ConfigError for a waypoint of a world agent outside the world (the static
   ///         geometry's plan-view box + 1 m), naming agents[i].waypoints[j].
-  void Attach(Simulation* sim) const;
+  void Attach(Simulation* sim);
 
   /// `scene` with every agent geom that has no class yet (a world-file `semantic_classes`
   /// entry wins) labelled with its agent class (effects/agent_path.h); builds the effects
@@ -86,6 +87,21 @@ class EffectsStage {
   std::shared_ptr<const EffectsFrame> Evaluate(const WorldSnapshot& snapshot,
                                                const Eigen::Vector3d& viewer_W);
 
+  /// a live change (session/live_effects.h): the run's effects, agents and preset become
+  /// these from now on; `engine` is the EffectsEngine bound to them (null when `effects` is
+  /// empty). each agent body attached (Attach) follows the path of the agent of the same name
+  /// in `agents`, or is parked when it has none (AgentParkedPose); the bodies' poses change
+  /// at the driver's next call (Simulation::ApplyMocapDrivers or the next step). call on the
+  /// loop thread at a step boundary (Evaluate and the mocap drivers run there).
+  /// @throws ConfigError("", 0, "npcs", ...) naming an agent without a body, before anything
+  ///         changes (MuJoCo 2.2.2 cannot add bodies to a loaded model).
+  void Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
+               std::optional<AdversityPreset> preset, std::unique_ptr<EffectsEngine> engine);
+  /// names of the agents whose bodies the model has (the agents at Attach), in order.
+  const std::vector<std::string>& agent_bodies() const { return body_names_; }
+  /// the world seed (keys the effects' random streams).
+  uint64_t seed() const { return seed_; }
+
   /// all effects (the world's, then the preset's) and all agents.
   const std::vector<EffectConfig>& effects() const { return effects_; }
   const std::vector<AgentConfig>& agents() const { return agents_; }
@@ -93,11 +109,13 @@ class EffectsStage {
   const std::optional<AdversityPreset>& preset() const { return preset_; }
 
   /// run.json entries: "name: type" per effect, "name: kind" per agent, preset "name (file)".
+  /// thread-safe against Replace (a live recording's header reads the preset label).
   std::vector<std::string> EffectLabels() const;
   std::vector<std::string> AgentLabels() const;
   std::string PresetLabel() const;
 
  private:
+  mutable std::mutex mu_;  // guards effects_, agents_, preset_ between Replace and the labels
   std::vector<EffectConfig> effects_;
   std::vector<AgentConfig> agents_;
   std::optional<AdversityPreset> preset_;
@@ -106,7 +124,19 @@ class EffectsStage {
   size_t world_agents_ = 0;  // agents_[0, world_agents_) are the world's, then the preset's
   std::vector<Eigen::Vector3d> robot_starts_;
   std::unique_ptr<EffectsEngine> engine_;
+  // the path each attached agent body follows (null = parked), shared with its mocap driver
+  struct AgentSlot {
+    std::shared_ptr<const AgentPath> path;
+    Pose parked;
+  };
+  std::vector<std::string> body_names_;
+  std::vector<std::shared_ptr<AgentSlot>> slots_;
 };
+
+/// where an agent body without an agent waits (a live change removed its NPC): at its path's
+/// start, 100 m below the agent's floor, out of every camera's and sensor's view above the
+/// floor.
+Pose AgentParkedPose(const AgentConfig& agent);
 
 /// the preset's effects and agents for a world whose scene at the start is (scene, X_WB),
 /// as described in the file header. pure and deterministic in (preset, world, seed).

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/world/adversity_edit.h"
 #include "penumbra/world/yaml_reader.h"
 
 #ifndef PENUMBRA_SOURCE_DIR
@@ -101,6 +103,32 @@ AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const s
   return p;
 }
 
+// the preset as the mapping of its blocks (what a preset file's entry holds)
+YAML::Node PresetNode(const AdversityPreset& p) {
+  YAML::Node n(YAML::NodeType::Map);
+  if (p.fog_mor_m) {
+    n["fog"]["mor_m"] = *p.fog_mor_m;
+    n["fog"]["height_falloff_per_m"] = p.fog_height_falloff_per_m;
+  }
+  if (p.dust_mor_m) n["dust"]["mor_m"] = *p.dust_mor_m;
+  if (p.smoke_sigma_t_per_m) {
+    n["smoke"]["sigma_t_per_m"] = *p.smoke_sigma_t_per_m;
+    n["smoke"]["coverage"] = p.smoke_coverage;
+    n["smoke"]["extent_fraction"] = p.smoke_extent_fraction;
+    n["smoke"]["height_m"] = p.smoke_height_m;
+  }
+  if (p.rain_rate_mm_h) n["rain"]["rate_mm_h"] = *p.rain_rate_mm_h;
+  if (p.snow_rate_mm_h) n["snow"]["rate_mm_h"] = *p.snow_rate_mm_h;
+  n["lights"]["scale"] = p.light_scale;
+  n["lights"]["flicker_depth"] = p.flicker_depth;
+  n["lights"]["flicker_hz"] = p.flicker_hz;
+  n["npcs"]["people"] = p.npc_people;
+  n["npcs"]["vehicles"] = p.npc_vehicles;
+  n["npcs"]["speed_m_s"] = p.npc_speed_m_s;
+  n["npcs"]["pause_sec"] = p.npc_pause_sec;
+  return n;
+}
+
 std::string Names(const std::vector<AdversityPreset>& presets) {
   std::string s;
   for (const AdversityPreset& p : presets) s += (s.empty() ? "" : ", ") + p.name;
@@ -162,6 +190,48 @@ std::string ResolveAdversitySpec(const std::string& spec, const std::string& bas
   }
   LoadAdversityPreset(resolved, file, line);  // checks it
   return resolved;
+}
+
+const std::vector<std::string>& AdversityPresetBlocks() {
+  static const std::vector<std::string> kBlocks = {"fog",  "dust",   "smoke", "rain",
+                                                   "snow", "lights", "npcs"};
+  return kBlocks;
+}
+
+AdversityPreset EditAdversityPreset(const AdversityPreset& base, const std::string& block,
+                                    const std::string& block_yaml) {
+  const std::vector<std::string>& blocks = AdversityPresetBlocks();
+  if (std::find(blocks.begin(), blocks.end(), block) == blocks.end()) {
+    std::string valid;
+    for (const std::string& b : blocks) valid += (valid.empty() ? "" : ", ") + b;
+    throw ConfigError("", 0, block, "unknown adversity block; expected one of: " + valid);
+  }
+  try {
+    YAML::Node node = PresetNode(base);
+    YAML::Node patch;
+    try {
+      patch = YAML::Load(block_yaml);
+    } catch (const YAML::Exception& e) {
+      throw ConfigError("", 0, block, "not a mapping (" + e.msg + "); expected a mapping or null");
+    }
+    if (patch.IsNull()) {
+      node.remove(block);
+    } else if (!patch.IsMap()) {
+      throw ConfigError("", 0, block, "expected a mapping of the block's keys, or null");
+    } else {
+      YAML::Node target = node[block];
+      if (!target.IsMap()) target = YAML::Node(YAML::NodeType::Map);
+      for (const auto& kv : patch) target[kv.first.as<std::string>()] = kv.second;
+      node[block] = target;
+    }
+    AdversityPreset p = ReadPreset(base.name, YamlReader(node, "", nullptr), base.file);
+    p.description = base.description;
+    return p;
+  } catch (const ConfigError& e) {
+    throw ConfigError("", 0, e.key(), e.problem());  // lines of a generated document mean nothing
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("", 0, block, "invalid value: " + e.msg);
+  }
 }
 
 AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& file, int line) {

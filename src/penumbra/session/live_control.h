@@ -1,0 +1,54 @@
+#pragma once
+// the live controls of a running world, as the bridges (ZeroMQ, ROS) and the browser viewer
+// reach them through their shared command dispatcher (issues 19 and 22): the adverse
+// conditions (session/live_effects.h) and run-log recording (session/live_recorder.h). a run
+// (app/runner.h RunOptions::on_live) hands its LiveControl to the caller once it is set up.
+//
+// in a SimLoop: effects() is the loop's first sink (changes apply before any other sink sees
+// the step) and recorder() follows the cameras and sensors (their sensor records reach it
+// before it closes); AddFirst / AddAfterOutputs say where. every change applied is recorded
+// as a "live" event in the active live recording and in the run's own log (RecordChangesTo).
+
+#include <cstdint>
+#include <string>
+
+#include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/runlog/run_log_writer.h"
+#include "penumbra/session/live_effects.h"
+#include "penumbra/session/live_recorder.h"
+#include "penumbra/session/session.h"
+
+namespace penumbra {
+
+/// the live controls of one Session's run. calls on effects() and recorder() are thread-safe
+/// (see their headers); the object lives as long as the run (RunWorld) and must not be used
+/// after it returns.
+class LiveControl {
+ public:
+  /// `session` must outlive this object; build it before the loop starts. `command_line`
+  /// goes into the headers of the logs recorder() writes.
+  LiveControl(Session& session, const std::string& command_line);
+  LiveControl(const LiveControl&) = delete;
+  LiveControl& operator=(const LiveControl&) = delete;
+
+  LiveEffects& effects() { return effects_; }
+  /// the step the loop last reached, -1 before the first (LiveEffects::step; thread-safe).
+  int64_t step() const { return effects_.step(); }
+  LiveRecorder& recorder() { return recorder_; }
+
+  /// every change applied is also recorded as a "live" event in `writer` (the run's own
+  /// --record log; may be null). call before the loop starts; `writer` must outlive the loop.
+  void RecordChangesTo(RunLogWriter* writer) { run_log_ = writer; }
+
+  /// adds effects() to `loop`: call before any other AddSink.
+  void AddFirst(SimLoop* loop) { loop->AddSink(&effects_); }
+  /// adds recorder() to `loop`: call after the output sinks (cameras, sensors).
+  void AddAfterOutputs(SimLoop* loop) { loop->AddSink(&recorder_); }
+
+ private:
+  LiveEffects effects_;
+  LiveRecorder recorder_;
+  RunLogWriter* run_log_ = nullptr;
+};
+
+}  // namespace penumbra
