@@ -55,7 +55,7 @@ TEST(ProceduralMaterial, MapsVaryAndStayPlausible) {
       const double nx = 2 * decode[n[3 * i]] - 1, ny = 2 * decode[n[3 * i + 1]] - 1,
                    nz = 2 * decode[n[3 * i + 2]] - 1;
       EXPECT_GT(nz, 0.3);
-      if (std::hypot(nx, ny) > 0.02) ++tilted;
+      if (std::hypot(nx, ny) > 0.012) ++tilted;  // above the 8-bit step (~0.01)
     }
     mean /= texels;
     const double sd = std::sqrt(std::max(0.0, sq / texels - mean * mean));

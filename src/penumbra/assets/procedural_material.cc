@@ -109,7 +109,8 @@ struct Generator {
     const float dy = std::min(y - row * pw, (row + 1) * pw - y);
     const float dx = LineDistance(xs, pl);
     const float g = Groove(std::min(dx, dy), 0.0005f, 0.0015f);
-    t.height_m = -0.001f * (1 - g) + 0.00005f * rings * g;
+    // brushed grain: 0.2 mm across the rings, 0.1 mm of fine fibre
+    t.height_m = -0.001f * (1 - g) + (0.0002f * rings + 0.0001f * fine) * g;
     t.albedo *= 0.35f + 0.65f * g;
     t.roughness = t.roughness * g + 0.9f * (1 - g);
     return t;
@@ -174,14 +175,15 @@ struct Generator {
 
   Texel Plaster(float u, float v) const {
     Texel t;
-    const int trowel = std::max(1, static_cast<int>(std::lround(size / 0.2f)));
+    // trowel undulation: 1 mm over ~0.1 m
+    const int trowel = std::max(1, static_cast<int>(std::lround(size / 0.1f)));
     const float w = Fbm(seed, 41, u, v, trowel, trowel, 3);
     // sand finish: 0.2 mm grains of ~4 mm
     const int gcells = std::max(4, static_cast<int>(std::lround(size / 0.004f)));
     const float grain = Fbm(seed, 42, u, v, gcells, gcells, 2);
-    t.albedo = tint * (0.97f + 0.05f * w + 0.03f * grain);
+    t.albedo = tint * (0.92f + 0.1f * w + 0.05f * grain);
     t.roughness = 0.88f + 0.08f * grain;
-    t.height_m = 0.0004f * w + 0.0002f * grain;
+    t.height_m = 0.001f * w + 0.0002f * grain;
     return t;
   }
 
@@ -194,7 +196,7 @@ struct Generator {
     const float dirt = Fbm(seed, 52, u, v, dirt_c, dirt_c, 4);
     t.albedo = tint * (0.85f + 0.25f * dirt);
     t.roughness = 0.32f + 0.12f * dirt + 0.04f * p;
-    t.height_m = 0.00003f * p;
+    t.height_m = 0.00006f * p;  // orange peel: 60 um over 4 mm
     // scratches: segments 2-20 cm long, 0.3-1 mm wide, bare steel in them
     const int n = std::max(1, static_cast<int>(std::lround(40 * size * size)));
     for (int k = 0; k < n; ++k) {

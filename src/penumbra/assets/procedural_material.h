@@ -14,10 +14,10 @@
 //
 // physical scale (per type, default image side size_m): wood planks 0.15 m wide, 1.2 m long,
 // staggered, 1 mm joints (1.2 m image); tiles 0.30 m with 4 mm recessed grout (0.6 m);
-// concrete pores of 1-4 mm and blotches of 0.1-0.5 m (2 m); plaster trowel undulation of
-// 0.1-0.3 m and grain of 1 mm (2 m); painted metal orange peel of 2-5 mm and scratches
+// concrete pores of 1-4 mm and blotches of 0.1-0.5 m (1 m); plaster trowel undulation of
+// ~0.1 m (1 mm) and 4 mm sand grains (1 m); painted metal orange peel of 4 mm and scratches
 // 2-20 cm long (1 m); cardboard flutes of 8 mm under the liner, fibres (0.5 m); fabric
-// threads of 1 mm in a plain weave (0.2 m).
+// threads of 1 mm in a plain weave (0.2 m). docs/assets.md has the table.
 
 #include <memory>
 
