@@ -17,6 +17,7 @@
 
 #include "penumbra/app/bench.h"
 #include "penumbra/app/bench_record.h"
+#include "penumbra/app/bench_ros.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -260,6 +261,7 @@ int RunCli(int argc, char** argv) {
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
+  const std::unique_ptr<BenchRosCommand> bench_ros = AddBenchRosCommand(*bench);
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -333,6 +335,7 @@ int RunCli(int argc, char** argv) {
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (eval.Selected()) return eval.Run();
     if (*bench_record->app) return bench_record->Run();
+    if (*bench_ros->app) return bench_ros->Run();
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

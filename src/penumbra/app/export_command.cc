@@ -9,6 +9,7 @@
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/replay/replay_runner.h"
+#include "penumbra/ros/rosbag_export.h"
 
 namespace penumbra {
 
@@ -48,11 +49,12 @@ bool ExportCommand::selected() const {
 
 int ExportCommand::Run() const {
   const State& s = *state_;
+  namespace fs = std::filesystem;
+  const fs::path input(s.input);
+  if (s.format == "rosbag") return RunRosbag();
   DatasetExportOptions options = s.options;
   options.format = ParseDatasetFormat(s.format);
   options.out_dir = s.out;
-  namespace fs = std::filesystem;
-  const fs::path input(s.input);
   // a run log is first replayed (replay/replay_runner.h, with the recorded conditions or the
   // given --world / --adversity) into a temporary run folder beside --out, exported from there
   std::optional<TempFolder> replayed;
@@ -97,12 +99,61 @@ int ExportCommand::Run() const {
   return 0;
 }
 
+int ExportCommand::RunRosbag() const {
+  const State& s = *state_;
+  namespace fs = std::filesystem;
+  const fs::path input(s.input);
+  const fs::path bag(s.out);
+  if (!s.options.camera.empty() || !s.options.camera2.empty() || !s.options.imu.empty())
+    throw ConfigError("", 0,
+                      !s.options.camera.empty()
+                          ? "--camera"
+                          : (!s.options.camera2.empty() ? "--camera2" : "--imu"),
+                      "a rosbag holds every camera, LiDAR and IMU of the run; expected no sensor "
+                      "selection with --format rosbag");
+  // a run log is replayed into a temporary run folder beside the bag first
+  std::optional<TempFolder> replayed;
+  fs::path run_dir = input;
+  if (input.extension() == ".plog") {
+    if (!fs::is_regular_file(input))
+      throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
+    if (bag.extension() != ".bag")
+      throw ConfigError("", 0, "--out",
+                        "'" + bag.string() + "'; expected a bag file name ending in .bag");
+    if (fs::exists(bag))
+      throw ConfigError("", 0, "--out",
+                        "'" + bag.string() + "' exists; expected a new file (never overwritten)");
+    const fs::path parent = fs::absolute(bag).parent_path();
+    fs::create_directories(parent);
+    replayed.emplace(parent / (fs::absolute(bag).filename().string() + ".replay-tmp"));
+    ReplayOptions replay;
+    replay.log_path = s.input;
+    replay.out_dir = replayed->path().string();
+    replay.force = true;
+    replay.world_override = s.replay_world;
+    replay.adversity = s.replay_adversity;
+    replay.progress = false;
+    spdlog::info("replaying {} into {} for the export", s.input, replay.out_dir);
+    ReplayLog(replay);
+    run_dir = replayed->path();
+  } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
+    throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
+                      "only for a run log (.plog) input, which is replayed first");
+  }
+  const RosbagExportSummary summary = ExportRosbag(run_dir, bag);
+  spdlog::info("exported {} messages on {} topics (names from {}) -> {}", summary.messages,
+               summary.counts.size(), summary.world_file, s.out);
+  return 0;
+}
+
 ExportCommand AddExportCommand(CLI::App& app) {
   ExportCommand c;
   c.state_ = std::make_shared<ExportCommand::State>();
   ExportCommand::State& s = *c.state_;
   s.command = app.add_subcommand(
-      "export", "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset");
+      "export",
+      "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset, or as a "
+      "ROS 1 bag");
   s.command
       ->add_option("run", s.input,
                    "output folder of `penumbra run`, or a run log (.plog), replayed first")
@@ -114,8 +165,9 @@ ExportCommand AddExportCommand(CLI::App& app) {
                         "for a .plog: adversity preset of the replay (replay --adversity)");
   s.command->add_option("--format,-f", s.format, "dataset layout")
       ->required()
-      ->check(CLI::IsMember({"tum", "euroc", "kitti"}));
-  s.command->add_option("--out,-o", s.out, "output folder (new or empty)")->required();
+      ->check(CLI::IsMember({"tum", "euroc", "kitti", "rosbag"}));
+  s.command->add_option("--out,-o", s.out, "output folder (new or empty); rosbag: a new FILE.bag")
+      ->required();
   s.command->add_option("--camera", s.options.camera,
                         "camera to export (default: the run's only camera)");
   s.command->add_option("--camera2", s.options.camera2,

@@ -1,9 +1,10 @@
 #pragma once
 // `penumbra export RUN_DIR --format tum|euroc|kitti --out DIR [--camera NAME]
 // [--camera2 NAME] [--imu NAME] [--sequence NN]`: a run's output folder in a public dataset
-// layout (dataset/dataset_export.h, docs/datasets.md). RUN may also be a run log (.plog): it
-// is first replayed (replay/replay_runner.h; --world and --adversity as `penumbra replay`'s)
-// into a temporary folder beside --out, removed afterwards.
+// layout (dataset/dataset_export.h, docs/datasets.md); `--format rosbag --out FILE.bag`: a ROS 1
+// bag of every sensor and robot state (ros/rosbag_export.h, docs/ros.md). RUN may also be a run log
+// (.plog): it is first replayed (replay/replay_runner.h; --world and --adversity as `penumbra
+// replay`'s) into a temporary folder beside --out, removed afterwards.
 
 #include <CLI/CLI.hpp>
 #include <memory>
@@ -23,6 +24,7 @@ class ExportCommand {
 
  private:
   friend ExportCommand AddExportCommand(CLI::App& app);
+  int RunRosbag() const;
   struct State;
   std::shared_ptr<State> state_;
 };

@@ -15,6 +15,7 @@
 #include "penumbra/world/effects_reader.h"
 #include "penumbra/world/mesh_import_config.h"
 #include "penumbra/world/procedural_material_config.h"
+#include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -41,7 +42,7 @@ class WorldParser {
         "seed",      "duration_sec", "physics", "render",    "sky",
         "robots",    "models",       "lights",  "cameras",   "mjcf_cameras",
         "materials", "output",       "agents",  "adversity", "semantic_classes",
-        "effects",   "sensors",      "record",  "metrics"};
+        "effects",   "sensors",      "record",  "metrics",   "ros"};
     if (root.IsNull() || !root.IsDefined()) {
       r.Fail("the world file is empty; expected a mapping with some of the keys: " +
              JoinNames(keys));
@@ -118,6 +119,16 @@ class WorldParser {
     if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
     if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
     if (r.Has("metrics")) w.metrics = ReadMetrics(r.Child("metrics"));
+    // `ros:` is checked here and read again by the ROS module (world/ros_config.h)
+    if (r.Has("ros")) {
+      const RosConfig ros = ReadRosConfig(r.Child("ros"));
+      try {
+        ros.ValidateOrThrow();
+        ValidateRosReferences(ros, w);
+      } catch (const ConfigError& e) {
+        throw ConfigError(file_, lines_ ? lines_->Find(e.key()) : 0, e.key(), e.problem());
+      }
+    }
     if (r.Has("adversity")) {
       const YamlReader a = r.Child("adversity");
       w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());

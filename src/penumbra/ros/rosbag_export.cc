@@ -1,0 +1,333 @@
+#include "penumbra/ros/rosbag_export.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/dataset/run_folder.h"
+#include "penumbra/output/pcd_writer.h"
+#include "penumbra/output/png_io.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/ros/ros_convert.h"
+#include "penumbra/ros/ros_graph.h"
+#include "penumbra/ros/rosbag_writer.h"
+#include "penumbra/scene/sim_time.h"
+#include "penumbra/world/ros_config.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// the lines of a CSV file after its header, split at commas, with their 1-based line numbers
+struct CsvRows {
+  fs::path path;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  std::vector<int> lines;
+
+  double Number(size_t row, size_t col) const {
+    if (col >= rows[row].size())
+      throw ConfigError(path.string(), lines[row], header.size() > col ? header[col] : "",
+                        "missing column " + std::to_string(col + 1));
+    const std::string& s = rows[row][col];
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size())
+      throw ConfigError(path.string(), lines[row], header.size() > col ? header[col] : "",
+                        "'" + s + "' is not a number");
+    return v;
+  }
+};
+
+std::vector<std::string> SplitComma(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) out.push_back(cell);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+CsvRows ReadCsvRows(const fs::path& path, const std::string& first_columns) {
+  std::ifstream in(path);
+  if (!in)
+    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+  CsvRows csv;
+  csv.path = path;
+  std::string line;
+  if (!std::getline(in, line) || line.rfind(first_columns, 0) != 0)
+    throw ConfigError(path.string(), 1, "", "header does not start with '" + first_columns + "'");
+  csv.header = SplitComma(line);
+  int n = 1;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty()) continue;
+    csv.rows.push_back(SplitComma(line));
+    csv.lines.push_back(n);
+  }
+  return csv;
+}
+
+nlohmann::json ReadJsonFile(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in)
+    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ConfigError(path.string(), 0, "", std::string("not valid JSON: ") + e.what());
+  }
+}
+
+// the run's world (names and `ros:` overrides): run.json "world_file"
+WorldConfig RunWorld(const fs::path& run_dir, std::string* world_file) {
+  const fs::path manifest = run_dir / "run.json";
+  const nlohmann::json j = ReadJsonFile(manifest);
+  if (!j.contains("world_file") || !j["world_file"].is_string())
+    throw ConfigError(manifest.string(), 0, "world_file",
+                      "missing; expected the world file of the run");
+  *world_file = j["world_file"].get<std::string>();
+  std::error_code ec;
+  if (!fs::is_regular_file(*world_file, ec))
+    throw ConfigError(manifest.string(), 0, "world_file",
+                      "the run's world file '" + *world_file +
+                          "' is gone; the export names topics and frames from it");
+  const std::string ext = fs::path(*world_file).extension().string();
+  if (ext == ".xml" || ext == ".urdf") return WorldForBareModel(*world_file);
+  return LoadWorldFile(*world_file);
+}
+
+}  // namespace
+
+RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_path) {
+  if (bag_path.extension() != ".bag")
+    throw ConfigError("", 0, "--out",
+                      "'" + bag_path.string() + "'; expected a bag file name ending in .bag");
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(bag_path, ec)))
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + bag_path.string() + "' exists; expected a new file (never overwritten)");
+  const RunFolder run(run_dir);
+  RosbagExportSummary summary;
+  const WorldConfig world = RunWorld(run_dir, &summary.world_file);
+
+  // the composed model poses the robots from trajectory.csv
+  const fs::path composed = run_dir / "composed.xml";
+  if (!fs::is_regular_file(composed, ec))
+    throw ConfigError(composed.string(), 0, "", "missing; expected the run's composed model");
+  Simulation sim = Simulation::LoadFromFile(composed.string());
+  const ModelInfo& model = sim.model_info();
+
+  // mounts: cameras as the run wrote them (camera_info.json, rig.json), LiDARs and IMUs from the
+  // world file
+  std::vector<RosSensorMount> mounts;
+  std::vector<RunCamera> cameras;
+  for (const std::string& name : run.CameraNames()) {
+    RunCamera cam = run.ReadCamera(name);
+    RosSensorMount m;
+    m.name = name;
+    m.kind = RosSensorKind::kCamera;
+    m.intrinsics.width = cam.width;
+    m.intrinsics.height = cam.height;
+    m.intrinsics.fx = cam.fx;
+    m.intrinsics.fy = cam.fy;
+    m.intrinsics.cx = cam.cx;
+    m.intrinsics.cy = cam.cy;
+    m.intrinsics.k1 = cam.distortion[0];
+    m.intrinsics.k2 = cam.distortion[1];
+    m.intrinsics.p1 = cam.distortion[2];
+    m.intrinsics.p2 = cam.distortion[3];
+    m.intrinsics.k3 = cam.distortion[4];
+    m.rgb = cam.has_rgb;
+    m.depth = cam.has_depth;
+    if (const std::optional<RunMount> mount = run.CameraMount(name)) {
+      m.body = mount->body == "world" ? 0 : model.Find(ModelObject::kBody, mount->body);
+      if (m.body < 0)
+        throw ConfigError((run_dir / "rig.json").string(), 0, "cameras." + name + ".body",
+                          "body '" + mount->body + "' is not in composed.xml");
+      m.X_BS = mount->X_BS;
+    } else {
+      // an MJCF camera: posed by the model's own camera
+      m.body = -1;
+      for (const CameraSpec& c : sim.scene().cameras)
+        if (c.name == name) m.mjcf_camera = c.mjcf_camera;
+      if (m.mjcf_camera < 0)
+        throw ConfigError((run_dir / "camera_info.json").string(), 0, name,
+                          "camera '" + name +
+                              "' has no mount in rig.json and is no MJCF camera "
+                              "of composed.xml");
+    }
+    mounts.push_back(m);
+    cameras.push_back(std::move(cam));
+  }
+  SceneDescription no_cameras;  // world cameras came from the run folder above
+  for (RosSensorMount& m : SensorMountsOf(world, model, no_cameras)) mounts.push_back(m);
+  const RosGraph graph =
+      BuildRosGraph(world, LoadRosConfig(world), model, mounts, sim.MocapBodyNames());
+
+  fs::create_directories(fs::absolute(bag_path).parent_path(), ec);
+  bool done = false;
+  struct RemoveUnlessDone {
+    const fs::path& path;
+    const bool& done;
+    ~RemoveUnlessDone() {
+      if (done) return;
+      std::error_code e;
+      fs::remove(path, e);
+    }
+  } cleanup{bag_path, done};
+  RosbagWriter bag(bag_path.string());
+  auto count = [&](const std::string& topic) { ++summary.counts[topic]; };
+
+  // cameras
+  for (size_t ci = 0; ci < cameras.size(); ++ci) {
+    const RunCamera& cam = cameras[ci];
+    const RosSensorGraph& s = *graph.FindSensor(cam.name);
+    for (const RunFrame& f : cam.frames) {
+      const RosHeader header = MakeRosHeader(f.time_sec, s.frame_id);
+      const int64_t t = header.stamp_ns;
+      const RosCameraInfo info = CameraInfoToRos(s.mount.intrinsics, 0, header);
+      if (cam.has_rgb) {
+        const PngImage png = ReadPng(cam.ImagePath("rgb", f.index).string());
+        if (png.channels != 3 || png.bit_depth != 8)
+          throw ConfigError(cam.ImagePath("rgb", f.index).string(), 0, "",
+                            "expected an 8-bit RGB PNG");
+        ImageU8 rgb(png.width, png.height, 3);
+        for (size_t i = 0; i < png.samples.size(); ++i)
+          rgb.data[i] = static_cast<uint8_t>(png.samples[i]);
+        bag.Write(s.image_topic, t, RgbToRos(std::move(rgb), header));
+        bag.Write(s.info_topic, t, info);
+        count(s.image_topic);
+        count(s.info_topic);
+      }
+      if (cam.has_depth) {
+        const PngImage png = ReadPng(cam.ImagePath("depth", f.index).string());
+        if (png.channels != 1 || png.bit_depth != 16)
+          throw ConfigError(cam.ImagePath("depth", f.index).string(), 0, "",
+                            "expected a 16-bit greyscale PNG");
+        bag.Write(s.depth_image_topic, t, DepthMmToRos(png.width, png.height, png.samples, header));
+        bag.Write(s.depth_info_topic, t, info);
+        count(s.depth_image_topic);
+        count(s.depth_info_topic);
+      }
+    }
+  }
+
+  // LiDARs and IMUs
+  for (const SensorConfig& sc : world.sensors) {
+    const RosSensorGraph* s = graph.FindSensor(sc.name);
+    if (!s) continue;
+    const int64_t latency_ns = RosStampNs(sc.latency_sec);
+    if (sc.type == "lidar") {
+      const fs::path dir = run_dir / "lidar" / sc.name;
+      if (!fs::is_directory(dir, ec)) continue;
+      const CsvRows index =
+          ReadCsvRows(dir / "index.csv", "scan,capture_time_sec,delivery_time_sec,file");
+      for (size_t r = 0; r < index.rows.size(); ++r) {
+        const double capture = index.Number(r, 1), delivery = index.Number(r, 2);
+        const std::vector<LidarPoint> points = ReadPcd((dir / index.rows[r].at(3)).string());
+        bag.Write(s->points_topic, RosStampNs(delivery),
+                  PointsToRos(points, MakeRosHeader(capture, s->frame_id)));
+        count(s->points_topic);
+      }
+    } else if (sc.type == "imu") {
+      if (!fs::is_regular_file(run_dir / "imu" / (sc.name + ".csv"), ec)) continue;
+      const RunImu imu = run.ReadImu(sc.name);
+      for (const RunImuSample& x : imu.samples) {
+        const RosHeader header = MakeRosHeader(x.time_sec, s->frame_id);
+        bag.Write(s->imu_topic, header.stamp_ns + latency_ns,
+                  ImuToRos(x.accel_m_s2, x.gyro_rad_s, s->mount.accel_noise_density,
+                           s->mount.gyro_noise_density, s->mount.rate_hz, header));
+        count(s->imu_topic);
+      }
+    }
+  }
+
+  // robots: trajectory.csv rows posed through the composed model at the state rate
+  const fs::path trajectory = run_dir / "trajectory.csv";
+  if (fs::is_regular_file(trajectory, ec)) {
+    const CsvRows traj = ReadCsvRows(trajectory, "step,time_sec");
+    const size_t nq = static_cast<size_t>(model.nq);
+    SimState state = sim.GetState();
+    const double dt = sim.timestep();
+    auto snapshot_of = [&](size_t row) {
+      const int64_t step = std::llround(traj.Number(row, 0));
+      state.step_count = step;
+      state.time_sec = SimTimeOfStep(step, dt);
+      if (traj.rows[row].size() != 2 + nq)
+        throw ConfigError(trajectory.string(), traj.lines[row], "",
+                          std::to_string(traj.rows[row].size() - 2) + " qpos values; expected " +
+                              std::to_string(nq) + " (the nq of composed.xml)");
+      for (size_t i = 0; i < nq; ++i) state.qpos[i] = traj.Number(row, 2 + i);
+      sim.SetState(state);
+      return sim.Snapshot(Simulation::SnapshotContent::kPoses);
+    };
+    bool first = true;
+    std::optional<WorldSnapshot> previous;
+    size_t previous_row = 0;
+    int64_t k = 0;
+    for (size_t row = 0; row < traj.rows.size(); ++row) {
+      const double time = traj.Number(row, 1);
+      if (time < static_cast<double>(k) / graph.state_rate_hz) continue;
+      while (static_cast<double>(k) / graph.state_rate_hz <= time) ++k;
+      const WorldSnapshot snap = snapshot_of(row);
+      // the step before, for the backward differences
+      std::optional<WorldSnapshot> before;
+      if (row > 0) before = row - 1 == previous_row && previous ? *previous : snapshot_of(row - 1);
+      const int64_t stamp = RosStampNs(snap.time_sec);
+      if (first) {
+        for (const RosTransform& tf : StaticTransforms(graph, snap)) {
+          bag.Write("/tf_static", stamp, tf);
+          count("/tf_static");
+        }
+        first = false;
+      }
+      for (const RosTransform& tf : DynamicTransforms(graph, snap)) {
+        bag.Write("/tf", stamp, tf);
+        count("/tf");
+      }
+      for (const RosRobotGraph& r : graph.robots) {
+        Eigen::Matrix<double, 6, 1> V = Eigen::Matrix<double, 6, 1>::Zero();
+        std::vector<double> qvel;
+        if (before) {
+          const double h = snap.time_sec - before->time_sec;
+          const Pose& a = before->X_WB[r.base_body];
+          const Pose& b = snap.X_WB[r.base_body];
+          const Eigen::AngleAxisd d(b.rotation() * a.rotation().transpose());
+          V.head<3>() = d.axis() * d.angle() / h;
+          V.tail<3>() = (b.translation() - a.translation()) / h;
+          qvel.assign(static_cast<size_t>(model.nv), 0.0);
+          for (int j : r.joints) {
+            const JointInfo& ji = model.joints[j];
+            qvel[ji.dof_adr] = (snap.qpos[ji.qpos_adr] - before->qpos[ji.qpos_adr]) / h;
+          }
+        }
+        bag.Write(r.odom_topic, stamp,
+                  OdometryToRos(snap.X_WB[r.base_body], V, r.odom_frame, r.base_frame, stamp));
+        bag.Write(r.joint_states_topic, stamp,
+                  JointStateToRos(model, r.joints, snap.qpos, qvel, {}, stamp));
+        count(r.odom_topic);
+        count(r.joint_states_topic);
+      }
+      previous = snap;
+      previous_row = row;
+    }
+  }
+  bag.Close();
+  done = true;
+  for (const auto& [topic, n] : summary.counts) summary.messages += n;
+  return summary;
+}
+
+}  // namespace penumbra

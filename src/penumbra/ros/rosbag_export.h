@@ -1,0 +1,45 @@
+#pragma once
+// `penumbra export RUN --format rosbag --out FILE.bag`: a run's output folder (README
+// "Outputs") as a ROS 1 bag with the topics and frames the live bridge publishes
+// (ros/ros_graph.h, docs/ros.md), written with the rosbag C++ API (ros/rosbag_writer.h):
+//
+//   cameras  <camera>/frames.csv + rgb/depth PNGs -> image_raw, camera_info, depth/image_raw,
+//            depth/camera_info, stamped with the frame's sim time
+//   LiDARs   lidar/<name>/index.csv + scan PCDs   -> points (PointCloud2), stamped with the
+//            capture time, recorded at the delivery time (capture + latency)
+//   IMUs     imu/<name>.csv                       -> data (Imu), likewise
+//   robots   trajectory.csv (qpos of every physics step) posed through the composed model
+//            (composed.xml) at ros.state_rate_hz: odom (Odometry), joint_states, /tf
+//            (odom -> base_link, moving sensors); /tf_static once (map -> odom, sensors fixed
+//            to their parent). trajectory.csv holds no velocities: the twist and the joint
+//            velocities are backward differences over one physics step; effort is left empty.
+//
+// names (topics, frames, `ros:` overrides) come from the run's world file (run.json
+// "world_file"), which must still be readable. a sample at sim time t has header stamp t and is
+// recorded at t (or its delivery time); rosbag's smallest record time is 1 ns, so records at
+// t = 0 are stored at 1 ns (their header stamps stay 0). no /clock is written: `rosbag play
+// --clock` publishes one.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace penumbra {
+
+/// what an export wrote.
+struct RosbagExportSummary {
+  std::string world_file;                 ///< the world file the names came from
+  std::map<std::string, int64_t> counts;  ///< messages per topic
+  int64_t messages = 0;                   ///< all messages
+};
+
+/// writes the bag `bag_path` (must not exist; its folder is created) from the run folder
+/// `run_dir`. if the export fails the partial bag is removed.
+/// @throws ConfigError for a missing or malformed run folder file (naming file and line), an
+///         unreadable world file, a bag path that exists or does not end in ".bag" (key "--out");
+///         Error if ROS 1 is not in this build or the bag cannot be written.
+RosbagExportSummary ExportRosbag(const std::filesystem::path& run_dir,
+                                 const std::filesystem::path& bag_path);
+
+}  // namespace penumbra
