@@ -196,7 +196,10 @@ struct Generator {
     const float dirt = Fbm(seed, 52, u, v, dirt_c, dirt_c, 4);
     t.albedo = tint * (0.85f + 0.25f * dirt);
     t.roughness = 0.32f + 0.12f * dirt + 0.04f * p;
-    t.height_m = 0.00006f * p;  // orange peel: 60 um over 4 mm
+    // orange peel (60 um over 4 mm) and dings of the sheet (0.5 mm over ~3 cm)
+    const int ding_c = std::max(1, static_cast<int>(std::lround(size / 0.03f)));
+    const float ding = Fbm(seed, 54, u, v, ding_c, ding_c, 2);
+    t.height_m = 0.00006f * p + 0.0005f * ding;
     // scratches: segments 2-20 cm long, 0.3-1 mm wide, bare steel in them
     const int n = std::max(1, static_cast<int>(std::lround(40 * size * size)));
     for (int k = 0; k < n; ++k) {
