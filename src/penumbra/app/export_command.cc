@@ -41,6 +41,29 @@ class TempFolder {
   std::filesystem::path path_;
 };
 
+// replays the run log `log_path` (replay/replay_runner.h, with the recorded conditions or the
+// given --world / --adversity) into a temporary run folder "<out>.replay-tmp" beside `out`,
+// kept in `replayed` (removed when it is destroyed); returns that folder.
+std::filesystem::path ReplayLogBeside(const std::string& log_path, const std::string& world_override,
+                                      const std::string& adversity,
+                                      const std::filesystem::path& out,
+                                      std::optional<TempFolder>* replayed) {
+  namespace fs = std::filesystem;
+  const fs::path parent = fs::absolute(out).parent_path();
+  fs::create_directories(parent);
+  replayed->emplace(parent / (fs::absolute(out).filename().string() + ".replay-tmp"));
+  ReplayOptions replay;
+  replay.log_path = log_path;
+  replay.out_dir = (*replayed)->path().string();
+  replay.force = true;
+  replay.world_override = world_override;
+  replay.adversity = adversity;
+  replay.progress = false;
+  spdlog::info("replaying {} into {} for the export", log_path, replay.out_dir);
+  ReplayLog(replay);
+  return (*replayed)->path();
+}
+
 }  // namespace
 
 bool ExportCommand::selected() const {
@@ -66,19 +89,7 @@ int ExportCommand::Run() const {
       throw ConfigError(
           "", 0, "--out",
           "'" + options.out_dir.string() + "' is not empty; expected a new or empty folder");
-    const fs::path parent = fs::absolute(options.out_dir).parent_path();
-    fs::create_directories(parent);
-    replayed.emplace(parent / (fs::absolute(options.out_dir).filename().string() + ".replay-tmp"));
-    ReplayOptions replay;
-    replay.log_path = s.input;
-    replay.out_dir = replayed->path().string();
-    replay.force = true;
-    replay.world_override = s.replay_world;
-    replay.adversity = s.replay_adversity;
-    replay.progress = false;
-    spdlog::info("replaying {} into {} for the export", s.input, replay.out_dir);
-    ReplayLog(replay);
-    run_dir = replayed->path();
+    run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, options.out_dir, &replayed);
     options.source_label = fs::absolute(input).lexically_normal().string();
   } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
     throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
@@ -123,19 +134,7 @@ int ExportCommand::RunRosbag() const {
     if (fs::exists(bag))
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "' exists; expected a new file (never overwritten)");
-    const fs::path parent = fs::absolute(bag).parent_path();
-    fs::create_directories(parent);
-    replayed.emplace(parent / (fs::absolute(bag).filename().string() + ".replay-tmp"));
-    ReplayOptions replay;
-    replay.log_path = s.input;
-    replay.out_dir = replayed->path().string();
-    replay.force = true;
-    replay.world_override = s.replay_world;
-    replay.adversity = s.replay_adversity;
-    replay.progress = false;
-    spdlog::info("replaying {} into {} for the export", s.input, replay.out_dir);
-    ReplayLog(replay);
-    run_dir = replayed->path();
+    run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, bag, &replayed);
   } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
     throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
                       "only for a run log (.plog) input, which is replayed first");
