@@ -19,6 +19,7 @@ pkgs=(
   ros-base-dev libroscpp-dev librosbag-dev libtf2-ros-dev libsensor-msgs-dev libnav-msgs-dev
   libgeometry-msgs-dev libstd-srvs-dev libtf2-msgs-dev  # ROS 1 bridge and rosbag export
   rosout rosbash python3-rosbag python3-rostopic  # roscore, rostopic, rosbag tools for the ROS tests
+  python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-tf2-msgs python3-std-srvs  # rostopic, rosservice of them
   libboost-dev libturbojpeg0-dev libjs-three  # browser viewer: Boost.Beast, JPEG frames, three.js
   chromium chromium-driver python3-websocket python3-selenium  # viewer tests drive a real headless Chromium
   libcgal-dev  # convex decomposition (CoACD) clipping and hulls

@@ -304,8 +304,10 @@ class Client:
         return self.request("set_adversity", preset=preset)
 
     def set_effect(self, effect, **params):
-        """Changes parameters of the world file's effect ``effect`` (names and units as in the
-        world file, docs/effects.md), e.g. ``set_effect("fog", density=0.2)``."""
+        """Changes one effect from the next step (docs/zmq-protocol.md ``set_effect``): an effect
+        of the world file (its world-file keys), a block of the live adversity preset (``fog``,
+        ``smoke``, ``rain``, ``snow``, ``lights``, ``npcs``, ``dust``), or a new effect (with
+        ``type``), e.g. ``set_effect("fog", mor_m=5.0)``."""
         return self.request("set_effect", effect=effect, params=params)
 
     def start_recording(self, path, sensors=False):

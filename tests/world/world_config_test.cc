@@ -622,7 +622,7 @@ TEST_F(WorldConfigTest, MissingModelFileNamesResolvedPath) {
 }
 
 TEST_F(WorldConfigTest, WrongModelExtension) {
-  ExpectError("models:\n  - name: r\n    file: models/room.obj\n", 3, "models[0].file",
+  ExpectError("models:\n  - name: r\n    file: models/room.step\n", 3, "models[0].file",
               "expected an MJCF (.xml) or URDF (.urdf) file");
 }
 

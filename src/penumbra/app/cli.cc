@@ -16,8 +16,12 @@
 #include <optional>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/app/bench_bridge.h"
 #include "penumbra/app/bench_record.h"
+#include "penumbra/app/bridge_flags.h"
 #include "penumbra/app/bench_ros.h"
+#include "penumbra/app/viewer_commands.h"
+#include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
@@ -210,6 +214,10 @@ int RunCli(int argc, char** argv) {
                   "write a run log of every physics step to FILE.plog (docs/run-log.md)");
   run->add_flag("--record-sensors", run_options.record_sensors,
                 "the run log also holds every camera image and sensor output");
+  BridgeFlags bridge_flags;
+  bridge_flags.Add(run);
+  ViewerFlag viewer_flag;
+  viewer_flag.Add(run);
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
@@ -261,7 +269,41 @@ int RunCli(int argc, char** argv) {
   bool no_controllers = false;
   bench_physics->add_flag("--no-controllers", no_controllers, "skip the controller-cost table of the bundled robot worlds");
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
+  const std::unique_ptr<BenchBridgeCommand> bench_bridge = AddBenchBridgeCommand(*bench);
   const std::unique_ptr<BenchRosCommand> bench_ros = AddBenchRosCommand(*bench);
+  // penumbra bench viewer / penumbra view (app/viewer_commands.h, docs/viewer.md)
+  CLI::App* bench_viewer = bench->add_subcommand(
+      "viewer", "live viewer: frames/s delivered, input-to-photon latency, steps/s with a viewer");
+  BenchViewerOptions viewer_bench;
+  bench_viewer->add_option("--world", viewer_bench.world_file,
+                           "world file (default: bundled default world)");
+  AddDecimal(
+      bench_viewer, "--seconds", [&](double v) { viewer_bench.seconds = v; }, 0, true,
+      "simulated seconds per timed run");
+  AddInteger(bench_viewer, "--rounds", &viewer_bench.rounds, 1, 100, "A/B pairs");
+  AddDecimal(
+      bench_viewer, "--camera-hz", [&](double v) { viewer_bench.camera_hz = v; }, 0, true,
+      "rate of the streamed camera, Hz");
+  AddInteger(bench_viewer, "--latency-samples", &viewer_bench.latency_samples, 0, 1000,
+             "teleop commands timed at real-time pacing (0 = none)");
+  CLI::App* view = app.add_subcommand(
+      "view", "a world served live to browsers: real time, paused at the start (docs/viewer.md)");
+  std::string view_world;
+  ViewOptions view_options;
+  view->add_option("world", view_world, "world file (.yaml) or model (.xml MJCF, .urdf)")
+      ->required();
+  view->add_option("--viewer", view_options.address,
+                   "HOST:PORT to serve on (default 127.0.0.1:8080; loopback unless told)");
+  view->add_option("--out,-o", view_options.out_dir,
+                   "keep the camera outputs in this folder (default: a temporary folder, removed "
+                   "at exit)");
+  AddDecimal(
+      view, "--duration", [&](double v) { view_options.duration_sec = v; }, 0, true,
+      "simulated seconds (default: the world's duration_sec)");
+  view->add_option("--adversity", view_options.adversity,
+                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME");
+  view->add_flag("--running", view_options.running, "start running instead of paused");
+  view->add_flag("--force", view_options.force, "--out may hold an earlier run's outputs");
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -277,6 +319,8 @@ int RunCli(int argc, char** argv) {
   const ExportCommand export_command = AddExportCommand(app);
   // penumbra replay (app/replay_command.h)
   const ReplayCommand replay = AddReplayCommand(app);
+  // penumbra benchmark / slam (app/benchmark_command.h)
+  const BenchmarkCommands benchmark_commands(app);
 
   // usage errors exit 2 with CLI11's message on stderr; --help and --version print to stdout
   // and exit 0
@@ -301,6 +345,8 @@ int RunCli(int argc, char** argv) {
       run_options.command_line = Args(argc, argv);
       if (!outputs.empty() || run->count("--outputs"))
         run_options.outputs = ParseCameraOutputs(outputs);
+      bridge_flags.Apply(*run, &run_options);
+      viewer_flag.Apply(*run, &run_options);
       g_stop_signal.store(0);
       run_options.stop_request = &g_stop_signal;
       const StopSignals stop_signals;
@@ -309,6 +355,13 @@ int RunCli(int argc, char** argv) {
       for (const auto& [name, n] : s.frames_per_camera) frames += n;
       spdlog::info("done: {:.3f} s sim time, {} steps, {} frames in {:.2f} s wall, peak RSS {:.0f} MiB -> {}",
                    s.sim_time_sec, s.physics_steps, frames, s.wall_time_sec, s.peak_rss_mib, s.out_dir);
+      if (s.interrupted && g_stop_signal.load() == 0) {
+        spdlog::info(
+            "stopped by a client's `stop` at {:.6g} s of sim time; outputs and run.json "
+            "written",
+            s.sim_time_sec);
+        return 0;
+      }
       if (s.interrupted) {
         const int sig = g_stop_signal.load();
         spdlog::warn("interrupted by {} at {:.6g} s of sim time; outputs and run.json written",
@@ -321,6 +374,11 @@ int RunCli(int argc, char** argv) {
       g_stop_signal.store(0);
       const StopSignals stop_signals;
       return replay.Run(Args(argc, argv), &g_stop_signal);
+    }
+    if (benchmark_commands.Selected()) {
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return benchmark_commands.Run(&g_stop_signal);
     }
     if (*bench_render) {
       render_bench.adversity = !no_adversity;
@@ -335,7 +393,16 @@ int RunCli(int argc, char** argv) {
     if (*bench_sensors) return BenchSensors(sensor_bench);
     if (eval.Selected()) return eval.Run();
     if (*bench_record->app) return bench_record->Run();
+    if (*bench_bridge->app) return bench_bridge->Run();
     if (*bench_ros->app) return bench_ros->Run();
+    if (*bench_viewer) return BenchViewer(viewer_bench);
+    if (*view) {
+      const WorldConfig world = LoadWorldOrModel(view_world);
+      view_options.command_line = Args(argc, argv);
+      g_stop_signal.store(0);
+      const StopSignals stop_signals;
+      return RunView(world, view_options, &g_stop_signal);
+    }
     if (*bench_physics) {
       physics_bench.controllers = !no_controllers;
       return BenchPhysics(physics_bench);

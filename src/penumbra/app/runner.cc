@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "penumbra/command/bridge_set.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/manifest_sink.h"
@@ -167,10 +168,20 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
 
   PhysicsSourceOptions physics_options;
   physics_options.realtime = options.realtime;
-  PhysicsSource physics(&sim, physics_options);
   SimLoopOptions loop_options;
   loop_options.end_time_sec = duration;
   loop_options.stop_request = options.stop_request;
+  // middleware bridges (--zmq, ...): commands and steps through one RunControl
+  std::unique_ptr<BridgeSet> bridges;
+  if (!options.bridges.empty()) {
+    bridges = std::make_unique<BridgeSet>(
+        session, world, outputs,
+        BridgeSetOptions{options.lockstep, options.realtime ? 1.0 : 0.0, options.stop_request,
+                         &live},
+        options.bridges);
+    bridges->Configure(&physics_options, &loop_options);
+  }
+  PhysicsSource physics(&sim, physics_options);
   SimLoop loop(&physics, loop_options);
   RunSummary summary;
   // the run log (--record): every step's state from the loop thread, closed (complete) at the
@@ -230,6 +241,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   outputs.AddTo(&loop);
   if (recorder) loop.AddSink(recorder.get());
   live.AddAfterOutputs(&loop);
+  if (bridges) bridges->AddTo(&loop);
   loop.AddSink(&manifest);
   rollback.Dismiss();
   if (options.on_live) options.on_live(live);

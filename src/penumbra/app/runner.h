@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/command/run_bridge.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -40,6 +41,12 @@ struct RunOptions {
   /// up to there, writes run.json with "interrupted": true and returns normally with
   /// RunSummary::interrupted set.
   const std::atomic<int>* stop_request = nullptr;
+  /// middleware bridges attached to the run (command/run_bridge.h, e.g. --zmq's). with any,
+  /// the run is live: its commands go through one CommandDispatcher, its steps through a
+  /// RunControl (command/bridge_set.h), which also does the --realtime pacing.
+  std::vector<RunBridgeFactory> bridges;
+  /// with bridges: the run starts paused and advances only by `step` requests (--lockstep).
+  bool lockstep = false;
   /// called once the run is set up, before its first step, on the caller's thread, with the
   /// run's live controls (session/live_control.h: adversity and effect changes, start/stop
   /// recording; thread-safe). the LiveControl lives until RunWorld returns: stop using it

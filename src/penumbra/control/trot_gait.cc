@@ -450,6 +450,14 @@ void TrotGait::FirstUpdate(const ControlInput& in, const Eigen::Vector3d& com,
   started_ = true;
 }
 
+void TrotGait::SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) {
+  if (waypoints.empty()) throw Error(label() + ": empty waypoint list; expected at least 1");
+  for (const auto& w : waypoints)
+    if (!w.allFinite()) throw Error(label() + ": non-finite waypoint coordinate");
+  route_.emplace(std::move(waypoints), loop, params_.tolerance_m);
+  override_.reset();
+}
+
 void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   const double t = in.time_sec();
   const Pose X_WB = in.X_WB(base_);

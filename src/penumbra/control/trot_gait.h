@@ -213,6 +213,11 @@ class TrotGait final : public Controller {
   void SetCommand(const TrotCommand& command) { override_ = command; }
   /// returns to the waypoints (if configured and not finished), else the script.
   void ClearCommand() { override_.reset(); }
+  /// replaces the waypoints (world x, y, m; at least 1) with `loop` from the next update on
+  /// (waypoint mode, also for a gait configured without waypoints) and clears a SetCommand
+  /// override; speed, yaw-rate limit and tolerance stay. physics thread, between steps.
+  /// @throws Error for an empty list or a non-finite coordinate.
+  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop);
 
   const TrotGaitParams& params() const { return params_; }
   /// the command in force at the last update (set, from the waypoints or scripted).

@@ -83,6 +83,22 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
   route_.Reset();
 }
 
+void WaypointFollower::SetTwist(double v_m_s, double yaw_rate) {
+  if (!std::isfinite(v_m_s) || !std::isfinite(yaw_rate))
+    throw Error(label() + ": twist must be finite (got v " + std::to_string(v_m_s) +
+                " m/s, yaw rate " + std::to_string(yaw_rate) + " rad/s)");
+  twist_ = std::array<double, 2>{v_m_s, yaw_rate};
+}
+
+void WaypointFollower::SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) {
+  if (waypoints.empty()) throw Error(label() + ": empty waypoint list; expected at least 1");
+  for (const auto& w : waypoints)
+    if (!w.allFinite()) throw Error(label() + ": non-finite waypoint coordinate");
+  route_ = WaypointRoute(std::move(waypoints), loop, params_.tolerance_m);
+  start_.reset();
+  twist_.reset();
+}
+
 void WaypointFollower::Compute(const ControlInput& input, std::span<double> ctrl) {
   const Pose X_WB = input.X_WB(base_body_);
   const Eigen::Vector2d p = X_WB.translation().head<2>();
@@ -101,7 +117,10 @@ void WaypointFollower::Compute(const ControlInput& input, std::span<double> ctrl
     tracking_ = {(a + s * ab - p).norm(), (route_.target() - p).norm()};
   }
   UnicycleCommand cmd;
-  if (!route_.finished())
+  if (twist_) {
+    cmd.v_m_s = (*twist_)[0];
+    cmd.yaw_rate = (*twist_)[1];
+  } else if (!route_.finished())
     cmd = PurePursuit(X_WB, route_.target(),
                       {params_.speed_m_s, params_.max_yaw_rate_deg_s * M_PI / 180.0});
   v_ = cmd.v_m_s;

@@ -92,6 +92,19 @@ class WaypointFollower final : public Controller {
     out->insert(out->end(), tracking_.begin(), tracking_.end());
   }
 
+  /// programmatic twist (e.g. a middleware's cmd_vel): from the next update on, the robot
+  /// drives at forward speed `v_m_s` (m/s) and yaw rate `yaw_rate` (rad/s, counter-clockwise
+  /// seen from above) instead of following the route, until ClearTwist() (the route pauses
+  /// meanwhile). call from the thread that steps the simulation, between steps.
+  /// @throws Error for a non-finite value.
+  void SetTwist(double v_m_s, double yaw_rate);
+  /// back to the route.
+  void ClearTwist() { twist_.reset(); }
+  /// replaces the route by `waypoints` (world x, y, m; at least 1) with `loop`, from the next
+  /// update on, and clears a twist; the tolerance, speed and yaw-rate limit stay. physics
+  /// thread, between steps. @throws Error for an empty list or a non-finite coordinate.
+  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop);
+
   const WaypointFollowerParams& params() const { return params_; }
   /// index of the waypoint being driven to.
   int target_index() const { return route_.target_index(); }
@@ -112,6 +125,7 @@ class WaypointFollower final : public Controller {
   WaypointRoute route_;
   double v_ = 0, omega_ = 0;
   std::optional<Eigen::Vector2d> start_;         ///< base origin at the first update (world xy, m)
+  std::optional<std::array<double, 2>> twist_;   ///< SetTwist: v (m/s), yaw rate (rad/s)
   std::array<double, 2> tracking_ = {NAN, NAN};  ///< see tracking_error_labels()
 };
 

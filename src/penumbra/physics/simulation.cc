@@ -604,6 +604,29 @@ std::vector<std::string> Simulation::MocapBodyNames() const {
   return names;
 }
 
+bool Simulation::MocapDriven(int mocap_id) const {
+  if (mocap_id < 0 || mocap_id >= impl_->m->nmocap)
+    throw Error("mocap id " + std::to_string(mocap_id) + " outside [0, " +
+                std::to_string(impl_->m->nmocap) + ")");
+  for (const auto& md : impl_->mocap_drivers)
+    if (md.mocap_id == mocap_id) return true;
+  return false;
+}
+
+void Simulation::SetMocapPose(int mocap_id, const Pose& X_WB) {
+  if (mocap_id < 0 || mocap_id >= impl_->m->nmocap)
+    throw Error("mocap id " + std::to_string(mocap_id) + " outside [0, " +
+                std::to_string(impl_->m->nmocap) + ")");
+  if (!X_WB.matrix().allFinite()) throw Error("mocap pose is not finite");
+  const Eigen::Quaterniond q = Eigen::Quaterniond(X_WB.linear()).normalized();
+  mjData* d = impl_->d;
+  for (int k = 0; k < 3; ++k) d->mocap_pos[3 * mocap_id + k] = X_WB.translation()[k];
+  d->mocap_quat[4 * mocap_id + 0] = q.w();
+  d->mocap_quat[4 * mocap_id + 1] = q.x();
+  d->mocap_quat[4 * mocap_id + 2] = q.y();
+  d->mocap_quat[4 * mocap_id + 3] = q.z();
+}
+
 void Simulation::SnapshotState(WorldSnapshot* out) const {
   const mjModel* m = impl_->m;
   const mjData* d = impl_->d;
@@ -827,5 +850,7 @@ std::span<double> Simulation::ctrl() { return {impl_->d->ctrl, static_cast<size_
 const std::string& Simulation::source() const { return impl_->source; }
 int Simulation::num_controllers() const { return static_cast<int>(impl_->controllers.size()); }
 const Controller& Simulation::controller(int i) const { return *impl_->controllers.at(i); }
+
+Controller& Simulation::mutable_controller(int i) { return *impl_->controllers.at(i); }
 
 }  // namespace penumbra

@@ -196,12 +196,23 @@ class Simulation {
 
   /// the names of the mocap bodies by mocap id (the order of SimState::mocap_pos / mocap_quat).
   std::vector<std::string> MocapBodyNames() const;
+  /// true when mocap body `mocap_id` has a driver (AddMocapDriver), which poses it every step.
+  /// @throws Error for an id outside [0, number of mocap bodies).
+  bool MocapDriven(int mocap_id) const;
+  /// sets the pose X_WB of mocap body `mocap_id` (position m, world frame; the rotation is
+  /// stored as a unit quaternion); it holds until set again. a driven body (MocapDriven) is
+  /// moved back by its driver at the next step. between steps, on the stepping thread.
+  /// @throws Error for a bad id or a non-finite pose.
+  void SetMocapPose(int mocap_id, const Pose& X_WB);
 
   /// the file the model came from ("<string>" for LoadFromString).
   const std::string& source() const;
   /// controllers added so far, in order.
   int num_controllers() const;
   const Controller& controller(int i) const;
+  /// controller `i` for commands (e.g. TrotGait::SetCommand); use it only from the thread that
+  /// steps the simulation, between steps. @throws std::out_of_range for a bad index.
+  Controller& mutable_controller(int i);
 
  private:
   struct Impl;

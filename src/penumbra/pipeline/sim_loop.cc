@@ -72,7 +72,11 @@ void SimLoop::Loop() {
         break;
       }
       if (!source_->Advance()) {
-        reason = LoopEndReason::kSourceEnded;
+        // a source that stops because a stop was requested meanwhile (e.g. a live run waiting
+        // for commands) ends as stopped
+        reason = options_.stop_request && options_.stop_request->load() != 0
+                     ? LoopEndReason::kStopRequested
+                     : LoopEndReason::kSourceEnded;
         break;
       }
     }

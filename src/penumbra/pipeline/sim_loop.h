@@ -30,7 +30,8 @@ struct SimLoopOptions {
   /// the loop ends after the snapshot of the first step whose time is >= end_time_sec - 1e-9 s.
   double end_time_sec = std::numeric_limits<double>::infinity();
   /// a stop request (e.g. set by a SIGINT handler; null = none): when it reads non-zero the
-  /// loop ends at the next step boundary (after that step's snapshot) with kStopRequested.
+  /// loop ends at the next step boundary (after that step's snapshot) with kStopRequested; so
+  /// does a source whose Advance returns false while it reads non-zero.
   const std::atomic<int>* stop_request = nullptr;
 };
 

@@ -3,9 +3,12 @@
 // posts the slow part of its work (rendering, ray tracing, formatting and writing files) here;
 // tasks run one at a time in the order they were posted, so results stay deterministic.
 
+#include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <functional>
+#include <mutex>
 #include <thread>
 
 #include "penumbra/core/bounded_queue.h"
@@ -29,19 +32,34 @@ class SinkWorker {
     report_error_ = std::move(report_error);
     thread_ = std::thread([this] {
       while (std::optional<std::function<void()>> task = queue_.Pop()) {
-        if (failed_) continue;
-        try {
-          (*task)();
-        } catch (...) {
-          failed_ = true;
-          if (report_error_) report_error_(std::current_exception());
+        if (!failed_) {
+          try {
+            (*task)();
+          } catch (...) {
+            failed_ = true;
+            if (report_error_) report_error_(std::current_exception());
+          }
         }
+        std::lock_guard<std::mutex> lock(done_mutex_);
+        ++done_;
+        done_cv_.notify_all();
       }
     });
   }
 
   /// queues `task` (after Start); blocks while `capacity` tasks wait. ignored after Finish.
-  void Post(std::function<void()> task) { queue_.Push(std::move(task)); }
+  void Post(std::function<void()> task) {
+    ++posted_;
+    queue_.Push(std::move(task));
+  }
+
+  /// blocks until every task posted so far has run (or was skipped after an error); from the
+  /// thread that posts. returns at once before Start or after Finish.
+  void Drain() {
+    if (!thread_.joinable() || finished_) return;
+    std::unique_lock<std::mutex> lock(done_mutex_);
+    done_cv_.wait(lock, [&] { return done_ >= posted_; });
+  }
 
   /// runs every posted task (or skips it after an error), then ends the thread.
   void Finish() {
@@ -60,6 +78,10 @@ class SinkWorker {
   std::thread thread_;
   bool failed_ = false;
   bool finished_ = false;
+  int64_t posted_ = 0;  // poster's thread
+  std::mutex done_mutex_;
+  std::condition_variable done_cv_;
+  int64_t done_ = 0;  // guarded by done_mutex_
 };
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 
 #include "penumbra/core/error.h"
 #include "penumbra/scene/texture_image.h"
@@ -217,6 +218,25 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
     : scene_(scene),
       srgb_to_linear_(SrgbDecodeTable()),
       max_anisotropy_(std::max(1, max_anisotropy)) {
+  // the PBR maps by name (file comment): "<material>/<map>"
+  std::unordered_map<std::string, int> by_name;
+  for (size_t t = 0; t < scene.textures.size(); ++t)
+    if (scene.textures[t].kind == Texture::Kind::k2D && scene.textures[t].image)
+      by_name.emplace(scene.textures[t].name, static_cast<int>(t));
+  maps_.resize(scene.materials.size());
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const std::string& name = scene.materials[i].name;
+    if (name.empty() || by_name.empty()) continue;
+    auto find = [&](const char* map) {
+      const auto it = by_name.find(name + "/" + map);
+      return it == by_name.end() ? -1 : it->second;
+    };
+    maps_[i].normal = find("normal");
+    maps_[i].metallic_roughness = find("metallic_roughness");
+    maps_[i].occlusion = find("occlusion");
+    maps_[i].emissive = find("emissive");
+    has_normal_maps_ |= maps_[i].normal >= 0;
+  }
   for (const Material& m : scene.materials) {
     if (m.texture < 0) continue;
     if (m.texture >= static_cast<int>(scene.textures.size()))
@@ -278,6 +298,108 @@ void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* p
   pbr->roughness = 1.0f - gloss;
 }
 
+// the 2d mapping of a material at a hit (render/material_eval.h, "texture mapping"): texture
+// coordinates (s, t) in images, their gradient J (images per metre of geom-frame displacement),
+// and what rho (texels per metre) is for a w x h image.
+struct MaterialEvaluator::Mapping2D {
+  enum class Kind { kTexcoords, kUniform, kPerFace };
+  Kind kind = Kind::kTexcoords;
+  float s = 0, t = 0;
+  Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
+  float uv_per_m = 0;    // kTexcoords
+  float rx = 1, ry = 1;  // texrepeat
+  float h0 = 1, h1 = 1;  // kPerFace: half sizes of the face
+  int a0 = -1, a1 = -1;  // planar: the face axes (image rows along -a1)
+
+  // texels per metre of surface for a w x h image (the expressions of the isotropic lookup).
+  float Rho(float w, float th) const {
+    switch (kind) {
+      case Kind::kTexcoords:
+        return uv_per_m * std::sqrt(w * th);
+      case Kind::kUniform:
+        return std::sqrt(std::abs(rx) * w * std::abs(ry) * th);
+      case Kind::kPerFace:
+        return std::sqrt(std::abs(rx) * w / (2 * h0) * std::abs(ry) * th / (2 * h1));
+    }
+    return 0;
+  }
+};
+
+MaterialEvaluator::Mapping2D MaterialEvaluator::MapAt(const SurfaceHit& hit,
+                                                      const Material& m) const {
+  Mapping2D map;
+  if (hit.has_uv) {
+    map.kind = Mapping2D::Kind::kTexcoords;
+    map.s = hit.uv.x();
+    map.t = hit.uv.y();
+    map.uv_per_m = hit.uv_per_m;
+    map.J = hit.duv_dp_G;
+    return map;
+  }
+  // planar projection along the dominant axis of the geom-frame normal: face axes (a0, a1) =
+  // the next two axes in cyclic order, image rows along -a1.
+  const Eigen::Vector3f& h = half_extent_G_[hit.geom];
+  const Eigen::Vector3f an = hit.n_G.cwiseAbs();
+  const int axis = (an.x() >= an.y() && an.x() >= an.z()) ? 0 : (an.y() >= an.z() ? 1 : 2);
+  const int a0 = (axis + 1) % 3, a1 = (axis + 2) % 3;
+  map.a0 = a0;
+  map.a1 = a1;
+  map.rx = m.texrepeat.x();
+  map.ry = m.texrepeat.y();
+  const bool infinite_plane =
+      scene_.geoms[hit.geom].shape == GeomShape::kPlane && !(h[a0] > 0 && h[a1] > 0);
+  if (m.texuniform || infinite_plane) {
+    map.kind = Mapping2D::Kind::kUniform;
+    map.s = hit.p_G[a0] * m.texrepeat.x();
+    map.t = -hit.p_G[a1] * m.texrepeat.y();
+    map.J(0, a0) = m.texrepeat.x();
+    map.J(1, a1) = -m.texrepeat.y();
+  } else {
+    map.kind = Mapping2D::Kind::kPerFace;
+    const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;
+    map.h0 = h0;
+    map.h1 = h1;
+    map.s = (0.5f * hit.p_G[a0] / h0 + 0.5f) * m.texrepeat.x();
+    map.t = (0.5f - 0.5f * hit.p_G[a1] / h1) * m.texrepeat.y();
+    map.J(0, a0) = 0.5f * m.texrepeat.x() / h0;
+    map.J(1, a1) = -0.5f * m.texrepeat.y() / h1;
+  }
+  return map;
+}
+
+Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Mapping2D& map,
+                                            bool aniso, const Eigen::Vector3f& major_G,
+                                            const Eigen::Vector3f& minor_G,
+                                            const TextureFootprint& footprint) const {
+  const float w = static_cast<float>(image.width());
+  const float th = static_cast<float>(image.height());
+  const float* decode = srgb_to_linear_;
+  auto trilinear = [&](float lod) {
+    return Trilinear(image, lod,
+                     [&](const TextureLevel& L) { return BilinearWrap(L, decode, map.s, map.t); });
+  };
+  // the axes in texture units and their squared lengths in level-0 texels.
+  Eigen::Vector2f major_st, minor_st;
+  float l2_major = 0, l2_minor = 0;
+  if (aniso) {
+    major_st = map.J * major_G;
+    minor_st = map.J * minor_G;
+    const Eigen::Vector2f texels(w, th);
+    l2_major = major_st.cwiseProduct(texels).squaredNorm();
+    l2_minor = minor_st.cwiseProduct(texels).squaredNorm();
+  }
+  if (aniso && l2_major > 0) {
+    // the axis the taps spread along: the longer one in texels.
+    const bool swap = l2_minor > l2_major;
+    const Eigen::Vector2f axis = swap ? minor_st : major_st;
+    const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
+    if (taps.n == 1) return trilinear(taps.lod);
+    return BilinearWrapTaps(image.level(TapLevel(image, taps.lod)), decode, map.s, map.t, axis.x(),
+                            axis.y(), taps.n);
+  }
+  return trilinear(TextureLod(footprint, map.Rho(w, th)));
+}
+
 SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
                                             const TextureFootprint& footprint) const {
   const Material& m = hit.material >= 0 ? scene_.materials[hit.material] : default_material_;
@@ -292,98 +414,107 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     if (shape == GeomShape::kPlane || (shape == GeomShape::kBox && hit.n_G.z() > 0.5f))
       out.mirror = std::min(m.reflectance, 1.0f);
   }
+  static const PbrMaps kNoMaps;
+  const PbrMaps& maps = hit.material >= 0 ? maps_[hit.material] : kNoMaps;
+  const bool pbr_maps = maps.metallic_roughness >= 0 || maps.occlusion >= 0 || maps.emissive >= 0;
   // tendons (geom -1) are drawn untextured
-  if (m.texture < 0 || hit.geom < 0) return out;
+  if ((m.texture < 0 && !pbr_maps) || hit.geom < 0) return out;
 
-  const Texture& tex = scene_.textures[m.texture];
-  const float w = static_cast<float>(tex.image->width());
-  const Eigen::Vector3f& h = half_extent_G_[hit.geom];
-  // texels per metre of surface of the mapping at the hit (rho, file comment); 0 = unknown.
-  float rho = 0;
   Eigen::Vector3f major_G, minor_G;
   const bool aniso = max_anisotropy_ > 1 && FootprintAxes(hit, footprint, &major_G, &minor_G);
-  Eigen::Vector3f c;
-  if (tex.kind == Texture::Kind::k2D) {
-    const float th = static_cast<float>(tex.image->height());
-    float s, t;
-    // texture units (1 = one image) per metre of geom-frame displacement (anisotropic path).
-    Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
-    if (hit.has_uv) {
-      s = hit.uv.x();
-      t = hit.uv.y();
-      rho = hit.uv_per_m * std::sqrt(w * th);
-      J = hit.duv_dp_G;
+  Mapping2D map;
+  bool mapped = false;
+  auto mapping = [&]() -> const Mapping2D& {
+    if (!mapped) map = MapAt(hit, m), mapped = true;
+    return map;
+  };
+  if (m.texture >= 0) {
+    const Texture& tex = scene_.textures[m.texture];
+    Eigen::Vector3f c;
+    if (tex.kind == Texture::Kind::k2D) {
+      c = Filter2D(*tex.image, mapping(), aniso, major_G, minor_G, footprint);
     } else {
-      // planar projection along the dominant axis of the geom-frame normal: face axes
-      // (a0, a1) = the next two axes in cyclic order, image rows along -a1.
-      const Eigen::Vector3f an = hit.n_G.cwiseAbs();
-      const int axis = (an.x() >= an.y() && an.x() >= an.z()) ? 0 : (an.y() >= an.z() ? 1 : 2);
-      const int a0 = (axis + 1) % 3, a1 = (axis + 2) % 3;
-      const bool infinite_plane =
-          scene_.geoms[hit.geom].shape == GeomShape::kPlane && !(h[a0] > 0 && h[a1] > 0);
-      if (m.texuniform || infinite_plane) {
-        s = hit.p_G[a0] * m.texrepeat.x();
-        t = -hit.p_G[a1] * m.texrepeat.y();
-        rho = std::sqrt(std::abs(m.texrepeat.x()) * w * std::abs(m.texrepeat.y()) * th);
-        J(0, a0) = m.texrepeat.x();
-        J(1, a1) = -m.texrepeat.y();
+      const Eigen::Vector3f& h = half_extent_G_[hit.geom];
+      const float w = static_cast<float>(tex.image->width());
+      auto q_of = [&](const Eigen::Vector3f& p_G) {
+        return Eigen::Vector3f(h.x() > 0 ? p_G.x() / h.x() : hit.n_G.x(),
+                               h.y() > 0 ? p_G.y() / h.y() : hit.n_G.y(),
+                               h.z() > 0 ? p_G.z() / h.z() : hit.n_G.z());
+      };
+      const float h_max = h.maxCoeff();
+      const float rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
+      if (aniso && rho > 0) {
+        const float rho2 = rho * rho;
+        const AnisoTaps taps =
+            TapsFor(major_G.squaredNorm() * rho2, minor_G.squaredNorm() * rho2, max_anisotropy_);
+        c.setZero();
+        for (int k = 0; k < taps.n; ++k)
+          c += SampleCube(m.texture, q_of(hit.p_G + TapOffset(k, taps.n) * major_G), taps.lod);
+        c /= static_cast<float>(taps.n);
       } else {
-        const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;
-        s = (0.5f * hit.p_G[a0] / h0 + 0.5f) * m.texrepeat.x();
-        t = (0.5f - 0.5f * hit.p_G[a1] / h1) * m.texrepeat.y();
-        rho = std::sqrt(std::abs(m.texrepeat.x()) * w / (2 * h0) * std::abs(m.texrepeat.y()) * th /
-                        (2 * h1));
-        J(0, a0) = 0.5f * m.texrepeat.x() / h0;
-        J(1, a1) = -0.5f * m.texrepeat.y() / h1;
+        c = SampleCube(m.texture, q_of(hit.p_G), TextureLod(footprint, rho));
       }
     }
-    // the axes in texture units and their squared lengths in level-0 texels.
-    Eigen::Vector2f major_st, minor_st;
-    float l2_major = 0, l2_minor = 0;
-    if (aniso) {
-      major_st = J * major_G;
-      minor_st = J * minor_G;
-      const Eigen::Vector2f texels(w, th);
-      l2_major = major_st.cwiseProduct(texels).squaredNorm();
-      l2_minor = minor_st.cwiseProduct(texels).squaredNorm();
-    }
-    if (aniso && l2_major > 0) {
-      // the axis the taps spread along: the longer one in texels.
-      const bool swap = l2_minor > l2_major;
-      const Eigen::Vector2f axis = swap ? minor_st : major_st;
-      const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
-      if (taps.n == 1) {
-        c = Sample2D(m.texture, s, t, taps.lod);
-      } else {
-        const TextureImage& image = *tex.image;
-        c = BilinearWrapTaps(image.level(TapLevel(image, taps.lod)), srgb_to_linear_, s, t,
-                             axis.x(), axis.y(), taps.n);
-      }
-    } else {
-      c = Sample2D(m.texture, s, t, TextureLod(footprint, rho));
-    }
-  } else {
-    auto q_of = [&](const Eigen::Vector3f& p_G) {
-      return Eigen::Vector3f(h.x() > 0 ? p_G.x() / h.x() : hit.n_G.x(),
-                             h.y() > 0 ? p_G.y() / h.y() : hit.n_G.y(),
-                             h.z() > 0 ? p_G.z() / h.z() : hit.n_G.z());
-    };
-    const float h_max = h.maxCoeff();
-    rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
-    if (aniso && rho > 0) {
-      const float rho2 = rho * rho;
-      const AnisoTaps taps =
-          TapsFor(major_G.squaredNorm() * rho2, minor_G.squaredNorm() * rho2, max_anisotropy_);
-      c.setZero();
-      for (int k = 0; k < taps.n; ++k)
-        c += SampleCube(m.texture, q_of(hit.p_G + TapOffset(k, taps.n) * major_G), taps.lod);
-      c /= static_cast<float>(taps.n);
-    } else {
-      c = SampleCube(m.texture, q_of(hit.p_G), TextureLod(footprint, rho));
-    }
+    out.pbr.base_color = out.pbr.base_color.cwiseProduct(c);
   }
-  out.pbr.base_color = out.pbr.base_color.cwiseProduct(c);
+  if (!pbr_maps) return out;
+  auto sample = [&](int tex) {
+    return Filter2D(*scene_.textures[tex].image, mapping(), aniso, major_G, minor_G, footprint);
+  };
+  if (maps.metallic_roughness >= 0) {
+    const Eigen::Vector3f c = sample(maps.metallic_roughness);
+    out.pbr.roughness *= c.y();
+    out.pbr.metallic *= c.z();
+  }
+  if (maps.occlusion >= 0) out.occlusion = std::clamp(sample(maps.occlusion).x(), 0.0f, 1.0f);
+  if (maps.emissive >= 0) out.emission = out.emission.cwiseProduct(sample(maps.emissive));
   return out;
+}
+
+void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& footprint) const {
+  if (hit->material < 0 || hit->geom < 0 || hit->geom >= static_cast<int>(R_WG_.size())) return;
+  const int normal_map = maps_[hit->material].normal;
+  if (normal_map < 0) return;
+  const Material& m = scene_.materials[hit->material];
+  const Eigen::Matrix3f& R_WG = R_WG_[hit->geom];
+  const Mapping2D map = MapAt(*hit, m);
+  // tangent t (increasing s) and bitangent b (towards the image's top row: decreasing t), geom
+  // frame: the columns of the pseudo-inverse of J restricted to the surface.
+  Eigen::Vector3f t_G, b_G;
+  if (map.a0 >= 0) {
+    t_G = Eigen::Vector3f::Zero();
+    b_G = Eigen::Vector3f::Zero();
+    t_G[map.a0] = map.J(0, map.a0) >= 0 ? 1.0f : -1.0f;
+    b_G[map.a1] = map.J(1, map.a1) >= 0 ? -1.0f : 1.0f;
+  } else {
+    const Eigen::Matrix2f JJt = map.J * map.J.transpose();
+    const float det = JJt.determinant();
+    if (!(std::abs(det) > 1e-20f)) return;
+    const Eigen::Matrix<float, 3, 2> P = map.J.transpose() * JJt.inverse();
+    t_G = P.col(0);
+    b_G = -P.col(1);
+  }
+  Eigen::Vector3f major_G, minor_G;
+  const bool aniso = max_anisotropy_ > 1 && FootprintAxes(*hit, footprint, &major_G, &minor_G);
+  const Eigen::Vector3f c =
+      Filter2D(*scene_.textures[normal_map].image, map, aniso, major_G, minor_G, footprint);
+  const Eigen::Vector3f tn(2 * c.x() - 1, 2 * c.y() - 1, 2 * c.z() - 1);
+  // outward shading normal, and the tangent frame around it (Gram-Schmidt), world frame.
+  const Eigen::Vector3f n = hit->front_face ? hit->ns_W : Eigen::Vector3f(-hit->ns_W);
+  Eigen::Vector3f t = R_WG * t_G;
+  t -= t.dot(n) * n;
+  const float lt = t.norm();
+  if (!(lt > 0)) return;
+  t /= lt;
+  Eigen::Vector3f b = R_WG * b_G;
+  b -= b.dot(n) * n + b.dot(t) * t;
+  const float lb = b.norm();
+  if (!(lb > 0)) return;
+  b /= lb;
+  const Eigen::Vector3f mapped = tn.x() * t + tn.y() * b + std::max(tn.z(), 0.0f) * n;
+  const float len = mapped.norm();
+  if (!(len > 0) || !mapped.allFinite()) return;
+  hit->ns_W = hit->front_face ? Eigen::Vector3f(mapped / len) : Eigen::Vector3f(-mapped / len);
 }
 
 }  // namespace penumbra

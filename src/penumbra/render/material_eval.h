@@ -52,7 +52,19 @@
 // deterministic: no random numbers; the lookup depends on the hit and the cone only, so images
 // do not depend on the thread count.
 
+// PBR maps (glTF 2.0 section 3.9; docs/assets.md): a material named M gets the 2d textures
+// named "M/normal", "M/metallic_roughness", "M/occlusion" and "M/emissive" as its maps, mapped
+// as its base texture is (mesh texcoords, else the planar mapping with its texrepeat and
+// texuniform; a material without a base texture maps them the same way). their texels hold
+// data, sRGB-encoded like every texture (so that filtering and mip levels average the values):
+// the decoded value v of a texel is the map's value. normal: tangent-space n = 2 v - 1, x
+// along increasing u, y towards the image's top row (decreasing v), z along the surface
+// normal (ApplyNormalMap). metallic_roughness: G multiplies roughness, B metallic.
+// occlusion: R is the ambient occlusion (SurfaceMaterial::occlusion). emissive: multiplies
+// Material::emission.
+
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
@@ -74,6 +86,9 @@ struct SurfaceMaterial {
   /// Material::reflectance on planes and on box faces whose geom-frame normal is +z, else 0.
   /// a constant weight (no Fresnel rise at grazing angles), as MuJoCo's.
   float mirror = 0;
+  /// ambient occlusion in [0, 1] from the material's occlusion map (1 without): the realtime
+  /// tier multiplies the sky light by it.
+  float occlusion = 1;
 };
 
 /// darkens and smooths an upward-facing surface for rain wetness w in [0, 1] (Lagarde, "Water
@@ -113,6 +128,25 @@ class MaterialEvaluator {
   /// `footprint` (file comment; the default footprint gives bilinear level-0 lookups).
   SurfaceMaterial Evaluate(const SurfaceHit& hit, const TextureFootprint& footprint = {}) const;
 
+  /// true when some material has a normal map (file comment, "PBR maps").
+  bool has_normal_maps() const { return has_normal_maps_; }
+
+  /// the rotation R_WG of every geom (index = SceneDescription::geoms) at the frame being
+  /// rendered, for normal mapping; the renderer sets it before tracing a frame (not while
+  /// Evaluate / ApplyNormalMap run). without it (or for geoms beyond it) normal maps are not
+  /// applied.
+  void SetGeomRotations(std::vector<Eigen::Matrix3f> R_WG) { R_WG_ = std::move(R_WG); }
+
+  /// normal mapping: replaces hit->ns_W by the material's normal map at the hit, filtered over
+  /// `footprint` as the base colour is; no change without a normal map. tangent frame (geom
+  /// frame, then rotated by the geom's R_WG, SetGeomRotations): mesh texcoords, t = dp/du and
+  /// b = -dp/dv of the hit triangle (the pseudo-inverse of SurfaceHit::duv_dp_G), Gram-Schmidt
+  /// against the interpolated normal; planar mapping, the mapping's face axes. the mapped
+  /// normal n = normalize(x t + y b + z n_s) with (x, y, z) = 2 c - 1, on the side of the
+  /// geometric normal (flipped with it; a mapped normal that would face away from the viewer
+  /// is bent back to the surface by UsableShadingNormal in the BSDF).
+  void ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& footprint = {}) const;
+
   /// linear rgb of texture `tex` at (s, t) in texture space (1 = one image), wrapped,
   /// trilinear at mip level `lod` (log2 of the footprint in level-0 texels; <= 0: bilinear in
   /// level 0). exposed for tests.
@@ -123,11 +157,27 @@ class MaterialEvaluator {
   Eigen::Vector3f SampleCube(int tex, const Eigen::Vector3f& q, float lod = 0) const;
 
  private:
+  struct Mapping2D;
+  // a material's PBR maps (texture indices, -1 none): see the file comment.
+  struct PbrMaps {
+    int normal = -1, metallic_roughness = -1, occlusion = -1, emissive = -1;
+    bool any() const {
+      return normal >= 0 || metallic_roughness >= 0 || occlusion >= 0 || emissive >= 0;
+    }
+  };
+  Mapping2D MapAt(const SurfaceHit& hit, const Material& m) const;
+  Eigen::Vector3f Filter2D(const TextureImage& image, const Mapping2D& map, bool aniso,
+                           const Eigen::Vector3f& major_G, const Eigen::Vector3f& minor_G,
+                           const TextureFootprint& footprint) const;
+
   const SceneDescription& scene_;
   Material default_material_;
   std::vector<Eigen::Vector3f> half_extent_G_;  // per geom: local bounding-box half extents
   const float* srgb_to_linear_;                 // 256 entries (SrgbDecodeTable)
   int max_anisotropy_ = 1;
+  std::vector<PbrMaps> maps_;  // per material
+  bool has_normal_maps_ = false;
+  std::vector<Eigen::Matrix3f> R_WG_;  // per geom, this frame (SetGeomRotations)
 };
 
 }  // namespace penumbra

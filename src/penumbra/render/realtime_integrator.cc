@@ -57,8 +57,10 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
   const Eigen::Vector3f d = ray.d.normalized();
   if (!ctx.scene->Intersect(ray, &h)) return ctx.sky->Radiance(d);
   const Eigen::Vector3f wo = -d;
-  SurfaceMaterial mat = ctx.materials->Evaluate(
-      h, ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h));
+  const TextureFootprint footprint =
+      ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h);
+  if (ctx.materials->has_normal_maps()) ctx.materials->ApplyNormalMap(&h, footprint);
+  SurfaceMaterial mat = ctx.materials->Evaluate(h, footprint);
   if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
   const Bsdf bsdf(mat.pbr, h.ns_W, h.ng_W, wo);
   const Eigen::Vector3f& n = bsdf.shading_normal();
@@ -69,7 +71,7 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
                                                    std::clamp(mat.pbr.roughness, 0.0f, 1.0f));
   const Eigen::Vector3f reflect =
       bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-  Eigen::Vector3f L = mat.emission + (sky_E * kInvPi).cwiseProduct(reflect);
+  Eigen::Vector3f L = mat.emission + (sky_E * (kInvPi * mat.occlusion)).cwiseProduct(reflect);
   const Eigen::Vector3f origin = OffsetRayOrigin(h.p_W, h.ng_W);
   for (int j = 0; j < ctx.lights->size(); ++j) {
     float u1, u2;
@@ -322,7 +324,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       p.Set(k, h.p_W);
       // shadow rays start off the surface on the lit side (lights behind it contribute 0).
       origin.Set(k, OffsetRayOrigin(h.p_W, h.ng_W));
-      sky_E.Set(k, scratch.sky_E[i]);
+      sky_E.Set(k, mat.occlusion * scratch.sky_E[i]);
 
       if (out.albedo) {
         float* a = out.albedo->at(u, v);

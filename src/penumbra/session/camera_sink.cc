@@ -198,6 +198,10 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   cf.body_id = std::move(img.truth.body_id);
   cf.semantic_class = std::move(img.truth.semantic_class);
   ++frames_;
+  if (options_.on_frame) {
+    auto shared = std::make_shared<const CameraFrame>(cf);
+    options_.on_frame(shared);
+  }
   writer_.Submit(std::move(cf));
 }
 

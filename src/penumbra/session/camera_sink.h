@@ -82,6 +82,11 @@ struct CameraSinkOptions {
   /// index in the scene (its noise streams), so a selected camera's frames do not depend on
   /// the selection.
   std::vector<std::string> cameras;
+  /// receives every frame as it is completed, with its raw images (the buffers the files are
+  /// encoded from), on the render thread, in capture order per camera, before the frame goes
+  /// to the writer (e.g. a bridge publishing images; command/run_bridge.h). may be empty;
+  /// when set, each frame is copied once into the shared object.
+  std::function<void(const std::shared_ptr<const CameraFrame>& frame)> on_frame;
 };
 
 /// every camera of `scene`. the render thread is the only user of `renderer`.
@@ -111,6 +116,15 @@ class CameraSink : public Sink {
   /// completes the pending exposures with the last snapshot (not after an error), waits for
   /// the render thread and the writer. @throws Error the first write error not yet reported.
   void OnFinish(const LoopFinish& finish) override;
+
+  /// replaces CameraSinkOptions::on_frame (before the loop starts).
+  void set_on_frame(std::function<void(const std::shared_ptr<const CameraFrame>& frame)> on_frame) {
+    options_.on_frame = std::move(on_frame);
+  }
+
+  /// loop thread, while the loop runs: blocks until every snapshot handed over so far is
+  /// rendered (frames whose exposure ended by then completed and given to on_frame).
+  void Drain() { worker_.Drain(); }
 
   /// frames.csv rows written per camera (read after OnFinish).
   std::map<std::string, int64_t> FramesWritten() const { return writer_.FramesWritten(); }

@@ -113,6 +113,18 @@ nlohmann::ordered_json MountJson(const ModelInfo& info, int body, const Pose& X_
   return j;
 }
 
+// a sample of `sensor` for SensorSink's on_sample
+SensorSample MakeSample(const std::string& sensor, const char* type, int64_t index, int64_t step,
+                        double time_sec) {
+  SensorSample s;
+  s.sensor = sensor;
+  s.type = type;
+  s.index = index;
+  s.step = step;
+  s.time_sec = time_sec;
+  return s;
+}
+
 }  // namespace
 
 struct SensorSink::Impl {
@@ -143,6 +155,7 @@ struct SensorSink::Impl {
     uint64_t stream = 0;
     MujocoSensorCsvWriter out;
     std::vector<double> values;
+    std::shared_ptr<const std::vector<std::string>> columns;  // made on the first sample
     int64_t written = 0;
   };
   struct GroundTruth {
@@ -170,6 +183,7 @@ struct SensorSink::Impl {
   std::vector<std::string> body_names;
   std::unique_ptr<RayQuery> ray_scene;
   SensorOutputCallback on_output;
+  SensorSampleCallback on_sample;
   // loop thread
   std::vector<SensorFiring> due;
   int64_t due_step = -1;
@@ -194,10 +208,17 @@ struct SensorSink::Impl {
     const SensorPoseAt pose = [&](double t) {
       return span > 0 ? InterpolatePose(X0, X1, std::min(1.0, t / span)) : X0;
     };
-    LidarScan scan;
+    auto scan_ptr = std::make_shared<LidarScan>();
+    LidarScan& scan = *scan_ptr;
     l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
     std::string pcd = l.out.Write(l.start_firing, scan);
     if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
+    if (on_sample) {
+      SensorSample sample =
+          MakeSample(l.cfg->name, "lidar", l.start_firing.index, start.step, start.time_sec);
+      sample.scan = std::move(scan_ptr);
+      on_sample(sample);
+    }
     ++l.written;
     busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
     busy["lidar_cpu"] += ThreadCpuSec() - c0;
@@ -355,6 +376,12 @@ void SensorSink::set_on_output(SensorOutputCallback on_output) {
   impl_->on_output = std::move(on_output);
 }
 
+void SensorSink::set_on_sample(SensorSampleCallback on_sample) {
+  impl_->on_sample = std::move(on_sample);
+}
+
+void SensorSink::Drain() { impl_->worker.Drain(); }
+
 void SensorSink::OnStart(const LoopStart& start) {
   impl_->schedule->StartAt(start.step);  // a loop from a later step (a replay): same indices
   impl_->worker.Start(start.report_error);
@@ -425,8 +452,15 @@ void SensorSink::Impl::Process(
       state.v_WS = V.tail<3>() + V.head<3>().cross(p_BS_W);
       state.gyro_bias = m.noise->gyro_bias();
       state.accel_bias = m.noise->accel_bias();
-      std::string row = m.out.Write(f, m.noise->Apply(f.index, truth));
+      const ImuSample measured = m.noise->Apply(f.index, truth);
+      std::string row = m.out.Write(f, measured);
       m.truth_out.Write(f, state);
+      if (s.on_sample) {
+        SensorSample sample = MakeSample(m.cfg->name, "imu", f.index, snap.step, snap.time_sec);
+        sample.values = {measured.accel_m_s2.x(), measured.accel_m_s2.y(), measured.accel_m_s2.z(),
+                         measured.gyro_rad_s.x(), measured.gyro_rad_s.y(), measured.gyro_rad_s.z()};
+        s.on_sample(sample);
+      }
       if (s.on_output)
         s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
@@ -439,6 +473,14 @@ void SensorSink::Impl::Process(
       if (m.stddev > 0)
         for (double& v : m.values) v += m.stddev * StandardNormal(&rng);
       std::string row = m.out.Write(f, m.values);
+      if (s.on_sample) {
+        if (!m.columns)
+          m.columns = std::make_shared<const std::vector<std::string>>(m.set->ColumnNames());
+        SensorSample sample = MakeSample(m.cfg->name, "mujoco", f.index, snap.step, snap.time_sec);
+        sample.values = m.values;
+        sample.columns = m.columns;
+        s.on_sample(sample);
+      }
       if (s.on_output)
         s.on_output(m.cfg->name, "sensor.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;

@@ -42,6 +42,7 @@
 #include "penumbra/pipeline/sink.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
+#include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/sensor_schedule.h"
 #include "penumbra/world/world_config.h"
 
@@ -60,6 +61,26 @@ using SensorEffectsAt = std::function<std::shared_ptr<const EffectsFrame>(
 using SensorOutputCallback = std::function<void(const std::string& sensor, const std::string& kind,
                                                 int64_t step, double time_sec, std::string bytes)>;
 
+/// one sample of a world-file sensor as its model produced it (what the files hold, unformatted),
+/// for bridges (command/run_bridge.h).
+struct SensorSample {
+  std::string sensor;   ///< the sensor's name in the world file
+  std::string type;     ///< "imu", "lidar" or "mujoco"
+  int64_t index = 0;    ///< sample (scan) index k
+  int64_t step = 0;     ///< physics step of the capture (a LiDAR scan: its start)
+  double time_sec = 0;  ///< sim time of that step, s
+  /// imu: accel x y z (m/s^2, specific force) then gyro x y z (rad/s), IMU frame, with noise;
+  /// mujoco: the set's values with noise, in `columns` order; lidar: empty.
+  std::vector<double> values;
+  /// mujoco: one name per value (MujocoSensorSet::ColumnNames); otherwise empty.
+  std::shared_ptr<const std::vector<std::string>> columns;
+  /// lidar: the completed scan (sensor frame at each beam's firing time); otherwise null.
+  std::shared_ptr<const LidarScan> scan;
+};
+
+/// receives every sensor sample; called on the sensor sink's thread, in step order.
+using SensorSampleCallback = std::function<void(const SensorSample& sample)>;
+
 /// all world-file sensors of one run.
 class SensorSink : public Sink {
  public:
@@ -75,6 +96,14 @@ class SensorSink : public Sink {
   /// `on_output` receives every sensor output written from now on (set before the loop
   /// starts; e.g. a run log's sensor records); empty = none. the files do not change.
   void set_on_output(SensorOutputCallback on_output);
+
+  /// `on_sample` receives every IMU, MuJoCo sensor and LiDAR sample from now on, as values
+  /// (set before the loop starts); empty = none.
+  void set_on_sample(SensorSampleCallback on_sample);
+
+  /// loop thread, while the loop runs: blocks until every snapshot handed over so far is
+  /// processed (its samples written and given to the callbacks).
+  void Drain();
 
   /// true when the world has no sensors.
   bool empty() const;

@@ -5,6 +5,9 @@
 #include <chrono>
 #include <filesystem>
 
+#include "penumbra/assets/mesh_model.h"
+#include "penumbra/assets/mjcf_mesh_conversion.h"
+#include "penumbra/assets/procedural_material.h"
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
@@ -50,7 +53,17 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   compose_options.timestep_sec = world_.timestep_sec;
   compose_options.physics = world_.physics;
   compose_options.ground_plane = world_.ground_plane;
-  ComposedScene composed = ComposeWorld(world_.models, compose_options);
+  // mesh files (models: entries with .obj, .gltf, ...) become generated MJCF models there too
+  std::vector<ModelConfig> models = world_.models;
+  const std::vector<ImportedModel> imported = ImportMeshModels(&models, mesh_dir, world_.file);
+  for (const ImportedModel& im : imported)
+    spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s", im.model,
+                 im.asset.file, im.asset.meshes.size(), im.asset.triangles,
+                 im.asset.materials.size(), im.import_sec);
+  ComposedScene composed = ComposeWorld(models, compose_options);
+  // MJCF <mesh> files MuJoCo 2.2.2 cannot read (glTF, FBX, COLLADA, PLY) become .msh files
+  for (const std::string& f : ConvertForeignMjcfMeshes(&composed, mesh_dir))
+    spdlog::info("converted MJCF mesh {} for MuJoCo", f);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
@@ -84,7 +97,10 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
 
   // the renderer's static scene, the effects engine on it, and the renderer
   t0 = Clock::now();
-  scene_ = effects_->Bind(AssembleScene(sim_->scene(), world_, sim_->Snapshot()));
+  SceneDescription extracted = sim_->scene();
+  ApplyImportedMaterials(imported, &extracted);
+  ApplyProceduralMaterials(ProceduralMaterialsOf(world_.file), world_.file, &extracted);
+  scene_ = effects_->Bind(AssembleScene(std::move(extracted), world_, sim_->Snapshot()));
   if (options.check_run_budget) {
     CheckRunMemory(world_, scene_, PhysicalMemoryBytes());  // before allocating
     if (auto work = DescribeRunWork(EstimateRunWork(world_, scene_, sim_->timestep())))

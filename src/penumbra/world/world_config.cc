@@ -13,6 +13,8 @@
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
 #include "penumbra/world/effects_reader.h"
+#include "penumbra/world/mesh_import_config.h"
+#include "penumbra/world/procedural_material_config.h"
 #include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
@@ -202,17 +204,19 @@ class WorldParser {
   }
 
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
-    if (is_robot) {
-      r.ExpectMap({"name", "file", "pose", "controller", "sensors", "sites", "initial_keyframe",
-                   "floating_base"});
-    } else {
-      r.ExpectMap({"name", "file", "pose", "sites", "initial_keyframe", "floating_base"});
-    }
+    std::vector<std::string_view> keys = {"name", "file", "pose"};
+    if (is_robot) keys.insert(keys.end(), {"controller", "sensors"});
+    keys.insert(keys.end(), {"sites", "initial_keyframe", "floating_base"});
+    keys.insert(keys.end(), MeshImportKeys().begin(), MeshImportKeys().end());
+    r.ExpectMap(keys);
     ModelConfig m;
     m.is_robot = is_robot;
     m.key = r.path();
     m.name = r.Child("name").String();
     m.file = Resolve(r.Child("file").String());
+    // checked here, read again by the session (world/mesh_import_config.h)
+    MeshImportConfig mesh;
+    ReadMeshImportKeys(r, IsMeshModelFile(m.file), &mesh);
     if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
     if (r.Has("floating_base")) m.floating_base = r.Child("floating_base").Bool();
     if (r.Has("initial_keyframe")) {
@@ -391,9 +395,11 @@ class WorldParser {
   }
 
   static MaterialOverride ReadMaterial(const std::string& name, const YamlReader& r) {
-    r.ExpectMap({"base_color", "roughness", "metallic", "specular", "emission"});
+    r.ExpectMap({"base_color", "roughness", "metallic", "specular", "emission", "procedural"});
     MaterialOverride m;
     m.name = name;
+    // checked here, read again by the session (world/procedural_material_config.h)
+    if (r.Has("procedural")) ReadProceduralMaterial(r.Child("procedural"));
     if (r.Has("base_color")) m.base_color = Vector3f(r.Child("base_color"));
     if (r.Has("roughness")) m.roughness = static_cast<float>(r.Child("roughness").Double());
     if (r.Has("metallic")) m.metallic = static_cast<float>(r.Child("metallic").Double());

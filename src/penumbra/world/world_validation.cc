@@ -10,6 +10,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/scene/scene_limits.h"
+#include "penumbra/world/mesh_import_config.h"
 
 namespace penumbra {
 
@@ -230,10 +231,12 @@ class Validator {
       }
       if (m.file.empty())
         Fail(path + ".file", "required; expected an MJCF (.xml) or URDF (.urdf) file");
-      if (!EndsWithNoCase(m.file, ".xml") && !EndsWithNoCase(m.file, ".urdf")) {
+      if (!EndsWithNoCase(m.file, ".xml") && !EndsWithNoCase(m.file, ".urdf") &&
+          !IsMeshModelFile(m.file)) {
         Fail(path + ".file", "'" + m.file +
                                  "' has an unknown extension; expected an MJCF (.xml) "
-                                 "or URDF (.urdf) file");
+                                 "or URDF (.urdf) file, or a mesh (.obj, .gltf, .glb, .fbx, "
+                                 ".dae, .stl, .ply)");
       }
       std::error_code ec;
       if (!std::filesystem::is_regular_file(m.file, ec)) {

@@ -60,6 +60,15 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     throw Error("Render: camera near_m " + std::to_string(view.near_m) +
                 " is not a finite distance >= 0");
   ray_scene_->Update(snapshot);
+  if (materials_.has_normal_maps()) {
+    // normal maps find their tangent frames in the geom frame: every geom's rotation now
+    std::vector<Eigen::Matrix3f> R_WG(scene_.geoms.size());
+    for (size_t g = 0; g < scene_.geoms.size(); ++g) {
+      const Geom& geom = scene_.geoms[g];
+      R_WG[g] = (snapshot.X_WB[geom.body].linear() * geom.X_BG.linear()).cast<float>();
+    }
+    materials_.SetGeomRotations(std::move(R_WG));
+  }
   lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
@@ -163,6 +172,17 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       }
     }
     if (buffers.radiance) {
+      // normal maps bend the shading normals the integrators see (after the ground truth,
+      // whose normals stay the surfaces')
+      if (materials_.has_normal_maps()) {
+        for (int i = 0; i < n; ++i) {
+          if (!did_hit[i]) continue;
+          const float d_len = rays[i].d.norm();
+          materials_.ApplyNormalMap(&hits[i],
+                                    ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
+                                                  rays[i].d / d_len, hits[i]));
+        }
+      }
       primary.rays = rays.get();
       primary.hits = hits.get();
       primary.did_hit = did_hit.get();

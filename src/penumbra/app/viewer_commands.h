@@ -1,0 +1,64 @@
+#pragma once
+// the live viewer's verbs (docs/viewer.md):
+//   penumbra run WORLD --viewer [HOST:PORT]   a run served to browsers (viewer/viewer_bridge.h)
+//   penumbra view WORLD [--viewer HOST:PORT]  the same at real-time pacing, paused at the start,
+//                                             outputs in a temporary folder unless --out
+//   penumbra bench viewer                     frames/s delivered, input-to-photon latency,
+//                                             physics steps/s with and without a viewer
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/app/runner.h"
+
+namespace CLI {
+class App;
+}
+
+namespace penumbra {
+
+/// the `--viewer [HOST:PORT]` flag of `penumbra run`.
+struct ViewerFlag {
+  std::string address;  ///< as given ("" = the default 127.0.0.1:8080)
+  /// adds the flag to `run`.
+  void Add(CLI::App* run);
+  /// adds the viewer bridge to options->bridges when the flag was given on `run`.
+  /// @throws ConfigError("", 0, "--viewer", ...) for a bad address or a missing web folder.
+  void Apply(const CLI::App& run, RunOptions* options) const;
+};
+
+/// options of `penumbra view`.
+struct ViewOptions {
+  std::string address;   ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
+  std::string out_dir;   ///< --out: keep the outputs here ("" = a temporary folder, removed)
+  bool running = false;  ///< --running: start running instead of paused
+  bool force = false;    ///< --force: --out may hold an earlier run's outputs
+  std::optional<double> duration_sec;  ///< --duration (default: the world's)
+  std::string adversity;               ///< --adversity preset spec
+  std::vector<std::string> command_line;
+};
+
+/// `penumbra view`: runs `world` with the viewer at real-time pacing, paused at the start
+/// unless options.running, until its duration ends or `stop_request` reads non-zero (Ctrl-C).
+/// returns 0 (also when stopped by a signal: that is how a view ends).
+/// @throws ConfigError for a bad address, world or output folder; Error when the port is in use.
+int RunView(const WorldConfig& world, const ViewOptions& options,
+            const std::atomic<int>* stop_request);
+
+/// options of `penumbra bench viewer`.
+struct BenchViewerOptions {
+  std::string world_file;    ///< default: the bundled default world
+  double seconds = 4;        ///< simulated seconds per timed run (as fast as possible)
+  int rounds = 2;            ///< A/B pairs (no viewer, viewer with one page attached)
+  double camera_hz = 30;     ///< rate of the streamed camera (the world's first, rgb only)
+  int latency_samples = 10;  ///< teleop commands timed at real-time pacing
+};
+
+/// runs the benchmark and prints its table to stdout; returns 0.
+/// @throws ConfigError for a bad world; Error when the viewer cannot start.
+int BenchViewer(const BenchViewerOptions& options);
+
+}  // namespace penumbra

@@ -1,0 +1,225 @@
+#include "penumbra/assets/mesh_model.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+uint64_t Fnv1a64(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+template <typename T>
+void Append(std::string* out, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  out->append(b, sizeof(T));
+}
+
+std::string XmlEscape(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// linear -> sRGB-encoded value in [0, 1] (IEC 61966-2-1), for MuJoCo's rgba.
+double LinearToSrgb(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+// writes `bytes` to dir/name unless a file of that name already holds them; returns the path.
+std::string WriteOnce(const fs::path& dir, const std::string& name, const std::string& bytes) {
+  const fs::path p = dir / name;
+  std::error_code ec;
+  if (fs::is_regular_file(p, ec) && fs::file_size(p, ec) == bytes.size()) return p.string();
+  WriteFileAtomic(p.string(), bytes);
+  return p.string();
+}
+
+}  // namespace
+
+std::string MshBytes(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3f> v = mesh.vertices;
+  std::vector<Eigen::Vector3f> n = mesh.normals;
+  std::vector<Eigen::Vector2f> t = mesh.texcoords;
+  // a flat mesh (a label, a floor tile): one unreferenced vertex off its plane, or qhull
+  // cannot build MuJoCo's convex hull
+  if (!v.empty() && !mesh.faces.empty()) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero(), area_n = Eigen::Vector3d::Zero();
+    Eigen::Vector3d lo = v[0].cast<double>(), hi = lo;
+    for (const Eigen::Vector3f& p : v) {
+      c += p.cast<double>();
+      lo = lo.cwiseMin(p.cast<double>());
+      hi = hi.cwiseMax(p.cast<double>());
+    }
+    c /= static_cast<double>(v.size());
+    for (const Eigen::Vector3i& f : mesh.faces) {
+      const Eigen::Vector3d a = v[f[0]].cast<double>();
+      area_n += (v[f[1]].cast<double>() - a).cross(v[f[2]].cast<double>() - a);
+    }
+    const double extent = (hi - lo).norm();
+    if (area_n.norm() > 0 && extent > 0) {
+      const Eigen::Vector3d nn = area_n.normalized();
+      double off = 0;
+      for (const Eigen::Vector3f& p : v)
+        off = std::max(off, std::abs((p.cast<double>() - c).dot(nn)));
+      if (off < 1e-6 * extent) {
+        v.push_back((c - 1e-4 * extent * nn).cast<float>());
+        if (!n.empty()) n.push_back(nn.cast<float>());
+        if (!t.empty()) t.push_back(Eigen::Vector2f::Zero());
+      }
+    }
+  }
+  while (!v.empty() && v.size() < 4) {
+    v.push_back(v.front());
+    if (!n.empty()) n.push_back(n.front());
+    if (!t.empty()) t.push_back(t.front());
+  }
+  std::string out;
+  Append<int32_t>(&out, static_cast<int32_t>(v.size()));
+  Append<int32_t>(&out, static_cast<int32_t>(n.size()));
+  Append<int32_t>(&out, static_cast<int32_t>(t.size()));
+  Append<int32_t>(&out, static_cast<int32_t>(mesh.faces.size()));
+  for (const Eigen::Vector3f& p : v)
+    for (int k = 0; k < 3; ++k) Append<float>(&out, p[k]);
+  for (const Eigen::Vector3f& p : n)
+    for (int k = 0; k < 3; ++k) Append<float>(&out, p[k]);
+  for (const Eigen::Vector2f& p : t)
+    for (int k = 0; k < 2; ++k) Append<float>(&out, p[k]);
+  for (const Eigen::Vector3i& f : mesh.faces)
+    for (int k = 0; k < 3; ++k) Append<int32_t>(&out, f[k]);
+  return out;
+}
+
+std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files) {
+  std::string x = fmt::format("<mujoco model=\"{}\">\n  <asset>\n",
+                              XmlEscape(fs::path(asset.file).stem().string()));
+  for (size_t i = 0; i < asset.meshes.size(); ++i)
+    x += fmt::format("    <mesh name=\"{}\" file=\"{}\"/>\n", XmlEscape(asset.meshes[i].mesh.name),
+                     XmlEscape(msh_files.at(i)));
+  for (const ImportedMaterial& m : asset.materials) {
+    const Eigen::Vector3f& c = m.factors.base_color;
+    x += fmt::format("    <material name=\"{}\" rgba=\"{:.6g} {:.6g} {:.6g} 1\"/>\n",
+                     XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
+                     LinearToSrgb(c.z()));
+  }
+  // geoms of the world body: MuJoCo computes no inertia for them, so open and flat meshes load
+  x += "  </asset>\n  <worldbody>\n";
+  for (const ImportedMesh& m : asset.meshes)
+    x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"/>\n",
+                     XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name));
+  x += "  </worldbody>\n</mujoco>\n";
+  return x;
+}
+
+std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
+                                            const std::string& dir, const std::string& world_file) {
+  std::vector<ImportedModel> out;
+  fs::path folder =
+      dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
+  bool made = false;
+  for (size_t i = 0; i < models->size(); ++i) {
+    ModelConfig& m = (*models)[i];
+    if (!IsMeshModelFile(m.file)) continue;
+    if (!made) {
+      std::error_code ec;
+      fs::create_directories(folder, ec);
+      if (ec)
+        throw Error("cannot create the mesh model folder " + folder.string() + ": " + ec.message());
+      made = true;
+    }
+    const std::string key = (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".file";
+    ImportedModel im;
+    im.model = m.name;
+    const MeshImportConfig config = MeshImportConfigOf(world_file, m.key);
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      im.asset = ImportMeshFile(m.file, config);
+    } catch (const ConfigError& e) {
+      // name the world-file entry; the problem names the mesh file
+      throw ConfigError(world_file, config.line, key,
+                        "cannot import mesh file " + e.file() + ": " + e.problem());
+    }
+    im.import_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string stem = fs::path(m.file).stem().string();
+    std::vector<std::string> msh_files;
+    for (const ImportedMesh& mesh : im.asset.meshes) {
+      const std::string bytes = MshBytes(mesh.mesh);
+      msh_files.push_back(
+          WriteOnce(folder, fmt::format("{}-{:016x}.msh", stem, Fnv1a64(bytes)), bytes));
+    }
+    const std::string xml = MeshModelMjcf(im.asset, msh_files);
+    m.file = WriteOnce(folder, fmt::format("{}-{:016x}.xml", stem, Fnv1a64(xml)), xml);
+    out.push_back(std::move(im));
+  }
+  return out;
+}
+
+void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescription* scene) {
+  for (const ImportedModel& im : models) {
+    for (const ImportedMaterial& mat : im.asset.materials) {
+      const std::string name = im.model + "/" + mat.name;
+      const int k = scene->FindMaterial(name);
+      if (k < 0) throw Error("imported material '" + name + "' is missing from the scene");
+      Material& m = scene->materials[k];
+      m.base_color = mat.factors.base_color;
+      m.roughness = mat.factors.roughness;
+      m.metallic = mat.factors.metallic;
+      m.emission = mat.factors.emission;
+      m.texrepeat = {1, 1};
+      m.texuniform = false;
+      auto add = [&](const std::shared_ptr<const TextureImage>& image, const char* map) {
+        if (!image) return -1;
+        Texture t;
+        t.name = name + "/" + map;
+        t.kind = Texture::Kind::k2D;
+        t.image = image;
+        scene->textures.push_back(std::move(t));
+        return static_cast<int>(scene->textures.size()) - 1;
+      };
+      // the maps by name (render/material_eval.h, "PBR maps")
+      m.texture = add(mat.base_color, "base_color");
+      add(mat.normal, "normal");
+      add(mat.metallic_roughness, "metallic_roughness");
+      add(mat.occlusion, "occlusion");
+      add(mat.emissive, "emissive");
+    }
+  }
+}
+
+}  // namespace penumbra

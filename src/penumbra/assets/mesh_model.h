@@ -1,0 +1,61 @@
+#pragma once
+// a mesh file placed by a world-file `models:` entry becomes an MJCF model that MuJoCo 2.2.2
+// compiles, plus the imported materials that the renderer's scene gets after extraction
+// (docs/assets.md).
+//
+// the generated MJCF (written next to the meshes, "<stem>-<hash>.xml"): one mesh geom of the
+// world body per imported mesh ("<i>_<mesh name>", MuJoCo binary .msh files with positions,
+// normals and texcoords in metres, z up), each with the material "<material name>" (rgba =
+// the base colour factor, sRGB): static geometry, for which MuJoCo 2.2.2 computes no inertia,
+// so open and flat meshes load (it refuses "mesh volume is too small" in a body). the geoms
+// collide with MuJoCo's default (the convex hull of each mesh) and are in group 0. as every
+// model, the composer prefixes the names with "<model>/" and places the geoms at the model pose.
+// ApplyImportedMaterials then gives the scene's "<model>/<material name>" materials the
+// imported factors and texture images.
+
+#include <string>
+#include <vector>
+
+#include "penumbra/assets/mesh_import.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// one mesh model after import: the model's name and what was read.
+struct ImportedModel {
+  std::string model;  ///< ModelConfig::name
+  ImportedAsset asset;
+  double import_sec = 0;  ///< wall time of ImportMeshFile (docs: import time per asset)
+};
+
+/// MuJoCo 2.2.2's binary .msh bytes of `mesh` (4 int32 counts nvertex, nnormal, ntexcoord,
+/// nface, then float32 positions, normals, texcoords and int32 faces, little-endian). meshes
+/// with fewer than 4 vertices get copies of their first vertex (MuJoCo's minimum); a flat mesh
+/// (all vertices within 1e-6 of its extent from one plane) gets one vertex no face uses,
+/// 1e-4 of its extent behind the plane, so that qhull can build MuJoCo's convex hull.
+std::string MshBytes(const TriangleMesh& mesh);
+
+/// the MJCF text of `asset` (file comment) whose <mesh file>s are `msh_files` (absolute paths,
+/// one per asset.meshes entry).
+std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files);
+
+/// imports every model of `models` whose file is a mesh (IsMeshModelFile), with the mesh keys
+/// of its world-file entry (MeshImportConfigOf(world_file, key)), and points its `file` at the
+/// generated MJCF in `dir` (created if missing; "" = the folder "penumbra-mesh-models" in the
+/// system's temporary folder). files are named by a hash of their content, so a second
+/// import writes nothing new. other models are left alone.
+/// @throws ConfigError naming the world file `world_file`, the entry's line and key when the
+///         mesh cannot be imported (the message names the mesh file), or Error when a file
+///         cannot be written.
+std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
+                                            const std::string& dir, const std::string& world_file);
+
+/// gives every material "<model>/<name>" of `scene` that an imported model defines its
+/// factors and images: base_color, roughness, metallic, emission, the base colour texture
+/// (Material::texture), and the normal, metallic-roughness, occlusion and emissive maps as 2d
+/// textures named "<model>/<name>/normal", ... (render/material_eval.h, "PBR maps").
+/// @throws Error when such a material is missing from the scene (a composer bug).
+void ApplyImportedMaterials(const std::vector<ImportedModel>& models, SceneDescription* scene);
+
+}  // namespace penumbra

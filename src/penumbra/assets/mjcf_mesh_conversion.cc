@@ -1,0 +1,106 @@
+#include "penumbra/assets/mjcf_mesh_conversion.h"
+
+#include <fmt/format.h>
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <functional>
+
+#include "penumbra/assets/mesh_import.h"
+#include "penumbra/assets/mesh_model.h"
+#include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
+
+namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+uint64_t Fnv1a64(const std::string& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+// the meshes of `asset` as one mesh (vertex indices offset per part; normals and texcoords
+// kept only when every part has them).
+TriangleMesh Merge(const ImportedAsset& asset) {
+  TriangleMesh out;
+  out.name = fs::path(asset.file).stem().string();
+  bool normals = true, texcoords = true;
+  for (const ImportedMesh& m : asset.meshes) {
+    normals &= !m.mesh.normals.empty();
+    texcoords &= !m.mesh.texcoords.empty();
+  }
+  for (const ImportedMesh& m : asset.meshes) {
+    const int base = static_cast<int>(out.vertices.size());
+    out.vertices.insert(out.vertices.end(), m.mesh.vertices.begin(), m.mesh.vertices.end());
+    if (normals)
+      out.normals.insert(out.normals.end(), m.mesh.normals.begin(), m.mesh.normals.end());
+    if (texcoords)
+      out.texcoords.insert(out.texcoords.end(), m.mesh.texcoords.begin(), m.mesh.texcoords.end());
+    for (const Eigen::Vector3i& f : m.mesh.faces)
+      out.faces.push_back(f + Eigen::Vector3i::Constant(base));
+  }
+  return out;
+}
+
+void Visit(tinyxml2::XMLElement* e, const std::function<void(tinyxml2::XMLElement*)>& fn) {
+  for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    fn(c);
+    Visit(c, fn);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed, const std::string& dir) {
+  std::vector<std::string> converted;
+  const fs::path folder =
+      dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
+  tinyxml2::XMLElement* root = composed->document->RootElement();
+  if (root == nullptr) return converted;
+  Visit(root, [&](tinyxml2::XMLElement* e) {
+    if (std::string(e->Name()) != "mesh") return;
+    const tinyxml2::XMLElement* parent = e->Parent() ? e->Parent()->ToElement() : nullptr;
+    if (parent == nullptr || std::string(parent->Name()) != "asset") return;
+    const char* file = e->Attribute("file");
+    if (file == nullptr) return;
+    const std::string ext = LowerExtension(file);
+    if (ext == ".stl" || ext == ".obj" || ext == ".msh" || !IsMeshModelFile(file)) return;
+    ImportedAsset asset;
+    try {
+      asset = ImportMeshFile(file, MeshImportConfig{});
+    } catch (const ConfigError& err) {
+      const auto it = composed->sources.find(e);
+      const std::string where = it != composed->sources.end() ? it->second.file : "";
+      const int line = it != composed->sources.end() ? it->second.line : 0;
+      throw ConfigError(where, line, "mesh.file",
+                        "cannot convert mesh file " + err.file() + " for MuJoCo: " + err.problem());
+    }
+    const std::string bytes = MshBytes(Merge(asset));
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    const fs::path out =
+        folder / fmt::format("{}-{:016x}.msh", fs::path(file).stem().string(), Fnv1a64(bytes));
+    if (!(fs::is_regular_file(out, ec) && fs::file_size(out, ec) == bytes.size()))
+      WriteFileAtomic(out, bytes);
+    converted.push_back(file);
+    e->SetAttribute("file", out.string().c_str());
+  });
+  return converted;
+}
+
+}  // namespace penumbra

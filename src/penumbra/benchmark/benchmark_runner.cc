@@ -1,0 +1,325 @@
+#include "penumbra/benchmark/benchmark_runner.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "penumbra/benchmark/benchmark_job.h"
+#include "penumbra/benchmark/benchmark_report.h"
+#include "penumbra/benchmark/method_process.h"
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+namespace fs = std::filesystem;
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void WriteText(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out.flush()) throw Error("cannot write " + p.string());
+}
+
+std::string Hms(double sec) {
+  const long s = std::lround(std::max(0.0, sec));
+  char buf[32];
+  if (s >= 3600)
+    snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  else
+    snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+
+bool Finished(const std::string& out, const BenchmarkJob& j) {
+  std::error_code ec;
+  return fs::is_regular_file(JobResultPath(out, j), ec);
+}
+
+// one line of progress: done / all, elapsed, ETA from the mean time of the jobs done here
+void Progress(bool on, size_t done, size_t all, size_t done_here, size_t failed,
+              Clock::time_point start) {
+  if (!on) return;
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  const std::string eta =
+      done_here > 0 && done < all ? ", ETA " + Hms(elapsed / done_here * (all - done)) : "";
+  const int width = 30;
+  const int filled = all ? static_cast<int>(width * done / all) : width;
+  spdlog::info("benchmark [{}{}] {}/{} jobs{}, {} elapsed{}", std::string(filled, '#'),
+               std::string(width - filled, '.'), done, all,
+               failed ? fmt::format(" ({} failed)", failed) : "", Hms(elapsed), eta);
+}
+
+// `command` through popen; its stdout (or nullopt when it cannot run / exits non-zero)
+std::optional<std::string> Capture(const std::string& command, int* exit_code = nullptr) {
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) return std::nullopt;
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int status = pclose(p);
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (exit_code) *exit_code = code;
+  if (code != 0) return std::nullopt;
+  return out;
+}
+
+pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const BenchmarkJob& j,
+                  const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid < 0) throw Error(std::string("cannot start a worker: ") + strerror(errno));
+  if (pid == 0) {
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int in = open("/dev/null", O_RDONLY);
+    if (fd < 0 || in < 0) _exit(127);
+    dup2(in, 0);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    const std::string index = std::to_string(j.index);
+    execl(o.penumbra_binary.c_str(), o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(),
+          "--out", o.out_dir.c_str(), "--job", index.c_str(), "--quiet",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// runs the unfinished jobs as local worker processes; returns the ids of jobs whose worker
+// failed
+std::vector<std::string> RunLocal(const BenchmarkOptions& o, const BenchmarkSpec& spec,
+                                  const std::vector<BenchmarkJob>& jobs, int workers,
+                                  Clock::time_point start) {
+  std::vector<const BenchmarkJob*> pending;
+  size_t done = 0;
+  for (const BenchmarkJob& j : jobs)
+    if (Finished(o.out_dir, j))
+      ++done;
+    else
+      pending.push_back(&j);
+  if (done > 0) spdlog::info("{} of {} jobs finished earlier: skipped", done, jobs.size());
+  fs::create_directories(fs::path(o.out_dir) / "logs");
+  std::map<pid_t, const BenchmarkJob*> running;
+  std::vector<std::string> failed;
+  size_t next = 0, done_here = 0;
+  bool stopping = false;
+  Progress(o.progress, done, jobs.size(), 0, 0, start);
+  while (next < pending.size() || !running.empty()) {
+    if (!stopping && o.stop_request && o.stop_request->load() != 0) {
+      stopping = true;
+      for (const auto& [pid, job] : running) kill(pid, SIGTERM);
+    }
+    while (!stopping && next < pending.size() && running.size() < static_cast<size_t>(workers)) {
+      const BenchmarkJob* j = pending[next++];
+      running[SpawnWorker(o, spec.file, *j, fs::path(o.out_dir) / "logs" / (j->id + ".log"))] = j;
+    }
+    if (stopping && running.empty()) break;
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    if (pid <= 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
+    }
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const BenchmarkJob* j = it->second;
+    running.erase(it);
+    const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && Finished(o.out_dir, *j);
+    if (!ok && !stopping) {
+      failed.push_back(j->id);
+      spdlog::error("job {} failed ({}); log: {}", j->id,
+                    WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
+                                      : "signal " + std::to_string(WTERMSIG(status)),
+                    (fs::path(o.out_dir) / "logs" / (j->id + ".log")).string());
+    }
+    if (ok) ++done;
+    ++done_here;
+    Progress(o.progress, done, jobs.size(), done_here, failed.size(), start);
+  }
+  return failed;
+}
+
+std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec& spec,
+                                  const std::vector<BenchmarkJob>& jobs, Clock::time_point start) {
+  std::vector<int> pending;
+  for (const BenchmarkJob& j : jobs)
+    if (!Finished(o.out_dir, j)) pending.push_back(j.index);
+  if (pending.size() < jobs.size())
+    spdlog::info("{} of {} jobs finished earlier: not submitted", jobs.size() - pending.size(),
+                 jobs.size());
+  if (pending.empty()) return {};
+  if (!Capture("command -v sbatch"))
+    throw ConfigError("", 0, "--slurm",
+                      "sbatch not found; expected Slurm's client commands (slurm-client) on PATH");
+  const fs::path dir = fs::path(o.out_dir) / "slurm";
+  fs::create_directories(dir);
+  const fs::path script = dir / "array.sbatch";
+  WriteText(script, SlurmBatchScript(spec, o.out_dir, o.penumbra_binary, pending));
+  int code = 0;
+  const std::optional<std::string> submitted =
+      Capture("sbatch --parsable " + ShellQuote(script.string()) + " 2>&1", &code);
+  if (!submitted)
+    throw Error("sbatch " + script.string() + " failed (exit " + std::to_string(code) + ")");
+  const std::string job_id = submitted->substr(0, submitted->find_first_of(";\n"));
+  spdlog::info("submitted Slurm job array {} ({} tasks): {}", job_id, pending.size(),
+               script.string());
+  size_t last = SIZE_MAX;
+  for (;;) {
+    if (o.stop_request && o.stop_request->load() != 0) {
+      Capture("scancel " + job_id);
+      throw Error("interrupted: Slurm job " + job_id + " cancelled; run again to resume");
+    }
+    const std::optional<std::string> queued =
+        Capture("squeue -h -j " + job_id + " -o %i 2>/dev/null");
+    size_t done = 0;
+    for (const BenchmarkJob& j : jobs) done += Finished(o.out_dir, j) ? 1 : 0;
+    if (done != last)
+      Progress(o.progress, done, jobs.size(), done - (jobs.size() - pending.size()), 0, start);
+    last = done;
+    if (queued && queued->find_first_not_of(" \n") == std::string::npos) break;
+    std::this_thread::sleep_for(
+        std::chrono::milliseconds(static_cast<int>(spec.slurm_poll_sec * 1000)));
+  }
+  std::vector<std::string> failed;
+  for (int i : pending)
+    if (!Finished(o.out_dir, jobs[i])) {
+      failed.push_back(jobs[i].id);
+      spdlog::error("job {} (array task {}) left no result; log: {}", jobs[i].id, i,
+                    (dir / (job_id + "_" + std::to_string(i) + ".out")).string());
+    }
+  return failed;
+}
+
+}  // namespace
+
+std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_dir,
+                             const std::string& penumbra_binary, const std::vector<int>& indices) {
+  std::string array;
+  for (int i : indices) {
+    if (!array.empty()) array += ',';
+    array += std::to_string(i);
+  }
+  const std::string out = fs::absolute(out_dir).lexically_normal().string();
+  std::string s = fmt::format(
+      "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH --output={}/slurm/%A_%a.out\n"
+      "#SBATCH --cpus-per-task={}\n",
+      spec.name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
+  for (const std::string& l : spec.sbatch_lines) s += fmt::format("{}\n", l);
+  s += "# one benchmark job (world x condition x trial) per array task; docs/benchmarks.md\n";
+  s += fmt::format("exec {} benchmark {} --out {} --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n",
+                   ShellQuote(penumbra_binary), ShellQuote(spec.file), ShellQuote(out));
+  return s;
+}
+
+void RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir, int index,
+                        const std::string& penumbra_binary, const std::atomic<int>* stop_request) {
+  const BenchmarkSpec spec = LoadBenchmarkSpec(spec_path);
+  const fs::path copy = fs::path(out_dir) / "spec.yaml";
+  std::error_code ec;
+  if (!fs::is_regular_file(copy, ec) || ReadText(copy) != ReadText(spec.file))
+    throw ConfigError(spec.file, 0, "",
+                      "differs from " + copy.string() +
+                          " (or that is missing); expected the spec the benchmark in '" + out_dir +
+                          "' was started with");
+  const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(spec);
+  if (index < 0 || index >= static_cast<int>(jobs.size()))
+    throw ConfigError("", 0, "--job",
+                      "index " + std::to_string(index) + " out of range; expected 0.." +
+                          std::to_string(jobs.size() - 1));
+  BenchmarkJobContext context;
+  context.out_dir = out_dir;
+  context.penumbra_binary = penumbra_binary;
+  context.stop_request = stop_request;
+  const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, jobs[index], context);
+  for (const BenchmarkRow& r : rows)
+    spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial,
+                 r.status, r.detail, r.ate_rmse_m);
+}
+
+int RunBenchmark(const BenchmarkOptions& o) {
+  const Clock::time_point start = Clock::now();
+  const BenchmarkSpec spec = LoadBenchmarkSpec(o.spec_path);
+  if (o.out_dir.empty()) throw ConfigError("", 0, "--out", "expected an output folder");
+  const fs::path out(o.out_dir);
+  const fs::path copy = out / "spec.yaml";
+  std::error_code ec;
+  if (o.force)
+    for (const char* p : {"spec.yaml", "recordings", "jobs", "logs", "slurm", "plots",
+                          "results.csv", "summary.md", "summary.csv", "report.md"})
+      fs::remove_all(out / p);
+  if (fs::is_regular_file(copy, ec) && ReadText(copy) != ReadText(spec.file))
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + o.out_dir + "' holds the results of another spec (its spec.yaml differs from " +
+            spec.file +
+            "); expected the same spec to resume, --force to start again, or another folder");
+  if (!fs::exists(copy, ec) && fs::exists(out, ec) && !fs::is_empty(out, ec))
+    throw ConfigError(
+        "", 0, "--out",
+        "'" + o.out_dir + "' is not empty and holds no benchmark; expected a new or empty folder");
+  fs::create_directories(out / "recordings");
+  WriteText(copy, ReadText(spec.file));
+
+  const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(spec);
+  spdlog::info(
+      "benchmark '{}': {} world(s) x {} condition(s) x {} trial(s) = {} jobs, {} method(s)",
+      spec.name, spec.worlds.size(), spec.conditions.size(), spec.seeds.size(), jobs.size(),
+      spec.methods.size());
+  // 1. the routes, recorded once
+  for (const BenchmarkWorld& w : spec.worlds) {
+    const std::string plog = RecordingPath(o.out_dir, w);
+    if (fs::is_regular_file(plog, ec)) continue;
+    spdlog::info("recording the route of world '{}' ({})", w.name, w.file);
+    const std::string tmp = plog.substr(0, plog.size() - 5) + ".partial.plog";
+    fs::remove(tmp, ec);
+    o.record(w, tmp);
+    fs::rename(tmp, plog);
+  }
+  // 2. the jobs
+  const int workers = o.workers > 0 ? o.workers : spec.workers;
+  const std::vector<std::string> failed =
+      o.slurm ? RunSlurm(o, spec, jobs, start) : RunLocal(o, spec, jobs, workers, start);
+  const bool interrupted = o.stop_request && o.stop_request->load() != 0;
+  // 3. the results of every finished job (also after an interruption)
+  std::vector<BenchmarkRow> rows;
+  for (const BenchmarkJob& j : jobs)
+    if (Finished(o.out_dir, j))
+      for (BenchmarkRow& r : ReadJobResult(JobResultPath(o.out_dir, j)))
+        rows.push_back(std::move(r));
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  WriteBenchmarkReport(spec, o.out_dir, rows, wall);
+  spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", rows.size(), o.out_dir, Hms(wall));
+  if (interrupted) {
+    spdlog::warn("interrupted; the finished jobs are kept and reported: the same command resumes");
+    return 130;
+  }
+  if (!failed.empty()) {
+    spdlog::error(
+        "{} job(s) failed in the harness (not a method's failure): their rows are missing",
+        failed.size());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace penumbra

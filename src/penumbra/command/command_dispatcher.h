@@ -1,0 +1,85 @@
+#pragma once
+// the one command layer of a live run, shared by every bridge (ZeroMQ, ROS, the browser
+// viewer): a decoded request (a JSON object: {"cmd": NAME, "id": ANY?, ...fields}, the schema
+// of docs/zmq-protocol.md) in, a reply object out. every field is checked here, before
+// anything is queued: a missing or mistyped field, a name the model does not have or an
+// unknown command gives an error reply naming the field (command/command_error.h), never an
+// exception. commands that change the simulation run through RunControl at a step boundary
+// (command/run_control.h), so lockstep runs stay deterministic.
+//
+// commands: hello, model_info, get_state, step, set_ctrl, twist, joint_targets, waypoints,
+// set_mocap, reset, pause, resume, set_realtime_factor, stop, and, through the run's
+// LiveControl (session/live_control.h), set_adversity, set_effect, start_recording and
+// stop_recording (not_available when the dispatcher has no LiveControl). transport-level
+// commands (the ZeroMQ bridge's `sync`) are the bridges' own.
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "penumbra/command/command_error.h"
+#include "penumbra/command/request_reader.h"
+#include "penumbra/command/run_control.h"
+#include "penumbra/session/live_control.h"
+#include "penumbra/session/session.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+
+/// the protocol version of docs/zmq-protocol.md that this build speaks.
+inline constexpr int kCommandProtocolVersion = 1;
+
+/// checks requests and carries them out on the run (see the file comment). thread-safe.
+class CommandDispatcher {
+ public:
+  /// receives the whole reply: {"ok", "cmd", "id" (when the request had one), ...}.
+  using Done = std::function<void(nlohmann::json reply)>;
+
+  /// `session`, `world` and `control` must outlive the dispatcher; `model_info` is the
+  /// `model_info` reply (command/run_description.h: DescribeRun). `lockstep`: the run was
+  /// started paused (hello's `mode`). `live`: the run's live effects and recorder (may be
+  /// null: the four live commands then reply not_available); it must outlive the dispatcher.
+  CommandDispatcher(Session& session, const WorldConfig& world, RunControl* control,
+                    nlohmann::json model_info, bool lockstep, LiveControl* live = nullptr);
+
+  /// checks `request` and carries it out; `done` receives the reply exactly once: at once (on
+  /// this thread) for errors and read-only commands, else on the loop thread once the command
+  /// was applied (for `step`: once the steps are taken and their outputs drained). never throws.
+  void Dispatch(const nlohmann::json& request, Done done);
+  /// Dispatch and wait for the reply. not from the loop thread (it would wait for itself).
+  nlohmann::json Call(const nlohmann::json& request);
+
+  /// the commands Dispatch knows, sorted.
+  static std::vector<std::string> CommandNames();
+  /// the `model_info` reply fields.
+  const nlohmann::json& model_info() const { return model_info_; }
+
+ private:
+  struct Target {
+    int index = -1;
+    std::string robot;
+    std::string type;
+    int joints = 0;  // joint_pd: joints in its command vectors
+  };
+  // checks the fields of command `cmd` and replies or queues (throws CommandError)
+  void Handle(const std::string& cmd, RequestReader& rd, const Done& done);
+  // set_adversity, set_effect, start_recording, stop_recording (throws CommandError)
+  nlohmann::json HandleLive(const std::string& cmd, RequestReader& rd);
+  // the controller a controller command addresses (`robot` field, or the only one)
+  const Target& FindTarget(RequestReader& rd, const std::string& command);
+
+  Session& session_;
+  const WorldConfig& world_;
+  RunControl* control_;
+  nlohmann::json model_info_;
+  bool lockstep_ = false;
+  LiveControl* live_ = nullptr;
+  std::vector<Target> targets_;
+  std::vector<std::string> actuator_names_;
+  std::vector<std::string> mocap_names_;
+  std::vector<bool> mocap_driven_;
+  std::vector<std::string> key_names_;
+};
+
+}  // namespace penumbra

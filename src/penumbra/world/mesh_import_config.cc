@@ -1,0 +1,109 @@
+#include "penumbra/world/mesh_import_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "penumbra/core/error.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace penumbra {
+namespace {
+
+constexpr double kMaxScale = 1e6;
+
+bool ValidAxis(const std::string& a) {
+  return a.empty() || a == "x" || a == "y" || a == "z" || a == "-x" || a == "-y" || a == "-z";
+}
+
+}  // namespace
+
+void MeshImportConfig::ValidateOrThrow(const std::string& file, const std::string& key) const {
+  if (!(scale >= 0 && scale <= kMaxScale))
+    throw ConfigError(file, line, key + ".scale",
+                      "expected metres per file unit in (0, 1e6] (0 = the format's default)");
+  if (!ValidAxis(up_axis))
+    throw ConfigError(file, line, key + ".up_axis",
+                      "'" + up_axis + "'; expected one of x, y, z, -x, -y, -z");
+  if (!(emissive_cd_m2 >= 0 && emissive_cd_m2 <= 1e9))
+    throw ConfigError(file, line, key + ".emissive_cd_m2", "expected a luminance in [0, 1e9]");
+}
+
+bool IsMeshModelFile(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".obj" || ext == ".gltf" || ext == ".glb" || ext == ".fbx" || ext == ".dae" ||
+         ext == ".stl" || ext == ".ply";
+}
+
+const std::vector<std::string_view>& MeshImportKeys() {
+  static const std::vector<std::string_view> keys = {"units", "scale", "up_axis", "handedness",
+                                                     "emissive_cd_m2"};
+  return keys;
+}
+
+void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out) {
+  out->line = r.line();
+  for (std::string_view k : MeshImportKeys()) {
+    if (r.Has(k) && !is_mesh)
+      r.Child(k).Fail(
+          "applies to mesh files only; expected a model file ending in .obj, .gltf, .glb, .fbx, "
+          ".dae, .stl or .ply");
+  }
+  if (r.Has("units") && r.Has("scale"))
+    r.Child("scale").Fail("given together with units; expected one of units and scale");
+  if (r.Has("units")) {
+    const std::string u = r.Child("units").Enum({"m", "cm", "mm", "in", "ft"});
+    out->scale = u == "m"    ? 1.0
+                 : u == "cm" ? 0.01
+                 : u == "mm" ? 0.001
+                 : u == "in" ? 0.0254
+                             : 0.3048;
+  }
+  if (r.Has("scale")) {
+    out->scale = r.Child("scale").Double();
+    if (!(out->scale > 0 && out->scale <= kMaxScale))
+      r.Child("scale").Fail("expected metres per file unit in (0, 1e6]");
+  }
+  if (r.Has("up_axis")) out->up_axis = r.Child("up_axis").Enum({"x", "y", "z", "-x", "-y", "-z"});
+  if (r.Has("handedness"))
+    out->left_handed = r.Child("handedness").Enum({"right", "left"}) == "left";
+  if (r.Has("emissive_cd_m2")) {
+    out->emissive_cd_m2 = r.Child("emissive_cd_m2").Double();
+    if (!(out->emissive_cd_m2 >= 0 && out->emissive_cd_m2 <= 1e9))
+      r.Child("emissive_cd_m2").Fail("expected a luminance in [0, 1e9] cd/m^2");
+  }
+}
+
+MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::string& key) {
+  MeshImportConfig out;
+  if (world_file.empty() || key.empty()) return out;
+  // key: "<list>[<index>]"
+  const size_t open = key.find('['), close = key.find(']');
+  if (open == std::string::npos || close == std::string::npos || close < open) return out;
+  const std::string list = key.substr(0, open);
+  const size_t index = std::stoul(key.substr(open + 1, close - open - 1));
+  // a world whose file is gone (a replay's recorded world): the format defaults
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(world_file);
+  } catch (const YAML::Exception&) {
+    return out;
+  }
+  const YamlReader doc(root, world_file, nullptr);
+  doc.ExpectMapAnyKeys();
+  if (!doc.Has(list)) return out;
+  const YamlReader entries = doc.Child(list);
+  if (index >= entries.size()) return out;
+  const YamlReader entry = entries.Element(index);
+  entry.ExpectMapAnyKeys();
+  const std::string file = entry.Has("file") ? entry.Child("file").String() : "";
+  ReadMeshImportKeys(entry, IsMeshModelFile(file), &out);
+  return out;
+}
+
+}  // namespace penumbra

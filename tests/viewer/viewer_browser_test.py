@@ -1,0 +1,355 @@
+#!/usr/bin/env python3
+"""the live viewer end to end, with a real headless Chromium (Debian's chromium and
+chromium-driver through python3-selenium) and raw WebSocket clients (python3-websocket):
+
+  penumbra view worlds/default.yaml --viewer 127.0.0.1:0   (real-time, paused at the start)
+
+checks: the page shows a camera frame (canvas not blank, equal to the run's PNG of the same
+frame within JPEG error), pause stops sim time, one step advances exactly one control period,
+the fog slider lowers the next frames' contrast, the teleop keys move the quadruped forward and
+back (ground-truth x), five viewers at once, a malformed message gets an error and the server
+keeps running; a screenshot of the whole page is saved as a test artefact (--artefacts).
+
+usage: viewer_browser_test.py --binary build/penumbra --source . [--artefacts DIR]
+"""
+
+import argparse
+import base64
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+import websocket
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
+
+T0 = time.monotonic()
+
+
+def log(msg):
+    print(f"[{time.monotonic() - T0:6.1f} s] {msg}", flush=True)
+
+
+def wait_for(what, fn, timeout=30.0, poll=0.05):
+    end = time.monotonic() + timeout
+    while True:
+        v = fn()
+        if v:
+            return v
+        if time.monotonic() > end:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(poll)
+
+
+def check(cond, msg):
+    if not cond:
+        raise AssertionError(msg)
+    log("ok: " + msg)
+
+
+class View:
+    """a `penumbra view` process; its stderr is collected to find the URL."""
+
+    def __init__(self, binary, world, out):
+        self.proc = subprocess.Popen(
+            [binary, "view", world, "--viewer", "127.0.0.1:0", "--out", out, "--duration", "120"],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.lines = []
+        self.url = None
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.lines.append(line.rstrip())
+            m = re.search(r"viewer: open (http://\S+/)", line)
+            if m:
+                self.url = m.group(1)
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+            try:
+                self.proc.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        return self.proc.returncode
+
+
+def ws_client(url):
+    c = websocket.create_connection(url.replace("http://", "ws://") + "ws", timeout=10)
+    return c
+
+
+def recv_json(c, want_type=None, timeout=10.0):
+    """the next text message (of `want_type`, skipping others)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        op, data = c.recv_data()
+        if op != websocket.ABNF.OPCODE_TEXT:
+            continue
+        m = json.loads(data)
+        if want_type is None or m.get("type") == want_type or (want_type == "reply" and "ok" in m):
+            return m
+    raise AssertionError(f"no {want_type} message within {timeout} s")
+
+
+CANVAS_STATS = """
+const c = document.querySelector('canvas.cam');
+const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+let n = 0, s = 0, s2 = 0;
+for (let i = 0; i < d.length; i += 4) {
+  const y = 0.2126 * d[i] + 0.7152 * d[i + 1] + 0.0722 * d[i + 2];
+  s += y; s2 += y * y; n++;
+}
+const mean = s / n;
+return {w: c.width, h: c.height, mean, std: Math.sqrt(Math.max(0, s2 / n - mean * mean)),
+        time_sec: Number(c.dataset.timeSec), step: Number(c.dataset.step),
+        index: window.penumbraViewer.lastFrame['camera/front/rgb'] ?
+               window.penumbraViewer.lastFrame['camera/front/rgb'].index : -1};
+"""
+
+# mean absolute difference (0..255 per channel) between the page's canvas and a PNG file
+COMPARE_PNG = """
+const [b64, done] = arguments;
+const img = new Image();
+img.onload = () => {
+  const c = document.querySelector('canvas.cam');
+  const a = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  const o = document.createElement('canvas');
+  o.width = img.width; o.height = img.height;
+  const ctx = o.getContext('2d');
+  ctx.drawImage(img, 0, 0);
+  const b = ctx.getImageData(0, 0, o.width, o.height).data;
+  if (a.length !== b.length) return done({error: `sizes ${c.width}x${c.height} vs ${img.width}x${img.height}`});
+  let s = 0;
+  for (let i = 0; i < a.length; i += 4) s += Math.abs(a[i] - b[i]) + Math.abs(a[i+1] - b[i+1]) + Math.abs(a[i+2] - b[i+2]);
+  done({mad: s / (3 * a.length / 4)});
+};
+img.onerror = () => done({error: 'png did not load'});
+img.src = 'data:image/png;base64,' + b64;
+"""
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--binary", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("--artefacts", default=None)
+    args = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="penumbra_viewer_test_")
+    artefacts = args.artefacts or tmp
+    os.makedirs(artefacts, exist_ok=True)
+    out = os.path.join(tmp, "out")
+    view = View(args.binary, os.path.join(args.source, "worlds", "default.yaml"), out)
+    driver = None
+    extra = []
+    ok = False
+    try:
+        wait_for("the viewer's URL", lambda: view.url or (view.proc.poll() is not None and
+                                                      sys.exit("penumbra view exited:\n" +
+                                                               "\n".join(view.lines))), 60)
+        url = view.url
+        log(f"viewer at {url}")
+
+        o = webdriver.ChromeOptions()
+        o.binary_location = "/usr/bin/chromium"
+        for a in ["--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+                  "--window-size=1600,1000", "--use-angle=swiftshader",
+                  "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"]:
+            o.add_argument(a)
+        o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+        driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=o)
+        driver.set_script_timeout(30)
+        js = driver.execute_script
+        driver.get(url)
+        log("page loaded")
+        wait_for("hello and scene", lambda: js(
+            "const v = window.penumbraViewer; return v.hello && v.scene && true;"))
+        hello = js("return window.penumbraViewer.hello;")
+        period = hello["control_period_sec"]
+        dt = hello["timestep_sec"]
+        check(hello["paused"], "the run starts paused")
+        check(len(js("return window.penumbraViewer.scene.geoms;")) > 20,
+              "the scene's geometry arrived")
+
+        # play: time runs, frames arrive and are drawn
+        driver.find_element("id", "play").click()
+        wait_for("sim time > 0.6 s", lambda: js("const s = window.penumbraViewer.state; return s ? s.time_sec : 0;") > 0.6,
+                 timeout=40)
+        wait_for("a drawn camera frame after t = 0", lambda: js(
+            "const f = window.penumbraViewer.lastFrame['camera/front/rgb']; return f && f.time_sec > 0;"))
+        stats = js(CANVAS_STATS)
+        check(stats["w"] == 640 and stats["h"] == 480 and stats["std"] > 8,
+              f"the camera canvas shows an image (640x480, luminance std {stats['std']:.1f})")
+
+        # pause: sim time stops
+        driver.find_element("id", "pause").click()
+        wait_for("the pause reply", lambda: js(
+            "return window.penumbraViewer.replies.some(r => r.cmd === 'pause' && r.ok);"))
+        time.sleep(0.4)
+        t1 = js("return [window.penumbraViewer.state.step, document.getElementById('simTime').textContent];")
+        time.sleep(1.2)
+        t2 = js("return [window.penumbraViewer.state.step, document.getElementById('simTime').textContent];")
+        check(t1 == t2, f"pause stops sim time (step, time {t1} after 1.2 s wall: {t2})")
+
+        # the frame on the canvas equals the run's PNG of that frame, within JPEG error
+        wait_for("the paused frame drawn", lambda: js(CANVAS_STATS)["index"] >= 0)
+        time.sleep(0.5)
+        stats = js(CANVAS_STATS)
+        idx = stats["index"]
+        png = os.path.join(out, "front", "rgb", f"{idx:06d}.png")
+        wait_for(f"{png} written", lambda: os.path.exists(png), timeout=20)
+        time.sleep(0.3)
+        with open(png, "rb") as f:
+            b64 = base64.b64encode(f.read()).decode()
+        r = driver.execute_async_script(COMPARE_PNG, b64)
+        quality = js("return window.penumbraViewer.lastHeader ? window.penumbraViewer.lastHeader.quality : -1;")
+        check("mad" in r and r["mad"] < 6.0,
+              f"canvas = {os.path.basename(png)} (t = {stats['time_sec']:.3f} s) within JPEG error "
+              f"(mean abs difference {r.get('mad', r)} of 255 at JPEG quality {quality})")
+        other = os.path.join(out, "front", "rgb", f"{max(0, idx - 5):06d}.png")
+        if idx >= 5 and os.path.exists(other):
+            with open(other, "rb") as f:
+                r2 = driver.execute_async_script(COMPARE_PNG, base64.b64encode(f.read()).decode())
+            check(r2["mad"] > r["mad"], f"an earlier frame differs more ({r2['mad']:.2f})")
+
+        # one step = one control period: from the pause's boundary to the step's
+        p0 = js("return window.penumbraViewer.replies.filter(r => r.cmd === 'pause' && r.ok).pop();")
+        driver.find_element("id", "step").click()
+        n = max(1, round(period / dt))
+        r1 = wait_for("the step reply", lambda: js(
+            "return window.penumbraViewer.replies.find(r => r.cmd === 'step' && r.ok);"))
+        check(r1["step"] - p0["step"] == n and abs((r1["time_sec"] - p0["time_sec"]) - period) < 1e-9,
+              f"step advances exactly one control period ({r1['step'] - p0['step']} steps, "
+              f"{r1['time_sec'] - p0['time_sec']:.6f} s; period {period} s)")
+        wait_for("the page's state at the step", lambda: js(
+            "const s = window.penumbraViewer.state; return s && s.step;") == r1["step"])
+
+        # fog: the next frames lose contrast
+        before = js(CANVAS_STATS)
+        t_change = js("return window.penumbraViewer.state.time_sec;")
+        js("const e = document.getElementById('effect_fog_mor_m'); e.value = 3;"
+           "e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change'));")
+        reply = wait_for("the set_effect reply", lambda: js(
+            "return window.penumbraViewer.replies.concat(window.penumbraViewer.errors)"
+            ".find(r => r.cmd === 'set_effect');"))
+        check(reply.get("ok"), f"set_effect fog accepted ({reply})")
+        driver.find_element("id", "play").click()
+        wait_for("a frame captured after the fog change", lambda: js(
+            "const f = window.penumbraViewer.lastFrame['camera/front/rgb'];"
+            f"return f && f.time_sec > {t_change} + 0.05;"), timeout=40)
+        driver.find_element("id", "pause").click()
+        time.sleep(0.5)
+        after = js(CANVAS_STATS)
+        check(after["std"] < 0.7 * before["std"],
+              f"fog MOR 3 m lowers the frame's contrast (luminance std {before['std']:.1f} -> "
+              f"{after['std']:.1f})")
+        js("const e = document.getElementById('effect_fog_mor_m'); e.value = 300;"
+           "e.dispatchEvent(new Event('change'));")
+
+        # teleop: W moves the robot forward (+x, its heading), S back
+        def trunk_x():
+            return js("const v = window.penumbraViewer; const i = v.scene.bodies.findIndex(b => b.trail);"
+                      "return [v.state.X_WB[7 * i], v.state.time_sec];")
+
+        driver.find_element("id", "play").click()
+
+        def hold(key, sim_sec):
+            x0 = trunk_x()
+            ActionChains(driver).key_down(key).perform()
+            wait_for(f"{sim_sec} s of sim time with '{key}' held",
+                     lambda: trunk_x()[1] >= x0[1] + sim_sec, timeout=40)
+            ActionChains(driver).key_up(key).perform()
+            return x0, trunk_x()
+
+        a0, a1 = hold("w", 1.5)
+        check(a1[0] - a0[0] > 0.2, f"'w' moves the quadruped forward: x {a0[0]:.3f} -> {a1[0]:.3f} m")
+        b0, b1 = hold("s", 1.5)
+        check(b1[0] < b0[0] - 0.05, f"'s' moves it back: x {b0[0]:.3f} -> {b1[0]:.3f} m")
+        latency = js("return window.penumbraViewer.lastTwistSentMs;")
+        check(latency is not None, "the page sent twists")
+
+        # five viewers at once: the page and four more clients
+        for _ in range(4):
+            c = ws_client(url)
+            extra.append(c)
+        for c in extra:
+            check(recv_json(c, "viewer_hello")["type"] == "viewer_hello"
+                  and recv_json(c, "scene")["type"] == "scene"
+                  and recv_json(c, "state")["time_sec"] >= 0, "an extra viewer gets hello, scene, state")
+        t_page = js("return window.penumbraViewer.state.time_sec;")
+        time.sleep(1.0)
+        check(js("return window.penumbraViewer.state.time_sec;") > t_page,
+              "the page keeps updating with five viewers connected")
+
+        # malformed messages: error replies; too large: closed with 1009; the server lives on
+        c = extra[0]
+        c.send("{not json")
+        r = recv_json(c, "reply")
+        check(r["ok"] is False and r["error"]["code"] == "malformed", f"malformed JSON -> {r['error']}")
+        c.send(json.dumps({"cmd": "warp", "id": 7}))
+        r = recv_json(c, "reply")
+        check(r["error"]["code"] == "unknown_command" and r["id"] == 7, "an unknown command -> error")
+        c.send(json.dumps({"cmd": "twist", "vx": "fast", "id": 8}))
+        r = recv_json(c, "reply")
+        check(r["error"]["code"] == "bad_field", f"a mistyped field -> {r['error']}")
+        closed = None
+        try:
+            c.send("x" * 100000)
+        except (BrokenPipeError, ConnectionResetError, websocket.WebSocketConnectionClosedException):
+            closed = -1  # the server closed it while the payload was still being written
+        end = time.monotonic() + 10
+        while time.monotonic() < end and closed is None:
+            try:
+                frame = c.recv_frame()  # raw frames: no automatic close reply to a gone peer
+                op, data = frame.opcode, frame.data
+            except (websocket.WebSocketConnectionClosedException, ConnectionResetError,
+                    BrokenPipeError):
+                closed = -1
+                break
+            if op == websocket.ABNF.OPCODE_CLOSE:
+                closed = int.from_bytes(data[:2], "big") if len(data) >= 2 else 0
+        check(closed in (1009, -1),
+              f"a 100 kB message closes that connection (close status {closed}; -1: closed "
+              "before the client finished writing)")
+        extra.pop(0)
+        c2 = ws_client(url)
+        extra.append(c2)
+        check(recv_json(c2, "viewer_hello")["type"] == "viewer_hello", "a new viewer still connects")
+        t_page = js("return window.penumbraViewer.state.time_sec;")
+        time.sleep(0.8)
+        check(js("return window.penumbraViewer.state.time_sec;") > t_page, "the run goes on")
+
+        shot = os.path.join(artefacts, "viewer.png")
+        driver.save_screenshot(shot)
+        log(f"screenshot: {shot}")
+        errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        check(not errors, f"no errors in the page's console ({errors[:3]})")
+        ok = True
+    finally:
+        for c in extra:
+            try:
+                c.close()
+            except Exception:
+                pass
+        if driver:
+            driver.quit()
+        rc = view.stop()
+        if not ok:
+            print("\n".join(view.lines[-40:]))
+        shutil.rmtree(tmp, ignore_errors=True)
+    check(rc == 0, f"penumbra view ends cleanly on SIGINT (exit {rc})")
+    log("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
