@@ -50,8 +50,8 @@ void ApplyStartPose(const std::string& text, WorldConfig* world) {
     pos = end + 1;
   }
   const auto bad = [&](const std::string& why) {
-    return ConfigError("", 0, "--start-pose", "'" + text + "': " + why +
-                                                  "; expected ROBOT,X,Y,YAW_DEG (m, m, deg)");
+    return ConfigError("", 0, "--start-pose",
+                       "'" + text + "': " + why + "; expected ROBOT,X,Y,YAW_DEG (m, m, deg)");
   };
   if (parts.size() != 4) throw bad("not 4 comma-separated fields");
   double v[3];

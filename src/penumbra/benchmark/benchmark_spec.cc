@@ -322,8 +322,8 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       r.ExpectMap({"kind", "name", "worlds", "conditions", "trials", "seeds", "methods", "metrics",
                    "render", "workers", "slurm"});
     else
-      r.ExpectMap({"kind", "name", "worlds", "conditions", "trials", "seeds", "methods",
-                   "metrics", "render", "workers", "keep_datasets", "slurm"});
+      r.ExpectMap({"kind", "name", "worlds", "conditions", "trials", "seeds", "methods", "metrics",
+                   "render", "workers", "keep_datasets", "slurm"});
     s.name = r.Has("name") ? Name(r.Child("name")) : fs::path(s.file).stem().string();
     if (nav && r.Has("metrics")) {
       const YamlReader m = r.Child("metrics");

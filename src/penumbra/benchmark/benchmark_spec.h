@@ -3,8 +3,9 @@
 // worlds (each a recorded route), which adversity conditions, how many trials (seeds), which
 // SLAM methods and which metrics. `kind: nav` makes it a navigation benchmark instead: its
 // worlds name a robot and point-goal episodes, its methods are closed-loop navigators
-// (benchmark/nav_spec.h has that half of the format); `kind: slam` is the default. loaded and checked as a whole before anything runs; every
-// error names the spec file, the 1-based line and the key path.
+// (benchmark/nav_spec.h has that half of the format); `kind: slam` is the default. loaded and
+// checked as a whole before anything runs; every error names the spec file, the 1-based line and
+// the key path.
 //
 //   name: slam                       # a label for the report
 //   worlds:
@@ -57,9 +58,9 @@ struct BenchmarkWorld {
   std::string camera_yaml;  ///< the camera as a one-line YAML mapping (outputs, depth_noise set)
   int line = 0;             ///< line of the entry in the spec
   // kind: nav only
-  std::string robot;                 ///< the world's robot (its `robots:` name)
+  std::string robot;                  ///< the world's robot (its `robots:` name)
   std::string profile = "quadruped";  ///< NavProfile name
-  std::vector<NavEpisode> episodes;  ///< at least one
+  std::vector<NavEpisode> episodes;   ///< at least one
 };
 
 /// one adversity condition.

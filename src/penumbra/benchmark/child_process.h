@@ -35,8 +35,8 @@ class ChildProcess {
   /// "exit N", "signal N (SIGNAME)"; "running" before it exited.
   std::string Describe() const;
   bool exited() const { return exited_; }
-  int exit_code() const { return exit_code_; }  ///< -1 unless it exited normally
-  int signal() const { return signal_; }        ///< 0 unless a signal ended it
+  int exit_code() const { return exit_code_; }   ///< -1 unless it exited normally
+  int signal() const { return signal_; }         ///< 0 unless a signal ended it
   double wall_sec() const { return wall_sec_; }  ///< from start to exit, s
   int pid() const { return pid_; }
 

@@ -1,8 +1,8 @@
 #include "penumbra/benchmark/nav_job.h"
 
 #include <arpa/inet.h>
-#include <signal.h>
 #include <netinet/in.h>
+#include <signal.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -13,8 +13,8 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -130,9 +130,8 @@ std::vector<NavPoseSample> ReadPoses(const fs::path& file, const std::string& bo
   const std::vector<std::string> head = SplitCsv(line);
   std::map<std::string, size_t> col;
   for (size_t i = 0; i < head.size(); ++i) col[head[i]] = i;
-  const std::vector<std::string> keys = {"time_sec",     body + "_x_m",  body + "_y_m",
-                                         body + "_z_m",  body + "_qw",   body + "_qx",
-                                         body + "_qy",   body + "_qz"};
+  const std::vector<std::string> keys = {"time_sec",   body + "_x_m", body + "_y_m", body + "_z_m",
+                                         body + "_qw", body + "_qx",  body + "_qy",  body + "_qz"};
   std::vector<size_t> idx;
   for (const std::string& k : keys) {
     if (!col.count(k)) throw Error(file.string() + ": no column " + k);
@@ -305,26 +304,25 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
     run = std::make_unique<ChildProcess>(argv, dir.string(), (dir / "run.log").string(),
                                          (dir / "run.log").string());
     // a bind failure shows within a moment: the run exits before it waits for a client
-    if (run->WaitFor(1.0) && Tail(dir / "run.log", 4000).find("Address already in use") !=
-                                 std::string::npos) {
+    if (run->WaitFor(1.0) &&
+        Tail(dir / "run.log", 4000).find("Address already in use") != std::string::npos) {
       spdlog::warn("job {}: port {} taken, trying another", job.id, port);
       continue;
     }
     break;
   }
-  std::map<std::string, std::string> values = {
-      {"penumbra", ShellQuote(context.penumbra_binary)},
-      {"pythonpath", ShellQuote(NavPythonPath())},
-      {"endpoint", ShellQuote(endpoint)},
-      {"goal_x", Num(ep.goal_x)},
-      {"goal_y", Num(ep.goal_y)},
-      {"radius", Num(ep.radius_m)},
-      {"timeout_sec", Num(ep.timeout_sec)},
-      {"robot", ShellQuote(w.profile)},
-      {"robot_name", ShellQuote(w.robot)},
-      {"out_dir", ShellQuote(work.string())},
-      {"workdir", ShellQuote(work.string())},
-      {"seed", std::to_string(job.seed)}};
+  std::map<std::string, std::string> values = {{"penumbra", ShellQuote(context.penumbra_binary)},
+                                               {"pythonpath", ShellQuote(NavPythonPath())},
+                                               {"endpoint", ShellQuote(endpoint)},
+                                               {"goal_x", Num(ep.goal_x)},
+                                               {"goal_y", Num(ep.goal_y)},
+                                               {"radius", Num(ep.radius_m)},
+                                               {"timeout_sec", Num(ep.timeout_sec)},
+                                               {"robot", ShellQuote(w.profile)},
+                                               {"robot_name", ShellQuote(w.robot)},
+                                               {"out_dir", ShellQuote(work.string())},
+                                               {"workdir", ShellQuote(work.string())},
+                                               {"seed", std::to_string(job.seed)}};
   const std::string command = FillTemplate(method.command, values);
   WriteText(work / "command.sh", "#!/bin/sh\n" + command + "\n");
   proc = std::make_unique<ChildProcess>(std::vector<std::string>{"/bin/sh", "-c", command},
@@ -360,8 +358,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   if (stopped) throw Error("job " + job.id + " interrupted");
 
   const Clock::time_point eval_start = Clock::now();
-  const bool run_ok = run->exit_code() == 0 || run->exit_code() == 143 ||
-                      run->exit_code() == 130;
+  const bool run_ok = run->exit_code() == 0 || run->exit_code() == 143 || run->exit_code() == 130;
   std::vector<NavPoseSample> poses;
   std::vector<ContactInterval> contacts;
   std::string eval_error;
@@ -383,8 +380,8 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   if (!run_ok || !eval_error.empty()) {
     row.status = "run_failed";
     row.end = "run_failed";
-    row.detail += "; " + (eval_error.empty() ? "" : eval_error + "; ") + "run.log: " +
-                  Tail(dir / "run.log", 300);
+    row.detail += "; " + (eval_error.empty() ? "" : eval_error + "; ") +
+                  "run.log: " + Tail(dir / "run.log", 300);
   } else {
     NavEpisodeTask task;
     task.goal_x = ep.goal_x;
@@ -406,8 +403,8 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
     else
       row.status = "ok";
     const NavEpisodeMetrics m = EvaluateNavEpisode(poses, contacts, task, row.status == "ok");
-    row.end = m.fell ? "fall"
-              : sim_timeout ? "sim_timeout"
+    row.end = m.fell         ? "fall"
+              : sim_timeout  ? "sim_timeout"
               : wall_timeout ? "wall_timeout"
                              : "method_exit";
     row.success = m.success;

@@ -51,7 +51,7 @@ struct NavRow {
   double sc = 0;  ///< S / (1 + c)
   bool fell = false;
   double method_sec = 0, run_sec = 0, eval_sec = 0;  ///< wall times, s
-  std::vector<std::pair<double, double>> path_xy;     ///< base xy at 10 Hz (plots), m
+  std::vector<std::pair<double, double>> path_xy;    ///< base xy at 10 Hz (plots), m
 };
 
 /// the nav jobs of a spec (kind: nav), in index order: world, episode, condition, method,

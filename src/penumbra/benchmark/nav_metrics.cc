@@ -9,8 +9,7 @@
 
 namespace penumbra {
 
-int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec,
-                    double until_sec) {
+int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec, double until_sec) {
   if (!(debounce_sec >= 0)) throw Error("CountCollisions: debounce_sec must be >= 0");
   std::map<std::pair<std::string, std::string>, std::vector<std::pair<double, double>>> by_pair;
   for (ContactInterval& c : intervals) {
@@ -51,8 +50,9 @@ NavEpisodeMetrics EvaluateNavEpisode(const std::vector<NavPoseSample>& poses,
     if (i > 0 && !(p.time_sec >= poses[i - 1].time_sec))
       throw Error("EvaluateNavEpisode: pose samples out of time order");
     // roll and pitch of X_WB (ZYX Euler angles), deg
-    const double roll = std::atan2(2 * (p.qw * p.qx + p.qy * p.qz),
-                                   1 - 2 * (p.qx * p.qx + p.qy * p.qy)) * 180 / M_PI;
+    const double roll =
+        std::atan2(2 * (p.qw * p.qx + p.qy * p.qz), 1 - 2 * (p.qx * p.qx + p.qy * p.qy)) * 180 /
+        M_PI;
     const double pitch =
         std::asin(std::clamp(2 * (p.qw * p.qy - p.qz * p.qx), -1.0, 1.0)) * 180 / M_PI;
     const bool fall = p.z < task.fall_height_m || std::abs(roll) > task.max_tilt_deg ||

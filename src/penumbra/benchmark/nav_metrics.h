@@ -34,8 +34,7 @@ struct ContactInterval {
 /// intervals that start after `until_sec` are ignored (contacts after the episode ended).
 /// debounce_sec = 0: every interval counts. @throws Error for debounce_sec < 0 or an interval
 /// with end_sec < start_sec.
-int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec,
-                    double until_sec);
+int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec, double until_sec);
 
 /// what a navigation episode is judged by.
 struct NavEpisodeTask {
@@ -53,9 +52,9 @@ struct NavEpisodeMetrics {
                          ///< end, no fall, and the method did not fail
   int collisions = 0;    ///< CountCollisions up to the end of the episode
   bool fell = false;
-  double fall_time_sec = -1;    ///< first sample that is a fall, s (-1: none)
-  double time_to_goal_sec = -1; ///< first sample within the radius, s; -1 when never (or not a
-                                ///< success)
+  double fall_time_sec = -1;         ///< first sample that is a fall, s (-1: none)
+  double time_to_goal_sec = -1;      ///< first sample within the radius, s; -1 when never (or not a
+                                     ///< success)
   double final_goal_distance_m = 0;  ///< horizontal, at the end
   double episode_time_sec = 0;       ///< time of the end sample minus the first sample's
   double path_length_m = 0;          ///< horizontal length of the base's path, m

@@ -154,13 +154,13 @@ void PlotPaths(const std::string& title, const std::vector<const NavRow*>& rows,
     if (pts.empty()) continue;
     cv::polylines(img, pts, false, col, 2, cv::LINE_AA);
     cv::drawMarker(img, pts.front(), col, cv::MARKER_SQUARE, 10, 2);
-    cv::putText(img,
-                fmt::format("trial {}: {}{}", rows[i]->trial,
-                            rows[i]->success ? "success" : "failure",
-                            rows[i]->collisions ? fmt::format(", {} coll.", rows[i]->collisions)
-                                                : std::string()),
-                {10, S + 30 - 18 * static_cast<int>(rows.size() - 1 - i)},
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, col, 1, cv::LINE_AA);
+    cv::putText(
+        img,
+        fmt::format(
+            "trial {}: {}{}", rows[i]->trial, rows[i]->success ? "success" : "failure",
+            rows[i]->collisions ? fmt::format(", {} coll.", rows[i]->collisions) : std::string()),
+        {10, S + 30 - 18 * static_cast<int>(rows.size() - 1 - i)}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+        col, 1, cv::LINE_AA);
   }
   cv::putText(img, "1 m grid; x right, y up", {S - 190, S + 30}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
               cv::Scalar(90, 90, 90), 1, cv::LINE_AA);
@@ -170,13 +170,30 @@ void PlotPaths(const std::string& title, const std::vector<const NavRow*>& rows,
 }  // namespace
 
 const std::vector<std::string>& NavCsvColumns() {
-  static const std::vector<std::string> kColumns = {
-      "world",        "episode",          "condition",   "method",
-      "trial",        "seed",             "status",      "end",
-      "success",      "collisions",       "sc",          "time_to_goal_sec",
-      "final_goal_distance_m", "episode_time_sec", "path_length_m", "fell",
-      "goal_x",       "goal_y",           "radius_m",    "timeout_sec",
-      "method_sec",   "run_sec",          "eval_sec",    "detail"};
+  static const std::vector<std::string> kColumns = {"world",
+                                                    "episode",
+                                                    "condition",
+                                                    "method",
+                                                    "trial",
+                                                    "seed",
+                                                    "status",
+                                                    "end",
+                                                    "success",
+                                                    "collisions",
+                                                    "sc",
+                                                    "time_to_goal_sec",
+                                                    "final_goal_distance_m",
+                                                    "episode_time_sec",
+                                                    "path_length_m",
+                                                    "fell",
+                                                    "goal_x",
+                                                    "goal_y",
+                                                    "radius_m",
+                                                    "timeout_sec",
+                                                    "method_sec",
+                                                    "run_sec",
+                                                    "eval_sec",
+                                                    "detail"};
   return kColumns;
 }
 
@@ -190,9 +207,9 @@ std::string NavCsv(const std::vector<NavRow>& rows) {
                        r.trial, r.seed, r.status, r.end);
     out += measured ? fmt::format("{},{},{},", r.success ? 1 : 0, r.collisions, Field(r.sc))
                     : std::string("0,,0,");
-    out += fmt::format("{},{},{},{},{},", Field(r.time_to_goal_sec),
-                       Field(r.final_goal_distance_m), Field(r.episode_time_sec),
-                       Field(r.path_length_m), measured ? (r.fell ? "1" : "0") : "");
+    out += fmt::format("{},{},{},{},{},", Field(r.time_to_goal_sec), Field(r.final_goal_distance_m),
+                       Field(r.episode_time_sec), Field(r.path_length_m),
+                       measured ? (r.fell ? "1" : "0") : "");
     out += fmt::format("{},{},{},{},", Field(r.goal_x), Field(r.goal_y), Field(r.radius_m),
                        Field(r.timeout_sec));
     out += fmt::format("{:.3f},{:.3f},{:.3f},", r.method_sec, r.run_sec, r.eval_sec);
@@ -217,8 +234,7 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
           std::vector<int> coll;
           std::vector<double> t, d;
           for (const NavRow& r : rows) {
-            if (r.world != w.name || r.condition != c.name || r.method != m.name ||
-                r.seed != seed)
+            if (r.world != w.name || r.condition != c.name || r.method != m.name || r.seed != seed)
               continue;
             ++l.rows;
             l.ok += r.status == "ok" ? 1 : 0;
@@ -314,8 +330,8 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
     const std::string success = "plots/" + w.name + "_success.png",
                       sc = "plots/" + w.name + "_sc.png";
     PlotMetric(spec, lines, w.name, "success rate", &NavSummaryLine::success, 1.0, out / success);
-    PlotMetric(spec, lines, w.name, "SC (success weighted by collisions)", &NavSummaryLine::sc,
-               1.0, out / sc);
+    PlotMetric(spec, lines, w.name, "SC (success weighted by collisions)", &NavSummaryLine::sc, 1.0,
+               out / sc);
     md += fmt::format("![{0} success]({1})\n\n![{0} SC]({2})\n\n", w.name, success, sc);
   }
   md += "## Paths (top view, every trial)\n\n";
@@ -348,8 +364,8 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
         md +=
             "| world | episode | condition | method | trial | status | detail |\n"
             "|---|---|---|---|---|---|---|\n";
-      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", r.world, r.episode,
-                        r.condition, r.method, r.trial, r.status, r.detail.substr(0, 200));
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", r.world, r.episode, r.condition,
+                        r.method, r.trial, r.status, r.detail.substr(0, 200));
     }
   if (failed == 0) md += "Every method process ended normally in every episode.\n";
   WriteFile(out / "report.md", md);

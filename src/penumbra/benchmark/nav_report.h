@@ -37,8 +37,7 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
                                          const std::vector<NavRow>& rows);
 
 /// the summary as Markdown tables (one per world).
-std::string NavSummaryMarkdown(const BenchmarkSpec& spec,
-                               const std::vector<NavSummaryLine>& lines);
+std::string NavSummaryMarkdown(const BenchmarkSpec& spec, const std::vector<NavSummaryLine>& lines);
 
 /// writes results.csv, summary.md, summary.csv, plots/*.png and report.md into `out_dir`.
 /// @throws Error if a file cannot be written.

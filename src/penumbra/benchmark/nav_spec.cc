@@ -19,9 +19,9 @@ void Range(const char* field, double v, double lo, double hi, bool lo_open) {
 }  // namespace
 
 void NavEpisode::ValidateOrThrow() const {
-  for (const auto& [field, v] : {std::pair{"goal", goal_x}, std::pair{"goal", goal_y},
-                                 std::pair{"start", start_x}, std::pair{"start", start_y},
-                                 std::pair{"start", start_yaw_deg}})
+  for (const auto& [field, v] :
+       {std::pair{"goal", goal_x}, std::pair{"goal", goal_y}, std::pair{"start", start_x},
+        std::pair{"start", start_y}, std::pair{"start", start_yaw_deg}})
     if (!std::isfinite(v)) throw ConfigError("", 0, field, "not finite; expected numbers");
   Range("radius", radius_m, 0, 3600, true);
   Range("timeout_sec", timeout_sec, 0, 3600, true);
@@ -44,14 +44,15 @@ NavRobotProfile NavProfile(const std::string& name) {
   if (name == "quadruped") return {"quadruped", "trunk", {"*_foot"}, 0.15, 45};
   if (name == "rover")
     return {"rover", "chassis", {"left_wheel", "right_wheel", "*_tire", "caster"}, -0.1, 45};
-  throw ConfigError("", 0, "profile", "unknown robot profile '" + SanitizeForMessage(name, 40) +
-                                          "'; expected quadruped or rover");
+  throw ConfigError(
+      "", 0, "profile",
+      "unknown robot profile '" + SanitizeForMessage(name, 40) + "'; expected quadruped or rover");
 }
 
 const std::vector<std::string>& NavMethodPlaceholders() {
   static const std::vector<std::string> kKeys = {
-      "penumbra", "pythonpath", "endpoint",   "goal_x",  "goal_y",  "radius",
-      "timeout_sec", "robot",   "robot_name", "out_dir", "workdir", "seed"};
+      "penumbra",    "pythonpath", "endpoint",   "goal_x",  "goal_y",  "radius",
+      "timeout_sec", "robot",      "robot_name", "out_dir", "workdir", "seed"};
   return kKeys;
 }
 
