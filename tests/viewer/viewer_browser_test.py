@@ -16,6 +16,7 @@ usage: viewer_browser_test.py --binary build/penumbra --source . [--artefacts DI
 import argparse
 import base64
 import json
+import math
 import os
 import re
 import shutil
@@ -256,25 +257,31 @@ def main():
         js("const e = document.getElementById('effect_fog_mor_m'); e.value = 300;"
            "e.dispatchEvent(new Event('change'));")
 
-        # teleop: W moves the robot forward (+x, its heading), S back
-        def trunk_x():
+        # teleop: W moves the robot forward along its heading, S back (the heading at key-down:
+        # the world's own controller may have turned the robot before the key is pressed)
+        def trunk():
             return js("const v = window.penumbraViewer; const i = v.scene.bodies.findIndex(b => b.trail);"
-                      "return [v.state.X_WB[7 * i], v.state.time_sec];")
+                      "return v.state.X_WB.slice(7 * i, 7 * i + 7).concat([v.state.time_sec]);")
 
         driver.find_element("id", "play").click()
 
         def hold(key, sim_sec):
-            x0 = trunk_x()
+            p0 = trunk()
             ActionChains(driver).key_down(key).perform()
             wait_for(f"{sim_sec} s of sim time with '{key}' held",
-                     lambda: trunk_x()[1] >= x0[1] + sim_sec, timeout=40)
+                     lambda: trunk()[7] >= p0[7] + sim_sec, timeout=40)
             ActionChains(driver).key_up(key).perform()
-            return x0, trunk_x()
+            p1 = trunk()
+            qw, qx, qy, qz = p0[3:7]
+            yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+            ahead = (p1[0] - p0[0]) * math.cos(yaw) + (p1[1] - p0[1]) * math.sin(yaw)
+            return p0, p1, ahead
 
-        a0, a1 = hold("w", 1.5)
-        check(a1[0] - a0[0] > 0.2, f"'w' moves the quadruped forward: x {a0[0]:.3f} -> {a1[0]:.3f} m")
-        b0, b1 = hold("s", 1.5)
-        check(b1[0] < b0[0] - 0.05, f"'s' moves it back: x {b0[0]:.3f} -> {b1[0]:.3f} m")
+        a0, a1, ahead = hold("w", 1.5)
+        check(ahead > 0.2, f"'w' moves the quadruped forward: {ahead:.3f} m along its heading "
+              f"(x, y {a0[0]:.3f}, {a0[1]:.3f} -> {a1[0]:.3f}, {a1[1]:.3f} m)")
+        b0, b1, back = hold("s", 1.5)
+        check(back < -0.05, f"'s' moves it back: {back:.3f} m along its heading")
         latency = js("return window.penumbraViewer.lastTwistSentMs;")
         check(latency is not None, "the page sent twists")
 
