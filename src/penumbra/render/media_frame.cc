@@ -21,7 +21,8 @@ MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
 void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                          const Camera& camera, const CameraView& view,
                          const RenderSettings& settings, const LightSampler& lights,
-                         const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool) {
+                         const RayScene& rays, const SkyModel& base_sky,
+                         SkyIrradianceVolume* sky_volume, ThreadPool* pool) {
   const EffectsFrame* fx = effects && !effects->empty() ? effects : nullptr;
   active_ = fx != nullptr;
   sky_ = &base_sky;
@@ -67,18 +68,25 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
   }
 
   media_.Build(fx);
-  if (!media_.empty() && settings.tier == RenderSettings::Tier::kRealtime) {
+  const bool realtime = settings.tier == RenderSettings::Tier::kRealtime;
+  // the sky let through by the static geometry, for the realtime media and the particles.
+  const SkyIrradianceVolume* occluded_sky = nullptr;
+  if (sky_volume != nullptr && ((realtime && !media_.empty()) || !fx->particles.empty())) {
+    sky_volume->Update(scene_, snapshot, *sky_, pool);
+    if (!sky_volume->empty()) occluded_sky = sky_volume;
+  }
+  if (!media_.empty() && realtime) {
     const uint64_t frame_key =
         HashKeys(HashKeys(settings.seed, static_cast<uint64_t>(view.camera_index)),
                  static_cast<uint64_t>(view.frame_index));
     realtime_.Build(media_, lights, rays, camera, frame_key, scene_.center_W.cast<float>(),
-                    scene_.extent_m, sky_ambient_, pool);
+                    scene_.extent_m, sky_ambient_, occluded_sky, pool);
     realtime_ok_ = true;
   }
   particles_.Build(fx, camera, view.exposure_time_sec,
                    settings.tier == RenderSettings::Tier::kRealtime, pool,
                    media_.empty() ? nullptr : &media_);
-  if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, pool);
+  if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, occluded_sky, pool);
 }
 
 }  // namespace penumbra

@@ -25,6 +25,7 @@
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -47,17 +48,22 @@ class MediaFrame {
   /// prepares `effects` at `snapshot` (none when `effects` is null or empty) for
   /// `view` (its exposure time, camera and frame index) seen through `camera`. `lights` must
   /// already be posed for the snapshot and `rays` updated. realtime light volumes are built only
-  /// for that tier.
+  /// for that tier. `sky_volume` (may be null) is the renderer's occluded sky light
+  /// (sky_irradiance_volume.h): Prepare brings it up to date (Update) with the frame's sky when
+  /// the media of the realtime tier or any particles need it, and they are then lit by the sky
+  /// it lets through (in the pathtraced tier the media's sky light is occluded by its own
+  /// shadow rays). it must outlive this object until the next Prepare.
   /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
   void Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects, const Camera& camera,
                const CameraView& view, const RenderSettings& settings, const LightSampler& lights,
-               const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool);
+               const RayScene& rays, const SkyModel& base_sky, SkyIrradianceVolume* sky_volume,
+               ThreadPool* pool);
 
   /// any effect is active this frame.
   bool active() const { return active_; }
   /// the sky to use this frame (base_sky of Prepare unless the effects change it).
   const SkyModel* sky() const { return sky_; }
-  /// sphere-average radiance of sky().
+  /// sphere-average radiance of sky() (unoccluded).
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
   /// media, or null when there are none.
   const MediaScene* media() const { return media_.empty() ? nullptr : &media_; }

@@ -497,8 +497,9 @@ bool ParticleScene::Intersect(const Ray& ray, float tmax, ParticleHit* hit) cons
 }
 
 void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
-                                   ThreadPool* pool) {
+                                   const SkyIrradianceVolume* sky_volume, ThreadPool* pool) {
   rain_radiance_.clear();
+  sky_volume_ = sky_volume;
   bool any = false;
   const bool culled = !visible_.empty();  // realtime: only streaks in the image are drawn
   for (int n = 0; n < count_ && !any; ++n)
@@ -543,7 +544,9 @@ Eigen::Vector3f ParticleScene::Shade(const ParticleHit& hit, const Eigen::Vector
       E += ls.E * kInv4Pi;
     }
   }
-  return ps.color.cwiseProduct(sky_ambient + E) + ps.emission;
+  const Eigen::Vector3f sky =
+      sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient) : sky_ambient;
+  return ps.color.cwiseProduct(sky + E) + ps.emission;
 }
 
 }  // namespace penumbra
