@@ -16,7 +16,8 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
   return sum * static_cast<float>(1.0 / (6.0 * M_PI));
 }
 
-MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
+MediaFrame::MediaFrame(const SceneDescription& scene, RayQueryFactory make_query)
+    : scene_(scene), shelter_(std::move(make_query)) {}
 
 void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                          const Camera& camera, const CameraView& view,
@@ -83,9 +84,12 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
                     scene_.extent_m, sky_ambient_, occluded_sky, pool);
     realtime_ok_ = true;
   }
+  bool sheltered = false;
+  for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ps.sheltered;
+  if (sheltered) shelter_.Update(scene_, snapshot, pool);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    settings.tier == RenderSettings::Tier::kRealtime, pool,
-                   media_.empty() ? nullptr : &media_);
+                   media_.empty() ? nullptr : &media_, sheltered ? &shelter_ : nullptr);
   if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, occluded_sky, pool);
 }
 

@@ -4,7 +4,8 @@
 // FrameContext::effects (null in clear conditions, so a frame without effects takes none of
 // the effects code paths):
 //  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
-//  - particle streaks for the frame's camera and exposure (ParticleScene);
+//  - particle streaks for the frame's camera and exposure (ParticleScene), without the
+//    sheltered precipitation that static geometry covers from above (ShelterMap);
 //  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
 //    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
 //    the scale changed (building SkyModel's tables is not free, docs/performance.md; the sun
@@ -25,6 +26,7 @@
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
@@ -42,8 +44,9 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
 /// per-frame effects state of one renderer. not thread-safe; the accessors are, after Prepare.
 class MediaFrame {
  public:
-  /// `scene` (the renderer's copy) must outlive this object.
-  explicit MediaFrame(const SceneDescription& scene);
+  /// `scene` (the renderer's copy) must outlive this object; `make_query` traces the shelter
+  /// map of the precipitation (shelter_map.h) when a frame has sheltered particles.
+  MediaFrame(const SceneDescription& scene, RayQueryFactory make_query);
 
   /// prepares `effects` at `snapshot` (none when `effects` is null or empty) for
   /// `view` (its exposure time, camera and frame index) seen through `camera`. `lights` must
@@ -88,6 +91,7 @@ class MediaFrame {
   RealtimeMedia realtime_;
   bool realtime_ok_ = false;
   ParticleScene particles_;
+  ShelterMap shelter_;  // built at the first frame with sheltered particles
   float wetness_ = 0;
 };
 

@@ -40,7 +40,10 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       materials_(scene_, settings_.max_anisotropy),
       lights_(scene_),
       sky_(scene_.sky),
-      effects_(scene_),
+      effects_(scene_,
+               [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+                 return std::make_unique<RayScene>(statics);
+               }),
       sky_volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
         return std::make_unique<RayScene>(statics);
       }),

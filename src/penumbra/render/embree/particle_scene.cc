@@ -81,7 +81,8 @@ bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vecto
 ParticleScene::~ParticleScene() = default;
 
 void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-                          bool pixel_hits, ThreadPool* pool, const MediaScene* media) {
+                          bool pixel_hits, ThreadPool* pool, const MediaScene* media,
+                          const ShelterMap* shelter) {
   fx_ = fx;
   count_ = 0;
   culled_ = 0;
@@ -188,6 +189,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     const Eigen::Vector3f& v = ps.velocity_W[i];
     const float r = ps.radius_m[i];
     if (!(r > 0)) return;
+    if (shelter != nullptr && ps.sheltered && shelter->Sheltered(p)) return;  // under a roof
     Eigen::Vector3f q = p + T * v;
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
     if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);

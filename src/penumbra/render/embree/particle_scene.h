@@ -57,6 +57,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/scene/effects_frame.h"
 
@@ -92,8 +93,11 @@ class ParticleScene {
   /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
   /// null). with pixel_hits, invisible rain streaks are culled (kRainCullContrast) using the
   /// homogeneous media of `media` (may be null: coverage alone).
+  /// `shelter` (may be null): particles of sets with ParticleSet::sheltered that it shelters
+  /// (static geometry above them) are not drawn.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr);
+             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
+             const ShelterMap* shelter = nullptr);
 
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
