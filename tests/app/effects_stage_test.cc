@@ -46,7 +46,7 @@ TEST(AdversityPlan, NoneAddsNothingMinorAndMajorAddTheirParts) {
   const Planned minor = Plan("minor", 7);
   EXPECT_EQ(Names(minor),
             (std::vector<std::string>{"adversity_fog", "adversity_smoke", "adversity_rain",
-                                      "adversity_dim", "adversity_person0", "adversity_person1"}));
+                                      "adversity_dim", "adversity_person0"}));
   const Planned major = Plan("major", 7);
   EXPECT_EQ(major.agents.size(), 5u);
   EXPECT_EQ(major.agents.back().kind, AgentKind::kForklift);
