@@ -1,6 +1,6 @@
 // precipitation falls only where the sky is open above (render/shelter_map.h, issue 20 point
-// 4): rain under a roofed box is not drawn, rain in the open is, and a set that is not
-// sheltered falls under the roof too.
+// 4): rain under a roofed box is not drawn, rain in the open is, and sparks are not
+// sheltered.
 
 #include <gtest/gtest.h>
 
@@ -62,7 +62,6 @@ TEST(ParticleShelterTest, RainFallsOnlyUnderTheOpenSky) {
   EffectsFrame fx;
   ParticleSet rain;
   rain.kind = ParticleKind::kRain;
-  rain.sheltered = true;
   int inside = 0, outside = 0;
   for (float x = -5; x <= 5.01f; x += 0.5f)
     for (float y = -1.5f; y <= 1.51f; y += 0.5f) {
@@ -81,11 +80,11 @@ TEST(ParticleShelterTest, RainFallsOnlyUnderTheOpenSky) {
   covered.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
   EXPECT_EQ(open.size(), inside + outside);
   EXPECT_EQ(covered.size(), outside);
-  // a set that is not sheltered falls everywhere.
-  fx.particles[0].sheltered = false;
-  ParticleScene leaking;
-  leaking.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
-  EXPECT_EQ(leaking.size(), inside + outside);
+  // sparks are never sheltered.
+  fx.particles[0].kind = ParticleKind::kSpark;
+  ParticleScene sparks;
+  sparks.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
+  EXPECT_EQ(sparks.size(), inside + outside);
 }
 
 }  // namespace

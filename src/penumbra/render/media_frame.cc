@@ -85,7 +85,8 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
     realtime_ok_ = true;
   }
   bool sheltered = false;
-  for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ps.sheltered;
+  for (const ParticleSet& ps : fx->particles)
+    sheltered = sheltered || ps.kind != ParticleKind::kSpark;
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    settings.tier == RenderSettings::Tier::kRealtime, pool,

@@ -5,7 +5,7 @@
 // the effects code paths):
 //  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
 //  - particle streaks for the frame's camera and exposure (ParticleScene), without the
-//    sheltered precipitation that static geometry covers from above (ShelterMap);
+//    rain and snow that static geometry covers from above (ShelterMap);
 //  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
 //    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
 //    the scale changed (building SkyModel's tables is not free, docs/performance.md; the sun
@@ -45,7 +45,7 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
 class MediaFrame {
  public:
   /// `scene` (the renderer's copy) must outlive this object; `make_query` traces the shelter
-  /// map of the precipitation (shelter_map.h) when a frame has sheltered particles.
+  /// map of the precipitation (shelter_map.h) when a frame has rain or snow.
   MediaFrame(const SceneDescription& scene, RayQueryFactory make_query);
 
   /// prepares `effects` at `snapshot` (none when `effects` is null or empty) for
@@ -91,7 +91,7 @@ class MediaFrame {
   RealtimeMedia realtime_;
   bool realtime_ok_ = false;
   ParticleScene particles_;
-  ShelterMap shelter_;  // built at the first frame with sheltered particles
+  ShelterMap shelter_;  // built at the first frame with rain or snow
   float wetness_ = 0;
 };
 

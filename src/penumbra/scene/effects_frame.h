@@ -46,12 +46,12 @@ struct HomogeneousMedium {
 /// -half + (i + 0.5, j + 0.5, k + 0.5) * 2 half / (nx, ny, nz); values between voxel centres
 /// are trilinear; outside the box density and emission are 0.
 struct GridMedium {
-  Pose X_WG = Pose::Identity();  ///< pose of the grid box in the world
+  Pose X_WG = Pose::Identity();              ///< pose of the grid box in the world
   Eigen::Vector3d half_extents_m{0.5, 0.5, 0.5};
   int nx = 0, ny = 0, nz = 0;
   /// (nz x ny x nx) density, index (k * ny + j) * nx + i, >= 0, dimensionless.
   std::shared_ptr<const std::vector<float>> density;
-  Eigen::Vector3f sigma_t_per_m{1, 1, 1};    ///< extinction at density 1, 1/m per channel
+  Eigen::Vector3f sigma_t_per_m{1, 1, 1};  ///< extinction at density 1, 1/m per channel
   Eigen::Vector3f albedo{0.9f, 0.9f, 0.9f};  ///< single-scattering albedo per channel
   float g = 0.0f;                            ///< Henyey-Greenstein asymmetry
   /// (nz x ny x nx x 3) emitted radiance per unit length, cd/m^2 per m per channel, or null
@@ -79,10 +79,6 @@ struct ParticleSet {
   std::vector<float> radius_m;              ///< (N) m
   Eigen::Vector3f color{1, 1, 1};           ///< albedo (rain, snow) in [0, 1]
   Eigen::Vector3f emission{0, 0, 0};        ///< cd/m^2 per channel (sparks)
-  /// precipitation falls only where the sky is open above: the renderer does not draw
-  /// particles that have static geometry above them (render/shelter_map.h). false: they fall
-  /// under roofs too.
-  bool sheltered = false;
 };
 
 /// everything the effects stage adds to one frame. empty by default = clear conditions.

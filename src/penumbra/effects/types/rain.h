@@ -31,9 +31,6 @@ struct RainParams {
   /// number density is kept. [1, 5e6]
   int max_particles = 200000;
   Eigen::Vector3d color{0.85, 0.9, 1.0};  ///< drop tint (albedo), [0, 1]
-  /// falls only where the sky is open above it (static geometry shelters it: indoor scenes
-  /// stay dry); false: it falls under roofs too (a leaking roof, a sprinkler).
-  bool sheltered = true;
 
   /// effect-type hooks (effects/effect_type.h).
   static std::vector<std::string_view> Keys();

@@ -29,9 +29,6 @@ struct SnowParams {
   Eigen::Vector3d box_half_extents_m{4, 4, 3};  ///< each > 0
   int max_particles = 200000;                   ///< [1, 5e6]
   Eigen::Vector3d color{0.95, 0.95, 0.97};      ///< [0, 1]
-  /// falls only where the sky is open above it (static geometry shelters it: indoor scenes
-  /// stay dry); false: it falls under roofs too (a leaking roof, a sprinkler).
-  bool sheltered = true;
 
   /// effect-type hooks (effects/effect_type.h).
   static std::vector<std::string_view> Keys();

@@ -93,8 +93,8 @@ class ParticleScene {
   /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
   /// null). with pixel_hits, invisible rain streaks are culled (kRainCullContrast) using the
   /// homogeneous media of `media` (may be null: coverage alone).
-  /// `shelter` (may be null): particles of sets with ParticleSet::sheltered that it shelters
-  /// (static geometry above them) are not drawn.
+  /// `shelter` (may be null): rain drops and snowflakes that it shelters (static geometry
+  /// above them) are not drawn; sparks are.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
              bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
              const ShelterMap* shelter = nullptr);
