@@ -55,6 +55,8 @@ void AddDecompositionOptions(CLI::App* app, DecompositionOptions* o, int* seed) 
   AddCount(app, "--iterations", &o->mcts_iterations, 1, 100000,
            "tree search iterations per cut (default 60)");
   AddCount(app, "--depth", &o->mcts_depth, 1, 16, "tree search depth (default 3)");
+  AddCount(app, "--search-samples", &o->search_samples, 16, 10000000,
+           "surface samples of the concavity inside the search (default 600)");
   AddCount(app, "--seed", seed, 0, 1000000000, "search seed (default 0)");
 }
 
@@ -114,21 +116,24 @@ int DecomposeCommands::RunDecompose() const {
   const Decomposition& d = result.decomposition;
   fmt::print("{}: {} triangles, volume {:.6g} m^3, largest extent {:.4g} m\n", name,
              mesh.triangles.size(), d.mesh_volume, d.extent);
-  fmt::print("method {}: {} parts, {} cuts, max concavity {:.4g} m ({:.4f} of the extent, "
-             "threshold {:.4f})\n",
-             DecompositionMethodName(d.method), d.parts.size(), d.cuts, d.max_concavity,
-             d.relative_max_concavity(), o.decomposition.concavity_threshold);
+  fmt::print(
+      "method {}: {} parts, {} cuts, max concavity {:.4g} m ({:.4f} of the extent, "
+      "threshold {:.4f})\n",
+      DecompositionMethodName(d.method), d.parts.size(), d.cuts, d.max_concavity,
+      d.relative_max_concavity(), o.decomposition.concavity_threshold);
   fmt::print("hull volumes / mesh volume {:.4f}; {:.3f} s{}\n", d.HullVolumeSum() / d.mesh_volume,
-             seconds, o.no_cache ? "" : (result.cache_hit ? " (cache hit)" : " (computed, cached)"));
-  if (d.hit_cut_limit) fmt::print("note: the cut limit ended the search before every piece was under the threshold\n");
+             seconds,
+             o.no_cache ? "" : (result.cache_hit ? " (cache hit)" : " (computed, cached)"));
+  if (d.hit_cut_limit)
+    fmt::print("note: the cut limit ended the search before every piece was under the threshold\n");
   if (d.hit_part_limit) fmt::print("note: --max-parts forced merges over the threshold\n");
   if (!o.obj_out.empty()) WritePartsObj(d, o.obj_out);
   if (!o.mjcf_out.empty()) {
     const PartsMjcf parts = PartsToMjcf(d, "part", "rgba=\"0.8 0.6 0.4 1\"");
     std::ofstream out(o.mjcf_out);
-    out << "<mujoco model=\"decomposed\">\n  <asset>\n" << parts.assets
-        << "  </asset>\n  <worldbody>\n    <body name=\"decomposed\">\n" << parts.geoms
-        << "    </body>\n  </worldbody>\n</mujoco>\n";
+    out << "<mujoco model=\"decomposed\">\n  <asset>\n"
+        << parts.assets << "  </asset>\n  <worldbody>\n    <body name=\"decomposed\">\n"
+        << parts.geoms << "    </body>\n  </worldbody>\n</mujoco>\n";
     if (!out) throw Error(o.mjcf_out + ": cannot write");
   }
   return 0;
@@ -137,11 +142,13 @@ int DecomposeCommands::RunDecompose() const {
 int DecomposeCommands::RunBench() const {
   DecompositionOptions base = bench_options.decomposition;
   base.seed = static_cast<uint64_t>(bench_options.seed);
-  fmt::print("convex decomposition: CoACD (threshold {:.4f} of the extent, max {} parts) vs "
-             "convex hull vs CGAL exact (Nef)\n",
-             base.concavity_threshold, base.max_parts);
-  fmt::print("max concavity: of the parts, over the mesh's largest extent; excess: how far the "
-             "hulls stick out of the mesh, over the extent; volume: hull volumes / mesh volume\n");
+  fmt::print(
+      "convex decomposition: CoACD (threshold {:.4f} of the extent, max {} parts) vs "
+      "convex hull vs CGAL exact (Nef)\n",
+      base.concavity_threshold, base.max_parts);
+  fmt::print(
+      "max concavity: of the parts, over the mesh's largest extent; excess: how far the "
+      "hulls stick out of the mesh, over the extent; volume: hull volumes / mesh volume\n");
   fmt::print("{:<6} {:>6} {:<6} {:>6} {:>14} {:>8} {:>8} {:>9}\n", "shape", "tris", "method",
              "parts", "max concavity", "excess", "volume", "time s");
   for (const std::string& shape : bench_options.shapes) {

@@ -19,16 +19,16 @@ namespace penumbra {
 
 /// options of `penumbra decompose`.
 struct DecomposeCommandOptions {
-  std::string mesh_file;       ///< the mesh (.off .obj .stl .ply), or "" with shape
-  std::string shape;           ///< a generated test shape (l, u, torus, bowl) instead
-  double scale = 1.0;          ///< m per mesh file unit
+  std::string mesh_file;              ///< the mesh (.off .obj .stl .ply), or "" with shape
+  std::string shape;                  ///< a generated test shape (l, u, torus, bowl) instead
+  double scale = 1.0;                 ///< m per mesh file unit
   std::string method_name = "coacd";  ///< coacd, hull or exact
   DecompositionOptions decomposition;
-  int seed = 0;                ///< the search seed
-  std::string obj_out;         ///< write the parts as OBJ here ("" = no)
-  std::string mjcf_out;        ///< write an MJCF model of the parts here ("" = no)
-  std::string cache_dir;       ///< cache folder ("" = DefaultDecompositionCacheDir())
-  bool no_cache = false;       ///< compute, neither read nor write the cache
+  int seed = 0;           ///< the search seed
+  std::string obj_out;    ///< write the parts as OBJ here ("" = no)
+  std::string mjcf_out;   ///< write an MJCF model of the parts here ("" = no)
+  std::string cache_dir;  ///< cache folder ("" = DefaultDecompositionCacheDir())
+  bool no_cache = false;  ///< compute, neither read nor write the cache
 };
 
 /// options of `penumbra bench decompose`.

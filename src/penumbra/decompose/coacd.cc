@@ -9,12 +9,15 @@
 //      threshold (and further while there are more than max_parts).
 // deterministic: candidate order and rollouts draw from Rng(HashKeys(seed, ...)), ties break
 // by index, and nothing runs concurrently.
+#include "penumbra/decompose/coacd.h"
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
 #include <map>
 #include <memory>
+#include <tuple>
 #include <utility>
 
 #include "penumbra/core/rng.h"
@@ -112,13 +115,24 @@ class Coacd {
     }
     return planes;
   }
+  // a cut with the search measure, memoised for the current search: the tree and its
+  // rollouts cut the same piece by the same candidate plane many times. the key holds the
+  // piece itself (not only its address) so that a freed piece's address is never reused.
+  const std::vector<PiecePtr>& SearchCut(const PiecePtr& piece, const CutPlane& plane) const {
+    const MemoKey key{piece.get(), plane.normal.x(), plane.normal.y(), plane.normal.z(),
+                      plane.offset};
+    auto it = memo_.find(key);
+    if (it == memo_.end())
+      it = memo_.emplace(key, std::make_pair(piece, Cut(*piece, plane, search_concavity_))).first;
+    return it->second.second;
+  }
   // state after cutting the most concave piece of `pieces` by `plane` (search measure)
   std::vector<PiecePtr> Apply(const std::vector<PiecePtr>& pieces, const CutPlane& plane) const {
     const size_t w = Worst(pieces);
     std::vector<PiecePtr> next;
     for (size_t i = 0; i < pieces.size(); ++i)
       if (i != w) next.push_back(pieces[i]);
-    for (PiecePtr& p : Cut(*pieces[w], plane, search_concavity_)) next.push_back(std::move(p));
+    for (const PiecePtr& p : SearchCut(pieces[w], plane)) next.push_back(p);
     return next;
   }
   std::unique_ptr<Node> MakeNode(std::vector<PiecePtr> pieces, int depth, Node* parent,
@@ -161,9 +175,11 @@ class Coacd {
     return cost;
   }
   CutPlane Search(const PiecePtr& piece, uint64_t cut_index) const;
-  CutPlane Refine(const Piece& piece, const CutPlane& plane) const;
+  CutPlane Refine(const PiecePtr& piece, const CutPlane& plane) const;
   std::vector<ConvexPart> Merge(std::vector<PiecePtr> parts, Decomposition* out) const;
 
+  using MemoKey = std::tuple<const Piece*, double, double, double, double>;
+  mutable std::map<MemoKey, std::pair<PiecePtr, std::vector<PiecePtr>>> memo_;
   const DecompositionOptions& options_;
   double extent_;
   double threshold_;
@@ -172,6 +188,7 @@ class Coacd {
 };
 
 CutPlane Coacd::Search(const PiecePtr& piece, uint64_t cut_index) const {
+  memo_.clear();
   Rng rng(HashKeys(options_.seed, 0x436f414344ULL, cut_index));
   std::unique_ptr<Node> root = MakeNode({piece}, 0, nullptr, CutPlane{}, rng);
   const double root_cost = std::max(root->cost, 1e-300);
@@ -223,25 +240,25 @@ CutPlane Coacd::Search(const PiecePtr& piece, uint64_t cut_index) const {
     plane.offset = 0.5 * (bounds[0][axis] + bounds[1][axis]);
     return plane;
   }
-  return Refine(*piece, best->plane);
+  return Refine(piece, best->plane);
 }
 
 // local search along the plane's axis: halving steps around the chosen offset, keeping a move
 // when it lowers the cost of the one cut
-CutPlane Coacd::Refine(const Piece& piece, const CutPlane& plane) const {
-  const auto bounds = MeshBounds(piece.mesh);
+CutPlane Coacd::Refine(const PiecePtr& piece, const CutPlane& plane) const {
+  const auto bounds = MeshBounds(piece->mesh);
   int axis = 0;
   plane.normal.cwiseAbs().maxCoeff(&axis);
   const double lo = bounds[0][axis], hi = bounds[1][axis];
   double step = (hi - lo) / (options_.planes_per_axis + 1.0) / 2.0;
   CutPlane best = plane;
-  double best_cost = Cost(Cut(piece, plane, search_concavity_));
+  double best_cost = Cost(SearchCut(piece, plane));
   for (int round = 0; round < 3; ++round) {
     for (double sign : {-1.0, 1.0}) {
       CutPlane trial = best;
       trial.offset = best.offset + sign * step;
       if (!(trial.offset > lo + 2 * snap_ && trial.offset < hi - 2 * snap_)) continue;
-      const double c = Cost(Cut(piece, trial, search_concavity_));
+      const double c = Cost(SearchCut(piece, trial));
       if (c < best_cost) {
         best_cost = c;
         best = trial;
@@ -271,14 +288,14 @@ std::vector<ConvexPart> Coacd::Merge(std::vector<PiecePtr> parts, Decomposition*
         return false;
     return true;
   };
-  auto merged_of = [&](const Part& a, const Part& b) {
+  auto merged_of = [&](const Part& a, const Part& b, const ConcavityOptions& measure) {
     Part m;
     m.mesh = ConcatenateMeshes({&a.mesh, &b.mesh});
     std::vector<Eigen::Vector3d> points = a.hull.vertices;
     points.insert(points.end(), b.hull.vertices.begin(), b.hull.vertices.end());
     m.hull = CanonicalMesh(ConvexHullOf(points));
     m.volume = a.volume + b.volume;
-    m.concavity = Concavity(m.mesh, m.volume, m.hull, options_.concavity).value();
+    m.concavity = Concavity(m.mesh, m.volume, m.hull, measure).value();
     m.bounds = MeshBounds(m.hull);
     return m;
   };
@@ -291,7 +308,8 @@ std::vector<ConvexPart> Coacd::Merge(std::vector<PiecePtr> parts, Decomposition*
     const std::pair<int, int> key{ids[i], ids[j]};
     auto it = cost_cache.find(key);
     if (it != cost_cache.end()) return it->second;
-    const double c = merged_of(current[i], current[j]).concavity;
+    // ranked with the search measure (fewer samples); a merge is accepted on the full one
+    const double c = merged_of(current[i], current[j], search_concavity_).concavity;
     cost_cache.emplace(key, c);
     return c;
   };
@@ -312,8 +330,13 @@ std::vector<ConvexPart> Coacd::Merge(std::vector<PiecePtr> parts, Decomposition*
         }
       if (!(best < std::numeric_limits<double>::infinity())) return;
       if (!over_threshold && best > threshold_) return;
-      if (over_threshold && best > threshold_) out->hit_part_limit = true;
-      Part m = merged_of(current[bi], current[bj]);
+      Part m = merged_of(current[bi], current[bj], options_.concavity);
+      if (!over_threshold && m.concavity > threshold_) {
+        // the full measure rejects what the search measure accepted: never try this pair again
+        cost_cache[{ids[bi], ids[bj]}] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      if (over_threshold && m.concavity > threshold_) out->hit_part_limit = true;
       current.erase(current.begin() + bj);
       ids.erase(ids.begin() + bj);
       current[bi] = std::move(m);

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "penumbra/core/error.h"
+#include "penumbra/decompose/coacd.h"
 #include "penumbra/decompose/convex_hull.h"
 #include "penumbra/decompose/exact_decomposition.h"
 

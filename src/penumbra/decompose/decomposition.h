@@ -83,7 +83,4 @@ Decomposition DecomposeMesh(const SolidMesh& mesh, const DecompositionOptions& o
 /// one part: the convex hull of the mesh, with its concavity.
 Decomposition DecomposeHull(const SolidMesh& mesh, const DecompositionOptions& options);
 
-/// the CoACD search (decompose/coacd.cc).
-Decomposition DecomposeCoacd(const SolidMesh& mesh, const DecompositionOptions& options);
-
 }  // namespace penumbra
