@@ -437,9 +437,16 @@ def test_live(binary, source):
             assert foggy < 0.7 * clear, f"fog MOR 2 m: contrast {clear:.1f} -> {foggy:.1f}"
             c.ok("set_effect", effect="fog", params=None)
             assert rgb_contrast(frame_after(50)) > 0.9 * clear, "removing the fog block"
-            # the bundled presets bring NPCs; this run started without NPC bodies (MuJoCo 2.2.2
-            # cannot add bodies to a loaded model), so they are refused, naming the reason
-            expect_error(c, pack({"cmd": "set_adversity", "preset": "major"}), "bad_field", "npcs")
+            # the bundled presets bring NPCs: a live run reserves their bodies (parked)
+            c.ok("set_adversity", preset="major")
+            major = rgb_contrast(frame_after(50))
+            assert major < 0.9 * clear, f"major: contrast {clear:.1f} -> {major:.1f}"
+            # a preset file asking for more NPCs than any bundled preset is refused, naming why
+            crowd = os.path.join(tmp, "crowd.yaml")
+            with open(crowd, "w") as f:
+                f.write("presets:\n  crowd:\n    npcs: {people: 9}\n")
+            expect_error(c, pack({"cmd": "set_adversity", "preset": crowd + "#crowd"}),
+                         "bad_field", "npcs")
             preset = os.path.join(tmp, "smoky.yaml")
             with open(preset, "w") as f:
                 f.write("presets:\n  smoky:\n    fog: {mor_m: 4}\n    lights: {scale: 0.4}\n")

@@ -134,6 +134,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   session_options.adversity = options.adversity;
   session_options.composed_xml_path = (out / "composed.xml").string();
   session_options.check_run_budget = true;
+  session_options.reserve_live_npcs = !options.bridges.empty();
   Session session(world, session_options);
   Simulation& sim = session.sim();
   const SceneDescription& scene = session.scene();

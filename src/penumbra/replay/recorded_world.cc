@@ -12,6 +12,9 @@ RecordedRunFlags ParseRecordedRunFlags(const std::string& command_line) {
   for (std::string a; in >> a;) args.push_back(a);
   RecordedRunFlags f;
   for (size_t i = 0; i < args.size(); ++i) {
+    if (i <= 1 && args[i] == "view") f.live = true;
+    for (const char* bridge : {"--zmq", "--ros", "--viewer"})
+      if (args[i] == bridge || args[i].rfind(std::string(bridge) + "=", 0) == 0) f.live = true;
     std::string flag = args[i], value;
     const size_t eq = flag.find('=');
     if (flag.rfind("--", 0) != 0) continue;

@@ -22,6 +22,9 @@ struct RecordedRunFlags {
   std::optional<std::string> tier;       ///< --tier: "realtime" or "pathtraced"
   std::optional<int> samples_per_pixel;  ///< --spp
   std::optional<std::string> outputs;    ///< --outputs list, e.g. "rgb,depth"
+  /// a live run: --zmq, --ros or --viewer given, or the `view` verb (its model has the
+  /// reserved NPC bodies: SessionOptions::reserve_live_npcs)
+  bool live = false;
 };
 
 /// the flags of `command_line` (RunLogHeader::command_line: the arguments joined by spaces),

@@ -133,6 +133,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   session_options.composed_xml_path = (out / "composed.xml").string();
   session_options.add_controllers = false;
   session_options.check_run_budget = true;
+  session_options.reserve_live_npcs = ParseRecordedRunFlags(header.command_line).live;
   Session session(world, session_options);
   Simulation& sim = session.sim();
 

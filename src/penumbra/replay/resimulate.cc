@@ -255,7 +255,9 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   // the recorded world as `run` set it up (its adversity preset's NPCs included)
   const WorldConfig world = RecordedWorld(header);
   SessionOptions session_options;
-  session_options.adversity = ParseRecordedRunFlags(header.command_line).adversity;
+  const RecordedRunFlags recorded_flags = ParseRecordedRunFlags(header.command_line);
+  session_options.adversity = recorded_flags.adversity;
+  session_options.reserve_live_npcs = recorded_flags.live;
   session_options.add_controllers = controllers;
   session_options.build_renderer = false;
   Session session(world, session_options);

@@ -170,8 +170,18 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   }
 }
 
+std::pair<int, int> LiveNpcReserve() {
+  int people = 0, vehicles = 0;
+  for (const char* name : {"minor", "major"}) {
+    const AdversityPreset p = LoadAdversityPreset(ResolveAdversitySpec(name, "", "", 0));
+    people = std::max(people, p.npc_people);
+    vehicles = std::max(vehicles, p.npc_vehicles);
+  }
+  return {people, vehicles};
+}
+
 EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
-                           const std::string& adversity_override)
+                           const std::string& adversity_override, bool reserve_live_npcs)
     : effects_(world.effects),
       agents_(world.agents),
       seed_(world.seed),
@@ -201,7 +211,29 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   }
   ValidateEffectsOrThrow(effects_, world.file);
   ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
-  AddAgentBodies(AgentBodySpecs(agents_), world.file, composed);
+  std::vector<MocapBodySpec> bodies = AgentBodySpecs(agents_);
+  if (reserve_live_npcs) {
+    // parked bodies named as PlanAdversityPreset names its NPCs, for those it did not plan
+    const auto [people, vehicles] = LiveNpcReserve();
+    const Eigen::Vector3d start =
+        robot_starts_.empty() ? Eigen::Vector3d::Zero() : robot_starts_.front();
+    for (int kind = 0; kind < 2; ++kind)
+      for (int i = 0; i < (kind == 0 ? people : vehicles); ++i) {
+        AgentConfig a;
+        a.name = std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
+        if (std::any_of(agents_.begin(), agents_.end(),
+                        [&](const AgentConfig& b) { return b.name == a.name; }))
+          continue;
+        a.kind = kind == 0 ? AgentKind::kPerson : AgentKind::kForklift;
+        a.waypoints = {start.head<2>(), start.head<2>() + Eigen::Vector2d(1, 0)};
+        a.route = AgentRoute::kLoop;
+        reserved_.push_back(a);
+      }
+    std::vector<MocapBodySpec> parked = AgentBodySpecs(reserved_);
+    for (size_t i = 0; i < parked.size(); ++i) parked[i].X_WB = AgentParkedPose(reserved_[i]);
+    bodies.insert(bodies.end(), parked.begin(), parked.end());
+  }
+  AddAgentBodies(bodies, world.file, composed);
 }
 
 EffectsStage::~EffectsStage() = default;
@@ -264,6 +296,15 @@ void EffectsStage::Attach(Simulation* sim) {
   for (const AgentConfig& a : agents_) {
     auto slot = std::make_shared<AgentSlot>();
     slot->path = std::make_shared<const AgentPath>(a);
+    slot->parked = AgentParkedPose(a);
+    sim->AddMocapDriver(AgentBodyName(a.name), [slot](double t) {
+      return slot->path ? slot->path->X_WA(t) : slot->parked;
+    });
+    body_names_.push_back(a.name);
+    slots_.push_back(std::move(slot));
+  }
+  for (const AgentConfig& a : reserved_) {
+    auto slot = std::make_shared<AgentSlot>();
     slot->parked = AgentParkedPose(a);
     sim->AddMocapDriver(AgentBodyName(a.name), [slot](double t) {
       return slot->path ? slot->path->X_WA(t) : slot->parked;

@@ -64,9 +64,12 @@ class EffectsStage {
   /// plans the run's effects and agents and adds the agents' bodies to `composed`.
   /// @param adversity_override a preset spec from the command line (--adversity), or ""
   ///        for the world's own `adversity` key
+  /// @param reserve_live_npcs also add parked bodies for the NPCs the bundled presets can ask
+  ///        for (LiveNpcReserve), so that a live change to a bundled preset can bring them in
+  ///        (session/live_effects.h; MuJoCo 2.2.2 cannot add bodies to a loaded model)
   /// @throws ConfigError for an unknown preset, invalid agents or invalid effects.
   EffectsStage(const WorldConfig& world, ComposedScene* composed,
-               const std::string& adversity_override = "");
+               const std::string& adversity_override = "", bool reserve_live_npcs = false);
   ~EffectsStage();
 
   /// checks the world's agents against `sim`'s static geometry, then drives every agent's
@@ -131,7 +134,14 @@ class EffectsStage {
   };
   std::vector<std::string> body_names_;
   std::vector<std::shared_ptr<AgentSlot>> slots_;
+  // parked NPC bodies without an agent at the start (reserve_live_npcs)
+  std::vector<AgentConfig> reserved_;
 };
+
+/// the NPC bodies a live run reserves: the most people and vehicles any bundled adversity
+/// preset (worlds/adversity/presets.yaml: minor, major) asks for.
+/// @throws ConfigError when the bundled presets cannot be read.
+std::pair<int, int> LiveNpcReserve();
 
 /// where an agent body without an agent waits (a live change removed its NPC): at its path's
 /// start, 100 m below the agent's floor, out of every camera's and sensor's view above the

@@ -65,7 +65,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   for (const std::string& f : ConvertForeignMjcfMeshes(&composed, mesh_dir))
     spdlog::info("converted MJCF mesh {} for MuJoCo", f);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
-  effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity);
+  effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity,
+                                            options.reserve_live_npcs);
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   // the document becomes text once: the file kept and what MuJoCo compiles
   composed_xml_ = composed.Xml();

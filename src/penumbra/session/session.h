@@ -45,6 +45,11 @@ struct SessionOptions {
   std::string composed_xml_path;
   /// add the controllers of the world's robots (AddWorldControllers).
   bool add_controllers = true;
+  /// a live run (bridges, viewer): reserve parked bodies for the NPCs of the bundled adversity
+  /// presets (session/effects_stage.h LiveNpcReserve), so that `set_adversity` to one of them
+  /// works at run time. changes the composed model (more mocap bodies): a replay of such a
+  /// run sets it too (replay/recorded_world.h RecordedRunFlags::live).
+  bool reserve_live_npcs = false;
   /// before the renderer is built: refuse a run whose cameras and LiDARs would not fit in the
   /// machine's physical memory (CheckRunMemory) and warn about a large amount of work
   /// (DescribeRunWork), as `penumbra run` does.
