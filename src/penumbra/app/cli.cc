@@ -32,6 +32,7 @@
 #include "penumbra/app/vdb_tool.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
+#include "penumbra/replay/world_override.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/world/world_config.h"
@@ -40,6 +41,36 @@ namespace penumbra {
 namespace {
 
 // a world file (.yaml/.yml) or a bare model (.xml MJCF, .urdf)
+// --start-pose ROBOT,X,Y,YAW_DEG: the robot's pose in the world file replaced (x, y, yaw)
+void ApplyStartPose(const std::string& text, WorldConfig* world) {
+  std::vector<std::string> parts;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    const size_t end = std::min(text.find(',', pos), text.size());
+    parts.push_back(text.substr(pos, end - pos));
+    pos = end + 1;
+  }
+  const auto bad = [&](const std::string& why) {
+    return ConfigError("", 0, "--start-pose",
+                       "'" + text + "': " + why + "; expected ROBOT,X,Y,YAW_DEG (m, m, deg)");
+  };
+  if (parts.size() != 4) throw bad("not 4 comma-separated fields");
+  double v[3];
+  for (int i = 0; i < 3; ++i) {
+    const std::optional<double> d = ParseDecimal(parts[i + 1]);
+    if (!d) throw bad("'" + parts[i + 1] + "' is not a number");
+    v[i] = *d;
+  }
+  for (ModelConfig& m : world->models)
+    if (m.is_robot && m.name == parts[0]) {
+      m.pose.xyz.x() = v[0];
+      m.pose.xyz.y() = v[1];
+      m.pose.rpy_deg.z() = v[2];
+      return;
+    }
+  throw bad("the world has no robot '" + parts[0] + "'");
+}
+
 WorldConfig LoadWorldOrModel(const std::string& path) {
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".xml" || ext == ".urdf" || ext == ".mjcf") return WorldForBareModel(path);
@@ -222,6 +253,15 @@ int RunCli(int argc, char** argv) {
   run->add_option("--adversity", run_options.adversity,
                   "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME "
                   "(worlds/adversity/presets.yaml; overrides the world's `adversity`)");
+  std::string run_override;
+  run->add_option("--override", run_override,
+                  "a world-file fragment whose top-level keys replace the world's (the keys "
+                  "`penumbra replay --world` takes: cameras, sensors, metrics, ...; physics "
+                  "keys are refused)");
+  std::string start_pose;
+  run->add_option("--start-pose", start_pose,
+                  "ROBOT,X,Y,YAW_DEG: place the robot ROBOT at (X, Y) m in the world frame, "
+                  "turned YAW_DEG about z (its z, roll and pitch stay the world file's)");
 
   // penumbra bench render|physics
   CLI::App* bench = app.add_subcommand("bench", "throughput benchmarks (not tests)");
@@ -338,6 +378,8 @@ int RunCli(int argc, char** argv) {
   try {
     if (*run) {
       WorldConfig world = LoadWorldOrModel(world_path);
+      if (!run_override.empty()) world = ApplyWorldOverride(world, run_override);
+      if (!start_pose.empty()) ApplyStartPose(start_pose, &world);
       if (duration) run_options.duration_sec = *duration;
       if (seed) world.seed = *seed;
       if (!tier.empty())

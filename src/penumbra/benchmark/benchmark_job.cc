@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "penumbra/benchmark/method_process.h"
+#include "penumbra/benchmark/nav_job.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/dataset/dataset_export.h"
@@ -112,6 +113,7 @@ void Evaluate(const Trajectory& gt, const Trajectory& est, const BenchmarkSpec& 
 }  // namespace
 
 std::vector<BenchmarkJob> PlanBenchmarkJobs(const BenchmarkSpec& spec) {
+  if (spec.kind == "nav") return PlanNavJobs(spec);
   std::vector<BenchmarkJob> jobs;
   for (size_t w = 0; w < spec.worlds.size(); ++w)
     for (size_t c = 0; c < spec.conditions.size(); ++c)

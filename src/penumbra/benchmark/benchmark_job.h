@@ -24,10 +24,12 @@
 
 namespace penumbra {
 
-/// one (world, condition, trial).
+/// one (world, condition, trial); for a nav spec one (world, episode, condition, method,
+/// trial) (benchmark/nav_job.h).
 struct BenchmarkJob {
   int index = 0;  ///< 0-based, world-major, then condition, then trial
   size_t world = 0, condition = 0, trial = 0;
+  size_t episode = 0, method = 0;  ///< nav jobs only
   uint64_t seed = 0;
   std::string id;  ///< "<world>__<condition>__t<trial>" (trial 1-based)
 };
@@ -58,7 +60,7 @@ struct BenchmarkJobContext {
   const std::atomic<int>* stop_request = nullptr;
 };
 
-/// the jobs of a spec, in index order.
+/// the jobs of a spec, in index order (a nav spec's: PlanNavJobs).
 std::vector<BenchmarkJob> PlanBenchmarkJobs(const BenchmarkSpec& spec);
 
 /// OUT/recordings/<world>.plog

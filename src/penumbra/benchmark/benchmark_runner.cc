@@ -20,6 +20,8 @@
 #include "penumbra/benchmark/benchmark_job.h"
 #include "penumbra/benchmark/benchmark_report.h"
 #include "penumbra/benchmark/method_process.h"
+#include "penumbra/benchmark/nav_job.h"
+#include "penumbra/benchmark/nav_report.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -250,6 +252,13 @@ void RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir
   context.out_dir = out_dir;
   context.penumbra_binary = penumbra_binary;
   context.stop_request = stop_request;
+  if (spec.kind == "nav") {
+    const NavRow r = RunNavJob(spec, jobs[index], context);
+    spdlog::info("{} {} {} {} trial {}: {} ({}), success {}, collisions {}, goal distance {} m",
+                 r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail,
+                 r.success ? 1 : 0, r.collisions, r.final_goal_distance_m);
+    return;
+  }
   const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, jobs[index], context);
   for (const BenchmarkRow& r : rows)
     spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial,
@@ -281,12 +290,21 @@ int RunBenchmark(const BenchmarkOptions& o) {
   WriteText(copy, ReadText(spec.file));
 
   const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(spec);
-  spdlog::info(
-      "benchmark '{}': {} world(s) x {} condition(s) x {} trial(s) = {} jobs, {} method(s)",
-      spec.name, spec.worlds.size(), spec.conditions.size(), spec.seeds.size(), jobs.size(),
-      spec.methods.size());
-  // 1. the routes, recorded once
+  const bool nav = spec.kind == "nav";
+  if (nav)
+    spdlog::info(
+        "navigation benchmark '{}': {} world(s), {} condition(s), {} method(s), {} trial(s) = {} "
+        "jobs (one episode each)",
+        spec.name, spec.worlds.size(), spec.conditions.size(), spec.methods.size(),
+        spec.seeds.size(), jobs.size());
+  else
+    spdlog::info(
+        "benchmark '{}': {} world(s) x {} condition(s) x {} trial(s) = {} jobs, {} method(s)",
+        spec.name, spec.worlds.size(), spec.conditions.size(), spec.seeds.size(), jobs.size(),
+        spec.methods.size());
+  // 1. the routes, recorded once (SLAM only: navigation runs closed loop)
   for (const BenchmarkWorld& w : spec.worlds) {
+    if (nav) break;
     const std::string plog = RecordingPath(o.out_dir, w);
     if (fs::is_regular_file(plog, ec)) continue;
     spdlog::info("recording the route of world '{}' ({})", w.name, w.file);
@@ -301,14 +319,24 @@ int RunBenchmark(const BenchmarkOptions& o) {
       o.slurm ? RunSlurm(o, spec, jobs, start) : RunLocal(o, spec, jobs, workers, start);
   const bool interrupted = o.stop_request && o.stop_request->load() != 0;
   // 3. the results of every finished job (also after an interruption)
-  std::vector<BenchmarkRow> rows;
-  for (const BenchmarkJob& j : jobs)
-    if (Finished(o.out_dir, j))
-      for (BenchmarkRow& r : ReadJobResult(JobResultPath(o.out_dir, j)))
-        rows.push_back(std::move(r));
+  size_t n_rows = 0;
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  WriteBenchmarkReport(spec, o.out_dir, rows, wall);
-  spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", rows.size(), o.out_dir, Hms(wall));
+  if (nav) {
+    std::vector<NavRow> rows;
+    for (const BenchmarkJob& j : jobs)
+      if (Finished(o.out_dir, j)) rows.push_back(ReadNavJobResult(JobResultPath(o.out_dir, j)));
+    WriteNavReport(spec, o.out_dir, rows, wall);
+    n_rows = rows.size();
+  } else {
+    std::vector<BenchmarkRow> rows;
+    for (const BenchmarkJob& j : jobs)
+      if (Finished(o.out_dir, j))
+        for (BenchmarkRow& r : ReadJobResult(JobResultPath(o.out_dir, j)))
+          rows.push_back(std::move(r));
+    WriteBenchmarkReport(spec, o.out_dir, rows, wall);
+    n_rows = rows.size();
+  }
+  spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", n_rows, o.out_dir, Hms(wall));
   if (interrupted) {
     spdlog::warn("interrupted; the finished jobs are kept and reported: the same command resumes");
     return 130;

@@ -51,8 +51,8 @@ AlignmentModel Align(const YamlReader& r) {
 }
 
 // checks that every {placeholder} of a template is known; `{{` and `}}` are literal braces
-void CheckTemplate(const YamlReader& r, const std::string& text) {
-  const std::vector<std::string>& known = MethodPlaceholders();
+void CheckTemplate(const YamlReader& r, const std::string& text,
+                   const std::vector<std::string>& known) {
   for (size_t i = 0; i < text.size(); ++i) {
     if (text[i] == '{' && i + 1 < text.size() && text[i + 1] == '{') {
       ++i;
@@ -154,7 +154,7 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
     m.command = c.String();
     if (m.command.find_first_not_of(" \t") == std::string::npos)
       c.Fail("empty; expected a command line");
-    CheckTemplate(c, m.command);
+    CheckTemplate(c, m.command, MethodPlaceholders());
   }
   if (r.Has("dataset")) m.dataset = r.Child("dataset").Enum({"tum", "euroc"});
   if (r.Has("trajectory")) {
@@ -167,6 +167,104 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
   if (r.Has("format")) m.format = r.Child("format").Enum({"tum", "tum_ns"});
   if (r.Has("timeout_sec")) m.timeout_sec = Positive(r.Child("timeout_sec"), 7 * 24 * 3600.0);
   if (r.Has("align")) m.align = Align(r.Child("align"));
+  return m;
+}
+
+// a ConfigError of a Validate call (key = the field) re-raised at the field's line
+template <typename F>
+void AtLine(const YamlReader& r, F&& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    if (r.Has(e.key())) r.Child(e.key()).Fail(e.problem());
+    r.Fail(e.key() + ": " + e.problem());
+  }
+}
+
+NavEpisode ReadEpisode(const YamlReader& r) {
+  r.ExpectMap({"name", "goal", "start", "radius", "timeout_sec"});
+  NavEpisode e;
+  e.line = r.line();
+  e.name = Name(r.Child("name"));
+  const YamlReader goal = r.Child("goal");
+  const std::vector<YamlReader> g = goal.List();
+  if (g.size() != 2) goal.Fail("expected [x, y] in m (world frame)");
+  e.goal_x = g[0].Double();
+  e.goal_y = g[1].Double();
+  if (r.Has("start")) {
+    const YamlReader start = r.Child("start");
+    const std::vector<YamlReader> s = start.List();
+    if (s.size() != 3) start.Fail("expected [x, y, yaw_deg] (m, m, deg; world frame)");
+    e.has_start = true;
+    e.start_x = s[0].Double();
+    e.start_y = s[1].Double();
+    e.start_yaw_deg = s[2].Double();
+  }
+  if (r.Has("radius")) e.radius_m = r.Child("radius").Double();
+  if (r.Has("timeout_sec")) e.timeout_sec = r.Child("timeout_sec").Double();
+  AtLine(r, [&] { e.ValidateOrThrow(); });
+  return e;
+}
+
+BenchmarkWorld ReadNavWorld(const YamlReader& r, const std::string& dir) {
+  r.ExpectMap({"name", "file", "robot", "profile", "episodes"});
+  BenchmarkWorld w;
+  w.line = r.line();
+  w.name = Name(r.Child("name"));
+  const YamlReader file = r.Child("file");
+  fs::path p = file.String();
+  if (p.is_relative()) p = fs::path(dir) / p;
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec))
+    file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
+  w.file = fs::weakly_canonical(p).string();
+  if (r.Has("profile")) {
+    std::vector<std::string_view> names;
+    for (const std::string& n : NavProfileNames()) names.push_back(n);
+    w.profile = r.Child("profile").Enum(names);
+  }
+  const YamlReader robot = r.Child("robot");
+  w.robot = robot.String();
+  const WorldConfig world = LoadWorldFile(w.file);
+  std::string robots;
+  bool found = false;
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) {
+      robots += (robots.empty() ? "" : ", ") + m.name;
+      found = found || m.name == w.robot;
+    }
+  if (!found)
+    robot.Fail("the world has no robot '" + SanitizeForMessage(w.robot, 40) +
+               "'; expected one of: " + (robots.empty() ? "(none)" : robots));
+  std::set<std::string> names;
+  const YamlReader episodes = r.Child("episodes");
+  for (const YamlReader& e : episodes.List()) {
+    w.episodes.push_back(ReadEpisode(e));
+    if (!names.insert(w.episodes.back().name).second)
+      e.Child("name").Fail("episode name appears twice in this world; expected unique names");
+  }
+  if (w.episodes.empty()) episodes.Fail("no episodes; expected at least one");
+  return w;
+}
+
+BenchmarkMethod ReadNavMethod(const YamlReader& r) {
+  r.ExpectMap({"name", "bundled", "command", "timeout_sec"});
+  BenchmarkMethod m;
+  m.name = Name(r.Child("name"));
+  m.timeout_sec = 600;
+  if (r.Has("bundled") == r.Has("command"))
+    r.Fail("expected exactly one of 'bundled' (penumbra_nav) and 'command' (a template)");
+  if (r.Has("bundled")) {
+    m.bundled = r.Child("bundled").Enum({"penumbra_nav"});
+    m.command = BundledNavCommand();
+  } else {
+    const YamlReader c = r.Child("command");
+    m.command = c.String();
+    if (m.command.find_first_not_of(" \t") == std::string::npos)
+      c.Fail("empty; expected a command line");
+    CheckTemplate(c, m.command, NavMethodPlaceholders());
+  }
+  if (r.Has("timeout_sec")) m.timeout_sec = Positive(r.Child("timeout_sec"), 7 * 24 * 3600.0);
   return m;
 }
 
@@ -218,10 +316,24 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
   try {
     const YAML::Node root = YAML::Load(text.str());
     YamlReader r(root, s.file, nullptr);
-    r.ExpectMap({"name", "worlds", "conditions", "trials", "seeds", "methods", "metrics", "render",
-                 "workers", "keep_datasets", "slurm"});
+    if (r.node().IsMap() && r.Has("kind")) s.kind = r.Child("kind").Enum({"slam", "nav"});
+    const bool nav = s.kind == "nav";
+    if (nav)
+      r.ExpectMap({"kind", "name", "worlds", "conditions", "trials", "seeds", "methods", "metrics",
+                   "render", "workers", "slurm"});
+    else
+      r.ExpectMap({"kind", "name", "worlds", "conditions", "trials", "seeds", "methods", "metrics",
+                   "render", "workers", "keep_datasets", "slurm"});
     s.name = r.Has("name") ? Name(r.Child("name")) : fs::path(s.file).stem().string();
-    if (r.Has("metrics")) {
+    if (nav && r.Has("metrics")) {
+      const YamlReader m = r.Child("metrics");
+      m.ExpectMap({"debounce_sec", "min_force_N", "pose_rate_hz", "floor"});
+      if (m.Has("debounce_sec")) s.nav_metrics.debounce_sec = m.Child("debounce_sec").Double();
+      if (m.Has("min_force_N")) s.nav_metrics.min_force_N = m.Child("min_force_N").Double();
+      if (m.Has("pose_rate_hz")) s.nav_metrics.pose_rate_hz = m.Child("pose_rate_hz").Double();
+      if (m.Has("floor")) s.nav_metrics.floor = m.Child("floor").String();
+      AtLine(m, [&] { s.nav_metrics.ValidateOrThrow(); });
+    } else if (r.Has("metrics")) {
       const YamlReader m = r.Child("metrics");
       m.ExpectMap({"align", "rpe_delta_sec", "max_dt_sec"});
       if (m.Has("align")) s.metrics.align = Align(m.Child("align"));
@@ -232,7 +344,7 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
     std::set<std::string> names;
     const YamlReader worlds = r.Child("worlds");
     for (const YamlReader& w : worlds.List()) {
-      s.worlds.push_back(ReadWorld(w, s.dir));
+      s.worlds.push_back(nav ? ReadNavWorld(w, s.dir) : ReadWorld(w, s.dir));
       if (!names.insert(s.worlds.back().name).second)
         w.Child("name").Fail("world name appears twice; expected unique names");
     }
@@ -266,7 +378,7 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
     names.clear();
     const YamlReader methods = r.Child("methods");
     for (const YamlReader& m : methods.List()) {
-      s.methods.push_back(ReadMethod(m, s.metrics));
+      s.methods.push_back(nav ? ReadNavMethod(m) : ReadMethod(m, s.metrics));
       if (!names.insert(s.methods.back().name).second)
         m.Child("name").Fail("method name appears twice; expected unique names");
     }
@@ -286,7 +398,7 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       if (s.workers < 1 || s.workers > 256)
         r.Child("workers").Fail("out of range; expected an integer in [1, 256]");
     }
-    if (r.Has("keep_datasets")) s.keep_datasets = r.Child("keep_datasets").Bool();
+    if (!nav && r.Has("keep_datasets")) s.keep_datasets = r.Child("keep_datasets").Bool();
     if (r.Has("slurm")) {
       const YamlReader sl = r.Child("slurm");
       sl.ExpectMap({"sbatch", "poll_sec"});

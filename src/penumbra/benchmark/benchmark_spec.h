@@ -1,8 +1,11 @@
 #pragma once
 // a benchmark specification (`penumbra benchmark SPEC.yaml`, docs/benchmarks.md): which
 // worlds (each a recorded route), which adversity conditions, how many trials (seeds), which
-// SLAM methods and which metrics. loaded and checked as a whole before anything runs; every
-// error names the spec file, the 1-based line and the key path.
+// SLAM methods and which metrics. `kind: nav` makes it a navigation benchmark instead: its
+// worlds name a robot and point-goal episodes, its methods are closed-loop navigators
+// (benchmark/nav_spec.h has that half of the format); `kind: slam` is the default. loaded and
+// checked as a whole before anything runs; every error names the spec file, the 1-based line and
+// the key path.
 //
 //   name: slam                       # a label for the report
 //   worlds:
@@ -41,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/benchmark/nav_spec.h"
 #include "penumbra/eval/umeyama.h"
 
 namespace penumbra {
@@ -53,6 +57,10 @@ struct BenchmarkWorld {
   std::string camera_name;  ///< the benchmark camera
   std::string camera_yaml;  ///< the camera as a one-line YAML mapping (outputs, depth_noise set)
   int line = 0;             ///< line of the entry in the spec
+  // kind: nav only
+  std::string robot;                  ///< the world's robot (its `robots:` name)
+  std::string profile = "quadruped";  ///< NavProfile name
+  std::vector<NavEpisode> episodes;   ///< at least one
 };
 
 /// one adversity condition.
@@ -61,7 +69,8 @@ struct BenchmarkCondition {
   std::string adversity;  ///< resolved preset spec (world/adversity_preset.h)
 };
 
-/// one SLAM method: a command template over an exported dataset.
+/// one SLAM method: a command template over an exported dataset; for a nav spec, a
+/// closed-loop navigator's command (NavMethodPlaceholders) and its wall-clock timeout.
 struct BenchmarkMethod {
   std::string name;
   std::string dataset = "tum";                ///< tum | euroc
@@ -70,7 +79,7 @@ struct BenchmarkMethod {
   std::string format = "tum";                 ///< tum | tum_ns
   double timeout_sec = 600;
   AlignmentModel align = AlignmentModel::kSe3;
-  std::string bundled;  ///< the `penumbra slam` method, "" for a command
+  std::string bundled;  ///< the `penumbra slam` method (nav: `penumbra_nav`), "" for a command
 };
 
 /// evaluation settings (docs/evaluation.md).
@@ -85,11 +94,13 @@ struct BenchmarkSpec {
   std::string file;  ///< the spec file, absolute
   std::string dir;   ///< its folder
   std::string name;
+  std::string kind = "slam";  ///< slam | nav
   std::vector<BenchmarkWorld> worlds;
   std::vector<BenchmarkCondition> conditions;
   std::vector<uint64_t> seeds;
   std::vector<BenchmarkMethod> methods;
   BenchmarkMetrics metrics;
+  NavMetricsConfig nav_metrics;   ///< kind: nav
   int render_threads = 1;         ///< per job (0 = all cores)
   std::string tier = "realtime";  ///< realtime | pathtraced
   int workers = 1;

@@ -1,0 +1,79 @@
+#pragma once
+// the metrics of a point-goal navigation episode, computed by the benchmark harness from what
+// the simulator itself wrote (the base body's ground-truth pose series and the robot's contact
+// intervals), never from the method's own report. the metrics follow the URLab paper's
+// navigation table (success, collisions, time to goal, goal distance, SC); SC, success
+// weighted by collisions, is from Eftekhar et al., "Selective Visual Representations Improve
+// Convergence and Generalization for Embodied AI", ICLR 2024: SC = (1/N) sum_i S_i / (1 + c_i)
+// over N episodes, S_i in {0, 1} the success and c_i the collision count of episode i.
+
+#include <string>
+#include <vector>
+
+namespace penumbra {
+
+/// one sample of the base body's pose X_WB (world frame: m; orientation a unit quaternion).
+struct NavPoseSample {
+  double time_sec = 0;
+  double x = 0, y = 0, z = 0;
+  double qw = 1, qx = 0, qy = 0, qz = 0;
+};
+
+/// one interval during which a (robot part, other part) pair was in contact, as the run's
+/// contacts metric writes them with a debounce of 0 (metrics/collision_counter.h): the pair's
+/// summed normal force was >= the threshold at every detection step from start to end.
+struct ContactInterval {
+  std::string a, b;      ///< the pair's sides (composed body names); (a, b) == (b, a)
+  double start_sec = 0;  ///< first instant in contact, s
+  double end_sec = 0;    ///< last instant in contact, s (>= start_sec)
+};
+
+/// collisions: the intervals of each unordered pair, sorted by start, merged while the next
+/// one starts less than `debounce_sec` after the end of the merged one (contact chatter, a
+/// bounce or a trot step along a wall are one collision); every merged run is one collision.
+/// intervals that start after `until_sec` are ignored (contacts after the episode ended).
+/// debounce_sec = 0: every interval counts. @throws Error for debounce_sec < 0 or an interval
+/// with end_sec < start_sec.
+int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec, double until_sec);
+
+/// what a navigation episode is judged by.
+struct NavEpisodeTask {
+  double goal_x = 0, goal_y = 0;  ///< world frame, m
+  double radius_m = 0.5;          ///< success radius, m
+  double timeout_sec = 60;        ///< sim time, s
+  double fall_height_m = 0.15;    ///< a fall: base z below this, m ...
+  double max_tilt_deg = 45;       ///< ... or |roll| or |pitch| above this, deg
+  double debounce_sec = 0.5;      ///< CountCollisions' window, s
+};
+
+/// an episode's metrics.
+struct NavEpisodeMetrics {
+  bool success = false;  ///< the base origin within radius_m of the goal (horizontal) at the
+                         ///< end, no fall, and the method did not fail
+  int collisions = 0;    ///< CountCollisions up to the end of the episode
+  bool fell = false;
+  double fall_time_sec = -1;         ///< first sample that is a fall, s (-1: none)
+  double time_to_goal_sec = -1;      ///< first sample within the radius, s; -1 when never (or not a
+                                     ///< success)
+  double final_goal_distance_m = 0;  ///< horizontal, at the end
+  double episode_time_sec = 0;       ///< time of the end sample minus the first sample's
+  double path_length_m = 0;          ///< horizontal length of the base's path, m
+  double sc = 0;                     ///< S / (1 + c) of this episode
+};
+
+/// the metrics of one episode from the base pose series (time-ordered, at least one sample)
+/// and the contact intervals. the episode ends at the last sample, at the first fall or at
+/// timeout_sec after the first sample, whichever comes first. `method_ok`: false makes the
+/// episode a failure (a method that crashed or was killed), its other metrics still computed.
+/// @throws Error for an empty or unordered series or a debounce < 0.
+NavEpisodeMetrics EvaluateNavEpisode(const std::vector<NavPoseSample>& poses,
+                                     const std::vector<ContactInterval>& contacts,
+                                     const NavEpisodeTask& task, bool method_ok);
+
+/// SC = mean over episodes of S_i / (1 + c_i) (Eftekhar et al. 2024); NaN for no episodes.
+/// `success` and `collisions` have one entry per episode. @throws Error when their sizes
+/// differ or a collision count is negative.
+double SuccessWeightedByCollisions(const std::vector<bool>& success,
+                                   const std::vector<int>& collisions);
+
+}  // namespace penumbra
