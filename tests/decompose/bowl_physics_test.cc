@@ -83,7 +83,7 @@ TEST(BowlPhysics, SphereRestsInsideTheDecomposedBowlNotOnItsHull) {
   // defaults but for max_parts (the bowl needs 64 under the threshold) and a search cut to 8
   // iterations and 150 samples, so that the test stays under ~30 s on a 2-core machine
   DecompositionOptions options;
-  options.max_parts = 64;
+  options.max_parts = 128;
   options.mcts_iterations = 8;
   options.search_samples = 150;
   const Decomposition parts = DecomposeMesh(bowl, options, "bowl");

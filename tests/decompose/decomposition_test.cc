@@ -53,6 +53,7 @@ DecompositionOptions OptionsOf(const ShapeCase& c) {
   options.concavity_threshold = c.threshold;
   options.mcts_iterations = c.mcts_iterations;
   options.search_samples = c.search_samples;
+  options.max_parts = 128;
   return options;
 }
 
