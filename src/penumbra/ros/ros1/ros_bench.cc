@@ -51,6 +51,10 @@ struct ChildReport {
           ack.publish(c);
           return;
         }
+        // flood frames are acknowledged too: the publisher keeps a window of frames in flight
+        rosgraph_msgs::Clock c;
+        c.clock = m->header.stamp;
+        ack.publish(c);
         const Clock::time_point now = Clock::now();
         if (report.received == 0) first = now;
         last = now;
@@ -160,8 +164,18 @@ RosBenchResult RunRosBench(const RosBenchOptions& o) {
   frame.header.frame_id = "flood";
   const Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                    std::chrono::duration<double>(o.seconds));
+  // at most kWindow frames unacknowledged: the rate a subscriber that keeps up receives
+  // (a publisher flooding faster only serialises frames roscpp then drops, starving the
+  // subscriber of CPU on a small machine)
+  constexpr uint64_t kWindow = 4;
   while (Clock::now() < end) {
-    frame.header.stamp.fromNSec(static_cast<uint64_t>(1000000 + r.frames_sent));
+    const uint64_t stamp = 1000000 + static_cast<uint64_t>(r.frames_sent);
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      cv.wait_for(lock, std::chrono::milliseconds(200),
+                  [&] { return acked + kWindow >= stamp || r.frames_sent < 1; });
+    }
+    frame.header.stamp.fromNSec(stamp);
     pub.publish(frame);
     ++r.frames_sent;
   }
