@@ -149,6 +149,9 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   outputs_options.end_time_sec = duration;
   outputs_options.progress = options.progress;
   outputs_options.metrics_mode = MetricsMode::kDynamics;
+  // a live run paced to the wall clock (bridges or viewer with --realtime): one snapshot
+  // waiting for the renderer, not four, so that a teleop command shows in the next frames
+  if (options.realtime && !options.bridges.empty()) outputs_options.render_queue = 1;
   // --record-sensors: every image file the cameras write also goes into the run log (set
   // once the log is open, before the loop starts)
   RunLogWriter* sensor_log = nullptr;
@@ -175,11 +178,11 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // middleware bridges (--zmq, ...): commands and steps through one RunControl
   std::unique_ptr<BridgeSet> bridges;
   if (!options.bridges.empty()) {
-    bridges = std::make_unique<BridgeSet>(
-        session, world, outputs,
-        BridgeSetOptions{options.lockstep, options.realtime ? 1.0 : 0.0, options.stop_request,
-                         &live},
-        options.bridges);
+    bridges =
+        std::make_unique<BridgeSet>(session, world, outputs,
+                                    BridgeSetOptions{options.lockstep, options.realtime ? 1.0 : 0.0,
+                                                     options.stop_request, &live},
+                                    options.bridges);
     bridges->Configure(&physics_options, &loop_options);
   }
   PhysicsSource physics(&sim, physics_options);

@@ -20,6 +20,7 @@ RunOutputs::RunOutputs(Session& session, const WorldConfig& world,
   CameraSinkOptions camera_options;
   camera_options.on_rendered = [this](double t, int64_t frames) { progress_->Update(t, frames); };
   camera_options.cameras = std::move(options.cameras);
+  camera_options.render_queue = options.render_queue;
   camera_options.writer.on_image = std::move(options.on_image);
   cameras_ =
       std::make_unique<CameraSink>(session.scene(), world, sim.timestep(), session.renderer(),

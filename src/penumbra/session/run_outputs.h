@@ -36,6 +36,10 @@ struct RunOutputsOptions {
   MetricsMode metrics_mode = MetricsMode::kDynamics;
   /// the cameras to render (CameraSinkOptions::cameras; empty = all).
   std::vector<std::string> cameras;
+  /// snapshots waiting for the render thread before the loop blocks
+  /// (CameraSinkOptions::render_queue, >= 1): 1 for a live run at real-time pacing, so that
+  /// a frame shows what the run did at most one render time ago.
+  int render_queue = 4;
   /// receives every image file the cameras write (AsyncFrameWriterOptions::on_image), e.g.
   /// the run log's sensor records; may be empty.
   CameraImageCallback on_image;
