@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_job.h"
 #include "penumbra/core/error.h"
@@ -25,22 +26,7 @@ namespace penumbra {
 namespace fs = std::filesystem;
 namespace {
 
-double Since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteText(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
-}
+using namespace benchmark_text;  // NOLINT: module-internal helpers
 
 nlohmann::json Num(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/core/error.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"
@@ -20,38 +21,7 @@ namespace penumbra {
 namespace fs = std::filesystem;
 namespace {
 
-std::string Field(double v) { return std::isfinite(v) ? FormatNumber(v) : ""; }
-
-std::string CsvQuote(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return out + "\"";
-}
-
-void WriteFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
-}
-
-SummaryCell Cell(const std::vector<double>& v) {
-  SummaryCell c;
-  c.n = static_cast<int>(v.size());
-  if (v.empty()) return c;
-  double sum = 0;
-  for (double x : v) sum += x;
-  c.mean = sum / c.n;
-  double ss = 0;
-  for (double x : v) ss += (x - c.mean) * (x - c.mean);
-  c.std = c.n > 1 ? std::sqrt(ss / (c.n - 1)) : 0.0;
-  return c;
-}
-
-std::string Pm(const SummaryCell& c, int digits) {
-  if (c.n == 0) return "-";
-  return fmt::format("{:.{}f} ± {:.{}f}", c.mean, digits, c.std, digits);
-}
+using namespace benchmark_text;  // NOLINT: module-internal helpers
 
 // a line plot: x = the conditions in spec order, one line per method with error bars (std)
 void PlotMetric(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines,
@@ -232,10 +202,10 @@ std::string SummaryMarkdown(const BenchmarkSpec& spec, const std::vector<Summary
 void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
                           const std::vector<BenchmarkRow>& rows, double wall_sec) {
   const fs::path out(out_dir);
-  WriteFile(out / "results.csv", BenchmarkCsv(rows));
+  WriteText(out / "results.csv", BenchmarkCsv(rows));
   const std::vector<SummaryLine> lines = Summarize(spec, rows);
   const std::string table = SummaryMarkdown(spec, lines);
-  WriteFile(out / "summary.md", table);
+  WriteText(out / "summary.md", table);
   std::string csv =
       "world,condition,method,trials,ok,ate_rmse_m_mean,ate_rmse_m_std,scaled_ate_m_mean,scaled_"
       "ate_m_std,"
@@ -248,7 +218,7 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
                        Field(l.coverage.mean), Field(l.coverage.std),
                        Field(l.tracked_fraction.mean), Field(l.tracked_fraction.std),
                        Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std));
-  WriteFile(out / "summary.csv", csv);
+  WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");
   std::string md = fmt::format(
@@ -305,7 +275,7 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
     const std::vector<uint8_t> png = RenderTrajectoryPlotPng(plot);
     const std::string name =
         "plots/traj_" + r.world + "__" + r.condition + "__" + r.method + ".png";
-    WriteFile(out / name, std::string(png.begin(), png.end()));
+    WriteText(out / name, std::string(png.begin(), png.end()));
     md += fmt::format("![{} {} {}]({})\n\n", r.world, r.condition, r.method, name);
   }
   md +=
@@ -321,7 +291,7 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
                         r.trial, r.status, r.detail.substr(0, 200));
     }
   if (failed == 0) md += "Every method tracked in every trial.\n";
-  WriteFile(out / "report.md", md);
+  WriteText(out / "report.md", md);
 }
 
 }  // namespace penumbra

@@ -1,8 +1,8 @@
 #include "penumbra/benchmark/benchmark_runner.h"
 
 #include <fcntl.h>
-#include <signal.h>
 #include <fmt/format.h>
+#include <signal.h>
 #include <spdlog/spdlog.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -19,6 +19,7 @@
 
 #include "penumbra/benchmark/benchmark_job.h"
 #include "penumbra/benchmark/benchmark_report.h"
+#include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_job.h"
 #include "penumbra/benchmark/nav_report.h"
@@ -28,20 +29,9 @@ namespace penumbra {
 namespace fs = std::filesystem;
 namespace {
 
+using namespace benchmark_text;  // NOLINT: module-internal helpers
+
 using Clock = std::chrono::steady_clock;
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteText(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
-}
 
 std::string Hms(double sec) {
   const long s = std::lround(std::max(0.0, sec));
@@ -223,7 +213,8 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
   }
   const std::string out = fs::absolute(out_dir).lexically_normal().string();
   std::string s = fmt::format(
-      "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH --output={}/slurm/%A_%a.out\n"
+      "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH "
+      "--output={}/slurm/%A_%a.out\n"
       "#SBATCH --cpus-per-task={}\n",
       spec.name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
   for (const std::string& l : spec.sbatch_lines) s += fmt::format("{}\n", l);

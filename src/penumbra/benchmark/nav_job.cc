@@ -19,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/benchmark/child_process.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_metrics.h"
@@ -29,24 +30,9 @@ namespace penumbra {
 namespace fs = std::filesystem;
 namespace {
 
+using namespace benchmark_text;  // NOLINT: module-internal helpers
+
 using Clock = std::chrono::steady_clock;
-
-double Since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteText(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
-}
 
 // true when 127.0.0.1:port can be bound now
 bool PortFree(int port) {

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/benchmark/nav_metrics.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
@@ -19,38 +20,7 @@ namespace penumbra {
 namespace fs = std::filesystem;
 namespace {
 
-std::string Field(double v) { return std::isfinite(v) ? FormatNumber(v) : ""; }
-
-std::string CsvQuote(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return out + "\"";
-}
-
-void WriteFile(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
-}
-
-SummaryCell Cell(const std::vector<double>& v) {
-  SummaryCell c;
-  c.n = static_cast<int>(v.size());
-  if (v.empty()) return c;
-  double sum = 0;
-  for (double x : v) sum += x;
-  c.mean = sum / c.n;
-  double ss = 0;
-  for (double x : v) ss += (x - c.mean) * (x - c.mean);
-  c.std = c.n > 1 ? std::sqrt(ss / (c.n - 1)) : 0.0;
-  return c;
-}
-
-std::string Pm(const SummaryCell& c, int digits) {
-  if (c.n == 0) return "-";
-  return fmt::format("{:.{}f} ± {:.{}f}", c.mean, digits, c.std, digits);
-}
+using namespace benchmark_text;  // NOLINT: module-internal helpers
 
 const cv::Scalar kColours[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
                                {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
@@ -299,10 +269,10 @@ std::string NavSummaryMarkdown(const BenchmarkSpec& spec,
 void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
                     const std::vector<NavRow>& rows, double wall_sec) {
   const fs::path out(out_dir);
-  WriteFile(out / "results.csv", NavCsv(rows));
+  WriteText(out / "results.csv", NavCsv(rows));
   const std::vector<NavSummaryLine> lines = SummarizeNav(spec, rows);
   const std::string table = NavSummaryMarkdown(spec, lines);
-  WriteFile(out / "summary.md", table);
+  WriteText(out / "summary.md", table);
   std::string csv =
       "world,condition,method,rows,ok,success_mean,success_std,collisions_mean,collisions_std,"
       "time_to_goal_sec_mean,time_to_goal_sec_std,goal_distance_m_mean,goal_distance_m_std,"
@@ -314,7 +284,7 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
                        Field(l.time_to_goal_sec.mean), Field(l.time_to_goal_sec.std),
                        Field(l.goal_distance_m.mean), Field(l.goal_distance_m.std),
                        Field(l.sc.mean), Field(l.sc.std));
-  WriteFile(out / "summary.csv", csv);
+  WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");
   size_t episodes = 0;
@@ -368,7 +338,7 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
                         r.method, r.trial, r.status, r.detail.substr(0, 200));
     }
   if (failed == 0) md += "Every method process ended normally in every episode.\n";
-  WriteFile(out / "report.md", md);
+  WriteText(out / "report.md", md);
 }
 
 }  // namespace penumbra
