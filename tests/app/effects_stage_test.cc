@@ -44,9 +44,8 @@ std::vector<std::string> Names(const Planned& p) {
 TEST(AdversityPlan, NoneAddsNothingMinorAndMajorAddTheirParts) {
   EXPECT_TRUE(Names(Plan("none", 7)).empty());
   const Planned minor = Plan("minor", 7);
-  EXPECT_EQ(Names(minor),
-            (std::vector<std::string>{"adversity_fog", "adversity_smoke", "adversity_rain",
-                                      "adversity_dim", "adversity_person0", "adversity_person1"}));
+  EXPECT_EQ(Names(minor), (std::vector<std::string>{"adversity_fog", "adversity_smoke",
+                                                    "adversity_rain", "adversity_dim"}));
   const Planned major = Plan("major", 7);
   EXPECT_EQ(major.agents.size(), 5u);
   EXPECT_EQ(major.agents.back().kind, AgentKind::kForklift);

@@ -68,11 +68,11 @@ TEST(EffectsRebuildTest, RebuiltRealtimeMediaMatchesFreshOne) {
   ThreadPool pool(2);
   RealtimeMedia reused, fresh;
   reused.Build(media_a, lights, rays, cam_a, 11, Eigen::Vector3f(5, 0, 1), 8.0,
-               Eigen::Vector3f::Constant(0.3f), &pool);
+               Eigen::Vector3f::Constant(0.3f), nullptr, &pool);
   reused.Build(media_b, lights, rays, cam_b, 22, Eigen::Vector3f(5, 0, 1), 8.0,
-               Eigen::Vector3f::Constant(0.4f), &pool);
+               Eigen::Vector3f::Constant(0.4f), nullptr, &pool);
   fresh.Build(media_b, lights, rays, cam_b, 22, Eigen::Vector3f(5, 0, 1), 8.0,
-              Eigen::Vector3f::Constant(0.4f), nullptr);
+              Eigen::Vector3f::Constant(0.4f), nullptr, nullptr);
   int compared = 0, with_light = 0;
   for (int v = 0; v < 120; v += 3) {
     for (int u = 0; u < 160; u += 3) {
@@ -85,8 +85,8 @@ TEST(EffectsRebuildTest, RebuiltRealtimeMediaMatchesFreshOne) {
         with_light += x.L_add.maxCoeff() > 0 ? 1 : 0;
         if (u + 1 < 160 && v + 1 < 120) {
           MediaQuad qx, qy;
-          reused.PrepareQuad(u, v, t, &qx);
-          fresh.PrepareQuad(u, v, t, &qy);
+          reused.PrepareQuad(u, v, t, r.o, d, &qx);
+          fresh.PrepareQuad(u, v, t, r.o, d, &qy);
           EXPECT_TRUE(SameBits(reused.IntegrateView(lights, r.o, d, t, u, v, &qx),
                                fresh.IntegrateView(lights, r.o, d, t, u, v, &qy)))
               << u << " " << v << " " << t;
@@ -124,9 +124,9 @@ TEST(EffectsRebuildTest, CameraDensityShortcutGivesTheFullFormula) {
       const Camera cam_at(at.X_WO, at.intrinsics), cam_above(above.X_WO, above.intrinsics);
       RealtimeMedia x, y;
       x.Build(media, lights, rays, cam_at, 5, Eigen::Vector3f(5, 0, 1), 8.0,
-              Eigen::Vector3f::Constant(0.4f), nullptr);
+              Eigen::Vector3f::Constant(0.4f), nullptr, nullptr);
       y.Build(media, lights, rays, cam_above, 5, Eigen::Vector3f(5, 0, 1), 8.0,
-              Eigen::Vector3f::Constant(0.4f), nullptr);
+              Eigen::Vector3f::Constant(0.4f), nullptr, nullptr);
       const Eigen::Vector3f o = cam_at.GenerateRay(0, 0).o;
       for (float dz : {-0.5f, -1e-3f, 0.0f, 1e-3f, 0.5f}) {
         const Eigen::Vector3f d = Eigen::Vector3f(1.0f, 0.3f, dz).normalized();

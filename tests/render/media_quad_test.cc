@@ -43,7 +43,7 @@ TEST(MediaQuadTest, SharedQuadLookupsMatchPerPixelLookups) {
   media.Build(&fx);
   RealtimeMedia rm;
   rm.Build(media, lights, rays, camera, 1234, Eigen::Vector3f(5, 0, 1), 8.0,
-           Eigen::Vector3f::Constant(0.4f), nullptr);
+           Eigen::Vector3f::Constant(0.4f), nullptr, nullptr);
 
   // distances: the floor z = 0, a wall x = 7 on the image's left half (world y > 0), sky.
   const float inf = std::numeric_limits<float>::infinity();
@@ -71,7 +71,7 @@ TEST(MediaQuadTest, SharedQuadLookupsMatchPerPixelLookups) {
       const float t_c = hits == 4 ? 0.25f * (t[0] + t[1] + t[2] + t[3]) : inf;
       (hits == 4 ? surface_quads : sky_quads) += 1;
       MediaQuad q;
-      rm.PrepareQuad(u0, v0, t_c, &q);
+      rm.PrepareQuad(u0, v0, t_c, o[0], d[0], &q);
       for (int c = 0; c < 4; ++c) {
         const int u = u0 + (c & 1), v = v0 + (c >> 1);
         // the surface, points 1 % and 3 % behind the quad's mean distance and the surface

@@ -143,7 +143,7 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
   refused([&] { fx.SetAdversity("foggiest"); }, "adversity", "expected one of: none, minor, major");
   refused([&] { fx.SetAdversity("/nonexistent/presets.yaml"); }, "adversity", "not found");
   // the preset the world started without has no NPC bodies
-  refused([&] { fx.SetAdversity("minor"); }, "npcs", "cannot add bodies");
+  refused([&] { fx.SetAdversity("major"); }, "npcs", "cannot add bodies");
   refused([&] { fx.SetEffect("npcs", {{"people", 1}}); }, "npcs", "cannot add bodies");
   // the world's own effect `fog`: world-file keys, checked as the world file's
   refused(

@@ -32,7 +32,7 @@ effects:
     region: {min: [2, 2, 0], max: [3, 3, 1.5]}
     emitters: [{position: [2.5, 2.5, 0.1], temperature_k: 1400}]
   - {name: storm, type: rain, rate_mm_h: 20, wind_m_s: [3, 0, 0], start_sec: 2, fade_in_sec: 1}
-  - {name: flurry, type: snow, rate_mm_h: 1, flake_diameter_mm: 6}
+  - {name: flurry, type: snow, rate_mm_h: 1, flake_diameter_mm: 6, sheltered: false}
   - {name: embers, type: sparks, fire: campfire, rate_per_s: 30}
   - {name: bad_bulb, type: light_event, light: ceiling, mode: strobe, frequency_hz: 4}
   - name: torch
@@ -74,9 +74,11 @@ TEST(WorldEffects, ParsesEveryType) {
   EXPECT_EQ(e[3].Get<VdbSmokeParams>().file, vdb);  // relative to the world file
   EXPECT_EQ(e[4].Get<FireParams>().fluid.emitters[0].temperature_k, 1400);
   EXPECT_EQ(e[5].Get<RainParams>().rate_mm_h, 20);
+  EXPECT_TRUE(e[5].Get<RainParams>().sheltered);  // the default
   EXPECT_EQ(e[5].start_sec, 2);
   EXPECT_TRUE(std::isinf(e[5].stop_sec));
   EXPECT_EQ(e[6].Get<SnowParams>().flake_diameter_mm, 6);
+  EXPECT_FALSE(e[6].Get<SnowParams>().sheltered);
   EXPECT_EQ(e[7].Get<SparksParams>().fire, "campfire");
   EXPECT_EQ(e[8].Get<LightEventParams>().mode, LightEventParams::Mode::kStrobe);
   ASSERT_EQ(e[9].Get<FlashlightParams>().waypoints.size(), 2u);
@@ -122,6 +124,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "effects[1].region.min", "expected min < max on every axis"},
         BadCase{"{name: r, type: rain, rate_mm_h: 0}", "effects[1].rate_mm_h", "expected (0, 500]"},
         BadCase{"{name: r, type: rain, hail: true}", "effects[1].hail", "unknown key 'hail'"},
+        BadCase{"{name: r, type: rain, sheltered: 3}", "effects[1].sheltered", "expected"},
         BadCase{"{name: a, type: rain}", "effects[1].name", "expected unique effect names"},
         BadCase{"{name: w, type: wetness, rain: nope}", "effects[1].rain",
                 "expected the name of a rain effect"},

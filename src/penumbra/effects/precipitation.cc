@@ -59,6 +59,7 @@ PrecipitationTable BuildRainTable(const RainParams& p, uint64_t seed, uint64_t e
   PrecipitationTable tab;
   tab.kind = ParticleKind::kRain;
   tab.color = p.color.cast<float>();
+  tab.sheltered = p.sheltered;
   const double n = RainNumberDensity(p.rate_mm_h, p.min_diameter_mm, p.max_diameter_mm);
   tab.half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
   const Eigen::Vector3d size = 2.0 * tab.half;
@@ -86,6 +87,7 @@ PrecipitationTable BuildSnowTable(const SnowParams& p, uint64_t seed, uint64_t e
   PrecipitationTable tab;
   tab.kind = ParticleKind::kSnow;
   tab.color = p.color.cast<float>();
+  tab.sheltered = p.sheltered;
   const double n = SnowNumberDensity(p);
   tab.half = EffectiveHalfExtents(p.box_half_extents_m, n, p.max_particles);
   const Eigen::Vector3d size = 2.0 * tab.half;
@@ -118,6 +120,7 @@ ParticleSet PlaceParticles(const PrecipitationTable& tab, double t, const Eigen:
   ParticleSet set;
   set.kind = tab.kind;
   set.color = tab.color;
+  set.sheltered = tab.sheltered;
   const Eigen::Vector3d size = 2.0 * tab.half;
   const Eigen::Vector3d lo = viewer_W - tab.half;
   const bool drift = !tab.omega.empty();

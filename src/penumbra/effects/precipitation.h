@@ -60,6 +60,7 @@ struct PrecipitationTable {
   std::vector<double> omega;           ///< (N) rad/s, empty for rain
   std::vector<Eigen::Vector3d> phase;  ///< (N) rad
   Eigen::Vector3f color{1, 1, 1};
+  bool sheltered = true;  ///< ParticleSet::sheltered of the placed particles
 };
 
 /// the drops of a rain effect (see SampleRain).

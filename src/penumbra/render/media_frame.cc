@@ -16,12 +16,14 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
   return sum * static_cast<float>(1.0 / (6.0 * M_PI));
 }
 
-MediaFrame::MediaFrame(const SceneDescription& scene) : scene_(scene) {}
+MediaFrame::MediaFrame(const SceneDescription& scene, RayQueryFactory make_query)
+    : scene_(scene), shelter_(std::move(make_query)) {}
 
 void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                          const Camera& camera, const CameraView& view,
                          const RenderSettings& settings, const LightSampler& lights,
-                         const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool) {
+                         const RayScene& rays, const SkyModel& base_sky,
+                         SkyIrradianceVolume* sky_volume, ThreadPool* pool) {
   const EffectsFrame* fx = effects && !effects->empty() ? effects : nullptr;
   active_ = fx != nullptr;
   sky_ = &base_sky;
@@ -67,18 +69,29 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
   }
 
   media_.Build(fx);
-  if (!media_.empty() && settings.tier == RenderSettings::Tier::kRealtime) {
+  const bool realtime = settings.tier == RenderSettings::Tier::kRealtime;
+  // the sky let through by the static geometry, for the realtime media and the particles.
+  const SkyIrradianceVolume* occluded_sky = nullptr;
+  if (sky_volume != nullptr && ((realtime && !media_.empty()) || !fx->particles.empty())) {
+    sky_volume->Update(scene_, snapshot, *sky_, pool);
+    if (!sky_volume->empty()) occluded_sky = sky_volume;
+  }
+  if (!media_.empty() && realtime) {
     const uint64_t frame_key =
         HashKeys(HashKeys(settings.seed, static_cast<uint64_t>(view.camera_index)),
                  static_cast<uint64_t>(view.frame_index));
     realtime_.Build(media_, lights, rays, camera, frame_key, scene_.center_W.cast<float>(),
-                    scene_.extent_m, sky_ambient_, pool);
+                    scene_.extent_m, sky_ambient_, occluded_sky, pool);
     realtime_ok_ = true;
   }
+  bool sheltered = false;
+  for (const ParticleSet& ps : fx->particles)
+    sheltered = sheltered || (ps.sheltered && ps.kind != ParticleKind::kSpark);
+  if (sheltered) shelter_.Update(scene_, snapshot, pool);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    settings.tier == RenderSettings::Tier::kRealtime, pool,
-                   media_.empty() ? nullptr : &media_);
-  if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, pool);
+                   media_.empty() ? nullptr : &media_, sheltered ? &shelter_ : nullptr);
+  if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, occluded_sky, pool);
 }
 
 }  // namespace penumbra

@@ -4,7 +4,8 @@
 // FrameContext::effects (null in clear conditions, so a frame without effects takes none of
 // the effects code paths):
 //  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
-//  - particle streaks for the frame's camera and exposure (ParticleScene);
+//  - particle streaks for the frame's camera and exposure (ParticleScene), without the
+//    rain and snow that static geometry covers from above (ShelterMap);
 //  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
 //    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
 //    the scale changed (building SkyModel's tables is not free, docs/performance.md; the sun
@@ -25,6 +26,8 @@
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/shelter_map.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -41,23 +44,29 @@ Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
 /// per-frame effects state of one renderer. not thread-safe; the accessors are, after Prepare.
 class MediaFrame {
  public:
-  /// `scene` (the renderer's copy) must outlive this object.
-  explicit MediaFrame(const SceneDescription& scene);
+  /// `scene` (the renderer's copy) must outlive this object; `make_query` traces the shelter
+  /// map of the precipitation (shelter_map.h) when a frame has rain or snow.
+  MediaFrame(const SceneDescription& scene, RayQueryFactory make_query);
 
   /// prepares `effects` at `snapshot` (none when `effects` is null or empty) for
   /// `view` (its exposure time, camera and frame index) seen through `camera`. `lights` must
   /// already be posed for the snapshot and `rays` updated. realtime light volumes are built only
-  /// for that tier.
+  /// for that tier. `sky_volume` (may be null) is the renderer's occluded sky light
+  /// (sky_irradiance_volume.h): Prepare brings it up to date (Update) with the frame's sky when
+  /// the media of the realtime tier or any particles need it, and they are then lit by the sky
+  /// it lets through (in the pathtraced tier the media's sky light is occluded by its own
+  /// shadow rays). it must outlive this object until the next Prepare.
   /// @throws ConfigError for malformed effects (see MediaScene::Build, ParticleScene::Build).
   void Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effects, const Camera& camera,
                const CameraView& view, const RenderSettings& settings, const LightSampler& lights,
-               const RayScene& rays, const SkyModel& base_sky, ThreadPool* pool);
+               const RayScene& rays, const SkyModel& base_sky, SkyIrradianceVolume* sky_volume,
+               ThreadPool* pool);
 
   /// any effect is active this frame.
   bool active() const { return active_; }
   /// the sky to use this frame (base_sky of Prepare unless the effects change it).
   const SkyModel* sky() const { return sky_; }
-  /// sphere-average radiance of sky().
+  /// sphere-average radiance of sky() (unoccluded).
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
   /// media, or null when there are none.
   const MediaScene* media() const { return media_.empty() ? nullptr : &media_; }
@@ -82,6 +91,7 @@ class MediaFrame {
   RealtimeMedia realtime_;
   bool realtime_ok_ = false;
   ParticleScene particles_;
+  ShelterMap shelter_;  // built at the first frame with rain or snow
   float wetness_ = 0;
 };
 

@@ -151,9 +151,11 @@ bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
 void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
                           const RayScene& scene, const Camera& camera, uint64_t frame_key,
                           const Eigen::Vector3f& bounds_center_W, double bounds_extent_m,
-                          const Eigen::Vector3f& sky_ambient, ThreadPool* pool) {
+                          const Eigen::Vector3f& sky_ambient, const SkyIrradianceVolume* sky_volume,
+                          ThreadPool* pool) {
   media_ = &media;
   sky_ambient_ = sky_ambient;
+  sky_volume_ = sky_volume != nullptr && !sky_volume->empty() ? sky_volume : nullptr;
   sky_ambient4_ = To4(sky_ambient);
   sigma_t4_.clear();
   sigma_s4_.clear();
@@ -207,7 +209,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       const Eigen::Vector3f x_G =
           -v.half + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(gl.cells_per_m);
       const Eigen::Vector3f p = R_WG * (x_G - v.p_GW);
-      Eigen::Vector3f src = sky_ambient;
+      Eigen::Vector3f src = SkyAmbientAt(p);
       for (int l = 0; l < nl; ++l) {
         LightSample ls;
         if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
@@ -572,9 +574,41 @@ Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   return out;
 }
 
-void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) const {
+Eigen::Vector3f RealtimeMedia::SkyAmbientAt(const Eigen::Vector3f& p_W) const {
+  return sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient_) : sky_ambient_;
+}
+
+Eigen::Array4f RealtimeMedia::SkyAlongRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                                          float t_end) const {
+  if (sky_volume_ == nullptr) return sky_ambient4_;
+  // the medium with the largest optical depth along the ray, and the point where half of its
+  // in-scatter weight 1 - T has accrued: T(t_med) = (1 + T(t_end)) / 2.
+  const AnalyticMedium* best = nullptr;
+  float best_tau = 0, best_a = 0, best_b = 0;
+  for (const AnalyticMedium& m : media_->analytic()) {
+    float a, b;
+    if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
+    const float sigma = Mean3(m.sigma_t);
+    const float tau = sigma * std::min(DensityIntegralF(m, o.z(), d.z(), a, b), 1e30f);
+    if (best == nullptr || tau > best_tau) best = &m, best_tau = tau, best_a = a, best_b = b;
+  }
+  if (best == nullptr || !(best_tau > 0)) return sky_ambient4_;
+  const float tau_med = -std::log1p(std::exp(-best_tau)) + std::log(2.0f);  // -ln((1 + T) / 2)
+  const double t =
+      best->InvertDensityIntegral(o.z(), d.z(), best_a, best_b, tau_med / Mean3(best->sigma_t));
+  const float t_med = std::isfinite(t) ? static_cast<float>(t) : 0.5f * (best_a + best_b);
+  if (!std::isfinite(t_med)) return sky_ambient4_;
+  return To4(sky_volume_->AmbientRadiance(o + t_med * d, sky_ambient_));
+}
+
+void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f& o,
+                                const Eigen::Vector3f& d_c, MediaQuad* quad) const {
   MediaQuad& q = *quad;
   q = MediaQuad();
+  if (sky_volume_ != nullptr && !media_->analytic().empty()) {
+    q.sky = SkyAlongRay(o, d_c, t_c);
+    q.has_sky = true;
+  }
   // grid froxels: the columns and weights of the quad's centre, then per column the slice that
   // holds t and the distances where that stays so (constant before the column's entry and
   // after its exit).
@@ -842,7 +876,10 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
     const Eigen::Array4f Th_a = exp_neg(tau_a);
     sky_w = (1.0f - Th_a) + (Th_a - Th_end) * Tg;
   }
-  L_add += albedo * sky_w * sky_ambient4_;
+  const Eigen::Array4f sky = sky_volume_ == nullptr             ? sky_ambient4_
+                             : quad != nullptr && quad->has_sky ? quad->sky
+                                                                : SkyAlongRay(o, d, t_end);
+  L_add += albedo * sky_w * sky;
   // light in-scatter from the froxel columns.
   if (!fog_froxels_.S.empty())
     L_add += quad != nullptr ? QuadFogFroxels(*quad, u, v, t_end) : LookupFogFroxels(u, v, t_end);

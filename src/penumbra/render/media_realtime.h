@@ -7,8 +7,10 @@
 //    most the grid's resolution): per light j the transmittance T_j through the grid from the
 //    cell centre to the light (midpoint-rule march of the full-resolution density, at most
 //    kGridLightSteps steps), and an isotropic in-scatter source S = sum_j E_j V_j T_j Th_j /
-//    (4 pi) + L_sky, with V_j one shadow ray per cell and light and Th_j the homogeneous
-//    media's transmittance to the light. the grid's phase function is isotropic in this tier.
+//    (4 pi) + L_sky(cell), with V_j one shadow ray per cell and light, Th_j the homogeneous
+//    media's transmittance to the light and L_sky(p) the sky's sphere-average radiance seen
+//    from p past the static geometry (SkyIrradianceVolume::AmbientRadiance; the unoccluded
+//    sky_ambient without a volume). the grid's phase function is isotropic in this tier.
 //  - a world light volume (kLightVolumeCells cells) over the scene's bounding box
 //    (SceneDescription::center_W, extent_m; clipped to the media boxes when every homogeneous
 //    medium is boxed) stores per light the channel-mean transmittance Th T_grid to the light,
@@ -17,9 +19,15 @@
 //    nothing is cached between frames (moving bodies would make frames depend on history).
 // per camera ray (IntegrateView), over [0, t_end] (t_end = surface distance or +inf):
 //  - homogeneous media: closed-form transmittance (media_scene.h); the sky in-scatter
-//    albedo (1 - T) L_sky in closed form, with L_sky the sphere-average sky radiance treated
-//    as an isotropic source that reaches every point of the medium unoccluded and
-//    unattenuated (Koschmieder's setting; the sky is not shadowed by walls in this tier);
+//    albedo (1 - T) L_sky in closed form, with the sky treated as an isotropic source that
+//    reaches every point of the medium unattenuated (Koschmieder's setting). L_sky is the
+//    sphere-average sky radiance that the static geometry lets through
+//    (SkyIrradianceVolume::AmbientRadiance: 0 inside a closed room, so fog there is lit by the
+//    lamps only), sampled once per ray (SkyAlongRay) at the point where half of the ray's
+//    in-scatter weight 1 - T has accrued (in the medium of largest optical depth); without a
+//    sky volume (no finite static geometry) it is the open sky's. one sample per ray is exact
+//    where L_sky is uniform along it (a closed room, the open); a ray that leaves a room
+//    through a door or window gets the sky of one point, not the mean along it;
 //    light in-scatter from a second, coarser froxel volume (one column per kFogFroxelBlock^2
 //    pixels, kFogFroxelSlices slices spaced exponentially from kFogFroxelNear to where the
 //    media's transmittance falls to 1 %, jittered per column from the centre pixel stream 3):
@@ -56,6 +64,7 @@
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 
 namespace penumbra {
 
@@ -99,18 +108,23 @@ struct MediaQuad {
   float f_lo = 1, f_hi = 0;                    ///< fog: log distances where fS holds (empty: none)
   Eigen::Array4f fS = Eigen::Array4f::Zero();  ///< fog in-scatter at t_c
   Eigen::Array4f fS_dlog = Eigen::Array4f::Zero();  ///< its change per unit of log distance
+  bool has_sky = false;                             ///< sky holds SkyAlongRay of the quad
+  Eigen::Array4f sky = Eigen::Array4f::Zero();      ///< occluded sky radiance of the media
 };
 
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
 class RealtimeMedia {
  public:
   /// precomputes the light volumes of `media` (which must outlive this object until the next
-  /// Build) for the posed `lights`; `sky_ambient` is the sphere-average sky radiance (cd/m^2).
+  /// Build) for the posed `lights`; `sky_ambient` is the sphere-average sky radiance (cd/m^2)
+  /// of the open sky; `sky_volume` (may be null or empty: the sky then lights the media
+  /// unoccluded) occludes it by the static geometry and must outlive this object likewise.
   /// shadow rays go through `scene`; the cells are spread over `pool` (may be null).
   /// the froxel volume is built for `camera`; `frame_key` is FrameContext::FrameKey().
   void Build(const MediaScene& media, const LightSampler& lights, const RayScene& scene,
              const Camera& camera, uint64_t frame_key, const Eigen::Vector3f& bounds_center_W,
-             double bounds_extent_m, const Eigen::Vector3f& sky_ambient, ThreadPool* pool);
+             double bounds_extent_m, const Eigen::Vector3f& sky_ambient,
+             const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
 
   /// rgb transmittance from p_W towards light j (unit direction wi, distance dist, +inf for
   /// directional lights) through every medium.
@@ -136,11 +150,20 @@ class RealtimeMedia {
                              const MediaQuad* quad = nullptr) const;
 
   /// the shared froxel lookups of the 2x2 quad of pixels (u0, v0) .. (u0 + 1, v0 + 1) at the
-  /// reference distance t_c (m; the mean of the pixels' distances, +inf for sky pixels).
-  void PrepareQuad(int u0, int v0, float t_c, MediaQuad* quad) const;
+  /// reference distance t_c (m; the mean of the pixels' distances, +inf for sky pixels), and
+  /// the occluded sky of the media (SkyAlongRay) along the ray from the camera centre o in the
+  /// quad's mean direction d_c (unit).
+  void PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f& o, const Eigen::Vector3f& d_c,
+                   MediaQuad* quad) const;
 
   const MediaScene* media() const { return media_; }
   const Eigen::Vector3f& sky_ambient() const { return sky_ambient_; }
+  /// the occluded sphere-average sky radiance at p_W (the sky volume's AmbientRadiance, or
+  /// sky_ambient() without one).
+  Eigen::Vector3f SkyAmbientAt(const Eigen::Vector3f& p_W) const;
+  /// the sky radiance lighting the homogeneous media along o + t d (d unit), t in [0, t_end]
+  /// (rgb, 4th lane 0): SkyAmbientAt at the ray's in-scatter median point (file comment).
+  Eigen::Array4f SkyAlongRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float t_end) const;
 
   /// one axis of the bilinear interpolation between froxel columns at an image position:
   /// columns i0 and i1 along the axis and the weight w of i1 (tables per frame).
@@ -215,6 +238,7 @@ class RealtimeMedia {
 
   const MediaScene* media_ = nullptr;
   Eigen::Vector3f sky_ambient_{0, 0, 0};
+  const SkyIrradianceVolume* sky_volume_ = nullptr;  // non-empty, or null
   // per homogeneous medium sigma_t and sigma_s, and the sky ambient, as 4-lane arrays (rgb, 0)
   // built once per frame (assembling them per pixel stalls on store forwarding).
   std::vector<Eigen::Array4f> sigma_t4_, sigma_s4_;

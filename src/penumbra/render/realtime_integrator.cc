@@ -238,8 +238,10 @@ void ApplyTileViewEffects(const FrameContext& ctx, const PrimaryHits& primary,
       for (int c = 0; c < 4; ++c)
         t_c += 0.25f * primary.hits[quad[c]].t * primary.rays[quad[c]].d.norm();
     }
+    Eigen::Vector3f d_c = Eigen::Vector3f::Zero();
+    for (int c = 0; c < 4; ++c) d_c += primary.rays[quad[c]].d.normalized();
     MediaQuad q;
-    rm->PrepareQuad(tile.x0 + x, tile.y0 + y, t_c, &q);
+    rm->PrepareQuad(tile.x0 + x, tile.y0 + y, t_c, primary.rays[i00].o, d_c.normalized(), &q);
     for (int c = 0; c < 4; ++c) apply(quad[c], &q);
     return true;
   };

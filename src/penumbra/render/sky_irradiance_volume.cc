@@ -18,6 +18,8 @@
 #include <emmintrin.h>
 #endif
 
+#include "penumbra/render/static_geometry.h"
+
 namespace penumbra {
 namespace {
 
@@ -61,64 +63,6 @@ inline Eigen::Vector3d OctDecode(double u, double v) {
     y = (1 - std::abs(u)) * std::copysign(1.0, v);
   }
   return {x, y, z};
-}
-
-// axis-aligned half extents of a geom's shape in its own frame; false for planes.
-bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
-                      Eigen::Vector3d* hi) {
-  const Eigen::Vector3d& s = g.size;
-  Eigen::Vector3d h = Eigen::Vector3d::Zero();
-  switch (g.shape) {
-    case GeomShape::kPlane:
-      return false;
-    case GeomShape::kSphere:
-      h = Eigen::Vector3d::Constant(s.x());
-      break;
-    case GeomShape::kCapsule:
-      h = {s.x(), s.x(), s.y() + s.x()};
-      break;
-    case GeomShape::kEllipsoid:
-    case GeomShape::kBox:
-      h = s;
-      break;
-    case GeomShape::kCylinder:
-      h = {s.x(), s.x(), s.y()};
-      break;
-    case GeomShape::kMesh: {
-      if (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())) return false;
-      const TriangleMesh& m = scene.meshes[g.mesh];
-      if (m.vertices.empty()) return false;
-      Eigen::Vector3f a = m.vertices[0], b = m.vertices[0];
-      for (const Eigen::Vector3f& v : m.vertices) a = a.cwiseMin(v), b = b.cwiseMax(v);
-      *lo = a.cast<double>();
-      *hi = b.cast<double>();
-      return true;
-    }
-    case GeomShape::kHeightField: {
-      if (g.hfield < 0 || g.hfield >= static_cast<int>(scene.hfields.size())) return false;
-      const HeightField& f = scene.hfields[g.hfield];
-      *lo = {-f.size_x, -f.size_y, -f.size_base};
-      *hi = {f.size_x, f.size_y, f.size_z};
-      return true;
-    }
-  }
-  *lo = -h;
-  *hi = h;
-  return true;
-}
-
-// the geoms a RayQuery traces (render/ray_query.h: groups <= 2, alpha >= 0.5) of static bodies.
-bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
-  if (g.group > 2) return false;
-  if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&
-      scene.materials[g.material].alpha < 0.5f)
-    return false;
-  return g.body == 0 || (g.body > 0 && g.body < static_cast<int>(scene.bodies.size()) &&
-                         scene.bodies[g.body].is_static);
-}
-
-bool IsStaticBody(const SceneDescription& scene, int b) {
-  return b == 0 || scene.bodies[b].is_static;
 }
 
 // the fixed ray directions shared by every probe (unit): the first pass (one per texel, with
@@ -774,6 +718,55 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     }
   }
   return e.cwiseMax(0.0f);
+}
+
+Eigen::Vector3f SkyIrradianceVolume::ProbeAmbient(int probe) const {
+  // the irradiance SH's l = 0 coefficient is A0 L00 = pi L00; the mean radiance over the
+  // sphere is L00 Y00.
+  const float* c = &sh_[static_cast<size_t>(probe) * kShStride + 3 * kShSlot[0]];
+  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / kPi);
+  return Eigen::Vector3f(c[0], c[1], c[2]) * kY00OverPi;
+}
+
+Eigen::Vector3f SkyIrradianceVolume::AmbientRadiance(const Eigen::Vector3f& p_W,
+                                                     const Eigen::Vector3f& open_sky) const {
+  if (empty()) return open_sky;
+  const Eigen::Vector3f g = (p_W - origin_) * inv_spacing_;
+  const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
+  if (!(g.x() >= 0 && g.y() >= 0 && g.z() >= 0 && g.x() <= nx - 1 && g.y() <= ny - 1 &&
+        g.z() <= nz - 1))
+    return open_sky;
+  const int i0 = std::max(0, std::min(static_cast<int>(g.x()), nx - 2));
+  const int j0 = std::max(0, std::min(static_cast<int>(g.y()), ny - 2));
+  const int k0 = std::max(0, std::min(static_cast<int>(g.z()), nz - 2));
+  const float f[3] = {g.x() - i0, g.y() - j0, g.z() - k0};
+  const float tol = kVisibilityTolerance * spacing_;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero(), dark = Eigen::Vector3f::Zero();
+  float wsum = 0, dark_lum = std::numeric_limits<float>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+    if (i0 + dx >= nx || j0 + dy >= ny || k0 + dz >= nz) continue;
+    const int p = ProbeIndex(i0 + dx, j0 + dy, k0 + dz);
+    if (!valid_[p]) continue;
+    const Eigen::Vector3f a = ProbeAmbient(p);
+    const float lum = 0.2126f * a.x() + 0.7152f * a.y() + 0.0722f * a.z();
+    if (lum < dark_lum) dark_lum = lum, dark = a;
+    const float tri = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
+    const Eigen::Vector3f to_p = p_W - position_[p];
+    const float r = to_p.norm();
+    float vis = 1;
+    if (r > 1e-6f) {
+      const float depth =
+          depth_scale_ * depth_q_[static_cast<size_t>(p) * kNumTexels + OctTexel(to_p / r)];
+      vis = std::clamp((depth + tol - r) / tol, 0.0f, 1.0f);
+    }
+    const float w = tri * vis;
+    if (!(w > 0)) continue;
+    sum += w * a;
+    wsum += w;
+  }
+  if (wsum > 0) return (sum / wsum).cwiseMax(0.0f);
+  return dark.cwiseMax(0.0f);
 }
 
 }  // namespace penumbra

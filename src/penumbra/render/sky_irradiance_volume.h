@@ -130,6 +130,23 @@ class SkyIrradianceVolume {
   Eigen::Vector3f Irradiance(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
                              const SkyModel& sky) const;
 
+  /// occluded sphere-average sky radiance (cd/m^2 per channel) at a world point p_W in free
+  /// space (participating media, particles): (1 / 4 pi) times the integral of the sky radiance
+  /// over the directions in which p_W sees the sky past the static geometry, i.e. the l = 0
+  /// band of the probes' radiance. of the 8 probes of the grid cell around p_W, invalid ones are
+  /// skipped and each other one is weighted by its trilinear weight x the visibility weight of
+  /// Irradiance (no normal: no tangent-plane test and no normal bias); when no probe passes, the
+  /// darkest valid probe of the cell, and 0 when none is valid (inside thick geometry). outside
+  /// the grid, or when empty, `open_sky` (the caller's unoccluded sphere-average radiance, e.g.
+  /// SkyAmbientRadiance of media_frame.h). in a closed room it is 0; in the open it is the sky's
+  /// (up to the ground plane, which the probes do not see: planes are not in the bounds but
+  /// they are traced). requires Relight after Build.
+  Eigen::Vector3f AmbientRadiance(const Eigen::Vector3f& p_W,
+                                  const Eigen::Vector3f& open_sky) const;
+
+  /// sphere-average radiance of one probe (its l = 0 band; no interpolation).
+  Eigen::Vector3f ProbeAmbient(int probe) const;
+
   /// irradiance SH of one probe evaluated at unit normal n (no interpolation, no clamping).
   Eigen::Vector3f ProbeIrradiance(int probe, const Eigen::Vector3f& n_W) const;
 

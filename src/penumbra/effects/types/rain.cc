@@ -7,7 +7,7 @@ namespace penumbra {
 
 std::vector<std::string_view> RainParams::Keys() {
   return {"rate_mm_h",     "wind_m_s", "min_diameter_mm", "max_diameter_mm", "box_half_extents_m",
-          "max_particles", "color"};
+          "max_particles", "color",    "sheltered"};
 }
 
 void RainParams::Read(const EffectParamReader& r) {
@@ -18,6 +18,7 @@ void RainParams::Read(const EffectParamReader& r) {
   r.Vec("box_half_extents_m", &box_half_extents_m);
   r.Int("max_particles", &max_particles);
   r.Vec("color", &color);
+  r.Bool("sheltered", &sheltered);
 }
 
 void RainParams::Validate(const EffectConfig&, EffectChecker* c) const {

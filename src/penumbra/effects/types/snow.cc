@@ -8,7 +8,8 @@ namespace penumbra {
 std::vector<std::string_view> SnowParams::Keys() {
   return {"rate_mm_h",          "flake_diameter_mm", "flake_density_kg_m3",
           "wind_m_s",           "turbulence_m_s",    "drift_frequency_hz",
-          "box_half_extents_m", "max_particles",     "color"};
+          "box_half_extents_m", "max_particles",     "color",
+          "sheltered"};
 }
 
 void SnowParams::Read(const EffectParamReader& r) {
@@ -21,6 +22,7 @@ void SnowParams::Read(const EffectParamReader& r) {
   r.Vec("box_half_extents_m", &box_half_extents_m);
   r.Int("max_particles", &max_particles);
   r.Vec("color", &color);
+  r.Bool("sheltered", &sheltered);
 }
 
 void SnowParams::Validate(const EffectConfig&, EffectChecker* c) const {

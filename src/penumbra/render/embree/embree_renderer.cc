@@ -40,7 +40,10 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       materials_(scene_, settings_.max_anisotropy),
       lights_(scene_),
       sky_(scene_.sky),
-      effects_(scene_),
+      effects_(scene_,
+               [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+                 return std::make_unique<RayScene>(statics);
+               }),
       sky_volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
         return std::make_unique<RayScene>(statics);
       }),
@@ -72,7 +75,8 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
-  effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_, &pool_);
+  effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_,
+                   &sky_volume_, &pool_);
   // realtime tier: sky light occluded by the static geometry, rebuilt only when the static
   // bodies move and relit when the sky changes (render/sky_irradiance_volume.h).
   if (settings_.tier == RenderSettings::Tier::kRealtime)

@@ -81,7 +81,8 @@ bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vecto
 ParticleScene::~ParticleScene() = default;
 
 void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-                          bool pixel_hits, ThreadPool* pool, const MediaScene* media) {
+                          bool pixel_hits, ThreadPool* pool, const MediaScene* media,
+                          const ShelterMap* shelter) {
   fx_ = fx;
   count_ = 0;
   culled_ = 0;
@@ -188,6 +189,9 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     const Eigen::Vector3f& v = ps.velocity_W[i];
     const float r = ps.radius_m[i];
     if (!(r > 0)) return;
+    if (shelter != nullptr && ps.sheltered && ps.kind != ParticleKind::kSpark &&
+        shelter->Sheltered(p))
+      return;  // rain or snow under a roof
     Eigen::Vector3f q = p + T * v;
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
     if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
@@ -497,8 +501,9 @@ bool ParticleScene::Intersect(const Ray& ray, float tmax, ParticleHit* hit) cons
 }
 
 void ParticleScene::PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
-                                   ThreadPool* pool) {
+                                   const SkyIrradianceVolume* sky_volume, ThreadPool* pool) {
   rain_radiance_.clear();
+  sky_volume_ = sky_volume;
   bool any = false;
   const bool culled = !visible_.empty();  // realtime: only streaks in the image are drawn
   for (int n = 0; n < count_ && !any; ++n)
@@ -543,7 +548,9 @@ Eigen::Vector3f ParticleScene::Shade(const ParticleHit& hit, const Eigen::Vector
       E += ls.E * kInv4Pi;
     }
   }
-  return ps.color.cwiseProduct(sky_ambient + E) + ps.emission;
+  const Eigen::Vector3f sky =
+      sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient) : sky_ambient;
+  return ps.color.cwiseProduct(sky + E) + ps.emission;
 }
 
 }  // namespace penumbra

@@ -26,6 +26,9 @@
 //    (4 pi)), i.e. the mean environment radiance times the transmission tint `color`.
 //  - snow: Lambertian of albedo `color` on the capsule's normal, lit by every light
 //    (unshadowed) and the sphere-average sky radiance.
+//  the sphere-average sky radiance is the one the static geometry lets through at the particle
+//  (SkyIrradianceVolume::AmbientRadiance) when the renderer hands a sky volume over (both
+//  tiers), else the open sky's.
 //  - sparks: emit ParticleSet::emission.
 // culling (realtime tier only, rain only): a rain streak is not drawn when its coverage times
 // an upper bound of the homogeneous media's transmittance from the camera to the streak's
@@ -54,6 +57,8 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/shelter_map.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
@@ -88,8 +93,12 @@ class ParticleScene {
   /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
   /// null). with pixel_hits, invisible rain streaks are culled (kRainCullContrast) using the
   /// homogeneous media of `media` (may be null: coverage alone).
+  /// `shelter` (may be null): rain drops and snowflakes that it shelters (static geometry
+  /// above them) are not drawn unless their set says otherwise (ParticleSet::sheltered);
+  /// sparks always are.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr);
+             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
+             const ShelterMap* shelter = nullptr);
 
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
@@ -106,11 +115,15 @@ class ParticleScene {
 
   /// evaluates every rain streak's radiance once, at its centre (rain shading does not depend
   /// on the hit point's normal), so that Shade looks it up; spread over `pool` (may be null).
+  /// `sky_volume` (may be null; must outlive this object until the next call) occludes the
+  /// sky light of every particle from here on (Shade): the sky term is then
+  /// SkyIrradianceVolume::AmbientRadiance at the particle instead of `sky_ambient`.
   void PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
-                      ThreadPool* pool);
+                      const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
 
   /// radiance (cd/m^2) of the streak at `hit`, point p_W, seen from direction wo (unit,
-  /// towards the viewer); `sky_ambient` is the sphere-average sky radiance.
+  /// towards the viewer); `sky_ambient` is the open sky's sphere-average radiance (occluded at
+  /// p_W by the sky volume of the last PrecomputeRain, if any).
   Eigen::Vector3f Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
                         const LightSampler& lights, const Eigen::Vector3f& sky_ambient) const;
 
@@ -128,8 +141,9 @@ class ParticleScene {
     float t = std::numeric_limits<float>::infinity();  // nearest streak t (ray units), +inf none
     int prim = -1;                                     // its primitive, -1 none
   };
-  std::vector<PixelStreak> pixel_;              // per pixel (one load per PixelHit)
-  std::vector<Eigen::Vector3f> rain_radiance_;  // per primitive (PrecomputeRain), or empty
+  std::vector<PixelStreak> pixel_;                   // per pixel (one load per PixelHit)
+  std::vector<Eigen::Vector3f> rain_radiance_;       // per primitive (PrecomputeRain), or empty
+  const SkyIrradianceVolume* sky_volume_ = nullptr;  // occluded sky (PrecomputeRain), or null
   std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
   bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
   // the streaks one chunk of drops keeps, in order (Build; kept between frames for their

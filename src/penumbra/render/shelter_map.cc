@@ -1,0 +1,103 @@
+#include "penumbra/render/shelter_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/static_geometry.h"
+
+namespace penumbra {
+
+ShelterMap::ShelterMap(RayQueryFactory make_query) : make_query_(std::move(make_query)) {
+  if (!make_query_) throw Error("ShelterMap: needs a RayQueryFactory");
+}
+
+void ShelterMap::Build(const SceneDescription& scene, const std::vector<Pose>& X_WB,
+                       ThreadPool* pool) {
+  if (X_WB.size() != scene.bodies.size())
+    throw Error("ShelterMap::Build: " + std::to_string(X_WB.size()) + " body poses, scene has " +
+                std::to_string(scene.bodies.size()) + " bodies");
+  built_ = true;
+  built_static_poses_ = X_WB;
+  roof_.clear();
+  nx_ = ny_ = 0;
+  // the static geoms and the bounds of the finite ones, world frame.
+  SceneDescription statics = scene;
+  statics.geoms.clear();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Geom& g : scene.geoms) {
+    if (!IsStaticVisible(scene, g)) continue;
+    statics.geoms.push_back(g);
+    Eigen::Vector3d a, b;
+    if (!LocalHalfExtents(scene, g, &a, &b)) continue;
+    const Pose X_WG = X_WB[g.body] * g.X_BG;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? b.x() : a.x(), (c & 2) ? b.y() : a.y(),
+                                   (c & 4) ? b.z() : a.z());
+      const Eigen::Vector3d p = X_WG * corner;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  if (!(lo.array() <= hi.array()).all()) return;  // no finite static geometry
+  // cells: kCellM, enlarged until the padded grid holds <= kMaxCells.
+  double cell = kCellM;
+  int nx = 0, ny = 0;
+  for (;;) {
+    nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)) + 2;
+    ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)) + 2;
+    if (static_cast<int64_t>(nx) * ny <= kMaxCells) break;
+    cell *= 1.25;
+  }
+  nx_ = nx, ny_ = ny;
+  cell_m_ = static_cast<float>(cell);
+  inv_cell_ = static_cast<float>(1.0 / cell);
+  origin_ = Eigen::Vector2f(static_cast<float>(lo.x() - cell), static_cast<float>(lo.y() - cell));
+  const float z_top = static_cast<float>(hi.z() + 1.0);
+  const std::unique_ptr<RayQuery> query = make_query_(statics);
+  WorldSnapshot snap;
+  snap.X_WB = X_WB;
+  query->Update(snap);
+  roof_.assign(static_cast<size_t>(nx) * ny, -std::numeric_limits<float>::infinity());
+  // one row of cells per task (a coherent batch of parallel rays).
+  auto row = [&](int64_t iy) {
+    std::vector<Ray> rays(nx);
+    std::vector<SurfaceHit> hits(nx);
+    std::unique_ptr<bool[]> did(new bool[nx]);
+    for (int ix = 0; ix < nx; ++ix) {
+      Ray& r = rays[ix];
+      r.o = Eigen::Vector3f(origin_.x() + (ix + 0.5f) * cell_m_,
+                            origin_.y() + (static_cast<float>(iy) + 0.5f) * cell_m_, z_top);
+      r.d = Eigen::Vector3f(0, 0, -1);
+    }
+    query->Intersect(rays, std::span<SurfaceHit>(hits), std::span<bool>(did.get(), nx));
+    for (int ix = 0; ix < nx; ++ix)
+      if (did[ix]) roof_[static_cast<size_t>(iy) * nx + ix] = z_top - hits[ix].t;
+  };
+  ParallelForOrSerial(pool, ny, row);
+}
+
+void ShelterMap::Update(const SceneDescription& scene, const WorldSnapshot& snapshot,
+                        ThreadPool* pool) {
+  bool rebuild = !built_ || snapshot.X_WB.size() != built_static_poses_.size();
+  for (size_t b = 0; !rebuild && b < snapshot.X_WB.size(); ++b)
+    rebuild = IsStaticBody(scene, static_cast<int>(b)) &&
+              snapshot.X_WB[b].matrix() != built_static_poses_[b].matrix();
+  if (rebuild) Build(scene, snapshot.X_WB, pool);
+}
+
+float ShelterMap::RoofHeight(float x, float y) const {
+  const float fx = (x - origin_.x()) * inv_cell_, fy = (y - origin_.y()) * inv_cell_;
+  if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return -std::numeric_limits<float>::infinity();
+  return roof_[static_cast<size_t>(fy) * nx_ + static_cast<size_t>(fx)];
+}
+
+bool ShelterMap::Sheltered(const Eigen::Vector3f& p_W) const {
+  if (roof_.empty()) return false;
+  return p_W.z() < RoofHeight(p_W.x(), p_W.y()) - kShelterMarginM;
+}
+
+}  // namespace penumbra

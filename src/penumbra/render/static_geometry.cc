@@ -1,0 +1,62 @@
+#include "penumbra/render/static_geometry.h"
+
+namespace penumbra {
+
+bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
+                      Eigen::Vector3d* hi) {
+  const Eigen::Vector3d& s = g.size;
+  Eigen::Vector3d h = Eigen::Vector3d::Zero();
+  switch (g.shape) {
+    case GeomShape::kPlane:
+      return false;
+    case GeomShape::kSphere:
+      h = Eigen::Vector3d::Constant(s.x());
+      break;
+    case GeomShape::kCapsule:
+      h = {s.x(), s.x(), s.y() + s.x()};
+      break;
+    case GeomShape::kEllipsoid:
+    case GeomShape::kBox:
+      h = s;
+      break;
+    case GeomShape::kCylinder:
+      h = {s.x(), s.x(), s.y()};
+      break;
+    case GeomShape::kMesh: {
+      if (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())) return false;
+      const TriangleMesh& m = scene.meshes[g.mesh];
+      if (m.vertices.empty()) return false;
+      Eigen::Vector3f a = m.vertices[0], b = m.vertices[0];
+      for (const Eigen::Vector3f& v : m.vertices) a = a.cwiseMin(v), b = b.cwiseMax(v);
+      *lo = a.cast<double>();
+      *hi = b.cast<double>();
+      return true;
+    }
+    case GeomShape::kHeightField: {
+      if (g.hfield < 0 || g.hfield >= static_cast<int>(scene.hfields.size())) return false;
+      const HeightField& f = scene.hfields[g.hfield];
+      *lo = {-f.size_x, -f.size_y, -f.size_base};
+      *hi = {f.size_x, f.size_y, f.size_z};
+      return true;
+    }
+  }
+  *lo = -h;
+  *hi = h;
+  return true;
+}
+
+// the geoms a RayQuery traces (render/ray_query.h: groups <= 2, alpha >= 0.5) of static bodies.
+bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
+  if (g.group > 2) return false;
+  if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&
+      scene.materials[g.material].alpha < 0.5f)
+    return false;
+  return g.body == 0 || (g.body > 0 && g.body < static_cast<int>(scene.bodies.size()) &&
+                         scene.bodies[g.body].is_static);
+}
+
+bool IsStaticBody(const SceneDescription& scene, int b) {
+  return b == 0 || scene.bodies[b].is_static;
+}
+
+}  // namespace penumbra

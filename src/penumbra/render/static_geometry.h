@@ -1,0 +1,23 @@
+#pragma once
+// the static geometry the precomputed lighting structures bake (the sky irradiance volume,
+// render/sky_irradiance_volume.h, and the shelter map, render/shelter_map.h): the geoms a
+// RayQuery traces (render/ray_query.h) of the world body and of static bodies.
+
+#include <Eigen/Core>
+
+#include "penumbra/scene/scene_description.h"
+
+namespace penumbra {
+
+/// axis-aligned bounds of a geom's shape in its own frame (m); false for planes (unbounded)
+/// and for meshes / height fields that are missing or empty.
+bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
+                      Eigen::Vector3d* hi);
+
+/// g is traced by a RayQuery (group <= 2, material alpha >= 0.5) and belongs to a static body.
+bool IsStaticVisible(const SceneDescription& scene, const Geom& g);
+
+/// body b is the world body or marked Body::is_static.
+bool IsStaticBody(const SceneDescription& scene, int b);
+
+}  // namespace penumbra
