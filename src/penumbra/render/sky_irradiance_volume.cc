@@ -281,24 +281,8 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   cell_pos_.clear();
 
   // the static geoms and the bounds of the finite ones, world frame.
-  SceneDescription statics = scene;
-  statics.geoms.clear();
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const Geom& g : scene.geoms) {
-    if (!IsStaticVisible(scene, g)) continue;
-    statics.geoms.push_back(g);
-    Eigen::Vector3d a, b;
-    if (!LocalHalfExtents(scene, g, &a, &b)) continue;
-    const Pose X_WG = X_WB[g.body] * g.X_BG;
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner((c & 1) ? b.x() : a.x(), (c & 2) ? b.y() : a.y(),
-                                   (c & 4) ? b.z() : a.z());
-      const Eigen::Vector3d p = X_WG * corner;
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  }
+  Eigen::Vector3d lo, hi;
+  SceneDescription statics = StaticGeoms(scene, X_WB, &lo, &hi);
   if (!(lo.array() <= hi.array()).all()) return;  // no finite static geometry
 
   // the grid: smallest spacing >= kMinSpacingM (in steps of 5%) with <= max_probes probes,

@@ -1,5 +1,7 @@
 #include "penumbra/render/static_geometry.h"
 
+#include <limits>
+
 namespace penumbra {
 
 bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
@@ -57,6 +59,31 @@ bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
 
 bool IsStaticBody(const SceneDescription& scene, int b) {
   return b == 0 || scene.bodies[b].is_static;
+}
+
+SceneDescription StaticGeoms(const SceneDescription& scene, const std::vector<Pose>& X_WB,
+                             Eigen::Vector3d* lo_W, Eigen::Vector3d* hi_W) {
+  SceneDescription statics = scene;
+  statics.geoms.clear();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Geom& g : scene.geoms) {
+    if (!IsStaticVisible(scene, g)) continue;
+    statics.geoms.push_back(g);
+    Eigen::Vector3d a, b;
+    if (!LocalHalfExtents(scene, g, &a, &b)) continue;
+    const Pose X_WG = X_WB[g.body] * g.X_BG;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? b.x() : a.x(), (c & 2) ? b.y() : a.y(),
+                                   (c & 4) ? b.z() : a.z());
+      const Eigen::Vector3d p = X_WG * corner;
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  *lo_W = lo;
+  *hi_W = hi;
+  return statics;
 }
 
 }  // namespace penumbra

@@ -4,7 +4,9 @@
 // RayQuery traces (render/ray_query.h) of the world body and of static bodies.
 
 #include <Eigen/Core>
+#include <vector>
 
+#include "penumbra/core/pose.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -19,5 +21,12 @@ bool IsStaticVisible(const SceneDescription& scene, const Geom& g);
 
 /// body b is the world body or marked Body::is_static.
 bool IsStaticBody(const SceneDescription& scene, int b);
+
+/// `scene` with only its static visible geoms (IsStaticVisible), and in *lo_W, *hi_W the world
+/// frame axis-aligned bounds (m) of the finite ones posed by X_WB (one pose per body; planes
+/// and empty meshes are left out of the bounds). with no finite static geom, *lo_W = +inf and
+/// *hi_W = -inf (lo > hi).
+SceneDescription StaticGeoms(const SceneDescription& scene, const std::vector<Pose>& X_WB,
+                             Eigen::Vector3d* lo_W, Eigen::Vector3d* hi_W);
 
 }  // namespace penumbra
