@@ -189,6 +189,23 @@ TEST(NavBenchmark, SpecLoadsAndPlansOneJobPerEpisodeConditionMethodTrial) {
   ASSERT_EQ(jobs.size(), 2u * 2u * 1u * 2u);
   EXPECT_EQ(jobs[0].id, "target__a__none__nav__t1");
   EXPECT_EQ(jobs[7].id, "target__b__minor__nav__t2");
+  // no camera: the world's own
+  EXPECT_TRUE(s.worlds[0].camera_yaml.empty());
+}
+
+TEST(NavBenchmark, SpecCameraGetsDepthAndTheD435Model) {
+  TempDir dir;
+  std::string text = NavSpec("      - {name: a, goal: [3, 0]}\n");
+  text.replace(text.find("    robot:"), 0,
+               "    camera: {name: nav_depth, attach: quadruped/camera_mount, width: 80, "
+               "height: 60, fovy_deg: 50, rate_hz: 10}\n");
+  const BenchmarkSpec s = LoadBenchmarkSpec(dir.Write("spec.yaml", text));
+  ASSERT_EQ(s.worlds.size(), 1u);
+  EXPECT_EQ(s.worlds[0].camera_name, "nav_depth");
+  EXPECT_NE(s.worlds[0].camera_yaml.find("outputs: [rgb, depth]"), std::string::npos)
+      << s.worlds[0].camera_yaml;
+  EXPECT_NE(s.worlds[0].camera_yaml.find("realsense_d435"), std::string::npos)
+      << s.worlds[0].camera_yaml;
 }
 
 TEST(NavBenchmark, SpecErrorsNameFileLineAndField) {
@@ -219,9 +236,16 @@ TEST(NavBenchmark, SpecErrorsNameFileLineAndField) {
   EXPECT_NE(e.find("quadruped"), std::string::npos) << e;
   // a SLAM key in a nav spec's world
   text = NavSpec("      - {name: a, goal: [3, 0]}\n");
-  text.replace(text.find("    robot:"), 0, "    camera: {name: c}\n");
+  text.replace(text.find("    robot:"), 0, "    duration_sec: 5\n");
   e = ErrorOf(text);
-  EXPECT_NE(e.find("unknown key 'camera'"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key 'duration_sec'"), std::string::npos) << e;
+  // the navigator's camera is checked as the SLAM spec's: a body the world lacks
+  text = NavSpec("      - {name: a, goal: [3, 0]}\n");
+  text.replace(text.find("    robot:"), 0,
+               "    camera: {name: c, attach: nowhere/mount, width: 80, height: 60}\n");
+  e = ErrorOf(text);
+  EXPECT_NE(e.find("spec.yaml:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("nowhere/mount"), std::string::npos) << e;
   // unknown kind
   e = ErrorOf("kind: rl\n");
   EXPECT_NE(e.find("kind"), std::string::npos) << e;

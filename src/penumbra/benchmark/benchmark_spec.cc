@@ -80,6 +80,7 @@ void CheckTemplate(const YamlReader& r, const std::string& text,
 }
 
 void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera);
+void ReadCamera(const YamlReader& cam, BenchmarkWorld* out);
 
 BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   r.ExpectMap({"name", "file", "duration_sec", "camera"});
@@ -94,7 +95,14 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
     file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
   w.file = fs::weakly_canonical(p).string();
   if (r.Has("duration_sec")) w.duration_sec = Positive(r.Child("duration_sec"), 3600);
-  const YamlReader cam = r.Child("camera");
+  ReadCamera(r.Child("camera"), &w);
+  return w;
+}
+
+// the benchmark camera `cam` of world `w` (its file set): a world-file camera with rgb and
+// depth outputs and, unless it says otherwise, the RealSense D435 depth model.
+void ReadCamera(const YamlReader& cam, BenchmarkWorld* out) {
+  BenchmarkWorld& w = *out;
   cam.ExpectMapAnyKeys();
   if (!cam.Has("name"))
     cam.Fail("no 'name'; expected a world-file camera with a name (docs/world-file.md)");
@@ -109,7 +117,6 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   out << YAML::Flow << node;
   w.camera_yaml = out.c_str();
   CheckCamera(w, cam);
-  return w;
 }
 
 BenchmarkCondition ReadCondition(const YamlReader& r, const std::string& dir,
@@ -207,7 +214,7 @@ NavEpisode ReadEpisode(const YamlReader& r) {
 }
 
 BenchmarkWorld ReadNavWorld(const YamlReader& r, const std::string& dir) {
-  r.ExpectMap({"name", "file", "robot", "profile", "episodes"});
+  r.ExpectMap({"name", "file", "robot", "profile", "camera", "episodes"});
   BenchmarkWorld w;
   w.line = r.line();
   w.name = Name(r.Child("name"));
@@ -244,6 +251,7 @@ BenchmarkWorld ReadNavWorld(const YamlReader& r, const std::string& dir) {
       e.Child("name").Fail("episode name appears twice in this world; expected unique names");
   }
   if (w.episodes.empty()) episodes.Fail("no episodes; expected at least one");
+  if (r.Has("camera")) ReadCamera(r.Child("camera"), &w);
   return w;
 }
 

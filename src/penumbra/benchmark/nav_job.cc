@@ -63,7 +63,8 @@ int FreePortPair() {
 
 std::string Num(double v) { return FormatNumber(v); }
 
-// the world override: the base's pose series and the robot's contacts (undebounced)
+// the world override: the base's pose series, the robot's contacts (undebounced) and the
+// spec's camera, if any
 std::string OverrideYaml(const BenchmarkSpec& spec, const BenchmarkWorld& w) {
   const NavRobotProfile profile = NavProfile(w.profile);
   const NavMetricsConfig& m = spec.nav_metrics;
@@ -79,6 +80,8 @@ std::string OverrideYaml(const BenchmarkSpec& spec, const BenchmarkWorld& w) {
          "\", b: \"" + m.floor + "\"}";
   s += "]\n      self_contacts: false\n      pair: body\n";
   s += "      rate_hz: " + Num(m.pose_rate_hz) + "\n";
+  // the spec's camera replaces the world's cameras (the navigator takes the first with depth)
+  if (!w.camera_yaml.empty()) s += "cameras:\n  - " + w.camera_yaml + "\n";
   return s;
 }
 

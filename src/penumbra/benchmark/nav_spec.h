@@ -9,6 +9,10 @@
 //       file: ../worlds/quadruped_target.yaml
 //       robot: quadruped                 # the world's robot (its `robots:` name)
 //       profile: quadruped               # quadruped | rover (default quadruped)
+//       camera: {name: nav_depth, attach: quadruped/camera_mount, width: 80, height: 60,
+//                fovy_deg: 50, rate_hz: 10}  # optional: replaces the world's cameras, as
+//                                     # the SLAM spec's camera (rgb + depth, D435 depth model
+//                                     # unless `depth_noise` says otherwise)
 //       episodes:
 //         - name: ahead                  # unique within the world
 //           goal: [3.0, 0.0]             # world frame x, y, m
