@@ -80,7 +80,7 @@ void CheckTemplate(const YamlReader& r, const std::string& text,
 }
 
 void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera);
-void ReadCamera(const YamlReader& cam, BenchmarkWorld* out);
+void ReadCamera(const YamlReader& cam, BenchmarkWorld* world);
 
 BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   r.ExpectMap({"name", "file", "duration_sec", "camera"});
@@ -101,8 +101,8 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
 
 // the benchmark camera `cam` of world `w` (its file set): a world-file camera with rgb and
 // depth outputs and, unless it says otherwise, the RealSense D435 depth model.
-void ReadCamera(const YamlReader& cam, BenchmarkWorld* out) {
-  BenchmarkWorld& w = *out;
+void ReadCamera(const YamlReader& cam, BenchmarkWorld* world) {
+  BenchmarkWorld& w = *world;
   cam.ExpectMapAnyKeys();
   if (!cam.Has("name"))
     cam.Fail("no 'name'; expected a world-file camera with a name (docs/world-file.md)");
