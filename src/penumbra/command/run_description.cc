@@ -2,24 +2,9 @@
 
 #include <Eigen/Geometry>
 
+#include "penumbra/control/joint_type_name.h"
+
 namespace penumbra {
-namespace {
-
-const char* JointTypeName(JointInfo::Type t) {
-  switch (t) {
-    case JointInfo::Type::kFree:
-      return "free";
-    case JointInfo::Type::kBall:
-      return "ball";
-    case JointInfo::Type::kSlide:
-      return "slide";
-    case JointInfo::Type::kHinge:
-      return "hinge";
-  }
-  return "hinge";
-}
-
-}  // namespace
 
 std::vector<std::string> ControllerCommands(const std::string& type) {
   if (type == "trot_gait" || type == "waypoint_follower") return {"twist", "waypoints"};

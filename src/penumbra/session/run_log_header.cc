@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "penumbra/compose/mjcf_assets.h"
+#include "penumbra/control/joint_type_name.h"
 #include "penumbra/physics/mujoco_version.h"
 
 namespace penumbra {
@@ -25,19 +26,6 @@ std::string Absolute(const std::string& path) {
   return ec ? path : p.lexically_normal().string();
 }
 
-const char* JointTypeName(JointInfo::Type t) {
-  switch (t) {
-    case JointInfo::Type::kFree:
-      return "free";
-    case JointInfo::Type::kBall:
-      return "ball";
-    case JointInfo::Type::kSlide:
-      return "slide";
-    case JointInfo::Type::kHinge:
-      return "hinge";
-  }
-  return "hinge";
-}
 
 }  // namespace
 
