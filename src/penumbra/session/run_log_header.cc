@@ -26,7 +26,6 @@ std::string Absolute(const std::string& path) {
   return ec ? path : p.lexically_normal().string();
 }
 
-
 }  // namespace
 
 RunLogLayout RunLogLayoutOf(const Simulation& sim) {
