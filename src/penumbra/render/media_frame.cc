@@ -85,11 +85,9 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
     realtime_ok_ = true;
   }
   bool sheltered = false;
-  for (const ParticleSet& ps : fx->particles)
-    sheltered = sheltered || (ps.sheltered && ps.kind != ParticleKind::kSpark);
+  for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
-  particles_.Build(fx, camera, view.exposure_time_sec,
-                   settings.tier == RenderSettings::Tier::kRealtime, pool,
+  particles_.Build(fx, camera, view.exposure_time_sec, realtime, pool,
                    media_.empty() ? nullptr : &media_, sheltered ? &shelter_ : nullptr);
   if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, occluded_sky, pool);
 }

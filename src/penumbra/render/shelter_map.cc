@@ -10,6 +10,10 @@
 
 namespace penumbra {
 
+bool ShelterApplies(const ParticleSet& ps) {
+  return ps.sheltered && ps.kind != ParticleKind::kSpark;
+}
+
 ShelterMap::ShelterMap(RayQueryFactory make_query) : make_query_(std::move(make_query)) {
   if (!make_query_) throw Error("ShelterMap: needs a RayQueryFactory");
 }

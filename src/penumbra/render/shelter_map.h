@@ -27,10 +27,15 @@
 #include "penumbra/core/pose.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/ray_query.h"
+#include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
+
+/// whether a shelter map keeps the particles of `ps` from falling under static geometry: rain
+/// and snow sets with ParticleSet::sheltered; never sparks.
+bool ShelterApplies(const ParticleSet& ps);
 
 /// the static geometry's roof height per plan cell (see the file comment).
 class ShelterMap {

@@ -189,8 +189,7 @@ void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double e
     const Eigen::Vector3f& v = ps.velocity_W[i];
     const float r = ps.radius_m[i];
     if (!(r > 0)) return;
-    if (shelter != nullptr && ps.sheltered && ps.kind != ParticleKind::kSpark &&
-        shelter->Sheltered(p))
+    if (shelter != nullptr && ShelterApplies(ps) && shelter->Sheltered(p))
       return;  // rain or snow under a roof
     Eigen::Vector3f q = p + T * v;
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
