@@ -17,15 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-uint64_t Fnv1a64(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 template <typename T>
 void Append(std::string* out, T v) {
   char b[sizeof(T)];
@@ -60,15 +51,6 @@ std::string XmlEscape(const std::string& s) {
 double LinearToSrgb(double v) {
   v = std::clamp(v, 0.0, 1.0);
   return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-}
-
-// writes `bytes` to dir/name unless a file of that name already holds them; returns the path.
-std::string WriteOnce(const fs::path& dir, const std::string& name, const std::string& bytes) {
-  const fs::path p = dir / name;
-  std::error_code ec;
-  if (fs::is_regular_file(p, ec) && fs::file_size(p, ec) == bytes.size()) return p.string();
-  WriteFileAtomic(p.string(), bytes);
-  return p.string();
 }
 
 }  // namespace
@@ -181,10 +163,10 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
     for (const ImportedMesh& mesh : im.asset.meshes) {
       const std::string bytes = MshBytes(mesh.mesh);
       msh_files.push_back(
-          WriteOnce(folder, fmt::format("{}-{:016x}.msh", stem, Fnv1a64(bytes)), bytes));
+          WriteContentNamedFile(folder, stem, ".msh", bytes));
     }
     const std::string xml = MeshModelMjcf(im.asset, msh_files);
-    m.file = WriteOnce(folder, fmt::format("{}-{:016x}.xml", stem, Fnv1a64(xml)), xml);
+    m.file = WriteContentNamedFile(folder, stem, ".xml", xml);
     out.push_back(std::move(im));
   }
   return out;

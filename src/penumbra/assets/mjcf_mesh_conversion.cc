@@ -25,15 +25,6 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
-uint64_t Fnv1a64(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 // the meshes of `asset` as one mesh (vertex indices offset per part; normals and texcoords
 // kept only when every part has them).
 TriangleMesh Merge(const ImportedAsset& asset) {
@@ -93,12 +84,10 @@ std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed, const
     const std::string bytes = MshBytes(Merge(asset));
     std::error_code ec;
     fs::create_directories(folder, ec);
-    const fs::path out =
-        folder / fmt::format("{}-{:016x}.msh", fs::path(file).stem().string(), Fnv1a64(bytes));
-    if (!(fs::is_regular_file(out, ec) && fs::file_size(out, ec) == bytes.size()))
-      WriteFileAtomic(out, bytes);
+    const std::string out =
+        WriteContentNamedFile(folder, fs::path(file).stem().string(), ".msh", bytes);
     converted.push_back(file);
-    e->SetAttribute("file", out.string().c_str());
+    e->SetAttribute("file", out.c_str());
   });
   return converted;
 }

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 
@@ -186,6 +187,27 @@ void LineFile::Fail(int err) {
   buffer_.clear();
   failure_ = "cannot write '" + path_.string() + "': " + Reason(err);
   throw Error(failure_);
+}
+
+uint64_t Fnv1a64(std::string_view bytes) {
+  uint64_t h = 14695981039346656037ull;
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string WriteContentNamedFile(const std::filesystem::path& dir, const std::string& stem,
+                                  const std::string& ext, std::string_view bytes) {
+  char hex[17];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(Fnv1a64(bytes)));
+  const std::filesystem::path p = dir / (stem + "-" + hex + ext);
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(p, ec) && std::filesystem::file_size(p, ec) == bytes.size())
+    return p.string();
+  WriteFileAtomic(p, bytes);
+  return p.string();
 }
 
 }  // namespace penumbra

@@ -11,6 +11,7 @@
 // errors name the path and the system's reason (e.g. "No space left on device").
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -28,6 +29,17 @@ bool IsTemporaryOutputName(const std::string& file_name);
 /// @throws Error naming `path` and the reason (cannot create, short write, cannot rename);
 ///         the temporary file is removed and `path` is left as it was.
 void WriteFileAtomic(const std::filesystem::path& path, std::string_view bytes);
+
+/// the 64-bit FNV-1a hash of `bytes` (Fowler, Noll, Vo; offset basis 14695981039346656037,
+/// prime 1099511628211): names cache files by their content.
+uint64_t Fnv1a64(std::string_view bytes);
+
+/// a content-named cache file: writes `bytes` to dir / "<stem>-<16 hex digits of
+/// Fnv1a64(bytes)><ext>" (WriteFileAtomic) unless a file of that name and size is already
+/// there, and returns its path. `dir` must exist.
+/// @throws Error as WriteFileAtomic.
+std::string WriteContentNamedFile(const std::filesystem::path& dir, const std::string& stem,
+                                  const std::string& ext, std::string_view bytes);
 
 /// creates the folder root / rel and its missing parents. `root` (the output folder the user
 /// named) is taken as given and may itself be a link; every component of `rel` below it must

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 
 namespace penumbra {
 namespace {
@@ -32,15 +33,6 @@ void AppendFloat(std::string* out, float v) {
   char b[4];
   std::memcpy(b, &v, 4);
   out->append(b, 4);
-}
-
-uint64_t Fnv1a64(const std::string& bytes) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
 }
 
 std::string ReadBytes(const fs::path& path) {
