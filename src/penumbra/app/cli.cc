@@ -278,7 +278,7 @@ int RunCli(int argc, char** argv) {
   // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
   CLI::App* sheet = app.add_subcommand("contact-sheet", "one instant of a world under adversity presets, side by side, as a PNG");
   ContactSheetOptions sheet_options;
-  sheet->add_option("--world", sheet_options.world_file, "world file (default: bundled default world)");
+  sheet->add_option("--world", sheet_options.worlds, "world file, one row each; repeat for more rows (default: bundled default world)");
   sheet->add_option("--presets", sheet_options.presets, "presets, left to right")->delimiter(',');
   AddDecimal(
       sheet, "--time", [&](double v) { sheet_options.time_sec = v; }, 0, false,

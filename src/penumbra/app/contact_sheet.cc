@@ -49,23 +49,30 @@ void DrawText(ImageU8* img, int x0, int y0, const std::string& text, int scale) 
 }  // namespace
 
 int MakeContactSheet(const ContactSheetOptions& o) {
-  WorldConfig world = LoadWorldFile(o.world_file.empty() ? DefaultWorldPath() : o.world_file);
-  world.render.threads = o.threads;
+  const std::vector<std::string> worlds =
+      o.worlds.empty() ? std::vector<std::string>{DefaultWorldPath()} : o.worlds;
   constexpr int kGap = 8, kBar = 28;
   const int n = static_cast<int>(o.presets.size());
-  ImageU8 sheet(n * o.width + (n - 1) * kGap, o.height + kBar, 3, 255);
-  for (int i = 0; i < n; ++i) {
-    PresetScene p = LoadPresetScene(world, o.presets[i]);
-    p.StepTo(o.time_sec);
-    const RenderedFrame f = p.Render(0, o.width, o.height);
-    const int x0 = i * (o.width + kGap);
-    for (int y = 0; y < o.height; ++y)
-      for (int x = 0; x < o.width; ++x)
-        for (int c = 0; c < 3; ++c) sheet.at(x0 + x, kBar + y)[c] = f.rgb.at(x, y)[c];
-    const std::string label = o.presets[i];
-    DrawText(&sheet, x0 + (o.width - static_cast<int>(label.size()) * 18) / 2, 3, label, 3);
-    fmt::print("{}: t = {:.3f} s, {} effects, {} agents\n", label, p.session->sim().time(),
-               p.session->effects().effects().size(), p.session->effects().agents().size());
+  const int rows = static_cast<int>(worlds.size()), row_h = o.height + kBar;
+  ImageU8 sheet(n * o.width + (n - 1) * kGap, rows * row_h + (rows - 1) * kGap, 3, 255);
+  for (int r = 0; r < rows; ++r) {
+    WorldConfig world = LoadWorldFile(worlds[r]);
+    world.render.threads = o.threads;
+    const int y0 = r * (row_h + kGap);
+    for (int i = 0; i < n; ++i) {
+      PresetScene p = LoadPresetScene(world, o.presets[i]);
+      p.StepTo(o.time_sec);
+      const RenderedFrame f = p.Render(0, o.width, o.height);
+      const int x0 = i * (o.width + kGap);
+      for (int y = 0; y < o.height; ++y)
+        for (int x = 0; x < o.width; ++x)
+          for (int c = 0; c < 3; ++c) sheet.at(x0 + x, y0 + kBar + y)[c] = f.rgb.at(x, y)[c];
+      const std::string label = o.presets[i];
+      DrawText(&sheet, x0 + (o.width - static_cast<int>(label.size()) * 18) / 2, y0 + 3, label, 3);
+      fmt::print("{} {}: t = {:.3f} s, {} effects, {} agents\n", worlds[r], label,
+                 p.session->sim().time(), p.session->effects().effects().size(),
+                 p.session->effects().agents().size());
+    }
   }
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());

@@ -1,6 +1,7 @@
 #pragma once
 // `penumbra contact-sheet`: the same instant of a world rendered under several adversity
-// presets, side by side with the preset names above, as one PNG (docs/effects.png).
+// presets, side by side with the preset names above, as one PNG (docs/effects.png); several
+// worlds give one row each (docs/environments.png).
 
 #include <string>
 #include <vector>
@@ -9,7 +10,8 @@ namespace penumbra {
 
 /// options of `penumbra contact-sheet`.
 struct ContactSheetOptions {
-  std::string world_file;  ///< default: the bundled default world
+  /// one row per world file, top down; empty = the bundled default world.
+  std::vector<std::string> worlds;
   std::vector<std::string> presets = {"none", "minor", "major"};
   double time_sec = 1.0;          ///< sim time of the frames
   int width = 640, height = 480;  ///< size of each frame (the world camera's field of view)
@@ -17,8 +19,8 @@ struct ContactSheetOptions {
   int threads = 0;  ///< render threads, 0 = all cores
 };
 
-/// renders the world's first camera at time_sec under every preset and writes the sheet
-/// ((height + 28) x (n width + (n - 1) 8) x 3 sRGB). returns 0.
+/// renders each world's first camera at time_sec under every preset and writes the sheet: one
+/// row per world, (rows (height + 28) + (rows - 1) 8) x (n width + (n - 1) 8) x 3 sRGB. returns 0.
 /// @throws ConfigError for an unknown world or preset.
 int MakeContactSheet(const ContactSheetOptions& options);
 

@@ -90,8 +90,17 @@ WorldConfig ApplyWorldOverride(const WorldConfig& recorded, const std::string& p
     models << YAML::Key << (robots ? "robots" : "models") << YAML::Value << YAML::BeginSeq;
     for (const ModelConfig& m : recorded.models) {
       if (m.is_robot != robots) continue;
-      models << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << m.name
-             << YAML::Key << "file" << YAML::Value << m.file << YAML::EndMap;
+      models << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << m.name;
+      // a generated building not generated yet (no file): its environment entry
+      if (m.environment && m.file.empty()) {
+        models << YAML::Key << "environment" << YAML::Value << YAML::BeginMap << YAML::Key << "type"
+               << YAML::Value << m.environment->type << YAML::Key << "seed" << YAML::Value
+               << m.environment->seed << YAML::Key << "texture_resolution" << YAML::Value
+               << m.environment->texture_resolution << YAML::EndMap;
+      } else {
+        models << YAML::Key << "file" << YAML::Value << m.file;
+      }
+      models << YAML::EndMap;
     }
     models << YAML::EndSeq;
   }

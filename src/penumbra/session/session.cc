@@ -13,6 +13,7 @@
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/environment/environment_model.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/renderer_factory.h"
 #include "penumbra/session/run_budget.h"
@@ -53,8 +54,24 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   compose_options.timestep_sec = world_.timestep_sec;
   compose_options.physics = world_.physics;
   compose_options.ground_plane = world_.ground_plane;
-  // mesh files (models: entries with .obj, .gltf, ...) become generated MJCF models there too
+  // generated environments (models: entries with environment:) become MJCF models next to the
+  // composed model ("environments"), their lamps world lights, their materials procedural ones
   std::vector<ModelConfig> models = world_.models;
+  const GeneratedModels generated = GenerateEnvironmentModels(
+      &models, options.composed_xml_path.empty()
+                   ? std::string()
+                   : (std::filesystem::path(options.composed_xml_path).parent_path() /
+                      "environments")
+                         .string());
+  for (const GeneratedModel& g : generated.models)
+    spdlog::info("generated {} ({}): {} geoms ({} colliding), {} furniture items, {} materials, "
+                 "{} lamps in {:.3f} s",
+                 g.model, g.file, g.environment.geoms, g.environment.colliding_geoms,
+                 g.environment.furniture, g.environment.materials.size(),
+                 g.environment.lights.size(), g.generate_sec);
+  world_.lights.insert(world_.lights.end(), generated.lights.begin(), generated.lights.end());
+  for (size_t i = 0; i < models.size(); ++i) world_.models[i].file = models[i].file;
+  // mesh files (models: entries with .obj, .gltf, ...) become generated MJCF models there too
   const std::vector<ImportedModel> imported = ImportMeshModels(&models, mesh_dir, world_.file);
   for (const ImportedModel& im : imported)
     spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s", im.model,
@@ -100,7 +117,10 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   t0 = Clock::now();
   SceneDescription extracted = sim_->scene();
   ApplyImportedMaterials(imported, &extracted);
-  ApplyProceduralMaterials(ProceduralMaterialsOf(world_.file), world_.file, &extracted);
+  std::vector<ProceduralMaterialEntry> procedural = generated.materials;
+  for (ProceduralMaterialEntry& e : ProceduralMaterialsOf(world_.file))
+    procedural.push_back(std::move(e));
+  ApplyProceduralMaterials(procedural, world_.file, &extracted);
   scene_ = effects_->Bind(AssembleScene(std::move(extracted), world_, sim_->Snapshot()));
   if (options.check_run_budget) {
     CheckRunMemory(world_, scene_, PhysicalMemoryBytes());  // before allocating

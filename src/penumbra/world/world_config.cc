@@ -206,6 +206,7 @@ class WorldParser {
   ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
     std::vector<std::string_view> keys = {"name", "file", "pose"};
     if (is_robot) keys.insert(keys.end(), {"controller", "sensors"});
+    if (!is_robot) keys.push_back("environment");
     keys.insert(keys.end(), {"sites", "initial_keyframe", "floating_base"});
     keys.insert(keys.end(), MeshImportKeys().begin(), MeshImportKeys().end());
     r.ExpectMap(keys);
@@ -213,6 +214,18 @@ class WorldParser {
     m.is_robot = is_robot;
     m.key = r.path();
     m.name = r.Child("name").String();
+    if (r.Has("environment")) {
+      // a generated building: no file, no mesh keys, no sites (nothing to name yet)
+      if (r.Has("file"))
+        r.Child("file").Fail("expected either file or environment, not both");
+      for (std::string_view k : {"sites", "initial_keyframe", "floating_base"})
+        if (r.Has(k)) r.Child(k).Fail("not allowed with environment: (a generated building)");
+      m.environment = ReadEnvironmentConfig(r.Child("environment"));
+      if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
+      return m;
+    }
+    if (!r.Has("file") && !is_robot)
+      r.Fail("expected file (an MJCF, URDF or mesh file) or environment (a generated building)");
     m.file = Resolve(r.Child("file").String());
     // checked here, read again by the session (world/mesh_import_config.h)
     MeshImportConfig mesh;

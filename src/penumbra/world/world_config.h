@@ -18,6 +18,7 @@
 #include "penumbra/render/render_settings.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/sensors/camera_sensor_config.h"
+#include "penumbra/world/environment_config.h"
 #include "penumbra/world/metrics_config.h"
 #include "penumbra/world/sensors_reader.h"
 
@@ -59,6 +60,10 @@ struct ModelConfig {
   /// key path of the entry in the world file ("robots[1]"), for errors found later; "" for
   /// models not from a world file.
   std::string key;
+  /// `environment:` (models only, instead of `file`): a generated building
+  /// (world/environment_config.h). `file` stays "" until the session generates its MJCF
+  /// (environment/environment_model.h) and points `file` at it.
+  std::optional<EnvironmentConfig> environment;
 };
 
 /// world-file `physics:` options besides timestep_sec. each one that is set overrides the

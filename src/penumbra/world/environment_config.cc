@@ -1,0 +1,37 @@
+#include "penumbra/world/environment_config.h"
+
+#include "penumbra/core/error.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace penumbra {
+
+const std::vector<std::string_view>& EnvironmentTypes() {
+  static const std::vector<std::string_view> kTypes = {"house", "warehouse"};
+  return kTypes;
+}
+
+void EnvironmentConfig::ValidateOrThrow(const std::string& file, int line,
+                                        const std::string& key) const {
+  bool known = false;
+  for (std::string_view t : EnvironmentTypes()) known = known || t == type;
+  if (!known)
+    throw ConfigError(file, line, key + ".type",
+                      "'" + type + "' is not an environment type; expected house or warehouse");
+  if (texture_resolution < 16 || texture_resolution > 4096)
+    throw ConfigError(file, line, key + ".texture_resolution",
+                      std::to_string(texture_resolution) + "; expected 16 ... 4096");
+}
+
+EnvironmentConfig ReadEnvironmentConfig(const YamlReader& r) {
+  r.ExpectMap({"type", "seed", "texture_resolution"});
+  EnvironmentConfig c;
+  c.type = r.Child("type").Enum(EnvironmentTypes());
+  if (r.Has("seed")) c.seed = r.Child("seed").Uint64();
+  if (r.Has("texture_resolution")) c.texture_resolution = r.Child("texture_resolution").Int();
+  if (c.texture_resolution < 16 || c.texture_resolution > 4096)
+    r.Child("texture_resolution")
+        .Fail(std::to_string(c.texture_resolution) + "; expected 16 ... 4096");
+  return c;
+}
+
+}  // namespace penumbra
