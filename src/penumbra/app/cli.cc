@@ -23,6 +23,7 @@
 #include "penumbra/app/viewer_commands.h"
 #include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/contact_sheet.h"
+#include "penumbra/app/heightfield_tool.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
 #include "penumbra/app/replay_command.h"
@@ -276,6 +277,20 @@ int RunCli(int argc, char** argv) {
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
   // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
+  // penumbra heightfield (app/heightfield_tool.h)
+  CLI::App* hfield = app.add_subcommand("heightfield", "a world's static geometry sampled from above into a MuJoCo hfield model");
+  HeightFieldOptions hfield_options;
+  hfield->add_option("world", hfield_options.world_file, "world file")->required();
+  hfield->add_option("--model", hfield_options.model, "sample only this model's geoms (default: every static geom)");
+  AddDecimal(
+      hfield, "--cell", [&](double v) { hfield_options.cell_m = v; }, 0, true,
+      "sample spacing, m (default 0.1)");
+  std::vector<double> hfield_extent;
+  hfield->add_option("--extent", hfield_extent, "plan rectangle x0,y0,x1,y1 in m (default: the geometry's bounds)")
+      ->delimiter(',')
+      ->expected(4);
+  hfield->add_option("--out,-o", hfield_options.out_dir, "output folder (default .)");
+  hfield->add_option("--name", hfield_options.name, "file stem (default: the model's name, or terrain)");
   CLI::App* sheet = app.add_subcommand("contact-sheet", "one instant of a world under adversity presets, side by side, as a PNG");
   ContactSheetOptions sheet_options;
   sheet->add_option("--world", sheet_options.worlds, "world file, one row each; repeat for more rows (default: bundled default world)");
@@ -427,6 +442,12 @@ int RunCli(int argc, char** argv) {
       return BenchRender(render_bench);
     }
     if (*sheet) return MakeContactSheet(sheet_options);
+    if (*hfield) {
+      if (!hfield_extent.empty())
+        hfield_options.extent = {hfield_extent[0], hfield_extent[1], hfield_extent[2],
+                                 hfield_extent[3]};
+      return RunHeightField(hfield_options);
+    }
     if (export_command.selected()) return export_command.Run();
     if (*make_vdb) {
       MakeSmokeVdb(vdb_path, vdb_options);

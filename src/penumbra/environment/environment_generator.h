@@ -33,9 +33,18 @@ struct PlanRect {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
+/// a file the model refers to (a height field): written next to the model under a name made
+/// from its content; `placeholder` in GeneratedEnvironment::mjcf stands for its absolute path.
+struct GeneratedFile {
+  std::string placeholder;  ///< e.g. "@terrain.hfield@"
+  std::string stem, ext;    ///< name parts of the written file ("terrain", ".hfield")
+  std::string bytes;
+};
+
 /// everything one generated environment consists of.
 struct GeneratedEnvironment {
   std::string mjcf;  ///< the model (MJCF 2.2.2 text, static geoms of the world body)
+  std::vector<GeneratedFile> files;  ///< files `mjcf` refers to by placeholder
   /// `procedural:` materials of the model's MJCF materials; `material` is the model-local name
   /// (the session prefixes "<model>/"), `line` 0.
   std::vector<ProceduralMaterialEntry> materials;

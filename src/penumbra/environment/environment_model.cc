@@ -25,7 +25,15 @@ GeneratedModels GenerateEnvironmentModels(std::vector<ModelConfig>* models,
     const auto t0 = std::chrono::steady_clock::now();
     g.environment = GenerateEnvironment(*m.environment);
     g.generate_sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    g.file = WriteContentNamedFile(folder, m.environment->type, ".xml", g.environment.mjcf);
+    // the files the model refers to, then the model with their paths
+    std::string mjcf = g.environment.mjcf;
+    for (const GeneratedFile& f : g.environment.files) {
+      const std::string path = WriteContentNamedFile(folder, f.stem, f.ext, f.bytes);
+      for (size_t at = mjcf.find(f.placeholder); at != std::string::npos;
+           at = mjcf.find(f.placeholder, at + path.size()))
+        mjcf.replace(at, f.placeholder.size(), path);
+    }
+    g.file = WriteContentNamedFile(folder, m.environment->type, ".xml", mjcf);
     m.file = g.file;
     for (ProceduralMaterialEntry e : g.environment.materials) {
       e.material = m.name + "/" + e.material;

@@ -120,6 +120,23 @@ std::string MjcfBuilder::AddPlane(const std::string& name, const Eigen::Vector3d
   return g.name;
 }
 
+std::string MjcfBuilder::AddHeightField(const std::string& name, const std::string& file,
+                                        const std::string& size, const Eigen::Vector3d& pos,
+                                        const std::string& material, bool collide) {
+  assets_.push_back(
+      fmt::format(R"(    <hfield name="{}" file="{}" size="{}"/>)", name, file, size));
+  GeomRecord g;
+  g.name = UniqueName(name);
+  g.type = "hfield";
+  g.hfield = name;
+  g.pos = pos;
+  g.plan_half_extent = std::numeric_limits<double>::infinity();
+  g.material = material;
+  g.collide = collide;
+  AddGeom(g);
+  return g.name;
+}
+
 std::string MjcfBuilder::BodyOf(const GeomRecord& g) const {
   if (g.plan_half_extent > kCellM / 2) return "";
   return "cell_" + CellIndex(g.pos.x()) + "_" + CellIndex(g.pos.y()) + (g.collide ? "" : "_visual");
@@ -135,8 +152,11 @@ int MjcfBuilder::bodies() const {
 }
 
 std::string MjcfBuilder::GeomXml(const GeomRecord& g, const Eigen::Vector3d& body_pos) {
-  std::string s = fmt::format(R"(<geom name="{}" type="{}" size="{}" pos="{}")", g.name, g.type,
-                              g.size, Vec(g.pos - body_pos));
+  std::string s = g.hfield.empty()
+                      ? fmt::format(R"(<geom name="{}" type="{}" size="{}" pos="{}")", g.name,
+                                    g.type, g.size, Vec(g.pos - body_pos))
+                      : fmt::format(R"(<geom name="{}" type="hfield" hfield="{}" pos="{}")", g.name,
+                                    g.hfield, Vec(g.pos - body_pos));
   if (g.yaw_deg != 0) s += fmt::format(R"( euler="0 0 {}")", Num(g.yaw_deg));
   s += fmt::format(R"( material="{}")", g.material);
   if (!g.collide) s += R"( contype="0" conaffinity="0")";
@@ -146,6 +166,7 @@ std::string MjcfBuilder::GeomXml(const GeomRecord& g, const Eigen::Vector3d& bod
 std::string MjcfBuilder::Xml(const std::string& model, const std::string& comment) const {
   std::string out = "<!--\n" + comment + "\n-->\n";
   out += fmt::format("<mujoco model=\"{}\">\n  <asset>\n", model);
+  for (const std::string& a : assets_) out += a + "\n";
   for (const std::string& m : materials_) out += m + "\n";
   out += "  </asset>\n  <worldbody>\n";
   // the world body's geoms, then one static body per cell (name order), geoms in call order

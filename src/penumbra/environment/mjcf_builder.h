@@ -62,6 +62,12 @@ class MjcfBuilder {
   std::string AddPlane(const std::string& name, const Eigen::Vector3d& center, double hx, double hy,
                        const std::string& material, bool collide);
 
+  /// a MuJoCo hfield asset `name` (MuJoCo's binary file `file`, `size` "sx sy sz base") and
+  /// its geom at `pos` (model frame), in the world body.
+  std::string AddHeightField(const std::string& name, const std::string& file,
+                             const std::string& size, const Eigen::Vector3d& pos,
+                             const std::string& material, bool collide);
+
   /// number of geoms, and of those that collide.
   int geoms() const { return static_cast<int>(geoms_.size()); }
   int colliding_geoms() const { return colliding_; }
@@ -75,6 +81,7 @@ class MjcfBuilder {
  private:
   struct GeomRecord {
     std::string name, type, size, material;
+    std::string hfield;            ///< the hfield asset of an hfield geom
     Eigen::Vector3d pos{0, 0, 0};  ///< model frame, m
     double yaw_deg = 0;
     double plan_half_extent = 0;  ///< largest plan half extent, m (planes: infinite)
@@ -86,7 +93,7 @@ class MjcfBuilder {
   std::string BodyOf(const GeomRecord& g) const;
   static std::string GeomXml(const GeomRecord& g, const Eigen::Vector3d& body_pos);
 
-  std::vector<std::string> materials_;
+  std::vector<std::string> materials_, assets_;
   std::vector<GeomRecord> geoms_;
   std::set<std::string> material_names_, geom_names_;
   int colliding_ = 0;

@@ -6,7 +6,7 @@
 namespace penumbra {
 
 const std::vector<std::string_view>& EnvironmentTypes() {
-  static const std::vector<std::string_view> kTypes = {"house", "warehouse"};
+  static const std::vector<std::string_view> kTypes = {"house", "warehouse", "outdoor"};
   return kTypes;
 }
 
@@ -15,8 +15,9 @@ void EnvironmentConfig::ValidateOrThrow(const std::string& file, int line,
   bool known = false;
   for (std::string_view t : EnvironmentTypes()) known = known || t == type;
   if (!known)
-    throw ConfigError(file, line, key + ".type",
-                      "'" + type + "' is not an environment type; expected house or warehouse");
+    throw ConfigError(
+        file, line, key + ".type",
+        "'" + type + "' is not an environment type; expected house, warehouse or outdoor");
   if (texture_resolution < 16 || texture_resolution > 4096)
     throw ConfigError(file, line, key + ".texture_resolution",
                       std::to_string(texture_resolution) + "; expected 16 ... 4096");

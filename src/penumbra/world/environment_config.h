@@ -20,7 +20,7 @@ class YamlReader;
 /// colours within the ranges docs/environments.md lists. same type + seed => identical MJCF and
 /// materials.
 struct EnvironmentConfig {
-  /// "house" or "warehouse" (EnvironmentTypes()).
+  /// "house", "warehouse" or "outdoor" (EnvironmentTypes()).
   std::string type;
   uint64_t seed = 0;
   /// texels per side of the generated procedural material maps, 16 ... 4096.
