@@ -84,6 +84,22 @@ void AddProceduralMaterial(MjcfBuilder* b, std::vector<ProceduralMaterialEntry>*
   out->push_back(std::move(e));
 }
 
+void EnvironmentBuilder::Procedural(const std::string& name, const std::string& type, uint64_t seed,
+                                    std::optional<Eigen::Vector3f> color, double size_m,
+                                    const Eigen::Vector3d& preview_rgb) {
+  AddProceduralMaterial(&b_, &out_.materials, name, type, seed, color, size_m, resolution_,
+                        preview_rgb);
+}
+
+GeneratedEnvironment EnvironmentBuilder::Finish(const PlanLayout& layout, const std::string& model,
+                                                const std::string& comment) {
+  out_.walkways = layout.walkways();
+  out_.geoms = b_.geoms();
+  out_.colliding_geoms = b_.colliding_geoms();
+  out_.mjcf = b_.Xml(model, comment);
+  return std::move(out_);
+}
+
 double AddCartonStack(MjcfBuilder* b, PlanRandom* rnd, const std::string& name,
                       const PlanFrame& frame, double w, double d, double z0, int max_layers,
                       double max_height_m, const std::string& material, bool collide) {

@@ -51,6 +51,25 @@ void AddProceduralMaterial(MjcfBuilder* b, std::vector<ProceduralMaterialEntry>*
                            std::optional<Eigen::Vector3f> color, double size_m, int resolution,
                            const Eigen::Vector3d& preview_rgb);
 
+/// what the generators (house, warehouse, outdoor) share: the MJCF being built, the result,
+/// the resolution of the procedural maps.
+class EnvironmentBuilder {
+ protected:
+  explicit EnvironmentBuilder(int texture_resolution) : resolution_(texture_resolution) {}
+
+  /// AddProceduralMaterial at this builder's resolution.
+  void Procedural(const std::string& name, const std::string& type, uint64_t seed,
+                  std::optional<Eigen::Vector3f> color, double size_m,
+                  const Eigen::Vector3d& preview_rgb);
+  /// the result: the walkways of `layout`, the geom counts, the MJCF of model `model`.
+  GeneratedEnvironment Finish(const PlanLayout& layout, const std::string& model,
+                              const std::string& comment);
+
+  MjcfBuilder b_;
+  GeneratedEnvironment out_;
+  int resolution_;
+};
+
 /// a stack of 1 ... `max_layers` cartons on the local rectangle [-w/2, w/2] x [0, d] of
 /// `frame` starting at height z0 (m): each layer a random count of cartons with random sizes
 /// that fit the rectangle, slightly turned. returns the stack's top height. `collide` for the

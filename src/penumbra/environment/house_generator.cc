@@ -46,11 +46,11 @@ const T& Pick(PlanRandom* r, const std::vector<T>& v) {
 }
 
 // the house while it is built: the MJCF, the plan, the random streams and what comes out.
-class House {
+class House : public EnvironmentBuilder {
  public:
   House(uint64_t seed, int resolution)
-      : seed_(seed),
-        resolution_(resolution),
+      : EnvironmentBuilder(resolution),
+        seed_(seed),
         layout_(MakeWalkways()),
         furniture_rnd_(seed, kFurniture),
         centre_rnd_(seed, kCentre),
@@ -61,11 +61,7 @@ class House {
     Shell();
     Lamps();
     Furnish();
-    out_.walkways = layout_.walkways();
-    out_.geoms = b_.geoms();
-    out_.colliding_geoms = b_.colliding_geoms();
-    out_.mjcf = b_.Xml("house", Comment());
-    return std::move(out_);
+    return Finish(layout_, "house", Comment());
   }
 
  private:
@@ -96,13 +92,6 @@ class House {
     for (const Eigen::Vector2d& p : layout_.walkways().front().points)
       s += fmt::format("({:.1f}, {:.1f}) ", p.x(), p.y());
     return s;
-  }
-
-  void Procedural(const std::string& name, const std::string& type, uint64_t seed,
-                  std::optional<Eigen::Vector3f> color, double size_m,
-                  const Eigen::Vector3d& preview_rgb) {
-    AddProceduralMaterial(&b_, &out_.materials, name, type, seed, color, size_m, resolution_,
-                          preview_rgb);
   }
 
   void Materials() {
@@ -654,11 +643,8 @@ class House {
   }
 
   uint64_t seed_;
-  int resolution_;
-  MjcfBuilder b_;
   PlanLayout layout_;
   PlanRandom furniture_rnd_, centre_rnd_, clutter_rnd_;
-  GeneratedEnvironment out_;
 };
 
 }  // namespace

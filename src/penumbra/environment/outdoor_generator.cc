@@ -36,11 +36,11 @@ double ValueNoise(uint64_t seed, int octave, double x, double y) {
   return (a + u * (b - a)) + v * ((c + u * (d - c)) - (a + u * (b - a)));
 }
 
-class Outdoor {
+class Outdoor : public EnvironmentBuilder {
  public:
   Outdoor(uint64_t seed, int resolution)
-      : seed_(seed),
-        resolution_(resolution),
+      : EnvironmentBuilder(resolution),
+        seed_(seed),
         layout_(MakeWalkways()),
         terrain_seed_(HashKeys(seed, kTerrain)),
         trees_rnd_(seed, kTrees),
@@ -54,12 +54,8 @@ class Outdoor {
     Trees();
     Rocks();
     Bushes();
-    out_.walkways = layout_.walkways();
-    out_.geoms = b_.geoms();
-    out_.colliding_geoms = b_.colliding_geoms();
     out_.rooms.push_back({"terrain", {-kHalf, -kHalf, kHalf, kHalf}});
-    out_.mjcf = b_.Xml("outdoor", Comment());
-    return std::move(out_);
+    return Finish(layout_, "outdoor", Comment());
   }
 
  private:
@@ -85,16 +81,15 @@ class Outdoor {
 
   void Materials() {
     PlanRandom r(seed_, kMaterials);
-    AddProceduralMaterial(&b_, &out_.materials, "ground", "concrete", r.Bits(),
-                          Eigen::Vector3f(0.3f, 0.38f, 0.17f), 3.0, resolution_, {0.45, 0.5, 0.3});
-    AddProceduralMaterial(&b_, &out_.materials, "bark", "wood", r.Bits(),
-                          Eigen::Vector3f(0.45f, 0.36f, 0.3f), 1.0, resolution_, {0.3, 0.22, 0.16});
-    AddProceduralMaterial(&b_, &out_.materials, "rock", "concrete", r.Bits(),
-                          Eigen::Vector3f(0.9f, 0.9f, 0.92f), 1.0, resolution_, {0.5, 0.5, 0.5});
-    AddProceduralMaterial(&b_, &out_.materials, "shelter_wood", "wood", r.Bits(), std::nullopt, 1.2,
-                          resolution_, {0.55, 0.4, 0.28});
-    AddProceduralMaterial(&b_, &out_.materials, "roof_metal", "painted_metal", r.Bits(),
-                          Eigen::Vector3f(0.45f, 0.12f, 0.1f), 1.0, resolution_, {0.45, 0.12, 0.1});
+    Procedural("ground", "concrete", r.Bits(), Eigen::Vector3f(0.3f, 0.38f, 0.17f), 3.0,
+               {0.45, 0.5, 0.3});
+    Procedural("bark", "wood", r.Bits(), Eigen::Vector3f(0.45f, 0.36f, 0.3f), 1.0,
+               {0.3, 0.22, 0.16});
+    Procedural("rock", "concrete", r.Bits(), Eigen::Vector3f(0.9f, 0.9f, 0.92f), 1.0,
+               {0.5, 0.5, 0.5});
+    Procedural("shelter_wood", "wood", r.Bits(), std::nullopt, 1.2, {0.55, 0.4, 0.28});
+    Procedural("roof_metal", "painted_metal", r.Bits(), Eigen::Vector3f(0.45f, 0.12f, 0.1f), 1.0,
+               {0.45, 0.12, 0.1});
     b_.AddMaterial("foliage_dark", {0.12, 0.3, 0.1}, 0.3, 0.2);
     b_.AddMaterial("foliage_light", {0.3, 0.45, 0.14}, 0.3, 0.2);
     b_.AddMaterial("bush", {0.2, 0.36, 0.12}, 0.3, 0.2);
@@ -246,14 +241,11 @@ class Outdoor {
   }
 
   uint64_t seed_;
-  int resolution_;
-  MjcfBuilder b_;
   PlanLayout layout_;
   uint64_t terrain_seed_;
   PlanRandom trees_rnd_, rocks_rnd_, bushes_rnd_;
   double shift_ = 0;
   SampledHeightField field_;
-  GeneratedEnvironment out_;
 };
 
 }  // namespace

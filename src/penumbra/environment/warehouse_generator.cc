@@ -34,11 +34,11 @@ struct RackRow {
   int dir;
 };
 
-class Warehouse {
+class Warehouse : public EnvironmentBuilder {
  public:
   Warehouse(uint64_t seed, int resolution)
-      : seed_(seed),
-        resolution_(resolution),
+      : EnvironmentBuilder(resolution),
+        seed_(seed),
         layout_(MakeWalkways()),
         racks_rnd_(seed, kRacks),
         staging_rnd_(seed, kStaging),
@@ -52,11 +52,7 @@ class Warehouse {
     Staging();
     EastShelving();
     Markings();
-    out_.walkways = layout_.walkways();
-    out_.geoms = b_.geoms();
-    out_.colliding_geoms = b_.colliding_geoms();
-    out_.mjcf = b_.Xml("warehouse", Comment());
-    return std::move(out_);
+    return Finish(layout_, "warehouse", Comment());
   }
 
  private:
@@ -79,13 +75,6 @@ class Warehouse {
         "  doors in the south wall (x = -10, -4, 2, 8); open floor x > 8.6 (forklift lane).\n"
         "  walkway 'tour' (kept 0.8 m clear): (-13, 1.4) (7.6, 1.4) (7.6, -4.8) (-12, -4.8)",
         seed_);
-  }
-
-  void Procedural(const std::string& name, const std::string& type, uint64_t seed,
-                  std::optional<Eigen::Vector3f> color, double size_m,
-                  const Eigen::Vector3d& preview_rgb) {
-    AddProceduralMaterial(&b_, &out_.materials, name, type, seed, color, size_m, resolution_,
-                          preview_rgb);
   }
 
   void Materials() {
@@ -292,11 +281,8 @@ class Warehouse {
   }
 
   uint64_t seed_;
-  int resolution_;
-  MjcfBuilder b_;
   PlanLayout layout_;
   PlanRandom racks_rnd_, staging_rnd_, loads_rnd_;
-  GeneratedEnvironment out_;
 };
 
 }  // namespace
