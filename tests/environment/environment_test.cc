@@ -219,6 +219,7 @@ TEST(EnvironmentWorldFile, EnvironmentEntriesAreChecked) {
   EXPECT_THROW(load("  - {name: h, environment: {type: house, texture_resolution: 8}}\n"),
                ConfigError);
   EXPECT_THROW(load("  - {name: h}\n"), ConfigError);
+  EXPECT_THROW(load("  - {name: h, environment: {type: house}, units: cm}\n"), ConfigError);
 }
 
 // the bundled worlds: the robot's waypoints are the walkway's points, and the quadruped walks

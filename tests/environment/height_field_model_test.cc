@@ -1,9 +1,9 @@
 // height fields from ray casts (render/height_field_sampling.h) written as MuJoCo hfield models
-// (environment/height_field_model.h): a terrain mesh z = f(x, y) sampled from above matches f
+// (assets/height_field_model.h): a terrain mesh z = f(x, y) sampled from above matches f
 // at the samples and, between them, within one cell's slope error; MuJoCo places the written
 // hfield where the samples say (a ball dropped on it rests at f + r); a quadruped trots across.
 
-#include "penumbra/environment/height_field_model.h"
+#include "penumbra/assets/height_field_model.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/height_field_sampling.h"
 #include "penumbra/render/renderer_factory.h"
@@ -160,6 +161,58 @@ TEST(HeightField, MujocoPlacesTheWrittenFieldAndAQuadrupedTrotsAcrossIt) {
   EXPECT_GT(end.x(), 1.8) << end.transpose();
   EXPECT_NEAR(end.y(), 0.3, 0.3);
   EXPECT_GT(min_clearance, 0.15);  // the trunk never came down to the ground: no fall
+}
+
+// the world-file option: a mesh model with `collision: heightfield` collides as the height
+// field sampled from it (the mesh itself visual only)
+TEST(HeightField, AMeshModelWithCollisionHeightfieldCollidesAsItsSampledField) {
+  testing::TempDir dir;
+  dir.Write("terrain.obj", TerrainObj(3.0, 0.05));
+  const std::string world = dir.Write(
+      "w.yaml",
+      "models:\n  - {name: ground, file: terrain.obj, up_axis: z, collision: heightfield, "
+      "heightfield_cell_m: 0.1}\n");
+  SessionOptions so;
+  so.build_renderer = false;
+  so.add_controllers = false;
+  Session session(LoadWorldFile(world), so);
+  const SceneDescription& scene = session.scene();
+  ASSERT_EQ(scene.hfields.size(), 1u);
+  const HeightField& h = scene.hfields[0];
+  EXPECT_EQ(h.cols, 61);  // [-3, 3] every 0.1 m
+  EXPECT_EQ(h.rows, 61);
+  const Geom* hg = nullptr;
+  for (const Geom& g : scene.geoms)
+    if (g.name == "ground/collision_heightfield") hg = &g;
+  ASSERT_NE(hg, nullptr);
+  EXPECT_EQ(hg->group, 3);  // not drawn
+  // the field's samples are f's heights where the world puts them
+  double worst = 0;
+  for (int r = 0; r < h.rows; r += 5)
+    for (int c = 0; c < h.cols; c += 5) {
+      const Eigen::Vector3d p_G(-h.size_x + 2 * h.size_x * c / (h.cols - 1),
+                                -h.size_y + 2 * h.size_y * r / (h.rows - 1),
+                                h.elevation[r * h.cols + c] * h.size_z);
+      const Eigen::Vector3d p_W = hg->X_BG * p_G;
+      worst = std::max(worst, std::abs(p_W.z() - F(p_W.x(), p_W.y())));
+    }
+  EXPECT_LT(worst, 1e-3);
+  // the mesh does not collide any more; the field does (MuJoCo's defaults)
+  const std::string& xml = session.composed_xml();
+  EXPECT_NE(xml.find("type=\"mesh\""), std::string::npos);
+  EXPECT_EQ(xml.find("type=\"mesh\" mesh=\"ground/"), xml.find("type=\"mesh\""));
+  EXPECT_NE(xml.find("contype=\"0\" conaffinity=\"0\""), std::string::npos);
+
+  // heightfield_cell_m needs collision: heightfield
+  const std::string bad = dir.Write(
+      "bad.yaml", "models:\n  - {name: ground, file: terrain.obj, heightfield_cell_m: 0.1}\n");
+  try {
+    LoadWorldFile(bad);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("models[0].heightfield_cell_m"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
-#include "penumbra/environment/height_field_model.h"
+#include "penumbra/assets/height_field_model.h"
 #include "penumbra/render/height_field_sampling.h"
 #include "penumbra/render/renderer_factory.h"
 #include "penumbra/render/static_geometry.h"

@@ -1,7 +1,7 @@
 #pragma once
 // `penumbra heightfield WORLD`: a world's static geometry (or one model's) sampled from above
 // with the renderer's ray queries (Embree) into a MuJoCo hfield model (render/
-// height_field_sampling.h, environment/height_field_model.h, docs/environments.md "Height
+// height_field_sampling.h, assets/height_field_model.h, docs/environments.md "Height
 // fields"): writes OUT/<name>.hfield and OUT/<name>.xml and prints the grid and its error
 // against the geometry at the cell centres.
 

@@ -8,9 +8,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <memory>
 
+#include "penumbra/assets/height_field_model.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {
@@ -108,7 +112,8 @@ std::string MshBytes(const TriangleMesh& mesh) {
   return out;
 }
 
-std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files) {
+std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files,
+                          const MeshModelCollision& collision) {
   std::string x = fmt::format("<mujoco model=\"{}\">\n  <asset>\n",
                               XmlEscape(fs::path(asset.file).stem().string()));
   for (size_t i = 0; i < asset.meshes.size(); ++i)
@@ -120,13 +125,55 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
                      XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
                      LinearToSrgb(c.z()));
   }
+  if (collision.hfield)
+    x += fmt::format("    <hfield name=\"collision_heightfield\" file=\"{}\" size=\"{}\"/>\n",
+                     XmlEscape(collision.hfield_file), HfieldSizeAttribute(*collision.hfield, 0.1));
   // geoms of the world body: MuJoCo computes no inertia for them, so open and flat meshes load
   x += "  </asset>\n  <worldbody>\n";
   for (const ImportedMesh& m : asset.meshes)
-    x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"/>\n",
-                     XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name));
+    x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"{2}/>\n",
+                     XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name),
+                     collision.mesh_geoms_collide ? "" : " contype=\"0\" conaffinity=\"0\"");
+  if (collision.hfield) {
+    const Eigen::Vector3d p = HfieldGeomPosition(*collision.hfield);
+    x += fmt::format(
+        "    <geom name=\"collision_heightfield\" type=\"hfield\" hfield=\"collision_heightfield\" "
+        "pos=\"{:.6f} {:.6f} {:.6f}\" group=\"3\"/>\n",
+        p.x(), p.y(), p.z());
+  }
   x += "  </worldbody>\n</mujoco>\n";
   return x;
+}
+
+SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell_m) {
+  // the asset's meshes as the static geoms of a scene of one body, traced with Embree
+  SceneDescription scene;
+  scene.bodies.push_back(Body{"world", -1, true});
+  scene.materials.push_back(Material{});
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (size_t i = 0; i < asset.meshes.size(); ++i) {
+    scene.meshes.push_back(asset.meshes[i].mesh);
+    Geom g;
+    g.name = asset.meshes[i].mesh.name;
+    g.id = static_cast<int>(i);
+    g.body = 0;
+    g.shape = GeomShape::kMesh;
+    g.mesh = static_cast<int>(i);
+    g.material = 0;
+    scene.geoms.push_back(g);
+    for (const Eigen::Vector3f& v : asset.meshes[i].mesh.vertices) {
+      lo = lo.cwiseMin(v.cast<double>());
+      hi = hi.cwiseMax(v.cast<double>());
+    }
+  }
+  if (!(lo.x() <= hi.x()))
+    throw Error("no triangles to sample a height field from in " + asset.file);
+  const std::unique_ptr<RayQuery> query = MakeRayQuery(scene, RenderSettings::Backend::kEmbree);
+  WorldSnapshot snapshot;
+  snapshot.X_WB = {Pose::Identity()};
+  query->Update(snapshot);
+  return SampleHeightField(*query, lo.head<2>(), hi.head<2>(), cell_m, hi.z() + 1, lo.z());
 }
 
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
@@ -162,10 +209,18 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
     std::vector<std::string> msh_files;
     for (const ImportedMesh& mesh : im.asset.meshes) {
       const std::string bytes = MshBytes(mesh.mesh);
-      msh_files.push_back(
-          WriteContentNamedFile(folder, stem, ".msh", bytes));
+      msh_files.push_back(WriteContentNamedFile(folder, stem, ".msh", bytes));
     }
-    const std::string xml = MeshModelMjcf(im.asset, msh_files);
+    // collision: the meshes' convex hulls, a height field sampled from the meshes, or nothing
+    MeshModelCollision collision;
+    collision.mesh_geoms_collide = config.collision == "hull";
+    if (config.collision == "heightfield") {
+      SampledHeightField field = SampleMeshHeightField(im.asset, config.heightfield_cell_m);
+      collision.hfield_file =
+          WriteContentNamedFile(folder, stem + "-collision", ".hfield", HfieldFileBytes(field));
+      collision.hfield = std::move(field);
+    }
+    const std::string xml = MeshModelMjcf(im.asset, msh_files, collision);
     m.file = WriteContentNamedFile(folder, stem, ".xml", xml);
     out.push_back(std::move(im));
   }

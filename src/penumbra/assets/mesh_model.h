@@ -13,10 +13,12 @@
 // ApplyImportedMaterials then gives the scene's "<model>/<material name>" materials the
 // imported factors and texture images.
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "penumbra/assets/mesh_import.h"
+#include "penumbra/render/height_field_sampling.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/world/world_config.h"
 
@@ -36,9 +38,27 @@ struct ImportedModel {
 /// 1e-4 of its extent behind the plane, so that qhull can build MuJoCo's convex hull.
 std::string MshBytes(const TriangleMesh& mesh);
 
+/// how a generated mesh model collides (MeshImportConfig::collision).
+struct MeshModelCollision {
+  /// false: the mesh geoms get contype = conaffinity = 0 (visual only).
+  bool mesh_geoms_collide = true;
+  /// with `hfield`: its MuJoCo binary file (absolute path).
+  std::string hfield_file;
+  /// a height field that collides instead (model frame): the asset "collision_heightfield"
+  /// and its geom "collision_heightfield" in group 3 (not drawn; render/ray_query.h traces
+  /// groups <= 2).
+  std::optional<SampledHeightField> hfield;
+};
+
 /// the MJCF text of `asset` (file comment) whose <mesh file>s are `msh_files` (absolute paths,
-/// one per asset.meshes entry).
-std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files);
+/// one per asset.meshes entry), colliding as `collision` says.
+std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::string>& msh_files,
+                          const MeshModelCollision& collision = {});
+
+/// the height field of `asset`'s triangles (model frame) sampled from above every `cell_m`
+/// over their plan bounds with an Embree RayQuery (render/height_field_sampling.h).
+/// @throws Error if the asset has no triangles or the grid is too large.
+SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell_m);
 
 /// imports every model of `models` whose file is a mesh (IsMeshModelFile), with the mesh keys
 /// of its world-file entry (MeshImportConfigOf(world_file, key)), and points its `file` at the

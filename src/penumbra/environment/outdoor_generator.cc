@@ -7,7 +7,7 @@
 
 #include "penumbra/core/rng.h"
 #include "penumbra/environment/building_parts.h"
-#include "penumbra/environment/height_field_model.h"
+#include "penumbra/assets/height_field_model.h"
 #include "penumbra/environment/mjcf_builder.h"
 #include "penumbra/environment/plan_layout.h"
 

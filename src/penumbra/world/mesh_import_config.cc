@@ -41,8 +41,9 @@ bool IsMeshModelFile(const std::string& path) {
 }
 
 const std::vector<std::string_view>& MeshImportKeys() {
-  static const std::vector<std::string_view> keys = {"units", "scale", "up_axis", "handedness",
-                                                     "emissive_cd_m2"};
+  static const std::vector<std::string_view> keys = {
+      "units",          "scale",     "up_axis",           "handedness",
+      "emissive_cd_m2", "collision", "heightfield_cell_m"};
   return keys;
 }
 
@@ -76,6 +77,15 @@ void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out
     out->emissive_cd_m2 = r.Child("emissive_cd_m2").Double();
     if (!(out->emissive_cd_m2 >= 0 && out->emissive_cd_m2 <= 1e9))
       r.Child("emissive_cd_m2").Fail("expected a luminance in [0, 1e9] cd/m^2");
+  }
+  if (r.Has("collision"))
+    out->collision = r.Child("collision").Enum({"hull", "heightfield", "none"});
+  if (r.Has("heightfield_cell_m")) {
+    if (out->collision != "heightfield")
+      r.Child("heightfield_cell_m").Fail("applies to collision: heightfield only");
+    out->heightfield_cell_m = r.Child("heightfield_cell_m").Double();
+    if (!(out->heightfield_cell_m >= 0.005 && out->heightfield_cell_m <= 10))
+      r.Child("heightfield_cell_m").Fail("expected a sample spacing in [0.005, 10] m");
   }
 }
 

@@ -26,6 +26,13 @@ struct MeshImportConfig {
   /// luminance, cd/m^2, of an emissive factor of 1 (glTF emissiveFactor / MTL Ke)
   /// (`emissive_cd_m2:`).
   double emissive_cd_m2 = 100;
+  /// `collision:` how the mesh collides: "hull" (MuJoCo's convex hull of each mesh of the
+  /// file), "heightfield" (a height field of the mesh sampled from above every
+  /// heightfield_cell_m: render/height_field_sampling.h; the mesh itself visual only), "none"
+  /// (visual only).
+  std::string collision = "hull";
+  /// `heightfield_cell_m:` sample spacing of `collision: heightfield`, m, in [0.005, 10].
+  double heightfield_cell_m = 0.1;
   /// 1-based world-file line of the entry (0 = unknown), for errors found at import.
   int line = 0;
 
@@ -38,7 +45,7 @@ struct MeshImportConfig {
 bool IsMeshModelFile(const std::string& path);
 
 /// the mesh keys a `models:` entry may have besides name/file/pose/...: units, scale, up_axis,
-/// handedness, emissive_cd_m2.
+/// handedness, emissive_cd_m2, collision, heightfield_cell_m.
 const std::vector<std::string_view>& MeshImportKeys();
 
 /// the mesh keys of the model entry at key path `key` ("models[0]", "robots[1]": ModelConfig::key)

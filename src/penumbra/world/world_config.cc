@@ -216,10 +216,11 @@ class WorldParser {
     m.name = r.Child("name").String();
     if (r.Has("environment")) {
       // a generated building: no file, no mesh keys, no sites (nothing to name yet)
-      if (r.Has("file"))
-        r.Child("file").Fail("expected either file or environment, not both");
+      if (r.Has("file")) r.Child("file").Fail("expected either file or environment, not both");
       for (std::string_view k : {"sites", "initial_keyframe", "floating_base"})
         if (r.Has(k)) r.Child(k).Fail("not allowed with environment: (a generated building)");
+      for (std::string_view k : MeshImportKeys())
+        if (r.Has(k)) r.Child(k).Fail("applies to mesh files only, not to environment:");
       m.environment = ReadEnvironmentConfig(r.Child("environment"));
       if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
       return m;

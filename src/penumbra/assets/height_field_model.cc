@@ -1,4 +1,4 @@
-#include "penumbra/environment/height_field_model.h"
+#include "penumbra/assets/height_field_model.h"
 
 #include <fmt/format.h>
 
