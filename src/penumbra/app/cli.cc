@@ -20,6 +20,7 @@
 #include "penumbra/app/bench_record.h"
 #include "penumbra/app/bridge_flags.h"
 #include "penumbra/app/bench_ros.h"
+#include "penumbra/app/decompose_command.h"
 #include "penumbra/app/viewer_commands.h"
 #include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/contact_sheet.h"
@@ -326,6 +327,8 @@ int RunCli(int argc, char** argv) {
   const std::unique_ptr<BenchRecordCommand> bench_record = AddBenchRecordCommand(*bench);
   const std::unique_ptr<BenchBridgeCommand> bench_bridge = AddBenchBridgeCommand(*bench);
   const std::unique_ptr<BenchRosCommand> bench_ros = AddBenchRosCommand(*bench);
+  // penumbra decompose / penumbra bench decompose (app/decompose_command.h, docs/collision.md)
+  const std::unique_ptr<DecomposeCommands> decompose = AddDecomposeCommands(app, *bench);
   // penumbra bench viewer / penumbra view (app/viewer_commands.h, docs/viewer.md)
   CLI::App* bench_viewer = bench->add_subcommand(
       "viewer", "live viewer: frames/s delivered, input-to-photon latency, steps/s with a viewer");
@@ -458,6 +461,8 @@ int RunCli(int argc, char** argv) {
     if (*bench_record->app) return bench_record->Run();
     if (*bench_bridge->app) return bench_bridge->Run();
     if (*bench_ros->app) return bench_ros->Run();
+    if (*decompose->bench) return decompose->RunBench();
+    if (*decompose->decompose) return decompose->RunDecompose();
     if (*bench_viewer) return BenchViewer(viewer_bench);
     if (*view) {
       const WorldConfig world = LoadWorldOrModel(view_world);

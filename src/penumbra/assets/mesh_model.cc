@@ -1,6 +1,7 @@
 #include "penumbra/assets/mesh_model.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -9,11 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 
 #include "penumbra/assets/height_field_model.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/decompose/decomposition_cache.h"
 #include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
@@ -125,6 +128,13 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
                      XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
                      LinearToSrgb(c.z()));
   }
+  for (size_t k = 0; k < collision.convex_parts.size(); ++k) {
+    std::string vertex;
+    for (const Eigen::Vector3d& v : collision.convex_parts[k])
+      vertex +=
+          fmt::format("{}{:.9g} {:.9g} {:.9g}", vertex.empty() ? "" : " ", v.x(), v.y(), v.z());
+    x += fmt::format("    <mesh name=\"collision_part_{}\" vertex=\"{}\"/>\n", k, vertex);
+  }
   if (collision.hfield)
     x += fmt::format("    <hfield name=\"collision_heightfield\" file=\"{}\" size=\"{}\"/>\n",
                      XmlEscape(collision.hfield_file), HfieldSizeAttribute(*collision.hfield, 0.1));
@@ -134,6 +144,11 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
     x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"{2}/>\n",
                      XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name),
                      collision.mesh_geoms_collide ? "" : " contype=\"0\" conaffinity=\"0\"");
+  for (size_t k = 0; k < collision.convex_parts.size(); ++k)
+    x += fmt::format(
+        "    <geom name=\"collision_part_{0}\" type=\"mesh\" mesh=\"collision_part_{0}\" "
+        "group=\"3\"/>\n",
+        k);
   if (collision.hfield) {
     const Eigen::Vector3d p = HfieldGeomPosition(*collision.hfield);
     x += fmt::format(
@@ -174,6 +189,26 @@ SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell
   snapshot.X_WB = {Pose::Identity()};
   query->Update(snapshot);
   return SampleHeightField(*query, lo.head<2>(), hi.head<2>(), cell_m, hi.z() + 1, lo.z());
+}
+
+SolidMesh WeldedSolid(const ImportedAsset& asset) {
+  SolidMesh out;
+  std::map<std::array<float, 3>, int> index;
+  for (const ImportedMesh& m : asset.meshes) {
+    std::vector<int> remap(m.mesh.vertices.size());
+    for (size_t i = 0; i < remap.size(); ++i) {
+      const Eigen::Vector3f& v = m.mesh.vertices[i];
+      const auto [it, added] =
+          index.emplace(std::array<float, 3>{v.x(), v.y(), v.z()}, int(out.vertices.size()));
+      if (added) out.vertices.push_back(v.cast<double>());
+      remap[i] = it->second;
+    }
+    for (const Eigen::Vector3i& f : m.mesh.faces) {
+      const std::array<int, 3> t = {remap.at(f[0]), remap.at(f[1]), remap.at(f[2])};
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) out.triangles.push_back(t);
+    }
+  }
+  return out;
 }
 
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
@@ -219,6 +254,42 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
       collision.hfield_file =
           WriteContentNamedFile(folder, stem + "-collision", ".hfield", HfieldFileBytes(field));
       collision.hfield = std::move(field);
+    }
+    if (config.collision == "coacd") {
+      DecompositionOptions options;
+      options.concavity_threshold = config.concavity_threshold;
+      options.max_parts = config.max_parts;
+      const SolidMesh solid = WeldedSolid(im.asset);
+      const auto t1 = std::chrono::steady_clock::now();
+      CachedDecomposition d;
+      try {
+        d = DecomposeCached(solid, options, DecompositionCache(DefaultDecompositionCacheDir()),
+                            m.file);
+      } catch (const ConfigError&) {
+        throw;
+      } catch (const Error& e) {
+        throw ConfigError(world_file, config.line,
+                          (m.key.empty() ? "models[" + m.name + "]" : m.key) + ".collision",
+                          std::string("collision: coacd needs a closed, consistently oriented "
+                                      "solid once coincident vertices are merged (else use hull, "
+                                      "heightfield or none): ") +
+                              e.what());
+      }
+      im.decompose_sec =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+      im.decomposition_cache_hit = d.cache_hit;
+      im.collision_parts = static_cast<int>(d.decomposition.parts.size());
+      im.relative_max_concavity = d.decomposition.relative_max_concavity();
+      im.hull_volume_ratio = d.decomposition.mesh_volume > 0
+                                 ? d.decomposition.HullVolumeSum() / d.decomposition.mesh_volume
+                                 : 0;
+      if (d.decomposition.hit_part_limit)
+        spdlog::warn(
+            "{}: max_parts {} forced merges over the concavity threshold {} (largest "
+            "concavity {:.4f} of the extent)",
+            m.file, config.max_parts, config.concavity_threshold, im.relative_max_concavity);
+      for (const ConvexPart& part : d.decomposition.parts)
+        collision.convex_parts.push_back(part.hull.vertices);
     }
     const std::string xml = MeshModelMjcf(im.asset, msh_files, collision);
     m.file = WriteContentNamedFile(folder, stem, ".xml", xml);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "penumbra/assets/mesh_import.h"
+#include "penumbra/decompose/solid_mesh.h"
 #include "penumbra/render/height_field_sampling.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/world/world_config.h"
@@ -29,6 +30,14 @@ struct ImportedModel {
   std::string model;  ///< ModelConfig::name
   ImportedAsset asset;
   double import_sec = 0;  ///< wall time of ImportMeshFile (docs: import time per asset)
+  /// `collision: coacd` only: convex parts, whether they came from the decomposition cache,
+  /// the wall time of the decomposition (or of the cache read), its largest concavity as a
+  /// fraction of the mesh's extent, and the sum of the parts' hull volumes over the mesh volume.
+  int collision_parts = 0;
+  bool decomposition_cache_hit = false;
+  double decompose_sec = 0;
+  double relative_max_concavity = 0;
+  double hull_volume_ratio = 0;
 };
 
 /// MuJoCo 2.2.2's binary .msh bytes of `mesh` (4 int32 counts nvertex, nnormal, ntexcoord,
@@ -48,7 +57,15 @@ struct MeshModelCollision {
   /// and its geom "collision_heightfield" in group 3 (not drawn; render/ray_query.h traces
   /// groups <= 2).
   std::optional<SampledHeightField> hfield;
+  /// convex parts that collide instead (model frame, m; `collision: coacd`): part k becomes the
+  /// asset "collision_part_<k>" (its vertices; MuJoCo takes their convex hull) and its geom
+  /// "collision_part_<k>" in group 3 (not drawn).
+  std::vector<std::vector<Eigen::Vector3d>> convex_parts;
 };
+
+/// the meshes of `asset` welded into one solid for convex decomposition: vertices at bit-equal
+/// positions merged (ordered by first use), degenerate triangles dropped.
+SolidMesh WeldedSolid(const ImportedAsset& asset);
 
 /// the MJCF text of `asset` (file comment) whose <mesh file>s are `msh_files` (absolute paths,
 /// one per asset.meshes entry), colliding as `collision` says.
@@ -64,10 +81,13 @@ SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell
 /// of its world-file entry (MeshImportConfigOf(world_file, key)), and points its `file` at the
 /// generated MJCF in `dir` (created if missing; "" = the folder "penumbra-mesh-models" in the
 /// system's temporary folder). files are named by a hash of their content, so a second
-/// import writes nothing new. other models are left alone.
+/// import writes nothing new. `collision: coacd` decomposes through the on-disk cache at
+/// DefaultDecompositionCacheDir() (decompose/decomposition_cache.h), so a second load reads
+/// the parts instead of computing them. other models are left alone.
 /// @throws ConfigError naming the world file `world_file`, the entry's line and key when the
-///         mesh cannot be imported (the message names the mesh file), or Error when a file
-///         cannot be written.
+///         mesh cannot be imported (the message names the mesh file) or, with `collision:
+///         coacd`, is not a closed, consistently oriented solid once welded (the message names
+///         the first bad edge), or Error when a file cannot be written.
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
                                             const std::string& dir, const std::string& world_file);
 

@@ -58,17 +58,18 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   // composed model ("environments"), their lamps world lights, their materials procedural ones
   std::vector<ModelConfig> models = world_.models;
   const GeneratedModels generated = GenerateEnvironmentModels(
-      &models, options.composed_xml_path.empty()
-                   ? std::string()
-                   : (std::filesystem::path(options.composed_xml_path).parent_path() /
-                      "environments")
-                         .string());
+      &models,
+      options.composed_xml_path.empty()
+          ? std::string()
+          : (std::filesystem::path(options.composed_xml_path).parent_path() / "environments")
+                .string());
   for (const GeneratedModel& g : generated.models)
-    spdlog::info("generated {} ({}): {} geoms ({} colliding), {} furniture items, {} materials, "
-                 "{} lamps in {:.3f} s",
-                 g.model, g.file, g.environment.geoms, g.environment.colliding_geoms,
-                 g.environment.furniture, g.environment.materials.size(),
-                 g.environment.lights.size(), g.generate_sec);
+    spdlog::info(
+        "generated {} ({}): {} geoms ({} colliding), {} furniture items, {} materials, "
+        "{} lamps in {:.3f} s",
+        g.model, g.file, g.environment.geoms, g.environment.colliding_geoms,
+        g.environment.furniture, g.environment.materials.size(), g.environment.lights.size(),
+        g.generate_sec);
   world_.lights.insert(world_.lights.end(), generated.lights.begin(), generated.lights.end());
   for (size_t i = 0; i < models.size(); ++i) world_.models[i].file = models[i].file;
   // mesh files (models: entries with .obj, .gltf, ...) become generated MJCF models there too
@@ -77,6 +78,13 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
     spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s", im.model,
                  im.asset.file, im.asset.meshes.size(), im.asset.triangles,
                  im.asset.materials.size(), im.import_sec);
+  for (const ImportedModel& im : imported)
+    if (im.collision_parts > 0)
+      spdlog::info(
+          "collision of {}: {} convex parts (CoACD, max concavity {:.4f} of the extent, "
+          "hull volumes {:.3f} x the mesh's) {} in {:.3f} s",
+          im.model, im.collision_parts, im.relative_max_concavity, im.hull_volume_ratio,
+          im.decomposition_cache_hit ? "read from the cache" : "computed", im.decompose_sec);
   ComposedScene composed = ComposeWorld(models, compose_options);
   // MJCF <mesh> files MuJoCo 2.2.2 cannot read (glTF, FBX, COLLADA, PLY) become .msh files
   for (const std::string& f : ConvertForeignMjcfMeshes(&composed, mesh_dir))

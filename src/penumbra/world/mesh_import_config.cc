@@ -41,9 +41,15 @@ bool IsMeshModelFile(const std::string& path) {
 }
 
 const std::vector<std::string_view>& MeshImportKeys() {
-  static const std::vector<std::string_view> keys = {
-      "units",          "scale",     "up_axis",           "handedness",
-      "emissive_cd_m2", "collision", "heightfield_cell_m"};
+  static const std::vector<std::string_view> keys = {"units",
+                                                     "scale",
+                                                     "up_axis",
+                                                     "handedness",
+                                                     "emissive_cd_m2",
+                                                     "collision",
+                                                     "heightfield_cell_m",
+                                                     "concavity_threshold",
+                                                     "max_parts"};
   return keys;
 }
 
@@ -79,13 +85,27 @@ void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out
       r.Child("emissive_cd_m2").Fail("expected a luminance in [0, 1e9] cd/m^2");
   }
   if (r.Has("collision"))
-    out->collision = r.Child("collision").Enum({"hull", "heightfield", "none"});
+    out->collision = r.Child("collision").Enum({"hull", "heightfield", "coacd", "none"});
   if (r.Has("heightfield_cell_m")) {
     if (out->collision != "heightfield")
       r.Child("heightfield_cell_m").Fail("applies to collision: heightfield only");
     out->heightfield_cell_m = r.Child("heightfield_cell_m").Double();
     if (!(out->heightfield_cell_m >= 0.005 && out->heightfield_cell_m <= 10))
       r.Child("heightfield_cell_m").Fail("expected a sample spacing in [0.005, 10] m");
+  }
+  if (r.Has("concavity_threshold")) {
+    if (out->collision != "coacd")
+      r.Child("concavity_threshold").Fail("applies to collision: coacd only");
+    out->concavity_threshold = r.Child("concavity_threshold").Double();
+    if (!(out->concavity_threshold >= 0.001 && out->concavity_threshold <= 1))
+      r.Child("concavity_threshold")
+          .Fail("expected a fraction of the mesh's largest extent in [0.001, 1]");
+  }
+  if (r.Has("max_parts")) {
+    if (out->collision != "coacd") r.Child("max_parts").Fail("applies to collision: coacd only");
+    out->max_parts = r.Child("max_parts").Int();
+    if (!(out->max_parts >= 1 && out->max_parts <= 1024))
+      r.Child("max_parts").Fail("expected a number of parts in [1, 1024]");
   }
 }
 

@@ -28,11 +28,19 @@ struct MeshImportConfig {
   double emissive_cd_m2 = 100;
   /// `collision:` how the mesh collides: "hull" (MuJoCo's convex hull of each mesh of the
   /// file), "heightfield" (a height field of the mesh sampled from above every
-  /// heightfield_cell_m: render/height_field_sampling.h; the mesh itself visual only), "none"
-  /// (visual only).
+  /// heightfield_cell_m: render/height_field_sampling.h; the mesh itself visual only), "coacd"
+  /// (the file's meshes welded into one closed solid and split into convex parts by CoACD,
+  /// decompose/coacd.h, cached on disk; the mesh itself visual only), "none" (visual only).
   std::string collision = "hull";
   /// `heightfield_cell_m:` sample spacing of `collision: heightfield`, m, in [0.005, 10].
   double heightfield_cell_m = 0.1;
+  /// `concavity_threshold:` of `collision: coacd`: the largest concavity a part may have, as a
+  /// fraction of the largest extent of the mesh's bounding box, in [0.001, 1]
+  /// (DecompositionOptions::concavity_threshold).
+  double concavity_threshold = 0.025;
+  /// `max_parts:` of `collision: coacd`: most convex parts, in [1, 1024]
+  /// (DecompositionOptions::max_parts).
+  int max_parts = 32;
   /// 1-based world-file line of the entry (0 = unknown), for errors found at import.
   int line = 0;
 
@@ -45,7 +53,7 @@ struct MeshImportConfig {
 bool IsMeshModelFile(const std::string& path);
 
 /// the mesh keys a `models:` entry may have besides name/file/pose/...: units, scale, up_axis,
-/// handedness, emissive_cd_m2, collision, heightfield_cell_m.
+/// handedness, emissive_cd_m2, collision, heightfield_cell_m, concavity_threshold, max_parts.
 const std::vector<std::string_view>& MeshImportKeys();
 
 /// the mesh keys of the model entry at key path `key` ("models[0]", "robots[1]": ModelConfig::key)
