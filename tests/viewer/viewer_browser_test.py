@@ -280,6 +280,11 @@ def main():
         a0, a1, ahead = hold("w", 1.5)
         check(ahead > 0.2, f"'w' moves the quadruped forward: {ahead:.3f} m along its heading "
               f"(x, y {a0[0]:.3f}, {a0[1]:.3f} -> {a1[0]:.3f}, {a1[1]:.3f} m)")
+        # let the trot come to rest first (key-up sent a zero twist): measured from a moving
+        # robot, 's' would first have to cancel the forward momentum, and on a loaded machine
+        # (CI's 2 cores running two tests) it once ended 0.09 m ahead after 1.5 s
+        t_rest = trunk()[7]
+        wait_for("1 s of sim time with no key held", lambda: trunk()[7] >= t_rest + 1.0, timeout=40)
         b0, b1, back = hold("s", 1.5)
         check(back < -0.05, f"'s' moves it back: {back:.3f} m along its heading")
         latency = js("return window.penumbraViewer.lastTwistSentMs;")

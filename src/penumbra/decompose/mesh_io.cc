@@ -1,11 +1,11 @@
 #include "penumbra/decompose/mesh_io.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
-#include <CGAL/Surface_mesh.h>
-#include <CGAL/boost/graph/IO/polygon_mesh_io.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 #include <fmt/format.h>
 
+#include <array>
+#include <assimp/Importer.hpp>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -13,40 +13,41 @@
 #include "penumbra/core/error.h"
 
 namespace penumbra {
-namespace {
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Mesh = CGAL::Surface_mesh<K::Point_3>;
-}  // namespace
 
 SolidMesh ReadMeshFile(const std::string& path, double scale) {
   if (!std::filesystem::is_regular_file(path))
     throw Error(path + ": no such file; expected a mesh (.off, .obj, .stl, .ply)");
-  Mesh sm;
-  bool ok = false;
-  try {
-    ok = CGAL::IO::read_polygon_mesh(path, sm, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    throw Error(path + ": cannot read the mesh (" + e.what() + ")");
-  }
-  if (!ok || sm.number_of_faces() == 0)
-    throw Error(path +
-                ": cannot read a polygon mesh from it; expected a closed, manifold "
-                "surface in .off, .obj, .stl or .ply");
-  CGAL::Polygon_mesh_processing::triangulate_faces(sm);
+  // assimp (as the world-file importer, assets/mesh_import.h) with the file's own coordinates:
+  // node transforms baked in, polygons triangulated; vertices at bit-equal positions merged
+  // across the file's meshes so that the surface is one solid
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+  if (!scene || !scene->mRootNode)
+    throw Error(path + ": cannot read the mesh (" + importer.GetErrorString() + ")");
   SolidMesh out;
-  std::map<Mesh::Vertex_index, int> index;
-  for (auto v : sm.vertices()) {
-    index[v] = static_cast<int>(out.vertices.size());
-    const auto& p = sm.point(v);
-    out.vertices.emplace_back(p.x() * scale, p.y() * scale, p.z() * scale);
+  std::map<std::array<double, 3>, int> index;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    std::vector<int> remap(mesh->mNumVertices);
+    for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
+      const aiVector3D& v = mesh->mVertices[i];
+      const std::array<double, 3> p = {v.x * scale, v.y * scale, v.z * scale};
+      const auto [it, added] = index.emplace(p, static_cast<int>(out.vertices.size()));
+      if (added) out.vertices.emplace_back(p[0], p[1], p[2]);
+      remap[i] = it->second;
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines
+      out.triangles.push_back(
+          {remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]});
+    }
   }
-  for (auto f : sm.faces()) {
-    std::array<int, 3> tri{};
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
-      if (k < 3) tri[k++] = index[v];
-    out.triangles.push_back(tri);
-  }
+  if (out.triangles.empty())
+    throw Error(path +
+                ": holds no triangles; expected a closed, manifold surface in .off, .obj, .stl "
+                "or .ply");
   return out;
 }
 

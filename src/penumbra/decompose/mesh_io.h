@@ -9,7 +9,7 @@
 
 namespace penumbra {
 
-/// reads OFF, OBJ, STL (ASCII or binary) or PLY with CGAL's polygon mesh reader (coincident
+/// reads OFF, OBJ, STL (ASCII or binary) or PLY with assimp in the file's own axes (coincident
 /// vertices merged, polygons triangulated), times `scale` (m per file unit).
 /// @throws Error "<path>: ..." when the file cannot be read or holds no triangles.
 SolidMesh ReadMeshFile(const std::string& path, double scale = 1.0);
