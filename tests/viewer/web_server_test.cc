@@ -183,12 +183,13 @@ TEST(WebServerTest, RepliesAndSurvivesMalformedMessages) {
   beast::error_code ec;
   c.ws.read(b, ec);
   // the close frame with 1009, or, when the server's close overtook the client's answer to
-  // it, a broken pipe / reset: either way the connection is gone
+  // it, a broken pipe / reset / not connected (the socket already shut down: seen once on CI's
+  // loaded 2 cores): either way the connection is gone
   if (ec == websocket::error::closed)
     EXPECT_EQ(c.ws.reason().code, websocket::close_code::too_big);
   else
     EXPECT_TRUE(ec == net::error::broken_pipe || ec == net::error::connection_reset ||
-                ec == net::error::eof)
+                ec == net::error::eof || ec == net::error::not_connected)
         << ec.message();
   Client d(f.server->port());
   EXPECT_EQ(json::parse(d.Read())["type"], "hello");

@@ -351,10 +351,7 @@ std::vector<ConvexPart> Coacd::Merge(std::vector<PiecePtr> parts, Decomposition*
 }
 
 Decomposition Coacd::Run(const SolidMesh& mesh) {
-  Decomposition out;
-  out.method = DecompositionMethod::kCoacd;
-  out.mesh_volume = MeshVolume(mesh);
-  out.extent = extent_;
+  Decomposition out = StartDecomposition(DecompositionMethod::kCoacd, mesh);
   std::deque<PiecePtr> queue;
   for (SolidMesh& component : ConnectedComponents(mesh))
     queue.push_back(MakePiece(std::move(component), options_.concavity));

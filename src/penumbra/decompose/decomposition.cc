@@ -65,12 +65,17 @@ double Decomposition::HullVolumeSum() const {
   return sum;
 }
 
-Decomposition DecomposeHull(const SolidMesh& mesh, const DecompositionOptions& options) {
+Decomposition StartDecomposition(DecompositionMethod method, const SolidMesh& mesh) {
   Decomposition out;
-  out.method = DecompositionMethod::kHull;
+  out.method = method;
   out.mesh_volume = MeshVolume(mesh);
   const auto bounds = MeshBounds(mesh);
   out.extent = (bounds[1] - bounds[0]).maxCoeff();
+  return out;
+}
+
+Decomposition DecomposeHull(const SolidMesh& mesh, const DecompositionOptions& options) {
+  Decomposition out = StartDecomposition(DecompositionMethod::kHull, mesh);
   ConvexPart part;
   part.hull = CanonicalMesh(ConvexHullOf(mesh.vertices));
   part.volume = out.mesh_volume;

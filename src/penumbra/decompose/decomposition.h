@@ -75,6 +75,9 @@ struct Decomposition {
   double HullVolumeSum() const;
 };
 
+/// a decomposition of `mesh` by `method` before any part: method, mesh_volume and extent set.
+Decomposition StartDecomposition(DecompositionMethod method, const SolidMesh& mesh);
+
 /// decomposes `mesh` (closed, outward oriented; see ValidateClosedMesh) with options.method.
 /// @throws Error from ValidateClosedMesh (named `name`), ConfigError from ValidateOrThrow.
 Decomposition DecomposeMesh(const SolidMesh& mesh, const DecompositionOptions& options,

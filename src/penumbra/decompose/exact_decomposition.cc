@@ -19,11 +19,7 @@ using Mesh = CGAL::Surface_mesh<K::Point_3>;
 }  // namespace
 
 Decomposition DecomposeExact(const SolidMesh& mesh, const DecompositionOptions& options) {
-  Decomposition out;
-  out.method = DecompositionMethod::kExact;
-  out.mesh_volume = MeshVolume(mesh);
-  const auto bounds = MeshBounds(mesh);
-  out.extent = (bounds[1] - bounds[0]).maxCoeff();
+  Decomposition out = StartDecomposition(DecompositionMethod::kExact, mesh);
   Mesh sm;
   std::vector<Mesh::Vertex_index> vi;
   for (const Eigen::Vector3d& v : mesh.vertices)
