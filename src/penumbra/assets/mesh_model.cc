@@ -10,13 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <memory>
 
 #include "penumbra/assets/height_field_model.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/decompose/decomposition_cache.h"
+#include "penumbra/decompose/mesh_io.h"
 #include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
@@ -128,13 +128,7 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
                      XmlEscape(m.name), LinearToSrgb(c.x()), LinearToSrgb(c.y()),
                      LinearToSrgb(c.z()));
   }
-  for (size_t k = 0; k < collision.convex_parts.size(); ++k) {
-    std::string vertex;
-    for (const Eigen::Vector3d& v : collision.convex_parts[k])
-      vertex +=
-          fmt::format("{}{:.9g} {:.9g} {:.9g}", vertex.empty() ? "" : " ", v.x(), v.y(), v.z());
-    x += fmt::format("    <mesh name=\"collision_part_{}\" vertex=\"{}\"/>\n", k, vertex);
-  }
+  x += collision.convex_parts.assets;
   if (collision.hfield)
     x += fmt::format("    <hfield name=\"collision_heightfield\" file=\"{}\" size=\"{}\"/>\n",
                      XmlEscape(collision.hfield_file), HfieldSizeAttribute(*collision.hfield, 0.1));
@@ -144,11 +138,7 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
     x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"{2}/>\n",
                      XmlEscape(m.mesh.name), XmlEscape(asset.materials.at(m.material).name),
                      collision.mesh_geoms_collide ? "" : " contype=\"0\" conaffinity=\"0\"");
-  for (size_t k = 0; k < collision.convex_parts.size(); ++k)
-    x += fmt::format(
-        "    <geom name=\"collision_part_{0}\" type=\"mesh\" mesh=\"collision_part_{0}\" "
-        "group=\"3\"/>\n",
-        k);
+  x += collision.convex_parts.geoms;
   if (collision.hfield) {
     const Eigen::Vector3d p = HfieldGeomPosition(*collision.hfield);
     x += fmt::format(
@@ -192,23 +182,14 @@ SampledHeightField SampleMeshHeightField(const ImportedAsset& asset, double cell
 }
 
 SolidMesh WeldedSolid(const ImportedAsset& asset) {
-  SolidMesh out;
-  std::map<std::array<float, 3>, int> index;
+  SolidMesh soup;
   for (const ImportedMesh& m : asset.meshes) {
-    std::vector<int> remap(m.mesh.vertices.size());
-    for (size_t i = 0; i < remap.size(); ++i) {
-      const Eigen::Vector3f& v = m.mesh.vertices[i];
-      const auto [it, added] =
-          index.emplace(std::array<float, 3>{v.x(), v.y(), v.z()}, int(out.vertices.size()));
-      if (added) out.vertices.push_back(v.cast<double>());
-      remap[i] = it->second;
-    }
-    for (const Eigen::Vector3i& f : m.mesh.faces) {
-      const std::array<int, 3> t = {remap.at(f[0]), remap.at(f[1]), remap.at(f[2])};
-      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) out.triangles.push_back(t);
-    }
+    const int base = static_cast<int>(soup.vertices.size());
+    for (const Eigen::Vector3f& v : m.mesh.vertices) soup.vertices.push_back(v.cast<double>());
+    for (const Eigen::Vector3i& f : m.mesh.faces)
+      soup.triangles.push_back({base + f[0], base + f[1], base + f[2]});
   }
-  return out;
+  return WeldVertices(soup);
 }
 
 std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
@@ -288,8 +269,7 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
             "{}: max_parts {} forced merges over the concavity threshold {} (largest "
             "concavity {:.4f} of the extent)",
             m.file, config.max_parts, config.concavity_threshold, im.relative_max_concavity);
-      for (const ConvexPart& part : d.decomposition.parts)
-        collision.convex_parts.push_back(part.hull.vertices);
+      collision.convex_parts = PartsToMjcf(d.decomposition, "collision_part", "group=\"3\"");
     }
     const std::string xml = MeshModelMjcf(im.asset, msh_files, collision);
     m.file = WriteContentNamedFile(folder, stem, ".xml", xml);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "penumbra/assets/mesh_import.h"
+#include "penumbra/decompose/mesh_io.h"
 #include "penumbra/decompose/solid_mesh.h"
 #include "penumbra/render/height_field_sampling.h"
 #include "penumbra/scene/scene_description.h"
@@ -57,10 +58,10 @@ struct MeshModelCollision {
   /// and its geom "collision_heightfield" in group 3 (not drawn; render/ray_query.h traces
   /// groups <= 2).
   std::optional<SampledHeightField> hfield;
-  /// convex parts that collide instead (model frame, m; `collision: coacd`): part k becomes the
-  /// asset "collision_part_<k>" (its vertices; MuJoCo takes their convex hull) and its geom
-  /// "collision_part_<k>" in group 3 (not drawn).
-  std::vector<std::vector<Eigen::Vector3d>> convex_parts;
+  /// convex parts that collide instead (model frame, m; `collision: coacd`): PartsToMjcf with
+  /// prefix "collision_part" (part k: the asset "collision_part_<k>" with its hull's vertices,
+  /// MuJoCo takes their convex hull, and its geom "collision_part_<k>") in group 3 (not drawn).
+  PartsMjcf convex_parts;
 };
 
 /// the meshes of `asset` welded into one solid for convex decomposition: vertices at bit-equal

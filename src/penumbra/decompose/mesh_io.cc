@@ -4,11 +4,9 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
-#include <array>
 #include <assimp/Importer.hpp>
 #include <filesystem>
 #include <fstream>
-#include <map>
 
 #include "penumbra/core/error.h"
 
@@ -25,25 +23,23 @@ SolidMesh ReadMeshFile(const std::string& path, double scale) {
       path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode)
     throw Error(path + ": cannot read the mesh (" + importer.GetErrorString() + ")");
-  SolidMesh out;
-  std::map<std::array<double, 3>, int> index;
+  SolidMesh soup;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* mesh = scene->mMeshes[m];
-    std::vector<int> remap(mesh->mNumVertices);
+    const int base = static_cast<int>(soup.vertices.size());
     for (unsigned i = 0; i < mesh->mNumVertices; ++i) {
       const aiVector3D& v = mesh->mVertices[i];
-      const std::array<double, 3> p = {v.x * scale, v.y * scale, v.z * scale};
-      const auto [it, added] = index.emplace(p, static_cast<int>(out.vertices.size()));
-      if (added) out.vertices.emplace_back(p[0], p[1], p[2]);
-      remap[i] = it->second;
+      soup.vertices.emplace_back(v.x * scale, v.y * scale, v.z * scale);
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       if (face.mNumIndices != 3) continue;  // points and lines
-      out.triangles.push_back(
-          {remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]});
+      soup.triangles.push_back({base + static_cast<int>(face.mIndices[0]),
+                                base + static_cast<int>(face.mIndices[1]),
+                                base + static_cast<int>(face.mIndices[2])});
     }
   }
+  const SolidMesh out = WeldVertices(soup);
   if (out.triangles.empty())
     throw Error(path +
                 ": holds no triangles; expected a closed, manifold surface in .off, .obj, .stl "
@@ -79,7 +75,7 @@ PartsMjcf PartsToMjcf(const Decomposition& decomposition, const std::string& pre
       vertex +=
           fmt::format("{}{:.17g} {:.17g} {:.17g}", vertex.empty() ? "" : " ", v.x(), v.y(), v.z());
     mjcf.assets += fmt::format("<mesh name=\"{}\" vertex=\"{}\"/>\n", name, vertex);
-    mjcf.geoms += fmt::format("<geom type=\"mesh\" mesh=\"{}\"{}{}/>\n", name,
+    mjcf.geoms += fmt::format("<geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\"{1}{2}/>\n", name,
                               geom_attributes.empty() ? "" : " ", geom_attributes);
   }
   return mjcf;

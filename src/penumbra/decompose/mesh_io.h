@@ -19,7 +19,8 @@ SolidMesh ReadMeshFile(const std::string& path, double scale = 1.0);
 void WritePartsObj(const Decomposition& decomposition, const std::string& path);
 
 /// the MJCF of the parts: one `<mesh name="<prefix>_<i>" vertex="..."/>` per part for
-/// `<asset>` and one `<geom type="mesh" mesh="<prefix>_<i>"/>` per part for a `<body>`, with
+/// `<asset>` and one `<geom name="<prefix>_<i>" type="mesh" mesh="<prefix>_<i>"/>` per part for a
+/// `<body>`, with
 /// `geom_attributes` (e.g. `rgba="..."`) added to each geom. vertices in m, printed with 17
 /// significant digits (exact round trip).
 struct PartsMjcf {

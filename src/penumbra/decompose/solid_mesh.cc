@@ -149,6 +149,24 @@ std::vector<SolidMesh> ConnectedComponents(const SolidMesh& mesh) {
   return parts;
 }
 
+SolidMesh WeldVertices(const SolidMesh& soup) {
+  SolidMesh out;
+  std::map<std::array<double, 3>, int> index;
+  std::vector<int> remap(soup.vertices.size());
+  for (size_t i = 0; i < soup.vertices.size(); ++i) {
+    const Eigen::Vector3d& v = soup.vertices[i];
+    const auto [it, added] = index.emplace(std::array<double, 3>{v.x(), v.y(), v.z()},
+                                           static_cast<int>(out.vertices.size()));
+    if (added) out.vertices.push_back(v);
+    remap[i] = it->second;
+  }
+  for (const auto& t : soup.triangles) {
+    const std::array<int, 3> r = {remap.at(t[0]), remap.at(t[1]), remap.at(t[2])};
+    if (r[0] != r[1] && r[1] != r[2] && r[0] != r[2]) out.triangles.push_back(r);
+  }
+  return out;
+}
+
 SolidMesh CanonicalMesh(const SolidMesh& mesh) {
   std::vector<int> order(mesh.vertices.size());
   std::iota(order.begin(), order.end(), 0);

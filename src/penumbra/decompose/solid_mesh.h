@@ -42,6 +42,11 @@ double MeshArea(const SolidMesh& mesh);
 /// @throws Error "<name>: <problem>" naming the first bad triangle or edge.
 void ValidateClosedMesh(const SolidMesh& mesh, const std::string& name);
 
+/// `soup` with vertices at bit-equal positions merged (numbered in first-use order) and the
+/// triangles that merging made degenerate dropped: the triangles of a file or of several
+/// meshes become one connected surface.
+SolidMesh WeldVertices(const SolidMesh& soup);
+
 /// `mesh` with unreferenced vertices dropped and indices renumbered in first-use order.
 SolidMesh CompactMesh(const SolidMesh& mesh);
 
