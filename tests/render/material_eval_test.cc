@@ -5,9 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
 
 namespace penumbra {
 namespace {
@@ -209,6 +212,95 @@ TEST(MaterialEvalTest, AnisotropicTapsRoundTheRatioAndShareOneLevel) {
   EXPECT_NEAR(evaluate(cos13), taps(1, major13, std::log2(2.6f * 1.3f)), 1e-5f);
   EXPECT_GT(std::abs(taps(1, major13, std::log2(2.6f * 1.3f)) - taps(2, major13, std::log2(2.6f))),
             1e-3f);
+}
+
+// a w x h texture of pseudo-random sRGB codes; a normal map's point mostly along +z (codes
+// 160-255 for z, 60-195 for x and y), as real ones do.
+std::shared_ptr<const TextureImage> Noise(int w, int h, uint64_t seed, bool normal = false) {
+  Rng rng(HashKeys(seed, 1));
+  std::vector<uint8_t> rgb(static_cast<size_t>(w) * h * 3);
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    const int code = static_cast<int>(rng.NextU64() >> 56);
+    rgb[i] = static_cast<uint8_t>(
+        !normal ? code : (i % 3 == 2 ? 160 + code * 95 / 255 : 60 + code * 135 / 255));
+  }
+  return std::make_shared<const TextureImage>(w, h, 1, std::move(rgb));
+}
+
+TEST(MaterialEvalTest, PackedMapsMatchSeparateLookups) {
+  // material 0 ("packed"): base, normal and metallic-roughness maps of one size (packed);
+  // material 1 ("loose"): a normal map of another size (filtered map by map). on a box (per-face
+  // mapping) and an infinite plane (uniform mapping), EvaluateAndMapNormal equals
+  // ApplyNormalMap then Evaluate up to float rounding, for isotropic and anisotropic
+  // footprints from head-on to grazing.
+  SceneDescription s;
+  s.bodies.push_back({"world", -1, true});
+  auto add_texture = [&](const std::string& name, std::shared_ptr<const TextureImage> im) {
+    Texture t;
+    t.name = name;
+    t.image = std::move(im);
+    s.textures.push_back(t);
+    return static_cast<int>(s.textures.size()) - 1;
+  };
+  for (const char* name : {"packed", "loose"}) {
+    Material m;
+    m.name = name;
+    m.base_color = {0.9f, 0.8f, 0.7f};
+    m.roughness = 0.8f;
+    m.metallic = 0.5f;
+    m.texrepeat = {3, 2};
+    const bool packed = std::string(name) == "packed";
+    m.texture = add_texture(std::string(name) + "/albedo", Noise(64, 32, packed ? 1 : 4));
+    add_texture(std::string(name) + "/normal", Noise(packed ? 64 : 32, 32, packed ? 2 : 5, true));
+    add_texture(std::string(name) + "/metallic_roughness", Noise(64, 32, packed ? 3 : 6));
+    s.materials.push_back(m);
+  }
+  Geom box;
+  box.shape = GeomShape::kBox;
+  box.size = {0.5, 0.3, 0.2};
+  Geom plane;
+  plane.shape = GeomShape::kPlane;
+  plane.size = {0, 0, 1};
+  s.geoms = {box, plane};
+  for (const int aniso : {1, 16}) {
+    MaterialEvaluator eval(s, aniso);
+    eval.SetGeomRotations({Eigen::Matrix3f::Identity(), Eigen::Matrix3f::Identity()});
+    Rng rng(HashKeys(7, aniso));
+    double max_base = 0, max_normal = 0, max_rm = 0;
+    for (int i = 0; i < 4000; ++i) {
+      SurfaceHit h;
+      h.geom = i % 2;
+      h.material = (i / 2) % 2;
+      const float x = rng.Uniform() - 0.5f, y = 0.6f * rng.Uniform() - 0.3f;
+      h.p_G = {x, y, 0.2f};
+      h.n_G = {0, 0, 1};
+      h.ng_W = h.ns_W = h.n_G;
+      h.p_W = h.p_G;
+      // from head-on to 89 degrees off the normal.
+      const float theta = 1.55f * rng.Uniform(), phi = 6.28f * rng.Uniform();
+      h.d_G = Eigen::Vector3f(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                              -std::cos(theta));
+      TextureFootprint f;
+      f.width_m = 0.05f * rng.Uniform() * rng.Uniform();
+      f.cos_incidence = std::cos(theta);
+      SurfaceHit separate = h;
+      eval.ApplyNormalMap(&separate, f);
+      const SurfaceMaterial a = eval.Evaluate(separate, f);
+      SurfaceHit fused = h;
+      const SurfaceMaterial b = eval.EvaluateAndMapNormal(&fused, f);
+      max_base =
+          std::max<double>(max_base, (a.pbr.base_color - b.pbr.base_color).cwiseAbs().maxCoeff());
+      max_normal = std::max<double>(max_normal, (separate.ns_W - fused.ns_W).cwiseAbs().maxCoeff());
+      max_rm = std::max<double>(max_rm, std::max(std::abs(a.pbr.roughness - b.pbr.roughness),
+                                                 std::abs(a.pbr.metallic - b.pbr.metallic)));
+      EXPECT_EQ(a.occlusion, b.occlusion);
+      ASSERT_LT((separate.ns_W - h.ns_W).norm() + (fused.ns_W - h.ns_W).norm(), 4.0f);
+    }
+    // the packed channels hold the decoded codes in steps of 1/65535 (<= 7.7e-6 off).
+    EXPECT_LT(max_base, 2e-5) << "aniso " << aniso;
+    EXPECT_LT(max_normal, 1e-4) << "aniso " << aniso;
+    EXPECT_LT(max_rm, 2e-5) << "aniso " << aniso;
+  }
 }
 
 TEST(MaterialEvalTest, MaterialFieldsAndDefaults) {

@@ -419,6 +419,53 @@ TEST(SkyIrradianceVolumeTest, AxisAlignedNormalsMatchTheFullShSum) {
   EXPECT_GT(lit, 1000);
 }
 
+TEST(SkyIrradianceVolumeTest, BlendThenEvaluateMatchesIrradiance) {
+  // Blend(p, n) then IrradianceAt(n) is Irradiance(p, n) up to rounding, inside the grid, in
+  // its cells that no probe lights and outside it. a shading normal other than the geometric
+  // one changes only the SH evaluation (checked at the end on a floor point).
+  const SceneDescription s = RoomWithWindow(DaylightSky());
+  const SkyModel sky(s.sky);
+  const SkyIrradianceVolume vol = BuildVolume(s, sky);
+  const float open = sky.Irradiance(Eigen::Vector3f::UnitZ()).maxCoeff();
+  Rng rng(HashKeys(5, 7));
+  int lit = 0, outside = 0, dark = 0;
+  SkyIrradianceVolume::ShBlend blend;
+  for (int i = 0; i < 2000; ++i) {
+    // points in the room and around it (outside the grid too).
+    const Eigen::Vector3f p(8.0f * rng.Uniform() - 4.0f, 8.0f * rng.Uniform() - 4.0f,
+                            5.0f * rng.Uniform() - 1.0f);
+    Eigen::Vector3f n(2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1);
+    if (!(n.norm() > 0.1f)) continue;
+    n.normalize();
+    vol.Blend(p, n, &blend);
+    const Eigen::Vector3f e = vol.Irradiance(p, n, sky);
+    const Eigen::Vector3f eb = vol.IrradianceAt(blend, n, sky);
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(e[c], eb[c], 1e-5f * open) << "p " << p.transpose() << " n " << n.transpose();
+    outside += blend.open_sky;
+    lit += !blend.open_sky && e.maxCoeff() > 1e-3f * open;
+    dark += !blend.open_sky && !(e.maxCoeff() > 0);
+    if (blend.open_sky) {
+      // outside: the unoccluded sky at whatever normal it is evaluated.
+      const Eigen::Vector3f up = vol.IrradianceAt(blend, Eigen::Vector3f::UnitZ(), sky);
+      const Eigen::Vector3f sky_up = sky.Irradiance(Eigen::Vector3f::UnitZ());
+      ASSERT_EQ(0, std::memcmp(up.data(), sky_up.data(), sizeof(float) * 3));
+    }
+  }
+  EXPECT_GT(lit, 300);
+  EXPECT_GT(outside, 100);
+  EXPECT_GT(dark, 0);
+  // a tilted shading normal on the floor under the window: the floor's weights, the SH at
+  // the tilted normal (tilted towards the window: brighter than the floor's own normal).
+  const Eigen::Vector3f p(0, -1.5f, 0);
+  vol.Blend(p, Eigen::Vector3f::UnitZ(), &blend);
+  const Eigen::Vector3f flat = vol.IrradianceAt(blend, Eigen::Vector3f::UnitZ(), sky);
+  const Eigen::Vector3f tilted =
+      vol.IrradianceAt(blend, Eigen::Vector3f(0, -0.5f, 1).normalized(), sky);
+  EXPECT_GT(Lum(tilted), Lum(flat));
+  EXPECT_GT(Lum(flat), 0.0);
+}
+
 TEST(SkyIrradianceVolumeTest, BitIdenticalForAnyThreadCount) {
   const SceneDescription s = RoomWithWindow(DaylightSky());
   const SkyModel sky(s.sky);

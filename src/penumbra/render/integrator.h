@@ -71,6 +71,10 @@ struct PrimaryHits {
   const Ray* rays = nullptr;         ///< camera ray through the pixel centre (t = z-depth)
   const SurfaceHit* hits = nullptr;  ///< valid where did_hit
   const bool* did_hit = nullptr;
+  /// the material of every hit pixel (MaterialEvaluator::EvaluateAndMapNormal over the pixel's
+  /// ray cone; `hits` then carry the normal-mapped shading normals), or null when the renderer
+  /// did not evaluate them (Integrator::wants_primary_materials).
+  const SurfaceMaterial* materials = nullptr;
 };
 
 /// full-frame images an integrator writes its tile into.
@@ -91,6 +95,10 @@ class Integrator {
   /// (the primary rays are counted by the renderer). called concurrently for different tiles.
   virtual int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
                              const FrameBuffers& out) const = 0;
+
+  /// whether the renderer should evaluate the primary hits' materials (PrimaryHits::materials);
+  /// else it only applies normal maps to them.
+  virtual bool wants_primary_materials() const { return false; }
 };
 
 }  // namespace penumbra

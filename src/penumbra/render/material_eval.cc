@@ -5,6 +5,10 @@
 #include <string>
 #include <unordered_map>
 
+#ifdef __AVX2__
+#include <immintrin.h>
+#endif
+
 #include "penumbra/core/error.h"
 #include "penumbra/scene/texture_image.h"
 
@@ -168,6 +172,36 @@ Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, flo
   return Eigen::Vector3f(r, g, b) * step;
 }
 
+// adds weight x the bilinear lookup (wrapped; (s, t) in images) of a packed level (w x h
+// texels of 8 linear channels, MaterialEvaluator::PackedLevel) to the 8 channels of `acc`.
+inline void AddBilinearPacked(const MaterialEvaluator::PackedLevel& L, float s, float t,
+                              float weight, float* acc) {
+  const auto [x0, y0, x1, y1, fx, fy] = WrapTexels(s, t, L.width, L.height);
+  const size_t w = static_cast<size_t>(L.width);
+  const uint16_t* p = L.texels.data();
+  const uint16_t* a = p + (static_cast<size_t>(y0) * w + x0) * 8;
+  const uint16_t* b = p + (static_cast<size_t>(y0) * w + x1) * 8;
+  const uint16_t* c = p + (static_cast<size_t>(y1) * w + x0) * 8;
+  const uint16_t* d = p + (static_cast<size_t>(y1) * w + x1) * 8;
+  const float k = weight * MaterialEvaluator::PackedLevel::kScale;
+  const float w00 = k * (1 - fx) * (1 - fy), w10 = k * fx * (1 - fy);
+  const float w01 = k * (1 - fx) * fy, w11 = k * fx * fy;
+#ifdef __AVX2__
+  // the 8 channels of a texel as one register.
+  auto texel = [](const uint16_t* q) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q));
+    return _mm256_cvtepi32_ps(_mm256_cvtepu16_epi32(v));
+  };
+  __m256 sum = _mm256_mul_ps(_mm256_set1_ps(w00), texel(a));
+  sum = _mm256_add_ps(sum, _mm256_mul_ps(_mm256_set1_ps(w10), texel(b)));
+  sum = _mm256_add_ps(sum, _mm256_mul_ps(_mm256_set1_ps(w01), texel(c)));
+  sum = _mm256_add_ps(sum, _mm256_mul_ps(_mm256_set1_ps(w11), texel(d)));
+  _mm256_storeu_ps(acc, _mm256_add_ps(_mm256_loadu_ps(acc), sum));
+#else
+  for (int j = 0; j < 8; ++j) acc[j] += w00 * a[j] + w10 * b[j] + w01 * c[j] + w11 * d[j];
+#endif
+}
+
 // offset of tap k of n along the major axis, in units of the axis: ((k + 1/2) / n - 1/2).
 float TapOffset(int k, int n) {
   return (static_cast<float>(k) + 0.5f) / static_cast<float>(n) - 0.5f;
@@ -248,6 +282,58 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
         (t.image->faces() != 6 || t.image->height() != 6 * t.image->width()))
       throw Error("cube texture '" + t.name +
                   "': expected six square faces stacked vertically (height = 6 width)");
+  }
+  // packed maps (file comment): a material's 2d base texture, normal and metallic-roughness
+  // maps, at least two of them, of one size, interleaved 8 bytes a texel, level by level.
+  packed_of_.assign(scene.materials.size(), -1);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    auto image_2d = [&](int tex) -> const TextureImage* {
+      if (tex < 0 || tex >= static_cast<int>(scene.textures.size())) return nullptr;
+      const Texture& t = scene.textures[tex];
+      return t.kind == Texture::Kind::k2D && t.image && t.image->faces() == 1 ? t.image.get()
+                                                                              : nullptr;
+    };
+    if (m.texture >= 0 && image_2d(m.texture) == nullptr) continue;  // a cube texture
+    const TextureImage* base = image_2d(m.texture);
+    const TextureImage* normal = image_2d(maps_[i].normal);
+    const TextureImage* mr = image_2d(maps_[i].metallic_roughness);
+    const TextureImage* first = base ? base : (normal ? normal : mr);
+    if ((base != nullptr) + (normal != nullptr) + (mr != nullptr) < 2) continue;
+    auto same = [&](const TextureImage* im) {
+      return im == nullptr || (im->width() == first->width() && im->height() == first->height() &&
+                               im->num_levels() == first->num_levels());
+    };
+    if (!same(base) || !same(normal) || !same(mr)) continue;
+    if (static_cast<int64_t>(first->width()) * first->height() > kMaxPackedTexels) continue;
+    PackedMaps pm;
+    pm.base = base != nullptr;
+    pm.normal = normal != nullptr;
+    pm.metallic_roughness = mr != nullptr;
+    for (int l = 0; l < first->num_levels(); ++l) {
+      const TextureLevel& L = first->level(l);
+      PackedLevel& P = pm.levels.emplace_back();
+      P.width = L.width;
+      P.height = L.height;
+      const size_t n = static_cast<size_t>(L.width) * L.height;
+      P.texels.assign(8 * n, 0);
+      // the decoded value of every 8-bit code in 1/65535 steps
+      uint16_t linear[256];
+      for (int code = 0; code < 256; ++code)
+        linear[code] =
+            static_cast<uint16_t>(std::lround(srgb_to_linear_[code] / PackedLevel::kScale));
+      auto put = [&](const TextureImage* im, int from, int count, int to) {
+        if (im == nullptr) return;
+        const uint8_t* src = im->level(l).rgb_srgb.data();
+        for (size_t k = 0; k < n; ++k)
+          for (int c = 0; c < count; ++c) P.texels[8 * k + to + c] = linear[src[3 * k + from + c]];
+      };
+      put(base, 0, 3, 0);
+      put(normal, 0, 3, 3);
+      put(mr, 1, 2, 6);
+    }
+    packed_of_[i] = static_cast<int>(packed_.size());
+    packed_.push_back(std::move(pm));
   }
   half_extent_G_.reserve(scene.geoms.size());
   for (const Geom& g : scene.geoms) half_extent_G_.push_back(GeomHalfExtents(scene, g));
@@ -367,17 +453,12 @@ MaterialEvaluator::Mapping2D MaterialEvaluator::MapAt(const SurfaceHit& hit,
   return map;
 }
 
-Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Mapping2D& map,
-                                            bool aniso, const Eigen::Vector3f& major_G,
-                                            const Eigen::Vector3f& minor_G,
-                                            const TextureFootprint& footprint) const {
-  const float w = static_cast<float>(image.width());
-  const float th = static_cast<float>(image.height());
-  const float* decode = srgb_to_linear_;
-  auto trilinear = [&](float lod) {
-    return Trilinear(image, lod,
-                     [&](const TextureLevel& L) { return BilinearWrap(L, decode, map.s, map.t); });
-  };
+MaterialEvaluator::FilterPlan MaterialEvaluator::PlanFilter(
+    int width, int height, const Mapping2D& map, bool aniso, const Eigen::Vector3f& major_G,
+    const Eigen::Vector3f& minor_G, const TextureFootprint& footprint) const {
+  const float w = static_cast<float>(width);
+  const float th = static_cast<float>(height);
+  FilterPlan plan;
   // the axes in texture units and their squared lengths in level-0 texels.
   Eigen::Vector2f major_st, minor_st;
   float l2_major = 0, l2_minor = 0;
@@ -393,16 +474,61 @@ Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Map
     const bool swap = l2_minor > l2_major;
     const Eigen::Vector2f axis = swap ? minor_st : major_st;
     const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
-    if (taps.n == 1) return trilinear(taps.lod);
-    return BilinearWrapTaps(image.level(TapLevel(image, taps.lod)), decode, map.s, map.t, axis.x(),
-                            axis.y(), taps.n);
+    plan.lod = taps.lod;
+    if (taps.n > 1) {
+      plan.n = taps.n;
+      plan.ds = axis.x();
+      plan.dt = axis.y();
+    }
+    return plan;
   }
-  return trilinear(TextureLod(footprint, map.Rho(w, th)));
+  plan.lod = TextureLod(footprint, map.Rho(w, th));
+  return plan;
 }
 
-SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
+Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Mapping2D& map,
+                                            bool aniso, const Eigen::Vector3f& major_G,
+                                            const Eigen::Vector3f& minor_G,
                                             const TextureFootprint& footprint) const {
-  const Material& m = hit.material >= 0 ? scene_.materials[hit.material] : default_material_;
+  const float* decode = srgb_to_linear_;
+  const FilterPlan plan =
+      PlanFilter(image.width(), image.height(), map, aniso, major_G, minor_G, footprint);
+  if (plan.n > 1)
+    return BilinearWrapTaps(image.level(TapLevel(image, plan.lod)), decode, map.s, map.t, plan.ds,
+                            plan.dt, plan.n);
+  return Trilinear(image, plan.lod,
+                   [&](const TextureLevel& L) { return BilinearWrap(L, decode, map.s, map.t); });
+}
+
+void MaterialEvaluator::FilterPacked(const PackedMaps& packed, const Mapping2D& map, bool aniso,
+                                     const Eigen::Vector3f& major_G, const Eigen::Vector3f& minor_G,
+                                     const TextureFootprint& footprint, float out[8]) const {
+  const PackedLevel& L0 = packed.levels.front();
+  const FilterPlan plan = PlanFilter(L0.width, L0.height, map, aniso, major_G, minor_G, footprint);
+  std::fill_n(out, 8, 0.0f);
+  const int last = static_cast<int>(packed.levels.size()) - 1;
+  if (plan.n > 1) {
+    const PackedLevel& L = packed.levels[std::min(static_cast<int>(plan.lod), last)];
+    const float step = 1.0f / static_cast<float>(plan.n);
+    const float o0 = 0.5f * step - 0.5f;
+    for (int k = 0; k < plan.n; ++k) {
+      const float o = o0 + static_cast<float>(k) * step;
+      AddBilinearPacked(L, map.s + o * plan.ds, map.t + o * plan.dt, step, out);
+    }
+    return;
+  }
+  // trilinear, as Trilinear: level 0 below lod 0, the last level beyond it.
+  if (!(plan.lod > 0)) return AddBilinearPacked(packed.levels[0], map.s, map.t, 1, out);
+  if (!(plan.lod < static_cast<float>(last)))
+    return AddBilinearPacked(packed.levels[last], map.s, map.t, 1, out);
+  const int l = static_cast<int>(plan.lod);
+  const float f = plan.lod - static_cast<float>(l);
+  if (!(f > 0)) return AddBilinearPacked(packed.levels[l], map.s, map.t, 1, out);
+  AddBilinearPacked(packed.levels[l], map.s, map.t, 1 - f, out);
+  AddBilinearPacked(packed.levels[l + 1], map.s, map.t, f, out);
+}
+
+SurfaceMaterial MaterialEvaluator::Untextured(const SurfaceHit& hit, const Material& m) const {
   SurfaceMaterial out;
   out.pbr.base_color = m.base_color;
   out.pbr.roughness = m.roughness;
@@ -414,6 +540,13 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     if (shape == GeomShape::kPlane || (shape == GeomShape::kBox && hit.n_G.z() > 0.5f))
       out.mirror = std::min(m.reflectance, 1.0f);
   }
+  return out;
+}
+
+SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
+                                            const TextureFootprint& footprint) const {
+  const Material& m = hit.material >= 0 ? scene_.materials[hit.material] : default_material_;
+  SurfaceMaterial out = Untextured(hit, m);
   static const PbrMaps kNoMaps;
   const PbrMaps& maps = hit.material >= 0 ? maps_[hit.material] : kNoMaps;
   const bool pbr_maps = maps.metallic_roughness >= 0 || maps.occlusion >= 0 || maps.emissive >= 0;
@@ -475,9 +608,18 @@ void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& 
   if (hit->material < 0 || hit->geom < 0 || hit->geom >= static_cast<int>(R_WG_.size())) return;
   const int normal_map = maps_[hit->material].normal;
   if (normal_map < 0) return;
-  const Material& m = scene_.materials[hit->material];
+  const Mapping2D map = MapAt(*hit, scene_.materials[hit->material]);
+  Eigen::Vector3f major_G, minor_G;
+  const bool aniso = max_anisotropy_ > 1 && FootprintAxes(*hit, footprint, &major_G, &minor_G);
+  BendNormal(map,
+             Filter2D(*scene_.textures[normal_map].image, map, aniso, major_G, minor_G, footprint),
+             hit);
+}
+
+void MaterialEvaluator::BendNormal(const Mapping2D& map, const Eigen::Vector3f& c,
+                                   SurfaceHit* hit) const {
+  if (hit->geom < 0 || hit->geom >= static_cast<int>(R_WG_.size())) return;
   const Eigen::Matrix3f& R_WG = R_WG_[hit->geom];
-  const Mapping2D map = MapAt(*hit, m);
   // tangent t (increasing s) and bitangent b (towards the image's top row: decreasing t), geom
   // frame: the columns of the pseudo-inverse of J restricted to the surface.
   Eigen::Vector3f t_G, b_G;
@@ -494,10 +636,6 @@ void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& 
     t_G = P.col(0);
     b_G = -P.col(1);
   }
-  Eigen::Vector3f major_G, minor_G;
-  const bool aniso = max_anisotropy_ > 1 && FootprintAxes(*hit, footprint, &major_G, &minor_G);
-  const Eigen::Vector3f c =
-      Filter2D(*scene_.textures[normal_map].image, map, aniso, major_G, minor_G, footprint);
   const Eigen::Vector3f tn(2 * c.x() - 1, 2 * c.y() - 1, 2 * c.z() - 1);
   // outward shading normal, and the tangent frame around it (Gram-Schmidt), world frame.
   const Eigen::Vector3f n = hit->front_face ? hit->ns_W : Eigen::Vector3f(-hit->ns_W);
@@ -506,15 +644,51 @@ void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& 
   const float lt = t.norm();
   if (!(lt > 0)) return;
   t /= lt;
-  Eigen::Vector3f b = R_WG * b_G;
-  b -= b.dot(n) * n + b.dot(t) * t;
-  const float lb = b.norm();
-  if (!(lb > 0)) return;
-  b /= lb;
+  // b minus its components along n and t, normalised, is +-(n x t) (n, t orthonormal).
+  const Eigen::Vector3f n_x_t = n.cross(t);
+  const float b_along = (R_WG * b_G).dot(n_x_t);
+  if (!(b_along != 0)) return;
+  const Eigen::Vector3f b = b_along > 0 ? n_x_t : Eigen::Vector3f(-n_x_t);
   const Eigen::Vector3f mapped = tn.x() * t + tn.y() * b + std::max(tn.z(), 0.0f) * n;
   const float len = mapped.norm();
   if (!(len > 0) || !mapped.allFinite()) return;
   hit->ns_W = hit->front_face ? Eigen::Vector3f(mapped / len) : Eigen::Vector3f(-mapped / len);
+}
+
+SurfaceMaterial MaterialEvaluator::EvaluateAndMapNormal(SurfaceHit* hit,
+                                                        const TextureFootprint& footprint) const {
+  const int packed = hit->material >= 0 && hit->geom >= 0 ? packed_of_[hit->material] : -1;
+  if (packed < 0) {
+    if (has_normal_maps_) ApplyNormalMap(hit, footprint);
+    return Evaluate(*hit, footprint);
+  }
+  // one mapping, one footprint and one set of taps for the base colour, normal and
+  // metallic-roughness maps (file comment, "packed maps").
+  const Material& m = scene_.materials[hit->material];
+  const PackedMaps& pm = packed_[packed];
+  SurfaceMaterial out = Untextured(*hit, m);
+  Eigen::Vector3f major_G, minor_G;
+  const bool aniso = max_anisotropy_ > 1 && FootprintAxes(*hit, footprint, &major_G, &minor_G);
+  const Mapping2D map = MapAt(*hit, m);
+  float c[8];
+  FilterPacked(pm, map, aniso, major_G, minor_G, footprint, c);
+  if (pm.base)
+    out.pbr.base_color = out.pbr.base_color.cwiseProduct(Eigen::Vector3f(c[0], c[1], c[2]));
+  if (pm.metallic_roughness) {
+    out.pbr.roughness *= c[6];
+    out.pbr.metallic *= c[7];
+  }
+  const PbrMaps& maps = maps_[hit->material];
+  if (maps.occlusion >= 0)
+    out.occlusion = std::clamp(
+        Filter2D(*scene_.textures[maps.occlusion].image, map, aniso, major_G, minor_G, footprint)
+            .x(),
+        0.0f, 1.0f);
+  if (maps.emissive >= 0)
+    out.emission = out.emission.cwiseProduct(
+        Filter2D(*scene_.textures[maps.emissive].image, map, aniso, major_G, minor_G, footprint));
+  if (pm.normal) BendNormal(map, Eigen::Vector3f(c[3], c[4], c[5]), hit);
+  return out;
 }
 
 }  // namespace penumbra

@@ -387,8 +387,7 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
         const float d_len = ray.d.norm();
         const float hit_path_m = path_m + hit.t * d_len;
         const TextureFootprint footprint = ConeFootprint(spread, hit_path_m, ray.d / d_len, hit);
-        if (ctx.materials->has_normal_maps()) ctx.materials->ApplyNormalMap(&hit, footprint);
-        SurfaceMaterial mat = ctx.materials->Evaluate(hit, footprint);
+        SurfaceMaterial mat = ctx.materials->EvaluateAndMapNormal(&hit, footprint);
         if (wetness > 0) ApplySurfaceWetness(wetness, hit.ns_W, &mat.pbr);
         if (vertex == 0) {
           for (int k = 0; k < 3; ++k) albedo_sum[k] += mat.pbr.base_color[k];

@@ -59,8 +59,7 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
   const Eigen::Vector3f wo = -d;
   const TextureFootprint footprint =
       ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h);
-  if (ctx.materials->has_normal_maps()) ctx.materials->ApplyNormalMap(&h, footprint);
-  SurfaceMaterial mat = ctx.materials->Evaluate(h, footprint);
+  SurfaceMaterial mat = ctx.materials->EvaluateAndMapNormal(&h, footprint);
   if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
   const Bsdf bsdf(mat.pbr, h.ns_W, h.ng_W, wo);
   const Eigen::Vector3f& n = bsdf.shading_normal();
@@ -122,13 +121,15 @@ void ForEachQuad(const PixelTile& tile, SharedFn&& shared, SingleFn&& single) {
 }
 
 // the sky irradiance on the shading normal of every hit pixel of the tile (the ambient term),
-// and that normal. with a sky volume (occluded sky light), a 2x2 quad of pixels that all see
-// one flat face (one geom, bitwise equal normals, points on one plane within 1 mm and within a
-// quarter probe spacing of each other) shares one lookup at the quad's mean point: the volume
-// interpolates probes one spacing apart (0.43 m in the default world), so across a quad
-// it changes by far less than the 8-bit output resolves, and the lookup is the costliest
-// per-pixel term of the tier. other quads (edges, curved or smooth-shaded faces) look up
-// every pixel.
+// and that normal. with a sky volume (occluded sky light), the probe weights and their mean SH
+// (SkyIrradianceVolume::Blend) follow the surface's position and geometric normal, and only
+// the SH evaluation the shading normal: a 2x2 quad of pixels that all see one flat face (one
+// geom, bitwise equal geometric normals, points on one plane within 1 mm and within a quarter
+// probe spacing of each other) shares one blend at the quad's mean point; the volume
+// interpolates probes one spacing apart (0.43 m in the default world), so across a quad it
+// changes by far less than the 8-bit output resolves, and the blend is the costliest per-pixel
+// term of the tier. every pixel then evaluates the blend at its own shading normal (normal
+// maps vary it from pixel to pixel). other quads (edges, curved faces) blend every pixel.
 void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scratch* scratch) {
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
@@ -149,15 +150,16 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
   }
   const float max_extent = 0.25f * volume->spacing();
   constexpr float kPlaneTolM = 1e-3f;
+  SkyIrradianceVolume::ShBlend blend;
   auto shared = [&](int, int, const int* quad) {
     const int i00 = quad[0];
     for (int c = 0; c < 4; ++c) {
       const int i = quad[c];
       if (!(primary.did_hit[i] && primary.hits[i].geom == primary.hits[i00].geom &&
-            scratch->n_s[i] == scratch->n_s[i00]))
+            primary.hits[i].ng_W == primary.hits[i00].ng_W))
         return false;
     }
-    const Eigen::Vector3f& n0 = scratch->n_s[i00];
+    const Eigen::Vector3f& n0 = primary.hits[i00].ng_W;
     const Eigen::Vector3f& p0 = primary.hits[i00].p_W;
     Eigen::Vector3f mean = Eigen::Vector3f::Zero();
     for (int c = 0; c < 4; ++c) {
@@ -166,13 +168,15 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
         return false;
       mean += 0.25f * primary.hits[quad[c]].p_W;
     }
-    const Eigen::Vector3f E = volume->Irradiance(mean, n0, *ctx.sky);
-    for (int c = 0; c < 4; ++c) scratch->sky_E[quad[c]] = E;
+    volume->Blend(mean, n0, &blend);
+    for (int c = 0; c < 4; ++c)
+      scratch->sky_E[quad[c]] = volume->IrradianceAt(blend, scratch->n_s[quad[c]], *ctx.sky);
     return true;
   };
   auto single = [&](int i) {
-    if (primary.did_hit[i])
-      scratch->sky_E[i] = volume->Irradiance(primary.hits[i].p_W, scratch->n_s[i], *ctx.sky);
+    if (!primary.did_hit[i]) return;
+    volume->Blend(primary.hits[i].p_W, primary.hits[i].ng_W, &blend);
+    scratch->sky_E[i] = volume->IrradianceAt(blend, scratch->n_s[i], *ctx.sky);
   };
   ForEachQuad(primary.tile, shared, single);
 }
@@ -316,7 +320,10 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const Eigen::Vector3f& wo = scratch.wo[i];
       // the texture is filtered over the pixel's ray cone where it meets the surface.
       SurfaceMaterial mat =
-          ctx.materials->Evaluate(h, ConeFootprint(spread, h.t * primary.rays[i].d.norm(), -wo, h));
+          primary.materials != nullptr
+              ? primary.materials[i]
+              : ctx.materials->Evaluate(
+                    h, ConeFootprint(spread, h.t * primary.rays[i].d.norm(), -wo, h));
       if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
       const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);

@@ -28,9 +28,12 @@
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
 // LightSampler::SampleLanes) and its shadow rays towards one light form one Embree packet
 // (RayScene::OccludedLanes); materials and textures are evaluated per pixel, textures filtered
-// over the pixel's ray cone (render/material_eval.h, Camera::pixel_spread_rad). the sky volume is
-// looked up once per 2x2 pixel quad that sees one flat face, at the quad's mean hit point (it
-// varies over a probe spacing, tens of pixels), else per pixel.
+// over the pixel's ray cone (render/material_eval.h, Camera::pixel_spread_rad), by the renderer
+// before the tile is shaded (PrimaryHits::materials; a material's base, normal and
+// metallic-roughness maps in one pass). the sky volume's probe weights are found once per 2x2
+// pixel quad that sees one flat face, at the quad's mean hit point and the face's geometric
+// normal (they vary over a probe spacing, tens of pixels), else per pixel; the resulting SH is
+// evaluated at every pixel's own shading normal (SkyIrradianceVolume::Blend, IrradianceAt).
 
 #include "penumbra/render/integrator.h"
 
@@ -44,6 +47,7 @@ class RealtimeIntegrator final : public Integrator {
  public:
   int64_t RenderTile(const FrameContext& ctx, const PrimaryHits& primary,
                      const FrameBuffers& out) const override;
+  bool wants_primary_materials() const override { return true; }
 };
 
 }  // namespace penumbra

@@ -596,16 +596,14 @@ Eigen::Vector3f SkyIrradianceVolume::ProbeIrradiance(int probe, const Eigen::Vec
   return e;
 }
 
-Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
-                                                const Eigen::Vector3f& n_W,
-                                                const SkyModel& sky) const {
-  if (empty()) return sky.Irradiance(n_W);
+bool SkyIrradianceVolume::LookupWeights(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
+                                        ProbeWeights* out) const {
   const Eigen::Vector3f q = p_W + (kNormalBias * spacing_) * n_W;
   const Eigen::Vector3f g = (q - origin_) * inv_spacing_;
   const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
   if (!(g.x() >= 0 && g.y() >= 0 && g.z() >= 0 && g.x() <= nx - 1 && g.y() <= ny - 1 &&
         g.z() <= nz - 1))
-    return sky.Irradiance(n_W);
+    return false;
   const int i0 = std::min(static_cast<int>(g.x()), nx - 2);
   const int j0 = std::min(static_cast<int>(g.y()), ny - 2);
   const int k0 = std::min(static_cast<int>(g.z()), nz - 2);
@@ -614,6 +612,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const float tol = kVisibilityTolerance * spacing_;
   const float inv_tol = 1.0f / tol;
   const int base = ProbeIndex(i0, j0, k0);
+  out->base = base;
   // probe index of corner c = dx + 2 dy + 4 dz: base + corner[c].
   const int32_t* corner = corner_offset_.data();
 
@@ -624,10 +623,11 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const F4 qx = Splat4(q.x()), qy = Splat4(q.y()), qz = Splat4(q.z());
   const F4 wx_tri = {1 - fx, fx, 1 - fx, fx}, wy_tri = {1 - fy, 1 - fy, fy, fy};
   const F4 wxy_tri = wx_tri * wy_tri;
-  alignas(16) float w[8];
+  float* w = out->w;
   alignas(16) int32_t texel[8];
   F4 r[2], d_n_r[2], tri[2];
-  unsigned front = 0;
+  unsigned& front = out->front;
+  front = 0;
   for (int h = 0; h < 2; ++h) {
     const F4 dx = Load4(cell + 4 * h) - qx, dy = Load4(cell + 8 + 4 * h) - qy,
              dz = Load4(cell + 16 + 4 * h) - qz;
@@ -651,7 +651,8 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     // offset of the texel in depth_q_ from the cell's first probe.
     Store4(texel + 4 * h, (ix + kOctSide * iy) + kNumTexels * Load4(corner + 4 * h));
   }
-  if (front == 0) return Eigen::Vector3f::Zero();
+  out->active = 0;
+  if (front == 0) return true;
   // the depth of each probe's ray towards q.
   const uint8_t* dq = &depth_q_[static_cast<size_t>(base) * kNumTexels];
   alignas(16) int32_t depth_q[8];
@@ -662,7 +663,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     depth_q[c] = dq[static_cast<uint32_t>(pair)];
     depth_q[c + 1] = dq[pair >> 32];
   }
-  unsigned active = 0;
+  unsigned& active = out->active;
   for (int h = 0; h < 2; ++h) {
     // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
     // ramps down to 0 over tol beyond that. r <= 1e-6: q on the probe, trilinear weight only.
@@ -675,6 +676,20 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     active |= MoveMask4(wh > 0.0f) << (4 * h);
   }
   active &= front;
+  return true;
+}
+
+Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
+                                                const Eigen::Vector3f& n_W,
+                                                const SkyModel& sky) const {
+  if (empty()) return sky.Irradiance(n_W);
+  ProbeWeights pw;
+  if (!LookupWeights(p_W, n_W, &pw)) return sky.Irradiance(n_W);
+  if (pw.front == 0) return Eigen::Vector3f::Zero();
+  const int base = pw.base;
+  const int32_t* corner = corner_offset_.data();
+  const float* w = pw.w;
+  const unsigned front = pw.front, active = pw.active;
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   float y[kNumSh];
   ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
@@ -702,6 +717,56 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
     }
   }
   return e.cwiseMax(0.0f);
+}
+
+void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3f& ng_W,
+                                ShBlend* out) const {
+  std::fill_n(out->c, 32, 0.0f);
+  out->open_sky = false;
+  ProbeWeights pw;
+  if (empty() || !LookupWeights(p_W, ng_W, &pw)) {
+    out->open_sky = true;
+    return;
+  }
+  if (pw.front == 0) return;
+  const int32_t* corner = corner_offset_.data();
+  const float* sh_base = &sh_[static_cast<size_t>(pw.base) * kShStride];
+  if (pw.active != 0) {
+    // the weighted mean of the probes' SH, all 7 packets.
+    F4 acc[kShStride / 4];
+    for (int i = 0; i < kShStride / 4; ++i) acc[i] = Splat4(0.0f);
+    float wsum = 0;
+    for (unsigned bits = pw.active; bits != 0; bits &= bits - 1) {
+      const int c = std::countr_zero(bits);
+      const float* sh = sh_base + corner[c] * kShStride;
+      const F4 wc = Splat4(pw.w[c]);
+      for (int i = 0; i < kShStride / 4; ++i) acc[i] += wc * Load4(sh + 4 * i);
+      wsum += pw.w[c];
+    }
+    const F4 inv = Splat4(1.0f / wsum);
+    for (int i = 0; i < kShStride / 4; ++i) Store4(out->c + 4 * i, acc[i] * inv);
+    return;
+  }
+  // no probe sees the point: the darkest valid probe in front of the surface (at ng_W).
+  float dark_lum = std::numeric_limits<float>::infinity();
+  int dark = -1;
+  for (unsigned bits = pw.front; bits != 0; bits &= bits - 1) {
+    const int c = std::countr_zero(bits);
+    const Eigen::Vector3f ej = ProbeIrradiance(pw.base + corner[c], ng_W);
+    const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
+    if (lum < dark_lum) dark_lum = lum, dark = c;
+  }
+  if (dark >= 0) std::copy_n(sh_base + corner[dark] * kShStride, kShStride, out->c);
+}
+
+Eigen::Vector3f SkyIrradianceVolume::IrradianceAt(const ShBlend& blend, const Eigen::Vector3f& n_W,
+                                                  const SkyModel& sky) const {
+  if (blend.open_sky) return sky.Irradiance(n_W);
+  float y[kNumSh];
+  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  F4 sum = Splat4(0.0f);
+  for (int k = 0; k < kNumSh; ++k) sum += y[k] * Load4(blend.c + 3 * kShSlot[k]);
+  return Eigen::Vector3f(sum[0], sum[1], sum[2]).cwiseMax(0.0f);
 }
 
 Eigen::Vector3f SkyIrradianceVolume::ProbeAmbient(int probe) const {

@@ -130,6 +130,32 @@ class SkyIrradianceVolume {
   Eigen::Vector3f Irradiance(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
                              const SkyModel& sky) const;
 
+  /// the interpolated irradiance SH of one surface point (Blend), to be evaluated at any
+  /// shading normal of that point (IrradianceAt).
+  struct ShBlend {
+    /// the probes' weighted mean SH in the volume's storage order (kShStride floats, padded),
+    /// or zero when no probe lights the point.
+    alignas(16) float c[32] = {};
+    /// the point lies outside the grid (or the volume is empty): IrradianceAt gives the
+    /// unoccluded SkyModel::Irradiance.
+    bool open_sky = false;
+  };
+
+  /// Irradiance in two steps, for surfaces whose shading normal varies faster than their
+  /// position and orientation (normal maps, smooth-shaded meshes): the probe weights of the
+  /// point p_W on a surface of unit geometric normal ng_W (tangent-plane test, normal bias,
+  /// visibility, the darkest-probe fallback: as Irradiance(p_W, ng_W)), and the weighted mean
+  /// of the probes' SH, which IrradianceAt then evaluates at a shading normal. Blend(p, n) and
+  /// IrradianceAt(that, n) give Irradiance(p, n) up to float rounding. requires Relight after
+  /// Build.
+  void Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3f& ng_W, ShBlend* out) const;
+
+  /// sky irradiance (lux per channel) at unit shading normal n_W of the point `blend` was made
+  /// for: its SH evaluated at n_W, clamped to >= 0; `sky`.Irradiance(n_W) where the blend is
+  /// open_sky.
+  Eigen::Vector3f IrradianceAt(const ShBlend& blend, const Eigen::Vector3f& n_W,
+                               const SkyModel& sky) const;
+
   /// occluded sphere-average sky radiance (cd/m^2 per channel) at a world point p_W in free
   /// space (participating media, particles): (1 / 4 pi) times the integral of the sky radiance
   /// over the directions in which p_W sees the sky past the static geometry, i.e. the l = 0
@@ -176,6 +202,16 @@ class SkyIrradianceVolume {
   static int TexelOf(const Eigen::Vector3f& w);
 
  private:
+  // the probe weights of a lookup at p_W with normal n_W (Irradiance): the cell's first probe,
+  // the corners in front of the surface and those with weight > 0 (bits c = dx + 2 dy + 4 dz),
+  // and the weights. false outside the grid.
+  struct ProbeWeights {
+    int base = 0;
+    unsigned front = 0, active = 0;
+    alignas(16) float w[8];
+  };
+  bool LookupWeights(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
+                     ProbeWeights* out) const;
   RayQueryFactory make_query_;
   std::array<int, 3> dims_{0, 0, 0};
   float spacing_ = 0;

@@ -177,16 +177,23 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     }
     if (buffers.radiance) {
       // normal maps bend the shading normals the integrators see (after the ground truth,
-      // whose normals stay the surfaces')
-      if (materials_.has_normal_maps()) {
+      // whose normals stay the surfaces'); the materials over the pixels' ray cones where the
+      // integrator takes them from here.
+      thread_local std::unique_ptr<SurfaceMaterial[]> mats(new SurfaceMaterial[kMax]);
+      const bool want_materials = integrator_->wants_primary_materials();
+      if (want_materials || materials_.has_normal_maps()) {
         for (int i = 0; i < n; ++i) {
           if (!did_hit[i]) continue;
           const float d_len = rays[i].d.norm();
-          materials_.ApplyNormalMap(&hits[i],
-                                    ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
-                                                  rays[i].d / d_len, hits[i]));
+          const TextureFootprint footprint = ConeFootprint(
+              camera.pixel_spread_rad(), hits[i].t * d_len, rays[i].d / d_len, hits[i]);
+          if (want_materials)
+            mats[i] = materials_.EvaluateAndMapNormal(&hits[i], footprint);
+          else
+            materials_.ApplyNormalMap(&hits[i], footprint);
         }
       }
+      primary.materials = want_materials ? mats.get() : nullptr;
       primary.rays = rays.get();
       primary.hits = hits.get();
       primary.did_hit = did_hit.get();
