@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
+#include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -16,6 +19,43 @@ ProceduralMaterialConfig Config(const std::string& type, uint64_t seed, int reso
   c.seed = seed;
   c.resolution = resolution;
   return c;
+}
+
+TEST(ProceduralMaterial, DiskCacheReturnsTheGeneratedMapsAndSurvivesABadEntry) {
+  testing::TempDir dir;
+  const std::string cache = (dir.path() / "materials").string();
+  const ProceduralMaterialConfig config = Config("wood", 7, 64);
+  const ProceduralMaps made = GenerateProceduralMaterial(config);
+  bool hit = true;
+  const ProceduralMaps first = CachedProceduralMaterial(config, cache, &hit);
+  EXPECT_FALSE(hit);
+  const ProceduralMaps second = CachedProceduralMaterial(config, cache, &hit);
+  EXPECT_TRUE(hit);
+  for (const ProceduralMaps* m : {&first, &second}) {
+    EXPECT_EQ(m->albedo->rgb_srgb(), made.albedo->rgb_srgb());
+    EXPECT_EQ(m->metal_roughness->rgb_srgb(), made.metal_roughness->rgb_srgb());
+    EXPECT_EQ(m->normal->rgb_srgb(), made.normal->rgb_srgb());
+    EXPECT_EQ(m->albedo->num_levels(), made.albedo->num_levels());
+    EXPECT_DOUBLE_EQ(m->size_m, made.size_m);
+  }
+  // another seed, resolution or colour is another entry.
+  ProceduralMaterialConfig other = config;
+  other.color = Eigen::Vector3f(0.5f, 0.4f, 0.3f);
+  EXPECT_NE(ProceduralMaterialKey(other), ProceduralMaterialKey(config));
+  CachedProceduralMaterial(other, cache, &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_NE(ProceduralMaterialKey(Config("wood", 8, 64)), ProceduralMaterialKey(config));
+  EXPECT_NE(ProceduralMaterialKey(Config("wood", 7, 128)), ProceduralMaterialKey(config));
+  // a truncated entry is a miss, and is written again.
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(cache)) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 2u);
+  for (const auto& f : files) std::filesystem::resize_file(f, 100);
+  const ProceduralMaps again = CachedProceduralMaterial(config, cache, &hit);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(again.normal->rgb_srgb(), made.normal->rgb_srgb());
+  CachedProceduralMaterial(config, cache, &hit);
+  EXPECT_TRUE(hit);
 }
 
 TEST(ProceduralMaterial, SameSeedSameMapsOtherSeedOtherMaps) {

@@ -1,10 +1,21 @@
 #include "penumbra/assets/procedural_material.h"
 
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
 #include <vector>
 
+#include "penumbra/core/cache_dir.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
+#include "penumbra/core/thread_pool.h"
 
 namespace penumbra {
 namespace {
@@ -301,7 +312,10 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
   const size_t count = static_cast<size_t>(n) * n;
   std::vector<uint8_t> albedo(count * 3), mr(count * 3), normal(count * 3);
   std::vector<float> height(count);
-  for (int y = 0; y < n; ++y)
+  // rows are independent (file comment): spread over the cores, the same bytes on any count.
+  ThreadPool pool(0);
+  pool.ParallelFor(n, [&](int64_t row) {
+    const int y = static_cast<int>(row);
     for (int x = 0; x < n; ++x) {
       const Texel tx = (gen.*fn)((x + 0.5f) / n, (y + 0.5f) / n);
       const size_t i = static_cast<size_t>(y) * n + x;
@@ -312,9 +326,11 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
       mr[3 * i + 2] = EncodeSrgb8(tx.metallic);
       height[i] = tx.height_m;
     }
+  });
   // normals by central differences (wrapped), x along +u, y towards the top row
   const float texel_m = static_cast<float>(out.size_m) / n;
-  for (int y = 0; y < n; ++y)
+  pool.ParallelFor(n, [&](int64_t row) {
+    const int y = static_cast<int>(row);
     for (int x = 0; x < n; ++x) {
       auto h = [&](int xi, int yi) {
         return height[static_cast<size_t>(Wrap(yi, n)) * n + Wrap(xi, n)];
@@ -326,10 +342,86 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
       const size_t i = static_cast<size_t>(y) * n + x;
       for (int c = 0; c < 3; ++c) normal[3 * i + c] = EncodeSrgb8((nn[c] + 1) * 0.5f);
     }
+  });
   out.albedo = MakeImage(n, std::move(albedo));
   out.metal_roughness = MakeImage(n, std::move(mr));
   out.normal = MakeImage(n, std::move(normal));
   return out;
+}
+
+std::string ProceduralMaterialKey(const ProceduralMaterialConfig& config) {
+  const double size_m = config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+  std::string color = "default";
+  if (config.color)
+    color = fmt::format("{:.9g},{:.9g},{:.9g}", config.color->x(), config.color->y(),
+                        config.color->z());
+  return fmt::format(
+      "penumbra-procedural v{} type={} seed={} size_m={:.17g} resolution={} color={}",
+      kProceduralMaterialVersion, config.type, config.seed, size_m, config.resolution, color);
+}
+
+namespace {
+
+constexpr char kMapsMagic[8] = {'P', 'N', 'M', 'A', 'P', 'S', '0', '1'};
+
+// the cache file: magic, key length (uint32) and key, then the level-0 bytes of the albedo,
+// metallic-roughness and normal maps (resolution^2 x 3 each).
+std::filesystem::path MapsPath(const std::string& cache_dir, const std::string& key) {
+  return std::filesystem::path(cache_dir) / fmt::format("{:016x}.pmaps", Fnv1a64(key));
+}
+
+std::optional<ProceduralMaps> LoadMaps(const std::filesystem::path& path, const std::string& key,
+                                       int n, double size_m) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t map_bytes = static_cast<size_t>(n) * n * 3;
+  const size_t head = sizeof kMapsMagic + sizeof(uint32_t) + key.size();
+  if (bytes.size() != head + 3 * map_bytes || std::memcmp(bytes.data(), kMapsMagic, 8) != 0)
+    return std::nullopt;
+  uint32_t key_len = 0;
+  std::memcpy(&key_len, bytes.data() + 8, sizeof key_len);
+  if (key_len != key.size() || bytes.compare(12, key.size(), key) != 0) return std::nullopt;
+  auto map = [&](int k) {
+    const char* p = bytes.data() + head + k * map_bytes;
+    return MakeImage(n, std::vector<uint8_t>(p, p + map_bytes));
+  };
+  ProceduralMaps maps;
+  maps.albedo = map(0);
+  maps.metal_roughness = map(1);
+  maps.normal = map(2);
+  maps.size_m = size_m;
+  return maps;
+}
+
+}  // namespace
+
+ProceduralMaps CachedProceduralMaterial(const ProceduralMaterialConfig& config,
+                                        const std::string& cache_dir, bool* cache_hit) {
+  const std::string key = ProceduralMaterialKey(config);
+  const double size_m = config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+  const std::filesystem::path path = MapsPath(cache_dir, key);
+  if (std::optional<ProceduralMaps> hit = LoadMaps(path, key, config.resolution, size_m)) {
+    if (cache_hit) *cache_hit = true;
+    return *std::move(hit);
+  }
+  if (cache_hit) *cache_hit = false;
+  ProceduralMaps maps = GenerateProceduralMaterial(config);
+  try {
+    std::error_code ec;
+    std::filesystem::create_directories(cache_dir, ec);
+    std::string bytes(kMapsMagic, sizeof kMapsMagic);
+    const uint32_t key_len = static_cast<uint32_t>(key.size());
+    bytes.append(reinterpret_cast<const char*>(&key_len), sizeof key_len);
+    bytes += key;
+    for (const auto& im : {maps.albedo, maps.metal_roughness, maps.normal})
+      bytes.append(reinterpret_cast<const char*>(im->rgb_srgb().data()), im->rgb_srgb().size());
+    WriteFileAtomic(path, bytes);
+  } catch (const std::exception& e) {
+    // a cache that cannot be written costs the next load time, nothing else.
+    spdlog::warn("procedural material cache not written: {}", e.what());
+  }
+  return maps;
 }
 
 void ApplyProceduralMaterials(const std::vector<ProceduralMaterialEntry>& entries,
@@ -340,7 +432,7 @@ void ApplyProceduralMaterials(const std::vector<ProceduralMaterialEntry>& entrie
       throw ConfigError(world_file, o.line, "materials." + o.material,
                         "no material with that name; expected a prefixed material name such as "
                         "'<model>/<material>'");
-    const ProceduralMaps maps = GenerateProceduralMaterial(o.config);
+    const ProceduralMaps maps = CachedProceduralMaterial(o.config, DefaultCacheDir("materials"));
     auto add = [&](const std::shared_ptr<const TextureImage>& image, const char* map) {
       Texture t;
       t.name = o.material + "/" + map;

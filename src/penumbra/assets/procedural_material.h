@@ -20,6 +20,7 @@
 // threads of 1 mm in a plain weave (0.2 m). docs/assets.md has the table.
 
 #include <memory>
+#include <string>
 
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/texture_image.h"
@@ -43,7 +44,27 @@ double ProceduralDefaultSize(const std::string& type);
 /// @throws Error for an unknown type.
 ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config);
 
-/// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps and
+/// bumped whenever GenerateProceduralMaterial's maps for the same config may change (the
+/// disk cache's entries of other versions are then never read).
+inline constexpr int kProceduralMaterialVersion = 1;
+
+/// the canonical text of `config` (type, seed, size, resolution, colour and
+/// kProceduralMaterialVersion) that names its maps in the cache.
+/// @throws Error for an unknown type.
+std::string ProceduralMaterialKey(const ProceduralMaterialConfig& config);
+
+/// GenerateProceduralMaterial through an on-disk cache in the folder `cache_dir` (created on
+/// the first store): the file "<16 hex digits of Fnv1a64(key)>.pmaps" holds the key and the
+/// three maps' level-0 bytes (3 x resolution^2 x 3 bytes; 2.4 MB at 512^2). a file whose key,
+/// size or header differs, or that cannot be read, counts as a miss; a miss generates the maps
+/// and stores them (written whole and renamed into place; a failed store only logs a warning).
+/// the mip levels are built at every load. `*cache_hit` (optional) tells which happened.
+/// @throws Error for an unknown type.
+ProceduralMaps CachedProceduralMaterial(const ProceduralMaterialConfig& config,
+                                        const std::string& cache_dir, bool* cache_hit = nullptr);
+
+/// for every `materials:` entry with `procedural:` (ProceduralMaterialsOf), generates its maps
+/// (CachedProceduralMaterial in DefaultCacheDir("materials"), core/cache_dir.h) and
 /// makes them the scene material's: texture (albedo, "<material>/albedo"), and the maps
 /// "<material>/metallic_roughness" and "<material>/normal" (render/material_eval.h, "PBR
 /// maps"), added to scene->textures; base_color 1, roughness and metallic

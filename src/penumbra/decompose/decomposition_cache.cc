@@ -12,6 +12,7 @@
 #include <sstream>
 #include <vector>
 
+#include "penumbra/core/cache_dir.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -73,16 +74,7 @@ class Reader {
 
 }  // namespace
 
-std::string DefaultDecompositionCacheDir() {
-  namespace fs = std::filesystem;
-  if (const char* d = std::getenv("PENUMBRA_CACHE_DIR"); d && *d)
-    return (fs::path(d) / "decompose").string();
-  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d)
-    return (fs::path(d) / "penumbra" / "decompose").string();
-  if (const char* d = std::getenv("HOME"); d && *d)
-    return (fs::path(d) / ".cache" / "penumbra" / "decompose").string();
-  return (fs::temp_directory_path() / "penumbra-cache" / "decompose").string();
-}
+std::string DefaultDecompositionCacheDir() { return DefaultCacheDir("decompose"); }
 
 std::string DecompositionKey(const SolidMesh& mesh, const DecompositionOptions& o) {
   Bytes b;
