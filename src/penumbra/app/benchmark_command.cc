@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -180,6 +181,9 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
+    // one OpenMP thread unless the caller chose otherwise: the benchmark runs its jobs side by
+    // side, and libgomp's spinning threads, more of them than cores, starve each other.
+    setenv("OMP_NUM_THREADS", "1", 0);
     execv(helper.c_str(), argv.data());
     throw Error("cannot run " + helper + " (built with penumbra): " + std::strerror(errno));
   }
