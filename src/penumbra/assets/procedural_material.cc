@@ -292,9 +292,18 @@ double ProceduralDefaultSize(const std::string& type) {
   throw Error("unknown procedural material type '" + type + "'");
 }
 
+namespace {
+
+// the image side of `config`, m: its size_m, else the type's default.
+double ImageSide(const ProceduralMaterialConfig& config) {
+  return config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+}
+
+}  // namespace
+
 ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config) {
   ProceduralMaps out;
-  out.size_m = config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+  out.size_m = ImageSide(config);
   const int n = config.resolution;
   Generator gen{config.seed, static_cast<float>(out.size_m),
                 config.color ? *config.color : DefaultColour(config.type)};
@@ -350,7 +359,7 @@ ProceduralMaps GenerateProceduralMaterial(const ProceduralMaterialConfig& config
 }
 
 std::string ProceduralMaterialKey(const ProceduralMaterialConfig& config) {
-  const double size_m = config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+  const double size_m = ImageSide(config);
   std::string color = "default";
   if (config.color)
     color = fmt::format("{:.9g},{:.9g},{:.9g}", config.color->x(), config.color->y(),
@@ -399,7 +408,7 @@ std::optional<ProceduralMaps> LoadMaps(const std::filesystem::path& path, const 
 ProceduralMaps CachedProceduralMaterial(const ProceduralMaterialConfig& config,
                                         const std::string& cache_dir, bool* cache_hit) {
   const std::string key = ProceduralMaterialKey(config);
-  const double size_m = config.size_m > 0 ? config.size_m : ProceduralDefaultSize(config.type);
+  const double size_m = ImageSide(config);
   const std::filesystem::path path = MapsPath(cache_dir, key);
   if (std::optional<ProceduralMaps> hit = LoadMaps(path, key, config.resolution, size_m)) {
     if (cache_hit) *cache_hit = true;

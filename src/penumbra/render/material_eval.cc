@@ -82,17 +82,28 @@ float TextureLod(const TextureFootprint& f, float rho) {
   return std::log2(f.width_m * rho / std::max(f.cos_incidence, kMinCosIncidence));
 }
 
+// the levels a trilinear lookup at `lod` reads in a chain of `num_levels` levels, with their
+// weights: add(level, weight) once (weight 1: level 0 for lod <= 0, the last level beyond it, or
+// an integer lod) or twice (floor(lod) with 1 - f, the next with f, f = the fraction of lod).
+template <typename AddFn>
+void TrilinearLevels(int num_levels, float lod, const AddFn& add) {
+  if (!(lod > 0)) return add(0, 1.0f);
+  const int last = num_levels - 1;
+  if (!(lod < static_cast<float>(last))) return add(last, 1.0f);
+  const int l = static_cast<int>(lod);
+  const float f = lod - static_cast<float>(l);
+  if (!(f > 0)) return add(l, 1.0f);
+  add(l, 1 - f);
+  add(l + 1, f);
+}
+
 // trilinear: bilinear(level) in the two levels around `lod`, mixed by its fraction.
 template <typename BilinearFn>
 Eigen::Vector3f Trilinear(const TextureImage& image, float lod, const BilinearFn& bilinear) {
-  if (!(lod > 0)) return bilinear(image.level(0));
-  const int last = image.num_levels() - 1;
-  if (!(lod < static_cast<float>(last))) return bilinear(image.level(last));
-  const int l = static_cast<int>(lod);
-  const float f = lod - static_cast<float>(l);
-  const Eigen::Vector3f a = bilinear(image.level(l));
-  if (!(f > 0)) return a;
-  return (1 - f) * a + f * bilinear(image.level(l + 1));
+  Eigen::Vector3f c = Eigen::Vector3f::Zero();
+  TrilinearLevels(image.num_levels(), lod,
+                  [&](int l, float w) { c += w * bilinear(image.level(l)); });
+  return c;
 }
 
 // the footprint ellipse's axes on the surface, geom frame (file comment, "anisotropic
@@ -139,10 +150,8 @@ inline AnisoTaps TapsFor(float l2_major, float l2_minor, int max_anisotropy) {
   return taps;
 }
 
-// the level index an integer lod (TapsFor, N > 1) selects, clamped to the image's levels.
-int TapLevel(const TextureImage& image, float lod) {
-  return std::min(static_cast<int>(lod), image.num_levels() - 1);
-}
+// the level index an integer lod (TapsFor, N > 1) selects, clamped to `num_levels` levels.
+int TapLevel(int num_levels, float lod) { return std::min(static_cast<int>(lod), num_levels - 1); }
 
 // mean of n bilinear lookups in one level (wrapped) at (s, t) + o_k (ds, dt), with the tap
 // offsets o_k = (k + 1/2) / n - 1/2 (footprint assembly along the major axis).
@@ -284,8 +293,13 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
                   "': expected six square faces stacked vertically (height = 6 width)");
   }
   // packed maps (file comment): a material's 2d base texture, normal and metallic-roughness
-  // maps, at least two of them, of one size, interleaved 8 bytes a texel, level by level.
+  // maps, at least two of them, of one size, interleaved as 8 linear 16-bit channels a texel,
+  // level by level.
   packed_of_.assign(scene.materials.size(), -1);
+  // the decoded value of every 8-bit code in steps of PackedLevel::kScale.
+  uint16_t linear[256];
+  for (int code = 0; code < 256; ++code)
+    linear[code] = static_cast<uint16_t>(std::lround(srgb_to_linear_[code] / PackedLevel::kScale));
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     auto image_2d = [&](int tex) -> const TextureImage* {
@@ -317,11 +331,6 @@ MaterialEvaluator::MaterialEvaluator(const SceneDescription& scene, int max_anis
       P.height = L.height;
       const size_t n = static_cast<size_t>(L.width) * L.height;
       P.texels.assign(8 * n, 0);
-      // the decoded value of every 8-bit code in 1/65535 steps
-      uint16_t linear[256];
-      for (int code = 0; code < 256; ++code)
-        linear[code] =
-            static_cast<uint16_t>(std::lround(srgb_to_linear_[code] / PackedLevel::kScale));
       auto put = [&](const TextureImage* im, int from, int count, int to) {
         if (im == nullptr) return;
         const uint8_t* src = im->level(l).rgb_srgb.data();
@@ -494,8 +503,8 @@ Eigen::Vector3f MaterialEvaluator::Filter2D(const TextureImage& image, const Map
   const FilterPlan plan =
       PlanFilter(image.width(), image.height(), map, aniso, major_G, minor_G, footprint);
   if (plan.n > 1)
-    return BilinearWrapTaps(image.level(TapLevel(image, plan.lod)), decode, map.s, map.t, plan.ds,
-                            plan.dt, plan.n);
+    return BilinearWrapTaps(image.level(TapLevel(image.num_levels(), plan.lod)), decode, map.s,
+                            map.t, plan.ds, plan.dt, plan.n);
   return Trilinear(image, plan.lod,
                    [&](const TextureLevel& L) { return BilinearWrap(L, decode, map.s, map.t); });
 }
@@ -506,9 +515,9 @@ void MaterialEvaluator::FilterPacked(const PackedMaps& packed, const Mapping2D& 
   const PackedLevel& L0 = packed.levels.front();
   const FilterPlan plan = PlanFilter(L0.width, L0.height, map, aniso, major_G, minor_G, footprint);
   std::fill_n(out, 8, 0.0f);
-  const int last = static_cast<int>(packed.levels.size()) - 1;
+  const int num_levels = static_cast<int>(packed.levels.size());
   if (plan.n > 1) {
-    const PackedLevel& L = packed.levels[std::min(static_cast<int>(plan.lod), last)];
+    const PackedLevel& L = packed.levels[TapLevel(num_levels, plan.lod)];
     const float step = 1.0f / static_cast<float>(plan.n);
     const float o0 = 0.5f * step - 0.5f;
     for (int k = 0; k < plan.n; ++k) {
@@ -517,15 +526,9 @@ void MaterialEvaluator::FilterPacked(const PackedMaps& packed, const Mapping2D& 
     }
     return;
   }
-  // trilinear, as Trilinear: level 0 below lod 0, the last level beyond it.
-  if (!(plan.lod > 0)) return AddBilinearPacked(packed.levels[0], map.s, map.t, 1, out);
-  if (!(plan.lod < static_cast<float>(last)))
-    return AddBilinearPacked(packed.levels[last], map.s, map.t, 1, out);
-  const int l = static_cast<int>(plan.lod);
-  const float f = plan.lod - static_cast<float>(l);
-  if (!(f > 0)) return AddBilinearPacked(packed.levels[l], map.s, map.t, 1, out);
-  AddBilinearPacked(packed.levels[l], map.s, map.t, 1 - f, out);
-  AddBilinearPacked(packed.levels[l + 1], map.s, map.t, f, out);
+  TrilinearLevels(num_levels, plan.lod, [&](int l, float w) {
+    AddBilinearPacked(packed.levels[l], map.s, map.t, w, out);
+  });
 }
 
 SurfaceMaterial MaterialEvaluator::Untextured(const SurfaceHit& hit, const Material& m) const {
@@ -591,17 +594,26 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     out.pbr.base_color = out.pbr.base_color.cwiseProduct(c);
   }
   if (!pbr_maps) return out;
-  auto sample = [&](int tex) {
-    return Filter2D(*scene_.textures[tex].image, mapping(), aniso, major_G, minor_G, footprint);
-  };
   if (maps.metallic_roughness >= 0) {
-    const Eigen::Vector3f c = sample(maps.metallic_roughness);
+    const Eigen::Vector3f c = Filter2D(*scene_.textures[maps.metallic_roughness].image, mapping(),
+                                       aniso, major_G, minor_G, footprint);
     out.pbr.roughness *= c.y();
     out.pbr.metallic *= c.z();
   }
-  if (maps.occlusion >= 0) out.occlusion = std::clamp(sample(maps.occlusion).x(), 0.0f, 1.0f);
-  if (maps.emissive >= 0) out.emission = out.emission.cwiseProduct(sample(maps.emissive));
+  ApplyOcclusionEmission(maps, mapping(), aniso, major_G, minor_G, footprint, &out);
   return out;
+}
+
+void MaterialEvaluator::ApplyOcclusionEmission(const PbrMaps& maps, const Mapping2D& map,
+                                               bool aniso, const Eigen::Vector3f& major_G,
+                                               const Eigen::Vector3f& minor_G,
+                                               const TextureFootprint& footprint,
+                                               SurfaceMaterial* out) const {
+  auto sample = [&](int tex) {
+    return Filter2D(*scene_.textures[tex].image, map, aniso, major_G, minor_G, footprint);
+  };
+  if (maps.occlusion >= 0) out->occlusion = std::clamp(sample(maps.occlusion).x(), 0.0f, 1.0f);
+  if (maps.emissive >= 0) out->emission = out->emission.cwiseProduct(sample(maps.emissive));
 }
 
 void MaterialEvaluator::ApplyNormalMap(SurfaceHit* hit, const TextureFootprint& footprint) const {
@@ -678,15 +690,7 @@ SurfaceMaterial MaterialEvaluator::EvaluateAndMapNormal(SurfaceHit* hit,
     out.pbr.roughness *= c[6];
     out.pbr.metallic *= c[7];
   }
-  const PbrMaps& maps = maps_[hit->material];
-  if (maps.occlusion >= 0)
-    out.occlusion = std::clamp(
-        Filter2D(*scene_.textures[maps.occlusion].image, map, aniso, major_G, minor_G, footprint)
-            .x(),
-        0.0f, 1.0f);
-  if (maps.emissive >= 0)
-    out.emission = out.emission.cwiseProduct(
-        Filter2D(*scene_.textures[maps.emissive].image, map, aniso, major_G, minor_G, footprint));
+  ApplyOcclusionEmission(maps_[hit->material], map, aniso, major_G, minor_G, footprint, &out);
   if (pm.normal) BendNormal(map, Eigen::Vector3f(c[3], c[4], c[5]), hit);
   return out;
 }

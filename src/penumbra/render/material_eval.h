@@ -217,6 +217,10 @@ class MaterialEvaluator {
   void FilterPacked(const PackedMaps& packed, const Mapping2D& map, bool aniso,
                     const Eigen::Vector3f& major_G, const Eigen::Vector3f& minor_G,
                     const TextureFootprint& footprint, float out[8]) const;
+  // multiplies in the occlusion and emissive maps of `maps` (each filtered alone).
+  void ApplyOcclusionEmission(const PbrMaps& maps, const Mapping2D& map, bool aniso,
+                              const Eigen::Vector3f& major_G, const Eigen::Vector3f& minor_G,
+                              const TextureFootprint& footprint, SurfaceMaterial* out) const;
   // bends hit->ns_W by the filtered normal-map texel c (ApplyNormalMap).
   void BendNormal(const Mapping2D& map, const Eigen::Vector3f& c, SurfaceHit* hit) const;
   Eigen::Vector3f Filter2D(const TextureImage& image, const Mapping2D& map, bool aniso,

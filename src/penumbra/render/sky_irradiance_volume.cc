@@ -201,12 +201,13 @@ inline I4 TexelIndex4(F4 t) {
 // coefficient k with y[k] != 0; kK... are those k in increasing order. the terms with y[k] = 0
 // that this leaves out would add an exact 0 to each channel, so the sum is bit for bit the
 // full one.
-template <int kLo, int kHi, int... kK>
-__attribute__((always_inline)) inline Eigen::Vector3f WeightedSh(const float* sh_base,
-                                                                 const int32_t* corner,
-                                                                 const float* w, unsigned active,
-                                                                 const float* y) {
-  F4 acc[kHi - kLo];
+// the weighted sum of packets kLo .. kHi - 1 of the active corners' SH (bits of `active`, in
+// increasing order, weight w[c], probe base + corner[c]) into acc[0 .. kHi - kLo); returns the
+// sum of the weights.
+template <int kLo, int kHi>
+__attribute__((always_inline)) inline float AccumulateSh(const float* sh_base,
+                                                         const int32_t* corner, const float* w,
+                                                         unsigned active, F4* acc) {
   for (int i = 0; i < kHi - kLo; ++i) acc[i] = Splat4(0.0f);
   float wsum = 0;
   for (unsigned bits = active; bits != 0; bits &= bits - 1) {
@@ -216,6 +217,16 @@ __attribute__((always_inline)) inline Eigen::Vector3f WeightedSh(const float* sh
     for (int i = 0; i < kHi - kLo; ++i) acc[i] += wc * Load4(sh + 4 * (kLo + i));
     wsum += w[c];
   }
+  return wsum;
+}
+
+template <int kLo, int kHi, int... kK>
+__attribute__((always_inline)) inline Eigen::Vector3f WeightedSh(const float* sh_base,
+                                                                 const int32_t* corner,
+                                                                 const float* w, unsigned active,
+                                                                 const float* y) {
+  F4 acc[kHi - kLo];
+  const float wsum = AccumulateSh<kLo, kHi>(sh_base, corner, w, active, acc);
   // packets kLo .. kHi - 1 of the sum at their place, zeros around them (one lane beyond a
   // coefficient is read).
   alignas(16) float a[kShStride + 4] = {};
@@ -689,7 +700,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const int base = pw.base;
   const int32_t* corner = corner_offset_.data();
   const float* w = pw.w;
-  const unsigned front = pw.front, active = pw.active;
+  const unsigned active = pw.active;
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   float y[kNumSh];
   ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
@@ -706,17 +717,25 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
       e = WeightedSh<0, 5, 0, 1, 6, 8>(sh_base, corner, w, active, y);
     else
       e = WeightedSh<0, kShStride / 4, 0, 1, 2, 3, 4, 5, 6, 7, 8>(sh_base, corner, w, active, y);
-  } else {
+  } else if (const int dark = DarkestFrontCorner(pw, n_W); dark >= 0) {
     // no probe sees q: the darkest valid probe in front of the surface.
-    float dark_lum = std::numeric_limits<float>::infinity();
-    for (unsigned bits = front; bits != 0; bits &= bits - 1) {
-      const int c = std::countr_zero(bits);
-      const Eigen::Vector3f ej = ProbeIrradiance(base + corner[c], n_W);
-      const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
-      if (lum < dark_lum) dark_lum = lum, e = ej;
-    }
+    e = ProbeIrradiance(base + corner[dark], n_W);
   }
   return e.cwiseMax(0.0f);
+}
+
+int SkyIrradianceVolume::DarkestFrontCorner(const ProbeWeights& pw,
+                                            const Eigen::Vector3f& n_W) const {
+  const int32_t* corner = corner_offset_.data();
+  float dark_lum = std::numeric_limits<float>::infinity();
+  int dark = -1;
+  for (unsigned bits = pw.front; bits != 0; bits &= bits - 1) {
+    const int c = std::countr_zero(bits);
+    const Eigen::Vector3f ej = ProbeIrradiance(pw.base + corner[c], n_W);
+    const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
+    if (lum < dark_lum) dark_lum = lum, dark = c;
+  }
+  return dark;
 }
 
 void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3f& ng_W,
@@ -734,29 +753,14 @@ void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3
   if (pw.active != 0) {
     // the weighted mean of the probes' SH, all 7 packets.
     F4 acc[kShStride / 4];
-    for (int i = 0; i < kShStride / 4; ++i) acc[i] = Splat4(0.0f);
-    float wsum = 0;
-    for (unsigned bits = pw.active; bits != 0; bits &= bits - 1) {
-      const int c = std::countr_zero(bits);
-      const float* sh = sh_base + corner[c] * kShStride;
-      const F4 wc = Splat4(pw.w[c]);
-      for (int i = 0; i < kShStride / 4; ++i) acc[i] += wc * Load4(sh + 4 * i);
-      wsum += pw.w[c];
-    }
+    const float wsum = AccumulateSh<0, kShStride / 4>(sh_base, corner, pw.w, pw.active, acc);
     const F4 inv = Splat4(1.0f / wsum);
     for (int i = 0; i < kShStride / 4; ++i) Store4(out->c + 4 * i, acc[i] * inv);
     return;
   }
   // no probe sees the point: the darkest valid probe in front of the surface (at ng_W).
-  float dark_lum = std::numeric_limits<float>::infinity();
-  int dark = -1;
-  for (unsigned bits = pw.front; bits != 0; bits &= bits - 1) {
-    const int c = std::countr_zero(bits);
-    const Eigen::Vector3f ej = ProbeIrradiance(pw.base + corner[c], ng_W);
-    const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
-    if (lum < dark_lum) dark_lum = lum, dark = c;
-  }
-  if (dark >= 0) std::copy_n(sh_base + corner[dark] * kShStride, kShStride, out->c);
+  if (const int dark = DarkestFrontCorner(pw, ng_W); dark >= 0)
+    std::copy_n(sh_base + corner[dark] * kShStride, kShStride, out->c);
 }
 
 Eigen::Vector3f SkyIrradianceVolume::IrradianceAt(const ShBlend& blend, const Eigen::Vector3f& n_W,

@@ -212,6 +212,10 @@ class SkyIrradianceVolume {
   };
   bool LookupWeights(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
                      ProbeWeights* out) const;
+  // the corner (bit index) of the darkest probe in front of the surface, judged by its
+  // irradiance luminance at n_W: the lookup's fallback when no probe sees the point; -1 when
+  // none is in front.
+  int DarkestFrontCorner(const ProbeWeights& pw, const Eigen::Vector3f& n_W) const;
   RayQueryFactory make_query_;
   std::array<int, 3> dims_{0, 0, 0};
   float spacing_ = 0;
