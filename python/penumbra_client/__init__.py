@@ -18,8 +18,8 @@ from .messages import LIDAR_POINT_DTYPE, Message, ModelInfo, State, StepResult, 
 from .protocol import (PROTOCOL_VERSION, BadFieldError, BadReplyError, CommandFailedError,
                        ConflictError, MalformedRequestError, MissingFieldError,
                        NotAvailableError, PenumbraError, PenumbraTimeoutError,
-                       RequestTooLargeError, RunEndedError, UnknownCommandError,
-                       UnknownFieldError, VersionMismatchError)
+                       RequestTooLargeError, RunEndedError, StoppingError,
+                       UnknownCommandError, UnknownFieldError, VersionMismatchError)
 from .spaces import Box, Dict
 
 __all__ = [
@@ -28,5 +28,5 @@ __all__ = [
     "depth_mm_to_m", "Box", "Dict", "PROTOCOL_VERSION", "PenumbraError", "PenumbraTimeoutError",
     "BadReplyError", "MalformedRequestError", "RequestTooLargeError", "UnknownCommandError",
     "MissingFieldError", "BadFieldError", "UnknownFieldError", "VersionMismatchError",
-    "ConflictError", "NotAvailableError", "RunEndedError", "CommandFailedError",
+    "ConflictError", "NotAvailableError", "RunEndedError", "StoppingError", "CommandFailedError",
 ]

@@ -93,6 +93,13 @@ class RunEndedError(PenumbraError):
     code = "run_ended"
 
 
+class StoppingError(RunEndedError):
+    """``stopping``: the run is stopping or has stopped and the command was not carried out
+    (queued when the run stopped, sent while the server shuts down, or ``start_recording``
+    after a stop). A kind of :class:`RunEndedError`."""
+    code = "stopping"
+
+
 class CommandFailedError(PenumbraError):
     """``failed``: the command was valid but failed while being applied."""
     code = "failed"
@@ -111,7 +118,7 @@ class BadReplyError(PenumbraError):
 ERROR_CLASSES = {cls.code: cls for cls in (
     MalformedRequestError, RequestTooLargeError, UnknownCommandError, MissingFieldError,
     BadFieldError, UnknownFieldError, VersionMismatchError, ConflictError, NotAvailableError,
-    RunEndedError, CommandFailedError)}
+    RunEndedError, StoppingError, CommandFailedError)}
 
 
 def _to_msgpack(value):

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -15,6 +16,8 @@
 
 #include "app/child_process.h"
 #include "common/temp_dir.h"
+#include "penumbra/runlog/run_log_codec.h"
+#include "penumbra/runlog/run_log_reader.h"
 
 namespace penumbra {
 namespace {
@@ -354,6 +357,56 @@ TEST(ReplayRunTest, ACutLogReplaysToItsLastCompleteChunk) {
   }
   const std::string manifest = ReadAll(out / "run.json");
   EXPECT_NE(manifest.find("log ends at chunk "), std::string::npos) << manifest;
+}
+
+// issue 33: a log with one flipped byte in a steps chunk is damaged, never "bit-exact": the
+// verdict names the chunk and its steps and the exit status is 1
+TEST(ReplayRunTest, ResimulateOfALogWithAFlippedStepByteReportsTheDamageAndFails) {
+  testing::TempDir tmp;
+  tmp.Write("ball.xml", R"(<mujoco><worldbody><geom type="plane" size="2 2 0.1"/>
+    <body pos="0 0 1"><freejoint/><geom type="sphere" size="0.1"/></body></worldbody></mujoco>)");
+  const std::string world = tmp.Write("w.yaml",
+                                      "duration_sec: 1.2\nmodels: [{name: s, file: ball.xml}]\n"
+                                      "cameras: [{name: cam, width: 16, height: 12, rate_hz: 5}]\n"
+                                      "mjcf_cameras: {enabled: false}\n");
+  const std::string log = (tmp.path() / "b.plog").string();
+  auto r = RunPenumbra(
+      {"run", world, "--out", (tmp.path() / "run").string(), "-q", "--record", log}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunPenumbra({"replay", log, "--resimulate"}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  ASSERT_EQ(r.out, "bit-exact (601 steps)\n");
+
+  // one byte in the middle of the second steps chunk (steps 256..511)
+  uint64_t at = 0;
+  {
+    RunLogReader reader = RunLogReader::Open(log);
+    int steps_chunks = 0;
+    for (const RunLogChunkInfo& c : reader.chunks())
+      if (c.kind == RunLogChunkKind::kSteps && ++steps_chunks == 2)
+        at = c.file_offset + runlog_codec::kChunkHeaderBytes + c.compressed_size / 2;
+    ASSERT_GE(steps_chunks, 2);
+  }
+  {
+    std::fstream f(log, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(at));
+    char b = 0;
+    f.read(&b, 1);
+    b = static_cast<char>(b ^ 0x01);
+    f.seekp(static_cast<std::streamoff>(at));
+    f.write(&b, 1);
+  }
+  for (const char* mode : {"", "ctrl"}) {
+    std::vector<std::string> args = {"replay", log, "--resimulate"};
+    if (*mode) args.push_back(mode);
+    r = RunPenumbra(args, tmp.path());
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_EQ(r.out.find("bit-exact ("), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.rfind("damaged log, not verified past step 255: log ends at chunk ", 0), 0u)
+        << r.out;
+    EXPECT_NE(r.out.find("CRC mismatch in chunk "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("steps 256..511"), std::string::npos) << r.out;
+  }
 }
 
 }  // namespace

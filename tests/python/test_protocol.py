@@ -57,7 +57,7 @@ class DecodeReplyTest(unittest.TestCase):
             "bad_field": pc.BadFieldError, "unknown_field": pc.UnknownFieldError,
             "version_mismatch": pc.VersionMismatchError, "conflict": pc.ConflictError,
             "not_available": pc.NotAvailableError, "run_ended": pc.RunEndedError,
-            "failed": pc.CommandFailedError,
+            "stopping": pc.StoppingError, "failed": pc.CommandFailedError,
         }
         for code, cls in cases.items():
             body = msgpack.packb({"ok": False, "cmd": "set_ctrl", "id": 2, "error": {

@@ -6,10 +6,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/recorder_sink.h"
+#include "penumbra/runlog/run_log_codec.h"
+#include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/session.h"
@@ -43,13 +47,15 @@ class ResimulateTest : public ::testing::Test {
     Session session(LoadWorldFile(world), o);
     PhysicsSource physics(&session.sim());
     RecorderSink recorder(log_, MakeRunLogHeader(session, "test", "penumbra run w.yaml"));
-    if (with_command_) recorder.writer().RecordEvent(10, 0.02, "command", R"({"v": 1})");
-    ASSERT_FALSE(testing::RunLoop(&physics, {&recorder}, 0.4).error);
+    if (with_command_) recorder.writer().RecordEvent(10, 0.02, "command", command_);
+    ASSERT_FALSE(testing::RunLoop(&physics, {&recorder}, duration_sec_).error);
   }
 
   testing::TempDir tmp_;
   std::string model_, log_;
   bool with_command_ = false;
+  std::string command_ = R"({"v": 1})";
+  double duration_sec_ = 0.4;
 };
 
 TEST_F(ResimulateTest, TheRecordingsOwnWorldIsBitExactInBothModes) {
@@ -113,6 +119,79 @@ TEST_F(ResimulateCommandsTest, CommandEventsAreRefusedUnlessTheLoggedCtrlIsAppli
   }
   o.mode = ResimulateMode::kCtrl;
   EXPECT_EQ(ResimulateLog(o).Describe(), "bit-exact (201 steps)");
+}
+
+class ResimulateStateCommandTest : public ResimulateTest {
+ protected:
+  void SetUp() override {
+    with_command_ = true;
+    command_ = R"({"cmd": "set_mocap", "body": "target", "xyz": [0, 0, 1]})";
+    ResimulateTest::SetUp();
+  }
+};
+
+TEST_F(ResimulateStateCommandTest, ACommandThatSetsTheStateIsRefusedInBothModesNamingIt) {
+  ResimulateOptions o;
+  o.log_path = log_;
+  EXPECT_THROW(ResimulateLog(o), ConfigError);
+  o.mode = ResimulateMode::kCtrl;
+  try {
+    ResimulateLog(o);
+    ADD_FAILURE() << "a set_mocap command was resimulated";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("1 command event(s) that change the state itself (the "
+                                         "first, 'set_mocap', at step 10)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// a log of 401 steps: two steps chunks (256 + 145 steps)
+class ResimulateDamagedTest : public ResimulateTest {
+ protected:
+  void SetUp() override {
+    duration_sec_ = 0.8;
+    ResimulateTest::SetUp();
+  }
+};
+
+TEST_F(ResimulateDamagedTest, AFlippedByteInAStepsChunkIsReportedAsDamageNeverBitExact) {
+  // one byte in the middle of the second steps chunk's body
+  uint64_t at = 0;
+  {
+    RunLogReader reader = RunLogReader::Open(log_);
+    int steps_chunks = 0;
+    for (const RunLogChunkInfo& c : reader.chunks())
+      if (c.kind == RunLogChunkKind::kSteps && ++steps_chunks == 2)
+        at = c.file_offset + runlog_codec::kChunkHeaderBytes + c.compressed_size / 2;
+    ASSERT_EQ(steps_chunks, 2);
+  }
+  {
+    std::fstream f(log_, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(at));
+    char b = 0;
+    f.read(&b, 1);
+    b = static_cast<char>(b ^ 0x10);
+    f.seekp(static_cast<std::streamoff>(at));
+    f.write(&b, 1);
+  }
+  for (ResimulateMode mode : {ResimulateMode::kControllers, ResimulateMode::kCtrl}) {
+    ResimulateOptions o;
+    o.log_path = log_;
+    o.mode = mode;
+    const ResimulateReport r = ResimulateLog(o);
+    EXPECT_FALSE(r.divergence);
+    EXPECT_FALSE(r.bit_exact());
+    ASSERT_TRUE(r.damage);
+    EXPECT_NE(r.damage->find("CRC mismatch in chunk"), std::string::npos) << *r.damage;
+    EXPECT_NE(r.damage->find("steps 256..400"), std::string::npos) << *r.damage;
+    // the steps before the damage were checked, and said so; "bit-exact (N steps)" never
+    EXPECT_EQ(r.steps_checked, 256);
+    EXPECT_EQ(r.Describe().rfind("damaged log, not verified past step 255: log ends at chunk", 0),
+              0u)
+        << r.Describe();
+    EXPECT_EQ(r.Describe().find("bit-exact ("), std::string::npos) << r.Describe();
+  }
 }
 
 }  // namespace

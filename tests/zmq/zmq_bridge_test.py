@@ -6,7 +6,16 @@ usage: zmq_bridge_test.py --binary PATH/penumbra --source REPO_ROOT [TEST ...]
 tests: lockstep (determinism across two runs, every frame and IMU sample due is delivered),
        errors (each kind of bad request gets an error reply and the next request works),
        stop (the `stop` command and SIGINT end the run with outputs intact),
-       free (free-running with --realtime: frames stream while the client only listens).
+       free (free-running with --realtime: frames stream while the client only listens),
+       live (set_adversity, set_effect, start/stop_recording),
+       shutdown (500 requests sent while the run stops all get a reply; a start_recording
+                 after `stop` is refused with `stopping` and leaves no file),
+       subscriptions (beyond 1024 distinct prefixes or the prefix length cap a subscription is
+                      dropped and logged),
+       unsubscribe (10,000 subscriptions whose subscribers leave: the command socket keeps
+                    answering),
+       bridge_log (the run log of a ZeroMQ-driven run holds its commands: --resimulate refuses
+                   it naming the first, --resimulate ctrl reproduces it bit-exactly).
 """
 import argparse
 import hashlib
@@ -476,8 +485,193 @@ def test_live(binary, source):
             server.kill()
 
 
+def test_shutdown(binary, source):
+    """500 requests in flight while the run stops: every one gets a reply, ok or `stopping`."""
+    pack = lambda d: msgpack.packb(d, use_bin_type=True)  # noqa: E731
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
+        late = os.path.join(tmp, "late.plog")
+        try:
+            c = Client(server, topics=())
+            c.ok("step", n=10)
+            d = c.ctx.socket(zmq.DEALER)
+            d.setsockopt(zmq.LINGER, 0)
+            d.setsockopt(zmq.RCVHWM, 0)
+            d.setsockopt(zmq.SNDHWM, 0)
+            d.connect(server.endpoint)
+            total = 500
+            for i in range(total):
+                if i == 200:
+                    body = {"cmd": "stop", "id": i}
+                elif i == 300:
+                    body = {"cmd": "start_recording", "id": i, "path": late}
+                elif i % 2:
+                    body = {"cmd": "get_state", "id": i}
+                else:
+                    body = {"cmd": "hello", "id": i, "protocol": 1}
+                d.send_multipart([b"", pack(body)])
+            replies = {}
+            poller = zmq.Poller()
+            poller.register(d, zmq.POLLIN)
+            deadline = time.time() + TIMEOUT_MS / 1000
+            while len(replies) < total and time.time() < deadline:
+                if not poller.poll(200):
+                    continue
+                r = msgpack.unpackb(d.recv_multipart()[-1], raw=False)
+                assert r["id"] not in replies, f"two replies to request {r['id']}"
+                replies[r["id"]] = r
+            missing = sorted(set(range(total)) - set(replies))
+            assert not missing, f"{len(missing)} of {total} requests got no reply: {missing[:10]}"
+            codes = {}
+            for i, r in replies.items():
+                code = "ok" if r["ok"] else r["error"]["code"]
+                codes[code] = codes.get(code, 0) + 1
+                # run_ended: a request that reached the run's queue after its end (a reply too)
+                assert code in ("ok", "stopping", "run_ended"), (i, r)
+            assert replies[200]["ok"], replies[200]
+            assert codes.get("stopping", 0) > 0, codes
+            # the requests before the stop were carried out
+            assert all(replies[i]["ok"] for i in range(200)), codes
+            # a recording asked for after the stop: refused, no file left behind
+            r = replies[300]
+            assert not r["ok"] and r["error"]["code"] == "stopping", r
+            assert not os.path.exists(late), "start_recording after stop left a file"
+            d.close()
+            c.close()
+            assert server.wait() == 0
+        finally:
+            server.kill()
+
+
+def wait_for_sync(c, subs):
+    """calls sync until every socket of `subs` received a sync message: each one's earlier
+    subscriptions have then been taken in by the server (ZeroMQ keeps a peer's order)."""
+    pending = list(subs)
+    deadline = time.time() + TIMEOUT_MS / 1000
+    while pending:
+        assert time.time() < deadline, f"{len(pending)} sockets never got a sync message"
+        c.call("sync", token="barrier")
+        for s in list(pending):
+            while s.poll(50):
+                if s.recv_multipart()[0] == b"sync":
+                    pending.remove(s)
+                    break
+
+
+def test_subscriptions(binary, source):
+    """subscriptions beyond the caps are dropped (and logged), the rest still work."""
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
+        try:
+            c = Client(server, topics=())
+            j = c.ctx.socket(zmq.SUB)
+            j.setsockopt(zmq.LINGER, 0)
+            j.setsockopt(zmq.SNDHWM, 0)
+            j.connect(c.hello["pub_endpoint"])
+            j.setsockopt(zmq.SUBSCRIBE, b"sync")  # 1 distinct prefix
+            for i in range(1023):                  # 1024: the cap
+                j.setsockopt(zmq.SUBSCRIBE, b"junk/%04d" % i)
+            j.setsockopt(zmq.SUBSCRIBE, b"clock")      # beyond the cap: dropped
+            j.setsockopt(zmq.SUBSCRIBE, b"c" * 300)    # longer than 256 bytes: dropped
+            j.setsockopt(zmq.UNSUBSCRIBE, b"junk/0000")
+            j.setsockopt(zmq.SUBSCRIBE, b"joint_states")  # room again: kept
+            wait_for_sync(c, [j])
+            r = c.ok("step", n=5)
+            # joint_states (after an unsubscribe made room) is published, clock is not
+            assert r["published"].get("joint_states") == 6, r["published"]
+            assert "clock" not in r["published"], r["published"]
+            j.close()
+            c.ok("stop")
+            c.close()
+            assert server.wait() == 0
+            with open(server.log_path) as f:
+                log = f.read()
+            assert "dropped the subscription 'clock': 1024 distinct subscriptions are held" in log, log
+            assert "dropped a subscription of 300 bytes" in log, log
+        finally:
+            server.kill()
+
+
+def test_unsubscribe(binary, source):
+    """10,000 subscriptions of 500 bytes, then their subscribers leave: the command socket
+    keeps answering (each request within a generous bound) while the server removes them."""
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
+        try:
+            c = Client(server, topics=(b"sync",))
+            subs = []
+            for k in range(10):
+                s = c.ctx.socket(zmq.SUB)
+                s.setsockopt(zmq.LINGER, 0)
+                s.setsockopt(zmq.SNDHWM, 0)
+                s.connect(c.hello["pub_endpoint"])
+                for i in range(1000):
+                    # prefixes that agree on their first 490 bytes
+                    s.setsockopt(zmq.SUBSCRIBE, b"x" * 490 + b"%02d%08d" % (k, i))
+                s.setsockopt(zmq.SUBSCRIBE, b"sync")
+                subs.append(s)
+            wait_for_sync(c, subs)
+            for s in subs:
+                s.close()
+            c.req.setsockopt(zmq.RCVTIMEO, 2000)
+            t_end = time.time() + 8
+            n = 0
+            while time.time() < t_end:
+                c.req.send(msgpack.packb({"cmd": "get_state"}, use_bin_type=True))
+                try:
+                    r = msgpack.unpackb(c.req.recv(), raw=False)
+                except zmq.Again:
+                    raise AssertionError(f"no reply within 2 s to request {n} after the "
+                                         "subscribers left")
+                assert r["ok"], r
+                n += 1
+                time.sleep(0.05)
+            c.req.setsockopt(zmq.RCVTIMEO, TIMEOUT_MS)
+            c.ok("stop")
+            c.close()
+            assert server.wait() == 0
+        finally:
+            server.kill()
+
+
+def test_bridge_log(binary, source):
+    """a run driven over ZeroMQ logs its commands; --resimulate refuses the log naming the
+    first, --resimulate ctrl (the logged ctrl) reproduces it bit-exactly."""
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        plog = os.path.join(tmp, "driven.plog")
+        server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep", "--record", plog])
+        try:
+            c = Client(server, topics=())
+            c.ok("step", n=20)
+            c.ok("twist", vx=0.3, yaw_rate=0.2)
+            c.ok("step", n=100)
+            c.ok("twist", clear=True)
+            c.ok("step", n=30)
+            c.ok("stop")
+            c.close()
+            assert server.wait() == 0
+        finally:
+            server.kill()
+        r = subprocess.run([binary, "replay", plog, "--resimulate"], capture_output=True,
+                           text=True)
+        assert r.returncode == 2, (r.returncode, r.stdout, r.stderr)
+        assert "diverged" not in r.stdout, r.stdout
+        assert "the log holds 2 command event(s) (the first, 'twist', at step 20)" in r.stderr, \
+            r.stderr
+        r = subprocess.run([binary, "replay", plog, "--resimulate", "ctrl"], capture_output=True,
+                           text=True)
+        assert r.returncode == 0, (r.returncode, r.stdout, r.stderr)
+        assert r.stdout.startswith("bit-exact ("), r.stdout
+
+
 TESTS = {"lockstep": test_lockstep, "errors": test_errors, "stop": test_stop,
-         "free": test_free, "live": test_live}
+         "free": test_free, "live": test_live, "shutdown": test_shutdown,
+         "subscriptions": test_subscriptions, "unsubscribe": test_unsubscribe,
+         "bridge_log": test_bridge_log}
 
 
 def main():

@@ -122,6 +122,8 @@ int ReplayCommand::Run(const std::vector<std::string>& command_line,
     std::cout << report.Describe() << std::endl;
     if (report.divergence) return 3;
     if (report.interrupted && stop_request) return 128 + stop_request->load();
+    // a damaged log (or one not checked to its end) is not bit-exact: a runtime failure
+    if (!report.bit_exact()) return 1;
     return 0;
   }
 

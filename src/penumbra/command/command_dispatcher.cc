@@ -159,7 +159,7 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
   RunControl& control = *control_;
   auto queue = [&](RunControl::Action action) {
     rd.CheckNoUnknown();
-    control.Submit(std::move(action), done);
+    control.Submit(LoggedAction(cmd, rd.request(), std::move(action)), done);
   };
   auto reply_now = [&](json fields) {
     json r = {{"ok", true}};
@@ -422,14 +422,40 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     return;
   }
   if (cmd == "stop") {
+    rd.CheckNoUnknown();
+    control.NoteStopQueued();
     queue([&control](Simulation& sim) {
       control.RequestStop();
       return StepTime(sim);
     });
     return;
   }
+  // a recording started while the run stops would get no step: refused rather than left empty
+  if (cmd == "start_recording" && (control.stopping() || (live_ && live_->recorder().finished())))
+    throw CommandError(command_code::kStopping, "",
+                       "the run is stopping; no recording can start now");
   // set_adversity, set_effect, start_recording, stop_recording
   reply_now(HandleLive(cmd, rd));
+}
+
+RunControl::Action CommandDispatcher::LoggedAction(const std::string& cmd, const json& request,
+                                                   RunControl::Action action) const {
+  static const char* const kChangesSimulation[] = {"set_ctrl",  "twist",     "joint_targets",
+                                                   "waypoints", "set_mocap", "reset"};
+  if (!live_ ||
+      std::find_if(std::begin(kChangesSimulation), std::end(kChangesSimulation),
+                   [&](const char* c) { return cmd == c; }) == std::end(kChangesSimulation))
+    return action;
+  // the request as carried out, logged at the step boundary it took effect at
+  json payload = request;
+  payload.erase("id");
+  return [live = live_, payload = std::move(payload), action = std::move(action)](Simulation& sim) {
+    const int64_t step = sim.step_count();
+    const double time_sec = sim.time();
+    json r = action(sim);
+    live->RecordCommand(step, time_sec, payload);
+    return r;
+  };
 }
 
 json CommandDispatcher::HandleLive(const std::string& cmd, RequestReader& rd) {

@@ -66,6 +66,10 @@ class CommandDispatcher {
   void Handle(const std::string& cmd, RequestReader& rd, const Done& done);
   // set_adversity, set_effect, start_recording, stop_recording (throws CommandError)
   nlohmann::json HandleLive(const std::string& cmd, RequestReader& rd);
+  // `action` that also records `request` as a "command" event of the run's logs (LiveControl::
+  // RecordCommand) once it ran, for the commands that change the simulation
+  RunControl::Action LoggedAction(const std::string& cmd, const nlohmann::json& request,
+                                  RunControl::Action action) const;
   // the controller a controller command addresses (`robot` field, or the only one)
   const Target& FindTarget(RequestReader& rd, const std::string& command);
 

@@ -20,6 +20,7 @@ inline constexpr const char* kVersionMismatch = "version_mismatch";
 inline constexpr const char* kConflict = "conflict";
 inline constexpr const char* kNotAvailable = "not_available";
 inline constexpr const char* kRunEnded = "run_ended";
+inline constexpr const char* kStopping = "stopping";
 inline constexpr const char* kFailed = "failed";
 }  // namespace command_code
 

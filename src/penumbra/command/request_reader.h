@@ -41,6 +41,9 @@ class RequestReader {
   /// @throws CommandError unknown_field naming the first key no getter read.
   void CheckNoUnknown() const;
 
+  /// the whole request as decoded.
+  const nlohmann::json& request() const { return request_; }
+
   /// `v` as a finite real, or throws bad_field naming `field`.
   static double RealValue(const nlohmann::json& v, const std::string& field);
 

@@ -225,7 +225,8 @@ void RunControl::OnFinish(const LoopFinish&) {
       }
       w.done(std::move(r));
     } else {
-      w.done(ErrorOnly(CommandError(command_code::kRunEnded, "", "the run has ended")));
+      w.done(ErrorOnly(CommandError(command_code::kStopping, "",
+                                    "the run stopped before this command was carried out")));
     }
   }
 }

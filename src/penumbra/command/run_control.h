@@ -90,6 +90,15 @@ class RunControl : public Sink {
   /// whether the run is paused (as of the last boundary), has ended.
   bool paused() const { return paused_.load(); }
   bool ended() const { return ended_.load(); }
+  /// whether the run takes no further step: a stop was requested (`stop`, the outside stop
+  /// request) or it has ended (any thread).
+  bool stopping() const {
+    return stop_queued_.load() || stop_.load() != 0 || ended_.load() ||
+           (options_.external_stop && options_.external_stop->load() != 0);
+  }
+  /// a `stop` command was queued (it ends the run at its boundary): from now on stopping()
+  /// is true, so requests that arrive after it are refused where a stop matters (thread-safe).
+  void NoteStopQueued() { stop_queued_.store(true); }
   /// the step and sim time of the last step boundary the loop thread passed (any thread).
   int64_t boundary_step() const { return boundary_step_.load(); }
   double boundary_time_sec() const { return boundary_time_.load(); }
@@ -105,7 +114,8 @@ class RunControl : public Sink {
   void OnStart(const LoopStart& start) override;
   SnapshotContent Wants(int64_t, double) override { return SnapshotContent::kNone; }
   void OnSnapshot(const std::shared_ptr<const WorldSnapshot>&) override {}
-  /// completes an active step request ("ended": true) and fails queued work (run_ended).
+  /// completes an active step request ("ended": true) and fails queued work that was not carried
+  /// out with a `stopping` error.
   void OnFinish(const LoopFinish& finish) override;
 
  private:
@@ -135,6 +145,7 @@ class RunControl : public Sink {
   std::atomic<int> stop_{0};
   std::atomic<bool> paused_{false};
   std::atomic<bool> ended_{false};
+  std::atomic<bool> stop_queued_{false};
   std::atomic<double> factor_{0};
   std::atomic<bool> factor_changed_{false};
   std::atomic<int64_t> boundary_step_{0};

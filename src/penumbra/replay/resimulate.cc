@@ -207,7 +207,19 @@ std::string ResimulateReport::Describe() const {
   if (interrupted)
     return fmt::format("stopped after {} steps (bit-exact so far, to step {})", steps_checked,
                        last_step);
+  if (damage)
+    return fmt::format(
+        "damaged log, not verified past step {}: {} ({} steps before it bit-exact; "
+        "expected an undamaged log with its end chunk)",
+        last_step, *damage, steps_checked);
+  if (steps_checked != steps_logged)
+    return fmt::format("not verified: {} of {} logged steps checked (to step {})", steps_checked,
+                       steps_logged, last_step);
   return fmt::format("bit-exact ({} steps)", steps_checked);
+}
+
+bool ResimulateReport::bit_exact() const {
+  return !divergence && !interrupted && !damage && steps_checked == steps_logged;
 }
 
 ResimulateReport ResimulateLog(const ResimulateOptions& options) {
@@ -219,24 +231,54 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
     spdlog::warn("resimulate: {}", w);
     report.warnings.push_back(w);
   };
+  // a damaged log is checked up to its damage and then reported as damaged, never bit-exact
+  report.damage = reader.damage();
+  report.steps_logged = reader.num_steps();
   if (reader.damage()) warn(options.log_path + ": " + *reader.damage() + "; checking up to there");
   for (const std::string& w : ChangedAssets(header))
     warn(w + "; the resimulation will likely diverge");
 
+  // commands a bridge carried out (docs/run-log.md, "command" events) are not re-injected:
+  // with the controllers on none may be in the log; with the logged ctrl applied only those
+  // that change the state itself (not through ctrl) make the log irreproducible
   const bool controllers = options.mode == ResimulateMode::kControllers;
-  if (controllers) {
-    int64_t commands = 0, first = -1;
+  {
+    int64_t commands = 0, first = -1, state_changes = 0, first_state_change = -1;
+    std::string first_cmd, state_cmd;
     for (const EventRecord& e : reader.Events()) {
       if (e.kind != "command") continue;
-      if (commands++ == 0) first = e.step;
+      const nlohmann::json payload = nlohmann::json::parse(e.payload, nullptr, false);
+      const std::string cmd =
+          payload.is_object() && payload.contains("cmd") && payload["cmd"].is_string()
+              ? payload["cmd"].get<std::string>()
+              : "";
+      if (commands++ == 0) {
+        first = e.step;
+        first_cmd = cmd;
+      }
+      if (cmd == "set_mocap" || cmd == "reset") {
+        if (state_changes++ == 0) {
+          first_state_change = e.step;
+          state_cmd = cmd;
+        }
+      }
     }
-    if (commands > 0)
+    const std::string named = first_cmd.empty() ? "" : ", '" + first_cmd + "',";
+    if (controllers && commands > 0)
       throw ConfigError(options.log_path, 0, "--resimulate",
-                        fmt::format("the log holds {} command event(s) (the first at step {}); "
+                        fmt::format("the log holds {} command event(s) (the first{} at step {}); "
                                     "re-injecting commands is not supported yet; expected "
                                     "--resimulate ctrl, which applies the logged ctrl with the "
                                     "controllers off",
-                                    commands, first));
+                                    commands, named, first));
+    if (!controllers && state_changes > 0)
+      throw ConfigError(options.log_path, 0, "--resimulate",
+                        fmt::format("the log holds {} command event(s) that change the state "
+                                    "itself (the first, '{}', at step {}); they are not "
+                                    "re-injected and the logged ctrl does not cover them, so "
+                                    "this run cannot be resimulated; expected a log without "
+                                    "set_mocap or reset commands",
+                                    state_changes, state_cmd, first_state_change));
   }
 
   // the output folder, as `run` prepares its own; left as found if the set-up fails

@@ -4,14 +4,19 @@
 // EVERY step: step count, time, qpos, qvel, act, ctrl, qacc_warmstart, qfrc_applied,
 // xfrc_applied, mocap_pos, mocap_quat, userdata and (with controllers) controller_next_update,
 // compared bit for bit (the logged step 0 against the initial state too). it reports
-// "bit-exact (N steps)" or the first divergent step, field and index with both values.
+// "bit-exact (N steps)" only when every logged step was read from a CRC-valid chunk and compared
+// and the log ended with its end chunk; else the first divergent step, field and index with both
+// values, or the damage (the chunk and its steps) that left the rest of the log unverified.
 //
 // modes:
-//   kControllers  the world's controllers run again and compute ctrl (the default). commands
-//                 logged as events would have to be re-injected; none exist yet (bridges,
-//                 issue 19), so a log that holds "command" events is refused in this mode.
+//   kControllers  the world's controllers run again and compute ctrl (the default). commands a
+//                 bridge carried out (ZeroMQ, ROS, the viewer: "command" events, docs/run-log.md)
+//                 are not re-injected, so a log that holds "command" events is refused in this
+//                 mode, naming the first.
 //   kCtrl         no controllers: before each step the ctrl the log holds after that step is
-//                 applied (what the controllers wrote), so physics alone is checked.
+//                 applied (what the controllers wrote), so physics alone is checked. commands
+//                 that only steer controllers or set ctrl are covered by the logged ctrl; a log
+//                 with a command that changes the state itself (set_mocap, reset) is refused.
 // it runs as a pipeline (docs/architecture.md): PhysicsSource -> SimLoop -> a checking sink
 // that compares every step's snapshot with the log (the first divergence ends the loop) and,
 // with an output folder (ResimulateOptions::out_dir), the world's `metrics:` sink with every
@@ -67,8 +72,19 @@ struct ResimulateReport {
   std::optional<Divergence> divergence;
   bool interrupted = false;           ///< stopped by the stop request before the log's end
   std::vector<std::string> warnings;  ///< damaged log, changed assets
-  /// "bit-exact (N steps)", or "diverged at step S (t = T s): FIELD[I] (WHAT): logged L,
-  /// simulated M" with 17 significant digits; "stopped after N steps (bit-exact so far)".
+  /// the reader's description of damage (a CRC mismatch, a cut chunk, no end chunk: "log ends
+  /// at chunk N (step S): ..."); the steps after it were not checked. nullopt for a whole log.
+  std::optional<std::string> damage;
+  /// step records the log holds in its CRC-valid chunks (all of them are compared unless the
+  /// check stops early).
+  int64_t steps_logged = 0;
+  /// the whole log was checked and matched: no divergence, no damage, not interrupted and
+  /// every logged step compared.
+  bool bit_exact() const;
+  /// "bit-exact (N steps)" (only when bit_exact()); "diverged at step S (t = T s): FIELD[I]
+  /// (WHAT): logged L, simulated M" with 17 significant digits; "stopped after N steps
+  /// (bit-exact so far)"; "damaged log, not verified past step S: DAMAGE (N steps before it
+  /// bit-exact)"; "not verified: N of M logged steps checked".
   std::string Describe() const;
 };
 

@@ -40,6 +40,13 @@ class LiveControl {
   /// --record log; may be null). call before the loop starts; `writer` must outlive the loop.
   void RecordChangesTo(RunLogWriter* writer) { run_log_ = writer; }
 
+  /// a command a bridge carried out that changes the simulation (set_ctrl, twist, ...; the
+  /// request without its id) at the step boundary after `step` (loop thread): recorded as a
+  /// "command" event at `step` in the run's own log and in an active live recording, so that
+  /// `replay --resimulate` knows the run was driven from outside (docs/run-log.md). a write
+  /// error is logged, not thrown (the command was carried out).
+  void RecordCommand(int64_t step, double time_sec, const nlohmann::json& command);
+
   /// adds effects() to `loop`: call before any other AddSink.
   void AddFirst(SimLoop* loop) { loop->AddSink(&effects_); }
   /// adds recorder() to `loop`: call after the output sinks (cameras, sensors).

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+
 #include "penumbra/core/error.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/session/run_log_header.h"
@@ -27,6 +29,9 @@ void LiveRecorder::StartRecording(const std::string& path, bool sensors) {
   if (writer_)
     throw ConfigError("", 0, "recording",
                       "already recording to " + writer_->path() + "; expected a stop first");
+  if (finished_)
+    throw ConfigError("", 0, "recording",
+                      "the run has ended; no step would be recorded; expected a running run");
   RunLogHeader header = MakeRunLogHeader(session_, PENUMBRA_VERSION, command_line_);
   header.has_sensor_records = sensors;
   writer_ = std::make_unique<RunLogWriter>(path, header);
@@ -67,6 +72,11 @@ LiveRecording LiveRecorder::StopRecording() {
   return r;
 }
 
+bool LiveRecorder::finished() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return finished_;
+}
+
 bool LiveRecorder::recording() const {
   std::lock_guard<std::mutex> lock(mu_);
   return writer_ != nullptr;
@@ -87,6 +97,16 @@ void LiveRecorder::OnChange(int64_t step, double time_sec, const nlohmann::json&
   if (!writer_ || !started_) return;
   try {
     writer_->RecordEvent(step, time_sec, "live", change.dump());
+  } catch (const std::exception& e) {
+    FailLocked(e);
+  }
+}
+
+void LiveRecorder::RecordCommand(int64_t step, double time_sec, const std::string& payload_json) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (!writer_ || !started_) return;
+  try {
+    writer_->RecordEvent(step, time_sec, "command", payload_json);
   } catch (const std::exception& e) {
     FailLocked(e);
   }
@@ -135,7 +155,17 @@ void LiveRecorder::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapsh
 
 void LiveRecorder::OnFinish(const LoopFinish&) {
   std::lock_guard<std::mutex> lock(mu_);
+  finished_ = true;
   if (!writer_) return;
+  if (!started_) {
+    // started as the run stopped: no step reached it; an empty log is removed, not left
+    const std::string path = writer_->path();
+    CloseLocked();
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    spdlog::warn("live recording {} removed: the run stopped before its first step", path);
+    return;
+  }
   at_finish_ = CloseLocked();
   spdlog::info("live recording closed at the end of the run: {} ({} steps, {} bytes)",
                at_finish_.path, at_finish_.steps, at_finish_.bytes);

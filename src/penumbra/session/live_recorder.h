@@ -48,8 +48,8 @@ class LiveRecorder : public Sink {
   /// `sensors`: the log also holds the cameras' images and the sensors' outputs from then on
   /// (sensor records, as --record-sensors), as far as they are written before the stop.
   /// @throws ConfigError("", 0, "path", ...) for an empty path; ConfigError("", 0,
-  ///         "recording", ...) when a recording is active; RunLogError when the file cannot
-  ///         be created.
+  ///         "recording", ...) when a recording is active or the loop has finished (no step
+  ///         would follow); RunLogError when the file cannot be created.
   void StartRecording(const std::string& path, bool sensors);
 
   /// closes the active log now (every record appended so far, then the end chunk) and says
@@ -60,6 +60,8 @@ class LiveRecorder : public Sink {
 
   /// whether a recording is active.
   bool recording() const;
+  /// whether the loop has finished (OnFinish ran): StartRecording is refused from then on.
+  bool finished() const;
 
   /// whether a recording with sensor records is active (thread-safe, lock-free): callers
   /// skip building records otherwise.
@@ -73,13 +75,18 @@ class LiveRecorder : public Sink {
   /// for logs started later and recorded in the active one.
   void OnChange(int64_t step, double time_sec, const nlohmann::json& change);
 
+  /// a command carried out at `step` (loop thread; LiveControl::RecordCommand): recorded as a
+  /// "command" event in the active log once it has its first step.
+  void RecordCommand(int64_t step, double time_sec, const std::string& payload_json);
+
   /// the finished recording of a log still open when the loop ended (closed in OnFinish),
   /// or one with path "" when none was.
   LiveRecording closed_at_finish() const;
 
   SnapshotContent Wants(int64_t step, double time_sec) override;
   void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override;
-  /// closes an open log. @throws RunLogError from closing it.
+  /// closes an open log; one that got no step (started as the run stopped) is removed instead
+  /// of being left empty (a warning says so). @throws RunLogError from closing it.
   void OnFinish(const LoopFinish& finish) override;
 
  private:
@@ -98,6 +105,7 @@ class LiveRecorder : public Sink {
   std::string error_;                    // a write error that ended the recording
   std::vector<nlohmann::json> history_;  // every change applied so far, with its step
   LiveRecording at_finish_;
+  bool finished_ = false;
 };
 
 }  // namespace penumbra

@@ -8,12 +8,15 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
+#include <unordered_set>
 #include <zmq.hpp>
 
 #include "penumbra/command/command_dispatcher.h"
@@ -28,6 +31,22 @@ using json = nlohmann::json;
 
 constexpr int64_t kHardMessageLimit = 64ll << 20;  // ZMQ_MAXMSGSIZE: peers above it are dropped
 constexpr size_t kMaxRequestFrames = 4;            // frames kept of one request (rest dropped)
+
+// subscriptions (docs/zmq-protocol.md, "Limits"). XPUB passes each distinct prefix up once,
+// however many subscribers share it, so these bound what the bridge keeps and checks:
+// prefixes beyond kMaxSubscriptions distinct ones, or longer than the prefix cap (256 bytes,
+// or the run's longest topic if longer: no topic needs a longer prefix), are dropped and
+// logged. a subscription message above twice the cap makes ZeroMQ drop that subscriber
+// (ZMQ_MAXMSGSIZE), which also bounds what ZeroMQ's own subscription tree holds per prefix.
+constexpr size_t kMaxSubscriptions = 1024;
+constexpr size_t kMinPrefixCap = 256;
+constexpr int kSubscriptionsPerTurn = 256;  // handled per turn of the publish thread
+constexpr int kLoggedDrops = 10;            // drops logged one by one, then only counted
+
+// shutdown: after the run ended, requests are answered with `stopping` until none came for
+// kDrainQuiet (or kDrainMax after the bridge was closed), then the sockets close
+constexpr auto kDrainQuiet = std::chrono::milliseconds(300);
+constexpr auto kDrainMax = std::chrono::seconds(3);
 
 json PoseJson(const Pose& X) {
   const Eigen::Quaterniond q(X.linear());
@@ -74,17 +93,22 @@ class ZmqBridge final : public RunBridge {
 
  private:
   struct Outgoing {
-    bool reply = false;
     std::vector<zmq::message_t> frames;
+    uint64_t after_publication = 0;  // a reply: sent once publications up to this one are
   };
 
-  void IoLoop();
+  void CommandLoop();
+  void PublishLoop();
   void HandleRequest(std::vector<zmq::message_t>& frames, size_t total_frames);
   void HandleSubscription(const zmq::message_t& m);
-  void SendReply(const std::vector<std::string>& envelope, json reply);
+  // queues a reply; `after_publications`: not sent before every publication queued so far
+  // (a `step` reply follows the messages of its steps)
+  void SendReply(const std::vector<std::string>& envelope, json reply,
+                 bool after_publications = false);
   void Publish(const std::string& topic, const json& header, zmq::message_t payload);
   bool Subscribed(const std::string& topic) const;
-  void Wake();
+  static void Wake(int fd);
+  static void Send(zmq::socket_t& s, Outgoing& o, const char* what);
   void Shutdown();
   void PublishImage(const std::string& topic, const CameraFrame& f, const char* encoding, int width,
                     int height, int bytes_per_pixel, zmq::message_t payload);
@@ -102,22 +126,30 @@ class ZmqBridge final : public RunBridge {
 
   zmq::context_t context_;
   zmq::socket_t router_, xpub_;
-  int wake_fd_ = -1;
-  std::thread io_;
+  // the command thread owns router_, the publish thread xpub_: ZeroMQ's own work on
+  // subscriptions (e.g. thousands removed when their subscriber leaves) never delays commands
+  int cmd_wake_fd_ = -1, pub_wake_fd_ = -1;
+  std::thread cmd_io_, pub_io_;
 
-  // subscriptions (I/O thread writes, everyone reads)
+  // subscriptions (publish thread writes, everyone reads)
   mutable std::mutex sub_mu_;
-  std::vector<std::string> prefixes_;
+  std::unordered_set<std::string> prefixes_;
+  size_t prefix_cap_ = kMinPrefixCap;
+  int64_t dropped_long_ = 0, dropped_over_cap_ = 0;
 
-  // the outgoing queue
+  // the outgoing queues
   std::mutex out_mu_;
   std::condition_variable out_cv_;
-  std::deque<Outgoing> queue_;
+  std::deque<Outgoing> publications_, replies_;
+  uint64_t queued_publications_ = 0;  // publications queued so far (their sequence)
+  std::atomic<uint64_t> sent_publications_{0};
   int pending_publications_ = 0;
   std::map<std::string, int64_t> published_;  // messages queued per topic
   int64_t dropped_ = 0;
   bool closing_ = false;
+  std::atomic<bool> stopping_{false};  // the run ended: requests get a `stopping` error
   std::atomic<bool> stop_io_{false};
+  std::atomic<bool> publish_done_{false};
 
   // loop thread: state topic schedule
   int64_t next_state_ = 0;
@@ -161,13 +193,14 @@ ZmqBridge::ZmqBridge(const RunBridgeContext& context, ZmqBridgeOptions options)
   }
   for (const char* t : {"clock", "joint_states", "ground_truth/poses", "contacts", "sync", "end"})
     topics_.push_back(t);
+  for (const json& t : topics_) prefix_cap_ = std::max(prefix_cap_, t.get<std::string>().size());
 
   router_.set(zmq::sockopt::linger, 1000);
   router_.set(zmq::sockopt::maxmsgsize, kHardMessageLimit);
   router_.set(zmq::sockopt::sndhwm, 10000);
   xpub_.set(zmq::sockopt::linger, 1000);
   xpub_.set(zmq::sockopt::sndhwm, options_.hwm);
-  xpub_.set(zmq::sockopt::maxmsgsize, int64_t{1} << 16);  // subscriptions are small
+  xpub_.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(1 + 2 * prefix_cap_));
   try {
     router_.bind(endpoint_);
   } catch (const zmq::error_t& e) {
@@ -180,55 +213,92 @@ ZmqBridge::ZmqBridge(const RunBridgeContext& context, ZmqBridgeOptions options)
     throw Error(
         fmt::format("cannot bind the ZeroMQ publish socket to {}: {}", pub_endpoint_, e.what()));
   }
-  wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (wake_fd_ < 0) throw Error("eventfd failed for the ZeroMQ bridge");
+  cmd_wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  pub_wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (cmd_wake_fd_ < 0 || pub_wake_fd_ < 0) {
+    if (cmd_wake_fd_ >= 0) close(cmd_wake_fd_);
+    if (pub_wake_fd_ >= 0) close(pub_wake_fd_);
+    throw Error("eventfd failed for the ZeroMQ bridge");
+  }
   spdlog::info("ZeroMQ: commands on {}, sensors published on {} (docs/zmq-protocol.md){}",
                endpoint_, pub_endpoint_,
                control_.paused() ? "; lockstep: waiting for `step` requests" : "");
-  io_ = std::thread([this] { IoLoop(); });
+  pub_io_ = std::thread([this] { PublishLoop(); });
+  cmd_io_ = std::thread([this] { CommandLoop(); });
 }
 
 ZmqBridge::~ZmqBridge() {
   Shutdown();
-  if (wake_fd_ >= 0) close(wake_fd_);
+  close(cmd_wake_fd_);
+  close(pub_wake_fd_);
 }
 
 void ZmqBridge::Shutdown() {
-  if (!io_.joinable()) return;
   {
     std::lock_guard<std::mutex> lock(out_mu_);
     closing_ = true;
   }
   out_cv_.notify_all();
+  stopping_.store(true);
   stop_io_.store(true);
-  Wake();
-  io_.join();
+  Wake(pub_wake_fd_);
+  Wake(cmd_wake_fd_);
+  if (pub_io_.joinable()) pub_io_.join();
+  if (cmd_io_.joinable()) cmd_io_.join();
 }
 
-void ZmqBridge::Wake() {
+void ZmqBridge::Wake(int fd) {
   const uint64_t one = 1;
-  const ssize_t n = write(wake_fd_, &one, sizeof(one));
+  const ssize_t n = write(fd, &one, sizeof(one));
   (void)n;
 }
 
 bool ZmqBridge::Subscribed(const std::string& topic) const {
+  // a subscription is a prefix of the topic: at most prefix_cap_ + 1 lookups
   std::lock_guard<std::mutex> lock(sub_mu_);
-  for (const std::string& p : prefixes_)
-    if (topic.compare(0, p.size(), p) == 0) return true;
+  if (prefixes_.empty()) return false;
+  const size_t n = std::min(topic.size(), prefix_cap_);
+  for (size_t k = 0; k <= n; ++k)
+    if (prefixes_.count(topic.substr(0, k)) > 0) return true;
   return false;
 }
 
 void ZmqBridge::HandleSubscription(const zmq::message_t& m) {
   if (m.size() == 0) return;
   const auto* b = static_cast<const char*>(m.data());
-  const std::string prefix(b + 1, m.size() - 1);
+  if (b[0] != 0 && b[0] != 1) return;  // not a subscription message
+  std::string prefix(b + 1, m.size() - 1);
   std::lock_guard<std::mutex> lock(sub_mu_);
-  if (b[0] == 1) {
-    prefixes_.push_back(prefix);
-  } else if (b[0] == 0) {
-    auto it = std::find(prefixes_.begin(), prefixes_.end(), prefix);
-    if (it != prefixes_.end()) prefixes_.erase(it);
+  if (b[0] == 0) {
+    prefixes_.erase(prefix);
+    return;
   }
+  // a printable excerpt for the log
+  const auto shown = [&] {
+    std::string e = prefix.substr(0, 40);
+    for (char& c : e)
+      if (c < 0x20 || c > 0x7e) c = '?';
+    return e + (prefix.size() > 40 ? "..." : "");
+  };
+  if (prefix.size() > prefix_cap_) {
+    if (++dropped_long_ <= kLoggedDrops)
+      spdlog::warn(
+          "ZeroMQ: dropped a subscription of {} bytes ('{}'): longer than {} bytes, "
+          "the longest prefix any topic needs{}",
+          prefix.size(), shown(), prefix_cap_,
+          dropped_long_ == kLoggedDrops ? "; further drops are only counted" : "");
+    return;
+  }
+  if (prefixes_.count(prefix) == 0 && prefixes_.size() >= kMaxSubscriptions) {
+    if (++dropped_over_cap_ <= kLoggedDrops)
+      spdlog::warn(
+          "ZeroMQ: dropped the subscription '{}': {} distinct subscriptions are held, "
+          "the limit{}",
+          shown(), kMaxSubscriptions,
+          dropped_over_cap_ == kLoggedDrops ? "; further drops are only counted" : "");
+    return;
+  }
+  prefixes_.insert(std::move(prefix));
 }
 
 void ZmqBridge::Publish(const std::string& topic, const json& header, zmq::message_t payload) {
@@ -253,22 +323,24 @@ void ZmqBridge::Publish(const std::string& topic, const json& header, zmq::messa
     }
     ++pending_publications_;
     ++published_[topic];
-    queue_.push_back(std::move(o));
+    ++queued_publications_;
+    publications_.push_back(std::move(o));
   }
-  Wake();
+  Wake(pub_wake_fd_);
 }
 
-void ZmqBridge::SendReply(const std::vector<std::string>& envelope, json reply) {
+void ZmqBridge::SendReply(const std::vector<std::string>& envelope, json reply,
+                          bool after_publications) {
   Outgoing o;
-  o.reply = true;
   for (const std::string& e : envelope) o.frames.emplace_back(e.data(), e.size());
   const std::string body = EncodeMsgpack(reply);
   o.frames.emplace_back(body.data(), body.size());
   {
     std::lock_guard<std::mutex> lock(out_mu_);
-    queue_.push_back(std::move(o));
+    if (after_publications) o.after_publication = queued_publications_;
+    replies_.push_back(std::move(o));
   }
-  Wake();
+  Wake(cmd_wake_fd_);
 }
 
 void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_frames) {
@@ -308,6 +380,16 @@ void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_
       request.is_object() && request.contains("cmd") && request["cmd"].is_string()
           ? request["cmd"].get<std::string>()
           : "";
+  // the run has ended: nothing more is carried out, but every request gets its reply
+  if (stopping_.load() || control_.ended()) {
+    const json* id = request.is_object() && request.contains("id") ? &request["id"] : nullptr;
+    SendReply(envelope,
+              ErrorReply(cmd.empty() ? json(nullptr) : json(cmd), id,
+                         CommandError(command_code::kStopping, "",
+                                      "the run has ended and the server is shutting down; the "
+                                      "command was not carried out")));
+    return;
+  }
   if (cmd == "sync") {
     const json* id = request.contains("id") ? &request["id"] : nullptr;
     try {
@@ -323,7 +405,7 @@ void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_
                 zmq::message_t());
       json r = {{"ok", true}, {"cmd", "sync"}, {"token", token}};
       if (id) r["id"] = *id;
-      SendReply(envelope, std::move(r));
+      SendReply(envelope, std::move(r), true);
     } catch (const CommandError& e) {
       SendReply(envelope, ErrorReply("sync", id, e));
     }
@@ -355,27 +437,45 @@ void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_
         reply["published"] = std::move(counts);
       }
     }
-    SendReply(envelope, std::move(reply));
+    SendReply(envelope, std::move(reply), cmd == "step");
   });
 }
 
-void ZmqBridge::IoLoop() {
+void ZmqBridge::Send(zmq::socket_t& s, Outgoing& o, const char* what) {
+  try {
+    for (size_t i = 0; i < o.frames.size(); ++i) {
+      const zmq::send_flags f = i + 1 < o.frames.size()
+                                    ? zmq::send_flags::sndmore | zmq::send_flags::dontwait
+                                    : zmq::send_flags::dontwait;
+      if (!s.send(o.frames[i], f)) break;
+    }
+  } catch (const zmq::error_t& e) {
+    spdlog::warn("ZeroMQ: dropped a {}: {}", what, e.what());
+  }
+}
+
+void ZmqBridge::CommandLoop() {
+  using Clock = std::chrono::steady_clock;
   zmq::pollitem_t items[] = {{router_.handle(), 0, ZMQ_POLLIN, 0},
-                             {xpub_.handle(), 0, ZMQ_POLLIN, 0},
-                             {nullptr, wake_fd_, ZMQ_POLLIN, 0}};
-  std::deque<Outgoing> sending;
+                             {nullptr, cmd_wake_fd_, ZMQ_POLLIN, 0}};
+  std::deque<Outgoing> waiting;  // replies in order, the first maybe waiting for publications
+  Clock::time_point last_request = Clock::now();
+  std::optional<Clock::time_point> closed_at;
   for (;;) {
+    const bool closing = stop_io_.load();
+    if (closing && !closed_at) closed_at = Clock::now();
     try {
-      zmq::poll(items, 3, std::chrono::milliseconds(100));
-      if (items[2].revents & ZMQ_POLLIN) {
+      zmq::poll(items, 2, std::chrono::milliseconds(closing ? 20 : 100));
+      if (items[1].revents & ZMQ_POLLIN) {
         uint64_t n = 0;
-        const ssize_t r = read(wake_fd_, &n, sizeof(n));
+        const ssize_t r = read(cmd_wake_fd_, &n, sizeof(n));
         (void)r;
       }
       // requests: one message at a time, at most kMaxRequestFrames frames kept
       for (int budget = 0; budget < 64; ++budget) {
         zmq::message_t part;
         if (!router_.recv(part, zmq::recv_flags::dontwait)) break;
+        last_request = Clock::now();
         std::vector<zmq::message_t> frames;
         size_t total = 1;
         frames.push_back(std::move(part));
@@ -387,43 +487,88 @@ void ZmqBridge::IoLoop() {
         }
         HandleRequest(frames, total);
       }
-      for (;;) {
-        zmq::message_t sub;
-        if (!xpub_.recv(sub, zmq::recv_flags::dontwait)) break;
-        HandleSubscription(sub);
-      }
     } catch (const zmq::error_t& e) {
       if (e.num() == ETERM) return;
       spdlog::warn("ZeroMQ: {}", e.what());
     } catch (const std::exception& e) {
       spdlog::warn("ZeroMQ: {}", e.what());
     }
-    // everything queued, in order
+    // replies in order; a `step` reply once the publications before it are sent
     {
       std::lock_guard<std::mutex> lock(out_mu_);
-      sending.swap(queue_);
-      pending_publications_ = 0;
-    }
-    out_cv_.notify_all();
-    for (Outgoing& o : sending) {
-      zmq::socket_t& s = o.reply ? router_ : xpub_;
-      try {
-        for (size_t i = 0; i < o.frames.size(); ++i) {
-          const zmq::send_flags f = i + 1 < o.frames.size()
-                                        ? zmq::send_flags::sndmore | zmq::send_flags::dontwait
-                                        : zmq::send_flags::dontwait;
-          if (!s.send(o.frames[i], f)) break;
-        }
-      } catch (const zmq::error_t& e) {
-        spdlog::warn("ZeroMQ: dropped a {}: {}", o.reply ? "reply" : "publication", e.what());
+      while (!replies_.empty()) {
+        waiting.push_back(std::move(replies_.front()));
+        replies_.pop_front();
       }
     }
-    sending.clear();
-    if (stop_io_.load()) {
+    const bool published_all = publish_done_.load();
+    while (!waiting.empty() &&
+           (published_all || waiting.front().after_publication <= sent_publications_.load())) {
+      Send(router_, waiting.front(), "reply");
+      waiting.pop_front();
+    }
+    if (!closed_at) continue;
+    // closing: answer (`stopping`) until the peers are quiet, then send what is left
+    const Clock::time_point now = Clock::now();
+    const Clock::time_point quiet_since = std::max(last_request, *closed_at);
+    bool queued = false;
+    {
       std::lock_guard<std::mutex> lock(out_mu_);
-      if (queue_.empty()) return;
+      queued = !replies_.empty();
+    }
+    if ((published_all && waiting.empty() && !queued && now - quiet_since >= kDrainQuiet) ||
+        now - *closed_at >= kDrainMax) {
+      for (Outgoing& o : waiting) Send(router_, o, "reply");
+      return;
     }
   }
+}
+
+void ZmqBridge::PublishLoop() {
+  zmq::pollitem_t items[] = {{xpub_.handle(), 0, ZMQ_POLLIN, 0},
+                             {nullptr, pub_wake_fd_, ZMQ_POLLIN, 0}};
+  std::deque<Outgoing> sending;
+  for (;;) {
+    try {
+      zmq::poll(items, 2, std::chrono::milliseconds(100));
+      if (items[1].revents & ZMQ_POLLIN) {
+        uint64_t n = 0;
+        const ssize_t r = read(pub_wake_fd_, &n, sizeof(n));
+        (void)r;
+      }
+      // subscriptions: a bounded number per turn, so publications keep flowing
+      for (int budget = 0; budget < kSubscriptionsPerTurn; ++budget) {
+        zmq::message_t sub;
+        if (!xpub_.recv(sub, zmq::recv_flags::dontwait)) break;
+        HandleSubscription(sub);
+      }
+    } catch (const zmq::error_t& e) {
+      if (e.num() == ETERM) break;
+      spdlog::warn("ZeroMQ: {}", e.what());
+    } catch (const std::exception& e) {
+      spdlog::warn("ZeroMQ: {}", e.what());
+    }
+    // everything queued, in order
+    uint64_t last = 0;
+    {
+      std::lock_guard<std::mutex> lock(out_mu_);
+      sending.swap(publications_);
+      pending_publications_ = 0;
+      last = queued_publications_;
+    }
+    out_cv_.notify_all();
+    for (Outgoing& o : sending) Send(xpub_, o, "publication");
+    const bool sent_any = !sending.empty();
+    sending.clear();
+    sent_publications_.store(last);
+    if (sent_any) Wake(cmd_wake_fd_);
+    if (stop_io_.load()) {
+      std::lock_guard<std::mutex> lock(out_mu_);
+      if (publications_.empty()) break;
+    }
+  }
+  publish_done_.store(true);
+  Wake(cmd_wake_fd_);
 }
 
 SnapshotContent ZmqBridge::Wants(int64_t step, double time_sec) {
@@ -611,6 +756,15 @@ void ZmqBridge::OnFinish(const LoopFinish& finish) {
   if (dropped > 0)
     spdlog::warn("ZeroMQ: {} publications dropped (outgoing queue full while running free)",
                  dropped);
+  {
+    std::lock_guard<std::mutex> lock(sub_mu_);
+    if (dropped_long_ + dropped_over_cap_ > 0)
+      spdlog::warn(
+          "ZeroMQ: {} subscriptions dropped ({} longer than {} bytes, {} beyond {} "
+          "distinct ones)",
+          dropped_long_ + dropped_over_cap_, dropped_long_, prefix_cap_, dropped_over_cap_,
+          kMaxSubscriptions);
+  }
   if (Subscribed("end"))
     Publish("end",
             {{"stamp", finish.time_sec},
@@ -619,7 +773,15 @@ void ZmqBridge::OnFinish(const LoopFinish& finish) {
              {"reason", reason},
              {"dropped", dropped}},
             zmq::message_t());
-  Shutdown();
+  // no more publications; requests from now on get `stopping` until the bridge is closed
+  {
+    std::lock_guard<std::mutex> lock(out_mu_);
+    closing_ = true;
+  }
+  out_cv_.notify_all();
+  stopping_.store(true);
+  Wake(cmd_wake_fd_);
+  Wake(pub_wake_fd_);
 }
 
 }  // namespace

@@ -6,17 +6,25 @@
 //                         scan, IMU / MuJoCo-sensor sample, and the state topics (clock,
 //                         joint_states, ground_truth/poses, contacts)
 //
-// one I/O thread owns both sockets. every outgoing message (publications from the loop, render
-// and sensor threads; replies from the dispatcher) goes through one queue in call order and is
-// sent by that thread, so a lockstep `step` reply always follows the messages of its steps. an
-// eventfd wakes the thread when the queue fills; zmq_poll waits on it and both sockets.
+// two I/O threads: the command thread owns the ROUTER socket, the publish thread the XPUB socket
+// (so ZeroMQ's work on subscriptions, e.g. thousands removed when their subscriber leaves, never
+// delays a reply). outgoing publications (from the loop, render and sensor threads) go through
+// one queue in call order; replies through another; a lockstep `step` reply is sent only once
+// every publication queued before it has been sent, so it always follows the messages of its
+// steps. eventfds wake the threads; zmq_poll waits on them and the sockets.
 //
 // robustness: requests above ZmqBridgeOptions::max_request_bytes get a too_large reply,
 // undecodable ones (not msgpack, truncated, too deep) a malformed reply, and the server keeps
 // serving; ZeroMQ drops peers that send more than 64 MiB in one message. only topics some
-// subscriber wants are formatted and sent (XPUB subscription messages). a full subscriber
+// subscriber wants are formatted and sent (XPUB subscription messages). subscriptions are
+// capped: 1024 distinct prefixes, each at most 256 bytes (or the run's longest topic); the
+// excess is dropped and logged, subscription messages above twice that make ZeroMQ drop the
+// subscriber, and at most 256 are handled per turn of the publish thread. a full subscriber
 // queue (SNDHWM) drops that subscriber's messages; a full outgoing queue drops publications
 // while the run is running free, and makes the producer wait while it is paused (lockstep).
+// shutdown: once the run ended every request gets a `stopping` error reply until the peers
+// have been quiet for 0.3 s (3 s at most after the bridge is destroyed); commands queued but
+// not carried out get `stopping` from the RunControl (docs/zmq-protocol.md).
 
 #include <cstdint>
 #include <memory>
