@@ -9,8 +9,10 @@
 
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
+#include "penumbra/core/error.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/runlog/run_log_reader.h"
+#include "penumbra/session/live_recorder.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/session.h"
@@ -125,6 +127,32 @@ TEST(RunLogRecordingTest, TheHeaderMapsTheStateByNameAndHashesTheFilesRead) {
   }
   EXPECT_EQ(worlds, 1);
   EXPECT_EQ(models, 2);
+}
+
+// issue 33: a live recording started as the run stops gets no step; it is removed, not left as
+// an empty log, and once the loop has finished no recording can start
+TEST(RunLogRecordingTest, ALiveRecordingThatGotNoStepIsRemovedAndNoneStartsAfterTheEnd) {
+  testing::TempDir tmp;
+  Session session(CrowdWorld(), PhysicsOnly());
+  LiveRecorder recorder(session, "penumbra run crowd.yaml");
+  const std::string late = (tmp.path() / "late.plog").string();
+  recorder.StartRecording(late, false);
+  ASSERT_TRUE(std::filesystem::exists(late));  // the header is written at once
+  EXPECT_FALSE(recorder.finished());
+  recorder.OnFinish(LoopFinish{});
+  EXPECT_TRUE(recorder.finished());
+  EXPECT_FALSE(recorder.recording());
+  EXPECT_FALSE(std::filesystem::exists(late));
+  EXPECT_EQ(recorder.closed_at_finish().path, "");
+  const std::string after = (tmp.path() / "after.plog").string();
+  try {
+    recorder.StartRecording(after, false);
+    ADD_FAILURE() << "a recording started after the loop finished";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "recording");
+    EXPECT_NE(std::string(e.what()).find("the run has ended"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(after));
 }
 
 }  // namespace
