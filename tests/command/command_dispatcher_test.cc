@@ -193,5 +193,17 @@ TEST_F(CommandDispatcherTest, StepNeedsAPausedRunAndEndsWithTheRun) {
   EXPECT_EQ(after.at("error").at("code"), "run_ended") << after.dump();
 }
 
+// issue 33: once a `stop` is queued, a start_recording would get no step; it is refused with
+// `stopping` (before anything else is checked), also when it arrives while the run finishes
+TEST_F(CommandDispatcherTest, StartRecordingAfterAStopIsRefusedWithStopping) {
+  LiveLoop live(world_);
+  EXPECT_TRUE(live.Call({{"cmd", "step"}, {"n", 2}}).at("ok").get<bool>());
+  EXPECT_TRUE(live.Call({{"cmd", "stop"}}).at("ok").get<bool>());
+  const json r = live.Call({{"cmd", "start_recording"}, {"path", "late.plog"}, {"id", 9}});
+  ASSERT_FALSE(r.at("ok").get<bool>()) << r.dump();
+  EXPECT_EQ(r.at("error").at("code"), "stopping") << r.dump();
+  EXPECT_EQ(r.at("id"), 9);
+}
+
 }  // namespace
 }  // namespace penumbra
