@@ -89,8 +89,11 @@ struct ResimulateReport {
 };
 
 /// resimulates the log (see the file header).
+/// a damaged log is not thrown: it is checked up to its damage and the report says so
+/// (ResimulateReport::damage, bit_exact() false).
 /// @throws RunLogError for a file that is not a readable run log; ConfigError naming the log
-///         when it holds command events in kControllers mode, when its model does not match
+///         when it holds command events in kControllers mode or set_mocap / reset command
+///         events in kCtrl mode (naming the first), when its model does not match
 ///         the recorded world's (state sizes), its first step is not 0 or it skips a step;
 ///         ConfigError("--out") for an output folder PrepareOutputFolder refuses, and the
 ///         metrics sink's for a bad `metrics:` (located in the recorded world); PhysicsError
