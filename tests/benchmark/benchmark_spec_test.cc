@@ -116,7 +116,7 @@ TEST(BenchmarkSpec, CommandsAreSplitAtLoadAndShellSyntaxIsRefusedWithFileLineAnd
   e = ErrorOf(Spec("", "  - {name: x, command: \"run {dataset} > log\"}\n"));
   EXPECT_NE(e.find("'>' redirects"), std::string::npos) << e;
   e = ErrorOf(Spec("", "  - {name: x, command: \"sh -c 'run {dataset}'\"}\n"));
-  EXPECT_NE(e.find("inside the script of 'sh -c'"), std::string::npos) << e;
+  EXPECT_NE(e.find("inside the inline program of 'sh -c'"), std::string::npos) << e;
   e = ErrorOf(Spec("", "  - {name: x, command: \"exec run {dataset}\"}\n"));
   EXPECT_NE(e.find("'exec' is a shell builtin"), std::string::npos) << e;
   // control characters in an extra #SBATCH line

@@ -121,16 +121,20 @@ TEST(CommandTemplate, RefusesWhatOnlyAShellWouldDo) {
             std::string::npos);
   EXPECT_NE(TemplateRefusal("exec prog").find("'exec' is a shell builtin"), std::string::npos);
   EXPECT_NE(TemplateRefusal("cd {workdir}").find("'cd' is a shell builtin"), std::string::npos);
-  // placeholders inside a shell's script would splice values into shell text
-  for (const char* t :
-       {"sh -c 'slam {dataset}'", "/bin/bash -ec 'slam {dataset}' bash",
-        "bash -o pipefail -c 'a {output} | b'", "/usr/bin/env A=1 sh -c 'x {seed}'"}) {
+  // placeholders inside a shell's (or another interpreter's) inline program would splice
+  // values into program text
+  for (const char* t : {"sh -c 'slam {dataset}'", "/bin/bash -ec 'slam {dataset}' bash",
+                        "bash -o pipefail -c 'a {output} | b'", "/usr/bin/env A=1 sh -c 'x {seed}'",
+                        "timeout 60 sh -c 'x {seed}'",
+                        "/usr/bin/python3 -u -c 'open(\"{output}\")'", "perl -e 'print {seed}'"}) {
     const std::string e = TemplateRefusal(t);
-    EXPECT_NE(e.find("inside the script"), std::string::npos) << t << ": " << e;
+    EXPECT_NE(e.find("inside the inline program"), std::string::npos) << t << ": " << e;
   }
-  // ... but not its positional arguments, and not literal braces
+  // ... but not their arguments, modules or literal braces
   EXPECT_EQ(TemplateRefusal("sh -c 'slam \"$1\"' sh {dataset}"), "");
   EXPECT_EQ(TemplateRefusal("sh -c 'echo {{x}}'"), "");
+  EXPECT_EQ(TemplateRefusal("python3 -c 'import sys; print(sys.argv[1])' {dataset}"), "");
+  EXPECT_EQ(TemplateRefusal("/usr/bin/python3 -m penumbra_nav --c {seed}"), "");
   EXPECT_EQ(TemplateRefusal("'FOO=1' x=2 {penumbra}"), "");
 }
 

@@ -59,11 +59,17 @@ bool ShellBuiltin(const std::string& w) {
   return std::find(kNames.begin(), kNames.end(), w) != kNames.end();
 }
 
-bool IsShell(const std::string& w) {
+// interpreters that take a program as an argument: what kind, by the program's file name
+enum class Interpreter { kNone, kShell, kPython, kOther };
+
+Interpreter InterpreterOf(const std::string& w) {
   const std::string base = w.substr(w.rfind('/') == std::string::npos ? 0 : w.rfind('/') + 1);
-  for (std::string_view s : {"sh", "bash", "dash", "zsh", "ksh", "mksh", "ash", "busybox"})
-    if (base == s) return true;
-  return false;
+  for (std::string_view s : {"sh", "bash", "dash", "zsh", "ksh", "mksh", "ash"})
+    if (base == s) return Interpreter::kShell;
+  if (base.rfind("python", 0) == 0) return Interpreter::kPython;
+  for (std::string_view s : {"perl", "ruby", "node", "nodejs"})
+    if (base == s) return Interpreter::kOther;
+  return Interpreter::kNone;
 }
 
 bool IsAssignment(const std::string& raw_word) {
@@ -86,31 +92,43 @@ bool HasPlaceholder(const std::string& w) {
   return false;
 }
 
-// a shell given a script with -c (after /usr/bin/env and its NAME=value words): the script
-// must not hold a placeholder
-void CheckShellScript(const std::vector<std::string>& words) {
-  size_t i = 0;
-  if (!words.empty() && (words[0] == "env" || words[0] == "/usr/bin/env" || words[0] == "/bin/env"))
-    for (i = 1; i < words.size() && (IsAssignment(words[i]) || words[i].rfind('-', 0) == 0); ++i) {
+// an interpreter given its program inline (sh -c SCRIPT, python3 -c CODE, perl -e CODE, ...):
+// the program text must not hold a placeholder, values go in as its arguments
+void CheckInlinePrograms(const std::vector<std::string>& words) {
+  for (size_t i = 0; i < words.size(); ++i) {
+    const Interpreter kind = InterpreterOf(words[i]);
+    if (kind == Interpreter::kNone) continue;
+    for (size_t j = i + 1; j < words.size(); ++j) {
+      const std::string& o = words[j];
+      const bool option =
+          o.size() >= 2 && (o[0] == '-' || (kind == Interpreter::kShell && o[0] == '+'));
+      if (!option || o == "--" || o[1] == '-') break;
+      if (kind == Interpreter::kShell && (o == "-o" || o == "+o")) {
+        ++j;
+        continue;
+      }
+      if (kind == Interpreter::kPython && o == "-m") break;
+      if (kind == Interpreter::kPython && (o == "-W" || o == "-X")) {
+        ++j;
+        continue;
+      }
+      // the flag that makes the next word the program: -c in a shell's option cluster
+      // (-ec), python's -c (or a cluster ending in it: -uc), -e / -E for perl, ruby, node
+      const bool inline_flag = kind == Interpreter::kShell ? o.find('c') != std::string::npos
+                               : kind == Interpreter::kPython
+                                   ? o.back() == 'c' && o.find_first_of("=:WX") == std::string::npos
+                                   : o.find_first_of("eE") != std::string::npos;
+      if (!inline_flag) continue;
+      if (j + 1 < words.size() && HasPlaceholder(words[j + 1]))
+        throw ConfigError(
+            "", 0, "",
+            "a placeholder inside the inline program of '" + words[i] + " " + o +
+                "' would put a value into program text; pass values as arguments after it "
+                "and read them there (sh -c 'slam \"$1\" > \"$2\"' sh {dataset} {output}; "
+                "python3 -c '...sys.argv[1]...' {dataset})");
+      break;
     }
-  if (i >= words.size() || !IsShell(words[i])) return;
-  bool script_follows = false;
-  size_t j = i + 1;
-  for (; j < words.size(); ++j) {
-    const std::string& o = words[j];
-    if (o == "--" || o.size() < 2 || (o[0] != '-' && o[0] != '+')) break;
-    if (o == "-o" || o == "+o") {
-      ++j;
-      continue;
-    }
-    if (o[1] != '-' && o.find('c') != std::string::npos) script_follows = true;
   }
-  if (script_follows && j < words.size() && HasPlaceholder(words[j]))
-    throw ConfigError("", 0, "",
-                      "a placeholder inside the script of '" + words[i] +
-                          " -c' would put a value into shell text; pass values as arguments "
-                          "after the script and read them as \"$1\", \"$2\": sh -c 'prog "
-                          "\"$1\" > \"$2\"' sh {dataset} {output}");
 }
 
 }  // namespace
@@ -206,7 +224,7 @@ std::vector<std::string> SplitCommandTemplate(const std::string& input) {
                           "' is a shell builtin or keyword, and the command runs without a "
                           "shell; expected a program (drop '" +
                           words[0] + "', or write sh -c '...')");
-  CheckShellScript(words);
+  CheckInlinePrograms(words);
   return words;
 }
 

@@ -18,7 +18,8 @@
 //     NAME=value PROGRAM ...`) or a shell builtin or keyword (exec, cd, export, ...);
 //   - a method that needs a shell writes one: `sh -c 'SCRIPT' sh {dataset} {output}`. the
 //     script may not hold a placeholder (that would splice a value into shell text); values
-//     are passed as its positional arguments and read as "$1", "$2", ...
+//     are passed as its positional arguments and read as "$1", "$2", ... the same holds for
+//     the inline program of python* -c and perl / ruby / node -e.
 // {name} placeholders and the {{ }} brace escapes are left in the words and filled per job.
 
 #include <map>
