@@ -106,7 +106,7 @@ TEST(BenchmarkInjection, SlurmRefusesControlCharactersInOutBeforeWritingAnything
   TempDir dir;
   const std::string spec =
       dir.Write("spec.yaml", InjectionSpec("  - {name: rgbd, bundled: opencv_rgbd}\n"));
-  for (const std::string name : {"a\nexec touch PWNED\n#", "a\rb", std::string("a\x01") + "b"}) {
+  for (const std::string name : {"a\nexec touch PWNED\n#", "a\rb", "a\x01" "b"}) {
     const fs::path out = dir.path() / name;
     std::string err;
     EXPECT_EQ(InjectionRun({"benchmark", spec, "--out", out.string(), "--slurm", "--quiet"},
