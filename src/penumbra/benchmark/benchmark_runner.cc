@@ -182,8 +182,15 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
       CaptureCommand({"sbatch", "--parsable", script.string()}, /*merge_stderr=*/true, &code);
   if (!submitted)
     throw Error("sbatch " + script.string() + " failed (exit " + std::to_string(code) + ")");
-  const std::string job_id = submitted->substr(0, submitted->find_first_of(";\n"));
-  if (job_id.empty() || job_id.find_first_not_of("0123456789") != std::string::npos)
+  // --parsable prints "ID" or "ID;CLUSTER" (after any warning lines on stderr): the last line
+  // that is one, and only digits reach scancel / squeue
+  std::string job_id;
+  std::istringstream lines(*submitted);
+  for (std::string line; std::getline(lines, line);) {
+    const std::string id = line.substr(0, line.find(';'));
+    if (!id.empty() && id.find_first_not_of("0123456789") == std::string::npos) job_id = id;
+  }
+  if (job_id.empty())
     throw Error("sbatch " + script.string() + " answered '" + SanitizeForMessage(*submitted, 200) +
                 "'; expected a job id");
   spdlog::info("submitted Slurm job array {} ({} tasks): {}", job_id, pending.size(),
