@@ -1,7 +1,8 @@
 // issue 33 point 7 for `penumbra benchmark`, through the real binary: SIGINT while methods
 // run exits 130, every method process is gone, and no job folder is left half-written
 // (interrupted jobs are removed, the report holds only finished jobs); SIGTERM while a route
-// is being recorded exits 143 at once and keeps no partial recording.
+// is being recorded exits 143 at once and keeps no partial recording; SIGINT during a nav
+// episode stops its simulator and its method.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -137,6 +138,58 @@ TEST(BenchmarkInterrupt, SigtermWhileRecordingARouteExits143AndKeepsNoPartialRec
   std::error_code ec;
   EXPECT_TRUE(fs::is_empty(out / "recordings", ec)) << FilesNamed(out / "recordings", "").size();
   EXPECT_FALSE(fs::exists(out / "jobs"));
+}
+
+// pids of the processes whose command line mentions `text`
+std::vector<int> ProcessesMentioning(const std::string& text) {
+  std::vector<int> found;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string cmdline = ReadAll(e.path() / "cmdline");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find(text) != std::string::npos && ProcessAlive(std::stoi(name)))
+      found.push_back(std::stoi(name));
+  }
+  return found;
+}
+
+TEST(BenchmarkInterrupt, SigintDuringANavEpisodeStopsTheRunAndTheMethod) {
+  TempDir dir;
+  const std::string spec = dir.Write(
+      "nav.yaml", std::string("kind: nav\nname: nav_intr\nworlds:\n  - name: target\n    file: ") +
+                      PENUMBRA_SOURCE_DIR +
+                      "/worlds/quadruped_target.yaml\n    robot: quadruped\n    episodes:\n"
+                      "      - {name: ahead, goal: [3, 0], timeout_sec: 30}\n"
+                      "conditions: [none]\ntrials: 1\nmethods:\n"
+                      "  - {name: hang, command: \"sh -c 'echo $$ > pid.txt; exec sleep 300'\"}\n");
+  const fs::path out = dir.path() / "out";
+  ChildProcess bench({PENUMBRA_BINARY, "benchmark", spec, "--out", out.string(), "--quiet"},
+                     dir.str(), (dir.path() / "stdout.txt").string(),
+                     (dir.path() / "stderr.txt").string());
+  const fs::path pid_file = out / "jobs" / "target__ahead__none__hang__t1" / "hang" / "pid.txt";
+  ASSERT_TRUE(WaitUntil(300, [&] {
+    const std::string pid = ReadAll(pid_file);
+    return bench.Exited() || (!pid.empty() && pid.back() == '\n');
+  }));
+  ASSERT_FALSE(bench.Exited()) << bench.Describe() << ReadAll(dir.path() / "stderr.txt");
+  const int method = std::stoi(ReadAll(pid_file));
+  // the simulator of the episode runs too (its command line names the job's run folder)
+  const std::vector<int> runs = ProcessesMentioning((out / "jobs").string());
+  ASSERT_FALSE(runs.empty());
+
+  ASSERT_EQ(kill(bench.pid(), SIGINT), 0);
+  const bool exited = bench.WaitFor(120);
+  if (!exited) bench.TerminateAndWait(5);
+  ASSERT_TRUE(exited) << "still running 120 s after SIGINT";
+  EXPECT_EQ(bench.exit_code(), 130) << ReadAll(dir.path() / "stderr.txt");
+  EXPECT_TRUE(WaitUntil(30, [&] { return !ProcessAlive(method); })) << method;
+  for (int pid : runs) EXPECT_TRUE(WaitUntil(30, [&] { return !ProcessAlive(pid); })) << pid;
+  EXPECT_EQ(ProcessesMentioning(out.string()), std::vector<int>{});
+  std::error_code ec;
+  EXPECT_TRUE(!fs::exists(out / "jobs") || fs::is_empty(out / "jobs", ec));
+  EXPECT_EQ(FilesNamed(out, "result.json"), std::vector<std::string>{});
 }
 
 }  // namespace
