@@ -288,11 +288,12 @@ TEST(WebServerTest, SlowClientGetsTheLatestFrameAndNeverBlocksThePublisher) {
 // upgraded; `origin` "" sends none. (beast's client does not hand back a declined response.)
 unsigned HandshakeStatus(const WebServer& server, const std::string& host,
                          const std::string& target, const std::string& origin) {
-  std::map<http::field, std::string> h = {{http::field::host, host},
-                                          {http::field::connection, "Upgrade"},
-                                          {http::field::upgrade, "websocket"},
-                                          {http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ=="},
-                                          {http::field::sec_websocket_version, "13"}};
+  std::map<http::field, std::string> h = {
+      {http::field::host, host},
+      {http::field::connection, "Upgrade"},
+      {http::field::upgrade, "websocket"},
+      {http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ=="},
+      {http::field::sec_websocket_version, "13"}};
   if (!origin.empty()) h[http::field::origin] = origin;
   return HttpGet(server.port(), target, http::verb::get, h).result_int();
 }
@@ -347,8 +348,7 @@ TEST(WebServerAccessTest, AllowedOriginsExtendTheListAndAreChecked) {
   const std::string good = "/ws?token=" + f.server->token();
   EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9000", good, "http://lab.example:9000"), 101u);
   EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9001", good, "http://lab.example:9001"), 403u);
-  EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9000", good, "https://lab.example:9000"),
-            403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9000", good, "https://lab.example:9000"), 403u);
   EXPECT_EQ(NormalizeOrigin("HTTPS://[::1]:8443/"), "https://[::1]:8443");
   for (const char* bad : {"lab.example", "ftp://lab.example", "http://lab.example/viewer",
                           "http://", "http://user@lab.example", "http://lab.example:0",

@@ -66,13 +66,14 @@ std::vector<std::string> CheckClientPath(std::string_view client_path,
       fail(std::string("holds the control character ") + hex);
     }
   }
-  if (path.front() == '/') fail("is absolute (starts with '/'); only paths inside the output folder are written");
+  if (path.front() == '/')
+    fail("is absolute (starts with '/'); only paths inside the output folder are written");
   std::vector<std::string> parts;
   size_t start = 0;
   for (;;) {
     const size_t slash = path.find('/', start);
-    parts.push_back(path.substr(start, slash == std::string::npos ? std::string::npos
-                                                                   : slash - start));
+    parts.push_back(
+        path.substr(start, slash == std::string::npos ? std::string::npos : slash - start));
     if (slash == std::string::npos) break;
     start = slash + 1;
   }
@@ -112,8 +113,7 @@ NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_v
       const int err = errno;
       const std::string what = WhatIsThere(dir.get(), parts[i]);
       const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
-      if (what == "a symbolic link")
-        fail(quoted + " is a symbolic link; links are never followed");
+      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
       if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
       if (err == ENOENT)
         fail("the folder " + quoted + " does not exist; only existing folders are written into");

@@ -1,7 +1,7 @@
 #include "penumbra/session/live_recorder.h"
 
-#include <spdlog/spdlog.h>
 #include <fcntl.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include "penumbra/core/error.h"

@@ -222,8 +222,7 @@ std::string CookieValue(std::string_view header, std::string_view name) {
 bool ConstantTimeEquals(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
   unsigned char diff = 0;
-  for (size_t i = 0; i < a.size(); ++i)
-    diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
   return diff == 0;
 }
 
@@ -466,11 +465,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     bool query_token = false;
     if (const std::string why = server_->Refusal(req, upgrade, &query_token); !why.empty()) {
       const int64_t n = ++server_->refused_;
-      if (n <= 10 || n % 1000 == 0)
+      if (n <= 10 || n % 1000 == 0) {
+        // the path only: a query may hold the token
+        const std::string_view target(req.target().data(), req.target().size());
         spdlog::warn("viewer: refused {} {} ({} refused so far): {}",
                      upgrade ? "a WebSocket to" : "a request for",
-                     SanitizeForMessage(std::string_view(req.target().data(), req.target().size()), 80),
-                     n, why);
+                     SanitizeForMessage(target.substr(0, target.find('?')), 80), n, why);
+      }
       if (why == "no token") {
         if (upgrade)
           return Respond(ErrorResponse(
@@ -506,9 +507,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     http::response<http::string_body> res = Serve(req);
     // a page opened with ?token= gets it as a cookie, so that its scripts and styles load
     if (query_token && res.result() == http::status::ok)
-      res.set(http::field::set_cookie,
-              fmt::format("{}={}; Path=/; HttpOnly; SameSite=Strict", server_->CookieName(),
-                          server_->token_));
+      res.set(http::field::set_cookie, fmt::format("{}={}; Path=/; HttpOnly; SameSite=Strict",
+                                                   server_->CookieName(), server_->token_));
     Respond(std::move(res));
   }
 
@@ -610,8 +610,8 @@ void WebServerImpl::Unregister(int id) { sessions_.erase(id); }
 void WebServerImpl::BuildAllowList() {
   const bool v6 = options_.host.find(':') != std::string::npos;
   const std::string bound = v6 ? "[" + options_.host + "]" : options_.host;
-  for (const std::string& name : {std::string("127.0.0.1"), std::string("localhost"),
-                                  std::string("[::1]"), bound}) {
+  for (const std::string& name :
+       {std::string("127.0.0.1"), std::string("localhost"), std::string("[::1]"), bound}) {
     const std::string n = Lower(name);
     hosts_.insert(fmt::format("{}:{}", n, port_));
     origins_.insert(fmt::format("http://{}:{}", n, port_));
@@ -631,7 +631,8 @@ std::string WebServerImpl::Refusal(const http::request<http::string_body>& req, 
                                    bool* query_token) const {
   const auto host_it = req.find(http::field::host);
   if (host_it == req.end()) return "no Host header";
-  const std::string host = Lower(std::string_view(host_it->value().data(), host_it->value().size()));
+  const std::string host =
+      Lower(std::string_view(host_it->value().data(), host_it->value().size()));
   if (!hosts_.count(host))
     return fmt::format(
         "Host '{}' is not a name of this viewer (127.0.0.1:{}, localhost:{}, [::1]:{} or the "
@@ -652,8 +653,8 @@ std::string WebServerImpl::Refusal(const http::request<http::string_body>& req, 
   if (*query_token) return "";
   if (!upgrade) {
     if (const auto it = req.find(http::field::cookie); it != req.end()) {
-      const std::string cookie = CookieValue(
-          std::string_view(it->value().data(), it->value().size()), CookieName());
+      const std::string cookie =
+          CookieValue(std::string_view(it->value().data(), it->value().size()), CookieName());
       if (ConstantTimeEquals(cookie, token_)) return "";
     }
   }
@@ -695,8 +696,8 @@ std::string WebServer::url() const {
   if (host == "0.0.0.0") host = "127.0.0.1";
   if (host == "::") host = "::1";
   const bool v6 = host.find(':') != std::string::npos;
-  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", host, v6 ? "]" : "",
-                     impl_->port_, impl_->token_);
+  return fmt::format("http://{}{}{}:{}/?token={}", v6 ? "[" : "", host, v6 ? "]" : "", impl_->port_,
+                     impl_->token_);
 }
 
 const std::string& WebServer::token() const { return impl_->token_; }
