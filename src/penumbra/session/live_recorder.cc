@@ -1,15 +1,21 @@
 #include "penumbra/session/live_recorder.h"
 
+#include <fcntl.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/session/run_log_header.h"
 
 namespace penumbra {
 
-LiveRecorder::LiveRecorder(Session& session, std::string command_line)
-    : session_(session), command_line_(std::move(command_line)) {}
+LiveRecorder::LiveRecorder(Session& session, std::string command_line,
+                           std::filesystem::path output_folder)
+    : session_(session),
+      command_line_(std::move(command_line)),
+      output_folder_(std::move(output_folder)) {}
 
 LiveRecorder::~LiveRecorder() {
   std::lock_guard<std::mutex> lock(mu_);
@@ -22,25 +28,40 @@ LiveRecorder::~LiveRecorder() {
 }
 
 void LiveRecorder::StartRecording(const std::string& path, bool sensors) {
-  if (path.empty()) throw ConfigError("", 0, "path", "empty; expected the .plog file to write");
   std::lock_guard<std::mutex> lock(mu_);
   if (writer_)
     throw ConfigError("", 0, "recording",
                       "already recording to " + writer_->path() + "; expected a stop first");
+  // the one policy for files a client names: a new file inside the output folder
+  NewOutputFile file;
+  try {
+    file = OpenNewFileInside(output_folder_, path, ".plog");
+  } catch (const OutputPathError& e) {
+    throw ConfigError("", 0, "path", e.what());
+  }
   RunLogHeader header = MakeRunLogHeader(session_, PENUMBRA_VERSION, command_line_);
   header.has_sensor_records = sensors;
-  writer_ = std::make_unique<RunLogWriter>(path, header);
+  try {
+    // named by its relative path: errors and replies never show the server's folders
+    writer_ = std::make_unique<RunLogWriter>(std::move(file.fd), file.relative, header);
+  } catch (...) {
+    // created above by this call: not left empty (removed where it was made, not by path)
+    ::unlinkat(file.folder.get(), file.name.c_str(), 0);
+    throw;
+  }
+  file_ = file.path.string();
   sensors_ = sensors;
   wants_sensors_ = sensors;
   started_ = false;
   first_step_ = last_step_ = -1;
   error_.clear();
-  spdlog::info("live recording to {} from the next step", path);
+  spdlog::info("live recording to {} from the next step", file_);
 }
 
 LiveRecording LiveRecorder::CloseLocked() {
   LiveRecording r;
   r.path = writer_->path();
+  r.file = file_;
   std::unique_ptr<RunLogWriter> writer = std::move(writer_);
   wants_sensors_ = false;
   writer->Close();
