@@ -32,8 +32,12 @@ function send(cmd, fields = {}) {
 }
 viewer.send = send;
 
+// the run's secret token, from the URL penumbra printed (http://127.0.0.1:PORT/?token=...):
+// the server refuses a WebSocket without it (docs/viewer.md, "Access")
+const token = new URLSearchParams(location.search).get('token') || '';
+
 function connect() {
-  ws = new WebSocket(`ws://${location.host}/ws`);
+  ws = new WebSocket(`ws://${location.host}/ws?token=${encodeURIComponent(token)}`);
   ws.binaryType = 'arraybuffer';
   ws.onopen = () => { viewer.connected = true; setBadge('connection', 'connected', 'on'); };
   ws.onclose = () => {
@@ -597,6 +601,11 @@ $('preset').addEventListener('change', () => send('set_adversity', { preset: $('
 $('addView').addEventListener('click', () => addCameraPanel());
 $('addPlot').addEventListener('click', () => addPlot($('plotSignal').value));
 let recording = false;
+// viewer.plog -> viewer-2.plog -> viewer-3.plog ...
+function nextRecordName(name) {
+  const m = /^(.*?)(?:-(\d+))?\.plog$/.exec(name);
+  return m ? `${m[1]}-${m[2] ? Number(m[2]) + 1 : 2}.plog` : name;
+}
 $('record').addEventListener('click', () => {
   const cmd = recording ? 'stop_recording' : 'start_recording';
   const fields = recording ? {} : { path: $('recordPath').value };
@@ -604,8 +613,10 @@ $('record').addEventListener('click', () => {
     recording = !recording;
     $('record').classList.toggle('active', recording);
     $('record').textContent = recording ? '\u25A0 stop' : '\u25CF record';
-    $('recordState').textContent = recording ? `recording to ${fields.path}` : `wrote ${r.path} (${r.bytes} bytes, ${r.steps} steps)`;
-  }).catch((e) => log(e.message));
+    $('recordState').textContent = recording ? `recording to ${fields.path}` : `wrote ${r.path} (${r.bytes} bytes, ${r.steps} steps) in the run's output folder`;
+    // a recording never overwrites a file: offer the next free-looking name
+    if (!recording) $('recordPath').value = nextRecordName($('recordPath').value);
+  }).catch((e) => { $('recordState').textContent = e.message; log(e.message); });
 });
 
 setInterval(() => { $('streamFps').textContent = streamFrames; streamFrames = 0; }, 1000);

@@ -311,8 +311,10 @@ class Client:
         return self.request("set_effect", effect=effect, params=params)
 
     def start_recording(self, path, sensors=False):
-        """Starts a run log (``.plog``, docs/run-log.md) at ``path`` (relative to the
-        server's current folder); ``sensors`` also records images and sensor outputs."""
+        """Starts a run log (``.plog``, docs/run-log.md) at ``path``: a new file inside the
+        run's output folder, relative to it (no absolute path, no ``..``, no symbolic link,
+        never over an existing file; docs/zmq-protocol.md); ``sensors`` also records images
+        and sensor outputs."""
         return self.request("start_recording", path=path, sensors=bool(sensors))
 
     def stop_recording(self):

@@ -66,6 +66,12 @@ TEST_F(CliTest, UsageErrorsExit2WithTheMessageOnStderrOnly) {
       {{"bench", "sensors", "--scans", "0x5"}, "--scans: '0x5'"},
       {{"contact-sheet", "--width", "8"}, "--width: '8' is not an integer in [16, 4096]"},
       {{"make-vdb", "x.vdb", "--blobs", "65"}, "--blobs: '65'"},
+      {{"run", w, "--viewer-allow-origin", "http://lab.example:8080"},
+       "--viewer-allow-origin: given without --viewer"},
+      {{"run", w, "--viewer", "127.0.0.1:0", "--viewer-allow-origin", "ftp://lab.example"},
+       "--viewer-allow-origin: 'ftp://lab.example' does not start with http:// or https://"},
+      {{"view", w, "--viewer-allow-origin", "http://lab.example/viewer"},
+       "--viewer-allow-origin: 'http://lab.example/viewer' holds a path"},
   };
   for (const Case& c : cases) {
     const testing::ProcessResult r = RunPenumbra(c.args, tmp_.path());

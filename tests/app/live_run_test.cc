@@ -68,7 +68,8 @@ TEST(LiveRunTest, AMidRunRecordingReplaysFromItsFirstStepWithTheLiveRunsImages) 
   ASSERT_EQ(world.cameras[0].width, 40);
   const fs::path run = tmp.path() / "run";
   const std::string full_log = (tmp.path() / "full.plog").string();
-  const std::string live_log = (tmp.path() / "live.plog").string();
+  // a live recording is a new file inside the run's output folder, named relative to it
+  const std::string live_log = (run / "live.plog").string();
   // paced to wall-clock time, and stopped (as by Ctrl-C) once the bridge thread is done: the
   // run lasts about a second and the bridge never talks to a run that has ended
   std::atomic<int> stop{0};
@@ -84,12 +85,12 @@ TEST(LiveRunTest, AMidRunRecordingReplaysFromItsFirstStepWithTheLiveRunsImages) 
   std::string bridge_error;
   std::thread bridge;
   options.on_live = [&](LiveControl& live) {
-    bridge = std::thread([&live, &recording, &bridge_error, &live_log, &stop] {
+    bridge = std::thread([&live, &recording, &bridge_error, &stop] {
       try {
         WaitForStep(live, 80);
         live.effects().SetEffect("fog", {{"mor_m", 2.0}});  // before the recording
         WaitForStep(live, 160);
-        live.recorder().StartRecording(live_log, false);
+        live.recorder().StartRecording("live.plog", false);
         WaitForStep(live, 300);
         live.effects().SetEffect("fog", {{"mor_m", 0.8}});  // during it
         WaitForStep(live, 440);
@@ -115,7 +116,8 @@ TEST(LiveRunTest, AMidRunRecordingReplaysFromItsFirstStepWithTheLiveRunsImages) 
   ASSERT_GE(summary.physics_steps, 520);
 
   // the live log: complete, from a step after the start to one before the end
-  EXPECT_EQ(recording.path, live_log);
+  EXPECT_EQ(recording.path, "live.plog");
+  EXPECT_EQ(recording.file, live_log);
   EXPECT_GT(recording.bytes, 0u);
   ASSERT_GE(recording.first_step, 160);
   // the stop came once the loop reached step 440: the recorder had appended 439 at least

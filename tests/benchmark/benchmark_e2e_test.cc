@@ -56,7 +56,7 @@ std::string ShortSpec() {
          "rate_hz: 10}\n"
          "conditions: [none, major]\ntrials: 2\nmethods:\n"
          "  - {name: rgbd, bundled: opencv_rgbd}\n"
-         "  - {name: crash, command: \"kill -SEGV $$\"}\n"
+         "  - {name: crash, command: \"sh -c 'kill -SEGV $$'\"}\n"
          "  - {name: silent, command: \"true\"}\n"
          "  - {name: slow, command: \"sleep 20\", timeout_sec: 0.5}\n"
          "render: {threads: 1}\nworkers: 2\n";

@@ -4,7 +4,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/benchmark/benchmark_report.h"
-#include "penumbra/benchmark/method_process.h"
+#include "penumbra/benchmark/command_template.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -86,27 +86,43 @@ TEST(BenchmarkSpec, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("YAML syntax error"), std::string::npos) << e;
 }
 
-TEST(MethodProcess, TemplatesAndQuoting) {
+TEST(MethodProcess, TemplatesFillBraces) {
   EXPECT_EQ(FillTemplate("a {x} {{y}} {x}", {{"x", "1"}}), "a 1 {y} 1");
   EXPECT_THROW(FillTemplate("{z}", {{"x", "1"}}), Error);
-  EXPECT_EQ(ShellQuote("it's"), "'it'\\''s'");
 }
 
-TEST(MethodProcess, ExitSignalAndTimeoutAreReported) {
+TEST(BenchmarkSpec, CommandsAreSplitAtLoadAndShellSyntaxIsRefusedWithFileLineAndField) {
   TempDir dir;
-  ProcessOutcome o = RunShellCommand("echo hi; exit 4", dir.str(), 10);
-  EXPECT_EQ(o.exit_code, 4);
-  EXPECT_FALSE(o.ok());
-  EXPECT_EQ(testing::ReadAll(dir.path() / "stdout.log"), "hi\n");
-  o = RunShellCommand("kill -SEGV $$", dir.str(), 10);
-  EXPECT_EQ(o.signal, 11);
-  EXPECT_EQ(o.Describe(), "signal 11 (SIGSEGV)");
-  o = RunShellCommand("sleep 30", dir.str(), 0.3);
-  EXPECT_TRUE(o.timed_out);
-  EXPECT_LT(o.wall_sec, 10);
-  o = RunShellCommand("pwd > here.txt", (dir.path() / "w").string(), 10);
-  EXPECT_TRUE(o.ok());
-  EXPECT_EQ(testing::ReadAll(dir.path() / "w" / "here.txt"), (dir.path() / "w").string() + "\n");
+  const BenchmarkSpec s = LoadBenchmarkSpec(dir.Write(
+      "spec.yaml",
+      Spec("",
+           "  - {name: rgbd, bundled: opencv_rgbd}\n"
+           "  - {name: mine, command: \"/opt/x/run 'a b' {dataset}/associations.txt\"}\n")));
+  ASSERT_EQ(s.methods.size(), 2u);
+  EXPECT_EQ(s.methods[0].command_words,
+            (std::vector<std::string>{"{penumbra}", "slam", "opencv_rgbd", "{dataset}", "{output}",
+                                      "--intrinsics", "{fx},{fy},{cx},{cy}"}));
+  EXPECT_EQ(s.methods[1].command_words,
+            (std::vector<std::string>{"/opt/x/run", "a b", "{dataset}/associations.txt"}));
+  // the template: a value in double quotes beside a command substitution
+  std::string e = ErrorOf(Spec("", "  - {name: x, command: 'run \"$(cat {dataset})\"'}\n"));
+  EXPECT_NE(e.find("spec.yaml:10: methods[0].command: column 6: '$' inside"), std::string::npos)
+      << e;
+  e = ErrorOf(Spec("", "  - {name: x, command: \"run {dataset}; touch X\"}\n"));
+  EXPECT_NE(e.find("methods[0].command: column 14: ';' separates commands"), std::string::npos)
+      << e;
+  e = ErrorOf(Spec("", "  - {name: x, command: \"run {dataset} | tee log\"}\n"));
+  EXPECT_NE(e.find("'|' makes a pipeline"), std::string::npos) << e;
+  e = ErrorOf(Spec("", "  - {name: x, command: \"run {dataset} > log\"}\n"));
+  EXPECT_NE(e.find("'>' redirects"), std::string::npos) << e;
+  e = ErrorOf(Spec("", "  - {name: x, command: \"sh -c 'run {dataset}'\"}\n"));
+  EXPECT_NE(e.find("inside the inline program of 'sh -c'"), std::string::npos) << e;
+  e = ErrorOf(Spec("", "  - {name: x, command: \"exec run {dataset}\"}\n"));
+  EXPECT_NE(e.find("'exec' is a shell builtin"), std::string::npos) << e;
+  // control characters in an extra #SBATCH line
+  e = ErrorOf(Spec("slurm: {sbatch: [\"#SBATCH --time=1\\r\"]}\n"));
+  EXPECT_NE(e.find("slurm.sbatch[0]"), std::string::npos) << e;
+  EXPECT_NE(e.find("without control characters"), std::string::npos) << e;
 }
 
 TEST(BenchmarkReport, SummaryIsMeanAndSampleStdOverOkTrials) {

@@ -119,7 +119,7 @@ TEST(NavBenchmark, GoalBehindAWallTimesOutOrCountsCollisions) {
           "      - {name: inside, goal: [2.5, 0], radius: 0.3, timeout_sec: 8}\n"
           "conditions: [none]\ntrials: 1\nmethods:\n"
           "  - {name: penumbra_nav, bundled: penumbra_nav, timeout_sec: 120}\n"
-          "  - {name: straight, command: \"PYTHONPATH={pythonpath} exec /usr/bin/python3 " +
+          "  - {name: straight, command: \"/usr/bin/env PYTHONPATH={pythonpath} /usr/bin/python3 " +
           src +
           "/tests/benchmark/straight_driver.py {endpoint}\", timeout_sec: 120}\n"
           "metrics: {debounce_sec: 0.5}\nworkers: 2\n");
@@ -184,6 +184,10 @@ TEST(NavBenchmark, SpecLoadsAndPlansOneJobPerEpisodeConditionMethodTrial) {
   EXPECT_TRUE(s.worlds[0].episodes[1].has_start);
   EXPECT_DOUBLE_EQ(s.worlds[0].episodes[1].start_yaw_deg, 10);
   EXPECT_NE(s.methods[0].command.find("-m penumbra_nav --endpoint {endpoint}"), std::string::npos);
+  // run without a shell: /usr/bin/env sets PYTHONPATH
+  ASSERT_GE(s.methods[0].command_words.size(), 3u);
+  EXPECT_EQ(s.methods[0].command_words[0], "/usr/bin/env");
+  EXPECT_EQ(s.methods[0].command_words[1], "PYTHONPATH={pythonpath}");
   EXPECT_DOUBLE_EQ(s.nav_metrics.debounce_sec, 0.5);
   const std::vector<BenchmarkJob> jobs = PlanBenchmarkJobs(s);
   ASSERT_EQ(jobs.size(), 2u * 2u * 1u * 2u);

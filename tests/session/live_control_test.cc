@@ -60,7 +60,7 @@ WorldConfig SmallDefaultWorld(const fs::path& out, double duration) {
 std::map<int, fs::path> RunWithChange(const WorldConfig& world, int64_t at_step,
                                       const std::function<void(LiveControl&)>& request) {
   Session session(world);
-  LiveControl live(session, "test");
+  LiveControl live(session, "test", world.output_dir);
   RunOutputsOptions oo;
   oo.end_time_sec = world.duration_sec;
   RunOutputs outputs(session, world, world.output_dir, oo);
@@ -128,7 +128,7 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
   SessionOptions o;
   o.build_renderer = false;
   Session session(world, o);
-  LiveControl live(session, "test");
+  LiveControl live(session, "test", ::testing::TempDir());
   LiveEffects& fx = live.effects();
   const auto refused = [&](const std::function<void()>& call, const std::string& key,
                            const std::string& words) {
@@ -221,7 +221,7 @@ TEST(LiveControlTest, NpcsOfTheStartingPresetMoveOrParkAndTheRestStayBitExact) {
   Session live_session(world, o), same_session(world, o);
   const std::vector<std::string>& npcs = live_session.effects().agent_bodies();
   ASSERT_EQ(npcs.size(), 5u);  // major: four people and a forklift
-  LiveControl live(live_session, "test");
+  LiveControl live(live_session, "test", ::testing::TempDir());
   // re-placing the same preset gives the same plan: nothing moves
   live.effects().SetAdversity("major");
   live.effects().Wants(0, 0.0);

@@ -134,9 +134,9 @@ TEST(RunLogRecordingTest, TheHeaderMapsTheStateByNameAndHashesTheFilesRead) {
 TEST(RunLogRecordingTest, ALiveRecordingThatGotNoStepIsRemovedAndNoneStartsAfterTheEnd) {
   testing::TempDir tmp;
   Session session(CrowdWorld(), PhysicsOnly());
-  LiveRecorder recorder(session, "penumbra run crowd.yaml");
-  const std::string late = (tmp.path() / "late.plog").string();
-  recorder.StartRecording(late, false);
+  LiveRecorder recorder(session, "penumbra run crowd.yaml", tmp.path());
+  const std::filesystem::path late = tmp.path() / "late.plog";
+  recorder.StartRecording("late.plog", false);
   ASSERT_TRUE(std::filesystem::exists(late));  // the header is written at once
   EXPECT_FALSE(recorder.finished());
   recorder.OnFinish(LoopFinish{});
@@ -144,9 +144,9 @@ TEST(RunLogRecordingTest, ALiveRecordingThatGotNoStepIsRemovedAndNoneStartsAfter
   EXPECT_FALSE(recorder.recording());
   EXPECT_FALSE(std::filesystem::exists(late));
   EXPECT_EQ(recorder.closed_at_finish().path, "");
-  const std::string after = (tmp.path() / "after.plog").string();
+  const std::filesystem::path after = tmp.path() / "after.plog";
   try {
-    recorder.StartRecording(after, false);
+    recorder.StartRecording("after.plog", false);
     ADD_FAILURE() << "a recording started after the loop finished";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.key(), "recording");

@@ -70,7 +70,7 @@ class View:
     def _read(self):
         for line in self.proc.stdout:
             self.lines.append(line.rstrip())
-            m = re.search(r"viewer: open (http://\S+/)", line)
+            m = re.search(r"viewer: open (http://\S+/\?token=[0-9a-f]{64}) ", line)
             if m:
                 self.url = m.group(1)
 
@@ -85,9 +85,25 @@ class View:
         return self.proc.returncode
 
 
-def ws_client(url):
-    c = websocket.create_connection(url.replace("http://", "ws://") + "ws", timeout=10)
-    return c
+def ws_client(url, origin=None):
+    """a WebSocket to the viewer of the printed URL (http://HOST:PORT/?token=T), with its token;
+    websocket-client sends Origin http://HOST:PORT (the page's own) unless told another."""
+    base, token = url.split("/?token=")
+    ws_url = base.replace("http://", "ws://") + "/ws?token=" + token
+    kw = {"origin": origin} if origin else {}
+    return websocket.create_connection(ws_url, timeout=10, **kw)
+
+
+def http_status(url, headers=None):
+    """the status of a GET of `url` (urllib raises on 4xx: caught)."""
+    import urllib.error
+    import urllib.request
+    try:
+        with urllib.request.urlopen(urllib.request.Request(url, headers=headers or {}),
+                                    timeout=10) as r:
+            return r.status, r.read().decode(errors="replace")
+    except urllib.error.HTTPError as e:
+        return e.code, e.read().decode(errors="replace")
 
 
 def recv_json(c, want_type=None, timeout=10.0):
@@ -181,6 +197,52 @@ def main():
         check(hello["paused"], "the run starts paused")
         check(len(js("return window.penumbraViewer.scene.geoms;")) > 20,
               "the scene's geometry arrived")
+        check(hello["world"] == "default.yaml",
+              f"hello names the world file only, no folder ({hello['world']!r})")
+
+        # access (docs/viewer.md "Access"): the page without its token, a page of another
+        # site, a rebinding Host and a wrong token are refused with 403 before any upgrade
+        base, token = url.split("/?token=")
+        status, body = http_status(base + "/")
+        check(status == 403 and "?token=" in body and token not in body,
+              f"the page without the token: 403 and a page that says to open the printed URL")
+        status, _ = http_status(url, {"Host": "evil.example:" + base.rsplit(":", 1)[1]})
+        check(status == 403, "a rebinding Host gets 403")
+        for what, kw in [("a foreign Origin", {"origin": "http://evil.example"}),
+                         ("a wrong token", {"url": base + "/?token=" + "0" * 64}),
+                         ("no token", {"url": base + "/?token="})]:
+            try:
+                ws_client(kw.get("url", url), kw.get("origin"))
+                refused = None
+            except websocket.WebSocketBadStatusException as e:
+                refused = e.status_code
+            check(refused == 403, f"a WebSocket with {what} gets 403 ({refused})")
+
+        # the record button writes into the run's output folder, and never over a file
+        driver.find_element("id", "record").click()
+        wait_for("the start_recording reply", lambda: js(
+            "return window.penumbraViewer.replies.some(r => r.cmd === 'start_recording' && r.ok);"))
+        c = ws_client(url)  # a second client steps, so that the page's replies hold no step
+        c.send(json.dumps({"cmd": "step", "n": 5, "id": 1}))
+        check(recv_json(c, "reply")["ok"], "five steps while recording")
+        c.close()
+        driver.find_element("id", "record").click()
+        stopped = wait_for("the stop_recording reply", lambda: js(
+            "return window.penumbraViewer.replies.find(r => r.cmd === 'stop_recording' && r.ok);"))
+        plog = os.path.join(out, "viewer.plog")
+        check(stopped["path"] == "viewer.plog" and stopped["steps"] >= 1 and
+              os.path.getsize(plog) == stopped["bytes"],
+              f"the record button wrote {plog} ({stopped['bytes']} bytes, {stopped['steps']} steps)")
+        with open(plog, "rb") as f:
+            check(f.read(5) == b"\x89PLOG", "it is a run log")
+        check(js("return document.getElementById('recordPath').value;") == "viewer-2.plog",
+              "the field offers the next name")
+        c = ws_client(url)
+        c.send(json.dumps({"cmd": "start_recording", "path": "viewer.plog", "id": 1}))
+        r = recv_json(c, "reply")
+        check(r["ok"] is False and "already exists" in r["error"]["message"],
+              f"a second recording to viewer.plog is refused ({r['error']['message']})")
+        c.close()
 
         # play: time runs, frames arrive and are drawn
         driver.find_element("id", "play").click()

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -38,13 +39,16 @@ std::string MakeWebRoot() {
   return root.string();
 }
 
+// one HTTP request on a fresh connection; Host is 127.0.0.1:PORT unless `headers` name one
 http::response<http::string_body> HttpGet(int port, const std::string& target,
-                                          http::verb verb = http::verb::get) {
+                                          http::verb verb = http::verb::get,
+                                          const std::map<http::field, std::string>& headers = {}) {
   net::io_context ioc;
   tcp::socket socket(ioc);
   socket.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));
   http::request<http::string_body> req{verb, target, 11};
-  req.set(http::field::host, "127.0.0.1");
+  req.set(http::field::host, "127.0.0.1:" + std::to_string(port));
+  for (const auto& [field, value] : headers) req.set(field, value);
   req.keep_alive(false);
   http::write(socket, req);
   beast::flat_buffer buffer;
@@ -54,14 +58,14 @@ http::response<http::string_body> HttpGet(int port, const std::string& target,
   return parser.release();
 }
 
-// a blocking WebSocket client
+// a blocking WebSocket client that presents the server's token (and no Origin, as programs do)
 struct Client {
   net::io_context ioc;
   websocket::stream<tcp::socket> ws{ioc};
-  explicit Client(int port) {
-    ws.next_layer().connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));
+  explicit Client(const WebServer& server) {
+    ws.next_layer().connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), server.port()));
     ws.read_message_max(64 << 20);
-    ws.handshake("127.0.0.1", "/ws");
+    ws.handshake("127.0.0.1:" + std::to_string(server.port()), "/ws?token=" + server.token());
   }
   std::string Read() {
     beast::flat_buffer b;
@@ -78,8 +82,9 @@ struct Fixture {
   WebServerOptions options;
   std::unique_ptr<WebServer> server;
   std::atomic<int> opened{0}, closed{0};
-  explicit Fixture(size_t max_message = 1024) {
+  explicit Fixture(size_t max_message = 1024, std::vector<std::string> allowed_origins = {}) {
     options.port = 0;
+    options.allowed_origins = std::move(allowed_origins);
     options.web_root = MakeWebRoot();
     options.max_message_bytes = max_message;
     WebServerHandlers h;
@@ -100,20 +105,22 @@ struct Fixture {
 TEST(WebServerTest, ServesStaticFilesSafely) {
   Fixture f;
   ASSERT_GT(f.server->port(), 0);
-  auto res = HttpGet(f.server->port(), "/");
+  const std::string t = "token=" + f.server->token();
+  auto res = HttpGet(f.server->port(), "/?" + t);
   EXPECT_EQ(res.result(), http::status::ok);
   EXPECT_EQ(res.body(), "<html>viewer</html>");
   EXPECT_EQ(res[http::field::content_type], "text/html; charset=utf-8");
-  res = HttpGet(f.server->port(), "/js/app.js?v=2");
+  res = HttpGet(f.server->port(), "/js/app.js?v=2&" + t);
   EXPECT_EQ(res.result(), http::status::ok);
   EXPECT_EQ(res.body(), "console.log(1);");
   EXPECT_EQ(res[http::field::content_type], "text/javascript; charset=utf-8");
-  EXPECT_EQ(HttpGet(f.server->port(), "/missing.js").result(), http::status::not_found);
-  EXPECT_EQ(HttpGet(f.server->port(), "/../../etc/passwd").result(), http::status::bad_request);
-  EXPECT_EQ(HttpGet(f.server->port(), "/js/%2e%2e/..").result(), http::status::bad_request);
-  EXPECT_EQ(HttpGet(f.server->port(), "/", http::verb::post).result(),
+  EXPECT_EQ(HttpGet(f.server->port(), "/missing.js?" + t).result(), http::status::not_found);
+  EXPECT_EQ(HttpGet(f.server->port(), "/../../etc/passwd?" + t).result(),
+            http::status::bad_request);
+  EXPECT_EQ(HttpGet(f.server->port(), "/js/%2e%2e/..?" + t).result(), http::status::bad_request);
+  EXPECT_EQ(HttpGet(f.server->port(), "/?" + t, http::verb::post).result(),
             http::status::method_not_allowed);
-  res = HttpGet(f.server->port(), "/", http::verb::head);
+  res = HttpGet(f.server->port(), "/?" + t, http::verb::head);
   EXPECT_EQ(res.result(), http::status::ok);
   EXPECT_EQ(f.server->stats().http_requests, 7);
   EXPECT_EQ(res[http::field::content_length], "19");
@@ -157,7 +164,7 @@ TEST(WebServerTest, RejectsBadOptions) {
 
 TEST(WebServerTest, RepliesAndSurvivesMalformedMessages) {
   Fixture f;
-  Client c(f.server->port());
+  Client c(*f.server);
   EXPECT_EQ(json::parse(c.Read())["type"], "hello");
   c.Write(R"({"cmd":"ping","x":1})");
   json r = json::parse(c.Read());
@@ -191,18 +198,18 @@ TEST(WebServerTest, RepliesAndSurvivesMalformedMessages) {
     EXPECT_TRUE(ec == net::error::broken_pipe || ec == net::error::connection_reset ||
                 ec == net::error::eof || ec == net::error::not_connected)
         << ec.message();
-  Client d(f.server->port());
+  Client d(*f.server);
   EXPECT_EQ(json::parse(d.Read())["type"], "hello");
   d.Write(R"({"cmd":"ping"})");
   EXPECT_EQ(json::parse(d.Read())["type"], "echo");
-  EXPECT_EQ(HttpGet(f.server->port(), "/").result(), http::status::ok);
+  EXPECT_EQ(HttpGet(f.server->port(), "/?token=" + f.server->token()).result(), http::status::ok);
 }
 
 TEST(WebServerTest, FiveClientsEachGetEveryMessageTheyAreSent) {
   Fixture f;
   std::vector<std::unique_ptr<Client>> clients;
   for (int i = 0; i < 5; ++i) {
-    clients.push_back(std::make_unique<Client>(f.server->port()));
+    clients.push_back(std::make_unique<Client>(*f.server));
     EXPECT_EQ(json::parse(clients.back()->Read())["type"], "hello");
   }
   EXPECT_EQ(f.server->stats().clients, 5);
@@ -238,9 +245,9 @@ TEST(WebServerTest, FiveClientsEachGetEveryMessageTheyAreSent) {
 
 TEST(WebServerTest, SlowClientGetsTheLatestFrameAndNeverBlocksThePublisher) {
   Fixture f;
-  Client slow(f.server->port());
+  Client slow(*f.server);
   EXPECT_EQ(json::parse(slow.Read())["type"], "hello");
-  Client fast(f.server->port());
+  Client fast(*f.server);
   EXPECT_EQ(json::parse(fast.Read())["type"], "hello");
   // 300 frames of 1 MiB, far more than the socket buffers hold; the slow client reads none
   // while they are published. a frame: 8-byte sequence number + payload
@@ -273,6 +280,136 @@ TEST(WebServerTest, SlowClientGetsTheLatestFrameAndNeverBlocksThePublisher) {
   f.server->Publish("camera/front", WebMessage::Binary(frame(kFrames - 1)));
   std::string a = slow.Read(), b = slow.Read();
   EXPECT_TRUE(a == "{\"t\":1}" || b == "{\"t\":1}");
+}
+
+// ---- access: Host, Origin and the token (docs/viewer.md "Access") ----
+
+// the HTTP status of a WebSocket handshake request (RFC 6455 4.1) on a real socket: 101 =
+// upgraded; `origin` "" sends none. (beast's client does not hand back a declined response.)
+unsigned HandshakeStatus(const WebServer& server, const std::string& host,
+                         const std::string& target, const std::string& origin) {
+  std::map<http::field, std::string> h = {
+      {http::field::host, host},
+      {http::field::connection, "Upgrade"},
+      {http::field::upgrade, "websocket"},
+      {http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ=="},
+      {http::field::sec_websocket_version, "13"}};
+  if (!origin.empty()) h[http::field::origin] = origin;
+  return HttpGet(server.port(), target, http::verb::get, h).result_int();
+}
+
+TEST(WebServerAccessTest, RefusesForeignOriginsRebindingHostsAndWrongTokensBeforeTheUpgrade) {
+  Fixture f;
+  const std::string port = std::to_string(f.server->port());
+  const std::string token = f.server->token();
+  const std::string host = "127.0.0.1:" + port, own = "http://127.0.0.1:" + port;
+  const std::string good = "/ws?token=" + token;
+  std::string wrong = token;
+  wrong.back() = wrong.back() == '0' ? '1' : '0';
+  // cross-site WebSocket hijacking: a page of another site, with the right token even
+  EXPECT_EQ(HandshakeStatus(*f.server, host, good, "http://evil.example"), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, host, good, "https://evil.example:" + port), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, host, good, "null"), 403u);
+  // DNS rebinding: the browser names the attacker's host in Host (and Origin)
+  EXPECT_EQ(HandshakeStatus(*f.server, "evil.example:" + port, good, ""), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "evil.example:8080", good, "http://evil.example:8080"),
+            403u);
+  // no token, an empty one, a wrong one
+  EXPECT_EQ(HandshakeStatus(*f.server, host, "/ws", own), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, host, "/ws?token=", own), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, host, "/ws?token=" + wrong, own), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, host, "/ws?token=" + token.substr(1), own), 403u);
+  EXPECT_EQ(f.opened.load(), 0);
+  EXPECT_EQ(f.server->stats().refused, 9);
+  // the refusal says why, in plain words, and never echoes the token
+  const auto res = HttpGet(f.server->port(), "/ws", http::verb::get,
+                           {{http::field::connection, "Upgrade"},
+                            {http::field::upgrade, "websocket"},
+                            {http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ=="},
+                            {http::field::sec_websocket_version, "13"},
+                            {http::field::origin, "http://evil.example"}});
+  EXPECT_EQ(res.result(), http::status::forbidden);
+  EXPECT_NE(res.body().find("Origin 'http://evil.example' is not allowed"), std::string::npos)
+      << res.body();
+  EXPECT_EQ(res.body().find(token), std::string::npos);
+  // the page's own origin on any loopback name, and programs that send no Origin, with the
+  // token: upgraded
+  EXPECT_EQ(HandshakeStatus(*f.server, host, good, own), 101u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "localhost:" + port, good, "http://localhost:" + port),
+            101u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "[::1]:" + port, good, "http://[::1]:" + port), 101u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "LocalHost:" + port, good, ""), 101u);
+  Client c(*f.server);
+  EXPECT_EQ(json::parse(c.Read())["type"], "hello");
+}
+
+TEST(WebServerAccessTest, AllowedOriginsExtendTheListAndAreChecked) {
+  Fixture f(1024, {"http://Lab.Example:9000/"});
+  const std::string good = "/ws?token=" + f.server->token();
+  EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9000", good, "http://lab.example:9000"), 101u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9001", good, "http://lab.example:9001"), 403u);
+  EXPECT_EQ(HandshakeStatus(*f.server, "lab.example:9000", good, "https://lab.example:9000"), 403u);
+  EXPECT_EQ(NormalizeOrigin("HTTPS://[::1]:8443/"), "https://[::1]:8443");
+  for (const char* bad : {"lab.example", "ftp://lab.example", "http://lab.example/viewer",
+                          "http://", "http://user@lab.example", "http://lab.example:0",
+                          "http://lab.example:99999", "http://lab example"}) {
+    WebServerOptions o;
+    o.port = 0;
+    o.web_root = MakeWebRoot();
+    o.allowed_origins = {bad};
+    try {
+      o.ValidateOrThrow();
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(e.key(), "--viewer-allow-origin") << bad;
+      EXPECT_NE(std::string(e.what()).find("expected http://HOST[:PORT]"), std::string::npos);
+    }
+  }
+}
+
+TEST(WebServerAccessTest, PagesNeedTheTokenOrTheCookieItSets) {
+  Fixture f;
+  const int port = f.server->port();
+  const std::string token = f.server->token();
+  EXPECT_EQ(token.size(), 64u);
+  EXPECT_EQ(token.find_first_not_of("0123456789abcdef"), std::string::npos);
+  EXPECT_EQ(f.server->url(), "http://127.0.0.1:" + std::to_string(port) + "/?token=" + token);
+  Fixture other;
+  EXPECT_NE(other.server->token(), token);
+  // without the token: a page that says to open the printed URL
+  auto res = HttpGet(port, "/");
+  EXPECT_EQ(res.result(), http::status::forbidden);
+  EXPECT_EQ(res[http::field::content_type], "text/html; charset=utf-8");
+  EXPECT_NE(res.body().find("http://127.0.0.1:PORT/?token=..."), std::string::npos);
+  EXPECT_EQ(res.body().find(token), std::string::npos);
+  EXPECT_EQ(HttpGet(port, "/js/app.js").result(), http::status::forbidden);
+  EXPECT_EQ(HttpGet(port, "/?token=" + token.substr(2)).result(), http::status::forbidden);
+  // with it: the page, and a cookie for its scripts
+  res = HttpGet(port, "/?token=" + token);
+  EXPECT_EQ(res.result(), http::status::ok);
+  const std::string cookie = "penumbra_viewer_token_" + std::to_string(port) + "=" + token;
+  EXPECT_EQ(res[http::field::set_cookie], cookie + "; Path=/; HttpOnly; SameSite=Strict");
+  res = HttpGet(port, "/js/app.js", http::verb::get, {{http::field::cookie, "a=b; " + cookie}});
+  EXPECT_EQ(res.result(), http::status::ok);
+  EXPECT_EQ(res.body(), "console.log(1);");
+  // the cookie does not open the WebSocket: it needs the token itself
+  EXPECT_EQ(HttpGet(port, "/ws", http::verb::get,
+                    {{http::field::connection, "Upgrade"},
+                     {http::field::upgrade, "websocket"},
+                     {http::field::sec_websocket_key, "dGhlIHNhbXBsZSBub25jZQ=="},
+                     {http::field::sec_websocket_version, "13"},
+                     {http::field::cookie, cookie}})
+                .result(),
+            http::status::forbidden);
+  // a rebinding Host or a foreign Origin is refused even with the token
+  EXPECT_EQ(HttpGet(port, "/?token=" + token, http::verb::get,
+                    {{http::field::host, "evil.example:" + std::to_string(port)}})
+                .result(),
+            http::status::forbidden);
+  EXPECT_EQ(HttpGet(port, "/js/app.js?token=" + token, http::verb::get,
+                    {{http::field::origin, "http://evil.example"}})
+                .result(),
+            http::status::forbidden);
 }
 
 }  // namespace

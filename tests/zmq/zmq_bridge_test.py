@@ -463,11 +463,18 @@ def test_live(binary, source):
             smoky = rgb_contrast(frame_after(50))
             assert smoky < 0.8 * clear, f"preset smoky: contrast {clear:.1f} -> {smoky:.1f}"
             c.ok("set_adversity", preset="none")
+            # recordings are new files inside the output folder only (docs/zmq-protocol.md):
+            # a path outside it is refused and nothing is written there
+            outside = os.path.join(tmp, "outside.plog")
+            for bad in (outside, "../outside.plog"):
+                expect_error(c, pack({"cmd": "start_recording", "path": bad}), "bad_field",
+                             "path")
+            assert not os.path.exists(outside)
             # a live recording of 20 steps, with the camera's images
-            plog = os.path.join(tmp, "live.plog")
-            r = c.ok("start_recording", path=plog, sensors=True)
+            plog = os.path.join(tmp, "out", "live.plog")
+            r = c.ok("start_recording", path="live.plog", sensors=True)
             first = r["from_step"]
-            expect_error(c, pack({"cmd": "start_recording", "path": plog}), "conflict",
+            expect_error(c, pack({"cmd": "start_recording", "path": "other.plog"}), "conflict",
                          "recording")
             c.ok("step", n=20)
             r = c.ok("stop_recording")

@@ -42,8 +42,9 @@ std::string SelfExecutable() {
 }
 
 // the route of a world recorded with no cameras (only the motion matters; replays add the
-// benchmark camera)
-void RecordRoute(const BenchmarkWorld& w, const std::string& plog) {
+// benchmark camera); it stops at the next physics step once *stop_request is set
+void RecordRoute(const BenchmarkWorld& w, const std::string& plog,
+                 const std::atomic<int>* stop_request) {
   WorldConfig world = LoadWorldFile(w.file);
   world.cameras.clear();
   world.mjcf_cameras.enabled = false;
@@ -53,6 +54,7 @@ void RecordRoute(const BenchmarkWorld& w, const std::string& plog) {
   run.force = true;
   run.record_file = plog;
   run.progress = false;
+  run.stop_request = stop_request;
   if (w.duration_sec > 0) run.duration_sec = w.duration_sec;
   fs::remove_all(run.out_dir);
   RunWorld(world, run);
@@ -136,8 +138,7 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
     if (s.job >= 0) {
       if (s.slurm)
         throw ConfigError("", 0, "--job", "not with --slurm (a worker runs one job here)");
-      RunBenchmarkWorker(s.spec, s.out, s.job, SelfExecutable(), stop_request);
-      return 0;
+      return RunBenchmarkWorker(s.spec, s.out, s.job, SelfExecutable(), stop_request);
     }
     BenchmarkOptions o;
     o.spec_path = s.spec;

@@ -28,8 +28,9 @@ class BenchmarkCommands {
   /// true when the parsed command line chose `benchmark` or `slam`.
   bool Selected() const;
 
-  /// runs the chosen verb; returns the exit code (benchmark: RunBenchmark's; slam: 0, or 3
-  /// when no frame was tracked after the first).
+  /// runs the chosen verb; returns the exit code (benchmark: RunBenchmark's, with --job
+  /// RunBenchmarkWorker's; both 128 + the signal when *stop_request interrupted them; slam: 0,
+  /// or 3 when no frame was tracked after the first).
   /// @throws ConfigError for bad input (exit code 2 in RunCli); Error for failures.
   int Run(const std::atomic<int>* stop_request) const;
 

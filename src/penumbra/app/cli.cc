@@ -351,7 +351,9 @@ int RunCli(int argc, char** argv) {
   view->add_option("world", view_world, "world file (.yaml) or model (.xml MJCF, .urdf)")
       ->required();
   view->add_option("--viewer", view_options.address,
-                   "HOST:PORT to serve on (default 127.0.0.1:8080; loopback unless told)");
+                   "HOST:PORT to serve on (default 127.0.0.1:8080; loopback unless told); open "
+                   "the URL it prints (it holds the run's secret token)");
+  AddViewerAllowOrigin(view, &view_options.allow_origins);
   view->add_option("--out,-o", view_options.out_dir,
                    "keep the camera outputs in this folder (default: a temporary folder, removed "
                    "at exit)");

@@ -156,7 +156,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // once the log is open, before the loop starts)
   RunLogWriter* sensor_log = nullptr;
   // the live controls (session/live_control.h); their recordings take sensor records too
-  LiveControl live(session, JoinArgs(options.command_line));
+  LiveControl live(session, JoinArgs(options.command_line), out);
   outputs_options.on_image = [&sensor_log, &live](const CameraFrame& f, const std::string& kind,
                                                   const std::vector<uint8_t>& png) {
     if (!sensor_log && !live.recorder().wants_sensor_records()) return;

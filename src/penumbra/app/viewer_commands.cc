@@ -25,26 +25,58 @@
 
 namespace penumbra {
 
+void AddViewerAllowOrigin(CLI::App* verb, std::vector<std::string>* origins) {
+  verb->add_option("--viewer-allow-origin", *origins,
+                   "let pages of this origin (http(s)://HOST[:PORT]) use the viewer too, besides "
+                   "its own page on 127.0.0.1/localhost/[::1]; repeatable (docs/viewer.md)")
+      ->type_name("ORIGIN")
+      ->allow_extra_args(false);  // one value per flag: a positional after it stays positional
+}
+
 void ViewerFlag::Add(CLI::App* run) {
   run->add_option("--viewer", address,
                   "serve a live viewer to browsers (docs/viewer.md) on HOST:PORT (default "
-                  "127.0.0.1:8080; loopback unless told)")
+                  "127.0.0.1:8080; loopback unless told); open the URL it prints (it holds the "
+                  "run's secret token)")
       ->expected(0, 1)
       ->type_name("[HOST:PORT]");
+  AddViewerAllowOrigin(run, &allow_origins);
 }
 
 void ViewerFlag::Apply(const CLI::App& run, RunOptions* options) const {
-  if (run.count("--viewer") == 0) return;
+  if (run.count("--viewer") == 0) {
+    if (run.count("--viewer-allow-origin") > 0)
+      throw ConfigError("", 0, "--viewer-allow-origin",
+                        "given without --viewer; expected it with --viewer (the viewer it opens)");
+    return;
+  }
   ViewerOptions v;
   ParseViewerAddress(address, &v);
+  v.allowed_origins = allow_origins;
   options->bridges.push_back(MakeViewerBridgeFactory(v));
 }
+
+namespace {
+
+// the live recordings (*.plog) under `dir`, relative to it
+std::vector<std::string> Recordings(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file(ec) && it->path().extension() == ".plog")
+      out.push_back(it->path().lexically_relative(dir).string());
+  return out;
+}
+
+}  // namespace
 
 int RunView(const WorldConfig& world, const ViewOptions& options,
             const std::atomic<int>* stop_request) {
   namespace fs = std::filesystem;
   ViewerOptions v;
   ParseViewerAddress(options.address, &v);
+  v.allowed_origins = options.allow_origins;
   RunOptions o;
   o.realtime = true;
   o.lockstep = !options.running;
@@ -63,16 +95,27 @@ int RunView(const WorldConfig& world, const ViewOptions& options,
   o.bridges.push_back(MakeViewerBridgeFactory(v));
   spdlog::info("penumbra view: {} {}; Ctrl-C ends it", world.file.empty() ? "model" : world.file,
                options.running ? "running in real time" : "paused: press play in the page");
+  // the page's record button writes into the output folder: a temporary one that holds a
+  // recording is kept (and named) instead of removed
+  auto clean_up = [&] {
+    if (!temporary) return;
+    const std::vector<std::string> logs = Recordings(o.out_dir);
+    if (!logs.empty()) {
+      spdlog::info("penumbra view: kept {} with {} live recording(s) ({}{})", o.out_dir,
+                   logs.size(), logs.front(), logs.size() > 1 ? ", ..." : "");
+      return;
+    }
+    std::error_code ec;
+    fs::remove_all(o.out_dir, ec);
+  };
   try {
     const RunSummary s = RunWorld(world, o);
     spdlog::info("view ended at {:.3f} s of sim time ({} steps)", s.sim_time_sec, s.physics_steps);
   } catch (...) {
-    std::error_code ec;
-    if (temporary) fs::remove_all(o.out_dir, ec);
+    clean_up();
     throw;
   }
-  std::error_code ec;
-  if (temporary) fs::remove_all(o.out_dir, ec);
+  clean_up();
   return 0;
 }
 
@@ -127,27 +170,30 @@ struct BenchPage {
   std::thread thread;
 
   void Start(const std::string& url) {
-    // url = http://HOST:PORT/
-    const std::string hostport = url.substr(7, url.size() - 8);
+    // url = http://HOST:PORT/?token=TOKEN (the page's URL: the WebSocket needs its token)
+    const size_t slash = url.find('/', 7);
+    const std::string hostport = url.substr(7, slash - 7);
     const size_t colon = hostport.rfind(':');
     const std::string host = hostport.substr(0, colon);
     const std::string port = hostport.substr(colon + 1);
-    thread = std::thread([this, host, port] {
+    const size_t token_at = url.find("?token=");
+    const std::string token = token_at == std::string::npos ? "" : url.substr(token_at + 7);
+    thread = std::thread([this, host, port, token] {
       try {
-        Run(host, port);
+        Run(host, port, token);
       } catch (const std::exception&) {
         // the run ended and the server closed the connection
       }
     });
   }
 
-  void Run(const std::string& host, const std::string& port) {
+  void Run(const std::string& host, const std::string& port, const std::string& token) {
     net::io_context ioc;
     tcp::resolver resolver(ioc);
     websocket::stream<tcp::socket> ws(ioc);
     net::connect(ws.next_layer(), resolver.resolve(host, port));
     ws.read_message_max(64 << 20);
-    ws.handshake(host, "/ws");
+    ws.handshake(host + ":" + port, "/ws?token=" + token);
     ws.text(true);
     ws.write(net::buffer(json{{"cmd", "subscribe"}, {"id", 0}, {"streams", {stream}}}.dump()));
     int next_id = 1, waiting_id = -1;

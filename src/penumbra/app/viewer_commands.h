@@ -20,20 +20,29 @@ class App;
 
 namespace penumbra {
 
-/// the `--viewer [HOST:PORT]` flag of `penumbra run`.
+/// the `--viewer [HOST:PORT]` and `--viewer-allow-origin ORIGIN` flags of `penumbra run`.
 struct ViewerFlag {
   std::string address;  ///< as given ("" = the default 127.0.0.1:8080)
-  /// adds the flag to `run`.
+  std::vector<std::string> allow_origins;  ///< --viewer-allow-origin, repeatable
+  /// adds the flags to `run`.
   void Add(CLI::App* run);
-  /// adds the viewer bridge to options->bridges when the flag was given on `run`.
-  /// @throws ConfigError("", 0, "--viewer", ...) for a bad address or a missing web folder.
+  /// adds the viewer bridge to options->bridges when --viewer was given on `run`.
+  /// @throws ConfigError("", 0, "--viewer", ...) for a bad address or a missing web folder;
+  ///         ConfigError("", 0, "--viewer-allow-origin", ...) for a bad origin or one given
+  ///         without --viewer.
   void Apply(const CLI::App& run, RunOptions* options) const;
 };
+
+/// adds `--viewer-allow-origin ORIGIN` (repeatable) to a verb that starts the viewer.
+void AddViewerAllowOrigin(CLI::App* verb, std::vector<std::string>* origins);
 
 /// options of `penumbra view`.
 struct ViewOptions {
   std::string address;   ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
-  std::string out_dir;   ///< --out: keep the outputs here ("" = a temporary folder, removed)
+  std::vector<std::string> allow_origins;  ///< --viewer-allow-origin, repeatable
+  /// --out: keep the outputs here ("" = a temporary folder, removed at exit unless it holds
+  /// a recording made with the page's record button)
+  std::string out_dir;
   bool running = false;  ///< --running: start running instead of paused
   bool force = false;    ///< --force: --out may hold an earlier run's outputs
   std::optional<double> duration_sec;  ///< --duration (default: the world's)

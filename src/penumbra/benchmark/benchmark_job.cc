@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "penumbra/benchmark/benchmark_text.h"
+#include "penumbra/benchmark/command_template.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_job.h"
 #include "penumbra/core/error.h"
@@ -156,7 +157,7 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
   replay.progress = false;
   replay.stop_request = context.stop_request;
   const ReplaySummary replayed = ReplayLog(replay);
-  if (replayed.interrupted) throw Error("job " + job.id + ": interrupted");
+  if (replayed.interrupted) throw JobInterrupted("job " + job.id + " interrupted in its replay");
   const double replay_sec = Since(t0);
 
   // 2. export the datasets the methods read
@@ -201,24 +202,26 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
     const fs::path workdir = dir / m.name;
     fs::create_directories(workdir);
     const fs::path dataset = dir / ("dataset_" + m.dataset);
+    // values are plain text inside their words: never read by a shell
     const std::map<std::string, std::string> values = {
-        {"penumbra", ShellQuote(context.penumbra_binary)},
-        {"dataset", ShellQuote(fs::absolute(dataset).string())},
-        {"output", ShellQuote(fs::absolute(workdir / "trajectory.txt").string())},
-        {"workdir", ShellQuote(fs::absolute(workdir).string())},
+        {"penumbra", context.penumbra_binary},
+        {"dataset", fs::absolute(dataset).string()},
+        {"output", fs::absolute(workdir / "trajectory.txt").string()},
+        {"workdir", fs::absolute(workdir).string()},
         {"fx", FormatNumber(camera.fx)},
         {"fy", FormatNumber(camera.fy)},
         {"cx", FormatNumber(camera.cx)},
         {"cy", FormatNumber(camera.cy)},
         {"width", std::to_string(camera.width)},
         {"height", std::to_string(camera.height)},
-        {"camera_info", ShellQuote(fs::absolute(dir / "camera_info.json").string())},
+        {"camera_info", fs::absolute(dir / "camera_info.json").string()},
         {"seed", std::to_string(job.seed)}};
-    const std::string command = FillTemplate(m.command, values);
-    WriteText(workdir / "command.sh", command + "\n");
+    const std::vector<std::string> argv = ExpandCommandTemplate(m.command_words, values);
+    WriteText(workdir / "command.sh", MethodCommandScript(argv, fs::absolute(workdir).string()));
     const ProcessOutcome outcome =
-        RunShellCommand(command, workdir.string(), m.timeout_sec, context.stop_request);
-    if (outcome.stopped) throw Error("job " + job.id + ": interrupted");
+        RunMethodCommand(argv, workdir.string(), m.timeout_sec, context.stop_request);
+    if (outcome.stopped)
+      throw JobInterrupted("job " + job.id + " interrupted while method " + m.name + " ran");
     row.method_sec = outcome.wall_sec;
     row.detail = outcome.Describe();
     const fs::path traj = workdir / m.trajectory;
@@ -260,10 +263,8 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
   }
   nlohmann::json j = nlohmann::json::array();
   for (const BenchmarkRow& r : rows) j.push_back(RowJson(r));
-  // written last and atomically: its presence marks the job finished
-  const fs::path result = JobResultPath(context.out_dir, job);
-  WriteText(result.string() + ".tmp", j.dump(1) + "\n");
-  fs::rename(result.string() + ".tmp", result);
+  // written last and atomically (WriteText): its presence marks the job finished
+  WriteText(JobResultPath(context.out_dir, job), j.dump(1) + "\n");
   return rows;
 }
 

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/core/error.h"
 
 namespace penumbra {
 
@@ -53,6 +54,13 @@ struct BenchmarkRow {
   double replay_sec = 0, export_sec = 0, method_sec = 0, eval_sec = 0;
 };
 
+/// thrown by a job that a stop request (SIGINT / SIGTERM) interrupted: its folder holds no
+/// result.json and may hold partial outputs (RunBenchmarkWorker removes it).
+class JobInterrupted : public Error {
+ public:
+  explicit JobInterrupted(const std::string& what) : Error(what) {}
+};
+
 /// what a job needs besides the spec.
 struct BenchmarkJobContext {
   std::string out_dir;          ///< the benchmark's output folder
@@ -71,8 +79,9 @@ std::string JobFolder(const std::string& out_dir, const BenchmarkJob& job);
 std::string JobResultPath(const std::string& out_dir, const BenchmarkJob& job);
 
 /// runs a job (its world's recording must exist) and writes its result.json.
-/// @throws ConfigError / Error when the harness itself fails (replay, export, a write);
-///         a method's failure is a row, not an exception.
+/// @throws JobInterrupted when context.stop_request is set while it runs; ConfigError / Error
+///         when the harness itself fails (replay, export, a write); a method's failure
+///         (including a program that cannot be started) is a row, not an exception.
 std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                                           const BenchmarkJobContext& context);
 

@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,9 +21,10 @@
 #include "penumbra/benchmark/benchmark_job.h"
 #include "penumbra/benchmark/benchmark_report.h"
 #include "penumbra/benchmark/benchmark_text.h"
-#include "penumbra/benchmark/method_process.h"
+#include "penumbra/benchmark/child_process.h"
 #include "penumbra/benchmark/nav_job.h"
 #include "penumbra/benchmark/nav_report.h"
+#include "penumbra/benchmark/shell_quote.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -62,28 +64,19 @@ void Progress(bool on, size_t done, size_t all, size_t done_here, size_t failed,
                failed ? fmt::format(" ({} failed)", failed) : "", Hms(elapsed), eta);
 }
 
-// `command` through popen; its stdout (or nullopt when it cannot run / exits non-zero)
-std::optional<std::string> Capture(const std::string& command, int* exit_code = nullptr) {
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) return std::nullopt;
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = pclose(p);
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (exit_code) *exit_code = code;
-  if (code != 0) return std::nullopt;
-  return out;
-}
-
 pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const BenchmarkJob& j,
                   const fs::path& log) {
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw Error(std::string("cannot start a worker: ") + strerror(errno));
   if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int in = open("/dev/null", O_RDONLY);
+    // its own process group: a terminal's Ctrl-C reaches only the harness, which stops each
+    // worker once (SIGTERM); SIGTERM too when the harness dies
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
     if (fd < 0 || in < 0) _exit(127);
     dup2(in, 0);
     dup2(fd, 1);
@@ -94,8 +87,21 @@ pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const
           static_cast<char*>(nullptr));
     _exit(127);
   }
+  setpgid(pid, pid);
   return pid;
 }
+
+// removes the folder of a job that did not finish (no result.json): partial outputs of an
+// interrupted job
+void RemoveUnfinished(const std::string& out, const BenchmarkJob& j) {
+  if (Finished(out, j)) return;
+  std::error_code ec;
+  fs::remove_all(JobFolder(out, j), ec);
+}
+
+int StopSignal(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
+
+std::string SignalName(int sig) { return sig == SIGTERM ? "SIGTERM" : "SIGINT"; }
 
 // runs the unfinished jobs as local worker processes; returns the ids of jobs whose worker
 // failed
@@ -117,8 +123,11 @@ std::vector<std::string> RunLocal(const BenchmarkOptions& o, const BenchmarkSpec
   bool stopping = false;
   Progress(o.progress, done, jobs.size(), 0, 0, start);
   while (next < pending.size() || !running.empty()) {
-    if (!stopping && o.stop_request && o.stop_request->load() != 0) {
+    if (!stopping && StopSignal(o.stop_request) != 0) {
       stopping = true;
+      if (!running.empty())
+        spdlog::warn("{}: stopping {} running job(s); their partial folders are removed",
+                     SignalName(StopSignal(o.stop_request)), running.size());
       for (const auto& [pid, job] : running) kill(pid, SIGTERM);
     }
     while (!stopping && next < pending.size() && running.size() < static_cast<size_t>(workers)) {
@@ -137,6 +146,7 @@ std::vector<std::string> RunLocal(const BenchmarkOptions& o, const BenchmarkSpec
     const BenchmarkJob* j = it->second;
     running.erase(it);
     const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && Finished(o.out_dir, *j);
+    if (stopping) RemoveUnfinished(o.out_dir, *j);
     if (!ok && !stopping) {
       failed.push_back(j->id);
       spdlog::error("job {} failed ({}); log: {}", j->id,
@@ -160,7 +170,7 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
     spdlog::info("{} of {} jobs finished earlier: not submitted", jobs.size() - pending.size(),
                  jobs.size());
   if (pending.empty()) return {};
-  if (!Capture("command -v sbatch"))
+  if (FindOnPath("sbatch").empty())
     throw ConfigError("", 0, "--slurm",
                       "sbatch not found; expected Slurm's client commands (slurm-client) on PATH");
   const fs::path dir = fs::path(o.out_dir) / "slurm";
@@ -169,20 +179,32 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
   WriteText(script, SlurmBatchScript(spec, o.out_dir, o.penumbra_binary, pending));
   int code = 0;
   const std::optional<std::string> submitted =
-      Capture("sbatch --parsable " + ShellQuote(script.string()) + " 2>&1", &code);
+      CaptureCommand({"sbatch", "--parsable", script.string()}, /*merge_stderr=*/true, &code);
   if (!submitted)
     throw Error("sbatch " + script.string() + " failed (exit " + std::to_string(code) + ")");
-  const std::string job_id = submitted->substr(0, submitted->find_first_of(";\n"));
+  // --parsable prints "ID" or "ID;CLUSTER" (after any warning lines on stderr): the last line
+  // that is one, and only digits reach scancel / squeue
+  std::string job_id;
+  std::istringstream lines(*submitted);
+  for (std::string line; std::getline(lines, line);) {
+    const std::string id = line.substr(0, line.find(';'));
+    if (!id.empty() && id.find_first_not_of("0123456789") == std::string::npos) job_id = id;
+  }
+  if (job_id.empty())
+    throw Error("sbatch " + script.string() + " answered '" + SanitizeForMessage(*submitted, 200) +
+                "'; expected a job id");
   spdlog::info("submitted Slurm job array {} ({} tasks): {}", job_id, pending.size(),
                script.string());
   size_t last = SIZE_MAX;
   for (;;) {
-    if (o.stop_request && o.stop_request->load() != 0) {
-      Capture("scancel " + job_id);
-      throw Error("interrupted: Slurm job " + job_id + " cancelled; run again to resume");
+    if (StopSignal(o.stop_request) != 0) {
+      CaptureCommand({"scancel", job_id});
+      spdlog::warn("{}: Slurm job array {} cancelled", SignalName(StopSignal(o.stop_request)),
+                   job_id);
+      return {};
     }
     const std::optional<std::string> queued =
-        Capture("squeue -h -j " + job_id + " -o %i 2>/dev/null");
+        CaptureCommand({"squeue", "-h", "-j", job_id, "-o", "%i"});
     size_t done = 0;
     for (const BenchmarkJob& j : jobs) done += Finished(o.out_dir, j) ? 1 : 0;
     if (done != last)
@@ -204,6 +226,30 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
 
 }  // namespace
 
+void CheckSlurmPaths(const std::string& out_dir, const std::string& spec_file,
+                     const std::string& penumbra_binary) {
+  const auto check = [](const std::string& key, const std::string& what, const std::string& v) {
+    if (const std::optional<size_t> at = FindControlCharacter(v))
+      throw ConfigError("", 0, key,
+                        what + " '" + SanitizeForMessage(v, 200) +
+                            "' holds a control character (byte " + std::to_string(*at) +
+                            ": newline, carriage return, NUL, tab or another below 0x20) that a "
+                            "Slurm batch script cannot carry; expected a path without control "
+                            "characters");
+  };
+  check("--out", "the output folder", out_dir);
+  check("spec", "the spec file", spec_file);
+  check("binary", "the penumbra binary", penumbra_binary);
+  const size_t bad = out_dir.find_first_of(" \t\"'\\#%");
+  if (bad != std::string::npos)
+    throw ConfigError("", 0, "--out",
+                      "the output folder '" + SanitizeForMessage(out_dir, 200) + "' holds '" +
+                          out_dir[bad] + "' (byte " + std::to_string(bad) +
+                          "), which the batch script's #SBATCH --output line cannot carry (blanks, "
+                          "quotes, \\, # and % have a meaning there); expected another --out for "
+                          "--slurm");
+}
+
 std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_dir,
                              const std::string& penumbra_binary, const std::vector<int>& indices) {
   std::string array;
@@ -212,6 +258,12 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
     array += std::to_string(i);
   }
   const std::string out = fs::absolute(out_dir).lexically_normal().string();
+  CheckSlurmPaths(out, spec.file, penumbra_binary);
+  for (const std::string& l : spec.sbatch_lines)
+    if (FindControlCharacter(l) || l.rfind("#SBATCH", 0) != 0)
+      throw ConfigError(spec.file, 0, "slurm.sbatch",
+                        "'" + SanitizeForMessage(l, 200) +
+                            "'; expected one '#SBATCH ...' line without control characters");
   std::string s = fmt::format(
       "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH "
       "--output={}/slurm/%A_%a.out\n"
@@ -224,8 +276,8 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
   return s;
 }
 
-void RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir, int index,
-                        const std::string& penumbra_binary, const std::atomic<int>* stop_request) {
+int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir, int index,
+                       const std::string& penumbra_binary, const std::atomic<int>* stop_request) {
   const BenchmarkSpec spec = LoadBenchmarkSpec(spec_path);
   const fs::path copy = fs::path(out_dir) / "spec.yaml";
   std::error_code ec;
@@ -243,23 +295,39 @@ void RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir
   context.out_dir = out_dir;
   context.penumbra_binary = penumbra_binary;
   context.stop_request = stop_request;
-  if (spec.kind == "nav") {
-    const NavRow r = RunNavJob(spec, jobs[index], context);
-    spdlog::info("{} {} {} {} trial {}: {} ({}), success {}, collisions {}, goal distance {} m",
-                 r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail,
-                 r.success ? 1 : 0, r.collisions, r.final_goal_distance_m);
-    return;
+  const BenchmarkJob& job = jobs[index];
+  try {
+    if (spec.kind == "nav") {
+      const NavRow r = RunNavJob(spec, job, context);
+      spdlog::info("{} {} {} {} trial {}: {} ({}), success {}, collisions {}, goal distance {} m",
+                   r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail,
+                   r.success ? 1 : 0, r.collisions, r.final_goal_distance_m);
+      return 0;
+    }
+    const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, job, context);
+    for (const BenchmarkRow& r : rows)
+      spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial,
+                   r.status, r.detail, r.ate_rmse_m);
+    return 0;
+  } catch (const Error& e) {
+    // a stop turns whatever the job was doing into an interruption: its folder goes
+    const int sig = StopSignal(stop_request);
+    if (sig == 0) throw;
+    RemoveUnfinished(out_dir, job);
+    spdlog::warn("{}: {}; its folder {} is removed (the same benchmark command runs it again)",
+                 SignalName(sig), e.what(), JobFolder(out_dir, job));
+    return 128 + sig;
   }
-  const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, jobs[index], context);
-  for (const BenchmarkRow& r : rows)
-    spdlog::info("{} {} {} trial {}: {} ({}) ATE {}", r.world, r.condition, r.method, r.trial,
-                 r.status, r.detail, r.ate_rmse_m);
 }
 
 int RunBenchmark(const BenchmarkOptions& o) {
   const Clock::time_point start = Clock::now();
   const BenchmarkSpec spec = LoadBenchmarkSpec(o.spec_path);
   if (o.out_dir.empty()) throw ConfigError("", 0, "--out", "expected an output folder");
+  // a path the batch script cannot carry is refused before anything is written
+  if (o.slurm)
+    CheckSlurmPaths(fs::absolute(o.out_dir).lexically_normal().string(), spec.file,
+                    o.penumbra_binary);
   const fs::path out(o.out_dir);
   const fs::path copy = out / "spec.yaml";
   std::error_code ec;
@@ -301,16 +369,25 @@ int RunBenchmark(const BenchmarkOptions& o) {
     spdlog::info("recording the route of world '{}' ({})", w.name, w.file);
     const std::string tmp = plog.substr(0, plog.size() - 5) + ".partial.plog";
     fs::remove(tmp, ec);
-    o.record(w, tmp);
+    o.record(w, tmp, o.stop_request);
+    if (const int sig = StopSignal(o.stop_request)) {
+      fs::remove(tmp, ec);
+      spdlog::warn(
+          "interrupted by {} while recording the route of world '{}': the partial recording is "
+          "removed, no job ran; the same command resumes",
+          SignalName(sig), w.name);
+      return 128 + sig;
+    }
     fs::rename(tmp, plog);
   }
   // 2. the jobs
   const int workers = o.workers > 0 ? o.workers : spec.workers;
   const std::vector<std::string> failed =
       o.slurm ? RunSlurm(o, spec, jobs, start) : RunLocal(o, spec, jobs, workers, start);
-  const bool interrupted = o.stop_request && o.stop_request->load() != 0;
+  const int stop_signal = StopSignal(o.stop_request);
   // 3. the results of every finished job (also after an interruption)
-  size_t n_rows = 0;
+  size_t n_rows = 0, n_finished = 0;
+  for (const BenchmarkJob& j : jobs) n_finished += Finished(o.out_dir, j) ? 1 : 0;
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   if (nav) {
     std::vector<NavRow> rows;
@@ -328,9 +405,12 @@ int RunBenchmark(const BenchmarkOptions& o) {
     n_rows = rows.size();
   }
   spdlog::info("{} rows -> {}/results.csv, report.md ({} wall)", n_rows, o.out_dir, Hms(wall));
-  if (interrupted) {
-    spdlog::warn("interrupted; the finished jobs are kept and reported: the same command resumes");
-    return 130;
+  if (stop_signal != 0) {
+    spdlog::warn(
+        "interrupted by {}: the {} finished job(s) are kept and reported, unfinished job folders "
+        "removed; the same command resumes",
+        SignalName(stop_signal), n_finished);
+    return 128 + stop_signal;
   }
   if (!failed.empty()) {
     spdlog::error(

@@ -11,6 +11,8 @@
 #include <set>
 #include <sstream>
 
+#include "penumbra/benchmark/command_template.h"
+#include "penumbra/benchmark/shell_quote.h"
 #include "penumbra/core/error.h"
 #include "penumbra/replay/world_override.h"
 #include "penumbra/world/adversity_preset.h"
@@ -76,6 +78,15 @@ void CheckTemplate(const YamlReader& r, const std::string& text,
              "}'; expected one of: " + names);
     }
     i = end;
+  }
+}
+
+// the template split into words (benchmark/command_template.h); a refusal names the field
+std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text) {
+  try {
+    return SplitCommandTemplate(text);
+  } catch (const ConfigError& e) {
+    r.Fail(e.problem());
   }
 }
 
@@ -156,12 +167,14 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
         r.Child(k).Fail("not allowed with 'bundled' (a bundled method reads TUM and writes TUM)");
     m.command =
         "{penumbra} slam " + m.bundled + " {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}";
+    m.command_words = SplitCommandTemplate(m.command);
   } else {
     const YamlReader c = r.Child("command");
     m.command = c.String();
     if (m.command.find_first_not_of(" \t") == std::string::npos)
       c.Fail("empty; expected a command line");
     CheckTemplate(c, m.command, MethodPlaceholders());
+    m.command_words = SplitAt(c, m.command);
   }
   if (r.Has("dataset")) m.dataset = r.Child("dataset").Enum({"tum", "euroc"});
   if (r.Has("trajectory")) {
@@ -265,12 +278,14 @@ BenchmarkMethod ReadNavMethod(const YamlReader& r) {
   if (r.Has("bundled")) {
     m.bundled = r.Child("bundled").Enum({"penumbra_nav"});
     m.command = BundledNavCommand();
+    m.command_words = SplitCommandTemplate(m.command);
   } else {
     const YamlReader c = r.Child("command");
     m.command = c.String();
     if (m.command.find_first_not_of(" \t") == std::string::npos)
       c.Fail("empty; expected a command line");
     CheckTemplate(c, m.command, NavMethodPlaceholders());
+    m.command_words = SplitAt(c, m.command);
   }
   if (r.Has("timeout_sec")) m.timeout_sec = Positive(r.Child("timeout_sec"), 7 * 24 * 3600.0);
   return m;
@@ -413,8 +428,10 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
       if (sl.Has("sbatch"))
         for (const YamlReader& l : sl.Child("sbatch").List()) {
           const std::string line = l.String();
-          if (line.rfind("#SBATCH", 0) != 0 || line.find('\n') != std::string::npos)
-            l.Fail("expected one '#SBATCH ...' line");
+          if (line.rfind("#SBATCH", 0) != 0 || FindControlCharacter(line))
+            l.Fail(
+                "expected one '#SBATCH ...' line without control characters (newline, "
+                "carriage return, tab, ...)");
           s.sbatch_lines.push_back(line);
         }
       if (sl.Has("poll_sec")) s.slurm_poll_sec = Positive(sl.Child("poll_sec"), 600);

@@ -38,7 +38,9 @@
 // folder), {output} (the default trajectory file, {workdir}/trajectory.txt), {workdir} (the
 // method's own folder, its current folder), {fx} {fy} {cx} {cy} {width} {height} (the
 // camera's pinhole intrinsics, pixels), {camera_info} (the run's camera_info.json), {seed}.
-// paths are substituted shell-quoted; `{{` and `}}` are literal braces.
+// `{{` and `}}` are literal braces. a command runs without a shell: the template is split
+// into words at load (benchmark/command_template.h: quotes group, nothing is expanded, shell
+// operators are refused) and each value is substituted as plain text inside its word.
 
 #include <cstdint>
 #include <string>
@@ -73,8 +75,10 @@ struct BenchmarkCondition {
 /// closed-loop navigator's command (NavMethodPlaceholders) and its wall-clock timeout.
 struct BenchmarkMethod {
   std::string name;
-  std::string dataset = "tum";                ///< tum | euroc
-  std::string command;                        ///< template (see the file header)
+  std::string dataset = "tum";  ///< tum | euroc
+  std::string command;          ///< template (see the file header)
+  /// `command` split into words (SplitCommandTemplate), placeholders still in them
+  std::vector<std::string> command_words;
   std::string trajectory = "trajectory.txt";  ///< relative to the method's work folder
   std::string format = "tum";                 ///< tum | tum_ns
   double timeout_sec = 600;

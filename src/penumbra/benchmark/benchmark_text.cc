@@ -23,9 +23,21 @@ std::string ReadText(const std::filesystem::path& p) {
 }
 
 void WriteText(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw Error("cannot write " + p.string());
+  const std::filesystem::path tmp = p.string() + ".tmp";
+  std::error_code ec;
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) {
+      std::filesystem::remove(tmp, ec);
+      throw Error("cannot write " + p.string());
+    }
+  }
+  std::filesystem::rename(tmp, p, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw Error("cannot write " + p.string() + ": " + ec.message());
+  }
 }
 
 std::string Field(double v) { return std::isfinite(v) ? FormatNumber(v) : ""; }

@@ -15,7 +15,9 @@ namespace penumbra::benchmark_text {
 double Since(std::chrono::steady_clock::time_point t);
 /// the whole file as bytes; "" when it cannot be read.
 std::string ReadText(const std::filesystem::path& p);
-/// replaces the file with `text`. @throws Error when it cannot be written.
+/// replaces the file with `text` atomically: written to `<p>.tmp` and renamed over `p`, so
+/// an interruption leaves the old file or the new one, never half of one.
+/// @throws Error when it cannot be written (the .tmp file is removed).
 void WriteText(const std::filesystem::path& p, const std::string& text);
 /// a CSV field: `v` as FormatNumber writes it, "" for NaN / infinity.
 std::string Field(double v);

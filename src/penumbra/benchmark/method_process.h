@@ -1,12 +1,12 @@
 #pragma once
-// running one SLAM method: a command template (benchmark/benchmark_spec.h) filled in and run
-// by /bin/sh in the method's work folder, with its stdout and stderr written to files there,
-// killed (its whole process group, SIGTERM then SIGKILL after 2 s) when it runs past its
-// timeout or when a stop is requested.
+// running one benchmark method: its command template expanded into an argument vector
+// (benchmark/command_template.h) and executed without a shell in the method's work folder,
+// with its stdout and stderr written to files there, killed (its whole process group, SIGTERM
+// then SIGKILL after 2 s) when it runs past its timeout or when a stop is requested.
 
 #include <atomic>
-#include <map>
 #include <string>
+#include <vector>
 
 namespace penumbra {
 
@@ -14,25 +14,27 @@ namespace penumbra {
 struct ProcessOutcome {
   bool timed_out = false;
   bool stopped = false;  ///< killed because of a stop request
-  int exit_code = -1;    ///< when it exited normally
+  int exit_code = -1;    ///< when it exited normally (127 when it could not be started)
   int signal = 0;        ///< when a signal ended it (0 = none)
   double wall_sec = 0;
-  /// "exit 0", "exit 3", "signal 11 (SIGSEGV)", "timeout after 600 s", ...
+  std::string start_error;  ///< why it could not be started ("" when it was)
+  /// "exit 0", "exit 3", "signal 11 (SIGSEGV)", "timeout after 600 s", "cannot run 'x': ...".
   std::string Describe() const;
   bool ok() const { return !timed_out && !stopped && signal == 0 && exit_code == 0; }
 };
 
-/// `text` with each `{key}` replaced by values.at(key) (`{{` / `}}` become braces).
-/// @throws Error for a placeholder not in `values` (templates are checked at spec load).
-std::string FillTemplate(const std::string& text, const std::map<std::string, std::string>& values);
+/// runs `argv` (argv[0] a path, or a name looked up on PATH) in `workdir` (created if missing),
+/// stdin from /dev/null, stdout to workdir/stdout.log, stderr to workdir/stderr.log, in a new
+/// process group; waits until it exits, runs past `timeout_sec` or *stop_request is set.
+/// a program that cannot be started is an outcome (exit 127 with start_error), not an error.
+/// @throws Error if argv is empty or no process can be created.
+ProcessOutcome RunMethodCommand(const std::vector<std::string>& argv, const std::string& workdir,
+                                double timeout_sec, const std::atomic<int>* stop_request = nullptr);
 
-/// `s` quoted for /bin/sh ('...' with embedded quotes escaped).
-std::string ShellQuote(const std::string& s);
-
-/// runs `/bin/sh -c command` in `workdir` (created if missing), stdout to
-/// workdir/stdout.log, stderr to workdir/stderr.log, in a new process group.
-/// @throws Error if the process cannot be started.
-ProcessOutcome RunShellCommand(const std::string& command, const std::string& workdir,
-                               double timeout_sec, const std::atomic<int>* stop_request = nullptr);
+/// the command.sh written beside a method's logs for people to re-run it by hand: a /bin/sh
+/// script that enters `workdir` and executes `argv`, every word quoted by ShellCommandLine
+/// (benchmark/shell_quote.h), so it runs exactly the argument vector the harness ran.
+/// @throws Error when a word holds a NUL byte.
+std::string MethodCommandScript(const std::vector<std::string>& argv, const std::string& workdir);
 
 }  // namespace penumbra

@@ -21,6 +21,7 @@
 
 #include "penumbra/benchmark/benchmark_text.h"
 #include "penumbra/benchmark/child_process.h"
+#include "penumbra/benchmark/command_template.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_metrics.h"
 #include "penumbra/core/error.h"
@@ -300,23 +301,23 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
     }
     break;
   }
-  std::map<std::string, std::string> values = {{"penumbra", ShellQuote(context.penumbra_binary)},
-                                               {"pythonpath", ShellQuote(NavPythonPath())},
-                                               {"endpoint", ShellQuote(endpoint)},
-                                               {"goal_x", Num(ep.goal_x)},
-                                               {"goal_y", Num(ep.goal_y)},
-                                               {"radius", Num(ep.radius_m)},
-                                               {"timeout_sec", Num(ep.timeout_sec)},
-                                               {"robot", ShellQuote(w.profile)},
-                                               {"robot_name", ShellQuote(w.robot)},
-                                               {"out_dir", ShellQuote(work.string())},
-                                               {"workdir", ShellQuote(work.string())},
-                                               {"seed", std::to_string(job.seed)}};
-  const std::string command = FillTemplate(method.command, values);
-  WriteText(work / "command.sh", "#!/bin/sh\n" + command + "\n");
-  proc = std::make_unique<ChildProcess>(std::vector<std::string>{"/bin/sh", "-c", command},
-                                        work.string(), (work / "stdout.log").string(),
-                                        (work / "stderr.log").string());
+  // values are plain text inside their words: never read by a shell
+  const std::map<std::string, std::string> values = {{"penumbra", context.penumbra_binary},
+                                                     {"pythonpath", NavPythonPath()},
+                                                     {"endpoint", endpoint},
+                                                     {"goal_x", Num(ep.goal_x)},
+                                                     {"goal_y", Num(ep.goal_y)},
+                                                     {"radius", Num(ep.radius_m)},
+                                                     {"timeout_sec", Num(ep.timeout_sec)},
+                                                     {"robot", w.profile},
+                                                     {"robot_name", w.robot},
+                                                     {"out_dir", work.string()},
+                                                     {"workdir", work.string()},
+                                                     {"seed", std::to_string(job.seed)}};
+  const std::vector<std::string> argv = ExpandCommandTemplate(method.command_words, values);
+  WriteText(work / "command.sh", MethodCommandScript(argv, work.string()));
+  proc = std::make_unique<ChildProcess>(argv, work.string(), (work / "stdout.log").string(),
+                                        (work / "stderr.log").string(), /*search_path=*/true);
   // the episode: until the method exits, the run ends (sim timeout) or the wall limit
   std::optional<Clock::time_point> run_end;
   for (;;) {
@@ -344,7 +345,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   // the run: stopped (SIGTERM: it finishes its outputs and run.json), killed after 60 s
   run->TerminateAndWait(60);
   row.run_sec = run->wall_sec();
-  if (stopped) throw Error("job " + job.id + " interrupted");
+  if (stopped) throw JobInterrupted("job " + job.id + " interrupted during its episode");
 
   const Clock::time_point eval_start = Clock::now();
   const bool run_ok = run->exit_code() == 0 || run->exit_code() == 143 || run->exit_code() == 130;
@@ -412,9 +413,8 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
       }
   }
   row.eval_sec = Since(eval_start);
-  const fs::path result = JobResultPath(context.out_dir, job);
-  WriteText(result.string() + ".tmp", RowJson(row).dump(1) + "\n");
-  fs::rename(result.string() + ".tmp", result);
+  // written last and atomically (WriteText): its presence marks the job finished
+  WriteText(JobResultPath(context.out_dir, job), RowJson(row).dump(1) + "\n");
   return row;
 }
 

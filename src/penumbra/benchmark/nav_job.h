@@ -2,7 +2,8 @@
 // one navigation benchmark job: (world, episode, condition, method, trial). the harness
 // starts the simulator, `penumbra run WORLD --zmq tcp://127.0.0.1:<free port> --lockstep
 // --adversity C --seed S --duration <episode timeout> --override override.yaml`, and the
-// method's command (an external process given the endpoint) side by side. the episode ends
+// method's command (an external process given the endpoint, its argument vector expanded
+// from the template without a shell: benchmark/command_template.h) side by side. the episode ends
 // when the method exits (the harness then stops the run with SIGTERM: outputs and run.json
 // are written), when the run reaches the episode's sim timeout (the method gets 3 s of wall
 // time to exit, then its process group is killed), or at the method's wall-clock timeout
@@ -59,8 +60,10 @@ struct NavRow {
 std::vector<BenchmarkJob> PlanNavJobs(const BenchmarkSpec& spec);
 
 /// runs one nav job and writes its result.json (see the file comment).
-/// @throws Error when the harness itself fails (a write, no free port); a failing method or
-///         simulator is a row, not an exception.
+/// @throws JobInterrupted when context.stop_request is set during the episode (the method and
+///         the run are stopped first); Error when the harness itself fails (a write, no free
+///         port); a failing method (one that cannot be started included) or simulator is a
+///         row, not an exception.
 NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                  const BenchmarkJobContext& context);
 

@@ -57,7 +57,8 @@ const std::vector<std::string>& NavMethodPlaceholders() {
 }
 
 std::string BundledNavCommand() {
-  return "PYTHONPATH={pythonpath} exec /usr/bin/python3 -m penumbra_nav --endpoint {endpoint} "
+  return "/usr/bin/env PYTHONPATH={pythonpath} /usr/bin/python3 -m penumbra_nav --endpoint "
+         "{endpoint} "
          "--goal {goal_x} {goal_y} --radius {radius} --timeout {timeout_sec} --robot {robot} "
          "--robot-name {robot_name} --out {out_dir}/episode.json";
 }

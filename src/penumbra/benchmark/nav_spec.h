@@ -84,7 +84,7 @@ struct NavMetricsConfig {
 const std::vector<std::string>& NavMethodPlaceholders();
 
 /// the command of the bundled navigator (python/penumbra_nav, run by /usr/bin/python3 with
-/// PYTHONPATH={pythonpath}, the source tree's python/ folder).
+/// PYTHONPATH={pythonpath}, the source tree's python/ folder, set by /usr/bin/env).
 std::string BundledNavCommand();
 
 }  // namespace penumbra

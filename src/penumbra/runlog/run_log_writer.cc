@@ -181,15 +181,27 @@ struct RunLogWriter::Impl {
 RunLogWriter::RunLogWriter(const std::string& path, const RunLogHeader& header,
                            const RunLogWriterOptions& options) {
   options.ValidateOrThrow();
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw RunLogError(fmt::format("run log {}: cannot be created: {}", path, std::strerror(errno)));
+  Start(fd, path, header, options);
+}
+
+RunLogWriter::RunLogWriter(UniqueFd fd, const std::string& name, const RunLogHeader& header,
+                           const RunLogWriterOptions& options) {
+  options.ValidateOrThrow();  // fd closes itself if this throws
+  Start(fd.release(), name, header, options);
+}
+
+void RunLogWriter::Start(int fd, const std::string& path, const RunLogHeader& header,
+                         const RunLogWriterOptions& options) {
   impl_ = std::make_unique<Impl>(options.max_pending_chunks);
   Impl& m = *impl_;
   m.path = path;
   m.header = header;
   m.header.format_version = kRunLogFormatVersion;
   m.options = options;
-  m.fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (m.fd < 0)
-    throw RunLogError(fmt::format("run log {}: cannot be created: {}", path, std::strerror(errno)));
+  m.fd = fd;
   // preamble and header chunk, before any step
   PendingChunk head;
   head.header.kind = RunLogChunkKind::kHeader;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/runlog/run_log_format.h"
 
 namespace penumbra {
@@ -54,6 +55,11 @@ class RunLogWriter {
   ///         from options.ValidateOrThrow.
   RunLogWriter(const std::string& path, const RunLogHeader& header,
                const RunLogWriterOptions& options = {});
+  /// as above, into a file the caller created (e.g. core/output_path_policy.h's
+  /// OpenNewFileInside); the writer owns `fd` from here on and closes it, also when this
+  /// throws. `name` stands for the file in stats, path() and every error message.
+  RunLogWriter(UniqueFd fd, const std::string& name, const RunLogHeader& header,
+               const RunLogWriterOptions& options = {});
   /// Close() if not closed (errors are then logged, not thrown).
   ~RunLogWriter();
   RunLogWriter(const RunLogWriter&) = delete;
@@ -89,6 +95,9 @@ class RunLogWriter {
   const std::string& path() const;
 
  private:
+  void Start(int fd, const std::string& name, const RunLogHeader& header,
+             const RunLogWriterOptions& options);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

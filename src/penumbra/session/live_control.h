@@ -10,6 +10,7 @@
 // as a "live" event in the active live recording and in the run's own log (RecordChangesTo).
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 #include "penumbra/pipeline/sim_loop.h"
@@ -26,8 +27,10 @@ namespace penumbra {
 class LiveControl {
  public:
   /// `session` must outlive this object; build it before the loop starts. `command_line`
-  /// goes into the headers of the logs recorder() writes.
-  LiveControl(Session& session, const std::string& command_line);
+  /// goes into the headers of the logs recorder() writes; `output_folder` is the run's output
+  /// folder, the only place recorder() writes (core/output_path_policy.h).
+  LiveControl(Session& session, const std::string& command_line,
+              const std::filesystem::path& output_folder);
   LiveControl(const LiveControl&) = delete;
   LiveControl& operator=(const LiveControl&) = delete;
 

@@ -1,17 +1,21 @@
 #include "penumbra/session/live_recorder.h"
 
+#include <fcntl.h>
 #include <spdlog/spdlog.h>
-
-#include <filesystem>
+#include <unistd.h>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/session/run_log_header.h"
 
 namespace penumbra {
 
-LiveRecorder::LiveRecorder(Session& session, std::string command_line)
-    : session_(session), command_line_(std::move(command_line)) {}
+LiveRecorder::LiveRecorder(Session& session, std::string command_line,
+                           std::filesystem::path output_folder)
+    : session_(session),
+      command_line_(std::move(command_line)),
+      output_folder_(std::move(output_folder)) {}
 
 LiveRecorder::~LiveRecorder() {
   std::lock_guard<std::mutex> lock(mu_);
@@ -24,7 +28,6 @@ LiveRecorder::~LiveRecorder() {
 }
 
 void LiveRecorder::StartRecording(const std::string& path, bool sensors) {
-  if (path.empty()) throw ConfigError("", 0, "path", "empty; expected the .plog file to write");
   std::lock_guard<std::mutex> lock(mu_);
   if (writer_)
     throw ConfigError("", 0, "recording",
@@ -32,20 +35,39 @@ void LiveRecorder::StartRecording(const std::string& path, bool sensors) {
   if (finished_)
     throw ConfigError("", 0, "recording",
                       "the run has ended; no step would be recorded; expected a running run");
+  // the one policy for files a client names: a new file inside the output folder
+  NewOutputFile file;
+  try {
+    file = OpenNewFileInside(output_folder_, path, ".plog");
+  } catch (const OutputPathError& e) {
+    throw ConfigError("", 0, "path", e.what());
+  }
   RunLogHeader header = MakeRunLogHeader(session_, PENUMBRA_VERSION, command_line_);
   header.has_sensor_records = sensors;
-  writer_ = std::make_unique<RunLogWriter>(path, header);
+  try {
+    // named by its relative path: errors and replies never show the server's folders
+    writer_ = std::make_unique<RunLogWriter>(std::move(file.fd), file.relative, header);
+  } catch (...) {
+    // created above by this call: not left empty (removed where it was made, not by path)
+    ::unlinkat(file.folder.get(), file.name.c_str(), 0);
+    throw;
+  }
+  file_ = file.path.string();
+  // kept to remove the file where it was made should no step reach it (OnFinish)
+  file_folder_ = std::move(file.folder);
+  file_name_ = file.name;
   sensors_ = sensors;
   wants_sensors_ = sensors;
   started_ = false;
   first_step_ = last_step_ = -1;
   error_.clear();
-  spdlog::info("live recording to {} from the next step", path);
+  spdlog::info("live recording to {} from the next step", file_);
 }
 
 LiveRecording LiveRecorder::CloseLocked() {
   LiveRecording r;
   r.path = writer_->path();
+  r.file = file_;
   std::unique_ptr<RunLogWriter> writer = std::move(writer_);
   wants_sensors_ = false;
   writer->Close();
@@ -158,12 +180,11 @@ void LiveRecorder::OnFinish(const LoopFinish&) {
   finished_ = true;
   if (!writer_) return;
   if (!started_) {
-    // started as the run stopped: no step reached it; an empty log is removed, not left
-    const std::string path = writer_->path();
-    CloseLocked();
-    std::error_code ec;
-    std::filesystem::remove(path, ec);
-    spdlog::warn("live recording {} removed: the run stopped before its first step", path);
+    // started as the run stopped: no step reached it; an empty log is removed (where it was
+    // made, not by path), not left
+    const LiveRecording r = CloseLocked();
+    if (file_folder_.get() >= 0) ::unlinkat(file_folder_.get(), file_name_.c_str(), 0);
+    spdlog::warn("live recording {} removed: the run stopped before its first step", r.path);
     return;
   }
   at_finish_ = CloseLocked();

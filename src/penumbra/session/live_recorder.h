@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -27,7 +28,8 @@ namespace penumbra {
 
 /// a finished live recording.
 struct LiveRecording {
-  std::string path;                         ///< the .plog written
+  std::string path;                         ///< the .plog written, relative to the output folder
+  std::string file;                         ///< the same on disk (output folder / path)
   uint64_t bytes = 0;                       ///< its size
   int64_t steps = 0;                        ///< step records in it
   int64_t first_step = -1, last_step = -1;  ///< its first and last step (-1: none)
@@ -38,18 +40,24 @@ struct LiveRecording {
 class LiveRecorder : public Sink {
  public:
   /// `session` must outlive this object. `command_line` goes into the logs' headers.
-  LiveRecorder(Session& session, std::string command_line);
+  /// `output_folder`: the run's output folder; every recording is a new file inside it
+  /// (core/output_path_policy.h).
+  LiveRecorder(Session& session, std::string command_line, std::filesystem::path output_folder);
   /// closes an open log (errors are logged).
   ~LiveRecorder() override;
   LiveRecorder(const LiveRecorder&) = delete;
   LiveRecorder& operator=(const LiveRecorder&) = delete;
 
-  /// creates `path` now (header written) and records from the next step the loop reaches.
-  /// `sensors`: the log also holds the cameras' images and the sensors' outputs from then on
-  /// (sensor records, as --record-sensors), as far as they are written before the stop.
-  /// @throws ConfigError("", 0, "path", ...) for an empty path; ConfigError("", 0,
-  ///         "recording", ...) when a recording is active or the loop has finished (no step
-  ///         would follow); RunLogError when the file cannot be created.
+  /// creates the new file `path` (relative to the output folder) now, header written, and
+  /// records from the next step the loop reaches. the path follows the one policy for files
+  /// clients name (core/output_path_policy.h: relative, no "..", no links, ends in .plog,
+  /// never overwrites). `sensors`: the log also holds the cameras' images and the sensors'
+  /// outputs from then on (sensor records, as --record-sensors), as far as they are written
+  /// before the stop.
+  /// @throws ConfigError("", 0, "path", ...) for a path the policy refuses (the problem names
+  ///         the path and the rule); ConfigError("", 0, "recording", ...) when a recording is
+  ///         active or the loop has finished (no step would follow; nothing is created then);
+  ///         RunLogError when the header cannot be written.
   void StartRecording(const std::string& path, bool sensors);
 
   /// closes the active log now (every record appended so far, then the end chunk) and says
@@ -95,6 +103,10 @@ class LiveRecorder : public Sink {
 
   Session& session_;
   std::string command_line_;
+  std::filesystem::path output_folder_;
+  std::string file_;      // the active log on disk
+  UniqueFd file_folder_;  // the folder holding it, and its name there (for unlinkat)
+  std::string file_name_;
   mutable std::mutex mu_;
   std::unique_ptr<RunLogWriter> writer_;
   bool sensors_ = false;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
@@ -36,6 +37,7 @@ void ViewerOptions::ValidateOrThrow() const {
   if (!(state_hz > 0 && state_hz <= 1000))
     throw ConfigError("", 0, "viewer.state_hz",
                       fmt::format("{}; expected a rate in (0, 1000] Hz", state_hz));
+  for (const std::string& o : allowed_origins) NormalizeOrigin(o);
   jpeg.ValidateOrThrow();
 }
 
@@ -129,11 +131,13 @@ class ViewerBridge : public RunBridge {
     so.web_root = options_.web_root.empty() ? FindWebRoot() : options_.web_root;
     so.max_message_bytes = options_.max_message_bytes;
     so.max_clients = options_.max_clients;
+    so.allowed_origins = options_.allowed_origins;
     WebServerHandlers h;
     h.on_open = [this](int client) { return OnOpen(client); };
     h.on_message = [this](int client, std::string_view text) { return OnMessage(client, text); };
     h.on_close = [this](int client) { OnClose(client); };
     server_ = std::make_unique<WebServer>(so, std::move(h));
+    // the URL holds the secret token: it is printed here only, never sent to a client
     spdlog::info("viewer: open {} in a browser (serving {})", server_->url(), so.web_root);
     if (options_.on_listening) options_.on_listening(server_->url());
     encoder_ = std::thread([this] { EncoderLoop(); });
@@ -257,7 +261,8 @@ class ViewerBridge : public RunBridge {
     for (const std::string& n : BundledAdversityPresetNames()) presets.push_back(n);
     hello_ = {{"type", "viewer_hello"},
               {"protocol", kCommandProtocolVersion},
-              {"world", world_.file},
+              // the file's name only: no client learns the server's folders
+              {"world", std::filesystem::path(world_.file).filename().string()},
               {"model", model_info_},
               {"timestep_sec", dt},
               {"control_period_sec", period},

@@ -18,6 +18,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/viewer/jpeg_encoder.h"
@@ -32,12 +33,17 @@ struct ViewerOptions {
   double state_hz = 30;            ///< state messages per wall-clock second while running
   size_t max_message_bytes = 64 * 1024;  ///< largest message accepted from a page
   int max_clients = 64;                  ///< pages connected at once
+  /// origins allowed besides the page's own and loopback (--viewer-allow-origin, repeatable;
+  /// viewer/web_server.h WebServerOptions::allowed_origins).
+  std::vector<std::string> allowed_origins;
   AdaptiveJpegOptions jpeg;              ///< JPEG quality range and byte budget per stream
-  /// called once the server listens, with its URL (e.g. to print it). may be empty.
+  /// called once the server listens, with its URL and secret token
+  /// ("http://127.0.0.1:PORT/?token=..."; e.g. to print it). may be empty.
   std::function<void(const std::string& url)> on_listening;
 
   /// @throws ConfigError (key "--viewer" or "viewer.<field>") for a bad host/port, a state
-  ///         rate outside (0, 1000] and the errors of the server and JPEG options.
+  ///         rate outside (0, 1000] and the errors of the server and JPEG options;
+  ///         (key "--viewer-allow-origin") for an origin that is not http(s)://HOST[:PORT].
   void ValidateOrThrow() const;
 };
 

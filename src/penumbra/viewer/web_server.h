@@ -10,6 +10,16 @@
 // never replaced; a client whose reply queue passes WebServerOptions::max_pending_replies is
 // disconnected.
 //
+// access (docs/viewer.md "Access"): every request, page or WebSocket, must name this server in
+// `Host` (127.0.0.1, localhost or [::1] with its port, the bound address, or the host of an
+// allowed origin: a DNS-rebinding page sends its own name and is refused), a browser's `Origin`
+// must be the page's own (those names as http://NAME:PORT) or one in allowed_origins, and the
+// request must carry the server's secret token (WebServer::token(), random from the OS, 256
+// bits): the WebSocket as /ws?token=TOKEN, a page as ?token=TOKEN or the cookie the server sets
+// when the page is opened with it. anything else is answered 403 before any upgrade (tokens
+// compared in constant time); a page without the token gets a short page that says to open the
+// URL the server printed (WebServer::url()).
+//
 // input: HTTP requests are GET/HEAD of files under the web root (no "..", no absolute paths),
 // with header and body limits; WebSocket messages larger than max_message_bytes close that
 // connection with status 1009 (message too big, RFC 6455 7.4.1); binary messages and anything a
@@ -33,9 +43,14 @@ struct WebServerOptions {
   size_t max_message_bytes = 64 * 1024;  ///< largest WebSocket message accepted from a client
   size_t max_pending_replies = 256;      ///< replies queued for one client before it is dropped
   int max_clients = 64;                  ///< WebSocket clients at once; more are refused (503)
+  /// origins allowed besides the page's own and the loopback ones (--viewer-allow-origin), as
+  /// browsers send them in `Origin`: "http://HOST[:PORT]" or "https://HOST[:PORT]"; their
+  /// HOST[:PORT] is then accepted in `Host` too (a reverse proxy, a LAN address).
+  std::vector<std::string> allowed_origins;
 
   /// @throws ConfigError (key "viewer.<field>") for an empty host, a port outside 0..65535, a
-  ///         web root that is not a folder, a zero message cap or max_clients < 1.
+  ///         web root that is not a folder, a zero message cap or max_clients < 1;
+  ///         ConfigError (key "--viewer-allow-origin") for an origin NormalizeOrigin refuses.
   void ValidateOrThrow() const;
 };
 
@@ -71,6 +86,7 @@ struct WebServerStats {
   int64_t messages_replaced = 0;  ///< published messages replaced before being sent
   int64_t bytes_sent = 0;         ///< WebSocket payload bytes written
   int64_t http_requests = 0;      ///< plain HTTP requests answered
+  int64_t refused = 0;            ///< requests answered 403 (Host, Origin or token)
 };
 
 /// the server; listening from construction to destruction.
@@ -86,8 +102,11 @@ class WebServer {
 
   /// the port listened on (the one picked when options.port was 0).
   int port() const;
-  /// "http://HOST:PORT/".
+  /// "http://HOST:PORT/?token=TOKEN": the page's URL with the secret token (HOST: the bound
+  /// address; 127.0.0.1 or [::1] when bound to every address).
   std::string url() const;
+  /// the secret token of this server (64 hex digits), made at construction.
+  const std::string& token() const;
 
   /// offers `message` to every client on `channel`; replaces a message of that channel a
   /// client has not been sent yet. returns at once.
@@ -102,6 +121,17 @@ class WebServer {
  private:
   std::shared_ptr<class WebServerImpl> impl_;
 };
+
+/// `origin` in the form browsers send it (lowercase, no trailing '/'): "http://" or
+/// "https://" followed by a host name, IPv4 address or [IPv6] address and an optional
+/// ":PORT" (1..65535), nothing else.
+/// @throws ConfigError("", 0, "--viewer-allow-origin", ...) naming the origin otherwise.
+std::string NormalizeOrigin(std::string_view origin);
+
+/// `bytes` random bytes from the OS (getrandom(2), /dev/urandom where it is missing) as
+/// lowercase hex.
+/// @throws Error naming the reason when the OS gives none.
+std::string MakeSecretToken(size_t bytes = 32);
 
 /// the Content-Type the server sends for a file name (by extension; unknown ones are
 /// application/octet-stream).

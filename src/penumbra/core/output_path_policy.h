@@ -1,0 +1,98 @@
+#pragma once
+// the one rule for files that a client of a running simulation names (start_recording over
+// ZeroMQ, the viewer's record button, ROS services: every command that writes goes through
+// OpenNewFileInside). a client may create a NEW file INSIDE the run's output folder and nowhere
+// else:
+//   - the path is relative to the output folder (no leading '/'), at most 1024 bytes, with no
+//     control characters (bytes below 0x20 and 0x7f) and no empty, "." or ".." component;
+//   - it ends in the required extension (".plog" for run logs) with a name before it;
+//   - every folder on the way must already exist and be a real folder: the walk opens each
+//     with openat(O_DIRECTORY | O_NOFOLLOW), so a symbolic link anywhere below the output
+//     folder is refused and nothing can be swapped in between the check and the use;
+//   - the file is created with O_CREAT | O_EXCL | O_NOFOLLOW: an existing file (or link) of
+//     that name is never overwritten or followed.
+// the output folder itself is taken as the user gave it (it may be a link the user made).
+//
+// errors name the path as the client gave it (escaped) and the rule it broke; they never name
+// the output folder's absolute path, so that a client learns nothing about the server's disk.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "penumbra/core/error.h"
+
+namespace penumbra {
+
+/// a file descriptor that closes itself (move-only).
+class UniqueFd {
+ public:
+  UniqueFd() = default;
+  explicit UniqueFd(int fd) : fd_(fd) {}
+  UniqueFd(UniqueFd&& other) noexcept : fd_(other.release()) {}
+  UniqueFd& operator=(UniqueFd&& other) noexcept;
+  UniqueFd(const UniqueFd&) = delete;
+  UniqueFd& operator=(const UniqueFd&) = delete;
+  ~UniqueFd();
+
+  /// the descriptor (-1 = none).
+  int get() const { return fd_; }
+  /// hands the descriptor over (the caller closes it); this object holds none after.
+  int release() {
+    const int fd = fd_;
+    fd_ = -1;
+    return fd;
+  }
+
+ private:
+  int fd_ = -1;
+};
+
+/// a client path refused by OpenNewFileInside: what() is "output path '<path>': <rule>;
+/// expected ...".
+class OutputPathError : public Error {
+ public:
+  OutputPathError(const std::string& client_path, const std::string& rule,
+                  std::string_view required_extension);
+  /// the path as the client gave it (unescaped).
+  const std::string& client_path() const { return client_path_; }
+  /// the rule it broke, e.g. "is absolute (starts with '/')".
+  const std::string& rule() const { return rule_; }
+
+ private:
+  std::string client_path_;
+  std::string rule_;
+};
+
+/// a file created by OpenNewFileInside.
+struct NewOutputFile {
+  UniqueFd fd;                 ///< open for writing (O_WRONLY | O_CLOEXEC), empty (0 bytes)
+  UniqueFd folder;             ///< the folder that holds it (O_DIRECTORY): for unlinkat
+  std::string name;            ///< its name in that folder
+  std::filesystem::path path;  ///< where it is: root / relative
+  std::string relative;        ///< the client's path, as checked (e.g. "logs/a.plog")
+};
+
+/// the longest client path accepted, in bytes.
+inline constexpr size_t kMaxClientPathBytes = 1024;
+
+/// checks `client_path` without touching the disk (the first four rules above) and returns
+/// its components.
+/// @throws OutputPathError naming the path and the rule it broke.
+std::vector<std::string> CheckClientPath(std::string_view client_path,
+                                         std::string_view required_extension);
+
+/// creates the new file `client_path` inside the folder `root` under the rules above (file
+/// mode 0644 less the umask).
+/// @param root               the run's output folder (must exist)
+/// @param client_path        the path a client sent, relative to `root`
+/// @param required_extension the ending the name must have, with its dot (e.g. ".plog")
+/// @throws OutputPathError naming `client_path` and the rule it broke (absolute, "..", empty
+///         or "." component, control character, too long, wrong ending, a folder on the way
+///         missing, not a folder or a symbolic link, the file existing, or the system's reason
+///         the file could not be created); nothing is created then.
+NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_view client_path,
+                                std::string_view required_extension);
+
+}  // namespace penumbra
