@@ -154,13 +154,11 @@ TEST_F(RunOutputsTest, SigintStopsAtAStepBoundaryWritesEverythingAndExits130) {
 TEST_F(RunOutputsTest, SigtermDoesTheSameAndExits143) { InterruptAndCheck(SIGTERM, 143); }
 
 TEST_F(RunOutputsTest, ASecondSignalExitsAtOnce) {
-  // frames that take seconds each (pathtraced, 4096 samples per pixel): after the first
-  // SIGINT the run would render the queued frames and then write run.json; the second SIGINT
-  // must end it before that, with 130 and no run.json
+  // large realtime frames (a pathtraced frame now stops between samples: see below):
+  // after the first SIGINT the run renders and writes the queued frames and then run.json;
+  // the second SIGINT must end it before that, with 130 and no run.json
   const fs::path out = tmp_.path() / "out";
-  const std::string world =
-      World("slow.yaml", 64, 48, 20, "rgb", 60,
-            "render: {tier: pathtraced, samples_per_pixel: 4096, denoise: false}\n");
+  const std::string world = World("slow.yaml", 2560, 1920, 20, "rgb", 60);
   ChildProcess p({"run", world, "--out", out.string(), "-q"}, tmp_.path());
   // composed.xml is written once the run is set up, after the handlers are installed
   bool set_up = false;
@@ -181,6 +179,43 @@ TEST_F(RunOutputsTest, ASecondSignalExitsAtOnce) {
   EXPECT_EQ(p.Wait(), 130) << p.err();
   EXPECT_FALSE(fs::exists(out / "run.json"));
   EXPECT_EQ(CountFiles(out / "cam" / "rgb", ".png"), 0);
+}
+
+// a pathtraced frame of 4096 samples per pixel takes minutes; a single SIGINT / SIGTERM stops
+// it between samples (render/path_integrator.h): the run exits 130 / 143 soon after (30 s is
+// far more than one sample pass of 64 x 48 pixels), writing run.json and the frames finished
+// before, and dropping the unfinished one
+void PathtracedFrameStopsWithinOnePass(const std::string& world, const fs::path& out, int sig,
+                                       int expected) {
+  ChildProcess p({"run", world, "--out", out.string(), "-q"}, out.parent_path());
+  bool set_up = false;
+  for (int i = 0; i < 3000 && !set_up; ++i) {
+    set_up = fs::exists(out / "composed.xml");
+    if (!set_up) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(set_up) << p.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // into the first frame
+  p.Signal(sig);
+  const int code = p.WaitFor(30);
+  if (code < 0) p.Signal(SIGKILL);
+  ASSERT_EQ(code, expected) << "still running 30 s after the signal; " << p.err();
+  EXPECT_NE(p.err().find("interrupted by"), std::string::npos) << p.err();
+  ASSERT_TRUE(fs::exists(out / "run.json")) << p.err();
+  const auto j = nlohmann::json::parse(ReadAll(out / "run.json"));
+  EXPECT_TRUE(j.at("interrupted").get<bool>());
+  // what was written is whole: a row per image, none partial
+  const int64_t rows = CsvRows(out / "cam" / "frames.csv");
+  EXPECT_EQ(CountFiles(out / "cam" / "rgb", ".png"), rows);
+  EXPECT_EQ(j.at("frames_per_camera").at("cam").get<int64_t>(), rows);
+  ExpectNothingPartial(out);
+}
+
+TEST_F(RunOutputsTest, PathtracedFrameStopsWithinOnePassOnSigintOrSigterm) {
+  const std::string world =
+      World("pt.yaml", 64, 48, 20, "rgb", 60,
+            "render: {tier: pathtraced, samples_per_pixel: 4096, denoise: false}\n");
+  PathtracedFrameStopsWithinOnePass(world, tmp_.path() / "int", SIGINT, 130);
+  PathtracedFrameStopsWithinOnePass(world, tmp_.path() / "term", SIGTERM, 143);
 }
 
 TEST_F(RunOutputsTest, SigkillLeavesNoTruncatedPngAndForceClearsTheRest) {

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -172,20 +173,27 @@ CLI::Option* AddDecimal(CLI::App* app, const std::string& name, std::function<vo
 std::atomic<int> g_stop_signal{0};
 static_assert(std::atomic<int>::is_always_lock_free);
 
+constexpr char kRunStopMessage[] =
+    "\npenumbra: stopping at the next physics step and writing the outputs "
+    "(signal again to exit at once)\n";
+constexpr char kExportStopMessage[] =
+    "\npenumbra: stopping the export and removing its partial output "
+    "(signal again to exit at once)\n";
+// the message of the first signal (set before the handler is installed)
+const char* g_stop_message = kRunStopMessage;
+
 extern "C" void OnStopSignal(int sig) {
   int expected = 0;
   if (!g_stop_signal.compare_exchange_strong(expected, sig)) _exit(128 + sig);
-  static const char kMsg[] =
-      "\npenumbra: stopping at the next physics step and writing the outputs "
-      "(signal again to exit at once)\n";
-  const ssize_t ignored = write(STDERR_FILENO, kMsg, sizeof(kMsg) - 1);
+  const ssize_t ignored = write(STDERR_FILENO, g_stop_message, strlen(g_stop_message));
   (void)ignored;
 }
 
 // installs OnStopSignal for SIGINT and SIGTERM while it lives
 class StopSignals {
  public:
-  StopSignals() {
+  explicit StopSignals(const char* message = kRunStopMessage) {
+    g_stop_message = message;
     struct sigaction sa = {};
     sa.sa_handler = OnStopSignal;
     sigemptyset(&sa.sa_mask);
@@ -453,7 +461,11 @@ int RunCli(int argc, char** argv) {
                                  hfield_extent[3]};
       return RunHeightField(hfield_options);
     }
-    if (export_command.selected()) return export_command.Run();
+    if (export_command.selected()) {
+      g_stop_signal.store(0);
+      const StopSignals stop_signals(kExportStopMessage);
+      return export_command.Run(&g_stop_signal);
+    }
     if (*make_vdb) {
       MakeSmokeVdb(vdb_path, vdb_options);
       return 0;

@@ -1,5 +1,6 @@
 #include "penumbra/app/export_command.h"
 
+#include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
@@ -7,6 +8,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/dataset/dataset_export.h"
+#include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/ros/rosbag_export.h"
@@ -42,26 +44,35 @@ class TempFolder {
 };
 
 // replays the run log `log_path` (replay/replay_runner.h, with the recorded conditions or the
-// given --world / --adversity) into a temporary run folder "<out>.replay-tmp" beside `out`,
-// kept in `replayed` (removed when it is destroyed); returns that folder.
-std::filesystem::path ReplayLogBeside(const std::string& log_path, const std::string& world_override,
+// given --world / --adversity) into a new temporary run folder "<out>.replay-tmp-<random>"
+// beside `out`, kept in `replayed` (removed when it is destroyed); returns that folder.
+// @throws ExportStopped when the stop request ended the replay.
+std::filesystem::path ReplayLogBeside(const std::string& log_path,
+                                      const std::string& world_override,
                                       const std::string& adversity,
                                       const std::filesystem::path& out,
+                                      const std::atomic<int>* stop_request,
                                       std::optional<TempFolder>* replayed) {
-  namespace fs = std::filesystem;
-  const fs::path parent = fs::absolute(out).parent_path();
-  fs::create_directories(parent);
-  replayed->emplace(parent / (fs::absolute(out).filename().string() + ".replay-tmp"));
+  replayed->emplace(MakeSiblingTempFolder(out, ".replay-tmp"));
   ReplayOptions replay;
   replay.log_path = log_path;
   replay.out_dir = (*replayed)->path().string();
-  replay.force = true;
   replay.world_override = world_override;
   replay.adversity = adversity;
   replay.progress = false;
+  replay.stop_request = stop_request;
   spdlog::info("replaying {} into {} for the export", log_path, replay.out_dir);
-  ReplayLog(replay);
+  const ReplaySummary summary = ReplayLog(replay);
+  if (summary.interrupted) throw ExportStopped(stop_request ? stop_request->load() : SIGINT);
+  CheckExportStop(stop_request);
   return (*replayed)->path();
+}
+
+// the exit code and message of a stopped export
+int Stopped(const ExportStopped& e, const std::string& out) {
+  spdlog::warn("interrupted by {}; the partial export was removed, nothing was written to {}",
+               e.signal() == SIGTERM ? "SIGTERM" : "SIGINT", out);
+  return 128 + e.signal();
 }
 
 }  // namespace
@@ -70,14 +81,15 @@ bool ExportCommand::selected() const {
   return state_ && state_->command && static_cast<bool>(*state_->command);
 }
 
-int ExportCommand::Run() const {
+int ExportCommand::Run(const std::atomic<int>* stop_request) const {
   const State& s = *state_;
   namespace fs = std::filesystem;
   const fs::path input(s.input);
-  if (s.format == "rosbag") return RunRosbag();
+  if (s.format == "rosbag") return RunRosbag(stop_request);
   DatasetExportOptions options = s.options;
   options.format = ParseDatasetFormat(s.format);
   options.out_dir = s.out;
+  options.stop_request = stop_request;
   // a run log is first replayed (replay/replay_runner.h, with the recorded conditions or the
   // given --world / --adversity) into a temporary run folder beside --out, exported from there
   std::optional<TempFolder> replayed;
@@ -85,18 +97,25 @@ int ExportCommand::Run() const {
   if (input.extension() == ".plog") {
     if (!fs::is_regular_file(input))
       throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
-    if (fs::exists(options.out_dir) && !fs::is_empty(options.out_dir))
-      throw ConfigError(
-          "", 0, "--out",
-          "'" + options.out_dir.string() + "' is not empty; expected a new or empty folder");
-    run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, options.out_dir, &replayed);
+    CheckExportFolder(options.out_dir);
+    try {
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, options.out_dir,
+                                stop_request, &replayed);
+    } catch (const ExportStopped& e) {
+      return Stopped(e, s.out);
+    }
     options.source_label = fs::absolute(input).lexically_normal().string();
   } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
     throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
                       "only for a run log (.plog) input, which is replayed first");
   }
   const RunFolder run(run_dir);
-  const DatasetExportSummary summary = ExportDataset(run, options);
+  DatasetExportSummary summary;
+  try {
+    summary = ExportDataset(run, options);
+  } catch (const ExportStopped& e) {
+    return Stopped(e, s.out);
+  }
   std::string sensors = "camera '" + summary.camera + "'";
   if (!summary.camera2.empty()) sensors += ", camera '" + summary.camera2 + "'";
   if (!summary.imu.empty())
@@ -110,7 +129,7 @@ int ExportCommand::Run() const {
   return 0;
 }
 
-int ExportCommand::RunRosbag() const {
+int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   const State& s = *state_;
   namespace fs = std::filesystem;
   const fs::path input(s.input);
@@ -134,12 +153,22 @@ int ExportCommand::RunRosbag() const {
     if (fs::exists(bag))
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "' exists; expected a new file (never overwritten)");
-    run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, bag, &replayed);
+    try {
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, bag, stop_request,
+                                &replayed);
+    } catch (const ExportStopped& e) {
+      return Stopped(e, s.out);
+    }
   } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
     throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
                       "only for a run log (.plog) input, which is replayed first");
   }
-  const RosbagExportSummary summary = ExportRosbag(run_dir, bag);
+  RosbagExportSummary summary;
+  try {
+    summary = ExportRosbag(run_dir, bag, stop_request);
+  } catch (const ExportStopped& e) {
+    return Stopped(e, s.out);
+  }
   spdlog::info("exported {} messages on {} topics (names from {}) -> {}", summary.messages,
                summary.counts.size(), summary.world_file, s.out);
   return 0;

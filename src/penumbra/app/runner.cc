@@ -136,6 +136,8 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   session_options.check_run_budget = true;
   session_options.reserve_live_npcs = !options.bridges.empty();
   Session session(world, session_options);
+  // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples
+  if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);
   Simulation& sim = session.sim();
   const SceneDescription& scene = session.scene();
   timings["compose_sec"] = session.timings().compose_sec;
@@ -214,7 +216,10 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     summary.out_dir = out.string();
     summary.sim_time_sec = f.time_sec;
     summary.physics_steps = sim.step_count();
-    summary.interrupted = f.reason == LoopEndReason::kStopRequested;
+    // a stop that came after the last step still ended the pathtraced frames being rendered
+    // (not written): the run is interrupted too
+    summary.interrupted = f.reason == LoopEndReason::kStopRequested ||
+                          (options.stop_request && options.stop_request->load() != 0);
     summary.frames_per_camera = outputs.cameras().FramesWritten();  // frames.csv rows written
     summary.wall_time_sec = SecondsSince(t_start);
     summary.peak_rss_mib = PeakResidentMemoryMiB();

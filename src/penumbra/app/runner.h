@@ -38,8 +38,9 @@ struct RunOptions {
   std::optional<CameraOutputs> outputs;
   /// a stop request (e.g. set by a SIGINT handler; nullptr = none): when it reads non-zero
   /// the run stops at the next physics step boundary, renders and writes what was captured
-  /// up to there, writes run.json with "interrupted": true and returns normally with
-  /// RunSummary::interrupted set.
+  /// up to there (a pathtraced frame stops between samples and is not written; also when the
+  /// request comes after the last step), writes run.json with "interrupted": true and returns
+  /// normally with RunSummary::interrupted set.
   const std::atomic<int>* stop_request = nullptr;
   /// middleware bridges attached to the run (command/run_bridge.h, e.g. --zmq's). with any,
   /// the run is live: its commands go through one CommandDispatcher, its steps through a

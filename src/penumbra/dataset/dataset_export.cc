@@ -1,14 +1,20 @@
 #include "penumbra/dataset/dataset_export.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <functional>
 #include <optional>
+#include <random>
 #include <system_error>
 
 #include "penumbra/core/error.h"
 #include "penumbra/dataset/euroc_export.h"
+#include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/kitti_export.h"
 #include "penumbra/dataset/tum_export.h"
 
@@ -31,20 +37,21 @@ std::string Pick(const std::string& named, const std::vector<std::string>& names
                         "s; expected one named with " + option + " (" + list + ")");
 }
 
-// the format's export into options.out_dir; `prepare` makes the folder once the inputs are read
+// the format's export into `dir`; `prepare` makes the folder once the inputs are read
 void Export(const RunFolder& run, const DatasetExportOptions& options, const RunCamera& cam0,
             const std::optional<RunCamera>& cam1, const std::string& source,
-            const std::function<void()>& prepare, DatasetExportSummary* summary) {
+            const std::function<fs::path()>& prepare, DatasetExportSummary* summary) {
+  const std::atomic<int>* stop = options.stop_request;
   if (options.format == DatasetFormat::kTum) {
-    prepare();
-    const TumExportResult r = ExportTum(cam0, source, options.out_dir);
+    const fs::path dir = prepare();
+    const TumExportResult r = ExportTum(cam0, source, dir, stop);
     summary->frames = r.frames;
     summary->depth_beyond_range = r.depth_beyond_range;
     return;
   }
   if (options.format == DatasetFormat::kKitti) {
-    prepare();
-    summary->frames = ExportKitti(cam0, cam1 ? &*cam1 : nullptr, options.sequence, options.out_dir);
+    const fs::path dir = prepare();
+    summary->frames = ExportKitti(cam0, cam1 ? &*cam1 : nullptr, options.sequence, dir, stop);
     return;
   }
   summary->imu = Pick(options.imu, run.ImuNames(), "--imu", "IMU");
@@ -61,8 +68,8 @@ void Export(const RunFolder& run, const DatasetExportOptions& options, const Run
   std::optional<EurocCamera> e1;
   if (cam1) e1 = mounted(*cam1);
   const EurocCamera e0 = mounted(cam0);
-  prepare();
-  const EurocExportResult r = ExportEuroc(e0, e1, imu, options.out_dir);
+  const fs::path dir = prepare();
+  const EurocExportResult r = ExportEuroc(e0, e1, imu, dir, stop);
   summary->frames = r.frames;
   summary->imu_samples = r.imu_samples;
 }
@@ -92,20 +99,40 @@ void DatasetExportOptions::ValidateOrThrow() const {
     throw ConfigError("", 0, "--sequence", "'" + sequence + "'; expected two digits (00 .. 99)");
 }
 
-void PrepareExportFolder(const fs::path& out) {
+void CheckExportFolder(const fs::path& out) {
   std::error_code ec;
-  if (fs::exists(fs::symlink_status(out, ec))) {
-    if (!fs::is_directory(out, ec))
-      throw ConfigError("", 0, "--out",
-                        "'" + out.string() + "' is not a folder; expected a new or empty folder");
-    if (!fs::is_empty(out, ec))
-      throw ConfigError("", 0, "--out",
-                        "'" + out.string() + "' is not empty; expected a new or empty folder");
-    return;
+  const fs::file_status st = fs::symlink_status(out, ec);
+  if (!fs::exists(st)) return;
+  if (fs::is_symlink(st))
+    throw ConfigError("", 0, "--out",
+                      "'" + out.string() +
+                          "' is a symbolic link; expected a new or empty folder (the dataset "
+                          "is renamed into place, which would replace the link)");
+  if (!fs::is_directory(st))
+    throw ConfigError("", 0, "--out",
+                      "'" + out.string() + "' is not a folder; expected a new or empty folder");
+  if (!fs::is_empty(out, ec))
+    throw ConfigError("", 0, "--out",
+                      "'" + out.string() + "' is not empty; expected a new or empty folder");
+}
+
+fs::path MakeSiblingTempFolder(const fs::path& out, const std::string& suffix) {
+  fs::path target = fs::absolute(out).lexically_normal();
+  if (target.filename().empty()) target = target.parent_path();  // "DIR/"
+  const fs::path parent = target.parent_path();
+  std::error_code ec;
+  fs::create_directories(parent, ec);
+  if (ec) throw Error("cannot create the folder " + parent.string() + ": " + ec.message());
+  std::random_device seed;
+  std::mt19937_64 rng((static_cast<uint64_t>(seed()) << 32) ^ seed());
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path p = parent / fmt::format("{}{}-{:012x}", target.filename().string(), suffix,
+                                            rng() & 0xffffffffffffULL);
+    if (::mkdir(p.c_str(), 0777) == 0) return p;
+    if (errno != EEXIST)
+      throw Error("cannot create the folder " + p.string() + ": " + std::strerror(errno));
   }
-  fs::create_directories(out, ec);
-  if (ec)
-    throw ConfigError("", 0, "--out", "cannot create '" + out.string() + "': " + ec.message());
+  throw Error("cannot create a temporary folder beside " + target.string());
 }
 
 DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOptions& options) {
@@ -118,29 +145,35 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
     summary.camera2 = options.camera2;
     cam1 = run.ReadCamera(options.camera2);
   }
-  // every input is read before the output folder is touched; a failed export removes what it
-  // wrote (the folder too when it made it)
+  // every input is read before anything is written; the dataset goes into a temporary folder
+  // beside out_dir, renamed to it when complete (rename(2) replaces an empty folder), removed
+  // when the export fails or is stopped
   const std::string source = options.source_label.empty()
                                  ? fs::absolute(run.dir()).lexically_normal().string()
                                  : options.source_label;
-  std::error_code ec;
-  const bool out_existed = fs::exists(fs::symlink_status(options.out_dir, ec));
-  bool prepared = false;
+  CheckExportFolder(options.out_dir);
+  CheckExportStop(options.stop_request);
+  std::optional<fs::path> temp;
   auto prepare = [&] {
-    PrepareExportFolder(options.out_dir);
-    prepared = true;
+    temp = MakeSiblingTempFolder(options.out_dir, ".export-tmp");
+    return *temp;
   };
   try {
     Export(run, options, cam0, cam1, source, prepare, &summary);
-  } catch (...) {
-    if (prepared) {
-      if (!out_existed) {
-        fs::remove_all(options.out_dir, ec);
-      } else {
-        for (const auto& e : fs::directory_iterator(options.out_dir, ec))
-          fs::remove_all(e.path(), ec);
-      }
+    CheckExportStop(options.stop_request);
+    if (temp && std::rename(temp->c_str(), options.out_dir.c_str()) != 0) {
+      const int err = errno;
+      if (err == ENOTEMPTY || err == EEXIST || err == ENOTDIR || err == EISDIR)
+        throw ConfigError("", 0, "--out",
+                          "'" + options.out_dir.string() +
+                              "' was filled or replaced during the export; expected a new or "
+                              "empty folder");
+      throw Error("cannot rename " + temp->string() + " to " + options.out_dir.string() + ": " +
+                  std::strerror(err));
     }
+  } catch (...) {
+    std::error_code ec;
+    if (temp) fs::remove_all(*temp, ec);
     throw;
   }
   return summary;

@@ -3,7 +3,14 @@
 // layout: TUM RGB-D (dataset/tum_export.h), EuRoC/ASL (dataset/euroc_export.h) or KITTI
 // odometry (dataset/kitti_export.h). docs/datasets.md states each format's frames and
 // timestamps and how Penumbra's map to them.
+//
+// the dataset is written into a new folder beside the output folder,
+// "<out>.export-tmp-<random>", and renamed to the output folder only when it is complete: the
+// output folder never holds a partial dataset (no images without their index files), and an
+// export that fails or is stopped (DatasetExportOptions::stop_request) removes the temporary
+// folder, leaving the output folder as it was.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -34,6 +41,9 @@ struct DatasetExportOptions {
   /// what the TUM lists' "# file:" line names as the source; "" = the run folder (absolute).
   /// (a run log exported through a temporary replay folder names the log.)
   std::string source_label;
+  /// a stop request (SIGINT / SIGTERM; null = none), read between frames: when it reads
+  /// non-zero the export throws ExportStopped (dataset/export_stop.h) and leaves nothing behind.
+  const std::atomic<int>* stop_request = nullptr;
 
   /// @throws ConfigError naming the option (--out, --camera2, --imu, --sequence) for an empty
   ///         output folder, a second camera with TUM or equal to the first, an IMU without
@@ -49,14 +59,26 @@ struct DatasetExportSummary {
   int64_t depth_beyond_range = 0;    ///< TUM only: depth pixels beyond 13.107 m, written as 0
 };
 
-/// makes `out` ready: creates it if missing; an existing one must be an empty folder.
-/// @throws ConfigError (key "--out") if it is a file, not empty, or cannot be created.
-void PrepareExportFolder(const std::filesystem::path& out);
+/// checks that `out` can receive a dataset: missing, or an empty folder that is not a
+/// symbolic link.
+/// @throws ConfigError (key "--out") if it is a file, a symbolic link or a folder that is not
+///         empty.
+void CheckExportFolder(const std::filesystem::path& out);
 
-/// exports `run` as `options` says (options.ValidateOrThrow() first, then PrepareExportFolder).
+/// a new, empty folder beside `out` (same parent, created if missing): "<out's name>" +
+/// `suffix` + "-" + 12 random hex digits, made with mkdir (never an existing one; permissions
+/// from the umask).
+/// @throws Error naming the folder if it cannot be created.
+std::filesystem::path MakeSiblingTempFolder(const std::filesystem::path& out,
+                                            const std::string& suffix);
+
+/// exports `run` as `options` says (options.ValidateOrThrow() and CheckExportFolder first; the
+/// inputs are read before anything is written), into a temporary sibling folder renamed to
+/// options.out_dir when complete.
 /// @throws ConfigError for a camera or IMU the run does not have (listing those it has), a
 ///         run with several cameras or IMUs and none named, and the format's own errors
-///         (see the format headers); Error if a file cannot be written.
+///         (see the format headers); Error if a file cannot be written; ExportStopped when
+///         options.stop_request is set. in every case nothing is left in or beside out_dir.
 DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOptions& options);
 
 }  // namespace penumbra

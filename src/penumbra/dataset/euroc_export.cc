@@ -6,6 +6,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/image_convert.h"
 
 namespace penumbra {
@@ -33,7 +34,8 @@ void CheckIncreasing(int64_t previous, int64_t ns, const fs::path& file, int64_t
                                   index, ns, previous));
 }
 
-int64_t WriteCamera(const RunCamera& cam, const Pose& X_BC, const fs::path& dir) {
+int64_t WriteCamera(const RunCamera& cam, const Pose& X_BC, const fs::path& dir,
+                    const std::atomic<int>* stop_request) {
   if (!cam.has_rgb)
     throw ConfigError(cam.folder.string(), 0, "",
                       "camera '" + cam.name + "' has no rgb images; expected rgb in its outputs");
@@ -42,11 +44,12 @@ int64_t WriteCamera(const RunCamera& cam, const Pose& X_BC, const fs::path& dir)
   std::string csv = "#timestamp [ns],filename\n";
   int64_t previous = -1;
   for (const RunFrame& f : cam.frames) {
+    CheckExportStop(stop_request);
     const int64_t ns = SecondsToNs(f.time_sec);
     CheckIncreasing(previous, ns, cam.folder / "frames.csv", f.index);
     previous = ns;
     const std::string name = fmt::format("{}.png", ns);
-    WriteGreyPng(cam.ImagePath("rgb", f.index), dir / "data" / name);
+    WriteGreyPng(cam, f.index, dir / "data" / name);
     csv += fmt::format("{},{}\n", ns, name);
   }
   WriteFileAtomic(dir / "data.csv", csv);
@@ -95,14 +98,15 @@ std::string EurocCameraYaml(const RunCamera& cam, const Pose& X_BC) {
 }
 
 EurocExportResult ExportEuroc(const EurocCamera& cam0, const std::optional<EurocCamera>& cam1,
-                              const RunImu& imu, const fs::path& out) {
+                              const RunImu& imu, const fs::path& out,
+                              const std::atomic<int>* stop_request) {
   const fs::path mav = out / "mav0";
   EurocExportResult result;
   const Pose X_B0 = CameraInImuFrame(imu.mount, imu.name, cam0.mount, cam0.camera.name);
   std::optional<Pose> X_B1;
   if (cam1) X_B1 = CameraInImuFrame(imu.mount, imu.name, cam1->mount, cam1->camera.name);
-  result.frames = WriteCamera(cam0.camera, X_B0, mav / "cam0");
-  if (cam1) WriteCamera(cam1->camera, *X_B1, mav / "cam1");
+  result.frames = WriteCamera(cam0.camera, X_B0, mav / "cam0", stop_request);
+  if (cam1) WriteCamera(cam1->camera, *X_B1, mav / "cam1", stop_request);
 
   // imu0: noisy samples at their capture times; the body frame is the IMU frame
   fs::create_directories(mav / "imu0");

@@ -25,6 +25,7 @@
 // same rigid body). timestamps: sim time in integer nanoseconds (rounded), the capture time of
 // each sample.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -60,9 +61,11 @@ std::string EurocCameraYaml(const RunCamera& cam, const Pose& X_BC);
 /// writes cam0 (and cam1), imu0 and state_groundtruth_estimate0 under OUT/mav0 (`out`: an
 /// existing, empty folder).
 /// @throws ConfigError as CameraInImuFrame and EurocCameraYaml, if a camera has no rgb images
-///         or an image is missing, or if two samples share a nanosecond timestamp; Error if a
-///         file cannot be written.
+///         or an image is missing or fails the checks of dataset/image_convert.h, or if two
+///         samples share a nanosecond timestamp; Error if a file cannot be written;
+///         ExportStopped when `stop_request` (may be null) reads non-zero between frames.
 EurocExportResult ExportEuroc(const EurocCamera& cam0, const std::optional<EurocCamera>& cam1,
-                              const RunImu& imu, const std::filesystem::path& out);
+                              const RunImu& imu, const std::filesystem::path& out,
+                              const std::atomic<int>* stop_request = nullptr);
 
 }  // namespace penumbra

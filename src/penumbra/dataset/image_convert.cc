@@ -1,31 +1,81 @@
 #include "penumbra/dataset/image_convert.h"
 
-#include <fstream>
+#include <fmt/format.h>
+
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/dataset/run_file.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
 
-cv::Mat ReadImage(const fs::path& path, int expected_type, const char* expected) {
-  const cv::Mat m = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (m.empty())
-    throw ConfigError(path.string(), 0, "",
-                      "missing or not a readable PNG; expected " + std::string(expected));
-  if (m.type() != expected_type)
+// a run image's file and its decoded pixels (OpenCV: BGR order for colour)
+struct CheckedPng {
+  std::string bytes;
+  cv::Mat image;
+};
+
+uint32_t BigEndian32(const std::string& b, size_t at) {
+  return (static_cast<uint32_t>(static_cast<uint8_t>(b[at])) << 24) |
+         (static_cast<uint32_t>(static_cast<uint8_t>(b[at + 1])) << 16) |
+         (static_cast<uint32_t>(static_cast<uint8_t>(b[at + 2])) << 8) |
+         static_cast<uint32_t>(static_cast<uint8_t>(b[at + 3]));
+}
+
+CheckedPng ReadCheckedPng(const RunCamera& cam, const std::string& kind, int64_t index) {
+  const bool rgb = kind == "rgb";
+  const int channels = rgb ? 3 : 1, bit_depth = rgb ? 8 : 16, colour_type = rgb ? 2 : 0;
+  const std::string expected =
+      fmt::format("{} PNG of {} x {} pixels (camera '{}' in camera_info.json)",
+                  rgb ? "an 8-bit RGB" : "a 16-bit greyscale", cam.width, cam.height, cam.name);
+  const fs::path relative = cam.RelativeImagePath(kind, index);
+  const std::string file = (cam.run_dir / relative).string();
+  // deflate never grows data by more than a few bytes per 16 KiB block; a PNG far larger than
+  // its pixels is not one of Penumbra's
+  const uint64_t raw = static_cast<uint64_t>(cam.width) * static_cast<uint64_t>(cam.height) *
+                           static_cast<uint64_t>(channels * bit_depth / 8) +
+                       static_cast<uint64_t>(cam.height);
+  CheckedPng p;
+  p.bytes = ReadRunFile(cam.run_dir, relative, 2 * raw + (1u << 20));
+  // the header is checked before anything is allocated for the pixels
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (p.bytes.size() < 33 || std::memcmp(p.bytes.data(), kSignature, 8) != 0 ||
+      p.bytes.compare(12, 4, "IHDR") != 0)
+    throw ConfigError(file, 0, "",
+                      "not a PNG file (no PNG signature and header); expected " + expected);
+  const uint32_t w = BigEndian32(p.bytes, 16), h = BigEndian32(p.bytes, 20);
+  const int depth = static_cast<uint8_t>(p.bytes[24]), type = static_cast<uint8_t>(p.bytes[25]);
+  if (w != static_cast<uint32_t>(cam.width) || h != static_cast<uint32_t>(cam.height))
+    throw ConfigError(file, 0, "", fmt::format("{} x {} pixels; expected {}", w, h, expected));
+  if (depth != bit_depth || type != colour_type)
     throw ConfigError(
-        path.string(), 0, "",
-        "image of OpenCV type " + cv::typeToString(m.type()) + "; expected " + expected);
-  return m;
+        file, 0, "",
+        fmt::format("PNG of bit depth {} and colour type {}; expected {}", depth, type, expected));
+  const cv::Mat encoded(1, static_cast<int>(p.bytes.size()), CV_8UC1, p.bytes.data());
+  try {
+    p.image = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+    p.image.release();
+  }
+  if (p.image.empty())
+    throw ConfigError(
+        file, 0, "",
+        "a truncated or corrupt PNG (it does not decode completely); expected " + expected);
+  if (p.image.type() != (rgb ? CV_8UC3 : CV_16UC1) || p.image.cols != cam.width ||
+      p.image.rows != cam.height)
+    throw ConfigError(file, 0, "",
+                      "decodes to an image of OpenCV type " + cv::typeToString(p.image.type()) +
+                          "; expected " + expected);
+  return p;
 }
 
 void WritePng(const fs::path& path, const cv::Mat& image) {
@@ -42,8 +92,29 @@ uint16_t TumDepthFromMillimetres(uint16_t mm) {
   return mm > 13107 ? 0 : static_cast<uint16_t>(5 * mm);
 }
 
-int64_t WriteTumDepthPng(const fs::path& mm_png, const fs::path& out) {
-  const cv::Mat mm = ReadImage(mm_png, CV_16UC1, "a 16-bit greyscale depth PNG (millimetres)");
+RunImage ReadRunImage(const RunCamera& cam, const std::string& kind, int64_t index) {
+  const CheckedPng p = ReadCheckedPng(cam, kind, index);
+  RunImage out;
+  out.width = p.image.cols;
+  out.height = p.image.rows;
+  out.channels = p.image.channels();
+  out.samples.resize(static_cast<size_t>(out.width) * out.height * out.channels);
+  size_t i = 0;
+  for (int y = 0; y < out.height; ++y) {
+    if (out.channels == 3) {
+      const cv::Vec3b* row = p.image.ptr<cv::Vec3b>(y);
+      for (int x = 0; x < out.width; ++x)
+        for (int c = 2; c >= 0; --c) out.samples[i++] = row[x][c];  // BGR -> RGB
+    } else {
+      const uint16_t* row = p.image.ptr<uint16_t>(y);
+      for (int x = 0; x < out.width; ++x) out.samples[i++] = row[x];
+    }
+  }
+  return out;
+}
+
+int64_t WriteTumDepthPng(const RunCamera& cam, int64_t index, const fs::path& out) {
+  const cv::Mat mm = ReadCheckedPng(cam, "depth", index).image;
   cv::Mat tum(mm.rows, mm.cols, CV_16UC1);
   int64_t beyond = 0;
   for (int y = 0; y < mm.rows; ++y) {
@@ -58,21 +129,17 @@ int64_t WriteTumDepthPng(const fs::path& mm_png, const fs::path& out) {
   return beyond;
 }
 
-void WriteGreyPng(const fs::path& rgb_png, const fs::path& out) {
-  // imread gives BGR channel order
-  const cv::Mat bgr = ReadImage(rgb_png, CV_8UC3, "an 8-bit RGB PNG");
+void WriteGreyPng(const RunCamera& cam, int64_t index, const fs::path& out, const fs::path* copy) {
+  // imdecode gives BGR channel order
+  const CheckedPng p = ReadCheckedPng(cam, "rgb", index);
   cv::Mat grey;
-  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(p.image, grey, cv::COLOR_BGR2GRAY);
   WritePng(out, grey);
+  if (copy) WriteFileAtomic(*copy, p.bytes);
 }
 
-void CopyImage(const fs::path& from, const fs::path& to) {
-  std::ifstream in(from, std::ios::binary);
-  if (!in)
-    throw ConfigError(from.string(), 0, "", "cannot open the image; expected it in the run folder");
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  WriteFileAtomic(to, bytes.str());
+void CopyImage(const RunCamera& cam, const std::string& kind, int64_t index, const fs::path& to) {
+  WriteFileAtomic(to, ReadCheckedPng(cam, kind, index).bytes);
 }
 
 }  // namespace penumbra

@@ -6,6 +6,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/image_convert.h"
 
 namespace penumbra {
@@ -38,14 +39,15 @@ void CheckCamera(const RunCamera& cam) {
                       "camera '" + cam.name + "' has no rgb images; expected rgb in its outputs");
 }
 
-void WriteImages(const RunCamera& cam, const fs::path& grey, const fs::path& colour) {
+void WriteImages(const RunCamera& cam, const fs::path& grey, const fs::path& colour,
+                 const std::atomic<int>* stop_request) {
   fs::create_directories(grey);
   fs::create_directories(colour);
   for (size_t i = 0; i < cam.frames.size(); ++i) {
+    CheckExportStop(stop_request);
     const std::string name = fmt::format("{:06d}.png", i);
-    const fs::path rgb = cam.ImagePath("rgb", cam.frames[i].index);
-    WriteGreyPng(rgb, grey / name);
-    CopyImage(rgb, colour / name);
+    const fs::path copy = colour / name;
+    WriteGreyPng(cam, cam.frames[i].index, grey / name, &copy);
   }
 }
 
@@ -87,7 +89,7 @@ std::string KittiCalib(const RunCamera& cam0, const RunCamera* cam1, const Pose&
 }
 
 int64_t ExportKitti(const RunCamera& cam0, const RunCamera* cam1, const std::string& sequence,
-                    const fs::path& out) {
+                    const fs::path& out, const std::atomic<int>* stop_request) {
   CheckCamera(cam0);
   if (cam1) CheckCamera(*cam1);
   if (cam0.frames.empty())
@@ -95,8 +97,8 @@ int64_t ExportKitti(const RunCamera& cam0, const RunCamera* cam1, const std::str
                       "no frames; expected at least one");
   const Pose X_10 = cam1 ? StereoExtrinsics(cam0, *cam1) : Pose::Identity();
   const fs::path seq = out / "sequences" / sequence;
-  WriteImages(cam0, seq / "image_0", seq / "image_2");
-  if (cam1) WriteImages(*cam1, seq / "image_1", seq / "image_3");
+  WriteImages(cam0, seq / "image_0", seq / "image_2", stop_request);
+  if (cam1) WriteImages(*cam1, seq / "image_1", seq / "image_3", stop_request);
   std::string times, poses;
   const Pose X_0W = cam0.frames[0].X_WO.inverse();
   for (const RunFrame& f : cam0.frames) {

@@ -21,6 +21,7 @@
 // Tr (Velodyne to camera 0) is the identity: no LiDAR scans are exported. times: sim time.
 // KITTI's images are undistorted and rectified, so a camera with lens distortion is refused.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -41,8 +42,11 @@ std::string KittiCalib(const RunCamera& cam0, const RunCamera* cam1, const Pose&
 /// writes the sequence `sequence` of camera 0 (and camera 1 when not null) under `out` (an
 /// existing, empty folder). returns the number of frames.
 /// @throws ConfigError as StereoExtrinsics, for a camera with distortion, no rgb images or a
-///         missing image; Error if a file cannot be written.
+///         missing image or one that fails the checks of dataset/image_convert.h; Error if a
+///         file cannot be written; ExportStopped when `stop_request` (may be null) reads non-zero
+///         between frames.
 int64_t ExportKitti(const RunCamera& cam0, const RunCamera* cam1, const std::string& sequence,
-                    const std::filesystem::path& out);
+                    const std::filesystem::path& out,
+                    const std::atomic<int>* stop_request = nullptr);
 
 }  // namespace penumbra

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/dataset/run_file.h"
 
 namespace penumbra {
 namespace {
@@ -17,21 +18,23 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+// `relative` under the run folder `dir`, parsed
+Json ReadJson(const fs::path& dir, const fs::path& relative) {
+  const std::string text = ReadRunFile(dir, relative);
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception& e) {
+    throw ConfigError((dir / relative).string(), 0, "", std::string("not valid JSON: ") + e.what());
+  }
 }
 
-Json ReadJson(const fs::path& path) {
-  try {
-    return Json::parse(ReadText(path));
-  } catch (const Json::exception& e) {
-    throw ConfigError(path.string(), 0, "", std::string("not valid JSON: ") + e.what());
-  }
+// a camera or IMU name from the run's JSON must name files inside the run folder
+void CheckSensorName(const std::string& name, const fs::path& file, const std::string& key) {
+  if (!IsPlainRelativePath(fs::path(name)))
+    throw ConfigError(file.string(), 0, key,
+                      "name '" + name +
+                          "' is not a path inside the run folder (absolute, empty or with a "
+                          "'.' or '..' component); expected a sensor name");
 }
 
 std::vector<std::string> Split(const std::string& line) {
@@ -73,8 +76,9 @@ struct Csv {
   }
 };
 
-Csv ReadCsv(const fs::path& path, const std::string& header) {
-  std::istringstream in(ReadText(path));
+Csv ReadCsv(const fs::path& dir, const fs::path& relative, const std::string& header) {
+  const fs::path path = dir / relative;
+  std::istringstream in(ReadRunFile(dir, relative));
   Csv csv;
   csv.path = path;
   csv.columns = Split(header);
@@ -150,6 +154,10 @@ fs::path RunCamera::ImagePath(const std::string& kind, int64_t index) const {
   return folder / kind / fmt::format("{:06d}.png", index);
 }
 
+fs::path RunCamera::RelativeImagePath(const std::string& kind, int64_t index) const {
+  return fs::path(name) / kind / fmt::format("{:06d}.png", index);
+}
+
 double RunCamera::MeanRateHz() const {
   if (frames.size() < 2) return 0;
   return static_cast<double>(frames.size() - 1) /
@@ -163,7 +171,8 @@ RunFolder::RunFolder(fs::path dir) : dir_(std::move(dir)) {
   if (!fs::is_directory(dir_, ec))
     throw ConfigError(dir_.string(), 0, "",
                       "not a folder; expected the output folder of `penumbra run`");
-  if (!fs::exists(dir_ / "camera_info.json", ec) && !fs::exists(dir_ / "rig.json", ec))
+  if (StatRunEntry(dir_, "camera_info.json") == RunEntry::kMissing &&
+      StatRunEntry(dir_, "rig.json") == RunEntry::kMissing)
     throw ConfigError(dir_.string(), 0, "",
                       "has neither camera_info.json nor rig.json; expected the output folder of "
                       "`penumbra run`");
@@ -171,18 +180,16 @@ RunFolder::RunFolder(fs::path dir) : dir_(std::move(dir)) {
 
 std::vector<std::string> RunFolder::CameraNames() const {
   std::vector<std::string> names;
-  std::error_code ec;
-  if (!fs::exists(dir_ / "camera_info.json", ec)) return names;
-  const Json j = ReadJson(dir_ / "camera_info.json");
+  if (StatRunEntry(dir_, "camera_info.json") == RunEntry::kMissing) return names;
+  const Json j = ReadJson(dir_, "camera_info.json");
   for (auto it = j.begin(); it != j.end(); ++it) names.push_back(it.key());
   return names;
 }
 
 std::vector<std::string> RunFolder::ImuNames() const {
   std::vector<std::string> names;
-  std::error_code ec;
-  if (!fs::exists(dir_ / "rig.json", ec)) return names;
-  const Json j = ReadJson(dir_ / "rig.json");
+  if (StatRunEntry(dir_, "rig.json") == RunEntry::kMissing) return names;
+  const Json j = ReadJson(dir_, "rig.json");
   if (j.contains("imus"))
     for (auto it = j["imus"].begin(); it != j["imus"].end(); ++it) names.push_back(it.key());
   return names;
@@ -194,9 +201,11 @@ RunCamera RunFolder::ReadCamera(const std::string& name) const {
     throw ConfigError("", 0, "--camera",
                       "the run has no camera '" + name + "'; expected one of: " + Joined(names));
   const fs::path info_path = dir_ / "camera_info.json";
-  const Json info = ReadJson(info_path)[name];
+  CheckSensorName(name, info_path, name);
+  const Json info = ReadJson(dir_, "camera_info.json")[name];
   RunCamera cam;
   cam.name = name;
+  cam.run_dir = dir_;
   cam.folder = dir_ / fs::path(name);
   try {
     cam.width = info.at("width").get<int>();
@@ -213,7 +222,12 @@ RunCamera RunFolder::ReadCamera(const std::string& name) const {
     throw ConfigError(info_path.string(), 0, name,
                       "expected width, height, K (9 numbers) and D (5 numbers)");
   }
-  const Csv csv = ReadCsv(cam.folder / "frames.csv", "frame,time_sec,x,y,z,qw,qx,qy,qz");
+  // the images are checked against this size before they are decoded (PNG limits: 2^31 - 1)
+  if (cam.width < 1 || cam.width > 65535 || cam.height < 1 || cam.height > 65535)
+    throw ConfigError(
+        info_path.string(), 0, name + ".width",
+        fmt::format("{} x {} pixels; expected 1 .. 65535 each", cam.width, cam.height));
+  const Csv csv = ReadCsv(dir_, fs::path(name) / "frames.csv", "frame,time_sec,x,y,z,qw,qx,qy,qz");
   for (size_t r = 0; r < csv.rows.size(); ++r) {
     RunFrame f;
     f.index = csv.Integer(r, 0);
@@ -226,16 +240,14 @@ RunCamera RunFolder::ReadCamera(const std::string& name) const {
                         "increasing rows");
     cam.frames.push_back(f);
   }
-  std::error_code ec;
-  cam.has_rgb = fs::is_directory(cam.folder / "rgb", ec);
-  cam.has_depth = fs::is_directory(cam.folder / "depth", ec);
+  cam.has_rgb = StatRunEntry(dir_, fs::path(name) / "rgb") == RunEntry::kFolder;
+  cam.has_depth = StatRunEntry(dir_, fs::path(name) / "depth") == RunEntry::kFolder;
   return cam;
 }
 
 std::optional<RunMount> RunFolder::CameraMount(const std::string& name) const {
-  std::error_code ec;
-  if (!fs::exists(dir_ / "rig.json", ec)) return std::nullopt;
-  const Json rig = ReadJson(dir_ / "rig.json");
+  if (StatRunEntry(dir_, "rig.json") == RunEntry::kMissing) return std::nullopt;
+  const Json rig = ReadJson(dir_, "rig.json");
   if (!rig.contains("cameras") || !rig["cameras"].contains(name)) return std::nullopt;
   return MountFromJson(rig["cameras"][name], dir_ / "rig.json", "cameras." + name);
 }
@@ -247,7 +259,8 @@ RunImu RunFolder::ReadImu(const std::string& name) const {
         "", 0, "--imu",
         "the run has no IMU '" + name + "' in rig.json; expected one of: " + Joined(names));
   const fs::path rig_path = dir_ / "rig.json";
-  const Json j = ReadJson(rig_path)["imus"][name];
+  CheckSensorName(name, rig_path, "imus." + name);
+  const Json j = ReadJson(dir_, "rig.json")["imus"][name];
   RunImu imu;
   imu.name = name;
   imu.mount = MountFromJson(j, rig_path, "imus." + name);
@@ -261,8 +274,8 @@ RunImu RunFolder::ReadImu(const std::string& name) const {
     throw ConfigError(rig_path.string(), 0, "imus." + name,
                       "expected rate_hz and the four noise parameters");
   }
-  const fs::path dir = dir_ / "imu";
-  const Csv s = ReadCsv(dir / (name + ".csv"),
+  const fs::path dir = "imu";
+  const Csv s = ReadCsv(dir_, dir / (name + ".csv"),
                         "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
                         "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s");
   for (size_t r = 0; r < s.rows.size(); ++r) {
@@ -278,7 +291,7 @@ RunImu RunFolder::ReadImu(const std::string& name) const {
                         "not after the previous row's; expected strictly increasing times");
     imu.samples.push_back(m);
   }
-  const Csv t = ReadCsv(dir / (name + "_truth.csv"),
+  const Csv t = ReadCsv(dir_, dir / (name + "_truth.csv"),
                         "sample,capture_time_sec,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,"
                         "bgx_rad_s,bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2");
   for (size_t r = 0; r < t.rows.size(); ++r) {

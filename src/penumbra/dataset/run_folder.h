@@ -14,7 +14,9 @@
 //   rig.json                    mounts of cameras, IMUs, LiDARs (session/sensor_sink.h)
 //
 // every error is a ConfigError naming the file, the 1-based line (0 for a whole file) and the
-// column or key, and what was expected.
+// column or key, and what was expected. every file is read through dataset/run_file.h: nothing
+// is read through a symbolic link below the run folder, and camera and IMU names (from
+// camera_info.json and rig.json) must be plain relative names (no "..", not absolute).
 
 #include <Eigen/Core>
 #include <array>
@@ -38,6 +40,7 @@ struct RunFrame {
 /// one camera of a run: calibration, frames and which images it has.
 struct RunCamera {
   std::string name;
+  std::filesystem::path run_dir;          ///< the run folder
   std::filesystem::path folder;           ///< <run>/<camera> ('/' in the name gives nested folders)
   int width = 0, height = 0;              ///< pixels
   double fx = 0, fy = 0, cx = 0, cy = 0;  ///< pinhole intrinsics, pixels
@@ -48,6 +51,8 @@ struct RunCamera {
 
   /// <folder>/<kind>/NNNNNN.png of frame `index` (kind "rgb" or "depth").
   std::filesystem::path ImagePath(const std::string& kind, int64_t index) const;
+  /// the same path relative to run_dir (<camera>/<kind>/NNNNNN.png), for ReadRunFile.
+  std::filesystem::path RelativeImagePath(const std::string& kind, int64_t index) const;
   /// frames per second over the run: (frames - 1) / (last time - first time); 0 for < 2 frames.
   double MeanRateHz() const;
 };
@@ -105,7 +110,9 @@ class RunFolder {
 
   /// reads a camera's calibration, frames.csv and which image folders exist.
   /// @throws ConfigError naming the file, line and column of the first bad value, or the
-  ///         camera names the run has when `name` is not one of them.
+  ///         camera names the run has when `name` is not one of them; a name that is not a
+  ///         plain relative path, a symbolic link on the way to its files, or a width or
+  ///         height outside 1 .. 65535.
   RunCamera ReadCamera(const std::string& name) const;
   /// the camera's mount from rig.json; nullopt for a camera rig.json does not list (an MJCF
   /// camera, or a run made before rig.json existed).

@@ -6,6 +6,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/image_convert.h"
 
 namespace penumbra {
@@ -14,7 +15,8 @@ namespace fs = std::filesystem;
 
 std::string TumTimestamp(double time_sec) { return fmt::format("{:.6f}", time_sec); }
 
-TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const fs::path& out) {
+TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const fs::path& out,
+                          const std::atomic<int>* stop_request) {
   if (!cam.has_rgb || !cam.has_depth)
     throw ConfigError(
         cam.folder.string(), 0, "",
@@ -32,6 +34,7 @@ TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const
   TumExportResult result;
   std::string previous;
   for (const RunFrame& f : cam.frames) {
+    CheckExportStop(stop_request);
     const std::string t = TumTimestamp(f.time_sec);
     if (!previous.empty() && std::stod(t) <= std::stod(previous))
       throw ConfigError((cam.folder / "frames.csv").string(), 0, "time_sec",
@@ -40,9 +43,8 @@ TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const
                                     f.index, f.time_sec, t));
     previous = t;
     const std::string rgb_name = "rgb/" + t + ".png", depth_name = "depth/" + t + ".png";
-    CopyImage(cam.ImagePath("rgb", f.index), out / rgb_name);
-    result.depth_beyond_range +=
-        WriteTumDepthPng(cam.ImagePath("depth", f.index), out / depth_name);
+    CopyImage(cam, "rgb", f.index, out / rgb_name);
+    result.depth_beyond_range += WriteTumDepthPng(cam, f.index, out / depth_name);
     rgb += t + " " + rgb_name + "\n";
     depth += t + " " + depth_name + "\n";
     assoc += t + " " + rgb_name + " " + t + " " + depth_name + "\n";

@@ -16,6 +16,7 @@
 // counts from the Unix epoch; Penumbra's sim time starts at 0). colour and depth come from the
 // same camera and frame, so they are registered 1:1 and associate with a time difference of 0.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -38,8 +39,11 @@ std::string TumTimestamp(double time_sec);
 /// `source` names the run in the lists' "# file:" header line.
 /// @throws ConfigError if the camera has no rgb or no depth images (naming the camera and the
 ///         world-file key that adds them), a frame's image is missing, or two frames share a
-///         6-decimal timestamp; Error if a file cannot be written.
+///         6-decimal timestamp, or an image that fails the checks of dataset/image_convert.h;
+///         Error if a file cannot be written; ExportStopped when `stop_request` (may be null)
+///         reads non-zero between frames.
 TumExportResult ExportTum(const RunCamera& cam, const std::string& source,
-                          const std::filesystem::path& out);
+                          const std::filesystem::path& out,
+                          const std::atomic<int>* stop_request = nullptr);
 
 }  // namespace penumbra

@@ -8,6 +8,7 @@
 // determinism: an integrator draws random numbers only from Rng(ctx.PixelStream(u, v, s)),
 // so images do not depend on the thread count or tile order.
 
+#include <atomic>
 #include <cstdint>
 
 #include "penumbra/core/image.h"
@@ -45,6 +46,11 @@ struct FrameContext {
   /// null in clear conditions (then both tiers render exactly as without effects). `sky`
   /// already is the effects' sky and `lights` carry the effects' light changes.
   const MediaFrame* effects = nullptr;
+  /// the renderer's stop request (Renderer::set_stop_request), or null: an integrator that
+  /// takes long per pixel (the pathtraced tier) reads it before every sample and, once it
+  /// reads non-zero, leaves the tile unfinished and sets *stopped.
+  const std::atomic<int>* stop_request = nullptr;
+  std::atomic<bool>* stopped = nullptr;
 
   /// stream id of pixel (u, v), sample s: HashKeys(HashKeys(seed, camera), frame, pixel, s)
   /// with pixel = v * width + u.

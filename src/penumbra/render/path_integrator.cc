@@ -177,6 +177,11 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
     int albedo_count = 0;
 
     for (int s = 0; s < spp; ++s) {
+      // a stop request ends the tile between samples (the frame is then discarded)
+      if (ctx.stop_request != nullptr && ctx.stop_request->load(std::memory_order_relaxed) != 0) {
+        if (ctx.stopped != nullptr) ctx.stopped->store(true, std::memory_order_relaxed);
+        return rays;
+      }
       Rng rng(ctx.PixelStream(u, v, s));
       const float jx = rng.Uniform(), jy = rng.Uniform();
       const Ray cam = ctx.camera->GenerateRay(static_cast<float>(u) + jx - 0.5f,

@@ -55,6 +55,11 @@
 //
 // random numbers: every path draws from Rng(ctx.PixelStream(u, v, s)) only, so images are
 // bit-identical for any thread count and tile order.
+//
+// stopping: before every sample (one path of one pixel) the tier reads FrameContext::
+// stop_request; once it is set the tile is left unfinished and FrameContext::stopped is set, so
+// a stop (SIGINT) waits for at most one path per render thread, not for the frame's
+// samples_per_pixel passes. a render that is not stopped is the same as without the check.
 
 #include "penumbra/render/emitter_sampler.h"
 #include "penumbra/render/integrator.h"

@@ -4,6 +4,7 @@
 // re-rendered without it. MakeRenderer (render/renderer_factory.h) builds the one of
 // RenderSettings::backend (Embree: render/embree/embree_renderer.h).
 
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -51,6 +52,10 @@ struct RenderedFrame {
   ImageI32 semantic_class;  ///< (H x W x 1) Geom::semantic_class of the hit geom, 0 = background
   double ev100 = 0;         ///< exposure value used for rgb
   int64_t rays = 0;  ///< rays traced for this frame (primary + shadow + secondary), for benchmarks
+  /// the stop request (Renderer::set_stop_request) ended this render before its radiance was
+  /// complete: rgb and radiance are unfinished and must not be used (the ground-truth images
+  /// are complete).
+  bool stopped = false;
 };
 
 /// renders frames of one scene. not thread-safe: one Render at a time (each call is
@@ -69,6 +74,15 @@ class Renderer {
   void Render(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out) {
     Render(snapshot, nullptr, view, out);
   }
+
+  /// a stop request (e.g. set by a SIGINT handler; null = none, the default). the pathtraced
+  /// tier reads it before every sample of every pixel: once it reads non-zero a render ends
+  /// within one sample per render thread, with RenderedFrame::stopped set. reading it changes
+  /// nothing in the images of a render it does not stop. `stop` must outlive the renderer.
+  void set_stop_request(const std::atomic<int>* stop) { stop_request_ = stop; }
+
+ protected:
+  const std::atomic<int>* stop_request_ = nullptr;
 };
 
 }  // namespace penumbra

@@ -135,6 +135,8 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   session_options.check_run_budget = true;
   session_options.reserve_live_npcs = ParseRecordedRunFlags(header.command_line).live;
   Session session(world, session_options);
+  // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples
+  if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);
   Simulation& sim = session.sim();
 
   // the live changes of the run (session/live_effects.h), applied at their steps as the run
@@ -201,7 +203,10 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     summary.out_dir = out.string();
     summary.last_step = f.step;
     summary.sim_time_sec = f.time_sec;
-    summary.interrupted = f.reason == LoopEndReason::kStopRequested;
+    // a stop that came after the last step still ended the pathtraced frames being rendered
+    // (not written): the run is interrupted too
+    summary.interrupted = f.reason == LoopEndReason::kStopRequested ||
+                          (options.stop_request && options.stop_request->load() != 0);
     summary.frames_per_camera = outputs.cameras().FramesWritten();
     summary.wall_time_sec = SecondsSince(t_start);
     summary.warnings = warnings;

@@ -47,7 +47,8 @@ struct ReplayOptions {
   bool progress = true;                   ///< progress bar / log lines
   std::vector<std::string> command_line;  ///< argv, for run.json
   /// a stop request (SIGINT): the replay stops at the next step, writes what it rendered and
-  /// run.json ("interrupted": true).
+  /// run.json ("interrupted": true); a pathtraced frame stops between samples and is not
+  /// written (also when the request comes after the last step).
   const std::atomic<int>* stop_request = nullptr;
 };
 

@@ -1,19 +1,28 @@
 #include "penumbra/ros/rosbag_export.h"
 
+#include <fcntl.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <stdio.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <random>
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image.h"
+#include "penumbra/dataset/export_stop.h"
+#include "penumbra/dataset/image_convert.h"
+#include "penumbra/dataset/run_file.h"
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/output/pcd_writer.h"
-#include "penumbra/output/png_io.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/ros/ros_convert.h"
 #include "penumbra/ros/ros_graph.h"
@@ -58,10 +67,11 @@ std::vector<std::string> SplitComma(const std::string& line) {
   return out;
 }
 
-CsvRows ReadCsvRows(const fs::path& path, const std::string& first_columns) {
-  std::ifstream in(path);
-  if (!in)
-    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+// `relative` under the run folder `run_dir` (read as dataset/run_file.h says)
+CsvRows ReadCsvRows(const fs::path& run_dir, const fs::path& relative,
+                    const std::string& first_columns) {
+  const fs::path path = run_dir / relative;
+  std::istringstream in(ReadRunFile(run_dir, relative));
   CsvRows csv;
   csv.path = path;
   std::string line;
@@ -78,12 +88,11 @@ CsvRows ReadCsvRows(const fs::path& path, const std::string& first_columns) {
   return csv;
 }
 
-nlohmann::json ReadJsonFile(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw ConfigError(path.string(), 0, "", "cannot open the file; expected it in a run folder");
+nlohmann::json ReadJsonFile(const fs::path& run_dir, const fs::path& relative) {
+  const fs::path path = run_dir / relative;
+  const std::string text = ReadRunFile(run_dir, relative);
   try {
-    return nlohmann::json::parse(in);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw ConfigError(path.string(), 0, "", std::string("not valid JSON: ") + e.what());
   }
@@ -92,7 +101,7 @@ nlohmann::json ReadJsonFile(const fs::path& path) {
 // the run's world (names and `ros:` overrides): run.json "world_file"
 WorldConfig RunWorld(const fs::path& run_dir, std::string* world_file) {
   const fs::path manifest = run_dir / "run.json";
-  const nlohmann::json j = ReadJsonFile(manifest);
+  const nlohmann::json j = ReadJsonFile(run_dir, "run.json");
   if (!j.contains("world_file") || !j["world_file"].is_string())
     throw ConfigError(manifest.string(), 0, "world_file",
                       "missing; expected the world file of the run");
@@ -107,9 +116,51 @@ WorldConfig RunWorld(const fs::path& run_dir, std::string* world_file) {
   return LoadWorldFile(*world_file);
 }
 
+// a new empty file beside `bag` for the bag to be written under: "<bag>.export-tmp-<random>",
+// created with O_EXCL | O_NOFOLLOW (never an existing file or a link)
+fs::path MakeTempBag(const fs::path& bag) {
+  std::random_device seed;
+  std::mt19937_64 rng((static_cast<uint64_t>(seed()) << 32) ^ seed());
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path p =
+        fs::path(bag.string() + fmt::format(".export-tmp-{:012x}", rng() & 0xffffffffffffULL));
+    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      ::close(fd);
+      return p;
+    }
+    if (errno != EEXIST)
+      throw Error("cannot create the bag " + bag.string() + ": " + std::strerror(errno));
+  }
+  throw Error("cannot create a temporary file beside " + bag.string());
+}
+
+// gives the complete bag `from` its name `to`, never replacing a file there
+void RenameNoReplace(const fs::path& from, const fs::path& to) {
+  auto exists = [&] {
+    return ConfigError("", 0, "--out",
+                       "'" + to.string() +
+                           "' was created during the export; expected a new file (never "
+                           "overwritten)");
+  };
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return;
+  if (errno == EEXIST) throw exists();
+  if (errno != EINVAL && errno != ENOSYS)
+    throw Error("cannot rename " + from.string() + " to " + to.string() + ": " +
+                std::strerror(errno));
+  // a file system without RENAME_NOREPLACE: a hard link fails on an existing name too
+  if (::link(from.c_str(), to.c_str()) != 0) {
+    if (errno == EEXIST) throw exists();
+    throw Error("cannot link " + from.string() + " to " + to.string() + ": " +
+                std::strerror(errno));
+  }
+  ::unlink(from.c_str());
+}
+
 }  // namespace
 
-RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_path) {
+RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_path,
+                                 const std::atomic<int>* stop_request) {
   if (bag_path.extension() != ".bag")
     throw ConfigError("", 0, "--out",
                       "'" + bag_path.string() + "'; expected a bag file name ending in .bag");
@@ -124,7 +175,7 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
 
   // the composed model poses the robots from trajectory.csv
   const fs::path composed = run_dir / "composed.xml";
-  if (!fs::is_regular_file(composed, ec))
+  if (StatRunEntry(run_dir, "composed.xml") != RunEntry::kFile)
     throw ConfigError(composed.string(), 0, "", "missing; expected the run's composed model");
   Simulation sim = Simulation::LoadFromFile(composed.string());
   const ModelInfo& model = sim.model_info();
@@ -176,7 +227,9 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
   const RosGraph graph =
       BuildRosGraph(world, LoadRosConfig(world), model, mounts, sim.MocapBodyNames());
 
+  CheckExportStop(stop_request);
   fs::create_directories(fs::absolute(bag_path).parent_path(), ec);
+  const fs::path temp_bag = MakeTempBag(bag_path);
   bool done = false;
   struct RemoveUnlessDone {
     const fs::path& path;
@@ -186,8 +239,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
       std::error_code e;
       fs::remove(path, e);
     }
-  } cleanup{bag_path, done};
-  RosbagWriter bag(bag_path.string());
+  } cleanup{temp_bag, done};
+  RosbagWriter bag(temp_bag.string(), bag_path.string());
   auto count = [&](const std::string& topic) { ++summary.counts[topic]; };
 
   // cameras
@@ -195,14 +248,13 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     const RunCamera& cam = cameras[ci];
     const RosSensorGraph& s = *graph.FindSensor(cam.name);
     for (const RunFrame& f : cam.frames) {
+      CheckExportStop(stop_request);
       const RosHeader header = MakeRosHeader(f.time_sec, s.frame_id);
       const int64_t t = header.stamp_ns;
       const RosCameraInfo info = CameraInfoToRos(s.mount.intrinsics, 0, header);
       if (cam.has_rgb) {
-        const PngImage png = ReadPng(cam.ImagePath("rgb", f.index).string());
-        if (png.channels != 3 || png.bit_depth != 8)
-          throw ConfigError(cam.ImagePath("rgb", f.index).string(), 0, "",
-                            "expected an 8-bit RGB PNG");
+        // decoded and checked against camera_info.json (dataset/image_convert.h)
+        const RunImage png = ReadRunImage(cam, "rgb", f.index);
         ImageU8 rgb(png.width, png.height, 3);
         for (size_t i = 0; i < png.samples.size(); ++i)
           rgb.data[i] = static_cast<uint8_t>(png.samples[i]);
@@ -212,10 +264,7 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
         count(s.info_topic);
       }
       if (cam.has_depth) {
-        const PngImage png = ReadPng(cam.ImagePath("depth", f.index).string());
-        if (png.channels != 1 || png.bit_depth != 16)
-          throw ConfigError(cam.ImagePath("depth", f.index).string(), 0, "",
-                            "expected a 16-bit greyscale PNG");
+        const RunImage png = ReadRunImage(cam, "depth", f.index);
         bag.Write(s.depth_image_topic, t, DepthMmToRos(png.width, png.height, png.samples, header));
         bag.Write(s.depth_info_topic, t, info);
         count(s.depth_image_topic);
@@ -230,20 +279,34 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     if (!s) continue;
     const int64_t latency_ns = RosStampNs(sc.latency_sec);
     if (sc.type == "lidar") {
-      const fs::path dir = run_dir / "lidar" / sc.name;
-      if (!fs::is_directory(dir, ec)) continue;
+      const fs::path rel = fs::path("lidar") / sc.name;
+      if (StatRunEntry(run_dir, rel) != RunEntry::kFolder) continue;
+      const fs::path dir = run_dir / rel;
       const CsvRows index =
-          ReadCsvRows(dir / "index.csv", "scan,capture_time_sec,delivery_time_sec,file");
+          ReadCsvRows(run_dir, rel / "index.csv", "scan,capture_time_sec,delivery_time_sec,file");
       for (size_t r = 0; r < index.rows.size(); ++r) {
+        CheckExportStop(stop_request);
         const double capture = index.Number(r, 1), delivery = index.Number(r, 2);
-        const std::vector<LidarPoint> points = ReadPcd((dir / index.rows[r].at(3)).string());
+        if (index.rows[r].size() < 4)
+          throw ConfigError(index.path.string(), index.lines[r], "file",
+                            "missing; expected the scan's PCD file name");
+        // a scan file named in index.csv: a file of this LiDAR's folder, reached by no link
+        const fs::path scan(index.rows[r][3]);
+        if (!IsPlainRelativePath(scan) || std::distance(scan.begin(), scan.end()) != 1 ||
+            StatRunEntry(run_dir, rel / scan) != RunEntry::kFile)
+          throw ConfigError(index.path.string(), index.lines[r], "file",
+                            "'" + scan.string() +
+                                "' is not a regular file in the LiDAR's folder; expected the "
+                                "name of a scan written by `penumbra run`");
+        const std::vector<LidarPoint> points = ReadPcd((dir / scan).string());
         bag.Write(s->points_topic, RosStampNs(delivery),
                   PointsToRos(points, MakeRosHeader(capture, s->frame_id)));
         count(s->points_topic);
       }
     } else if (sc.type == "imu") {
-      if (!fs::is_regular_file(run_dir / "imu" / (sc.name + ".csv"), ec)) continue;
+      if (StatRunEntry(run_dir, fs::path("imu") / (sc.name + ".csv")) != RunEntry::kFile) continue;
       const RunImu imu = run.ReadImu(sc.name);
+      CheckExportStop(stop_request);
       for (const RunImuSample& x : imu.samples) {
         const RosHeader header = MakeRosHeader(x.time_sec, s->frame_id);
         bag.Write(s->imu_topic, header.stamp_ns + latency_ns,
@@ -256,8 +319,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
 
   // robots: trajectory.csv rows posed through the composed model at the state rate
   const fs::path trajectory = run_dir / "trajectory.csv";
-  if (fs::is_regular_file(trajectory, ec)) {
-    const CsvRows traj = ReadCsvRows(trajectory, "step,time_sec");
+  if (StatRunEntry(run_dir, "trajectory.csv") == RunEntry::kFile) {
+    const CsvRows traj = ReadCsvRows(run_dir, "trajectory.csv", "step,time_sec");
     const size_t nq = static_cast<size_t>(model.nq);
     SimState state = sim.GetState();
     const double dt = sim.timestep();
@@ -278,6 +341,7 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     size_t previous_row = 0;
     int64_t k = 0;
     for (size_t row = 0; row < traj.rows.size(); ++row) {
+      CheckExportStop(stop_request);
       const double time = traj.Number(row, 1);
       if (time < static_cast<double>(k) / graph.state_rate_hz) continue;
       while (static_cast<double>(k) / graph.state_rate_hz <= time) ++k;
@@ -324,7 +388,9 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
       previous_row = row;
     }
   }
+  CheckExportStop(stop_request);
   bag.Close();
+  RenameNoReplace(temp_bag, bag_path);
   done = true;
   for (const auto& [topic, n] : summary.counts) summary.messages += n;
   return summary;

@@ -19,7 +19,15 @@
 // recorded at t (or its delivery time); rosbag's smallest record time is 1 ns, so records at
 // t = 0 are stored at 1 ns (their header stamps stay 0). no /clock is written: `rosbag play
 // --clock` publishes one.
+//
+// the run folder's files are read as dataset/run_file.h says (no symbolic link below the run
+// folder is followed; images are decoded and checked against camera_info.json,
+// dataset/image_convert.h). the bag is written under a temporary name beside it,
+// "<bag>.export-tmp-<random>", and renamed to its name (never replacing a file) only when it is
+// complete; an export that fails (a full disk: exit 1 with the system's reason) or is stopped
+// removes it.
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -35,11 +43,15 @@ struct RosbagExportSummary {
 };
 
 /// writes the bag `bag_path` (must not exist; its folder is created) from the run folder
-/// `run_dir`. if the export fails the partial bag is removed.
-/// @throws ConfigError for a missing or malformed run folder file (naming file and line), an
-///         unreadable world file, a bag path that exists or does not end in ".bag" (key "--out");
-///         Error if ROS 1 is not in this build or the bag cannot be written.
+/// `run_dir`. if the export fails or is stopped nothing is left at or beside bag_path.
+/// @throws ConfigError for a missing or malformed run folder file (naming file and line), a
+///         symbolic link or a bad image in it, an unreadable world file, a bag path that exists
+///         or does not end in ".bag" (key "--out"); Error if ROS 1 is not in this build or the
+///         bag cannot be written (the system's reason, e.g. "No space left on device");
+///         ExportStopped (dataset/export_stop.h) when `stop_request` (may be null) reads
+///         non-zero, checked between messages.
 RosbagExportSummary ExportRosbag(const std::filesystem::path& run_dir,
-                                 const std::filesystem::path& bag_path);
+                                 const std::filesystem::path& bag_path,
+                                 const std::atomic<int>* stop_request = nullptr);
 
 }  // namespace penumbra

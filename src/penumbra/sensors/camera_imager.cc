@@ -146,6 +146,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     }
     RenderedFrame* target = k == truth_k ? &out->truth : &sub;
     renderer->Render(*snap, effects, view, target);
+    out->stopped = target->stopped;
+    if (out->stopped) return;  // unfinished: the auto-exposure state is left as it was
     if (want_rgb) {
       const std::vector<float>& r = target->radiance.data;
       for (size_t i = 0; i < r.size(); ++i) accum_.data[i] += r[i];

@@ -48,6 +48,9 @@ struct CameraImages {
   double time_sec = 0;  ///< capture time t0 (exposure starts)
   double mid_exposure_time_sec = 0;  ///< time of the ground-truth images, t0 + s_{n/2}
   Pose X_WO = Pose::Identity();      ///< optical frame at mid_exposure_time_sec (row 0)
+  /// the renderer's stop request ended a render of this frame (RenderedFrame::stopped): the
+  /// images are unfinished and must not be used.
+  bool stopped = false;
 };
 
 /// checks the ranges of `c` (see CameraSensorConfig).
@@ -71,7 +74,8 @@ class CameraImager {
   /// renders and forms frame `frame_index` captured at `start`. `effects` are what this camera
   /// sees at `start` (scene/effects_frame.h; null = clear conditions), used for every
   /// sub-frame. `X_WO_start` / `X_WO_end` are the optical frame at `start` and at `end`;
-  /// `end` = null (or not later than start) means nothing moves during the exposure.
+  /// `end` = null (or not later than start) means nothing moves during the exposure. when a
+  /// render is stopped (RenderedFrame::stopped) Capture returns at once with out->stopped set.
   /// @throws Error from the renderer.
   void Capture(Renderer* renderer, const WorldSnapshot& start, const EffectsFrame* effects,
                const Pose& X_WO_start, const WorldSnapshot* end, const Pose& X_WO_end,

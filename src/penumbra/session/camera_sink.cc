@@ -184,6 +184,14 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
   render_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (img.stopped) {
+    // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
+    spdlog::info(
+        "camera '{}': frame {} at {:.6g} s was being rendered when the run was stopped; "
+        "not written",
+        spec.name, p.frame, p.start->time_sec);
+    return;
+  }
   CameraFrame cf;
   cf.camera = spec.name;
   cf.index = p.frame;

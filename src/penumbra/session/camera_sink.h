@@ -18,6 +18,10 @@
 // images are exact. frames.csv time/pose: the capture instant, or mid-exposure (sub-frame n/2)
 // when the frame uses motion blur or a rolling shutter.
 //
+// stopping: when the renderer's stop request (Renderer::set_stop_request) ends a render (the
+// pathtraced tier stops between samples), that frame and any rendered after it are dropped:
+// no image, no frames.csv row.
+//
 // timing: camera c fires its frame k at the first physics step whose time is >= k / rate_hz, on
 // the step count, so frames never drift however the rate and timestep relate; a camera faster
 // than physics renders once per step. the effects a camera sees (scene/effects_frame.h) are

@@ -131,6 +131,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   ctx.settings = &settings_;
   ctx.camera_index = view.camera_index;
   ctx.frame_index = view.frame_index;
+  std::atomic<bool> stopped{false};
+  ctx.stop_request = stop_request_;
+  ctx.stopped = &stopped;
+  out->stopped = false;
 
   const int tiles_x = (W + kTileSize - 1) / kTileSize;
   const int tiles_y = (H + kTileSize - 1) / kTileSize;
@@ -202,6 +206,9 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     }
   });
   out->rays = static_cast<int64_t>(W) * H + secondary_rays.load();
+  // a stopped render's radiance is unfinished: not denoised, not developed
+  out->stopped = stopped.load();
+  if (out->stopped) return;
 
   if (want.rgb) {
     if (denoise) {

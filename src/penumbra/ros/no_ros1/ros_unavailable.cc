@@ -19,7 +19,9 @@ namespace {
 bool RosAvailable() { return false; }
 
 struct RosbagWriter::Impl {};
-RosbagWriter::RosbagWriter(const std::string& path) { NoRos("writing the bag " + path); }
+RosbagWriter::RosbagWriter(const std::string& path, const std::string& shown_path) {
+  NoRos("writing the bag " + (shown_path.empty() ? path : shown_path));
+}
 RosbagWriter::~RosbagWriter() = default;
 void RosbagWriter::Write(const std::string&, int64_t, const RosImage&) {}
 void RosbagWriter::Write(const std::string&, int64_t, const RosCameraInfo&) {}
