@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
 
 namespace penumbra {
@@ -146,6 +147,7 @@ std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r) {
     e.ExpectMap({"name", "id", "bodies", "geoms", "materials"});
     SemanticClassConfig c;
     c.name = e.Child("name").String();
+    if (auto problem = NameLengthProblem(c.name)) e.Child("name").Fail(*problem);
     const YamlReader id = e.Child("id");
     c.id = id.Int();
     if (c.id < 1 || c.id > 65535)

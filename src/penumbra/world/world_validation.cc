@@ -9,6 +9,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/mesh_import_config.h"
 
@@ -46,7 +47,7 @@ const Range kUnit = Range::Closed(0, 1);
 const Range kImageSize = Range::Closed(1, 16384);
 const Range kRate = Range::OpenClosed(0, 10000);
 const Range kNearClip = Range::Closed(0, 10);
-const Range kFovy = Range::Open(0, kMaxFovyDeg);
+const Range kFovy = {kMinFovyDeg, kMaxFovyDeg, false, true};  // [0.1, 179)
 // positions given in the world file (scene/scene_limits.h: Embree's float precision)
 const Range kPosition = Range::Closed(-kMaxPositionM, kMaxPositionM);
 
@@ -130,8 +131,9 @@ class Validator {
   // world-level names: models, lights, cameras.
   void CheckName(const std::string& path, const std::string& name) const {
     if (name.empty()) Fail(path, "required; expected a name of letters, digits, '_' or '-'");
+    if (auto problem = NameLengthProblem(name)) Fail(path, *problem);
     if (!IsValidWorldName(name)) {
-      Fail(path, "'" + name + "' has characters other than letters, digits, '_' or '-'");
+      Fail(path, "'" + Excerpt(name) + "' has characters other than letters, digits, '_' or '-'");
     }
   }
 
@@ -319,7 +321,17 @@ class Validator {
     if (c.fovy_deg && c.intrinsics) {
       Fail(path + ".intrinsics", "fovy_deg and intrinsics both given; expected one of them");
     }
-    if (c.fovy_deg) Check(path + ".fovy_deg", *c.fovy_deg, kFovy);
+    if (c.fovy_deg) {
+      Check(path + ".fovy_deg", *c.fovy_deg, kFovy);
+      // square pixels: a very wide or very tall image stretches the other axis
+      const CameraIntrinsics k = CameraIntrinsics::FromFovy(c.width, c.height, *c.fovy_deg);
+      if (auto problem = FindIntrinsicsProblem(k))
+        Fail(path + ".fovy_deg", "fovy_deg " + FormatNumber(*c.fovy_deg) + " at " +
+                                     std::to_string(c.width) + " x " + std::to_string(c.height) +
+                                     " px: " + *problem +
+                                     " (square pixels; expected another fovy_deg or image size, or "
+                                     "intrinsics)");
+    }
     if (c.intrinsics) {
       const CameraIntrinsics& k = *c.intrinsics;
       Check(path + ".intrinsics.fx", k.fx, Range::Above(0));
