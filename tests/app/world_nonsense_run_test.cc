@@ -13,6 +13,7 @@
 
 #include "app/child_process.h"
 #include "common/temp_dir.h"
+#include "penumbra/session/run_budget.h"
 
 namespace penumbra {
 namespace {
@@ -158,6 +159,33 @@ TEST_F(WorldNonsenseRunTest, ALitWorldDoesNotWarn) {
                             "illuminance_lux: 20000}]\n"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("is black"), std::string::npos) << r.err;
+}
+
+TEST(RunBudgetPathSamples, HugeSampleCountsOfThePathtracedTierAreWarned) {
+  // the case: --spp 65536 at 64 x 48, about 20 minutes a frame; 1 s at 10 Hz
+  WorldConfig world;
+  world.duration_sec = 1;
+  world.render.tier = RenderSettings::Tier::kPathtraced;
+  world.render.samples_per_pixel = 65536;
+  SceneDescription scene;
+  CameraSpec cam;
+  cam.name = "c";
+  cam.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
+  scene.cameras = {cam};
+  RunWork w = EstimateRunWork(world, scene, 0.01);
+  EXPECT_DOUBLE_EQ(w.path_samples, 11 * 64.0 * 48 * 65536);
+  const auto text = DescribeRunWork(w);
+  ASSERT_TRUE(text);
+  EXPECT_NE(text->find("2.21e+09 path samples (pathtraced: pixels x samples_per_pixel x frames)"),
+            std::string::npos)
+      << *text;
+  EXPECT_NE(text->find("render.samples_per_pixel (--spp)"), std::string::npos) << *text;
+  // the default 16 spp is far below; the realtime tier traces no path samples
+  world.render.samples_per_pixel = 16;
+  EXPECT_FALSE(DescribeRunWork(EstimateRunWork(world, scene, 0.01)));
+  world.render.samples_per_pixel = 65536;
+  world.render.tier = RenderSettings::Tier::kRealtime;
+  EXPECT_EQ(EstimateRunWork(world, scene, 0.01).path_samples, 0);
 }
 
 }  // namespace

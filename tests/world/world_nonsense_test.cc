@@ -155,6 +155,25 @@ TEST_F(WorldNonsenseTest, SensorNamesCannotBeDotsOrControlCharacters) {
                 "sensors[0].name", "control characters");
 }
 
+TEST_F(WorldNonsenseTest, LightLevelsStayWithinFloats) {
+  // 1e308 became infinity in the renderer's 32-bit floats
+  ExpectRefused("lights:\n  - {name: s, type: sun, direction: [0, 0, -1], illuminance_lux: 1e308}\n",
+                2, "lights[0].illuminance_lux", "got 1e+308; expected (0, 1e+06]");
+  ExpectRefused("lights:\n  - {name: l, type: point, intensity_cd: 1e308}\n", 2,
+                "lights[0].intensity_cd", "expected (0, 1e+09]");
+  ExpectRefused("lights:\n  - {name: l, type: point, power_w: 1e308}\n", 2, "lights[0].power_w",
+                "expected (0, 1e+07]");
+  ExpectRefused("lights:\n  - {name: l, type: point, intensity_cd: 10, radius_m: 1e308}\n", 2,
+                "lights[0].radius_m", "expected [0, 1e+05]");
+  ExpectRefused("sky: {zenith_luminance_cd_m2: 1e308}\n", 1, "sky.zenith_luminance_cd_m2",
+                "expected [0, 1e+10]");
+  ExpectRefused("sky: {luminance_cd_m2: 1e20}\n", 1, "sky.luminance_cd_m2", "expected [0, 1e+10]");
+  EXPECT_NO_THROW(ParseWorld(
+      "lights:\n  - {name: s, type: sun, direction: [0, 0, -1], illuminance_lux: 120000}\n"
+      "  - {name: l, type: spot, direction: [0, 0, -1], intensity_cd: 1e7}\n",
+      world_));
+}
+
 TEST(NameLimits, ExcerptCutsAtACharacterBoundaryAndEscapes) {
   EXPECT_EQ(Excerpt("short"), "short");
   EXPECT_EQ(Excerpt(std::string(40, 'z'), 8), "zzzzzzzz...");

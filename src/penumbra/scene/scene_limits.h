@@ -38,6 +38,16 @@ inline constexpr double kMaxFovyDeg = 179;
 /// cx in [-10 width, 11 width], cy in [-10 height, 11 height] (px). an off-centre crop keeps its
 /// principal point near the image; cx = 1e6 for 640 px is a typo.
 inline constexpr double kMaxPrincipalPointOffset = 10.0;
+/// largest light levels a world file may give (the renderer works in 32-bit floats, so 1e308
+/// became infinity): sun / directional illuminance (lx; direct sunlight is ~1.2e5), point and
+/// spot luminous intensity (cd; a lighthouse is ~1e7), their power (W), and luminance (cd/m^2)
+/// of the sky and of emissive materials (the sun's disk is ~1.6e9).
+inline constexpr double kMaxIlluminanceLux = 1e6;
+inline constexpr double kMaxIntensityCd = 1e9;
+inline constexpr double kMaxLightPowerW = 1e7;
+inline constexpr double kMaxLuminanceCdM2 = 1e10;
+/// largest emitter radius of a point or spot light (m), as geom sizes.
+inline constexpr double kMaxLightRadiusM = 1e5;
 /// physics timestep range (s), for physics.timestep_sec and the MJCF <option timestep>.
 /// the lower end keeps 1 s of simulated time at <= 1e6 steps.
 inline constexpr double kMinTimestepSec = 1e-6;

@@ -23,6 +23,9 @@ std::string Prefixed(const std::string& robot, const std::string& name) {
   return robot + "/" + name;
 }
 
+// largest noise parameter of a sensor (standard deviations, densities, random walks).
+constexpr double kMaxSensorNoise = 1e3;
+
 double NonNegative(const YamlReader& r, const std::string& unit) {
   const double v = r.Double();
   if (v < 0) r.Fail("got " + FormatNumber(v) + "; expected a number >= 0 (" + unit + ")");
@@ -144,7 +147,10 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
       if (!n.Has(k)) continue;
       const YamlReader c = n.Child(k);
       const double v = c.Double();
-      if (!(v >= 0)) c.Fail(sensor + "got " + FormatNumber(v) + "; expected a noise value >= 0");
+      // 1e308 made every reading infinite
+      if (!(v >= 0 && v <= kMaxSensorNoise))
+        c.Fail(sensor + "got " + FormatNumber(v) + "; expected a noise value >= 0 and <= " +
+               FormatNumber(kMaxSensorNoise));
       if (k == "dropout_probability" && v > 1)
         c.Fail(sensor + "got " + FormatNumber(v) + "; expected a probability in [0, 1]");
       s.params["noise." + std::string(k)] = v;

@@ -113,6 +113,7 @@ class WorldParser {
       rec.ExpectMap({"file", "sensors"});
       if (!rec.Has("file")) rec.Fail("no 'file'; expected record: {file: NAME.plog}");
       w.record.file = rec.Child("file").String();
+      w.record.given = true;
       if (rec.Has("sensors")) w.record.sensors = rec.Child("sensors").Bool();
     }
     if (r.Has("semantic_classes"))

@@ -101,6 +101,8 @@ class Validator {
   // `record:` (a run log): a .plog file name, or nothing recorded
   void CheckRecord() const {
     const std::string& f = w_.record.file;
+    if (f.empty() && w_.record.given)
+      Fail("record.file", "empty; expected a file name ending in .plog");
     if (f.empty()) {
       if (w_.record.sensors)
         Fail("record.sensors", "true without record.file; expected record: {file: NAME.plog}");
@@ -175,7 +177,8 @@ class Validator {
 
   void CheckPose(const std::string& path, const PoseConfig& p) const {
     Check3(path + ".xyz", p.xyz, kPosition);
-    Check3(path + ".rpy_deg", p.rpy_deg, Range::Finite());
+    // every rotation is within one turn; 1e308 deg has no digits left for the angle
+    Check3(path + ".rpy_deg", p.rpy_deg, Range::Closed(-360, 360));
   }
 
   void CheckOutputs(const std::string& path, const CameraOutputs& o) const {
@@ -204,11 +207,12 @@ class Validator {
   void CheckSky() const {
     const SkyConfig& s = w_.sky;
     Check3("sky.color", s.color, kUnit);
-    Check("sky.luminance_cd_m2", s.luminance_cd_m2, Range::AtLeast(0));
+    Check("sky.luminance_cd_m2", s.luminance_cd_m2, Range::Closed(0, kMaxLuminanceCdM2));
     Check("sky.turbidity", s.turbidity, Range::Closed(1.7, 10));
     Check("sky.sun_elevation_deg", s.sun_elevation_deg, Range::Closed(-90, 90));
     Check("sky.sun_azimuth_deg", s.sun_azimuth_deg, Range::Closed(-360, 360));
-    Check("sky.zenith_luminance_cd_m2", s.zenith_luminance_cd_m2, Range::AtLeast(0));
+    Check("sky.zenith_luminance_cd_m2", s.zenith_luminance_cd_m2,
+          Range::Closed(0, kMaxLuminanceCdM2));
   }
 
   // key path of w_.models[i]: robots come first, then static models.
@@ -277,7 +281,8 @@ class Validator {
         Fail(path + ".illuminance_lux",
              "required for sun and directional lights; expected lux > 0");
       }
-      Check(path + ".illuminance_lux", *l.illuminance_lux, Range::Above(0));
+      Check(path + ".illuminance_lux", *l.illuminance_lux,
+            Range::OpenClosed(0, kMaxIlluminanceLux));
       if (l.intensity_cd || l.power_w) {
         Fail(path + (l.intensity_cd ? ".intensity_cd" : ".power_w"),
              "does not apply to sun and directional lights; expected illuminance_lux");
@@ -294,9 +299,10 @@ class Validator {
                                         : "neither intensity_cd nor power_w given") +
                  "; expected exactly one of them for point and spot lights");
       }
-      if (l.intensity_cd) Check(path + ".intensity_cd", *l.intensity_cd, Range::Above(0));
-      if (l.power_w) Check(path + ".power_w", *l.power_w, Range::Above(0));
-      Check(path + ".radius_m", l.radius_m, Range::AtLeast(0));
+      if (l.intensity_cd)
+        Check(path + ".intensity_cd", *l.intensity_cd, Range::OpenClosed(0, kMaxIntensityCd));
+      if (l.power_w) Check(path + ".power_w", *l.power_w, Range::OpenClosed(0, kMaxLightPowerW));
+      Check(path + ".radius_m", l.radius_m, Range::Closed(0, kMaxLightRadiusM));
       Check3(path + ".position", l.position, kPosition);
     }
     if (l.type == Light::Type::kSpot) {
@@ -398,7 +404,7 @@ class Validator {
       if (m.roughness) Check(path + ".roughness", *m.roughness, kUnit);
       if (m.metallic) Check(path + ".metallic", *m.metallic, kUnit);
       if (m.specular) Check(path + ".specular", *m.specular, kUnit);
-      if (m.emission) Check3(path + ".emission", *m.emission, Range::AtLeast(0));
+      if (m.emission) Check3(path + ".emission", *m.emission, Range::Closed(0, kMaxLuminanceCdM2));
     }
   }
 
