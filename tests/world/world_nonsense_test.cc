@@ -174,6 +174,39 @@ TEST_F(WorldNonsenseTest, LightLevelsStayWithinFloats) {
       world_));
 }
 
+TEST_F(WorldNonsenseTest, CameraSensorValuesAndRotationsAreBounded) {
+  const std::string cam = "cameras:\n  - name: c\n";
+  // an exposure of 1e308 s waited for an end snapshot that never came
+  ExpectRefused(cam + "    exposure_time_sec: 1e308\n", 3, "cameras[0].exposure_time_sec",
+                "camera 'c': got 1e+308; expected [0, 60] (seconds)");
+  ExpectRefused(cam + "    rolling_shutter_line_time_sec: 5\n", 3,
+                "cameras[0].rolling_shutter_line_time_sec", "expected [0, 0.01] (seconds per row)");
+  ExpectRefused(cam + "    noise: {iso: 1e308}\n", 3, "cameras[0].noise.iso",
+                "expected (0, 1e+07] (ISO)");
+  ExpectRefused(cam + "    noise: {full_well_e: 1e-300}\n", 3, "cameras[0].noise.full_well_e",
+                "expected [1, 1e+09] (electrons)");
+  // a baseline of 1e308 m put the right camera's rays at infinity
+  ExpectRefused(cam + "    stereo: {baseline_m: 1e308}\n", 3, "cameras[0].stereo.baseline_m",
+                "expected (0, 100] (m)");
+  ExpectRefused("cameras:\n  - {name: c, pose: {rpy_deg: [0, 0, 1e308]}}\n", 2,
+                "cameras[0].pose.rpy_deg", "component 2 is 1e+308; expected each of the 3 numbers "
+                                           "in [-360, 360]");
+  EXPECT_NO_THROW(ParseWorld(
+      "cameras:\n  - {name: c, pose: {rpy_deg: [-360, 0, 360]}, exposure_time_sec: 30, "
+      "noise: {iso: 3200}, stereo: {baseline_m: 0.12}}\n",
+      world_));
+}
+
+TEST_F(WorldNonsenseTest, SensorNoiseAndRecordFileAreChecked) {
+  ExpectRefused(
+      "sensors:\n  - name: i\n    type: imu\n    body: world\n"
+      "    noise: {accel_noise_density: 1e308}\n",
+      5, "sensors[0].noise.accel_noise_density", "expected a noise value >= 0 and <= 1000");
+  // `record: {file: ""}` silently recorded nothing
+  ExpectRefused("record: {file: \"\"}\n", 1, "record.file",
+                "empty; expected a file name ending in .plog");
+}
+
 TEST(NameLimits, ExcerptCutsAtACharacterBoundaryAndEscapes) {
   EXPECT_EQ(Excerpt("short"), "short");
   EXPECT_EQ(Excerpt(std::string(40, 'z'), 8), "zzzzzzzz...");
