@@ -113,7 +113,9 @@ class WorldParser {
       rec.ExpectMap({"file", "sensors"});
       if (!rec.Has("file")) rec.Fail("no 'file'; expected record: {file: NAME.plog}");
       w.record.file = rec.Child("file").String();
-      w.record.given = true;
+      // `record: {file: ""}` used to record nothing without a word
+      if (w.record.file.empty())
+        rec.Child("file").Fail("empty; expected a file name ending in .plog");
       if (rec.Has("sensors")) w.record.sensors = rec.Child("sensors").Bool();
     }
     if (r.Has("semantic_classes"))

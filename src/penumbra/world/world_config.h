@@ -167,8 +167,6 @@ struct RecordConfig {
   std::string file;
   /// also record each camera image, LiDAR scan and IMU / sensor row (--record-sensors).
   bool sensors = false;
-  /// true when the world file has a `record:` block (an empty `file` is then refused).
-  bool given = false;
 };
 
 class LineTable;

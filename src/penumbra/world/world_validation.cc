@@ -101,8 +101,6 @@ class Validator {
   // `record:` (a run log): a .plog file name, or nothing recorded
   void CheckRecord() const {
     const std::string& f = w_.record.file;
-    if (f.empty() && w_.record.given)
-      Fail("record.file", "empty; expected a file name ending in .plog");
     if (f.empty()) {
       if (w_.record.sensors)
         Fail("record.sensors", "true without record.file; expected record: {file: NAME.plog}");
