@@ -55,7 +55,9 @@ class WorldNonsenseRunTest : public ::testing::Test {
     return testing::RunPenumbra(args, dir_.path());
   }
 
-  std::string WorldPath() const { return (dir_.path() / ("w" + std::to_string(runs_) + ".yaml")).string(); }
+  std::string WorldPath() const {
+    return (dir_.path() / ("w" + std::to_string(runs_) + ".yaml")).string();
+  }
 
   testing::TempDir dir_;
   int runs_ = 0;
@@ -130,10 +132,11 @@ TEST_F(WorldNonsenseRunTest, AWorldWithoutLightWarnsOncePerCamera) {
 }
 
 TEST_F(WorldNonsenseRunTest, AnExposureFarTooDarkWarns) {
-  const testing::ProcessResult r = Run(NonsenseWorld(
-      "", "render: {exposure: {mode: manual, ev100: 30}}\n"
-          "lights: [{name: l, type: point, position: [0, 0, 2], intensity_cd: 50}]\n"
-          "sky: {type: uniform, luminance_cd_m2: 1}\n"));
+  const testing::ProcessResult r =
+      Run(NonsenseWorld("",
+                        "render: {exposure: {mode: manual, ev100: 30}}\n"
+                        "lights: [{name: l, type: point, position: [0, 0, 2], intensity_cd: 50}]\n"
+                        "sky: {type: uniform, luminance_cd_m2: 1}\n"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("camera 'c': frame 0 (t = 0 s) is black"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("manual exposure ev100 30"), std::string::npos) << r.err;
@@ -143,10 +146,11 @@ TEST_F(WorldNonsenseRunTest, AnExposureFarTooDarkWarns) {
 TEST_F(WorldNonsenseRunTest, ACameraThatNoLightReachesWarns) {
   // the world's only light is a narrow spot pointing at the empty sky (and the sky is black):
   // the world has light, but nothing the camera sees is lit
-  const testing::ProcessResult r = Run(NonsenseWorld(
-      "", "sky: {type: uniform, luminance_cd_m2: 0}\n"
-          "lights: [{name: up, type: spot, position: [0, 0, 2.5], direction: [0, 0, 1], "
-          "intensity_cd: 100, inner_angle_deg: 5, outer_angle_deg: 10}]\n"));
+  const testing::ProcessResult r = Run(
+      NonsenseWorld("",
+                    "sky: {type: uniform, luminance_cd_m2: 0}\n"
+                    "lights: [{name: up, type: spot, position: [0, 0, 2.5], direction: [0, 0, 1], "
+                    "intensity_cd: 100, inner_angle_deg: 5, outer_angle_deg: 10}]\n"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("camera 'c': frame 0 (t = 0 s) is black"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("no light reaches it: the camera may be inside a model's geometry"),
@@ -156,8 +160,9 @@ TEST_F(WorldNonsenseRunTest, ACameraThatNoLightReachesWarns) {
 
 TEST_F(WorldNonsenseRunTest, ALitWorldDoesNotWarn) {
   const testing::ProcessResult r =
-      Run(NonsenseWorld("", "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1], "
-                            "illuminance_lux: 20000}]\n"));
+      Run(NonsenseWorld("",
+                        "lights: [{name: sun, type: sun, direction: [0.3, 0.2, -1], "
+                        "illuminance_lux: 20000}]\n"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("is black"), std::string::npos) << r.err;
 }

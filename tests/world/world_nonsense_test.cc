@@ -87,8 +87,8 @@ TEST_F(WorldNonsenseTest, FieldOfViewHasALowerBound) {
                 "got 1e-300; expected [0.1, 179)");
   ExpectRefused("cameras:\n  - name: c\n    fovy_deg: 0.05\n", 3, "cameras[0].fovy_deg",
                 "expected [0.1, 179)");
-  EXPECT_NO_THROW(ParseWorld("cameras:\n  - {name: c, fovy_deg: 0.1, width: 64, height: 48}\n",
-                             world_));
+  EXPECT_NO_THROW(
+      ParseWorld("cameras:\n  - {name: c, fovy_deg: 0.1, width: 64, height: 48}\n", world_));
   EXPECT_NO_THROW(ParseWorld("cameras:\n  - {name: c, fovy_deg: 170}\n", world_));
   // square pixels: fovy 60 on a 16384 x 16 line stretches the horizontal view to 179.8 deg
   ExpectRefused("cameras:\n  - {name: c, fovy_deg: 60, width: 16384, height: 16}\n", 2,
@@ -114,18 +114,18 @@ TEST_F(WorldNonsenseTest, FocalLengthsAndPrincipalPointsAreBoundedByTheImage) {
       "    intrinsics: {fx: 30000, fy: 30000, cx: 1e6, cy: 24}\n",
       5, "cameras[0].intrinsics", "cx is 1e+06 for 64 px; expected [-640, 704]");
   // off-centre crops near the image stay fine, as does the narrowest accepted view
-  EXPECT_NO_THROW(ParseWorld(
-      "cameras:\n  - name: c\n    width: 64\n    height: 48\n"
-      "    intrinsics: {fx: 36000, fy: 27000, cx: -200, cy: 300}\n",
-      world_));
+  EXPECT_NO_THROW(
+      ParseWorld("cameras:\n  - name: c\n    width: 64\n    height: 48\n"
+                 "    intrinsics: {fx: 36000, fy: 27000, cx: -200, cy: 300}\n",
+                 world_));
 }
 
 TEST_F(WorldNonsenseTest, OverlongNamesAreRefusedWithTheLineAndABoundedEcho) {
   const std::string huge(100000, 'a');
-  std::string what = ExpectRefused("duration_sec: 1\ncameras:\n  - name: " + huge + "\n", 3,
-                                   "cameras[0].name",
-                                   "a name of 100000 characters ('aaaaaaaaaaaaaaaa...'); expected "
-                                   "at most 64 characters");
+  std::string what =
+      ExpectRefused("duration_sec: 1\ncameras:\n  - name: " + huge + "\n", 3, "cameras[0].name",
+                    "a name of 100000 characters ('aaaaaaaaaaaaaaaa...'); expected "
+                    "at most 64 characters");
   EXPECT_LT(what.size(), 400u) << what.substr(0, 1000);
   const std::string max(kMaxNameLength, 'c');
   EXPECT_NO_THROW(ParseWorld("cameras:\n  - name: " + max + "\n", world_));
@@ -151,14 +151,15 @@ TEST_F(WorldNonsenseTest, OverlongNamesAreRefusedWithTheLineAndABoundedEcho) {
 TEST_F(WorldNonsenseTest, SensorNamesCannotBeDotsOrControlCharacters) {
   ExpectRefused("sensors:\n  - {name: '..', type: imu, body: world}\n", 2, "sensors[0].name",
                 "not '.' or '..'");
-  ExpectRefused("sensors:\n  - {name: \"a\\x01b\", type: imu, body: world}\n", 2,
-                "sensors[0].name", "control characters");
+  ExpectRefused("sensors:\n  - {name: \"a\\x01b\", type: imu, body: world}\n", 2, "sensors[0].name",
+                "control characters");
 }
 
 TEST_F(WorldNonsenseTest, LightLevelsStayWithinFloats) {
   // 1e308 became infinity in the renderer's 32-bit floats
-  ExpectRefused("lights:\n  - {name: s, type: sun, direction: [0, 0, -1], illuminance_lux: 1e308}\n",
-                2, "lights[0].illuminance_lux", "got 1e+308; expected (0, 1e+06]");
+  ExpectRefused(
+      "lights:\n  - {name: s, type: sun, direction: [0, 0, -1], illuminance_lux: 1e308}\n", 2,
+      "lights[0].illuminance_lux", "got 1e+308; expected (0, 1e+06]");
   ExpectRefused("lights:\n  - {name: l, type: point, intensity_cd: 1e308}\n", 2,
                 "lights[0].intensity_cd", "expected (0, 1e+09]");
   ExpectRefused("lights:\n  - {name: l, type: point, power_w: 1e308}\n", 2, "lights[0].power_w",
@@ -189,12 +190,13 @@ TEST_F(WorldNonsenseTest, CameraSensorValuesAndRotationsAreBounded) {
   ExpectRefused(cam + "    stereo: {baseline_m: 1e308}\n", 3, "cameras[0].stereo.baseline_m",
                 "expected (0, 100] (m)");
   ExpectRefused("cameras:\n  - {name: c, pose: {rpy_deg: [0, 0, 1e308]}}\n", 2,
-                "cameras[0].pose.rpy_deg", "component 2 is 1e+308; expected each of the 3 numbers "
-                                           "in [-360, 360]");
-  EXPECT_NO_THROW(ParseWorld(
-      "cameras:\n  - {name: c, pose: {rpy_deg: [-360, 0, 360]}, exposure_time_sec: 30, "
-      "noise: {iso: 3200}, stereo: {baseline_m: 0.12}}\n",
-      world_));
+                "cameras[0].pose.rpy_deg",
+                "component 2 is 1e+308; expected each of the 3 numbers "
+                "in [-360, 360]");
+  EXPECT_NO_THROW(
+      ParseWorld("cameras:\n  - {name: c, pose: {rpy_deg: [-360, 0, 360]}, exposure_time_sec: 30, "
+                 "noise: {iso: 3200}, stereo: {baseline_m: 0.12}}\n",
+                 world_));
 }
 
 TEST_F(WorldNonsenseTest, SensorNoiseAndRecordFileAreChecked) {

@@ -210,11 +210,11 @@ void RefuseEmptyValues(const CLI::App& app) {
     for (const std::string& v : o->results()) {
       if (!v.empty()) continue;
       const std::string name = o->get_name();
-      throw ConfigError("", 0, name,
-                        "an empty value; expected a non-empty " +
-                            std::string(o->nonpositional() ? "value (leave " + name +
-                                                                 " out for its default)"
-                                                           : "argument"));
+      throw ConfigError(
+          "", 0, name,
+          "an empty value; expected a non-empty " +
+              std::string(o->nonpositional() ? "value (leave " + name + " out for its default)"
+                                             : "argument"));
     }
   }
   for (const CLI::App* sub : app.get_subcommands()) RefuseEmptyValues(*sub);

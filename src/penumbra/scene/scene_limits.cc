@@ -109,18 +109,17 @@ std::optional<std::string> FindIntrinsicsProblem(const CameraIntrinsics& k) {
     const double margin = kMaxPrincipalPointOffset * size;
     if (v >= -margin && v <= size + margin) return std::nullopt;
     return std::string(c) + " is " + Num(v) + " for " + std::to_string(size) + " px; expected [" +
-           Num(-margin) + ", " + Num(size + margin) +
-           "] (px: the principal point within " + Num(kMaxPrincipalPointOffset) +
-           " image sizes of the image)";
+           Num(-margin) + ", " + Num(size + margin) + "] (px: the principal point within " +
+           Num(kMaxPrincipalPointOffset) + " image sizes of the image)";
   };
   if (auto p = centre("cx", k.cx, k.width)) return p;
   if (auto p = centre("cy", k.cy, k.height)) return p;
   const double tan_min = std::tan(0.5 * kMinFovyDeg * M_PI / 180.0);
   const auto narrow = [&](const char* f, double fv, int size) {
-    return std::string("the ") + (f[1] == 'x' ? "horizontal" : "vertical") +
-           " field of view is " + Num(2 * std::atan(0.5 * size / fv) * 180.0 / M_PI) + " deg (" +
-           f + " " + Num(fv) + " for " + std::to_string(size) + " px); expected at least " +
-           Num(kMinFovyDeg) + " deg, i.e. " + f + " <= " + Num(0.5 * size / tan_min);
+    return std::string("the ") + (f[1] == 'x' ? "horizontal" : "vertical") + " field of view is " +
+           Num(2 * std::atan(0.5 * size / fv) * 180.0 / M_PI) + " deg (" + f + " " + Num(fv) +
+           " for " + std::to_string(size) + " px); expected at least " + Num(kMinFovyDeg) +
+           " deg, i.e. " + f + " <= " + Num(0.5 * size / tan_min);
   };
   if (k.fx > 0.5 * k.width / tan_min) return narrow("fx", k.fx, k.width);
   if (k.fy > 0.5 * k.height / tan_min) return narrow("fy", k.fy, k.height);

@@ -4,8 +4,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -23,8 +23,8 @@ namespace {
 constexpr uint8_t kBlackLevel = 2;
 
 bool IsBlack(const ImageU8& rgb) {
-  return !rgb.data.empty() && std::all_of(rgb.data.begin(), rgb.data.end(),
-                                          [](uint8_t v) { return v <= kBlackLevel; });
+  return !rgb.data.empty() &&
+         std::all_of(rgb.data.begin(), rgb.data.end(), [](uint8_t v) { return v <= kBlackLevel; });
 }
 
 // true when nothing in the scene gives light: no light with intensity and colour, a black sky,
@@ -35,8 +35,7 @@ bool SceneHasNoLight(const SceneDescription& scene) {
   for (const Material& m : scene.materials)
     if (m.emission.maxCoeff() > 0) return false;
   const Sky& s = scene.sky;
-  return s.type == Sky::Type::kUniform ? !(s.radiance.maxCoeff() > 0)
-                                       : !(s.zenith_luminance > 0);
+  return s.type == Sky::Type::kUniform ? !(s.radiance.maxCoeff() > 0) : !(s.zenith_luminance > 0);
 }
 
 // the likely cause of a black frame, for the warning.

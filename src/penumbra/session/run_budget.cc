@@ -150,8 +150,8 @@ std::optional<std::string> DescribeRunWork(const RunWork& w) {
       "; warned above {:.0e} steps, {:.0e} frames, {}, {:.0e} rays, {:.0e} grid steps or {:.0e} "
       "path samples (docs/world-file.md \"Input limits\"): check duration_sec, "
       "physics.timestep_sec, the camera rates and sizes and render.samples_per_pixel (--spp)",
-      kWarnPhysicsSteps, kWarnCameraFrames, Bytes(kWarnImageBytes), kWarnLidarRays,
-      kWarnFluidSteps, kWarnPathSamples);
+      kWarnPhysicsSteps, kWarnCameraFrames, Bytes(kWarnImageBytes), kWarnLidarRays, kWarnFluidSteps,
+      kWarnPathSamples);
   return s;
 }
 

@@ -149,8 +149,8 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
       const double v = c.Double();
       // 1e308 made every reading infinite
       if (!(v >= 0 && v <= kMaxSensorNoise))
-        c.Fail(sensor + "got " + FormatNumber(v) + "; expected a noise value >= 0 and <= " +
-               FormatNumber(kMaxSensorNoise));
+        c.Fail(sensor + "got " + FormatNumber(v) +
+               "; expected a noise value >= 0 and <= " + FormatNumber(kMaxSensorNoise));
       if (k == "dropout_probability" && v > 1)
         c.Fail(sensor + "got " + FormatNumber(v) + "; expected a probability in [0, 1]");
       s.params["noise." + std::string(k)] = v;
