@@ -139,7 +139,7 @@ TEST(LimitsRun, MjcfCameraFovyIsCheckedLikeWorldCameras) {
   penumbra::testing::TempDir dir;
   const std::string wide = dir.Write("wide.xml", Ball("0.005", "0.2", "0 0 1", "180"));
   ExpectExit2(RunChild(dir, wide),
-              "MJCF camera 'wide/eye': fovy is 180 deg; expected (0, 179) deg");
+              "MJCF camera 'wide/eye': fovy is 180 deg; expected [0.1, 179) deg");
 }
 
 TEST(LimitsRun, DegenerateTimestepsAndDurationsExit2InsteadOfHanging) {

@@ -109,7 +109,7 @@ TEST(FindSceneLimitProblem, MjcfCameraFieldOfView) {
   const auto p = FindSceneLimitProblem(s.scene, s.initial);
   ASSERT_TRUE(p);
   EXPECT_EQ(p->object, "MJCF camera 'm/eye'");
-  EXPECT_EQ(p->problem, "fovy is 180 deg; expected (0, 179) deg, as for world-file cameras");
+  EXPECT_EQ(p->problem, "fovy is 180 deg; expected [0.1, 179) deg, as for world-file cameras");
   // skipped when the world disables MJCF cameras
   EXPECT_FALSE(FindSceneLimitProblem(s.scene, s.initial, /*mjcf_cameras=*/false));
   // a good fovy, but the camera sits far away

@@ -209,6 +209,25 @@ class StopSignals {
   struct sigaction old_int_ = {}, old_term_ = {};
 };
 
+// an empty value ("") given to an option that takes one, e.g. `--out ""`: refused instead of
+// falling back to the default (options whose value is optional, `--zmq`, are skipped: CLI11
+// records their bare form as "" too). walks the subcommands that were parsed.
+void RefuseEmptyValues(const CLI::App& app) {
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->count() == 0 || o->get_expected_min() < 1) continue;
+    for (const std::string& v : o->results()) {
+      if (!v.empty()) continue;
+      const std::string name = o->get_name();
+      throw ConfigError(
+          "", 0, name,
+          "an empty value; expected a non-empty " +
+              std::string(o->nonpositional() ? "value (leave " + name + " out for its default)"
+                                             : "argument"));
+    }
+  }
+  for (const CLI::App* sub : app.get_subcommands()) RefuseEmptyValues(*sub);
+}
+
 // errors and logs go to stderr; stdout carries only what was asked for (--help, --version)
 void LogToStderr() {
   auto logger =
@@ -401,6 +420,7 @@ int RunCli(int argc, char** argv) {
   if (vdb_seed) vdb_options.seed = *vdb_seed;
 
   try {
+    RefuseEmptyValues(app);
     if (*run) {
       WorldConfig world = LoadWorldOrModel(world_path);
       if (!run_override.empty()) world = ApplyWorldOverride(world, run_override);
@@ -498,7 +518,8 @@ int RunCli(int argc, char** argv) {
         "(docs/world-file.md \"Input limits\")");
     return 1;
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
+    // bounded: a message may quote input (a 100 KB name in a path)
+    spdlog::error("{}", SanitizeForMessage(e.what(), 2048));
     return 1;
   }
   return 0;

@@ -3,6 +3,8 @@
 #include <charconv>
 #include <cmath>
 
+#include "penumbra/core/error.h"
+
 namespace penumbra {
 
 bool GlobMatch(std::string_view p, std::string_view t) {
@@ -50,6 +52,20 @@ std::optional<double> ParseDecimal(std::string_view s) {
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+std::string Excerpt(std::string_view text, size_t max_bytes) {
+  if (text.size() <= max_bytes) return SanitizeForMessage(text, 4 * max_bytes + 16);
+  // cut at a character boundary
+  size_t n = max_bytes;
+  while (n > 0 && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
+  return SanitizeForMessage(text.substr(0, n), 4 * max_bytes + 16) + "...";
+}
+
+std::optional<std::string> NameLengthProblem(std::string_view name) {
+  if (name.size() <= kMaxNameLength) return std::nullopt;
+  return "a name of " + std::to_string(name.size()) + " characters ('" + Excerpt(name, 16) +
+         "'); expected at most " + std::to_string(kMaxNameLength) + " characters";
 }
 
 }  // namespace penumbra

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 
 namespace penumbra {
 namespace {
@@ -54,6 +55,7 @@ void AgentConfig::ValidateOrThrow(const std::string& file, const std::string& ke
     throw ConfigError(file, at > 0 ? at : line, path, problem);
   };
   static const std::regex kName("[A-Za-z0-9_-]+");
+  if (auto problem = NameLengthProblem(name)) fail("name", *problem);
   if (!std::regex_match(name, kName))
     fail("name", "'" + name + "' is not a valid name; expected letters, digits, '_' and '-'");
   if (waypoints.size() < 2)

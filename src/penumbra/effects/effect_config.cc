@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 
 namespace penumbra {
 
@@ -141,7 +142,9 @@ double EffectConfig::Weight(double t) const {
 std::optional<EffectConfig::Problem> EffectConfig::Validate() const {
   using R = EffectRange;
   EffectChecker c;
-  if (!IsValidName(name)) {
+  if (auto problem = NameLengthProblem(name)) {
+    c.Fail("name", *problem);
+  } else if (!IsValidName(name)) {
     c.Fail("name", "'" + name +
                        "' is not a valid effect name; expected a non-empty name of "
                        "the characters A-Z a-z 0-9 _ -");

@@ -59,6 +59,7 @@ WorldConfig ApplyWorldOverride(const WorldConfig& recorded, const std::string& p
   try {
     const std::vector<YAML::Node> docs = YAML::LoadAll(text.str());
     root = docs.empty() ? YAML::Node() : docs.front();
+    RefuseYamlTags(text.str(), path);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
                       "YAML syntax error: " + e.msg);

@@ -105,6 +105,24 @@ std::optional<std::string> FindIntrinsicsProblem(const CameraIntrinsics& k) {
   };
   if (reach_x > tan_max * k.fx) return wide("fx", k.fx, "cx", reach_x, k.width);
   if (reach_y > tan_max * k.fy) return wide("fy", k.fy, "cy", reach_y, k.height);
+  const auto centre = [&](const char* c, double v, int size) -> std::optional<std::string> {
+    const double margin = kMaxPrincipalPointOffset * size;
+    if (v >= -margin && v <= size + margin) return std::nullopt;
+    return std::string(c) + " is " + Num(v) + " for " + std::to_string(size) + " px; expected [" +
+           Num(-margin) + ", " + Num(size + margin) + "] (px: the principal point within " +
+           Num(kMaxPrincipalPointOffset) + " image sizes of the image)";
+  };
+  if (auto p = centre("cx", k.cx, k.width)) return p;
+  if (auto p = centre("cy", k.cy, k.height)) return p;
+  const double tan_min = std::tan(0.5 * kMinFovyDeg * M_PI / 180.0);
+  const auto narrow = [&](const char* f, double fv, int size) {
+    return std::string("the ") + (f[1] == 'x' ? "horizontal" : "vertical") + " field of view is " +
+           Num(2 * std::atan(0.5 * size / fv) * 180.0 / M_PI) + " deg (" + f + " " + Num(fv) +
+           " for " + std::to_string(size) + " px); expected at least " + Num(kMinFovyDeg) +
+           " deg, i.e. " + f + " <= " + Num(0.5 * size / tan_min);
+  };
+  if (k.fx > 0.5 * k.width / tan_min) return narrow("fx", k.fx, k.width);
+  if (k.fy > 0.5 * k.height / tan_min) return narrow("fy", k.fy, k.height);
   return std::nullopt;
 }
 
@@ -131,11 +149,11 @@ std::optional<SceneLimitProblem> FindSceneLimitProblem(const SceneDescription& s
     const std::string body = body_name(c.body);
     // MJCF cameras carry MuJoCo's fovy as intrinsics of the extraction size
     const double fovy = 2 * std::atan(0.5 * c.intrinsics.height / c.intrinsics.fy) * 180 / M_PI;
-    if (!(std::isfinite(c.intrinsics.fy) && c.intrinsics.fy > 0 && fovy > 0 &&
+    if (!(std::isfinite(c.intrinsics.fy) && c.intrinsics.fy > 0 && fovy >= kMinFovyDeg &&
           fovy < kMaxFovyDeg)) {
       return SceneLimitProblem{what, body,
-                               "fovy is " + Num(fovy) + " deg; expected (0, " + Num(kMaxFovyDeg) +
-                                   ") deg, as for world-file cameras"};
+                               "fovy is " + Num(fovy) + " deg; expected [" + Num(kMinFovyDeg) +
+                                   ", " + Num(kMaxFovyDeg) + ") deg, as for world-file cameras"};
     }
     if (c.mjcf_camera < static_cast<int>(initial.X_W_mjcam.size())) {
       if (auto p = PositionProblem("position", initial.X_W_mjcam[c.mjcf_camera].translation()))

@@ -28,9 +28,26 @@ inline constexpr double kMaxPositionM = 1e5;
 inline constexpr double kMinGeomSizeM = 1e-6;
 inline constexpr double kMaxGeomSizeM = 1e5;
 /// vertical field of view (deg) of a camera given by fovy (world file, MJCF) is in
-/// (0, kMaxFovyDeg); with explicit intrinsics every pixel's ray stays within kMaxFovyDeg / 2
-/// of the optical axis horizontally and vertically.
+/// [kMinFovyDeg, kMaxFovyDeg); with explicit intrinsics every pixel's ray stays within
+/// kMaxFovyDeg / 2 of the optical axis horizontally and vertically, and the image spans at
+/// least kMinFovyDeg both ways. below 0.1 deg neighbouring pixels' rays differ by less than
+/// ~1e-5 (fy > 573 x height): a fovy_deg of 1e-300 gave fx = 2.75e303 and one colour.
+inline constexpr double kMinFovyDeg = 0.1;
 inline constexpr double kMaxFovyDeg = 179;
+/// the principal point (cx, cy) of explicit intrinsics lies within 10 image sizes of the image:
+/// cx in [-10 width, 11 width], cy in [-10 height, 11 height] (px). an off-centre crop keeps its
+/// principal point near the image; cx = 1e6 for 640 px is a typo.
+inline constexpr double kMaxPrincipalPointOffset = 10.0;
+/// largest light levels a world file may give (the renderer works in 32-bit floats, so 1e308
+/// became infinity): sun / directional illuminance (lx; direct sunlight is ~1.2e5), point and
+/// spot luminous intensity (cd; a lighthouse is ~1e7), their power (W), and luminance (cd/m^2)
+/// of the sky and of emissive materials (the sun's disk is ~1.6e9).
+inline constexpr double kMaxIlluminanceLux = 1e6;
+inline constexpr double kMaxIntensityCd = 1e9;
+inline constexpr double kMaxLightPowerW = 1e7;
+inline constexpr double kMaxLuminanceCdM2 = 1e10;
+/// largest emitter radius of a point or spot light (m), as geom sizes.
+inline constexpr double kMaxLightRadiusM = 1e5;
 /// physics timestep range (s), for physics.timestep_sec and the MJCF <option timestep>.
 /// the lower end keeps 1 s of simulated time at <= 1e6 steps.
 inline constexpr double kMinTimestepSec = 1e-6;
@@ -44,9 +61,11 @@ inline constexpr int kMaxLidarBeamsPerScan = 1 << 22;
 /// components above FLT_LARGE = 1.844e18); rays beyond it, or with NaN/Inf, are misses.
 inline constexpr float kMaxRayComponent = 1e18f;
 
-/// what is wrong with pinhole intrinsics, or nothing: fx, fy finite and > 0, cx, cy finite,
-/// and every pixel centre's ray within kMaxFovyDeg / 2 of the optical axis, i.e.
-/// max(|0 - cx|, |width - 1 - cx|) / fx <= tan(kMaxFovyDeg / 2) and the same for y.
+/// what is wrong with pinhole intrinsics, or nothing: fx, fy finite and > 0, cx, cy finite and
+/// within 10 image sizes of the image (kMaxPrincipalPointOffset), every pixel centre's ray
+/// within kMaxFovyDeg / 2 of the optical axis, i.e. max(|0 - cx|, |width - 1 - cx|) / fx <=
+/// tan(kMaxFovyDeg / 2) and the same for y, and the image at least kMinFovyDeg wide and tall,
+/// i.e. fx <= width / (2 tan(kMinFovyDeg / 2)) (573 x width) and the same for fy, height.
 /// the message names the failing value and the accepted range (px).
 std::optional<std::string> FindIntrinsicsProblem(const CameraIntrinsics& k);
 

@@ -1,8 +1,11 @@
 #include "penumbra/session/camera_sink.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +17,59 @@
 #include "penumbra/session/scene_assembly.h"
 
 namespace penumbra {
+namespace {
+
+// a frame counts as black when no byte of its rgb image is above this (of 255)
+constexpr uint8_t kBlackLevel = 2;
+
+bool IsBlack(const ImageU8& rgb) {
+  return !rgb.data.empty() &&
+         std::all_of(rgb.data.begin(), rgb.data.end(), [](uint8_t v) { return v <= kBlackLevel; });
+}
+
+// true when nothing in the scene gives light: no light with intensity and colour, a black sky,
+// no emissive material (effects may still add lights: the rendered radiance decides).
+bool SceneHasNoLight(const SceneDescription& scene) {
+  for (const Light& l : scene.lights)
+    if (l.active && l.intensity > 0 && l.color.maxCoeff() > 0) return false;
+  for (const Material& m : scene.materials)
+    if (m.emission.maxCoeff() > 0) return false;
+  const Sky& s = scene.sky;
+  return s.type == Sky::Type::kUniform ? !(s.radiance.maxCoeff() > 0) : !(s.zenith_luminance > 0);
+}
+
+// the likely cause of a black frame, for the warning.
+std::string BlackFrameCause(const SceneDescription& scene, const RenderSettings& render,
+                            const CameraImages& img) {
+  float brightest = 0;
+  for (float v : img.radiance.data)
+    if (std::isfinite(v)) brightest = std::max(brightest, v);
+  if (brightest > 0) {
+    return fmt::format(
+        "at exposure EV100 {:.3g} ({} exposure{}, compensation_ev {:.3g}) although its brightest "
+        "pixel is {:.3g} cd/m^2: the exposure is too dark; expected render.exposure with {}",
+        img.ev100, render.auto_exposure ? "auto" : "manual",
+        render.auto_exposure ? "" : fmt::format(" ev100 {:.3g}", render.ev100),
+        render.exposure_compensation_ev, brightest,
+        render.auto_exposure
+            ? std::string("a larger compensation_ev")
+            : fmt::format("ev100 at most about {:.3g} (log2 of the brightest luminance x 100 / "
+                          "12.5), a larger compensation_ev or mode: auto",
+                          std::log2(brightest * 8.0)));
+  }
+  if (SceneHasNoLight(scene)) {
+    return "because the world has no light: no light with an intensity and colour above 0, a "
+           "black sky (sky.luminance_cd_m2 or sky.color 0, or zenith_luminance_cd_m2 0) and no "
+           "emissive material; expected lights:, a sky or an emissive material";
+  }
+  return fmt::format(
+      "because no light reaches it: the camera may be inside a model's geometry (its position "
+      "at this frame is [{:.3g}, {:.3g}, {:.3g}] m) or see only unlit surfaces; expected the "
+      "camera outside every model, facing something lit",
+      img.X_WO.translation().x(), img.X_WO.translation().y(), img.X_WO.translation().z());
+}
+
+}  // namespace
 
 double CaptureSpanSec(const CameraSpec& spec, const CameraSensorConfig& c) {
   if (c.motion_blur_samples <= 1 && c.rolling_shutter_line_time_sec <= 0) return 0.0;
@@ -45,6 +101,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
                        CameraSinkOptions options)
     : scene_(scene),
       renderer_(renderer),
+      render_(world.render),
       effects_(std::move(effects)),
       options_(std::move(options)),
       writer_(output_dir,
@@ -60,6 +117,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
       shutters_(scene, world),
       worker_(static_cast<size_t>(std::max(1, options_.render_queue))) {
   selected_.assign(scene.cameras.size(), options_.cameras.empty() ? 1 : 0);
+  warned_black_.assign(scene.cameras.size(), 0);
   for (const std::string& name : options_.cameras) {
     const int c = scene.FindCamera(name);
     if (c < 0) {
@@ -184,6 +242,7 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
   render_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+<<<<<<< HEAD
   if (img.stopped) {
     // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
     spdlog::info(
@@ -191,6 +250,14 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
         "not written",
         spec.name, p.frame, p.start->time_sec);
     return;
+=======
+  // the first black frame of each camera gets a warning with the likely cause
+  if (!warned_black_[p.camera] && IsBlack(img.rgb)) {
+    warned_black_[p.camera] = 1;
+    spdlog::warn("camera '{}': frame {} (t = {:.6g} s) is black (every pixel <= {} of 255) {}",
+                 spec.name, p.frame, img.mid_exposure_time_sec, kBlackLevel,
+                 BlackFrameCause(scene_, render_, img));
+>>>>>>> sec-limits
   }
   CameraFrame cf;
   cf.camera = spec.name;

@@ -22,6 +22,11 @@
 // pathtraced tier stops between samples), that frame and any rendered after it are dropped:
 // no image, no frames.csv row.
 //
+// a camera's first black frame (every rgb byte <= 2) logs one warning naming the camera, the
+// frame and the likely cause: an exposure too dark for the scene (radiance above 0), a world
+// without light (no lit light, black sky, no emissive material), or no light reaching the
+// camera (inside geometry, or facing only unlit surfaces). docs/cameras.md ("Black frames").
+//
 // timing: camera c fires its frame k at the first physics step whose time is >= k / rate_hz, on
 // the step count, so frames never drift however the rate and timestep relate; a camera faster
 // than physics renders once per step. the effects a camera sees (scene/effects_frame.h) are
@@ -156,6 +161,7 @@ class CameraSink : public Sink {
 
   const SceneDescription& scene_;
   Renderer* renderer_;
+  RenderSettings render_;  // the world's exposure settings (for the black-frame warning)
   ViewerEffects effects_;
   CameraSinkOptions options_;
   std::function<void(std::exception_ptr)> report_error_;
@@ -168,6 +174,7 @@ class CameraSink : public Sink {
   std::optional<Capture> capture_;
   // render thread
   std::vector<CameraImager> imagers_;
+  std::vector<char> warned_black_;  // per scene camera: its black-frame warning was logged
   std::vector<double> span_;
   std::deque<Pending> pending_;
   std::shared_ptr<const WorldSnapshot> last_;

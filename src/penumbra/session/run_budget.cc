@@ -7,6 +7,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/sensors/lidar_pattern.h"
+#include "penumbra/session/camera_specs.h"
 
 namespace penumbra {
 namespace {
@@ -113,11 +114,17 @@ RunWork EstimateRunWork(const WorldConfig& world, const SceneDescription& scene,
   RunWork w;
   const double t = world.duration_sec;
   if (timestep_sec > 0) w.physics_steps = std::ceil(t / timestep_sec);
-  for (const CameraSpec& c : scene.cameras) {
+  const std::vector<CameraSensorConfig> sensor = SensorConfigsFor(scene, world);
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    const CameraSpec& c = scene.cameras[i];
     const double frames = std::floor(t * c.rate_hz) + 1;  // frame 0 at t = 0
+    const double pixels = double(c.intrinsics.width) * double(c.intrinsics.height);
     w.camera_frames += frames;
-    w.image_bytes += frames * double(c.intrinsics.width) * double(c.intrinsics.height) *
-                     ImageBytesPerPixel(c.outputs);
+    w.image_bytes += frames * pixels * ImageBytesPerPixel(c.outputs);
+    if (world.render.tier == RenderSettings::Tier::kPathtraced && c.outputs.rgb) {
+      const int blur = i < sensor.size() ? std::max(1, sensor[i].motion_blur_samples) : 1;
+      w.path_samples += frames * pixels * world.render.samples_per_pixel * blur;
+    }
   }
   for (const SensorConfig& s : world.sensors)
     if (const auto beams = LidarBeams(s)) w.lidar_rays += beams->first * (t * beams->second + 1);
@@ -129,19 +136,22 @@ RunWork EstimateRunWork(const WorldConfig& world, const SceneDescription& scene,
 std::optional<std::string> DescribeRunWork(const RunWork& w) {
   if (!(w.physics_steps > kWarnPhysicsSteps || w.camera_frames > kWarnCameraFrames ||
         w.image_bytes > kWarnImageBytes || w.lidar_rays > kWarnLidarRays ||
-        w.fluid_steps > kWarnFluidSteps))
+        w.fluid_steps > kWarnFluidSteps || w.path_samples > kWarnPathSamples))
     return std::nullopt;
   std::string s =
       fmt::format("this run will take ~{:.3g} physics steps and {:.3g} frames (~{} of images)",
                   w.physics_steps, w.camera_frames, Bytes(w.image_bytes));
   if (w.lidar_rays > 0) s += fmt::format(", {:.3g} LiDAR rays", w.lidar_rays);
   if (w.fluid_steps > 0) s += fmt::format(", {:.3g} smoke/fire grid steps", w.fluid_steps);
+  if (w.path_samples > 0)
+    s += fmt::format(", {:.3g} path samples (pathtraced: pixels x samples_per_pixel x frames)",
+                     w.path_samples);
   s += fmt::format(
-      "; warned above {:.0e} steps, {:.0e} frames, {}, {:.0e} rays or {:.0e} grid steps "
-      "(docs/world-file.md \"Input limits\"): check duration_sec, physics.timestep_sec and the "
-      "camera rates and sizes",
-      kWarnPhysicsSteps, kWarnCameraFrames, Bytes(kWarnImageBytes), kWarnLidarRays,
-      kWarnFluidSteps);
+      "; warned above {:.0e} steps, {:.0e} frames, {}, {:.0e} rays, {:.0e} grid steps or {:.0e} "
+      "path samples (docs/world-file.md \"Input limits\"): check duration_sec, "
+      "physics.timestep_sec, the camera rates and sizes and render.samples_per_pixel (--spp)",
+      kWarnPhysicsSteps, kWarnCameraFrames, Bytes(kWarnImageBytes), kWarnLidarRays, kWarnFluidSteps,
+      kWarnPathSamples);
   return s;
 }
 

@@ -33,6 +33,9 @@ inline constexpr double kWarnCameraFrames = 1e5;
 inline constexpr double kWarnImageBytes = 1e10;
 inline constexpr double kWarnLidarRays = 1e10;
 inline constexpr double kWarnFluidSteps = 1e5;
+/// pathtraced tier: pixels x samples_per_pixel x frames (x motion_blur_samples), summed over
+/// the cameras (docs/performance.md gives the measured samples per second).
+inline constexpr double kWarnPathSamples = 1e9;
 
 /// estimated resident memory (bytes) of camera `camera` for the render `tier`.
 double EstimateCameraMemoryBytes(const CameraSpec& camera, RenderSettings::Tier tier);
@@ -55,6 +58,9 @@ struct RunWork {
   double image_bytes = 0;    ///< uncompressed bytes of every output image written
   double lidar_rays = 0;     ///< sum over LiDARs of beams per scan x scans
   double fluid_steps = 0;    ///< smoke plume and fire grid steps (duration / dt_sec each)
+  /// pathtraced tier: camera paths traced, pixels x samples_per_pixel x frames (x motion blur
+  /// sub-frames); 0 in the realtime tier.
+  double path_samples = 0;
 };
 
 /// estimates a run's work. `timestep_sec` is the physics timestep that the run uses.

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_edit.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -47,6 +48,7 @@ int RangedInt(const YamlReader& r, int lo, int hi) {
 
 AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const std::string& file) {
   static const std::regex kName("[A-Za-z0-9_-]+");
+  if (auto problem = NameLengthProblem(name)) r.Fail("preset " + *problem);
   if (!std::regex_match(name, kName))
     r.Fail("preset name '" + name + "' is not valid; expected letters, digits, '_' and '-'");
   r.ExpectMap({"description", "fog", "dust", "smoke", "rain", "snow", "lights", "npcs"});
@@ -160,6 +162,7 @@ std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path) {
   std::vector<AdversityPreset> out;
   try {
     const YAML::Node root = YAML::Load(text.str());
+    RefuseYamlTags(text.str(), path);
     YamlReader r(root, path, nullptr);
     r.ExpectMap({"presets"});
     const YamlReader presets = r.Child("presets");
@@ -211,6 +214,11 @@ AdversityPreset EditAdversityPreset(const AdversityPreset& base, const std::stri
     YAML::Node patch;
     try {
       patch = YAML::Load(block_yaml);
+      try {
+        RefuseYamlTags(block_yaml, "");
+      } catch (const ConfigError& e) {
+        throw ConfigError("", 0, block, e.problem());
+      }
     } catch (const YAML::Exception& e) {
       throw ConfigError("", 0, block, "not a mapping (" + e.msg + "); expected a mapping or null");
     }

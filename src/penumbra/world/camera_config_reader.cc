@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
 
 namespace penumbra {
@@ -23,6 +24,16 @@ double Positive(const YamlReader& r, const CameraConfig& c, const std::string& u
   const double v = r.Double();
   if (!(v > 0))
     r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected a number > 0 (" + unit + ")");
+  return v;
+}
+
+// a number in [lo, hi] (lo_open: (lo, hi]); 1e308 or 1e-300 where a camera needs a sane value
+double Within(const YamlReader& r, const CameraConfig& c, double lo, double hi, bool lo_open,
+              const std::string& unit) {
+  const double v = r.Double();
+  if (!((lo_open ? v > lo : v >= lo) && v <= hi))
+    r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected " + (lo_open ? "(" : "[") +
+           FormatNumber(lo) + ", " + FormatNumber(hi) + "] (" + unit + ")");
   return v;
 }
 
@@ -82,25 +93,25 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
     }
   }
   if (r.Has("exposure_time_sec"))
-    s.exposure_time_sec = NonNegative(r.Child("exposure_time_sec"), *c, "seconds");
+    s.exposure_time_sec = Within(r.Child("exposure_time_sec"), *c, 0, 60, false, "seconds");
   if (r.Has("motion_blur_samples"))
     s.motion_blur_samples = IntIn(r.Child("motion_blur_samples"), *c, 1, 64);
   if (r.Has("rolling_shutter_line_time_sec"))
     s.rolling_shutter_line_time_sec =
-        NonNegative(r.Child("rolling_shutter_line_time_sec"), *c, "seconds per row");
+        Within(r.Child("rolling_shutter_line_time_sec"), *c, 0, 0.01, false, "seconds per row");
   if (r.Has("auto_exposure_time_constant_sec"))
     s.auto_exposure_time_constant_sec =
-        NonNegative(r.Child("auto_exposure_time_constant_sec"), *c, "seconds");
+        Within(r.Child("auto_exposure_time_constant_sec"), *c, 0, 3600, false, "seconds");
   if (r.Has("noise")) {
     const YamlReader n = r.Child("noise");
     n.ExpectMap({"enabled", "full_well_e", "read_noise_e", "iso", "base_iso", "adc_bits"});
     s.noise.enabled = n.Has("enabled") ? n.Child("enabled").Bool() : true;
     if (n.Has("full_well_e"))
-      s.noise.full_well_e = Positive(n.Child("full_well_e"), *c, "electrons");
+      s.noise.full_well_e = Within(n.Child("full_well_e"), *c, 1, 1e9, false, "electrons");
     if (n.Has("read_noise_e"))
-      s.noise.read_noise_e = NonNegative(n.Child("read_noise_e"), *c, "electrons");
-    if (n.Has("iso")) s.noise.iso = Positive(n.Child("iso"), *c, "ISO");
-    if (n.Has("base_iso")) s.noise.base_iso = Positive(n.Child("base_iso"), *c, "ISO");
+      s.noise.read_noise_e = Within(n.Child("read_noise_e"), *c, 0, 1e6, false, "electrons");
+    if (n.Has("iso")) s.noise.iso = Within(n.Child("iso"), *c, 0, 1e7, true, "ISO");
+    if (n.Has("base_iso")) s.noise.base_iso = Within(n.Child("base_iso"), *c, 0, 1e7, true, "ISO");
     if (n.Has("adc_bits")) s.noise.adc_bits = IntIn(n.Child("adc_bits"), *c, 1, 16);
   }
   if (r.Has("jpeg_quality")) s.jpeg_quality = IntIn(r.Child("jpeg_quality"), *c, 0, 100);
@@ -134,7 +145,7 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
               "MJCF cameras cannot be made stereo pairs; expected a world-file camera "
               "(under cameras:) for a stereo pair");
     st.ExpectMap({"baseline_m"});
-    s.stereo_baseline_m = Positive(st.Child("baseline_m"), *c, "m");
+    s.stereo_baseline_m = Within(st.Child("baseline_m"), *c, 0, 100, true, "m");
   }
 }
 
@@ -146,6 +157,7 @@ std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r) {
     e.ExpectMap({"name", "id", "bodies", "geoms", "materials"});
     SemanticClassConfig c;
     c.name = e.Child("name").String();
+    if (auto problem = NameLengthProblem(c.name)) e.Child("name").Fail(*problem);
     const YamlReader id = e.Child("id");
     c.id = id.Int();
     if (c.id < 1 || c.id > 65535)

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/world/world_validation.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -152,6 +153,7 @@ void MetricsConfig::ValidateOrThrow() const {
   for (size_t i = 0; i < series.size(); ++i) {
     const MetricConfig& m = series[i];
     const std::string key = "metrics.series[" + std::to_string(i) + "]";
+    if (auto problem = NameLengthProblem(m.name)) Fail(key + ".name", *problem);
     if (!IsValidWorldName(m.name))
       Fail(key + ".name", "'" + m.name +
                               "' is not a valid metric name; expected letters, digits, '_' or "

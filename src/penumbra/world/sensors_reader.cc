@@ -1,9 +1,11 @@
 #include "penumbra/world/sensors_reader.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -20,6 +22,9 @@ std::string Prefixed(const std::string& robot, const std::string& name) {
   if (robot.empty() || name == "world") return name;
   return robot + "/" + name;
 }
+
+// largest noise parameter of a sensor (standard deviations, densities, random walks).
+constexpr double kMaxSensorNoise = 1e3;
 
 double NonNegative(const YamlReader& r, const std::string& unit) {
   const double v = r.Double();
@@ -52,10 +57,16 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   s.line = r.line();
   s.key = r.path();
   s.robot = robot;
-  if (s.name.empty() || s.name.find_first_of("/\\ \t") != std::string::npos)
+  if (auto problem = NameLengthProblem(s.name)) r.Child("name").Fail(*problem);
+  const bool control = std::any_of(s.name.begin(), s.name.end(), [](char ch) {
+    return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F;
+  });
+  if (s.name.empty() || s.name.find_first_of("/\\ \t") != std::string::npos || control ||
+      s.name == "." || s.name == "..")
     r.Child("name").Fail("'" + s.name +
                          "' is not a valid sensor name; expected a non-empty "
-                         "name without '/', '\\' or spaces (it names output files)");
+                         "name without '/', '\\', spaces or control characters, not '.' or "
+                         "'..' (it names output files)");
   s.type = r.Child("type").Enum({"lidar", "imu", "mujoco", "ground_truth"});
   std::vector<std::string_view> keys = {"name", "type", "rate_hz", "latency_sec"};
   std::vector<std::string_view> noise_keys;
@@ -136,7 +147,10 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
       if (!n.Has(k)) continue;
       const YamlReader c = n.Child(k);
       const double v = c.Double();
-      if (!(v >= 0)) c.Fail(sensor + "got " + FormatNumber(v) + "; expected a noise value >= 0");
+      // 1e308 made every reading infinite
+      if (!(v >= 0 && v <= kMaxSensorNoise))
+        c.Fail(sensor + "got " + FormatNumber(v) +
+               "; expected a noise value >= 0 and <= " + FormatNumber(kMaxSensorNoise));
       if (k == "dropout_probability" && v > 1)
         c.Fail(sensor + "got " + FormatNumber(v) + "; expected a probability in [0, 1]");
       s.params["noise." + std::string(k)] = v;

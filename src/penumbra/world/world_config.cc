@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
@@ -112,6 +113,9 @@ class WorldParser {
       rec.ExpectMap({"file", "sensors"});
       if (!rec.Has("file")) rec.Fail("no 'file'; expected record: {file: NAME.plog}");
       w.record.file = rec.Child("file").String();
+      // `record: {file: ""}` used to record nothing without a word
+      if (w.record.file.empty())
+        rec.Child("file").Fail("empty; expected a file name ending in .plog");
       if (rec.Has("sensors")) w.record.sensors = rec.Child("sensors").Bool();
     }
     if (r.Has("semantic_classes"))
@@ -243,6 +247,7 @@ class WorldParser {
         s.ExpectMap({"name", "body", "geom", "pose"});
         SiteConfig site;
         site.name = s.Child("name").String();
+        if (auto problem = NameLengthProblem(site.name)) s.Child("name").Fail(*problem);
         if (site.name.empty() || site.name.find('/') != std::string::npos)
           s.Child("name").Fail("'" + site.name + "'; expected a non-empty name without '/'");
         if (s.Has("body") == s.Has("geom"))
@@ -449,6 +454,7 @@ WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_nam
   try {
     // a world file is one YAML document: a second one would be silently ignored
     const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
+    RefuseYamlTags(yaml_text, file_name);
     for (size_t d = 1; d < docs.size(); ++d) {
       if (docs[d].IsNull()) continue;
       throw ConfigError(file_name, MarkLine(docs[d].Mark()), "",

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/mesh_import_config.h"
 
@@ -46,7 +47,7 @@ const Range kUnit = Range::Closed(0, 1);
 const Range kImageSize = Range::Closed(1, 16384);
 const Range kRate = Range::OpenClosed(0, 10000);
 const Range kNearClip = Range::Closed(0, 10);
-const Range kFovy = Range::Open(0, kMaxFovyDeg);
+const Range kFovy = {kMinFovyDeg, kMaxFovyDeg, false, true};  // [0.1, 179)
 // positions given in the world file (scene/scene_limits.h: Embree's float precision)
 const Range kPosition = Range::Closed(-kMaxPositionM, kMaxPositionM);
 
@@ -130,8 +131,9 @@ class Validator {
   // world-level names: models, lights, cameras.
   void CheckName(const std::string& path, const std::string& name) const {
     if (name.empty()) Fail(path, "required; expected a name of letters, digits, '_' or '-'");
+    if (auto problem = NameLengthProblem(name)) Fail(path, *problem);
     if (!IsValidWorldName(name)) {
-      Fail(path, "'" + name + "' has characters other than letters, digits, '_' or '-'");
+      Fail(path, "'" + Excerpt(name) + "' has characters other than letters, digits, '_' or '-'");
     }
   }
 
@@ -173,7 +175,8 @@ class Validator {
 
   void CheckPose(const std::string& path, const PoseConfig& p) const {
     Check3(path + ".xyz", p.xyz, kPosition);
-    Check3(path + ".rpy_deg", p.rpy_deg, Range::Finite());
+    // every rotation is within one turn; 1e308 deg has no digits left for the angle
+    Check3(path + ".rpy_deg", p.rpy_deg, Range::Closed(-360, 360));
   }
 
   void CheckOutputs(const std::string& path, const CameraOutputs& o) const {
@@ -202,11 +205,12 @@ class Validator {
   void CheckSky() const {
     const SkyConfig& s = w_.sky;
     Check3("sky.color", s.color, kUnit);
-    Check("sky.luminance_cd_m2", s.luminance_cd_m2, Range::AtLeast(0));
+    Check("sky.luminance_cd_m2", s.luminance_cd_m2, Range::Closed(0, kMaxLuminanceCdM2));
     Check("sky.turbidity", s.turbidity, Range::Closed(1.7, 10));
     Check("sky.sun_elevation_deg", s.sun_elevation_deg, Range::Closed(-90, 90));
     Check("sky.sun_azimuth_deg", s.sun_azimuth_deg, Range::Closed(-360, 360));
-    Check("sky.zenith_luminance_cd_m2", s.zenith_luminance_cd_m2, Range::AtLeast(0));
+    Check("sky.zenith_luminance_cd_m2", s.zenith_luminance_cd_m2,
+          Range::Closed(0, kMaxLuminanceCdM2));
   }
 
   // key path of w_.models[i]: robots come first, then static models.
@@ -275,7 +279,8 @@ class Validator {
         Fail(path + ".illuminance_lux",
              "required for sun and directional lights; expected lux > 0");
       }
-      Check(path + ".illuminance_lux", *l.illuminance_lux, Range::Above(0));
+      Check(path + ".illuminance_lux", *l.illuminance_lux,
+            Range::OpenClosed(0, kMaxIlluminanceLux));
       if (l.intensity_cd || l.power_w) {
         Fail(path + (l.intensity_cd ? ".intensity_cd" : ".power_w"),
              "does not apply to sun and directional lights; expected illuminance_lux");
@@ -292,9 +297,10 @@ class Validator {
                                         : "neither intensity_cd nor power_w given") +
                  "; expected exactly one of them for point and spot lights");
       }
-      if (l.intensity_cd) Check(path + ".intensity_cd", *l.intensity_cd, Range::Above(0));
-      if (l.power_w) Check(path + ".power_w", *l.power_w, Range::Above(0));
-      Check(path + ".radius_m", l.radius_m, Range::AtLeast(0));
+      if (l.intensity_cd)
+        Check(path + ".intensity_cd", *l.intensity_cd, Range::OpenClosed(0, kMaxIntensityCd));
+      if (l.power_w) Check(path + ".power_w", *l.power_w, Range::OpenClosed(0, kMaxLightPowerW));
+      Check(path + ".radius_m", l.radius_m, Range::Closed(0, kMaxLightRadiusM));
       Check3(path + ".position", l.position, kPosition);
     }
     if (l.type == Light::Type::kSpot) {
@@ -319,7 +325,17 @@ class Validator {
     if (c.fovy_deg && c.intrinsics) {
       Fail(path + ".intrinsics", "fovy_deg and intrinsics both given; expected one of them");
     }
-    if (c.fovy_deg) Check(path + ".fovy_deg", *c.fovy_deg, kFovy);
+    if (c.fovy_deg) {
+      Check(path + ".fovy_deg", *c.fovy_deg, kFovy);
+      // square pixels: a very wide or very tall image stretches the other axis
+      const CameraIntrinsics k = CameraIntrinsics::FromFovy(c.width, c.height, *c.fovy_deg);
+      if (auto problem = FindIntrinsicsProblem(k))
+        Fail(path + ".fovy_deg", "fovy_deg " + FormatNumber(*c.fovy_deg) + " at " +
+                                     std::to_string(c.width) + " x " + std::to_string(c.height) +
+                                     " px: " + *problem +
+                                     " (square pixels; expected another fovy_deg or image size, or "
+                                     "intrinsics)");
+    }
     if (c.intrinsics) {
       const CameraIntrinsics& k = *c.intrinsics;
       Check(path + ".intrinsics.fx", k.fx, Range::Above(0));
@@ -386,7 +402,7 @@ class Validator {
       if (m.roughness) Check(path + ".roughness", *m.roughness, kUnit);
       if (m.metallic) Check(path + ".metallic", *m.metallic, kUnit);
       if (m.specular) Check(path + ".specular", *m.specular, kUnit);
-      if (m.emission) Check3(path + ".emission", *m.emission, Range::AtLeast(0));
+      if (m.emission) Check3(path + ".emission", *m.emission, Range::Closed(0, kMaxLuminanceCdM2));
     }
   }
 

@@ -1,8 +1,11 @@
 #include "penumbra/world/yaml_reader.h"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "penumbra/core/error.h"
 
@@ -46,7 +49,55 @@ int MarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1
 // plain (unquoted) scalars only: a quoted "5" is a string in YAML, not a number.
 bool IsPlainScalar(const YAML::Node& n) { return n.IsScalar() && n.Tag() != "!"; }
 
+// the parser's events of a document, refusing the first node with a tag of its own. yaml-cpp
+// gives untagged nodes the non-specific tags "?" (plain scalars, mappings, lists) and "!"
+// (quoted scalars); anything else was written in the file.
+class TagRefuser : public YAML::EventHandler {
+ public:
+  explicit TagRefuser(const std::string& file) : file_(file) {}
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t,
+                const std::string&) override {
+    Check(mark, tag);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    Check(mark, tag);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    Check(mark, tag);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void Check(const YAML::Mark& mark, const std::string& tag) const {
+    if (tag.empty() || tag == "?" || tag == "!") return;
+    // yaml-cpp expands the standard "!!" handle
+    const std::string kStandard = "tag:yaml.org,2002:";
+    const std::string shown =
+        tag.rfind(kStandard, 0) == 0 ? "!!" + tag.substr(kStandard.size()) : tag;
+    throw ConfigError(file_, MarkLine(mark), "",
+                      "YAML tag '" + shown +
+                          "' is not supported; expected a plain value, list or mapping without a "
+                          "tag (Penumbra reads no YAML tags: remove it)");
+  }
+  const std::string& file_;
+};
+
 }  // namespace
+
+void RefuseYamlTags(const std::string& text, const std::string& file) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  TagRefuser refuser(file);
+  while (parser.HandleNextDocument(refuser)) {
+  }
+}
 
 YamlReader::YamlReader(const YAML::Node& root, std::string file, LineTable* lines)
     : node_(root), path_(), line_(MarkLine(root.Mark())) {

@@ -110,6 +110,14 @@ class YamlReader {
   std::shared_ptr<const Context> ctx_;
 };
 
+/// refuses YAML tags: every node of every document of `text` must carry no tag (a plain or a
+/// quoted value, a mapping or a list as written). Penumbra's files read no tags, so a tag such
+/// as `!foo 3`, `!!binary ...` or `!!str 5` would otherwise be dropped without a word.
+/// works on the parser's events, so aliases are not expanded.
+/// @throws ConfigError(file, line of the tagged node, "", "YAML tag '!foo' ...; expected ...");
+///         YAML::ParserException for a syntax error (as YAML::Load).
+void RefuseYamlTags(const std::string& text, const std::string& file);
+
 /// "a, b, c" from a list of names.
 std::string JoinNames(const std::vector<std::string_view>& names);
 
