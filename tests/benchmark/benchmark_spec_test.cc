@@ -33,6 +33,13 @@ std::string ErrorOf(const std::string& text) {
   return "";
 }
 
+// a YAML tag (`!foo`, `!!binary`) would be dropped silently by yaml-cpp: refused with its line
+TEST(BenchmarkSpec, YamlTagsAreRefusedWithTheirLine) {
+  const std::string e = ErrorOf(Spec("trials: !foo 3\n"));
+  EXPECT_NE(e.find("spec.yaml:11"), std::string::npos) << e;
+  EXPECT_NE(e.find("YAML tag '!foo'"), std::string::npos) << e;
+}
+
 TEST(BenchmarkSpec, LoadsWithDefaults) {
   TempDir dir;
   const BenchmarkSpec s = LoadBenchmarkSpec(dir.Write("spec.yaml", Spec("")));

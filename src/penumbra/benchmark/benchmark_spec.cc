@@ -337,6 +337,7 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
   std::stringstream text;
   text << in.rdbuf();
   try {
+    RefuseYamlTags(text.str(), s.file);
     const YAML::Node root = YAML::Load(text.str());
     YamlReader r(root, s.file, nullptr);
     if (r.node().IsMap() && r.Has("kind")) s.kind = r.Child("kind").Enum({"slam", "nav"});

@@ -242,7 +242,6 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
   render_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-<<<<<<< HEAD
   if (img.stopped) {
     // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
     spdlog::info(
@@ -250,14 +249,13 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
         "not written",
         spec.name, p.frame, p.start->time_sec);
     return;
-=======
+  }
   // the first black frame of each camera gets a warning with the likely cause
   if (!warned_black_[p.camera] && IsBlack(img.rgb)) {
     warned_black_[p.camera] = 1;
     spdlog::warn("camera '{}': frame {} (t = {:.6g} s) is black (every pixel <= {} of 255) {}",
                  spec.name, p.frame, img.mid_exposure_time_sec, kBlackLevel,
                  BlackFrameCause(scene_, render_, img));
->>>>>>> sec-limits
   }
   CameraFrame cf;
   cf.camera = spec.name;
