@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 #include "penumbra/core/output_file.h"
 
 namespace penumbra {
@@ -17,6 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 cv::Mat ReadImage(const fs::path& path, int expected_type, const char* expected) {
+  CheckImageFileSize(path);  // the declared size against the caps before decoding
   const cv::Mat m = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (m.empty())
     throw ConfigError(path.string(), 0, "",
