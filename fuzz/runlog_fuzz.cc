@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <numeric>
 #include <string>
 
 #include "penumbra/runlog/run_log_reader.h"
@@ -44,7 +45,7 @@ void ReadEverything(const std::string& path, penumbra::RunLogReadMode mode) {
     while (r.NextRecord(&record)) {
     }
     StepRecord step;
-    if (r.SeekStep(r.first_step() + (r.last_step() - r.first_step()) / 2))
+    if (r.SeekStep(std::midpoint(r.first_step(), r.last_step())))
       while (r.NextStep(&step)) {
       }
     r.Events();
