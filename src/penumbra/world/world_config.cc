@@ -447,33 +447,35 @@ bool HasModelExtension(const fs::path& p) {
 // null (a trailing '---') does not count
 class YamlDocumentCounter : public YAML::EventHandler {
  public:
-  void OnDocumentStart(const YAML::Mark& mark) override {
-    mark_ = mark;
-    content_ = false;
-  }
+  void OnDocumentStart(const YAML::Mark&) override { content_ = false; }
   void OnDocumentEnd() override {
     if (content_) marks.push_back(mark_);
   }
   void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnAlias(const YAML::Mark&, YAML::anchor_t) override { content_ = true; }
-  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Content(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
                 const std::string&) override {
-    content_ = true;
+    Content(mark);
   }
-  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
                        YAML::EmitterStyle::value) override {
-    content_ = true;
+    Content(mark);
   }
   void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
                   YAML::EmitterStyle::value) override {
-    content_ = true;
+    Content(mark);
   }
   void OnMapEnd() override {}
 
-  std::vector<YAML::Mark> marks;  ///< where each document with content starts
+  /// where the root node of each document with content starts
+  std::vector<YAML::Mark> marks;
 
  private:
+  void Content(const YAML::Mark& mark) {
+    if (!content_) mark_ = mark;
+    content_ = true;
+  }
   YAML::Mark mark_;
   bool content_ = false;
 };
