@@ -25,6 +25,7 @@ pkgs=(
   libcgal-dev  # convex decomposition (CoACD) clipping and hulls
   libopencv-contrib-dev libopen3d-dev  # bundled SLAM methods (cv::rgbd, cv::kinfu, Open3D odometry)
   slurm-wlm munge  # benchmark sweeps on Slurm, tested on a single-node cluster
+  clang libclang-rt-14-dev  # libFuzzer + sanitizers for bench/fuzz/run.sh (docs/fuzzing.md)
 )
 missing=()
 for p in "${pkgs[@]}"; do

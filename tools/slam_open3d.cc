@@ -21,6 +21,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/slam/rgbd_odometry.h"
 
@@ -38,9 +39,11 @@ open3d::geometry::Image ToOpen3d(const cv::Mat& m, int channels, int bytes_per_c
 std::shared_ptr<open3d::geometry::RGBDImage> ReadFrame(const RgbdFrameFiles& f,
                                                        const RgbdOdometryOptions& options,
                                                        cv::Size& size) {
+  CheckImageFileSize(f.rgb);  // declared sizes against the caps before decoding
   cv::Mat bgr = cv::imread(f.rgb.string(), cv::IMREAD_COLOR);
   if (bgr.empty())
     throw ConfigError(f.rgb.string(), 0, "", "cannot read the colour image; expected an 8-bit PNG");
+  CheckImageFileSize(f.depth);
   const cv::Mat depth = cv::imread(f.depth.string(), cv::IMREAD_ANYDEPTH);
   if (depth.empty() || depth.type() != CV_16U)
     throw ConfigError(f.depth.string(), 0, "",

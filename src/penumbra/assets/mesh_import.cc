@@ -19,6 +19,7 @@
 #include <tuple>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 
 namespace penumbra {
 namespace {
@@ -223,6 +224,9 @@ std::shared_ptr<const TextureImage> DecodeTextureImage(const std::vector<unsigne
                                                        TextureMap map, float param,
                                                        const std::string& what) {
   cv::Mat img;
+  // the declared size against the caps before decoding
+  CheckImageBytesSize(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                      what);
   if (!bytes.empty()) img = cv::imdecode(bytes, cv::IMREAD_COLOR);
   if (img.empty() || img.cols < 1 || img.rows < 1)
     throw Error(what + ": not a readable image (" + std::to_string(bytes.size()) +

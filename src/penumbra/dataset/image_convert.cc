@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/dataset/run_file.h"
 
@@ -46,6 +47,7 @@ CheckedPng ReadCheckedPng(const RunCamera& cam, const std::string& kind, int64_t
                        static_cast<uint64_t>(cam.height);
   CheckedPng p;
   p.bytes = ReadRunFile(cam.run_dir, relative, 2 * raw + (1u << 20));
+  CheckImageBytesSize(p.bytes, file);  // the declared size against the caps before decoding
   // the header is checked before anything is allocated for the pixels
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (p.bytes.size() < 33 || std::memcmp(p.bytes.data(), kSignature, 8) != 0 ||

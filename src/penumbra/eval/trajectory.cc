@@ -9,7 +9,6 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
-#include <sstream>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
@@ -37,6 +36,28 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   return fields;
 }
 
+// a byte that has no place in a text file: NUL and the control characters other than tab,
+// line feed and carriage return
+bool IsBinaryByte(unsigned char c) {
+  return (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f;
+}
+
+// checks the bytes of the text that one line (without its '\n') holds: "" or the problem
+std::string LineProblem(std::string_view line) {
+  for (size_t i = 0; i < line.size(); ++i)
+    if (IsBinaryByte(static_cast<unsigned char>(line[i])))
+      return fmt::format(
+          "column {} holds the byte 0x{:02x}, not text ('{}'): binary data; "
+          "expected a TUM text file of lines 'timestamp tx ty tz qx qy qz qw'",
+          i + 1, static_cast<unsigned char>(line[i]), SanitizeForMessage(line.substr(0, 32), 32));
+  if (line.size() > kTumMaxLineBytes)
+    return fmt::format(
+        "line of more than {} bytes ('{}...'); expected a TUM text file of lines "
+        "'timestamp tx ty tz qx qy qz qw'",
+        kTumMaxLineBytes, SanitizeForMessage(line.substr(0, 32), 32));
+  return "";
+}
+
 }  // namespace
 
 Eigen::Matrix3Xd Trajectory::Positions() const {
@@ -47,6 +68,10 @@ Eigen::Matrix3Xd Trajectory::Positions() const {
 }
 
 Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) {
+  if (text.size() > kTumMaxFileBytes)
+    throw ConfigError(source, 0, "",
+                      fmt::format("{} bytes; expected a TUM trajectory of at most {} bytes",
+                                  text.size(), kTumMaxFileBytes));
   Trajectory t;
   int line_number = 0;
   int previous_line = 0;
@@ -56,6 +81,8 @@ Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) 
     const std::string_view line = text.substr(pos, end - pos);
     pos = end + 1;
     ++line_number;
+    if (const std::string bad = LineProblem(line); !bad.empty())
+      throw ConfigError(source, line_number, "", bad);
     const std::vector<std::string_view> fields = SplitFields(line);
     if (fields.empty() || fields.front().front() == '#') continue;
     if (fields.size() != kFieldNames.size())
@@ -72,6 +99,18 @@ Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) 
                         kFieldNames[k], SanitizeForMessage(fields[k], 64), kExpectedLine));
       v[k] = *x;
     }
+    // finite is not enough: 1e308 squares to infinity in every error metric
+    if (!(std::abs(v[0]) <= kTumMaxAbsTimestampSec))
+      throw ConfigError(source, line_number, "",
+                        fmt::format("timestamp {} is beyond +-{:g} s; expected seconds (Unix "
+                                    "time or time since the start)",
+                                    v[0], kTumMaxAbsTimestampSec));
+    for (size_t k = 1; k <= 3; ++k)
+      if (!(std::abs(v[k]) <= kTumMaxAbsCoordinateM))
+        throw ConfigError(source, line_number, "",
+                          fmt::format("field {} ({}) {} is beyond +-{:g} m; expected a position "
+                                      "in metres (docs/evaluation.md \"Input limits\")",
+                                      k + 1, kFieldNames[k], v[k], kTumMaxAbsCoordinateM));
     // quaternion: file order x y z w
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     const double norm = q.norm();
@@ -112,11 +151,41 @@ Trajectory ReadTumTrajectory(const std::filesystem::path& path) {
     throw ConfigError(
         path.string(), 0, "",
         fmt::format("cannot be read ({}); expected a TUM trajectory file", std::strerror(errno)));
-  std::ostringstream ss;
-  ss << f.rdbuf();
+  // read in blocks, each checked as it arrives: a device, pipe or huge binary file is refused
+  // at its first bad byte or line, before more than a block past the limit is held
+  std::string text;
+  std::array<char, 1 << 16> block;
+  int line = 1;
+  size_t line_start = 0;
+  while (f) {
+    f.read(block.data(), block.size());
+    const size_t n = static_cast<size_t>(f.gcount());
+    if (n == 0) break;
+    if (text.size() + n > kTumMaxFileBytes)
+      throw ConfigError(path.string(), line, "",
+                        fmt::format("more than {} bytes; expected a TUM trajectory file of at "
+                                    "most {} bytes (docs/evaluation.md \"Input limits\")",
+                                    kTumMaxFileBytes, kTumMaxFileBytes));
+    const size_t from = text.size();
+    text.append(block.data(), n);
+    for (size_t i = from; i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        if (const std::string bad =
+                LineProblem(std::string_view(text).substr(line_start, i - line_start));
+            !bad.empty())
+          throw ConfigError(path.string(), line, "", bad);
+        ++line;
+        line_start = i + 1;
+      }
+    }
+    const std::string_view open_line = std::string_view(text).substr(line_start);
+    if (const std::string bad = LineProblem(open_line.substr(0, kTumMaxLineBytes + 1));
+        !bad.empty())
+      throw ConfigError(path.string(), line, "", bad);
+  }
   if (f.bad())
     throw ConfigError(path.string(), 0, "", "read failed; expected a TUM trajectory file");
-  return ParseTumTrajectory(ss.str(), path.string());
+  return ParseTumTrajectory(text, path.string());
 }
 
 std::string FormatTumTrajectory(const Trajectory& trajectory) {

@@ -10,6 +10,7 @@
 // frame W. fields are separated by spaces, tabs or commas (as TUM's associate.py accepts);
 // lines whose first non-blank character is '#' and blank lines are skipped.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -35,17 +36,31 @@ struct Trajectory {
 /// (a file written with 4 decimals is off by < 1e-3; a norm far from 1 means wrong columns.)
 constexpr double kTumQuaternionNormTolerance = 1e-2;
 
+/// input limits of TUM files (docs/evaluation.md "Input limits"): most bytes of a file
+/// (256 MiB, about 3 million poses) and of one line (4096).
+constexpr uint64_t kTumMaxFileBytes = uint64_t{256} << 20;
+constexpr size_t kTumMaxLineBytes = 4096;
+/// most |tx|, |ty|, |tz| (m): 1000 km, beyond any trajectory a robot drives, and small enough
+/// that squared errors and sums of them stay exact enough in doubles.
+constexpr double kTumMaxAbsCoordinateM = 1e6;
+/// most |timestamp| (s): 1e10 s is the year 2286 as Unix time.
+constexpr double kTumMaxAbsTimestampSec = 1e10;
+
 /// parses TUM trajectory text. `source` names the text in errors (a file path).
 /// each pose line must hold exactly 8 finite decimal numbers; quaternions are normalised.
 /// @throws ConfigError(source, line, "", problem) naming the 1-based line and what was
-///         expected, for: a line with another number of fields, a field that is not a finite
-///         number, a quaternion whose norm is 0 or differs from 1 by more than
-///         kTumQuaternionNormTolerance, a timestamp not after the previous pose's; and
-///         (line 0) for text that holds no pose at all.
+///         expected, for: a line longer than kTumMaxLineBytes, a NUL or other control byte
+///         (binary data, not text), a line with another number of fields, a field that is not
+///         a finite number, a position coordinate beyond kTumMaxAbsCoordinateM or a timestamp
+///         beyond kTumMaxAbsTimestampSec, a quaternion whose norm is 0 or differs from 1 by
+///         more than kTumQuaternionNormTolerance, a timestamp not after the previous pose's;
+///         and (line 0) for text that holds no pose at all or is larger than kTumMaxFileBytes.
 Trajectory ParseTumTrajectory(std::string_view text, const std::string& source);
 
-/// reads and parses a TUM trajectory file (ParseTumTrajectory).
-/// @throws ConfigError naming `path` if it cannot be read or does not parse.
+/// reads and parses a TUM trajectory file (ParseTumTrajectory). the file is read in blocks
+/// and refused at the first NUL or control byte, overlong line or byte past kTumMaxFileBytes,
+/// so that /dev/zero or a huge binary file stops at once.
+/// @throws ConfigError naming `path` (and the line) if it cannot be read or does not parse.
 Trajectory ReadTumTrajectory(const std::filesystem::path& path);
 
 /// the trajectory as TUM text: a '#' header line, then one line per pose, every number in the

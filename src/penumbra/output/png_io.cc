@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 #include "penumbra/core/output_file.h"
 
 // speed settings, measured on 640 x 480 frames of worlds/default.yaml (realtime tier),
@@ -157,6 +158,8 @@ bool DecodeHeader(DecodeJob* job, png_uint_32* width, png_uint_32* height, int* 
                   int* bit_depth, size_t* row_bytes) {
   if (setjmp(png_jmpbuf(job->png))) return false;
   png_init_io(job->png, job->file);
+  // libpng refuses larger IHDR sizes itself, before any row is allocated
+  png_set_user_limits(job->png, kMaxImageFileSide, kMaxImageFileSide);
   png_read_info(job->png, job->info);
   png_set_expand(job->png);  // palette -> rgb, grey < 8 bits -> 8 bits, tRNS -> alpha
   png_set_interlace_handling(job->png);
@@ -267,6 +270,9 @@ PngImage ReadPng(const std::string& path) {
   if (!DecodeHeader(&job, &width, &height, &channels, &bit_depth, &row_bytes)) {
     throw Error("cannot read PNG '" + path + "': " + job.err);
   }
+  // dimensions against the caps before the rows are allocated
+  if (const std::string bad = ImageFileSizeProblem({width, height}, "PNG"); !bad.empty())
+    throw Error("cannot read PNG '" + path + "': " + bad);
   if (bit_depth != 8 && bit_depth != 16) {
     throw Error("cannot read PNG '" + path + "': unsupported bit depth " +
                 std::to_string(bit_depth));

@@ -50,11 +50,18 @@ void EncodeField(const std::vector<T>& v, const std::vector<T>* prev, std::strin
   }
 }
 
+// `expected` < 0: any count up to kMaxLayoutEntries (no layout to check against)
 template <typename T>
-void DecodeField(BodyReader* in, const std::vector<T>* prev, const char* name,
+void DecodeField(BodyReader* in, const std::vector<T>* prev, const char* name, int64_t expected,
                  std::vector<T>* out) {
   const uint8_t enc = in->U8();
   const uint32_t n = in->U32();
+  if (expected >= 0 && n != static_cast<uint64_t>(expected))
+    in->Fail(
+        fmt::format("field {} has {} entries; the header's layout says {}", name, n, expected));
+  if (expected < 0 && n > static_cast<uint64_t>(kMaxLayoutEntries))
+    in->Fail(
+        fmt::format("field {} has {} entries; expected at most {}", name, n, kMaxLayoutEntries));
   if (enc == kFieldZero) {
     out->assign(n, std::bit_cast<T>(uint64_t{0}));
     return;
@@ -117,8 +124,24 @@ std::string DecodeChunkHeader(const uint8_t* p, ChunkHeader* out) {
   out->last_step = static_cast<int64_t>(LoadU64(p + 32));
   out->raw_size = LoadU64(p + 40);
   out->stored_size = LoadU64(p + 48);
+  // sizes against the format's caps before anything adds to them or allocates them
+  const bool header = out->kind == RunLogChunkKind::kHeader;
+  const uint64_t cap = header ? kMaxHeaderChunkBytes : kMaxChunkBodyBytes;
+  const char* cap_name = header ? "header chunk" : "chunk body";
+  if (out->stored_size > cap)
+    return fmt::format(
+        "stored size {} bytes is above the format's maximum {} of {} bytes "
+        "(docs/run-log.md \"Limits\")",
+        out->stored_size, cap_name, cap);
+  if (out->raw_size > cap)
+    return fmt::format(
+        "uncompressed size {} bytes is above the format's maximum {} of {} bytes "
+        "(docs/run-log.md \"Limits\")",
+        out->raw_size, cap_name, cap);
   if (out->codec == kCodecNone && out->raw_size != out->stored_size)
     return "an uncompressed body whose raw and stored sizes differ";
+  if (out->record_count > 0 && out->first_step > out->last_step)
+    return fmt::format("first step {} is after last step {}", out->first_step, out->last_step);
   return "";
 }
 
@@ -143,6 +166,10 @@ std::string ZstdCompress(std::string_view raw, int level) {
 }
 
 std::string ZstdDecompress(std::string_view stored, uint64_t raw_size) {
+  if (raw_size > kMaxChunkBodyBytes)
+    throw RunLogError(
+        fmt::format("declared uncompressed size {} bytes is above the format's maximum of {} bytes",
+                    raw_size, kMaxChunkBodyBytes));
   const unsigned long long content = ZSTD_getFrameContentSize(stored.data(), stored.size());
   if (content == ZSTD_CONTENTSIZE_ERROR) throw RunLogError("body is not a zstd frame");
   if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != raw_size)
@@ -190,22 +217,59 @@ void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body) 
   enc(r.controller_next_update, p ? p->controller_next_update : r.controller_next_update);
 }
 
-void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out) {
+void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
+                const RunLogLayout* layout) {
   out->step = in->I64();
   out->time_sec = in->F64();
   const StepRecord* p = prev;
-  DecodeField(in, p ? &p->qpos : nullptr, "qpos", &out->qpos);
-  DecodeField(in, p ? &p->qvel : nullptr, "qvel", &out->qvel);
-  DecodeField(in, p ? &p->act : nullptr, "act", &out->act);
-  DecodeField(in, p ? &p->ctrl : nullptr, "ctrl", &out->ctrl);
-  DecodeField(in, p ? &p->qacc_warmstart : nullptr, "qacc_warmstart", &out->qacc_warmstart);
-  DecodeField(in, p ? &p->qfrc_applied : nullptr, "qfrc_applied", &out->qfrc_applied);
-  DecodeField(in, p ? &p->xfrc_applied : nullptr, "xfrc_applied", &out->xfrc_applied);
-  DecodeField(in, p ? &p->mocap_pos : nullptr, "mocap_pos", &out->mocap_pos);
-  DecodeField(in, p ? &p->mocap_quat : nullptr, "mocap_quat", &out->mocap_quat);
-  DecodeField(in, p ? &p->userdata : nullptr, "userdata", &out->userdata);
+  // entries each field must have (-1: no layout given)
+  auto want = [&](int count, int per) -> int64_t { return layout ? int64_t{count} * per : -1; };
+  const RunLogLayout l = layout ? *layout : RunLogLayout{};
+  DecodeField(in, p ? &p->qpos : nullptr, "qpos", want(l.nq, 1), &out->qpos);
+  DecodeField(in, p ? &p->qvel : nullptr, "qvel", want(l.nv, 1), &out->qvel);
+  DecodeField(in, p ? &p->act : nullptr, "act", want(l.na, 1), &out->act);
+  DecodeField(in, p ? &p->ctrl : nullptr, "ctrl", want(l.nu, 1), &out->ctrl);
+  DecodeField(in, p ? &p->qacc_warmstart : nullptr, "qacc_warmstart", want(l.nv, 1),
+              &out->qacc_warmstart);
+  DecodeField(in, p ? &p->qfrc_applied : nullptr, "qfrc_applied", want(l.nv, 1),
+              &out->qfrc_applied);
+  DecodeField(in, p ? &p->xfrc_applied : nullptr, "xfrc_applied", want(l.nbody, 6),
+              &out->xfrc_applied);
+  DecodeField(in, p ? &p->mocap_pos : nullptr, "mocap_pos", want(l.nmocap, 3), &out->mocap_pos);
+  DecodeField(in, p ? &p->mocap_quat : nullptr, "mocap_quat", want(l.nmocap, 4), &out->mocap_quat);
+  DecodeField(in, p ? &p->userdata : nullptr, "userdata", want(l.nuserdata, 1), &out->userdata);
   DecodeField(in, p ? &p->controller_next_update : nullptr, "controller_next_update",
-              &out->controller_next_update);
+              want(l.num_controllers, 1), &out->controller_next_update);
+}
+
+uint64_t StepRecordMemoryBytes(const RunLogLayout& l) {
+  const uint64_t entries = uint64_t(l.nq) + 3 * uint64_t(l.nv) + uint64_t(l.na) + uint64_t(l.nu) +
+                           6 * uint64_t(l.nbody) + 7 * uint64_t(l.nmocap) + uint64_t(l.nuserdata) +
+                           uint64_t(l.num_controllers);
+  return sizeof(StepRecord) + 8 * entries;
+}
+
+std::string CheckLayout(const RunLogLayout& l) {
+  const std::pair<const char*, int> counts[] = {
+      {"nq", l.nq},         {"nv", l.nv},
+      {"na", l.na},         {"nu", l.nu},
+      {"nmocap", l.nmocap}, {"nuserdata", l.nuserdata},
+      {"nbody", l.nbody},   {"num_controllers", l.num_controllers}};
+  for (const auto& [name, n] : counts)
+    if (n < 0 || n > kMaxLayoutEntries)
+      return fmt::format("layout.{} is {}; expected 0 to {}", name, n, kMaxLayoutEntries);
+  for (size_t i = 0; i < l.joints.size(); ++i) {
+    const RunLogJoint& j = l.joints[i];
+    if (j.qpos_adr < 0 || j.qpos_width < 0 || int64_t{j.qpos_adr} + j.qpos_width > l.nq)
+      return fmt::format(
+          "layout.joints[{}] ('{}'): qpos_adr {} and qpos_width {} are not inside nq {}", i,
+          j.name.substr(0, 64), j.qpos_adr, j.qpos_width, l.nq);
+    if (j.qvel_adr < 0 || j.qvel_width < 0 || int64_t{j.qvel_adr} + j.qvel_width > l.nv)
+      return fmt::format(
+          "layout.joints[{}] ('{}'): qvel_adr {} and qvel_width {} are not inside nv {}", i,
+          j.name.substr(0, 64), j.qvel_adr, j.qvel_width, l.nv);
+  }
+  return "";
 }
 
 void EncodeEvent(const EventRecord& e, std::string* body) {
@@ -291,9 +355,26 @@ std::string HeaderToJson(const RunLogHeader& h) {
 
 RunLogHeader HeaderFromJson(std::string_view text) {
   using nlohmann::json;
+  if (text.size() > kMaxHeaderChunkBytes)
+    throw RunLogError(fmt::format("header chunk: {} bytes of JSON; expected at most {}",
+                                  text.size(), kMaxHeaderChunkBytes));
+  // values and nesting counted while parsing, so that a small text cannot build a huge or
+  // deeply nested document
+  uint64_t values = 0;
+  const json::parser_callback_t limit = [&values](int depth, json::parse_event_t event, json&) {
+    if (depth > kMaxHeaderJsonDepth)
+      throw RunLogError(
+          fmt::format("header chunk: JSON nested deeper than {} levels", kMaxHeaderJsonDepth));
+    if ((event == json::parse_event_t::value || event == json::parse_event_t::object_start ||
+         event == json::parse_event_t::array_start) &&
+        ++values > kMaxHeaderJsonValues)
+      throw RunLogError(
+          fmt::format("header chunk: more than {} JSON values", kMaxHeaderJsonValues));
+    return true;
+  };
   json j;
   try {
-    j = json::parse(text);
+    j = json::parse(text, limit);
   } catch (const json::exception& e) {
     throw RunLogError(std::string("header chunk is not valid JSON: ") + e.what());
   }
@@ -361,6 +442,8 @@ RunLogHeader HeaderFromJson(std::string_view text) {
     get(jj, "qvel_width", &x.qvel_width, wj);
     l.joints.push_back(std::move(x));
   }
+  if (const std::string bad = CheckLayout(l); !bad.empty())
+    throw RunLogError("header chunk: " + bad);
   return h;
 }
 

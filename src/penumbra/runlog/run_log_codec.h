@@ -34,6 +34,38 @@ inline constexpr uint8_t kFieldZero = 0;   ///< n entries, all +0.0 (or 0); no d
 inline constexpr uint8_t kFieldXor = 1;    ///< n words, each XORed with the previous record's
 inline constexpr uint8_t kFieldPlain = 2;  ///< n words as they are
 
+// limits of the format (docs/run-log.md "Limits"). every length read from a log is checked
+// against the bytes left in the file and against these caps before anything is allocated;
+// the writer never writes a log that breaks them.
+
+/// most bytes a chunk body may have, stored or decompressed (256 MiB). a chunk header that
+/// declares more is damaged.
+inline constexpr uint64_t kMaxChunkBodyBytes = uint64_t{256} << 20;
+/// most bytes the header chunk's JSON may have after decompression (64 MiB).
+inline constexpr uint64_t kMaxHeaderChunkBytes = uint64_t{64} << 20;
+/// most JSON values (objects, arrays, numbers, strings, ...) and nesting depth of the header
+/// chunk's JSON.
+inline constexpr uint64_t kMaxHeaderJsonValues = uint64_t{4} << 20;
+inline constexpr int kMaxHeaderJsonDepth = 32;
+/// most entries of any layout count (nq, nv, na, nu, nuserdata, num_controllers) and most
+/// bodies and mocap bodies (4,194,304; a MuJoCo model has thousands at most).
+inline constexpr int kMaxLayoutEntries = 1 << 22;
+/// most memory the decoded records of one chunk may take (512 MiB): a steps chunk's record
+/// count times StepRecordMemoryBytes(layout). the writer closes steps chunks at half of it.
+inline constexpr uint64_t kMaxChunkDecodedBytes = uint64_t{512} << 20;
+/// bytes of the smallest record of each kind in a body (all strings and fields empty).
+inline constexpr uint64_t kMinStepRecordBytes = 16 + 11 * 5;
+inline constexpr uint64_t kMinEventRecordBytes = 16 + 4 + 8;
+inline constexpr uint64_t kMinSensorRecordBytes = 16 + 4 + 4 + 8;
+
+/// bytes one decoded step record of `layout` takes in memory (the record and its vectors'
+/// entries); layout counts must be within [0, kMaxLayoutEntries] (no overflow).
+uint64_t StepRecordMemoryBytes(const RunLogLayout& layout);
+/// checks a layout read from a log or given to the writer: every count within
+/// [0, kMaxLayoutEntries], every joint's qpos and qvel span inside nq and nv. returns "" or
+/// the problem ("layout.nq is -3; expected 0 to 4194304").
+std::string CheckLayout(const RunLogLayout& layout);
+
 /// a chunk header as stored (RunLogChunkInfo less the file offset, plus the codec).
 struct ChunkHeader {
   RunLogChunkKind kind = RunLogChunkKind::kSteps;
@@ -51,7 +83,8 @@ std::string EncodePreamble(uint32_t version);
 /// the 64-byte header of `h` (with its CRC).
 std::string EncodeChunkHeader(const ChunkHeader& h);
 /// parses 64 bytes; returns "" and fills `out`, or the reason they are not a valid chunk
-/// header ("bad chunk magic", "header CRC mismatch", "unknown chunk kind 9", ...).
+/// header ("bad chunk magic", "header CRC mismatch", "unknown chunk kind 9", a raw or stored
+/// size above kMaxChunkBodyBytes (kMaxHeaderChunkBytes for the header chunk), ...).
 std::string DecodeChunkHeader(const uint8_t* bytes, ChunkHeader* out);
 
 /// CRC-32 (ISO-HDLC, zlib crc32) of `n` bytes.
@@ -59,8 +92,10 @@ uint32_t Crc32(const void* data, size_t n);
 
 /// zstd at `level`. @throws RunLogError with zstd's message.
 std::string ZstdCompress(std::string_view raw, int level);
-/// zstd decompression of a frame whose content is `raw_size` bytes.
-/// @throws RunLogError when the data is not such a frame.
+/// zstd decompression of a frame whose content is `raw_size` bytes (at most
+/// kMaxChunkBodyBytes). the frame's own content size, where it declares one, must equal
+/// `raw_size`; nothing larger than `raw_size` is allocated.
+/// @throws RunLogError when the data is not such a frame or `raw_size` is above the cap.
 std::string ZstdDecompress(std::string_view stored, uint64_t raw_size);
 
 /// appends little-endian values to a buffer.
@@ -113,8 +148,11 @@ class BodyReader {
 /// appends `r` to a steps body; `prev` is the previous record of the same chunk (null for
 /// the chunk's first), against which fields of equal size are XORed.
 void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body);
-/// reads one step record; `prev` as for EncodeStep. @throws RunLogError on malformed data.
-void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out);
+/// reads one step record; `prev` as for EncodeStep. with a `layout`, every field must have the
+/// layout's number of entries (as the writer enforces); without one, at most kMaxLayoutEntries.
+/// @throws RunLogError on malformed data (naming the field, the entries found and expected).
+void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
+                const RunLogLayout* layout = nullptr);
 
 /// appends an event / sensor record to a body.
 void EncodeEvent(const EventRecord& e, std::string* body);
@@ -125,7 +163,9 @@ SensorRecord DecodeSensor(BodyReader* in);
 
 /// the header as the JSON text of a header chunk.
 std::string HeaderToJson(const RunLogHeader& h);
-/// parses a header chunk's JSON. @throws RunLogError naming a missing or mistyped key.
+/// parses a header chunk's JSON (at most kMaxHeaderJsonValues values nested at most
+/// kMaxHeaderJsonDepth deep) and checks its layout (CheckLayout).
+/// @throws RunLogError naming a missing or mistyped key, a bad layout or a cap exceeded.
 RunLogHeader HeaderFromJson(std::string_view json);
 
 }  // namespace penumbra::runlog_codec

@@ -96,11 +96,32 @@ struct RunLogReader::Impl {
     }
   }
 
+  // refuses a record count that the body cannot hold or whose decoded records would take more
+  // than kMaxChunkDecodedBytes, before anything is allocated for them
+  void CheckRecordCount(size_t pos, uint64_t body_bytes, uint64_t min_record_bytes,
+                        uint64_t record_memory_bytes) const {
+    const RunLogChunkInfo& c = chunks[pos];
+    if (c.record_count > body_bytes / min_record_bytes)
+      throw RunLogError(fmt::format(
+          "{}: {} at byte {}: {} records declared; its {}-byte body holds at most {} of at least "
+          "{} bytes each",
+          path, ChunkName(c), c.file_offset, c.record_count, body_bytes,
+          body_bytes / min_record_bytes, min_record_bytes));
+    if (c.record_count > kMaxChunkDecodedBytes / record_memory_bytes)
+      throw RunLogError(fmt::format(
+          "{}: {} at byte {}: {} records of {} bytes each would take more than the format's "
+          "maximum of {} bytes decoded per chunk (docs/run-log.md \"Limits\")",
+          path, ChunkName(c), c.file_offset, c.record_count, record_memory_bytes,
+          kMaxChunkDecodedBytes));
+  }
+
   std::vector<StepRecord> DecodeSteps(size_t pos) {
     const std::string body = Body(pos);
+    CheckRecordCount(pos, body.size(), kMinStepRecordBytes, StepRecordMemoryBytes(header.layout));
     BodyReader in(body, fmt::format("{}: {}", path, ChunkName(chunks[pos])));
     std::vector<StepRecord> out(chunks[pos].record_count);
-    for (size_t i = 0; i < out.size(); ++i) DecodeStep(&in, i ? &out[i - 1] : nullptr, &out[i]);
+    for (size_t i = 0; i < out.size(); ++i)
+      DecodeStep(&in, i ? &out[i - 1] : nullptr, &out[i], &header.layout);
     if (!in.done()) in.Fail("bytes left after the last record");
     return out;
   }
@@ -114,7 +135,12 @@ struct RunLogReader::Impl {
     }
     if (c.kind != RunLogChunkKind::kEvents && c.kind != RunLogChunkKind::kSensors) return out;
     const std::string body = Body(pos);
+    // a decoded event or sensor record takes its strings' bytes plus the record itself
+    const bool events = c.kind == RunLogChunkKind::kEvents;
+    CheckRecordCount(pos, body.size(), events ? kMinEventRecordBytes : kMinSensorRecordBytes,
+                     sizeof(RunLogRecord));
     BodyReader in(body, fmt::format("{}: {}", path, ChunkName(c)));
+    out.reserve(c.record_count);
     for (uint32_t i = 0; i < c.record_count; ++i) {
       if (c.kind == RunLogChunkKind::kEvents)
         out.emplace_back(DecodeEvent(&in));
@@ -166,6 +192,7 @@ void RunLogReader::Impl::ReadPreambleAndHeader() {
                                h.index, RunLogChunkKindName(h.kind));
   bool cut = false;
   if (header_error.empty()) {
+    // stored_size is at most kMaxHeaderChunkBytes here (DecodeChunkHeader): the sum cannot wrap
     std::string stored;
     if (!ReadAt(kPreambleBytes + kChunkHeaderBytes, h.stored_size + kChunkTrailerBytes, &stored)) {
       cut = true;
@@ -266,13 +293,17 @@ void RunLogReader::Impl::ScanChunks() {
       why = fmt::format("{} is a second header chunk", name);
       break;
     }
-    const uint64_t need = h.stored_size + kChunkTrailerBytes;
+    // checked arithmetic: the declared size is compared with what is left before adding to it
+    // (DecodeChunkHeader has capped it at kMaxChunkBodyBytes as well)
     const uint64_t left = file_size - offset - kChunkHeaderBytes;
-    if (need > left) {
-      why = fmt::format("{} is cut off: the file ends {} bytes into its {}-byte body and CRC", name,
-                        left, need);
+    if (h.stored_size > left || kChunkTrailerBytes > left - h.stored_size) {
+      why = fmt::format(
+          "{} is cut off: the file ends {} bytes into its {}-byte body and CRC (chunk header at "
+          "byte {})",
+          name, left, h.stored_size + kChunkTrailerBytes, offset);
       break;
     }
+    const uint64_t need = h.stored_size + kChunkTrailerBytes;
     ReadAt(offset + kChunkHeaderBytes, need, &body);
     uint32_t crc;
     std::memcpy(&crc, body.data() + h.stored_size, 4);

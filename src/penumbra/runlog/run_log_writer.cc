@@ -69,6 +69,10 @@ void RunLogWriterOptions::ValidateOrThrow() const {
     throw ConfigError("", 0, "record.chunk_steps",
                       fmt::format("{} is not a step count; expected >= 1", chunk_steps));
   if (chunk_bytes < 1) throw ConfigError("", 0, "record.chunk_bytes", "0; expected >= 1");
+  if (chunk_bytes > runlog_codec::kMaxChunkBodyBytes / 2)
+    throw ConfigError("", 0, "record.chunk_bytes",
+                      fmt::format("{}; expected at most {} (docs/run-log.md \"Limits\")",
+                                  chunk_bytes, runlog_codec::kMaxChunkBodyBytes / 2));
   if (zstd_level < 1 || zstd_level > 19)
     throw ConfigError("", 0, "record.zstd_level", fmt::format("{}; expected 1 to 19", zstd_level));
   if (max_pending_chunks < 1)
@@ -140,6 +144,14 @@ struct RunLogWriter::Impl {
     ChunkHeader h = c.header;
     h.index = index;
     h.raw_size = c.raw.size();
+    // a reader refuses a larger chunk (docs/run-log.md "Limits")
+    const uint64_t cap =
+        h.kind == RunLogChunkKind::kHeader ? kMaxHeaderChunkBytes : kMaxChunkBodyBytes;
+    if (h.raw_size > cap)
+      throw RunLogError(fmt::format(
+          "a {} chunk of {} bytes is above the format's maximum of {} bytes (docs/run-log.md "
+          "\"Limits\"); record fewer or smaller sensor outputs",
+          RunLogChunkKindName(h.kind), h.raw_size, cap));
     std::string stored;
     if (!c.raw.empty()) stored = ZstdCompress(c.raw, options.zstd_level);
     if (c.raw.empty() || stored.size() >= c.raw.size()) {
@@ -178,9 +190,26 @@ struct RunLogWriter::Impl {
   }
 };
 
+namespace {
+
+// the writer never writes what the reader refuses (docs/run-log.md "Limits"): checked before the
+// file is opened or written
+void ThrowIfUnreadable(const std::string& path, const RunLogHeader& header) {
+  std::string bad = CheckLayout(header.layout);
+  if (bad.empty() && StepRecordMemoryBytes(header.layout) > kMaxChunkDecodedBytes / 2)
+    bad = fmt::format(
+        "one step of this model takes {} bytes, more than a run log chunk may hold "
+        "(docs/run-log.md \"Limits\")",
+        StepRecordMemoryBytes(header.layout));
+  if (!bad.empty()) throw RunLogError(fmt::format("run log {}: {}", path, bad));
+}
+
+}  // namespace
+
 RunLogWriter::RunLogWriter(const std::string& path, const RunLogHeader& header,
                            const RunLogWriterOptions& options) {
   options.ValidateOrThrow();
+  ThrowIfUnreadable(path, header);
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0)
     throw RunLogError(fmt::format("run log {}: cannot be created: {}", path, std::strerror(errno)));
@@ -190,6 +219,7 @@ RunLogWriter::RunLogWriter(const std::string& path, const RunLogHeader& header,
 RunLogWriter::RunLogWriter(UniqueFd fd, const std::string& name, const RunLogHeader& header,
                            const RunLogWriterOptions& options) {
   options.ValidateOrThrow();  // fd closes itself if this throws
+  ThrowIfUnreadable(name, header);
   Start(fd.release(), name, header, options);
 }
 
@@ -257,8 +287,10 @@ void RunLogWriter::Append(const StepRecord& r) {
   if (m.first_step < 0) m.first_step = r.step;
   m.last_step = r.step;
   ++m.n_steps;
+  // a chunk also closes at half the decoded size a reader accepts (docs/run-log.md "Limits")
   if (m.steps.count >= static_cast<uint32_t>(m.options.chunk_steps) ||
-      m.steps.body.size() >= m.options.chunk_bytes)
+      m.steps.body.size() >= m.options.chunk_bytes ||
+      (m.steps.count + 1) * StepRecordMemoryBytes(l) > kMaxChunkDecodedBytes / 2)
     m.FlushSteps();
 }
 

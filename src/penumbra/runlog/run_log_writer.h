@@ -19,7 +19,8 @@ namespace penumbra {
 struct RunLogWriterOptions {
   /// a steps chunk is closed after this many step records (>= 1) ...
   int chunk_steps = 256;
-  /// ... or once its raw body reaches this many bytes (>= 1), whichever comes first. events
+  /// ... or once its raw body reaches this many bytes (1 to 128 MiB), whichever comes first
+  /// (or at half the decoded size a reader accepts, docs/run-log.md "Limits"). events
   /// and sensor records pending at that point are written as chunks of their own at the same
   /// time, so a killed process loses at most the records since the last steps chunk.
   size_t chunk_bytes = size_t{1} << 20;

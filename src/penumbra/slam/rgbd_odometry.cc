@@ -7,6 +7,7 @@
 #include <opencv2/rgbd/depth.hpp>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/image_file_limits.h"
 
 namespace penumbra {
 namespace {
@@ -18,9 +19,11 @@ struct CvFrame {
 
 CvFrame ReadFrame(const RgbdFrameFiles& f, cv::Size expected) {
   CvFrame out;
+  CheckImageFileSize(f.rgb);  // declared sizes against the caps before decoding
   const cv::Mat rgb = cv::imread(f.rgb.string(), cv::IMREAD_COLOR);
   if (rgb.empty())
     throw ConfigError(f.rgb.string(), 0, "", "cannot read the colour image; expected an 8-bit PNG");
+  CheckImageFileSize(f.depth);
   const cv::Mat depth = cv::imread(f.depth.string(), cv::IMREAD_ANYDEPTH);
   if (depth.empty() || depth.type() != CV_16U)
     throw ConfigError(f.depth.string(), 0, "",

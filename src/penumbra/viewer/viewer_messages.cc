@@ -166,7 +166,14 @@ std::pair<json, std::string> UnpackFrameMessage(const std::string& m) {
   const uint32_t n = b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<uint32_t>(b[3]) << 24);
   if (m.size() < 4 + static_cast<size_t>(n))
     throw Error("frame message: header length " + std::to_string(n) + " exceeds the message");
-  return {json::parse(m.substr(4, n)), m.substr(4 + n)};
+  // the documented error for a header that is not JSON, not the parser's own exception
+  json header;
+  try {
+    header = json::parse(m.substr(4, n));
+  } catch (const json::exception& e) {
+    throw Error(std::string("frame message: the header is not JSON: ") + e.what());
+  }
+  return {std::move(header), m.substr(4 + n)};
 }
 
 }  // namespace penumbra

@@ -38,7 +38,7 @@ nlohmann::json BodyPosesJson(const WorldSnapshot& snapshot);
 std::string PackFrameMessage(const nlohmann::json& header, const std::string& payload);
 
 /// the header and payload of a PackFrameMessage result.
-/// @throws Error for a message shorter than its header length says.
+/// @throws Error for a message shorter than its header length says or whose header is not JSON.
 std::pair<nlohmann::json, std::string> UnpackFrameMessage(const std::string& message);
 
 }  // namespace penumbra

@@ -1,11 +1,13 @@
 #include "penumbra/world/world_config.h"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "penumbra/core/error.h"
@@ -446,22 +448,71 @@ bool HasModelExtension(const fs::path& p) {
   return ext == ".xml" || ext == ".urdf";
 }
 
+// counts the documents of a YAML stream without building nodes; a document that holds only a
+// null (a trailing '---') does not count
+class YamlDocumentCounter : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override { content_ = false; }
+  void OnDocumentEnd() override {
+    if (content_) marks.push_back(mark_);
+  }
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Content(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    Content(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    Content(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    Content(mark);
+  }
+  void OnMapEnd() override {}
+
+  /// where the root node of each document with content starts
+  std::vector<YAML::Mark> marks;
+
+ private:
+  void Content(const YAML::Mark& mark) {
+    if (!content_) mark_ = mark;
+    content_ = true;
+  }
+  YAML::Mark mark_;
+  bool content_ = false;
+};
+
+// where the second YAML document with content starts, if there is one. at most
+// kMaxYamlDocuments documents are read (an endless stream of empty documents is cut there)
+std::optional<YAML::Mark> SecondYamlDocument(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  YamlDocumentCounter counter;
+  for (int d = 0; d < kMaxYamlDocuments && counter.marks.size() < 2; ++d)
+    if (!parser.HandleNextDocument(counter)) break;
+  if (counter.marks.size() >= 2) return counter.marks[1];
+  return std::nullopt;
+}
+
 }  // namespace
 
 WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name) {
   auto lines = std::make_shared<LineTable>();
   WorldConfig w;
   try {
-    // a world file is one YAML document: a second one would be silently ignored
-    const std::vector<YAML::Node> docs = YAML::LoadAll(yaml_text);
-    RefuseYamlTags(yaml_text, file_name);
-    for (size_t d = 1; d < docs.size(); ++d) {
-      if (docs[d].IsNull()) continue;
-      throw ConfigError(file_name, MarkLine(docs[d].Mark()), "",
+    // a world file is one YAML document: a second one would be silently ignored. the
+    // documents are counted with a bounded loop, not YAML::LoadAll: yaml-cpp 0.7's LoadAll
+    // never ends on some 7-byte inputs (",sn\xd4 !:" yields empty documents for ever, found by
+    // fuzz/world_fuzz.cc), taking all memory
+    if (const std::optional<YAML::Mark> second = SecondYamlDocument(yaml_text))
+      throw ConfigError(file_name, MarkLine(*second), "",
                         "a second YAML document (after '---'); expected the world in one "
                         "document");
-    }
-    const YAML::Node root = docs.empty() ? YAML::Node() : docs.front();
+    RefuseYamlTags(yaml_text, file_name);
+    const YAML::Node root = YAML::Load(yaml_text);
     w = WorldParser(file_name, lines.get()).Parse(root);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(file_name, MarkLine(e.mark), "", "YAML syntax error: " + e.msg);

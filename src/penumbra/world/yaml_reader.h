@@ -110,6 +110,10 @@ class YamlReader {
   std::shared_ptr<const Context> ctx_;
 };
 
+/// the most YAML documents a reader of Penumbra's files walks: yaml-cpp 0.7 yields empty
+/// documents for ever on some short inputs (",sn\xd4 !:"), so every loop over documents stops here
+inline constexpr int kMaxYamlDocuments = 1024;
+
 /// refuses YAML tags: every node of every document of `text` must carry no tag (a plain or a
 /// quoted value, a mapping or a list as written). Penumbra's files read no tags, so a tag such
 /// as `!foo 3`, `!!binary ...` or `!!str 5` would otherwise be dropped without a word.
