@@ -4,9 +4,11 @@
 # each for SECONDS with its seed corpus, and prints a table target / runs / crashes.
 #
 #   bench/fuzz/run.sh [--seconds S] [--targets "runlog tum ..."] [--build DIR] [--jobs N]
+#                     [--parallel]
 #
 # defaults: 1800 s per target, every target, build folder build-fuzz, 2 build jobs. targets run
-# one at a time under `nice -n 19` on one core. new inputs go to DIR/corpus/<target> (the seed
+# one at a time under `nice -n 19` on one core; --parallel runs them side by side (each gets its
+# S seconds of wall time, sharing the cores). new inputs go to DIR/corpus/<target> (the seed
 # corpus in fuzz/corpus/ is read, never written); crashes, leaks, timeouts and out-of-memory
 # inputs go to DIR/findings/<target>/ and make the script exit 1. each target's libFuzzer log
 # is DIR/logs/<target>.log. needs clang and libclang-rt-14-dev (scripts/install-deps.sh).
@@ -17,14 +19,16 @@ seconds=1800
 targets="runlog world tum request viewer_messages"
 build="$root/build-fuzz"
 jobs=2
+parallel=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
     --targets) targets="$2"; shift 2 ;;
     --build) build="$(realpath -m "$2")"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
-    *) echo "run.sh: unknown argument '$1'; expected --seconds, --targets, --build or --jobs" >&2
+    --parallel) parallel=1; shift ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    *) echo "run.sh: unknown argument '$1'; expected --seconds, --targets, --build, --jobs or --parallel" >&2
        exit 2 ;;
   esac
 done
@@ -58,19 +62,29 @@ export ASAN_OPTIONS="${ASAN_OPTIONS:-abort_on_error=1:detect_leaks=1:malloc_cont
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 declare -A runs crashes
 failed=0
-for t in $targets; do
-  work="$build/corpus/$t"
-  findings="$build/findings/$t"
+# one target for $seconds: its libFuzzer exit status goes to logs/<target>.rc
+fuzz_one() {
+  local t="$1" work="$build/corpus/$1" findings="$build/findings/$1"
   mkdir -p "$work" "$findings"
   echo "== $t: ${seconds} s" >&2
-  set +e
   # -rss_limit_mb: an input that makes a parser take 2 GB (or malloc that much at once) is a
   # finding; -timeout: one input running 30 s is a finding (a hang)
   nice -n 19 "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 \
     -print_final_stats=1 -artifact_prefix="$findings/" "$work" "$root/fuzz/corpus/$t" \
     >"$build/logs/$t.log" 2>&1
-  rc=$?
-  set -e
+  echo $? >"$build/logs/$t.rc"
+}
+set +e
+if [ "$parallel" = 1 ]; then
+  for t in $targets; do fuzz_one "$t" & done
+  wait
+else
+  for t in $targets; do fuzz_one "$t"; done
+fi
+set -e
+for t in $targets; do
+  findings="$build/findings/$t"
+  rc=$(cat "$build/logs/$t.rc")
   # (a run killed from outside leaves no final stats: runs "?")
   runs[$t]=$( { grep -o 'stat::number_of_executed_units: *[0-9]*' "$build/logs/$t.log" || true; } |
              grep -o '[0-9]*$' | tail -1 || true)
