@@ -25,8 +25,8 @@ constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
 std::optional<ImageFileSize> PeekImageFileSize(std::string_view b) {
   // PNG: signature, then the IHDR chunk (length 13, "IHDR", width, height, ...)
   if (b.substr(0, 8) == kPngSignature) {
-    if (b.size() < 24 || b.substr(12, 4) != "IHDR") return std::nullopt;
-    return ImageFileSize{BigEndian32(b, 16), BigEndian32(b, 20)};
+    if (b.size() < 26 || b.substr(12, 4) != "IHDR") return std::nullopt;
+    return ImageFileSize{BigEndian32(b, 16), BigEndian32(b, 20), uint8_t(b[24]), uint8_t(b[25])};
   }
   // JPEG: SOI, then segments (0xff, marker, 16-bit length including itself) up to the first
   // start of frame (SOF0..SOF15 less DHT c4, JPG c8 and DAC cc): precision, height, width

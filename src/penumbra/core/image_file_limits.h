@@ -22,6 +22,10 @@ inline constexpr uint32_t kMaxImageFileSide = 1 << 15;
 struct ImageFileSize {
   uint32_t width = 0;
   uint32_t height = 0;
+  /// PNG only (0 for JPEG): IHDR's bit depth (1..16) and colour type (0 grey, 2 RGB, 3 palette,
+  /// 4 grey + alpha, 6 RGBA; PNG specification, section 11.2.2)
+  int png_bit_depth = 0;
+  int png_colour_type = 0;
 };
 
 /// the size that `bytes` (a whole file, or at least its beginning) declare: PNG by its signature

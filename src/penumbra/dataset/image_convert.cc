@@ -2,10 +2,10 @@
 
 #include <fmt/format.h>
 
-#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,13 +25,6 @@ struct CheckedPng {
   cv::Mat image;
 };
 
-uint32_t BigEndian32(const std::string& b, size_t at) {
-  return (static_cast<uint32_t>(static_cast<uint8_t>(b[at])) << 24) |
-         (static_cast<uint32_t>(static_cast<uint8_t>(b[at + 1])) << 16) |
-         (static_cast<uint32_t>(static_cast<uint8_t>(b[at + 2])) << 8) |
-         static_cast<uint32_t>(static_cast<uint8_t>(b[at + 3]));
-}
-
 CheckedPng ReadCheckedPng(const RunCamera& cam, const std::string& kind, int64_t index) {
   const bool rgb = kind == "rgb";
   const int channels = rgb ? 3 : 1, bit_depth = rgb ? 8 : 16, colour_type = rgb ? 2 : 0;
@@ -47,15 +40,15 @@ CheckedPng ReadCheckedPng(const RunCamera& cam, const std::string& kind, int64_t
                        static_cast<uint64_t>(cam.height);
   CheckedPng p;
   p.bytes = ReadRunFile(cam.run_dir, relative, 2 * raw + (1u << 20));
-  CheckImageBytesSize(p.bytes, file);  // the declared size against the caps before decoding
-  // the header is checked before anything is allocated for the pixels
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (p.bytes.size() < 33 || std::memcmp(p.bytes.data(), kSignature, 8) != 0 ||
-      p.bytes.compare(12, 4, "IHDR") != 0)
+  // the header is checked (against the caps, then against camera_info.json) before anything is
+  // allocated for the pixels
+  const std::optional<ImageFileSize> declared = PeekImageFileSize(p.bytes);
+  if (!declared || declared->png_bit_depth == 0)
     throw ConfigError(file, 0, "",
                       "not a PNG file (no PNG signature and header); expected " + expected);
-  const uint32_t w = BigEndian32(p.bytes, 16), h = BigEndian32(p.bytes, 20);
-  const int depth = static_cast<uint8_t>(p.bytes[24]), type = static_cast<uint8_t>(p.bytes[25]);
+  CheckImageBytesSize(p.bytes, file);
+  const uint32_t w = declared->width, h = declared->height;
+  const int depth = declared->png_bit_depth, type = declared->png_colour_type;
   if (w != static_cast<uint32_t>(cam.width) || h != static_cast<uint32_t>(cam.height))
     throw ConfigError(file, 0, "", fmt::format("{} x {} pixels; expected {}", w, h, expected));
   if (depth != bit_depth || type != colour_type)

@@ -9,35 +9,12 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_path_policy.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
-
-// a file descriptor closed when it goes out of scope
-class RunFd {
- public:
-  explicit RunFd(int fd) : fd_(fd) {}
-  RunFd(const RunFd&) = delete;
-  RunFd& operator=(const RunFd&) = delete;
-  ~RunFd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  int get() const { return fd_; }
-  void Reset(int fd) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = fd;
-  }
-  int Release() {
-    const int fd = fd_;
-    fd_ = -1;
-    return fd;
-  }
-
- private:
-  int fd_ = -1;
-};
 
 // the error for an entry `name` of the folder `dir_fd` (shown as `shown`) that could not be
 // opened with errno `err`
@@ -64,7 +41,7 @@ int OpenParentFolder(const fs::path& run_dir, const fs::path& relative, std::str
     throw ConfigError(shown.string(), 0, "",
                       "not a path inside the run folder (absolute, empty or with a '.' or '..' "
                       "component); expected a file or folder name inside it");
-  RunFd dir(::open(run_dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  UniqueFd dir(::open(run_dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (dir.get() < 0)
     throw ConfigError(run_dir.string(), 0, "",
                       std::string("cannot open the run folder: ") + std::strerror(errno));
@@ -76,10 +53,10 @@ int OpenParentFolder(const fs::path& run_dir, const fs::path& relative, std::str
     const int next =
         ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
     if (next < 0) RefuseEntry(dir.get(), parts[i], walked, errno, "a folder");
-    dir.Reset(next);
+    dir = UniqueFd(next);
   }
   *last = parts.back();
-  return dir.Release();
+  return dir.release();
 }
 
 }  // namespace
@@ -95,7 +72,7 @@ bool IsPlainRelativePath(const fs::path& relative) {
 
 RunEntry StatRunEntry(const fs::path& run_dir, const fs::path& relative) {
   std::string last;
-  const RunFd dir(OpenParentFolder(run_dir, relative, &last));
+  const UniqueFd dir(OpenParentFolder(run_dir, relative, &last));
   struct stat st {};
   if (fstatat(dir.get(), last.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) {
     if (errno == ENOENT) return RunEntry::kMissing;
@@ -114,9 +91,9 @@ RunEntry StatRunEntry(const fs::path& run_dir, const fs::path& relative) {
 std::string ReadRunFile(const fs::path& run_dir, const fs::path& relative, uint64_t max_bytes) {
   const fs::path shown = run_dir / relative;
   std::string last;
-  const RunFd dir(OpenParentFolder(run_dir, relative, &last));
+  const UniqueFd dir(OpenParentFolder(run_dir, relative, &last));
   // O_NONBLOCK: a FIFO opens at once (and is refused below) instead of waiting for a writer
-  const RunFd file(
+  const UniqueFd file(
       ::openat(dir.get(), last.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC));
   if (file.get() < 0) RefuseEntry(dir.get(), last, shown, errno, "a regular file");
   struct stat st {};
