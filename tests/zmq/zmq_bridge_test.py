@@ -30,6 +30,7 @@ import time
 
 import msgpack
 import zmq
+from zmq.utils.monitor import recv_monitor_message
 
 TIMEOUT_MS = 20000
 
@@ -655,6 +656,70 @@ def test_unsubscribe(binary, source):
             server.kill()
 
 
+def resident_mb(pid):
+    """resident memory of process `pid`, MB (/proc/PID/status VmRSS)."""
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    raise AssertionError(f"no VmRSS in /proc/{pid}/status")
+
+
+def test_subscription_memory(binary, source):
+    """10,000 distinct subscriptions of 1 KB from one subscriber add less than 50 MB to the
+    server (ZeroMQ disconnects a subscriber whose subscription message is over the size cap;
+    without that cap they added about 330 MB), while a subscriber within the caps still gets
+    its topic, and no longer once it unsubscribed."""
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
+        try:
+            c = Client(server, topics=(b"clock",))
+            r = c.ok("step", n=1)
+            assert r["published"].get("clock", 0) >= 1, r["published"]
+            c.receive(r["published"])
+            before = resident_mb(server.proc.pid)
+            flood = c.ctx.socket(zmq.SUB)
+            flood.setsockopt(zmq.LINGER, 0)
+            flood.setsockopt(zmq.SNDHWM, 0)
+            monitor = flood.get_monitor_socket(zmq.EVENT_DISCONNECTED)
+            flood.connect(c.hello["pub_endpoint"])
+            for i in range(10000):
+                flood.setsockopt(zmq.SUBSCRIBE, b"%08d" % i + b"y" * 1016)
+            # the server has read the flood once it disconnected the subscriber, or once its
+            # memory grew by the bound (it took them in)
+            deadline = time.time() + TIMEOUT_MS / 1000
+            grown = 0.0
+            while grown < 50:
+                assert time.time() < deadline, "neither a disconnect nor memory growth"
+                if monitor.poll(100):
+                    event = recv_monitor_message(monitor)
+                    assert event["event"] == zmq.EVENT_DISCONNECTED, event
+                    break
+                grown = resident_mb(server.proc.pid) - before
+            grown = resident_mb(server.proc.pid) - before
+            assert grown < 50, f"10,000 subscriptions of 1 KB added {grown:.0f} MB to the server"
+            # the subscriber within the caps: clock still arrives, and stops after unsubscribing
+            r = c.ok("step", n=1)
+            assert r["published"].get("clock", 0) >= 1, r["published"]
+            c.receive(r["published"])
+            c.sub.setsockopt(zmq.UNSUBSCRIBE, b"clock")
+            c.sub.setsockopt(zmq.SUBSCRIBE, b"sync")
+            wait_for_sync(c, [c.sub])
+            c.unsubscribe_sync()
+            r = c.ok("step", n=1)
+            assert "clock" not in r["published"], r["published"]
+            assert not c.sub.poll(200), "a message arrived after the unsubscribe"
+            flood.disable_monitor()
+            monitor.close()
+            flood.close()
+            c.ok("stop")
+            c.close()
+            assert server.wait() == 0
+        finally:
+            server.kill()
+
+
 def test_bridge_log(binary, source):
     """a run driven over ZeroMQ logs its commands; --resimulate refuses the log naming the
     first, --resimulate ctrl (the logged ctrl) reproduces it bit-exactly."""
@@ -689,7 +754,7 @@ def test_bridge_log(binary, source):
 TESTS = {"lockstep": test_lockstep, "errors": test_errors, "stop": test_stop,
          "free": test_free, "live": test_live, "shutdown": test_shutdown,
          "subscriptions": test_subscriptions, "unsubscribe": test_unsubscribe,
-         "bridge_log": test_bridge_log}
+         "subscription_memory": test_subscription_memory, "bridge_log": test_bridge_log}
 
 
 def main():

@@ -38,6 +38,9 @@ constexpr size_t kMaxRequestFrames = 4;            // frames kept of one request
 // or the run's longest topic if longer: no topic needs a longer prefix), are dropped and
 // logged. a subscription message above twice the cap makes ZeroMQ drop that subscriber
 // (ZMQ_MAXMSGSIZE), which also bounds what ZeroMQ's own subscription tree holds per prefix.
+// the number of prefixes in that tree is not bounded: ZMQ_XPUB_MANUAL still records every
+// subscription of every subscriber (measured the same memory), a subscription message names
+// no subscriber (Peer-Address is the IP only), and XPUB cannot disconnect one subscriber.
 constexpr size_t kMaxSubscriptions = 1024;
 constexpr size_t kMinPrefixCap = 256;
 constexpr int kSubscriptionsPerTurn = 256;  // handled per turn of the publish thread
