@@ -246,7 +246,7 @@ TEST(LiveControlTest, ClientPresetFilesStayInsideTheWorldFolderAndAreNotQuoted) 
       EXPECT_NE(m.find(words), std::string::npos) << spec << ": " << m;
       EXPECT_EQ(m.find("SECRET"), std::string::npos) << spec << ": " << m;
       EXPECT_EQ(m.find("api_token"), std::string::npos) << spec << ": " << m;
-      EXPECT_EQ(m.find(tmp.str()), std::string::npos) << spec << ": " << m;
+      EXPECT_EQ(m.find((tmp.path() / "world").string()), std::string::npos) << spec << ": " << m;
     }
   };
   refused(secret, "is absolute");

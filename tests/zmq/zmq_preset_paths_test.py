@@ -63,7 +63,7 @@ def main():
                 assert err["code"] == "bad_field" and err["field"] == "preset", (spec, r)
                 m = err["message"]
                 assert words in m, (spec, m)
-                for leaked in ("SECRET", "api_token", passwd_first, tmp):
+                for leaked in ("SECRET", "api_token", passwd_first, folder):
                     assert leaked not in m, f"{spec}: the reply quotes {leaked!r}: {m}"
             # a preset file inside the world file's folder, named relative to it
             r = c.ok("set_adversity", preset="presets/smoky.yaml#smoky")
