@@ -299,8 +299,9 @@ class Client:
                             qwxyz=None if qwxyz is None else [float(v) for v in qwxyz])
 
     def set_adversity(self, preset):
-        """Switches the adversity preset (e.g. ``"none"``, ``"minor"``, ``"major"``,
-        ``"fog:0.7"``) at the next step boundary."""
+        """Switches the adversity preset (``"none"``, ``"minor"``, ``"major"``, or
+        ``"FILE.yaml"`` / ``"FILE.yaml#NAME"`` inside the world file's folder, relative to it)
+        at the next step boundary."""
         return self.request("set_adversity", preset=preset)
 
     def set_effect(self, effect, **params):

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/temp_dir.h"
@@ -125,6 +126,76 @@ TEST_F(OutputPathPolicyTest, TheFolderItselfMayBeALinkTheUserMade) {
   EXPECT_TRUE(fs::is_regular_file(root_ / "a.plog"));
   EXPECT_NE(PolicyRefusal(tmp_.path() / "absent", "a.plog").find("cannot be opened"),
             std::string::npos);
+}
+
+// the read side (ReadExistingFileInside: set_adversity's preset files): an existing regular
+// file inside the folder, never outside it, never through a link, never more than the cap;
+// a refusal names the path and the rule and never quotes the file
+std::string ReadRefusal(const fs::path& root, const std::string& client_path,
+                        size_t max_bytes = 1 << 20) {
+  try {
+    ReadExistingFileInside(root, client_path, ".yaml", max_bytes, "the world file's folder");
+  } catch (const InputPathError& e) {
+    EXPECT_EQ(e.client_path(), client_path);
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(OutputPathPolicyTest, ReadsAnExistingFileInsideTheFolder) {
+  tmp_.Write("out/presets/fog.yaml", "presets: {}\n");
+  const ExistingInputFile f =
+      ReadExistingFileInside(root_, "presets/fog.yaml", ".yaml", 100, "the folder");
+  EXPECT_EQ(f.text, "presets: {}\n");
+  EXPECT_EQ(f.relative, "presets/fog.yaml");
+  EXPECT_EQ(f.path, root_ / "presets/fog.yaml");
+}
+
+TEST_F(OutputPathPolicyTest, ReadRefusesPathsOutsideTheFolderAndQuotesNoContent) {
+  const std::string secret = tmp_.Write("outside/secret.yaml", "token: SECRET-CONTENT\n");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {secret, "is absolute"},
+      {"../outside/secret.yaml", "'..' component"},
+      {"logs/../../outside/secret.yaml", "'..' component"},
+      {"./a.yaml", "'.' component"},
+      {"a.yml", "does not end in .yaml"},
+      {"missing.yaml", "does not exist"},
+      {"nofolder/a.yaml", "the folder 'nofolder' does not exist"},
+  };
+  for (const auto& [path, rule] : cases) {
+    const std::string m = ReadRefusal(root_, path);
+    EXPECT_NE(m.find(rule), std::string::npos) << path << ": " << m;
+    EXPECT_EQ(m.find("SECRET"), std::string::npos) << m;
+    EXPECT_EQ(m.find(root_.string() + "/"), std::string::npos) << m;
+  }
+}
+
+TEST_F(OutputPathPolicyTest, ReadNeverFollowsALinkBelowTheFolder) {
+  const std::string secret = tmp_.Write("outside/secret.yaml", "token: SECRET-CONTENT\n");
+  fs::create_symlink(secret, root_ / "link.yaml");
+  fs::create_symlink(outside_, root_ / "dir");
+  fs::create_symlink("/etc/passwd", root_ / "passwd.yaml");
+  for (const auto& [path, rule] : std::vector<std::pair<std::string, std::string>>{
+           {"link.yaml", "is a symbolic link"},
+           {"passwd.yaml", "is a symbolic link"},
+           {"dir/secret.yaml", "'dir' is a symbolic link"}}) {
+    const std::string m = ReadRefusal(root_, path);
+    EXPECT_NE(m.find(rule), std::string::npos) << path << ": " << m;
+    EXPECT_EQ(m.find("SECRET"), std::string::npos) << m;
+    EXPECT_EQ(m.find("root:"), std::string::npos) << m;
+  }
+}
+
+TEST_F(OutputPathPolicyTest, ReadRefusesSpecialAndOversizedFiles) {
+  ASSERT_EQ(::mkfifo((root_ / "fifo.yaml").c_str(), 0600), 0);
+  EXPECT_NE(ReadRefusal(root_, "fifo.yaml").find("not a regular file"), std::string::npos);
+  fs::create_directories(root_ / "dir.yaml");
+  EXPECT_NE(ReadRefusal(root_, "dir.yaml").find("is a folder"), std::string::npos);
+  tmp_.Write("out/big.yaml", std::string(101, 'x'));
+  EXPECT_NE(ReadRefusal(root_, "big.yaml", 100).find("101 bytes long, more than 100"),
+            std::string::npos);
+  tmp_.Write("out/ok.yaml", std::string(100, 'x'));
+  EXPECT_EQ(ReadRefusal(root_, "ok.yaml", 100), "");
 }
 
 }  // namespace

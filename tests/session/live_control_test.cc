@@ -141,7 +141,7 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
     }
   };
   refused([&] { fx.SetAdversity("foggiest"); }, "adversity", "expected one of: none, minor, major");
-  refused([&] { fx.SetAdversity("/nonexistent/presets.yaml"); }, "adversity", "not found");
+  refused([&] { fx.SetAdversity("/nonexistent/presets.yaml"); }, "preset", "is absolute");
   // the preset the world started without has no NPC bodies
   refused([&] { fx.SetAdversity("major"); }, "npcs", "cannot add bodies");
   refused([&] { fx.SetEffect("npcs", {{"people", 1}}); }, "npcs", "cannot add bodies");
@@ -212,6 +212,63 @@ TEST(LiveControlTest, BadRequestsAreRefusedNamingTheFieldAndChangeNothing) {
   fx.Wants(1, 0.002);
   ASSERT_EQ(session.effects().effects().size(), 1u);
   EXPECT_EQ(session.effects().effects()[0].name, "fog");
+}
+
+// a client's preset file (set_adversity) is read from inside the world file's folder only:
+// an absolute path, "..", a symbolic link or a non-YAML file is refused naming the rule, and
+// no refusal quotes the file's content; a preset file inside the folder still works
+TEST(LiveControlTest, ClientPresetFilesStayInsideTheWorldFolderAndAreNotQuoted) {
+  penumbra::testing::TempDir tmp;
+  WorldConfig world = LoadWorldFile((kWorlds / "effects" / "fog.yaml").string());
+  world.file = (tmp.path() / "world" / "fog.yaml").string();  // the folder presets come from
+  fs::create_directories(tmp.path() / "world" / "presets");
+  const std::string secret = tmp.Write("outside/secret.yaml", "api_token: SECRET-TOKEN\n");
+  const std::string notes = tmp.Write("outside/notes.txt", "one line of SECRET-TEXT\n");
+  tmp.Write("world/presets/smoky.yaml",
+            "presets:\n  smoky:\n    fog: {mor_m: 4}\n    lights: {scale: 0.4}\n");
+  tmp.Write("world/bad.yaml", "presets:\n  p:\n    fog: {mor_m: SECRET-VALUE}\n");
+  tmp.Write("world/text.yaml", "one line of SECRET-TEXT\n");
+  fs::create_symlink(secret, tmp.path() / "world" / "link.yaml");
+  fs::create_symlink(notes, tmp.path() / "world" / "notes.yaml");
+  fs::create_symlink(tmp.path() / "outside", tmp.path() / "world" / "out");
+  SessionOptions o;
+  o.build_renderer = false;
+  Session session(world, o);
+  LiveControl live(session, "test", tmp.path());
+  LiveEffects& fx = live.effects();
+  const auto refused = [&](const std::string& spec, const std::string& words) {
+    try {
+      fx.SetAdversity(spec);
+      ADD_FAILURE() << spec << ": accepted; expected a refusal";
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(e.key(), "preset") << m;
+      EXPECT_NE(m.find(words), std::string::npos) << spec << ": " << m;
+      EXPECT_EQ(m.find("SECRET"), std::string::npos) << spec << ": " << m;
+      EXPECT_EQ(m.find("api_token"), std::string::npos) << spec << ": " << m;
+      EXPECT_EQ(m.find((tmp.path() / "world").string()), std::string::npos) << spec << ": " << m;
+    }
+  };
+  refused(secret, "is absolute");
+  refused(secret + "#p", "is absolute");
+  refused("../outside/secret.yaml", "'..' component");
+  refused("presets/../../outside/secret.yaml", "'..' component");
+  refused("link.yaml", "is a symbolic link");
+  refused("notes.yaml", "is a symbolic link");
+  refused("out/secret.yaml", "'out' is a symbolic link");
+  refused("bad.yaml", "line 3: not a valid adversity preset file");
+  refused("text.yaml#x", "line 1: not a valid adversity preset file");
+  refused("presets/smoky.yaml#other", "unknown preset 'other' in 'presets/smoky.yaml'");
+  EXPECT_EQ(fx.pending(), 0u);
+
+  // a preset file inside the folder, named relative to it
+  fx.SetAdversity("presets/smoky.yaml#smoky");
+  fx.SetAdversity("presets/smoky.yaml");  // its only preset
+  EXPECT_EQ(fx.pending(), 2u);
+  fx.Wants(0, 0.0);
+  ASSERT_TRUE(session.effects().preset());
+  EXPECT_EQ(session.effects().preset()->name, "smoky");
+  EXPECT_EQ(*session.effects().preset()->fog_mor_m, 4.0);
 }
 
 TEST(LiveControlTest, NpcsOfTheStartingPresetMoveOrParkAndTheRestStayBitExact) {

@@ -452,15 +452,16 @@ def test_live(binary, source):
             major = rgb_contrast(frame_after(50))
             assert major < 0.9 * clear, f"major: contrast {clear:.1f} -> {major:.1f}"
             # a preset file asking for more NPCs than any bundled preset is refused, naming why
+            # (preset files are named relative to the world file's folder, here tmp)
             crowd = os.path.join(tmp, "crowd.yaml")
             with open(crowd, "w") as f:
                 f.write("presets:\n  crowd:\n    npcs: {people: 9}\n")
-            expect_error(c, pack({"cmd": "set_adversity", "preset": crowd + "#crowd"}),
+            expect_error(c, pack({"cmd": "set_adversity", "preset": "crowd.yaml#crowd"}),
                          "bad_field", "npcs")
             preset = os.path.join(tmp, "smoky.yaml")
             with open(preset, "w") as f:
                 f.write("presets:\n  smoky:\n    fog: {mor_m: 4}\n    lights: {scale: 0.4}\n")
-            c.ok("set_adversity", preset=preset + "#smoky")
+            c.ok("set_adversity", preset="smoky.yaml#smoky")
             smoky = rgb_contrast(frame_after(50))
             assert smoky < 0.8 * clear, f"preset smoky: contrast {clear:.1f} -> {smoky:.1f}"
             c.ok("set_adversity", preset="none")

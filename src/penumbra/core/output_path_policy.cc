@@ -5,8 +5,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 
 namespace penumbra {
 namespace {
@@ -25,6 +28,52 @@ std::string WhatIsThere(int dirfd, const std::string& name) {
   if (S_ISDIR(st.st_mode)) return "a folder";
   if (S_ISREG(st.st_mode)) return "a file";
   return "a special file";
+}
+
+// the path rules shared by the write and the read side; `fail` throws
+std::vector<std::string> SplitClientPath(const std::string& path,
+                                         std::string_view required_extension, bool reading,
+                                         const std::function<void(const std::string&)>& fail) {
+  if (path.empty()) fail("is empty");
+  if (path.size() > kMaxClientPathBytes)
+    fail("is " + std::to_string(path.size()) + " bytes long, more than " +
+         std::to_string(kMaxClientPathBytes));
+  for (const char c : path) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b < 0x20 || b == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", b);
+      fail(std::string("holds the control character ") + hex);
+    }
+  }
+  if (path.front() == '/')
+    fail(reading
+             ? "is absolute (starts with '/'); only files inside the folder are read"
+             : "is absolute (starts with '/'); only paths inside the output folder are written");
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (;;) {
+    const size_t slash = path.find('/', start);
+    parts.push_back(
+        path.substr(start, slash == std::string::npos ? std::string::npos : slash - start));
+    if (slash == std::string::npos) break;
+    start = slash + 1;
+  }
+  for (const std::string& p : parts) {
+    if (p == "..")
+      fail(reading ? "has a '..' component (it would leave the folder)"
+                   : "has a '..' component (it would leave the output folder)");
+    if (p.empty()) fail("has an empty component ('//' or a trailing '/')");
+    if (p == ".") fail("has a '.' component");
+  }
+  const std::string& name = parts.back();
+  if (name.size() < required_extension.size() ||
+      name.compare(name.size() - required_extension.size(), std::string::npos,
+                   required_extension) != 0)
+    fail("does not end in " + std::string(required_extension));
+  if (name.size() == required_extension.size())
+    fail("has no name before " + std::string(required_extension));
+  return parts;
 }
 
 }  // namespace
@@ -51,45 +100,9 @@ OutputPathError::OutputPathError(const std::string& client_path, const std::stri
 std::vector<std::string> CheckClientPath(std::string_view client_path,
                                          std::string_view required_extension) {
   const std::string path(client_path);
-  auto fail = [&](const std::string& rule) {
+  return SplitClientPath(path, required_extension, false, [&](const std::string& rule) {
     throw OutputPathError(path, rule, required_extension);
-  };
-  if (path.empty()) fail("is empty");
-  if (path.size() > kMaxClientPathBytes)
-    fail("is " + std::to_string(path.size()) + " bytes long, more than " +
-         std::to_string(kMaxClientPathBytes));
-  for (const char c : path) {
-    const auto b = static_cast<unsigned char>(c);
-    if (b < 0x20 || b == 0x7f) {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", b);
-      fail(std::string("holds the control character ") + hex);
-    }
-  }
-  if (path.front() == '/')
-    fail("is absolute (starts with '/'); only paths inside the output folder are written");
-  std::vector<std::string> parts;
-  size_t start = 0;
-  for (;;) {
-    const size_t slash = path.find('/', start);
-    parts.push_back(
-        path.substr(start, slash == std::string::npos ? std::string::npos : slash - start));
-    if (slash == std::string::npos) break;
-    start = slash + 1;
-  }
-  for (const std::string& p : parts) {
-    if (p == "..") fail("has a '..' component (it would leave the output folder)");
-    if (p.empty()) fail("has an empty component ('//' or a trailing '/')");
-    if (p == ".") fail("has a '.' component");
-  }
-  const std::string& name = parts.back();
-  if (name.size() < required_extension.size() ||
-      name.compare(name.size() - required_extension.size(), std::string::npos,
-                   required_extension) != 0)
-    fail("does not end in " + std::string(required_extension));
-  if (name.size() == required_extension.size())
-    fail("has no name before " + std::string(required_extension));
-  return parts;
+  });
 }
 
 NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_view client_path,
@@ -137,6 +150,85 @@ NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_v
   out.fd = std::move(fd);
   out.folder = std::move(dir);
   out.name = name;
+  out.path = root / path;
+  out.relative = path;
+  return out;
+}
+
+InputPathError::InputPathError(const std::string& client_path, const std::string& rule,
+                               std::string_view required_extension, std::string_view folder_name)
+    : Error("file '" + SanitizeForMessage(client_path, 300) + "': " + rule +
+            "; expected an existing file ending in " + std::string(required_extension) +
+            ", named relative to " + std::string(folder_name) + " (no '..', no symbolic link)"),
+      client_path_(client_path),
+      rule_(rule) {}
+
+ExistingInputFile ReadExistingFileInside(const std::filesystem::path& root,
+                                         std::string_view client_path,
+                                         std::string_view required_extension, size_t max_bytes,
+                                         std::string_view folder_name) {
+  const std::string path(client_path);
+  auto fail = [&](const std::string& rule) {
+    throw InputPathError(path, rule, required_extension, folder_name);
+  };
+  const std::vector<std::string> parts = SplitClientPath(path, required_extension, true, fail);
+  // the folder as the user named it (a link there is the user's own choice)
+  UniqueFd dir(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir.get() < 0) fail(std::string("the folder cannot be opened: ") + std::strerror(errno));
+  // each folder below it: opened relative to the one above, never through a link
+  std::string walked;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    walked += (walked.empty() ? "" : "/") + parts[i];
+    UniqueFd next(
+        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+    if (next.get() < 0) {
+      const int err = errno;
+      const std::string what = WhatIsThere(dir.get(), parts[i]);
+      const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
+      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
+      if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
+      if (err == ENOENT) fail("the folder " + quoted + " does not exist");
+      fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
+    }
+    dir = std::move(next);
+  }
+  // the file: never through a link, and without blocking on a FIFO
+  const std::string& name = parts.back();
+  UniqueFd fd(
+      ::openat(dir.get(), name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY | O_CLOEXEC));
+  if (fd.get() < 0) {
+    const int err = errno;
+    const std::string what = WhatIsThere(dir.get(), name);
+    if (what == "a symbolic link") fail("is a symbolic link; links are never followed");
+    if (err == ENOENT) fail("does not exist");
+    fail(std::string("cannot be opened: ") + std::strerror(err));
+  }
+  struct stat st;
+  if (::fstat(fd.get(), &st) != 0) fail(std::string("cannot be read: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) fail("is a folder, not a file");
+  if (!S_ISREG(st.st_mode)) fail("is a special file (FIFO, device or socket), not a regular file");
+  if (static_cast<uint64_t>(st.st_size) > max_bytes)
+    fail("is " + std::to_string(st.st_size) + " bytes long, more than " +
+         std::to_string(max_bytes));
+  // read at most max_bytes + 1: a file that grew since fstat is refused, not read on
+  ExistingInputFile out;
+  out.text.resize(static_cast<size_t>(st.st_size));
+  size_t got = 0;
+  for (;;) {
+    if (got == out.text.size()) {
+      if (out.text.size() > max_bytes) break;
+      out.text.resize(std::min(max_bytes + 1, out.text.size() + 4096));
+    }
+    const ssize_t n = ::read(fd.get(), out.text.data() + got, out.text.size() - got);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail(std::string("cannot be read: ") + std::strerror(errno));
+    }
+    if (n == 0) break;
+    got += static_cast<size_t>(n);
+  }
+  if (got > max_bytes) fail("is more than " + std::to_string(max_bytes) + " bytes long");
+  out.text.resize(got);
   out.path = root / path;
   out.relative = path;
   return out;

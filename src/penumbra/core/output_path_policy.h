@@ -15,6 +15,13 @@
 //
 // errors name the path as the client gave it (escaped) and the rule it broke; they never name
 // the output folder's absolute path, so that a client learns nothing about the server's disk.
+//
+// the read side (ReadExistingFileInside: set_adversity's preset files) has the same rules for
+// the path, applied to a folder the caller names (the world file's folder): the path is
+// relative, has no "..", "." or empty component, ends in the required extension, every
+// folder on the way and the file itself are opened with O_NOFOLLOW (a symbolic link anywhere
+// below the folder is refused), the file must be a regular file (no FIFO or device: opened
+// with O_NONBLOCK, then checked) of at most a given size, read whole.
 
 #include <filesystem>
 #include <string>
@@ -74,6 +81,29 @@ struct NewOutputFile {
   std::string relative;        ///< the client's path, as checked (e.g. "logs/a.plog")
 };
 
+/// a client path refused by ReadExistingFileInside: what() is "file '<path>': <rule>; expected
+/// an existing file ending in <ext>, named relative to <folder>".
+class InputPathError : public Error {
+ public:
+  InputPathError(const std::string& client_path, const std::string& rule,
+                 std::string_view required_extension, std::string_view folder_name);
+  /// the path as the client gave it (unescaped).
+  const std::string& client_path() const { return client_path_; }
+  /// the rule it broke, e.g. "is absolute (starts with '/')".
+  const std::string& rule() const { return rule_; }
+
+ private:
+  std::string client_path_;
+  std::string rule_;
+};
+
+/// a file read by ReadExistingFileInside.
+struct ExistingInputFile {
+  std::string text;            ///< its whole content
+  std::filesystem::path path;  ///< where it is: root / relative
+  std::string relative;        ///< the client's path, as checked (e.g. "presets/fog.yaml")
+};
+
 /// the longest client path accepted, in bytes.
 inline constexpr size_t kMaxClientPathBytes = 1024;
 
@@ -94,5 +124,23 @@ std::vector<std::string> CheckClientPath(std::string_view client_path,
 ///         the file could not be created); nothing is created then.
 NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_view client_path,
                                 std::string_view required_extension);
+
+/// reads the existing regular file `client_path` inside the folder `root` under the read rules
+/// above (the path rules of CheckClientPath; no symbolic link followed below `root`).
+/// @param root               the folder the client may read from (taken as given: a link there
+///                           is the user's own choice)
+/// @param client_path        the path a client sent, relative to `root`
+/// @param required_extension the ending the name must have, with its dot (e.g. ".yaml")
+/// @param max_bytes          the largest file read; a larger one is refused before reading
+/// @param folder_name        how errors name `root` to the client (e.g. "the world file's
+///                           folder"); its absolute path is never named
+/// @throws InputPathError naming `client_path` and the rule it broke (the rules of
+///         CheckClientPath, a folder on the way or the file missing, a symbolic link, not a
+///         folder, not a regular file, larger than `max_bytes`, or the system's reason it could
+///         not be opened or read). the message never holds any of the file's content.
+ExistingInputFile ReadExistingFileInside(const std::filesystem::path& root,
+                                         std::string_view client_path,
+                                         std::string_view required_extension, size_t max_bytes,
+                                         std::string_view folder_name);
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <utility>
 #include <variant>
 
@@ -13,6 +14,8 @@
 
 namespace penumbra {
 namespace {
+
+namespace fs = std::filesystem;
 
 const std::vector<std::string_view> kCommonKeys = {"type",        "start_sec",    "stop_sec",
                                                    "fade_in_sec", "fade_out_sec", "region"};
@@ -80,6 +83,12 @@ LiveEffects::LiveEffects(Session& session) : session_(session) {
     const auto it = std::find(mocap.begin(), mocap.end(), AgentBodyName(agent));
     if (it != mocap.end()) agent_mocap_ids_.push_back(static_cast<int>(it - mocap.begin()));
   }
+  // preset files clients name are read from inside the world file's folder only
+  if (!session.world().file.empty()) {
+    std::error_code ec;
+    const fs::path world_file = fs::absolute(session.world().file, ec);
+    if (!ec) preset_folder_ = world_file.parent_path();
+  }
   requested_.own = session.world().effects;
   requested_.preset = session.effects().preset();
 }
@@ -133,11 +142,19 @@ void LiveEffects::Queue(State s, nlohmann::json record, int64_t step) {
 
 void LiveEffects::SetAdversity(const std::string& preset_spec) {
   const std::string spec = preset_spec.empty() ? std::string("none") : preset_spec;
-  const std::string resolved = ResolveAdversitySpec(spec, "", "", 0);
+  std::string detail;
+  ClientAdversityPreset requested;
+  try {
+    requested = LoadClientAdversityPreset(spec, preset_folder_, &detail);
+  } catch (const ConfigError&) {
+    // the client gets the file's name, line and rule; the server's user the whole error
+    if (!detail.empty()) spdlog::warn("set_adversity: {}", detail);
+    throw;
+  }
   std::lock_guard<std::mutex> lock(mu_);
   State s = requested_;
-  s.preset = LoadAdversityPreset(resolved);
-  Queue(std::move(s), {{"op", "set_adversity"}, {"spec", resolved}}, -1);
+  s.preset = std::move(requested.preset);
+  Queue(std::move(s), {{"op", "set_adversity"}, {"spec", requested.spec}}, -1);
 }
 
 LiveEffects::State LiveEffects::EditEffect(const std::string& name,

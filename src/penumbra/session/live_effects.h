@@ -31,6 +31,7 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -65,12 +66,18 @@ class LiveEffects : public Sink {
   LiveEffects(const LiveEffects&) = delete;
   LiveEffects& operator=(const LiveEffects&) = delete;
 
-  /// replaces the adversity preset: `preset_spec` as --adversity takes it
-  /// (world/adversity_preset.h: a bundled name, FILE.yaml or FILE.yaml#NAME, relative to the
-  /// current folder); "none" (or "") clears it. the world's own effects stay. recorded as
-  /// {"op": "set_adversity", "spec": <spec with the file path made absolute>}.
-  /// @throws ConfigError("", 0, "adversity", ...) for an unknown preset or a bad preset file;
-  ///         ConfigError("", 0, "npcs", ...) when it asks for more NPCs than the run has bodies.
+  /// replaces the adversity preset with one a client asked for (the bridges and the viewer):
+  /// `preset_spec` is a bundled name, or FILE.yaml / FILE.yaml#NAME inside the world file's
+  /// folder, named relative to it (world/adversity_preset.h LoadClientAdversityPreset: no
+  /// absolute path, no "..", no symbolic link, ends in .yaml, at most 1 MiB); "none" (or "")
+  /// clears it. the world's own effects stay. a preset file that does not parse is refused
+  /// naming its line and the rule; its full error (with the values it quotes) goes to the
+  /// server's log only. recorded as {"op": "set_adversity", "spec": <the file's path on the
+  /// server, #NAME>}.
+  /// @throws ConfigError("", 0, "adversity", ...) for an unknown bundled preset;
+  ///         ConfigError("", 0, "preset", ...) for a file path the rules refuse or a bad preset
+  ///         file (no content quoted); ConfigError("", 0, "npcs", ...) when it asks for more
+  ///         NPCs than the run has bodies.
   void SetAdversity(const std::string& preset_spec);
 
   /// changes, adds or removes one effect; `params` is a JSON object (or null). what
@@ -134,7 +141,8 @@ class LiveEffects : public Sink {
   State EditEffect(const std::string& name, const nlohmann::json& params) const;
 
   Session& session_;
-  std::vector<Pose> X_WB_start_;  // every body's pose at the start (the static ones stay)
+  std::filesystem::path preset_folder_;  // the world file's folder ("" = none): preset files
+  std::vector<Pose> X_WB_start_;         // every body's pose at the start (the static ones stay)
   std::vector<Eigen::Vector3d> robot_starts_;
   std::vector<int> agent_mocap_ids_;
   mutable std::mutex mu_;

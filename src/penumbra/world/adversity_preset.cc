@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_edit.h"
 #include "penumbra/world/yaml_reader.h"
@@ -159,10 +160,15 @@ std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;
   text << in.rdbuf();
+  return ParseAdversityPresets(text.str(), path);
+}
+
+std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
+                                                   const std::string& path) {
   std::vector<AdversityPreset> out;
   try {
-    const YAML::Node root = YAML::Load(text.str());
-    RefuseYamlTags(text.str(), path);
+    const YAML::Node root = YAML::Load(text);
+    RefuseYamlTags(text, path);
     YamlReader r(root, path, nullptr);
     r.ExpectMap({"presets"});
     const YamlReader presets = r.Child("presets");
@@ -275,6 +281,74 @@ AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& 
   throw ConfigError(file, line, "adversity",
                     "unknown preset '" + spec + "'; expected one of: " + Names(bundled) +
                         ", or a preset file (FILE.yaml or FILE.yaml#NAME)");
+}
+
+ClientAdversityPreset LoadClientAdversityPreset(const std::string& spec,
+                                                const std::filesystem::path& folder,
+                                                std::string* detail) {
+  ClientAdversityPreset out;
+  if (!IsFileSpec(spec)) {
+    out.preset = LoadAdversityPreset(spec);  // a bundled name; errors quote only the spec
+    out.spec = spec;
+    return out;
+  }
+  const size_t hash = spec.find('#');
+  const std::string relative = spec.substr(0, hash);
+  const std::string shown = SanitizeForMessage(relative, 300);
+  if (folder.empty())
+    throw ConfigError(
+        "", 0, "preset",
+        "preset file '" + shown +
+            "': this run has no world file, so no folder to read preset files "
+            "from; expected a bundled preset (" +
+            [] {
+              std::string names;
+              for (const std::string& n : BundledAdversityPresetNames())
+                names += (names.empty() ? "" : ", ") + n;
+              return names;
+            }() +
+            ")");
+  ExistingInputFile file;
+  try {
+    file = ReadExistingFileInside(folder, relative, ".yaml", kMaxClientPresetFileBytes,
+                                  "the world file's folder");
+  } catch (const InputPathError& e) {
+    throw ConfigError("", 0, "preset", e.what());
+  }
+  // the file's own errors quote its values and keys: the client, which may not be able to
+  // read the file itself, gets the file's name, the line and the rule; `detail` the rest
+  std::vector<AdversityPreset> presets;
+  try {
+    presets = ParseAdversityPresets(file.text, file.path.string());
+  } catch (const ConfigError& e) {
+    if (detail) *detail = e.what();
+    throw ConfigError(
+        "", 0, "preset",
+        "preset file '" + shown + "'" + (e.line() > 0 ? ", line " + std::to_string(e.line()) : "") +
+            ": not a valid adversity preset file (the server's log names the key and the "
+            "value); expected 'presets:' mapping names ([A-Za-z0-9_-]+) to blocks fog, dust, "
+            "smoke, rain, snow, lights, npcs (world/adversity_preset.h)");
+  }
+  out.spec = file.path.lexically_normal().string();
+  if (hash == std::string::npos) {
+    if (presets.size() != 1)
+      throw ConfigError(
+          "", 0, "preset",
+          "preset file '" + shown + "' holds " + std::to_string(presets.size()) +
+              " presets; expected FILE.yaml#NAME with NAME one of: " + Names(presets));
+    out.preset = presets.front();
+    return out;
+  }
+  const std::string name = spec.substr(hash + 1);
+  for (const AdversityPreset& p : presets)
+    if (p.name == name) {
+      out.preset = p;
+      out.spec += "#" + name;
+      return out;
+    }
+  throw ConfigError("", 0, "preset",
+                    "unknown preset '" + SanitizeForMessage(name, 100) + "' in '" + shown +
+                        "'; expected one of: " + Names(presets));
 }
 
 }  // namespace penumbra

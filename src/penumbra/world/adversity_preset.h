@@ -24,7 +24,15 @@
 //   NAME            a preset of the bundled file
 //   FILE.yaml       the only preset of a user file (relative to the world file's folder)
 //   FILE.yaml#NAME  preset NAME of a user file
+//
+// a spec from a client of a running world (set_adversity over ZeroMQ, the viewer, ROS) goes
+// through LoadClientAdversityPreset: a preset file must be inside the world file's folder,
+// named relative to it (core/output_path_policy.h ReadExistingFileInside: no "..", no
+// symbolic link, ends in .yaml, at most kMaxClientPresetFileBytes), and its errors name the
+// file, the line and the rule but never quote the file's content.
 
+#include <cstddef>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,6 +76,11 @@ std::string BundledAdversityPresetsPath();
 ///         file, unknown keys, wrong types and out-of-range values.
 std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path);
 
+/// every preset of the preset file text `text` (`path` names it in errors), in file order.
+/// @throws ConfigError as LoadAdversityPresetFile.
+std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
+                                                   const std::string& path);
+
 /// the names of the bundled presets ("none", "minor", "major").
 std::vector<std::string> BundledAdversityPresetNames();
 
@@ -83,5 +96,29 @@ std::string ResolveAdversitySpec(const std::string& spec, const std::string& bas
 /// @throws ConfigError as ResolveAdversitySpec.
 AdversityPreset LoadAdversityPreset(const std::string& spec, const std::string& file = "",
                                     int line = 0);
+
+/// the largest preset file a client may name, in bytes (the bundled one is about 2 KB).
+inline constexpr size_t kMaxClientPresetFileBytes = 1 << 20;
+
+/// a preset a client asked for, and the spec that names it on the server.
+struct ClientAdversityPreset {
+  AdversityPreset preset;
+  /// the bundled name, or the file's path (world folder / client path, lexically normal)
+  /// with "#NAME" when given: what a run log records (LoadAdversityPreset reads it again).
+  std::string spec;
+};
+
+/// the preset named by `spec` as a client sent it (see the file header): a bundled name, or
+/// FILE.yaml / FILE.yaml#NAME read from inside `folder` (the world file's folder; "" = the
+/// run has none: only bundled names) under ReadExistingFileInside's rules.
+/// @param detail  receives the full error of a preset file that did not parse (with the
+///                keys and values it quotes) for the server's own log; may be null
+/// @throws ConfigError("", 0, "adversity", ...) for an unknown bundled name;
+///         ConfigError("", 0, "preset", ...) for a path the rules refuse (the path and the
+///         rule), a file that is not a valid preset file (its name, the line and the rule, no
+///         content), or an unknown NAME (the file's preset names).
+ClientAdversityPreset LoadClientAdversityPreset(const std::string& spec,
+                                                const std::filesystem::path& folder,
+                                                std::string* detail = nullptr);
 
 }  // namespace penumbra
