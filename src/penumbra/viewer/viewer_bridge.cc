@@ -71,6 +71,17 @@ void ParseViewerAddress(const std::string& spec, ViewerOptions* options) {
 
 namespace {
 
+// the world's preset as a client sees it: a bundled name as it is, a preset file by its file
+// name (and #NAME) only, so that no client learns the server's folders
+std::string PresetForClient(const std::string& spec) {
+  if (spec.empty()) return "none";
+  const size_t hash = spec.find('#');
+  const std::string file = spec.substr(0, hash);
+  if (file.find('/') == std::string::npos) return spec;
+  return std::filesystem::path(file).filename().string() +
+         (hash == std::string::npos ? "" : spec.substr(hash));
+}
+
 using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -267,7 +278,7 @@ class ViewerBridge : public RunBridge {
               {"timestep_sec", dt},
               {"control_period_sec", period},
               {"presets", presets},
-              {"preset", world_.adversity.empty() ? "none" : world_.adversity},
+              {"preset", PresetForClient(world_.adversity)},
               {"effect_sliders", EffectSliders()},
               {"joint_controls", joint_controls},
               {"teleop_robots", teleop},
