@@ -97,6 +97,38 @@ OutputPathError::OutputPathError(const std::string& client_path, const std::stri
       client_path_(client_path),
       rule_(rule) {}
 
+namespace {
+
+// opens the folder that holds the last of `parts` (checked components below `root`): `root` as
+// the user named it (a link there is the user's own choice), then each folder below it relative
+// to the one above with O_NOFOLLOW, so no link is followed; `fail` (which throws) gets the rule
+// broken. `root_name` names root in messages, `missing_hint` follows "does not exist".
+template <typename Fail>
+UniqueFd OpenFolderOf(const std::filesystem::path& root, const std::vector<std::string>& parts,
+                      const std::string& root_name, const std::string& missing_hint, Fail fail) {
+  UniqueFd dir(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir.get() < 0) fail(root_name + " cannot be opened: " + std::strerror(errno));
+  std::string walked;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    walked += (walked.empty() ? "" : "/") + parts[i];
+    UniqueFd next(
+        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+    if (next.get() < 0) {
+      const int err = errno;
+      const std::string what = WhatIsThere(dir.get(), parts[i]);
+      const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
+      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
+      if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
+      if (err == ENOENT) fail("the folder " + quoted + " does not exist" + missing_hint);
+      fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
+    }
+    dir = std::move(next);
+  }
+  return dir;
+}
+
+}  // namespace
+
 std::vector<std::string> CheckClientPath(std::string_view client_path,
                                          std::string_view required_extension) {
   const std::string path(client_path);
@@ -112,28 +144,8 @@ NewOutputFile OpenNewFileInside(const std::filesystem::path& root, std::string_v
   auto fail = [&](const std::string& rule) {
     throw OutputPathError(path, rule, required_extension);
   };
-  // the output folder as the user named it (a link there is the user's own choice)
-  UniqueFd dir(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (dir.get() < 0)
-    fail(std::string("the run's output folder cannot be opened: ") + std::strerror(errno));
-  // each folder below it: opened relative to the one above, never through a link
-  std::string walked;
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    walked += (walked.empty() ? "" : "/") + parts[i];
-    UniqueFd next(
-        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
-    if (next.get() < 0) {
-      const int err = errno;
-      const std::string what = WhatIsThere(dir.get(), parts[i]);
-      const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
-      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
-      if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
-      if (err == ENOENT)
-        fail("the folder " + quoted + " does not exist; only existing folders are written into");
-      fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
-    }
-    dir = std::move(next);
-  }
+  UniqueFd dir = OpenFolderOf(root, parts, "the run's output folder",
+                              "; only existing folders are written into", fail);
   const std::string& name = parts.back();
   UniqueFd fd(::openat(dir.get(), name.c_str(),
                        O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
@@ -172,26 +184,7 @@ ExistingInputFile ReadExistingFileInside(const std::filesystem::path& root,
     throw InputPathError(path, rule, required_extension, folder_name);
   };
   const std::vector<std::string> parts = SplitClientPath(path, required_extension, true, fail);
-  // the folder as the user named it (a link there is the user's own choice)
-  UniqueFd dir(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (dir.get() < 0) fail(std::string("the folder cannot be opened: ") + std::strerror(errno));
-  // each folder below it: opened relative to the one above, never through a link
-  std::string walked;
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    walked += (walked.empty() ? "" : "/") + parts[i];
-    UniqueFd next(
-        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
-    if (next.get() < 0) {
-      const int err = errno;
-      const std::string what = WhatIsThere(dir.get(), parts[i]);
-      const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
-      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
-      if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
-      if (err == ENOENT) fail("the folder " + quoted + " does not exist");
-      fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
-    }
-    dir = std::move(next);
-  }
+  UniqueFd dir = OpenFolderOf(root, parts, "the folder", "", fail);
   // the file: never through a link, and without blocking on a FIFO
   const std::string& name = parts.back();
   UniqueFd fd(
