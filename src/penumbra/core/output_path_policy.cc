@@ -97,6 +97,20 @@ OutputPathError::OutputPathError(const std::string& client_path, const std::stri
       client_path_(client_path),
       rule_(rule) {}
 
+UniqueFd OpenFoldersNoFollow(UniqueFd dir, const std::vector<std::string>& parts,
+                             const std::function<void(int, size_t, int)>& refuse) {
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    UniqueFd next(
+        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+    if (next.get() < 0) {
+      refuse(dir.get(), i, errno);
+      throw Error("folder '" + SanitizeForMessage(parts[i], 300) + "' cannot be opened");
+    }
+    dir = std::move(next);
+  }
+  return dir;
+}
+
 namespace {
 
 // opens the folder that holds the last of `parts` (checked components below `root`): `root` as
@@ -108,23 +122,16 @@ UniqueFd OpenFolderOf(const std::filesystem::path& root, const std::vector<std::
                       const std::string& root_name, const std::string& missing_hint, Fail fail) {
   UniqueFd dir(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (dir.get() < 0) fail(root_name + " cannot be opened: " + std::strerror(errno));
-  std::string walked;
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    walked += (walked.empty() ? "" : "/") + parts[i];
-    UniqueFd next(
-        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
-    if (next.get() < 0) {
-      const int err = errno;
-      const std::string what = WhatIsThere(dir.get(), parts[i]);
-      const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
-      if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
-      if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
-      if (err == ENOENT) fail("the folder " + quoted + " does not exist" + missing_hint);
-      fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
-    }
-    dir = std::move(next);
-  }
-  return dir;
+  return OpenFoldersNoFollow(std::move(dir), parts, [&](int parent_fd, size_t i, int err) {
+    std::string walked;
+    for (size_t k = 0; k <= i; ++k) walked += (k ? "/" : "") + parts[k];
+    const std::string what = WhatIsThere(parent_fd, parts[i]);
+    const std::string quoted = "'" + SanitizeForMessage(walked, 300) + "'";
+    if (what == "a symbolic link") fail(quoted + " is a symbolic link; links are never followed");
+    if (!what.empty() && what != "a folder") fail(quoted + " is " + what + ", not a folder");
+    if (err == ENOENT) fail("the folder " + quoted + " does not exist" + missing_hint);
+    fail("the folder " + quoted + " cannot be opened: " + std::strerror(err));
+  });
 }
 
 }  // namespace

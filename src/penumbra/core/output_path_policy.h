@@ -24,6 +24,7 @@
 // with O_NONBLOCK, then checked) of at most a given size, read whole.
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -103,6 +104,20 @@ struct ExistingInputFile {
   std::filesystem::path path;  ///< where it is: root / relative
   std::string relative;        ///< the client's path, as checked (e.g. "presets/fog.yaml")
 };
+
+/// the walk below a trusted folder that every "inside this folder" rule uses (OpenNewFileInside,
+/// ReadExistingFileInside, export's ReadRunFile): opens `parts[0]`, then `parts[1]` inside it,
+/// ... up to but not including `parts.back()`, each relative to the one above with
+/// openat(O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC), so no symbolic link below `dir` is followed and
+/// nothing can be swapped in between check and use.
+/// @param dir    the open folder to start from (taken over)
+/// @param refuse called with the folder that could not be opened from (fd), the index of the
+///               part and errno when a step fails; must throw (the caller's error and message)
+/// @returns the folder that holds `parts.back()`
+/// @throws whatever `refuse` throws; Error if `refuse` returns.
+UniqueFd OpenFoldersNoFollow(
+    UniqueFd dir, const std::vector<std::string>& parts,
+    const std::function<void(int parent_fd, size_t index, int err)>& refuse);
 
 /// the longest client path accepted, in bytes.
 inline constexpr size_t kMaxClientPathBytes = 1024;

@@ -47,14 +47,11 @@ int OpenParentFolder(const fs::path& run_dir, const fs::path& relative, std::str
                       std::string("cannot open the run folder: ") + std::strerror(errno));
   std::vector<std::string> parts;
   for (const fs::path& p : relative) parts.push_back(p.string());
-  fs::path walked = run_dir;
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    walked /= parts[i];
-    const int next =
-        ::openat(dir.get(), parts[i].c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
-    if (next < 0) RefuseEntry(dir.get(), parts[i], walked, errno, "a folder");
-    dir = UniqueFd(next);
-  }
+  dir = OpenFoldersNoFollow(std::move(dir), parts, [&](int parent_fd, size_t i, int err) {
+    fs::path walked = run_dir;
+    for (size_t k = 0; k <= i; ++k) walked /= parts[k];
+    RefuseEntry(parent_fd, parts[i], walked, err, "a folder");
+  });
   *last = parts.back();
   return dir.release();
 }
