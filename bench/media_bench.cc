@@ -16,9 +16,9 @@
 #include <memory>
 
 #include "penumbra/physics/simulation.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/media_common.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {

@@ -1,6 +1,8 @@
 # reads src/penumbra/DEPENDENCIES (its header describes the format): one line per module,
 # `module: dep dep ...`, '#' starting a comment. after penumbra_read_dependencies(<file>),
 # PENUMBRA_MODULES lists the modules in file order and PENUMBRA_DEPS_<module> the deps of each.
+# a sub-module (a sub-folder with its own line, e.g. render/cpu) is named by its path;
+# penumbra_module_target(<module> <var>) gives its library name (penumbra_render_cpu).
 # scripts/check_module_deps.py parses the same file; tests/meta checks both read it alike.
 #
 # script mode prints the parsed table, one "module: deps" line each, to stderr:
@@ -24,11 +26,11 @@ function(penumbra_read_dependencies table)
     if(line STREQUAL "")
       continue()
     endif()
-    if(NOT line MATCHES "^([a-z][a-z0-9_]*)[ \t]*:(.*)$")
+    if(NOT line MATCHES "^([a-z][a-z0-9_]*(/[a-z][a-z0-9_]*)*)[ \t]*:(.*)$")
       message(FATAL_ERROR "${table}:${n}: got '${line}'; expected 'module: dep dep ...'")
     endif()
     set(module "${CMAKE_MATCH_1}")
-    string(REGEX MATCHALL "[^ \t\r]+" deps "${CMAKE_MATCH_2}")
+    string(REGEX MATCHALL "[^ \t\r]+" deps "${CMAKE_MATCH_3}")
     if(module IN_LIST modules)
       message(FATAL_ERROR "${table}:${n}: module '${module}' has a second line")
     endif()
@@ -36,6 +38,11 @@ function(penumbra_read_dependencies table)
     set(PENUMBRA_DEPS_${module} "${deps}" PARENT_SCOPE)
   endforeach()
   set(PENUMBRA_MODULES "${modules}" PARENT_SCOPE)
+endfunction()
+
+function(penumbra_module_target module out_var)
+  string(REPLACE "/" "_" target "penumbra_${module}")
+  set(${out_var} "${target}" PARENT_SCOPE)
 endfunction()
 
 if(CMAKE_SCRIPT_MODE_FILE AND DEFINED PENUMBRA_DEPENDENCIES)

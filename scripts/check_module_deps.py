@@ -3,11 +3,16 @@
 
 src/penumbra/DEPENDENCIES has one line per module (a folder of src/penumbra; `main` is the files
 directly in src/penumbra): `module: dep dep ...`, '#' starting a comment. CMake links each
-module's penumbra_<dep> libraries from it. This script fails (exit status 1) when
+module's penumbra_<dep> libraries from it. A sub-module is a sub-folder with a line of its own,
+named by its path (`render/cpu`: src/penumbra/render/cpu/, library penumbra_render_cpu); its
+files belong to it, not to the parent, and other sub-folders belong to the module above them.
+This script fails (exit status 1) when
 
   - a file of module M includes "penumbra/D/..." and D is not on M's line (file:line and the
     edge are named; when the table already leads from D back to M, the cycle the include would
     close is printed too);
+  - a module lists (or includes) one of its own sub-modules: the root of a module stays below
+    its sub-modules (render/ includes neither render/cpu/ nor render/embree/);
   - a dep on M's line is included by no file of M (an unused edge: the table must equal the real
     includes). Lines of modules whose folder does not exist yet are exempt (planned modules);
   - the table has a cycle (the cycle is printed: "a -> b -> a");
@@ -27,9 +32,9 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SOURCE_EXTS = (".h", ".hh", ".hpp", ".cc", ".cpp", ".cxx", ".inl", ".inc", ".ipp")
-INCLUDE_RE = re.compile(r'^\s*#\s*include\s*[<"]penumbra/([^/">]+)/')
-LINE_RE = re.compile(r"^([A-Za-z0-9_.-]+)\s*:(.*)$")
-NAME_RE = re.compile(r"^[a-z][a-z0-9_]*$")
+INCLUDE_RE = re.compile(r'^\s*#\s*include\s*[<"]penumbra/((?:[^/">]+/)+)[^/">]+[">]')
+LINE_RE = re.compile(r"^([A-Za-z0-9_./-]+)\s*:(.*)$")
+NAME_RE = re.compile(r"^[a-z][a-z0-9_]*(/[a-z][a-z0-9_]*)*$")
 MAIN = "main"  # the files directly in src/penumbra (main.cc: the executable)
 
 
@@ -89,15 +94,30 @@ def read_table(path, shown):
     return table, errors
 
 
-def scan_includes(src):
+def owner(path, sub_modules):
+    """The module of a folder path ('render/cpu/x' -> 'render/cpu' when that is a sub-module of
+    the table, else its first component 'render')."""
+    parts = path.split("/")
+    for n in range(len(parts), 1, -1):
+        if "/".join(parts[:n]) in sub_modules:
+            return "/".join(parts[:n])
+    return parts[0]
+
+
+def is_sub_module(name):
+    return "/" in name
+
+
+def scan_includes(src, sub_modules=()):
     """Every include of another module: [(path relative to src, line, module, dep)], and the
-    set of modules that have source files."""
+    set of modules that have source files. sub_modules: the table's names with a '/'."""
     edges = []
     modules = set()
     for folder, dirs, files in os.walk(src):
         dirs.sort()
         rel_folder = os.path.relpath(folder, src)
-        module = MAIN if rel_folder == "." else rel_folder.split(os.sep)[0]
+        module = MAIN if rel_folder == "." else owner(rel_folder.replace(os.sep, "/"),
+                                                      sub_modules)
         for name in sorted(files):
             if not name.endswith(SOURCE_EXTS):
                 continue
@@ -106,14 +126,20 @@ def scan_includes(src):
             with open(os.path.join(folder, name), encoding="utf-8", errors="replace") as f:
                 for n, line in enumerate(f, start=1):
                     m = INCLUDE_RE.match(line)
-                    if m and m.group(1) != module:
-                        edges.append((rel, n, module, m.group(1)))
+                    if not m:
+                        continue
+                    dep = owner(m.group(1).rstrip("/"), sub_modules)
+                    if dep != module:
+                        edges.append((rel, n, module, dep))
     return edges, modules
 
 
-def module_folders(src):
-    """Folders directly under src (candidate modules), sorted."""
-    return sorted(d for d in os.listdir(src) if os.path.isdir(os.path.join(src, d)))
+def module_folders(src, sub_modules=()):
+    """Folders directly under src (candidate modules) and the sub-modules whose folder exists,
+    sorted."""
+    tops = [d for d in os.listdir(src) if os.path.isdir(os.path.join(src, d))]
+    subs = [m for m in sub_modules if os.path.isdir(os.path.join(src, *m.split("/")))]
+    return sorted(tops + subs)
 
 
 def find_cycles(graph):
@@ -190,8 +216,9 @@ def check(root):
         return errors, [], {}
     notes = []
     graph = table.graph()
-    edges, with_sources = scan_includes(src)
-    on_disk = set(module_folders(src)) | ({MAIN} & with_sources)
+    sub_modules = {m for m in table.deps if is_sub_module(m)}
+    edges, with_sources = scan_includes(src, sub_modules)
+    on_disk = set(module_folders(src, sub_modules)) | ({MAIN} & with_sources)
 
     for m in sorted(on_disk - set(table.deps)):
         where = os.path.join(shown_src, m) + os.sep if m != MAIN else shown_src + " (top level)"
@@ -210,6 +237,12 @@ def check(root):
             continue
         if dep in table.deps[module]:
             continue
+        if dep.startswith(module + "/"):
+            errors.append(f"{shown}:{n}: {module} -> {dep}: {module}/ includes its own "
+                          f"sub-module {dep}/; the root of a module must not include its "
+                          f"sub-modules: move what it needs into {module}/ or behind an "
+                          "interface there")
+            continue
         msg = (f"{shown}:{n}: {module} -> {dep}: '{dep}' is not on the '{module}:' line "
                f"({shown_table}:{table.lines[module]}: {module}: {' '.join(table.deps[module])})")
         back = shortest_path(graph, dep, module)
@@ -221,6 +254,12 @@ def check(root):
         errors.append(msg)
 
     for module, deps in table.deps.items():
+        for d in deps:
+            if d.startswith(module + "/"):
+                errors.append(f"{shown_table}:{table.lines[module]}: {module} -> {d}: a module "
+                              f"must not depend on its own sub-module ({d} sits on top of "
+                              f"{module}); move what {module} needs from {d} into {module}, or "
+                              "hide it behind an interface there")
         if module not in on_disk:
             notes.append(f"{shown_table}:{table.lines[module]}: module '{module}' has no folder "
                          f"{os.path.join(shown_src, module)}{os.sep} yet; only the cycle check "
@@ -245,8 +284,11 @@ def check(root):
 def derive(root):
     """The table the includes imply, lowest module first."""
     src = os.path.join(root, "src", "penumbra")
-    edges, with_sources = scan_includes(src)
-    graph = {m: set() for m in sorted(set(module_folders(src)) | ({MAIN} & with_sources))}
+    table, errors = read_table(os.path.join(src, "DEPENDENCIES"), "DEPENDENCIES")
+    sub_modules = {m for m in table.deps if is_sub_module(m)} if not errors else set()
+    edges, with_sources = scan_includes(src, sub_modules)
+    graph = {m: set() for m in sorted(set(module_folders(src, sub_modules)) |
+                                      ({MAIN} & with_sources))}
     for _, _, module, dep in edges:
         graph.setdefault(module, set()).add(dep)
         graph.setdefault(dep, set())

@@ -189,12 +189,82 @@ class CheckModuleDepsTest(unittest.TestCase):
         self.assertEqual(rc, 1, out)
         self.assertIn("cycle: scene -> physics -> scene", out)
 
+    def test_sub_modules_own_their_folders(self):
+        # render/cpu and render/embree have lines: their files are theirs; render/deep has none,
+        # so its files are render's
+        table = ("core:\nrender: core\nrender/embree: render core\n"
+                 "render/cpu: render/embree render\n")
+        t = self.tree(table, {
+            "core/x.h": "",
+            "render/x.h": inc("core"),
+            "render/deep/y.h": inc("render") + inc("core"),
+            "render/embree/x.cc": inc("render") + inc("core") + inc("render/embree", "y.h"),
+            "render/cpu/x.cc": inc("render/embree") + inc("render") + inc("render/cpu", "y.h"),
+        })
+        rc, out = t.check()
+        self.assertEqual(rc, 0, out)
+        self.assertIn("OK: 4 modules, 6 includes of other modules", out)
+        # render/cpu including core directly is an edge of render/cpu, not of render
+        t.write("render/cpu/z.h", "\n" + inc("core"))
+        rc, out = t.check()
+        self.assertEqual(rc, 1, out)
+        self.assertIn("src/penumbra/render/cpu/z.h:2: render/cpu -> core: 'core' is not on the "
+                      "'render/cpu:' line", out)
+        self.assertEqual(check_module_deps.owner("render/cpu/a", {"render/cpu"}), "render/cpu")
+        self.assertEqual(check_module_deps.owner("render/cpux", {"render/cpu"}), "render")
+
+    def test_root_including_its_sub_module_fails(self):
+        table = ("core:\nrender: core\nrender/embree: render core\n"
+                 "render/cpu: render/embree render\n")
+        files = {
+            "core/x.h": "",
+            "render/x.h": inc("core") + inc("render/embree", "ray_scene.h"),
+            "render/embree/x.cc": inc("render") + inc("core"),
+            "render/cpu/x.cc": inc("render/embree") + inc("render"),
+        }
+        rc, out = self.tree(table, files).check()
+        self.assertEqual(rc, 1, out)
+        self.assertIn("src/penumbra/render/x.h:2: render -> render/embree: render/ includes its "
+                      "own sub-module render/embree/; the root of a module must not include its "
+                      "sub-modules", out)
+        # listing the edge is refused too (and closes a cycle)
+        rc, out = self.tree(table.replace("render: core", "render: render/embree core"),
+                            files).check()
+        self.assertEqual(rc, 1, out)
+        self.assertIn("DEPENDENCIES:2: render -> render/embree: a module must not depend on its "
+                      "own sub-module", out)
+        self.assertIn("cycle: render -> render/embree -> render", out)
+
+    def test_render_root_of_the_real_tree_includes_neither_cpu_nor_embree(self):
+        tmp = tempfile.TemporaryDirectory()
+        self.addCleanup(tmp.cleanup)
+        src = os.path.join(tmp.name, "src", "penumbra")
+        shutil.copytree(os.path.join(ROOT, "src", "penumbra"), src)
+        with open(os.path.join(src, "DEPENDENCIES"), encoding="utf-8") as f:
+            self.assertRegex(f.read(), r"(?m)^render: scene core$")
+        rc, out = run_checker(tmp.name)
+        self.assertEqual(rc, 0, out)
+        for header, planted, sub in (("camera.h", "embree/ray_scene.h", "render/embree"),
+                                     ("ray_query.h", "cpu/integrator.h", "render/cpu")):
+            path = os.path.join(src, "render", header)
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+            with open(path, "a", encoding="utf-8") as f:
+                f.write(f'#include "penumbra/render/{planted}"\n')
+            rc, out = run_checker(tmp.name)
+            self.assertEqual(rc, 1, out)
+            self.assertRegex(out, rf"src/penumbra/render/{re.escape(header)}:\d+: render -> "
+                                  rf"{sub}: render/ includes its own sub-module {sub}/")
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(text)
+
     def test_cmake_reads_the_table_as_the_checker_does(self):
         cmake = os.environ.get("CMAKE_COMMAND") or shutil.which("cmake")
         if not cmake:
             self.skipTest("no cmake")
         tricky = ("# comment; with [brackets] and a: colon\n\ncore:   # trailing\n"
-                  "scene:core\n  render :  scene   core  \n\t\napp: render scene core # [x;y]\n")
+                  "scene:core\n  render :  scene   core  \n\t\napp: render scene core # [x;y]\n"
+                  "render/cpu: render scene\n")
         with tempfile.TemporaryDirectory() as tmp:
             tricky_path = os.path.join(tmp, "DEPENDENCIES")
             with open(tricky_path, "w", encoding="utf-8") as f:

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "penumbra/core/rng.h"
-#include "penumbra/render/analytic_lanes.h"
+#include "penumbra/render/embree/analytic_lanes.h"
 
 namespace penumbra {
 namespace {

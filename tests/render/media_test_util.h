@@ -5,7 +5,7 @@
 #include <cmath>
 #include <memory>
 
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/scene/effects_frame.h"
 #include "render_test_util.h"
 

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/material_eval.h"
-#include "penumbra/render/renderer_factory.h"
 #include "render_test_util.h"
 
 namespace penumbra {

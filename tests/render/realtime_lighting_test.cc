@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "render_test_util.h"
 
 namespace penumbra {

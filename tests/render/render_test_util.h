@@ -6,8 +6,8 @@
 #include <string>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 

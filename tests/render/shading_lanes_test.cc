@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "penumbra/core/rng.h"
-#include "penumbra/render/bsdf_lanes.h"
+#include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/light_sampler.h"
 
 namespace penumbra {

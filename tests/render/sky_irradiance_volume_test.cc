@@ -16,9 +16,9 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/core/thread_pool.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/embree/ray_scene.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/render/sky_model.h"
 #include "render_test_util.h"
 

@@ -30,10 +30,10 @@
 #include <utility>
 #include <vector>
 
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/camera_distortion.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {

@@ -8,9 +8,9 @@
 #include <limits>
 
 #include "camera_sensor_test_util.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 
 namespace penumbra {
 namespace {

@@ -6,8 +6,8 @@
 
 #include "camera_sensor_test_util.h"
 #include "penumbra/core/error.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 
 namespace penumbra {

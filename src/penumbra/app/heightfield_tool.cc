@@ -4,11 +4,11 @@
 
 #include <filesystem>
 
+#include "penumbra/assets/height_field_model.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
-#include "penumbra/assets/height_field_model.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/height_field_sampling.h"
-#include "penumbra/render/renderer_factory.h"
 #include "penumbra/render/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"

@@ -17,7 +17,7 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/decompose/decomposition_cache.h"
 #include "penumbra/decompose/mesh_io.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 
 namespace penumbra {
 namespace {

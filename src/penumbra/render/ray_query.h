@@ -8,7 +8,7 @@
 // posing, the scene), and grows when a user needs more (e.g. batched occlusion).
 //
 // implementations: RayScene (Embree 3, render/embree/ray_scene.h). MakeRayQuery
-// (render/renderer_factory.h) builds the one RenderSettings::backend names.
+// (render/backends/renderer_factory.h) builds the one RenderSettings::backend names.
 //
 // contract of every backend:
 //  - traced geoms: those in MJCF groups <= 2 whose material has alpha >= 0.5;

@@ -9,7 +9,7 @@ namespace penumbra {
 /// render quality and image formation. both tiers share one code path (scene,
 /// materials, lights, camera); they differ in the light transport they simulate.
 struct RenderSettings {
-  /// the ray-tracing backend: MakeRenderer and MakeRayQuery (render/renderer_factory.h) build
+  /// the ray-tracing backend: MakeRenderer and MakeRayQuery (render/backends/) build
   /// its Renderer and RayQuery.
   enum class Backend {
     kEmbree,  ///< Intel Embree 3 on the CPU (render/embree/)

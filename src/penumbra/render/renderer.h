@@ -1,8 +1,8 @@
 #pragma once
 // the renderer interface: turns a WorldSnapshot seen from one camera into images.
 // implementations never touch the physics engine, so a recorded run can be
-// re-rendered without it. MakeRenderer (render/renderer_factory.h) builds the one of
-// RenderSettings::backend (Embree: render/embree/embree_renderer.h).
+// re-rendered without it. MakeRenderer (render/backends/renderer_factory.h) builds the one of
+// RenderSettings::backend (Embree: render/cpu/embree_renderer.h).
 
 #include <atomic>
 #include <memory>

@@ -1,7 +1,7 @@
 #include <chrono>
 #include <memory>
 
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 
 namespace penumbra {

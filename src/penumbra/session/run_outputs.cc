@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "penumbra/physics/mujoco_version.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 
 namespace penumbra {
 

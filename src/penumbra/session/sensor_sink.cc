@@ -15,7 +15,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/output/sensor_writers.h"
 #include "penumbra/pipeline/sink_worker.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"

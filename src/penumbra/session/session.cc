@@ -15,7 +15,7 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/environment/environment_model.h"
 #include "penumbra/physics/urdf_converter.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
 

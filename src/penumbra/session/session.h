@@ -54,7 +54,7 @@ struct SessionOptions {
   /// machine's physical memory (CheckRunMemory) and warn about a large amount of work
   /// (DescribeRunWork), as `penumbra run` does.
   bool check_run_budget = false;
-  /// build the renderer (render/renderer_factory.h: MakeRenderer with the world's render
+  /// build the renderer (render/backends/: MakeRenderer with the world's render
   /// settings); off for physics- or sensor-only work and for callers with their own render
   /// settings.
   bool build_renderer = true;

@@ -1,7 +1,7 @@
 // geometry of rendered images: exact depth, projection, segmentation, instancing,
 // all geom shapes, determinism across thread counts.
 
-#include "penumbra/render/embree/embree_renderer.h"
+#include "penumbra/render/cpu/embree_renderer.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
-#include <embree3/rtcore.h>
+#include "penumbra/render/embree/embree_version.h"
 
-#include "penumbra/render/embree/embree_renderer.h"
+#include <embree3/rtcore.h>
 
 namespace penumbra {
 

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/analytic_lanes.h"
 #include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/embree/analytic_lanes.h"
 #include "penumbra/render/moving_bounds.h"
 #include "penumbra/render/ray_cone.h"
 #include "penumbra/render/triangle_shapes.h"

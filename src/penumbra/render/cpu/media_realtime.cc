@@ -1,4 +1,4 @@
-#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/cpu/media_realtime.h"
 
 #include <emmintrin.h>
 

@@ -1,4 +1,4 @@
-#include "penumbra/render/embree/embree_renderer.h"
+#include "penumbra/render/cpu/embree_renderer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -7,9 +7,9 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera_ground_truth.h"
-#include "penumbra/render/path_integrator.h"
+#include "penumbra/render/cpu/path_integrator.h"
+#include "penumbra/render/cpu/realtime_integrator.h"
 #include "penumbra/render/ray_cone.h"
-#include "penumbra/render/realtime_integrator.h"
 
 namespace penumbra {
 namespace {
@@ -74,7 +74,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   }
   lights_.Update(snapshot, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  // adverse conditions (media, particles, sky and light changes): render/media_frame.h.
+  // adverse conditions (media, particles, sky and light changes): render/cpu/media_frame.h.
   effects_.Prepare(snapshot, effects, camera, view, settings_, lights_, *ray_scene_, sky_,
                    &sky_volume_, &pool_);
   // realtime tier: sky light occluded by the static geometry, rebuilt only when the static

@@ -1,4 +1,4 @@
-#include "penumbra/render/analytic_lanes.h"
+#include "penumbra/render/embree/analytic_lanes.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "penumbra/render/path_integrator.h"
+#include "penumbra/render/cpu/path_integrator.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "penumbra/render/bsdf_lanes.h"
+#include "penumbra/render/cpu/bsdf_lanes.h"
 
 namespace penumbra {
 namespace {

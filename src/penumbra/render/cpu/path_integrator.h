@@ -25,7 +25,7 @@
 // Russian roulette from the 4th vertex on (after 3 bounces): a path continues with probability
 // q = min(1, max channel of its throughput) and is reweighted by 1 / q (unbiased).
 //
-// adverse conditions (FrameContext::effects, render/media_frame.h), when present:
+// adverse conditions (FrameContext::effects, render/cpu/media_frame.h), when present:
 //   - participating media (render/media_scene.h): every ray segment is tracked from its origin
 //     to the surface, lamp or infinity by spectral delta tracking; a real scattering event is
 //     a path vertex (counted against max_bounces, Russian roulette as at surfaces) with the
@@ -61,8 +61,8 @@
 // a stop (SIGINT) waits for at most one path per render thread, not for the frame's
 // samples_per_pixel passes. a render that is not stopped is the same as without the check.
 
+#include "penumbra/render/cpu/integrator.h"
 #include "penumbra/render/emitter_sampler.h"
-#include "penumbra/render/integrator.h"
 
 namespace penumbra {
 

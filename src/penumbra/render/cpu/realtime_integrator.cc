@@ -1,4 +1,4 @@
-#include "penumbra/render/realtime_integrator.h"
+#include "penumbra/render/cpu/realtime_integrator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
-#include "penumbra/render/bsdf_lanes.h"
+#include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/media_common.h"
 
 namespace penumbra {
@@ -183,7 +183,7 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
-// alpha-composited over it (render/media_realtime.h, render/embree/particle_scene.h). no random
+// alpha-composited over it (render/cpu/media_realtime.h, render/embree/particle_scene.h). no random
 // numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
 // shared froxel lookups of the pixel's 2x2 quad, or null.
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,

@@ -1,9 +1,10 @@
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/embree/embree_renderer.h"
+#include "penumbra/render/cpu/embree_renderer.h"
+#include "penumbra/render/embree/embree_version.h"
 #include "penumbra/render/embree/ray_scene.h"
 
 namespace penumbra {

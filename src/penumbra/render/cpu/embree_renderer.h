@@ -1,6 +1,6 @@
 #pragma once
 // the Embree ray tracer: the Renderer of RenderSettings::Backend::kEmbree (MakeRenderer,
-// render/renderer_factory.h).
+// render/backends/renderer_factory.h).
 //
 // per frame: pose the RayScene and the lights from the snapshot (the top-level BVH is
 // recommitted only when a body moved), split the image into kTileSize x kTileSize tiles spread
@@ -13,10 +13,10 @@
 #include <string>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/denoiser.h"
+#include "penumbra/render/cpu/denoiser.h"
+#include "penumbra/render/cpu/integrator.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/film.h"
-#include "penumbra/render/integrator.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
 #include "penumbra/render/renderer.h"
@@ -52,7 +52,7 @@ class EmbreeRenderer final : public Renderer {
   MaterialEvaluator materials_;
   LightSampler lights_;
   SkyModel sky_;
-  MediaFrame effects_;              // per-frame effects state (render/media_frame.h)
+  MediaFrame effects_;              // per-frame effects state (render/cpu/media_frame.h)
   SkyIrradianceVolume sky_volume_;  // realtime tier: occluded sky light, built at the first frame
   Film film_;
   ThreadPool pool_;
@@ -66,8 +66,5 @@ class EmbreeRenderer final : public Renderer {
 /// @throws as the EmbreeRenderer constructor.
 std::unique_ptr<Renderer> MakeEmbreeRenderer(const SceneDescription& scene,
                                              const RenderSettings& settings);
-
-/// the version of the Embree library built against (RTC_VERSION_STRING, e.g. "3.13.5").
-std::string EmbreeVersion();
 
 }  // namespace penumbra

@@ -1,7 +1,7 @@
-// the backend factory (render/renderer_factory.h): RenderSettings::backend picks the Renderer
-// and the RayQuery; the only backend today is Embree.
+// the backend factory (render/backends/renderer_factory.h): RenderSettings::backend picks the
+// Renderer and the RayQuery; the only backend today is Embree.
 
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/embree/embree_renderer.h"
+#include "penumbra/render/cpu/embree_renderer.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "render/render_test_util.h"
 

@@ -1,4 +1,4 @@
-#include "penumbra/render/denoiser.h"
+#include "penumbra/render/cpu/denoiser.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "penumbra/render/media_frame.h"
+#include "penumbra/render/cpu/media_frame.h"
 
 #include <cmath>
 

@@ -2,7 +2,7 @@
 // with analytic values, multiple importance sampling against a quadrature reference, and
 // determinism across thread counts.
 
-#include "penumbra/render/path_integrator.h"
+#include "penumbra/render/cpu/path_integrator.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <cstring>
 #include <limits>
 
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/bsdf.h"
-#include "penumbra/render/renderer_factory.h"
-#include "render_test_util.h"
+#include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {

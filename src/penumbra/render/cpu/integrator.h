@@ -1,6 +1,6 @@
 #pragma once
 // the light-transport interface shared by both render tiers. the renderer
-// (render/embree_renderer) splits a frame into tiles, traces the pixel-centre camera ray
+// (render/cpu/embree_renderer) splits a frame into tiles, traces the pixel-centre camera ray
 // of every pixel of a tile once (those hits give the exact depth and segmentation
 // images), and hands them to an Integrator, which estimates the radiance of every pixel
 // of the tile. tiles never overlap, so integrators write their pixels without locks.
@@ -14,10 +14,10 @@
 #include "penumbra/core/image.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/camera.h"
+#include "penumbra/render/cpu/media_frame.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
-#include "penumbra/render/media_frame.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
@@ -42,7 +42,7 @@ struct FrameContext {
   const RenderSettings* settings = nullptr;
   int camera_index = 0;     ///< CameraView::camera_index
   int64_t frame_index = 0;  ///< CameraView::frame_index
-  /// adverse conditions of this frame (media, particles, wetness; render/media_frame.h), or
+  /// adverse conditions of this frame (media, particles, wetness; render/cpu/media_frame.h), or
   /// null in clear conditions (then both tiers render exactly as without effects). `sky`
   /// already is the effects' sky and `lights` carry the effects' light changes.
   const MediaFrame* effects = nullptr;
