@@ -11,6 +11,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/cpu/embree_renderer.h"
+#include "penumbra/render/embree/embree_version.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "render/render_test_util.h"
 
