@@ -19,6 +19,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/session/live_control.h"
 #include "penumbra/session/session.h"
 #include "penumbra/viewer/image_maps.h"
 #include "penumbra/viewer/viewer_messages.h"
@@ -163,6 +164,11 @@ class ViewerBridge : public RunBridge {
 
   SnapshotContent Wants(int64_t step, double time_sec) override {
     steps_.Add();
+    // an adversity change no page was told of (another client's): the new state, once
+    if (LiveControl* live = dispatcher_.live();
+        live && clients_.load() > 0 &&
+        live->effects().requested_adversity().changes > published_changes_.load())
+      PublishStatus(json::object());
     // the first step's state is kept for pages that connect later (e.g. to a paused run)
     if (clients_.load() == 0 && state_step_ >= 0) return SnapshotContent::kNone;
     const Clock::time_point now = Clock::now();
@@ -185,7 +191,7 @@ class ViewerBridge : public RunBridge {
 
   void OnFinish(const LoopFinish& finish) override {
     ended_ = true;
-    PublishStatus(json{{"ended", true}, {"step", finish.step}, {"time_sec", finish.time_sec}});
+    PublishStatus(json{{"step", finish.step}, {"time_sec", finish.time_sec}});
     StopEncoder();
   }
 
@@ -315,37 +321,54 @@ class ViewerBridge : public RunBridge {
             {"value", value},          {"unit", "rad"}};
   }
 
+  // the adversity sliders: block, key, range and the value that removes the block ("off");
+  // their values come with every status message (AdversityJson)
   json EffectSliders() const {
-    AdversityPreset p;
-    if (!world_.adversity.empty()) {
-      try {
-        p = LoadAdversityPreset(world_.adversity);
-      } catch (const std::exception& e) {
-        spdlog::warn("viewer: adversity preset: {}", e.what());
-      }
-    }
-    auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
     auto slider = [](const char* block, const char* key, const char* label, const char* unit,
-                     double min, double max, double step, double off, json value) {
-      return json{{"block", block}, {"key", key},      {"label", label}, {"unit", unit},
-                  {"min", min},     {"max", max},      {"step", step},   {"off", off},
-                  {"value", value}, {"integer", false}};
+                     double min, double max, double step, double off) {
+      return json{{"block", block}, {"key", key}, {"label", label},
+                  {"unit", unit},   {"min", min}, {"max", max},
+                  {"step", step},   {"off", off}, {"integer", false}};
     };
     json s = json::array();
-    s.push_back(slider("fog", "mor_m", "fog MOR", "m", 2, 300, 1, 300, opt(p.fog_mor_m)));
-    s.push_back(slider("smoke", "sigma_t_per_m", "smoke extinction", "1/m", 0, 3, 0.05, 0,
-                       opt(p.smoke_sigma_t_per_m)));
-    s.push_back(
-        slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0, opt(p.rain_rate_mm_h)));
-    s.push_back(
-        slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0, opt(p.snow_rate_mm_h)));
-    s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1, p.light_scale));
-    // MuJoCo cannot add bodies to a loaded model: the run has the NPCs it started with
-    json npcs =
-        slider("npcs", "people", "NPC count", "", 0, std::max(p.npc_people, 0), 1, 0, p.npc_people);
+    s.push_back(slider("fog", "mor_m", "fog MOR", "m", 2, 300, 1, 300));
+    s.push_back(slider("smoke", "sigma_t_per_m", "smoke extinction", "1/m", 0, 3, 0.05, 0));
+    s.push_back(slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0));
+    s.push_back(slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0));
+    s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1));
+    // MuJoCo cannot add bodies to a loaded model: the run has the NPC bodies it started with
+    // (a live run also parks bodies for the bundled presets' NPCs: session/live_effects.h)
+    const int npc_bodies = std::max(
+        0, static_cast<int>(session_.effects().agent_bodies().size() - world_.agents.size()));
+    json npcs = slider("npcs", "people", "NPC count", "", 0, npc_bodies, 1, 0);
     npcs["integer"] = true;
     s.push_back(npcs);
     return s;
+  }
+
+  // the adversity the run is in (as requested: a queued change applies at the next step
+  // boundary): the preset's name, whether a block was changed since, and each slider's value
+  // ("<block>.<key>"; null = the block is off)
+  json AdversityJson() const {
+    RequestedAdversity r;
+    if (LiveControl* live = dispatcher_.live()) {
+      r = live->effects().requested_adversity();
+    } else {
+      r.preset = session_.effects().preset();
+      if (r.preset && !r.preset->name.empty()) r.name = r.preset->name;
+    }
+    const AdversityPreset p = r.preset.value_or(AdversityPreset{});
+    auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+    json values = {{"fog.mor_m", opt(p.fog_mor_m)},
+                   {"smoke.sigma_t_per_m", opt(p.smoke_sigma_t_per_m)},
+                   {"rain.rate_mm_h", opt(p.rain_rate_mm_h)},
+                   {"snow.rate_mm_h", opt(p.snow_rate_mm_h)},
+                   {"lights.scale", p.light_scale},
+                   {"npcs.people", p.npc_people}};
+    return {{"preset", PresetForClient(r.name)},
+            {"edited", r.edited},
+            {"changes", r.changes},
+            {"values", values}};
   }
 
   // ---- server handlers (server thread) ----
@@ -354,7 +377,8 @@ class ViewerBridge : public RunBridge {
     json hello = hello_;
     hello["paused"] = control_.paused();
     hello["realtime_factor"] = control_.realtime_factor();
-    std::vector<WebMessage> out = {WebMessage::Text(hello.dump()), WebMessage{scene_, false}};
+    std::vector<WebMessage> out = {WebMessage::Text(hello.dump()), WebMessage{scene_, false},
+                                   WebMessage::Text(StatusJson(json::object()).dump())};
     std::lock_guard<std::mutex> lock(mu_);
     if (last_state_) out.push_back(WebMessage{last_state_, false});
     return out;
@@ -386,11 +410,14 @@ class ViewerBridge : public RunBridge {
     dispatcher_.Dispatch(request, [this, client, cmd](json reply) {
       server_->Send(client, WebMessage::Text(reply.dump()));
       // the run's state changed at a boundary: every page learns it at once
-      if (reply.value("ok", false) && (cmd == "pause" || cmd == "resume" || cmd == "step" ||
-                                       cmd == "reset" || cmd == "set_realtime_factor")) {
-        json status = {{"paused", control_.paused()},
-                       {"realtime_factor", control_.realtime_factor()}};
-        if (reply.contains("step")) status["step"] = reply["step"];
+      if (reply.value("ok", false) &&
+          (cmd == "pause" || cmd == "resume" || cmd == "step" || cmd == "reset" ||
+           cmd == "set_realtime_factor" || cmd == "set_adversity" || cmd == "set_effect")) {
+        json status = json::object();
+        if (reply.contains("step") && cmd != "set_adversity" && cmd != "set_effect")
+          status["step"] = reply["step"];
+        if (reply.contains("applies_from_step"))
+          status["applies_from_step"] = reply["applies_from_step"];
         if (reply.contains("time_sec")) status["time_sec"] = reply["time_sec"];
         PublishStatus(status);
       }
@@ -473,9 +500,26 @@ class ViewerBridge : public RunBridge {
       }
   }
 
-  void PublishStatus(json fields) {
+  // the state the page's controls show, in full (docs/viewer.md "status"): run state, real-
+  // time factor and adversity, with `fields` (step, time_sec of a boundary) added
+  json StatusJson(json fields) const {
     fields["type"] = "status";
-    server_->Publish("status", WebMessage::Text(fields.dump()));
+    fields["paused"] = control_.paused();
+    fields["ended"] = ended_.load();
+    fields["realtime_factor"] = control_.realtime_factor();
+    fields["adversity"] = AdversityJson();
+    return fields;
+  }
+
+  // every page learns the new state at once; the adversity changes it shows are noted, so
+  // that a change from another client (ZeroMQ) is published once at the next step (Wants)
+  void PublishStatus(json fields) {
+    json status = StatusJson(std::move(fields));
+    const int64_t changes = status["adversity"]["changes"];
+    int64_t seen = published_changes_.load();
+    while (seen < changes && !published_changes_.compare_exchange_weak(seen, changes)) {
+    }
+    server_->Publish("status", WebMessage::Text(status.dump()));
   }
 
   // ---- encoder thread ----
@@ -666,6 +710,7 @@ class ViewerBridge : public RunBridge {
   std::unique_ptr<WebServer> server_;
   std::atomic<int> clients_{0};
   std::atomic<bool> ended_{false};
+  std::atomic<int64_t> published_changes_{0};  // adversity changes the pages were told of
 
   // loop thread
   Clock::time_point last_state_wall_ = Clock::now();
