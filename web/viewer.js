@@ -423,6 +423,9 @@ function onScene(s) {
     scene3.add(line);
     trails.set(i, { line, points, count: 0 });
   });
+  // the poses as the run started (a paused run sends no state before its first step)
+  if (s.X_WB && !viewer.state) applyPoses(s.X_WB);
+  else if (viewer.state) applyPoses(viewer.state.X_WB);
 }
 
 function onState(m) {
@@ -432,7 +435,13 @@ function onState(m) {
   $('stepsPerSec').textContent = Math.round(m.steps_per_sec);
   $('renderFps').textContent = m.render_fps.toFixed(1);
   setBadge('runState', m.ended ? 'ended' : m.paused ? 'paused' : 'running', m.paused ? 'off' : 'on');
-  const X = m.X_WB;
+  applyPoses(m.X_WB);
+  for (const [, t] of trails) t.line.visible = $('showTrails').checked;
+  if (m.signals) pushSignals(m.time_sec, m.signals);
+}
+
+// the bodies' poses (7 per body: x y z qw qx qy qz) onto the overview, its trails and camera
+function applyPoses(X) {
   if (X && bodyNodes.length * 7 === X.length) {
     bodyNodes.forEach((n, i) => {
       n.position.set(X[7 * i], X[7 * i + 1], X[7 * i + 2]);
@@ -451,8 +460,6 @@ function onState(m) {
       t.line.geometry.attributes.position.needsUpdate = true;
     }
   }
-  for (const [, t] of trails) t.line.visible = $('showTrails').checked;
-  if (m.signals) pushSignals(m.time_sec, m.signals);
 }
 
 // the orbit camera's target is the robot: placed behind and above it at the first state,
@@ -592,7 +599,9 @@ function pushSignals(t, signals) {
   }
   if (plots.length === 0) {
     const keys = Object.keys(signals);
-    const first = keys.find((k) => k.startsWith('imu/')) || keys.find((k) => k.startsWith('contacts/normal'));
+    // the first robot's contact force (its weight when it stands), else an IMU, else all contacts
+    const first = keys.find((k) => /^contacts\/.+\/normal_force_N$/.test(k)) ||
+      keys.find((k) => k.startsWith('imu/')) || keys.find((k) => k.startsWith('contacts/normal'));
     if (first) addPlot(first);
   }
 }

@@ -4,7 +4,10 @@ chromium-driver through python3-selenium) and raw WebSocket clients (python3-web
 
   penumbra view worlds/default.yaml --viewer 127.0.0.1:0   (real-time, paused at the start)
 
-checks: the page shows a camera frame (canvas not blank, equal to the run's PNG of the same
+checks: the adversity controls show the run's state (choosing `major` moves every slider to
+major's values of worlds/adversity/presets.yaml, a slider change and `none` too, a second page
+agrees, the run applies it at its next step), the 3D scene view starts on the robot (orbit
+target = the trunk's position, the robot's own pixels visible in the overview), the page shows a camera frame (canvas not blank, equal to the run's PNG of the same
 frame within JPEG error), pause stops sim time, one step advances exactly one control period,
 the fog slider lowers the next frames' contrast, the teleop keys move the quadruped forward and
 back (ground-truth x), five viewers at once, a malformed message gets an error and the server
@@ -258,11 +261,13 @@ return {robot_pixels: n, pixels: a.length / 4, bodies: robot.length, cut: v.cutA
 
 def check_scene_view_on_robot(driver, js, artefacts):
     wait_for("the overview camera placed", lambda: js(
-        "const v = window.penumbraViewer; return v.view3 && v.state && v.robotBody >= 0;"))
+        "const v = window.penumbraViewer; return v.view3 && v.scene && v.robotBody >= 0;"))
     time.sleep(0.3)
     v = js("const v = window.penumbraViewer; const i = v.robotBody;"
-           "return {name: v.scene.bodies[i].name, X: v.state.X_WB.slice(7 * i, 7 * i + 3),"
-           " view: v.view3};")
+           "const X = v.state ? v.state.X_WB : v.scene.X_WB;"
+           "return {name: v.scene.bodies[i].name, X: X.slice(7 * i, 7 * i + 3),"
+           " view: v.view3, has_state: !!v.state};")
+    log(f"scene view checked {'with' if v['has_state'] else 'before any'} state message")
     check(v["name"] == "go1/trunk", f"the scene view orbits the robot's root body ({v['name']})")
     d = math.dist(v["X"], v["view"]["target"])
     check(d < 1e-6, f"the orbit target is the trunk's position {v['X']} (off by {d:.2e} m)")
@@ -339,12 +344,13 @@ def main():
         # status message. choosing `major` moves every slider to major's values (from
         # worlds/adversity/presets.yaml, read here), the run applies it at its next step (the
         # server's log), and a second page sees the same; `none` moves them back
-        check_adversity_controls(driver, js, view, url, args.source, artefacts)
-
         # the scene view starts on the robot (issue 38): the orbit camera's target is the
-        # robot's trunk of the run's state, and the robot's own pixels show in the overview
+        # robot's trunk as the run starts (paused: no state message yet), and the robot's own pixels show in the overview
         # (the overview rendered with and without the robot's bodies differs)
         check_scene_view_on_robot(driver, js, artefacts)
+
+        check_adversity_controls(driver, js, view, url, args.source, artefacts)
+
 
         # the record button writes into the run's output folder, and never over a file
         driver.find_element("id", "record").click()

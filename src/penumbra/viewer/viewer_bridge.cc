@@ -292,13 +292,28 @@ class ViewerBridge : public RunBridge {
               {"waypoint_robots", waypoint},
               {"record_available", true},
               {"colormap", colormap}};
-    scene_ = std::make_shared<const std::string>(SceneJson(session_.scene()).dump());
+    // with the bodies' poses as the run starts: a page of a run paused at its start gets no
+    // state message before the first step, and places its bodies and camera from these
+    json scene = SceneJson(session_.scene());
+    scene["X_WB"] = BodyPosesJson(sim.Snapshot(Simulation::SnapshotContent::kPoses));
+    scene_ = std::make_shared<const std::string>(scene.dump());
     for (const json& j : model_info_.value("joints", json::array())) {
       const std::string type = j.value("type", "");
       if (type == "hinge" || type == "slide")
         joint_signals_.emplace_back("joint/" + j.value("name", ""), j.value("qpos_adr", 0));
     }
     for (const CameraSpec& c : session_.scene().cameras) intrinsics_[c.name] = c.intrinsics;
+    // the robot each body belongs to (composed names "<robot>/<body>"), for the robots'
+    // contact forces
+    const std::vector<std::string>& bodies = sim.model_info().body_names;
+    body_robot_.assign(bodies.size(), -1);
+    for (const ModelConfig& m : world_.models) {
+      if (!m.is_robot) continue;
+      const int r = static_cast<int>(robot_names_.size());
+      robot_names_.push_back(m.name);
+      for (size_t b = 0; b < bodies.size(); ++b)
+        if (bodies[b].rfind(m.name + "/", 0) == 0) body_robot_[b] = r;
+    }
   }
 
   json JointControl(const std::string& robot, const std::vector<std::string>& joints) const {
@@ -562,9 +577,24 @@ class ViewerBridge : public RunBridge {
     json signals = json::object();
     for (const auto& [name, adr] : joint_signals_)
       if (adr < static_cast<int>(s.qpos.size())) signals[name] = s.qpos[adr];
+    // every contact's normal force (contact frame x, MuJoCo mj_contactForce), summed: all
+    // contacts (resting furniture included), and per robot those between one of its bodies
+    // and anything else (its own self contacts are internal forces)
     double normal = 0;
-    for (const WorldSnapshot::Contact& c : s.contacts) normal += c.force_N.x();
+    std::vector<double> robot_normal(robot_names_.size(), 0.0);
+    auto robot_of = [this](int body) {
+      return body >= 0 && body < static_cast<int>(body_robot_.size()) ? body_robot_[body] : -1;
+    };
+    for (const WorldSnapshot::Contact& c : s.contacts) {
+      normal += c.force_N.x();
+      const int r1 = robot_of(c.body1), r2 = robot_of(c.body2);
+      if (r1 == r2) continue;
+      if (r1 >= 0) robot_normal[r1] += c.force_N.x();
+      if (r2 >= 0) robot_normal[r2] += c.force_N.x();
+    }
     signals["contacts/normal_force_N"] = normal;
+    for (size_t r = 0; r < robot_names_.size(); ++r)
+      signals["contacts/" + robot_names_[r] + "/normal_force_N"] = robot_normal[r];
     signals["contacts/count"] = s.contacts.size();
     for (size_t i = 0; i < s.tracking_error.size(); ++i)
       signals[fmt::format("control/tracking_error[{}]", i)] = s.tracking_error[i];
@@ -706,6 +736,8 @@ class ViewerBridge : public RunBridge {
   std::shared_ptr<const std::string> scene_;
   double control_period_sec_ = 0;
   std::vector<std::pair<std::string, int>> joint_signals_;
+  std::vector<std::string> robot_names_;  // the world's robots
+  std::vector<int> body_robot_;           // body -> index in robot_names_, -1 for none
   std::map<std::string, CameraIntrinsics> intrinsics_;
   std::unique_ptr<WebServer> server_;
   std::atomic<int> clients_{0};
