@@ -92,6 +92,9 @@ def main():
             "const s = window.penumbraViewer.state; return s ? s.time_sec : 0;") >= args.seconds,
                  600)
         driver.find_element("id", "pause").click()
+        wait_for("the pause reply and the page's paused badge", lambda: js(
+            "return window.penumbraViewer.replies.some(r => r.cmd === 'pause' && r.ok) &&"
+            " document.getElementById('runState').textContent === 'paused';"), 60)
         wait_for("a camera frame of the paused time", lambda: js(
             "const f = window.penumbraViewer.lastFrame['camera/front/rgb'];"
             f"return f && f.time_sec >= {args.seconds} - 0.15;"), 120)

@@ -155,7 +155,8 @@ function renderAdversity(a) {
     const v = a.values[name];
     const shown = v === null || v === undefined ? e.slider.off : v;
     e.input.value = shown;
-    e.out.textContent = `${Number(shown).toPrecision(3)} ${e.slider.unit}`;
+    const text = e.slider.integer ? String(Math.round(shown)) : Number(shown).toPrecision(3);
+    e.out.textContent = `${text} ${e.slider.unit}`;
   }
 }
 

@@ -16,6 +16,8 @@ import re
 import shlex
 import subprocess
 import sys
+import tempfile
+import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(__file__))
@@ -46,20 +48,35 @@ class ReadmeZmqSnippetTest(unittest.TestCase):
         server_argv, client_argv = readme_snippet()
         self.assertEqual(server_argv[0], "./build/penumbra")
         server_argv[0] = penumbra_binary()
-        server = subprocess.Popen(server_argv, cwd=REPO, stdout=subprocess.PIPE,
-                                  stderr=subprocess.STDOUT, text=True)
-        try:
-            client = subprocess.run(client_argv, cwd=REPO, capture_output=True, text=True,
-                                    timeout=300)
-            out = server.communicate(timeout=120)[0]
-        finally:
-            if server.poll() is None:
-                server.kill()
-                server.wait()
-        print(client.stdout, client.stderr, out[-3000:], sep="\n", file=sys.stderr)
+        # the server's log goes to a file: a pipe nobody reads while the client runs could fill
+        # and stall the server
+        with tempfile.TemporaryFile("w+") as log:
+            server = subprocess.Popen(server_argv, cwd=REPO, stdout=log, stderr=subprocess.STDOUT)
+            client = subprocess.Popen(client_argv, cwd=REPO, stdout=subprocess.PIPE,
+                                      stderr=subprocess.PIPE, text=True)
+            try:
+                # the snippet's REQ socket waits for ever for a server that died: watch both
+                end, server_gone = time.monotonic() + 300, None
+                while client.poll() is None and time.monotonic() < end:
+                    if server.poll() is not None:
+                        server_gone = server_gone or time.monotonic()
+                        if time.monotonic() - server_gone > 10:
+                            break
+                    time.sleep(0.1)
+                if client.poll() is None:
+                    client.kill()
+                client_out, client_err = client.communicate()
+                server.wait(timeout=120)
+            finally:
+                if server.poll() is None:
+                    server.kill()
+                    server.wait()
+                log.seek(0)
+                out = log.read()
+        print(client_out, client_err, out[-3000:], sep="\n", file=sys.stderr)
         self.assertEqual(client.returncode, 0,
-                         f"{client_argv[0]} -c ... exited {client.returncode}: {client.stderr}")
-        lines = client.stdout.strip().splitlines()
+                         f"{client_argv[0]} -c ... exited {client.returncode}: {client_err}")
+        lines = client_out.strip().splitlines()
         topics = ast.literal_eval(lines[0])
         self.assertIn("camera/front/rgb", topics)
         published = ast.literal_eval(lines[1])
