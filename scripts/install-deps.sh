@@ -21,7 +21,7 @@ pkgs=(
   rosout rosbash python3-rosbag python3-rostopic  # roscore, rostopic, rosbag tools for the ROS tests
   python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-tf2-msgs python3-std-srvs  # rostopic, rosservice of them
   libboost-dev libturbojpeg0-dev libjs-three  # browser viewer: Boost.Beast, JPEG frames, three.js
-  chromium chromium-driver python3-websocket python3-selenium  # viewer tests drive a real headless Chromium
+  chromium chromium-driver python3-websocket python3-selenium python3-yaml  # viewer tests drive a real headless Chromium (yaml: the bundled presets)
   libcgal-dev  # convex decomposition (CoACD) clipping and hulls
   libopencv-contrib-dev libopen3d-dev  # bundled SLAM methods (cv::rgbd, cv::kinfu, Open3D odometry)
   slurm-wlm munge  # benchmark sweeps on Slurm, tested on a single-node cluster

@@ -115,16 +115,48 @@ function sliderRow(parent, label, min, max, step, value, unit, oninput) {
   return input;
 }
 
+// the adversity sliders: their ranges come with hello, their values only with the server's
+// status messages (renderAdversity): the page never shows a value the run is not in
+const effectInputs = new Map();   // "block.key" -> {input, out, slider, dragging}
+
 function buildEffectSliders(sliders) {
   const box = $('effectSliders');
   box.innerHTML = '';
+  effectInputs.clear();
   for (const s of sliders) {
-    const input = sliderRow(box, s.label, s.min, s.max, s.step, s.value ?? s.off, s.unit, (v) => {
+    const input = sliderRow(box, s.label, s.min, s.max, s.step, s.off, s.unit, (v) => {
       // the slider's "off" end removes the block
       const params = v === s.off ? null : { [s.key]: s.integer ? Math.round(v) : v };
-      send('set_effect', { effect: s.block, params }).catch((e) => log(e.message));
+      send('set_effect', { effect: s.block, params }).catch((e) => {
+        log(e.message);
+        renderAdversity(viewer.adversity);   // refused: back to the run's value
+      });
     });
     input.id = `effect_${s.block}_${s.key}`;
+    const e = { input, out: input.nextElementSibling, slider: s, dragging: false };
+    input.addEventListener('pointerdown', () => { e.dragging = true; });
+    input.addEventListener('change', () => { e.dragging = false; });
+    effectInputs.set(`${s.block}.${s.key}`, e);
+  }
+  if (viewer.adversity) renderAdversity(viewer.adversity);
+}
+
+// shows the run's adversity (a status message's `adversity`): preset, and each slider's value
+// (null: the block is off, the slider at its off end)
+function renderAdversity(a) {
+  if (!a) return;
+  viewer.adversity = a;
+  const preset = $('preset');
+  if (![...preset.options].some((o) => o.value === a.preset)) preset.add(new Option(a.preset, a.preset));
+  preset.value = a.preset;
+  $('presetEdited').textContent = a.edited ? 'changed live' : '';
+  for (const [name, e] of effectInputs) {
+    if (e.dragging) continue;
+    const v = a.values[name];
+    const shown = v === null || v === undefined ? e.slider.off : v;
+    e.input.value = shown;
+    const text = e.slider.integer ? String(Math.round(shown)) : Number(shown).toPrecision(3);
+    e.out.textContent = `${text} ${e.slider.unit}`;
   }
 }
 
@@ -274,7 +306,13 @@ const sunLight = new THREE.DirectionalLight(0xffffff, 0.6);
 sunLight.position.set(3, 5, 10);
 scene3.add(sunLight);
 scene3.add(new THREE.AxesHelper(0.5));
+// for the tests: the overview's renderer, scene, camera and body nodes
+viewer.three = { renderer, scene: scene3, camera: camera3, bodyNodes: () => bodyNodes, cutAway: () => cutAway() };
 let bodyNodes = [];
+let robotBody = -1;          // the body the camera orbits (findRobotBody)
+let cameraPlaced = false;    // the camera was put on the robot (first state after a scene)
+let staticObjects = [];      // static geoms the cut-away may hide
+const robotPos = new THREE.Vector3();
 const trails = new Map();    // body index -> {line, points, count}
 const frusta = new Map();    // camera -> LineSegments
 const lidarClouds = new Map();
@@ -337,21 +375,41 @@ function geomObject(g, s) {
   return obj;
 }
 
+// the robot the scene view orbits: the root body (one of the world's free bodies) of the
+// first controlled robot, else the first free body; -1 when the scene has none
+function findRobotBody(s) {
+  const robots = ((viewer.hello && viewer.hello.model && viewer.hello.model.controllers) || [])
+    .map((c) => c.robot).filter((r) => r);
+  for (const r of robots) {
+    const i = s.bodies.findIndex((b) => b.trail && b.name.startsWith(r + '/'));
+    if (i >= 0) return i;
+  }
+  return s.bodies.findIndex((b) => b.trail && !b.name.startsWith('agents/'));
+}
+
 function onScene(s) {
   const first = !viewer.scene;
   viewer.scene = s;
   if (first && s.center) {
+    // until the first state places the robot: the whole world from above
     const [cx, cy, cz] = s.center, e = Math.max(1, s.extent || 5);
     orbit.target.set(cx, cy, Math.max(0, cz - 0.3 * e));
-    camera3.position.set(cx - 0.9 * e, cy - 1.1 * e, cz + 0.9 * e);
+    camera3.position.set(cx, cy - 0.3 * e, cz + 1.5 * e);
     orbit.update();
   }
+  robotBody = findRobotBody(s);
+  viewer.robotBody = robotBody;
+  cameraPlaced = false;
   for (const n of bodyNodes) scene3.remove(n);
   bodyNodes = s.bodies.map(() => new THREE.Group());
   for (const n of bodyNodes) scene3.add(n);
+  staticObjects = [];
   for (const g of s.geoms) {
     const o = geomObject(g, s);
-    if (o) bodyNodes[g.body].add(o);
+    if (!o) continue;
+    bodyNodes[g.body].add(o);
+    // walls, ceilings and furniture may hide the robot: cut away (cutAway)
+    if (s.bodies[g.body].static && g.shape !== 'plane' && g.shape !== 'hfield') staticObjects.push(o);
   }
   for (const [, t] of trails) scene3.remove(t.line);
   trails.clear();
@@ -366,6 +424,9 @@ function onScene(s) {
     scene3.add(line);
     trails.set(i, { line, points, count: 0 });
   });
+  // the poses as the run started (a paused run sends no state before its first step)
+  if (s.X_WB && !viewer.state) applyPoses(s.X_WB);
+  else if (viewer.state) applyPoses(viewer.state.X_WB);
 }
 
 function onState(m) {
@@ -375,12 +436,19 @@ function onState(m) {
   $('stepsPerSec').textContent = Math.round(m.steps_per_sec);
   $('renderFps').textContent = m.render_fps.toFixed(1);
   setBadge('runState', m.ended ? 'ended' : m.paused ? 'paused' : 'running', m.paused ? 'off' : 'on');
-  const X = m.X_WB;
+  applyPoses(m.X_WB);
+  for (const [, t] of trails) t.line.visible = $('showTrails').checked;
+  if (m.signals) pushSignals(m.time_sec, m.signals);
+}
+
+// the bodies' poses (7 per body: x y z qw qx qy qz) onto the overview, its trails and camera
+function applyPoses(X) {
   if (X && bodyNodes.length * 7 === X.length) {
     bodyNodes.forEach((n, i) => {
       n.position.set(X[7 * i], X[7 * i + 1], X[7 * i + 2]);
       n.quaternion.set(X[7 * i + 4], X[7 * i + 5], X[7 * i + 6], X[7 * i + 3]);
     });
+    followRobot(X);
     for (const [i, t] of trails) {
       const k = t.count % 4000;
       const last = t.count ? (t.count - 1) % 4000 : -1;
@@ -393,13 +461,57 @@ function onState(m) {
       t.line.geometry.attributes.position.needsUpdate = true;
     }
   }
-  for (const [, t] of trails) t.line.visible = $('showTrails').checked;
-  if (m.signals) pushSignals(m.time_sec, m.signals);
+}
+
+// the orbit camera's target is the robot: placed behind and above it at the first state,
+// then it follows the robot's motion (the user's rotation and zoom are kept)
+function followRobot(X) {
+  if (robotBody < 0) return;
+  const p = new THREE.Vector3(X[7 * robotBody], X[7 * robotBody + 1], X[7 * robotBody + 2]);
+  if (!cameraPlaced) {
+    const q = new THREE.Quaternion(X[7 * robotBody + 4], X[7 * robotBody + 5], X[7 * robotBody + 6], X[7 * robotBody + 3]);
+    const back = new THREE.Vector3(1, 0, 0).applyQuaternion(q).setZ(0);
+    if (back.lengthSq() < 1e-6) back.set(1, 0, 0);
+    back.normalize().multiplyScalar(-1.6);
+    orbit.target.copy(p);
+    camera3.position.set(p.x + back.x, p.y + back.y, p.z + 1.4);
+    cameraPlaced = true;
+  } else if ($('followRobot').checked) {
+    const d = p.clone().sub(robotPos);
+    orbit.target.add(d);
+    camera3.position.add(d);
+  }
+  robotPos.copy(p);
+  orbit.update();
+}
+
+// static geometry between the camera and the robot is hidden (walls, ceiling cut away): rays
+// from the camera to the robot's origin and to points 0.25 m around it
+const cutRay = new THREE.Raycaster();
+function cutAway() {
+  for (const o of staticObjects) o.visible = true;
+  if (robotBody < 0 || !cameraPlaced || !$('cutAway').checked) return;
+  const hidden = new Set();
+  for (const [dx, dy, dz] of [[0, 0, 0], [0.25, 0, 0], [-0.25, 0, 0], [0, 0.25, 0], [0, -0.25, 0], [0, 0, 0.2]]) {
+    const to = robotPos.clone().add(new THREE.Vector3(dx, dy, dz));
+    const dir = to.clone().sub(camera3.position);
+    const far = dir.length();
+    cutRay.set(camera3.position, dir.normalize());
+    cutRay.far = far;
+    for (const hit of cutRay.intersectObjects(staticObjects, true)) {
+      let o = hit.object;
+      while (o && !staticObjects.includes(o)) o = o.parent;
+      if (o) hidden.add(o);
+    }
+  }
+  for (const o of hidden) o.visible = false;
+  viewer.cutAway = hidden.size;
 }
 
 // a change of the run's state at a step boundary (pause, resume, step, reset, end)
 function onStatus(m) {
   viewer.status = m;
+  if (m.adversity) renderAdversity(m.adversity);
   if (m.time_sec !== undefined) $('simTime').textContent = m.time_sec.toFixed(3);
   if (m.step !== undefined) $('simStep').textContent = m.step;
   if (m.realtime_factor !== undefined && document.activeElement !== $('rtf')) $('rtf').value = m.realtime_factor;
@@ -466,7 +578,9 @@ renderer.domElement.addEventListener('click', (ev) => {
 function animate() {
   requestAnimationFrame(animate);
   if (overview.clientWidth !== renderer.domElement.width / window.devicePixelRatio) resize3();
+  cutAway();
   renderer.render(scene3, camera3);
+  viewer.view3 = { target: orbit.target.toArray(), camera: camera3.position.toArray() };
 }
 
 // ---------- plots ----------
@@ -486,7 +600,9 @@ function pushSignals(t, signals) {
   }
   if (plots.length === 0) {
     const keys = Object.keys(signals);
-    const first = keys.find((k) => k.startsWith('imu/')) || keys.find((k) => k.startsWith('contacts/normal'));
+    // the first robot's contact force (its weight when it stands), else an IMU, else all contacts
+    const first = keys.find((k) => /^contacts\/.+\/normal_force_N$/.test(k)) ||
+      keys.find((k) => k.startsWith('imu/')) || keys.find((k) => k.startsWith('contacts/normal'));
     if (first) addPlot(first);
   }
 }
@@ -597,7 +713,10 @@ $('reset').addEventListener('click', () => {
   send('reset').catch((e) => log(e.message));
 });
 $('rtf').addEventListener('change', () => send('set_realtime_factor', { factor: Number($('rtf').value) }).catch((e) => log(e.message)));
-$('preset').addEventListener('change', () => send('set_adversity', { preset: $('preset').value }).catch((e) => log(e.message)));
+$('preset').addEventListener('change', () => send('set_adversity', { preset: $('preset').value }).catch((e) => {
+  log(e.message);
+  renderAdversity(viewer.adversity);   // refused: back to the run's preset
+}));
 $('addView').addEventListener('click', () => addCameraPanel());
 $('addPlot').addEventListener('click', () => addPlot($('plotSignal').value));
 let recording = false;

@@ -20,18 +20,23 @@ Each control period (one frame of the nose camera `front`, 0.1 s) it
 
 It prints one JSON object: the number of control periods, whether it arrived, the last
 seen depth and bearing, the sim time. Nothing here knows where the target is: only images.
+
+On exit, also on Ctrl-C (SIGINT) or SIGTERM, it sends ``stop`` to the server, which then writes
+its outputs and exits (as on Ctrl-C); ``--leave-running`` keeps the server running instead.
+Exit status: 0 arrived, 1 not arrived, 130 / 143 interrupted.
 """
 
 import argparse
 import json
 import math
 import os
+import signal
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from penumbra_client import Client  # noqa: E402
+from penumbra_client import Client, PenumbraError  # noqa: E402
 
 
 def find_target(rgb, min_pixels=4):
@@ -99,12 +104,44 @@ def main(argv=None):
     p.add_argument("--stop-distance", type=float, default=0.8, help="m")
     p.add_argument("--max-periods", type=int, default=300, help="control periods (frames)")
     p.add_argument("--timeout", type=float, default=60.0, help="s per request")
+    p.add_argument("--leave-running", action="store_true",
+                   help="do not stop the server on exit (default: send it `stop`)")
     args = p.parse_args(argv)
+
+    # SIGTERM ends the loop as Ctrl-C does, so that the server is stopped either way
+    got = {"signal": signal.SIGINT}
+
+    def on_sigterm(signum, frame):
+        got["signal"] = signum
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, on_sigterm)
+    status = 130
     with Client(args.endpoint, timeout_sec=args.timeout, name="steer_to_target") as c:
-        result = steer(c, camera=args.camera, stop_distance_m=args.stop_distance,
-                       max_periods=args.max_periods)
-    print(json.dumps(result))
-    return 0 if result["arrived"] else 1
+        try:
+            result = steer(c, camera=args.camera, stop_distance_m=args.stop_distance,
+                           max_periods=args.max_periods)
+            print(json.dumps(result))
+            status = 0 if result["arrived"] else 1
+        except KeyboardInterrupt:
+            status = 128 + int(got["signal"])
+            print("steer_to_target: interrupted", file=sys.stderr)
+        finally:
+            if not args.leave_running:
+                stop_server(c)
+    return status
+
+
+def stop_server(client):
+    """Sends ``stop`` (the server writes its outputs and exits); an interrupted request's late
+    reply is skipped by its id. A server that is gone already is not an error."""
+    client.timeout_sec = 10.0
+    try:
+        r = client.stop()
+        print(f"steer_to_target: stopped the server at {r.get('time_sec', 0):.3f} s of sim time",
+              file=sys.stderr)
+    except PenumbraError as e:
+        print(f"steer_to_target: could not stop the server: {e}", file=sys.stderr)
 
 
 if __name__ == "__main__":

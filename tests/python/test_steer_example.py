@@ -31,7 +31,8 @@ class SteerExampleTest(unittest.TestCase):
 
             proc = subprocess.run(
                 [sys.executable, os.path.join(REPO, "python", "examples", "steer_to_target.py"),
-                 "--endpoint", server.endpoint], capture_output=True, text=True, timeout=300)
+                 "--endpoint", server.endpoint, "--leave-running"],
+                capture_output=True, text=True, timeout=300)
             self.assertEqual(proc.returncode, 0, proc.stdout + proc.stderr)
             result = json.loads(proc.stdout.strip().splitlines()[-1])
             end = client.get_state().qpos

@@ -310,5 +310,52 @@ TEST(LiveControlTest, NpcsOfTheStartingPresetMoveOrParkAndTheRestStayBitExact) {
   EXPECT_EQ(live_session.effects().agents().size(), 1u);
 }
 
+// what the viewer's controls show (issue 38): the preset as requested, its name, whether a
+// block was changed since, and a count of accepted changes; a refused change leaves it
+TEST(LiveControlTest, RequestedAdversityFollowsEveryAcceptedChange) {
+  const WorldConfig world = LoadWorldFile((kWorlds / "effects" / "fog.yaml").string());
+  SessionOptions o;
+  o.build_renderer = false;
+  o.reserve_live_npcs = true;
+  Session session(world, o);
+  LiveControl live(session, "test", ::testing::TempDir());
+  LiveEffects& fx = live.effects();
+  RequestedAdversity r = fx.requested_adversity();
+  EXPECT_EQ(r.name, "none");
+  EXPECT_FALSE(r.edited);
+  EXPECT_EQ(r.changes, 0);
+  EXPECT_TRUE(!r.preset || r.preset->empty());
+
+  fx.SetAdversity("major");
+  r = fx.requested_adversity();
+  EXPECT_EQ(r.name, "major");
+  EXPECT_FALSE(r.edited);
+  EXPECT_EQ(r.changes, 1);
+  ASSERT_TRUE(r.preset);
+  EXPECT_EQ(r.preset->fog_mor_m, 12.0);
+  EXPECT_EQ(r.preset->npc_people, 4);
+  EXPECT_EQ(r.preset->light_scale, 0.25);
+
+  fx.SetEffect("fog", {{"mor_m", 40}});  // the world's own effect: not the preset's block
+  EXPECT_FALSE(fx.requested_adversity().edited);
+  fx.SetEffect("rain", {{"rate_mm_h", 5}});
+  r = fx.requested_adversity();
+  EXPECT_EQ(r.name, "major");
+  EXPECT_TRUE(r.edited);
+  EXPECT_EQ(r.changes, 3);
+  EXPECT_EQ(r.preset->rain_rate_mm_h, 5.0);
+  EXPECT_EQ(r.preset->fog_mor_m, 12.0);
+
+  EXPECT_THROW(fx.SetEffect("lights", {{"scale", 2}}), ConfigError);
+  EXPECT_EQ(fx.requested_adversity().changes, 3);
+
+  fx.SetAdversity("none");
+  r = fx.requested_adversity();
+  EXPECT_EQ(r.name, "none");
+  EXPECT_FALSE(r.edited);
+  EXPECT_EQ(r.changes, 4);
+  EXPECT_TRUE(!r.preset || r.preset->empty());
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -4,7 +4,10 @@ chromium-driver through python3-selenium) and raw WebSocket clients (python3-web
 
   penumbra view worlds/default.yaml --viewer 127.0.0.1:0   (real-time, paused at the start)
 
-checks: the page shows a camera frame (canvas not blank, equal to the run's PNG of the same
+checks: the adversity controls show the run's state (choosing `major` moves every slider to
+major's values of worlds/adversity/presets.yaml, a slider change and `none` too, a second page
+agrees, the run applies it at its next step), the 3D scene view starts on the robot (orbit
+target = the trunk's position, the robot's own pixels visible in the overview), the page shows a camera frame (canvas not blank, equal to the run's PNG of the same
 frame within JPEG error), pause stops sim time, one step advances exactly one control period,
 the fog slider lowers the next frames' contrast, the teleop keys move the quadruped forward and
 back (ground-truth x), five viewers at once, a malformed message gets an error and the server
@@ -156,6 +159,131 @@ img.src = 'data:image/png;base64,' + b64;
 """
 
 
+SLIDER_VALUES = """
+const out = {};
+for (const e of document.querySelectorAll('#effectSliders input[type=range]'))
+  out[e.id] = {value: Number(e.value), min: Number(e.min), max: Number(e.max),
+               shown: e.nextElementSibling.textContent};
+return {preset: document.getElementById('preset').value,
+        edited: (document.getElementById('presetEdited') || {}).textContent || '', sliders: out};
+"""
+
+
+def expected_sliders(preset):
+    """slider id -> value a page must show for a preset of the bundled file (a missing block:
+    the slider's off end, as docs/viewer.md says)."""
+    fog = preset.get("fog", {}).get("mor_m")
+    return {"effect_fog_mor_m": fog if fog is not None else 300,
+            "effect_smoke_sigma_t_per_m": preset.get("smoke", {}).get("sigma_t_per_m", 0),
+            "effect_rain_rate_mm_h": preset.get("rain", {}).get("rate_mm_h", 0),
+            "effect_snow_rate_mm_h": preset.get("snow", {}).get("rate_mm_h", 0),
+            "effect_lights_scale": preset.get("lights", {}).get("scale", 1),
+            "effect_npcs_people": preset.get("npcs", {}).get("people", 0)}
+
+
+def choose_preset(driver, js, name, want):
+    """chooses preset `name` in the page, waits for the server's reply, then up to 10 s for
+    the sliders to show `want` (slider id -> value); returns what they show then."""
+    from selenium.webdriver.support.ui import Select
+    count = "return window.penumbraViewer.replies.filter(r => r.cmd === 'set_adversity').length;"
+    n = js(count)
+    Select(driver.find_element("id", "preset")).select_by_value(name)
+    wait_for(f"the set_adversity reply ({name})", lambda: js(count) > n)
+    end = time.monotonic() + 10
+    while True:
+        shown = js(SLIDER_VALUES)
+        got = {k: shown["sliders"][k]["value"] for k in want}
+        if got == want or time.monotonic() > end:
+            return shown, got
+        time.sleep(0.1)
+
+
+def check_adversity_controls(driver, js, view, url, source, artefacts):
+    import yaml
+    with open(os.path.join(source, "worlds", "adversity", "presets.yaml")) as f:
+        presets = yaml.safe_load(f)["presets"]
+    shown = js(SLIDER_VALUES)
+    want = expected_sliders(presets["none"])
+    check(all(abs(shown["sliders"][k]["value"] - v) < 1e-9 for k, v in want.items()),
+          f"at the start the sliders show the world's conditions (none): {shown['sliders']}")
+    want = expected_sliders(presets["major"])
+    shown, got = choose_preset(driver, js, "major", want)
+    check(got == want, f"after choosing major the sliders show major's values {got} (expected {want})")
+    check(shown["sliders"]["effect_npcs_people"]["max"] >= want["effect_npcs_people"],
+          f"the NPC slider reaches major's people count (max {shown['sliders']['effect_npcs_people']['max']})")
+    check(shown["sliders"]["effect_fog_mor_m"]["shown"].startswith("12.0"),
+          f"the fog label reads {shown['sliders']['effect_fog_mor_m']['shown']!r}")
+    # the run applies it at the next step: one step from another client, then the server's log
+    c = ws_client(url)
+    status = recv_json(c, "status")
+    check(status["adversity"]["preset"] == "major" and
+          status["adversity"]["values"]["fog.mor_m"] == 12 and
+          status["adversity"]["values"]["npcs.people"] == 4,
+          f"a second page's first status says major too ({status['adversity']})")
+    c.send(json.dumps({"cmd": "step", "n": 1, "id": 1}))
+    check(recv_json(c, "reply")["ok"], "one step")
+    c.close()
+    wait_for("the server's log of the applied change", lambda: any(
+        "live change at step" in line and '"spec":"major"' in line for line in view.lines))
+    log("ok: the run applied major at its next step (server log)")
+    driver.save_screenshot(os.path.join(artefacts, "viewer_major.png"))
+    # a slider change: the page shows the value the server sends back, marked as changed live
+    js("const e = document.getElementById('effect_fog_mor_m'); e.value = 40;"
+       "e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change'));")
+    wait_for("the status after the fog change", lambda: js(
+        "const a = window.penumbraViewer.adversity; return a && a.values['fog.mor_m'];") == 40)
+    shown = js(SLIDER_VALUES)
+    check(shown["sliders"]["effect_fog_mor_m"]["value"] == 40 and shown["preset"] == "major"
+          and shown["edited"] == "changed live" and shown["sliders"]["effect_npcs_people"]["value"] == 4,
+          f"after the fog slider: fog 40 m, the rest of major kept, marked as changed ({shown})")
+    want = expected_sliders(presets["none"])
+    shown, got = choose_preset(driver, js, "none", want)
+    check(got == want and shown["edited"] == "", f"after choosing none the sliders are back off: {got}")
+
+
+ROBOT_PIXELS = """
+const v = window.penumbraViewer, t = v.three, r = t.renderer;
+const robot = v.scene.bodies.map((b, i) => [b, i]).filter(([b]) => b.name.startsWith(arguments[0] + '/'))
+  .map(([, i]) => i);
+function grab() {
+  t.cutAway();
+  r.render(t.scene, t.camera);
+  const c = document.createElement('canvas');
+  c.width = r.domElement.width; c.height = r.domElement.height;
+  const ctx = c.getContext('2d');
+  ctx.drawImage(r.domElement, 0, 0);
+  return ctx.getImageData(0, 0, c.width, c.height).data;
+}
+const a = grab();
+for (const i of robot) t.bodyNodes()[i].visible = false;
+const b = grab();
+for (const i of robot) t.bodyNodes()[i].visible = true;
+let n = 0;
+for (let i = 0; i < a.length; i += 4)
+  if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) > 30) n++;
+return {robot_pixels: n, pixels: a.length / 4, bodies: robot.length, cut: v.cutAway};
+"""
+
+
+def check_scene_view_on_robot(driver, js, artefacts):
+    wait_for("the overview camera placed", lambda: js(
+        "const v = window.penumbraViewer; return v.view3 && v.scene && v.robotBody >= 0;"))
+    time.sleep(0.3)
+    v = js("const v = window.penumbraViewer; const i = v.robotBody;"
+           "const X = v.state ? v.state.X_WB : v.scene.X_WB;"
+           "return {name: v.scene.bodies[i].name, X: X.slice(7 * i, 7 * i + 3),"
+           " view: v.view3, has_state: !!v.state};")
+    log(f"scene view checked {'with' if v['has_state'] else 'before any'} state message")
+    check(v["name"] == "go1/trunk", f"the scene view orbits the robot's root body ({v['name']})")
+    d = math.dist(v["X"], v["view"]["target"])
+    check(d < 1e-6, f"the orbit target is the trunk's position {v['X']} (off by {d:.2e} m)")
+    px = js(ROBOT_PIXELS, "go1")
+    check(px["robot_pixels"] > 0.01 * px["pixels"],
+          f"the robot is visible in the scene view: {px['robot_pixels']} of {px['pixels']} pixels "
+          f"are the robot's ({px['bodies']} bodies; {px['cut']} static geoms cut away)")
+    driver.find_element("id", "overview").screenshot(os.path.join(artefacts, "viewer_scene.png"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--binary", required=True)
@@ -217,6 +345,18 @@ def main():
             except websocket.WebSocketBadStatusException as e:
                 refused = e.status_code
             check(refused == 403, f"a WebSocket with {what} gets 403 ({refused})")
+
+        # the adversity controls show the run's state (issue 38): the page renders the server's
+        # status message. choosing `major` moves every slider to major's values (from
+        # worlds/adversity/presets.yaml, read here), the run applies it at its next step (the
+        # server's log), and a second page sees the same; `none` moves them back
+        # the scene view starts on the robot (issue 38): the orbit camera's target is the
+        # robot's trunk as the run starts (paused: no state message yet), and the robot's own pixels show in the overview
+        # (the overview rendered with and without the robot's bodies differs)
+        check_scene_view_on_robot(driver, js, artefacts)
+
+        check_adversity_controls(driver, js, view, url, args.source, artefacts)
+
 
         # the record button writes into the run's output folder, and never over a file
         driver.find_element("id", "record").click()
@@ -300,11 +440,13 @@ def main():
         # fog: the next frames lose contrast
         before = js(CANVAS_STATS)
         t_change = js("return window.penumbraViewer.state.time_sec;")
+        n_effect_replies = js("return window.penumbraViewer.replies.concat(window.penumbraViewer"
+                              ".errors).filter(r => r.cmd === 'set_effect').length;")
         js("const e = document.getElementById('effect_fog_mor_m'); e.value = 3;"
            "e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change'));")
         reply = wait_for("the set_effect reply", lambda: js(
             "return window.penumbraViewer.replies.concat(window.penumbraViewer.errors)"
-            ".find(r => r.cmd === 'set_effect');"))
+            f".filter(r => r.cmd === 'set_effect')[{n_effect_replies}];"))
         check(reply.get("ok"), f"set_effect fog accepted ({reply})")
         driver.find_element("id", "play").click()
         wait_for("a frame captured after the fog change", lambda: js(
@@ -360,9 +502,10 @@ def main():
             check(recv_json(c, "viewer_hello")["type"] == "viewer_hello"
                   and recv_json(c, "scene")["type"] == "scene"
                   and recv_json(c, "state")["time_sec"] >= 0, "an extra viewer gets hello, scene, state")
+        # (waited for, not a fixed second: on a loaded machine a real-time step may take longer)
         t_page = js("return window.penumbraViewer.state.time_sec;")
-        time.sleep(1.0)
-        check(js("return window.penumbraViewer.state.time_sec;") > t_page,
+        check(wait_for("a newer state on the page", lambda: js(
+            "return window.penumbraViewer.state.time_sec;") > t_page, timeout=30),
               "the page keeps updating with five viewers connected")
 
         # malformed messages: error replies; too large: closed with 1009; the server lives on
@@ -400,8 +543,8 @@ def main():
         extra.append(c2)
         check(recv_json(c2, "viewer_hello")["type"] == "viewer_hello", "a new viewer still connects")
         t_page = js("return window.penumbraViewer.state.time_sec;")
-        time.sleep(0.8)
-        check(js("return window.penumbraViewer.state.time_sec;") > t_page, "the run goes on")
+        check(wait_for("a newer state on the page", lambda: js(
+            "return window.penumbraViewer.state.time_sec;") > t_page, timeout=30), "the run goes on")
 
         shot = os.path.join(artefacts, "viewer.png")
         driver.save_screenshot(shot)

@@ -54,6 +54,8 @@ class CommandDispatcher {
   static std::vector<std::string> CommandNames();
   /// the `model_info` reply fields.
   const nlohmann::json& model_info() const { return model_info_; }
+  /// the run's live controls (the `live` of the constructor; null when it has none).
+  LiveControl* live() const { return live_; }
 
  private:
   struct Target {

@@ -91,6 +91,8 @@ LiveEffects::LiveEffects(Session& session) : session_(session) {
   }
   requested_.own = session.world().effects;
   requested_.preset = session.effects().preset();
+  if (requested_.preset && !requested_.preset->name.empty())
+    requested_.preset_name = requested_.preset->name;
 }
 
 LiveEffects::~LiveEffects() = default;
@@ -138,6 +140,7 @@ void LiveEffects::Queue(State s, nlohmann::json record, int64_t step) {
   c.record = std::move(record);
   requested_ = std::move(s);
   queue_.push_back(std::move(c));
+  ++changes_;
 }
 
 void LiveEffects::SetAdversity(const std::string& preset_spec) {
@@ -154,6 +157,8 @@ void LiveEffects::SetAdversity(const std::string& preset_spec) {
   std::lock_guard<std::mutex> lock(mu_);
   State s = requested_;
   s.preset = std::move(requested.preset);
+  s.preset_name = s.preset && !s.preset->name.empty() ? s.preset->name : spec;
+  s.preset_edited = false;
   Queue(std::move(s), {{"op", "set_adversity"}, {"spec", requested.spec}}, -1);
 }
 
@@ -187,6 +192,7 @@ LiveEffects::State LiveEffects::EditEffect(const std::string& name,
       base.file = "live changes";
     }
     s.preset = EditAdversityPreset(base, name, params.dump());
+    s.preset_edited = true;
     return s;
   }
   if (name.rfind("adversity_", 0) == 0)
@@ -227,6 +233,8 @@ void LiveEffects::ScheduleRecorded(int64_t step, const nlohmann::json& change) {
     const std::string spec = change["spec"].get<std::string>();
     s = requested_;
     s.preset = LoadAdversityPreset(spec);
+    s.preset_name = s.preset->name.empty() ? spec : s.preset->name;
+    s.preset_edited = false;
     record = {{"op", op}, {"spec", spec}};
   } else if (op == "set_effect" && change.contains("name") && change["name"].is_string()) {
     const std::string name = change["name"].get<std::string>();
@@ -240,6 +248,16 @@ void LiveEffects::ScheduleRecorded(int64_t step, const nlohmann::json& change) {
                           "\"set_effect\", \"name\": ..., \"params\": ...}");
   }
   Queue(std::move(s), std::move(record), step);
+}
+
+RequestedAdversity LiveEffects::requested_adversity() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  RequestedAdversity r;
+  r.preset = requested_.preset;
+  r.name = requested_.preset_name;
+  r.edited = requested_.preset_edited;
+  r.changes = changes_;
+  return r;
 }
 
 size_t LiveEffects::pending() const {

@@ -55,6 +55,15 @@ namespace penumbra {
 using LiveChangeCallback =
     std::function<void(int64_t step, double time_sec, const nlohmann::json& change)>;
 
+/// the adversity preset of a run as requested so far (LiveEffects::requested_adversity): what
+/// every step from the next boundary on sees, once the queued changes are applied.
+struct RequestedAdversity {
+  std::optional<AdversityPreset> preset;  ///< the live preset; nullopt or empty() = none
+  std::string name = "none";  ///< the preset's name as chosen (bundled name or NAME of a file)
+  bool edited = false;        ///< a block (fog, smoke, ...) was changed since it was chosen
+  int64_t changes = 0;        ///< accepted changes so far (grows by one per change)
+};
+
 /// the live adverse conditions of one Session; a pipeline sink that applies the queued
 /// changes. register it as the loop's first sink.
 class LiveEffects : public Sink {
@@ -112,6 +121,10 @@ class LiveEffects : public Sink {
 
   /// changes requested and not applied yet.
   size_t pending() const;
+  /// the adversity preset as requested so far: the run's own at the start, then after every
+  /// accepted SetAdversity / SetEffect / ScheduleRecorded (applied or still queued; a queued
+  /// change applies at the next step boundary). thread-safe.
+  RequestedAdversity requested_adversity() const;
   /// the step the loop last reached (its Wants), -1 before the first (thread-safe).
   int64_t step() const { return step_.load(std::memory_order_acquire); }
 
@@ -125,6 +138,8 @@ class LiveEffects : public Sink {
   struct State {
     std::vector<EffectConfig> own;
     std::optional<AdversityPreset> preset;
+    std::string preset_name = "none";
+    bool preset_edited = false;
   };
   struct Change {
     int64_t step = -1;  // -1 = the next step boundary
@@ -148,6 +163,7 @@ class LiveEffects : public Sink {
   mutable std::mutex mu_;
   State requested_;
   std::deque<Change> queue_;
+  int64_t changes_ = 0;
   LiveChangeCallback on_applied_;
   std::atomic<int64_t> step_{-1};
 };

@@ -19,6 +19,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/sensors/lidar_scanner.h"
+#include "penumbra/session/live_control.h"
 #include "penumbra/session/session.h"
 #include "penumbra/viewer/image_maps.h"
 #include "penumbra/viewer/viewer_messages.h"
@@ -163,6 +164,11 @@ class ViewerBridge : public RunBridge {
 
   SnapshotContent Wants(int64_t step, double time_sec) override {
     steps_.Add();
+    // an adversity change no page was told of (another client's): the new state, once
+    if (LiveControl* live = dispatcher_.live();
+        live && clients_.load() > 0 &&
+        live->effects().requested_adversity().changes > published_changes_.load())
+      PublishStatus(json::object());
     // the first step's state is kept for pages that connect later (e.g. to a paused run)
     if (clients_.load() == 0 && state_step_ >= 0) return SnapshotContent::kNone;
     const Clock::time_point now = Clock::now();
@@ -185,7 +191,7 @@ class ViewerBridge : public RunBridge {
 
   void OnFinish(const LoopFinish& finish) override {
     ended_ = true;
-    PublishStatus(json{{"ended", true}, {"step", finish.step}, {"time_sec", finish.time_sec}});
+    PublishStatus(json{{"step", finish.step}, {"time_sec", finish.time_sec}});
     StopEncoder();
   }
 
@@ -286,13 +292,28 @@ class ViewerBridge : public RunBridge {
               {"waypoint_robots", waypoint},
               {"record_available", true},
               {"colormap", colormap}};
-    scene_ = std::make_shared<const std::string>(SceneJson(session_.scene()).dump());
+    // with the bodies' poses as the run starts: a page of a run paused at its start gets no
+    // state message before the first step, and places its bodies and camera from these
+    json scene = SceneJson(session_.scene());
+    scene["X_WB"] = BodyPosesJson(sim.Snapshot(Simulation::SnapshotContent::kPoses));
+    scene_ = std::make_shared<const std::string>(scene.dump());
     for (const json& j : model_info_.value("joints", json::array())) {
       const std::string type = j.value("type", "");
       if (type == "hinge" || type == "slide")
         joint_signals_.emplace_back("joint/" + j.value("name", ""), j.value("qpos_adr", 0));
     }
     for (const CameraSpec& c : session_.scene().cameras) intrinsics_[c.name] = c.intrinsics;
+    // the robot each body belongs to (composed names "<robot>/<body>"), for the robots'
+    // contact forces
+    const std::vector<std::string>& bodies = sim.model_info().body_names;
+    body_robot_.assign(bodies.size(), -1);
+    for (const ModelConfig& m : world_.models) {
+      if (!m.is_robot) continue;
+      const int r = static_cast<int>(robot_names_.size());
+      robot_names_.push_back(m.name);
+      for (size_t b = 0; b < bodies.size(); ++b)
+        if (bodies[b].rfind(m.name + "/", 0) == 0) body_robot_[b] = r;
+    }
   }
 
   json JointControl(const std::string& robot, const std::vector<std::string>& joints) const {
@@ -315,37 +336,54 @@ class ViewerBridge : public RunBridge {
             {"value", value},          {"unit", "rad"}};
   }
 
+  // the adversity sliders: block, key, range and the value that removes the block ("off");
+  // their values come with every status message (AdversityJson)
   json EffectSliders() const {
-    AdversityPreset p;
-    if (!world_.adversity.empty()) {
-      try {
-        p = LoadAdversityPreset(world_.adversity);
-      } catch (const std::exception& e) {
-        spdlog::warn("viewer: adversity preset: {}", e.what());
-      }
-    }
-    auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
     auto slider = [](const char* block, const char* key, const char* label, const char* unit,
-                     double min, double max, double step, double off, json value) {
-      return json{{"block", block}, {"key", key},      {"label", label}, {"unit", unit},
-                  {"min", min},     {"max", max},      {"step", step},   {"off", off},
-                  {"value", value}, {"integer", false}};
+                     double min, double max, double step, double off) {
+      return json{{"block", block}, {"key", key}, {"label", label},
+                  {"unit", unit},   {"min", min}, {"max", max},
+                  {"step", step},   {"off", off}, {"integer", false}};
     };
     json s = json::array();
-    s.push_back(slider("fog", "mor_m", "fog MOR", "m", 2, 300, 1, 300, opt(p.fog_mor_m)));
-    s.push_back(slider("smoke", "sigma_t_per_m", "smoke extinction", "1/m", 0, 3, 0.05, 0,
-                       opt(p.smoke_sigma_t_per_m)));
-    s.push_back(
-        slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0, opt(p.rain_rate_mm_h)));
-    s.push_back(
-        slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0, opt(p.snow_rate_mm_h)));
-    s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1, p.light_scale));
-    // MuJoCo cannot add bodies to a loaded model: the run has the NPCs it started with
-    json npcs =
-        slider("npcs", "people", "NPC count", "", 0, std::max(p.npc_people, 0), 1, 0, p.npc_people);
+    s.push_back(slider("fog", "mor_m", "fog MOR", "m", 2, 300, 1, 300));
+    s.push_back(slider("smoke", "sigma_t_per_m", "smoke extinction", "1/m", 0, 3, 0.05, 0));
+    s.push_back(slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0));
+    s.push_back(slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0));
+    s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1));
+    // MuJoCo cannot add bodies to a loaded model: the run has the NPC bodies it started with
+    // (a live run also parks bodies for the bundled presets' NPCs: session/live_effects.h)
+    const int npc_bodies = std::max(
+        0, static_cast<int>(session_.effects().agent_bodies().size() - world_.agents.size()));
+    json npcs = slider("npcs", "people", "NPC count", "", 0, npc_bodies, 1, 0);
     npcs["integer"] = true;
     s.push_back(npcs);
     return s;
+  }
+
+  // the adversity the run is in (as requested: a queued change applies at the next step
+  // boundary): the preset's name, whether a block was changed since, and each slider's value
+  // ("<block>.<key>"; null = the block is off)
+  json AdversityJson() const {
+    RequestedAdversity r;
+    if (LiveControl* live = dispatcher_.live()) {
+      r = live->effects().requested_adversity();
+    } else {
+      r.preset = session_.effects().preset();
+      if (r.preset && !r.preset->name.empty()) r.name = r.preset->name;
+    }
+    const AdversityPreset p = r.preset.value_or(AdversityPreset{});
+    auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+    json values = {{"fog.mor_m", opt(p.fog_mor_m)},
+                   {"smoke.sigma_t_per_m", opt(p.smoke_sigma_t_per_m)},
+                   {"rain.rate_mm_h", opt(p.rain_rate_mm_h)},
+                   {"snow.rate_mm_h", opt(p.snow_rate_mm_h)},
+                   {"lights.scale", p.light_scale},
+                   {"npcs.people", p.npc_people}};
+    return {{"preset", PresetForClient(r.name)},
+            {"edited", r.edited},
+            {"changes", r.changes},
+            {"values", values}};
   }
 
   // ---- server handlers (server thread) ----
@@ -354,7 +392,8 @@ class ViewerBridge : public RunBridge {
     json hello = hello_;
     hello["paused"] = control_.paused();
     hello["realtime_factor"] = control_.realtime_factor();
-    std::vector<WebMessage> out = {WebMessage::Text(hello.dump()), WebMessage{scene_, false}};
+    std::vector<WebMessage> out = {WebMessage::Text(hello.dump()), WebMessage{scene_, false},
+                                   WebMessage::Text(StatusJson(json::object()).dump())};
     std::lock_guard<std::mutex> lock(mu_);
     if (last_state_) out.push_back(WebMessage{last_state_, false});
     return out;
@@ -386,11 +425,14 @@ class ViewerBridge : public RunBridge {
     dispatcher_.Dispatch(request, [this, client, cmd](json reply) {
       server_->Send(client, WebMessage::Text(reply.dump()));
       // the run's state changed at a boundary: every page learns it at once
-      if (reply.value("ok", false) && (cmd == "pause" || cmd == "resume" || cmd == "step" ||
-                                       cmd == "reset" || cmd == "set_realtime_factor")) {
-        json status = {{"paused", control_.paused()},
-                       {"realtime_factor", control_.realtime_factor()}};
-        if (reply.contains("step")) status["step"] = reply["step"];
+      if (reply.value("ok", false) &&
+          (cmd == "pause" || cmd == "resume" || cmd == "step" || cmd == "reset" ||
+           cmd == "set_realtime_factor" || cmd == "set_adversity" || cmd == "set_effect")) {
+        json status = json::object();
+        if (reply.contains("step") && cmd != "set_adversity" && cmd != "set_effect")
+          status["step"] = reply["step"];
+        if (reply.contains("applies_from_step"))
+          status["applies_from_step"] = reply["applies_from_step"];
         if (reply.contains("time_sec")) status["time_sec"] = reply["time_sec"];
         PublishStatus(status);
       }
@@ -473,9 +515,26 @@ class ViewerBridge : public RunBridge {
       }
   }
 
-  void PublishStatus(json fields) {
+  // the state the page's controls show, in full (docs/viewer.md "status"): run state, real-
+  // time factor and adversity, with `fields` (step, time_sec of a boundary) added
+  json StatusJson(json fields) const {
     fields["type"] = "status";
-    server_->Publish("status", WebMessage::Text(fields.dump()));
+    fields["paused"] = control_.paused();
+    fields["ended"] = ended_.load();
+    fields["realtime_factor"] = control_.realtime_factor();
+    fields["adversity"] = AdversityJson();
+    return fields;
+  }
+
+  // every page learns the new state at once; the adversity changes it shows are noted, so
+  // that a change from another client (ZeroMQ) is published once at the next step (Wants)
+  void PublishStatus(json fields) {
+    json status = StatusJson(std::move(fields));
+    const int64_t changes = status["adversity"]["changes"];
+    int64_t seen = published_changes_.load();
+    while (seen < changes && !published_changes_.compare_exchange_weak(seen, changes)) {
+    }
+    server_->Publish("status", WebMessage::Text(status.dump()));
   }
 
   // ---- encoder thread ----
@@ -518,9 +577,24 @@ class ViewerBridge : public RunBridge {
     json signals = json::object();
     for (const auto& [name, adr] : joint_signals_)
       if (adr < static_cast<int>(s.qpos.size())) signals[name] = s.qpos[adr];
+    // every contact's normal force (contact frame x, MuJoCo mj_contactForce), summed: all
+    // contacts (resting furniture included), and per robot those between one of its bodies
+    // and anything else (its own self contacts are internal forces)
     double normal = 0;
-    for (const WorldSnapshot::Contact& c : s.contacts) normal += c.force_N.x();
+    std::vector<double> robot_normal(robot_names_.size(), 0.0);
+    auto robot_of = [this](int body) {
+      return body >= 0 && body < static_cast<int>(body_robot_.size()) ? body_robot_[body] : -1;
+    };
+    for (const WorldSnapshot::Contact& c : s.contacts) {
+      normal += c.force_N.x();
+      const int r1 = robot_of(c.body1), r2 = robot_of(c.body2);
+      if (r1 == r2) continue;
+      if (r1 >= 0) robot_normal[r1] += c.force_N.x();
+      if (r2 >= 0) robot_normal[r2] += c.force_N.x();
+    }
     signals["contacts/normal_force_N"] = normal;
+    for (size_t r = 0; r < robot_names_.size(); ++r)
+      signals["contacts/" + robot_names_[r] + "/normal_force_N"] = robot_normal[r];
     signals["contacts/count"] = s.contacts.size();
     for (size_t i = 0; i < s.tracking_error.size(); ++i)
       signals[fmt::format("control/tracking_error[{}]", i)] = s.tracking_error[i];
@@ -662,10 +736,13 @@ class ViewerBridge : public RunBridge {
   std::shared_ptr<const std::string> scene_;
   double control_period_sec_ = 0;
   std::vector<std::pair<std::string, int>> joint_signals_;
+  std::vector<std::string> robot_names_;  // the world's robots
+  std::vector<int> body_robot_;           // body -> index in robot_names_, -1 for none
   std::map<std::string, CameraIntrinsics> intrinsics_;
   std::unique_ptr<WebServer> server_;
   std::atomic<int> clients_{0};
   std::atomic<bool> ended_{false};
+  std::atomic<int64_t> published_changes_{0};  // adversity changes the pages were told of
 
   // loop thread
   Clock::time_point last_state_wall_ = Clock::now();
