@@ -25,6 +25,8 @@ pkgs=(
   libcgal-dev  # convex decomposition (CoACD) clipping and hulls
   libopencv-contrib-dev libopen3d-dev  # bundled SLAM methods (cv::rgbd, cv::kinfu, Open3D odometry)
   slurm-wlm munge  # benchmark sweeps on Slurm, tested on a single-node cluster
+  pybind11-dev python3-pybind11  # the batched rollout's Python module (_penumbra_rollout)
+  python3-torch python3-matplotlib python3-opencv  # train/ (PPO, curves) and the policy walking test
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for bench/fuzz/run.sh (docs/fuzzing.md)
 )
 missing=()
