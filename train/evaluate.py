@@ -35,6 +35,11 @@ def main():
     p.add_argument("--commands", default="0.5,0,0;0,0,0.5;0.5,0,0.5",
                    help="';'-separated vx,vy,wz commands")
     p.add_argument("--threads", type=int, default=0)
+    p.add_argument("--model", default="", help="MJCF scene instead of train/go1_flat.xml, e.g. "
+                   "a world's composed.xml (with --name-prefix go1/ --spawn-at-model-pose)")
+    p.add_argument("--name-prefix", default="")
+    p.add_argument("--spawn-at-model-pose", action="store_true",
+                   help="start at the model's robot pose (the world's), not at the origin")
     p.add_argument("--json", default="")
     args = p.parse_args()
 
@@ -43,7 +48,10 @@ def main():
 
     commands = [tuple(float(v) for v in c.split(",")) for c in args.commands.split(";")]
     cfg = QuadrupedEnvConfig(num_threads=args.threads, add_noise=False,
-                             episode_length_s=args.seconds + 1.0)
+                             episode_length_s=args.seconds + 1.0, name_prefix=args.name_prefix,
+                             spawn_at_model_pose=args.spawn_at_model_pose)
+    if args.model:
+        cfg.model_path = args.model
     results = []
     for cmd in commands:
         n = args.seeds
@@ -98,7 +106,7 @@ def main():
               f"wz {vel[:, 2].mean():.3f} [{vel[:, 2].min():.3f}, {vel[:, 2].max():.3f}]", flush=True)
     if args.json:
         with open(args.json, "w") as f:
-            json.dump({"policy": args.policy, "tolerance": args.tolerance, "settle_s": args.settle,
+            json.dump({"policy": args.policy, "model": args.model or cfg.model_path, "tolerance": args.tolerance, "settle_s": args.settle,
                        "results": results}, f, indent=1)
 
 

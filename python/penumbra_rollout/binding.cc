@@ -28,7 +28,10 @@ void CheckShape(const DoubleArray& a, const char* name, py::ssize_t rows, py::ss
   const bool ok1 = a.ndim() == 1 && rows == 1 && a.shape(0) == cols;
   if (!ok2 && !ok1) {
     std::string got = "(";
-    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+      if (i > 0) got += ", ";
+      got += std::to_string(a.shape(i));
+    }
     got += a.ndim() == 1 ? ",)" : ")";
     throw py::value_error(std::string(name) + ": got an array of shape " + got + "; expected (" +
                           std::to_string(rows) + ", " + std::to_string(cols) + ")");

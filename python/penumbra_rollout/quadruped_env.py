@@ -47,6 +47,9 @@ class QuadrupedEnvConfig:
     """Settings of :class:`QuadrupedVelocityEnv` (defaults: legged_gym's A1 values)."""
 
     model_path: str = DEFAULT_MODEL
+    # prefix of the robot's joint, actuator and sensor names in the model (e.g. "go1/" in a
+    # world's composed.xml)
+    name_prefix: str = ""
     num_threads: int = 0
     decimation: int = 10
     kp: float = 20.0
@@ -82,6 +85,9 @@ class QuadrupedEnvConfig:
     only_positive_rewards: bool = True
     # spawn: trunk height (m) and legged_gym's reset randomisation
     spawn_height: float = 0.42
+    # False: every episode starts at (0, 0, spawn_height) facing +x; True: at the model's own
+    # base position and heading (qpos0, e.g. a world's robot pose) with z = spawn_height
+    spawn_at_model_pose: bool = False
     # termination: trunk contact (trunk_touch > 0), or the body's z axis more than this far
     # below horizontal-up (projected gravity z above -cos(limit))
     max_tilt_rad: float = 1.2
@@ -123,20 +129,32 @@ class QuadrupedVelocityEnv:
         self.max_episode_length = int(round(c.episode_length_s / self.dt))
         self.resample_steps = int(round(c.resampling_time_s / self.dt))
         # policy order -> actuator index, and the qpos / dof address of each policy joint
+        pre = c.name_prefix
         act_joints = list(s.actuator_joints)
         jnames = list(s.joint_names)
-        self.policy_to_act = np.array([act_joints.index(n) for n in POLICY_JOINT_ORDER])
-        self.q_adr = np.array([s.joint_qpos_adr[jnames.index(n)] for n in POLICY_JOINT_ORDER])
-        self.v_adr = np.array([s.joint_dof_adr[jnames.index(n)] for n in POLICY_JOINT_ORDER])
-        rng_ = np.array([s.joint_range[jnames.index(n)] for n in POLICY_JOINT_ORDER])
+
+        def find(names, name, what):
+            if pre + name not in names:
+                raise ValueError(f"{c.model_path}: no {what} named '{pre + name}'")
+            return names.index(pre + name)
+
+        self.policy_to_act = np.array([find(act_joints, n, "actuator driving joint")
+                                       for n in POLICY_JOINT_ORDER])
+        jidx = [find(jnames, n, "joint") for n in POLICY_JOINT_ORDER]
+        self.q_adr = np.array([s.joint_qpos_adr[j] for j in jidx])
+        self.v_adr = np.array([s.joint_dof_adr[j] for j in jidx])
+        base = find(jnames, "trunk_free", "free joint")
+        self.base_q = s.joint_qpos_adr[base]
+        self.base_v = s.joint_dof_adr[base]
+        rng_ = np.array([s.joint_range[j] for j in jidx])
         mid = rng_.mean(axis=1)
         half = (rng_[:, 1] - rng_[:, 0]) / 2 * c.soft_dof_pos_limit
         self.soft_lo, self.soft_hi = mid - half, mid + half
         self.default_q = np.array([DEFAULT_JOINT_POS[n] for n in POLICY_JOINT_ORDER])
         snames = list(s.sensor_names)
-        self.foot_touch_adr = np.array([s.sensor_adr[snames.index(f"{leg}_foot_touch")]
+        self.foot_touch_adr = np.array([s.sensor_adr[find(snames, f"{leg}_foot_touch", "sensor")]
                                         for leg in LEGS])
-        self.trunk_touch_adr = s.sensor_adr[snames.index("trunk_touch")]
+        self.trunk_touch_adr = s.sensor_adr[find(snames, "trunk_touch", "sensor")]
         self.qpos0 = np.array(s.qpos0)
 
         self.single_observation_space = Box(-np.inf, np.inf, (OBS_DIM,), np.float32)
@@ -173,11 +191,12 @@ class QuadrupedVelocityEnv:
 
     def _read(self):
         qpos, qvel, ctrl, sens = self.stepper.read_state()
-        quat = qpos[:, 3:7]
-        self.base_pos = qpos[:, 0:3]
+        bq, bv = self.base_q, self.base_v
+        quat = qpos[:, bq + 3:bq + 7]
+        self.base_pos = qpos[:, bq:bq + 3]
         self.base_quat = quat
-        self.base_lin_vel = quat_rotate_inverse(quat, qvel[:, 0:3])
-        self.base_ang_vel = qvel[:, 3:6].copy()  # free joint: angular velocity in the body frame
+        self.base_lin_vel = quat_rotate_inverse(quat, qvel[:, bv:bv + 3])
+        self.base_ang_vel = qvel[:, bv + 3:bv + 6].copy()  # free joint: angular velocity in the body frame
         grav = np.zeros_like(self.base_lin_vel)
         grav[:, 2] = -1.0
         self.projected_gravity = quat_rotate_inverse(quat, grav)
@@ -205,11 +224,14 @@ class QuadrupedVelocityEnv:
         c = self.cfg
         for i in ids:
             qpos = self.qpos0.copy()
-            qpos[0:3] = (0.0, 0.0, c.spawn_height)
-            qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+            bq, bv = self.base_q, self.base_v
+            if not c.spawn_at_model_pose:
+                qpos[bq:bq + 2] = 0.0
+                qpos[bq + 3:bq + 7] = (1.0, 0.0, 0.0, 0.0)
+            qpos[bq + 2] = c.spawn_height
             qpos[self.q_adr] = self.default_q * self.rng.uniform(0.5, 1.5, 12)
             qvel = np.zeros(self.stepper.nv)
-            qvel[0:6] = self.rng.uniform(-0.5, 0.5, 6)
+            qvel[bv:bv + 6] = self.rng.uniform(-0.5, 0.5, 6)
             self.stepper.reset(int(i), qpos, qvel)
         self.actions[ids] = 0.0
         self.last_actions[ids] = 0.0
