@@ -51,7 +51,9 @@ def main():
                              episode_length_s=args.seconds + 1.0, name_prefix=args.name_prefix,
                              spawn_at_model_pose=args.spawn_at_model_pose)
     if args.model:
+        # on terrain the trunk's world z says nothing of its height above the ground
         cfg.model_path = args.model
+        cfg.min_base_height = -np.inf
     results = []
     for cmd in commands:
         n = args.seeds
@@ -69,6 +71,7 @@ def main():
         steps = int(round(args.seconds / dt))
         settle = int(round(args.settle / dt))
         count = 0
+        min_z = np.full(n, np.inf)
         start_xy = np.array([s.base_pos[0, :2].copy() for s, _ in per_seed_obs])
         for t in range(steps):
             for i, (sub, o) in enumerate(per_seed_obs):
@@ -82,6 +85,7 @@ def main():
                     fell[i] = True
                     fell_at[i] = (t + 1) * dt
                     continue
+                min_z[i] = min(min_z[i], sub.base_pos[0, 2])
                 if t >= settle:
                     vel[i] += [sub.base_lin_vel[0, 0], sub.base_lin_vel[0, 1], sub.base_ang_vel[0, 2]]
             if t >= settle:
@@ -97,13 +101,14 @@ def main():
                 ok &= np.abs(vel[:, k]) <= args.tolerance * 0.5
         r = {"command": cmd, "seeds": n, "seconds": args.seconds, "falls": int(fell.sum()),
              "passed": int(ok.sum()), "mean_vx": vel[:, 0].tolist(), "mean_vy": vel[:, 1].tolist(),
-             "mean_wz": vel[:, 2].tolist(), "distance_m": dist.tolist(),
+             "mean_wz": vel[:, 2].tolist(), "distance_m": dist.tolist(), "min_trunk_z_m": min_z.tolist(),
              "fell_at_s": [None if np.isnan(f) else float(f) for f in fell_at]}
         results.append(r)
         print(f"command vx={cmd[0]} vy={cmd[1]} wz={cmd[2]}: passed {r['passed']}/{n}, falls "
               f"{r['falls']}; vx {vel[:, 0].mean():.3f} [{vel[:, 0].min():.3f}, {vel[:, 0].max():.3f}] "
               f"vy {vel[:, 1].mean():.3f} [{vel[:, 1].min():.3f}, {vel[:, 1].max():.3f}] "
-              f"wz {vel[:, 2].mean():.3f} [{vel[:, 2].min():.3f}, {vel[:, 2].max():.3f}]", flush=True)
+              f"wz {vel[:, 2].mean():.3f} [{vel[:, 2].min():.3f}, {vel[:, 2].max():.3f}] "
+              f"min trunk z {min_z.min():.3f} m", flush=True)
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"policy": args.policy, "model": args.model or cfg.model_path, "tolerance": args.tolerance, "settle_s": args.settle,

@@ -91,14 +91,18 @@ def plot_curves(csv_path, png_path):
     if not rows:
         return False
     x = np.array([float(r["env_steps"]) for r in rows]) / 1e6
-    fig, ax = plt.subplots(2, 2, figsize=(10, 7))
+    fig, ax = plt.subplots(2, 3, figsize=(14, 7))
     for a, keys, title in [
             (ax[0, 0], ["mean_episode_return"], "episode return"),
             (ax[0, 1], ["mean_episode_length_s"], "episode length (s)"),
             (ax[1, 0], ["rew_tracking_lin_vel", "rew_tracking_ang_vel"],
              "tracking reward per second (max 1.0 / 0.5)"),
-            (ax[1, 1], ["action_std"], "policy std")]:
+            (ax[1, 1], ["action_std"], "policy std"),
+            (ax[0, 2], ["mean_base_height"], "mean trunk height (m)"),
+            (ax[1, 2], ["steps_per_s"], "policy steps / s")]:
         for k in keys:
+            if k not in rows[0]:
+                continue
             y = np.array([float(r[k]) if r[k] not in ("", "nan") else np.nan for r in rows])
             a.plot(x, y, label=k)
         a.set_title(title)
@@ -162,7 +166,7 @@ def main(argv=None):
     csv_path = os.path.join(args.out, "progress.csv")
     fields = ["iteration", "env_steps", "wall_s", "steps_per_s", "mean_reward",
               "mean_episode_return", "mean_episode_length_s", "rew_tracking_lin_vel",
-              "rew_tracking_ang_vel", "action_std", "value_loss", "surrogate_loss", "lr", "kl"]
+              "rew_tracking_ang_vel", "mean_base_height", "action_std", "value_loss", "surrogate_loss", "lr", "kl"]
     new_csv = not (args.resume and os.path.exists(csv_path))
     csv_f = open(csv_path, "a" if not new_csv else "w", newline="")
     writer = csv.DictWriter(csv_f, fieldnames=fields)
@@ -197,6 +201,7 @@ def main(argv=None):
     for it in range(it0 + 1, args.iterations + 1):
         t_it = time.time()
         sums_before = dict(env.episode_sums)
+        height_sum = 0.0
         with torch.no_grad():
             for t in range(T):
                 d = model.dist(obs)
@@ -222,6 +227,7 @@ def main(argv=None):
                 ep_ret[done] = 0.0
                 ep_len[done] = 0
                 obs = torch.as_tensor(obs_np, device=dev)
+                height_sum += float(env.base_pos[:, 2].mean())
             last_val = model.value(obs)
             adv = torch.zeros(T, N, device=dev)
             gae = torch.zeros(N, device=dev)
@@ -286,6 +292,7 @@ def main(argv=None):
             "mean_episode_length_s": float(np.mean(done_lengths[-200:]) * env.dt) if done_lengths else "nan",
             "rew_tracking_lin_vel": sums.get("tracking_lin_vel", 0.0),
             "rew_tracking_ang_vel": sums.get("tracking_ang_vel", 0.0),
+            "mean_base_height": height_sum / T,
             "action_std": float(model.log_std.exp().mean()),
             "value_loss": vl_sum / n_mb, "surrogate_loss": sl_sum / n_mb, "lr": lr,
             "kl": kl_sum / n_mb,
@@ -296,7 +303,7 @@ def main(argv=None):
             print(f"it {it} steps {steps} wall {wall:.0f}s sps {row['steps_per_s']} "
                   f"ret {row['mean_episode_return']} len {row['mean_episode_length_s']} "
                   f"lin {row['rew_tracking_lin_vel']:.3f} ang {row['rew_tracking_ang_vel']:.3f} "
-                  f"std {row['action_std']:.3f}", flush=True)
+                  f"h {row['mean_base_height']:.3f} std {row['action_std']:.3f}", flush=True)
         done_returns = done_returns[-200:]
         done_lengths = done_lengths[-200:]
         now = time.time()

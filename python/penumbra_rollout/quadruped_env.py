@@ -81,6 +81,10 @@ class QuadrupedEnvConfig:
     w_feet_air_time: float = 1.0
     w_action_rate: float = -0.01
     w_dof_pos_limits: float = -10.0
+    # (trunk height - target)^2: legged_gym's base_height term, weight 0 in its base config;
+    # without it the policy learns to track commands crawling on bent legs
+    w_base_height: float = -30.0
+    base_height_target: float = 0.28
     soft_dof_pos_limit: float = 0.9
     only_positive_rewards: bool = True
     # spawn: trunk height (m) and legged_gym's reset randomisation
@@ -91,6 +95,9 @@ class QuadrupedEnvConfig:
     # termination: trunk contact (trunk_touch > 0), or the body's z axis more than this far
     # below horizontal-up (projected gravity z above -cos(limit))
     max_tilt_rad: float = 1.2
+    # and (training on flat ground) when the trunk origin sinks below this height (m); -inf
+    # for terrain, where the world z of the trunk says nothing about its height above ground
+    min_base_height: float = 0.15
 
 
 def quat_rotate_inverse(q, v):
@@ -291,7 +298,8 @@ class QuadrupedVelocityEnv:
 
         # terminations: base contact (legged_gym terminate_after_contacts_on = base) or tilt
         bad = ~np.isfinite(self.base_pos).all(axis=1)
-        terminated = (self.trunk_touch > 0.0) | (self.projected_gravity[:, 2] > -np.cos(c.max_tilt_rad)) | bad
+        terminated = ((self.trunk_touch > 0.0) | (self.projected_gravity[:, 2] > -np.cos(c.max_tilt_rad))
+                      | (self.base_pos[:, 2] < c.min_base_height) | bad)
         truncated = (self.episode_step >= self.max_episode_length) & ~terminated
 
         rew = self._rewards()
@@ -345,6 +353,7 @@ class QuadrupedVelocityEnv:
             "feet_air_time": c.w_feet_air_time * air,
             "action_rate": c.w_action_rate * np.sum((self.last_actions - self.actions) ** 2, axis=1),
             "dof_pos_limits": c.w_dof_pos_limits * out_of_limits,
+            "base_height": c.w_base_height * (self.base_pos[:, 2] - c.base_height_target) ** 2,
         }
         total = np.zeros(self.num_envs)
         for k, v in terms.items():
