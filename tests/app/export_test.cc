@@ -315,11 +315,10 @@ TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
 // file for file, and the temporary replay folder is gone
 TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
   ASSERT_EQ(Export("tum", out_.path() / "from_run", {"--camera", "front"}).exit_code, 0);
-  const testing::ProcessResult r =
-      RunPenumbra({"export", (dir_->path() / "run.plog").string(), "--format", "tum", "--out",
-                   (out_.path() / "from_log").string(), "--camera", "front", "--depth",
-                   "ground-truth"},
-                  dir_->path());
+  const testing::ProcessResult r = RunPenumbra(
+      {"export", (dir_->path() / "run.plog").string(), "--format", "tum", "--out",
+       (out_.path() / "from_log").string(), "--camera", "front", "--depth", "ground-truth"},
+      dir_->path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::vector<std::string> names;
   for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_run")) {
@@ -359,8 +358,9 @@ TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
 TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
   const fs::path log = dir_->path() / "run.plog";
   auto export_log = [&](const std::string& name, std::vector<std::string> extra) {
-    std::vector<std::string> args = {"export", log.string(), "--format", "tum", "--out",
-                                     (out_.path() / name).string(), "--camera", "front"};
+    std::vector<std::string> args = {"export",   log.string(), "--format",
+                                     "tum",      "--out",      (out_.path() / name).string(),
+                                     "--camera", "front"};
     args.insert(args.end(), extra.begin(), extra.end());
     return RunPenumbra(args, dir_->path());
   };
@@ -382,7 +382,8 @@ TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
   for (size_t i = 3; i < lines.size(); ++i) {
     const std::string file = lines[i].substr(lines[i].find(' ') + 1);
     const cv::Mat truth = cv::imread((out_.path() / "truth" / file).string(), cv::IMREAD_UNCHANGED);
-    const cv::Mat noisy = cv::imread((out_.path() / "sensor" / file).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat noisy =
+        cv::imread((out_.path() / "sensor" / file).string(), cv::IMREAD_UNCHANGED);
     const cv::Mat again =
         cv::imread((out_.path() / "sensor_again" / file).string(), cv::IMREAD_UNCHANGED);
     ASSERT_EQ(noisy.type(), CV_16UC1) << file;

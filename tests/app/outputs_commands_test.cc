@@ -63,8 +63,8 @@ TEST(AdversityFlag, ABadValueIsTheFlagsErrorNotTheWorldFiles) {
   testing::TempDir dir;
   const std::string world = kOcSource + "/worlds/default.yaml";
   const testing::ProcessResult r =
-      RunPenumbra({"run", world, "--out", (dir.path() / "out").string(), "--quiet",
-                   "--adversity", "heavy", "--duration", "0.1"},
+      RunPenumbra({"run", world, "--out", (dir.path() / "out").string(), "--quiet", "--adversity",
+                   "heavy", "--duration", "0.1"},
                   dir.path());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--adversity: unknown preset 'heavy'; expected one of: none, minor, "
@@ -79,10 +79,9 @@ TEST(PathtracedProgress, EverySamplePassOfEveryFrameGetsALineWithAnEta) {
   testing::TempDir dir;
   dir.Write("box.xml", kOcBoxMjcf);
   const std::string world = dir.Write("world.yaml", kOcBoxWorld);
-  const testing::ProcessResult r =
-      RunPenumbra({"run", world, "--out", (dir.path() / "shown").string(), "--progress-interval",
-                   "0"},
-                  dir.path());
+  const testing::ProcessResult r = RunPenumbra(
+      {"run", world, "--out", (dir.path() / "shown").string(), "--progress-interval", "0"},
+      dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // frames at 0, 0.1 and 0.2 s; 4 samples per pixel; stderr is a file (log lines)
   for (int frame = 0; frame < 3; ++frame)
@@ -132,9 +131,8 @@ TEST(FallDetection, ARobotOnItsBackIsReportedFallenInRunJsonAndOnStderr) {
   testing::TempDir dir;
   // upside down, 0.5 m above the floor: it lands on its back and stays there
   const std::string fallen = dir.Write("fallen.yaml", OcQuadrupedWorld("180, 0, 0", "0.5"));
-  const testing::ProcessResult r =
-      RunPenumbra({"run", fallen, "--out", (dir.path() / "fallen").string(), "--quiet"},
-                  dir.path());
+  const testing::ProcessResult r = RunPenumbra(
+      {"run", fallen, "--out", (dir.path() / "fallen").string(), "--quiet"}, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(ReadAll(dir.path() / "fallen" / "run.json"));
   ASSERT_TRUE(j.contains("falls")) << j.dump(2);
@@ -151,9 +149,8 @@ TEST(FallDetection, ARobotOnItsBackIsReportedFallenInRunJsonAndOnStderr) {
 
   // standing (its qpos0 is the standing pose), no controller: not fallen
   const std::string upright = dir.Write("upright.yaml", OcQuadrupedWorld("0, 0, 0", "0"));
-  const testing::ProcessResult u =
-      RunPenumbra({"run", upright, "--out", (dir.path() / "upright").string(), "--quiet"},
-                  dir.path());
+  const testing::ProcessResult u = RunPenumbra(
+      {"run", upright, "--out", (dir.path() / "upright").string(), "--quiet"}, dir.path());
   ASSERT_EQ(u.exit_code, 0) << u.err;
   const nlohmann::json ju = nlohmann::json::parse(ReadAll(dir.path() / "upright" / "run.json"));
   const nlohmann::json& uq = ju["falls"]["robots"]["quadruped"];

@@ -273,10 +273,10 @@ TEST(TrackedPath, AnEstimateThatBarelyMovesIsNotRewarded) {
   }
   EvaluationOptions o;
   o.alignment = AlignmentModel::kNone;
-  const TrajectoryEvaluation still = EvaluateTrajectory(Make(t, gt_X), Make(t, still_X), o, "gt",
-                                                        "est");
-  const TrajectoryEvaluation good = EvaluateTrajectory(Make(t, gt_X), Make(t, good_X), o, "gt",
-                                                       "est");
+  const TrajectoryEvaluation still =
+      EvaluateTrajectory(Make(t, gt_X), Make(t, still_X), o, "gt", "est");
+  const TrajectoryEvaluation good =
+      EvaluateTrajectory(Make(t, gt_X), Make(t, good_X), o, "gt", "est");
   EXPECT_NEAR(still.ate_m.rmse, 0.99 * std::sqrt(10.0), 1e-12);
   EXPECT_NEAR(still.coverage, 100.0, 1e-9);
   EXPECT_NEAR(still.scaled_ate_m, 0.99 * std::sqrt(10.0) / 100.0, 1e-12);
@@ -306,17 +306,17 @@ TEST(TrackedPath, LostStretchesLeaveTheirGroundTruthPathOut) {
   }
   EvaluationOptions o;
   o.alignment = AlignmentModel::kNone;
-  const TrajectoryEvaluation r = EvaluateTrajectory(Make(gt_t, gt_X), Make(est_t, est_X), o, "gt",
-                                                    "est");
+  const TrajectoryEvaluation r =
+      EvaluateTrajectory(Make(gt_t, gt_X), Make(est_t, est_X), o, "gt", "est");
   EXPECT_DOUBLE_EQ(r.tracked_ground_truth_path_m, 6.0);
   EXPECT_DOUBLE_EQ(r.ground_truth_full_path_m, 10.0);
   EXPECT_DOUBLE_EQ(r.tracked_path_coverage, 0.6);
   EXPECT_NEAR(r.tracked_scaled_ate_m, 0.5, 1e-12);
   // a ground truth that does not move: undefined (NaN), as the paper's coverage of a still
   // estimate is
-  const TrajectoryEvaluation fixed = EvaluateTrajectory(
-      Make({0, 1, 2}, {At(1, 0, 0), At(1, 0, 0), At(1, 0, 0)}),
-      Make({0, 1, 2}, {At(1, 0, 0), At(2, 0, 0), At(3, 0, 0)}), o, "gt", "est");
+  const TrajectoryEvaluation fixed =
+      EvaluateTrajectory(Make({0, 1, 2}, {At(1, 0, 0), At(1, 0, 0), At(1, 0, 0)}),
+                         Make({0, 1, 2}, {At(1, 0, 0), At(2, 0, 0), At(3, 0, 0)}), o, "gt", "est");
   EXPECT_TRUE(std::isnan(fixed.tracked_path_coverage));
   EXPECT_TRUE(std::isnan(fixed.tracked_scaled_ate_m));
 }

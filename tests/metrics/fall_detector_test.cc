@@ -11,7 +11,8 @@ namespace penumbra {
 namespace {
 
 Eigen::Quaterniond FdRoll(double deg) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(deg * std::numbers::pi / 180, Eigen::Vector3d::UnitX()));
+  return Eigen::Quaterniond(
+      Eigen::AngleAxisd(deg * std::numbers::pi / 180, Eigen::Vector3d::UnitX()));
 }
 
 TEST(BaseTilt, AngleBetweenTheBodyZAndTheWorldZ) {

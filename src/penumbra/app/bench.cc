@@ -98,13 +98,15 @@ int BenchRender(const RenderBenchOptions& options) {
   }
   // the target is the realtime tier's; a pathtraced run says so instead of a verdict
   if (options.tier == "realtime") {
-    fmt::print("target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: {} ({:.1f} "
-               "frames/s here)\n",
-               kRenderTargetFps, TargetVerdict(fps_640x480, kRenderTargetFps), fps_640x480);
+    fmt::print(
+        "target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: {} ({:.1f} "
+        "frames/s here)\n",
+        kRenderTargetFps, TargetVerdict(fps_640x480, kRenderTargetFps), fps_640x480);
   } else {
-    fmt::print("target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: not "
-               "applicable (tier {})\n",
-               kRenderTargetFps, options.tier);
+    fmt::print(
+        "target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: not "
+        "applicable (tier {})\n",
+        kRenderTargetFps, options.tier);
   }
   if (options.adversity) BenchRenderAdversity(options);  // app/effects_bench.h
   return 0;

@@ -42,13 +42,15 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
     if (std::string(preset) == "major") major_fps = n / sum.render_wall;
   }
   if (options.tier == "realtime") {
-    fmt::print("target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: {} "
-               "({:.1f} frames/s here)\n",
-               kMajorPresetTargetFps, TargetVerdict(major_fps, kMajorPresetTargetFps), major_fps);
+    fmt::print(
+        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: {} "
+        "({:.1f} frames/s here)\n",
+        kMajorPresetTargetFps, TargetVerdict(major_fps, kMajorPresetTargetFps), major_fps);
   } else {
-    fmt::print("target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: not "
-               "applicable (tier {})\n",
-               kMajorPresetTargetFps, options.tier);
+    fmt::print(
+        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: not "
+        "applicable (tier {})\n",
+        kMajorPresetTargetFps, options.tier);
   }
 }
 

@@ -49,13 +49,10 @@ class TempFolder {
 // given --world / --adversity) into a new temporary run folder "<out>.replay-tmp-<random>"
 // beside `out`, kept in `replayed` (removed when it is destroyed); returns that folder.
 // @throws ExportStopped when the stop request ended the replay.
-std::filesystem::path ReplayLogBeside(const std::string& log_path,
-                                      const std::string& world_override,
-                                      const std::string& adversity, ReplayDepth depth,
-                                      const std::filesystem::path& out,
-                                      const std::atomic<int>* stop_request,
-                                      std::optional<TempFolder>* replayed,
-                                      ReplaySummary* summary_out = nullptr) {
+std::filesystem::path ReplayLogBeside(
+    const std::string& log_path, const std::string& world_override, const std::string& adversity,
+    ReplayDepth depth, const std::filesystem::path& out, const std::atomic<int>* stop_request,
+    std::optional<TempFolder>* replayed, ReplaySummary* summary_out = nullptr) {
   replayed->emplace(MakeSiblingTempFolder(out, ".replay-tmp"));
   ReplayOptions replay;
   replay.log_path = log_path;
@@ -126,9 +123,10 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
     } else if (model != replay.depth_models.end() && !model->second.empty()) {
       options.depth_source = "sensor_model";
       options.depth_model = model->second;
-      options.depth_note = "the replay of the run log rendered the camera's depth through this "
-                           "sensor model (docs/cameras.md \"RGB-D depth noise\"), the camera's "
-                           "own world-file depth_noise or else the benchmarks' realsense_d435";
+      options.depth_note =
+          "the replay of the run log rendered the camera's depth through this "
+          "sensor model (docs/cameras.md \"RGB-D depth noise\"), the camera's "
+          "own world-file depth_noise or else the benchmarks' realsense_d435";
     }
   } else {
     if (!s.replay_world.empty() || !s.replay_adversity.empty())
@@ -141,9 +139,10 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
                         "the sensor model or exact; a run folder's depth images are exported as "
                         "its camera wrote them (world-file `depth_noise`, docs/cameras.md)");
     options.depth_source = "as_recorded";
-    options.depth_note = "the run folder's depth images as its camera wrote them: exact unless "
-                         "the camera had a world-file depth_noise (see the run's world file); "
-                         "export the run log (.plog) for the sensor model";
+    options.depth_note =
+        "the run folder's depth images as its camera wrote them: exact unless "
+        "the camera had a world-file depth_noise (see the run's world file); "
+        "export the run log (.plog) for the sensor model";
   }
   const RunFolder run(run_dir);
   DatasetExportSummary summary;

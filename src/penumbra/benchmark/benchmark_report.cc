@@ -222,10 +222,9 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
       "tracked_scaled_ate_m_mean,tracked_scaled_ate_m_std\n";
   for (const SummaryLine& l : lines)
     csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world,
-                       l.condition,
-                       l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean), Field(l.ate_rmse_m.std),
-                       Field(l.scaled_ate_m.mean), Field(l.scaled_ate_m.std),
-                       Field(l.coverage.mean), Field(l.coverage.std),
+                       l.condition, l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean),
+                       Field(l.ate_rmse_m.std), Field(l.scaled_ate_m.mean),
+                       Field(l.scaled_ate_m.std), Field(l.coverage.mean), Field(l.coverage.std),
                        Field(l.tracked_fraction.mean), Field(l.tracked_fraction.std),
                        Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std),
                        Field(l.tracked_path_coverage.mean), Field(l.tracked_path_coverage.std),

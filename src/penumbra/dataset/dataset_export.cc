@@ -190,7 +190,8 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
   };
   try {
     Export(run, options, cam0, cam1, source, prepare, &summary);
-    if (temp) WriteFileAtomic(*temp / "penumbra_export.yaml", ExportMetadataYaml(options, source, summary));
+    if (temp)
+      WriteFileAtomic(*temp / "penumbra_export.yaml", ExportMetadataYaml(options, source, summary));
     CheckExportStop(options.stop_request);
     if (temp && std::rename(temp->c_str(), options.out_dir.c_str()) != 0) {
       const int err = errno;

@@ -143,7 +143,8 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& ground_truth, const Tr
   r.tracked_path_coverage = r.ground_truth_full_path_m > 0
                                 ? r.tracked_ground_truth_path_m / r.ground_truth_full_path_m
                                 : nan;
-  r.tracked_scaled_ate_m = r.tracked_path_coverage > 0 ? r.ate_m.rmse / r.tracked_path_coverage : nan;
+  r.tracked_scaled_ate_m =
+      r.tracked_path_coverage > 0 ? r.ate_m.rmse / r.tracked_path_coverage : nan;
   return r;
 }
 

@@ -19,9 +19,8 @@ double BaseTiltDeg(const Eigen::Quaterniond& q_WB) {
   // / |q|^2
   const double n2 = q_WB.squaredNorm();
   if (!(n2 > 0)) return 0;
-  const double r22 = (q_WB.w() * q_WB.w() - q_WB.x() * q_WB.x() - q_WB.y() * q_WB.y() +
-                      q_WB.z() * q_WB.z()) /
-                     n2;
+  const double r22 =
+      (q_WB.w() * q_WB.w() - q_WB.x() * q_WB.x() - q_WB.y() * q_WB.y() + q_WB.z() * q_WB.z()) / n2;
   return std::acos(std::clamp(r22, -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 

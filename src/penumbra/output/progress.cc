@@ -25,11 +25,11 @@ std::string FormatProgressLine(double sim_time_sec, double total_sim_sec, int64_
   const int filled = std::clamp(static_cast<int>(std::floor(f * bar_width)), 0, bar_width);
   const int percent = std::clamp(static_cast<int>(std::floor(f * 100.0 + 1e-9)), 0, 100);
   // a slow tier (pathtraced: minutes a frame) would read "0.0 fps": seconds per frame instead
-  const std::string rate =
-      fps > 0 && fps < 1 ? fmt::format("{:.1f} s/frame", 1.0 / fps) : fmt::format("{:.1f} fps", fps);
-  return fmt::format("[{}{}] {:3d}% sim {:.2f}/{:.2f} s  {} frames  {}",
-                     std::string(filled, '#'), std::string(bar_width - filled, ' '), percent,
-                     sim_time_sec, total_sim_sec, frames, rate);
+  const std::string rate = fps > 0 && fps < 1 ? fmt::format("{:.1f} s/frame", 1.0 / fps)
+                                              : fmt::format("{:.1f} fps", fps);
+  return fmt::format("[{}{}] {:3d}% sim {:.2f}/{:.2f} s  {} frames  {}", std::string(filled, '#'),
+                     std::string(bar_width - filled, ' '), percent, sim_time_sec, total_sim_sec,
+                     frames, rate);
 }
 
 std::string ProgressReporter::FormatPassLine(const std::string& label, int pass, int passes,

@@ -88,9 +88,9 @@ class ProgressReporter {
   double sim_time_sec_ = 0;
   int64_t frames_ = 0;
   bool finished_ = false;
-  double frame_start_ = 0;      // wall time of the current frame's pass 0
+  double frame_start_ = 0;  // wall time of the current frame's pass 0
   double last_pass_line_ = -1e300;
-  int frame_pass_lines_ = 0;    // pass lines of the current frame
+  int frame_pass_lines_ = 0;  // pass lines of the current frame
 };
 
 }  // namespace penumbra

@@ -73,10 +73,11 @@ struct RenderProgress {
   int passes = 0;             ///< samples_per_pixel
 };
 
-/// receives RenderProgress: once with passes_done = 0 when a render starts, once each time a
-/// further whole pass is done (tiles finished on the thread that called Render: the
-/// callback always runs on that thread, never on a render worker), and with passes_done =
-/// passes when it is complete (not for a stopped render).
+/// receives RenderProgress: once with passes_done = 0 when a render starts, then once for
+/// each pass 1, 2, ..., passes in order (not for a stopped render), each as soon as the thread
+/// that called Render sees it done: the callback always runs on that thread, never on a
+/// render worker, so passes the workers finish while that thread renders a tile, or after it
+/// ran out of tiles, are reported together then.
 using RenderProgressCallback = std::function<void(const RenderProgress&)>;
 
 /// renders frames of one scene. not thread-safe: one Render at a time (each call is

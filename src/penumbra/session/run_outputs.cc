@@ -42,11 +42,12 @@ RunOutputs::RunOutputs(Session& session, const WorldConfig& world,
     std::vector<std::string> names;
     for (const CameraSpec& c : session.scene().cameras) names.push_back(c.name);
     renderer->set_progress_callback([this, names](const RenderProgress& p) {
-      const std::string name = p.camera_index >= 0 && p.camera_index < static_cast<int>(names.size())
-                                   ? names[p.camera_index]
-                                   : std::to_string(p.camera_index);
-      progress_->RenderPass(fmt::format("camera '{}' frame {}", name, p.frame_index),
-                            p.passes_done, p.passes);
+      const std::string name =
+          p.camera_index >= 0 && p.camera_index < static_cast<int>(names.size())
+              ? names[p.camera_index]
+              : std::to_string(p.camera_index);
+      progress_->RenderPass(fmt::format("camera '{}' frame {}", name, p.frame_index), p.passes_done,
+                            p.passes);
     });
   }
 }

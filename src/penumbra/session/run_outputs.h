@@ -55,8 +55,9 @@ struct RunOutputsOptions {
 class RunOutputs {
  public:
   /// builds the sinks in this order: cameras, sensors, trajectory, metrics (when `world` has
-  /// `metrics:`), falls (when a robot has a free joint), then the progress reporter. `world` is the world the session was built
-  /// from, with the run's overrides applied; `session` and `world` must outlive this object.
+  /// `metrics:`), falls (when a robot has a free joint), then the progress reporter. `world` is the
+  /// world the session was built from, with the run's overrides applied; `session` and `world` must
+  /// outlive this object.
   /// @throws ConfigError from the sinks (bad camera or sensor settings, an unknown --cameras
   ///         name, a metric name that matches nothing); Error if an output cannot be created.
   RunOutputs(Session& session, const WorldConfig& world, const std::filesystem::path& out_dir,

@@ -221,19 +221,24 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
         const int64_t tile_samples = static_cast<int64_t>(n) * spp;
         const int64_t done = samples_done.fetch_add(tile_samples) + tile_samples;
         const int passes_done = static_cast<int>(std::min<int64_t>(done / pixels, spp));
-        if (std::this_thread::get_id() == caller && passes_done > progress.passes_done &&
-            !stopped.load(std::memory_order_relaxed)) {
+        // one report per pass crossed since the last (a tile may hold more than one pass)
+        if (std::this_thread::get_id() == caller && !stopped.load(std::memory_order_relaxed)) {
           progress.samples_done = done;
-          progress.passes_done = passes_done;
-          progress_(progress);
+          while (progress.passes_done < passes_done) {
+            ++progress.passes_done;
+            progress_(progress);
+          }
         }
       }
     }
   });
-  if (report && !stopped.load() && progress.passes_done < spp) {
+  // the passes the other threads finished after this one ran out of tiles
+  if (report && !stopped.load()) {
     progress.samples_done = progress.samples_total;
-    progress.passes_done = spp;
-    progress_(progress);
+    while (progress.passes_done < spp) {
+      ++progress.passes_done;
+      progress_(progress);
+    }
   }
   out->rays = static_cast<int64_t>(W) * H + secondary_rays.load();
   // a stopped render's radiance is unfinished: not denoised, not developed
