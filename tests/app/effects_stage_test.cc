@@ -96,7 +96,7 @@ TEST(AdversityPlan, UnknownPresetListsTheValidNames) {
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "<command line>: adversity: unknown preset 'apocalypse'; expected one of: none, "
+              "<command line>: --adversity: unknown preset 'apocalypse'; expected one of: none, "
               "minor, major, or a preset file (FILE.yaml or FILE.yaml#NAME)");
   }
 }

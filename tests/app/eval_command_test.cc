@@ -79,6 +79,10 @@ TEST_F(EvalCommandTest, AteJsonOnStdoutAndInAFile) {
   EXPECT_DOUBLE_EQ(j["coverage"].get<double>(), 0.837851590451812);
   EXPECT_DOUBLE_EQ(j["scaled_ate_m"].get<double>(), 0.6672028802541238);
   EXPECT_DOUBLE_EQ(j["time_tracked"]["fraction"].get<double>(), 1.0);
+  // every interval tracked: the whole 3 m ground-truth path, so the ATE is not rescaled
+  EXPECT_DOUBLE_EQ(j["tracked_path"]["coverage"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(j["tracked_path"]["scaled_ate_m"].get<double>(), 0.5590169943749475);
+  EXPECT_DOUBLE_EQ(j["tracked_path"]["ground_truth_path_m"].get<double>(), 3.0);
   EXPECT_FALSE(j.contains("rpe"));
 }
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -309,20 +310,22 @@ TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
   EXPECT_NE(r.err.find("only for a run log"), std::string::npos) << r.err;
 }
 
-// a run log is replayed with the recorded conditions and exported: the dataset is the one the
-// run's own folder gives, file for file, and the temporary replay folder is gone
+// a run log is replayed with the recorded conditions and exported with --depth ground-truth:
+// the dataset is the one the run's own folder gives (the run's camera has no depth_noise),
+// file for file, and the temporary replay folder is gone
 TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
   ASSERT_EQ(Export("tum", out_.path() / "from_run", {"--camera", "front"}).exit_code, 0);
-  const testing::ProcessResult r =
-      RunPenumbra({"export", (dir_->path() / "run.plog").string(), "--format", "tum", "--out",
-                   (out_.path() / "from_log").string(), "--camera", "front"},
-                  dir_->path());
+  const testing::ProcessResult r = RunPenumbra(
+      {"export", (dir_->path() / "run.plog").string(), "--format", "tum", "--out",
+       (out_.path() / "from_log").string(), "--camera", "front", "--depth", "ground-truth"},
+      dir_->path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::vector<std::string> names;
   for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_run")) {
     if (!e.is_regular_file()) continue;
     const fs::path rel = fs::relative(e.path(), out_.path() / "from_run");
     names.push_back(rel.string());
+    if (rel == "penumbra_export.yaml") continue;  // names the source and the depth: below
     // the lists name their source: the run folder, or the log
     std::string a = ReadAll(e.path()), b = ReadAll(out_.path() / "from_log" / rel);
     const std::string run_line = "# file: '" + run().string() + "'\n";
@@ -338,6 +341,80 @@ TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
     log_files += e.is_regular_file();
   EXPECT_EQ(log_files, names.size());
   EXPECT_FALSE(fs::exists(out_.path() / "from_log.replay-tmp"));
+  const std::string meta_run = ReadAll(out_.path() / "from_run" / "penumbra_export.yaml");
+  const std::string meta_log = ReadAll(out_.path() / "from_log" / "penumbra_export.yaml");
+  EXPECT_NE(meta_run.find("depth:\n  source: as_recorded\n"), std::string::npos) << meta_run;
+  EXPECT_NE(meta_log.find("depth:\n  source: ground_truth\n"), std::string::npos) << meta_log;
+  EXPECT_NE(meta_log.find("source: '" + (dir_->path() / "run.plog").string() + "'"),
+            std::string::npos)
+      << meta_log;
+}
+
+// the README's replay -> export path: by default the replay renders the depth through the
+// benchmarks' sensor model (realsense_d435: sigma_z = z^2 0.08 / (fx 0.05), fx the depth image's
+// focal length in pixels), so the exported depth differs from the ground truth by that
+// model's statistics; the same seed gives the same dataset; a run folder's depth is exported
+// as the run wrote it and --depth is refused there
+TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
+  const fs::path log = dir_->path() / "run.plog";
+  auto export_log = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"export",   log.string(), "--format",
+                                     "tum",      "--out",      (out_.path() / name).string(),
+                                     "--camera", "front"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunPenumbra(args, dir_->path());
+  };
+  ASSERT_EQ(export_log("sensor", {}).exit_code, 0);
+  ASSERT_EQ(export_log("sensor_again", {"--depth", "sensor"}).exit_code, 0);
+  ASSERT_EQ(export_log("truth", {"--depth", "ground-truth"}).exit_code, 0);
+  const std::string meta = ReadAll(out_.path() / "sensor" / "penumbra_export.yaml");
+  EXPECT_NE(meta.find("depth:\n  source: sensor_model\n  model: realsense_d435\n"),
+            std::string::npos)
+      << meta;
+  // the wall is fronto-parallel at 1.5 m: every pixel's z is 1.5 m (7500 in TUM units); the
+  // 32 x 24 camera with fovy 60 deg has fx = fy = 12 / tan(30 deg) = 20.78 px
+  const double fx = 12.0 / std::tan(30.0 * M_PI / 180.0);
+  const double sigma_m = 1.5 * 1.5 * 0.08 / (fx * 0.05);  // 0.1732 m
+  const auto lines = Lines(out_.path() / "truth" / "depth.txt");
+  ASSERT_GE(lines.size(), 3u + 5u);
+  double sum = 0, sum2 = 0;
+  int64_t n = 0, holes = 0;
+  for (size_t i = 3; i < lines.size(); ++i) {
+    const std::string file = lines[i].substr(lines[i].find(' ') + 1);
+    const cv::Mat truth = cv::imread((out_.path() / "truth" / file).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat noisy =
+        cv::imread((out_.path() / "sensor" / file).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat again =
+        cv::imread((out_.path() / "sensor_again" / file).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(noisy.type(), CV_16UC1) << file;
+    EXPECT_EQ(cv::norm(noisy, again, cv::NORM_INF), 0.0) << file;  // deterministic
+    for (int v = 0; v < truth.rows; ++v)
+      for (int u = 0; u < truth.cols; ++u) {
+        const double t = truth.at<uint16_t>(v, u), z = noisy.at<uint16_t>(v, u);
+        EXPECT_NEAR(t, 7500, 1.0);  // ground truth: exact
+        if (z == 0) {
+          ++holes;
+          continue;
+        }
+        const double e = (z - t) / 5000.0;
+        sum += e;
+        sum2 += e * e;
+        ++n;
+      }
+  }
+  ASSERT_GT(n, 2000);
+  EXPECT_LT(holes, n / 100);
+  const double mean = sum / n, std = std::sqrt(sum2 / n - mean * mean);
+  // the model's axial sigma within 10 % (n > 2000 samples: the estimate's own spread is ~2 %);
+  // the mean within 4 standard errors of 0
+  EXPECT_NEAR(std, sigma_m, 0.1 * sigma_m) << "n " << n;
+  EXPECT_NEAR(mean, 0.0, 4 * sigma_m / std::sqrt(static_cast<double>(n)));
+  // a run folder: exported as recorded; --depth is a run-log option
+  const testing::ProcessResult folder =
+      Export("tum", out_.path() / "folder", {"--camera", "front", "--depth", "sensor"});
+  EXPECT_EQ(folder.exit_code, 2);
+  EXPECT_NE(folder.err.find("--depth: only for a run log (.plog) input"), std::string::npos)
+      << folder.err;
 }
 
 }  // namespace

@@ -229,6 +229,98 @@ TEST(TrackedTime, GapsLongerThanTheLimitAreNotTracked) {
   EXPECT_DOUBLE_EQ(MedianPeriod({0, 1, 3, 4, 10}), 1.5);  // {1, 2, 1, 6} -> (1 + 2) / 2
 }
 
+TEST(TrackedTime, TwoLostFramesCountDespiteTimestampRounding) {
+  // 10 Hz ground truth at 4.3 .. 5.4 s as a TUM file writes it; the estimate lost 4.7 and 4.8
+  // (two frames). the gap 4.9 - 4.6 = 0.3000000000000007 s is exactly 3 periods, the default
+  // limit 3 x median period = 3 x 0.09999999999999964 = 0.29999999999999893 s: the docs count
+  // it, and with the relative tolerance of 1e-9 it counts -> every interval tracked, 1.1 s.
+  std::vector<double> gt_t, est_t;
+  std::vector<Pose> gt_X, est_X;
+  for (int k = 43; k <= 54; ++k) {
+    const double t = std::stod(std::to_string(k / 10) + "." + std::to_string(k % 10));
+    gt_t.push_back(t);
+    gt_X.push_back(At(t, 0, 0));
+    if (k == 47 || k == 48) continue;
+    est_t.push_back(t);
+    est_X.push_back(At(t, 0, 0));
+  }
+  ASSERT_EQ(gt_t[6] - gt_t[3], 0.3000000000000007);
+  const TrajectoryEvaluation r =
+      EvaluateTrajectory(Make(gt_t, gt_X), Make(est_t, est_X), EvaluationOptions{}, "gt", "est");
+  EXPECT_EQ(r.tracked.max_gap_sec, 0.29999999999999893);
+  EXPECT_NEAR(r.tracked.tracked_sec, 1.1, 1e-12);  // 0.8 s (fraction 0.727) before
+  EXPECT_NEAR(r.tracked.fraction, 1.0, 1e-12);
+  // the two values on their own, and a real third lost frame (0.4 s) still a loss
+  EXPECT_DOUBLE_EQ(ComputeTrackedTime({4.6, 4.9}, 4.6, 4.9, 0.29999999999999893).fraction, 1.0);
+  EXPECT_TRUE(GapIsTracked(0.3000000000000007, 0.29999999999999893));
+  EXPECT_FALSE(GapIsTracked(5.0 - 4.6, 0.29999999999999893));
+  EXPECT_FALSE(GapIsTracked(0.3 * (1 + 1e-8), 0.3));
+}
+
+TEST(TrackedPath, AnEstimateThatBarelyMovesIsNotRewarded) {
+  // ground truth along x from 0 to 10 m at 1 Hz (10 m); the estimate barely moves:
+  // x_k = 5 + 0.01 (k - 5), no alignment. errors |0.99 (k - 5)|: ATE RMSE = 0.99 sqrt(10)
+  // = 3.1306548835 m. the paper's coverage = 10 / 0.1 = 100 -> scaled ATE 0.0313 m (better
+  // than a good estimate's 0.05 below); every interval is tracked, so the tracked path
+  // coverage is 1 and its scaled ATE is the ATE itself.
+  std::vector<double> t;
+  std::vector<Pose> gt_X, still_X, good_X;
+  for (int k = 0; k <= 10; ++k) {
+    t.push_back(k);
+    gt_X.push_back(At(k, 0, 0));
+    still_X.push_back(At(5 + 0.01 * (k - 5), 0, 0));
+    good_X.push_back(At(k, k % 2 == 0 ? 0.05 : -0.05, 0));
+  }
+  EvaluationOptions o;
+  o.alignment = AlignmentModel::kNone;
+  const TrajectoryEvaluation still =
+      EvaluateTrajectory(Make(t, gt_X), Make(t, still_X), o, "gt", "est");
+  const TrajectoryEvaluation good =
+      EvaluateTrajectory(Make(t, gt_X), Make(t, good_X), o, "gt", "est");
+  EXPECT_NEAR(still.ate_m.rmse, 0.99 * std::sqrt(10.0), 1e-12);
+  EXPECT_NEAR(still.coverage, 100.0, 1e-9);
+  EXPECT_NEAR(still.scaled_ate_m, 0.99 * std::sqrt(10.0) / 100.0, 1e-12);
+  EXPECT_DOUBLE_EQ(still.ground_truth_full_path_m, 10.0);
+  EXPECT_DOUBLE_EQ(still.tracked_ground_truth_path_m, 10.0);
+  EXPECT_DOUBLE_EQ(still.tracked_path_coverage, 1.0);
+  EXPECT_DOUBLE_EQ(still.tracked_scaled_ate_m, still.ate_m.rmse);
+  // the paper's figure ranks the still estimate first, the tracked-path one last
+  EXPECT_NEAR(good.ate_m.rmse, 0.05, 1e-12);
+  EXPECT_LT(still.scaled_ate_m, good.scaled_ate_m);
+  EXPECT_GT(still.tracked_scaled_ate_m, 50 * good.tracked_scaled_ate_m);
+}
+
+TEST(TrackedPath, LostStretchesLeaveTheirGroundTruthPathOut) {
+  // ground truth 0 .. 10 m along x at 1 Hz; the estimate (exact) lost 3 .. 7 s: tracked
+  // intervals 0-1, 1-2, 2-3, 7-8, 8-9, 9-10 cover 6 m of the 10 m path -> 0.6; the estimate
+  // is offset 0.3 m in y (ATE 0.3) -> tracked scaled ATE 0.3 / 0.6 = 0.5 m.
+  std::vector<double> gt_t, est_t;
+  std::vector<Pose> gt_X, est_X;
+  for (int k = 0; k <= 10; ++k) {
+    gt_t.push_back(k);
+    gt_X.push_back(At(k, 0, 0));
+    if (k <= 3 || k >= 7) {
+      est_t.push_back(k);
+      est_X.push_back(At(k, 0.3, 0));
+    }
+  }
+  EvaluationOptions o;
+  o.alignment = AlignmentModel::kNone;
+  const TrajectoryEvaluation r =
+      EvaluateTrajectory(Make(gt_t, gt_X), Make(est_t, est_X), o, "gt", "est");
+  EXPECT_DOUBLE_EQ(r.tracked_ground_truth_path_m, 6.0);
+  EXPECT_DOUBLE_EQ(r.ground_truth_full_path_m, 10.0);
+  EXPECT_DOUBLE_EQ(r.tracked_path_coverage, 0.6);
+  EXPECT_NEAR(r.tracked_scaled_ate_m, 0.5, 1e-12);
+  // a ground truth that does not move: undefined (NaN), as the paper's coverage of a still
+  // estimate is
+  const TrajectoryEvaluation fixed =
+      EvaluateTrajectory(Make({0, 1, 2}, {At(1, 0, 0), At(1, 0, 0), At(1, 0, 0)}),
+                         Make({0, 1, 2}, {At(1, 0, 0), At(2, 0, 0), At(3, 0, 0)}), o, "gt", "est");
+  EXPECT_TRUE(std::isnan(fixed.tracked_path_coverage));
+  EXPECT_TRUE(std::isnan(fixed.tracked_scaled_ate_m));
+}
+
 TEST(Evaluation, TooFewAssociatedPosesNameTheFilesAndTheSpans) {
   const Trajectory gt = Make({0, 1, 2}, {At(0, 0, 0), At(1, 0, 0), At(2, 0, 0)});
   const Trajectory est = Make({100, 101}, {At(0, 0, 0), At(1, 0, 0)});

@@ -22,6 +22,55 @@ TEST(FormatProgressLine, MatchesTheDocumentedLayout) {
   EXPECT_NE(FormatProgressLine(0.0, 0.0, 1, 1, 4).find("100%"), std::string::npos);
 }
 
+TEST(FormatProgressLine, BelowOneFramePerSecondItReadsSecondsPerFrame) {
+  // one pathtraced frame in 160 s read "0.0 fps" before
+  EXPECT_EQ(FormatProgressLine(0.1, 10.0, 1, 1.0 / 160.0, 4),
+            "[    ]   1% sim 0.10/10.00 s  1 frames  160.0 s/frame");
+  EXPECT_NE(FormatProgressLine(0.1, 10.0, 1, 1.0, 4).find("1.0 fps"), std::string::npos);
+}
+
+TEST(ProgressReporter, SamplePassLinesCarryAnEtaAndAreRateLimited) {
+  EXPECT_EQ(ProgressReporter::FormatPassLine("camera 'c' frame 2", 1, 4, 40.0),
+            "camera 'c' frame 2: sample pass 1/4 (25%), 40.0 s, ETA 120.0 s");
+  std::vector<std::string> lines;
+  double now = 0;
+  ProgressOptions opt;
+  opt.mode = ProgressOptions::Mode::kLog;
+  opt.clock = [&] { return now; };
+  opt.log = [&](const std::string& s) { lines.push_back(s); };
+  opt.pass_interval_sec = 1.0;
+  ProgressReporter p(10.0, opt);
+  // a fast frame (0.3 s for 4 passes): no line
+  for (int pass = 0; pass <= 4; ++pass) {
+    now = 0.075 * pass;
+    p.RenderPass("f0", pass, 4);
+  }
+  EXPECT_TRUE(lines.empty());
+  // a slow one starting at 10 s: passes at +0.5 (too early), +1.2 (line), +1.5 (too soon
+  // after it), +1.8 (the last pass of a frame that had a line: line)
+  now = 10;
+  p.RenderPass("f1", 0, 4);
+  for (const auto& [t, pass] : {std::pair{10.5, 1}, {11.2, 2}, {11.5, 3}, {11.8, 4}}) {
+    now = t;
+    p.RenderPass("f1", pass, 4);
+  }
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "f1: sample pass 2/4 (50%), 1.2 s, ETA 1.2 s");
+  EXPECT_EQ(lines[1], "f1: sample pass 4/4 (100%), 1.8 s, ETA 0.0 s");
+  // interval 0: every pass
+  lines.clear();
+  opt.pass_interval_sec = 0;
+  ProgressReporter every(10.0, opt);
+  for (int pass = 0; pass <= 3; ++pass) every.RenderPass("f", pass, 3);
+  EXPECT_EQ(lines.size(), 3u);
+  // off: nothing
+  lines.clear();
+  opt.mode = ProgressOptions::Mode::kOff;
+  ProgressReporter off(10.0, opt);
+  for (int pass = 0; pass <= 3; ++pass) off.RenderPass("f", pass, 3);
+  EXPECT_TRUE(lines.empty());
+}
+
 TEST(FormatProgressLine, PercentRoundsDown) {
   // 99.96 % must not print as 100 % before the end
   EXPECT_NE(FormatProgressLine(9.996, 10.0, 0, 0, 10).find(" 99%"), std::string::npos);

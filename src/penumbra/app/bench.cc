@@ -30,6 +30,10 @@ std::string BenchComposedPath() {
 
 }  // namespace
 
+const char* TargetVerdict(double measured, double target) {
+  return measured >= target ? "met" : "NOT met";
+}
+
 std::string DefaultWorldPath() {
   const std::filesystem::path installed =
       std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "default.yaml";
@@ -62,6 +66,7 @@ int BenchRender(const RenderBenchOptions& options) {
   fmt::print("penumbra bench render: world {}\n", world.file);
   fmt::print("camera '{}', tier {}, {} render threads requested (0 = all cores), {} timed frames\n",
              cam.name, options.tier, options.threads, options.frames);
+  double fps_640x480 = 0;
   for (auto [w, h] : {std::pair{640, 480}, std::pair{800, 800}}) {
     CameraView view;
     view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
@@ -89,8 +94,20 @@ int BenchRender(const RenderBenchOptions& options) {
     fmt::print("{}x{} rgb+depth {}: {:.1f} frames/s, {:.2f} ms/frame, {:.1f} Mrays/s\n", w, h,
                options.tier, options.frames / seconds, 1e3 * seconds / options.frames,
                rays / seconds * 1e-6);
+    if (w == 640) fps_640x480 = options.frames / seconds;
   }
-  fmt::print("target (2-core CI machine): >= 30 frames/s at 640x480 realtime\n");
+  // the target is the realtime tier's; a pathtraced run says so instead of a verdict
+  if (options.tier == "realtime") {
+    fmt::print(
+        "target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: {} ({:.1f} "
+        "frames/s here)\n",
+        kRenderTargetFps, TargetVerdict(fps_640x480, kRenderTargetFps), fps_640x480);
+  } else {
+    fmt::print(
+        "target (2-core CI machine): >= {:g} frames/s at 640x480 realtime: not "
+        "applicable (tier {})\n",
+        kRenderTargetFps, options.tier);
+  }
   if (options.adversity) BenchRenderAdversity(options);  // app/effects_bench.h
   return 0;
 }
@@ -114,7 +131,7 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
   fmt::print("{} steps of {:.1f} s sim time each way\n", r.steps, options.sim_seconds);
   fmt::print("penumbra Simulation::Step: {:.0f} steps/s\n", r.penumbra_steps_per_sec);
   fmt::print("bare mj_step loop:         {:.0f} steps/s\n", r.bare_steps_per_sec);
-  fmt::print("ratio: {:.3f} (target >= 0.95)\n", r.ratio);
+  fmt::print("ratio: {:.3f} (target >= 0.95: {})\n", r.ratio, TargetVerdict(r.ratio, 0.95));
 
   // controller cost on every bundled world with controllers
   if (options.controllers) {
@@ -146,8 +163,8 @@ int BenchPhysics(const PhysicsBenchOptions& options) {
         if (m.is_robot && !m.controller.type.empty())
           types += (types.empty() ? "" : ", ") + m.controller.type;
       fmt::print(
-          "  {:<14} {:<20} {:>9.0f} vs {:>9.0f} steps/s  ratio {:.3f}{}\n", name, types,
-          c.controlled_steps_per_sec, c.replay_steps_per_sec, c.ratio,
+          "  {:<14} {:<20} {:>9.0f} vs {:>9.0f} steps/s  ratio {:.3f} ({}){}\n", name, types,
+          c.controlled_steps_per_sec, c.replay_steps_per_sec, c.ratio, TargetVerdict(c.ratio, 0.9),
           c.replay_identical
               ? ""
               : "  (replay diverges from the controlled run: controller slower than physics rate)");

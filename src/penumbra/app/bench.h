@@ -32,6 +32,16 @@ struct PhysicsBenchOptions {
 /// prints Penumbra's physics steps/s against a bare mj_step loop on the same model. returns 0.
 int BenchPhysics(const PhysicsBenchOptions& options);
 
+/// the frame rate `penumbra bench render` aims for: 640x480 rgb+depth, realtime tier, on the
+/// 2-core CI machine (docs/benchmarks.md), frames/s.
+inline constexpr double kRenderTargetFps = 30.0;
+/// the adversity preset `major`'s target of the same measurement, frames/s.
+inline constexpr double kMajorPresetTargetFps = 10.0;
+
+/// "met" when `measured` >= `target`, else "NOT met": the verdict the bench commands print
+/// after each target line (a higher-is-better figure).
+const char* TargetVerdict(double measured, double target);
+
 /// the bundled default world (worlds/default.yaml in the source tree).
 std::string DefaultWorldPath();
 

@@ -264,6 +264,11 @@ int RunCli(int argc, char** argv) {
   AddInteger(run, "--threads", &threads, 0, 256, "render threads (0 = all cores)");
   AddUint64(run, "--seed", &seed, "world seed (overrides seed)");
   run->add_flag("--quiet,-q", quiet, "no progress output");
+  AddDecimal(
+      run, "--progress-interval", [&](double v) { run_options.progress_interval_sec = v; }, 0,
+      false,
+      "pathtraced tier: the least seconds between sample-pass progress lines (with an ETA; "
+      "default 1, 0 = every pass)");
   run->add_flag("--force", run_options.force,
                 "the output folder may hold an earlier run's outputs: remove them first "
                 "(anything else there is refused)");

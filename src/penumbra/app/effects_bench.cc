@@ -14,6 +14,7 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
                                                    : RenderSettings::Tier::kRealtime;
   fmt::print("adversity presets (worlds/adversity/presets.yaml), 640x480 rgb+depth {}:\n",
              options.tier);
+  double major_fps = 0;
   for (const char* preset : {"none", "minor", "major"}) {
     PresetScene p = LoadPresetScene(world, preset);
     p.StepTo(1.0);
@@ -38,8 +39,19 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
         preset, n / sum.render_wall, 1e3 * sum.render_wall / n, rays / sum.render_wall * 1e-6,
         1e3 * sum.render_cpu / n, 2.0 * n / sum.render_cpu, 1e3 * sum.effects_wall / n,
         p.session->effects().effects().size(), p.session->effects().agents().size());
+    if (std::string(preset) == "major") major_fps = n / sum.render_wall;
   }
-  fmt::print("target (2-core CI machine): major >= 10 frames/s at 640x480 realtime\n");
+  if (options.tier == "realtime") {
+    fmt::print(
+        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: {} "
+        "({:.1f} frames/s here)\n",
+        kMajorPresetTargetFps, TargetVerdict(major_fps, kMajorPresetTargetFps), major_fps);
+  } else {
+    fmt::print(
+        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: not "
+        "applicable (tier {})\n",
+        kMajorPresetTargetFps, options.tier);
+  }
 }
 
 }  // namespace penumbra

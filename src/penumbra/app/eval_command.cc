@@ -176,6 +176,11 @@ Json EvalCommand::State::ToJson(bool ate_verb, const TrajectoryEvaluation& r) co
                          {"tracked_sec", r.tracked.tracked_sec},
                          {"total_sec", r.tracked.total_sec},
                          {"max_gap_sec", r.tracked.max_gap_sec}};
+    // beside the paper's coverage: the ground-truth path the tracked intervals cover
+    j["tracked_path"] = {{"coverage", Number(r.tracked_path_coverage)},
+                         {"scaled_ate_m", Number(r.tracked_scaled_ate_m)},
+                         {"tracked_ground_truth_path_m", r.tracked_ground_truth_path_m},
+                         {"ground_truth_path_m", r.ground_truth_full_path_m}};
   } else {
     j["rpe"] = {
         {"delta", r.rpe_delta.seconds ? Json(*r.rpe_delta.seconds) : Json(r.rpe_delta.frames)},
@@ -219,6 +224,14 @@ std::string EvalCommand::State::ToText(bool ate_verb, const TrajectoryEvaluation
         "time tracked  {:.6g} ({:.6g} s of {:.6g} s; intervals > {:.6g} s between "
         "associated poses not counted)\n",
         r.tracked.fraction, r.tracked.tracked_sec, r.tracked.total_sec, r.tracked.max_gap_sec);
+    if (std::isfinite(r.tracked_path_coverage))
+      t += fmt::format(
+          "tracked path  coverage {:.6g} (ground-truth path over tracked intervals {:.6g} m / "
+          "whole ground-truth path {:.6g} m), scaled ATE {:.6g} m\n",
+          r.tracked_path_coverage, r.tracked_ground_truth_path_m, r.ground_truth_full_path_m,
+          r.tracked_scaled_ate_m);
+    else
+      t += "tracked path  undefined (the ground truth does not move)\n";
   } else {
     t += fmt::format("RPE           delta {}: {} pose pairs\n", DeltaText(r.rpe_delta),
                      r.rpe.size());

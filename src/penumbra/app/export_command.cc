@@ -23,6 +23,8 @@ struct ExportCommand::State {
   std::string out;
   std::string replay_world;  // --world for a .plog input
   std::string replay_adversity;
+  std::string depth = "sensor";  // --depth: sensor | ground-truth
+  CLI::Option* depth_option = nullptr;
 };
 
 namespace {
@@ -47,12 +49,10 @@ class TempFolder {
 // given --world / --adversity) into a new temporary run folder "<out>.replay-tmp-<random>"
 // beside `out`, kept in `replayed` (removed when it is destroyed); returns that folder.
 // @throws ExportStopped when the stop request ended the replay.
-std::filesystem::path ReplayLogBeside(const std::string& log_path,
-                                      const std::string& world_override,
-                                      const std::string& adversity,
-                                      const std::filesystem::path& out,
-                                      const std::atomic<int>* stop_request,
-                                      std::optional<TempFolder>* replayed) {
+std::filesystem::path ReplayLogBeside(
+    const std::string& log_path, const std::string& world_override, const std::string& adversity,
+    ReplayDepth depth, const std::filesystem::path& out, const std::atomic<int>* stop_request,
+    std::optional<TempFolder>* replayed, ReplaySummary* summary_out = nullptr) {
   replayed->emplace(MakeSiblingTempFolder(out, ".replay-tmp"));
   ReplayOptions replay;
   replay.log_path = log_path;
@@ -61,8 +61,10 @@ std::filesystem::path ReplayLogBeside(const std::string& log_path,
   replay.adversity = adversity;
   replay.progress = false;
   replay.stop_request = stop_request;
+  replay.depth = depth;
   spdlog::info("replaying {} into {} for the export", log_path, replay.out_dir);
   const ReplaySummary summary = ReplayLog(replay);
+  if (summary_out) *summary_out = summary;
   if (summary.interrupted) throw ExportStopped(stop_request ? stop_request->load() : SIGINT);
   CheckExportStop(stop_request);
   return (*replayed)->path();
@@ -98,16 +100,49 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
     if (!fs::is_regular_file(input))
       throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
     CheckExportFolder(options.out_dir);
+    // the replay renders the depth with the benchmarks' sensor model (a camera's own
+    // depth_noise first) or exact (--depth ground-truth)
+    const bool truth = s.depth == "ground-truth";
+    ReplaySummary replay;
     try {
-      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, options.out_dir,
-                                stop_request, &replayed);
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity,
+                                truth ? ReplayDepth::kGroundTruth : ReplayDepth::kSensor,
+                                options.out_dir, stop_request, &replayed, &replay);
     } catch (const ExportStopped& e) {
       return Stopped(e, s.out);
     }
     options.source_label = fs::absolute(input).lexically_normal().string();
-  } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
-    throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
-                      "only for a run log (.plog) input, which is replayed first");
+    const RunFolder replayed_run(run_dir);
+    const std::vector<std::string> names = replayed_run.CameraNames();
+    const std::string camera =
+        !options.camera.empty() ? options.camera : (names.size() == 1 ? names[0] : "");
+    const auto model = replay.depth_models.find(camera);
+    if (truth) {
+      options.depth_source = "ground_truth";
+      options.depth_note = "exact z-depth of the replayed run log (--depth ground-truth)";
+    } else if (model != replay.depth_models.end() && !model->second.empty()) {
+      options.depth_source = "sensor_model";
+      options.depth_model = model->second;
+      options.depth_note =
+          "the replay of the run log rendered the camera's depth through this "
+          "sensor model (docs/cameras.md \"RGB-D depth noise\"), the camera's "
+          "own world-file depth_noise or else the benchmarks' realsense_d435";
+    }
+  } else {
+    if (!s.replay_world.empty() || !s.replay_adversity.empty())
+      throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
+                        "only for a run log (.plog) input, which is replayed first");
+    // a run folder's depth is what its camera wrote; the model is chosen at replay
+    if (s.depth_option && s.depth_option->count() > 0)
+      throw ConfigError("", 0, "--depth",
+                        "only for a run log (.plog) input, whose replay renders the depth with "
+                        "the sensor model or exact; a run folder's depth images are exported as "
+                        "its camera wrote them (world-file `depth_noise`, docs/cameras.md)");
+    options.depth_source = "as_recorded";
+    options.depth_note =
+        "the run folder's depth images as its camera wrote them: exact unless "
+        "the camera had a world-file depth_noise (see the run's world file); "
+        "export the run log (.plog) for the sensor model";
   }
   const RunFolder run(run_dir);
   DatasetExportSummary summary;
@@ -141,6 +176,10 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
                           : (!s.options.camera2.empty() ? "--camera2" : "--imu"),
                       "a rosbag holds every camera, LiDAR and IMU of the run; expected no sensor "
                       "selection with --format rosbag");
+  if (s.depth_option && s.depth_option->count() > 0)
+    throw ConfigError("", 0, "--depth",
+                      "not for --format rosbag, whose depth images are the run's as recorded; "
+                      "expected --format tum");
   // a run log is replayed into a temporary run folder beside the bag first
   std::optional<TempFolder> replayed;
   fs::path run_dir = input;
@@ -154,8 +193,8 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "' exists; expected a new file (never overwritten)");
     try {
-      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, bag, stop_request,
-                                &replayed);
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity,
+                                ReplayDepth::kAsRecorded, bag, stop_request, &replayed);
     } catch (const ExportStopped& e) {
       return Stopped(e, s.out);
     }
@@ -202,6 +241,13 @@ ExportCommand AddExportCommand(CLI::App& app) {
                         "second camera: EuRoC cam1, KITTI image_1 (a synchronised stereo pair)");
   s.command->add_option("--imu", s.options.imu, "IMU for EuRoC (default: the run's only IMU)");
   s.command->add_option("--sequence", s.options.sequence, "KITTI sequence number (two digits)");
+  s.depth_option =
+      s.command
+          ->add_option("--depth", s.depth,
+                       "for a .plog: depth images through the depth sensor model the benchmarks "
+                       "use (sensor, default: the camera's own depth_noise, else realsense_d435) "
+                       "or exact (ground-truth)")
+          ->check(CLI::IsMember({"sensor", "ground-truth"}));
   return c;
 }
 

@@ -150,6 +150,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   RunOutputsOptions outputs_options;
   outputs_options.end_time_sec = duration;
   outputs_options.progress = options.progress;
+  outputs_options.progress_pass_interval_sec = options.progress_interval_sec;
   outputs_options.metrics_mode = MetricsMode::kDynamics;
   // a live run paced to the wall clock (bridges or viewer with --realtime): one snapshot
   // waiting for the renderer, not four, so that a teleop command shows in the next frames

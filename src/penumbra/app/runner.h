@@ -23,6 +23,9 @@ struct RunOptions {
   std::optional<double> duration_sec;  ///< overrides the world's duration
   bool realtime = false;               ///< pace physics to wall-clock time (default: as fast as possible)
   bool progress = true;                ///< progress bar on a terminal / log lines otherwise
+  /// --progress-interval: the least wall time between the pathtraced tier's sample-pass
+  /// lines, s (ProgressOptions::pass_interval_sec; 0 = every pass)
+  double progress_interval_sec = 1.0;
   std::vector<std::string> command_line;  ///< argv, recorded in run.json
   /// adversity preset spec (--adversity; world/adversity_preset.h), "" = the world's own
   std::string adversity;

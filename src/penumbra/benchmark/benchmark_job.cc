@@ -52,6 +52,8 @@ nlohmann::json RowJson(const BenchmarkRow& r) {
           {"coverage", Num(r.coverage)},
           {"scaled_ate_m", Num(r.scaled_ate_m)},
           {"tracked_fraction", Num(r.tracked_fraction)},
+          {"tracked_path_coverage", Num(r.tracked_path_coverage)},
+          {"tracked_scaled_ate_m", Num(r.tracked_scaled_ate_m)},
           {"scale", Num(r.scale)},
           {"replay_sec", r.replay_sec},
           {"export_sec", r.export_sec},
@@ -94,6 +96,8 @@ void Evaluate(const Trajectory& gt, const Trajectory& est, const BenchmarkSpec& 
   row.coverage = e.coverage;
   row.scaled_ate_m = e.scaled_ate_m;
   row.tracked_fraction = e.tracked.fraction;
+  row.tracked_path_coverage = e.tracked_path_coverage;
+  row.tracked_scaled_ate_m = e.tracked_scaled_ate_m;
   row.scale = e.alignment.scale;
 }
 
@@ -291,6 +295,9 @@ std::vector<BenchmarkRow> ReadJobResult(const std::string& path) {
       r.coverage = NumOf(e.at("coverage"));
       r.scaled_ate_m = NumOf(e.at("scaled_ate_m"));
       r.tracked_fraction = NumOf(e.at("tracked_fraction"));
+      // absent from job results written before these figures existed
+      r.tracked_path_coverage = NumOf(e.value("tracked_path_coverage", nlohmann::json()));
+      r.tracked_scaled_ate_m = NumOf(e.value("tracked_scaled_ate_m", nlohmann::json()));
       r.scale = NumOf(e.at("scale"));
       r.replay_sec = e.at("replay_sec");
       r.export_sec = e.at("export_sec");

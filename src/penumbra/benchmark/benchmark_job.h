@@ -49,6 +49,9 @@ struct BenchmarkRow {
   double ate_rmse_m = NAN, ate_mean_m = NAN, ate_max_m = NAN;
   double rpe_trans_rmse_m = NAN, rpe_rot_rmse_deg = NAN;
   double coverage = NAN, scaled_ate_m = NAN, tracked_fraction = NAN;
+  /// beside the paper's coverage: the ground-truth path the tracked intervals cover / the whole
+  /// ground-truth path, and ATE RMSE / that coverage (eval/trajectory_evaluation.h)
+  double tracked_path_coverage = NAN, tracked_scaled_ate_m = NAN;
   double scale = NAN;  ///< the alignment's scale (1 for se3)
   /// wall times, s: replay (rendering) and export are per job (the same in each of its rows)
   double replay_sec = 0, export_sec = 0, method_sec = 0, eval_sec = 0;

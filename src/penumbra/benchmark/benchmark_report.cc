@@ -114,6 +114,8 @@ const std::vector<std::string>& BenchmarkCsvColumns() {
                                                     "coverage",
                                                     "scaled_ate_m",
                                                     "tracked_fraction",
+                                                    "tracked_path_coverage",
+                                                    "tracked_scaled_ate_m",
                                                     "scale",
                                                     "replay_sec",
                                                     "export_sec",
@@ -131,7 +133,8 @@ std::string BenchmarkCsv(const std::vector<BenchmarkRow>& rows) {
     out += fmt::format("{},{},{},{},{},{},{},{},", r.world, r.condition, r.method, r.trial, r.seed,
                        r.status, r.frames, r.poses);
     for (double v : {r.ate_rmse_m, r.ate_mean_m, r.ate_max_m, r.rpe_trans_rmse_m,
-                     r.rpe_rot_rmse_deg, r.coverage, r.scaled_ate_m, r.tracked_fraction, r.scale})
+                     r.rpe_rot_rmse_deg, r.coverage, r.scaled_ate_m, r.tracked_fraction,
+                     r.tracked_path_coverage, r.tracked_scaled_ate_m, r.scale})
       out += Field(v) + ",";
     out += fmt::format("{:.3f},{:.3f},{:.3f},{:.3f},", r.replay_sec, r.export_sec, r.method_sec,
                        r.eval_sec);
@@ -150,7 +153,7 @@ std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
         l.world = w.name;
         l.condition = c.name;
         l.method = m.name;
-        std::vector<double> ate, sate, cov, rpet, rper, tracked;
+        std::vector<double> ate, sate, cov, rpet, rper, tracked, tcov, tsate;
         for (const BenchmarkRow& r : rows) {
           if (r.world != w.name || r.condition != c.name || r.method != m.name) continue;
           ++l.trials;
@@ -161,12 +164,16 @@ std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
           if (std::isfinite(r.ate_rmse_m)) ate.push_back(r.ate_rmse_m);
           if (std::isfinite(r.scaled_ate_m)) sate.push_back(r.scaled_ate_m);
           if (std::isfinite(r.coverage)) cov.push_back(r.coverage);
+          if (std::isfinite(r.tracked_path_coverage)) tcov.push_back(r.tracked_path_coverage);
+          if (std::isfinite(r.tracked_scaled_ate_m)) tsate.push_back(r.tracked_scaled_ate_m);
           if (std::isfinite(r.rpe_trans_rmse_m)) rpet.push_back(r.rpe_trans_rmse_m);
           if (std::isfinite(r.rpe_rot_rmse_deg)) rper.push_back(r.rpe_rot_rmse_deg);
         }
         l.ate_rmse_m = Cell(ate);
         l.scaled_ate_m = Cell(sate);
         l.coverage = Cell(cov);
+        l.tracked_path_coverage = Cell(tcov);
+        l.tracked_scaled_ate_m = Cell(tsate);
         l.rpe_trans_rmse_m = Cell(rpet);
         l.rpe_rot_rmse_deg = Cell(rper);
         l.tracked_fraction = Cell(tracked);
@@ -184,15 +191,16 @@ std::string SummaryMarkdown(const BenchmarkSpec& spec, const std::vector<Summary
         "s)\n\n",
         w.name, FormatNumber(spec.metrics.rpe_delta_sec));
     out +=
-        "| condition | method | ok | ATE RMSE (m) | scaled ATE (m) | coverage | tracked fraction | "
-        "RPE (m) | RPE (deg) |\n";
-    out += "|---|---|---|---|---|---|---|---|---|\n";
+        "| condition | method | ok | ATE RMSE (m) | scaled ATE (m) | coverage | tracked path "
+        "coverage | tracked-path scaled ATE (m) | tracked fraction | RPE (m) | RPE (deg) |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const SummaryLine& l : lines) {
       if (l.world != w.name) continue;
-      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |\n", l.condition,
-                         l.method, l.ok, l.trials, Pm(l.ate_rmse_m, 4), Pm(l.scaled_ate_m, 4),
-                         Pm(l.coverage, 3), Pm(l.tracked_fraction, 3), Pm(l.rpe_trans_rmse_m, 4),
-                         Pm(l.rpe_rot_rmse_deg, 2));
+      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                         l.condition, l.method, l.ok, l.trials, Pm(l.ate_rmse_m, 4),
+                         Pm(l.scaled_ate_m, 4), Pm(l.coverage, 3), Pm(l.tracked_path_coverage, 3),
+                         Pm(l.tracked_scaled_ate_m, 4), Pm(l.tracked_fraction, 3),
+                         Pm(l.rpe_trans_rmse_m, 4), Pm(l.rpe_rot_rmse_deg, 2));
     }
     out += "\n";
   }
@@ -210,14 +218,17 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
       "world,condition,method,trials,ok,ate_rmse_m_mean,ate_rmse_m_std,scaled_ate_m_mean,scaled_"
       "ate_m_std,"
       "coverage_mean,coverage_std,tracked_fraction_mean,tracked_fraction_std,rpe_trans_rmse_m_mean,"
-      "rpe_trans_rmse_m_std\n";
+      "rpe_trans_rmse_m_std,tracked_path_coverage_mean,tracked_path_coverage_std,"
+      "tracked_scaled_ate_m_mean,tracked_scaled_ate_m_std\n";
   for (const SummaryLine& l : lines)
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world, l.condition,
-                       l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean), Field(l.ate_rmse_m.std),
-                       Field(l.scaled_ate_m.mean), Field(l.scaled_ate_m.std),
-                       Field(l.coverage.mean), Field(l.coverage.std),
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world,
+                       l.condition, l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean),
+                       Field(l.ate_rmse_m.std), Field(l.scaled_ate_m.mean),
+                       Field(l.scaled_ate_m.std), Field(l.coverage.mean), Field(l.coverage.std),
                        Field(l.tracked_fraction.mean), Field(l.tracked_fraction.std),
-                       Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std));
+                       Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std),
+                       Field(l.tracked_path_coverage.mean), Field(l.tracked_path_coverage.std),
+                       Field(l.tracked_scaled_ate_m.mean), Field(l.tracked_scaled_ate_m.std));
   WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");

@@ -29,6 +29,8 @@ struct SummaryLine {
   std::string world, condition, method;
   int trials = 0, ok = 0;
   SummaryCell ate_rmse_m, scaled_ate_m, coverage, rpe_trans_rmse_m, rpe_rot_rmse_deg;
+  /// beside coverage and scaled ATE: the tracked path coverage and the ATE scaled by it
+  SummaryCell tracked_path_coverage, tracked_scaled_ate_m;
   /// over all trials: a failed trial counts as 0 tracked
   SummaryCell tracked_fraction;
 };

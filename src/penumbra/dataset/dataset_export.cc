@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/dataset/euroc_export.h"
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/kitti_export.h"
@@ -135,6 +136,35 @@ fs::path MakeSiblingTempFolder(const fs::path& out, const std::string& suffix) {
   throw Error("cannot create a temporary folder beside " + target.string());
 }
 
+std::string ExportMetadataYaml(const DatasetExportOptions& options, const std::string& source,
+                               const DatasetExportSummary& summary) {
+  // YAML single-quoted scalars: a quote is written twice
+  auto q = [](const std::string& v) {
+    std::string out = "'";
+    for (char c : v) {
+      if (c == '\'') out += '\'';
+      out += (c == '\n' || c == '\r') ? ' ' : c;
+    }
+    return out + "'";
+  };
+  const char* format = options.format == DatasetFormat::kTum     ? "tum"
+                       : options.format == DatasetFormat::kEuroc ? "euroc"
+                                                                 : "kitti";
+  std::string y = "# written by penumbra export (docs/datasets.md)\n";
+  y += "source: " + q(source) + "\n";
+  y += std::string("format: ") + format + "\n";
+  y += "camera: " + q(summary.camera) + "\n";
+  if (!summary.camera2.empty()) y += "camera2: " + q(summary.camera2) + "\n";
+  if (!summary.imu.empty()) y += "imu: " + q(summary.imu) + "\n";
+  if (options.format == DatasetFormat::kTum) {
+    y += "depth:\n";
+    y += "  source: " + options.depth_source + "\n";
+    if (!options.depth_model.empty()) y += "  model: " + options.depth_model + "\n";
+    if (!options.depth_note.empty()) y += "  note: " + q(options.depth_note) + "\n";
+  }
+  return y;
+}
+
 DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOptions& options) {
   options.ValidateOrThrow();
   DatasetExportSummary summary;
@@ -160,6 +190,8 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
   };
   try {
     Export(run, options, cam0, cam1, source, prepare, &summary);
+    if (temp)
+      WriteFileAtomic(*temp / "penumbra_export.yaml", ExportMetadataYaml(options, source, summary));
     CheckExportStop(options.stop_request);
     if (temp && std::rename(temp->c_str(), options.out_dir.c_str()) != 0) {
       const int err = errno;

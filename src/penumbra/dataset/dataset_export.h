@@ -41,6 +41,13 @@ struct DatasetExportOptions {
   /// what the TUM lists' "# file:" line names as the source; "" = the run folder (absolute).
   /// (a run log exported through a temporary replay folder names the log.)
   std::string source_label;
+  /// what the run's depth images are, for the dataset's penumbra_export.yaml (TUM):
+  /// `depth_source` "sensor_model" (with `depth_model`, a sensors/depth_noise.h preset),
+  /// "ground_truth" (exact z-depth) or "as_recorded" (as the run's camera wrote them: its
+  /// world-file depth_noise if it had one, else exact); `depth_note` says how it was made.
+  std::string depth_source = "as_recorded";
+  std::string depth_model;
+  std::string depth_note;
   /// a stop request (SIGINT / SIGTERM; null = none), read between frames: when it reads
   /// non-zero the export throws ExportStopped (dataset/export_stop.h) and leaves nothing behind.
   const std::atomic<int>* stop_request = nullptr;
@@ -72,9 +79,15 @@ void CheckExportFolder(const std::filesystem::path& out);
 std::filesystem::path MakeSiblingTempFolder(const std::filesystem::path& out,
                                             const std::string& suffix);
 
+/// the text of the dataset's penumbra_export.yaml: source, format, cameras and (TUM) the
+/// depth block of `options` (docs/datasets.md "penumbra_export.yaml").
+std::string ExportMetadataYaml(const DatasetExportOptions& options, const std::string& source,
+                               const DatasetExportSummary& summary);
+
 /// exports `run` as `options` says (options.ValidateOrThrow() and CheckExportFolder first; the
 /// inputs are read before anything is written), into a temporary sibling folder renamed to
-/// options.out_dir when complete.
+/// options.out_dir when complete; the folder also gets penumbra_export.yaml
+/// (ExportMetadataYaml).
 /// @throws ConfigError for a camera or IMU the run does not have (listing those it has), a
 ///         run with several cameras or IMUs and none named, and the format's own errors
 ///         (see the format headers); Error if a file cannot be written; ExportStopped when

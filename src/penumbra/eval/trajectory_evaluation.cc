@@ -127,6 +127,24 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& ground_truth, const Tr
       3.0 * std::max(MedianPeriod(ground_truth.time_sec), MedianPeriod(estimate.time_sec)));
   r.tracked = ComputeTrackedTime(r.pair_time_sec, r.ground_truth_start_sec, r.ground_truth_end_sec,
                                  max_gap_sec);
+
+  // 4. the ground-truth path the tracked intervals cover: the pairs are in ground-truth
+  // order, so the ground-truth poses between pair k-1 and pair k are indices a_k-1 .. a_k
+  const Eigen::Matrix3Xd gt_all = ground_truth.Positions();
+  r.ground_truth_full_path_m = PathLength(gt_all);
+  for (size_t k = 1; k < n; ++k) {
+    if (!GapIsTracked(r.pair_time_sec[k] - r.pair_time_sec[k - 1], max_gap_sec)) continue;
+    const size_t a0 = r.association.pairs[k - 1].first, a1 = r.association.pairs[k].first;
+    for (size_t i = a0; i < a1; ++i)
+      r.tracked_ground_truth_path_m +=
+          (gt_all.col(static_cast<Eigen::Index>(i + 1)) - gt_all.col(static_cast<Eigen::Index>(i)))
+              .norm();
+  }
+  r.tracked_path_coverage = r.ground_truth_full_path_m > 0
+                                ? r.tracked_ground_truth_path_m / r.ground_truth_full_path_m
+                                : nan;
+  r.tracked_scaled_ate_m =
+      r.tracked_path_coverage > 0 ? r.ate_m.rmse / r.tracked_path_coverage : nan;
   return r;
 }
 

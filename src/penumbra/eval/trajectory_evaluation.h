@@ -8,7 +8,12 @@
 //   3. ATE, RPE (trajectory_metrics.h) and the benchmark figures of the URLab paper:
 //      coverage = ground-truth path length / aligned estimated path length, both over the
 //      associated poses in ground-truth time order; scaled ATE = ATE RMSE / coverage;
-//      fraction of ground-truth time tracked (ComputeTrackedTime).
+//      fraction of ground-truth time tracked (ComputeTrackedTime);
+//   4. beside the paper's coverage, which rewards an estimate that barely moves (its path is
+//      short, so coverage > 1 and the scaled ATE shrinks): the tracked path coverage = the
+//      ground-truth path length over the tracked intervals (between consecutive associated
+//      poses, GapIsTracked) / the length of the whole ground-truth path, in [0, 1], and the
+//      tracked scaled ATE = ATE RMSE / tracked path coverage (>= ATE RMSE; docs/evaluation.md).
 
 #include <optional>
 #include <string>
@@ -66,9 +71,20 @@ struct TrajectoryEvaluation {
   double coverage = 0;
   double scaled_ate_m = 0;  ///< ate_m.rmse / coverage; NaN when coverage is NaN or 0
   TrackedTime tracked;
+
+  /// the whole ground truth's path (every pose, associated or not), m
+  double ground_truth_full_path_m = 0;
+  /// the ground truth's path over the tracked intervals: for consecutive associated poses
+  /// whose interval GapIsTracked, the ground-truth polyline between their two poses, m
+  double tracked_ground_truth_path_m = 0;
+  /// tracked_ground_truth_path_m / ground_truth_full_path_m in [0, 1]; NaN when the ground
+  /// truth does not move
+  double tracked_path_coverage = 0;
+  /// ate_m.rmse / tracked_path_coverage; NaN when that coverage is NaN or 0
+  double tracked_scaled_ate_m = 0;
 };
 
-/// evaluates `estimate` against `ground_truth` (steps 1-3 above). `ground_truth_name` and
+/// evaluates `estimate` against `ground_truth` (steps 1-4 above). `ground_truth_name` and
 /// `estimate_name` (file paths) name the inputs in errors.
 /// @throws ConfigError from options.ValidateOrThrow(); naming the estimate when fewer than 2
 ///         poses associate (with both time spans and a hint at --max-dt / --offset), and when

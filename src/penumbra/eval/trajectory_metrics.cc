@@ -124,6 +124,10 @@ std::vector<RelativePoseError> RelativePoseErrors(const std::vector<double>& tim
   return out;
 }
 
+bool GapIsTracked(double gap_sec, double max_gap_sec) {
+  return gap_sec <= max_gap_sec * (1.0 + kTrackedGapRelTolerance);
+}
+
 TrackedTime ComputeTrackedTime(const std::vector<double>& associated_time_sec,
                                double ground_truth_start_sec, double ground_truth_end_sec,
                                double max_gap_sec) {
@@ -132,7 +136,7 @@ TrackedTime ComputeTrackedTime(const std::vector<double>& associated_time_sec,
   t.total_sec = ground_truth_end_sec - ground_truth_start_sec;
   for (size_t k = 1; k < associated_time_sec.size(); ++k) {
     const double gap = associated_time_sec[k] - associated_time_sec[k - 1];
-    if (gap <= max_gap_sec) t.tracked_sec += gap;
+    if (GapIsTracked(gap, max_gap_sec)) t.tracked_sec += gap;
   }
   t.fraction =
       t.total_sec > 0 ? t.tracked_sec / t.total_sec : std::numeric_limits<double>::quiet_NaN();

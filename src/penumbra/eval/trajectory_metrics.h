@@ -69,17 +69,30 @@ std::vector<RelativePoseError> RelativePoseErrors(const std::vector<double>& tim
                                                   const std::vector<Pose>& X_V_est,
                                                   const RpeDelta& delta, double max_dt_sec);
 
+/// relative tolerance of the gap limit: an interval counts as tracked when it is at most
+/// max_gap_sec * (1 + kTrackedGapRelTolerance). timestamps are decimal numbers held in binary
+/// doubles, so an interval of exactly 3 sample periods (two lost frames) and the default limit
+/// of 3 x the median period differ by rounding alone (e.g. 4.9 - 4.6 = 0.3000000000000007 s
+/// against 3 x (4.4 - 4.3) = 0.29999999999999893 s); 1e-9 is far above that rounding (about
+/// 1e-15 relative) and far below a real extra frame (1/3 relative). docs/evaluation.md.
+inline constexpr double kTrackedGapRelTolerance = 1e-9;
+
+/// true when an interval of `gap_sec` between consecutive associated poses counts as tracked
+/// under the limit `max_gap_sec`: gap_sec <= max_gap_sec * (1 + kTrackedGapRelTolerance).
+bool GapIsTracked(double gap_sec, double max_gap_sec);
+
 /// how much of the ground truth's time span the estimate tracked.
 struct TrackedTime {
-  double tracked_sec = 0;  ///< sum of the intervals between consecutive associated poses <= max gap
+  double tracked_sec = 0;  ///< sum of the intervals between consecutive associated poses that
+                           ///< GapIsTracked
   double total_sec = 0;    ///< last minus first ground-truth timestamp
   double fraction = 0;     ///< tracked_sec / total_sec (NaN when total_sec is 0)
   double max_gap_sec = 0;  ///< the gap limit used
 };
 
 /// tracked time: with tau_1 < ... < tau_K the ground-truth times of the associated poses,
-/// tracked = sum over k of (tau_k+1 - tau_k) for the intervals with tau_k+1 - tau_k <=
-/// max_gap_sec (longer ones are tracking losses); total = ground_truth_end_sec -
+/// tracked = sum over k of (tau_k+1 - tau_k) for the intervals with GapIsTracked(tau_k+1 -
+/// tau_k, max_gap_sec) (longer ones are tracking losses); total = ground_truth_end_sec -
 /// ground_truth_start_sec.
 TrackedTime ComputeTrackedTime(const std::vector<double>& associated_time_sec,
                                double ground_truth_start_sec, double ground_truth_end_sec,

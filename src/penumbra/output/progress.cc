@@ -24,9 +24,46 @@ std::string FormatProgressLine(double sim_time_sec, double total_sim_sec, int64_
   bar_width = std::max(bar_width, 1);
   const int filled = std::clamp(static_cast<int>(std::floor(f * bar_width)), 0, bar_width);
   const int percent = std::clamp(static_cast<int>(std::floor(f * 100.0 + 1e-9)), 0, 100);
-  return fmt::format("[{}{}] {:3d}% sim {:.2f}/{:.2f} s  {} frames  {:.1f} fps",
-                     std::string(filled, '#'), std::string(bar_width - filled, ' '), percent,
-                     sim_time_sec, total_sim_sec, frames, fps);
+  // a slow tier (pathtraced: minutes a frame) would read "0.0 fps": seconds per frame instead
+  const std::string rate = fps > 0 && fps < 1 ? fmt::format("{:.1f} s/frame", 1.0 / fps)
+                                              : fmt::format("{:.1f} fps", fps);
+  return fmt::format("[{}{}] {:3d}% sim {:.2f}/{:.2f} s  {} frames  {}", std::string(filled, '#'),
+                     std::string(bar_width - filled, ' '), percent, sim_time_sec, total_sim_sec,
+                     frames, rate);
+}
+
+std::string ProgressReporter::FormatPassLine(const std::string& label, int pass, int passes,
+                                             double elapsed_sec) {
+  const int percent = passes > 0 ? static_cast<int>(100.0 * pass / passes) : 100;
+  const double eta = pass > 0 ? elapsed_sec * (passes - pass) / pass : 0.0;
+  return fmt::format("{}: sample pass {}/{} ({}%), {:.1f} s, ETA {:.1f} s", label, pass, passes,
+                     percent, elapsed_sec, eta);
+}
+
+void ProgressReporter::RenderPass(const std::string& label, int pass, int passes) {
+  if (finished_ || options_.mode == ProgressOptions::Mode::kOff) return;
+  const double now = Now();
+  if (pass <= 0) {
+    frame_start_ = now;
+    frame_pass_lines_ = 0;
+    return;
+  }
+  const double interval = std::max(0.0, options_.pass_interval_sec);
+  const bool due = now - frame_start_ >= interval && now - last_pass_line_ >= interval;
+  const bool last_of_shown_frame = pass >= passes && frame_pass_lines_ > 0;
+  if (!due && !last_of_shown_frame) return;
+  const std::string line = FormatPassLine(label, pass, passes, now - frame_start_);
+  last_pass_line_ = now;
+  ++frame_pass_lines_;
+  if (options_.mode == ProgressOptions::Mode::kBar) {
+    // the line above the bar, then the bar again
+    const size_t pad = last_len_ > line.size() ? last_len_ - line.size() : 0;
+    std::fprintf(options_.stream, "\r%s%*s\n", line.c_str(), static_cast<int>(pad), "");
+    last_len_ = 0;
+    Draw(now);
+  } else {
+    options_.log(line);
+  }
 }
 
 ProgressReporter::ProgressReporter(double total_sim_sec, ProgressOptions options)

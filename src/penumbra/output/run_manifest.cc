@@ -46,6 +46,7 @@ std::string RunManifestJson(const RunManifest& m) {
     r["sensor_records"] = m.record_sensor_records;
     j["record"] = r;
   }
+  if (!m.falls_json.empty()) j["falls"] = nlohmann::ordered_json::parse(m.falls_json);
   if (m.replay) {
     const ReplayManifest& r = *m.replay;
     nlohmann::ordered_json rj;

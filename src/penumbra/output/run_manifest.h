@@ -65,6 +65,10 @@ struct RunManifest {
   int64_t record_first_step = -1, record_last_step = -1;
   int64_t record_events = 0;
   int64_t record_sensor_records = 0;
+  /// the fall verdicts of the floating-base robots (metrics/fall_detector.h,
+  /// FallSink::SummaryJson): a JSON object as text, written as the key "falls" after "record"
+  /// (before "replay" and "metrics") only when not empty.
+  std::string falls_json;
   /// the world file's `metrics:` summaries (metrics/metrics_sink.h, MetricsSink::SummaryJson):
   /// a JSON object as text, written as the key "metrics" (last) only when not empty.
   std::string metrics_json;

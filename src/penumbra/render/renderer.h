@@ -5,8 +5,11 @@
 // RenderSettings::backend (Embree: render/cpu/embree_renderer.h).
 
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "penumbra/core/image.h"
 #include "penumbra/render/camera.h"
@@ -58,6 +61,25 @@ struct RenderedFrame {
   bool stopped = false;
 };
 
+/// how far one Render of the pathtraced tier has got (RenderSettings::samples_per_pixel
+/// passes over the image; the tier renders tile by tile, all of a pixel's samples at once, so
+/// a pass here is the equivalent count: samples traced / pixels).
+struct RenderProgress {
+  int camera_index = 0;       ///< CameraView::camera_index of the render
+  int64_t frame_index = 0;    ///< CameraView::frame_index of the render
+  int64_t samples_done = 0;   ///< pixel samples traced so far
+  int64_t samples_total = 0;  ///< width * height * samples_per_pixel
+  int passes_done = 0;        ///< samples_done / (width * height), rounded down
+  int passes = 0;             ///< samples_per_pixel
+};
+
+/// receives RenderProgress: once with passes_done = 0 when a render starts, then once for
+/// each pass 1, 2, ..., passes in order (not for a stopped render), each as soon as the thread
+/// that called Render sees it done: the callback always runs on that thread, never on a
+/// render worker, so passes the workers finish while that thread renders a tile, or after it
+/// ran out of tiles, are reported together then.
+using RenderProgressCallback = std::function<void(const RenderProgress&)>;
+
 /// renders frames of one scene. not thread-safe: one Render at a time (each call is
 /// parallel inside).
 class Renderer {
@@ -81,8 +103,14 @@ class Renderer {
   /// nothing in the images of a render it does not stop. `stop` must outlive the renderer.
   void set_stop_request(const std::atomic<int>* stop) { stop_request_ = stop; }
 
+  /// progress of the pathtraced tier's renders (see RenderProgressCallback; empty = none, the
+  /// default; the realtime tier reports none). reading the progress changes nothing in the
+  /// images.
+  void set_progress_callback(RenderProgressCallback callback) { progress_ = std::move(callback); }
+
  protected:
   const std::atomic<int>* stop_request_ = nullptr;
+  RenderProgressCallback progress_;
 };
 
 }  // namespace penumbra

@@ -117,6 +117,19 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     world.mjcf_cameras.outputs = *options.outputs;
     for (CameraConfig& c : world.mjcf_cameras.overrides) c.outputs = *options.outputs;
   }
+  if (options.depth != ReplayDepth::kAsRecorded) {
+    auto set_depth_model = [&](CameraConfig& c) {
+      if (!c.outputs.depth) return;
+      DepthNoiseConfig& d = c.sensor.depth_noise;
+      if (options.depth == ReplayDepth::kGroundTruth) {
+        d = DepthNoiseConfig{};
+      } else if (d.preset.empty()) {
+        d.preset = options.default_depth_noise;
+      }
+    };
+    for (CameraConfig& c : world.cameras) set_depth_model(c);
+    for (CameraConfig& c : world.mjcf_cameras.overrides) set_depth_model(c);
+  }
   world.output_dir = options.out_dir;
   world.render.seed = world.seed;
   world.ValidateOrThrow();
@@ -210,6 +223,10 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     summary.frames_per_camera = outputs.cameras().FramesWritten();
     summary.wall_time_sec = SecondsSince(t_start);
     summary.warnings = warnings;
+    for (const CameraConfig& c : world.cameras)
+      if (c.outputs.depth) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
+    for (const CameraConfig& c : world.mjcf_cameras.overrides)
+      if (c.outputs.depth) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
     timings["total_sec"] = summary.wall_time_sec;
     RunManifest m = outputs.Describe(
         header.world_file.empty() ? header.model_file : header.world_file, options.command_line,

@@ -23,6 +23,13 @@
 
 namespace penumbra {
 
+/// the depth images of a replay's cameras with a depth output.
+enum class ReplayDepth {
+  kAsRecorded,   ///< each camera's world-file `depth_noise` (none = exact depth)
+  kSensor,       ///< each camera's own `depth_noise`, else ReplayOptions::default_depth_noise
+  kGroundTruth,  ///< exact z-depth for every camera (their `depth_noise` dropped)
+};
+
 /// what `penumbra replay` (kinematic) is asked for.
 struct ReplayOptions {
   std::string log_path;  ///< the .plog
@@ -39,6 +46,12 @@ struct ReplayOptions {
   /// the list as given, for run.json.
   std::optional<CameraOutputs> outputs;
   std::string outputs_text;
+  /// the depth model of the world-file cameras and MJCF camera overrides with a depth output
+  /// (`penumbra export` of a run log asks for kSensor unless --depth ground-truth).
+  ReplayDepth depth = ReplayDepth::kAsRecorded;
+  /// the depth_noise preset kSensor gives a camera without its own: the benchmarks' camera
+  /// model (benchmark/benchmark_spec.h), sensors/depth_noise.h.
+  std::string default_depth_noise = "realsense_d435";
   /// --cameras: the cameras to render, by name (empty = all).
   std::vector<std::string> cameras;
   /// the window of sim time replayed: from the first logged step at or after from_sec, to the
@@ -62,6 +75,9 @@ struct ReplaySummary {
   bool interrupted = false;
   /// warnings (damaged log, changed assets, dropped mocap bodies), also logged and in run.json.
   std::vector<std::string> warnings;
+  /// the depth_noise preset of each world-file camera and MJCF camera override with a depth
+  /// output, by name ("" = exact depth), after ReplayOptions::depth.
+  std::map<std::string, std::string> depth_models;
 };
 
 /// refuses an output folder (`out_dir`, --out) that holds the log at `log_path` (or is its

@@ -193,7 +193,14 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   std::string spec_file = world.file;
   int spec_line = world.adversity_line;
   if (!adversity_override.empty()) {
-    spec = ResolveAdversitySpec(adversity_override, "", "", 0);
+    // a bad command-line value is the flag's, not the world file's `adversity` line (errors
+    // inside a preset file keep that file's name and line)
+    try {
+      spec = ResolveAdversitySpec(adversity_override, "", "", 0);
+    } catch (const ConfigError& e) {
+      if (!e.file().empty()) throw;
+      throw ConfigError("", 0, "--adversity", e.problem());
+    }
     spec_file.clear();
     spec_line = 0;
   }

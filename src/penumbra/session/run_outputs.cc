@@ -1,5 +1,7 @@
 #include "penumbra/session/run_outputs.h"
 
+#include <fmt/format.h>
+
 #include <initializer_list>
 #include <utility>
 
@@ -29,15 +31,34 @@ RunOutputs::RunOutputs(Session& session, const WorldConfig& world,
       std::make_unique<SensorSink>(world, sim, session.scene(), out_dir.string(), viewer_effects);
   trajectory_ = std::make_unique<TrajectorySink>(out_dir / "trajectory.csv", sim.qpos().size());
   metrics_ = MakeMetricsSink(world, sim, out_dir.string(), options.metrics_mode);
+  falls_ = MakeFallSink(world, sim);
   ProgressOptions progress_options;
   progress_options.mode =
       options.progress ? ProgressOptions::Mode::kAuto : ProgressOptions::Mode::kOff;
+  progress_options.pass_interval_sec = options.progress_pass_interval_sec;
   progress_.emplace(options.end_time_sec, progress_options);
+  // the pathtraced tier's sample passes, on the render thread (as on_rendered above)
+  if (Renderer* renderer = session.renderer(); renderer && options.progress) {
+    std::vector<std::string> names;
+    for (const CameraSpec& c : session.scene().cameras) names.push_back(c.name);
+    renderer->set_progress_callback([this, names](const RenderProgress& p) {
+      const std::string name =
+          p.camera_index >= 0 && p.camera_index < static_cast<int>(names.size())
+              ? names[p.camera_index]
+              : std::to_string(p.camera_index);
+      progress_->RenderPass(fmt::format("camera '{}' frame {}", name, p.frame_index), p.passes_done,
+                            p.passes);
+    });
+  }
+}
+
+RunOutputs::~RunOutputs() {
+  if (Renderer* renderer = session_.renderer()) renderer->set_progress_callback({});
 }
 
 void RunOutputs::AddTo(SimLoop* loop) {
   for (Sink* sink : std::initializer_list<Sink*>{sensors_.get(), cameras_.get(), trajectory_.get(),
-                                                 metrics_.get()})
+                                                 metrics_.get(), falls_.get()})
     if (sink) loop->AddSink(sink);
 }
 
@@ -68,6 +89,7 @@ RunManifest RunOutputs::Describe(const std::string& world_file,
   m.effects = effects.EffectLabels();
   m.agents = effects.AgentLabels();
   if (metrics_) m.metrics_json = metrics_->SummaryJson();  // its OnFinish ran before
+  if (falls_) m.falls_json = falls_->SummaryJson();
   return m;
 }
 

@@ -2,7 +2,8 @@
 // the output sinks of a run, built once for `penumbra run` (app/runner.cc) and `penumbra
 // replay` (replay/replay_runner.cc): the cameras (session/camera_sink.h), the sensors
 // (session/sensor_sink.h), trajectory.csv (output/trajectory_sink.h), the world's `metrics:`
-// (metrics/metrics_sink.h) and the progress bar, plus the run.json fields they share. the
+// (metrics/metrics_sink.h), the fall detector (metrics/fall_detector.h) and the progress bar,
+// plus the run.json fields they share. the
 // callers add what differs (the run log recorder, the replay's manifest object, the source)
 // and the ManifestSink last.
 
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/metrics/fall_detector.h"
 #include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/progress.h"
 #include "penumbra/output/run_manifest.h"
@@ -31,6 +33,9 @@ struct RunOutputsOptions {
   double end_time_sec = 0;
   /// draw a progress bar / log progress lines (ProgressOptions::Mode::kAuto) or nothing.
   bool progress = false;
+  /// the pathtraced tier's sample-pass lines: ProgressOptions::pass_interval_sec (--progress-
+  /// interval), s.
+  double progress_pass_interval_sec = 1.0;
   /// what the snapshots give the metrics sink: kDynamics for live physics, kKinematic for a
   /// replay that only moves the bodies.
   MetricsMode metrics_mode = MetricsMode::kDynamics;
@@ -50,21 +55,26 @@ struct RunOutputsOptions {
 class RunOutputs {
  public:
   /// builds the sinks in this order: cameras, sensors, trajectory, metrics (when `world` has
-  /// `metrics:`), then the progress reporter. `world` is the world the session was built
-  /// from, with the run's overrides applied; `session` and `world` must outlive this object.
+  /// `metrics:`), falls (when a robot has a free joint), then the progress reporter. `world` is the
+  /// world the session was built from, with the run's overrides applied; `session` and `world` must
+  /// outlive this object.
   /// @throws ConfigError from the sinks (bad camera or sensor settings, an unknown --cameras
   ///         name, a metric name that matches nothing); Error if an output cannot be created.
   RunOutputs(Session& session, const WorldConfig& world, const std::filesystem::path& out_dir,
              RunOutputsOptions options);
   RunOutputs(const RunOutputs&) = delete;
   RunOutputs& operator=(const RunOutputs&) = delete;
+  /// detaches the progress reporter from the session's renderer.
+  ~RunOutputs();
 
   CameraSink& cameras() { return *cameras_; }
   SensorSink& sensors() { return *sensors_; }
   /// the metrics sink, or nullptr when the world has no `metrics:`.
   MetricsSink* metrics() { return metrics_.get(); }
+  /// the fall detector, or nullptr when no robot of the world has a free joint.
+  FallSink* falls() { return falls_.get(); }
 
-  /// adds the sinks to `loop` in the order sensors, cameras, trajectory, metrics (the caller
+  /// adds the sinks to `loop` in the order sensors, cameras, trajectory, metrics, falls (the caller
   /// adds its own sinks after them, the ManifestSink last).
   void AddTo(SimLoop* loop);
 
@@ -88,6 +98,7 @@ class RunOutputs {
   std::unique_ptr<SensorSink> sensors_;
   std::unique_ptr<TrajectorySink> trajectory_;
   std::unique_ptr<MetricsSink> metrics_;
+  std::unique_ptr<FallSink> falls_;  // null when no robot has a free joint
 };
 
 }  // namespace penumbra

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <string>
+#include <thread>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera_ground_truth.h"
@@ -139,6 +140,19 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   const int tiles_x = (W + kTileSize - 1) / kTileSize;
   const int tiles_y = (H + kTileSize - 1) / kTileSize;
   std::atomic<int64_t> secondary_rays{0};
+  // progress of the pathtraced tier: samples of finished tiles, reported on this thread only
+  const bool report = progress_ && buffers.radiance != nullptr &&
+                      settings_.tier == RenderSettings::Tier::kPathtraced;
+  const int spp = std::max(1, settings_.samples_per_pixel);
+  const int64_t pixels = static_cast<int64_t>(W) * H;
+  RenderProgress progress;
+  progress.camera_index = view.camera_index;
+  progress.frame_index = view.frame_index;
+  progress.samples_total = pixels * spp;
+  progress.passes = spp;
+  std::atomic<int64_t> samples_done{0};
+  const std::thread::id caller = std::this_thread::get_id();
+  if (report) progress_(progress);
   const float near = static_cast<float>(view.near_m);
   ImageI32* seg = want.segmentation ? &out->geom_id : nullptr;
   pool_.ParallelFor(static_cast<int64_t>(tiles_x) * tiles_y, [&](int64_t k) {
@@ -203,8 +217,29 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       primary.did_hit = did_hit.get();
       secondary_rays.fetch_add(integrator_->RenderTile(ctx, primary, buffers),
                                std::memory_order_relaxed);
+      if (report) {
+        const int64_t tile_samples = static_cast<int64_t>(n) * spp;
+        const int64_t done = samples_done.fetch_add(tile_samples) + tile_samples;
+        const int passes_done = static_cast<int>(std::min<int64_t>(done / pixels, spp));
+        // one report per pass crossed since the last (a tile may hold more than one pass)
+        if (std::this_thread::get_id() == caller && !stopped.load(std::memory_order_relaxed)) {
+          progress.samples_done = done;
+          while (progress.passes_done < passes_done) {
+            ++progress.passes_done;
+            progress_(progress);
+          }
+        }
+      }
     }
   });
+  // the passes the other threads finished after this one ran out of tiles
+  if (report && !stopped.load()) {
+    progress.samples_done = progress.samples_total;
+    while (progress.passes_done < spp) {
+      ++progress.passes_done;
+      progress_(progress);
+    }
+  }
   out->rays = static_cast<int64_t>(W) * H + secondary_rays.load();
   // a stopped render's radiance is unfinished: not denoised, not developed
   out->stopped = stopped.load();
