@@ -1,7 +1,7 @@
 #include "penumbra/session/static_terrain_ray_caster.h"
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/static_geometry.h"
 
 namespace penumbra {
