@@ -12,6 +12,7 @@ pkgs=(
   libzstd-dev zlib1g-dev libssl-dev  # run logs (.plog): zstd chunks, CRC32, SHA-256 asset hashes
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
+  libopencv-dnn-dev  # the policy controller runs ONNX policies (control/onnx_policy_network.h)
   libgtest-dev libgmock-dev libbenchmark-dev
   python3  # scripts/, the module dependency check and outputs_thread_invariance (standard library only)
   cppzmq-dev libzmq3-dev libmsgpack-cxx-dev  # ZeroMQ bridge (command/ + zmq/)

@@ -261,7 +261,7 @@ class Client:
         return self.request("set_ctrl", ctrl=ctrl)
 
     def twist(self, vx=0.0, vy=0.0, yaw_rate=0.0, robot=None):
-        """Velocity command for a mobile robot's controller (``trot_gait``,
+        """Velocity command for a mobile robot's controller (``trot_gait``, ``policy``,
         ``waypoint_follower``); it holds until the next twist or :meth:`clear_twist`.
 
         :param vx: forward speed, m/s, in the heading frame.
@@ -287,8 +287,8 @@ class Client:
                             values=[float(v) for v in values])
 
     def waypoints(self, points, loop=False, robot=None):
-        """A new route (world x, y in m, at least one point) for a ``waypoint_follower`` or
-        ``trot_gait`` controller; replaces the route and clears a twist."""
+        """A new route (world x, y in m, at least one point) for a ``waypoint_follower``,
+        ``trot_gait`` or ``policy`` controller; replaces the route and clears a twist."""
         return self.request("waypoints", robot=robot, loop=bool(loop),
                             points=[[float(p[0]), float(p[1])] for p in points])
 

@@ -10,7 +10,7 @@
 
 #include "penumbra/command/run_description.h"
 #include "penumbra/control/joint_controller.h"
-#include "penumbra/control/trot_gait.h"
+#include "penumbra/control/twist_command.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
 
@@ -136,10 +136,11 @@ const CommandDispatcher::Target& CommandDispatcher::FindTarget(RequestReader& rd
   if (accepting.empty())
     throw CommandError(
         command_code::kNotAvailable, "",
-        fmt::format("no controller of this world accepts '{}' (it needs a robot "
-                    "with a {} controller)",
-                    command,
-                    command == "joint_targets" ? "joint_pd" : "trot_gait or waypoint_follower"));
+        fmt::format(
+            "no controller of this world accepts '{}' (it needs a robot "
+            "with a {} controller)",
+            command,
+            command == "joint_targets" ? "joint_pd" : "trot_gait, policy or waypoint_follower"));
   const std::string robot = rd.String("robot", "");
   if (robot.empty()) {
     if (accepting.size() > 1)
@@ -261,11 +262,11 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     }
     queue([t, clear, vx, vy, yaw_rate](Simulation& sim) {
       Controller& c = sim.mutable_controller(t.index);
-      if (auto* gait = dynamic_cast<TrotGait*>(&c)) {
+      if (auto* legged = dynamic_cast<TwistCommandable*>(&c)) {
         if (clear)
-          gait->ClearCommand();
+          legged->ClearCommand();
         else
-          gait->SetCommand(TrotCommand{vx, vy, yaw_rate});
+          legged->SetCommand(TrotCommand{vx, vy, yaw_rate});
       } else if (auto* wf = dynamic_cast<WaypointFollower*>(&c)) {
         if (clear)
           wf->ClearTwist();
@@ -324,8 +325,8 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
     const bool loop = rd.Bool("loop", false);
     queue([t, points = std::move(points), loop](Simulation& sim) {
       Controller& c = sim.mutable_controller(t.index);
-      if (auto* gait = dynamic_cast<TrotGait*>(&c))
-        gait->SetWaypoints(points, loop);
+      if (auto* legged = dynamic_cast<TwistCommandable*>(&c))
+        legged->SetWaypoints(points, loop);
       else if (auto* wf = dynamic_cast<WaypointFollower*>(&c))
         wf->SetWaypoints(points, loop);
       json r = StepTime(sim);
@@ -402,7 +403,7 @@ void CommandDispatcher::Handle(const std::string& cmd, RequestReader& rd, const 
       sim.ApplyMocapDrivers(ids);
       for (int i = 0; i < sim.num_controllers(); ++i) {
         Controller& c = sim.mutable_controller(i);
-        if (auto* gait = dynamic_cast<TrotGait*>(&c)) gait->ClearCommand();
+        if (auto* legged = dynamic_cast<TwistCommandable*>(&c)) legged->ClearCommand();
         if (auto* wf = dynamic_cast<WaypointFollower*>(&c)) wf->ClearTwist();
       }
       return StepTime(sim);

@@ -7,7 +7,8 @@
 namespace penumbra {
 
 std::vector<std::string> ControllerCommands(const std::string& type) {
-  if (type == "trot_gait" || type == "waypoint_follower") return {"twist", "waypoints"};
+  if (type == "trot_gait" || type == "policy" || type == "waypoint_follower")
+    return {"twist", "waypoints"};
   if (type == "joint_pd") return {"joint_targets"};
   return {};
 }

@@ -13,7 +13,8 @@
 namespace penumbra {
 
 /// the command names (docs/zmq-protocol.md) a controller of type `type` accepts: "twist" and
-/// "waypoints" for trot_gait and waypoint_follower, "joint_targets" for joint_pd, none else.
+/// "waypoints" for trot_gait, policy and waypoint_follower, "joint_targets" for joint_pd, none
+/// else.
 std::vector<std::string> ControllerCommands(const std::string& type);
 
 /// the robot a controller belongs to, from its context key "robots[NAME].controller"

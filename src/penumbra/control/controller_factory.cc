@@ -7,8 +7,9 @@
 #include "penumbra/control/diff_ik.h"
 #include "penumbra/control/joint_controller.h"
 #include "penumbra/control/keyframe_playback.h"
-#include "penumbra/control/trot_gait.h"
 #include "penumbra/control/multirotor_pid.h"
+#include "penumbra/control/policy_controller.h"
+#include "penumbra/control/trot_gait.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
 
@@ -32,6 +33,10 @@ const std::map<std::string, Maker>& Registry() {
       {"keyframe_playback",
        [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
          return std::make_unique<KeyframePlayback>(KeyframePlaybackParams::Parse(p, prefix), c);
+       }},
+      {"policy",
+       [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {
+         return std::make_unique<PolicyController>(PolicyParams::Parse(p, prefix), c);
        }},
       {"trot_gait",
        [](ControllerParams& p, const std::string& prefix, const ControllerContext& c) {

@@ -2,12 +2,13 @@
 // builds controllers from world-file `controller:` blocks.
 //
 // types (the `type:` key):
-//   diff_ik             differential inverse kinematics for arms (control/diff_ik.h)
-//   joint_pd            joint-space position / velocity / effort control (control/joint_controller.h)
-//   keyframe_playback   MJCF keys or CSV joint targets over time (control/keyframe_playback.h)
-//   multirotor_pid      cascaded multirotor flight controller (control/multirotor_pid.h)
-//   trot_gait           model-based trot gait for 12-DoF quadrupeds (control/trot_gait.h)
-//   waypoint_follower   differential-drive waypoint follower (control/waypoint_follower.h)
+//   diff_ik            differential inverse kinematics for arms (control/diff_ik.h)
+//   joint_pd           joint-space position / velocity / effort (control/joint_controller.h)
+//   keyframe_playback  MJCF keys or CSV joint targets over time (control/keyframe_playback.h)
+//   multirotor_pid     cascaded multirotor flight controller (control/multirotor_pid.h)
+//   policy             a learned ONNX policy on observation terms (control/policy_controller.h)
+//   trot_gait          model-based trot gait for 12-DoF quadrupeds (control/trot_gait.h)
+//   waypoint_follower  differential-drive waypoint follower (control/waypoint_follower.h)
 
 #include <memory>
 #include <string>

@@ -141,48 +141,14 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     }
   }
 
-  // commands: a list of {t, vx, vy, yaw_rate}, t strictly increasing
-  if (const YAML::Node* cmds = p.Raw("commands")) {
-    if (!cmds->IsSequence())
-      p.Fail("commands", "got " + Describe(*cmds) +
-                             "; expected a list of {t, vx, vy, yaw_rate} with increasing t");
-    for (size_t i = 0; i < cmds->size(); ++i) {
-      const std::string key = "commands[" + std::to_string(i) + "]";
-      const YAML::Node c = (*cmds)[i];
-      if (!c.IsMap()) p.Fail(key, "got " + Describe(c) + "; expected {t, vx, vy, yaw_rate}");
-      for (const auto& kv : c) {
-        const std::string k = kv.first.Scalar();
-        if (k != "t" && k != "vx" && k != "vy" && k != "yaw_rate")
-          p.Fail(key + "." + k, "unknown key; expected only t, vx, vy, yaw_rate");
-      }
-      if (!c["t"]) p.Fail(key + ".t", "missing; expected a time >= 0 (s)");
-      TimedTrotCommand tc;
-      tc.t_sec = NumberAt(p, c["t"], key + ".t", "a time >= 0 (s)");
-      if (tc.t_sec < 0) p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time >= 0 (s)");
-      if (!g.commands.empty() && tc.t_sec <= g.commands.back().t_sec)
-        p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time > the previous entry's");
-      if (c["vx"]) tc.command.vx = NumberAt(p, c["vx"], key + ".vx", "a speed (m/s)");
-      if (c["vy"]) tc.command.vy = NumberAt(p, c["vy"], key + ".vy", "a speed (m/s)");
-      if (c["yaw_rate"])
-        tc.command.yaw_rate = NumberAt(p, c["yaw_rate"], key + ".yaw_rate", "a rate (rad/s)");
-      g.commands.push_back(tc);
-    }
-  }
-
-  // waypoint mode: the route keys only make sense with waypoints
-  if (p.Has("waypoints")) {
-    g.waypoints = p.Points2("waypoints", 1);
-    g.loop = p.Bool("loop", true);
-    g.speed_m_s = p.Number("speed_m_s", 0.5, 0, kInf, true);
-    g.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 60, 0, kInf, true);
-    g.tolerance_m = p.Number("tolerance_m", 0.15, 0, kInf, true);
-  } else {
-    for (const char* k : {"loop", "speed_m_s", "max_yaw_rate_deg_s", "tolerance_m"})
-      if (p.Has(k))
-        p.Fail(k,
-               "only valid in waypoint mode; expected also `waypoints: [[x, y], ...]` "
-               "(world frame, m)");
-  }
+  // commands and waypoint route: the keys shared with the policy controller
+  TwistScriptParams script = TwistScriptParams::Parse(p);
+  g.commands = std::move(script.commands);
+  g.waypoints = std::move(script.waypoints);
+  g.loop = script.loop;
+  g.speed_m_s = script.speed_m_s;
+  g.max_yaw_rate_deg_s = script.max_yaw_rate_deg_s;
+  g.tolerance_m = script.tolerance_m;
 
   g.period_sec = p.Number("period_sec", 0.36, 0.05, 5, false);
   g.duty = p.Number("duty", 0.5, 0.3, 0.8);
@@ -233,7 +199,8 @@ void TrotGaitParams::ValidateOrThrow(const ControllerContext& c) const {
     for (int k = 0; k < 3; ++k) {
       if (l.signs[k] != 1 && l.signs[k] != -1)
         check.Fail(key + ".signs", "got " + std::to_string(l.signs[k]) + "; expected 1 or -1");
-      if (!std::isfinite(l.offsets_rad[k])) check.Fail(key + ".offsets_rad", "expected finite angles");
+      if (!std::isfinite(l.offsets_rad[k]))
+        check.Fail(key + ".offsets_rad", "expected finite angles");
       if (l.actuators[k].empty()) check.Fail(key + ".actuators", "expected 3 actuator names");
     }
   }
@@ -247,7 +214,8 @@ void TrotGaitParams::ValidateOrThrow(const ControllerContext& c) const {
       check.Fail("commands[" + std::to_string(i) + "]", "expected finite vx, vy, yaw_rate");
   }
   for (const Eigen::Vector2d& w : waypoints)
-    if (!w.allFinite()) check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
+    if (!w.allFinite())
+      check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
   if (!waypoints.empty()) {
     check.Positive("speed_m_s", speed_m_s);
     check.Positive("max_yaw_rate_deg_s", max_yaw_rate_deg_s);

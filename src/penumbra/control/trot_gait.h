@@ -122,27 +122,15 @@
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/quadruped_leg_kinematics.h"
 #include "penumbra/control/quadruped_stance_forces.h"
+#include "penumbra/control/twist_command.h"
 #include "penumbra/control/waypoint_route.h"
 
 namespace penumbra {
 
-/// a twist command in the robot's heading frame.
-struct TrotCommand {
-  double vx = 0;        ///< forward speed (m/s)
-  double vy = 0;        ///< leftward speed (m/s)
-  double yaw_rate = 0;  ///< rad/s, counter-clockwise seen from above
-};
-
-/// one scripted command, active from `t_sec` until the next entry.
-struct TimedTrotCommand {
-  double t_sec = 0;
-  TrotCommand command;
-};
-
 /// names and sign conventions of one leg (full model names).
 struct TrotLegConfig {
-  std::string hip, thigh, calf;                   ///< hinge joints
-  std::string foot;                               ///< site at the foot point
+  std::string hip, thigh, calf;          ///< hinge joints
+  std::string foot;                      ///< site at the foot point
   std::array<std::string, 3> actuators;  ///< motors or position/velocity servos (hip, thigh, calf)
   std::array<double, 3> signs = {1, 1, 1};        ///< +-1
   std::array<double, 3> offsets_rad = {0, 0, 0};  ///< q_canonical = sign q + offset
@@ -187,7 +175,7 @@ struct TrotGaitParams {
 };
 
 /// the trot gait controller (see the file comment).
-class TrotGait final : public Controller {
+class TrotGait final : public Controller, public TwistCommandable {
  public:
   /// @throws ConfigError if `params` are out of range.
   TrotGait(TrotGaitParams params, ControllerContext context);
@@ -210,14 +198,14 @@ class TrotGait final : public Controller {
   /// `command` replaces the waypoints and the scripted list until ClearCommand() (the
   /// route pauses meanwhile). call it from the thread that steps the simulation, between
   /// steps.
-  void SetCommand(const TrotCommand& command) { override_ = command; }
+  void SetCommand(const TrotCommand& command) override { override_ = command; }
   /// returns to the waypoints (if configured and not finished), else the script.
-  void ClearCommand() { override_.reset(); }
+  void ClearCommand() override { override_.reset(); }
   /// replaces the waypoints (world x, y, m; at least 1) with `loop` from the next update on
   /// (waypoint mode, also for a gait configured without waypoints) and clears a SetCommand
   /// override; speed, yaw-rate limit and tolerance stay. physics thread, between steps.
   /// @throws Error for an empty list or a non-finite coordinate.
-  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop);
+  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) override;
 
   const TrotGaitParams& params() const { return params_; }
   /// the command in force at the last update (set, from the waypoints or scripted).

@@ -304,7 +304,7 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
               throw ConfigError("", 0, s->key + ".robot",
                                 "the controller of robot '" + c.robot + "' (" + t.type +
                                     ") reports no tracking error; expected a robot driven by "
-                                    "waypoint_follower or trot_gait");
+                                    "waypoint_follower, trot_gait or policy");
             s->ranges.push_back({offset, static_cast<int>(t.labels.size())});
             for (const std::string& l : t.labels) cols.push_back(c.robot + "/" + l);
             found = true;

@@ -11,6 +11,7 @@
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
+#include "penumbra/control/policy_controller.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/environment/environment_model.h"
@@ -18,6 +19,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/static_terrain_ray_caster.h"
 
 namespace penumbra {
 namespace {
@@ -136,6 +138,15 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
       spdlog::warn("{}", *work);
   }
   if (options.build_renderer) renderer_ = MakeRenderer(scene_, world_.render);
+  // policies with a height scan cast rays onto the static scene (the terrain)
+  for (int i = 0; i < sim_->num_controllers(); ++i) {
+    auto* policy = dynamic_cast<PolicyController*>(&sim_->mutable_controller(i));
+    if (!policy || !policy->needs_terrain_ray_caster()) continue;
+    if (!terrain_)
+      terrain_ =
+          std::make_unique<StaticTerrainRayCaster>(scene_, sim_->Snapshot(), world_.render.backend);
+    policy->SetTerrainRayCaster(terrain_.get());
+  }
   timings_.scene_build_sec = SecondsSince(t0);
 }
 

@@ -15,7 +15,9 @@
 //                world file's lights, sky, cameras and materials (session/scene_assembly.h),
 //                agent geoms labelled and the effects engine built on it (EffectsStage::Bind);
 //                optionally the run's memory and work are checked (session/run_budget.h);
-//                then the renderer (render/renderer.h) is built for that scene.
+//                then the renderer (render/renderer.h) is built for that scene, and policy
+//                controllers with a height scan get the static scene's terrain ray caster
+//                (session/static_terrain_ray_caster.h).
 // a Session is then stepped and rendered by its user (app/runner.cc, app/bench.cc, ...); it
 // owns everything it built and is neither copied nor moved (what it hands out by reference
 // stays valid for its lifetime).
@@ -24,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/control/terrain_ray_caster.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
@@ -107,6 +110,8 @@ class Session {
  private:
   WorldConfig world_;
   std::unique_ptr<EffectsStage> effects_;
+  /// the height scans' ray caster (null without one); outlives sim_'s controllers that use it
+  std::unique_ptr<TerrainRayCaster> terrain_;
   std::unique_ptr<Simulation> sim_;
   SceneDescription scene_;
   std::unique_ptr<Renderer> renderer_;

@@ -240,7 +240,8 @@ class ViewerBridge : public RunBridge {
         if (cmd == "twist") teleop.push_back(robot);
         if (cmd == "waypoints") waypoint.push_back(robot);
       }
-      if (has_twist && c.value("type", "") == "trot_gait") teleop_vy = true;
+      if (has_twist && (c.value("type", "") == "trot_gait" || c.value("type", "") == "policy"))
+        teleop_vy = true;
       if (index >= 0 && index < sim.num_controllers()) {
         const Controller& ctl = sim.controller(index);
         // the control period: of the teleoperated controller, else of the first

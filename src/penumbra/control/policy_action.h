@@ -1,0 +1,58 @@
+#pragma once
+// how a learned policy's output becomes actuator commands (control/policy_controller.h).
+// world-file form (inside the policy controller block):
+//   action:
+//     type: joint_position   # joint_position | joint_velocity | joint_torque
+//     scale: 0.25            # one number or one per joint
+//     clip: 100              # > 0: the raw output is clamped to [-clip, clip] first (optional)
+//     kp: 20                 # N m/rad (N/m), one or per joint: PD through any actuator
+//     kd: 0.5                # N m s/rad (N s/m), one or per joint
+//     actuators: [FR_hip, ...]   # one per policy joint (default: the joint names)
+//
+// with a the raw output (clamped by clip) and j a policy joint:
+//   joint_position  q*_j = q_default,j + scale_j a_j (the offset is the default pose).
+//                   with kp: tau_j = kp_j (q*_j - q_j) - kd_j qdot_j at every physics step
+//                   (legged_gym's "P" control, its _compute_torques), applied through the
+//                   joint's actuator by its force law (control/actuator_drive.h: motors,
+//                   position or velocity servos). without kp: the actuators must be position
+//                   servos (MJCF <position>) and get ctrl = gear q*_j (the servo closes the
+//                   loop, as Isaac Lab's implicit actuators and mjlab's position actuators do).
+//   joint_velocity  qd*_j = scale_j a_j. with kd: tau_j = kd_j (qd*_j - qdot_j) through the
+//                   actuator; without: velocity servos (MJCF <velocity>), ctrl = gear qd*_j.
+//   joint_torque    tau_j = scale_j a_j through the actuator (kp, kd not allowed).
+// every ctrl is clamped to the actuator's forcerange / ctrlrange (control/actuator_drive.h).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/control/controller_params.h"
+
+namespace YAML {
+class Node;
+}
+
+namespace penumbra {
+
+/// what the policy's outputs are.
+enum class PolicyActionKind { kJointPosition, kJointVelocity, kJointTorque };
+
+/// the world-file name of an action kind ("joint_position", ...).
+const char* PolicyActionKindName(PolicyActionKind kind);
+
+/// the `action:` block (see the file comment).
+struct PolicyActionParams {
+  PolicyActionKind kind = PolicyActionKind::kJointPosition;
+  std::vector<double> scale = {1.0};   ///< 1 value or one per joint
+  std::optional<double> clip;          ///< > 0
+  std::vector<double> kp, kd;          ///< empty = servo actuators; else 1 value or per joint
+  std::vector<std::string> actuators;  ///< full names, one per joint; empty = joint names
+
+  /// overrides the fields present in the mapping `node` (key path `key`); actuator names get
+  /// `name_prefix`.
+  /// @throws ConfigError naming key.<field> for unknown fields and bad values.
+  void ParseOver(ControllerParams& params, const YAML::Node& node, const std::string& key,
+                 const std::string& name_prefix);
+};
+
+}  // namespace penumbra
