@@ -97,9 +97,13 @@ AutolimitsChange ApplyMujoco3Autolimits(const MjcfSource& src, std::vector<std::
        sec = sec->NextSiblingElement("actuator")) {
     for (XMLElement* a = sec->FirstChildElement(); a; a = a->NextSiblingElement()) {
       if (!IsActuatorTag(a->Name())) continue;
-      limit(a, false, nullptr, "ctrlrange", "ctrllimited", &change.actuator_ctrl);
+      // MuJoCo 2.2.2's schema: <adhesion> and <damper> are always ctrl-limited and have no
+      // ctrllimited; only <general> has actlimited (checked with mujoco-compile)
+      if (!Is(a, "adhesion") && !Is(a, "damper"))
+        limit(a, false, nullptr, "ctrlrange", "ctrllimited", &change.actuator_ctrl);
       limit(a, false, nullptr, "forcerange", "forcelimited", &change.actuator_force);
-      limit(a, false, nullptr, "actrange", "actlimited", &change.actuator_act);
+      if (Is(a, "general"))
+        limit(a, false, nullptr, "actrange", "actlimited", &change.actuator_act);
     }
   }
   if (change.total() == 0) return change;

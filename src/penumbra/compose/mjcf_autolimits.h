@@ -29,7 +29,9 @@ struct AutolimitsChange {
 /// for an MJCF model whose <compiler> does not set autolimits (MuJoCo 3 then defaults it to
 /// "true"): writes limited="true" on every joint and tendon (spatial, fixed) that has a range
 /// and no limited, and ctrllimited / forcelimited / actlimited="true" on every actuator that
-/// has a ctrlrange / forcerange / actrange without them, each range or limited written on the
+/// has a ctrlrange / forcerange / actrange without them (ctrllimited not on <adhesion> and
+/// <damper>, actlimited only on <general>: MuJoCo 2.2.2 has those attributes only there),
+/// each range or limited written on the
 /// element or inherited from its default class (class=, else the enclosing body's
 /// childclass, then the class's parents; actuator defaults of any actuator tag share one slot
 /// per class, the last written winning, as MuJoCo's parser does). a limited="auto" counts as
