@@ -528,9 +528,13 @@ TEST(RunOutputsMeshes, ForceReplacesARunWhoseWorldHasAMeshModel) {
   EXPECT_TRUE(fs::exists(out / "run.json"));
   // the same with a relative --out (the mesh model's MJCF named its .msh files relative to
   // the working folder, which MuJoCo looked for relative to the MJCF: "not found")
-  r = RunPenumbra({"run", world, "--out", "rel", "-q"}, tmp.path());
+  // (the child runs in this process's working folder: a relative path from there)
+  const std::string rel = fs::relative(tmp.path() / "rel", fs::current_path()).string();
+  ASSERT_FALSE(fs::path(rel).is_absolute());
+  r = RunPenumbra({"run", world, "--out", rel, "-q"}, tmp.path());
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  r = RunPenumbra({"run", world, "--out", "rel", "-q", "--force"}, tmp.path());
+  EXPECT_TRUE(fs::exists(tmp.path() / "rel" / "run.json"));
+  r = RunPenumbra({"run", world, "--out", rel, "-q", "--force"}, tmp.path());
   EXPECT_EQ(r.exit_code, 0) << r.err;
   // a file of another name in meshes/ is still not Penumbra's
   tmp.Write("out/meshes/mine.xml", "<mujoco/>");
