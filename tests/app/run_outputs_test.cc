@@ -490,3 +490,58 @@ TEST_F(RunOutputsTest, DivergenceRecordsTheSimTimeReached) {
 
 }  // namespace
 }  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// issue 38: a world with a mesh model writes meshes/<stem>-<hash>.msh and .xml beside
+// composed.xml; running it again into the same folder with --force replaces that run (it
+// refused them as "files Penumbra did not write")
+TEST(RunOutputsMeshes, ForceReplacesARunWhoseWorldHasAMeshModel) {
+  testing::TempDir tmp;
+  tmp.Write("cube.obj",
+            "v -0.1 0 -0.1\nv 0.1 0 -0.1\nv 0.1 0.2 -0.1\nv -0.1 0.2 -0.1\n"
+            "v -0.1 0 0.1\nv 0.1 0 0.1\nv 0.1 0.2 0.1\nv -0.1 0.2 0.1\n"
+            "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+            "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+  tmp.Write("floor.xml",
+            "<mujoco><worldbody><geom name=\"ground\" type=\"plane\" size=\"0 0 0.05\"/>"
+            "</worldbody></mujoco>\n");
+  const std::string world = tmp.Write("world.yaml",
+                                      "duration_sec: 0.02\n"
+                                      "models:\n"
+                                      "  - {name: floor, file: floor.xml}\n"
+                                      "  - {name: crate, file: cube.obj}\n");
+  const fs::path out = tmp.path() / "out";
+  ProcessResult r = RunPenumbra({"run", world, "--out", out.string(), "-q"}, tmp.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int msh = 0, xml = 0;
+  for (const auto& e : fs::directory_iterator(out / "meshes")) {
+    msh += e.path().extension() == ".msh";
+    xml += e.path().extension() == ".xml";
+  }
+  ASSERT_GE(msh, 1);
+  ASSERT_GE(xml, 1);
+  r = RunPenumbra({"run", world, "--out", out.string(), "-q", "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("did not write"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(out / "run.json"));
+  // the same with a relative --out (the mesh model's MJCF named its .msh files relative to
+  // the working folder, which MuJoCo looked for relative to the MJCF: "not found")
+  // (the child runs in this process's working folder: a relative path from there)
+  const std::string rel = fs::relative(tmp.path() / "rel", fs::current_path()).string();
+  ASSERT_FALSE(fs::path(rel).is_absolute());
+  r = RunPenumbra({"run", world, "--out", rel, "-q"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(tmp.path() / "rel" / "run.json"));
+  r = RunPenumbra({"run", world, "--out", rel, "-q", "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // a file of another name in meshes/ is still not Penumbra's
+  tmp.Write("out/meshes/mine.xml", "<mujoco/>");
+  r = RunPenumbra({"run", world, "--out", out.string(), "-q", "--force"}, tmp.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("'meshes/mine.xml'"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace penumbra

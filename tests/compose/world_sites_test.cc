@@ -4,6 +4,7 @@
 #include <mujoco/mujoco.h>
 
 #include <string>
+#include <vector>
 
 #include "common/temp_dir.h"
 #include "penumbra/compose/scene_composer.h"
@@ -93,6 +94,76 @@ TEST(WorldSites, BadNamesAreErrorsNamingTheKey) {
   EXPECT_EQ(key, "robots[0].sites[1].name");
   std::tie(key, what) = error(Site("ok", "link", "", {0, 0, 0}));
   EXPECT_EQ(key, "robots[0].sites[1].name");
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// geoms positioned through default classes in every way MJCF allows: a nested class
+// (Menagerie's Go2 feet), a body's childclass, a fromto set by a class, a geom's own pos over
+// its class's, a class of the second model (composed classes are prefixed)
+const char* kDefaultsModel =
+    "<mujoco>\n"
+    "  <default>\n"
+    "    <default class=\"collision\">\n"
+    "      <geom group=\"3\"/>\n"
+    "      <default class=\"foot\"><geom type=\"sphere\" size=\"0.02\" pos=\"-0.002 0 -0.213\"/>"
+    "</default>\n"
+    "      <default class=\"rod\"><geom type=\"capsule\" size=\"0.01\" "
+    "fromto=\"0 0 0 0.2 0 0.1\"/></default>\n"
+    "    </default>\n"
+    "    <default class=\"limb\"><geom type=\"box\" size=\"0.01 0.01 0.01\" pos=\"0 0.05 0\"/>"
+    "</default>\n"
+    "  </default>\n"
+    "  <worldbody><body name=\"calf\" pos=\"0 0 1\" euler=\"0 30 0\" childclass=\"limb\">\n"
+    "    <joint name=\"knee\" type=\"hinge\"/>\n"
+    "    <geom name=\"FR\" class=\"foot\"/>\n"
+    "    <geom name=\"shin\"/>\n"
+    "    <geom name=\"rod\" class=\"rod\"/>\n"
+    "    <geom name=\"own\" class=\"foot\" pos=\"0.01 0 -0.1\"/>\n"
+    "  </body></worldbody>\n"
+    "</mujoco>\n";
+
+TEST(WorldSites, GeomCentresComeFromDefaultClassesAsMujocoCompilesThem) {
+  penumbra::testing::TempDir dir;
+  const std::string file = dir.Write("dog.xml", kDefaultsModel);
+  std::vector<ModelConfig> models;
+  for (const char* name : {"a", "b"}) {
+    ModelConfig m;
+    m.name = name;
+    m.file = file;
+    m.key = std::string("robots[") + name + "]";
+    m.pose.xyz = Eigen::Vector3d(name[0] == 'a' ? 0 : 2, 0, 0);
+    for (const char* g : {"FR", "shin", "rod", "own"})
+      m.sites.push_back(Site(std::string(g) + "_site", "", g, {0, 0, 0}));
+    models.push_back(m);
+  }
+  const ComposedScene s = ComposeWorld(models, {});
+  const std::string path = dir.Write("composed.xml", s.Xml());
+  char error[1000] = "";
+  mjModel* model = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
+  ASSERT_NE(model, nullptr) << error;
+  mjData* d = mj_makeData(model);
+  mj_forward(model, d);
+  for (const char* m : {"a/", "b/"}) {
+    for (const char* g : {"FR", "shin", "rod", "own"}) {
+      const int geom = mj_name2id(model, mjOBJ_GEOM, (std::string(m) + g).c_str());
+      const int site = mj_name2id(model, mjOBJ_SITE, (std::string(m) + g + "_site").c_str());
+      ASSERT_GE(geom, 0) << m << g;
+      ASSERT_GE(site, 0) << m << g;
+      // the site sits where MuJoCo compiled the geom (primitive geoms: the centre)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(d->site_xpos[3 * site + k], d->geom_xpos[3 * geom + k], 1e-9) << m << g;
+    }
+  }
+  // and the foot is not on the knee axis (what reading only the geom's own pos gave)
+  const int foot = mj_name2id(model, mjOBJ_SITE, "a/FR_site");
+  EXPECT_NEAR(model->site_pos[3 * foot + 2], -0.213, 1e-12);
+  mj_deleteData(d);
+  mj_deleteModel(model);
 }
 
 }  // namespace

@@ -168,10 +168,199 @@ TEST(ForeignRobotWorld, ServoArmWithoutATcpSiteMovesWithDiffIkFromTheWorldFile) 
   while (sim.time() < 4.0 - 1e-9) sim.Step();
   const Eigen::Vector3d end = tcp();
   const Eigen::Vector3d target(0.45, 0.15, 0.35);
-  std::printf("[ measured ] TCP from (%.3f, %.3f, %.3f) to (%.4f, %.4f, %.4f), error %.4f m\n",
+  std::printf("[ measured ] TCP from (%.3f, %.3f, %.3f) to (%.4f, %.4f, %.4f), error %.3e m\n",
               start.x(), start.y(), start.z(), end.x(), end.y(), end.z(), (end - target).norm());
   EXPECT_GT((start - target).norm(), 0.1);
   EXPECT_LT((end - target).norm(), 0.01);
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// a stand-in of Menagerie's Go2 structure: the bundled quadruped with its foot sites and
+// touch sensors removed, foot geoms named FR, FL, RR, RL with no pos of their own, positioned
+// by a nested default class (<default class="collision"><default class="foot"><geom pos=...>),
+// as unitree_go2/go2.xml writes them
+std::string Go2StyleQuadruped() {
+  std::ifstream f(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/models/quadruped.xml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  std::string xml = ss.str();
+  xml = std::regex_replace(xml, std::regex("<site name=\"(FR|FL|RR|RL)_foot\"[^>]*/>"), "");
+  xml = std::regex_replace(xml, std::regex("<touch name=\"(FR|FL|RR|RL)_foot_touch\"[^>]*/>"), "");
+  xml = std::regex_replace(
+      xml,
+      std::regex("<geom name=\"(FR|FL|RR|RL)_foot\" class=\"go1_foot\" size=\"0.02\" "
+                 "pos=\"0 0 -0.213\"/>"),
+      "<geom name=\"$1\" class=\"foot\"/>");
+  xml = std::regex_replace(
+      xml, std::regex("<default class=\"go1_collision\">\\s*<geom group=\"0\"/>\\s*</default>"),
+      "<default class=\"go1_collision\"><geom group=\"0\"/>"
+      "<default class=\"foot\"><geom type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.213\" "
+      "material=\"rubber\" friction=\"0.8 0.02 0.01\" priority=\"1\" solref=\"0.01 1\"/>"
+      "</default></default>");
+  EXPECT_NE(xml.find("<geom name=\"RL\" class=\"foot\"/>"), std::string::npos);
+  EXPECT_NE(xml.find("<default class=\"foot\">"), std::string::npos);
+  EXPECT_EQ(xml.find("pos=\"0 0 -0.213\" size=\"0.025\""), std::string::npos);
+  return xml;
+}
+
+// issue 38: the documented Go2 walkthrough (sites at the foot geoms) on a model whose foot
+// geoms get their pos from a default class: the sites land at the foot centres (0.213 m
+// below the knee axis, not on it) and trot_gait walks
+TEST(ForeignRobotWorld, Go2StyleFootGeomsPositionedByADefaultClassGiveFootSitesThatWalk) {
+  penumbra::testing::TempDir dir;
+  dir.Write("floor.xml",
+            "<mujoco><worldbody><geom name=\"ground\" type=\"plane\" size=\"0 0 0.05\"/>"
+            "</worldbody></mujoco>\n");
+  dir.Write("go2/go2.xml", Go2StyleQuadruped());
+  std::string legs;
+  for (const char* l : {"FR", "FL", "RR", "RL"}) {
+    const std::string s = l;
+    legs += "        " + s + ": {hip: " + s + "_hip, thigh: " + s + "_thigh, calf: " + s +
+            "_calf, foot: " + s + "_tip}\n";
+  }
+  const std::string world = dir.Write("world.yaml",
+                                      "duration_sec: 3\n"
+                                      "models:\n"
+                                      "  - {name: floor, file: floor.xml}\n"
+                                      "robots:\n"
+                                      "  - name: dog\n"
+                                      "    file: go2/go2.xml\n"
+                                      "    initial_keyframe: stand\n"
+                                      "    sites:\n"
+                                      "      - {name: FR_tip, geom: FR}\n"
+                                      "      - {name: FL_tip, geom: FL}\n"
+                                      "      - {name: RR_tip, geom: RR}\n"
+                                      "      - {name: RL_tip, geom: RL}\n"
+                                      "    controller:\n"
+                                      "      type: trot_gait\n"
+                                      "      base_body: trunk\n"
+                                      "      legs:\n" +
+                                          legs + "      commands: [{t: 0, vx: 0.5}]\n");
+  SessionOptions options;
+  options.build_renderer = false;
+  Session session(LoadWorldFile(world), options);
+  Simulation& sim = session.sim();
+  const ModelInfo& info = sim.model_info();
+  for (const char* l : {"FR", "FL", "RR", "RL"}) {
+    const int site = info.Find(ModelObject::kSite, std::string("dog/") + l + "_tip");
+    ASSERT_GE(site, 0) << l;
+    EXPECT_EQ(info.body_names[info.site_body[site]], std::string("dog/") + l + "_calf");
+    EXPECT_NEAR(info.site_X_BS[site].translation().z(), -0.213, 1e-12) << l;
+    EXPECT_NEAR(info.site_X_BS[site].translation().head<2>().norm(), 0, 1e-12) << l;
+  }
+  const auto& names = info.body_names;
+  const int trunk =
+      static_cast<int>(std::find(names.begin(), names.end(), "dog/trunk") - names.begin());
+  ASSERT_LT(trunk, static_cast<int>(names.size()));
+  const double x0 = sim.Snapshot().X_WB[trunk].translation().x();
+  while (sim.time() < 3.0 - 1e-9) sim.Step();
+  const Pose X = sim.Snapshot().X_WB[trunk];
+  const double dx = X.translation().x() - x0;
+  std::printf("[ measured ] Go2-style foot geoms (pos from a default class): %.3f m in 3 s\n", dx);
+  EXPECT_GT(dx, 1.1);
+  EXPECT_GT(X.linear()(2, 2), 0.95);
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+// the bundled quadruped with every knee joint turned round (axis 0 -1 0, so its angles are
+// the negatives of the Unitree convention's: ref +1.8, range [0.888, 2.818]); same rest pose
+std::string InvertedKneeQuadruped() {
+  std::ifstream f(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/models/quadruped.xml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  std::string xml = ss.str();
+  xml = std::regex_replace(
+      xml, std::regex("<joint name=\"(FR|FL|RR|RL)_calf\" class=\"go1_calf\" ref=\"-1.8\"/>"),
+      "<joint name=\"$1_calf\" class=\"go1_calf\" axis=\"0 -1 0\" range=\"0.888 2.818\" "
+      "ref=\"1.8\"/>");
+  xml = std::regex_replace(xml, std::regex("<key name=\"stand\"[^>]*/>"), "");
+  EXPECT_NE(xml.find("<joint name=\"RL_calf\" class=\"go1_calf\" axis=\"0 -1 0\""),
+            std::string::npos);
+  return xml;
+}
+
+std::string InvertedKneeWorld(const std::string& signs) {
+  std::string legs;
+  for (const char* l : {"FR", "FL", "RR", "RL"}) {
+    const std::string s = l;
+    legs += "        " + s + ": {hip: " + s + "_hip, thigh: " + s + "_thigh, calf: " + s +
+            "_calf, foot: " + s + "_foot" + signs + "}\n";
+  }
+  return "duration_sec: 3\n"
+         "models:\n"
+         "  - {name: floor, file: floor.xml}\n"
+         "robots:\n"
+         "  - name: dog\n"
+         "    file: dog.xml\n"
+         "    controller:\n"
+         "      type: trot_gait\n"
+         "      base_body: trunk\n"
+         "      legs:\n" +
+         legs + "      commands: [{t: 0, vx: 0.5}]\n";
+}
+
+// issue 38: a quadruped whose knee joints turn the other way than trot_gait's convention,
+// run without `signs`, gets a warning at start-up naming the knee joints and the setting;
+// with the setting it names, no warning and it walks
+TEST(ForeignRobotWorld, InvertedKneeSignsAreWarnedAtStartWithTheSettingThatFixesThem) {
+  penumbra::testing::TempDir dir;
+  dir.Write("floor.xml",
+            "<mujoco><worldbody><geom name=\"ground\" type=\"plane\" size=\"0 0 0.05\"/>"
+            "</worldbody></mujoco>\n");
+  dir.Write("dog.xml", InvertedKneeQuadruped());
+  SessionOptions options;
+  options.build_renderer = false;
+  {
+    Session session(LoadWorldFile(dir.Write("world.yaml", InvertedKneeWorld(""))), options);
+    Simulation& sim = session.sim();
+    sim.RunDueControllers();  // the first update: the start-pose check
+    std::string all;
+    for (const std::string& w : sim.TakeWarnings()) all += w + "\n";
+    for (const char* l : {"FR", "FL", "RR", "RL"}) {
+      const std::string leg = l;
+      EXPECT_NE(all.find("legs." + leg + ": joint(s) 'dog/" + leg +
+                         "_calf' move the foot opposite to trot_gait's leg convention"),
+                std::string::npos)
+          << all;
+      EXPECT_NE(all.find("set legs." + leg + ".signs: [1, 1, -1] (now [1, 1, 1])"),
+                std::string::npos)
+          << all;
+      EXPECT_NE(all.find("legs." + leg + ": in the start pose the knee 'dog/" + leg + "_calf'"),
+                std::string::npos)
+          << all;
+    }
+    EXPECT_EQ(all.find("_hip'"), std::string::npos) << all;
+    EXPECT_EQ(all.find("_thigh'"), std::string::npos) << all;
+  }
+  Session session(LoadWorldFile(dir.Write("world2.yaml", InvertedKneeWorld(", signs: [1, 1, -1]"))),
+                  options);
+  Simulation& sim = session.sim();
+  const auto& names = sim.model_info().body_names;
+  const int trunk =
+      static_cast<int>(std::find(names.begin(), names.end(), "dog/trunk") - names.begin());
+  ASSERT_LT(trunk, static_cast<int>(names.size()));
+  const double x0 = sim.Snapshot().X_WB[trunk].translation().x();
+  std::string all;
+  while (sim.time() < 3.0 - 1e-9) {
+    sim.Step();
+    for (const std::string& w : sim.TakeWarnings()) all += w + "\n";
+  }
+  EXPECT_EQ(all.find("trot_gait"), std::string::npos) << all;
+  const Pose X = sim.Snapshot().X_WB[trunk];
+  std::printf("[ measured ] inverted knees with signs [1, 1, -1]: %.3f m in 3 s\n",
+              X.translation().x() - x0);
+  EXPECT_GT(X.translation().x() - x0, 1.1);
+  EXPECT_GT(X.linear()(2, 2), 0.95);
 }
 
 }  // namespace

@@ -17,9 +17,11 @@ TEST(ModelLoadError, NamesTheModelFileAndLineOfTheElementMujocoRejected) {
             "<mujoco>\n  <worldbody>\n"
             "    <geom name=\"ground\" type=\"plane\" size=\"5 5 0.1\"/>\n"
             "  </worldbody>\n</mujoco>\n");
-  // a compiler error (range without limited), reported by MuJoCo as "line = N"
+  // a compiler error (range without limited, with autolimits explicitly off, which the
+  // MuJoCo-3 defaults layer leaves to MuJoCo), reported by MuJoCo as "line = N"
   const std::string robot = dir.Write("robot.xml",
                                       "<mujoco>\n"
+                                      "  <compiler autolimits=\"false\"/>\n"
                                       "  <worldbody>\n"
                                       "    <body name=\"base\" pos=\"0 0 1\">\n"
                                       "      <geom size=\"0.1\"/>\n"
@@ -40,7 +42,7 @@ TEST(ModelLoadError, NamesTheModelFileAndLineOfTheElementMujocoRejected) {
     ADD_FAILURE() << "MuJoCo loaded a joint with range but no limited";
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.file(), robot) << e.what();
-    EXPECT_EQ(e.line(), 5) << e.what();
+    EXPECT_EQ(e.line(), 6) << e.what();
     EXPECT_NE(std::string(e.what()).find("has `range` but not `limited`"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("composed.xml line "), std::string::npos) << e.what();

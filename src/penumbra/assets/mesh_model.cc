@@ -197,6 +197,10 @@ std::vector<ImportedModel> ImportMeshModels(std::vector<ModelConfig>* models,
   std::vector<ImportedModel> out;
   fs::path folder =
       dir.empty() ? fs::temp_directory_path() / "penumbra-mesh-models" : fs::path(dir);
+  // absolute: the generated MJCF names its .msh files by these paths, which MuJoCo resolves
+  // against the MJCF's own folder (a relative --out gave "out/meshes/out/meshes/x.msh")
+  std::error_code abs_ec;
+  if (const fs::path a = fs::absolute(folder, abs_ec); !abs_ec) folder = a;
   bool made = false;
   for (size_t i = 0; i < models->size(); ++i) {
     ModelConfig& m = (*models)[i];

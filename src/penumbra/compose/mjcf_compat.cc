@@ -122,7 +122,14 @@ const std::vector<ElementHint>& ElementHints() {
 
 std::string Where(const Origin& o) { return o.file + ":" + std::to_string(o.line); }
 
-void Visit(const MjcfSource& src, XMLElement* e, std::vector<std::string>* warnings) {
+// a keyword without a faithful 2.2.2 form: reported all together after the walk
+struct Rejection {
+  const XMLElement* element;
+  std::string key, problem;
+};
+
+void Visit(const MjcfSource& src, XMLElement* e, std::vector<std::string>* warnings,
+           std::vector<Rejection>* rejections) {
   const std::string tag = e->Name();
   for (const Rule& r : Rules()) {
     if (tag != r.tag) continue;
@@ -143,17 +150,20 @@ void Visit(const MjcfSource& src, XMLElement* e, std::vector<std::string>* warni
         e->DeleteAttribute(r.attr);
         break;
       case Action::kReject:
-        src.Fail(e, key,
-                 std::string("'") + r.attr + "' is newer than MuJoCo 2.2.2 (Penumbra's physics); " +
-                     r.text);
+        rejections->push_back({e, key,
+                               std::string("'") + r.attr +
+                                   "' is newer than MuJoCo 2.2.2 (Penumbra's physics); " + r.text});
+        break;
       case Action::kLightType: {
         const std::string type = v;
         if (type != "directional" && type != "spot") {
-          src.Fail(e, key,
-                   "light type '" + type +
-                       "' is newer than MuJoCo 2.2.2, which has spot and directional lights; "
-                       "expected type=\"spot\" or \"directional\" (2.2.2: directional=\"false\" "
-                       "or \"true\")");
+          rejections->push_back(
+              {e, key,
+               "light type '" + type +
+                   "' is newer than MuJoCo 2.2.2, which has spot and directional lights; "
+                   "expected type=\"spot\" or \"directional\" (2.2.2: directional=\"false\" "
+                   "or \"true\")"});
+          break;
         }
         const char* directional = type == "directional" ? "true" : "false";
         warnings->push_back(Where(src.Where(e)) + ": " + what +
@@ -166,7 +176,7 @@ void Visit(const MjcfSource& src, XMLElement* e, std::vector<std::string>* warni
     }
   }
   for (XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
-    Visit(src, c, warnings);
+    Visit(src, c, warnings, rejections);
   }
 }
 
@@ -174,7 +184,22 @@ void Visit(const MjcfSource& src, XMLElement* e, std::vector<std::string>* warni
 
 void DowngradeMjcf3(const MjcfSource& src, std::vector<std::string>* warnings) {
   if (src.root() == nullptr) return;
-  Visit(src, src.root(), warnings);
+  std::vector<Rejection> rejections;
+  Visit(src, src.root(), warnings, &rejections);
+  if (rejections.empty()) return;
+  // all of them in one error: the first names the file, line and key; the others follow
+  std::string problem = rejections[0].problem;
+  if (rejections.size() > 1) {
+    problem = "(1 of " + std::to_string(rejections.size()) +
+              " keywords newer than MuJoCo 2.2.2 in this model) " + problem;
+    for (size_t i = 1; i < rejections.size(); ++i) {
+      const Rejection& r = rejections[i];
+      // the other ones by place and keyword (the first's advice applies to its repeats)
+      problem += "; (" + std::to_string(i + 1) + ") " + Where(src.Where(r.element)) + ": " + r.key +
+                 (r.key == rejections[0].key ? "" : ": " + r.problem);
+    }
+  }
+  src.Fail(rejections[0].element, rejections[0].key, problem);
 }
 
 std::optional<std::string> NewerElementHint(const std::string& tag) {

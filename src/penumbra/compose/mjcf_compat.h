@@ -22,7 +22,10 @@ namespace penumbra::compose {
 /// `directional`; one warning line each is appended to `warnings`.
 /// @throws ConfigError(file, line, "<element>.<attribute>", ...) for keywords without a
 ///         faithful 2.2.2 form (position kv / dampratio / inheritrange, body gravcomp,
-///         joint actuatorfrcrange, ...), saying what to write instead.
+///         joint actuatorfrcrange, ...), saying what to write instead: ONE error for all of
+///         them, naming the first (its file, line and key) and then every other one by file,
+///         line and key ("(2) spot.xml:40: position.kv; (3) ..."), so that a model with
+///         several is fixed in one pass.
 void DowngradeMjcf3(const MjcfSource& src, std::vector<std::string>* warnings);
 
 /// a hint for an MJCF element that MuJoCo 2.2.2 does not have but a newer MuJoCo does

@@ -39,6 +39,13 @@ class DefaultTree {
   /// class on the path cls -> root that sets it; nullptr if none does.
   const char* Lookup(int cls, const char* tag, const char* attr) const;
 
+  /// parent class of class `cls` (-1 for the root).
+  int Parent(int cls) const { return classes_[cls].parent; }
+  /// the <default> elements that make up class `cls` (in document order).
+  const std::vector<tinyxml2::XMLElement*>& Sections(int cls) const {
+    return classes_[cls].sections;
+  }
+
   /// true if the actuator default slot of class `cls` ends with activation dynamics
   /// (MJCF shares one actuator default among general/motor/...: the last one written
   /// sets dyntype; general sets it only with an explicit dyntype=).

@@ -5,6 +5,7 @@
 #include <functional>
 #include <set>
 
+#include "penumbra/compose/mjcf_autolimits.h"
 #include "penumbra/compose/mjcf_compat.h"
 #include "penumbra/compose/mjcf_text.h"
 #include "penumbra/core/error.h"
@@ -94,6 +95,7 @@ ModelComposer::ModelComposer(const ModelConfig& config,
     : config_(config), prefix_(config.name + "/") {
   src_ = MjcfSource::Load(config.file, urdf_to_mjcf);
   DowngradeMjcf3(*src_, &compat_warnings_);
+  ApplyMujoco3Autolimits(*src_, &compat_warnings_);
   if (config.floating_base) AddFloatingBase();
   X_WM_ = config.pose.ToPose();
   q_WM_ = Eigen::Quaterniond(X_WM_.linear()).normalized();

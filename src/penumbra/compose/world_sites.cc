@@ -3,6 +3,7 @@
 #include <tinyxml2.h>
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -46,14 +47,60 @@ std::string Listing(const std::map<std::string, XMLElement*>& all, const std::st
   return out.empty() ? "none" : out;
 }
 
-Eigen::Vector3d GeomCentre(const XMLElement* geom) {
-  if (const char* fromto = geom->Attribute("fromto")) {
+// the composed document's default classes by name (class names are unique: each model's are
+// prefixed with its name)
+std::map<std::string, const XMLElement*> DefaultClasses(const XMLElement* root) {
+  std::map<std::string, const XMLElement*> out;
+  const std::function<void(const XMLElement*)> walk = [&](const XMLElement* d) {
+    if (const char* c = d->Attribute("class")) out.emplace(c, d);
+    for (const XMLElement* e = d->FirstChildElement("default"); e;
+         e = e->NextSiblingElement("default"))
+      walk(e);
+  };
+  for (const XMLElement* d = root->FirstChildElement("default"); d;
+       d = d->NextSiblingElement("default"))
+    walk(d);
+  return out;
+}
+
+// the value of `attr` that `geom` has, written on it or inherited from its default class as
+// MuJoCo resolves it: its class=, else the childclass of the nearest enclosing body, then that
+// class's ancestors (every element of the composed document has one of the two: the composer
+// gives top-level elements their model's root class); nullptr when none sets it
+const char* GeomAttribute(const XMLElement* geom, const char* attr,
+                          const std::map<std::string, const XMLElement*>& classes) {
+  if (const char* v = geom->Attribute(attr)) return v;
+  const char* cls = geom->Attribute("class");
+  for (const tinyxml2::XMLNode* n = geom->Parent(); cls == nullptr && n; n = n->Parent()) {
+    const XMLElement* p = n->ToElement();
+    if (p == nullptr || std::string(p->Name()) == "worldbody") break;
+    if (std::string(p->Name()) == "body") cls = p->Attribute("childclass");
+  }
+  if (cls == nullptr) return nullptr;
+  const auto it = classes.find(cls);
+  for (const XMLElement* d = it == classes.end() ? nullptr : it->second;
+       d && std::string(d->Name()) == "default";
+       d = d->Parent() ? d->Parent()->ToElement() : nullptr) {
+    // several <geom> defaults in one class: the last one written wins
+    const char* v = nullptr;
+    for (const XMLElement* g = d->FirstChildElement("geom"); g; g = g->NextSiblingElement("geom"))
+      if (const char* a = g->Attribute(attr)) v = a;
+    if (v) return v;
+  }
+  return nullptr;
+}
+
+// the geom's centre in its body's frame: the midpoint of its fromto (which MuJoCo uses over
+// pos), else its pos, each written on it or set by its default class; the origin when neither
+Eigen::Vector3d GeomCentre(const XMLElement* geom,
+                           const std::map<std::string, const XMLElement*>& classes) {
+  if (const char* fromto = GeomAttribute(geom, "fromto", classes)) {
     const auto v = ParseNumbers(fromto);
     if (v && v->size() == 6) {
       return 0.5 * Eigen::Vector3d((*v)[0] + (*v)[3], (*v)[1] + (*v)[4], (*v)[2] + (*v)[5]);
     }
   }
-  if (const char* pos = geom->Attribute("pos")) {
+  if (const char* pos = GeomAttribute(geom, "pos", classes)) {
     const auto v = ParseNumbers(pos);
     if (v && v->size() == 3) return Eigen::Vector3d((*v)[0], (*v)[1], (*v)[2]);
   }
@@ -70,6 +117,7 @@ void AddWorldSites(const std::vector<ModelConfig>& models, XMLElement* root) {
   if (world == nullptr) world = root->InsertNewChildElement("worldbody");
   Names names;
   Collect(world, &names);
+  const auto classes = DefaultClasses(root);
   for (const ModelConfig& m : models) {
     const std::string prefix = m.name + "/";
     const std::string entry = m.key.empty() ? "models[" + m.name + "]" : m.key;
@@ -93,7 +141,7 @@ void AddWorldSites(const std::vector<ModelConfig>& models, XMLElement* root) {
                   "'; expected one of its named geoms: " + Listing(names.geoms, prefix));
         }
         parent = it->second->Parent()->ToElement();
-        X_PS.translation() += GeomCentre(it->second);
+        X_PS.translation() += GeomCentre(it->second, classes);
       } else if (s.body == "world") {
         parent = world;
       } else {

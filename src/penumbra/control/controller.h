@@ -13,6 +13,7 @@
 
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "penumbra/control/control_input.h"
@@ -73,12 +74,21 @@ class Controller {
   /// "type (key)" for messages, e.g. "waypoint_follower (robots[rover].controller)".
   std::string label() const;
 
+  /// the warnings the controller raised since the last call (e.g. trot_gait's check of the
+  /// leg joints' signs at Initialize and of the start pose at its first update), emptied;
+  /// the simulation logs them (Simulation::TakeWarnings, prefixed with label()).
+  std::vector<std::string> TakeWarnings() { return std::exchange(warnings_, {}); }
+
  protected:
+  /// records a warning for TakeWarnings (one sentence, no trailing newline).
+  void Warn(std::string text) { warnings_.push_back(std::move(text)); }
+
   /// called by Initialize with ids[i] = model index of RequiredNames()[i] (all valid).
   virtual void OnInitialize(const ModelInfo& model, const std::vector<int>& ids) = 0;
 
  private:
   ControllerContext context_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace penumbra

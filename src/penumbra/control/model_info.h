@@ -27,6 +27,12 @@ struct JointInfo {
   int body = 0;      ///< body the joint moves
   bool limited = false;
   double range[2] = {0, 0};  ///< limits (m or rad) when limited
+  /// hinge / slide: the axis (unit) and the anchor point in the frame of `body` (MuJoCo
+  /// jnt_axis, jnt_pos), and the joint's value in the model's rest configuration (qpos0,
+  /// = the MJCF ref; rad or m): body_X_PB are the frames at these values.
+  Eigen::Vector3d axis_B = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d pos_B = Eigen::Vector3d::Zero();
+  double qpos0 = 0;
 };
 
 /// how an actuator turns its ctrl u into its scalar force f (MuJoCo's gain/bias model,

@@ -349,6 +349,39 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
       fail(key,
            "zero thigh or calf length; expected the calf body and the foot site away "
            "from the thigh and calf joint axes");
+    // start-up check of the signs: each joint's axis in the base frame at the model's rest
+    // configuration (from the model) against the canonical axis times its sign (hip about +x,
+    // thigh and calf about +y turned by the abduction angle); opposite directions mean the
+    // joint turns the other way, so the legs would push the wrong way
+    const std::array<Pose, 3> X_base_joint = {*X_base_hip, *X_base_hip * *X_hip_thigh,
+                                              *X_base_hip * *X_hip_thigh * *X_thigh_calf};
+    const double q_abduction = cfg.signs[0] * model.joints[joint[0]].qpos0 + cfg.offsets_rad[0];
+    const Eigen::Vector3d canonical_pitch =
+        Eigen::AngleAxisd(q_abduction, Eigen::Vector3d::UnitX()) * Eigen::Vector3d::UnitY();
+    const std::array<Eigen::Vector3d, 3> canonical = {Eigen::Vector3d::UnitX(), canonical_pitch,
+                                                      canonical_pitch};
+    std::array<double, 3> suggested = cfg.signs;
+    std::string inverted;
+    for (int j = 0; j < 3; ++j) {
+      const JointInfo& ji = model.joints[joint[j]];
+      const Eigen::Vector3d axis = X_base_joint[j].linear() * ji.axis_B.normalized();
+      if (axis.dot(cfg.signs[j] * canonical[j]) > -0.5) continue;
+      suggested[j] = -cfg.signs[j];
+      inverted += (inverted.empty() ? "'" : ", '") + ji.name + "'";
+    }
+    if (!inverted.empty()) {
+      const auto list = [](const std::array<double, 3>& v) {
+        return "[" + std::to_string(static_cast<int>(v[0])) + ", " +
+               std::to_string(static_cast<int>(v[1])) + ", " +
+               std::to_string(static_cast<int>(v[2])) + "]";
+      };
+      Warn(key + ": joint(s) " + inverted +
+           " move the foot opposite to trot_gait's leg convention at the model's rest pose "
+           "(hip abduction about +x, thigh and calf about +y, docs/robots/quadruped.md); the "
+           "legs will push the wrong way: set " +
+           key + ".signs: " + list(suggested) + " (now " + list(cfg.signs) +
+           "), and offsets_rad if their zero differs");
+    }
   }
   hold_.clear();
   for (const auto& [name, v] : params_.hold) hold_.emplace_back(ids[k++], v);
@@ -411,6 +444,33 @@ void TrotGait::FirstUpdate(const ControlInput& in, const Eigen::Vector3d& com,
     legs_[i].in_swing = false;
   }
   const Pose X = in.X_WB(base_);
+  // start-pose check: in the canonical convention a standing leg has its foot below the hip
+  // and its knee bent backwards (q_calf < 0); otherwise a sign or offset is wrong, or the knee
+  // bends forwards, which trot_gait's inverse kinematics (knee backwards) does not produce
+  const auto qpos = in.qpos();
+  for (int i = 0; i < 4; ++i) {
+    const TrotLegConfig& cfg = params_.legs[i];
+    const double q_calf = cfg.signs[2] * qpos[legs_[i].qpos[2]] + cfg.offsets_rad[2];
+    const Eigen::Vector3d foot_B = X.inverse() * feet[i];
+    const double below = hip_B_[i].z() - foot_B.z();
+    const double reach = geometry_[i].thigh_m + geometry_[i].calf_m;
+    const std::string key = std::string("legs.") + TrotGaitParams::kLegNames[i];
+    if (q_calf > 0.05) {
+      Warn(key + ": in the start pose the knee '" + cfg.calf + "' is at " + std::to_string(q_calf) +
+           " rad in trot_gait's convention, i.e. bent forwards; trot_gait bends knees "
+           "backwards (calf angle < 0): if the joint turns the other way set " +
+           key +
+           ".signs[2] (and offsets_rad[2] for another zero); a leg whose knee really bends "
+           "forwards is not supported and will stumble");
+    } else if (below < 0.25 * reach) {
+      Warn(key + ": in the start pose the foot '" + cfg.foot + "' is " + std::to_string(below) +
+           " m below the hip (expected about " + std::to_string(0.5 * reach) +
+           " m or more for a "
+           "standing leg of reach " +
+           std::to_string(reach) +
+           " m): check the leg's signs and offsets_rad, and the start pose (initial_keyframe)");
+    }
+  }
   psi_ref_ = std::atan2(X.linear()(1, 0), X.linear()(0, 0));
   p_ref_ = com.head<2>();
   reference_ = TrotCommand{};

@@ -44,7 +44,22 @@ bool IsScanFile(const std::string& name) {
   return std::all_of(name.begin() + 5, name.end() - 4, [](char c) { return c >= '0' && c <= '9'; });
 }
 
-enum class Kind { kTop, kCameraFolder, kImageFolder, kLidarFolder, kSensorFolder };
+// a content-named file of the `meshes` folder (core/output_file.h WriteContentNamedFile):
+// STEM-<16 hex digits>.stl / .msh / .xml / .hfield: STL meshes converted from a URDF's
+// COLLADA and other meshes, MuJoCo .msh meshes, the MJCF models of mesh models and their
+// collision height fields (assets/mesh_model.h, assets/mjcf_mesh_conversion.h)
+bool IsMeshFile(const std::string& name) {
+  const size_t dot = name.rfind('.');
+  if (dot == std::string::npos) return false;
+  const std::string ext = name.substr(dot);
+  if (ext != ".stl" && ext != ".msh" && ext != ".xml" && ext != ".hfield") return false;
+  if (dot < 18 || name[dot - 17] != '-') return false;
+  return std::all_of(name.begin() + static_cast<std::ptrdiff_t>(dot - 16),
+                     name.begin() + static_cast<std::ptrdiff_t>(dot),
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
+enum class Kind { kTop, kCameraFolder, kImageFolder, kLidarFolder, kSensorFolder, kMeshFolder };
 
 class Scanner {
  public:
@@ -71,6 +86,7 @@ class Scanner {
           if (file && EndsWith(name, ".plog")) continue;  // a run log (--record)
           if (dir_entry) {
             Folder(p, name == "lidar"              ? Kind::kLidarFolder
+                      : name == "meshes"           ? Kind::kMeshFolder
                       : kSensorFolders.count(name) ? Kind::kSensorFolder
                                                    : Kind::kCameraFolder);
             continue;
@@ -96,6 +112,9 @@ class Scanner {
             Folder(p, Kind::kLidarFolder);
             continue;
           }
+          break;
+        case Kind::kMeshFolder:
+          if (file && IsMeshFile(name)) continue;
           break;
         case Kind::kSensorFolder:
           if (file && EndsWith(name, ".csv")) continue;

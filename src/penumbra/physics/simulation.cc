@@ -165,6 +165,9 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     ji.limited = m->jnt_limited[j] != 0;
     ji.range[0] = m->jnt_range[2 * j];
     ji.range[1] = m->jnt_range[2 * j + 1];
+    ji.axis_B = Eigen::Vector3d(m->jnt_axis[3 * j], m->jnt_axis[3 * j + 1], m->jnt_axis[3 * j + 2]);
+    ji.pos_B = Eigen::Vector3d(m->jnt_pos[3 * j], m->jnt_pos[3 * j + 1], m->jnt_pos[3 * j + 2]);
+    ji.qpos0 = m->qpos0[m->jnt_qposadr[j]];
     info.joints.push_back(ji);
   }
   for (int a = 0; a < m->nu; ++a) {
@@ -261,6 +264,9 @@ struct Simulation::Impl {
   std::vector<std::unique_ptr<Controller>> controllers;
   std::vector<Schedule> schedule;
   std::vector<char> due;
+  // the step (steps) at which the due controllers already ran ahead of Step()
+  // (RunDueControllers); -1 = none
+  int64_t controllers_ran_at = -1;
   int64_t steps = 0;
   int seen_warnings[mjNWARNING] = {};
   int warning_messages[mjNWARNING] = {};
@@ -323,6 +329,18 @@ struct Simulation::Impl {
     throw PhysicsError(failure);
   }
 
+  // sets due[i] for the controllers due at time t; true if any is
+  bool MarkDue(double t) {
+    const double tol = 1e-6 * m->opt.timestep;
+    bool any = false;
+    for (size_t i = 0; i < controllers.size(); ++i) {
+      const Schedule& sc = schedule[i];
+      due[i] = sc.rate_hz <= 0 || t + tol >= static_cast<double>(sc.next) / sc.rate_hz;
+      any |= due[i] != 0;
+    }
+    return any;
+  }
+
   void RunControllers(double t, int64_t step) {
     MujocoControlInput input(m, d, &info, &jacp, &jacr);
     std::span<double> ctrl(d->ctrl, static_cast<size_t>(m->nu));
@@ -330,6 +348,8 @@ struct Simulation::Impl {
     for (size_t i = 0; i < controllers.size(); ++i) {
       if (!due[i]) continue;
       controllers[i]->Compute(input, ctrl);
+      for (std::string& w : controllers[i]->TakeWarnings())
+        warnings.push_back(controllers[i]->label() + ": " + w);
       if (AnyNonFinite(d->ctrl, m->nu)) {
         for (int a = 0; a < m->nu; ++a)
           if (!std::isfinite(d->ctrl[a]))
@@ -491,6 +511,8 @@ Simulation Simulation::LoadFromString(const std::string& mjcf_xml,
 void Simulation::AddController(std::unique_ptr<Controller> controller) {
   if (!controller) throw Error("Simulation::AddController: null controller");
   controller->Initialize(impl_->info);
+  for (std::string& w : controller->TakeWarnings())
+    impl_->warnings.push_back(controller->label() + ": " + w);
   const double rate = controller->rate_hz();
   if (!(std::isfinite(rate) && rate >= 0)) {
     const ControllerContext& c = controller->context();
@@ -536,14 +558,9 @@ void Simulation::Step() {
   mjData* d = s.d;
   const double t = d->time;
   const int64_t step = s.steps + 1;
-  const double tol = 1e-6 * m->opt.timestep;
-  bool any_due = false;
-  for (size_t i = 0; i < s.controllers.size(); ++i) {
-    const Impl::Schedule& sc = s.schedule[i];
-    const bool due = sc.rate_hz <= 0 || t + tol >= static_cast<double>(sc.next) / sc.rate_hz;
-    s.due[i] = due;
-    any_due |= due;
-  }
+  // controllers run ahead of the step (RunDueControllers) are not run again
+  const bool any_due = s.controllers_ran_at != s.steps && s.MarkDue(t);
+  s.controllers_ran_at = -1;
   try {
     if (any_due) {
       // position and velocity stages first, so controllers see a consistent state
@@ -688,6 +705,7 @@ void Simulation::SetState(const SimState& s) {
   for (size_t i = 0; i < impl.schedule.size(); ++i)
     impl.schedule[i].next = s.controller_next_update[i];
   impl.steps = s.step_count;
+  impl.controllers_ran_at = -1;
   impl.failed = false;
   impl.failure.clear();
 }
@@ -758,6 +776,26 @@ void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix
           m->key_mquat[static_cast<size_t>(k) * 4 * m->nmocap + 4 * mocap + i];
   }
   mj_forward(m, d);
+}
+
+void Simulation::RunDueControllers() {
+  Impl& s = *impl_;
+  if (s.failed) throw PhysicsError(s.failure + " (the simulation cannot continue)");
+  if (s.controllers_ran_at == s.steps) return;
+  const double t = s.d->time;
+  const int64_t step = s.steps + 1;
+  if (!s.MarkDue(t)) return;
+  try {
+    mj_step1(s.m, s.d);
+    s.RunControllers(t, step);
+  } catch (const MujocoError& e) {
+    s.Fail(t, step, std::string("MuJoCo error: ") + e.what());
+  } catch (const std::exception&) {
+    throw;
+  } catch (...) {
+    s.Fail(t, step, "MuJoCo error (reported while another model was being loaded)");
+  }
+  s.controllers_ran_at = s.steps;
 }
 
 double Simulation::time() const { return impl_->d->time; }

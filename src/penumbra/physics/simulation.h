@@ -112,6 +112,19 @@ class Simulation {
   ///         non-finite ctrl; message: "<model>: t = <time> s (step <n>): ... body '<name>' ...".
   void Step();
 
+  /// runs the controllers due at the current step now (MuJoCo's position and velocity stages,
+  /// then each due controller writes ctrl), as the next Step() would, so that a snapshot of
+  /// this instant already holds the ctrl the step from it applies: its accelerations and
+  /// acceleration sensors (an IMU's accelerometer) are those of the applied forces, not of
+  /// the ctrl before the first control update (a standing robot with ctrl 0 falls freely and
+  /// its IMU reads 0 instead of gravity). the next Step() does not run them again at this
+  /// step, so the trajectory is the same bit for bit. no-op when no controller is due or they
+  /// already ran at this step (session/physics_source.h calls it before the first snapshot of
+  /// a run; later snapshots hold the ctrl of the last update, so an update that falls on a
+  /// snapshot's step shows in the next one).
+  /// @throws PhysicsError as Step() does for a controller writing a non-finite ctrl.
+  void RunDueControllers();
+
   /// the current state (SimState: physics, step count, controller schedule).
   SimState GetState() const;
   /// restores a state taken with GetState from a Simulation of the same model with the same

@@ -347,6 +347,15 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
     live.ScheduleRecorded(e.step, change);
   }
 
+  // ctrl mode: the ctrl of the initial state as logged (the controllers' first update, which
+  // the recording run computed before its first snapshot: PhysicsSource)
+  if (!controllers) {
+    std::span<double> ctrl = sim.ctrl();
+    if (first.ctrl.size() != ctrl.size())
+      throw ConfigError(options.log_path, 0, "", "logged ctrl has another size than the model's");
+    std::copy(first.ctrl.begin(), first.ctrl.end(), ctrl.begin());
+  }
+
   // the pipeline: physics -> SimLoop -> the check (+ the metrics and run.json)
   LogCheck check(&reader, layout, controllers, options.log_path, std::move(first), &report);
   PhysicsSourceOptions physics_options;

@@ -21,10 +21,15 @@ std::shared_ptr<WorldSnapshot> TakeSnapshot(const Simulation& sim, SnapshotConte
 }
 
 std::shared_ptr<const WorldSnapshot> PhysicsSource::Snapshot(SnapshotContent content) {
+  // the first snapshot (the run's start, before any step of this source): the controllers due
+  // now run first, so that it holds the ctrl the first step applies and its sensors see it (a
+  // standing robot with no ctrl yet would fall freely: an IMU read 0 instead of gravity)
+  if (!advanced_) sim_->RunDueControllers();
   return TakeSnapshot(*sim_, content);
 }
 
 bool PhysicsSource::Advance() {
+  advanced_ = true;
   if (!wall0_) wall0_ = Clock::now();
   if (options_.realtime) {
     std::this_thread::sleep_until(*wall0_ + std::chrono::duration_cast<Clock::duration>(

@@ -44,6 +44,9 @@ class PhysicsSource : public Source {
   double time_sec() const override { return time_sec_; }
   /// kState: the state only (Simulation::SnapshotState: time, step, qpos, qvel, act, ctrl,
   /// ...); kPoses / kFull: Simulation::Snapshot's kPoses / kFull (which include the state).
+  /// before the first Advance, the controllers due at the start run first
+  /// (Simulation::RunDueControllers): the first snapshot holds the ctrl of the first step and
+  /// its sensors (an IMU) see those forces, not a robot with ctrl 0.
   std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override;
   /// one Simulation::Step (after the realtime wait and PhysicsSourceOptions::before_step);
   /// logs the simulation's warnings. true, or false when before_step returned false.
@@ -61,6 +64,7 @@ class PhysicsSource : public Source {
   double time_sec_ = 0;
   std::optional<Clock::time_point> wall0_;
   double busy_sec_ = 0;
+  bool advanced_ = false;  // Advance was called: the controllers have run at least once
 };
 
 }  // namespace penumbra
