@@ -93,7 +93,7 @@ TEST(AgentsInPhysics, TheAgentFollowsItsPathWhateverItTouches) {
     worst_rot = std::max(worst_rot, (run.X_W_agent[k].linear() - expected.linear()).norm());
   }
   EXPECT_LE(lowest, 0);
-  EXPECT_GT(lowest, -0.06) << "the pelvis drops at most h (1 - cos theta_max)";
+  EXPECT_GT(lowest, -0.06) << "the pelvis drops at most l (1 - cos theta_max)";
   std::printf("agent pose vs path over %zu steps: max position error %.3g m, rotation %.3g\n",
               run.time.size(), worst_pos, worst_rot);
   // the pose at every step is the path's pose at that step's sim time (1 mm / 1e-9 tolerance)

@@ -151,7 +151,7 @@ TEST(WalkerGait, AppearanceIsAPureFunctionOfSeedAndName) {
   EXPECT_NEAR(mean, 1.70, 0.015);
   EXPECT_NEAR(sd, 0.09, 0.015);
   EXPECT_GE(shirts.size(), 10u);
-  EXPECT_EQ(differs, n);
+  EXPECT_GE(differs, n - 10);  // only heights clipped to 1.50 or 1.95 m can coincide
 }
 
 TEST(AgentAnimation, AWheelTurnsByDistanceOverRadius) {

@@ -363,12 +363,9 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   try {
     poses = ReadPoses(run_dir / "metrics" / "nav_base.csv", w.robot + "/" + profile.base_body);
     contacts = ReadContacts(run_dir / "metrics" / "nav_contacts_episodes.csv");
-    // a collision is the robot's, whichever of its parts touched: the robot is one side
-    const std::string prefix = w.robot + "/";
-    for (ContactInterval& c : contacts) {
-      if (c.a.rfind(prefix, 0) == 0) c.a = w.robot;
-      if (c.b.rfind(prefix, 0) == 0) c.b = w.robot;
-    }
+    // a collision is the robot's, whichever of its parts touched: the robot is one side, and
+    // an agent's limbs and wheels are the agent
+    NameContactSides(w.robot, &contacts);
     if (poses.empty()) eval_error = "the run wrote no pose sample";
   } catch (const Error& e) {
     eval_error = e.what();

@@ -9,6 +9,22 @@
 
 namespace penumbra {
 
+void NameContactSides(const std::string& robot, std::vector<ContactInterval>* contacts) {
+  const std::string prefix = robot + "/";
+  const auto name = [&](std::string* side) {
+    if (side->rfind(prefix, 0) == 0) {
+      *side = robot;
+    } else if (side->rfind("agents/", 0) == 0) {
+      const size_t part = side->find('/', 7);
+      if (part != std::string::npos) side->resize(part);
+    }
+  };
+  for (ContactInterval& c : *contacts) {
+    name(&c.a);
+    name(&c.b);
+  }
+}
+
 bool AgentMadeContact(const ContactInterval& c, const std::string& robot) {
   if (robot.empty()) return false;
   const bool robot_is_a = c.a == robot;

@@ -31,6 +31,12 @@ struct ContactInterval {
   double a_toward_b_m_s = 0, b_toward_a_m_s = 0;
 };
 
+/// names the sides of `contacts` as the judge counts them, in place: every part of the robot
+/// (a body "<robot>/...") becomes `robot`, every body of an NPC agent (its root "agents/<name>"
+/// and its limbs or wheels "agents/<name>/<part>", compose/agent_bodies.h) becomes its root,
+/// so that one robot touching one agent is one pair whichever limbs touch.
+void NameContactSides(const std::string& robot, std::vector<ContactInterval>* contacts);
+
 /// an agent slower than this towards the robot never makes a contact, m/s (a standing agent
 /// touched by a robot that bounces back is still the robot's collision).
 inline constexpr double kAgentContactMinSpeed = 0.1;

@@ -124,7 +124,8 @@ WalkerJointAngles WalkerGaitAngles(const WalkerSkeleton& s, double phase, double
     q.shoulder[side] = -0.6 * opposite_hip;
     q.elbow[side] = 15 * kDeg + 20 * kDeg * scale * std::max(0.0, -std::cos(kTwoPi * w));
   }
-  q.pelvis_drop_m = s.hip_height_m * (1 - std::cos(q.hip[0]));
+  // the straight stance leg (hip to ankle) keeps the ankle at its standing height
+  q.pelvis_drop_m = (s.thigh_m + s.shank_m) * (1 - std::cos(q.hip[0]));
   return q;
 }
 

@@ -16,7 +16,8 @@
 // lambda = 1.29 m, f = 1.0 Hz, 120 steps/min). the cycle is sinusoidal: the hip (thigh) angle
 // is theta_max cos(2 pi phase) with theta_max = asin(lambda / (4 h)), so that at heel strike
 // (phase 0 for the left leg, 0.5 for the right) the feet are a step (lambda / 2) apart; the
-// pelvis drops by h (1 - cos theta) so the straight stance leg keeps its foot on the floor;
+// pelvis drops by l (1 - cos theta), l the hip-to-ankle length, so the straight stance leg
+// keeps its foot on the floor;
 // the knee flexes only in the second half of the leg's cycle (swing, up to 60 deg at 1.3 m/s,
 // scaled by theta_max); the arms swing against the legs (shoulder -0.6 x the opposite hip)
 // with the elbow bent 15 deg plus up to 20 deg in the forward swing. the gait stays a walk at

@@ -5,7 +5,9 @@
 //   <out>/metrics/<name>.csv            step,time_sec,<columns...>: one row per sample; column
 //                                       names carry their unit ("go1/trunk_x_m",
 //                                       "go1/FR_calf_N_m", "normal_force_N"; docs/metrics.md)
-//   <out>/metrics/<name>_episodes.csv   contacts metrics: one row per collision episode
+//   <out>/metrics/<name>_episodes.csv   contacts metrics: one row per collision episode, with
+//                                       each side's speed towards the other at its start
+//                                       (MetricsModel::BodyMovers; docs/metrics.md)
 //
 // a series samples at the first physics step whose time is at least k / rate_hz (k = 0, 1,
 // ...); a contacts metric also looks at every physics step (detect_hz = 0) or at its detection
