@@ -79,7 +79,7 @@ AgentConfig WalkersPerson(const std::string& name, double x0, double speed) {
 double WalkersAngleAboutY(const Eigen::Matrix3d& R) { return std::atan2(R(0, 2), R(0, 0)); }
 
 TEST(Walkers, LimbBodiesAreMocapGeomsThatSwingAtTheStrideFrequency) {
-  WalkersSim w(WalkersWorld({WalkersPerson("walker", -3, 1.3)}));
+  WalkersSim w(WalkersWorld({WalkersPerson("walker", -6.5, 1.3)}));  // walks to x = -1.5
   const SceneDescription scene = w.stage.Bind(w.sim.scene());
   const int root = scene.FindBody("agents/walker");
   ASSERT_GE(root, 0);
@@ -106,15 +106,15 @@ TEST(Walkers, LimbBodiesAreMocapGeomsThatSwingAtTheStrideFrequency) {
     const double t = s.time_sec;
     const double flexion =
         -WalkersAngleAboutY(s.X_WB[root].linear().transpose() * s.X_WB[thigh].linear());
-    if (t > 1.0 && prev < 0 && flexion >= 0) crossings.push_back(t);
+    if (t > 0.8 && t < 3.8 && prev < 0 && flexion >= 0) crossings.push_back(t);
     prev = flexion;
     worst = std::max(worst, (s.X_WB[thigh].matrix() - expected.Poses(t)[1].matrix()).norm());
   }
+  ASSERT_GE(crossings.size(), 3u);
   const double hz = (crossings.size() - 1) / (crossings.back() - crossings.front());
   const double model_hz = WalkerStrideFrequency(1.3, 0.530 * 1.75);
   std::printf("thigh in the physics: %zu cycles, %.4f Hz (model %.4f Hz), pose error %.2g\n",
               crossings.size() - 1, hz, model_hz, worst);
-  EXPECT_GE(crossings.size(), 3u);
   EXPECT_NEAR(hz, model_hz, 0.01 * model_hz);
   EXPECT_LT(worst, 1e-6) << "the body follows the animator at every step";
 }
@@ -122,7 +122,9 @@ TEST(Walkers, LimbBodiesAreMocapGeomsThatSwingAtTheStrideFrequency) {
 TEST(Walkers, ARayHitsTheLegAtItsHeightAndPassesBetweenTheLegs) {
   // a standing 1.75 m person at x = 3 facing +x: hips (and legs) at y = +-0.0875 m, shins r
   // 0.0525 m from the knee (0.499 m) down, thighs r 0.07 m from the hip (0.9275 m) down
-  WalkersSim w(WalkersWorld({WalkersPerson("p", 3, 0)}));
+  AgentConfig standing = WalkersPerson("p", 3, 0);
+  standing.waypoints[1] = Eigen::Vector2d(4, 0);  // facing +x, inside the arena
+  WalkersSim w(WalkersWorld({standing}));
   const SceneDescription scene = w.stage.Bind(w.sim.scene());
   std::unique_ptr<RayQuery> rays = MakeRayQuery(scene, RenderSettings::Backend::kEmbree);
   rays->Update(w.sim.Snapshot(Simulation::SnapshotContent::kPoses));
@@ -211,9 +213,13 @@ TEST(Walkers, HeightsAndColoursFollowTheSeed) {
   EXPECT_EQ(x.composed.Xml(), y.composed.Xml());
   const SceneDescription scene = x.sim.scene();
   const int root = scene.FindBody("agents/p0");
-  for (const Geom& g : scene.geoms)
-    if (g.body == root && g.name == "agents/p0/head")
-      EXPECT_NEAR(g.X_BG.translation().z() + g.size[0], s1[0].height_m, 1e-9);
+  int heads = 0;
+  for (const Geom& g : scene.geoms) {
+    if (g.body != root || g.name != "agents/p0/head") continue;
+    ++heads;
+    EXPECT_NEAR(g.X_BG.translation().z() + g.size[0], s1[0].height_m, 1e-9);
+  }
+  EXPECT_EQ(heads, 1);
   // a given height wins
   a.height_given = true;
   a.height_m = 1.9;
