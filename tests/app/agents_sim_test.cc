@@ -109,8 +109,8 @@ TEST(AgentsInPhysics, AWalkingPersonPushesAFreeBox) {
   // crate qpos: x, y, z, qw, qx, qy, qz
   const double x_with = with.qpos.back()[0];
   const double x_without = without.qpos.back()[0];
-  std::printf("crate x after 4 s: %.4f m with the agent, %.4f m without (y %.4f, z %.4f)\n",
-              x_with, x_without, with.qpos.back()[1], with.qpos.back()[2]);
+  std::printf("crate x after 4 s: %.4f m with the agent, %.4f m without (y %.4f, z %.4f)\n", x_with,
+              x_without, with.qpos.back()[1], with.qpos.back()[2]);
   EXPECT_NEAR(x_without, 2.0, 1e-3) << "the crate rests without the agent";
   // the person's swinging legs (shins r 0.0525 m, feet 6.8 cm high) kick the 0.3 m crate
   // ahead and aside out of its path: it must have moved by more than 0.5 m, forward, and still

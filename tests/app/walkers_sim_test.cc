@@ -236,7 +236,8 @@ TEST(Walkers, WheelsSpinByDistanceOverRadiusInThePhysics) {
   while (w.sim.time() < 1.5 - 1e-9) w.sim.Step();
   const WorldSnapshot s = w.sim.Snapshot(Simulation::SnapshotContent::kPoses);
   const double distance = s.X_WB[root].translation().x() + 4;
-  const double angle = WalkersAngleAboutY(s.X_WB[root].linear().transpose() * s.X_WB[wheel].linear());
+  const double angle =
+      WalkersAngleAboutY(s.X_WB[root].linear().transpose() * s.X_WB[wheel].linear());
   std::printf("forklift after %.3f m: wheel at %.4f rad, distance / radius %.4f rad\n", distance,
               angle, distance / 0.25);
   EXPECT_NEAR(distance, 3.0, 1e-6);

@@ -53,7 +53,8 @@ robots:
 models:
   - {name: arena, file: arena.xml}
 agents:
-  - )" + agent_yaml + R"(
+  - )" + agent_yaml +
+         R"(
 metrics:
   rate_hz: 50
   series:
@@ -79,8 +80,8 @@ std::vector<ContactInterval> AttributionRun(const std::string& agent_yaml, bool 
   options.build_renderer = false;
   options.add_controllers = drive;
   Session session(world, options);
-  std::unique_ptr<MetricsSink> sink = MakeMetricsSink(
-      world, session.sim(), (dir.path() / "out").string(), MetricsMode::kDynamics);
+  std::unique_ptr<MetricsSink> sink =
+      MakeMetricsSink(world, session.sim(), (dir.path() / "out").string(), MetricsMode::kDynamics);
   PhysicsSource source(&session.sim());
   const LoopFinish f = testing::RunLoop(&source, {sink.get()}, world.duration_sec);
   EXPECT_FALSE(f.error);
@@ -98,9 +99,8 @@ std::vector<ContactInterval> AttributionRun(const std::string& agent_yaml, bool 
     ContactInterval c{f[1], f[2], std::stod(f[3]), std::stod(f[4])};
     c.a_toward_b_m_s = std::stod(f[6]);
     c.b_toward_a_m_s = std::stod(f[7]);
-    std::printf("  %s | %s from %.3f s: %s -> %.3f m/s, %s -> %.3f m/s\n", c.a.c_str(),
-                c.b.c_str(), c.start_sec, c.a.c_str(), c.a_toward_b_m_s, c.b.c_str(),
-                c.b_toward_a_m_s);
+    std::printf("  %s | %s from %.3f s: %s -> %.3f m/s, %s -> %.3f m/s\n", c.a.c_str(), c.b.c_str(),
+                c.start_sec, c.a.c_str(), c.a_toward_b_m_s, c.b.c_str(), c.b_toward_a_m_s);
     out.push_back(c);
   }
   NameContactSides("rover", &out);  // as the harness does
@@ -186,8 +186,7 @@ TEST(NavContactAttribution, TheRuleOnHandMadeIntervals) {
   NavEpisodeTask task;
   task.goal_x = 1;
   task.robot = "go1";
-  const std::vector<NavPoseSample> poses = {{0, 0, 0, 0.3, 1, 0, 0, 0},
-                                            {6, 1, 0, 0.3, 1, 0, 0, 0}};
+  const std::vector<NavPoseSample> poses = {{0, 0, 0, 0.3, 1, 0, 0, 0}, {6, 1, 0, 0.3, 1, 0, 0, 0}};
   const NavEpisodeMetrics m = EvaluateNavEpisode(poses, list, task, true);
   EXPECT_EQ(m.collisions, 2);
   EXPECT_EQ(m.agent_contacts, 1);

@@ -87,8 +87,8 @@ TEST(AgentBodies, EachSpecBecomesAMocapBodyAtItsPose) {
   EXPECT_NEAR(hip.at(1), 2, 1e-9);
   EXPECT_NEAR(hip.at(2), 0.5 + 0.53 * 2.0, 1e-9);
   EXPECT_NE(Geom(thigh, "agents/walker/thigh_l"), nullptr);
-  for (const char* part : {"thigh_r", "shin_l", "shin_r", "upper_arm_l", "upper_arm_r",
-                           "forearm_l", "forearm_r"})
+  for (const char* part :
+       {"thigh_r", "shin_l", "shin_r", "upper_arm_l", "upper_arm_r", "forearm_l", "forearm_r"})
     EXPECT_NE(Body(doc, std::string("agents/walker/") + part), nullptr) << part;
   // vehicles: a wheel body per wheel, at its axle, with a tyre and a hub bar
   const auto* wheel = Body(doc, "agents/fl/wheel_rr");

@@ -2,6 +2,8 @@
 // Alexander (1984), the leg angle oscillating at the stride frequency the walking speed
 // implies, the stance foot on the floor, wheels that spin by distance / radius and steer by the
 // bicycle model, appearance per seed, and poses that are pure functions of time.
+#include "penumbra/effects/agent_animation.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -10,7 +12,6 @@
 #include <set>
 
 #include "penumbra/core/error.h"
-#include "penumbra/effects/agent_animation.h"
 
 namespace penumbra {
 namespace {
@@ -83,8 +84,8 @@ TEST(WalkerGait, TheThighOscillatesAtTheStrideFrequencyOfTheSpeedAndTheStrideGro
     const Oscillation o = ThighOscillation(&a, 2.0, 12.0);
     const double expected = WalkerStrideFrequency(v, a.skeleton().hip_height_m);
     const double stride = v / o.frequency_hz;  // distance walked per measured cycle
-    std::printf("v %.1f m/s: thigh %.4f Hz (model %.4f Hz), stride %.3f m, amplitude %.1f deg\n",
-                v, o.frequency_hz, expected, stride, o.amplitude * 180 / M_PI);
+    std::printf("v %.1f m/s: thigh %.4f Hz (model %.4f Hz), stride %.3f m, amplitude %.1f deg\n", v,
+                o.frequency_hz, expected, stride, o.amplitude * 180 / M_PI);
     EXPECT_NEAR(o.frequency_hz, expected, 1e-3 * expected) << v;
     EXPECT_GT(stride, prev_stride) << v;
     EXPECT_GT(o.amplitude, prev_amp) << v;

@@ -302,8 +302,8 @@ int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir,
       spdlog::info(
           "{} {} {} {} trial {}: {} ({}), success {}, collisions {} (+ {} by agents), goal "
           "distance {} m",
-          r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail,
-          r.success ? 1 : 0, r.collisions, r.agent_contacts, r.final_goal_distance_m);
+          r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail, r.success ? 1 : 0,
+          r.collisions, r.agent_contacts, r.final_goal_distance_m);
       return 0;
     }
     const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, job, context);

@@ -48,9 +48,10 @@ CollisionCounts CountCollisionsByCause(std::vector<ContactInterval> intervals, d
   }
   CollisionCounts counts;
   for (auto& [pair, list] : by_pair) {
-    std::stable_sort(list.begin(), list.end(), [](const ContactInterval* x, const ContactInterval* y) {
-      return std::pair(x->start_sec, x->end_sec) < std::pair(y->start_sec, y->end_sec);
-    });
+    std::stable_sort(
+        list.begin(), list.end(), [](const ContactInterval* x, const ContactInterval* y) {
+          return std::pair(x->start_sec, x->end_sec) < std::pair(y->start_sec, y->end_sec);
+        });
     double end = 0;
     for (size_t i = 0; i < list.size(); ++i) {
       if (i == 0 || list[i]->start_sec - end >= debounce_sec) {

@@ -82,10 +82,10 @@ struct NavEpisodeTask {
 
 /// an episode's metrics.
 struct NavEpisodeMetrics {
-  bool success = false;  ///< the base origin within radius_m of the goal (horizontal) at the
-                         ///< end, no fall, and the method did not fail
-  int collisions = 0;    ///< collisions the robot caused up to the end of the episode
-                         ///< (CountCollisionsByCause); SC counts these
+  bool success = false;    ///< the base origin within radius_m of the goal (horizontal) at the
+                           ///< end, no fall, and the method did not fail
+  int collisions = 0;      ///< collisions the robot caused up to the end of the episode
+                           ///< (CountCollisionsByCause); SC counts these
   int agent_contacts = 0;  ///< contacts an agent made (walked / drove into the robot)
   bool fell = false;
   double fall_time_sec = -1;         ///< first sample that is a fall, s (-1: none)

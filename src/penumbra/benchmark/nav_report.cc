@@ -129,9 +129,8 @@ void PlotPaths(const std::string& title, const std::vector<const NavRow*>& rows,
         fmt::format(
             "trial {}: {}{}", rows[i]->trial, rows[i]->success ? "success" : "failure",
             (rows[i]->collisions ? fmt::format(", {} coll.", rows[i]->collisions) : std::string()) +
-                (rows[i]->agent_contacts
-                     ? fmt::format(", {} by agents", rows[i]->agent_contacts)
-                     : std::string())),
+                (rows[i]->agent_contacts ? fmt::format(", {} by agents", rows[i]->agent_contacts)
+                                         : std::string())),
         {10, S + 30 - 18 * static_cast<int>(rows.size() - 1 - i)}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
         col, 1, cv::LINE_AA);
   }
@@ -179,8 +178,8 @@ std::string NavCsv(const std::vector<NavRow>& rows) {
     const bool measured = r.status != "run_failed";
     out += fmt::format("{},{},{},{},{},{},{},{},", r.world, r.episode, r.condition, r.method,
                        r.trial, r.seed, r.status, r.end);
-    out += measured ? fmt::format("{},{},{},{},", r.success ? 1 : 0, r.collisions,
-                                  r.agent_contacts, Field(r.sc))
+    out += measured ? fmt::format("{},{},{},{},", r.success ? 1 : 0, r.collisions, r.agent_contacts,
+                                  Field(r.sc))
                     : std::string("0,,,0,");
     out += fmt::format("{},{},{},{},{},", Field(r.time_to_goal_sec), Field(r.final_goal_distance_m),
                        Field(r.episode_time_sec), Field(r.path_length_m),
@@ -267,10 +266,10 @@ std::string NavSummaryMarkdown(const BenchmarkSpec& spec,
         "goal distance (m) | SC |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const NavSummaryLine& l : lines) {
       if (l.world != w.name) continue;
-      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |\n", l.condition,
-                         l.method, l.ok, l.rows, Pm(l.success, 2), Pm(l.collisions, 2),
-                         Pm(l.agent_contacts, 2), Pm(l.time_to_goal_sec, 1),
-                         Pm(l.goal_distance_m, 2), Pm(l.sc, 2));
+      out +=
+          fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |\n", l.condition, l.method,
+                      l.ok, l.rows, Pm(l.success, 2), Pm(l.collisions, 2), Pm(l.agent_contacts, 2),
+                      Pm(l.time_to_goal_sec, 1), Pm(l.goal_distance_m, 2), Pm(l.sc, 2));
     }
     out += "\n";
   }
@@ -286,16 +285,17 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
   WriteText(out / "summary.md", table);
   std::string csv =
       "world,condition,method,rows,ok,success_mean,success_std,collisions_mean,collisions_std,"
-      "agent_contacts_mean,agent_contacts_std,time_to_goal_sec_mean,time_to_goal_sec_std,goal_distance_m_mean,goal_distance_m_std,"
+      "agent_contacts_mean,agent_contacts_std,time_to_goal_sec_mean,time_to_goal_sec_std,goal_"
+      "distance_m_mean,goal_distance_m_std,"
       "sc_mean,sc_std\n";
   for (const NavSummaryLine& l : lines)
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world,
-                       l.condition, l.method, l.rows, l.ok, Field(l.success.mean),
-                       Field(l.success.std), Field(l.collisions.mean), Field(l.collisions.std),
-                       Field(l.agent_contacts.mean), Field(l.agent_contacts.std),
-                       Field(l.time_to_goal_sec.mean), Field(l.time_to_goal_sec.std),
-                       Field(l.goal_distance_m.mean), Field(l.goal_distance_m.std),
-                       Field(l.sc.mean), Field(l.sc.std));
+    csv +=
+        fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world, l.condition,
+                    l.method, l.rows, l.ok, Field(l.success.mean), Field(l.success.std),
+                    Field(l.collisions.mean), Field(l.collisions.std), Field(l.agent_contacts.mean),
+                    Field(l.agent_contacts.std), Field(l.time_to_goal_sec.mean),
+                    Field(l.time_to_goal_sec.std), Field(l.goal_distance_m.mean),
+                    Field(l.goal_distance_m.std), Field(l.sc.mean), Field(l.sc.std));
   WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");

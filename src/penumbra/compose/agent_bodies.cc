@@ -105,13 +105,12 @@ void AddPersonSegment(BodyWriter* w, WalkerSegment segment, const WalkerSkeleton
       break;
     case WalkerSegment::kUpperArmL:
     case WalkerSegment::kUpperArmR:
-      w->FromTo("upper_arm" + lr, "capsule", V(0, 0, 0), V(0, 0, -k.upper_arm_m), 0.026 * h,
-                shirt, 2);
+      w->FromTo("upper_arm" + lr, "capsule", V(0, 0, 0), V(0, 0, -k.upper_arm_m), 0.026 * h, shirt,
+                2);
       break;
     case WalkerSegment::kForearmL:
     case WalkerSegment::kForearmR:
-      w->FromTo("forearm" + lr, "capsule", V(0, 0, 0), V(0, 0, -k.forearm_m), 0.022 * h, skin,
-                1.5);
+      w->FromTo("forearm" + lr, "capsule", V(0, 0, 0), V(0, 0, -k.forearm_m), 0.022 * h, skin, 1.5);
       w->Sphere("hand" + lr, V(0, 0, -k.forearm_m - 0.04 * h), 0.03 * h, skin, 0.5);
       break;
   }

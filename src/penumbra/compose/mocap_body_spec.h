@@ -24,7 +24,7 @@ struct MocapBodySpec {
 
   std::string name;  ///< [A-Za-z0-9_-]+, unique; the body is named "agents/<name>"
   Shape shape = Shape::kPerson;
-  double height_m = 1.75;        ///< kPerson: standing height (m), (0, 3]; other shapes ignore it
+  double height_m = 1.75;  ///< kPerson: standing height (m), (0, 3]; other shapes ignore it
   /// kPerson: sRGB colours (each channel in [0, 1]) of the shirt (torso, upper arms), the
   /// trousers (pelvis, legs) and the skin (head, neck, forearms, hands)
   std::array<double, 3> shirt_rgb{0.15, 0.35, 0.75};

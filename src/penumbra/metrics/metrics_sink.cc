@@ -385,8 +385,8 @@ std::vector<int> MetricsModel::BodyMovers() const {
   std::map<std::string, int> world_children;
   for (int b = 1; b < n; ++b) {
     int r = b;
-    for (int guard = 0; guard < n && r > 0 && r < static_cast<int>(body_parent.size()) &&
-                        body_parent[r] > 0;
+    for (int guard = 0;
+         guard < n && r > 0 && r < static_cast<int>(body_parent.size()) && body_parent[r] > 0;
          ++guard)
       r = body_parent[r];
     top[b] = r;
@@ -549,14 +549,14 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
           for (size_t b = 0; b < mover_.size() && b < snap.X_WB.size(); ++b)
             mover_W[b] = snap.X_WB[b].translation();
           const double dt = snap.time_sec - s.prev_detect_sec;
-          const bool have_prev = std::isfinite(dt) && dt > 0 && s.prev_mover_W.size() == mover_W.size();
+          const bool have_prev =
+              std::isfinite(dt) && dt > 0 && s.prev_mover_W.size() == mover_W.size();
           for (const auto& [pair, count] : s.counter->count_by_pair()) {
             const auto it = before.find(pair);
             if (it != before.end() && it->second == count) continue;  // no new episode
-            s.approach[pair] = ApproachSpeeds(pair, strongest[pair].p_W, strongest[pair].n_ab,
-                                              c.geom_pairs, mover_W, have_prev ? &s.prev_mover_W
-                                                                               : nullptr,
-                                              dt);
+            s.approach[pair] =
+                ApproachSpeeds(pair, strongest[pair].p_W, strongest[pair].n_ab, c.geom_pairs,
+                               mover_W, have_prev ? &s.prev_mover_W : nullptr, dt);
           }
           s.prev_mover_W = std::move(mover_W);
           s.prev_detect_sec = snap.time_sec;
@@ -589,11 +589,11 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
 void MetricsSink::AppendEpisode(Series* s, const CollisionEpisode& e) {
   const auto it = s->approach.find(e.pair);
   const std::pair<double, double> v = it == s->approach.end() ? std::pair{0.0, 0.0} : it->second;
-  s->episodes.Append(fmt::format(
-      "{},{},{},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g}\n", ++s->episode_rows,
-      SideName(model_, s->config.geom_pairs, e.pair.first),
-      SideName(model_, s->config.geom_pairs, e.pair.second), e.start_sec, e.end_sec,
-      e.peak_force_N, v.first, v.second));
+  s->episodes.Append(fmt::format("{},{},{},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g}\n", ++s->episode_rows,
+                                 SideName(model_, s->config.geom_pairs, e.pair.first),
+                                 SideName(model_, s->config.geom_pairs, e.pair.second), e.start_sec,
+                                 e.end_sec, e.peak_force_N, v.first + 0.0,
+                                 v.second + 0.0));  // + 0.0: no "-0"
 }
 
 std::pair<double, double> MetricsSink::ApproachSpeeds(

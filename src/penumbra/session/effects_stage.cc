@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "penumbra/compose/agent_bodies.h"
-#include "penumbra/effects/agent_animation.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/effects/agent_animation.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/session/floor_map.h"
 #include "penumbra/world/yaml_reader.h"
@@ -221,7 +221,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
     for (int kind = 0; kind < 2; ++kind)
       for (int i = 0; i < (kind == 0 ? people : vehicles); ++i) {
         AgentConfig a;
-        a.name = std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
+        a.name =
+            std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
         if (std::any_of(agents_.begin(), agents_.end(),
                         [&](const AgentConfig& b) { return b.name == a.name; }))
           continue;
@@ -327,8 +328,8 @@ void EffectsStage::AgentSlot::Follow(std::shared_ptr<const AgentPath> new_path) 
   path = std::move(new_path);
   const std::shared_ptr<const AgentPath> p = path;
   const Pose rest = parked;
-  animator = std::make_shared<AgentAnimator>(
-      kind, height_m, [p, rest](double t) { return p ? p->X_WA(t) : rest; });
+  animator = std::make_shared<AgentAnimator>(kind, height_m,
+                                             [p, rest](double t) { return p ? p->X_WA(t) : rest; });
 }
 
 void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
@@ -357,8 +358,7 @@ SceneDescription EffectsStage::Bind(SceneDescription scene) {
   for (const std::vector<AgentConfig>* list : {&agents_, &reserved_})
     for (const AgentConfig& a : *list)
       for (Geom& g : scene.geoms)
-        if (g.body > 0 && g.semantic_class == 0 &&
-            IsAgentBodyOf(scene.bodies[g.body].name, a.name))
+        if (g.body > 0 && g.semantic_class == 0 && IsAgentBodyOf(scene.bodies[g.body].name, a.name))
           g.semantic_class = AgentSemanticClass(a.kind);
   if (!effects_.empty()) engine_ = std::make_unique<EffectsEngine>(effects_, seed_, scene);
   return scene;
