@@ -17,6 +17,7 @@ pkgs=(
   python3  # scripts/, the module dependency check and outputs_thread_invariance (standard library only)
   cppzmq-dev libzmq3-dev libmsgpack-cxx-dev  # ZeroMQ bridge (command/ + zmq/)
   python3-zmq python3-msgpack python3-numpy  # python/penumbra_client and its tests
+  python3-pil  # scripts/walkers_contact_sheet.py (docs/npcs-walkers.png)
   ros-base-dev libroscpp-dev librosbag-dev libtf2-ros-dev libsensor-msgs-dev libnav-msgs-dev
   libgeometry-msgs-dev libstd-srvs-dev libtf2-msgs-dev  # ROS 1 bridge and rosbag export
   rosout rosbash python3-rosbag python3-rostopic  # roscore, rostopic, rosbag tools for the ROS tests

@@ -73,6 +73,8 @@ AgentConfig Walker() {
   a.speed_m_s = 1.0;
   a.pause_sec = 0.5;
   a.route = AgentRoute::kPingPong;
+  a.height_m = 1.75;
+  a.height_given = true;
   return a;
 }
 
@@ -80,13 +82,18 @@ TEST(AgentsInPhysics, TheAgentFollowsItsPathWhateverItTouches) {
   const AgentConfig a = Walker();
   const AgentPath path(a);
   const SimRun run = Simulate({a}, 5.0);
-  double worst_pos = 0, worst_rot = 0;
+  double worst_pos = 0, worst_rot = 0, lowest = 0;
   for (size_t k = 0; k < run.time.size(); ++k) {
     const Pose expected = path.X_WA(run.time[k]);
-    worst_pos =
-        std::max(worst_pos, (run.X_W_agent[k].translation() - expected.translation()).norm());
+    // the root (pelvis) bobs down with the walking cycle (effects/walker_gait.h); its floor
+    // position and heading are the path's
+    const Eigen::Vector3d d = run.X_W_agent[k].translation() - expected.translation();
+    worst_pos = std::max(worst_pos, d.head<2>().norm());
+    lowest = std::min(lowest, d.z());
     worst_rot = std::max(worst_rot, (run.X_W_agent[k].linear() - expected.linear()).norm());
   }
+  EXPECT_LE(lowest, 0);
+  EXPECT_GT(lowest, -0.06) << "the pelvis drops at most l (1 - cos theta_max)";
   std::printf("agent pose vs path over %zu steps: max position error %.3g m, rotation %.3g\n",
               run.time.size(), worst_pos, worst_rot);
   // the pose at every step is the path's pose at that step's sim time (1 mm / 1e-9 tolerance)
@@ -102,12 +109,16 @@ TEST(AgentsInPhysics, AWalkingPersonPushesAFreeBox) {
   // crate qpos: x, y, z, qw, qx, qy, qz
   const double x_with = with.qpos.back()[0];
   const double x_without = without.qpos.back()[0];
-  std::printf("crate x after 4 s: %.4f m with the agent, %.4f m without\n", x_with, x_without);
+  std::printf("crate x after 4 s: %.4f m with the agent, %.4f m without (y %.4f, z %.4f)\n", x_with,
+              x_without, with.qpos.back()[1], with.qpos.back()[2]);
   EXPECT_NEAR(x_without, 2.0, 1e-3) << "the crate rests without the agent";
-  // the person (torso front at x + 0.11, legs r 0.07) reached x = 4 m: the crate (0.3 m)
-  // must have been shoved ahead of it by more than 1.5 m
-  EXPECT_GT(x_with, 3.5) << "crate x " << x_with;
-  EXPECT_TRUE(std::isfinite(with.qpos.back()[2]));
+  // the person's swinging legs (shins r 0.0525 m, feet 6.8 cm high) kick the 0.3 m crate
+  // ahead and aside out of its path: it must have moved by more than 0.5 m, forward, and still
+  // stand on the floor (measured: 0.94 m forward, 0.37 m aside)
+  const double moved = std::hypot(x_with - 2.0, with.qpos.back()[1]);
+  EXPECT_GT(moved, 0.5) << "crate x " << x_with;
+  EXPECT_GT(x_with, 2.5);
+  EXPECT_NEAR(with.qpos.back()[2], 0.15, 0.01) << "on the floor";
 }
 
 TEST(AgentsInPhysics, RunsAreBitIdentical) {
@@ -138,18 +149,18 @@ TEST(AgentsInPhysics, AgentBodiesAreMocapWithCollidingGeomsAndSemanticClass) {
   int person_geoms = 0, lift_geoms = 0;
   double top = 0;
   for (const Geom& g : scene.geoms) {
-    if (g.body == person) {
+    if (g.body > 0 && IsAgentBodyOf(scene.bodies[g.body].name, "walker")) {
       ++person_geoms;
       EXPECT_EQ(g.semantic_class, kSemanticClassPerson) << g.name;
       if (g.shape == GeomShape::kSphere) top = std::max(top, g.X_BG.translation().z() + g.size[0]);
     }
-    if (g.body == forklift) {
+    if (g.body > 0 && IsAgentBodyOf(scene.bodies[g.body].name, "lift")) {
       ++lift_geoms;
       EXPECT_EQ(g.semantic_class, kSemanticClassVehicle) << g.name;
     }
   }
-  EXPECT_GE(person_geoms, 6);
-  EXPECT_GE(lift_geoms, 10);
+  EXPECT_GE(person_geoms, 14);  // root: pelvis, torso, neck, head; limbs: 10 geoms
+  EXPECT_GE(lift_geoms, 20);    // body: 13 geoms; wheels: tyre and hub each
   EXPECT_NEAR(top, 1.75, 1e-9) << "head top of a 1.75 m person";
   EXPECT_THROW(sim.AddMocapDriver("arena/crate", [](double) { return Pose::Identity(); }),
                ConfigError);
@@ -196,8 +207,11 @@ TEST(AgentsInPhysics, KeyframesWithMocapPosesAreExtendedByTheAgents) {
   ComposedScene composed = ComposeWorld({m}, ComposeOptions{});
   AgentConfig a = Walker();
   a.waypoints = {{3, 1}, {4, 1}};
-  AddAgentBodies(AgentBodySpecs({a}), "", &composed);
-  EXPECT_NE(composed.Xml().find("mpos=\"1 0 2 3 1 0\""), std::string::npos) << composed.Xml();
+  AddAgentBodies(AgentBodySpecs({a}, 0), "", &composed);
+  // the target's pose, then the person's root and its 8 limbs at their standing poses
+  EXPECT_NE(composed.Xml().find("mpos=\"1 0 2 3 1 0 "), std::string::npos) << composed.Xml();
+  Simulation loaded = Simulation::LoadFromString(composed.Xml());
+  EXPECT_EQ(loaded.MocapBodyNames().size(), 1u + 1u + 8u);
   Simulation sim = Simulation::LoadFromString(composed.Xml());
   EXPECT_EQ(sim.model_info().keys.size(), 1u);
 }

@@ -72,11 +72,31 @@ TEST(AgentBodies, EachSpecBecomesAMocapBodyAtItsPose) {
   EXPECT_NEAR(q[0], std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(q[3], std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(q[1], 0, 1e-12);
-  // a person's parts scale with its height: the head sphere's centre at height - 0.11 m
+  // a person's parts scale with its height: the head sphere's top at the height
   const auto* head = Geom(p, "agents/walker/head");
   ASSERT_NE(head, nullptr);
-  EXPECT_NEAR(Numbers(head, "pos").at(2), 2.0 - 0.11, 1e-12);
-  EXPECT_EQ(Numbers(head, "size"), (std::vector<double>{0.11}));
+  EXPECT_NEAR(Numbers(head, "pos").at(2) + Numbers(head, "size").at(0), 2.0, 1e-12);
+  EXPECT_NEAR(Numbers(head, "size").at(0), 0.063 * 2.0, 1e-12);
+  // its limbs are mocap bodies of their own, standing: the left thigh hangs from the hip
+  // (0.53 H up, 0.05 H to the left; the body frame turned by the person's yaw)
+  const auto* thigh = Body(doc, "agents/walker/thigh_l");
+  ASSERT_NE(thigh, nullptr) << xml;
+  EXPECT_STREQ(thigh->Attribute("mocap"), "true");
+  const std::vector<double> hip = Numbers(thigh, "pos");
+  EXPECT_NEAR(hip.at(0), 1 - 0.1, 1e-9);  // yaw 90 deg: left is -x
+  EXPECT_NEAR(hip.at(1), 2, 1e-9);
+  EXPECT_NEAR(hip.at(2), 0.5 + 0.53 * 2.0, 1e-9);
+  EXPECT_NE(Geom(thigh, "agents/walker/thigh_l"), nullptr);
+  for (const char* part :
+       {"thigh_r", "shin_l", "shin_r", "upper_arm_l", "upper_arm_r", "forearm_l", "forearm_r"})
+    EXPECT_NE(Body(doc, std::string("agents/walker/") + part), nullptr) << part;
+  // vehicles: a wheel body per wheel, at its axle, with a tyre and a hub bar
+  const auto* wheel = Body(doc, "agents/fl/wheel_rr");
+  ASSERT_NE(wheel, nullptr);
+  EXPECT_EQ(Numbers(wheel, "pos"), (std::vector<double>{-0.55, -0.49, 0.25}));
+  EXPECT_NE(Geom(wheel, "agents/fl/wheel_rr"), nullptr);
+  EXPECT_NE(Geom(wheel, "agents/fl/wheel_rr_hub"), nullptr);
+  EXPECT_NE(Body(doc, "agents/trolley/wheel_fl"), nullptr);
 
   const auto* c = Body(doc, "agents/trolley");
   ASSERT_NE(c, nullptr);
@@ -113,6 +133,13 @@ TEST(AgentBodies, InvalidSpecsAreRefusedNamingSpecAndField) {
   bad.height_m = 0;
   EXPECT_EQ(error_of({bad}),
             "mocap body spec 0 ('a'): height_m: got 0; expected a finite number > 0 (m)");
+  bad = ok;
+  bad.height_m = 3.5;
+  EXPECT_EQ(error_of({bad}), "mocap body spec 0 ('a'): height_m: got 3.5; expected at most 3 (m)");
+  bad = ok;
+  bad.shirt_rgb[1] = 1.5;
+  EXPECT_EQ(error_of({bad}),
+            "mocap body spec 0 ('a'): shirt_rgb: got 1.5; expected a channel in [0, 1]");
   bad = ok;
   bad.X_WB.translation().x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(error_of({bad}), "mocap body spec 0 ('a'): X_WB: expected a finite pose");

@@ -299,11 +299,14 @@ TEST(LiveControlTest, NpcsOfTheStartingPresetMoveOrParkAndTheRestStayBitExact) {
   const std::vector<std::string> mocap = a.MocapBodyNames();
   for (size_t m = 0; m < mocap.size(); ++m) {
     const double za = sa.mocap_pos[3 * m + 2], zb = sb.mocap_pos[3 * m + 2];
-    if (mocap[m] == AgentBodyName("adversity_person0")) {
+    if (IsAgentBodyOf(mocap[m], "adversity_person0")) {  // its root and limbs
       EXPECT_EQ(za, zb) << mocap[m];
       EXPECT_EQ(sa.mocap_pos[3 * m], sb.mocap_pos[3 * m]) << mocap[m];
     } else {
-      EXPECT_NEAR(za, zb - 100.0, 1e-9) << mocap[m] << " parked";
+      // parked 100 m down, standing: a person's pelvis without the walking cycle's drop
+      // (< 6 cm), its limbs at rest instead of mid-stride
+      EXPECT_NEAR(za, zb - 100.0, 0.2) << mocap[m] << " parked";
+      EXPECT_LT(za, -90.0) << mocap[m];
     }
   }
   EXPECT_EQ(sa.qpos, sb.qpos);  // the change is at a step boundary: the state is the same

@@ -103,11 +103,12 @@ TEST(RunLogRecordingTest, TheHeaderMapsTheStateByNameAndHashesTheFilesRead) {
   EXPECT_EQ(l.nq, static_cast<int>(s.qpos.size()));
   EXPECT_EQ(l.nv, static_cast<int>(s.qvel.size()));
   EXPECT_EQ(l.nu, static_cast<int>(s.ctrl.size()));
-  EXPECT_EQ(l.nmocap, 6);  // six agents
+  // six agents: five people (root + 8 limbs) and a forklift (root + 4 wheels)
+  EXPECT_EQ(l.nmocap, 5 * 9 + 5);
   EXPECT_EQ(l.num_controllers, 1);
   EXPECT_EQ(l.controller_names, std::vector<std::string>{"waypoint_follower"});
   EXPECT_EQ(static_cast<int>(l.body_names.size()), l.nbody);
-  EXPECT_EQ(static_cast<int>(l.mocap_body_names.size()), 6);
+  EXPECT_EQ(static_cast<int>(l.mocap_body_names.size()), 5 * 9 + 5);
   // the rover's free joint: 7 qpos entries at its address, 6 qvel
   bool found_free = false;
   for (const RunLogJoint& j : l.joints)

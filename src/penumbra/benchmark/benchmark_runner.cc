@@ -299,9 +299,11 @@ int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir,
   try {
     if (spec.kind == "nav") {
       const NavRow r = RunNavJob(spec, job, context);
-      spdlog::info("{} {} {} {} trial {}: {} ({}), success {}, collisions {}, goal distance {} m",
-                   r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail,
-                   r.success ? 1 : 0, r.collisions, r.final_goal_distance_m);
+      spdlog::info(
+          "{} {} {} {} trial {}: {} ({}), success {}, collisions {} (+ {} by agents), goal "
+          "distance {} m",
+          r.world, r.episode, r.condition, r.method, r.trial, r.status, r.detail, r.success ? 1 : 0,
+          r.collisions, r.agent_contacts, r.final_goal_distance_m);
       return 0;
     }
     const std::vector<BenchmarkRow> rows = RunBenchmarkJob(spec, job, context);

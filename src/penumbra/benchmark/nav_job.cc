@@ -143,13 +143,20 @@ std::vector<ContactInterval> ReadContacts(const fs::path& file) {
   std::ifstream in(file);
   if (!in) throw Error("the run wrote no " + file.string());
   std::string line;
-  std::getline(in, line);  // episode,a,b,start_sec,end_sec,peak_force_N
+  // episode,a,b,start_sec,end_sec,peak_force_N[,a_speed_toward_b_m_s,b_speed_toward_a_m_s]
+  std::getline(in, line);
+  const size_t columns = SplitCsv(line).size();
   std::vector<ContactInterval> out;
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     const std::vector<std::string> f = SplitCsv(line);
-    if (f.size() != 6) break;
-    out.push_back({f[1], f[2], ToDouble(f[3], file), ToDouble(f[4], file)});
+    if (f.size() != columns || (columns != 6 && columns != 8)) break;
+    ContactInterval c{f[1], f[2], ToDouble(f[3], file), ToDouble(f[4], file)};
+    if (columns == 8) {
+      c.a_toward_b_m_s = ToDouble(f[6], file);
+      c.b_toward_a_m_s = ToDouble(f[7], file);
+    }
+    out.push_back(c);
   }
   return out;
 }
@@ -177,6 +184,7 @@ nlohmann::json RowJson(const NavRow& r) {
           {"timeout_sec", r.timeout_sec},
           {"success", r.success},
           {"collisions", r.collisions},
+          {"agent_contacts", r.agent_contacts},
           {"time_to_goal_sec", OptNum(r.time_to_goal_sec)},
           {"final_goal_distance_m", OptNum(r.final_goal_distance_m)},
           {"episode_time_sec", OptNum(r.episode_time_sec)},
@@ -355,12 +363,9 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   try {
     poses = ReadPoses(run_dir / "metrics" / "nav_base.csv", w.robot + "/" + profile.base_body);
     contacts = ReadContacts(run_dir / "metrics" / "nav_contacts_episodes.csv");
-    // a collision is the robot's, whichever of its parts touched: the robot is one side
-    const std::string prefix = w.robot + "/";
-    for (ContactInterval& c : contacts) {
-      if (c.a.rfind(prefix, 0) == 0) c.a = w.robot;
-      if (c.b.rfind(prefix, 0) == 0) c.b = w.robot;
-    }
+    // a collision is the robot's, whichever of its parts touched: the robot is one side, and
+    // an agent's limbs and wheels are the agent
+    NameContactSides(w.robot, &contacts);
     if (poses.empty()) eval_error = "the run wrote no pose sample";
   } catch (const Error& e) {
     eval_error = e.what();
@@ -381,6 +386,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
     task.fall_height_m = profile.fall_height_m;
     task.max_tilt_deg = profile.max_tilt_deg;
     task.debounce_sec = spec.nav_metrics.debounce_sec;
+    task.robot = w.robot;
     // first pass: how the episode ended per the ground truth
     const NavEpisodeMetrics probe = EvaluateNavEpisode(poses, contacts, task, true);
     const bool sim_timeout = probe.episode_time_sec >= ep.timeout_sec - 1e-6;
@@ -399,6 +405,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                              : "method_exit";
     row.success = m.success;
     row.collisions = m.collisions;
+    row.agent_contacts = m.agent_contacts;
     row.time_to_goal_sec = m.success ? m.time_to_goal_sec : NAN;
     row.final_goal_distance_m = m.final_goal_distance_m;
     row.episode_time_sec = m.episode_time_sec;
@@ -437,6 +444,7 @@ NavRow ReadNavJobResult(const std::string& path) {
     r.timeout_sec = e.at("timeout_sec");
     r.success = e.at("success");
     r.collisions = e.at("collisions");
+    r.agent_contacts = e.value("agent_contacts", 0);  // results written before it existed
     r.time_to_goal_sec = NumOf(e.at("time_to_goal_sec"));
     r.final_goal_distance_m = NumOf(e.at("final_goal_distance_m"));
     r.episode_time_sec = NumOf(e.at("episode_time_sec"));

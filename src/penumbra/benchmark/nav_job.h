@@ -46,7 +46,8 @@ struct NavRow {
   std::string detail;  ///< the method's and the run's exit, and why a row is not ok
   double goal_x = 0, goal_y = 0, radius_m = 0, timeout_sec = 0;
   bool success = false;
-  int collisions = 0;
+  int collisions = 0;      ///< collisions the robot caused (SC counts these)
+  int agent_contacts = 0;  ///< contacts an agent made (benchmark/nav_metrics.h AgentMadeContact)
   double time_to_goal_sec = NAN;  ///< NaN unless success
   double final_goal_distance_m = NAN, episode_time_sec = NAN, path_length_m = NAN;
   double sc = 0;  ///< S / (1 + c)

@@ -9,6 +9,62 @@
 
 namespace penumbra {
 
+void NameContactSides(const std::string& robot, std::vector<ContactInterval>* contacts) {
+  const std::string prefix = robot + "/";
+  const auto name = [&](std::string* side) {
+    if (side->rfind(prefix, 0) == 0) {
+      *side = robot;
+    } else if (side->rfind("agents/", 0) == 0) {
+      const size_t part = side->find('/', 7);
+      if (part != std::string::npos) side->resize(part);
+    }
+  };
+  for (ContactInterval& c : *contacts) {
+    name(&c.a);
+    name(&c.b);
+  }
+}
+
+bool AgentMadeContact(const ContactInterval& c, const std::string& robot) {
+  if (robot.empty()) return false;
+  const bool robot_is_a = c.a == robot;
+  if (!robot_is_a && c.b != robot) return false;
+  const std::string& other = robot_is_a ? c.b : c.a;
+  if (other.rfind("agents/", 0) != 0) return false;
+  const double agent_speed = robot_is_a ? c.b_toward_a_m_s : c.a_toward_b_m_s;
+  const double robot_speed = robot_is_a ? c.a_toward_b_m_s : c.b_toward_a_m_s;
+  return agent_speed >= kAgentContactMinSpeed && agent_speed > robot_speed;
+}
+
+CollisionCounts CountCollisionsByCause(std::vector<ContactInterval> intervals, double debounce_sec,
+                                       double until_sec, const std::string& robot) {
+  if (!(debounce_sec >= 0)) throw Error("CountCollisions: debounce_sec must be >= 0");
+  std::map<std::pair<std::string, std::string>, std::vector<const ContactInterval*>> by_pair;
+  for (const ContactInterval& c : intervals) {
+    if (!(c.end_sec >= c.start_sec))
+      throw Error("CountCollisions: a contact interval ends before it starts");
+    if (c.start_sec > until_sec) continue;
+    by_pair[std::minmax(c.a, c.b)].push_back(&c);
+  }
+  CollisionCounts counts;
+  for (auto& [pair, list] : by_pair) {
+    std::stable_sort(
+        list.begin(), list.end(), [](const ContactInterval* x, const ContactInterval* y) {
+          return std::pair(x->start_sec, x->end_sec) < std::pair(y->start_sec, y->end_sec);
+        });
+    double end = 0;
+    for (size_t i = 0; i < list.size(); ++i) {
+      if (i == 0 || list[i]->start_sec - end >= debounce_sec) {
+        (AgentMadeContact(*list[i], robot) ? counts.agent : counts.robot) += 1;
+        end = list[i]->end_sec;
+      } else {
+        end = std::max(end, list[i]->end_sec);
+      }
+    }
+  }
+  return counts;
+}
+
 int CountCollisions(std::vector<ContactInterval> intervals, double debounce_sec, double until_sec) {
   if (!(debounce_sec >= 0)) throw Error("CountCollisions: debounce_sec must be >= 0");
   std::map<std::pair<std::string, std::string>, std::vector<std::pair<double, double>>> by_pair;
@@ -73,7 +129,10 @@ NavEpisodeMetrics EvaluateNavEpisode(const std::vector<NavPoseSample>& poses,
   const NavPoseSample& last = poses[end];
   m.final_goal_distance_m = dist(last);
   m.episode_time_sec = last.time_sec - t0;
-  m.collisions = CountCollisions(contacts, task.debounce_sec, last.time_sec);
+  const CollisionCounts counts =
+      CountCollisionsByCause(contacts, task.debounce_sec, last.time_sec, task.robot);
+  m.collisions = counts.robot;
+  m.agent_contacts = counts.agent;
   m.success = method_ok && !m.fell && m.final_goal_distance_m <= task.radius_m;
   if (!m.success) m.time_to_goal_sec = -1;
   m.sc = m.success ? 1.0 / (1.0 + m.collisions) : 0.0;

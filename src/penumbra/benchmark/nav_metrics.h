@@ -26,7 +26,40 @@ struct ContactInterval {
   std::string a, b;      ///< the pair's sides (composed body names); (a, b) == (b, a)
   double start_sec = 0;  ///< first instant in contact, s
   double end_sec = 0;    ///< last instant in contact, s (>= start_sec)
+  /// at the start: the speed of a's mover towards b's and of b's towards a's (m/s; the
+  /// episodes file's a_speed_toward_b_m_s, b_speed_toward_a_m_s; metrics/metrics_sink.h)
+  double a_toward_b_m_s = 0, b_toward_a_m_s = 0;
 };
+
+/// names the sides of `contacts` as the judge counts them, in place: every part of the robot
+/// (a body "<robot>/...") becomes `robot`, every body of an NPC agent (its root "agents/<name>"
+/// and its limbs or wheels "agents/<name>/<part>", compose/agent_bodies.h) becomes its root,
+/// so that one robot touching one agent is one pair whichever limbs touch.
+void NameContactSides(const std::string& robot, std::vector<ContactInterval>* contacts);
+
+/// an agent slower than this towards the robot never makes a contact, m/s (a standing agent
+/// touched by a robot that bounces back is still the robot's collision).
+inline constexpr double kAgentContactMinSpeed = 0.1;
+
+/// who made a contact of the robot named `robot` (ContactInterval sides already named by the
+/// robot, not its parts): an NPC agent (the other side is an agent body, "agents/...", see
+/// compose/agent_bodies.h) whose speed towards the robot at the start of the contact is at
+/// least kAgentContactMinSpeed and exceeds the robot's speed towards it made the contact
+/// (true); any other contact (a wall, a table, a box, an agent the robot drove into, or a pair
+/// without the robot) is the robot's (false).
+bool AgentMadeContact(const ContactInterval& contact, const std::string& robot);
+
+/// collisions split by who made them (AgentMadeContact).
+struct CollisionCounts {
+  int robot = 0;  ///< caused by the robot
+  int agent = 0;  ///< made by an agent walking or driving into the robot
+};
+
+/// CountCollisions with each merged run attributed by its first interval (AgentMadeContact
+/// with `robot`; "" = every collision is the robot's). robot + agent = CountCollisions.
+/// @throws Error as CountCollisions.
+CollisionCounts CountCollisionsByCause(std::vector<ContactInterval> intervals, double debounce_sec,
+                                       double until_sec, const std::string& robot);
 
 /// collisions: the intervals of each unordered pair, sorted by start, merged while the next
 /// one starts less than `debounce_sec` after the end of the merged one (contact chatter, a
@@ -44,13 +77,16 @@ struct NavEpisodeTask {
   double fall_height_m = 0.15;    ///< a fall: base z below this, m ...
   double max_tilt_deg = 45;       ///< ... or |roll| or |pitch| above this, deg
   double debounce_sec = 0.5;      ///< CountCollisions' window, s
+  std::string robot;  ///< the robot's side name in the contacts ("": no agent attribution)
 };
 
 /// an episode's metrics.
 struct NavEpisodeMetrics {
-  bool success = false;  ///< the base origin within radius_m of the goal (horizontal) at the
-                         ///< end, no fall, and the method did not fail
-  int collisions = 0;    ///< CountCollisions up to the end of the episode
+  bool success = false;    ///< the base origin within radius_m of the goal (horizontal) at the
+                           ///< end, no fall, and the method did not fail
+  int collisions = 0;      ///< collisions the robot caused up to the end of the episode
+                           ///< (CountCollisionsByCause); SC counts these
+  int agent_contacts = 0;  ///< contacts an agent made (walked / drove into the robot)
   bool fell = false;
   double fall_time_sec = -1;         ///< first sample that is a fall, s (-1: none)
   double time_to_goal_sec = -1;      ///< first sample within the radius, s; -1 when never (or not a

@@ -128,7 +128,9 @@ void PlotPaths(const std::string& title, const std::vector<const NavRow*>& rows,
         img,
         fmt::format(
             "trial {}: {}{}", rows[i]->trial, rows[i]->success ? "success" : "failure",
-            rows[i]->collisions ? fmt::format(", {} coll.", rows[i]->collisions) : std::string()),
+            (rows[i]->collisions ? fmt::format(", {} coll.", rows[i]->collisions) : std::string()) +
+                (rows[i]->agent_contacts ? fmt::format(", {} by agents", rows[i]->agent_contacts)
+                                         : std::string())),
         {10, S + 30 - 18 * static_cast<int>(rows.size() - 1 - i)}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
         col, 1, cv::LINE_AA);
   }
@@ -150,6 +152,7 @@ const std::vector<std::string>& NavCsvColumns() {
                                                     "end",
                                                     "success",
                                                     "collisions",
+                                                    "agent_contacts",
                                                     "sc",
                                                     "time_to_goal_sec",
                                                     "final_goal_distance_m",
@@ -175,8 +178,9 @@ std::string NavCsv(const std::vector<NavRow>& rows) {
     const bool measured = r.status != "run_failed";
     out += fmt::format("{},{},{},{},{},{},{},{},", r.world, r.episode, r.condition, r.method,
                        r.trial, r.seed, r.status, r.end);
-    out += measured ? fmt::format("{},{},{},", r.success ? 1 : 0, r.collisions, Field(r.sc))
-                    : std::string("0,,0,");
+    out += measured ? fmt::format("{},{},{},{},", r.success ? 1 : 0, r.collisions, r.agent_contacts,
+                                  Field(r.sc))
+                    : std::string("0,,,0,");
     out += fmt::format("{},{},{},{},{},", Field(r.time_to_goal_sec), Field(r.final_goal_distance_m),
                        Field(r.episode_time_sec), Field(r.path_length_m),
                        measured ? (r.fell ? "1" : "0") : "");
@@ -198,10 +202,10 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
         l.world = w.name;
         l.condition = c.name;
         l.method = m.name;
-        std::vector<double> success, collisions, ttg, dist, sc;
+        std::vector<double> success, collisions, agent_contacts, ttg, dist, sc;
         for (uint64_t seed : spec.seeds) {
           std::vector<bool> s;
-          std::vector<int> coll;
+          std::vector<int> coll, agent;
           std::vector<double> t, d;
           for (const NavRow& r : rows) {
             if (r.world != w.name || r.condition != c.name || r.method != m.name || r.seed != seed)
@@ -211,6 +215,7 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
             const bool measured = r.status != "run_failed";
             s.push_back(measured && r.success);
             coll.push_back(measured ? r.collisions : 0);
+            agent.push_back(measured ? r.agent_contacts : 0);
             if (measured && r.success && std::isfinite(r.time_to_goal_sec))
               t.push_back(r.time_to_goal_sec);
             if (measured && std::isfinite(r.final_goal_distance_m))
@@ -218,9 +223,11 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
           }
           if (s.empty()) continue;
           double ns = 0, nc = 0;
-          for (size_t i = 0; i < s.size(); ++i) ns += s[i] ? 1 : 0, nc += coll[i];
+          double na = 0;
+          for (size_t i = 0; i < s.size(); ++i) ns += s[i] ? 1 : 0, nc += coll[i], na += agent[i];
           success.push_back(ns / s.size());
           collisions.push_back(nc / s.size());
+          agent_contacts.push_back(na / s.size());
           sc.push_back(SuccessWeightedByCollisions(s, coll));
           if (!t.empty()) {
             double sum = 0;
@@ -235,6 +242,7 @@ std::vector<NavSummaryLine> SummarizeNav(const BenchmarkSpec& spec,
         }
         l.success = Cell(success);
         l.collisions = Cell(collisions);
+        l.agent_contacts = Cell(agent_contacts);
         l.time_to_goal_sec = Cell(ttg);
         l.goal_distance_m = Cell(dist);
         l.sc = Cell(sc);
@@ -249,17 +257,19 @@ std::string NavSummaryMarkdown(const BenchmarkSpec& spec,
   for (const BenchmarkWorld& w : spec.worlds) {
     out += fmt::format(
         "**{}** ({} episode(s) per trial; per trial the mean over the episodes, then mean ± std "
-        "over trials; time to goal over the successful episodes; collisions debounced over {} "
-        "s, feet/wheels on the floor not counted; SC = mean S/(1+c))\n\n",
+        "over trials; time to goal over the successful episodes; collisions the robot caused, "
+        "debounced over {} s, feet/wheels on the floor not counted; agent contacts: agents that "
+        "walked or drove into the robot, not in SC; SC = mean S/(1+c))\n\n",
         w.name, w.episodes.size(), FormatNumber(spec.nav_metrics.debounce_sec));
     out +=
-        "| condition | method | ok | success | collisions | time to goal (s) | goal distance (m) "
-        "| SC |\n|---|---|---|---|---|---|---|---|\n";
+        "| condition | method | ok | success | collisions | agent contacts | time to goal (s) | "
+        "goal distance (m) | SC |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const NavSummaryLine& l : lines) {
       if (l.world != w.name) continue;
-      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} |\n", l.condition, l.method,
-                         l.ok, l.rows, Pm(l.success, 2), Pm(l.collisions, 2),
-                         Pm(l.time_to_goal_sec, 1), Pm(l.goal_distance_m, 2), Pm(l.sc, 2));
+      out +=
+          fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |\n", l.condition, l.method,
+                      l.ok, l.rows, Pm(l.success, 2), Pm(l.collisions, 2), Pm(l.agent_contacts, 2),
+                      Pm(l.time_to_goal_sec, 1), Pm(l.goal_distance_m, 2), Pm(l.sc, 2));
     }
     out += "\n";
   }
@@ -275,15 +285,17 @@ void WriteNavReport(const BenchmarkSpec& spec, const std::string& out_dir,
   WriteText(out / "summary.md", table);
   std::string csv =
       "world,condition,method,rows,ok,success_mean,success_std,collisions_mean,collisions_std,"
-      "time_to_goal_sec_mean,time_to_goal_sec_std,goal_distance_m_mean,goal_distance_m_std,"
+      "agent_contacts_mean,agent_contacts_std,time_to_goal_sec_mean,time_to_goal_sec_std,goal_"
+      "distance_m_mean,goal_distance_m_std,"
       "sc_mean,sc_std\n";
   for (const NavSummaryLine& l : lines)
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world, l.condition,
-                       l.method, l.rows, l.ok, Field(l.success.mean), Field(l.success.std),
-                       Field(l.collisions.mean), Field(l.collisions.std),
-                       Field(l.time_to_goal_sec.mean), Field(l.time_to_goal_sec.std),
-                       Field(l.goal_distance_m.mean), Field(l.goal_distance_m.std),
-                       Field(l.sc.mean), Field(l.sc.std));
+    csv +=
+        fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world, l.condition,
+                    l.method, l.rows, l.ok, Field(l.success.mean), Field(l.success.std),
+                    Field(l.collisions.mean), Field(l.collisions.std), Field(l.agent_contacts.mean),
+                    Field(l.agent_contacts.std), Field(l.time_to_goal_sec.mean),
+                    Field(l.time_to_goal_sec.std), Field(l.goal_distance_m.mean),
+                    Field(l.goal_distance_m.std), Field(l.sc.mean), Field(l.sc.std));
   WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");

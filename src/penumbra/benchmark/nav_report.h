@@ -30,6 +30,7 @@ struct NavSummaryLine {
   std::string world, condition, method;
   int rows = 0, ok = 0;  ///< episode rows, and those with status ok
   SummaryCell success, collisions, time_to_goal_sec, goal_distance_m, sc;
+  SummaryCell agent_contacts;  ///< mean contacts agents made per episode (not in SC)
 };
 
 /// the summary lines in spec order (world, condition, method).

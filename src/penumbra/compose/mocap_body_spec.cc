@@ -19,6 +19,17 @@ void MocapBodySpec::ValidateOrThrow(size_t index) const {
   if (!(std::isfinite(height_m) && height_m > 0))
     throw Error(where + "height_m: got " + compose::FormatNumbers({height_m}) +
                 "; expected a finite number > 0 (m)");
+  if (height_m > 3)
+    throw Error(where + "height_m: got " + compose::FormatNumbers({height_m}) +
+                "; expected at most 3 (m)");
+  for (const auto& [key, rgb] :
+       {std::pair<const char*, const std::array<double, 3>*>{"shirt_rgb", &shirt_rgb},
+        {"trousers_rgb", &trousers_rgb},
+        {"skin_rgb", &skin_rgb}})
+    for (double c : *rgb)
+      if (!(c >= 0 && c <= 1))
+        throw Error(where + key + ": got " + compose::FormatNumbers({c}) +
+                    "; expected a channel in [0, 1]");
   if (!X_WB.matrix().allFinite()) throw Error(where + "X_WB: expected a finite pose");
 }
 

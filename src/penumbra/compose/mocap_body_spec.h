@@ -5,6 +5,7 @@
 // step through Simulation::AddMocapDriver); the caller (app/effects_stage.cc) converts its agents
 // to specs.
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -23,11 +24,17 @@ struct MocapBodySpec {
 
   std::string name;  ///< [A-Za-z0-9_-]+, unique; the body is named "agents/<name>"
   Shape shape = Shape::kPerson;
-  double height_m = 1.75;        ///< kPerson: standing height (m), > 0; other shapes ignore it
+  double height_m = 1.75;  ///< kPerson: standing height (m), (0, 3]; other shapes ignore it
+  /// kPerson: sRGB colours (each channel in [0, 1]) of the shirt (torso, upper arms), the
+  /// trousers (pelvis, legs) and the skin (head, neck, forearms, hands)
+  std::array<double, 3> shirt_rgb{0.15, 0.35, 0.75};
+  std::array<double, 3> trousers_rgb{0.12, 0.14, 0.22};
+  std::array<double, 3> skin_rgb{0.80, 0.62, 0.50};
   Pose X_WB = Pose::Identity();  ///< the body frame in the world at t = 0 (m); finite
 
   /// @throws Error naming the spec (`index`, its name) and the field when the name is empty or
-  ///         has other characters, height_m is not finite and > 0 or X_WB is not finite.
+  ///         has other characters, height_m is not finite and in (0, 3], a colour channel is
+  ///         outside [0, 1] or X_WB is not finite.
   void ValidateOrThrow(size_t index) const;
 };
 

@@ -59,6 +59,9 @@ struct AgentConfig {
   AgentRoute route = AgentRoute::kLoop;
   double floor_z = 0;      ///< height of the floor it walks on, m, finite
   double height_m = 1.75;  ///< person: body height, [0.5, 2.5] m (others ignore it)
+  /// person: height_m was given (world file `height_m`); otherwise the body's height is drawn
+  /// from the world seed (effects/walker_gait.h WalkerAppearanceOf) and height_m is unused
+  bool height_given = false;
   int line = 0;            ///< line of the entry in the world file (0 = unknown)
 
   /// checks names, ranges and the path (>= 2 waypoints, consecutive waypoints >= 1 cm

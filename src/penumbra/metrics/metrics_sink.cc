@@ -149,6 +149,10 @@ struct MetricsSink::Series {
   std::string episodes_name;
   LineFile episodes;
   int64_t episode_rows = 0;
+  // approach speeds at the start of each pair's current episode: (a toward b, b toward a)
+  std::map<ContactPairKey, std::pair<double, double>> approach;
+  std::vector<Eigen::Vector3d> prev_mover_W;  // mover origins at the previous detection
+  double prev_detect_sec = kNaN;
   // output
   std::string file_name;
   LineFile file;
@@ -159,7 +163,10 @@ struct MetricsSink::Series {
 MetricsModel MetricsModel::FromSimulation(const WorldConfig& world, const Simulation& sim) {
   MetricsModel m;
   const SceneDescription& scene = sim.scene();
-  for (const Body& b : scene.bodies) m.body_names.push_back(b.name);
+  for (const Body& b : scene.bodies) {
+    m.body_names.push_back(b.name);
+    m.body_parent.push_back(b.parent);
+  }
   int ngeom = 0;
   for (const Geom& g : scene.geoms) ngeom = std::max(ngeom, g.id + 1);
   m.geom_names.assign(ngeom, "");
@@ -189,6 +196,7 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
                          const std::string& out_dir, MetricsMode mode)
     : model_(std::move(model)), mode_(mode), worker_(256) {
   config.ValidateOrThrow();
+  mover_ = model_.BodyMovers();
   CreateOutputFolder(out_dir, "metrics");
   const std::filesystem::path dir = std::filesystem::path(out_dir) / "metrics";
   const bool dynamics = mode == MetricsMode::kDynamics;
@@ -353,7 +361,9 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
                 "collisions"};
         s->episodes_name = c.name + "_episodes.csv";
         s->episodes = LineFile(dir / s->episodes_name);
-        s->episodes.Append("episode,a,b,start_sec,end_sec,peak_force_N\n");
+        s->episodes.Append(
+            "episode,a,b,start_sec,end_sec,peak_force_N,a_speed_toward_b_m_s,"
+            "b_speed_toward_a_m_s\n");
         break;
       }
     }
@@ -368,6 +378,31 @@ MetricsSink::MetricsSink(const MetricsConfig& config, MetricsModel model,
 }
 
 MetricsSink::~MetricsSink() { worker_.Finish(); }
+
+std::vector<int> MetricsModel::BodyMovers() const {
+  const int n = static_cast<int>(body_names.size());
+  std::vector<int> top(n, 0);
+  std::map<std::string, int> world_children;
+  for (int b = 1; b < n; ++b) {
+    int r = b;
+    for (int guard = 0;
+         guard < n && r > 0 && r < static_cast<int>(body_parent.size()) && body_parent[r] > 0;
+         ++guard)
+      r = body_parent[r];
+    top[b] = r;
+    if (r == b) world_children[body_names[b]] = b;
+  }
+  // a world child named "<other world child>/<part>" moves with that one (an agent's parts)
+  std::vector<int> mover(n, 0);
+  for (int b = 1; b < n; ++b) {
+    const std::string& name = body_names[top[b]];
+    const size_t slash = name.rfind('/');
+    const auto it = slash == std::string::npos ? world_children.end()
+                                               : world_children.find(name.substr(0, slash));
+    mover[b] = it != world_children.end() ? it->second : top[b];
+  }
+  return mover;
+}
 
 void MetricsSink::OnStart(const LoopStart& start) { worker_.Start(start.report_error); }
 
@@ -463,6 +498,11 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
       case MetricKind::kContacts: {
         const MetricConfig& c = s.config;
         std::map<ContactPairKey, double> pair_force;
+        struct Strongest {
+          double force_N = -1;
+          Eigen::Vector3d p_W = Eigen::Vector3d::Zero(), n_ab = Eigen::Vector3d::UnitX();
+        };
+        std::map<ContactPairKey, Strongest> strongest;
         int n = 0;
         double total = 0;
         const int ng = static_cast<int>(s.geom_model.size());
@@ -490,17 +530,37 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
           int a = side(g1), b = side(g2);
           if (fixed(a) != fixed(b) ? fixed(a) : a > b) std::swap(a, b);
           const double fn = std::max(0.0, ct.force_N.x());
+          // the pair's strongest contact: its point and its normal from side a towards b
+          Strongest& st = strongest[{a, b}];
+          if (fn >= st.force_N) {
+            st.force_N = fn;
+            st.p_W = ct.p_W;
+            st.n_ab = side(g1) == a ? ct.normal_W : Eigen::Vector3d(-ct.normal_W);
+          }
           pair_force[{a, b}] += fn;
           total += fn;
           ++n;
         }
-        auto side_name = [&](int id) { return SideName(model_, c.geom_pairs, id); };
         if (detect[i]) {
+          const std::map<ContactPairKey, int64_t> before = s.counter->count_by_pair();
           s.counter->Update(snap.time_sec, pair_force);
-          for (const CollisionEpisode& e : s.counter->TakeClosed())
-            s.episodes.Append(fmt::format("{},{},{},{:.9g},{:.9g},{:.9g}\n", ++s.episode_rows,
-                                          side_name(e.pair.first), side_name(e.pair.second),
-                                          e.start_sec, e.end_sec, e.peak_force_N));
+          // mover origins now and their velocities since the previous detection
+          std::vector<Eigen::Vector3d> mover_W(mover_.size(), Eigen::Vector3d::Zero());
+          for (size_t b = 0; b < mover_.size() && b < snap.X_WB.size(); ++b)
+            mover_W[b] = snap.X_WB[b].translation();
+          const double dt = snap.time_sec - s.prev_detect_sec;
+          const bool have_prev =
+              std::isfinite(dt) && dt > 0 && s.prev_mover_W.size() == mover_W.size();
+          for (const auto& [pair, count] : s.counter->count_by_pair()) {
+            const auto it = before.find(pair);
+            if (it != before.end() && it->second == count) continue;  // no new episode
+            s.approach[pair] =
+                ApproachSpeeds(pair, strongest[pair].p_W, strongest[pair].n_ab, c.geom_pairs,
+                               mover_W, have_prev ? &s.prev_mover_W : nullptr, dt);
+          }
+          s.prev_mover_W = std::move(mover_W);
+          s.prev_detect_sec = snap.time_sec;
+          for (const CollisionEpisode& e : s.counter->TakeClosed()) AppendEpisode(&s, e);
         }
         int active = 0;
         double max_pair = 0;
@@ -526,17 +586,50 @@ void MetricsSink::Process(const WorldSnapshot& snap, const std::vector<uint8_t>&
   }
 }
 
+void MetricsSink::AppendEpisode(Series* s, const CollisionEpisode& e) {
+  const auto it = s->approach.find(e.pair);
+  const std::pair<double, double> v = it == s->approach.end() ? std::pair{0.0, 0.0} : it->second;
+  s->episodes.Append(fmt::format("{},{},{},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g}\n", ++s->episode_rows,
+                                 SideName(model_, s->config.geom_pairs, e.pair.first),
+                                 SideName(model_, s->config.geom_pairs, e.pair.second), e.start_sec,
+                                 e.end_sec, e.peak_force_N, v.first + 0.0,
+                                 v.second + 0.0));  // + 0.0: no "-0"
+}
+
+std::pair<double, double> MetricsSink::ApproachSpeeds(
+    const ContactPairKey& pair, const Eigen::Vector3d& p_contact_W, const Eigen::Vector3d& n_ab,
+    bool geom_pairs, const std::vector<Eigen::Vector3d>& mover_W,
+    const std::vector<Eigen::Vector3d>* prev_mover_W, double dt) const {
+  // the mover of a side (its body's, see MetricsModel::body_mover), or -1 for a world geom
+  const auto mover = [&](int id) {
+    const int body = geom_pairs ? model_.geom_body.at(id) : id;
+    return body > 0 && body < static_cast<int>(mover_.size()) ? mover_[body] : -1;
+  };
+  const int ma = mover(pair.first), mb = mover(pair.second);
+  const auto position = [&](int m) { return m > 0 ? mover_W[m] : p_contact_W; };
+  const auto velocity = [&](int m) -> Eigen::Vector3d {
+    if (m <= 0 || !prev_mover_W) return Eigen::Vector3d::Zero();
+    return (mover_W[m] - (*prev_mover_W)[m]) / dt;
+  };
+  // the horizontal line from a's mover to b's (a world geom: the contact point)
+  Eigen::Vector3d u = position(mb) - position(ma);
+  u.z() = 0;
+  if (u.norm() < 1e-6) {
+    u = n_ab;
+    u.z() = 0;
+  }
+  if (u.norm() < 1e-9) return {0.0, 0.0};
+  u.normalize();
+  return {velocity(ma).dot(u), -velocity(mb).dot(u)};
+}
+
 void MetricsSink::OnFinish(const LoopFinish&) {
   worker_.Finish();
   for (auto& sp : series_) {
     Series& s = *sp;
     if (s.counter) {
       s.counter->Finish();
-      auto side_name = [&](int id) { return SideName(model_, s.config.geom_pairs, id); };
-      for (const CollisionEpisode& e : s.counter->TakeClosed())
-        s.episodes.Append(fmt::format("{},{},{},{:.9g},{:.9g},{:.9g}\n", ++s.episode_rows,
-                                      side_name(e.pair.first), side_name(e.pair.second),
-                                      e.start_sec, e.end_sec, e.peak_force_N));
+      for (const CollisionEpisode& e : s.counter->TakeClosed()) AppendEpisode(&s, e);
       s.episodes.Close();
     }
     s.file.Close();

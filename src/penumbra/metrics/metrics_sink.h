@@ -5,7 +5,9 @@
 //   <out>/metrics/<name>.csv            step,time_sec,<columns...>: one row per sample; column
 //                                       names carry their unit ("go1/trunk_x_m",
 //                                       "go1/FR_calf_N_m", "normal_force_N"; docs/metrics.md)
-//   <out>/metrics/<name>_episodes.csv   contacts metrics: one row per collision episode
+//   <out>/metrics/<name>_episodes.csv   contacts metrics: one row per collision episode, with
+//                                       each side's speed towards the other at its start
+//                                       (MetricsModel::BodyMovers; docs/metrics.md)
 //
 // a series samples at the first physics step whose time is at least k / rate_hz (k = 0, 1,
 // ...); a contacts metric also looks at every physics step (detect_hz = 0) or at its detection
@@ -28,6 +30,7 @@
 #include <vector>
 
 #include "penumbra/control/model_info.h"
+#include "penumbra/metrics/collision_counter.h"
 #include "penumbra/pipeline/sink.h"
 #include "penumbra/pipeline/sink_worker.h"
 #include "penumbra/scene/scene_description.h"
@@ -48,6 +51,7 @@ enum class MetricsMode {
 /// what the sink needs to know about the composed model: names and index maps.
 struct MetricsModel {
   std::vector<std::string> body_names;     ///< by body index (0 = world)
+  std::vector<int> body_parent;            ///< by body index: parent body (-1 for the world)
   std::vector<std::string> geom_names;     ///< by MuJoCo geom id ("" if unnamed)
   std::vector<int> geom_body;              ///< body index of each geom
   std::vector<JointInfo> joints;           ///< by MuJoCo joint id (control/model_info.h)
@@ -64,6 +68,12 @@ struct MetricsModel {
   /// false when the simulation runs none of the world's controllers (a replay without them):
   /// tracking_error metrics are then unavailable, not an error.
   bool has_controllers = true;
+
+  /// by body index: the body whose origin stands for the body's motion in contact attribution
+  /// (its *mover*): the topmost ancestor below the world (a robot's root link), except that a
+  /// world child named "<w>/<part>" where "<w>" is also a world child moves with "<w>" (an NPC
+  /// agent's limbs and wheels move with its root, compose/agent_bodies.h). 0 for the world.
+  std::vector<int> BodyMovers() const;
 
   /// from a composed, loaded world: scene bodies and geoms, joints, sensors, and the
   /// controllers of `world`'s robots (in Session's order: robots with a controller, in file
@@ -109,7 +119,16 @@ class MetricsSink : public Sink {
   void Process(const WorldSnapshot& s, const std::vector<uint8_t>& rows,
                const std::vector<uint8_t>& detect);
 
+  void AppendEpisode(Series* s, const CollisionEpisode& e);
+  std::pair<double, double> ApproachSpeeds(const ContactPairKey& pair,
+                                           const Eigen::Vector3d& p_contact_W,
+                                           const Eigen::Vector3d& n_ab, bool geom_pairs,
+                                           const std::vector<Eigen::Vector3d>& mover_W,
+                                           const std::vector<Eigen::Vector3d>* prev_mover_W,
+                                           double dt) const;
+
   MetricsModel model_;
+  std::vector<int> mover_;  // model_.BodyMovers()
   MetricsMode mode_;
   std::vector<std::unique_ptr<Series>> series_;
   std::vector<uint8_t> due_rows_, due_detect_;  // of the step last asked for

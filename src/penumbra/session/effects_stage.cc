@@ -8,6 +8,7 @@
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/effects/agent_animation.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/session/floor_map.h"
 #include "penumbra/world/yaml_reader.h"
@@ -218,7 +219,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   }
   ValidateEffectsOrThrow(effects_, world.file);
   ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
-  std::vector<MocapBodySpec> bodies = AgentBodySpecs(agents_);
+  std::vector<MocapBodySpec> bodies = AgentBodySpecs(agents_, seed_);
   if (reserve_live_npcs) {
     // parked bodies named as PlanAdversityPreset names its NPCs, for those it did not plan
     const auto [people, vehicles] = LiveNpcReserve();
@@ -227,7 +228,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
     for (int kind = 0; kind < 2; ++kind)
       for (int i = 0; i < (kind == 0 ? people : vehicles); ++i) {
         AgentConfig a;
-        a.name = std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
+        a.name =
+            std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
         if (std::any_of(agents_.begin(), agents_.end(),
                         [&](const AgentConfig& b) { return b.name == a.name; }))
           continue;
@@ -236,7 +238,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
         a.route = AgentRoute::kLoop;
         reserved_.push_back(a);
       }
-    std::vector<MocapBodySpec> parked = AgentBodySpecs(reserved_);
+    std::vector<MocapBodySpec> parked = AgentBodySpecs(reserved_, seed_);
     for (size_t i = 0; i < parked.size(); ++i) parked[i].X_WB = AgentParkedPose(reserved_[i]);
     bodies.insert(bodies.end(), parked.begin(), parked.end());
   }
@@ -245,7 +247,11 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
 
 EffectsStage::~EffectsStage() = default;
 
-std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents) {
+WalkerAppearance AgentAppearance(const AgentConfig& agent, uint64_t seed) {
+  return WalkerAppearanceOf(seed, agent.name, agent.height_given ? agent.height_m : 0.0);
+}
+
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents, uint64_t seed) {
   std::vector<MocapBodySpec> specs;
   for (const AgentConfig& a : agents) {
     MocapBodySpec s;
@@ -261,7 +267,11 @@ std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents
         s.shape = MocapBodySpec::Shape::kCart;
         break;
     }
-    s.height_m = a.height_m;
+    const WalkerAppearance look = AgentAppearance(a, seed);
+    s.height_m = look.height_m;
+    s.shirt_rgb = {look.shirt.r, look.shirt.g, look.shirt.b};
+    s.trousers_rgb = {look.trousers.r, look.trousers.g, look.trousers.b};
+    s.skin_rgb = {look.skin.r, look.skin.g, look.skin.b};
     s.X_WB = AgentPath(a).X_WA(0.0);
     specs.push_back(std::move(s));
   }
@@ -300,25 +310,33 @@ void EffectsStage::Attach(Simulation* sim) {
         }
     }
   }
-  for (const AgentConfig& a : agents_) {
+  // the root and part bodies of every agent follow its animator (effects/agent_animation.h),
+  // which a live change replaces with the new path's
+  const auto attach = [&](const AgentConfig& a, std::shared_ptr<const AgentPath> path) {
     auto slot = std::make_shared<AgentSlot>();
-    slot->path = std::make_shared<const AgentPath>(a);
+    slot->kind = a.kind;
+    slot->height_m = AgentAppearance(a, seed_).height_m;
     slot->parked = AgentParkedPose(a);
-    sim->AddMocapDriver(AgentBodyName(a.name), [slot](double t) {
-      return slot->path ? slot->path->X_WA(t) : slot->parked;
-    });
+    slot->Follow(std::move(path));
+    sim->AddMocapDriver(AgentBodyName(a.name),
+                        [slot](double t) { return slot->animator->Poses(t)[0]; });
+    const std::vector<std::string> parts = AgentPartNames(a.kind);
+    for (size_t j = 0; j < parts.size(); ++j)
+      sim->AddMocapDriver(AgentPartBodyName(a.name, parts[j]),
+                          [slot, j](double t) { return slot->animator->Poses(t)[j + 1]; });
     body_names_.push_back(a.name);
     slots_.push_back(std::move(slot));
-  }
-  for (const AgentConfig& a : reserved_) {
-    auto slot = std::make_shared<AgentSlot>();
-    slot->parked = AgentParkedPose(a);
-    sim->AddMocapDriver(AgentBodyName(a.name), [slot](double t) {
-      return slot->path ? slot->path->X_WA(t) : slot->parked;
-    });
-    body_names_.push_back(a.name);
-    slots_.push_back(std::move(slot));
-  }
+  };
+  for (const AgentConfig& a : agents_) attach(a, std::make_shared<const AgentPath>(a));
+  for (const AgentConfig& a : reserved_) attach(a, nullptr);
+}
+
+void EffectsStage::AgentSlot::Follow(std::shared_ptr<const AgentPath> new_path) {
+  path = std::move(new_path);
+  const std::shared_ptr<const AgentPath> p = path;
+  const Pose rest = parked;
+  animator = std::make_shared<AgentAnimator>(kind, height_m,
+                                             [p, rest](double t) { return p ? p->X_WA(t) : rest; });
 }
 
 void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
@@ -334,7 +352,7 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
                             "loaded model); expected at most the NPCs the run started with");
     paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
   }
-  for (size_t i = 0; i < slots_.size(); ++i) slots_[i]->path = paths[i];
+  for (size_t i = 0; i < slots_.size(); ++i) slots_[i]->Follow(paths[i]);
   std::lock_guard<std::mutex> lock(mu_);
   effects_ = std::move(effects);
   agents_ = std::move(agents);
@@ -343,12 +361,12 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
 }
 
 SceneDescription EffectsStage::Bind(SceneDescription scene) {
-  for (const AgentConfig& a : agents_) {
-    const int body = scene.FindBody(AgentBodyName(a.name));
-    for (Geom& g : scene.geoms)
-      if (body >= 0 && g.body == body && g.semantic_class == 0)
-        g.semantic_class = AgentSemanticClass(a.kind);
-  }
+  // every body of an agent (root and parts), the parked reserve's too
+  for (const std::vector<AgentConfig>* list : {&agents_, &reserved_})
+    for (const AgentConfig& a : *list)
+      for (Geom& g : scene.geoms)
+        if (g.body > 0 && g.semantic_class == 0 && IsAgentBodyOf(scene.bodies[g.body].name, a.name))
+          g.semantic_class = AgentSemanticClass(a.kind);
   if (!effects_.empty()) engine_ = std::make_unique<EffectsEngine>(effects_, seed_, scene);
   return scene;
 }

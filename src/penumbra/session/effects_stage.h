@@ -5,10 +5,11 @@
 // order in a run (app/runner.cc):
 //   1. compose the models, then EffectsStage(world, &composed, ...) plans the preset
 //      (regions and NPC paths need the scene: with a preset it compiles the composed
-//      document once more to read the static geometry) and adds one mocap body per agent
-//      to `composed`;
+//      document once more to read the static geometry) and adds the mocap bodies of every
+//      agent (root and parts: limbs, wheels; compose/agent_bodies.h) to `composed`;
 //   2. load the simulation, Attach(&sim): the world's agents are checked against the
-//      world's extent, then every agent body is driven from its path;
+//      world's extent, then every agent's root body is driven from its path and its part
+//      bodies from the root's motion (effects/agent_animation.h);
 //   3. Bind(scene): labels agent geoms (Geom::semantic_class, effects/agent_path.h) and
 //      builds the EffectsEngine on the final scene;
 //   4. per rendered frame, after physics: Evaluate(snapshot, camera position) -> the
@@ -45,6 +46,7 @@
 
 #include "penumbra/compose/mocap_body_spec.h"
 #include "penumbra/compose/scene_composer.h"
+#include "penumbra/effects/agent_animation.h"
 #include "penumbra/effects/agent_path.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/effects_engine.h"
@@ -131,6 +133,11 @@ class EffectsStage {
   struct AgentSlot {
     std::shared_ptr<const AgentPath> path;
     Pose parked;
+    AgentKind kind = AgentKind::kPerson;
+    double height_m = 1.75;
+    std::shared_ptr<AgentAnimator> animator;  // poses the root and parts from path (or parked)
+    // follows `new_path` (null: parked) from now on, with a fresh animator
+    void Follow(std::shared_ptr<const AgentPath> new_path);
   };
   std::vector<std::string> body_names_;
   std::vector<std::shared_ptr<AgentSlot>> slots_;
@@ -156,9 +163,14 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents);
 
+/// what agent `agent` looks like in a run of world seed `seed`: WalkerAppearanceOf(seed, its
+/// name, its height_m when height_given, else 0: drawn from the seed).
+WalkerAppearance AgentAppearance(const AgentConfig& agent, uint64_t seed);
+
 /// the mocap body of each agent for compose/agent_bodies.h, in the same order: name, shape of
-/// its kind, height and its path's pose at t = 0 (AgentPath::X_WA(0)).
+/// its kind, height and colours (AgentAppearance) and its path's pose at t = 0
+/// (AgentPath::X_WA(0)).
 /// @throws ConfigError if an agent is invalid (as AgentPath's constructor).
-std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents);
+std::vector<MocapBodySpec> AgentBodySpecs(const std::vector<AgentConfig>& agents, uint64_t seed);
 
 }  // namespace penumbra

@@ -79,10 +79,13 @@ LiveEffects::LiveEffects(Session& session) : session_(session) {
   for (const ModelConfig& m : session.world().models)
     if (m.is_robot) robot_starts_.push_back(m.pose.xyz);
   const std::vector<std::string> mocap = sim.MocapBodyNames();
-  for (const std::string& agent : session.effects().agent_bodies()) {
-    const auto it = std::find(mocap.begin(), mocap.end(), AgentBodyName(agent));
-    if (it != mocap.end()) agent_mocap_ids_.push_back(static_cast<int>(it - mocap.begin()));
-  }
+  // every body of an agent: its root and its parts (limbs, wheels)
+  for (size_t i = 0; i < mocap.size(); ++i)
+    for (const std::string& agent : session.effects().agent_bodies())
+      if (IsAgentBodyOf(mocap[i], agent)) {
+        agent_mocap_ids_.push_back(static_cast<int>(i));
+        break;
+      }
   // preset files clients name are read from inside the world file's folder only
   if (!session.world().file.empty()) {
     std::error_code ec;

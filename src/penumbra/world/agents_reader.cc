@@ -48,7 +48,10 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
                                   : AgentRoute::kOnce;
     }
     if (r.Has("floor_z")) a.floor_z = note(r.Child("floor_z")).Double();
-    if (r.Has("height_m")) a.height_m = note(r.Child("height_m")).Double();
+    if (r.Has("height_m")) {
+      a.height_m = note(r.Child("height_m")).Double();
+      a.height_given = true;
+    }
     a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
       auto it = lines.find(key);
       return it == lines.end() ? 0 : it->second;
