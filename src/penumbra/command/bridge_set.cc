@@ -20,6 +20,7 @@ BridgeSet::BridgeSet(Session& session, const WorldConfig& world, RunOutputs& out
   std::erase(bridges_, nullptr);
 
   CameraSink& cameras = outputs.cameras();
+  cameras_ = &cameras;
   SensorSink& sensors = outputs.sensors();
   cameras.set_on_frame([this](const std::shared_ptr<const CameraFrame>& frame) {
     for (auto& b : bridges_) b->OnCameraFrame(frame);
@@ -38,7 +39,13 @@ BridgeSet::~BridgeSet() = default;
 void BridgeSet::Configure(PhysicsSourceOptions* physics, SimLoopOptions* loop) {
   physics->realtime = false;
   RunControl* control = control_.get();
-  physics->before_step = [control](Simulation& sim) { return control->BeforeStep(sim); };
+  CameraSink* cameras = cameras_;
+  physics->before_step = [control, cameras](Simulation& sim) {
+    // at real-time pacing no captured frame waits for the renderer when commands apply: the
+    // next rendered frame shows them (a live view drops no frame, it never queues stale ones)
+    if (control->realtime_factor() > 0) cameras->Drain();
+    return control->BeforeStep(sim);
+  };
   loop->stop_request = control_->stop_flag();
 }
 

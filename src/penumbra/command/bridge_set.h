@@ -12,6 +12,14 @@
 // camera frames and sensor samples reach every bridge (CameraSink::set_on_frame,
 // SensorSink::set_on_sample); the RunControl drains the camera and sensor threads before a
 // step reply (command/run_bridge.h states the guarantee).
+//
+// live view at real-time pacing (realtime factor > 0, e.g. `penumbra view`, `run --realtime
+// --viewer`): before every step the loop waits until every camera frame captured so far is
+// rendered and handed to the bridges (CameraSink::Drain), and only then applies the queued
+// commands and steps. no frame captured before a command is still waiting for the renderer
+// when the command applies, so a teleop key shows on the next rendered frame (not behind one
+// or two stale ones); every captured frame is still rendered and written. running as fast as
+// possible (factor 0) keeps the render queue (RunOutputsOptions::render_queue) for throughput.
 
 #include <atomic>
 #include <memory>
@@ -54,7 +62,8 @@ class BridgeSet {
   BridgeSet(const BridgeSet&) = delete;
   BridgeSet& operator=(const BridgeSet&) = delete;
 
-  /// sets the physics source's before_step to the RunControl gate, turns its own pacing off
+  /// sets the physics source's before_step to the RunControl gate (after draining the camera
+  /// thread while the realtime factor is > 0: see the file comment), turns its own pacing off
   /// (the RunControl paces) and makes the loop's stop request the RunControl's flag.
   void Configure(PhysicsSourceOptions* physics, SimLoopOptions* loop);
   /// adds the RunControl, then every bridge, to `loop` (after the outputs and recorder, before
@@ -70,6 +79,7 @@ class BridgeSet {
   std::unique_ptr<RunControl> control_;
   std::unique_ptr<CommandDispatcher> dispatcher_;
   std::vector<std::unique_ptr<RunBridge>> bridges_;
+  CameraSink* cameras_ = nullptr;
 };
 
 }  // namespace penumbra
