@@ -10,6 +10,9 @@ frames=${2:-50}
 work=$(mktemp -d)
 tar -C "$work" -xJf "$tarball"
 pkg=$work/penumbra-gpu
+# the carried libraries: the executables find them through their run path, the libraries
+# they load (e.g. MuJoCo its libccd) through this
+export LD_LIBRARY_PATH=$pkg/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 # the binaries were built in /work/wt-cuda and find the worlds there (PENUMBRA_SOURCE_DIR)
 if [ ! -e /work/wt-cuda/worlds ]; then
   mkdir -p /work/wt-cuda && ln -sfn "$pkg/src/worlds" /work/wt-cuda/worlds
