@@ -50,9 +50,9 @@ RenderSettings::Backend ResolveBackend(RenderSettings::Backend backend) {
           "renderer: render.backend auto: CUDA device '{}' found, rendering on the GPU "
           "(cuda backend; --backend cpu for the CPU)",
           s.name);
-    else
-      spdlog::info("renderer: render.backend auto: no CUDA device ({}), rendering on the CPU",
-                   s.why);
+    else  // the CPU, as always without a GPU: only at debug level
+      spdlog::debug("renderer: render.backend auto: no CUDA device ({}), rendering on the CPU",
+                    s.why);
   });
   return s.available ? RenderSettings::Backend::kCuda : RenderSettings::Backend::kEmbree;
 }

@@ -26,7 +26,7 @@ struct CudaDeviceStatus {
 CudaDeviceStatus ProbeCudaDevice();
 
 /// `backend` with kAuto resolved: kCuda when ProbeCudaDevice finds a device, else kEmbree (the
-/// first resolution logs which, once per process).
+/// first resolution that finds a device says so in one log line, once per process).
 RenderSettings::Backend ResolveBackend(RenderSettings::Backend backend);
 
 /// the Renderer of settings.backend over `scene` (copied) with `settings`.
