@@ -32,7 +32,7 @@ TEST(RenderSettingsTest, EachRangeIsChecked) {
       {[](RenderSettings* s) { s->exposure_compensation_ev = NAN; },
        "render.exposure.compensation_ev", "expected [-20, 20]"},
       {[](RenderSettings* s) { s->backend = static_cast<RenderSettings::Backend>(7); },
-       "render.backend", "unknown backend; expected one of: embree"},
+       "render.backend", "unknown backend; expected one of: cpu, cuda, auto (embree = cpu)"},
   };
   for (const Case& c : cases) {
     RenderSettings s;

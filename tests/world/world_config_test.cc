@@ -347,7 +347,7 @@ TEST_F(WorldConfigTest, EmptyMappingGivesDefaults) {
   EXPECT_TRUE(w.cameras.empty());
   EXPECT_EQ(w.sky.type, Sky::Type::kUniform);
   EXPECT_EQ(w.render.tier, RenderSettings::Tier::kRealtime);
-  EXPECT_EQ(w.render.backend, RenderSettings::Backend::kEmbree);
+  EXPECT_EQ(w.render.backend, RenderSettings::Backend::kAuto);
   EXPECT_EQ(w.render.samples_per_pixel, 16);
   EXPECT_TRUE(w.render.auto_exposure);
   EXPECT_TRUE(w.mjcf_cameras.enabled);
@@ -355,8 +355,14 @@ TEST_F(WorldConfigTest, EmptyMappingGivesDefaults) {
 }
 
 TEST_F(WorldConfigTest, RenderBackendIsRead) {
-  const WorldConfig w = ParseWorld("render:\n  backend: embree\n", world_);
-  EXPECT_EQ(w.render.backend, RenderSettings::Backend::kEmbree);
+  EXPECT_EQ(ParseWorld("render:\n  backend: embree\n", world_).render.backend,
+            RenderSettings::Backend::kEmbree);
+  EXPECT_EQ(ParseWorld("render:\n  backend: cpu\n", world_).render.backend,
+            RenderSettings::Backend::kEmbree);
+  EXPECT_EQ(ParseWorld("render:\n  backend: cuda\n", world_).render.backend,
+            RenderSettings::Backend::kCuda);
+  EXPECT_EQ(ParseWorld("render:\n  backend: auto\n", world_).render.backend,
+            RenderSettings::Backend::kAuto);
 }
 
 TEST_F(WorldConfigTest, KeysWithoutValueMeanEmptyListOrMapping) {
@@ -636,7 +642,7 @@ TEST_F(WorldConfigTest, UnknownEnumValueListsValidOnes) {
   ExpectError("render:\n  tier: fast\n", 2, "render.tier",
               "unknown value 'fast'; expected one of: realtime, pathtraced");
   ExpectError("render:\n  backend: optix\n", 2, "render.backend",
-              "unknown value 'optix'; expected one of: embree");
+              "unknown value 'optix'; expected one of: cpu, embree, cuda, auto");
   ExpectError("lights:\n  - name: a\n    type: area\n", 3, "lights[0].type",
               "expected one of: sun, directional, point, spot");
 }

@@ -48,6 +48,8 @@ int BenchRender(const RenderBenchOptions& options) {
   world.render.threads = options.threads;
   world.render.tier = options.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
                                                    : RenderSettings::Tier::kRealtime;
+  if (!options.backend.empty())
+    world.render.backend = RenderSettings::BackendFromName(options.backend);
   Session session(world);  // session/session.h
   Simulation& sim = session.sim();
   const SceneDescription& scene = session.scene();

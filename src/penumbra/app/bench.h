@@ -13,6 +13,7 @@ struct RenderBenchOptions {
   int warmup_frames = 5;    ///< untimed frames first
   int threads = 0;          ///< render threads, 0 = all cores
   std::string tier = "realtime";
+  std::string backend;  ///< cpu, cuda or auto; "" = the world's render.backend
   bool adversity = true;    ///< also time the presets none/minor/major (app/effects_bench.h)
 };
 

@@ -260,6 +260,11 @@ int RunCli(int argc, char** argv) {
       "simulated seconds (overrides duration_sec)");
   run->add_flag("--realtime", run_options.realtime, "pace physics to wall-clock time");
   run->add_option("--tier", tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
+  std::string backend;
+  run->add_option("--backend", backend,
+                  "render backend: cpu, cuda (an NVIDIA GPU) or auto (cuda when a CUDA device is "
+                  "present; overrides render.backend; docs/gpu.md)")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   AddInteger(run, "--spp", &spp, 1, 65536, "samples per pixel (pathtraced)");
   AddInteger(run, "--threads", &threads, 0, 256, "render threads (0 = all cores)");
   AddUint64(run, "--seed", &seed, "world seed (overrides seed)");
@@ -307,6 +312,9 @@ int RunCli(int argc, char** argv) {
   AddInteger(bench_render, "--threads", &render_bench.threads, 0, 256,
              "render threads (0 = all cores)");
   bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
+  bench_render->add_option("--backend", render_bench.backend,
+                           "render backend: cpu, cuda or auto (default: the world's; docs/gpu.md)")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
   // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
@@ -436,6 +444,7 @@ int RunCli(int argc, char** argv) {
         world.render.tier = tier == "pathtraced" ? RenderSettings::Tier::kPathtraced : RenderSettings::Tier::kRealtime;
       if (spp > 0) world.render.samples_per_pixel = spp;
       if (threads >= 0) world.render.threads = threads;
+      if (!backend.empty()) world.render.backend = RenderSettings::BackendFromName(backend);
       run_options.progress = !quiet;
       run_options.command_line = Args(argc, argv);
       if (!outputs.empty() || run->count("--outputs"))

@@ -3,15 +3,17 @@
 // double precision: plane (rectangle), sphere, ellipsoid, cylinder (with caps) and
 // capsule (cylinder with hemispherical ends). used as Embree user geometry by RayScene.
 //
+// the formulas are analytic_shape_math.h's (plain arrays, PB_HOST_DEVICE: the CUDA backend
+// runs the same code); these are their Eigen forms.
+//
 // quadratic roots use the numerically stable form of Pharr, Jakob, Humphreys, "Physically
 // Based Rendering", 4th ed., sec. 6.8.1 (discriminant from the ray's closest approach).
 
 #include <Eigen/Core>
 
-namespace penumbra {
+#include "penumbra/render/analytic_shape_math.h"
 
-/// the analytic shapes. sizes follow MuJoCo's geom_size (see Geom::size).
-enum class AnalyticKind { kPlane, kSphere, kCapsule, kEllipsoid, kCylinder };
+namespace penumbra {
 
 /// an analytic shape centred at the origin of its frame, axis along z.
 struct AnalyticShape {
@@ -19,9 +21,6 @@ struct AnalyticShape {
   /// plane: half x, half y; sphere: r; capsule / cylinder: r, half length; ellipsoid: radii.
   Eigen::Vector3d size{1, 1, 1};
 };
-
-/// which part of a shape a ray hit (selects the normal formula).
-enum class ShapePart { kMain = 0, kTop = 1, kBottom = 2 };
 
 /// smallest t in (tmin, tmax) at which o + t d meets the surface of `shape`; also reports
 /// the part hit. d need not be unit. returns false if there is none.

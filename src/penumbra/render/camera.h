@@ -78,6 +78,17 @@ class Camera {
   /// off-axis pixels and lens distortion change it, which the cone ignores).
   float pixel_spread_rad() const { return pixel_spread_rad_; }
 
+  /// the terms of GenerateRay for a projective() camera: the ray through pixel (u, v) is
+  /// o_W + t (((u - cx) inv_fx) ex_W + ((v - cy) inv_fy) ey_W + ez_W) (ex, ey, ez: the optical
+  /// axes in the world). the CUDA backend's primary rays take them (render/cuda/).
+  struct PinholeTerms {
+    Eigen::Vector3f o_W, ex_W, ey_W, ez_W;
+    float cx, cy, inv_fx, inv_fy;
+  };
+  PinholeTerms pinhole_terms() const {
+    return {o_W_, ex_W_, ey_W_, ez_W_, cx_, cy_, inv_fx_, inv_fy_};
+  }
+
   int width() const { return intrinsics_.width; }
   int height() const { return intrinsics_.height; }
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }

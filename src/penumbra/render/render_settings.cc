@@ -25,9 +25,18 @@ void CheckClosed(const char* key, double v, double lo, double hi) {
 
 }  // namespace
 
+RenderSettings::Backend RenderSettings::BackendFromName(const std::string& name) {
+  if (name == "cpu" || name == "embree") return Backend::kEmbree;
+  if (name == "cuda") return Backend::kCuda;
+  if (name == "auto") return Backend::kAuto;
+  throw ConfigError("", 0, "render.backend",
+                    "got '" + name + "'; expected one of: cpu, cuda, auto (embree = cpu)");
+}
+
 void RenderSettings::ValidateOrThrow() const {
-  if (backend != Backend::kEmbree) {
-    throw ConfigError("", 0, "render.backend", "unknown backend; expected one of: embree");
+  if (backend != Backend::kEmbree && backend != Backend::kCuda && backend != Backend::kAuto) {
+    throw ConfigError("", 0, "render.backend",
+                      "unknown backend; expected one of: cpu, cuda, auto (embree = cpu)");
   }
   if (tier != Tier::kRealtime && tier != Tier::kPathtraced) {
     throw ConfigError("", 0, "render.tier", "unknown tier; expected one of: realtime, pathtraced");

@@ -12,9 +12,11 @@ struct RenderSettings {
   /// the ray-tracing backend: MakeRenderer and MakeRayQuery (render/backends/) build
   /// its Renderer and RayQuery.
   enum class Backend {
-    kEmbree,  ///< Intel Embree 3 on the CPU (render/embree/)
+    kEmbree,  ///< Embree 3 on the CPU (render/cpu/, render/embree/); world key `cpu`, `embree`
+    kCuda,    ///< the CUDA backend on an NVIDIA GPU (render/cuda/, docs/gpu.md); world key `cuda`
+    kAuto,    ///< kCuda when a CUDA device is present (one log line says so), else kEmbree
   };
-  Backend backend = Backend::kEmbree;
+  Backend backend = Backend::kAuto;
   enum class Tier {
     kRealtime,    ///< direct lighting with ray-traced (hard or soft) shadows + sky ambient, 1 sample/pixel
     kPathtraced,  ///< unidirectional path tracing, NEE with MIS, N samples/pixel, denoised
@@ -45,6 +47,10 @@ struct RenderSettings {
 
   /// throws ConfigError if a value is out of range.
   void ValidateOrThrow() const;
+
+  /// the backend a world's `render.backend` or a `--backend` flag names: cpu (or embree), cuda
+  /// or auto. @throws ConfigError (key "render.backend") for any other name.
+  static Backend BackendFromName(const std::string& name);
 };
 
 }  // namespace penumbra

@@ -163,9 +163,12 @@ class WorldParser {
   static void ReadRender(const YamlReader& r, RenderSettings* s) {
     r.ExpectMap({"backend", "tier", "samples_per_pixel", "max_bounces", "denoise", "threads",
                  "exposure", "tone_map", "max_anisotropy"});
-    // one backend so far: Enum names it in the error for any other value
-    if (r.Has("backend") && r.Child("backend").Enum({"embree"}) == "embree")
-      s->backend = RenderSettings::Backend::kEmbree;
+    // cpu (also spelt embree, its ray tracer), cuda or auto (docs/gpu.md): Enum names them in
+    // the error for any other value
+    if (r.Has("backend")) {
+      s->backend = RenderSettings::BackendFromName(
+          r.Child("backend").Enum({"cpu", "embree", "cuda", "auto"}));
+    }
     if (r.Has("tier")) {
       s->tier = r.Child("tier").Enum({"realtime", "pathtraced"}) == "realtime"
                     ? RenderSettings::Tier::kRealtime

@@ -15,8 +15,25 @@
 
 namespace penumbra {
 
+/// whether a CUDA device can be used: cudaGetDeviceCount succeeded with >= 1 device (any error,
+/// e.g. "CUDA driver version is insufficient for CUDA runtime version" on a machine without a
+/// GPU, means none). probed once per process.
+struct CudaDeviceStatus {
+  bool available = false;
+  std::string name;  ///< the first device's name, when available
+  std::string why;   ///< why none is usable, when not available
+};
+CudaDeviceStatus ProbeCudaDevice();
+
+/// `backend` with kAuto resolved: kCuda when ProbeCudaDevice finds a device, else kEmbree (the
+/// first resolution that finds a device says so in one log line, once per process).
+RenderSettings::Backend ResolveBackend(RenderSettings::Backend backend);
+
 /// the Renderer of settings.backend over `scene` (copied) with `settings`.
-/// @throws ConfigError for bad settings (settings.ValidateOrThrow); Error if the backend
+/// backend cuda: the CUDA backend (render/cuda/cuda_renderer.h), with a CPU renderer for the
+/// frames it does not render on the GPU yet.
+/// @throws ConfigError for bad settings (settings.ValidateOrThrow), or backend cuda without a
+/// usable CUDA device; Error if the backend
 /// cannot be initialised or the scene refers to missing meshes, height fields, materials or
 /// textures.
 std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,

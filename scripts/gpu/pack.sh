@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# packs the CUDA backend's GPU tests and benchmark for a GPU machine without this machine's
+# packages (docs/gpu.md, "Running on a GPU machine"): render_cuda_gpu_tests, render_cuda_tests
+# and render_cuda_bench (render, scene, physics, effects, session; not the `penumbra` binary, whose
+# OpenCV codecs, ROS and viewer libraries are too large to carry), every library `ldd` lists for
+# them except the C library's own (libc, libm, libdl, libpthread, librt, ld-linux: the target's
+# newer glibc runs them) and the CUDA driver (the target's), the bundled worlds, and
+# scripts/gpu/check.sh. the binaries find the libraries through their $ORIGIN/../lib run path
+# (CMakeLists.txt). writes one xz-compressed tarball and fails if it is 64 MiB or more.
+#
+#   scripts/gpu/pack.sh [build-dir] [out.tar.xz]      (default: build, .gpu/penumbra-gpu.tar.xz)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=${1:-$root/build}
+out=${2:-$root/.gpu/penumbra-gpu.tar.xz}
+bins=(render_cuda_gpu_tests render_cuda_tests render_cuda_bench)
+nice cmake --build "$build" -j2 --target "${bins[@]}"
+stage=$(mktemp -d)
+trap 'rm -rf "$stage"' EXIT
+mkdir -p "$stage/penumbra-gpu/bin" "$stage/penumbra-gpu/lib" "$stage/penumbra-gpu/src"
+for b in "${bins[@]}"; do
+  cp "$build/$b" "$stage/penumbra-gpu/bin/"
+  strip "$stage/penumbra-gpu/bin/$b"
+done
+# libraries: everything ldd resolves, less glibc's and the driver's
+for b in "${bins[@]}"; do ldd "$build/$b"; done |
+  awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
+  grep -v -E '/(libc|libm|libdl|libpthread|librt|libresolv|ld-linux-x86-64|libcuda)\.so' |
+  while read -r lib; do
+    cp -L "$lib" "$stage/penumbra-gpu/lib/"
+    strip --strip-unneeded "$stage/penumbra-gpu/lib/$(basename "$lib")" 2>/dev/null || true
+  done
+# the worlds and their assets (the tests and the benchmark load worlds/*.yaml by path)
+cp -r "$root/worlds" "$stage/penumbra-gpu/src/"
+cp "$root/scripts/gpu/check.sh" "$stage/penumbra-gpu/"
+mkdir -p "$(dirname "$out")"
+tar -C "$stage" -cf - penumbra-gpu | xz -T2 -9 > "$out"
+size=$(stat -c %s "$out")
+echo "pack: $out, $((size / 1024 / 1024)) MiB, $(ls "$stage/penumbra-gpu/lib" | wc -l) libraries"
+if [ "$size" -ge $((64 * 1024 * 1024)) ]; then
+  echo "pack: $out is 64 MiB or more: too large to carry" >&2
+  exit 1
+fi

@@ -1,0 +1,26 @@
+#pragma once
+// binned surface-area-heuristic BVH construction on the CPU (Wald, "On fast construction of
+// SAH-based bounding volume hierarchies", IEEE Symposium on Interactive Ray Tracing 2007): 16
+// bins per axis over the primitives' centroids, leaves of at most 4 primitives.
+
+#include <cstdint>
+#include <vector>
+
+#include "penumbra/render/cuda/bvh_types.h"
+
+namespace penumbra::cuda {
+
+/// an axis-aligned box of one primitive.
+struct PrimBox {
+  float lo[3], hi[3];
+};
+
+/// builds a BVH over `boxes`: appends its nodes to *nodes (root first, children of an inner
+/// node adjacent; node indices relative to the first appended node) and the primitive order to
+/// *prim_index (leaf ranges index *prim_index from `prim_base`'s first appended element; each
+/// element is `prim_base` + a box index). an empty `boxes` gives one empty leaf with an empty
+/// box. deterministic (no threads, no unordered containers).
+void BuildBvh(const std::vector<PrimBox>& boxes, int32_t prim_base, std::vector<BvhNode>* nodes,
+              std::vector<int32_t>* prim_index);
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,26 @@
+#include "penumbra/render/cuda/bvh_ray_query.h"
+
+#include "penumbra/render/cuda/bvh_traversal.h"
+
+namespace penumbra::cuda {
+
+void BvhRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                                 std::span<bool> did_hit) const {
+  const SceneView view = bvh_.view();
+  for (size_t i = 0; i < rays.size(); ++i) {
+    did_hit[i] = false;
+    if (!IsTraceableRay(rays[i])) continue;
+    TraceHit th;
+    TraceClosest(view, ToTraceRay(rays[i]), &th);
+    if (th.instance < 0) continue;
+    did_hit[i] = true;
+    bvh_.FinishHit(rays[i], th, &hits[i]);
+  }
+}
+
+bool BvhRayQuery::Occluded(const Ray& ray) const {
+  if (!IsTraceableRay(ray)) return false;
+  return TraceOccluded(bvh_.view(), ToTraceRay(ray));
+}
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,36 @@
+#pragma once
+// the CUDA backend's traversal (render/cuda/bvh_traversal.h) run on the CPU as a RayQuery: the
+// same PB_HOST_DEVICE code the GPU kernels run, so the tests check the backend's geometry
+// against Embree's RayScene on machines without a GPU. one thread; for the tests and as the
+// reference of the GPU query, not for speed.
+
+#include <span>
+
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/ray_query.h"
+
+namespace penumbra::cuda {
+
+/// RayQuery over a BvhScene, traversed on the host (see the file comment).
+class BvhRayQuery final : public RayQuery {
+ public:
+  /// @throws Error as BvhScene. `scene` is referenced: it must outlive the query.
+  explicit BvhRayQuery(const SceneDescription& scene) : bvh_(scene) {}
+  const SceneDescription& scene() const override { return bvh_.scene(); }
+  void Update(const WorldSnapshot& snapshot) override { bvh_.Update(snapshot); }
+  /// true if anything blocks `ray` in (tmin, tmax); untraceable rays are not occluded.
+  bool Occluded(const Ray& ray) const;
+  const BvhScene& bvh() const { return bvh_; }
+
+ private:
+  void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                      std::span<bool> did_hit) const override;
+  BvhScene bvh_;
+};
+
+/// the traversal's form of `ray`.
+inline TraceRay ToTraceRay(const Ray& r) {
+  return {{r.o.x(), r.o.y(), r.o.z()}, {r.d.x(), r.d.y(), r.d.z()}, r.tmin, r.tmax};
+}
+
+}  // namespace penumbra::cuda

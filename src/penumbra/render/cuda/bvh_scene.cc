@@ -1,0 +1,301 @@
+#include "penumbra/render/cuda/bvh_scene.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/triangle_shapes.h"
+
+namespace penumbra::cuda {
+namespace {
+
+// half-size (m) of the quad that stands in for an infinite MJCF plane (RayScene's
+// kInfinitePlaneHalfSize, render/embree/ray_scene.h; the root may not include render/embree).
+constexpr double kInfinitePlane = 1e4;
+
+AnalyticKind KindOf(GeomShape shape) {
+  switch (shape) {
+    case GeomShape::kPlane:
+      return AnalyticKind::kPlane;
+    case GeomShape::kSphere:
+      return AnalyticKind::kSphere;
+    case GeomShape::kCapsule:
+      return AnalyticKind::kCapsule;
+    case GeomShape::kEllipsoid:
+      return AnalyticKind::kEllipsoid;
+    default:
+      return AnalyticKind::kCylinder;
+  }
+}
+
+void ToRowMajor(const Pose& X, float m[12]) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[4 * r + c] = static_cast<float>(X.linear()(r, c));
+    m[4 * r + 3] = static_cast<float>(X.translation()(r));
+  }
+}
+
+F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+BvhScene::BvhScene(const SceneDescription& scene) : scene_(scene) {
+  const int num_bodies = static_cast<int>(scene.bodies.size());
+  X_WB_.assign(num_bodies, Pose::Identity());
+  static_poses_ = X_WB_;
+  groups_.resize(1);
+  std::vector<int> group_of_body(num_bodies, -1);
+  for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
+    const Geom& g = scene.geoms[gi];
+    if (g.group > 2) continue;
+    if (g.material >= static_cast<int>(scene.materials.size()))
+      throw Error("BvhScene: geom '" + g.name + "' refers to missing material " +
+                  std::to_string(g.material));
+    if (g.material >= 0 && scene.materials[g.material].alpha < 0.5f) continue;
+    if (g.body < 0 || g.body >= num_bodies)
+      throw Error("BvhScene: geom '" + g.name + "' refers to missing body " +
+                  std::to_string(g.body));
+    if (g.shape == GeomShape::kMesh &&
+        (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())))
+      throw Error("BvhScene: geom '" + g.name + "' refers to missing mesh " +
+                  std::to_string(g.mesh));
+    if (g.shape == GeomShape::kHeightField &&
+        (g.hfield < 0 || g.hfield >= static_cast<int>(scene.hfields.size())))
+      throw Error("BvhScene: geom '" + g.name + "' refers to missing height field " +
+                  std::to_string(g.hfield));
+    if (g.body == 0 || scene.bodies[g.body].is_static) {
+      groups_[0].geoms.push_back(gi);
+    } else {
+      int& k = group_of_body[g.body];
+      if (k < 0) {
+        k = static_cast<int>(groups_.size());
+        groups_.emplace_back();
+        groups_.back().body = g.body;
+      }
+      groups_[k].geoms.push_back(gi);
+    }
+  }
+  BuildAll();
+}
+
+void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, int record) {
+  const Geom& geom = scene_.geoms[gi];
+  if (geom.shape == GeomShape::kBox || geom.shape == GeomShape::kMesh ||
+      geom.shape == GeomShape::kHeightField) {
+    const TriangleShape shape = geom.shape == GeomShape::kBox ? BoxTriangles(geom.size)
+                                : geom.shape == GeomShape::kMesh
+                                    ? MeshTriangles(scene_.meshes[geom.mesh])
+                                    : HeightFieldTriangles(scene_.hfields[geom.hfield]);
+    const Eigen::Matrix3f R = X_IG.linear().cast<float>();
+    const Eigen::Vector3f p = X_IG.translation().cast<float>();
+    std::vector<Eigen::Vector3f> v_I(shape.vertices.size());
+    for (size_t i = 0; i < v_I.size(); ++i) v_I[i] = R * shape.vertices[i] + p;
+    for (size_t f = 0; f < shape.faces.size(); ++f) {
+      const Eigen::Vector3i& face = shape.faces[f];
+      const Eigen::Vector3f &a = v_I[face[0]], &b = v_I[face[1]], &c = v_I[face[2]];
+      Triangle tri{ToF3(a), ToF3(b - a), ToF3(c - a)};
+      PrimRef ref;
+      ref.kind = 0;
+      ref.index = static_cast<int32_t>(triangles_.size());
+      ref.record = record;
+      ref.face = static_cast<int32_t>(f);
+      triangles_.push_back(tri);
+      prims_.push_back(ref);
+      PrimBox box;
+      const Eigen::Vector3f lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+      for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
+      boxes->push_back(box);
+    }
+    return;
+  }
+  AnalyticPrim a;
+  a.kind = KindOf(geom.shape);
+  a.size[0] = geom.size.x(), a.size[1] = geom.size.y(), a.size[2] = geom.size.z();
+  if (a.kind == AnalyticKind::kPlane) {
+    a.size[0] = geom.size.x() > 0 ? geom.size.x() : kInfinitePlane;
+    a.size[1] = geom.size.y() > 0 ? geom.size.y() : kInfinitePlane;
+    a.size[2] = 0;
+  }
+  const Pose X_GI = X_IG.inverse();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) a.R_GI[3 * r + c] = X_GI.linear()(r, c);
+    a.p_GI[r] = X_GI.translation()(r);
+  }
+  AnalyticShape shape;
+  shape.kind = a.kind;
+  shape.size = {a.size[0], a.size[1], a.size[2]};
+  const Eigen::Vector3d h = AnalyticHalfExtents(shape);
+  if (!(h.minCoeff() >= 0) || !h.allFinite() ||
+      (a.kind != AnalyticKind::kPlane && !(h.minCoeff() > 0)))
+    throw Error("BvhScene: geom '" + geom.name + "' has a non-positive size for its shape");
+  // group-frame box of the rotated geom box, padded as RayScene's AnalyticBounds
+  const Eigen::Vector3d c = X_IG.translation();
+  const Eigen::Vector3d e = X_IG.linear().cwiseAbs() * h;
+  const Eigen::Vector3d pad = 1e-6 * (Eigen::Vector3d::Ones() + c.cwiseAbs() + e);
+  PrimBox box;
+  for (int k = 0; k < 3; ++k) {
+    box.lo[k] = static_cast<float>(c[k] - e[k] - pad[k]);
+    box.hi[k] = static_cast<float>(c[k] + e[k] + pad[k]);
+  }
+  PrimRef ref;
+  ref.kind = 1;
+  ref.index = static_cast<int32_t>(analytics_.size());
+  ref.record = record;
+  analytics_.push_back(a);
+  prims_.push_back(ref);
+  boxes->push_back(box);
+}
+
+void BvhScene::BuildAll() {
+  const auto start = std::chrono::steady_clock::now();
+  nodes_.clear();
+  prim_index_.clear();
+  prims_.clear();
+  triangles_.clear();
+  analytics_.clear();
+  blases_.clear();
+  records_.clear();
+  record_group_.clear();
+  X_GI_.clear();
+  for (size_t k = 0; k < groups_.size(); ++k) {
+    Group& g = groups_[k];
+    std::vector<PrimBox> boxes;
+    const int32_t prim_base = static_cast<int32_t>(prims_.size());
+    for (int gi : g.geoms) {
+      const Geom& geom = scene_.geoms[gi];
+      const Pose X_IG = g.body < 0 ? Pose(static_poses_[geom.body] * geom.X_BG) : geom.X_BG;
+      Record rec;
+      rec.geom = gi;
+      rec.material = geom.material;
+      rec.mujoco_id = geom.id;
+      rec.body = geom.body;
+      rec.semantic_class = geom.semantic_class;
+      const int record = static_cast<int>(records_.size());
+      records_.push_back(rec);
+      record_group_.push_back(static_cast<int>(k));
+      X_GI_.push_back(X_IG.inverse());
+      AddGeom(gi, X_IG, &boxes, record);
+    }
+    if (boxes.empty()) {
+      g.blas = -1;
+      continue;
+    }
+    Blas blas;
+    blas.node_offset = static_cast<int32_t>(nodes_.size());
+    BuildBvh(boxes, prim_base, &nodes_, &prim_index_);
+    blas.num_nodes = static_cast<int32_t>(nodes_.size()) - blas.node_offset;
+    g.blas = static_cast<int>(blases_.size());
+    blases_.push_back(blas);
+  }
+  ++geometry_version_;
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  SetInstances();
+}
+
+void BvhScene::SetInstances() {
+  instances_.clear();
+  for (size_t k = 0; k < groups_.size(); ++k) {
+    Group& g = groups_[k];
+    if (g.blas < 0) continue;
+    g.X_WI = g.body < 0 ? Pose::Identity() : X_WB_[g.body];
+    Instance in;
+    in.blas = g.blas;
+    in.group = static_cast<int32_t>(k);
+    ToRowMajor(g.X_WI, in.X_WI);
+    ToRowMajor(g.X_WI.inverse(), in.X_IW);
+    // world box of the posed root box
+    const BvhNode& root = nodes_[blases_[g.blas].node_offset];
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? root.hi[0] : root.lo[0],
+                                   (c & 2) ? root.hi[1] : root.lo[1],
+                                   (c & 4) ? root.hi[2] : root.lo[2]);
+      const Eigen::Vector3d w = g.X_WI * corner;
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+    // pad against float rounding of the transformed ray
+    const Eigen::Vector3d pad =
+        1e-5 * (Eigen::Vector3d::Ones() + lo.cwiseAbs().cwiseMax(hi.cwiseAbs()));
+    for (int a = 0; a < 3; ++a) {
+      in.lo[a] = static_cast<float>(lo[a] - pad[a]);
+      in.hi[a] = static_cast<float>(hi[a] + pad[a]);
+    }
+    instances_.push_back(in);
+  }
+}
+
+void BvhScene::Update(const WorldSnapshot& snapshot) {
+  if (snapshot.X_WB.size() != X_WB_.size())
+    throw Error("BvhScene::Update: snapshot has " + std::to_string(snapshot.X_WB.size()) +
+                " body poses, scene has " + std::to_string(X_WB_.size()) + " bodies");
+  X_WB_ = snapshot.X_WB;
+  bool static_moved = false;
+  for (int gi : groups_[0].geoms) {
+    const int b = scene_.geoms[gi].body;
+    if (snapshot.X_WB[b].matrix() != static_poses_[b].matrix()) static_moved = true;
+  }
+  if (static_moved) {
+    static_poses_ = snapshot.X_WB;
+    BuildAll();
+    return;
+  }
+  SetInstances();
+}
+
+SceneView BvhScene::view() const {
+  SceneView v;
+  v.nodes = nodes_.data();
+  v.prim_index = prim_index_.data();
+  v.prims = prims_.data();
+  v.triangles = triangles_.data();
+  v.analytics = analytics_.data();
+  v.blases = blases_.data();
+  v.instances = instances_.data();
+  v.num_instances = static_cast<int32_t>(instances_.size());
+  v.records = records_.data();
+  return v;
+}
+
+void BvhScene::FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) const {
+  const PrimRef& pr = prims_[th.prim];
+  const Record& rec = records_[pr.record];
+  const Group& g = groups_[record_group_[pr.record]];
+  const Pose& X_GI = X_GI_[pr.record];
+  hit->t = th.t;
+  hit->p_W = ray.o + th.t * ray.d;
+  hit->geom = rec.geom;
+  hit->material = rec.material;
+  hit->has_uv = false;
+  hit->uv.setZero();
+  hit->uv_per_m = 0;
+  hit->duv_dp_G.setZero();
+  const Eigen::Vector3d p_W =
+      ray.o.cast<double>() + static_cast<double>(th.t) * ray.d.cast<double>();
+  const Eigen::Vector3d p_G = X_GI * (g.X_WI.inverse() * p_W);
+  const Eigen::Matrix3d R_GW = X_GI.linear() * g.X_WI.linear().transpose();
+  Eigen::Vector3d n_G;
+  if (pr.kind == 1) {
+    const AnalyticPrim& a = analytics_[pr.index];
+    AnalyticNormalArrays(a.kind, a.size, p_G.data(), th.part, n_G.data());
+  } else {
+    const Triangle& t = triangles_[pr.index];
+    const Eigen::Vector3d e1(t.e1.x, t.e1.y, t.e1.z), e2(t.e2.x, t.e2.y, t.e2.z);
+    const Eigen::Vector3d n_I = e1.cross(e2);
+    const double len = n_I.norm();
+    n_G = len > 0 ? Eigen::Vector3d(X_GI.linear() * (n_I / len)) : Eigen::Vector3d::UnitZ();
+  }
+  hit->p_G = p_G.cast<float>();
+  hit->n_G = n_G.cast<float>();
+  hit->d_G = (R_GW * ray.d.cast<double>()).normalized().cast<float>();
+  Eigen::Vector3f ng_W = (R_GW.transpose() * n_G).cast<float>();
+  hit->front_face = ng_W.dot(ray.d) <= 0;
+  if (!hit->front_face) ng_W = -ng_W;
+  hit->ng_W = ng_W;
+  hit->ns_W = ng_W;
+}
+
+}  // namespace penumbra::cuda

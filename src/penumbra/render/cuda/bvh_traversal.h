@@ -1,0 +1,176 @@
+#pragma once
+// closest-hit and occlusion traversal of the two-level BVH of bvh_types.h, written once as
+// PB_HOST_DEVICE functions: BvhRayQuery runs them on the CPU (and the tests check them there
+// against Embree), the CUDA kernels (cuda_kernels.cu) on the GPU.
+//
+// top level: every instance whose world box the ray enters, nearest box first not needed (a
+// handful of instances); the ray is taken to the instance frame in float (as Embree's
+// instancing). bottom level: a stack traversal, the nearer child first, slab tests of
+// Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
+// triangles: Moller and Trumbore, "Fast, minimum storage ray/triangle intersection" (JGT
+// 1997), in float; analytic shapes: IntersectAnalyticArrays (render/analytic_shapes.h) in
+// double in the geom frame, as RayScene.
+
+#include <cmath>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/render/analytic_shape_math.h"
+#include "penumbra/render/cuda/bvh_types.h"
+
+namespace penumbra::cuda {
+
+/// deepest BLAS the traversal's stack holds (the builder keeps trees shallower).
+constexpr int kMaxBvhDepth = 64;
+
+/// p transformed by the row-major 3x4 matrix m (rotation and translation).
+PB_HOST_DEVICE inline F3 TransformPoint(const float m[12], F3 p) {
+  return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+          m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
+}
+
+/// v rotated by the rotation part of the row-major 3x4 matrix m.
+PB_HOST_DEVICE inline F3 TransformVector(const float m[12], F3 v) {
+  return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+          m[8] * v.x + m[9] * v.y + m[10] * v.z};
+}
+
+/// entry distance of o + t d (inv_d = 1 / d per axis) into box [lo, hi] within [tmin, tmax],
+/// or +infinity if the ray misses it.
+PB_HOST_DEVICE inline float SlabEntry(const float lo[3], const float hi[3], F3 o, F3 inv_d,
+                                      float tmin, float tmax) {
+  const float tx0 = (lo[0] - o.x) * inv_d.x, tx1 = (hi[0] - o.x) * inv_d.x;
+  const float ty0 = (lo[1] - o.y) * inv_d.y, ty1 = (hi[1] - o.y) * inv_d.y;
+  const float tz0 = (lo[2] - o.z) * inv_d.z, tz1 = (hi[2] - o.z) * inv_d.z;
+  const float t0 = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), tmin));
+  const float t1 = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
+  return t0 <= t1 ? t0 : INFINITY;
+}
+
+/// Moller-Trumbore: t in (tmin, tmax) and barycentrics (u, v) of the hit of o + t d with tri.
+PB_HOST_DEVICE inline bool IntersectTriangle(const Triangle& tri, F3 o, F3 d, float tmin,
+                                             float tmax, float* t, float* u, float* v) {
+  const F3 p{d.y * tri.e2.z - d.z * tri.e2.y, d.z * tri.e2.x - d.x * tri.e2.z,
+             d.x * tri.e2.y - d.y * tri.e2.x};
+  const float det = tri.e1.x * p.x + tri.e1.y * p.y + tri.e1.z * p.z;
+  if (det == 0.0f) return false;
+  const float inv = 1.0f / det;
+  const F3 s{o.x - tri.v0.x, o.y - tri.v0.y, o.z - tri.v0.z};
+  const float uu = (s.x * p.x + s.y * p.y + s.z * p.z) * inv;
+  if (!(uu >= 0.0f && uu <= 1.0f)) return false;
+  const F3 q{s.y * tri.e1.z - s.z * tri.e1.y, s.z * tri.e1.x - s.x * tri.e1.z,
+             s.x * tri.e1.y - s.y * tri.e1.x};
+  const float vv = (d.x * q.x + d.y * q.y + d.z * q.z) * inv;
+  if (!(vv >= 0.0f && uu + vv <= 1.0f)) return false;
+  const float tt = (tri.e2.x * q.x + tri.e2.y * q.y + tri.e2.z * q.z) * inv;
+  if (!(tt > tmin && tt < tmax)) return false;
+  *t = tt, *u = uu, *v = vv;
+  return true;
+}
+
+/// the hit of o + t d (group frame) with analytic prim a, t in (tmin, tmax), in double.
+PB_HOST_DEVICE inline bool IntersectAnalyticPrim(const AnalyticPrim& a, F3 o, F3 d, float tmin,
+                                                 float tmax, float* t, int* part) {
+  const double* R = a.R_GI;
+  const double oi[3] = {o.x, o.y, o.z}, di[3] = {d.x, d.y, d.z};
+  double og[3], dg[3];
+  for (int r = 0; r < 3; ++r) {
+    og[r] = R[3 * r] * oi[0] + R[3 * r + 1] * oi[1] + R[3 * r + 2] * oi[2] + a.p_GI[r];
+    dg[r] = R[3 * r] * di[0] + R[3 * r + 1] * di[1] + R[3 * r + 2] * di[2];
+  }
+  double td;
+  if (!IntersectAnalyticArrays(a.kind, a.size, og, dg, tmin, tmax, &td, part)) return false;
+  const float tf = static_cast<float>(td);
+  if (!(tf < tmax)) return false;
+  *t = tf;
+  return true;
+}
+
+/// traverses one BLAS with the ray in its frame; any_hit: stop at the first hit (occlusion).
+/// updates *hit (t shrinks) and returns whether it hit.
+PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
+                                        F3 d, float tmin, bool any_hit, TraceHit* hit) {
+  const F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
+  const BvhNode* nodes = s.nodes + blas.node_offset;
+  int stack[kMaxBvhDepth];
+  int top = 0;
+  bool found = false;
+  int node = 0;
+  if (SlabEntry(nodes[0].lo, nodes[0].hi, o, inv, tmin, hit->t) == INFINITY) return false;
+  while (true) {
+    const BvhNode& n = nodes[node];
+    if (n.count > 0) {
+      for (int k = 0; k < n.count; ++k) {
+        const int pi = s.prim_index[n.first + k];
+        const PrimRef& pr = s.prims[pi];
+        float t, u = 0, v = 0;
+        int part = 0;
+        const bool h =
+            pr.kind == 0
+                ? IntersectTriangle(s.triangles[pr.index], o, d, tmin, hit->t, &t, &u, &v)
+                : IntersectAnalyticPrim(s.analytics[pr.index], o, d, tmin, hit->t, &t, &part);
+        if (!h) continue;
+        hit->t = t, hit->u = u, hit->v = v, hit->part = part;
+        hit->prim = pi, hit->instance = instance;
+        found = true;
+        if (any_hit) return true;
+      }
+    } else {
+      const int a = n.first, b = n.first + 1;
+      const float ta = SlabEntry(nodes[a].lo, nodes[a].hi, o, inv, tmin, hit->t);
+      const float tb = SlabEntry(nodes[b].lo, nodes[b].hi, o, inv, tmin, hit->t);
+      const bool ha = ta != INFINITY, hb = tb != INFINITY;
+      if (ha && hb) {
+        const int nearer = ta <= tb ? a : b, farther = ta <= tb ? b : a;
+        if (top < kMaxBvhDepth) stack[top++] = farther;
+        node = nearer;
+        continue;
+      }
+      if (ha || hb) {
+        node = ha ? a : b;
+        continue;
+      }
+    }
+    // pop, skipping nodes now farther than the closest hit
+    bool next = false;
+    while (top > 0) {
+      const int c = stack[--top];
+      if (SlabEntry(nodes[c].lo, nodes[c].hi, o, inv, tmin, hit->t) != INFINITY) {
+        node = c;
+        next = true;
+        break;
+      }
+    }
+    if (!next) break;
+  }
+  return found;
+}
+
+/// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.
+PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, TraceHit* hit) {
+  hit->t = r.tmax;
+  hit->instance = -1;
+  hit->prim = -1;
+  const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
+  for (int i = 0; i < s.num_instances; ++i) {
+    const Instance& in = s.instances[i];
+    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, false, hit);
+  }
+}
+
+/// true if anything blocks ray r in (tmin, tmax).
+PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) {
+  TraceHit hit;
+  hit.t = r.tmax;
+  const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
+  for (int i = 0; i < s.num_instances; ++i) {
+    const Instance& in = s.instances[i];
+    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    if (TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit)) return true;
+  }
+  return false;
+}
+
+}  // namespace penumbra::cuda

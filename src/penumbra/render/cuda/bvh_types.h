@@ -1,0 +1,107 @@
+#pragma once
+// the CUDA backend's scene in flat arrays of plain structs, read by the same traversal code on
+// the CPU (tests, BvhRayQuery) and on the GPU (CudaRayQuery, CudaRenderer): a two-level BVH as
+// RayScene's Embree scenes (render/embree/ray_scene.h). bottom level: one BVH per instanced
+// group (the static bodies merged in the world frame, built once and again only if a static
+// body moves; each moving body in its body frame, built once); top level: the instances, their
+// transforms rewritten from every snapshot (no rebuild). no Eigen and no standard containers
+// here: device code reads these through raw pointers (render/cuda/bvh_traversal.h).
+
+#include <cstdint>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/render/analytic_shape_math.h"
+
+namespace penumbra::cuda {
+
+/// a float 3-vector (no Eigen in device code).
+struct F3 {
+  float x = 0, y = 0, z = 0;
+};
+
+/// a BVH node: a box and either two children (count == 0: children at `first` and
+/// `first + 1`) or a leaf of `count` primitives prim_index[first .. first + count).
+struct BvhNode {
+  float lo[3], hi[3];
+  int32_t first = 0;
+  int32_t count = 0;
+};
+
+/// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them).
+struct Triangle {
+  F3 v0, e1, e2;
+};
+
+/// an analytic shape (render/analytic_shapes.h) and the map from its group's frame to its own:
+/// p_G = R_GI p_I + p_GI (double, as RayScene).
+struct AnalyticPrim {
+  AnalyticKind kind = AnalyticKind::kSphere;
+  double size[3] = {1, 1, 1};
+  double R_GI[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< row-major
+  double p_GI[3] = {0, 0, 0};
+};
+
+/// a primitive: a triangle (kind 0) or an analytic shape (kind 1), with the record (geom) it
+/// belongs to and its index in that geom's mesh (triangles) for normals.
+struct PrimRef {
+  int32_t kind = 0;    ///< 0 = triangle, 1 = analytic
+  int32_t index = 0;   ///< into triangles or analytics
+  int32_t record = 0;  ///< into the scene's records
+  int32_t face = 0;    ///< triangle: face index in its geom's mesh
+};
+
+/// a bottom-level BVH: its nodes at nodes[node_offset ..], node 0 the root.
+struct Blas {
+  int32_t node_offset = 0;
+  int32_t num_nodes = 0;
+};
+
+/// an instance of a BLAS posed in the world: X_WI and its inverse as row-major 3x4 floats,
+/// and the world-frame box of the posed BLAS (for the top level).
+struct Instance {
+  int32_t blas = 0;
+  int32_t group = 0;
+  float X_WI[12];  ///< row-major [R | p]
+  float X_IW[12];
+  float lo[3], hi[3];
+};
+
+/// what a primitive's record stands for.
+struct Record {
+  int32_t geom = -1;       ///< index into SceneDescription::geoms
+  int32_t material = -1;   ///< index into SceneDescription::materials
+  int32_t mujoco_id = -1;  ///< Geom::id
+  int32_t body = -1;       ///< Geom::body
+  int32_t semantic_class = 0;
+};
+
+/// the arrays of one scene (host or device pointers) as the traversal reads them.
+struct SceneView {
+  const BvhNode* nodes = nullptr;
+  const int32_t* prim_index = nullptr;  ///< leaf ranges index this, it indexes prims
+  const PrimRef* prims = nullptr;
+  const Triangle* triangles = nullptr;
+  const AnalyticPrim* analytics = nullptr;
+  const Blas* blases = nullptr;
+  const Instance* instances = nullptr;
+  int32_t num_instances = 0;
+  const Record* records = nullptr;  ///< by PrimRef::record
+};
+
+/// a ray in the traversal's form (world frame; d not necessarily unit).
+struct TraceRay {
+  F3 o, d;
+  float tmin = 0, tmax = 0;
+};
+
+/// the closest hit of a traced ray: t, the instance and primitive, and where on it (triangle:
+/// barycentrics u, v; analytic: part in `part`).
+struct TraceHit {
+  float t = 0;
+  int32_t instance = -1;  ///< -1 = miss
+  int32_t prim = -1;      ///< into prims
+  float u = 0, v = 0;
+  int32_t part = 0;
+};
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,307 @@
+// the CUDA backend's device code (cuda_kernels.h): the kernels run bvh_traversal.h, the same
+// PB_HOST_DEVICE functions the CPU tests run.
+
+#include <cuda_runtime.h>
+
+#include <cmath>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/analytic_shape_math.h"
+#include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
+
+namespace penumbra::cuda {
+namespace {
+
+void Check(cudaError_t e, const char* what) {
+  if (e != cudaSuccess)
+    throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(e));
+}
+
+// a device buffer that grows (never shrinks) to the bytes asked for.
+struct Buffer {
+  void* p = nullptr;
+  size_t bytes = 0;
+  void Reserve(size_t n) {
+    if (n <= bytes) return;
+    if (p) cudaFree(p);
+    p = nullptr;
+    bytes = 0;
+    Check(cudaMalloc(&p, n), "cudaMalloc");
+    bytes = n;
+  }
+  void Upload(const void* src, size_t n, cudaStream_t s) {
+    Reserve(n > 0 ? n : 1);
+    if (n > 0) Check(cudaMemcpyAsync(p, src, n, cudaMemcpyHostToDevice, s), "cudaMemcpyAsync");
+  }
+  ~Buffer() {
+    if (p) cudaFree(p);
+  }
+};
+
+__global__ void TraceKernel(SceneView s, const TraceRay* rays, int64_t n, TraceHit* hits) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  TraceHit h;
+  TraceClosest(s, rays[i], &h);
+  hits[i] = h;
+}
+
+__global__ void OccludedKernel(SceneView s, const TraceRay* rays, int64_t n, uint8_t* occ) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  occ[i] = TraceOccluded(s, rays[i]) ? 1 : 0;
+}
+
+// unit world normal of hit h of world ray (o, d), facing the ray.
+__device__ F3 HitNormal(const SceneView& s, const TraceRay& r, const TraceHit& h) {
+  const Instance& in = s.instances[h.instance];
+  const PrimRef& pr = s.prims[h.prim];
+  F3 n_I;
+  if (pr.kind == 0) {
+    const Triangle& t = s.triangles[pr.index];
+    n_I = {t.e1.y * t.e2.z - t.e1.z * t.e2.y, t.e1.z * t.e2.x - t.e1.x * t.e2.z,
+           t.e1.x * t.e2.y - t.e1.y * t.e2.x};
+  } else {
+    const AnalyticPrim& a = s.analytics[pr.index];
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    const double p_I[3] = {o.x + static_cast<double>(h.t) * d.x,
+                           o.y + static_cast<double>(h.t) * d.y,
+                           o.z + static_cast<double>(h.t) * d.z};
+    double p_G[3], n_G[3];
+    for (int k = 0; k < 3; ++k)
+      p_G[k] = a.R_GI[3 * k] * p_I[0] + a.R_GI[3 * k + 1] * p_I[1] + a.R_GI[3 * k + 2] * p_I[2] +
+               a.p_GI[k];
+    AnalyticNormalArrays(a.kind, a.size, p_G, h.part, n_G);
+    // n_I = R_GI^T n_G
+    n_I = {static_cast<float>(a.R_GI[0] * n_G[0] + a.R_GI[3] * n_G[1] + a.R_GI[6] * n_G[2]),
+           static_cast<float>(a.R_GI[1] * n_G[0] + a.R_GI[4] * n_G[1] + a.R_GI[7] * n_G[2]),
+           static_cast<float>(a.R_GI[2] * n_G[0] + a.R_GI[5] * n_G[1] + a.R_GI[8] * n_G[2])};
+  }
+  F3 n = TransformVector(in.X_WI, n_I);
+  const float len = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
+  n = len > 0 ? F3{n.x / len, n.y / len, n.z / len} : F3{0, 0, 1};
+  if (n.x * r.d.x + n.y * r.d.y + n.z * r.d.z > 0) n = {-n.x, -n.y, -n.z};
+  return n;
+}
+
+struct DevicePrimary {
+  float* depth;
+  int32_t* geom_id;
+  float* range;
+  float* normal_O;
+  int32_t* body_id;
+  int32_t* semantic;
+};
+
+__global__ void PrimaryKernel(SceneView s, PinholeCamera c, DevicePrimary out) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= c.width || v >= c.height) return;
+  const float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
+  const float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
+  TraceRay r;
+  r.o = c.o;
+  r.d = {x * c.ex.x + y * c.ey.x + c.ez.x, x * c.ex.y + y * c.ey.y + c.ez.y,
+         x * c.ex.z + y * c.ey.z + c.ez.z};
+  r.tmin = c.near;
+  r.tmax = INFINITY;
+  TraceHit h;
+  TraceClosest(s, r, &h);
+  const bool hit = h.instance >= 0;
+  const Record* rec = hit ? &s.records[s.prims[h.prim].record] : nullptr;
+  const int64_t i = static_cast<int64_t>(v) * c.width + u;
+  if (out.depth) out.depth[i] = hit ? h.t : 0.0f;
+  if (out.geom_id) out.geom_id[i] = rec && rec->geom >= 0 ? rec->mujoco_id : -1;
+  if (out.range)
+    out.range[i] = hit ? h.t * sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z) : 0.0f;
+  if (out.body_id) out.body_id[i] = rec ? rec->body : -1;
+  if (out.semantic) out.semantic[i] = rec ? rec->semantic_class : 0;
+  if (out.normal_O) {
+    float* n = out.normal_O + 3 * i;
+    if (hit) {
+      const F3 w = HitNormal(s, r, h);
+      n[0] = c.ex.x * w.x + c.ex.y * w.y + c.ex.z * w.z;
+      n[1] = c.ey.x * w.x + c.ey.y * w.y + c.ey.z * w.z;
+      n[2] = c.ez.x * w.x + c.ez.y * w.y + c.ez.z * w.z;
+    } else {
+      n[0] = n[1] = n[2] = 0.0f;
+    }
+  }
+}
+
+}  // namespace
+
+bool ProbeDevice(std::string* name, std::string* why) {
+  int count = 0;
+  const cudaError_t e = cudaGetDeviceCount(&count);
+  if (e != cudaSuccess) {
+    if (why) *why = cudaGetErrorString(e);
+    cudaGetLastError();  // clear the sticky error
+    return false;
+  }
+  if (count < 1) {
+    if (why) *why = "no CUDA device";
+    return false;
+  }
+  cudaDeviceProp prop;
+  if (cudaGetDeviceProperties(&prop, 0) != cudaSuccess) {
+    if (why) *why = "cudaGetDeviceProperties failed";
+    return false;
+  }
+  if (name) *name = prop.name;
+  return true;
+}
+
+struct DeviceScene::Impl {
+  cudaStream_t stream = nullptr;
+  Buffer nodes, prim_index, prims, triangles, analytics, blases, records, instances;
+  Buffer rays, hits, out[6];
+  int64_t geometry_version = -1;
+  SceneView view;
+};
+
+DeviceScene::DeviceScene() : impl_(new Impl) {
+  try {
+    Check(cudaStreamCreate(&impl_->stream), "cudaStreamCreate");
+  } catch (...) {
+    delete impl_;
+    throw;
+  }
+}
+
+DeviceScene::~DeviceScene() {
+  if (impl_->stream) cudaStreamDestroy(impl_->stream);
+  delete impl_;
+}
+
+void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version) {
+  Impl& m = *impl_;
+  if (geometry_version != m.geometry_version) {
+    m.nodes.Upload(v.nodes, n.nodes * sizeof(BvhNode), m.stream);
+    m.prim_index.Upload(v.prim_index, n.prim_index * sizeof(int32_t), m.stream);
+    m.prims.Upload(v.prims, n.prims * sizeof(PrimRef), m.stream);
+    m.triangles.Upload(v.triangles, n.triangles * sizeof(Triangle), m.stream);
+    m.analytics.Upload(v.analytics, n.analytics * sizeof(AnalyticPrim), m.stream);
+    m.blases.Upload(v.blases, n.blases * sizeof(Blas), m.stream);
+    m.records.Upload(v.records, n.records * sizeof(Record), m.stream);
+    m.geometry_version = geometry_version;
+  }
+  m.instances.Upload(v.instances, v.num_instances * sizeof(Instance), m.stream);
+  m.view.nodes = static_cast<const BvhNode*>(m.nodes.p);
+  m.view.prim_index = static_cast<const int32_t*>(m.prim_index.p);
+  m.view.prims = static_cast<const PrimRef*>(m.prims.p);
+  m.view.triangles = static_cast<const Triangle*>(m.triangles.p);
+  m.view.analytics = static_cast<const AnalyticPrim*>(m.analytics.p);
+  m.view.blases = static_cast<const Blas*>(m.blases.p);
+  m.view.records = static_cast<const Record*>(m.records.p);
+  m.view.instances = static_cast<const Instance*>(m.instances.p);
+  m.view.num_instances = v.num_instances;
+  Check(cudaStreamSynchronize(m.stream), "uploading the scene");
+}
+
+void DeviceScene::Trace(const TraceRay* rays, int64_t n, TraceHit* hits) {
+  if (n <= 0) return;
+  Impl& m = *impl_;
+  m.rays.Upload(rays, n * sizeof(TraceRay), m.stream);
+  m.hits.Reserve(n * sizeof(TraceHit));
+  const int block = 128;
+  TraceKernel<<<static_cast<unsigned>((n + block - 1) / block), block, 0, m.stream>>>(
+      m.view, static_cast<const TraceRay*>(m.rays.p), n, static_cast<TraceHit*>(m.hits.p));
+  Check(cudaGetLastError(), "TraceKernel launch");
+  Check(cudaMemcpyAsync(hits, m.hits.p, n * sizeof(TraceHit), cudaMemcpyDeviceToHost, m.stream),
+        "copying hits back");
+  Check(cudaStreamSynchronize(m.stream), "TraceKernel");
+}
+
+void DeviceScene::Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded) {
+  if (n <= 0) return;
+  Impl& m = *impl_;
+  m.rays.Upload(rays, n * sizeof(TraceRay), m.stream);
+  m.hits.Reserve(n);
+  const int block = 128;
+  OccludedKernel<<<static_cast<unsigned>((n + block - 1) / block), block, 0, m.stream>>>(
+      m.view, static_cast<const TraceRay*>(m.rays.p), n, static_cast<uint8_t*>(m.hits.p));
+  Check(cudaGetLastError(), "OccludedKernel launch");
+  Check(cudaMemcpyAsync(occluded, m.hits.p, n, cudaMemcpyDeviceToHost, m.stream),
+        "copying occlusion back");
+  Check(cudaStreamSynchronize(m.stream), "OccludedKernel");
+}
+
+namespace {
+
+DevicePrimary Reserve(Buffer* out, int64_t pixels, const PrimaryOutputs& want) {
+  DevicePrimary d{};
+  auto take = [&](int k, bool on, size_t bytes) -> void* {
+    if (!on) return nullptr;
+    out[k].Reserve(bytes);
+    return out[k].p;
+  };
+  d.depth = static_cast<float*>(take(0, want.depth, pixels * 4));
+  d.geom_id = static_cast<int32_t*>(take(1, want.geom_id, pixels * 4));
+  d.range = static_cast<float*>(take(2, want.range, pixels * 4));
+  d.normal_O = static_cast<float*>(take(3, want.normal_O, pixels * 12));
+  d.body_id = static_cast<int32_t*>(take(4, want.body_id, pixels * 4));
+  d.semantic = static_cast<int32_t*>(take(5, want.semantic, pixels * 4));
+  return d;
+}
+
+}  // namespace
+
+void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& want) {
+  Impl& m = *impl_;
+  const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
+  if (pixels <= 0) return;
+  const DevicePrimary d = Reserve(m.out, pixels, want);
+  const dim3 block(8, 8);
+  const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
+  PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
+  Check(cudaGetLastError(), "PrimaryKernel launch");
+  auto back = [&](void* host, const void* dev, size_t bytes) {
+    if (host)
+      Check(cudaMemcpyAsync(host, dev, bytes, cudaMemcpyDeviceToHost, m.stream),
+            "copying an image back");
+  };
+  back(want.depth, d.depth, pixels * 4);
+  back(want.geom_id, d.geom_id, pixels * 4);
+  back(want.range, d.range, pixels * 4);
+  back(want.normal_O, d.normal_O, pixels * 12);
+  back(want.body_id, d.body_id, pixels * 4);
+  back(want.semantic, d.semantic, pixels * 4);
+  Check(cudaStreamSynchronize(m.stream), "PrimaryKernel");
+}
+
+double DeviceScene::TimePrimary(const PinholeCamera& c, int count, bool depth_and_seg_only) {
+  Impl& m = *impl_;
+  const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
+  PrimaryOutputs want;
+  float f = 0;
+  int32_t i = 0;
+  want.depth = &f;
+  want.geom_id = &i;
+  if (!depth_and_seg_only) {
+    want.range = &f;
+    want.normal_O = &f;
+    want.body_id = &i;
+    want.semantic = &i;
+  }
+  const DevicePrimary d = Reserve(m.out, pixels, want);
+  const dim3 block(8, 8);
+  const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
+  PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);  // warm-up
+  cudaEvent_t a, b;
+  Check(cudaEventCreate(&a), "cudaEventCreate");
+  Check(cudaEventCreate(&b), "cudaEventCreate");
+  Check(cudaEventRecord(a, m.stream), "cudaEventRecord");
+  for (int k = 0; k < count; ++k) PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
+  Check(cudaEventRecord(b, m.stream), "cudaEventRecord");
+  Check(cudaEventSynchronize(b), "PrimaryKernel (timed)");
+  float ms = 0;
+  cudaEventElapsedTime(&ms, a, b);
+  cudaEventDestroy(a);
+  cudaEventDestroy(b);
+  return ms / count;
+}
+
+}  // namespace penumbra::cuda

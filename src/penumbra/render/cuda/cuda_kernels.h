@@ -1,0 +1,73 @@
+#pragma once
+// the CUDA backend's device side, behind a plain-struct interface (no Eigen, no CUDA headers
+// here, so that the classes calling it build with the host compiler): device probe, device
+// copies of a BvhScene's arrays, and the kernels that run bvh_traversal.h on the GPU.
+// implemented in cuda_kernels.cu. every function throws penumbra::Error naming the CUDA call
+// and its message when the runtime reports an error.
+
+#include <cstdint>
+#include <string>
+
+#include "penumbra/render/cuda/bvh_types.h"
+
+namespace penumbra::cuda {
+
+/// true if a CUDA device can be used (cudaGetDeviceCount succeeds with >= 1 device); else
+/// false, with the runtime's message in *why (e.g. "CUDA driver version is insufficient for
+/// CUDA runtime version" on a machine without a GPU driver). *name: the first device's name.
+bool ProbeDevice(std::string* name, std::string* why);
+
+/// a pinhole camera as the primary-ray kernel takes it: world ray through pixel (u, v) (pixel
+/// centres are integers) is o + t (((u - cx) inv_fx) ex + ((v - cy) inv_fy) ey + ez), as
+/// Camera::GenerateRay (render/camera.h) for a camera without distortion or motion.
+struct PinholeCamera {
+  F3 o, ex, ey, ez;
+  float cx = 0, cy = 0, inv_fx = 1, inv_fy = 1;
+  float near = 0;
+  int width = 0, height = 0;
+};
+
+/// host buffers a primary render fills (null = not wanted), each width x height (x 3 for
+/// normals), row-major: as RenderedFrame's depth_m, geom_id, range_m, normal_O, body_id,
+/// semantic_class.
+struct PrimaryOutputs {
+  float* depth = nullptr;
+  int32_t* geom_id = nullptr;
+  float* range = nullptr;
+  float* normal_O = nullptr;
+  int32_t* body_id = nullptr;
+  int32_t* semantic = nullptr;
+};
+
+/// the device copy of a BvhScene, its staging buffers and a stream.
+class DeviceScene {
+ public:
+  DeviceScene();
+  ~DeviceScene();
+  DeviceScene(const DeviceScene&) = delete;
+  DeviceScene& operator=(const DeviceScene&) = delete;
+
+  /// the sizes of a SceneView's arrays.
+  struct Sizes {
+    int64_t nodes = 0, prim_index = 0, prims = 0, triangles = 0, analytics = 0, blases = 0,
+            records = 0;
+  };
+  /// copies the arrays of `view` (host pointers) to the device: all of them when
+  /// geometry_version differs from the last call's, else the instances only.
+  void Sync(const SceneView& view, const Sizes& sizes, int64_t geometry_version);
+  /// closest hits of n rays (host arrays).
+  void Trace(const TraceRay* rays, int64_t n, TraceHit* hits);
+  /// occlusion of n rays (host arrays): occluded[i] = 1 if blocked.
+  void Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded);
+  /// one camera's primary rays: the ground-truth images of `out` (copied back to the host).
+  void RenderPrimary(const PinholeCamera& camera, const PrimaryOutputs& out);
+  /// `count` renders of `camera` into device memory only (no copy back), timed with CUDA
+  /// events: the mean milliseconds per frame (benchmarks).
+  double TimePrimary(const PinholeCamera& camera, int count, bool depth_and_seg_only);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace penumbra::cuda

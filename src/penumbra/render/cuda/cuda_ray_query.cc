@@ -1,0 +1,65 @@
+#include "penumbra/render/cuda/cuda_ray_query.h"
+
+#include <string>
+#include <vector>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/cuda/bvh_ray_query.h"
+
+namespace penumbra::cuda {
+
+void SyncDevice(const BvhScene& scene, DeviceScene* device) {
+  DeviceScene::Sizes n;
+  n.nodes = static_cast<int64_t>(scene.nodes().size());
+  n.prim_index = static_cast<int64_t>(scene.prim_index().size());
+  n.prims = static_cast<int64_t>(scene.prims().size());
+  n.triangles = static_cast<int64_t>(scene.triangles().size());
+  n.analytics = static_cast<int64_t>(scene.analytics().size());
+  n.blases = static_cast<int64_t>(scene.blases().size());
+  n.records = static_cast<int64_t>(scene.records().size());
+  device->Sync(scene.view(), n, scene.geometry_version());
+}
+
+CudaRayQuery::CudaRayQuery(const SceneDescription& scene)
+    : bvh_(scene), device_(std::make_unique<DeviceScene>()) {
+  SyncDevice(bvh_, device_.get());
+}
+
+void CudaRayQuery::Update(const WorldSnapshot& snapshot) {
+  bvh_.Update(snapshot);
+  SyncDevice(bvh_, device_.get());
+}
+
+void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                                  std::span<bool> did_hit) const {
+  // untraceable rays are misses: traced as empty segments (tmax < tmin)
+  std::vector<TraceRay> in(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    in[i] = ToTraceRay(rays[i]);
+    if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
+  }
+  std::vector<TraceHit> out(rays.size());
+  const std::lock_guard<std::mutex> lock(mutex_);
+  device_->Trace(in.data(), static_cast<int64_t>(in.size()), out.data());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    did_hit[i] = out[i].instance >= 0;
+    if (did_hit[i]) bvh_.FinishHit(rays[i], out[i], &hits[i]);
+  }
+}
+
+void CudaRayQuery::Occluded(std::span<const Ray> rays, std::span<bool> occluded) const {
+  if (occluded.size() < rays.size())
+    throw Error("CudaRayQuery::Occluded: " + std::to_string(occluded.size()) + " results for " +
+                std::to_string(rays.size()) + " rays");
+  std::vector<TraceRay> in(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    in[i] = ToTraceRay(rays[i]);
+    if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
+  }
+  std::vector<uint8_t> out(rays.size());
+  const std::lock_guard<std::mutex> lock(mutex_);
+  device_->Occluded(in.data(), static_cast<int64_t>(in.size()), out.data());
+  for (size_t i = 0; i < rays.size(); ++i) occluded[i] = out[i] != 0;
+}
+
+}  // namespace penumbra::cuda

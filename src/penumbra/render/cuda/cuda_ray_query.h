@@ -1,0 +1,41 @@
+#pragma once
+// the CUDA backend's RayQuery (render/ray_query.h): the rays of a batch traced by
+// bvh_traversal.h on the GPU (cuda_kernels.h), their hits finished on the host as BvhRayQuery
+// finishes them (BvhScene::FinishHit). the LiDAR and the sky irradiance volume use it through
+// MakeRayQuery (render/backends/renderer_factory.h) with backend cuda.
+
+#include <memory>
+#include <mutex>
+#include <span>
+
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/ray_query.h"
+
+namespace penumbra::cuda {
+
+/// the arrays and sizes of `scene` as DeviceScene::Sync takes them.
+void SyncDevice(const BvhScene& scene, DeviceScene* device);
+
+/// RayQuery on the GPU (see the file comment).
+class CudaRayQuery final : public RayQuery {
+ public:
+  /// @throws Error as BvhScene, or if the CUDA runtime fails (no device: check ProbeDevice
+  /// first). `scene` is referenced: it must outlive the query.
+  explicit CudaRayQuery(const SceneDescription& scene);
+  const SceneDescription& scene() const override { return bvh_.scene(); }
+  void Update(const WorldSnapshot& snapshot) override;
+  /// occlusion of rays[i] in (tmin, tmax) for every i (untraceable rays are not occluded).
+  /// @throws Error if occluded is shorter than rays.
+  void Occluded(std::span<const Ray> rays, std::span<bool> occluded) const;
+
+ private:
+  void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                      std::span<bool> did_hit) const override;
+  BvhScene bvh_;
+  std::unique_ptr<DeviceScene> device_;
+  // Intersect is thread-safe (RayQuery): one batch at a time on the device
+  mutable std::mutex mutex_;
+};
+
+}  // namespace penumbra::cuda
