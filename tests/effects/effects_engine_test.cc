@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "penumbra/core/error.h"
 #include "penumbra/effects/blackbody.h"
@@ -21,6 +22,32 @@ EffectConfig Fog() {
   e.stop_sec = 9;
   e.fade_in_sec = 2;
   return e;
+}
+
+// an unbounded fog is a layer: its top defaults to the top of the model's bounding sphere,
+// layer_top_m overrides it, a region replaces it.
+TEST(EffectsEngineTest, UnboundedFogIsALayerWithATop) {
+  SceneDescription scene;
+  scene.center_W = Eigen::Vector3d(1, 2, 0.5);
+  scene.extent_m = 4;
+  {
+    EffectsEngine engine({Fog()}, 1, scene);
+    auto f = engine.Evaluate(5.0, {0, 0, 0});
+    ASSERT_EQ(f->homogeneous_media.size(), 1u);
+    EXPECT_FLOAT_EQ(f->homogeneous_media[0].layer_top_m, 4.5f);
+  }
+  EffectConfig top = Fog();
+  top.Get<FogParams>().layer_top_m = 30;
+  EffectConfig boxed = Fog();
+  boxed.name = "boxed";
+  boxed.region = BoxRegion{{0, 0, 0}, {1, 1, 1}};
+  EffectsEngine engine({top, boxed}, 1, scene);
+  auto f = engine.Evaluate(5.0, {0, 0, 0});
+  ASSERT_EQ(f->homogeneous_media.size(), 2u);
+  EXPECT_FLOAT_EQ(f->homogeneous_media[0].layer_top_m, 30.0f);
+  EXPECT_TRUE(std::isinf(f->homogeneous_media[1].layer_top_m));
+  top.Get<FogParams>().layer_top_m = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(top.Validate()->key, "layer_top_m");
 }
 
 TEST(EffectsEngineTest, EmptyConfigGivesAnEmptyFrame) {

@@ -242,6 +242,58 @@ TEST(CameraImagerTest, NoiseJpegAndDropletsAreSeededAndLocal) {
   EXPECT_EQ(capture(drops, dry, 0).data, base.data);
 }
 
+// lens droplets follow the shelter map at the camera: none under a roof in the rain, drops
+// under open sky, fading over kDropletLifetimeSec after the camera goes indoors.
+TEST(CameraImagerTest, LensDropletsOnlyUnderOpenSky) {
+  SceneDescription scene = BlackScene();
+  scene.sky.radiance = Eigen::Vector3f(0.2f, 0.1f, 0.05f);
+  const int m = AddMaterial(&scene, Eigen::Vector3f::Zero(), Eigen::Vector3f(0.05f, 0.2f, 0.1f));
+  AddGeom(&scene, GeomShape::kSphere, Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(3, 0, 0), m);
+  AddGeom(&scene, GeomShape::kSphere, Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(3, 5, 0), m);
+  // a static roof 1 m above the origin (the world body)
+  AddGeom(&scene, GeomShape::kBox, Eigen::Vector3d(1, 1, 0.05), Eigen::Vector3d(0, 0, 1), m);
+  RenderSettings rs = Realtime();
+  rs.ev100 = std::log2(0.3 / (0.18 * 1.2));
+  auto renderer = MakeRenderer(scene, rs);
+  const Pose indoors = LookingAlongX(Eigen::Vector3d::Zero());
+  const Pose outdoors = LookingAlongX(Eigen::Vector3d(0, 5, 0));
+  auto fx = std::make_shared<EffectsFrame>();
+  ParticleSet rain;
+  rain.kind = ParticleKind::kRain;
+  rain.position_W.push_back(Eigen::Vector3f(50, 50, 50));  // far out of view
+  rain.velocity_W.push_back(Eigen::Vector3f(0, 0, -5));
+  rain.radius_m.push_back(0.001f);
+  fx->particles.push_back(rain);
+  CameraSensorConfig drops;
+  drops.lens_droplet_count = 3;
+  CameraSensorConfig dry_lens;
+  dry_lens.lens_droplets = false;
+  auto capture = [&](CameraImager* imager, const Pose& X, double t) {
+    CameraImages im;
+    imager->Capture(renderer.get(), Snapshot(scene, t), fx.get(), X, nullptr, X, 0, &im);
+    return im.rgb;
+  };
+  auto reference = [&](const Pose& X, double t) {
+    CameraImager imager(Spec(96, 64, 80), dry_lens, rs, 1, scene);
+    return capture(&imager, X, t);
+  };
+  // indoors in the rain: no drops at all
+  {
+    CameraImager imager(Spec(96, 64, 80), drops, rs, 1, scene);
+    EXPECT_EQ(capture(&imager, indoors, 0.0).data, reference(indoors, 0.0).data);
+  }
+  // outdoors: drops; then indoors they stay a while (fading) and are gone after the lifetime
+  CameraImager imager(Spec(96, 64, 80), drops, rs, 1, scene);
+  EXPECT_NE(capture(&imager, outdoors, 0.0).data, reference(outdoors, 0.0).data);
+  EXPECT_NE(capture(&imager, indoors, 0.5).data, reference(indoors, 0.5).data);
+  EXPECT_EQ(capture(&imager, indoors, 0.5 + kDropletLifetimeSec).data,
+            reference(indoors, 0.5 + kDropletLifetimeSec).data);
+  EXPECT_EQ(LensDropletCount(6, std::nullopt, 1.0), 0);
+  EXPECT_EQ(LensDropletCount(6, 1.0, 1.0), 6);
+  EXPECT_EQ(LensDropletCount(6, 1.0, 1.0 + 0.5 * kDropletLifetimeSec), 3);
+  EXPECT_EQ(LensDropletCount(6, 1.0, 1.0 + kDropletLifetimeSec), 0);
+}
+
 TEST(CameraImagerTest, ThreadCountDoesNotChangeTheImages) {
   SceneDescription scene = BlackScene();
   scene.sky.radiance = Eigen::Vector3f(0.2f, 0.1f, 0.05f);

@@ -27,6 +27,7 @@ cameras:
     noise: {full_well_e: 6000, read_noise_e: 2.5, iso: 800, adc_bits: 10}
     jpeg_quality: 85
     lens_droplets: {count: 4}
+    white_balance: 3200
     depth_noise: {preset: realsense_d435, max_range_m: 6}
     stereo: {baseline_m: 0.12}
 semantic_classes:
@@ -57,6 +58,8 @@ TEST(CameraConfigReaderTest, SensorKeysAndClassesParse) {
   EXPECT_EQ(s.noise.adc_bits, 10);
   EXPECT_EQ(s.jpeg_quality, 85);
   EXPECT_EQ(s.lens_droplet_count, 4);
+  EXPECT_EQ(s.white_balance.mode, WhiteBalance::Mode::kKelvin);
+  EXPECT_EQ(s.white_balance.kelvin, 3200);
   EXPECT_EQ(s.depth_noise.preset, "realsense_d435");
   EXPECT_EQ(*s.depth_noise.max_range_m, 6);
   EXPECT_EQ(*s.stereo_baseline_m, 0.12);
@@ -94,6 +97,8 @@ TEST(CameraConfigReaderTest, BadValuesNameCameraAndKey) {
       {"    noise: {full_well_e: 0}\n", "cameras[0].noise.full_well_e"},
       {"    noise: {adc_bits: 17}\n", "cameras[0].noise.adc_bits"},
       {"    jpeg_quality: 101\n", "cameras[0].jpeg_quality"},
+      {"    white_balance: 1000\n", "cameras[0].white_balance"},
+      {"    white_balance: sunny\n", "cameras[0].white_balance"},
       {"    depth_noise: {preset: kinect_v3}\n", "cameras[0].depth_noise.preset"},
       {"    stereo: {baseline_m: 0}\n", "cameras[0].stereo.baseline_m"},
       {"    distortion: {k4: 0.1}\n", "cameras[0].distortion.k4"},

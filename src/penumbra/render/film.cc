@@ -55,6 +55,22 @@ void FilmicIndices(const float* src, int n, float exposure, int32_t* index) {
   }
 }
 
+// as FilmicIndices and ClampIndices with one exposure per channel (white balance gains folded
+// in); n a multiple of 3.
+void BalancedIndices(const float* src, int n, const float exposure[3], bool filmic,
+                     int32_t* index) {
+  for (int i = 0; i + 3 <= n; i += 3) {
+    const float x[3] = {src[i] * exposure[0], src[i + 1] * exposure[1], src[i + 2] * exposure[2]};
+    if (filmic) {
+      float y[3];
+      HuePreservingFilmic(x, y);
+      for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(y[c]);
+    } else {
+      for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(std::clamp(x[c], 0.0f, 1.0f));
+    }
+  }
+}
+
 // sum over the n pixels of an RGB row of ln(max(L, kMinLuminance)), L the Rec. 709 luminance,
 // as the logarithm of their product: the product's binary exponent and mantissa are kept apart
 // (four interleaved partial products), and ln is taken once per row. exact but for the
@@ -135,10 +151,14 @@ double Film::Ev100(const ImageF& radiance, ThreadPool* pool) const {
   return base - settings_.exposure_compensation_ev;
 }
 
-void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb) const {
+void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb,
+                   const Eigen::Vector3f& wb_gains) const {
   const int w = radiance.width, h = radiance.height;
   if (rgb->width != w || rgb->height != h || rgb->channels != 3) *rgb = ImageU8(w, h, 3);
   const float exposure = static_cast<float>(ExposureFromEv100(ev100));
+  const bool balanced = wb_gains != Eigen::Vector3f::Ones();
+  const float channel_exposure[3] = {exposure * wb_gains[0], exposure * wb_gains[1],
+                                     exposure * wb_gains[2]};
   const bool filmic = settings_.tone_map == RenderSettings::ToneMap::kFilmic;
   const uint8_t* lut = oetf_lut_.data();
   ParallelForOrSerial(pool, h, [&](int v) {
@@ -149,7 +169,9 @@ void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, Image
     int32_t index[kChunk];
     for (int i0 = 0; i0 < 3 * w; i0 += kChunk) {
       const int m = std::min(kChunk, 3 * w - i0);
-      if (filmic) {
+      if (balanced) {
+        BalancedIndices(src + i0, m, channel_exposure, filmic, index);
+      } else if (filmic) {
         FilmicIndices(src + i0, m, exposure, index);
       } else {
         ClampIndices(src + i0, m, exposure, index);

@@ -18,11 +18,15 @@
 //             channel most, so bright saturated colours drift towards the nearest secondary
 //             (orange to yellow, blue to cyan) and wash out. grey pixels get exactly the
 //             per-channel curve. linear: clamp to [0, 1], per channel.
+//   white balance  optional per-channel gains on the linear radiance, before the exposure and
+//             the tone map (render/white_balance.h); the max-RGB filmic map then keeps their
+//             hue and saturation.
 //   encoding  sRGB OETF (IEC 61966-2-1) to 8 bits through a 65536-entry table (within 1 code
 //             value of the exact rounding).
 // luminance uses the Rec. 709 weights (0.2126, 0.7152, 0.0722). all sums run in a fixed order,
 // so results do not depend on the thread count.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
@@ -64,7 +68,10 @@ class Film {
 
   /// exposes `radiance` ((H x W x 3) cd/m^2) with EV100 `ev100`, tone maps and encodes it
   /// into `rgb` ((H x W x 3) uint8 sRGB, resized). rows are spread over `pool` (may be null).
-  void Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb) const;
+  /// `wb_gains` (white balance, render/white_balance.h) multiply the channels of the linear
+  /// radiance before the exposure and the tone map; unit gains leave the image as it was.
+  void Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb,
+               const Eigen::Vector3f& wb_gains = Eigen::Vector3f::Ones()) const;
 
  private:
   RenderSettings settings_;

@@ -221,6 +221,11 @@ void MediaScene::Build(const EffectsFrame* fx) {
       m.box_max = h.region->max_W.cast<float>();
       if (!(m.box_min.array() <= m.box_max.array()).all())
         throw ConfigError("", 0, key + ".region", "expected min_W <= max_W per axis");
+    } else if (std::isfinite(h.layer_top_m)) {
+      // a layer of fog: unbounded in x, y and downwards, up to its top (docs/effects.md).
+      m.bounded = true;
+      m.box_min = Eigen::Vector3f::Constant(-kInfF);
+      m.box_max = Eigen::Vector3f(kInfF, kInfF, h.layer_top_m);
     }
     m.sigma_bar = m.sigma_t.maxCoeff();
     if (m.sigma_bar > 0) analytic_.push_back(m);

@@ -42,7 +42,9 @@ struct AnalyticMedium {
   float g = 0;                       ///< Henyey-Greenstein asymmetry
   float falloff = 0;                 ///< height falloff k, 1/m (0 = uniform)
   float base = 0;                    ///< world z below which the density is 1
-  bool bounded = false;              ///< confined to the box [box_min, box_max]
+  /// confined to the box [box_min, box_max]; a layer (HomogeneousMedium::layer_top_m) is the
+  /// box with infinite x, y and lower z bounds.
+  bool bounded = false;
   Eigen::Vector3f box_min{0, 0, 0}, box_max{0, 0, 0};
   float sigma_bar = 0;  ///< majorant rate at full density: max channel of sigma_t
 

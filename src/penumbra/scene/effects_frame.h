@@ -14,6 +14,7 @@
 // their coefficients where they overlap.
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -37,8 +38,13 @@ struct HomogeneousMedium {
   float g = 0.0f;                          ///< Henyey-Greenstein asymmetry in (-1, 1)
   float height_falloff_per_m = 0.0f;       ///< 0 = uniform density; > 0 = height fog
   float base_height_m = 0.0f;              ///< height (world z) below which density is full
-  /// where the medium is; nullopt = everywhere (the whole world is inside it).
+  /// where the medium is; nullopt = a layer unbounded in x and y below layer_top_m.
   std::optional<BoxRegion> region;
+  /// world z (m) of the top of the layer an unbounded medium (no region) fills; light from
+  /// above (sun, sky) crosses only the part of its path below it. +inf = no top (the medium
+  /// fills the whole world, and the sun and sky behind it are never reached). ignored with a
+  /// region.
+  float layer_top_m = std::numeric_limits<float>::infinity();
 };
 
 /// a voxel grid on a box: smoke, steam, fire. the grid spans the box
@@ -46,12 +52,12 @@ struct HomogeneousMedium {
 /// -half + (i + 0.5, j + 0.5, k + 0.5) * 2 half / (nx, ny, nz); values between voxel centres
 /// are trilinear; outside the box density and emission are 0.
 struct GridMedium {
-  Pose X_WG = Pose::Identity();              ///< pose of the grid box in the world
+  Pose X_WG = Pose::Identity();  ///< pose of the grid box in the world
   Eigen::Vector3d half_extents_m{0.5, 0.5, 0.5};
   int nx = 0, ny = 0, nz = 0;
   /// (nz x ny x nx) density, index (k * ny + j) * nx + i, >= 0, dimensionless.
   std::shared_ptr<const std::vector<float>> density;
-  Eigen::Vector3f sigma_t_per_m{1, 1, 1};  ///< extinction at density 1, 1/m per channel
+  Eigen::Vector3f sigma_t_per_m{1, 1, 1};    ///< extinction at density 1, 1/m per channel
   Eigen::Vector3f albedo{0.9f, 0.9f, 0.9f};  ///< single-scattering albedo per channel
   float g = 0.0f;                            ///< Henyey-Greenstein asymmetry
   /// (nz x ny x nx x 3) emitted radiance per unit length, cd/m^2 per m per channel, or null

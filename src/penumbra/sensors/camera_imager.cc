@@ -10,6 +10,8 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/white_balance.h"
 #include "penumbra/sensors/camera_lens_droplets.h"
 #include "penumbra/sensors/image_noise.h"
 
@@ -74,6 +76,10 @@ void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string&
                              "; expected 0 (lossless) or a JPEG quality in [1, 100]");
   if (c.lens_droplet_count < 0 || c.lens_droplet_count > 1000)
     fail("lens_droplets.count", "expected an integer in [0, 1000]");
+  if (c.white_balance.mode == WhiteBalance::Mode::kKelvin &&
+      !(c.white_balance.kelvin >= WhiteBalance::kMinKelvin &&
+        c.white_balance.kelvin <= WhiteBalance::kMaxKelvin))
+    fail("white_balance", "expected a colour temperature in [1667, 25000] K");
   if (c.stereo_baseline_m && (!(*c.stereo_baseline_m > 0) || !std::isfinite(*c.stereo_baseline_m)))
     fail("stereo.baseline_m", "expected a finite baseline > 0 (m)");
   ValidateImageNoiseOrThrow(c.noise, key_prefix + ".noise");
@@ -95,6 +101,8 @@ CameraImager::CameraImager(const CameraSpec& spec, const CameraSensorConfig& con
     depth_model_ = DepthNoisePreset(config.depth_noise, key + ".depth_noise");
   if (config.noise.enabled || depth_model_ || config.motion_blur_samples > 1)
     pool_ = std::make_unique<ThreadPool>(render_settings.threads);
+  if (config.white_balance.mode == WhiteBalance::Mode::kDaylight)
+    daylight_white_ = DaylightWhite(scene);
 }
 
 void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
@@ -172,6 +180,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     last_ev_ = ev;
     last_time_ = start.time_sec;
     out->ev100 = ev;
+    const Eigen::Vector3f wb_gains = GainsForFrame(c.white_balance, daylight_white_, accum_);
     if (c.noise.enabled) {
       const float h = static_cast<float>(ExposureFromEv100(ev));
       if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
@@ -181,15 +190,32 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
                       &dn_, pool_.get());
       const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
       for (float& v : dn_.data) v *= inv_max;
-      film_.Develop(dn_, -std::log2(1.2), pool_.get(), &out->rgb);  // exposure H = 1
-    } else if (n == 1 && ev == out->truth.ev100 && !out->truth.rgb.empty()) {
+      film_.Develop(dn_, -std::log2(1.2), pool_.get(), &out->rgb, wb_gains);  // exposure H = 1
+    } else if (n == 1 && ev == out->truth.ev100 && !out->truth.rgb.empty() &&
+               wb_gains == Eigen::Vector3f::Ones()) {
       out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV
     } else {
-      film_.Develop(accum_, ev, pool_.get(), &out->rgb);
+      film_.Develop(accum_, ev, pool_.get(), &out->rgb, wb_gains);
     }
-    if (c.lens_droplets && IsRaining(effects))
-      ApplyLensDroplets(c.lens_droplet_count, start.time_sec,
-                        HashKeys(settings_.seed, camera_index_, 3), &out->rgb);
+    if (c.lens_droplets) {
+      // drops land only while the camera is under open sky in the rain (the shelter map of
+      // the static scene at the optical centre); after that they run off over
+      // kDropletLifetimeSec (the count falls linearly to 0).
+      if (IsRaining(effects)) {
+        if (!shelter_) {
+          const RenderSettings::Backend backend = settings_.backend;
+          shelter_ = std::make_unique<ShelterMap>(
+              [backend](const SceneDescription& s) { return MakeRayQuery(s, backend); });
+        }
+        shelter_->Update(scene_, start, pool_.get());
+        if (!shelter_->Sheltered(X_WO_start.translation().cast<float>()))
+          last_wet_time_ = start.time_sec;
+      }
+      const int count = LensDropletCount(c.lens_droplet_count, last_wet_time_, start.time_sec);
+      if (count > 0)
+        ApplyLensDroplets(count, start.time_sec, HashKeys(settings_.seed, camera_index_, 3),
+                          &out->rgb);
+    }
     if (c.jpeg_quality > 0) RoundTripJpeg(c.jpeg_quality, &out->rgb);
   } else {
     out->rgb = ImageU8();

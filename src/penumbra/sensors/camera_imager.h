@@ -33,6 +33,7 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/shelter_map.h"
 #include "penumbra/sensors/camera_sensor_config.h"
 #include "penumbra/sensors/depth_noise.h"
 
@@ -92,6 +93,11 @@ class CameraImager {
   int camera_index_;
   const SceneDescription& scene_;
   std::optional<DepthNoiseModel> depth_model_;
+  Eigen::Vector3f daylight_white_{1, 1, 1};  // DaylightWhite(scene_), for white_balance daylight
+  // lens droplets: where rain can reach the camera (built at the first frame with rain) and
+  // the sim time the lens was last under open sky in the rain
+  std::unique_ptr<ShelterMap> shelter_;
+  std::optional<double> last_wet_time_;
   std::optional<double> last_ev_, last_time_;
   std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;

@@ -15,6 +15,13 @@ bool IsRaining(const EffectsFrame* effects) {
   return false;
 }
 
+int LensDropletCount(int count, const std::optional<double>& last_wet_time_sec, double time_sec) {
+  if (!last_wet_time_sec || count <= 0) return 0;
+  const double dt = std::max(0.0, time_sec - *last_wet_time_sec);
+  const double f = std::clamp(1.0 - dt / kDropletLifetimeSec, 0.0, 1.0);
+  return static_cast<int>(std::lround(count * f));
+}
+
 void ApplyLensDroplets(int count, double time_sec, uint64_t key, ImageU8* rgb) {
   if (count <= 0 || rgb->empty() || rgb->channels != 3) return;
   const int W = rgb->width, H = rgb->height;

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "penumbra/render/white_balance.h"
+
 namespace penumbra {
 
 /// photon transfer model of the image sensor (EMVA Standard 1288, release 3.1, "Standard for
@@ -52,6 +54,12 @@ struct CameraSensorConfig {
   int jpeg_quality = 0;        ///< 0 = lossless; 1..100 = JPEG round trip at this quality
   bool lens_droplets = true;   ///< water drops on the lens while it rains (EffectsFrame kRain)
   int lens_droplet_count = 6;  ///< drops on the lens while it rains, >= 0
+  /// white balance of the rgb image (render/white_balance.h), applied to the linear radiance
+  /// before exposure and tone map. default daylight: the scene's sky and sun on a horizontal
+  /// surface is the illuminant (a camera's daylight preset for the scene's own daylight), so
+  /// neutral materials under it come out neutral; gray world (auto) would instead tint a frame
+  /// filled by one coloured object.
+  WhiteBalance white_balance;
   DepthNoiseConfig depth_noise;
   /// stereo pair: > 0 makes two cameras "<name>/left" and "<name>/right", the right one
   /// baseline_m along the left optical x axis.

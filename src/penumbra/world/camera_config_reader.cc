@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 
 #include "penumbra/core/text_match.h"
@@ -67,6 +68,7 @@ const std::vector<std::string_view>& CameraSensorKeys() {
                                                      "noise",
                                                      "jpeg_quality",
                                                      "lens_droplets",
+                                                     "white_balance",
                                                      "depth_noise",
                                                      "stereo"};
   return keys;
@@ -120,6 +122,27 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
     l.ExpectMap({"enabled", "count"});
     if (l.Has("enabled")) s.lens_droplets = l.Child("enabled").Bool();
     if (l.Has("count")) s.lens_droplet_count = IntIn(l.Child("count"), *c, 0, 1000);
+  }
+  if (r.Has("white_balance")) {
+    const YamlReader w = r.Child("white_balance");
+    const std::string v = w.String();
+    if (v == "auto") {
+      s.white_balance.mode = WhiteBalance::Mode::kAuto;
+    } else if (v == "daylight") {
+      s.white_balance.mode = WhiteBalance::Mode::kDaylight;
+    } else if (v == "none") {
+      s.white_balance.mode = WhiteBalance::Mode::kNone;
+    } else {
+      char* end = nullptr;
+      const double k = std::strtod(v.c_str(), &end);
+      if (v.empty() || end != v.c_str() + v.size() || !(k >= WhiteBalance::kMinKelvin) ||
+          !(k <= WhiteBalance::kMaxKelvin))
+        w.Fail(Who(*c) + "white_balance '" + v +
+               "' is not known; expected auto, daylight, none or a colour temperature in "
+               "[1667, 25000] K");
+      s.white_balance.mode = WhiteBalance::Mode::kKelvin;
+      s.white_balance.kelvin = k;
+    }
   }
   if (r.Has("depth_noise")) {
     const YamlReader d = r.Child("depth_noise");

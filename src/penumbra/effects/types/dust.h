@@ -2,6 +2,7 @@
 // the `dust` effect type: a coloured, absorbing homogeneous haze.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string_view>
 
 #include "penumbra/effects/effect_type.h"
@@ -20,6 +21,10 @@ struct DustParams : HomogeneousMediumType<DustParams> {
   double g = 0.6;                           ///< (-1, 1)
   double height_falloff_per_m = 0;          ///< >= 0
   double base_height_m = 0;                 ///< finite
+  /// without a region: world z (m) of the top of the layer the medium fills (unbounded in x,
+  /// y and downwards); the sun and sky cross only the part of their path below it. nullopt =
+  /// the top of the model's bounding sphere (SceneDescription::center_W.z + extent_m).
+  std::optional<double> layer_top_m;
 
   /// the albedo's world-file key and field; the hooks are HomogeneousMediumType's.
   static constexpr std::string_view kAlbedoKey = "color";

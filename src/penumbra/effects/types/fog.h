@@ -2,6 +2,7 @@
 // the `fog` effect type: a homogeneous scattering medium with optional height falloff.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string_view>
 
 #include "penumbra/effects/effect_type.h"
@@ -18,6 +19,10 @@ struct FogParams : HomogeneousMediumType<FogParams> {
   double g = 0.8;  ///< Henyey-Greenstein asymmetry, (-1, 1); water fog is strongly forward (~0.8)
   double height_falloff_per_m = 0;  ///< >= 0, 0 = uniform
   double base_height_m = 0;         ///< finite; full density below this height
+  /// without a region: world z (m) of the top of the layer the medium fills (unbounded in x,
+  /// y and downwards); the sun and sky cross only the part of their path below it. nullopt =
+  /// the top of the model's bounding sphere (SceneDescription::center_W.z + extent_m).
+  std::optional<double> layer_top_m;
 
   /// the albedo's world-file key and field; the hooks are HomogeneousMediumType's.
   static constexpr std::string_view kAlbedoKey = "albedo";

@@ -35,7 +35,8 @@ void CheckExtinction(const ExtinctionSpec& e, EffectChecker* c) {
 
 HomogeneousMedium MakeHomogeneousMedium(double sigma_t_per_m, const Eigen::Vector3d& albedo,
                                         double g, double height_falloff_per_m, double base_height_m,
-                                        const std::optional<BoxRegion>& region, double w) {
+                                        const std::optional<BoxRegion>& region, double layer_top_m,
+                                        double w) {
   HomogeneousMedium m;
   m.sigma_t_per_m = Eigen::Vector3f::Constant(static_cast<float>(sigma_t_per_m * w));
   m.albedo = albedo.cast<float>();
@@ -43,7 +44,12 @@ HomogeneousMedium MakeHomogeneousMedium(double sigma_t_per_m, const Eigen::Vecto
   m.height_falloff_per_m = static_cast<float>(height_falloff_per_m);
   m.base_height_m = static_cast<float>(base_height_m);
   m.region = region;
+  if (!region) m.layer_top_m = static_cast<float>(layer_top_m);
   return m;
+}
+
+double DefaultLayerTopM(const SceneDescription& scene) {
+  return scene.center_W.z() + scene.extent_m;
 }
 
 namespace {
@@ -51,24 +57,27 @@ namespace {
 template <typename P>
 class HomogeneousMediumInstance : public EffectInstance {
  public:
-  explicit HomogeneousMediumInstance(const EffectConfig& e) : e_(e), p_(e.Get<P>()) {}
+  HomogeneousMediumInstance(const EffectConfig& e, double layer_top_m)
+      : e_(e), p_(e.Get<P>()), layer_top_m_(layer_top_m) {}
   void Evaluate(const EffectEvalContext& ctx, EffectsFrame* frame) override {
     if (ctx.weight <= 0) return;
     frame->homogeneous_media.push_back(
         MakeHomogeneousMedium(p_.extinction.SigmaT(), p_.*P::kAlbedo, p_.g, p_.height_falloff_per_m,
-                              p_.base_height_m, e_.region, ctx.weight));
+                              p_.base_height_m, e_.region, layer_top_m_, ctx.weight));
   }
 
  private:
   const EffectConfig& e_;
   const P& p_;
+  double layer_top_m_;
 };
 
 }  // namespace
 
 template <typename P>
 std::vector<std::string_view> HomogeneousMediumType<P>::Keys() {
-  return {"sigma_t_per_m", "mor_m", P::kAlbedoKey, "g", "height_falloff_per_m", "base_height_m"};
+  return {"sigma_t_per_m",        "mor_m",         P::kAlbedoKey, "g",
+          "height_falloff_per_m", "base_height_m", "layer_top_m"};
 }
 
 template <typename P>
@@ -79,6 +88,7 @@ void HomogeneousMediumType<P>::Read(const EffectParamReader& r) {
   r.Num("g", &p.g);
   r.Num("height_falloff_per_m", &p.height_falloff_per_m);
   r.Num("base_height_m", &p.base_height_m);
+  if (r.Has("layer_top_m")) p.layer_top_m = r.Double("layer_top_m");
 }
 
 template <typename P>
@@ -89,12 +99,15 @@ void HomogeneousMediumType<P>::Validate(const EffectConfig&, EffectChecker* c) c
   c->Phase("g", p.g);
   c->In("height_falloff_per_m", p.height_falloff_per_m, EffectRange::AtLeast(0));
   c->In("base_height_m", p.base_height_m, EffectRange::Finite());
+  if (p.layer_top_m) c->In("layer_top_m", *p.layer_top_m, EffectRange::Finite());
 }
 
 template <typename P>
 std::unique_ptr<EffectInstance> HomogeneousMediumType<P>::Bind(const EffectConfig& e,
-                                                               const EffectBindContext&) const {
-  return std::make_unique<HomogeneousMediumInstance<P>>(e);
+                                                               const EffectBindContext& ctx) const {
+  const P& p = static_cast<const P&>(*this);
+  return std::make_unique<HomogeneousMediumInstance<P>>(
+      e, p.layer_top_m ? *p.layer_top_m : DefaultLayerTopM(ctx.scene));
 }
 
 template struct HomogeneousMediumType<FogParams>;
