@@ -30,7 +30,7 @@ AgentKindModel KindModel(AgentKind kind) {
   switch (kind) {
     case AgentKind::kPerson:
       m.disc_radius_m = 0.25;
-      m.walkable = {0.3, 0.15, 2.0, 0.0};
+      m.walkable = {0.3, 0.1, 2.0, 0.0};
       break;
     case AgentKind::kForklift:
       m.disc_radius_m = 1.2;

@@ -51,7 +51,8 @@ struct AgentKindModel {
   double wheelbase_m = 0;       ///< vehicles: L of the bicycle model (0 for people)
 };
 
-/// person: disc 0.25 m, walkable radius 0.3 m, steps 0.15 m, passes under 2.0 m.
+/// person: disc 0.25 m, walkable radius 0.3 m, steps 0.1 m (a 0.144 m pallet is an obstacle),
+/// passes under 2.0 m.
 /// forklift: disc 1.45 m (its 2.75 x 1.1 m footprint about the origin), walkable radius 0.7 m
 /// (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes under 2.3 m, turning
 /// radius 2.0 m, wheelbase 1.3 m. cart: disc 0.6 m, walkable 0.45 m, turning radius 0.8 m,
@@ -59,6 +60,23 @@ struct AgentKindModel {
 AgentKindModel KindModel(AgentKind kind);
 /// true for the kinds driven by the bicycle model (forklift, cart).
 bool IsVehicle(AgentKind kind);
+
+/// where a world's crowds go: its rooms or zones and its lanes (walkways, aisles, trails), in
+/// the world frame. generated environments provide them (environment/environment_generator.h
+/// GeneratedEnvironment::rooms and walkways; session/session.cc).
+struct CrowdSites {
+  struct Area {
+    std::string name;
+    Eigen::Vector2d min_W{0, 0}, max_W{0, 0};  ///< plan bounding box, m
+  };
+  struct Lane {
+    std::string name;
+    std::vector<Eigen::Vector2d> points_W;  ///< polyline, m
+  };
+  std::vector<Area> areas;
+  std::vector<Lane> lanes;
+  bool empty() const { return areas.empty() && lanes.empty(); }
+};
 
 /// a robot as the crowd sees it: a disc in the plan.
 struct CrowdRobot {

@@ -10,7 +10,7 @@
 namespace penumbra {
 
 WalkableGrid::WalkableGrid(const OccupancyGrid& occupancy, double radius_m,
-                           const Eigen::Vector2d& seed_W)
+                           const std::vector<Eigen::Vector2d>& seeds_W)
     : min_(occupancy.min_W),
       cell_m_(occupancy.cell_m),
       radius_m_(radius_m),
@@ -50,39 +50,41 @@ WalkableGrid::WalkableGrid(const OccupancyGrid& occupancy, double radius_m,
           cell_m_ * (std::min({ix, iy, nx_ - 1 - ix, ny_ - 1 - iy}) + 0.5);
       if (to_edge < radius_m) free[Index(ix, iy)] = 0;
     }
-  // the component reachable from the free cell nearest the seed
+  // the components reachable from the free cells nearest the seeds
   walkable_.assign(free.size(), 0);
-  int seed = -1;
-  double best = 1e300;
-  for (int iy = 0; iy < ny_; ++iy)
-    for (int ix = 0; ix < nx_; ++ix) {
-      if (!free[Index(ix, iy)]) continue;
-      const double d = (CellCentre(ix, iy) - seed_W).squaredNorm();
-      if (d < best) {
-        best = d;
-        seed = Index(ix, iy);
-      }
-    }
-  if (seed < 0) return;
-  std::deque<int> queue{seed};
-  walkable_[seed] = 1;
-  while (!queue.empty()) {
-    const int i = queue.front();
-    queue.pop_front();
-    ++count_;
-    const int x = i % nx_, y = i / nx_;
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int qx = x + dx, qy = y + dy;
-        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= nx_ || qy >= ny_) continue;
-        const int j = Index(qx, qy);
-        // diagonal steps only between two free side cells (no corner cutting)
-        if (dx != 0 && dy != 0 && (!free[Index(x + dx, y)] || !free[Index(x, y + dy)])) continue;
-        if (free[j] && !walkable_[j]) {
-          walkable_[j] = 1;
-          queue.push_back(j);
+  for (const Eigen::Vector2d& seed_W : seeds_W) {
+    int seed = -1;
+    double best = 1e300;
+    for (int iy = 0; iy < ny_; ++iy)
+      for (int ix = 0; ix < nx_; ++ix) {
+        if (!free[Index(ix, iy)]) continue;
+        const double d = (CellCentre(ix, iy) - seed_W).squaredNorm();
+        if (d < best) {
+          best = d;
+          seed = Index(ix, iy);
         }
       }
+    if (seed < 0 || walkable_[seed]) continue;
+    std::deque<int> queue{seed};
+    walkable_[seed] = 1;
+    while (!queue.empty()) {
+      const int i = queue.front();
+      queue.pop_front();
+      ++count_;
+      const int x = i % nx_, y = i / nx_;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = y + dy;
+          if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= nx_ || qy >= ny_) continue;
+          const int j = Index(qx, qy);
+          // diagonal steps only between two free side cells (no corner cutting)
+          if (dx != 0 && dy != 0 && (!free[Index(x + dx, y)] || !free[Index(x, y + dy)])) continue;
+          if (free[j] && !walkable_[j]) {
+            walkable_[j] = 1;
+            queue.push_back(j);
+          }
+        }
+    }
   }
 }
 

@@ -48,9 +48,14 @@ class WalkableGrid {
  public:
   /// @param occupancy the floor's occupancy (blocked cells)
   /// @param radius_m  clearance of the agent's centre from blocked cells, m (>= 0)
-  /// @param seed_W    the region is the 8-connected set of free cells reachable from the
-  ///                  free cell nearest to seed_W (every free cell if none is free)
-  WalkableGrid(const OccupancyGrid& occupancy, double radius_m, const Eigen::Vector2d& seed_W);
+  /// @param seeds_W   the region is the union of the 8-connected sets of free cells reachable
+  ///                  from the free cell nearest to each seed (empty if no cell is free)
+  /// @throws Error for an inconsistent occupancy grid or a negative radius.
+  WalkableGrid(const OccupancyGrid& occupancy, double radius_m,
+               const std::vector<Eigen::Vector2d>& seeds_W);
+  /// one seed.
+  WalkableGrid(const OccupancyGrid& occupancy, double radius_m, const Eigen::Vector2d& seed_W)
+      : WalkableGrid(occupancy, radius_m, std::vector<Eigen::Vector2d>{seed_W}) {}
 
   /// true if p lies in a walkable cell.
   bool Walkable(const Eigen::Vector2d& p) const;

@@ -37,7 +37,8 @@ bool LocalBox(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* c,
 }  // namespace
 
 FloorMap::FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
-                   const Eigen::Vector2d& centre_W, double band_lo_m, double band_hi_m)
+                   const Eigen::Vector2d& centre_W, double band_lo_m, double band_hi_m,
+                   double reach_m)
     : floor_z_(floor_z) {
   struct Box2 {
     Eigen::Vector2d lo, hi;
@@ -60,7 +61,7 @@ FloorMap::FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB,
     if (cw.z() + ew.z() < floor_z + band_lo_m || cw.z() - ew.z() > floor_z + band_hi_m) continue;
     blockers.push_back({(cw - ew).head<2>(), (cw + ew).head<2>()});
   }
-  const Eigen::Vector2d near(5.0, 5.0), reach(15.0, 15.0);
+  const Eigen::Vector2d near(5.0, 5.0), reach(reach_m, reach_m);
   min_ = centre_W - near;
   max_ = centre_W + near;
   if (has_bounds_) {

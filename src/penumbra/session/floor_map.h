@@ -27,8 +27,11 @@ class FloorMap {
   /// @param band_lo_m, band_hi_m  the height band above the floor in which static geometry
   ///                 blocks a cell (an agent kind's step height and head clearance,
   ///                 effects/walkable_grid.h WalkableProfile); the defaults are the presets'
+  /// @param reach_m  the clip: centre_W +- reach_m (15 m for the presets' area; the NPCs' map
+  ///                 takes 40 m, a whole generated building)
   FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
-           const Eigen::Vector2d& centre_W, double band_lo_m = 0.05, double band_hi_m = 2.0);
+           const Eigen::Vector2d& centre_W, double band_lo_m = 0.05, double band_hi_m = 2.0,
+           double reach_m = 15.0);
 
   /// lower / upper corner (xy) of the mapped area, m.
   const Eigen::Vector2d& min_W() const { return min_; }
