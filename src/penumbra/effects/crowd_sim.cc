@@ -66,6 +66,7 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   replan_at_.assign(n, 0);
   gear_.assign(n, 1);
   speed_.assign(n, 0);
+  slow_since_.assign(n, 0);
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     rngs_.emplace_back(HashKeys(seed, kCrowdStream, i));
@@ -87,13 +88,20 @@ std::vector<CrowdDecision> CrowdSim::TakeDecisions() {
   return out;
 }
 
-void CrowdSim::MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what) {
+void CrowdSim::MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
+                        const std::vector<CrowdRobot>& robots) {
   Plan& plan = plans_[i];
   CrowdDecision d;
   d.time_sec = time_;
   d.agent = static_cast<int>(i);
   d.goal_W = goal;
-  auto points = region(i).Plan(states_[i].position_W, goal);
+  std::vector<std::pair<Eigen::Vector2d, double>> keep_out;
+  if (agents_[i].behaviour == AgentBehaviour::kAvoid)
+    for (const CrowdRobot& r : robots)
+      keep_out.emplace_back(r.position_W, r.radius_m + agents_[i].clearance_m +
+                                              KindModel(agents_[i].kind).disc_radius_m);
+  auto points = region(i).Plan(states_[i].position_W, goal, keep_out);
+  slow_since_[i] = time_;
   if (!points) {
     plan.active = false;
     d.what = "blocked";
@@ -125,7 +133,7 @@ void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
                                         ? Eigen::Vector2d(robot.velocity_W.normalized())
                                         : Eigen::Vector2d(std::cos(robot.yaw), std::sin(robot.yaw));
     const double ahead = robot.radius_m + KindModel(a.kind).disc_radius_m + 0.5;
-    MakePlan(i, robot.position_W + ahead * heading, "block");
+    MakePlan(i, robot.position_W + ahead * heading, "block", robots);
     replan_at_[i] = time_ + kBlockReplanSec;
     return;
   }
@@ -145,7 +153,7 @@ void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
     next = goal_index_[i] + 1;
   }
   goal_index_[i] = next;
-  MakePlan(i, a.waypoints[next], "goal");
+  MakePlan(i, a.waypoints[next], "goal", robots);
 }
 
 Eigen::Vector2d CrowdSim::Preferred(size_t i) {
@@ -195,6 +203,16 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
       d.goal_W = plan.goal;
       decisions_.push_back(d);
     }
+    if (plan.active && a.behaviour != AgentBehaviour::kBlock && time_ - slow_since_[i] > 4.0) {
+      // stuck: give the goal up for the next
+      CrowdDecision d;
+      d.time_sec = time_;
+      d.agent = static_cast<int>(i);
+      d.what = "stuck";
+      d.goal_W = plan.goal;
+      decisions_.push_back(d);
+      plan.active = false;
+    }
     if (!plan.active && time_ >= pause_until_[i] && a.behaviour != AgentBehaviour::kBlock)
       ChooseGoal(i, robots);
     preferred[i] = Preferred(i);
@@ -211,7 +229,9 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     const bool vehicle = IsVehicle(a.kind);
     for (size_t j = 0; j < n; ++j) {
       if (j == i) continue;
-      const Eigen::Vector2d rel = states_[j].position_W - s.position_W;
+      Eigen::Vector2d rel = states_[j].position_W - s.position_W;
+      // two centres in one place: the lower index steps west, the higher east
+      if (rel.norm() < 1e-6) rel = Eigen::Vector2d(j > i ? 1e-3 : -1e-3, 0);
       const double r = own + KindModel(agents_[j].kind).disc_radius_m + kSafetyM;
       if (rel.norm() > kNeighbourM + r) continue;
       const double responsibility = (vehicle || IsVehicle(agents_[j].kind)) ? 1.0 : 0.5;
@@ -252,7 +272,18 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     v = std::clamp(v, prev - kVehicleAccel * dt_, prev + kVehicleAccel * dt_);
     new_speed[i] = std::max(0.0, v);
   }
-  // integrate, keeping every centre on its walkable region
+  // integrate, keeping every centre on its walkable region and never moving deeper into
+  // another agent's disc (the others as far as they moved this step: index order)
+  const auto crowds = [&](size_t i, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+    const double ri = KindModel(agents_[i].kind).disc_radius_m;
+    for (size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const double r = ri + KindModel(agents_[j].kind).disc_radius_m;
+      const double d = (to - states_[j].position_W).norm();
+      if (d < r && d < (from - states_[j].position_W).norm()) return true;
+    }
+    return false;
+  };
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     CrowdAgentState& s = states_[i];
@@ -260,12 +291,15 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     const Eigen::Vector2d old = s.position_W;
     if (!IsVehicle(a.kind)) {
       const Eigen::Vector2d step = velocity[i] * dt_;
-      Eigen::Vector2d next = old + step;
-      if (!reg.Walkable(next)) {
-        const Eigen::Vector2d along_x(old.x() + step.x(), old.y());
-        const Eigen::Vector2d along_y(old.x(), old.y() + step.y());
-        next = reg.Walkable(along_x) ? along_x : reg.Walkable(along_y) ? along_y : old;
-      }
+      // the whole step, along x or y alone, half of it, or none
+      Eigen::Vector2d next = old;
+      for (const Eigen::Vector2d& c :
+           {Eigen::Vector2d(old + step), Eigen::Vector2d(old.x() + step.x(), old.y()),
+            Eigen::Vector2d(old.x(), old.y() + step.y()), Eigen::Vector2d(old + 0.5 * step)})
+        if (reg.Walkable(c) && !crowds(i, old, c)) {
+          next = c;
+          break;
+        }
       s.position_W = next;
       const Eigen::Vector2d moved = next - old;
       if (moved.norm() > 0.05 * dt_) {
@@ -294,7 +328,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
       const double new_drive_yaw = drive_yaw + yaw_rate * dt_;
       const double mid = drive_yaw + 0.5 * yaw_rate * dt_;
       const Eigen::Vector2d next = old + v * dt_ * Eigen::Vector2d(std::cos(mid), std::sin(mid));
-      if (reg.Walkable(next)) {
+      if (reg.Walkable(next) && !crowds(i, old, next)) {
         s.position_W = next;
         s.yaw = WrapAngle(gear_[i] > 0 ? new_drive_yaw : new_drive_yaw - M_PI);
         speed_[i] = v;
@@ -303,6 +337,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
       }
     }
     s.velocity_W = (s.position_W - old) / dt_;
+    if (s.velocity_W.norm() >= 0.1) slow_since_[i] = time_;
   }
   time_ += dt_;
 }

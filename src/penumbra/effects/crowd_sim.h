@@ -14,7 +14,10 @@
 //             agent's) along its heading, replanned every second. on reaching a goal
 //             (within 0.2 m; vehicles 0.6 m) the agent pauses
 //             pause_sec. each new goal and plan is a CrowdDecision.
-//   plan      WalkableGrid::Plan from the agent to its goal on its kind's region.
+//   plan      WalkableGrid::Plan from the agent to its goal on its kind's region; an `avoid`
+//             agent's plan keeps out of the robots' discs plus its clearance. an agent that
+//             has a plan but moved slower than 0.1 m/s for 4 s (a jam, a robot in a door)
+//             gives up its goal and takes the next ("stuck").
 //   preferred towards the next point of the plan at speed_m_s, slowing to stop at the goal.
 //   people    ORCA (tau 2 s): other agents as discs (responsibility 1/2 between people, 1
 //             against vehicles, which keep to their lanes); robots: avoid -> disc radius
@@ -29,8 +32,10 @@
 //             velocity along the heading satisfies the ORCA half-planes of the others and the
 //             robots (responsibility 1), else 0 (it stops). a pingpong lane is driven back in
 //             reverse (forklifts do), steering as a rear-steered bicycle.
-//   walkable  a centre may only move to a walkable point of its kind's region: the step is
-//             taken whole, else along x or y alone, else not at all.
+//   walkable  a centre may only move to a walkable point of its kind's region and never deeper
+//             into another agent's disc (agents already moved this step where they are now):
+//             the step is taken whole, else along x or y alone, else half, else not at all
+//             (a vehicle: whole or not at all).
 
 #include <Eigen/Core>
 #include <memory>
@@ -136,7 +141,8 @@ class CrowdSim {
     bool active = false;
   };
   void ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots);
-  void MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what);
+  void MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
+                const std::vector<CrowdRobot>& robots);
   Eigen::Vector2d Preferred(size_t i);
   void AddRobotLines(size_t i, const std::vector<CrowdRobot>& robots, double own_radius,
                      const Eigen::Vector2d& v_a, std::vector<OrcaLine>* lines) const;
@@ -154,6 +160,7 @@ class CrowdSim {
   std::vector<double> replan_at_;   // block: the time of the next replan
   std::vector<int> gear_;           // vehicles: +1 forward, -1 reverse
   std::vector<double> speed_;       // vehicles: signed speed along the heading, m/s
+  std::vector<double> slow_since_;  // start of the agent's current spell below 0.1 m/s
   std::vector<CrowdDecision> decisions_;
 };
 

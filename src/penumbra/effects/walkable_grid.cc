@@ -139,8 +139,17 @@ std::optional<Eigen::Vector2d> WalkableGrid::NearestWalkable(const Eigen::Vector
   return out;
 }
 
-std::optional<std::vector<Eigen::Vector2d>> WalkableGrid::Plan(const Eigen::Vector2d& from,
-                                                               const Eigen::Vector2d& to) const {
+std::optional<std::vector<Eigen::Vector2d>> WalkableGrid::Plan(
+    const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+    const std::vector<std::pair<Eigen::Vector2d, double>>& keep_out) const {
+  const auto kept_out = [&](const Eigen::Vector2d& p) {
+    for (const auto& [c, r] : keep_out)
+      if ((p - c).norm() < r) return true;
+    return false;
+  };
+  const auto open_cell = [&](int x, int y) {
+    return CellWalkable(x, y) && !kept_out(CellCentre(x, y));
+  };
   const std::optional<Eigen::Vector2d> a = NearestWalkable(from), b = NearestWalkable(to);
   if (!a || !b) return std::nullopt;
   int sx = 0, sy = 0, gx = 0, gy = 0;
@@ -168,9 +177,8 @@ std::optional<std::vector<Eigen::Vector2d>> WalkableGrid::Plan(const Eigen::Vect
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         if (dx == 0 && dy == 0) continue;
-        if (!CellWalkable(x + dx, y + dy)) continue;
-        if (dx != 0 && dy != 0 && (!CellWalkable(x + dx, y) || !CellWalkable(x, y + dy)))
-          continue;
+        if (!open_cell(x + dx, y + dy)) continue;
+        if (dx != 0 && dy != 0 && (!open_cell(x + dx, y) || !open_cell(x, y + dy))) continue;
         const int j = Index(x + dx, y + dy);
         const double step = (dx != 0 && dy != 0) ? std::sqrt(2.0) : 1.0;
         if (g[i] + step < g[j]) {
@@ -191,7 +199,10 @@ std::optional<std::vector<Eigen::Vector2d>> WalkableGrid::Plan(const Eigen::Vect
   size_t k = 0;
   while (k + 1 < cells.size()) {
     size_t next = k + 1;
-    for (size_t m = k + 2; m < cells.size() && SegmentWalkable(cells[k], cells[m]); ++m) next = m;
+    for (size_t m = k + 2; m < cells.size() && SegmentWalkable(cells[k], cells[m]) &&
+                           (keep_out.empty() || !kept_out(0.5 * (cells[k] + cells[m])));
+         ++m)
+      next = m;
     path.push_back(cells[next]);
     k = next;
   }

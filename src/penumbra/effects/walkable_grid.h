@@ -69,8 +69,11 @@ class WalkableGrid {
   /// to their nearest walkable cell centre when outside the region). nothing if `to` cannot
   /// be reached. Hart, Nilsson, Raphael, "A Formal Basis for the Heuristic Determination of
   /// Minimum Cost Paths", IEEE Trans. SSC 4(2), 1968.
-  std::optional<std::vector<Eigen::Vector2d>> Plan(const Eigen::Vector2d& from,
-                                                   const Eigen::Vector2d& to) const;
+  /// `keep_out` discs (centre, radius; e.g. a robot and the clearance an agent keeps from it)
+  /// are not entered, except where the path starts.
+  std::optional<std::vector<Eigen::Vector2d>> Plan(
+      const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+      const std::vector<std::pair<Eigen::Vector2d, double>>& keep_out = {}) const;
 
   int nx() const { return nx_; }
   int ny() const { return ny_; }

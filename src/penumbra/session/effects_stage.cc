@@ -114,44 +114,18 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     a.floor_z = map.floor_z();
     return a;
   };
-  for (int i = 0; i < preset.npc_people; ++i) {
-    const std::string name = "adversity_person" + std::to_string(i);
-    Rng rng(HashKeys(seed, kNpcStream, 0, i));
-    AgentConfig a = base(name, AgentKind::kPerson);
-    a.speed_m_s = preset.npc_speed_m_s;
-    a.height_m = 1.55 + 0.4 * rng.UniformD();
-    if (i % 2 == 1 && !walk_lanes.empty()) {
-      std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
-      if ((i / 2 / walk_lanes.size()) % 2 == 1 || !away(lane.front(), 1.5))
-        std::reverse(lane.begin(), lane.end());
-      if (away(lane.front(), 1.5)) {
-        a.waypoints = lane;
-        a.route = AgentRoute::kPingPong;
-        a.goals = AgentGoals::kPatrol;
-        agents->push_back(a);
-        continue;
-      }
-    }
-    if (pois.size() < 2) {
-      spdlog::warn("adversity preset '{}': no points of interest for {}; left out", preset.name,
-                   name);
-      continue;
-    }
-    const size_t offset = rng.NextU64() % pois.size();
-    size_t start = pois.size();
-    for (size_t k = 0; k < pois.size() && start == pois.size(); ++k)
-      if (away(pois[(offset + k) % pois.size()], 1.5)) start = (offset + k) % pois.size();
-    if (start == pois.size()) {
-      spdlog::warn("adversity preset '{}': every point of interest is near a robot; {} left out",
-                   preset.name, name);
-      continue;
-    }
-    for (size_t k = 0; k < pois.size(); ++k) a.waypoints.push_back(pois[(start + k) % pois.size()]);
-    a.goals = AgentGoals::kRandom;
-    a.route = AgentRoute::kLoop;
-    agents->push_back(a);
-  }
-  // vehicles on lanes
+  // every start keeps the discs of the agents placed before it 0.3 m apart
+  std::vector<std::pair<Eigen::Vector2d, double>> taken;
+  const auto free_start = [&](const Eigen::Vector2d& p, double radius, double from_robot) {
+    if (!away(p, from_robot)) return false;
+    for (const auto& [q, r] : taken)
+      if ((p - q).norm() < radius + r + 0.3) return false;
+    return true;
+  };
+  const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+  const double vehicle_r = KindModel(AgentKind::kForklift).disc_radius_m;
+  // vehicles first: their lanes' ends are few
+  std::vector<AgentConfig> vehicle_agents;
   std::vector<std::vector<Eigen::Vector2d>> drive_lanes;
   for (const CrowdSites::Lane& l : sites.lanes) {
     std::vector<Eigen::Vector2d> pts = DrivableStretch(vehicles, l.points_W);
@@ -166,9 +140,9 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     std::vector<Eigen::Vector2d> lane;
     if (!drive_lanes.empty()) {
       lane = drive_lanes[j % drive_lanes.size()];
-      if ((j / drive_lanes.size()) % 2 == 1 || !away(lane.front(), 2.5))
-        std::reverse(lane.begin(), lane.end());
-      if (!away(lane.front(), 2.5)) lane.clear();
+      if ((j / drive_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
+      if (!free_start(lane.front(), vehicle_r, 2.5)) std::reverse(lane.begin(), lane.end());
+      if (!free_start(lane.front(), vehicle_r, 2.5)) lane.clear();
     } else if (sites.lanes.empty()) {
       // no lanes in the world: a straight drivable lane drawn from the seed
       Rng rng(HashKeys(seed, kNpcStream, 1, j));
@@ -176,19 +150,67 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
         const auto p = DrawWalkable(vehicles, &rng), q = DrawWalkable(vehicles, &rng);
         if (!p || !q) break;
         const double len = (*q - *p).norm();
-        if (len >= 3.0 && len <= 12.0 && away(*p, 2.5) && away(*q, 2.5) &&
+        if (len >= 3.0 && len <= 12.0 && free_start(*p, vehicle_r, 2.5) && away(*q, 2.5) &&
             vehicles.SegmentWalkable(*p, *q))
           lane = {*p, *q};
       }
     }
     if (lane.size() < 2) {
-      spdlog::warn("adversity preset '{}': no lane a forklift fits for {}; left out", preset.name,
-                   name);
+      spdlog::warn("adversity preset '{}': no free lane a forklift fits for {}; left out",
+                   preset.name, name);
       continue;
     }
     a.waypoints = lane;
+    taken.emplace_back(lane.front(), vehicle_r);
+    vehicle_agents.push_back(a);
+  }
+  for (int i = 0; i < preset.npc_people; ++i) {
+    const std::string name = "adversity_person" + std::to_string(i);
+    Rng rng(HashKeys(seed, kNpcStream, 0, i));
+    AgentConfig a = base(name, AgentKind::kPerson);
+    a.speed_m_s = preset.npc_speed_m_s;
+    a.height_m = 1.55 + 0.4 * rng.UniformD();
+    if (i % 2 == 1 && !walk_lanes.empty()) {
+      std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
+      if ((i / 2 / walk_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
+      if (!free_start(lane.front(), person_r, 1.5)) std::reverse(lane.begin(), lane.end());
+      if (free_start(lane.front(), person_r, 1.5)) {
+        a.waypoints = lane;
+        a.route = AgentRoute::kPingPong;
+        a.goals = AgentGoals::kPatrol;
+        taken.emplace_back(lane.front(), person_r);
+        agents->push_back(a);
+        continue;
+      }
+    }
+    if (pois.size() < 2) {
+      spdlog::warn("adversity preset '{}': no points of interest for {}; left out", preset.name,
+                   name);
+      continue;
+    }
+    // the start: a free point of interest (from a drawn offset), else a free walkable cell
+    const size_t offset = rng.NextU64() % pois.size();
+    std::optional<Eigen::Vector2d> start;
+    for (size_t k = 0; k < pois.size() && !start; ++k)
+      if (free_start(pois[(offset + k) % pois.size()], person_r, 1.5))
+        start = pois[(offset + k) % pois.size()];
+    for (int k = 0; k < 400 && !start; ++k)
+      if (const auto p = DrawWalkable(people, &rng))
+        if (free_start(*p, person_r, 1.5)) start = *p;
+    if (!start) {
+      spdlog::warn("adversity preset '{}': no free start for {}; left out", preset.name, name);
+      continue;
+    }
+    a.waypoints.push_back(*start);
+    for (size_t k = 0; k < pois.size(); ++k)
+      if ((pois[(offset + k) % pois.size()] - *start).norm() > 0.05)
+        a.waypoints.push_back(pois[(offset + k) % pois.size()]);
+    a.goals = AgentGoals::kRandom;
+    a.route = AgentRoute::kLoop;
+    taken.emplace_back(*start, person_r);
     agents->push_back(a);
   }
+  agents->insert(agents->end(), vehicle_agents.begin(), vehicle_agents.end());
 }
 
 // appends an effect named `name` of type P (default parameters, no region) to `effects`;
