@@ -67,6 +67,7 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   gear_.assign(n, 1);
   speed_.assign(n, 0);
   slow_since_.assign(n, 0);
+  active_.assign(n, 1);
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     rngs_.emplace_back(HashKeys(seed, kCrowdStream, i));
@@ -80,6 +81,11 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
 
 const WalkableGrid& CrowdSim::region(size_t i) const {
   return IsVehicle(agents_[i].kind) ? *vehicle_region_ : *person_region_;
+}
+
+void CrowdSim::SetActive(size_t i, bool active) {
+  active_.at(i) = active ? 1 : 0;
+  if (!active) states_[i].velocity_W = Eigen::Vector2d::Zero();
 }
 
 std::vector<CrowdDecision> CrowdSim::TakeDecisions() {
@@ -188,6 +194,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
   // goals and preferred velocities
   std::vector<Eigen::Vector2d> preferred(n);
   for (size_t i = 0; i < n; ++i) {
+    if (!active_[i]) continue;
     const AgentConfig& a = agents_[i];
     Plan& plan = plans_[i];
     if (a.behaviour == AgentBehaviour::kBlock && !robots.empty()) {
@@ -222,13 +229,14 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
   std::vector<double> new_speed(n, 0.0);
   std::vector<OrcaLine> lines;
   for (size_t i = 0; i < n; ++i) {
+    if (!active_[i]) continue;
     const AgentConfig& a = agents_[i];
     const double own = KindModel(a.kind).disc_radius_m;
     const CrowdAgentState& s = states_[i];
     lines.clear();
     const bool vehicle = IsVehicle(a.kind);
     for (size_t j = 0; j < n; ++j) {
-      if (j == i) continue;
+      if (j == i || !active_[j]) continue;
       Eigen::Vector2d rel = states_[j].position_W - s.position_W;
       // two centres in one place: the lower index steps west, the higher east
       if (rel.norm() < 1e-6) rel = Eigen::Vector2d(j > i ? 1e-3 : -1e-3, 0);
@@ -277,7 +285,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
   const auto crowds = [&](size_t i, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
     const double ri = KindModel(agents_[i].kind).disc_radius_m;
     for (size_t j = 0; j < n; ++j) {
-      if (j == i) continue;
+      if (j == i || !active_[j]) continue;
       const double r = ri + KindModel(agents_[j].kind).disc_radius_m;
       const double d = (to - states_[j].position_W).norm();
       if (d < r && d < (from - states_[j].position_W).norm()) return true;
@@ -285,6 +293,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     return false;
   };
   for (size_t i = 0; i < n; ++i) {
+    if (!active_[i]) continue;
     const AgentConfig& a = agents_[i];
     CrowdAgentState& s = states_[i];
     const WalkableGrid& reg = region(i);

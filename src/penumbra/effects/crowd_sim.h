@@ -130,6 +130,10 @@ class CrowdSim {
   const std::vector<CrowdAgentState>& states() const { return states_; }
   /// the region agent i walks on.
   const WalkableGrid& region(size_t i) const;
+  /// takes agent i out of the crowd (a live change removed it) or back in: an inactive agent
+  /// neither moves nor is avoided.
+  void SetActive(size_t i, bool active);
+  bool active(size_t i) const { return active_[i] != 0; }
   /// decisions made since the last call, in order; clears them.
   std::vector<CrowdDecision> TakeDecisions();
 
@@ -160,7 +164,8 @@ class CrowdSim {
   std::vector<double> replan_at_;   // block: the time of the next replan
   std::vector<int> gear_;           // vehicles: +1 forward, -1 reverse
   std::vector<double> speed_;       // vehicles: signed speed along the heading, m/s
-  std::vector<double> slow_since_;  // start of the agent's current spell below 0.1 m/s
+  std::vector<double> slow_since_;
+  std::vector<uint8_t> active_;  // start of the agent's current spell below 0.1 m/s
   std::vector<CrowdDecision> decisions_;
 };
 

@@ -51,6 +51,8 @@ class CrowdRunner {
   /// receives each decision (time, JSON payload with agent, what, goal, plan_points).
   void set_decision_sink(std::function<void(double, const std::string&)> sink);
   const CrowdSim& crowd() const { return *crowd_; }
+  /// agent i in or out of the crowd (CrowdSim::SetActive), from the next crowd step.
+  void SetActive(size_t i, bool active) { crowd_->SetActive(i, active); }
 
  private:
   void AdvanceTo(double time_sec);

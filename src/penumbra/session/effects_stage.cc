@@ -124,46 +124,6 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
   };
   const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
   const double vehicle_r = KindModel(AgentKind::kForklift).disc_radius_m;
-  // vehicles first: their lanes' ends are few
-  std::vector<AgentConfig> vehicle_agents;
-  std::vector<std::vector<Eigen::Vector2d>> drive_lanes;
-  for (const CrowdSites::Lane& l : sites.lanes) {
-    std::vector<Eigen::Vector2d> pts = DrivableStretch(vehicles, l.points_W);
-    if (!pts.empty()) drive_lanes.push_back(std::move(pts));
-  }
-  for (int j = 0; j < preset.npc_vehicles; ++j) {
-    const std::string name = "adversity_forklift" + std::to_string(j);
-    AgentConfig a = base(name, AgentKind::kForklift);
-    a.speed_m_s = preset.npc_speed_m_s * 1.5;
-    a.route = AgentRoute::kPingPong;
-    a.goals = AgentGoals::kPatrol;
-    std::vector<Eigen::Vector2d> lane;
-    if (!drive_lanes.empty()) {
-      lane = drive_lanes[j % drive_lanes.size()];
-      if ((j / drive_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
-      if (!free_start(lane.front(), vehicle_r, 2.5)) std::reverse(lane.begin(), lane.end());
-      if (!free_start(lane.front(), vehicle_r, 2.5)) lane.clear();
-    } else if (sites.lanes.empty()) {
-      // no lanes in the world: a straight drivable lane drawn from the seed
-      Rng rng(HashKeys(seed, kNpcStream, 1, j));
-      for (int k = 0; k < 200 && lane.empty(); ++k) {
-        const auto p = DrawWalkable(vehicles, &rng), q = DrawWalkable(vehicles, &rng);
-        if (!p || !q) break;
-        const double len = (*q - *p).norm();
-        if (len >= 3.0 && len <= 12.0 && free_start(*p, vehicle_r, 2.5) && away(*q, 2.5) &&
-            vehicles.SegmentWalkable(*p, *q))
-          lane = {*p, *q};
-      }
-    }
-    if (lane.size() < 2) {
-      spdlog::warn("adversity preset '{}': no free lane a forklift fits for {}; left out",
-                   preset.name, name);
-      continue;
-    }
-    a.waypoints = lane;
-    taken.emplace_back(lane.front(), vehicle_r);
-    vehicle_agents.push_back(a);
-  }
   for (int i = 0; i < preset.npc_people; ++i) {
     const std::string name = "adversity_person" + std::to_string(i);
     Rng rng(HashKeys(seed, kNpcStream, 0, i));
@@ -209,6 +169,74 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     a.route = AgentRoute::kLoop;
     taken.emplace_back(*start, person_r);
     agents->push_back(a);
+  }
+  // then vehicles (people's places do not depend on how many vehicles there are: a live
+  // change of the vehicle count keeps the people where they are)
+  std::vector<AgentConfig> vehicle_agents;
+  std::vector<std::vector<Eigen::Vector2d>> drive_lanes;
+  for (const CrowdSites::Lane& l : sites.lanes) {
+    std::vector<Eigen::Vector2d> pts = DrivableStretch(vehicles, l.points_W);
+    if (!pts.empty()) drive_lanes.push_back(std::move(pts));
+  }
+  for (int j = 0; j < preset.npc_vehicles; ++j) {
+    const std::string name = "adversity_forklift" + std::to_string(j);
+    AgentConfig a = base(name, AgentKind::kForklift);
+    a.speed_m_s = preset.npc_speed_m_s * 1.5;
+    a.route = AgentRoute::kPingPong;
+    a.goals = AgentGoals::kPatrol;
+    std::vector<Eigen::Vector2d> lane;
+    if (!drive_lanes.empty()) {
+      lane = drive_lanes[j % drive_lanes.size()];
+      if ((j / drive_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
+      // the start: the first free point (every 0.25 m) of the lane's first half, from either end
+      std::vector<Eigen::Vector2d> found;
+      for (int side = 0; side < 2 && found.empty(); ++side) {
+        if (side == 1) std::reverse(lane.begin(), lane.end());
+        double total = 0;
+        for (size_t k = 0; k + 1 < lane.size(); ++k) total += (lane[k + 1] - lane[k]).norm();
+        double along = 0;
+        for (size_t k = 0; k + 1 < lane.size() && found.empty() && along < 0.5 * total; ++k) {
+          const double len = (lane[k + 1] - lane[k]).norm();
+          for (double t = 0; t < len && found.empty() && along + t < 0.5 * total; t += 0.25) {
+            const Eigen::Vector2d p = lane[k] + (lane[k + 1] - lane[k]) * (t / len);
+            if (free_start(p, vehicle_r, 2.5)) {
+              found.push_back(p);
+              found.insert(found.end(), lane.begin() + k + 1, lane.end());
+            }
+          }
+          along += len;
+        }
+      }
+      lane = found;
+    } else if (sites.lanes.empty()) {
+      // no lanes in the world: a straight drivable lane drawn from the seed
+      Rng rng(HashKeys(seed, kNpcStream, 1, j));
+      std::vector<Eigen::Vector2d> fallback;
+      for (int k = 0; k < 200 && lane.empty(); ++k) {
+        const auto p = DrawWalkable(vehicles, &rng), q = DrawWalkable(vehicles, &rng);
+        if (!p || !q) break;
+        const double len = (*q - *p).norm();
+        if (len < 3.0 || len > 12.0 || !away(*p, 2.5) || !away(*q, 2.5) ||
+            !vehicles.SegmentWalkable(*p, *q))
+          continue;
+        if (free_start(*p, vehicle_r, 2.5))
+          lane = {*p, *q};
+        else if (free_start(*q, vehicle_r, 2.5))
+          lane = {*q, *p};
+        else if (fallback.empty())
+          fallback = {*p, *q};  // clear of the robots only
+      }
+      // a small room: the lane may start by a person (the crowd separates them)
+      if (lane.empty()) lane = fallback;
+    }
+    if (lane.size() < 2) {
+      spdlog::warn("adversity preset '{}': no free lane a forklift fits for {}; left out",
+                   preset.name, name);
+      continue;
+    }
+    a.waypoints = lane;
+    taken.emplace_back(lane.front(), vehicle_r);
+    vehicle_agents.push_back(a);
   }
   agents->insert(agents->end(), vehicle_agents.begin(), vehicle_agents.end());
 }
@@ -528,15 +556,45 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
     else
       paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
   }
-  // the new crowd starts now (its decisions and goals from the seed, its time from now)
-  std::shared_ptr<CrowdRunner> crowd = MakeCrowd(agents, sim_ ? sim_->time() : 0.0);
+  // crowd agents the running crowd has, unchanged, go on in it (the others in it leave it);
+  // else the new crowd starts now (its goals from the seed, its time from now)
+  bool keep = crowd_ != nullptr;
+  std::vector<size_t> index_in_crowd;
+  for (size_t k = 0; keep && k < crowd_slot.size(); ++k) {
+    const std::string& name = body_names_[crowd_slot[k]];
+    const std::vector<AgentConfig>& running = crowd_->crowd().agents();
+    size_t found = running.size();
+    for (size_t m = 0; m < running.size(); ++m)
+      if (running[m].name == name) found = m;
+    const auto same = [](const AgentConfig& x, const AgentConfig& y) {
+      return x.kind == y.kind && x.waypoints == y.waypoints && x.speed_m_s == y.speed_m_s &&
+             x.pause_sec == y.pause_sec && x.route == y.route && x.goals == y.goals &&
+             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m &&
+             x.floor_z == y.floor_z;
+    };
+    const auto it = std::find_if(agents.begin(), agents.end(),
+                                 [&](const AgentConfig& a) { return a.name == name; });
+    keep = found < running.size() && same(running[found], *it);
+    index_in_crowd.push_back(found);
+  }
+  std::shared_ptr<CrowdRunner> crowd;
+  if (keep) {
+    crowd = crowd_;
+    for (size_t m = 0; m < crowd->crowd().agents().size(); ++m)
+      crowd->SetActive(m, std::find(index_in_crowd.begin(), index_in_crowd.end(), m) !=
+                              index_in_crowd.end());
+  } else {
+    crowd = MakeCrowd(agents, sim_ ? sim_->time() : 0.0);
+    index_in_crowd.clear();
+    for (size_t k = 0; k < crowd_slot.size(); ++k) index_in_crowd.push_back(k);
+  }
   for (size_t i = 0; i < slots_.size(); ++i) {
     slots_[i]->path = paths[i];
     slots_[i]->crowd = nullptr;
   }
   for (size_t k = 0; k < crowd_slot.size(); ++k) {
     slots_[crowd_slot[k]]->crowd = crowd;
-    slots_[crowd_slot[k]]->crowd_index = k;
+    slots_[crowd_slot[k]]->crowd_index = index_in_crowd[k];
   }
   crowd_ = crowd;
   std::lock_guard<std::mutex> lock(mu_);
