@@ -34,11 +34,11 @@ OccupancyGrid TwoRoomsGrid() {
 TEST(WalkableGridTest, InflatesByRadiusAndKeepsTheSeedsComponent) {
   const WalkableGrid person(TwoRoomsGrid(), 0.3, {-5, 1});
   EXPECT_TRUE(person.Walkable({-5, 1}));
-  EXPECT_TRUE(person.Walkable({5, 3}));          // through the door
-  EXPECT_FALSE(person.Walkable({-3, 2}));        // the table
-  EXPECT_FALSE(person.Walkable({-3, 2.75}));     // 0.25 m from the table's edge
-  EXPECT_TRUE(person.Walkable({-3, 2.85}));      // 0.35 m from it
-  EXPECT_FALSE(person.Walkable({-5.8, 1}));      // 0.2 m from the outer wall
+  EXPECT_TRUE(person.Walkable({5, 3}));       // through the door
+  EXPECT_FALSE(person.Walkable({-3, 2}));     // the table
+  EXPECT_FALSE(person.Walkable({-3, 2.75}));  // 0.25 m from the table's edge
+  EXPECT_TRUE(person.Walkable({-3, 2.85}));   // 0.35 m from it
+  EXPECT_FALSE(person.Walkable({-5.8, 1}));   // 0.2 m from the outer wall
   // a 1.6 m wide body does not fit the 1.2 m door: the right room is another component
   const WalkableGrid wide(TwoRoomsGrid(), 0.8, {-5, 1});
   EXPECT_TRUE(wide.Walkable({-5, 1}));
@@ -107,7 +107,7 @@ TEST(CrowdSimTest, CrossingWalkersStayWalkableAndApart) {
   auto person = std::make_shared<const WalkableGrid>(TwoRoomsGrid(), 0.3, Eigen::Vector2d(-5, 1));
   auto vehicle = std::make_shared<const WalkableGrid>(TwoRoomsGrid(), 0.7, Eigen::Vector2d(-5, 1));
   std::vector<AgentConfig> agents = {
-      Walker("a", {{-5, 2}, {5, 2}}),   Walker("b", {{5, 2.2}, {-5, 1.8}}),
+      Walker("a", {{-5, 2}, {5, 2}}), Walker("b", {{5, 2.2}, {-5, 1.8}}),
       Walker("c", {{-4, 0.6}, {4, 3.4}}), Walker("d", {{4, 0.6}, {-4, 3.4}}),
       Walker("e", {{-1.5, 3.5}, {2, 0.5}})};
   agents[4].goals = AgentGoals::kRandom;
@@ -123,8 +123,7 @@ TEST(CrowdSimTest, CrossingWalkersStayWalkableAndApart) {
       travelled += (sim.states()[i].position_W - before[i].position_W).norm();
       for (size_t j = i + 1; j < agents.size(); ++j)
         worst_overlap = std::max(
-            worst_overlap,
-            0.5 - (sim.states()[i].position_W - sim.states()[j].position_W).norm());
+            worst_overlap, 0.5 - (sim.states()[i].position_W - sim.states()[j].position_W).norm());
     }
   }
   EXPECT_LE(worst_overlap, 0.05);
@@ -137,9 +136,9 @@ std::shared_ptr<const WalkableGrid> RoomsFor(double radius) {
 
 TEST(CrowdSimTest, AvoidAgentsKeepTheirClearanceFromAStandingRobot) {
   // four walkers patrolling straight through where the robot stands, in the right room
-  std::vector<AgentConfig> agents = {Walker("a", {{1, 2}, {5.5, 2}}), Walker("b", {{5.5, 2.1}, {1, 1.9}}),
-                                     Walker("c", {{3, 0.4}, {3.2, 3.6}}),
-                                     Walker("d", {{3.3, 3.6}, {2.9, 0.4}})};
+  std::vector<AgentConfig> agents = {
+      Walker("a", {{1, 2}, {5.5, 2}}), Walker("b", {{5.5, 2.1}, {1, 1.9}}),
+      Walker("c", {{3, 0.4}, {3.2, 3.6}}), Walker("d", {{3.3, 3.6}, {2.9, 0.4}})};
   for (AgentConfig& a : agents) {
     a.route = AgentRoute::kPingPong;
     a.clearance_m = 0.6;
@@ -200,8 +199,8 @@ TEST(CrowdSimTest, BlockAgentsStepIntoTheRobotsPath) {
 std::vector<uint64_t> CrowdBits(uint64_t seed) {
   std::vector<AgentConfig> agents;
   for (int i = 0; i < 6; ++i) {
-    AgentConfig a = Walker("w" + std::to_string(i),
-                           {{-5 + i, 0.6}, {4, 3.4}, {-4, 3.4}, {5, 0.6}, {-2, 2}});
+    AgentConfig a =
+        Walker("w" + std::to_string(i), {{-5 + i, 0.6}, {4, 3.4}, {-4, 3.4}, {5, 0.6}, {-2, 2}});
     a.goals = AgentGoals::kRandom;
     agents.push_back(a);
   }

@@ -26,8 +26,7 @@ TEST(CrowdReplayTest, ReplayPosesTheCrowdAsTheRunDid) {
   const std::string preset = (dir.path() / "crowd_preset.yaml").string();
   std::ofstream(preset) << "presets:\n  crowd:\n    npcs: {people: 4}\n";
   const std::string path = (dir.path() / "crowd.plog").string();
-  const WorldConfig world =
-      LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml");
+  const WorldConfig world = LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml");
   SessionOptions o;
   o.build_renderer = false;
   o.adversity = preset;
@@ -83,7 +82,8 @@ TEST(CrowdReplayTest, ReplayPosesTheCrowdAsTheRunDid) {
       ASSERT_NE(it, mnames.end());
       const size_t m = it - mnames.begin();
       for (int k = 0; k < 3; ++k)
-        EXPECT_EQ(std::bit_cast<uint64_t>(p[k]), std::bit_cast<uint64_t>(logged.mocap_pos[3 * m + k]));
+        EXPECT_EQ(std::bit_cast<uint64_t>(p[k]),
+                  std::bit_cast<uint64_t>(logged.mocap_pos[3 * m + k]));
       if (i == 0 && compared == 0) first = p;
       if (i == 0) moved = std::max(moved, (p - first).norm());
     }

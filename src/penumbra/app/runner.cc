@@ -215,9 +215,10 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     // the crowd's decisions (goals, plans, pauses) as "npc" events (docs/npcs.md)
     RunLogWriter* npc_log = &recorder->writer();
     const double timestep = sim.timestep();
-    session.effects().set_crowd_decision_sink([npc_log, timestep](double t, const std::string& json) {
-      npc_log->RecordEvent(std::llround(t / timestep), t, "npc", json);
-    });
+    session.effects().set_crowd_decision_sink(
+        [npc_log, timestep](double t, const std::string& json) {
+          npc_log->RecordEvent(std::llround(t / timestep), t, "npc", json);
+        });
     spdlog::info("recording the run to {}", record_path);
   }
   outputs.sensors().set_on_output([&sensor_log, &live](const std::string& sensor,

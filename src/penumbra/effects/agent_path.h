@@ -81,7 +81,7 @@ struct AgentConfig {
   AgentBehaviour behaviour = AgentBehaviour::kAvoid;  ///< crowd motion only
   AgentGoals goals = AgentGoals::kPatrol;             ///< crowd motion only
   double clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m (crowd only)
-  int line = 0;            ///< line of the entry in the world file (0 = unknown)
+  int line = 0;              ///< line of the entry in the world file (0 = unknown)
 
   /// checks names, ranges and the path (>= 2 waypoints, consecutive waypoints >= 1 cm
   /// apart, every value finite).

@@ -10,15 +10,15 @@ namespace {
 
 // key of the crowd's random goal draws (core/rng.h streams)
 constexpr uint64_t kCrowdStream = 0xC20D5E1D0ULL;
-constexpr double kTau = 2.0;            // ORCA time horizon, s
-constexpr double kNeighbourM = 8.0;     // neighbours farther than this are not considered, m
-constexpr double kReachedM = 0.2;       // a goal within this is reached (people), m
+constexpr double kTau = 2.0;              // ORCA time horizon, s
+constexpr double kNeighbourM = 8.0;       // neighbours farther than this are not considered, m
+constexpr double kReachedM = 0.2;         // a goal within this is reached (people), m
 constexpr double kVehicleReachedM = 0.6;  // ... by a vehicle (its turns are limited), m
-constexpr double kWaypointM = 0.3;      // a plan point within this is passed, m
-constexpr double kTurnRate = 6.0;       // people's heading rate limit, rad/s
-constexpr double kLookAheadM = 1.5;     // pure pursuit look-ahead, m
-constexpr double kVehicleAccel = 1.5;   // vehicles' speed change limit, m/s^2
-constexpr double kSafetyM = 0.02;       // added to every combined radius, m
+constexpr double kWaypointM = 0.3;        // a plan point within this is passed, m
+constexpr double kTurnRate = 6.0;         // people's heading rate limit, rad/s
+constexpr double kLookAheadM = 1.5;       // pure pursuit look-ahead, m
+constexpr double kVehicleAccel = 1.5;     // vehicles' speed change limit, m/s^2
+constexpr double kSafetyM = 0.02;         // added to every combined radius, m
 constexpr double kBlockReplanSec = 1.0;
 
 double WrapAngle(double a) { return std::remainder(a, 2 * M_PI); }
@@ -71,7 +71,8 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     rngs_.emplace_back(HashKeys(seed, kCrowdStream, i));
-    const Eigen::Vector2d start = region(i).NearestWalkable(a.waypoints[0]).value_or(a.waypoints[0]);
+    const Eigen::Vector2d start =
+        region(i).NearestWalkable(a.waypoints[0]).value_or(a.waypoints[0]);
     states_[i].position_W = start;
     const Eigen::Vector2d d = a.waypoints[1] - a.waypoints[0];
     states_[i].yaw = std::atan2(d.y(), d.x());
@@ -128,7 +129,8 @@ void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
   const AgentConfig& a = agents_[i];
   const int n = static_cast<int>(a.waypoints.size());
   if (a.behaviour == AgentBehaviour::kBlock && !robots.empty()) {
-    // the point 0.5 m beyond the discs' contact ahead of the nearest robot along its heading (its velocity when moving)
+    // the point 0.5 m beyond the discs' contact ahead of the nearest robot along its heading (its
+    // velocity when moving)
     size_t best = 0;
     for (size_t r = 1; r < robots.size(); ++r)
       if ((robots[r].position_W - states_[i].position_W).squaredNorm() <
@@ -200,7 +202,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     if (a.behaviour == AgentBehaviour::kBlock && !robots.empty()) {
       if (time_ >= replan_at_[i] && time_ >= pause_until_[i]) ChooseGoal(i, robots);
     } else if (plan.active && (states_[i].position_W - plan.goal).norm() <
-                                   (IsVehicle(a.kind) ? kVehicleReachedM : kReachedM)) {
+                                  (IsVehicle(a.kind) ? kVehicleReachedM : kReachedM)) {
       plan.active = false;
       pause_until_[i] = time_ + a.pause_sec;
       CrowdDecision d;

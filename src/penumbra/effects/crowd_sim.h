@@ -94,10 +94,10 @@ struct CrowdRobot {
 /// one decision of the crowd (what a run log records as an "npc" event).
 struct CrowdDecision {
   double time_sec = 0;
-  int agent = 0;            ///< index into the agents
-  std::string what;         ///< "goal", "replan", "pause", "blocked" (no plan to the goal)
+  int agent = 0;     ///< index into the agents
+  std::string what;  ///< "goal", "replan", "pause", "blocked" (no plan to the goal)
   Eigen::Vector2d goal_W{0, 0};
-  int plan_points = 0;      ///< points of the plan made (0 = none)
+  int plan_points = 0;  ///< points of the plan made (0 = none)
 };
 
 /// the state of one crowd agent.
@@ -158,12 +158,12 @@ class CrowdSim {
   std::vector<CrowdAgentState> states_;
   std::vector<Plan> plans_;
   std::vector<Rng> rngs_;
-  std::vector<int> goal_index_;     // patrol: the waypoint headed for; random: the last drawn
-  std::vector<int> patrol_dir_;     // pingpong: +1 / -1
+  std::vector<int> goal_index_;  // patrol: the waypoint headed for; random: the last drawn
+  std::vector<int> patrol_dir_;  // pingpong: +1 / -1
   std::vector<double> pause_until_;
-  std::vector<double> replan_at_;   // block: the time of the next replan
-  std::vector<int> gear_;           // vehicles: +1 forward, -1 reverse
-  std::vector<double> speed_;       // vehicles: signed speed along the heading, m/s
+  std::vector<double> replan_at_;  // block: the time of the next replan
+  std::vector<int> gear_;          // vehicles: +1 forward, -1 reverse
+  std::vector<double> speed_;      // vehicles: signed speed along the heading, m/s
   std::vector<double> slow_since_;
   std::vector<uint8_t> active_;  // start of the agent's current spell below 0.1 m/s
   std::vector<CrowdDecision> decisions_;

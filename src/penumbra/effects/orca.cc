@@ -50,8 +50,8 @@ bool OptimiseOnLine(const std::vector<OrcaLine>& lines, size_t i, double max_spe
 
 // the 2-d program; returns the number of lines satisfied in order (lines.size() = all) and the
 // optimum over those in *result
-size_t Solve2d(const std::vector<OrcaLine>& lines, double max_speed,
-               const Eigen::Vector2d& target, bool maximise, Eigen::Vector2d* result) {
+size_t Solve2d(const std::vector<OrcaLine>& lines, double max_speed, const Eigen::Vector2d& target,
+               bool maximise, Eigen::Vector2d* result) {
   if (maximise) {
     *result = target * max_speed;  // target is a unit direction
   } else if (target.squaredNorm() > max_speed * max_speed) {

@@ -46,8 +46,7 @@ WalkableGrid::WalkableGrid(const OccupancyGrid& occupancy, double radius_m,
     }
   for (int iy = 0; iy < ny_; ++iy)
     for (int ix = 0; ix < nx_; ++ix) {
-      const double to_edge =
-          cell_m_ * (std::min({ix, iy, nx_ - 1 - ix, ny_ - 1 - iy}) + 0.5);
+      const double to_edge = cell_m_ * (std::min({ix, iy, nx_ - 1 - ix, ny_ - 1 - iy}) + 0.5);
       if (to_edge < radius_m) free[Index(ix, iy)] = 0;
     }
   // the components reachable from the free cells nearest the seeds

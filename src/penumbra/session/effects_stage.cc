@@ -399,7 +399,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
     for (int kind = 0; kind < 2; ++kind)
       for (int i = 0; i < (kind == 0 ? people : vehicles); ++i) {
         AgentConfig a;
-        a.name = std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
+        a.name =
+            std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
         if (std::any_of(agents_.begin(), agents_.end(),
                         [&](const AgentConfig& b) { return b.name == a.name; }))
           continue;
@@ -526,8 +527,8 @@ std::shared_ptr<CrowdRunner> EffectsStage::MakeCrowd(const std::vector<AgentConf
   npc_map_ = std::make_shared<const NpcMap>(
       sim_->scene(), sim_->Snapshot(Simulation::SnapshotContent::kPoses).X_WB, floor_z, centre,
       person_seeds, vehicle_seeds);
-  auto sim = std::make_unique<CrowdSim>(std::move(crowd), npc_map_->person(), npc_map_->vehicle(),
-                                        seed_);
+  auto sim =
+      std::make_unique<CrowdSim>(std::move(crowd), npc_map_->person(), npc_map_->vehicle(), seed_);
   auto runner = std::make_shared<CrowdRunner>(std::move(sim), sim_, CrowdRobotsOf(robots_, *sim_),
                                               floor_z, start_sec);
   if (decision_sink_) runner->set_decision_sink(decision_sink_);
@@ -569,8 +570,7 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
     const auto same = [](const AgentConfig& x, const AgentConfig& y) {
       return x.kind == y.kind && x.waypoints == y.waypoints && x.speed_m_s == y.speed_m_s &&
              x.pause_sec == y.pause_sec && x.route == y.route && x.goals == y.goals &&
-             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m &&
-             x.floor_z == y.floor_z;
+             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m && x.floor_z == y.floor_z;
     };
     const auto it = std::find_if(agents.begin(), agents.end(),
                                  [&](const AgentConfig& a) { return a.name == name; });
@@ -581,8 +581,8 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
   if (keep) {
     crowd = crowd_;
     for (size_t m = 0; m < crowd->crowd().agents().size(); ++m)
-      crowd->SetActive(m, std::find(index_in_crowd.begin(), index_in_crowd.end(), m) !=
-                              index_in_crowd.end());
+      crowd->SetActive(
+          m, std::find(index_in_crowd.begin(), index_in_crowd.end(), m) != index_in_crowd.end());
   } else {
     crowd = MakeCrowd(agents, sim_ ? sim_->time() : 0.0);
     index_in_crowd.clear();

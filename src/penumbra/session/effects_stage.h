@@ -157,8 +157,7 @@ class EffectsStage {
   };
   // a crowd runner for the crowd agents of `agents` (null if none), with its time 0 at
   // start_sec; sets npc_map_
-  std::shared_ptr<CrowdRunner> MakeCrowd(const std::vector<AgentConfig>& agents,
-                                         double start_sec);
+  std::shared_ptr<CrowdRunner> MakeCrowd(const std::vector<AgentConfig>& agents, double start_sec);
   CrowdSites sites_;
   std::vector<ModelConfig> robots_;
   Simulation* sim_ = nullptr;

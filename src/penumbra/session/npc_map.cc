@@ -44,7 +44,8 @@ NpcMap::NpcMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, dou
                               kReachM);
   const FloorMap vehicle_floor(scene, X_WB, floor_z, centre_W, v.step_height_m, v.head_clearance_m,
                                kReachM);
-  person_ = std::make_shared<const WalkableGrid>(person_floor.Occupancy(), p.radius_m, person_seeds);
+  person_ =
+      std::make_shared<const WalkableGrid>(person_floor.Occupancy(), p.radius_m, person_seeds);
   vehicle_ =
       std::make_shared<const WalkableGrid>(vehicle_floor.Occupancy(), v.radius_m, vehicle_seeds);
 }
@@ -56,13 +57,12 @@ ImageU8 NpcMap::Draw(const CrowdSites& sites, const std::vector<Eigen::Vector2d>
   ImageU8 img(g.nx() * ppc, g.ny() * ppc, 3, 0);
   for (int iy = 0; iy < g.ny(); ++iy)
     for (int ix = 0; ix < g.nx(); ++ix) {
-      Rgb8 c{205, 205, 205};                                        // free, too close
-      if (g.CellBlocked(ix, iy)) c = {70, 70, 75};                  // blocked
-      if (g.CellWalkable(ix, iy)) c = {150, 215, 140};              // people
-      if (vehicle_->CellWalkable(ix, iy)) c = {110, 160, 225};      // vehicles (and people)
+      Rgb8 c{205, 205, 205};                                    // free, too close
+      if (g.CellBlocked(ix, iy)) c = {70, 70, 75};              // blocked
+      if (g.CellWalkable(ix, iy)) c = {150, 215, 140};          // people
+      if (vehicle_->CellWalkable(ix, iy)) c = {110, 160, 225};  // vehicles (and people)
       for (int dv = 0; dv < ppc; ++dv)
-        for (int du = 0; du < ppc; ++du)
-          Put(&img, ix * ppc + du, (g.ny() - 1 - iy) * ppc + dv, c);
+        for (int du = 0; du < ppc; ++du) Put(&img, ix * ppc + du, (g.ny() - 1 - iy) * ppc + dv, c);
     }
   const auto to_px = [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d c = (p - g.min_W()) / g.cell_m() * ppc;

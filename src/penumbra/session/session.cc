@@ -123,7 +123,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
     spdlog::info("converted MJCF mesh {} for MuJoCo", f);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity,
-                                            options.reserve_live_npcs, CrowdSitesOf(generated, world_.models));
+                                            options.reserve_live_npcs,
+                                            CrowdSitesOf(generated, world_.models));
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   // the document becomes text once: the file kept and what MuJoCo compiles
   composed_xml_ = composed.Xml();

@@ -61,7 +61,7 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
     }
     if (r.Has("goals"))
       a.goals = note(r.Child("goals")).Enum({"patrol", "random"}) == "random" ? AgentGoals::kRandom
-                                                                             : AgentGoals::kPatrol;
+                                                                              : AgentGoals::kPatrol;
     if (r.Has("clearance_m")) a.clearance_m = note(r.Child("clearance_m")).Double();
     a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
       auto it = lines.find(key);
