@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""the contact sheet of docs/npcs-walkers.png from a run of worlds/effects/walkers.yaml.
+"""the contact sheet of docs/npc_walkers.png from a run of worlds/effects/walkers.yaml.
 
   ./build/penumbra run worlds/effects/walkers.yaml --out /tmp/walkers_run --duration 1.25
-  /usr/bin/python3 scripts/walkers_contact_sheet.py /tmp/walkers_run docs/npcs-walkers.png
+  /usr/bin/python3 scripts/walkers_contact_sheet.py /tmp/walkers_run docs/npc_walkers.png
 
 top row: the `side` camera's rgb at t = 0.4, 0.8 and 1.2 s; bottom row at 1.2 s: depth
 (colour-mapped 1-8 m), instance segmentation (one random colour per body: every limb is a body

@@ -26,6 +26,7 @@
 #include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/contact_sheet.h"
 #include "penumbra/app/heightfield_tool.h"
+#include "penumbra/app/npc_map_command.h"
 #include "penumbra/app/eval_command.h"
 #include "penumbra/app/export_command.h"
 #include "penumbra/app/replay_command.h"
@@ -343,6 +344,13 @@ int RunCli(int argc, char** argv) {
   AddInteger(sheet, "--height", &sheet_options.height, 16, 4096, "frame height");
   sheet->add_option("--out,-o", sheet_options.out, "output PNG (default docs/effects.png)");
   AddInteger(sheet, "--threads", &sheet_options.threads, 0, 256, "render threads (0 = all cores)");
+  // penumbra npc-map (app/npc_map_command.h)
+  CLI::App* npc_map = app.add_subcommand("npc-map", "the walkable map of a world's NPCs (people, vehicles, areas, lanes) as a PNG");
+  NpcMapOptions npc_map_options;
+  npc_map->add_option("world", npc_map_options.world_file, "world file")->required();
+  npc_map->add_option("--out,-o", npc_map_options.out, "output PNG (default npc_map.png)");
+  npc_map->add_option("--adversity", npc_map_options.adversity, "adversity preset whose crowd to place (default: the world's own)");
+  AddInteger(npc_map, "--pixels", &npc_map_options.pixels_per_cell, 1, 16, "pixels per 0.1 m cell (default 4)");
   CLI::App* make_vdb = app.add_subcommand("make-vdb", "write a procedural smoke cloud as an OpenVDB file (float grid 'density')");
   std::string vdb_path;
   SmokeVdbOptions vdb_options;
@@ -489,6 +497,7 @@ int RunCli(int argc, char** argv) {
       return BenchRender(render_bench);
     }
     if (*sheet) return MakeContactSheet(sheet_options);
+    if (*npc_map) return WriteNpcMap(npc_map_options);
     if (*hfield) {
       if (!hfield_extent.empty())
         hfield_options.extent = {hfield_extent[0], hfield_extent[1], hfield_extent[2],

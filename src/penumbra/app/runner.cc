@@ -12,6 +12,7 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
+#include "penumbra/output/png_io.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/simulation.h"
@@ -136,6 +137,16 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   session_options.check_run_budget = true;
   session_options.reserve_live_npcs = !options.bridges.empty();
   Session session(world, session_options);
+  // a crowd's walkable map goes with the run (npc_map.png, docs/npcs.md)
+  if (const std::shared_ptr<const NpcMap> npc_map = session.effects().npc_map()) {
+    std::vector<Eigen::Vector2d> robots, agents;
+    for (const ModelConfig& m : world.models)
+      if (m.is_robot) robots.push_back(m.pose.xyz.head<2>());
+    for (const CrowdAgentState& a : session.effects().crowd()->crowd().states())
+      agents.push_back(a.position_W);
+    WritePngRgb8((out / "npc_map.png").string(),
+                 npc_map->Draw(session.effects().sites(), robots, agents));
+  }
   // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples
   if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);
   Simulation& sim = session.sim();
@@ -202,6 +213,13 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     recorder = std::make_unique<RecorderSink>(record_path, header);
     if (world.record.sensors) sensor_log = &recorder->writer();
     live.RecordChangesTo(&recorder->writer());
+    // the crowd's decisions (goals, plans, pauses) as "npc" events (docs/npcs.md)
+    RunLogWriter* npc_log = &recorder->writer();
+    const double timestep = sim.timestep();
+    session.effects().set_crowd_decision_sink(
+        [npc_log, timestep](double t, const std::string& json) {
+          npc_log->RecordEvent(std::llround(t / timestep), t, "npc", json);
+        });
     spdlog::info("recording the run to {}", record_path);
   }
   outputs.sensors().set_on_output([&sensor_log, &live](const std::string& sensor,

@@ -43,6 +43,26 @@ const char* AgentRouteName(AgentRoute route) {
   return "?";
 }
 
+const char* AgentMotionName(AgentMotion motion) {
+  return motion == AgentMotion::kCrowd ? "crowd" : "scripted";
+}
+
+const char* AgentBehaviourName(AgentBehaviour behaviour) {
+  switch (behaviour) {
+    case AgentBehaviour::kAvoid:
+      return "avoid";
+    case AgentBehaviour::kIgnore:
+      return "ignore";
+    case AgentBehaviour::kBlock:
+      return "block";
+  }
+  return "?";
+}
+
+const char* AgentGoalsName(AgentGoals goals) {
+  return goals == AgentGoals::kRandom ? "random" : "patrol";
+}
+
 int AgentSemanticClass(AgentKind kind) {
   return kind == AgentKind::kPerson ? kSemanticClassPerson : kSemanticClassVehicle;
 }
@@ -81,6 +101,8 @@ void AgentConfig::ValidateOrThrow(const std::string& file, const std::string& ke
   if (!std::isfinite(floor_z)) fail("floor_z", "not finite; expected a height in m");
   if (!(std::isfinite(height_m) && height_m >= 0.5 && height_m <= 2.5))
     fail("height_m", "got " + Num(height_m) + "; expected [0.5, 2.5] m");
+  if (!(std::isfinite(clearance_m) && clearance_m >= 0 && clearance_m <= 10))
+    fail("clearance_m", "got " + Num(clearance_m) + "; expected [0, 10] m");
 }
 
 void ValidateAgentsOrThrow(const std::vector<AgentConfig>& agents, const std::string& file) {

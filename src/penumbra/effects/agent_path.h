@@ -36,6 +36,19 @@ enum class AgentKind {
 /// how an agent continues after its last waypoint (see the file header).
 enum class AgentRoute { kLoop, kPingPong, kOnce };
 
+/// how an agent moves: `scripted` follows its waypoints in straight legs as a pure function of
+/// time (this file); `crowd` plans on the walkable region of its kind and avoids the others
+/// and the robots (effects/crowd_sim.h).
+enum class AgentMotion { kScripted, kCrowd };
+
+/// what a crowd agent does about the robots (effects/crowd_sim.h): `avoid` keeps clearance_m
+/// from them, `ignore` walks as if they were not there, `block` steps into a robot's path.
+enum class AgentBehaviour { kAvoid, kIgnore, kBlock };
+
+/// a crowd agent's goals: `patrol` visits its waypoints in route order, `random` walks to a
+/// waypoint (point of interest) drawn from the world seed each time it reached one.
+enum class AgentGoals { kPatrol, kRandom };
+
 /// semantic-segmentation class ids of agent geoms (Geom::semantic_class). the ids are the
 /// Cityscapes label ids (Cordts et al., "The Cityscapes Dataset for Semantic Urban Scene
 /// Understanding", CVPR 2016): 24 = person, 27 = truck (used for every vehicle agent).
@@ -45,6 +58,11 @@ inline constexpr int kSemanticClassVehicle = 27;
 /// world-file name of a kind ("person", "forklift", "cart") and of a route.
 const char* AgentKindName(AgentKind kind);
 const char* AgentRouteName(AgentRoute route);
+/// world-file names of motions ("scripted", "crowd"), behaviours ("avoid", "ignore",
+/// "block") and goals ("patrol", "random").
+const char* AgentMotionName(AgentMotion motion);
+const char* AgentBehaviourName(AgentBehaviour behaviour);
+const char* AgentGoalsName(AgentGoals goals);
 /// semantic class of every geom of an agent of `kind`.
 int AgentSemanticClass(AgentKind kind);
 
@@ -62,7 +80,11 @@ struct AgentConfig {
   /// person: height_m was given (world file `height_m`); otherwise the body's height is drawn
   /// from the world seed (effects/walker_gait.h WalkerAppearanceOf) and height_m is unused
   bool height_given = false;
-  int line = 0;            ///< line of the entry in the world file (0 = unknown)
+  AgentMotion motion = AgentMotion::kScripted;
+  AgentBehaviour behaviour = AgentBehaviour::kAvoid;  ///< crowd motion only
+  AgentGoals goals = AgentGoals::kPatrol;             ///< crowd motion only
+  double clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m (crowd only)
+  int line = 0;              ///< line of the entry in the world file (0 = unknown)
 
   /// checks names, ranges and the path (>= 2 waypoints, consecutive waypoints >= 1 cm
   /// apart, every value finite).

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 const std::set<std::string> kTopFiles = {
     "run.json",         "composed.xml",          "trajectory.csv", "camera_info.yaml",
-    "camera_info.json", "semantic_classes.json", "rig.json"};
+    "camera_info.json", "semantic_classes.json", "rig.json",       "npc_map.png"};
 const std::set<std::string> kSensorFolders = {"imu", "sensors", "ground_truth"};
 // image folders are named after the camera outputs
 bool IsImageFolder(const std::string& name) {

@@ -26,31 +26,220 @@ std::vector<Eigen::Vector3d> RobotStarts(const WorldConfig& world) {
   return out;
 }
 
-// a closed loop of 3-4 waypoints for one NPC, or nothing after 200 draws
-std::optional<std::vector<Eigen::Vector2d>> DrawLoop(const FloorMap& map, uint64_t stream,
-                                                     double clearance,
-                                                     const std::vector<Eigen::Vector3d>& robots) {
-  Rng rng(stream);
-  const auto away_from_robots = [&](const Eigen::Vector2d& p) {
-    for (const Eigen::Vector3d& r : robots)
-      if ((p - r.head<2>()).norm() < 1.5) return false;
-    return true;
-  };
-  for (int attempt = 0; attempt < 200; ++attempt) {
-    const int n = 3 + static_cast<int>(rng.NextU64() % 2);
-    std::vector<Eigen::Vector2d> pts;
-    bool ok = true;
-    for (int i = 0; i < n && ok; ++i) {
-      Eigen::Vector2d p;
-      ok =
-          map.RandomFreePoint(rng.NextU64(), &p) && away_from_robots(p) && map.IsFree(p, clearance);
-      if (ok && !pts.empty())
-        ok = (p - pts.back()).norm() > 1.0 && map.SegmentFree(pts.back(), p, clearance);
-      if (ok) pts.push_back(p);
+// the longest stretch of `lane` (vertices snapped to `region` within 0.3 m, consecutive ones
+// joined by walkable segments), or nothing when shorter than 3 m
+std::vector<Eigen::Vector2d> DrivableStretch(const WalkableGrid& region,
+                                             const std::vector<Eigen::Vector2d>& lane) {
+  std::vector<Eigen::Vector2d> best, run;
+  double best_len = 0, run_len = 0;
+  const auto close_run = [&] {
+    if (run.size() >= 2 && run_len > best_len) {
+      best = run;
+      best_len = run_len;
     }
-    if (ok && map.SegmentFree(pts.back(), pts.front(), clearance)) return pts;
+    run.clear();
+    run_len = 0;
+  };
+  for (const Eigen::Vector2d& p : lane) {
+    const std::optional<Eigen::Vector2d> q = region.NearestWalkable(p);
+    if (!q || (*q - p).norm() > 0.3) {
+      close_run();
+      continue;
+    }
+    if (!run.empty() && !region.SegmentWalkable(run.back(), *q)) close_run();
+    if (!run.empty()) run_len += (*q - run.back()).norm();
+    if (run.empty() || (*q - run.back()).norm() > 0.05) run.push_back(*q);
+  }
+  close_run();
+  if (best_len < 3.0) best.clear();
+  return best;
+}
+
+// a uniformly drawn walkable cell centre of `region` (rejection sampling, 4000 draws)
+std::optional<Eigen::Vector2d> DrawWalkable(const WalkableGrid& region, Rng* rng) {
+  const uint64_t cells = static_cast<uint64_t>(region.nx()) * region.ny();
+  for (int k = 0; k < 4000; ++k) {
+    const uint64_t c = rng->NextU64() % cells;
+    const int ix = static_cast<int>(c % region.nx()), iy = static_cast<int>(c / region.nx());
+    if (region.CellWalkable(ix, iy)) return region.CellCentre(ix, iy);
   }
   return std::nullopt;
+}
+
+// the preset's crowd (see the header's "npcs")
+void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const CrowdSites& sites,
+                    const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                    std::vector<AgentConfig>* agents) {
+  const WalkableGrid& people = *map.person();
+  const WalkableGrid& vehicles = *map.vehicle();
+  const auto away = [&](const Eigen::Vector2d& p, double d) {
+    for (const Eigen::Vector3d& r : robot_starts)
+      if ((p - r.head<2>()).norm() < d) return false;
+    return true;
+  };
+  // points of interest: area centres and lane points, at least 1 m apart
+  std::vector<Eigen::Vector2d> pois;
+  const auto add_poi = [&](const Eigen::Vector2d& p, double snap) {
+    const std::optional<Eigen::Vector2d> q = people.NearestWalkable(p);
+    if (!q || (*q - p).norm() > snap) return;
+    for (const Eigen::Vector2d& o : pois)
+      if ((o - *q).norm() < 1.0) return;
+    pois.push_back(*q);
+  };
+  for (const CrowdSites::Area& a : sites.areas) add_poi(0.5 * (a.min_W + a.max_W), 3.0);
+  for (const CrowdSites::Lane& l : sites.lanes)
+    for (const Eigen::Vector2d& p : l.points_W) add_poi(p, 0.5);
+  if (pois.size() < 2) {
+    Rng rng(HashKeys(seed, kNpcStream, 7));
+    for (int k = 0; k < 200 && pois.size() < 6; ++k)
+      if (const auto p = DrawWalkable(people, &rng)) {
+        bool far = true;
+        for (const Eigen::Vector2d& o : pois) far = far && (o - *p).norm() >= 2.0;
+        if (far) pois.push_back(*p);
+      }
+  }
+  // lanes people can walk
+  std::vector<std::vector<Eigen::Vector2d>> walk_lanes;
+  for (const CrowdSites::Lane& l : sites.lanes) {
+    std::vector<Eigen::Vector2d> pts = DrivableStretch(people, l.points_W);
+    if (!pts.empty()) walk_lanes.push_back(std::move(pts));
+  }
+  const auto base = [&](const std::string& name, AgentKind kind) {
+    AgentConfig a;
+    a.name = name;
+    a.kind = kind;
+    a.motion = AgentMotion::kCrowd;
+    a.behaviour = preset.npc_behaviour;
+    a.clearance_m = preset.npc_clearance_m;
+    a.pause_sec = preset.npc_pause_sec;
+    a.floor_z = map.floor_z();
+    return a;
+  };
+  // every start keeps the discs of the agents placed before it 0.3 m apart
+  std::vector<std::pair<Eigen::Vector2d, double>> taken;
+  const auto free_start = [&](const Eigen::Vector2d& p, double radius, double from_robot) {
+    if (!away(p, from_robot)) return false;
+    for (const auto& [q, r] : taken)
+      if ((p - q).norm() < radius + r + 0.3) return false;
+    return true;
+  };
+  const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+  const double vehicle_r = KindModel(AgentKind::kForklift).disc_radius_m;
+  for (int i = 0; i < preset.npc_people; ++i) {
+    const std::string name = "adversity_person" + std::to_string(i);
+    Rng rng(HashKeys(seed, kNpcStream, 0, i));
+    AgentConfig a = base(name, AgentKind::kPerson);
+    a.speed_m_s = preset.npc_speed_m_s;
+    a.height_m = 1.55 + 0.4 * rng.UniformD();
+    if (i % 2 == 1 && !walk_lanes.empty()) {
+      std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
+      if ((i / 2 / walk_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
+      if (!free_start(lane.front(), person_r, 1.5)) std::reverse(lane.begin(), lane.end());
+      if (free_start(lane.front(), person_r, 1.5)) {
+        a.waypoints = lane;
+        a.route = AgentRoute::kPingPong;
+        a.goals = AgentGoals::kPatrol;
+        taken.emplace_back(lane.front(), person_r);
+        agents->push_back(a);
+        continue;
+      }
+    }
+    if (pois.size() < 2) {
+      spdlog::warn("adversity preset '{}': no points of interest for {}; left out", preset.name,
+                   name);
+      continue;
+    }
+    // the start: a free point of interest (from a drawn offset), else a free walkable cell
+    const size_t offset = rng.NextU64() % pois.size();
+    std::optional<Eigen::Vector2d> start;
+    for (size_t k = 0; k < pois.size() && !start; ++k)
+      if (free_start(pois[(offset + k) % pois.size()], person_r, 1.5))
+        start = pois[(offset + k) % pois.size()];
+    for (int k = 0; k < 400 && !start; ++k)
+      if (const auto p = DrawWalkable(people, &rng))
+        if (free_start(*p, person_r, 1.5)) start = *p;
+    if (!start) {
+      spdlog::warn("adversity preset '{}': no free start for {}; left out", preset.name, name);
+      continue;
+    }
+    a.waypoints.push_back(*start);
+    for (size_t k = 0; k < pois.size(); ++k)
+      if ((pois[(offset + k) % pois.size()] - *start).norm() > 0.05)
+        a.waypoints.push_back(pois[(offset + k) % pois.size()]);
+    a.goals = AgentGoals::kRandom;
+    a.route = AgentRoute::kLoop;
+    taken.emplace_back(*start, person_r);
+    agents->push_back(a);
+  }
+  // then vehicles (people's places do not depend on how many vehicles there are: a live
+  // change of the vehicle count keeps the people where they are)
+  std::vector<AgentConfig> vehicle_agents;
+  std::vector<std::vector<Eigen::Vector2d>> drive_lanes;
+  for (const CrowdSites::Lane& l : sites.lanes) {
+    std::vector<Eigen::Vector2d> pts = DrivableStretch(vehicles, l.points_W);
+    if (!pts.empty()) drive_lanes.push_back(std::move(pts));
+  }
+  for (int j = 0; j < preset.npc_vehicles; ++j) {
+    const std::string name = "adversity_forklift" + std::to_string(j);
+    AgentConfig a = base(name, AgentKind::kForklift);
+    a.speed_m_s = preset.npc_speed_m_s * 1.5;
+    a.route = AgentRoute::kPingPong;
+    a.goals = AgentGoals::kPatrol;
+    std::vector<Eigen::Vector2d> lane;
+    if (!drive_lanes.empty()) {
+      lane = drive_lanes[j % drive_lanes.size()];
+      if ((j / drive_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
+      // the start: the first free point (every 0.25 m) of the lane's first half, from either end
+      std::vector<Eigen::Vector2d> found;
+      for (int side = 0; side < 2 && found.empty(); ++side) {
+        if (side == 1) std::reverse(lane.begin(), lane.end());
+        double total = 0;
+        for (size_t k = 0; k + 1 < lane.size(); ++k) total += (lane[k + 1] - lane[k]).norm();
+        double along = 0;
+        for (size_t k = 0; k + 1 < lane.size() && found.empty() && along < 0.5 * total; ++k) {
+          const double len = (lane[k + 1] - lane[k]).norm();
+          for (double t = 0; t < len && found.empty() && along + t < 0.5 * total; t += 0.25) {
+            const Eigen::Vector2d p = lane[k] + (lane[k + 1] - lane[k]) * (t / len);
+            if (free_start(p, vehicle_r, 2.5)) {
+              found.push_back(p);
+              found.insert(found.end(), lane.begin() + k + 1, lane.end());
+            }
+          }
+          along += len;
+        }
+      }
+      lane = found;
+    } else if (sites.lanes.empty()) {
+      // no lanes in the world: a straight drivable lane drawn from the seed
+      Rng rng(HashKeys(seed, kNpcStream, 1, j));
+      std::vector<Eigen::Vector2d> fallback;
+      for (int k = 0; k < 200 && lane.empty(); ++k) {
+        const auto p = DrawWalkable(vehicles, &rng), q = DrawWalkable(vehicles, &rng);
+        if (!p || !q) break;
+        const double len = (*q - *p).norm();
+        if (len < 3.0 || len > 12.0 || !away(*p, 2.5) || !away(*q, 2.5) ||
+            !vehicles.SegmentWalkable(*p, *q))
+          continue;
+        if (free_start(*p, vehicle_r, 2.5))
+          lane = {*p, *q};
+        else if (free_start(*q, vehicle_r, 2.5))
+          lane = {*q, *p};
+        else if (fallback.empty())
+          fallback = {*p, *q};  // clear of the robots only
+      }
+      // a small room: the lane may start by a person (the crowd separates them)
+      if (lane.empty()) lane = fallback;
+    }
+    if (lane.size() < 2) {
+      spdlog::warn("adversity preset '{}': no free lane a forklift fits for {}; left out",
+                   preset.name, name);
+      continue;
+    }
+    a.waypoints = lane;
+    taken.emplace_back(lane.front(), vehicle_r);
+    vehicle_agents.push_back(a);
+  }
+  agents->insert(agents->end(), vehicle_agents.begin(), vehicle_agents.end());
 }
 
 // appends an effect named `name` of type P (default parameters, no region) to `effects`;
@@ -67,17 +256,17 @@ P& AppendEffect(std::vector<EffectConfig>* effects, std::string name) {
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
                          const std::vector<Pose>& X_WB,
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
-                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents) {
-  double lowest = 0;
+                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
+                         const CrowdSites& sites) {
   Eigen::Vector2d centre(0, 0);
+  for (const Eigen::Vector3d& r : robot_starts)
+    centre += r.head<2>() / static_cast<double>(robot_starts.size());
+  // the floor: the highest static upward plane at or below the lowest robot, else its z
+  double lowest = 0;
   if (!robot_starts.empty()) {
     lowest = robot_starts.front().z();
-    for (const Eigen::Vector3d& r : robot_starts) {
-      lowest = std::min(lowest, r.z());
-      centre += r.head<2>() / static_cast<double>(robot_starts.size());
-    }
+    for (const Eigen::Vector3d& r : robot_starts) lowest = std::min(lowest, r.z());
   }
-  // the floor: the highest static upward plane at or below the lowest robot, else its z
   double floor_z = -1e300;
   for (const Geom& g : scene.geoms) {
     if (g.shape != GeomShape::kPlane || !scene.bodies[g.body].is_static) continue;
@@ -143,31 +332,17 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
     p.frequency_hz = preset.flicker_hz;
   }
 
-  // NPCs: people first, then vehicles; each on its own random stream
-  for (int kind = 0; kind < 2; ++kind) {
-    const int count = kind == 0 ? preset.npc_people : preset.npc_vehicles;
-    if (count == 0) continue;
-    const double clearance = kind == 0 ? 0.4 : 1.2;
-    map.Flood(flood_seed, clearance);
-    for (int i = 0; i < count; ++i) {
-      const std::string name =
-          std::string("adversity_") + (kind == 0 ? "person" : "forklift") + std::to_string(i);
-      const auto loop = DrawLoop(map, HashKeys(seed, kNpcStream, kind, i), clearance, robot_starts);
-      if (!loop) {
-        spdlog::warn("adversity preset '{}': no free path found for {}; left out", preset.name,
-                     name);
-        continue;
-      }
-      AgentConfig a;
-      a.name = name;
-      a.kind = kind == 0 ? AgentKind::kPerson : AgentKind::kForklift;
-      a.waypoints = *loop;
-      a.speed_m_s = preset.npc_speed_m_s * (kind == 0 ? 1.0 : 1.5);
-      a.pause_sec = preset.npc_pause_sec;
-      a.route = AgentRoute::kLoop;
-      a.floor_z = floor_z;
-      agents->push_back(a);
-    }
+  // NPCs: a crowd on the walkable map seeded at the robots' starts (and the lanes, for vehicles)
+  if (preset.npc_people + preset.npc_vehicles > 0) {
+    std::vector<Eigen::Vector2d> person_seeds{flood_seed};
+    for (const Eigen::Vector3d& r : robot_starts) person_seeds.push_back(r.head<2>());
+    std::vector<Eigen::Vector2d> vehicle_seeds = person_seeds;
+    for (const CrowdSites::Lane& l : sites.lanes)
+      vehicle_seeds.insert(vehicle_seeds.end(), l.points_W.begin(), l.points_W.end());
+    // the NPCs' floor also knows floor slabs (a generated building's floor box)
+    const NpcMap npc_map(scene, X_WB, NpcFloorHeight(scene, X_WB, robot_starts), centre,
+                         person_seeds, vehicle_seeds);
+    PlanPresetNpcs(preset, npc_map, sites, robot_starts, seed, agents);
   }
 }
 
@@ -182,13 +357,17 @@ std::pair<int, int> LiveNpcReserve() {
 }
 
 EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
-                           const std::string& adversity_override, bool reserve_live_npcs)
+                           const std::string& adversity_override, bool reserve_live_npcs,
+                           CrowdSites sites)
     : effects_(world.effects),
       agents_(world.agents),
       seed_(world.seed),
       world_file_(world.file),
       world_agents_(world.agents.size()),
-      robot_starts_(RobotStarts(world)) {
+      robot_starts_(RobotStarts(world)),
+      sites_(std::move(sites)) {
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) robots_.push_back(m);
   ValidateAgentsOrThrow(agents_, world.file);
   std::string spec = world.adversity;
   std::string spec_file = world.file;
@@ -215,7 +394,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   if (preset_ && !preset_->empty()) {
     const Simulation probe = Simulation::LoadFromString(composed->Xml(), world.timestep_sec);
     PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, world.seed,
-                        &effects_, &agents_);
+                        &effects_, &agents_, sites_);
   }
   ValidateEffectsOrThrow(effects_, world.file);
   ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
@@ -310,13 +489,24 @@ void EffectsStage::Attach(Simulation* sim) {
         }
     }
   }
-  // the root and part bodies of every agent follow its animator (effects/agent_animation.h),
-  // which a live change replaces with the new path's
-  const auto attach = [&](const AgentConfig& a, std::shared_ptr<const AgentPath> path) {
+  // the root and part bodies of every agent follow its animator (effects/agent_animation.h)
+  // over the root's pose: its crowd's (motion: crowd, session/crowd_runner.h), its path's, or
+  // parked; a live change gives an agent whose motion changed a fresh animator
+  sim_ = sim;
+  crowd_ = MakeCrowd(agents_, 0.0);
+  size_t crowd_index = 0;
+  const auto attach = [&](const AgentConfig& a, bool parked_reserve) {
     auto slot = std::make_shared<AgentSlot>();
     slot->kind = a.kind;
     slot->height_m = AgentAppearance(a, seed_).height_m;
     slot->parked = AgentParkedPose(a);
+    std::shared_ptr<const AgentPath> path;
+    if (!parked_reserve && a.motion == AgentMotion::kCrowd && crowd_) {
+      slot->crowd = crowd_;
+      slot->crowd_index = crowd_index++;
+    } else if (!parked_reserve) {
+      path = std::make_shared<const AgentPath>(a);
+    }
     slot->Follow(std::move(path));
     sim->AddMocapDriver(AgentBodyName(a.name),
                         [slot](double t) { return slot->animator->Poses(t)[0]; });
@@ -327,22 +517,63 @@ void EffectsStage::Attach(Simulation* sim) {
     body_names_.push_back(a.name);
     slots_.push_back(std::move(slot));
   };
-  for (const AgentConfig& a : agents_) attach(a, std::make_shared<const AgentPath>(a));
-  for (const AgentConfig& a : reserved_) attach(a, nullptr);
+  for (const AgentConfig& a : agents_) attach(a, false);
+  for (const AgentConfig& a : reserved_) attach(a, true);
 }
 
 void EffectsStage::AgentSlot::Follow(std::shared_ptr<const AgentPath> new_path) {
   path = std::move(new_path);
   const std::shared_ptr<const AgentPath> p = path;
+  const std::shared_ptr<CrowdRunner> c = crowd;
+  const size_t ci = crowd_index;
   const Pose rest = parked;
-  animator = std::make_shared<AgentAnimator>(kind, height_m,
-                                             [p, rest](double t) { return p ? p->X_WA(t) : rest; });
+  animator = std::make_shared<AgentAnimator>(kind, height_m, [p, c, ci, rest](double t) {
+    if (c) return c->X_WA(ci, t);
+    return p ? p->X_WA(t) : rest;
+  });
+}
+
+std::shared_ptr<CrowdRunner> EffectsStage::MakeCrowd(const std::vector<AgentConfig>& agents,
+                                                     double start_sec) {
+  std::vector<AgentConfig> crowd;
+  for (const AgentConfig& a : agents)
+    if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+  if (crowd.empty() || !sim_) return nullptr;
+  Eigen::Vector2d centre(0, 0);
+  for (const Eigen::Vector3d& r : robot_starts_)
+    centre += r.head<2>() / static_cast<double>(robot_starts_.size());
+  std::vector<Eigen::Vector2d> person_seeds{
+      robot_starts_.empty() ? centre : Eigen::Vector2d(robot_starts_.front().head<2>())};
+  for (const Eigen::Vector3d& r : robot_starts_) person_seeds.push_back(r.head<2>());
+  std::vector<Eigen::Vector2d> vehicle_seeds = person_seeds;
+  for (const CrowdSites::Lane& l : sites_.lanes)
+    vehicle_seeds.insert(vehicle_seeds.end(), l.points_W.begin(), l.points_W.end());
+  for (const AgentConfig& a : crowd) {
+    std::vector<Eigen::Vector2d>& seeds = IsVehicle(a.kind) ? vehicle_seeds : person_seeds;
+    seeds.insert(seeds.end(), a.waypoints.begin(), a.waypoints.end());
+  }
+  const double floor_z = crowd.front().floor_z;
+  npc_map_ = std::make_shared<const NpcMap>(
+      sim_->scene(), sim_->Snapshot(Simulation::SnapshotContent::kPoses).X_WB, floor_z, centre,
+      person_seeds, vehicle_seeds);
+  auto sim =
+      std::make_unique<CrowdSim>(std::move(crowd), npc_map_->person(), npc_map_->vehicle(), seed_);
+  auto runner = std::make_shared<CrowdRunner>(std::move(sim), sim_, CrowdRobotsOf(robots_, *sim_),
+                                              floor_z, start_sec);
+  if (decision_sink_) runner->set_decision_sink(decision_sink_);
+  return runner;
+}
+
+void EffectsStage::set_crowd_decision_sink(std::function<void(double, const std::string&)> sink) {
+  decision_sink_ = std::move(sink);
+  if (crowd_) crowd_->set_decision_sink(decision_sink_);
 }
 
 void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
                            std::optional<AdversityPreset> preset,
                            std::unique_ptr<EffectsEngine> engine) {
   std::vector<std::shared_ptr<const AgentPath>> paths(slots_.size());
+  std::vector<size_t> crowd_slot;  // slot of each crowd agent, in the crowd's order
   for (const AgentConfig& a : agents) {
     const auto it = std::find(body_names_.begin(), body_names_.end(), a.name);
     if (it == body_names_.end())
@@ -350,9 +581,59 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
                         "agent '" + a.name +
                             "' has no body in this run (MuJoCo 2.2.2 cannot add bodies to a "
                             "loaded model); expected at most the NPCs the run started with");
-    paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
+    if (a.motion == AgentMotion::kCrowd)
+      crowd_slot.push_back(it - body_names_.begin());
+    else
+      paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
   }
-  for (size_t i = 0; i < slots_.size(); ++i) slots_[i]->Follow(paths[i]);
+  // crowd agents the running crowd has, unchanged, go on in it (the others in it leave it);
+  // else the new crowd starts now (its goals from the seed, its time from now)
+  bool keep = crowd_ != nullptr;
+  std::vector<size_t> index_in_crowd;
+  for (size_t k = 0; keep && k < crowd_slot.size(); ++k) {
+    const std::string& name = body_names_[crowd_slot[k]];
+    const std::vector<AgentConfig>& running = crowd_->crowd().agents();
+    size_t found = running.size();
+    for (size_t m = 0; m < running.size(); ++m)
+      if (running[m].name == name) found = m;
+    const auto same = [](const AgentConfig& x, const AgentConfig& y) {
+      return x.kind == y.kind && x.waypoints == y.waypoints && x.speed_m_s == y.speed_m_s &&
+             x.pause_sec == y.pause_sec && x.route == y.route && x.goals == y.goals &&
+             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m && x.floor_z == y.floor_z;
+    };
+    const auto it = std::find_if(agents.begin(), agents.end(),
+                                 [&](const AgentConfig& a) { return a.name == name; });
+    keep = found < running.size() && same(running[found], *it);
+    index_in_crowd.push_back(found);
+  }
+  std::shared_ptr<CrowdRunner> crowd;
+  if (keep) {
+    crowd = crowd_;
+    for (size_t m = 0; m < crowd->crowd().agents().size(); ++m)
+      crowd->SetActive(
+          m, std::find(index_in_crowd.begin(), index_in_crowd.end(), m) != index_in_crowd.end());
+  } else {
+    crowd = MakeCrowd(agents, sim_ ? sim_->time() : 0.0);
+    index_in_crowd.clear();
+    for (size_t k = 0; k < crowd_slot.size(); ++k) index_in_crowd.push_back(k);
+  }
+  // every slot follows its new source; an agent that goes on in the same crowd keeps its
+  // animator (its limbs' motion state), the others get a fresh one
+  for (size_t i = 0; i < slots_.size(); ++i) {
+    AgentSlot& s = *slots_[i];
+    std::shared_ptr<CrowdRunner> c;
+    size_t ci = 0;
+    for (size_t k = 0; k < crowd_slot.size(); ++k)
+      if (crowd_slot[k] == i) {
+        c = crowd;
+        ci = index_in_crowd[k];
+      }
+    const bool same_crowd_agent = c && s.crowd == c && s.crowd_index == ci && s.animator;
+    s.crowd = c;
+    s.crowd_index = ci;
+    if (!same_crowd_agent) s.Follow(paths[i]);
+  }
+  crowd_ = crowd;
   std::lock_guard<std::mutex> lock(mu_);
   effects_ = std::move(effects);
   agents_ = std::move(agents);

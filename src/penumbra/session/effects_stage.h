@@ -30,14 +30,21 @@
 //   rain, snow around the viewer (effect defaults), at the preset rate
 //   lights     a `blackout` light event on "*" at min_scale = lights.scale for the whole
 //              run, plus a `flicker` event when flicker_depth > 0
-//   npcs       people (and forklifts at 1.5x speed) on closed loops of 3-4 waypoints drawn
-//              from the world seed among the free floor cells reachable from the first
-//              robot (clearance 0.4 m for people, 1.2 m for forklifts; every leg straight
-//              and clear; no waypoint within 1.5 m of a robot's start). an NPC for which no
-//              such path is found within 200 draws is left out (logged).
+//   npcs       crowd agents (effects/crowd_sim.h; docs/npcs.md) on the walkable map
+//              (session/npc_map.h) seeded at the robots' starts. points of interest: the
+//              walkable points nearest the world's area centres and lane points (CrowdSites,
+//              from a generated environment's rooms and walkways), else 6 walkable points
+//              drawn from the seed. person i: odd i patrol a lane there and back when
+//              one is walkable, else random goals among the points of interest; it starts
+//              at one >= 1.5 m from every robot start. vehicles (forklifts at 1.5x speed) drive
+//              a lane (its longest drivable stretch, >= 3 m) there and back; without lanes
+//              in the world, a straight drivable lane of 3-12 m drawn from the seed; a world
+//              whose lanes no forklift fits (the house) gets none (logged). behaviour and
+//              clearance from the preset.
 // preset effects and agents are named "adversity_<what>" and follow the world's own.
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -48,11 +55,14 @@
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/effects/agent_animation.h"
 #include "penumbra/effects/agent_path.h"
+#include "penumbra/effects/crowd_sim.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/effects_engine.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
+#include "penumbra/session/crowd_runner.h"
+#include "penumbra/session/npc_map.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/world_config.h"
 
@@ -70,8 +80,10 @@ class EffectsStage {
   ///        for (LiveNpcReserve), so that a live change to a bundled preset can bring them in
   ///        (session/live_effects.h; MuJoCo 2.2.2 cannot add bodies to a loaded model)
   /// @throws ConfigError for an unknown preset, invalid agents or invalid effects.
+  /// @param sites the world's areas and lanes for placing crowds (CrowdSites; empty = none)
   EffectsStage(const WorldConfig& world, ComposedScene* composed,
-               const std::string& adversity_override = "", bool reserve_live_npcs = false);
+               const std::string& adversity_override = "", bool reserve_live_npcs = false,
+               CrowdSites sites = {});
   ~EffectsStage();
 
   /// checks the world's agents against `sim`'s static geometry, then drives every agent's
@@ -104,6 +116,14 @@ class EffectsStage {
                std::optional<AdversityPreset> preset, std::unique_ptr<EffectsEngine> engine);
   /// names of the agents whose bodies the model has (the agents at Attach), in order.
   const std::vector<std::string>& agent_bodies() const { return body_names_; }
+  /// the walkable map of the crowd (null when no agent has `motion: crowd`), its sites, and
+  /// the running crowd (null likewise).
+  std::shared_ptr<const NpcMap> npc_map() const { return npc_map_; }
+  const CrowdSites& sites() const { return sites_; }
+  std::shared_ptr<const CrowdRunner> crowd() const { return crowd_; }
+  /// every crowd decision from now on goes to `sink` (sim time, JSON payload; app/runner.cc
+  /// records them as "npc" events of the run log). called from the physics thread.
+  void set_crowd_decision_sink(std::function<void(double, const std::string&)> sink);
   /// the world seed (keys the effects' random streams).
   uint64_t seed() const { return seed_; }
 
@@ -129,9 +149,12 @@ class EffectsStage {
   size_t world_agents_ = 0;  // agents_[0, world_agents_) are the world's, then the preset's
   std::vector<Eigen::Vector3d> robot_starts_;
   std::unique_ptr<EffectsEngine> engine_;
-  // the path each attached agent body follows (null = parked), shared with its mocap driver
+  // the path each attached agent body follows (null = parked), shared with its mocap driver;
+  // crowd agents follow the crowd instead
   struct AgentSlot {
     std::shared_ptr<const AgentPath> path;
+    std::shared_ptr<CrowdRunner> crowd;
+    size_t crowd_index = 0;
     Pose parked;
     AgentKind kind = AgentKind::kPerson;
     double height_m = 1.75;
@@ -139,6 +162,15 @@ class EffectsStage {
     // follows `new_path` (null: parked) from now on, with a fresh animator
     void Follow(std::shared_ptr<const AgentPath> new_path);
   };
+  // a crowd runner for the crowd agents of `agents` (null if none), with its time 0 at
+  // start_sec; sets npc_map_
+  std::shared_ptr<CrowdRunner> MakeCrowd(const std::vector<AgentConfig>& agents, double start_sec);
+  CrowdSites sites_;
+  std::vector<ModelConfig> robots_;
+  Simulation* sim_ = nullptr;
+  std::shared_ptr<const NpcMap> npc_map_;
+  std::shared_ptr<CrowdRunner> crowd_;
+  std::function<void(double, const std::string&)> decision_sink_;
   std::vector<std::string> body_names_;
   std::vector<std::shared_ptr<AgentSlot>> slots_;
   // parked NPC bodies without an agent at the start (reserve_live_npcs)
@@ -158,10 +190,12 @@ Pose AgentParkedPose(const AgentConfig& agent);
 /// the preset's effects and agents for a world whose scene at the start is (scene, X_WB),
 /// as described in the file header. pure and deterministic in (preset, world, seed).
 /// @param robot_starts start positions (world xy) of the robots' root bodies
+/// @param sites        the world's areas and lanes (empty: points drawn from the seed)
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
                          const std::vector<Pose>& X_WB,
                          const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
-                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents);
+                         std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
+                         const CrowdSites& sites = {});
 
 /// what agent `agent` looks like in a run of world seed `seed`: WalkerAppearanceOf(seed, its
 /// name, its height_m when height_given, else 0: drawn from the seed).

@@ -37,7 +37,8 @@ bool LocalBox(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* c,
 }  // namespace
 
 FloorMap::FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
-                   const Eigen::Vector2d& centre_W)
+                   const Eigen::Vector2d& centre_W, double band_lo_m, double band_hi_m,
+                   double reach_m)
     : floor_z_(floor_z) {
   struct Box2 {
     Eigen::Vector2d lo, hi;
@@ -57,10 +58,10 @@ FloorMap::FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB,
     hi = hi.cwiseMax((cw + ew).head<2>());
     has_bounds_ = true;
     // blocks the floor if it overlaps the band where people and vehicles are
-    if (cw.z() + ew.z() < floor_z + 0.05 || cw.z() - ew.z() > floor_z + 2.0) continue;
+    if (cw.z() + ew.z() < floor_z + band_lo_m || cw.z() - ew.z() > floor_z + band_hi_m) continue;
     blockers.push_back({(cw - ew).head<2>(), (cw + ew).head<2>()});
   }
-  const Eigen::Vector2d near(5.0, 5.0), reach(15.0, 15.0);
+  const Eigen::Vector2d near(5.0, 5.0), reach(reach_m, reach_m);
   min_ = centre_W - near;
   max_ = centre_W + near;
   if (has_bounds_) {
@@ -157,6 +158,16 @@ bool FloorMap::ReachableBounds(Eigen::Vector2d* lo, Eigen::Vector2d* hi) const {
     *hi = hi->cwiseMax(c + Eigen::Vector2d::Constant(kCellM));
   }
   return true;
+}
+
+OccupancyGrid FloorMap::Occupancy() const {
+  OccupancyGrid g;
+  g.min_W = min_;
+  g.cell_m = kCellM;
+  g.nx = nx_;
+  g.ny = ny_;
+  g.blocked = blocked_;
+  return g;
 }
 
 bool FloorMap::RandomFreePoint(uint64_t u, Eigen::Vector2d* p) const {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/effects/walkable_grid.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -23,8 +24,14 @@ class FloorMap {
   ///                 [floor_z + 0.05, floor_z + 2.0] block the cells under them (planes never do)
   /// @param centre_W the grid covers the static geoms' bounding box (xy) joined with
   ///                 centre_W +- 5 m, clipped to centre_W +- 15 m
+  /// @param band_lo_m, band_hi_m  the height band above the floor in which static geometry
+  ///                 blocks a cell (an agent kind's step height and head clearance,
+  ///                 effects/walkable_grid.h WalkableProfile); the defaults are the presets'
+  /// @param reach_m  the clip: centre_W +- reach_m (15 m for the presets' area; the NPCs' map
+  ///                 takes 40 m, a whole generated building)
   FloorMap(const SceneDescription& scene, const std::vector<Pose>& X_WB, double floor_z,
-           const Eigen::Vector2d& centre_W);
+           const Eigen::Vector2d& centre_W, double band_lo_m = 0.05, double band_hi_m = 2.0,
+           double reach_m = 15.0);
 
   /// lower / upper corner (xy) of the mapped area, m.
   const Eigen::Vector2d& min_W() const { return min_; }
@@ -50,6 +57,8 @@ class FloorMap {
   /// a uniformly drawn reachable free point (cell centre), from the 64-bit draw `u`;
   /// false if there is none.
   bool RandomFreePoint(uint64_t u, Eigen::Vector2d* p) const;
+  /// the blocked cells as an occupancy grid (effects/walkable_grid.h).
+  OccupancyGrid Occupancy() const;
 
  private:
   int Index(int ix, int iy) const { return iy * nx_ + ix; }

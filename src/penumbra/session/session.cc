@@ -30,6 +30,38 @@ double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// the generated environments' rooms and walkways in the world frame: where crowds go
+// (session/effects_stage.h)
+CrowdSites CrowdSitesOf(const GeneratedModels& generated, const std::vector<ModelConfig>& models) {
+  CrowdSites sites;
+  for (const GeneratedModel& g : generated.models) {
+    Pose X_WM = Pose::Identity();
+    for (const ModelConfig& m : models)
+      if (m.name == g.model) X_WM = m.pose.ToPose();
+    for (const auto& [name, r] : g.environment.rooms) {
+      CrowdSites::Area a;
+      a.name = g.model + "/" + name;
+      a.min_W = Eigen::Vector2d(1e300, 1e300);
+      a.max_W = -a.min_W;
+      for (const Eigen::Vector2d& c : {Eigen::Vector2d(r.x0, r.y0), Eigen::Vector2d(r.x1, r.y0),
+                                       Eigen::Vector2d(r.x0, r.y1), Eigen::Vector2d(r.x1, r.y1)}) {
+        const Eigen::Vector2d w = (X_WM * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>();
+        a.min_W = a.min_W.cwiseMin(w);
+        a.max_W = a.max_W.cwiseMax(w);
+      }
+      sites.areas.push_back(a);
+    }
+    for (const Walkway& w : g.environment.walkways) {
+      CrowdSites::Lane l;
+      l.name = g.model + "/" + w.name;
+      for (const Eigen::Vector2d& p : w.points)
+        l.points_W.push_back((X_WM * Eigen::Vector3d(p.x(), p.y(), 0)).head<2>());
+      sites.lanes.push_back(std::move(l));
+    }
+  }
+  return sites;
+}
+
 }  // namespace
 
 void AddWorldControllers(const WorldConfig& world, Simulation* sim) {
@@ -93,7 +125,8 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
     spdlog::info("converted MJCF mesh {} for MuJoCo", f);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
   effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity,
-                                            options.reserve_live_npcs);
+                                            options.reserve_live_npcs,
+                                            CrowdSitesOf(generated, world_.models));
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   // the document becomes text once: the file kept and what MuJoCo compiles
   composed_xml_ = composed.Xml();

@@ -97,11 +97,18 @@ AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const s
   }
   if (r.Has("npcs")) {
     const YamlReader s = r.Child("npcs");
-    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec"});
+    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m"});
     if (s.Has("people")) p.npc_people = RangedInt(s.Child("people"), 0, 100);
     if (s.Has("vehicles")) p.npc_vehicles = RangedInt(s.Child("vehicles"), 0, 20);
     if (s.Has("speed_m_s")) p.npc_speed_m_s = Ranged(s.Child("speed_m_s"), 0, 5, true, "m/s");
     if (s.Has("pause_sec")) p.npc_pause_sec = Ranged(s.Child("pause_sec"), 0, 60, false, "s");
+    if (s.Has("behaviour")) {
+      const std::string b = s.Child("behaviour").Enum({"avoid", "ignore", "block"});
+      p.npc_behaviour = b == "avoid"    ? AgentBehaviour::kAvoid
+                        : b == "ignore" ? AgentBehaviour::kIgnore
+                                        : AgentBehaviour::kBlock;
+    }
+    if (s.Has("clearance_m")) p.npc_clearance_m = Ranged(s.Child("clearance_m"), 0, 10, false, "m");
   }
   return p;
 }
@@ -129,6 +136,8 @@ YAML::Node PresetNode(const AdversityPreset& p) {
   n["npcs"]["vehicles"] = p.npc_vehicles;
   n["npcs"]["speed_m_s"] = p.npc_speed_m_s;
   n["npcs"]["pause_sec"] = p.npc_pause_sec;
+  n["npcs"]["behaviour"] = AgentBehaviourName(p.npc_behaviour);
+  n["npcs"]["clearance_m"] = p.npc_clearance_m;
   return n;
 }
 

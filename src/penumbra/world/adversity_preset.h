@@ -16,7 +16,8 @@
 //       rain:   {rate_mm_h: R}
 //       snow:   {rate_mm_h: R}
 //       lights: {scale: K, flicker_depth: D, flicker_hz: F}
-//       npcs:   {people: N, vehicles: V, speed_m_s: S, pause_sec: P}
+//       npcs:   {people: N, vehicles: V, speed_m_s: S, pause_sec: P,
+//                behaviour: avoid | ignore | block, clearance_m: C}
 // every block is optional; MOR is the meteorological optical range (WMO No. 8, 2018;
 // sigma_t = 2.996 / MOR, Koschmieder), rain and snow rates are water-equivalent mm/h.
 //
@@ -36,6 +37,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "penumbra/effects/agent_path.h"
 
 namespace penumbra {
 
@@ -62,6 +65,9 @@ struct AdversityPreset {
   int npc_vehicles = 0;                  ///< forklifts, [0, 20]
   double npc_speed_m_s = 1.2;            ///< people's speed, (0, 5]; vehicles drive at 1.5x
   double npc_pause_sec = 1.0;            ///< pause at each waypoint, [0, 60]
+  /// what the NPCs do about the robots (effects/agent_path.h AgentBehaviour)
+  AgentBehaviour npc_behaviour = AgentBehaviour::kAvoid;
+  double npc_clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m
 
   /// true when the preset changes nothing (e.g. `none`).
   bool empty() const;

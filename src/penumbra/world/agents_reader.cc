@@ -26,7 +26,7 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
   for (const YamlReader& r : list.List()) {
     note(r);
     r.ExpectMap({"name", "type", "waypoints", "speed_m_s", "pause_sec", "start_delay_sec", "route",
-                 "floor_z", "height_m"});
+                 "floor_z", "height_m", "motion", "behaviour", "goals", "clearance_m"});
     AgentConfig a;
     a.line = r.line();
     a.name = note(r.Child("name")).String();
@@ -52,6 +52,20 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
       a.height_m = note(r.Child("height_m")).Double();
       a.height_given = true;
     }
+    if (r.Has("motion"))
+      a.motion = note(r.Child("motion")).Enum({"scripted", "crowd"}) == "crowd"
+                     ? AgentMotion::kCrowd
+                     : AgentMotion::kScripted;
+    if (r.Has("behaviour")) {
+      const std::string b = note(r.Child("behaviour")).Enum({"avoid", "ignore", "block"});
+      a.behaviour = b == "avoid"    ? AgentBehaviour::kAvoid
+                    : b == "ignore" ? AgentBehaviour::kIgnore
+                                    : AgentBehaviour::kBlock;
+    }
+    if (r.Has("goals"))
+      a.goals = note(r.Child("goals")).Enum({"patrol", "random"}) == "random" ? AgentGoals::kRandom
+                                                                              : AgentGoals::kPatrol;
+    if (r.Has("clearance_m")) a.clearance_m = note(r.Child("clearance_m")).Double();
     a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
       auto it = lines.find(key);
       return it == lines.end() ? 0 : it->second;

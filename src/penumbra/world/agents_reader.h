@@ -4,7 +4,8 @@
 //   name (required), type (person | forklift | cart, default person),
 //   waypoints (required, >= 2 [x, y] in m), speed_m_s (0, 20], pause_sec [0, 3600],
 //   start_delay_sec [0, 3600], route (loop | pingpong | once), floor_z (m),
-//   height_m [0.5, 2.5] (person).
+//   height_m [0.5, 2.5] (person), motion (scripted | crowd), behaviour (avoid | ignore |
+//   block), goals (patrol | random), clearance_m [0, 10] (docs/npcs.md).
 
 #include <vector>
 

@@ -1,0 +1,172 @@
+#pragma once
+// the crowd model of NPC agents with `motion: crowd` (issue 39; docs/npcs.md): goals, A* plans
+// on the walkable region of the agent's kind (effects/walkable_grid.h), reciprocal collision
+// avoidance among agents and against the robots (ORCA, effects/orca.h), and a kinematic bicycle
+// model for vehicles that follow lanes. the model is separate from physics: it steps at a fixed
+// dt and reads only the robots' discs (position, velocity, heading), so it runs without
+// rendering or MuJoCo (tests, `penumbra npc-map`) and, in a run, from the agents' mocap drivers
+// (session/effects_stage.h).
+//
+// per step (every agent in index order; sums in a fixed order; no unordered containers):
+//   goals     patrol: the waypoints in route order (loop, pingpong, once); random: a waypoint
+//             (point of interest) other than the last, drawn from the agent's stream keyed by
+//             the seed; block: the point 0.5 m ahead of the nearest robot's disc (plus the
+//             agent's) along its heading, replanned every second. on reaching a goal
+//             (within 0.2 m; vehicles 0.6 m) the agent pauses
+//             pause_sec. each new goal and plan is a CrowdDecision.
+//   plan      WalkableGrid::Plan from the agent to its goal on its kind's region; an `avoid`
+//             agent's plan keeps out of the robots' discs plus its clearance. an agent that
+//             has a plan but moved slower than 0.1 m/s for 4 s (a jam, a robot in a door)
+//             gives up its goal and takes the next ("stuck").
+//   preferred towards the next point of the plan at speed_m_s, slowing to stop at the goal.
+//   people    ORCA (tau 2 s): other agents as discs (responsibility 1/2 between people, 1
+//             against vehicles, which keep to their lanes); robots: avoid -> disc radius
+//             robot + agent + clearance_m, block -> robot + agent, ignore -> not at all
+//             (responsibility 1: robots are not assumed to avoid). heading turns towards the
+//             velocity at <= 6 rad/s.
+//   vehicles  the kinematic bicycle model (rear-axle reference point, wheelbase L): position
+//             moves at speed v along the heading, heading rate v tan(delta) / L, steering
+//             |delta| <= atan(L / turning_radius); delta from pure pursuit of the plan
+//             (look-ahead 1.5 m; Coulter, "Implementation of the Pure Pursuit Path Tracking
+//             Algorithm", CMU-RI-TR-92-01, 1992). speed: the largest v <= speed_m_s whose
+//             velocity along the heading satisfies the ORCA half-planes of the others and the
+//             robots (responsibility 1), else 0 (it stops). a pingpong lane is driven back in
+//             reverse (forklifts do), steering as a rear-steered bicycle.
+//   walkable  a centre may only move to a walkable point of its kind's region and never deeper
+//             into another agent's disc (agents already moved this step where they are now):
+//             the step is taken whole, else along x or y alone, else half, else not at all
+//             (a vehicle: whole or not at all).
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/rng.h"
+#include "penumbra/effects/agent_path.h"
+#include "penumbra/effects/orca.h"
+#include "penumbra/effects/walkable_grid.h"
+
+namespace penumbra {
+
+/// disc radius (plan view, ORCA and overlap), walkable profile and wheelbase of a kind.
+struct AgentKindModel {
+  double disc_radius_m = 0.25;  ///< the agent's body as a disc about its origin, m
+  WalkableProfile walkable;     ///< what its walkable region is built from
+  double wheelbase_m = 0;       ///< vehicles: L of the bicycle model (0 for people)
+};
+
+/// person: disc 0.25 m, walkable radius 0.3 m, steps 0.1 m (a 0.144 m pallet is an obstacle),
+/// passes under 2.0 m.
+/// forklift: disc 1.45 m (its 2.75 x 1.1 m footprint about the origin), walkable radius 0.7 m
+/// (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes under 2.3 m, turning
+/// radius 2.0 m, wheelbase 1.3 m. cart: disc 0.6 m, walkable 0.45 m, turning radius 0.8 m,
+/// wheelbase 0.7 m.
+AgentKindModel KindModel(AgentKind kind);
+/// true for the kinds driven by the bicycle model (forklift, cart).
+bool IsVehicle(AgentKind kind);
+
+/// where a world's crowds go: its rooms or zones and its lanes (walkways, aisles, trails), in
+/// the world frame. generated environments provide them (environment/environment_generator.h
+/// GeneratedEnvironment::rooms and walkways; session/session.cc).
+struct CrowdSites {
+  struct Area {
+    std::string name;
+    Eigen::Vector2d min_W{0, 0}, max_W{0, 0};  ///< plan bounding box, m
+  };
+  struct Lane {
+    std::string name;
+    std::vector<Eigen::Vector2d> points_W;  ///< polyline, m
+  };
+  std::vector<Area> areas;
+  std::vector<Lane> lanes;
+  bool empty() const { return areas.empty() && lanes.empty(); }
+};
+
+/// a robot as the crowd sees it: a disc in the plan.
+struct CrowdRobot {
+  Eigen::Vector2d position_W{0, 0};  ///< m
+  Eigen::Vector2d velocity_W{0, 0};  ///< m/s
+  double yaw = 0;                    ///< heading, rad
+  double radius_m = 0.45;            ///< disc radius, m
+};
+
+/// one decision of the crowd (what a run log records as an "npc" event).
+struct CrowdDecision {
+  double time_sec = 0;
+  int agent = 0;     ///< index into the agents
+  std::string what;  ///< "goal", "replan", "pause", "blocked" (no plan to the goal)
+  Eigen::Vector2d goal_W{0, 0};
+  int plan_points = 0;  ///< points of the plan made (0 = none)
+};
+
+/// the state of one crowd agent.
+struct CrowdAgentState {
+  Eigen::Vector2d position_W{0, 0};  ///< agent frame origin (plan), m
+  Eigen::Vector2d velocity_W{0, 0};  ///< m/s
+  double yaw = 0;                    ///< heading, rad
+};
+
+/// the crowd: agents of `motion: crowd`, stepped together.
+class CrowdSim {
+ public:
+  /// @param agents    the crowd's agents (validated AgentConfigs; their waypoints are patrol
+  ///                  points, points of interest or a vehicle's lane; the agent starts at the
+  ///                  walkable point nearest waypoints[0])
+  /// @param person_region, vehicle_region  walkable regions (shared, not null) of people and
+  ///                  of vehicles (forklift and cart share the vehicle region)
+  /// @param seed      world seed (random goals)
+  /// @param dt        step, s (> 0)
+  /// @throws Error for a null region or dt <= 0.
+  CrowdSim(std::vector<AgentConfig> agents, std::shared_ptr<const WalkableGrid> person_region,
+           std::shared_ptr<const WalkableGrid> vehicle_region, uint64_t seed, double dt = 0.05);
+
+  /// advances one step with the robots where they are now.
+  void Step(const std::vector<CrowdRobot>& robots);
+
+  double time_sec() const { return time_; }
+  double dt() const { return dt_; }
+  const std::vector<AgentConfig>& agents() const { return agents_; }
+  const std::vector<CrowdAgentState>& states() const { return states_; }
+  /// the region agent i walks on.
+  const WalkableGrid& region(size_t i) const;
+  /// takes agent i out of the crowd (a live change removed it) or back in: an inactive agent
+  /// neither moves nor is avoided.
+  void SetActive(size_t i, bool active);
+  bool active(size_t i) const { return active_[i] != 0; }
+  /// decisions made since the last call, in order; clears them.
+  std::vector<CrowdDecision> TakeDecisions();
+
+ private:
+  struct Plan {
+    std::vector<Eigen::Vector2d> points;
+    size_t next = 0;  // index of the point headed for
+    Eigen::Vector2d goal{0, 0};
+    bool active = false;
+  };
+  void ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots);
+  void MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
+                const std::vector<CrowdRobot>& robots);
+  Eigen::Vector2d Preferred(size_t i);
+  void AddRobotLines(size_t i, const std::vector<CrowdRobot>& robots, double own_radius,
+                     const Eigen::Vector2d& v_a, std::vector<OrcaLine>* lines) const;
+
+  std::vector<AgentConfig> agents_;
+  std::shared_ptr<const WalkableGrid> person_region_, vehicle_region_;
+  double dt_;
+  double time_ = 0;
+  std::vector<CrowdAgentState> states_;
+  std::vector<Plan> plans_;
+  std::vector<Rng> rngs_;
+  std::vector<int> goal_index_;  // patrol: the waypoint headed for; random: the last drawn
+  std::vector<int> patrol_dir_;  // pingpong: +1 / -1
+  std::vector<double> pause_until_;
+  std::vector<double> replan_at_;  // block: the time of the next replan
+  std::vector<int> gear_;          // vehicles: +1 forward, -1 reverse
+  std::vector<double> speed_;      // vehicles: signed speed along the heading, m/s
+  std::vector<double> slow_since_;
+  std::vector<uint8_t> active_;  // start of the agent's current spell below 0.1 m/s
+  std::vector<CrowdDecision> decisions_;
+};
+
+}  // namespace penumbra

@@ -1,0 +1,227 @@
+#include "penumbra/effects/crowd_sim.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "penumbra/effects/orca.h"
+#include "penumbra/effects/walkable_grid.h"
+
+namespace penumbra {
+namespace {
+
+// two 6 x 4 m rooms side by side, a wall at x = 0 with a 1.2 m door at y in [1.4, 2.6], and a
+// 1 x 1 m table in the left room at (-3, 2)
+OccupancyGrid TwoRoomsGrid() {
+  OccupancyGrid g;
+  g.min_W = {-6.2, -0.2};
+  g.cell_m = 0.1;
+  g.nx = 124;
+  g.ny = 44;
+  g.blocked.assign(static_cast<size_t>(g.nx) * g.ny, 0);
+  for (int iy = 0; iy < g.ny; ++iy)
+    for (int ix = 0; ix < g.nx; ++ix) {
+      const double x = g.min_W.x() + (ix + 0.5) * g.cell_m, y = g.min_W.y() + (iy + 0.5) * g.cell_m;
+      const bool outer = x < -6.0 || x > 6.0 || y < 0.0 || y > 4.0;
+      const bool wall = std::abs(x) < 0.1 && !(y > 1.4 && y < 2.6);
+      const bool table = std::abs(x + 3) < 0.5 && std::abs(y - 2) < 0.5;
+      g.blocked[iy * g.nx + ix] = outer || wall || table;
+    }
+  return g;
+}
+
+TEST(WalkableGridTest, InflatesByRadiusAndKeepsTheSeedsComponent) {
+  const WalkableGrid person(TwoRoomsGrid(), 0.3, {-5, 1});
+  EXPECT_TRUE(person.Walkable({-5, 1}));
+  EXPECT_TRUE(person.Walkable({5, 3}));       // through the door
+  EXPECT_FALSE(person.Walkable({-3, 2}));     // the table
+  EXPECT_FALSE(person.Walkable({-3, 2.75}));  // 0.25 m from the table's edge
+  EXPECT_TRUE(person.Walkable({-3, 2.85}));   // 0.35 m from it
+  EXPECT_FALSE(person.Walkable({-5.8, 1}));   // 0.2 m from the outer wall
+  // a 1.6 m wide body does not fit the 1.2 m door: the right room is another component
+  const WalkableGrid wide(TwoRoomsGrid(), 0.8, {-5, 1});
+  EXPECT_TRUE(wide.Walkable({-5, 1}));
+  EXPECT_FALSE(wide.Walkable({3, 2}));
+  // planning there ends at the walkable cell nearest the goal, on this side of the wall
+  const auto plan = wide.Plan({-5, 1}, {3, 2});
+  ASSERT_TRUE(plan.has_value());
+  EXPECT_LT(plan->back().x(), 0.0);
+}
+
+TEST(WalkableGridTest, PlanGoesThroughTheDoorAroundTheTable) {
+  const WalkableGrid g(TwoRoomsGrid(), 0.3, {-5, 1});
+  const auto plan = g.Plan({-5, 2}, {5, 2});
+  ASSERT_TRUE(plan.has_value());
+  EXPECT_EQ(plan->front(), Eigen::Vector2d(-5, 2));
+  EXPECT_EQ(plan->back(), Eigen::Vector2d(5, 2));
+  double length = 0;
+  for (size_t i = 0; i + 1 < plan->size(); ++i) {
+    EXPECT_TRUE(g.SegmentWalkable((*plan)[i], (*plan)[i + 1]));
+    length += ((*plan)[i + 1] - (*plan)[i]).norm();
+  }
+  // around the table (0.5 + 0.3 clear) costs a little more than the straight 10 m
+  EXPECT_GT(length, 10.05);
+  EXPECT_LT(length, 10.8);
+}
+
+TEST(OrcaTest, HeadOnPairPassesAndFreeAgentKeepsItsVelocity) {
+  // nothing near: the preferred velocity
+  EXPECT_TRUE(SolveOrcaVelocity({}, 1.5, {1, 0}).isApprox(Eigen::Vector2d(1, 0)));
+  // too fast: clipped to the speed disc
+  EXPECT_NEAR(SolveOrcaVelocity({}, 1.0, {3, 4}).norm(), 1.0, 1e-12);
+  // head on at 4 m, 1 m/s each: the ORCA velocity leaves the collision course
+  const Eigen::Vector2d va(1, 0), vb(-1, 0);
+  const OrcaLine l = OrcaHalfPlane(va, {4, 0}, va - vb, 0.5, 5.0, 0.05, 0.5);
+  const Eigen::Vector2d v = SolveOrcaVelocity({l}, 1.5, va);
+  // with B's mirrored choice the relative velocity 2 v_y... lies outside the cone
+  const Eigen::Vector2d rel = v - Eigen::Vector2d(-v.x(), -v.y());
+  const double t_closest = std::max(0.0, Eigen::Vector2d(4, 0).dot(rel) / rel.squaredNorm());
+  const double miss = (Eigen::Vector2d(4, 0) - t_closest * rel).norm();
+  EXPECT_GE(miss, 0.5 - 1e-6);
+  EXPECT_GT(std::abs(v.y()), 0.01);
+}
+
+TEST(OrcaTest, InfeasibleConstraintsGiveTheLeastViolation) {
+  // two opposite half-planes that exclude each other: y >= 1 and y <= -1
+  std::vector<OrcaLine> lines(2);
+  lines[0].point = {0, 1};
+  lines[0].direction = {1, 0};  // left of +x: y >= 1
+  lines[1].point = {0, -1};
+  lines[1].direction = {-1, 0};  // left of -x: y <= -1
+  const Eigen::Vector2d v = SolveOrcaVelocity(lines, 2.0, {1, 0});
+  EXPECT_NEAR(v.y(), 0.0, 1e-9);  // violates both by 1, the least possible largest violation
+}
+
+AgentConfig Walker(const std::string& name, std::vector<Eigen::Vector2d> points) {
+  AgentConfig a;
+  a.name = name;
+  a.motion = AgentMotion::kCrowd;
+  a.waypoints = std::move(points);
+  a.speed_m_s = 1.3;
+  a.pause_sec = 0.5;
+  return a;
+}
+
+TEST(CrowdSimTest, CrossingWalkersStayWalkableAndApart) {
+  auto person = std::make_shared<const WalkableGrid>(TwoRoomsGrid(), 0.3, Eigen::Vector2d(-5, 1));
+  auto vehicle = std::make_shared<const WalkableGrid>(TwoRoomsGrid(), 0.7, Eigen::Vector2d(-5, 1));
+  std::vector<AgentConfig> agents = {
+      Walker("a", {{-5, 2}, {5, 2}}), Walker("b", {{5, 2.2}, {-5, 1.8}}),
+      Walker("c", {{-4, 0.6}, {4, 3.4}}), Walker("d", {{4, 0.6}, {-4, 3.4}}),
+      Walker("e", {{-1.5, 3.5}, {2, 0.5}})};
+  agents[4].goals = AgentGoals::kRandom;
+  agents[4].waypoints = {{-1.5, 3.5}, {2, 0.5}, {-5, 0.5}, {5, 3.5}};
+  CrowdSim sim(agents, person, vehicle, 42);
+  double worst_overlap = 0;
+  double travelled = 0;
+  for (int k = 0; k < 1200; ++k) {  // 60 s
+    const auto before = sim.states();
+    sim.Step({});
+    for (size_t i = 0; i < agents.size(); ++i) {
+      EXPECT_TRUE(person->Walkable(sim.states()[i].position_W)) << agents[i].name << " at " << k;
+      travelled += (sim.states()[i].position_W - before[i].position_W).norm();
+      for (size_t j = i + 1; j < agents.size(); ++j)
+        worst_overlap = std::max(
+            worst_overlap, 0.5 - (sim.states()[i].position_W - sim.states()[j].position_W).norm());
+    }
+  }
+  EXPECT_LE(worst_overlap, 0.05);
+  EXPECT_GT(travelled, 5 * 30.0);  // everyone keeps walking (5 agents, > 30 m each on average)
+}
+
+std::shared_ptr<const WalkableGrid> RoomsFor(double radius) {
+  return std::make_shared<const WalkableGrid>(TwoRoomsGrid(), radius, Eigen::Vector2d(-5, 1));
+}
+
+TEST(CrowdSimTest, AvoidAgentsKeepTheirClearanceFromAStandingRobot) {
+  // four walkers patrolling straight through where the robot stands, in the right room
+  std::vector<AgentConfig> agents = {
+      Walker("a", {{1, 2}, {5.5, 2}}), Walker("b", {{5.5, 2.1}, {1, 1.9}}),
+      Walker("c", {{3, 0.4}, {3.2, 3.6}}), Walker("d", {{3.3, 3.6}, {2.9, 0.4}})};
+  for (AgentConfig& a : agents) {
+    a.route = AgentRoute::kPingPong;
+    a.clearance_m = 0.6;
+  }
+  CrowdSim sim(agents, RoomsFor(0.3), RoomsFor(0.7), 3);
+  CrowdRobot robot;
+  robot.position_W = {3.1, 2.0};
+  robot.radius_m = 0.4;
+  double least_gap = 1e9;
+  for (int k = 0; k < 1200; ++k) {
+    sim.Step({robot});
+    for (const CrowdAgentState& s : sim.states())
+      least_gap = std::min(least_gap, (s.position_W - robot.position_W).norm() - 0.4 - 0.25);
+  }
+  EXPECT_GE(least_gap, 0.6 - 0.01);
+  // `ignore` walkers go straight through the robot's disc
+  for (AgentConfig& a : agents) a.behaviour = AgentBehaviour::kIgnore;
+  CrowdSim careless(agents, RoomsFor(0.3), RoomsFor(0.7), 3);
+  least_gap = 1e9;
+  for (int k = 0; k < 400; ++k) {
+    careless.Step({robot});
+    for (const CrowdAgentState& s : careless.states())
+      least_gap = std::min(least_gap, (s.position_W - robot.position_W).norm() - 0.4 - 0.25);
+  }
+  EXPECT_LT(least_gap, 0.0);
+}
+
+TEST(CrowdSimTest, BlockAgentsStepIntoTheRobotsPath) {
+  AgentConfig a = Walker("blocker", {{-5, 3.5}, {-4, 3.5}});
+  a.behaviour = AgentBehaviour::kBlock;
+  CrowdSim sim({a}, RoomsFor(0.3), RoomsFor(0.7), 5);
+  // the robot drives east along y = 1 at 0.3 m/s from x = -5.5
+  CrowdRobot robot;
+  robot.radius_m = 0.4;
+  robot.velocity_W = {0.3, 0};
+  bool in_path = false;
+  for (int k = 0; k < 400 && !in_path; ++k) {  // 20 s
+    robot.position_W = {-5.5 + 0.3 * sim.time_sec(), 1.0};
+    sim.Step({robot});
+    const Eigen::Vector2d p = sim.states()[0].position_W;
+    // within the robot's swept corridor (its width plus the agent's), ahead of it, < 1.5 m away
+    in_path = std::abs(p.y() - 1.0) < 0.4 + 0.25 && p.x() > robot.position_W.x() &&
+              p.x() - robot.position_W.x() < 1.5;
+  }
+  EXPECT_TRUE(in_path);
+  // an `avoid` agent with the same goals never does
+  a.behaviour = AgentBehaviour::kAvoid;
+  a.waypoints = {{-5, 3.5}, {-1, 3.5}};
+  CrowdSim calm({a}, RoomsFor(0.3), RoomsFor(0.7), 5);
+  for (int k = 0; k < 400; ++k) {
+    robot.position_W = {-5.5 + 0.3 * calm.time_sec(), 1.0};
+    calm.Step({robot});
+    EXPECT_GT(std::abs(calm.states()[0].position_W.y() - 1.0), 0.65);
+  }
+}
+
+// every agent's pose over 30 s of a mixed crowd (random goals) as raw bits
+std::vector<uint64_t> CrowdBits(uint64_t seed) {
+  std::vector<AgentConfig> agents;
+  for (int i = 0; i < 6; ++i) {
+    AgentConfig a =
+        Walker("w" + std::to_string(i), {{-5 + i, 0.6}, {4, 3.4}, {-4, 3.4}, {5, 0.6}, {-2, 2}});
+    a.goals = AgentGoals::kRandom;
+    agents.push_back(a);
+  }
+  CrowdSim sim(agents, RoomsFor(0.3), RoomsFor(0.7), seed);
+  std::vector<uint64_t> bits;
+  for (int k = 0; k < 600; ++k) {
+    sim.Step({});
+    for (const CrowdAgentState& s : sim.states())
+      for (double v : {s.position_W.x(), s.position_W.y(), s.yaw}) {
+        uint64_t b = 0;
+        std::memcpy(&b, &v, sizeof b);
+        bits.push_back(b);
+      }
+  }
+  return bits;
+}
+
+TEST(CrowdSimTest, SameSeedGivesBitIdenticalTrajectories) {
+  EXPECT_EQ(CrowdBits(9), CrowdBits(9));
+  EXPECT_NE(CrowdBits(9), CrowdBits(10));
+}
+
+}  // namespace
+}  // namespace penumbra
