@@ -17,7 +17,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/ray_query.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/render/renderer_factory.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/session/effects_stage.h"
 
 namespace penumbra {

@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
@@ -90,6 +92,47 @@ std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, s
 
 void ControllerParams::CheckNoUnknownKeys() const {
   if (const auto unknown = impl_->keys.UnknownKeys()) Fail(unknown->first, unknown->second);
+}
+
+std::string DescribeParamNode(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
+  if (n.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+double ParamNumberAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
+                     const std::string& expected) {
+  double v = 0;
+  bool ok = n.IsScalar();
+  if (ok) {
+    try {
+      v = n.as<double>();
+    } catch (const YAML::Exception&) {
+      ok = false;
+    }
+  }
+  if (!ok || !std::isfinite(v))
+    p.Fail(key, "got " + DescribeParamNode(n) + "; expected " + expected);
+  return v;
+}
+
+std::vector<double> ParamNumbersAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
+                                   const std::string& expected, bool (*ok)(double)) {
+  std::vector<double> out;
+  if (n.IsSequence()) {
+    if (n.size() == 0) p.Fail(key, "got an empty list; expected " + expected);
+    for (size_t i = 0; i < n.size(); ++i) {
+      const std::string k = key + "[" + std::to_string(i) + "]";
+      const double v = ParamNumberAt(p, n[i], k, expected);
+      if (!ok(v)) p.Fail(k, "got " + n[i].Scalar() + "; expected " + expected);
+      out.push_back(v);
+    }
+    return out;
+  }
+  const double v = ParamNumberAt(p, n, key, expected + " (or a list of them)");
+  if (!ok(v)) p.Fail(key, "got " + n.Scalar() + "; expected " + expected);
+  return {v};
 }
 
 }  // namespace penumbra

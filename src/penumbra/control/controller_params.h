@@ -62,4 +62,19 @@ class ControllerParams {
   std::unique_ptr<Impl> impl_;
 };
 
+/// a YAML node described for an error message: 'text', "a list of N items", "a mapping" or
+/// "nothing".
+std::string DescribeParamNode(const YAML::Node& node);
+
+/// a finite number from `node` (a value under a key that ControllerParams::Raw returned, or an
+/// element of one). @throws ConfigError through p.Fail(key, "got ...; expected " + expected).
+double ParamNumberAt(ControllerParams& p, const YAML::Node& node, const std::string& key,
+                     const std::string& expected);
+
+/// a number or a list of numbers (at least one) from `node`, each finite and accepted by `ok`;
+/// list elements are reported as key[i]. @throws ConfigError through p.Fail.
+std::vector<double> ParamNumbersAt(ControllerParams& p, const YAML::Node& node,
+                                   const std::string& key, const std::string& expected,
+                                   bool (*ok)(double));
+
 }  // namespace penumbra

@@ -5,47 +5,7 @@
 #include <cmath>
 
 namespace penumbra {
-namespace {
-
-std::string DescribeActionNode(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-double ActionNumber(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                    const std::string& expected) {
-  double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v))
-    p.Fail(key, "got " + DescribeActionNode(n) + "; expected " + expected);
-  return v;
-}
-
-std::vector<double> ActionNumbers(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                                  const std::string& expected, bool non_negative) {
-  std::vector<double> out;
-  const bool list = n.IsSequence();
-  if (list && n.size() == 0) p.Fail(key, "got an empty list; expected " + expected);
-  for (size_t i = 0; i < (list ? n.size() : 1); ++i) {
-    const std::string k = list ? key + "[" + std::to_string(i) + "]" : key;
-    const YAML::Node e = list ? n[i] : n;
-    const double v = ActionNumber(p, e, k, expected);
-    if (non_negative && v < 0) p.Fail(k, "got " + e.Scalar() + "; expected " + expected);
-    out.push_back(v);
-  }
-  return out;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 const char* PolicyActionKindName(PolicyActionKind kind) {
   switch (kind) {
@@ -62,7 +22,7 @@ const char* PolicyActionKindName(PolicyActionKind kind) {
 void PolicyActionParams::ParseOver(ControllerParams& p, const YAML::Node& n, const std::string& key,
                                    const std::string& prefix) {
   if (!n.IsMap())
-    p.Fail(key, "got " + DescribeActionNode(n) +
+    p.Fail(key, "got " + DescribeParamNode(n) +
                     "; expected {type: joint_position | joint_velocity | joint_torque, scale, "
                     "clip, kp, kd, actuators}");
   for (const auto& kv : n) {
@@ -80,27 +40,33 @@ void PolicyActionParams::ParseOver(ControllerParams& p, const YAML::Node& n, con
         found = true;
       }
     if (!found)
-      p.Fail(key + ".type", "got " + DescribeActionNode(n["type"]) +
+      p.Fail(key + ".type", "got " + DescribeParamNode(n["type"]) +
                                 "; expected joint_position, joint_velocity or joint_torque");
   }
-  if (n["scale"]) scale = ActionNumbers(p, n["scale"], key + ".scale", "a finite number", false);
+  if (n["scale"])
+    scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a finite number",
+                           [](double) { return true; });
   if (n["clip"]) {
-    const double c = ActionNumber(p, n["clip"], key + ".clip", "a number > 0");
+    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number > 0");
     if (!(c > 0)) p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number > 0");
     clip = c;
   }
-  if (n["kp"]) kp = ActionNumbers(p, n["kp"], key + ".kp", "a gain >= 0 (N m/rad)", true);
-  if (n["kd"]) kd = ActionNumbers(p, n["kd"], key + ".kd", "a gain >= 0 (N m s/rad)", true);
+  if (n["kp"])
+    kp = ParamNumbersAt(p, n["kp"], key + ".kp", "a gain >= 0 (N m/rad)",
+                        [](double v) { return v >= 0; });
+  if (n["kd"])
+    kd = ParamNumbersAt(p, n["kd"], key + ".kd", "a gain >= 0 (N m s/rad)",
+                        [](double v) { return v >= 0; });
   if (n["actuators"]) {
     const YAML::Node a = n["actuators"];
     if (!a.IsSequence() || a.size() == 0)
       p.Fail(key + ".actuators",
-             "got " + DescribeActionNode(a) + "; expected a list of actuator names");
+             "got " + DescribeParamNode(a) + "; expected a list of actuator names");
     actuators.clear();
     for (size_t i = 0; i < a.size(); ++i) {
       if (!a[i].IsScalar() || a[i].Scalar().empty())
         p.Fail(key + ".actuators[" + std::to_string(i) + "]",
-               "got " + DescribeActionNode(a[i]) + "; expected an actuator name");
+               "got " + DescribeParamNode(a[i]) + "; expected an actuator name");
       actuators.push_back(prefix + a[i].Scalar());
     }
   }

@@ -18,29 +18,6 @@
 namespace penumbra {
 namespace {
 
-std::string DescribePolicyNode(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-double PolicyNumber(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                    const std::string& expected) {
-  double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v))
-    p.Fail(key, "got " + DescribePolicyNode(n) + "; expected " + expected);
-  return v;
-}
-
 // value i of a 1-or-n list
 double Pick(const std::vector<double>& v, size_t i) { return v.size() == 1 ? v[0] : v[i]; }
 
@@ -77,7 +54,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
   g.base_body = prefix + p.String("base_body");
   const YAML::Node* joints = p.Raw("joints");
   if (!joints || !joints->IsSequence() || joints->size() == 0)
-    p.Fail("joints", std::string(joints ? "got " + DescribePolicyNode(*joints) : "missing") +
+    p.Fail("joints", std::string(joints ? "got " + DescribeParamNode(*joints) : "missing") +
                          "; expected the policy's joints in its training order");
   if (joints->size() > 1000) p.Fail("joints", "more than 1000 joints; expected at most 1000");
   std::set<std::string> seen;
@@ -85,7 +62,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
     const YAML::Node j = (*joints)[i];
     const std::string key = "joints[" + std::to_string(i) + "]";
     if (!j.IsScalar() || j.Scalar().empty())
-      p.Fail(key, "got " + DescribePolicyNode(j) + "; expected a joint name");
+      p.Fail(key, "got " + DescribeParamNode(j) + "; expected a joint name");
     if (!seen.insert(j.Scalar()).second)
       p.Fail(key, "joint '" + j.Scalar() + "' is listed twice; expected each joint once");
     g.local_joints.push_back(j.Scalar());
@@ -94,7 +71,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
   if (const YAML::Node* d = p.Raw("default_joint_pos")) {
     if (d->IsSequence()) {
       for (size_t i = 0; i < d->size(); ++i)
-        g.default_joint_pos.push_back(PolicyNumber(
+        g.default_joint_pos.push_back(ParamNumberAt(
             p, (*d)[i], "default_joint_pos[" + std::to_string(i) + "]", "a position (rad or m)"));
       if (g.default_joint_pos.size() != g.joints.size())
         p.Fail("default_joint_pos", "has " + std::to_string(d->size()) + " values; expected " +
@@ -110,10 +87,10 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
                           "); expected an ECMAScript pattern matching joint names");
         }
         g.default_joint_patterns.push_back(
-            {pat, PolicyNumber(p, kv.second, key, "a position (rad or m)")});
+            {pat, ParamNumberAt(p, kv.second, key, "a position (rad or m)")});
       }
     } else {
-      p.Fail("default_joint_pos", "got " + DescribePolicyNode(*d) +
+      p.Fail("default_joint_pos", "got " + DescribeParamNode(*d) +
                                       "; expected a list (one per joint) or a mapping "
                                       "{pattern: value}");
     }
@@ -132,7 +109,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
 
   if (const YAML::Node* obs = p.Raw("observations")) {
     if (!obs->IsSequence() || obs->size() == 0)
-      p.Fail("observations", "got " + DescribePolicyNode(*obs) +
+      p.Fail("observations", "got " + DescribeParamNode(*obs) +
                                  "; expected a list of terms {term: ..., scale, clip, noise, "
                                  "history}");
     g.observations.clear();

@@ -32,50 +32,9 @@ constexpr TermName kTermNames[] = {
     {ObservationTermKind::kSensor, "sensor"},
 };
 
-std::string DescribeObsNode(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-double ObsNumber(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                 const std::string& expected) {
-  double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v)) p.Fail(key, "got " + DescribeObsNode(n) + "; expected " + expected);
-  return v;
-}
-
-// a number or a list of numbers, each checked by `ok`
-std::vector<double> ObsNumbers(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                               const std::string& expected, bool (*ok)(double)) {
-  std::vector<double> out;
-  if (n.IsSequence()) {
-    if (n.size() == 0) p.Fail(key, "got an empty list; expected " + expected);
-    for (size_t i = 0; i < n.size(); ++i) {
-      const std::string k = key + "[" + std::to_string(i) + "]";
-      const double v = ObsNumber(p, n[i], k, expected);
-      if (!ok(v)) p.Fail(k, "got " + n[i].Scalar() + "; expected " + expected);
-      out.push_back(v);
-    }
-    return out;
-  }
-  const double v = ObsNumber(p, n, key, expected + " (or a list of them)");
-  if (!ok(v)) p.Fail(key, "got " + n.Scalar() + "; expected " + expected);
-  return {v};
-}
-
 std::string ObsName(ControllerParams& p, const YAML::Node& n, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty())
-    p.Fail(key, "got " + DescribeObsNode(n) + "; expected a name");
+    p.Fail(key, "got " + DescribeParamNode(n) + "; expected a name");
   return n.Scalar();
 }
 
@@ -117,7 +76,7 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
                                                    const std::string& prefix) {
   const std::string expected_term =
       "expected {term: <" + ObservationTermNames() + ">, scale, clip, noise, history, ...}";
-  if (!n.IsMap()) p.Fail(key, "got " + DescribeObsNode(n) + "; " + expected_term);
+  if (!n.IsMap()) p.Fail(key, "got " + DescribeParamNode(n) + "; " + expected_term);
   if (!n["term"]) p.Fail(key + ".term", "missing; " + expected_term);
   const std::string name = ObsName(p, n["term"], key + ".term");
   const auto kind = ObservationTermFromName(name);
@@ -155,18 +114,18 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
   }
 
   if (n["scale"])
-    t.scale =
-        ObsNumbers(p, n["scale"], key + ".scale", "a finite number", [](double) { return true; });
+    t.scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a finite number",
+                             [](double) { return true; });
   if (n["clip"]) {
-    const double c = ObsNumber(p, n["clip"], key + ".clip", "a number > 0");
+    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number > 0");
     if (!(c > 0)) p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number > 0");
     t.clip = c;
   }
   if (n["noise"])
-    t.noise = ObsNumbers(p, n["noise"], key + ".noise", "a half-width >= 0",
-                         [](double v) { return v >= 0; });
+    t.noise = ParamNumbersAt(p, n["noise"], key + ".noise", "a half-width >= 0",
+                             [](double v) { return v >= 0; });
   if (n["history"]) {
-    const double h = ObsNumber(p, n["history"], key + ".history", "an integer >= 1");
+    const double h = ParamNumberAt(p, n["history"], key + ".history", "an integer >= 1");
     if (!(h >= 1 && h <= 1000 && h == std::floor(h)))
       p.Fail(key + ".history", "got " + n["history"].Scalar() + "; expected an integer 1 .. 1000");
     t.history = static_cast<int>(h);
@@ -178,14 +137,15 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
       if (n["size_m"]) {
         const YAML::Node s = n["size_m"];
         if (!s.IsSequence() || s.size() != 2)
-          p.Fail(key + ".size_m", "got " + DescribeObsNode(s) + "; expected [size_x, size_y] (m)");
-        g.size_x_m = ObsNumber(p, s[0], key + ".size_m[0]", "a length >= 0 (m)");
-        g.size_y_m = ObsNumber(p, s[1], key + ".size_m[1]", "a length >= 0 (m)");
+          p.Fail(key + ".size_m",
+                 "got " + DescribeParamNode(s) + "; expected [size_x, size_y] (m)");
+        g.size_x_m = ParamNumberAt(p, s[0], key + ".size_m[0]", "a length >= 0 (m)");
+        g.size_y_m = ParamNumberAt(p, s[1], key + ".size_m[1]", "a length >= 0 (m)");
         if (g.size_x_m < 0 || g.size_y_m < 0 || g.size_x_m > 100 || g.size_y_m > 100)
           p.Fail(key + ".size_m", "expected lengths 0 .. 100 m");
       }
       if (n["resolution_m"]) {
-        g.resolution_m = ObsNumber(p, n["resolution_m"], key + ".resolution_m", "a length > 0");
+        g.resolution_m = ParamNumberAt(p, n["resolution_m"], key + ".resolution_m", "a length > 0");
         if (!(g.resolution_m > 0))
           p.Fail(key + ".resolution_m", "got " + n["resolution_m"].Scalar() + "; expected > 0");
       }
@@ -194,14 +154,14 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
                                           std::to_string(g.ny()) +
                                           " rays; expected at most 100000");
       if (n["offset_m"])
-        g.offset_m = ObsNumber(p, n["offset_m"], key + ".offset_m", "a length (m)");
+        g.offset_m = ParamNumberAt(p, n["offset_m"], key + ".offset_m", "a length (m)");
       if (n["start_m"]) {
-        g.start_m = ObsNumber(p, n["start_m"], key + ".start_m", "a height > 0 (m)");
+        g.start_m = ParamNumberAt(p, n["start_m"], key + ".start_m", "a height > 0 (m)");
         if (!(g.start_m > 0)) p.Fail(key + ".start_m", "expected a height > 0 (m)");
       }
       if (n["max_distance_m"]) {
         g.max_distance_m =
-            ObsNumber(p, n["max_distance_m"], key + ".max_distance_m", "a length > 0 (m)");
+            ParamNumberAt(p, n["max_distance_m"], key + ".max_distance_m", "a length > 0 (m)");
         if (!(g.max_distance_m > 0)) p.Fail(key + ".max_distance_m", "expected a length > 0 (m)");
       }
       if (n["order"]) {
@@ -219,12 +179,12 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
         t.sensors.push_back(
             prefix + ObsName(p, n["sensors"][i], key + ".sensors[" + std::to_string(i) + "]"));
       if (n["threshold_n"])
-        t.threshold_n = ObsNumber(p, n["threshold_n"], key + ".threshold_n", "a force (N)");
+        t.threshold_n = ParamNumberAt(p, n["threshold_n"], key + ".threshold_n", "a force (N)");
       break;
     }
     case ObservationTermKind::kPhase:
       if (!n["period_sec"]) p.Fail(key + ".period_sec", "missing; expected a period > 0 (s)");
-      t.period_sec = ObsNumber(p, n["period_sec"], key + ".period_sec", "a period > 0 (s)");
+      t.period_sec = ParamNumberAt(p, n["period_sec"], key + ".period_sec", "a period > 0 (s)");
       if (!(t.period_sec > 0)) p.Fail(key + ".period_sec", "expected a period > 0 (s)");
       break;
     case ObservationTermKind::kSensor:

@@ -32,31 +32,9 @@ constexpr std::array<double, 4> kPhaseOffset = {0.0, 0.5, 0.5, 0.0};
 // a wrapped into [-pi, pi)
 double WrapAngle(double a) { return a - 2 * M_PI * std::floor((a + M_PI) / (2 * M_PI)); }
 
-std::string Describe(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-// finite number from a YAML scalar, or Fail(key).
-double NumberAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                const std::string& expected) {
-  double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v)) p.Fail(key, "got " + Describe(n) + "; expected " + expected);
-  return v;
-}
-
 std::string NameAt(ControllerParams& p, const YAML::Node& n, const std::string& key) {
-  if (!n.IsScalar() || n.Scalar().empty()) p.Fail(key, "got " + Describe(n) + "; expected a name");
+  if (!n.IsScalar() || n.Scalar().empty())
+    p.Fail(key, "got " + DescribeParamNode(n) + "; expected a name");
   return n.Scalar();
 }
 
@@ -84,7 +62,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
       "expected a mapping with the legs FR, FL, RR, RL, each {hip, thigh, calf, foot, "
       "signs, offsets_rad, actuators}";
   if (!legs) p.Fail("legs", "missing; " + legs_expected);
-  if (!legs->IsMap()) p.Fail("legs", "got " + Describe(*legs) + "; " + legs_expected);
+  if (!legs->IsMap()) p.Fail("legs", "got " + DescribeParamNode(*legs) + "; " + legs_expected);
   for (const auto& kv : *legs) {
     const std::string k = kv.first.Scalar();
     if (std::find_if(kLegNames.begin(), kLegNames.end(), [&](const char* n) { return k == n; }) ==
@@ -95,7 +73,8 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     const std::string key = std::string("legs.") + kLegNames[i];
     const YAML::Node n = (*legs)[kLegNames[i]];
     if (!n) p.Fail(key, "missing; " + legs_expected);
-    if (!n.IsMap()) p.Fail(key, "got " + Describe(n) + "; expected {hip, thigh, calf, foot, ...}");
+    if (!n.IsMap())
+      p.Fail(key, "got " + DescribeParamNode(n) + "; expected {hip, thigh, calf, foot, ...}");
     static const std::set<std::string> kKeys = {"hip",   "thigh",       "calf",     "foot",
                                                 "signs", "offsets_rad", "actuators"};
     for (const auto& kv : n)
@@ -115,7 +94,8 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     if (n["actuators"]) {
       const YAML::Node a = n["actuators"];
       if (!a.IsSequence() || a.size() != 3)
-        p.Fail(key + ".actuators", "got " + Describe(a) + "; expected [hip, thigh, calf] names");
+        p.Fail(key + ".actuators",
+               "got " + DescribeParamNode(a) + "; expected [hip, thigh, calf] names");
       for (int k = 0; k < 3; ++k)
         leg.actuators[k] = prefix + NameAt(p, a[k], key + ".actuators[" + std::to_string(k) + "]");
     }
@@ -123,10 +103,10 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
       const YAML::Node s = n["signs"];
       if (!s.IsSequence() || s.size() != 3)
         p.Fail(key + ".signs",
-               "got " + Describe(s) + "; expected [s_hip, s_thigh, s_calf], each 1 or -1");
+               "got " + DescribeParamNode(s) + "; expected [s_hip, s_thigh, s_calf], each 1 or -1");
       for (int k = 0; k < 3; ++k) {
         const std::string sk = key + ".signs[" + std::to_string(k) + "]";
-        const double v = NumberAt(p, s[k], sk, "1 or -1");
+        const double v = ParamNumberAt(p, s[k], sk, "1 or -1");
         if (v != 1 && v != -1) p.Fail(sk, "got " + s[k].Scalar() + "; expected 1 or -1");
         leg.signs[k] = v;
       }
@@ -134,10 +114,10 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     if (n["offsets_rad"]) {
       const YAML::Node o = n["offsets_rad"];
       if (!o.IsSequence() || o.size() != 3)
-        p.Fail(key + ".offsets_rad", "got " + Describe(o) + "; expected 3 angles (rad)");
+        p.Fail(key + ".offsets_rad", "got " + DescribeParamNode(o) + "; expected 3 angles (rad)");
       for (int k = 0; k < 3; ++k)
-        leg.offsets_rad[k] = NumberAt(p, o[k], key + ".offsets_rad[" + std::to_string(k) + "]",
-                                      "a finite angle (rad)");
+        leg.offsets_rad[k] = ParamNumberAt(p, o[k], key + ".offsets_rad[" + std::to_string(k) + "]",
+                                           "a finite angle (rad)");
     }
   }
 
@@ -173,10 +153,11 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   g.friction = p.Number("friction", 0.6, 0, 5, true);
   if (const YAML::Node* hold = p.Raw("hold")) {
     if (!hold->IsMap())
-      p.Fail("hold", "got " + Describe(*hold) + "; expected a mapping {actuator: ctrl}");
+      p.Fail("hold", "got " + DescribeParamNode(*hold) + "; expected a mapping {actuator: ctrl}");
     for (const auto& kv : *hold) {
       const std::string k = kv.first.Scalar();
-      g.hold.emplace_back(prefix + k, NumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
+      g.hold.emplace_back(prefix + k,
+                          ParamNumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
     }
   }
   g.rate_hz = p.Number("rate_hz", 250, 0, kInf, true);

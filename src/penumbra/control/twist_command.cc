@@ -9,32 +9,7 @@
 #include "penumbra/core/error.h"
 
 namespace penumbra {
-namespace {
-
-std::string DescribeTwistNode(const YAML::Node& n) {
-  if (n.IsScalar()) return "'" + n.Scalar() + "'";
-  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
-  if (n.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-double TwistNumber(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                   const std::string& expected) {
-  double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok || !std::isfinite(v))
-    p.Fail(key, "got " + DescribeTwistNode(n) + "; expected " + expected);
-  return v;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -42,13 +17,13 @@ TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
   // commands: a list of {t, vx, vy, yaw_rate}, t strictly increasing
   if (const YAML::Node* cmds = p.Raw("commands")) {
     if (!cmds->IsSequence())
-      p.Fail("commands", "got " + DescribeTwistNode(*cmds) +
+      p.Fail("commands", "got " + DescribeParamNode(*cmds) +
                              "; expected a list of {t, vx, vy, yaw_rate} with increasing t");
     for (size_t i = 0; i < cmds->size(); ++i) {
       const std::string key = "commands[" + std::to_string(i) + "]";
       const YAML::Node c = (*cmds)[i];
       if (!c.IsMap())
-        p.Fail(key, "got " + DescribeTwistNode(c) + "; expected {t, vx, vy, yaw_rate}");
+        p.Fail(key, "got " + DescribeParamNode(c) + "; expected {t, vx, vy, yaw_rate}");
       for (const auto& kv : c) {
         const std::string k = kv.first.Scalar();
         if (k != "t" && k != "vx" && k != "vy" && k != "yaw_rate")
@@ -56,14 +31,14 @@ TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
       }
       if (!c["t"]) p.Fail(key + ".t", "missing; expected a time >= 0 (s)");
       TimedTrotCommand tc;
-      tc.t_sec = TwistNumber(p, c["t"], key + ".t", "a time >= 0 (s)");
+      tc.t_sec = ParamNumberAt(p, c["t"], key + ".t", "a time >= 0 (s)");
       if (tc.t_sec < 0) p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time >= 0 (s)");
       if (!s.commands.empty() && tc.t_sec <= s.commands.back().t_sec)
         p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time > the previous entry's");
-      if (c["vx"]) tc.command.vx = TwistNumber(p, c["vx"], key + ".vx", "a speed (m/s)");
-      if (c["vy"]) tc.command.vy = TwistNumber(p, c["vy"], key + ".vy", "a speed (m/s)");
+      if (c["vx"]) tc.command.vx = ParamNumberAt(p, c["vx"], key + ".vx", "a speed (m/s)");
+      if (c["vy"]) tc.command.vy = ParamNumberAt(p, c["vy"], key + ".vy", "a speed (m/s)");
       if (c["yaw_rate"])
-        tc.command.yaw_rate = TwistNumber(p, c["yaw_rate"], key + ".yaw_rate", "a rate (rad/s)");
+        tc.command.yaw_rate = ParamNumberAt(p, c["yaw_rate"], key + ".yaw_rate", "a rate (rad/s)");
       s.commands.push_back(tc);
     }
   }

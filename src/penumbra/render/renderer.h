@@ -113,4 +113,9 @@ class Renderer {
   RenderProgressCallback progress_;
 };
 
+/// the checks every backend's Render makes before tracing: one body pose per scene body and a
+/// finite near plane >= 0. @throws Error "Render: ..." naming what is wrong.
+void CheckRenderInputs(size_t num_scene_bodies, const WorldSnapshot& snapshot,
+                       const CameraView& view);
+
 }  // namespace penumbra

@@ -1,6 +1,10 @@
 #include "penumbra/render/static_geometry.h"
 
 #include <limits>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/analytic_shapes.h"
 
 namespace penumbra {
 
@@ -48,6 +52,49 @@ bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vecto
 }
 
 // the geoms a RayQuery traces (render/ray_query.h: groups <= 2, alpha >= 0.5) of static bodies.
+bool IsRayVisible(const SceneDescription& scene, const Geom& geom, const std::string& who) {
+  if (geom.group > 2) return false;
+  if (geom.material >= static_cast<int>(scene.materials.size()))
+    throw Error(who + ": geom '" + geom.name + "' refers to missing material " +
+                std::to_string(geom.material));
+  return !(geom.material >= 0 && scene.materials[geom.material].alpha < 0.5f);
+}
+
+void ValidateRayGeom(const SceneDescription& scene, const Geom& geom, const std::string& who) {
+  const std::string what = who + ": geom '" + geom.name + "' ";
+  if (geom.body < 0 || geom.body >= static_cast<int>(scene.bodies.size()))
+    throw Error(what + "refers to missing body " + std::to_string(geom.body));
+  switch (geom.shape) {
+    case GeomShape::kMesh:
+      if (geom.mesh < 0 || geom.mesh >= static_cast<int>(scene.meshes.size()))
+        throw Error(what + "refers to missing mesh " + std::to_string(geom.mesh));
+      break;
+    case GeomShape::kHeightField:
+      if (geom.hfield < 0 || geom.hfield >= static_cast<int>(scene.hfields.size()))
+        throw Error(what + "refers to missing height field " + std::to_string(geom.hfield));
+      break;
+    case GeomShape::kBox:
+      if (!(geom.size.minCoeff() > 0) || !geom.size.allFinite())
+        throw Error(what + "has a non-positive box size");
+      break;
+    case GeomShape::kPlane:
+      if (!(geom.size.x() >= 0 && geom.size.y() >= 0) || !geom.size.allFinite())
+        throw Error(what + "has a negative plane size");
+      break;
+    default: {
+      AnalyticShape shape;
+      shape.kind = geom.shape == GeomShape::kSphere      ? AnalyticKind::kSphere
+                   : geom.shape == GeomShape::kCapsule   ? AnalyticKind::kCapsule
+                   : geom.shape == GeomShape::kEllipsoid ? AnalyticKind::kEllipsoid
+                                                         : AnalyticKind::kCylinder;
+      shape.size = geom.size;
+      const Eigen::Vector3d h = AnalyticHalfExtents(shape);
+      if (!(h.minCoeff() > 0) || !h.allFinite())
+        throw Error(what + "has a non-positive size for its shape");
+    }
+  }
+}
+
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {
   if (g.group > 2) return false;
   if (g.material >= 0 && g.material < static_cast<int>(scene.materials.size()) &&

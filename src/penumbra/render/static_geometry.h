@@ -4,6 +4,7 @@
 // RayQuery traces (render/ray_query.h) of the world body and of static bodies.
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "penumbra/core/pose.h"
@@ -15,6 +16,14 @@ namespace penumbra {
 /// and for meshes / height fields that are missing or empty.
 bool LocalHalfExtents(const SceneDescription& scene, const Geom& g, Eigen::Vector3d* lo,
                       Eigen::Vector3d* hi);
+
+/// g is traced by a RayQuery: group <= 2 and its material (if any) has alpha >= 0.5.
+/// @throws Error "<who>: geom 'name' refers to missing material N".
+bool IsRayVisible(const SceneDescription& scene, const Geom& g, const std::string& who);
+
+/// checks a traced geom's references (body, mesh, height field) and sizes (positive box and
+/// analytic sizes, non-negative plane size). @throws Error "<who>: geom 'name' ..." naming it.
+void ValidateRayGeom(const SceneDescription& scene, const Geom& g, const std::string& who);
 
 /// g is traced by a RayQuery (group <= 2, material alpha >= 0.5) and belongs to a static body.
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g);

@@ -57,12 +57,7 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
 
 void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                             const CameraView& view, RenderedFrame* out) {
-  if (snapshot.X_WB.size() != scene_.bodies.size())
-    throw Error("Render: snapshot has " + std::to_string(snapshot.X_WB.size()) +
-                " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
-  if (!(view.near_m >= 0 && std::isfinite(view.near_m)))
-    throw Error("Render: camera near_m " + std::to_string(view.near_m) +
-                " is not a finite distance >= 0");
+  CheckRenderInputs(scene_.bodies.size(), snapshot, view);
   ray_scene_->Update(snapshot);
   if (materials_.has_normal_maps()) {
     // normal maps find their tangent frames in the geom frame: every geom's rotation now

@@ -8,6 +8,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/static_geometry.h"
 #include "penumbra/render/triangle_shapes.h"
 
 namespace penumbra::cuda {
@@ -51,22 +52,8 @@ BvhScene::BvhScene(const SceneDescription& scene) : scene_(scene) {
   std::vector<int> group_of_body(num_bodies, -1);
   for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
     const Geom& g = scene.geoms[gi];
-    if (g.group > 2) continue;
-    if (g.material >= static_cast<int>(scene.materials.size()))
-      throw Error("BvhScene: geom '" + g.name + "' refers to missing material " +
-                  std::to_string(g.material));
-    if (g.material >= 0 && scene.materials[g.material].alpha < 0.5f) continue;
-    if (g.body < 0 || g.body >= num_bodies)
-      throw Error("BvhScene: geom '" + g.name + "' refers to missing body " +
-                  std::to_string(g.body));
-    if (g.shape == GeomShape::kMesh &&
-        (g.mesh < 0 || g.mesh >= static_cast<int>(scene.meshes.size())))
-      throw Error("BvhScene: geom '" + g.name + "' refers to missing mesh " +
-                  std::to_string(g.mesh));
-    if (g.shape == GeomShape::kHeightField &&
-        (g.hfield < 0 || g.hfield >= static_cast<int>(scene.hfields.size())))
-      throw Error("BvhScene: geom '" + g.name + "' refers to missing height field " +
-                  std::to_string(g.hfield));
+    if (!IsRayVisible(scene, g, "BvhScene")) continue;
+    ValidateRayGeom(scene, g, "BvhScene");
     if (g.body == 0 || scene.bodies[g.body].is_static) {
       groups_[0].geoms.push_back(gi);
     } else {

@@ -70,12 +70,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
     cpu_->Render(snapshot, effects, view, out);
     return;
   }
-  if (snapshot.X_WB.size() != scene_.bodies.size())
-    throw Error("Render: snapshot has " + std::to_string(snapshot.X_WB.size()) +
-                " body poses, scene has " + std::to_string(scene_.bodies.size()) + " bodies");
-  if (!(view.near_m >= 0 && std::isfinite(view.near_m)))
-    throw Error("Render: camera near_m " + std::to_string(view.near_m) +
-                " is not a finite distance >= 0");
+  CheckRenderInputs(scene_.bodies.size(), snapshot, view);
   bvh_->Update(snapshot);
   SyncDevice(*bvh_, device_.get());
   const PinholeCamera c = PinholeOf(view);

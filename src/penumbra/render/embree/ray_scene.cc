@@ -13,6 +13,7 @@
 #include "penumbra/render/embree/analytic_lanes.h"
 #include "penumbra/render/moving_bounds.h"
 #include "penumbra/render/ray_cone.h"
+#include "penumbra/render/static_geometry.h"
 #include "penumbra/render/triangle_shapes.h"
 #include "penumbra/scene/scene_limits.h"
 
@@ -635,46 +636,6 @@ struct RayScene::Impl {
   }
 };
 
-namespace {
-
-// checks the references and sizes of a visible geom.
-void ValidateGeom(const SceneDescription& scene, const Geom& geom) {
-  const std::string what = "RayScene: geom '" + geom.name + "' ";
-  if (geom.body < 0 || geom.body >= static_cast<int>(scene.bodies.size()))
-    throw Error(what + "refers to missing body " + std::to_string(geom.body));
-  switch (geom.shape) {
-    case GeomShape::kMesh:
-      if (geom.mesh < 0 || geom.mesh >= static_cast<int>(scene.meshes.size()))
-        throw Error(what + "refers to missing mesh " + std::to_string(geom.mesh));
-      break;
-    case GeomShape::kHeightField:
-      if (geom.hfield < 0 || geom.hfield >= static_cast<int>(scene.hfields.size()))
-        throw Error(what + "refers to missing height field " + std::to_string(geom.hfield));
-      break;
-    case GeomShape::kBox:
-      if (!(geom.size.minCoeff() > 0) || !geom.size.allFinite())
-        throw Error(what + "has a non-positive box size");
-      break;
-    case GeomShape::kPlane:
-      if (!(geom.size.x() >= 0 && geom.size.y() >= 0) || !geom.size.allFinite())
-        throw Error(what + "has a negative plane size");
-      break;
-    default: {
-      AnalyticShape shape;
-      shape.kind = geom.shape == GeomShape::kSphere      ? AnalyticKind::kSphere
-                   : geom.shape == GeomShape::kCapsule   ? AnalyticKind::kCapsule
-                   : geom.shape == GeomShape::kEllipsoid ? AnalyticKind::kEllipsoid
-                                                         : AnalyticKind::kCylinder;
-      shape.size = geom.size;
-      const Eigen::Vector3d h = AnalyticHalfExtents(shape);
-      if (!(h.minCoeff() > 0) || !h.allFinite())
-        throw Error(what + "has a non-positive size for its shape");
-    }
-  }
-}
-
-}  // namespace
-
 RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>()), scene_(scene) {
   Impl& m = *impl_;
   m.scene = &scene;
@@ -689,12 +650,8 @@ RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>
   std::vector<int> group_of_body(num_bodies, -1);
   for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
     const Geom& geom = scene.geoms[gi];
-    if (geom.group > 2) continue;
-    if (geom.material >= static_cast<int>(scene.materials.size()))
-      throw Error("RayScene: geom '" + geom.name + "' refers to missing material " +
-                  std::to_string(geom.material));
-    if (geom.material >= 0 && scene.materials[geom.material].alpha < 0.5f) continue;
-    ValidateGeom(scene, geom);
+    if (!IsRayVisible(scene, geom, "RayScene")) continue;
+    ValidateRayGeom(scene, geom, "RayScene");
     if (geom.body == 0 || scene.bodies[geom.body].is_static) {
       m.groups[0].geoms.push_back(gi);
     } else {
