@@ -68,19 +68,27 @@ TEST(AdversityPlan, NpcPathsAreClearOfFurnitureAndTheRobotAndDependOnTheSeed) {
     EXPECT_EQ(a.agents[i].waypoints, b.agents[i].waypoints);
   EXPECT_NE(a.agents[0].waypoints, c.agents[0].waypoints);
 
-  // an independent check of the legs against the room's static geoms
+  // an independent check against the room's static geoms: preset NPCs are crowd agents
+  // (docs/npcs.md) whose waypoints are their start and the points they walk between (people) or
+  // their lane (vehicles); each is free of furniture for the agent's disc, and a person starts
+  // at least 1.5 m from the robot
   WorldConfig world = LoadWorldFile(kDefaultWorld);
   ComposeOptions opts;
   opts.urdf_to_mjcf = ConvertUrdfToMjcf;
   const ComposedScene composed = ComposeWorld(world.models, opts);
   Simulation sim = Simulation::LoadFromString(composed.Xml());
   const FloorMap map(sim.scene(), sim.Snapshot().X_WB, 0.0, Eigen::Vector2d(-0.2, -1.45));
+  ASSERT_FALSE(a.agents.empty());
   for (const AgentConfig& agent : a.agents) {
-    const double clearance = agent.kind == AgentKind::kPerson ? 0.4 : 1.2;
+    EXPECT_EQ(agent.motion, AgentMotion::kCrowd) << agent.name;
+    // the walkable grid's discs (0.3 m people, 0.7 m vehicles) less a cell of rounding
+    const double radius = agent.kind == AgentKind::kPerson ? 0.2 : 0.55;
     const auto& w = agent.waypoints;
+    ASSERT_FALSE(w.empty()) << agent.name;
+    if (agent.kind == AgentKind::kPerson)
+      EXPECT_GE((w[0] - Eigen::Vector2d(-0.2, -1.45)).norm(), 1.5) << agent.name;
     for (size_t i = 0; i < w.size(); ++i) {
-      EXPECT_TRUE(map.SegmentFree(w[i], w[(i + 1) % w.size()], clearance - 0.01)) << agent.name;
-      EXPECT_GE((w[i] - Eigen::Vector2d(-0.2, -1.45)).norm(), 1.5) << agent.name;
+      EXPECT_TRUE(map.SegmentFree(w[i], w[i], radius)) << agent.name << " waypoint " << i;
       // inside the room's interior
       EXPECT_GT(w[i].x(), -4.0);
       EXPECT_LT(w[i].x(), 4.0);
