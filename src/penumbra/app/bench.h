@@ -8,13 +8,13 @@ namespace penumbra {
 
 /// options of `penumbra bench render`.
 struct RenderBenchOptions {
-  std::string world_file;   ///< world to render (default: the bundled default world)
-  int frames = 60;          ///< timed frames per resolution
-  int warmup_frames = 5;    ///< untimed frames first
-  int threads = 0;          ///< render threads, 0 = all cores
+  std::string world_file;  ///< world to render (default: the bundled default world)
+  int frames = 60;         ///< timed frames per resolution
+  int warmup_frames = 5;   ///< untimed frames first
+  int threads = 0;         ///< render threads, 0 = all cores
   std::string tier = "realtime";
-  std::string backend;  ///< cpu, cuda or auto; "" = the world's render.backend
-  bool adversity = true;    ///< also time the presets none/minor/major (app/effects_bench.h)
+  std::string backend;    ///< cpu, cuda or auto; "" = the world's render.backend
+  bool adversity = true;  ///< also time the presets none/minor/major (app/effects_bench.h)
 };
 
 /// renders the world's first camera at 640x480 and 800x800 (RGB + depth) while the
@@ -42,6 +42,12 @@ inline constexpr double kMajorPresetTargetFps = 10.0;
 /// "met" when `measured` >= `target`, else "NOT met": the verdict the bench commands print
 /// after each target line (a higher-is-better figure).
 const char* TargetVerdict(double measured, double target);
+
+/// prints the realtime frame-rate target line of a render bench: "target (2-core CI machine):
+/// <subject>>= T frames/s at 640x480 realtime: met|NOT met (F frames/s here)", or "not
+/// applicable (tier X)" when `tier` is not "realtime". `subject` is "" or e.g. "major ".
+void PrintRealtimeFpsTarget(const std::string& subject, double target_fps, double measured_fps,
+                            const std::string& tier);
 
 /// the bundled default world (worlds/default.yaml in the source tree).
 std::string DefaultWorldPath();

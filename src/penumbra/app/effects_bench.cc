@@ -41,17 +41,7 @@ void BenchRenderAdversity(const RenderBenchOptions& options) {
         p.session->effects().effects().size(), p.session->effects().agents().size());
     if (std::string(preset) == "major") major_fps = n / sum.render_wall;
   }
-  if (options.tier == "realtime") {
-    fmt::print(
-        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: {} "
-        "({:.1f} frames/s here)\n",
-        kMajorPresetTargetFps, TargetVerdict(major_fps, kMajorPresetTargetFps), major_fps);
-  } else {
-    fmt::print(
-        "target (2-core CI machine): major >= {:g} frames/s at 640x480 realtime: not "
-        "applicable (tier {})\n",
-        kMajorPresetTargetFps, options.tier);
-  }
+  PrintRealtimeFpsTarget("major ", kMajorPresetTargetFps, major_fps, options.tier);
 }
 
 }  // namespace penumbra

@@ -25,6 +25,19 @@ ObservationTermConfig Term(ObservationTermKind kind, std::vector<double> scale =
   return t;
 }
 
+// the 1.6 x 1.0 m height scan at 0.1 m, 0.5 m offset, that legged_gym's and Isaac Lab's rough
+// terrain configurations both use; scale = clip, in their own grid order
+ObservationTermConfig HeightScanTerm(double scale_and_clip, bool x_fastest) {
+  ObservationTermConfig h =
+      Term(ObservationTermKind::kHeightScan, {scale_and_clip}, scale_and_clip);
+  h.grid.size_x_m = 1.6;
+  h.grid.size_y_m = 1.0;
+  h.grid.resolution_m = 0.1;
+  h.grid.offset_m = 0.5;
+  h.grid.x_fastest = x_fastest;
+  return h;
+}
+
 }  // namespace
 
 const char* PolicyConventionName(PolicyConvention convention) {
@@ -66,13 +79,7 @@ PolicyPreset MakePolicyPreset(PolicyConvention convention) {
                         Term(K::kJointVel, {0.05}, kClip),
                         Term(K::kLastAction, {1.0}, kClip)};
       if (convention == PolicyConvention::kLeggedGymRough) {
-        ObservationTermConfig h = Term(K::kHeightScan, {5.0}, 5.0);
-        h.grid.size_x_m = 1.6;
-        h.grid.size_y_m = 1.0;
-        h.grid.resolution_m = 0.1;
-        h.grid.offset_m = 0.5;
-        h.grid.x_fastest = false;
-        p.observations.push_back(h);
+        p.observations.push_back(HeightScanTerm(5.0, /*x_fastest=*/false));
       }
       p.action.clip = 100;
       break;
@@ -83,13 +90,7 @@ PolicyPreset MakePolicyPreset(PolicyConvention convention) {
                         Term(K::kVelocityCommand), Term(K::kJointPos),   Term(K::kJointVel),
                         Term(K::kLastAction)};
       if (convention == PolicyConvention::kIsaacLabRough) {
-        ObservationTermConfig h = Term(K::kHeightScan, {1.0}, 1.0);
-        h.grid.size_x_m = 1.6;
-        h.grid.size_y_m = 1.0;
-        h.grid.resolution_m = 0.1;
-        h.grid.offset_m = 0.5;
-        h.grid.x_fastest = true;
-        p.observations.push_back(h);
+        p.observations.push_back(HeightScanTerm(1.0, /*x_fastest=*/true));
       }
       break;
     case PolicyConvention::kMjlab:

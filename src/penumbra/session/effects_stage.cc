@@ -262,21 +262,7 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
   for (const Eigen::Vector3d& r : robot_starts)
     centre += r.head<2>() / static_cast<double>(robot_starts.size());
   // the floor: the highest static upward plane at or below the lowest robot, else its z
-  double lowest = 0;
-  if (!robot_starts.empty()) {
-    lowest = robot_starts.front().z();
-    for (const Eigen::Vector3d& r : robot_starts) lowest = std::min(lowest, r.z());
-  }
-  double floor_z = -1e300;
-  for (const Geom& g : scene.geoms) {
-    if (g.shape != GeomShape::kPlane || !scene.bodies[g.body].is_static) continue;
-    const Pose X_WG =
-        (g.body < static_cast<int>(X_WB.size()) ? X_WB[g.body] : Pose::Identity()) * g.X_BG;
-    if (X_WG.linear()(2, 2) < 0.99) continue;
-    const double z = X_WG.translation().z();
-    if (z <= lowest + 0.05) floor_z = std::max(floor_z, z);
-  }
-  if (floor_z == -1e300) floor_z = lowest;
+  const double floor_z = NpcFloorHeight(scene, X_WB, robot_starts, /*with_slabs=*/false);
   FloorMap map(scene, X_WB, floor_z, centre);
   const Eigen::Vector2d flood_seed =
       robot_starts.empty() ? centre : Eigen::Vector2d(robot_starts.front().head<2>());

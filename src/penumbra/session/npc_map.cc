@@ -94,7 +94,7 @@ ImageU8 NpcMap::Draw(const CrowdSites& sites, const std::vector<Eigen::Vector2d>
 }
 
 double NpcFloorHeight(const SceneDescription& scene, const std::vector<Pose>& X_WB,
-                      const std::vector<Eigen::Vector3d>& robot_starts) {
+                      const std::vector<Eigen::Vector3d>& robot_starts, bool with_slabs) {
   double lowest = 0;
   if (!robot_starts.empty()) {
     lowest = robot_starts.front().z();
@@ -111,7 +111,7 @@ double NpcFloorHeight(const SceneDescription& scene, const std::vector<Pose>& X_
     double z = -1e300;
     if (g.shape == GeomShape::kPlane) {
       z = X_WG.translation().z();
-    } else if (g.shape == GeomShape::kBox && !robot_starts.empty()) {
+    } else if (with_slabs && g.shape == GeomShape::kBox && !robot_starts.empty()) {
       // a floor slab: an upright box under the first robot's start, at least 2 x 2 m
       const Eigen::Vector3d e = X_WG.linear().cwiseAbs() * g.size;
       const Eigen::Vector2d d = (robot_starts.front().head<2>() - X_WG.translation().head<2>());

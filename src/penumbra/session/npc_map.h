@@ -46,10 +46,11 @@ class NpcMap {
   std::shared_ptr<const WalkableGrid> person_, vehicle_;
 };
 
-/// the floor height of a preset's NPCs: the highest static upward plane, or top of an upright
-/// static box at least 2 x 2 m under the first robot's start (a floor slab), at or below the
-/// lowest robot start (+ 0.05 m); else the lowest start's z (0 without robots).
+/// the floor height of a preset's NPCs: the highest static upward plane, or (with_slabs) top
+/// of an upright static box at least 2 x 2 m under the first robot's start (a floor slab), at
+/// or below the lowest robot start (+ 0.05 m); else the lowest start's z (0 without robots).
+/// the preset's fog base and robots' area use planes only (with_slabs false).
 double NpcFloorHeight(const SceneDescription& scene, const std::vector<Pose>& X_WB,
-                      const std::vector<Eigen::Vector3d>& robot_starts);
+                      const std::vector<Eigen::Vector3d>& robot_starts, bool with_slabs = true);
 
 }  // namespace penumbra
