@@ -281,7 +281,7 @@ class WorldParser {
     c.line = r.line();
     c.params = YAML::Node(YAML::NodeType::Map);
     for (auto it = r.node().begin(); it != r.node().end(); ++it)
-      if (it->first.Scalar() != "type") c.params.force_insert(it->first, it->second);
+      if (it->first.Scalar() != "type") c.params.node().force_insert(it->first, it->second);
     return c;
   }
 
