@@ -13,6 +13,7 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
 
 #include <string>
 

@@ -11,6 +11,7 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
+#include <yaml-cpp/yaml.h>
 
 #include <optional>
 #include <string>

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/world_config.h"
 

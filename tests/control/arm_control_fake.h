@@ -3,6 +3,8 @@
 // actuator on a tendon, prefixed "a/") and a fake ControlInput over it, for unit tests of
 // the joint servo and the arm controllers without MuJoCo.
 
+#include <yaml-cpp/yaml.h>
+
 #include <vector>
 
 #include "penumbra/control/control_input.h"

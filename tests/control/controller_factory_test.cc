@@ -4,6 +4,7 @@
 #include "penumbra/control/controller_factory.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"

@@ -5,6 +5,7 @@
 #include "penumbra/control/policy_controller.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>

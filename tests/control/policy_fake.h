@@ -7,6 +7,8 @@
 // joints: motors with gear 1 (gear 2 on j5), ctrlrange +-100; sensors q/touch0 .. q/touch3
 // (1 value each, sensordata 0..3) and q/gyro (3 values, sensordata 4..6).
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Geometry>
 #include <string>
 #include <vector>

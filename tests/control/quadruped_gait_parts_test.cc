@@ -2,6 +2,7 @@
 // distribution, swing trajectory and the parameter parser's errors.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -236,7 +237,7 @@ void WalkTheRoute(const std::string& world_name, double min_distance_m) {
   ASSERT_NE(building, nullptr);
   const GeneratedEnvironment env = GenerateEnvironment(*building->environment);
   const Walkway& walkway = env.walkways.front();
-  const YAML::Node waypoints = robot->controller.params["waypoints"];
+  const YAML::Node waypoints = robot->controller.params.node()["waypoints"];
   ASSERT_EQ(waypoints.size() + 1, walkway.points.size());
   EXPECT_NEAR(robot->pose.xyz.x(), walkway.points[0].x(), 1e-9);
   EXPECT_NEAR(robot->pose.xyz.y(), walkway.points[0].y(), 1e-9);

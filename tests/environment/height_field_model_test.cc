@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <filesystem>
@@ -129,8 +130,8 @@ TEST(HeightField, MujocoPlacesTheWrittenFieldAndAQuadrupedTrotsAcrossIt) {
     if (!m.is_robot) continue;
     m.pose.xyz = {-2.2, 0.3, F(-2.2, 0.3)};
     m.pose.rpy_deg = {0, 0, 0};
-    m.controller.params["waypoints"] = YAML::Load("[[2.2, 0.3]]");
-    m.controller.params["loop"] = false;
+    m.controller.params.node()["waypoints"] = YAML::Load("[[2.2, 0.3]]");
+    m.controller.params.node()["loop"] = false;
     models.push_back(m);
   }
   ASSERT_EQ(models.size(), 1u);

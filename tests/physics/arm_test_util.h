@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <memory>

@@ -3,6 +3,7 @@
 // torque motors; actuators whose force cannot be set are refused with an error naming the
 // actuator and its type instead of being misread.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 #include <sstream>

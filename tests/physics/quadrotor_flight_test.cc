@@ -5,6 +5,7 @@
 // error < 0.15 m; bit-identical trajectories on two runs.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>

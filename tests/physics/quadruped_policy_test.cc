@@ -3,6 +3,7 @@
 // bit-identical between two simulations, with seeded observation noise.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "penumbra/control/policy_controller.h"
 #include "physics/quadruped_test_util.h"

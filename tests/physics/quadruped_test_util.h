@@ -4,6 +4,7 @@
 // criteria need (trunk contact, trajectory).
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>

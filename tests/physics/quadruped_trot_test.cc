@@ -4,6 +4,7 @@
 // standing keyframe `stand`.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 #include <sstream>

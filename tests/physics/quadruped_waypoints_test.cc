@@ -3,6 +3,7 @@
 // command sources keep their precedence (programmatic > waypoints > script).
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>

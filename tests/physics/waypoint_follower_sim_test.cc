@@ -2,6 +2,7 @@
 // world-file style controller block through the factory, with composer-style names).
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 

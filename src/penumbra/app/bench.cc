@@ -7,6 +7,7 @@
 #include <string>
 
 #include "penumbra/app/effects_bench.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/controller_cost_benchmark.h"
 #include "penumbra/physics/physics_benchmark.h"

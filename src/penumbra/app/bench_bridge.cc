@@ -17,6 +17,7 @@
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/physics_source.h"

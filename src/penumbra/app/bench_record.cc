@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "penumbra/app/bench.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
@@ -31,7 +32,7 @@ struct Round {
   uint64_t log_bytes = 0;
 };
 
-double ProcessCpuSec() {
+double RecordProcessCpuSec() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
@@ -57,9 +58,9 @@ Round RunRound(const WorldConfig& world, double seconds, const std::string& log_
     loop.AddSink(recorder.get());
   }
   const auto t0 = Clock::now();
-  const double cpu0 = ProcessCpuSec();
+  const double cpu0 = RecordProcessCpuSec();
   const LoopFinish f = loop.Run();
-  const double cpu = ProcessCpuSec() - cpu0;
+  const double cpu = RecordProcessCpuSec() - cpu0;
   const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
   if (f.error) std::rethrow_exception(f.error);
   Round r;
@@ -70,7 +71,7 @@ Round RunRound(const WorldConfig& world, double seconds, const std::string& log_
   return r;
 }
 
-double Median(std::vector<double> v) {
+double RecordMedian(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -125,12 +126,12 @@ int BenchRecord(const BenchRecordOptions& options) {
         i + 1, a.steps_per_sec, a.cpu_us_per_step, b.steps_per_sec, b.cpu_us_per_step,
         b.steps_per_sec / a.steps_per_sec);
   }
-  const double m_off = Median(off), m_on = Median(on);
+  const double m_off = RecordMedian(off), m_on = RecordMedian(on);
   fmt::print("median: off {:.0f} steps/s, on {:.0f} steps/s, ratio {:.3f} (target >= 0.9)\n", m_off,
              m_on, m_on / m_off);
   // the CPU time of the process (loop and writer threads): the ratio a single free core
   // would see, independent of other load on the machine
-  const double c_off = Median(cpu_off), c_on = Median(cpu_on);
+  const double c_off = RecordMedian(cpu_off), c_on = RecordMedian(cpu_on);
   fmt::print("median CPU: off {:.1f} us/step, on {:.1f} us/step (+{:.1f} us), CPU ratio {:.3f}\n",
              c_off, c_on, c_on - c_off, c_off / c_on);
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "penumbra/command/bridge_set.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/manifest_sink.h"

@@ -287,7 +287,7 @@ ViewerRound RunViewerRound(const WorldConfig& world, double seconds, bool viewer
   return r;
 }
 
-double Median(std::vector<double> v) {
+double ViewerMedian(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
@@ -327,15 +327,15 @@ int BenchViewer(const BenchViewerOptions& options) {
     fps.push_back(b.frames_per_sec);
     kb.push_back(b.kbytes_per_frame);
   }
-  const double ratio = Median(with) / Median(without);
+  const double ratio = ViewerMedian(with) / ViewerMedian(without);
   fmt::print(
       "physics steps/s (as fast as possible, median): without viewer {:.0f}, with viewer "
       "and one page {:.0f}: ratio {:.3f} (target >= 0.95)\n",
-      Median(without), Median(with), ratio);
+      ViewerMedian(without), ViewerMedian(with), ratio);
   fmt::print(
       "frames/s delivered to the page, {}x{} camera (median): {:.1f} (target >= 20; the "
       "renderer's rate is the limit), {:.0f} kB/frame\n",
-      cam.width, cam.height, Median(fps), Median(kb));
+      cam.width, cam.height, ViewerMedian(fps), ViewerMedian(kb));
   if (options.latency_samples > 0) {
     const double seconds = std::max(options.seconds, 0.6 * options.latency_samples + 2);
     const ViewerRound rt = RunViewerRound(world, seconds, true, true, options.latency_samples);
@@ -348,7 +348,7 @@ int BenchViewer(const BenchViewerOptions& options) {
           "input-to-photon latency at real-time pacing (teleop twist sent -> first frame "
           "captured after it received), {} samples: median {:.0f} ms, min {:.0f}, max "
           "{:.0f} (target < 150 ms); frames {:.1f}/s\n",
-          l.size(), Median(l), l.front(), l.back(), rt.frames_per_sec);
+          l.size(), ViewerMedian(l), l.front(), l.back(), rt.frames_per_sec);
     }
   }
   return 0;

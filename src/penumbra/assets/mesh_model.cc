@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 template <typename T>
-void Append(std::string* out, T v) {
+void AppendMeshBytes(std::string* out, T v) {
   char b[sizeof(T)];
   std::memcpy(b, &v, sizeof(T));
   out->append(b, sizeof(T));
@@ -100,18 +100,18 @@ std::string MshBytes(const TriangleMesh& mesh) {
     if (!t.empty()) t.push_back(t.front());
   }
   std::string out;
-  Append<int32_t>(&out, static_cast<int32_t>(v.size()));
-  Append<int32_t>(&out, static_cast<int32_t>(n.size()));
-  Append<int32_t>(&out, static_cast<int32_t>(t.size()));
-  Append<int32_t>(&out, static_cast<int32_t>(mesh.faces.size()));
+  AppendMeshBytes<int32_t>(&out, static_cast<int32_t>(v.size()));
+  AppendMeshBytes<int32_t>(&out, static_cast<int32_t>(n.size()));
+  AppendMeshBytes<int32_t>(&out, static_cast<int32_t>(t.size()));
+  AppendMeshBytes<int32_t>(&out, static_cast<int32_t>(mesh.faces.size()));
   for (const Eigen::Vector3f& p : v)
-    for (int k = 0; k < 3; ++k) Append<float>(&out, p[k]);
+    for (int k = 0; k < 3; ++k) AppendMeshBytes<float>(&out, p[k]);
   for (const Eigen::Vector3f& p : n)
-    for (int k = 0; k < 3; ++k) Append<float>(&out, p[k]);
+    for (int k = 0; k < 3; ++k) AppendMeshBytes<float>(&out, p[k]);
   for (const Eigen::Vector2f& p : t)
-    for (int k = 0; k < 2; ++k) Append<float>(&out, p[k]);
+    for (int k = 0; k < 2; ++k) AppendMeshBytes<float>(&out, p[k]);
   for (const Eigen::Vector3i& f : mesh.faces)
-    for (int k = 0; k < 3; ++k) Append<int32_t>(&out, f[k]);
+    for (int k = 0; k < 3; ++k) AppendMeshBytes<int32_t>(&out, f[k]);
   return out;
 }
 

@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string LowerExtension(const std::string& path) {
+std::string LowerMeshExtension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -69,7 +69,7 @@ std::vector<std::string> ConvertForeignMjcfMeshes(ComposedScene* composed, const
     if (parent == nullptr || std::string(parent->Name()) != "asset") return;
     const char* file = e->Attribute("file");
     if (file == nullptr) return;
-    const std::string ext = LowerExtension(file);
+    const std::string ext = LowerMeshExtension(file);
     if (ext == ".stl" || ext == ".obj" || ext == ".msh" || !IsMeshModelFile(file)) return;
     ImportedAsset asset;
     try {

@@ -24,6 +24,7 @@
 #include "penumbra/benchmark/command_template.h"
 #include "penumbra/benchmark/method_process.h"
 #include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -62,7 +63,7 @@ int FreePortPair() {
   throw Error("no free pair of loopback TCP ports found for the run's ZeroMQ sockets");
 }
 
-std::string Num(double v) { return FormatNumber(v); }
+std::string NavNum(double v) { return FormatNumber(v); }
 
 // the world override: the base's pose series, the robot's contacts (undebounced) and the
 // spec's camera, if any
@@ -70,17 +71,17 @@ std::string OverrideYaml(const BenchmarkSpec& spec, const BenchmarkWorld& w) {
   const NavRobotProfile profile = NavProfile(w.profile);
   const NavMetricsConfig& m = spec.nav_metrics;
   std::string s = "# written by penumbra benchmark (benchmark/nav_job.h)\nmetrics:\n";
-  s += "  rate_hz: " + Num(m.pose_rate_hz) + "\n  series:\n";
+  s += "  rate_hz: " + NavNum(m.pose_rate_hz) + "\n  series:\n";
   s += "    - {name: nav_base, type: body_pose, bodies: [\"" + w.robot + "/" + profile.base_body +
-       "\"], rate_hz: " + Num(m.pose_rate_hz) + "}\n";
+       "\"], rate_hz: " + NavNum(m.pose_rate_hz) + "}\n";
   s += "    - name: nav_contacts\n      type: contacts\n";
-  s += "      min_force_N: " + Num(m.min_force_N) + "\n      debounce_sec: 0\n";
+  s += "      min_force_N: " + NavNum(m.min_force_N) + "\n      debounce_sec: 0\n";
   s += "      between: [{a: \"" + w.robot + "/*\", b: \"*\"}]\n      exclude: [";
   for (size_t i = 0; i < profile.ground_parts.size(); ++i)
     s += std::string(i ? ", " : "") + "{a: \"" + w.robot + "/" + profile.ground_parts[i] +
          "\", b: \"" + m.floor + "\"}";
   s += "]\n      self_contacts: false\n      pair: body\n";
-  s += "      rate_hz: " + Num(m.pose_rate_hz) + "\n";
+  s += "      rate_hz: " + NavNum(m.pose_rate_hz) + "\n";
   // the spec's camera replaces the world's cameras (the navigator takes the first with depth)
   if (!w.camera_yaml.empty()) s += "cameras:\n  - " + w.camera_yaml + "\n";
   return s;
@@ -164,7 +165,7 @@ std::vector<ContactInterval> ReadContacts(const fs::path& file) {
 nlohmann::json OptNum(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
-double NumOf(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : NAN; }
+double NavNumOf(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : NAN; }
 
 nlohmann::json RowJson(const NavRow& r) {
   nlohmann::json path = nlohmann::json::array();
@@ -207,13 +208,7 @@ std::string Tail(const fs::path& file, size_t bytes) {
 
 }  // namespace
 
-std::string NavPythonPath() {
-#ifdef PENUMBRA_SOURCE_DIR
-  return (fs::path(PENUMBRA_SOURCE_DIR) / "python").string();
-#else
-  return "python";
-#endif
-}
+std::string NavPythonPath() { return (fs::path(PENUMBRA_SOURCE_DIR) / "python").string(); }
 
 std::vector<BenchmarkJob> PlanNavJobs(const BenchmarkSpec& spec) {
   std::vector<BenchmarkJob> jobs;
@@ -288,15 +283,15 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                                      "--seed",
                                      std::to_string(job.seed),
                                      "--duration",
-                                     Num(ep.timeout_sec),
+                                     NavNum(ep.timeout_sec),
                                      "--threads",
                                      std::to_string(spec.render_threads),
                                      "--override",
                                      (dir / "override.yaml").string()};
     if (ep.has_start) {
       argv.push_back("--start-pose");
-      argv.push_back(w.robot + "," + Num(ep.start_x) + "," + Num(ep.start_y) + "," +
-                     Num(ep.start_yaw_deg));
+      argv.push_back(w.robot + "," + NavNum(ep.start_x) + "," + NavNum(ep.start_y) + "," +
+                     NavNum(ep.start_yaw_deg));
     }
     fs::remove_all(run_dir);
     run = std::make_unique<ChildProcess>(argv, dir.string(), (dir / "run.log").string(),
@@ -313,10 +308,10 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   const std::map<std::string, std::string> values = {{"penumbra", context.penumbra_binary},
                                                      {"pythonpath", NavPythonPath()},
                                                      {"endpoint", endpoint},
-                                                     {"goal_x", Num(ep.goal_x)},
-                                                     {"goal_y", Num(ep.goal_y)},
-                                                     {"radius", Num(ep.radius_m)},
-                                                     {"timeout_sec", Num(ep.timeout_sec)},
+                                                     {"goal_x", NavNum(ep.goal_x)},
+                                                     {"goal_y", NavNum(ep.goal_y)},
+                                                     {"radius", NavNum(ep.radius_m)},
+                                                     {"timeout_sec", NavNum(ep.timeout_sec)},
                                                      {"robot", w.profile},
                                                      {"robot_name", w.robot},
                                                      {"out_dir", work.string()},
@@ -445,10 +440,10 @@ NavRow ReadNavJobResult(const std::string& path) {
     r.success = e.at("success");
     r.collisions = e.at("collisions");
     r.agent_contacts = e.value("agent_contacts", 0);  // results written before it existed
-    r.time_to_goal_sec = NumOf(e.at("time_to_goal_sec"));
-    r.final_goal_distance_m = NumOf(e.at("final_goal_distance_m"));
-    r.episode_time_sec = NumOf(e.at("episode_time_sec"));
-    r.path_length_m = NumOf(e.at("path_length_m"));
+    r.time_to_goal_sec = NavNumOf(e.at("time_to_goal_sec"));
+    r.final_goal_distance_m = NavNumOf(e.at("final_goal_distance_m"));
+    r.episode_time_sec = NavNumOf(e.at("episode_time_sec"));
+    r.path_length_m = NavNumOf(e.at("path_length_m"));
     r.sc = e.at("sc");
     r.fell = e.at("fell");
     r.method_sec = e.at("method_sec");

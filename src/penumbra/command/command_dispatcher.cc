@@ -12,6 +12,7 @@
 #include "penumbra/control/joint_controller.h"
 #include "penumbra/control/twist_command.h"
 #include "penumbra/control/waypoint_follower.h"
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

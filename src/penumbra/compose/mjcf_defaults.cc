@@ -7,7 +7,7 @@ namespace {
 
 using tinyxml2::XMLElement;
 
-bool Is(const XMLElement* e, const char* name) { return std::string(e->Name()) == name; }
+bool IsTag(const XMLElement* e, const char* name) { return std::string(e->Name()) == name; }
 
 }  // namespace
 
@@ -112,8 +112,8 @@ int DefaultTree::ClassOf(const XMLElement* elem, bool in_worldbody, const MjcfSo
   if (in_worldbody) {
     for (const tinyxml2::XMLNode* n = elem->Parent(); n; n = n->Parent()) {
       const XMLElement* p = n->ToElement();
-      if (p == nullptr || Is(p, "worldbody")) break;
-      if (Is(p, "body") && p->Attribute("childclass")) return resolve(p, "childclass");
+      if (p == nullptr || IsTag(p, "worldbody")) break;
+      if (IsTag(p, "body") && p->Attribute("childclass")) return resolve(p, "childclass");
     }
   }
   return kRoot;

@@ -19,7 +19,9 @@ constexpr double kDegToRad = M_PI / 180.0;
 const char* const kOrientationAttrs[] = {"quat", "axisangle", "xyaxes", "zaxis", "euler"};
 const char* const kAlternativeAttrs[] = {"axisangle", "xyaxes", "zaxis", "euler"};
 
-bool Is(const XMLElement* e, const char* name) { return std::string(e->Name()) == name; }
+bool IsElementNamed(const XMLElement* e, const char* name) {
+  return std::string(e->Name()) == name;
+}
 
 // compiler attributes that the composer carries over (MJCF 2.2.2 <compiler>), besides
 // angle, eulerseq, meshdir, texturedir, assetdir, strippath and coordinate
@@ -195,7 +197,7 @@ std::string ModelComposer::Key(const XMLElement* elem, const char* attr) const {
   std::vector<std::string> parts;
   for (const XMLElement* e = elem; e && e != src_->root();) {
     std::string part = e->Name();
-    if (const char* n = e->Attribute(Is(e, "default") ? "class" : "name")) {
+    if (const char* n = e->Attribute(IsElementNamed(e, "default") ? "class" : "name")) {
       part += std::string("[") + n + "]";
     }
     parts.push_back(part);
@@ -291,7 +293,7 @@ void ModelComposer::ReadCompiler() {
       }
     }
     for (XMLElement* sub = c->FirstChildElement(); sub; sub = sub->NextSiblingElement()) {
-      if (!Is(sub, "lengthrange")) {
+      if (!IsElementNamed(sub, "lengthrange")) {
         src_->Fail(sub, std::string("compiler.") + sub->Name(),
                    "unsupported element; expected <lengthrange>");
       }
@@ -328,7 +330,7 @@ void ModelComposer::CollectNames() {
       continue;
     }
     VisitSection(*src_, section, elem, [&](XMLElement* e, const ElementSpec& spec) {
-      if (Is(e, "composite")) {
+      if (IsElementNamed(e, "composite")) {
         has_composite_ = true;
         const char* p = e->Attribute("prefix");
         composite_prefixes_.push_back(p ? p : "");
@@ -336,7 +338,8 @@ void ModelComposer::CollectNames() {
       if (!spec.defines || *spec.defines == NameKind::kClass) return;
       // an unnamed mesh, skin, hfield or texture is named after its file (MuJoCo 2.2.2)
       if (section == "asset" && !e->Attribute("name") && e->Attribute("file") &&
-          (Is(e, "mesh") || Is(e, "skin") || Is(e, "hfield") || Is(e, "texture"))) {
+          (IsElementNamed(e, "mesh") || IsElementNamed(e, "skin") || IsElementNamed(e, "hfield") ||
+           IsElementNamed(e, "texture"))) {
         std::string stem = StripPath(e->Attribute("file"));
         if (const size_t dot = stem.find_last_of('.'); dot != std::string::npos) {
           stem.resize(dot);
@@ -513,7 +516,7 @@ void ModelComposer::ProcessJoint(XMLElement* j, const Eigen::Vector3d& body_pos,
                                  const Eigen::Quaterniond& body_quat) {
   std::string type = "free";
   int cls = DefaultTree::kRoot;
-  if (Is(j, "joint")) {
+  if (IsElementNamed(j, "joint")) {
     cls = defaults_.ClassOf(j, true, *src_);
     const char* t = j->Attribute("type");
     if (!t) t = defaults_.Lookup(cls, "joint", "type");
@@ -525,7 +528,7 @@ void ModelComposer::ProcessJoint(XMLElement* j, const Eigen::Vector3d& body_pos,
   }
   const auto value = [&](const char* attr, size_t n) {
     const char* v = j->Attribute(attr);
-    if (!v && Is(j, "joint")) v = defaults_.Lookup(cls, "joint", attr);
+    if (!v && IsElementNamed(j, "joint")) v = defaults_.Lookup(cls, "joint", attr);
     return Numbers(j, attr, v, n);
   };
   // hinge and ball angles follow compiler angle; slide joints are in metres
@@ -635,7 +638,7 @@ void ModelComposer::ResolveAssetPaths() {
 void ModelComposer::ReadKeys() {
   for (XMLElement* sec : Sections("keyframe")) {
     for (XMLElement* k = sec->FirstChildElement(); k; k = k->NextSiblingElement()) {
-      if (!Is(k, "key")) continue;  // reported by Rename
+      if (!IsElementNamed(k, "key")) continue;  // reported by Rename
       KeyData key;
       key.elem = k;
       if (const char* n = k->Attribute("name")) key.name = n;
@@ -736,7 +739,7 @@ void ModelComposer::Rename() {
           e->SetAttribute(name_attr, ResolveRef(e, Key(e, name_attr), *kind, name).c_str());
         }
       }
-      if (Is(e, "composite")) {
+      if (IsElementNamed(e, "composite")) {
         const char* p = e->Attribute("prefix");
         e->SetAttribute("prefix", (prefix_ + (p ? p : "")).c_str());
       }

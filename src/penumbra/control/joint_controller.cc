@@ -9,7 +9,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kJointInf = std::numeric_limits<double>::infinity();
 
 const char* ModeKey(JointCommand::Mode m) {
   switch (m) {
@@ -29,7 +29,7 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
   JointPdParams j;
   j.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0, 10.0);
   const size_t n = j.servo.joints.size();
-  j.target = ReadOptionalNumbers(p, "target", n, -kInf, kInf, "rad or m, one per joint");
+  j.target = ReadOptionalNumbers(p, "target", n, -kJointInf, kJointInf, "rad or m, one per joint");
   j.commands = ParseCommandScript<JointCommand>(p, "commands", [n](ParamNode& item) {
     JointCommand c;
     int found = 0;
@@ -38,7 +38,7 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
       if (!item.Has(ModeKey(mode))) continue;
       ++found;
       c.mode = mode;
-      c.values = item.Numbers(ModeKey(mode), n, -kInf, kInf, "one per joint");
+      c.values = item.Numbers(ModeKey(mode), n, -kJointInf, kJointInf, "one per joint");
     }
     if (found != 1)
       item.FailHere(std::string(found ? "got more than one of" : "missing") +
@@ -46,7 +46,7 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
                     "or tau (effort)");
     return c;
   });
-  j.rate_hz = p.Number("rate_hz", 0, 0, kInf);
+  j.rate_hz = p.Number("rate_hz", 0, 0, kJointInf);
   p.CheckNoUnknownKeys();
   return j;
 }

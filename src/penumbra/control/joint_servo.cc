@@ -10,7 +10,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kServoInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void Fail(const ControllerContext& c, const std::string& key,
                        const std::string& problem) {
@@ -48,17 +48,17 @@ JointServoParams JointServoParams::Parse(ControllerParams& p, const std::string&
     return std::vector<double>(n, v);
   };
   const bool torque = s.output == ServoOutput::kTorque;
-  s.kp =
-      ReadPerJoint(p, "kp", n, torque ? fallback(default_kp) : std::vector<double>(n, 0), 0, kInf);
-  s.kd =
-      ReadPerJoint(p, "kd", n, torque ? fallback(default_kd) : std::vector<double>(n, 0), 0, kInf);
+  s.kp = ReadPerJoint(p, "kp", n, torque ? fallback(default_kp) : std::vector<double>(n, 0), 0,
+                      kServoInf);
+  s.kd = ReadPerJoint(p, "kd", n, torque ? fallback(default_kd) : std::vector<double>(n, 0), 0,
+                      kServoInf);
   s.gravity_compensation = p.Bool("gravity_compensation", true);
   s.max_velocity =
-      ReadPerJoint(p, "max_velocity", n, fallback(default_max_velocity), 0, kInf, true);
-  s.max_acceleration =
-      ReadPerJoint(p, "max_acceleration", n, fallback(default_max_acceleration), 0, kInf, true);
-  if (p.Has("max_effort")) s.max_effort = ReadPerJoint(p, "max_effort", n, {}, 0, kInf, true);
-  s.limit_margin = p.Number("limit_margin", 0.01, 0, kInf);
+      ReadPerJoint(p, "max_velocity", n, fallback(default_max_velocity), 0, kServoInf, true);
+  s.max_acceleration = ReadPerJoint(p, "max_acceleration", n, fallback(default_max_acceleration), 0,
+                                    kServoInf, true);
+  if (p.Has("max_effort")) s.max_effort = ReadPerJoint(p, "max_effort", n, {}, 0, kServoInf, true);
+  s.limit_margin = p.Number("limit_margin", 0.01, 0, kServoInf);
   return s;
 }
 
@@ -149,11 +149,11 @@ void JointServo::Bind(const ModelInfo& model, std::span<const int> ids,
       q_min_[i] = joint.range[0] + m;
       q_max_[i] = joint.range[1] - m;
     } else {
-      q_min_[i] = -kInf;
-      q_max_[i] = kInf;
+      q_min_[i] = -kServoInf;
+      q_max_[i] = kServoInf;
     }
     qd_max_[i] = params_.max_velocity[i];
-    double effort = kInf;
+    double effort = kServoInf;
     if (act.ctrl_limited)
       effort =
           std::max(std::abs(act.ctrl_range[0]), std::abs(act.ctrl_range[1])) * std::abs(gear_[i]);

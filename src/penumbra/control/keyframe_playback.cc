@@ -16,7 +16,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kKeyframeInf = std::numeric_limits<double>::infinity();
 
 std::string Trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r");
@@ -172,12 +172,12 @@ KeyframePlaybackParams KeyframePlaybackParams::Parse(ControllerParams& p,
         f.key = prefix + item.String("key");
         item.Raw("q");
       } else {
-        f.q = item.Numbers("q", n, -kInf, kInf, "rad or m, one per joint");
+        f.q = item.Numbers("q", n, -kKeyframeInf, kKeyframeInf, "rad or m, one per joint");
         item.Raw("key");
       }
       if (item.Has("gripper")) {
         if (!gripper) item.Fail("gripper", "given without gripper_actuator/gripper_joint");
-        f.gripper = item.Number("gripper", std::nullopt, -kInf, kInf);
+        f.gripper = item.Number("gripper", std::nullopt, -kKeyframeInf, kKeyframeInf);
       } else if (gripper && f.key.empty()) {
         item.Fail("gripper",
                   "missing; expected the gripper_joint value (m or rad) for a q frame "
@@ -197,7 +197,7 @@ KeyframePlaybackParams KeyframePlaybackParams::Parse(ControllerParams& p,
     }
   }
   k.loop = p.Bool("loop", false);
-  k.rate_hz = p.Number("rate_hz", 0, 0, kInf);
+  k.rate_hz = p.Number("rate_hz", 0, 0, kKeyframeInf);
   p.CheckNoUnknownKeys();
   return k;
 }

@@ -13,19 +13,19 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kPidInf = std::numeric_limits<double>::infinity();
+constexpr double kPidDegToRad = M_PI / 180.0;
 // velocity integrator: input clipped to this error (m/s), and frozen while the thrust axis is
 // more than this far from its setpoint (rad), so an upset or a large step does not wind it up
 constexpr double kIntegratorErrorClip = 0.5;
-const double kCosIntegratorMaxTiltError = std::cos(20 * kDegToRad);
+const double kCosIntegratorMaxTiltError = std::cos(20 * kPidDegToRad);
 
-double WrapAngle(double a) {
+double PidWrapAngle(double a) {
   a = std::remainder(a, 2 * M_PI);  // in [-pi, pi]
   return a <= -M_PI ? a + 2 * M_PI : a;
 }
 
-std::string Fmt(double v) {
+std::string PidFmt(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
@@ -33,9 +33,9 @@ std::string Fmt(double v) {
 
 using param::Repr;
 
-std::string RangeText(double min, double max, bool min_exclusive) {
-  return std::string(min_exclusive ? "> " : ">= ") + Fmt(min) +
-         (std::isinf(max) ? "" : " and <= " + Fmt(max));
+std::string PidRangeText(double min, double max, bool min_exclusive) {
+  return std::string(min_exclusive ? "> " : ">= ") + PidFmt(min) +
+         (std::isinf(max) ? "" : " and <= " + PidFmt(max));
 }
 
 // readers for values inside structured parameters (commands, rotor list); errors name the
@@ -51,10 +51,10 @@ double NodeNumber(const ControllerParams& p, const YAML::Node& n, const std::str
       ok = false;
     }
   }
-  const std::string range = RangeText(min, max, min_exclusive);
+  const std::string range = PidRangeText(min, max, min_exclusive);
   if (!ok || !std::isfinite(v)) p.Fail(key, "got " + Repr(n) + "; expected a number " + range);
   if (v < min || (min_exclusive && v == min) || v > max)
-    p.Fail(key, "got " + Fmt(v) + "; expected a number " + range);
+    p.Fail(key, "got " + PidFmt(v) + "; expected a number " + range);
   return v;
 }
 
@@ -63,7 +63,7 @@ Eigen::Vector3d NodeVec3(const ControllerParams& p, const YAML::Node& n, const s
   if (!n.IsSequence() || n.size() != 3) p.Fail(key, "got " + Repr(n) + "; expected " + what);
   Eigen::Vector3d v;
   for (int k = 0; k < 3; ++k)
-    v[k] = NodeNumber(p, n[k], key + "[" + std::to_string(k) + "]", -kInf, kInf);
+    v[k] = NodeNumber(p, n[k], key + "[" + std::to_string(k) + "]", -kPidInf, kPidInf);
   return v;
 }
 
@@ -111,7 +111,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
   TimedMultirotorCommand tc;
   MultirotorCommand& c = tc.command;
   if (!n["t"]) p.Fail(key + ".t", "missing; expected the start time in s (sim time, >= 0)");
-  tc.t_sec = NodeNumber(p, n["t"], key + ".t", 0, kInf);
+  tc.t_sec = NodeNumber(p, n["t"], key + ".t", 0, kPidInf);
   if (!n["mode"])
     p.Fail(key + ".mode",
            "missing; expected one of idle, takeoff, hover, waypoints, velocity, land");
@@ -137,8 +137,8 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
   }
 
   const std::string speed_key = key + ".speed_m_s";
-  if (n["speed_m_s"]) c.speed_m_s = NodeNumber(p, n["speed_m_s"], speed_key, 0, kInf, true);
-  if (n["yaw_deg"]) c.yaw_deg = NodeNumber(p, n["yaw_deg"], key + ".yaw_deg", -kInf, kInf);
+  if (n["speed_m_s"]) c.speed_m_s = NodeNumber(p, n["speed_m_s"], speed_key, 0, kPidInf, true);
+  if (n["yaw_deg"]) c.yaw_deg = NodeNumber(p, n["yaw_deg"], key + ".yaw_deg", -kPidInf, kPidInf);
   switch (c.mode) {
     case M::kIdle:
     case M::kLand:
@@ -146,7 +146,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
     case M::kTakeoff:
       if (!n["altitude_m"])
         p.Fail(key + ".altitude_m", "missing; expected the target altitude (world z, m)");
-      c.altitude_m = NodeNumber(p, n["altitude_m"], key + ".altitude_m", -kInf, kInf);
+      c.altitude_m = NodeNumber(p, n["altitude_m"], key + ".altitude_m", -kPidInf, kPidInf);
       break;
     case M::kHover:
       if (n["position"])
@@ -169,7 +169,8 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
         c.velocity_m_s =
             NodeVec3(p, n["velocity_m_s"], key + ".velocity_m_s", "[vx, vy, vz] (m/s)");
       if (n["yaw_rate_deg_s"])
-        c.yaw_rate_deg_s = NodeNumber(p, n["yaw_rate_deg_s"], key + ".yaw_rate_deg_s", -kInf, kInf);
+        c.yaw_rate_deg_s =
+            NodeNumber(p, n["yaw_rate_deg_s"], key + ".yaw_rate_deg_s", -kPidInf, kPidInf);
       if (n["frame"]) {
         const std::string f = NodeName(p, n["frame"], key + ".frame");
         if (f == "world") {
@@ -223,7 +224,7 @@ void MultirotorCommand::ValidateOrThrow(const ControllerContext& c, const std::s
   if (mode == Mode::kWaypoints && waypoints.empty())
     fail("waypoints", "empty; expected at least 1 [x, y, z] point");
   if (!(std::isfinite(speed_m_s) && speed_m_s > 0))
-    fail("speed_m_s", "got " + Fmt(speed_m_s) + "; expected a number > 0");
+    fail("speed_m_s", "got " + PidFmt(speed_m_s) + "; expected a number > 0");
   if (yaw_deg && !std::isfinite(*yaw_deg)) fail("yaw_deg", "not finite; expected degrees");
   if (!velocity_m_s.allFinite()) fail("velocity_m_s", "not finite; expected [vx, vy, vz] (m/s)");
   if (!std::isfinite(yaw_rate_deg_s)) fail("yaw_rate_deg_s", "not finite; expected deg/s");
@@ -255,9 +256,11 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
                                   std::to_string(MultirotorMixer::kMaxRotors));
 
   auto pos = [&](const char* key, double fallback) {
-    return p.Number(key, fallback, 0, kInf, true);
+    return p.Number(key, fallback, 0, kPidInf, true);
   };
-  auto nonneg = [&](const char* key, double fallback) { return p.Number(key, fallback, 0, kInf); };
+  auto nonneg = [&](const char* key, double fallback) {
+    return p.Number(key, fallback, 0, kPidInf);
+  };
   m.rate_hz = pos("rate_hz", m.rate_hz);
   m.gravity_m_s2 = pos("gravity_m_s2", m.gravity_m_s2);
   m.max_speed_xy_m_s = pos("max_speed_xy_m_s", m.max_speed_xy_m_s);
@@ -300,8 +303,8 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
       const std::string key = "commands[" + std::to_string(i) + "]";
       TimedMultirotorCommand tc = ParseCommand(p, (*cmds)[i], key);
       if (!m.commands.empty() && tc.t_sec < m.commands.back().t_sec)
-        p.Fail(key + ".t", "got " + Fmt(tc.t_sec) + ", before the previous command's t = " +
-                               Fmt(m.commands.back().t_sec) + "; expected non-decreasing times");
+        p.Fail(key + ".t", "got " + PidFmt(tc.t_sec) + ", before the previous command's t = " +
+                               PidFmt(m.commands.back().t_sec) + "; expected non-decreasing times");
       m.commands.push_back(std::move(tc));
     }
   }
@@ -315,7 +318,7 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
   };
   auto check = [&](const char* key, double v, bool strictly_positive) {
     if (!std::isfinite(v) || v < 0 || (strictly_positive && v == 0))
-      fail(key, "got " + Fmt(v) + "; expected a number " + (strictly_positive ? "> 0" : ">= 0"));
+      fail(key, "got " + PidFmt(v) + "; expected a number " + (strictly_positive ? "> 0" : ">= 0"));
   };
   if (base_body.empty()) fail("base_body", "missing; expected a body name");
   if (rotor_actuators.size() < 4 ||
@@ -339,7 +342,7 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
   check("max_accel_m_s2", max_accel_m_s2, true);
   check("max_jerk_m_s3", max_jerk_m_s3, true);
   check("max_tilt_deg", max_tilt_deg, true);
-  if (max_tilt_deg > 80) fail("max_tilt_deg", "got " + Fmt(max_tilt_deg) + "; expected <= 80");
+  if (max_tilt_deg > 80) fail("max_tilt_deg", "got " + PidFmt(max_tilt_deg) + "; expected <= 80");
   check("max_roll_pitch_rate_deg_s", max_roll_pitch_rate_deg_s, true);
   check("max_yaw_rate_deg_s", max_yaw_rate_deg_s, true);
   check("yaw_speed_deg_s", yaw_speed_deg_s, true);
@@ -367,7 +370,7 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
   for (size_t i = 0; i < commands.size(); ++i) {
     const std::string key = "commands[" + std::to_string(i) + "]";
     if (!(std::isfinite(commands[i].t_sec) && commands[i].t_sec >= 0))
-      fail(key + ".t", "got " + Fmt(commands[i].t_sec) + "; expected a time >= 0 (s)");
+      fail(key + ".t", "got " + PidFmt(commands[i].t_sec) + "; expected a time >= 0 (s)");
     if (i > 0 && commands[i].t_sec < commands[i - 1].t_sec)
       fail(key + ".t", "before the previous command; expected non-decreasing times");
     commands[i].command.ValidateOrThrow(c, key);
@@ -377,7 +380,7 @@ void MultirotorPidParams::ValidateOrThrow(const ControllerContext& c) const {
 MultirotorPid::MultirotorPid(MultirotorPidParams params, ControllerContext context)
     : Controller(std::move(context)), params_(std::move(params)) {
   params_.ValidateOrThrow(this->context());
-  tan_max_tilt_ = std::tan(params_.max_tilt_deg * kDegToRad);
+  tan_max_tilt_ = std::tan(params_.max_tilt_deg * kPidDegToRad);
 }
 
 std::vector<NameRequirement> MultirotorPid::RequiredNames() const {
@@ -449,7 +452,7 @@ void MultirotorPid::ApplyCommand(const MultirotorCommand& cmd, const Eigen::Vect
     yaw_ref_ = yaw;
   }
   const Eigen::Vector3d start = p_ref_;
-  yaw_target_ = cmd.yaw_deg ? WrapAngle(*cmd.yaw_deg * kDegToRad) : yaw_ref_;
+  yaw_target_ = cmd.yaw_deg ? PidWrapAngle(*cmd.yaw_deg * kPidDegToRad) : yaw_ref_;
   face_path_ = false;
   mode_ = cmd.mode;
   path_time_ = 0;
@@ -478,8 +481,8 @@ void MultirotorPid::ApplyCommand(const MultirotorCommand& cmd, const Eigen::Vect
       path_ = MultirotorPath(start, {}, 1, accel);
       v_cmd_ = cmd.velocity_m_s;
       yaw_rate_cmd_ =
-          std::clamp(cmd.yaw_rate_deg_s * kDegToRad, -params_.max_yaw_rate_deg_s * kDegToRad,
-                     params_.max_yaw_rate_deg_s * kDegToRad);
+          std::clamp(cmd.yaw_rate_deg_s * kPidDegToRad, -params_.max_yaw_rate_deg_s * kPidDegToRad,
+                     params_.max_yaw_rate_deg_s * kPidDegToRad);
       frame_ = cmd.frame;
       break;
     case M::kLand:
@@ -515,7 +518,7 @@ void MultirotorPid::UpdateReference(double dt, const Eigen::Vector3d& p) {
     const Eigen::Vector3d lead = p_ref_ - p;
     if (lead.norm() > params_.leash_m) p_ref_ = p + lead * (params_.leash_m / lead.norm());
     yaw_rate_ff_ = yaw_rate_cmd_;
-    yaw_ref_ = WrapAngle(yaw_ref_ + yaw_rate_cmd_ * dt);
+    yaw_ref_ = PidWrapAngle(yaw_ref_ + yaw_rate_cmd_ * dt);
     return;
   }
 
@@ -535,10 +538,10 @@ void MultirotorPid::UpdateReference(double dt, const Eigen::Vector3d& p) {
     const Eigen::Vector2d d = (v[s.segment + 1] - v[s.segment]).head<2>();
     if (d.norm() > 1e-3) yaw_target_ = std::atan2(d.y(), d.x());
   }
-  const double err = WrapAngle(yaw_target_ - yaw_ref_);
-  const double max_step = params_.yaw_speed_deg_s * kDegToRad * dt;
+  const double err = PidWrapAngle(yaw_target_ - yaw_ref_);
+  const double max_step = params_.yaw_speed_deg_s * kPidDegToRad * dt;
   const double step = std::clamp(err, -max_step, max_step);
-  yaw_ref_ = WrapAngle(yaw_ref_ + step);
+  yaw_ref_ = PidWrapAngle(yaw_ref_ + step);
   yaw_rate_ff_ = step / dt;
 }
 
@@ -684,8 +687,8 @@ void MultirotorPid::Compute(const ControlInput& input, std::span<double> ctrl) {
   w_sp += R.transpose().col(2) * yaw_rate_ff_;  // world yaw rate in body axes
   const Eigen::Vector3d b3_dot = (m / F.norm()) * (j_ff_ - j_ff_.dot(b3) * b3);
   w_sp += R.transpose() * b3.cross(b3_dot);
-  const double rp_max = params_.max_roll_pitch_rate_deg_s * kDegToRad;
-  const double yaw_max = params_.max_yaw_rate_deg_s * kDegToRad;
+  const double rp_max = params_.max_roll_pitch_rate_deg_s * kPidDegToRad;
+  const double yaw_max = params_.max_yaw_rate_deg_s * kPidDegToRad;
   w_sp.x() = std::clamp(w_sp.x(), -rp_max, rp_max);
   w_sp.y() = std::clamp(w_sp.y(), -rp_max, rp_max);
   w_sp.z() = std::clamp(w_sp.z(), -yaw_max, yaw_max);

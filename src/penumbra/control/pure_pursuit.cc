@@ -7,7 +7,7 @@ namespace penumbra {
 namespace {
 
 // a wrapped into (-pi, pi]
-double WrapAngle(double a) {
+double PursuitWrapAngle(double a) {
   a = std::remainder(a, 2 * M_PI);  // in [-pi, pi]
   return a <= -M_PI ? a + 2 * M_PI : a;
 }
@@ -23,7 +23,7 @@ UnicycleCommand PurePursuit(const Pose& X_WB, const Eigen::Vector2d& goal_W,
   const Eigen::Vector2d to_goal = goal_W - p;
   const double d = to_goal.norm();
   const double psi = std::atan2(forward.y(), forward.x());
-  const double alpha = WrapAngle(std::atan2(to_goal.y(), to_goal.x()) - psi);
+  const double alpha = PursuitWrapAngle(std::atan2(to_goal.y(), to_goal.x()) - psi);
   const double omega_max = limits.max_yaw_rate;
   if (std::abs(alpha) > 0.5 * M_PI) {
     // goal behind: turn in place

@@ -19,7 +19,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kGaitInf = std::numeric_limits<double>::infinity();
 constexpr double kGravity = 9.81;
 // reference heading / position may lead the robot by at most this much (anti-windup)
 constexpr double kMaxHeadingLead = 0.3;
@@ -30,7 +30,7 @@ constexpr double kTouchdownDepth = 0.005;
 constexpr std::array<double, 4> kPhaseOffset = {0.0, 0.5, 0.5, 0.0};
 
 // a wrapped into [-pi, pi)
-double WrapAngle(double a) { return a - 2 * M_PI * std::floor((a + M_PI) / (2 * M_PI)); }
+double GaitWrapAngle(double a) { return a - 2 * M_PI * std::floor((a + M_PI) / (2 * M_PI)); }
 
 std::string NameAt(ControllerParams& p, const YAML::Node& n, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty())
@@ -134,22 +134,22 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   g.duty = p.Number("duty", 0.5, 0.3, 0.8);
   g.swing_height_m = p.Number("swing_height_m", 0.08, 0, 1);
   if (p.Has("body_height_m"))
-    g.body_height_m = p.Number("body_height_m", std::nullopt, 0, kInf, true);
+    g.body_height_m = p.Number("body_height_m", std::nullopt, 0, kGaitInf, true);
   if (p.Has("raibert_gain")) g.raibert_gain = p.Number("raibert_gain", std::nullopt, 0, 10);
-  if (p.Has("max_step_m")) g.max_step_m = p.Number("max_step_m", std::nullopt, 0, kInf, true);
-  g.max_accel_m_s2 = p.Number("max_accel_m_s2", 1.5, 0, kInf, true);
-  g.max_yaw_accel_rad_s2 = p.Number("max_yaw_accel_rad_s2", 3, 0, kInf, true);
-  g.kp_xy = p.Number("kp_xy", 25, 0, kInf);
-  g.kd_xy = p.Number("kd_xy", 8, 0, kInf);
-  g.kp_z = p.Number("kp_z", 400, 0, kInf);
-  g.kd_z = p.Number("kd_z", 40, 0, kInf);
-  g.kp_tilt = p.Number("kp_tilt", 400, 0, kInf);
-  g.kd_tilt = p.Number("kd_tilt", 40, 0, kInf);
-  g.kp_yaw = p.Number("kp_yaw", 150, 0, kInf);
-  g.kd_yaw = p.Number("kd_yaw", 25, 0, kInf);
-  g.swing_kp = p.Number("swing_kp", 60, 0, kInf);
-  g.swing_kd = p.Number("swing_kd", 1.5, 0, kInf);
-  g.stance_kd = p.Number("stance_kd", 0.5, 0, kInf);
+  if (p.Has("max_step_m")) g.max_step_m = p.Number("max_step_m", std::nullopt, 0, kGaitInf, true);
+  g.max_accel_m_s2 = p.Number("max_accel_m_s2", 1.5, 0, kGaitInf, true);
+  g.max_yaw_accel_rad_s2 = p.Number("max_yaw_accel_rad_s2", 3, 0, kGaitInf, true);
+  g.kp_xy = p.Number("kp_xy", 25, 0, kGaitInf);
+  g.kd_xy = p.Number("kd_xy", 8, 0, kGaitInf);
+  g.kp_z = p.Number("kp_z", 400, 0, kGaitInf);
+  g.kd_z = p.Number("kd_z", 40, 0, kGaitInf);
+  g.kp_tilt = p.Number("kp_tilt", 400, 0, kGaitInf);
+  g.kd_tilt = p.Number("kd_tilt", 40, 0, kGaitInf);
+  g.kp_yaw = p.Number("kp_yaw", 150, 0, kGaitInf);
+  g.kd_yaw = p.Number("kd_yaw", 25, 0, kGaitInf);
+  g.swing_kp = p.Number("swing_kp", 60, 0, kGaitInf);
+  g.swing_kd = p.Number("swing_kd", 1.5, 0, kGaitInf);
+  g.stance_kd = p.Number("stance_kd", 0.5, 0, kGaitInf);
   g.friction = p.Number("friction", 0.6, 0, 5, true);
   if (const YAML::Node* hold = p.Raw("hold")) {
     if (!hold->IsMap())
@@ -160,7 +160,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
                           ParamNumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
     }
   }
-  g.rate_hz = p.Number("rate_hz", 250, 0, kInf, true);
+  g.rate_hz = p.Number("rate_hz", 250, 0, kGaitInf, true);
   p.CheckNoUnknownKeys();
   return g;
 }
@@ -286,8 +286,8 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
         leg.q_lo[j] = std::min(a, b);
         leg.q_hi[j] = std::max(a, b);
       } else {
-        leg.q_lo[j] = -kInf;
-        leg.q_hi[j] = kInf;
+        leg.q_lo[j] = -kGaitInf;
+        leg.q_hi[j] = kGaitInf;
       }
     }
     const int foot_site = ids[k++];
@@ -511,7 +511,7 @@ void TrotGait::Compute(const ControlInput& in, std::span<double> ctrl) {
   reference_.vy = slew(reference_.vy, command_.vy, params_.max_accel_m_s2);
   reference_.yaw_rate = slew(reference_.yaw_rate, command_.yaw_rate, params_.max_yaw_accel_rad_s2);
   const double psi = std::atan2(R(1, 0), R(0, 0));
-  psi_ref_ = psi + std::clamp(WrapAngle(psi_ref_ + reference_.yaw_rate * dt - psi),
+  psi_ref_ = psi + std::clamp(GaitWrapAngle(psi_ref_ + reference_.yaw_rate * dt - psi),
                               -kMaxHeadingLead, kMaxHeadingLead);
   const double cp = std::cos(psi), sp = std::sin(psi);
   const Eigen::Vector2d v_ref_xy(cp * reference_.vx - sp * reference_.vy,

@@ -10,7 +10,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kWaypointInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
@@ -20,14 +20,14 @@ WaypointFollowerParams WaypointFollowerParams::Parse(ControllerParams& p,
   w.base_body = name_prefix + p.String("base_body");
   w.left_actuator = name_prefix + p.String("left_actuator");
   w.right_actuator = name_prefix + p.String("right_actuator");
-  w.wheel_radius_m = p.Number("wheel_radius_m", std::nullopt, 0, kInf, true);
-  w.track_width_m = p.Number("track_width_m", std::nullopt, 0, kInf, true);
-  w.speed_m_s = p.Number("speed_m_s", 0.5, 0, kInf, true);
-  w.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 90, 0, kInf, true);
+  w.wheel_radius_m = p.Number("wheel_radius_m", std::nullopt, 0, kWaypointInf, true);
+  w.track_width_m = p.Number("track_width_m", std::nullopt, 0, kWaypointInf, true);
+  w.speed_m_s = p.Number("speed_m_s", 0.5, 0, kWaypointInf, true);
+  w.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 90, 0, kWaypointInf, true);
   w.waypoints = p.Points2("waypoints", 1);
   w.loop = p.Bool("loop", true);
-  w.tolerance_m = p.Number("tolerance_m", 0.15, 0, kInf, true);
-  w.rate_hz = p.Number("rate_hz", 50, 0, kInf, true);
+  w.tolerance_m = p.Number("tolerance_m", 0.15, 0, kWaypointInf, true);
+  w.rate_hz = p.Number("rate_hz", 50, 0, kWaypointInf, true);
   p.CheckNoUnknownKeys();
   if (w.left_actuator == w.right_actuator)
     p.Fail("right_actuator", "same actuator as left_actuator ('" + w.left_actuator +

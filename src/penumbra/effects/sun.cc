@@ -7,9 +7,9 @@ namespace penumbra {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-double Rad(double d) { return d * kPi / 180.0; }
-double Deg(double r) { return r * 180.0 / kPi; }
+constexpr double kSunPi = 3.14159265358979323846;
+double Rad(double d) { return d * kSunPi / 180.0; }
+double Deg(double r) { return r * 180.0 / kSunPi; }
 
 // NOAA's refraction correction (degrees) for an apparent-elevation estimate e (degrees).
 double Refraction(double e) {

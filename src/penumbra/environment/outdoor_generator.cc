@@ -18,7 +18,7 @@ constexpr double kHalf = 30;                         // terrain half extent, m
 constexpr double kCell = 0.25;                       // terrain sample spacing, m
 constexpr double kPathHalf = 1.2, kPathBlend = 3.0;  // flat path half width, blend width, m
 
-enum Purpose : uint64_t { kMaterials = 21, kTerrain, kTrees, kRocks, kBushes };
+enum OutdoorPurpose : uint64_t { kOutdoorMaterials = 21, kTerrain, kTrees, kRocks, kBushes };
 
 // one octave of value noise: lattice values in [-1, 1] from the seed, smoothstep between them
 double ValueNoise(uint64_t seed, int octave, double x, double y) {
@@ -80,7 +80,7 @@ class Outdoor : public EnvironmentBuilder {
   }
 
   void Materials() {
-    PlanRandom r(seed_, kMaterials);
+    PlanRandom r(seed_, kOutdoorMaterials);
     Procedural("ground", "concrete", r.Bits(), Eigen::Vector3f(0.3f, 0.38f, 0.17f), 3.0,
                {0.45, 0.5, 0.3});
     Procedural("bark", "wood", r.Bits(), Eigen::Vector3f(0.45f, 0.36f, 0.3f), 1.0,

@@ -12,8 +12,8 @@
 namespace penumbra {
 namespace {
 
-constexpr double kHalfX = 15, kHalfY = 10;  // interior half extents, m
-constexpr double kHeight = 8;               // floor to roof, m
+constexpr double kWarehouseHalfX = 15, kWarehouseHalfY = 10;  // interior half extents, m
+constexpr double kWarehouseHeight = 8;                        // floor to roof, m
 constexpr double kWall = 0.25;              // wall thickness, m
 constexpr double kBay = 2.7;                // rack bay width (upright centres), m
 constexpr double kRackDepth = 1.1;          // one rack's depth, m
@@ -24,7 +24,7 @@ constexpr double kLevels[] = {0.0, 1.7, 3.3, 4.9};
 constexpr double kUprightHeight = 6.2;
 constexpr double kPalletW = 1.2, kPalletD = 1.0, kPalletH = 0.144;  // EUR pallet, m
 
-enum Purpose : uint64_t { kMaterials = 11, kRacks, kStaging, kLoads };
+enum WarehousePurpose : uint64_t { kWarehouseMaterials = 11, kRacks, kStaging, kLoads };
 
 // a rack: its bays run along +x from kRackX0; `face_y` is the aisle-side face, `dir` +1 when
 // the rack extends towards +y from it, -1 towards -y
@@ -78,7 +78,7 @@ class Warehouse : public EnvironmentBuilder {
   }
 
   void Materials() {
-    PlanRandom r(seed_, kMaterials);
+    PlanRandom r(seed_, kWarehouseMaterials);
     const std::vector<Eigen::Vector3f> walls = {
         {0.75f, 0.77f, 0.78f}, {0.62f, 0.70f, 0.78f}, {0.80f, 0.78f, 0.70f}, {0.55f, 0.6f, 0.55f}};
     const std::vector<Eigen::Vector3f> uprights = {
@@ -111,35 +111,37 @@ class Warehouse : public EnvironmentBuilder {
 
   void Shell() {
     const PlanFrame world;
-    const double xe = kHalfX + kWall, ye = kHalfY + kWall;
+    const double xe = kWarehouseHalfX + kWall, ye = kWarehouseHalfY + kWall;
     b_.AddBox("floor_hall", world, {0, 0, -0.05}, {xe, ye, 0.05}, "floor_concrete", true);
     b_.AddPlane("ground", {0, 0, -0.06}, 60, 60, "asphalt", false);
-    b_.AddBox("roof", world, {0, 0, kHeight + 0.1}, {xe, ye, 0.1}, "roof", false);
-    const WallStyle style{"wall_metal", "trim_grey", kWall, kHeight};
-    const double yo = kHalfY + kWall / 2, xo = kHalfX + kWall / 2;
+    b_.AddBox("roof", world, {0, 0, kWarehouseHeight + 0.1}, {xe, ye, 0.1}, "roof", false);
+    const WallStyle style{"wall_metal", "trim_grey", kWall, kWarehouseHeight};
+    const double yo = kWarehouseHalfY + kWall / 2, xo = kWarehouseHalfX + kWall / 2;
     std::vector<WallOpening> docks;
     for (const double x : {-10.0, -4.0, 2.0, 8.0}) docks.push_back({x + xe, 3.2, 0, 4.2});
     AddWall(&b_, "wall_s", {-xe, -yo}, {xe, -yo}, docks, style);
     AddWall(&b_, "wall_n", {-xe, yo}, {xe, yo}, {}, style);
-    AddWall(&b_, "wall_w", {-xo, -kHalfY}, {-xo, kHalfY}, {}, style);
-    AddWall(&b_, "wall_e", {xo, -kHalfY}, {xo, kHalfY}, {}, style);
+    AddWall(&b_, "wall_w", {-xo, -kWarehouseHalfY}, {-xo, kWarehouseHalfY}, {}, style);
+    AddWall(&b_, "wall_e", {xo, -kWarehouseHalfY}, {xo, kWarehouseHalfY}, {}, style);
     // rolled-up door housings above the docks, and the dock zones kept free inside
     for (const double x : {-10.0, -4.0, 2.0, 8.0}) {
-      b_.AddBox("dock_housing", world, {x, -kHalfY + 0.2, 4.45}, {1.7, 0.2, 0.22}, "trim_grey",
-                false);
-      layout_.Take({x - 1.8, -kHalfY, x + 1.8, -kHalfY + 1.2});
+      b_.AddBox("dock_housing", world, {x, -kWarehouseHalfY + 0.2, 4.45}, {1.7, 0.2, 0.22},
+                "trim_grey", false);
+      layout_.Take({x - 1.8, -kWarehouseHalfY, x + 1.8, -kWarehouseHalfY + 1.2});
     }
-    out_.rooms.push_back({"hall", {-kHalfX, -kHalfY, kHalfX, kHalfY}});
-    out_.rooms.push_back({"staging", {-kHalfX, -kHalfY, kHalfX, -6.0}});
-    out_.rooms.push_back({"east_floor", {8.6, -6.0, kHalfX, kHalfY}});
+    out_.rooms.push_back(
+        {"hall", {-kWarehouseHalfX, -kWarehouseHalfY, kWarehouseHalfX, kWarehouseHalfY}});
+    out_.rooms.push_back({"staging", {-kWarehouseHalfX, -kWarehouseHalfY, kWarehouseHalfX, -6.0}});
+    out_.rooms.push_back({"east_floor", {8.6, -6.0, kWarehouseHalfX, kWarehouseHalfY}});
   }
 
   void Lamps() {
     int i = 0;
     for (const double y : {-5.0, 4.5})
       for (const double x : {-11.25, -3.75, 3.75, 11.25})
-        out_.lights.push_back(AddCeilingLamp(&b_, fmt::format("highbay_{}", i++), x, y, kHeight,
-                                             0.6, 0.25, 7000, "lamp_housing", "lamp_diffuser"));
+        out_.lights.push_back(AddCeilingLamp(&b_, fmt::format("highbay_{}", i++), x, y,
+                                             kWarehouseHeight, 0.6, 0.25, 7000, "lamp_housing",
+                                             "lamp_diffuser"));
   }
 
   // one pallet slot's load: the pallet and what stands on it, in a frame centred on the
@@ -168,7 +170,7 @@ class Warehouse : public EnvironmentBuilder {
   }
 
   void Racks() {
-    const std::vector<RackRow> rows = {{"rack_a", kHalfY - kRackDepth, 1},
+    const std::vector<RackRow> rows = {{"rack_a", kWarehouseHalfY - kRackDepth, 1},
                                        {"rack_b_s", 3.0, 1},
                                        {"rack_b_n", 5.2, -1},
                                        {"rack_c_n", -0.2, -1},
@@ -226,7 +228,8 @@ class Warehouse : public EnvironmentBuilder {
   // pallets staged in the south strip (y < -6), clear of the dock mouths
   void Staging() {
     const int count = staging_rnd_.Int(6, 14);
-    const PlanRect zone{-kHalfX + 0.3, -kHalfY + 0.3, kHalfX - 0.3, -6.0};
+    const PlanRect zone{-kWarehouseHalfX + 0.3, -kWarehouseHalfY + 0.3, kWarehouseHalfX - 0.3,
+                        -6.0};
     for (int i = 0; i < count; ++i) {
       for (int attempt = 0; attempt < 30; ++attempt) {
         const PlanFrame f{{staging_rnd_.Uniform(zone.x0 + 0.7, zone.x1 - 0.7),
@@ -244,10 +247,13 @@ class Warehouse : public EnvironmentBuilder {
 
   // long-span shelving along the east wall's north half, cartons on three shelves
   void EastShelving() {
-    const PlanFrame f{{kHalfX, 1.0}, M_PI / 2};  // x along the wall northwards, y westwards
+    const PlanFrame f{{kWarehouseHalfX, 1.0},
+                      M_PI / 2};  // x along the wall northwards, y westwards
     const double length = 7.5, depth = 0.6;
     const PlanRect fp = FootprintOf(f, 0, 0, length, depth);
-    if (!layout_.TryTake(fp, {-kHalfX, -kHalfY, kHalfX, kHalfY})) return;
+    if (!layout_.TryTake(fp,
+                         {-kWarehouseHalfX, -kWarehouseHalfY, kWarehouseHalfX, kWarehouseHalfY}))
+      return;
     ++out_.furniture;
     for (double x = 0; x <= length + 1e-9; x += length / 3)
       for (const double y : {0.03, depth - 0.03})

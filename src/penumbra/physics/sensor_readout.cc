@@ -188,7 +188,7 @@ std::string Unit(const mjModel* m, int s) {
   }
 }
 
-std::string Name(const mjModel* m, int type, int id) {
+std::string SensorObjectName(const mjModel* m, int type, int id) {
   if (id < 0) return "";
   const char* n = mj_id2name(m, type, id);
   return n ? n : "";
@@ -201,7 +201,7 @@ std::vector<SensorDescription> DescribeMujocoSensors(const mjModel_* mm) {
   std::vector<SensorDescription> out;
   for (int s = 0; s < m->nsensor; ++s) {
     SensorDescription i;
-    i.name = Name(m, mjOBJ_SENSOR, s);
+    i.name = SensorObjectName(m, mjOBJ_SENSOR, s);
     i.id = s;
     i.type = TypeName(m->sensor_type[s]);
     i.adr = m->sensor_adr[s];
@@ -218,9 +218,9 @@ std::vector<SensorDescription> DescribeMujocoSensors(const mjModel_* mm) {
       for (int k = 0; k < i.dim; ++k) i.components.push_back(std::to_string(k));
     }
     i.object_type = ObjName(m->sensor_objtype[s]);
-    i.object_name = Name(m, m->sensor_objtype[s], m->sensor_objid[s]);
+    i.object_name = SensorObjectName(m, m->sensor_objtype[s], m->sensor_objid[s]);
     if (m->sensor_reftype[s] > 0 && m->sensor_refid[s] >= 0)
-      i.reference_name = Name(m, m->sensor_reftype[s], m->sensor_refid[s]);
+      i.reference_name = SensorObjectName(m, m->sensor_reftype[s], m->sensor_refid[s]);
     i.noise_stddev = m->sensor_noise[s];
     i.cutoff = m->sensor_cutoff[s];
     out.push_back(std::move(i));

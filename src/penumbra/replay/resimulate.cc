@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/manifest_sink.h"

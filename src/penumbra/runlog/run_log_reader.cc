@@ -6,11 +6,8 @@
 #include <cstring>
 #include <fstream>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/runlog/run_log_codec.h"
-
-#ifndef PENUMBRA_VERSION
-#define PENUMBRA_VERSION "unknown"
-#endif
 
 namespace penumbra {
 

@@ -12,7 +12,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kScanPi = 3.14159265358979323846;
 constexpr double kBinDeg = 0.5;  // angular bins of beams for the particle lookup
 constexpr int kChunk = 256;
 constexpr int kSoftSamples = 48;
@@ -173,7 +173,7 @@ LidarScanner::LidarScanner(LidarConfig config, uint64_t stream_seed)
     : config_(std::move(config)), seed_(stream_seed) {
   config_.ValidateOrThrow();
   const LidarPattern& p = config_.pattern;
-  p_th_ = config_.reference_reflectivity / kPi / (p.max_range_m * p.max_range_m);
+  p_th_ = config_.reference_reflectivity / kScanPi / (p.max_range_m * p.max_range_m);
   const int n = static_cast<int>(p.beams.size());
   dir_S_.resize(n);
   for (int i = 0; i < n; ++i) p.Direction(i, &dir_S_[i].x(), &dir_S_[i].y(), &dir_S_[i].z());
@@ -183,8 +183,8 @@ LidarScanner::LidarScanner(LidarConfig config, uint64_t stream_seed)
   std::vector<int> count(static_cast<size_t>(n_az_) * n_el_ + 1, 0);
   std::vector<int> bin(n);
   for (int i = 0; i < n; ++i) {
-    const double az = std::atan2(dir_S_[i].y(), dir_S_[i].x()) * 180 / kPi + 180;  // [0, 360]
-    const double el = std::asin(std::clamp(dir_S_[i].z(), -1.0f, 1.0f)) * 180 / kPi + 90;
+    const double az = std::atan2(dir_S_[i].y(), dir_S_[i].x()) * 180 / kScanPi + 180;  // [0, 360]
+    const double el = std::asin(std::clamp(dir_S_[i].z(), -1.0f, 1.0f)) * 180 / kScanPi + 90;
     const int a = std::min(n_az_ - 1, static_cast<int>(az / kBinDeg));
     const int e = std::min(n_el_ - 1, static_cast<int>(el / kBinDeg));
     bin[i] = a * n_el_ + e;
@@ -193,7 +193,7 @@ LidarScanner::LidarScanner(LidarConfig config, uint64_t stream_seed)
   el_min_deg_ = 90;
   el_max_deg_ = -90;
   for (int i = 0; i < n; ++i) {
-    const double el = std::asin(std::clamp(dir_S_[i].z(), -1.0f, 1.0f)) * 180 / kPi;
+    const double el = std::asin(std::clamp(dir_S_[i].z(), -1.0f, 1.0f)) * 180 / kScanPi;
     el_min_deg_ = std::min(el_min_deg_, el);
     el_max_deg_ = std::max(el_max_deg_, el);
   }
@@ -229,7 +229,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
     for (const GridMedium& g : effects->grid_media)
       beta_max += g.max_density * g.sigma_t_per_m[0] * g.albedo[0] * kBetaPerSigma;
   }
-  const double bound_numerator = std::max(beta_max * pulse_len, 1.0 / kPi);
+  const double bound_numerator = std::max(beta_max * pulse_len, 1.0 / kScanPi);
 
   // particle candidates per beam (CSR by beam), from the scan-start pose
   std::vector<int> cand_start;
@@ -256,7 +256,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
           const double R = std::max((X_SW[0] * p_W).norm() - 1.0, pat.min_range_m);
           const double r_beam = R * tan_half_div;
           const double cover = r_beam > rp ? (rp * rp) / (r_beam * r_beam) : 1.0;
-          if (rho_of_set[s] / kPi * cover / (R * R) + 5 * sigma_n < p_th_) continue;
+          if (rho_of_set[s] / kScanPi * cover / (R * R) + 5 * sigma_n < p_th_) continue;
         }
         double az_lo = 1e9, az_hi = -1e9, el_lo = 1e9, el_hi = -1e9, ang = 0, az_ref = 0;
         bool in_range = false;
@@ -265,12 +265,12 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
           const double dist = p_S.norm();
           if (dist < pat.min_range_m - rp || dist > pat.max_range_m + rp || dist <= 0) continue;
           in_range = true;
-          ang = std::max(ang,
-                         std::asin(std::min(1.0, (rp + dist * tan_half_div) / dist)) * 180 / kPi);
-          double az = std::atan2(p_S.y(), p_S.x()) * 180 / kPi + 180;
+          ang = std::max(
+              ang, std::asin(std::min(1.0, (rp + dist * tan_half_div) / dist)) * 180 / kScanPi);
+          double az = std::atan2(p_S.y(), p_S.x()) * 180 / kScanPi + 180;
           if (az_lo > az_hi) az_ref = az;
           az = az_ref + std::remainder(az - az_ref, 360.0);  // unwrap around the first key
-          const double el = std::asin(std::clamp(p_S.z() / dist, -1.0, 1.0)) * 180 / kPi + 90;
+          const double el = std::asin(std::clamp(p_S.z() / dist, -1.0, 1.0)) * 180 / kScanPi + 90;
           az_lo = std::min(az_lo, az);
           az_hi = std::max(az_hi, az);
           el_lo = std::min(el_lo, el);
@@ -395,7 +395,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
                               ? Luminance(desc.materials[h.material].base_color)
                               : 0.8f;
         const double cos_t = std::abs(static_cast<double>(h.ng_W.dot(ray.d)));
-        double p = rho * cos_t / kPi / (r * r);
+        double p = rho * cos_t / kScanPi / (r * r);
         if (has_media) {
           // zero if the soft-target march already showed it undetectable; else T^2 from the
           // march's optical depth (exact for uniform media: the initial segment is exact and
@@ -432,7 +432,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
           if (R < pat.min_range_m || R >= r_end) continue;
           const double rho = ps.kind == ParticleKind::kRain ? 0.02 : Luminance(ps.color);
           const double cover = r_beam > 0 ? std::min(1.0, (rp * rp) / (r_beam * r_beam)) : 1.0;
-          double p = rho / kPi * cover / (R * R);
+          double p = rho / kScanPi * cover / (R * R);
           if (has_media) p *= std::exp(-2 * media.OpticalDepth(o, d, R));
           if (p > p_best_part) {
             p_best_part = p;
@@ -451,7 +451,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
       if (!(best_p >= p_th_)) continue;
       if (u_drop < config_.dropout_probability) continue;
       const double intensity =
-          kPi * best_p * (config_.intensity_range_normalized ? best_r * best_r : 1.0);
+          kScanPi * best_p * (config_.intensity_range_normalized ? best_r * best_r : 1.0);
       if (intensity < config_.min_intensity) continue;
       const double range = best_r + config_.range_noise_stddev_m * n_range;
       if (range <= 0) continue;

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/output/recorder_sink.h"

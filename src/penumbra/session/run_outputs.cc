@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <utility>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/physics/mujoco_version.h"
 #include "penumbra/render/backends/renderer_factory.h"
 

@@ -9,15 +9,12 @@
 #include <regex>
 #include <sstream>
 
+#include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_edit.h"
 #include "penumbra/world/yaml_reader.h"
-
-#ifndef PENUMBRA_SOURCE_DIR
-#define PENUMBRA_SOURCE_DIR "."
-#endif
 
 namespace fs = std::filesystem;
 

@@ -14,23 +14,23 @@ namespace penumbra {
 
 namespace {
 
-[[noreturn]] void Fail(const std::string& key, const std::string& problem) {
+[[noreturn]] void RosFail(const std::string& key, const std::string& problem) {
   throw ConfigError("", 0, key, problem);
 }
 
 void CheckTopic(const std::string& key, const std::string& topic) {
   if (!topic.empty() && !IsValidRosName(topic))
-    Fail(key, "'" + topic +
-                  "' is not a ROS graph name; expected letters, digits, '_' and single '/' "
-                  "(starting with a letter, '/' or '~', not ending in '/')");
+    RosFail(key, "'" + topic +
+                     "' is not a ROS graph name; expected letters, digits, '_' and single '/' "
+                     "(starting with a letter, '/' or '~', not ending in '/')");
 }
 
 void CheckFrame(const std::string& key, const std::string& id, bool required) {
   if (id.empty() && !required) return;
   if (!IsValidFrameId(id))
-    Fail(key, "'" + id +
-                  "' is not a tf frame id; expected letters, digits, '_', '-', '.' and '/' "
-                  "with no leading '/'");
+    RosFail(key, "'" + id +
+                     "' is not a tf frame id; expected letters, digits, '_', '-', '.' and '/' "
+                     "with no leading '/'");
 }
 
 }  // namespace
@@ -98,16 +98,16 @@ void RosConfig::ValidateOrThrow() const {
   if (!ns.empty() && ns != "/") CheckTopic("ros.namespace", ns);
   CheckFrame("ros.map_frame", map_frame, true);
   if (!std::isfinite(state_rate_hz) || state_rate_hz <= 0 || state_rate_hz > 1000)
-    Fail("ros.state_rate_hz",
-         "got " + FormatNumber(state_rate_hz) + "; expected (0, 1000] per second of sim time");
+    RosFail("ros.state_rate_hz",
+            "got " + FormatNumber(state_rate_hz) + "; expected (0, 1000] per second of sim time");
   std::set<std::string> seen;
   for (const RosRobotConfig& r : robots) {
     const std::string key = "ros.robots." + r.robot;
-    if (!seen.insert(r.robot).second) Fail(key, "listed twice; expected one entry per robot");
+    if (!seen.insert(r.robot).second) RosFail(key, "listed twice; expected one entry per robot");
     if (r.base_body.find('/') != std::string::npos)
-      Fail(key + ".base_body", "'" + r.base_body +
-                                   "'; expected the model-local body name (without \"" + r.robot +
-                                   "/\")");
+      RosFail(key + ".base_body", "'" + r.base_body +
+                                      "'; expected the model-local body name (without \"" +
+                                      r.robot + "/\")");
     CheckFrame(key + ".base_frame", r.base_frame, false);
     CheckFrame(key + ".odom_frame", r.odom_frame, false);
     CheckTopic(key + ".namespace", r.ns);
@@ -115,7 +115,7 @@ void RosConfig::ValidateOrThrow() const {
   seen.clear();
   for (const RosSensorConfig& s : sensors) {
     const std::string key = "ros.sensors." + s.sensor;
-    if (!seen.insert(s.sensor).second) Fail(key, "listed twice; expected one entry per sensor");
+    if (!seen.insert(s.sensor).second) RosFail(key, "listed twice; expected one entry per sensor");
     CheckTopic(key + ".topic", s.topic);
     CheckFrame(key + ".frame_id", s.frame_id, false);
   }
@@ -140,15 +140,15 @@ void ValidateRosReferences(const RosConfig& ros, const WorldConfig& world) {
     }
   for (const RosRobotConfig& r : ros.robots)
     if (!robot_names.count(r.robot))
-      Fail("ros.robots." + r.robot, "'" + r.robot +
-                                        "' is not a robot of the world; expected one of: " +
-                                        (robots.empty() ? std::string("(none)") : robots));
+      RosFail("ros.robots." + r.robot, "'" + r.robot +
+                                           "' is not a robot of the world; expected one of: " +
+                                           (robots.empty() ? std::string("(none)") : robots));
   for (const RosSensorConfig& s : ros.sensors)
     if (s.sensor.find('/') == std::string::npos && !sensor_names.count(s.sensor))
-      Fail("ros.sensors." + s.sensor,
-           "'" + s.sensor + "' is not a camera, LiDAR or IMU of the world; expected one of: " +
-               (sensors.empty() ? std::string("(none)") : sensors) +
-               " (or an MJCF camera \"<model>/<camera>\")");
+      RosFail("ros.sensors." + s.sensor,
+              "'" + s.sensor + "' is not a camera, LiDAR or IMU of the world; expected one of: " +
+                  (sensors.empty() ? std::string("(none)") : sensors) +
+                  " (or an MJCF camera \"<model>/<camera>\")");
 }
 
 RosConfig LoadRosConfig(const WorldConfig& world) {

@@ -281,7 +281,7 @@ class WorldParser {
     c.line = r.line();
     c.params = YAML::Node(YAML::NodeType::Map);
     for (auto it = r.node().begin(); it != r.node().end(); ++it)
-      if (it->first.Scalar() != "type") c.params.force_insert(it->first, it->second);
+      if (it->first.Scalar() != "type") c.params.node().force_insert(it->first, it->second);
     return c;
   }
 
@@ -437,7 +437,7 @@ class WorldParser {
   fs::path base_dir_;
 };
 
-int MarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
+int ConfigMarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
 std::string LowerExtension(const fs::path& p) {
   std::string ext = p.extension().string();
@@ -511,17 +511,18 @@ WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_nam
     // never ends on some 7-byte inputs (",sn\xd4 !:" yields empty documents for ever, found by
     // fuzz/world_fuzz.cc), taking all memory
     if (const std::optional<YAML::Mark> second = SecondYamlDocument(yaml_text))
-      throw ConfigError(file_name, MarkLine(*second), "",
+      throw ConfigError(file_name, ConfigMarkLine(*second), "",
                         "a second YAML document (after '---'); expected the world in one "
                         "document");
     RefuseYamlTags(yaml_text, file_name);
     const YAML::Node root = YAML::Load(yaml_text);
     w = WorldParser(file_name, lines.get()).Parse(root);
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(file_name, MarkLine(e.mark), "", "YAML syntax error: " + e.msg);
+    throw ConfigError(file_name, ConfigMarkLine(e.mark), "", "YAML syntax error: " + e.msg);
   } catch (const YAML::Exception& e) {
     // any other yaml-cpp failure still names the file (and line when yaml-cpp knows it)
-    throw ConfigError(file_name, MarkLine(e.mark), "", "cannot read the YAML document: " + e.msg);
+    throw ConfigError(file_name, ConfigMarkLine(e.mark), "",
+                      "cannot read the YAML document: " + e.msg);
   }
   ValidateWorld(w, *lines);
   w.lines = std::move(lines);

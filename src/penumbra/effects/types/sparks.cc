@@ -10,7 +10,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kSparksPi = 3.14159265358979323846;
 
 class SparksInstance : public EffectInstance {
  public:
@@ -30,7 +30,7 @@ class SparksInstance : public EffectInstance {
     const int64_t kmin = std::max<int64_t>(
         0, static_cast<int64_t>(std::ceil((t - sp.lifetime_sec) * sp.rate_per_s)));
     const int64_t kmax = static_cast<int64_t>(std::floor(t * sp.rate_per_s));
-    const double cos_max = std::cos(sp.spread_deg * kPi / 180.0);
+    const double cos_max = std::cos(sp.spread_deg * kSparksPi / 180.0);
     for (int64_t k = kmin; k <= kmax; ++k) {
       const double born = k / sp.rate_per_s;
       const double tau = t - born;
@@ -39,7 +39,7 @@ class SparksInstance : public EffectInstance {
       Rng rng(HashKeys(key_, 3, static_cast<uint64_t>(k)));
       const double u_keep = rng.UniformD();
       const double cos_t = 1.0 - rng.UniformD() * (1.0 - cos_max);
-      const double phi = 2 * kPi * rng.UniformD();
+      const double phi = 2 * kSparksPi * rng.UniformD();
       const double speed = sp.speed_m_s * (0.5 + 0.5 * rng.UniformD());
       if (u_keep >= wb) continue;
       const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
