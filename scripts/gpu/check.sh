@@ -5,13 +5,21 @@
 # rates), the parity table (parity.sh), and prints one summary table, then the measurements
 # (docs/gpu.md).
 #
-#   scripts/gpu/check.sh [tarball] [benchmark frames]     (default .gpu/penumbra-gpu.tar.xz, 50)
+#   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
+#                                           (default .gpu/penumbra-gpu.tar.xz, 50)
+#   CHECK_LOG_DIR=DIR CHECK_LIMIT_S=60 scripts/gpu/check.sh ...  (logs kept in DIR; the steps'
+#   limits are multiples of CHECK_LIMIT_S: gpu tests 3x, batch 1.5x, parity 2x, bench 1.5x,
+#   sessions 0.75x, host tests 1x)
 set -uo pipefail
 tarball=${1:-.gpu/penumbra-gpu.tar.xz}
 frames=${2:-50}
 work=$(mktemp -d)
-tar -C "$work" -xJf "$tarball"
-pkg=$work/penumbra-gpu
+if [ -d "$tarball" ]; then
+  pkg=$(cd "$tarball" && pwd)  # an unpacked pack
+else
+  tar -C "$work" -xJf "$tarball"
+  pkg=$work/penumbra-gpu
+fi
 # the carried libraries: the executables find them through their run path, the libraries
 # they load (e.g. MuJoCo its libccd) through this
 export LD_LIBRARY_PATH=$pkg/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
@@ -20,26 +28,32 @@ src=$(cat "$pkg/source-dir.txt" 2>/dev/null || echo /work/wt-cuda)
 if [ ! -e "$src/worlds" ]; then
   mkdir -p "$src" && ln -sfn "$pkg/src/worlds" "$src/worlds"
 fi
-log=$work/log
+# the logs of each step (CHECK_LOG_DIR to keep them, e.g. in a folder that is copied back);
+# each step has its own time limit (CHECK_LIMIT_S seconds times its share), so one slow step
+# cannot take the others' results with it
+log=${CHECK_LOG_DIR:-$work/log}
 mkdir -p "$log"
+limit=${CHECK_LIMIT_S:-60}
 card=$(nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap --format=csv,noheader 2>/dev/null || echo "none")
 cpu="$(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
+echo "card: $card; CPU: $cpu" > "$log/card.txt"
 count() { grep -c -E "$1" "$2" || true; }
-"$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
-host_rc=$?
-"$pkg/bin/render_cuda_gpu_tests" > "$log/gpu.txt" 2>&1
+timeout $((limit * 3)) "$pkg/bin/render_cuda_gpu_tests" > "$log/gpu.txt" 2>&1
 gpu_rc=$?
-"$pkg/bin/render_cuda_bench" --frames "$frames" "$pkg/src/worlds/default.yaml" \
-  "$pkg/src/worlds/house.yaml" > "$log/bench.txt" 2>&1
-bench_rc=$?
-"$pkg/bin/render_cuda_bench" --frames "$frames" --batch 1,64,1024 --size 128x128 \
-  "$pkg/src/worlds/house.yaml" > "$log/batch.txt" 2>&1
+timeout $((limit * 3 / 2)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 1,64,1024 \
+  --size 128x128 "$pkg/src/worlds/house.yaml" > "$log/batch.txt" 2>&1
 batch_rc=$?
-"$pkg/bin/render_cuda_bench" --frames "$frames" --batch 64 --size 128x128 --sessions 4 \
-  "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1
-sessions_rc=$?
-"$pkg/parity.sh" "$pkg/bin/render_cuda_bench" "$pkg/src/worlds" > "$log/parity.txt" 2>&1
+timeout $((limit * 2)) "$pkg/parity.sh" "$pkg/bin/render_cuda_bench" "$pkg/src/worlds" \
+  > "$log/parity.txt" 2>&1
 parity_rc=$?
+timeout $((limit * 3 / 2)) "$pkg/bin/render_cuda_bench" --frames "$frames" \
+  "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" > "$log/bench.txt" 2>&1
+bench_rc=$?
+timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 64 \
+  --size 128x128 --sessions 4 "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1
+sessions_rc=$?
+timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
+host_rc=$?
 verdict() { [ "$1" -eq 0 ] && echo "pass" || echo "FAIL (rc $1)"; }
 echo "| check | result |"
 echo "|---|---|"

@@ -49,7 +49,7 @@ class BackendFlagTest : public ::testing::Test {
 };
 
 // the bytes of every file under `dir` but run.json (which holds the command line and times)
-std::map<std::string, std::string> ImageFiles(const fs::path& dir) {
+std::map<std::string, std::string> BackendImageFiles(const fs::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir))
     if (e.is_regular_file() && e.path().extension() == ".png")
@@ -59,13 +59,13 @@ std::map<std::string, std::string> ImageFiles(const fs::path& dir) {
 
 TEST_F(BackendFlagTest, EveryRenderingVerbTakesCpu) {
   const std::string log = Path("w.plog");
-  ProcessResult r = Penumbra({"run", world_, "--backend", "cpu", "--out", Path("run_cpu"), "-q",
-                              "--record", log});
+  ProcessResult r = Penumbra(
+      {"run", world_, "--backend", "cpu", "--out", Path("run_cpu"), "-q", "--record", log});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_FALSE(ImageFiles(Path("run_cpu")).empty());
+  EXPECT_FALSE(BackendImageFiles(Path("run_cpu")).empty());
   r = Penumbra({"replay", log, "--backend", "cpu", "--out", Path("replay_cpu"), "-q"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(ImageFiles(Path("replay_cpu")) == ImageFiles(Path("run_cpu")));
+  EXPECT_TRUE(BackendImageFiles(Path("replay_cpu")) == BackendImageFiles(Path("run_cpu")));
   r = Penumbra({"export", log, "--backend", "cpu", "--format", "tum", "--out", Path("tum"),
                 "--depth", "ground-truth"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -88,11 +88,10 @@ TEST_F(BackendFlagTest, EveryRenderingVerbTakesCpu) {
   EXPECT_EQ(r.err.find("--backend"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("none.yaml"), std::string::npos) << r.err;
   // export of a run folder renders nothing: --backend is refused there
-  r = Penumbra({"export", Path("run_cpu"), "--backend", "cpu", "--format", "tum", "--out",
-                Path("tum2")});
+  r = Penumbra(
+      {"export", Path("run_cpu"), "--backend", "cpu", "--format", "tum", "--out", Path("tum2")});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("--backend: only for a run log (.plog) input"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("--backend: only for a run log (.plog) input"), std::string::npos) << r.err;
 }
 
 TEST_F(BackendFlagTest, AutoWithoutADeviceRendersTheCpuBytes) {
@@ -101,8 +100,8 @@ TEST_F(BackendFlagTest, AutoWithoutADeviceRendersTheCpuBytes) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = Penumbra({"run", world_, "--backend", "auto", "--out", Path("b"), "-q"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_FALSE(ImageFiles(Path("a")).empty());
-  EXPECT_TRUE(ImageFiles(Path("a")) == ImageFiles(Path("b")));
+  EXPECT_FALSE(BackendImageFiles(Path("a")).empty());
+  EXPECT_TRUE(BackendImageFiles(Path("a")) == BackendImageFiles(Path("b")));
 }
 
 TEST_F(BackendFlagTest, CudaWithoutADeviceIsRefusedNamingTheFlag) {

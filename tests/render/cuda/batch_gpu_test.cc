@@ -79,11 +79,10 @@ std::vector<uint8_t> BatchBytes(const cuda::BatchImages& img) {
 std::vector<uint8_t> CameraBytes(const cuda::BatchImages& img, int k) {
   std::vector<uint8_t> out;
   const int64_t n = 4 * img.layout->pixels();
-  for (const void* p : {static_cast<const void*>(img.depth(k)),
-                        static_cast<const void*>(img.geom_id(k)),
-                        static_cast<const void*>(img.body_id(k)),
-                        static_cast<const void*>(img.semantic(k)),
-                        static_cast<const void*>(img.range(k))}) {
+  for (const void* p :
+       {static_cast<const void*>(img.depth(k)), static_cast<const void*>(img.geom_id(k)),
+        static_cast<const void*>(img.body_id(k)), static_cast<const void*>(img.semantic(k)),
+        static_cast<const void*>(img.range(k))}) {
     const uint8_t* b = static_cast<const uint8_t*>(p);
     out.insert(out.end(), b, b + n);
   }
@@ -141,8 +140,7 @@ TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
     for (int i = 0; i < n; ++i) {
       same_bits += std::memcmp(&f.depth_m.data[i], one.depth(0) + i, 4) == 0;
       depth_bad += std::abs(f.depth_m.data[i] - one.depth(0)[i]) > 1e-6f * (1 + f.depth_m.data[i]);
-      seg_bad += f.geom_id.data[i] != one.geom_id(0)[i] ||
-                 f.body_id.data[i] != one.body_id(0)[i] ||
+      seg_bad += f.geom_id.data[i] != one.geom_id(0)[i] || f.body_id.data[i] != one.body_id(0)[i] ||
                  f.semantic_class.data[i] != one.semantic(0)[i];
       hits += f.depth_m.data[i] > 0;
     }

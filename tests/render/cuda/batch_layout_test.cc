@@ -160,8 +160,8 @@ TEST(BatchPixelTruth, HostRunMatchesTheCpuBackend) {
   for (int v = 0; v < 72; ++v)
     for (int u = 0; u < 96; ++u) {
       const cuda::TraceRay r =
-          cuda::PinholePixelRay(f3(t.o_W), f3(t.ex_W), f3(t.ey_W), f3(t.ez_W), t.cx, t.cy,
-                                t.inv_fx, t.inv_fy, static_cast<float>(view.near_m), u, v);
+          cuda::PinholePixelRay(f3(t.o_W), f3(t.ex_W), f3(t.ey_W), f3(t.ez_W), t.cx, t.cy, t.inv_fx,
+                                t.inv_fy, static_cast<float>(view.near_m), u, v);
       const cuda::PixelTruth p = cuda::TracePixelTruth(sv, r);
       const int i = v * 96 + u;
       hits += p.depth > 0;

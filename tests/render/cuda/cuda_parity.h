@@ -27,7 +27,7 @@ namespace penumbra::cuda_parity {
 struct ParityRow {
   std::string world;
   int pixels = 0;
-  int hit = 0;                 ///< pixels the CPU backend's depth hit
+  int hit = 0;                  ///< pixels the CPU backend's depth hit
   double depth_within_1mm = 0;  ///< % of pixels
   double seg_equal = 0;         ///< % of pixels
   int ties = 0;                 ///< of the differing ids: same depth within 1e-5 (coplanar)
@@ -67,9 +67,8 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
   const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
   ParityRow row;
-  row.world = world_file.substr(world_file.find("worlds/") == std::string::npos
-                                    ? 0
-                                    : world_file.find("worlds/") + 7);
+  row.world = world_file.substr(
+      world_file.find("worlds/") == std::string::npos ? 0 : world_file.find("worlds/") + 7);
   RenderedFrame a, b;
   cpu->Render(snap, nullptr, view, &a);
   gpu->Render(snap, nullptr, view, &b);
@@ -102,7 +101,8 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
       se += d * d;
     }
     const double mse = se / std::max<size_t>(1, ca.rgb.data.size());
-    row.rgb = mse == 0 ? "PSNR inf (equal)" : fmt::format("PSNR {:.1f} dB", 10 * std::log10(255.0 * 255.0 / mse));
+    row.rgb = mse == 0 ? "PSNR inf (equal)"
+                       : fmt::format("PSNR {:.1f} dB", 10 * std::log10(255.0 * 255.0 / mse));
   }
   return row;
 }
@@ -115,11 +115,10 @@ inline std::string FormatParity(const std::vector<ParityRow>& rows, int width, i
       "|---|---:|---:|---:|---:|---:|---|---|\n",
       width, height);
   for (const ParityRow& r : rows)
-    s += fmt::format("| {} | {} of {} | {:.3f} % | {:.3f} % | {} | {:.3f} % | {} | {} |\n",
-                     r.world, r.hit, r.pixels, r.depth_within_1mm, r.seg_equal, r.ties,
+    s += fmt::format("| {} | {} of {} | {:.3f} % | {:.3f} % | {} | {:.3f} % | {} | {} |\n", r.world,
+                     r.hit, r.pixels, r.depth_within_1mm, r.seg_equal, r.ties,
                      r.seg_equal + 100.0 * r.ties / r.pixels,
-                     !r.effects ? "none" : (r.effects_on_gpu ? "on GPU" : "cpu fallback"),
-                     r.rgb);
+                     !r.effects ? "none" : (r.effects_on_gpu ? "on GPU" : "cpu fallback"), r.rgb);
   return s;
 }
 

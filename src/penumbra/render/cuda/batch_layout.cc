@@ -17,15 +17,16 @@ bool Finite3(const F3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && s
 BatchLayout::BatchLayout(int width, int height, int max_cameras, const BatchOutputs& outputs)
     : width_(width), height_(height), max_cameras_(max_cameras), outputs_(outputs) {
   if (width < 1 || width > 16384 || height < 1 || height > 16384)
-    throw Error(fmt::format("batch rendering: image size {}x{}; expected width and height in "
-                            "[1, 16384]",
-                            width, height));
+    throw Error(
+        fmt::format("batch rendering: image size {}x{}; expected width and height in "
+                    "[1, 16384]",
+                    width, height));
   if (max_cameras < 1 || max_cameras > 65535)
-    throw Error(fmt::format("batch rendering: {} cameras per batch; expected 1 to 65535",
-                            max_cameras));
+    throw Error(
+        fmt::format("batch rendering: {} cameras per batch; expected 1 to 65535", max_cameras));
   const bool on[kBatchPlaneCount] = {outputs.depth, outputs.segmentation,
-                                     outputs.instance_segmentation,
-                                     outputs.semantic_segmentation, outputs.range};
+                                     outputs.instance_segmentation, outputs.semantic_segmentation,
+                                     outputs.range};
   for (int p = 0; p < kBatchPlaneCount; ++p) index_[p] = on[p] ? planes_++ : -1;
   if (planes_ == 0)
     throw Error(
@@ -57,8 +58,7 @@ void BatchLayout::Check(const BatchCamera* cameras, int count, int num_worlds) c
     if (!Finite3(c.o) || !Finite3(c.ex) || !Finite3(c.ey) || !Finite3(c.ez))
       throw bad("a pose that is not finite; expected finite o, ex, ey, ez");
     if (!std::isfinite(c.cx) || !std::isfinite(c.cy) || !std::isfinite(c.near) || c.near < 0 ||
-        !(c.inv_fx > 0) || !(c.inv_fy > 0) || !std::isfinite(c.inv_fx) ||
-        !std::isfinite(c.inv_fy))
+        !(c.inv_fx > 0) || !(c.inv_fy > 0) || !std::isfinite(c.inv_fx) || !std::isfinite(c.inv_fy))
       throw bad("intrinsics; expected finite cx, cy, near >= 0 and finite inv_fx, inv_fy > 0");
   }
 }

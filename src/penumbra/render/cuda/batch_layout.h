@@ -66,8 +66,8 @@ class BatchLayout {
   /// bytes of the largest batch (each slot's buffer).
   int64_t capacity_bytes() const { return bytes(max_cameras_); }
 
-  /// checks a batch cameras[0 .. count): 1 to max_cameras cameras, each of a world in [0, num_worlds), the
-  /// batch's width and height, finite pose and intrinsics, inv_fx and inv_fy > 0.
+  /// checks a batch cameras[0 .. count): 1 to max_cameras cameras, each of a world in [0,
+  /// num_worlds), the batch's width and height, finite pose and intrinsics, inv_fx and inv_fy > 0.
   /// @throws Error naming the camera's index and the field.
   void Check(const BatchCamera* cameras, int count, int num_worlds) const;
 

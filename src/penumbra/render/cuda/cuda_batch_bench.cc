@@ -59,8 +59,8 @@ double TimePipeline(BatchRenderer* r, std::span<const BatchCamera> cams, int bat
 
 CameraView OrbitView(const CameraView& view, double yaw_rad) {
   CameraView v = view;
-  v.X_WO.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                    view.X_WO.linear();
+  v.X_WO.linear() =
+      Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * view.X_WO.linear();
   return v;
 }
 
@@ -112,8 +112,8 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       rows.push_back({count, "cuda",
                       pinned ? "batch, pinned copy overlapped" : "batch, pageable copy", count / s,
                       1e3 * s});
-      if (pinned) rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3),
-                                  kernel_ms});
+      if (pinned)
+        rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3), kernel_ms});
     }
   }
   // the CPU backend: the same views one after another (each Render on all its threads)
@@ -139,8 +139,8 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       views[k].outputs.normals = false;
     }
     for (int k = 0; k < std::min(count, 4); ++k)  // warm-up
-      if (Renderer* cpu = worlds[world_of[k]].cpu) cpu->Render(worlds[world_of[k]].snapshot,
-                                                               views[k], &f);
+      if (Renderer* cpu = worlds[world_of[k]].cpu)
+        cpu->Render(worlds[world_of[k]].snapshot, views[k], &f);
     const auto t0 = BenchClock::now();
     int rendered = 0;
     for (int b = 0; b < cpu_batches; ++b)
@@ -150,8 +150,8 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
           ++rendered;
         }
     const double s = SecondsSince(t0);
-    rows.push_back({count, "cpu", "Render() per camera, all cores", rendered / s,
-                    1e3 * s / cpu_batches});
+    rows.push_back(
+        {count, "cpu", "Render() per camera, all cores", rendered / s, 1e3 * s / cpu_batches});
   }
   return rows;
 }
@@ -162,9 +162,9 @@ std::string FormatBatchBench(const std::string& label, int width, int height,
       "| world | size | outputs | cameras | backend | timed | frames/s | ms/batch |\n"
       "|---|---|---|---:|---|---|---:|---:|\n";
   for (const BatchBenchRow& r : rows)
-    s += fmt::format("| {} | {}x{} | {} | {} | {} | {} | {:.0f} | {:.3f} |\n", label, width,
-                     height, OutputsLabel(outputs), r.cameras, r.backend, r.timed,
-                     r.frames_per_sec, r.ms_per_batch);
+    s += fmt::format("| {} | {}x{} | {} | {} | {} | {} | {:.0f} | {:.3f} |\n", label, width, height,
+                     OutputsLabel(outputs), r.cameras, r.backend, r.timed, r.frames_per_sec,
+                     r.ms_per_batch);
   return s;
 }
 

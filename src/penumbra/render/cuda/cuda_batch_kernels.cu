@@ -104,8 +104,7 @@ BatchDevice::BatchDevice(const BatchLayout& layout, BatchCopy copy) : impl_(new 
         m.host[s] = new uint8_t[bytes];
       CheckBatch(cudaEventCreate(&m.started[s]), "cudaEventCreate");
       CheckBatch(cudaEventCreate(&m.done[s]), "cudaEventCreate");
-      CheckBatch(cudaEventCreateWithFlags(&m.copied[s], cudaEventDisableTiming),
-                 "cudaEventCreate");
+      CheckBatch(cudaEventCreateWithFlags(&m.copied[s], cudaEventDisableTiming), "cudaEventCreate");
     }
   } catch (...) {
     m.Release();

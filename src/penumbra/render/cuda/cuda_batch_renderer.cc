@@ -30,8 +30,8 @@ int BatchRenderer::AddWorld(const SceneDescription& scene) {
 
 void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot) {
   if (world < 0 || world >= num_worlds())
-    throw Error(fmt::format("batch rendering: world {}; expected a world in [0, {})", world,
-                            num_worlds()));
+    throw Error(
+        fmt::format("batch rendering: world {}; expected a world in [0, {})", world, num_worlds()));
   World& w = *worlds_[world];
   w.bvh->Update(snapshot);
   // the submitted kernels read this world's transforms (and, after a rebuild, its arrays)

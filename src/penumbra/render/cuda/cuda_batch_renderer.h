@@ -48,7 +48,7 @@ struct BatchConfig {
 struct BatchImages {
   const uint8_t* base = nullptr;  ///< the batch's buffer (host or device pointer)
   const BatchLayout* layout = nullptr;
-  int cameras = 0;      ///< cameras in the batch
+  int cameras = 0;         ///< cameras in the batch
   bool on_device = false;  ///< base is a device pointer
   /// camera k's depth (m, 0 = miss) / range (m) / segmentation (geom id, -1 = miss) /
   /// instance (body id) / semantic class; null if not rendered.
