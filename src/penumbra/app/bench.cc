@@ -76,8 +76,8 @@ int BenchRenderBatch(const WorldConfig& world, const RenderBenchOptions& options
   const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
       worlds, options.batch_width, options.batch_height, counts, options.frames, outputs);
   const std::string name = world.file.substr(world.file.find_last_of('/') + 1);
-  fmt::print("{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height,
-                                          outputs, rows));
+  fmt::print(
+      "{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height, outputs, rows));
   return 0;
 #else
   throw ConfigError("", 0, "--batch",

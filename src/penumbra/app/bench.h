@@ -21,9 +21,9 @@ struct RenderBenchOptions {
   /// --batch N: batch rendering (render/cuda/cuda_batch_renderer.h) of N cameras per launch
   /// instead (backend cuda); 0 = the single-camera benchmark.
   int batch = 0;
-  int batch_width = 128;   ///< --size WxH of the batch benchmark
+  int batch_width = 128;  ///< --size WxH of the batch benchmark
   int batch_height = 128;
-  int sessions = 1;  ///< --sessions S: the batch's cameras spread over S sessions of the world
+  int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
   bool adversity = true;  ///< also time the presets none/minor/major (app/effects_bench.h)
 };
 

@@ -82,9 +82,9 @@ pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const
     dup2(fd, 1);
     dup2(fd, 2);
     const std::string index = std::to_string(j.index);
-    std::vector<const char*> argv = {o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(),
-                                     "--out", o.out_dir.c_str(), "--job", index.c_str(),
-                                     "--quiet"};
+    std::vector<const char*> argv = {
+        o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(), "--out",
+        o.out_dir.c_str(),         "--job",     index.c_str(),     "--quiet"};
     if (!o.backend.empty()) {
       argv.push_back("--backend");
       argv.push_back(o.backend.c_str());

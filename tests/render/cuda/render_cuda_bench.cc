@@ -30,10 +30,10 @@
 #include "penumbra/render/cuda/cuda_batch_bench.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "render/cuda/cuda_parity.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
+#include "render/cuda/cuda_parity.h"
 
 namespace penumbra {
 namespace {
@@ -167,7 +167,8 @@ int Main(int argc, char** argv) {
   if (parity) {
     if (width == 0) width = 320, height = 240;
     std::vector<cuda_parity::ParityRow> rows;
-    for (const std::string& w : worlds) rows.push_back(cuda_parity::MeasureParity(w, width, height));
+    for (const std::string& w : worlds)
+      rows.push_back(cuda_parity::MeasureParity(w, width, height));
     fmt::print("\n{}", cuda_parity::FormatParity(rows, width, height));
     return 0;
   }
