@@ -1,34 +1,90 @@
 #!/usr/bin/env bash
 # on a GPU machine: unpacks scripts/gpu/pack.sh's tarball, names the card, runs the CUDA
-# backend's tests (the `gpu` tests and the host traversal tests) and its benchmark beside the
-# CPU backend, and prints one table (docs/gpu.md).
+# backend's tests (the `gpu` tests and the host tests) and its benchmarks beside the CPU
+# backend (single camera; batches of 1, 64 and 1024 cameras at 128x128 in the house; copy
+# rates), the parity table (parity.sh), and prints one summary table, then the measurements
+# (docs/gpu.md).
 #
-#   scripts/gpu/check.sh [tarball] [benchmark frames]     (default .gpu/penumbra-gpu.tar.xz, 50)
+#   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
+#                                           (default .gpu/penumbra-gpu.tar.xz, 50)
+#   CHECK_LOG_DIR=DIR CHECK_LIMIT_S=60 scripts/gpu/check.sh ...  (logs kept in DIR; the steps'
+#   limits are multiples of CHECK_LIMIT_S: gpu tests 3x, batch 1.5x, parity 2x, bench 1.5x,
+#   sessions 0.75x, host tests 1x)
 set -uo pipefail
 tarball=${1:-.gpu/penumbra-gpu.tar.xz}
 frames=${2:-50}
 work=$(mktemp -d)
-tar -C "$work" -xJf "$tarball"
-pkg=$work/penumbra-gpu
+if [ -d "$tarball" ]; then
+  pkg=$(cd "$tarball" && pwd)  # an unpacked pack
+else
+  tar -C "$work" -xJf "$tarball"
+  pkg=$work/penumbra-gpu
+fi
 # the carried libraries: the executables find them through their run path, the libraries
 # they load (e.g. MuJoCo its libccd) through this
 export LD_LIBRARY_PATH=$pkg/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-# the binaries were built in /work/wt-cuda and find the worlds there (PENUMBRA_SOURCE_DIR)
-if [ ! -e /work/wt-cuda/worlds ]; then
-  mkdir -p /work/wt-cuda && ln -sfn "$pkg/src/worlds" /work/wt-cuda/worlds
+# the binaries find the worlds in the source folder they were built in (PENUMBRA_SOURCE_DIR)
+src=$(cat "$pkg/source-dir.txt" 2>/dev/null || echo /work/wt-cuda)
+if [ ! -e "$src/worlds" ]; then
+  mkdir -p "$src" && ln -sfn "$pkg/src/worlds" "$src/worlds"
 fi
-echo "== card"
-nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap --format=csv,noheader || true
-echo "== CPU: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
-echo "== host traversal tests (render_cuda_tests)"
-"$pkg/bin/render_cuda_tests" 2>&1 | grep -E '^\[ +(OK|FAILED|PASSED|SKIPPED) +\]|Failure|actual'
-host_rc=${PIPESTATUS[0]}
-echo "== gpu tests (render_cuda_gpu_tests, ctest label gpu)"
-"$pkg/bin/render_cuda_gpu_tests" 2>&1 | grep -E '^\[ +(OK|FAILED|PASSED|SKIPPED) +\]|frame [0-9]+:|Failure|actual|skipped'
-gpu_rc=${PIPESTATUS[0]}
-echo "== benchmark (render_cuda_bench, $frames frames)"
-"$pkg/bin/render_cuda_bench" --frames "$frames" "$pkg/src/worlds/default.yaml" \
-  "$pkg/src/worlds/house.yaml" 2>&1 | grep -v '^\[20'
-bench_rc=${PIPESTATUS[0]}
-echo "== result: host tests rc $host_rc, gpu tests rc $gpu_rc, benchmark rc $bench_rc"
-exit $(( host_rc | gpu_rc | bench_rc ))
+# the logs of each step (CHECK_LOG_DIR to keep them, e.g. in a folder that is copied back);
+# each step has its own time limit (CHECK_LIMIT_S seconds times its share), so one slow step
+# cannot take the others' results with it
+log=${CHECK_LOG_DIR:-$work/log}
+mkdir -p "$log"
+limit=${CHECK_LIMIT_S:-60}
+card=$(nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap --format=csv,noheader 2>/dev/null || echo "none")
+cpu="$(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"
+echo "card: $card; CPU: $cpu" > "$log/card.txt"
+count() { grep -c -E "$1" "$2" || true; }
+timeout $((limit * 3)) "$pkg/bin/render_cuda_gpu_tests" > "$log/gpu.txt" 2>&1
+gpu_rc=$?
+timeout $((limit * 3 / 2)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 1,64,1024 \
+  --size 128x128 "$pkg/src/worlds/house.yaml" > "$log/batch.txt" 2>&1
+batch_rc=$?
+timeout $((limit * 2)) "$pkg/parity.sh" "$pkg/bin/render_cuda_bench" "$pkg/src/worlds" \
+  > "$log/parity.txt" 2>&1
+parity_rc=$?
+timeout $((limit * 3 / 2)) "$pkg/bin/render_cuda_bench" --frames "$frames" \
+  "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" > "$log/bench.txt" 2>&1
+bench_rc=$?
+timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 64 \
+  --size 128x128 --sessions 4 "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1
+sessions_rc=$?
+timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
+host_rc=$?
+verdict() { [ "$1" -eq 0 ] && echo "pass" || echo "FAIL (rc $1)"; }
+echo "| check | result |"
+echo "|---|---|"
+echo "| card | $card |"
+echo "| CPU | $cpu |"
+echo "| host tests (render_cuda_tests) | $(verdict $host_rc): $(count '^\[ +OK ' "$log/host.txt") ok, $(count '^\[ +FAILED +\] [A-Z]' "$log/host.txt") failed |"
+echo "| gpu tests (render_cuda_gpu_tests, label gpu) | $(verdict $gpu_rc): $(count '^\[ +OK ' "$log/gpu.txt") ok, $(count '^\[ +FAILED +\] [A-Z]' "$log/gpu.txt") failed, $(count '^\[ +SKIPPED ' "$log/gpu.txt") skipped |"
+echo "| single-camera bench | $(verdict $bench_rc) |"
+echo "| batch bench (house, 128x128) | $(verdict $batch_rc) |"
+echo "| batch bench, 4 sessions | $(verdict $sessions_rc) |"
+echo "| parity table | $(verdict $parity_rc) |"
+# the benchmark rows, cuda beside cpu: single camera (world, size, outputs, backend, timed,
+# frames/s) and batches (world, size, outputs, cameras, backend, timed, frames/s)
+awk -F'|' 'NF == 9 && $2 ~ /yaml/ {
+             gsub(/^ +| +$/, "", $7);
+             printf "| bench:%s%s%s 1 camera,%s,%s | %s frames/s |\n", $2, $3, $4, $5, $6, $7 }
+           NF == 10 && $2 ~ /yaml/ {
+             gsub(/^ +| +$/, "", $8);
+             printf "| bench:%s%s%s%s cameras,%s,%s | %s frames/s |\n", $2, $3, $4, $5, $6, $7, $8 }' \
+  "$log/bench.txt" "$log/batch.txt" "$log/sessions.txt"
+awk -F'|' '$2 ~ /pinned|pageable/ { gsub(/^ +| +$/, "", $4);
+             printf "| copy back:%s%s MiB | %s GB/s |\n", $2, $3, $4 }' "$log/batch.txt"
+echo
+echo "== failures and frame lines of the tests"
+grep -h -E 'Failure|FAILED|frame [0-9]+:|camera [0-9]+ \(|skipped' "$log/host.txt" "$log/gpu.txt" | head -60
+echo
+echo "== single camera"; grep -v '^\[20' "$log/bench.txt"
+echo
+echo "== batch"; grep -v '^\[20' "$log/batch.txt"
+echo
+echo "== batch, sessions"; grep -v '^\[20' "$log/sessions.txt"
+echo
+echo "== parity"; cat "$log/parity.txt"
+exit $(( host_rc | gpu_rc | bench_rc | batch_rc | sessions_rc | parity_rc ))

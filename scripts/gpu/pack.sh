@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # packs the CUDA backend's GPU tests and benchmark for a GPU machine without this machine's
-# packages (docs/gpu.md, "Running on a GPU machine"): render_cuda_gpu_tests, render_cuda_tests
-# and render_cuda_bench (render, scene, physics, effects, session; not the `penumbra` binary, whose
-# OpenCV codecs, ROS and viewer libraries are too large to carry), every library `ldd` lists for
-# them except the C library's own (libc, libm, libdl, libpthread, librt, ld-linux: the target's
-# newer glibc runs them) and the CUDA driver (the target's), the bundled worlds, and
-# scripts/gpu/check.sh. the binaries find the libraries through their $ORIGIN/../lib run path
-# (CMakeLists.txt). writes one xz-compressed tarball and fails if it is 64 MiB or more.
+# packages (docs/gpu.md, "The lean pack"): render_cuda_gpu_tests, render_cuda_tests and
+# render_cuda_bench (render, scene, physics, effects, session; not the `penumbra` binary, whose
+# OpenCV codecs, ROS and viewer libraries are too large to carry; linked --as-needed and with
+# textures decoded by libpng and TurboJPEG, so OpenCV's imgcodecs and its GDAL, codec and ICU
+# libraries are not loaded), every library `ldd` lists for them except the C library's own
+# (libc, libm, libdl, libpthread, librt, ld-linux: the target's newer glibc runs them) and the
+# CUDA driver (the target's), the bundled worlds, and scripts/gpu/check.sh and parity.sh. the
+# binaries find the libraries through their $ORIGIN/../lib run path (CMakeLists.txt) and the
+# worlds at the source path they were built from (recorded in source-dir.txt). writes one
+# xz-compressed tarball and fails if it is 64 MiB or more.
 #
 #   scripts/gpu/pack.sh [build-dir] [out.tar.xz]      (default: build, .gpu/penumbra-gpu.tar.xz)
 set -euo pipefail
@@ -30,13 +33,20 @@ for b in "${bins[@]}"; do ldd "$build/$b"; done |
     cp -L "$lib" "$stage/penumbra-gpu/lib/"
     strip --strip-unneeded "$stage/penumbra-gpu/lib/$(basename "$lib")" 2>/dev/null || true
   done
+if ls "$stage/penumbra-gpu/lib" | grep -q -E 'libopencv_imgcodecs|libgdal'; then
+  echo "pack: OpenCV imgcodecs / GDAL are linked again; the pack is no longer lean" >&2
+  exit 1
+fi
 # the worlds and their assets (the tests and the benchmark load worlds/*.yaml by path)
 cp -r "$root/worlds" "$stage/penumbra-gpu/src/"
-cp "$root/scripts/gpu/check.sh" "$stage/penumbra-gpu/"
+cp "$root/scripts/gpu/check.sh" "$root/scripts/gpu/parity.sh" "$stage/penumbra-gpu/"
+# the source folder the binaries were built in (PENUMBRA_SOURCE_DIR): check.sh links the
+# worlds there
+grep -m1 '^CMAKE_HOME_DIRECTORY:' "$build/CMakeCache.txt" | cut -d= -f2 > "$stage/penumbra-gpu/source-dir.txt"
 mkdir -p "$(dirname "$out")"
 tar -C "$stage" -cf - penumbra-gpu | xz -T2 -9 > "$out"
 size=$(stat -c %s "$out")
-echo "pack: $out, $((size / 1024 / 1024)) MiB, $(ls "$stage/penumbra-gpu/lib" | wc -l) libraries"
+echo "pack: $out, $((size / 1024 / 1024)) MiB ($size bytes), $(ls "$stage/penumbra-gpu/lib" | wc -l) libraries"
 if [ "$size" -ge $((64 * 1024 * 1024)) ]; then
   echo "pack: $out is 64 MiB or more: too large to carry" >&2
   exit 1

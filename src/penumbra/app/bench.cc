@@ -12,10 +12,15 @@
 #include "penumbra/physics/controller_cost_benchmark.h"
 #include "penumbra/physics/physics_benchmark.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
+#if defined(PENUMBRA_WITH_CUDA)
+#include "penumbra/render/cuda/cuda_batch_bench.h"
+#include "penumbra/render/cuda/cuda_batch_kernels.h"
+#endif
 
 namespace penumbra {
 namespace {
@@ -28,6 +33,59 @@ std::string BenchComposedPath() {
       std::filesystem::temp_directory_path() / fmt::format("penumbra_bench_{}", ::getpid());
   std::filesystem::create_directories(dir);
   return (dir / "composed.xml").string();
+}
+
+// `bench render --batch N`: N cameras over options.sessions sessions of `world` in one launch
+// (render/cuda/cuda_batch_bench.h), beside the CPU backend rendering the same views
+int BenchRenderBatch(const WorldConfig& world, const RenderBenchOptions& options) {
+  if (ResolveBackend(world.render.backend) != RenderSettings::Backend::kCuda)
+    throw ConfigError("", 0, "--batch",
+                      "batch rendering runs on the CUDA backend; expected --backend cuda (or "
+                      "auto on a machine with a CUDA device; docs/gpu.md)");
+#if defined(PENUMBRA_WITH_CUDA)
+  std::vector<std::unique_ptr<Session>> sessions;
+  std::vector<cuda::BatchBenchWorld> worlds;
+  SessionOptions so;
+  so.build_renderer = false;
+  so.add_controllers = false;
+  for (int s = 0; s < options.sessions; ++s) {
+    sessions.push_back(std::make_unique<Session>(world, so));
+    Simulation& sim = sessions.back()->sim();
+    while (sim.time() < 1.0) sim.Step();
+    const SceneDescription& scene = sessions.back()->scene();
+    if (scene.cameras.empty())
+      throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
+    cuda::BatchBenchWorld w;
+    w.scene = &scene;
+    w.snapshot = sim.Snapshot();
+    const CameraSpec& cam = scene.cameras.front();
+    w.view.X_WO = CameraPoseInWorld(cam, w.snapshot);
+    w.view.intrinsics = cam.intrinsics;
+    w.view.near_m = cam.near_m;
+    worlds.push_back(w);
+  }
+  // the CPU backend on all cores (or --threads), one renderer: the sessions are the same world
+  RenderSettings cpu_settings = world.render;
+  cpu_settings.backend = RenderSettings::Backend::kEmbree;
+  cpu_settings.threads = options.threads;
+  const std::unique_ptr<Renderer> cpu = MakeRenderer(sessions.front()->scene(), cpu_settings);
+  for (cuda::BatchBenchWorld& w : worlds) w.cpu = cpu.get();
+  const CudaDeviceStatus dev = ProbeCudaDevice();
+  fmt::print("penumbra bench render --batch {}: world {}, {} session(s), device {}\n",
+             options.batch, world.file, options.sessions, dev.name);
+  const cuda::BatchOutputs outputs;
+  const int counts[] = {options.batch};
+  const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
+      worlds, options.batch_width, options.batch_height, counts, options.frames, outputs);
+  const std::string name = world.file.substr(world.file.find_last_of('/') + 1);
+  fmt::print(
+      "{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height, outputs, rows));
+  return 0;
+#else
+  throw ConfigError("", 0, "--batch",
+                    "this penumbra was built without the CUDA backend (no nvcc at build time); "
+                    "expected a build with CUDA (docs/gpu.md)");
+#endif
 }
 
 }  // namespace
@@ -67,8 +125,8 @@ int BenchRender(const RenderBenchOptions& options) {
   world.render.threads = options.threads;
   world.render.tier = options.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
                                                    : RenderSettings::Tier::kRealtime;
-  if (!options.backend.empty())
-    world.render.backend = RenderSettings::BackendFromName(options.backend);
+  if (options.backend) world.render.backend = *options.backend;
+  if (options.batch > 0) return BenchRenderBatch(world, options);
   Session session(world);  // session/session.h
   Simulation& sim = session.sim();
   const SceneDescription& scene = session.scene();

@@ -2,7 +2,10 @@
 // `penumbra bench render|physics`: throughput measurements on real worlds. these
 // are benchmarks, never pass/fail tests; they print numbers and targets.
 
+#include <optional>
 #include <string>
+
+#include "penumbra/render/render_settings.h"
 
 namespace penumbra {
 
@@ -13,7 +16,14 @@ struct RenderBenchOptions {
   int warmup_frames = 5;   ///< untimed frames first
   int threads = 0;         ///< render threads, 0 = all cores
   std::string tier = "realtime";
-  std::string backend;    ///< cpu, cuda or auto; "" = the world's render.backend
+  /// --backend; nullopt = the world's render.backend.
+  std::optional<RenderSettings::Backend> backend;
+  /// --batch N: batch rendering (render/cuda/cuda_batch_renderer.h) of N cameras per launch
+  /// instead (backend cuda); 0 = the single-camera benchmark.
+  int batch = 0;
+  int batch_width = 128;  ///< --size WxH of the batch benchmark
+  int batch_height = 128;
+  int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
   bool adversity = true;  ///< also time the presets none/minor/major (app/effects_bench.h)
 };
 

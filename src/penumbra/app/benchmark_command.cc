@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "penumbra/app/backend_flag.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/benchmark/benchmark_runner.h"
 #include "penumbra/core/error.h"
@@ -28,6 +29,7 @@ struct BenchmarkCommands::State {
   std::string spec, out;
   int workers = 0, job = -1;
   bool slurm = false, force = false, quiet = false;
+  BackendFlag backend;  // --backend: every job's replay or run
   std::string method, dataset, trajectory, intrinsics, camera_info, camera;
   double min_depth_m = 0.2, max_depth_m = 6.0;
 };
@@ -104,6 +106,7 @@ BenchmarkCommands::BenchmarkCommands(CLI::App& app) : state_(std::make_unique<St
       ->add_option("--job", s.job,
                    "run only job K (the worker side; used by local workers and Slurm)")
       ->check(CLI::Range(0, 1000000));
+  s.backend.Add(s.benchmark, "each world's render.backend");
 
   s.slam =
       app.add_subcommand("slam", "run a bundled RGB-D odometry method over a TUM RGB-D folder");
@@ -135,10 +138,12 @@ bool BenchmarkCommands::Selected() const { return *state_->benchmark || *state_-
 int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
   const State& s = *state_;
   if (*s.benchmark) {
+    s.backend.Resolve();  // cuda without a device: refused before anything runs
     if (s.job >= 0) {
       if (s.slurm)
         throw ConfigError("", 0, "--job", "not with --slurm (a worker runs one job here)");
-      return RunBenchmarkWorker(s.spec, s.out, s.job, SelfExecutable(), stop_request);
+      return RunBenchmarkWorker(s.spec, s.out, s.job, SelfExecutable(), stop_request,
+                                s.backend.text());
     }
     BenchmarkOptions o;
     o.spec_path = s.spec;
@@ -147,6 +152,7 @@ int BenchmarkCommands::Run(const std::atomic<int>* stop_request) const {
     o.workers = s.workers;
     o.slurm = s.slurm;
     o.force = s.force;
+    o.backend = s.backend.text();
     o.progress = !s.quiet;
     o.record = RecordRoute;
     o.stop_request = stop_request;

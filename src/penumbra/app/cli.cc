@@ -16,6 +16,7 @@
 #include <limits>
 #include <optional>
 
+#include "penumbra/app/backend_flag.h"
 #include "penumbra/app/bench.h"
 #include "penumbra/app/bench_bridge.h"
 #include "penumbra/app/bench_record.h"
@@ -262,11 +263,8 @@ int RunCli(int argc, char** argv) {
       "simulated seconds (overrides duration_sec)");
   run->add_flag("--realtime", run_options.realtime, "pace physics to wall-clock time");
   run->add_option("--tier", tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
-  std::string backend;
-  run->add_option("--backend", backend,
-                  "render backend: cpu, cuda (an NVIDIA GPU) or auto (cuda when a CUDA device is "
-                  "present; overrides render.backend; docs/gpu.md)")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  BackendFlag run_backend;
+  run_backend.Add(run);
   AddInteger(run, "--spp", &spp, 1, 65536, "samples per pixel (pathtraced)");
   AddInteger(run, "--threads", &threads, 0, 256, "render threads (0 = all cores)");
   AddUint64(run, "--seed", &seed, "world seed (overrides seed)");
@@ -314,9 +312,27 @@ int RunCli(int argc, char** argv) {
   AddInteger(bench_render, "--threads", &render_bench.threads, 0, 256,
              "render threads (0 = all cores)");
   bench_render->add_option("--tier", render_bench.tier, "render tier")->check(CLI::IsMember({"realtime", "pathtraced"}));
-  bench_render->add_option("--backend", render_bench.backend,
-                           "render backend: cpu, cuda or auto (default: the world's; docs/gpu.md)")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  BackendFlag bench_render_backend;
+  bench_render_backend.Add(bench_render);
+  AddInteger(bench_render, "--batch", &render_bench.batch, 1, 65535,
+             "batch rendering: N cameras per launch on the CUDA backend (depth+seg; "
+             "docs/gpu.md)");
+  std::string bench_size;
+  bench_render->add_option("--size", bench_size, "WxH of each camera in --batch (default 128x128)")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            const size_t x = v.find('x');
+            const std::optional<uint64_t> w =
+                x == std::string::npos ? std::nullopt : ParseUnsigned(v.substr(0, x));
+            const std::optional<uint64_t> h =
+                x == std::string::npos ? std::nullopt : ParseUnsigned(v.substr(x + 1));
+            if (!w || !h || *w < 1 || *h < 1 || *w > 16384 || *h > 16384)
+              return "'" + v + "' is not WxH with W and H in [1, 16384], e.g. 128x128";
+            return "";
+          },
+          "WxH", ""));
+  AddInteger(bench_render, "--sessions", &render_bench.sessions, 1, 64,
+             "--batch: spread the cameras over this many sessions of the world (default 1)");
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
   // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
@@ -345,6 +361,8 @@ int RunCli(int argc, char** argv) {
   AddInteger(sheet, "--height", &sheet_options.height, 16, 4096, "frame height");
   sheet->add_option("--out,-o", sheet_options.out, "output PNG (default docs/effects.png)");
   AddInteger(sheet, "--threads", &sheet_options.threads, 0, 256, "render threads (0 = all cores)");
+  BackendFlag sheet_backend;
+  sheet_backend.Add(sheet, "each world's render.backend");
   // penumbra npc-map (app/npc_map_command.h)
   CLI::App* npc_map = app.add_subcommand("npc-map", "the walkable map of a world's NPCs (people, vehicles, areas, lanes) as a PNG");
   NpcMapOptions npc_map_options;
@@ -413,6 +431,8 @@ int RunCli(int argc, char** argv) {
                    "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME");
   view->add_flag("--running", view_options.running, "start running instead of paused");
   view->add_flag("--force", view_options.force, "--out may hold an earlier run's outputs");
+  BackendFlag view_backend;
+  view_backend.Add(view);
   CLI::App* bench_sensors = bench->add_subcommand("sensors", "LiDAR rays/s and ms/scan, IMU/MuJoCo sensor overhead");
   SensorBenchOptions sensor_bench;
   bench_sensors->add_option("--world", sensor_bench.world_file, "world file (default: bundled default world)");
@@ -453,7 +473,7 @@ int RunCli(int argc, char** argv) {
         world.render.tier = tier == "pathtraced" ? RenderSettings::Tier::kPathtraced : RenderSettings::Tier::kRealtime;
       if (spp > 0) world.render.samples_per_pixel = spp;
       if (threads >= 0) world.render.threads = threads;
-      if (!backend.empty()) world.render.backend = RenderSettings::BackendFromName(backend);
+      run_backend.Apply(&world.render);
       run_options.progress = !quiet;
       run_options.command_line = Args(argc, argv);
       if (!outputs.empty() || run->count("--outputs"))
@@ -495,9 +515,23 @@ int RunCli(int argc, char** argv) {
     }
     if (*bench_render) {
       render_bench.adversity = !no_adversity;
+      render_bench.backend = bench_render_backend.Resolve();
+      if (!bench_size.empty() || bench_render->count("--sessions") > 0) {
+        if (render_bench.batch == 0)
+          throw ConfigError("", 0, bench_size.empty() ? "--sessions" : "--size",
+                            "applies to --batch only; expected it with --batch N");
+      }
+      if (!bench_size.empty()) {
+        const size_t x = bench_size.find('x');
+        render_bench.batch_width = static_cast<int>(*ParseUnsigned(bench_size.substr(0, x)));
+        render_bench.batch_height = static_cast<int>(*ParseUnsigned(bench_size.substr(x + 1)));
+      }
       return BenchRender(render_bench);
     }
-    if (*sheet) return MakeContactSheet(sheet_options);
+    if (*sheet) {
+      sheet_options.backend = sheet_backend.Resolve();
+      return MakeContactSheet(sheet_options);
+    }
     if (*npc_map) return WriteNpcMap(npc_map_options);
     if (*hfield) {
       if (!hfield_extent.empty())
@@ -523,7 +557,9 @@ int RunCli(int argc, char** argv) {
     if (*decompose->decompose) return decompose->RunDecompose();
     if (*bench_viewer) return BenchViewer(viewer_bench);
     if (*view) {
-      const WorldConfig world = LoadWorldOrModel(view_world);
+      const std::optional<RenderSettings::Backend> backend = view_backend.Resolve();
+      WorldConfig world = LoadWorldOrModel(view_world);
+      if (backend) world.render.backend = *backend;
       view_options.command_line = Args(argc, argv);
       g_stop_signal.store(0);
       const StopSignals stop_signals;

@@ -58,6 +58,7 @@ int MakeContactSheet(const ContactSheetOptions& o) {
   for (int r = 0; r < rows; ++r) {
     WorldConfig world = LoadWorldFile(worlds[r]);
     world.render.threads = o.threads;
+    if (o.backend) world.render.backend = *o.backend;
     const int y0 = r * (row_h + kGap);
     for (int i = 0; i < n; ++i) {
       PresetScene p = LoadPresetScene(world, o.presets[i]);

@@ -3,8 +3,11 @@
 // presets, side by side with the preset names above, as one PNG (docs/effects.png); several
 // worlds give one row each (docs/environments.png).
 
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "penumbra/render/render_settings.h"
 
 namespace penumbra {
 
@@ -17,6 +20,8 @@ struct ContactSheetOptions {
   int width = 640, height = 480;  ///< size of each frame (the world camera's field of view)
   std::string out = "docs/effects.png";
   int threads = 0;  ///< render threads, 0 = all cores
+  /// --backend; nullopt = each world's render.backend.
+  std::optional<RenderSettings::Backend> backend;
 };
 
 /// renders each world's first camera at time_sec under every preset and writes the sheet: one

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "penumbra/app/backend_flag.h"
 #include "penumbra/core/error.h"
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/export_stop.h"
@@ -25,6 +26,7 @@ struct ExportCommand::State {
   std::string replay_adversity;
   std::string depth = "sensor";  // --depth: sensor | ground-truth
   CLI::Option* depth_option = nullptr;
+  BackendFlag backend;  // --backend for a .plog input's replay
 };
 
 namespace {
@@ -51,7 +53,8 @@ class TempFolder {
 // @throws ExportStopped when the stop request ended the replay.
 std::filesystem::path ReplayLogBeside(
     const std::string& log_path, const std::string& world_override, const std::string& adversity,
-    ReplayDepth depth, const std::filesystem::path& out, const std::atomic<int>* stop_request,
+    std::optional<RenderSettings::Backend> backend, ReplayDepth depth,
+    const std::filesystem::path& out, const std::atomic<int>* stop_request,
     std::optional<TempFolder>* replayed, ReplaySummary* summary_out = nullptr) {
   replayed->emplace(MakeSiblingTempFolder(out, ".replay-tmp"));
   ReplayOptions replay;
@@ -59,6 +62,7 @@ std::filesystem::path ReplayLogBeside(
   replay.out_dir = (*replayed)->path().string();
   replay.world_override = world_override;
   replay.adversity = adversity;
+  replay.backend = backend;
   replay.progress = false;
   replay.stop_request = stop_request;
   replay.depth = depth;
@@ -68,6 +72,13 @@ std::filesystem::path ReplayLogBeside(
   if (summary.interrupted) throw ExportStopped(stop_request ? stop_request->load() : SIGINT);
   CheckExportStop(stop_request);
   return (*replayed)->path();
+}
+
+// --backend with a run folder: nothing is rendered
+ConfigError BackendNotForRunFolder() {
+  return ConfigError("", 0, "--backend",
+                     "only for a run log (.plog) input, whose replay renders; a run folder's "
+                     "images are exported as they were written");
 }
 
 // the exit code and message of a stopped export
@@ -88,6 +99,7 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
   namespace fs = std::filesystem;
   const fs::path input(s.input);
   if (s.format == "rosbag") return RunRosbag(stop_request);
+  const std::optional<RenderSettings::Backend> backend = s.backend.Resolve();
   DatasetExportOptions options = s.options;
   options.format = ParseDatasetFormat(s.format);
   options.out_dir = s.out;
@@ -105,7 +117,7 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
     const bool truth = s.depth == "ground-truth";
     ReplaySummary replay;
     try {
-      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity,
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, backend,
                                 truth ? ReplayDepth::kGroundTruth : ReplayDepth::kSensor,
                                 options.out_dir, stop_request, &replayed, &replay);
     } catch (const ExportStopped& e) {
@@ -132,6 +144,7 @@ int ExportCommand::Run(const std::atomic<int>* stop_request) const {
     if (!s.replay_world.empty() || !s.replay_adversity.empty())
       throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
                         "only for a run log (.plog) input, which is replayed first");
+    if (s.backend.given()) throw BackendNotForRunFolder();
     // a run folder's depth is what its camera wrote; the model is chosen at replay
     if (s.depth_option && s.depth_option->count() > 0)
       throw ConfigError("", 0, "--depth",
@@ -169,6 +182,7 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   namespace fs = std::filesystem;
   const fs::path input(s.input);
   const fs::path bag(s.out);
+  const std::optional<RenderSettings::Backend> backend = s.backend.Resolve();
   if (!s.options.camera.empty() || !s.options.camera2.empty() || !s.options.imu.empty())
     throw ConfigError("", 0,
                       !s.options.camera.empty()
@@ -193,7 +207,7 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "' exists; expected a new file (never overwritten)");
     try {
-      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity,
+      run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, backend,
                                 ReplayDepth::kAsRecorded, bag, stop_request, &replayed);
     } catch (const ExportStopped& e) {
       return Stopped(e, s.out);
@@ -201,6 +215,8 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   } else if (!s.replay_world.empty() || !s.replay_adversity.empty()) {
     throw ConfigError("", 0, s.replay_world.empty() ? "--adversity" : "--world",
                       "only for a run log (.plog) input, which is replayed first");
+  } else if (s.backend.given()) {
+    throw BackendNotForRunFolder();
   }
   RosbagExportSummary summary;
   try {
@@ -230,6 +246,7 @@ ExportCommand AddExportCommand(CLI::App& app) {
                         "to add depth to a camera");
   s.command->add_option("--adversity", s.replay_adversity,
                         "for a .plog: adversity preset of the replay (replay --adversity)");
+  s.backend.Add(s.command, "the recorded render.backend (for a .plog input)");
   s.command->add_option("--format,-f", s.format, "dataset layout")
       ->required()
       ->check(CLI::IsMember({"tum", "euroc", "kitti", "rosbag"}));

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <optional>
 
+#include "penumbra/app/backend_flag.h"
 #include "penumbra/app/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
@@ -25,6 +26,7 @@ struct ReplayCommand::State {
   std::optional<double> from_sec, to_sec;
   bool quiet = false;
   int threads = -1;
+  BackendFlag backend;
 };
 
 namespace {
@@ -83,6 +85,7 @@ ReplayCommand::ReplayCommand(CLI::App& app) : state_(std::make_unique<State>()) 
                 "images of every camera, comma-separated: rgb, depth, segmentation, range, "
                 "normals, instance_segmentation, semantic_segmentation (default: as recorded)");
   r->add_flag("--quiet,-q", s.quiet, "no progress output");
+  s.backend.Add(r, "as recorded");
   s.resimulate_option =
       r->add_option("--resimulate", s.resimulate,
                     "re-run physics from the log and check every step: `--resimulate` runs the "
@@ -104,7 +107,7 @@ int ReplayCommand::Run(const std::vector<std::string>& command_line,
   if (s.resimulate_option->count() > 0) {
     // physics only: the options that change what is seen do not apply
     for (const char* flag : {"--adversity", "--world", "--tier", "--cameras", "--from", "--to",
-                             "--threads", "--outputs"})
+                             "--threads", "--outputs", "--backend"})
       if (r->count(flag) > 0)
         throw ConfigError("", 0, flag,
                           "does not apply to --resimulate, which re-runs the recorded physics "
@@ -140,6 +143,7 @@ int ReplayCommand::Run(const std::vector<std::string>& command_line,
   o.from_sec = s.from_sec;
   o.to_sec = s.to_sec;
   o.threads = s.threads;
+  o.backend = s.backend.Resolve();
   o.progress = !s.quiet;
   o.stop_request = stop_request;
   o.command_line = command_line;

@@ -13,11 +13,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <set>
 #include <tuple>
 
+#include "penumbra/assets/image_decode.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/image_file_limits.h"
 
@@ -223,22 +222,12 @@ void StoreTexels(TextureMap map, float param, std::vector<uint8_t>* rgb) {
 std::shared_ptr<const TextureImage> DecodeTextureImage(const std::vector<unsigned char>& bytes,
                                                        TextureMap map, float param,
                                                        const std::string& what) {
-  cv::Mat img;
   // the declared size against the caps before decoding
   CheckImageBytesSize(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
                       what);
-  if (!bytes.empty()) img = cv::imdecode(bytes, cv::IMREAD_COLOR);
-  if (img.empty() || img.cols < 1 || img.rows < 1)
-    throw Error(what + ": not a readable image (" + std::to_string(bytes.size()) +
-                " bytes); expected a PNG or JPEG file");
-  cv::Mat rgb;
-  cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
-  std::vector<uint8_t> data(rgb.total() * 3);
-  for (int y = 0; y < rgb.rows; ++y)
-    std::copy_n(rgb.ptr<uint8_t>(y), static_cast<size_t>(rgb.cols) * 3,
-                data.data() + static_cast<size_t>(y) * rgb.cols * 3);
-  StoreTexels(map, param, &data);
-  return std::make_shared<const TextureImage>(rgb.cols, rgb.rows, 1, std::move(data));
+  DecodedRgb8 img = DecodeImageRgb8(bytes, what);  // assets/image_decode.h
+  StoreTexels(map, param, &img.rgb);
+  return std::make_shared<const TextureImage>(img.width, img.height, 1, std::move(img.rgb));
 }
 
 ImportedAsset ImportMeshFile(const std::string& path, const MeshImportConfig& config) {

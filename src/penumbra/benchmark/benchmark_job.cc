@@ -157,6 +157,8 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
   replay.tier = spec.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
                                           : RenderSettings::Tier::kRealtime;
   replay.threads = spec.render_threads;
+  if (!context.backend.empty())
+    replay.backend = RenderSettings::BackendFromName(context.backend);
   replay.cameras = {world.camera_name};
   replay.progress = false;
   replay.stop_request = context.stop_request;

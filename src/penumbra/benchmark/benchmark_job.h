@@ -69,6 +69,8 @@ struct BenchmarkJobContext {
   std::string out_dir;          ///< the benchmark's output folder
   std::string penumbra_binary;  ///< {penumbra}
   const std::atomic<int>* stop_request = nullptr;
+  /// the render backend of the job's replay or run ("cpu", "cuda", "auto"; "" = the world's).
+  std::string backend;
 };
 
 /// the jobs of a spec, in index order (a nav spec's: PlanNavJobs).

@@ -82,9 +82,15 @@ pid_t SpawnWorker(const BenchmarkOptions& o, const std::string& spec_path, const
     dup2(fd, 1);
     dup2(fd, 2);
     const std::string index = std::to_string(j.index);
-    execl(o.penumbra_binary.c_str(), o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(),
-          "--out", o.out_dir.c_str(), "--job", index.c_str(), "--quiet",
-          static_cast<char*>(nullptr));
+    std::vector<const char*> argv = {
+        o.penumbra_binary.c_str(), "benchmark", spec_path.c_str(), "--out",
+        o.out_dir.c_str(),         "--job",     index.c_str(),     "--quiet"};
+    if (!o.backend.empty()) {
+      argv.push_back("--backend");
+      argv.push_back(o.backend.c_str());
+    }
+    argv.push_back(nullptr);
+    execv(o.penumbra_binary.c_str(), const_cast<char* const*>(argv.data()));
     _exit(127);
   }
   setpgid(pid, pid);
@@ -176,7 +182,7 @@ std::vector<std::string> RunSlurm(const BenchmarkOptions& o, const BenchmarkSpec
   const fs::path dir = fs::path(o.out_dir) / "slurm";
   fs::create_directories(dir);
   const fs::path script = dir / "array.sbatch";
-  WriteText(script, SlurmBatchScript(spec, o.out_dir, o.penumbra_binary, pending));
+  WriteText(script, SlurmBatchScript(spec, o.out_dir, o.penumbra_binary, pending, o.backend));
   int code = 0;
   const std::optional<std::string> submitted =
       CaptureCommand({"sbatch", "--parsable", script.string()}, /*merge_stderr=*/true, &code);
@@ -251,7 +257,8 @@ void CheckSlurmPaths(const std::string& out_dir, const std::string& spec_file,
 }
 
 std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_dir,
-                             const std::string& penumbra_binary, const std::vector<int>& indices) {
+                             const std::string& penumbra_binary, const std::vector<int>& indices,
+                             const std::string& backend) {
   std::string array;
   for (int i : indices) {
     if (!array.empty()) array += ',';
@@ -271,13 +278,15 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
       spec.name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
   for (const std::string& l : spec.sbatch_lines) s += fmt::format("{}\n", l);
   s += "# one benchmark job (world x condition x trial) per array task; docs/benchmarks.md\n";
-  s += fmt::format("exec {} benchmark {} --out {} --job \"$SLURM_ARRAY_TASK_ID\" --quiet\n",
-                   ShellQuote(penumbra_binary), ShellQuote(spec.file), ShellQuote(out));
+  s += fmt::format("exec {} benchmark {} --out {} --job \"$SLURM_ARRAY_TASK_ID\" --quiet{}\n",
+                   ShellQuote(penumbra_binary), ShellQuote(spec.file), ShellQuote(out),
+                   backend.empty() ? "" : " --backend " + ShellQuote(backend));
   return s;
 }
 
 int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir, int index,
-                       const std::string& penumbra_binary, const std::atomic<int>* stop_request) {
+                       const std::string& penumbra_binary, const std::atomic<int>* stop_request,
+                       const std::string& backend) {
   const BenchmarkSpec spec = LoadBenchmarkSpec(spec_path);
   const fs::path copy = fs::path(out_dir) / "spec.yaml";
   std::error_code ec;
@@ -295,6 +304,7 @@ int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir,
   context.out_dir = out_dir;
   context.penumbra_binary = penumbra_binary;
   context.stop_request = stop_request;
+  context.backend = backend;
   const BenchmarkJob& job = jobs[index];
   try {
     if (spec.kind == "nav") {

@@ -31,6 +31,9 @@ struct BenchmarkOptions {
   bool slurm = false;           ///< submit a Slurm job array instead of local workers
   bool force = false;           ///< remove an earlier benchmark's outputs from out_dir first
   bool progress = true;
+  /// the render backend of every job ("cpu", "cuda", "auto"; `penumbra benchmark --backend`),
+  /// passed to each worker as --backend; "" = the worlds' render.backend.
+  std::string backend;
   RecordRouteFn record;
   const std::atomic<int>* stop_request = nullptr;
 };
@@ -53,8 +56,10 @@ int RunBenchmark(const BenchmarkOptions& options);
 /// returns 0, or 128 + the signal when *stop_request interrupted the job (its folder is then
 /// removed: no partial job is left).
 /// @throws ConfigError for an index out of range; what RunBenchmarkJob throws.
+/// `backend` ("" = the worlds' render.backend) renders the job's replay or run.
 int RunBenchmarkWorker(const std::string& spec_path, const std::string& out_dir, int index,
-                       const std::string& penumbra_binary, const std::atomic<int>* stop_request);
+                       const std::string& penumbra_binary, const std::atomic<int>* stop_request,
+                       const std::string& backend = "");
 
 /// checks what a Slurm batch script interpolates: `out_dir` (absolute; it goes into the
 /// `#SBATCH --output=` line and the command line), the spec file and the binary (the command
@@ -68,10 +73,12 @@ void CheckSlurmPaths(const std::string& out_dir, const std::string& spec_file,
 
 /// the Slurm batch script for the unfinished jobs `indices` (also written by RunBenchmark
 /// as OUT/slurm/array.sbatch). every interpolated path is checked (CheckSlurmPaths) and the
-/// command line's words are quoted with ShellQuote (benchmark/shell_quote.h).
+/// command line's words are quoted with ShellQuote (benchmark/shell_quote.h). `backend` (""
+/// = none) is passed to each task as --backend.
 /// @throws ConfigError as CheckSlurmPaths, or for an extra `#SBATCH` line holding a control
 ///         character.
 std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_dir,
-                             const std::string& penumbra_binary, const std::vector<int>& indices);
+                             const std::string& penumbra_binary, const std::vector<int>& indices,
+                             const std::string& backend = "");
 
 }  // namespace penumbra

@@ -288,6 +288,10 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                                      std::to_string(spec.render_threads),
                                      "--override",
                                      (dir / "override.yaml").string()};
+    if (!context.backend.empty()) {
+      argv.push_back("--backend");
+      argv.push_back(context.backend);
+    }
     if (ep.has_start) {
       argv.push_back("--start-pose");
       argv.push_back(w.robot + "," + NavNum(ep.start_x) + "," + NavNum(ep.start_y) + "," +

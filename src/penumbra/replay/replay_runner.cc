@@ -112,6 +112,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     adversity = ParseRecordedRunFlags(header.command_line).adversity;
   if (options.tier) world.render.tier = *options.tier;
   if (options.threads >= 0) world.render.threads = options.threads;
+  if (options.backend) world.render.backend = *options.backend;
   if (options.outputs) {
     for (CameraConfig& c : world.cameras) c.outputs = *options.outputs;
     world.mjcf_cameras.outputs = *options.outputs;

@@ -42,6 +42,8 @@ struct ReplayOptions {
   std::string world_override;
   std::optional<RenderSettings::Tier> tier;  ///< --tier; nullopt = as recorded
   int threads = -1;                          ///< render threads, -1 = as recorded (0 = all cores)
+  /// --backend: the render backend (render.backend); nullopt = as recorded.
+  std::optional<RenderSettings::Backend> backend;
   /// --outputs: replaces the outputs of every camera; nullopt = as recorded. outputs_text is
   /// the list as given, for run.json.
   std::optional<CameraOutputs> outputs;

@@ -6,8 +6,15 @@
 //   - cuda depth+seg, kernel: the primary-ray kernel alone (CUDA events, images stay on the GPU);
 //   - cuda all ground truth (depth, seg, instance, semantic, range, normals), Render();
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
-// and the BVH build time. prints one markdown table. usage:
-//   render_cuda_bench [--frames N] [world.yaml ...]
+// and the BVH build time. prints one markdown table.
+// --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
+// batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
+// depth+seg, pinned and pageable copies, the kernel alone and the CPU backend; then the
+// device-to-host copy rates, pinned and pageable.
+// --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
+// 320x240; scripts/gpu/parity.sh). usage:
+//   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity]
+//                     [world.yaml ...]
 
 #include <fmt/format.h>
 
@@ -20,10 +27,13 @@
 
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/cuda/cuda_batch_bench.h"
+#include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
+#include "render/cuda/cuda_parity.h"
 
 namespace penumbra {
 namespace {
@@ -44,13 +54,103 @@ double TimeRenders(Renderer* r, const WorldSnapshot& snap, const CameraView& vie
   return std::chrono::duration<double>(Clock::now() - t0).count() / frames;
 }
 
+// a positive integer argument, or 0
+int PositiveArg(const std::string& s) {
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  return end && *end == '\0' && v > 0 && v < (1 << 30) ? static_cast<int>(v) : 0;
+}
+
+// --batch: K cameras over `sessions` sessions of each world, in batches
+int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& counts, int width,
+              int height, int sessions, int frames) {
+  for (const std::string& file : worlds) {
+    std::vector<std::unique_ptr<Session>> owned;
+    std::vector<std::unique_ptr<Renderer>> cpus;
+    std::vector<cuda::BatchBenchWorld> bench_worlds;
+    for (int s = 0; s < sessions; ++s) {
+      SessionOptions so;
+      so.build_renderer = false;
+      so.add_controllers = false;
+      owned.push_back(std::make_unique<Session>(LoadWorldFile(file), so));
+      Simulation& sim = owned.back()->sim();
+      while (sim.time() < 1.0) sim.Step();
+      const SceneDescription& scene = owned.back()->scene();
+      RenderSettings cpu_settings;
+      cpu_settings.backend = RenderSettings::Backend::kEmbree;
+      cpu_settings.threads = 0;
+      cpus.push_back(MakeRenderer(scene, cpu_settings));
+      cuda::BatchBenchWorld w;
+      w.scene = &scene;
+      w.snapshot = sim.Snapshot();
+      const CameraSpec& cam = scene.cameras.front();
+      w.view.X_WO = CameraPoseInWorld(cam, w.snapshot);
+      w.view.intrinsics = cam.intrinsics;
+      w.view.near_m = cam.near_m;
+      w.cpu = s == 0 ? cpus.back().get() : nullptr;  // the CPU row: one session's renderer
+      bench_worlds.push_back(w);
+    }
+    if (sessions > 1)
+      for (cuda::BatchBenchWorld& w : bench_worlds) w.cpu = cpus.front().get();
+    cuda::BatchOutputs outputs;
+    const std::vector<cuda::BatchBenchRow> rows =
+        cuda::RunBatchBench(bench_worlds, width, height, counts, frames, outputs);
+    const std::string name = file.substr(file.find_last_of('/') + 1);
+    fmt::print("\n{}", cuda::FormatBatchBench(
+                           sessions > 1 ? fmt::format("{} x{} sessions", name, sessions) : name,
+                           width, height, outputs, rows));
+  }
+  fmt::print("\n| copy back, device to host | MiB | GB/s |\n|---|---:|---:|\n");
+  for (const int64_t mib : {1, 16, 128}) {
+    const cuda::CopyRates r = cuda::MeasureCopyRates(mib << 20, 20);
+    fmt::print("| pinned (cudaMallocHost) | {} | {:.1f} |\n", mib, r.pinned_gbps);
+    fmt::print("| pageable (new[]) | {} | {:.1f} |\n", mib, r.pageable_gbps);
+  }
+  return 0;
+}
+
 int Main(int argc, char** argv) {
   int frames = 50;
+  int width = 0, height = 0, sessions = 1;
+  bool parity = false;
+  std::vector<int> batch;
   std::vector<std::string> worlds;
+  const auto usage = [](const std::string& why) {
+    fmt::print(stderr,
+               "render_cuda_bench: {}\nusage: render_cuda_bench [--frames N] [--batch N,... "
+               "[--size WxH] [--sessions S] | --parity [--size WxH]] [world.yaml ...]\n",
+               why);
+    return 2;
+  };
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) {
-      frames = std::atoi(argv[++i]);
+    const bool has_value = i + 1 < argc;
+    if (a == "--frames" && has_value) {
+      frames = PositiveArg(argv[++i]);
+      if (frames == 0) return usage("--frames: expected a positive integer");
+    } else if (a == "--sessions" && has_value) {
+      sessions = PositiveArg(argv[++i]);
+      if (sessions == 0) return usage("--sessions: expected a positive integer");
+    } else if (a == "--size" && has_value) {
+      const std::string v = argv[++i];
+      const size_t x = v.find('x');
+      width = x == std::string::npos ? 0 : PositiveArg(v.substr(0, x));
+      height = x == std::string::npos ? 0 : PositiveArg(v.substr(x + 1));
+      if (width == 0 || height == 0) return usage("--size '" + v + "': expected WxH, e.g. 128x128");
+    } else if (a == "--batch" && has_value) {
+      std::string v = argv[++i];
+      size_t pos = 0;
+      while (pos <= v.size()) {
+        const size_t end = std::min(v.find(',', pos), v.size());
+        const int k = PositiveArg(v.substr(pos, end - pos));
+        if (k == 0 || k > 65535) return usage("--batch '" + v + "': expected N[,N...], 1 to 65535");
+        batch.push_back(k);
+        pos = end + 1;
+      }
+    } else if (a == "--parity") {
+      parity = true;
+    } else if (a.rfind("--", 0) == 0) {
+      return usage("unknown option '" + a + "'");
     } else {
       worlds.push_back(a);
     }
@@ -60,6 +160,22 @@ int Main(int argc, char** argv) {
               std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml"};
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("device: {}\n", dev.available ? dev.name : "none (" + dev.why + ")");
+  if ((parity || !batch.empty()) && !dev.available) {
+    fmt::print(stderr, "render_cuda_bench: --batch and --parity need a CUDA device\n");
+    return 1;
+  }
+  if (parity) {
+    if (width == 0) width = 320, height = 240;
+    std::vector<cuda_parity::ParityRow> rows;
+    for (const std::string& w : worlds)
+      rows.push_back(cuda_parity::MeasureParity(w, width, height));
+    fmt::print("\n{}", cuda_parity::FormatParity(rows, width, height));
+    return 0;
+  }
+  if (!batch.empty()) {
+    if (width == 0) width = height = 128;
+    return BatchMain(worlds, batch, width, height, sessions, frames);
+  }
   std::vector<Row> rows;
   std::vector<std::string> builds;
   for (const std::string& file : worlds) {

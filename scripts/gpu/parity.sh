@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# on a GPU machine, in an unpacked pack (scripts/gpu/pack.sh) or a build folder: prints the
+# parity table of the CUDA backend against the CPU backend (issue 35, item 7; docs/gpu.md
+# "Parity") for the default, house, warehouse and outdoor worlds and every worlds/effects/*.yaml:
+# the first camera at 320x240 after 1 s, depth within 1 mm %, segmentation equal %, same-depth
+# ties, whether the frame with the world's effects is on the GPU, and the rgb PSNR where rgb is
+# on the GPU, else "cpu fallback".
+#
+#   scripts/gpu/parity.sh BENCH_BINARY WORLDS_DIR [WxH]
+set -uo pipefail
+bench=${1:?render_cuda_bench binary}
+worlds=${2:?worlds folder}
+size=${3:-320x240}
+files=("$worlds/default.yaml" "$worlds/house.yaml" "$worlds/warehouse.yaml" "$worlds/outdoor.yaml")
+for f in "$worlds"/effects/*.yaml; do files+=("$f"); done
+"$bench" --parity --size "$size" "${files[@]}" 2>&1 | grep -v '^\[20'
+exit "${PIPESTATUS[0]}"

@@ -1,0 +1,100 @@
+#pragma once
+// the host-side bookkeeping of batch rendering (cuda_batch_renderer.h): which images a batch
+// renders, where each camera's image of each output lies in the batch's one buffer, the checks
+// of a batch's cameras, and the ring of buffer slots that lets a batch's copy back overlap the
+// next batch's kernel. plain C++ (no CUDA): built and tested on every machine; C++17, as
+// cuda_batch_kernels.cu includes it.
+
+#include <array>
+#include <cstdint>
+
+#include "penumbra/render/cuda/cuda_kernels.h"
+
+namespace penumbra::cuda {
+
+/// the images a batch renders: the ground truth of the pixel-centre ray (rgb is not on the
+/// GPU yet, docs/gpu.md). each is one 4-byte value per pixel: depth and range float metres,
+/// segmentation (MuJoCo geom id), instance (body id) and semantic class int32, as
+/// RenderedFrame's depth_m, geom_id, body_id, semantic_class and range_m.
+struct BatchOutputs {
+  bool depth = true;
+  bool segmentation = true;
+  bool instance_segmentation = false;
+  bool semantic_segmentation = false;
+  bool range = false;
+};
+
+/// one camera of a batch: the world it looks at (the index BatchRenderer::AddWorld returned)
+/// and its pinhole camera (CudaRenderer::PinholeOf); its width and height must be the batch's.
+struct BatchCamera {
+  int32_t world = 0;
+  PinholeCamera camera;
+};
+
+/// the planes of a batch's buffer, in buffer order.
+enum class BatchPlane { kDepth = 0, kSegmentation, kInstance, kSemantic, kRange };
+inline constexpr int kBatchPlaneCount = 5;
+
+/// where a batch's images lie in its one buffer: the planes that are on (BatchOutputs), in
+/// BatchPlane order, each `cameras` x height x width 4-byte values, camera-major then row-major
+/// (camera k's pixel (u, v) at k * width * height + v * width + u). a batch of k cameras uses
+/// the first bytes(k) bytes, so it is copied back in one transfer.
+class BatchLayout {
+ public:
+  /// @throws Error if width or height is not in [1, 16384], max_cameras not in [1, 65535] (the
+  ///         kernel's grid z), or no output is on.
+  BatchLayout(int width, int height, int max_cameras, const BatchOutputs& outputs);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int max_cameras() const { return max_cameras_; }
+  const BatchOutputs& outputs() const { return outputs_; }
+  /// pixels of one camera's image.
+  int64_t pixels() const { return static_cast<int64_t>(width_) * height_; }
+  /// true if plane p is on.
+  bool has(BatchPlane p) const { return index_[static_cast<int>(p)] >= 0; }
+  /// the planes that are on.
+  int planes() const { return planes_; }
+  /// byte offset of plane p (on) in the buffer of a batch of `cameras` cameras.
+  int64_t plane_offset(BatchPlane p, int cameras) const;
+  /// byte offset of camera k's image of plane p in the buffer of a batch of `cameras`.
+  int64_t image_offset(BatchPlane p, int cameras, int k) const {
+    return plane_offset(p, cameras) + 4 * pixels() * k;
+  }
+  /// bytes of the images of a batch of `cameras` cameras.
+  int64_t bytes(int cameras) const { return 4 * pixels() * planes_ * cameras; }
+  /// bytes of the largest batch (each slot's buffer).
+  int64_t capacity_bytes() const { return bytes(max_cameras_); }
+
+  /// checks a batch cameras[0 .. count): 1 to max_cameras cameras, each of a world in [0,
+  /// num_worlds), the batch's width and height, finite pose and intrinsics, inv_fx and inv_fy > 0.
+  /// @throws Error naming the camera's index and the field.
+  void Check(const BatchCamera* cameras, int count, int num_worlds) const;
+
+ private:
+  int width_, height_, max_cameras_;
+  BatchOutputs outputs_;
+  std::array<int, kBatchPlaneCount> index_{};  // position among the planes that are on, -1 off
+  int planes_ = 0;
+};
+
+/// the ring of kSlots buffer slots batches rotate through: ticket t (the t-th batch
+/// submitted, from 0) renders into slot t % kSlots, so batch t + 1's kernel runs while batch t
+/// is copied back; batch t's images stay readable until batch t + kSlots is submitted.
+class BatchTickets {
+ public:
+  static constexpr int kSlots = 2;
+  /// takes the next ticket.
+  int64_t Take() { return next_++; }
+  /// the slot of ticket t.
+  static int SlotOf(int64_t t) { return static_cast<int>(t % kSlots); }
+  /// tickets taken so far.
+  int64_t taken() const { return next_; }
+  /// true if ticket t was taken and its slot not reused since (its images are readable).
+  bool Readable(int64_t t) const { return t >= 0 && t < next_ && t >= next_ - kSlots; }
+
+ private:
+  int64_t next_ = 0;
+};
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,171 @@
+#include "penumbra/render/cuda/cuda_batch_bench.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+
+#include "penumbra/render/cuda/cuda_batch_renderer.h"
+
+namespace penumbra::cuda {
+namespace {
+
+using BenchClock = std::chrono::steady_clock;
+
+double SecondsSince(BenchClock::time_point t0) {
+  return std::chrono::duration<double>(BenchClock::now() - t0).count();
+}
+
+std::string OutputsLabel(const BatchOutputs& o) {
+  std::string s;
+  const auto add = [&](bool on, const char* name) {
+    if (!on) return;
+    if (!s.empty()) s += "+";
+    s += name;
+  };
+  add(o.depth, "depth");
+  add(o.segmentation, "seg");
+  add(o.instance_segmentation, "instance");
+  add(o.semantic_segmentation, "semantic");
+  add(o.range, "range");
+  return s;
+}
+
+// wall seconds per batch of `batches` batches of `cams`, each Submit overlapping the previous
+// batch's copy back; *kernel_ms: the kernels' mean (CUDA events)
+double TimePipeline(BatchRenderer* r, std::span<const BatchCamera> cams, int batches,
+                    double* kernel_ms) {
+  for (int i = 0; i < 2; ++i) r->Wait(r->Submit(cams));  // warm-up
+  double kernel_sum = 0;
+  const auto t0 = BenchClock::now();
+  int64_t previous = -1;
+  for (int i = 0; i < batches; ++i) {
+    const int64_t t = r->Submit(cams);
+    if (previous >= 0) {
+      r->Wait(previous);
+      kernel_sum += r->kernel_ms(previous);
+    }
+    previous = t;
+  }
+  r->Wait(previous);
+  kernel_sum += r->kernel_ms(previous);
+  const double s = SecondsSince(t0) / batches;
+  if (kernel_ms) *kernel_ms = kernel_sum / batches;
+  return s;
+}
+
+}  // namespace
+
+CameraView OrbitView(const CameraView& view, double yaw_rad) {
+  CameraView v = view;
+  v.X_WO.linear() =
+      Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() * view.X_WO.linear();
+  return v;
+}
+
+std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds, int count,
+                                        std::vector<int>* world_of) {
+  std::vector<CameraView> views;
+  world_of->clear();
+  const int n = static_cast<int>(worlds.size());
+  for (int k = 0; k < count; ++k) {
+    const int w = k % n;
+    views.push_back(OrbitView(worlds[w].view, 2 * M_PI * k / count));
+    world_of->push_back(w);
+  }
+  return views;
+}
+
+std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds, int width,
+                                         int height, std::span<const int> camera_counts,
+                                         int batches, const BatchOutputs& outputs) {
+  std::vector<BatchBenchRow> rows;
+  int max_cameras = 1;
+  for (int k : camera_counts) max_cameras = std::max(max_cameras, k);
+  for (const BatchCopy copy : {BatchCopy::kPinned, BatchCopy::kPageable}) {
+    BatchConfig config;
+    config.width = width;
+    config.height = height;
+    config.max_cameras = max_cameras;
+    config.outputs = outputs;
+    config.copy = copy;
+    BatchRenderer r(config);
+    for (const BatchBenchWorld& w : worlds) {
+      const int i = r.AddWorld(*w.scene);
+      r.UpdateWorld(i, w.snapshot);
+    }
+    for (int count : camera_counts) {
+      std::vector<int> world_of;
+      std::vector<CameraView> views = BatchBenchViews(worlds, count, &world_of);
+      std::vector<BatchCamera> cams;
+      for (int k = 0; k < count; ++k) {
+        views[k].intrinsics = CameraIntrinsics::FromFovy(
+            width, height,
+            2.0 * std::atan(0.5 * views[k].intrinsics.height / views[k].intrinsics.fy) * 180.0 /
+                M_PI);
+        cams.push_back(BatchRenderer::CameraOf(world_of[k], views[k]));
+      }
+      double kernel_ms = 0;
+      const double s = TimePipeline(&r, cams, batches, &kernel_ms);
+      const bool pinned = copy == BatchCopy::kPinned;
+      rows.push_back({count, "cuda",
+                      pinned ? "batch, pinned copy overlapped" : "batch, pageable copy", count / s,
+                      1e3 * s});
+      if (pinned)
+        rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3), kernel_ms});
+    }
+  }
+  // the CPU backend: the same views one after another (each Render on all its threads)
+  for (int count : camera_counts) {
+    std::vector<int> world_of;
+    std::vector<CameraView> views = BatchBenchViews(worlds, count, &world_of);
+    bool any = false;
+    for (const BatchBenchWorld& w : worlds) any = any || w.cpu;
+    if (!any) continue;
+    RenderedFrame f;
+    const int cpu_batches = std::max(1, std::min(batches, 2048 / count));
+    for (int k = 0; k < count; ++k) {
+      views[k].intrinsics = CameraIntrinsics::FromFovy(
+          width, height,
+          2.0 * std::atan(0.5 * views[k].intrinsics.height / views[k].intrinsics.fy) * 180.0 /
+              M_PI);
+      views[k].outputs.rgb = false;
+      views[k].outputs.depth = outputs.depth;
+      views[k].outputs.segmentation = outputs.segmentation;
+      views[k].outputs.instance_segmentation = outputs.instance_segmentation;
+      views[k].outputs.semantic_segmentation = outputs.semantic_segmentation;
+      views[k].outputs.range = outputs.range;
+      views[k].outputs.normals = false;
+    }
+    for (int k = 0; k < std::min(count, 4); ++k)  // warm-up
+      if (Renderer* cpu = worlds[world_of[k]].cpu)
+        cpu->Render(worlds[world_of[k]].snapshot, views[k], &f);
+    const auto t0 = BenchClock::now();
+    int rendered = 0;
+    for (int b = 0; b < cpu_batches; ++b)
+      for (int k = 0; k < count; ++k)
+        if (Renderer* cpu = worlds[world_of[k]].cpu) {
+          cpu->Render(worlds[world_of[k]].snapshot, views[k], &f);
+          ++rendered;
+        }
+    const double s = SecondsSince(t0);
+    rows.push_back(
+        {count, "cpu", "Render() per camera, all cores", rendered / s, 1e3 * s / cpu_batches});
+  }
+  return rows;
+}
+
+std::string FormatBatchBench(const std::string& label, int width, int height,
+                             const BatchOutputs& outputs, std::span<const BatchBenchRow> rows) {
+  std::string s =
+      "| world | size | outputs | cameras | backend | timed | frames/s | ms/batch |\n"
+      "|---|---|---|---:|---|---|---:|---:|\n";
+  for (const BatchBenchRow& r : rows)
+    s += fmt::format("| {} | {}x{} | {} | {} | {} | {} | {:.0f} | {:.3f} |\n", label, width, height,
+                     OutputsLabel(outputs), r.cameras, r.backend, r.timed, r.frames_per_sec,
+                     r.ms_per_batch);
+  return s;
+}
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,58 @@
+#pragma once
+// the batch-rendering benchmark shared by `penumbra bench render --batch N` (app/bench.cc) and
+// render_cuda_bench (scripts/gpu/check.sh): K cameras spread over N worlds rendered by
+// BatchRenderer, with pinned and with pageable copies back, the kernel alone, and the CPU
+// backend rendering the same views one by one. a benchmark, never a pass/fail test.
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "penumbra/render/cuda/batch_layout.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra::cuda {
+
+/// one world of the benchmark: its scene, the snapshot it is rendered at, the base view of its
+/// cameras (their pose is X_WO turned about the world z axis through the camera, see
+/// OrbitView) and, optionally, a CPU renderer of the same scene to time beside the GPU.
+struct BatchBenchWorld {
+  const SceneDescription* scene = nullptr;
+  WorldSnapshot snapshot;
+  CameraView view;
+  Renderer* cpu = nullptr;  ///< null: no CPU row for this world
+};
+
+/// one measured row: frames/s are camera images per second.
+struct BatchBenchRow {
+  int cameras = 0;
+  std::string backend;  ///< "cuda" or "cpu"
+  std::string timed;    ///< what the time covers
+  double frames_per_sec = 0;
+  double ms_per_batch = 0;
+};
+
+/// `view` turned by `yaw_rad` about the world z axis through its optical centre.
+CameraView OrbitView(const CameraView& view, double yaw_rad);
+
+/// the views of a batch of `count` cameras over `worlds`: camera k in world k % N, turned by
+/// 2 pi k / count (OrbitView of that world's view); `world_of` receives each camera's world.
+std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds, int count,
+                                        std::vector<int>* world_of);
+
+/// times batches of each count of `camera_counts` (width x height, `outputs`): `batches`
+/// batches each with pinned copies overlapped with the next kernel (wall clock from the first
+/// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events),
+/// and the CPU renderers rendering the same views one at a time (at least one batch).
+/// @throws Error if the CUDA runtime fails.
+std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds, int width,
+                                         int height, std::span<const int> camera_counts,
+                                         int batches, const BatchOutputs& outputs);
+
+/// the rows as a markdown table (world label in the first column).
+std::string FormatBatchBench(const std::string& label, int width, int height,
+                             const BatchOutputs& outputs, std::span<const BatchBenchRow> rows);
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,244 @@
+// the device side of batch rendering (cuda_batch_kernels.h). the pixel's ray and ground truth
+// are primary_pixel.h's PB_HOST_DEVICE functions, the traversal bvh_traversal.h's: no formula
+// here that the host does not run too. no atomics: every pixel is written by one thread, so a
+// batch's images are the same bits run to run.
+
+#include <cuda_runtime.h>
+
+#include <string>
+#include <vector>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/cuda/cuda_batch_kernels.h"
+#include "penumbra/render/cuda/primary_pixel.h"
+
+namespace penumbra::cuda {
+namespace {
+
+void CheckBatch(cudaError_t e, const char* what) {
+  if (e != cudaSuccess)
+    throw Error(std::string("CUDA batch rendering: ") + what + ": " + cudaGetErrorString(e));
+}
+
+// the planes of one batch (device pointers; null = off)
+struct BatchPlanes {
+  float* depth;
+  int32_t* geom_id;
+  int32_t* body_id;
+  int32_t* semantic;
+  float* range;
+};
+
+// one thread per pixel of every camera: block (8, 8), grid z = the camera.
+__global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* cameras, int width,
+                                   int height, BatchPlanes out) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= width || v >= height) return;
+  const int k = blockIdx.z;
+  const BatchCamera& b = cameras[k];
+  const PinholeCamera& c = b.camera;
+  const TraceRay r =
+      PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
+  const PixelTruth p = TracePixelTruth(views[b.world], r);
+  const int64_t i = static_cast<int64_t>(k) * width * height + static_cast<int64_t>(v) * width + u;
+  if (out.depth) out.depth[i] = p.depth;
+  if (out.geom_id) out.geom_id[i] = p.geom_id;
+  if (out.body_id) out.body_id[i] = p.body_id;
+  if (out.semantic) out.semantic[i] = p.semantic;
+  if (out.range) out.range[i] = p.range;
+}
+
+}  // namespace
+
+struct BatchDevice::Impl {
+  explicit Impl(const BatchLayout& l) : layout(l) {}
+  BatchLayout layout;
+  BatchCopy copy = BatchCopy::kPinned;
+  cudaStream_t compute = nullptr, copier = nullptr;
+  uint8_t* device[BatchTickets::kSlots] = {};
+  uint8_t* host[BatchTickets::kSlots] = {};
+  BatchCamera* cameras[BatchTickets::kSlots] = {};
+  SceneView* views[BatchTickets::kSlots] = {};
+  int views_capacity[BatchTickets::kSlots] = {};
+  cudaEvent_t started[BatchTickets::kSlots] = {}, done[BatchTickets::kSlots] = {},
+              copied[BatchTickets::kSlots] = {};
+  bool pending_copy[BatchTickets::kSlots] = {};
+  bool used[BatchTickets::kSlots] = {};
+
+  void Release() {
+    for (int s = 0; s < BatchTickets::kSlots; ++s) {
+      if (device[s]) cudaFree(device[s]);
+      if (cameras[s]) cudaFree(cameras[s]);
+      if (views[s]) cudaFree(views[s]);
+      if (host[s]) {
+        if (copy == BatchCopy::kPinned)
+          cudaFreeHost(host[s]);
+        else
+          delete[] host[s];
+      }
+      for (cudaEvent_t e : {started[s], done[s], copied[s]})
+        if (e) cudaEventDestroy(e);
+    }
+    if (compute) cudaStreamDestroy(compute);
+    if (copier) cudaStreamDestroy(copier);
+  }
+};
+
+BatchDevice::BatchDevice(const BatchLayout& layout, BatchCopy copy) : impl_(new Impl(layout)) {
+  Impl& m = *impl_;
+  m.copy = copy;
+  try {
+    CheckBatch(cudaStreamCreateWithFlags(&m.compute, cudaStreamNonBlocking), "cudaStreamCreate");
+    CheckBatch(cudaStreamCreateWithFlags(&m.copier, cudaStreamNonBlocking), "cudaStreamCreate");
+    const size_t bytes = static_cast<size_t>(layout.capacity_bytes());
+    for (int s = 0; s < BatchTickets::kSlots; ++s) {
+      CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.device[s]), bytes), "cudaMalloc (images)");
+      CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.cameras[s]),
+                            sizeof(BatchCamera) * layout.max_cameras()),
+                 "cudaMalloc (cameras)");
+      if (copy == BatchCopy::kPinned)
+        CheckBatch(cudaMallocHost(reinterpret_cast<void**>(&m.host[s]), bytes),
+                   "cudaMallocHost (pinned images)");
+      else if (copy == BatchCopy::kPageable)
+        m.host[s] = new uint8_t[bytes];
+      CheckBatch(cudaEventCreate(&m.started[s]), "cudaEventCreate");
+      CheckBatch(cudaEventCreate(&m.done[s]), "cudaEventCreate");
+      CheckBatch(cudaEventCreateWithFlags(&m.copied[s], cudaEventDisableTiming), "cudaEventCreate");
+    }
+  } catch (...) {
+    m.Release();
+    delete impl_;
+    throw;
+  }
+}
+
+BatchDevice::~BatchDevice() {
+  cudaStreamSynchronize(impl_->compute);
+  cudaStreamSynchronize(impl_->copier);
+  impl_->Release();
+  delete impl_;
+}
+
+void BatchDevice::WaitForKernels() {
+  CheckBatch(cudaStreamSynchronize(impl_->compute), "waiting for the batch kernels");
+}
+
+void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
+                         const BatchCamera* cameras, int count) {
+  Impl& m = *impl_;
+  const BatchLayout& l = m.layout;
+  // the slot's device buffer is free once its previous copy back has run
+  if (m.pending_copy[slot])
+    CheckBatch(cudaStreamWaitEvent(m.compute, m.copied[slot], 0), "cudaStreamWaitEvent");
+  if (num_views > m.views_capacity[slot]) {
+    CheckBatch(cudaStreamSynchronize(m.compute), "waiting for the batch kernels");
+    if (m.views[slot]) cudaFree(m.views[slot]);
+    m.views[slot] = nullptr;
+    m.views_capacity[slot] = 0;
+    CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.views[slot]), sizeof(SceneView) * num_views),
+               "cudaMalloc (worlds)");
+    m.views_capacity[slot] = num_views;
+  }
+  // from pageable memory: the call returns once the source is staged, so the host arrays may
+  // change after it; the kernel below is ordered after the copies on the same stream
+  CheckBatch(cudaMemcpyAsync(m.views[slot], views, sizeof(SceneView) * num_views,
+                             cudaMemcpyHostToDevice, m.compute),
+             "copying the worlds");
+  CheckBatch(cudaMemcpyAsync(m.cameras[slot], cameras, sizeof(BatchCamera) * count,
+                             cudaMemcpyHostToDevice, m.compute),
+             "copying the cameras");
+  uint8_t* base = m.device[slot];
+  const auto plane = [&](BatchPlane p) -> void* {
+    return l.has(p) ? base + l.plane_offset(p, count) : nullptr;
+  };
+  BatchPlanes out;
+  out.depth = static_cast<float*>(plane(BatchPlane::kDepth));
+  out.geom_id = static_cast<int32_t*>(plane(BatchPlane::kSegmentation));
+  out.body_id = static_cast<int32_t*>(plane(BatchPlane::kInstance));
+  out.semantic = static_cast<int32_t*>(plane(BatchPlane::kSemantic));
+  out.range = static_cast<float*>(plane(BatchPlane::kRange));
+  const dim3 block(8, 8);
+  const dim3 grid((l.width() + 7) / 8, (l.height() + 7) / 8, count);
+  CheckBatch(cudaEventRecord(m.started[slot], m.compute), "cudaEventRecord");
+  BatchPrimaryKernel<<<grid, block, 0, m.compute>>>(m.views[slot], m.cameras[slot], l.width(),
+                                                    l.height(), out);
+  CheckBatch(cudaGetLastError(), "BatchPrimaryKernel launch");
+  CheckBatch(cudaEventRecord(m.done[slot], m.compute), "cudaEventRecord");
+  m.used[slot] = true;
+  if (m.copy == BatchCopy::kNone) return;
+  // the copy back on its own stream, after this kernel: it overlaps the next batch's kernel
+  CheckBatch(cudaStreamWaitEvent(m.copier, m.done[slot], 0), "cudaStreamWaitEvent");
+  CheckBatch(cudaMemcpyAsync(m.host[slot], base, static_cast<size_t>(l.bytes(count)),
+                             cudaMemcpyDeviceToHost, m.copier),
+             "copying the images back");
+  CheckBatch(cudaEventRecord(m.copied[slot], m.copier), "cudaEventRecord");
+  m.pending_copy[slot] = true;
+}
+
+const uint8_t* BatchDevice::Wait(int slot) {
+  Impl& m = *impl_;
+  if (!m.used[slot]) return m.host[slot];
+  if (m.copy == BatchCopy::kNone) {
+    CheckBatch(cudaEventSynchronize(m.done[slot]), "BatchPrimaryKernel");
+    return nullptr;
+  }
+  CheckBatch(cudaEventSynchronize(m.copied[slot]), "copying the images back");
+  return m.host[slot];
+}
+
+const uint8_t* BatchDevice::device_buffer(int slot) const { return impl_->device[slot]; }
+const uint8_t* BatchDevice::host_buffer(int slot) const { return impl_->host[slot]; }
+void* BatchDevice::kernel_event(int slot) const { return impl_->done[slot]; }
+void* BatchDevice::stream() const { return impl_->compute; }
+
+double BatchDevice::kernel_ms(int slot) const {
+  float ms = 0;
+  CheckBatch(cudaEventElapsedTime(&ms, impl_->started[slot], impl_->done[slot]),
+             "cudaEventElapsedTime");
+  return ms;
+}
+
+CopyRates MeasureCopyRates(int64_t bytes, int repeats) {
+  CopyRates r;
+  void* dev = nullptr;
+  void* pinned = nullptr;
+  std::vector<uint8_t> pageable(static_cast<size_t>(bytes));
+  cudaStream_t s = nullptr;
+  cudaEvent_t a = nullptr, b = nullptr;
+  const auto release = [&] {
+    if (dev) cudaFree(dev);
+    if (pinned) cudaFreeHost(pinned);
+    if (a) cudaEventDestroy(a);
+    if (b) cudaEventDestroy(b);
+    if (s) cudaStreamDestroy(s);
+  };
+  try {
+    CheckBatch(cudaMalloc(&dev, bytes), "cudaMalloc");
+    CheckBatch(cudaMemset(dev, 1, bytes), "cudaMemset");
+    CheckBatch(cudaMallocHost(&pinned, bytes), "cudaMallocHost");
+    CheckBatch(cudaStreamCreate(&s), "cudaStreamCreate");
+    CheckBatch(cudaEventCreate(&a), "cudaEventCreate");
+    CheckBatch(cudaEventCreate(&b), "cudaEventCreate");
+    const auto rate = [&](void* host) {
+      CheckBatch(cudaMemcpyAsync(host, dev, bytes, cudaMemcpyDeviceToHost, s), "warm-up copy");
+      CheckBatch(cudaEventRecord(a, s), "cudaEventRecord");
+      for (int i = 0; i < repeats; ++i)
+        CheckBatch(cudaMemcpyAsync(host, dev, bytes, cudaMemcpyDeviceToHost, s), "timed copy");
+      CheckBatch(cudaEventRecord(b, s), "cudaEventRecord");
+      CheckBatch(cudaEventSynchronize(b), "timed copies");
+      float ms = 0;
+      CheckBatch(cudaEventElapsedTime(&ms, a, b), "cudaEventElapsedTime");
+      return ms > 0 ? static_cast<double>(bytes) * repeats / (ms * 1e-3) / 1e9 : 0.0;
+    };
+    r.pinned_gbps = rate(pinned);
+    r.pageable_gbps = rate(pageable.data());
+  } catch (...) {
+    release();
+    throw;
+  }
+  release();
+  return r;
+}
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,138 @@
+#pragma once
+// batch rendering on the GPU (issue 35, item 6; docs/gpu.md "Batch rendering"): the cameras of
+// one world, and the cameras of N independent worlds (N sessions in one process), rendered by
+// one kernel launch into one device buffer; the images copied back in one pinned transfer per
+// batch on a second stream, overlapped with the next batch's kernel, or left on the device for
+// a consumer on the GPU (the device-pointer API below). the images are the ground truth of each
+// pixel-centre ray (depth, segmentation, instance and semantic segmentation, range; rgb is not
+// on the GPU yet), the same bits as the same camera in a batch of its own.
+//
+//   BatchRenderer batch({.width = 128, .height = 128, .max_cameras = 1024});
+//   const int house = batch.AddWorld(session.scene());
+//   batch.UpdateWorld(house, session.sim().Snapshot());
+//   std::vector<BatchCamera> cams = ...;               // BatchRenderer::CameraOf(house, view)
+//   const int64_t t = batch.Submit(cams);              // returns at once
+//   ... step the worlds, UpdateWorld, Submit(t + 1) ... // overlaps t's copy back
+//   const BatchImages img = batch.Wait(t);             // host images of batch t
+//   const float* depth_of_camera_3 = img.depth(3);
+//
+// threading: one thread at a time (not thread-safe).
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "penumbra/render/cuda/batch_layout.h"
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/cuda_batch_kernels.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/world_snapshot.h"
+
+namespace penumbra::cuda {
+
+/// what a BatchRenderer renders and where the images go.
+struct BatchConfig {
+  int width = 128;         ///< every camera's image width, px
+  int height = 128;        ///< every camera's image height, px
+  int max_cameras = 1024;  ///< most cameras in one batch (sizes the buffers), 1 to 65535
+  BatchOutputs outputs;    ///< default depth and segmentation
+  BatchCopy copy = BatchCopy::kPinned;
+};
+
+/// the images of one batch, on the host (BatchRenderer::Wait) or on the device
+/// (BatchRenderer::DeviceImages): camera k's image of an output is width x height row-major
+/// 4-byte values (BatchLayout), null if that output is off.
+struct BatchImages {
+  const uint8_t* base = nullptr;  ///< the batch's buffer (host or device pointer)
+  const BatchLayout* layout = nullptr;
+  int cameras = 0;         ///< cameras in the batch
+  bool on_device = false;  ///< base is a device pointer
+  /// camera k's depth (m, 0 = miss) / range (m) / segmentation (geom id, -1 = miss) /
+  /// instance (body id) / semantic class; null if not rendered.
+  const float* depth(int k) const { return Plane<float>(BatchPlane::kDepth, k); }
+  const float* range(int k) const { return Plane<float>(BatchPlane::kRange, k); }
+  const int32_t* geom_id(int k) const { return Plane<int32_t>(BatchPlane::kSegmentation, k); }
+  const int32_t* body_id(int k) const { return Plane<int32_t>(BatchPlane::kInstance, k); }
+  const int32_t* semantic(int k) const { return Plane<int32_t>(BatchPlane::kSemantic, k); }
+
+ private:
+  template <typename T>
+  const T* Plane(BatchPlane p, int k) const {
+    if (!base || !layout->has(p) || k < 0 || k >= cameras) return nullptr;
+    return reinterpret_cast<const T*>(base + layout->image_offset(p, cameras, k));
+  }
+};
+
+/// batch rendering (see the file comment).
+class BatchRenderer {
+ public:
+  /// @throws Error for a bad config (BatchLayout) or if the CUDA runtime fails (no device:
+  ///         check ProbeCudaDevice first).
+  explicit BatchRenderer(const BatchConfig& config);
+  ~BatchRenderer();
+
+  /// adds a world (one session's scene, copied) and builds its BVH on the host and the
+  /// device; returns its index for BatchCamera::world (0, 1, ...). bodies are at the
+  /// identity until UpdateWorld.
+  /// @throws Error as BvhScene, or if the CUDA runtime fails.
+  int AddWorld(const SceneDescription& scene);
+  /// worlds added.
+  int num_worlds() const { return static_cast<int>(worlds_.size()); }
+  /// poses world `world`'s bodies from `snapshot` (its instances' transforms; the static BVH is
+  /// rebuilt only if a static body moved). waits for the kernels already submitted (they read
+  /// the transforms), not for their copies back.
+  /// @throws Error for a bad index or snapshot (BvhScene::Update).
+  void UpdateWorld(int world, const WorldSnapshot& snapshot);
+
+  /// renders `cameras` (BatchLayout::Check) in one kernel launch and starts the copy back
+  /// (BatchCopy); returns the batch's ticket (0, 1, ...) at once. the images of ticket t stay
+  /// readable until ticket t + 2 is submitted.
+  /// @throws Error for bad cameras (naming the camera), or if the CUDA runtime fails.
+  int64_t Submit(std::span<const BatchCamera> cameras);
+  /// blocks until batch `ticket` is on the host and returns its host images (with
+  /// BatchCopy::kNone: until its kernel finished; the images' base is then null).
+  /// @throws Error if the ticket was not submitted or its slot was reused (t + 2 submitted).
+  BatchImages Wait(int64_t ticket);
+
+  /// the device-pointer API: batch `ticket`'s images in device memory (BatchImages with
+  /// on_device true), readable by work that runs after ready_event(ticket) (e.g. enqueued on
+  /// stream() after Submit, or on another stream after cudaStreamWaitEvent(s,
+  /// ready_event(ticket))) and done before ticket + 2 is submitted (whose kernel overwrites
+  /// the buffer). does not wait.
+  /// @throws Error as Wait.
+  BatchImages DeviceImages(int64_t ticket) const;
+  /// the cudaEvent_t (as void*) recorded after batch `ticket`'s kernel.
+  void* ready_event(int64_t ticket) const;
+  /// the cudaStream_t (as void*) the kernels run on.
+  void* stream() const { return device_->stream(); }
+  /// milliseconds batch `ticket`'s kernel took (CUDA events; call after Wait(ticket)).
+  double kernel_ms(int64_t ticket) const;
+
+  const BatchLayout& layout() const { return layout_; }
+  /// world `world`'s BVH on the host (tests, build times).
+  const BvhScene& bvh(int world) const { return *worlds_.at(world)->bvh; }
+
+  /// the batch camera of `view` (a pinhole camera: no distortion, no motion) in world `world`.
+  /// @throws Error if the view has lens distortion or motion (not on the GPU yet).
+  static BatchCamera CameraOf(int world, const CameraView& view);
+
+ private:
+  struct World {
+    SceneDescription scene;
+    std::unique_ptr<BvhScene> bvh;
+    std::unique_ptr<DeviceScene> device;
+  };
+  void CheckTicket(int64_t ticket) const;
+
+  BatchLayout layout_;
+  std::unique_ptr<BatchDevice> device_;
+  std::vector<std::unique_ptr<World>> worlds_;
+  std::vector<SceneView> views_;  // each world's device arrays, as the kernel reads them
+  std::vector<int> counts_;       // cameras of the batch in each slot
+  BatchTickets tickets_;
+};
+
+}  // namespace penumbra::cuda

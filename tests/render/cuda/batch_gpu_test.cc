@@ -1,0 +1,218 @@
+// batch rendering on a GPU (render/cuda/cuda_batch_renderer.h; ctest label `gpu`): the cameras
+// of two worlds (the default room and the house, two sessions) in one launch give the same
+// bits as each camera in a batch of its own and agree with the single-camera CudaRenderer;
+// two renderers render the same bits (determinism); overlapped batches keep their own images;
+// the copy modes give the same images; a ticket whose slot was reused is refused. without a
+// device every test prints "skipped: no CUDA device".
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/error.h"
+#include "penumbra/physics/simulation.h"
+#include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/cuda/cuda_batch_bench.h"
+#include "penumbra/render/cuda/cuda_batch_renderer.h"
+#include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/session.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra {
+namespace {
+
+#define PB_REQUIRE_CUDA_DEVICE_FOR_BATCH()                                       \
+  do {                                                                           \
+    if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device"; \
+  } while (0)
+
+constexpr int kBatchW = 96, kBatchH = 72;
+
+struct BatchWorld {
+  std::unique_ptr<Session> session;
+  WorldSnapshot snap;
+  CameraView view;
+};
+
+BatchWorld LoadBatchWorld(const std::string& name) {
+  SessionOptions so;
+  so.build_renderer = false;
+  so.add_controllers = false;
+  BatchWorld w;
+  w.session = std::make_unique<Session>(
+      LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + name), so);
+  for (int s = 0; s < 150; ++s) w.session->sim().Step();
+  w.snap = w.session->sim().Snapshot();
+  const CameraSpec& cam = w.session->scene().cameras.front();
+  w.view.X_WO = CameraPoseInWorld(cam, w.snap);
+  w.view.intrinsics = CameraIntrinsics::FromFovy(kBatchW, kBatchH, 70);
+  w.view.near_m = cam.near_m;
+  w.view.outputs.rgb = false;
+  w.view.outputs.depth = w.view.outputs.segmentation = true;
+  w.view.outputs.instance_segmentation = w.view.outputs.semantic_segmentation = true;
+  w.view.outputs.range = true;
+  return w;
+}
+
+cuda::BatchConfig AllTruth(int max_cameras, cuda::BatchCopy copy = cuda::BatchCopy::kPinned) {
+  cuda::BatchConfig c;
+  c.width = kBatchW;
+  c.height = kBatchH;
+  c.max_cameras = max_cameras;
+  c.outputs.instance_segmentation = c.outputs.semantic_segmentation = c.outputs.range = true;
+  c.copy = copy;
+  return c;
+}
+
+// the host bytes of a batch (every plane)
+std::vector<uint8_t> BatchBytes(const cuda::BatchImages& img) {
+  const int64_t n = img.layout->bytes(img.cameras);
+  return std::vector<uint8_t>(img.base, img.base + n);
+}
+
+// camera k's images of a batch, as bytes, plane by plane
+std::vector<uint8_t> CameraBytes(const cuda::BatchImages& img, int k) {
+  std::vector<uint8_t> out;
+  const int64_t n = 4 * img.layout->pixels();
+  for (const void* p :
+       {static_cast<const void*>(img.depth(k)), static_cast<const void*>(img.geom_id(k)),
+        static_cast<const void*>(img.body_id(k)), static_cast<const void*>(img.semantic(k)),
+        static_cast<const void*>(img.range(k))}) {
+    const uint8_t* b = static_cast<const uint8_t*>(p);
+    out.insert(out.end(), b, b + n);
+  }
+  return out;
+}
+
+class BatchRendering : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    PB_REQUIRE_CUDA_DEVICE_FOR_BATCH();
+    worlds_.push_back(LoadBatchWorld("default.yaml"));
+    worlds_.push_back(LoadBatchWorld("house.yaml"));
+  }
+  // 8 cameras over both worlds: camera k in world k % 2, turned by 2 pi k / 8
+  std::vector<cuda::BatchCamera> Cameras(std::vector<CameraView>* views) const {
+    std::vector<cuda::BatchCamera> cams;
+    for (int k = 0; k < 8; ++k) {
+      const CameraView v = cuda::OrbitView(worlds_[k % 2].view, 2 * M_PI * k / 8);
+      if (views) views->push_back(v);
+      cams.push_back(cuda::BatchRenderer::CameraOf(k % 2, v));
+    }
+    return cams;
+  }
+  void AddWorlds(cuda::BatchRenderer* r) const {
+    for (const BatchWorld& w : worlds_) r->UpdateWorld(r->AddWorld(w.session->scene()), w.snap);
+  }
+  std::vector<BatchWorld> worlds_;
+};
+
+TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
+  std::vector<CameraView> views;
+  const std::vector<cuda::BatchCamera> cams = Cameras(&views);
+  cuda::BatchRenderer r(AllTruth(8));
+  AddWorlds(&r);
+  ASSERT_EQ(r.num_worlds(), 2);
+  const cuda::BatchImages all = r.Wait(r.Submit(cams));
+  ASSERT_EQ(all.cameras, 8);
+  const std::vector<uint8_t> batched = BatchBytes(all);
+  RenderSettings gpu_settings;
+  gpu_settings.backend = RenderSettings::Backend::kCuda;
+  for (int k = 0; k < 8; ++k) {
+    SCOPED_TRACE("camera " + std::to_string(k));
+    const cuda::BatchImages one = r.Wait(r.Submit(std::span(&cams[k], 1)));
+    ASSERT_EQ(one.cameras, 1);
+    cuda::BatchImages again = all;
+    again.base = batched.data();
+    EXPECT_TRUE(CameraBytes(one, 0) == CameraBytes(again, k));
+    // the single-camera renderer (CudaRenderer) of the same view: same depth, same ids
+    const BatchWorld& w = worlds_[k % 2];
+    const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
+    RenderedFrame f;
+    single->Render(w.snap, views[k], &f);
+    const int n = kBatchW * kBatchH;
+    int same_bits = 0, depth_bad = 0, seg_bad = 0, hits = 0;
+    for (int i = 0; i < n; ++i) {
+      same_bits += std::memcmp(&f.depth_m.data[i], one.depth(0) + i, 4) == 0;
+      depth_bad += std::abs(f.depth_m.data[i] - one.depth(0)[i]) > 1e-6f * (1 + f.depth_m.data[i]);
+      seg_bad += f.geom_id.data[i] != one.geom_id(0)[i] || f.body_id.data[i] != one.body_id(0)[i] ||
+                 f.semantic_class.data[i] != one.semantic(0)[i];
+      hits += f.depth_m.data[i] > 0;
+    }
+    std::printf("camera %d (%s): %d of %d depth values the same bits as CudaRenderer's, %d hit\n",
+                k, k % 2 ? "house" : "default", same_bits, n, hits);
+    EXPECT_GT(hits, 0);
+    EXPECT_LE(depth_bad, n / 1000);
+    EXPECT_LE(seg_bad, n / 1000);
+  }
+}
+
+TEST_F(BatchRendering, TwoRunsGiveTheSameBits) {
+  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
+  std::vector<uint8_t> first;
+  for (int run = 0; run < 2; ++run) {
+    cuda::BatchRenderer r(AllTruth(8));
+    AddWorlds(&r);
+    const std::vector<uint8_t> bytes = BatchBytes(r.Wait(r.Submit(cams)));
+    if (run == 0)
+      first = bytes;
+    else
+      EXPECT_TRUE(bytes == first) << "two runs of the same batch differ";
+  }
+  // pageable copies give the same bits as pinned ones
+  cuda::BatchRenderer pageable(AllTruth(8, cuda::BatchCopy::kPageable));
+  AddWorlds(&pageable);
+  EXPECT_TRUE(BatchBytes(pageable.Wait(pageable.Submit(cams))) == first);
+}
+
+TEST_F(BatchRendering, OverlappedBatchesKeepTheirOwnImages) {
+  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
+  cuda::BatchRenderer r(AllTruth(8));
+  AddWorlds(&r);
+  // reference: each half alone, waited at once
+  const std::vector<uint8_t> a = BatchBytes(r.Wait(r.Submit(std::span(cams).first(4))));
+  const std::vector<uint8_t> b = BatchBytes(r.Wait(r.Submit(std::span(cams).last(4))));
+  ASSERT_TRUE(a != b);
+  // two in flight, then a third that reuses the first's slot
+  const int64_t ta = r.Submit(std::span(cams).first(4));
+  const int64_t tb = r.Submit(std::span(cams).last(4));
+  EXPECT_TRUE(BatchBytes(r.Wait(ta)) == a);
+  EXPECT_TRUE(BatchBytes(r.Wait(tb)) == b);
+  const int64_t tc = r.Submit(std::span(cams).last(4));
+  EXPECT_THROW(r.Wait(ta), Error);
+  EXPECT_TRUE(BatchBytes(r.Wait(tc)) == b);
+  EXPECT_TRUE(BatchBytes(r.Wait(tb)) == b);
+  // the device-pointer API: the images stay on the device
+  const cuda::BatchImages d = r.DeviceImages(tc);
+  EXPECT_TRUE(d.on_device);
+  EXPECT_NE(d.depth(3), nullptr);
+  EXPECT_NE(r.ready_event(tc), nullptr);
+  EXPECT_NE(r.stream(), nullptr);
+  // a bad camera is refused before anything runs, naming it
+  std::vector<cuda::BatchCamera> bad = cams;
+  bad[5].world = 7;
+  try {
+    r.Submit(bad);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 5: world 7"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(BatchRendering, DeviceOnlyBatchesAreNotCopiedBack) {
+  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
+  cuda::BatchRenderer r(AllTruth(8, cuda::BatchCopy::kNone));
+  AddWorlds(&r);
+  const int64_t t = r.Submit(cams);
+  EXPECT_EQ(r.Wait(t).base, nullptr);
+  EXPECT_NE(r.DeviceImages(t).base, nullptr);
+  EXPECT_GT(r.kernel_ms(t), 0.0);
+}
+
+}  // namespace
+}  // namespace penumbra
