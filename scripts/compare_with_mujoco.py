@@ -11,16 +11,16 @@ field of view of camera_info.json), at the model's initial state, and reports pe
   segmentation render (geom ids);
 - hue (deg) and saturation (HSV, of the 8-bit sRGB pixels as displayed) of the labelled parts:
   the median over each geom's pixels that both renderers see, for the largest parts;
-- shadow contrast of the floor (plane geoms): 1 - (10th percentile) / (median) of the floor
+- shadow contrast of the floor (plane geoms): 1 - (2nd percentile) / (median) of the floor
   pixels' luminance (Rec. 709 of the decoded sRGB values) near the model (inside its silhouette's
-  bounding box grown by half its size): the darkest floor, where the shadow lies, against the
+  bounding box grown by its size on every side): the darkest floor, where the shadow lies, against the
   typical floor. a proxy: a checker floor's dark squares count too, in both renderers alike;
 - the background (skybox) colour: the mean of the pixels that no geom covers.
 
 Writes <out>/<model>/{penumbra,mujoco}.png, a side-by-side pair <pairs>/<model>.png (MuJoCo
 left, Penumbra right) when --pairs is given, <out>/results.json and a Markdown table (stdout and
-<out>/table.md). With --min-iou, --max-background-diff and --min-shadow-contrast-ratio it exits 1
-when a model falls outside them (the ctest check `compare_with_mujoco`).
+<out>/table.md). With --min-iou, --max-background-hue-diff and --min-shadow-contrast-ratio it exits
+1 when a model falls outside them (the ctest check `compare_with_mujoco`).
 
     xvfb-run -a /usr/bin/python3 scripts/compare_with_mujoco.py --binary build/penumbra \\
         --tool build/mujoco_offscreen --out /tmp/cmp --pairs docs/compare_mujoco
@@ -104,14 +104,14 @@ def shadow_contrast(lum, floor_mask, model_mask):
         return None
     vs, us = np.nonzero(model_mask)
     v0, v1, u0, u1 = vs.min(), vs.max(), us.min(), us.max()
-    dv, du = (v1 - v0) // 2 + 1, (u1 - u0) // 2 + 1
+    dv, du = (v1 - v0) + 1, (u1 - u0) + 1
     near = np.zeros_like(floor_mask)
     near[max(0, v0 - dv):v1 + dv + 1, max(0, u0 - du):u1 + du + 1] = True
     values = lum[floor_mask & near]
     if values.size < 50:
         return None
     median = float(np.median(values))
-    return 1.0 - float(np.percentile(values, 10)) / median if median > 0 else None
+    return 1.0 - float(np.percentile(values, 2)) / median if median > 0 else None
 
 
 def compare_model(model, args):
@@ -226,9 +226,9 @@ def main():
     ap.add_argument("--out", required=True, help="work folder (replaced)")
     ap.add_argument("--pairs", help="folder for the side-by-side PNGs (e.g. docs/compare_mujoco)")
     ap.add_argument("--min-iou", type=float, help="exit 1 if a model's silhouette IoU is lower")
-    ap.add_argument("--max-background-diff", type=float,
-                    help="exit 1 if a model's mean background colours (8-bit sRGB) differ by more "
-                         "than this in some channel (both renderers show a background)")
+    ap.add_argument("--max-background-hue-diff", type=float,
+                    help="exit 1 if the hues of a model's mean background colours (its skybox) "
+                         "differ by more than this many degrees (both renderers show one)")
     ap.add_argument("--min-shadow-contrast-ratio", type=float,
                     help="exit 1 if Penumbra's floor shadow contrast is below this fraction of "
                          "MuJoCo's (models with a floor)")
@@ -254,12 +254,15 @@ def main():
         if args.min_iou is not None and r["iou"] < args.min_iou:
             problems.append("%s: silhouette IoU %.3f < %.3f" % (r["name"], r["iou"], args.min_iou))
         b = r["background_rgb"]
-        if args.max_background_diff is not None and b["mujoco"] and b["penumbra"]:
-            diff = max(abs(x - y) for x, y in zip(b["mujoco"], b["penumbra"]))
-            if diff > args.max_background_diff:
-                problems.append("%s: background %s (MuJoCo) vs %s (Penumbra): %.0f > %.0f" %
-                                (r["name"], b["mujoco"], b["penumbra"], diff,
-                                 args.max_background_diff))
+        if args.max_background_hue_diff is not None and b["mujoco"] and b["penumbra"]:
+            h_mj, _ = hue_sat(np.array([b["mujoco"]]))
+            h_pb, _ = hue_sat(np.array([b["penumbra"]]))
+            diff = hue_distance(h_mj, h_pb)
+            if diff > args.max_background_hue_diff:
+                problems.append("%s: background %s (MuJoCo, hue %.0f deg) vs %s (Penumbra, hue "
+                                "%.0f deg): %.0f > %.0f deg" %
+                                (r["name"], b["mujoco"], h_mj, b["penumbra"], h_pb, diff,
+                                 args.max_background_hue_diff))
         c = r["shadow_contrast"]
         if (args.min_shadow_contrast_ratio is not None and c["mujoco"] is not None and
                 c["penumbra"] is not None and
