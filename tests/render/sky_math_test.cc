@@ -62,7 +62,8 @@ TEST(SkyMathTest, ZenithScaleGivesTheDiffuseIlluminance) {
   const double per_zenith = SkyModel::HorizontalIlluminancePerZenithLuminance(sky);
   ASSERT_GT(per_zenith, 1.0);
   const double target = SkyDiffuseHorizontalIlluminance(45, 3);
-  sky.zenith_luminance = static_cast<float>(target / per_zenith);
+  sky.zenith_luminance = SkyModel::PhysicalZenithLuminance(sky);
+  EXPECT_NEAR(sky.zenith_luminance, target / per_zenith, 1e-3 * sky.zenith_luminance);
   const Eigen::Vector3f e = SkyModel(sky).Irradiance(Eigen::Vector3f::UnitZ());
   const double lum = 0.2126 * e.x() + 0.7152 * e.y() + 0.0722 * e.z();
   EXPECT_NEAR(lum / target, 1.0, 0.02);

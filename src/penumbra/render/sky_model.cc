@@ -430,6 +430,15 @@ double SkyModel::HorizontalIlluminancePerZenithLuminance(const Sky& sky) {
   return e;
 }
 
+float SkyModel::PhysicalZenithLuminance(const Sky& sky) {
+  const double per_zenith = HorizontalIlluminancePerZenithLuminance(sky);
+  const Eigen::Vector3d sun = sky.sun_direction_W.normalized();
+  const float elevation_deg =
+      static_cast<float>(std::asin(std::clamp(sun.z(), -1.0, 1.0)) * 180.0 / kPi);
+  const double diffuse = SkyDiffuseHorizontalIlluminance(elevation_deg, sky.turbidity);
+  return per_zenith > 0 ? static_cast<float>(diffuse / per_zenith) : 0.0f;
+}
+
 Eigen::Vector3f SkyModel::Radiance(const Eigen::Vector3f& dir_W) const {
   return impl_->Eval(dir_W.cast<double>()).cast<float>();
 }

@@ -63,6 +63,13 @@ class SkyModel {
   /// @throws ConfigError as the constructor for a bad turbidity or sun direction.
   static double HorizontalIlluminancePerZenithLuminance(const Sky& sky);
 
+  /// the zenith luminance (cd/m^2) of daylight by the numbers for `sky`'s sun elevation and
+  /// turbidity: the one whose upper hemisphere gives the clear sky's diffuse horizontal
+  /// illuminance SkyDiffuseHorizontalIlluminance (render/sky_math.h) on a horizontal surface;
+  /// 0 with the sun at or below the horizon.
+  /// @throws ConfigError as the constructor for a bad turbidity or sun direction.
+  static float PhysicalZenithLuminance(const Sky& sky);
+
   /// irradiance (lux per channel) on a surface with unit normal n_W from the whole sky,
   /// ignoring occlusion: integral of Radiance(w) max(0, n.w) dw. precomputed on an octahedral
   /// grid of normals, bilinear between nodes (no trigonometry; within 1% of the integral).

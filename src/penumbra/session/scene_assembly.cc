@@ -327,11 +327,8 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
     // luminance is the one that gives the clear sky's diffuse horizontal illuminance there.
     const float elevation = static_cast<float>(s.sun_elevation_deg);
     const float turbidity = static_cast<float>(s.turbidity);
-    if (scene.sky.type == Sky::Type::kDaylight) {
-      const double per_zenith = SkyModel::HorizontalIlluminancePerZenithLuminance(scene.sky);
-      const double diffuse = SkyDiffuseHorizontalIlluminance(elevation, turbidity);
-      scene.sky.zenith_luminance = per_zenith > 0 ? static_cast<float>(diffuse / per_zenith) : 0.0f;
-    }
+    if (scene.sky.type == Sky::Type::kDaylight)
+      scene.sky.zenith_luminance = SkyModel::PhysicalZenithLuminance(scene.sky);
     Light sun;
     sun.name = "default_sun";
     sun.type = Light::Type::kDirectional;
