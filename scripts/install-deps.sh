@@ -30,6 +30,7 @@ pkgs=(
   pybind11-dev python3-pybind11  # the batched rollout's Python module (_penumbra_rollout)
   python3-torch python3-matplotlib python3-opencv  # train/ (PPO, curves) and the policy walking test
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for bench/fuzz/run.sh (docs/fuzzing.md)
+  libglfw3-dev xvfb xauth  # scripts/compare_with_mujoco.py: MuJoCo's own renderer (tools/mujoco_offscreen.cc) under Xvfb
 )
 missing=()
 for p in "${pkgs[@]}"; do

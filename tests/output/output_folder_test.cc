@@ -40,6 +40,8 @@ void WriteEarlierRun(const testing::TempDir& dir) {
                         "out/sensors/joints.csv",
                         "out/ground_truth/gt.csv",
                         "out/ground_truth/gt_contacts.csv",
+                        "out/environments/outdoor-6df88287a734f8a6.xml",
+                        "out/environments/outdoor-terrain-c52f209b89af0ab6.hfield",
                         "out/cam/rgb/.000001.png.tmp-42-7"})
     dir.Write(f, "x");
 }

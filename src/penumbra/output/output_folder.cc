@@ -47,7 +47,9 @@ bool IsScanFile(const std::string& name) {
 // a content-named file of the `meshes` folder (core/output_file.h WriteContentNamedFile):
 // STEM-<16 hex digits>.stl / .msh / .xml / .hfield: STL meshes converted from a URDF's
 // COLLADA and other meshes, MuJoCo .msh meshes, the MJCF models of mesh models and their
-// collision height fields (assets/mesh_model.h, assets/mjcf_mesh_conversion.h)
+// collision height fields (assets/mesh_model.h, assets/mjcf_mesh_conversion.h); the
+// `environments` folder holds the same kind of files: generated environments' models and
+// terrain height fields (session/session.cc)
 bool IsMeshFile(const std::string& name) {
   const size_t dot = name.rfind('.');
   if (dot == std::string::npos) return false;
@@ -85,10 +87,10 @@ class Scanner {
           if (file && kTopFiles.count(name)) continue;
           if (file && EndsWith(name, ".plog")) continue;  // a run log (--record)
           if (dir_entry) {
-            Folder(p, name == "lidar"              ? Kind::kLidarFolder
-                      : name == "meshes"           ? Kind::kMeshFolder
-                      : kSensorFolders.count(name) ? Kind::kSensorFolder
-                                                   : Kind::kCameraFolder);
+            Folder(p, name == "lidar"                              ? Kind::kLidarFolder
+                      : name == "meshes" || name == "environments" ? Kind::kMeshFolder
+                      : kSensorFolders.count(name)                 ? Kind::kSensorFolder
+                                                                   : Kind::kCameraFolder);
             continue;
           }
           if (!file) {

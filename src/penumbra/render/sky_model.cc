@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/sky_math.h"
 
 namespace penumbra {
 namespace {
@@ -173,6 +174,11 @@ struct SkyModel::Impl {
     if (type == Sky::Type::kUniform) return uniform;
     return d.z() < 0 ? ground : Upper(d);
   }
+  // MJCF skybox seen by camera and mirror rays (null: none), and the radiance of a white texel.
+  SkyboxBackground skybox;
+  double skybox_white = 0;
+
+  void SetUpDaylight(const Sky& sky);
   void BuildSampling();
   void BuildIrradiance();
 };
@@ -276,7 +282,97 @@ void SkyModel::Impl::BuildIrradiance() {
   }
 }
 
-SkyModel::SkyModel(const Sky& sky) {
+// the daylight model's state for `sky` (a daylight sky): validation, Perez coefficients, zenith
+// values and the ground below the horizon.
+void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
+  const double t = sky.turbidity;
+  if (!(t >= 1.7 && t <= 10))
+    throw ConfigError("", 0, "sky.turbidity",
+                      "got " + std::to_string(t) + "; expected a turbidity in [1.7, 10]");
+  const double norm = sky.sun_direction_W.norm();
+  if (!(norm > 1e-9) || !sky.sun_direction_W.allFinite())
+    throw ConfigError("", 0, "sky.sun_direction_W", "expected a non-zero finite direction");
+  if (!(sky.zenith_luminance >= 0) || !std::isfinite(sky.zenith_luminance))
+    throw ConfigError("", 0, "sky.zenith_luminance", "expected a finite luminance >= 0 cd/m^2");
+  // the model's fits hold for the sun above the horizon; a lower sun is moved up to it.
+  Eigen::Vector3d sun = sky.sun_direction_W / norm;
+  if (sun.z() < 0) {
+    sun.z() = 0;
+    sun = sun.norm() > 1e-9 ? Eigen::Vector3d(sun.normalized()) : Eigen::Vector3d(1, 0, 0);
+  }
+  this->sun = sun;
+  const double ts = std::acos(std::clamp(sun.z(), 0.0, 1.0));
+  this->theta_sun = ts;
+  // Perez coefficients as linear functions of turbidity (Preetham et al. 1999, appendix A.2).
+  this->perez_y = {0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251,
+                   0.1206 * t - 2.5771, -0.0670 * t + 0.3703};
+  this->perez_x = {-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125,
+                   -0.0641 * t - 0.8989, -0.0033 * t + 0.0452};
+  this->perez_yc = {-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102,
+                    -0.0441 * t - 1.6537, -0.0109 * t + 0.0529};
+  // zenith chromaticity (appendix A.2): [T^2 T 1] M [ts^3 ts^2 ts 1]^T.
+  const double t_vec[3] = {t * t, t, 1};
+  const double s_vec[4] = {ts * ts * ts, ts * ts, ts, 1};
+  static constexpr double kMx[3][4] = {{0.00166, -0.00375, 0.00209, 0},
+                                       {-0.02903, 0.06377, -0.03202, 0.00394},
+                                       {0.11693, -0.21196, 0.06052, 0.25886}};
+  static constexpr double kMy[3][4] = {{0.00275, -0.00610, 0.00317, 0},
+                                       {-0.04214, 0.08970, -0.04153, 0.00516},
+                                       {0.15346, -0.26756, 0.06670, 0.26688}};
+  double xz = 0, yz = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) {
+      xz += t_vec[i] * kMx[i][j] * s_vec[j];
+      yz += t_vec[i] * kMy[i][j] * s_vec[j];
+    }
+  // the zenith luminance of the model, Yz = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192
+  // kcd/m^2, is replaced by the configured Sky::zenith_luminance (the overall scale of the
+  // model's luminance is only a fit; its angular distribution is kept).
+  const double cos_ts = std::cos(ts);
+  this->y_scale = sky.zenith_luminance / this->perez_y(1.0, ts, cos_ts);
+  this->x_scale = xz / this->perez_x(1.0, ts, cos_ts);
+  this->yc_scale = yz / this->perez_yc(1.0, ts, cos_ts);
+  // below the horizon: a Lambertian ground of albedo kGroundAlbedo lit by this sky alone
+  // (the sun is a separate Light; its bounce is not included), radiance
+  // G = albedo / pi * E_up, with E_up the sky irradiance on an upward-facing surface.
+  // constant over the lower hemisphere, it darkens the horizon value as a ground bounce.
+  double e_up[3] = {0, 0, 0};
+  const double dphi = 2 * kPi / kSampleCols;
+  for (int r = 0; r < kSampleRows; ++r) {
+    const double t0 = r * 0.5 * kPi / kSampleRows, t1 = (r + 1) * 0.5 * kPi / kSampleRows;
+    const double theta = 0.5 * (t0 + t1);
+    // integral of cos(theta) d omega over the cell.
+    const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
+    for (int c = 0; c < kSampleCols; ++c) {
+      const Eigen::Vector3d l = this->Upper(DirectionFromAngles(theta, (c + 0.5) * dphi));
+      for (int k = 0; k < 3; ++k) e_up[k] += l[k] * w;
+    }
+  }
+  this->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / kPi);
+}
+
+SkyboxBackground MjcfSkyboxOf(const SceneDescription& scene) {
+  SkyboxBackground out;
+  for (const Texture& t : scene.textures) {
+    if (t.kind == Texture::Kind::kSkybox && t.image != nullptr) {
+      out.image = t.image;
+      break;
+    }
+  }
+  if (out.image == nullptr) return out;
+  double e = 0;
+  for (const Light& l : scene.lights) {
+    if (l.type != Light::Type::kDirectional || !l.active || l.body != 0 || l.mjcf_light >= 0)
+      continue;
+    const double n = l.direction_B.norm();
+    const double cosine = n > 0 ? -l.direction_B.z() / n : 0.0;
+    if (cosine > 0) e += static_cast<double>(l.intensity) * cosine;
+  }
+  out.sun_horizontal_lux = static_cast<float>(e);
+  return out;
+}
+
+SkyModel::SkyModel(const Sky& sky, SkyboxBackground skybox) {
   auto impl = std::make_shared<Impl>();
   impl->type = sky.type;
   if (sky.type == Sky::Type::kUniform) {
@@ -285,79 +381,96 @@ SkyModel::SkyModel(const Sky& sky) {
                         "uniform sky radiance must be finite and >= 0 per channel");
     impl->uniform = sky.radiance.cast<double>();
   } else {
-    const double t = sky.turbidity;
-    if (!(t >= 1.7 && t <= 10))
-      throw ConfigError("", 0, "sky.turbidity",
-                        "got " + std::to_string(t) + "; expected a turbidity in [1.7, 10]");
-    const double norm = sky.sun_direction_W.norm();
-    if (!(norm > 1e-9) || !sky.sun_direction_W.allFinite())
-      throw ConfigError("", 0, "sky.sun_direction_W", "expected a non-zero finite direction");
-    if (!(sky.zenith_luminance >= 0) || !std::isfinite(sky.zenith_luminance))
-      throw ConfigError("", 0, "sky.zenith_luminance", "expected a finite luminance >= 0 cd/m^2");
-    // the model's fits hold for the sun above the horizon; a lower sun is moved up to it.
-    Eigen::Vector3d sun = sky.sun_direction_W / norm;
-    if (sun.z() < 0) {
-      sun.z() = 0;
-      sun = sun.norm() > 1e-9 ? Eigen::Vector3d(sun.normalized()) : Eigen::Vector3d(1, 0, 0);
-    }
-    impl->sun = sun;
-    const double ts = std::acos(std::clamp(sun.z(), 0.0, 1.0));
-    impl->theta_sun = ts;
-    // Perez coefficients as linear functions of turbidity (Preetham et al. 1999, appendix A.2).
-    impl->perez_y = {0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251,
-                     0.1206 * t - 2.5771, -0.0670 * t + 0.3703};
-    impl->perez_x = {-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125,
-                     -0.0641 * t - 0.8989, -0.0033 * t + 0.0452};
-    impl->perez_yc = {-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102,
-                      -0.0441 * t - 1.6537, -0.0109 * t + 0.0529};
-    // zenith chromaticity (appendix A.2): [T^2 T 1] M [ts^3 ts^2 ts 1]^T.
-    const double t_vec[3] = {t * t, t, 1};
-    const double s_vec[4] = {ts * ts * ts, ts * ts, ts, 1};
-    static constexpr double kMx[3][4] = {{0.00166, -0.00375, 0.00209, 0},
-                                         {-0.02903, 0.06377, -0.03202, 0.00394},
-                                         {0.11693, -0.21196, 0.06052, 0.25886}};
-    static constexpr double kMy[3][4] = {{0.00275, -0.00610, 0.00317, 0},
-                                         {-0.04214, 0.08970, -0.04153, 0.00516},
-                                         {0.15346, -0.26756, 0.06670, 0.26688}};
-    double xz = 0, yz = 0;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 4; ++j) {
-        xz += t_vec[i] * kMx[i][j] * s_vec[j];
-        yz += t_vec[i] * kMy[i][j] * s_vec[j];
-      }
-    // the zenith luminance of the model, Yz = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192
-    // kcd/m^2, is replaced by the configured Sky::zenith_luminance (the overall scale of the
-    // model's luminance is only a fit; its angular distribution is kept).
-    const double cos_ts = std::cos(ts);
-    impl->y_scale = sky.zenith_luminance / impl->perez_y(1.0, ts, cos_ts);
-    impl->x_scale = xz / impl->perez_x(1.0, ts, cos_ts);
-    impl->yc_scale = yz / impl->perez_yc(1.0, ts, cos_ts);
-    // below the horizon: a Lambertian ground of albedo kGroundAlbedo lit by this sky alone
-    // (the sun is a separate Light; its bounce is not included), radiance
-    // G = albedo / pi * E_up, with E_up the sky irradiance on an upward-facing surface.
-    // constant over the lower hemisphere, it darkens the horizon value as a ground bounce.
-    double e_up[3] = {0, 0, 0};
-    const double dphi = 2 * kPi / kSampleCols;
-    for (int r = 0; r < kSampleRows; ++r) {
-      const double t0 = r * 0.5 * kPi / kSampleRows, t1 = (r + 1) * 0.5 * kPi / kSampleRows;
-      const double theta = 0.5 * (t0 + t1);
-      // integral of cos(theta) d omega over the cell.
-      const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
-      for (int c = 0; c < kSampleCols; ++c) {
-        const Eigen::Vector3d l = impl->Upper(DirectionFromAngles(theta, (c + 0.5) * dphi));
-        for (int k = 0; k < 3; ++k) e_up[k] += l[k] * w;
-      }
-    }
-    impl->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / kPi);
+    impl->SetUpDaylight(sky);
   }
+  if (skybox.image != nullptr) {
+    if (skybox.image->faces() != 6 || skybox.image->level(0).width != skybox.image->level(0).height)
+      throw ConfigError("", 0, "skybox",
+                        "expected a skybox texture of six square faces (MuJoCo's cube layout)");
+    if (!(skybox.sun_horizontal_lux >= 0) || !std::isfinite(skybox.sun_horizontal_lux))
+      throw ConfigError("", 0, "skybox.sun_horizontal_lux", "expected a finite value >= 0 lux");
+  }
+  impl->skybox = std::move(skybox);
   impl->BuildSampling();
   impl->BuildIrradiance();
+  if (impl->skybox.image != nullptr) {
+    // a white Lambertian surface facing up under the sky and the sun.
+    const Eigen::Vector3f e = OctLookup(impl->irradiance, kIrrSide, Eigen::Vector3f(0, 0, 1));
+    const double e_up = Luminance(e.cast<double>()) + impl->skybox.sun_horizontal_lux;
+    impl->skybox_white = e_up / kPi;
+  }
   impl_ = std::move(impl);
+}
+
+double SkyModel::HorizontalIlluminancePerZenithLuminance(const Sky& sky) {
+  Sky unit = sky;
+  unit.type = Sky::Type::kDaylight;
+  unit.zenith_luminance = 1.0f;
+  Impl m;
+  m.type = Sky::Type::kDaylight;
+  m.SetUpDaylight(unit);
+  // luminance Y (the Perez function of Y scaled to the zenith) times cos(theta) over the upper
+  // hemisphere, midpoint rule.
+  constexpr int kRows = 256, kCols = 512;
+  const double dphi = 2 * kPi / kCols;
+  double e = 0;
+  for (int r = 0; r < kRows; ++r) {
+    const double t0 = r * 0.5 * kPi / kRows, t1 = (r + 1) * 0.5 * kPi / kRows;
+    const double theta = 0.5 * (t0 + t1);
+    // integral of cos(theta) d omega over the cell.
+    const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
+    double row = 0;
+    for (int c = 0; c < kCols; ++c) {
+      const Eigen::Vector3d d = DirectionFromAngles(theta, (c + 0.5) * dphi);
+      const double cos_gamma = std::clamp(d.dot(m.sun), -1.0, 1.0);
+      row += m.y_scale * m.perez_y(std::clamp(d.z(), 0.0, 1.0), std::acos(cos_gamma), cos_gamma);
+    }
+    e += row * w;
+  }
+  return e;
+}
+
+float SkyModel::PhysicalZenithLuminance(const Sky& sky) {
+  const double per_zenith = HorizontalIlluminancePerZenithLuminance(sky);
+  const Eigen::Vector3d sun = sky.sun_direction_W.normalized();
+  const float elevation_deg =
+      static_cast<float>(std::asin(std::clamp(sun.z(), -1.0, 1.0)) * 180.0 / kPi);
+  const double diffuse = SkyDiffuseHorizontalIlluminance(elevation_deg, sky.turbidity);
+  return per_zenith > 0 ? static_cast<float>(diffuse / per_zenith) : 0.0f;
 }
 
 Eigen::Vector3f SkyModel::Radiance(const Eigen::Vector3f& dir_W) const {
   return impl_->Eval(dir_W.cast<double>()).cast<float>();
 }
+
+Eigen::Vector3f SkyModel::Background(const Eigen::Vector3f& dir_W) const {
+  const Impl& m = *impl_;
+  if (m.skybox.image == nullptr) return Radiance(dir_W);
+  float qx, qy, qz, s, t;
+  int face = 0;
+  SkyboxLookupDirection(dir_W.x(), dir_W.y(), dir_W.z(), &qx, &qy, &qz);
+  if (!CubeFaceCoords(qx, qy, qz, &face, &s, &t)) return Eigen::Vector3f::Zero();
+  // bilinear between the texel centres of level 0, clamped to the face.
+  const TextureLevel& level = m.skybox.image->level(0);
+  const int w = level.width;
+  const float* decode = SrgbDecodeTable();
+  const float fx = std::clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
+  const float fy = std::clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
+  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, w - 1);
+  const float ax = fx - x0, ay = fy - y0;
+  const auto texel = [&](int x, int y) {
+    const uint8_t* p = level.rgb_srgb.data() + 3 * ((static_cast<size_t>(face) * w + y) * w + x);
+    return Eigen::Vector3f(decode[p[0]], decode[p[1]], decode[p[2]]);
+  };
+  const Eigen::Vector3f c = (1 - ay) * ((1 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
+                            ay * ((1 - ax) * texel(x0, y1) + ax * texel(x1, y1));
+  return c * static_cast<float>(m.skybox_white);
+}
+
+const SkyboxBackground& SkyModel::skybox() const { return impl_->skybox; }
+
+float SkyModel::skybox_white_luminance() const { return static_cast<float>(impl_->skybox_white); }
 
 Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
   return OctLookup(impl_->irradiance, kIrrSide, n_W);

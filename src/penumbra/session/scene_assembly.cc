@@ -6,6 +6,8 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/sky_math.h"
+#include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
 #include "penumbra/session/camera_specs.h"
@@ -320,13 +322,19 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
   scene.sky.sun_direction_W = DirectionFromElevationAzimuth(s.sun_elevation_deg, s.sun_azimuth_deg);
 
   if (world.default_lights) {
-    // a sun matching the sky's sun, plus a soft key light so bare models read well
+    // the bare-model daylight, by the numbers (render/sky_math.h): the sun carries its
+    // direct-normal illuminance at the sky's elevation and turbidity, and the sky's zenith
+    // luminance is the one that gives the clear sky's diffuse horizontal illuminance there.
+    const float elevation = static_cast<float>(s.sun_elevation_deg);
+    const float turbidity = static_cast<float>(s.turbidity);
+    if (scene.sky.type == Sky::Type::kDaylight)
+      scene.sky.zenith_luminance = SkyModel::PhysicalZenithLuminance(scene.sky);
     Light sun;
     sun.name = "default_sun";
     sun.type = Light::Type::kDirectional;
     sun.direction_B = -scene.sky.sun_direction_W;
     sun.color = {1.0f, 0.96f, 0.9f};
-    sun.intensity = 50000.0f;
+    sun.intensity = SunDirectNormalIlluminance(elevation, turbidity);
     sun.angular_radius_deg = 0.2665f;
     scene.lights.push_back(sun);
   }

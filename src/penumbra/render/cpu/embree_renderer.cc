@@ -40,7 +40,7 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       ray_scene_(std::make_unique<RayScene>(scene_)),
       materials_(scene_, settings_.max_anisotropy),
       lights_(scene_),
-      sky_(scene_.sky),
+      sky_(scene_.sky, MjcfSkyboxOf(scene_)),
       effects_(scene_,
                [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
                  return std::make_unique<RayScene>(statics);

@@ -54,7 +54,7 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
       if (fx->sun_direction_W) sky.sun_direction_W = *fx->sun_direction_W;
       sky.radiance *= fx->sky_luminance_scale;
       sky.zenith_luminance *= fx->sky_luminance_scale;
-      effects_sky_ = std::make_unique<SkyModel>(sky);
+      effects_sky_ = std::make_unique<SkyModel>(sky, base_sky.skybox());
       effects_sky_sun_ = fx->sun_direction_W;
       effects_sky_scale_ = fx->sky_luminance_scale;
     }

@@ -379,7 +379,10 @@ int64_t PathIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHits& p
           // the ray leaves the scene: sky and sun discs.
           if (fl.sky_active) {
             const float w = from_camera ? 1.0f : PowerHeuristic(prev_pdf, ctx.sky->Pdf(ray.d));
-            L += w * beta.cwiseProduct(ctx.sky->Radiance(ray.d));
+            // the camera and mirrors see the MJCF skybox where there is one (Background).
+            const bool seen = from_camera || prev_pdf == kInf;
+            L +=
+                w * beta.cwiseProduct(seen ? ctx.sky->Background(ray.d) : ctx.sky->Radiance(ray.d));
           }
           for (const SunDisc& sun : fl.suns) {
             if (ray.d.dot(sun.to_sun) < sun.cos_max) continue;

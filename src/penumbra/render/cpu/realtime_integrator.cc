@@ -55,7 +55,7 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
   SurfaceHit h;
   ++*traced;
   const Eigen::Vector3f d = ray.d.normalized();
-  if (!ctx.scene->Intersect(ray, &h)) return ctx.sky->Radiance(d);
+  if (!ctx.scene->Intersect(ray, &h)) return ctx.sky->Background(d);
   const Eigen::Vector3f wo = -d;
   const TextureFootprint footprint =
       ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h);
@@ -307,7 +307,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         pbr.roughness[k] = 1, pbr.metallic[k] = 0, pbr.specular[k] = 0;
         if (k < m) {
           const int u = lane_u[k], v = lane_v[k];
-          const Eigen::Vector3f sky = ctx.sky->Radiance(primary.rays[i].d.normalized());
+          const Eigen::Vector3f sky = ctx.sky->Background(primary.rays[i].d.normalized());
           float* Lp = out.radiance->at(u, v);
           Lp[0] = sky.x(), Lp[1] = sky.y(), Lp[2] = sky.z();
           if (out.albedo) std::fill_n(out.albedo->at(u, v), 3, 0.0f);

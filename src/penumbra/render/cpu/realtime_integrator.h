@@ -11,7 +11,8 @@
 // the context has one; else the unoccluded SkyModel::Irradiance(n)) and S is Karis' analytic
 // fit of the split-sum specular reflectance ("Physically based shading on mobile", Unreal
 // Engine blog 2014); unoccluded, this is exact for a uniform sky and a Lambertian surface. rays
-// that miss see SkyModel::Radiance.
+// that miss (from the camera or off a mirror) see SkyModel::Background: the MJCF skybox where
+// there is one, else SkyModel::Radiance.
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
 // pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
