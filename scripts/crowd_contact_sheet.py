@@ -33,8 +33,8 @@ CAMERAS = {
              "width: 480, height: 300, fovy_deg: 72, rate_hz: 0.5, "
              "outputs: [rgb]}",
     # above the west end of the main aisle, looking east along it
-    "warehouse": "{name: overview, pose: {xyz: [-16.0, 1.4, 5.0], rpy_deg: [0, 20, 0]}, "
-                 "width: 480, height: 300, fovy_deg: 60, rate_hz: 0.5, "
+    "warehouse": "{name: overview, pose: {xyz: [-14.7, 1.4, 4.0], rpy_deg: [0, 18, 0]}, "
+                 "width: 480, height: 300, fovy_deg: 65, rate_hz: 0.5, "
                  "outputs: [rgb]}",
 }
 TIMES = [2.0, 4.0, 6.0]

