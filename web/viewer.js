@@ -424,10 +424,64 @@ function onScene(s) {
     scene3.add(line);
     trails.set(i, { line, points, count: 0 });
   });
+  buildNpcMap(s.npc_map);
   // the poses as the run started (a paused run sends no state before its first step)
   if (s.X_WB && !viewer.state) applyPoses(s.X_WB);
   else if (viewer.state) applyPoses(viewer.state.X_WB);
 }
+
+// a crowd's walkable map (scene.npc_map, docs/npcs.md) on its floor: one texel per cell, the
+// colours of `penumbra npc-map` (people green, vehicles blue, blocked and too-close cells left
+// clear), the lanes as orange lines and the areas' centres as red dots
+let npcMapObject = null;
+const npcMapColours = { '2': [150, 215, 140, 150], '3': [110, 160, 225, 170] };
+function buildNpcMap(m) {
+  if (npcMapObject) scene3.remove(npcMapObject);
+  npcMapObject = null;
+  viewer.npcMap = null;
+  if (!m || !m.nx || !m.ny || m.cells.length !== m.nx * m.ny) return;
+  const data = new Uint8Array(4 * m.nx * m.ny);
+  let drawn = 0;
+  for (let i = 0; i < m.cells.length; i++) {
+    const c = npcMapColours[m.cells[i]];
+    if (!c) continue;
+    data.set(c, 4 * i);
+    drawn++;
+  }
+  // row 0 of the texture (v = 0) is the grid's row iy = 0, the plane's south edge
+  const texture = new THREE.DataTexture(data, m.nx, m.ny, THREE.RGBAFormat);
+  texture.magFilter = THREE.NearestFilter;
+  texture.minFilter = THREE.NearestFilter;
+  texture.needsUpdate = true;
+  // 5 cm above the crowd's floor: above floor slabs (the house's top 3 cm higher) and rugs
+  const w = m.nx * m.cell_m, h = m.ny * m.cell_m, z = m.z + 0.05;
+  const group = new THREE.Group();
+  const plane = new THREE.Mesh(new THREE.PlaneBufferGeometry(w, h),
+    new THREE.MeshBasicMaterial({ map: texture, transparent: true, depthWrite: false }));
+  plane.position.set(m.min[0] + w / 2, m.min[1] + h / 2, z);
+  group.add(plane);
+  const laneMaterial = new THREE.LineBasicMaterial({ color: 0xf08c14 });
+  for (const lane of m.lanes || []) {
+    const pts = [];
+    for (const [x, y] of lane.points) pts.push(x, y, z + 0.005);
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
+    group.add(new THREE.Line(geo, laneMaterial));
+  }
+  const dot = new THREE.MeshBasicMaterial({ color: 0xd21e1e });
+  for (const a of m.areas || []) {
+    const d = new THREE.Mesh(new THREE.CircleBufferGeometry(0.15, 16), dot);
+    d.position.set((a.min[0] + a.max[0]) / 2, (a.min[1] + a.max[1]) / 2, z + 0.005);
+    group.add(d);
+  }
+  group.visible = $('showNpcMap').checked;
+  scene3.add(group);
+  npcMapObject = group;
+  viewer.npcMap = { nx: m.nx, ny: m.ny, cells: drawn, lanes: (m.lanes || []).length };
+}
+$('showNpcMap').addEventListener('change', () => {
+  if (npcMapObject) npcMapObject.visible = $('showNpcMap').checked;
+});
 
 function onState(m) {
   viewer.state = m;

@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
 
+#include "penumbra/effects/agent_animation.h"
 #include "penumbra/effects/orca.h"
 #include "penumbra/effects/walkable_grid.h"
 
@@ -193,6 +195,105 @@ TEST(CrowdSimTest, BlockAgentsStepIntoTheRobotsPath) {
     calm.Step({robot});
     EXPECT_GT(std::abs(calm.states()[0].position_W.y() - 1.0), 0.65);
   }
+}
+
+// a 16 x 16 m hall with walls round it
+OccupancyGrid OpenHallGrid() {
+  OccupancyGrid g;
+  g.min_W = {-8.2, -8.2};
+  g.cell_m = 0.1;
+  g.nx = 164;
+  g.ny = 164;
+  g.blocked.assign(static_cast<size_t>(g.nx) * g.ny, 0);
+  for (int iy = 0; iy < g.ny; ++iy)
+    for (int ix = 0; ix < g.nx; ++ix) {
+      const double x = g.min_W.x() + (ix + 0.5) * g.cell_m, y = g.min_W.y() + (iy + 0.5) * g.cell_m;
+      g.blocked[iy * g.nx + ix] = std::abs(x) > 8.0 || std::abs(y) > 8.0;
+    }
+  return g;
+}
+
+TEST(CrowdSimTest, VehicleWheelbaseIsTheBodysAxleSpacing) {
+  // the bicycle model steers the body that is drawn: its wheelbase is the distance between
+  // the body's front and rear axles (compose/agent_bodies.cc places the wheels there)
+  for (AgentKind kind : {AgentKind::kForklift, AgentKind::kCart}) {
+    double front = -1e9, rear = 1e9;
+    for (const AgentWheel& w : AgentWheels(kind)) {
+      front = std::max(front, w.centre.x());
+      rear = std::min(rear, w.centre.x());
+    }
+    EXPECT_NEAR(KindModel(kind).wheelbase_m, front - rear, 1e-12);
+    EXPECT_NEAR(AgentWheelbase(kind), front - rear, 1e-12);
+  }
+  EXPECT_NEAR(KindModel(AgentKind::kForklift).wheelbase_m, 1.1, 1e-12);
+  EXPECT_NEAR(KindModel(AgentKind::kCart).wheelbase_m, 0.8, 1e-12);
+  EXPECT_EQ(KindModel(AgentKind::kPerson).wheelbase_m, 0.0);
+}
+
+TEST(CrowdSimTest, AForkliftsWheelsSteerAsItsBicycleModelTurns) {
+  // a forklift patrolling a square in an open hall: in its corners the crowd's bicycle model
+  // turns on curvature k (measured from its poses) with steering atan(L k); the rear wheels of
+  // its body, animated from the same poses, must show that angle (negated: rear steering)
+  const auto hall =
+      std::make_shared<const WalkableGrid>(OpenHallGrid(), 0.7, Eigen::Vector2d(0, 0));
+  AgentConfig f;
+  f.name = "lift";
+  f.kind = AgentKind::kForklift;
+  f.motion = AgentMotion::kCrowd;
+  f.waypoints = {{-4, -4}, {4, -4}, {4, 4}, {-4, 4}};
+  f.route = AgentRoute::kLoop;
+  f.speed_m_s = 1.5;
+  f.pause_sec = 0;
+  CrowdSim sim({f}, hall, hall, 1);
+  std::vector<CrowdAgentState> states = {sim.states()[0]};
+  for (int k = 0; k < 800; ++k) {  // 40 s
+    sim.Step({});
+    states.push_back(sim.states()[0]);
+  }
+  const double dt = sim.dt();
+  // the crowd's poses, linear between its steps
+  const auto X_WA = [&](double t) {
+    const double u = std::clamp(t / dt, 0.0, static_cast<double>(states.size() - 1));
+    const size_t k = std::min(static_cast<size_t>(u), states.size() - 2);
+    const double a = u - static_cast<double>(k);
+    const CrowdAgentState &s0 = states[k], &s1 = states[k + 1];
+    Pose X = Pose::Identity();
+    const Eigen::Vector2d p = (1 - a) * s0.position_W + a * s1.position_W;
+    const double yaw = s0.yaw + a * std::remainder(s1.yaw - s0.yaw, 2 * M_PI);
+    X.translation() = Eigen::Vector3d(p.x(), p.y(), 0);
+    X.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    return X;
+  };
+  AgentAnimator animator(AgentKind::kForklift, 1.75, X_WA);
+  const std::vector<AgentWheel> wheels = AgentWheels(AgentKind::kForklift);
+  const AgentWheel* rear = nullptr;
+  for (const AgentWheel& w : wheels)
+    if (w.steer == -1) rear = &w;
+  ASSERT_NE(rear, nullptr);
+  const double L = KindModel(AgentKind::kForklift).wheelbase_m;
+  int compared = 0;
+  double worst = 0;
+  // steady turns: the curvature over each of the last four 0.25 s windows agrees within 2 %
+  const int w = 5;
+  for (size_t k = 4 * w; k + 1 < states.size(); ++k) {
+    double kappa[4];
+    bool steady = true;
+    for (int j = 0; j < 4; ++j) {
+      const CrowdAgentState &a = states[k - (j + 1) * w], &b = states[k - j * w];
+      const double ds = (b.position_W - a.position_W).norm();
+      steady = steady && ds > 0.2;
+      kappa[j] = steady ? std::remainder(b.yaw - a.yaw, 2 * M_PI) / ds : 0;
+    }
+    for (int j = 1; j < 4 && steady; ++j)
+      steady = std::abs(kappa[j] - kappa[0]) <= 0.02 * std::abs(kappa[0]);
+    if (!steady || std::abs(kappa[0]) < 0.2) continue;
+    const double want = -std::atan(L * kappa[0]);
+    const double got = animator.SteerAngle(static_cast<double>(k) * dt, *rear);
+    worst = std::max(worst, std::abs(got - want));
+    ++compared;
+  }
+  EXPECT_GE(compared, 5);  // steady stretches of its corners
+  EXPECT_LT(worst, 0.01);   // rad
 }
 
 // every agent's pose over 30 s of a mixed crowd (random goals) as raw bits

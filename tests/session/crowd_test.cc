@@ -135,6 +135,81 @@ TEST(CrowdTest, WarehouseForkliftsDriveTheAisleAmongPeopleFor60s) {
     if (a.kind == AgentKind::kForklift) EXPECT_GE(a.waypoints.size(), 2u);
 }
 
+TEST(CrowdTest, PresetPeopleAreAsTallAsThePresetDrewThem) {
+  // the preset draws each person's height in [1.55, 1.95] m from the seed; the walker's body
+  // (compose/agent_bodies.cc: head radius 0.063 H) must be built at that height
+  const testing::TempDir dir;
+  const Session session(LoadWorldFile(CrowdWorldPath("house.yaml")),
+                        CrowdSessionOptions(CrowdPresetFile(dir, "{people: 6}")));
+  int people = 0;
+  double lo = 10, hi = 0;
+  for (const AgentConfig& a : session.effects().agents()) {
+    if (a.kind != AgentKind::kPerson) continue;
+    ++people;
+    EXPECT_TRUE(a.height_given) << a.name;
+    EXPECT_GE(a.height_m, 1.55);
+    EXPECT_LE(a.height_m, 1.95);
+    lo = std::min(lo, a.height_m);
+    hi = std::max(hi, a.height_m);
+    const std::string head = "agents/" + a.name + "/head";
+    int found = 0;
+    for (const Geom& g : session.scene().geoms)
+      if (g.name == head) {
+        ++found;
+        EXPECT_NEAR(g.size.x(), 0.063 * a.height_m, 1e-12) << a.name;
+      }
+    EXPECT_EQ(found, 1) << head;
+  }
+  EXPECT_EQ(people, 6);
+  EXPECT_GT(hi - lo, 0.05);  // not one height for all
+}
+
+TEST(CrowdTest, BlockPeopleOfAPresetReachTheStandingRobotsPathInBothWorlds) {
+  // `behaviour: block` in a preset: each person walks from where the preset placed it (>= 1.5 m
+  // from the robot) into the robot's path: ahead of it along its heading, within its width
+  // plus the person's, less than 2 m in front
+  for (const std::string world_file : {"house.yaml", "warehouse.yaml"}) {
+    const testing::TempDir dir;
+    const Session session(
+        LoadWorldFile(CrowdWorldPath(world_file)),
+        CrowdSessionOptions(CrowdPresetFile(dir, "{people: 3, behaviour: block}")));
+    std::vector<AgentConfig> crowd;
+    for (const AgentConfig& a : session.effects().agents())
+      if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+    ASSERT_EQ(crowd.size(), 3u) << world_file;
+    const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
+    ASSERT_TRUE(map);
+    CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
+    CrowdRobot robot;
+    for (const ModelConfig& m : session.world().models)
+      if (m.is_robot) {
+        robot.position_W = m.pose.xyz.head<2>();
+        robot.yaw = m.pose.rpy_deg.z() * M_PI / 180;
+        robot.radius_m = 0.45;
+        break;
+      }
+    const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
+    const Eigen::Vector2d left(-heading.y(), heading.x());
+    const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+    std::vector<double> reached(crowd.size(), -1);
+    for (int k = 0; k < 600; ++k) {  // 30 s
+      sim.Step({robot});
+      for (size_t i = 0; i < crowd.size(); ++i) {
+        const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
+        const double ahead = d.dot(heading), side = std::abs(d.dot(left));
+        if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
+          reached[i] = sim.time_sec();
+        EXPECT_TRUE(sim.region(i).Walkable(sim.states()[i].position_W));
+      }
+    }
+    for (size_t i = 0; i < crowd.size(); ++i) {
+      EXPECT_GT((crowd[i].waypoints[0] - robot.position_W).norm(), 1.5);
+      EXPECT_GE(reached[i], 0.0) << world_file << ": " << crowd[i].name << " never stood in the "
+                                 << "robot's path";
+    }
+  }
+}
+
 // every agent body's mocap pose over `steps` physics steps of a session with a crowd
 std::vector<double> CrowdTrajectory(uint64_t seed, int steps) {
   const testing::TempDir dir;

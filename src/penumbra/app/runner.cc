@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "penumbra/command/bridge_set.h"
 #include "penumbra/core/build_info.h"
@@ -19,6 +20,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/live_control.h"
+#include "penumbra/session/npc_map_json.h"
 #include "penumbra/session/physics_source.h"
 #include "penumbra/session/run_log_header.h"
 #include "penumbra/session/run_outputs.h"
@@ -147,6 +149,11 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
       agents.push_back(a.position_W);
     WritePngRgb8((out / "npc_map.png").string(),
                  npc_map->Draw(session.effects().sites(), robots, agents));
+    // the same map as data (what the viewer's scene view draws)
+    const std::string json_path = (out / "npc_map.json").string();
+    std::ofstream json_file(json_path);
+    json_file << NpcMapJson(session).dump() << "\n";
+    if (!json_file) throw Error("cannot write " + json_path);
   }
   // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples
   if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);

@@ -37,15 +37,14 @@ std::vector<AgentWheel> AgentWheels(AgentKind kind) {
 }
 
 double AgentWheelbase(AgentKind kind) {
-  switch (kind) {
-    case AgentKind::kPerson:
-      return 0;
-    case AgentKind::kForklift:
-      return 1.1;
-    case AgentKind::kCart:
-      return 0.8;
+  // the body's own axles: the crowd's bicycle model (effects/crowd_sim.h KindModel) and the
+  // wheels' steering read this one number
+  double front = 0, rear = 0;
+  for (const AgentWheel& w : AgentWheels(kind)) {
+    front = std::max(front, w.centre.x());
+    rear = std::min(rear, w.centre.x());
   }
-  return 0;
+  return front - rear;
 }
 
 std::vector<std::string> AgentPartNames(AgentKind kind) {

@@ -47,7 +47,8 @@ struct AgentWheel {
 /// the wheels of a vehicle kind (none for a person): forklift r 0.25 m, wheelbase 1.1 m, rear
 /// steering; cart r 0.1 m, wheelbase 0.8 m, front castors.
 std::vector<AgentWheel> AgentWheels(AgentKind kind);
-/// distance between the front and rear axles, m (0 for a person).
+/// distance between the front and rear axles of AgentWheels(kind), m (0 for a person):
+/// forklift 1.1 m, cart 0.8 m. the crowd's bicycle model uses it too (KindModel).
 double AgentWheelbase(AgentKind kind);
 
 /// the part names of an agent of `kind` after its root, in body order: the walker segments

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "penumbra/core/error.h"
+#include "penumbra/effects/agent_animation.h"
 
 namespace penumbra {
 namespace {
@@ -35,12 +36,12 @@ AgentKindModel KindModel(AgentKind kind) {
     case AgentKind::kForklift:
       m.disc_radius_m = 1.2;
       m.walkable = {0.7, 0.05, 2.3, 2.0};
-      m.wheelbase_m = 1.3;
+      m.wheelbase_m = AgentWheelbase(kind);
       break;
     case AgentKind::kCart:
       m.disc_radius_m = 0.6;
       m.walkable = {0.45, 0.05, 1.2, 0.8};
-      m.wheelbase_m = 0.7;
+      m.wheelbase_m = AgentWheelbase(kind);
       break;
   }
   return m;

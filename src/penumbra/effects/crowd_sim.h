@@ -58,10 +58,11 @@ struct AgentKindModel {
 
 /// person: disc 0.25 m, walkable radius 0.3 m, steps 0.1 m (a 0.144 m pallet is an obstacle),
 /// passes under 2.0 m.
-/// forklift: disc 1.45 m (its 2.75 x 1.1 m footprint about the origin), walkable radius 0.7 m
-/// (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes under 2.3 m, turning
-/// radius 2.0 m, wheelbase 1.3 m. cart: disc 0.6 m, walkable 0.45 m, turning radius 0.8 m,
-/// wheelbase 0.7 m.
+/// forklift: disc 1.2 m (its chassis and counterweight about the origin, not the fork tips),
+/// walkable radius 0.7 m (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes
+/// under 2.3 m, turning radius 2.0 m. cart: disc 0.6 m, walkable 0.45 m, turning radius 0.8 m.
+/// wheelbase: the body's axle spacing, AgentWheelbase (effects/agent_animation.h): forklift
+/// 1.1 m, cart 0.8 m.
 AgentKindModel KindModel(AgentKind kind);
 /// true for the kinds driven by the bicycle model (forklift, cart).
 bool IsVehicle(AgentKind kind);

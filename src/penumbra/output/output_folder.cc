@@ -18,8 +18,9 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::set<std::string> kTopFiles = {
-    "run.json",         "composed.xml",          "trajectory.csv", "camera_info.yaml",
-    "camera_info.json", "semantic_classes.json", "rig.json",       "npc_map.png"};
+    "run.json",         "composed.xml",     "trajectory.csv",
+    "camera_info.yaml", "camera_info.json", "semantic_classes.json",
+    "rig.json",         "npc_map.png",      "npc_map.json"};
 const std::set<std::string> kSensorFolders = {"imu", "sensors", "ground_truth"};
 // image folders are named after the camera outputs
 bool IsImageFolder(const std::string& name) {

@@ -130,7 +130,9 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     Rng rng(HashKeys(seed, kNpcStream, 0, i));
     AgentConfig a = base(name, AgentKind::kPerson);
     a.speed_m_s = preset.npc_speed_m_s;
+    // the preset's own spread of heights (the walkers' bodies read height_m only when given)
     a.height_m = 1.55 + 0.4 * rng.UniformD();
+    a.height_given = true;
     if (i % 2 == 1 && !walk_lanes.empty()) {
       std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
       if ((i / 2 / walk_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());

@@ -20,6 +20,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/session/live_control.h"
+#include "penumbra/session/npc_map_json.h"
 #include "penumbra/session/session.h"
 #include "penumbra/viewer/image_maps.h"
 #include "penumbra/viewer/viewer_messages.h"
@@ -297,6 +298,8 @@ class ViewerBridge : public RunBridge {
     // state message before the first step, and places its bodies and camera from these
     json scene = SceneJson(session_.scene());
     scene["X_WB"] = BodyPosesJson(sim.Snapshot(Simulation::SnapshotContent::kPoses));
+    // a crowd's walkable map, drawn on the floor of the scene view (docs/npcs.md)
+    if (session_.effects().npc_map()) scene["npc_map"] = NpcMapJson(session_);
     scene_ = std::make_shared<const std::string>(scene.dump());
     for (const json& j : model_info_.value("joints", json::array())) {
       const std::string type = j.value("type", "");
