@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "penumbra/render/backends/renderer_factory.h"
@@ -101,6 +102,7 @@ TEST(LampLightingTest, WhiteCeilingNextToASmallLampIsNoiseFreeInOneFrame) {
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);
   const LampTestNoise noise = LampTestCeilingNoise(f, view, 100, 0.6, 1.2);
+  RecordProperty("residual_percent_of_mean", std::to_string(100 * noise.residual / noise.mean));
   ASSERT_GT(noise.pixels, 3000);
   ASSERT_GT(noise.mean, 0);
   EXPECT_LT(noise.residual, 0.01 * noise.mean) << "mean " << noise.mean;
@@ -116,10 +118,11 @@ TEST(LampLightingTest, CeilingInTheFixturesPenumbraIsNoiseFreeInOneFrame) {
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);
   const LampTestNoise noise = LampTestCeilingNoise(f, view, 100, 0.35, 1.1);
+  RecordProperty("residual_percent_of_mean", std::to_string(100 * noise.residual / noise.mean));
   ASSERT_GT(noise.pixels, 3000);
   ASSERT_GT(noise.mean, 0);
-  // measured 3.5 %: the tile's outermost pixels estimate their own fraction from 16 points,
-  // in steps of 1/16 (main: see the report of issue 36 item 5).
+  // measured 2.7 % (main: 113 %); the bare ceiling above: 0.2 %, the fall-off.s curvature
+  // (main: 26 %).
   EXPECT_LT(noise.residual, 0.05 * noise.mean) << "mean " << noise.mean;
 }
 
@@ -166,34 +169,38 @@ TEST(LampLightingTest, SphereLightCosineMatchesNumericalIntegration) {
 }
 
 TEST(LampLightingTest, NoSkyLightLeaksIntoTheFootOfABoxOnAFloorSlab) {
-  // a closed room (floor slab 5 cm thick, walls, ceiling; no ground below it) under a bright
-  // uniform sky, a box standing on the floor and no lamp: every surface inside is dark. the
-  // sky irradiance volume's probes under the floor see the sky from below; they used to light
-  // the foot of the box through the slab.
+  // a closed 8 x 8 x 3 m room (floor slab 2 cm thick, walls, ceiling; no ground below it)
+  // under a bright uniform sky, a box standing on the floor and no lamp: every surface inside
+  // is dark. the sky irradiance volume's probes under the floor see the sky from below, and
+  // its visibility tolerance (0.1 spacing, about 4.5 cm here) is wider than the slab: they
+  // used to light the foot of the box through it.
   SceneDescription s = EmptyScene();
   s.sky.radiance = {1000, 1000, 1000};
   const int grey = AddMaterial(&s, Eigen::Vector3f::Constant(0.7f));
-  AddGeom(&s, GeomShape::kBox, {2.2, 2.2, 0.025}, Translation(0, 0, -0.025), 0, grey);  // floor
-  AddGeom(&s, GeomShape::kBox, {2.2, 2.2, 0.05}, Translation(0, 0, 2.55), 0, grey);     // ceiling
-  AddGeom(&s, GeomShape::kBox, {0.05, 2.2, 1.3}, Translation(2.15, 0, 1.25), 0, grey);
-  AddGeom(&s, GeomShape::kBox, {0.05, 2.2, 1.3}, Translation(-2.15, 0, 1.25), 0, grey);
-  AddGeom(&s, GeomShape::kBox, {2.2, 0.05, 1.3}, Translation(0, 2.15, 1.25), 0, grey);
-  AddGeom(&s, GeomShape::kBox, {2.2, 0.05, 1.3}, Translation(0, -2.15, 1.25), 0, grey);
+  AddGeom(&s, GeomShape::kBox, {4.2, 4.2, 0.01}, Translation(0, 0, -0.01), 0, grey);  // floor
+  AddGeom(&s, GeomShape::kBox, {4.2, 4.2, 0.05}, Translation(0, 0, 3.05), 0, grey);   // ceiling
+  AddGeom(&s, GeomShape::kBox, {0.05, 4.2, 1.55}, Translation(4.15, 0, 1.5), 0, grey);
+  AddGeom(&s, GeomShape::kBox, {0.05, 4.2, 1.55}, Translation(-4.15, 0, 1.5), 0, grey);
+  AddGeom(&s, GeomShape::kBox, {4.2, 0.05, 1.55}, Translation(0, 4.15, 1.5), 0, grey);
+  AddGeom(&s, GeomShape::kBox, {4.2, 0.05, 1.55}, Translation(0, -4.15, 1.5), 0, grey);
   const int box = AddGeom(&s, GeomShape::kBox, {0.25, 0.6, 0.4}, Translation(1.5, 0, 0.4), 0,
                           grey);  // front face x = 1.25, on the floor
   auto r = MakeRenderer(s, TestSettings());
   const CameraView view = MakeView(CameraLookingAlongX({-1.0, 0, 0.3}), 160, 120, 60);
   RenderedFrame f;
   r->Render(IdentitySnapshot(s), view, &f);
-  int box_pixels = 0;
+  int box_pixels = 0, floor_pixels = 0;
   float brightest = 0;
   for (int v = 0; v < f.radiance.height; ++v)
     for (int u = 0; u < f.radiance.width; ++u) {
-      if (*f.geom_id.at(u, v) != 100 + box) continue;
-      ++box_pixels;
+      const int id = *f.geom_id.at(u, v);
+      if (id == 100) ++floor_pixels;
+      if (id != 100 + box && id != 100) continue;
+      box_pixels += id == 100 + box ? 1 : 0;
       brightest = std::max(brightest, f.radiance.at(u, v)[1]);
     }
   ASSERT_GT(box_pixels, 500);
+  ASSERT_GT(floor_pixels, 500);
   // the open sky would give 1000 x 0.7 / 2 = 350 on the box's vertical face.
   EXPECT_LT(brightest, 1.0f);
 }

@@ -218,19 +218,20 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       own[i] = 0;
       if (!(seen[0] && seen[1])) continue;
       // a penumbra: the pixel's other lattice points; on the tile's outermost pixels, whose
-      // window lacks the next tile's half, every point of the 16-point lattice instead, and the
-      // pixel keeps its own fraction (a window cut there leans inwards: steps at tile edges).
+      // window lacks the next tile's half, every point of the 64-point lattice instead, and the
+      // pixel keeps its own fraction (a window cut there leans inwards: steps at tile edges; 16
+      // points of its own left lines of 1/16 steps along the tile edges).
       const SurfaceHit& h = primary.hits[i];
       const int x = i % tile.width, y = i / tile.width;
       const int u = tile.x0 + x, v = tile.y0 + y;
       const int s = LightStratum(u, v);
       own[i] = x == 0 || y == 0 || x == tile.width - 1 || y == tile.height - 1;
-      const int extra = own[i] ? kLightStrata : kPenumbraRays;
+      const int extra = own[i] ? kLightStrata * kPenumbraRays : kPenumbraRays;
       Ray sr;
       sr.o = OffsetRayOrigin(h.p_W, h.ng_W);
       for (int r = 1; r < extra; ++r) {
-        // own: points 4 (s + r) of the 64-point lattice, the 16-point lattice without s.
-        const int index = own[i] ? kPenumbraRays * ((s + r) % kLightStrata) : kPenumbraRays * s + r;
+        // own: every other point of the 64-point lattice.
+        const int index = (kPenumbraRays * s + r) % (kLightStrata * kPenumbraRays);
         float u1, u2;
         LightStratumUniforms(index, kLightStrata * kPenumbraRays, &u1, &u2);
         LightSample ls;
