@@ -121,7 +121,7 @@ TEST(LampLightingTest, CeilingInTheFixturesPenumbraIsNoiseFreeInOneFrame) {
   RecordProperty("residual_percent_of_mean", std::to_string(100 * noise.residual / noise.mean));
   ASSERT_GT(noise.pixels, 3000);
   ASSERT_GT(noise.mean, 0);
-  // measured 2.7 % (main: 113 %); the bare ceiling above: 0.2 %, the fall-off.s curvature
+  // measured 2.7 % (main: 113 %); the bare ceiling above: 0.2 %, the fall-off's curvature
   // (main: 26 %).
   EXPECT_LT(noise.residual, 0.05 * noise.mean) << "mean " << noise.mean;
 }
