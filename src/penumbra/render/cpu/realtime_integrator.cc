@@ -176,34 +176,51 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   visible.resize(n);
   rays.resize(n);
   fraction.resize(n);
-  // the window [x - 2, x + 2] cut at the tile's edges (shifting it inside the tile instead
-  // made steps of several % at every tile edge across a lamp's penumbra).
-  auto window = [](int x, int size, int* x0, int* x1) {
-    *x0 = std::max(x - 2, 0);
-    *x1 = std::min(x + 2, size - 1);
-  };
-  auto same_surface = [&](int i, int ii) {
-    if (ii == i) return true;
+  bool any = false;
+  for (int j = 0; j < num_lights; ++j) any = any || IsExtendedLight(ctx.lights->lights()[j]);
+  if (!any) return;
+  // per pixel, which pixels of the window [x - 2, x + 2] x [y - 2, y + 2], cut at the tile's
+  // edges, lie on its surface (bit (dy + 2) 5 + dx + 2), once for all lights. (shifting the
+  // window inside the tile instead made steps of several % at every tile edge across a lamp's
+  // penumbra.)
+  thread_local std::vector<uint32_t> near;
+  near.assign(n, 0u);
+  for (int i = 0; i < n; ++i) {
+    if (!primary.did_hit[i]) continue;
     const SurfaceHit& h = primary.hits[i];
-    const SurfaceHit& g = primary.hits[ii];
-    if (g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) return false;
-    const Eigen::Vector3f dp = g.p_W - h.p_W;
-    return std::abs(h.ng_W.dot(dp)) <= 0.05f * dp.norm() + 1e-5f;
-  };
-  // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
-  auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
     const int x = i % tile.width, y = i / tile.width;
-    int xa, xb, ya, yb;
-    window(x, tile.width, &xa, &xb);
-    window(y, tile.height, &ya, &yb);
-    for (int yy = ya; yy <= yb; ++yy) {
-      const float wy = yy == y - 2 || yy == y + 2 ? 0.5f : 1.0f;
-      for (int xx = xa; xx <= xb; ++xx) {
-        const int ii = yy * tile.width + xx;
-        if (vis[ii] < 0 || !same_surface(i, ii)) continue;
-        fn(ii, wy * (xx == x - 2 || xx == x + 2 ? 0.5f : 1.0f));
+    uint32_t bits = 0;
+    for (int dy = -2; dy <= 2; ++dy) {
+      if (y + dy < 0 || y + dy >= tile.height) continue;
+      for (int dx = -2; dx <= 2; ++dx) {
+        if (x + dx < 0 || x + dx >= tile.width) continue;
+        const int ii = i + dy * tile.width + dx;
+        if (ii != i) {
+          const SurfaceHit& g = primary.hits[ii];
+          if (!primary.did_hit[ii] || g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) continue;
+          // within 5 % of its distance from i's tangent plane.
+          const Eigen::Vector3f dp = g.p_W - h.p_W;
+          const float off = h.ng_W.dot(dp);
+          if (!(off * off <= 0.0025f * dp.squaredNorm() + 1e-10f)) continue;
+        }
+        bits |= 1u << ((dy + 2) * 5 + dx + 2);
       }
     }
+    near[i] = bits;
+  }
+  // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
+  auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
+    for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
+      const int b = __builtin_ctz(bits);
+      const int dy = b / 5 - 2, dx = b % 5 - 2;
+      const int ii = i + dy * tile.width + dx;
+      if (vis[ii] < 0) continue;
+      fn(ii, (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f));
+    }
+  };
+  auto same_surface = [&](int i, int ii) {
+    const int dy = ii / tile.width - i / tile.width, dx = ii % tile.width - i % tile.width;
+    return (near[i] >> ((dy + 2) * 5 + dx + 2) & 1u) != 0;
   };
   for (int j = 0; j < num_lights; ++j) {
     if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
