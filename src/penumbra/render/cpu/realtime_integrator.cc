@@ -112,7 +112,7 @@ struct Scratch {
 constexpr int kPenumbraRays = 4;
 
 // a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
-// analytic (render/lamp_math.h) and its visibility shared over 4x4 pixels.
+// analytic (render/lamp_math.h) and its visibility shared over 5x5 pixels.
 bool IsExtendedLight(const PosedLight& l) {
   return l.type == Light::Type::kDirectional ? l.cos_angular_radius < 1.0f : l.radius_m > 0;
 }
