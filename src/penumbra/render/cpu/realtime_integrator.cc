@@ -184,30 +184,34 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   // window inside the tile instead made steps of several % at every tile edge across a lamp's
   // penumbra.)
   thread_local std::vector<uint32_t> near;
-  near.assign(n, 0u);
-  for (int i = 0; i < n; ++i) {
-    if (!primary.did_hit[i]) continue;
-    const SurfaceHit& h = primary.hits[i];
-    const int x = i % tile.width, y = i / tile.width;
-    uint32_t bits = 0;
-    for (int dy = -2; dy <= 2; ++dy) {
-      if (y + dy < 0 || y + dy >= tile.height) continue;
-      for (int dx = -2; dx <= 2; ++dx) {
-        if (x + dx < 0 || x + dx >= tile.width) continue;
-        const int ii = i + dy * tile.width + dx;
-        if (ii != i) {
-          const SurfaceHit& g = primary.hits[ii];
-          if (!primary.did_hit[ii] || g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) continue;
-          // within 5 % of its distance from i's tangent plane.
-          const Eigen::Vector3f dp = g.p_W - h.p_W;
-          const float off = h.ng_W.dot(dp);
-          if (!(off * off <= 0.0025f * dp.squaredNorm() + 1e-10f)) continue;
+  bool near_done = false;
+  auto compute_near = [&] {
+    near_done = true;
+    near.assign(n, 0u);
+    for (int i = 0; i < n; ++i) {
+      if (!primary.did_hit[i]) continue;
+      const SurfaceHit& h = primary.hits[i];
+      const int x = i % tile.width, y = i / tile.width;
+      uint32_t bits = 0;
+      for (int dy = -2; dy <= 2; ++dy) {
+        if (y + dy < 0 || y + dy >= tile.height) continue;
+        for (int dx = -2; dx <= 2; ++dx) {
+          if (x + dx < 0 || x + dx >= tile.width) continue;
+          const int ii = i + dy * tile.width + dx;
+          if (ii != i) {
+            const SurfaceHit& g = primary.hits[ii];
+            if (!primary.did_hit[ii] || g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) continue;
+            // within 5 % of its distance from i's tangent plane.
+            const Eigen::Vector3f dp = g.p_W - h.p_W;
+            const float off = h.ng_W.dot(dp);
+            if (!(off * off <= 0.0025f * dp.squaredNorm() + 1e-10f)) continue;
+          }
+          bits |= 1u << ((dy + 2) * 5 + dx + 2);
         }
-        bits |= 1u << ((dy + 2) * 5 + dx + 2);
       }
+      near[i] = bits;
     }
-    near[i] = bits;
-  }
+  };
   // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
   auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
     for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
@@ -226,6 +230,22 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
     if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
     const int8_t* vis = &scratch.area_vis[static_cast<size_t>(j) * n];
     const Eigen::Vector3f* c = &scratch.area_c[static_cast<size_t>(j) * n];
+    // a tile whose verdicts towards j all agree (most of them): every window's fraction is
+    // that verdict, exactly.
+    bool seen_in_tile[2] = {false, false};
+    for (int i = 0; i < n; ++i)
+      if (vis[i] >= 0) seen_in_tile[vis[i]] = true;
+    if (!(seen_in_tile[0] && seen_in_tile[1])) {
+      if (!seen_in_tile[1]) continue;
+      for (int i = 0; i < n; ++i) {
+        if (vis[i] < 0 || !(scratch.keep[i] > 0)) continue;
+        const float V = scratch.keep[i];
+        float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+        Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
+      }
+      continue;
+    }
+    if (!near_done) compute_near();
     for (int i = 0; i < n; ++i) {
       if (vis[i] < 0) continue;
       visible[i] = static_cast<float>(vis[i]);
