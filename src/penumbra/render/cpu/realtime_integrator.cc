@@ -125,31 +125,52 @@ bool IsExtendedLight(const PosedLight& l) {
 // (written to s->wi, s->distance).
 Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, const BsdfLanes& bsdf,
                                     const LaneMask& on, LightSampleLanes* s) {
-  Vec3Lanes wi_rep;
-  Lanes scale = Lanes::Zero();
-  const float c_W[3] = {l.position_W.x(), l.position_W.y(), l.position_W.z()};
+  // the axis, sin^2 sigma and near distance of every lane (SphereLightAxis's arithmetic).
+  Vec3Lanes w;
+  Lanes sin2, dist_near;
+  if (l.type == Light::Type::kDirectional) {
+    w = {Lanes::Constant(-l.direction_W.x()), Lanes::Constant(-l.direction_W.y()),
+         Lanes::Constant(-l.direction_W.z())};
+    sin2 = Lanes::Constant(1.0f - l.cos_angular_radius * l.cos_angular_radius);
+    dist_near = Lanes::Constant(std::numeric_limits<float>::infinity());
+  } else {
+    const Vec3Lanes t{l.position_W.x() - p.x, l.position_W.y() - p.y, l.position_W.z() - p.z};
+    const Lanes d2 = t.Dot(t);
+    const Lanes d = d2.sqrt();
+    const Lanes inv = (d > 0.0f).select(1.0f / d, 0.0f);
+    w = {t.x * inv, t.y * inv, t.z * inv};
+    sin2 = (d2 > 0.0f).select((l.radius_m * l.radius_m / d2).min(1.0f), 1.0f);
+    dist_near = (d - l.radius_m).max(0.0f);
+  }
+  const Lanes cos_t = bsdf.n.Dot(w);
+  const Lanes sin_sigma = sin2.max(0.0f).sqrt();
+  // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
+  // a light straddling it (few lanes) goes through ExtendedLightShading.
+  Vec3Lanes wi_rep = w;
+  Lanes scale = (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero());
   for (int k = 0; k < kLanes; ++k) {
-    float w[3], sin2, dist_near = std::numeric_limits<float>::infinity();
-    if (l.type == Light::Type::kDirectional) {
-      w[0] = -l.direction_W.x(), w[1] = -l.direction_W.y(), w[2] = -l.direction_W.z();
-      sin2 = 1.0f - l.cos_angular_radius * l.cos_angular_radius;
-    } else {
-      const float p_k[3] = {p.x[k], p.y[k], p.z[k]};
-      SphereLightAxis(c_W, l.radius_m, p_k, w, &sin2, &dist_near);
+    if (!on[k]) {
+      scale[k] = 0;
+      continue;
     }
+    // (a lane whose cos^2 rounds to >= sin^2 sigma but cos to < sin sigma takes the slow path,
+    // as ExtendedLightShading would.)
+    if ((cos_t[k] * cos_t[k] >= sin2[k] || !(sin2[k] > 0)) &&
+        !(cos_t[k] > 0 && cos_t[k] < sin_sigma[k]))
+      continue;
+    const float wk[3] = {w.x[k], w.y[k], w.z[k]};
     const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
     float r[3];
-    const float sk = ExtendedLightShading(w, sin2, n, r);
+    scale[k] = ExtendedLightShading(wk, sin2[k], n, r);
     wi_rep.x[k] = r[0], wi_rep.y[k] = r[1], wi_rep.z[k] = r[2];
-    scale[k] = on[k] ? sk : 0.0f;
-    // the shadow ray: the lane's lattice point, or the shading direction where that point lies
-    // below the geometric surface (it would test the surface itself, not the occluders).
-    const float ng_wi =
-        bsdf.ng.x[k] * s->wi.x[k] + bsdf.ng.y[k] * s->wi.y[k] + bsdf.ng.z[k] * s->wi.z[k];
-    if (!(ng_wi > 0)) {
-      s->wi.x[k] = r[0], s->wi.y[k] = r[1], s->wi.z[k] = r[2];
-      s->distance[k] = dist_near;
-    }
+  }
+  // the shadow ray: the lane's lattice point, or the shading direction where that point lies
+  // below the geometric surface (it would test the surface itself, not the occluders).
+  const Lanes ng_wi = bsdf.ng.Dot(s->wi);
+  for (int k = 0; k < kLanes; ++k) {
+    if (ng_wi[k] > 0) continue;
+    s->wi.x[k] = wi_rep.x[k], s->wi.y[k] = wi_rep.y[k], s->wi.z[k] = wi_rep.z[k];
+    s->distance[k] = dist_near[k];
   }
   const Vec3Lanes f = bsdf.Eval(wi_rep);
   return Where(on, Vec3Lanes{f.x * s->E.x * scale, f.y * s->E.y * scale, f.z * s->E.z * scale});
