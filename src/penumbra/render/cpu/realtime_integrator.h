@@ -20,7 +20,9 @@
 // fraction of visible shadow rays over the 5x5 pixels around the pixel on the same surface,
 // each pixel's ray going through its own point of a 16-point Fibonacci lattice over the
 // light's cone (a 4x4 ordered-dither assignment, LightStratum), and 4 points (64 in a window)
-// for pixels whose window sees both lit and shadowed verdicts (a penumbra). before (issue 36):
+// for pixels whose window sees both lit and shadowed verdicts (a penumbra); a tile's outermost
+// penumbra pixels, whose window the tile edge cuts, trace all 64 points themselves, and a
+// lamp's fraction is averaged once more over 3x3 pixels. before (issue 36):
 // one random point per pixel and frame: salt-and-pepper speckle wherever a lamp is partly
 // hidden or near the horizon, and different speckle every frame.
 //
