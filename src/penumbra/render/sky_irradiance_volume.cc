@@ -392,6 +392,27 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     }
     return static_cast<int>(texels.size());
   };
+  // a probe under the scene's floor: most of its upward rays hit geometry (the floor's underside)
+  // and most of its downward rays escape (no ground below the floor: the scene stands over the
+  // sky's lower half). no camera looks there; its light, the sky seen from below, leaked up
+  // through the floor into the foot of every wall and cabinet standing on it (a floor slab is
+  // thinner than the visibility tolerance, and a texel's ray can pass under a wall), so such a
+  // probe is invalid. outdoors a ground plane blocks the downward rays and keeps its probes.
+  auto under_floor = [&](const uint16_t* open) {
+    int up = 0, up_blocked = 0, down = 0, down_open = 0;
+    for (int r = 0; r < kRaysPerProbe; ++r) {
+      const float z = dirs.dir[r].z();
+      const bool escaped = open[dirs.texel[r]] != 0;
+      if (z > 0.2f) {
+        ++up;
+        up_blocked += escaped ? 0 : 1;
+      } else if (z < -0.2f) {
+        ++down;
+        down_open += escaped ? 1 : 0;
+      }
+    }
+    return 2 * up_blocked > up && 2 * down_open > down;
+  };
   constexpr int kChunk = 16;
   auto trace = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
@@ -404,7 +425,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       Eigen::Vector3f d_back = Eigen::Vector3f::Zero();
       const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
       if (trace_probe(x, m, open, &t_back, &d_back) <= max_back) {
-        valid_[p] = 1;
+        valid_[p] = under_floor(open) ? 0 : 1;
         continue;
       }
       // inside geometry: relocate just past the closest back face when that is within half a
@@ -414,7 +435,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
       const Eigen::Vector3f y = x + (t_back + kRelocateMargin * spacing_) * d_back;
       float t2;
       Eigen::Vector3f d2;
-      if (trace_probe(y, m, open, &t2, &d2) <= max_back) {
+      if (trace_probe(y, m, open, &t2, &d2) <= max_back && !under_floor(open)) {
         valid_[p] = 1;
         position_[p] = y;
       }

@@ -7,6 +7,7 @@
 
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
+#include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
 
 namespace penumbra {
@@ -94,13 +95,252 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
 
 // per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
-  std::vector<Lanes> u1, u2;              // per light: random numbers of every lane
   std::vector<LightSampleLanes> samples;  // per light
   std::vector<Vec3Lanes> contrib;         // per light: unshadowed f cos E
   std::vector<Eigen::Vector3f> wo;        // per tile pixel: unit direction towards the camera
   std::vector<Eigen::Vector3f> n_s;       // per tile pixel: usable shading normal
   std::vector<Eigen::Vector3f> sky_E;     // per tile pixel: sky irradiance on n_s
+  // lights with an extent (IsExtendedLight), per light j and tile pixel i at [j n + i]: the
+  // unshadowed contribution waiting for the shared visibility (ResolveSharedVisibility) and the
+  // pixel's own shadow ray's verdict (1 visible, 0 occluded, -1 none traced).
+  std::vector<Eigen::Vector3f> area_c;
+  std::vector<int8_t> area_vis;
+  std::vector<float> keep;  // per tile pixel: 1 - SurfaceMaterial::mirror
 };
+
+// shadow rays per pixel towards a light with an extent in a penumbra (1 elsewhere).
+constexpr int kPenumbraRays = 4;
+
+// a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
+// analytic (render/lamp_math.h) and its visibility shared over 5x5 pixels.
+bool IsExtendedLight(const PosedLight& l) {
+  return l.type == Light::Type::kDirectional ? l.cos_angular_radius < 1.0f : l.radius_m > 0;
+}
+
+// the unshadowed contribution f(wo, wi) E_i of extended light `l`, sampled as `s` (stratum
+// direction, illuminance I / d^2 or E_sun), for every lane in `on`: the BRDF at the direction to
+// the light's centre (tilted above the horizon where the light straddles it) times the
+// horizon-clipped illuminance of the sphere or disc (SphereLightCosine). lanes whose stratum
+// direction is below the geometric surface get that tilted direction for their shadow ray
+// (written to s->wi, s->distance).
+Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, const BsdfLanes& bsdf,
+                                    const LaneMask& on, LightSampleLanes* s) {
+  // the axis, sin^2 sigma and near distance of every lane (SphereLightAxis's arithmetic).
+  Vec3Lanes w;
+  Lanes sin2, dist_near;
+  if (l.type == Light::Type::kDirectional) {
+    w = {Lanes::Constant(-l.direction_W.x()), Lanes::Constant(-l.direction_W.y()),
+         Lanes::Constant(-l.direction_W.z())};
+    sin2 = Lanes::Constant(1.0f - l.cos_angular_radius * l.cos_angular_radius);
+    dist_near = Lanes::Constant(std::numeric_limits<float>::infinity());
+  } else {
+    const Vec3Lanes t{l.position_W.x() - p.x, l.position_W.y() - p.y, l.position_W.z() - p.z};
+    const Lanes d2 = t.Dot(t);
+    const Lanes d = d2.sqrt();
+    const Lanes inv = (d > 0.0f).select(1.0f / d, 0.0f);
+    w = {t.x * inv, t.y * inv, t.z * inv};
+    sin2 = (d2 > 0.0f).select((l.radius_m * l.radius_m / d2).min(1.0f), 1.0f);
+    dist_near = (d - l.radius_m).max(0.0f);
+  }
+  const Lanes cos_t = bsdf.n.Dot(w);
+  const Lanes sin_sigma = sin2.max(0.0f).sqrt();
+  // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
+  // a light straddling it (few lanes) goes through ExtendedLightShading.
+  Vec3Lanes wi_rep = w;
+  Lanes scale = (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero());
+  for (int k = 0; k < kLanes; ++k) {
+    if (!on[k]) {
+      scale[k] = 0;
+      continue;
+    }
+    // (a lane whose cos^2 rounds to >= sin^2 sigma but cos to < sin sigma takes the slow path,
+    // as ExtendedLightShading would.)
+    if ((cos_t[k] * cos_t[k] >= sin2[k] || !(sin2[k] > 0)) &&
+        !(cos_t[k] > 0 && cos_t[k] < sin_sigma[k]))
+      continue;
+    const float wk[3] = {w.x[k], w.y[k], w.z[k]};
+    const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
+    float r[3];
+    scale[k] = ExtendedLightShading(wk, sin2[k], n, r);
+    wi_rep.x[k] = r[0], wi_rep.y[k] = r[1], wi_rep.z[k] = r[2];
+  }
+  // the shadow ray: the lane's lattice point, or the shading direction where that point lies
+  // below the geometric surface (it would test the surface itself, not the occluders).
+  const Lanes ng_wi = bsdf.ng.Dot(s->wi);
+  for (int k = 0; k < kLanes; ++k) {
+    if (ng_wi[k] > 0) continue;
+    s->wi.x[k] = wi_rep.x[k], s->wi.y[k] = wi_rep.y[k], s->wi.z[k] = wi_rep.z[k];
+    s->distance[k] = dist_near[k];
+  }
+  const Vec3Lanes f = bsdf.Eval(wi_rep);
+  return Where(on, Vec3Lanes{f.x * s->E.x * scale, f.y * s->E.y * scale, f.z * s->E.z * scale});
+}
+
+// adds the extended lights' contributions of a tile to its radiance: pixel i's light j counts
+// c_ij times the fraction of visible shadow rays over the 5x5 pixels around it (weights 1/2 on
+// the outer rows and columns, so each pixel of a 4x4 lattice block weighs 1; cut at the tile's
+// edges, where fewer lattice points are averaged) that lie on the same surface as pixel i (same
+// geom, normals within 25 degrees, within 5 % of their distance from its tangent plane) and traced
+// towards j (the ratio estimator of Heitz et al. 2018 with the shadow term shared). a pixel whose
+// window holds both visible and occluded verdicts (a penumbra) traces kPenumbraRays - 1 more rays
+// through its other lattice points first, so that a window there averages 64 points, not 16;
+// a lamp's visible fraction is then averaged once more over 3x3 pixels on the same surface.
+// adds the rays traced to *traced.
+void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary,
+                             const Scratch& scratch, const FrameBuffers& out, int64_t* traced) {
+  const PixelTile& tile = primary.tile;
+  const int n = tile.width * tile.height;
+  const int num_lights = ctx.lights->size();
+  thread_local std::vector<float> visible, rays, fraction;
+  thread_local std::vector<uint8_t> own;  // 1: the pixel's own fraction, no window
+  own.resize(n);
+  visible.resize(n);
+  rays.resize(n);
+  fraction.resize(n);
+  bool any = false;
+  for (int j = 0; j < num_lights; ++j) any = any || IsExtendedLight(ctx.lights->lights()[j]);
+  if (!any) return;
+  // per pixel, which pixels of the window [x - 2, x + 2] x [y - 2, y + 2], cut at the tile's
+  // edges, lie on its surface (bit (dy + 2) 5 + dx + 2), once for all lights. (shifting the
+  // window inside the tile instead made steps of several % at every tile edge across a lamp's
+  // penumbra.)
+  thread_local std::vector<uint32_t> near;
+  bool near_done = false;
+  auto compute_near = [&] {
+    near_done = true;
+    near.assign(n, 0u);
+    for (int i = 0; i < n; ++i) {
+      if (!primary.did_hit[i]) continue;
+      const SurfaceHit& h = primary.hits[i];
+      const int x = i % tile.width, y = i / tile.width;
+      uint32_t bits = 0;
+      for (int dy = -2; dy <= 2; ++dy) {
+        if (y + dy < 0 || y + dy >= tile.height) continue;
+        for (int dx = -2; dx <= 2; ++dx) {
+          if (x + dx < 0 || x + dx >= tile.width) continue;
+          const int ii = i + dy * tile.width + dx;
+          if (ii != i) {
+            const SurfaceHit& g = primary.hits[ii];
+            if (!primary.did_hit[ii] || g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) continue;
+            // within 5 % of its distance from i's tangent plane.
+            const Eigen::Vector3f dp = g.p_W - h.p_W;
+            const float off = h.ng_W.dot(dp);
+            if (!(off * off <= 0.0025f * dp.squaredNorm() + 1e-10f)) continue;
+          }
+          bits |= 1u << ((dy + 2) * 5 + dx + 2);
+        }
+      }
+      near[i] = bits;
+    }
+  };
+  // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
+  auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
+    for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
+      const int b = __builtin_ctz(bits);
+      const int dy = b / 5 - 2, dx = b % 5 - 2;
+      const int ii = i + dy * tile.width + dx;
+      if (vis[ii] < 0) continue;
+      fn(ii, (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f));
+    }
+  };
+  auto same_surface = [&](int i, int ii) {
+    const int dy = ii / tile.width - i / tile.width, dx = ii % tile.width - i % tile.width;
+    return (near[i] >> ((dy + 2) * 5 + dx + 2) & 1u) != 0;
+  };
+  for (int j = 0; j < num_lights; ++j) {
+    if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
+    const int8_t* vis = &scratch.area_vis[static_cast<size_t>(j) * n];
+    const Eigen::Vector3f* c = &scratch.area_c[static_cast<size_t>(j) * n];
+    // a tile whose verdicts towards j all agree (most of them): every window's fraction is
+    // that verdict, exactly.
+    bool seen_in_tile[2] = {false, false};
+    for (int i = 0; i < n; ++i)
+      if (vis[i] >= 0) seen_in_tile[vis[i]] = true;
+    if (!(seen_in_tile[0] && seen_in_tile[1])) {
+      if (!seen_in_tile[1]) continue;
+      for (int i = 0; i < n; ++i) {
+        if (vis[i] < 0 || !(scratch.keep[i] > 0)) continue;
+        const float V = scratch.keep[i];
+        float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+        Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
+      }
+      continue;
+    }
+    if (!near_done) compute_near();
+    for (int i = 0; i < n; ++i) {
+      if (vis[i] < 0) continue;
+      visible[i] = static_cast<float>(vis[i]);
+      rays[i] = 1;
+      bool seen[2] = {false, false};
+      for_window(vis, i, [&](int ii, float) { seen[vis[ii]] = true; });
+      own[i] = 0;
+      if (!(seen[0] && seen[1])) continue;
+      // a penumbra: the pixel's other lattice points; on the tile's outermost pixels, whose
+      // window lacks the next tile's half, every point of the 64-point lattice instead, and the
+      // pixel keeps its own fraction (a window cut there leans inwards: steps at tile edges; 16
+      // points of its own left lines of 1/16 steps along the tile edges).
+      const SurfaceHit& h = primary.hits[i];
+      const int x = i % tile.width, y = i / tile.width;
+      const int u = tile.x0 + x, v = tile.y0 + y;
+      const int s = LightStratum(u, v);
+      own[i] = x == 0 || y == 0 || x == tile.width - 1 || y == tile.height - 1;
+      const int extra = own[i] ? kLightStrata * kPenumbraRays : kPenumbraRays;
+      Ray sr;
+      sr.o = OffsetRayOrigin(h.p_W, h.ng_W);
+      for (int r = 1; r < extra; ++r) {
+        // own: every other point of the 64-point lattice.
+        const int index = (kPenumbraRays * s + r) % (kLightStrata * kPenumbraRays);
+        float u1, u2;
+        LightStratumUniforms(index, kLightStrata * kPenumbraRays, &u1, &u2);
+        LightSample ls;
+        if (!ctx.lights->Sample(j, h.p_W, u1, u2, &ls) || !(ls.wi.dot(h.ng_W) > 0)) continue;
+        sr.d = ls.wi;
+        sr.tmax = ls.distance * (1.0f - 1e-4f);  // +inf stays +inf
+        ++*traced;
+        rays[i] += 1;
+        if (!ctx.scene->Occluded(sr)) visible[i] += 1;
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      if (vis[i] < 0) continue;
+      if (own[i]) {
+        fraction[i] = visible[i] / rays[i];
+        continue;
+      }
+      float w_rays = 0, w_visible = 0;
+      for_window(vis, i, [&](int ii, float w) {
+        w_rays += w * rays[ii];
+        w_visible += w * visible[ii];
+      });
+      fraction[i] = w_visible / w_rays;
+    }
+    // a lamp's penumbrae (tens of pixels wide next to its fixture) once more over the 3x3
+    // pixels on the same surface: the 5x5 windows' 16 lattice points leave 4-pixel steps
+    // along them. the sun's (a pixel or two wide) stay as they are.
+    const bool smooth = ctx.lights->lights()[j].type != Light::Type::kDirectional;
+    for (int i = 0; i < n; ++i) {
+      if (vis[i] < 0) continue;
+      float V = fraction[i];
+      if (smooth && !own[i]) {
+        const int x = i % tile.width, y = i / tile.width;
+        float sum = 0;
+        int count = 0;
+        for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, tile.height - 1); ++yy)
+          for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, tile.width - 1); ++xx) {
+            const int ii = yy * tile.width + xx;
+            if (vis[ii] < 0 || !same_surface(i, ii)) continue;
+            sum += fraction[ii];
+            ++count;
+          }
+        V = sum / static_cast<float>(count);
+      }
+      V *= scratch.keep[i];
+      if (!(V > 0)) continue;
+      float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+      Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
+    }
+  }
+}
 
 // walks the tile by 2x2 pixel quads, row-major: shared(q) is offered every quad that lies fully
 // inside the tile (q = its 4 pixel indices, row-major) and returns whether it handled the quad;
@@ -260,10 +500,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
   const int num_lights = ctx.lights->size();
-  scratch.u1.resize(num_lights);
-  scratch.u2.resize(num_lights);
   scratch.samples.resize(num_lights);
   scratch.contrib.resize(num_lights);
+  scratch.area_c.resize(static_cast<size_t>(num_lights) * n);
+  scratch.area_vis.assign(static_cast<size_t>(num_lights) * n, -1);
+  scratch.keep.resize(n);
   TileSkyIrradiance(ctx, primary, &scratch);
   int64_t traced = 0;
   const uint64_t frame_key = ctx.FrameKey();
@@ -345,21 +586,12 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     if (!hit.any()) continue;
-    // random numbers: light j's (u1, u2) from the top 48 bits of draw j of the pixel's stream,
-    // as Rng::Uniform2 takes them; computed for every lane at once (idle lanes' values are
-    // never used).
-    {
-      alignas(64) uint64_t stream[kLanes];
-      for (int k = 0; k < kLanes; ++k)
-        stream[k] = static_cast<uint64_t>(lane_v[k]) * width + static_cast<uint64_t>(lane_u[k]);
-      for (int k = 0; k < kLanes; ++k)
-        stream[k] = FrameContext::PixelStream(frame_key, stream[k], 0);
-      for (int j = 0; j < num_lights; ++j) {
-        float* u1 = scratch.u1[j].data();
-        float* u2 = scratch.u2[j].data();
-        for (int k = 0; k < kLanes; ++k) Rng::Uniform2Of(Rng::DrawAt(stream[k], j), &u1[k], &u2[k]);
-      }
-    }
+    // the lattice point of every lane's pixel (render/lamp_math.h): where its shadow rays
+    // towards lights with an extent go. no random numbers.
+    Lanes stratum_u1, stratum_u2;
+    for (int k = 0; k < kLanes; ++k)
+      LightStratumUniforms(kPenumbraRays * LightStratum(lane_u[k], lane_v[k]),
+                           kLightStrata * kPenumbraRays, &stratum_u1[k], &stratum_u2[k]);
     bsdf.SetCoefficients(pbr);
 
     // emission and sky ambient, E_sky / pi (c_diff (1 - S) + S).
@@ -383,10 +615,15 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     for (int j = 0; j < num_lights; ++j) {
       LightSampleLanes& s = scratch.samples[j];
       Vec3Lanes& c = scratch.contrib[j];
-      ctx.lights->SampleLanes(j, p, scratch.u1[j], scratch.u2[j], &s);
-      const Vec3Lanes f = bsdf.Eval(s.wi);
+      ctx.lights->SampleLanes(j, p, stratum_u1, stratum_u2, &s);
       const LaneMask on = hit && s.valid;
-      c = Where(on, Vec3Lanes{f.x * s.E.x, f.y * s.E.y, f.z * s.E.z});
+      const PosedLight& light = ctx.lights->lights()[j];
+      if (IsExtendedLight(light)) {
+        c = ExtendedLightContribution(light, p, bsdf, on, &s);
+      } else {
+        const Vec3Lanes f = bsdf.Eval(s.wi);
+        c = Where(on, Vec3Lanes{f.x * s.E.x, f.y * s.E.y, f.z * s.E.z});
+      }
       if (rm != nullptr) {
         // attenuation of the light by the media between the surface and the light.
         for (int k = 0; k < kLanes; ++k) {
@@ -422,11 +659,22 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       LaneMask occluded;
       ctx.scene->OccludedLanes(origin, s.wi, tmax, shadowed, &occluded);
       traced += shadowed.count();
+      if (IsExtendedLight(ctx.lights->lights()[j])) {
+        // the verdict waits for its neighbours' (ResolveSharedVisibility).
+        const size_t base = static_cast<size_t>(j) * n + static_cast<size_t>(i0);
+        for (int k = 0; k < m; ++k) {
+          if (!shadowed[k]) continue;
+          scratch.area_vis[base + k] = occluded[k] ? 0 : 1;
+          scratch.area_c[base + k] = Eigen::Vector3f(c.x[k], c.y[k], c.z[k]);
+        }
+        continue;
+      }
       const LaneMask visible = shadowed && !occluded;
       L = L + Where(visible, c);
     }
     for (int k = 0; k < m; ++k) {
       if (!hit[k]) continue;
+      scratch.keep[i0 + k] = 1.0f - mirror[k];
       Eigen::Vector3f Lk(L.x[k], L.y[k], L.z[k]);
       if (mirror[k] > 0) {
         // the mirror layer: (1 - r) L + r L_mirror, its light samples after this pixel's.
@@ -446,6 +694,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       Lp[0] = Lk.x(), Lp[1] = Lk.y(), Lp[2] = Lk.z();
     }
   }
+  // the shadowed light of lights with an extent, its visibility shared between neighbours.
+  ResolveSharedVisibility(ctx, primary, scratch, out, &traced);
   // the effects once every pixel of the tile holds its surface or sky radiance.
   if (fx != nullptr) ApplyTileViewEffects(ctx, primary, out);
   return traced;

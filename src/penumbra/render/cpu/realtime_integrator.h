@@ -1,10 +1,9 @@
 #pragma once
-// the `realtime` tier: direct lighting with ray-traced shadows, one sample per pixel.
+// the `realtime` tier: direct lighting with ray-traced shadows, no random numbers.
 //
 // per pixel, at the surface seen through the pixel centre:
 //   L = Le + sum over lights  f(wo, wi) |n . wi| E_i V_i  + ambient
-// with E_i the illuminance of one sample of light i (LightSampler; lights with an extent
-// are jittered per pixel for soft shadows), V_i its visibility from one shadow ray, f the
+// with E_i the illuminance of light i (LightSampler), V_i its visibility, f the
 // metallic-roughness BRDF (bsdf.h), and the sky ambient
 //   ambient = E_sky(p, n) / pi x (c_diff (1 - S) + S),   S = EnvBRDF(F0, n.v, roughness)
 // where E_sky is the sky irradiance occluded by the static geometry (SkyIrradianceVolume, when
@@ -14,10 +13,24 @@
 // that miss (from the camera or off a mirror) see SkyModel::Background: the MJCF skybox where
 // there is one, else SkyModel::Radiance.
 //
+// point lights, spots without a radius and a sun without a disc: wi towards the light, V_i from
+// one shadow ray. lights with an extent (a lamp's sphere, radius_m > 0; the sun's disc,
+// angular radius > 0), render/lamp_math.h: E_i is the sphere's (or disc's) illuminance clipped
+// by the surface's horizon in closed form (Snyder 1996, SphereLightCosine), f taken at the
+// direction to its centre (tilted above the horizon where it straddles it), and V_i the
+// fraction of visible shadow rays over the 5x5 pixels around the pixel on the same surface,
+// each pixel's ray going through its own point of a 16-point Fibonacci lattice over the
+// light's cone (a 4x4 ordered-dither assignment, LightStratum), and 4 points (64 in a window)
+// for pixels whose window sees both lit and shadowed verdicts (a penumbra); a tile's outermost
+// penumbra pixels, whose window the tile edge cuts, trace all 64 points themselves, and a
+// lamp's fraction is averaged once more over 3x3 pixels. before (issue 36):
+// one random point per pixel and frame: salt-and-pepper speckle wherever a lamp is partly
+// hidden or near the horizon, and different speckle every frame.
+//
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the
-// pixel's unshadowed radiance (their contribution is added unshadowed). random numbers:
-// Rng(ctx.PixelStream(u, v, 0)), one 64-bit draw per light in light order, split into the
-// light's two uniforms by Rng::Uniform2.
+// pixel's unshadowed radiance (their contribution is added unshadowed). random numbers: only
+// for the mirror layer's light samples, Rng(ctx.PixelStream(u, v, 0)) from draw
+// number-of-lights on.
 //
 // adverse conditions (FrameContext::effects): surface wetness changes the material of
 // upward-facing surfaces; each light's contribution is attenuated by the media between the
@@ -27,7 +40,7 @@
 // alpha-composited over it (render/embree/particle_scene.h). without effects nothing changes.
 //
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
-// LightSampler::SampleLanes) and its shadow rays towards one light form one Embree packet
+// LightSampler::SampleLanes) and its first shadow rays towards one light form one Embree packet
 // (RayScene::OccludedLanes); materials and textures are evaluated per pixel, textures filtered
 // over the pixel's ray cone (render/material_eval.h, Camera::pixel_spread_rad), by the renderer
 // before the tile is shaded (PrimaryHits::materials; a material's base, normal and
