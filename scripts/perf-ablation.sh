@@ -117,7 +117,7 @@ for i in "${!world_files[@]}"; do
     read -r m lo hi <<<"$(stats ${fps[$p]})"
     read -r cm clo chi <<<"$(stats ${cpu[$p]})"
     read -r sm slo shi <<<"$(stats ${share[$p]})"
-    printf '| %s | %s | %.1f (%.1f-%.1f) | %.0f (%.0f-%.0f) | %.2f (%.2f-%.2f) |\n' "${worlds[$i]}" "$p" "$m" "$lo" "$hi" "$cm" "$clo" "$chi" "$sm" "$slo" "$shi"
+    printf '| %s | %s | %.1f (%.1f-%.1f) | %.0f (%.0f-%.0f) | %.2f (%.2f to %.2f) |\n' "${worlds[$i]}" "$p" "$m" "$lo" "$hi" "$cm" "$clo" "$chi" "$sm" "$slo" "$shi"
   done
   unset fps cpu share
 done

@@ -157,9 +157,9 @@ int BenchRender(const RenderBenchOptions& options) {
     }
     fmt::print(
         "{}x{} rgb+depth {}: {:.1f} frames/s, {:.2f} ms/frame, {:.1f} Mrays/s, {:.2f} "
-        "cpu-ms/frame\n",
+        "cpu-ms/frame, {} rays/frame\n",
         w, h, options.tier, options.frames / seconds, 1e3 * seconds / options.frames,
-        rays / seconds * 1e-6, 1e3 * cpu_seconds / options.frames);
+        rays / seconds * 1e-6, 1e3 * cpu_seconds / options.frames, rays / options.frames);
     if (w == 640) fps_640x480 = options.frames / seconds;
   }
   // the target is the realtime tier's; a pathtraced run says so instead of a verdict

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/occluder_math.h"
 #include "penumbra/render/static_geometry.h"
 
 namespace penumbra {
@@ -159,42 +160,14 @@ bool SunOccluderMap::HitsBox(const Box& b, const Eigen::Vector3f& o_W,
                              const Eigen::Vector3f& d_W) const {
   const Eigen::Vector3f o = b.R_GW * (o_W - b.p_W);
   const Eigen::Vector3f d = b.R_GW * d_W;
-  float t_near = 0, t_far = std::numeric_limits<float>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0) {
-      if (!(std::abs(o[a]) < b.half[a])) return false;
-      continue;
-    }
-    const float inv = 1.0f / d[a];
-    float t0 = (-b.half[a] - o[a]) * inv, t1 = (b.half[a] - o[a]) * inv;
-    if (t0 > t1) std::swap(t0, t1);
-    t_near = std::max(t_near, t0);
-    t_far = std::min(t_far, t1);
-  }
-  // entry ahead of the origin (t_near > 0 also when the origin is outside on every axis) and
-  // a chord of at least kMinChordM (in |d| units: d is scaled to unit length below).
-  const float d_len = d_W.norm();
-  return t_near > 0 && (t_far - t_near) * d_len > kMinChordM && std::isfinite(t_near);
+  return BoxChordAhead(o.data(), d.data(), b.half.data(), d_W.norm(), kMinChordM, true);
 }
 
 bool SunOccluderMap::CrossesBoxAhead(const Box& b, const Eigen::Vector3f& o_W,
                                      const Eigen::Vector3f& d_W) const {
   const Eigen::Vector3f o = b.R_GW * (o_W - b.p_W);
   const Eigen::Vector3f d = b.R_GW * d_W;
-  float t_near = -std::numeric_limits<float>::infinity();
-  float t_far = std::numeric_limits<float>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0) {
-      if (!(std::abs(o[a]) < b.half[a])) return false;
-      continue;
-    }
-    const float inv = 1.0f / d[a];
-    float t0 = (-b.half[a] - o[a]) * inv, t1 = (b.half[a] - o[a]) * inv;
-    if (t0 > t1) std::swap(t0, t1);
-    t_near = std::max(t_near, t0);
-    t_far = std::min(t_far, t1);
-  }
-  return t_far > 0 && (t_far - t_near) * d_W.norm() > kMinChordM && std::isfinite(t_far);
+  return BoxChordAhead(o.data(), d.data(), b.half.data(), d_W.norm(), kMinChordM, false);
 }
 
 int SunOccluderMap::CellOf(const Eigen::Vector3f& p_W) const {

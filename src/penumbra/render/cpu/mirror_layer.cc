@@ -95,10 +95,7 @@ int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, co
                           first_draw, &traced);
   };
   // the grid step of pixel i's layer: 1 (every pixel), 2 or 4 (file comment).
-  auto step = [&](int i) {
-    if (!sparse_on || mirror[i] >= kMirrorDenseReflectance) return 1;
-    return mirror[i] >= kMirrorHalfStepReflectance ? 2 : 4;
-  };
+  auto step = [&](int i) { return sparse_on ? MirrorGridStep(mirror[i]) : 1; };
   // the traced pixels: those on their layer's grid (tiles start at multiples of 16, so the
   // tile's grid is the image's).
   for (int i = 0; i < n; ++i) {
@@ -115,10 +112,9 @@ int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, co
     const int x = i % w, y = i / w, s = step(i);
     const SurfaceHit& h = primary.hits[i];
     const int gx = x - x % s, gy = y - y % s;
-    const float fx = static_cast<float>(x % s) / static_cast<float>(s);
-    const float fy = static_cast<float>(y % s) / static_cast<float>(s);
     const int xs[2] = {gx, gx + s}, ys[2] = {gy, gy + s};
-    const float wx[2] = {1.0f - fx, fx}, wy[2] = {1.0f - fy, fy};
+    const float wx[2] = {MirrorGridWeight(x % s, s, 0), MirrorGridWeight(x % s, s, 1)};
+    const float wy[2] = {MirrorGridWeight(y % s, s, 0), MirrorGridWeight(y % s, s, 1)};
     Eigen::Vector3f acc = Eigen::Vector3f::Zero();
     float wsum = 0;
     for (int b = 0; b < 2; ++b) {
@@ -140,8 +136,7 @@ int64_t ApplyMirrorLayer(const FrameContext& ctx, const PrimaryHits& primary, co
     if (!(mirror[i] > 0)) continue;
     float* Lp = out.radiance->at(tile.x0 + i % w, tile.y0 + i / w);
     const float r = mirror[i];
-    const Eigen::Vector3f L = (1.0f - r) * Eigen::Vector3f(Lp[0], Lp[1], Lp[2]) + r * Lm[i];
-    Lp[0] = L.x(), Lp[1] = L.y(), Lp[2] = L.z();
+    for (int c = 0; c < 3; ++c) Lp[c] = MirrorBlend(Lp[c], Lm[i][c], r);
   }
   return traced;
 }

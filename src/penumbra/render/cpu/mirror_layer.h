@@ -19,6 +19,7 @@
 // reflected contrast). the reflection's random numbers are as before (draws num_lights ... of
 // the traced pixel's stream), so the dense layer is bit-identical to the per-pixel one, and so
 // is the whole image of a scene without weak mirrors.
+// the grid, its weights and the blend are render/mirror_math.h's (shared with the CUDA backend).
 // RenderAblation::mirror_sparse = false traces every pixel (bench comparisons).
 //
 // determinism: per tile, independent of thread count and tile order.
@@ -27,14 +28,9 @@
 #include <cstdint>
 
 #include "penumbra/render/cpu/integrator.h"
+#include "penumbra/render/mirror_math.h"
 
 namespace penumbra {
-
-/// mirror weights at or above this are traced at every pixel (file comment).
-constexpr float kMirrorDenseReflectance = 0.25f;
-/// mirror weights in [this, kMirrorDenseReflectance) are traced at every 2nd pixel in u and v,
-/// weaker ones at every 4th.
-constexpr float kMirrorHalfStepReflectance = 0.1f;
 
 /// radiance arriving along the mirrored ray `ray` (see the file comment), its light samples'
 /// numbers from draws first_draw ... of the pixel's `stream`. one reflection: a mirror seen in
