@@ -78,7 +78,7 @@ bench_fps() {
     echo "$out" >&2
     return 1
   fi
-  awk '$1 == "640x480" && /frames\/s/ { f = ""; c = ""; for (i = 1; i <= NF; ++i) { if ($i == "frames/s,") f = $(i - 1); if ($i == "cpu-ms/frame") c = $(i - 1) } if (f != "" && c != "") print f, c; exit }' <<<"$out"
+  awk '$1 == "640x480" && /frames\/s/ { f = ""; c = ""; for (i = 1; i <= NF; ++i) { if ($i == "frames/s,") f = $(i - 1); if ($i == "cpu-ms/frame" || $i == "cpu-ms/frame,") c = $(i - 1) } if (f != "" && c != "") print f, c; exit }' <<<"$out"
 }
 
 stats() {

@@ -318,10 +318,11 @@ int RunCli(int argc, char** argv) {
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
-  bench_render->add_option("--ablate", render_bench.ablate,
-                           "switch parts of the CPU renderer off to time what they cost: mirror, "
-                           "mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, "
-                           "film (docs/performance.md)")
+  bench_render
+      ->add_option("--ablate", render_bench.ablate,
+                   "switch parts of the CPU renderer off to time what they cost: mirror, "
+                   "mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, "
+                   "film (docs/performance.md)")
       ->delimiter(',');
   bench_render->add_flag("--only-640x480", render_bench.only_640x480,
                          "time only 640x480 (skip 800x800)");
