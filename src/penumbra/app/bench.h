@@ -4,6 +4,9 @@
 
 #include <optional>
 #include <string>
+#include <vector>
+
+#include "penumbra/render/render_ablation.h"
 
 #include "penumbra/render/render_settings.h"
 
@@ -25,7 +28,20 @@ struct RenderBenchOptions {
   int batch_height = 128;
   int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
   bool adversity = true;  ///< also time the presets none/minor/major (app/effects_bench.h)
+  /// parts of the renderer to switch off (RenderAblation's fields by their --ablate names:
+  /// mirror, mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, film); the
+  /// frames/s then say what the part costs (docs/performance.md, "What costs what").
+  std::vector<std::string> ablate;
+  /// time only the 640x480 resolution (skip 800x800).
+  bool only_640x480 = false;
 };
+
+/// the names `penumbra bench render --ablate` takes, in RenderAblation's order.
+const std::vector<std::string>& AblationNames();
+
+/// switches off the parts `names` names in *ablation. @throws ConfigError naming an unknown
+/// part and listing the known ones.
+void ApplyAblation(const std::vector<std::string>& names, RenderAblation* ablation);
 
 /// renders the world's first camera at 640x480 and 800x800 (RGB + depth) while the
 /// world moves, and prints frames/s and Mrays/s for each. returns 0.

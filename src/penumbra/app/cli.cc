@@ -335,6 +335,14 @@ int RunCli(int argc, char** argv) {
              "--batch: spread the cameras over this many sessions of the world (default 1)");
   bool no_adversity = false;
   bench_render->add_flag("--no-adversity", no_adversity, "skip the none/minor/major preset lines");
+  bench_render
+      ->add_option("--ablate", render_bench.ablate,
+                   "switch parts of the CPU renderer off to time what they cost: mirror, "
+                   "mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, "
+                   "film (docs/performance.md)")
+      ->delimiter(',');
+  bench_render->add_flag("--only-640x480", render_bench.only_640x480,
+                         "time only 640x480 (skip 800x800)");
   // penumbra contact-sheet / make-vdb (app/contact_sheet.h, app/vdb_tool.h)
   // penumbra heightfield (app/heightfield_tool.h)
   CLI::App* hfield = app.add_subcommand("heightfield", "a world's static geometry sampled from above into a MuJoCo hfield model");

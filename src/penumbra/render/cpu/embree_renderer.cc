@@ -77,6 +77,11 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   // bodies move and relit when the sky changes (render/sky_irradiance_volume.h).
   if (settings_.tier == RenderSettings::Tier::kRealtime)
     sky_volume_.Update(scene_, snapshot, *effects_.sky(), &pool_);
+  // realtime tier: the sun shadow rays the static boxes block are not traced (same image;
+  // render/sun_occluder_map.h), rebuilt when the static bodies move or the sun turns.
+  const bool use_sun_occluders =
+      settings_.tier == RenderSettings::Tier::kRealtime && ablation_.sun_occluder;
+  if (use_sun_occluders) sun_occluders_.Update(scene_, snapshot, lights_, &pool_);
   const int W = camera.width(), H = camera.height();
   const CameraOutputs& want = view.outputs;
   const bool denoise = want.rgb && denoiser_ != nullptr;
@@ -120,11 +125,14 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   ctx.materials = &materials_;
   ctx.lights = &lights_;
   ctx.sky = effects_.sky();
-  if (settings_.tier == RenderSettings::Tier::kRealtime && !sky_volume_.empty())
+  if (settings_.tier == RenderSettings::Tier::kRealtime && !sky_volume_.empty() &&
+      ablation_.sky_volume)
     ctx.sky_volume = &sky_volume_;
+  if (use_sun_occluders && !sun_occluders_.empty()) ctx.sun_occluders = &sun_occluders_;
   ctx.effects = effects_.active() ? &effects_ : nullptr;
   ctx.camera = &camera;
   ctx.settings = &settings_;
+  ctx.ablation = &ablation_;
   ctx.camera_index = view.camera_index;
   ctx.frame_index = view.frame_index;
   std::atomic<bool> stopped{false};
@@ -198,8 +206,10 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
         for (int i = 0; i < n; ++i) {
           if (!did_hit[i]) continue;
           const float d_len = rays[i].d.norm();
-          const TextureFootprint footprint = ConeFootprint(
-              camera.pixel_spread_rad(), hits[i].t * d_len, rays[i].d / d_len, hits[i]);
+          const TextureFootprint footprint =
+              ablation_.texture_filter ? ConeFootprint(camera.pixel_spread_rad(), hits[i].t * d_len,
+                                                       rays[i].d / d_len, hits[i])
+                                       : TextureFootprint{};
           if (want_materials)
             mats[i] = materials_.EvaluateAndMapNormal(&hits[i], footprint);
           else
@@ -240,7 +250,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   out->stopped = stopped.load();
   if (out->stopped) return;
 
-  if (want.rgb) {
+  if (want.rgb && ablation_.film) {
     if (denoise) {
       DenoiserGuides guides;
       guides.albedo = &albedo_;

@@ -19,9 +19,11 @@
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
+#include "penumbra/render/render_ablation.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
+#include "penumbra/render/sun_occluder_map.h"
 
 namespace penumbra {
 
@@ -45,15 +47,22 @@ class EmbreeRenderer final : public Renderer {
   const RayScene& ray_scene() const { return *ray_scene_; }
   const RenderSettings& settings() const { return settings_; }
 
+  /// parts switched off for `penumbra bench render --ablate` (render/render_ablation.h);
+  /// from the next Render on.
+  void set_ablation(const RenderAblation& ablation) { ablation_ = ablation; }
+  const RenderAblation& ablation() const { return ablation_; }
+
  private:
   const SceneDescription scene_;  // owned copy; everything below refers to it
   const RenderSettings settings_;
+  RenderAblation ablation_;  // all parts on unless a bench switches some off
   std::unique_ptr<RayScene> ray_scene_;
   MaterialEvaluator materials_;
   LightSampler lights_;
   SkyModel sky_;
   MediaFrame effects_;              // per-frame effects state (render/cpu/media_frame.h)
   SkyIrradianceVolume sky_volume_;  // realtime tier: occluded sky light, built at the first frame
+  SunOccluderMap sun_occluders_;    // realtime tier: sun shadow rays the static boxes block
   Film film_;
   ThreadPool pool_;
   std::unique_ptr<Integrator> integrator_;

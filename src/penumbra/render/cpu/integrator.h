@@ -18,9 +18,11 @@
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/material_eval.h"
+#include "penumbra/render/render_ablation.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
+#include "penumbra/render/sun_occluder_map.h"
 
 namespace penumbra {
 
@@ -38,8 +40,13 @@ struct FrameContext {
   /// the realtime tier's sky light occluded by the static geometry, lit by `sky`
   /// (render/sky_irradiance_volume.h), or null: then the sky irradiance is unoccluded.
   const SkyIrradianceVolume* sky_volume = nullptr;
+  /// the realtime tier's sun shadow rays that the static boxes provably block
+  /// (render/sun_occluder_map.h), or null: then every shadow ray is traced.
+  const SunOccluderMap* sun_occluders = nullptr;
   const Camera* camera = nullptr;
   const RenderSettings* settings = nullptr;
+  /// parts switched off by a bench (render/render_ablation.h), or null: all on.
+  const RenderAblation* ablation = nullptr;
   int camera_index = 0;     ///< CameraView::camera_index
   int64_t frame_index = 0;  ///< CameraView::frame_index
   /// adverse conditions of this frame (media, particles, wetness; render/cpu/media_frame.h), or

@@ -8,6 +8,7 @@
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/lamp_math.h"
+#include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/media_common.h"
 
 namespace penumbra {
@@ -36,63 +37,6 @@ inline Vec3Lanes EnvBrdfApprox(const Vec3Lanes& f0, const Lanes& n_v, const Lane
           (f0.z * a + b).max(0.0f).min(1.0f)};
 }
 
-// EnvBrdfApprox for one shading point (the same formula, scalar exp2).
-inline Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
-  const float r0 = 1.0f - roughness, r1 = 0.0425f - 0.0275f * roughness;
-  const float a004 = std::min(r0 * r0, std::exp2(-9.28f * n_v)) * r0 + r1;
-  const float a = -1.04f * a004 + 1.04f - 0.572f * roughness;
-  const float b = 1.04f * a004 - 0.04f + 0.022f * roughness;
-  return (f0 * a + Eigen::Vector3f::Constant(b)).cwiseMax(0.0f).cwiseMin(1.0f);
-}
-
-// radiance arriving along a mirrored ray `ray` (the mirror layer, SurfaceMaterial::mirror):
-// the sky where it escapes, else the surface it hits shaded as the tier shades what the camera
-// sees (emission, sky ambient, one sample of every light with a shadow ray), the light samples'
-// numbers from draws first_draw ... of the pixel's `stream`. one reflection: a mirror seen in a
-// mirror shows its BRDF only. `path_m`: the camera-to-mirror distance (texture level of detail);
-// no media or particles along the mirrored ray.
-Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float path_m, float wetness,
-                               uint64_t stream, uint64_t first_draw, int64_t* traced) {
-  SurfaceHit h;
-  ++*traced;
-  const Eigen::Vector3f d = ray.d.normalized();
-  if (!ctx.scene->Intersect(ray, &h)) return ctx.sky->Background(d);
-  const Eigen::Vector3f wo = -d;
-  const TextureFootprint footprint =
-      ConeFootprint(ctx.camera->pixel_spread_rad(), path_m + h.t * ray.d.norm(), d, h);
-  SurfaceMaterial mat = ctx.materials->EvaluateAndMapNormal(&h, footprint);
-  if (wetness > 0) ApplySurfaceWetness(wetness, h.ns_W, &mat.pbr);
-  const Bsdf bsdf(mat.pbr, h.ns_W, h.ng_W, wo);
-  const Eigen::Vector3f& n = bsdf.shading_normal();
-  const Eigen::Vector3f sky_E = ctx.sky_volume != nullptr
-                                    ? ctx.sky_volume->Irradiance(h.p_W, n, *ctx.sky)
-                                    : ctx.sky->Irradiance(n);
-  const Eigen::Vector3f spec = EnvBrdfApproxScalar(bsdf.f0(), std::max(n.dot(wo), 0.0f),
-                                                   std::clamp(mat.pbr.roughness, 0.0f, 1.0f));
-  const Eigen::Vector3f reflect =
-      bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-  Eigen::Vector3f L = mat.emission + (sky_E * (kInvPi * mat.occlusion)).cwiseProduct(reflect);
-  const Eigen::Vector3f origin = OffsetRayOrigin(h.p_W, h.ng_W);
-  for (int j = 0; j < ctx.lights->size(); ++j) {
-    float u1, u2;
-    Rng::Uniform2Of(Rng::DrawAt(stream, first_draw + j), &u1, &u2);
-    LightSample s;
-    if (!ctx.lights->Sample(j, h.p_W, u1, u2, &s)) continue;
-    const Eigen::Vector3f c = bsdf.Eval(s.wi).cwiseProduct(s.E);
-    if (!(c.maxCoeff() > 0)) continue;
-    if (s.cast_shadow) {
-      Ray sr;
-      sr.o = origin;
-      sr.d = s.wi;
-      sr.tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
-      ++*traced;
-      if (ctx.scene->Occluded(sr)) continue;
-    }
-    L += c;
-  }
-  return L;
-}
-
 // per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
   std::vector<LightSampleLanes> samples;  // per light
@@ -105,7 +49,7 @@ struct Scratch {
   // pixel's own shadow ray's verdict (1 visible, 0 occluded, -1 none traced).
   std::vector<Eigen::Vector3f> area_c;
   std::vector<int8_t> area_vis;
-  std::vector<float> keep;  // per tile pixel: 1 - SurfaceMaterial::mirror
+  std::vector<float> mirror;              // per tile pixel: SurfaceMaterial::mirror, 0 = none
 };
 
 // shadow rays per pixel towards a light with an extent in a penumbra (1 elsewhere).
@@ -259,10 +203,9 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
     if (!(seen_in_tile[0] && seen_in_tile[1])) {
       if (!seen_in_tile[1]) continue;
       for (int i = 0; i < n; ++i) {
-        if (vis[i] < 0 || !(scratch.keep[i] > 0)) continue;
-        const float V = scratch.keep[i];
+        if (vis[i] < 0) continue;
         float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
-        Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
+        Lp[0] += c[i].x(), Lp[1] += c[i].y(), Lp[2] += c[i].z();
       }
       continue;
     }
@@ -334,7 +277,6 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
           }
         V = sum / static_cast<float>(count);
       }
-      V *= scratch.keep[i];
       if (!(V > 0)) continue;
       float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
       Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
@@ -504,8 +446,11 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   scratch.contrib.resize(num_lights);
   scratch.area_c.resize(static_cast<size_t>(num_lights) * n);
   scratch.area_vis.assign(static_cast<size_t>(num_lights) * n, -1);
-  scratch.keep.resize(n);
   TileSkyIrradiance(ctx, primary, &scratch);
+  scratch.mirror.assign(n, 0.0f);
+  bool any_mirror = false;
+  static const RenderAblation kAllOn;
+  const RenderAblation& ablation = ctx.ablation != nullptr ? *ctx.ablation : kAllOn;
   int64_t traced = 0;
   const uint64_t frame_key = ctx.FrameKey();
   const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
@@ -530,7 +475,6 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
     }
     LaneMask hit = LaneMask::Constant(false);
-    float mirror[kLanes] = {};  // SurfaceMaterial::mirror of every lane
     BsdfLanes bsdf;
     PbrLanes pbr;
     Vec3Lanes p, origin, L, emission, sky_E;
@@ -569,7 +513,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const Eigen::Vector3f& n_s = scratch.n_s[i];
       bsdf.SetFrame(k, n_s, h.ng_W, wo);
       pbr.Set(k, mat.pbr);
-      mirror[k] = mat.mirror;
+      if (mat.mirror > 0 && ablation.mirror) scratch.mirror[i] = mat.mirror, any_mirror = true;
       emission.Set(k, mat.emission);
       p.Set(k, h.p_W);
       // shadow rays start off the surface on the lit side (lights behind it contribute 0).
@@ -648,7 +592,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const LaneMask lit = GreaterThan(LuminanceLanes(c), 0.0f);
       if (!lit.any()) continue;
       const LaneMask shadowed =
-          ctx.lights->lights()[j].cast_shadow
+          ctx.lights->lights()[j].cast_shadow && ablation.shadows
               ? lit && GreaterEqual(LuminanceLanes(c), kNegligibleLight * total)
               : LaneMask::Constant(false);
       const LaneMask unshadowed = lit && !shadowed;
@@ -656,46 +600,38 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       if (!shadowed.any()) continue;
       const LightSampleLanes& s = scratch.samples[j];
       const Lanes tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
+      // the sun's rays that a static box provably blocks are occluded without tracing them.
+      const LaneMask skipped = ctx.sun_occluders != nullptr && j == ctx.sun_occluders->light_index()
+                                   ? ctx.sun_occluders->BlocksLanes(origin, s.wi, shadowed)
+                                   : LaneMask::Constant(false);
+      const LaneMask to_trace = shadowed && !skipped;
       LaneMask occluded;
-      ctx.scene->OccludedLanes(origin, s.wi, tmax, shadowed, &occluded);
-      traced += shadowed.count();
+      if (to_trace.any()) ctx.scene->OccludedLanes(origin, s.wi, tmax, to_trace, &occluded);
+      traced += to_trace.count();
       if (IsExtendedLight(ctx.lights->lights()[j])) {
-        // the verdict waits for its neighbours' (ResolveSharedVisibility).
+        // the verdict waits for its neighbours' (ResolveSharedVisibility); a lane the sun-occluder
+        // map skipped is occluded (the map's verdict is exact for that ray).
         const size_t base = static_cast<size_t>(j) * n + static_cast<size_t>(i0);
         for (int k = 0; k < m; ++k) {
           if (!shadowed[k]) continue;
-          scratch.area_vis[base + k] = occluded[k] ? 0 : 1;
+          scratch.area_vis[base + k] = skipped[k] || occluded[k] ? 0 : 1;
           scratch.area_c[base + k] = Eigen::Vector3f(c.x[k], c.y[k], c.z[k]);
         }
         continue;
       }
-      const LaneMask visible = shadowed && !occluded;
+      const LaneMask visible = to_trace && !occluded;
       L = L + Where(visible, c);
     }
     for (int k = 0; k < m; ++k) {
       if (!hit[k]) continue;
-      scratch.keep[i0 + k] = 1.0f - mirror[k];
-      Eigen::Vector3f Lk(L.x[k], L.y[k], L.z[k]);
-      if (mirror[k] > 0) {
-        // the mirror layer: (1 - r) L + r L_mirror, its light samples after this pixel's.
-        const int i = i0 + k;
-        const SurfaceHit& h = primary.hits[i];
-        const Eigen::Vector3f d = primary.rays[i].d.normalized();
-        const Eigen::Vector3f wi = d - 2.0f * d.dot(h.ng_W) * h.ng_W;
-        const uint64_t stream = FrameContext::PixelStream(
-            frame_key, static_cast<uint64_t>(lane_v[k]) * width + static_cast<uint64_t>(lane_u[k]),
-            0);
-        const Eigen::Vector3f Lm =
-            MirrorRadiance(ctx, SpawnRay(h, wi), h.t * primary.rays[i].d.norm(), wetness, stream,
-                           static_cast<uint64_t>(num_lights), &traced);
-        Lk = (1.0f - mirror[k]) * Lk + mirror[k] * Lm;
-      }
       float* Lp = out.radiance->at(lane_u[k], lane_v[k]);
-      Lp[0] = Lk.x(), Lp[1] = Lk.y(), Lp[2] = Lk.z();
+      Lp[0] = L.x[k], Lp[1] = L.y[k], Lp[2] = L.z[k];
     }
   }
   // the shadowed light of lights with an extent, its visibility shared between neighbours.
   ResolveSharedVisibility(ctx, primary, scratch, out, &traced);
+  // the mirror layer once every pixel holds its own radiance (render/cpu/mirror_layer.h).
+  if (any_mirror) traced += ApplyMirrorLayer(ctx, primary, scratch.mirror.data(), wetness, out);
   // the effects once every pixel of the tile holds its surface or sky radiance.
   if (fx != nullptr) ApplyTileViewEffects(ctx, primary, out);
   return traced;
