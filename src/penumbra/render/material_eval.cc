@@ -506,14 +506,25 @@ void MaterialEvaluator::BendNormal(const Mapping2D& map, const Eigen::Vector3f& 
     t_G = P.col(0);
     b_G = -P.col(1);
   }
-  // the rest is shared with the GPU (texture_math.h).
-  const Eigen::Vector3f t = R_WG * t_G, b = R_WG * b_G;
-  Float3 mapped;
-  if (!penumbra::BendNormal(Float3{hit->ns_W.x(), hit->ns_W.y(), hit->ns_W.z()}, hit->front_face,
-                  Float3{t.x(), t.y(), t.z()}, Float3{b.x(), b.y(), b.z()},
-                  Float3{c.x(), c.y(), c.z()}, &mapped))
-    return;
-  hit->ns_W = Eigen::Vector3f(mapped.x, mapped.y, mapped.z);
+  // the GPU's BendNormal (texture_math.h) is this arithmetic on Float3; here Eigen's vectorised
+  // dot and cross products round differently in the last bit (docs/gpu.md).
+  const Eigen::Vector3f tn(2 * c.x() - 1, 2 * c.y() - 1, 2 * c.z() - 1);
+  // outward shading normal, and the tangent frame around it (Gram-Schmidt), world frame.
+  const Eigen::Vector3f n = hit->front_face ? hit->ns_W : Eigen::Vector3f(-hit->ns_W);
+  Eigen::Vector3f t = R_WG * t_G;
+  t -= t.dot(n) * n;
+  const float lt = t.norm();
+  if (!(lt > 0)) return;
+  t /= lt;
+  // b minus its components along n and t, normalised, is +-(n x t) (n, t orthonormal).
+  const Eigen::Vector3f n_x_t = n.cross(t);
+  const float b_along = (R_WG * b_G).dot(n_x_t);
+  if (!(b_along != 0)) return;
+  const Eigen::Vector3f b = b_along > 0 ? n_x_t : Eigen::Vector3f(-n_x_t);
+  const Eigen::Vector3f mapped = tn.x() * t + tn.y() * b + std::max(tn.z(), 0.0f) * n;
+  const float len = mapped.norm();
+  if (!(len > 0) || !mapped.allFinite()) return;
+  hit->ns_W = hit->front_face ? Eigen::Vector3f(mapped / len) : Eigen::Vector3f(-mapped / len);
 }
 
 SurfaceMaterial MaterialEvaluator::EvaluateAndMapNormal(SurfaceHit* hit,

@@ -306,7 +306,8 @@ PB_HOST_DEVICE inline PlanarFilterPlan PlanPlanarFilter(const PlanarMap& map, fl
                          map.j1 * minor_a1, w, th, max_anisotropy);
 }
 
-/// normal mapping (render/material_eval.h, MaterialEvaluator::ApplyNormalMap): the unit world
+/// normal mapping (render/material_eval.h, MaterialEvaluator::ApplyNormalMap; the CPU keeps its
+/// Eigen form of these lines, whose vectorised products round differently: docs/gpu.md): the unit world
 /// shading normal that texel c of a tangent-space normal map ((x, y, z) = 2 c - 1) gives at a
 /// surface of unit shading normal ns (as the hit has it: flipped towards the ray on back faces,
 /// front_face false), with the mapping's tangent t_W (increasing s) and bitangent b_W (towards

@@ -155,8 +155,16 @@ void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float
       if (g.hit == 0) {
         e = sky_.Radiance(v);
       } else {
-        const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z);
-        e = occluded ? volume_.Irradiance(v, ng, sky_) : sky_.Irradiance(ng);
+        // the probes' blend at the point and geometric normal, evaluated at the shading normal
+        // (RealtimeIntegrator's TileSkyIrradiance, per pixel).
+        const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z), ns(g.ns.x, g.ns.y, g.ns.z);
+        if (occluded) {
+          SkyIrradianceVolume::ShBlend blend;
+          volume_.Blend(v, ng, &blend);
+          e = volume_.IrradianceAt(blend, ns, sky_);
+        } else {
+          e = sky_.Irradiance(ns);
+        }
       }
       out[i] = ToFloat3(e);
     }
@@ -200,13 +208,14 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
   const SceneView scene = bvh.view();
+  const RealtimeFrameView geo_view = data.View(scene, nullptr);
   std::vector<PixelGeometry> geometry(n);
   if (out->depth_m.width != W || out->depth_m.height != H || out->depth_m.channels != 1)
     out->depth_m = ImageF(W, H, 1);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     for (int u = 0; u < W; ++u) {
       const int64_t i = v * W + u;
-      geometry[i] = PrimaryGeometry(scene, c, u, static_cast<int>(v), &out->depth_m.data[i]);
+      geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i]);
     }
   });
   std::vector<Float3> sky(n);

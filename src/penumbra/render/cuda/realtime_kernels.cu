@@ -14,14 +14,13 @@
 namespace penumbra::cuda {
 namespace {
 
-__global__ void GeometryKernel(SceneView s, PinholeCamera c, PixelGeometry* geometry,
-                               float* depth) {
+__global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= c.width || v >= c.height) return;
-  const int64_t i = static_cast<int64_t>(v) * c.width + u;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   float t;
-  geometry[i] = PrimaryGeometry(s, c, u, v, &t);
+  geometry[i] = PrimaryGeometry(f, u, v, &t);
   depth[i] = t;
 }
 
@@ -94,11 +93,21 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.radiance.Reserve(sizeof(Float3) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
-  // (1) primary geometry and depth
+  // the frame with the device copies
+  RealtimeFrameView f = host_frame;
+  f.scene = scene->device_view();
+  f.materials = m.materials.as<MaterialPod>();
+  f.textures = m.textures.as<TexturePod>();
+  f.texels = m.texels.as<uint8_t>();
+  f.srgb_decode = m.decode.as<float>();
+  f.geoms = m.geoms.as<GeomPod>();
+  f.lights = m.lights.as<LightPod>();
+  f.sky_term = m.sky.as<Float3>();
+  // (1) primary geometry (materials and normal maps included) and depth
   const dim3 block(16, 8);
   const dim3 grid((W + block.x - 1) / block.x, (H + block.y - 1) / block.y);
-  GeometryKernel<<<grid, block, 0, stream>>>(scene->device_view(), c,
-                                             m.geometry.as<PixelGeometry>(), m.depth.as<float>());
+  GeometryKernel<<<grid, block, 0, stream>>>(f, m.geometry.as<PixelGeometry>(),
+                                             m.depth.as<float>());
   Check(cudaGetLastError(), "GeometryKernel");
   m.host_geometry.resize(n);
   m.geometry.Download(m.host_geometry.data(), sizeof(PixelGeometry) * n, stream);
@@ -109,15 +118,6 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   sky(m.host_geometry.data(), n, m.host_sky.data());
   m.sky.Upload(m.host_sky.data(), sizeof(Float3) * n, stream);
   // (3) shading
-  RealtimeFrameView f = host_frame;
-  f.scene = scene->device_view();
-  f.materials = m.materials.as<MaterialPod>();
-  f.textures = m.textures.as<TexturePod>();
-  f.texels = m.texels.as<uint8_t>();
-  f.srgb_decode = m.decode.as<float>();
-  f.geoms = m.geoms.as<GeomPod>();
-  f.lights = m.lights.as<LightPod>();
-  f.sky_term = m.sky.as<Float3>();
   ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
   Check(cudaGetLastError(), "ShadeKernel");
   // (4) exposure from the rows' log-luminance sums
@@ -157,7 +157,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count) {
   Check(cudaEventCreate(&stop), "cudaEventCreate");
   Check(cudaEventRecord(start, stream), "cudaEventRecord");
   for (int k = 0; k < count; ++k) {
-    GeometryKernel<<<grid, block, 0, stream>>>(f.scene, f.camera, m.geometry.as<PixelGeometry>(),
+    GeometryKernel<<<grid, block, 0, stream>>>(f, m.geometry.as<PixelGeometry>(),
                                                m.depth.as<float>());
     ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
     RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,

@@ -92,12 +92,21 @@ struct RealtimeFrameView {
   const Float3* sky_term = nullptr;
 };
 
-/// what a pixel's primary ray hits, for the host's sky pass: p_W and the unit geometric
-/// normal facing the ray where it hits; the unit ray direction where it does not.
+/// what a pixel's primary ray hits, for the host's sky pass: p_W, the unit geometric normal
+/// facing the ray and the unit shading normal (normal map applied, UsableShadingNormal) where
+/// it hits; the unit ray direction where it does not.
 struct PixelGeometry {
   Float3 p_or_d;
   Float3 ng;
+  Float3 ns;
   int32_t hit = 0;
+};
+
+/// a surface point as the realtime tier shades it: the textured material and the frame.
+struct ShadingPoint {
+  Float3 p, ng, n, wo;  ///< point, geometric normal (facing the ray), shading normal, to viewer
+  Float3 base, emission;
+  float roughness = 0.5f, metallic = 0, specular = 0.5f, occlusion = 1;
 };
 
 PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
@@ -150,27 +159,6 @@ PB_HOST_DEVICE inline F3 HitNormal(const SceneView& s, const TraceRay& r, const 
   if (!front) n = {-n.x, -n.y, -n.z};
   if (front_face) *front_face = front;
   return n;
-}
-
-/// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
-/// (0 on a miss).
-PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const SceneView& s, const PinholeCamera& c,
-                                                    int u, int v, float* t_hit) {
-  const TraceRay r = PrimaryRay(c, u, v);
-  TraceHit h;
-  TraceClosest(s, r, &h);
-  PixelGeometry g;
-  *t_hit = 0;
-  if (h.instance < 0) {
-    const float inv = 1.0f / sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
-    g.p_or_d = Float3{r.d.x * inv, r.d.y * inv, r.d.z * inv};
-    return g;
-  }
-  *t_hit = h.t;
-  g.hit = 1;
-  g.p_or_d = Float3{r.o.x + h.t * r.d.x, r.o.y + h.t * r.d.y, r.o.z + h.t * r.d.z};
-  g.ng = ToFloat3(HitNormal(s, r, h));
-  return g;
 }
 
 /// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
@@ -278,31 +266,30 @@ PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j
   return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
 }
 
-/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
-/// escapes).
-PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+/// the shading point of hit h of primary ray r (d_len = |r.d|): the material with its
+/// textures and PBR maps filtered over the pixel's ray cone (MaterialEvaluator's order: base
+/// colour, metallic-roughness, occlusion, emissive, normal map), and the shading normal the
+/// viewer sees (UsableShadingNormal).
+PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, const TraceRay& r,
+                                                   const TraceHit& h, float d_len) {
   const SceneView& s = f.scene;
-  const TraceRay r = PrimaryRay(f.camera, u, v);
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const Float3 sky = f.sky_term[pixel];
-  TraceHit h;
-  TraceClosest(s, r, &h);
-  if (h.instance < 0) return sky;
-  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  ShadingPoint sp;
   const Float3 d{r.d.x / d_len, r.d.y / d_len, r.d.z / d_len};
-  const Float3 wo = -d;
-  const Float3 p{r.o.x + h.t * r.d.x, r.o.y + h.t * r.d.y, r.o.z + h.t * r.d.z};
+  sp.wo = -d;
+  sp.p = Float3{r.o.x + h.t * r.d.x, r.o.y + h.t * r.d.y, r.o.z + h.t * r.d.z};
   bool front_face = true;
-  const Float3 ng = ToFloat3(HitNormal(s, r, h, &front_face));
+  sp.ng = ToFloat3(HitNormal(s, r, h, &front_face));
+  const Float3& p = sp.p;
+  const Float3& ng = sp.ng;
   const Record& rec = s.records[s.prims[h.prim].record];
   const MaterialPod& m = rec.material >= 0 ? f.materials[rec.material] : f.default_material;
-  Float3 base = m.base_color;
-  float roughness = m.roughness, metallic = m.metallic, occlusion = 1;
-  Float3 emission = m.emission;
+  sp.base = m.base_color;
+  sp.roughness = m.roughness;
+  sp.metallic = m.metallic;
+  sp.specular = m.specular;
+  sp.emission = m.emission;
   Float3 ns = ng;
   if (m.any_map() && rec.geom >= 0 && f.geoms[rec.geom].untextured == 0) {
-    // the material's textures and PBR maps over the pixel's ray cone (MaterialEvaluator's
-    // order: base colour, metallic-roughness, occlusion, emissive, normal).
     const GeomPod& g = f.geoms[rec.geom];
     const Float3 p_G = ToFloat3(TransformPoint(g.X_GW, ToF3(p)));
     const Float3 n_G = ToFloat3(TransformVector(g.X_GW, ToF3(ng)));
@@ -312,18 +299,18 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
                                                  cos_inc, f.max_anisotropy);
     if (m.texture >= 0) {
       const Float3 c = FilterPlanar(f, m.texture, fp);
-      base = Float3{base.x * c.x, base.y * c.y, base.z * c.z};
+      sp.base = Float3{sp.base.x * c.x, sp.base.y * c.y, sp.base.z * c.z};
     }
     if (m.metallic_roughness_map >= 0) {
       const Float3 c = FilterPlanar(f, m.metallic_roughness_map, fp);
-      roughness *= c.y;
-      metallic *= c.z;
+      sp.roughness *= c.y;
+      sp.metallic *= c.z;
     }
     if (m.occlusion_map >= 0)
-      occlusion = pbm::Clamp(FilterPlanar(f, m.occlusion_map, fp).x, 0.0f, 1.0f);
+      sp.occlusion = pbm::Clamp(FilterPlanar(f, m.occlusion_map, fp).x, 0.0f, 1.0f);
     if (m.emissive_map >= 0) {
       const Float3 c = FilterPlanar(f, m.emissive_map, fp);
-      emission = Float3{emission.x * c.x, emission.y * c.y, emission.z * c.z};
+      sp.emission = Float3{sp.emission.x * c.x, sp.emission.y * c.y, sp.emission.z * c.z};
     }
     if (m.normal_map >= 0) {
       // the planar mapping's tangent (+-a0) and bitangent (-+a1) in the world: rows of R_GW.
@@ -336,13 +323,60 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
         ns = bent;
     }
   }
+  sp.n = pbm::Dot<float>(ns, sp.wo) > 0 ? ns : ng;
+  return sp;
+}
+
+/// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
+/// (0 on a miss).
+PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
+                                                    float* t_hit) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  PixelGeometry g;
+  *t_hit = 0;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  if (h.instance < 0) {
+    const float inv = 1.0f / d_len;
+    g.p_or_d = Float3{r.d.x * inv, r.d.y * inv, r.d.z * inv};
+    return g;
+  }
+  *t_hit = h.t;
+  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
+  g.hit = 1;
+  g.p_or_d = sp.p;
+  g.ng = sp.ng;
+  g.ns = sp.n;
+  return g;
+}
+
+/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
+/// escapes).
+PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+  const SceneView& s = f.scene;
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const Float3 sky = f.sky_term[pixel];
+  TraceHit h;
+  TraceClosest(s, r, &h);
+  if (h.instance < 0) return sky;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
+  const Float3& p = sp.p;
+  const Float3& ng = sp.ng;
+  const Float3& n = sp.n;
+  const Float3& wo = sp.wo;
+  const float roughness = sp.roughness;
+  const Float3 emission = sp.emission;
+  const float occlusion = sp.occlusion;
   // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
   // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
   Float3 c_diff, f0;
   float alpha;
-  BrdfCoefficientsOf<float, Float3>(base, roughness, metallic, m.specular, &c_diff, &f0, &alpha);
+  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &c_diff, &f0,
+                                    &alpha);
   const float a2 = alpha * alpha;
-  const Float3 n = pbm::Dot<float>(ns, wo) > 0 ? ns : ng;
   const float n_v = pbm::Dot<float>(n, wo);
   const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), roughness);
   const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
