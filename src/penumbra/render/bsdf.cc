@@ -62,8 +62,8 @@ BrdfCoefficients BrdfCoefficients::From(const PbrParams& params) {
   BrdfCoefficients c;
   Float3 c_diff, f0;
   BrdfCoefficientsOf<float, Float3>(
-      Float3{params.base_color.x(), params.base_color.y(), params.base_color.z()},
-      params.roughness, params.metallic, params.specular, &c_diff, &f0, &c.alpha);
+      Float3{params.base_color.x(), params.base_color.y(), params.base_color.z()}, params.roughness,
+      params.metallic, params.specular, &c_diff, &f0, &c.alpha);
   c.c_diff = Eigen::Vector3f(c_diff.x, c_diff.y, c_diff.z);
   c.f0 = Eigen::Vector3f(f0.x, f0.y, f0.z);
   return c;

@@ -18,13 +18,13 @@ enum class LightKind : int32_t { kDirectional = 0, kPoint = 1, kSpot = 2 };
 /// a light posed in the world for one snapshot, as plain data (LightSampler::pods()).
 struct LightPod {
   LightKind kind = LightKind::kPoint;
-  Float3 position_W;                 ///< point, spot
-  Float3 direction_W{0, 0, -1};      ///< unit, direction light travels (directional, spot)
-  Float3 intensity_rgb;              ///< color x intensity (cd or lux per channel)
+  Float3 position_W;                   ///< point, spot
+  Float3 direction_W{0, 0, -1};        ///< unit, direction light travels (directional, spot)
+  Float3 intensity_rgb;                ///< color x intensity (cd or lux per channel)
   float cos_inner = 1, cos_outer = 1;  ///< spot cone cosines
-  float radius_m = 0;                ///< > 0: a sphere sampled for soft shadows
-  float cos_angular_radius = 1;      ///< directional: cosine of the sun disc's angular radius
-  int32_t cast_shadow = 1;           ///< 1: trace a shadow ray
+  float radius_m = 0;                  ///< > 0: a sphere sampled for soft shadows
+  float cos_angular_radius = 1;        ///< directional: cosine of the sun disc's angular radius
+  int32_t cast_shadow = 1;             ///< 1: trace a shadow ray
 };
 
 /// a unit direction sampled uniformly in the cone of cosine `cos_max` around the unit axis w

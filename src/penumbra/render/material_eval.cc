@@ -279,7 +279,7 @@ struct MaterialEvaluator::Mapping2D {
   float h0 = 1, h1 = 1;  // kPerFace: half sizes of the face
   int a0 = -1, a1 = -1;  // planar: the face axes (image rows along -a1)
 
-  PlanarMap planar;      // planar kinds (texture_math.h)
+  PlanarMap planar;  // planar kinds (texture_math.h)
 
   // texels per metre of surface for a w x h image (the expressions of the isotropic lookup).
   float Rho(float w, float th) const {

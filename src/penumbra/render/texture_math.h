@@ -77,8 +77,8 @@ PB_HOST_DEVICE inline Float3 BilinearWrap(const TextureLevelView& L, const float
 
 /// bilinear lookup in face `face` of one level of a cube texture, clamped to the face; (s, t)
 /// in [0, 1].
-PB_HOST_DEVICE inline Float3 BilinearFace(const TextureLevelView& L, const float* decode,
-                                          int face, float s, float t) {
+PB_HOST_DEVICE inline Float3 BilinearFace(const TextureLevelView& L, const float* decode, int face,
+                                          float s, float t) {
   const int w = L.width;
   const float x = pbm::Clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
   const float y = pbm::Clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
@@ -302,13 +302,13 @@ PB_HOST_DEVICE inline PlanarFilterPlan PlanPlanarFilter(const PlanarMap& map, fl
                                                         float major_a1, float minor_a0,
                                                         float minor_a1, float w, float th,
                                                         int max_anisotropy) {
-  return PlanAnisotropic(map.j0 * major_a0, map.j1 * major_a1, map.j0 * minor_a0,
-                         map.j1 * minor_a1, w, th, max_anisotropy);
+  return PlanAnisotropic(map.j0 * major_a0, map.j1 * major_a1, map.j0 * minor_a0, map.j1 * minor_a1,
+                         w, th, max_anisotropy);
 }
 
 /// normal mapping (render/material_eval.h, MaterialEvaluator::ApplyNormalMap; the CPU keeps its
-/// Eigen form of these lines, whose vectorised products round differently: docs/gpu.md): the unit world
-/// shading normal that texel c of a tangent-space normal map ((x, y, z) = 2 c - 1) gives at a
+/// Eigen form of these lines, whose vectorised products round differently: docs/gpu.md): the unit
+/// world shading normal that texel c of a tangent-space normal map ((x, y, z) = 2 c - 1) gives at a
 /// surface of unit shading normal ns (as the hit has it: flipped towards the ray on back faces,
 /// front_face false), with the mapping's tangent t_W (increasing s) and bitangent b_W (towards
 /// the image's top row), world frame, not yet orthogonal: t is made orthogonal to the outward

@@ -39,13 +39,14 @@ TEST_P(RealtimeRgbGpu, MatchesCpuBackendAndRepeatsBitForBit) {
   EXPECT_EQ(g->cpu_frames(), 0);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
-  std::printf("%s 640x480 rgb+depth: PSNR %.2f dB (ev100 cpu %.4f gpu %.4f), depth > 1 mm on "
-              "%.4f %% of pixels, second render %s\n",
-              GetParam().c_str(), psnr, want.ev100, got.ev100, 100 * depth_bad,
-              got.rgb.data == again.rgb.data && got.radiance.data == again.radiance.data &&
-                      got.depth_m.data == again.depth_m.data
-                  ? "bit-identical"
-                  : "DIFFERENT");
+  std::printf(
+      "%s 640x480 rgb+depth: PSNR %.2f dB (ev100 cpu %.4f gpu %.4f), depth > 1 mm on "
+      "%.4f %% of pixels, second render %s\n",
+      GetParam().c_str(), psnr, want.ev100, got.ev100, 100 * depth_bad,
+      got.rgb.data == again.rgb.data && got.radiance.data == again.radiance.data &&
+              got.depth_m.data == again.depth_m.data
+          ? "bit-identical"
+          : "DIFFERENT");
   EXPECT_GE(psnr, 40.0);
   EXPECT_LE(depth_bad, 0.001);
   EXPECT_EQ(got.rgb.data, again.rgb.data);

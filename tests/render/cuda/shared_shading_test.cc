@@ -25,8 +25,7 @@ namespace {
 
 Eigen::Vector3f SharedUnit(Rng* rng) {
   for (;;) {
-    const Eigen::Vector3f v(2 * rng->Uniform() - 1, 2 * rng->Uniform() - 1,
-                            2 * rng->Uniform() - 1);
+    const Eigen::Vector3f v(2 * rng->Uniform() - 1, 2 * rng->Uniform() - 1, 2 * rng->Uniform() - 1);
     if (v.squaredNorm() > 0.01f && v.squaredNorm() <= 1) return v.normalized();
   }
 }
@@ -60,8 +59,7 @@ TEST(SharedShading, BrdfFloatFollowsTheLanesAndBsdf) {
     Float3 c_diff, f0;
     float alpha;
     BrdfCoefficientsOf<float, Float3>(SharedF3(params[k].base_color), params[k].roughness,
-                                      params[k].metallic, params[k].specular, &c_diff, &f0,
-                                      &alpha);
+                                      params[k].metallic, params[k].specular, &c_diff, &f0, &alpha);
     const float n_v = pbm::Dot<float>(SharedF3(n[k]), SharedF3(wo[k]));
     const Float3 f = BrdfEvalWorld<float, Float3>(SharedF3(n[k]), SharedF3(n[k]), SharedF3(wo[k]),
                                                   n_v, c_diff, f0, alpha * alpha, SharedF3(wi[k]));
@@ -87,8 +85,7 @@ TEST(SharedShading, EnvBrdfFloatFollowsTheLanes) {
   }
   const Vec3Lanes l = EnvBrdfApprox<Lanes, Vec3Lanes>(f0, n_v, rough);
   for (int k = 0; k < kLanes; ++k) {
-    const Float3 s =
-        EnvBrdfApprox<float, Float3>(SharedF3(f0.Lane(k)), n_v[k], rough[k]);
+    const Float3 s = EnvBrdfApprox<float, Float3>(SharedF3(f0.Lane(k)), n_v[k], rough[k]);
     // Eigen's vectorised exp and expf differ by a few ulp
     EXPECT_NEAR(s.x, l.x[k], 1e-6f);
     EXPECT_NEAR(s.y, l.y[k], 1e-6f);

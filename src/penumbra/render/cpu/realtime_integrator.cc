@@ -19,8 +19,7 @@ inline Lanes LuminanceLanes(const Vec3Lanes& c) { return pbm::Luminance709(c.x, 
 
 // the split-sum ambient specular fit (render/brdf_math.h) for one shading point.
 inline Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
-  const Float3 s =
-      EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
+  const Float3 s = EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
   return Eigen::Vector3f(s.x, s.y, s.z);
 }
 

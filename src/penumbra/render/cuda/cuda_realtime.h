@@ -58,9 +58,8 @@ class DeviceRealtime {
   /// renders one frame of `frame` (host pointers for its geoms and lights; the scene arrays,
   /// materials and textures are replaced by the device copies of `scene` and Upload) with
   /// `num_geoms` geoms; returns the EV100. `filmic`: the film's tone map.
-  double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms,
-                bool filmic, const SkyFn& sky, const ExposureFn& exposure,
-                const RealtimeOutputs& out);
+  double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms, bool filmic,
+                const SkyFn& sky, const ExposureFn& exposure, const RealtimeOutputs& out);
 
   /// `count` runs of the frame's device work as Render left it (geometry, shading, row sums
   /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with

@@ -12,8 +12,8 @@
 #include <memory>
 #include <string>
 
-#include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/core/thread_pool.h"
+#include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_frame.h"

@@ -163,8 +163,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count) {
     RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,
                                                       m.rows.as<double>());
     DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
-        m.radiance.as<Float3>(), n, m.exposure, m.filmic, m.lut.as<uint8_t>(),
-        m.rgb.as<uint8_t>());
+        m.radiance.as<Float3>(), n, m.exposure, m.filmic, m.lut.as<uint8_t>(), m.rgb.as<uint8_t>());
   }
   Check(cudaGetLastError(), "realtime kernels");
   Check(cudaEventRecord(stop, stream), "cudaEventRecord");

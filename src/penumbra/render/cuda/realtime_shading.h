@@ -66,7 +66,7 @@ struct TexturePod {
 /// a geom as the GPU maps textures on it, posed for the frame.
 struct GeomPod {
   float X_GW[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};  ///< row-major [R | p], world to geom
-  Float3 half_extent;    ///< local bounding-box half extents (MaterialEvaluator's)
+  Float3 half_extent;          ///< local bounding-box half extents (MaterialEvaluator's)
   int32_t infinite_plane = 0;  ///< a plane without finite size in the face's axes
   int32_t plane = 0;           ///< GeomShape::kPlane
   int32_t untextured = 0;      ///< a mesh with texture coordinates (not mapped on the GPU yet)
@@ -76,7 +76,7 @@ struct GeomPod {
 struct RealtimeFrameView {
   SceneView scene;
   PinholeCamera camera;
-  float spread_rad = 0;  ///< Camera::pixel_spread_rad
+  float spread_rad = 0;                    ///< Camera::pixel_spread_rad
   const MaterialPod* materials = nullptr;  ///< by SceneDescription material index
   MaterialPod default_material;            ///< for material -1
   const GeomPod* geoms = nullptr;          ///< by SceneDescription geom index
@@ -193,8 +193,8 @@ PB_HOST_DEVICE inline PlanarFootprint PlanarFootprintAt(const MaterialPod& m, co
   if (m.texuniform != 0 || infinite)
     fp.map = PlanarMapUniform(p[a0], p[a1], rx, ry);
   else
-    fp.map = PlanarMapPerFace(p[a0], p[a1], h[a0] > 0 ? h[a0] : 1.0f, h[a1] > 0 ? h[a1] : 1.0f,
-                              rx, ry);
+    fp.map =
+        PlanarMapPerFace(p[a0], p[a1], h[a0] > 0 ? h[a0] : 1.0f, h[a1] > 0 ? h[a1] : 1.0f, rx, ry);
   if (max_anisotropy > 1 && width_m > 0) {
     const float dn = d_G.x * n_G.x + d_G.y * n_G.y + d_G.z * n_G.z;
     const Float3 t{d_G.x - dn * n_G.x, d_G.y - dn * n_G.y, d_G.z - dn * n_G.z};
@@ -204,7 +204,8 @@ PB_HOST_DEVICE inline PlanarFootprint PlanarFootprintAt(const MaterialPod& m, co
       const float major_len = width_m / pbm::Max(cos_incidence, kMinCosIncidence);
       const Float3 b{n_G.y * tu.z - n_G.z * tu.y, n_G.z * tu.x - n_G.x * tu.z,
                      n_G.x * tu.y - n_G.y * tu.x};
-      fp.major[0] = tu.x * major_len, fp.major[1] = tu.y * major_len, fp.major[2] = tu.z * major_len;
+      fp.major[0] = tu.x * major_len, fp.major[1] = tu.y * major_len,
+      fp.major[2] = tu.z * major_len;
       fp.minor[0] = b.x * width_m, fp.minor[1] = b.y * width_m, fp.minor[2] = b.z * width_m;
       fp.axes = true;
     }
@@ -223,8 +224,8 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
   bool planned = false;
   if (fp.axes) {
     const PlanarFilterPlan plan =
-        PlanPlanarFilter(fp.map, fp.major[fp.a0], fp.major[fp.a1], fp.minor[fp.a0],
-                         fp.minor[fp.a1], w, th, f.max_anisotropy);
+        PlanPlanarFilter(fp.map, fp.major[fp.a0], fp.major[fp.a1], fp.minor[fp.a0], fp.minor[fp.a1],
+                         w, th, f.max_anisotropy);
     if (plan.ok) {
       lod = plan.lod, n = plan.n, ds = plan.ds, dt = plan.dt;
       planned = true;
@@ -319,8 +320,7 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
       const Float3 t_W{st * R[4 * fp.a0], st * R[4 * fp.a0 + 1], st * R[4 * fp.a0 + 2]};
       const Float3 b_W{sb * R[4 * fp.a1], sb * R[4 * fp.a1 + 1], sb * R[4 * fp.a1 + 2]};
       Float3 bent;
-      if (BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent))
-        ns = bent;
+      if (BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent)) ns = bent;
     }
   }
   sp.n = pbm::Dot<float>(ns, sp.wo) > 0 ? ns : ng;
