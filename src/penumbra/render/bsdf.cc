@@ -58,15 +58,14 @@ inline void Basis(const Eigen::Vector3f& n, Eigen::Vector3f* t, Eigen::Vector3f*
 }  // namespace
 
 BrdfCoefficients BrdfCoefficients::From(const PbrParams& params) {
+  // the shared formula (render/brdf_math.h), as the realtime tier's lanes and the GPU take it.
   BrdfCoefficients c;
-  const float metallic = std::clamp(params.metallic, 0.0f, 1.0f);
-  const Eigen::Vector3f base = params.base_color.cwiseMax(0.0f).cwiseMin(1.0f);
-  const float r = std::clamp(params.roughness, 0.0f, 1.0f);
-  c.alpha = std::max(r * r, kMinAlpha);
-  const Eigen::Vector3f f0_dielectric =
-      Eigen::Vector3f::Constant(0.08f * std::clamp(params.specular, 0.0f, 1.0f));
-  c.f0 = f0_dielectric + (base - f0_dielectric) * metallic;
-  c.c_diff = base * (1.0f - metallic);
+  Float3 c_diff, f0;
+  BrdfCoefficientsOf<float, Float3>(
+      Float3{params.base_color.x(), params.base_color.y(), params.base_color.z()}, params.roughness,
+      params.metallic, params.specular, &c_diff, &f0, &c.alpha);
+  c.c_diff = Eigen::Vector3f(c_diff.x, c_diff.y, c_diff.z);
+  c.f0 = Eigen::Vector3f(f0.x, f0.y, f0.z);
   return c;
 }
 

@@ -22,6 +22,8 @@
 
 #include <Eigen/Core>
 
+#include "penumbra/render/brdf_math.h"
+
 namespace penumbra {
 
 /// parameters of the metallic-roughness BRDF at one surface point.
@@ -32,9 +34,6 @@ struct PbrParams {
   float metallic = 0.0f;  ///< [0, 1]
   float specular = 0.5f;  ///< dielectric specular scale, F0 = 0.08 specular
 };
-
-/// smallest GGX alpha used (roughness 0 becomes a very sharp lobe instead of a delta).
-constexpr float kMinAlpha = 1e-3f;
 
 /// result of Bsdf::Sample.
 struct BsdfSample {

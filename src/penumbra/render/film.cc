@@ -13,16 +13,11 @@
 namespace penumbra {
 namespace {
 
-constexpr int kLutSize = 65536;
+constexpr int kLutSize = kFilmLutSize;
 
-inline float Luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+inline float Luminance(const float* c) { return pbm::Luminance709(c[0], c[1], c[2]); }
 
-// table index of a tone-mapped value x in [0, 1]: round(x (kLutSize - 1)); NaN-safe
-// (!(x > 0) maps to 0).
-inline int LutIndex(float x) {
-  const int k = x > 0 ? static_cast<int>(x * (kLutSize - 1) + 0.5f) : 0;
-  return std::min(k, kLutSize - 1);
-}
+inline int LutIndex(float x) { return FilmLutIndex(x); }
 
 // table indices of n exposed values src[i] * exposure clamped to [0, 1] (the linear tone map).
 // with SSE2, four at a time, with the same IEEE operations in the same order and the same NaN
@@ -44,31 +39,10 @@ void ClampIndices(const float* src, int n, float exposure, int32_t* index) {
   for (; i < n; ++i) index[i] = LutIndex(std::clamp(src[i] * exposure, 0.0f, 1.0f));
 }
 
-// table indices of n / 3 exposed RGB pixels src * exposure through the hue-preserving filmic
-// map (HuePreservingFilmic).
-void FilmicIndices(const float* src, int n, float exposure, int32_t* index) {
-  for (int i = 0; i + 3 <= n; i += 3) {
-    const float x[3] = {src[i] * exposure, src[i + 1] * exposure, src[i + 2] * exposure};
-    float y[3];
-    HuePreservingFilmic(x, y);
-    for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(y[c]);
-  }
-}
-
-// as FilmicIndices and ClampIndices with one exposure per channel (white balance gains folded
-// in); n a multiple of 3.
-void BalancedIndices(const float* src, int n, const float exposure[3], bool filmic,
-                     int32_t* index) {
-  for (int i = 0; i + 3 <= n; i += 3) {
-    const float x[3] = {src[i] * exposure[0], src[i + 1] * exposure[1], src[i + 2] * exposure[2]};
-    if (filmic) {
-      float y[3];
-      HuePreservingFilmic(x, y);
-      for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(y[c]);
-    } else {
-      for (int c = 0; c < 3; ++c) index[i + c] = LutIndex(std::clamp(x[c], 0.0f, 1.0f));
-    }
-  }
+// table indices of n / 3 exposed RGB pixels src * exposure[c] (white balance gains folded in)
+// through the shared per-pixel map (DevelopPixelIndices, render/film_math.h); n a multiple of 3.
+void PixelIndices(const float* src, int n, const float exposure[3], bool filmic, int32_t* index) {
+  for (int i = 0; i + 3 <= n; i += 3) DevelopPixelIndices(src + i, exposure, filmic, index + i);
 }
 
 // sum over the n pixels of an RGB row of ln(max(L, kMinLuminance)), L the Rec. 709 luminance,
@@ -103,29 +77,6 @@ double SumLog(const float* rgb, int n) {
 
 }  // namespace
 
-double ExposureFromEv100(double ev100) { return 1.0 / (1.2 * std::exp2(ev100)); }
-
-float AcesFilmic(float x) {
-  constexpr float a = 2.51f, b = 0.03f, c = 2.43f, d = 0.59f, e = 0.14f;
-  x = std::max(x, 0.0f);
-  return std::clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0f, 1.0f);
-}
-
-void HuePreservingFilmic(const float x[3], float y[3]) {
-  // the largest channel; NaN channels never win, so they stay NaN (and encode as 0).
-  float m = 0.0f;
-  for (int c = 0; c < 3; ++c)
-    if (x[c] > m) m = x[c];
-  // m = +inf gives NaN (black), as the per-channel curve did.
-  const float ratio = m > 0.0f ? AcesFilmic(m) / m : 0.0f;
-  for (int c = 0; c < 3; ++c) y[c] = std::clamp(std::max(x[c], 0.0f) * ratio, 0.0f, 1.0f);
-}
-
-float SrgbOetf(float linear) {
-  const float v = std::clamp(linear, 0.0f, 1.0f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
 Film::Film(const RenderSettings& settings) : settings_(settings), oetf_lut_(kLutSize) {
   for (int i = 0; i < kLutSize; ++i) {
     const double v = static_cast<double>(i) / (kLutSize - 1);
@@ -145,9 +96,13 @@ double Film::LogAverageLuminance(const ImageF& radiance, ThreadPool* pool) const
 }
 
 double Film::Ev100(const ImageF& radiance, ThreadPool* pool) const {
-  const double base = settings_.auto_exposure
-                          ? std::log2(LogAverageLuminance(radiance, pool) / (0.18 * 1.2))
-                          : settings_.ev100;
+  return Ev100FromLogAverage(settings_.auto_exposure ? LogAverageLuminance(radiance, pool)
+                                                     : kMinLuminance);
+}
+
+double Film::Ev100FromLogAverage(double log_average) const {
+  const double base =
+      settings_.auto_exposure ? std::log2(log_average / (0.18 * 1.2)) : settings_.ev100;
   return base - settings_.exposure_compensation_ev;
 }
 
@@ -169,10 +124,8 @@ void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, Image
     int32_t index[kChunk];
     for (int i0 = 0; i0 < 3 * w; i0 += kChunk) {
       const int m = std::min(kChunk, 3 * w - i0);
-      if (balanced) {
-        BalancedIndices(src + i0, m, channel_exposure, filmic, index);
-      } else if (filmic) {
-        FilmicIndices(src + i0, m, exposure, index);
+      if (balanced || filmic) {
+        PixelIndices(src + i0, m, channel_exposure, filmic, index);
       } else {
         ClampIndices(src + i0, m, exposure, index);
       }

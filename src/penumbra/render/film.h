@@ -32,6 +32,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
+#include "penumbra/render/film_math.h"
 #include "penumbra/render/render_settings.h"
 
 namespace penumbra {
@@ -40,18 +41,8 @@ namespace penumbra {
 /// driving the exposure to infinity).
 constexpr double kMinLuminance = 1e-4;
 
-/// photometric exposure H for an exposure value at ISO 100: 1 / (1.2 2^ev100).
-double ExposureFromEv100(double ev100);
-
-/// ACES filmic fit (Narkowicz 2015) of a non-negative exposed value, in [0, 1].
-float AcesFilmic(float x);
-
-/// hue-preserving filmic map of an exposed linear RGB value x (>= 0; NaN channels stay NaN):
-/// y = x AcesFilmic(m) / m, m = max(x), each y in [0, 1]; all 0 when m <= 0.
-void HuePreservingFilmic(const float x[3], float y[3]);
-
-/// sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
-float SrgbOetf(float linear);
+// ExposureFromEv100, AcesFilmic, HuePreservingFilmic and SrgbOetf: render/film_math.h (shared
+// with the CUDA backend).
 
 /// turns radiance images into display images. immutable, thread-compatible.
 class Film {
@@ -65,6 +56,15 @@ class Film {
   /// the EV100 used for `radiance`: auto (from its log-average luminance) or manual, minus
   /// the exposure compensation.
   double Ev100(const ImageF& radiance, ThreadPool* pool) const;
+
+  /// the EV100 used for an image whose log-average luminance is `log_average` (cd/m^2): as
+  /// Ev100, for a log-average computed elsewhere (the CUDA backend's).
+  double Ev100FromLogAverage(double log_average) const;
+
+  /// the sRGB encoding table (kFilmLutSize 8-bit codes of i / (kFilmLutSize - 1)).
+  const std::vector<uint8_t>& oetf_lut() const { return oetf_lut_; }
+  /// the tone map is the hue-preserving filmic map (else a clamp).
+  bool filmic() const { return settings_.tone_map == RenderSettings::ToneMap::kFilmic; }
 
   /// exposes `radiance` ((H x W x 3) cd/m^2) with EV100 `ev100`, tone maps and encodes it
   /// into `rgb` ((H x W x 3) uint8 sRGB, resized). rows are spread over `pool` (may be null).

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/light_math.h"
 
 namespace penumbra {
 namespace {
@@ -41,43 +42,6 @@ inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float
   return (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
 }
 
-// SampleCone for every lane (same arithmetic).
-inline Vec3Lanes SampleConeLanes(const Vec3Lanes& w, const Lanes& cos_max, const Lanes& u1,
-                                 const Lanes& u2) {
-  const Lanes cos_t = 1.0f - u1 * (1.0f - cos_max);
-  const Lanes sin_t = (1.0f - cos_t * cos_t).max(0.0f).sqrt();
-  Lanes sp, cp;
-  SinCos2Pi(u2, &sp, &cp);
-  Lanes sign;
-  for (int k = 0; k < kLanes; ++k) sign[k] = w.z[k] >= 0 ? 1.0f : -1.0f;
-  const Lanes a = -1.0f / (sign + w.z);
-  const Lanes b = w.x * w.y * a;
-  const Vec3Lanes t{1.0f + sign * w.x * w.x * a, sign * b, -sign * w.x};
-  const Vec3Lanes bt{b, sign + w.y * w.y * a, -w.y};
-  const Lanes sc = sin_t * cp, ss = sin_t * sp;
-  Vec3Lanes d{sc * t.x + ss * bt.x + cos_t * w.x, sc * t.y + ss * bt.y + cos_t * w.y,
-              sc * t.z + ss * bt.z + cos_t * w.z};
-  const Lanes inv = 1.0f / d.Dot(d).sqrt();
-  return d * inv;
-}
-
-// SampleConeLanes around one axis w shared by every lane (the sun): the basis is computed once,
-// with the same arithmetic, so the directions equal those of SampleConeLanes.
-inline Vec3Lanes SampleConeLanes(const Eigen::Vector3f& w, float cos_max, const Lanes& u1,
-                                 const Lanes& u2) {
-  const Lanes cos_t = 1.0f - u1 * (1.0f - cos_max);
-  const Lanes sin_t = (1.0f - cos_t * cos_t).max(0.0f).sqrt();
-  Lanes sp, cp;
-  SinCos2Pi(u2, &sp, &cp);
-  Eigen::Vector3f t, bt;
-  ConeBasis(w, &t, &bt);
-  const Lanes sc = sin_t * cp, ss = sin_t * sp;
-  Vec3Lanes d{sc * t.x() + ss * bt.x() + cos_t * w.x(), sc * t.y() + ss * bt.y() + cos_t * w.y(),
-              sc * t.z() + ss * bt.z() + cos_t * w.z()};
-  const Lanes inv = 1.0f / d.Dot(d).sqrt();
-  return d * inv;
-}
-
 // the pose-independent part of a light.
 PosedLight Unposed(const Light& l) {
   PosedLight p;
@@ -106,6 +70,7 @@ LightSampler::LightSampler(const SceneDescription& scene)
     lights_.push_back(Unposed(l));
     base_intensity_rgb_.push_back(lights_.back().intensity_rgb);
   }
+  SyncPods();
 }
 
 void LightSampler::Update(const WorldSnapshot& snapshot, const EffectsFrame* effects) {
@@ -162,6 +127,7 @@ void LightSampler::Update(const WorldSnapshot& snapshot, const EffectsFrame* eff
     p.position_W = pos.cast<float>();
     p.direction_W = n > 0 ? Eigen::Vector3f((dir / n).cast<float>()) : Eigen::Vector3f(0, 0, -1);
   }
+  SyncPods();
 }
 
 bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
@@ -207,53 +173,26 @@ bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
 
 void LightSampler::SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, const Lanes& u2,
                                LightSampleLanes* s) const {
-  const PosedLight& l = lights_[i];
-  if (l.type == Light::Type::kDirectional) {
-    const Eigen::Vector3f to_light = -l.direction_W;
-    if (l.cos_angular_radius < 1.0f) {
-      s->wi = SampleConeLanes(to_light, l.cos_angular_radius, u1, u2);
-    } else {
-      s->wi = {Lanes::Constant(to_light.x()), Lanes::Constant(to_light.y()),
-               Lanes::Constant(to_light.z())};
-    }
-    s->distance = Lanes::Constant(std::numeric_limits<float>::infinity());
-    s->E = {Lanes::Constant(l.intensity_rgb.x()), Lanes::Constant(l.intensity_rgb.y()),
-            Lanes::Constant(l.intensity_rgb.z())};
-    s->valid = LaneMask::Constant(true);
-    return;
-  }
-  const Vec3Lanes to_light{l.position_W.x() - p_W.x, l.position_W.y() - p_W.y,
-                           l.position_W.z() - p_W.z};
-  const Lanes d2 = to_light.Dot(to_light);
-  const Lanes d = d2.sqrt();
-  s->valid = GreaterThan(d, l.radius_m);
-  Lanes atten = Lanes::Ones();
-  if (l.type == Light::Type::kSpot) {
-    const Lanes cos_axis = -(to_light.x * l.direction_W.x() + to_light.y * l.direction_W.y() +
-                             to_light.z * l.direction_W.z()) /
-                           d;
-    if (l.cos_inner <= l.cos_outer) {
-      for (int k = 0; k < kLanes; ++k) atten[k] = cos_axis[k] >= l.cos_outer ? 1.0f : 0.0f;
-    } else {
-      const Lanes t = ((cos_axis - l.cos_outer) / (l.cos_inner - l.cos_outer)).max(0.0f).min(1.0f);
-      atten = t * t * (3.0f - 2.0f * t);
-    }
-    s->valid = s->valid && GreaterThan(atten, 0.0f);
-  }
-  const Lanes scale = atten / d2;
-  s->E = {l.intensity_rgb.x() * scale, l.intensity_rgb.y() * scale, l.intensity_rgb.z() * scale};
-  const Lanes inv_d = 1.0f / d;
-  const Vec3Lanes w = to_light * inv_d;
-  if (l.radius_m > 0) {
-    const Lanes sin2 = (l.radius_m * l.radius_m) / d2;
-    const Lanes cos_max = (1.0f - sin2).max(0.0f).sqrt();
-    s->wi = SampleConeLanes(w, cos_max, u1, u2);
-    const Lanes b = s->wi.Dot(to_light);
-    const Lanes disc = (b * b - (d2 - l.radius_m * l.radius_m)).max(0.0f);
-    s->distance = (b - disc.sqrt()).max(0.0f);
-  } else {
-    s->wi = w;
-    s->distance = d;
+  SampleLight<Lanes, Vec3Lanes, LaneMask>(pods_[i], p_W, u1, u2, &s->wi, &s->distance, &s->E,
+                                          &s->valid);
+}
+
+void LightSampler::SyncPods() {
+  pods_.resize(lights_.size());
+  for (size_t i = 0; i < lights_.size(); ++i) {
+    const PosedLight& l = lights_[i];
+    LightPod& p = pods_[i];
+    p.kind = l.type == Light::Type::kDirectional ? LightKind::kDirectional
+             : l.type == Light::Type::kSpot      ? LightKind::kSpot
+                                                 : LightKind::kPoint;
+    p.position_W = {l.position_W.x(), l.position_W.y(), l.position_W.z()};
+    p.direction_W = {l.direction_W.x(), l.direction_W.y(), l.direction_W.z()};
+    p.intensity_rgb = {l.intensity_rgb.x(), l.intensity_rgb.y(), l.intensity_rgb.z()};
+    p.cos_inner = l.cos_inner;
+    p.cos_outer = l.cos_outer;
+    p.radius_m = l.radius_m;
+    p.cos_angular_radius = l.cos_angular_radius;
+    p.cast_shadow = l.cast_shadow ? 1 : 0;
   }
 }
 

@@ -28,6 +28,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "penumbra/render/light_math.h"
 #include "penumbra/render/shading_lanes.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
@@ -83,6 +84,9 @@ class LightSampler {
   int num_scene_lights() const { return static_cast<int>(sources_.size()); }
   /// the posed lights (after Update).
   const std::vector<PosedLight>& lights() const { return lights_; }
+  /// the posed lights as plain data (render/light_math.h), one per lights() entry: what
+  /// SampleLanes and the CUDA kernels sample.
+  const std::vector<LightPod>& pods() const { return pods_; }
 
   /// samples light `i` as seen from world point p_W with two uniform numbers in [0, 1)
   /// (used only by lights with an extent). returns false when the light sends nothing to
@@ -90,7 +94,8 @@ class LightSampler {
   bool Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2, LightSample* s) const;
 
   /// Sample() for kLanes shading points at once, lane k with (p_W, u1, u2) lane k: the same
-  /// model, random-number use and arithmetic, so it agrees with Sample() to float rounding.
+  /// model and random-number use, so it agrees with Sample() to float rounding. the arithmetic
+  /// is the shared SampleLight (render/light_math.h) the CUDA kernels run.
   void SampleLanes(int i, const Vec3Lanes& p_W, const Lanes& u1, const Lanes& u2,
                    LightSampleLanes* s) const;
 
@@ -100,6 +105,9 @@ class LightSampler {
   std::vector<Eigen::Vector3f> base_intensity_rgb_;  // per kept light, before effects
   int num_bodies_ = 0;
   std::vector<PosedLight> lights_;
+  std::vector<LightPod> pods_;  // lights_ as plain data (SyncPods)
+  // rewrites pods_ from lights_.
+  void SyncPods();
 };
 
 }  // namespace penumbra

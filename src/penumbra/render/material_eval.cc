@@ -10,91 +10,42 @@
 #endif
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/texture_math.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
 namespace {
 
-// the smallest |cos| of incidence the level of detail divides by (grazing rays).
-constexpr float kMinCosIncidence = 1e-4f;
-
-// the four texels around wrapped coordinates (s, t) (in images, 1 = one image) of a w x h
-// level, and the bilinear fractions between them.
-struct WrappedTexels {
-  int x0, y0, x1, y1;
-  float fx, fy;
-};
-inline WrappedTexels WrapTexels(float s, float t, int w, int h) {
-  // texel centres at (i + 0.5) / w; wrap the integer part away first to keep precision.
-  const float x = (s - std::floor(s)) * static_cast<float>(w) - 0.5f;
-  const float y = (t - std::floor(t)) * static_cast<float>(h) - 0.5f;
-  const float x0f = std::floor(x), y0f = std::floor(y);
-  WrappedTexels q;
-  q.fx = x - x0f;
-  q.fy = y - y0f;
-  // x0f in [-1, w - 1] and y0f in [-1, h - 1] (texel centres), so one step wraps them.
-  q.x0 = static_cast<int>(x0f);
-  q.y0 = static_cast<int>(y0f);
-  q.x1 = q.x0 + 1;
-  q.y1 = q.y0 + 1;
-  q.x0 = q.x0 < 0 ? q.x0 + w : q.x0;
-  q.y0 = q.y0 < 0 ? q.y0 + h : q.y0;
-  q.x1 = q.x1 >= w ? q.x1 - w : q.x1;
-  q.y1 = q.y1 >= h ? q.y1 - h : q.y1;
-  return q;
+// the shared texture formulas (render/texture_math.h) on the scene's texture levels.
+inline TextureLevelView ViewOf(const TextureLevel& L) {
+  return TextureLevelView{L.rgb_srgb.data(), L.width, L.height};
 }
+inline Eigen::Vector3f ToEigen(const Float3& c) { return Eigen::Vector3f(c.x, c.y, c.z); }
 
 // bilinear lookup in one level, wrapped; (s, t) in images (1 = one image).
 Eigen::Vector3f BilinearWrap(const TextureLevel& L, const float* decode, float s, float t) {
-  const int w = L.width, h = L.height;
-  const auto [x0, y0, x1, y1, fx, fy] = WrapTexels(s, t, w, h);
-  const uint8_t* p = L.rgb_srgb.data();
-  auto texel = [&](int xi, int yi) {
-    const uint8_t* q = p + (static_cast<size_t>(yi) * w + xi) * 3;
-    return Eigen::Vector3f(decode[q[0]], decode[q[1]], decode[q[2]]);
-  };
-  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
-         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+  return ToEigen(BilinearWrap(ViewOf(L), decode, s, t));
 }
 
 // bilinear lookup in face `face` of one level, clamped to the face; (s, t) in [0, 1].
 Eigen::Vector3f BilinearFace(const TextureLevel& L, const float* decode, int face, float s,
                              float t) {
-  const int w = L.width;
-  const float x = std::clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const float y = std::clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, w - 1);
-  const float fx = x - x0, fy = y - y0;
-  const uint8_t* p = L.rgb_srgb.data() + static_cast<size_t>(face) * w * w * 3;
-  auto texel = [&](int xi, int yi) {
-    const uint8_t* c = p + (static_cast<size_t>(yi) * w + xi) * 3;
-    return Eigen::Vector3f(decode[c[0]], decode[c[1]], decode[c[2]]);
-  };
-  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x1, y0)) +
-         fy * ((1 - fx) * texel(x0, y1) + fx * texel(x1, y1));
+  return ToEigen(BilinearFace(ViewOf(L), decode, face, s, t));
 }
 
-// the mip level of a footprint on a mapping of rho texels per metre (file comment); 0 when the
-// footprint or rho is 0.
+// the mip level of a footprint on a mapping of rho texels per metre (file comment).
 float TextureLod(const TextureFootprint& f, float rho) {
-  if (!(f.width_m > 0) || !(rho > 0)) return 0;
-  return std::log2(f.width_m * rho / std::max(f.cos_incidence, kMinCosIncidence));
+  return penumbra::TextureLod(f.width_m, f.cos_incidence, rho);
 }
 
-// the levels a trilinear lookup at `lod` reads in a chain of `num_levels` levels, with their
-// weights: add(level, weight) once (weight 1: level 0 for lod <= 0, the last level beyond it, or
-// an integer lod) or twice (floor(lod) with 1 - f, the next with f, f = the fraction of lod).
+// the levels a trilinear lookup at `lod` reads, with their weights: add(level, weight) once or
+// twice (TrilinearLevels of texture_math.h).
 template <typename AddFn>
 void TrilinearLevels(int num_levels, float lod, const AddFn& add) {
-  if (!(lod > 0)) return add(0, 1.0f);
-  const int last = num_levels - 1;
-  if (!(lod < static_cast<float>(last))) return add(last, 1.0f);
-  const int l = static_cast<int>(lod);
-  const float f = lod - static_cast<float>(l);
-  if (!(f > 0)) return add(l, 1.0f);
-  add(l, 1 - f);
-  add(l + 1, f);
+  int level[2];
+  float weight[2];
+  const int n = penumbra::TrilinearLevels(num_levels, lod, level, weight);
+  for (int i = 0; i < n; ++i) add(level[i], weight[i]);
 }
 
 // trilinear: bilinear(level) in the two levels around `lod`, mixed by its fraction.
@@ -122,63 +73,10 @@ bool FootprintAxes(const SurfaceHit& hit, const TextureFootprint& f, Eigen::Vect
   return true;
 }
 
-// the taps of an anisotropic lookup for squared axis lengths (in level-0 texels^2) l2_major,
-// l2_minor: their number N and level. N = the axis ratio rounded to the nearest integer (below
-// 1.5: one tap), capped at max_anisotropy. one tap keeps the trilinear lookup at lambda = log2
-// of the longer axis; several taps share the mip level nearest to lambda = log2(max(L_min,
-// L_maj / N)), an integer, each a bilinear lookup in that level only. the squared lengths
-// spare the square roots, and the level of several taps comes from the float exponent:
-// round(lambda) = floor(log2(2 l^2) / 2) = floor(ilogb(2 l^2) / 2).
-struct AnisoTaps {
-  int n = 1;
-  float lod = 0;
-};
-inline AnisoTaps TapsFor(float l2_major, float l2_minor, int max_anisotropy) {
-  if (l2_minor > l2_major) std::swap(l2_major, l2_minor);
-  AnisoTaps taps;
-  const float cap = static_cast<float>(max_anisotropy);
-  const float ratio = l2_minor > 0 ? std::min(cap, std::sqrt(l2_major / l2_minor)) : cap;
-  taps.n = std::max(1, static_cast<int>(ratio + 0.5f));
-  if (taps.n == 1) {
-    taps.lod = l2_major > 0 ? 0.5f * std::log2(l2_major) : 0.0f;
-    return taps;
-  }
-  const float nf = static_cast<float>(taps.n);
-  const float l2 = std::max(l2_minor, l2_major / (nf * nf));
-  // l2 >= 1/2 gives a level >= 0 (smaller footprints: level 0).
-  taps.lod = l2 >= 0.5f ? static_cast<float>(std::ilogb(2 * l2) / 2) : 0.0f;
-  return taps;
-}
-
-// the level index an integer lod (TapsFor, N > 1) selects, clamped to `num_levels` levels.
-int TapLevel(int num_levels, float lod) { return std::min(static_cast<int>(lod), num_levels - 1); }
-
-// mean of n bilinear lookups in one level (wrapped) at (s, t) + o_k (ds, dt), with the tap
-// offsets o_k = (k + 1/2) / n - 1/2 (footprint assembly along the major axis).
+// mean of n bilinear lookups in one level (wrapped) along the major axis (texture_math.h).
 Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, float s, float t,
                                  float ds, float dt, int n) {
-  const int w = L.width, h = L.height;
-  const uint8_t* p = L.rgb_srgb.data();
-  const float step = 1.0f / static_cast<float>(n);
-  const float o0 = 0.5f * step - 0.5f;
-  float r = 0, g = 0, b = 0;
-  for (int k = 0; k < n; ++k) {
-    const float o = o0 + static_cast<float>(k) * step;
-    const float u = s + o * ds, v = t + o * dt;
-    const auto [x0, y0, x1, y1, fx, fy] = WrapTexels(u, v, w, h);
-    const uint8_t* r0 = p + static_cast<size_t>(y0) * w * 3;
-    const uint8_t* r1 = p + static_cast<size_t>(y1) * w * 3;
-    const uint8_t* a = r0 + x0 * 3;
-    const uint8_t* bq = r0 + x1 * 3;
-    const uint8_t* c = r1 + x0 * 3;
-    const uint8_t* d = r1 + x1 * 3;
-    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy);
-    const float w01 = (1 - fx) * fy, w11 = fx * fy;
-    r += w00 * decode[a[0]] + w10 * decode[bq[0]] + w01 * decode[c[0]] + w11 * decode[d[0]];
-    g += w00 * decode[a[1]] + w10 * decode[bq[1]] + w01 * decode[c[1]] + w11 * decode[d[1]];
-    b += w00 * decode[a[2]] + w10 * decode[bq[2]] + w01 * decode[c[2]] + w11 * decode[d[2]];
-  }
-  return Eigen::Vector3f(r, g, b) * step;
+  return ToEigen(BilinearWrapTaps(ViewOf(L), decode, s, t, ds, dt, n));
 }
 
 // adds weight x the bilinear lookup (wrapped; (s, t) in images) of a packed level (w x h
@@ -211,12 +109,8 @@ inline void AddBilinearPacked(const MaterialEvaluator::PackedLevel& L, float s, 
 #endif
 }
 
-// offset of tap k of n along the major axis, in units of the axis: ((k + 1/2) / n - 1/2).
-float TapOffset(int k, int n) {
-  return (static_cast<float>(k) + 0.5f) / static_cast<float>(n) - 0.5f;
-}
+}  // namespace
 
-// half extents of a geom's bounding box in its own frame (zero where a shape is flat).
 Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g) {
   const Eigen::Vector3d& s = g.size;
   switch (g.shape) {
@@ -246,8 +140,6 @@ Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g) {
   }
   return Eigen::Vector3f::Ones();
 }
-
-}  // namespace
 
 TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::Vector3f& d_unit,
                                const SurfaceHit& hit) {
@@ -355,28 +247,9 @@ Eigen::Vector3f MaterialEvaluator::Sample2D(int tex, float s, float t, float lod
 }
 
 Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q, float lod) const {
-  const Eigen::Vector3f a = q.cwiseAbs();
   int face;
-  float sc, tc, ma;
-  // OpenGL 4.6 core spec, table 8.19 (face selection and (sc, tc) per major axis).
-  if (a.x() >= a.y() && a.x() >= a.z()) {
-    ma = a.x();
-    face = q.x() >= 0 ? 0 : 1;
-    sc = q.x() >= 0 ? -q.z() : q.z();
-    tc = -q.y();
-  } else if (a.y() >= a.z()) {
-    ma = a.y();
-    face = q.y() >= 0 ? 2 : 3;
-    sc = q.x();
-    tc = q.y() >= 0 ? q.z() : -q.z();
-  } else {
-    ma = a.z();
-    face = q.z() >= 0 ? 4 : 5;
-    sc = q.z() >= 0 ? q.x() : -q.x();
-    tc = -q.y();
-  }
-  if (!(ma > 0)) return Eigen::Vector3f::Ones();
-  const float s = 0.5f * (sc / ma + 1.0f), t = 0.5f * (tc / ma + 1.0f);
+  float s, t;
+  if (!CubeFaceCoords(Float3{q.x(), q.y(), q.z()}, &face, &s, &t)) return Eigen::Vector3f::Ones();
   const float* decode = srgb_to_linear_;
   return Trilinear(*scene_.textures[tex].image, lod,
                    [&](const TextureLevel& L) { return BilinearFace(L, decode, face, s, t); });
@@ -406,17 +279,12 @@ struct MaterialEvaluator::Mapping2D {
   float h0 = 1, h1 = 1;  // kPerFace: half sizes of the face
   int a0 = -1, a1 = -1;  // planar: the face axes (image rows along -a1)
 
+  PlanarMap planar;  // planar kinds (texture_math.h)
+
   // texels per metre of surface for a w x h image (the expressions of the isotropic lookup).
   float Rho(float w, float th) const {
-    switch (kind) {
-      case Kind::kTexcoords:
-        return uv_per_m * std::sqrt(w * th);
-      case Kind::kUniform:
-        return std::sqrt(std::abs(rx) * w * std::abs(ry) * th);
-      case Kind::kPerFace:
-        return std::sqrt(std::abs(rx) * w / (2 * h0) * std::abs(ry) * th / (2 * h1));
-    }
-    return 0;
+    if (kind == Kind::kTexcoords) return uv_per_m * std::sqrt(w * th);
+    return planar.rho(w, th);
   }
 };
 
@@ -445,20 +313,19 @@ MaterialEvaluator::Mapping2D MaterialEvaluator::MapAt(const SurfaceHit& hit,
       scene_.geoms[hit.geom].shape == GeomShape::kPlane && !(h[a0] > 0 && h[a1] > 0);
   if (m.texuniform || infinite_plane) {
     map.kind = Mapping2D::Kind::kUniform;
-    map.s = hit.p_G[a0] * m.texrepeat.x();
-    map.t = -hit.p_G[a1] * m.texrepeat.y();
-    map.J(0, a0) = m.texrepeat.x();
-    map.J(1, a1) = -m.texrepeat.y();
+    map.planar = PlanarMapUniform(hit.p_G[a0], hit.p_G[a1], m.texrepeat.x(), m.texrepeat.y());
   } else {
     map.kind = Mapping2D::Kind::kPerFace;
     const float h0 = h[a0] > 0 ? h[a0] : 1.0f, h1 = h[a1] > 0 ? h[a1] : 1.0f;
     map.h0 = h0;
     map.h1 = h1;
-    map.s = (0.5f * hit.p_G[a0] / h0 + 0.5f) * m.texrepeat.x();
-    map.t = (0.5f - 0.5f * hit.p_G[a1] / h1) * m.texrepeat.y();
-    map.J(0, a0) = 0.5f * m.texrepeat.x() / h0;
-    map.J(1, a1) = -0.5f * m.texrepeat.y() / h1;
+    map.planar =
+        PlanarMapPerFace(hit.p_G[a0], hit.p_G[a1], h0, h1, m.texrepeat.x(), m.texrepeat.y());
   }
+  map.s = map.planar.s;
+  map.t = map.planar.t;
+  map.J(0, a0) = map.planar.j0;
+  map.J(1, a1) = map.planar.j1;
   return map;
 }
 
@@ -468,28 +335,19 @@ MaterialEvaluator::FilterPlan MaterialEvaluator::PlanFilter(
   const float w = static_cast<float>(width);
   const float th = static_cast<float>(height);
   FilterPlan plan;
-  // the axes in texture units and their squared lengths in level-0 texels.
-  Eigen::Vector2f major_st, minor_st;
-  float l2_major = 0, l2_minor = 0;
   if (aniso) {
-    major_st = map.J * major_G;
-    minor_st = map.J * minor_G;
-    const Eigen::Vector2f texels(w, th);
-    l2_major = major_st.cwiseProduct(texels).squaredNorm();
-    l2_minor = minor_st.cwiseProduct(texels).squaredNorm();
-  }
-  if (aniso && l2_major > 0) {
-    // the axis the taps spread along: the longer one in texels.
-    const bool swap = l2_minor > l2_major;
-    const Eigen::Vector2f axis = swap ? minor_st : major_st;
-    const AnisoTaps taps = TapsFor(l2_major, l2_minor, max_anisotropy_);
-    plan.lod = taps.lod;
-    if (taps.n > 1) {
-      plan.n = taps.n;
-      plan.ds = axis.x();
-      plan.dt = axis.y();
+    // the axes in texture units, then the taps (texture_math.h, shared with the GPU).
+    const Eigen::Vector2f major_st = map.J * major_G;
+    const Eigen::Vector2f minor_st = map.J * minor_G;
+    const PlanarFilterPlan p = PlanAnisotropic(major_st.x(), major_st.y(), minor_st.x(),
+                                               minor_st.y(), w, th, max_anisotropy_);
+    if (p.ok) {
+      plan.lod = p.lod;
+      plan.n = p.n;
+      plan.ds = p.ds;
+      plan.dt = p.dt;
+      return plan;
     }
-    return plan;
   }
   plan.lod = TextureLod(footprint, map.Rho(w, th));
   return plan;
@@ -648,6 +506,8 @@ void MaterialEvaluator::BendNormal(const Mapping2D& map, const Eigen::Vector3f& 
     t_G = P.col(0);
     b_G = -P.col(1);
   }
+  // the GPU's BendNormal (texture_math.h) is this arithmetic on Float3; here Eigen's vectorised
+  // dot and cross products round differently in the last bit (docs/gpu.md).
   const Eigen::Vector3f tn(2 * c.x() - 1, 2 * c.y() - 1, 2 * c.z() - 1);
   // outward shading normal, and the tangent frame around it (Gram-Schmidt), world frame.
   const Eigen::Vector3f n = hit->front_face ? hit->ns_W : Eigen::Vector3f(-hit->ns_W);

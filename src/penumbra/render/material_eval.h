@@ -125,6 +125,10 @@ struct TextureFootprint {
 TextureFootprint ConeFootprint(float spread_rad, float distance_m, const Eigen::Vector3f& d_unit,
                                const SurfaceHit& hit);
 
+/// half extents of the bounding box of geom `g` of `scene` in its own frame (zero where a shape
+/// is flat; a plane's z): what the planar texture mapping and cube lookups scale by.
+Eigen::Vector3f GeomHalfExtents(const SceneDescription& scene, const Geom& g);
+
 /// the largest level-0 texel count (width x height) of packed maps (file comment).
 constexpr int64_t kMaxPackedTexels = 1024 * 1024;
 
@@ -141,6 +145,17 @@ class MaterialEvaluator {
   /// material at `hit` (default Material when hit.material < 0), its texture filtered over
   /// `footprint` (file comment; the default footprint gives bilinear level-0 lookups).
   SurfaceMaterial Evaluate(const SurfaceHit& hit, const TextureFootprint& footprint = {}) const;
+
+  /// a material's PBR maps: texture indices into SceneDescription::textures, -1 none (file
+  /// comment, "PBR maps").
+  struct PbrMaps {
+    int normal = -1, metallic_roughness = -1, occlusion = -1, emissive = -1;
+    bool any() const {
+      return normal >= 0 || metallic_roughness >= 0 || occlusion >= 0 || emissive >= 0;
+    }
+  };
+  /// the PBR maps of material `material` (index into SceneDescription::materials).
+  const PbrMaps& pbr_maps(int material) const { return maps_[material]; }
 
   /// true when some material has a normal map (file comment, "PBR maps").
   bool has_normal_maps() const { return has_normal_maps_; }
@@ -188,13 +203,6 @@ class MaterialEvaluator {
 
  private:
   struct Mapping2D;
-  // a material's PBR maps (texture indices, -1 none): see the file comment.
-  struct PbrMaps {
-    int normal = -1, metallic_roughness = -1, occlusion = -1, emissive = -1;
-    bool any() const {
-      return normal >= 0 || metallic_roughness >= 0 || occlusion >= 0 || emissive >= 0;
-    }
-  };
   // a material's packed maps: its levels, and which maps they hold.
   struct PackedMaps {
     std::vector<PackedLevel> levels;

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+
+#include "penumbra/render/shading_math.h"
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -217,30 +219,47 @@ inline Vec3Lanes Where(const LaneMask& m, const Vec3Lanes& v) {
 }
 #endif
 
-/// sin(2 pi u) and cos(2 pi u) for u in [0, 1): quadrant from 4u, then Taylor polynomials of
-/// degree 7 / 8 on [-pi/4, pi/4] rotated by pi/4 (absolute error < 1e-6). branch-free, so that
-/// loops over lanes vectorise.
-inline void SinCos2Pi(float u, float* s, float* c) {
-  const int q = static_cast<int>(u * 4.0f);  // quadrant 0..3 (u >= 0)
-  const float x = (u * 4.0f - static_cast<float>(q) - 0.5f) * 1.5707963267948966f;  // [-pi/4, pi/4)
-  const float x2 = x * x;
-  const float sx = x * (1.0f + x2 * (-1.0f / 6 + x2 * (1.0f / 120 + x2 * (-1.0f / 5040))));
-  const float cx =
-      1.0f + x2 * (-0.5f + x2 * (1.0f / 24 + x2 * (-1.0f / 720 + x2 * (1.0f / 40320))));
-  // angle within the quadrant = x + pi/4.
-  constexpr float kH = 0.70710678118654752f;
-  const float sr = (sx + cx) * kH, cr = (cx - sx) * kH;
-  // rotate by q quarter turns: odd quadrants swap sin and cos; cos < 0 in quadrants 1, 2 and
-  // sin < 0 in quadrants 2, 3.
-  const bool odd = (q & 1) != 0;
-  const float a = odd ? sr : cr, b = odd ? cr : sr;
-  *c = (q == 1 || q == 2) ? -a : a;
-  *s = q >= 2 ? -b : b;
-}
-
+namespace pbm {
 /// SinCos2Pi for every lane.
 inline void SinCos2Pi(const Lanes& u, Lanes* s, Lanes* c) {
   for (int k = 0; k < kLanes; ++k) SinCos2Pi(u[k], &(*s)[k], &(*c)[k]);
 }
+}  // namespace pbm
+
+/// sin(2 pi u) and cos(2 pi u) for u in [0, 1) (the shared formula, render/shading_math.h),
+/// for a float or every lane.
+using pbm::SinCos2Pi;
+
+// the Lanes overloads of the shared formulas' helpers (render/shading_math.h): the same names,
+// so that one template body serves float and Lanes.
+namespace pbm {
+inline Lanes Min(const Lanes& a, float b) { return a.min(b); }
+inline Lanes Min(const Lanes& a, const Lanes& b) { return a.min(b); }
+inline Lanes Max(const Lanes& a, float b) { return a.max(b); }
+inline Lanes Max(const Lanes& a, const Lanes& b) { return a.max(b); }
+/// x.max(lo).min(hi): std::clamp lane by lane for x not NaN.
+inline Lanes Clamp(const Lanes& x, float lo, float hi) { return x.max(lo).min(hi); }
+inline Lanes Sqrt(const Lanes& x) { return x.sqrt(); }
+/// Eigen's vectorised exp (within 2 ulp of the exact value).
+inline Lanes Exp(const Lanes& x) { return x.exp(); }
+inline Lanes WhereAllPositive(const Lanes& c0, const Lanes& c1, const Lanes& c2, const Lanes& a) {
+  return penumbra::WhereAllPositive(c0, c1, c2, a);
+}
+inline Lanes StepGreaterEqual(const Lanes& x, float e) {
+  Lanes s;
+  for (int k = 0; k < kLanes; ++k) s[k] = x[k] >= e ? 1.0f : 0.0f;
+  return s;
+}
+inline LaneMask GreaterThan(const Lanes& a, float b) { return penumbra::GreaterThan(a, b); }
+template <>
+inline Lanes Splat<Lanes>(float x) {
+  return Lanes::Constant(x);
+}
+inline Lanes SignNonNegative(const Lanes& x) {
+  Lanes s;
+  for (int k = 0; k < kLanes; ++k) s[k] = x[k] >= 0 ? 1.0f : -1.0f;
+  return s;
+}
+}  // namespace pbm
 
 }  // namespace penumbra

@@ -164,11 +164,13 @@ TEST_P(CudaBackendWorlds, GroundTruthImagesMatchCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBackendWorlds,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml"));
 
-TEST(CudaBackend, RgbFramesGoToTheCpuRenderer) {
+TEST(CudaBackend, PathtracedRgbFramesGoToTheCpuRenderer) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("default.yaml");
   RenderSettings settings;
   settings.backend = RenderSettings::Backend::kCuda;
+  settings.tier = RenderSettings::Tier::kPathtraced;
+  settings.samples_per_pixel = 1;
   const std::unique_ptr<Renderer> gpu = MakeRenderer(session->scene(), settings);
   const WorldSnapshot snap = session->sim().Snapshot();
   CameraView view;

@@ -5,6 +5,9 @@
 //   - cuda depth+seg, Render(): the whole frame (instance update, upload, kernel, copy back);
 //   - cuda depth+seg, kernel: the primary-ray kernel alone (CUDA events, images stay on the GPU);
 //   - cuda all ground truth (depth, seg, instance, semantic, range, normals), Render();
+//   - cuda rgb+depth (realtime tier), Render(): the whole frame (the primary geometry copied
+//     to the host for the sky terms, shading, exposure, film, rgb, radiance and depth copied
+//     back), and its kernels alone (CUDA events; the last frame's sky terms, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 // and the BVH build time. prints one markdown table.
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
@@ -230,6 +233,10 @@ int Main(int argc, char** argv) {
         rows.push_back({name, size, "depth+seg", "cuda", "kernel only", 1e3 / ms});
         rows.push_back({name, size, "all ground truth", "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, all, n)});
+        rows.push_back({name, size, "rgb+depth realtime", "cuda", "Render()",
+                        1 / TimeRenders(gpu.get(), snap, rgb, n)});
+        const double rgb_ms = g->device_realtime().TimeKernels(&g->device(), n);
+        rows.push_back({name, size, "rgb+depth realtime", "cuda", "kernels only", 1e3 / rgb_ms});
       }
       const int nc = std::max(3, n / 10);
       rows.push_back(

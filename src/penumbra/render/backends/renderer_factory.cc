@@ -81,7 +81,7 @@ std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,
 #if PENUMBRA_WITH_CUDA
       RenderSettings cpu = settings;
       cpu.backend = RenderSettings::Backend::kEmbree;
-      return std::make_unique<cuda::CudaRenderer>(scene, MakeEmbreeRenderer(scene, cpu));
+      return std::make_unique<cuda::CudaRenderer>(scene, MakeEmbreeRenderer(scene, cpu), settings);
 #else
       break;
 #endif

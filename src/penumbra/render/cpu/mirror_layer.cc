@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "penumbra/render/brdf_math.h"
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/media_common.h"
 
@@ -12,14 +13,10 @@ namespace {
 
 constexpr float kInvPiMirror = 0.318309886183790671538f;
 
-// split-sum specular reflectance, analytic fit (Karis 2014, "Physically based shading on
-// mobile"), for one shading point (the realtime integrator's EnvBrdfApprox, scalar exp2).
+// the split-sum ambient specular fit (render/brdf_math.h) for one shading point.
 Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
-  const float r0 = 1.0f - roughness, r1 = 0.0425f - 0.0275f * roughness;
-  const float a004 = std::min(r0 * r0, std::exp2(-9.28f * n_v)) * r0 + r1;
-  const float a = -1.04f * a004 + 1.04f - 0.572f * roughness;
-  const float b = 1.04f * a004 - 0.04f + 0.022f * roughness;
-  return (f0 * a + Eigen::Vector3f::Constant(b)).cwiseMax(0.0f).cwiseMin(1.0f);
+  const Float3 s = EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
+  return Eigen::Vector3f(s.x, s.y, s.z);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "penumbra/render/brdf_math.h"
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/lamp_math.h"
@@ -16,26 +17,7 @@ namespace {
 
 constexpr float kInvPi = 0.318309886183790671538f;
 
-inline Lanes LuminanceLanes(const Vec3Lanes& c) {
-  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
-}
-
-// split-sum specular reflectance, analytic fit (Karis 2014, "Physically based shading on mobile"),
-// for every lane. exp2(-9.28 n.v) is taken as exp(-9.28 ln2 n.v) with Eigen's vectorised exp
-// (within 2 ulp of the exact value; the rounded product adds < 4e-7 relative for n.v in [0, 1]).
-inline Vec3Lanes EnvBrdfApprox(const Vec3Lanes& f0, const Lanes& n_v, const Lanes& roughness) {
-  constexpr float kLn2 = 0.693147180559945309f;
-  const Lanes r0 = roughness * -1.0f + 1.0f;
-  const Lanes r1 = roughness * -0.0275f + 0.0425f;
-  const Lanes r2 = roughness * -0.572f + 1.04f;
-  const Lanes r3 = roughness * 0.022f - 0.04f;
-  const Lanes e = (n_v * (-9.28f * kLn2)).exp();
-  const Lanes a004 = (r0 * r0).min(e) * r0 + r1;
-  const Lanes a = a004 * -1.04f + r2;
-  const Lanes b = a004 * 1.04f + r3;
-  return {(f0.x * a + b).max(0.0f).min(1.0f), (f0.y * a + b).max(0.0f).min(1.0f),
-          (f0.z * a + b).max(0.0f).min(1.0f)};
-}
+inline Lanes LuminanceLanes(const Vec3Lanes& c) { return pbm::Luminance709(c.x, c.y, c.z); }
 
 // per-thread scratch, sized once per light count and reused across tiles and frames.
 struct Scratch {
@@ -540,7 +522,8 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
 
     // emission and sky ambient, E_sky / pi (c_diff (1 - S) + S).
     {
-      const Vec3Lanes spec = EnvBrdfApprox(bsdf.f0, bsdf.n_v.max(0.0f), pbr.roughness);
+      const Vec3Lanes spec =
+          EnvBrdfApprox<Lanes, Vec3Lanes>(bsdf.f0, bsdf.n_v.max(0.0f), pbr.roughness);
       const Vec3Lanes reflect{bsdf.c_diff.x * (1.0f - spec.x) + spec.x,
                               bsdf.c_diff.y * (1.0f - spec.y) + spec.y,
                               bsdf.c_diff.z * (1.0f - spec.z) + spec.z};

@@ -9,36 +9,12 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shape_math.h"
 #include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/realtime_shading.h"
 
 namespace penumbra::cuda {
 namespace {
-
-void Check(cudaError_t e, const char* what) {
-  if (e != cudaSuccess)
-    throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(e));
-}
-
-// a device buffer that grows (never shrinks) to the bytes asked for.
-struct Buffer {
-  void* p = nullptr;
-  size_t bytes = 0;
-  void Reserve(size_t n) {
-    if (n <= bytes) return;
-    if (p) cudaFree(p);
-    p = nullptr;
-    bytes = 0;
-    Check(cudaMalloc(&p, n), "cudaMalloc");
-    bytes = n;
-  }
-  void Upload(const void* src, size_t n, cudaStream_t s) {
-    Reserve(n > 0 ? n : 1);
-    if (n > 0) Check(cudaMemcpyAsync(p, src, n, cudaMemcpyHostToDevice, s), "cudaMemcpyAsync");
-  }
-  ~Buffer() {
-    if (p) cudaFree(p);
-  }
-};
 
 __global__ void TraceKernel(SceneView s, const TraceRay* rays, int64_t n, TraceHit* hits) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
@@ -54,38 +30,6 @@ __global__ void OccludedKernel(SceneView s, const TraceRay* rays, int64_t n, uin
   occ[i] = TraceOccluded(s, rays[i]) ? 1 : 0;
 }
 
-// unit world normal of hit h of world ray (o, d), facing the ray.
-__device__ F3 HitNormal(const SceneView& s, const TraceRay& r, const TraceHit& h) {
-  const Instance& in = s.instances[h.instance];
-  const PrimRef& pr = s.prims[h.prim];
-  F3 n_I;
-  if (pr.kind == 0) {
-    const Triangle& t = s.triangles[pr.index];
-    n_I = {t.e1.y * t.e2.z - t.e1.z * t.e2.y, t.e1.z * t.e2.x - t.e1.x * t.e2.z,
-           t.e1.x * t.e2.y - t.e1.y * t.e2.x};
-  } else {
-    const AnalyticPrim& a = s.analytics[pr.index];
-    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    const double p_I[3] = {o.x + static_cast<double>(h.t) * d.x,
-                           o.y + static_cast<double>(h.t) * d.y,
-                           o.z + static_cast<double>(h.t) * d.z};
-    double p_G[3], n_G[3];
-    for (int k = 0; k < 3; ++k)
-      p_G[k] = a.R_GI[3 * k] * p_I[0] + a.R_GI[3 * k + 1] * p_I[1] + a.R_GI[3 * k + 2] * p_I[2] +
-               a.p_GI[k];
-    AnalyticNormalArrays(a.kind, a.size, p_G, h.part, n_G);
-    // n_I = R_GI^T n_G
-    n_I = {static_cast<float>(a.R_GI[0] * n_G[0] + a.R_GI[3] * n_G[1] + a.R_GI[6] * n_G[2]),
-           static_cast<float>(a.R_GI[1] * n_G[0] + a.R_GI[4] * n_G[1] + a.R_GI[7] * n_G[2]),
-           static_cast<float>(a.R_GI[2] * n_G[0] + a.R_GI[5] * n_G[1] + a.R_GI[8] * n_G[2])};
-  }
-  F3 n = TransformVector(in.X_WI, n_I);
-  const float len = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
-  n = len > 0 ? F3{n.x / len, n.y / len, n.z / len} : F3{0, 0, 1};
-  if (n.x * r.d.x + n.y * r.d.y + n.z * r.d.z > 0) n = {-n.x, -n.y, -n.z};
-  return n;
-}
-
 struct DevicePrimary {
   float* depth;
   int32_t* geom_id;
@@ -99,14 +43,7 @@ __global__ void PrimaryKernel(SceneView s, PinholeCamera c, DevicePrimary out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= c.width || v >= c.height) return;
-  const float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
-  const float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
-  TraceRay r;
-  r.o = c.o;
-  r.d = {x * c.ex.x + y * c.ey.x + c.ez.x, x * c.ex.y + y * c.ey.y + c.ez.y,
-         x * c.ex.z + y * c.ey.z + c.ez.z};
-  r.tmin = c.near;
-  r.tmax = INFINITY;
+  const TraceRay r = PrimaryRay(c, u, v);
   TraceHit h;
   TraceClosest(s, r, &h);
   const bool hit = h.instance >= 0;
@@ -170,6 +107,9 @@ DeviceScene::DeviceScene() : impl_(new Impl) {
     throw;
   }
 }
+
+const SceneView& DeviceScene::device_view() const { return impl_->view; }
+void* DeviceScene::stream() const { return impl_->stream; }
 
 DeviceScene::~DeviceScene() {
   if (impl_->stream) cudaStreamDestroy(impl_->stream);

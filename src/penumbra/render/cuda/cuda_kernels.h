@@ -66,6 +66,10 @@ class DeviceScene {
   /// `count` renders of `camera` into device memory only (no copy back), timed with CUDA
   /// events: the mean milliseconds per frame (benchmarks).
   double TimePrimary(const PinholeCamera& camera, int count, bool depth_and_seg_only);
+  /// the device arrays as the kernels read them (after Sync), and the stream every copy and
+  /// kernel of this scene runs on (a cudaStream_t).
+  const SceneView& device_view() const;
+  void* stream() const;
 
  private:
   struct Impl;

@@ -8,6 +8,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
+#include "penumbra/scene/texture_image.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -22,48 +23,45 @@ T* Shape(Image<T>* img, bool want, int w, int h, int c) {
   return img->data.data();
 }
 
-F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
-
 }  // namespace
 
 CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu)
+    : CudaRenderer(scene, std::move(cpu), RenderSettings()) {}
+
+CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu,
+                           const RenderSettings& settings)
     : scene_(scene), cpu_(std::move(cpu)) {
   if (!cpu_) throw Error("CudaRenderer: no CPU renderer for the frames the GPU cannot render");
   bvh_ = std::make_unique<BvhScene>(scene_);
   device_ = std::make_unique<DeviceScene>();
   SyncDevice(*bvh_, device_.get());
+  realtime_ = std::make_unique<RealtimeFrameData>(scene_, settings);
+  device_realtime_ = std::make_unique<DeviceRealtime>();
+  pool_ = std::make_unique<ThreadPool>(settings.threads);
 }
+
+CudaRenderer::~CudaRenderer() = default;
 
 bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
-  return !view.outputs.rgb && (effects == nullptr || effects->empty()) &&
-         !view.intrinsics.has_distortion() && !view.motion.moving();
+  return (effects == nullptr || effects->empty()) && !view.intrinsics.has_distortion() &&
+         !view.motion.moving();
 }
 
-PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) {
-  const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  const Camera::PinholeTerms t = camera.pinhole_terms();
-  PinholeCamera c;
-  c.o = ToF3(t.o_W);
-  c.ex = ToF3(t.ex_W);
-  c.ey = ToF3(t.ey_W);
-  c.ez = ToF3(t.ez_W);
-  c.cx = t.cx;
-  c.cy = t.cy;
-  c.inv_fx = t.inv_fx;
-  c.inv_fy = t.inv_fy;
-  c.near = static_cast<float>(view.near_m);
-  c.width = camera.width();
-  c.height = camera.height();
-  return c;
+std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
+  return realtime_->Unsupported(effects, view);
 }
+
+PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
 
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
-  if (!OnGpu(effects, view)) {
+  const std::string rgb_why = view.outputs.rgb ? RgbNotOnGpu(effects, view) : "";
+  if (!OnGpu(effects, view) || !rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(
-          "renderer: cuda backend: rgb, effects, lens distortion and camera motion are not on "
-          "the GPU yet; such frames are rendered by the CPU renderer (docs/gpu.md)");
+          "renderer: cuda backend: {} not on the GPU yet (effects, lens distortion, camera "
+          "motion, pathtraced rgb); such frames are rendered by the CPU renderer (docs/gpu.md)",
+          rgb_why.empty() ? std::string("this frame's camera or effects are") : rgb_why + " is");
       told_cpu_ = true;
     }
     ++cpu_frames_;
@@ -76,20 +74,64 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const PinholeCamera c = PinholeOf(view);
   const CameraOutputs& want = view.outputs;
   const int W = c.width, H = c.height;
-  out->radiance = ImageF();
-  out->rgb = ImageU8();
+  out->ev100 = 0;
+  if (want.rgb) {
+    RenderRgb(snapshot, view, out);
+  } else {
+    out->radiance = ImageF();
+    out->rgb = ImageU8();
+  }
   PrimaryOutputs o;
-  o.depth = Shape(&out->depth_m, want.depth, W, H, 1);
+  // with rgb, depth comes from the realtime path's primary rays
+  o.depth = want.rgb ? nullptr : Shape(&out->depth_m, want.depth, W, H, 1);
   o.geom_id = Shape(&out->geom_id, want.segmentation, W, H, 1);
   o.range = Shape(&out->range_m, want.range, W, H, 1);
   o.normal_O = Shape(&out->normal_O, want.normals, W, H, 3);
   o.body_id = Shape(&out->body_id, want.instance_segmentation, W, H, 1);
   o.semantic = Shape(&out->semantic_class, want.semantic_segmentation, W, H, 1);
-  device_->RenderPrimary(c, o);
-  out->ev100 = 0;
+  if (o.depth || o.geom_id || o.range || o.normal_O || o.body_id || o.semantic)
+    device_->RenderPrimary(c, o);
   out->rays = static_cast<int64_t>(W) * H;
   out->stopped = false;
   ++gpu_frames_;
+}
+
+void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& view,
+                             RenderedFrame* out) {
+  if (!realtime_uploaded_) {
+    RealtimeStatic st;
+    st.materials = realtime_->materials().data();
+    st.num_materials = static_cast<int64_t>(realtime_->materials().size());
+    st.textures = realtime_->textures().data();
+    st.num_textures = static_cast<int64_t>(realtime_->textures().size());
+    st.texels = realtime_->texels().data();
+    st.num_texel_bytes = static_cast<int64_t>(realtime_->texels().size());
+    st.srgb_decode = SrgbDecodeTable();
+    st.oetf_lut = realtime_->film().oetf_lut().data();
+    device_realtime_->Upload(st);
+    realtime_uploaded_ = true;
+  }
+  realtime_->Prepare(snapshot, view, pool_.get());
+  const PinholeCamera& c = realtime_->camera();
+  const int W = c.width, H = c.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  Shape(&out->radiance, true, W, H, 3);
+  Shape(&out->rgb, true, W, H, 3);
+  RealtimeOutputs o;
+  o.radiance = out->radiance.data.data();
+  o.rgb = out->rgb.data.data();
+  o.depth = Shape(&out->depth_m, view.outputs.depth, W, H, 1);
+  const RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
+  out->ev100 = device_realtime_->Render(
+      device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
+      realtime_->film().filmic(),
+      [&](const PixelGeometry* g, int64_t count, Float3* sky) {
+        realtime_->SkyTerms(g, count, sky, pool_.get());
+      },
+      [&](const std::vector<double>& rows, float exposure[3]) {
+        return realtime_->Ev100(rows, n, exposure);
+      },
+      o);
 }
 
 }  // namespace penumbra::cuda

@@ -1,17 +1,22 @@
 #pragma once
-// the CUDA backend's Renderer (render/renderer.h). on the GPU now: the images of the pixel
-// centre's primary ray of a pinhole camera (no lens distortion, no motion) under clear
-// conditions: depth, segmentation (geom ids), instance (body) and semantic segmentation,
-// range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu. everything else (rgb
-// and radiance, distorted or moving cameras, effects) is not on the GPU yet: such a frame is
-// rendered whole by the CPU renderer handed in (`cpu`), so every output exists and equals the
-// CPU backend's for those frames; docs/gpu.md lists what is where.
+// the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (no lens
+// distortion, no motion) under clear conditions: the images of the pixel centre's primary ray
+// (depth, segmentation (geom ids), instance (body) and semantic segmentation, range and normals,
+// traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the realtime tier, rgb and
+// radiance (realtime_shading.h's functions in realtime_kernels.cu; the sky terms on the host,
+// realtime_frame.h). everything else (the pathtraced tier, distorted or moving cameras, effects)
+// is not on the GPU yet: such a frame is rendered whole by the CPU renderer handed in (`cpu`),
+// so every output exists and equals the CPU backend's for those frames; docs/gpu.md lists what
+// is where.
 
 #include <memory>
 #include <string>
 
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
 
 namespace penumbra::cuda {
@@ -23,12 +28,20 @@ class CudaRenderer final : public Renderer {
   /// cannot yet (not null).
   /// @throws Error as BvhScene, or if the CUDA runtime fails.
   CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu);
+  /// as above, with the render settings of the GPU's rgb (tier, film, anisotropy, seed; the
+  /// two-argument form takes the default RenderSettings).
+  CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu,
+               const RenderSettings& settings);
+  ~CudaRenderer() override;
 
   void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
               RenderedFrame* out) override;
 
-  /// true if `view` under `effects` renders on the GPU (else on the CPU renderer).
+  /// true if `view`'s ground-truth images under `effects` render on the GPU (else on the CPU
+  /// renderer).
   static bool OnGpu(const EffectsFrame* effects, const CameraView& view);
+  /// "" if `view`'s rgb under `effects` renders on the GPU, else why not.
+  std::string RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const;
 
   /// frames rendered on the GPU and on the CPU renderer so far.
   int64_t gpu_frames() const { return gpu_frames_; }
@@ -37,18 +50,28 @@ class CudaRenderer final : public Renderer {
   /// the scene's BVH (host side) and device copy, for benchmarks.
   const BvhScene& bvh() const { return *bvh_; }
   DeviceScene& device() { return *device_; }
+  /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
+  DeviceRealtime& device_realtime() { return *device_realtime_; }
 
   /// the GPU's pinhole form of `view` (view must be OnGpu).
   static PinholeCamera PinholeOf(const CameraView& view);
 
  private:
+  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h).
+  void RenderRgb(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out);
+
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
   std::unique_ptr<DeviceScene> device_;
   std::unique_ptr<Renderer> cpu_;
+  std::unique_ptr<RealtimeFrameData> realtime_;
+  std::unique_ptr<DeviceRealtime> device_realtime_;
+  std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
+  bool realtime_uploaded_ = false;
   int64_t gpu_frames_ = 0;
   int64_t cpu_frames_ = 0;
   bool told_cpu_ = false;
+  bool told_rgb_ = false;
 };
 
 }  // namespace penumbra::cuda

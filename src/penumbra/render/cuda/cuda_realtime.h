@@ -1,0 +1,74 @@
+#pragma once
+// the realtime tier on the GPU (realtime_shading.h per pixel, realtime_frame.h on the host):
+// device copies of a scene's materials, textures, geoms and lights, and the frame's kernels.
+// implemented in realtime_kernels.cu; plain structs only here (no Eigen, no CUDA headers).
+// every function throws penumbra::Error naming the CUDA call when the runtime reports an error.
+//
+// a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth;
+// (2) the host turns the geometry into sky terms (`sky`: SkyModel and SkyIrradianceVolume run on
+// the CPU, realtime_frame.h) which are uploaded; (3) the shading kernel (ShadeRealtimePixel);
+// (4) per-row log-luminance sums, which the host (`exposure`) turns into the frame's EV100 and
+// exposures; (5) the film kernel (DevelopPixel). every sum runs in a fixed order and no atomics
+// touch an output: frames are bit-identical run to run on one GPU.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/realtime_shading.h"
+
+namespace penumbra::cuda {
+
+/// a frame's host buffers (width x height pixels; radiance and rgb x 3), each may be null.
+struct RealtimeOutputs {
+  float* radiance = nullptr;
+  uint8_t* rgb = nullptr;
+  float* depth = nullptr;
+};
+
+/// the scene-constant data of the realtime path (host arrays, copied once by Upload).
+struct RealtimeStatic {
+  const MaterialPod* materials = nullptr;
+  int64_t num_materials = 0;
+  const TexturePod* textures = nullptr;
+  int64_t num_textures = 0;
+  const uint8_t* texels = nullptr;
+  int64_t num_texel_bytes = 0;
+  const float* srgb_decode = nullptr;  ///< 256 entries
+  const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries
+};
+
+/// the device side of the realtime path.
+class DeviceRealtime {
+ public:
+  DeviceRealtime();
+  ~DeviceRealtime();
+  DeviceRealtime(const DeviceRealtime&) = delete;
+  DeviceRealtime& operator=(const DeviceRealtime&) = delete;
+
+  /// copies the scene-constant data to the device.
+  void Upload(const RealtimeStatic& data);
+
+  /// host sky pass: sky terms of n pixels from their primary geometry.
+  using SkyFn = std::function<void(const PixelGeometry* geometry, int64_t n, Float3* sky)>;
+  /// host exposure: the EV100 from the rows' log-luminance sums, and the per-channel exposures.
+  using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
+
+  /// renders one frame of `frame` (host pointers for its geoms and lights; the scene arrays,
+  /// materials and textures are replaced by the device copies of `scene` and Upload) with
+  /// `num_geoms` geoms; returns the EV100. `filmic`: the film's tone map.
+  double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms, bool filmic,
+                const SkyFn& sky, const ExposureFn& exposure, const RealtimeOutputs& out);
+
+  /// `count` runs of the frame's device work as Render left it (geometry, shading, row sums
+  /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with
+  /// CUDA events: mean milliseconds per frame (benchmarks).
+  double TimeKernels(DeviceScene* scene, int count);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace penumbra::cuda

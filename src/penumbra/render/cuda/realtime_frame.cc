@@ -1,0 +1,250 @@
+#include "penumbra/render/cuda/realtime_frame.h"
+
+#include <cmath>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/cuda/bvh_ray_query.h"
+#include "penumbra/render/material_eval.h"
+#include "penumbra/scene/texture_image.h"
+
+namespace penumbra::cuda {
+namespace {
+
+Float3 ToFloat3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
+F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+
+MaterialPod PodOf(const Material& m, const std::vector<int>& texture_slot) {
+  MaterialPod p;
+  p.base_color = ToFloat3(m.base_color);
+  p.roughness = m.roughness;
+  p.metallic = m.metallic;
+  p.specular = m.specular;
+  p.emission = ToFloat3(m.emission);
+  p.texture = m.texture >= 0 && m.texture < static_cast<int>(texture_slot.size())
+                  ? texture_slot[m.texture]
+                  : -1;
+  p.texrepeat[0] = m.texrepeat.x();
+  p.texrepeat[1] = m.texrepeat.y();
+  p.texuniform = m.texuniform ? 1 : 0;
+  return p;
+}
+
+}  // namespace
+
+PinholeCamera PinholeCameraOf(const CameraView& view) {
+  const Camera camera(view.X_WO, view.intrinsics, view.motion);
+  const Camera::PinholeTerms t = camera.pinhole_terms();
+  PinholeCamera c;
+  c.o = ToF3(t.o_W);
+  c.ex = ToF3(t.ex_W);
+  c.ey = ToF3(t.ey_W);
+  c.ez = ToF3(t.ez_W);
+  c.cx = t.cx;
+  c.cy = t.cy;
+  c.inv_fx = t.inv_fx;
+  c.inv_fy = t.inv_fy;
+  c.near = static_cast<float>(view.near_m);
+  c.width = camera.width();
+  c.height = camera.height();
+  return c;
+}
+
+RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings)
+    : scene_(scene),
+      settings_(settings),
+      lights_(scene),
+      sky_(scene.sky),
+      volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+        return std::make_unique<BvhRayQuery>(statics);
+      }),
+      film_(settings) {
+  // 2d textures with one face: every level's texels, one after the other.
+  std::vector<int> slot(scene.textures.size(), -1);
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture& t = scene.textures[i];
+    if (t.kind != Texture::Kind::k2D || !t.image || t.image->faces() != 1) continue;
+    const TextureImage& im = *t.image;
+    if (im.num_levels() > kMaxTextureLevels)
+      throw Error("texture '" + t.name + "': " + std::to_string(im.num_levels()) +
+                  " mip levels, the CUDA backend takes at most " +
+                  std::to_string(kMaxTextureLevels));
+    TexturePod pod;
+    pod.num_levels = im.num_levels();
+    for (int l = 0; l < im.num_levels(); ++l) {
+      const TextureLevel& L = im.level(l);
+      pod.width[l] = L.width;
+      pod.height[l] = L.height;
+      pod.level_offset[l] = static_cast<int64_t>(texels_.size());
+      texels_.insert(texels_.end(), L.rgb_srgb.begin(), L.rgb_srgb.end());
+    }
+    slot[i] = static_cast<int>(textures_.size());
+    textures_.push_back(pod);
+  }
+  // the PBR maps by name, as MaterialEvaluator finds them
+  const MaterialEvaluator evaluator(scene, settings.max_anisotropy);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    MaterialPod pod = PodOf(scene.materials[i], slot);
+    const MaterialEvaluator::PbrMaps& maps = evaluator.pbr_maps(static_cast<int>(i));
+    auto slot_of = [&](int tex) {
+      return tex >= 0 && tex < static_cast<int>(slot.size()) ? slot[tex] : -1;
+    };
+    pod.normal_map = slot_of(maps.normal);
+    pod.metallic_roughness_map = slot_of(maps.metallic_roughness);
+    pod.occlusion_map = slot_of(maps.occlusion);
+    pod.emissive_map = slot_of(maps.emissive);
+    materials_.push_back(pod);
+  }
+  default_material_ = PodOf(Material(), slot);
+  geoms_.resize(scene.geoms.size());
+  for (size_t g = 0; g < scene.geoms.size(); ++g) {
+    const Geom& geom = scene.geoms[g];
+    GeomPod& pod = geoms_[g];
+    pod.half_extent = ToFloat3(GeomHalfExtents(scene, geom));
+    pod.plane = geom.shape == GeomShape::kPlane ? 1 : 0;
+    pod.untextured = geom.shape == GeomShape::kMesh && geom.mesh >= 0 &&
+                             geom.mesh < static_cast<int>(scene.meshes.size()) &&
+                             !scene.meshes[geom.mesh].texcoords.empty()
+                         ? 1
+                         : 0;
+  }
+}
+
+std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
+                                           const CameraView& view) const {
+  if (settings_.tier != RenderSettings::Tier::kRealtime) return "the pathtraced tier";
+  if (effects != nullptr && !effects->empty()) return "effects";
+  if (view.intrinsics.has_distortion()) return "lens distortion";
+  if (view.motion.moving()) return "camera motion";
+  return "";
+}
+
+void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
+                                ThreadPool* pool) {
+  lights_.Update(snapshot, nullptr);
+  for (size_t g = 0; g < scene_.geoms.size(); ++g) {
+    const Geom& geom = scene_.geoms[g];
+    const Pose X_GW = (snapshot.X_WB[geom.body] * geom.X_BG).inverse();
+    float* m = geoms_[g].X_GW;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[4 * r + c] = static_cast<float>(X_GW.linear()(r, c));
+      m[4 * r + 3] = static_cast<float>(X_GW.translation()(r));
+    }
+  }
+  camera_ = PinholeCameraOf(view);
+  const Camera camera(view.X_WO, view.intrinsics, view.motion);
+  spread_rad_ = camera.pixel_spread_rad();
+  // FrameContext::FrameKey() (render/cpu/integrator.h).
+  frame_key_ = HashKeys(HashKeys(settings_.seed, static_cast<uint64_t>(view.camera_index)),
+                        static_cast<uint64_t>(view.frame_index));
+  volume_.Update(scene_, snapshot, sky_, pool);
+}
+
+void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
+                                 ThreadPool* pool) const {
+  constexpr int64_t kChunk = 4096;
+  const bool occluded = !volume_.empty();
+  ParallelForOrSerial(pool, (n + kChunk - 1) / kChunk, [&](int64_t chunk) {
+    const int64_t end = std::min(n, (chunk + 1) * kChunk);
+    for (int64_t i = chunk * kChunk; i < end; ++i) {
+      const PixelGeometry& g = geometry[i];
+      const Eigen::Vector3f v(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
+      Eigen::Vector3f e;
+      if (g.hit == 0) {
+        e = sky_.Radiance(v);
+      } else {
+        // the probes' blend at the point and geometric normal, evaluated at the shading normal
+        // (RealtimeIntegrator's TileSkyIrradiance, per pixel).
+        const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z), ns(g.ns.x, g.ns.y, g.ns.z);
+        if (occluded) {
+          SkyIrradianceVolume::ShBlend blend;
+          volume_.Blend(v, ng, &blend);
+          e = volume_.IrradianceAt(blend, ns, sky_);
+        } else {
+          e = sky_.Irradiance(ns);
+        }
+      }
+      out[i] = ToFloat3(e);
+    }
+  });
+}
+
+RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* sky) const {
+  RealtimeFrameView f;
+  f.scene = scene;
+  f.camera = camera_;
+  f.spread_rad = spread_rad_;
+  f.materials = materials_.data();
+  f.default_material = default_material_;
+  f.geoms = geoms_.data();
+  f.textures = textures_.data();
+  f.texels = texels_.data();
+  f.srgb_decode = SrgbDecodeTable();
+  f.lights = lights_.pods().data();
+  f.num_lights = lights_.size();
+  f.max_anisotropy = settings_.max_anisotropy < 1 ? 1 : settings_.max_anisotropy;
+  f.frame_key = frame_key_;
+  f.sky_term = sky;
+  return f;
+}
+
+double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
+                                float exposure[3]) const {
+  double total = 0;
+  for (double s : row_sums) total += s;  // row order: independent of the launch
+  const double log_average = pixels > 0 ? std::exp(total / static_cast<double>(pixels))
+                                        : static_cast<double>(kMinLuminance);
+  const double ev100 = film_.Ev100FromLogAverage(log_average);
+  const float e = static_cast<float>(ExposureFromEv100(ev100));
+  exposure[0] = exposure[1] = exposure[2] = e;
+  return ev100;
+}
+
+void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
+                          RenderedFrame* out) {
+  const PinholeCamera& c = data.camera();
+  const int W = c.width, H = c.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const SceneView scene = bvh.view();
+  const RealtimeFrameView geo_view = data.View(scene, nullptr);
+  std::vector<PixelGeometry> geometry(n);
+  if (out->depth_m.width != W || out->depth_m.height != H || out->depth_m.channels != 1)
+    out->depth_m = ImageF(W, H, 1);
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) {
+      const int64_t i = v * W + u;
+      geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i]);
+    }
+  });
+  std::vector<Float3> sky(n);
+  data.SkyTerms(geometry.data(), n, sky.data(), pool);
+  const RealtimeFrameView f = data.View(scene, sky.data());
+  std::vector<Float3> radiance(n);
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) radiance[v * W + u] = ShadeRealtimePixel(f, u, static_cast<int>(v));
+  });
+  std::vector<double> rows(H);
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    rows[v] = RowLogLuminance(radiance.data(), W, static_cast<int>(v), kMinLuminance);
+  });
+  float exposure[3];
+  out->ev100 = data.Ev100(rows, n, exposure);
+  if (out->radiance.width != W || out->radiance.height != H || out->radiance.channels != 3)
+    out->radiance = ImageF(W, H, 3);
+  if (out->rgb.width != W || out->rgb.height != H || out->rgb.channels != 3)
+    out->rgb = ImageU8(W, H, 3);
+  const bool filmic = data.film().filmic();
+  const uint8_t* lut = data.film().oetf_lut().data();
+  for (int64_t i = 0; i < n; ++i) {
+    out->radiance.data[3 * i] = radiance[i].x;
+    out->radiance.data[3 * i + 1] = radiance[i].y;
+    out->radiance.data[3 * i + 2] = radiance[i].z;
+    DevelopPixel(radiance[i], exposure, filmic, lut, &out->rgb.data[3 * i]);
+  }
+  out->rays = n;
+  out->stopped = false;
+}
+
+}  // namespace penumbra::cuda

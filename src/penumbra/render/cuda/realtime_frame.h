@@ -1,0 +1,91 @@
+#pragma once
+// the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
+// materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
+// posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
+// key; the per-pixel sky terms from the primary rays' geometry (SkyModel::Radiance where a ray
+// escapes; where it hits, the occluded sky irradiance of the realtime tier's
+// SkyIrradianceVolume, or SkyModel::Irradiance without one: the CPU backend's own code, run on
+// the host); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
+// GPU). no CUDA runtime here: this file builds on machines without nvcc.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/image.h"
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/film.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/render_settings.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/render/sky_irradiance_volume.h"
+#include "penumbra/render/sky_model.h"
+
+namespace penumbra::cuda {
+
+/// the plain data of a scene's realtime frames (file comment). not thread-safe.
+class RealtimeFrameData {
+ public:
+  /// copies the materials, textures and geoms of `scene` (referenced: it must outlive this).
+  /// `settings`: the tier's film, anisotropy and seed.
+  /// @throws Error if a texture has more than kMaxTextureLevels levels.
+  RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings);
+
+  /// why a frame of `view` cannot be rendered by the GPU realtime path ("" if it can): not
+  /// the realtime tier, a camera that is not a pinhole, or effects.
+  std::string Unsupported(const EffectsFrame* effects, const CameraView& view) const;
+
+  /// poses the lights and geoms from `snapshot`, sets the camera and frame key of `view`, and
+  /// updates the sky volume (built on the first call and when the static bodies move).
+  void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
+
+  /// the sky term of every pixel (RealtimeFrameView::sky_term) from its primary geometry.
+  void SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out, ThreadPool* pool) const;
+
+  /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).
+  RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
+
+  /// the EV100 of a frame whose rows' log-luminance sums are `row_sums` (film.h's auto
+  /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop.
+  double Ev100(const std::vector<double>& row_sums, int64_t pixels, float exposure[3]) const;
+
+  const std::vector<MaterialPod>& materials() const { return materials_; }
+  const std::vector<TexturePod>& textures() const { return textures_; }
+  const std::vector<uint8_t>& texels() const { return texels_; }
+  const std::vector<GeomPod>& geoms() const { return geoms_; }
+  const std::vector<LightPod>& lights() const { return lights_.pods(); }
+  const PinholeCamera& camera() const { return camera_; }
+  const Film& film() const { return film_; }
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  const SceneDescription& scene_;
+  RenderSettings settings_;
+  std::vector<MaterialPod> materials_;
+  MaterialPod default_material_;
+  std::vector<TexturePod> textures_;
+  std::vector<uint8_t> texels_;
+  std::vector<GeomPod> geoms_;
+  LightSampler lights_;
+  SkyModel sky_;
+  SkyIrradianceVolume volume_;
+  Film film_;
+  PinholeCamera camera_;
+  float spread_rad_ = 0;
+  uint64_t frame_key_ = 0;
+};
+
+/// the pinhole camera of `view` as the kernels take it (view must be a projective camera).
+PinholeCamera PinholeCameraOf(const CameraView& view);
+
+/// renders a realtime frame (rgb, radiance, depth) with the GPU path's per-pixel functions on
+/// the CPU over `bvh` (posed for the frame) and `data` (Prepared for it): the parity of the GPU
+/// path with the CPU backend can be checked on machines without a GPU. rows over `pool`.
+void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
+                          RenderedFrame* out);
+
+}  // namespace penumbra::cuda

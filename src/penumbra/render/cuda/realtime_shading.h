@@ -1,0 +1,445 @@
+#pragma once
+// the CUDA backend's realtime tier, per pixel, as PB_HOST_DEVICE functions over plain data: the
+// kernels of realtime_kernels.cu run them on the GPU and RealtimeHostRenderer
+// (realtime_frame.h) runs the same functions on the CPU (tests, and machines without a GPU).
+// the formulas are the shared ones of render/ (brdf_math.h, light_math.h, texture_math.h,
+// film_math.h) that the CPU backend's RealtimeIntegrator and Film call; this file only chains
+// them as render/cpu/realtime_integrator.cc does:
+//
+//   L = Le + E_sky / pi (c_diff (1 - S) + S) + sum over lights f(wo, wi) |n . wi| E_i V_i
+//
+// with the same random numbers (Rng::DrawAt(PixelStream(u, v, 0), light)), the same
+// negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total) and
+// shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal) and the
+// sky radiance of rays that escape come per pixel from the host (SkyModel and
+// SkyIrradianceVolume's own code, RealtimeSkyTerms). what the GPU path does not model yet
+// (docs/gpu.md): texture coordinates of meshes (such materials are untextured), normal maps and
+// PBR maps, the mirror layer (SurfaceMaterial::mirror), cube textures on geoms (untextured), and
+// interpolated shading normals (the geometric normal shades).
+
+#include <cstdint>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/brdf_math.h"
+#include "penumbra/render/cuda/bvh_traversal.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/film_math.h"
+#include "penumbra/render/light_math.h"
+#include "penumbra/render/shading_math.h"
+#include "penumbra/render/texture_math.h"
+
+namespace penumbra::cuda {
+
+/// lights below this fraction of a pixel's unshadowed radiance get no shadow ray (as
+/// RealtimeIntegrator's kNegligibleLight).
+constexpr float kGpuNegligibleLight = 1e-3f;
+/// render/ray.h's kRayOffsetScale (shadow-ray origins pushed off the surface).
+constexpr float kGpuRayOffsetScale = 5e-5f;
+/// the most mip levels a texture has (a 65536-texel side).
+constexpr int kMaxTextureLevels = 17;
+
+/// a material as the GPU evaluates it (Material's factors and its 2d base texture).
+struct MaterialPod {
+  Float3 base_color{0.8f, 0.8f, 0.8f};
+  float roughness = 0.5f, metallic = 0, specular = 0.5f;
+  Float3 emission;
+  int32_t texture = -1;  ///< into the frame's textures: a 2d texture, planar-mapped; -1 none
+  float texrepeat[2] = {1, 1};
+  int32_t texuniform = 0;
+  /// the PBR maps (render/material_eval.h, "PBR maps"), into the frame's textures; -1 none.
+  int32_t normal_map = -1, metallic_roughness_map = -1, occlusion_map = -1, emissive_map = -1;
+  PB_HOST_DEVICE bool any_map() const {
+    return texture >= 0 || normal_map >= 0 || metallic_roughness_map >= 0 || occlusion_map >= 0 ||
+           emissive_map >= 0;
+  }
+};
+
+/// a 2d texture: its mip levels' texels at texels[level_offset[l]] (bytes).
+struct TexturePod {
+  int32_t num_levels = 0;
+  int32_t width[kMaxTextureLevels] = {};
+  int32_t height[kMaxTextureLevels] = {};
+  int64_t level_offset[kMaxTextureLevels] = {};
+};
+
+/// a geom as the GPU maps textures on it, posed for the frame.
+struct GeomPod {
+  float X_GW[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};  ///< row-major [R | p], world to geom
+  Float3 half_extent;          ///< local bounding-box half extents (MaterialEvaluator's)
+  int32_t infinite_plane = 0;  ///< a plane without finite size in the face's axes
+  int32_t plane = 0;           ///< GeomShape::kPlane
+  int32_t untextured = 0;      ///< a mesh with texture coordinates (not mapped on the GPU yet)
+};
+
+/// everything a realtime frame reads, as device (or host) pointers.
+struct RealtimeFrameView {
+  SceneView scene;
+  PinholeCamera camera;
+  float spread_rad = 0;                    ///< Camera::pixel_spread_rad
+  const MaterialPod* materials = nullptr;  ///< by SceneDescription material index
+  MaterialPod default_material;            ///< for material -1
+  const GeomPod* geoms = nullptr;          ///< by SceneDescription geom index
+  const TexturePod* textures = nullptr;
+  const uint8_t* texels = nullptr;
+  const float* srgb_decode = nullptr;  ///< 256 entries (SrgbDecodeTable)
+  const LightPod* lights = nullptr;
+  int32_t num_lights = 0;
+  int32_t max_anisotropy = 1;
+  uint64_t frame_key = 0;  ///< FrameContext::FrameKey()
+  /// per pixel: E_sky on the surface the pixel's ray hits, or the sky radiance where it
+  /// escapes (RealtimeSkyTerms).
+  const Float3* sky_term = nullptr;
+};
+
+/// what a pixel's primary ray hits, for the host's sky pass: p_W, the unit geometric normal
+/// facing the ray and the unit shading normal (normal map applied, UsableShadingNormal) where
+/// it hits; the unit ray direction where it does not.
+struct PixelGeometry {
+  Float3 p_or_d;
+  Float3 ng;
+  Float3 ns;
+  int32_t hit = 0;
+};
+
+/// a surface point as the realtime tier shades it: the textured material and the frame.
+struct ShadingPoint {
+  Float3 p, ng, n, wo;  ///< point, geometric normal (facing the ray), shading normal, to viewer
+  Float3 base, emission;
+  float roughness = 0.5f, metallic = 0, specular = 0.5f, occlusion = 1;
+};
+
+PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
+PB_HOST_DEVICE inline F3 ToF3(const Float3& v) { return F3{v.x, v.y, v.z}; }
+
+/// the pixel-centre ray of pixel (u, v) (PinholeCamera's formula).
+PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
+  const float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
+  const float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
+  TraceRay r;
+  r.o = c.o;
+  r.d = {x * c.ex.x + y * c.ey.x + c.ez.x, x * c.ex.y + y * c.ey.y + c.ez.y,
+         x * c.ex.z + y * c.ey.z + c.ez.z};
+  r.tmin = c.near;
+  r.tmax = INFINITY;
+  return r;
+}
+
+/// the unit world normal of hit h of world ray r (the geometric normal of the triangle or
+/// analytic shape), facing the ray; *front_face (if given): the ray hit the outward side.
+PB_HOST_DEVICE inline F3 HitNormal(const SceneView& s, const TraceRay& r, const TraceHit& h,
+                                   bool* front_face = nullptr) {
+  const Instance& in = s.instances[h.instance];
+  const PrimRef& pr = s.prims[h.prim];
+  F3 n_I;
+  if (pr.kind == 0) {
+    const Triangle& t = s.triangles[pr.index];
+    n_I = {t.e1.y * t.e2.z - t.e1.z * t.e2.y, t.e1.z * t.e2.x - t.e1.x * t.e2.z,
+           t.e1.x * t.e2.y - t.e1.y * t.e2.x};
+  } else {
+    const AnalyticPrim& a = s.analytics[pr.index];
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    const double p_I[3] = {o.x + static_cast<double>(h.t) * d.x,
+                           o.y + static_cast<double>(h.t) * d.y,
+                           o.z + static_cast<double>(h.t) * d.z};
+    double p_G[3], n_G[3];
+    for (int k = 0; k < 3; ++k)
+      p_G[k] = a.R_GI[3 * k] * p_I[0] + a.R_GI[3 * k + 1] * p_I[1] + a.R_GI[3 * k + 2] * p_I[2] +
+               a.p_GI[k];
+    AnalyticNormalArrays(a.kind, a.size, p_G, h.part, n_G);
+    // n_I = R_GI^T n_G
+    n_I = {static_cast<float>(a.R_GI[0] * n_G[0] + a.R_GI[3] * n_G[1] + a.R_GI[6] * n_G[2]),
+           static_cast<float>(a.R_GI[1] * n_G[0] + a.R_GI[4] * n_G[1] + a.R_GI[7] * n_G[2]),
+           static_cast<float>(a.R_GI[2] * n_G[0] + a.R_GI[5] * n_G[1] + a.R_GI[8] * n_G[2])};
+  }
+  F3 n = TransformVector(in.X_WI, n_I);
+  const float len = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
+  n = len > 0 ? F3{n.x / len, n.y / len, n.z / len} : F3{0, 0, 1};
+  const bool front = !(n.x * r.d.x + n.y * r.d.y + n.z * r.d.z > 0);
+  if (!front) n = {-n.x, -n.y, -n.z};
+  if (front_face) *front_face = front;
+  return n;
+}
+
+/// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
+/// planar mapping along the dominant axis a0, a1 of the geom-frame normal n_G; the footprint's
+/// anisotropic axes, FootprintAxes, when max_anisotropy > 1).
+struct PlanarFootprint {
+  PlanarMap map;
+  int a0 = 0, a1 = 1;
+  bool axes = false;
+  float major[3] = {0, 0, 0}, minor[3] = {0, 0, 0};
+  float width_m = 0, cos_incidence = 1;
+};
+
+/// the footprint of material m on geom g at geom-frame point p_G, normal n_G and ray direction
+/// d_G, for a cone width_m wide met at |cos| cos_incidence.
+PB_HOST_DEVICE inline PlanarFootprint PlanarFootprintAt(const MaterialPod& m, const GeomPod& g,
+                                                        const Float3& p_G, const Float3& n_G,
+                                                        const Float3& d_G, float width_m,
+                                                        float cos_incidence, int max_anisotropy) {
+  PlanarFootprint fp;
+  fp.width_m = width_m;
+  fp.cos_incidence = cos_incidence;
+  const float an[3] = {fabsf(n_G.x), fabsf(n_G.y), fabsf(n_G.z)};
+  const int axis = (an[0] >= an[1] && an[0] >= an[2]) ? 0 : (an[1] >= an[2] ? 1 : 2);
+  fp.a0 = (axis + 1) % 3;
+  fp.a1 = (axis + 2) % 3;
+  const float p[3] = {p_G.x, p_G.y, p_G.z};
+  const float h[3] = {g.half_extent.x, g.half_extent.y, g.half_extent.z};
+  const float rx = m.texrepeat[0], ry = m.texrepeat[1];
+  const int a0 = fp.a0, a1 = fp.a1;
+  const bool infinite = g.plane != 0 && !(h[a0] > 0 && h[a1] > 0);
+  if (m.texuniform != 0 || infinite)
+    fp.map = PlanarMapUniform(p[a0], p[a1], rx, ry);
+  else
+    fp.map =
+        PlanarMapPerFace(p[a0], p[a1], h[a0] > 0 ? h[a0] : 1.0f, h[a1] > 0 ? h[a1] : 1.0f, rx, ry);
+  if (max_anisotropy > 1 && width_m > 0) {
+    const float dn = d_G.x * n_G.x + d_G.y * n_G.y + d_G.z * n_G.z;
+    const Float3 t{d_G.x - dn * n_G.x, d_G.y - dn * n_G.y, d_G.z - dn * n_G.z};
+    const float len = sqrtf(t.x * t.x + t.y * t.y + t.z * t.z);
+    if (len > 1e-4f) {
+      const Float3 tu{t.x / len, t.y / len, t.z / len};
+      const float major_len = width_m / pbm::Max(cos_incidence, kMinCosIncidence);
+      const Float3 b{n_G.y * tu.z - n_G.z * tu.y, n_G.z * tu.x - n_G.x * tu.z,
+                     n_G.x * tu.y - n_G.y * tu.x};
+      fp.major[0] = tu.x * major_len, fp.major[1] = tu.y * major_len,
+      fp.major[2] = tu.z * major_len;
+      fp.minor[0] = b.x * width_m, fp.minor[1] = b.y * width_m, fp.minor[2] = b.z * width_m;
+      fp.axes = true;
+    }
+  }
+  return fp;
+}
+
+/// the linear rgb of texture `slot` over footprint fp (material_eval.h's filtering: anisotropic
+/// taps in one level, else trilinear over the isotropic level of detail).
+PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
+                                          const PlanarFootprint& fp) {
+  const TexturePod& tex = f.textures[slot];
+  const float w = static_cast<float>(tex.width[0]), th = static_cast<float>(tex.height[0]);
+  float lod = 0, ds = 0, dt = 0;
+  int n = 1;
+  bool planned = false;
+  if (fp.axes) {
+    const PlanarFilterPlan plan =
+        PlanPlanarFilter(fp.map, fp.major[fp.a0], fp.major[fp.a1], fp.minor[fp.a0], fp.minor[fp.a1],
+                         w, th, f.max_anisotropy);
+    if (plan.ok) {
+      lod = plan.lod, n = plan.n, ds = plan.ds, dt = plan.dt;
+      planned = true;
+    }
+  }
+  if (!planned) lod = TextureLod(fp.width_m, fp.cos_incidence, fp.map.rho(w, th));
+  if (n > 1) {
+    const int l = TapLevel(tex.num_levels, lod);
+    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
+    return BilinearWrapTaps(L, f.srgb_decode, fp.map.s, fp.map.t, ds, dt, n);
+  }
+  int level[2];
+  float weight[2];
+  const int count = TrilinearLevels(tex.num_levels, lod, level, weight);
+  Float3 c{0, 0, 0};
+  for (int i = 0; i < count; ++i) {
+    const int l = level[i];
+    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
+    c = c + weight[i] * BilinearWrap(L, f.srgb_decode, fp.map.s, fp.map.t);
+  }
+  return c;
+}
+
+/// the unshadowed contribution f(wo, wi) |n . wi| E of one sample of light j at p (0 where the
+/// light sends nothing), its direction *wi and distance *dist: the light's two uniform numbers
+/// from draw j of the pixel's random-number stream (as RealtimeIntegrator).
+PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j, uint64_t stream,
+                                               const Float3& p, const Float3& n, const Float3& ng,
+                                               const Float3& wo, float n_v, const Float3& c_diff,
+                                               const Float3& f0, float a2, Float3* wi,
+                                               float* dist) {
+  float u1, u2;
+  Rng::Uniform2Of(Rng::DrawAt(stream, static_cast<uint64_t>(j)), &u1, &u2);
+  Float3 E;
+  bool valid;
+  SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, wi, dist, &E, &valid);
+  if (!valid) return Float3{0, 0, 0};
+  const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, *wi);
+  return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
+}
+
+/// the shading point of hit h of primary ray r (d_len = |r.d|): the material with its
+/// textures and PBR maps filtered over the pixel's ray cone (MaterialEvaluator's order: base
+/// colour, metallic-roughness, occlusion, emissive, normal map), and the shading normal the
+/// viewer sees (UsableShadingNormal).
+PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, const TraceRay& r,
+                                                   const TraceHit& h, float d_len) {
+  const SceneView& s = f.scene;
+  ShadingPoint sp;
+  const Float3 d{r.d.x / d_len, r.d.y / d_len, r.d.z / d_len};
+  sp.wo = -d;
+  sp.p = Float3{r.o.x + h.t * r.d.x, r.o.y + h.t * r.d.y, r.o.z + h.t * r.d.z};
+  bool front_face = true;
+  sp.ng = ToFloat3(HitNormal(s, r, h, &front_face));
+  const Float3& p = sp.p;
+  const Float3& ng = sp.ng;
+  const Record& rec = s.records[s.prims[h.prim].record];
+  const MaterialPod& m = rec.material >= 0 ? f.materials[rec.material] : f.default_material;
+  sp.base = m.base_color;
+  sp.roughness = m.roughness;
+  sp.metallic = m.metallic;
+  sp.specular = m.specular;
+  sp.emission = m.emission;
+  Float3 ns = ng;
+  if (m.any_map() && rec.geom >= 0 && f.geoms[rec.geom].untextured == 0) {
+    const GeomPod& g = f.geoms[rec.geom];
+    const Float3 p_G = ToFloat3(TransformPoint(g.X_GW, ToF3(p)));
+    const Float3 n_G = ToFloat3(TransformVector(g.X_GW, ToF3(ng)));
+    const Float3 d_G = ToFloat3(TransformVector(g.X_GW, ToF3(d)));
+    const float cos_inc = pbm::Min(1.0f, fabsf(ng.x * d.x + ng.y * d.y + ng.z * d.z));
+    const PlanarFootprint fp = PlanarFootprintAt(m, g, p_G, n_G, d_G, f.spread_rad * h.t * d_len,
+                                                 cos_inc, f.max_anisotropy);
+    if (m.texture >= 0) {
+      const Float3 c = FilterPlanar(f, m.texture, fp);
+      sp.base = Float3{sp.base.x * c.x, sp.base.y * c.y, sp.base.z * c.z};
+    }
+    if (m.metallic_roughness_map >= 0) {
+      const Float3 c = FilterPlanar(f, m.metallic_roughness_map, fp);
+      sp.roughness *= c.y;
+      sp.metallic *= c.z;
+    }
+    if (m.occlusion_map >= 0)
+      sp.occlusion = pbm::Clamp(FilterPlanar(f, m.occlusion_map, fp).x, 0.0f, 1.0f);
+    if (m.emissive_map >= 0) {
+      const Float3 c = FilterPlanar(f, m.emissive_map, fp);
+      sp.emission = Float3{sp.emission.x * c.x, sp.emission.y * c.y, sp.emission.z * c.z};
+    }
+    if (m.normal_map >= 0) {
+      // the planar mapping's tangent (+-a0) and bitangent (-+a1) in the world: rows of R_GW.
+      const float st = fp.map.j0 >= 0 ? 1.0f : -1.0f, sb = fp.map.j1 >= 0 ? -1.0f : 1.0f;
+      const float* R = g.X_GW;
+      const Float3 t_W{st * R[4 * fp.a0], st * R[4 * fp.a0 + 1], st * R[4 * fp.a0 + 2]};
+      const Float3 b_W{sb * R[4 * fp.a1], sb * R[4 * fp.a1 + 1], sb * R[4 * fp.a1 + 2]};
+      Float3 bent;
+      if (BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent)) ns = bent;
+    }
+  }
+  sp.n = pbm::Dot<float>(ns, sp.wo) > 0 ? ns : ng;
+  return sp;
+}
+
+/// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
+/// (0 on a miss).
+PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
+                                                    float* t_hit) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  PixelGeometry g;
+  *t_hit = 0;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  if (h.instance < 0) {
+    const float inv = 1.0f / d_len;
+    g.p_or_d = Float3{r.d.x * inv, r.d.y * inv, r.d.z * inv};
+    return g;
+  }
+  *t_hit = h.t;
+  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
+  g.hit = 1;
+  g.p_or_d = sp.p;
+  g.ng = sp.ng;
+  g.ns = sp.n;
+  return g;
+}
+
+/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
+/// escapes).
+PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+  const SceneView& s = f.scene;
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const Float3 sky = f.sky_term[pixel];
+  TraceHit h;
+  TraceClosest(s, r, &h);
+  if (h.instance < 0) return sky;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
+  const Float3& p = sp.p;
+  const Float3& ng = sp.ng;
+  const Float3& n = sp.n;
+  const Float3& wo = sp.wo;
+  const float roughness = sp.roughness;
+  const Float3 emission = sp.emission;
+  const float occlusion = sp.occlusion;
+  // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
+  // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
+  Float3 c_diff, f0;
+  float alpha;
+  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &c_diff, &f0,
+                                    &alpha);
+  const float a2 = alpha * alpha;
+  const float n_v = pbm::Dot<float>(n, wo);
+  const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), roughness);
+  const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
+                       c_diff.z * (1.0f - spec.z) + spec.z};
+  const Float3 sky_E = occlusion * sky;
+  Float3 L{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
+           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
+           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
+  // shadow rays start off the surface on the lit side.
+  const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
+  const float off = kGpuRayOffsetScale * (1.0f + amax);
+  const F3 origin{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
+  const uint64_t stream = HashKeys(HashKeys(f.frame_key, static_cast<uint64_t>(pixel)), 0);
+  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+  float total = pbm::Luminance709(L.x, L.y, L.z);
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = LightContribution(f, j, stream, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    total += pbm::Luminance709(c.x, c.y, c.z);
+  }
+  // lights in order: negligible or shadowless contributions are added as they are, the others
+  // after a shadow ray.
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = LightContribution(f, j, stream, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    const float lum = pbm::Luminance709(c.x, c.y, c.z);
+    if (!(lum > 0)) continue;
+    if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
+      TraceRay sr;
+      sr.o = origin;
+      sr.d = ToF3(wi);
+      sr.tmin = 0;
+      sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
+      if (TraceOccluded(s, sr)) continue;
+    }
+    L = L + c;
+  }
+  return L;
+}
+
+/// the sum over row v of the log-luminance terms (film_math.h's LogLuminanceTerm), in column
+/// order (the exposure's log-average; rows are summed on the host in row order).
+PB_HOST_DEVICE inline double RowLogLuminance(const Float3* radiance, int width, int v,
+                                             double min_luminance) {
+  double sum = 0;
+  for (int u = 0; u < width; ++u) {
+    const Float3& c = radiance[static_cast<int64_t>(v) * width + u];
+    const float rgb[3] = {c.x, c.y, c.z};
+    sum += LogLuminanceTerm(rgb, min_luminance);
+  }
+  return sum;
+}
+
+/// the 8-bit sRGB code of every channel of one pixel (film_math.h's DevelopPixelIndices, then
+/// the encoding table).
+PB_HOST_DEVICE inline void DevelopPixel(const Float3& c, const float exposure[3], bool filmic,
+                                        const uint8_t* lut, uint8_t out[3]) {
+  const float rgb[3] = {c.x, c.y, c.z};
+  int32_t index[3];
+  DevelopPixelIndices(rgb, exposure, filmic, index);
+  for (int k = 0; k < 3; ++k) out[k] = lut[index[k]];
+}
+
+}  // namespace penumbra::cuda

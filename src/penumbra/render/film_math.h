@@ -1,0 +1,76 @@
+#pragma once
+// the film's per-pixel formulas (render/film.h: exposure, white-balance gains, the
+// hue-preserving ACES filmic map or a clamp, the sRGB encoding table's index), shared by Film
+// on the CPU and the CUDA kernels. scalar (float) functions.
+
+#include <cmath>
+#include <cstdint>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/render/shading_math.h"
+
+namespace penumbra {
+
+/// entries of the sRGB encoding table (Film): code of i / (kFilmLutSize - 1).
+constexpr int kFilmLutSize = 65536;
+
+/// photometric exposure H for an exposure value at ISO 100: 1 / (1.2 2^ev100) (saturation-based
+/// speed, Lagarde & de Rousiers, "Moving Frostbite to physically based rendering", 2014, eq. 12).
+PB_HOST_DEVICE inline double ExposureFromEv100(double ev100) { return 1.0 / (1.2 * exp2(ev100)); }
+
+/// ACES filmic fit (Narkowicz 2015, "ACES filmic tone mapping curve") of a non-negative exposed
+/// value, in [0, 1].
+PB_HOST_DEVICE inline float AcesFilmic(float x) {
+  constexpr float a = 2.51f, b = 0.03f, c = 2.43f, d = 0.59f, e = 0.14f;
+  x = pbm::Max(x, 0.0f);
+  return pbm::Clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0f, 1.0f);
+}
+
+/// hue-preserving filmic map of an exposed linear RGB value x (>= 0; NaN channels stay NaN):
+/// y = x AcesFilmic(m) / m, m = max(x), each y in [0, 1]; all 0 when m <= 0 (Naik and Murthy,
+/// IEEE Trans. Image Processing 12(12), 2003: max-RGB scaling keeps hue and saturation).
+PB_HOST_DEVICE inline void HuePreservingFilmic(const float x[3], float y[3]) {
+  // the largest channel; NaN channels never win, so they stay NaN (and encode as 0).
+  float m = 0.0f;
+  for (int c = 0; c < 3; ++c)
+    if (x[c] > m) m = x[c];
+  // m = +inf gives NaN (black), as the per-channel curve did.
+  const float ratio = m > 0.0f ? AcesFilmic(m) / m : 0.0f;
+  for (int c = 0; c < 3; ++c) y[c] = pbm::Clamp(pbm::Max(x[c], 0.0f) * ratio, 0.0f, 1.0f);
+}
+
+/// sRGB OETF (IEC 61966-2-1) of a linear value in [0, 1].
+PB_HOST_DEVICE inline float SrgbOetf(float linear) {
+  const float v = pbm::Clamp(linear, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+}
+
+/// index into the encoding table of a tone-mapped value x in [0, 1]: round(x (size - 1));
+/// NaN-safe (!(x > 0) maps to 0).
+PB_HOST_DEVICE inline int32_t FilmLutIndex(float x) {
+  const int32_t k = x > 0 ? static_cast<int32_t>(x * (kFilmLutSize - 1) + 0.5f) : 0;
+  return k < kFilmLutSize - 1 ? k : kFilmLutSize - 1;
+}
+
+/// the encoding-table indices of one pixel of linear radiance rgb: each channel times its
+/// exposure (exposure x white-balance gain), then the hue-preserving filmic map (filmic) or a
+/// clamp to [0, 1] per channel.
+PB_HOST_DEVICE inline void DevelopPixelIndices(const float rgb[3], const float exposure[3],
+                                               bool filmic, int32_t index[3]) {
+  const float x[3] = {rgb[0] * exposure[0], rgb[1] * exposure[1], rgb[2] * exposure[2]};
+  if (filmic) {
+    float y[3];
+    HuePreservingFilmic(x, y);
+    for (int c = 0; c < 3; ++c) index[c] = FilmLutIndex(y[c]);
+  } else {
+    for (int c = 0; c < 3; ++c) index[c] = FilmLutIndex(pbm::Clamp(x[c], 0.0f, 1.0f));
+  }
+}
+
+/// ln(max(L, min_luminance)) of a pixel's Rec. 709 luminance L (the log-average's term).
+PB_HOST_DEVICE inline double LogLuminanceTerm(const float rgb[3], double min_luminance) {
+  const double L = static_cast<double>(pbm::Luminance709(rgb[0], rgb[1], rgb[2]));
+  return log(L < min_luminance ? min_luminance : L);
+}
+
+}  // namespace penumbra

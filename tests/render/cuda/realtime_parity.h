@@ -1,0 +1,66 @@
+#pragma once
+// helpers of the realtime rgb parity tests (host: realtime_host_test.cc; GPU:
+// realtime_rgb_gpu_test.cc): a bundled world after 1 s of simulation, its first camera's view,
+// and the image comparisons of issue 35 (rgb PSNR, depth within 1 mm).
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "penumbra/physics/simulation.h"
+#include "penumbra/render/renderer.h"
+#include "penumbra/session/scene_assembly.h"
+#include "penumbra/session/session.h"
+#include "penumbra/world/world_config.h"
+
+namespace penumbra::realtime_parity {
+
+/// bundled world `name` (worlds/<name>) after 1 s of simulation, without its renderer.
+inline std::unique_ptr<Session> LoadSimulated(const std::string& name) {
+  SessionOptions so;
+  so.build_renderer = false;
+  so.add_controllers = false;
+  auto session = std::make_unique<Session>(
+      LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + name), so);
+  while (session->sim().time() < 1.0) session->sim().Step();
+  return session;
+}
+
+/// the first camera of `scene` at w x h (its vertical field of view), rgb and depth.
+inline CameraView RgbDepthView(const SceneDescription& scene, const WorldSnapshot& snap, int w,
+                               int h) {
+  const CameraSpec& cam = scene.cameras.front();
+  CameraView view;
+  view.X_WO = CameraPoseInWorld(cam, snap);
+  const double fovy_deg =
+      2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+  view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
+  view.near_m = cam.near_m;
+  view.outputs.rgb = true;
+  view.outputs.depth = true;
+  view.outputs.segmentation = false;
+  return view;
+}
+
+/// PSNR (dB) of two 8-bit images of one size: 10 log10(255^2 / MSE); 99 when equal.
+inline double Psnr(const ImageU8& a, const ImageU8& b) {
+  if (a.data.size() != b.data.size() || a.data.empty()) return 0;
+  double se = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) {
+    const double d = static_cast<double>(a.data[i]) - static_cast<double>(b.data[i]);
+    se += d * d;
+  }
+  if (se == 0) return 99;
+  return 10.0 * std::log10(255.0 * 255.0 / (se / static_cast<double>(a.data.size())));
+}
+
+/// the fraction of pixels whose depths differ by more than 1 mm.
+inline double DepthMismatch(const ImageF& a, const ImageF& b) {
+  if (a.data.size() != b.data.size() || a.data.empty()) return 1;
+  int64_t bad = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) bad += std::abs(a.data[i] - b.data[i]) > 1e-3f;
+  return static_cast<double>(bad) / static_cast<double>(a.data.size());
+}
+
+}  // namespace penumbra::realtime_parity
