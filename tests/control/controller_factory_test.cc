@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
 
@@ -71,6 +74,23 @@ TEST(ControllerFactory, BuildsWaypointFollowerWithPrefixedNames) {
   // no robot name: no prefix
   auto bare = MakeController(Config(kGood), "", "w.yaml");
   EXPECT_EQ(dynamic_cast<WaypointFollower*>(bare.get())->params().base_body, "chassis");
+}
+
+// a differential drive takes twists without sideways speed and routes; its command names
+// (model_info's "commands") come from those capabilities
+TEST(ControllerFactory, WaypointFollowerIsATwistAndWaypointTarget) {
+  std::unique_ptr<Controller> c = MakeController(Config(kGood), "rover", "w.yaml");
+  TwistTarget* twist = AsTwistTarget(*c);
+  ASSERT_NE(twist, nullptr);
+  ASSERT_NE(AsWaypointTarget(*c), nullptr);
+  EXPECT_EQ(AsJointTarget(*c), nullptr);
+  EXPECT_FALSE(twist->lateral());
+  EXPECT_EQ(ControllerCommands(*c), (std::vector<std::string>{"twist", "waypoints"}));
+  EXPECT_THROW(twist->SetTwist(TrotCommand{0.5, 0.1, 0}), Error);
+  EXPECT_THROW(twist->SetTwist(TrotCommand{NAN, 0, 0}), Error);
+  twist->SetTwist(TrotCommand{0.5, 0, 0.2});
+  twist->ClearTwist();
+  EXPECT_THROW(AsWaypointTarget(*c)->SetWaypoints({}, false), Error);
 }
 
 TEST(ControllerFactory, OptionalKeysHaveDefaults) {

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "arm_control_fake.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/joint_controller.h"
 #include "penumbra/core/error.h"
 
@@ -158,6 +159,28 @@ TEST(JointPd, ModesAndCommandApi) {
   // malformed commands fail in the caller's thread
   EXPECT_THROW(pd->PushCommand(JointCommand::Position({1, 2})), Error);
   EXPECT_THROW(pd->SetCommand(JointCommand::Velocity({0, 0, 0, NAN, 0, 0, 0})), Error);
+}
+
+// what the command bus sees of a joint_pd: its JointTarget capability and nothing else
+TEST(JointPd, IsAJointTargetOnly) {
+  const ModelInfo m = ArmModel();
+  auto pd = MakePd(m, "kp: 100\nkd: 0\n");
+  ASSERT_NE(pd, nullptr);
+  Controller& c = *pd;
+  JointTarget* target = AsJointTarget(c);
+  ASSERT_NE(target, nullptr);
+  EXPECT_EQ(target->command_joints(), pd->params().servo.joints);
+  EXPECT_EQ(target->command_joints().size(), 7u);
+  EXPECT_EQ(AsTwistTarget(c), nullptr);
+  EXPECT_EQ(AsWaypointTarget(c), nullptr);
+  EXPECT_EQ(ControllerCommands(c), (std::vector<std::string>{"joint_targets"}));
+  // through the interface as through the class: checked in the caller's thread, then applied
+  EXPECT_THROW(target->SetCommand(JointCommand::Position({1, 2})), Error);
+  target->SetCommand(JointCommand::Effort({1, 2, 3, 4, 5, 6, 7}));
+  FakeInput in(m);
+  std::vector<double> ctrl(8, 0.0);
+  pd->Compute(in, ctrl);
+  EXPECT_EQ(pd->active_command().mode, JointCommand::Mode::kEffort);
 }
 
 TEST(JointPd, ConfigErrors) {

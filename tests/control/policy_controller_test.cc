@@ -300,25 +300,27 @@ TEST(PolicyControllerTest, TakesVelocityCommandsLikeTrotGait) {
                       "action: {kp: 20, kd: 0.5}\n"
                       "commands: [{t: 0, vx: 0.3}, {t: 1, yaw_rate: 0.5}]\n");
   c->Initialize(m);
-  auto* twist = dynamic_cast<TwistCommandable*>(c.get());
+  TwistTarget* twist = AsTwistTarget(*c);
   ASSERT_NE(twist, nullptr);
+  EXPECT_TRUE(twist->lateral());
+  EXPECT_EQ(ControllerCommands(*c), (std::vector<std::string>{"twist", "waypoints"}));
   PolicyController* p = AsPolicy(c);
   QuadInput in(m);
   std::vector<double> ctrl(m.nu, 0.0);
   c->Compute(in, ctrl);
   EXPECT_FLOAT_EQ(p->last_observation()[0], 0.3f);  // scripted
-  twist->SetCommand(TrotCommand{-0.2, 0.1, 0.4});
+  twist->SetTwist(TrotCommand{-0.2, 0.1, 0.4});
   for (int k = 0; k < 10; ++k) c->Compute(in, ctrl);  // decimation 4 at 50 Hz / 5 ms
   EXPECT_FLOAT_EQ(p->last_observation()[0], -0.2f);
   EXPECT_FLOAT_EQ(p->last_observation()[1], 0.1f);
   EXPECT_FLOAT_EQ(p->last_observation()[2], 0.4f);
-  twist->ClearCommand();
+  twist->ClearTwist();
   in.t_ = 1.5;
   for (int k = 0; k < 4; ++k) c->Compute(in, ctrl);
   EXPECT_FLOAT_EQ(p->last_observation()[0], 0.0f);
   EXPECT_FLOAT_EQ(p->last_observation()[2], 0.5f);
   // a route: pure pursuit towards a point straight ahead gives vx > 0, no yaw
-  twist->SetWaypoints({Eigen::Vector2d(3, 0)}, false);
+  AsWaypointTarget(*c)->SetWaypoints({Eigen::Vector2d(3, 0)}, false);
   for (int k = 0; k < 4; ++k) c->Compute(in, ctrl);
   EXPECT_GT(p->last_observation()[0], 0.0f);
   EXPECT_NEAR(p->last_observation()[2], 0.0f, 1e-6);

@@ -167,7 +167,7 @@ TEST(QuadrupedTrot, SetCommandOverridesTheScript) {
   Rig rig = MakeRig("quadruped", Ground::kFlat, Config("[{t: 0, vx: 0}]"));
   const Eigen::Vector3d p0 = Trunk(rig).translation();
   RunUntil(&rig, 0.5);
-  rig.gait->SetCommand({0.0, -0.3, 0.0});  // sideways to the right
+  rig.gait->SetTwist({0.0, -0.3, 0.0});  // sideways to the right
   RunUntil(&rig, 3.5);
   EXPECT_EQ(rig.gait->command().vy, -0.3);
   const Eigen::Vector3d p1 = Trunk(rig).translation();
@@ -175,7 +175,7 @@ TEST(QuadrupedTrot, SetCommandOverridesTheScript) {
               p1.y() - p0.y(), p1.x() - p0.x());
   EXPECT_NEAR(p1.y() - p0.y(), -0.9, 0.15);
   EXPECT_LT(std::abs(p1.x() - p0.x()), 0.1);
-  rig.gait->ClearCommand();  // back to the script: stand (trot in place)
+  rig.gait->ClearTwist();  // back to the script: stand (trot in place)
   RunUntil(&rig, 4.5);
   EXPECT_EQ(rig.gait->command().vy, 0.0);
   const Eigen::Vector3d p2 = Trunk(rig).translation();

@@ -122,7 +122,7 @@ TEST(QuadrupedWaypoints, CommandSourcesKeepTheirPrecedence) {
   EXPECT_NEAR(rig.gait->command().yaw_rate, 0.0, 0.05);
   // programmatic beats waypoints: walk backwards for 2 s, the route pauses (slewing from
   // +0.5 to -0.3 m/s takes 0.53 s: about -0.39 m in all)
-  rig.gait->SetCommand({-0.3, 0, 0});
+  rig.gait->SetTwist({-0.3, 0, 0});
   const double x1 = Trunk(rig).translation().x();
   RunUntil(&rig, 3.0);
   EXPECT_EQ(rig.gait->command().vx, -0.3);
@@ -131,7 +131,7 @@ TEST(QuadrupedWaypoints, CommandSourcesKeepTheirPrecedence) {
   EXPECT_LT(Trunk(rig).translation().x(), x1 - 0.25);
   EXPECT_EQ(rig.gait->route()->reached(), 0);
   // cleared: the route resumes and finishes, then the script turns the robot in place
-  rig.gait->ClearCommand();
+  rig.gait->ClearTwist();
   while (!rig.gait->route()->finished() && rig.sim.time() < 10.0) rig.sim.Step();
   ASSERT_TRUE(rig.gait->route()->finished());
   const double t_done = rig.sim.time();

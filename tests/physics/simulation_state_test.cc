@@ -86,7 +86,7 @@ TEST(SimulationState, RestoringMidRunRepeatsTheFollowingStepsBitForBit) {
   Simulation sim = LoadQuadruped();
   StepAndRecord(&sim, 301);  // lands, mid-way between two controller updates
   const SimState saved = sim.GetState();
-  EXPECT_EQ(saved.step_count, 301);
+  EXPECT_EQ(saved.step, 301);
   EXPECT_EQ(saved.time_sec, sim.time());
   const Trace first = StepAndRecord(&sim, 400);
   ASSERT_GT(first.max_contacts, 0u);  // the feet touch the floor
@@ -122,7 +122,7 @@ TEST(SimulationState, AStateOfAnotherModelIsRefusedNamingTheField) {
         << e.what();
   }
   s = sim.GetState();
-  s.step_count = 10;  // time_sec is that of step 0
+  s.step = 10;  // time_sec is that of step 0
   EXPECT_THROW(sim.SetState(s), Error);
   s.controller_next_update.clear();
   EXPECT_THROW(sim.SetState(s), Error);
@@ -150,7 +150,7 @@ TEST(SimulationState, ApplyMocapDriversPosesOnlyTheListedDrivenBodies) {
     return X;
   });
   SimState s = sim.GetState();
-  s.step_count = 100;
+  s.step = 100;
   s.time_sec = SimTimeOfStep(100, sim.timestep());
   s.mocap_pos = {7, 7, 7, 8, 8, 8};
   sim.SetState(s);

@@ -83,7 +83,7 @@ TEST(StateMap, TheSameLayoutCopiesEverything) {
   const StepRecord r = RecordOf(l, 42);
   SimState s = EmptyState(l);
   map.Apply(r, &s);
-  EXPECT_EQ(s.step_count, 42);
+  EXPECT_EQ(s.step, 42);
   EXPECT_EQ(s.time_sec, r.time_sec);
   EXPECT_EQ(s.qpos, r.qpos);
   EXPECT_EQ(s.qvel, r.qvel);

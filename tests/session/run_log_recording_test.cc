@@ -67,7 +67,7 @@ TEST(RunLogRecordingTest, RecordedStatesEqualAFreshSimulationsStateAtEveryStep) 
     // as the run's PhysicsSource did before its first snapshot (Simulation::RunDueControllers)
     if (r.step == 0) sim.RunDueControllers();
     const SimState s = sim.GetState();
-    ASSERT_EQ(r.step, s.step_count);
+    ASSERT_EQ(r.step, s.step);
     EXPECT_EQ(std::bit_cast<uint64_t>(r.time_sec), std::bit_cast<uint64_t>(s.time_sec));
     EXPECT_TRUE(SameBits(r.qpos, s.qpos)) << r.step;
     EXPECT_TRUE(SameBits(r.qvel, s.qvel)) << r.step;

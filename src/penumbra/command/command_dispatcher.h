@@ -7,15 +7,18 @@
 // exception. commands that change the simulation run through RunControl at a step boundary
 // (command/run_control.h), so lockstep runs stay deterministic.
 //
-// commands: hello, model_info, get_state, step, set_ctrl, twist, joint_targets, waypoints,
-// set_mocap, reset, pause, resume, set_realtime_factor, stop, and, through the run's
-// LiveControl (session/live_control.h), set_adversity, set_effect, start_recording and
-// stop_recording (not_available when the dispatcher has no LiveControl). transport-level
-// commands (the ZeroMQ bridge's `sync`) are the bridges' own.
+// commands: one table (Commands(): name, when it is carried out, whether it is logged, its
+// handler) that Dispatch looks a request's `cmd` up in; it equals the table of
+// docs/zmq-protocol.md "Commands" (tests/command/command_table_test.cc). the live commands
+// (set_adversity, set_effect, start_recording, stop_recording) go through the run's
+// LiveControl (session/live_control.h; not_available when the dispatcher has none).
+// transport-level commands (the ZeroMQ bridge's `sync`) are the bridges' own.
 
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "penumbra/command/command_error.h"
@@ -50,7 +53,28 @@ class CommandDispatcher {
   /// Dispatch and wait for the reply. not from the loop thread (it would wait for itself).
   nlohmann::json Call(const nlohmann::json& request);
 
-  /// the commands Dispatch knows, sorted.
+  /// when a command is carried out (docs/zmq-protocol.md "Commands", column "carried out").
+  enum class CommandTiming {
+    kNow,           ///< checked and answered at once, on the caller's thread
+    kStepBoundary,  ///< queued and carried out by the loop thread at the next step boundary
+    kLive,          ///< a live change (LiveControl), applied from the next step
+  };
+  /// one row of the command table.
+  struct CommandInfo {
+    std::string_view name;  ///< the request's `cmd`
+    CommandTiming timing;
+    /// it changes the simulation: recorded as a "command" event of the run's logs
+    /// (LiveControl::RecordCommand) once it ran.
+    bool logged = false;
+    /// checks the request's fields and replies or queues (throws CommandError).
+    void (CommandDispatcher::*handle)(const CommandInfo& info, RequestReader& rd,
+                                      const Done& done) = nullptr;
+  };
+  /// the command table, sorted by name.
+  static std::span<const CommandInfo> Commands();
+  /// the row of command `name`, or nullptr.
+  static const CommandInfo* FindCommand(std::string_view name);
+  /// the commands Dispatch knows, sorted (the names of Commands()).
   static std::vector<std::string> CommandNames();
   /// the `model_info` reply fields.
   const nlohmann::json& model_info() const { return model_info_; }
@@ -61,16 +85,37 @@ class CommandDispatcher {
   struct Target {
     int index = -1;
     std::string robot;
-    std::string type;
-    int joints = 0;  // joint_pd: joints in its command vectors
+    std::vector<std::string> commands;  // ControllerCommands (controller_capabilities.h)
+    int joints = 0;                     // JointTarget: joints in its command vectors
+    bool lateral = true;                // TwistTarget: can move sideways
+    std::string type;                   // Controller::type(), for messages
   };
-  // checks the fields of command `cmd` and replies or queues (throws CommandError)
-  void Handle(const std::string& cmd, RequestReader& rd, const Done& done);
-  // set_adversity, set_effect, start_recording, stop_recording (throws CommandError)
-  nlohmann::json HandleLive(const std::string& cmd, RequestReader& rd);
+  // the handlers of the command table (each checks its fields; throws CommandError)
+  void Hello(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void ModelInfo(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void GetState(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void Step(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void SetCtrl(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void Twist(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void JointTargets(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void Waypoints(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void SetMocap(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void Reset(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void PauseResume(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void SetRealtimeFactor(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void Stop(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void SetAdversity(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void SetEffect(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void StartRecording(const CommandInfo& info, RequestReader& rd, const Done& done);
+  void StopRecording(const CommandInfo& info, RequestReader& rd, const Done& done);
+  // checks that no unknown field is left and submits `action` to the run control
+  void Queue(const CommandInfo& info, RequestReader& rd, const Done& done,
+             RunControl::Action action);
+  // the run's live controls (throws not_available without them)
+  LiveControl& Live(const CommandInfo& info) const;
   // `action` that also records `request` as a "command" event of the run's logs (LiveControl::
-  // RecordCommand) once it ran, for the commands that change the simulation
-  RunControl::Action LoggedAction(const std::string& cmd, const nlohmann::json& request,
+  // RecordCommand) once it ran, for the commands that change the simulation (info.logged)
+  RunControl::Action LoggedAction(const CommandInfo& info, const nlohmann::json& request,
                                   RunControl::Action action) const;
   // the controller a controller command addresses (`robot` field, or the only one)
   const Target& FindTarget(RequestReader& rd, const std::string& command);

@@ -89,7 +89,7 @@ void RunControl::Reanchor(const Simulation& sim) {
 nlohmann::json RunControl::StateJson(const Simulation& sim) const {
   const SimState s = sim.GetState();
   const WorldSnapshot snap = sim.Snapshot(Simulation::SnapshotContent::kFull);
-  return {{"step", s.step_count},
+  return {{"step", s.step},
           {"time_sec", s.time_sec},
           {"qpos", s.qpos},
           {"qvel", s.qvel},

@@ -2,16 +2,10 @@
 
 #include <Eigen/Geometry>
 
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/joint_type_name.h"
 
 namespace penumbra {
-
-std::vector<std::string> ControllerCommands(const std::string& type) {
-  if (type == "trot_gait" || type == "policy" || type == "waypoint_follower")
-    return {"twist", "waypoints"};
-  if (type == "joint_pd") return {"joint_targets"};
-  return {};
-}
 
 std::string ControllerRobot(const Controller& controller) {
   const std::string& key = controller.context().key;
@@ -132,7 +126,7 @@ nlohmann::json DescribeRun(Session& session, const WorldConfig& world) {
     controllers.push_back({{"index", i},
                            {"robot", ControllerRobot(c)},
                            {"type", c.type()},
-                           {"commands", ControllerCommands(c.type())}});
+                           {"commands", ControllerCommands(c)}});
   }
   j["controllers"] = std::move(controllers);
   return j;

@@ -12,10 +12,7 @@
 
 namespace penumbra {
 
-/// the command names (docs/zmq-protocol.md) a controller of type `type` accepts: "twist" and
-/// "waypoints" for trot_gait, policy and waypoint_follower, "joint_targets" for joint_pd, none
-/// else.
-std::vector<std::string> ControllerCommands(const std::string& type);
+// the command names a controller accepts: ControllerCommands (control/controller_capabilities.h).
 
 /// the robot a controller belongs to, from its context key "robots[NAME].controller"
 /// ("" for a controller built in code).

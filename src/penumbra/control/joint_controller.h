@@ -38,21 +38,13 @@
 
 #include "penumbra/control/command_script.h"
 #include "penumbra/control/controller.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/joint_servo.h"
 
 namespace penumbra {
 
-/// a joint_pd command: one value per joint of the controller, in its joint order.
-struct JointCommand {
-  enum class Mode { kPosition, kVelocity, kEffort };
-  Mode mode = Mode::kPosition;
-  std::vector<double> values;  ///< (n) rad or m / rad/s or m/s / N m or N
-
-  static JointCommand Position(std::vector<double> q) { return {Mode::kPosition, std::move(q)}; }
-  static JointCommand Velocity(std::vector<double> qd) { return {Mode::kVelocity, std::move(qd)}; }
-  static JointCommand Effort(std::vector<double> tau) { return {Mode::kEffort, std::move(tau)}; }
-};
+// JointCommand and the JointTarget interface: control/controller_capabilities.h.
 
 /// parameters of a JointPdController (see the file comment).
 struct JointPdParams {
@@ -69,7 +61,7 @@ struct JointPdParams {
 };
 
 /// joint-space PD / velocity / effort controller (see the file comment).
-class JointPdController final : public Controller {
+class JointPdController final : public Controller, public JointTarget {
  public:
   /// @throws ConfigError if `params` are inconsistent.
   JointPdController(JointPdParams params, ControllerContext context);
@@ -86,7 +78,9 @@ class JointPdController final : public Controller {
                    double at_time_sec = -std::numeric_limits<double>::infinity());
   /// replaces every queued command by `command` (latest wins). thread-safe; throws as
   /// PushCommand.
-  void SetCommand(JointCommand command);
+  void SetCommand(JointCommand command) override;
+  /// the joints of the command vectors (params().servo.joints).
+  const std::vector<std::string>& command_joints() const override { return params_.servo.joints; }
 
   const JointPdParams& params() const { return params_; }
   /// the active mode and its command values (physics thread).

@@ -51,6 +51,7 @@
 #include <vector>
 
 #include "penumbra/control/controller.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/policy_action.h"
 #include "penumbra/control/policy_network.h"
@@ -92,7 +93,10 @@ struct PolicyParams {
 };
 
 /// the policy controller (see the file comment).
-class PolicyController final : public Controller, public TwistCommandable {
+class PolicyController final : public Controller,
+                               public TwistTarget,
+                               public WaypointTarget,
+                               public TerrainRayCasterUser {
  public:
   /// @throws ConfigError for inconsistent params.
   PolicyController(PolicyParams params, ControllerContext context);
@@ -111,14 +115,18 @@ class PolicyController final : public Controller, public TwistCommandable {
     out->insert(out->end(), tracking_.begin(), tracking_.end());
   }
 
-  void SetCommand(const TrotCommand& command) override { source_.SetCommand(command); }
-  void ClearCommand() override { source_.ClearCommand(); }
+  void SetTwist(const TrotCommand& command) override { source_.SetCommand(command); }
+  void ClearTwist() override { source_.ClearCommand(); }
+  /// a legged base moves sideways.
+  bool lateral() const override { return true; }
   void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) override;
 
   /// the terrain ray caster of height_scan terms (not owned; must outlive the controller).
-  void SetTerrainRayCaster(const TerrainRayCaster* caster) { observation_.SetRayCaster(caster); }
+  void SetTerrainRayCaster(const TerrainRayCaster* caster) override {
+    observation_.SetRayCaster(caster);
+  }
   /// whether an observation term casts rays onto the terrain.
-  bool needs_terrain_ray_caster() const { return observation_.needs_ray_caster(); }
+  bool needs_terrain_ray_caster() const override { return observation_.needs_ray_caster(); }
 
   const PolicyParams& params() const { return params_; }
   /// physics steps per policy update (valid after Initialize).

@@ -175,7 +175,7 @@ struct TrotGaitParams {
 };
 
 /// the trot gait controller (see the file comment).
-class TrotGait final : public Controller, public TwistCommandable {
+class TrotGait final : public Controller, public TwistTarget, public WaypointTarget {
  public:
   /// @throws ConfigError if `params` are out of range.
   TrotGait(TrotGaitParams params, ControllerContext context);
@@ -195,14 +195,16 @@ class TrotGait final : public Controller, public TwistCommandable {
   }
 
   /// programmatic command source (e.g. a middleware's cmd_vel): from the next update on,
-  /// `command` replaces the waypoints and the scripted list until ClearCommand() (the
+  /// `command` replaces the waypoints and the scripted list until ClearTwist() (the
   /// route pauses meanwhile). call it from the thread that steps the simulation, between
   /// steps.
-  void SetCommand(const TrotCommand& command) override { override_ = command; }
+  void SetTwist(const TrotCommand& command) override { override_ = command; }
   /// returns to the waypoints (if configured and not finished), else the script.
-  void ClearCommand() override { override_.reset(); }
+  void ClearTwist() override { override_.reset(); }
+  /// a legged base moves sideways.
+  bool lateral() const override { return true; }
   /// replaces the waypoints (world x, y, m; at least 1) with `loop` from the next update on
-  /// (waypoint mode, also for a gait configured without waypoints) and clears a SetCommand
+  /// (waypoint mode, also for a gait configured without waypoints) and clears a SetTwist
   /// override; speed, yaw-rate limit and tolerance stay. physics thread, between steps.
   /// @throws Error for an empty list or a non-finite coordinate.
   void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) override;

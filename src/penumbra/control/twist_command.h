@@ -1,9 +1,8 @@
 #pragma once
 // planar velocity commands for legged and wheeled base controllers: the twist (vx, vy forward /
-// left in the heading frame, m/s; yaw rate, rad/s), the interface through which the command bus
-// (command/command_dispatcher.h: the `twist` and `waypoints` requests of the ZeroMQ and ROS
-// bridges, the viewer's teleop and the navigation baseline) reaches a controller, and the
-// command source shared by controllers that take them (trot_gait's keys).
+// left in the heading frame, m/s; yaw rate, rad/s): the command source shared by controllers
+// that take them (trot_gait's keys). the command bus reaches such a controller through its
+// TwistTarget and WaypointTarget interfaces (control/controller_capabilities.h).
 //
 // world-file keys TwistCommandSource reads (inside the controller block):
 //   commands:                      # scripted twist, held from each t (s) to the next
@@ -25,39 +24,20 @@
 #include <optional>
 #include <vector>
 
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/waypoint_route.h"
 #include "penumbra/core/pose.h"
 
 namespace penumbra {
 
-/// a twist command in the robot's heading frame.
-struct TrotCommand {
-  double vx = 0;        ///< forward speed (m/s)
-  double vy = 0;        ///< leftward speed (m/s)
-  double yaw_rate = 0;  ///< rad/s, counter-clockwise seen from above
-};
+// TrotCommand (a twist) and the TwistTarget / WaypointTarget interfaces of the controllers
+// that take them: control/controller_capabilities.h.
 
 /// one scripted command, active from `t_sec` until the next entry.
 struct TimedTrotCommand {
   double t_sec = 0;
   TrotCommand command;
-};
-
-/// a controller that follows twist commands and waypoint routes. the command dispatcher
-/// (command/command_dispatcher.h) routes `twist` and `waypoints` requests to every controller
-/// implementing it. all three are called from the thread that steps the simulation, between
-/// steps, and take effect at the next control update.
-class TwistCommandable {
- public:
-  virtual ~TwistCommandable() = default;
-  /// `command` replaces the waypoints and the script until ClearCommand().
-  virtual void SetCommand(const TrotCommand& command) = 0;
-  /// returns to the waypoints (if any and not finished), else the script.
-  virtual void ClearCommand() = 0;
-  /// replaces the route (world x, y, m; at least 1) and clears a SetCommand override.
-  /// @throws Error for an empty list or a non-finite coordinate.
-  virtual void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) = 0;
 };
 
 /// the scripted commands and route of a controller block (see the file comment).

@@ -83,10 +83,14 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
   route_.Reset();
 }
 
-void WaypointFollower::SetTwist(double v_m_s, double yaw_rate) {
+void WaypointFollower::SetTwist(const TrotCommand& command) {
+  const double v_m_s = command.vx, yaw_rate = command.yaw_rate;
   if (!std::isfinite(v_m_s) || !std::isfinite(yaw_rate))
     throw Error(label() + ": twist must be finite (got v " + std::to_string(v_m_s) +
                 " m/s, yaw rate " + std::to_string(yaw_rate) + " rad/s)");
+  if (command.vy != 0)
+    throw Error(label() + ": a differential drive cannot move sideways; vy must be 0 (got " +
+                std::to_string(command.vy) + " m/s)");
   twist_ = std::array<double, 2>{v_m_s, yaw_rate};
 }
 

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "penumbra/control/controller.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/waypoint_route.h"
 
@@ -73,7 +74,7 @@ struct WaypointFollowerParams {
 };
 
 /// differential-drive waypoint follower (see the file comment).
-class WaypointFollower final : public Controller {
+class WaypointFollower final : public Controller, public TwistTarget, public WaypointTarget {
  public:
   /// @throws ConfigError if `params` are out of range.
   WaypointFollower(WaypointFollowerParams params, ControllerContext context);
@@ -93,17 +94,19 @@ class WaypointFollower final : public Controller {
   }
 
   /// programmatic twist (e.g. a middleware's cmd_vel): from the next update on, the robot
-  /// drives at forward speed `v_m_s` (m/s) and yaw rate `yaw_rate` (rad/s, counter-clockwise
-  /// seen from above) instead of following the route, until ClearTwist() (the route pauses
-  /// meanwhile). call from the thread that steps the simulation, between steps.
-  /// @throws Error for a non-finite value.
-  void SetTwist(double v_m_s, double yaw_rate);
+  /// drives at forward speed command.vx (m/s) and yaw rate command.yaw_rate (rad/s,
+  /// counter-clockwise seen from above) instead of following the route, until ClearTwist()
+  /// (the route pauses meanwhile). call from the thread that steps the simulation, between
+  /// steps. @throws Error for a non-finite value or vy != 0 (a differential drive).
+  void SetTwist(const TrotCommand& command) override;
   /// back to the route.
-  void ClearTwist() { twist_.reset(); }
+  void ClearTwist() override { twist_.reset(); }
+  /// a differential drive cannot move sideways.
+  bool lateral() const override { return false; }
   /// replaces the route by `waypoints` (world x, y, m; at least 1) with `loop`, from the next
   /// update on, and clears a twist; the tolerance, speed and yaw-rate limit stay. physics
   /// thread, between steps. @throws Error for an empty list or a non-finite coordinate.
-  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop);
+  void SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) override;
 
   const WaypointFollowerParams& params() const { return params_; }
   /// index of the waypoint being driven to.

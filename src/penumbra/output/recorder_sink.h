@@ -13,9 +13,6 @@
 
 namespace penumbra {
 
-/// the StepRecord of a snapshot's state (step, time and every state vector of WorldSnapshot).
-StepRecord StepRecordOf(const WorldSnapshot& snapshot);
-
 /// records every step of a run into a run log.
 class RecorderSink : public Sink {
  public:
@@ -43,7 +40,6 @@ class RecorderSink : public Sink {
  private:
   std::unique_ptr<RunLogWriter> writer_;
   int64_t last_step_ = -1;
-  StepRecord scratch_;  // the record appended, storage reused from step to step
 };
 
 }  // namespace penumbra

@@ -2,20 +2,17 @@
 
 #include <cstring>
 
+#include "penumbra/physics/mujoco_state.h"
+
 namespace penumbra {
 
 void CopyStateForForward(const mjModel* m, const mjData* live, mjData* d) {
   d->time = live->time;
-  std::memcpy(d->qpos, live->qpos, sizeof(mjtNum) * m->nq);
-  std::memcpy(d->qvel, live->qvel, sizeof(mjtNum) * m->nv);
-  std::memcpy(d->act, live->act, sizeof(mjtNum) * m->na);
-  std::memcpy(d->ctrl, live->ctrl, sizeof(mjtNum) * m->nu);
-  std::memcpy(d->qfrc_applied, live->qfrc_applied, sizeof(mjtNum) * m->nv);
-  std::memcpy(d->xfrc_applied, live->xfrc_applied, sizeof(mjtNum) * 6 * m->nbody);
-  std::memcpy(d->mocap_pos, live->mocap_pos, sizeof(mjtNum) * 3 * m->nmocap);
-  std::memcpy(d->mocap_quat, live->mocap_quat, sizeof(mjtNum) * 4 * m->nmocap);
-  std::memcpy(d->qacc_warmstart, live->qacc_warmstart, sizeof(mjtNum) * m->nv);
-  std::memcpy(d->userdata, live->userdata, sizeof(mjtNum) * m->nuserdata);
+  const StateDims dims = MujocoStateDims(m, 0);
+  for (const StateFieldInfo& f : kStateFields)
+    if (f.mujoco)
+      std::memcpy(MujocoStatePtr(d, f.field), MujocoStatePtr(live, f.field),
+                  sizeof(mjtNum) * StateFieldSize(f, dims));
 }
 
 void FillSensorGroundTruth(const mjModel* m, const mjData* d, WorldSnapshot* out) {

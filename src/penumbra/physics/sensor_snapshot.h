@@ -8,8 +8,8 @@
 
 namespace penumbra {
 
-/// copies everything mj_forward reads (time, qpos, qvel, act, ctrl, applied forces, mocap
-/// poses, solver warm start) from `live` into the scratch `scratch`.
+/// copies everything mj_forward reads (time and every MuJoCo field of the state table,
+/// scene/sim_state.h) from `live` into the scratch `scratch`.
 void CopyStateForForward(const mjModel* m, const mjData* live, mjData* scratch);
 
 /// fills out->sensordata, out->V_WB and out->contacts from `d` after mj_forward.

@@ -7,9 +7,11 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <type_traits>
 
 #include "penumbra/core/error.h"
 #include "penumbra/physics/mujoco_runtime.h"
+#include "penumbra/physics/mujoco_state.h"
 #include "penumbra/physics/scene_extractor.h"
 #include "penumbra/physics/sensor_snapshot.h"
 #include "penumbra/scene/scene_limits.h"
@@ -591,24 +593,28 @@ void Simulation::Step() {
 }
 
 SimState Simulation::GetState() const {
+  SimState s;
+  GetState(&s);
+  return s;
+}
+
+void Simulation::GetState(SimState* out) const {
   const mjModel* m = impl_->m;
   const mjData* d = impl_->d;
-  const auto copy = [](const mjtNum* x, int n) { return std::vector<double>(x, x + n); };
-  SimState s;
-  s.step_count = impl_->steps;
-  s.time_sec = d->time;
-  s.qpos = copy(d->qpos, m->nq);
-  s.qvel = copy(d->qvel, m->nv);
-  s.act = copy(d->act, m->na);
-  s.ctrl = copy(d->ctrl, m->nu);
-  s.qacc_warmstart = copy(d->qacc_warmstart, m->nv);
-  s.qfrc_applied = copy(d->qfrc_applied, m->nv);
-  s.xfrc_applied = copy(d->xfrc_applied, 6 * m->nbody);
-  s.mocap_pos = copy(d->mocap_pos, 3 * m->nmocap);
-  s.mocap_quat = copy(d->mocap_quat, 4 * m->nmocap);
-  s.userdata = copy(d->userdata, m->nuserdata);
-  for (const Impl::Schedule& sc : impl_->schedule) s.controller_next_update.push_back(sc.next);
-  return s;
+  const StateDims dims = MujocoStateDims(m, static_cast<int64_t>(impl_->schedule.size()));
+  out->step = impl_->steps;
+  out->time_sec = d->time;
+  ForEachStateField(
+      [&](const StateFieldInfo& f, auto& v) {
+        v.resize(StateFieldSize(f, dims));
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::vector<double>>) {
+          const mjtNum* src = MujocoStatePtr(d, f.field);
+          std::copy(src, src + v.size(), v.begin());
+        } else {
+          for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->schedule[i].next;
+        }
+      },
+      *out);
 }
 
 std::vector<std::string> Simulation::MocapBodyNames() const {
@@ -644,67 +650,31 @@ void Simulation::SetMocapPose(int mocap_id, const Pose& X_WB) {
   d->mocap_quat[4 * mocap_id + 3] = q.z();
 }
 
-void Simulation::SnapshotState(WorldSnapshot* out) const {
-  const mjModel* m = impl_->m;
-  const mjData* d = impl_->d;
-  out->time_sec = d->time;
-  out->step = impl_->steps;
-  out->qpos.assign(d->qpos, d->qpos + m->nq);
-  out->qvel.assign(d->qvel, d->qvel + m->nv);
-  out->act.assign(d->act, d->act + m->na);
-  out->ctrl.assign(d->ctrl, d->ctrl + m->nu);
-  out->qacc_warmstart.assign(d->qacc_warmstart, d->qacc_warmstart + m->nv);
-  out->qfrc_applied.assign(d->qfrc_applied, d->qfrc_applied + m->nv);
-  out->xfrc_applied.assign(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody);
-  out->mocap_pos.assign(d->mocap_pos, d->mocap_pos + 3 * m->nmocap);
-  out->mocap_quat.assign(d->mocap_quat, d->mocap_quat + 4 * m->nmocap);
-  out->userdata.assign(d->userdata, d->userdata + m->nuserdata);
-  out->controller_next_update.resize(impl_->schedule.size());
-  for (size_t i = 0; i < impl_->schedule.size(); ++i)
-    out->controller_next_update[i] = impl_->schedule[i].next;
-}
+void Simulation::SnapshotState(WorldSnapshot* out) const { GetState(out); }
 
 void Simulation::SetState(const SimState& s) {
   Impl& impl = *impl_;
   const mjModel* m = impl.m;
   mjData* d = impl.d;
-  const auto check = [&](const char* field, size_t got, size_t expected) {
-    if (got != expected)
-      throw Error(impl.source + ": SetState: " + field + " has " + std::to_string(got) +
-                  " entries; expected " + std::to_string(expected) + " for this model");
-  };
-  check("qpos", s.qpos.size(), m->nq);
-  check("qvel", s.qvel.size(), m->nv);
-  check("act", s.act.size(), m->na);
-  check("ctrl", s.ctrl.size(), m->nu);
-  check("qacc_warmstart", s.qacc_warmstart.size(), m->nv);
-  check("qfrc_applied", s.qfrc_applied.size(), m->nv);
-  check("xfrc_applied", s.xfrc_applied.size(), 6 * static_cast<size_t>(m->nbody));
-  check("mocap_pos", s.mocap_pos.size(), 3 * static_cast<size_t>(m->nmocap));
-  check("mocap_quat", s.mocap_quat.size(), 4 * static_cast<size_t>(m->nmocap));
-  check("userdata", s.userdata.size(), m->nuserdata);
-  check("controller_next_update", s.controller_next_update.size(), impl.schedule.size());
-  if (s.step_count < 0 || s.time_sec != SimTimeOfStep(s.step_count, m->opt.timestep))
+  const std::string bad =
+      StateSizeMismatch(s, MujocoStateDims(m, static_cast<int64_t>(impl.schedule.size())));
+  if (!bad.empty()) throw Error(impl.source + ": SetState: " + bad + " for this model");
+  if (s.step < 0 || s.time_sec != SimTimeOfStep(s.step, m->opt.timestep))
     throw Error(impl.source + ": SetState: time_sec " + FormatSeconds(s.time_sec) +
-                " is not the time of step " + std::to_string(s.step_count) + " (" +
-                FormatSeconds(SimTimeOfStep(s.step_count, m->opt.timestep)) + " s)");
-  const auto put = [](const std::vector<double>& x, mjtNum* out) {
-    if (!x.empty()) std::memcpy(out, x.data(), sizeof(mjtNum) * x.size());
-  };
+                " is not the time of step " + std::to_string(s.step) + " (" +
+                FormatSeconds(SimTimeOfStep(s.step, m->opt.timestep)) + " s)");
   d->time = s.time_sec;
-  put(s.qpos, d->qpos);
-  put(s.qvel, d->qvel);
-  put(s.act, d->act);
-  put(s.ctrl, d->ctrl);
-  put(s.qacc_warmstart, d->qacc_warmstart);
-  put(s.qfrc_applied, d->qfrc_applied);
-  put(s.xfrc_applied, d->xfrc_applied);
-  put(s.mocap_pos, d->mocap_pos);
-  put(s.mocap_quat, d->mocap_quat);
-  put(s.userdata, d->userdata);
-  for (size_t i = 0; i < impl.schedule.size(); ++i)
-    impl.schedule[i].next = s.controller_next_update[i];
-  impl.steps = s.step_count;
+  ForEachStateField(
+      [&](const StateFieldInfo& f, const auto& v) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::vector<double>>) {
+          if (!v.empty())
+            std::memcpy(MujocoStatePtr(d, f.field), v.data(), sizeof(mjtNum) * v.size());
+        } else {
+          for (size_t i = 0; i < v.size(); ++i) impl.schedule[i].next = v[i];
+        }
+      },
+      s);
+  impl.steps = s.step;
   impl.controllers_ran_at = -1;
   impl.failed = false;
   impl.failure.clear();

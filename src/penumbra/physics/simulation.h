@@ -36,37 +36,7 @@ namespace penumbra {
 
 // PhysicsRateHz and SimTimeOfStep (the time of each step): scene/sim_time.h.
 
-/// everything a bit-exact restart of a Simulation needs (Simulation::GetState / SetState),
-/// for MuJoCo 2.2.2: mj_step is a function of exactly these mjData fields (the set MuJoCo 3
-/// later named mjSTATE_INTEGRATION, less eq_active and plugin_state, which 2.2.2's mjData does
-/// not have) and of the model; every other mjData field is recomputed from them by the next
-/// step's mj_forward. qacc_warmstart is the constraint solver's starting point: without it the
-/// next contact solve starts elsewhere and the trajectory differs in the last bits.
-/// plus penumbra's own: the step count (time is SimTimeOfStep(step_count)) and each
-/// controller's next update (its schedule on sim time).
-///
-/// NOT included: the controllers' own memory (waypoint index, gait phase, integrators, ...).
-/// SetState restores physics and the controllers' schedule only; a restart is bit-exact for a
-/// simulation whose controllers keep no state between updates, or that has none. mocap
-/// drivers (AddMocapDriver) are pure functions of time and need nothing.
-/// vectors are MuJoCo's, in its order and units (sizes from the model: nq, nv, na, nu, nmocap,
-/// nuserdata, nbody).
-struct SimState {
-  int64_t step_count = 0;              ///< steps completed since loading
-  double time_sec = 0;                 ///< mjData time (SimTimeOfStep(step_count, timestep))
-  std::vector<double> qpos;            ///< (nq) joint positions
-  std::vector<double> qvel;            ///< (nv) joint velocities
-  std::vector<double> act;             ///< (na) actuator activations
-  std::vector<double> ctrl;            ///< (nu) controls
-  std::vector<double> qacc_warmstart;  ///< (nv) constraint solver warm start
-  std::vector<double> qfrc_applied;    ///< (nv) applied generalized forces
-  std::vector<double> xfrc_applied;    ///< (6 nbody) applied Cartesian wrenches
-  std::vector<double> mocap_pos;       ///< (3 nmocap) mocap body positions, m, world frame
-  std::vector<double> mocap_quat;      ///< (4 nmocap) mocap body orientations (w, x, y, z)
-  std::vector<double> userdata;        ///< (nuserdata) user data
-  /// (number of controllers) index of each controller's next update (see Controller::rate_hz)
-  std::vector<int64_t> controller_next_update;
-};
+// SimState (what GetState / SetState carry) and its field table: scene/sim_state.h.
 
 /// a MuJoCo simulation with pluggable controllers.
 class Simulation {
@@ -127,12 +97,14 @@ class Simulation {
 
   /// the current state (SimState: physics, step count, controller schedule).
   SimState GetState() const;
+  /// as GetState(), into `out`, reusing its vectors' storage.
+  void GetState(SimState* out) const;
   /// restores a state taken with GetState from a Simulation of the same model with the same
   /// number of controllers: the following steps are bit-identical to those that followed
   /// GetState (with stateless controllers; see SimState). also clears a PhysicsError, so a
   /// simulation can be restarted from a state before it failed.
   /// @throws Error naming the first field whose size does not match this model, or when
-  ///         time_sec is not SimTimeOfStep(step_count, timestep()); the state is unchanged then.
+  ///         time_sec is not SimTimeOfStep(step, timestep()); the state is unchanged then.
   void SetState(const SimState& state);
 
   /// poses the mocap bodies among `mocap_ids` (mocap ids, see MocapBodyNames) that have a
@@ -177,10 +149,8 @@ class Simulation {
     kFull,
   };
 
-  /// copies the current state into `out`'s state fields (time_sec, step, qpos, qvel, act,
-  /// ctrl, qacc_warmstart, qfrc_applied, xfrc_applied, mocap_pos, mocap_quat, userdata,
-  /// controller_next_update: the content of GetState), reusing their storage; other fields
-  /// are left as they are. Snapshot() does this too.
+  /// copies the current state into `out`'s SimState part (GetState(out)), reusing its
+  /// storage; the other fields are left as they are. Snapshot() does this too.
   void SnapshotState(WorldSnapshot* out) const;
 
   /// the world at the current time (see SnapshotContent).

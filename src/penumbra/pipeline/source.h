@@ -15,9 +15,8 @@ namespace penumbra {
 /// holds everything of a poorer one).
 enum class SnapshotContent {
   kNone = 0,  ///< no snapshot at this step
-  /// time_sec, step, qpos, qvel and, from live physics, the rest of the simulation state
-  /// (act, ctrl, qacc_warmstart, applied forces, mocap poses, userdata, controllers' schedule:
-  /// WorldSnapshot) (trajectory rows, recorders)
+  /// the snapshot's SimState part (scene/sim_state.h): time_sec, step, qpos, qvel and, from
+  /// live physics, every other field of the state table (trajectory rows, recorders)
   kState = 1,
   kPoses = 2,  ///< kState plus X_WB, X_W_mjcam, light poses (cameras, effects)
   kFull = 3,   ///< kPoses plus sensordata, V_WB, contacts, qfrc_actuator, tracking_error

@@ -33,7 +33,7 @@ namespace penumbra {
 namespace {
 
 // what entry i of a state field belongs to, from the log's layout
-std::string EntryOwner(const RunLogLayout& l, const std::string& field, int64_t i) {
+std::string EntryOwner(const RunLogLayout& l, StateField field, int64_t i) {
   const auto joint = [&](bool qpos) -> std::string {
     for (const RunLogJoint& j : l.joints) {
       const int adr = qpos ? j.qpos_adr : j.qvel_adr;
@@ -53,19 +53,32 @@ std::string EntryOwner(const RunLogLayout& l, const std::string& field, int64_t 
   static const char* const kWxyz[] = {"w", "x", "y", "z"};
   static const char* const kWrench[] = {"torque x", "torque y", "torque z",
                                         "force x",  "force y",  "force z"};
-  if (field == "qpos") return joint(true);
-  if (field == "qvel" || field == "qacc_warmstart" || field == "qfrc_applied") return joint(false);
-  if (field == "ctrl") return named(l.actuator_names, i, "actuator", 1, nullptr);
-  if (field == "act") return named(l.actuator_names, i + (l.nu - l.na), "actuator", 1, nullptr);
-  if (field == "xfrc_applied") return named(l.body_names, i, "body", 6, kWrench);
-  if (field == "mocap_pos") return named(l.mocap_body_names, i, "mocap body", 3, kXyz);
-  if (field == "mocap_quat") return named(l.mocap_body_names, i, "mocap body", 4, kWxyz);
-  if (field == "controller_next_update")
-    return named(l.controller_names, i, "controller", 1, nullptr);
+  // by what the field's entries index (its dimension), act being the last na actuators
+  if (field == StateField::kAct)
+    return named(l.actuator_names, i + (l.nu - l.na), "actuator", 1, nullptr);
+  switch (StateFieldOf(field).dim) {
+    case StateDim::kNq:
+      return joint(true);
+    case StateDim::kNv:
+      return joint(false);
+    case StateDim::kNu:
+      return named(l.actuator_names, i, "actuator", 1, nullptr);
+    case StateDim::kNbody:
+      return named(l.body_names, i, "body", 6, kWrench);
+    case StateDim::kNmocap:
+      return field == StateField::kMocapPos ? named(l.mocap_body_names, i, "mocap body", 3, kXyz)
+                                            : named(l.mocap_body_names, i, "mocap body", 4, kWxyz);
+    case StateDim::kNumControllers:
+      return named(l.controller_names, i, "controller", 1, nullptr);
+    case StateDim::kNa:
+    case StateDim::kNuserdata:
+      return "";
+  }
   return "";
 }
 
-bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+bool SameEntry(double a, double b) { return std::memcmp(&a, &b, sizeof(double)) == 0; }
+bool SameEntry(int64_t a, int64_t b) { return a == b; }
 
 // the first difference between the logged record and the simulated state, if any
 std::optional<Divergence> Compare(const StepRecord& r, const SimState& s, const RunLogLayout& l,
@@ -73,72 +86,43 @@ std::optional<Divergence> Compare(const StepRecord& r, const SimState& s, const 
   Divergence d;
   d.step = r.step;
   d.time_sec = r.time_sec;
-  if (r.step != s.step_count) {
+  if (r.step != s.step) {
     d.field = "step";
     d.logged = static_cast<double>(r.step);
-    d.simulated = static_cast<double>(s.step_count);
+    d.simulated = static_cast<double>(s.step);
     return d;
   }
-  if (!SameBits(r.time_sec, s.time_sec)) {
+  if (!SameEntry(r.time_sec, s.time_sec)) {
     d.field = "time_sec";
     d.logged = r.time_sec;
     d.simulated = s.time_sec;
     return d;
   }
-  const auto vec = [&](const char* field, const std::vector<double>& a,
-                       const std::vector<double>& b) -> bool {
-    if (a.size() != b.size()) {
-      d.field = std::string("size of ") + field;
-      d.logged = static_cast<double>(a.size());
-      d.simulated = static_cast<double>(b.size());
-      return true;
-    }
-    for (size_t i = 0; i < a.size(); ++i) {
-      if (SameBits(a[i], b[i])) continue;
-      d.field = field;
-      d.index = static_cast<int64_t>(i);
-      d.what = EntryOwner(l, field, d.index);
-      d.logged = a[i];
-      d.simulated = b[i];
-      return true;
-    }
-    return false;
-  };
-  if (vec("qpos", r.qpos, s.qpos) || vec("qvel", r.qvel, s.qvel) || vec("act", r.act, s.act) ||
-      vec("ctrl", r.ctrl, s.ctrl) || vec("qacc_warmstart", r.qacc_warmstart, s.qacc_warmstart) ||
-      vec("qfrc_applied", r.qfrc_applied, s.qfrc_applied) ||
-      vec("xfrc_applied", r.xfrc_applied, s.xfrc_applied) ||
-      vec("mocap_pos", r.mocap_pos, s.mocap_pos) || vec("mocap_quat", r.mocap_quat, s.mocap_quat) ||
-      vec("userdata", r.userdata, s.userdata))
-    return d;
-  if (check_schedule) {
-    const auto to_d = [](const std::vector<int64_t>& v) {
-      return std::vector<double>(v.begin(), v.end());
-    };
-    if (vec("controller_next_update", to_d(r.controller_next_update),
-            to_d(s.controller_next_update)))
-      return d;
-  }
+  bool found = false;
+  ForEachStateField(
+      [&](const StateFieldInfo& f, const auto& a, const auto& b) {
+        if (found || (f.field == StateField::kControllerNextUpdate && !check_schedule)) return;
+        if (a.size() != b.size()) {
+          d.field = "size of " + std::string(f.name);
+          d.logged = static_cast<double>(a.size());
+          d.simulated = static_cast<double>(b.size());
+          found = true;
+          return;
+        }
+        for (size_t i = 0; i < a.size(); ++i) {
+          if (SameEntry(a[i], b[i])) continue;
+          d.field = std::string(f.name);
+          d.index = static_cast<int64_t>(i);
+          d.what = EntryOwner(l, f.field, d.index);
+          d.logged = static_cast<double>(a[i]);
+          d.simulated = static_cast<double>(b[i]);
+          found = true;
+          return;
+        }
+      },
+      r, s);
+  if (found) return d;
   return std::nullopt;
-}
-
-// the simulated state a snapshot carries (PhysicsSource fills every state field)
-SimState StateOf(const WorldSnapshot& s) {
-  SimState st;
-  st.step_count = s.step;
-  st.time_sec = s.time_sec;
-  st.qpos = s.qpos;
-  st.qvel = s.qvel;
-  st.act = s.act;
-  st.ctrl = s.ctrl;
-  st.qacc_warmstart = s.qacc_warmstart;
-  st.qfrc_applied = s.qfrc_applied;
-  st.xfrc_applied = s.xfrc_applied;
-  st.mocap_pos = s.mocap_pos;
-  st.mocap_quat = s.mocap_quat;
-  st.userdata = s.userdata;
-  st.controller_next_update = s.controller_next_update;
-  return st;
 }
 
 // the log read in step with the simulation: before each step the record of that step is read
@@ -177,7 +161,7 @@ class LogCheck : public Sink {
   void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) override {
     if (snapshot->step <= last_checked_) return;
     last_checked_ = snapshot->step;
-    report_->divergence = Compare(record_, StateOf(*snapshot), layout_, controllers_);
+    report_->divergence = Compare(record_, *snapshot, layout_, controllers_);
     ++report_->steps_checked;
     report_->last_step = record_.step;
   }

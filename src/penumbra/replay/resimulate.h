@@ -1,9 +1,9 @@
 #pragma once
 // `penumbra replay FILE.plog --resimulate`: the recorded run simulated again from its recorded
 // world (replay/recorded_world.h, set up as `run` sets it up) and checked against the log at
-// EVERY step: step count, time, qpos, qvel, act, ctrl, qacc_warmstart, qfrc_applied,
-// xfrc_applied, mocap_pos, mocap_quat, userdata and (with controllers) controller_next_update,
-// compared bit for bit (the logged step 0 against the initial state too). it reports
+// EVERY step: step count, time and every vector of the state table (scene/sim_state.h
+// kStateFields; controller_next_update only with controllers), compared bit for bit (the
+// logged step 0 against the initial state too). it reports
 // "bit-exact (N steps)" only when every logged step was read from a CRC-valid chunk and compared
 // and the log ended with its end chunk; else the first divergent step, field and index with both
 // values, or the damage (the chunk and its steps) that left the rest of the log unverified.

@@ -24,17 +24,19 @@ bool SameJoints(const std::vector<RunLogJoint>& a, const std::vector<RunLogJoint
   return true;
 }
 
+// the same sizes (but the controllers', which are not mapped) and names
 bool SameLayout(const RunLogLayout& a, const RunLogLayout& b) {
-  return a.nq == b.nq && a.nv == b.nv && a.na == b.na && a.nu == b.nu && a.nmocap == b.nmocap &&
-         a.nuserdata == b.nuserdata && a.nbody == b.nbody && SameJoints(a.joints, b.joints) &&
-         a.actuator_names == b.actuator_names && a.mocap_body_names == b.mocap_body_names &&
-         a.body_names == b.body_names;
+  StateDims da = a.dims(), db = b.dims();
+  da[StateDim::kNumControllers] = db[StateDim::kNumControllers] = 0;
+  return da == db && SameJoints(a.joints, b.joints) && a.actuator_names == b.actuator_names &&
+         a.mocap_body_names == b.mocap_body_names && a.body_names == b.body_names;
 }
 
 template <typename T>
-void CheckSize(const char* field, const std::vector<T>& v, size_t expected, const char* side) {
-  if (v.size() != expected)
-    throw Error("replay state map: " + std::string(side) + " " + field + " has " +
+void CheckSize(std::string_view field, const std::vector<T>& v, int64_t expected,
+               const char* side) {
+  if (static_cast<int64_t>(v.size()) != expected)
+    throw Error("replay state map: " + std::string(side) + " " + std::string(field) + " has " +
                 std::to_string(v.size()) + " entries; expected " + std::to_string(expected));
 }
 
@@ -104,8 +106,8 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
            std::to_string(b.qvel_width) + "; the log records it as " + a.type +
            " with qpos width " + std::to_string(a.qpos_width) + " and qvel width " +
            std::to_string(a.qvel_width) + kFixed);
-    AddSpan(&qpos_, a.qpos_adr, b.qpos_adr, a.qpos_width);
-    AddSpan(&qvel_, a.qvel_adr, b.qvel_adr, a.qvel_width);
+    AddSpan(&Spans(StateDim::kNq), a.qpos_adr, b.qpos_adr, a.qpos_width);
+    AddSpan(&Spans(StateDim::kNv), a.qvel_adr, b.qvel_adr, a.qvel_width);
   }
   for (size_t j = 0; j < model.joints.size(); ++j)
     if (!model_joint_seen[j])
@@ -121,14 +123,14 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
            " that the log records" + kFixed);
     const int b = act_to[i];
     model_act_seen[b] = 1;
-    AddSpan(&ctrl_, static_cast<int>(i), b, 1);
+    AddSpan(&Spans(StateDim::kNu), static_cast<int>(i), b, 1);
     const int log_act = static_cast<int>(i) - (log.nu - log.na);
     const int model_act = b - (model.nu - model.na);
     if ((log_act >= 0) != (model_act >= 0))
       fail("the replay model's " + Quoted(log.actuator_names[i], "actuator", i) +
            (model_act >= 0 ? " has" : " has no") + " activation state; the log records it " +
            (log_act >= 0 ? "with" : "without") + " one" + kFixed);
-    if (log_act >= 0) AddSpan(&act_, log_act, model_act, 1);
+    if (log_act >= 0) AddSpan(&Spans(StateDim::kNa), log_act, model_act, 1);
   }
   for (size_t a = 0; a < model.actuator_names.size(); ++a)
     if (!model_act_seen[a])
@@ -138,6 +140,7 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
   if (log.nuserdata != model.nuserdata)
     fail("the replay model has " + std::to_string(model.nuserdata) +
          " userdata entries; the log records " + std::to_string(log.nuserdata) + kFixed);
+  AddSpan(&Spans(StateDim::kNuserdata), 0, 0, log.nuserdata);
 
   // mocap bodies: logged ones follow the log, the model's others keep their drivers
   const std::vector<int> mocap_to = MatchNames(log.mocap_body_names, model.mocap_body_names);
@@ -149,8 +152,7 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
       continue;
     }
     model_mocap_seen[b] = 1;
-    AddSpan(&mocap_pos_, 3 * static_cast<int>(i), 3 * b, 3);
-    AddSpan(&mocap_quat_, 4 * static_cast<int>(i), 4 * b, 4);
+    AddSpan(&Spans(StateDim::kNmocap), static_cast<int>(i), b, 1);
   }
   for (size_t b = 0; b < model.mocap_body_names.size(); ++b)
     if (!model_mocap_seen[b]) unlogged_mocap_.push_back(static_cast<int>(b));
@@ -158,48 +160,36 @@ StateMap::StateMap(const RunLogLayout& log, const RunLogLayout& model, const std
   // applied wrenches per body
   const std::vector<int> body_to = MatchNames(log.body_names, model.body_names);
   for (size_t i = 0; i < log.body_names.size(); ++i)
-    if (body_to[i] >= 0) AddSpan(&xfrc_, 6 * static_cast<int>(i), 6 * body_to[i], 6);
+    if (body_to[i] >= 0) AddSpan(&Spans(StateDim::kNbody), static_cast<int>(i), body_to[i], 1);
 }
 
 void StateMap::Apply(const StepRecord& r, SimState* s) const {
-  CheckSize("qpos", r.qpos, log_.nq, "logged");
-  CheckSize("qvel", r.qvel, log_.nv, "logged");
-  CheckSize("act", r.act, log_.na, "logged");
-  CheckSize("ctrl", r.ctrl, log_.nu, "logged");
-  CheckSize("qacc_warmstart", r.qacc_warmstart, log_.nv, "logged");
-  CheckSize("qfrc_applied", r.qfrc_applied, log_.nv, "logged");
-  CheckSize("xfrc_applied", r.xfrc_applied, 6 * static_cast<size_t>(log_.nbody), "logged");
-  CheckSize("mocap_pos", r.mocap_pos, 3 * static_cast<size_t>(log_.nmocap), "logged");
-  CheckSize("mocap_quat", r.mocap_quat, 4 * static_cast<size_t>(log_.nmocap), "logged");
-  CheckSize("userdata", r.userdata, log_.nuserdata, "logged");
-  CheckSize("qpos", s->qpos, model_.nq, "replay");
-  CheckSize("qvel", s->qvel, model_.nv, "replay");
-  CheckSize("act", s->act, model_.na, "replay");
-  CheckSize("ctrl", s->ctrl, model_.nu, "replay");
-  CheckSize("qacc_warmstart", s->qacc_warmstart, model_.nv, "replay");
-  CheckSize("qfrc_applied", s->qfrc_applied, model_.nv, "replay");
-  CheckSize("xfrc_applied", s->xfrc_applied, 6 * static_cast<size_t>(model_.nbody), "replay");
-  CheckSize("mocap_pos", s->mocap_pos, 3 * static_cast<size_t>(model_.nmocap), "replay");
-  CheckSize("mocap_quat", s->mocap_quat, 4 * static_cast<size_t>(model_.nmocap), "replay");
-  CheckSize("userdata", s->userdata, model_.nuserdata, "replay");
-
-  const auto copy = [](const std::vector<Span>& spans, const std::vector<double>& src,
-                       std::vector<double>* dst) {
-    for (const Span& sp : spans)
-      std::copy_n(src.begin() + sp.src, sp.length, dst->begin() + sp.dst);
+  // every field but the controllers' schedule, which is not mapped
+  const StateDims log_dims = log_.dims(), model_dims = model_.dims();
+  const auto mapped = [](const StateFieldInfo& f) {
+    return f.field != StateField::kControllerNextUpdate;
   };
-  s->step_count = r.step;
+  ForEachStateField(
+      [&](const StateFieldInfo& f, const auto& v) {
+        if (mapped(f)) CheckSize(f.name, v, StateFieldSize(f, log_dims), "logged");
+      },
+      r);
+  ForEachStateField(
+      [&](const StateFieldInfo& f, const auto& v) {
+        if (mapped(f)) CheckSize(f.name, v, StateFieldSize(f, model_dims), "replay");
+      },
+      *s);
+  s->step = r.step;
   s->time_sec = r.time_sec;
-  copy(qpos_, r.qpos, &s->qpos);
-  copy(qvel_, r.qvel, &s->qvel);
-  copy(qvel_, r.qacc_warmstart, &s->qacc_warmstart);
-  copy(qvel_, r.qfrc_applied, &s->qfrc_applied);
-  copy(ctrl_, r.ctrl, &s->ctrl);
-  copy(act_, r.act, &s->act);
-  copy(xfrc_, r.xfrc_applied, &s->xfrc_applied);
-  copy(mocap_pos_, r.mocap_pos, &s->mocap_pos);
-  copy(mocap_quat_, r.mocap_quat, &s->mocap_quat);
-  s->userdata = r.userdata;
+  ForEachStateField(
+      [&](const StateFieldInfo& f, auto& dst, const auto& src) {
+        if (!mapped(f)) return;
+        // spans count units of the field's dimension (a joint's coordinates, a body)
+        for (const Span& sp : spans_[static_cast<size_t>(f.dim)])
+          std::copy_n(src.begin() + int64_t{f.per} * sp.src, int64_t{f.per} * sp.length,
+                      dst.begin() + int64_t{f.per} * sp.dst);
+      },
+      *s, r);
 }
 
 }  // namespace penumbra

@@ -6,9 +6,9 @@
 // can move. the rules:
 //
 //   joints         every joint of the log must be in the replay model with the same type and
-//                  widths, and every joint of the replay model must be in the log: qpos, qvel,
-//                  qacc_warmstart and qfrc_applied are copied joint by joint. a missing joint
-//                  or a changed width is an error naming it (robots and models cannot change
+//                  widths, and every joint of the replay model must be in the log: qpos and
+//                  every field of size nv (scene/sim_state.h) are copied joint by joint. a missing
+//                  joint or a changed width is an error naming it (robots and models cannot change
 //                  in a replay).
 //   actuators      the same, for ctrl and act (MuJoCo 2.2.2 keeps act[i] for actuator
 //                  nu - na + i, the stateful actuators last).
@@ -24,6 +24,7 @@
 // the same kind. the controllers' schedule (controller_next_update) is not mapped: a kinematic
 // replay runs no controllers.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -65,7 +66,10 @@ class StateMap {
   static void AddSpan(std::vector<Span>* spans, int src, int dst, int length);
 
   RunLogLayout log_, model_;
-  std::vector<Span> qpos_, qvel_, ctrl_, act_, xfrc_, mocap_pos_, mocap_quat_;
+  std::vector<Span>& Spans(StateDim dim) { return spans_[static_cast<size_t>(dim)]; }
+  // the copy plan per state dimension, in its units (a field of `per` entries per unit copies
+  // per * length entries); the controllers' dimension stays empty (not mapped)
+  std::array<std::vector<Span>, kNumStateDims> spans_;
   std::vector<int> unlogged_mocap_;
   std::vector<std::string> dropped_mocap_;
   bool identity_ = false;

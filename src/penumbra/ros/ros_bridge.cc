@@ -10,7 +10,7 @@
 #include <mutex>
 
 #include "penumbra/command/command_dispatcher.h"
-#include "penumbra/control/joint_controller.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros1_node.h"
 #include "penumbra/ros/ros_convert.h"
@@ -198,10 +198,10 @@ class RosBridge : public RunBridge {
       // the joint order of the robot's joint_pd controller, to map names
       std::vector<std::string> joints;
       for (int i = 0; i < sim.num_controllers(); ++i)
-        if (const auto* pd = dynamic_cast<const JointPdController*>(&sim.controller(i)))
-          if (pd->params().servo.joints.size() > 0 &&
-              pd->params().servo.joints.front().rfind(robot + "/", 0) == 0)
-            joints = pd->params().servo.joints;
+        if (const JointTarget* joint_target = AsJointTarget(sim.controller(i)))
+          if (!joint_target->command_joints().empty() &&
+              joint_target->command_joints().front().rfind(robot + "/", 0) == 0)
+            joints = joint_target->command_joints();
       node_->SubscribeJointState(r.joint_commands_topic, [this, robot,
                                                           joints](const RosJointState& m) {
         const char* mode = !m.position.empty()   ? "position"

@@ -326,7 +326,7 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     const double dt = sim.timestep();
     auto snapshot_of = [&](size_t row) {
       const int64_t step = std::llround(traj.Number(row, 0));
-      state.step_count = step;
+      state.step = step;
       state.time_sec = SimTimeOfStep(step, dt);
       if (traj.rows[row].size() != 2 + nq)
         throw ConfigError(trajectory.string(), traj.lines[row], "",

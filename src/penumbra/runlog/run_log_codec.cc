@@ -52,8 +52,8 @@ void EncodeField(const std::vector<T>& v, const std::vector<T>* prev, std::strin
 
 // `expected` < 0: any count up to kMaxLayoutEntries (no layout to check against)
 template <typename T>
-void DecodeField(BodyReader* in, const std::vector<T>* prev, const char* name, int64_t expected,
-                 std::vector<T>* out) {
+void DecodeField(BodyReader* in, const std::vector<T>* prev, std::string_view name,
+                 int64_t expected, std::vector<T>* out) {
   const uint8_t enc = in->U8();
   const uint32_t n = in->U32();
   if (expected >= 0 && n != static_cast<uint64_t>(expected))
@@ -201,63 +201,56 @@ void BodyReader::Fail(const std::string& problem) const {
 void EncodeStep(const StepRecord& r, const StepRecord* prev, std::string* body) {
   PutI64(body, r.step);
   PutF64(body, r.time_sec);
-  const StepRecord* p = prev;
-  // fields in file order; each against the same field of the previous record
-  auto enc = [&](const auto& v, const auto& pv) { EncodeField(v, p ? &pv : nullptr, body); };
-  enc(r.qpos, p ? p->qpos : r.qpos);
-  enc(r.qvel, p ? p->qvel : r.qvel);
-  enc(r.act, p ? p->act : r.act);
-  enc(r.ctrl, p ? p->ctrl : r.ctrl);
-  enc(r.qacc_warmstart, p ? p->qacc_warmstart : r.qacc_warmstart);
-  enc(r.qfrc_applied, p ? p->qfrc_applied : r.qfrc_applied);
-  enc(r.xfrc_applied, p ? p->xfrc_applied : r.xfrc_applied);
-  enc(r.mocap_pos, p ? p->mocap_pos : r.mocap_pos);
-  enc(r.mocap_quat, p ? p->mocap_quat : r.mocap_quat);
-  enc(r.userdata, p ? p->userdata : r.userdata);
-  enc(r.controller_next_update, p ? p->controller_next_update : r.controller_next_update);
+  // fields in table order (the file order); each against the same field of the previous record
+  if (prev) {
+    ForEachStateField(
+        [&](const StateFieldInfo&, const auto& v, const auto& pv) { EncodeField(v, &pv, body); }, r,
+        *prev);
+  } else {
+    ForEachStateField(
+        [&](const StateFieldInfo&, const auto& v) {
+          EncodeField(v, static_cast<const std::decay_t<decltype(v)>*>(nullptr), body);
+        },
+        r);
+  }
 }
 
 void DecodeStep(BodyReader* in, const StepRecord* prev, StepRecord* out,
                 const RunLogLayout* layout) {
   out->step = in->I64();
   out->time_sec = in->F64();
-  const StepRecord* p = prev;
   // entries each field must have (-1: no layout given)
-  auto want = [&](int count, int per) -> int64_t { return layout ? int64_t{count} * per : -1; };
-  const RunLogLayout l = layout ? *layout : RunLogLayout{};
-  DecodeField(in, p ? &p->qpos : nullptr, "qpos", want(l.nq, 1), &out->qpos);
-  DecodeField(in, p ? &p->qvel : nullptr, "qvel", want(l.nv, 1), &out->qvel);
-  DecodeField(in, p ? &p->act : nullptr, "act", want(l.na, 1), &out->act);
-  DecodeField(in, p ? &p->ctrl : nullptr, "ctrl", want(l.nu, 1), &out->ctrl);
-  DecodeField(in, p ? &p->qacc_warmstart : nullptr, "qacc_warmstart", want(l.nv, 1),
-              &out->qacc_warmstart);
-  DecodeField(in, p ? &p->qfrc_applied : nullptr, "qfrc_applied", want(l.nv, 1),
-              &out->qfrc_applied);
-  DecodeField(in, p ? &p->xfrc_applied : nullptr, "xfrc_applied", want(l.nbody, 6),
-              &out->xfrc_applied);
-  DecodeField(in, p ? &p->mocap_pos : nullptr, "mocap_pos", want(l.nmocap, 3), &out->mocap_pos);
-  DecodeField(in, p ? &p->mocap_quat : nullptr, "mocap_quat", want(l.nmocap, 4), &out->mocap_quat);
-  DecodeField(in, p ? &p->userdata : nullptr, "userdata", want(l.nuserdata, 1), &out->userdata);
-  DecodeField(in, p ? &p->controller_next_update : nullptr, "controller_next_update",
-              want(l.num_controllers, 1), &out->controller_next_update);
+  const StateDims dims = layout ? layout->dims() : StateDims{};
+  const auto want = [&](const StateFieldInfo& f) -> int64_t {
+    return layout ? StateFieldSize(f, dims) : -1;
+  };
+  if (prev) {
+    ForEachStateField([&](const StateFieldInfo& f, auto& v,
+                          const auto& pv) { DecodeField(in, &pv, f.name, want(f), &v); },
+                      *out, *prev);
+  } else {
+    ForEachStateField(
+        [&](const StateFieldInfo& f, auto& v) {
+          DecodeField(in, static_cast<const std::decay_t<decltype(v)>*>(nullptr), f.name, want(f),
+                      &v);
+        },
+        *out);
+  }
 }
 
 uint64_t StepRecordMemoryBytes(const RunLogLayout& l) {
-  const uint64_t entries = uint64_t(l.nq) + 3 * uint64_t(l.nv) + uint64_t(l.na) + uint64_t(l.nu) +
-                           6 * uint64_t(l.nbody) + 7 * uint64_t(l.nmocap) + uint64_t(l.nuserdata) +
-                           uint64_t(l.num_controllers);
+  const StateDims dims = l.dims();
+  uint64_t entries = 0;
+  for (const StateFieldInfo& f : kStateFields) entries += uint64_t(StateFieldSize(f, dims));
   return sizeof(StepRecord) + 8 * entries;
 }
 
 std::string CheckLayout(const RunLogLayout& l) {
-  const std::pair<const char*, int> counts[] = {
-      {"nq", l.nq},         {"nv", l.nv},
-      {"na", l.na},         {"nu", l.nu},
-      {"nmocap", l.nmocap}, {"nuserdata", l.nuserdata},
-      {"nbody", l.nbody},   {"num_controllers", l.num_controllers}};
-  for (const auto& [name, n] : counts)
-    if (n < 0 || n > kMaxLayoutEntries)
-      return fmt::format("layout.{} is {}; expected 0 to {}", name, n, kMaxLayoutEntries);
+  const StateDims dims = l.dims();
+  for (int i = 0; i < kNumStateDims; ++i)
+    if (dims.n[i] < 0 || dims.n[i] > kMaxLayoutEntries)
+      return fmt::format("layout.{} is {}; expected 0 to {}", kStateDimNames[i], dims.n[i],
+                         kMaxLayoutEntries);
   for (size_t i = 0; i < l.joints.size(); ++i) {
     const RunLogJoint& j = l.joints[i];
     if (j.qpos_adr < 0 || j.qpos_width < 0 || int64_t{j.qpos_adr} + j.qpos_width > l.nq)
@@ -321,19 +314,13 @@ std::string HeaderToJson(const RunLogHeader& h) {
                       {"qvel_adr", j.qvel_adr},
                       {"qvel_width", j.qvel_width}});
   const RunLogLayout& l = h.layout;
-  json layout = {{"nq", l.nq},
-                 {"nv", l.nv},
-                 {"na", l.na},
-                 {"nu", l.nu},
-                 {"nmocap", l.nmocap},
-                 {"nuserdata", l.nuserdata},
-                 {"nbody", l.nbody},
-                 {"num_controllers", l.num_controllers},
-                 {"joints", joints},
+  json layout = {{"joints", joints},
                  {"actuator_names", l.actuator_names},
                  {"mocap_body_names", l.mocap_body_names},
                  {"body_names", l.body_names},
                  {"controller_names", l.controller_names}};
+  const StateDims dims = l.dims();
+  for (int i = 0; i < kNumStateDims; ++i) layout[std::string(kStateDimNames[i])] = dims.n[i];
   json j = {{"format_version", h.format_version},
             {"penumbra_version", h.penumbra_version},
             {"mujoco_version", h.mujoco_version},
@@ -416,14 +403,13 @@ RunLogHeader HeaderFromJson(std::string_view text) {
   }
   RunLogLayout& l = h.layout;
   const char* w = "layout: ";
-  get(layout, "nq", &l.nq, w);
-  get(layout, "nv", &l.nv, w);
-  get(layout, "na", &l.na, w);
-  get(layout, "nu", &l.nu, w);
-  get(layout, "nmocap", &l.nmocap, w);
-  get(layout, "nuserdata", &l.nuserdata, w);
-  get(layout, "nbody", &l.nbody, w);
-  get(layout, "num_controllers", &l.num_controllers, w);
+  StateDims dims;
+  for (int i = 0; i < kNumStateDims; ++i) {
+    int n = 0;
+    get(layout, std::string(kStateDimNames[i]).c_str(), &n, w);
+    dims.n[i] = n;
+  }
+  l.set_dims(dims);
   get(layout, "actuator_names", &l.actuator_names, w);
   get(layout, "mocap_body_names", &l.mocap_body_names, w);
   get(layout, "body_names", &l.body_names, w);

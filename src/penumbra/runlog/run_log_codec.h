@@ -54,7 +54,7 @@ inline constexpr int kMaxLayoutEntries = 1 << 22;
 /// count times StepRecordMemoryBytes(layout). the writer closes steps chunks at half of it.
 inline constexpr uint64_t kMaxChunkDecodedBytes = uint64_t{512} << 20;
 /// bytes of the smallest record of each kind in a body (all strings and fields empty).
-inline constexpr uint64_t kMinStepRecordBytes = 16 + 11 * 5;
+inline constexpr uint64_t kMinStepRecordBytes = 16 + uint64_t{kNumStateFields} * 5;
 inline constexpr uint64_t kMinEventRecordBytes = 16 + 4 + 8;
 inline constexpr uint64_t kMinSensorRecordBytes = 16 + 4 + 4 + 8;
 

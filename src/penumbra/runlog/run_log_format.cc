@@ -30,7 +30,24 @@ std::string Sha256With(Feed&& feed) {
   return hex;
 }
 
+// the counts of RunLogLayout by StateDim (kStateDimNames order)
+constexpr std::array<int RunLogLayout::*, kNumStateDims> kLayoutCounts = {
+    &RunLogLayout::nq,     &RunLogLayout::nv,
+    &RunLogLayout::na,     &RunLogLayout::nu,
+    &RunLogLayout::nmocap, &RunLogLayout::nuserdata,
+    &RunLogLayout::nbody,  &RunLogLayout::num_controllers};
+
 }  // namespace
+
+StateDims RunLogLayout::dims() const {
+  StateDims d;
+  for (int i = 0; i < kNumStateDims; ++i) d.n[i] = this->*kLayoutCounts[i];
+  return d;
+}
+
+void RunLogLayout::set_dims(const StateDims& d) {
+  for (int i = 0; i < kNumStateDims; ++i) this->*kLayoutCounts[i] = static_cast<int>(d.n[i]);
+}
 
 std::string_view RunLogChunkKindName(RunLogChunkKind kind) {
   switch (kind) {

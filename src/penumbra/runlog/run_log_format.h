@@ -7,9 +7,10 @@
 // in-memory types the writer (runlog/run_log_writer.h) takes and the reader
 // (runlog/run_log_reader.h) returns, and the format constants.
 //
-// this module depends on core only: it knows nothing of MuJoCo, the pipeline or snapshots.
-// the vectors of a StepRecord are MuJoCo's, in its order and units; their sizes are those of
-// RunLogLayout (the same content as physics/simulation.h SimState).
+// this module depends on core and scene/sim_state.h only: it knows nothing of MuJoCo, the
+// pipeline or snapshots. a StepRecord is a SimState (scene/sim_state.h): its vectors are
+// MuJoCo's, in its order and units; their sizes are those of RunLogLayout (dims()), and the
+// codec writes and reads them in kStateFields order.
 
 #include <array>
 #include <cstdint>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/sim_state.h"
 
 namespace penumbra {
 
@@ -44,7 +46,7 @@ struct RunLogJoint {
   std::string type;    ///< "free", "ball", "slide" or "hinge"
   int qpos_adr = 0;    ///< first index in qpos
   int qpos_width = 0;  ///< entries in qpos (free 7, ball 4, slide/hinge 1)
-  int qvel_adr = 0;    ///< first index in qvel (and qacc_warmstart, qfrc_applied)
+  int qvel_adr = 0;    ///< first index in qvel (and every other field of size nv)
   int qvel_width = 0;  ///< entries in qvel (free 6, ball 3, slide/hinge 1)
 };
 
@@ -52,7 +54,7 @@ struct RunLogJoint {
 /// joint's, actuator's or body's values by name without the model.
 struct RunLogLayout {
   int nq = 0;               ///< size of qpos
-  int nv = 0;               ///< size of qvel, qacc_warmstart, qfrc_applied
+  int nv = 0;               ///< degrees of freedom (size of qvel and the other nv fields)
   int na = 0;               ///< size of act
   int nu = 0;               ///< size of ctrl
   int nmocap = 0;           ///< mocap bodies (mocap_pos has 3 nmocap entries, mocap_quat 4 nmocap)
@@ -64,6 +66,11 @@ struct RunLogLayout {
   std::vector<std::string> mocap_body_names;  ///< (nmocap) by mocap id
   std::vector<std::string> body_names;        ///< (nbody) by body id (0 = "world")
   std::vector<std::string> controller_names;  ///< (num_controllers) e.g. "go1: trot_gait"
+
+  /// the counts above as the state table's dimensions (scene/sim_state.h).
+  StateDims dims() const;
+  /// sets the counts above from `dims`.
+  void set_dims(const StateDims& dims);
 };
 
 /// a file the run read and its content hash (lowercase hex SHA-256 of its bytes).
@@ -101,24 +108,10 @@ struct RunLogHeader {
   std::string adversity;
 };
 
-/// the simulation state after `step` steps (physics/simulation.h SimState): vectors in
-/// MuJoCo's order and units, sizes from RunLogLayout (n = 0 entries allowed for an empty
-/// model part).
-struct StepRecord {
-  int64_t step = 0;                    ///< steps completed since loading (0 = initial state)
-  double time_sec = 0;                 ///< sim time, s
-  std::vector<double> qpos;            ///< (nq)
-  std::vector<double> qvel;            ///< (nv)
-  std::vector<double> act;             ///< (na)
-  std::vector<double> ctrl;            ///< (nu)
-  std::vector<double> qacc_warmstart;  ///< (nv)
-  std::vector<double> qfrc_applied;    ///< (nv) N or N m per dof
-  std::vector<double> xfrc_applied;    ///< (6 nbody) torque, force per body, world frame
-  std::vector<double> mocap_pos;       ///< (3 nmocap) m, world frame
-  std::vector<double> mocap_quat;      ///< (4 nmocap) w, x, y, z
-  std::vector<double> userdata;        ///< (nuserdata)
-  std::vector<int64_t> controller_next_update;  ///< (num_controllers) step of next update
-};
+/// the simulation state after `step` steps: a SimState (scene/sim_state.h), vectors in
+/// MuJoCo's order and units, sizes from RunLogLayout::dims() (n = 0 entries allowed for an
+/// empty model part).
+using StepRecord = SimState;
 
 /// something that happened at a step besides the state: a command a bridge received, an
 /// effect parameter change, a note. kind is free text ("command", "effect", "note", ...);

@@ -55,13 +55,6 @@ struct OpenChunk {
   }
 };
 
-void CheckSize(const std::string& path, int64_t step, const char* field, size_t got, int expected) {
-  if (got != static_cast<size_t>(expected))
-    throw RunLogError(
-        fmt::format("run log {}: step {}: {} has {} entries; the header's layout says {}", path,
-                    step, field, got, expected));
-}
-
 }  // namespace
 
 void RunLogWriterOptions::ValidateOrThrow() const {
@@ -268,18 +261,15 @@ void RunLogWriter::Append(const StepRecord& r) {
     throw RunLogError(fmt::format("run log {}: step {} appended after step {}; steps must increase",
                                   m.path, r.step, m.last_step));
   const RunLogLayout& l = m.header.layout;
-  CheckSize(m.path, r.step, "qpos", r.qpos.size(), l.nq);
-  CheckSize(m.path, r.step, "qvel", r.qvel.size(), l.nv);
-  CheckSize(m.path, r.step, "act", r.act.size(), l.na);
-  CheckSize(m.path, r.step, "ctrl", r.ctrl.size(), l.nu);
-  CheckSize(m.path, r.step, "qacc_warmstart", r.qacc_warmstart.size(), l.nv);
-  CheckSize(m.path, r.step, "qfrc_applied", r.qfrc_applied.size(), l.nv);
-  CheckSize(m.path, r.step, "xfrc_applied", r.xfrc_applied.size(), 6 * l.nbody);
-  CheckSize(m.path, r.step, "mocap_pos", r.mocap_pos.size(), 3 * l.nmocap);
-  CheckSize(m.path, r.step, "mocap_quat", r.mocap_quat.size(), 4 * l.nmocap);
-  CheckSize(m.path, r.step, "userdata", r.userdata.size(), l.nuserdata);
-  CheckSize(m.path, r.step, "controller_next_update", r.controller_next_update.size(),
-            l.num_controllers);
+  const StateDims dims = l.dims();
+  ForEachStateField(
+      [&](const StateFieldInfo& f, const auto& v) {
+        if (static_cast<int64_t>(v.size()) != StateFieldSize(f, dims))
+          throw RunLogError(
+              fmt::format("run log {}: step {}: {} has {} entries; the header's layout says {}",
+                          m.path, r.step, f.name, v.size(), StateFieldSize(f, dims)));
+      },
+      r);
   EncodeStep(r, m.has_prev ? &m.prev : nullptr, &m.steps.body);
   m.steps.Note(r.step);
   m.prev = r;  // same sizes every step: the vectors' storage is reused

@@ -11,13 +11,16 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/scene/sim_state.h"
 
 namespace penumbra {
 
-/// state of a world at one simulation step.
-struct WorldSnapshot {
-  double time_sec = 0.0;  ///< simulation time
-  int64_t step = 0;       ///< physics steps taken since the start
+/// state of a world at one simulation step: its SimState (step, time_sec and the state vectors,
+/// scene/sim_state.h: what a bit-exact continuation needs, for recorders; filled by
+/// PhysicsSource for every snapshot content, SnapshotContent::kState and up, and empty when a
+/// source does not have them) and what is derived from it for renderers, sensors and metrics.
+/// the SimState part is a SimState: `SimState s = snapshot;` copies exactly the state.
+struct WorldSnapshot : SimState {
   /// X_WB for every body of SceneDescription::bodies (index 0 = world = identity).
   std::vector<Pose> X_WB;
   /// X_W_mjcam: pose of every MJCF camera in MuJoCo's camera convention (x right,
@@ -35,23 +38,6 @@ struct WorldSnapshot {
   };
   /// the paths of SceneDescription::tendons at this instant (empty if the model has none).
   std::vector<TendonPath> tendon_paths;
-  /// joint positions and velocities (MuJoCo qpos / qvel), for recording and replay.
-  std::vector<double> qpos;
-  std::vector<double> qvel;
-  /// the rest of the simulation state (physics/simulation.h SimState, MuJoCo's order and
-  /// units), for recorders: what a bit-exact continuation needs besides time, qpos and qvel.
-  /// filled by PhysicsSource for every snapshot content (SnapshotContent::kState and up);
-  /// empty when a source does not have them.
-  std::vector<double> act;             ///< (na) actuator activations
-  std::vector<double> ctrl;            ///< (nu) controls
-  std::vector<double> qacc_warmstart;  ///< (nv) constraint solver warm start
-  std::vector<double> qfrc_applied;    ///< (nv) applied generalized forces
-  std::vector<double> xfrc_applied;    ///< (6 nbody) applied Cartesian wrenches, world frame
-  std::vector<double> mocap_pos;       ///< (3 nmocap) mocap body positions, m, world frame
-  std::vector<double> mocap_quat;      ///< (4 nmocap) mocap body orientations (w, x, y, z)
-  std::vector<double> userdata;        ///< (nuserdata) MuJoCo user data
-  /// (number of controllers) step index of each controller's next update
-  std::vector<int64_t> controller_next_update;
   /// MuJoCo sensordata at this instant (Simulation::Snapshot evaluates the model's sensors
   /// for the snapshot's own state on a scratch copy); index with the adr/dim of
   /// scene/sensor_description.h. empty if the model has no sensors.

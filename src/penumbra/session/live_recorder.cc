@@ -169,7 +169,7 @@ void LiveRecorder::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapsh
       started_ = true;
       first_step_ = snapshot->step;
     }
-    writer_->Append(StepRecordOf(*snapshot));
+    writer_->Append(*snapshot);  // its SimState part is the step record
     last_step_ = snapshot->step;
   } catch (const std::exception& e) {
     FailLocked(e);

@@ -33,14 +33,7 @@ RunLogLayout RunLogLayoutOf(const Simulation& sim) {
   const ModelInfo& info = sim.model_info();
   const SimState state = sim.GetState();
   RunLogLayout l;
-  l.nq = static_cast<int>(state.qpos.size());
-  l.nv = static_cast<int>(state.qvel.size());
-  l.na = static_cast<int>(state.act.size());
-  l.nu = static_cast<int>(state.ctrl.size());
-  l.nmocap = static_cast<int>(state.mocap_pos.size() / 3);
-  l.nuserdata = static_cast<int>(state.userdata.size());
-  l.nbody = static_cast<int>(state.xfrc_applied.size() / 6);
-  l.num_controllers = static_cast<int>(state.controller_next_update.size());
+  l.set_dims(StateDimsOf(state));
   for (const JointInfo& j : info.joints) {
     RunLogJoint x;
     x.name = j.name;

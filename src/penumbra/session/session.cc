@@ -10,8 +10,8 @@
 #include "penumbra/assets/procedural_material.h"
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_factory.h"
-#include "penumbra/control/policy_controller.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/environment/environment_model.h"
@@ -171,14 +171,14 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
       spdlog::warn("{}", *work);
   }
   if (options.build_renderer) renderer_ = MakeRenderer(scene_, world_.render);
-  // policies with a height scan cast rays onto the static scene (the terrain)
+  // controllers with a height scan (policies) cast rays onto the static scene (the terrain)
   for (int i = 0; i < sim_->num_controllers(); ++i) {
-    auto* policy = dynamic_cast<PolicyController*>(&sim_->mutable_controller(i));
-    if (!policy || !policy->needs_terrain_ray_caster()) continue;
+    TerrainRayCasterUser* user = AsTerrainRayCasterUser(sim_->mutable_controller(i));
+    if (!user || !user->needs_terrain_ray_caster()) continue;
     if (!terrain_)
       terrain_ =
           std::make_unique<StaticTerrainRayCaster>(scene_, sim_->Snapshot(), world_.render.backend);
-    policy->SetTerrainRayCaster(terrain_.get());
+    user->SetTerrainRayCaster(terrain_.get());
   }
   timings_.scene_build_sec = SecondsSince(t0);
 }

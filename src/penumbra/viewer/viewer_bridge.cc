@@ -15,7 +15,7 @@
 
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_control.h"
-#include "penumbra/control/joint_controller.h"
+#include "penumbra/control/controller_capabilities.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/sensors/lidar_scanner.h"
@@ -248,8 +248,8 @@ class ViewerBridge : public RunBridge {
         // the control period: of the teleoperated controller, else of the first
         if (period == dt || has_twist)
           period = ctl.rate_hz() > 0 ? std::max(dt, std::round(1.0 / ctl.rate_hz() / dt) * dt) : dt;
-        if (const auto* pd = dynamic_cast<const JointPdController*>(&ctl))
-          joint_controls.push_back(JointControl(robot, pd->params().servo.joints));
+        if (const JointTarget* joint_target = AsJointTarget(ctl))
+          joint_controls.push_back(JointControl(robot, joint_target->command_joints()));
       }
     }
     if (sim.num_controllers() == 0) {
