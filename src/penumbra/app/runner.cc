@@ -152,7 +152,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     // the same map as data (what the viewer's scene view draws)
     const std::string json_path = (out / "npc_map.json").string();
     std::ofstream json_file(json_path);
-    json_file << NpcMapJson(session).dump() << "\n";
+    json_file << NpcMapJson(session) << "\n";
     if (!json_file) throw Error("cannot write " + json_path);
   }
   // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples

@@ -1,11 +1,14 @@
 #include "penumbra/session/npc_map_json.h"
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 namespace penumbra {
 
-nlohmann::json NpcMapJson(const Session& session) {
+namespace {
+
+nlohmann::json NpcMapJsonValue(const Session& session) {
   using nlohmann::json;
   const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
   if (!map) return nullptr;
@@ -46,5 +49,9 @@ nlohmann::json NpcMapJson(const Session& session) {
           {"robots", robots},
           {"agents", agents}};
 }
+
+}  // namespace
+
+std::string NpcMapJson(const Session& session) { return NpcMapJsonValue(session).dump(); }
 
 }  // namespace penumbra

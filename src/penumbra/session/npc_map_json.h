@@ -3,7 +3,7 @@
 // viewer's scene view draws on the floor (the scene message's "npc_map") and what a run saves
 // next to npc_map.png (npc_map.json).
 
-#include <nlohmann/json.hpp>
+#include <string>
 
 #include "penumbra/session/session.h"
 
@@ -18,7 +18,8 @@ namespace penumbra {
 ///  "person_cells", "vehicle_cells": walkable cells of each region, "lanes": [{"name",
 ///  "points": [[x, y], ...]}], "areas": [{"name", "min": [x, y], "max": [x, y]}], "robots":
 ///  [[x, y], ...], "agents": [[x, y], ...]} (world frame, m).
-/// reads the crowd's states: call before the run steps or on the loop thread.
-nlohmann::json NpcMapJson(const Session& session);
+/// returned as JSON text (one line; "null" without a crowd), so this header needs no JSON
+/// library. reads the crowd's states: call before the run steps or on the loop thread.
+std::string NpcMapJson(const Session& session);
 
 }  // namespace penumbra

@@ -299,7 +299,7 @@ class ViewerBridge : public RunBridge {
     json scene = SceneJson(session_.scene());
     scene["X_WB"] = BodyPosesJson(sim.Snapshot(Simulation::SnapshotContent::kPoses));
     // a crowd's walkable map, drawn on the floor of the scene view (docs/npcs.md)
-    if (session_.effects().npc_map()) scene["npc_map"] = NpcMapJson(session_);
+    if (session_.effects().npc_map()) scene["npc_map"] = nlohmann::json::parse(NpcMapJson(session_));
     scene_ = std::make_shared<const std::string>(scene.dump());
     for (const json& j : model_info_.value("joints", json::array())) {
       const std::string type = j.value("type", "");

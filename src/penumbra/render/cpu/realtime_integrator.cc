@@ -8,8 +8,8 @@
 #include "penumbra/render/brdf_math.h"
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
-#include "penumbra/render/lamp_math.h"
 #include "penumbra/render/cpu/mirror_layer.h"
+#include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
 
 namespace penumbra {
@@ -31,7 +31,7 @@ struct Scratch {
   // pixel's own shadow ray's verdict (1 visible, 0 occluded, -1 none traced).
   std::vector<Eigen::Vector3f> area_c;
   std::vector<int8_t> area_vis;
-  std::vector<float> mirror;              // per tile pixel: SurfaceMaterial::mirror, 0 = none
+  std::vector<float> mirror;  // per tile pixel: SurfaceMaterial::mirror, 0 = none
 };
 
 // shadow rays per pixel towards a light with an extent in a penumbra (1 elsewhere).

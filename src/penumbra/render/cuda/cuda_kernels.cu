@@ -141,7 +141,6 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
   Check(cudaStreamSynchronize(m.stream), "uploading the scene");
 }
 
-const SceneView& DeviceScene::device_view() const { return impl_->view; }
 
 void DeviceScene::Trace(const TraceRay* rays, int64_t n, TraceHit* hits) {
   if (n <= 0) return;

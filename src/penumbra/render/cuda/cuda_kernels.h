@@ -55,8 +55,6 @@ class DeviceScene {
   /// copies the arrays of `view` (host pointers) to the device: all of them when
   /// geometry_version differs from the last call's, else the instances only.
   void Sync(const SceneView& view, const Sizes& sizes, int64_t geometry_version);
-  /// the device arrays as the kernels read them (device pointers; valid until the next Sync).
-  const SceneView& device_view() const;
   /// closest hits of n rays (host arrays).
   void Trace(const TraceRay* rays, int64_t n, TraceHit* hits);
   /// occlusion of n rays (host arrays): occluded[i] = 1 if blocked.
