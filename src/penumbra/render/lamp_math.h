@@ -34,6 +34,9 @@ namespace penumbra {
 
 /// points of the visibility lattice over a light's cone (one per pixel of a 4x4 block).
 constexpr int kLightStrata = 16;
+/// shadow rays per pixel towards a light with an extent in a penumbra (the CPU's shared
+/// visibility; the CUDA path traces all of them at every pixel).
+constexpr int kLightPenumbraRays = 4;
 
 /// the factor c with which a sphere of intensity I (cd) at distance d, subtending angular radius
 /// sigma (sin2_sigma = sin^2 sigma, in [0, 1)), lights a surface whose unit normal makes angle

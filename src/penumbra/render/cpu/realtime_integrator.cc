@@ -35,7 +35,7 @@ struct Scratch {
 };
 
 // shadow rays per pixel towards a light with an extent in a penumbra (1 elsewhere).
-constexpr int kPenumbraRays = 4;
+constexpr int kPenumbraRays = kLightPenumbraRays;
 
 // a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
 // analytic (render/lamp_math.h) and its visibility shared over 5x5 pixels.

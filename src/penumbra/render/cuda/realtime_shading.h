@@ -8,7 +8,10 @@
 //
 //   L = Le + E_sky / pi (c_diff (1 - S) + S) + sum over lights f(wo, wi) |n . wi| E_i V_i
 //
-// with the same random numbers (Rng::DrawAt(PixelStream(u, v, 0), light)), the same
+// with the same lattice points per pixel (render/lamp_math.h: LightStratum, no random numbers),
+// lamps and the sun's disc in the same closed form (ExtendedLightShading) and their visibility
+// as the fraction of the pixel's kLightPenumbraRays lattice points, or of all 64 in a penumbra
+// (the CPU shares the verdicts of neighbouring pixels instead, Heitz et al. 2018), the same
 // negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total) and
 // shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal) and the
 // sky radiance of rays that escape come per pixel from the host (SkyModel and
@@ -25,6 +28,7 @@
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/film_math.h"
+#include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
 #include "penumbra/render/shading_math.h"
 #include "penumbra/render/texture_math.h"
@@ -249,22 +253,68 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
   return c;
 }
 
-/// the unshadowed contribution f(wo, wi) |n . wi| E of one sample of light j at p (0 where the
-/// light sends nothing), its direction *wi and distance *dist: the light's two uniform numbers
-/// from draw j of the pixel's random-number stream (as RealtimeIntegrator).
-PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j, uint64_t stream,
+/// whether light l has an extent: a sphere lamp (radius > 0) or the sun's disc (as the CPU
+/// realtime integrator's IsExtendedLight).
+PB_HOST_DEVICE inline bool IsExtendedLightPod(const LightPod& l) {
+  return l.kind == LightKind::kDirectional ? l.cos_angular_radius < 1.0f : l.radius_m > 0;
+}
+
+/// the two uniform numbers of lattice point r (0 <= r < kLightPenumbraRays) of pixel (u, v):
+/// point kLightPenumbraRays LightStratum(u, v) + r of the kLightStrata kLightPenumbraRays
+/// lattice (render/lamp_math.h), as RealtimeIntegrator takes them.
+PB_HOST_DEVICE inline void PixelLatticeUniforms(int u, int v, int r, float* u1, float* u2) {
+  LightStratumUniforms(kLightPenumbraRays * LightStratum(u, v) + r,
+                       kLightStrata * kLightPenumbraRays, u1, u2);
+}
+
+/// the unshadowed contribution f(wo, wi) |n . wi| E of light j at p for pixel (u, v), as the
+/// CPU realtime integrator computes it (0 where the light sends nothing): a light without an
+/// extent sampled at the pixel's lattice point; a lamp or sun disc in closed form
+/// (ExtendedLightShading: the BRDF towards the light's centre, tilted above the horizon where
+/// the light straddles it). *wi, *dist: the shadow ray of the pixel's first lattice point (the
+/// shading direction where that point lies below the geometric surface).
+PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j, int u, int v,
                                                const Float3& p, const Float3& n, const Float3& ng,
                                                const Float3& wo, float n_v, const Float3& c_diff,
                                                const Float3& f0, float a2, Float3* wi,
                                                float* dist) {
   float u1, u2;
-  Rng::Uniform2Of(Rng::DrawAt(stream, static_cast<uint64_t>(j)), &u1, &u2);
+  PixelLatticeUniforms(u, v, 0, &u1, &u2);
   Float3 E;
   bool valid;
-  SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, wi, dist, &E, &valid);
+  const LightPod& l = f.lights[j];
+  SampleLight<float, Float3, bool>(l, p, u1, u2, wi, dist, &E, &valid);
   if (!valid) return Float3{0, 0, 0};
-  const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, *wi);
-  return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
+  if (!IsExtendedLightPod(l)) {
+    const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, *wi);
+    return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
+  }
+  // the axis, sin^2 sigma and near distance (SphereLightAxis's arithmetic).
+  float w[3], sin2, dist_near;
+  if (l.kind == LightKind::kDirectional) {
+    w[0] = -l.direction_W.x, w[1] = -l.direction_W.y, w[2] = -l.direction_W.z;
+    sin2 = 1.0f - l.cos_angular_radius * l.cos_angular_radius;
+    dist_near = INFINITY;
+  } else {
+    const float t[3] = {l.position_W.x - p.x, l.position_W.y - p.y, l.position_W.z - p.z};
+    const float d2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+    const float d = sqrtf(d2);
+    const float inv = d > 0.0f ? 1.0f / d : 0.0f;
+    w[0] = t[0] * inv, w[1] = t[1] * inv, w[2] = t[2] * inv;
+    sin2 = d2 > 0.0f ? pbm::Min(l.radius_m * l.radius_m / d2, 1.0f) : 1.0f;
+    dist_near = pbm::Max(d - l.radius_m, 0.0f);
+  }
+  const float nn[3] = {n.x, n.y, n.z};
+  const float cos_t = nn[0] * w[0] + nn[1] * w[1] + nn[2] * w[2];
+  const float sin_sigma = sqrtf(pbm::Max(sin2, 0.0f));
+  float rep[3] = {w[0], w[1], w[2]};
+  float scale = cos_t > 1e-6f ? 1.0f : 0.0f;
+  if (!((cos_t * cos_t >= sin2 || !(sin2 > 0)) && !(cos_t > 0 && cos_t < sin_sigma)))
+    scale = ExtendedLightShading(w, sin2, nn, rep);
+  const Float3 wi_rep{rep[0], rep[1], rep[2]};
+  if (!(pbm::Dot<float>(ng, *wi) > 0)) *wi = wi_rep, *dist = dist_near;
+  const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, wi_rep);
+  return Float3{fr.x * E.x * scale, fr.y * E.y * scale, fr.z * E.z * scale};
 }
 
 /// the shading point of hit h of primary ray r (d_len = |r.d|): the material with its
@@ -389,13 +439,12 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
   const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
   const float off = kGpuRayOffsetScale * (1.0f + amax);
   const F3 origin{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
-  const uint64_t stream = HashKeys(HashKeys(f.frame_key, static_cast<uint64_t>(pixel)), 0);
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
   float total = pbm::Luminance709(L.x, L.y, L.z);
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi;
     float dist;
-    const Float3 c = LightContribution(f, j, stream, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
   // lights in order: negligible or shadowless contributions are added as they are, the others
@@ -403,7 +452,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi;
     float dist;
-    const Float3 c = LightContribution(f, j, stream, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
     const float lum = pbm::Luminance709(c.x, c.y, c.z);
     if (!(lum > 0)) continue;
     if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
@@ -412,7 +461,32 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
       sr.d = ToF3(wi);
       sr.tmin = 0;
       sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
-      if (TraceOccluded(s, sr)) continue;
+      if (!IsExtendedLightPod(f.lights[j])) {
+        if (TraceOccluded(s, sr)) continue;
+      } else {
+        // a lamp or the sun's disc: the visible fraction of the pixel's kLightPenumbraRays
+        // lattice points, and in a penumbra (they disagree) of every point of the lattice (the
+        // CPU shares its verdicts over neighbouring pixels instead, as it does at tile edges).
+        float rays = 1, visible = TraceOccluded(s, sr) ? 0.0f : 1.0f;
+        const int first = kLightPenumbraRays * LightStratum(u, v);
+        constexpr int kAll = kLightStrata * kLightPenumbraRays;
+        for (int r = 1; r < kAll; ++r) {
+          if (r == kLightPenumbraRays && (visible == 0 || visible == rays)) break;
+          float u1, u2, d_r;
+          Float3 w_r, E_r;
+          bool ok;
+          LightStratumUniforms((first + r) % kAll, kAll, &u1, &u2);
+          SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
+          if (!ok || !(pbm::Dot<float>(ng, w_r) > 0)) continue;
+          sr.d = ToF3(w_r);
+          sr.tmax = d_r * (1.0f - 1e-4f);
+          rays += 1;
+          if (!TraceOccluded(s, sr)) visible += 1;
+        }
+        const float V = visible / rays;
+        L = L + Float3{V * c.x, V * c.y, V * c.z};
+        continue;
+      }
     }
     L = L + c;
   }
