@@ -96,6 +96,23 @@ PB_HOST_DEVICE inline void SphereLightAxis(const float c[3], float r, const floa
   *near_m = fmaxf(d - r, 0.0f);
 }
 
+/// whether a light has an extent whose light and shadows the realtime tier treats in closed
+/// form: a directional light with a sun disc (cos of its angular radius < 1) or a lamp with a
+/// radius > 0.
+PB_HOST_DEVICE inline bool HasLightExtent(bool directional, float cos_angular_radius,
+                                          float radius_m) {
+  return directional ? cos_angular_radius < 1.0f : radius_m > 0;
+}
+
+/// whether a light of angular radius sigma (sin^2 sigma, sin sigma) around a direction at
+/// cos_t to the shading normal straddles the horizon, so that ExtendedLightShading must tilt
+/// it (else it lies wholly above, factor 1, or wholly below, factor 0). a point whose cos^2
+/// rounds to >= sin^2 sigma but cos to < sin sigma counts as straddling, as
+/// ExtendedLightShading would treat it.
+PB_HOST_DEVICE inline bool LightStraddlesHorizon(float cos_t, float sin2_sigma, float sin_sigma) {
+  return !((cos_t * cos_t >= sin2_sigma || !(sin2_sigma > 0)) && !(cos_t > 0 && cos_t < sin_sigma));
+}
+
 /// how a light of angular radius sigma around unit direction w is shaded at a point with unit
 /// shading normal n: writes the direction wi (unit) at which to evaluate the BRDF, f(wo, wi)
 /// |n . wi| (w, or w tilted above the horizon, TiltTowardsNormal to SphereLightShadingCosine)

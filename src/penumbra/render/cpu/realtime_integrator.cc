@@ -40,7 +40,7 @@ constexpr int kPenumbraRays = kLightPenumbraRays;
 // a light with an extent: a sphere lamp (radius > 0) or the sun's disc. its unshadowed light is
 // analytic (render/lamp_math.h) and its visibility shared over 5x5 pixels.
 bool IsExtendedLight(const PosedLight& l) {
-  return l.type == Light::Type::kDirectional ? l.cos_angular_radius < 1.0f : l.radius_m > 0;
+  return HasLightExtent(l.type == Light::Type::kDirectional, l.cos_angular_radius, l.radius_m);
 }
 
 // the unshadowed contribution f(wo, wi) E_i of extended light `l`, sampled as `s` (stratum
@@ -79,11 +79,7 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
       scale[k] = 0;
       continue;
     }
-    // (a lane whose cos^2 rounds to >= sin^2 sigma but cos to < sin sigma takes the slow path,
-    // as ExtendedLightShading would.)
-    if ((cos_t[k] * cos_t[k] >= sin2[k] || !(sin2[k] > 0)) &&
-        !(cos_t[k] > 0 && cos_t[k] < sin_sigma[k]))
-      continue;
+    if (!LightStraddlesHorizon(cos_t[k], sin2[k], sin_sigma[k])) continue;
     const float wk[3] = {w.x[k], w.y[k], w.z[k]};
     const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
     float r[3];

@@ -256,7 +256,7 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
 /// whether light l has an extent: a sphere lamp (radius > 0) or the sun's disc (as the CPU
 /// realtime integrator's IsExtendedLight).
 PB_HOST_DEVICE inline bool IsExtendedLightPod(const LightPod& l) {
-  return l.kind == LightKind::kDirectional ? l.cos_angular_radius < 1.0f : l.radius_m > 0;
+  return HasLightExtent(l.kind == LightKind::kDirectional, l.cos_angular_radius, l.radius_m);
 }
 
 /// the two uniform numbers of lattice point r (0 <= r < kLightPenumbraRays) of pixel (u, v):
@@ -289,28 +289,23 @@ PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j
     const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, *wi);
     return Float3{fr.x * E.x, fr.y * E.y, fr.z * E.z};
   }
-  // the axis, sin^2 sigma and near distance (SphereLightAxis's arithmetic).
+  // the axis, sin^2 sigma and near distance.
   float w[3], sin2, dist_near;
   if (l.kind == LightKind::kDirectional) {
     w[0] = -l.direction_W.x, w[1] = -l.direction_W.y, w[2] = -l.direction_W.z;
     sin2 = 1.0f - l.cos_angular_radius * l.cos_angular_radius;
     dist_near = INFINITY;
   } else {
-    const float t[3] = {l.position_W.x - p.x, l.position_W.y - p.y, l.position_W.z - p.z};
-    const float d2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-    const float d = sqrtf(d2);
-    const float inv = d > 0.0f ? 1.0f / d : 0.0f;
-    w[0] = t[0] * inv, w[1] = t[1] * inv, w[2] = t[2] * inv;
-    sin2 = d2 > 0.0f ? pbm::Min(l.radius_m * l.radius_m / d2, 1.0f) : 1.0f;
-    dist_near = pbm::Max(d - l.radius_m, 0.0f);
+    const float c[3] = {l.position_W.x, l.position_W.y, l.position_W.z};
+    const float pp[3] = {p.x, p.y, p.z};
+    SphereLightAxis(c, l.radius_m, pp, w, &sin2, &dist_near);
   }
   const float nn[3] = {n.x, n.y, n.z};
   const float cos_t = nn[0] * w[0] + nn[1] * w[1] + nn[2] * w[2];
   const float sin_sigma = sqrtf(pbm::Max(sin2, 0.0f));
   float rep[3] = {w[0], w[1], w[2]};
   float scale = cos_t > 1e-6f ? 1.0f : 0.0f;
-  if (!((cos_t * cos_t >= sin2 || !(sin2 > 0)) && !(cos_t > 0 && cos_t < sin_sigma)))
-    scale = ExtendedLightShading(w, sin2, nn, rep);
+  if (LightStraddlesHorizon(cos_t, sin2, sin_sigma)) scale = ExtendedLightShading(w, sin2, nn, rep);
   const Float3 wi_rep{rep[0], rep[1], rep[2]};
   if (!(pbm::Dot<float>(ng, *wi) > 0)) *wi = wi_rep, *dist = dist_near;
   const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, wi_rep);
