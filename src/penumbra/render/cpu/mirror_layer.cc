@@ -11,8 +11,6 @@
 namespace penumbra {
 namespace {
 
-constexpr float kInvPiMirror = 0.318309886183790671538f;
-
 // the split-sum ambient specular fit (render/brdf_math.h) for one shading point.
 Eigen::Vector3f EnvBrdfApproxScalar(const Eigen::Vector3f& f0, float n_v, float roughness) {
   const Float3 s = EnvBrdfApprox<float, Float3>(Float3{f0.x(), f0.y(), f0.z()}, n_v, roughness);
@@ -41,7 +39,7 @@ Eigen::Vector3f MirrorRadiance(const FrameContext& ctx, const Ray& ray, float pa
                                                    std::clamp(mat.pbr.roughness, 0.0f, 1.0f));
   const Eigen::Vector3f reflect =
       bsdf.diffuse_color().cwiseProduct(Eigen::Vector3f::Ones() - spec) + spec;
-  Eigen::Vector3f L = mat.emission + (sky_E * (kInvPiMirror * mat.occlusion)).cwiseProduct(reflect);
+  Eigen::Vector3f L = mat.emission + (sky_E * (pbm::kInvPi * mat.occlusion)).cwiseProduct(reflect);
   const Eigen::Vector3f origin = OffsetRayOrigin(h.p_W, h.ng_W);
   const bool shadows = ctx.ablation == nullptr || ctx.ablation->shadows;
   for (int j = 0; j < ctx.lights->size(); ++j) {

@@ -15,8 +15,6 @@
 namespace penumbra {
 namespace {
 
-constexpr float kInvPi = 0.318309886183790671538f;
-
 inline Lanes LuminanceLanes(const Vec3Lanes& c) { return pbm::Luminance709(c.x, c.y, c.z); }
 
 // per-thread scratch, sized once per light count and reused across tiles and frames.
@@ -523,8 +521,9 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       const Vec3Lanes reflect{bsdf.c_diff.x * (1.0f - spec.x) + spec.x,
                               bsdf.c_diff.y * (1.0f - spec.y) + spec.y,
                               bsdf.c_diff.z * (1.0f - spec.z) + spec.z};
-      L = {emission.x + (sky_E.x * kInvPi) * reflect.x, emission.y + (sky_E.y * kInvPi) * reflect.y,
-           emission.z + (sky_E.z * kInvPi) * reflect.z};
+      L = {emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
+           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
+           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
     }
 
     // where the surface points lie in the media's light volume (shared by all lights).
