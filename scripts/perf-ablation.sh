@@ -58,15 +58,9 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-[[ ${#worlds[@]} -gt 0 ]] || worlds=(default house warehouse outdoor)
+source "$(dirname "${BASH_SOURCE[0]}")/perf-common.sh"
+perf_resolve_worlds
 [[ ${#parts[@]} -gt 0 ]] || parts=(mirror mirror-sparse sky-volume texture-filter shadows sun-occluder film)
-world_files=()
-for w in "${worlds[@]}"; do
-  if [[ $w == */* || $w == *.yaml ]]; then f=$w; else f=$repo/worlds/$w.yaml; fi
-  [[ -f $f ]] || { echo "$0: world '$w': no file $f; expected a bundled world name or a world file" >&2; exit 2; }
-  world_files+=("$f")
-done
 
 # "frames/s cpu-ms/frame" of one bench run ("" = all parts on)
 bench_fps() {
@@ -81,9 +75,6 @@ bench_fps() {
   awk '$1 == "640x480" && /frames\/s/ { f = ""; c = ""; for (i = 1; i <= NF; ++i) { if ($i == "frames/s,") f = $(i - 1); if ($i == "cpu-ms/frame" || $i == "cpu-ms/frame,") c = $(i - 1) } if (f != "" && c != "") print f, c; exit }' <<<"$out"
 }
 
-stats() {
-  printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%s %s %s\n", m, v[1], v[NR] }'
-}
 
 echo "perf-ablation: $bin"
 echo "bench render --no-adversity --only-640x480 --frames $frames, rgb+depth, $rounds interleaved rounds, $(nproc) core(s), load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -63,18 +63,8 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-[[ ${#worlds[@]} -gt 0 ]] || worlds=(default house warehouse outdoor)
-world_files=()
-for w in "${worlds[@]}"; do
-  if [[ $w == */* || $w == *.yaml ]]; then
-    f=$w
-  else
-    f=$repo/worlds/$w.yaml
-  fi
-  [[ -f $f ]] || { echo "$0: world '$w': no file $f; expected a bundled world name or a world file" >&2; exit 2; }
-  world_files+=("$f")
-done
+source "$(dirname "${BASH_SOURCE[0]}")/perf-common.sh"
+perf_resolve_worlds
 
 # frames/s of one bench run: the "<size> rgb+depth ...: X frames/s" line
 bench_fps() {
@@ -87,10 +77,6 @@ bench_fps() {
   awk -v size="$size" '$1 == size && /frames\/s/ { for (i = 1; i <= NF; ++i) if ($i == "frames/s,") { print $(i - 1); exit } }' <<<"$out"
 }
 
-# median, min and max of the numbers given
-stats() {
-  printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2; printf "%s %s %s\n", m, v[1], v[NR] }'
-}
 
 echo "perf-compare: OLD $old_bin"
 echo "              NEW $new_bin"
