@@ -373,12 +373,13 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
 }
 
 /// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
-/// (0 on a miss).
+/// (0 on a miss); *hit_out (if given): the hit itself, for ShadeRealtimeHit.
 PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
-                                                    float* t_hit) {
+                                                    float* t_hit, TraceHit* hit_out = nullptr) {
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
   TraceClosest(f.scene, r, &h);
+  if (hit_out) *hit_out = h;
   PixelGeometry g;
   *t_hit = 0;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
@@ -396,96 +397,173 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
   return g;
 }
 
-/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
-/// escapes).
-PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+/// a pixel's shadow-ray start for a lamp's or the sun disc's lattice points: the shaded point
+/// p, its geometric normal ng, the shadow rays' origin and the pixel's first lattice index
+/// (kLightPenumbraRays LightStratum(u, v)).
+struct PenumbraQuery {
+  Float3 p, ng;
+  F3 origin;
+  int32_t first = 0;
+};
+
+/// counts the lattice points r = begin, begin + step, ... < end (<= kLightStrata
+/// kLightPenumbraRays) of extended light l seen from q: *rays += the points above the geometric surface (the others
+/// do not count), *visible += those whose shadow ray is not blocked. integer counts: any split
+/// of the points over threads sums to the same numbers.
+PB_HOST_DEVICE inline void CountLatticeVisibility(const SceneView& s, const LightPod& l,
+                                                  const PenumbraQuery& q, int begin, int end,
+                                                  int step, int* rays, int* visible) {
+  constexpr int kAll = kLightStrata * kLightPenumbraRays;
+  for (int r = begin; r < end; r += step) {
+    float u1, u2, d_r;
+    Float3 w_r, E_r;
+    bool ok;
+    LightStratumUniforms((q.first + r) % kAll, kAll, &u1, &u2);
+    SampleLight<float, Float3, bool>(l, q.p, u1, u2, &w_r, &d_r, &E_r, &ok);
+    if (!ok || !(pbm::Dot<float>(q.ng, w_r) > 0)) continue;
+    TraceRay sr;
+    sr.o = q.origin;
+    sr.d = ToF3(w_r);
+    sr.tmin = 0;
+    sr.tmax = d_r * (1.0f - 1e-4f);
+    *rays += 1;
+    if (!TraceOccluded(s, sr)) *visible += 1;
+  }
+}
+
+/// the penumbra refinement one thread does alone: where `need` (the pixel's kLightPenumbraRays
+/// lattice points disagree), every other point of the lattice. the CUDA kernels can instead
+/// share each such pixel's points among the lanes of a warp (realtime_kernels.cu): the same
+/// counts.
+struct SerialPenumbraRefiner {
+  PB_HOST_DEVICE void operator()(const SceneView& s, const LightPod& l, bool need,
+                                 const PenumbraQuery& q, int* rays, int* visible) const {
+    if (need)
+      CountLatticeVisibility(s, l, q, kLightPenumbraRays, kLightStrata * kLightPenumbraRays, 1,
+                             rays, visible);
+  }
+};
+
+/// lights whose unshadowed contribution ShadeRealtimeHit keeps between its two loops (the
+/// others are evaluated twice).
+constexpr int kShadeCachedLights = 16;
+
+/// the linear radiance (the file comment's L; the sky term where the ray escapes) of pixel
+/// (u, v) whose primary ray r (PrimaryRay) has the closest hit h (TraceClosest). every light's
+/// contribution is evaluated once; lamps and the sun's disc whose kLightPenumbraRays lattice
+/// points disagree are refined by `refine` (SerialPenumbraRefiner, or a warp-shared one on the
+/// GPU, which every lane must call the same number of times: this function calls it once per
+/// light whatever the pixel). `active` false: a thread outside the image that only takes part
+/// in `refine` (its result is {0, 0, 0}).
+template <typename Refiner>
+PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
+                                              const TraceRay& r, const TraceHit& h, bool active,
+                                              const Refiner& refine) {
   const SceneView& s = f.scene;
-  const TraceRay r = PrimaryRay(f.camera, u, v);
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const Float3 sky = f.sky_term[pixel];
-  TraceHit h;
-  TraceClosest(s, r, &h);
-  if (h.instance < 0) return sky;
-  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
-  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
-  const Float3& p = sp.p;
-  const Float3& ng = sp.ng;
-  const Float3& n = sp.n;
-  const Float3& wo = sp.wo;
-  const float roughness = sp.roughness;
-  const Float3 emission = sp.emission;
-  const float occlusion = sp.occlusion;
-  // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
-  // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
-  Float3 c_diff, f0;
-  float alpha;
-  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &c_diff, &f0,
-                                    &alpha);
-  const float a2 = alpha * alpha;
-  const float n_v = pbm::Dot<float>(n, wo);
-  const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), roughness);
-  const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
-                       c_diff.z * (1.0f - spec.z) + spec.z};
-  const Float3 sky_E = occlusion * sky;
-  Float3 L{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
-           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
-           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
-  // shadow rays start off the surface on the lit side.
-  const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
-  const float off = kGpuRayOffsetScale * (1.0f + amax);
-  const F3 origin{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
-  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
-  float total = pbm::Luminance709(L.x, L.y, L.z);
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-    total += pbm::Luminance709(c.x, c.y, c.z);
+  const bool hit = active && h.instance >= 0;
+  Float3 L{0, 0, 0};
+  ShadingPoint sp;
+  Float3 c_diff{0, 0, 0}, f0{0, 0, 0};
+  float a2 = 0, n_v = 0, total = 0;
+  PenumbraQuery q;
+  Float3 cached_c[kShadeCachedLights], cached_wi[kShadeCachedLights];
+  float cached_dist[kShadeCachedLights];
+  if (hit) {
+    const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+    sp = EvaluateSurface(f, r, h, d_len);
+    const Float3& p = sp.p;
+    const Float3& ng = sp.ng;
+    // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
+    // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
+    float alpha;
+    BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff,
+                                      &f0, &alpha);
+    a2 = alpha * alpha;
+    n_v = pbm::Dot<float>(sp.n, sp.wo);
+    const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), sp.roughness);
+    const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
+                         c_diff.z * (1.0f - spec.z) + spec.z};
+    const Float3 sky_E = sp.occlusion * f.sky_term[static_cast<int64_t>(v) * f.camera.width + u];
+    L = Float3{sp.emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
+               sp.emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
+               sp.emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
+    // shadow rays start off the surface on the lit side.
+    const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
+    const float off = kGpuRayOffsetScale * (1.0f + amax);
+    q.p = p;
+    q.ng = ng;
+    q.origin = F3{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
+    q.first = kLightPenumbraRays * LightStratum(u, v);
+    // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+    total = pbm::Luminance709(L.x, L.y, L.z);
+    for (int j = 0; j < f.num_lights; ++j) {
+      Float3 wi;
+      float dist;
+      const Float3 c =
+          LightContribution(f, j, u, v, p, sp.n, ng, sp.wo, n_v, c_diff, f0, a2, &wi, &dist);
+      if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
+      total += pbm::Luminance709(c.x, c.y, c.z);
+    }
   }
   // lights in order: negligible or shadowless contributions are added as they are, the others
-  // after a shadow ray.
+  // after a shadow ray (`add`: 0 nothing, 1 c, 2 the visible fraction of c).
   for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-    const float lum = pbm::Luminance709(c.x, c.y, c.z);
-    if (!(lum > 0)) continue;
-    if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
-      TraceRay sr;
-      sr.o = origin;
-      sr.d = ToF3(wi);
-      sr.tmin = 0;
-      sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
-      if (!IsExtendedLightPod(f.lights[j])) {
-        if (TraceOccluded(s, sr)) continue;
-      } else {
-        // a lamp or the sun's disc: the visible fraction of the pixel's kLightPenumbraRays
-        // lattice points, and in a penumbra (they disagree) of every point of the lattice (the
-        // CPU shares its verdicts over neighbouring pixels instead, as it does at tile edges).
-        float rays = 1, visible = TraceOccluded(s, sr) ? 0.0f : 1.0f;
-        const int first = kLightPenumbraRays * LightStratum(u, v);
-        constexpr int kAll = kLightStrata * kLightPenumbraRays;
-        for (int r = 1; r < kAll; ++r) {
-          if (r == kLightPenumbraRays && (visible == 0 || visible == rays)) break;
-          float u1, u2, d_r;
-          Float3 w_r, E_r;
-          bool ok;
-          LightStratumUniforms((first + r) % kAll, kAll, &u1, &u2);
-          SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
-          if (!ok || !(pbm::Dot<float>(ng, w_r) > 0)) continue;
-          sr.d = ToF3(w_r);
-          sr.tmax = d_r * (1.0f - 1e-4f);
-          rays += 1;
-          if (!TraceOccluded(s, sr)) visible += 1;
+    const LightPod& light = f.lights[j];
+    Float3 c{0, 0, 0};
+    int add = 0, rays = 1, visible = 0;
+    bool need = false;
+    if (hit) {
+      Float3 wi;
+      float dist;
+      if (j < kShadeCachedLights)
+        c = cached_c[j], wi = cached_wi[j], dist = cached_dist[j];
+      else
+        c = LightContribution(f, j, u, v, sp.p, sp.n, sp.ng, sp.wo, n_v, c_diff, f0, a2, &wi,
+                              &dist);
+      const float lum = pbm::Luminance709(c.x, c.y, c.z);
+      if (lum > 0) {
+        add = 1;
+        if (light.cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
+          TraceRay sr;
+          sr.o = q.origin;
+          sr.d = ToF3(wi);
+          sr.tmin = 0;
+          sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
+          if (!IsExtendedLightPod(light)) {
+            if (TraceOccluded(s, sr)) add = 0;
+          } else {
+            // a lamp or the sun's disc: the visible fraction of the pixel's kLightPenumbraRays
+            // lattice points, and in a penumbra (they disagree) of every point of the lattice
+            // (the CPU shares its verdicts over neighbouring pixels instead, as it does at
+            // tile edges).
+            add = 2;
+            visible = TraceOccluded(s, sr) ? 0 : 1;
+            CountLatticeVisibility(s, light, q, 1, kLightPenumbraRays, 1, &rays, &visible);
+            need = !(visible == 0 || visible == rays);
+          }
         }
-        const float V = visible / rays;
-        L = L + Float3{V * c.x, V * c.y, V * c.z};
-        continue;
       }
     }
-    L = L + c;
+    refine(s, light, need, q, &rays, &visible);
+    if (add == 1) {
+      L = L + c;
+    } else if (add == 2) {
+      const float V = static_cast<float>(visible) / static_cast<float>(rays);
+      L = L + Float3{V * c.x, V * c.y, V * c.z};
+    }
   }
-  return L;
+  if (hit) return L;
+  return active && h.instance < 0 ? f.sky_term[static_cast<int64_t>(v) * f.camera.width + u]
+                                  : Float3{0, 0, 0};
+}
+
+/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
+/// escapes): its primary ray traced, then ShadeRealtimeHit with the serial refinement.
+PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  return ShadeRealtimeHit(f, u, v, r, h, true, SerialPenumbraRefiner());
 }
 
 /// the sum over row v of the log-luminance terms (film_math.h's LogLuminanceTerm), in column
