@@ -57,15 +57,20 @@ TEST_P(PenumbraLaneSplit, SameRadianceAsSerialRefinement) {
   std::vector<Float3> sky(n);
   data.SkyTerms(geometry.data(), n, sky.data(), &pool);
   const cuda::RealtimeFrameView f = data.View(bvh.view(), sky.data());
-  int refined = 0, differ = 0;
-  for (int v = 0; v < c.height; ++v)
+  // rows over the pool; each row counts its own refinements and differences
+  std::vector<int> row_refined(c.height, 0), row_differ(c.height, 0);
+  ParallelForOrSerial(&pool, c.height, [&](int64_t row) {
+    const int v = static_cast<int>(row);
     for (int u = 0; u < c.width; ++u) {
       const int64_t i = static_cast<int64_t>(v) * c.width + u;
       const Float3 serial = cuda::ShadeRealtimePixel(f, u, v);
-      const Float3 split = cuda::ShadeRealtimeHit(f, u, v, cuda::PrimaryRay(c, u, v), hits[i],
-                                                  true, LaneSplitRefiner{&refined});
-      if (!(serial.x == split.x && serial.y == split.y && serial.z == split.z)) ++differ;
+      const Float3 split = cuda::ShadeRealtimeHit(f, u, v, cuda::PrimaryRay(c, u, v), hits[i], true,
+                                                  LaneSplitRefiner{&row_refined[v]});
+      if (!(serial.x == split.x && serial.y == split.y && serial.z == split.z)) ++row_differ[v];
     }
+  });
+  int refined = 0, differ = 0;
+  for (int v = 0; v < c.height; ++v) refined += row_refined[v], differ += row_differ[v];
   std::printf("%s 160x120: %d pixel-lights refined, %d pixels differ\n", GetParam().c_str(),
               refined, differ);
   EXPECT_GT(refined, 0);

@@ -57,14 +57,23 @@ struct RealtimeKernelOptions {
   /// and the outputs, which are then copied into the frame's images); else it copies
   /// to and from pageable memory directly.
   bool pinned = true;
+  /// Render() splits the image into this many bands of rows (1 to kMaxRealtimeBands): the
+  /// host computes band b + 1's sky terms while the GPU shades band b.
+  int bands = 4;
 };
 
+/// the most bands RealtimeKernelOptions::bands takes.
+constexpr int kMaxRealtimeBands = 16;
+
 /// the host clock's time of Render()'s stages, milliseconds (benchmarks).
+/// geometry + sky + shade + film = total.
 struct RealtimeStageTimes {
   double geometry = 0;  ///< upload of geoms and lights, geometry kernel, geometry to the host
-  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms)
-  double shade = 0;     ///< sky terms up, shading and row-sum kernels, row sums back
-  double film = 0;      ///< exposure, film kernel, the outputs copied to the frame's images
+  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms), all bands
+  /// from the last band's sky terms to the row sums on the host (the last band's shading,
+  /// the row-sum kernel, the row sums back; the other bands' shading overlaps `sky`)
+  double shade = 0;
+  double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
   double total = 0;
 };
 

@@ -3,6 +3,7 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <string>
@@ -53,8 +54,8 @@ struct WarpPenumbraRefiner {
       lq.origin.z = __shfl_sync(kFullWarp, q.origin.z, leader);
       lq.first = __shfl_sync(kFullWarp, q.first, leader);
       int r = 0, vis = 0;
-      CountLatticeVisibility(s, l, lq, kLightPenumbraRays + lane,
-                             kLightStrata * kLightPenumbraRays, 32, &r, &vis);
+      CountLatticeVisibility(s, l, lq, kLightPenumbraRays + lane, kLightStrata * kLightPenumbraRays,
+                             32, &r, &vis);
       r = __reduce_add_sync(kFullWarp, r);
       vis = __reduce_add_sync(kFullWarp, vis);
       if (lane == leader) *rays += r, *visible += vis;
@@ -64,11 +65,13 @@ struct WarpPenumbraRefiner {
 
 // kReuse: the primary hit from GeometryKernel; kWarp: WarpPenumbraRefiner (every thread of a
 // warp stays to the end, those outside the image too).
+// rows [v0, v1) of the image.
 template <bool kReuse, bool kWarp>
-__global__ void ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance) {
+__global__ void ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance, int v0,
+                            int v1) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  const bool active = u < f.camera.width && v < f.camera.height;
+  const int v = v0 + blockIdx.y * blockDim.y + threadIdx.y;
+  const bool active = u < f.camera.width && v < v1;
   if (!kWarp && !active) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const TraceRay r = PrimaryRay(f.camera, u, v);
@@ -166,6 +169,7 @@ struct DeviceRealtime::Impl {
   std::vector<double> host_rows;
   cudaStream_t copy_stream = nullptr;
   cudaEvent_t geometry_done = nullptr, shade_done = nullptr;
+  cudaEvent_t band_ready[kMaxRealtimeBands] = {};
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -174,21 +178,26 @@ struct DeviceRealtime::Impl {
   int filmic = 1;
   bool rendered = false;
 
-  // launches the geometry, shading and row-sum kernels of frame f on `stream` as `o` says.
-  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
-                     cudaStream_t stream) {
-    const int W = f.camera.width, H = f.camera.height;
-    const dim3 grid = PixelGrid(W, H);
+  // launches the shading kernel of rows [v0, v1) of frame f on `stream` as `o` says.
+  void LaunchShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o, int v0, int v1,
+                   cudaStream_t stream) {
+    if (v1 <= v0) return;
+    const dim3 grid = PixelGrid(f.camera.width, v1 - v0);
     TraceHit* h = o.reuse_hit ? hits.as<TraceHit>() : nullptr;
+    Float3* L = radiance.as<Float3>();
     if (o.reuse_hit && o.warp_penumbra)
-      ShadeKernel<true, true><<<grid, kPixelBlock, 0, stream>>>(f, h, radiance.as<Float3>());
+      ShadeKernel<true, true><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
     else if (o.reuse_hit)
-      ShadeKernel<true, false><<<grid, kPixelBlock, 0, stream>>>(f, h, radiance.as<Float3>());
+      ShadeKernel<true, false><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
     else if (o.warp_penumbra)
-      ShadeKernel<false, true><<<grid, kPixelBlock, 0, stream>>>(f, h, radiance.as<Float3>());
+      ShadeKernel<false, true><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
     else
-      ShadeKernel<false, false><<<grid, kPixelBlock, 0, stream>>>(f, h, radiance.as<Float3>());
+      ShadeKernel<false, false><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
     Check(cudaGetLastError(), "ShadeKernel");
+  }
+  // launches the row-sum kernel of frame f on `stream` as `o` says.
+  void LaunchRows(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream) {
+    const int W = f.camera.width, H = f.camera.height;
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
@@ -196,6 +205,12 @@ struct DeviceRealtime::Impl {
       RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
     Check(cudaGetLastError(), "RowSumKernel");
+  }
+  // the shading and row-sum kernels of the whole frame.
+  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                     cudaStream_t stream) {
+    LaunchShade(f, o, 0, f.camera.height, stream);
+    LaunchRows(f, o, stream);
   }
   void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
                       cudaStream_t stream) {
@@ -213,15 +228,15 @@ struct DeviceRealtime::Impl {
     if (copy_stream) cudaStreamDestroy(copy_stream);
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (shade_done) cudaEventDestroy(shade_done);
+    for (cudaEvent_t e : band_ready)
+      if (e) cudaEventDestroy(e);
   }
 };
 
 DeviceRealtime::DeviceRealtime() : impl_(new Impl) {}
 DeviceRealtime::~DeviceRealtime() { delete impl_; }
 
-void DeviceRealtime::set_options(const RealtimeKernelOptions& options) {
-  impl_->options = options;
-}
+void DeviceRealtime::set_options(const RealtimeKernelOptions& options) { impl_->options = options; }
 const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->options; }
 const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
 
@@ -246,6 +261,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.shade_done, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.band_ready)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
   }
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
@@ -291,27 +308,58 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     host_sky = m.host_sky.data();
     host_rows = m.host_rows.data();
   }
-  // (1) primary geometry (materials and normal maps included) and depth; pinned: the depth
-  // goes back on the copy stream while the host computes the sky terms
+  // bands of whole blocks of rows: the host computes band b + 1's sky terms while the GPU
+  // shades band b (pinned memory only: pageable copies block the host)
+  const int bands = o.pinned ? std::max(1, std::min(o.bands, kMaxRealtimeBands)) : 1;
+  const int band_rows = static_cast<int>((H + bands * static_cast<int>(kPixelBlock.y) - 1) /
+                                         (bands * static_cast<int>(kPixelBlock.y)) * kPixelBlock.y);
+  // (1) primary geometry (materials and normal maps included) and depth; pinned: the geometry
+  // goes back band by band and the depth after it, on the copy stream
   m.LaunchGeometry(f, o, stream);
-  m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
-  if (out.depth) {
-    if (o.pinned) {
-      Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
-      Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
-      m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
-    } else {
-      m.depth.Download(out.depth, sizeof(float) * n, stream);
+  double sky_ms = 0;
+  auto t1 = Clock::now();
+  if (o.pinned) {
+    Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
+    Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
+    for (int b = 0; b < bands; ++b) {
+      const int64_t v0 = std::min<int64_t>(H, static_cast<int64_t>(b) * band_rows);
+      const int64_t v1 = std::min<int64_t>(H, v0 + band_rows);
+      Check(cudaMemcpyAsync(host_geometry + v0 * W, m.geometry.as<PixelGeometry>() + v0 * W,
+                            sizeof(PixelGeometry) * (v1 - v0) * W, cudaMemcpyDeviceToHost,
+                            m.copy_stream),
+            "cudaMemcpyAsync");
+      Check(cudaEventRecord(m.band_ready[b], m.copy_stream), "cudaEventRecord");
     }
+    if (out.depth) m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
+    // (2) each band's sky terms on the host, then (3) its shading
+    for (int b = 0; b < bands; ++b) {
+      const int64_t v0 = std::min<int64_t>(H, static_cast<int64_t>(b) * band_rows);
+      const int64_t v1 = std::min<int64_t>(H, v0 + band_rows);
+      Check(cudaEventSynchronize(m.band_ready[b]), "GeometryKernel");
+      if (b == 0) t1 = Clock::now();
+      const auto ts = Clock::now();
+      sky(host_geometry + v0 * W, (v1 - v0) * W, host_sky + v0 * W);
+      sky_ms += MsSince(ts);
+      Check(cudaMemcpyAsync(m.sky.as<Float3>() + v0 * W, host_sky + v0 * W,
+                            sizeof(Float3) * (v1 - v0) * W, cudaMemcpyHostToDevice, stream),
+            "cudaMemcpyAsync");
+      m.LaunchShade(f, o, static_cast<int>(v0), static_cast<int>(v1), stream);
+    }
+  } else {
+    m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
+    if (out.depth) m.depth.Download(out.depth, sizeof(float) * n, stream);
+    Check(cudaStreamSynchronize(stream), "GeometryKernel");
+    t1 = Clock::now();
+    // (2) the sky terms on the host
+    const auto ts = Clock::now();
+    sky(host_geometry, n, host_sky);
+    sky_ms = MsSince(ts);
+    m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
+    // (3) shading
+    m.LaunchShade(f, o, 0, H, stream);
   }
-  Check(cudaStreamSynchronize(stream), "GeometryKernel");
-  const auto t1 = Clock::now();
-  // (2) the sky terms on the host
-  sky(host_geometry, n, host_sky);
-  const auto t2 = Clock::now();
-  m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
-  // (3) shading and (4) the rows' log-luminance sums
-  m.LaunchShading(f, o, stream);
+  // (4) the rows' log-luminance sums
+  m.LaunchRows(f, o, stream);
   m.rows.Download(host_rows, sizeof(double) * H, stream);
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
   const auto t3 = Clock::now();
@@ -334,9 +382,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
   }
+  // geometry: until the first band's geometry is on the host; sky: the host's sky terms;
+  // shade: the rest until the row sums are back (the bands' waits and shading that the sky
+  // terms did not hide)
   m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  m.times.sky = std::chrono::duration<double, std::milli>(t2 - t1).count();
-  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t2).count();
+  m.times.sky = sky_ms;
+  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t1).count() - sky_ms;
   m.times.film = MsSince(t3);
   m.times.total = MsSince(t0);
   m.frame = f;

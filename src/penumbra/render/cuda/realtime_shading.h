@@ -407,9 +407,9 @@ struct PenumbraQuery {
 };
 
 /// counts the lattice points r = begin, begin + step, ... < end (<= kLightStrata
-/// kLightPenumbraRays) of extended light l seen from q: *rays += the points above the geometric surface (the others
-/// do not count), *visible += those whose shadow ray is not blocked. integer counts: any split
-/// of the points over threads sums to the same numbers.
+/// kLightPenumbraRays) of extended light l seen from q: *rays += the points above the geometric
+/// surface (the others do not count), *visible += those whose shadow ray is not blocked. integer
+/// counts: any split of the points over threads sums to the same numbers.
 PB_HOST_DEVICE inline void CountLatticeVisibility(const SceneView& s, const LightPod& l,
                                                   const PenumbraQuery& q, int begin, int end,
                                                   int step, int* rays, int* visible) {
@@ -476,8 +476,8 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
     // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
     // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
     float alpha;
-    BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff,
-                                      &f0, &alpha);
+    BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff, &f0,
+                                      &alpha);
     a2 = alpha * alpha;
     n_v = pbm::Dot<float>(sp.n, sp.wo);
     const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), sp.roughness);
