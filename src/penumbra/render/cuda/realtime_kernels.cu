@@ -31,6 +31,30 @@ __global__ void ShadeKernel(RealtimeFrameView f, Float3* radiance) {
   radiance[static_cast<int64_t>(v) * f.camera.width + u] = ShadeRealtimePixel(f, u, v);
 }
 
+// the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
+// each reads its neighbours' results of the step before.
+__global__ void VisibilityRaysKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityRays(f, u, v);
+}
+
+__global__ void VisibilityFractionKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityFraction(f, u, v);
+}
+
+__global__ void VisibilityResolveKernel(RealtimeFrameView f, Float3* radiance) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
+}
+
 __global__ void RowSumKernel(const Float3* radiance, int width, int height, double* rows) {
   const int v = blockIdx.x * blockDim.x + threadIdx.x;
   if (v >= height) return;
@@ -53,6 +77,8 @@ __global__ void DevelopKernel(const Float3* radiance, int64_t n, Exposure exposu
 struct DeviceRealtime::Impl {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
   Buffer geometry, depth, sky, radiance, rows, rgb;
+  // the shared visibility's buffers (RealtimeFrameView)
+  Buffer window, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   std::vector<PixelGeometry> host_geometry;
   std::vector<Float3> host_sky;
   std::vector<Float3> host_radiance;
@@ -93,6 +119,14 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.radiance.Reserve(sizeof(Float3) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
+  const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
+  m.window.Reserve(sizeof(uint32_t) * n);
+  m.area_c.Reserve(sizeof(Float3) * nl);
+  m.area_vis.Reserve(sizeof(int8_t) * nl);
+  m.area_visible.Reserve(sizeof(float) * nl);
+  m.area_rays.Reserve(sizeof(float) * nl);
+  m.area_own.Reserve(sizeof(uint8_t) * nl);
+  m.area_fraction.Reserve(sizeof(float) * nl);
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
@@ -103,6 +137,14 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.geoms = m.geoms.as<GeomPod>();
   f.lights = m.lights.as<LightPod>();
   f.sky_term = m.sky.as<Float3>();
+  f.geometry = m.geometry.as<PixelGeometry>();
+  f.window = m.window.as<uint32_t>();
+  f.area_c = m.area_c.as<Float3>();
+  f.area_vis = m.area_vis.as<int8_t>();
+  f.area_visible = m.area_visible.as<float>();
+  f.area_rays = m.area_rays.as<float>();
+  f.area_own = m.area_own.as<uint8_t>();
+  f.area_fraction = m.area_fraction.as<float>();
   // (1) primary geometry (materials and normal maps included) and depth
   const dim3 block(16, 8);
   const dim3 grid((W + block.x - 1) / block.x, (H + block.y - 1) / block.y);
@@ -120,6 +162,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // (3) shading
   ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
   Check(cudaGetLastError(), "ShadeKernel");
+  VisibilityRaysKernel<<<grid, block, 0, stream>>>(f);
+  Check(cudaGetLastError(), "VisibilityRaysKernel");
+  VisibilityFractionKernel<<<grid, block, 0, stream>>>(f);
+  Check(cudaGetLastError(), "VisibilityFractionKernel");
+  VisibilityResolveKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
+  Check(cudaGetLastError(), "VisibilityResolveKernel");
   // (4) exposure from the rows' log-luminance sums
   RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,
                                                     m.rows.as<double>());
@@ -160,6 +208,9 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count) {
     GeometryKernel<<<grid, block, 0, stream>>>(f, m.geometry.as<PixelGeometry>(),
                                                m.depth.as<float>());
     ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
+    VisibilityRaysKernel<<<grid, block, 0, stream>>>(f);
+    VisibilityFractionKernel<<<grid, block, 0, stream>>>(f);
+    VisibilityResolveKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
     RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,
                                                       m.rows.as<double>());
     DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
