@@ -103,12 +103,10 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     const bool repeatable = want.rgb.data == again.rgb.data &&
                             want.radiance.data == again.radiance.data &&
                             want.depth_m.data == again.depth_m.data;
-    // Render(): pinned copies and the sky terms of one band computed while the GPU shades
-    // the band before (default), pinned in one band, pageable
-    for (const int how : {0, 1, 2}) {
+    // Render(): pinned copies (default) and pageable ones
+    for (const bool pinned : {true, false}) {
       cuda::RealtimeKernelOptions o = fast;
-      o.pinned = how < 2;
-      if (how == 1) o.bands = 1;
+      o.pinned = pinned;
       rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
@@ -121,14 +119,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       }
       const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
       fmt::print(
-          "| {} | {} | cuda Render(), {} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
+          "| {} | {} | cuda Render(), {} copies | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} | {} |\n",
-          name, size,
-          how == 0   ? fmt::format("pinned, {} bands", fast.bands)
-          : how == 1 ? std::string("pinned, 1 band")
-                     : std::string("pageable copies"),
-          1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
-          sum.film / frames, f.rgb.data == want.rgb.data ? "yes" : "NO");
+          name, size, pinned ? "pinned" : "pageable", 1 / s, 1e3 * s, sum.geometry / frames,
+          sum.sky / frames, sum.shade / frames, sum.film / frames,
+          f.rgb.data == want.rgb.data ? "yes" : "NO");
     }
     rt.set_options(fast);
     // the kernels alone: the default, each speed-up off, all off
@@ -141,12 +136,14 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_hit = false;
     variants.push_back({"kernels, primary ray traced twice", o});
     o = fast;
-    o.warp_penumbra = false;
-    variants.push_back({"kernels, penumbra per thread", o});
+    o.min_blocks = 4;
+    variants.push_back({"kernels, shading <= 128 registers", o});
+    o.min_blocks = 6;
+    variants.push_back({"kernels, shading <= 85 registers", o});
     o = fast;
     o.rows_per_warp = false;
     variants.push_back({"kernels, row sums per thread", o});
-    o.reuse_hit = o.warp_penumbra = false;
+    o.reuse_hit = false;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);
     for (const Variant& var : variants) {

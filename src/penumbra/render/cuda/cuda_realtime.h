@@ -40,38 +40,32 @@ struct RealtimeStatic {
 };
 
 /// how the realtime kernels run (the defaults are the fast ones; the others stay for the
-/// benchmark's ablations, render_cuda_bench --realtime-ablation). every variant computes the
-/// same images: only the order of a row's log-luminance sum (rows_per_warp) can change the
-/// exposure's last bits.
+/// benchmark's ablations, render_cuda_bench --realtime). every variant computes the same
+/// radiance and depth; only the order of a row's log-luminance sum (rows_per_warp) could move
+/// the exposure's last bits.
 struct RealtimeKernelOptions {
   /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
   /// again).
   bool reuse_hit = true;
-  /// the lanes of a warp share the lattice points of each pixel in a penumbra (else each
-  /// thread traces its own pixel's points, and the warp waits for the slowest).
-  bool warp_penumbra = true;
   /// one warp sums a row's log-luminance terms (32 strided partial sums, then a fixed tree);
   /// else one thread sums the row in column order.
   bool rows_per_warp = true;
   /// Render() copies through page-locked host buffers (the geometry and sky terms' round trip,
-  /// and the outputs, which are then copied into the frame's images); else it copies
-  /// to and from pageable memory directly.
+  /// the row sums, and the outputs, which are then copied into the frame's images; the depth
+  /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
   bool pinned = true;
-  /// Render() splits the image into this many bands of rows (1 to kMaxRealtimeBands): the
-  /// host computes band b + 1's sky terms while the GPU shades band b.
-  int bands = 4;
+  /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
+  /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
+  /// warps in flight, maybe spills). with reuse_hit only.
+  int min_blocks = 0;
 };
-
-/// the most bands RealtimeKernelOptions::bands takes.
-constexpr int kMaxRealtimeBands = 16;
 
 /// the host clock's time of Render()'s stages, milliseconds (benchmarks).
 /// geometry + sky + shade + film = total.
 struct RealtimeStageTimes {
   double geometry = 0;  ///< upload of geoms and lights, geometry kernel, geometry to the host
-  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms), all bands
-  /// from the last band's sky terms to the row sums on the host (the last band's shading,
-  /// the row-sum kernel, the row sums back; the other bands' shading overlaps `sky`)
+  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms)
+  /// sky terms up, shading, shared-visibility and row-sum kernels, row sums back
   double shade = 0;
   double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
   double total = 0;

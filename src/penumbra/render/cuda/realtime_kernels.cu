@@ -3,7 +3,6 @@
 
 #include <cuda_runtime.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <string>
@@ -30,64 +29,46 @@ __global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, flo
   depth[i] = t;
 }
 
-// the lanes of a warp share the lattice points of each of their pixels in a penumbra: for each
-// such pixel (in lane order) every lane traces the points kLightPenumbraRays + lane,
-// + lane + 32, ..., and the integer counts are summed over the warp (the same counts as the
-// serial loop, in any order). every lane of the warp must call it, once per light.
-struct WarpPenumbraRefiner {
-  __device__ void operator()(const SceneView& s, const LightPod& l, bool need,
-                             const PenumbraQuery& q, int* rays, int* visible) const {
-    const int lane = static_cast<int>((threadIdx.y * blockDim.x + threadIdx.x) & 31u);
-    unsigned pending = __ballot_sync(kFullWarp, need);
-    while (pending != 0) {
-      const int leader = __ffs(pending) - 1;
-      pending &= pending - 1;
-      PenumbraQuery lq;
-      lq.p.x = __shfl_sync(kFullWarp, q.p.x, leader);
-      lq.p.y = __shfl_sync(kFullWarp, q.p.y, leader);
-      lq.p.z = __shfl_sync(kFullWarp, q.p.z, leader);
-      lq.ng.x = __shfl_sync(kFullWarp, q.ng.x, leader);
-      lq.ng.y = __shfl_sync(kFullWarp, q.ng.y, leader);
-      lq.ng.z = __shfl_sync(kFullWarp, q.ng.z, leader);
-      lq.origin.x = __shfl_sync(kFullWarp, q.origin.x, leader);
-      lq.origin.y = __shfl_sync(kFullWarp, q.origin.y, leader);
-      lq.origin.z = __shfl_sync(kFullWarp, q.origin.z, leader);
-      lq.first = __shfl_sync(kFullWarp, q.first, leader);
-      int r = 0, vis = 0;
-      CountLatticeVisibility(s, l, lq, kLightPenumbraRays + lane, kLightStrata * kLightPenumbraRays,
-                             32, &r, &vis);
-      r = __reduce_add_sync(kFullWarp, r);
-      vis = __reduce_add_sync(kFullWarp, vis);
-      if (lane == leader) *rays += r, *visible += vis;
-    }
-  }
-};
-
-// kReuse: the primary hit from GeometryKernel; kWarp: WarpPenumbraRefiner (every thread of a
-// warp stays to the end, those outside the image too).
-// rows [v0, v1) of the image.
-template <bool kReuse, bool kWarp>
-__global__ void ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance, int v0,
-                            int v1) {
+// kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
+// threads each SM must hold (__launch_bounds__: at most 65536 / (128 kMinBlocks) registers).
+template <bool kReuse, int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = v0 + blockIdx.y * blockDim.y + threadIdx.y;
-  const bool active = u < f.camera.width && v < v1;
-  if (!kWarp && !active) return;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
-  if (active) {
-    if (kReuse)
-      h = hits[i];
-    else
-      TraceClosest(f.scene, r, &h);
-  }
-  Float3 L;
-  if (kWarp)
-    L = ShadeRealtimeHit(f, u, v, r, h, active, WarpPenumbraRefiner());
+  if (kReuse)
+    h = hits[i];
   else
-    L = ShadeRealtimeHit(f, u, v, r, h, true, SerialPenumbraRefiner());
-  if (active) radiance[i] = L;
+    TraceClosest(f.scene, r, &h);
+  radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
+}
+
+// the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
+// each reads its neighbours' results of the step before.
+__global__ void VisibilityRaysKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityRays(f, u, v);
+}
+
+__global__ void VisibilityFractionKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityFraction(f, u, v);
+}
+
+__global__ void VisibilityResolveKernel(RealtimeFrameView f, Float3* radiance) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
 }
 
 __global__ void RowSumKernel(const Float3* radiance, int width, int height, double* rows) {
@@ -162,14 +143,15 @@ dim3 PixelGrid(int W, int H) {
 struct DeviceRealtime::Impl {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
   Buffer geometry, depth, sky, radiance, rows, rgb, hits;
+  // the shared visibility's buffers (RealtimeFrameView)
+  Buffer window, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   std::vector<PixelGeometry> host_geometry;
   std::vector<Float3> host_sky;
   std::vector<double> host_rows;
   cudaStream_t copy_stream = nullptr;
-  cudaEvent_t geometry_done = nullptr, shade_done = nullptr;
-  cudaEvent_t band_ready[kMaxRealtimeBands] = {};
+  cudaEvent_t geometry_done = nullptr;
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -178,26 +160,35 @@ struct DeviceRealtime::Impl {
   int filmic = 1;
   bool rendered = false;
 
-  // launches the shading kernel of rows [v0, v1) of frame f on `stream` as `o` says.
-  void LaunchShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o, int v0, int v1,
-                   cudaStream_t stream) {
-    if (v1 <= v0) return;
-    const dim3 grid = PixelGrid(f.camera.width, v1 - v0);
-    TraceHit* h = o.reuse_hit ? hits.as<TraceHit>() : nullptr;
-    Float3* L = radiance.as<Float3>();
-    if (o.reuse_hit && o.warp_penumbra)
-      ShadeKernel<true, true><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
-    else if (o.reuse_hit)
-      ShadeKernel<true, false><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
-    else if (o.warp_penumbra)
-      ShadeKernel<false, true><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
-    else
-      ShadeKernel<false, false><<<grid, kPixelBlock, 0, stream>>>(f, h, L, v0, v1);
-    Check(cudaGetLastError(), "ShadeKernel");
+  void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                      cudaStream_t stream) {
+    GeometryKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
+        f, geometry.as<PixelGeometry>(), depth.as<float>(),
+        o.reuse_hit ? hits.as<TraceHit>() : nullptr);
+    Check(cudaGetLastError(), "GeometryKernel");
   }
-  // launches the row-sum kernel of frame f on `stream` as `o` says.
-  void LaunchRows(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream) {
+  // the shading, shared-visibility and row-sum kernels of frame f on `stream` as `o` says.
+  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                     cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
+    const dim3 grid = PixelGrid(W, H);
+    TraceHit* h = hits.as<TraceHit>();
+    Float3* L = radiance.as<Float3>();
+    if (!o.reuse_hit)
+      ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L);
+    else if (o.min_blocks >= 6)
+      ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    else if (o.min_blocks >= 4)
+      ShadeKernel<true, 4><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    else
+      ShadeKernel<true, 1><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    Check(cudaGetLastError(), "ShadeKernel");
+    VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    Check(cudaGetLastError(), "VisibilityRaysKernel");
+    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    Check(cudaGetLastError(), "VisibilityFractionKernel");
+    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
+    Check(cudaGetLastError(), "VisibilityResolveKernel");
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
@@ -205,19 +196,6 @@ struct DeviceRealtime::Impl {
       RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
     Check(cudaGetLastError(), "RowSumKernel");
-  }
-  // the shading and row-sum kernels of the whole frame.
-  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
-                     cudaStream_t stream) {
-    LaunchShade(f, o, 0, f.camera.height, stream);
-    LaunchRows(f, o, stream);
-  }
-  void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
-                      cudaStream_t stream) {
-    GeometryKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
-        f, geometry.as<PixelGeometry>(), depth.as<float>(),
-        o.reuse_hit ? hits.as<TraceHit>() : nullptr);
-    Check(cudaGetLastError(), "GeometryKernel");
   }
   void LaunchFilm(int64_t n, const Exposure& e, int film, cudaStream_t stream) {
     DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
@@ -227,9 +205,6 @@ struct DeviceRealtime::Impl {
   ~Impl() {
     if (copy_stream) cudaStreamDestroy(copy_stream);
     if (geometry_done) cudaEventDestroy(geometry_done);
-    if (shade_done) cudaEventDestroy(shade_done);
-    for (cudaEvent_t e : band_ready)
-      if (e) cudaEventDestroy(e);
   }
 };
 
@@ -260,9 +235,6 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   if (!m.copy_stream) {
     Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
-    Check(cudaEventCreateWithFlags(&m.shade_done, cudaEventDisableTiming), "cudaEventCreate");
-    for (cudaEvent_t& e : m.band_ready)
-      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
   }
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
@@ -276,6 +248,14 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
   if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
+  const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
+  m.window.Reserve(sizeof(uint32_t) * n);
+  m.area_c.Reserve(sizeof(Float3) * nl);
+  m.area_vis.Reserve(sizeof(int8_t) * nl);
+  m.area_visible.Reserve(sizeof(float) * nl);
+  m.area_rays.Reserve(sizeof(float) * nl);
+  m.area_own.Reserve(sizeof(uint8_t) * nl);
+  m.area_fraction.Reserve(sizeof(float) * nl);
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
@@ -286,6 +266,14 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.geoms = m.geoms.as<GeomPod>();
   f.lights = m.lights.as<LightPod>();
   f.sky_term = m.sky.as<Float3>();
+  f.geometry = m.geometry.as<PixelGeometry>();
+  f.window = m.window.as<uint32_t>();
+  f.area_c = m.area_c.as<Float3>();
+  f.area_vis = m.area_vis.as<int8_t>();
+  f.area_visible = m.area_visible.as<float>();
+  f.area_rays = m.area_rays.as<float>();
+  f.area_own = m.area_own.as<uint8_t>();
+  f.area_fraction = m.area_fraction.as<float>();
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;
@@ -308,58 +296,27 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     host_sky = m.host_sky.data();
     host_rows = m.host_rows.data();
   }
-  // bands of whole blocks of rows: the host computes band b + 1's sky terms while the GPU
-  // shades band b (pinned memory only: pageable copies block the host)
-  const int bands = o.pinned ? std::max(1, std::min(o.bands, kMaxRealtimeBands)) : 1;
-  const int band_rows = static_cast<int>((H + bands * static_cast<int>(kPixelBlock.y) - 1) /
-                                         (bands * static_cast<int>(kPixelBlock.y)) * kPixelBlock.y);
-  // (1) primary geometry (materials and normal maps included) and depth; pinned: the geometry
-  // goes back band by band and the depth after it, on the copy stream
+  // (1) primary geometry (materials and normal maps included) and depth; pinned: the depth
+  // goes back on the copy stream while the host computes the sky terms
   m.LaunchGeometry(f, o, stream);
-  double sky_ms = 0;
-  auto t1 = Clock::now();
-  if (o.pinned) {
-    Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
-    Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
-    for (int b = 0; b < bands; ++b) {
-      const int64_t v0 = std::min<int64_t>(H, static_cast<int64_t>(b) * band_rows);
-      const int64_t v1 = std::min<int64_t>(H, v0 + band_rows);
-      Check(cudaMemcpyAsync(host_geometry + v0 * W, m.geometry.as<PixelGeometry>() + v0 * W,
-                            sizeof(PixelGeometry) * (v1 - v0) * W, cudaMemcpyDeviceToHost,
-                            m.copy_stream),
-            "cudaMemcpyAsync");
-      Check(cudaEventRecord(m.band_ready[b], m.copy_stream), "cudaEventRecord");
+  m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
+  if (out.depth) {
+    if (o.pinned) {
+      Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
+      Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
+      m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
+    } else {
+      m.depth.Download(out.depth, sizeof(float) * n, stream);
     }
-    if (out.depth) m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
-    // (2) each band's sky terms on the host, then (3) its shading
-    for (int b = 0; b < bands; ++b) {
-      const int64_t v0 = std::min<int64_t>(H, static_cast<int64_t>(b) * band_rows);
-      const int64_t v1 = std::min<int64_t>(H, v0 + band_rows);
-      Check(cudaEventSynchronize(m.band_ready[b]), "GeometryKernel");
-      if (b == 0) t1 = Clock::now();
-      const auto ts = Clock::now();
-      sky(host_geometry + v0 * W, (v1 - v0) * W, host_sky + v0 * W);
-      sky_ms += MsSince(ts);
-      Check(cudaMemcpyAsync(m.sky.as<Float3>() + v0 * W, host_sky + v0 * W,
-                            sizeof(Float3) * (v1 - v0) * W, cudaMemcpyHostToDevice, stream),
-            "cudaMemcpyAsync");
-      m.LaunchShade(f, o, static_cast<int>(v0), static_cast<int>(v1), stream);
-    }
-  } else {
-    m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
-    if (out.depth) m.depth.Download(out.depth, sizeof(float) * n, stream);
-    Check(cudaStreamSynchronize(stream), "GeometryKernel");
-    t1 = Clock::now();
-    // (2) the sky terms on the host
-    const auto ts = Clock::now();
-    sky(host_geometry, n, host_sky);
-    sky_ms = MsSince(ts);
-    m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
-    // (3) shading
-    m.LaunchShade(f, o, 0, H, stream);
   }
-  // (4) the rows' log-luminance sums
-  m.LaunchRows(f, o, stream);
+  Check(cudaStreamSynchronize(stream), "GeometryKernel");
+  const auto t1 = Clock::now();
+  // (2) the sky terms on the host
+  sky(host_geometry, n, host_sky);
+  const auto t2 = Clock::now();
+  m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
+  // (3) shading, the shared visibility and (4) the rows' log-luminance sums
+  m.LaunchShading(f, o, stream);
   m.rows.Download(host_rows, sizeof(double) * H, stream);
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
   const auto t3 = Clock::now();
@@ -382,12 +339,9 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
   }
-  // geometry: until the first band's geometry is on the host; sky: the host's sky terms;
-  // shade: the rest until the row sums are back (the bands' waits and shading that the sky
-  // terms did not hide)
   m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  m.times.sky = sky_ms;
-  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t1).count() - sky_ms;
+  m.times.sky = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t2).count();
   m.times.film = MsSince(t3);
   m.times.total = MsSince(t0);
   m.frame = f;
