@@ -56,14 +56,15 @@ PB_HOST_DEVICE inline float ShadowWindowWeight(int dx, int dy) {
 
 /// whether the hit g (geom, unit normal ng_g facing the ray, point p_g) lies on the surface of
 /// hit i: the same geom, normals within 25 degrees (dot >= 0.9) and g within 5 % of its
-/// distance from i's tangent plane. points in m, world frame.
+/// distance from i's tangent plane. points in m, world frame. the sums run x + (y + z), the
+/// order of Eigen's 3-vector dot and squaredNorm, which the CPU backend used before.
 PB_HOST_DEVICE inline bool SameShadowSurface(int geom_i, const float ng_i[3], const float p_i[3],
                                              int geom_g, const float ng_g[3], const float p_g[3]) {
-  if (geom_g != geom_i || !(ng_i[0] * ng_g[0] + ng_i[1] * ng_g[1] + ng_i[2] * ng_g[2] >= 0.9f))
+  if (geom_g != geom_i || !(ng_i[0] * ng_g[0] + (ng_i[1] * ng_g[1] + ng_i[2] * ng_g[2]) >= 0.9f))
     return false;
   const float dp[3] = {p_g[0] - p_i[0], p_g[1] - p_i[1], p_g[2] - p_i[2]};
-  const float off = ng_i[0] * dp[0] + ng_i[1] * dp[1] + ng_i[2] * dp[2];
-  return off * off <= 0.0025f * (dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2]) + 1e-10f;
+  const float off = ng_i[0] * dp[0] + (ng_i[1] * dp[1] + ng_i[2] * dp[2]);
+  return off * off <= 0.0025f * (dp[0] * dp[0] + (dp[1] * dp[1] + dp[2] * dp[2])) + 1e-10f;
 }
 
 /// whether tile-local pixel (x, y) lies on its tile's outermost ring (its window lacks the next
