@@ -82,10 +82,12 @@ std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::strin
       throw Error("ConvertUrdfToMjcf: MuJoCo could not save " + urdf_path + " as MJCF: " + error);
     }
   }
-  std::ifstream out(tmpl, std::ios::binary);
-  std::stringstream os;
-  os << out.rdbuf();
-  mjcf = os.str();
+  try {
+    mjcf = ReadInputFile(tmpl, "MJCF file MuJoCo saved");
+  } catch (...) {
+    std::filesystem::remove(tmpl);
+    throw;
+  }
   std::filesystem::remove(tmpl);
   for (const auto& [name, bytes] : meshes.files) {
     const std::string from = "file=\"" + name + "\"";
