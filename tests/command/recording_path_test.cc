@@ -15,8 +15,8 @@
 #include "penumbra/command/run_description.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_format.h"
-#include "penumbra/session/live_control.h"
-#include "penumbra/session/physics_source.h"
+#include "penumbra/live/live_control.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -1,9 +1,9 @@
-// live changes of a running world (session/live_effects.h, live_control.h): a change requested
+// live changes of a running world (live/live_effects.h, live_control.h): a change requested
 // during step k applies from step k + 1 on, in every frame after and in none before; bad
 // requests are refused naming the field before anything changes; the NPCs of the preset a run
 // started with move onto the new preset's paths or park, and no more can be added.
 
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +17,8 @@
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -1,4 +1,4 @@
-// recording a run through the pipeline (output/recorder_sink.h, session/run_log_header.h): the
+// recording a run through the pipeline (output/recorder_sink.h, live/run_log_header.h): the
 // log's step records are the simulation's own state (Simulation::GetState) at every step,
 // bit for bit, from step 0; the header maps that state by name and hashes the files read.
 
@@ -12,9 +12,9 @@
 #include "penumbra/core/error.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/session/live_recorder.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/live/live_recorder.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

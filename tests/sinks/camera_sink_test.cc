@@ -1,7 +1,7 @@
 // the cameras as a pipeline sink: per-camera effects travel beside the immutable snapshot to
 // the renderer, every image kind reaches the files through the frame writer, and a render
 // error ends the run.
-#include "penumbra/session/camera_sink.h"
+#include "penumbra/sinks/camera_sink.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 

@@ -1,4 +1,4 @@
-#include "penumbra/session/physics_source.h"
+#include "penumbra/sinks/physics_source.h"
 
 #include <gtest/gtest.h>
 

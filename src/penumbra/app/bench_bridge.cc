@@ -20,7 +20,7 @@
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
 #include "penumbra/zmq/msgpack_json.h"
 #include "penumbra/zmq/zmq_bridge.h"

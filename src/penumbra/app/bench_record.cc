@@ -15,8 +15,8 @@
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

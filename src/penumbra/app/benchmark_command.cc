@@ -11,7 +11,7 @@
 #include <fstream>
 
 #include "penumbra/app/backend_flag.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/benchmark/benchmark_runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"

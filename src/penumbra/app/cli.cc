@@ -30,7 +30,7 @@
 #include "penumbra/app/heightfield_tool.h"
 #include "penumbra/app/npc_map_command.h"
 #include "penumbra/app/replay_command.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/app/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
 #include "penumbra/app/viewer_commands.h"

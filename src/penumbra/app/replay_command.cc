@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "penumbra/app/backend_flag.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/replay/replay_runner.h"

@@ -14,8 +14,8 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/sensor_sink.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

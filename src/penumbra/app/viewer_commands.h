@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 
 namespace CLI {
 class App;

@@ -1,6 +1,6 @@
 #pragma once
 // the bridges of one live run and what they share: the RunControl, the CommandDispatcher and
-// the model description, wired into a run's outputs and loop. app/runner.cc builds one when
+// the model description, wired into a run's outputs and loop. run/runner.cc builds one when
 // RunOptions::bridges is not empty:
 //
 //   RunOutputs outputs(...);
@@ -30,8 +30,8 @@
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/sinks/run_outputs.h"
 
 namespace penumbra {
 

@@ -1,5 +1,5 @@
 #pragma once
-// RunControl: the loop-thread side of the command layer. a live run (app/runner.cc with
+// RunControl: the loop-thread side of the command layer. a live run (run/runner.cc with
 // bridges) steps its Simulation through a PhysicsSource whose before_step hook is
 // RunControl::BeforeStep, so everything that changes the simulation happens there, on the
 // loop thread, at a step boundary:

@@ -1,4 +1,4 @@
-#include "penumbra/session/json_effect_reader.h"
+#include "penumbra/live/json_effect_reader.h"
 
 #include <climits>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// an effect's parameters given as JSON (a live change, session/live_effects.h) read through the
+// an effect's parameters given as JSON (a live change, live/live_effects.h) read through the
 // effect types' own readers (effects/effect_type.h EffectParamReader): the keys and value
 // types of the world file's `effects:` entries (docs/effects.md), with errors naming the key
 // path and what was expected.

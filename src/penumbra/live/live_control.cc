@@ -1,4 +1,4 @@
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 
 #include <spdlog/spdlog.h>
 

@@ -1,8 +1,8 @@
 #pragma once
 // the live controls of a running world, as the bridges (ZeroMQ, ROS) and the browser viewer
 // reach them through their shared command dispatcher (issues 19 and 22): the adverse
-// conditions (session/live_effects.h) and run-log recording (session/live_recorder.h). a run
-// (app/runner.h RunOptions::on_live) hands its LiveControl to the caller once it is set up.
+// conditions (live/live_effects.h) and run-log recording (live/live_recorder.h). a run
+// (run/runner.h RunOptions::on_live) hands its LiveControl to the caller once it is set up.
 //
 // in a SimLoop: effects() is the loop's first sink (changes apply before any other sink sees
 // the step) and recorder() follows the cameras and sensors (their sensor records reach it
@@ -15,8 +15,8 @@
 
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_writer.h"
-#include "penumbra/session/live_effects.h"
-#include "penumbra/session/live_recorder.h"
+#include "penumbra/live/live_effects.h"
+#include "penumbra/live/live_recorder.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

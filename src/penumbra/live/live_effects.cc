@@ -1,4 +1,4 @@
-#include "penumbra/session/live_effects.h"
+#include "penumbra/live/live_effects.h"
 
 #include <spdlog/spdlog.h>
 
@@ -10,7 +10,7 @@
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
-#include "penumbra/session/json_effect_reader.h"
+#include "penumbra/live/json_effect_reader.h"
 
 namespace penumbra {
 namespace {

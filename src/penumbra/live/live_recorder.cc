@@ -1,4 +1,4 @@
-#include "penumbra/session/live_recorder.h"
+#include "penumbra/live/live_recorder.h"
 
 #include <fcntl.h>
 #include <spdlog/spdlog.h>
@@ -8,7 +8,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/output/recorder_sink.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/live/run_log_header.h"
 
 namespace penumbra {
 

@@ -1,4 +1,4 @@
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/live/run_log_header.h"
 
 #include <filesystem>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -19,11 +19,11 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 #include "penumbra/session/npc_map_json.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
+#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 
@@ -177,7 +177,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // --record-sensors: every image file the cameras write also goes into the run log (set
   // once the log is open, before the loop starts)
   RunLogWriter* sensor_log = nullptr;
-  // the live controls (session/live_control.h); their recordings take sensor records too
+  // the live controls (live/live_control.h); their recordings take sensor records too
   LiveControl live(session, JoinArgs(options.command_line), out);
   outputs_options.on_image = [&sensor_log, &live](const CameraFrame& f, const std::string& kind,
                                                   const std::vector<uint8_t>& png) {

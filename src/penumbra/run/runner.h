@@ -52,7 +52,7 @@ struct RunOptions {
   /// with bridges: the run starts paused and advances only by `step` requests (--lockstep).
   bool lockstep = false;
   /// called once the run is set up, before its first step, on the caller's thread, with the
-  /// run's live controls (session/live_control.h: adversity and effect changes, start/stop
+  /// run's live controls (live/live_control.h: adversity and effect changes, start/stop
   /// recording; thread-safe). the LiveControl lives until RunWorld returns: stop using it
   /// before then (e.g. in a sink's OnFinish). may be empty.
   std::function<void(LiveControl&)> on_live;

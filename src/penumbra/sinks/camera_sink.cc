@@ -1,4 +1,4 @@
-#include "penumbra/session/camera_sink.h"
+#include "penumbra/sinks/camera_sink.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

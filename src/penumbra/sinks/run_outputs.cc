@@ -1,4 +1,4 @@
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/sinks/run_outputs.h"
 
 #include <fmt/format.h>
 

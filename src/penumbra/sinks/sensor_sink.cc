@@ -1,4 +1,4 @@
-#include "penumbra/session/sensor_sink.h"
+#include "penumbra/sinks/sensor_sink.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
