@@ -1,12 +1,12 @@
 // `penumbra benchmark --backend B` reaches every job: the Slurm array's command line carries
-// `--backend B` (quoted), and none when no backend was given (benchmark/benchmark_runner.h).
+// `--backend B` (quoted), and none when no backend was given (campaign/benchmark_runner.h).
 
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/benchmark_runner.h"
+#include "penumbra/campaign/benchmark_runner.h"
 
 namespace penumbra {
 namespace {

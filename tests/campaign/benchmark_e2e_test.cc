@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/benchmark_report.h"
+#include "penumbra/campaign/benchmark_report.h"
 
 namespace penumbra {
 namespace {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/benchmark_runner.h"
-#include "penumbra/benchmark/child_process.h"
+#include "penumbra/campaign/benchmark_runner.h"
+#include "penumbra/campaign/child_process.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

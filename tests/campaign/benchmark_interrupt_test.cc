@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/child_process.h"
+#include "penumbra/campaign/child_process.h"
 
 namespace penumbra {
 namespace {

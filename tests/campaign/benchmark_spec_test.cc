@@ -1,10 +1,10 @@
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_spec.h"
 
 #include <gtest/gtest.h>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/benchmark_report.h"
-#include "penumbra/benchmark/command_template.h"
+#include "penumbra/campaign/benchmark_report.h"
+#include "penumbra/campaign/command_template.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

@@ -1,8 +1,8 @@
-// method command templates without a shell (benchmark/command_template.h): the word grammar,
+// method command templates without a shell (campaign/command_template.h): the word grammar,
 // its refusals, values substituted as plain text into one argument each, and the quoting of
-// the scripts written for people (benchmark/shell_quote.h), checked against a real /bin/sh.
+// the scripts written for people (campaign/shell_quote.h), checked against a real /bin/sh.
 
-#include "penumbra/benchmark/command_template.h"
+#include "penumbra/campaign/command_template.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/child_process.h"
-#include "penumbra/benchmark/method_process.h"
-#include "penumbra/benchmark/shell_quote.h"
+#include "penumbra/campaign/child_process.h"
+#include "penumbra/campaign/method_process.h"
+#include "penumbra/campaign/shell_quote.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

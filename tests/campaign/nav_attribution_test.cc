@@ -1,4 +1,4 @@
-// who made a contact between the robot and an NPC (benchmark/nav_metrics.h AgentMadeContact):
+// who made a contact between the robot and an NPC (campaign/nav_metrics.h AgentMadeContact):
 // two scripted runs through the real physics and the contacts metric (metrics/metrics_sink.h
 // writes each episode's approach speeds), judged as the nav harness judges them: the rover
 // driven into a standing person is the robot's collision; a person walking into the standing
@@ -11,7 +11,7 @@
 
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
@@ -30,7 +30,7 @@ constexpr const char* kAttributionArena = R"(<mujoco model="arena">
 </mujoco>)";
 
 // the rover at the origin heading +x (driven at 0.5 m/s to x = 3 when `drive`), one person
-// with `agent_yaml`, and the nav harness's contacts metric (benchmark/nav_job.cc)
+// with `agent_yaml`, and the nav harness's contacts metric (campaign/nav_job.cc)
 std::string AttributionWorld(const std::string& agent_yaml) {
   return std::string(R"(seed: 1
 duration_sec: 4

@@ -1,9 +1,9 @@
 // issue 20's nav acceptance, parts (b) and (c), through the real `penumbra benchmark` with a
 // `kind: nav` spec: every job starts a real lockstep `penumbra run --zmq` and a real method
-// process (the bundled python3 -m penumbra_nav, or tests/benchmark/straight_driver.py), and the
+// process (the bundled python3 -m penumbra_nav, or tests/campaign/straight_driver.py), and the
 // harness judges the episode from the run's own pose and contact series.
 //   (b) the baseline navigator reaches a goal 3 m ahead under `none`: success, no collision;
-//   (c) a goal inside a closed pen (tests/benchmark/data/nav_wall.yaml): the navigator times
+//   (c) a goal inside a closed pen (tests/campaign/data/nav_wall.yaml): the navigator times
 //       out honestly (success 0), and a blind method that trots straight into the pen's
 //       wall is charged a collision (success 0, SC 0).
 // plus the spec checks of the nav format (errors naming file:line and the field).
@@ -17,8 +17,8 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/benchmark/benchmark_spec.h"
-#include "penumbra/benchmark/nav_report.h"
+#include "penumbra/campaign/benchmark_spec.h"
+#include "penumbra/campaign/nav_report.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -115,13 +115,13 @@ TEST(NavBenchmark, GoalBehindAWallTimesOutOrCountsCollisions) {
   const std::string spec = dir.Write(
       "wall.yaml",
       "kind: nav\nname: wall\nworlds:\n  - name: pen\n    file: " + src +
-          "/tests/benchmark/data/nav_wall.yaml\n    robot: quadruped\n    episodes:\n"
+          "/tests/campaign/data/nav_wall.yaml\n    robot: quadruped\n    episodes:\n"
           "      - {name: inside, goal: [2.5, 0], radius: 0.3, timeout_sec: 8}\n"
           "conditions: [none]\ntrials: 1\nmethods:\n"
           "  - {name: penumbra_nav, bundled: penumbra_nav, timeout_sec: 120}\n"
           "  - {name: straight, command: \"/usr/bin/env PYTHONPATH={pythonpath} /usr/bin/python3 " +
           src +
-          "/tests/benchmark/straight_driver.py {endpoint}\", timeout_sec: 120}\n"
+          "/tests/campaign/straight_driver.py {endpoint}\", timeout_sec: 120}\n"
           "metrics: {debounce_sec: 0.5}\nworkers: 2\n");
   const fs::path out = fs::path(dir.path()) / "out";
   ASSERT_EQ(RunBenchmarkCli(spec + " --out " + out.string() + " --quiet"), 0);

@@ -3,13 +3,13 @@
 // judgement (time to goal, fall, timeout) on hand-made pose series, and the summary's mean
 // +- std over trials.
 
-#include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/campaign/nav_metrics.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "penumbra/benchmark/nav_report.h"
+#include "penumbra/campaign/nav_report.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

@@ -1,4 +1,4 @@
-"""`penumbra benchmark --slurm` against a real single-node Slurm (tests/benchmark/slurm_cluster.py:
+"""`penumbra benchmark --slurm` against a real single-node Slurm (tests/campaign/slurm_cluster.py:
 munged, slurmctld and slurmd started here on localhost): a 4-job array (one world, 2
 conditions, 2 trials) gives the same rows as the local workers; re-submitting submits only
 the unfinished job; SIGINT while array tasks run a hanging method exits 130, cancels the

@@ -1,5 +1,5 @@
 """A deliberately blind navigation method for the benchmark's wall test
-(tests/benchmark/nav_e2e_test.cc): it trots straight ahead at 0.4 m/s over the ZeroMQ bridge,
+(tests/campaign/nav_e2e_test.cc): it trots straight ahead at 0.4 m/s over the ZeroMQ bridge,
 ignoring the goal and every obstacle, until the run ends. A real external process, so the
 harness's collision counting is exercised on real contacts.
 

@@ -12,7 +12,7 @@
 
 #include "penumbra/app/backend_flag.h"
 #include "penumbra/run/runner.h"
-#include "penumbra/benchmark/benchmark_runner.h"
+#include "penumbra/campaign/benchmark_runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/eval/trajectory.h"

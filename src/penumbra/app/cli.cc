@@ -17,10 +17,10 @@
 #include <optional>
 
 #include "penumbra/app/backend_flag.h"
-#include "penumbra/app/bench.h"
-#include "penumbra/app/bench_bridge.h"
-#include "penumbra/app/bench_record.h"
-#include "penumbra/app/bench_ros.h"
+#include "penumbra/bench/bench.h"
+#include "penumbra/bench/bench_bridge.h"
+#include "penumbra/bench/bench_record.h"
+#include "penumbra/bench/bench_ros.h"
 #include "penumbra/app/benchmark_command.h"
 #include "penumbra/app/bridge_flags.h"
 #include "penumbra/app/contact_sheet.h"
@@ -31,7 +31,7 @@
 #include "penumbra/app/npc_map_command.h"
 #include "penumbra/app/replay_command.h"
 #include "penumbra/run/runner.h"
-#include "penumbra/app/sensor_bench.h"
+#include "penumbra/bench/sensor_bench.h"
 #include "penumbra/app/vdb_tool.h"
 #include "penumbra/app/viewer_commands.h"
 #include "penumbra/core/build_info.h"

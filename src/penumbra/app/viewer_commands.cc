@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 #include "penumbra/core/error.h"
 #include "penumbra/viewer/viewer_bridge.h"
 #include "penumbra/viewer/viewer_messages.h"

@@ -1,4 +1,4 @@
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "penumbra/app/effects_bench.h"
+#include "penumbra/bench/effects_bench.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/controller_cost_benchmark.h"
@@ -223,7 +223,7 @@ int BenchRender(const RenderBenchOptions& options) {
   }
   // the target is the realtime tier's; a pathtraced run says so instead of a verdict
   PrintRealtimeFpsTarget("", kRenderTargetFps, fps_640x480, options.tier);
-  if (options.adversity) BenchRenderAdversity(options);  // app/effects_bench.h
+  if (options.adversity) BenchRenderAdversity(options);  // bench/effects_bench.h
   return 0;
 }
 

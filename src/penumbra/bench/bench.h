@@ -27,7 +27,7 @@ struct RenderBenchOptions {
   int batch_width = 128;  ///< --size WxH of the batch benchmark
   int batch_height = 128;
   int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
-  bool adversity = true;  ///< also time the presets none/minor/major (app/effects_bench.h)
+  bool adversity = true;  ///< also time the presets none/minor/major (bench/effects_bench.h)
   /// parts of the renderer to switch off (RenderAblation's fields by their --ablate names:
   /// mirror, mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, film); the
   /// frames/s then say what the part costs (docs/performance.md, "What costs what").

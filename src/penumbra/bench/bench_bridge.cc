@@ -1,4 +1,4 @@
-#include "penumbra/app/bench_bridge.h"
+#include "penumbra/bench/bench_bridge.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"

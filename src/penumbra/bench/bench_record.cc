@@ -1,4 +1,4 @@
-#include "penumbra/app/bench_record.h"
+#include "penumbra/bench/bench_record.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/pipeline/sim_loop.h"

@@ -1,4 +1,4 @@
-#include "penumbra/app/bench_ros.h"
+#include "penumbra/bench/bench_ros.h"
 
 #include <fmt/format.h>
 

@@ -1,8 +1,8 @@
-#include "penumbra/app/effects_bench.h"
+#include "penumbra/bench/effects_bench.h"
 
 #include <fmt/format.h>
 
-#include "penumbra/app/preset_scene.h"
+#include "penumbra/bench/preset_scene.h"
 
 namespace penumbra {
 

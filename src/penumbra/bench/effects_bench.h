@@ -1,8 +1,8 @@
 #pragma once
 // the adversity part of `penumbra bench render`: frames/s of the world's first camera at
-// 640x480 under the bundled presets none, minor and major (app/preset_scene.h).
+// 640x480 under the bundled presets none, minor and major (bench/preset_scene.h).
 
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 
 namespace penumbra {
 

@@ -1,4 +1,4 @@
-#include "penumbra/app/preset_scene.h"
+#include "penumbra/bench/preset_scene.h"
 
 #include <chrono>
 #include <cmath>

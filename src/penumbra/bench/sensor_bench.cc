@@ -1,4 +1,4 @@
-#include "penumbra/app/sensor_bench.h"
+#include "penumbra/bench/sensor_bench.h"
 
 #include <fmt/format.h>
 #include <time.h>
@@ -8,7 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "penumbra/app/bench.h"
+#include "penumbra/bench/bench.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/backends/renderer_factory.h"

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/benchmark_job.h"
+#include "penumbra/campaign/benchmark_job.h"
 
 #include <spdlog/spdlog.h>
 
@@ -10,10 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "penumbra/benchmark/benchmark_text.h"
-#include "penumbra/benchmark/command_template.h"
-#include "penumbra/benchmark/method_process.h"
-#include "penumbra/benchmark/nav_job.h"
+#include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/command_template.h"
+#include "penumbra/campaign/method_process.h"
+#include "penumbra/campaign/nav_job.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/dataset/dataset_export.h"

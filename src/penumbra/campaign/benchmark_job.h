@@ -20,13 +20,13 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_spec.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 
 /// one (world, condition, trial); for a nav spec one (world, episode, condition, method,
-/// trial) (benchmark/nav_job.h).
+/// trial) (campaign/nav_job.h).
 struct BenchmarkJob {
   int index = 0;  ///< 0-based, world-major, then condition, then trial
   size_t world = 0, condition = 0, trial = 0;

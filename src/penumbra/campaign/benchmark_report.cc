@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/benchmark_report.h"
+#include "penumbra/campaign/benchmark_report.h"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "penumbra/benchmark/benchmark_text.h"
+#include "penumbra/campaign/benchmark_text.h"
 #include "penumbra/core/error.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/benchmark/benchmark_job.h"
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_job.h"
+#include "penumbra/campaign/benchmark_spec.h"
 
 namespace penumbra {
 

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/benchmark_runner.h"
+#include "penumbra/campaign/benchmark_runner.h"
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -18,13 +18,13 @@
 #include <sstream>
 #include <thread>
 
-#include "penumbra/benchmark/benchmark_job.h"
-#include "penumbra/benchmark/benchmark_report.h"
-#include "penumbra/benchmark/benchmark_text.h"
-#include "penumbra/benchmark/child_process.h"
-#include "penumbra/benchmark/nav_job.h"
-#include "penumbra/benchmark/nav_report.h"
-#include "penumbra/benchmark/shell_quote.h"
+#include "penumbra/campaign/benchmark_job.h"
+#include "penumbra/campaign/benchmark_report.h"
+#include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/child_process.h"
+#include "penumbra/campaign/nav_job.h"
+#include "penumbra/campaign/nav_report.h"
+#include "penumbra/campaign/shell_quote.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

@@ -1,11 +1,11 @@
 #pragma once
 // `penumbra benchmark SPEC.yaml --out DIR` (docs/benchmarks.md): the spec is loaded and
 // checked; every world's route is recorded once (OUT/recordings/<world>.plog); the jobs
-// (world x condition x trial, benchmark/benchmark_job.h) run as worker processes of this
+// (world x condition x trial, campaign/benchmark_job.h) run as worker processes of this
 // binary (`penumbra benchmark SPEC --out DIR --job K`), N at a time locally, or as one Slurm
 // job array (one task per job, `sbatch`, then `squeue` until none is left); the results are
 // collected into results.csv, the summary, the plots and report.md
-// (benchmark/benchmark_report.h). jobs that finished earlier (their result.json exists) are
+// (campaign/benchmark_report.h). jobs that finished earlier (their result.json exists) are
 // skipped, so running the same command again resumes an interrupted benchmark, and
 // re-submitting to Slurm submits only the unfinished jobs.
 
@@ -13,7 +13,7 @@
 #include <functional>
 #include <string>
 
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_spec.h"
 
 namespace penumbra {
 
@@ -73,7 +73,7 @@ void CheckSlurmPaths(const std::string& out_dir, const std::string& spec_file,
 
 /// the Slurm batch script for the unfinished jobs `indices` (also written by RunBenchmark
 /// as OUT/slurm/array.sbatch). every interpolated path is checked (CheckSlurmPaths) and the
-/// command line's words are quoted with ShellQuote (benchmark/shell_quote.h). `backend` (""
+/// command line's words are quoted with ShellQuote (campaign/shell_quote.h). `backend` (""
 /// = none) is passed to each task as --backend.
 /// @throws ConfigError as CheckSlurmPaths, or for an extra `#SBATCH` line holding a control
 ///         character.

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_spec.h"
 
 #include <stdlib.h>
 #include <unistd.h>
@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "penumbra/benchmark/command_template.h"
-#include "penumbra/benchmark/shell_quote.h"
+#include "penumbra/campaign/command_template.h"
+#include "penumbra/campaign/shell_quote.h"
 #include "penumbra/core/error.h"
 #include "penumbra/replay/world_override.h"
 #include "penumbra/world/adversity_preset.h"
@@ -81,7 +81,7 @@ void CheckTemplate(const YamlReader& r, const std::string& text,
   }
 }
 
-// the template split into words (benchmark/command_template.h); a refusal names the field
+// the template split into words (campaign/command_template.h); a refusal names the field
 std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text) {
   try {
     return SplitCommandTemplate(text);

@@ -3,7 +3,7 @@
 // worlds (each a recorded route), which adversity conditions, how many trials (seeds), which
 // SLAM methods and which metrics. `kind: nav` makes it a navigation benchmark instead: its
 // worlds name a robot and point-goal episodes, its methods are closed-loop navigators
-// (benchmark/nav_spec.h has that half of the format); `kind: slam` is the default. loaded and
+// (campaign/nav_spec.h has that half of the format); `kind: slam` is the default. loaded and
 // checked as a whole before anything runs; every error names the spec file, the 1-based line and
 // the key path.
 //
@@ -39,14 +39,14 @@
 // method's own folder, its current folder), {fx} {fy} {cx} {cy} {width} {height} (the
 // camera's pinhole intrinsics, pixels), {camera_info} (the run's camera_info.json), {seed}.
 // `{{` and `}}` are literal braces. a command runs without a shell: the template is split
-// into words at load (benchmark/command_template.h: quotes group, nothing is expanded, shell
+// into words at load (campaign/command_template.h: quotes group, nothing is expanded, shell
 // operators are refused) and each value is substituted as plain text inside its word.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "penumbra/benchmark/nav_spec.h"
+#include "penumbra/campaign/nav_spec.h"
 #include "penumbra/eval/umeyama.h"
 
 namespace penumbra {

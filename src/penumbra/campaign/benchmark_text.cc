@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/benchmark_text.h"
+#include "penumbra/campaign/benchmark_text.h"
 
 #include <fmt/format.h>
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/benchmark/benchmark_report.h"
+#include "penumbra/campaign/benchmark_report.h"
 
 namespace penumbra::benchmark_text {
 

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/child_process.h"
+#include "penumbra/campaign/child_process.h"
 
 #include <fcntl.h>
 #include <signal.h>

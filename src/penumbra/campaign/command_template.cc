@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/command_template.h"
+#include "penumbra/campaign/command_template.h"
 
 #include <algorithm>
 #include <array>

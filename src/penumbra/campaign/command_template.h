@@ -4,7 +4,7 @@
 // split into words once, when the spec is loaded; each job substitutes its {placeholders}
 // inside each word as plain text, so a value (a path holding spaces, quotes, `$(...)` or `;`)
 // stays one argument and is never read by a shell. the process is started with execvp
-// (benchmark/child_process.h), never through /bin/sh.
+// (campaign/child_process.h), never through /bin/sh.
 //
 // the word grammar, a small subset of the POSIX shell's that means the same under /bin/sh:
 //   - blanks (space, tab) separate words; trailing newlines are ignored;

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/method_process.h"
+#include "penumbra/campaign/method_process.h"
 
 #include <string.h>
 
@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <thread>
 
-#include "penumbra/benchmark/child_process.h"
-#include "penumbra/benchmark/shell_quote.h"
+#include "penumbra/campaign/child_process.h"
+#include "penumbra/campaign/shell_quote.h"
 
 namespace penumbra {
 

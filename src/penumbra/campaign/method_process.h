@@ -1,6 +1,6 @@
 #pragma once
 // running one benchmark method: its command template expanded into an argument vector
-// (benchmark/command_template.h) and executed without a shell in the method's work folder,
+// (campaign/command_template.h) and executed without a shell in the method's work folder,
 // with its stdout and stderr written to files there, killed (its whole process group, SIGTERM
 // then SIGKILL after 2 s) when it runs past its timeout or when a stop is requested.
 
@@ -33,7 +33,7 @@ ProcessOutcome RunMethodCommand(const std::vector<std::string>& argv, const std:
 
 /// the command.sh written beside a method's logs for people to re-run it by hand: a /bin/sh
 /// script that enters `workdir` and executes `argv`, every word quoted by ShellCommandLine
-/// (benchmark/shell_quote.h), so it runs exactly the argument vector the harness ran.
+/// (campaign/shell_quote.h), so it runs exactly the argument vector the harness ran.
 /// @throws Error when a word holds a NUL byte.
 std::string MethodCommandScript(const std::vector<std::string>& argv, const std::string& workdir);
 

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/nav_job.h"
+#include "penumbra/campaign/nav_job.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -19,11 +19,11 @@
 #include <sstream>
 #include <thread>
 
-#include "penumbra/benchmark/benchmark_text.h"
-#include "penumbra/benchmark/child_process.h"
-#include "penumbra/benchmark/command_template.h"
-#include "penumbra/benchmark/method_process.h"
-#include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/child_process.h"
+#include "penumbra/campaign/command_template.h"
+#include "penumbra/campaign/method_process.h"
+#include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
@@ -70,7 +70,7 @@ std::string NavNum(double v) { return FormatNumber(v); }
 std::string OverrideYaml(const BenchmarkSpec& spec, const BenchmarkWorld& w) {
   const NavRobotProfile profile = NavProfile(w.profile);
   const NavMetricsConfig& m = spec.nav_metrics;
-  std::string s = "# written by penumbra benchmark (benchmark/nav_job.h)\nmetrics:\n";
+  std::string s = "# written by penumbra benchmark (campaign/nav_job.h)\nmetrics:\n";
   s += "  rate_hz: " + NavNum(m.pose_rate_hz) + "\n  series:\n";
   s += "    - {name: nav_base, type: body_pose, bodies: [\"" + w.robot + "/" + profile.base_body +
        "\"], rate_hz: " + NavNum(m.pose_rate_hz) + "}\n";

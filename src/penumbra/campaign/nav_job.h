@@ -3,14 +3,14 @@
 // starts the simulator, `penumbra run WORLD --zmq tcp://127.0.0.1:<free port> --lockstep
 // --adversity C --seed S --duration <episode timeout> --override override.yaml`, and the
 // method's command (an external process given the endpoint, its argument vector expanded
-// from the template without a shell: benchmark/command_template.h) side by side. the episode ends
+// from the template without a shell: campaign/command_template.h) side by side. the episode ends
 // when the method exits (the harness then stops the run with SIGTERM: outputs and run.json
 // are written), when the run reaches the episode's sim timeout (the method gets 3 s of wall
 // time to exit, then its process group is killed), or at the method's wall-clock timeout
 // (both are stopped). the override adds two metric series to the run (metrics/metrics_sink.h):
 // the robot base's pose (nav_base.csv) and the robot's contacts with anything but its own
 // parts and its feet/wheels on the floor, undebounced (nav_contacts_episodes.csv). the row's
-// metrics come from those files alone (benchmark/nav_metrics.h), never from the method. the
+// metrics come from those files alone (campaign/nav_metrics.h), never from the method. the
 // robot is one side of every contact pair (all its bodies are named after it), so a collision
 // is (robot, environment body): a trunk and two legs against one wall within the debounce
 // window are one collision, the wall and then a table two.
@@ -28,8 +28,8 @@
 #include <utility>
 #include <vector>
 
-#include "penumbra/benchmark/benchmark_job.h"
-#include "penumbra/benchmark/benchmark_spec.h"
+#include "penumbra/campaign/benchmark_job.h"
+#include "penumbra/campaign/benchmark_spec.h"
 
 namespace penumbra {
 
@@ -47,7 +47,7 @@ struct NavRow {
   double goal_x = 0, goal_y = 0, radius_m = 0, timeout_sec = 0;
   bool success = false;
   int collisions = 0;      ///< collisions the robot caused (SC counts these)
-  int agent_contacts = 0;  ///< contacts an agent made (benchmark/nav_metrics.h AgentMadeContact)
+  int agent_contacts = 0;  ///< contacts an agent made (campaign/nav_metrics.h AgentMadeContact)
   double time_to_goal_sec = NAN;  ///< NaN unless success
   double final_goal_distance_m = NAN, episode_time_sec = NAN, path_length_m = NAN;
   double sc = 0;  ///< S / (1 + c)

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/campaign/nav_metrics.h"
 
 #include <algorithm>
 #include <cmath>

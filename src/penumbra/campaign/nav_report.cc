@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/nav_report.h"
+#include "penumbra/campaign/nav_report.h"
 
 #include <fmt/format.h>
 
@@ -11,8 +11,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "penumbra/benchmark/benchmark_text.h"
-#include "penumbra/benchmark/nav_metrics.h"
+#include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/benchmark/benchmark_report.h"
-#include "penumbra/benchmark/benchmark_spec.h"
-#include "penumbra/benchmark/nav_job.h"
+#include "penumbra/campaign/benchmark_report.h"
+#include "penumbra/campaign/benchmark_spec.h"
+#include "penumbra/campaign/nav_job.h"
 
 namespace penumbra {
 

@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/nav_spec.h"
+#include "penumbra/campaign/nav_spec.h"
 
 #include <cmath>
 

@@ -1,7 +1,7 @@
 #pragma once
 // the navigation half of a benchmark spec (`kind: nav`, docs/benchmarks.md "Navigation"):
 // point-goal episodes per world, the robot profile the harness judges them with, and the
-// harness's metric settings. read by LoadBenchmarkSpec (benchmark/benchmark_spec.h).
+// harness's metric settings. read by LoadBenchmarkSpec (campaign/benchmark_spec.h).
 //
 //   kind: nav
 //   worlds:

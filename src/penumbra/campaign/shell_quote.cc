@@ -1,4 +1,4 @@
-#include "penumbra/benchmark/shell_quote.h"
+#include "penumbra/campaign/shell_quote.h"
 
 #include "penumbra/core/error.h"
 

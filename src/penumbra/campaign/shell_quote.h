@@ -2,7 +2,7 @@
 // quoting for the shell scripts the benchmark writes for people and for Slurm (a method's
 // command.sh, the sbatch array script): every value goes through ShellQuote, which makes any
 // string one literal word of /bin/sh and bash. nothing the benchmark runs itself goes through
-// a shell (benchmark/command_template.h).
+// a shell (campaign/command_template.h).
 
 #include <cstddef>
 #include <optional>
