@@ -17,9 +17,9 @@
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/session/session.h"
 #include "penumbra/sinks/physics_source.h"
 #include "penumbra/sinks/run_outputs.h"
-#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
@@ -71,10 +71,9 @@ std::map<int, fs::path> RunWithChange(const WorldConfig& world, int64_t at_step,
   StepHook hook(at_step, [&] {
     if (request) request(live);
   });
-  live.AddFirst(&loop);
+  live.AddTo(&loop);
   loop.AddSink(&hook);
   outputs.AddTo(&loop);
-  live.AddAfterOutputs(&loop);
   const LoopFinish f = loop.Run();
   if (f.error) std::rethrow_exception(f.error);
   std::map<int, fs::path> frames;

@@ -66,8 +66,8 @@ class BridgeSet {
   /// thread while the realtime factor is > 0: see the file comment), turns its own pacing off
   /// (the RunControl paces) and makes the loop's stop request the RunControl's flag.
   void Configure(PhysicsSourceOptions* physics, SimLoopOptions* loop);
-  /// adds the RunControl, then every bridge, to `loop` (after the outputs and recorder, before
-  /// the manifest).
+  /// adds the RunControl, then every bridge, to `loop` (their stages, kRunControl and kBridges,
+  /// put them after the outputs and recorders and before the manifest).
   void AddTo(SimLoop* loop);
 
   RunControl& control() { return *control_; }

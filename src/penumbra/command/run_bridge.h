@@ -32,8 +32,8 @@
 
 #include "penumbra/output/camera_frame.h"
 #include "penumbra/pipeline/sink.h"
-#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -55,6 +55,8 @@ struct RunBridgeContext {
 /// one middleware bridge of a live run (see the file comment).
 class RunBridge : public Sink {
  public:
+  /// SinkStage::kBridges: after the run control.
+  SinkStage stage() const override { return SinkStage::kBridges; }
   ~RunBridge() override = default;
   /// a completed camera frame (render thread).
   virtual void OnCameraFrame(const std::shared_ptr<const CameraFrame>& frame) {}

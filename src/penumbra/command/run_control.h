@@ -50,6 +50,8 @@ struct RunControlOptions {
 /// queues commands for the loop thread and gates its steps (see the file comment).
 class RunControl : public Sink {
  public:
+  /// SinkStage::kRunControl: after the outputs and recorders: a step reply follows its outputs.
+  SinkStage stage() const override { return SinkStage::kRunControl; }
   /// work run on the loop thread at a step boundary with the simulation; returns the reply's
   /// fields. may throw CommandError (becomes an error reply) or anything else (a `failed` reply).
   using Action = std::function<nlohmann::json(Simulation& sim)>;

@@ -4,19 +4,20 @@
 // conditions (live/live_effects.h) and run-log recording (live/live_recorder.h). a run
 // (run/runner.h RunOptions::on_live) hands its LiveControl to the caller once it is set up.
 //
-// in a SimLoop: effects() is the loop's first sink (changes apply before any other sink sees
-// the step) and recorder() follows the cameras and sensors (their sensor records reach it
-// before it closes); AddFirst / AddAfterOutputs say where. every change applied is recorded
+// in a SimLoop: effects() is a kLiveChanges sink (changes apply before any other sink sees the
+// step) and recorder() a kRecording sink (after the cameras and sensors, so their records reach
+// it before it closes): their stages (pipeline/sink.h SinkStage) say where, whatever the order
+// of AddSink calls. every change applied is recorded
 // as a "live" event in the active live recording and in the run's own log (RecordChangesTo).
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 
-#include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/runlog/run_log_writer.h"
 #include "penumbra/live/live_effects.h"
 #include "penumbra/live/live_recorder.h"
+#include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/runlog/run_log_writer.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -50,10 +51,11 @@ class LiveControl {
   /// error is logged, not thrown (the command was carried out).
   void RecordCommand(int64_t step, double time_sec, const nlohmann::json& command);
 
-  /// adds effects() to `loop`: call before any other AddSink.
-  void AddFirst(SimLoop* loop) { loop->AddSink(&effects_); }
-  /// adds recorder() to `loop`: call after the output sinks (cameras, sensors).
-  void AddAfterOutputs(SimLoop* loop) { loop->AddSink(&recorder_); }
+  /// adds effects() and recorder() to `loop` (their stages order them among its sinks).
+  void AddTo(SimLoop* loop) {
+    loop->AddSink(&effects_);
+    loop->AddSink(&recorder_);
+  }
 
  private:
   LiveEffects effects_;

@@ -68,6 +68,8 @@ struct RequestedAdversity {
 /// changes. register it as the loop's first sink.
 class LiveEffects : public Sink {
  public:
+  /// SinkStage::kLiveChanges: a change applies before any other sink sees its step.
+  SinkStage stage() const override { return SinkStage::kLiveChanges; }
   /// the conditions as `session` set them up. `session` must outlive this object; build it
   /// before the loop starts (it reads the static bodies' poses from the simulation).
   explicit LiveEffects(Session& session);

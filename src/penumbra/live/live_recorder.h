@@ -39,6 +39,9 @@ struct LiveRecording {
 /// cameras and sensors, so that their sensor records reach it before it closes at the end).
 class LiveRecorder : public Sink {
  public:
+  /// SinkStage::kRecording: after the cameras and sensors: their records of a step reach the log
+  /// first.
+  SinkStage stage() const override { return SinkStage::kRecording; }
   /// `session` must outlive this object. `command_line` goes into the logs' headers.
   /// `output_folder`: the run's output folder; every recording is a new file inside it
   /// (core/output_path_policy.h).

@@ -12,6 +12,8 @@
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/live/live_control.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/png_io.h"
@@ -19,13 +21,11 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/live/live_control.h"
 #include "penumbra/session/npc_map_json.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/live/run_log_header.h"
-#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/sinks/run_outputs.h"
 
 namespace penumbra {
 namespace {
@@ -271,12 +271,11 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
     }
     return m;
   });
-  // the recorder after the cameras, sensors and metrics (their sensor records reach it
-  // before it closes) and before the manifest (which reports its size)
-  live.AddFirst(&loop);
+  // the sinks' stages order them (pipeline/sink.h SinkStage): live changes, outputs, recorders,
+  // the run control, the bridges, run.json
+  live.AddTo(&loop);
   outputs.AddTo(&loop);
   if (recorder) loop.AddSink(recorder.get());
-  live.AddAfterOutputs(&loop);
   if (bridges) bridges->AddTo(&loop);
   loop.AddSink(&manifest);
   rollback.Dismiss();
