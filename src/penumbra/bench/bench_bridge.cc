@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -20,8 +19,8 @@
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/zmq/msgpack_json.h"
 #include "penumbra/zmq/zmq_bridge.h"
 
@@ -218,25 +217,7 @@ PhysicsRound RunPhysics(const WorldConfig& world, double seconds, bool with_brid
 
 }  // namespace
 
-std::unique_ptr<BenchBridgeCommand> AddBenchBridgeCommand(CLI::App& bench) {
-  auto cmd = std::make_unique<BenchBridgeCommand>();
-  BenchBridgeOptions& o = cmd->options;
-  cmd->app = bench.add_subcommand(
-      "bridge",
-      "ZeroMQ bridge: lockstep round trip, free-running frames/s, physics with the bridge idle");
-  cmd->app->add_option("--world", o.world_file, "world file (default: worlds/quadruped.yaml)");
-  cmd->app->add_option("--trips", o.trips, "lockstep round trips timed")
-      ->check(CLI::Range(10, 1000000));
-  cmd->app->add_option("--seconds", o.seconds, "wall seconds of free-running frames")
-      ->check(CLI::Range(0.1, 600.0));
-  cmd->app->add_option("--round-seconds", o.round_seconds, "simulated seconds per physics round")
-      ->check(CLI::Range(0.01, 3600.0));
-  cmd->app->add_option("--rounds", o.rounds, "physics A/B rounds")->check(CLI::Range(1, 100));
-  return cmd;
-}
-
-int BenchBridgeCommand::Run() const {
-  const BenchBridgeOptions& o = options;
+int BenchBridge(const BenchBridgeOptions& o) {
   WorldConfig world = LoadWorldFile(o.world_file.empty() ? std::string(PENUMBRA_SOURCE_DIR) +
                                                                "/worlds/quadruped.yaml"
                                                          : o.world_file);

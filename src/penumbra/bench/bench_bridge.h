@@ -14,10 +14,6 @@
 #include <memory>
 #include <string>
 
-namespace CLI {
-class App;
-}
-
 namespace penumbra {
 
 /// options of `penumbra bench bridge`.
@@ -30,15 +26,8 @@ struct BenchBridgeOptions {
 };
 
 /// the verb as registered on `penumbra bench`.
-struct BenchBridgeCommand {
-  CLI::App* app = nullptr;  ///< the `bridge` subcommand (true when it was given)
-  BenchBridgeOptions options;
-  /// runs the benchmark, prints its table to stdout; returns 0.
-  /// @throws ConfigError for a bad world; Error when no loopback port pair can be bound.
-  int Run() const;
-};
-
-/// adds `bridge` to `bench` (the `penumbra bench` subcommand).
-std::unique_ptr<BenchBridgeCommand> AddBenchBridgeCommand(CLI::App& bench);
+/// runs the benchmark, prints its table to stdout; returns 0.
+/// @throws ConfigError for a bad world; Error when no loopback port pair can be bound.
+int BenchBridge(const BenchBridgeOptions& options);
 
 }  // namespace penumbra

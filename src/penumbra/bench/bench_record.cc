@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -12,12 +11,12 @@
 
 #include "penumbra/bench/bench.h"
 #include "penumbra/core/build_info.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -78,25 +77,6 @@ double RecordMedian(std::vector<double> v) {
 }
 
 }  // namespace
-
-std::unique_ptr<BenchRecordCommand> AddBenchRecordCommand(CLI::App& bench) {
-  auto cmd = std::make_unique<BenchRecordCommand>();
-  BenchRecordOptions& o = cmd->options;
-  cmd->app = bench.add_subcommand(
-      "record", "physics steps/s with run-log recording on vs off, and the size of a 60 s log");
-  cmd->app->add_option("--world", o.world_file, "world file (default: bundled default world)");
-  cmd->app->add_option("--seconds", o.round_seconds, "simulated seconds per timed round")
-      ->check(CLI::Range(0.01, 3600.0));
-  cmd->app->add_option("--rounds", o.rounds, "A/B rounds (off, on)")->check(CLI::Range(1, 100));
-  cmd->app->add_option("--size-seconds", o.size_seconds, "simulated seconds of the sized log")
-      ->check(CLI::Range(0.01, 3600.0));
-  cmd->app->add_option("--log-dir", o.log_dir, "folder for the logs (default: temporary)");
-  cmd->app->add_option("--zstd-level", o.zstd_level, "the writer's zstd level")
-      ->check(CLI::Range(1, 19));
-  return cmd;
-}
-
-int BenchRecordCommand::Run() const { return BenchRecord(options); }
 
 int BenchRecord(const BenchRecordOptions& options) {
   WorldConfig world =

@@ -9,10 +9,6 @@
 
 #include "penumbra/runlog/run_log_writer.h"
 
-namespace CLI {
-class App;
-}
-
 namespace penumbra {
 
 /// options of `penumbra bench record`.
@@ -26,18 +22,7 @@ struct BenchRecordOptions {
 };
 
 /// the verb as registered on `penumbra bench`.
-struct BenchRecordCommand {
-  CLI::App* app = nullptr;  ///< the `record` subcommand (true when it was given)
-  BenchRecordOptions options;
-  /// runs the benchmark, prints its table to stdout; returns 0.
-  /// @throws ConfigError for a bad world; RunLogError when a log cannot be written.
-  int Run() const;
-};
-
-/// adds `record` to `bench` (the `penumbra bench` subcommand).
-std::unique_ptr<BenchRecordCommand> AddBenchRecordCommand(CLI::App& bench);
-
-/// runs the benchmark (BenchRecordCommand::Run). returns 0.
+/// runs the benchmark with `options`, prints its table to stdout. returns 0.
 int BenchRecord(const BenchRecordOptions& options);
 
 }  // namespace penumbra

@@ -5,26 +5,12 @@
 // publisher sending pre-rendered frames back to back (target: >= 100). needs a running master
 // (roscore; ROS_MASTER_URI). a benchmark, never a pass/fail test: it prints numbers and targets.
 
-#include <memory>
-
 #include "penumbra/ros/ros_bench.h"
-
-namespace CLI {
-class App;
-}
 
 namespace penumbra {
 
-/// the verb as registered on `penumbra bench`.
-struct BenchRosCommand {
-  CLI::App* app = nullptr;  ///< the `ros` subcommand (true when it was given)
-  RosBenchOptions options;
-  /// runs the benchmark, prints its table to stdout; returns 0.
-  /// @throws Error when no master answers or this build has no ROS 1.
-  int Run() const;
-};
-
-/// adds `ros` to `bench` (the `penumbra bench` subcommand).
-std::unique_ptr<BenchRosCommand> AddBenchRosCommand(CLI::App& bench);
+/// runs the benchmark with `options`, prints its table to stdout; returns 0.
+/// @throws Error when no master answers or this build has no ROS 1.
+int BenchRos(const RosBenchOptions& options);
 
 }  // namespace penumbra
