@@ -90,7 +90,10 @@ def layout_block(order, desc):
         lines += [" " * len(head) + b for b in body[1:]]
     lines += [
         "tests/<module>/    GoogleTest suites mirroring src/ (tests/meta: the build's own checks)",
-        "bench/             Google Benchmark micro-benchmarks",
+        "bench/             Penumbra's own speed: Google Benchmark micro-benchmarks, the fuzzing",
+        "                   script (the `penumbra bench` harnesses are src/penumbra/bench/)",
+        "benchmarks/        campaign specs of `penumbra benchmark` (SLAM, navigation; run by",
+        "                   src/penumbra/campaign/)",
         "python/            penumbra_client (Python client of the ZeroMQ bridge), penumbra_nav,",
         "                   penumbra_rollout, examples/",
         "worlds/            bundled worlds and models",

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "penumbra/app/preset_scene.h"
+#include "penumbra/bench/preset_scene.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/world/world_config.h"

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/trot_gait.h"

@@ -1,4 +1,4 @@
-// live controls in a whole `penumbra run` (app/runner.h RunOptions::on_live): a recording
+// live controls in a whole `penumbra run` (run/runner.h RunOptions::on_live): a recording
 // started and stopped from another thread while the run goes on is a complete log that
 // `penumbra replay` renders from its first step with the live run's images, byte for byte,
 // including the live fog changes made before and during it; the run's own --record log holds
@@ -15,11 +15,11 @@
 #include <thread>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/resimulate.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -16,7 +16,7 @@
 #include <set>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/world/world_config.h"

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/resimulate.h"

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <string>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/world/world_config.h"
 

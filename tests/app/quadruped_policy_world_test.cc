@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -8,7 +8,7 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/world_config.h"
 

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "common/temp_dir.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/pcd_writer.h"
 #include "penumbra/sensors/imu_model.h"

@@ -12,7 +12,7 @@
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
+#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

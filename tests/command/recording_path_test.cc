@@ -13,11 +13,11 @@
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
+#include "penumbra/live/live_control.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_format.h"
-#include "penumbra/session/live_control.h"
-#include "penumbra/session/physics_source.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/physics_source.h"
 
 namespace penumbra {
 namespace {
@@ -55,9 +55,8 @@ class RecordingLoop {
     lo.end_time_sec = 1.0;
     lo.stop_request = control_->stop_flag();
     loop_ = std::make_unique<SimLoop>(source_.get(), lo);
-    live_->AddFirst(loop_.get());
+    live_->AddTo(loop_.get());
     loop_->AddSink(control_.get());
-    live_->AddAfterOutputs(loop_.get());
     loop_->Start();
   }
   ~RecordingLoop() {

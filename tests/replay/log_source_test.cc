@@ -14,8 +14,8 @@
 #include "penumbra/effects/agent_path.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/replay/recorded_world.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

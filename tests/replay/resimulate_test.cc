@@ -14,8 +14,8 @@
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/runlog/run_log_codec.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -12,7 +12,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/run/runner.h"
 
 namespace penumbra {
 

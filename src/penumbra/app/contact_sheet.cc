@@ -5,8 +5,8 @@
 #include <array>
 #include <filesystem>
 
-#include "penumbra/app/bench.h"
-#include "penumbra/app/preset_scene.h"
+#include "penumbra/bench/bench.h"
+#include "penumbra/bench/preset_scene.h"
 #include "penumbra/output/png_io.h"
 
 namespace penumbra {

@@ -64,38 +64,7 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-}  // namespace
-
-std::unique_ptr<DecomposeCommands> AddDecomposeCommands(CLI::App& app, CLI::App& bench) {
-  auto c = std::make_unique<DecomposeCommands>();
-  c->decompose = app.add_subcommand(
-      "decompose", "convex decomposition of a closed mesh for collision (docs/collision.md)");
-  DecomposeCommandOptions& o = c->options;
-  c->decompose->add_option("mesh", o.mesh_file, "closed mesh: .off .obj .stl .ply");
-  c->decompose->add_option("--shape", o.shape, "a generated test shape instead of a file")
-      ->check(CLI::IsMember(TestShapeNames()));
-  AddNumber(c->decompose, "--scale", &o.scale, 1e-9, 1e9, "m per mesh file unit (default 1)");
-  c->decompose->add_option("--method", o.method_name, "coacd (default), hull or exact")
-      ->check(CLI::IsMember({"coacd", "hull", "exact"}));
-  AddDecompositionOptions(c->decompose, &o.decomposition, &o.seed);
-  c->decompose->add_option("--obj", o.obj_out, "write the parts as OBJ (one object per part)");
-  c->decompose->add_option("--mjcf", o.mjcf_out, "write an MJCF model with one geom per part");
-  c->decompose->add_option("--cache-dir", o.cache_dir,
-                           "cache folder (default $PENUMBRA_CACHE_DIR/decompose or "
-                           "~/.cache/penumbra/decompose)");
-  c->decompose->add_flag("--no-cache", o.no_cache, "neither read nor write the cache");
-
-  c->bench = bench.add_subcommand(
-      "decompose", "CoACD vs convex hull vs CGAL exact decomposition on the test shapes");
-  c->bench->add_option("--shapes", c->bench_options.shapes, "test shapes (default all)")
-      ->check(CLI::IsMember(TestShapeNames()))
-      ->delimiter(',');
-  c->bench->add_flag("!--no-exact", c->bench_options.exact, "skip CGAL's exact decomposition");
-  AddDecompositionOptions(c->bench, &c->bench_options.decomposition, &c->bench_options.seed);
-  return c;
-}
-
-int DecomposeCommands::RunDecompose() const {
+int RunDecompose(const DecomposeCommandOptions& options) {
   DecomposeCommandOptions o = options;
   o.decomposition.method = ParseDecompositionMethod(o.method_name, "--method");
   o.decomposition.seed = static_cast<uint64_t>(o.seed);
@@ -139,38 +108,62 @@ int DecomposeCommands::RunDecompose() const {
   return 0;
 }
 
-int DecomposeCommands::RunBench() const {
-  DecompositionOptions base = bench_options.decomposition;
-  base.seed = static_cast<uint64_t>(bench_options.seed);
-  fmt::print(
-      "convex decomposition: CoACD (threshold {:.4f} of the extent, max {} parts) vs "
-      "convex hull vs CGAL exact (Nef)\n",
-      base.concavity_threshold, base.max_parts);
-  fmt::print(
-      "max concavity: of the parts, over the mesh's largest extent; excess: how far the "
-      "hulls stick out of the mesh, over the extent; volume: hull volumes / mesh volume\n");
-  fmt::print("{:<6} {:>6} {:<6} {:>6} {:>14} {:>8} {:>8} {:>9}\n", "shape", "tris", "method",
-             "parts", "max concavity", "excess", "volume", "time s");
-  for (const std::string& shape : bench_options.shapes) {
-    const SolidMesh mesh = MakeTestShape(shape);
-    for (DecompositionMethod method :
-         {DecompositionMethod::kCoacd, DecompositionMethod::kHull, DecompositionMethod::kExact}) {
-      if (method == DecompositionMethod::kExact && !bench_options.exact) continue;
-      DecompositionOptions o = base;
-      o.method = method;
-      const auto t0 = std::chrono::steady_clock::now();
-      const Decomposition d = DecomposeMesh(mesh, o, shape);
-      const double seconds = Seconds(t0);
-      std::vector<SolidMesh> hulls;
-      for (const ConvexPart& p : d.parts) hulls.push_back(p.hull);
-      const double excess = HullExcessDistance(hulls, mesh, 4000) / d.extent;
-      fmt::print("{:<6} {:>6} {:<6} {:>6} {:>14.4f} {:>8.4f} {:>8.4f} {:>9.3f}\n", shape,
-                 mesh.triangles.size(), DecompositionMethodName(method), d.parts.size(),
-                 d.relative_max_concavity(), excess, d.HullVolumeSum() / d.mesh_volume, seconds);
-      std::fflush(stdout);
-    }
+class DecomposeCommand : public Command {
+ public:
+  std::string name() const override { return "decompose"; }
+  std::string summary() const override {
+    return "convex decomposition of a closed mesh for collision (docs/collision.md)";
   }
-  return 0;
+
+  void AddOptions(CLI::App* verb) override {
+    DecomposeCommandOptions& o = options_;
+    verb->add_option("mesh", o.mesh_file, "closed mesh: .off .obj .stl .ply");
+    verb->add_option("--shape", o.shape, "a generated test shape instead of a file")
+        ->check(CLI::IsMember(TestShapeNames()));
+    AddNumber(verb, "--scale", &o.scale, 1e-9, 1e9, "m per mesh file unit (default 1)");
+    verb->add_option("--method", o.method_name, "coacd (default), hull or exact")
+        ->check(CLI::IsMember({"coacd", "hull", "exact"}));
+    AddDecompositionOptions(verb, &o.decomposition, &o.seed);
+    verb->add_option("--obj", o.obj_out, "write the parts as OBJ (one object per part)");
+    verb->add_option("--mjcf", o.mjcf_out, "write an MJCF model with one geom per part");
+    verb->add_option("--cache-dir", o.cache_dir,
+                     "cache folder (default $PENUMBRA_CACHE_DIR/decompose or "
+                     "~/.cache/penumbra/decompose)");
+    verb->add_flag("--no-cache", o.no_cache, "neither read nor write the cache");
+  }
+
+  int Run(const CommandArgs&) override { return RunDecompose(options_); }
+
+ private:
+  DecomposeCommandOptions options_;
+};
+
+class BenchDecomposeCommand : public Command {
+ public:
+  std::string name() const override { return "bench decompose"; }
+  std::string summary() const override {
+    return "CoACD vs convex hull vs CGAL exact decomposition on the test shapes";
+  }
+
+  void AddOptions(CLI::App* verb) override {
+    verb->add_option("--shapes", options_.shapes, "test shapes (default all)")
+        ->check(CLI::IsMember(TestShapeNames()))
+        ->delimiter(',');
+    verb->add_flag("!--no-exact", options_.exact, "skip CGAL's exact decomposition");
+    AddDecompositionOptions(verb, &options_.decomposition, &options_.seed);
+  }
+
+  int Run(const CommandArgs&) override { return BenchDecompose(options_); }
+
+ private:
+  BenchDecomposeOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeDecomposeCommand() { return std::make_unique<DecomposeCommand>(); }
+std::unique_ptr<Command> MakeBenchDecomposeCommand() {
+  return std::make_unique<BenchDecomposeCommand>();
 }
 
 }  // namespace penumbra

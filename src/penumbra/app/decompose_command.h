@@ -2,18 +2,15 @@
 // `penumbra decompose MESH`: convex decomposition of a closed mesh for collision
 // (decompose/, docs/collision.md), printed as a summary and written as OBJ parts and MJCF; and
 // `penumbra bench decompose`: CoACD vs the plain convex hull vs CGAL's exact decomposition on
-// the test shapes (parts, max concavity, hull volume over mesh volume, time). the bench is a
-// benchmark, never a pass/fail test.
+// the test shapes, whose harness is bench/decompose_bench.h.
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "penumbra/app/command.h"
+#include "penumbra/bench/decompose_bench.h"
 #include "penumbra/decompose/decomposition.h"
-
-namespace CLI {
-class App;
-}
 
 namespace penumbra {
 
@@ -31,28 +28,9 @@ struct DecomposeCommandOptions {
   bool no_cache = false;  ///< compute, neither read nor write the cache
 };
 
-/// options of `penumbra bench decompose`.
-struct BenchDecomposeOptions {
-  std::vector<std::string> shapes = {"l", "u", "torus", "bowl"};
-  bool exact = true;  ///< include CGAL's exact decomposition (slow)
-  DecompositionOptions decomposition;
-  int seed = 0;  ///< the search seed
-};
-
-/// both verbs as registered.
-struct DecomposeCommands {
-  CLI::App* decompose = nullptr;  ///< `penumbra decompose`
-  CLI::App* bench = nullptr;      ///< `penumbra bench decompose`
-  DecomposeCommandOptions options;
-  BenchDecomposeOptions bench_options;
-  /// runs `penumbra decompose`; prints the summary; returns 0.
-  /// @throws Error for an unreadable or open mesh, ConfigError for bad options.
-  int RunDecompose() const;
-  /// runs the benchmark; prints the table; returns 0.
-  int RunBench() const;
-};
-
-/// adds `decompose` to `app` and `decompose` to `bench` (the `penumbra bench` subcommand).
-std::unique_ptr<DecomposeCommands> AddDecomposeCommands(CLI::App& app, CLI::App& bench);
+/// the `decompose` verb (app/command.h).
+std::unique_ptr<Command> MakeDecomposeCommand();
+/// the `bench decompose` verb (app/command.h).
+std::unique_ptr<Command> MakeBenchDecomposeCommand();
 
 }  // namespace penumbra

@@ -85,11 +85,19 @@ struct EvalCommand::State {
   std::string ToText(bool ate_verb, const TrajectoryEvaluation& r) const;
 };
 
-EvalCommand::EvalCommand(CLI::App& app) : state_(std::make_unique<State>()) {
+EvalCommand::EvalCommand() : state_(std::make_unique<State>()) {}
+EvalCommand::~EvalCommand() = default;
+
+std::string EvalCommand::name() const { return "eval"; }
+
+std::string EvalCommand::summary() const {
+  return "trajectory metrics of an estimate against ground truth (TUM files; "
+         "docs/evaluation.md)";
+}
+
+void EvalCommand::AddOptions(CLI::App* eval) {
   State& s = *state_;
-  s.eval = app.add_subcommand("eval",
-                              "trajectory metrics of an estimate against ground truth (TUM files; "
-                              "docs/evaluation.md)");
+  s.eval = eval;
   s.eval->require_subcommand(1);
   s.ate = s.eval->add_subcommand(
       "ate", "absolute trajectory error, coverage, scaled ATE and time tracked");
@@ -131,14 +139,6 @@ EvalCommand::EvalCommand(CLI::App& app) : state_(std::make_unique<State>()) {
                                      "pose pairs this many seconds apart (instead of --delta)");
   delta->excludes(delta_sec);
 }
-
-EvalCommand::~EvalCommand() = default;
-EvalCommand::EvalCommand(EvalCommand&&) noexcept = default;
-EvalCommand& EvalCommand::operator=(EvalCommand&&) noexcept = default;
-
-EvalCommand AddEvalCommand(CLI::App& app) { return EvalCommand(app); }
-
-bool EvalCommand::Selected() const { return state_->eval->parsed(); }
 
 Json EvalCommand::State::ToJson(bool ate_verb, const TrajectoryEvaluation& r) const {
   Json j;
@@ -241,7 +241,7 @@ std::string EvalCommand::State::ToText(bool ate_verb, const TrajectoryEvaluation
   return t;
 }
 
-int EvalCommand::Run() const {
+int EvalCommand::Run(const CommandArgs&) {
   const State& s = *state_;
   const bool ate_verb = s.ate->parsed();
   EvaluationOptions options;

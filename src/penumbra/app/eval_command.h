@@ -4,38 +4,34 @@
 // stdout as text (or JSON with --format json); --json FILE and --plot FILE.png write files.
 
 #include <memory>
+#include <string>
 
-namespace CLI {
-class App;
-}
+#include "penumbra/app/command.h"
 
 namespace penumbra {
 
-/// the `eval` verb: its options registered on a CLI11 app, and its run.
-class EvalCommand {
+/// the `eval` verb (app/command.h): `eval ate` and `eval rpe`.
+class EvalCommand : public Command {
  public:
-  /// registers `eval` with its sub-verbs `ate` and `rpe` and their options on `app`.
-  explicit EvalCommand(CLI::App& app);
-  ~EvalCommand();
-  EvalCommand(EvalCommand&&) noexcept;
-  EvalCommand& operator=(EvalCommand&&) noexcept;
+  EvalCommand();
+  ~EvalCommand() override;
+  EvalCommand(const EvalCommand&) = delete;
+  EvalCommand& operator=(const EvalCommand&) = delete;
 
-  /// true when the parsed command line chose `eval` (call after app.parse).
-  bool Selected() const;
-
+  std::string name() const override;
+  std::string summary() const override;
+  /// adds `ate` and `rpe` with their options to `eval`.
+  void AddOptions(CLI::App* eval) override;
   /// reads both files, evaluates, writes the report to stdout and the --json / --plot files.
   /// returns the exit code (0).
   /// @throws ConfigError for an unreadable or malformed input file, too few associated poses,
   ///         or (rpe) no pose pair at the requested delta: bad input, exit code 2 in RunCli;
   ///         Error when an output file cannot be written (exit code 1).
-  int Run() const;
+  int Run(const CommandArgs& args) override;
 
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
-
-/// registers `penumbra eval` on `app` (EvalCommand's constructor).
-EvalCommand AddEvalCommand(CLI::App& app);
 
 }  // namespace penumbra

@@ -3,10 +3,12 @@
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <optional>
 
 #include "penumbra/app/backend_flag.h"
+#include "penumbra/app/stop_signals.h"
 #include "penumbra/core/error.h"
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/export_stop.h"
@@ -90,11 +92,19 @@ int Stopped(const ExportStopped& e, const std::string& out) {
 
 }  // namespace
 
-bool ExportCommand::selected() const {
-  return state_ && state_->command && static_cast<bool>(*state_->command);
+ExportCommand::ExportCommand() : state_(std::make_unique<State>()) {}
+ExportCommand::~ExportCommand() = default;
+
+std::string ExportCommand::name() const { return "export"; }
+
+std::string ExportCommand::summary() const {
+  return "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset, or as "
+         "a ROS 1 bag";
 }
 
-int ExportCommand::Run(const std::atomic<int>* stop_request) const {
+int ExportCommand::Run(const CommandArgs& args) {
+  const StopSignals stop_signals(kExportStopMessage);
+  const std::atomic<int>* stop_request = args.stop_signal;
   const State& s = *state_;
   namespace fs = std::filesystem;
   const fs::path input(s.input);
@@ -229,14 +239,9 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   return 0;
 }
 
-ExportCommand AddExportCommand(CLI::App& app) {
-  ExportCommand c;
-  c.state_ = std::make_shared<ExportCommand::State>();
-  ExportCommand::State& s = *c.state_;
-  s.command = app.add_subcommand(
-      "export",
-      "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset, or as a "
-      "ROS 1 bag");
+void ExportCommand::AddOptions(CLI::App* command) {
+  State& s = *state_;
+  s.command = command;
   s.command
       ->add_option("run", s.input,
                    "output folder of `penumbra run`, or a run log (.plog), replayed first")
@@ -265,7 +270,6 @@ ExportCommand AddExportCommand(CLI::App& app) {
                        "use (sensor, default: the camera's own depth_noise, else realsense_d435) "
                        "or exact (ground-truth)")
           ->check(CLI::IsMember({"sensor", "ground-truth"}));
-  return c;
 }
 
 }  // namespace penumbra

@@ -11,34 +11,37 @@
 // frames; the partial dataset or bag and the replay folder are removed, --out is left as it was,
 // and Run returns 128 + the signal (130 / 143).
 
-#include <CLI/CLI.hpp>
 #include <atomic>
 #include <memory>
 #include <string>
 
+#include "penumbra/app/command.h"
+
 namespace penumbra {
 
-/// the `export` verb: its options, filled by CLI11 while parsing.
-class ExportCommand {
+/// the `export` verb (app/command.h).
+class ExportCommand : public Command {
  public:
-  /// true when the command line chose `export`.
-  bool selected() const;
-  /// runs the export; returns the exit code: 0, or 128 + signal when `stop_request` (may be
-  /// null; set by the SIGINT / SIGTERM handler) was set (nothing written).
+  ExportCommand();
+  ~ExportCommand() override;
+  ExportCommand(const ExportCommand&) = delete;
+  ExportCommand& operator=(const ExportCommand&) = delete;
+
+  std::string name() const override;
+  std::string summary() const override;
+  /// adds the run argument and the options to `export`.
+  void AddOptions(CLI::App* command) override;
+  /// runs the export with SIGINT / SIGTERM handlers installed (app/stop_signals.h); returns the
+  /// exit code: 0, or 128 + signal when a signal stopped it (nothing written).
   /// @throws ConfigError for bad input (a missing run folder, an unknown camera, a non-empty
   ///         --out, a symbolic link or a bad image in the run folder, ...: exit code 2 in
-  ///         cli.cc); Error if a file cannot be written (exit code 1).
-  int Run(const std::atomic<int>* stop_request = nullptr) const;
+  ///         RunCli); Error if a file cannot be written (exit code 1).
+  int Run(const CommandArgs& args) override;
 
  private:
-  friend ExportCommand AddExportCommand(CLI::App& app);
   int RunRosbag(const std::atomic<int>* stop_request) const;
   struct State;
-  std::shared_ptr<State> state_;
+  std::unique_ptr<State> state_;
 };
-
-/// adds the `export` subcommand to `app`; the returned command reads its options after
-/// app.parse().
-ExportCommand AddExportCommand(CLI::App& app);
 
 }  // namespace penumbra

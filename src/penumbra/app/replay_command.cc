@@ -10,11 +10,12 @@
 #include <optional>
 
 #include "penumbra/app/backend_flag.h"
-#include "penumbra/app/runner.h"
+#include "penumbra/app/stop_signals.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/resimulate.h"
+#include "penumbra/run/runner.h"
 
 namespace penumbra {
 
@@ -53,12 +54,18 @@ void AddSeconds(CLI::App* app, const std::string& name, std::optional<double>* t
 
 }  // namespace
 
-ReplayCommand::ReplayCommand(CLI::App& app) : state_(std::make_unique<State>()) {
+ReplayCommand::ReplayCommand() : state_(std::make_unique<State>()) {}
+ReplayCommand::~ReplayCommand() = default;
+
+std::string ReplayCommand::name() const { return "replay"; }
+
+std::string ReplayCommand::summary() const {
+  return "render a recorded run (.plog, run --record) again under other visual conditions, or "
+         "re-run its physics and check it against the log (--resimulate)";
+}
+
+void ReplayCommand::AddOptions(CLI::App* r) {
   State& s = *state_;
-  CLI::App* r = app.add_subcommand(
-      "replay",
-      "render a recorded run (.plog, run --record) again under other visual conditions, or "
-      "re-run its physics and check it against the log (--resimulate)");
   s.verb = r;
   ReplayOptions& o = s.options;
   r->add_option("log", o.log_path, "run log (.plog) written by penumbra run --record")->required();
@@ -94,14 +101,10 @@ ReplayCommand::ReplayCommand(CLI::App& app) : state_(std::make_unique<State>()) 
           ->check(CLI::IsMember({"controllers", "ctrl"}));
 }
 
-ReplayCommand::~ReplayCommand() = default;
-ReplayCommand::ReplayCommand(ReplayCommand&&) noexcept = default;
-ReplayCommand& ReplayCommand::operator=(ReplayCommand&&) noexcept = default;
-
-bool ReplayCommand::Selected() const { return state_->verb->parsed(); }
-
-int ReplayCommand::Run(const std::vector<std::string>& command_line,
-                       const std::atomic<int>* stop_request) const {
+int ReplayCommand::Run(const CommandArgs& args) {
+  const StopSignals stop_signals;
+  const std::vector<std::string>& command_line = args.command_line;
+  const std::atomic<int>* stop_request = args.stop_signal;
   const State& s = *state_;
   CLI::App* r = s.verb;
   if (s.resimulate_option->count() > 0) {
@@ -160,7 +163,5 @@ int ReplayCommand::Run(const std::vector<std::string>& command_line,
   }
   return 0;
 }
-
-ReplayCommand AddReplayCommand(CLI::App& app) { return ReplayCommand(app); }
 
 }  // namespace penumbra

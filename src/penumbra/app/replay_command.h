@@ -8,39 +8,34 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
+#include "penumbra/app/command.h"
 
 namespace penumbra {
 
-/// the `replay` verb: its options registered on a CLI11 app, and its run.
-class ReplayCommand {
+/// the `replay` verb (app/command.h).
+class ReplayCommand : public Command {
  public:
-  /// registers `replay` and its options on `app`.
-  explicit ReplayCommand(CLI::App& app);
-  ~ReplayCommand();
-  ReplayCommand(ReplayCommand&&) noexcept;
-  ReplayCommand& operator=(ReplayCommand&&) noexcept;
+  ReplayCommand();
+  ~ReplayCommand() override;
+  ReplayCommand(const ReplayCommand&) = delete;
+  ReplayCommand& operator=(const ReplayCommand&) = delete;
 
-  /// true when the parsed command line chose `replay` (call after app.parse).
-  bool Selected() const;
-
-  /// runs the replay (or the resimulation); `command_line` (argv) goes into run.json;
-  /// `stop_request` (may be null) is set by the SIGINT / SIGTERM handler. returns the exit code: 0
+  std::string name() const override;
+  std::string summary() const override;
+  /// adds the log argument and the options to `replay`.
+  void AddOptions(CLI::App* replay) override;
+  /// runs the replay (or the resimulation) with SIGINT / SIGTERM handlers installed
+  /// (app/stop_signals.h); the command line (argv) goes into run.json. returns the exit code: 0
   /// done (bit-exact for --resimulate), 3 when the resimulation diverged (the first divergence is
   /// printed on stdout), 128 + signal when stopped by a signal (outputs and run.json written).
   /// @throws ConfigError for bad options or input (exit code 2 in RunCli), RunLogError for a
   ///         file that is not a readable run log, Error for a write failure or a run log that
   ///         cannot be read (exit code 1).
-  int Run(const std::vector<std::string>& command_line, const std::atomic<int>* stop_request) const;
+  int Run(const CommandArgs& args) override;
 
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
-
-/// registers `penumbra replay` on `app` (ReplayCommand's constructor).
-ReplayCommand AddReplayCommand(CLI::App& app);
 
 }  // namespace penumbra

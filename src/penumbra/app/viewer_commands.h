@@ -5,6 +5,7 @@
 //                                             outputs in a temporary folder unless --out
 //   penumbra bench viewer                     frames/s delivered, input-to-photon latency,
 //                                             physics steps/s with and without a viewer
+//                                             (the harness: bench/viewer_bench.h)
 
 #include <atomic>
 #include <memory>
@@ -12,7 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "penumbra/app/runner.h"
+#include "penumbra/app/command.h"
+#include "penumbra/run/runner.h"
 
 namespace CLI {
 class App;
@@ -22,7 +24,7 @@ namespace penumbra {
 
 /// the `--viewer [HOST:PORT]` and `--viewer-allow-origin ORIGIN` flags of `penumbra run`.
 struct ViewerFlag {
-  std::string address;  ///< as given ("" = the default 127.0.0.1:8080)
+  std::string address;                     ///< as given ("" = the default 127.0.0.1:8080)
   std::vector<std::string> allow_origins;  ///< --viewer-allow-origin, repeatable
   /// adds the flags to `run`.
   void Add(CLI::App* run);
@@ -38,13 +40,13 @@ void AddViewerAllowOrigin(CLI::App* verb, std::vector<std::string>* origins);
 
 /// options of `penumbra view`.
 struct ViewOptions {
-  std::string address;   ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
+  std::string address;                     ///< --viewer HOST:PORT ("" = 127.0.0.1:8080)
   std::vector<std::string> allow_origins;  ///< --viewer-allow-origin, repeatable
   /// --out: keep the outputs here ("" = a temporary folder, removed at exit unless it holds
   /// a recording made with the page's record button)
   std::string out_dir;
-  bool running = false;  ///< --running: start running instead of paused
-  bool force = false;    ///< --force: --out may hold an earlier run's outputs
+  bool running = false;                ///< --running: start running instead of paused
+  bool force = false;                  ///< --force: --out may hold an earlier run's outputs
   std::optional<double> duration_sec;  ///< --duration (default: the world's)
   std::string adversity;               ///< --adversity preset spec
   std::vector<std::string> command_line;
@@ -57,17 +59,9 @@ struct ViewOptions {
 int RunView(const WorldConfig& world, const ViewOptions& options,
             const std::atomic<int>* stop_request);
 
-/// options of `penumbra bench viewer`.
-struct BenchViewerOptions {
-  std::string world_file;    ///< default: the bundled default world
-  double seconds = 4;        ///< simulated seconds per timed run (as fast as possible)
-  int rounds = 2;            ///< A/B pairs (no viewer, viewer with one page attached)
-  double camera_hz = 30;     ///< rate of the streamed camera (the world's first, rgb only)
-  int latency_samples = 10;  ///< teleop commands timed at real-time pacing
-};
-
-/// runs the benchmark and prints its table to stdout; returns 0.
-/// @throws ConfigError for a bad world; Error when the viewer cannot start.
-int BenchViewer(const BenchViewerOptions& options);
+/// the `view` verb (app/command.h): RunView of a world file or model.
+std::unique_ptr<Command> MakeViewCommand();
+/// the `bench viewer` verb (app/command.h): BenchViewer.
+std::unique_ptr<Command> MakeBenchViewerCommand();
 
 }  // namespace penumbra

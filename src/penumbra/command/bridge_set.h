@@ -1,6 +1,6 @@
 #pragma once
 // the bridges of one live run and what they share: the RunControl, the CommandDispatcher and
-// the model description, wired into a run's outputs and loop. app/runner.cc builds one when
+// the model description, wired into a run's outputs and loop. run/runner.cc builds one when
 // RunOptions::bridges is not empty:
 //
 //   RunOutputs outputs(...);
@@ -30,8 +30,8 @@
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/sinks/run_outputs.h"
 
 namespace penumbra {
 
@@ -66,8 +66,8 @@ class BridgeSet {
   /// thread while the realtime factor is > 0: see the file comment), turns its own pacing off
   /// (the RunControl paces) and makes the loop's stop request the RunControl's flag.
   void Configure(PhysicsSourceOptions* physics, SimLoopOptions* loop);
-  /// adds the RunControl, then every bridge, to `loop` (after the outputs and recorder, before
-  /// the manifest).
+  /// adds the RunControl, then every bridge, to `loop` (their stages, kRunControl and kBridges,
+  /// put them after the outputs and recorders and before the manifest).
   void AddTo(SimLoop* loop);
 
   RunControl& control() { return *control_; }

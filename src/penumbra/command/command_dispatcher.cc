@@ -473,7 +473,7 @@ LiveControl& CommandDispatcher::Live(const CommandInfo& info) const {
   if (!live_)
     throw CommandError(command_code::kNotAvailable, "",
                        fmt::format("'{}' is not available: this run has no live controls "
-                                   "(session/live_control.h)",
+                                   "(live/live_control.h)",
                                    info.name));
   return *live_;
 }

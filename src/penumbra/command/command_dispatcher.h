@@ -11,7 +11,7 @@
 // handler) that Dispatch looks a request's `cmd` up in; it equals the table of
 // docs/zmq-protocol.md "Commands" (tests/command/command_table_test.cc). the live commands
 // (set_adversity, set_effect, start_recording, stop_recording) go through the run's
-// LiveControl (session/live_control.h; not_available when the dispatcher has none).
+// LiveControl (live/live_control.h; not_available when the dispatcher has none).
 // transport-level commands (the ZeroMQ bridge's `sync`) are the bridges' own.
 
 #include <functional>
@@ -24,7 +24,7 @@
 #include "penumbra/command/command_error.h"
 #include "penumbra/command/request_reader.h"
 #include "penumbra/command/run_control.h"
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

@@ -1,6 +1,6 @@
 #pragma once
 // the hook by which middleware bridges (ZeroMQ, ROS, the browser viewer) attach to a live
-// `penumbra run`: RunOptions::bridges (app/runner.h) holds factories; the runner calls each
+// `penumbra run`: RunOptions::bridges (run/runner.h) holds factories; the runner calls each
 // factory once the run is set up, with a RunBridgeContext, and wires the bridge it returns:
 //
 //   - as a pipeline Sink (pipeline/sink.h), added to the run's SimLoop after the outputs and
@@ -8,7 +8,7 @@
 //     the bridge publishes, e.g. kFull at a state rate), OnFinish; loop thread;
 //   - OnCameraFrame: every camera frame as it is completed, with its raw images
 //     (output/camera_frame.h: rgb8, depth in m, segmentation ...), on the render thread;
-//   - OnSensorSample: every IMU, MuJoCo-sensor and LiDAR sample (session/sensor_sink.h), on the
+//   - OnSensorSample: every IMU, MuJoCo-sensor and LiDAR sample (sinks/sensor_sink.h), on the
 //     sensor thread;
 //   - commands: the context's CommandDispatcher (command/command_dispatcher.h) is the one
 //     command layer of the run; a bridge turns its middleware's requests into dispatcher
@@ -32,8 +32,8 @@
 
 #include "penumbra/output/camera_frame.h"
 #include "penumbra/pipeline/sink.h"
-#include "penumbra/session/sensor_sink.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -55,6 +55,8 @@ struct RunBridgeContext {
 /// one middleware bridge of a live run (see the file comment).
 class RunBridge : public Sink {
  public:
+  /// SinkStage::kBridges: after the run control.
+  SinkStage stage() const override { return SinkStage::kBridges; }
   ~RunBridge() override = default;
   /// a completed camera frame (render thread).
   virtual void OnCameraFrame(const std::shared_ptr<const CameraFrame>& frame) {}

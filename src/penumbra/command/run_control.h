@@ -1,5 +1,5 @@
 #pragma once
-// RunControl: the loop-thread side of the command layer. a live run (app/runner.cc with
+// RunControl: the loop-thread side of the command layer. a live run (run/runner.cc with
 // bridges) steps its Simulation through a PhysicsSource whose before_step hook is
 // RunControl::BeforeStep, so everything that changes the simulation happens there, on the
 // loop thread, at a step boundary:
@@ -50,6 +50,8 @@ struct RunControlOptions {
 /// queues commands for the loop thread and gates its steps (see the file comment).
 class RunControl : public Sink {
  public:
+  /// SinkStage::kRunControl: after the outputs and recorders: a step reply follows its outputs.
+  SinkStage stage() const override { return SinkStage::kRunControl; }
   /// work run on the loop thread at a step boundary with the simulation; returns the reply's
   /// fields. may throw CommandError (becomes an error reply) or anything else (a `failed` reply).
   using Action = std::function<nlohmann::json(Simulation& sim)>;

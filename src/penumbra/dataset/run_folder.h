@@ -11,7 +11,7 @@
 //                               gyro_{x,y,z}_rad_s (IMU frame S)
 //   imu/<name>_truth.csv        sample,capture_time_sec,X_WS,v_WS,gyro and accel biases
 //                               (output/sensor_writers.h)
-//   rig.json                    mounts of cameras, IMUs, LiDARs (session/sensor_sink.h)
+//   rig.json                    mounts of cameras, IMUs, LiDARs (sinks/sensor_sink.h)
 //
 // every error is a ConfigError naming the file, the 1-based line (0 for a whole file) and the
 // column or key, and what was expected. every file is read through dataset/run_file.h: nothing

@@ -14,6 +14,8 @@ namespace penumbra {
 /// writes DIR/run.json when the loop ends.
 class ManifestSink : public Sink {
  public:
+  /// SinkStage::kManifest: last: run.json is written after every other sink finished.
+  SinkStage stage() const override { return SinkStage::kManifest; }
   /// `describe` fills the manifest from the finished run (frames, timings, ...) on the loop
   /// thread in OnFinish; the sink sets RunManifest::error from LoopFinish::error.
   ManifestSink(std::string output_dir, std::function<RunManifest(const LoopFinish&)> describe);

@@ -16,6 +16,8 @@ namespace penumbra {
 /// records every step of a run into a run log.
 class RecorderSink : public Sink {
  public:
+  /// SinkStage::kRecording: after the outputs: the step's sensor records reach the log first.
+  SinkStage stage() const override { return SinkStage::kRecording; }
   /// opens the log: creates `path` and writes its header now.
   /// @throws RunLogError naming the path when it cannot be created or written.
   RecorderSink(const std::string& path, const RunLogHeader& header,

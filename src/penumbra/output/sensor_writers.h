@@ -1,5 +1,5 @@
 #pragma once
-// the files of the world-file sensors (session/sensor_sink.h runs the sensors; these write the
+// the files of the world-file sensors (sinks/sensor_sink.h runs the sensors; these write the
 // records the sensor models return):
 //
 //   <out>/lidar/<name>/scan_<k>.pcd   binary PCD v0.7 (output/pcd_writer.h)

@@ -1,8 +1,28 @@
 #include "penumbra/pipeline/sim_loop.h"
 
+#include <algorithm>
+
 #include "penumbra/core/error.h"
 
 namespace penumbra {
+
+const char* SinkStageName(SinkStage stage) {
+  switch (stage) {
+    case SinkStage::kLiveChanges:
+      return "live_changes";
+    case SinkStage::kOutputs:
+      return "outputs";
+    case SinkStage::kRecording:
+      return "recording";
+    case SinkStage::kRunControl:
+      return "run_control";
+    case SinkStage::kBridges:
+      return "bridges";
+    case SinkStage::kManifest:
+      return "manifest";
+  }
+  return "unknown";
+}
 
 std::string ErrorMessage(std::exception_ptr e) {
   try {
@@ -25,9 +45,19 @@ void SimLoop::AddSink(Sink* sink) {
   sinks_.push_back(sink);
 }
 
+std::vector<Sink*> SimLoop::OrderedSinks() const {
+  std::vector<Sink*> ordered = sinks_;
+  // stable: registration order within a stage
+  std::stable_sort(ordered.begin(), ordered.end(), [](const Sink* a, const Sink* b) {
+    return static_cast<int>(a->stage()) < static_cast<int>(b->stage());
+  });
+  return ordered;
+}
+
 void SimLoop::Start() {
   if (started_) throw Error("SimLoop: started twice");
   started_ = true;
+  sinks_ = OrderedSinks();
   thread_ = std::thread([this] { Loop(); });
 }
 

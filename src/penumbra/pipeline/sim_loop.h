@@ -45,7 +45,8 @@ class SimLoop {
   SimLoop(const SimLoop&) = delete;
   SimLoop& operator=(const SimLoop&) = delete;
 
-  /// registers a sink; before Start. sinks are called in registration order.
+  /// registers a sink; before Start. sinks are called in the order of their stage
+  /// (Sink::stage(), pipeline/sink.h), and in registration order within a stage.
   /// @throws Error if the loop was started.
   void AddSink(Sink* sink);
 
@@ -58,6 +59,9 @@ class SimLoop {
     Start();
     return Wait();
   }
+
+  /// the sinks in the order the loop calls them (by stage, then registration).
+  std::vector<Sink*> OrderedSinks() const;
 
   /// records an error (thread-safe; the first one wins) and ends the loop at the next step
   /// boundary; true if it was the first. also usable after the loop ended, for errors of

@@ -2,6 +2,10 @@
 // a consumer of the snapshots a SimLoop (pipeline/sim_loop.h) takes from its source: cameras,
 // sensors, the trajectory file, the run manifest; later recorders, bridges, viewers.
 //
+// order: every sink declares its stage (SinkStage, stage()); a SimLoop calls its sinks stage by
+// stage in the order of SinkStage, and sinks of one stage in registration order. the order of
+// AddSink calls therefore says nothing about which sink sees a step first.
+//
 // threading: a SimLoop calls every method of a sink on its loop thread (the thread that
 // advances the source), in this order: OnStart once; then for each step Wants and, when a
 // snapshot is taken at that step, OnSnapshot; then OnFinish once. the loop waits for each
@@ -49,10 +53,37 @@ struct LoopFinish {
   std::exception_ptr error;
 };
 
-/// receives snapshots from a SimLoop (threading: see the file comment).
+/// where a sink runs in a SimLoop: the loop calls OnStart, Wants, OnSnapshot and OnFinish of
+/// its sinks stage by stage in this order (registration order within a stage).
+enum class SinkStage {
+  /// changes to the world a step shows (live effects, live/live_effects.h): before any
+  /// other sink sees the step, so a change applies to every output of the step alike.
+  kLiveChanges = 0,
+  /// the outputs of a step: cameras, sensors, trajectory, metrics, falls, progress (default).
+  kOutputs = 1,
+  /// run-log recorders: after the outputs, so that a step's camera and sensor records reach
+  /// the log before it closes in OnFinish.
+  kRecording = 2,
+  /// the step gate of a live run (command/run_control.h): after the outputs and recorders, so
+  /// that a step reply follows the step's outputs.
+  kRunControl = 3,
+  /// middleware bridges and viewers (command/run_bridge.h), after the run control.
+  kBridges = 4,
+  /// run.json (output/manifest_sink.h): last, so that every other sink finished when it is
+  /// written.
+  kManifest = 5,
+};
+
+/// the stage's name ("live_changes", "outputs", ...), for messages and tests.
+const char* SinkStageName(SinkStage stage);
+
+/// receives snapshots from a SimLoop (order and threading: see the file comment).
 class Sink {
  public:
   virtual ~Sink() = default;
+
+  /// where the loop calls this sink (SinkStage); kOutputs unless a sink says otherwise.
+  virtual SinkStage stage() const { return SinkStage::kOutputs; }
 
   /// the loop starts. @throws anything: the loop then ends with that error before any step.
   virtual void OnStart(const LoopStart& start) {}
@@ -69,7 +100,7 @@ class Sink {
   virtual void OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot) = 0;
 
   /// the loop ended (after the last OnSnapshot): finish the sink's work (drain its threads,
-  /// close its files). called for every sink, also after an error, in registration order.
+  /// close its files). called for every sink, also after an error, in stage order.
   /// @throws anything: recorded as an error of the run (first one wins).
   virtual void OnFinish(const LoopFinish& finish) {}
 };

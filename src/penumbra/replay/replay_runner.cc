@@ -18,8 +18,8 @@
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
-#include "penumbra/session/live_effects.h"
-#include "penumbra/session/run_outputs.h"
+#include "penumbra/live/live_effects.h"
+#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -153,7 +153,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);
   Simulation& sim = session.sim();
 
-  // the live changes of the run (session/live_effects.h), applied at their steps as the run
+  // the live changes of the run (live/live_effects.h), applied at their steps as the run
   // applied them; a replay under --adversity shows its own conditions instead
   LiveEffects live(session);
   int64_t live_changes = 0;
@@ -193,7 +193,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   timings["load_sec"] = session.timings().load_sec;
   timings["scene_build_sec"] = session.timings().scene_build_sec;
 
-  // the sinks of `penumbra run` (session/run_outputs.h), fed by the log; the world's
+  // the sinks of `penumbra run` (sinks/run_outputs.h), fed by the log; the world's
   // `metrics:` on the kinematic quantities of the snapshots
   RunOutputsOptions outputs_options;
   outputs_options.end_time_sec = end_time;

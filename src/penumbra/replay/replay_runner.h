@@ -52,7 +52,7 @@ struct ReplayOptions {
   /// (`penumbra export` of a run log asks for kSensor unless --depth ground-truth).
   ReplayDepth depth = ReplayDepth::kAsRecorded;
   /// the depth_noise preset kSensor gives a camera without its own: the benchmarks' camera
-  /// model (benchmark/benchmark_spec.h), sensors/depth_noise.h.
+  /// model (campaign/benchmark_spec.h), sensors/depth_noise.h.
   std::string default_depth_noise = "realsense_d435";
   /// --cameras: the cameras to render, by name (empty = all).
   std::vector<std::string> cameras;

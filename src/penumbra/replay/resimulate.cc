@@ -24,9 +24,9 @@
 #include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/session/live_effects.h"
-#include "penumbra/session/physics_source.h"
-#include "penumbra/session/run_log_header.h"
+#include "penumbra/live/live_effects.h"
+#include "penumbra/sinks/physics_source.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {
@@ -318,7 +318,7 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
                                   "state) to resimulate from",
                                   first.step));
 
-  // the live changes of the run (session/live_effects.h) at their steps: those that moved or
+  // the live changes of the run (live/live_effects.h) at their steps: those that moved or
   // parked NPCs changed the physics from there
   LiveEffects live(session);
   for (const EventRecord& e : reader.Events()) {

@@ -38,7 +38,7 @@ namespace penumbra {
 class StateMap {
  public:
   /// plans the copy from `log` (the header's layout) to `model` (the replay model's layout,
-  /// session/run_log_header.h RunLogLayoutOf). `log_name` names the log in errors.
+  /// live/run_log_header.h RunLogLayoutOf). `log_name` names the log in errors.
   /// @throws ConfigError(log_name, 0, "", ...) naming the first joint or actuator of the log
   ///         that the replay model lacks or holds with another type or width, the first joint
   ///         or actuator of the replay model that the log lacks, or a different nuserdata.

@@ -4,7 +4,7 @@
 // time; each step reads the robots' root poses from the simulation (a robot without a free
 // joint stands at its world-file pose), and the agents' poses between two crowd steps are
 // interpolated (position linearly, heading along the shorter arc). every CrowdDecision goes
-// to the decision sink (a run log's "npc" events, app/runner.cc).
+// to the decision sink (a run log's "npc" events, run/runner.cc).
 
 #include <functional>
 #include <memory>

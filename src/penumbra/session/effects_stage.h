@@ -2,7 +2,7 @@
 // the adverse-condition stage of a run: the world's `effects:`, its NPC
 // `agents:` and an adversity preset (world key `adversity`, or --adversity) put together.
 //
-// order in a run (app/runner.cc):
+// order in a run (run/runner.cc):
 //   1. compose the models, then EffectsStage(world, &composed, ...) plans the preset
 //      (regions and NPC paths need the scene: with a preset it compiles the composed
 //      document once more to read the static geometry) and adds the mocap bodies of every
@@ -78,7 +78,7 @@ class EffectsStage {
   ///        for the world's own `adversity` key
   /// @param reserve_live_npcs also add parked bodies for the NPCs the bundled presets can ask
   ///        for (LiveNpcReserve), so that a live change to a bundled preset can bring them in
-  ///        (session/live_effects.h; MuJoCo 2.2.2 cannot add bodies to a loaded model)
+  ///        (live/live_effects.h; MuJoCo 2.2.2 cannot add bodies to a loaded model)
   /// @throws ConfigError for an unknown preset, invalid agents or invalid effects.
   /// @param sites the world's areas and lanes for placing crowds (CrowdSites; empty = none)
   EffectsStage(const WorldConfig& world, ComposedScene* composed,
@@ -104,7 +104,7 @@ class EffectsStage {
   std::shared_ptr<const EffectsFrame> Evaluate(const WorldSnapshot& snapshot,
                                                const Eigen::Vector3d& viewer_W);
 
-  /// a live change (session/live_effects.h): the run's effects, agents and preset become
+  /// a live change (live/live_effects.h): the run's effects, agents and preset become
   /// these from now on; `engine` is the EffectsEngine bound to them (null when `effects` is
   /// empty). each agent body attached (Attach) follows the path of the agent of the same name
   /// in `agents`, or is parked when it has none (AgentParkedPose); the bodies' poses change
@@ -121,7 +121,7 @@ class EffectsStage {
   std::shared_ptr<const NpcMap> npc_map() const { return npc_map_; }
   const CrowdSites& sites() const { return sites_; }
   std::shared_ptr<const CrowdRunner> crowd() const { return crowd_; }
-  /// every crowd decision from now on goes to `sink` (sim time, JSON payload; app/runner.cc
+  /// every crowd decision from now on goes to `sink` (sim time, JSON payload; run/runner.cc
   /// records them as "npc" events of the run log). called from the physics thread.
   void set_crowd_decision_sink(std::function<void(double, const std::string&)> sink);
   /// the world seed (keys the effects' random streams).

@@ -45,7 +45,7 @@ std::string CameraSizeKey(const WorldConfig& world, const CameraSpec& c) {
   return "cameras";
 }
 
-// the beams per scan and scan rate of a LiDAR entry (as session/sensor_sink.cc builds it);
+// the beams per scan and scan rate of a LiDAR entry (as sinks/sensor_sink.cc builds it);
 // nothing when the pattern is invalid (the sensor stage reports that with the key).
 std::optional<std::pair<double, double>> LidarBeams(const SensorConfig& s) {
   if (s.type != "lidar") return std::nullopt;

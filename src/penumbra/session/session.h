@@ -18,7 +18,7 @@
 //                then the renderer (render/renderer.h) is built for that scene, and policy
 //                controllers with a height scan get the static scene's terrain ray caster
 //                (session/static_terrain_ray_caster.h).
-// a Session is then stepped and rendered by its user (app/runner.cc, app/bench.cc, ...); it
+// a Session is then stepped and rendered by its user (run/runner.cc, bench/bench.cc, ...); it
 // owns everything it built and is neither copied nor moved (what it hands out by reference
 // stays valid for its lifetime).
 

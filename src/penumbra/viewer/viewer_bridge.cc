@@ -19,7 +19,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/sensors/lidar_scanner.h"
-#include "penumbra/session/live_control.h"
+#include "penumbra/live/live_control.h"
 #include "penumbra/session/npc_map_json.h"
 #include "penumbra/session/session.h"
 #include "penumbra/viewer/image_maps.h"
@@ -356,7 +356,7 @@ class ViewerBridge : public RunBridge {
     s.push_back(slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0));
     s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1));
     // MuJoCo cannot add bodies to a loaded model: the run has the NPC bodies it started with
-    // (a live run also parks bodies for the bundled presets' NPCs: session/live_effects.h)
+    // (a live run also parks bodies for the bundled presets' NPCs: live/live_effects.h)
     const int npc_bodies = std::max(
         0, static_cast<int>(session_.effects().agent_bodies().size() - world_.agents.size()));
     json npcs = slider("npcs", "people", "NPC count", "", 0, npc_bodies, 1, 0);

@@ -52,7 +52,7 @@ struct ViewerOptions {
 /// @throws ConfigError("", 0, "--viewer", ...) for a port that is not 0..65535 or an empty host.
 void ParseViewerAddress(const std::string& spec, ViewerOptions* options);
 
-/// a factory for RunOptions::bridges (app/runner.h).
+/// a factory for RunOptions::bridges (run/runner.h).
 RunBridgeFactory MakeViewerBridgeFactory(ViewerOptions options);
 
 }  // namespace penumbra

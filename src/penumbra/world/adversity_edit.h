@@ -1,6 +1,6 @@
 #pragma once
 // a live change of one block of an adversity preset (world/adversity_preset.h), as
-// session/live_effects.h applies it while a run goes on. implemented in adversity_preset.cc,
+// live/live_effects.h applies it while a run goes on. implemented in adversity_preset.cc,
 // with the preset file's reader, so that a block is checked exactly as a preset file's is.
 
 #include <string>

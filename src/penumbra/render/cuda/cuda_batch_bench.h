@@ -1,5 +1,5 @@
 #pragma once
-// the batch-rendering benchmark shared by `penumbra bench render --batch N` (app/bench.cc) and
+// the batch-rendering benchmark shared by `penumbra bench render --batch N` (bench/bench.cc) and
 // render_cuda_bench (scripts/gpu/check.sh): K cameras spread over N worlds rendered by
 // BatchRenderer, with pinned and with pageable copies back, the kernel alone, and the CPU
 // backend rendering the same views one by one. a benchmark, never a pass/fail test.

@@ -1,0 +1,81 @@
+#pragma once
+// `penumbra bench render|physics`: throughput measurements on real worlds. these
+// are benchmarks, never pass/fail tests; they print numbers and targets.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "penumbra/render/render_ablation.h"
+
+#include "penumbra/render/render_settings.h"
+
+namespace penumbra {
+
+/// options of `penumbra bench render`.
+struct RenderBenchOptions {
+  std::string world_file;  ///< world to render (default: the bundled default world)
+  int frames = 60;         ///< timed frames per resolution
+  int warmup_frames = 5;   ///< untimed frames first
+  int threads = 0;         ///< render threads, 0 = all cores
+  std::string tier = "realtime";
+  /// --backend; nullopt = the world's render.backend.
+  std::optional<RenderSettings::Backend> backend;
+  /// --batch N: batch rendering (render/cuda/cuda_batch_renderer.h) of N cameras per launch
+  /// instead (backend cuda); 0 = the single-camera benchmark.
+  int batch = 0;
+  int batch_width = 128;  ///< --size WxH of the batch benchmark
+  int batch_height = 128;
+  int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
+  bool adversity = true;  ///< also time the presets none/minor/major (bench/effects_bench.h)
+  /// parts of the renderer to switch off (RenderAblation's fields by their --ablate names:
+  /// mirror, mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, film); the
+  /// frames/s then say what the part costs (docs/performance.md, "What costs what").
+  std::vector<std::string> ablate;
+  /// time only the 640x480 resolution (skip 800x800).
+  bool only_640x480 = false;
+};
+
+/// the names `penumbra bench render --ablate` takes, in RenderAblation's order.
+const std::vector<std::string>& AblationNames();
+
+/// switches off the parts `names` names in *ablation. @throws ConfigError naming an unknown
+/// part and listing the known ones.
+void ApplyAblation(const std::vector<std::string>& names, RenderAblation* ablation);
+
+/// renders the world's first camera at 640x480 and 800x800 (RGB + depth) while the
+/// world moves, and prints frames/s and Mrays/s for each. returns 0.
+int BenchRender(const RenderBenchOptions& options);
+
+/// options of `penumbra bench physics`.
+struct PhysicsBenchOptions {
+  std::string world_file;  ///< world whose composed model is stepped (default world)
+  std::string model_file;  ///< or a bare MJCF file
+  double sim_seconds = 20;
+  bool controllers = true;         ///< also report controller cost on the bundled robot worlds
+  double controller_seconds = 10;  ///< simulated seconds per controller-cost episode
+};
+
+/// prints Penumbra's physics steps/s against a bare mj_step loop on the same model. returns 0.
+int BenchPhysics(const PhysicsBenchOptions& options);
+
+/// the frame rate `penumbra bench render` aims for: 640x480 rgb+depth, realtime tier, on the
+/// 2-core CI machine (docs/benchmarks.md), frames/s.
+inline constexpr double kRenderTargetFps = 30.0;
+/// the adversity preset `major`'s target of the same measurement, frames/s.
+inline constexpr double kMajorPresetTargetFps = 10.0;
+
+/// "met" when `measured` >= `target`, else "NOT met": the verdict the bench commands print
+/// after each target line (a higher-is-better figure).
+const char* TargetVerdict(double measured, double target);
+
+/// prints the realtime frame-rate target line of a render bench: "target (2-core CI machine):
+/// <subject>>= T frames/s at 640x480 realtime: met|NOT met (F frames/s here)", or "not
+/// applicable (tier X)" when `tier` is not "realtime". `subject` is "" or e.g. "major ".
+void PrintRealtimeFpsTarget(const std::string& subject, double target_fps, double measured_fps,
+                            const std::string& tier);
+
+/// the bundled default world (worlds/default.yaml in the source tree).
+std::string DefaultWorldPath();
+
+}  // namespace penumbra

@@ -1,0 +1,308 @@
+#include "penumbra/campaign/benchmark_report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/core/error.h"
+#include "penumbra/eval/trajectory.h"
+#include "penumbra/eval/trajectory_evaluation.h"
+#include "penumbra/eval/trajectory_plot.h"
+#include "penumbra/world/yaml_reader.h"
+
+namespace penumbra {
+namespace fs = std::filesystem;
+namespace {
+
+using namespace benchmark_text;  // NOLINT: module-internal helpers
+
+// a line plot: x = the conditions in spec order, one line per method with error bars (std)
+void PlotMetric(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines,
+                const std::string& world, const std::string& label,
+                SummaryCell SummaryLine::*metric, const fs::path& file) {
+  const int W = 900, H = 560, left = 90, right = 220, top = 50, bottom = 70;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  double ymax = 0;
+  for (const SummaryLine& l : lines)
+    if (l.world == world && (l.*metric).n > 0)
+      ymax = std::max(ymax, (l.*metric).mean + (l.*metric).std);
+  if (!(ymax > 0)) ymax = 1;
+  const double step = std::pow(10.0, std::floor(std::log10(ymax / 4)));
+  double tick = step;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (ymax / (m * step) <= 6) {
+      tick = m * step;
+      break;
+    }
+  ymax = std::ceil(ymax / tick) * tick;
+  const int pw = W - left - right, ph = H - top - bottom;
+  const size_t nc = spec.conditions.size();
+  auto X = [&](size_t c) {
+    return left + static_cast<int>(std::lround(pw * (nc == 1 ? 0.5 : (c + 0.5) / nc)));
+  };
+  auto Y = [&](double v) { return top + ph - static_cast<int>(std::lround(ph * v / ymax)); };
+  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
+  for (double v = 0; v <= ymax + tick / 2; v += tick) {
+    cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, grey, 1, cv::LINE_AA);
+    cv::putText(img, fmt::format("{:g}", v), {8, Y(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black,
+                1, cv::LINE_AA);
+  }
+  cv::rectangle(img, {left, top}, {left + pw, top + ph}, black, 1);
+  for (size_t c = 0; c < nc; ++c)
+    cv::putText(img, spec.conditions[c].name, {X(c) - 20, top + ph + 25}, cv::FONT_HERSHEY_SIMPLEX,
+                0.55, black, 1, cv::LINE_AA);
+  cv::putText(img, "adversity condition", {left + pw / 2 - 80, H - 15}, cv::FONT_HERSHEY_SIMPLEX,
+              0.55, black, 1, cv::LINE_AA);
+  cv::putText(img, spec.name + " / " + world + ": " + label, {left, 30}, cv::FONT_HERSHEY_SIMPLEX,
+              0.65, black, 1, cv::LINE_AA);
+  static const cv::Scalar kColours[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
+                                        {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
+  for (size_t m = 0; m < spec.methods.size(); ++m) {
+    const cv::Scalar col = kColours[m % 6];
+    std::vector<cv::Point> pts;
+    for (size_t c = 0; c < nc; ++c)
+      for (const SummaryLine& l : lines) {
+        if (l.world != world || l.condition != spec.conditions[c].name ||
+            l.method != spec.methods[m].name)
+          continue;
+        const SummaryCell& v = l.*metric;
+        if (v.n == 0) {
+          cv::drawMarker(img, {X(c), top + ph - 8}, col, cv::MARKER_TILTED_CROSS, 12,
+                         2);  // no trial ok
+          continue;
+        }
+        const cv::Point p(X(c) + static_cast<int>(m) * 4, Y(v.mean));
+        pts.push_back(p);
+        cv::line(img, {p.x, Y(std::max(0.0, v.mean - v.std))}, {p.x, Y(v.mean + v.std)}, col, 1,
+                 cv::LINE_AA);
+        cv::circle(img, p, 4, col, cv::FILLED, cv::LINE_AA);
+      }
+    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2, cv::LINE_AA);
+    const int ly = top + 20 + 24 * static_cast<int>(m);
+    cv::line(img, {left + pw + 15, ly - 4}, {left + pw + 40, ly - 4}, col, 2, cv::LINE_AA);
+    cv::putText(img, spec.methods[m].name, {left + pw + 46, ly}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                black, 1, cv::LINE_AA);
+  }
+  cv::putText(img, "mean +- std over trials; x: no trial tracked", {left, H - 40 + 0},
+              cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(90, 90, 90), 1, cv::LINE_AA);
+  if (!cv::imwrite(file.string(), img)) throw Error("cannot write " + file.string());
+}
+
+}  // namespace
+
+const std::vector<std::string>& BenchmarkCsvColumns() {
+  static const std::vector<std::string> kColumns = {"world",
+                                                    "condition",
+                                                    "method",
+                                                    "trial",
+                                                    "seed",
+                                                    "status",
+                                                    "frames",
+                                                    "poses",
+                                                    "ate_rmse_m",
+                                                    "ate_mean_m",
+                                                    "ate_max_m",
+                                                    "rpe_trans_rmse_m",
+                                                    "rpe_rot_rmse_deg",
+                                                    "coverage",
+                                                    "scaled_ate_m",
+                                                    "tracked_fraction",
+                                                    "tracked_path_coverage",
+                                                    "tracked_scaled_ate_m",
+                                                    "scale",
+                                                    "replay_sec",
+                                                    "export_sec",
+                                                    "method_sec",
+                                                    "eval_sec",
+                                                    "detail"};
+  return kColumns;
+}
+
+std::string BenchmarkCsv(const std::vector<BenchmarkRow>& rows) {
+  std::string out;
+  for (const std::string& c : BenchmarkCsvColumns()) out += (out.empty() ? "" : ",") + c;
+  out += "\n";
+  for (const BenchmarkRow& r : rows) {
+    out += fmt::format("{},{},{},{},{},{},{},{},", r.world, r.condition, r.method, r.trial, r.seed,
+                       r.status, r.frames, r.poses);
+    for (double v : {r.ate_rmse_m, r.ate_mean_m, r.ate_max_m, r.rpe_trans_rmse_m,
+                     r.rpe_rot_rmse_deg, r.coverage, r.scaled_ate_m, r.tracked_fraction,
+                     r.tracked_path_coverage, r.tracked_scaled_ate_m, r.scale})
+      out += Field(v) + ",";
+    out += fmt::format("{:.3f},{:.3f},{:.3f},{:.3f},", r.replay_sec, r.export_sec, r.method_sec,
+                       r.eval_sec);
+    out += CsvQuote(r.detail) + "\n";
+  }
+  return out;
+}
+
+std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
+                                   const std::vector<BenchmarkRow>& rows) {
+  std::vector<SummaryLine> lines;
+  for (const BenchmarkWorld& w : spec.worlds)
+    for (const BenchmarkCondition& c : spec.conditions)
+      for (const BenchmarkMethod& m : spec.methods) {
+        SummaryLine l;
+        l.world = w.name;
+        l.condition = c.name;
+        l.method = m.name;
+        std::vector<double> ate, sate, cov, rpet, rper, tracked, tcov, tsate;
+        for (const BenchmarkRow& r : rows) {
+          if (r.world != w.name || r.condition != c.name || r.method != m.name) continue;
+          ++l.trials;
+          const bool ok = r.status == "ok";
+          l.ok += ok ? 1 : 0;
+          tracked.push_back(ok && std::isfinite(r.tracked_fraction) ? r.tracked_fraction : 0.0);
+          if (!ok) continue;
+          if (std::isfinite(r.ate_rmse_m)) ate.push_back(r.ate_rmse_m);
+          if (std::isfinite(r.scaled_ate_m)) sate.push_back(r.scaled_ate_m);
+          if (std::isfinite(r.coverage)) cov.push_back(r.coverage);
+          if (std::isfinite(r.tracked_path_coverage)) tcov.push_back(r.tracked_path_coverage);
+          if (std::isfinite(r.tracked_scaled_ate_m)) tsate.push_back(r.tracked_scaled_ate_m);
+          if (std::isfinite(r.rpe_trans_rmse_m)) rpet.push_back(r.rpe_trans_rmse_m);
+          if (std::isfinite(r.rpe_rot_rmse_deg)) rper.push_back(r.rpe_rot_rmse_deg);
+        }
+        l.ate_rmse_m = Cell(ate);
+        l.scaled_ate_m = Cell(sate);
+        l.coverage = Cell(cov);
+        l.tracked_path_coverage = Cell(tcov);
+        l.tracked_scaled_ate_m = Cell(tsate);
+        l.rpe_trans_rmse_m = Cell(rpet);
+        l.rpe_rot_rmse_deg = Cell(rper);
+        l.tracked_fraction = Cell(tracked);
+        lines.push_back(l);
+      }
+  return lines;
+}
+
+std::string SummaryMarkdown(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines) {
+  std::string out;
+  for (const BenchmarkWorld& w : spec.worlds) {
+    out += fmt::format(
+        "**{}** (mean ± std over the trials that tracked; `ok` = trials with a trajectory "
+        "that matches the ground truth; tracked fraction counts failed trials as 0; RPE over {} "
+        "s)\n\n",
+        w.name, FormatNumber(spec.metrics.rpe_delta_sec));
+    out +=
+        "| condition | method | ok | ATE RMSE (m) | scaled ATE (m) | coverage | tracked path "
+        "coverage | tracked-path scaled ATE (m) | tracked fraction | RPE (m) | RPE (deg) |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const SummaryLine& l : lines) {
+      if (l.world != w.name) continue;
+      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                         l.condition, l.method, l.ok, l.trials, Pm(l.ate_rmse_m, 4),
+                         Pm(l.scaled_ate_m, 4), Pm(l.coverage, 3), Pm(l.tracked_path_coverage, 3),
+                         Pm(l.tracked_scaled_ate_m, 4), Pm(l.tracked_fraction, 3),
+                         Pm(l.rpe_trans_rmse_m, 4), Pm(l.rpe_rot_rmse_deg, 2));
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
+                          const std::vector<BenchmarkRow>& rows, double wall_sec) {
+  const fs::path out(out_dir);
+  WriteText(out / "results.csv", BenchmarkCsv(rows));
+  const std::vector<SummaryLine> lines = Summarize(spec, rows);
+  const std::string table = SummaryMarkdown(spec, lines);
+  WriteText(out / "summary.md", table);
+  std::string csv =
+      "world,condition,method,trials,ok,ate_rmse_m_mean,ate_rmse_m_std,scaled_ate_m_mean,scaled_"
+      "ate_m_std,"
+      "coverage_mean,coverage_std,tracked_fraction_mean,tracked_fraction_std,rpe_trans_rmse_m_mean,"
+      "rpe_trans_rmse_m_std,tracked_path_coverage_mean,tracked_path_coverage_std,"
+      "tracked_scaled_ate_m_mean,tracked_scaled_ate_m_std\n";
+  for (const SummaryLine& l : lines)
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world,
+                       l.condition, l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean),
+                       Field(l.ate_rmse_m.std), Field(l.scaled_ate_m.mean),
+                       Field(l.scaled_ate_m.std), Field(l.coverage.mean), Field(l.coverage.std),
+                       Field(l.tracked_fraction.mean), Field(l.tracked_fraction.std),
+                       Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std),
+                       Field(l.tracked_path_coverage.mean), Field(l.tracked_path_coverage.std),
+                       Field(l.tracked_scaled_ate_m.mean), Field(l.tracked_scaled_ate_m.std));
+  WriteText(out / "summary.csv", csv);
+
+  fs::create_directories(out / "plots");
+  std::string md = fmt::format(
+      "# Benchmark `{}`\n\nspec: `{}`; {} world(s) x {} condition(s) x {} trial(s) x {} "
+      "method(s) = {} rows; wall time {:.1f} s.\n\n## Summary\n\n{}",
+      spec.name, spec.file, spec.worlds.size(), spec.conditions.size(), spec.seeds.size(),
+      spec.methods.size(), rows.size(), wall_sec, table);
+  md += "## Metric vs adversity\n\n";
+  for (const BenchmarkWorld& w : spec.worlds) {
+    const std::string ate = "plots/" + w.name + "_ate.png",
+                      tracked = "plots/" + w.name + "_tracked.png";
+    PlotMetric(spec, lines, w.name, "ATE RMSE (m)", &SummaryLine::ate_rmse_m, out / ate);
+    PlotMetric(spec, lines, w.name, "tracked fraction", &SummaryLine::tracked_fraction,
+               out / tracked);
+    md += fmt::format("![{0} ATE]({1})\n\n![{0} tracked fraction]({2})\n\n", w.name, ate, tracked);
+  }
+  // top views of the first trial of every (world, condition, method) that tracked
+  md += "## Trajectories (top view, first trial)\n\n";
+  for (const BenchmarkRow& r : rows) {
+    if (r.trial != 1 || r.status != "ok") continue;
+    const fs::path job = out / "jobs" / (r.world + "__" + r.condition + "__t1");
+    const fs::path est_file = job / r.method / "estimate.txt";
+    std::error_code ec;
+    if (!fs::is_regular_file(est_file, ec)) continue;
+    const Trajectory gt = ReadTumTrajectory(job / "groundtruth.txt"),
+                     est = ReadTumTrajectory(est_file);
+    const BenchmarkMethod* method = nullptr;
+    for (const BenchmarkMethod& m : spec.methods)
+      if (m.name == r.method) method = &m;
+    EvaluationOptions options;
+    options.association.max_dt_sec = spec.metrics.max_dt_sec;
+    options.alignment = method ? method->align : spec.metrics.align;
+    TrajectoryEvaluation e;
+    try {
+      e = EvaluateTrajectory(gt, est, options, "groundtruth", "estimate");
+    } catch (const ConfigError&) {
+      continue;
+    }
+    TrajectoryPlot plot;
+    plot.title = fmt::format("{} / {} / {} (trial 1): ATE RMSE {:.4f} m", r.world, r.condition,
+                             r.method, e.ate_m.rmse);
+    plot.ground_truth_m = gt.Positions();
+    plot.ground_truth_time_sec = gt.time_sec;
+    plot.estimate_m = e.aligned_estimate_all_positions;
+    plot.estimate_time_sec = est.time_sec;
+    plot.estimate_label = r.method;
+    plot.max_gap_sec = e.tracked.max_gap_sec;
+    plot.error_time_sec = e.pair_time_sec;
+    plot.error = e.ate_errors_m;
+    plot.error_label = "ATE (m)";
+    plot.error_rmse = e.ate_m.rmse;
+    plot.width = 1000;
+    plot.height = 500;
+    const std::vector<uint8_t> png = RenderTrajectoryPlotPng(plot);
+    const std::string name =
+        "plots/traj_" + r.world + "__" + r.condition + "__" + r.method + ".png";
+    WriteText(out / name, std::string(png.begin(), png.end()));
+    md += fmt::format("![{} {} {}]({})\n\n", r.world, r.condition, r.method, name);
+  }
+  md +=
+      "## Rows\n\nEvery (world, condition, method, trial): [results.csv](results.csv) (columns in "
+      "docs/benchmarks.md).\n\n";
+  int failed = 0;
+  for (const BenchmarkRow& r : rows)
+    if (r.status != "ok") {
+      if (failed++ == 0)
+        md +=
+            "| world | condition | method | trial | status | detail |\n|---|---|---|---|---|---|\n";
+      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r.world, r.condition, r.method,
+                        r.trial, r.status, r.detail.substr(0, 200));
+    }
+  if (failed == 0) md += "Every method tracked in every trial.\n";
+  WriteText(out / "report.md", md);
+}
+
+}  // namespace penumbra
