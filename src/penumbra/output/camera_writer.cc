@@ -224,21 +224,22 @@ void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string&
     const std::string kind(k.name);
     const fs::path path = folder_ / k.folder / name;
     std::vector<uint8_t> bytes;
+    PngWriteTimes t;
     switch (k.encoding) {
       case ImageEncoding::kPngRgb8:
         CheckFrameImage(frame.rgb, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
-        bytes = WritePngRgb8(path.string(), frame.rgb, png_options_);
+        bytes = WritePngRgb8(path.string(), frame.rgb, png_options_, &t);
         break;
       case ImageEncoding::kPngRgb8Normals: {
         const ImageF& img = FloatImage(frame, k.kind);
         CheckFrameImage(img, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
-        bytes = WritePngRgb8(path.string(), NormalsToRgb8(img), png_options_);
+        bytes = WritePngRgb8(path.string(), NormalsToRgb8(img), png_options_, &t);
         break;
       }
       case ImageEncoding::kPngGray16Millimetres: {
         const ImageF& img = FloatImage(frame, k.kind);
         CheckFrameImage(img, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
-        bytes = WritePngGray16(path.string(), DepthToMillimetres(img), png_options_);
+        bytes = WritePngGray16(path.string(), DepthToMillimetres(img), png_options_, &t);
         break;
       }
       case ImageEncoding::kPngGray16IdPlusOne:
@@ -258,10 +259,12 @@ void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string&
           u16 = IdsToU16(ids, plus_one ? 1 : 0,
                          k.kind == ImageKind::kInstanceSegmentation ? "body" : "semantic class");
         }
-        bytes = WritePngGray16(path.string(), u16, png_options_);
+        bytes = WritePngGray16(path.string(), u16, png_options_, &t);
         break;
       }
     }
+    encode_ns_ += static_cast<int64_t>(t.encode_sec * 1e9);
+    write_ns_ += static_cast<int64_t>(t.write_sec * 1e9);
     written->push_back(path);
     if (on_image_) on_image_(frame, kind, bytes);
   }

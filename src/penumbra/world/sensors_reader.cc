@@ -7,10 +7,10 @@
 #include <string_view>
 #include <variant>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 namespace {
@@ -20,10 +20,10 @@ std::string Prefixed(const std::string& robot, const std::string& name) {
   return robot + "/" + name;
 }
 
-// the sensor registry's reader (sensors/sensor_type.h) over one YAML node of the entry
-class YamlSensorParamReader : public SensorParamReader {
+// the sensor registry's reader (sensors/sensor_type.h) over one node of the entry (config/)
+class WorldSensorParamReader : public SensorParamReader {
  public:
-  YamlSensorParamReader(YamlReader node, std::string robot)
+  WorldSensorParamReader(ParamReader node, std::string robot)
       : node_(std::move(node)), robot_(std::move(robot)) {}
 
   bool Has(std::string_view k) const override { return node_.Has(k); }
@@ -35,14 +35,14 @@ class YamlSensorParamReader : public SensorParamReader {
   }
   std::vector<std::string> Names(std::string_view k) const override {
     std::vector<std::string> out;
-    for (const YamlReader& e : node_.Child(k).List()) out.push_back(Prefixed(robot_, e.String()));
+    for (const ParamReader& e : node_.Child(k).List()) out.push_back(Prefixed(robot_, e.String()));
     return out;
   }
   std::unique_ptr<SensorParamReader> Map(std::string_view k,
                                          const std::vector<std::string_view>& keys) const override {
-    YamlReader child = node_.Child(k);
+    ParamReader child = node_.Child(k);
     child.ExpectMap(keys);
-    return std::make_unique<YamlSensorParamReader>(std::move(child), robot_);
+    return std::make_unique<WorldSensorParamReader>(std::move(child), robot_);
   }
   [[noreturn]] void Fail(std::string_view k, const std::string& problem) const override {
     if (k.empty()) node_.Fail(problem);
@@ -50,14 +50,14 @@ class YamlSensorParamReader : public SensorParamReader {
   }
 
  private:
-  YamlReader node_;
+  ParamReader node_;
   std::string robot_;
 };
 
-SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s);
+SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, SensorConfig s);
 
 // every error after the name names the sensor: "sensor '<name>': <problem>"
-SensorConfig ReadSensor(const YamlReader& r, const std::string& robot) {
+SensorConfig ReadSensor(const ParamReader& r, const std::string& robot) {
   r.ExpectMapAnyKeys();
   SensorConfig s;
   s.name = r.Child("name").String();
@@ -75,7 +75,7 @@ SensorConfig ReadSensor(const YamlReader& r, const std::string& robot) {
   }
 }
 
-SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s) {
+SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, SensorConfig s) {
   s.line = r.line();
   s.key = r.path();
   s.robot = robot;
@@ -103,12 +103,12 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   r.ExpectMap(keys);
   const std::string sensor = "sensor '" + s.name + "': ";
   if (r.Has("rate_hz")) {
-    const YamlReader c = r.Child("rate_hz");
+    const ParamReader c = r.Child("rate_hz");
     s.rate_hz = c.Double();
     if (!(*s.rate_hz > 0))
       c.Fail(sensor + "got " + FormatNumber(*s.rate_hz) + "; expected a rate > 0 (Hz)");
   }
-  const YamlSensorParamReader reader(r, robot);
+  const WorldSensorParamReader reader(r, robot);
   if (r.Has("latency_sec")) s.latency_sec = reader.NonNegative("latency_sec", "s");
   if (r.Has("body")) s.body = Prefixed(robot, r.Child("body").String());
   if (r.Has("site")) s.site = Prefixed(robot, r.Child("site").String());
@@ -122,17 +122,17 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   if (type.attach == SensorAttach::kDefaultWorld && s.body.empty() && s.site.empty())
     s.body = "world";
   if (r.Has("pose")) {
-    const YamlReader p = r.Child("pose");
+    const ParamReader p = r.Child("pose");
     p.ExpectMap({"xyz", "rpy_deg"});
     if (p.Has("xyz")) {
-      const YamlReader c = p.Child("xyz");
+      const ParamReader c = p.Child("xyz");
       s.xyz = c.Vector3();
       if (!(s.xyz.cwiseAbs().maxCoeff() <= kMaxPositionM))
         c.Fail(sensor + "got [" + FormatNumber(s.xyz.x()) + ", " + FormatNumber(s.xyz.y()) + ", " +
                FormatNumber(s.xyz.z()) + "]; expected each of the 3 numbers in [" +
                FormatNumber(-kMaxPositionM) + ", " + FormatNumber(kMaxPositionM) + "] (m)");
     }
-    if (p.Has("rpy_deg")) s.rpy_deg = p.Child("rpy_deg").Vector3();
+    if (const auto found = p.Find("rpy_deg")) s.rpy_deg = found->Vector3();
   }
   std::visit([&](auto& p) { p.Read(reader); }, s.params);
   return s;
@@ -140,10 +140,10 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
 
 }  // namespace
 
-std::vector<SensorConfig> ReadSensors(const YamlReader& list, const std::string& file,
+std::vector<SensorConfig> ReadSensors(const ParamReader& list, const std::string& file,
                                       const std::string& robot) {
   std::vector<SensorConfig> out;
-  for (const YamlReader& e : list.List()) {
+  for (const ParamReader& e : list.List()) {
     out.push_back(ReadSensor(e, robot));
     out.back().file = file;
   }
