@@ -17,6 +17,13 @@ scripts/check_module_deps.py. The rules and their allow-lists live in scripts/bu
                   "module_deps_exempt" (app, main) have no limit and "module_deps_allowed" holds
                   today's larger modules with their count as a ceiling (lower it when a module
                   sheds deps; the checker says so)
+  sensor-kinds    no string literal that is a sensor type's name ("lidar", "imu", ...: the kTypeName
+                  of each src/penumbra/sensors/types/*.h) in src/penumbra outside sensors/types/
+                  and world/ (go through the registry, sensors/sensor_types.h: SensorKind,
+                  SensorKindName, the types' kOutputFolder); comments do not count. the
+                  allow-list "sensor_kind_literals" maps a file to the literals it may hold
+                  with another meaning (an MJCF <mujoco> element, a CLI option); it may only
+                  shrink
   preprocessed    with --compile-commands: `g++ -E` of every C++ translation unit of the build;
                   fails when one is above "preprocessed_lines.per_unit" or all together above
                   "preprocessed_lines.total" (scripts/build_stats/preprocessed_lines.py measures
@@ -130,6 +137,68 @@ def check_sources(root, rules):
         "no json.hpp in headers (include it in the .cc; pass a forward-declared type or a "
         "string across the header)")
     errors += check_module_deps_count(root, rules)
+    errors += check_sensor_kind_literals(src, files, rules)
+    return errors
+
+
+TYPE_NAME_RE = re.compile(r'\bkTypeName\s*=\s*"([^"]*)"')
+# a C++ string literal (no raw strings in this code base), or a comment to skip
+TOKEN_RE = re.compile(r'//[^\n]*|/\*.*?\*/|"((?:[^"\\\n]|\\.)*)"|\'(?:[^\'\\\n]|\\.)*\'',
+                      re.S)
+SENSOR_KIND_HOMES = ("sensors/types/", "world/")
+
+
+def sensor_type_names(src, files):
+    """the kTypeName of every sensor type header (sensors/types/*.h)."""
+    names = set()
+    for rel in files:
+        if rel.startswith("sensors/types/") and rel.endswith(HEADER_EXTS):
+            with open(os.path.join(src, rel), encoding="utf-8", errors="replace") as f:
+                names.update(TYPE_NAME_RE.findall(f.read()))
+    return names
+
+
+def string_literals(text):
+    """(1-based line, content) of every string literal of C++ source `text`, comments skipped."""
+    out = []
+    for m in TOKEN_RE.finditer(text):
+        if m.group(1) is not None:
+            out.append((text.count("\n", 0, m.start()) + 1, m.group(1)))
+    return out
+
+
+def check_sensor_kind_literals(src, files, rules):
+    names = sensor_type_names(src, files)
+    allowed = rules.get("sensor_kind_literals", {})
+    if not names:
+        return [] if not allowed else [
+            "src/penumbra/sensors/types/: no sensor type (kTypeName) found; expected the "
+            "registry of sensor types there"]
+    errors = []
+    found = set()
+    for rel in files:
+        if rel.startswith(SENSOR_KIND_HOMES):
+            continue
+        with open(os.path.join(src, rel), encoding="utf-8", errors="replace") as f:
+            text = f.read()
+        for line, literal in string_literals(text):
+            if literal not in names:
+                continue
+            if literal in allowed.get(rel, []):
+                found.add((rel, literal))
+                continue
+            errors.append(f'src/penumbra/{rel}:{line}: sensor type name "{literal}" as a string '
+                          "literal; expected the sensor registry (sensors/sensor_types.h: "
+                          "SensorKind, SensorKindName, the type's kOutputFolder) outside "
+                          "sensors/types/ and world/")
+    for rel in sorted(allowed):
+        if rel.startswith("_"):
+            continue
+        for literal in allowed[rel]:
+            if (rel, literal) not in found:
+                errors.append(f'scripts/build_rules.json: sensor_kind_literals lists "{literal}" '
+                              f"in {rel}, which no longer holds it; remove it (the list may "
+                              "only shrink)")
     return errors
 
 

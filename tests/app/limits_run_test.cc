@@ -216,7 +216,7 @@ struct Assembled {
     CameraSpec cam;
     cam.name = "front";
     cam.intrinsics = CameraIntrinsics::FromFovy(640, 480, 60);
-    cam.outputs.depth = true;
+    cam.outputs[ImageKind::kDepth] = true;
     CameraConfig c;
     c.name = "front";
     world.cameras.push_back(c);

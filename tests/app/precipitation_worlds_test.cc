@@ -25,7 +25,7 @@ PngImage FirstFrontFrame(const std::string& world_file, bool with_effects, const
   for (CameraConfig& c : world.cameras) {
     c.width = 160;
     c.height = 120;
-    c.outputs = CameraOutputs{true, false, false};
+    c.outputs = CameraOutputs{ImageKind::kRgb};
   }
   world.cameras.erase(std::remove_if(world.cameras.begin(), world.cameras.end(),
                                      [](const CameraConfig& c) { return c.name != "front"; }),

@@ -169,8 +169,9 @@ TEST(Walkers, TheCameraLabelsLimbPixelsPerson) {
   view.X_WO.linear() = RotationBodyFromOptical();
   view.X_WO.translation() = Eigen::Vector3d(0, 0.8, 0.9);
   view.intrinsics = CameraIntrinsics::FromFovy(120, 160, 70);
-  view.outputs.rgb = false;
-  view.outputs.semantic_segmentation = view.outputs.instance_segmentation = true;
+  view.outputs[ImageKind::kRgb] = false;
+  view.outputs[ImageKind::kSemanticSegmentation] = view.outputs[ImageKind::kInstanceSegmentation] =
+      true;
   RenderedFrame f;
   renderer->Render(w.sim.Snapshot(), view, &f);
   std::map<std::string, int> limb_pixels;

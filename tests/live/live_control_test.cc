@@ -51,7 +51,7 @@ WorldConfig SmallDefaultWorld(const fs::path& out, double duration) {
   w.cameras.resize(1);
   w.cameras[0].width = 48;
   w.cameras[0].height = 36;
-  w.cameras[0].outputs = CameraOutputs{true, false, false};
+  w.cameras[0].outputs = CameraOutputs{ImageKind::kRgb};
   return w;
 }
 

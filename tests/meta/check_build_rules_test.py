@@ -108,6 +108,55 @@ class BuildRulesTest(unittest.TestCase):
         self.assertEqual(rc, 1)
         self.assertIn("yaml_cpp_files lists scene/s.cc, which no longer includes yaml-cpp", out)
 
+    SENSOR_TYPES = {
+        "src/penumbra/sensors/types/lidar.h":
+            'struct L {\n  static constexpr std::string_view kTypeName = "lidar";\n};\n',
+        "src/penumbra/sensors/types/imu.h":
+            'struct I {\n  static constexpr std::string_view kTypeName = "imu";\n};\n',
+    }
+
+    def test_sensor_kind_literal_outside_the_registry_fails(self):
+        files = dict(self.SENSOR_TYPES)
+        files["src/penumbra/scene/s.cc"] = 'int a;\nbool L(const T& s) { return s.type == "lidar"; }\n'
+        rc, out = self.tree(files).rules()
+        self.assertEqual(rc, 1)
+        self.assertIn('src/penumbra/scene/s.cc:2: sensor type name "lidar" as a string literal', out)
+        # a name taken from the registry's headers: "imu" too, in a header
+        files["src/penumbra/scene/s.cc"] = "// x\n"
+        files["src/penumbra/scene/t.h"] = 'const char* k = "imu";\n'
+        rc, out = self.tree(files).rules()
+        self.assertEqual(rc, 1)
+        self.assertIn('src/penumbra/scene/t.h:1: sensor type name "imu"', out)
+
+    def test_sensor_kind_literals_in_the_registry_world_and_comments_pass(self):
+        files = dict(self.SENSOR_TYPES)
+        files["src/penumbra/world/r.cc"] = 'auto t = r.Enum({"lidar", "imu"});\n'
+        files["src/penumbra/sensors/types/lidar.cc"] = 'const char* f = "lidar";\n'
+        files["src/penumbra/scene/s.cc"] = ('// a "lidar" in a comment\n/* "imu" */\n'
+                                            'const char* a = "lidar/";  // a topic prefix\n'
+                                            'const char* b = "say \\"imu\\"";\n')
+        rc, out = self.tree(files).rules()
+        self.assertEqual(rc, 0, out)
+
+    def test_allow_listed_sensor_kind_literal_passes_and_a_stale_entry_fails(self):
+        files = dict(self.SENSOR_TYPES)
+        files["src/penumbra/compose/m.cc"] = 'auto* root = doc.NewElement("imu");\n'
+        rules = {"sensor_kind_literals": {"_why": "x", "compose/m.cc": ["imu"]}}
+        self.assertEqual(self.tree(files, rules=rules).rules()[0], 0)
+        # the entry allows that literal in that file only
+        files["src/penumbra/compose/m.cc"] = 'auto* root = doc.NewElement("lidar");\n'
+        rc, out = self.tree(files, rules=rules).rules()
+        self.assertEqual(rc, 1)
+        self.assertIn('compose/m.cc:1: sensor type name "lidar"', out)
+        self.assertIn('sensor_kind_literals lists "imu" in compose/m.cc, which no longer holds it',
+                      out)
+
+    def test_sensor_type_names_come_from_this_trees_registry(self):
+        sys.path.insert(0, os.path.join(ROOT, "scripts"))
+        import check_build_rules  # noqa: E402
+        src = os.path.join(ROOT, "src", "penumbra")
+        names = check_build_rules.sensor_type_names(src, check_build_rules.source_files(src))
+        self.assertEqual(names, {"lidar", "imu", "mujoco", "ground_truth"})
     def test_yaml_cpp_in_tests_or_bench_fails(self):
         t = self.tree({"tests/scene/s_test.cc": '#include "penumbra/config/yaml_document.h"\n',
                        "bench/b.cc": "// x\n"})

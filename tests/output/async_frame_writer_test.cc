@@ -40,7 +40,7 @@ std::vector<std::string> CsvLines(const std::filesystem::path& p) {
 
 CameraOutputs AllOutputs() {
   CameraOutputs o;
-  o.rgb = o.depth = o.segmentation = true;
+  o[ImageKind::kRgb] = o[ImageKind::kDepth] = o[ImageKind::kSegmentation] = true;
   return o;
 }
 

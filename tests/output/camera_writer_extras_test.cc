@@ -18,8 +18,9 @@ namespace fs = std::filesystem;
 using testing::TempDir;
 
 CameraOutputs ExtrasOnly() {
-  CameraOutputs o{false, false, false};
-  o.range = o.normals = o.instance_segmentation = o.semantic_segmentation = true;
+  CameraOutputs o = CameraOutputs::None();
+  o[ImageKind::kRange] = o[ImageKind::kNormals] = o[ImageKind::kInstanceSegmentation] =
+      o[ImageKind::kSemanticSegmentation] = true;
   return o;
 }
 

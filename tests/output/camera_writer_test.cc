@@ -168,7 +168,7 @@ TEST(CameraWriter, WritesImagesPosesAndIntrinsics) {
   TempDir dir;
   const CameraIntrinsics intr = CameraIntrinsics::FromFovy(8, 6, 70.0);
   CameraOutputs outs;
-  outs.rgb = outs.depth = outs.segmentation = true;
+  outs[ImageKind::kRgb] = outs[ImageKind::kDepth] = outs[ImageKind::kSegmentation] = true;
   CameraWriter w(dir.str(), "rover/head", intr, outs);
   const auto folder = dir.path() / "rover" / "head";
   EXPECT_EQ(w.folder(), folder);
@@ -228,9 +228,9 @@ TEST(CameraWriter, WritesImagesPosesAndIntrinsics) {
 TEST(CameraWriter, OnlyRequestedOutputsAreWritten) {
   TempDir dir;
   CameraOutputs outs;
-  outs.rgb = true;
-  outs.depth = false;
-  outs.segmentation = false;
+  outs[ImageKind::kRgb] = true;
+  outs[ImageKind::kDepth] = false;
+  outs[ImageKind::kSegmentation] = false;
   CameraWriter w(dir.str(), "front", CameraIntrinsics::FromFovy(4, 3, 60), outs);
   CameraFrame f = MakeFrame("front", 0, 4, 3);
   f.depth_m = ImageF();  // not requested, may be empty
@@ -243,7 +243,7 @@ TEST(CameraWriter, OnlyRequestedOutputsAreWritten) {
 TEST(CameraWriter, RejectsMismatchedFrames) {
   TempDir dir;
   CameraOutputs outs;
-  outs.depth = true;
+  outs[ImageKind::kDepth] = true;
   CameraWriter w(dir.str(), "front", CameraIntrinsics::FromFovy(4, 3, 60), outs);
   EXPECT_THROW(w.Write(MakeFrame("other", 0, 4, 3)), Error);  // wrong camera
   EXPECT_THROW(w.Write(MakeFrame("front", 0, 5, 3)), Error);  // wrong size
@@ -267,8 +267,8 @@ TEST(CameraWriter, BadNamesAreConfigErrors) {
 TEST(CameraWriter, SegmentationIdTooLargeIsAnError) {
   TempDir dir;
   CameraOutputs outs;
-  outs.rgb = false;
-  outs.segmentation = true;
+  outs[ImageKind::kRgb] = false;
+  outs[ImageKind::kSegmentation] = true;
   CameraWriter w(dir.str(), "seg", CameraIntrinsics::FromFovy(4, 3, 60), outs);
   CameraFrame f = MakeFrame("seg", 0, 4, 3);
   f.geom_id.data[5] = 70000;

@@ -95,9 +95,9 @@ inline CameraView MakeView(const Pose& X_WO, int w, int h, double fovy_deg, bool
   CameraView v;
   v.X_WO = X_WO;
   v.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
-  v.outputs.rgb = rgb;
-  v.outputs.depth = depth;
-  v.outputs.segmentation = seg;
+  v.outputs[ImageKind::kRgb] = rgb;
+  v.outputs[ImageKind::kDepth] = depth;
+  v.outputs[ImageKind::kSegmentation] = seg;
   return v;
 }
 

@@ -78,7 +78,7 @@ CameraView FarView() {
   X_WO.linear() =
       Eigen::AngleAxisd(2 * kDeg, Eigen::Vector3d::UnitY()).toRotationMatrix() * X_WO.linear();
   CameraView view = MakeView(X_WO, 320, 240, 20, true, false, false);
-  view.outputs.range = true;
+  view.outputs[ImageKind::kRange] = true;
   return view;
 }
 

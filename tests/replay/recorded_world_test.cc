@@ -50,8 +50,8 @@ TEST(RecordedWorld, TheRecordedTextAtItsRecordedPathWithTheRunsFlags) {
   EXPECT_EQ(w.render.seed, 12u);
   ASSERT_EQ(w.cameras.size(), 1u);
   EXPECT_EQ(w.cameras[0].width, 160);
-  EXPECT_TRUE(w.cameras[0].outputs.rgb);
-  EXPECT_FALSE(w.cameras[0].outputs.depth);
+  EXPECT_TRUE(w.cameras[0].outputs[ImageKind::kRgb]);
+  EXPECT_FALSE(w.cameras[0].outputs[ImageKind::kDepth]);
   EXPECT_EQ(w.render.tier, RenderSettings::Tier::kPathtraced);
   EXPECT_EQ(w.render.samples_per_pixel, 2);
   ASSERT_EQ(w.models.size(), 2u);

@@ -203,7 +203,7 @@ cv::Mat RenderSupersampled(Renderer* r, const SceneDescription& s, const Pose& X
       view.intrinsics = k;
       view.intrinsics.cx = k.cx - ((i + 0.5) / S - 0.5);
       view.intrinsics.cy = k.cy - ((j + 0.5) / S - 0.5);
-      view.outputs = CameraOutputs{true, false, false};
+      view.outputs = CameraOutputs{ImageKind::kRgb};
       RenderedFrame f;
       r->Render(snap, view, &f);
       for (int v = 0; v < k.height; ++v)

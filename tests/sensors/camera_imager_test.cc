@@ -48,7 +48,7 @@ CameraSpec Spec(int w, int h, double f) {
   spec.intrinsics.fx = spec.intrinsics.fy = f;
   spec.intrinsics.cx = 0.5 * (w - 1);
   spec.intrinsics.cy = 0.5 * (h - 1);
-  spec.outputs = CameraOutputs{true, false, false};
+  spec.outputs = CameraOutputs{ImageKind::kRgb};
   return spec;
 }
 
@@ -306,7 +306,7 @@ TEST(CameraImagerTest, ThreadCountDoesNotChangeTheImages) {
   cfg.rolling_shutter_line_time_sec = 1e-4;
   cfg.depth_noise.preset = "kinect_v2";
   CameraSpec spec = Spec(64, 48, 50);
-  spec.outputs.depth = true;
+  spec.outputs[ImageKind::kDepth] = true;
   const Pose X0 = LookingAlongX(Eigen::Vector3d::Zero());
   const Pose X1 = LookingAlongX(Eigen::Vector3d(0, -0.05, 0.01));
   auto run = [&](int threads) {

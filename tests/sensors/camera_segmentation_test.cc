@@ -86,9 +86,11 @@ TEST(CameraSegmentationTest, IdsClassesRangeAndNormalsAreExactPerPixel) {
   view.intrinsics.k1 = -0.2;
   view.intrinsics.k2 = 0.05;
   view.intrinsics.p1 = 1e-3;
-  view.outputs.rgb = false;
-  view.outputs.depth = view.outputs.segmentation = view.outputs.range = view.outputs.normals = true;
-  view.outputs.instance_segmentation = view.outputs.semantic_segmentation = true;
+  view.outputs[ImageKind::kRgb] = false;
+  view.outputs[ImageKind::kDepth] = view.outputs[ImageKind::kSegmentation] =
+      view.outputs[ImageKind::kRange] = view.outputs[ImageKind::kNormals] = true;
+  view.outputs[ImageKind::kInstanceSegmentation] = view.outputs[ImageKind::kSemanticSegmentation] =
+      true;
   RenderedFrame f;
   renderer->Render(testing::Snapshot(s, 0), view, &f);
 

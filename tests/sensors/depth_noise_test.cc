@@ -38,7 +38,7 @@ DepthStats MeasureWall(const std::string& preset, double z) {
   CameraSpec spec;
   spec.name = "rgbd";
   spec.intrinsics = CameraIntrinsics::FromFovy(160, 120, 40);
-  spec.outputs = CameraOutputs{false, true, false};
+  spec.outputs = CameraOutputs{ImageKind::kDepth};
   CameraSensorConfig cfg;
   cfg.depth_noise.preset = preset;
   CameraImager imager(spec, cfg, rs, 0, scene);

@@ -57,9 +57,9 @@ CameraView ViewFor(const Pose& X_WO, int w, int h, double fovy) {
   CameraView v;
   v.X_WO = X_WO;
   v.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy);
-  v.outputs.rgb = true;
-  v.outputs.depth = false;
-  v.outputs.segmentation = true;
+  v.outputs[ImageKind::kRgb] = true;
+  v.outputs[ImageKind::kDepth] = false;
+  v.outputs[ImageKind::kSegmentation] = true;
   return v;
 }
 

@@ -34,7 +34,7 @@ CameraView TopView() {
   view.X_WO.linear() = R;
   view.X_WO.translation() = Eigen::Vector3d(0, 0, 2);
   view.intrinsics = CameraIntrinsics::FromFovy(kSize, kSize, 40);
-  view.outputs.rgb = true;
+  view.outputs[ImageKind::kRgb] = true;
   return view;
 }
 

@@ -92,9 +92,8 @@ TEST(Session, AnImuOnAnUnknownBodyIsAConfigErrorNamingIt) {
   WorldConfig world = LoadWorldFile(WorldPath("default.yaml"));
   SensorConfig imu;
   imu.name = "imu_x";
-  imu.type = "imu";
+  imu.params = ImuSensorParams{};  // the consumer_mems preset
   imu.body = "no_such_body";
-  imu.preset = "consumer_mems";
   imu.rate_hz = 100;
   world.sensors.push_back(imu);
   SessionOptions options;

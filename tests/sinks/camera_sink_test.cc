@@ -32,14 +32,14 @@ class FakeRenderer : public Renderer {
     effect_times.push_back(effects ? effects->time_sec : -1.0);
     const int W = view.intrinsics.width, H = view.intrinsics.height;
     const CameraOutputs& o = view.outputs;
-    out->radiance = o.rgb ? ImageF(W, H, 3, 0.5f) : ImageF();
-    out->rgb = o.rgb ? ImageU8(W, H, 3, 100) : ImageU8();
-    out->depth_m = o.depth ? ImageF(W, H, 1, 1.5f) : ImageF();
-    out->geom_id = o.segmentation ? ImageI32(W, H, 1, 2) : ImageI32();
-    out->range_m = o.range ? ImageF(W, H, 1, 2.0f) : ImageF();
-    out->normal_O = o.normals ? ImageF(W, H, 3, 0.0f) : ImageF();
-    out->body_id = o.instance_segmentation ? ImageI32(W, H, 1, 1) : ImageI32();
-    out->semantic_class = o.semantic_segmentation ? ImageI32(W, H, 1, 0) : ImageI32();
+    out->radiance = o[ImageKind::kRgb] ? ImageF(W, H, 3, 0.5f) : ImageF();
+    out->rgb = o[ImageKind::kRgb] ? ImageU8(W, H, 3, 100) : ImageU8();
+    out->depth_m = o[ImageKind::kDepth] ? ImageF(W, H, 1, 1.5f) : ImageF();
+    out->geom_id = o[ImageKind::kSegmentation] ? ImageI32(W, H, 1, 2) : ImageI32();
+    out->range_m = o[ImageKind::kRange] ? ImageF(W, H, 1, 2.0f) : ImageF();
+    out->normal_O = o[ImageKind::kNormals] ? ImageF(W, H, 3, 0.0f) : ImageF();
+    out->body_id = o[ImageKind::kInstanceSegmentation] ? ImageI32(W, H, 1, 1) : ImageI32();
+    out->semantic_class = o[ImageKind::kSemanticSegmentation] ? ImageI32(W, H, 1, 0) : ImageI32();
     out->ev100 = 8;
   }
   int calls = 0;
@@ -56,9 +56,10 @@ struct SmallCameraWorld {
     c.width = 32;
     c.height = 24;
     c.rate_hz = 20;
-    c.outputs = CameraOutputs{true, true, true};
-    c.outputs.range = c.outputs.normals = true;
-    c.outputs.instance_segmentation = c.outputs.semantic_segmentation = true;
+    c.outputs = CameraOutputs{ImageKind::kRgb, ImageKind::kDepth, ImageKind::kSegmentation};
+    c.outputs[ImageKind::kRange] = c.outputs[ImageKind::kNormals] = true;
+    c.outputs[ImageKind::kInstanceSegmentation] = c.outputs[ImageKind::kSemanticSegmentation] =
+        true;
     SessionOptions o;
     o.build_renderer = false;
     session = std::make_unique<Session>(world, o);

@@ -44,8 +44,9 @@ TEST(CameraConfigReaderTest, SensorKeysAndClassesParse) {
   EXPECT_EQ(c.p1, 0.001);
   EXPECT_EQ(c.p2, -0.0005);
   EXPECT_EQ(c.k3, -0.01);
-  EXPECT_TRUE(c.outputs.range && c.outputs.normals && c.outputs.instance_segmentation &&
-              c.outputs.semantic_segmentation && !c.outputs.segmentation);
+  EXPECT_TRUE(c.outputs[ImageKind::kRange] && c.outputs[ImageKind::kNormals] &&
+              c.outputs[ImageKind::kInstanceSegmentation] &&
+              c.outputs[ImageKind::kSemanticSegmentation] && !c.outputs[ImageKind::kSegmentation]);
   const CameraSensorConfig& s = c.sensor;
   EXPECT_EQ(s.exposure_time_sec, 0.02);
   EXPECT_EQ(s.motion_blur_samples, 5);

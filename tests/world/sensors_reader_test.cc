@@ -58,24 +58,37 @@ sensors:
   ASSERT_EQ(w.sensors.size(), 4u);
   const SensorConfig& l = w.sensors[0];
   EXPECT_EQ(l.name, "top");
-  EXPECT_EQ(l.type, "lidar");
+  EXPECT_EQ(l.kind(), SensorKind::kLidar);
   EXPECT_EQ(l.body, "r/b");
-  EXPECT_EQ(l.preset, "ouster_os1_128");
+  ASSERT_NE(l.get<LidarSensorParams>(), nullptr);
+  const LidarSensorParams& lp = *l.get<LidarSensorParams>();
+  EXPECT_EQ(lp.preset, "ouster_os1_128");
   EXPECT_EQ(*l.rate_hz, 20);
   EXPECT_EQ(l.latency_sec, 0.1);
-  EXPECT_EQ(l.Param("columns", 0), 1024);
-  EXPECT_EQ(l.Param("media", 1), 0);
-  EXPECT_EQ(l.Param("noise.range_stddev_m", 0), 0.02);
+  EXPECT_EQ(lp.columns, 1024);
+  EXPECT_FALSE(lp.media);
+  EXPECT_EQ(lp.range_stddev_m, 0.02);
+  EXPECT_EQ(lp.dropout_probability, 0.05);
+  EXPECT_FALSE(lp.beam_divergence_mrad);  // not given: the preset's
   EXPECT_NEAR(l.X_AS().translation().z(), 0.2, 1e-12);
   EXPECT_EQ(l.key, "sensors[0]");
-  EXPECT_EQ(w.sensors[1].type, "mujoco");
+  EXPECT_EQ(w.sensors[1].kind(), SensorKind::kMujoco);
   EXPECT_FALSE(w.sensors[1].rate_hz);
-  EXPECT_EQ(w.sensors[2].Param("contacts", 1), 0);
+  ASSERT_NE(w.sensors[2].get<GroundTruthSensorParams>(), nullptr);
+  EXPECT_FALSE(w.sensors[2].get<GroundTruthSensorParams>()->contacts);
+  EXPECT_EQ(w.sensors[2].get<GroundTruthSensorParams>()->bodies, std::vector<std::string>{"r/b"});
   const SensorConfig& imu = w.sensors[3];  // robot sensors come after the top-level list
   EXPECT_EQ(imu.robot, "r");
   EXPECT_EQ(imu.body, "r/b");  // prefixed with the robot name
   EXPECT_EQ(imu.key, "robots[0].sensors[0]");
-  EXPECT_EQ(imu.Param("noise.gyro_noise_density", 0), 1e-4);
+  ASSERT_NE(imu.get<ImuSensorParams>(), nullptr);
+  EXPECT_EQ(imu.get<ImuSensorParams>()->preset, "tactical");
+  EXPECT_EQ(imu.get<ImuSensorParams>()->gyro_noise_density, 1e-4);
+  EXPECT_FALSE(imu.get<ImuSensorParams>()->accel_noise_density);  // not given: the preset's
+  // the model's noise: the preset with the override
+  EXPECT_EQ(imu.get<ImuSensorParams>()->MakeNoise().gyro_noise_density, 1e-4);
+  EXPECT_EQ(imu.get<ImuSensorParams>()->MakeNoise().accel_noise_density,
+            ImuPreset("tactical").accel_noise_density);
 }
 
 TEST_F(SensorsReaderTest, InvalidSettingsNameSensorAndKey) {

@@ -250,7 +250,8 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(front.fovy_deg, 70);
   EXPECT_FALSE(front.intrinsics.has_value());
   EXPECT_EQ(front.rate_hz, 15);
-  EXPECT_TRUE(front.outputs.rgb && front.outputs.depth && front.outputs.segmentation);
+  EXPECT_TRUE(front.outputs[ImageKind::kRgb] && front.outputs[ImageKind::kDepth] &&
+              front.outputs[ImageKind::kSegmentation]);
   EXPECT_FALSE(front.is_mjcf_override);
   EXPECT_FALSE(front.auto_frame);
   const CameraConfig& cal = w.cameras[1];
@@ -263,9 +264,9 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(cal.intrinsics->cx, 640.5);
   EXPECT_EQ(cal.intrinsics->cy, 360.5);
   EXPECT_EQ(cal.rate_hz, 10);  // default
-  EXPECT_FALSE(cal.outputs.rgb);
-  EXPECT_TRUE(cal.outputs.depth);
-  EXPECT_FALSE(cal.outputs.segmentation);
+  EXPECT_FALSE(cal.outputs[ImageKind::kRgb]);
+  EXPECT_TRUE(cal.outputs[ImageKind::kDepth]);
+  EXPECT_FALSE(cal.outputs[ImageKind::kSegmentation]);
 
   // mjcf cameras: overrides inherit the block's defaults
   const MjcfCameraDefaults& mc = w.mjcf_cameras;
@@ -273,7 +274,8 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(mc.width, 800);
   EXPECT_EQ(mc.height, 600);
   EXPECT_EQ(mc.rate_hz, 5);
-  EXPECT_TRUE(mc.outputs.rgb && !mc.outputs.depth && mc.outputs.segmentation);
+  EXPECT_TRUE(mc.outputs[ImageKind::kRgb] && !mc.outputs[ImageKind::kDepth] &&
+              mc.outputs[ImageKind::kSegmentation]);
   ASSERT_EQ(mc.overrides.size(), 2u);
   EXPECT_EQ(mc.overrides[0].name, "rover/head");
   EXPECT_TRUE(mc.overrides[0].is_mjcf_override);
@@ -282,8 +284,9 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
   EXPECT_EQ(mc.overrides[0].rate_hz, 30);
   EXPECT_EQ(mc.overrides[0].fovy_deg, 70);
   EXPECT_EQ(mc.overrides[0].near_m, 0.05);
-  EXPECT_TRUE(mc.overrides[0].outputs.rgb && mc.overrides[0].outputs.depth &&
-              !mc.overrides[0].outputs.segmentation);
+  EXPECT_TRUE(mc.overrides[0].outputs[ImageKind::kRgb] &&
+              mc.overrides[0].outputs[ImageKind::kDepth] &&
+              !mc.overrides[0].outputs[ImageKind::kSegmentation]);
   EXPECT_EQ(mc.overrides[1].name, "room/corner");
   EXPECT_EQ(mc.overrides[1].width, 800);
   EXPECT_EQ(mc.overrides[1].height, 600);
@@ -387,8 +390,8 @@ TEST_F(WorldConfigTest, CameraDefaultsToFovy60AndRgb) {
   EXPECT_EQ(w.cameras[0].fovy_deg, 60);
   EXPECT_EQ(w.cameras[0].width, 640);
   EXPECT_EQ(w.cameras[0].height, 480);
-  EXPECT_TRUE(w.cameras[0].outputs.rgb);
-  EXPECT_FALSE(w.cameras[0].outputs.depth);
+  EXPECT_TRUE(w.cameras[0].outputs[ImageKind::kRgb]);
+  EXPECT_FALSE(w.cameras[0].outputs[ImageKind::kDepth]);
   EXPECT_EQ(w.cameras[0].attach, "world");
   EXPECT_EQ(w.cameras[0].near_m, 0.01);
 }
@@ -784,7 +787,8 @@ TEST_F(WorldConfigTest, WorldForBareModel) {
   EXPECT_EQ(c.height, 480);
   EXPECT_EQ(c.fovy_deg, 45);
   EXPECT_EQ(c.rate_hz, 30);
-  EXPECT_TRUE(c.outputs.rgb && c.outputs.depth && c.outputs.segmentation);
+  EXPECT_TRUE(c.outputs[ImageKind::kRgb] && c.outputs[ImageKind::kDepth] &&
+              c.outputs[ImageKind::kSegmentation]);
 
   EXPECT_FALSE(w.ground_plane);  // an MJCF brings its own floor (or floats on purpose)
 

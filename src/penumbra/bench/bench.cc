@@ -190,9 +190,9 @@ int BenchRender(const RenderBenchOptions& options) {
     if (options.only_640x480 && w != 640) continue;
     CameraView view;
     view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
-    view.outputs.rgb = true;
-    view.outputs.depth = true;
-    view.outputs.segmentation = false;
+    view.outputs[ImageKind::kRgb] = true;
+    view.outputs[ImageKind::kDepth] = true;
+    view.outputs[ImageKind::kSegmentation] = false;
     view.camera_index = 0;
     view.near_m = cam.near_m;
     RenderedFrame frame;

@@ -48,8 +48,8 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTimin
         2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
   }
-  view.outputs.rgb = true;
-  view.outputs.depth = true;
+  view.outputs[ImageKind::kRgb] = true;
+  view.outputs[ImageKind::kDepth] = true;
   view.exposure_time_sec = cam.exposure_time_sec;
   view.near_m = cam.near_m;
   view.frame_index = snap.step;

@@ -75,17 +75,16 @@ int BenchSensors(const SensorBenchOptions& options) {
   }
   SensorConfig imu;
   imu.name = "bench_imu";
-  imu.type = "imu";
+  imu.params = ImuSensorParams{};  // the consumer_mems preset
   imu.body = mount;
-  imu.preset = "consumer_mems";
   imu.rate_hz = 200;
   SensorConfig mj;
   mj.name = "bench_mujoco";
-  mj.type = "mujoco";
+  mj.params = MujocoSensorParams{};
   mj.rate_hz = 100;
   SensorConfig gt;
   gt.name = "bench_ground_truth";
-  gt.type = "ground_truth";
+  gt.params = GroundTruthSensorParams{};
   gt.rate_hz = 100;
   world.sensors = {imu, mj, gt};
   const std::unique_ptr<Session> session = LoadWithSensors(world);

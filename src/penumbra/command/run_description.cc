@@ -83,10 +83,9 @@ nlohmann::json DescribeRun(Session& session, const WorldConfig& world) {
 
   json cameras = json::array();
   for (const CameraSpec& c : session.scene().cameras) {
-    CameraOutputs o = c.outputs;
     json outputs = json::array();
-    for (std::string_view name : CameraOutputs::kNames)
-      if (*o.Flag(name)) outputs.push_back(std::string(name));
+    for (const ImageKindInfo& k : kImageKinds)
+      if (c.outputs[k.kind]) outputs.push_back(std::string(k.name));
     const CameraIntrinsics& in = c.intrinsics;
     cameras.push_back({{"name", c.name},
                        {"width", in.width},
@@ -104,19 +103,18 @@ nlohmann::json DescribeRun(Session& session, const WorldConfig& world) {
 
   json world_sensors = json::array();
   for (const SensorConfig& s : world.sensors) {
+    // the type's default rate; a LiDAR's comes from its preset (null here)
+    const SensorTypeInfo& type = Info(s.kind());
     json rate = nullptr;
     if (s.rate_hz)
       rate = *s.rate_hz;
-    else if (s.type == "imu")
-      rate = 200.0;
-    else if (s.type != "lidar")
-      rate = 100.0;
+    else if (!type.rate_from_model)
+      rate = type.default_rate_hz;
     world_sensors.push_back(
         {{"name", s.name},
-         {"type", s.type},
+         {"type", std::string(type.name)},
          {"rate_hz", rate},
-         {"frame_id",
-          s.type == "mujoco" || s.type == "ground_truth" ? std::string("world") : s.name}});
+         {"frame_id", type.attach == SensorAttach::kNone ? std::string("world") : s.name}});
   }
   j["sensors"] = std::move(world_sensors);
 

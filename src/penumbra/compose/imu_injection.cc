@@ -61,7 +61,7 @@ std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name) 
 
 void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scene) {
   bool any = false;
-  for (const SensorConfig& s : sensors) any = any || s.type == "imu";
+  for (const SensorConfig& s : sensors) any = any || s.kind() == SensorKind::kImu;
   if (!any) return;
   XMLElement* root = scene->document->RootElement();
   if (!root) throw Error("AddImuSensors: the composed MJCF has no <mujoco> root");
@@ -70,7 +70,7 @@ void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scen
   XMLElement* sensor_section = root->FirstChildElement("sensor");
   if (!sensor_section) sensor_section = root->InsertNewChildElement("sensor");
   for (const SensorConfig& s : sensors) {
-    if (s.type != "imu") continue;
+    if (s.kind() != SensorKind::kImu) continue;
     const Pose X_AS = s.X_AS();
     const bool identity = X_AS.isApprox(Pose::Identity(), 1e-12);
     std::string site_name;

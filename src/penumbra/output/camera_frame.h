@@ -8,6 +8,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/core/pose.h"
+#include "penumbra/scene/image_kind.h"
 
 namespace penumbra {
 
@@ -28,6 +29,30 @@ struct CameraFrame {
   ImageI32 body_id;  ///< (H x W x 1) body index of the hit, -1 = background
   ImageI32 semantic_class;  ///< (H x W x 1) semantic class id of the hit, 0 = none
 };
+
+/// calls `fn(image)` with the frame's image of `kind` (scene/image_kind.h): an ImageU8 (rgb), an
+/// ImageF (depth_m, range_m, normal_O) or an ImageI32 (geom_id, body_id, semantic_class); returns
+/// what fn returns (the same type for every image type).
+template <typename F>
+decltype(auto) WithImage(const CameraFrame& f, ImageKind kind, F&& fn) {
+  switch (kind) {
+    case ImageKind::kRgb:
+      return fn(f.rgb);
+    case ImageKind::kDepth:
+      return fn(f.depth_m);
+    case ImageKind::kSegmentation:
+      return fn(f.geom_id);
+    case ImageKind::kRange:
+      return fn(f.range_m);
+    case ImageKind::kNormals:
+      return fn(f.normal_O);
+    case ImageKind::kInstanceSegmentation:
+      return fn(f.body_id);
+    case ImageKind::kSemanticSegmentation:
+      break;
+  }
+  return fn(f.semantic_class);
+}
 
 /// receives each image file a camera writer wrote: the frame (camera, index, step, time), the
 /// output kind ("rgb", "depth", "segmentation", ...) and the PNG bytes (the file's content).

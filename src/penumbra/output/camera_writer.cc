@@ -31,6 +31,32 @@ void CheckFrameImage(const Image<T>& image, int channels, const CameraIntrinsics
   }
 }
 
+// the frame's image of a kind of PixelType kF32 / kI32 (scene/image_kind.h)
+const ImageF& FloatImage(const CameraFrame& f, ImageKind kind) {
+  switch (kind) {
+    case ImageKind::kDepth:
+      return f.depth_m;
+    case ImageKind::kRange:
+      return f.range_m;
+    case ImageKind::kNormals:
+      return f.normal_O;
+    default:
+      throw Error("image kind '" + std::string(ImageKindName(kind)) + "' is not float");
+  }
+}
+const ImageI32& IdImage(const CameraFrame& f, ImageKind kind) {
+  switch (kind) {
+    case ImageKind::kSegmentation:
+      return f.geom_id;
+    case ImageKind::kInstanceSegmentation:
+      return f.body_id;
+    case ImageKind::kSemanticSegmentation:
+      return f.semantic_class;
+    default:
+      throw Error("image kind '" + std::string(ImageKindName(kind)) + "' has no ids");
+  }
+}
+
 }  // namespace
 
 ImageU16 DepthToMillimetres(const ImageF& depth_m) {
@@ -139,13 +165,8 @@ CameraWriter::CameraWriter(const std::string& output_dir, const std::string& cam
   }
   const fs::path rel = CameraFolder(camera);
   CreateOutputFolder(output_dir, rel);
-  if (outputs_.rgb) CreateOutputFolder(output_dir, rel / "rgb");
-  if (outputs_.depth) CreateOutputFolder(output_dir, rel / "depth");
-  if (outputs_.segmentation) CreateOutputFolder(output_dir, rel / "segmentation");
-  if (outputs_.range) CreateOutputFolder(output_dir, rel / "range");
-  if (outputs_.normals) CreateOutputFolder(output_dir, rel / "normals");
-  if (outputs_.instance_segmentation) CreateOutputFolder(output_dir, rel / "instance_segmentation");
-  if (outputs_.semantic_segmentation) CreateOutputFolder(output_dir, rel / "semantic_segmentation");
+  for (const ImageKindInfo& k : kImageKinds)
+    if (outputs_[k.kind]) CreateOutputFolder(output_dir, rel / k.folder);
 
   // ordered_json keeps the key order below
   nlohmann::ordered_json j;
@@ -159,14 +180,8 @@ CameraWriter::CameraWriter(const std::string& output_dir, const std::string& cam
   j["model"] = "pinhole";
   j["optical_frame"] = "opencv (x right, y down, z forward)";
   nlohmann::ordered_json files = nlohmann::ordered_json::object();
-  if (outputs_.rgb) files["rgb"] = "rgb/NNNNNN.png: 8-bit sRGB";
-  if (outputs_.depth) {
-    files["depth"] =
-        "depth/NNNNNN.png: 16-bit z-depth in millimetres, 0 = no return, 65535 = 65.535 m or more";
-  }
-  if (outputs_.segmentation) {
-    files["segmentation"] = "segmentation/NNNNNN.png: 16-bit MuJoCo geom id + 1, 0 = background";
-  }
+  for (const ImageKindInfo& k : kImageKinds)
+    if (outputs_[k.kind] && !k.file_note.empty()) files[std::string(k.name)] = k.file_note;
   files["frames"] =
       "frames.csv: pose of the optical frame in the world (m, unit quaternion, qw >= 0)";
   j["files"] = files;
@@ -202,62 +217,56 @@ void CameraWriter::WriteImages(const CameraFrame& frame) const {
 
 void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string& name,
                                     std::vector<fs::path>* written) const {
-  // one PNG per image kind, at <folder>/<kind>/<name>, recorded in `written`
-  auto add_times = [&](const PngWriteTimes& t) {
+  // one PNG per image kind, at <folder>/<kind folder>/<name>, recorded in `written`, in the
+  // order of the image-kind table (scene/image_kind.h)
+  for (const ImageKindInfo& k : kImageKinds) {
+    if (!outputs_[k.kind]) continue;
+    const std::string kind(k.name);
+    const fs::path path = folder_ / k.folder / name;
+    std::vector<uint8_t> bytes;
+    PngWriteTimes t;
+    switch (k.encoding) {
+      case ImageEncoding::kPngRgb8:
+        CheckFrameImage(frame.rgb, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
+        bytes = WritePngRgb8(path.string(), frame.rgb, png_options_, &t);
+        break;
+      case ImageEncoding::kPngRgb8Normals: {
+        const ImageF& img = FloatImage(frame, k.kind);
+        CheckFrameImage(img, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
+        bytes = WritePngRgb8(path.string(), NormalsToRgb8(img), png_options_, &t);
+        break;
+      }
+      case ImageEncoding::kPngGray16Millimetres: {
+        const ImageF& img = FloatImage(frame, k.kind);
+        CheckFrameImage(img, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
+        bytes = WritePngGray16(path.string(), DepthToMillimetres(img), png_options_, &t);
+        break;
+      }
+      case ImageEncoding::kPngGray16IdPlusOne:
+      case ImageEncoding::kPngGray16Id: {
+        const ImageI32& ids = IdImage(frame, k.kind);
+        CheckFrameImage(ids, k.channels, intrinsics_, camera_, frame.index, kind.c_str());
+        ImageU16 u16;
+        if (k.kind == ImageKind::kSegmentation) {
+          // geom ids: the message names the camera, frame and sample
+          try {
+            u16 = SegmentationToU16(ids);
+          } catch (const Error& e) {
+            throw Error(fmt::format("camera '{}' frame {}: {}", camera_, frame.index, e.what()));
+          }
+        } else {
+          const bool plus_one = k.encoding == ImageEncoding::kPngGray16IdPlusOne;
+          u16 = IdsToU16(ids, plus_one ? 1 : 0,
+                         k.kind == ImageKind::kInstanceSegmentation ? "body" : "semantic class");
+        }
+        bytes = WritePngGray16(path.string(), u16, png_options_, &t);
+        break;
+      }
+    }
     encode_ns_ += static_cast<int64_t>(t.encode_sec * 1e9);
     write_ns_ += static_cast<int64_t>(t.write_sec * 1e9);
-  };
-  auto write8 = [&](const char* kind, const ImageU8& img) {
-    PngWriteTimes t;
-    const std::vector<uint8_t> bytes =
-        WritePngRgb8((folder_ / kind / name).string(), img, png_options_, &t);
-    add_times(t);
-    written->push_back(folder_ / kind / name);
+    written->push_back(path);
     if (on_image_) on_image_(frame, kind, bytes);
-  };
-  auto write16 = [&](const char* kind, const ImageU16& img) {
-    PngWriteTimes t;
-    const std::vector<uint8_t> bytes =
-        WritePngGray16((folder_ / kind / name).string(), img, png_options_, &t);
-    add_times(t);
-    written->push_back(folder_ / kind / name);
-    if (on_image_) on_image_(frame, kind, bytes);
-  };
-  if (outputs_.rgb) {
-    CheckFrameImage(frame.rgb, 3, intrinsics_, camera_, frame.index, "rgb");
-    write8("rgb", frame.rgb);
-  }
-  if (outputs_.depth) {
-    CheckFrameImage(frame.depth_m, 1, intrinsics_, camera_, frame.index, "depth");
-    write16("depth", DepthToMillimetres(frame.depth_m));
-  }
-  if (outputs_.segmentation) {
-    CheckFrameImage(frame.geom_id, 1, intrinsics_, camera_, frame.index, "segmentation");
-    ImageU16 seg;
-    try {
-      seg = SegmentationToU16(frame.geom_id);
-    } catch (const Error& e) {
-      throw Error(fmt::format("camera '{}' frame {}: {}", camera_, frame.index, e.what()));
-    }
-    write16("segmentation", seg);
-  }
-  // ground truth beyond the geom ids (the same pixel-centre rays)
-  if (outputs_.range) {
-    CheckFrameImage(frame.range_m, 1, intrinsics_, camera_, frame.index, "range");
-    write16("range", DepthToMillimetres(frame.range_m));
-  }
-  if (outputs_.normals) {
-    CheckFrameImage(frame.normal_O, 3, intrinsics_, camera_, frame.index, "normals");
-    write8("normals", NormalsToRgb8(frame.normal_O));
-  }
-  if (outputs_.instance_segmentation) {
-    CheckFrameImage(frame.body_id, 1, intrinsics_, camera_, frame.index, "instance_segmentation");
-    write16("instance_segmentation", IdsToU16(frame.body_id, 1, "body"));
-  }
-  if (outputs_.semantic_segmentation) {
-    CheckFrameImage(frame.semantic_class, 1, intrinsics_, camera_, frame.index,
-                    "semantic_segmentation");
-    write16("semantic_segmentation", IdsToU16(frame.semantic_class, 0, "semantic class"));
   }
 }
 

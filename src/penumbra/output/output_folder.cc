@@ -10,7 +10,8 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
-#include "penumbra/scene/scene_description.h"
+#include "penumbra/scene/image_kind.h"
+#include "penumbra/sensors/sensor_types.h"
 
 namespace penumbra {
 namespace {
@@ -21,12 +22,12 @@ const std::set<std::string> kTopFiles = {
     "run.json",         "composed.xml",     "trajectory.csv",
     "camera_info.yaml", "camera_info.json", "semantic_classes.json",
     "rig.json",         "npc_map.png",      "npc_map.json"};
-const std::set<std::string> kSensorFolders = {"imu", "sensors", "ground_truth"};
-// image folders are named after the camera outputs
-bool IsImageFolder(const std::string& name) {
-  return std::find(CameraOutputs::kNames.begin(), CameraOutputs::kNames.end(), name) !=
-         CameraOutputs::kNames.end();
-}
+// the sensor types' folders of CSV files (a LiDAR's folder holds a folder per sensor)
+const std::set<std::string> kSensorFolders = {std::string(ImuSensorParams::kOutputFolder),
+                                              std::string(MujocoSensorParams::kOutputFolder),
+                                              std::string(GroundTruthSensorParams::kOutputFolder)};
+// image folders are the image kinds' folders (scene/image_kind.h)
+bool IsImageFolder(const std::string& name) { return IsImageKindFolder(name); }
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
@@ -88,7 +89,7 @@ class Scanner {
           if (file && kTopFiles.count(name)) continue;
           if (file && EndsWith(name, ".plog")) continue;  // a run log (--record)
           if (dir_entry) {
-            Folder(p, name == "lidar"                              ? Kind::kLidarFolder
+            Folder(p, name == LidarSensorParams::kOutputFolder     ? Kind::kLidarFolder
                       : name == "meshes" || name == "environments" ? Kind::kMeshFolder
                       : kSensorFolders.count(name)                 ? Kind::kSensorFolder
                                                                    : Kind::kCameraFolder);

@@ -7,11 +7,18 @@
 #include <iterator>
 
 #include "penumbra/output/pcd_writer.h"
+#include "penumbra/sensors/sensor_types.h"
 
 namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
+
+// the run folders of the sensor types (sensors/sensor_types.h)
+const fs::path kLidarFolder(LidarSensorParams::kOutputFolder);
+const fs::path kImuFolder(ImuSensorParams::kOutputFolder);
+const fs::path kMujocoFolder(MujocoSensorParams::kOutputFolder);
+const fs::path kGroundTruthFolder(GroundTruthSensorParams::kOutputFolder);
 
 // a streaming CSV under the output folder `out` (whole rows only, core/output_file.h)
 LineFile OpenCsv(const fs::path& out, const fs::path& rel) {
@@ -22,7 +29,7 @@ LineFile OpenCsv(const fs::path& out, const fs::path& rel) {
 }  // namespace
 
 LidarScanWriter::LidarScanWriter(const fs::path& out, const std::string& name)
-    : dir_(out / "lidar" / name), index_(OpenCsv(out, fs::path("lidar") / name / "index.csv")) {
+    : dir_(out / kLidarFolder / name), index_(OpenCsv(out, kLidarFolder / name / "index.csv")) {
   index_.Append(
       "scan,capture_time_sec,delivery_time_sec,file,points,medium_returns,"
       "particle_returns\n");
@@ -39,7 +46,7 @@ std::string LidarScanWriter::Write(const SensorFiring& f, const LidarScan& scan)
 }
 
 ImuCsvWriter::ImuCsvWriter(const fs::path& out, const std::string& name)
-    : csv_(OpenCsv(out, fs::path("imu") / (name + ".csv"))) {
+    : csv_(OpenCsv(out, kImuFolder / (name + ".csv"))) {
   csv_.Append(
       "sample,capture_time_sec,delivery_time_sec,accel_x_m_s2,accel_y_m_s2,"
       "accel_z_m_s2,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s\n");
@@ -55,7 +62,7 @@ std::string ImuCsvWriter::Write(const SensorFiring& f, const ImuSample& o) {
 }
 
 ImuTruthCsvWriter::ImuTruthCsvWriter(const fs::path& out, const std::string& name)
-    : csv_(OpenCsv(out, fs::path("imu") / (name + "_truth.csv"))) {
+    : csv_(OpenCsv(out, kImuFolder / (name + "_truth.csv"))) {
   csv_.Append(
       "sample,capture_time_sec,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,bgx_rad_s,"
       "bgy_rad_s,bgz_rad_s,bax_m_s2,bay_m_s2,baz_m_s2\n");
@@ -75,7 +82,7 @@ void ImuTruthCsvWriter::Write(const SensorFiring& f, const ImuTruth& t) {
 
 MujocoSensorCsvWriter::MujocoSensorCsvWriter(const fs::path& out, const std::string& name,
                                              const std::vector<std::string>& columns)
-    : csv_(OpenCsv(out, fs::path("sensors") / (name + ".csv"))) {
+    : csv_(OpenCsv(out, kMujocoFolder / (name + ".csv"))) {
   std::string header = "sample,capture_time_sec,delivery_time_sec";
   for (const std::string& col : columns) header += "," + col;
   csv_.Append(header + "\n");
@@ -96,7 +103,7 @@ GroundTruthCsvWriter::GroundTruthCsvWriter(const fs::path& out, const std::strin
                                            bool contacts)
     : bodies_(bodies),
       contacts_(contacts),
-      csv_(OpenCsv(out, fs::path("ground_truth") / (name + ".csv"))) {
+      csv_(OpenCsv(out, kGroundTruthFolder / (name + ".csv"))) {
   std::string header = "sample,time_sec";
   for (int b : bodies_) {
     const std::string& n = body_names.at(b);
@@ -106,7 +113,7 @@ GroundTruthCsvWriter::GroundTruthCsvWriter(const fs::path& out, const std::strin
   }
   csv_.Append(header + "\n");
   if (contacts_) {
-    contacts_csv_ = OpenCsv(out, fs::path("ground_truth") / (name + "_contacts.csv"));
+    contacts_csv_ = OpenCsv(out, kGroundTruthFolder / (name + "_contacts.csv"));
     contacts_csv_.Append(
         "sample,time_sec,geom1,geom2,body1,body2,px_m,py_m,pz_m,nx,ny,nz,"
         "distance_m,fn_N,ft1_N,ft2_N\n");

@@ -19,10 +19,10 @@ Image<T>* Prepare(bool want, int w, int h, int c, Image<T>* img) {
 
 GroundTruthImages PrepareGroundTruth(const CameraOutputs& want, int W, int H, RenderedFrame* out) {
   GroundTruthImages g;
-  g.range_m = Prepare(want.range, W, H, 1, &out->range_m);
-  g.normal_O = Prepare(want.normals, W, H, 3, &out->normal_O);
-  g.body_id = Prepare(want.instance_segmentation, W, H, 1, &out->body_id);
-  g.semantic_class = Prepare(want.semantic_segmentation, W, H, 1, &out->semantic_class);
+  g.range_m = Prepare(want[ImageKind::kRange], W, H, 1, &out->range_m);
+  g.normal_O = Prepare(want[ImageKind::kNormals], W, H, 3, &out->normal_O);
+  g.body_id = Prepare(want[ImageKind::kInstanceSegmentation], W, H, 1, &out->body_id);
+  g.semantic_class = Prepare(want[ImageKind::kSemanticSegmentation], W, H, 1, &out->semantic_class);
   g.any = g.range_m || g.normal_O || g.body_id || g.semantic_class;
   return g;
 }

@@ -55,7 +55,7 @@ WorldConfig RecordedWorld(const RunLogHeader& header) {
   if (flags.samples_per_pixel && *flags.samples_per_pixel > 0)
     world.render.samples_per_pixel = *flags.samples_per_pixel;
   if (flags.outputs) {
-    CameraOutputs o{false, false, false};
+    CameraOutputs o = CameraOutputs::None();
     std::istringstream list(*flags.outputs);
     for (std::string name; std::getline(list, name, ',');)
       if (bool* flag = o.Flag(name)) *flag = true;

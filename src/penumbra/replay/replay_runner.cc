@@ -120,7 +120,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   }
   if (options.depth != ReplayDepth::kAsRecorded) {
     auto set_depth_model = [&](CameraConfig& c) {
-      if (!c.outputs.depth) return;
+      if (!c.outputs[ImageKind::kDepth]) return;
       DepthNoiseConfig& d = c.sensor.depth_noise;
       if (options.depth == ReplayDepth::kGroundTruth) {
         d = DepthNoiseConfig{};
@@ -225,9 +225,9 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     summary.wall_time_sec = SecondsSince(t_start);
     summary.warnings = warnings;
     for (const CameraConfig& c : world.cameras)
-      if (c.outputs.depth) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
+      if (c.outputs[ImageKind::kDepth]) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
     for (const CameraConfig& c : world.mjcf_cameras.overrides)
-      if (c.outputs.depth) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
+      if (c.outputs[ImageKind::kDepth]) summary.depth_models[c.name] = c.sensor.depth_noise.preset;
     timings["total_sec"] = summary.wall_time_sec;
     RunManifest m = outputs.Describe(
         header.world_file.empty() ? header.model_file : header.world_file, options.command_line,

@@ -151,13 +151,13 @@ class RosBridge : public RunBridge {
     if (it == sensors_.end() || node_->Subscribers(it->second.second) == 0) return;
     const RosSensorGraph& s = *it->second.first;
     const RosHeader header = MakeRosHeader(sample.time_sec, s.frame_id);
-    if (sample.type == "imu" && sample.values.size() >= 6) {
+    if (sample.kind == SensorKind::kImu && sample.values.size() >= 6) {
       const Eigen::Vector3d accel(sample.values[0], sample.values[1], sample.values[2]);
       const Eigen::Vector3d gyro(sample.values[3], sample.values[4], sample.values[5]);
       node_->Publish(it->second.second,
                      ImuToRos(accel, gyro, s.mount.accel_noise_density, s.mount.gyro_noise_density,
                               s.mount.rate_hz, header));
-    } else if (sample.type == "lidar" && sample.scan) {
+    } else if (sample.kind == SensorKind::kLidar && sample.scan) {
       node_->Publish(it->second.second, PointsToRos(sample.scan->points, header));
     }
   }

@@ -272,15 +272,15 @@ std::vector<RosSensorMount> SensorMountsOf(const WorldConfig& world, const Model
     m.mjcf_camera = c.mjcf_camera;
     m.X_BS = c.X_BO;
     m.intrinsics = c.intrinsics;
-    m.rgb = c.outputs.rgb;
-    m.depth = c.outputs.depth;
+    m.rgb = c.outputs[ImageKind::kRgb];
+    m.depth = c.outputs[ImageKind::kDepth];
     out.push_back(m);
   }
   for (const SensorConfig& sc : world.sensors) {
-    if (sc.type != "lidar" && sc.type != "imu") continue;
+    if (sc.kind() != SensorKind::kLidar && sc.kind() != SensorKind::kImu) continue;
     RosSensorMount m;
     m.name = sc.name;
-    m.kind = sc.type == "lidar" ? RosSensorKind::kLidar : RosSensorKind::kImu;
+    m.kind = sc.kind() == SensorKind::kLidar ? RosSensorKind::kLidar : RosSensorKind::kImu;
     Pose X_BA = Pose::Identity();
     if (!sc.site.empty()) {
       const int site = model.Find(ModelObject::kSite, sc.site);
@@ -300,9 +300,9 @@ std::vector<RosSensorMount> SensorMountsOf(const WorldConfig& world, const Model
     m.X_BS = X_BA * sc.X_AS();
     if (m.kind == RosSensorKind::kImu) {
       m.rate_hz = sc.rate_hz.value_or(200);
-      const ImuNoiseConfig nc = ImuPreset(sc.preset);
-      m.accel_noise_density = sc.Param("noise.accel_noise_density", nc.accel_noise_density);
-      m.gyro_noise_density = sc.Param("noise.gyro_noise_density", nc.gyro_noise_density);
+      const ImuNoiseConfig nc = sc.get<ImuSensorParams>()->MakeNoise();
+      m.accel_noise_density = nc.accel_noise_density;
+      m.gyro_noise_density = nc.gyro_noise_density;
     }
     out.push_back(m);
   }

@@ -254,7 +254,7 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
       const RosCameraInfo info = CameraInfoToRos(s.mount.intrinsics, 0, header);
       if (cam.has_rgb) {
         // decoded and checked against camera_info.json (dataset/image_convert.h)
-        const RunImage png = ReadRunImage(cam, "rgb", f.index);
+        const RunImage png = ReadRunImage(cam, std::string(Info(ImageKind::kRgb).folder), f.index);
         ImageU8 rgb(png.width, png.height, 3);
         for (size_t i = 0; i < png.samples.size(); ++i)
           rgb.data[i] = static_cast<uint8_t>(png.samples[i]);
@@ -264,7 +264,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
         count(s.info_topic);
       }
       if (cam.has_depth) {
-        const RunImage png = ReadRunImage(cam, "depth", f.index);
+        const RunImage png =
+            ReadRunImage(cam, std::string(Info(ImageKind::kDepth).folder), f.index);
         bag.Write(s.depth_image_topic, t, DepthMmToRos(png.width, png.height, png.samples, header));
         bag.Write(s.depth_info_topic, t, info);
         count(s.depth_image_topic);
@@ -278,8 +279,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     const RosSensorGraph* s = graph.FindSensor(sc.name);
     if (!s) continue;
     const int64_t latency_ns = RosStampNs(sc.latency_sec);
-    if (sc.type == "lidar") {
-      const fs::path rel = fs::path("lidar") / sc.name;
+    if (sc.kind() == SensorKind::kLidar) {
+      const fs::path rel = fs::path(LidarSensorParams::kOutputFolder) / sc.name;
       if (StatRunEntry(run_dir, rel) != RunEntry::kFolder) continue;
       const fs::path dir = run_dir / rel;
       const CsvRows index =
@@ -303,8 +304,10 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
                   PointsToRos(points, MakeRosHeader(capture, s->frame_id)));
         count(s->points_topic);
       }
-    } else if (sc.type == "imu") {
-      if (StatRunEntry(run_dir, fs::path("imu") / (sc.name + ".csv")) != RunEntry::kFile) continue;
+    } else if (sc.kind() == SensorKind::kImu) {
+      if (StatRunEntry(run_dir, fs::path(ImuSensorParams::kOutputFolder) / (sc.name + ".csv")) !=
+          RunEntry::kFile)
+        continue;
       const RunImu imu = run.ReadImu(sc.name);
       CheckExportStop(stop_request);
       for (const RunImuSample& x : imu.samples) {

@@ -42,9 +42,9 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
 
 CameraOutputs ParseCameraOutputs(const std::string& list) {
   std::string valid;
-  for (std::string_view v : CameraOutputs::kNames)
-    valid += (valid.empty() ? "" : ", ") + std::string(v);
-  CameraOutputs o{false, false, false};
+  for (const ImageKindInfo& k : kImageKinds)
+    valid += (valid.empty() ? "" : ", ") + std::string(k.name);
+  CameraOutputs o = CameraOutputs::None();
   size_t start = 0, count = 0;
   while (start <= list.size()) {
     size_t end = list.find(',', start);

@@ -43,17 +43,4 @@ TextureMemory CountTextureMemory(const std::vector<Texture>& textures) {
   return m;
 }
 
-bool* CameraOutputs::Flag(std::string_view name) {
-  bool* const flags[] = {&rgb,
-                         &depth,
-                         &segmentation,
-                         &range,
-                         &normals,
-                         &instance_segmentation,
-                         &semantic_segmentation};
-  for (size_t i = 0; i < kNames.size(); ++i)
-    if (kNames[i] == name) return flags[i];
-  return nullptr;
-}
-
 }  // namespace penumbra

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/scene/image_kind.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
@@ -181,28 +182,13 @@ struct CameraIntrinsics {
   static CameraIntrinsics FromFovy(int width, int height, double fovy_deg);
 };
 
-/// which images a camera produces.
-struct CameraOutputs {
-  bool rgb = true;
-  bool depth = false;         ///< z-depth in metres along the optical axis
-  bool segmentation = false;  ///< geom id + 1 per pixel, 0 = background
-  bool range = false;         ///< distance from the optical centre to the hit along the ray, m
-  bool normals = false;       ///< unit surface normal (facing the camera) in the optical frame
-  bool instance_segmentation = false;  ///< body index + 1 per pixel, 0 = background
-  bool semantic_segmentation =
-      false;  ///< Geom::semantic_class per pixel, 0 = background/unlabelled
-
-  /// the output names, in this order: they name the world file's `outputs` entries, the
-  /// `--outputs` flag's list and the image folders of a run.
-  static constexpr std::array<std::string_view, 7> kNames = {"rgb",
-                                                             "depth",
-                                                             "segmentation",
-                                                             "range",
-                                                             "normals",
-                                                             "instance_segmentation",
-                                                             "semantic_segmentation"};
-  /// the flag of output `name` (one of kNames), or nullptr for any other name.
-  bool* Flag(std::string_view name);
+/// which images a camera produces, one flag per ImageKind (scene/image_kind.h): rgb only unless
+/// set otherwise.
+struct CameraOutputs : ImageKindSet {
+  CameraOutputs() : ImageKindSet{ImageKind::kRgb} {}
+  CameraOutputs(std::initializer_list<ImageKind> kinds) : ImageKindSet(kinds) {}
+  /// no image at all (the start of a list read from a file or flag).
+  static CameraOutputs None() { return CameraOutputs({}); }
 };
 
 /// a camera: rigidly attached to a body, or an MJCF camera posed by the snapshot.

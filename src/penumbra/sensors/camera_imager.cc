@@ -119,9 +119,10 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
 
   CameraOutputs internal = spec_.outputs;
   if (depth_model_) {
-    internal.depth = internal.normals = internal.segmentation = true;
+    for (ImageKind k : {ImageKind::kDepth, ImageKind::kNormals, ImageKind::kSegmentation})
+      internal[k] = true;
   }
-  const bool want_rgb = spec_.outputs.rgb;
+  const bool want_rgb = spec_.outputs[ImageKind::kRgb];
   if (want_rgb) {
     if (accum_.width != W || accum_.height != H || accum_.channels != 3) accum_ = ImageF(W, H, 3);
     std::fill(accum_.data.begin(), accum_.data.end(), 0.0f);
@@ -138,7 +139,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.exposure_time_sec = T;
     view.outputs = internal;
     if (k != truth_k) {
-      view.outputs = CameraOutputs{want_rgb, false, false};
+      view.outputs = CameraOutputs::None();
+      view.outputs[ImageKind::kRgb] = want_rgb;
     }
     if (moving) {
       view.motion.X_WO_end = X_WO_end;

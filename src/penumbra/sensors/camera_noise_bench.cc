@@ -40,7 +40,7 @@ std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames) {
   CameraSpec spec;
   spec.name = "bench";
   spec.intrinsics = CameraIntrinsics::FromFovy(320, 240, 60);
-  spec.outputs = CameraOutputs{true, true, false};
+  spec.outputs = CameraOutputs{ImageKind::kRgb, ImageKind::kDepth};
   Pose X0 = Pose::Identity();
   X0.linear() = RotationBodyFromOptical();
   X0.translation() = Eigen::Vector3d(0, 0, 1);

@@ -12,17 +12,15 @@
 namespace penumbra {
 namespace {
 
-int NumOutputs(const CameraOutputs& o) {
-  return o.rgb + o.depth + o.segmentation + o.range + o.normals + o.instance_segmentation +
-         o.semantic_segmentation;
-}
+int NumOutputs(const CameraOutputs& o) { return o.count(); }
 
-// uncompressed bytes per pixel of the images a camera writes (output/camera_writer.h: rgb
-// 8-bit x 3, normals 8-bit x 3, the others 16-bit x 1).
+// uncompressed bytes per pixel of the images a camera writes (scene/image_kind.h: rgb and
+// normals 8-bit x 3, the others 16-bit x 1).
 double ImageBytesPerPixel(const CameraOutputs& o) {
-  return 3.0 * o.rgb + 3.0 * o.normals +
-         2.0 * (o.depth + o.segmentation + o.range + o.instance_segmentation +
-                o.semantic_segmentation);
+  double bytes = 0;
+  for (const ImageKindInfo& k : kImageKinds)
+    if (o[k.kind]) bytes += EncodedBytesPerPixel(k.encoding);
+  return bytes;
 }
 
 std::string Bytes(double b) {
@@ -48,12 +46,13 @@ std::string CameraSizeKey(const WorldConfig& world, const CameraSpec& c) {
 // the beams per scan and scan rate of a LiDAR entry (as sinks/sensor_sink.cc builds it);
 // nothing when the pattern is invalid (the sensor stage reports that with the key).
 std::optional<std::pair<double, double>> LidarBeams(const SensorConfig& s) {
-  if (s.type != "lidar") return std::nullopt;
+  const LidarSensorParams* lidar = s.get<LidarSensorParams>();
+  if (!lidar) return std::nullopt;
   LidarPatternOptions po;
-  po.columns = static_cast<int>(s.Param("columns", 0));
+  po.columns = lidar->columns;
   po.rate_hz = s.rate_hz.value_or(0);
   try {
-    const LidarPattern p = MakeLidarPattern(s.preset, po);
+    const LidarPattern p = MakeLidarPattern(lidar->preset, po);
     return std::make_pair(static_cast<double>(p.beams.size()), p.rate_hz);
   } catch (const Error&) {
     return std::nullopt;
@@ -121,7 +120,7 @@ RunWork EstimateRunWork(const WorldConfig& world, const SceneDescription& scene,
     const double pixels = double(c.intrinsics.width) * double(c.intrinsics.height);
     w.camera_frames += frames;
     w.image_bytes += frames * pixels * ImageBytesPerPixel(c.outputs);
-    if (world.render.tier == RenderSettings::Tier::kPathtraced && c.outputs.rgb) {
+    if (world.render.tier == RenderSettings::Tier::kPathtraced && c.outputs[ImageKind::kRgb]) {
       const int blur = i < sensor.size() ? std::max(1, sensor[i].motion_blur_samples) : 1;
       w.path_samples += frames * pixels * world.render.samples_per_pixel * blur;
     }

@@ -114,11 +114,11 @@ nlohmann::ordered_json MountJson(const ModelInfo& info, int body, const Pose& X_
 }
 
 // a sample of `sensor` for SensorSink's on_sample
-SensorSample MakeSample(const std::string& sensor, const char* type, int64_t index, int64_t step,
+SensorSample MakeSample(const std::string& sensor, SensorKind kind, int64_t index, int64_t step,
                         double time_sec) {
   SensorSample s;
   s.sensor = sensor;
-  s.type = type;
+  s.kind = kind;
   s.index = index;
   s.step = step;
   s.time_sec = time_sec;
@@ -165,9 +165,9 @@ struct SensorSink::Impl {
     GroundTruthCsvWriter out;
     int64_t written = 0;
   };
-  // what each schedule id stands for
+  // what each schedule id stands for: the sensor's type and its index in that type's list
   struct Entry {
-    int kind = 0;  // 0 lidar, 1 imu, 2 mujoco, 3 ground truth
+    SensorKind kind = SensorKind::kLidar;
     int index = 0;
   };
 
@@ -190,6 +190,12 @@ struct SensorSink::Impl {
   double effects_sec = 0;
   // sink thread
   std::map<std::string, double> busy;
+  // busy seconds of a sensor type (its name), or of a part of it ("<name>_<part>")
+  double& Busy(SensorKind kind, std::string_view part = {}) {
+    std::string key(SensorKindName(kind));
+    if (!part.empty()) key += "_" + std::string(part);
+    return busy[key];
+  }
   SinkWorker worker{8};
 
   // the sensors `due` read `snap`; on the sink thread, in step order. `scan_effects`: per
@@ -214,14 +220,14 @@ struct SensorSink::Impl {
     std::string pcd = l.out.Write(l.start_firing, scan);
     if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     if (on_sample) {
-      SensorSample sample =
-          MakeSample(l.cfg->name, "lidar", l.start_firing.index, start.step, start.time_sec);
+      SensorSample sample = MakeSample(l.cfg->name, SensorKind::kLidar, l.start_firing.index,
+                                       start.step, start.time_sec);
       sample.scan = std::move(scan_ptr);
       on_sample(sample);
     }
     ++l.written;
-    busy["lidar"] += std::chrono::duration<double>(Clock::now() - t0).count();
-    busy["lidar_cpu"] += ThreadCpuSec() - c0;
+    Busy(SensorKind::kLidar) += std::chrono::duration<double>(Clock::now() - t0).count();
+    Busy(SensorKind::kLidar, "cpu") += ThreadCpuSec() - c0;
   }
 };
 
@@ -253,36 +259,24 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
   const double physics_rate = s.schedule->physics_rate_hz();
   for (const SensorConfig& c : s.configs) {
     const uint64_t stream = SensorStreamSeed(world.seed, c.name);
-    double rate = c.rate_hz.value_or(c.type == "imu" ? 200.0 : 100.0);
+    const SensorTypeInfo& type = Info(c.kind());
+    double rate = c.rate_hz.value_or(type.default_rate_hz);
     // a rate above the physics rate fires once per step (sensors/sensor_schedule.h)
-    if (rate > physics_rate && c.type != "lidar") {
+    if (rate > physics_rate && !type.rate_from_model) {
       spdlog::warn(
           "{}:{}: {}.rate_hz: sensor '{}' at {:.6g} Hz is faster than the physics "
           "rate ({:.6g} Hz); it records one sample per physics step",
           c.file, c.line, c.key, c.name, rate, physics_rate);
       rate = physics_rate;
     }
-    if (c.type == "lidar") {
+    // the models of the registry's types (sensors/sensor_types.h)
+    if (const LidarSensorParams* p = c.get<LidarSensorParams>()) {
       Impl::Lidar l;
       l.cfg = &c;
       l.mount = ResolveMount(c, info);
       LidarConfig lc;
-      LidarPatternOptions po;
-      po.columns = static_cast<int>(c.Param("columns", 0));
-      po.rate_hz = c.rate_hz.value_or(0);
-      po.max_range_m = c.Param("max_range_m", 0);
-      po.min_range_m = c.Param("min_range_m", -1);
       try {
-        lc.pattern = MakeLidarPattern(c.preset, po);
-        if (c.params.count("beam_divergence_mrad"))
-          lc.pattern.beam_divergence_rad = c.Param("beam_divergence_mrad", 0) * 1e-3;
-        lc.range_noise_stddev_m = c.Param("noise.range_stddev_m", 0);
-        lc.dropout_probability = c.Param("noise.dropout_probability", 0);
-        lc.min_intensity = c.Param("noise.min_intensity", 0);
-        lc.receiver_noise = c.Param("noise.receiver_noise", 0);
-        lc.reference_reflectivity = c.Param("reference_reflectivity", 0.1);
-        lc.intensity_range_normalized = c.Param("intensity_range_normalized", 1) != 0;
-        lc.media = c.Param("media", 1) != 0;
+        lc = p->MakeConfig(c.rate_hz.value_or(0));
         l.scanner = std::make_unique<LidarScanner>(lc, stream);
       } catch (const ConfigError&) {
         throw;
@@ -292,9 +286,9 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       rate = lc.pattern.rate_hz;
       l.out = LidarScanWriter(out, c.name);
       rig["lidars"][c.name] = MountJson(info, l.mount.body, l.mount.X_BS);
-      s.entries.push_back({0, static_cast<int>(s.lidars.size())});
+      s.entries.push_back({SensorKind::kLidar, static_cast<int>(s.lidars.size())});
       s.lidars.push_back(std::move(l));
-    } else if (c.type == "imu") {
+    } else if (const ImuSensorParams* p = c.get<ImuSensorParams>()) {
       Impl::Imu m;
       m.cfg = &c;
       const auto [acc, gyr] = ImuSensorNames(c.name);
@@ -306,11 +300,7 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
                               "' (AddImuSensors was not applied)");
       m.accel = sim.sensor_info()[ia];
       m.gyro = sim.sensor_info()[ig];
-      ImuNoiseConfig nc = ImuPreset(c.preset);
-      nc.accel_noise_density = c.Param("noise.accel_noise_density", nc.accel_noise_density);
-      nc.accel_random_walk = c.Param("noise.accel_random_walk", nc.accel_random_walk);
-      nc.gyro_noise_density = c.Param("noise.gyro_noise_density", nc.gyro_noise_density);
-      nc.gyro_random_walk = c.Param("noise.gyro_random_walk", nc.gyro_random_walk);
+      const ImuNoiseConfig nc = p->MakeNoise();
       m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
       m.mount = ResolveMount(c, info);
       m.out = ImuCsvWriter(out, c.name);
@@ -322,29 +312,29 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       j["accelerometer_noise_density"] = nc.accel_noise_density;
       j["accelerometer_random_walk"] = nc.accel_random_walk;
       rig["imus"][c.name] = j;
-      s.entries.push_back({1, static_cast<int>(s.imus.size())});
+      s.entries.push_back({SensorKind::kImu, static_cast<int>(s.imus.size())});
       s.imus.push_back(std::move(m));
-    } else if (c.type == "mujoco") {
+    } else if (const MujocoSensorParams* p = c.get<MujocoSensorParams>()) {
       Impl::Mujoco m;
       m.cfg = &c;
       try {
-        m.set = std::make_unique<MujocoSensorSet>(sim.sensor_info(), c.names);
+        m.set = std::make_unique<MujocoSensorSet>(sim.sensor_info(), p->sensors);
       } catch (const Error& e) {
         throw SensorError(c, "sensors", e.what());
       }
-      m.stddev = c.Param("noise.stddev", 0);
+      m.stddev = p->stddev;
       m.stream = stream;
       m.out = MujocoSensorCsvWriter(out, c.name, m.set->ColumnNames());
-      s.entries.push_back({2, static_cast<int>(s.mujocos.size())});
+      s.entries.push_back({SensorKind::kMujoco, static_cast<int>(s.mujocos.size())});
       s.mujocos.push_back(std::move(m));
-    } else {
+    } else if (const GroundTruthSensorParams* p = c.get<GroundTruthSensorParams>()) {
       Impl::GroundTruth g;
       g.cfg = &c;
-      if (c.names.empty()) {
+      if (p->bodies.empty()) {
         for (size_t b = 1; b < info.body_names.size(); ++b)
           if (!info.body_names[b].empty()) g.bodies.push_back(static_cast<int>(b));
       } else {
-        for (const std::string& n : c.names) {
+        for (const std::string& n : p->bodies) {
           int found = -1;
           for (size_t b = 0; b < info.body_names.size(); ++b)
             if (info.body_names[b] == n) found = static_cast<int>(b);
@@ -353,9 +343,9 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
           g.bodies.push_back(found);
         }
       }
-      g.contacts = c.Param("contacts", 1) != 0;
+      g.contacts = p->contacts;
       g.out = GroundTruthCsvWriter(out, c.name, g.bodies, info.body_names, g.contacts);
-      s.entries.push_back({3, static_cast<int>(s.truths.size())});
+      s.entries.push_back({SensorKind::kGroundTruth, static_cast<int>(s.truths.size())});
       s.truths.push_back(std::move(g));
     }
     try {
@@ -405,7 +395,7 @@ void SensorSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot
     const auto t0 = Clock::now();
     for (size_t i = 0; i < s.due.size(); ++i) {
       const Impl::Entry e = s.entries[s.due[i].sensor];
-      if (e.kind != 0) continue;
+      if (e.kind != SensorKind::kLidar) continue;
       const Pose X0 = s.lidars[e.index].mount.X_WS(*snapshot);
       scan_effects[i] = s.effects_at(*snapshot, X0.translation());
     }
@@ -425,7 +415,7 @@ void SensorSink::Impl::Process(
     const SensorFiring& f = due[i];
     const Impl::Entry e = s.entries[f.sensor];
     const auto t0 = Clock::now();
-    if (e.kind == 0) {
+    if (e.kind == SensorKind::kLidar) {
       Impl::Lidar& l = s.lidars[e.index];
       if (l.pending) s.TraceScan(l, snap);
       l.pending = true;
@@ -434,7 +424,7 @@ void SensorSink::Impl::Process(
       l.start_effects = scan_effects[i];
       continue;
     }
-    if (e.kind == 1) {
+    if (e.kind == SensorKind::kImu) {
       Impl::Imu& m = s.imus[e.index];
       const auto a = MujocoSensorValues(snap, m.accel);
       const auto w = MujocoSensorValues(snap, m.gyro);
@@ -456,7 +446,8 @@ void SensorSink::Impl::Process(
       std::string row = m.out.Write(f, measured);
       m.truth_out.Write(f, state);
       if (s.on_sample) {
-        SensorSample sample = MakeSample(m.cfg->name, "imu", f.index, snap.step, snap.time_sec);
+        SensorSample sample =
+            MakeSample(m.cfg->name, SensorKind::kImu, f.index, snap.step, snap.time_sec);
         sample.values = {measured.accel_m_s2.x(), measured.accel_m_s2.y(), measured.accel_m_s2.z(),
                          measured.gyro_rad_s.x(), measured.gyro_rad_s.y(), measured.gyro_rad_s.z()};
         s.on_sample(sample);
@@ -464,8 +455,8 @@ void SensorSink::Impl::Process(
       if (s.on_output)
         s.on_output(m.cfg->name, "imu.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
-      s.busy["imu"] += std::chrono::duration<double>(Clock::now() - t0).count();
-    } else if (e.kind == 2) {
+      s.Busy(SensorKind::kImu) += std::chrono::duration<double>(Clock::now() - t0).count();
+    } else if (e.kind == SensorKind::kMujoco) {
       Impl::Mujoco& m = s.mujocos[e.index];
       m.values.clear();
       m.set->Read(snap, &m.values);
@@ -476,7 +467,8 @@ void SensorSink::Impl::Process(
       if (s.on_sample) {
         if (!m.columns)
           m.columns = std::make_shared<const std::vector<std::string>>(m.set->ColumnNames());
-        SensorSample sample = MakeSample(m.cfg->name, "mujoco", f.index, snap.step, snap.time_sec);
+        SensorSample sample =
+            MakeSample(m.cfg->name, SensorKind::kMujoco, f.index, snap.step, snap.time_sec);
         sample.values = m.values;
         sample.columns = m.columns;
         s.on_sample(sample);
@@ -484,12 +476,12 @@ void SensorSink::Impl::Process(
       if (s.on_output)
         s.on_output(m.cfg->name, "sensor.csv", snap.step, snap.time_sec, std::move(row));
       ++m.written;
-      s.busy["mujoco"] += std::chrono::duration<double>(Clock::now() - t0).count();
+      s.Busy(SensorKind::kMujoco) += std::chrono::duration<double>(Clock::now() - t0).count();
     } else {
       Impl::GroundTruth& g = s.truths[e.index];
       g.out.Write(f.index, snap);
       ++g.written;
-      s.busy["ground_truth"] += std::chrono::duration<double>(Clock::now() - t0).count();
+      s.Busy(SensorKind::kGroundTruth) += std::chrono::duration<double>(Clock::now() - t0).count();
     }
   }
 }
@@ -497,8 +489,8 @@ void SensorSink::Impl::Process(
 void SensorSink::OnFinish(const LoopFinish&) {
   Impl& s = *impl_;
   s.worker.Finish();
-  s.busy["lidar_effects"] += s.effects_sec;
-  if (!s.lidars.empty()) s.busy["lidar"] += s.effects_sec;
+  s.Busy(SensorKind::kLidar, "effects") += s.effects_sec;
+  if (!s.lidars.empty()) s.Busy(SensorKind::kLidar) += s.effects_sec;
   // every file is closed (and its error, if any, seen); the first error is rethrown
   std::exception_ptr first;
   auto close = [&](auto& writer) {

@@ -65,7 +65,7 @@ using SensorOutputCallback = std::function<void(const std::string& sensor, const
 /// for bridges (command/run_bridge.h).
 struct SensorSample {
   std::string sensor;   ///< the sensor's name in the world file
-  std::string type;     ///< "imu", "lidar" or "mujoco"
+  SensorKind kind = SensorKind::kImu;  ///< kImu, kLidar or kMujoco (sensors/sensor_types.h)
   int64_t index = 0;    ///< sample (scan) index k
   int64_t step = 0;     ///< physics step of the capture (a LiDAR scan: its start)
   double time_sec = 0;  ///< sim time of that step, s
@@ -122,7 +122,7 @@ class SensorSink : public Sink {
 
   /// samples (scans) written per sensor (read after OnFinish).
   std::map<std::string, int64_t> samples() const;
-  /// wall time spent per sensor type ("lidar", "imu", "mujoco", "ground_truth"), s; also
+  /// wall time spent per sensor type (its SensorKindName: "lidar", "imu", ...), s; also
   /// "lidar_effects" (evaluating the effects a LiDAR sees, on the loop thread, part of "lidar")
   /// and "lidar_cpu" (thread CPU time of the LiDAR work). read after OnFinish.
   std::map<std::string, double> busy_sec() const;

@@ -213,13 +213,13 @@ class ViewerBridge : public RunBridge {
   void OnSensorSample(const SensorSample& s) override {
     if (clients_.load() == 0) return;
     std::lock_guard<std::mutex> lock(sig_mu_);
-    if (s.type == "imu" && s.values.size() >= 6) {
+    if (s.kind == SensorKind::kImu && s.values.size() >= 6) {
       static const char* kAxes[6] = {"accel_x", "accel_y", "accel_z", "gyro_x", "gyro_y", "gyro_z"};
       for (int k = 0; k < 6; ++k) sensor_signals_["imu/" + s.sensor + "/" + kAxes[k]] = s.values[k];
-    } else if (s.type == "mujoco" && s.columns) {
+    } else if (s.kind == SensorKind::kMujoco && s.columns) {
       for (size_t k = 0; k < s.values.size() && k < s.columns->size(); ++k)
         sensor_signals_["sensor/" + s.sensor + "/" + (*s.columns)[k]] = s.values[k];
-    } else if (s.type == "lidar" && s.scan) {
+    } else if (s.kind == SensorKind::kLidar && s.scan) {
       pending_lidar_[s.sensor] = s;
     }
   }
@@ -476,10 +476,10 @@ class ViewerBridge : public RunBridge {
       const CameraSpec* spec = nullptr;
       for (const CameraSpec& c : session_.scene().cameras)
         if (c.name == camera) spec = &c;
-      const bool kind_ok =
-          spec &&
-          ((kind == "rgb" && spec->outputs.rgb) || (kind == "depth" && spec->outputs.depth) ||
-           (kind == "segmentation" && spec->outputs.rgb && spec->outputs.segmentation));
+      const bool kind_ok = spec && ((kind == "rgb" && spec->outputs[ImageKind::kRgb]) ||
+                                    (kind == "depth" && spec->outputs[ImageKind::kDepth]) ||
+                                    (kind == "segmentation" && spec->outputs[ImageKind::kRgb] &&
+                                     spec->outputs[ImageKind::kSegmentation]));
       if (!kind_ok)
         return CommandErrorReply(
                    cmd, id, command_code::kBadField, field,
@@ -721,7 +721,7 @@ class ViewerBridge : public RunBridge {
         const Eigen::Vector3d w = *X_WS * Eigen::Vector3d(p.x, p.y, p.z);
         for (int k = 0; k < 3; ++k) pts.push_back(std::round(w[k] * 1e3) / 1e3);
       }
-      json m = {{"type", "lidar"},
+      json m = {{"type", std::string(SensorKindName(SensorKind::kLidar))},
                 {"sensor", name},
                 {"time_sec", s.time_sec},
                 {"points", std::move(pts)}};

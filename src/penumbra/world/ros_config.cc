@@ -134,7 +134,7 @@ void ValidateRosReferences(const RosConfig& ros, const WorldConfig& world) {
     sensors += (sensors.empty() ? "" : ", ") + c.name;
   }
   for (const SensorConfig& s : world.sensors)
-    if (s.type == "lidar" || s.type == "imu") {
+    if (s.kind() == SensorKind::kLidar || s.kind() == SensorKind::kImu) {
       sensor_names.insert(s.name);
       sensors += (sensors.empty() ? "" : ", ") + s.name;
     }

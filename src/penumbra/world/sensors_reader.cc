@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
+#include <string_view>
+#include <variant>
 
 #include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
@@ -12,25 +15,44 @@
 namespace penumbra {
 namespace {
 
-// the presets of sensors/lidar_pattern.h and sensors/imu_model.h (the world module does not
-// link the sensors module; tests/sensors checks that both lists agree)
-const std::vector<std::string_view> kLidarPresets = {
-    "velodyne_vlp16", "ouster_os1_64", "ouster_os1_128", "livox_mid40", "solid_state_raster"};
-const std::vector<std::string_view> kImuPresets = {"consumer_mems", "tactical", "ideal"};
-
 std::string Prefixed(const std::string& robot, const std::string& name) {
   if (robot.empty() || name == "world") return name;
   return robot + "/" + name;
 }
 
-// largest noise parameter of a sensor (standard deviations, densities, random walks).
-constexpr double kMaxSensorNoise = 1e3;
+// the sensor registry's reader (sensors/sensor_type.h) over one node of the entry (config/)
+class WorldSensorParamReader : public SensorParamReader {
+ public:
+  WorldSensorParamReader(ParamReader node, std::string robot)
+      : node_(std::move(node)), robot_(std::move(robot)) {}
 
-double NonNegative(const ParamReader& r, const std::string& unit) {
-  const double v = r.Double();
-  if (v < 0) r.Fail("got " + FormatNumber(v) + "; expected a number >= 0 (" + unit + ")");
-  return v;
-}
+  bool Has(std::string_view k) const override { return node_.Has(k); }
+  double Double(std::string_view k) const override { return node_.Child(k).Double(); }
+  int Integer(std::string_view k) const override { return node_.Child(k).Int(); }
+  bool Boolean(std::string_view k) const override { return node_.Child(k).Bool(); }
+  std::string Enum(std::string_view k, const std::vector<std::string_view>& valid) const override {
+    return node_.Child(k).Enum(valid);
+  }
+  std::vector<std::string> Names(std::string_view k) const override {
+    std::vector<std::string> out;
+    for (const ParamReader& e : node_.Child(k).List()) out.push_back(Prefixed(robot_, e.String()));
+    return out;
+  }
+  std::unique_ptr<SensorParamReader> Map(std::string_view k,
+                                         const std::vector<std::string_view>& keys) const override {
+    ParamReader child = node_.Child(k);
+    child.ExpectMap(keys);
+    return std::make_unique<WorldSensorParamReader>(std::move(child), robot_);
+  }
+  [[noreturn]] void Fail(std::string_view k, const std::string& problem) const override {
+    if (k.empty()) node_.Fail(problem);
+    node_.Child(k).Fail(problem);
+  }
+
+ private:
+  ParamReader node_;
+  std::string robot_;
+};
 
 SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, SensorConfig s);
 
@@ -67,24 +89,17 @@ SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, Se
                          "' is not a valid sensor name; expected a non-empty "
                          "name without '/', '\\', spaces or control characters, not '.' or "
                          "'..' (it names output files)");
-  s.type = r.Child("type").Enum({"lidar", "imu", "mujoco", "ground_truth"});
+  // the type's keys and parameters come from the sensor registry (sensors/sensor_types.h)
+  std::vector<std::string_view> types;
+  for (const SensorTypeInfo& t : kSensorTypes) types.push_back(t.name);
+  const SensorKind kind = *SensorKindFromName(r.Child("type").Enum(types));
+  const SensorTypeInfo& type = Info(kind);
+  s.params = DefaultSensorParams(kind);
   std::vector<std::string_view> keys = {"name", "type", "rate_hz", "latency_sec"};
-  std::vector<std::string_view> noise_keys;
-  if (s.type == "lidar") {
-    keys.insert(keys.end(), {"body", "site", "pose", "preset", "columns", "min_range_m",
-                             "max_range_m", "beam_divergence_mrad", "reference_reflectivity",
-                             "intensity_range_normalized", "media", "noise"});
-    noise_keys = {"range_stddev_m", "dropout_probability", "min_intensity", "receiver_noise"};
-  } else if (s.type == "imu") {
-    keys.insert(keys.end(), {"body", "site", "pose", "preset", "noise"});
-    noise_keys = {"accel_noise_density", "accel_random_walk", "gyro_noise_density",
-                  "gyro_random_walk"};
-  } else if (s.type == "mujoco") {
-    keys.insert(keys.end(), {"sensors", "noise"});
-    noise_keys = {"stddev"};
-  } else {
-    keys.insert(keys.end(), {"bodies", "contacts"});
-  }
+  if (type.attach != SensorAttach::kNone) keys.insert(keys.end(), {"body", "site", "pose"});
+  const std::vector<std::string_view> type_keys =
+      std::visit([](const auto& p) { return std::decay_t<decltype(p)>::Keys(); }, s.params);
+  keys.insert(keys.end(), type_keys.begin(), type_keys.end());
   r.ExpectMap(keys);
   const std::string sensor = "sensor '" + s.name + "': ";
   if (r.Has("rate_hz")) {
@@ -93,14 +108,19 @@ SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, Se
     if (!(*s.rate_hz > 0))
       c.Fail(sensor + "got " + FormatNumber(*s.rate_hz) + "; expected a rate > 0 (Hz)");
   }
-  if (const auto found = r.Find("latency_sec")) s.latency_sec = NonNegative(*found, "s");
-  if (const auto found = r.Find("body")) s.body = Prefixed(robot, found->String());
-  if (const auto found = r.Find("site")) s.site = Prefixed(robot, found->String());
+  const WorldSensorParamReader reader(r, robot);
+  if (r.Has("latency_sec")) s.latency_sec = reader.NonNegative("latency_sec", "s");
+  if (r.Has("body")) s.body = Prefixed(robot, r.Child("body").String());
+  if (r.Has("site")) s.site = Prefixed(robot, r.Child("site").String());
   if (!s.body.empty() && !s.site.empty())
     r.Child("site").Fail(sensor + "both body and site are set; expected one of them");
-  if (s.type == "imu" && s.body.empty() && s.site.empty())
-    r.Fail(sensor + "an imu needs 'body' or 'site' to attach to");
-  if ((s.type == "lidar") && s.body.empty() && s.site.empty()) s.body = "world";
+  if (type.attach == SensorAttach::kRequired && s.body.empty() && s.site.empty())
+    r.Fail(sensor +
+           (std::string_view("aeiou").find(type.name.front()) == std::string_view::npos ? "a "
+                                                                                        : "an ") +
+           std::string(type.name) + " needs 'body' or 'site' to attach to");
+  if (type.attach == SensorAttach::kDefaultWorld && s.body.empty() && s.site.empty())
+    s.body = "world";
   if (r.Has("pose")) {
     const ParamReader p = r.Child("pose");
     p.ExpectMap({"xyz", "rpy_deg"});
@@ -114,52 +134,7 @@ SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, Se
     }
     if (const auto found = p.Find("rpy_deg")) s.rpy_deg = found->Vector3();
   }
-  if (s.type == "lidar") {
-    s.preset = r.Child("preset").Enum(kLidarPresets);
-  } else if (s.type == "imu") {
-    s.preset = r.Has("preset") ? r.Child("preset").Enum(kImuPresets) : "consumer_mems";
-  }
-  if (r.Has("columns")) {
-    const ParamReader c = r.Child("columns");
-    const int v = c.Int();
-    if (v < 1 || v > kMaxLidarBeamsPerScan)
-      c.Fail(sensor + "got " + std::to_string(v) + "; expected an integer in [1, " +
-             std::to_string(kMaxLidarBeamsPerScan) + "] (rings x columns is at most " +
-             std::to_string(kMaxLidarBeamsPerScan) + " beams per scan)");
-    s.params["columns"] = v;
-  }
-  for (const char* k : {"min_range_m", "max_range_m"})
-    if (r.Has(k)) s.params[k] = NonNegative(r.Child(k), "m");
-  if (r.Has("beam_divergence_mrad"))
-    s.params["beam_divergence_mrad"] = NonNegative(r.Child("beam_divergence_mrad"), "mrad");
-  if (r.Has("reference_reflectivity")) {
-    const ParamReader c = r.Child("reference_reflectivity");
-    const double v = c.Double();
-    if (!(v > 0 && v <= 1)) c.Fail(sensor + "got " + FormatNumber(v) + "; expected (0, 1]");
-    s.params["reference_reflectivity"] = v;
-  }
-  for (const char* k : {"intensity_range_normalized", "media", "contacts"})
-    if (r.Has(k)) s.params[k] = r.Child(k).Bool() ? 1 : 0;
-  if (r.Has("noise")) {
-    const ParamReader n = r.Child("noise");
-    n.ExpectMap(noise_keys);
-    for (std::string_view k : noise_keys) {
-      if (!n.Has(k)) continue;
-      const ParamReader c = n.Child(k);
-      const double v = c.Double();
-      // 1e308 made every reading infinite
-      if (!(v >= 0 && v <= kMaxSensorNoise))
-        c.Fail(sensor + "got " + FormatNumber(v) +
-               "; expected a noise value >= 0 and <= " + FormatNumber(kMaxSensorNoise));
-      if (k == "dropout_probability" && v > 1)
-        c.Fail(sensor + "got " + FormatNumber(v) + "; expected a probability in [0, 1]");
-      s.params["noise." + std::string(k)] = v;
-    }
-  }
-  for (const char* k : {"sensors", "bodies"}) {
-    if (!r.Has(k)) continue;
-    for (const ParamReader& e : r.Child(k).List()) s.names.push_back(Prefixed(robot, e.String()));
-  }
+  std::visit([&](auto& p) { p.Read(reader); }, s.params);
   return s;
 }
 

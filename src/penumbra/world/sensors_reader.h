@@ -28,12 +28,12 @@
 // body/site existence is checked after composition (session/sensor_sink), naming the entry.
 
 #include <Eigen/Core>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/sensors/sensor_types.h"
 
 namespace penumbra {
 
@@ -42,7 +42,8 @@ class ParamReader;
 /// one world-file sensor.
 struct SensorConfig {
   std::string name;
-  std::string type;   ///< "lidar", "imu", "mujoco", "ground_truth"
+  /// the type's parameters (sensors/sensor_types.h); the alternative held is the sensor's type.
+  SensorParams params;
   std::string robot;  ///< robot it was listed under ("" = top-level list)
   std::string body;   ///< attach body, composed name ("world" = world frame); "" if site set
   std::string site;   ///< attach site, composed name; "" if body set
@@ -50,21 +51,18 @@ struct SensorConfig {
   Eigen::Vector3d rpy_deg{0, 0, 0};  ///< and roll, pitch, yaw (deg, REP-103)
   /// X_AS: pose of the sensor frame S in the attach frame A.
   Pose X_AS() const { return PoseFromXyzRpyDeg(xyz, rpy_deg); }
-  std::string preset;
   std::optional<double> rate_hz;  ///< nullopt = the type's default
   double latency_sec = 0;
-  /// overrides and noise values by key path below the entry ("columns", "noise.stddev", ...);
-  /// booleans are stored as 0 / 1.
-  std::map<std::string, double> params;
-  std::vector<std::string> names;  ///< mujoco: sensor names; ground_truth: body names
-  std::string file;                ///< world file, for messages
-  int line = 0;                    ///< line of the entry
-  std::string key;  ///< key path of the entry, e.g. "sensors[1]" or "robots[0].sensors[0]"
+  std::string file;  ///< world file, for messages
+  int line = 0;      ///< line of the entry
+  std::string key;   ///< key path of the entry, e.g. "sensors[1]" or "robots[0].sensors[0]"
 
-  /// value of params[k] or `fallback`.
-  double Param(const std::string& k, double fallback) const {
-    auto it = params.find(k);
-    return it == params.end() ? fallback : it->second;
+  /// the sensor's type.
+  SensorKind kind() const { return KindOf(params); }
+  /// the type's parameters; nullptr when the sensor is of another type.
+  template <typename P>
+  const P* get() const {
+    return std::get_if<P>(&params);
   }
 };
 

@@ -340,9 +340,9 @@ class WorldParser {
   }
 
   static CameraOutputs ReadOutputs(const ParamReader& r) {
-    CameraOutputs o{false, false, false};
-    const std::vector<std::string_view> names(CameraOutputs::kNames.begin(),
-                                              CameraOutputs::kNames.end());
+    CameraOutputs o = CameraOutputs::None();
+    std::vector<std::string_view> names;
+    for (const ImageKindInfo& k : kImageKinds) names.push_back(k.name);
     for (const ParamReader& e : r.List()) {
       const std::string v = e.Enum(names);
       bool& flag = *o.Flag(v);
@@ -532,7 +532,7 @@ WorldConfig WorldForBareModel(const std::string& model_path) {
   cam.height = 480;
   cam.fovy_deg = 45;
   cam.rate_hz = 30;
-  cam.outputs = CameraOutputs{true, true, true};
+  cam.outputs = CameraOutputs{ImageKind::kRgb, ImageKind::kDepth, ImageKind::kSegmentation};
   w.cameras.push_back(cam);
 
   w.mjcf_cameras.enabled = true;

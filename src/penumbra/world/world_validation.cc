@@ -180,11 +180,11 @@ class Validator {
   }
 
   void CheckOutputs(const std::string& path, const CameraOutputs& o) const {
-    if (!o.rgb && !o.depth && !o.segmentation && !o.range && !o.normals &&
-        !o.instance_segmentation && !o.semantic_segmentation) {
-      Fail(path,
-           "no output selected; expected a non-empty list of: rgb, depth, segmentation, range, "
-           "normals, instance_segmentation, semantic_segmentation");
+    if (o.empty()) {
+      std::string names;
+      for (const ImageKindInfo& k : kImageKinds)
+        names += (names.empty() ? "" : ", ") + std::string(k.name);
+      Fail(path, "no output selected; expected a non-empty list of: " + names);
     }
   }
 

@@ -186,13 +186,13 @@ ZmqBridge::ZmqBridge(const RunBridgeContext& context, ZmqBridgeOptions options)
     for (const json& o : c.at("outputs")) {
       const std::string out = o.get<std::string>();
       topics_.push_back(base + out);
-      if (out == "depth") topics_.push_back(base + "depth_mm");
+      if (out == ImageKindName(ImageKind::kDepth)) topics_.push_back(base + "depth_mm");
     }
   }
   for (const SensorConfig& s : context.world.sensors) {
-    if (s.type == "imu") topics_.push_back("imu/" + s.name);
-    if (s.type == "lidar") topics_.push_back("lidar/" + s.name);
-    if (s.type == "mujoco") topics_.push_back("sensor/" + s.name);
+    if (s.kind() == SensorKind::kImu) topics_.push_back("imu/" + s.name);
+    if (s.kind() == SensorKind::kLidar) topics_.push_back("lidar/" + s.name);
+    if (s.kind() == SensorKind::kMujoco) topics_.push_back("sensor/" + s.name);
   }
   for (const char* t : {"clock", "joint_states", "ground_truth/poses", "contacts", "sync", "end"})
     topics_.push_back(t);
@@ -675,13 +675,22 @@ void ZmqBridge::OnCameraFrame(const std::shared_ptr<const CameraFrame>& frame) {
     using T = typename std::decay_t<decltype(img.data)>::value_type;
     return SharedMessage<CameraFrame>(img.data.data(), img.data.size() * sizeof(T), frame);
   };
-  if (!f.rgb.empty() && Subscribed(base + "rgb"))
-    PublishImage(base + "rgb", f, "rgb8", f.rgb.width, f.rgb.height, 3, shared(f.rgb));
-  if (!f.depth_m.empty()) {
-    if (Subscribed(base + "depth"))
-      PublishImage(base + "depth", f, "32FC1", f.depth_m.width, f.depth_m.height, 4,
-                   shared(f.depth_m));
-    if (Subscribed(base + "depth_mm")) {
+  // one topic per image kind (scene/image_kind.h), named after it, in the table's order; its
+  // ROS encoding follows from the pixel type and channels (rgb8, 32FC1, 32FC3, 32SC1)
+  for (const ImageKindInfo& k : kImageKinds) {
+    WithImage(f, k.kind, [&](const auto& img) {
+      using T = typename std::decay_t<decltype(img.data)>::value_type;
+      const std::string topic = base + std::string(k.name);
+      if (img.empty() || !Subscribed(topic)) return;
+      const std::string encoding =
+          k.pixel == PixelType::kU8
+              ? "rgb8"
+              : (k.pixel == PixelType::kF32 ? "32FC" : "32SC") + std::to_string(k.channels);
+      PublishImage(topic, f, encoding.c_str(), img.width, img.height,
+                   static_cast<int>(sizeof(T)) * k.channels, shared(img));
+    });
+    // depth also as 16-bit millimetres
+    if (k.kind == ImageKind::kDepth && !f.depth_m.empty() && Subscribed(base + "depth_mm")) {
       zmq::message_t mm(f.depth_m.data.size() * sizeof(uint16_t));
       auto* out = static_cast<uint16_t*>(mm.data());
       for (size_t i = 0; i < f.depth_m.data.size(); ++i) {
@@ -692,41 +701,26 @@ void ZmqBridge::OnCameraFrame(const std::shared_ptr<const CameraFrame>& frame) {
                    std::move(mm));
     }
   }
-  if (!f.geom_id.empty() && Subscribed(base + "segmentation"))
-    PublishImage(base + "segmentation", f, "32SC1", f.geom_id.width, f.geom_id.height, 4,
-                 shared(f.geom_id));
-  if (!f.range_m.empty() && Subscribed(base + "range"))
-    PublishImage(base + "range", f, "32FC1", f.range_m.width, f.range_m.height, 4,
-                 shared(f.range_m));
-  if (!f.normal_O.empty() && Subscribed(base + "normals"))
-    PublishImage(base + "normals", f, "32FC3", f.normal_O.width, f.normal_O.height, 12,
-                 shared(f.normal_O));
-  if (!f.body_id.empty() && Subscribed(base + "instance_segmentation"))
-    PublishImage(base + "instance_segmentation", f, "32SC1", f.body_id.width, f.body_id.height, 4,
-                 shared(f.body_id));
-  if (!f.semantic_class.empty() && Subscribed(base + "semantic_segmentation"))
-    PublishImage(base + "semantic_segmentation", f, "32SC1", f.semantic_class.width,
-                 f.semantic_class.height, 4, shared(f.semantic_class));
 }
 
 void ZmqBridge::OnSensorSample(const SensorSample& sample) {
   json h = {{"stamp", sample.time_sec},
             {"sim_step", sample.step},
-            {"frame_id", sample.type == "mujoco" ? std::string("world") : sample.sensor},
+            {"frame_id", sample.kind == SensorKind::kMujoco ? std::string("world") : sample.sensor},
             {"index", sample.index}};
-  if (sample.type == "imu") {
+  if (sample.kind == SensorKind::kImu) {
     const std::string topic = "imu/" + sample.sensor;
     if (!Subscribed(topic) || sample.values.size() != 6) return;
     h["accel"] = {sample.values[0], sample.values[1], sample.values[2]};
     h["gyro"] = {sample.values[3], sample.values[4], sample.values[5]};
     Publish(topic, h, zmq::message_t());
-  } else if (sample.type == "mujoco") {
+  } else if (sample.kind == SensorKind::kMujoco) {
     const std::string topic = "sensor/" + sample.sensor;
     if (!Subscribed(topic)) return;
     h["columns"] = sample.columns ? json(*sample.columns) : json::array();
     h["values"] = sample.values;
     Publish(topic, h, zmq::message_t());
-  } else if (sample.type == "lidar" && sample.scan) {
+  } else if (sample.kind == SensorKind::kLidar && sample.scan) {
     const std::string topic = "lidar/" + sample.sensor;
     if (!Subscribed(topic)) return;
     const auto& pts = sample.scan->points;

@@ -52,10 +52,11 @@ BatchWorld LoadBatchWorld(const std::string& name) {
   w.view.X_WO = CameraPoseInWorld(cam, w.snap);
   w.view.intrinsics = CameraIntrinsics::FromFovy(kBatchW, kBatchH, 70);
   w.view.near_m = cam.near_m;
-  w.view.outputs.rgb = false;
-  w.view.outputs.depth = w.view.outputs.segmentation = true;
-  w.view.outputs.instance_segmentation = w.view.outputs.semantic_segmentation = true;
-  w.view.outputs.range = true;
+  w.view.outputs[ImageKind::kRgb] = false;
+  w.view.outputs[ImageKind::kDepth] = w.view.outputs[ImageKind::kSegmentation] = true;
+  w.view.outputs[ImageKind::kInstanceSegmentation] =
+      w.view.outputs[ImageKind::kSemanticSegmentation] = true;
+  w.view.outputs[ImageKind::kRange] = true;
   return w;
 }
 

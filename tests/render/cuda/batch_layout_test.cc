@@ -144,8 +144,9 @@ TEST(BatchPixelTruth, HostRunMatchesTheCpuBackend) {
   view.X_WO = CameraPoseInWorld(scene.cameras.front(), snap);
   view.intrinsics = CameraIntrinsics::FromFovy(96, 72, 60);
   view.near_m = scene.cameras.front().near_m;
-  view.outputs.rgb = false;
-  view.outputs.depth = view.outputs.segmentation = view.outputs.range = true;
+  view.outputs[ImageKind::kRgb] = false;
+  view.outputs[ImageKind::kDepth] = view.outputs[ImageKind::kSegmentation] =
+      view.outputs[ImageKind::kRange] = true;
   RenderSettings settings;
   settings.backend = RenderSettings::Backend::kEmbree;
   settings.threads = 1;

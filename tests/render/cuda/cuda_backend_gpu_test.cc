@@ -114,10 +114,11 @@ TEST_P(CudaBackendWorlds, GroundTruthImagesMatchCpuBackend) {
     view.X_WO = CameraPoseInWorld(cam, snap);
     view.intrinsics = CameraIntrinsics::FromFovy(320, 240, 60);
     view.near_m = cam.near_m;
-    view.outputs.rgb = false;
-    view.outputs.depth = view.outputs.segmentation = view.outputs.range = true;
-    view.outputs.normals = view.outputs.instance_segmentation = true;
-    view.outputs.semantic_segmentation = true;
+    view.outputs[ImageKind::kRgb] = false;
+    view.outputs[ImageKind::kDepth] = view.outputs[ImageKind::kSegmentation] =
+        view.outputs[ImageKind::kRange] = true;
+    view.outputs[ImageKind::kNormals] = view.outputs[ImageKind::kInstanceSegmentation] = true;
+    view.outputs[ImageKind::kSemanticSegmentation] = true;
     RenderedFrame a, b;
     cpu->Render(snap, view, &a);
     gpu->Render(snap, view, &b);
@@ -176,7 +177,7 @@ TEST(CudaBackend, PathtracedRgbFramesGoToTheCpuRenderer) {
   CameraView view;
   view.X_WO = CameraPoseInWorld(session->scene().cameras.front(), snap);
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
-  view.outputs.rgb = true;
+  view.outputs[ImageKind::kRgb] = true;
   RenderedFrame f;
   gpu->Render(snap, view, &f);
   EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);

@@ -55,8 +55,8 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   view.near_m = cam.near_m;
   view.exposure_time_sec = cam.exposure_time_sec;
   view.frame_index = snap.step;
-  view.outputs.rgb = false;
-  view.outputs.depth = view.outputs.segmentation = true;
+  view.outputs[ImageKind::kRgb] = false;
+  view.outputs[ImageKind::kDepth] = view.outputs[ImageKind::kSegmentation] = true;
   const std::shared_ptr<const EffectsFrame> fx =
       session.effects().Evaluate(snap, view.X_WO.translation());
   RenderSettings cpu_settings;
@@ -88,7 +88,7 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   row.effects = fx && !fx->empty();
   row.effects_on_gpu = cuda::CudaRenderer::OnGpu(fx.get(), view);
   CameraView rgb_view = view;
-  rgb_view.outputs.rgb = true;
+  rgb_view.outputs[ImageKind::kRgb] = true;
   if (!cuda::CudaRenderer::OnGpu(fx.get(), rgb_view)) {
     row.rgb = "cpu fallback";
   } else {

@@ -78,7 +78,7 @@ TEST_P(RealtimeParityAttribution, SplitsTheRgbErrorByFeature) {
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   CameraView view = realtime_parity::RgbDepthView(scene, snap, size.width, size.height);
-  view.outputs.segmentation = true;
+  view.outputs[ImageKind::kSegmentation] = true;
   const RenderedFrame cpu = RenderCpuWith(scene, snap, view, RenderAblation());
   RenderAblation no_mirror;
   no_mirror.mirror = false;

@@ -37,9 +37,9 @@ inline CameraView RgbDepthView(const SceneDescription& scene, const WorldSnapsho
       2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
   view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
   view.near_m = cam.near_m;
-  view.outputs.rgb = true;
-  view.outputs.depth = true;
-  view.outputs.segmentation = false;
+  view.outputs[ImageKind::kRgb] = true;
+  view.outputs[ImageKind::kDepth] = true;
+  view.outputs[ImageKind::kSegmentation] = false;
   return view;
 }
 

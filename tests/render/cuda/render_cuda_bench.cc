@@ -90,7 +90,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     view.X_WO = CameraPoseInWorld(cam, snap);
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
     view.near_m = cam.near_m;
-    view.outputs.rgb = view.outputs.depth = true;
+    view.outputs[ImageKind::kRgb] = view.outputs[ImageKind::kDepth] = true;
     RenderSettings gpu_settings;
     gpu_settings.backend = RenderSettings::Backend::kCuda;
     const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
@@ -329,14 +329,15 @@ int Main(int argc, char** argv) {
       view.X_WO = CameraPoseInWorld(cam, snap);
       view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
       view.near_m = cam.near_m;
-      view.outputs.rgb = false;
-      view.outputs.depth = view.outputs.segmentation = true;
+      view.outputs[ImageKind::kRgb] = false;
+      view.outputs[ImageKind::kDepth] = view.outputs[ImageKind::kSegmentation] = true;
       CameraView all = view;
-      all.outputs.range = all.outputs.normals = true;
-      all.outputs.instance_segmentation = all.outputs.semantic_segmentation = true;
+      all.outputs[ImageKind::kRange] = all.outputs[ImageKind::kNormals] = true;
+      all.outputs[ImageKind::kInstanceSegmentation] =
+          all.outputs[ImageKind::kSemanticSegmentation] = true;
       CameraView rgb = view;
-      rgb.outputs.rgb = true;
-      rgb.outputs.segmentation = false;
+      rgb.outputs[ImageKind::kRgb] = true;
+      rgb.outputs[ImageKind::kSegmentation] = false;
       const int n = w * h < 100000 ? frames * 10 : frames;
       if (gpu) {
         auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());

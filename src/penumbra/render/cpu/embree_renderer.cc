@@ -84,16 +84,16 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   if (use_sun_occluders) sun_occluders_.Update(scene_, snapshot, lights_, &pool_);
   const int W = camera.width(), H = camera.height();
   const CameraOutputs& want = view.outputs;
-  const bool denoise = want.rgb && denoiser_ != nullptr;
+  const bool denoise = want[ImageKind::kRgb] && denoiser_ != nullptr;
 
-  if (want.rgb) {
+  if (want[ImageKind::kRgb]) {
     Reshape(&out->radiance, W, H, 3);
   } else {
     out->radiance = ImageF();
     out->rgb = ImageU8();
   }
   ImageF* depth = nullptr;
-  if (want.depth) {
+  if (want[ImageKind::kDepth]) {
     Reshape(&out->depth_m, W, H, 1);
     depth = &out->depth_m;
   } else {
@@ -103,14 +103,14 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       depth = &depth_;
     }
   }
-  if (want.segmentation) {
+  if (want[ImageKind::kSegmentation]) {
     Reshape(&out->geom_id, W, H, 1);
   } else {
     out->geom_id = ImageI32();
   }
   const GroundTruthImages truth = PrepareGroundTruth(want, W, H, out);
   FrameBuffers buffers;
-  if (want.rgb) {
+  if (want[ImageKind::kRgb]) {
     buffers.radiance = &out->radiance;
     if (denoise) {
       Reshape(&albedo_, W, H, 3);
@@ -157,7 +157,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   const std::thread::id caller = std::this_thread::get_id();
   if (report) progress_(progress);
   const float near = static_cast<float>(view.near_m);
-  ImageI32* seg = want.segmentation ? &out->geom_id : nullptr;
+  ImageI32* seg = want[ImageKind::kSegmentation] ? &out->geom_id : nullptr;
   pool_.ParallelFor(static_cast<int64_t>(tiles_x) * tiles_y, [&](int64_t k) {
     // per-thread buffers of one tile, allocated once (no per-tile initialisation).
     constexpr int kMax = kTileSize * kTileSize;
@@ -250,7 +250,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
   out->stopped = stopped.load();
   if (out->stopped) return;
 
-  if (want.rgb && ablation_.film) {
+  if (want[ImageKind::kRgb] && ablation_.film) {
     if (denoise) {
       DenoiserGuides guides;
       guides.albedo = &albedo_;

@@ -130,13 +130,13 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
           width, height,
           2.0 * std::atan(0.5 * views[k].intrinsics.height / views[k].intrinsics.fy) * 180.0 /
               M_PI);
-      views[k].outputs.rgb = false;
-      views[k].outputs.depth = outputs.depth;
-      views[k].outputs.segmentation = outputs.segmentation;
-      views[k].outputs.instance_segmentation = outputs.instance_segmentation;
-      views[k].outputs.semantic_segmentation = outputs.semantic_segmentation;
-      views[k].outputs.range = outputs.range;
-      views[k].outputs.normals = false;
+      views[k].outputs[ImageKind::kRgb] = false;
+      views[k].outputs[ImageKind::kDepth] = outputs.depth;
+      views[k].outputs[ImageKind::kSegmentation] = outputs.segmentation;
+      views[k].outputs[ImageKind::kInstanceSegmentation] = outputs.instance_segmentation;
+      views[k].outputs[ImageKind::kSemanticSegmentation] = outputs.semantic_segmentation;
+      views[k].outputs[ImageKind::kRange] = outputs.range;
+      views[k].outputs[ImageKind::kNormals] = false;
     }
     for (int k = 0; k < std::min(count, 4); ++k)  // warm-up
       if (Renderer* cpu = worlds[world_of[k]].cpu)

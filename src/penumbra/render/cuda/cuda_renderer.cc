@@ -55,7 +55,7 @@ PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCa
 
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
-  const std::string rgb_why = view.outputs.rgb ? RgbNotOnGpu(effects, view) : "";
+  const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
   if (!OnGpu(effects, view) || !rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(
@@ -75,7 +75,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const CameraOutputs& want = view.outputs;
   const int W = c.width, H = c.height;
   out->ev100 = 0;
-  if (want.rgb) {
+  if (want[ImageKind::kRgb]) {
     RenderRgb(snapshot, view, out);
   } else {
     out->radiance = ImageF();
@@ -83,12 +83,13 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   }
   PrimaryOutputs o;
   // with rgb, depth comes from the realtime path's primary rays
-  o.depth = want.rgb ? nullptr : Shape(&out->depth_m, want.depth, W, H, 1);
-  o.geom_id = Shape(&out->geom_id, want.segmentation, W, H, 1);
-  o.range = Shape(&out->range_m, want.range, W, H, 1);
-  o.normal_O = Shape(&out->normal_O, want.normals, W, H, 3);
-  o.body_id = Shape(&out->body_id, want.instance_segmentation, W, H, 1);
-  o.semantic = Shape(&out->semantic_class, want.semantic_segmentation, W, H, 1);
+  o.depth =
+      want[ImageKind::kRgb] ? nullptr : Shape(&out->depth_m, want[ImageKind::kDepth], W, H, 1);
+  o.geom_id = Shape(&out->geom_id, want[ImageKind::kSegmentation], W, H, 1);
+  o.range = Shape(&out->range_m, want[ImageKind::kRange], W, H, 1);
+  o.normal_O = Shape(&out->normal_O, want[ImageKind::kNormals], W, H, 3);
+  o.body_id = Shape(&out->body_id, want[ImageKind::kInstanceSegmentation], W, H, 1);
+  o.semantic = Shape(&out->semantic_class, want[ImageKind::kSemanticSegmentation], W, H, 1);
   if (o.depth || o.geom_id || o.range || o.normal_O || o.body_id || o.semantic)
     device_->RenderPrimary(c, o);
   out->rays = static_cast<int64_t>(W) * H;
@@ -120,7 +121,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   RealtimeOutputs o;
   o.radiance = out->radiance.data.data();
   o.rgb = out->rgb.data.data();
-  o.depth = Shape(&out->depth_m, view.outputs.depth, W, H, 1);
+  o.depth = Shape(&out->depth_m, view.outputs[ImageKind::kDepth], W, H, 1);
   const RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
   out->ev100 = device_realtime_->Render(
       device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
