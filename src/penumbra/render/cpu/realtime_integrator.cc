@@ -11,6 +11,7 @@
 #include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/shadow_window_math.h"
 
 namespace penumbra {
 namespace {
@@ -162,21 +163,16 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       const float* p = &hit_p[3 * i];
       const float* nn = &hit_n[3 * i];
       const int x = xs[i], y = ys[i];
-      uint32_t bits = 1u << (2 * 5 + 2);
+      uint32_t bits = 1u << ShadowWindowBit(0, 0);
       for (int dy = -2; dy <= 2; ++dy) {
         if (y + dy < 0 || y + dy >= tile.height) continue;
         for (int dx = -2; dx <= 2; ++dx) {
           if (x + dx < 0 || x + dx >= tile.width) continue;
           const int ii = i + dy * tile.width + dx;
-          if (ii == i || hit_geom[ii] != geom) continue;
-          const float* q = &hit_p[3 * ii];
-          const float* m = &hit_n[3 * ii];
-          if (!(nn[0] * m[0] + nn[1] * m[1] + nn[2] * m[2] >= 0.9f)) continue;
-          // within 5 % of its distance from i's tangent plane.
-          const float d0 = q[0] - p[0], d1 = q[1] - p[1], d2 = q[2] - p[2];
-          const float off = nn[0] * d0 + nn[1] * d1 + nn[2] * d2;
-          if (!(off * off <= 0.0025f * (d0 * d0 + d1 * d1 + d2 * d2) + 1e-10f)) continue;
-          bits |= 1u << ((dy + 2) * 5 + dx + 2);
+          if (ii == i || hit_geom[ii] != geom ||
+              !SameShadowSurface(geom, nn, p, hit_geom[ii], &hit_n[3 * ii], &hit_p[3 * ii]))
+            continue;
+          bits |= 1u << ShadowWindowBit(dx, dy);
         }
       }
       near[i] = bits;
@@ -214,11 +210,11 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
   auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
     for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
-      const int b = __builtin_ctz(bits);
+      const int b = LowestSetBit(bits);
       const int dy = b / 5 - 2, dx = b % 5 - 2;
       const int ii = i + dy * tile.width + dx;
       if (vis[ii] < 0) continue;
-      fn(ii, (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f));
+      fn(ii, ShadowWindowWeight(dx, dy));
     }
   };
 
@@ -304,7 +300,7 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       const int first = first_point(i);
       const float share = pbm::Luminance709(c[i].x(), c[i].y(), c[i].z()) / scratch.total[i];
       const int points = PenumbraLatticePoints(share);
-      own[i] = x == 0 || y == 0 || x == tile.width - 1 || y == tile.height - 1;
+      own[i] = OnShadowTileRing(x, y, ShadowTile{tile.x0, tile.y0, tile.width, tile.height});
       const int extra = own[i] ? points : std::max(1, points / kLightStrata);
       for (int r = 1; r < extra; ++r)
         trace_point(i, own[i] ? PenumbraLatticeIndex(first, r, points) : first + r);
