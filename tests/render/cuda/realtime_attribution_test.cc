@@ -1,17 +1,17 @@
 // where the CUDA realtime rgb path (run on the CPU: RenderRealtimeOnHost) differs from the CPU
-// backend, by feature (docs/gpu.md, "Where the realtime rgb differs"). for each bundled world
-// the first camera after 1 s is rendered by the CPU backend with every part on, with the mirror
-// layer off and with shadows off (RenderAblation), and by the GPU path; the per-feature masks
-// are the pixels that see the sky (CPU depth 0), that a mirror layer changes (mirror on vs
-// off), that lie in a shadow's penumbra (within 2 px of the boundary of the pixels shadows
-// change) and the rest; the squared rgb error is split over them (the shares sum to the
-// whole, asserted) and printed, with the PSNR each feature would leave if it matched, and the
-// PSNR the GPU path's radiance would reach with the CPU's exposure. the GPU path against the
-// CPU backend without its mirror layer (the one feature the GPU path lacks in these worlds)
-// must reach 55 dB. with
-// PENUMBRA_PARITY_DUMP=<dir> the images are written there as raw arrays
-// (scripts/gpu/parity_attribution.py turns them into difference images and a per-material
-// table); PENUMBRA_PARITY_SIZE=WxH changes the 160x120 default.
+// backend, by feature (docs/gpu.md, "Where the realtime rgb differs"). for the bundled default,
+// house, warehouse and outdoor worlds and effects/walkers.yaml (whose frames have no effects:
+// the GPU renders them; its rover's mirror materials are its whole gap), the first camera after 1 s
+// is rendered by the CPU backend with every part on, with the mirror layer off and with shadows off
+// (RenderAblation), and by the GPU path; the per-feature masks are the pixels that see the sky (CPU
+// depth 0), that a mirror layer changes (mirror on vs off), that lie in a shadow's penumbra (within
+// 2 px of the boundary of the pixels shadows change) and the rest; the squared rgb error is split
+// over them (the shares sum to the whole, asserted) and printed, with the PSNR each feature would
+// leave if it matched, and the PSNR the GPU path's radiance would reach with the CPU's exposure.
+// the GPU path against the CPU backend without its mirror layer (the one feature the GPU path lacks
+// in these worlds) must reach 55 dB. with PENUMBRA_PARITY_DUMP=<dir> the images are written there
+// as raw arrays (scripts/gpu/parity_attribution.py turns them into difference images and a
+// per-material table); PENUMBRA_PARITY_SIZE=WxH changes the 160x120 default.
 
 #include <gtest/gtest.h>
 
@@ -156,13 +156,16 @@ TEST_P(RealtimeParityAttribution, SplitsTheRgbErrorByFeature) {
   EXPECT_NEAR(PsnrOfSquaredError(total, 3.0 * n), psnr, 1e-9);
   // the mirror layer is the GPU path's one known omission in these worlds: without it the two
   // backends agree to float rounding (measured at 160x120: default 99 dB, i.e. equal; house
-  // 81.0, warehouse 61.8, outdoor 66.8; 31.7 / 47.9 / 36.4 / 40.3 before the GPU path took
-  // the CPU's shared shadow verdicts and per-quad sky blends).
+  // 81.0, warehouse 61.8, outdoor 66.8, walkers 95.7; 31.7 / 47.9 / 36.4 / 40.3 / 29.8 before
+  // the GPU path took the CPU's shared shadow verdicts and per-quad sky blends).
   EXPECT_GE(realtime_parity::Psnr(cpu_nm.rgb, gpu.rgb), 55.0);
 
   const char* dir = std::getenv("PENUMBRA_PARITY_DUMP");
   if (dir == nullptr) return;
-  const std::string base = std::string(dir) + "/" + GetParam().substr(0, GetParam().find('.'));
+  std::string name = GetParam().substr(0, GetParam().find('.'));
+  for (char& c : name)
+    if (c == '/') c = '_';
+  const std::string base = std::string(dir) + "/" + name;
   DumpRaw(base + "_cpu_rgb.u8", cpu.rgb.data);
   DumpRaw(base + "_cpu_nomirror_rgb.u8", cpu_nm.rgb.data);
   DumpRaw(base + "_cpu_noshadow_rgb.u8", cpu_ns.rgb.data);
@@ -186,7 +189,7 @@ TEST_P(RealtimeParityAttribution, SplitsTheRgbErrorByFeature) {
 
 INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeParityAttribution,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml",
-                                           "outdoor.yaml"));
+                                           "outdoor.yaml", "effects/walkers.yaml"));
 
 }  // namespace
 }  // namespace penumbra
