@@ -3,7 +3,8 @@
 # `penumbra bench render --no-adversity` of two binaries on the bundled worlds, interleaved
 # (A B A B ..., so that load drifting on a shared machine hits both alike), and prints per world
 # the frames/s of each binary (median and min-max over the rounds) and the ratio NEW/OLD
-# (median and min-max of the per-round ratios).
+# (median and min-max of the per-round ratios), then the same for the CPU time of the render
+# threads per frame (the bench's cpu-ms/frame; steadier than frames/s on a loaded machine).
 #
 #   scripts/perf-compare.sh OLD_BIN NEW_BIN [--frames N] [--rounds R] [--size 640x480|800x800]
 #                           [--worlds WORLD...]
@@ -66,15 +67,18 @@ done
 source "$(dirname "${BASH_SOURCE[0]}")/perf-common.sh"
 perf_resolve_worlds
 
-# frames/s of one bench run: the "<size> rgb+depth ...: X frames/s" line
+# "FPS CPU_MS" of one bench run: the "<size> rgb+depth ...: X frames/s, ..., Y cpu-ms/frame"
+# line (640x480 alone is timed when that is the size asked for)
 bench_fps() {
   local bin=$1 world=$2 out
-  if ! out=$(nice "$bin" bench render --world "$world" --frames "$frames" --no-adversity 2>&1); then
+  local args=(bench render --world "$world" --frames "$frames" --no-adversity)
+  [[ $size == 640x480 ]] && args+=(--only-640x480)
+  if ! out=$(nice "$bin" "${args[@]}" 2>&1); then
     echo "$0: '$bin bench render --world $world' failed:" >&2
     echo "$out" >&2
     return 1
   fi
-  awk -v size="$size" '$1 == size && /frames\/s/ { for (i = 1; i <= NF; ++i) if ($i == "frames/s,") { print $(i - 1); exit } }' <<<"$out"
+  awk -v size="$size" '$1 == size && /frames\/s/ { f = ""; c = ""; for (i = 1; i <= NF; ++i) { if ($i == "frames/s,") f = $(i - 1); if ($i == "cpu-ms/frame,") c = $(i - 1) } if (f != "" && c != "") print f, c; exit }' <<<"$out"
 }
 
 
@@ -86,22 +90,32 @@ for i in "${!world_files[@]}"; do
   olds=()
   news=()
   ratios=()
+  old_cpu=()
+  new_cpu=()
+  cpu_ratios=()
   for ((r = 1; r <= rounds; ++r)); do
-    a=$(bench_fps "$old_bin" "${world_files[$i]}")
-    b=$(bench_fps "$new_bin" "${world_files[$i]}")
-    [[ -n $a && -n $b ]] || { echo "$0: no '$size ... frames/s' line from the bench on ${worlds[$i]}" >&2; exit 1; }
+    read -r a ac <<<"$(bench_fps "$old_bin" "${world_files[$i]}")"
+    read -r b bc <<<"$(bench_fps "$new_bin" "${world_files[$i]}")"
+    [[ -n $a && -n $b && -n $ac && -n $bc ]] || { echo "$0: no '$size ... frames/s, ... cpu-ms/frame' line from the bench on ${worlds[$i]}" >&2; exit 1; }
     olds+=("$a")
     news+=("$b")
+    old_cpu+=("$ac")
+    new_cpu+=("$bc")
     ratios+=("$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.3f", (a > 0 ? b / a : 0) }')")
-    echo "  ${worlds[$i]} round $r: old $a, new $b frames/s" >&2
+    cpu_ratios+=("$(awk -v a="$ac" -v b="$bc" 'BEGIN { printf "%.3f", (a > 0 ? b / a : 0) }')")
+    echo "  ${worlds[$i]} round $r: old $a, new $b frames/s; old $ac, new $bc cpu-ms/frame" >&2
   done
   read -r om omin omax <<<"$(stats "${olds[@]}")"
   read -r nm nmin nmax <<<"$(stats "${news[@]}")"
   read -r rm rmin rmax <<<"$(stats "${ratios[@]}")"
-  rows+=("$(printf '| %s | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.3f (%.3f-%.3f) |' \
-    "${worlds[$i]}" "$om" "$omin" "$omax" "$nm" "$nmin" "$nmax" "$rm" "$rmin" "$rmax")")
+  read -r ocm ocmin ocmax <<<"$(stats "${old_cpu[@]}")"
+  read -r ncm ncmin ncmax <<<"$(stats "${new_cpu[@]}")"
+  read -r crm crmin crmax <<<"$(stats "${cpu_ratios[@]}")"
+  rows+=("$(printf '| %s | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.3f (%.3f-%.3f) | %.1f (%.1f-%.1f) | %.1f (%.1f-%.1f) | %.3f (%.3f-%.3f) |' \
+    "${worlds[$i]}" "$om" "$omin" "$omax" "$nm" "$nmin" "$nmax" "$rm" "$rmin" "$rmax" \
+    "$ocm" "$ocmin" "$ocmax" "$ncm" "$ncmin" "$ncmax" "$crm" "$crmin" "$crmax")")
 done
 echo
-echo "| world | old frames/s | new frames/s | ratio new/old |"
-echo "|---|---|---|---|"
+echo "| world | old frames/s | new frames/s | ratio new/old | old cpu-ms/frame | new cpu-ms/frame | cpu ratio new/old |"
+echo "|---|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"

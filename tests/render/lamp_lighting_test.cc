@@ -140,6 +140,80 @@ TEST(LampLightingTest, LampLightIsTheSameEveryFrame) {
   EXPECT_TRUE(a.radiance.data == b.radiance.data);
 }
 
+TEST(LampLightingTest, PenumbraBudgetFollowsTheLightsShare) {
+  // one lattice point moves the pixel's luminance by about share / points: at most 1/64.
+  int last = 0;
+  for (float share = 0; share <= 1.0f; share += 1.0f / 256) {
+    const int points = PenumbraLatticePoints(share);
+    EXPECT_LE(share / points, 1.0f / 64 + 1e-6f) << share;
+    EXPECT_GE(points, last) << share;  // never fewer for a larger share
+    last = points;
+  }
+  EXPECT_EQ(PenumbraLatticePoints(1.0f), kLightStrata * kLightPenumbraRays);
+  EXPECT_EQ(PenumbraLatticePoints(0.01f), kLightPenumbraRays);
+  EXPECT_EQ(PenumbraLatticePoints(std::nanf("")), kLightPenumbraRays);
+  // a pixel's points: distinct, its own point first, spread over the cone (every quarter of
+  // u1 = 1 - cos, i.e. of the cone's solid angle, holds points / 4 of them).
+  for (int points : {4, 16, 32, 64})
+    for (int stratum = 0; stratum < kLightStrata; ++stratum) {
+      const int first = kLightPenumbraRays * stratum;
+      std::vector<int> seen(kLightStrata * kLightPenumbraRays, 0);
+      int quarter[4] = {0, 0, 0, 0};
+      for (int r = 0; r < points; ++r) {
+        const int index = PenumbraLatticeIndex(first, r, points);
+        ASSERT_GE(index, 0);
+        ASSERT_LT(index, kLightStrata * kLightPenumbraRays);
+        if (r == 0) EXPECT_EQ(index, first);
+        EXPECT_EQ(seen[index]++, 0) << points << " " << stratum;
+        float u1, u2;
+        LightStratumUniforms(index, kLightStrata * kLightPenumbraRays, &u1, &u2);
+        ++quarter[std::min(3, static_cast<int>(u1 * 4))];
+      }
+      for (int q = 0; q < 4; ++q) EXPECT_EQ(quarter[q], points / 4) << points << " " << q;
+    }
+}
+
+TEST(LampLightingTest, FaintLampsPenumbraTakesFewerRays) {
+  // issue 37: a pixel in a lamp's penumbra traces as many lattice points as the lamp's share of
+  // its light asks for (PenumbraLatticePoints). the fixture's penumbra on the ceiling, lit by the
+  // lamp alone (A: 64 points per window, all 64 on a tile's edge pixels) and with a 20 000 cd
+  // point light 2.2 m below the ceiling beside it (B: there the lamp gives 1-10 % of a pixel's
+  // light: 4-16 points): the lamp's rays drop to less than half, its light does not change.
+  // on main the lamp traced the same rays in both (B - C = A).
+  const SceneDescription a = LampTestCeiling(true);
+  SceneDescription b = a;
+  Light bright;
+  bright.type = Light::Type::kPoint;
+  bright.position_B = {0, 0, 0.5};
+  bright.intensity = 20000;
+  b.lights.push_back(bright);
+  SceneDescription c = b;  // the bright light alone
+  c.lights.erase(c.lights.begin());
+  SceneDescription dark = a;  // no light
+  dark.lights.clear();
+  const CameraView view = MakeView(LampTestCameraLookingUp({0, 0, 1.4}), 160, 160, 90);
+  RenderedFrame fa, fb, fc, fd;
+  MakeRenderer(a, TestSettings())->Render(IdentitySnapshot(a), view, &fa);
+  MakeRenderer(b, TestSettings())->Render(IdentitySnapshot(b), view, &fb);
+  MakeRenderer(c, TestSettings())->Render(IdentitySnapshot(c), view, &fc);
+  MakeRenderer(dark, TestSettings())->Render(IdentitySnapshot(dark), view, &fd);
+  const int64_t lamp_rays_alone = fa.rays, lamp_rays_beside = fb.rays - fc.rays;
+  RecordProperty("lamp_rays_alone", std::to_string(lamp_rays_alone));
+  RecordProperty("lamp_rays_beside_bright_light", std::to_string(lamp_rays_beside));
+  EXPECT_LT(lamp_rays_beside, lamp_rays_alone / 2);
+  // the lamp's light over the penumbra patch: B - C against A - dark, green channel.
+  const LampTestNoise na = LampTestCeilingNoise(fa, view, 100, 0.35, 1.1);
+  const LampTestNoise nb = LampTestCeilingNoise(fb, view, 100, 0.35, 1.1);
+  const LampTestNoise nc = LampTestCeilingNoise(fc, view, 100, 0.35, 1.1);
+  const LampTestNoise nd = LampTestCeilingNoise(fd, view, 100, 0.35, 1.1);
+  ASSERT_GT(na.pixels, 3000);
+  const double lamp_alone = na.mean - nd.mean, lamp_beside = nb.mean - nc.mean;
+  ASSERT_GT(lamp_alone, 0);
+  EXPECT_NEAR(lamp_beside, lamp_alone, 0.02 * lamp_alone);
+  // the lamp stays below a tenth of the light there (else the test would not test the budget).
+  EXPECT_LT(lamp_beside, 0.1 * nb.mean);
+}
+
 TEST(LampLightingTest, SphereLightCosineMatchesNumericalIntegration) {
   // E d^2 / I of a uniform sphere (radiance I / (pi r^2)) against a midpoint-rule integral of
   // L cos over the part of its cone above the horizon, for angles across the horizon.

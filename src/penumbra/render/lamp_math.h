@@ -38,6 +38,14 @@ constexpr int kLightStrata = 16;
 /// visibility; the CUDA path traces all of them at every pixel).
 constexpr int kLightPenumbraRays = 4;
 
+/// a light's share of a pixel's unshadowed luminance at or above which a pixel in its penumbra
+/// traces all kLightStrata kLightPenumbraRays (64) lattice points (PenumbraLatticePoints).
+constexpr float kPenumbraShareAllPoints = 0.5f;
+/// the share at or above which it traces half of them (32).
+constexpr float kPenumbraShareHalfPoints = 0.25f;
+/// the share at or above which it traces kLightStrata (16) of them; below, kLightPenumbraRays.
+constexpr float kPenumbraShareStrata = 1.0f / 16.0f;
+
 /// the factor c with which a sphere of intensity I (cd) at distance d, subtending angular radius
 /// sigma (sin2_sigma = sin^2 sigma, in [0, 1)), lights a surface whose unit normal makes angle
 /// theta with the direction to the sphere's centre: E = (I / d^2) c, lux (Snyder 1996, see
@@ -148,6 +156,35 @@ PB_HOST_DEVICE inline void LightStratumUniforms(int index, int count, float* u1,
   *u1 = (static_cast<float>(index) + 0.5f) / static_cast<float>(count);
   const float a = static_cast<float>(index) * kInvGolden;
   *u2 = a - floorf(a);
+}
+
+/// the shadow-ray budget of a pixel in the penumbra of a light with an extent: how many points of
+/// the kLightStrata kLightPenumbraRays (64) point lattice decide the pixel's visibility of the
+/// light, given the light's share of the pixel's unshadowed luminance (share = Y(f E) / Y(L),
+/// Y the Rec. 709 luminance, L the pixel's radiance with every light unshadowed, in [0, 1]):
+/// 64 at share >= kPenumbraShareAllPoints (1/2), 32 at share >= kPenumbraShareHalfPoints (1/4),
+/// 16 at share >= kPenumbraShareStrata (1/16), else kLightPenumbraRays (4). one point of a lattice
+/// of N moves the pixel's luminance by about share / N, which so stays below about 1/64 (the step
+/// of a light that alone lights the pixel with all 64 points): a faint lamp's penumbra needs few
+/// rays. a NaN share counts as 0. the CPU's shared visibility (render/cpu/realtime_integrator.cc)
+/// traces max(1, N / 16) points per pixel of a window of 16, or N points of its own at a tile's
+/// edge; a pixel that traces all its points itself (the CUDA path) traces N.
+PB_HOST_DEVICE inline int PenumbraLatticePoints(float share) {
+  if (share >= kPenumbraShareAllPoints) return kLightStrata * kLightPenumbraRays;
+  if (share >= kPenumbraShareHalfPoints) return kLightStrata * kLightPenumbraRays / 2;
+  if (share >= kPenumbraShareStrata) return kLightStrata;
+  return kLightPenumbraRays;
+}
+
+/// the index (into the kLightStrata kLightPenumbraRays point lattice, LightStratumUniforms) of
+/// point r, 0 <= r < points, of a pixel that traces `points` (64, 16 or 4: PenumbraLatticePoints)
+/// points of its own, starting at its own point `first` = kLightPenumbraRays LightStratum(u, v):
+/// every (64 / points)-th point from `first`, so that any budget spreads over the whole cone
+/// (for 64, the points first, first + 1, ...; for 32, the even points; for 16, the points of the
+/// 16-point lattice; for 4, one per quarter of the cone's solid angle).
+PB_HOST_DEVICE inline int PenumbraLatticeIndex(int first, int r, int points) {
+  constexpr int kAll = kLightStrata * kLightPenumbraRays;
+  return (first + r * (kAll / points)) % kAll;
 }
 
 }  // namespace penumbra

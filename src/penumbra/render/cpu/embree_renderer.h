@@ -32,6 +32,9 @@ class EmbreeRenderer final : public Renderer {
  public:
   /// side of the square pixel tiles that threads work on.
   static constexpr int kTileSize = 16;
+  // the realtime tier's shared visibility keeps a tile row's pixels in one 32-bit word with two
+  // bits to spare on either side (realtime_integrator.cc).
+  static_assert(kTileSize <= 28, "tile rows must fit the shared visibility's row words");
 
   /// copies `scene` and builds its ray scene.
   /// @throws ConfigError for bad settings or sky; Error if Embree fails or the scene refers

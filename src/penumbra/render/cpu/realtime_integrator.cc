@@ -31,6 +31,7 @@ struct Scratch {
   std::vector<Eigen::Vector3f> area_c;
   std::vector<int8_t> area_vis;
   std::vector<float> mirror;  // per tile pixel: SurfaceMaterial::mirror, 0 = none
+  std::vector<float> total;   // per tile pixel: luminance of the radiance, all lights unshadowed
 };
 
 // shadow rays per pixel towards a light with an extent in a penumbra (1 elsewhere).
@@ -103,53 +104,107 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
 // edges, where fewer lattice points are averaged) that lie on the same surface as pixel i (same
 // geom, normals within 25 degrees, within 5 % of their distance from its tangent plane) and traced
 // towards j (the ratio estimator of Heitz et al. 2018 with the shadow term shared). a pixel whose
-// window holds both visible and occluded verdicts (a penumbra) traces kPenumbraRays - 1 more rays
-// through its other lattice points first, so that a window there averages 64 points, not 16;
-// a lamp's visible fraction is then averaged once more over 3x3 pixels on the same surface.
-// adds the rays traced to *traced.
+// window holds both visible and occluded verdicts (a penumbra) traces more rays through its other
+// lattice points first, as many as the light's share of its unshadowed luminance asks for
+// (PenumbraLatticePoints, render/lamp_math.h: up to kPenumbraRays - 1 more, so that a window
+// there averages up to 64 points, not 16); a lamp's visible fraction is then averaged once more
+// over 3x3 pixels on the same surface. the windows are tested as bit masks (one 32-bit word per
+// tile row, EmbreeRenderer::kTileSize <= 28), and a window or 3x3 block whose verdicts agree
+// takes that verdict without summing. adds the rays traced to *traced.
 void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary,
                              const Scratch& scratch, const FrameBuffers& out, int64_t* traced) {
   const PixelTile& tile = primary.tile;
   const int n = tile.width * tile.height;
   const int num_lights = ctx.lights->size();
   thread_local std::vector<float> visible, rays, fraction;
-  thread_local std::vector<uint8_t> own;  // 1: the pixel's own fraction, no window
+  thread_local std::vector<uint8_t> own;                  // 1: the pixel's own fraction, no window
+  thread_local std::vector<uint8_t> mixed, seen_visible;  // per pixel: its window's verdicts
   own.resize(n);
   visible.resize(n);
   rays.resize(n);
   fraction.resize(n);
+  struct {
+    Vec3Lanes p, ng;  // the pixels' hit points and geometric normals
+    Lanes u1, u2;     // their lattice points (LightStratumUniforms)
+    int pixel[kLanes];
+  } queue;
+  mixed.resize(n);
+  seen_visible.resize(n);
   bool any = false;
   for (int j = 0; j < num_lights; ++j) any = any || IsExtendedLight(ctx.lights->lights()[j]);
   if (!any) return;
+  // every pixel's column and row in the tile.
+  thread_local std::vector<uint8_t> xs, ys;
+  xs.resize(n), ys.resize(n);
+  for (int y = 0, i = 0; y < tile.height; ++y)
+    for (int x = 0; x < tile.width; ++x, ++i)
+      xs[i] = static_cast<uint8_t>(x), ys[i] = static_cast<uint8_t>(y);
   // per pixel, which pixels of the window [x - 2, x + 2] x [y - 2, y + 2], cut at the tile's
   // edges, lie on its surface (bit (dy + 2) 5 + dx + 2), once for all lights. (shifting the
   // window inside the tile instead made steps of several % at every tile edge across a lamp's
   // penumbra.)
   thread_local std::vector<uint32_t> near;
+  thread_local std::vector<float> hit_p, hit_n;  // per pixel: p_W and ng_W, xyz
+  thread_local std::vector<int> hit_geom;        // per pixel: the geom, -1 none
   bool near_done = false;
   auto compute_near = [&] {
     near_done = true;
     near.assign(n, 0u);
+    // the hits' points, normals and geoms side by side (the hits themselves are large).
+    hit_p.resize(3 * n), hit_n.resize(3 * n), hit_geom.resize(n);
+    for (int i = 0; i < n; ++i) {
+      const SurfaceHit& h = primary.hits[i];
+      hit_geom[i] = primary.did_hit[i] ? h.geom : -1;
+      for (int a = 0; a < 3; ++a) hit_p[3 * i + a] = h.p_W[a], hit_n[3 * i + a] = h.ng_W[a];
+    }
     for (int i = 0; i < n; ++i) {
       if (!primary.did_hit[i]) continue;
-      const SurfaceHit& h = primary.hits[i];
-      const int x = i % tile.width, y = i / tile.width;
-      uint32_t bits = 0;
+      const int geom = hit_geom[i];
+      const float* p = &hit_p[3 * i];
+      const float* nn = &hit_n[3 * i];
+      const int x = xs[i], y = ys[i];
+      uint32_t bits = 1u << ShadowWindowBit(0, 0);
       for (int dy = -2; dy <= 2; ++dy) {
         if (y + dy < 0 || y + dy >= tile.height) continue;
         for (int dx = -2; dx <= 2; ++dx) {
           if (x + dx < 0 || x + dx >= tile.width) continue;
           const int ii = i + dy * tile.width + dx;
-          if (ii != i) {
-            const SurfaceHit& g = primary.hits[ii];
-            if (!primary.did_hit[ii] || !SameShadowSurface(h.geom, h.ng_W.data(), h.p_W.data(),
-                                                           g.geom, g.ng_W.data(), g.p_W.data()))
-              continue;
-          }
+          if (ii == i || hit_geom[ii] != geom ||
+              !SameShadowSurface(geom, nn, p, hit_geom[ii], &hit_n[3 * ii], &hit_p[3 * ii]))
+            continue;
           bits |= 1u << ShadowWindowBit(dx, dy);
         }
       }
       near[i] = bits;
+    }
+  };
+  // the bits of pixel (x, y)'s window (as near[i]) that are set in `rows` (bit x of rows[y]:
+  // pixel (x, y)).
+  auto window_bits = [&](const uint32_t* rows, int x, int y) {
+    uint32_t w = 0;
+    for (int dy = -2; dy <= 2; ++dy) {
+      const int yy = y + dy;
+      if (yy < 0 || yy >= tile.height) continue;
+      w |= (((rows[yy] << 2) >> x) & 31u) << ((dy + 2) * 5);
+    }
+    return w;
+  };
+  // per tile row, bit x: pixels with an occluded verdict, a visible one, more than one ray.
+  thread_local std::vector<uint32_t> rows_occluded, rows_visible, rows_more;
+  rows_occluded.resize(tile.height), rows_visible.resize(tile.height),
+      rows_more.resize(tile.height);
+  // per tile row, bit x: pixels with a fraction, with fraction 1, with fraction 0.
+  thread_local std::vector<uint32_t> rows_has, rows_lit, rows_dark;
+  rows_has.resize(tile.height), rows_lit.resize(tile.height), rows_dark.resize(tile.height);
+  auto fill_rows = [&](const int8_t* vis) {
+    for (int y = 0; y < tile.height; ++y) {
+      uint32_t o = 0, v = 0;
+      for (int x = 0; x < tile.width; ++x) {
+        const int8_t b = vis[y * tile.width + x];
+        o |= static_cast<uint32_t>(b == 0) << x;
+        v |= static_cast<uint32_t>(b == 1) << x;
+      }
+      rows_occluded[y] = o, rows_visible[y] = v, rows_more[y] = 0;
     }
   };
   // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
@@ -162,67 +217,116 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       fn(ii, ShadowWindowWeight(dx, dy));
     }
   };
-  auto same_surface = [&](int i, int ii) {
-    const int dy = ii / tile.width - i / tile.width, dx = ii % tile.width - i % tile.width;
-    return (near[i] >> ShadowWindowBit(dx, dy) & 1u) != 0;
-  };
+
   for (int j = 0; j < num_lights; ++j) {
     if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
     const int8_t* vis = &scratch.area_vis[static_cast<size_t>(j) * n];
     const Eigen::Vector3f* c = &scratch.area_c[static_cast<size_t>(j) * n];
-    // a tile whose verdicts towards j all agree (most of them): every window's fraction is
-    // that verdict, exactly.
+    // the shadow rays through further lattice points, kLanes at a time: their directions as
+    // lanes (LightSampler::SampleLanes) and one Embree packet (a pixel's rays share their origin
+    // and go to one light: coherent). point(i, index) queues pixel i's ray through point `index`
+    // of the 64-point lattice (the pixel's own point r of `points`, PenumbraLatticeIndex, or its
+    // point first + r inside a window); flush() traces the queue and adds to rays[] and
+    // visible[] the rays whose point lies above the geometric surface and their verdicts.
+    int queued = 0;
+    auto flush = [&] {
+      if (queued == 0) return;
+      for (int k = queued; k < kLanes; ++k) {  // idle lanes repeat the first
+        queue.p.Set(k, queue.p.Lane(0)), queue.ng.Set(k, queue.ng.Lane(0));
+        queue.u1[k] = queue.u1[0], queue.u2[k] = queue.u2[0];
+      }
+      LightSampleLanes ls;
+      ctx.lights->SampleLanes(j, queue.p, queue.u1, queue.u2, &ls);
+      const LaneMask active =
+          LaneMask((1u << queued) - 1u) && ls.valid && GreaterThan(queue.ng.Dot(ls.wi), 0.0f);
+      Vec3Lanes o;
+      for (int k = 0; k < kLanes; ++k) o.Set(k, OffsetRayOrigin(queue.p.Lane(k), queue.ng.Lane(k)));
+      const Lanes tmax = ls.distance * (1.0f - 1e-4f);  // +inf stays +inf
+      LaneMask occluded;
+      if (active.any()) ctx.scene->OccludedLanes(o, ls.wi, tmax, active, &occluded);
+      *traced += active.count();
+      for (int k = 0; k < queued; ++k) {
+        if (!active[k]) continue;
+        rays[queue.pixel[k]] += 1;
+        if (!occluded[k]) visible[queue.pixel[k]] += 1;
+      }
+      queued = 0;
+    };
+    auto trace_point = [&](int i, int index) {
+      LightStratumUniforms(index, kLightStrata * kPenumbraRays, &queue.u1[queued],
+                           &queue.u2[queued]);
+      queue.p.Set(queued, primary.hits[i].p_W);
+      queue.ng.Set(queued, primary.hits[i].ng_W);
+      queue.pixel[queued] = i;
+      if (++queued == kLanes) flush();
+    };
+    auto first_point = [&](int i) {
+      return kPenumbraRays * LightStratum(tile.x0 + xs[i], tile.y0 + ys[i]);
+    };
     bool seen_in_tile[2] = {false, false};
     for (int i = 0; i < n; ++i)
       if (vis[i] >= 0) seen_in_tile[vis[i]] = true;
     if (!(seen_in_tile[0] && seen_in_tile[1])) {
+      // every verdict towards j in the tile agrees (most tiles): every window's fraction is that
+      // verdict, exactly.
       if (!seen_in_tile[1]) continue;
       for (int i = 0; i < n; ++i) {
         if (vis[i] < 0) continue;
-        float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+        float* Lp = out.radiance->at(tile.x0 + xs[i], tile.y0 + ys[i]);
         Lp[0] += c[i].x(), Lp[1] += c[i].y(), Lp[2] += c[i].z();
       }
       continue;
     }
     if (!near_done) compute_near();
+    fill_rows(vis);
     for (int i = 0; i < n; ++i) {
       if (vis[i] < 0) continue;
       visible[i] = static_cast<float>(vis[i]);
       rays[i] = 1;
-      bool seen[2] = {false, false};
-      for_window(vis, i, [&](int ii, float) { seen[vis[ii]] = true; });
+      const uint32_t wo = near[i] & window_bits(rows_occluded.data(), xs[i], ys[i]);
+      const uint32_t wv = near[i] & window_bits(rows_visible.data(), xs[i], ys[i]);
+      seen_visible[i] = wv != 0;
       own[i] = 0;
-      if (!(seen[0] && seen[1])) continue;
-      // a penumbra: the pixel's other lattice points; on the tile's outermost pixels, whose
-      // window lacks the next tile's half, every point of the 64-point lattice instead, and the
-      // pixel keeps its own fraction (a window cut there leans inwards: steps at tile edges; 16
-      // points of its own left lines of 1/16 steps along the tile edges).
-      const SurfaceHit& h = primary.hits[i];
-      const int x = i % tile.width, y = i / tile.width;
-      const int u = tile.x0 + x, v = tile.y0 + y;
-      const int s = LightStratum(u, v);
+      mixed[i] = wo != 0 && wv != 0;
+      if (!mixed[i]) continue;
+      // a penumbra: the pixel's other lattice points, as many as the light's share of the
+      // pixel's unshadowed luminance asks for (PenumbraLatticePoints: 64 points for a light
+      // that dominates the pixel, fewer for a faint one, whose visibility moves the pixel
+      // little): max(1, points / 16) per pixel of a window of 16. on the tile's outermost
+      // pixels, whose window lacks the next tile's half, `points` points of their own instead,
+      // and the pixel keeps its own fraction (a window cut there leans inwards: steps at tile
+      // edges).
+      const int x = xs[i], y = ys[i];
+      const int first = first_point(i);
+      const float share = pbm::Luminance709(c[i].x(), c[i].y(), c[i].z()) / scratch.total[i];
+      const int points = PenumbraLatticePoints(share);
       own[i] = OnShadowTileRing(x, y, ShadowTile{tile.x0, tile.y0, tile.width, tile.height});
-      const int extra = own[i] ? kLightStrata * kPenumbraRays : kPenumbraRays;
-      Ray sr;
-      sr.o = OffsetRayOrigin(h.p_W, h.ng_W);
-      for (int r = 1; r < extra; ++r) {
-        // own: every other point of the 64-point lattice.
-        const int index = (kPenumbraRays * s + r) % (kLightStrata * kPenumbraRays);
-        float u1, u2;
-        LightStratumUniforms(index, kLightStrata * kPenumbraRays, &u1, &u2);
-        LightSample ls;
-        if (!ctx.lights->Sample(j, h.p_W, u1, u2, &ls) || !(ls.wi.dot(h.ng_W) > 0)) continue;
-        sr.d = ls.wi;
-        sr.tmax = ls.distance * (1.0f - 1e-4f);  // +inf stays +inf
-        ++*traced;
-        rays[i] += 1;
-        if (!ctx.scene->Occluded(sr)) visible[i] += 1;
-      }
+      const int extra = own[i] ? points : std::max(1, points / kLightStrata);
+      for (int r = 1; r < extra; ++r)
+        trace_point(i, own[i] ? PenumbraLatticeIndex(first, r, points) : first + r);
+      if (extra > 1) rows_more[y] |= 1u << x;
     }
+    flush();
+    std::fill(rows_has.begin(), rows_has.end(), 0u);
+    std::fill(rows_lit.begin(), rows_lit.end(), 0u);
+    std::fill(rows_dark.begin(), rows_dark.end(), 0u);
+    auto note_fraction = [&](int i) {
+      const uint32_t bit = 1u << xs[i];
+      rows_has[ys[i]] |= bit;
+      if (fraction[i] == 1.0f) rows_lit[ys[i]] |= bit;
+      if (fraction[i] == 0.0f) rows_dark[ys[i]] |= bit;
+    };
     for (int i = 0; i < n; ++i) {
       if (vis[i] < 0) continue;
       if (own[i]) {
         fraction[i] = visible[i] / rays[i];
+        note_fraction(i);
+        continue;
+      }
+      // a window of agreeing verdicts of one ray each: that verdict, exactly.
+      if (!mixed[i] && (near[i] & window_bits(rows_more.data(), xs[i], ys[i])) == 0) {
+        fraction[i] = seen_visible[i] ? 1.0f : 0.0f;
+        note_fraction(i);
         continue;
       }
       float w_rays = 0, w_visible = 0;
@@ -231,29 +335,40 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
         w_visible += w * visible[ii];
       });
       fraction[i] = w_visible / w_rays;
+      note_fraction(i);
     }
     // a lamp's penumbrae (tens of pixels wide next to its fixture) once more over the 3x3
     // pixels on the same surface: the 5x5 windows' 16 lattice points leave 4-pixel steps
     // along them. the sun's (a pixel or two wide) stay as they are.
     const bool smooth = ctx.lights->lights()[j].type != Light::Type::kDirectional;
+    // the 3x3 pixels around a window's centre (bits as near[i]).
+    constexpr uint32_t kInner3x3 = (7u << 6) | (7u << 11) | (7u << 16);
     for (int i = 0; i < n; ++i) {
       if (vis[i] < 0) continue;
       float V = fraction[i];
+      const int x = xs[i], y = ys[i];
       if (smooth && !own[i]) {
-        const int x = i % tile.width, y = i / tile.width;
-        float sum = 0;
-        int count = 0;
-        for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, tile.height - 1); ++yy)
-          for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, tile.width - 1); ++xx) {
-            const int ii = yy * tile.width + xx;
-            if (vis[ii] < 0 || !same_surface(i, ii)) continue;
-            sum += fraction[ii];
-            ++count;
-          }
-        V = sum / static_cast<float>(count);
+        // the same-surface pixels of the 3x3 all fully visible or all occluded (most): V is that.
+        const uint32_t nb = near[i] & kInner3x3 & window_bits(rows_has.data(), x, y);
+        if ((nb & ~window_bits(rows_lit.data(), x, y)) == 0) {
+          V = 1.0f;
+        } else if ((nb & ~window_bits(rows_dark.data(), x, y)) == 0) {
+          V = 0.0f;
+        } else {
+          float sum = 0;
+          int count = 0;
+          for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, tile.height - 1); ++yy)
+            for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, tile.width - 1); ++xx) {
+              const int ii = yy * tile.width + xx;
+              if (vis[ii] < 0 || (near[i] >> ((yy - y + 2) * 5 + xx - x + 2) & 1u) == 0) continue;
+              sum += fraction[ii];
+              ++count;
+            }
+          V = sum / static_cast<float>(count);
+        }
       }
       if (!(V > 0)) continue;
-      float* Lp = out.radiance->at(tile.x0 + i % tile.width, tile.y0 + i / tile.width);
+      float* Lp = out.radiance->at(tile.x0 + x, tile.y0 + y);
       Lp[0] += V * c[i].x(), Lp[1] += V * c[i].y(), Lp[2] += V * c[i].z();
     }
   }
@@ -423,6 +538,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   scratch.area_vis.assign(static_cast<size_t>(num_lights) * n, -1);
   TileSkyIrradiance(ctx, primary, &scratch);
   scratch.mirror.assign(n, 0.0f);
+  scratch.total.resize(n);
   bool any_mirror = false;
   static const RenderAblation kAllOn;
   const RenderAblation& ablation = ctx.ablation != nullptr ? *ctx.ablation : kAllOn;
@@ -562,6 +678,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       }
       total += LuminanceLanes(c);
     }
+    for (int k = 0; k < m; ++k) scratch.total[i0 + k] = total[k];
     // lights in order: negligible or shadowless contributions are added as they are, the
     // others after one packet of shadow rays.
     for (int j = 0; j < num_lights; ++j) {
@@ -576,6 +693,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       L = L + Where(unshadowed, c);
       if (!shadowed.any()) continue;
       const LightSampleLanes& s = scratch.samples[j];
+      const bool extended = IsExtendedLight(ctx.lights->lights()[j]);
       const Lanes tmax = s.distance * (1.0f - 1e-4f);  // +inf stays +inf
       // the sun's rays that a static box provably blocks are occluded without tracing them.
       const LaneMask skipped = ctx.sun_occluders != nullptr && j == ctx.sun_occluders->light_index()
@@ -585,7 +703,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
       LaneMask occluded;
       if (to_trace.any()) ctx.scene->OccludedLanes(origin, s.wi, tmax, to_trace, &occluded);
       traced += to_trace.count();
-      if (IsExtendedLight(ctx.lights->lights()[j])) {
+      if (extended) {
         // the verdict waits for its neighbours' (ResolveSharedVisibility); a lane the sun-occluder
         // map skipped is occluded (the map's verdict is exact for that ray).
         const size_t base = static_cast<size_t>(j) * n + static_cast<size_t>(i0);

@@ -20,11 +20,13 @@
 // direction to its centre (tilted above the horizon where it straddles it), and V_i the
 // fraction of visible shadow rays over the 5x5 pixels around the pixel on the same surface,
 // each pixel's ray going through its own point of a 16-point Fibonacci lattice over the
-// light's cone (a 4x4 ordered-dither assignment, LightStratum), and 4 points (64 in a window)
-// for pixels whose window sees both lit and shadowed verdicts (a penumbra); a tile's outermost
-// penumbra pixels, whose window the tile edge cuts, trace all 64 points themselves, and a
-// lamp's fraction is averaged once more over 3x3 pixels. before (issue 36):
-// one random point per pixel and frame: salt-and-pepper speckle wherever a lamp is partly
+// light's cone (a 4x4 ordered-dither assignment, LightStratum), and for pixels whose window sees
+// both lit and shadowed verdicts (a penumbra) up to 4 points (64 in a window), as many as the
+// light's share of the pixel's unshadowed luminance asks for (PenumbraLatticePoints: a faint
+// lamp's penumbra needs few); a tile's outermost penumbra pixels, whose window the tile edge
+// cuts, trace that many of the 64 points themselves (64, 32, 16 or 4), and a lamp's fraction is
+// averaged once more over 3x3 pixels. the further points' rays go as 16-wide packets. before (issue
+// 36): one random point per pixel and frame: salt-and-pepper speckle wherever a lamp is partly
 // hidden or near the horizon, and different speckle every frame.
 //
 // shadow rays are skipped for lights that contribute less than kNegligibleLight of the

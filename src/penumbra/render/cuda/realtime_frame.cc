@@ -267,12 +267,14 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   // the shared visibility's buffers (RealtimeFrameView), per pixel and per light and pixel.
   const size_t nl = static_cast<size_t>(n) * static_cast<size_t>(f.num_lights);
   std::vector<uint32_t> window(n);
+  std::vector<float> total(n);
   std::vector<Float3> area_c(nl);
   std::vector<int8_t> area_vis(nl);
   std::vector<float> area_visible(nl), area_rays(nl), area_fraction(nl);
   std::vector<uint8_t> area_own(nl);
   f.geometry = geometry.data();
   f.window = window.data();
+  f.total = total.data();
   f.area_c = area_c.data();
   f.area_vis = area_vis.data();
   f.area_visible = area_visible.data();

@@ -144,7 +144,7 @@ struct DeviceRealtime::Impl {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
   Buffer geometry, depth, sky, radiance, rows, rgb, hits;
   // the shared visibility's buffers (RealtimeFrameView)
-  Buffer window, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
+  Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   std::vector<PixelGeometry> host_geometry;
@@ -250,6 +250,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
   const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
   m.window.Reserve(sizeof(uint32_t) * n);
+  m.total.Reserve(sizeof(float) * n);
   m.area_c.Reserve(sizeof(Float3) * nl);
   m.area_vis.Reserve(sizeof(int8_t) * nl);
   m.area_visible.Reserve(sizeof(float) * nl);
@@ -268,6 +269,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.sky_term = m.sky.as<Float3>();
   f.geometry = m.geometry.as<PixelGeometry>();
   f.window = m.window.as<uint32_t>();
+  f.total = m.total.as<float>();
   f.area_c = m.area_c.as<Float3>();
   f.area_vis = m.area_vis.as<int8_t>();
   f.area_visible = m.area_visible.as<float>();

@@ -110,13 +110,16 @@ struct RealtimeFrameView {
   const Float3* sky_term = nullptr;
   /// the shared visibility of lights with an extent (render/shadow_window_math.h), per pixel i
   /// of the n = width x height image: its primary geometry (PrimaryGeometry) and its 5x5
-  /// window's same-surface mask (SharedVisibilityRays); per light j and pixel i at [j n + i]:
+  /// window's same-surface mask (SharedVisibilityRays), the luminance of its radiance with
+  /// every light unshadowed (ShadeRealtimePixel; decides the penumbra ray budget,
+  /// PenumbraLatticePoints); per light j and pixel i at [j n + i]:
   /// the unshadowed contribution and the pixel's own shadow ray's verdict (1 visible,
   /// 0 occluded, -1 none traced; ShadeRealtimePixel), the visible and traced rays after the
   /// penumbra rays, whether the pixel keeps its own fraction (a tile's outer ring), and the
   /// window's fraction (SharedVisibilityFraction). device or host arrays the caller owns.
   const PixelGeometry* geometry = nullptr;
   uint32_t* window = nullptr;
+  float* total = nullptr;
   Float3* area_c = nullptr;
   int8_t* area_vis = nullptr;
   float* area_visible = nullptr;
@@ -471,6 +474,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
     if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
+  f.total[pixel] = total;
   // lights in order: negligible or shadowless contributions are added as they are, the others
   // after a shadow ray; those of lights with an extent wait for their neighbours' verdicts.
   for (int j = 0; j < f.num_lights; ++j) {
@@ -516,10 +520,12 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
 /// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
 /// v)'s window mask (f.window: the pixels of its 5x5 window, cut at its tile's edges, on its
 /// surface, ShadowWindowBit) and, per light with an extent whose verdicts in the window
-/// disagree (a penumbra), kLightPenumbraRays - 1 more shadow rays through the pixel's other
-/// lattice points, or every other point of the kLightStrata kLightPenumbraRays lattice on a
-/// tile's outer ring (f.area_own: that pixel keeps its own fraction); f.area_visible,
-/// f.area_rays: the pixel's visible and traced rays.
+/// disagree (a penumbra), more shadow rays through points of the kLightStrata
+/// kLightPenumbraRays lattice, as many as the light's share of the pixel's unshadowed luminance
+/// asks for (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility):
+/// points - 1 more of the pixel's own points (PenumbraLatticeIndex) on a tile's outer ring
+/// (f.area_own: that pixel keeps its own fraction), else max(1, points / kLightStrata) - 1 more
+/// after its first; f.area_visible, f.area_rays: the pixel's visible and traced rays.
 PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
   const int W = f.camera.width, H = f.camera.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -564,7 +570,10 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
       const bool own = OnShadowTileRing(x, y, tile);
       f.area_own[k] = own ? 1 : 0;
       constexpr int kAll = kLightStrata * kLightPenumbraRays;
-      const int extra = own ? kAll : kLightPenumbraRays;
+      const Float3 c = f.area_c[k];
+      const int points = PenumbraLatticePoints(pbm::Luminance709(c.x, c.y, c.z) / f.total[i]);
+      const int shared = points / kLightStrata > 1 ? points / kLightStrata : 1;
+      const int extra = own ? points : shared;
       const int first = kLightPenumbraRays * LightStratum(u, v);
       const Float3 p = gi.p_or_d, ng = gi.ng;
       const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
@@ -576,7 +585,8 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
         float u1, u2, d_r;
         Float3 w_r, E_r;
         bool ok;
-        LightStratumUniforms((first + r) % kAll, kAll, &u1, &u2);
+        LightStratumUniforms(own ? PenumbraLatticeIndex(first, r, points) : first + r, kAll, &u1,
+                             &u2);
         SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
         if (!ok || !(pbm::Dot<float>(w_r, ng) > 0)) continue;
         sr.d = ToF3(w_r);
