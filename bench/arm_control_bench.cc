@@ -13,11 +13,11 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
-#include <yaml-cpp/yaml.h>
 
 #include <string>
 
 #include "controller_cost_harness.h"
+#include "penumbra/config/yaml_document.h"
 
 namespace penumbra {
 namespace {
@@ -55,7 +55,7 @@ void BM_ArmControllerCost(benchmark::State& state, const std::string& type,
   bench::MeasureControllerCost(state,
                                {.steps = 3000,
                                 .load = [&] { return Simulation::LoadFromFile(xml); },
-                                .controller = {type, YAML::Load(std::string(kServo) + block), 0}});
+                                .controller = {type, ParseYaml(std::string(kServo) + block), 0}});
 }
 
 BENCHMARK_CAPTURE(BM_ArmControllerCost, diff_ik, std::string("diff_ik"), std::string(kDiffIk))

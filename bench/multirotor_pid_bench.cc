@@ -11,12 +11,12 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
-#include <yaml-cpp/yaml.h>
 
 #include <optional>
 #include <string>
 
 #include "controller_cost_harness.h"
+#include "penumbra/config/yaml_document.h"
 
 namespace penumbra {
 namespace {
@@ -29,12 +29,12 @@ void BM_MultirotorPidCost(benchmark::State& state) {
       "<include file=\"quadrotor.xml\"/></mujoco>";
   const ControllerConfig cfg{
       "multirotor_pid",
-      YAML::Load("base_body: base\n"
-                 "rotor_actuators: [thrust_fr, thrust_rl, thrust_fl, thrust_rr]\n"
-                 "commands:\n"
-                 "  - {t: 0, mode: takeoff, altitude_m: 1.5}\n"
-                 "  - {t: 3, mode: waypoints, speed_m_s: 1.0,\n"
-                 "     waypoints: [[4, 0, 1.5], [4, 4, 1.5], [0, 4, 1.5], [0, 0, 1.5]]}\n"),
+      ParseYaml("base_body: base\n"
+                "rotor_actuators: [thrust_fr, thrust_rl, thrust_fl, thrust_rr]\n"
+                "commands:\n"
+                "  - {t: 0, mode: takeoff, altitude_m: 1.5}\n"
+                "  - {t: 3, mode: waypoints, speed_m_s: 1.0,\n"
+                "     waypoints: [[4, 0, 1.5], [4, 4, 1.5], [0, 4, 1.5], [0, 0, 1.5]]}\n"),
       0};
   bench::MeasureControllerCost(
       state, {.steps = kSteps,

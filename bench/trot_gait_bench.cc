@@ -13,12 +13,12 @@
 // executable's folder (e.g. build/../worlds/models).
 
 #include <benchmark/benchmark.h>
-#include <yaml-cpp/yaml.h>
 
 #include <optional>
 #include <string>
 
 #include "controller_cost_harness.h"
+#include "penumbra/config/yaml_document.h"
 
 namespace penumbra {
 namespace {
@@ -42,7 +42,7 @@ void BM_TrotGaitCost(benchmark::State& state, const std::string& robot, double s
   constexpr int kSteps = 2000;
   const std::string dir = bench::ModelsDir("quadruped.xml");
   const std::string xml = SceneXml(robot);
-  const ControllerConfig cfg{"trot_gait", YAML::Load(GaitYaml(speed, extra)), 0};
+  const ControllerConfig cfg{"trot_gait", ParseYaml(GaitYaml(speed, extra)), 0};
   bench::MeasureControllerCost(
       state, {.steps = kSteps,
               .load = [&] { return Simulation::LoadFromString(xml, std::nullopt, dir); },

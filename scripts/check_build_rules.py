@@ -3,8 +3,14 @@
 scripts/check_module_deps.py. The rules and their allow-lists live in scripts/build_rules.json:
 
   yaml-cpp        `#include <yaml-cpp/...>` only in src/penumbra/config/*.cc, or in a file of the
-                  allow-list "yaml_cpp_files" (today's includers; the list may only shrink: an
-                  entry whose file no longer includes yaml-cpp is an error too, remove it)
+                  allow-list "yaml_cpp_files" (the list may only shrink: an entry whose file no
+                  longer includes yaml-cpp is an error too, remove it); the C++ of tests/, bench/,
+                  fuzz/, tools/ and python/ is held to it too (a test parses YAML through
+                  config/yaml_document.h)
+  whole-file      no hand-written whole-file read in src/ (`<< in.rdbuf()`,
+                  `std::istreambuf_iterator`): read a file whole through core/input_file.h
+                  (ReadInputFile: size checked before allocation, errors naming the file), or list
+                  the file in the allow-list "whole_file_reads" (it may only shrink)
   json-header     no `#include <nlohmann/json.hpp>` (or json_fwd.hpp) in a header of src/, except
                   the allow-list "json_headers" (same rule: it may only shrink)
   module-deps     at most "max_module_deps" modules on a line of src/penumbra/DEPENDENCIES;
@@ -34,6 +40,9 @@ sys.path.insert(0, HERE)
 import check_module_deps  # noqa: E402
 
 YAML_RE = re.compile(r'^\s*#\s*include\s*[<"]yaml-cpp/')
+WHOLE_FILE_RE = re.compile(r'^.*?((<<\s*\w+(\.|->)rdbuf\(\))|istreambuf_iterator)')
+# folders beside src/penumbra whose C++ the yaml-cpp rule covers too (relative to the root)
+OTHER_CODE = ("tests", "bench", "fuzz", "tools", "python")
 JSON_RE = re.compile(r'^\s*#\s*include\s*[<"]nlohmann/json(_fwd)?\.hpp[>"]')
 HEADER_EXTS = (".h", ".hpp", ".hh")
 SOURCE_EXTS = (".h", ".hpp", ".hh", ".cc", ".cpp", ".cu", ".cuh")
@@ -66,7 +75,8 @@ def first_match(path, regex):
     return 0
 
 
-def check_includes(src, files, regex, allowed, allowed_key, is_subject, what, expected):
+def check_includes(src, files, regex, allowed, allowed_key, is_subject, what, expected,
+                   verb="includes"):
     errors = []
     found = set()
     for rel in files:
@@ -77,10 +87,26 @@ def check_includes(src, files, regex, allowed, allowed_key, is_subject, what, ex
             continue
         found.add(rel)
         if rel not in allowed:
-            errors.append(f"src/penumbra/{rel}:{n}: includes {what}; expected {expected}")
+            errors.append(f"src/penumbra/{rel}:{n}: {verb} {what}; expected {expected}")
     for rel in sorted(set(allowed) - found):
         errors.append(f"scripts/build_rules.json: {allowed_key} lists {rel}, which no longer "
-                      f"includes {what}; remove it from the list (it may only shrink)")
+                      f"{verb} {what}; remove it from the list (it may only shrink)")
+    return errors
+
+
+def check_other_code(root):
+    """yaml-cpp includes in the C++ outside src/penumbra (tests, benchmarks, fuzz targets, ...)."""
+    errors = []
+    for folder in OTHER_CODE:
+        base = os.path.join(root, folder)
+        if not os.path.isdir(base):
+            continue
+        for rel in source_files(base):
+            n = first_match(os.path.join(base, rel), YAML_RE)
+            if n:
+                errors.append(f"{folder}/{rel}:{n}: includes yaml-cpp; expected yaml-cpp only in "
+                              "src/penumbra/config/*.cc (parse YAML with "
+                              "penumbra/config/yaml_document.h)")
     return errors
 
 
@@ -92,6 +118,12 @@ def check_sources(root, rules):
         src, files, YAML_RE, rules.get("yaml_cpp_files", []), "yaml_cpp_files",
         lambda rel: not (rel.startswith("config/") and rel.endswith(".cc")), "yaml-cpp",
         "yaml-cpp only in src/penumbra/config/*.cc (read parameters through config/)")
+    errors += check_other_code(root)
+    errors += check_includes(
+        src, files, WHOLE_FILE_RE, rules.get("whole_file_reads", []), "whole_file_reads",
+        lambda rel: rel != "core/input_file.cc", "a file whole by hand",
+        "files read whole through core/input_file.h (ReadInputFile: size checked before "
+        "allocation, errors naming the file)", verb="reads")
     errors += check_includes(
         src, files, JSON_RE, rules.get("json_headers", []), "json_headers",
         lambda rel: rel.endswith(HEADER_EXTS), "nlohmann/json.hpp",

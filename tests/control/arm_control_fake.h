@@ -3,10 +3,9 @@
 // actuator on a tendon, prefixed "a/") and a fake ControlInput over it, for unit tests of
 // the joint servo and the arm controllers without MuJoCo.
 
-#include <yaml-cpp/yaml.h>
-
 #include <vector>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/control_input.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/model_info.h"
@@ -101,7 +100,7 @@ inline ControllerConfig Block(const std::string& type, const std::string& body) 
   ControllerConfig cfg;
   cfg.type = type;
   cfg.line = 30;
-  cfg.params = YAML::Load("type: " + type + "\n" + body);
+  cfg.params = ParseYaml("type: " + type + "\n" + body);
   return cfg;
 }
 

@@ -4,11 +4,11 @@
 #include "penumbra/control/command_script.h"
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <atomic>
 #include <thread>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -23,7 +23,7 @@ ControllerContext Context() { return {"world.yaml", 12, "robots[arm].controller"
 
 // a command of the test: {t, id, value}
 std::vector<TimedCommand<Cmd>> Parse(const std::string& yaml) {
-  ControllerParams p(YAML::Load(yaml), Context());
+  ControllerParams p(ParseYaml(yaml), Context());
   auto script = ParseCommandScript<Cmd>(p, "commands", [](ParamNode& n) {
     Cmd c;
     c.id = static_cast<int>(n.Number("id", std::nullopt, 0, 100));
@@ -62,7 +62,7 @@ TEST(CommandScript, ParsesTimedItemsInOrder) {
 }
 
 TEST(CommandScript, AbsentScriptIsEmpty) {
-  ControllerParams p(YAML::Load("{}"), Context());
+  ControllerParams p(ParseYaml("{}"), Context());
   EXPECT_TRUE(ParseCommandScript<Cmd>(p, "commands", [](ParamNode&) { return Cmd{}; }).empty());
 }
 

@@ -4,10 +4,10 @@
 #include "penumbra/control/controller_factory.h"
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
@@ -31,7 +31,7 @@ tolerance_m: 0.15
 ControllerConfig Config(const std::string& yaml, const std::string& type = "waypoint_follower") {
   ControllerConfig c;
   c.type = type;
-  c.params = YAML::Load(yaml);
+  c.params = ParseYaml(yaml);
   c.line = 21;
   return c;
 }

@@ -5,12 +5,12 @@
 #include "penumbra/control/policy_controller.h"
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "control/policy_fake.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/policy_preset.h"
 #include "penumbra/core/error.h"
 
@@ -139,9 +139,9 @@ TEST(PolicyControllerTest, RefusesAGarbageFileNamingIt) {
   }
   ControllerConfig cfg;
   cfg.type = "policy";
-  cfg.params = YAML::Load("type: policy\n" + std::string(kReversedJoints) + "model: " + path +
-                          "\nobservations: [{term: velocity_command}, {term: joint_pos}]\n"
-                          "action: {kp: 20, kd: 0.5}\n");
+  cfg.params = ParseYaml("type: policy\n" + std::string(kReversedJoints) + "model: " + path +
+                         "\nobservations: [{term: velocity_command}, {term: joint_pos}]\n"
+                         "action: {kp: 20, kd: 0.5}\n");
   auto c = MakeController(cfg, "q", "/elsewhere/world.yaml");
   const ModelInfo m = QuadModel();
   const std::string e = ErrorOf([&] { c->Initialize(m); });

@@ -7,12 +7,11 @@
 // joints: motors with gear 1 (gear 2 on j5), ctrlrange +-100; sensors q/touch0 .. q/touch3
 // (1 value each, sensordata 0..3) and q/gyro (3 values, sensordata 4..6).
 
-#include <yaml-cpp/yaml.h>
-
 #include <Eigen/Geometry>
 #include <string>
 #include <vector>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/control_input.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/model_info.h"
@@ -93,7 +92,7 @@ inline std::unique_ptr<Controller> MakePolicy(const std::string& body) {
   ControllerConfig cfg;
   cfg.type = "policy";
   cfg.line = 7;
-  cfg.params = YAML::Load("type: policy\n" + body);
+  cfg.params = ParseYaml("type: policy\n" + body);
   return MakeController(cfg, "q", PENUMBRA_SOURCE_DIR "/tests/control/fixtures/world.yaml");
 }
 

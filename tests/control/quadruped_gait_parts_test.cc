@@ -2,10 +2,10 @@
 // distribution, swing trajectory and the parameter parser's errors.
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/quadruped_leg_kinematics.h"
 #include "penumbra/control/quadruped_stance_forces.h"
@@ -170,7 +170,7 @@ std::string Legs() {
 }
 
 std::string Error(const std::string& yaml) {
-  ControllerConfig cfg{"trot_gait", YAML::Load(yaml), 12};
+  ControllerConfig cfg{"trot_gait", ParseYaml(yaml), 12};
   try {
     MakeController(cfg, "dog", "world.yaml");
   } catch (const ConfigError& e) {
@@ -181,9 +181,9 @@ std::string Error(const std::string& yaml) {
 
 TEST(TrotGaitParams, ParsesPrefixedNamesCommandsAndHold) {
   ControllerConfig cfg{"trot_gait",
-                       YAML::Load("base_body: trunk\n" + Legs() +
-                                  "commands: [{t: 0}, {t: 1.5, vx: 0.5, yaw_rate: -0.2}]\n"
-                                  "period_sec: 0.4\nduty: 0.6\nhold: {arm: 0.5}\n"),
+                       ParseYaml("base_body: trunk\n" + Legs() +
+                                 "commands: [{t: 0}, {t: 1.5, vx: 0.5, yaw_rate: -0.2}]\n"
+                                 "period_sec: 0.4\nduty: 0.6\nhold: {arm: 0.5}\n"),
                        3};
   std::unique_ptr<Controller> c = MakeController(cfg, "dog", "world.yaml");
   auto* g = dynamic_cast<TrotGait*>(c.get());

@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -237,13 +236,15 @@ void WalkTheRoute(const std::string& world_name, double min_distance_m) {
   ASSERT_NE(building, nullptr);
   const GeneratedEnvironment env = GenerateEnvironment(*building->environment);
   const Walkway& walkway = env.walkways.front();
-  const YAML::Node waypoints = robot->controller.params.node()["waypoints"];
+  const ConfigValue waypoints = robot->controller.params["waypoints"];
   ASSERT_EQ(waypoints.size() + 1, walkway.points.size());
   EXPECT_NEAR(robot->pose.xyz.x(), walkway.points[0].x(), 1e-9);
   EXPECT_NEAR(robot->pose.xyz.y(), walkway.points[0].y(), 1e-9);
   for (size_t i = 0; i < waypoints.size(); ++i) {
-    EXPECT_NEAR(waypoints[i][0].as<double>(), walkway.points[i + 1].x(), 1e-9);
-    EXPECT_NEAR(waypoints[i][1].as<double>(), walkway.points[i + 1].y(), 1e-9);
+    double x = 0, y = 0;
+    ASSERT_TRUE(waypoints[i][0].ToDouble(&x) && waypoints[i][1].ToDouble(&y));
+    EXPECT_NEAR(x, walkway.points[i + 1].x(), 1e-9);
+    EXPECT_NEAR(y, walkway.points[i + 1].y(), 1e-9);
   }
 
   SessionOptions options;

@@ -7,13 +7,13 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
@@ -130,8 +130,8 @@ TEST(HeightField, MujocoPlacesTheWrittenFieldAndAQuadrupedTrotsAcrossIt) {
     if (!m.is_robot) continue;
     m.pose.xyz = {-2.2, 0.3, F(-2.2, 0.3)};
     m.pose.rpy_deg = {0, 0, 0};
-    m.controller.params.node()["waypoints"] = YAML::Load("[[2.2, 0.3]]");
-    m.controller.params.node()["loop"] = false;
+    m.controller.params = WithEntry(m.controller.params, "waypoints", ParseYaml("[[2.2, 0.3]]"));
+    m.controller.params = WithEntry(m.controller.params, "loop", ConfigValue::Scalar("false"));
     models.push_back(m);
   }
   ASSERT_EQ(models.size(), 1u);

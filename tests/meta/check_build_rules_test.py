@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Tests of scripts/check_build_rules.py and scripts/module_docs.py: each test writes a small
 tree (src/penumbra, scripts/build_rules.json, README.md, docs/architecture.md) to a temporary
-folder, plants one violation (a yaml-cpp include outside config/, json.hpp in a header, an 11th
+folder, plants one violation (a yaml-cpp include outside config/ or in a test, a whole-file read
+by hand outside core/input_file.cc, json.hpp in a header, an 11th
 module dep, a translation unit above the preprocessed-lines budget, a stale module table, a
 module without a MODULES entry), runs the script and asserts its exit status and message; and
 the same tree without the violation passes.
@@ -31,6 +32,7 @@ def run(script, *args):
 
 BASE_RULES = {
     "yaml_cpp_files": [],
+    "whole_file_reads": [],
     "json_headers": [],
     "max_module_deps": 10,
     "module_deps_exempt": ["app", "main"],
@@ -105,6 +107,42 @@ class BuildRulesTest(unittest.TestCase):
         rc, out = t.rules()
         self.assertEqual(rc, 1)
         self.assertIn("yaml_cpp_files lists scene/s.cc, which no longer includes yaml-cpp", out)
+
+    def test_yaml_cpp_in_tests_or_bench_fails(self):
+        t = self.tree({"tests/scene/s_test.cc": '#include "penumbra/config/yaml_document.h"\n',
+                       "bench/b.cc": "// x\n"})
+        self.assertEqual(t.rules()[0], 0)
+        t = self.tree({"tests/scene/s_test.cc": "#include <yaml-cpp/yaml.h>\n"})
+        rc, out = t.rules()
+        self.assertEqual(rc, 1)
+        self.assertIn("tests/scene/s_test.cc:1: includes yaml-cpp", out)
+        t = self.tree({"bench/b.cc": "// b\n#include <yaml-cpp/yaml.h>\n"})
+        rc, out = t.rules()
+        self.assertEqual(rc, 1)
+        self.assertIn("bench/b.cc:2: includes yaml-cpp", out)
+
+    def test_whole_file_read_by_hand_fails(self):
+        body = "std::string f(std::ifstream& in) {\n  std::ostringstream s;\n  s << in.rdbuf();\n}\n"
+        t = self.tree({"src/penumbra/core/input_file.cc": body})
+        self.assertEqual(t.rules()[0], 0)
+        t = self.tree({"src/penumbra/scene/s.cc": body})
+        rc, out = t.rules()
+        self.assertEqual(rc, 1)
+        self.assertIn("src/penumbra/scene/s.cc:3: reads a file whole by hand; expected files read "
+                      "whole through core/input_file.h", out)
+        it = "auto b = std::string(std::istreambuf_iterator<char>(in), {});\n"
+        t = self.tree({"src/penumbra/scene/s.cc": it})
+        self.assertEqual(t.rules()[0], 1)
+        # the allow-list passes it and may only shrink
+        t = self.tree({"src/penumbra/scene/s.cc": body},
+                      rules={"whole_file_reads": ["scene/s.cc"]})
+        self.assertEqual(t.rules()[0], 0)
+        t = self.tree({"src/penumbra/scene/s.cc": "// read through core/input_file.h\n"},
+                      rules={"whole_file_reads": ["scene/s.cc"]})
+        rc, out = t.rules()
+        self.assertEqual(rc, 1)
+        self.assertIn("whole_file_reads lists scene/s.cc, which no longer reads a file whole by "
+                      "hand", out)
 
     def test_json_in_a_header_fails(self):
         t = self.tree({"src/penumbra/scene/s.h": "#pragma once\n#include <nlohmann/json.hpp>\n"})

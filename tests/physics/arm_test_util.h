@@ -5,13 +5,13 @@
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/pose.h"
 #include "penumbra/core/rng.h"
@@ -43,7 +43,7 @@ inline ControllerConfig Block(const std::string& type, const std::string& body, 
   ControllerConfig cfg;
   cfg.type = type;
   cfg.line = line;
-  cfg.params = YAML::Load("type: " + type + "\n" + body);
+  cfg.params = ParseYaml("type: " + type + "\n" + body);
   return cfg;
 }
 

@@ -3,12 +3,12 @@
 // torque motors; actuators whose force cannot be set are refused with an error naming the
 // actuator and its type instead of being misread.
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 #include <sstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 #include "quadruped_test_util.h"
 
@@ -41,7 +41,7 @@ std::string ModelWithActuators(const std::string& replacement, const std::string
 
 Rig LoadRig(const std::string& dir, const std::string& config) {
   Rig rig{Simulation::LoadFromString(SceneXml("quadruped", Ground::kFlat), std::nullopt, dir)};
-  ControllerConfig cfg{"trot_gait", YAML::Load(config), 1};
+  ControllerConfig cfg{"trot_gait", ParseYaml(config), 1};
   rig.sim.AddController(MakeController(cfg, "", "test.yaml"));
   rig.trunk = rig.sim.scene().FindBody("trunk");
   return rig;
@@ -57,7 +57,7 @@ TEST(ForeignActuators, TrotGaitDrivesPositionServosLikeMotors) {
   const std::string config = Config("[{t: 0, vx: 0.5}]", LegsYaml());
   Rig motors{
       Simulation::LoadFromString(SceneXml("quadruped", Ground::kFlat), std::nullopt, kModelsDir)};
-  motors.sim.AddController(MakeController({"trot_gait", YAML::Load(config), 1}, "", "test.yaml"));
+  motors.sim.AddController(MakeController({"trot_gait", ParseYaml(config), 1}, "", "test.yaml"));
   motors.trunk = motors.sim.scene().FindBody("trunk");
   const double reference = ForwardDistance(&motors, 3.0);
 
@@ -83,7 +83,7 @@ TEST(ForeignActuators, OtherActuatorsAreRefusedNamingTheType) {
   ModelWithActuators("<general gainprm=\"20\" biastype=\"affine\" biasprm=\"0 -50 0\"", dir);
   Simulation sim =
       Simulation::LoadFromString(SceneXml("quadruped", Ground::kFlat), std::nullopt, dir);
-  ControllerConfig cfg{"trot_gait", YAML::Load(Config("[{t: 0, vx: 0.5}]", LegsYaml())), 3};
+  ControllerConfig cfg{"trot_gait", ParseYaml(Config("[{t: 0, vx: 0.5}]", LegsYaml())), 3};
   try {
     sim.AddController(MakeController(cfg, "", "test.yaml"));
     ADD_FAILURE() << "trot_gait accepted actuators it cannot drive";

@@ -5,13 +5,13 @@
 // error < 0.15 m; bit-identical trajectories on two runs.
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/multirotor_pid.h"
 #include "penumbra/core/error.h"
@@ -45,7 +45,7 @@ MultirotorPid* AddPid(Simulation* sim, const std::string& extra_yaml) {
   ControllerConfig cfg;
   cfg.type = "multirotor_pid";
   cfg.line = 20;
-  cfg.params = YAML::Load(std::string(kBaseParams) + extra_yaml);
+  cfg.params = ParseYaml(std::string(kBaseParams) + extra_yaml);
   std::unique_ptr<Controller> c = MakeController(cfg, "", "quadrotor.yaml");
   auto* pid = dynamic_cast<MultirotorPid*>(c.get());
   sim->AddController(std::move(c));
@@ -173,7 +173,7 @@ TEST(QuadrotorFlight, WrongRotorNamesFailAtLoadListingThem) {
   ControllerConfig cfg;
   cfg.type = "multirotor_pid";
   cfg.line = 14;
-  cfg.params = YAML::Load(R"(base_body: base
+  cfg.params = ParseYaml(R"(base_body: base
 rotor_actuators: [thrust_fr, motor_rl, thrust_fl, motor_rr]
 commands: [{t: 0, mode: takeoff, altitude_m: 1.5}]
 )");
@@ -198,7 +198,7 @@ TEST(QuadrotorFlight, BadCommandsFailAtParseNamingTheKey) {
     cfg.type = "multirotor_pid";
     cfg.line = 9;
     cfg.params =
-        YAML::Load((base ? std::string(kBaseParams) : std::string("base_body: base\n")) + extra);
+        ParseYaml((base ? std::string(kBaseParams) : std::string("base_body: base\n")) + extra);
     try {
       MakeController(cfg, "drone", "w.yaml");
     } catch (const ConfigError& e) {

@@ -3,8 +3,8 @@
 // bit-identical between two simulations, with seeded observation noise.
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/policy_controller.h"
 #include "physics/quadruped_test_util.h"
 
@@ -38,7 +38,7 @@ Simulation PolicySim(const std::string& model, const std::string& extra,
   ControllerConfig cfg;
   cfg.type = "policy";
   cfg.line = 1;
-  cfg.params = YAML::Load(PolicyYaml(model, extra));
+  cfg.params = ParseYaml(PolicyYaml(model, extra));
   std::unique_ptr<Controller> c =
       MakeController(cfg, "", PENUMBRA_SOURCE_DIR "/worlds/policy_test.yaml");
   *policy = dynamic_cast<PolicyController*>(c.get());

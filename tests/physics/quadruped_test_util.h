@@ -4,7 +4,6 @@
 // criteria need (trunk contact, trajectory).
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -14,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/quadruped_leg_kinematics.h"
@@ -158,7 +158,7 @@ inline Rig MakeRig(const std::string& robot, Ground ground, const std::string& c
   ControllerConfig cfg;
   cfg.type = "trot_gait";
   cfg.line = 1;
-  cfg.params = YAML::Load(config_yaml);
+  cfg.params = ParseYaml(config_yaml);
   std::unique_ptr<Controller> c = MakeController(cfg, "", "test.yaml");
   rig.gait = dynamic_cast<TrotGait*>(c.get());
   rig.sim.AddController(std::move(c));

@@ -4,12 +4,12 @@
 // standing keyframe `stand`.
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <fstream>
 #include <sstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 #include "quadruped_test_util.h"
 
@@ -200,7 +200,7 @@ TEST(QuadrupedTrot, MissingNamesFailAtLoadListingAll) {
   legs.replace(legs.find("RL_foot,"), 8, "RL_toe,");
   Simulation sim =
       Simulation::LoadFromString(SceneXml("quadruped", Ground::kFlat), std::nullopt, kModelsDir);
-  ControllerConfig cfg{"trot_gait", YAML::Load("base_body: body\n" + legs), 7};
+  ControllerConfig cfg{"trot_gait", ParseYaml("base_body: body\n" + legs), 7};
   try {
     sim.AddController(MakeController(cfg, "", "world.yaml"));
     FAIL() << "expected a ConfigError";
@@ -256,7 +256,7 @@ TEST(QuadrupedTrot, JointSignsMapReversedAxes) {
   auto walk = [&](const std::string& model_xml, const std::string& asset_dir,
                   const std::string& legs_yaml) {
     Rig rig{Simulation::LoadFromString(model_xml, std::nullopt, asset_dir)};
-    ControllerConfig cfg{"trot_gait", YAML::Load(Config("[{t: 0, vx: 0.5}]", legs_yaml)), 1};
+    ControllerConfig cfg{"trot_gait", ParseYaml(Config("[{t: 0, vx: 0.5}]", legs_yaml)), 1};
     rig.sim.AddController(MakeController(cfg, "", "test.yaml"));
     rig.trunk = rig.sim.scene().FindBody("trunk");
     const double x0 = Trunk(rig).translation().x();

@@ -3,11 +3,11 @@
 // command sources keep their precedence (programmatic > waypoints > script).
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 #include "quadruped_test_util.h"
 
@@ -150,7 +150,7 @@ TEST(QuadrupedWaypoints, CommandSourcesKeepTheirPrecedence) {
 TEST(QuadrupedWaypoints, BadWaypointConfigFailsNamingTheKey) {
   auto error_of = [](const std::string& yaml) -> std::string {
     try {
-      MakeController(ControllerConfig{"trot_gait", YAML::Load(yaml), 4}, "", "world.yaml");
+      MakeController(ControllerConfig{"trot_gait", ParseYaml(yaml), 4}, "", "world.yaml");
     } catch (const ConfigError& e) {
       return e.what();
     }

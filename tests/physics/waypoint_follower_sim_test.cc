@@ -2,10 +2,10 @@
 // world-file style controller block through the factory, with composer-style names).
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/control/waypoint_follower.h"
 #include "penumbra/core/error.h"
@@ -46,7 +46,7 @@ ControllerConfig SquareConfig(bool loop) {
   ControllerConfig cfg;
   cfg.type = "waypoint_follower";
   cfg.line = 12;
-  cfg.params = YAML::Load(std::string(R"(type: waypoint_follower
+  cfg.params = ParseYaml(std::string(R"(type: waypoint_follower
 base_body: chassis
 left_actuator: left_wheel
 right_actuator: right_wheel
@@ -57,7 +57,7 @@ max_yaw_rate_deg_s: 90
 waypoints: [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0]]
 tolerance_m: 0.15
 loop: )") + (loop ? "true" : "false") +
-                          "\n");
+                         "\n");
   return cfg;
 }
 
@@ -110,7 +110,7 @@ TEST(WaypointFollowerSim, LoopKeepsGoing) {
 
 TEST(WaypointFollowerSim, MissingNamesFailAtLoadListingAll) {
   ControllerConfig cfg = SquareConfig(false);
-  cfg.params = YAML::Load(R"(base_body: hull_link
+  cfg.params = ParseYaml(R"(base_body: hull_link
 left_actuator: left_wheel
 right_actuator: right_motor
 wheel_radius_m: 0.05

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 #include <unistd.h>
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -311,19 +311,21 @@ TEST_F(WorldConfigTest, FullFileParsesIntoExpectedValues) {
 
 TEST_F(WorldConfigTest, ControllerParamsKeptAsYaml) {
   const WorldConfig w = ParseWorld(kFullWorld, world_);
-  const YAML::Node& p = w.models[0].controller.params;
+  const ConfigValue& p = w.models[0].controller.params;
   EXPECT_EQ(w.models[0].controller.line, 25);
   ASSERT_TRUE(p.IsMap());
   EXPECT_EQ(p.size(), 2u);  // type is not repeated
   EXPECT_FALSE(p["type"]);
-  EXPECT_EQ(p["speed_m_s"].as<double>(), 0.5);
+  double v = 0;
+  EXPECT_TRUE(p["speed_m_s"].ToDouble(&v));
+  EXPECT_EQ(v, 0.5);
   ASSERT_TRUE(p["waypoints"].IsSequence());
   ASSERT_EQ(p["waypoints"].size(), 2u);
-  EXPECT_EQ(p["waypoints"][1][1].as<double>(), 1.0);
+  EXPECT_TRUE(p["waypoints"][1][1].ToDouble(&v));
+  EXPECT_EQ(v, 1.0);
   // the world file's own nodes, not a re-parsed copy: they keep their place in the file
-  // (yaml-cpp marks are 0-based)
-  EXPECT_EQ(p["speed_m_s"].Mark().line + 1, 27);
-  EXPECT_EQ(p["waypoints"].Mark().line + 1, 28);
+  EXPECT_EQ(p["speed_m_s"].line(), 27);
+  EXPECT_EQ(p["waypoints"].line(), 28);
 }
 
 TEST_F(WorldConfigTest, ControllerWithOnlyTypeHasEmptyMapParams) {
@@ -331,7 +333,7 @@ TEST_F(WorldConfigTest, ControllerWithOnlyTypeHasEmptyMapParams) {
       "robots:\n  - name: r\n    file: models/rover.xml\n    controller: {type: idle}\n", world_);
   EXPECT_EQ(w.models[0].controller.type, "idle");
   EXPECT_EQ(w.models[0].controller.line, 4);
-  const YAML::Node& p = w.models[0].controller.params;
+  const ConfigValue& p = w.models[0].controller.params;
   EXPECT_TRUE(p.IsMap());
   EXPECT_EQ(p.size(), 0u);
 }
@@ -418,7 +420,8 @@ TEST_F(WorldConfigTest, LoadWorldFileReadsFromDisk) {
   EXPECT_EQ(a.file, world_);
   ASSERT_EQ(a.models.size(), b.models.size());
   for (size_t i = 0; i < a.models.size(); ++i) EXPECT_EQ(a.models[i].file, b.models[i].file);
-  EXPECT_EQ(YAML::Dump(a.models[0].controller.params), YAML::Dump(b.models[0].controller.params));
+  EXPECT_EQ(EmitYamlFlow(a.models[0].controller.params),
+            EmitYamlFlow(b.models[0].controller.params));
   EXPECT_EQ(a.lights.size(), 4u);
 }
 
@@ -519,6 +522,14 @@ TEST_F(WorldConfigTest, RateOutOfRange) {
 TEST_F(WorldConfigTest, TimestepOutOfRange) {
   ExpectError("physics:\n  timestep_sec: 0.5\n", 2, "physics.timestep_sec",
               "got 0.5; expected [1e-06, 0.1]");
+}
+
+// the physics block reads each key once (ParamReader::Find) and reports the others with the keys
+// it read (ReportUnused): the same message as the up-front list it replaced
+TEST_F(WorldConfigTest, PhysicsUnknownKeyListsTheKeysRead) {
+  ExpectError("physics:\n  timestep_sec: 0.002\n  integrater: RK4\n", 3, "physics.integrater",
+              "unknown key 'integrater'; expected one of: timestep_sec, integrator, gravity_mps2, "
+              "solver_iterations, cone");
 }
 
 TEST_F(WorldConfigTest, RenderSamplesOutOfRangeNamesWorldFileAndLine) {

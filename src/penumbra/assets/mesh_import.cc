@@ -19,6 +19,7 @@
 #include "penumbra/assets/image_decode.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/image_file_limits.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -77,9 +78,8 @@ void FbxFrame(const aiScene* scene, std::string* up, double* metres_per_unit) {
 }
 
 std::vector<unsigned char> ReadFileBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::vector<unsigned char>((std::istreambuf_iterator<char>(in)),
-                                    std::istreambuf_iterator<char>());
+  const std::string bytes = ReadInputFile(path, "texture file");
+  return std::vector<unsigned char>(bytes.begin(), bytes.end());
 }
 
 // loads the images a scene's materials reference, once each (by path and encoding).

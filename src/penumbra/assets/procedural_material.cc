@@ -14,6 +14,7 @@
 
 #include "penumbra/core/cache_dir.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/thread_pool.h"
 
@@ -381,9 +382,12 @@ std::filesystem::path MapsPath(const std::string& cache_dir, const std::string& 
 
 std::optional<ProceduralMaps> LoadMaps(const std::filesystem::path& path, const std::string& key,
                                        int n, double size_m) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes;
+  try {
+    bytes = ReadInputFile(path, "procedural material cache file");
+  } catch (const ConfigError&) {
+    return std::nullopt;  // absent, unreadable or too large: generate again
+  }
   const size_t map_bytes = static_cast<size_t>(n) * n * 3;
   const size_t head = sizeof kMapsMagic + sizeof(uint32_t) + key.size();
   if (bytes.size() != head + 3 * map_bytes || std::memcmp(bytes.data(), kMapsMagic, 8) != 0)

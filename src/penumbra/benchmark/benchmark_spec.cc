@@ -2,7 +2,6 @@
 
 #include <stdlib.h>
 #include <unistd.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +13,7 @@
 #include "penumbra/benchmark/command_template.h"
 #include "penumbra/benchmark/shell_quote.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/replay/world_override.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/world_config.h"
@@ -121,12 +121,10 @@ void ReadCamera(const YamlReader& cam, BenchmarkWorld* world) {
   w.camera_name = cam_name.String();
   if (w.camera_name.empty() || w.camera_name.find_first_of(" \t\n{}[],:#") != std::string::npos)
     cam_name.Fail("expected a camera name without spaces or YAML punctuation");
-  YAML::Node node = YAML::Clone(cam.node());
-  node["outputs"] = YAML::Load("[rgb, depth]");
-  if (!node["depth_noise"]) node["depth_noise"] = YAML::Load("{preset: realsense_d435}");
-  YAML::Emitter out;
-  out << YAML::Flow << node;
-  w.camera_yaml = out.c_str();
+  ConfigValue node = WithEntry(cam.node(), "outputs", ParseYaml("[rgb, depth]", ""));
+  if (!node["depth_noise"])
+    node = WithEntry(node, "depth_noise", ParseYaml("{preset: realsense_d435}", ""));
+  w.camera_yaml = EmitYamlFlow(node);
   CheckCamera(w, cam);
 }
 
@@ -333,13 +331,9 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
   BenchmarkSpec s;
   s.file = fs::absolute(path).lexically_normal().string();
   s.dir = fs::path(s.file).parent_path().string();
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  try {
-    RefuseYamlTags(text.str(), s.file);
-    const YAML::Node root = YAML::Load(text.str());
-    YamlReader r(root, s.file, nullptr);
+  const std::string text = ReadInputFile(path, "benchmark spec");
+  {
+    YamlReader r(ParseYaml(text, s.file), s.file, nullptr);
     if (r.node().IsMap() && r.Has("kind")) s.kind = r.Child("kind").Enum({"slam", "nav"});
     const bool nav = s.kind == "nav";
     if (nav)
@@ -437,9 +431,6 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
         }
       if (sl.Has("poll_sec")) s.slurm_poll_sec = Positive(sl.Child("poll_sec"), 600);
     }
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(s.file, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-                      "YAML syntax error: " + e.msg);
   }
   return s;
 }

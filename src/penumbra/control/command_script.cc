@@ -1,9 +1,9 @@
 #include "penumbra/control/command_script.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <sstream>
+
+#include "penumbra/config/config_value.h"
 
 namespace penumbra {
 namespace command_script_detail {
@@ -11,7 +11,7 @@ namespace command_script_detail {
 std::vector<std::pair<double, ParamNode>> ReadTimedItems(ControllerParams& params,
                                                          const std::string& key) {
   std::vector<std::pair<double, ParamNode>> out;
-  const YAML::Node* list = params.Raw(key);
+  const ConfigValue* list = params.Raw(key);
   if (!list || list->IsNull()) return out;
   if (!list->IsSequence())
     params.Fail(key, "expected a list of timed commands, e.g. [{t: 0.0, ...}, {t: 1.5, ...}]");

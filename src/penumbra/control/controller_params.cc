@@ -1,25 +1,25 @@
 #include "penumbra/control/controller_params.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 
 struct ControllerParams::Impl {
-  YAML::Node root;
+  ConfigValue root;
   ParamMapping keys;
 };
 
 using param::Repr;
 
-ControllerParams::ControllerParams(const YAML::Node& params, ControllerContext context)
+ControllerParams::ControllerParams(const ConfigValue& params, ControllerContext context)
     : context_(std::move(context)), impl_(std::make_unique<Impl>()) {
   impl_->root = params;
-  if (impl_->root.IsNull()) return;  // an empty block: no parameters
+  // an empty block (or none set in code): no parameters
+  if (!impl_->root.IsDefined() || impl_->root.IsNull()) return;
   if (!impl_->root.IsMap()) {
     throw ConfigError(context_.file, context_.line, context_.key,
                       "got " + Repr(impl_->root) + "; expected a mapping of controller parameters");
@@ -37,10 +37,10 @@ void ControllerParams::Fail(const std::string& key, const std::string& problem) 
 
 bool ControllerParams::Has(const std::string& key) const { return impl_->keys.Has(key); }
 
-const YAML::Node* ControllerParams::Get(const std::string& key) { return impl_->keys.Get(key); }
+const ConfigValue* ControllerParams::Get(const std::string& key) { return impl_->keys.Get(key); }
 
 std::string ControllerParams::String(const std::string& key) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   if (const auto problem = param::NameProblem(n)) Fail(key, *problem);
   return n->Scalar();
 }
@@ -55,26 +55,22 @@ double ControllerParams::Number(const std::string& key, std::optional<double> fa
 }
 
 bool ControllerParams::Bool(const std::string& key, bool fallback) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   if (!n) return fallback;
-  if (n->IsScalar()) {
-    try {
-      return n->as<bool>();
-    } catch (const YAML::Exception&) {
-    }
-  }
+  bool v = false;
+  if (n->ToBoolLoose(&v)) return v;
   Fail(key, "got " + Repr(*n) + "; expected true or false");
 }
 
 std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, size_t min_count) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   const std::string expected = "expected a list of at least " + std::to_string(min_count) +
                                " [x, y] pairs of numbers (m), e.g. [[1.0, 0.0], [1.0, 1.0]]";
   if (!n) Fail(key, "missing; " + expected);
   if (!n->IsSequence()) Fail(key, "got " + Repr(*n) + "; " + expected);
   std::vector<Eigen::Vector2d> pts;
   for (size_t i = 0; i < n->size(); ++i) {
-    const YAML::Node p = (*n)[i];
+    const ConfigValue p = (*n)[i];
     const std::string item_key = key + "[" + std::to_string(i) + "]";
     if (!p.IsSequence() || p.size() != 2) Fail(item_key, "got " + Repr(p) + "; expected [x, y]");
     Eigen::Vector2d v;
@@ -94,31 +90,25 @@ void ControllerParams::CheckNoUnknownKeys() const {
   if (const auto unknown = impl_->keys.UnknownKeys()) Fail(unknown->first, unknown->second);
 }
 
-std::string DescribeParamNode(const YAML::Node& n) {
+std::string DescribeParamNode(const ConfigValue& n) {
   if (n.IsScalar()) return "'" + n.Scalar() + "'";
   if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
   if (n.IsMap()) return "a mapping";
   return "nothing";
 }
 
-double ParamNumberAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
+double ParamNumberAt(ControllerParams& p, const ConfigValue& n, const std::string& key,
                      const std::string& expected) {
   double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
+  const bool ok = n.ToDoubleLoose(&v);
   if (!ok || !std::isfinite(v))
     p.Fail(key, "got " + DescribeParamNode(n) + "; expected " + expected);
   return v;
 }
 
-std::vector<double> ParamNumbersAt(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                                   const std::string& expected, bool (*ok)(double)) {
+std::vector<double> ParamNumbersAt(ControllerParams& p, const ConfigValue& n,
+                                   const std::string& key, const std::string& expected,
+                                   bool (*ok)(double)) {
   std::vector<double> out;
   if (n.IsSequence()) {
     if (n.size() == 0) p.Fail(key, "got an empty list; expected " + expected);

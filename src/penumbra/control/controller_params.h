@@ -1,5 +1,5 @@
 #pragma once
-// typed, validated access to a controller's YAML parameter map (the
+// typed, validated access to a controller's parameter map (config/config_value.h) (the
 // `controller:` block of a robot in a world file). every error is a ConfigError
 // naming the world file, the block's line and the full key path, e.g.
 // "world.yaml:12: robots[rover].controller.speed_m_s: got -1; expected a number > 0".
@@ -10,11 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/controller.h"
-
-namespace YAML {
-class Node;
-}
 
 namespace penumbra {
 
@@ -22,10 +19,10 @@ namespace penumbra {
 /// known; CheckNoUnknownKeys() then rejects anything else (typos fail loudly).
 class ControllerParams {
  public:
-  /// reads `params` (a YAML mapping, or a null node for no parameters; the `type` key, if
+  /// reads `params` (a mapping, or a null or undefined value for no parameters; the `type` key, if
   /// present, is ignored here). the nodes are shared, not copied; they are only read.
   /// @throws ConfigError if `params` is neither null nor a mapping.
-  ControllerParams(const YAML::Node& params, ControllerContext context);
+  ControllerParams(const ConfigValue& params, ControllerContext context);
   ~ControllerParams();
   ControllerParams(const ControllerParams&) = delete;
   ControllerParams& operator=(const ControllerParams&) = delete;
@@ -42,10 +39,10 @@ class ControllerParams {
   /// list of [x, y] pairs of finite numbers, at least `min_count`.
   std::vector<Eigen::Vector2d> Points2(const std::string& key, size_t min_count);
 
-  /// the YAML node of `key`, for structured values the typed readers above don't cover
+  /// the value of `key`, for structured values the typed readers above don't cover
   /// (lists of mappings, nested blocks); nullptr when absent. marks `key` as known. the
   /// node lives as long as this object; report bad values with Fail("key[i].sub", ...).
-  const YAML::Node* Raw(const std::string& key) { return Get(key); }
+  const ConfigValue* Raw(const std::string& key) { return Get(key); }
 
   /// @throws ConfigError listing the keys that were never read, and the allowed keys.
   void CheckNoUnknownKeys() const;
@@ -55,25 +52,25 @@ class ControllerParams {
   const ControllerContext& context() const { return context_; }
 
  private:
-  const YAML::Node* Get(const std::string& key);
+  const ConfigValue* Get(const std::string& key);
 
   ControllerContext context_;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-/// a YAML node described for an error message: 'text', "a list of N items", "a mapping" or
+/// a value described for an error message: 'text', "a list of N items", "a mapping" or
 /// "nothing".
-std::string DescribeParamNode(const YAML::Node& node);
+std::string DescribeParamNode(const ConfigValue& node);
 
 /// a finite number from `node` (a value under a key that ControllerParams::Raw returned, or an
 /// element of one). @throws ConfigError through p.Fail(key, "got ...; expected " + expected).
-double ParamNumberAt(ControllerParams& p, const YAML::Node& node, const std::string& key,
+double ParamNumberAt(ControllerParams& p, const ConfigValue& node, const std::string& key,
                      const std::string& expected);
 
 /// a number or a list of numbers (at least one) from `node`, each finite and accepted by `ok`;
 /// list elements are reported as key[i]. @throws ConfigError through p.Fail.
-std::vector<double> ParamNumbersAt(ControllerParams& p, const YAML::Node& node,
+std::vector<double> ParamNumbersAt(ControllerParams& p, const ConfigValue& node,
                                    const std::string& key, const std::string& expected,
                                    bool (*ok)(double));
 

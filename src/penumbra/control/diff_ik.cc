@@ -1,13 +1,12 @@
-#include "penumbra/control/param_check.h"
 #include "penumbra/control/diff_ik.h"
-
-#include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "penumbra/config/config_value.h"
+#include "penumbra/control/param_check.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -37,17 +36,15 @@ Pose ReadPose(ParamNode& n, bool xyz_optional, bool* has_xyz, bool* has_rpy) {
 }
 
 // parses open | close | a number
-ArmCommand ReadGripper(const YAML::Node& node, const std::function<void(std::string)>& fail) {
+ArmCommand ReadGripper(const ConfigValue& node, const std::function<void(std::string)>& fail) {
   if (node.IsScalar()) {
     const std::string s = node.Scalar();
     if (s == "open") return ArmCommand::Gripper(ArmCommand::GripperAction::kOpen);
     if (s == "close" || s == "closed")
       return ArmCommand::Gripper(ArmCommand::GripperAction::kClose);
-    try {
-      const double v = node.as<double>();
-      if (std::isfinite(v)) return ArmCommand::Gripper(ArmCommand::GripperAction::kValue, v);
-    } catch (const YAML::Exception&) {
-    }
+    double v = 0;
+    if (node.ToDoubleLoose(&v) && std::isfinite(v))
+      return ArmCommand::Gripper(ArmCommand::GripperAction::kValue, v);
   }
   fail("expected open, close or a ctrl value (a number)");
   return {};
@@ -134,7 +131,7 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
     if (p.Has("gripper_open")) d.gripper_open = p.Number("gripper_open", std::nullopt, -kInf, kInf);
     if (p.Has("gripper_closed"))
       d.gripper_closed = p.Number("gripper_closed", std::nullopt, -kInf, kInf);
-    if (const YAML::Node* g = p.Raw("gripper_initial"))
+    if (const ConfigValue* g = p.Raw("gripper_initial"))
       d.gripper_initial = ReadGripper(*g, [&](const std::string& e) {
         p.Fail("gripper_initial", "got '" + (g->IsScalar() ? g->Scalar() : "?") + "'; " + e);
       });
@@ -155,7 +152,7 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
     if (item.Has("gripper")) {
       if (!has_gripper)
         item.Fail("gripper", "a gripper command, but no gripper_actuator is configured");
-      const YAML::Node* g = item.Raw("gripper");
+      const ConfigValue* g = item.Raw("gripper");
       return ReadGripper(*g, [&](const std::string& e) {
         item.Fail("gripper", "got '" + (g->IsScalar() ? g->Scalar() : "?") + "'; " + e);
       });
@@ -192,7 +189,8 @@ void DiffIkParams::ValidateOrThrow(const ControllerContext& c) const {
   check.Positive("orientation_gain", orientation_gain);
   check.NonNegative("damping", damping);
   if (!(std::isfinite(damping_max) && damping_max >= damping))
-    check.Fail("damping_max", "got " + std::to_string(damping_max) + "; expected a number >= damping");
+    check.Fail("damping_max",
+               "got " + std::to_string(damping_max) + "; expected a number >= damping");
   check.Positive("manipulability_threshold", manipulability_threshold);
   check.Positive("max_linear_speed_m_s", max_linear_speed_m_s);
   check.Positive("max_angular_speed_deg_s", max_angular_speed_rad_s);
@@ -206,11 +204,11 @@ void DiffIkParams::ValidateOrThrow(const ControllerContext& c) const {
   check.NonNegative("rate_hz", rate_hz);
   if (posture && posture->size() != servo.joints.size())
     check.Fail("posture", "got " + std::to_string(posture->size()) + " values; expected " +
-                        std::to_string(servo.joints.size()));
+                              std::to_string(servo.joints.size()));
   for (size_t i = 0; i < commands.size(); ++i)
     if (commands[i].command.kind == ArmCommand::Kind::kGripper && gripper_actuator.empty())
       check.Fail("commands[" + std::to_string(i) + "].gripper",
-           "a gripper command, but no gripper_actuator is configured");
+                 "a gripper command, but no gripper_actuator is configured");
 }
 
 DiffIkController::DiffIkController(DiffIkParams params, ControllerContext context)

@@ -1,7 +1,5 @@
 #include "penumbra/control/keyframe_playback.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/command_script.h"
 #include "penumbra/control/param_node.h"
 #include "penumbra/core/error.h"

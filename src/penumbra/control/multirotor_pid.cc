@@ -1,12 +1,11 @@
 #include "penumbra/control/multirotor_pid.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
@@ -40,17 +39,10 @@ std::string PidRangeText(double min, double max, bool min_exclusive) {
 
 // readers for values inside structured parameters (commands, rotor list); errors name the
 // full key path through ControllerParams::Fail
-double NodeNumber(const ControllerParams& p, const YAML::Node& n, const std::string& key,
+double NodeNumber(const ControllerParams& p, const ConfigValue& n, const std::string& key,
                   double min, double max, bool min_exclusive = false) {
   double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
+  const bool ok = n.ToDoubleLoose(&v);
   const std::string range = PidRangeText(min, max, min_exclusive);
   if (!ok || !std::isfinite(v)) p.Fail(key, "got " + Repr(n) + "; expected a number " + range);
   if (v < min || (min_exclusive && v == min) || v > max)
@@ -58,7 +50,7 @@ double NodeNumber(const ControllerParams& p, const YAML::Node& n, const std::str
   return v;
 }
 
-Eigen::Vector3d NodeVec3(const ControllerParams& p, const YAML::Node& n, const std::string& key,
+Eigen::Vector3d NodeVec3(const ControllerParams& p, const ConfigValue& n, const std::string& key,
                          const char* what) {
   if (!n.IsSequence() || n.size() != 3) p.Fail(key, "got " + Repr(n) + "; expected " + what);
   Eigen::Vector3d v;
@@ -67,18 +59,14 @@ Eigen::Vector3d NodeVec3(const ControllerParams& p, const YAML::Node& n, const s
   return v;
 }
 
-std::string NodeName(const ControllerParams& p, const YAML::Node& n, const std::string& key) {
+std::string NodeName(const ControllerParams& p, const ConfigValue& n, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty()) p.Fail(key, "got " + Repr(n) + "; expected a name");
   return n.Scalar();
 }
 
-bool NodeBool(const ControllerParams& p, const YAML::Node& n, const std::string& key) {
-  if (n.IsScalar()) {
-    try {
-      return n.as<bool>();
-    } catch (const YAML::Exception&) {
-    }
-  }
+bool NodeBool(const ControllerParams& p, const ConfigValue& n, const std::string& key) {
+  bool v = false;
+  if (n.ToBoolLoose(&v)) return v;
   p.Fail(key, "got " + Repr(n) + "; expected true or false");
 }
 
@@ -102,7 +90,7 @@ std::vector<std::string> ModeKeys(MultirotorCommand::Mode mode) {
   return {};
 }
 
-TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node& n,
+TimedMultirotorCommand ParseCommand(const ControllerParams& p, const ConfigValue& n,
                                     const std::string& key) {
   using M = MultirotorCommand::Mode;
   if (!n.IsMap())
@@ -127,7 +115,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
            "got '" + mode + "'; expected one of idle, takeoff, hover, waypoints, velocity, land");
 
   const std::vector<std::string> allowed = ModeKeys(c.mode);
-  for (const auto& kv : n) {
+  for (const auto& kv : n.pairs()) {
     const std::string k = kv.first.Scalar();
     if (k == "t" || k == "mode" || std::find(allowed.begin(), allowed.end(), k) != allowed.end())
       continue;
@@ -153,7 +141,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const YAML::Node&
         c.position = NodeVec3(p, n["position"], key + ".position", "[x, y, z] (world, m)");
       break;
     case M::kWaypoints: {
-      const YAML::Node w = n["waypoints"];
+      const ConfigValue w = n["waypoints"];
       const char* expected = "a list of at least 1 [x, y, z] point (world, m)";
       if (!w) p.Fail(key + ".waypoints", std::string("missing; expected ") + expected);
       if (!w.IsSequence() || w.size() == 0)
@@ -235,7 +223,7 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
   MultirotorPidParams m;
   m.base_body = name_prefix + p.String("base_body");
 
-  const YAML::Node* rotors = p.Raw("rotor_actuators");
+  const ConfigValue* rotors = p.Raw("rotor_actuators");
   const char* rotors_expected =
       "a list of at least 4 rotor actuator names, e.g. [thrust_fr, thrust_rl, thrust_fl, "
       "thrust_rr]";
@@ -294,7 +282,7 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
   m.rate_i_limit_rad_s2 = nonneg("rate_i_limit_rad_s2", m.rate_i_limit_rad_s2);
   m.derivative_cutoff_hz = pos("derivative_cutoff_hz", m.derivative_cutoff_hz);
 
-  if (const YAML::Node* cmds = p.Raw("commands")) {
+  if (const ConfigValue* cmds = p.Raw("commands")) {
     if (!cmds->IsSequence())
       p.Fail("commands", "got " + Repr(*cmds) +
                              "; expected a list of timed commands, e.g. [{t: 0, mode: takeoff, "

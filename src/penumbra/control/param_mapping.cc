@@ -5,9 +5,8 @@
 
 namespace penumbra {
 
-void ParamMapping::Load(const YAML::Node& node) {
-  if (node.IsMap())
-    for (const auto& kv : node) entries_.emplace_back(kv.first.Scalar(), kv.second);
+void ParamMapping::Load(const ConfigValue& node) {
+  for (const ConfigEntry& e : node.entries()) entries_.emplace_back(e.key, ConfigValue(e.value));
 }
 
 bool ParamMapping::Has(const std::string& key) const {
@@ -16,7 +15,7 @@ bool ParamMapping::Has(const std::string& key) const {
   return false;
 }
 
-const YAML::Node* ParamMapping::Get(const std::string& key) {
+const ConfigValue* ParamMapping::Get(const std::string& key) {
   known_.insert(key);
   for (const auto& e : entries_)
     if (e.first == key) return &e.second;
@@ -38,7 +37,7 @@ std::optional<std::pair<std::string, std::string>> ParamMapping::UnknownKeys() c
 
 namespace param {
 
-std::string Repr(const YAML::Node& n) {
+std::string Repr(const ConfigValue& n) {
   if (n.IsScalar()) return "'" + n.Scalar() + "'";
   if (n.IsSequence())
     return "a list of " + std::to_string(n.size()) + (n.size() == 1 ? " item" : " items");
@@ -58,23 +57,15 @@ std::string RangeText(double min, double max, bool min_exclusive) {
   return s;
 }
 
-bool ToNumber(const YAML::Node& n, double* v) {
-  if (!n.IsScalar()) return false;
-  try {
-    *v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-  return std::isfinite(*v);
-}
+bool ToNumber(const ConfigValue& n, double* v) { return n.ToDoubleLoose(v) && std::isfinite(*v); }
 
-std::optional<std::string> NameProblem(const YAML::Node* n) {
+std::optional<std::string> NameProblem(const ConfigValue* n) {
   if (!n) return "missing; expected a name";
   if (!n->IsScalar() || n->Scalar().empty()) return "got " + Repr(*n) + "; expected a name";
   return std::nullopt;
 }
 
-double ReadNumber(const YAML::Node* n, std::optional<double> fallback, double min, double max,
+double ReadNumber(const ConfigValue* n, std::optional<double> fallback, double min, double max,
                   bool min_exclusive, const std::string& range, std::string* problem) {
   if (!n) {
     if (fallback) return *fallback;

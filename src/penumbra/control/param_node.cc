@@ -1,16 +1,15 @@
 #include "penumbra/control/param_node.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 
 struct ParamNode::Impl {
-  YAML::Node node;
+  ConfigValue node;
   ParamMapping keys;
 };
 
@@ -32,7 +31,7 @@ std::string RangeText(double min, double max, bool min_exclusive) {
 
 }  // namespace
 
-ParamNode::ParamNode(const YAML::Node& node, std::string path, ControllerContext context)
+ParamNode::ParamNode(const ConfigValue& node, std::string path, ControllerContext context)
     : impl_(std::make_unique<Impl>()), path_(std::move(path)), context_(std::move(context)) {
   impl_->node = node;
   impl_->keys.Load(node);
@@ -53,16 +52,16 @@ void ParamNode::FailHere(const std::string& problem) const { FailAt(context_, pa
 
 bool ParamNode::Has(const std::string& key) const { return impl_->keys.Has(key); }
 
-const YAML::Node* ParamNode::Get(const std::string& key) {
+const ConfigValue* ParamNode::Get(const std::string& key) {
   if (!impl_->node.IsMap()) FailHere("got " + Repr(impl_->node) + "; expected a mapping");
   return impl_->keys.Get(key);
 }
 
-const YAML::Node* ParamNode::Raw(const std::string& key) { return Get(key); }
+const ConfigValue* ParamNode::Raw(const std::string& key) { return Get(key); }
 
 double ParamNode::Number(const std::string& key, std::optional<double> fallback, double min,
                          double max) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   std::string problem;
   const double v =
       param::ReadNumber(n, fallback, min, max, false, RangeText(min, max, false), &problem);
@@ -72,7 +71,7 @@ double ParamNode::Number(const std::string& key, std::optional<double> fallback,
 
 std::vector<double> ParamNode::Numbers(const std::string& key, size_t count, double min, double max,
                                        const std::string& unit) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   const std::string expected =
       "expected a list of " + std::to_string(count) + " numbers" +
       (unit.empty() ? "" : " (" + unit + ")") +
@@ -88,13 +87,13 @@ std::vector<double> ParamNode::Numbers(const std::string& key, size_t count, dou
 }
 
 std::string ParamNode::String(const std::string& key) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   if (const auto problem = param::NameProblem(n)) Fail(key, *problem);
   return n->Scalar();
 }
 
 ParamNode ParamNode::Child(const std::string& key) {
-  const YAML::Node* n = Get(key);
+  const ConfigValue* n = Get(key);
   if (!n) Fail(key, "missing; expected a mapping");
   if (!n->IsMap()) Fail(key, "got " + Repr(*n) + "; expected a mapping");
   return ParamNode(*n, KeyPath(key), context_);
@@ -106,14 +105,14 @@ void ParamNode::CheckNoUnknownKeys() const {
 
 std::vector<std::string> ReadNameList(ControllerParams& params, const std::string& key,
                                       size_t min_count, const std::string& prefix) {
-  const YAML::Node* n = params.Raw(key);
+  const ConfigValue* n = params.Raw(key);
   const std::string expected =
       "expected a list of at least " + std::to_string(min_count) + " names, e.g. [joint1, joint2]";
   if (!n) params.Fail(key, "missing; " + expected);
   if (!n->IsSequence()) params.Fail(key, "got " + Repr(*n) + "; " + expected);
   std::vector<std::string> out;
   for (size_t i = 0; i < n->size(); ++i) {
-    const YAML::Node item = (*n)[i];
+    const ConfigValue item = (*n)[i];
     const std::string item_key = key + "[" + std::to_string(i) + "]";
     if (!item.IsScalar() || item.Scalar().empty())
       params.Fail(item_key, "got " + Repr(item) + "; expected a name");
@@ -135,12 +134,12 @@ std::vector<double> ReadPerJoint(ControllerParams& params, const std::string& ke
   const std::string range = RangeText(min, max, min_exclusive);
   const std::string expected = "expected a number " + range + " or a list of " +
                                std::to_string(count) + " such numbers (one per joint)";
-  const YAML::Node* n = params.Raw(key);
+  const ConfigValue* n = params.Raw(key);
   if (!n) {
     if (fallback) return *fallback;
     params.Fail(key, "missing; " + expected);
   }
-  auto check = [&](const YAML::Node& item, const std::string& item_key) {
+  auto check = [&](const ConfigValue& item, const std::string& item_key) {
     double v = 0;
     if (!ToNumber(item, &v) || v < min || v > max || (min_exclusive && v == min))
       params.Fail(item_key, "got " + Repr(item) + "; " + expected);
@@ -157,7 +156,7 @@ std::optional<std::vector<double>> ReadOptionalNumbers(ControllerParams& params,
                                                        const std::string& key, size_t count,
                                                        double min, double max,
                                                        const std::string& unit) {
-  const YAML::Node* n = params.Raw(key);
+  const ConfigValue* n = params.Raw(key);
   if (!n) return std::nullopt;
   const std::string expected =
       "expected a list of " + std::to_string(count) + " numbers" +

@@ -10,23 +10,20 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/controller.h"
 #include "penumbra/control/controller_params.h"
 
-namespace YAML {
-class Node;
-}
-
 namespace penumbra {
 
-/// reader over one YAML mapping that lives inside a controller block. keys read through it
+/// reader over one mapping that lives inside a controller block. keys read through it
 /// are marked known; CheckNoUnknownKeys() rejects the rest. the node must outlive the reader.
 class ParamNode {
  public:
-  /// @param node    a YAML node (any kind; non-mappings fail on first use)
+  /// @param node    a value (any kind; non-mappings fail on first use)
   /// @param path    its key path relative to the controller block, e.g. "commands[2]"
   /// @param context where the controller block is (file, line, key)
-  ParamNode(const YAML::Node& node, std::string path, ControllerContext context);
+  ParamNode(const ConfigValue& node, std::string path, ControllerContext context);
   ~ParamNode();
   ParamNode(ParamNode&&) noexcept;
   ParamNode(const ParamNode&) = delete;
@@ -44,7 +41,7 @@ class ParamNode {
   /// the mapping under `key` (required).
   ParamNode Child(const std::string& key);
   /// the raw value under `key` (nullptr when absent); marks it known.
-  const YAML::Node* Raw(const std::string& key);
+  const ConfigValue* Raw(const std::string& key);
   /// "<path>.<key>" relative to the controller block.
   std::string KeyPath(const std::string& key) const;
 
@@ -59,7 +56,7 @@ class ParamNode {
   const ControllerContext& context() const { return context_; }
 
  private:
-  const YAML::Node* Get(const std::string& key);
+  const ConfigValue* Get(const std::string& key);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

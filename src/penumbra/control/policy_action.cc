@@ -1,8 +1,8 @@
 #include "penumbra/control/policy_action.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
+
+#include "penumbra/config/config_value.h"
 
 namespace penumbra {
 namespace {}  // namespace
@@ -19,13 +19,13 @@ const char* PolicyActionKindName(PolicyActionKind kind) {
   return "?";
 }
 
-void PolicyActionParams::ParseOver(ControllerParams& p, const YAML::Node& n, const std::string& key,
-                                   const std::string& prefix) {
+void PolicyActionParams::ParseOver(ControllerParams& p, const ConfigValue& n,
+                                   const std::string& key, const std::string& prefix) {
   if (!n.IsMap())
     p.Fail(key, "got " + DescribeParamNode(n) +
                     "; expected {type: joint_position | joint_velocity | joint_torque, scale, "
                     "clip, kp, kd, actuators}");
-  for (const auto& kv : n) {
+  for (const auto& kv : n.pairs()) {
     const std::string k = kv.first.Scalar();
     if (k != "type" && k != "scale" && k != "clip" && k != "kp" && k != "kd" && k != "actuators")
       p.Fail(key + "." + k, "unknown field; expected only type, scale, clip, kp, kd, actuators");
@@ -58,7 +58,7 @@ void PolicyActionParams::ParseOver(ControllerParams& p, const YAML::Node& n, con
     kd = ParamNumbersAt(p, n["kd"], key + ".kd", "a gain >= 0 (N m s/rad)",
                         [](double v) { return v >= 0; });
   if (n["actuators"]) {
-    const YAML::Node a = n["actuators"];
+    const ConfigValue a = n["actuators"];
     if (!a.IsSequence() || a.size() == 0)
       p.Fail(key + ".actuators",
              "got " + DescribeParamNode(a) + "; expected a list of actuator names");

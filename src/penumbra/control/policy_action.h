@@ -26,11 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/controller_params.h"
-
-namespace YAML {
-class Node;
-}
 
 namespace penumbra {
 
@@ -51,7 +48,7 @@ struct PolicyActionParams {
   /// overrides the fields present in the mapping `node` (key path `key`); actuator names get
   /// `name_prefix`.
   /// @throws ConfigError naming key.<field> for unknown fields and bad values.
-  void ParseOver(ControllerParams& params, const YAML::Node& node, const std::string& key,
+  void ParseOver(ControllerParams& params, const ConfigValue& node, const std::string& key,
                  const std::string& name_prefix);
 };
 

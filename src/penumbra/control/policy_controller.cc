@@ -1,7 +1,5 @@
 #include "penumbra/control/policy_controller.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -10,6 +8,7 @@
 #include <regex>
 #include <set>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/actuator_drive.h"
 #include "penumbra/control/onnx_policy_network.h"
 #include "penumbra/control/policy_preset.h"
@@ -52,14 +51,14 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
   }
 
   g.base_body = prefix + p.String("base_body");
-  const YAML::Node* joints = p.Raw("joints");
+  const ConfigValue* joints = p.Raw("joints");
   if (!joints || !joints->IsSequence() || joints->size() == 0)
     p.Fail("joints", std::string(joints ? "got " + DescribeParamNode(*joints) : "missing") +
                          "; expected the policy's joints in its training order");
   if (joints->size() > 1000) p.Fail("joints", "more than 1000 joints; expected at most 1000");
   std::set<std::string> seen;
   for (size_t i = 0; i < joints->size(); ++i) {
-    const YAML::Node j = (*joints)[i];
+    const ConfigValue j = (*joints)[i];
     const std::string key = "joints[" + std::to_string(i) + "]";
     if (!j.IsScalar() || j.Scalar().empty())
       p.Fail(key, "got " + DescribeParamNode(j) + "; expected a joint name");
@@ -68,7 +67,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
     g.local_joints.push_back(j.Scalar());
     g.joints.push_back(prefix + j.Scalar());
   }
-  if (const YAML::Node* d = p.Raw("default_joint_pos")) {
+  if (const ConfigValue* d = p.Raw("default_joint_pos")) {
     if (d->IsSequence()) {
       for (size_t i = 0; i < d->size(); ++i)
         g.default_joint_pos.push_back(ParamNumberAt(
@@ -77,7 +76,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
         p.Fail("default_joint_pos", "has " + std::to_string(d->size()) + " values; expected " +
                                         std::to_string(g.joints.size()) + " (one per joint)");
     } else if (d->IsMap()) {
-      for (const auto& kv : *d) {
+      for (const auto& kv : (*d).pairs()) {
         const std::string pat = kv.first.Scalar();
         const std::string key = "default_joint_pos." + pat;
         try {
@@ -107,7 +106,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
   }
   g.seed = static_cast<uint64_t>(p.Number("seed", 0, 0, 9007199254740992.0));
 
-  if (const YAML::Node* obs = p.Raw("observations")) {
+  if (const ConfigValue* obs = p.Raw("observations")) {
     if (!obs->IsSequence() || obs->size() == 0)
       p.Fail("observations", "got " + DescribeParamNode(*obs) +
                                  "; expected a list of terms {term: ..., scale, clip, noise, "
@@ -120,7 +119,7 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
     p.Fail("observations", "missing; expected a list of observation terms or a preset (" +
                                PolicyConventionNames() + ")");
   }
-  if (const YAML::Node* a = p.Raw("action")) g.action.ParseOver(p, *a, "action", prefix);
+  if (const ConfigValue* a = p.Raw("action")) g.action.ParseOver(p, *a, "action", prefix);
   g.script = TwistScriptParams::Parse(p);
   p.CheckNoUnknownKeys();
   return g;

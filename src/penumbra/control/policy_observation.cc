@@ -1,12 +1,11 @@
 #include "penumbra/control/policy_observation.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <set>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -32,7 +31,7 @@ constexpr TermName kTermNames[] = {
     {ObservationTermKind::kSensor, "sensor"},
 };
 
-std::string ObsName(ControllerParams& p, const YAML::Node& n, const std::string& key) {
+std::string ObsName(ControllerParams& p, const ConfigValue& n, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty())
     p.Fail(key, "got " + DescribeParamNode(n) + "; expected a name");
   return n.Scalar();
@@ -71,7 +70,7 @@ int HeightScanGrid::ny() const {
   return static_cast<int>(std::floor(size_y_m / resolution_m + 1e-9)) + 1;
 }
 
-ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YAML::Node& n,
+ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const ConfigValue& n,
                                                    const std::string& key,
                                                    const std::string& prefix) {
   const std::string expected_term =
@@ -104,7 +103,7 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
     default:
       break;
   }
-  for (const auto& kv : n) {
+  for (const auto& kv : n.pairs()) {
     const std::string k = kv.first.Scalar();
     if (!allowed.count(k)) {
       std::string list;
@@ -135,7 +134,7 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const YA
     case ObservationTermKind::kHeightScan: {
       HeightScanGrid& g = t.grid;
       if (n["size_m"]) {
-        const YAML::Node s = n["size_m"];
+        const ConfigValue s = n["size_m"];
         if (!s.IsSequence() || s.size() != 2)
           p.Fail(key + ".size_m",
                  "got " + DescribeParamNode(s) + "; expected [size_x, size_y] (m)");

@@ -47,15 +47,12 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/control_input.h"
 #include "penumbra/control/controller.h"
 #include "penumbra/control/controller_params.h"
 #include "penumbra/control/terrain_ray_caster.h"
 #include "penumbra/control/twist_command.h"
-
-namespace YAML {
-class Node;
-}
 
 namespace penumbra {
 
@@ -110,7 +107,7 @@ struct ObservationTermConfig {
   /// reads one `observations[i]` mapping (`key` is its key path for errors); sensor names
   /// get `name_prefix`.
   /// @throws ConfigError naming key.<field> for unknown fields, unknown terms and bad values.
-  static ObservationTermConfig Parse(ControllerParams& params, const YAML::Node& node,
+  static ObservationTermConfig Parse(ControllerParams& params, const ConfigValue& node,
                                      const std::string& key, const std::string& name_prefix);
 };
 

@@ -1,7 +1,5 @@
 #include "penumbra/control/trot_gait.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -10,6 +8,7 @@
 #include <limits>
 #include <set>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/actuator_drive.h"
 #include "penumbra/control/param_check.h"
 #include "penumbra/control/pure_pursuit.h"
@@ -32,7 +31,7 @@ constexpr std::array<double, 4> kPhaseOffset = {0.0, 0.5, 0.5, 0.0};
 // a wrapped into [-pi, pi)
 double GaitWrapAngle(double a) { return a - 2 * M_PI * std::floor((a + M_PI) / (2 * M_PI)); }
 
-std::string NameAt(ControllerParams& p, const YAML::Node& n, const std::string& key) {
+std::string NameAt(ControllerParams& p, const ConfigValue& n, const std::string& key) {
   if (!n.IsScalar() || n.Scalar().empty())
     p.Fail(key, "got " + DescribeParamNode(n) + "; expected a name");
   return n.Scalar();
@@ -57,13 +56,13 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   g.base_body = prefix + p.String("base_body");
 
   // legs: exactly FR, FL, RR, RL, each a mapping of names and conventions
-  const YAML::Node* legs = p.Raw("legs");
+  const ConfigValue* legs = p.Raw("legs");
   const std::string legs_expected =
       "expected a mapping with the legs FR, FL, RR, RL, each {hip, thigh, calf, foot, "
       "signs, offsets_rad, actuators}";
   if (!legs) p.Fail("legs", "missing; " + legs_expected);
   if (!legs->IsMap()) p.Fail("legs", "got " + DescribeParamNode(*legs) + "; " + legs_expected);
-  for (const auto& kv : *legs) {
+  for (const auto& kv : (*legs).pairs()) {
     const std::string k = kv.first.Scalar();
     if (std::find_if(kLegNames.begin(), kLegNames.end(), [&](const char* n) { return k == n; }) ==
         kLegNames.end())
@@ -71,13 +70,13 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   }
   for (int i = 0; i < 4; ++i) {
     const std::string key = std::string("legs.") + kLegNames[i];
-    const YAML::Node n = (*legs)[kLegNames[i]];
+    const ConfigValue n = (*legs)[kLegNames[i]];
     if (!n) p.Fail(key, "missing; " + legs_expected);
     if (!n.IsMap())
       p.Fail(key, "got " + DescribeParamNode(n) + "; expected {hip, thigh, calf, foot, ...}");
     static const std::set<std::string> kKeys = {"hip",   "thigh",       "calf",     "foot",
                                                 "signs", "offsets_rad", "actuators"};
-    for (const auto& kv : n)
+    for (const auto& kv : n.pairs())
       if (!kKeys.count(kv.first.Scalar()))
         p.Fail(key + "." + kv.first.Scalar(),
                "unknown key; expected only hip, thigh, calf, foot, signs, offsets_rad, actuators");
@@ -92,7 +91,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
     leg.foot = name("foot");
     leg.actuators = {leg.hip, leg.thigh, leg.calf};
     if (n["actuators"]) {
-      const YAML::Node a = n["actuators"];
+      const ConfigValue a = n["actuators"];
       if (!a.IsSequence() || a.size() != 3)
         p.Fail(key + ".actuators",
                "got " + DescribeParamNode(a) + "; expected [hip, thigh, calf] names");
@@ -100,7 +99,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
         leg.actuators[k] = prefix + NameAt(p, a[k], key + ".actuators[" + std::to_string(k) + "]");
     }
     if (n["signs"]) {
-      const YAML::Node s = n["signs"];
+      const ConfigValue s = n["signs"];
       if (!s.IsSequence() || s.size() != 3)
         p.Fail(key + ".signs",
                "got " + DescribeParamNode(s) + "; expected [s_hip, s_thigh, s_calf], each 1 or -1");
@@ -112,7 +111,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
       }
     }
     if (n["offsets_rad"]) {
-      const YAML::Node o = n["offsets_rad"];
+      const ConfigValue o = n["offsets_rad"];
       if (!o.IsSequence() || o.size() != 3)
         p.Fail(key + ".offsets_rad", "got " + DescribeParamNode(o) + "; expected 3 angles (rad)");
       for (int k = 0; k < 3; ++k)
@@ -151,10 +150,10 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   g.swing_kd = p.Number("swing_kd", 1.5, 0, kGaitInf);
   g.stance_kd = p.Number("stance_kd", 0.5, 0, kGaitInf);
   g.friction = p.Number("friction", 0.6, 0, 5, true);
-  if (const YAML::Node* hold = p.Raw("hold")) {
+  if (const ConfigValue* hold = p.Raw("hold")) {
     if (!hold->IsMap())
       p.Fail("hold", "got " + DescribeParamNode(*hold) + "; expected a mapping {actuator: ctrl}");
-    for (const auto& kv : *hold) {
+    for (const auto& kv : (*hold).pairs()) {
       const std::string k = kv.first.Scalar();
       g.hold.emplace_back(prefix + k,
                           ParamNumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));

@@ -1,10 +1,9 @@
 #include "penumbra/control/twist_command.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <limits>
 
+#include "penumbra/config/config_value.h"
 #include "penumbra/control/pure_pursuit.h"
 #include "penumbra/core/error.h"
 
@@ -15,16 +14,16 @@ TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   TwistScriptParams s;
   // commands: a list of {t, vx, vy, yaw_rate}, t strictly increasing
-  if (const YAML::Node* cmds = p.Raw("commands")) {
+  if (const ConfigValue* cmds = p.Raw("commands")) {
     if (!cmds->IsSequence())
       p.Fail("commands", "got " + DescribeParamNode(*cmds) +
                              "; expected a list of {t, vx, vy, yaw_rate} with increasing t");
     for (size_t i = 0; i < cmds->size(); ++i) {
       const std::string key = "commands[" + std::to_string(i) + "]";
-      const YAML::Node c = (*cmds)[i];
+      const ConfigValue c = (*cmds)[i];
       if (!c.IsMap())
         p.Fail(key, "got " + DescribeParamNode(c) + "; expected {t, vx, vy, yaw_rate}");
-      for (const auto& kv : c) {
+      for (const auto& kv : c.pairs()) {
         const std::string k = kv.first.Scalar();
         if (k != "t" && k != "vx" && k != "vy" && k != "yaw_rate")
           p.Fail(key + "." + k, "unknown key; expected only t, vx, vy, yaw_rate");

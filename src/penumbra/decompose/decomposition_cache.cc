@@ -14,6 +14,7 @@
 
 #include "penumbra/core/cache_dir.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -107,11 +108,12 @@ std::string DecompositionCache::PathOf(const std::string& key) const {
 }
 
 std::optional<Decomposition> DecompositionCache::Load(const std::string& key) const {
-  std::ifstream in(PathOf(key), std::ios::binary);
-  if (!in) return std::nullopt;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string bytes = ss.str();
+  std::string bytes;
+  try {
+    bytes = ReadInputFile(PathOf(key), "decomposition cache file");
+  } catch (const ConfigError&) {
+    return std::nullopt;  // absent, unreadable or too large: decompose again
+  }
   Reader r(bytes);
   char magic[8];
   for (char& c : magic)

@@ -94,6 +94,17 @@ std::map<std::string, int64_t> AsyncFrameWriter::FramesWritten() const {
   return out;
 }
 
+PngWriteTimes AsyncFrameWriter::PngTimes() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  PngWriteTimes sum;
+  for (const auto& [name, cam] : cameras_) {
+    const PngWriteTimes t = cam->writer->png_times();
+    sum.encode_sec += t.encode_sec;
+    sum.write_sec += t.write_sec;
+  }
+  return sum;
+}
+
 void AsyncFrameWriter::WorkerLoop() {
   std::unique_lock<std::mutex> lock(mu_);
   while (true) {

@@ -80,6 +80,10 @@ class AsyncFrameWriter {
   /// frames.csv rows written per camera so far (sorted by camera name).
   std::map<std::string, int64_t> FramesWritten() const;
 
+  /// the PNG encoding and file writing of every camera's images so far, s (summed over the
+  /// worker threads, which run beside the caller's).
+  PngWriteTimes PngTimes() const;
+
  private:
   struct CameraState {
     std::unique_ptr<CameraWriter> writer;

@@ -203,15 +203,23 @@ void CameraWriter::WriteImages(const CameraFrame& frame) const {
 void CameraWriter::WriteFrameImages(const CameraFrame& frame, const std::string& name,
                                     std::vector<fs::path>* written) const {
   // one PNG per image kind, at <folder>/<kind>/<name>, recorded in `written`
+  auto add_times = [&](const PngWriteTimes& t) {
+    encode_ns_ += static_cast<int64_t>(t.encode_sec * 1e9);
+    write_ns_ += static_cast<int64_t>(t.write_sec * 1e9);
+  };
   auto write8 = [&](const char* kind, const ImageU8& img) {
+    PngWriteTimes t;
     const std::vector<uint8_t> bytes =
-        WritePngRgb8((folder_ / kind / name).string(), img, png_options_);
+        WritePngRgb8((folder_ / kind / name).string(), img, png_options_, &t);
+    add_times(t);
     written->push_back(folder_ / kind / name);
     if (on_image_) on_image_(frame, kind, bytes);
   };
   auto write16 = [&](const char* kind, const ImageU16& img) {
+    PngWriteTimes t;
     const std::vector<uint8_t> bytes =
-        WritePngGray16((folder_ / kind / name).string(), img, png_options_);
+        WritePngGray16((folder_ / kind / name).string(), img, png_options_, &t);
+    add_times(t);
     written->push_back(folder_ / kind / name);
     if (on_image_) on_image_(frame, kind, bytes);
   };

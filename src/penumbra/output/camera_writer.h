@@ -18,6 +18,7 @@
 // 999999). a camera name with '/' maps to nested folders ("rover/head" ->
 // DIR/rover/head/).
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -106,6 +107,12 @@ class CameraWriter {
   const std::filesystem::path& folder() const { return folder_; }
   /// rows appended to frames.csv so far.
   int64_t frames_written() const { return frames_written_; }
+  /// the PNG encoding and file writing of every image written so far, s (summed over the
+  /// threads that ran WriteImages).
+  PngWriteTimes png_times() const {
+    return {1e-9 * static_cast<double>(encode_ns_.load()),
+            1e-9 * static_cast<double>(write_ns_.load())};
+  }
 
  private:
   void WriteFrameImages(const CameraFrame& frame, const std::string& name,
@@ -120,6 +127,7 @@ class CameraWriter {
   int64_t last_index_ = -1;
   int64_t frames_written_ = 0;
   CameraImageCallback on_image_;
+  mutable std::atomic<int64_t> encode_ns_{0}, write_ns_{0};
 };
 
 }  // namespace penumbra

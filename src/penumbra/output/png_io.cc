@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cerrno>
+#include <chrono>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
@@ -218,27 +219,44 @@ std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptio
                 options, PNG_FILTER_UP);
 }
 
+namespace {
+// adds the encoding (t0 to t1) and the write (t1 to now) to *times, if given.
+void AddPngTimes(PngWriteTimes* times, std::chrono::steady_clock::time_point t0,
+                 std::chrono::steady_clock::time_point t1) {
+  if (!times) return;
+  const auto t2 = std::chrono::steady_clock::now();
+  times->encode_sec += std::chrono::duration<double>(t1 - t0).count();
+  times->write_sec += std::chrono::duration<double>(t2 - t1).count();
+}
+}  // namespace
+
 std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
-                                  const PngEncodeOptions& options) {
+                                  const PngEncodeOptions& options, PngWriteTimes* times) {
   std::vector<uint8_t> bytes;
+  const auto t0 = std::chrono::steady_clock::now();
   try {
     bytes = EncodePngRgb8(image, options);
   } catch (const Error& e) {
     throw Error("cannot write PNG '" + path + "': " + e.what());
   }
+  const auto t1 = std::chrono::steady_clock::now();
   WriteFileBytes(path, bytes);
+  AddPngTimes(times, t0, t1);
   return bytes;
 }
 
 std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
-                                    const PngEncodeOptions& options) {
+                                    const PngEncodeOptions& options, PngWriteTimes* times) {
   std::vector<uint8_t> bytes;
+  const auto t0 = std::chrono::steady_clock::now();
   try {
     bytes = EncodePngGray16(image, options);
   } catch (const Error& e) {
     throw Error("cannot write PNG '" + path + "': " + e.what());
   }
+  const auto t1 = std::chrono::steady_clock::now();
   WriteFileBytes(path, bytes);
+  AddPngTimes(times, t0, t1);
   return bytes;
 }
 

@@ -36,17 +36,26 @@ std::vector<uint8_t> EncodePngRgb8(const ImageU8& image, const PngEncodeOptions&
 /// @throws Error as EncodePngRgb8 (channels must be 1).
 std::vector<uint8_t> EncodePngGray16(const ImageU16& image, const PngEncodeOptions& options = {});
 
+/// where WritePngRgb8 / WritePngGray16 spent their time, s (added to by each call given one).
+struct PngWriteTimes {
+  double encode_sec = 0;  ///< the PNG encoding (libpng, zlib)
+  double write_sec = 0;   ///< writing the bytes to the file and renaming it into place
+};
+
 /// writes EncodePngRgb8(image) to `path` (replacing an existing file): whole under a
 /// temporary name, then renamed into place (core/output_file.h), so `path` is never a
-/// truncated PNG. returns the bytes written.
+/// truncated PNG. returns the bytes written. `times` (if given): the encoding's and the
+/// write's wall time are added to it.
 /// @throws Error naming `path` and the reason (bad image, cannot open, short write).
 std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
-                                  const PngEncodeOptions& options = {});
+                                  const PngEncodeOptions& options = {},
+                                  PngWriteTimes* times = nullptr);
 
 /// writes EncodePngGray16(image) to `path` as WritePngRgb8 does; returns the bytes written.
 /// @throws Error naming `path` and the reason.
 std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
-                                    const PngEncodeOptions& options = {});
+                                    const PngEncodeOptions& options = {},
+                                    PngWriteTimes* times = nullptr);
 
 /// a decoded PNG: samples as stored in the file (palette images are expanded to
 /// RGB, greyscale below 8 bits to 8 bits; 16-bit samples are kept exact).

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/physics/mujoco_runtime.h"
 #include "penumbra/physics/urdf_meshes.h"
@@ -46,14 +47,10 @@ std::string WithImportOptions(const std::string& urdf) {
 }  // namespace
 
 std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::string& mesh_dir) {
-  std::ifstream in(urdf_path, std::ios::binary);
-  if (!in)
-    throw ConfigError(urdf_path, 0, "", "cannot read the URDF file; expected a readable file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = ReadInputFile(urdf_path, "URDF file");
   // meshes MuJoCo cannot read become STL files: in memory for this load, on disk for the
   // composed model
-  const UrdfMeshConversion meshes = ConvertUrdfMeshes(urdf_path, ss.str());
+  const UrdfMeshConversion meshes = ConvertUrdfMeshes(urdf_path, text);
   const std::string urdf = WithImportOptions(meshes.urdf);
   const std::filesystem::path dir =
       mesh_dir.empty() ? std::filesystem::temp_directory_path() / "penumbra-urdf-meshes"
@@ -85,10 +82,12 @@ std::string ConvertUrdfToMjcfInto(const std::string& urdf_path, const std::strin
       throw Error("ConvertUrdfToMjcf: MuJoCo could not save " + urdf_path + " as MJCF: " + error);
     }
   }
-  std::ifstream out(tmpl, std::ios::binary);
-  std::stringstream os;
-  os << out.rdbuf();
-  mjcf = os.str();
+  try {
+    mjcf = ReadInputFile(tmpl, "MJCF file MuJoCo saved");
+  } catch (...) {
+    std::filesystem::remove(tmpl);
+    throw;
+  }
   std::filesystem::remove(tmpl);
   for (const auto& [name, bytes] : meshes.files) {
     const std::string from = "file=\"" + name + "\"";

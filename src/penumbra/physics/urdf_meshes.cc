@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/output_file.h"
 
 namespace penumbra {
@@ -35,12 +36,7 @@ void AppendFloat(std::string* out, float v) {
   out->append(b, 4);
 }
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string ReadBytes(const fs::path& path) { return ReadInputFile(path, "URDF mesh file"); }
 
 // the candidate paths of a URDF mesh filename, in lookup order (see the header).
 std::vector<fs::path> MeshCandidates(const fs::path& urdf_dir, std::string f) {

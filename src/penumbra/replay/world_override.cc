@@ -1,19 +1,14 @@
 #include "penumbra/replay/world_override.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
+#include "penumbra/core/input_file.h"
 #include "penumbra/world/sensors_reader.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 namespace {
-
-int LineOf(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
 
 // why a top-level key cannot be replaced, or "" when it can
 std::string Refusal(const std::string& key) {
@@ -49,67 +44,54 @@ WorldConfig ApplyWorldOverride(const WorldConfig& recorded, const std::string& p
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw ConfigError(path, 0, "", "world override file not found; expected an existing YAML file");
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!in) throw ConfigError(path, 0, "", "cannot read the world override file");
+  const std::string text = ReadInputFile(path, "world override file");
 
-  // the keys it names, checked before anything else
-  YAML::Node root;
-  try {
-    // the first document (not YAML::LoadAll: yaml-cpp 0.7's LoadAll never ends on some short
-    // inputs, docs/fuzzing.md)
-    root = YAML::Load(text.str());
-    RefuseYamlTags(text.str(), path);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-                      "YAML syntax error: " + e.msg);
-  }
-  if (!root.IsDefined() || root.IsNull() || !root.IsMap() ||
-      root.Style() == YAML::EmitterStyle::Flow)
-    throw ConfigError(path, root.IsDefined() && !root.IsNull() ? LineOf(root) : 0, "",
+  // the keys it names, checked before anything else (the first document, as before)
+  YamlParseOptions first_only;
+  first_only.single_document = false;
+  const ConfigValue root = ParseYaml(text, path, first_only);
+  if (!root.IsMap() || root.IsFlow())
+    throw ConfigError(path, root.IsDefined() && !root.IsNull() ? root.line() : 0, "",
                       "expected a world-file fragment: a block mapping (one `key: value` per "
                       "line) of some of the keys " +
                           std::string("cameras, lights, sky, materials, render, effects, ..."));
   WorldOverride result;
   result.file = path;
-  for (auto it = root.begin(); it != root.end(); ++it) {
-    const std::string key = it->first.Scalar();
-    const std::string why = Refusal(key);
-    if (!why.empty()) throw ConfigError(path, LineOf(it->first), key, why);
-    result.keys.push_back(key);
+  for (const ConfigEntry& e : root.entries()) {
+    const std::string why = Refusal(e.key);
+    if (!why.empty()) throw ConfigError(path, e.key_line, e.key, why);
+    result.keys.push_back(e.key);
   }
 
   // the fragment read as a world file of the recorded models (names only: enough for the
   // checks of attach bodies and material names), so that its values are checked, its
   // relative paths resolve against its folder and its errors name its lines
-  YAML::Emitter models;
-  models << YAML::BeginMap;
+  std::string models;
   for (const bool robots : {true, false}) {
     const bool any = std::any_of(recorded.models.begin(), recorded.models.end(),
                                  [&](const ModelConfig& m) { return m.is_robot == robots; });
     if (!any) continue;
-    models << YAML::Key << (robots ? "robots" : "models") << YAML::Value << YAML::BeginSeq;
+    models += robots ? "robots:\n" : "models:\n";
     for (const ModelConfig& m : recorded.models) {
       if (m.is_robot != robots) continue;
-      models << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << m.name;
+      ConfigValue entry = WithEntry(ConfigValue::Map(), "name", ConfigValue::Scalar(m.name));
       // a generated building not generated yet (no file): its environment entry
       if (m.environment && m.file.empty()) {
-        models << YAML::Key << "environment" << YAML::Value << YAML::BeginMap << YAML::Key << "type"
-               << YAML::Value << m.environment->type << YAML::Key << "seed" << YAML::Value
-               << m.environment->seed << YAML::Key << "texture_resolution" << YAML::Value
-               << m.environment->texture_resolution << YAML::EndMap;
+        ConfigValue env = ConfigValue::Map();
+        env = WithEntry(env, "type", ConfigValue::Scalar(m.environment->type));
+        env = WithEntry(env, "seed", ConfigValue::Scalar(std::to_string(m.environment->seed)));
+        env = WithEntry(env, "texture_resolution",
+                        ConfigValue::Scalar(std::to_string(m.environment->texture_resolution)));
+        entry = WithEntry(entry, "environment", env);
       } else {
-        models << YAML::Key << "file" << YAML::Value << m.file;
+        entry = WithEntry(entry, "file", ConfigValue::Scalar(m.file));
       }
-      models << YAML::EndMap;
+      models += "  - " + EmitYamlFlow(entry) + "\n";
     }
-    models << YAML::EndSeq;
   }
-  models << YAML::EndMap;
-  std::string combined = text.str();
+  std::string combined = text;
   if (!combined.empty() && combined.back() != '\n') combined += '\n';
-  if (!recorded.models.empty()) combined += models.c_str() + std::string("\n");
+  combined += models;
   const WorldConfig o = ParseWorld(combined, path);
 
   WorldConfig w = recorded;

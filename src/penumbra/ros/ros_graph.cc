@@ -1,7 +1,5 @@
 #include "penumbra/ros/ros_graph.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cctype>
 #include <map>
@@ -34,10 +32,10 @@ std::string ModelOf(const std::string& composed) {
 
 // the controller's `base_body` parameter (model-local), or ""
 std::string ControllerBaseBody(const ModelConfig& m) {
-  const YAML::Node& p = m.controller.params;
+  const ConfigValue& p = m.controller.params;
   if (!p || !p.IsMap()) return "";
-  const YAML::Node b = p["base_body"];
-  return b && b.IsScalar() ? b.as<std::string>() : "";
+  const ConfigValue b = p["base_body"];
+  return b && b.IsScalar() ? b.Scalar() : "";
 }
 
 }  // namespace

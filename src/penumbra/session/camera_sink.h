@@ -139,6 +139,8 @@ class CameraSink : public Sink {
   std::map<std::string, int64_t> FramesWritten() const { return writer_.FramesWritten(); }
   /// wall time spent rendering and forming images, s (read after OnFinish).
   double render_sec() const { return render_sec_; }
+  /// the writer threads' PNG encoding and file writing, s (read after OnFinish).
+  PngWriteTimes png_times() const { return writer_.PngTimes(); }
 
  private:
   struct Pending {

@@ -79,8 +79,8 @@ class RunOutputs {
   void AddTo(SimLoop* loop);
 
   /// on the loop's finish (from the ManifestSink's describe callback, after every other
-  /// sink's OnFinish): ends the progress bar and adds "sensors_<kind>_sec" and "render_sec"
-  /// to `timings`.
+  /// sink's OnFinish): ends the progress bar and adds "sensors_<kind>_sec", "render_sec",
+  /// "png_encode_sec" and "png_write_sec" (the frame writer's threads) to `timings`.
   void Finish(std::map<std::string, double>* timings);
 
   /// run.json's shared fields: `world_file`, seed, the versions, `command_line`, the sim

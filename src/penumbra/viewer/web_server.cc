@@ -26,6 +26,7 @@
 #include <thread>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 
@@ -530,19 +531,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
         server_->options_.web_root, std::string_view(req.target().data(), req.target().size()));
     if (path.empty())
       return ErrorResponse(http::status::bad_request, "bad path", req.version(), req.keep_alive());
-    std::ifstream in(path, std::ios::binary);
-    std::error_code ec;
-    if (!in || !std::filesystem::is_regular_file(path, ec))
+    std::string body;
+    try {
+      body = ReadInputFile(path, "web file");  // a regular file, at most 256 MiB
+    } catch (const ConfigError&) {
       return ErrorResponse(http::status::not_found, "not found", req.version(), req.keep_alive());
-    std::ostringstream body;
-    body << in.rdbuf();
+    }
     http::response<http::string_body> res{http::status::ok, req.version()};
     res.set(http::field::content_type, std::string(MimeTypeFor(path)));
     res.set(http::field::cache_control, "no-cache");
     res.keep_alive(req.keep_alive());
-    if (req.method() == http::verb::get) res.body() = body.str();
+    if (req.method() == http::verb::get) res.body() = body;
     res.prepare_payload();
-    if (req.method() == http::verb::head) res.content_length(body.str().size());
+    if (req.method() == http::verb::head) res.content_length(body.size());
     return res;
   }
 

@@ -1,7 +1,5 @@
 #include "penumbra/world/adversity_preset.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,12 +7,14 @@
 #include <regex>
 #include <sstream>
 
+#include "penumbra/config/param_reader.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_edit.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace fs = std::filesystem;
 
@@ -28,7 +28,7 @@ bool IsFileSpec(const std::string& spec) {
 }
 
 // reads a number and checks lo < v <= hi (open_lo) or lo <= v <= hi
-double Ranged(const YamlReader& r, double lo, double hi, bool open_lo, const char* unit) {
+double Ranged(const ParamReader& r, double lo, double hi, bool open_lo, const char* unit) {
   const double v = r.Double();
   if (open_lo ? !(v > lo && v <= hi) : !(v >= lo && v <= hi))
     r.Fail("got " + FormatNumber(v) + "; expected " + (open_lo ? "(" : "[") + FormatNumber(lo) +
@@ -36,7 +36,7 @@ double Ranged(const YamlReader& r, double lo, double hi, bool open_lo, const cha
   return v;
 }
 
-int RangedInt(const YamlReader& r, int lo, int hi) {
+int RangedInt(const ParamReader& r, int lo, int hi) {
   const int v = r.Int();
   if (v < lo || v > hi)
     r.Fail("got " + std::to_string(v) + "; expected an integer in [" + std::to_string(lo) + ", " +
@@ -44,7 +44,7 @@ int RangedInt(const YamlReader& r, int lo, int hi) {
   return v;
 }
 
-AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const std::string& file) {
+AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const std::string& file) {
   static const std::regex kName("[A-Za-z0-9_-]+");
   if (auto problem = NameLengthProblem(name)) r.Fail("preset " + *problem);
   if (!std::regex_match(name, kName))
@@ -53,88 +53,108 @@ AdversityPreset ReadPreset(const std::string& name, const YamlReader& r, const s
   AdversityPreset p;
   p.name = name;
   p.file = file;
-  if (r.Has("description")) p.description = r.Child("description").String();
+  if (const auto found = r.Find("description")) p.description = found->String();
   if (r.Has("fog")) {
-    const YamlReader f = r.Child("fog");
+    const ParamReader f = r.Child("fog");
     f.ExpectMap({"mor_m", "height_falloff_per_m"});
     p.fog_mor_m = Ranged(f.Child("mor_m"), 0, 1e5, true, "m");
     if (f.Has("height_falloff_per_m"))
       p.fog_height_falloff_per_m = Ranged(f.Child("height_falloff_per_m"), 0, 10, false, "1/m");
   }
   if (r.Has("dust")) {
-    const YamlReader f = r.Child("dust");
+    const ParamReader f = r.Child("dust");
     f.ExpectMap({"mor_m"});
     p.dust_mor_m = Ranged(f.Child("mor_m"), 0, 1e5, true, "m");
   }
   if (r.Has("smoke")) {
-    const YamlReader s = r.Child("smoke");
+    const ParamReader s = r.Child("smoke");
     s.ExpectMap({"sigma_t_per_m", "coverage", "extent_fraction", "height_m"});
     p.smoke_sigma_t_per_m = Ranged(s.Child("sigma_t_per_m"), 0, 100, true, "1/m");
-    if (s.Has("coverage")) p.smoke_coverage = Ranged(s.Child("coverage"), 0, 1, false, "");
+    if (const auto found = s.Find("coverage")) p.smoke_coverage = Ranged(*found, 0, 1, false, "");
     if (s.Has("extent_fraction"))
       p.smoke_extent_fraction = Ranged(s.Child("extent_fraction"), 0, 1, true, "");
-    if (s.Has("height_m")) p.smoke_height_m = Ranged(s.Child("height_m"), 0, 100, true, "m");
+    if (const auto found = s.Find("height_m")) p.smoke_height_m = Ranged(*found, 0, 100, true, "m");
   }
   if (r.Has("rain")) {
-    const YamlReader s = r.Child("rain");
+    const ParamReader s = r.Child("rain");
     s.ExpectMap({"rate_mm_h"});
     p.rain_rate_mm_h = Ranged(s.Child("rate_mm_h"), 0, 500, true, "mm/h");
   }
   if (r.Has("snow")) {
-    const YamlReader s = r.Child("snow");
+    const ParamReader s = r.Child("snow");
     s.ExpectMap({"rate_mm_h"});
     p.snow_rate_mm_h = Ranged(s.Child("rate_mm_h"), 0, 100, true, "mm/h");
   }
   if (r.Has("lights")) {
-    const YamlReader s = r.Child("lights");
+    const ParamReader s = r.Child("lights");
     s.ExpectMap({"scale", "flicker_depth", "flicker_hz"});
-    if (s.Has("scale")) p.light_scale = Ranged(s.Child("scale"), 0, 1, false, "");
-    if (s.Has("flicker_depth")) p.flicker_depth = Ranged(s.Child("flicker_depth"), 0, 1, false, "");
-    if (s.Has("flicker_hz")) p.flicker_hz = Ranged(s.Child("flicker_hz"), 0, 100, true, "Hz");
+    if (const auto found = s.Find("scale")) p.light_scale = Ranged(*found, 0, 1, false, "");
+    if (const auto found = s.Find("flicker_depth"))
+      p.flicker_depth = Ranged(*found, 0, 1, false, "");
+    if (const auto found = s.Find("flicker_hz")) p.flicker_hz = Ranged(*found, 0, 100, true, "Hz");
   }
   if (r.Has("npcs")) {
-    const YamlReader s = r.Child("npcs");
+    const ParamReader s = r.Child("npcs");
     s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m"});
-    if (s.Has("people")) p.npc_people = RangedInt(s.Child("people"), 0, 100);
-    if (s.Has("vehicles")) p.npc_vehicles = RangedInt(s.Child("vehicles"), 0, 20);
-    if (s.Has("speed_m_s")) p.npc_speed_m_s = Ranged(s.Child("speed_m_s"), 0, 5, true, "m/s");
-    if (s.Has("pause_sec")) p.npc_pause_sec = Ranged(s.Child("pause_sec"), 0, 60, false, "s");
+    if (const auto found = s.Find("people")) p.npc_people = RangedInt(*found, 0, 100);
+    if (const auto found = s.Find("vehicles")) p.npc_vehicles = RangedInt(*found, 0, 20);
+    if (const auto found = s.Find("speed_m_s")) p.npc_speed_m_s = Ranged(*found, 0, 5, true, "m/s");
+    if (const auto found = s.Find("pause_sec")) p.npc_pause_sec = Ranged(*found, 0, 60, false, "s");
     if (s.Has("behaviour")) {
       const std::string b = s.Child("behaviour").Enum({"avoid", "ignore", "block"});
       p.npc_behaviour = b == "avoid"    ? AgentBehaviour::kAvoid
                         : b == "ignore" ? AgentBehaviour::kIgnore
                                         : AgentBehaviour::kBlock;
     }
-    if (s.Has("clearance_m")) p.npc_clearance_m = Ranged(s.Child("clearance_m"), 0, 10, false, "m");
+    if (const auto found = s.Find("clearance_m"))
+      p.npc_clearance_m = Ranged(*found, 0, 10, false, "m");
   }
   return p;
 }
 
+// a number of a generated preset document (shortest text that reads back the same double)
+ConfigValue PresetNumber(double v) { return ConfigValue::Scalar(FormatNumber(v)); }
+
+// a mapping of `entries`, in order
+ConfigValue PresetBlock(std::initializer_list<std::pair<const char*, ConfigValue>> entries) {
+  ConfigValue m = ConfigValue::Map();
+  for (const auto& [key, value] : entries) m = WithEntry(m, key, value);
+  return m;
+}
+
 // the preset as the mapping of its blocks (what a preset file's entry holds)
-YAML::Node PresetNode(const AdversityPreset& p) {
-  YAML::Node n(YAML::NodeType::Map);
+ConfigValue PresetNode(const AdversityPreset& p) {
+  ConfigValue n = ConfigValue::Map();
   if (p.fog_mor_m) {
-    n["fog"]["mor_m"] = *p.fog_mor_m;
-    n["fog"]["height_falloff_per_m"] = p.fog_height_falloff_per_m;
+    n = WithEntry(
+        n, "fog",
+        PresetBlock({{"mor_m", PresetNumber(*p.fog_mor_m)},
+                     {"height_falloff_per_m", PresetNumber(p.fog_height_falloff_per_m)}}));
   }
-  if (p.dust_mor_m) n["dust"]["mor_m"] = *p.dust_mor_m;
+  if (p.dust_mor_m) n = WithEntry(n, "dust", PresetBlock({{"mor_m", PresetNumber(*p.dust_mor_m)}}));
   if (p.smoke_sigma_t_per_m) {
-    n["smoke"]["sigma_t_per_m"] = *p.smoke_sigma_t_per_m;
-    n["smoke"]["coverage"] = p.smoke_coverage;
-    n["smoke"]["extent_fraction"] = p.smoke_extent_fraction;
-    n["smoke"]["height_m"] = p.smoke_height_m;
+    n = WithEntry(n, "smoke",
+                  PresetBlock({{"sigma_t_per_m", PresetNumber(*p.smoke_sigma_t_per_m)},
+                               {"coverage", PresetNumber(p.smoke_coverage)},
+                               {"extent_fraction", PresetNumber(p.smoke_extent_fraction)},
+                               {"height_m", PresetNumber(p.smoke_height_m)}}));
   }
-  if (p.rain_rate_mm_h) n["rain"]["rate_mm_h"] = *p.rain_rate_mm_h;
-  if (p.snow_rate_mm_h) n["snow"]["rate_mm_h"] = *p.snow_rate_mm_h;
-  n["lights"]["scale"] = p.light_scale;
-  n["lights"]["flicker_depth"] = p.flicker_depth;
-  n["lights"]["flicker_hz"] = p.flicker_hz;
-  n["npcs"]["people"] = p.npc_people;
-  n["npcs"]["vehicles"] = p.npc_vehicles;
-  n["npcs"]["speed_m_s"] = p.npc_speed_m_s;
-  n["npcs"]["pause_sec"] = p.npc_pause_sec;
-  n["npcs"]["behaviour"] = AgentBehaviourName(p.npc_behaviour);
-  n["npcs"]["clearance_m"] = p.npc_clearance_m;
+  if (p.rain_rate_mm_h)
+    n = WithEntry(n, "rain", PresetBlock({{"rate_mm_h", PresetNumber(*p.rain_rate_mm_h)}}));
+  if (p.snow_rate_mm_h)
+    n = WithEntry(n, "snow", PresetBlock({{"rate_mm_h", PresetNumber(*p.snow_rate_mm_h)}}));
+  n = WithEntry(n, "lights",
+                PresetBlock({{"scale", PresetNumber(p.light_scale)},
+                             {"flicker_depth", PresetNumber(p.flicker_depth)},
+                             {"flicker_hz", PresetNumber(p.flicker_hz)}}));
+  n = WithEntry(
+      n, "npcs",
+      PresetBlock({{"people", PresetNumber(p.npc_people)},
+                   {"vehicles", PresetNumber(p.npc_vehicles)},
+                   {"speed_m_s", PresetNumber(p.npc_speed_m_s)},
+                   {"pause_sec", PresetNumber(p.npc_pause_sec)},
+                   {"behaviour", ConfigValue::Scalar(AgentBehaviourName(p.npc_behaviour))},
+                   {"clearance_m", PresetNumber(p.npc_clearance_m)}}));
   return n;
 }
 
@@ -163,26 +183,18 @@ std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path) {
   if (!fs::is_regular_file(path, ec))
     throw ConfigError(path, 0, "",
                       "adversity preset file not found; expected an existing YAML file");
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseAdversityPresets(text.str(), path);
+  return ParseAdversityPresets(ReadInputFile(path, "adversity preset file"), path);
 }
 
 std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
                                                    const std::string& path) {
   std::vector<AdversityPreset> out;
-  try {
-    const YAML::Node root = YAML::Load(text);
-    RefuseYamlTags(text, path);
-    YamlReader r(root, path, nullptr);
+  {
+    const ParamReader r(ParseYaml(text, path), path, nullptr);
     r.ExpectMap({"presets"});
-    const YamlReader presets = r.Child("presets");
+    const ParamReader presets = r.Child("presets");
     for (const auto& [name, p] : presets.Entries()) out.push_back(ReadPreset(name, p, path));
     if (out.empty()) presets.Fail("no presets; expected a mapping of preset names to presets");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "",
-                      "YAML syntax error: " + e.msg);
   }
   return out;
 }
@@ -222,35 +234,38 @@ AdversityPreset EditAdversityPreset(const AdversityPreset& base, const std::stri
     throw ConfigError("", 0, block, "unknown adversity block; expected one of: " + valid);
   }
   try {
-    YAML::Node node = PresetNode(base);
-    YAML::Node patch;
+    ConfigValue node = PresetNode(base);
+    ConfigValue patch;
     try {
-      patch = YAML::Load(block_yaml);
-      try {
-        RefuseYamlTags(block_yaml, "");
-      } catch (const ConfigError& e) {
-        throw ConfigError("", 0, block, e.problem());
-      }
-    } catch (const YAML::Exception& e) {
-      throw ConfigError("", 0, block, "not a mapping (" + e.msg + "); expected a mapping or null");
+      YamlParseOptions first_only;
+      first_only.single_document = false;
+      patch = ParseYaml(block_yaml, "", first_only);
+    } catch (const ConfigError& e) {
+      if (e.problem().rfind("YAML tag", 0) == 0) throw ConfigError("", 0, block, e.problem());
+      throw ConfigError("", 0, block,
+                        "not a mapping (" + e.problem() + "); expected a mapping or null");
     }
     if (patch.IsNull()) {
-      node.remove(block);
+      node = WithoutEntry(node, block);
     } else if (!patch.IsMap()) {
       throw ConfigError("", 0, block, "expected a mapping of the block's keys, or null");
     } else {
-      YAML::Node target = node[block];
-      if (!target.IsMap()) target = YAML::Node(YAML::NodeType::Map);
-      for (const auto& kv : patch) target[kv.first.as<std::string>()] = kv.second;
-      node[block] = target;
+      ConfigValue target = node[block];
+      if (!target.IsMap()) target = ConfigValue::Map();
+      for (const ConfigEntry& e : patch.entries()) {
+        if (!e.key_is_scalar)
+          throw ConfigError("", 0, block,
+                            "invalid value: a list or mapping as a key; expected "
+                            "the block's key names");
+        target = WithEntry(target, e.key, ConfigValue(e.value));
+      }
+      node = WithEntry(node, block, target);
     }
-    AdversityPreset p = ReadPreset(base.name, YamlReader(node, "", nullptr), base.file);
+    AdversityPreset p = ReadPreset(base.name, ParamReader(node, "", nullptr), base.file);
     p.description = base.description;
     return p;
   } catch (const ConfigError& e) {
     throw ConfigError("", 0, e.key(), e.problem());  // lines of a generated document mean nothing
-  } catch (const YAML::Exception& e) {
-    throw ConfigError("", 0, block, "invalid value: " + e.msg);
   }
 }
 

@@ -8,7 +8,7 @@
 namespace penumbra {
 namespace {
 
-Eigen::Vector2d ReadPoint(const YamlReader& r) {
+Eigen::Vector2d ReadPoint(const ParamReader& r) {
   if (!r.node().IsSequence() || r.size() != 2)
     r.Fail("expected a floor point [x, y] (2 numbers, m)");
   return {r.Element(0).Double(), r.Element(1).Double()};
@@ -16,14 +16,14 @@ Eigen::Vector2d ReadPoint(const YamlReader& r) {
 
 }  // namespace
 
-std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& file) {
+std::vector<AgentConfig> ReadAgents(const ParamReader& list, const std::string& file) {
   std::vector<AgentConfig> agents;
   std::map<std::string, int> lines;  // key path -> line, for validation messages
-  const auto note = [&](const YamlReader& r) {
+  const auto note = [&](const ParamReader& r) {
     lines[r.path()] = r.line();
     return r;
   };
-  for (const YamlReader& r : list.List()) {
+  for (const ParamReader& r : list.List()) {
     note(r);
     r.ExpectMap({"name", "type", "waypoints", "speed_m_s", "pause_sec", "start_delay_sec", "route",
                  "floor_z", "height_m", "motion", "behaviour", "goals", "clearance_m"});
@@ -36,18 +36,18 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
                : t == "forklift" ? AgentKind::kForklift
                                  : AgentKind::kCart;
     }
-    const YamlReader w = note(r.Child("waypoints"));
-    for (const YamlReader& p : w.List()) a.waypoints.push_back(ReadPoint(note(p)));
-    if (r.Has("speed_m_s")) a.speed_m_s = note(r.Child("speed_m_s")).Double();
-    if (r.Has("pause_sec")) a.pause_sec = note(r.Child("pause_sec")).Double();
-    if (r.Has("start_delay_sec")) a.start_delay_sec = note(r.Child("start_delay_sec")).Double();
+    const ParamReader w = note(r.Child("waypoints"));
+    for (const ParamReader& p : w.List()) a.waypoints.push_back(ReadPoint(note(p)));
+    if (const auto found = r.Find("speed_m_s")) a.speed_m_s = note(*found).Double();
+    if (const auto found = r.Find("pause_sec")) a.pause_sec = note(*found).Double();
+    if (const auto found = r.Find("start_delay_sec")) a.start_delay_sec = note(*found).Double();
     if (r.Has("route")) {
       const std::string t = note(r.Child("route")).Enum({"loop", "pingpong", "once"});
       a.route = t == "loop"       ? AgentRoute::kLoop
                 : t == "pingpong" ? AgentRoute::kPingPong
                                   : AgentRoute::kOnce;
     }
-    if (r.Has("floor_z")) a.floor_z = note(r.Child("floor_z")).Double();
+    if (const auto found = r.Find("floor_z")) a.floor_z = note(*found).Double();
     if (r.Has("height_m")) {
       a.height_m = note(r.Child("height_m")).Double();
       a.height_given = true;
@@ -65,7 +65,7 @@ std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& f
     if (r.Has("goals"))
       a.goals = note(r.Child("goals")).Enum({"patrol", "random"}) == "random" ? AgentGoals::kRandom
                                                                               : AgentGoals::kPatrol;
-    if (r.Has("clearance_m")) a.clearance_m = note(r.Child("clearance_m")).Double();
+    if (const auto found = r.Find("clearance_m")) a.clearance_m = note(*found).Double();
     a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
       auto it = lines.find(key);
       return it == lines.end() ? 0 : it->second;

@@ -9,8 +9,8 @@
 
 #include <vector>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/effects/agent_path.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 
@@ -19,6 +19,6 @@ namespace penumbra {
 /// @throws ConfigError naming the file, line, key path ("agents[1].speed_m_s") and the
 ///         valid range: unknown keys, wrong types, < 2 waypoints, a negative or zero speed,
 ///         duplicate names.
-std::vector<AgentConfig> ReadAgents(const YamlReader& list, const std::string& file);
+std::vector<AgentConfig> ReadAgents(const ParamReader& list, const std::string& file);
 
 }  // namespace penumbra

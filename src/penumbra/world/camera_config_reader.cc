@@ -14,14 +14,14 @@ namespace {
 // "cameras[2] ('front')" for messages.
 std::string Who(const CameraConfig& c) { return "camera '" + c.name + "': "; }
 
-double NonNegative(const YamlReader& r, const CameraConfig& c, const std::string& unit) {
+double NonNegative(const ParamReader& r, const CameraConfig& c, const std::string& unit) {
   const double v = r.Double();
   if (!(v >= 0))
     r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected a number >= 0 (" + unit + ")");
   return v;
 }
 
-double Positive(const YamlReader& r, const CameraConfig& c, const std::string& unit) {
+double Positive(const ParamReader& r, const CameraConfig& c, const std::string& unit) {
   const double v = r.Double();
   if (!(v > 0))
     r.Fail(Who(c) + "got " + FormatNumber(v) + "; expected a number > 0 (" + unit + ")");
@@ -29,7 +29,7 @@ double Positive(const YamlReader& r, const CameraConfig& c, const std::string& u
 }
 
 // a number in [lo, hi] (lo_open: (lo, hi]); 1e308 or 1e-300 where a camera needs a sane value
-double Within(const YamlReader& r, const CameraConfig& c, double lo, double hi, bool lo_open,
+double Within(const ParamReader& r, const CameraConfig& c, double lo, double hi, bool lo_open,
               const std::string& unit) {
   const double v = r.Double();
   if (!((lo_open ? v > lo : v >= lo) && v <= hi))
@@ -38,7 +38,7 @@ double Within(const YamlReader& r, const CameraConfig& c, double lo, double hi, 
   return v;
 }
 
-int IntIn(const YamlReader& r, const CameraConfig& c, int lo, int hi) {
+int IntIn(const ParamReader& r, const CameraConfig& c, int lo, int hi) {
   const int v = r.Int();
   if (v < lo || v > hi)
     r.Fail(Who(c) + "got " + std::to_string(v) + "; expected an integer in [" + std::to_string(lo) +
@@ -74,10 +74,10 @@ const std::vector<std::string_view>& CameraSensorKeys() {
   return keys;
 }
 
-void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
+void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
   CameraSensorConfig& s = c->sensor;
   if (r.Has("distortion")) {
-    const YamlReader d = r.Child("distortion");
+    const ParamReader d = r.Child("distortion");
     d.ExpectMap({"k1", "k2", "p1", "p2", "k3"});
     double* field[] = {&c->k1, &c->k2, &c->p1, &c->p2, &c->k3};
     const char* name[] = {"k1", "k2", "p1", "p2", "k3"};
@@ -105,26 +105,27 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
     s.auto_exposure_time_constant_sec =
         Within(r.Child("auto_exposure_time_constant_sec"), *c, 0, 3600, false, "seconds");
   if (r.Has("noise")) {
-    const YamlReader n = r.Child("noise");
+    const ParamReader n = r.Child("noise");
     n.ExpectMap({"enabled", "full_well_e", "read_noise_e", "iso", "base_iso", "adc_bits"});
     s.noise.enabled = n.Has("enabled") ? n.Child("enabled").Bool() : true;
     if (n.Has("full_well_e"))
       s.noise.full_well_e = Within(n.Child("full_well_e"), *c, 1, 1e9, false, "electrons");
     if (n.Has("read_noise_e"))
       s.noise.read_noise_e = Within(n.Child("read_noise_e"), *c, 0, 1e6, false, "electrons");
-    if (n.Has("iso")) s.noise.iso = Within(n.Child("iso"), *c, 0, 1e7, true, "ISO");
-    if (n.Has("base_iso")) s.noise.base_iso = Within(n.Child("base_iso"), *c, 0, 1e7, true, "ISO");
-    if (n.Has("adc_bits")) s.noise.adc_bits = IntIn(n.Child("adc_bits"), *c, 1, 16);
+    if (const auto found = n.Find("iso")) s.noise.iso = Within(*found, *c, 0, 1e7, true, "ISO");
+    if (const auto found = n.Find("base_iso"))
+      s.noise.base_iso = Within(*found, *c, 0, 1e7, true, "ISO");
+    if (const auto found = n.Find("adc_bits")) s.noise.adc_bits = IntIn(*found, *c, 1, 16);
   }
-  if (r.Has("jpeg_quality")) s.jpeg_quality = IntIn(r.Child("jpeg_quality"), *c, 0, 100);
+  if (const auto found = r.Find("jpeg_quality")) s.jpeg_quality = IntIn(*found, *c, 0, 100);
   if (r.Has("lens_droplets")) {
-    const YamlReader l = r.Child("lens_droplets");
+    const ParamReader l = r.Child("lens_droplets");
     l.ExpectMap({"enabled", "count"});
-    if (l.Has("enabled")) s.lens_droplets = l.Child("enabled").Bool();
-    if (l.Has("count")) s.lens_droplet_count = IntIn(l.Child("count"), *c, 0, 1000);
+    if (const auto found = l.Find("enabled")) s.lens_droplets = found->Bool();
+    if (const auto found = l.Find("count")) s.lens_droplet_count = IntIn(*found, *c, 0, 1000);
   }
   if (r.Has("white_balance")) {
-    const YamlReader w = r.Child("white_balance");
+    const ParamReader w = r.Child("white_balance");
     const std::string v = w.String();
     if (v == "auto") {
       s.white_balance.mode = WhiteBalance::Mode::kAuto;
@@ -145,24 +146,25 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
     }
   }
   if (r.Has("depth_noise")) {
-    const YamlReader d = r.Child("depth_noise");
+    const ParamReader d = r.Child("depth_noise");
     d.ExpectMap({"preset", "min_range_m", "max_range_m"});
     std::vector<std::string_view> presets(std::begin(kDepthNoisePresets),
                                           std::end(kDepthNoisePresets));
-    const YamlReader p = d.Child("preset");
+    const ParamReader p = d.Child("preset");
     s.depth_noise.preset = p.String();
     if (std::find(presets.begin(), presets.end(), s.depth_noise.preset) == presets.end())
       p.Fail(Who(*c) + "unknown depth noise preset '" + s.depth_noise.preset +
              "'; expected one of: " + JoinNames(presets));
     if (d.Has("min_range_m"))
       s.depth_noise.min_range_m = NonNegative(d.Child("min_range_m"), *c, "m");
-    if (d.Has("max_range_m")) s.depth_noise.max_range_m = Positive(d.Child("max_range_m"), *c, "m");
+    if (const auto found = d.Find("max_range_m"))
+      s.depth_noise.max_range_m = Positive(*found, *c, "m");
     if (s.depth_noise.min_range_m && s.depth_noise.max_range_m &&
         !(*s.depth_noise.max_range_m > *s.depth_noise.min_range_m))
       d.Child("max_range_m").Fail(Who(*c) + "expected max_range_m > min_range_m");
   }
   if (r.Has("stereo")) {
-    const YamlReader st = r.Child("stereo");
+    const ParamReader st = r.Child("stereo");
     if (c->is_mjcf_override)
       st.Fail(Who(*c) +
               "MJCF cameras cannot be made stereo pairs; expected a world-file camera "
@@ -172,16 +174,16 @@ void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c) {
   }
 }
 
-std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r) {
+std::vector<SemanticClassConfig> ReadSemanticClasses(const ParamReader& r) {
   std::vector<SemanticClassConfig> out;
   std::set<std::string> names;
   std::set<int> ids;
-  for (const YamlReader& e : r.List()) {
+  for (const ParamReader& e : r.List()) {
     e.ExpectMap({"name", "id", "bodies", "geoms", "materials"});
     SemanticClassConfig c;
     c.name = e.Child("name").String();
     if (auto problem = NameLengthProblem(c.name)) e.Child("name").Fail(*problem);
-    const YamlReader id = e.Child("id");
+    const ParamReader id = e.Child("id");
     c.id = id.Int();
     if (c.id < 1 || c.id > 65535)
       id.Fail("class '" + c.name + "': got " + std::to_string(c.id) +
@@ -192,7 +194,7 @@ std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r) {
       id.Fail("class id " + std::to_string(c.id) + " is used twice; expected unique ids");
     auto patterns = [&](const char* key, std::vector<std::string>* v) {
       if (!e.Has(key)) return;
-      for (const YamlReader& p : e.Child(key).List()) v->push_back(p.String());
+      for (const ParamReader& p : e.Child(key).List()) v->push_back(p.String());
     };
     patterns("bodies", &c.bodies);
     patterns("geoms", &c.geoms);

@@ -18,8 +18,8 @@
 
 #include <vector>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/world/world_config.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 
@@ -31,9 +31,9 @@ const std::vector<std::string_view>& CameraSensorKeys();
 /// known at load; MJCF camera overrides without one are checked at scene assembly). `stereo` is
 /// rejected for MJCF camera overrides.
 /// @throws ConfigError naming the file, line, key path and the camera.
-void ReadCameraSensorKeys(const YamlReader& r, CameraConfig* c);
+void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c);
 
 /// reads the `semantic_classes:` list. @throws ConfigError for bad ids, duplicate names/ids.
-std::vector<SemanticClassConfig> ReadSemanticClasses(const YamlReader& r);
+std::vector<SemanticClassConfig> ReadSemanticClasses(const ParamReader& r);
 
 }  // namespace penumbra

@@ -18,7 +18,7 @@ const std::vector<std::string_view> kCommonKeys = {
 // remember each key's line for the validation errors.
 class EntryReader : public EffectParamReader {
  public:
-  EntryReader(const YamlReader& r, LineTable* lines, const fs::path* base_dir)
+  EntryReader(const ParamReader& r, LineTable* lines, const fs::path* base_dir)
       : r_(r), lines_(lines), base_dir_(base_dir) {}
 
   bool Has(std::string_view k) const override { return r_.Has(k); }
@@ -32,7 +32,7 @@ class EntryReader : public EffectParamReader {
   }
   std::vector<std::unique_ptr<EffectParamReader>> List(std::string_view k) const override {
     std::vector<std::unique_ptr<EffectParamReader>> out;
-    for (const YamlReader& er : Child(k).List()) {
+    for (const ParamReader& er : Child(k).List()) {
       lines_->Record(er.path(), er.line());
       out.push_back(std::make_unique<EntryReader>(er, lines_, base_dir_));
     }
@@ -45,19 +45,19 @@ class EntryReader : public EffectParamReader {
     return p.lexically_normal().string();
   }
 
-  YamlReader Child(std::string_view k) const {
-    YamlReader c = r_.Child(k);
+  ParamReader Child(std::string_view k) const {
+    ParamReader c = r_.Child(k);
     lines_->Record(c.path(), c.line());
     return c;
   }
 
  private:
-  YamlReader r_;
+  ParamReader r_;
   LineTable* lines_;
   const fs::path* base_dir_;
 };
 
-EffectConfig ReadEffect(const YamlReader& r, const fs::path& base_dir, LineTable* lines) {
+EffectConfig ReadEffect(const ParamReader& r, const fs::path& base_dir, LineTable* lines) {
   r.ExpectMapAnyKeys();
   lines->Record(r.path(), r.line());
   EntryReader e(r, lines, &base_dir);
@@ -75,7 +75,7 @@ EffectConfig ReadEffect(const YamlReader& r, const fs::path& base_dir, LineTable
   e.Num("fade_in_sec", &c.fade_in_sec);
   e.Num("fade_out_sec", &c.fade_out_sec);
   if (e.Has("region")) {
-    const YamlReader rr = e.Child("region");
+    const ParamReader rr = e.Child("region");
     rr.ExpectMap({"min", "max"});
     EntryReader re(rr, lines, &base_dir);
     BoxRegion b;
@@ -90,7 +90,7 @@ EffectConfig ReadEffect(const YamlReader& r, const fs::path& base_dir, LineTable
 
 }  // namespace
 
-std::vector<EffectConfig> ReadEffects(const YamlReader& list, const std::string& file) {
+std::vector<EffectConfig> ReadEffects(const ParamReader& list, const std::string& file) {
   std::error_code ec;
   const fs::path abs =
       file.empty() ? fs::current_path(ec) / "world.yaml" : fs::absolute(fs::path(file), ec);
@@ -98,7 +98,7 @@ std::vector<EffectConfig> ReadEffects(const YamlReader& list, const std::string&
   LineTable lines;
   lines.Record(list.path(), list.line());
   std::vector<EffectConfig> out;
-  for (const YamlReader& r : list.List()) out.push_back(ReadEffect(r, base_dir, &lines));
+  for (const ParamReader& r : list.List()) out.push_back(ReadEffect(r, base_dir, &lines));
   // ranges and cross-effect rules, with the line of the offending key
   ValidateEffectsOrThrow(out, file, [&](const std::string& key) { return lines.Find(key); });
   return out;

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/effects/effect_config.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 
@@ -25,6 +25,6 @@ namespace penumbra {
 /// @throws ConfigError naming the file, line, key path ("effects[2].mor_m") and what was
 ///         expected: unknown keys or types, wrong value types, out-of-range values
 ///         (EffectConfig::Validate), duplicate names, dangling rain / fire references.
-std::vector<EffectConfig> ReadEffects(const YamlReader& list, const std::string& file);
+std::vector<EffectConfig> ReadEffects(const ParamReader& list, const std::string& file);
 
 }  // namespace penumbra

@@ -1,7 +1,7 @@
 #include "penumbra/world/environment_config.h"
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 
@@ -23,12 +23,12 @@ void EnvironmentConfig::ValidateOrThrow(const std::string& file, int line,
                       std::to_string(texture_resolution) + "; expected 16 ... 4096");
 }
 
-EnvironmentConfig ReadEnvironmentConfig(const YamlReader& r) {
+EnvironmentConfig ReadEnvironmentConfig(const ParamReader& r) {
   r.ExpectMap({"type", "seed", "texture_resolution"});
   EnvironmentConfig c;
   c.type = r.Child("type").Enum(EnvironmentTypes());
-  if (r.Has("seed")) c.seed = r.Child("seed").Uint64();
-  if (r.Has("texture_resolution")) c.texture_resolution = r.Child("texture_resolution").Int();
+  if (const auto found = r.Find("seed")) c.seed = found->Uint64();
+  if (const auto found = r.Find("texture_resolution")) c.texture_resolution = found->Int();
   if (c.texture_resolution < 16 || c.texture_resolution > 4096)
     r.Child("texture_resolution")
         .Fail(std::to_string(c.texture_resolution) + "; expected 16 ... 4096");

@@ -13,7 +13,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 
 /// what to generate. the floor plan of each type is fixed (its walls, doors and walkways, so a
 /// route written for it stays valid); the seed varies the furniture, clutter, materials and
@@ -36,6 +36,6 @@ const std::vector<std::string_view>& EnvironmentTypes();
 
 /// reads an `environment:` mapping (type, seed, texture_resolution) and validates it.
 /// @throws ConfigError naming the line and key for unknown keys, types and bad values.
-EnvironmentConfig ReadEnvironmentConfig(const YamlReader& r);
+EnvironmentConfig ReadEnvironmentConfig(const ParamReader& r);
 
 }  // namespace penumbra

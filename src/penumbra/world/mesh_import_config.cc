@@ -1,14 +1,14 @@
 #include "penumbra/world/mesh_import_config.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 
+#include "penumbra/config/param_reader.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
-#include "penumbra/world/yaml_reader.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -53,7 +53,7 @@ const std::vector<std::string_view>& MeshImportKeys() {
   return keys;
 }
 
-void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out) {
+void ReadMeshImportKeys(const ParamReader& r, bool is_mesh, MeshImportConfig* out) {
   out->line = r.line();
   for (std::string_view k : MeshImportKeys()) {
     if (r.Has(k) && !is_mesh)
@@ -76,7 +76,8 @@ void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out
     if (!(out->scale > 0 && out->scale <= kMaxScale))
       r.Child("scale").Fail("expected metres per file unit in (0, 1e6]");
   }
-  if (r.Has("up_axis")) out->up_axis = r.Child("up_axis").Enum({"x", "y", "z", "-x", "-y", "-z"});
+  if (const auto found = r.Find("up_axis"))
+    out->up_axis = found->Enum({"x", "y", "z", "-x", "-y", "-z"});
   if (r.Has("handedness"))
     out->left_handed = r.Child("handedness").Enum({"right", "left"}) == "left";
   if (r.Has("emissive_cd_m2")) {
@@ -118,18 +119,18 @@ MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::st
   const std::string list = key.substr(0, open);
   const size_t index = std::stoul(key.substr(open + 1, close - open - 1));
   // a world whose file is gone (a replay's recorded world): the format defaults
-  YAML::Node root;
+  ConfigValue root;
   try {
-    root = YAML::LoadFile(world_file);
-  } catch (const YAML::Exception&) {
+    root = ParseYaml(ReadInputFile(world_file, "world file"), world_file);
+  } catch (const ConfigError&) {
     return out;
   }
-  const YamlReader doc(root, world_file, nullptr);
+  const ParamReader doc(root, world_file, nullptr);
   doc.ExpectMapAnyKeys();
   if (!doc.Has(list)) return out;
-  const YamlReader entries = doc.Child(list);
+  const ParamReader entries = doc.Child(list);
   if (index >= entries.size()) return out;
-  const YamlReader entry = entries.Element(index);
+  const ParamReader entry = entries.Element(index);
   entry.ExpectMapAnyKeys();
   const std::string file = entry.Has("file") ? entry.Child("file").String() : "";
   ReadMeshImportKeys(entry, IsMeshModelFile(file), &out);

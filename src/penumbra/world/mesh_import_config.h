@@ -8,7 +8,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 
 /// how a mesh file's coordinates and materials are converted (docs/assets.md, "Units and axes").
 /// a point p of the file becomes R_up (M p) scale in the model frame: M mirrors the file's x axis
@@ -68,6 +68,6 @@ MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::st
 /// @throws ConfigError naming the line and key: both `units` and `scale`, an unknown unit,
 ///         axis or handedness, a non-positive scale, or mesh keys on a model whose file is not
 ///         a mesh (`is_mesh` false).
-void ReadMeshImportKeys(const YamlReader& r, bool is_mesh, MeshImportConfig* out);
+void ReadMeshImportKeys(const ParamReader& r, bool is_mesh, MeshImportConfig* out);
 
 }  // namespace penumbra

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <map>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/world_validation.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 namespace {
@@ -57,25 +57,25 @@ std::vector<std::string_view> KindKeys(MetricKind kind) {
   return {};
 }
 
-std::vector<std::string> Names(const YamlReader& r) {
+std::vector<std::string> Names(const ParamReader& r) {
   std::vector<std::string> out;
-  for (const YamlReader& e : r.List()) out.push_back(e.String());
+  for (const ParamReader& e : r.List()) out.push_back(e.String());
   return out;
 }
 
-std::vector<ContactPairRule> ReadRules(const YamlReader& r) {
+std::vector<ContactPairRule> ReadRules(const ParamReader& r) {
   std::vector<ContactPairRule> rules;
-  for (const YamlReader& e : r.List()) {
+  for (const ParamReader& e : r.List()) {
     e.ExpectMap({"a", "b"});
     ContactPairRule rule;
-    if (e.Has("a")) rule.a = e.Child("a").String();
-    if (e.Has("b")) rule.b = e.Child("b").String();
+    if (const auto found = e.Find("a")) rule.a = found->String();
+    if (const auto found = e.Find("b")) rule.b = found->String();
     rules.push_back(rule);
   }
   return rules;
 }
 
-MetricConfig ReadEntry(const YamlReader& r) {
+MetricConfig ReadEntry(const ParamReader& r) {
   r.ExpectMapAnyKeys();
   MetricConfig m;
   m.name = r.Child("name").String();
@@ -89,7 +89,7 @@ MetricConfig ReadEntry(const YamlReader& r) {
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       child.Fail("does not apply to a " + type + " metric; expected one of: " + JoinNames(keys));
   }
-  if (r.Has("rate_hz")) m.rate_hz = r.Child("rate_hz").Double();
+  if (const auto found = r.Find("rate_hz")) m.rate_hz = found->Double();
   switch (m.kind) {
     case MetricKind::kBodyPose:
     case MetricKind::kBodyTwist:
@@ -104,8 +104,8 @@ MetricConfig ReadEntry(const YamlReader& r) {
       m.body = r.Child("body").String();
       if (r.Has("to_body") == r.Has("to_point"))
         r.Fail("a distance metric needs exactly one of to_body and to_point");
-      if (r.Has("to_body")) m.to_body = r.Child("to_body").String();
-      if (r.Has("to_point")) m.to_point_m = r.Child("to_point").Vector3();
+      if (const auto found = r.Find("to_body")) m.to_body = found->String();
+      if (const auto found = r.Find("to_point")) m.to_point_m = found->Vector3();
       break;
     case MetricKind::kSensor:
       m.sensors = Names(r.Child("sensors"));
@@ -114,13 +114,13 @@ MetricConfig ReadEntry(const YamlReader& r) {
       m.robot = r.Child("robot").String();
       break;
     case MetricKind::kContacts:
-      if (r.Has("min_force_N")) m.min_force_N = r.Child("min_force_N").Double();
-      if (r.Has("debounce_sec")) m.debounce_sec = r.Child("debounce_sec").Double();
-      if (r.Has("between")) m.between = ReadRules(r.Child("between"));
-      if (r.Has("exclude")) m.exclude = ReadRules(r.Child("exclude"));
-      if (r.Has("self_contacts")) m.self_contacts = r.Child("self_contacts").Bool();
-      if (r.Has("pair")) m.geom_pairs = r.Child("pair").Enum({"body", "geom"}) == "geom";
-      if (r.Has("detect_hz")) m.detect_hz = r.Child("detect_hz").Double();
+      if (const auto found = r.Find("min_force_N")) m.min_force_N = found->Double();
+      if (const auto found = r.Find("debounce_sec")) m.debounce_sec = found->Double();
+      if (const auto found = r.Find("between")) m.between = ReadRules(*found);
+      if (const auto found = r.Find("exclude")) m.exclude = ReadRules(*found);
+      if (const auto found = r.Find("self_contacts")) m.self_contacts = found->Bool();
+      if (const auto found = r.Find("pair")) m.geom_pairs = found->Enum({"body", "geom"}) == "geom";
+      if (const auto found = r.Find("detect_hz")) m.detect_hz = found->Double();
       break;
   }
   return m;
@@ -209,12 +209,12 @@ void MetricsConfig::ValidateOrThrow() const {
   }
 }
 
-MetricsConfig ReadMetrics(const YamlReader& r) {
+MetricsConfig ReadMetrics(const ParamReader& r) {
   r.ExpectMap({"rate_hz", "series"});
   MetricsConfig c;
-  if (r.Has("rate_hz")) c.rate_hz = r.Child("rate_hz").Double();
+  if (const auto found = r.Find("rate_hz")) c.rate_hz = found->Double();
   if (r.Has("series"))
-    for (const YamlReader& e : r.Child("series").List()) c.series.push_back(ReadEntry(e));
+    for (const ParamReader& e : r.Child("series").List()) c.series.push_back(ReadEntry(e));
   return c;
 }
 

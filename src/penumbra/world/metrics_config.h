@@ -39,7 +39,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 
 /// what a metric records (`type:`); units and columns in docs/metrics.md.
 enum class MetricKind {
@@ -107,6 +107,6 @@ struct MetricsConfig {
 /// @throws ConfigError naming the file, line and key path: unknown keys (also keys that do not
 ///         apply to the entry's type), wrong types, unknown types, missing required keys,
 ///         out-of-range values, duplicate names.
-MetricsConfig ReadMetrics(const YamlReader& r);
+MetricsConfig ReadMetrics(const ParamReader& r);
 
 }  // namespace penumbra

@@ -1,9 +1,9 @@
 #include "penumbra/world/procedural_material_config.h"
 
-#include <yaml-cpp/yaml.h>
-
+#include "penumbra/config/param_reader.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
-#include "penumbra/world/yaml_reader.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 
@@ -28,11 +28,11 @@ void ProceduralMaterialConfig::ValidateOrThrow(const std::string& file, int line
     throw ConfigError(file, line, key + ".color", "expected 3 numbers in [0, 1]");
 }
 
-ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r) {
+ProceduralMaterialConfig ReadProceduralMaterial(const ParamReader& r) {
   r.ExpectMap({"type", "seed", "size_m", "resolution", "color"});
   ProceduralMaterialConfig c;
   c.type = r.Child("type").Enum(ProceduralTypes());
-  if (r.Has("seed")) c.seed = r.Child("seed").Uint64();
+  if (const auto found = r.Find("seed")) c.seed = found->Uint64();
   if (r.Has("size_m")) {
     c.size_m = r.Child("size_m").Double();
     if (!(c.size_m > 0 && c.size_m <= 100)) r.Child("size_m").Fail("expected a size in (0, 100] m");
@@ -55,13 +55,13 @@ std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& wo
   std::vector<ProceduralMaterialEntry> out;
   if (world_file.empty()) return out;
   // a world whose file is gone (a replay's recorded world): none
-  YAML::Node root;
+  ConfigValue root;
   try {
-    root = YAML::LoadFile(world_file);
-  } catch (const YAML::Exception&) {
+    root = ParseYaml(ReadInputFile(world_file, "world file"), world_file);
+  } catch (const ConfigError&) {
     return out;
   }
-  const YamlReader doc(root, world_file, nullptr);
+  const ParamReader doc(root, world_file, nullptr);
   doc.ExpectMapAnyKeys();
   if (!doc.Has("materials")) return out;
   for (auto& [name, entry] : doc.Child("materials").Entries()) {

@@ -12,7 +12,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 
 /// what to generate. the maps tile every `size_m` metres (one image); on primitives (planes,
 /// boxes, ...) they are laid out per metre (texuniform), on meshes with texcoords one image
@@ -50,6 +50,6 @@ std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& wo
 
 /// reads a `procedural:` mapping (type, seed, size_m, resolution, color).
 /// @throws ConfigError naming the line and key for unknown keys, types and bad values.
-ProceduralMaterialConfig ReadProceduralMaterial(const YamlReader& r);
+ProceduralMaterialConfig ReadProceduralMaterial(const ParamReader& r);
 
 }  // namespace penumbra

@@ -1,14 +1,14 @@
 #include "penumbra/world/ros_config.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cctype>
 #include <cmath>
 #include <set>
 
+#include "penumbra/config/param_reader.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/world/world_config.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 
@@ -59,35 +59,35 @@ bool IsValidFrameId(const std::string& id) {
   return true;
 }
 
-RosConfig ReadRosConfig(const YamlReader& r) {
+RosConfig ReadRosConfig(const ParamReader& r) {
   r.ExpectMap({"namespace", "map_frame", "state_rate_hz", "robots", "sensors"});
   RosConfig c;
-  if (r.Has("namespace")) c.ns = r.Child("namespace").String();
-  if (r.Has("map_frame")) c.map_frame = r.Child("map_frame").String();
-  if (r.Has("state_rate_hz")) c.state_rate_hz = r.Child("state_rate_hz").Double();
+  if (const auto found = r.Find("namespace")) c.ns = found->String();
+  if (const auto found = r.Find("map_frame")) c.map_frame = found->String();
+  if (const auto found = r.Find("state_rate_hz")) c.state_rate_hz = found->Double();
   if (r.Has("robots")) {
-    const YamlReader robots = r.Child("robots");
+    const ParamReader robots = r.Child("robots");
     robots.ExpectMapAnyKeys();
     for (auto& [name, e] : robots.Entries()) {
       e.ExpectMap({"base_body", "base_frame", "odom_frame", "namespace"});
       RosRobotConfig rc;
       rc.robot = name;
-      if (e.Has("base_body")) rc.base_body = e.Child("base_body").String();
-      if (e.Has("base_frame")) rc.base_frame = e.Child("base_frame").String();
-      if (e.Has("odom_frame")) rc.odom_frame = e.Child("odom_frame").String();
-      if (e.Has("namespace")) rc.ns = e.Child("namespace").String();
+      if (const auto found = e.Find("base_body")) rc.base_body = found->String();
+      if (const auto found = e.Find("base_frame")) rc.base_frame = found->String();
+      if (const auto found = e.Find("odom_frame")) rc.odom_frame = found->String();
+      if (const auto found = e.Find("namespace")) rc.ns = found->String();
       c.robots.push_back(rc);
     }
   }
   if (r.Has("sensors")) {
-    const YamlReader sensors = r.Child("sensors");
+    const ParamReader sensors = r.Child("sensors");
     sensors.ExpectMapAnyKeys();
     for (auto& [name, e] : sensors.Entries()) {
       e.ExpectMap({"topic", "frame_id"});
       RosSensorConfig sc;
       sc.sensor = name;
-      if (e.Has("topic")) sc.topic = e.Child("topic").String();
-      if (e.Has("frame_id")) sc.frame_id = e.Child("frame_id").String();
+      if (const auto found = e.Find("topic")) sc.topic = found->String();
+      if (const auto found = e.Find("frame_id")) sc.frame_id = found->String();
       c.sensors.push_back(sc);
     }
   }
@@ -153,15 +153,10 @@ void ValidateRosReferences(const RosConfig& ros, const WorldConfig& world) {
 
 RosConfig LoadRosConfig(const WorldConfig& world) {
   if (world.file.empty()) return RosConfig{};
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(world.file);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(world.file, e.mark.line + 1, "", std::string("cannot read: ") + e.what());
-  }
+  const ConfigValue root = ParseYaml(ReadInputFile(world.file, "world file"), world.file);
   if (!root.IsMap() || !root["ros"]) return RosConfig{};
   LineTable lines;
-  const YamlReader r(root, world.file, &lines);
+  const ParamReader r(root, world.file, &lines);
   const RosConfig c = ReadRosConfig(r.Child("ros"));
   try {
     c.ValidateOrThrow();

@@ -32,7 +32,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 struct WorldConfig;
 
 /// `ros.robots.<name>`.
@@ -67,7 +67,7 @@ struct RosConfig {
 
 /// reads the `ros:` section (types and keys; ranges in RosConfig::ValidateOrThrow).
 /// @throws ConfigError naming file, line and key path.
-RosConfig ReadRosConfig(const YamlReader& r);
+RosConfig ReadRosConfig(const ParamReader& r);
 
 /// checks that every robot of `ros.robots` is a robot of `world` and every sensor of
 /// `ros.sensors` is a world-file camera, LiDAR or IMU (a name with '/', an MJCF camera, is

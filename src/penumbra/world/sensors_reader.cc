@@ -4,10 +4,10 @@
 #include <cmath>
 #include <set>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 namespace {
@@ -26,16 +26,16 @@ std::string Prefixed(const std::string& robot, const std::string& name) {
 // largest noise parameter of a sensor (standard deviations, densities, random walks).
 constexpr double kMaxSensorNoise = 1e3;
 
-double NonNegative(const YamlReader& r, const std::string& unit) {
+double NonNegative(const ParamReader& r, const std::string& unit) {
   const double v = r.Double();
   if (v < 0) r.Fail("got " + FormatNumber(v) + "; expected a number >= 0 (" + unit + ")");
   return v;
 }
 
-SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s);
+SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, SensorConfig s);
 
 // every error after the name names the sensor: "sensor '<name>': <problem>"
-SensorConfig ReadSensor(const YamlReader& r, const std::string& robot) {
+SensorConfig ReadSensor(const ParamReader& r, const std::string& robot) {
   r.ExpectMapAnyKeys();
   SensorConfig s;
   s.name = r.Child("name").String();
@@ -53,7 +53,7 @@ SensorConfig ReadSensor(const YamlReader& r, const std::string& robot) {
   }
 }
 
-SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, SensorConfig s) {
+SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, SensorConfig s) {
   s.line = r.line();
   s.key = r.path();
   s.robot = robot;
@@ -88,31 +88,31 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   r.ExpectMap(keys);
   const std::string sensor = "sensor '" + s.name + "': ";
   if (r.Has("rate_hz")) {
-    const YamlReader c = r.Child("rate_hz");
+    const ParamReader c = r.Child("rate_hz");
     s.rate_hz = c.Double();
     if (!(*s.rate_hz > 0))
       c.Fail(sensor + "got " + FormatNumber(*s.rate_hz) + "; expected a rate > 0 (Hz)");
   }
-  if (r.Has("latency_sec")) s.latency_sec = NonNegative(r.Child("latency_sec"), "s");
-  if (r.Has("body")) s.body = Prefixed(robot, r.Child("body").String());
-  if (r.Has("site")) s.site = Prefixed(robot, r.Child("site").String());
+  if (const auto found = r.Find("latency_sec")) s.latency_sec = NonNegative(*found, "s");
+  if (const auto found = r.Find("body")) s.body = Prefixed(robot, found->String());
+  if (const auto found = r.Find("site")) s.site = Prefixed(robot, found->String());
   if (!s.body.empty() && !s.site.empty())
     r.Child("site").Fail(sensor + "both body and site are set; expected one of them");
   if (s.type == "imu" && s.body.empty() && s.site.empty())
     r.Fail(sensor + "an imu needs 'body' or 'site' to attach to");
   if ((s.type == "lidar") && s.body.empty() && s.site.empty()) s.body = "world";
   if (r.Has("pose")) {
-    const YamlReader p = r.Child("pose");
+    const ParamReader p = r.Child("pose");
     p.ExpectMap({"xyz", "rpy_deg"});
     if (p.Has("xyz")) {
-      const YamlReader c = p.Child("xyz");
+      const ParamReader c = p.Child("xyz");
       s.xyz = c.Vector3();
       if (!(s.xyz.cwiseAbs().maxCoeff() <= kMaxPositionM))
         c.Fail(sensor + "got [" + FormatNumber(s.xyz.x()) + ", " + FormatNumber(s.xyz.y()) + ", " +
                FormatNumber(s.xyz.z()) + "]; expected each of the 3 numbers in [" +
                FormatNumber(-kMaxPositionM) + ", " + FormatNumber(kMaxPositionM) + "] (m)");
     }
-    if (p.Has("rpy_deg")) s.rpy_deg = p.Child("rpy_deg").Vector3();
+    if (const auto found = p.Find("rpy_deg")) s.rpy_deg = found->Vector3();
   }
   if (s.type == "lidar") {
     s.preset = r.Child("preset").Enum(kLidarPresets);
@@ -120,7 +120,7 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
     s.preset = r.Has("preset") ? r.Child("preset").Enum(kImuPresets) : "consumer_mems";
   }
   if (r.Has("columns")) {
-    const YamlReader c = r.Child("columns");
+    const ParamReader c = r.Child("columns");
     const int v = c.Int();
     if (v < 1 || v > kMaxLidarBeamsPerScan)
       c.Fail(sensor + "got " + std::to_string(v) + "; expected an integer in [1, " +
@@ -133,7 +133,7 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   if (r.Has("beam_divergence_mrad"))
     s.params["beam_divergence_mrad"] = NonNegative(r.Child("beam_divergence_mrad"), "mrad");
   if (r.Has("reference_reflectivity")) {
-    const YamlReader c = r.Child("reference_reflectivity");
+    const ParamReader c = r.Child("reference_reflectivity");
     const double v = c.Double();
     if (!(v > 0 && v <= 1)) c.Fail(sensor + "got " + FormatNumber(v) + "; expected (0, 1]");
     s.params["reference_reflectivity"] = v;
@@ -141,11 +141,11 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   for (const char* k : {"intensity_range_normalized", "media", "contacts"})
     if (r.Has(k)) s.params[k] = r.Child(k).Bool() ? 1 : 0;
   if (r.Has("noise")) {
-    const YamlReader n = r.Child("noise");
+    const ParamReader n = r.Child("noise");
     n.ExpectMap(noise_keys);
     for (std::string_view k : noise_keys) {
       if (!n.Has(k)) continue;
-      const YamlReader c = n.Child(k);
+      const ParamReader c = n.Child(k);
       const double v = c.Double();
       // 1e308 made every reading infinite
       if (!(v >= 0 && v <= kMaxSensorNoise))
@@ -158,17 +158,17 @@ SensorConfig ReadSensorFields(const YamlReader& r, const std::string& robot, Sen
   }
   for (const char* k : {"sensors", "bodies"}) {
     if (!r.Has(k)) continue;
-    for (const YamlReader& e : r.Child(k).List()) s.names.push_back(Prefixed(robot, e.String()));
+    for (const ParamReader& e : r.Child(k).List()) s.names.push_back(Prefixed(robot, e.String()));
   }
   return s;
 }
 
 }  // namespace
 
-std::vector<SensorConfig> ReadSensors(const YamlReader& list, const std::string& file,
+std::vector<SensorConfig> ReadSensors(const ParamReader& list, const std::string& file,
                                       const std::string& robot) {
   std::vector<SensorConfig> out;
-  for (const YamlReader& e : list.List()) {
+  for (const ParamReader& e : list.List()) {
     out.push_back(ReadSensor(e, robot));
     out.back().file = file;
   }

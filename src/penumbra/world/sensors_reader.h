@@ -37,7 +37,7 @@
 
 namespace penumbra {
 
-class YamlReader;
+class ParamReader;
 
 /// one world-file sensor.
 struct SensorConfig {
@@ -73,7 +73,7 @@ struct SensorConfig {
 /// @throws ConfigError (file, line, key path such as sensors[2].rate_hz, expected range)
 ///         for unknown keys or types, a missing name/type/preset, zero or negative rates,
 ///         negative latency or noise, unknown presets, body and site both or neither (imu).
-std::vector<SensorConfig> ReadSensors(const YamlReader& list, const std::string& file,
+std::vector<SensorConfig> ReadSensors(const ParamReader& list, const std::string& file,
                                       const std::string& robot);
 
 /// checks that sensor names are unique over `sensors`.

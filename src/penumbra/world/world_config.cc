@@ -1,8 +1,5 @@
 #include "penumbra/world/world_config.h"
 
-#include <yaml-cpp/eventhandler.h>
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -10,7 +7,10 @@
 #include <optional>
 #include <sstream>
 
+#include "penumbra/config/param_reader.h"
+#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
@@ -20,7 +20,6 @@
 #include "penumbra/world/procedural_material_config.h"
 #include "penumbra/world/ros_config.h"
 #include "penumbra/world/world_validation.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace fs = std::filesystem;
 
@@ -39,8 +38,8 @@ class WorldParser {
     base_dir_ = abs.parent_path();
   }
 
-  WorldConfig Parse(const YAML::Node& root) {
-    YamlReader r(root, file_, lines_);
+  WorldConfig Parse(const ConfigValue& root) {
+    ParamReader r(root, file_, lines_);
     const std::vector<std::string_view> keys = {
         "seed",      "duration_sec", "physics", "render",    "sky",
         "robots",    "models",       "lights",  "cameras",   "mjcf_cameras",
@@ -54,14 +53,15 @@ class WorldParser {
 
     WorldConfig w;
     w.file = file_;
-    if (r.Has("seed")) w.seed = r.Child("seed").Uint64();
-    if (r.Has("duration_sec")) w.duration_sec = r.Child("duration_sec").Double();
-    if (r.Has("physics")) {
-      YamlReader p = r.Child("physics");
-      p.ExpectMap({"timestep_sec", "integrator", "gravity_mps2", "solver_iterations", "cone"});
-      if (p.Has("timestep_sec")) w.timestep_sec = p.Child("timestep_sec").Double();
-      if (p.Has("integrator")) {
-        const YamlReader i = p.Child("integrator");
+    if (const auto found = r.Find("seed")) w.seed = found->Uint64();
+    if (const auto found = r.Find("duration_sec")) w.duration_sec = found->Double();
+    if (const auto physics = r.Find("physics")) {
+      // each key read once; ReportUnused names any other key with the keys read
+      const ParamReader& p = *physics;
+      p.ExpectMapAnyKeys();
+      if (const auto found = p.Find("timestep_sec")) w.timestep_sec = found->Double();
+      if (const auto integrator = p.Find("integrator")) {
+        const ParamReader& i = *integrator;
         if (i.String() == "implicitfast") {
           i.Fail(
               "'implicitfast' is newer than MuJoCo 2.2.2 (Penumbra's physics); expected one of: "
@@ -69,25 +69,26 @@ class WorldParser {
         }
         w.physics.integrator = i.Enum({"Euler", "RK4", "implicit"});
       }
-      if (p.Has("gravity_mps2")) w.physics.gravity_mps2 = p.Child("gravity_mps2").Vector3();
-      if (p.Has("solver_iterations")) {
-        w.physics.solver_iterations = p.Child("solver_iterations").Int();
-      }
-      if (p.Has("cone")) w.physics.cone = p.Child("cone").Enum({"pyramidal", "elliptic"});
+      if (const auto found = p.Find("gravity_mps2")) w.physics.gravity_mps2 = found->Vector3();
+      if (const auto found = p.Find("solver_iterations"))
+        w.physics.solver_iterations = found->Int();
+      if (const auto found = p.Find("cone"))
+        w.physics.cone = found->Enum({"pyramidal", "elliptic"});
+      p.ReportUnused();
     }
-    if (r.Has("render")) ReadRender(r.Child("render"), &w.render);
+    if (const auto found = r.Find("render")) ReadRender(*found, &w.render);
     w.render.seed = w.seed;
-    if (r.Has("sky")) ReadSky(r.Child("sky"), &w.sky);
+    if (const auto found = r.Find("sky")) ReadSky(*found, &w.sky);
     // robots first, then static models, each in file order
     if (r.Has("robots")) {
-      for (const YamlReader& m : r.Child("robots").List()) w.models.push_back(ReadModel(m, true));
+      for (const ParamReader& m : r.Child("robots").List()) w.models.push_back(ReadModel(m, true));
     }
     if (r.Has("models")) {
-      for (const YamlReader& m : r.Child("models").List()) w.models.push_back(ReadModel(m, false));
+      for (const ParamReader& m : r.Child("models").List()) w.models.push_back(ReadModel(m, false));
     }
-    if (r.Has("sensors")) w.sensors = ReadSensors(r.Child("sensors"), file_, "");
+    if (const auto found = r.Find("sensors")) w.sensors = ReadSensors(*found, file_, "");
     if (r.Has("robots")) {
-      for (const YamlReader& m : r.Child("robots").List())
+      for (const ParamReader& m : r.Child("robots").List())
         if (m.Has("sensors")) {
           const auto robot = ReadSensors(m.Child("sensors"), file_, m.Child("name").String());
           w.sensors.insert(w.sensors.end(), robot.begin(), robot.end());
@@ -95,36 +96,36 @@ class WorldParser {
     }
     ValidateSensorNames(w.sensors);
     if (r.Has("lights")) {
-      for (const YamlReader& l : r.Child("lights").List()) w.lights.push_back(ReadLight(l));
+      for (const ParamReader& l : r.Child("lights").List()) w.lights.push_back(ReadLight(l));
     }
     if (r.Has("cameras")) {
-      for (const YamlReader& c : r.Child("cameras").List()) w.cameras.push_back(ReadCamera(c));
+      for (const ParamReader& c : r.Child("cameras").List()) w.cameras.push_back(ReadCamera(c));
     }
-    if (r.Has("mjcf_cameras")) ReadMjcfCameras(r.Child("mjcf_cameras"), &w.mjcf_cameras);
+    if (const auto found = r.Find("mjcf_cameras")) ReadMjcfCameras(*found, &w.mjcf_cameras);
     if (r.Has("materials")) {
       for (auto& [name, m] : r.Child("materials").Entries())
         w.materials.push_back(ReadMaterial(name, m));
     }
     if (r.Has("output")) {
-      YamlReader o = r.Child("output");
+      ParamReader o = r.Child("output");
       o.ExpectMap({"dir"});
-      if (o.Has("dir")) w.output_dir = o.Child("dir").String();
+      if (const auto found = o.Find("dir")) w.output_dir = found->String();
     }
     if (r.Has("record")) {
-      YamlReader rec = r.Child("record");
+      ParamReader rec = r.Child("record");
       rec.ExpectMap({"file", "sensors"});
       if (!rec.Has("file")) rec.Fail("no 'file'; expected record: {file: NAME.plog}");
       w.record.file = rec.Child("file").String();
       // `record: {file: ""}` used to record nothing without a word
       if (w.record.file.empty())
         rec.Child("file").Fail("empty; expected a file name ending in .plog");
-      if (rec.Has("sensors")) w.record.sensors = rec.Child("sensors").Bool();
+      if (const auto found = rec.Find("sensors")) w.record.sensors = found->Bool();
     }
     if (r.Has("semantic_classes"))
       w.semantic_classes = ReadSemanticClasses(r.Child("semantic_classes"));
-    if (r.Has("agents")) w.agents = ReadAgents(r.Child("agents"), file_);
-    if (r.Has("effects")) w.effects = ReadEffects(r.Child("effects"), file_);
-    if (r.Has("metrics")) w.metrics = ReadMetrics(r.Child("metrics"));
+    if (const auto found = r.Find("agents")) w.agents = ReadAgents(*found, file_);
+    if (const auto found = r.Find("effects")) w.effects = ReadEffects(*found, file_);
+    if (const auto found = r.Find("metrics")) w.metrics = ReadMetrics(*found);
     // `ros:` is checked here and read again by the ROS module (world/ros_config.h)
     if (r.Has("ros")) {
       const RosConfig ros = ReadRosConfig(r.Child("ros"));
@@ -136,7 +137,7 @@ class WorldParser {
       }
     }
     if (r.Has("adversity")) {
-      const YamlReader a = r.Child("adversity");
+      const ParamReader a = r.Child("adversity");
       w.adversity = ResolveAdversitySpec(a.String(), base_dir_.string(), file_, a.line());
       w.adversity_line = a.line();
     }
@@ -152,15 +153,15 @@ class WorldParser {
     return p.lexically_normal().string();
   }
 
-  static void ReadPose(const YamlReader& r, PoseConfig* pose) {
+  static void ReadPose(const ParamReader& r, PoseConfig* pose) {
     r.ExpectMap({"xyz", "rpy_deg"});
-    if (r.Has("xyz")) pose->xyz = r.Child("xyz").Vector3();
-    if (r.Has("rpy_deg")) pose->rpy_deg = r.Child("rpy_deg").Vector3();
+    if (const auto found = r.Find("xyz")) pose->xyz = found->Vector3();
+    if (const auto found = r.Find("rpy_deg")) pose->rpy_deg = found->Vector3();
   }
 
-  static Eigen::Vector3f Vector3f(const YamlReader& r) { return r.Vector3().cast<float>(); }
+  static Eigen::Vector3f Vector3f(const ParamReader& r) { return r.Vector3().cast<float>(); }
 
-  static void ReadRender(const YamlReader& r, RenderSettings* s) {
+  static void ReadRender(const ParamReader& r, RenderSettings* s) {
     r.ExpectMap({"backend", "tier", "samples_per_pixel", "max_bounces", "denoise", "threads",
                  "exposure", "tone_map", "max_anisotropy"});
     // cpu (also spelt embree, its ray tracer), cuda or auto (docs/gpu.md): Enum names them in
@@ -174,16 +175,17 @@ class WorldParser {
                     ? RenderSettings::Tier::kRealtime
                     : RenderSettings::Tier::kPathtraced;
     }
-    if (r.Has("samples_per_pixel")) s->samples_per_pixel = r.Child("samples_per_pixel").Int();
-    if (r.Has("max_bounces")) s->max_bounces = r.Child("max_bounces").Int();
-    if (r.Has("denoise")) s->denoise = r.Child("denoise").Bool();
-    if (r.Has("threads")) s->threads = r.Child("threads").Int();
-    if (r.Has("max_anisotropy")) s->max_anisotropy = r.Child("max_anisotropy").Int();
+    if (const auto found = r.Find("samples_per_pixel")) s->samples_per_pixel = found->Int();
+    if (const auto found = r.Find("max_bounces")) s->max_bounces = found->Int();
+    if (const auto found = r.Find("denoise")) s->denoise = found->Bool();
+    if (const auto found = r.Find("threads")) s->threads = found->Int();
+    if (const auto found = r.Find("max_anisotropy")) s->max_anisotropy = found->Int();
     if (r.Has("exposure")) {
-      YamlReader e = r.Child("exposure");
+      ParamReader e = r.Child("exposure");
       e.ExpectMap({"mode", "ev100", "compensation_ev"});
-      if (e.Has("mode")) s->auto_exposure = e.Child("mode").Enum({"auto", "manual"}) == "auto";
-      if (e.Has("ev100")) s->ev100 = e.Child("ev100").Double();
+      if (const auto found = e.Find("mode"))
+        s->auto_exposure = found->Enum({"auto", "manual"}) == "auto";
+      if (const auto found = e.Find("ev100")) s->ev100 = found->Double();
       if (e.Has("compensation_ev")) {
         s->exposure_compensation_ev = e.Child("compensation_ev").Double();
       }
@@ -195,24 +197,24 @@ class WorldParser {
     }
   }
 
-  static void ReadSky(const YamlReader& r, SkyConfig* s) {
+  static void ReadSky(const ParamReader& r, SkyConfig* s) {
     r.ExpectMap({"type", "color", "luminance_cd_m2", "turbidity", "sun_elevation_deg",
                  "sun_azimuth_deg", "zenith_luminance_cd_m2"});
     if (r.Has("type")) {
       s->type = r.Child("type").Enum({"uniform", "daylight"}) == "uniform" ? Sky::Type::kUniform
                                                                            : Sky::Type::kDaylight;
     }
-    if (r.Has("color")) s->color = Vector3f(r.Child("color"));
-    if (r.Has("luminance_cd_m2")) s->luminance_cd_m2 = r.Child("luminance_cd_m2").Double();
-    if (r.Has("turbidity")) s->turbidity = r.Child("turbidity").Double();
-    if (r.Has("sun_elevation_deg")) s->sun_elevation_deg = r.Child("sun_elevation_deg").Double();
-    if (r.Has("sun_azimuth_deg")) s->sun_azimuth_deg = r.Child("sun_azimuth_deg").Double();
+    if (const auto found = r.Find("color")) s->color = Vector3f(*found);
+    if (const auto found = r.Find("luminance_cd_m2")) s->luminance_cd_m2 = found->Double();
+    if (const auto found = r.Find("turbidity")) s->turbidity = found->Double();
+    if (const auto found = r.Find("sun_elevation_deg")) s->sun_elevation_deg = found->Double();
+    if (const auto found = r.Find("sun_azimuth_deg")) s->sun_azimuth_deg = found->Double();
     if (r.Has("zenith_luminance_cd_m2")) {
       s->zenith_luminance_cd_m2 = r.Child("zenith_luminance_cd_m2").Double();
     }
   }
 
-  ModelConfig ReadModel(const YamlReader& r, bool is_robot) const {
+  ModelConfig ReadModel(const ParamReader& r, bool is_robot) const {
     std::vector<std::string_view> keys = {"name", "file", "pose"};
     if (is_robot) keys.insert(keys.end(), {"controller", "sensors"});
     if (!is_robot) keys.push_back("environment");
@@ -225,13 +227,14 @@ class WorldParser {
     m.name = r.Child("name").String();
     if (r.Has("environment")) {
       // a generated building: no file, no mesh keys, no sites (nothing to name yet)
-      if (r.Has("file")) r.Child("file").Fail("expected either file or environment, not both");
+      if (const auto found = r.Find("file"))
+        found->Fail("expected either file or environment, not both");
       for (std::string_view k : {"sites", "initial_keyframe", "floating_base"})
         if (r.Has(k)) r.Child(k).Fail("not allowed with environment: (a generated building)");
       for (std::string_view k : MeshImportKeys())
         if (r.Has(k)) r.Child(k).Fail("applies to mesh files only, not to environment:");
       m.environment = ReadEnvironmentConfig(r.Child("environment"));
-      if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
+      if (const auto found = r.Find("pose")) ReadPose(*found, &m.pose);
       return m;
     }
     if (!r.Has("file") && !is_robot)
@@ -240,15 +243,15 @@ class WorldParser {
     // checked here, read again by the session (world/mesh_import_config.h)
     MeshImportConfig mesh;
     ReadMeshImportKeys(r, IsMeshModelFile(m.file), &mesh);
-    if (r.Has("pose")) ReadPose(r.Child("pose"), &m.pose);
-    if (r.Has("floating_base")) m.floating_base = r.Child("floating_base").Bool();
+    if (const auto found = r.Find("pose")) ReadPose(*found, &m.pose);
+    if (const auto found = r.Find("floating_base")) m.floating_base = found->Bool();
     if (r.Has("initial_keyframe")) {
       m.initial_keyframe = r.Child("initial_keyframe").String();
       if (m.initial_keyframe.empty())
         r.Child("initial_keyframe").Fail("empty; expected the name of one of the model's <key>s");
     }
     if (r.Has("sites")) {
-      for (const YamlReader& s : r.Child("sites").List()) {
+      for (const ParamReader& s : r.Child("sites").List()) {
         s.ExpectMap({"name", "body", "geom", "pose"});
         SiteConfig site;
         site.name = s.Child("name").String();
@@ -259,33 +262,31 @@ class WorldParser {
           s.Fail(
               "expected exactly one of body (the parent body) and geom (a geom whose centre "
               "the site marks)");
-        if (s.Has("body")) site.body = s.Child("body").String();
-        if (s.Has("geom")) site.geom = s.Child("geom").String();
-        if (s.Has("pose")) ReadPose(s.Child("pose"), &site.pose);
+        if (const auto found = s.Find("body")) site.body = found->String();
+        if (const auto found = s.Find("geom")) site.geom = found->String();
+        if (const auto found = s.Find("pose")) ReadPose(*found, &site.pose);
         for (const SiteConfig& other : m.sites)
           if (other.name == site.name)
             s.Child("name").Fail("duplicate site '" + site.name + "'; expected unique names");
         m.sites.push_back(site);
       }
     }
-    if (r.Has("controller")) m.controller = ReadController(r.Child("controller"));
+    if (const auto found = r.Find("controller")) m.controller = ReadController(*found);
     return m;
   }
 
   // `type` picks the controller; the rest of the mapping stays YAML nodes for it.
-  static ControllerConfig ReadController(const YamlReader& r) {
+  static ControllerConfig ReadController(const ParamReader& r) {
     r.ExpectMapAnyKeys();
     ControllerConfig c;
     c.type = r.Child("type").String();
     if (c.type.empty()) r.Child("type").Fail("empty; expected a controller type name");
     c.line = r.line();
-    c.params = YAML::Node(YAML::NodeType::Map);
-    for (auto it = r.node().begin(); it != r.node().end(); ++it)
-      if (it->first.Scalar() != "type") c.params.node().force_insert(it->first, it->second);
+    c.params = WithoutEntry(r.node(), "type");
     return c;
   }
 
-  static LightConfig ReadLight(const YamlReader& r) {
+  static LightConfig ReadLight(const ParamReader& r) {
     r.ExpectMapAnyKeys();
     LightConfig l;
     const std::string type =
@@ -321,28 +322,28 @@ class WorldParser {
     r.ExpectMap(keys);
 
     l.name = r.Child("name").String();
-    if (r.Has("attach")) l.attach = r.Child("attach").String();
-    if (r.Has("position")) l.position = r.Child("position").Vector3();
-    if (r.Has("direction")) l.direction = r.Child("direction").Vector3();
-    if (r.Has("color")) l.color = Vector3f(r.Child("color"));
-    if (r.Has("illuminance_lux")) l.illuminance_lux = r.Child("illuminance_lux").Double();
-    if (r.Has("intensity_cd")) l.intensity_cd = r.Child("intensity_cd").Double();
-    if (r.Has("power_w")) l.power_w = r.Child("power_w").Double();
-    if (r.Has("inner_angle_deg")) l.inner_angle_deg = r.Child("inner_angle_deg").Double();
-    if (r.Has("outer_angle_deg")) l.outer_angle_deg = r.Child("outer_angle_deg").Double();
-    if (r.Has("radius_m")) l.radius_m = r.Child("radius_m").Double();
+    if (const auto found = r.Find("attach")) l.attach = found->String();
+    if (const auto found = r.Find("position")) l.position = found->Vector3();
+    if (const auto found = r.Find("direction")) l.direction = found->Vector3();
+    if (const auto found = r.Find("color")) l.color = Vector3f(*found);
+    if (const auto found = r.Find("illuminance_lux")) l.illuminance_lux = found->Double();
+    if (const auto found = r.Find("intensity_cd")) l.intensity_cd = found->Double();
+    if (const auto found = r.Find("power_w")) l.power_w = found->Double();
+    if (const auto found = r.Find("inner_angle_deg")) l.inner_angle_deg = found->Double();
+    if (const auto found = r.Find("outer_angle_deg")) l.outer_angle_deg = found->Double();
+    if (const auto found = r.Find("radius_m")) l.radius_m = found->Double();
     if (r.Has("angular_diameter_deg")) {
       l.angular_diameter_deg = r.Child("angular_diameter_deg").Double();
     }
-    if (r.Has("cast_shadow")) l.cast_shadow = r.Child("cast_shadow").Bool();
+    if (const auto found = r.Find("cast_shadow")) l.cast_shadow = found->Bool();
     return l;
   }
 
-  static CameraOutputs ReadOutputs(const YamlReader& r) {
+  static CameraOutputs ReadOutputs(const ParamReader& r) {
     CameraOutputs o{false, false, false};
     const std::vector<std::string_view> names(CameraOutputs::kNames.begin(),
                                               CameraOutputs::kNames.end());
-    for (const YamlReader& e : r.List()) {
+    for (const ParamReader& e : r.List()) {
       const std::string v = e.Enum(names);
       bool& flag = *o.Flag(v);
       if (flag) e.Fail("'" + v + "' is listed twice; expected each output once");
@@ -353,12 +354,12 @@ class WorldParser {
 
   // width, height, fovy_deg / intrinsics, rate_hz, outputs: shared by world cameras
   // and MJCF camera overrides.
-  static void ReadCameraOptics(const YamlReader& r, CameraConfig* c) {
-    if (r.Has("width")) c->width = r.Child("width").Int();
-    if (r.Has("height")) c->height = r.Child("height").Int();
-    if (r.Has("fovy_deg")) c->fovy_deg = r.Child("fovy_deg").Double();
+  static void ReadCameraOptics(const ParamReader& r, CameraConfig* c) {
+    if (const auto found = r.Find("width")) c->width = found->Int();
+    if (const auto found = r.Find("height")) c->height = found->Int();
+    if (const auto found = r.Find("fovy_deg")) c->fovy_deg = found->Double();
     if (r.Has("intrinsics")) {
-      YamlReader k = r.Child("intrinsics");
+      ParamReader k = r.Child("intrinsics");
       if (c->fovy_deg) k.Fail("fovy_deg and intrinsics both given; expected one of them");
       k.ExpectMap({"fx", "fy", "cx", "cy"});
       CameraIntrinsics in;
@@ -371,33 +372,33 @@ class WorldParser {
       in.cy = k.Has("cy") ? k.Child("cy").Double() : 0.5 * (c->height - 1);
       c->intrinsics = in;
     }
-    if (r.Has("rate_hz")) c->rate_hz = r.Child("rate_hz").Double();
-    if (r.Has("outputs")) c->outputs = ReadOutputs(r.Child("outputs"));
-    if (r.Has("near_m")) c->near_m = r.Child("near_m").Double();
+    if (const auto found = r.Find("rate_hz")) c->rate_hz = found->Double();
+    if (const auto found = r.Find("outputs")) c->outputs = ReadOutputs(*found);
+    if (const auto found = r.Find("near_m")) c->near_m = found->Double();
   }
 
-  static CameraConfig ReadCamera(const YamlReader& r) {
+  static CameraConfig ReadCamera(const ParamReader& r) {
     std::vector<std::string_view> keys = {"name",     "attach",     "pose",    "width",   "height",
                                           "fovy_deg", "intrinsics", "rate_hz", "outputs", "near_m"};
     keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());
     r.ExpectMap(keys);
     CameraConfig c;
     c.name = r.Child("name").String();
-    if (r.Has("attach")) c.attach = r.Child("attach").String();
-    if (r.Has("pose")) ReadPose(r.Child("pose"), &c.pose);
+    if (const auto found = r.Find("attach")) c.attach = found->String();
+    if (const auto found = r.Find("pose")) ReadPose(*found, &c.pose);
     ReadCameraOptics(r, &c);
     if (!c.fovy_deg && !c.intrinsics) c.fovy_deg = 60;
     ReadCameraSensorKeys(r, &c);
     return c;
   }
 
-  static void ReadMjcfCameras(const YamlReader& r, MjcfCameraDefaults* m) {
+  static void ReadMjcfCameras(const ParamReader& r, MjcfCameraDefaults* m) {
     r.ExpectMap({"enabled", "width", "height", "rate_hz", "outputs", "overrides"});
-    if (r.Has("enabled")) m->enabled = r.Child("enabled").Bool();
-    if (r.Has("width")) m->width = r.Child("width").Int();
-    if (r.Has("height")) m->height = r.Child("height").Int();
-    if (r.Has("rate_hz")) m->rate_hz = r.Child("rate_hz").Double();
-    if (r.Has("outputs")) m->outputs = ReadOutputs(r.Child("outputs"));
+    if (const auto found = r.Find("enabled")) m->enabled = found->Bool();
+    if (const auto found = r.Find("width")) m->width = found->Int();
+    if (const auto found = r.Find("height")) m->height = found->Int();
+    if (const auto found = r.Find("rate_hz")) m->rate_hz = found->Double();
+    if (const auto found = r.Find("outputs")) m->outputs = ReadOutputs(*found);
     if (!r.Has("overrides")) return;
     for (auto& [name, o] : r.Child("overrides").Entries()) {
       std::vector<std::string_view> keys = {"width",    "height",     "rate_hz", "outputs",
@@ -418,17 +419,17 @@ class WorldParser {
     }
   }
 
-  static MaterialOverride ReadMaterial(const std::string& name, const YamlReader& r) {
+  static MaterialOverride ReadMaterial(const std::string& name, const ParamReader& r) {
     r.ExpectMap({"base_color", "roughness", "metallic", "specular", "emission", "procedural"});
     MaterialOverride m;
     m.name = name;
     // checked here, read again by the session (world/procedural_material_config.h)
-    if (r.Has("procedural")) ReadProceduralMaterial(r.Child("procedural"));
-    if (r.Has("base_color")) m.base_color = Vector3f(r.Child("base_color"));
-    if (r.Has("roughness")) m.roughness = static_cast<float>(r.Child("roughness").Double());
-    if (r.Has("metallic")) m.metallic = static_cast<float>(r.Child("metallic").Double());
-    if (r.Has("specular")) m.specular = static_cast<float>(r.Child("specular").Double());
-    if (r.Has("emission")) m.emission = Vector3f(r.Child("emission"));
+    if (const auto found = r.Find("procedural")) ReadProceduralMaterial(*found);
+    if (const auto found = r.Find("base_color")) m.base_color = Vector3f(*found);
+    if (const auto found = r.Find("roughness")) m.roughness = static_cast<float>(found->Double());
+    if (const auto found = r.Find("metallic")) m.metallic = static_cast<float>(found->Double());
+    if (const auto found = r.Find("specular")) m.specular = static_cast<float>(found->Double());
+    if (const auto found = r.Find("emission")) m.emission = Vector3f(*found);
     return m;
   }
 
@@ -436,8 +437,6 @@ class WorldParser {
   LineTable* lines_;
   fs::path base_dir_;
 };
-
-int ConfigMarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
 std::string LowerExtension(const fs::path& p) {
   std::string ext = p.extension().string();
@@ -451,79 +450,15 @@ bool HasModelExtension(const fs::path& p) {
   return ext == ".xml" || ext == ".urdf";
 }
 
-// counts the documents of a YAML stream without building nodes; a document that holds only a
-// null (a trailing '---') does not count
-class YamlDocumentCounter : public YAML::EventHandler {
- public:
-  void OnDocumentStart(const YAML::Mark&) override { content_ = false; }
-  void OnDocumentEnd() override {
-    if (content_) marks.push_back(mark_);
-  }
-  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { Content(mark); }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                const std::string&) override {
-    Content(mark);
-  }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                       YAML::EmitterStyle::value) override {
-    Content(mark);
-  }
-  void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
-                  YAML::EmitterStyle::value) override {
-    Content(mark);
-  }
-  void OnMapEnd() override {}
-
-  /// where the root node of each document with content starts
-  std::vector<YAML::Mark> marks;
-
- private:
-  void Content(const YAML::Mark& mark) {
-    if (!content_) mark_ = mark;
-    content_ = true;
-  }
-  YAML::Mark mark_;
-  bool content_ = false;
-};
-
-// where the second YAML document with content starts, if there is one. at most
-// kMaxYamlDocuments documents are read (an endless stream of empty documents is cut there)
-std::optional<YAML::Mark> SecondYamlDocument(const std::string& text) {
-  std::istringstream in(text);
-  YAML::Parser parser(in);
-  YamlDocumentCounter counter;
-  for (int d = 0; d < kMaxYamlDocuments && counter.marks.size() < 2; ++d)
-    if (!parser.HandleNextDocument(counter)) break;
-  if (counter.marks.size() >= 2) return counter.marks[1];
-  return std::nullopt;
-}
-
 }  // namespace
 
 WorldConfig ParseWorld(const std::string& yaml_text, const std::string& file_name) {
   auto lines = std::make_shared<LineTable>();
-  WorldConfig w;
-  try {
-    // a world file is one YAML document: a second one would be silently ignored. the
-    // documents are counted with a bounded loop, not YAML::LoadAll: yaml-cpp 0.7's LoadAll
-    // never ends on some 7-byte inputs (",sn\xd4 !:" yields empty documents for ever, found by
-    // fuzz/world_fuzz.cc), taking all memory
-    if (const std::optional<YAML::Mark> second = SecondYamlDocument(yaml_text))
-      throw ConfigError(file_name, ConfigMarkLine(*second), "",
-                        "a second YAML document (after '---'); expected the world in one "
-                        "document");
-    RefuseYamlTags(yaml_text, file_name);
-    const YAML::Node root = YAML::Load(yaml_text);
-    w = WorldParser(file_name, lines.get()).Parse(root);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(file_name, ConfigMarkLine(e.mark), "", "YAML syntax error: " + e.msg);
-  } catch (const YAML::Exception& e) {
-    // any other yaml-cpp failure still names the file (and line when yaml-cpp knows it)
-    throw ConfigError(file_name, ConfigMarkLine(e.mark), "",
-                      "cannot read the YAML document: " + e.msg);
-  }
+  // a world file is one YAML document: a second one would be silently ignored
+  YamlParseOptions options;
+  options.what = "the world";
+  const ConfigValue root = ParseYaml(yaml_text, file_name, options);
+  WorldConfig w = WorldParser(file_name, lines.get()).Parse(root);
   ValidateWorld(w, *lines);
   w.lines = std::move(lines);
   // directions are stored as unit vectors (ValidateWorld rejected zero vectors)
@@ -541,11 +476,7 @@ WorldConfig LoadWorldFile(const std::string& path) {
         "world file not found: " + fs::absolute(path, ec).lexically_normal().string() +
             "; expected an existing YAML file");
   }
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!in) throw ConfigError(path, 0, "", "cannot read the world file; expected a readable file");
-  return ParseWorld(text.str(), path);
+  return ParseWorld(ReadInputFile(path, "world file"), path);
 }
 
 ConfigError LocateInWorld(const WorldConfig& world, const ConfigError& e) {

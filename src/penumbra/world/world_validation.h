@@ -5,8 +5,8 @@
 
 #include <string>
 
+#include "penumbra/config/param_reader.h"
 #include "penumbra/world/world_config.h"
-#include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
 

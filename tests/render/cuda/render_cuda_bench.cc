@@ -14,10 +14,14 @@
 // batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
 // depth+seg, pinned and pageable copies, the kernel alone and the CPU backend; then the
 // device-to-host copy rates, pinned and pageable.
+// --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
+// Render() with pinned and with pageable copies and where its time goes (RealtimeStageTimes),
+// the kernels alone as they run by default and with each speed-up of RealtimeKernelOptions
+// turned off (ablations; each variant's rgb compared with the default's), and the CPU backend.
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh). usage:
-//   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity]
-//                     [world.yaml ...]
+//   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
+//                     --realtime [--size WxH]] [world.yaml ...]
 
 #include <fmt/format.h>
 
@@ -62,6 +66,108 @@ int PositiveArg(const std::string& s) {
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
   return end && *end == '\0' && v > 0 && v < (1 << 30) ? static_cast<int>(v) : 0;
+}
+
+// --realtime: the realtime tier's Render() stages and kernel ablations (file comment)
+int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, int frames) {
+  fmt::print(
+      "\n| world | size | variant | frames/s | ms/frame | geometry ms | sky (host) ms | shade ms "
+      "| film+copies ms | rgb as default |\n|---|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+  for (const std::string& file : worlds) {
+    SessionOptions so;
+    so.build_renderer = false;
+    Session session(LoadWorldFile(file), so);
+    Simulation& sim = session.sim();
+    while (sim.time() < 1.0) sim.Step();
+    const WorldSnapshot snap = sim.Snapshot();
+    const SceneDescription& scene = session.scene();
+    const CameraSpec& cam = scene.cameras.front();
+    const std::string name = file.substr(file.find_last_of('/') + 1);
+    const std::string size = fmt::format("{}x{}", width, height);
+    const double fovy_deg =
+        2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+    CameraView view;
+    view.X_WO = CameraPoseInWorld(cam, snap);
+    view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
+    view.near_m = cam.near_m;
+    view.outputs.rgb = view.outputs.depth = true;
+    RenderSettings gpu_settings;
+    gpu_settings.backend = RenderSettings::Backend::kCuda;
+    const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
+    auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+    cuda::DeviceRealtime& rt = g->device_realtime();
+    const cuda::RealtimeKernelOptions fast = rt.options();
+    RenderedFrame want, again;
+    gpu->Render(snap, view, &want);
+    gpu->Render(snap, view, &again);
+    const bool repeatable = want.rgb.data == again.rgb.data &&
+                            want.radiance.data == again.radiance.data &&
+                            want.depth_m.data == again.depth_m.data;
+    // Render(): pinned copies (default) and pageable ones
+    for (const bool pinned : {true, false}) {
+      cuda::RealtimeKernelOptions o = fast;
+      o.pinned = pinned;
+      rt.set_options(o);
+      RenderedFrame f;
+      for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
+      cuda::RealtimeStageTimes sum;
+      const auto t0 = Clock::now();
+      for (int i = 0; i < frames; ++i) {
+        gpu->Render(snap, view, &f);
+        const cuda::RealtimeStageTimes& t = rt.last_stage_times();
+        sum.geometry += t.geometry, sum.sky += t.sky, sum.shade += t.shade, sum.film += t.film;
+      }
+      const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
+      fmt::print(
+          "| {} | {} | cuda Render(), {} copies | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
+          "{:.3f} | {:.3f} | {} |\n",
+          name, size, pinned ? "pinned" : "pageable", 1 / s, 1e3 * s, sum.geometry / frames,
+          sum.sky / frames, sum.shade / frames, sum.film / frames,
+          f.rgb.data == want.rgb.data ? "yes" : "NO");
+    }
+    rt.set_options(fast);
+    // the kernels alone: the default, each speed-up off, all off
+    struct Variant {
+      const char* what;
+      cuda::RealtimeKernelOptions o;
+    };
+    std::vector<Variant> variants = {{"kernels, all speed-ups", fast}};
+    cuda::RealtimeKernelOptions o = fast;
+    o.reuse_hit = false;
+    variants.push_back({"kernels, primary ray traced twice", o});
+    o = fast;
+    o.min_blocks = 4;
+    variants.push_back({"kernels, shading <= 128 registers", o});
+    o.min_blocks = 6;
+    variants.push_back({"kernels, shading <= 85 registers", o});
+    o = fast;
+    o.rows_per_warp = false;
+    variants.push_back({"kernels, row sums per thread", o});
+    o.reuse_hit = false;
+    variants.push_back({"kernels, all speed-ups off", o});
+    const int kernel_frames = std::max(10, frames * 4);
+    for (const Variant& var : variants) {
+      // the variant's image: one Render with it
+      rt.set_options(var.o);
+      RenderedFrame f;
+      gpu->Render(snap, view, &f);
+      const double ms = rt.TimeKernels(&g->device(), kernel_frames, var.o);
+      fmt::print("| {} | {} | {} | {:.0f} | {:.3f} | | | | | {} |\n", name, size, var.what,
+                 1e3 / ms, ms, f.rgb.data == want.rgb.data ? "yes" : "NO");
+    }
+    rt.set_options(fast);
+    gpu->Render(snap, view, &want);
+    RenderSettings cpu_settings;
+    cpu_settings.backend = RenderSettings::Backend::kEmbree;
+    cpu_settings.threads = 0;
+    const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
+    const double cpu_s = TimeRenders(cpu.get(), snap, view, std::max(3, frames / 10));
+    fmt::print("| {} | {} | cpu Render(), all cores | {:.0f} | {:.3f} | | | | | |\n", name, size,
+               1 / cpu_s, 1e3 * cpu_s);
+    fmt::print("| {} | {} | cuda, two renders bit-identical | {} | | | | | | |\n", name, size,
+               repeatable ? "yes" : "NO");
+  }
+  return 0;
 }
 
 // --batch: K cameras over `sessions` sessions of each world, in batches
@@ -115,13 +221,14 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
 int Main(int argc, char** argv) {
   int frames = 50;
   int width = 0, height = 0, sessions = 1;
-  bool parity = false;
+  bool parity = false, realtime = false;
   std::vector<int> batch;
   std::vector<std::string> worlds;
   const auto usage = [](const std::string& why) {
     fmt::print(stderr,
                "render_cuda_bench: {}\nusage: render_cuda_bench [--frames N] [--batch N,... "
-               "[--size WxH] [--sessions S] | --parity [--size WxH]] [world.yaml ...]\n",
+               "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH]] "
+               "[world.yaml ...]\n",
                why);
     return 2;
   };
@@ -150,6 +257,8 @@ int Main(int argc, char** argv) {
         batch.push_back(k);
         pos = end + 1;
       }
+    } else if (a == "--realtime") {
+      realtime = true;
     } else if (a == "--parity") {
       parity = true;
     } else if (a.rfind("--", 0) == 0) {
@@ -163,9 +272,13 @@ int Main(int argc, char** argv) {
               std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml"};
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("device: {}\n", dev.available ? dev.name : "none (" + dev.why + ")");
-  if ((parity || !batch.empty()) && !dev.available) {
-    fmt::print(stderr, "render_cuda_bench: --batch and --parity need a CUDA device\n");
+  if ((parity || realtime || !batch.empty()) && !dev.available) {
+    fmt::print(stderr, "render_cuda_bench: --batch, --parity and --realtime need a CUDA device\n");
     return 1;
+  }
+  if (realtime) {
+    if (width == 0) width = 640, height = 480;
+    return RealtimeMain(worlds, width, height, frames);
   }
   if (parity) {
     if (width == 0) width = 320, height = 240;

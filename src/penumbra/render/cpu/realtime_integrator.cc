@@ -11,6 +11,7 @@
 #include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/shadow_window_math.h"
 
 namespace penumbra {
 namespace {
@@ -141,13 +142,11 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
           const int ii = i + dy * tile.width + dx;
           if (ii != i) {
             const SurfaceHit& g = primary.hits[ii];
-            if (!primary.did_hit[ii] || g.geom != h.geom || !(h.ng_W.dot(g.ng_W) >= 0.9f)) continue;
-            // within 5 % of its distance from i's tangent plane.
-            const Eigen::Vector3f dp = g.p_W - h.p_W;
-            const float off = h.ng_W.dot(dp);
-            if (!(off * off <= 0.0025f * dp.squaredNorm() + 1e-10f)) continue;
+            if (!primary.did_hit[ii] || !SameShadowSurface(h.geom, h.ng_W.data(), h.p_W.data(),
+                                                           g.geom, g.ng_W.data(), g.p_W.data()))
+              continue;
           }
-          bits |= 1u << ((dy + 2) * 5 + dx + 2);
+          bits |= 1u << ShadowWindowBit(dx, dy);
         }
       }
       near[i] = bits;
@@ -156,16 +155,16 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   // calls fn(ii, weight) for the pixels of i's window on i's surface with a verdict.
   auto for_window = [&](const int8_t* vis, int i, auto&& fn) {
     for (uint32_t bits = near[i]; bits != 0; bits &= bits - 1) {
-      const int b = __builtin_ctz(bits);
+      const int b = LowestSetBit(bits);
       const int dy = b / 5 - 2, dx = b % 5 - 2;
       const int ii = i + dy * tile.width + dx;
       if (vis[ii] < 0) continue;
-      fn(ii, (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f));
+      fn(ii, ShadowWindowWeight(dx, dy));
     }
   };
   auto same_surface = [&](int i, int ii) {
     const int dy = ii / tile.width - i / tile.width, dx = ii % tile.width - i % tile.width;
-    return (near[i] >> ((dy + 2) * 5 + dx + 2) & 1u) != 0;
+    return (near[i] >> ShadowWindowBit(dx, dy) & 1u) != 0;
   };
   for (int j = 0; j < num_lights; ++j) {
     if (!IsExtendedLight(ctx.lights->lights()[j])) continue;
@@ -202,7 +201,7 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       const int x = i % tile.width, y = i / tile.width;
       const int u = tile.x0 + x, v = tile.y0 + y;
       const int s = LightStratum(u, v);
-      own[i] = x == 0 || y == 0 || x == tile.width - 1 || y == tile.height - 1;
+      own[i] = OnShadowTileRing(x, y, ShadowTile{tile.x0, tile.y0, tile.width, tile.height});
       const int extra = own[i] ? kLightStrata * kPenumbraRays : kPenumbraRays;
       Ray sr;
       sr.o = OffsetRayOrigin(h.p_W, h.ng_W);

@@ -91,7 +91,12 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
                                         F3 d, float tmin, bool any_hit, TraceHit* hit) {
   const F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
   const BvhNode* nodes = s.nodes + blas.node_offset;
+  // the farther children still to visit, with their boxes' entry distances: a popped node is
+  // visited if its entry is not beyond the closest hit found since (the entry does not depend
+  // on the ray's far end, so this is the slab test against the shorter ray, without reloading
+  // the box).
   int stack[kMaxBvhDepth];
+  float stack_t[kMaxBvhDepth];
   int top = 0;
   bool found = false;
   int node = 0;
@@ -121,7 +126,10 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
       const bool ha = ta != INFINITY, hb = tb != INFINITY;
       if (ha && hb) {
         const int nearer = ta <= tb ? a : b, farther = ta <= tb ? b : a;
-        if (top < kMaxBvhDepth) stack[top++] = farther;
+        if (top < kMaxBvhDepth) {
+          stack[top] = farther;
+          stack_t[top++] = ta <= tb ? tb : ta;
+        }
         node = nearer;
         continue;
       }
@@ -133,9 +141,9 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     // pop, skipping nodes now farther than the closest hit
     bool next = false;
     while (top > 0) {
-      const int c = stack[--top];
-      if (SlabEntry(nodes[c].lo, nodes[c].hi, o, inv, tmin, hit->t) != INFINITY) {
-        node = c;
+      --top;
+      if (stack_t[top] <= hit->t) {
+        node = stack[top];
         next = true;
         break;
       }

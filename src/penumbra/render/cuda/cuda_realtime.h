@@ -39,6 +39,38 @@ struct RealtimeStatic {
   const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries
 };
 
+/// how the realtime kernels run (the defaults are the fast ones; the others stay for the
+/// benchmark's ablations, render_cuda_bench --realtime). every variant computes the same
+/// radiance and depth; only the order of a row's log-luminance sum (rows_per_warp) could move
+/// the exposure's last bits.
+struct RealtimeKernelOptions {
+  /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
+  /// again).
+  bool reuse_hit = true;
+  /// one warp sums a row's log-luminance terms (32 strided partial sums, then a fixed tree);
+  /// else one thread sums the row in column order.
+  bool rows_per_warp = true;
+  /// Render() copies through page-locked host buffers (the geometry and sky terms' round trip,
+  /// the row sums, and the outputs, which are then copied into the frame's images; the depth
+  /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
+  bool pinned = true;
+  /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
+  /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
+  /// warps in flight, maybe spills). with reuse_hit only.
+  int min_blocks = 0;
+};
+
+/// the host clock's time of Render()'s stages, milliseconds (benchmarks).
+/// geometry + sky + shade + film = total.
+struct RealtimeStageTimes {
+  double geometry = 0;  ///< upload of geoms and lights, geometry kernel, geometry to the host
+  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms)
+  /// sky terms up, shading, shared-visibility and row-sum kernels, row sums back
+  double shade = 0;
+  double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
+  double total = 0;
+};
+
 /// the device side of the realtime path.
 class DeviceRealtime {
  public:
@@ -65,6 +97,14 @@ class DeviceRealtime {
   /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with
   /// CUDA events: mean milliseconds per frame (benchmarks).
   double TimeKernels(DeviceScene* scene, int count);
+  /// TimeKernels with the kernels run as `options` says (Render's options are unchanged).
+  double TimeKernels(DeviceScene* scene, int count, const RealtimeKernelOptions& options);
+
+  /// the options of the next Render calls.
+  void set_options(const RealtimeKernelOptions& options);
+  const RealtimeKernelOptions& options() const;
+  /// the stages of the last Render.
+  const RealtimeStageTimes& last_stage_times() const;
 
  private:
   struct Impl;

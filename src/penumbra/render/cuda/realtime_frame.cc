@@ -144,29 +144,72 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
 
 void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
                                  ThreadPool* pool) const {
-  constexpr int64_t kChunk = 4096;
+  const int W = camera_.width, H = camera_.height;
+  if (n != static_cast<int64_t>(W) * H)
+    throw Error("RealtimeFrameData::SkyTerms: " + std::to_string(n) + " pixels, the camera has " +
+                std::to_string(static_cast<int64_t>(W) * H));
   const bool occluded = !volume_.empty();
-  ParallelForOrSerial(pool, (n + kChunk - 1) / kChunk, [&](int64_t chunk) {
-    const int64_t end = std::min(n, (chunk + 1) * kChunk);
-    for (int64_t i = chunk * kChunk; i < end; ++i) {
-      const PixelGeometry& g = geometry[i];
-      const Eigen::Vector3f v(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
-      Eigen::Vector3f e;
-      if (g.hit == 0) {
-        e = sky_.Radiance(v);
+  // the probes' blend at the point and geometric normal, evaluated at the shading normal.
+  auto single = [&](int64_t i) {
+    const PixelGeometry& g = geometry[i];
+    const Eigen::Vector3f v(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
+    Eigen::Vector3f e;
+    if (g.hit == 0) {
+      e = sky_.Radiance(v);
+    } else {
+      const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z), ns(g.ns.x, g.ns.y, g.ns.z);
+      if (occluded) {
+        SkyIrradianceVolume::ShBlend blend;
+        volume_.Blend(v, ng, &blend);
+        e = volume_.IrradianceAt(blend, ns, sky_);
       } else {
-        // the probes' blend at the point and geometric normal, evaluated at the shading normal
-        // (RealtimeIntegrator's TileSkyIrradiance, per pixel).
-        const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z), ns(g.ns.x, g.ns.y, g.ns.z);
-        if (occluded) {
-          SkyIrradianceVolume::ShBlend blend;
-          volume_.Blend(v, ng, &blend);
-          e = volume_.IrradianceAt(blend, ns, sky_);
-        } else {
-          e = sky_.Irradiance(ns);
-        }
+        e = sky_.Irradiance(ns);
       }
-      out[i] = ToFloat3(e);
+    }
+    out[i] = ToFloat3(e);
+  };
+  // as RealtimeIntegrator's TileSkyIrradiance: a 2x2 quad at even (u, v) (tiles start at
+  // multiples of 16) whose pixels see one flat face (one geom, bitwise equal geometric
+  // normals, points on one plane within 1 mm and within a quarter probe spacing of each other)
+  // shares one blend at the quad's mean point; other pixels blend on their own.
+  const float max_extent = occluded ? 0.25f * volume_.spacing() : 0.0f;
+  constexpr float kPlaneTolM = 1e-3f;
+  auto shared = [&](const int64_t* quad) {
+    const PixelGeometry& g0 = geometry[quad[0]];
+    for (int c = 0; c < 4; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      if (!(g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
+            g.ng.z == g0.ng.z))
+        return false;
+    }
+    const Eigen::Vector3f n0(g0.ng.x, g0.ng.y, g0.ng.z);
+    const Eigen::Vector3f p0(g0.p_or_d.x, g0.p_or_d.y, g0.p_or_d.z);
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (int c = 0; c < 4; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      const Eigen::Vector3f p(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
+      const Eigen::Vector3f dp = p - p0;
+      if (!(std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent))
+        return false;
+      mean += 0.25f * p;
+    }
+    SkyIrradianceVolume::ShBlend blend;
+    volume_.Blend(mean, n0, &blend);
+    for (int c = 0; c < 4; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      out[quad[c]] =
+          ToFloat3(volume_.IrradianceAt(blend, Eigen::Vector3f(g.ns.x, g.ns.y, g.ns.z), sky_));
+    }
+    return true;
+  };
+  ParallelForOrSerial(pool, (H + 1) / 2, [&](int64_t row) {
+    const int v0 = static_cast<int>(2 * row);
+    for (int u0 = 0; u0 < W; u0 += 2) {
+      const int64_t i00 = static_cast<int64_t>(v0) * W + u0;
+      const int64_t quad[4] = {i00, i00 + 1, i00 + W, i00 + W + 1};
+      if (occluded && u0 + 1 < W && v0 + 1 < H && shared(quad)) continue;
+      for (int c = 0; c < 4; ++c)
+        if (u0 + (c & 1) < W && v0 + (c >> 1) < H) single(quad[c]);
     }
   });
 }
@@ -220,10 +263,37 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   });
   std::vector<Float3> sky(n);
   data.SkyTerms(geometry.data(), n, sky.data(), pool);
-  const RealtimeFrameView f = data.View(scene, sky.data());
+  RealtimeFrameView f = data.View(scene, sky.data());
+  // the shared visibility's buffers (RealtimeFrameView), per pixel and per light and pixel.
+  const size_t nl = static_cast<size_t>(n) * static_cast<size_t>(f.num_lights);
+  std::vector<uint32_t> window(n);
+  std::vector<Float3> area_c(nl);
+  std::vector<int8_t> area_vis(nl);
+  std::vector<float> area_visible(nl), area_rays(nl), area_fraction(nl);
+  std::vector<uint8_t> area_own(nl);
+  f.geometry = geometry.data();
+  f.window = window.data();
+  f.area_c = area_c.data();
+  f.area_vis = area_vis.data();
+  f.area_visible = area_visible.data();
+  f.area_rays = area_rays.data();
+  f.area_own = area_own.data();
+  f.area_fraction = area_fraction.data();
   std::vector<Float3> radiance(n);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     for (int u = 0; u < W; ++u) radiance[v * W + u] = ShadeRealtimePixel(f, u, static_cast<int>(v));
+  });
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));
+  });
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) SharedVisibilityFraction(f, u, static_cast<int>(v));
+  });
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int u = 0; u < W; ++u) {
+      Float3& L = radiance[v * W + u];
+      L = SharedVisibilityResolve(f, u, static_cast<int>(v), L);
+    }
   });
   std::vector<double> rows(H);
   ParallelForOrSerial(pool, H, [&](int64_t v) {

@@ -43,7 +43,9 @@ class RealtimeFrameData {
   /// updates the sky volume (built on the first call and when the static bodies move).
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
 
-  /// the sky term of every pixel (RealtimeFrameView::sky_term) from its primary geometry.
+  /// the sky term of every pixel (RealtimeFrameView::sky_term) from its primary geometry, n =
+  /// the Prepared camera's width x height pixels, row-major; with a sky volume a 2x2 quad on one
+  /// flat face shares one probe blend, as RealtimeIntegrator does. @throws Error for another n.
   void SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out, ThreadPool* pool) const;
 
   /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).

@@ -3,6 +3,8 @@
 
 #include <cuda_runtime.h>
 
+#include <chrono>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -14,27 +16,80 @@
 namespace penumbra::cuda {
 namespace {
 
-__global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth) {
+constexpr unsigned kFullWarp = 0xffffffffu;
+
+__global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth,
+                               TraceHit* hits) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   float t;
-  geometry[i] = PrimaryGeometry(f, u, v, &t);
+  geometry[i] = PrimaryGeometry(f, u, v, &t, hits ? &hits[i] : nullptr);
   depth[i] = t;
 }
 
-__global__ void ShadeKernel(RealtimeFrameView f, Float3* radiance) {
+// kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
+// threads each SM must hold (__launch_bounds__: at most 65536 / (128 kMinBlocks) registers).
+template <bool kReuse, int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
-  radiance[static_cast<int64_t>(v) * f.camera.width + u] = ShadeRealtimePixel(f, u, v);
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  if (kReuse)
+    h = hits[i];
+  else
+    TraceClosest(f.scene, r, &h);
+  radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
+}
+
+// the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
+// each reads its neighbours' results of the step before.
+__global__ void VisibilityRaysKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityRays(f, u, v);
+}
+
+__global__ void VisibilityFractionKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  SharedVisibilityFraction(f, u, v);
+}
+
+__global__ void VisibilityResolveKernel(RealtimeFrameView f, Float3* radiance) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
 }
 
 __global__ void RowSumKernel(const Float3* radiance, int width, int height, double* rows) {
   const int v = blockIdx.x * blockDim.x + threadIdx.x;
   if (v >= height) return;
   rows[v] = RowLogLuminance(radiance, width, v, 1e-4);
+}
+
+// one warp per row: lane k sums columns k, k + 32, ... in order, then a fixed butterfly.
+__global__ void RowSumWarpKernel(const Float3* radiance, int width, int height, double* rows) {
+  const int lane = threadIdx.x & 31;
+  const int v = blockIdx.x * (blockDim.x / 32) + threadIdx.x / 32;
+  if (v >= height) return;  // whole warps leave together
+  double sum = 0;
+  for (int u = lane; u < width; u += 32) {
+    const Float3& c = radiance[static_cast<int64_t>(v) * width + u];
+    const float rgb[3] = {c.x, c.y, c.z};
+    sum += LogLuminanceTerm(rgb, 1e-4);
+  }
+  for (int offset = 16; offset > 0; offset /= 2) sum += __shfl_xor_sync(kFullWarp, sum, offset);
+  if (lane == 0) rows[v] = sum;
 }
 
 struct Exposure {
@@ -48,24 +103,117 @@ __global__ void DevelopKernel(const Float3* radiance, int64_t n, Exposure exposu
   DevelopPixel(radiance[i], exposure.e, filmic != 0, lut, rgb + 3 * i);
 }
 
+// page-locked host memory that grows (never shrinks).
+struct PinnedBuffer {
+  void* p = nullptr;
+  size_t bytes = 0;
+  PinnedBuffer() = default;
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+  void Reserve(size_t n) {
+    if (n <= bytes) return;
+    if (p) cudaFreeHost(p);
+    p = nullptr;
+    bytes = 0;
+    Check(cudaMallocHost(&p, n), "cudaMallocHost (realtime frame)");
+    bytes = n;
+  }
+  template <typename T>
+  T* as() const {
+    return static_cast<T*>(p);
+  }
+  ~PinnedBuffer() {
+    if (p) cudaFreeHost(p);
+  }
+};
+
+using Clock = std::chrono::steady_clock;
+double MsSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// the grid of the per-pixel kernels (whole warps of 16 x 2 pixels).
+const dim3 kPixelBlock(16, 8);
+dim3 PixelGrid(int W, int H) {
+  return dim3((W + kPixelBlock.x - 1) / kPixelBlock.x, (H + kPixelBlock.y - 1) / kPixelBlock.y);
+}
+
 }  // namespace
 
 struct DeviceRealtime::Impl {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
-  Buffer geometry, depth, sky, radiance, rows, rgb;
+  Buffer geometry, depth, sky, radiance, rows, rgb, hits;
+  // the shared visibility's buffers (RealtimeFrameView)
+  Buffer window, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
+  // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
+  PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   std::vector<PixelGeometry> host_geometry;
   std::vector<Float3> host_sky;
-  std::vector<Float3> host_radiance;
   std::vector<double> host_rows;
+  cudaStream_t copy_stream = nullptr;
+  cudaEvent_t geometry_done = nullptr;
+  RealtimeKernelOptions options;
+  RealtimeStageTimes times;
   // the last frame, for TimeKernels.
   RealtimeFrameView frame;
   Exposure exposure{{1, 1, 1}};
   int filmic = 1;
   bool rendered = false;
+
+  void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                      cudaStream_t stream) {
+    GeometryKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
+        f, geometry.as<PixelGeometry>(), depth.as<float>(),
+        o.reuse_hit ? hits.as<TraceHit>() : nullptr);
+    Check(cudaGetLastError(), "GeometryKernel");
+  }
+  // the shading, shared-visibility and row-sum kernels of frame f on `stream` as `o` says.
+  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                     cudaStream_t stream) {
+    const int W = f.camera.width, H = f.camera.height;
+    const dim3 grid = PixelGrid(W, H);
+    TraceHit* h = hits.as<TraceHit>();
+    Float3* L = radiance.as<Float3>();
+    if (!o.reuse_hit)
+      ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L);
+    else if (o.min_blocks >= 6)
+      ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    else if (o.min_blocks >= 4)
+      ShadeKernel<true, 4><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    else
+      ShadeKernel<true, 1><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+    Check(cudaGetLastError(), "ShadeKernel");
+    VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    Check(cudaGetLastError(), "VisibilityRaysKernel");
+    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    Check(cudaGetLastError(), "VisibilityFractionKernel");
+    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
+    Check(cudaGetLastError(), "VisibilityResolveKernel");
+    if (o.rows_per_warp)
+      RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
+                                                        rows.as<double>());
+    else
+      RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
+                                                        rows.as<double>());
+    Check(cudaGetLastError(), "RowSumKernel");
+  }
+  void LaunchFilm(int64_t n, const Exposure& e, int film, cudaStream_t stream) {
+    DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
+        radiance.as<Float3>(), n, e, film, lut.as<uint8_t>(), rgb.as<uint8_t>());
+    Check(cudaGetLastError(), "DevelopKernel");
+  }
+  ~Impl() {
+    if (copy_stream) cudaStreamDestroy(copy_stream);
+    if (geometry_done) cudaEventDestroy(geometry_done);
+  }
 };
 
 DeviceRealtime::DeviceRealtime() : impl_(new Impl) {}
 DeviceRealtime::~DeviceRealtime() { delete impl_; }
+
+void DeviceRealtime::set_options(const RealtimeKernelOptions& options) { impl_->options = options; }
+const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->options; }
+const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
 
 void DeviceRealtime::Upload(const RealtimeStatic& d) {
   Impl& m = *impl_;
@@ -81,7 +229,13 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
                               int64_t num_geoms, bool filmic, const SkyFn& sky,
                               const ExposureFn& exposure, const RealtimeOutputs& out) {
   Impl& m = *impl_;
+  const RealtimeKernelOptions o = m.options;
+  const auto t0 = Clock::now();
   cudaStream_t stream = static_cast<cudaStream_t>(scene->stream());
+  if (!m.copy_stream) {
+    Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
+    Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
+  }
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -93,6 +247,15 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.radiance.Reserve(sizeof(Float3) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
+  if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
+  const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
+  m.window.Reserve(sizeof(uint32_t) * n);
+  m.area_c.Reserve(sizeof(Float3) * nl);
+  m.area_vis.Reserve(sizeof(int8_t) * nl);
+  m.area_visible.Reserve(sizeof(float) * nl);
+  m.area_rays.Reserve(sizeof(float) * nl);
+  m.area_own.Reserve(sizeof(uint8_t) * nl);
+  m.area_fraction.Reserve(sizeof(float) * nl);
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
@@ -103,39 +266,84 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.geoms = m.geoms.as<GeomPod>();
   f.lights = m.lights.as<LightPod>();
   f.sky_term = m.sky.as<Float3>();
-  // (1) primary geometry (materials and normal maps included) and depth
-  const dim3 block(16, 8);
-  const dim3 grid((W + block.x - 1) / block.x, (H + block.y - 1) / block.y);
-  GeometryKernel<<<grid, block, 0, stream>>>(f, m.geometry.as<PixelGeometry>(),
-                                             m.depth.as<float>());
-  Check(cudaGetLastError(), "GeometryKernel");
-  m.host_geometry.resize(n);
-  m.geometry.Download(m.host_geometry.data(), sizeof(PixelGeometry) * n, stream);
-  if (out.depth) m.depth.Download(out.depth, sizeof(float) * n, stream);
+  f.geometry = m.geometry.as<PixelGeometry>();
+  f.window = m.window.as<uint32_t>();
+  f.area_c = m.area_c.as<Float3>();
+  f.area_vis = m.area_vis.as<int8_t>();
+  f.area_visible = m.area_visible.as<float>();
+  f.area_rays = m.area_rays.as<float>();
+  f.area_own = m.area_own.as<uint8_t>();
+  f.area_fraction = m.area_fraction.as<float>();
+  // host buffers of the round trips and outputs
+  PixelGeometry* host_geometry;
+  Float3* host_sky;
+  double* host_rows;
+  if (o.pinned) {
+    m.pin_geometry.Reserve(sizeof(PixelGeometry) * n);
+    m.pin_sky.Reserve(sizeof(Float3) * n);
+    m.pin_rows.Reserve(sizeof(double) * H);
+    host_geometry = m.pin_geometry.as<PixelGeometry>();
+    host_sky = m.pin_sky.as<Float3>();
+    host_rows = m.pin_rows.as<double>();
+    if (out.rgb) m.pin_rgb.Reserve(3 * n);
+    if (out.radiance) m.pin_radiance.Reserve(sizeof(Float3) * n);
+    if (out.depth) m.pin_depth.Reserve(sizeof(float) * n);
+  } else {
+    m.host_geometry.resize(n);
+    m.host_sky.resize(n);
+    m.host_rows.resize(H);
+    host_geometry = m.host_geometry.data();
+    host_sky = m.host_sky.data();
+    host_rows = m.host_rows.data();
+  }
+  // (1) primary geometry (materials and normal maps included) and depth; pinned: the depth
+  // goes back on the copy stream while the host computes the sky terms
+  m.LaunchGeometry(f, o, stream);
+  m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
+  if (out.depth) {
+    if (o.pinned) {
+      Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
+      Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
+      m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
+    } else {
+      m.depth.Download(out.depth, sizeof(float) * n, stream);
+    }
+  }
   Check(cudaStreamSynchronize(stream), "GeometryKernel");
+  const auto t1 = Clock::now();
   // (2) the sky terms on the host
-  m.host_sky.resize(n);
-  sky(m.host_geometry.data(), n, m.host_sky.data());
-  m.sky.Upload(m.host_sky.data(), sizeof(Float3) * n, stream);
-  // (3) shading
-  ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
-  Check(cudaGetLastError(), "ShadeKernel");
-  // (4) exposure from the rows' log-luminance sums
-  RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,
-                                                    m.rows.as<double>());
-  Check(cudaGetLastError(), "RowSumKernel");
-  m.host_rows.resize(H);
-  m.rows.Download(m.host_rows.data(), sizeof(double) * H, stream);
+  sky(host_geometry, n, host_sky);
+  const auto t2 = Clock::now();
+  m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
+  // (3) shading, the shared visibility and (4) the rows' log-luminance sums
+  m.LaunchShading(f, o, stream);
+  m.rows.Download(host_rows, sizeof(double) * H, stream);
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
+  const auto t3 = Clock::now();
+  if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
   Exposure e;
   const double ev100 = exposure(m.host_rows, e.e);
-  // (5) film
-  DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
-      m.radiance.as<Float3>(), n, e, filmic ? 1 : 0, m.lut.as<uint8_t>(), m.rgb.as<uint8_t>());
-  Check(cudaGetLastError(), "DevelopKernel");
-  if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
-  if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
-  Check(cudaStreamSynchronize(stream), "DevelopKernel");
+  // (5) film; pinned: the radiance goes back on the copy stream while the film kernel runs
+  if (out.radiance && o.pinned)
+    m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
+  m.LaunchFilm(n, e, filmic ? 1 : 0, stream);
+  if (o.pinned) {
+    if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+    Check(cudaStreamSynchronize(stream), "DevelopKernel");
+    Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
+    if (out.rgb) std::memcpy(out.rgb, m.pin_rgb.p, 3 * n);
+    if (out.radiance) std::memcpy(out.radiance, m.pin_radiance.p, sizeof(Float3) * n);
+    if (out.depth) std::memcpy(out.depth, m.pin_depth.p, sizeof(float) * n);
+  } else {
+    if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
+    if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
+    Check(cudaStreamSynchronize(stream), "DevelopKernel");
+  }
+  m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  m.times.sky = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t2).count();
+  m.times.film = MsSince(t3);
+  m.times.total = MsSince(t0);
   m.frame = f;
   m.exposure = e;
   m.filmic = filmic ? 1 : 0;
@@ -144,26 +352,30 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
 }
 
 double DeviceRealtime::TimeKernels(DeviceScene* scene, int count) {
+  return TimeKernels(scene, count, impl_->options);
+}
+
+double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
+                                   const RealtimeKernelOptions& options) {
   Impl& m = *impl_;
   if (!m.rendered || count < 1) return 0;
   cudaStream_t stream = static_cast<cudaStream_t>(scene->stream());
   const RealtimeFrameView& f = m.frame;
-  const int W = f.camera.width, H = f.camera.height;
-  const int64_t n = static_cast<int64_t>(W) * H;
-  const dim3 block(16, 8);
-  const dim3 grid((W + block.x - 1) / block.x, (H + block.y - 1) / block.y);
+  const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  if (options.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
+  // one untimed run (first launch of a kernel variant)
+  m.LaunchGeometry(f, options, stream);
+  m.LaunchShading(f, options, stream);
+  m.LaunchFilm(n, m.exposure, m.filmic, stream);
+  Check(cudaStreamSynchronize(stream), "realtime kernels");
   cudaEvent_t start, stop;
   Check(cudaEventCreate(&start), "cudaEventCreate");
   Check(cudaEventCreate(&stop), "cudaEventCreate");
   Check(cudaEventRecord(start, stream), "cudaEventRecord");
   for (int k = 0; k < count; ++k) {
-    GeometryKernel<<<grid, block, 0, stream>>>(f, m.geometry.as<PixelGeometry>(),
-                                               m.depth.as<float>());
-    ShadeKernel<<<grid, block, 0, stream>>>(f, m.radiance.as<Float3>());
-    RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(m.radiance.as<Float3>(), W, H,
-                                                      m.rows.as<double>());
-    DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
-        m.radiance.as<Float3>(), n, m.exposure, m.filmic, m.lut.as<uint8_t>(), m.rgb.as<uint8_t>());
+    m.LaunchGeometry(f, options, stream);
+    m.LaunchShading(f, options, stream);
+    m.LaunchFilm(n, m.exposure, m.filmic, stream);
   }
   Check(cudaGetLastError(), "realtime kernels");
   Check(cudaEventRecord(stop, stream), "cudaEventRecord");

@@ -10,14 +10,16 @@
 //
 // with the same lattice points per pixel (render/lamp_math.h: LightStratum, no random numbers),
 // lamps and the sun's disc in the same closed form (ExtendedLightShading) and their visibility
-// as the fraction of the pixel's kLightPenumbraRays lattice points, or of all 64 in a penumbra
-// (the CPU shares the verdicts of neighbouring pixels instead, Heitz et al. 2018), the same
-// negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total) and
-// shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal) and the
-// sky radiance of rays that escape come per pixel from the host (SkyModel and
-// SkyIrradianceVolume's own code, RealtimeSkyTerms). what the GPU path does not model yet
-// (docs/gpu.md): texture coordinates of meshes (such materials are untextured), normal maps and
-// PBR maps, the mirror layer (SurfaceMaterial::mirror), cube textures on geoms (untextured), and
+// V_i shared between neighbouring pixels as the CPU shares it (render/shadow_window_math.h:
+// the ratio estimator of Heitz et al. 2018 over each pixel's 5x5 same-surface window, cut at
+// the 16x16 tiles' edges; SharedVisibilityRays / Fraction / Resolve after ShadeRealtimePixel),
+// the same negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total)
+// and shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal,
+// one probe blend per flat 2x2 quad as the CPU) and the sky radiance of rays that escape come
+// per pixel from the host (SkyModel and SkyIrradianceVolume's own code,
+// RealtimeFrameData::SkyTerms). what the GPU path does not model yet (docs/gpu.md): texture
+// coordinates of meshes (such materials are untextured), the mirror layer
+// (SurfaceMaterial::mirror), cube textures on geoms (untextured), MJCF skyboxes, and
 // interpolated shading normals (the geometric normal shades).
 
 #include <cstdint>
@@ -31,6 +33,7 @@
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
 #include "penumbra/render/shading_math.h"
+#include "penumbra/render/shadow_window_math.h"
 #include "penumbra/render/texture_math.h"
 
 namespace penumbra::cuda {
@@ -76,6 +79,17 @@ struct GeomPod {
   int32_t untextured = 0;      ///< a mesh with texture coordinates (not mapped on the GPU yet)
 };
 
+/// what a pixel's primary ray hits, for the host's sky pass: p_W, the unit geometric normal
+/// facing the ray and the unit shading normal (normal map applied, UsableShadingNormal) where
+/// it hits; the unit ray direction where it does not.
+struct PixelGeometry {
+  Float3 p_or_d;
+  Float3 ng;
+  Float3 ns;
+  int32_t hit = 0;
+  int32_t geom = -1;  ///< the hit's SceneDescription geom index (-1: none or not a geom)
+};
+
 /// everything a realtime frame reads, as device (or host) pointers.
 struct RealtimeFrameView {
   SceneView scene;
@@ -94,16 +108,21 @@ struct RealtimeFrameView {
   /// per pixel: E_sky on the surface the pixel's ray hits, or the sky radiance where it
   /// escapes (RealtimeSkyTerms).
   const Float3* sky_term = nullptr;
-};
-
-/// what a pixel's primary ray hits, for the host's sky pass: p_W, the unit geometric normal
-/// facing the ray and the unit shading normal (normal map applied, UsableShadingNormal) where
-/// it hits; the unit ray direction where it does not.
-struct PixelGeometry {
-  Float3 p_or_d;
-  Float3 ng;
-  Float3 ns;
-  int32_t hit = 0;
+  /// the shared visibility of lights with an extent (render/shadow_window_math.h), per pixel i
+  /// of the n = width x height image: its primary geometry (PrimaryGeometry) and its 5x5
+  /// window's same-surface mask (SharedVisibilityRays); per light j and pixel i at [j n + i]:
+  /// the unshadowed contribution and the pixel's own shadow ray's verdict (1 visible,
+  /// 0 occluded, -1 none traced; ShadeRealtimePixel), the visible and traced rays after the
+  /// penumbra rays, whether the pixel keeps its own fraction (a tile's outer ring), and the
+  /// window's fraction (SharedVisibilityFraction). device or host arrays the caller owns.
+  const PixelGeometry* geometry = nullptr;
+  uint32_t* window = nullptr;
+  Float3* area_c = nullptr;
+  int8_t* area_vis = nullptr;
+  float* area_visible = nullptr;
+  float* area_rays = nullptr;
+  uint8_t* area_own = nullptr;
+  float* area_fraction = nullptr;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -375,10 +394,11 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
 /// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
 /// (0 on a miss).
 PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
-                                                    float* t_hit) {
+                                                    float* t_hit, TraceHit* hit_out = nullptr) {
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
   TraceClosest(f.scene, r, &h);
+  if (hit_out) *hit_out = h;
   PixelGeometry g;
   *t_hit = 0;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
@@ -390,21 +410,27 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
   *t_hit = h.t;
   const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
   g.hit = 1;
+  g.geom = f.scene.records[f.scene.prims[h.prim].record].geom;
   g.p_or_d = sp.p;
   g.ng = sp.ng;
   g.ns = sp.n;
   return g;
 }
 
-/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
-/// escapes).
-PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+/// lights whose unshadowed contribution ShadeRealtimeHit keeps between its two loops (the
+/// others are evaluated twice).
+constexpr int kShadeCachedLights = 16;
+
+/// ShadeRealtimePixel of pixel (u, v) whose primary ray r (PrimaryRay) has the closest hit h
+/// (TraceClosest; the CUDA kernels take it from the geometry pass instead of tracing it again).
+/// every light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
+PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
+                                              const TraceRay& r, const TraceHit& h) {
   const SceneView& s = f.scene;
-  const TraceRay r = PrimaryRay(f.camera, u, v);
   const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
   const Float3 sky = f.sky_term[pixel];
-  TraceHit h;
-  TraceClosest(s, r, &h);
   if (h.instance < 0) return sky;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
@@ -436,18 +462,24 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
   const F3 origin{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
   float total = pbm::Luminance709(L.x, L.y, L.z);
+  Float3 cached_c[kShadeCachedLights], cached_wi[kShadeCachedLights];
+  float cached_dist[kShadeCachedLights];
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi;
     float dist;
     const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
   // lights in order: negligible or shadowless contributions are added as they are, the others
-  // after a shadow ray.
+  // after a shadow ray; those of lights with an extent wait for their neighbours' verdicts.
   for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
+    Float3 wi, c;
     float dist;
-    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    if (j < kShadeCachedLights)
+      c = cached_c[j], wi = cached_wi[j], dist = cached_dist[j];
+    else
+      c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
     const float lum = pbm::Luminance709(c.x, c.y, c.z);
     if (!(lum > 0)) continue;
     if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
@@ -456,34 +488,170 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
       sr.d = ToF3(wi);
       sr.tmin = 0;
       sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
-      if (!IsExtendedLightPod(f.lights[j])) {
-        if (TraceOccluded(s, sr)) continue;
-      } else {
-        // a lamp or the sun's disc: the visible fraction of the pixel's kLightPenumbraRays
-        // lattice points, and in a penumbra (they disagree) of every point of the lattice (the
-        // CPU shares its verdicts over neighbouring pixels instead, as it does at tile edges).
-        float rays = 1, visible = TraceOccluded(s, sr) ? 0.0f : 1.0f;
-        const int first = kLightPenumbraRays * LightStratum(u, v);
-        constexpr int kAll = kLightStrata * kLightPenumbraRays;
-        for (int r = 1; r < kAll; ++r) {
-          if (r == kLightPenumbraRays && (visible == 0 || visible == rays)) break;
-          float u1, u2, d_r;
-          Float3 w_r, E_r;
-          bool ok;
-          LightStratumUniforms((first + r) % kAll, kAll, &u1, &u2);
-          SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
-          if (!ok || !(pbm::Dot<float>(ng, w_r) > 0)) continue;
-          sr.d = ToF3(w_r);
-          sr.tmax = d_r * (1.0f - 1e-4f);
-          rays += 1;
-          if (!TraceOccluded(s, sr)) visible += 1;
-        }
-        const float V = visible / rays;
-        L = L + Float3{V * c.x, V * c.y, V * c.z};
+      const bool occluded = TraceOccluded(s, sr);
+      if (IsExtendedLightPod(f.lights[j])) {
+        f.area_vis[j * n_pixels + pixel] = occluded ? 0 : 1;
+        f.area_c[j * n_pixels + pixel] = c;
         continue;
       }
+      if (occluded) continue;
     }
     L = L + c;
+  }
+  return L;
+}
+
+/// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
+/// escapes) without the shadowed light of lights with an extent: their unshadowed contribution
+/// and the pixel's own shadow ray's verdict go to f.area_c and f.area_vis, resolved by
+/// SharedVisibilityRays, SharedVisibilityFraction and SharedVisibilityResolve once every pixel
+/// has them (as the CPU's RealtimeIntegrator defers them to ResolveSharedVisibility).
+PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  return ShadeRealtimeHit(f, u, v, r, h);
+}
+
+/// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
+/// v)'s window mask (f.window: the pixels of its 5x5 window, cut at its tile's edges, on its
+/// surface, ShadowWindowBit) and, per light with an extent whose verdicts in the window
+/// disagree (a penumbra), kLightPenumbraRays - 1 more shadow rays through the pixel's other
+/// lattice points, or every other point of the kLightStrata kLightPenumbraRays lattice on a
+/// tile's outer ring (f.area_own: that pixel keeps its own fraction); f.area_visible,
+/// f.area_rays: the pixel's visible and traced rays.
+PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
+  const int W = f.camera.width, H = f.camera.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int64_t i = static_cast<int64_t>(v) * W + u;
+  const ShadowTile tile = ShadowTileOf(u, v, W, H);
+  const int x = u - tile.x0, y = v - tile.y0;
+  const PixelGeometry& gi = f.geometry[i];
+  uint32_t bits = 0;
+  if (gi.hit != 0) {
+    const float ng_i[3] = {gi.ng.x, gi.ng.y, gi.ng.z},
+                p_i[3] = {gi.p_or_d.x, gi.p_or_d.y, gi.p_or_d.z};
+    for (int dy = -kShadowWindowRadius; dy <= kShadowWindowRadius; ++dy) {
+      if (y + dy < 0 || y + dy >= tile.height) continue;
+      for (int dx = -kShadowWindowRadius; dx <= kShadowWindowRadius; ++dx) {
+        if (x + dx < 0 || x + dx >= tile.width) continue;
+        const int64_t ii = i + static_cast<int64_t>(dy) * W + dx;
+        if (ii != i) {
+          const PixelGeometry& g = f.geometry[ii];
+          const float ng_g[3] = {g.ng.x, g.ng.y, g.ng.z},
+                      p_g[3] = {g.p_or_d.x, g.p_or_d.y, g.p_or_d.z};
+          if (g.hit == 0 || !SameShadowSurface(gi.geom, ng_i, p_i, g.geom, ng_g, p_g)) continue;
+        }
+        bits |= 1u << ShadowWindowBit(dx, dy);
+      }
+    }
+  }
+  f.window[i] = bits;
+  for (int j = 0; j < f.num_lights; ++j) {
+    const int64_t k = j * n + i;
+    f.area_own[k] = 0;
+    const int8_t vis = f.area_vis[k];
+    if (vis < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    float visible = static_cast<float>(vis), rays = 1;
+    bool seen[2] = {false, false};
+    for (uint32_t b = bits; b != 0; b &= b - 1) {
+      const int bit = LowestSetBit(b);
+      const int64_t ii = i + static_cast<int64_t>(bit / 5 - 2) * W + (bit % 5 - 2);
+      const int8_t w = f.area_vis[j * n + ii];
+      if (w >= 0) seen[w] = true;
+    }
+    if (seen[0] && seen[1]) {
+      const bool own = OnShadowTileRing(x, y, tile);
+      f.area_own[k] = own ? 1 : 0;
+      constexpr int kAll = kLightStrata * kLightPenumbraRays;
+      const int extra = own ? kAll : kLightPenumbraRays;
+      const int first = kLightPenumbraRays * LightStratum(u, v);
+      const Float3 p = gi.p_or_d, ng = gi.ng;
+      const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
+      const float off = kGpuRayOffsetScale * (1.0f + amax);
+      TraceRay sr;
+      sr.o = F3{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
+      sr.tmin = 0;
+      for (int r = 1; r < extra; ++r) {
+        float u1, u2, d_r;
+        Float3 w_r, E_r;
+        bool ok;
+        LightStratumUniforms((first + r) % kAll, kAll, &u1, &u2);
+        SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
+        if (!ok || !(pbm::Dot<float>(w_r, ng) > 0)) continue;
+        sr.d = ToF3(w_r);
+        sr.tmax = d_r * (1.0f - 1e-4f);  // +inf stays +inf
+        rays += 1;
+        if (!TraceOccluded(f.scene, sr)) visible += 1;
+      }
+    }
+    f.area_visible[k] = visible;
+    f.area_rays[k] = rays;
+  }
+}
+
+/// the shared visibility, step 2 of 3 (after SharedVisibilityRays at every pixel): per light
+/// with an extent that pixel (u, v) traced a verdict towards, the weighted fraction of visible
+/// rays over its window (ShadowWindowWeight), or its own fraction on a tile's ring in a
+/// penumbra (f.area_fraction).
+PB_HOST_DEVICE inline void SharedVisibilityFraction(const RealtimeFrameView& f, int u, int v) {
+  const int W = f.camera.width;
+  const int64_t n = static_cast<int64_t>(W) * f.camera.height;
+  const int64_t i = static_cast<int64_t>(v) * W + u;
+  for (int j = 0; j < f.num_lights; ++j) {
+    const int64_t k = j * n + i;
+    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    if (f.area_own[k] != 0) {
+      f.area_fraction[k] = f.area_visible[k] / f.area_rays[k];
+      continue;
+    }
+    float w_rays = 0, w_visible = 0;
+    for (uint32_t b = f.window[i]; b != 0; b &= b - 1) {
+      const int bit = LowestSetBit(b);
+      const int dy = bit / 5 - 2, dx = bit % 5 - 2;
+      const int64_t kk = k + static_cast<int64_t>(dy) * W + dx;
+      if (f.area_vis[kk] < 0) continue;
+      const float w = ShadowWindowWeight(dx, dy);
+      w_rays += w * f.area_rays[kk];
+      w_visible += w * f.area_visible[kk];
+    }
+    f.area_fraction[k] = w_visible / w_rays;
+  }
+}
+
+/// the shared visibility, step 3 of 3 (after SharedVisibilityFraction at every pixel): pixel
+/// (u, v)'s radiance L plus, per light with an extent, V times its unshadowed contribution, V
+/// the window's fraction, for a lamp once more averaged over the 3x3 pixels of its tile on the
+/// same surface (a lamp's penumbrae are tens of pixels wide; the sun's stay as they are).
+PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f, int u, int v,
+                                                     Float3 L) {
+  const int W = f.camera.width, H = f.camera.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int64_t i = static_cast<int64_t>(v) * W + u;
+  const ShadowTile tile = ShadowTileOf(u, v, W, H);
+  const int x = u - tile.x0, y = v - tile.y0;
+  for (int j = 0; j < f.num_lights; ++j) {
+    const int64_t k = j * n + i;
+    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    float V = f.area_fraction[k];
+    if (f.lights[j].kind != LightKind::kDirectional && f.area_own[k] == 0) {
+      float sum = 0;
+      int count = 0;
+      for (int yy = y - 1 < 0 ? 0 : y - 1; yy <= (y + 1 < tile.height ? y + 1 : tile.height - 1);
+           ++yy)
+        for (int xx = x - 1 < 0 ? 0 : x - 1; xx <= (x + 1 < tile.width ? x + 1 : tile.width - 1);
+             ++xx) {
+          const int64_t kk = k + static_cast<int64_t>(yy - y) * W + (xx - x);
+          if (f.area_vis[kk] < 0 || (f.window[i] >> ShadowWindowBit(xx - x, yy - y) & 1u) == 0)
+            continue;
+          sum += f.area_fraction[kk];
+          ++count;
+        }
+      V = sum / static_cast<float>(count);
+    }
+    if (!(V > 0)) continue;
+    const Float3& c = f.area_c[k];
+    L = Float3{L.x + V * c.x, L.y + V * c.y, L.z + V * c.z};
   }
   return L;
 }

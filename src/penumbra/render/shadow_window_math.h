@@ -1,0 +1,76 @@
+#pragma once
+// the realtime tier's shared shadow verdicts for lights with an extent (sphere lamps, the sun's
+// disc) as formulas both backends call (issue 35 item 3; PB_HOST_DEVICE, core/host_device.h;
+// the shared shading contract: Eigen-free, no std:: containers). a pixel's visibility of such
+// a light is the ratio estimator of Heitz, Hill and McGuire, "Combining Analytic Direct
+// Illumination and Stochastic Shadows" (I3D 2018) with the shadow term shared: the weighted
+// fraction of visible shadow rays over the 5x5 pixels around it that lie on the same surface
+// (same geom, normals within 25 degrees, within 5 % of their distance from its tangent plane),
+// the window cut at the edges of the renderer's 16x16 pixel tiles. render/cpu/
+// realtime_integrator.cc (ResolveSharedVisibility) and the CUDA path
+// (render/cuda/realtime_shading.h, SharedVisibility*) apply it.
+
+#include <cstdint>
+
+#include "penumbra/core/host_device.h"
+
+namespace penumbra {
+
+/// side of the square pixel tiles whose edges cut the windows (EmbreeRenderer::kTileSize).
+constexpr int kShadowTileSize = 16;
+/// the window reaches this many pixels on each side (5x5).
+constexpr int kShadowWindowRadius = 2;
+
+/// the tile of pixel (u, v) in a width x height image: first column and row, size.
+struct ShadowTile {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
+/// the kShadowTileSize tile that holds pixel (u, v) (cut at the image's right and bottom edges).
+PB_HOST_DEVICE inline ShadowTile ShadowTileOf(int u, int v, int width, int height) {
+  ShadowTile t;
+  t.x0 = u - u % kShadowTileSize;
+  t.y0 = v - v % kShadowTileSize;
+  t.width = width - t.x0 < kShadowTileSize ? width - t.x0 : kShadowTileSize;
+  t.height = height - t.y0 < kShadowTileSize ? height - t.y0 : kShadowTileSize;
+  return t;
+}
+
+/// the index of the lowest set bit of b != 0 (walks a window mask in row-major order).
+PB_HOST_DEVICE inline int LowestSetBit(uint32_t b) {
+#ifdef __CUDA_ARCH__
+  return __ffs(static_cast<int>(b)) - 1;
+#else
+  return __builtin_ctz(b);
+#endif
+}
+
+/// the bit of window offset (dx, dy), |dx|, |dy| <= kShadowWindowRadius, in a window mask.
+PB_HOST_DEVICE inline int ShadowWindowBit(int dx, int dy) { return (dy + 2) * 5 + dx + 2; }
+
+/// the weight of window offset (dx, dy): 1/2 on the outer rows and columns, so that each
+/// pixel of a 4x4 lattice block weighs 1.
+PB_HOST_DEVICE inline float ShadowWindowWeight(int dx, int dy) {
+  return (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f);
+}
+
+/// whether the hit g (geom, unit normal ng_g facing the ray, point p_g) lies on the surface of
+/// hit i: the same geom, normals within 25 degrees (dot >= 0.9) and g within 5 % of its
+/// distance from i's tangent plane. points in m, world frame. the sums run x + (y + z), the
+/// order of Eigen's 3-vector dot and squaredNorm, which the CPU backend used before.
+PB_HOST_DEVICE inline bool SameShadowSurface(int geom_i, const float ng_i[3], const float p_i[3],
+                                             int geom_g, const float ng_g[3], const float p_g[3]) {
+  if (geom_g != geom_i || !(ng_i[0] * ng_g[0] + (ng_i[1] * ng_g[1] + ng_i[2] * ng_g[2]) >= 0.9f))
+    return false;
+  const float dp[3] = {p_g[0] - p_i[0], p_g[1] - p_i[1], p_g[2] - p_i[2]};
+  const float off = ng_i[0] * dp[0] + (ng_i[1] * dp[1] + ng_i[2] * dp[2]);
+  return off * off <= 0.0025f * (dp[0] * dp[0] + (dp[1] * dp[1] + dp[2] * dp[2])) + 1e-10f;
+}
+
+/// whether tile-local pixel (x, y) lies on its tile's outermost ring (its window lacks the next
+/// tile's half: in a penumbra it traces the whole lattice and keeps its own fraction).
+PB_HOST_DEVICE inline bool OnShadowTileRing(int x, int y, const ShadowTile& t) {
+  return x == 0 || y == 0 || x == t.width - 1 || y == t.height - 1;
+}
+
+}  // namespace penumbra
