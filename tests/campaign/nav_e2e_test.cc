@@ -20,6 +20,7 @@
 #include "penumbra/campaign/benchmark_spec.h"
 #include "penumbra/campaign/nav_report.h"
 #include "penumbra/core/error.h"
+#include "penumbra/world/adversity_preset.h"
 
 namespace penumbra {
 namespace {
@@ -253,6 +254,38 @@ TEST(NavBenchmark, SpecErrorsNameFileLineAndField) {
   // unknown kind
   e = ErrorOf("kind: rl\n");
   EXPECT_NE(e.find("kind"), std::string::npos) << e;
+}
+
+// the bundled navigation benchmark runs levels of its own (benchmarks/nav_presets.yaml), not
+// the shared presets calibrated for RGB-D odometry, whose `minor` has no people: each level
+// adds people who step into the robot's path and shortens the depth camera's range
+TEST(NavBenchmark, BundledSpecRunsItsOwnNavigationLevels) {
+  const BenchmarkSpec s =
+      LoadBenchmarkSpec(std::string(PENUMBRA_SOURCE_DIR) + "/benchmarks/nav.yaml");
+  ASSERT_EQ(s.conditions.size(), 3u);
+  EXPECT_EQ(s.conditions[0].name, "none");
+  EXPECT_EQ(s.conditions[1].name, "minor");
+  EXPECT_EQ(s.conditions[2].name, "major");
+  const AdversityPreset none = LoadAdversityPreset(s.conditions[0].adversity);
+  const AdversityPreset minor = LoadAdversityPreset(s.conditions[1].adversity);
+  const AdversityPreset major = LoadAdversityPreset(s.conditions[2].adversity);
+  EXPECT_TRUE(none.empty());
+  for (const BenchmarkCondition& c : {s.conditions[1], s.conditions[2]})
+    EXPECT_NE(c.adversity.find("benchmarks/nav_presets.yaml#"), std::string::npos) << c.adversity;
+  // people in the robot's path: some under minor, more under major
+  EXPECT_GE(minor.npc_people, 1);
+  EXPECT_GT(major.npc_people, minor.npc_people);
+  EXPECT_EQ(minor.npc_behaviour, AgentBehaviour::kBlock);
+  EXPECT_EQ(major.npc_behaviour, AgentBehaviour::kBlock);
+  // no blocking vehicle (it would drive at the robot)
+  EXPECT_EQ(minor.npc_vehicles, 0);
+  EXPECT_EQ(major.npc_vehicles, 0);
+  // the depth camera's range: fog under both, denser under major, smoke under major only
+  ASSERT_TRUE(minor.fog_mor_m.has_value());
+  ASSERT_TRUE(major.fog_mor_m.has_value());
+  EXPECT_LT(*major.fog_mor_m, *minor.fog_mor_m);
+  EXPECT_FALSE(minor.smoke_sigma_t_per_m.has_value());
+  EXPECT_TRUE(major.smoke_sigma_t_per_m.has_value());
 }
 
 }  // namespace

@@ -240,5 +240,42 @@ TEST(CrowdTest, SameSeedGivesBitIdenticalCrowdTrajectories) {
   EXPECT_NE(a, c);  // another seed: another crowd
 }
 
+TEST(CrowdTest, AgentRootsMoveSmoothlyBetweenCrowdSteps) {
+  // the crowd steps every 0.05 s and the physics every 0.002 s: between two crowd steps a
+  // person's root moves on, at its walking speed (<= 1 m/s here), at every physics step; it
+  // neither holds still for part of the crowd step nor jumps to catch up (the jump read as a
+  // 5 m/s approach in the contacts metric)
+  const testing::TempDir dir;
+  SessionOptions o = CrowdSessionOptions(CrowdPresetFile(dir, "{people: 4, speed_m_s: 0.8}"));
+  o.add_controllers = true;
+  Session session(LoadWorldFile(CrowdWorldPath("house.yaml")), o);
+  const std::vector<std::string> names = session.sim().MocapBodyNames();
+  std::vector<size_t> roots;
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i].rfind("agents/", 0) == 0 && names[i].find('/', 7) == std::string::npos)
+      roots.push_back(i);
+  ASSERT_EQ(roots.size(), 4u);
+  const double dt = session.sim().timestep();
+  std::vector<double> before;
+  double fastest = 0, travelled = 0;
+  int still = 0, moving = 0;
+  for (int k = 0; k < 2500; ++k) {  // 5 s
+    session.sim().Step();
+    const std::vector<double> p = session.sim().GetState().mocap_pos;
+    if (!before.empty())
+      for (size_t r : roots) {
+        const double d = std::hypot(p[3 * r] - before[3 * r], p[3 * r + 1] - before[3 * r + 1]);
+        fastest = std::max(fastest, d / dt);
+        travelled += d;
+        (d == 0 ? still : moving) += 1;
+      }
+    before = p;
+  }
+  EXPECT_GT(travelled, 4 * 1.0);  // they walk
+  EXPECT_LE(fastest, 1.0) << "a root moved " << fastest * dt << " m in one physics step";
+  // a walking person holds still only where it pauses or waits: not half of every crowd step
+  EXPECT_GT(moving, 3 * still);
+}
+
 }  // namespace
 }  // namespace penumbra

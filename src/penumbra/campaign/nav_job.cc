@@ -355,7 +355,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   if (stopped) throw JobInterrupted("job " + job.id + " interrupted during its episode");
 
   const Clock::time_point eval_start = Clock::now();
-  const bool run_ok = run->exit_code() == 0 || run->exit_code() == 143 || run->exit_code() == 130;
+  const bool run_ok = NavRunDelivered(run->exit_code(), run->signal(), run_dir.string());
   std::vector<NavPoseSample> poses;
   std::vector<ContactInterval> contacts;
   std::string eval_error;
@@ -422,6 +422,14 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   // written last and atomically (WriteText): its presence marks the job finished
   WriteText(JobResultPath(context.out_dir, job), RowJson(row).dump(1) + "\n");
   return row;
+}
+
+bool NavRunDelivered(int exit_code, int signal, const std::string& run_dir) {
+  if (exit_code == 0 || exit_code == 128 + SIGTERM || exit_code == 128 + SIGINT) return true;
+  // the signal's default action: the run had no handler left (it was past its end)
+  if (signal != SIGTERM && signal != SIGINT) return false;
+  std::error_code ec;
+  return fs::is_regular_file(fs::path(run_dir) / "run.json", ec);
 }
 
 NavRow ReadNavJobResult(const std::string& path) {

@@ -68,6 +68,15 @@ std::vector<BenchmarkJob> PlanNavJobs(const BenchmarkSpec& spec);
 NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                  const BenchmarkJobContext& context);
 
+/// whether a nav episode's run delivered its outputs, from how its process ended (exit_code,
+/// signal as ChildProcess reports them) and its output folder `run_dir`: it exited 0, or it was
+/// stopped by the harness's SIGTERM (or a SIGINT) and either its handler ended it (exit 143 or
+/// 130: it wrote its outputs) or the signal itself ended it after it had written run.json (the
+/// run's last file, output/run_manifest.h: a run that had reached its duration and was
+/// closing down when the SIGTERM came). anything else (another exit code or signal, no
+/// run.json after a bare signal) is a failed run.
+bool NavRunDelivered(int exit_code, int signal, const std::string& run_dir);
+
 /// reads a nav job's result.json. @throws ConfigError naming the file if it is malformed.
 NavRow ReadNavJobResult(const std::string& path);
 

@@ -90,7 +90,10 @@ std::vector<CrowdRobot> CrowdRunner::Robots() {
 
 void CrowdRunner::AdvanceTo(double time_sec) {
   const double local = time_sec - start_sec_;
-  while (crowd_->time_sec() + 0.5 * crowd_->dt() <= local) {
+  // the crowd stays a step ahead of the time asked for, so that X_WA interpolates within
+  // [t1 - dt, t1] and never holds a pose (stepping at the middle of the interval instead made
+  // the roots stand still for half of each crowd step and then jump half a step ahead)
+  while (crowd_->time_sec() < local) {
     previous_ = crowd_->states();
     crowd_->Step(Robots());
     std::vector<CrowdDecision> decisions = crowd_->TakeDecisions();

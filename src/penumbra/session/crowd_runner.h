@@ -3,8 +3,9 @@
 // agents' mocap drivers on the physics thread. the crowd steps at its own dt (0.05 s) on sim
 // time; each step reads the robots' root poses from the simulation (a robot without a free
 // joint stands at its world-file pose), and the agents' poses between two crowd steps are
-// interpolated (position linearly, heading along the shorter arc). every CrowdDecision goes
-// to the decision sink (a run log's "npc" events, run/runner.cc).
+// interpolated (position linearly, heading along the shorter arc; the crowd is stepped as soon
+// as the time asked for passes its own, so the poses are continuous in time). every CrowdDecision
+// goes to the decision sink (a run log's "npc" events, run/runner.cc).
 
 #include <functional>
 #include <memory>
