@@ -16,7 +16,7 @@
 //   void Read(const SensorParamReader& r);           // parse and validate the keys present
 //
 // and the factory of its model (create), named after what it makes (LidarSensorParams::
-// MakeConfig, ImuSensorParams::MakeNoise, ...), used by session/sensor_sink.cc.
+// MakeConfig, ImuSensorParams::MakeNoise, ...), used by sinks/sensor_sink.cc.
 //
 // keys in Read are relative to the sensor entry ("columns", "noise.stddev"); the world reader
 // (world/sensors_reader.cc) implements SensorParamReader over the YAML file and adds the

@@ -2,7 +2,7 @@
 // the sensor registry: every sensor type, in one list. adding a sensor type = its own
 // sensors/types/<name>.{h,cc} (the contract is in sensor_type.h), its enumerator at the END of
 // SensorKind and its entry at the END of SensorParams below, and its model in
-// session/sensor_sink.cc. nothing else compares type names: the world reader, the run
+// sinks/sensor_sink.cc. nothing else compares type names: the world reader, the run
 // description, the bridges and the output folders go through the list.
 
 #include <array>

@@ -25,7 +25,7 @@
 //
 // under a robot (robots[i].sensors) the same entries attach to that robot: body and site
 // names and mujoco sensor names are given without the "<robot>/" prefix and get it here.
-// body/site existence is checked after composition (session/sensor_sink), naming the entry.
+// body/site existence is checked after composition (sinks/sensor_sink), naming the entry.
 
 #include <Eigen/Core>
 #include <optional>
