@@ -47,8 +47,8 @@ const World& DefaultWorld() {
     const double fovy =
         2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180 / M_PI;
     out->view.intrinsics = CameraIntrinsics::FromFovy(640, 480, fovy);
-    out->view.outputs.rgb = true;
-    out->view.outputs.depth = true;
+    out->view.outputs[ImageKind::kRgb] = true;
+    out->view.outputs[ImageKind::kDepth] = true;
     out->view.X_WO = CameraPoseInWorld(cam, out->snapshot);
     out->view.exposure_time_sec = 0.01;
     return out;

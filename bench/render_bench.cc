@@ -165,8 +165,8 @@ void BM_RenderRoom(benchmark::State& state) {
   const Pose X_WC = PoseFromXyzRpyDeg({-2.8, -2.3, 1.6}, {0, 20, 40});
   view.X_WO = X_WC * Pose(RotationBodyFromOptical());
   view.intrinsics = CameraIntrinsics::FromFovy(640, 480, 60);
-  view.outputs.rgb = true;
-  view.outputs.depth = true;
+  view.outputs[ImageKind::kRgb] = true;
+  view.outputs[ImageKind::kDepth] = true;
   RenderedFrame frame;
   int64_t rays = 0;
   for (auto _ : state) {

@@ -36,7 +36,7 @@ TEST(PngWriteTimes, AsyncFrameWriterSumsItsCameras) {
   TempDir dir;
   AsyncFrameWriter writer(dir.str());
   CameraOutputs outputs;
-  outputs.rgb = outputs.depth = true;
+  outputs[ImageKind::kRgb] = outputs[ImageKind::kDepth] = true;
   writer.AddCamera("left", CameraIntrinsics::FromFovy(32, 24, 70), outputs);
   writer.AddCamera("right", CameraIntrinsics::FromFovy(32, 24, 70), outputs);
   EXPECT_EQ(writer.PngTimes().encode_sec, 0);
