@@ -1,5 +1,6 @@
 // the realtime tier's rgb and depth on the GPU (ctest label `gpu`) against the CPU backend on
-// the bundled default, house, warehouse and outdoor worlds at 640x480: rgb PSNR >= 40 dB, depth
+// the bundled default, house, warehouse and outdoor worlds and effects/walkers.yaml (the mirror
+// layer: its rover's materials have reflectance 0.2 and 0.4) at 640x480: rgb PSNR >= 40 dB, depth
 // within 1 mm on >= 99.9 % of pixels, and two GPU renders bit-identical (rgb, radiance, depth).
 // without a device every test prints "skipped: no CUDA device".
 
@@ -56,7 +57,7 @@ TEST_P(RealtimeRgbGpu, MatchesCpuBackendAndRepeatsBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeRgbGpu,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml",
-                                           "outdoor.yaml"));
+                                           "outdoor.yaml", "effects/walkers.yaml"));
 
 }  // namespace
 }  // namespace penumbra

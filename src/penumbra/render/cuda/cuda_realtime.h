@@ -6,10 +6,13 @@
 //
 // a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth;
 // (2) the host turns the geometry into sky terms (`sky`: SkyModel and SkyIrradianceVolume run on
-// the CPU, realtime_frame.h) which are uploaded; (3) the shading kernel (ShadeRealtimePixel);
-// (4) per-row log-luminance sums, which the host (`exposure`) turns into the frame's EV100 and
-// exposures; (5) the film kernel (DevelopPixel). every sum runs in a fixed order and no atomics
-// touch an output: frames are bit-identical run to run on one GPU.
+// the CPU, realtime_frame.h) which are uploaded; with a mirror layer in the scene, (1) also
+// traces the mirrored rays (TraceMirrorRay), whose geometry makes the same round trip for its
+// sky terms; (3) the shading kernel (ShadeRealtimePixel), the shared visibility's kernels and
+// the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which the
+// host (`exposure`) turns into the frame's EV100 and exposures; (5) the film kernel (DevelopPixel).
+// every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
+// run on one GPU.
 
 #include <cstdint>
 #include <functional>
@@ -63,9 +66,10 @@ struct RealtimeKernelOptions {
 /// the host clock's time of Render()'s stages, milliseconds (benchmarks).
 /// geometry + sky + shade + film = total.
 struct RealtimeStageTimes {
-  double geometry = 0;  ///< upload of geoms and lights, geometry kernel, geometry to the host
-  double sky = 0;       ///< the host's sky terms (RealtimeFrameData::SkyTerms)
-  /// sky terms up, shading, shared-visibility and row-sum kernels, row sums back
+  /// upload of geoms and lights, geometry (and mirrored-ray) kernels, geometry to the host
+  double geometry = 0;
+  double sky = 0;  ///< the host's sky terms (RealtimeFrameData::SkyTerms)
+  /// sky terms up, shading, shared-visibility, mirror-layer and row-sum kernels, row sums back
   double shade = 0;
   double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
   double total = 0;
@@ -82,8 +86,11 @@ class DeviceRealtime {
   /// copies the scene-constant data to the device.
   void Upload(const RealtimeStatic& data);
 
-  /// host sky pass: sky terms of n pixels from their primary geometry.
-  using SkyFn = std::function<void(const PixelGeometry* geometry, int64_t n, Float3* sky)>;
+  /// host sky pass: sky terms of n pixels from their primary geometry, and of their mirrored
+  /// rays from theirs (mirror and mirror_sky null when the frame has no mirror layer,
+  /// RealtimeFrameView::any_mirror).
+  using SkyFn = std::function<void(const PixelGeometry* geometry, const PixelGeometry* mirror,
+                                   int64_t n, Float3* sky, Float3* mirror_sky)>;
   /// host exposure: the EV100 from the rows' log-luminance sums, and the per-channel exposures.
   using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
 

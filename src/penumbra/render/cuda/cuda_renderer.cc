@@ -126,8 +126,10 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   out->ev100 = device_realtime_->Render(
       device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
       realtime_->film().filmic(),
-      [&](const PixelGeometry* g, int64_t count, Float3* sky) {
+      [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, Float3* sky,
+          Float3* mirror_sky) {
         realtime_->SkyTerms(g, count, sky, pool_.get());
+        if (mirror != nullptr) realtime_->MirrorSkyTerms(mirror, count, mirror_sky, pool_.get());
       },
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);

@@ -1,5 +1,6 @@
 #include "penumbra/render/cuda/realtime_frame.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -29,6 +30,7 @@ MaterialPod PodOf(const Material& m, const std::vector<int>& texture_slot) {
   p.texrepeat[0] = m.texrepeat.x();
   p.texrepeat[1] = m.texrepeat.y();
   p.texuniform = m.texuniform ? 1 : 0;
+  p.mirror = m.reflectance > 0 ? std::min(m.reflectance, 1.0f) : 0.0f;
   return p;
 }
 
@@ -95,15 +97,18 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
     pod.metallic_roughness_map = slot_of(maps.metallic_roughness);
     pod.occlusion_map = slot_of(maps.occlusion);
     pod.emissive_map = slot_of(maps.emissive);
+    any_mirror_ = any_mirror_ || pod.mirror > 0;
     materials_.push_back(pod);
   }
   default_material_ = PodOf(Material(), slot);
+  any_mirror_ = any_mirror_ || default_material_.mirror > 0;
   geoms_.resize(scene.geoms.size());
   for (size_t g = 0; g < scene.geoms.size(); ++g) {
     const Geom& geom = scene.geoms[g];
     GeomPod& pod = geoms_[g];
     pod.half_extent = ToFloat3(GeomHalfExtents(scene, geom));
     pod.plane = geom.shape == GeomShape::kPlane ? 1 : 0;
+    pod.box = geom.shape == GeomShape::kBox ? 1 : 0;
     pod.untextured = geom.shape == GeomShape::kMesh && geom.mesh >= 0 &&
                              geom.mesh < static_cast<int>(scene.meshes.size()) &&
                              !scene.meshes[geom.mesh].texcoords.empty()
@@ -214,6 +219,28 @@ void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float
   });
 }
 
+void RealtimeFrameData::MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out,
+                                       ThreadPool* pool) const {
+  const int W = camera_.width, H = camera_.height;
+  if (n != static_cast<int64_t>(W) * H)
+    throw Error("RealtimeFrameData::MirrorSkyTerms: " + std::to_string(n) +
+                " pixels, the camera has " + std::to_string(static_cast<int64_t>(W) * H));
+  const bool occluded = !volume_.empty();
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    for (int64_t i = v * W; i < (v + 1) * W; ++i) {
+      const PixelGeometry& g = mirror[i];
+      if (g.hit < 0) continue;
+      const Eigen::Vector3f x(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
+      if (g.hit == 0) {
+        out[i] = ToFloat3(sky_.Background(x));
+        continue;
+      }
+      const Eigen::Vector3f ns(g.ns.x, g.ns.y, g.ns.z);
+      out[i] = ToFloat3(occluded ? volume_.Irradiance(x, ns, sky_) : sky_.Irradiance(ns));
+    }
+  });
+}
+
 RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* sky) const {
   RealtimeFrameView f;
   f.scene = scene;
@@ -230,6 +257,7 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.max_anisotropy = settings_.max_anisotropy < 1 ? 1 : settings_.max_anisotropy;
   f.frame_key = frame_key_;
   f.sky_term = sky;
+  f.any_mirror = any_mirror_ ? 1 : 0;
   return f;
 }
 
@@ -261,9 +289,32 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i]);
     }
   });
+  // the mirror layer's rays, traced from the primary geometry (on the GPU their geometry
+  // makes the round trip to the host with the primary geometry's)
+  std::vector<PixelGeometry> mirror_geometry;
+  std::vector<TraceHit> mirror_hits;
+  std::vector<Float3> mirror_sky, mirror_radiance;
+  if (data.any_mirror()) {
+    mirror_geometry.resize(n);
+    mirror_hits.resize(n);
+    mirror_sky.resize(n);
+    mirror_radiance.resize(n);
+    RealtimeFrameView mirror_view = geo_view;
+    mirror_view.geometry = geometry.data();
+    mirror_view.mirror_geometry = mirror_geometry.data();
+    mirror_view.mirror_hits = mirror_hits.data();
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) TraceMirrorRay(mirror_view, u, static_cast<int>(v));
+    });
+    data.MirrorSkyTerms(mirror_geometry.data(), n, mirror_sky.data(), pool);
+  }
   std::vector<Float3> sky(n);
   data.SkyTerms(geometry.data(), n, sky.data(), pool);
   RealtimeFrameView f = data.View(scene, sky.data());
+  f.mirror_geometry = mirror_geometry.data();
+  f.mirror_hits = mirror_hits.data();
+  f.mirror_sky = mirror_sky.data();
+  f.mirror_radiance = mirror_radiance.data();
   // the shared visibility's buffers (RealtimeFrameView), per pixel and per light and pixel.
   const size_t nl = static_cast<size_t>(n) * static_cast<size_t>(f.num_lights);
   std::vector<uint32_t> window(n);
@@ -297,6 +348,17 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       L = SharedVisibilityResolve(f, u, static_cast<int>(v), L);
     }
   });
+  if (f.any_mirror != 0) {
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) ShadeMirrorHit(f, u, static_cast<int>(v));
+    });
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) {
+        Float3& L = radiance[v * W + u];
+        L = ApplyMirrorLayer(f, u, static_cast<int>(v), L);
+      }
+    });
+  }
   std::vector<double> rows(H);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     rows[v] = RowLogLuminance(radiance.data(), W, static_cast<int>(v), kMinLuminance);

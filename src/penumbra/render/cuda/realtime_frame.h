@@ -5,7 +5,10 @@
 // key; the per-pixel sky terms from the primary rays' geometry (SkyModel::Radiance where a ray
 // escapes; where it hits, the occluded sky irradiance of the realtime tier's
 // SkyIrradianceVolume, or SkyModel::Irradiance without one: the CPU backend's own code, run on
-// the host); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// the host); the sky terms of the mirror layer's reflected rays (MirrorSkyTerms: the occluded
+// sky irradiance at their hits, SkyIrradianceVolume::Irradiance at the shading normal as
+// render/cpu/mirror_layer.cc, or the sky's Background where they escape); and the film's
+// exposure and encoding table. RenderRealtimeOnHost runs the GPU
 // path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
 // GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
@@ -48,6 +51,17 @@ class RealtimeFrameData {
   /// flat face shares one probe blend, as RealtimeIntegrator does. @throws Error for another n.
   void SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out, ThreadPool* pool) const;
 
+  /// the sky term of every pixel's mirrored ray (RealtimeFrameView::mirror_sky) from its
+  /// geometry (TraceMirrorRay; n pixels as SkyTerms): where it hits, the occluded sky
+  /// irradiance at the hit's shading normal (SkyIrradianceVolume::Irradiance, no shared blends:
+  /// render/cpu/mirror_layer.cc's MirrorRadiance), where it escapes SkyModel::Background;
+  /// pixels that traced none (hit -1) are left as they are. @throws Error for another n.
+  void MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out, ThreadPool* pool) const;
+
+  /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
+  /// skip the layer's kernels and its part of the host's sky pass.
+  bool any_mirror() const { return any_mirror_; }
+
   /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).
   RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
 
@@ -79,6 +93,7 @@ class RealtimeFrameData {
   PinholeCamera camera_;
   float spread_rad_ = 0;
   uint64_t frame_key_ = 0;
+  bool any_mirror_ = false;
 };
 
 /// the pinhole camera of `view` as the kernels take it (view must be a projective camera).

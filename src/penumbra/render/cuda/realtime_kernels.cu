@@ -29,6 +29,30 @@ __global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, flo
   depth[i] = t;
 }
 
+// the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
+// shading and the blend after the shared visibility.
+__global__ void MirrorTraceKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  TraceMirrorRay(f, u, v);
+}
+
+__global__ void MirrorShadeKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  ShadeMirrorHit(f, u, v);
+}
+
+__global__ void MirrorBlendKernel(RealtimeFrameView f, Float3* radiance) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  radiance[i] = ApplyMirrorLayer(f, u, v, radiance[i]);
+}
+
 // kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
 // threads each SM must hold (__launch_bounds__: at most 65536 / (128 kMinBlocks) registers).
 template <bool kReuse, int kMinBlocks>
@@ -145,10 +169,13 @@ struct DeviceRealtime::Impl {
   Buffer geometry, depth, sky, radiance, rows, rgb, hits;
   // the shared visibility's buffers (RealtimeFrameView)
   Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
+  // the mirror layer's buffers (RealtimeFrameView)
+  Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
-  std::vector<PixelGeometry> host_geometry;
-  std::vector<Float3> host_sky;
+  PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
+  std::vector<PixelGeometry> host_geometry, host_mirror_geometry;
+  std::vector<Float3> host_sky, host_mirror_sky;
   std::vector<double> host_rows;
   cudaStream_t copy_stream = nullptr;
   cudaEvent_t geometry_done = nullptr;
@@ -166,6 +193,10 @@ struct DeviceRealtime::Impl {
         f, geometry.as<PixelGeometry>(), depth.as<float>(),
         o.reuse_hit ? hits.as<TraceHit>() : nullptr);
     Check(cudaGetLastError(), "GeometryKernel");
+    if (f.any_mirror != 0) {
+      MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(f);
+      Check(cudaGetLastError(), "MirrorTraceKernel");
+    }
   }
   // the shading, shared-visibility and row-sum kernels of frame f on `stream` as `o` says.
   void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
@@ -189,6 +220,12 @@ struct DeviceRealtime::Impl {
     Check(cudaGetLastError(), "VisibilityFractionKernel");
     VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
     Check(cudaGetLastError(), "VisibilityResolveKernel");
+    if (f.any_mirror != 0) {
+      MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+      Check(cudaGetLastError(), "MirrorShadeKernel");
+      MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
+      Check(cudaGetLastError(), "MirrorBlendKernel");
+    }
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
@@ -257,6 +294,13 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.area_rays.Reserve(sizeof(float) * nl);
   m.area_own.Reserve(sizeof(uint8_t) * nl);
   m.area_fraction.Reserve(sizeof(float) * nl);
+  const bool mirror = host_frame.any_mirror != 0;
+  if (mirror) {
+    m.mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
+    m.mirror_hits.Reserve(sizeof(TraceHit) * n);
+    m.mirror_sky.Reserve(sizeof(Float3) * n);
+    m.mirror_radiance.Reserve(sizeof(Float3) * n);
+  }
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
@@ -276,10 +320,18 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.area_rays = m.area_rays.as<float>();
   f.area_own = m.area_own.as<uint8_t>();
   f.area_fraction = m.area_fraction.as<float>();
+  if (mirror) {
+    f.mirror_geometry = m.mirror_geometry.as<PixelGeometry>();
+    f.mirror_hits = m.mirror_hits.as<TraceHit>();
+    f.mirror_sky = m.mirror_sky.as<Float3>();
+    f.mirror_radiance = m.mirror_radiance.as<Float3>();
+  }
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;
   double* host_rows;
+  PixelGeometry* host_mirror_geometry = nullptr;
+  Float3* host_mirror_sky = nullptr;
   if (o.pinned) {
     m.pin_geometry.Reserve(sizeof(PixelGeometry) * n);
     m.pin_sky.Reserve(sizeof(Float3) * n);
@@ -290,6 +342,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     if (out.rgb) m.pin_rgb.Reserve(3 * n);
     if (out.radiance) m.pin_radiance.Reserve(sizeof(Float3) * n);
     if (out.depth) m.pin_depth.Reserve(sizeof(float) * n);
+    if (mirror) {
+      m.pin_mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
+      m.pin_mirror_sky.Reserve(sizeof(Float3) * n);
+      host_mirror_geometry = m.pin_mirror_geometry.as<PixelGeometry>();
+      host_mirror_sky = m.pin_mirror_sky.as<Float3>();
+    }
   } else {
     m.host_geometry.resize(n);
     m.host_sky.resize(n);
@@ -297,11 +355,18 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     host_geometry = m.host_geometry.data();
     host_sky = m.host_sky.data();
     host_rows = m.host_rows.data();
+    if (mirror) {
+      m.host_mirror_geometry.resize(n);
+      m.host_mirror_sky.resize(n);
+      host_mirror_geometry = m.host_mirror_geometry.data();
+      host_mirror_sky = m.host_mirror_sky.data();
+    }
   }
   // (1) primary geometry (materials and normal maps included) and depth; pinned: the depth
   // goes back on the copy stream while the host computes the sky terms
   m.LaunchGeometry(f, o, stream);
   m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
+  if (mirror) m.mirror_geometry.Download(host_mirror_geometry, sizeof(PixelGeometry) * n, stream);
   if (out.depth) {
     if (o.pinned) {
       Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
@@ -314,9 +379,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   Check(cudaStreamSynchronize(stream), "GeometryKernel");
   const auto t1 = Clock::now();
   // (2) the sky terms on the host
-  sky(host_geometry, n, host_sky);
+  sky(host_geometry, host_mirror_geometry, n, host_sky, host_mirror_sky);
   const auto t2 = Clock::now();
   m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
+  if (mirror) m.mirror_sky.Upload(host_mirror_sky, sizeof(Float3) * n, stream);
   // (3) shading, the shared visibility and (4) the rows' log-luminance sums
   m.LaunchShading(f, o, stream);
   m.rows.Download(host_rows, sizeof(double) * H, stream);

@@ -17,10 +17,15 @@
 // and shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal,
 // one probe blend per flat 2x2 quad as the CPU) and the sky radiance of rays that escape come
 // per pixel from the host (SkyModel and SkyIrradianceVolume's own code,
-// RealtimeFrameData::SkyTerms). what the GPU path does not model yet (docs/gpu.md): texture
-// coordinates of meshes (such materials are untextured), the mirror layer
-// (SurfaceMaterial::mirror), cube textures on geoms (untextured), MJCF skyboxes, and
-// interpolated shading normals (the geometric normal shades).
+// RealtimeFrameData::SkyTerms). the mirror layer (SurfaceMaterial::mirror, weight r: L becomes
+// (1 - r) L + r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray traced on the layer's
+// grid (render/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
+// light and a shadow ray and the occluded sky irradiance at the hit, which the host computes
+// with the primary sky terms (RealtimeFrameData::MirrorSkyTerms; ShadeMirrorHit), the other
+// layer pixels interpolated from the grid and blended (ApplyMirrorLayer). what the GPU path
+// does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
+// untextured), cube textures on geoms (untextured), MJCF skyboxes, and interpolated shading
+// normals (the geometric normal shades).
 
 #include <cstdint>
 
@@ -32,6 +37,7 @@
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
+#include "penumbra/render/mirror_math.h"
 #include "penumbra/render/shading_math.h"
 #include "penumbra/render/shadow_window_math.h"
 #include "penumbra/render/texture_math.h"
@@ -56,6 +62,9 @@ struct MaterialPod {
   int32_t texuniform = 0;
   /// the PBR maps (render/material_eval.h, "PBR maps"), into the frame's textures; -1 none.
   int32_t normal_map = -1, metallic_roughness_map = -1, occlusion_map = -1, emissive_map = -1;
+  /// the mirror layer's weight on a plane or a box's top face: min(reflectance, 1), 0 none
+  /// (MaterialEvaluator::Untextured's SurfaceMaterial::mirror).
+  float mirror = 0;
   PB_HOST_DEVICE bool any_map() const {
     return texture >= 0 || normal_map >= 0 || metallic_roughness_map >= 0 || occlusion_map >= 0 ||
            emissive_map >= 0;
@@ -76,18 +85,21 @@ struct GeomPod {
   Float3 half_extent;          ///< local bounding-box half extents (MaterialEvaluator's)
   int32_t infinite_plane = 0;  ///< a plane without finite size in the face's axes
   int32_t plane = 0;           ///< GeomShape::kPlane
+  int32_t box = 0;             ///< GeomShape::kBox (its top face, n_G.z > 0.5, takes a mirror)
   int32_t untextured = 0;      ///< a mesh with texture coordinates (not mapped on the GPU yet)
 };
 
-/// what a pixel's primary ray hits, for the host's sky pass: p_W, the unit geometric normal
-/// facing the ray and the unit shading normal (normal map applied, UsableShadingNormal) where
-/// it hits; the unit ray direction where it does not.
+/// what a pixel's primary ray (or its mirrored ray, TraceMirrorRay) hits, for the host's sky
+/// pass: p_W, the unit geometric normal facing the ray and the unit shading normal (normal map
+/// applied, UsableShadingNormal) where it hits; the unit ray direction where it does not.
 struct PixelGeometry {
   Float3 p_or_d;
   Float3 ng;
   Float3 ns;
+  /// 1 hit, 0 miss; -1 (mirrored rays only): the pixel traced no mirrored ray.
   int32_t hit = 0;
   int32_t geom = -1;  ///< the hit's SceneDescription geom index (-1: none or not a geom)
+  float mirror = 0;   ///< the hit surface's mirror weight r (ShadingPoint::mirror), 0 none
 };
 
 /// everything a realtime frame reads, as device (or host) pointers.
@@ -126,6 +138,15 @@ struct RealtimeFrameView {
   float* area_rays = nullptr;
   uint8_t* area_own = nullptr;
   float* area_fraction = nullptr;
+  /// the mirror layer (any_mirror: some material has one), per pixel: the mirrored ray's
+  /// geometry (hit -1 where the pixel traces none; TraceMirrorRay) and closest hit, its sky
+  /// term from the host (E_sky at the hit, or the sky's Background where it escapes;
+  /// RealtimeFrameData::MirrorSkyTerms) and the reflected radiance L_m (ShadeMirrorHit).
+  int32_t any_mirror = 0;
+  PixelGeometry* mirror_geometry = nullptr;
+  TraceHit* mirror_hits = nullptr;
+  const Float3* mirror_sky = nullptr;
+  Float3* mirror_radiance = nullptr;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -133,10 +154,19 @@ struct ShadingPoint {
   Float3 p, ng, n, wo;  ///< point, geometric normal (facing the ray), shading normal, to viewer
   Float3 base, emission;
   float roughness = 0.5f, metallic = 0, specular = 0.5f, occlusion = 1;
+  float mirror = 0;  ///< the mirror layer's weight r (MaterialPod::mirror where it applies)
 };
 
 PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
 PB_HOST_DEVICE inline F3 ToF3(const Float3& v) { return F3{v.x, v.y, v.z}; }
+
+/// the origin of rays leaving point p on the side of unit normal n: p pushed off the surface by
+/// kGpuRayOffsetScale (1 + |p|_inf) along n (render/ray.h's OffsetRayOrigin).
+PB_HOST_DEVICE inline F3 OffsetOrigin(const Float3& p, const Float3& n) {
+  const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
+  const float off = kGpuRayOffsetScale * (1.0f + amax);
+  return F3{p.x + off * n.x, p.y + off * n.y, p.z + off * n.z};
+}
 
 /// the pixel-centre ray of pixel (u, v) (PinholeCamera's formula).
 PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
@@ -334,12 +364,15 @@ PB_HOST_DEVICE inline Float3 LightContribution(const RealtimeFrameView& f, int j
   return Float3{fr.x * E.x * scale, fr.y * E.y * scale, fr.z * E.z * scale};
 }
 
-/// the shading point of hit h of primary ray r (d_len = |r.d|): the material with its
-/// textures and PBR maps filtered over the pixel's ray cone (MaterialEvaluator's order: base
-/// colour, metallic-roughness, occlusion, emissive, normal map), and the shading normal the
-/// viewer sees (UsableShadingNormal).
+/// the shading point of hit h of ray r (d_len = |r.d|): the material with its textures and
+/// PBR maps filtered over the pixel's ray cone (MaterialEvaluator's order: base colour,
+/// metallic-roughness, occlusion, emissive, normal map), its mirror weight (a plane, or a
+/// box's face whose outward geom-frame normal has z > 0.5, as MaterialEvaluator::Untextured),
+/// and the shading normal the viewer sees (UsableShadingNormal). path_m: the cone's length
+/// before r's origin (a mirrored ray: the camera-to-mirror distance; 0 for a primary ray).
 PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, const TraceRay& r,
-                                                   const TraceHit& h, float d_len) {
+                                                   const TraceHit& h, float d_len,
+                                                   float path_m = 0) {
   const SceneView& s = f.scene;
   ShadingPoint sp;
   const Float3 d{r.d.x / d_len, r.d.y / d_len, r.d.z / d_len};
@@ -356,6 +389,13 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
   sp.metallic = m.metallic;
   sp.specular = m.specular;
   sp.emission = m.emission;
+  if (m.mirror > 0 && rec.geom >= 0) {
+    const GeomPod& g = f.geoms[rec.geom];
+    // the outward normal's geom-frame z: row 2 of R_GW times the normal facing the ray.
+    const float* R = g.X_GW;
+    const float nz = R[8] * ng.x + R[9] * ng.y + R[10] * ng.z;
+    if (g.plane != 0 || (g.box != 0 && (front_face ? nz : -nz) > 0.5f)) sp.mirror = m.mirror;
+  }
   Float3 ns = ng;
   if (m.any_map() && rec.geom >= 0 && f.geoms[rec.geom].untextured == 0) {
     const GeomPod& g = f.geoms[rec.geom];
@@ -363,8 +403,10 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
     const Float3 n_G = ToFloat3(TransformVector(g.X_GW, ToF3(ng)));
     const Float3 d_G = ToFloat3(TransformVector(g.X_GW, ToF3(d)));
     const float cos_inc = pbm::Min(1.0f, fabsf(ng.x * d.x + ng.y * d.y + ng.z * d.z));
-    const PlanarFootprint fp = PlanarFootprintAt(m, g, p_G, n_G, d_G, f.spread_rad * h.t * d_len,
-                                                 cos_inc, f.max_anisotropy);
+    const float width_m =
+        path_m > 0 ? f.spread_rad * (path_m + h.t * d_len) : f.spread_rad * h.t * d_len;
+    const PlanarFootprint fp =
+        PlanarFootprintAt(m, g, p_G, n_G, d_G, width_m, cos_inc, f.max_anisotropy);
     if (m.texture >= 0) {
       const Float3 c = FilterPlanar(f, m.texture, fp);
       sp.base = Float3{sp.base.x * c.x, sp.base.y * c.y, sp.base.z * c.z};
@@ -417,6 +459,7 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
   g.p_or_d = sp.p;
   g.ng = sp.ng;
   g.ns = sp.n;
+  g.mirror = sp.mirror;
   return g;
 }
 
@@ -460,9 +503,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
            emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
            emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
   // shadow rays start off the surface on the lit side.
-  const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
-  const float off = kGpuRayOffsetScale * (1.0f + amax);
-  const F3 origin{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
+  const F3 origin = OffsetOrigin(p, ng);
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
   float total = pbm::Luminance709(L.x, L.y, L.z);
   Float3 cached_c[kShadeCachedLights], cached_wi[kShadeCachedLights];
@@ -576,10 +617,8 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
       const int extra = own ? points : shared;
       const int first = kLightPenumbraRays * LightStratum(u, v);
       const Float3 p = gi.p_or_d, ng = gi.ng;
-      const float amax = pbm::Max(pbm::Max(fabsf(p.x), fabsf(p.y)), fabsf(p.z));
-      const float off = kGpuRayOffsetScale * (1.0f + amax);
       TraceRay sr;
-      sr.o = F3{p.x + off * ng.x, p.y + off * ng.y, p.z + off * ng.z};
+      sr.o = OffsetOrigin(p, ng);
       sr.tmin = 0;
       for (int r = 1; r < extra; ++r) {
         float u1, u2, d_r;
@@ -664,6 +703,202 @@ PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f,
     L = Float3{L.x + V * c.x, L.y + V * c.y, L.z + V * c.z};
   }
   return L;
+}
+
+/// the mirrored view ray of pixel (u, v), whose primary geometry f.geometry holds a hit: the
+/// unit primary direction d reflected about the geometric normal, d - 2 (d . ng) ng, from the
+/// hit pushed off the surface on that side (render/ray.h's SpawnRay); *path_m: the
+/// camera-to-hit distance (the texture cone's length before the ray).
+PB_HOST_DEVICE inline TraceRay MirrorRay(const RealtimeFrameView& f, int u, int v, float* path_m) {
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const PixelGeometry& g = f.geometry[i];
+  const TraceRay pr = PrimaryRay(f.camera, u, v);
+  const float d_len = sqrtf(pr.d.x * pr.d.x + pr.d.y * pr.d.y + pr.d.z * pr.d.z);
+  const Float3 d{pr.d.x / d_len, pr.d.y / d_len, pr.d.z / d_len};
+  const Float3& ng = g.ng;
+  const Float3& p = g.p_or_d;
+  const float k = 2.0f * pbm::Dot<float>(d, ng);
+  const Float3 wi{d.x - k * ng.x, d.y - k * ng.y, d.z - k * ng.z};
+  const float side = pbm::Dot<float>(wi, ng) >= 0 ? 1.0f : -1.0f;
+  TraceRay r;
+  r.o = OffsetOrigin(p, Float3{side * ng.x, side * ng.y, side * ng.z});
+  r.d = ToF3(wi);
+  r.tmin = 0;
+  r.tmax = INFINITY;
+  const Float3 to_cam{p.x - pr.o.x, p.y - pr.o.y, p.z - pr.o.z};
+  *path_m = sqrtf(pbm::Dot<float>(to_cam, to_cam));
+  return r;
+}
+
+/// the traced grid pixels whose reflected radiance pixel (u, v) of the mirror layer takes when
+/// it is off its layer's grid (render/mirror_math.h, as render/cpu/mirror_layer.cc): of the up
+/// to 4 grid pixels around it in its 16x16 tile (ShadowTileOf), those with a layer of the same
+/// grid step on the same flat face (same geom, equal geometric normal), in the CPU's order (v,
+/// then u); their pixel indices in idx and bilinear weights (MirrorGridWeight) in w. returns
+/// how many (0: the pixel traces its own ray).
+PB_HOST_DEVICE inline int MirrorGridNeighbours(const RealtimeFrameView& f, int u, int v,
+                                               int64_t idx[4], float w[4]) {
+  const int W = f.camera.width, H = f.camera.height;
+  const PixelGeometry& gi = f.geometry[static_cast<int64_t>(v) * W + u];
+  const int s = MirrorGridStep(gi.mirror);
+  const ShadowTile tile = ShadowTileOf(u, v, W, H);
+  const int x = u - tile.x0, y = v - tile.y0;
+  const int gx = x - x % s, gy = y - y % s;
+  const int xs[2] = {gx, gx + s}, ys[2] = {gy, gy + s};
+  const float wx[2] = {MirrorGridWeight(x % s, s, 0), MirrorGridWeight(x % s, s, 1)};
+  const float wy[2] = {MirrorGridWeight(y % s, s, 0), MirrorGridWeight(y % s, s, 1)};
+  int count = 0;
+  for (int b = 0; b < 2; ++b) {
+    if (!(wy[b] > 0) || ys[b] >= tile.height) continue;
+    for (int a = 0; a < 2; ++a) {
+      if (!(wx[a] > 0) || xs[a] >= tile.width) continue;
+      const int64_t j = static_cast<int64_t>(tile.y0 + ys[b]) * W + tile.x0 + xs[a];
+      const PixelGeometry& gj = f.geometry[j];
+      // a grid pixel of a layer with this step traces its own ray.
+      if (!(gj.mirror > 0) || MirrorGridStep(gj.mirror) != s) continue;
+      if (gj.geom != gi.geom || !(gj.ng.x == gi.ng.x && gj.ng.y == gi.ng.y && gj.ng.z == gi.ng.z))
+        continue;
+      idx[count] = j;
+      w[count] = wx[a] * wy[b];
+      ++count;
+    }
+  }
+  return count;
+}
+
+/// whether pixel (u, v) traces its own mirrored ray: its surface has a mirror layer and the
+/// pixel lies on the layer's grid, or no grid pixel around it can lend it theirs.
+PB_HOST_DEVICE inline bool MirrorTraces(const RealtimeFrameView& f, int u, int v) {
+  const int W = f.camera.width;
+  const float r = f.geometry[static_cast<int64_t>(v) * W + u].mirror;
+  if (!(r > 0)) return false;
+  const int s = MirrorGridStep(r);
+  if ((u % kShadowTileSize) % s == 0 && (v % kShadowTileSize) % s == 0) return true;
+  int64_t idx[4];
+  float w[4];
+  return MirrorGridNeighbours(f, u, v, idx, w) == 0;
+}
+
+/// the mirror layer, step 1 of 3 (after PrimaryGeometry at every pixel): where pixel (u, v)
+/// traces (MirrorTraces), its mirrored ray's closest hit (f.mirror_hits) and geometry for the
+/// host's sky pass (f.mirror_geometry; hit -1 where it traces none).
+PB_HOST_DEVICE inline void TraceMirrorRay(const RealtimeFrameView& f, int u, int v) {
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  PixelGeometry g;
+  g.hit = -1;
+  if (!MirrorTraces(f, u, v)) {
+    f.mirror_geometry[i] = g;
+    return;
+  }
+  float path_m;
+  const TraceRay r = MirrorRay(f, u, v, &path_m);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  f.mirror_hits[i] = h;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  if (h.instance < 0) {
+    g.hit = 0;
+    g.p_or_d = Float3{r.d.x / d_len, r.d.y / d_len, r.d.z / d_len};
+  } else {
+    const ShadingPoint sp = EvaluateSurface(f, r, h, d_len, path_m);
+    g.hit = 1;
+    g.geom = f.scene.records[f.scene.prims[h.prim].record].geom;
+    g.p_or_d = sp.p;
+    g.ng = sp.ng;
+    g.ns = sp.n;
+  }
+  f.mirror_geometry[i] = g;
+}
+
+/// the mirror layer, step 2 of 3 (after the host's mirror sky terms): the reflected radiance
+/// L_m of a pixel that traced a mirrored ray (f.mirror_radiance), as render/cpu/mirror_layer.cc's
+/// MirrorRadiance: the sky's where it escapes, else the hit's emission, its ambient term
+/// E_sky / pi occlusion (c_diff (1 - S) + S) and one sample of every light (random numbers:
+/// draws num_lights + j of the pixel's stream 0, FrameContext::PixelStream) through the BRDF,
+/// with a shadow ray where the light casts shadows. one reflection: a mirror seen in a mirror
+/// shows its BRDF only.
+PB_HOST_DEVICE inline void ShadeMirrorHit(const RealtimeFrameView& f, int u, int v) {
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  if (f.mirror_geometry[i].hit < 0) return;
+  const Float3 sky = f.mirror_sky[i];
+  const TraceHit h = f.mirror_hits[i];
+  if (h.instance < 0) {
+    f.mirror_radiance[i] = sky;
+    return;
+  }
+  float path_m;
+  const TraceRay r = MirrorRay(f, u, v, &path_m);
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len, path_m);
+  const Float3& p = sp.p;
+  const Float3& ng = sp.ng;
+  const Float3& n = sp.n;
+  const Float3& wo = sp.wo;
+  Float3 c_diff, f0;
+  float alpha;
+  BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff, &f0,
+                                    &alpha);
+  const float a2 = alpha * alpha;
+  const float n_v = pbm::Dot<float>(n, wo);
+  const Float3 spec =
+      EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), pbm::Clamp(sp.roughness, 0.0f, 1.0f));
+  const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
+                       c_diff.z * (1.0f - spec.z) + spec.z};
+  const float k = pbm::kInvPi * sp.occlusion;
+  Float3 L{sp.emission.x + (sky.x * k) * reflect.x, sp.emission.y + (sky.y * k) * reflect.y,
+           sp.emission.z + (sky.z * k) * reflect.z};
+  TraceRay sr;
+  sr.o = OffsetOrigin(p, ng);
+  sr.tmin = 0;
+  const uint64_t pixel =
+      static_cast<uint64_t>(v) * static_cast<uint64_t>(f.camera.width) + static_cast<uint64_t>(u);
+  const uint64_t stream = HashKeys(HashKeys(f.frame_key, pixel), uint64_t{0});
+  const uint64_t first_draw = static_cast<uint64_t>(f.num_lights);
+  for (int j = 0; j < f.num_lights; ++j) {
+    float u1, u2;
+    Rng::Uniform2Of(Rng::DrawAt(stream, first_draw + static_cast<uint64_t>(j)), &u1, &u2);
+    Float3 wi, E;
+    float dist;
+    bool valid;
+    SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &wi, &dist, &E, &valid);
+    if (!valid) continue;
+    const Float3 fr = BrdfEvalWorld<float, Float3>(n, ng, wo, n_v, c_diff, f0, a2, wi);
+    const Float3 c{fr.x * E.x, fr.y * E.y, fr.z * E.z};
+    if (!(pbm::Max(pbm::Max(c.x, c.y), c.z) > 0)) continue;
+    if (f.lights[j].cast_shadow != 0) {
+      sr.d = ToF3(wi);
+      sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
+      if (TraceOccluded(f.scene, sr)) continue;
+    }
+    L = L + c;
+  }
+  f.mirror_radiance[i] = L;
+}
+
+/// the mirror layer, step 3 of 3 (after ShadeMirrorHit at every pixel, and after the shared
+/// visibility): pixel (u, v)'s radiance L blended with its reflected radiance L_m,
+/// (1 - r) L + r L_m (MirrorBlend), L_m its own or the MirrorGridNeighbours' weighted mean;
+/// L unchanged where its surface has no mirror layer.
+PB_HOST_DEVICE inline Float3 ApplyMirrorLayer(const RealtimeFrameView& f, int u, int v, Float3 L) {
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const float r = f.geometry[i].mirror;
+  if (!(r > 0)) return L;
+  Float3 Lm;
+  if (f.mirror_geometry[i].hit >= 0) {
+    Lm = f.mirror_radiance[i];
+  } else {
+    int64_t idx[4];
+    float w[4];
+    const int count = MirrorGridNeighbours(f, u, v, idx, w);
+    Float3 acc{0, 0, 0};
+    float wsum = 0;
+    for (int k = 0; k < count; ++k) {
+      acc = acc + w[k] * f.mirror_radiance[idx[k]];
+      wsum += w[k];
+    }
+    Lm = Float3{acc.x / wsum, acc.y / wsum, acc.z / wsum};
+  }
+  return Float3{MirrorBlend(L.x, Lm.x, r), MirrorBlend(L.y, Lm.y, r), MirrorBlend(L.z, Lm.z, r)};
 }
 
 /// the sum over row v of the log-luminance terms (film_math.h's LogLuminanceTerm), in column
