@@ -1,4 +1,4 @@
-// the nav harness's judgement of how an episode's run ended (benchmark/nav_job.h
+// the nav harness's judgement of how an episode's run ended (campaign/nav_job.h
 // NavRunDelivered): a run that had reached its duration and written run.json when the
 // harness's SIGTERM came, and died of that signal with its handler already gone, delivered its
 // episode (the warehouse aisle_12m `major` seed-3 episode of the nav benchmark was marked
@@ -24,7 +24,7 @@ TEST(NavJob, RunKilledBySigtermAfterItsOutputsDeliveredItsEpisode) {
   const fs::path run_dir = dir.path() / "run";
   // a real run to its end: exit 0 and run.json
   ChildProcess run({PENUMBRA_BINARY, "run",
-                    (fs::path(PENUMBRA_SOURCE_DIR) / "tests/benchmark/data/nav_wall.yaml").string(),
+                    (fs::path(PENUMBRA_SOURCE_DIR) / "tests/campaign/data/nav_wall.yaml").string(),
                     "--out", run_dir.string(), "--force", "--quiet", "--duration", "0.02"},
                    dir.path().string(), (dir.path() / "run.log").string(),
                    (dir.path() / "run.log").string());
