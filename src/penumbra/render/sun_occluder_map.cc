@@ -210,12 +210,17 @@ inline __mmask16 FiniteLanes(__m512 x) {
   return _mm512_cmp_ps_mask(_mm512_sub_ps(x, x), _mm512_setzero_ps(), _CMP_EQ_OQ);
 }
 
-// row i of R times (x, y, z): R(i,0) x + R(i,1) y + R(i,2) z, summed left to right as Eigen's
-// fixed-size product of HitsBox does.
+// a0 b0 + (a1 b1 + a2 b2): the order in which Eigen sums a 3-vector's dot product,
+// squaredNorm and each row of a fixed-size 3x3 product (measured with this build's flags; also
+// render/shadow_window_math.h).
+inline __m512 Dot3(__m512 a0, __m512 a1, __m512 a2, __m512 b0, __m512 b1, __m512 b2) {
+  return _mm512_add_ps(_mm512_mul_ps(a0, b0),
+                       _mm512_add_ps(_mm512_mul_ps(a1, b1), _mm512_mul_ps(a2, b2)));
+}
+
+// row i of R times (x, y, z), as Eigen's R * v in HitsBox.
 inline __m512 RowTimes(const Eigen::Matrix3f& R, int i, __m512 x, __m512 y, __m512 z) {
-  return _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(_mm512_set1_ps(R(i, 0)), x),
-                                     _mm512_mul_ps(_mm512_set1_ps(R(i, 1)), y)),
-                       _mm512_mul_ps(_mm512_set1_ps(R(i, 2)), z));
+  return Dot3(_mm512_set1_ps(R(i, 0)), _mm512_set1_ps(R(i, 1)), _mm512_set1_ps(R(i, 2)), x, y, z);
 }
 
 }  // namespace
@@ -234,9 +239,7 @@ LaneMask SunOccluderMap::BlocksLanes(const Vec3Lanes& o_W, const Vec3Lanes& d_W,
   const __m512 dx = Load(d_W.x), dy = Load(d_W.y), dz = Load(d_W.z);
   const __m512 zero = _mm512_setzero_ps();
   // finite rays with a direction (Blocks' first test); d2 = |d|^2 as Eigen's squaredNorm.
-  const __m512 d2 =
-      _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
-                    _mm512_mul_ps(dz, dz));
+  const __m512 d2 = Dot3(dx, dy, dz, dx, dy, dz);
   __mmask16 todo = static_cast<__mmask16>(active.bits()) & FiniteLanes(ox) & FiniteLanes(oy) &
                    FiniteLanes(oz) & FiniteLanes(dx) & FiniteLanes(dy) & FiniteLanes(dz) &
                    _mm512_cmp_ps_mask(d2, zero, _CMP_GT_OQ);
@@ -275,17 +278,15 @@ LaneMask SunOccluderMap::BlocksLanes(const Vec3Lanes& o_W, const Vec3Lanes& d_W,
       const __m512 ux = _mm512_div_ps(dx, d_len), uy = _mm512_div_ps(dy, d_len),
                    uz = _mm512_div_ps(dz, d_len);
       const float sx = built_to_sun_.x(), sy = built_to_sun_.y(), sz = built_to_sun_.z();
-      const __m512 dot = _mm512_add_ps(
-          _mm512_add_ps(_mm512_mul_ps(ux, _mm512_set1_ps(sx)), _mm512_mul_ps(uy, _mm512_set1_ps(sy))),
-          _mm512_mul_ps(uz, _mm512_set1_ps(sz)));
+      const __m512 dot =
+          Dot3(ux, uy, uz, _mm512_set1_ps(sx), _mm512_set1_ps(sy), _mm512_set1_ps(sz));
       const __m512 cx = _mm512_sub_ps(_mm512_mul_ps(uy, _mm512_set1_ps(sz)),
                                       _mm512_mul_ps(uz, _mm512_set1_ps(sy)));
       const __m512 cy = _mm512_sub_ps(_mm512_mul_ps(uz, _mm512_set1_ps(sx)),
                                       _mm512_mul_ps(ux, _mm512_set1_ps(sz)));
       const __m512 cz = _mm512_sub_ps(_mm512_mul_ps(ux, _mm512_set1_ps(sy)),
                                       _mm512_mul_ps(uy, _mm512_set1_ps(sx)));
-      const __m512 c2 = _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(cx, cx), _mm512_mul_ps(cy, cy)),
-                                      _mm512_mul_ps(cz, cz));
+      const __m512 c2 = Dot3(cx, cy, cz, cx, cy, cz);
       const __mmask16 on_disc =
           _mm512_mask_cmp_ps_mask(open, dot, zero, _CMP_GT_OQ) &
           _mm512_cmp_ps_mask(c2, _mm512_set1_ps(disc_sin2_), _CMP_LE_OQ);
