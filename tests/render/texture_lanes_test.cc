@@ -38,9 +38,9 @@ TEST(TextureLanesTest, TapsAreBitIdenticalToTheScalarFormula) {
       const Float3 want = BilinearWrapTaps(level, decode, s, t, ds, dt, n);
       const Float3 got = BilinearWrapTapsLanes(level, decode, s, t, ds, dt, n);
       ASSERT_TRUE(SameBits(want, got))
-          << w << "x" << h << " s " << s << " t " << t << " ds " << ds << " dt " << dt << " n "
-          << n << ": scalar (" << want.x << ", " << want.y << ", " << want.z << ") lanes ("
-          << got.x << ", " << got.y << ", " << got.z << ")";
+          << w << "x" << h << " s " << s << " t " << t << " ds " << ds << " dt " << dt << " n " << n
+          << ": scalar (" << want.x << ", " << want.y << ", " << want.z << ") lanes (" << got.x
+          << ", " << got.y << ", " << got.z << ")";
       ++checked;
     }
   }
@@ -55,8 +55,8 @@ TEST(TextureLanesTest, TapsOnTexelCentresAndEdgesAreBitIdentical) {
   std::vector<uint8_t> texels(static_cast<size_t>(w) * h * 3);
   for (size_t k = 0; k < texels.size(); ++k) texels[k] = static_cast<uint8_t>(37 * k + 11);
   const TextureLevelView level{texels.data(), w, h};
-  const float coords[] = {-1.0f, -0.5f, -0.0f, 0.0f, 0.0625f, 0.5f, 0.9375f, 1.0f, 1.0f - 1e-7f,
-                          -1e-9f, 2.0f};
+  const float coords[] = {-1.0f,   -0.5f, -0.0f,        0.0f,   0.0625f, 0.5f,
+                          0.9375f, 1.0f,  1.0f - 1e-7f, -1e-9f, 2.0f};
   for (float s : coords)
     for (float t : coords)
       for (int n : {1, 2, 3, 16}) {

@@ -287,9 +287,8 @@ LaneMask SunOccluderMap::BlocksLanes(const Vec3Lanes& o_W, const Vec3Lanes& d_W,
       const __m512 cz = _mm512_sub_ps(_mm512_mul_ps(ux, _mm512_set1_ps(sy)),
                                       _mm512_mul_ps(uy, _mm512_set1_ps(sx)));
       const __m512 c2 = Dot3(cx, cy, cz, cx, cy, cz);
-      const __mmask16 on_disc =
-          _mm512_mask_cmp_ps_mask(open, dot, zero, _CMP_GT_OQ) &
-          _mm512_cmp_ps_mask(c2, _mm512_set1_ps(disc_sin2_), _CMP_LE_OQ);
+      const __mmask16 on_disc = _mm512_mask_cmp_ps_mask(open, dot, zero, _CMP_GT_OQ) &
+                                _mm512_cmp_ps_mask(c2, _mm512_set1_ps(disc_sin2_), _CMP_LE_OQ);
       hit |= on_disc;
       open &= static_cast<__mmask16>(~on_disc);
     }
@@ -312,8 +311,8 @@ LaneMask SunOccluderMap::BlocksLanes(const Vec3Lanes& o_W, const Vec3Lanes& d_W,
         const __m512 nh = _mm512_set1_ps(-b.half[a]);
         // d_a == 0: inside the slab or no hit; else the slab's entry and exit.
         const __mmask16 flat = _mm512_cmp_ps_mask(d[a], zero, _CMP_EQ_OQ);
-        const __mmask16 in_slab = _mm512_cmp_ps_mask(o[a], h, _CMP_LT_OQ) &
-                                  _mm512_cmp_ps_mask(o[a], nh, _CMP_GT_OQ);
+        const __mmask16 in_slab =
+            _mm512_cmp_ps_mask(o[a], h, _CMP_LT_OQ) & _mm512_cmp_ps_mask(o[a], nh, _CMP_GT_OQ);
         ok &= static_cast<__mmask16>(~flat | in_slab);
         const __m512 inv_d = _mm512_div_ps(_mm512_set1_ps(1.0f), d[a]);
         __m512 t0 = _mm512_mul_ps(_mm512_sub_ps(nh, o[a]), inv_d);
@@ -323,8 +322,8 @@ LaneMask SunOccluderMap::BlocksLanes(const Vec3Lanes& o_W, const Vec3Lanes& d_W,
         const __m512 hi = _mm512_mask_blend_ps(swap, t1, t0);
         // t_near = lo > t_near ? lo : t_near; t_far = hi < t_far ? hi : t_far (flat axes skip).
         const __mmask16 slab = static_cast<__mmask16>(~flat);
-        t_near = _mm512_mask_blend_ps(slab & _mm512_cmp_ps_mask(lo, t_near, _CMP_GT_OQ), t_near,
-                                      lo);
+        t_near =
+            _mm512_mask_blend_ps(slab & _mm512_cmp_ps_mask(lo, t_near, _CMP_GT_OQ), t_near, lo);
         t_far = _mm512_mask_blend_ps(slab & _mm512_cmp_ps_mask(hi, t_far, _CMP_LT_OQ), t_far, hi);
       }
       const __mmask16 through =

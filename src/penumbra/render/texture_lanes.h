@@ -27,8 +27,7 @@ inline Float3 BilinearWrapTapsLanes(const TextureLevelView& L, const float* deco
   const int w = L.width, h = L.height;
   // levels whose byte offsets do not fit 31 bits, and more than 16 taps, take the scalar formula.
   const int64_t bytes = static_cast<int64_t>(w) * h * 3;
-  if (n > 16 || bytes > (int64_t{1} << 30))
-    return BilinearWrapTaps(L, decode, s, t, ds, dt, n);
+  if (n > 16 || bytes > (int64_t{1} << 30)) return BilinearWrapTaps(L, decode, s, t, ds, dt, n);
   const float step = 1.0f / static_cast<float>(n);
   const float o0 = 0.5f * step - 0.5f;
   const __m512 k = _mm512_setr_ps(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -39,14 +38,12 @@ inline Float3 BilinearWrapTapsLanes(const TextureLevelView& L, const float* deco
   // WrapTexels: x = (u - floor(u)) w - 0.5, x0 = floor(x), fx = x - x0, wrapped by one step.
   constexpr int kFloor = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
   const __m512 half = _mm512_set1_ps(0.5f);
-  const __m512 x = _mm512_sub_ps(
-      _mm512_mul_ps(_mm512_sub_ps(u, _mm512_roundscale_ps(u, kFloor)),
-                    _mm512_set1_ps(static_cast<float>(w))),
-      half);
-  const __m512 y = _mm512_sub_ps(
-      _mm512_mul_ps(_mm512_sub_ps(v, _mm512_roundscale_ps(v, kFloor)),
-                    _mm512_set1_ps(static_cast<float>(h))),
-      half);
+  const __m512 x = _mm512_sub_ps(_mm512_mul_ps(_mm512_sub_ps(u, _mm512_roundscale_ps(u, kFloor)),
+                                               _mm512_set1_ps(static_cast<float>(w))),
+                                 half);
+  const __m512 y = _mm512_sub_ps(_mm512_mul_ps(_mm512_sub_ps(v, _mm512_roundscale_ps(v, kFloor)),
+                                               _mm512_set1_ps(static_cast<float>(h))),
+                                 half);
   const __m512 x0f = _mm512_roundscale_ps(x, kFloor), y0f = _mm512_roundscale_ps(y, kFloor);
   const __m512 fx = _mm512_sub_ps(x, x0f), fy = _mm512_sub_ps(y, y0f);
   const __m512i wv = _mm512_set1_epi32(w), hv = _mm512_set1_epi32(h);

@@ -78,7 +78,7 @@ TEST(ShadowWindowLanesTest, ScalarMasksOnAKnownTile) {
   SameSurfaceWindowsLanes(w, h, did_hit, geom, p, n, lanes);
   const uint32_t all = (1u << 25) - 1;
   EXPECT_EQ(near[12], all & ~(1u << ShadowWindowBit(1, -2)) & ~(1u << ShadowWindowBit(-1, 2)));
-  EXPECT_EQ(near[3], 0u);  // missed
+  EXPECT_EQ(near[3], 0u);                            // missed
   EXPECT_EQ(near[21], 1u << ShadowWindowBit(0, 0));  // alone on its geom
   for (int i = 0; i < count; ++i) EXPECT_EQ(lanes[i], near[i]) << i;
 }

@@ -159,8 +159,8 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
       hit_geom[i] = primary.did_hit[i] ? h.geom : -1;
       for (int a = 0; a < 3; ++a) hit_p[3 * i + a] = h.p_W[a], hit_n[3 * i + a] = h.ng_W[a];
     }
-    SameSurfaceWindowsLanes(tile.width, tile.height, primary.did_hit, hit_geom.data(),
-                            hit_p.data(), hit_n.data(), near.data());
+    SameSurfaceWindowsLanes(tile.width, tile.height, primary.did_hit, hit_geom.data(), hit_p.data(),
+                            hit_n.data(), near.data());
   };
   // the bits of pixel (x, y)'s window (as near[i]) that are set in `rows` (bit x of rows[y]:
   // pixel (x, y)).

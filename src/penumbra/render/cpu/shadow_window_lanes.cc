@@ -10,8 +10,8 @@
 
 namespace penumbra {
 
-void SameSurfaceWindows(int width, int height, const bool* did_hit, const int* geom,
-                        const float* p, const float* n, uint32_t* near) {
+void SameSurfaceWindows(int width, int height, const bool* did_hit, const int* geom, const float* p,
+                        const float* n, uint32_t* near) {
   for (int y = 0, i = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x, ++i) {
       near[i] = 0;
@@ -70,9 +70,11 @@ void SameSurfaceWindowsLanes(int width, int height, const bool* did_hit, const i
       __mmask16 hit = 0;
       for (int k = 0; k < 16 && x0 + k < width; ++k)
         hit |= static_cast<__mmask16>(did_hit[i0 + k] ? 1u << k : 0u);
-      const __m512 pix = _mm512_maskz_loadu_ps(row, px + i0), piy = _mm512_maskz_loadu_ps(row, py + i0),
+      const __m512 pix = _mm512_maskz_loadu_ps(row, px + i0),
+                   piy = _mm512_maskz_loadu_ps(row, py + i0),
                    piz = _mm512_maskz_loadu_ps(row, pz + i0);
-      const __m512 nix = _mm512_maskz_loadu_ps(row, nx + i0), niy = _mm512_maskz_loadu_ps(row, ny + i0),
+      const __m512 nix = _mm512_maskz_loadu_ps(row, nx + i0),
+                   niy = _mm512_maskz_loadu_ps(row, ny + i0),
                    niz = _mm512_maskz_loadu_ps(row, nz + i0);
       const __m512i gi = _mm512_maskz_loadu_epi32(row, g + i0);
       __m512i bits = _mm512_maskz_mov_epi32(hit, _mm512_set1_epi32(1 << ShadowWindowBit(0, 0)));
@@ -94,17 +96,20 @@ void SameSurfaceWindowsLanes(int width, int height, const bool* did_hit, const i
           const __m512 njx = _mm512_maskz_loadu_ps(same, nx + j0),
                        njy = _mm512_maskz_loadu_ps(same, ny + j0),
                        njz = _mm512_maskz_loadu_ps(same, nz + j0);
-          const __m512 cos = _mm512_add_ps(
-              _mm512_mul_ps(nix, njx), _mm512_add_ps(_mm512_mul_ps(niy, njy), _mm512_mul_ps(niz, njz)));
+          const __m512 cos =
+              _mm512_add_ps(_mm512_mul_ps(nix, njx),
+                            _mm512_add_ps(_mm512_mul_ps(niy, njy), _mm512_mul_ps(niz, njz)));
           same = _mm512_mask_cmp_ps_mask(same, cos, cos_min, _CMP_GE_OQ);
           if (same == 0) continue;
           const __m512 dpx = _mm512_sub_ps(_mm512_maskz_loadu_ps(same, px + j0), pix);
           const __m512 dpy = _mm512_sub_ps(_mm512_maskz_loadu_ps(same, py + j0), piy);
           const __m512 dpz = _mm512_sub_ps(_mm512_maskz_loadu_ps(same, pz + j0), piz);
-          const __m512 off = _mm512_add_ps(
-              _mm512_mul_ps(nix, dpx), _mm512_add_ps(_mm512_mul_ps(niy, dpy), _mm512_mul_ps(niz, dpz)));
-          const __m512 len2 = _mm512_add_ps(
-              _mm512_mul_ps(dpx, dpx), _mm512_add_ps(_mm512_mul_ps(dpy, dpy), _mm512_mul_ps(dpz, dpz)));
+          const __m512 off =
+              _mm512_add_ps(_mm512_mul_ps(nix, dpx),
+                            _mm512_add_ps(_mm512_mul_ps(niy, dpy), _mm512_mul_ps(niz, dpz)));
+          const __m512 len2 =
+              _mm512_add_ps(_mm512_mul_ps(dpx, dpx),
+                            _mm512_add_ps(_mm512_mul_ps(dpy, dpy), _mm512_mul_ps(dpz, dpz)));
           same = _mm512_mask_cmp_ps_mask(same, _mm512_mul_ps(off, off),
                                          _mm512_add_ps(_mm512_mul_ps(flat, len2), eps), _CMP_LE_OQ);
           bits = _mm512_mask_or_epi32(bits, same, bits,

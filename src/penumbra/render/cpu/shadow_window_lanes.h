@@ -16,8 +16,8 @@ namespace penumbra {
 /// geom[i] == geom[j] and SameShadowSurface(geom[i], n_i, p_i, geom[j], n_j, p_j), with its own
 /// bit (0, 0) always set; 0 for pixels that did not hit. geom: per pixel, -1 none; p, n: per
 /// pixel xyz (hit point and geometric normal, world frame); near: width x height words out.
-void SameSurfaceWindows(int width, int height, const bool* did_hit, const int* geom,
-                        const float* p, const float* n, uint32_t* near);
+void SameSurfaceWindows(int width, int height, const bool* did_hit, const int* geom, const float* p,
+                        const float* n, uint32_t* near);
 
 /// SameSurfaceWindows with each tile row's pixels as SIMD lanes; the same output, bit for bit.
 void SameSurfaceWindowsLanes(int width, int height, const bool* did_hit, const int* geom,
