@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "penumbra/render/backends/render_ablation_switch.h"
@@ -130,6 +131,57 @@ TEST(SunOccluderMapTest, NeverSkipsARayThatReachesTheSun) {
   EXPECT_FALSE(map.Blocks({NAN, 0, 1}, to_sun));
   EXPECT_FALSE(map.Blocks({50, 0, 1}, -to_sun));
   EXPECT_FALSE(map.Blocks({0, 0, 1}, Eigen::Vector3f::Zero()));
+}
+
+// BlocksLanes (16 rays at once, AVX-512 where built with it) gives every active lane exactly
+// Blocks' verdict and inactive lanes false: packets of rays from one spot (one or two cells, as a
+// tile row's shadow rays), from scattered points, sun-jittered and arbitrary directions, whole
+// cells (rays from high under the roof), points outside the grid, non-finite and zero rays.
+TEST(SunOccluderMapTest, LanesGiveEveryRayBlocksVerdict) {
+  const SceneDescription s = SunMapRoom();
+  WorldSnapshot snap = IdentitySnapshot(s);
+  LightSampler lights(s);
+  lights.Update(snap);
+  SunOccluderMap map;
+  map.Update(s, snap, lights, nullptr);
+  ASSERT_FALSE(map.empty());
+  const Eigen::Vector3f to_sun = -lights.lights()[0].direction_W;
+  std::mt19937 rng(38);
+  std::uniform_real_distribution<float> ux(-4.0f, 4.0f), uz(-0.2f, 3.2f), u01(0, 1);
+  int blocked = 0, lanes = 0;
+  for (int packet = 0; packet < 20000; ++packet) {
+    Vec3Lanes o, d;
+    const Eigen::Vector3f spot(ux(rng), ux(rng), packet % 5 == 0 ? 2.4f : uz(rng));
+    for (int k = 0; k < kLanes; ++k) {
+      // packets 0, 1 mod 3: rays from within 0.3 m of one spot; else scattered.
+      const Eigen::Vector3f jitter(0.3f * u01(rng), 0.02f * u01(rng), 0.0f);
+      const Eigen::Vector3f ok = packet % 3 != 2 ? Eigen::Vector3f(spot + jitter)
+                                                 : Eigen::Vector3f(ux(rng), ux(rng), uz(rng));
+      Eigen::Vector3f dk =
+          SunMapConeDir(to_sun, 2 * 0.2665f * static_cast<float>(M_PI) / 180, &rng);
+      if ((packet + k) % 7 == 3)
+        dk = SunMapConeDir(Eigen::Vector3f::UnitZ(), static_cast<float>(M_PI), &rng);
+      if ((packet + k) % 11 == 5) dk *= 3.0f;  // not unit
+      o.Set(k, ok);
+      d.Set(k, dk);
+    }
+    if (packet % 13 == 0) o.x[3] = NAN;
+    if (packet % 17 == 0) d.Set(5, Eigen::Vector3f::Zero());
+    if (packet % 19 == 0) o.Set(7, Eigen::Vector3f(50, 0, 1));
+    if (packet % 23 == 0) d.z[9] = std::numeric_limits<float>::infinity();
+    const LaneMask active(packet % 4 == 0 ? 0xffffu : static_cast<uint32_t>(rng()) & 0xffffu);
+    const LaneMask got = map.BlocksLanes(o, d, active);
+    for (int k = 0; k < kLanes; ++k) {
+      const bool want = active[k] && map.Blocks(o.Lane(k), d.Lane(k));
+      ASSERT_EQ(got[k], want) << "packet " << packet << " lane " << k << " o "
+                              << o.Lane(k).transpose() << " d " << d.Lane(k).transpose();
+      blocked += want ? 1 : 0;
+      lanes += active[k] ? 1 : 0;
+    }
+  }
+  // both verdicts occur often.
+  EXPECT_GT(blocked, lanes / 10);
+  EXPECT_LT(blocked, lanes - lanes / 10);
 }
 
 TEST(SunOccluderMapTest, FollowsTheStaticPosesAndTheSun) {

@@ -10,6 +10,7 @@
 #endif
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/texture_lanes.h"
 #include "penumbra/render/texture_math.h"
 #include "penumbra/scene/texture_image.h"
 
@@ -73,10 +74,11 @@ bool FootprintAxes(const SurfaceHit& hit, const TextureFootprint& f, Eigen::Vect
   return true;
 }
 
-// mean of n bilinear lookups in one level (wrapped) along the major axis (texture_math.h).
+// mean of n bilinear lookups in one level (wrapped) along the major axis (texture_math.h), the
+// taps as SIMD lanes (texture_lanes.h: bit-identical to the shared formula).
 Eigen::Vector3f BilinearWrapTaps(const TextureLevel& L, const float* decode, float s, float t,
                                  float ds, float dt, int n) {
-  return ToEigen(BilinearWrapTaps(ViewOf(L), decode, s, t, ds, dt, n));
+  return ToEigen(BilinearWrapTapsLanes(ViewOf(L), decode, s, t, ds, dt, n));
 }
 
 // adds weight x the bilinear lookup (wrapped; (s, t) in images) of a packed level (w x h

@@ -9,6 +9,7 @@
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
+#include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
 #include "penumbra/render/shadow_window_math.h"
@@ -149,34 +150,17 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
   bool near_done = false;
   auto compute_near = [&] {
     near_done = true;
-    near.assign(n, 0u);
-    // the hits' points, normals and geoms side by side (the hits themselves are large).
+    near.resize(n);
+    // the hits' points, normals and geoms side by side (the hits themselves are large), then
+    // the masks with a tile row's pixels as SIMD lanes (render/cpu/shadow_window_lanes.h).
     hit_p.resize(3 * n), hit_n.resize(3 * n), hit_geom.resize(n);
     for (int i = 0; i < n; ++i) {
       const SurfaceHit& h = primary.hits[i];
       hit_geom[i] = primary.did_hit[i] ? h.geom : -1;
       for (int a = 0; a < 3; ++a) hit_p[3 * i + a] = h.p_W[a], hit_n[3 * i + a] = h.ng_W[a];
     }
-    for (int i = 0; i < n; ++i) {
-      if (!primary.did_hit[i]) continue;
-      const int geom = hit_geom[i];
-      const float* p = &hit_p[3 * i];
-      const float* nn = &hit_n[3 * i];
-      const int x = xs[i], y = ys[i];
-      uint32_t bits = 1u << ShadowWindowBit(0, 0);
-      for (int dy = -2; dy <= 2; ++dy) {
-        if (y + dy < 0 || y + dy >= tile.height) continue;
-        for (int dx = -2; dx <= 2; ++dx) {
-          if (x + dx < 0 || x + dx >= tile.width) continue;
-          const int ii = i + dy * tile.width + dx;
-          if (ii == i || hit_geom[ii] != geom ||
-              !SameShadowSurface(geom, nn, p, hit_geom[ii], &hit_n[3 * ii], &hit_p[3 * ii]))
-            continue;
-          bits |= 1u << ShadowWindowBit(dx, dy);
-        }
-      }
-      near[i] = bits;
-    }
+    SameSurfaceWindowsLanes(tile.width, tile.height, primary.did_hit, hit_geom.data(), hit_p.data(),
+                            hit_n.data(), near.data());
   };
   // the bits of pixel (x, y)'s window (as near[i]) that are set in `rows` (bit x of rows[y]:
   // pixel (x, y)).
