@@ -148,11 +148,15 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
 }
 
 void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
-                                 ThreadPool* pool) const {
+                                 ThreadPool* pool, int row0, int row1) const {
   const int W = camera_.width, H = camera_.height;
   if (n != static_cast<int64_t>(W) * H)
     throw Error("RealtimeFrameData::SkyTerms: " + std::to_string(n) + " pixels, the camera has " +
                 std::to_string(static_cast<int64_t>(W) * H));
+  if (row1 < 0 || row1 > H) row1 = H;
+  if (row0 < 0 || row0 % 2 != 0 || (row1 % 2 != 0 && row1 != H))
+    throw Error("RealtimeFrameData::SkyTerms: rows [" + std::to_string(row0) + ", " +
+                std::to_string(row1) + "): the bounds must be even (2x2 quads) or the last row");
   const bool occluded = !volume_.empty();
   // the probes' blend at the point and geometric normal, evaluated at the shading normal.
   auto single = [&](int64_t i) {
@@ -207,8 +211,10 @@ void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float
     }
     return true;
   };
-  ParallelForOrSerial(pool, (H + 1) / 2, [&](int64_t row) {
-    const int v0 = static_cast<int>(2 * row);
+  const int quad_row0 = row0 / 2, quad_rows = (row1 + 1) / 2 - quad_row0;
+  if (quad_rows <= 0) return;
+  ParallelForOrSerial(pool, quad_rows, [&](int64_t row) {
+    const int v0 = static_cast<int>(2 * (quad_row0 + row));
     for (int u0 = 0; u0 < W; u0 += 2) {
       const int64_t i00 = static_cast<int64_t>(v0) * W + u0;
       const int64_t quad[4] = {i00, i00 + 1, i00 + W, i00 + W + 1};
@@ -220,13 +226,17 @@ void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float
 }
 
 void RealtimeFrameData::MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out,
-                                       ThreadPool* pool) const {
+                                       ThreadPool* pool, int row0, int row1) const {
   const int W = camera_.width, H = camera_.height;
   if (n != static_cast<int64_t>(W) * H)
     throw Error("RealtimeFrameData::MirrorSkyTerms: " + std::to_string(n) +
                 " pixels, the camera has " + std::to_string(static_cast<int64_t>(W) * H));
+  if (row1 < 0 || row1 > H) row1 = H;
+  row0 = std::max(row0, 0);
+  if (row1 <= row0) return;
   const bool occluded = !volume_.empty();
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
+  ParallelForOrSerial(pool, row1 - row0, [&](int64_t r) {
+    const int64_t v = row0 + r;
     for (int64_t i = v * W; i < (v + 1) * W; ++i) {
       const PixelGeometry& g = mirror[i];
       if (g.hit < 0) continue;
