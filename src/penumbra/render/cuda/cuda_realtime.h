@@ -8,7 +8,8 @@
 // (2) the host turns the geometry into sky terms (`sky`: SkyModel and SkyIrradianceVolume run on
 // the CPU, realtime_frame.h) which are uploaded; with a mirror layer in the scene, (1) also
 // traces the mirrored rays (TraceMirrorRay), whose geometry makes the same round trip for its
-// sky terms. with pinned copies the round trip runs in 4 bands of rows: band k's geometry comes
+// sky terms. with pinned copies the round trip runs in bands of rows (4 by default,
+// RealtimeKernelOptions::sky_bands): band k's geometry comes
 // back while the host computes band k - 1's sky terms, and band k's shading kernel runs on the
 // GPU while the host computes band k + 1's; (3) the shading kernel (ShadeRealtimePixel, per
 // band), the shared visibility's kernels and
@@ -49,6 +50,9 @@ struct RealtimeStatic {
   const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries
 };
 
+/// the most bands of rows RealtimeKernelOptions::sky_bands may ask for.
+constexpr int kMaxSkyBands = 16;
+
 /// how the realtime kernels run (the defaults are the fast ones; the others stay for the
 /// benchmark's ablations, render_cuda_bench --realtime). every variant computes the same
 /// radiance and depth; only the order of a row's log-luminance sum (rows_per_warp) could move
@@ -64,6 +68,10 @@ struct RealtimeKernelOptions {
   /// the row sums, and the outputs, which are then copied into the frame's images; the depth
   /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
   bool pinned = true;
+  /// with pinned copies, Render()'s bands of rows (1 to kMaxSkyBands): band k's geometry goes
+  /// to the host, its sky terms come back and it is shaded while the host computes band
+  /// k + 1's (1: the whole frame at once). pageable copies: always 1.
+  int sky_bands = 4;
   /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
   /// warps in flight, maybe spills). with reuse_hit only.

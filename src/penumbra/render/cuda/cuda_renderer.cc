@@ -132,9 +132,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
       realtime_->film().filmic(),
       [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, int row0, int row1,
           Float3* sky, Float3* mirror_sky) {
-        realtime_->SkyTerms(g, count, sky, pool_.get(), row0, row1);
-        if (mirror != nullptr)
-          realtime_->MirrorSkyTerms(mirror, count, mirror_sky, pool_.get(), row0, row1);
+        realtime_->FrameSkyTerms(g, mirror, count, sky, mirror_sky, pool_.get(), row0, row1);
       },
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);

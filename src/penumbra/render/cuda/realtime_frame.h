@@ -60,9 +60,14 @@ class RealtimeFrameData {
   /// irradiance at the hit's shading normal (SkyIrradianceVolume::Irradiance, no shared blends:
   /// render/cpu/mirror_layer.cc's MirrorRadiance), where it escapes SkyModel::Background;
   /// pixels that traced none (hit -1) are left as they are; rows [row0, row1) only, as
-  /// SkyTerms. @throws Error for another n.
+  /// SkyTerms. @throws as SkyTerms.
   void MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out, ThreadPool* pool,
                       int row0 = 0, int row1 = -1) const;
+
+  /// SkyTerms and, where `mirror` is not null, MirrorSkyTerms of rows [row0, row1) in one
+  /// parallel loop over pairs of rows (the same bits as the two calls). @throws as SkyTerms.
+  void FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror, int64_t n,
+                     Float3* sky, Float3* mirror_sky, ThreadPool* pool, int row0, int row1) const;
 
   /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
   /// skip the layer's kernels and its part of the host's sky pass.
@@ -97,6 +102,12 @@ class RealtimeFrameData {
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;
+  // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
+  int CheckRows(const char* what, int64_t n, int row0, int row1) const;
+  // the sky terms of the pixels of rows 2 q and 2 q + 1 below row1 (SkyTerms' 2x2 quads).
+  void SkyQuadRow(const PixelGeometry* geometry, Float3* out, int q, int row1) const;
+  // the mirrored rays' sky terms of row v (MirrorSkyTerms).
+  void MirrorSkyRow(const PixelGeometry* mirror, Float3* out, int v) const;
   float spread_rad_ = 0;
   uint64_t frame_key_ = 0;
   bool any_mirror_ = false;

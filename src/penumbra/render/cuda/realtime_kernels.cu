@@ -159,23 +159,33 @@ double MsSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// Render's bands of rows: the host computes band k's sky terms while band k + 1's geometry
-// comes back and band k - 1 shades on the GPU.
-constexpr int kSkyBands = 4;
+// one host copy of ParallelCopy.
+struct HostCopy {
+  void* dst;
+  const void* src;
+  size_t n;
+};
 
-// copies n bytes from src to dst in chunks through `parallel` (serially if it is empty).
-void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, void* dst, const void* src,
-                  size_t n) {
+// the copies, in chunks of 256 KiB, in one loop through `parallel` (serially if it is empty).
+void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel,
+                  const std::vector<HostCopy>& copies) {
   constexpr size_t kChunk = size_t{256} << 10;
-  const int64_t chunks = static_cast<int64_t>((n + kChunk - 1) / kChunk);
-  if (!parallel || chunks < 2) {
-    std::memcpy(dst, src, n);
-    return;
-  }
-  parallel(chunks, [&](int64_t c) {
-    const size_t a = static_cast<size_t>(c) * kChunk, b = std::min(n, a + kChunk);
-    std::memcpy(static_cast<char*>(dst) + a, static_cast<const char*>(src) + a, b - a);
-  });
+  struct Chunk {
+    char* dst;
+    const char* src;
+    size_t n;
+  };
+  std::vector<Chunk> chunks;
+  for (const HostCopy& c : copies)
+    for (size_t a = 0; a < c.n; a += kChunk)
+      chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
+                        std::min(kChunk, c.n - a)});
+  auto copy = [&](int64_t i) { std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n); };
+  const int64_t count = static_cast<int64_t>(chunks.size());
+  if (parallel && count > 1)
+    parallel(count, copy);
+  else
+    for (int64_t i = 0; i < count; ++i) copy(i);
 }
 
 // the grid of the per-pixel kernels (whole warps of 16 x 2 pixels).
@@ -205,7 +215,7 @@ struct DeviceRealtime::Impl {
   cudaEvent_t geometry_done = nullptr;
   cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
   // band k's geometry is on the host (Render's bands)
-  cudaEvent_t band_done[kSkyBands] = {};
+  cudaEvent_t band_done[kMaxSkyBands] = {};
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -429,7 +439,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
     Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
   }
-  const int bands = o.pinned ? kSkyBands : 1;
+  const int bands = o.pinned ? std::clamp(o.sky_bands, 1, kMaxSkyBands) : 1;
   const int band_rows = bands == 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
   auto band_row = [&](int k) { return std::min(H, k * band_rows); };
   for (int k = 0; k < bands; ++k) {
@@ -496,10 +506,11 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
-    if (out.rgb) ParallelCopy(out.parallel, out.rgb, m.pin_rgb.p, 3 * n);
-    if (out.radiance)
-      ParallelCopy(out.parallel, out.radiance, m.pin_radiance.p, sizeof(Float3) * n);
-    if (out.depth) ParallelCopy(out.parallel, out.depth, m.pin_depth.p, sizeof(float) * n);
+    std::vector<HostCopy> copies;
+    if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)});
+    if (out.radiance) copies.push_back({out.radiance, m.pin_radiance.p, sizeof(Float3) * n});
+    if (out.depth) copies.push_back({out.depth, m.pin_depth.p, sizeof(float) * n});
+    ParallelCopy(out.parallel, copies);
   } else {
     if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
