@@ -8,8 +8,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <string>
+#include <vector>
 
+#include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
@@ -58,6 +61,60 @@ TEST_P(RealtimeHostPath, MatchesCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPath,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml",
                                            "outdoor.yaml", "effects/walkers.yaml"));
+
+// the GPU's Render() asks for the sky terms band by band (rows [r0, r1)): every pixel's bits are
+// those of the whole frame's pass, primary and mirrored; odd bounds before the last row are
+// refused (a 2x2 quad would be split).
+TEST(RealtimeHostPathFrames, SkyTermsInBandsEqualTheWholeFrame) {
+  // the default room: a sky volume (its walls) and a mirror layer (the floor's reflectance)
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
+  const SceneDescription& scene = session->scene();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 119);
+  cuda::BvhScene bvh(scene);
+  bvh.Update(snap);
+  cuda::RealtimeFrameData data(scene, RenderSettings());
+  ThreadPool pool(0);
+  data.Prepare(snap, view, &pool);
+  ASSERT_TRUE(data.any_mirror());
+  const int W = data.camera().width, H = data.camera().height;
+  ASSERT_EQ(H, 119);
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const cuda::RealtimeFrameView geo_view = data.View(bvh.view(), nullptr);
+  std::vector<cuda::PixelGeometry> geometry(n), mirror(n);
+  std::vector<cuda::TraceHit> mirror_hits(n);
+  std::vector<float> depth(n);
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u)
+      geometry[static_cast<int64_t>(v) * W + u] =
+          cuda::PrimaryGeometry(geo_view, u, v, &depth[static_cast<int64_t>(v) * W + u]);
+  cuda::RealtimeFrameView mirror_view = geo_view;
+  mirror_view.geometry = geometry.data();
+  mirror_view.mirror_geometry = mirror.data();
+  mirror_view.mirror_hits = mirror_hits.data();
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) cuda::TraceMirrorRay(mirror_view, u, v);
+  const Float3 unset{-1, -1, -1};
+  std::vector<Float3> whole(n, unset), banded(n, unset), mirror_whole(n, unset),
+      mirror_banded(n, unset);
+  data.SkyTerms(geometry.data(), n, whole.data(), &pool);
+  data.MirrorSkyTerms(mirror.data(), n, mirror_whole.data(), &pool);
+  const int bounds[] = {0, 30, 60, 90, H};
+  for (int k = 0; k + 1 < 5; ++k) {
+    data.SkyTerms(geometry.data(), n, banded.data(), &pool, bounds[k], bounds[k + 1]);
+    data.MirrorSkyTerms(mirror.data(), n, mirror_banded.data(), &pool, bounds[k], bounds[k + 1]);
+  }
+  int64_t differ = 0, mirrored = 0;
+  for (int64_t i = 0; i < n; ++i) {
+    differ += std::memcmp(&whole[i], &banded[i], sizeof(Float3)) != 0;
+    differ += std::memcmp(&mirror_whole[i], &mirror_banded[i], sizeof(Float3)) != 0;
+    mirrored += mirror[i].hit >= 0;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(mirrored, 0);
+  EXPECT_THROW(data.SkyTerms(geometry.data(), n, banded.data(), &pool, 1, 30), Error);
+  EXPECT_THROW(data.SkyTerms(geometry.data(), n, banded.data(), &pool, 0, 31), Error);
+}
 
 TEST(RealtimeHostPathFrames, PathtracedAndEffectsAreNotOnTheGpuPath) {
   const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");

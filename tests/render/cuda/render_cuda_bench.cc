@@ -15,9 +15,10 @@
 // depth+seg, pinned and pageable copies, the kernel alone and the CPU backend; then the
 // device-to-host copy rates, pinned and pageable.
 // --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
-// Render() with pinned and with pageable copies and where its time goes (RealtimeStageTimes),
-// the kernels alone as they run by default and with each speed-up of RealtimeKernelOptions
-// turned off (ablations; each variant's rgb compared with the default's), and the CPU backend.
+// Render() with pinned copies (4 bands of rows, and 1, 2 and 8) and with pageable copies, and
+// where its time goes (RealtimeStageTimes), the kernels alone as they run by default and with
+// each speed-up of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with
+// the default's), and the CPU backend.
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh). usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
@@ -103,10 +104,17 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     const bool repeatable = want.rgb.data == again.rgb.data &&
                             want.radiance.data == again.radiance.data &&
                             want.depth_m.data == again.depth_m.data;
-    // Render(): pinned copies (default) and pageable ones
-    for (const bool pinned : {true, false}) {
+    // Render(): pinned copies (default), pinned with other band counts, and pageable ones
+    std::vector<cuda::RealtimeKernelOptions> copy_variants = {fast};
+    for (const int bands : {1, 2, 8}) {
       cuda::RealtimeKernelOptions o = fast;
-      o.pinned = pinned;
+      o.sky_bands = bands;
+      if (bands != fast.sky_bands) copy_variants.push_back(o);
+    }
+    copy_variants.push_back(fast);
+    copy_variants.back().pinned = false;
+    for (const cuda::RealtimeKernelOptions& o : copy_variants) {
+      const bool pinned = o.pinned;
       rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
@@ -121,9 +129,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       fmt::print(
           "| {} | {} | cuda Render(), {} copies | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} | {} |\n",
-          name, size, pinned ? "pinned" : "pageable", 1 / s, 1e3 * s, sum.geometry / frames,
-          sum.sky / frames, sum.shade / frames, sum.film / frames,
-          f.rgb.data == want.rgb.data ? "yes" : "NO");
+          name, size,
+          pinned ? fmt::format("pinned, {} band{}", o.sky_bands, o.sky_bands == 1 ? "" : "s")
+                 : std::string("pageable"),
+          1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
+          sum.film / frames, f.rgb.data == want.rgb.data ? "yes" : "NO");
     }
     rt.set_options(fast);
     // the kernels alone: the default, each speed-up off, all off

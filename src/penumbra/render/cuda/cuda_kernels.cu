@@ -116,7 +116,7 @@ DeviceScene::~DeviceScene() {
   delete impl_;
 }
 
-void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version) {
+void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version, bool wait) {
   Impl& m = *impl_;
   if (geometry_version != m.geometry_version) {
     m.nodes.Upload(v.nodes, n.nodes * sizeof(BvhNode), m.stream);
@@ -138,9 +138,8 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
   m.view.records = static_cast<const Record*>(m.records.p);
   m.view.instances = static_cast<const Instance*>(m.instances.p);
   m.view.num_instances = v.num_instances;
-  Check(cudaStreamSynchronize(m.stream), "uploading the scene");
+  if (wait) Check(cudaStreamSynchronize(m.stream), "uploading the scene");
 }
-
 
 void DeviceScene::Trace(const TraceRay* rays, int64_t n, TraceHit* hits) {
   if (n <= 0) return;

@@ -53,8 +53,10 @@ class DeviceScene {
             records = 0;
   };
   /// copies the arrays of `view` (host pointers) to the device: all of them when
-  /// geometry_version differs from the last call's, else the instances only.
-  void Sync(const SceneView& view, const Sizes& sizes, int64_t geometry_version);
+  /// geometry_version differs from the last call's, else the instances only. `wait`: returns
+  /// when the copies are done; else once they are queued on stream() (the host arrays may
+  /// change at once: they are staged), for callers whose kernels run on stream() after them.
+  void Sync(const SceneView& view, const Sizes& sizes, int64_t geometry_version, bool wait = true);
   /// closest hits of n rays (host arrays).
   void Trace(const TraceRay* rays, int64_t n, TraceHit* hits);
   /// occlusion of n rays (host arrays): occluded[i] = 1 if blocked.

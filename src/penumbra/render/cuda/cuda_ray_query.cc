@@ -8,7 +8,7 @@
 
 namespace penumbra::cuda {
 
-void SyncDevice(const BvhScene& scene, DeviceScene* device) {
+void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   DeviceScene::Sizes n;
   n.nodes = static_cast<int64_t>(scene.nodes().size());
   n.prim_index = static_cast<int64_t>(scene.prim_index().size());
@@ -17,7 +17,7 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device) {
   n.analytics = static_cast<int64_t>(scene.analytics().size());
   n.blases = static_cast<int64_t>(scene.blases().size());
   n.records = static_cast<int64_t>(scene.records().size());
-  device->Sync(scene.view(), n, scene.geometry_version());
+  device->Sync(scene.view(), n, scene.geometry_version(), wait);
 }
 
 CudaRayQuery::CudaRayQuery(const SceneDescription& scene)

@@ -14,8 +14,8 @@
 
 namespace penumbra::cuda {
 
-/// the arrays and sizes of `scene` as DeviceScene::Sync takes them.
-void SyncDevice(const BvhScene& scene, DeviceScene* device);
+/// the arrays and sizes of `scene` as DeviceScene::Sync takes them (`wait` as there).
+void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait = true);
 
 /// RayQuery on the GPU (see the file comment).
 class CudaRayQuery final : public RayQuery {

@@ -8,7 +8,11 @@
 // (2) the host turns the geometry into sky terms (`sky`: SkyModel and SkyIrradianceVolume run on
 // the CPU, realtime_frame.h) which are uploaded; with a mirror layer in the scene, (1) also
 // traces the mirrored rays (TraceMirrorRay), whose geometry makes the same round trip for its
-// sky terms; (3) the shading kernel (ShadeRealtimePixel), the shared visibility's kernels and
+// sky terms. with pinned copies the round trip runs in bands of rows (4 by default,
+// RealtimeKernelOptions::sky_bands): band k's geometry comes
+// back while the host computes band k - 1's sky terms, and band k's shading kernel runs on the
+// GPU while the host computes band k + 1's; (3) the shading kernel (ShadeRealtimePixel, per
+// band), the shared visibility's kernels and
 // the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which the
 // host (`exposure`) turns into the frame's EV100 and exposures; (5) the film kernel (DevelopPixel).
 // every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
@@ -25,9 +29,13 @@ namespace penumbra::cuda {
 
 /// a frame's host buffers (width x height pixels; radiance and rgb x 3), each may be null.
 struct RealtimeOutputs {
+  /// runs body(0) .. body(count - 1), in any order and possibly at once (a thread pool).
+  using ParallelFn = std::function<void(int64_t count, const std::function<void(int64_t)>& body)>;
   float* radiance = nullptr;
   uint8_t* rgb = nullptr;
   float* depth = nullptr;
+  /// copies the pinned outputs into these buffers in chunks through it (empty: one thread).
+  ParallelFn parallel;
 };
 
 /// the scene-constant data of the realtime path (host arrays, copied once by Upload).
@@ -41,6 +49,9 @@ struct RealtimeStatic {
   const float* srgb_decode = nullptr;  ///< 256 entries
   const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries
 };
+
+/// the most bands of rows RealtimeKernelOptions::sky_bands may ask for.
+constexpr int kMaxSkyBands = 16;
 
 /// how the realtime kernels run (the defaults are the fast ones; the others stay for the
 /// benchmark's ablations, render_cuda_bench --realtime). every variant computes the same
@@ -57,6 +68,10 @@ struct RealtimeKernelOptions {
   /// the row sums, and the outputs, which are then copied into the frame's images; the depth
   /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
   bool pinned = true;
+  /// with pinned copies, Render()'s bands of rows (1 to kMaxSkyBands): band k's geometry goes
+  /// to the host, its sky terms come back and it is shaded while the host computes band
+  /// k + 1's (1: the whole frame at once). pageable copies: always 1.
+  int sky_bands = 4;
   /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
   /// warps in flight, maybe spills). with reuse_hit only.
@@ -66,10 +81,12 @@ struct RealtimeKernelOptions {
 /// the host clock's time of Render()'s stages, milliseconds (benchmarks).
 /// geometry + sky + shade + film = total.
 struct RealtimeStageTimes {
-  /// upload of geoms and lights, geometry (and mirrored-ray) kernels, geometry to the host
+  /// upload of geoms and lights, geometry (and mirrored-ray) kernels, the first band's
+  /// geometry on the host
   double geometry = 0;
-  double sky = 0;  ///< the host's sky terms (RealtimeFrameData::SkyTerms)
-  /// sky terms up, shading, shared-visibility, mirror-layer and row-sum kernels, row sums back
+  double sky = 0;  ///< the host's sky terms, all bands (RealtimeFrameData::SkyTerms)
+  /// the rest until the row sums are on the host: waiting for the other bands' geometry, sky
+  /// terms up, shading, shared-visibility, mirror-layer and row-sum kernels, row sums back
   double shade = 0;
   double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
   double total = 0;
@@ -86,11 +103,12 @@ class DeviceRealtime {
   /// copies the scene-constant data to the device.
   void Upload(const RealtimeStatic& data);
 
-  /// host sky pass: sky terms of n pixels from their primary geometry, and of their mirrored
-  /// rays from theirs (mirror and mirror_sky null when the frame has no mirror layer,
-  /// RealtimeFrameView::any_mirror).
+  /// host sky pass: the sky terms of the pixels of rows [row0, row1) from their primary
+  /// geometry, and of their mirrored rays from theirs (mirror and mirror_sky null when the
+  /// frame has no mirror layer, RealtimeFrameView::any_mirror). every array holds all n
+  /// pixels of the frame (row-major); row0 is even, row1 even or the last row + 1.
   using SkyFn = std::function<void(const PixelGeometry* geometry, const PixelGeometry* mirror,
-                                   int64_t n, Float3* sky, Float3* mirror_sky)>;
+                                   int64_t n, int row0, int row1, Float3* sky, Float3* mirror_sky)>;
   /// host exposure: the EV100 from the rows' log-luminance sums, and the per-channel exposures.
   using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
 

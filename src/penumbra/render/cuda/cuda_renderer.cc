@@ -70,7 +70,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   }
   CheckRenderInputs(scene_.bodies.size(), snapshot, view);
   bvh_->Update(snapshot);
-  SyncDevice(*bvh_, device_.get());
+  // the frame's kernels run on the device scene's stream, after the copies: no wait here
+  SyncDevice(*bvh_, device_.get(), /*wait=*/false);
   const PinholeCamera c = PinholeOf(view);
   const CameraOutputs& want = view.outputs;
   const int W = c.width, H = c.height;
@@ -122,14 +123,16 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   o.radiance = out->radiance.data.data();
   o.rgb = out->rgb.data.data();
   o.depth = Shape(&out->depth_m, view.outputs[ImageKind::kDepth], W, H, 1);
+  o.parallel = [this](int64_t count, const std::function<void(int64_t)>& body) {
+    ParallelForOrSerial(pool_.get(), count, body);
+  };
   const RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
   out->ev100 = device_realtime_->Render(
       device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
       realtime_->film().filmic(),
-      [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, Float3* sky,
-          Float3* mirror_sky) {
-        realtime_->SkyTerms(g, count, sky, pool_.get());
-        if (mirror != nullptr) realtime_->MirrorSkyTerms(mirror, count, mirror_sky, pool_.get());
+      [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, int row0, int row1,
+          Float3* sky, Float3* mirror_sky) {
+        realtime_->FrameSkyTerms(g, mirror, count, sky, mirror_sky, pool_.get(), row0, row1);
       },
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);

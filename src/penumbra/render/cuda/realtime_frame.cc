@@ -147,12 +147,22 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
   volume_.Update(scene_, snapshot, sky_, pool);
 }
 
-void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
-                                 ThreadPool* pool) const {
+int RealtimeFrameData::CheckRows(const char* what, int64_t n, int row0, int row1) const {
   const int W = camera_.width, H = camera_.height;
   if (n != static_cast<int64_t>(W) * H)
-    throw Error("RealtimeFrameData::SkyTerms: " + std::to_string(n) + " pixels, the camera has " +
-                std::to_string(static_cast<int64_t>(W) * H));
+    throw Error(std::string("RealtimeFrameData::") + what + ": " + std::to_string(n) +
+                " pixels, the camera has " + std::to_string(static_cast<int64_t>(W) * H));
+  if (row1 < 0 || row1 > H) row1 = H;
+  if (row0 < 0 || row0 % 2 != 0 || (row1 % 2 != 0 && row1 != H))
+    throw Error(std::string("RealtimeFrameData::") + what + ": rows [" + std::to_string(row0) +
+                ", " + std::to_string(row1) +
+                "): the bounds must be even (2x2 quads) or the last row + 1");
+  return row1;
+}
+
+void RealtimeFrameData::SkyQuadRow(const PixelGeometry* geometry, Float3* out, int q,
+                                   int row1) const {
+  const int W = camera_.width;
   const bool occluded = !volume_.empty();
   // the probes' blend at the point and geometric normal, evaluated at the shading normal.
   auto single = [&](int64_t i) {
@@ -207,37 +217,56 @@ void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float
     }
     return true;
   };
-  ParallelForOrSerial(pool, (H + 1) / 2, [&](int64_t row) {
-    const int v0 = static_cast<int>(2 * row);
-    for (int u0 = 0; u0 < W; u0 += 2) {
-      const int64_t i00 = static_cast<int64_t>(v0) * W + u0;
-      const int64_t quad[4] = {i00, i00 + 1, i00 + W, i00 + W + 1};
-      if (occluded && u0 + 1 < W && v0 + 1 < H && shared(quad)) continue;
-      for (int c = 0; c < 4; ++c)
-        if (u0 + (c & 1) < W && v0 + (c >> 1) < H) single(quad[c]);
+  const int v0 = 2 * q;
+  for (int u0 = 0; u0 < W; u0 += 2) {
+    const int64_t i00 = static_cast<int64_t>(v0) * W + u0;
+    const int64_t quad[4] = {i00, i00 + 1, i00 + W, i00 + W + 1};
+    if (occluded && u0 + 1 < W && v0 + 1 < row1 && shared(quad)) continue;
+    for (int c = 0; c < 4; ++c)
+      if (u0 + (c & 1) < W && v0 + (c >> 1) < row1) single(quad[c]);
+  }
+}
+
+void RealtimeFrameData::MirrorSkyRow(const PixelGeometry* mirror, Float3* out, int v) const {
+  const int W = camera_.width;
+  const bool occluded = !volume_.empty();
+  for (int64_t i = static_cast<int64_t>(v) * W; i < static_cast<int64_t>(v + 1) * W; ++i) {
+    const PixelGeometry& g = mirror[i];
+    if (g.hit < 0) continue;
+    const Eigen::Vector3f x(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
+    if (g.hit == 0) {
+      out[i] = ToFloat3(sky_.Background(x));
+      continue;
     }
-  });
+    const Eigen::Vector3f ns(g.ns.x, g.ns.y, g.ns.z);
+    out[i] = ToFloat3(occluded ? volume_.Irradiance(x, ns, sky_) : sky_.Irradiance(ns));
+  }
+}
+
+void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
+                                 ThreadPool* pool, int row0, int row1) const {
+  FrameSkyTerms(geometry, nullptr, n, out, nullptr, pool, row0, row1);
 }
 
 void RealtimeFrameData::MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out,
-                                       ThreadPool* pool) const {
-  const int W = camera_.width, H = camera_.height;
-  if (n != static_cast<int64_t>(W) * H)
-    throw Error("RealtimeFrameData::MirrorSkyTerms: " + std::to_string(n) +
-                " pixels, the camera has " + std::to_string(static_cast<int64_t>(W) * H));
-  const bool occluded = !volume_.empty();
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int64_t i = v * W; i < (v + 1) * W; ++i) {
-      const PixelGeometry& g = mirror[i];
-      if (g.hit < 0) continue;
-      const Eigen::Vector3f x(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
-      if (g.hit == 0) {
-        out[i] = ToFloat3(sky_.Background(x));
-        continue;
-      }
-      const Eigen::Vector3f ns(g.ns.x, g.ns.y, g.ns.z);
-      out[i] = ToFloat3(occluded ? volume_.Irradiance(x, ns, sky_) : sky_.Irradiance(ns));
-    }
+                                       ThreadPool* pool, int row0, int row1) const {
+  row1 = CheckRows("MirrorSkyTerms", n, row0, row1);
+  if (row1 <= row0) return;
+  ParallelForOrSerial(pool, row1 - row0,
+                      [&](int64_t r) { MirrorSkyRow(mirror, out, row0 + static_cast<int>(r)); });
+}
+
+void RealtimeFrameData::FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror,
+                                      int64_t n, Float3* sky, Float3* mirror_sky, ThreadPool* pool,
+                                      int row0, int row1) const {
+  row1 = CheckRows("SkyTerms", n, row0, row1);
+  const int quad_row0 = row0 / 2, quad_rows = (row1 + 1) / 2 - quad_row0;
+  if (quad_rows <= 0) return;
+  ParallelForOrSerial(pool, quad_rows, [&](int64_t r) {
+    const int q = quad_row0 + static_cast<int>(r);
+    SkyQuadRow(geometry, sky, q, row1);
+    if (mirror == nullptr) return;
+    for (int v = 2 * q; v < 2 * q + 2 && v < row1; ++v) MirrorSkyRow(mirror, mirror_sky, v);
   });
 }
 

@@ -48,15 +48,26 @@ class RealtimeFrameData {
 
   /// the sky term of every pixel (RealtimeFrameView::sky_term) from its primary geometry, n =
   /// the Prepared camera's width x height pixels, row-major; with a sky volume a 2x2 quad on one
-  /// flat face shares one probe blend, as RealtimeIntegrator does. @throws Error for another n.
-  void SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out, ThreadPool* pool) const;
+  /// flat face shares one probe blend, as RealtimeIntegrator does. only rows [row0, row1) are
+  /// read and written (row1 < 0: to the last row); the bits of a pixel do not depend on the
+  /// rows asked for. @throws Error for another n, an odd row0, or an odd row1 before the last
+  /// row + 1.
+  void SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out, ThreadPool* pool,
+                int row0 = 0, int row1 = -1) const;
 
   /// the sky term of every pixel's mirrored ray (RealtimeFrameView::mirror_sky) from its
   /// geometry (TraceMirrorRay; n pixels as SkyTerms): where it hits, the occluded sky
   /// irradiance at the hit's shading normal (SkyIrradianceVolume::Irradiance, no shared blends:
   /// render/cpu/mirror_layer.cc's MirrorRadiance), where it escapes SkyModel::Background;
-  /// pixels that traced none (hit -1) are left as they are. @throws Error for another n.
-  void MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out, ThreadPool* pool) const;
+  /// pixels that traced none (hit -1) are left as they are; rows [row0, row1) only, as
+  /// SkyTerms. @throws as SkyTerms.
+  void MirrorSkyTerms(const PixelGeometry* mirror, int64_t n, Float3* out, ThreadPool* pool,
+                      int row0 = 0, int row1 = -1) const;
+
+  /// SkyTerms and, where `mirror` is not null, MirrorSkyTerms of rows [row0, row1) in one
+  /// parallel loop over pairs of rows (the same bits as the two calls). @throws as SkyTerms.
+  void FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror, int64_t n,
+                     Float3* sky, Float3* mirror_sky, ThreadPool* pool, int row0, int row1) const;
 
   /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
   /// skip the layer's kernels and its part of the host's sky pass.
@@ -91,6 +102,12 @@ class RealtimeFrameData {
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;
+  // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
+  int CheckRows(const char* what, int64_t n, int row0, int row1) const;
+  // the sky terms of the pixels of rows 2 q and 2 q + 1 below row1 (SkyTerms' 2x2 quads).
+  void SkyQuadRow(const PixelGeometry* geometry, Float3* out, int q, int row1) const;
+  // the mirrored rays' sky terms of row v (MirrorSkyTerms).
+  void MirrorSkyRow(const PixelGeometry* mirror, Float3* out, int v) const;
   float spread_rad_ = 0;
   uint64_t frame_key_ = 0;
   bool any_mirror_ = false;

@@ -3,6 +3,7 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <string>
@@ -55,12 +56,14 @@ __global__ void MirrorBlendKernel(RealtimeFrameView f, Float3* radiance) {
 
 // kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
 // threads each SM must hold (__launch_bounds__: at most 65536 / (128 kMinBlocks) registers).
+// rows [row0, row1) of the frame (Render shades the image band by band as the bands' sky terms
+// arrive).
 template <bool kReuse, int kMinBlocks>
 __global__ void __launch_bounds__(128, kMinBlocks)
-    ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance) {
+    ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance, int row0, int row1) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (u >= f.camera.width || v >= row1) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
@@ -156,6 +159,35 @@ double MsSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
+// one host copy of ParallelCopy.
+struct HostCopy {
+  void* dst;
+  const void* src;
+  size_t n;
+};
+
+// the copies, in chunks of 256 KiB, in one loop through `parallel` (serially if it is empty).
+void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel,
+                  const std::vector<HostCopy>& copies) {
+  constexpr size_t kChunk = size_t{256} << 10;
+  struct Chunk {
+    char* dst;
+    const char* src;
+    size_t n;
+  };
+  std::vector<Chunk> chunks;
+  for (const HostCopy& c : copies)
+    for (size_t a = 0; a < c.n; a += kChunk)
+      chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
+                        std::min(kChunk, c.n - a)});
+  auto copy = [&](int64_t i) { std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n); };
+  const int64_t count = static_cast<int64_t>(chunks.size());
+  if (parallel && count > 1)
+    parallel(count, copy);
+  else
+    for (int64_t i = 0; i < count; ++i) copy(i);
+}
+
 // the grid of the per-pixel kernels (whole warps of 16 x 2 pixels).
 const dim3 kPixelBlock(16, 8);
 dim3 PixelGrid(int W, int H) {
@@ -174,11 +206,16 @@ struct DeviceRealtime::Impl {
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
+  // pinned staging of the per-frame uploads (posed geoms, lights)
+  PinnedBuffer pin_geoms, pin_lights;
   std::vector<PixelGeometry> host_geometry, host_mirror_geometry;
   std::vector<Float3> host_sky, host_mirror_sky;
   std::vector<double> host_rows;
   cudaStream_t copy_stream = nullptr;
   cudaEvent_t geometry_done = nullptr;
+  cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
+  // band k's geometry is on the host (Render's bands)
+  cudaEvent_t band_done[kMaxSkyBands] = {};
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -198,22 +235,34 @@ struct DeviceRealtime::Impl {
       Check(cudaGetLastError(), "MirrorTraceKernel");
     }
   }
-  // the shading, shared-visibility and row-sum kernels of frame f on `stream` as `o` says.
-  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
-                     cudaStream_t stream) {
-    const int W = f.camera.width, H = f.camera.height;
-    const dim3 grid = PixelGrid(W, H);
+  // the shading kernel of rows [row0, row1) of frame f on `stream` as `o` says.
+  void LaunchShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream,
+                   int row0, int row1) {
+    if (row1 <= row0) return;
+    const dim3 grid = PixelGrid(f.camera.width, row1 - row0);
     TraceHit* h = hits.as<TraceHit>();
     Float3* L = radiance.as<Float3>();
     if (!o.reuse_hit)
-      ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L);
+      ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
     else if (o.min_blocks >= 6)
-      ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+      ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     else if (o.min_blocks >= 4)
-      ShadeKernel<true, 4><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+      ShadeKernel<true, 4><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     else
-      ShadeKernel<true, 1><<<grid, kPixelBlock, 0, stream>>>(f, h, L);
+      ShadeKernel<true, 1><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     Check(cudaGetLastError(), "ShadeKernel");
+  }
+  // the shading, shared-visibility and row-sum kernels of frame f on `stream` as `o` says.
+  void LaunchShading(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                     cudaStream_t stream) {
+    LaunchShade(f, o, stream, 0, f.camera.height);
+    LaunchAfterShade(f, o, stream);
+  }
+  // the kernels after the shading kernel: shared visibility, mirror layer, row sums.
+  void LaunchAfterShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
+                        cudaStream_t stream) {
+    const int W = f.camera.width, H = f.camera.height;
+    const dim3 grid = PixelGrid(W, H);
     VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
     Check(cudaGetLastError(), "VisibilityRaysKernel");
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(f);
@@ -242,6 +291,9 @@ struct DeviceRealtime::Impl {
   ~Impl() {
     if (copy_stream) cudaStreamDestroy(copy_stream);
     if (geometry_done) cudaEventDestroy(geometry_done);
+    if (radiance_done) cudaEventDestroy(radiance_done);
+    for (cudaEvent_t e : band_done)
+      if (e) cudaEventDestroy(e);
   }
 };
 
@@ -272,12 +324,28 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   if (!m.copy_stream) {
     Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
+    Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.band_done)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
   }
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
-  m.geoms.Upload(host_frame.geoms, sizeof(GeomPod) * num_geoms, stream);
-  m.lights.Upload(host_frame.lights, sizeof(LightPod) * host_frame.num_lights, stream);
+  // the posed geoms and lights: pinned, asynchronous (the last frame's copies are done: it
+  // ended with a synchronisation)
+  const size_t geom_bytes = sizeof(GeomPod) * num_geoms;
+  const size_t light_bytes = sizeof(LightPod) * host_frame.num_lights;
+  if (o.pinned) {
+    m.pin_geoms.Reserve(geom_bytes > 0 ? geom_bytes : 1);
+    m.pin_lights.Reserve(light_bytes > 0 ? light_bytes : 1);
+    if (geom_bytes > 0) std::memcpy(m.pin_geoms.p, host_frame.geoms, geom_bytes);
+    if (light_bytes > 0) std::memcpy(m.pin_lights.p, host_frame.lights, light_bytes);
+    m.geoms.Upload(m.pin_geoms.p, geom_bytes, stream);
+    m.lights.Upload(m.pin_lights.p, light_bytes, stream);
+  } else {
+    m.geoms.Upload(host_frame.geoms, geom_bytes, stream);
+    m.lights.Upload(host_frame.lights, light_bytes, stream);
+  }
   m.geometry.Reserve(sizeof(PixelGeometry) * n);
   m.depth.Reserve(sizeof(float) * n);
   m.sky.Reserve(sizeof(Float3) * n);
@@ -362,54 +430,95 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       host_mirror_sky = m.host_mirror_sky.data();
     }
   }
-  // (1) primary geometry (materials and normal maps included) and depth; pinned: the depth
-  // goes back on the copy stream while the host computes the sky terms
+  // (1) primary geometry (materials and normal maps included) and depth, then the geometry
+  // back to the host in bands of rows (even row counts: the sky terms' 2x2 quads stay in one
+  // band); pinned: the bands and the depth go back on the copy stream
   m.LaunchGeometry(f, o, stream);
-  m.geometry.Download(host_geometry, sizeof(PixelGeometry) * n, stream);
-  if (mirror) m.mirror_geometry.Download(host_mirror_geometry, sizeof(PixelGeometry) * n, stream);
-  if (out.depth) {
-    if (o.pinned) {
-      Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
-      Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
-      m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
-    } else {
-      m.depth.Download(out.depth, sizeof(float) * n, stream);
-    }
+  cudaStream_t down = o.pinned ? m.copy_stream : stream;
+  if (o.pinned) {
+    Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
+    Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
   }
-  Check(cudaStreamSynchronize(stream), "GeometryKernel");
-  const auto t1 = Clock::now();
-  // (2) the sky terms on the host
-  sky(host_geometry, host_mirror_geometry, n, host_sky, host_mirror_sky);
-  const auto t2 = Clock::now();
-  m.sky.Upload(host_sky, sizeof(Float3) * n, stream);
-  if (mirror) m.mirror_sky.Upload(host_mirror_sky, sizeof(Float3) * n, stream);
-  // (3) shading, the shared visibility and (4) the rows' log-luminance sums
-  m.LaunchShading(f, o, stream);
+  const int bands = o.pinned ? std::clamp(o.sky_bands, 1, kMaxSkyBands) : 1;
+  const int band_rows = bands == 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
+  auto band_row = [&](int k) { return std::min(H, k * band_rows); };
+  for (int k = 0; k < bands; ++k) {
+    const int r0 = band_row(k), r1 = band_row(k + 1);
+    if (r1 > r0) {
+      const size_t off = static_cast<size_t>(r0) * W, count = static_cast<size_t>(r1 - r0) * W;
+      Check(cudaMemcpyAsync(host_geometry + off, m.geometry.as<PixelGeometry>() + off,
+                            sizeof(PixelGeometry) * count, cudaMemcpyDeviceToHost, down),
+            "cudaMemcpyAsync");
+      if (mirror)
+        Check(
+            cudaMemcpyAsync(host_mirror_geometry + off, m.mirror_geometry.as<PixelGeometry>() + off,
+                            sizeof(PixelGeometry) * count, cudaMemcpyDeviceToHost, down),
+            "cudaMemcpyAsync");
+    }
+    Check(cudaEventRecord(m.band_done[k], down), "cudaEventRecord");
+  }
+  if (out.depth) {
+    if (o.pinned)
+      m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
+    else
+      m.depth.Download(out.depth, sizeof(float) * n, stream);
+  }
+  // (2) per band: its sky terms on the host, up to the device, and (3) its shading kernel,
+  // which overlaps the next band's sky terms
+  double sky_ms = 0;
+  Clock::time_point t1 = t0;
+  for (int k = 0; k < bands; ++k) {
+    const int r0 = band_row(k), r1 = band_row(k + 1);
+    Check(cudaEventSynchronize(m.band_done[k]), "GeometryKernel");
+    const auto ts = Clock::now();
+    if (k == 0) t1 = ts;
+    if (r1 <= r0) continue;
+    sky(host_geometry, host_mirror_geometry, n, r0, r1, host_sky, host_mirror_sky);
+    sky_ms += MsSince(ts);
+    const size_t off = static_cast<size_t>(r0) * W, count = static_cast<size_t>(r1 - r0) * W;
+    Check(cudaMemcpyAsync(m.sky.as<Float3>() + off, host_sky + off, sizeof(Float3) * count,
+                          cudaMemcpyHostToDevice, stream),
+          "cudaMemcpyAsync");
+    if (mirror)
+      Check(cudaMemcpyAsync(m.mirror_sky.as<Float3>() + off, host_mirror_sky + off,
+                            sizeof(Float3) * count, cudaMemcpyHostToDevice, stream),
+            "cudaMemcpyAsync");
+    m.LaunchShade(f, o, stream, r0, r1);
+  }
+  // the shared visibility, the mirror layer and (4) the rows' log-luminance sums; pinned: the
+  // radiance goes back on the copy stream while the host computes the exposure and the film
+  // kernel runs
+  m.LaunchAfterShade(f, o, stream);
+  if (out.radiance && o.pinned) {
+    Check(cudaEventRecord(m.radiance_done, stream), "cudaEventRecord");
+    Check(cudaStreamWaitEvent(m.copy_stream, m.radiance_done, 0), "cudaStreamWaitEvent");
+    m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
+  }
   m.rows.Download(host_rows, sizeof(double) * H, stream);
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
   const auto t3 = Clock::now();
   if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
   Exposure e;
   const double ev100 = exposure(m.host_rows, e.e);
-  // (5) film; pinned: the radiance goes back on the copy stream while the film kernel runs
-  if (out.radiance && o.pinned)
-    m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
+  // (5) film
   m.LaunchFilm(n, e, filmic ? 1 : 0, stream);
   if (o.pinned) {
     if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
-    if (out.rgb) std::memcpy(out.rgb, m.pin_rgb.p, 3 * n);
-    if (out.radiance) std::memcpy(out.radiance, m.pin_radiance.p, sizeof(Float3) * n);
-    if (out.depth) std::memcpy(out.depth, m.pin_depth.p, sizeof(float) * n);
+    std::vector<HostCopy> copies;
+    if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)});
+    if (out.radiance) copies.push_back({out.radiance, m.pin_radiance.p, sizeof(Float3) * n});
+    if (out.depth) copies.push_back({out.depth, m.pin_depth.p, sizeof(float) * n});
+    ParallelCopy(out.parallel, copies);
   } else {
     if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
   }
   m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  m.times.sky = std::chrono::duration<double, std::milli>(t2 - t1).count();
-  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t2).count();
+  m.times.sky = sky_ms;
+  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t1).count() - sky_ms;
   m.times.film = MsSince(t3);
   m.times.total = MsSince(t0);
   m.frame = f;
