@@ -10,8 +10,8 @@
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
-#include "penumbra/session/camera_specs.h"
 #include "penumbra/session/geom_extents.h"
+#include "penumbra/world/camera_specs.h"
 
 namespace penumbra {
 namespace {

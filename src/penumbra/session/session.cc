@@ -17,9 +17,9 @@
 #include "penumbra/environment/environment_model.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/static_terrain_ray_caster.h"
+#include "penumbra/world/run_budget.h"
 
 namespace penumbra {
 namespace {
