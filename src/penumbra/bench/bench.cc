@@ -18,7 +18,7 @@
 #include "penumbra/render/backends/render_ablation_switch.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 #if defined(PENUMBRA_WITH_CUDA)
