@@ -18,9 +18,9 @@
 #include "penumbra/command/run_description.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/zmq/msgpack_json.h"
 #include "penumbra/zmq/zmq_bridge.h"
 

@@ -13,10 +13,10 @@
 #include "penumbra/core/build_info.h"
 #include "penumbra/live/run_log_header.h"
 #include "penumbra/output/recorder_sink.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -9,14 +9,14 @@
 #include <filesystem>
 
 #include "penumbra/bench/bench.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/sensor_sink.h"
 
 namespace penumbra {
 namespace {
