@@ -19,7 +19,7 @@
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {

@@ -31,7 +31,7 @@
 #include "penumbra/command/run_control.h"
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "penumbra/core/error.h"
+#include "penumbra/live/live_effects.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/run_manifest.h"
@@ -18,9 +19,8 @@
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
-#include "penumbra/live/live_effects.h"
-#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {
@@ -193,7 +193,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   timings["load_sec"] = session.timings().load_sec;
   timings["scene_build_sec"] = session.timings().scene_build_sec;
 
-  // the sinks of `penumbra run` (sinks/run_outputs.h), fed by the log; the world's
+  // the sinks of `penumbra run` (sinks/run/run_outputs.h), fed by the log; the world's
   // `metrics:` on the kinematic quantities of the snapshots
   RunOutputsOptions outputs_options;
   outputs_options.end_time_sec = end_time;

@@ -25,7 +25,7 @@
 #include "penumbra/session/npc_map_json.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {

@@ -21,9 +21,9 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/output/trajectory_sink.h"
 #include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/session/session.h"
 #include "penumbra/sinks/camera_sink.h"
 #include "penumbra/sinks/sensor_sink.h"
-#include "penumbra/session/session.h"
 
 namespace penumbra {
 
