@@ -51,18 +51,6 @@ int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec) {
   return n;
 }
 
-void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path) {
-  // --force empties the output folder: never the one that holds the log being replayed
-  std::error_code ec;
-  const fs::path log = fs::weakly_canonical(log_path, ec);
-  const fs::path out = fs::weakly_canonical(out_dir, ec);
-  const std::string rel = log.lexically_relative(out).string();
-  if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
-    throw ConfigError("", 0, "--out",
-                      "'" + out_dir + "' holds the log being replayed (" + log_path +
-                          "); expected another output folder");
-}
-
 ReplaySummary ReplayLog(const ReplayOptions& options) {
   if (options.out_dir.empty())
     throw ConfigError("", 0, "--out", "required; expected the replay's output folder");

@@ -24,7 +24,6 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/replay/recorded_world.h"
-#include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/session.h"
