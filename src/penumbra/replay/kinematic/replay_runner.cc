@@ -1,4 +1,4 @@
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
