@@ -11,7 +11,6 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"

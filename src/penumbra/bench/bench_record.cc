@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <vector>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/live/run_log_header.h"
 #include "penumbra/output/recorder_sink.h"
@@ -17,6 +16,7 @@
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/session.h"
+#include "penumbra/world/default_world.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

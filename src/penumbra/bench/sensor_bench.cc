@@ -8,7 +8,6 @@
 #include <cmath>
 #include <filesystem>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
@@ -17,6 +16,7 @@
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/session/session.h"
 #include "penumbra/sinks/sensor_sink.h"
+#include "penumbra/world/default_world.h"
 
 namespace penumbra {
 namespace {
