@@ -1,4 +1,4 @@
-#include "penumbra/bench/viewer_bench.h"
+#include "penumbra/bench/net/viewer_bench.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

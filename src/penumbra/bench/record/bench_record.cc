@@ -1,4 +1,4 @@
-#include "penumbra/bench/bench_record.h"
+#include "penumbra/bench/record/bench_record.h"
 
 #include <fmt/format.h>
 #include <unistd.h>

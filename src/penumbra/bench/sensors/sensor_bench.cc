@@ -1,4 +1,4 @@
-#include "penumbra/bench/sensor_bench.h"
+#include "penumbra/bench/sensors/sensor_bench.h"
 
 #include <fmt/format.h>
 #include <time.h>

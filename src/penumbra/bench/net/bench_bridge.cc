@@ -1,4 +1,4 @@
-#include "penumbra/bench/bench_bridge.h"
+#include "penumbra/bench/net/bench_bridge.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
