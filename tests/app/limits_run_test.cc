@@ -16,9 +16,9 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
-#include "penumbra/session/run_budget.h"
+#include "penumbra/run/runner.h"
+#include "penumbra/world/run_budget.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

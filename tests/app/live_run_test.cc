@@ -15,11 +15,11 @@
 #include <thread>
 
 #include "common/temp_dir.h"
-#include "penumbra/run/runner.h"
-#include "penumbra/replay/replay_runner.h"
-#include "penumbra/replay/resimulate.h"
-#include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/live/live_control.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
+#include "penumbra/replay/resimulate.h"
+#include "penumbra/run/runner.h"
+#include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

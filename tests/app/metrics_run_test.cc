@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "penumbra/run/runner.h"
 #include "penumbra/core/error.h"
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 #include "penumbra/replay/resimulate.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

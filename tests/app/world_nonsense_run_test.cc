@@ -13,7 +13,7 @@
 
 #include "app/child_process.h"
 #include "common/temp_dir.h"
-#include "penumbra/session/run_budget.h"
+#include "penumbra/world/run_budget.h"
 
 namespace penumbra {
 namespace {

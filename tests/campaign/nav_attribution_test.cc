@@ -13,7 +13,7 @@
 #include "common/temp_dir.h"
 #include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/metrics/metrics_sink.h"
-#include "penumbra/sinks/physics_source.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -11,8 +11,8 @@
 #include "common/temp_dir.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -14,10 +14,10 @@
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
 #include "penumbra/live/live_control.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_format.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
 
 namespace penumbra {
 namespace {

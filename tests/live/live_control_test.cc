@@ -16,10 +16,10 @@
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/core/error.h"
 #include "penumbra/output/png_io.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {

@@ -13,7 +13,7 @@
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
-#include "penumbra/sinks/physics_source.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

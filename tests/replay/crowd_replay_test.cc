@@ -11,11 +11,11 @@
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/compose/agent_bodies.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/output/recorder_sink.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/replay/log_source.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

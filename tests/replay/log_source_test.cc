@@ -12,10 +12,10 @@
 #include "penumbra/core/error.h"
 #include "penumbra/effects/agent_animation.h"
 #include "penumbra/effects/agent_path.h"
-#include "penumbra/output/recorder_sink.h"
-#include "penumbra/replay/recorded_world.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/live/run_log_header.h"
+#include "penumbra/output/recorder_sink.h"
+#include "penumbra/physics/physics_source.h"
+#include "penumbra/replay/recorded_world.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

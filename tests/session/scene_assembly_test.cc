@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "common/temp_dir.h"
+#include "penumbra/scene/camera_pose.h"
 
 namespace penumbra {
 namespace {

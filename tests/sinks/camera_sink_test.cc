@@ -12,8 +12,8 @@
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
 

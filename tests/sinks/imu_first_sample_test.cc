@@ -7,7 +7,7 @@
 #include <string>
 
 #include "common/temp_dir.h"
-#include "penumbra/sinks/physics_source.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

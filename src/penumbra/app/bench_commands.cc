@@ -7,10 +7,10 @@
 #include "penumbra/app/backend_flag.h"
 #include "penumbra/app/cli_options.h"
 #include "penumbra/bench/bench.h"
-#include "penumbra/bench/bench_bridge.h"
-#include "penumbra/bench/bench_record.h"
-#include "penumbra/bench/bench_ros.h"
-#include "penumbra/bench/sensor_bench.h"
+#include "penumbra/bench/net/bench_bridge.h"
+#include "penumbra/bench/net/bench_ros.h"
+#include "penumbra/bench/record/bench_record.h"
+#include "penumbra/bench/sensors/sensor_bench.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {

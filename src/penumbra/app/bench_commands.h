@@ -3,10 +3,10 @@
 // benchmarks, never pass/fail tests; docs/benchmarks.md, docs/performance.md):
 //   bench render    frames/s and Mrays/s (bench/bench.h BenchRender)
 //   bench physics   physics steps/s vs a bare mj_step loop (BenchPhysics)
-//   bench record    run-log recording on vs off (bench/bench_record.h)
-//   bench bridge    the ZeroMQ bridge (bench/bench_bridge.h)
-//   bench ros       the ROS 1 transport (bench/bench_ros.h)
-//   bench sensors   LiDAR rays/s, IMU/MuJoCo sensor overhead (bench/sensor_bench.h)
+//   bench record    run-log recording on vs off (bench/record/bench_record.h)
+//   bench bridge    the ZeroMQ bridge (bench/net/bench_bridge.h)
+//   bench ros       the ROS 1 transport (bench/net/bench_ros.h)
+//   bench sensors   LiDAR rays/s, IMU/MuJoCo sensor overhead (bench/sensors/sensor_bench.h)
 // (the `bench decompose` and `bench viewer` verbs are in app/decompose_command.h and
 // app/viewer_commands.h, beside `decompose` and `view`; their harnesses are in bench/ too.)
 

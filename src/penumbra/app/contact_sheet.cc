@@ -5,9 +5,9 @@
 #include <array>
 #include <filesystem>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/bench/preset_scene.h"
 #include "penumbra/output/png_io.h"
+#include "penumbra/world/default_world.h"
 
 namespace penumbra {
 namespace {

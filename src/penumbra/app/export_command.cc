@@ -13,7 +13,7 @@
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/run_folder.h"
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 #include "penumbra/ros/rosbag_export.h"
 
 namespace penumbra {
@@ -49,8 +49,8 @@ class TempFolder {
   std::filesystem::path path_;
 };
 
-// replays the run log `log_path` (replay/replay_runner.h, with the recorded conditions or the
-// given --world / --adversity) into a new temporary run folder "<out>.replay-tmp-<random>"
+// replays the run log `log_path` (replay/kinematic/replay_runner.h, with the recorded conditions or
+// the given --world / --adversity) into a new temporary run folder "<out>.replay-tmp-<random>"
 // beside `out`, kept in `replayed` (removed when it is destroyed); returns that folder.
 // @throws ExportStopped when the stop request ended the replay.
 std::filesystem::path ReplayLogBeside(
@@ -114,8 +114,8 @@ int ExportCommand::Run(const CommandArgs& args) {
   options.format = ParseDatasetFormat(s.format);
   options.out_dir = s.out;
   options.stop_request = stop_request;
-  // a run log is first replayed (replay/replay_runner.h, with the recorded conditions or the
-  // given --world / --adversity) into a temporary run folder beside --out, exported from there
+  // a run log is first replayed (replay/kinematic/replay_runner.h, with the recorded conditions or
+  // the given --world / --adversity) into a temporary run folder beside --out, exported from there
   std::optional<TempFolder> replayed;
   fs::path run_dir = input;
   if (input.extension() == ".plog") {

@@ -3,8 +3,8 @@
 // [--camera2 NAME] [--imu NAME] [--sequence NN]`: a run's output folder in a public dataset
 // layout (dataset/dataset_export.h, docs/datasets.md); `--format rosbag --out FILE.bag`: a ROS 1
 // bag of every sensor and robot state (ros/rosbag_export.h, docs/ros.md). RUN may also be a run log
-// (.plog): it is first replayed (replay/replay_runner.h; --world and --adversity as `penumbra
-// replay`'s) into a temporary folder beside --out ("<out>.replay-tmp-<random>"), removed
+// (.plog): it is first replayed (replay/kinematic/replay_runner.h; --world and --adversity as
+// `penumbra replay`'s) into a temporary folder beside --out ("<out>.replay-tmp-<random>"), removed
 // afterwards.
 //
 // SIGINT / SIGTERM (the stop request): the replay stops at its next step, the export between

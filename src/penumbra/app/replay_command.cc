@@ -13,7 +13,7 @@
 #include "penumbra/app/stop_signals.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 #include "penumbra/replay/resimulate.h"
 #include "penumbra/run/runner.h"
 

@@ -1,7 +1,7 @@
 #pragma once
 // `penumbra replay FILE.plog ...`: a recorded run (a run log, `penumbra run --record`) rendered
-// again under other visual conditions (replay/replay_runner.h), or simulated again and checked
-// against the log step by step (--resimulate, replay/resimulate.h). docs/replay.md.
+// again under other visual conditions (replay/kinematic/replay_runner.h), or simulated again and
+// checked against the log step by step (--resimulate, replay/resimulate.h). docs/replay.md.
 
 #include <atomic>
 #include <memory>

@@ -16,7 +16,7 @@
 #include "penumbra/app/backend_flag.h"
 #include "penumbra/app/cli_options.h"
 #include "penumbra/app/stop_signals.h"
-#include "penumbra/bench/viewer_bench.h"
+#include "penumbra/bench/net/viewer_bench.h"
 #include "penumbra/core/error.h"
 #include "penumbra/viewer/viewer_bridge.h"
 #include "penumbra/viewer/viewer_messages.h"

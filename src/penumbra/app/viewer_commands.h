@@ -5,7 +5,7 @@
 //                                             outputs in a temporary folder unless --out
 //   penumbra bench viewer                     frames/s delivered, input-to-photon latency,
 //                                             physics steps/s with and without a viewer
-//                                             (the harness: bench/viewer_bench.h)
+//                                             (the harness: bench/net/viewer_bench.h)
 
 #include <atomic>
 #include <memory>

@@ -18,8 +18,9 @@
 #include "penumbra/render/backends/render_ablation_switch.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
+#include "penumbra/world/default_world.h"
 #include "penumbra/world/world_config.h"
 #if defined(PENUMBRA_WITH_CUDA)
 #include "penumbra/render/cuda/cuda_batch_bench.h"
@@ -121,13 +122,6 @@ void PrintRealtimeFpsTarget(const std::string& subject, double target_fps, doubl
         "(tier {})\n",
         subject, target_fps, tier);
   }
-}
-
-std::string DefaultWorldPath() {
-  const std::filesystem::path installed =
-      std::filesystem::path(PENUMBRA_SOURCE_DIR) / "worlds" / "default.yaml";
-  if (std::filesystem::exists(installed)) return installed.string();
-  return "worlds/default.yaml";
 }
 
 const std::vector<std::string>& AblationNames() {

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "penumbra/render/render_ablation.h"
-
 #include "penumbra/render/render_settings.h"
 
 namespace penumbra {
@@ -74,8 +73,5 @@ const char* TargetVerdict(double measured, double target);
 /// applicable (tier X)" when `tier` is not "realtime". `subject` is "" or e.g. "major ".
 void PrintRealtimeFpsTarget(const std::string& subject, double target_fps, double measured_fps,
                             const std::string& tier);
-
-/// the bundled default world (worlds/default.yaml in the source tree).
-std::string DefaultWorldPath();
 
 }  // namespace penumbra

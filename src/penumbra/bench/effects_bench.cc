@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "penumbra/bench/preset_scene.h"
+#include "penumbra/world/default_world.h"
 
 namespace penumbra {
 

@@ -5,7 +5,7 @@
 #include <ctime>
 
 #include "penumbra/core/error.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 
 namespace penumbra {
 namespace {

@@ -20,7 +20,7 @@
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
@@ -157,8 +157,7 @@ std::vector<BenchmarkRow> RunBenchmarkJob(const BenchmarkSpec& spec, const Bench
   replay.tier = spec.tier == "pathtraced" ? RenderSettings::Tier::kPathtraced
                                           : RenderSettings::Tier::kRealtime;
   replay.threads = spec.render_threads;
-  if (!context.backend.empty())
-    replay.backend = RenderSettings::BackendFromName(context.backend);
+  if (!context.backend.empty()) replay.backend = RenderSettings::BackendFromName(context.backend);
   replay.cameras = {world.camera_name};
   replay.progress = false;
   replay.stop_request = context.stop_request;

@@ -29,9 +29,9 @@
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 

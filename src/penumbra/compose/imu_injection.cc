@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/sensors/mujoco_sensors.h"
 
 namespace penumbra {
 namespace {
@@ -54,10 +55,6 @@ std::string AddImuSite(XMLElement* body, const std::string& imu_name, const Pose
 }
 
 }  // namespace
-
-std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name) {
-  return {"penumbra_imu/" + imu_name + "/accel", "penumbra_imu/" + imu_name + "/gyro"};
-}
 
 void AddImuSensors(const std::vector<SensorConfig>& sensors, ComposedScene* scene) {
   bool any = false;

@@ -5,19 +5,16 @@
 //  - attached to a site with an identity pose: that site;
 //  - otherwise a new site "penumbra_imu/<name>" in the attach body (or the site's body)
 //    at X_BS = X_B,attach * X_attach,S (pos + quat);
-// sensor names: "penumbra_imu/<name>/accel" and "penumbra_imu/<name>/gyro" (ImuSensorNames).
+// sensor names: "penumbra_imu/<name>/accel" and "penumbra_imu/<name>/gyro" (ImuSensorNames,
+// sensors/mujoco_sensors.h).
 
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/world/sensors_reader.h"
 
 namespace penumbra {
-
-/// the MuJoCo sensor names (accelerometer, gyro) of world-file IMU `imu_name`.
-std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name);
 
 /// adds the IMU sites and sensors of `sensors` (entries of other types are ignored) to
 /// scene->document (in place).

@@ -69,7 +69,7 @@ bool IsVehicle(AgentKind kind);
 
 /// where a world's crowds go: its rooms or zones and its lanes (walkways, aisles, trails), in
 /// the world frame. generated environments provide them (environment/environment_generator.h
-/// GeneratedEnvironment::rooms and walkways; session/session.cc).
+/// GeneratedEnvironment::rooms and walkways; environment/model_sources.h).
 struct CrowdSites {
   struct Area {
     std::string name;

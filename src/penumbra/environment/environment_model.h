@@ -1,7 +1,8 @@
 #pragma once
 // a world-file `models:` entry with `environment:` (world/environment_config.h) becomes a
 // generated MJCF model, plus the procedural materials and ceiling lamps that go with it
-// (docs/environments.md). called by the session before composing, as mesh files are imported.
+// (docs/environments.md). called before composing, as mesh files are imported
+// (environment/model_sources.h).
 
 #include <string>
 #include <vector>

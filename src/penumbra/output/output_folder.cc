@@ -161,6 +161,18 @@ std::vector<std::string> ForeignOutputEntries(const fs::path& out, size_t limit)
   return s.found;
 }
 
+void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path) {
+  // --force empties the output folder: never the one that holds the log being replayed
+  std::error_code ec;
+  const fs::path log = fs::weakly_canonical(log_path, ec);
+  const fs::path out = fs::weakly_canonical(out_dir, ec);
+  const std::string rel = log.lexically_relative(out).string();
+  if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
+    throw ConfigError("", 0, "--out",
+                      "'" + out_dir + "' holds the log being replayed (" + log_path +
+                          "); expected another output folder");
+}
+
 void PrepareOutputFolder(const fs::path& out, bool force, const std::string& key) {
   auto fail = [&](const std::string& what) {
     return ConfigError("", 0, key, "output folder '" + out.string() + "' " + what);

@@ -31,6 +31,11 @@ std::vector<std::string> ForeignOutputEntries(const std::filesystem::path& out, 
 void PrepareOutputFolder(const std::filesystem::path& out, bool force,
                          const std::string& key = "--out");
 
+/// refuses an output folder (`out_dir`, --out) of a replay or resimulation that holds the
+/// run log it reads (`log_path`) (or is its folder's parent): --force would empty it.
+/// @throws ConfigError("--out") naming both.
+void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path);
+
 /// a run refused while it sets up (bad input found once the model is composed: an unknown
 /// body, a scene too large) leaves its output folder as it found it, empty or absent, so that
 /// the corrected command runs without --force. everything in the folder is the run's own: it

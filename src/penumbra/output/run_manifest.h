@@ -11,8 +11,8 @@
 
 namespace penumbra {
 
-/// what a replay (`penumbra replay`, replay/replay_runner.h) rendered, and how: run.json's
-/// "replay" object.
+/// what a replay (`penumbra replay`, replay/kinematic/replay_runner.h) rendered, and how:
+/// run.json's "replay" object.
 struct ReplayManifest {
   std::string log;  ///< the run log replayed, as given on the command line
   /// "kinematic" (the log's states, no physics), "resimulate" (physics again, the world's
@@ -41,10 +41,10 @@ struct ReplayManifest {
 struct RunManifest {
   std::string world_file;  ///< path of the world file or bare model
   uint64_t seed = 0;
-  std::string penumbra_version;                      ///< e.g. "0.1.0"
-  std::string mujoco_version;                        ///< e.g. "2.2.2" (mj_versionString)
-  std::string embree_version;                        ///< e.g. "3.13.5"
-  std::vector<std::string> command_line;             ///< argv, one entry per argument
+  std::string penumbra_version;           ///< e.g. "0.1.0"
+  std::string mujoco_version;             ///< e.g. "2.2.2" (mj_versionString)
+  std::string embree_version;             ///< e.g. "3.13.5"
+  std::vector<std::string> command_line;  ///< argv, one entry per argument
   double sim_duration_sec = 0;  ///< sim time reached: time of the last completed physics step
   /// true when the run was stopped early (SIGINT / SIGTERM); written always
   bool interrupted = false;

@@ -89,7 +89,7 @@ class Simulation {
   /// the ctrl before the first control update (a standing robot with ctrl 0 falls freely and
   /// its IMU reads 0 instead of gravity). the next Step() does not run them again at this
   /// step, so the trajectory is the same bit for bit. no-op when no controller is due or they
-  /// already ran at this step (sinks/physics_source.h calls it before the first snapshot of
+  /// already ran at this step (physics/physics_source.h calls it before the first snapshot of
   /// a run; later snapshots hold the ctrl of the last update, so an update that falls on a
   /// snapshot's step shows in the next one).
   /// @throws PhysicsError as Step() does for a controller writing a non-finite ctrl.

@@ -1,7 +1,7 @@
 #pragma once
 // a source of world snapshots for the SimLoop (pipeline/sim_loop.h): something that stands at
 // one step of a run, can hand out the world at that step as an immutable WorldSnapshot and move
-// on to the next step. live physics is one (sinks/physics_source.h); a recorded run read
+// on to the next step. live physics is one (physics/physics_source.h); a recorded run read
 // back from a log is another (it has every snapshot already and only walks through them).
 
 #include <cstdint>

@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include "penumbra/core/error.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/live/run_log_header.h"
+#include "penumbra/physics/physics_source.h"
 
 namespace penumbra {
 

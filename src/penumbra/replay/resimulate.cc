@@ -13,20 +13,19 @@
 
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/live/live_effects.h"
+#include "penumbra/live/run_log_header.h"
 #include "penumbra/metrics/metrics_sink.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/physics/mujoco_version.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/replay/recorded_world.h"
-#include "penumbra/replay/replay_runner.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
-#include "penumbra/live/live_effects.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/live/run_log_header.h"
 #include "penumbra/session/session.h"
 
 namespace penumbra {

@@ -19,13 +19,13 @@
 #include "penumbra/output/png_io.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/output/run_manifest.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/npc_map_json.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {

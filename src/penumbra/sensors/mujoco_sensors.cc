@@ -4,6 +4,10 @@
 
 namespace penumbra {
 
+std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name) {
+  return {"penumbra_imu/" + imu_name + "/accel", "penumbra_imu/" + imu_name + "/gyro"};
+}
+
 std::string UnitSuffix(const std::string& unit) {
   if (unit == "1" || unit.empty()) return "";
   std::string out;

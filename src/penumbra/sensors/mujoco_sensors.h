@@ -8,12 +8,18 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "penumbra/scene/sensor_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
+
+/// the MuJoCo sensor names (accelerometer, gyro) of world-file IMU `imu_name`, as
+/// compose/imu_injection.h adds them to the composed model: "penumbra_imu/<name>/accel" and
+/// "penumbra_imu/<name>/gyro".
+std::pair<std::string, std::string> ImuSensorNames(const std::string& imu_name);
 
 /// a unit string as a column-name suffix: "m/s^2" -> "m_s2", "N m" -> "N_m", "1" -> "".
 std::string UnitSuffix(const std::string& unit);

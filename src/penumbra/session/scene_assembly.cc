@@ -10,8 +10,8 @@
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_limits.h"
 #include "penumbra/scene/world_snapshot.h"
-#include "penumbra/session/camera_specs.h"
 #include "penumbra/session/geom_extents.h"
+#include "penumbra/world/camera_specs.h"
 
 namespace penumbra {
 namespace {
@@ -342,15 +342,6 @@ SceneDescription AssembleScene(SceneDescription scene, const WorldConfig& world,
   AssembleCameras(scene, world, initial);
   ApplySemanticClasses(world.semantic_classes, &scene);
   return scene;
-}
-
-Pose CameraPoseInWorld(const CameraSpec& camera, const WorldSnapshot& snapshot) {
-  if (camera.mjcf_camera >= 0) {
-    Pose X_OpticalInCam = Pose::Identity();
-    X_OpticalInCam.linear() = RotationMujocoCameraFromOptical();
-    return snapshot.X_W_mjcam.at(camera.mjcf_camera) * X_OpticalInCam;
-  }
-  return snapshot.X_WB.at(camera.body) * camera.X_BO;
 }
 
 }  // namespace penumbra

@@ -34,7 +34,4 @@ inline const Eigen::Vector3d kAutoFrameView{-1.0, -0.6, -0.45};
 SceneDescription AssembleScene(SceneDescription extracted, const WorldConfig& world,
                                const WorldSnapshot& initial);
 
-/// pose of a camera's optical frame in the world at `snapshot` (X_WO).
-Pose CameraPoseInWorld(const CameraSpec& camera, const WorldSnapshot& snapshot);
-
 }  // namespace penumbra

@@ -5,21 +5,18 @@
 #include <chrono>
 #include <filesystem>
 
-#include "penumbra/assets/mesh_model.h"
-#include "penumbra/assets/mjcf_mesh_conversion.h"
-#include "penumbra/assets/procedural_material.h"
 #include "penumbra/compose/imu_injection.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/control/controller_capabilities.h"
 #include "penumbra/control/controller_factory.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
-#include "penumbra/environment/environment_model.h"
+#include "penumbra/environment/model_sources.h"
 #include "penumbra/physics/urdf_converter.h"
 #include "penumbra/render/backends/renderer_factory.h"
-#include "penumbra/session/run_budget.h"
 #include "penumbra/session/scene_assembly.h"
 #include "penumbra/session/static_terrain_ray_caster.h"
+#include "penumbra/world/run_budget.h"
 
 namespace penumbra {
 namespace {
@@ -28,38 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// the generated environments' rooms and walkways in the world frame: where crowds go
-// (session/effects_stage.h)
-CrowdSites CrowdSitesOf(const GeneratedModels& generated, const std::vector<ModelConfig>& models) {
-  CrowdSites sites;
-  for (const GeneratedModel& g : generated.models) {
-    Pose X_WM = Pose::Identity();
-    for (const ModelConfig& m : models)
-      if (m.name == g.model) X_WM = m.pose.ToPose();
-    for (const auto& [name, r] : g.environment.rooms) {
-      CrowdSites::Area a;
-      a.name = g.model + "/" + name;
-      a.min_W = Eigen::Vector2d(1e300, 1e300);
-      a.max_W = -a.min_W;
-      for (const Eigen::Vector2d& c : {Eigen::Vector2d(r.x0, r.y0), Eigen::Vector2d(r.x1, r.y0),
-                                       Eigen::Vector2d(r.x0, r.y1), Eigen::Vector2d(r.x1, r.y1)}) {
-        const Eigen::Vector2d w = (X_WM * Eigen::Vector3d(c.x(), c.y(), 0)).head<2>();
-        a.min_W = a.min_W.cwiseMin(w);
-        a.max_W = a.max_W.cwiseMax(w);
-      }
-      sites.areas.push_back(a);
-    }
-    for (const Walkway& w : g.environment.walkways) {
-      CrowdSites::Lane l;
-      l.name = g.model + "/" + w.name;
-      for (const Eigen::Vector2d& p : w.points)
-        l.points_W.push_back((X_WM * Eigen::Vector3d(p.x(), p.y(), 0)).head<2>());
-      sites.lanes.push_back(std::move(l));
-    }
-  }
-  return sites;
 }
 
 }  // namespace
@@ -89,44 +54,21 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   compose_options.physics = world_.physics;
   compose_options.ground_plane = world_.ground_plane;
   // generated environments (models: entries with environment:) become MJCF models next to the
-  // composed model ("environments"), their lamps world lights, their materials procedural ones
-  std::vector<ModelConfig> models = world_.models;
-  const GeneratedModels generated = GenerateEnvironmentModels(
-      &models,
+  // composed model ("environments"), mesh files MJCF models in mesh_dir (environment/
+  // model_sources.h: their lamps become world lights, their materials come in the scene step)
+  const ModelSources sources(
+      &world_,
       options.composed_xml_path.empty()
           ? std::string()
           : (std::filesystem::path(options.composed_xml_path).parent_path() / "environments")
-                .string());
-  for (const GeneratedModel& g : generated.models)
-    spdlog::info(
-        "generated {} ({}): {} geoms ({} colliding), {} furniture items, {} materials, "
-        "{} lamps in {:.3f} s",
-        g.model, g.file, g.environment.geoms, g.environment.colliding_geoms,
-        g.environment.furniture, g.environment.materials.size(), g.environment.lights.size(),
-        g.generate_sec);
-  world_.lights.insert(world_.lights.end(), generated.lights.begin(), generated.lights.end());
-  for (size_t i = 0; i < models.size(); ++i) world_.models[i].file = models[i].file;
-  // mesh files (models: entries with .obj, .gltf, ...) become generated MJCF models there too
-  const std::vector<ImportedModel> imported = ImportMeshModels(&models, mesh_dir, world_.file);
-  for (const ImportedModel& im : imported)
-    spdlog::info("imported {} ({}): {} meshes, {} triangles, {} materials in {:.3f} s", im.model,
-                 im.asset.file, im.asset.meshes.size(), im.asset.triangles,
-                 im.asset.materials.size(), im.import_sec);
-  for (const ImportedModel& im : imported)
-    if (im.collision_parts > 0)
-      spdlog::info(
-          "collision of {}: {} convex parts (CoACD, max concavity {:.4f} of the extent, "
-          "hull volumes {:.3f} x the mesh's) {} in {:.3f} s",
-          im.model, im.collision_parts, im.relative_max_concavity, im.hull_volume_ratio,
-          im.decomposition_cache_hit ? "read from the cache" : "computed", im.decompose_sec);
-  ComposedScene composed = ComposeWorld(models, compose_options);
-  // MJCF <mesh> files MuJoCo 2.2.2 cannot read (glTF, FBX, COLLADA, PLY) become .msh files
-  for (const std::string& f : ConvertForeignMjcfMeshes(&composed, mesh_dir))
-    spdlog::info("converted MJCF mesh {} for MuJoCo", f);
+                .string(),
+      mesh_dir);
+  ComposedScene composed = ComposeWorld(sources.models(), compose_options);
+  sources.ConvertComposedMeshes(&composed);
   AddImuSensors(world_.sensors, &composed);  // world-file IMUs (compose/imu_injection.h)
-  effects_ = std::make_unique<EffectsStage>(world_, &composed, options.adversity,
-                                            options.reserve_live_npcs,
-                                            CrowdSitesOf(generated, world_.models));
+  effects_ =
+      std::make_unique<EffectsStage>(world_, &composed, options.adversity,
+                                     options.reserve_live_npcs, sources.crowd_sites(world_.models));
   for (const std::string& w : composed.warnings) spdlog::warn("composer: {}", w);
   // the document becomes text once: the file kept and what MuJoCo compiles
   composed_xml_ = composed.Xml();
@@ -159,11 +101,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
   // the renderer's static scene, the effects engine on it, and the renderer
   t0 = Clock::now();
   SceneDescription extracted = sim_->scene();
-  ApplyImportedMaterials(imported, &extracted);
-  std::vector<ProceduralMaterialEntry> procedural = generated.materials;
-  for (ProceduralMaterialEntry& e : ProceduralMaterialsOf(world_.file))
-    procedural.push_back(std::move(e));
-  ApplyProceduralMaterials(procedural, world_.file, &extracted);
+  sources.ApplyMaterials(world_.file, &extracted);
   scene_ = effects_->Bind(AssembleScene(std::move(extracted), world_, sim_->Snapshot()));
   if (options.check_run_budget) {
     CheckRunMemory(world_, scene_, PhysicalMemoryBytes());  // before allocating

@@ -14,7 +14,7 @@
 //   3. scene     the renderer's SceneDescription: the compiled model's scene joined with the
 //                world file's lights, sky, cameras and materials (session/scene_assembly.h),
 //                agent geoms labelled and the effects engine built on it (EffectsStage::Bind);
-//                optionally the run's memory and work are checked (session/run_budget.h);
+//                optionally the run's memory and work are checked (world/run_budget.h);
 //                then the renderer (render/renderer.h) is built for that scene, and policy
 //                controllers with a height scan get the static scene's terrain ray caster
 //                (session/static_terrain_ray_caster.h).

@@ -13,8 +13,8 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/output/camera_info.h"
 #include "penumbra/output/camera_writer.h"
-#include "penumbra/session/camera_specs.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
+#include "penumbra/world/camera_specs.h"
 
 namespace penumbra {
 namespace {

@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "penumbra/compose/imu_injection.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
 #include "penumbra/core/rng.h"

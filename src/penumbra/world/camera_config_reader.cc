@@ -84,7 +84,7 @@ void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
     for (int i = 0; i < 5; ++i)
       if (d.Has(name[i])) *field[i] = d.Child(name[i]).Double();
     // an MJCF camera override without fovy_deg / intrinsics keeps the MJCF fovy, known only
-    // after compilation: scene assembly checks it then (session/camera_specs.h)
+    // after compilation: scene assembly checks it then (world/camera_specs.h)
     const bool optics_known = c->fovy_deg || c->intrinsics;
     const CameraIntrinsics k = IntrinsicsOf(*c);
     if (optics_known && k.fx > 0 && k.fy > 0 && k.width > 0 && k.height > 0) {

@@ -19,7 +19,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_batch_bench.h"
 #include "penumbra/render/cuda/cuda_batch_renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

@@ -19,7 +19,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/primary_pixel.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

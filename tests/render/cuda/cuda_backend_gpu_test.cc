@@ -18,7 +18,7 @@
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

@@ -17,7 +17,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 

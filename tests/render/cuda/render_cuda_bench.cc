@@ -38,7 +38,7 @@
 #include "penumbra/render/cuda/cuda_batch_bench.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
-#include "penumbra/session/scene_assembly.h"
+#include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 #include "render/cuda/cuda_parity.h"

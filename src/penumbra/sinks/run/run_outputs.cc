@@ -1,4 +1,4 @@
-#include "penumbra/sinks/run_outputs.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 #include <fmt/format.h>
 

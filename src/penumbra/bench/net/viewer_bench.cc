@@ -1,4 +1,4 @@
-#include "penumbra/bench/viewer_bench.h"
+#include "penumbra/bench/net/viewer_bench.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -15,11 +15,11 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/core/error.h"
 #include "penumbra/run/runner.h"
 #include "penumbra/viewer/viewer_bridge.h"
 #include "penumbra/viewer/viewer_messages.h"
+#include "penumbra/world/default_world.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

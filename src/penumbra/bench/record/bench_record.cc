@@ -1,4 +1,4 @@
-#include "penumbra/bench/bench_record.h"
+#include "penumbra/bench/record/bench_record.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -9,14 +9,14 @@
 #include <filesystem>
 #include <vector>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/live/run_log_header.h"
 #include "penumbra/output/recorder_sink.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
+#include "penumbra/world/default_world.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {

@@ -1,4 +1,4 @@
-#include "penumbra/replay/replay_runner.h"
+#include "penumbra/replay/kinematic/replay_runner.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "penumbra/core/error.h"
+#include "penumbra/live/live_effects.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
 #include "penumbra/output/run_manifest.h"
@@ -18,9 +19,8 @@
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
-#include "penumbra/live/live_effects.h"
-#include "penumbra/sinks/run_outputs.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/run/run_outputs.h"
 
 namespace penumbra {
 namespace {
@@ -49,18 +49,6 @@ int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec) {
   while (n > 0 && SimTimeOfStep(n - 1, timestep_sec) >= time_sec - 1e-9) --n;
   while (SimTimeOfStep(n, timestep_sec) < time_sec - 1e-9) ++n;
   return n;
-}
-
-void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path) {
-  // --force empties the output folder: never the one that holds the log being replayed
-  std::error_code ec;
-  const fs::path log = fs::weakly_canonical(log_path, ec);
-  const fs::path out = fs::weakly_canonical(out_dir, ec);
-  const std::string rel = log.lexically_relative(out).string();
-  if (!ec && !rel.empty() && rel.rfind("..", 0) != 0)
-    throw ConfigError("", 0, "--out",
-                      "'" + out_dir + "' holds the log being replayed (" + log_path +
-                          "); expected another output folder");
 }
 
 ReplaySummary ReplayLog(const ReplayOptions& options) {
@@ -193,7 +181,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   timings["load_sec"] = session.timings().load_sec;
   timings["scene_build_sec"] = session.timings().scene_build_sec;
 
-  // the sinks of `penumbra run` (sinks/run_outputs.h), fed by the log; the world's
+  // the sinks of `penumbra run` (sinks/run/run_outputs.h), fed by the log; the world's
   // `metrics:` on the kinematic quantities of the snapshots
   RunOutputsOptions outputs_options;
   outputs_options.end_time_sec = end_time;

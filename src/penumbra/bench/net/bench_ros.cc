@@ -1,4 +1,4 @@
-#include "penumbra/bench/bench_ros.h"
+#include "penumbra/bench/net/bench_ros.h"
 
 #include <fmt/format.h>
 

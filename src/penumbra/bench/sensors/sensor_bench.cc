@@ -1,4 +1,4 @@
-#include "penumbra/bench/sensor_bench.h"
+#include "penumbra/bench/sensors/sensor_bench.h"
 
 #include <fmt/format.h>
 #include <time.h>
@@ -8,15 +8,15 @@
 #include <cmath>
 #include <filesystem>
 
-#include "penumbra/bench/bench.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/lidar_scanner.h"
-#include "penumbra/sinks/physics_source.h"
-#include "penumbra/sinks/sensor_sink.h"
 #include "penumbra/session/session.h"
+#include "penumbra/sinks/sensor_sink.h"
+#include "penumbra/world/default_world.h"
 
 namespace penumbra {
 namespace {

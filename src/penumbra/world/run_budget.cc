@@ -1,4 +1,4 @@
-#include "penumbra/session/run_budget.h"
+#include "penumbra/world/run_budget.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -7,7 +7,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/sensors/lidar_pattern.h"
-#include "penumbra/session/camera_specs.h"
+#include "penumbra/world/camera_specs.h"
 
 namespace penumbra {
 namespace {

@@ -1,4 +1,4 @@
-#include "penumbra/sinks/physics_source.h"
+#include "penumbra/physics/physics_source.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 #pragma once
 // the output sinks of a run, built once for `penumbra run` (run/runner.cc) and `penumbra
-// replay` (replay/replay_runner.cc): the cameras (sinks/camera_sink.h), the sensors
+// replay` (replay/kinematic/replay_runner.cc): the cameras (sinks/camera_sink.h), the sensors
 // (sinks/sensor_sink.h), trajectory.csv (output/trajectory_sink.h), the world's `metrics:`
 // (metrics/metrics_sink.h), the fall detector (metrics/fall_detector.h) and the progress bar,
 // plus the run.json fields they share. the
@@ -21,9 +21,9 @@
 #include "penumbra/output/run_manifest.h"
 #include "penumbra/output/trajectory_sink.h"
 #include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/session/session.h"
 #include "penumbra/sinks/camera_sink.h"
 #include "penumbra/sinks/sensor_sink.h"
-#include "penumbra/session/session.h"
 
 namespace penumbra {
 

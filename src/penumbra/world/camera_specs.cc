@@ -1,4 +1,4 @@
-#include "penumbra/session/camera_specs.h"
+#include "penumbra/world/camera_specs.h"
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"

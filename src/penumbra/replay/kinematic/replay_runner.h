@@ -82,11 +82,6 @@ struct ReplaySummary {
   std::map<std::string, std::string> depth_models;
 };
 
-/// refuses an output folder (`out_dir`, --out) that holds the log at `log_path` (or is its
-/// folder's parent): --force would empty it.
-/// @throws ConfigError("--out") naming both.
-void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string& log_path);
-
 /// the first step whose time (SimTimeOfStep) is >= time_sec - 1e-9 s (the SimLoop's end rule).
 int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec);
 

@@ -1,4 +1,4 @@
-#include "penumbra/session/camera_specs.h"
+#include "penumbra/world/camera_specs.h"
 
 #include <gtest/gtest.h>
 

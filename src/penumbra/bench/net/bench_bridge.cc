@@ -1,4 +1,4 @@
-#include "penumbra/bench/bench_bridge.h"
+#include "penumbra/bench/net/bench_bridge.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -11,16 +11,15 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
-#include "penumbra/bench/bench.h"
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
 #include "penumbra/command/run_control.h"
 #include "penumbra/command/run_description.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
 #include "penumbra/session/session.h"
-#include "penumbra/sinks/physics_source.h"
 #include "penumbra/zmq/msgpack_json.h"
 #include "penumbra/zmq/zmq_bridge.h"
 
