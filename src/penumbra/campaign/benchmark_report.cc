@@ -6,11 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/metric_plot.h"
 #include "penumbra/core/error.h"
 #include "penumbra/eval/trajectory.h"
 #include "penumbra/eval/trajectory_evaluation.h"
@@ -23,12 +21,11 @@ namespace {
 
 using namespace benchmark_text;  // NOLINT: module-internal helpers
 
-// a line plot: x = the conditions in spec order, one line per method with error bars (std)
+// a line plot: x = the conditions in spec order, one line per method with error bars (std),
+// the y axis up to a round number above the largest mean + std, ticks at 1, 2 or 5 x 10^k
 void PlotMetric(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines,
                 const std::string& world, const std::string& label,
                 SummaryCell SummaryLine::*metric, const fs::path& file) {
-  const int W = 900, H = 560, left = 90, right = 220, top = 50, bottom = 70;
-  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   double ymax = 0;
   for (const SummaryLine& l : lines)
     if (l.world == world && (l.*metric).n > 0)
@@ -41,58 +38,13 @@ void PlotMetric(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines
       tick = m * step;
       break;
     }
-  ymax = std::ceil(ymax / tick) * tick;
-  const int pw = W - left - right, ph = H - top - bottom;
-  const size_t nc = spec.conditions.size();
-  auto X = [&](size_t c) {
-    return left + static_cast<int>(std::lround(pw * (nc == 1 ? 0.5 : (c + 0.5) / nc)));
-  };
-  auto Y = [&](double v) { return top + ph - static_cast<int>(std::lround(ph * v / ymax)); };
-  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
-  for (double v = 0; v <= ymax + tick / 2; v += tick) {
-    cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, grey, 1, cv::LINE_AA);
-    cv::putText(img, fmt::format("{:g}", v), {8, Y(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black,
-                1, cv::LINE_AA);
-  }
-  cv::rectangle(img, {left, top}, {left + pw, top + ph}, black, 1);
-  for (size_t c = 0; c < nc; ++c)
-    cv::putText(img, spec.conditions[c].name, {X(c) - 20, top + ph + 25}, cv::FONT_HERSHEY_SIMPLEX,
-                0.55, black, 1, cv::LINE_AA);
-  cv::putText(img, "adversity condition", {left + pw / 2 - 80, H - 15}, cv::FONT_HERSHEY_SIMPLEX,
-              0.55, black, 1, cv::LINE_AA);
-  cv::putText(img, spec.name + " / " + world + ": " + label, {left, 30}, cv::FONT_HERSHEY_SIMPLEX,
-              0.65, black, 1, cv::LINE_AA);
-  static const cv::Scalar kColours[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
-                                        {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
-  for (size_t m = 0; m < spec.methods.size(); ++m) {
-    const cv::Scalar col = kColours[m % 6];
-    std::vector<cv::Point> pts;
-    for (size_t c = 0; c < nc; ++c)
-      for (const SummaryLine& l : lines) {
-        if (l.world != world || l.condition != spec.conditions[c].name ||
-            l.method != spec.methods[m].name)
-          continue;
-        const SummaryCell& v = l.*metric;
-        if (v.n == 0) {
-          cv::drawMarker(img, {X(c), top + ph - 8}, col, cv::MARKER_TILTED_CROSS, 12,
-                         2);  // no trial ok
-          continue;
-        }
-        const cv::Point p(X(c) + static_cast<int>(m) * 4, Y(v.mean));
-        pts.push_back(p);
-        cv::line(img, {p.x, Y(std::max(0.0, v.mean - v.std))}, {p.x, Y(v.mean + v.std)}, col, 1,
-                 cv::LINE_AA);
-        cv::circle(img, p, 4, col, cv::FILLED, cv::LINE_AA);
-      }
-    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2, cv::LINE_AA);
-    const int ly = top + 20 + 24 * static_cast<int>(m);
-    cv::line(img, {left + pw + 15, ly - 4}, {left + pw + 40, ly - 4}, col, 2, cv::LINE_AA);
-    cv::putText(img, spec.methods[m].name, {left + pw + 46, ly}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                black, 1, cv::LINE_AA);
-  }
-  cv::putText(img, "mean +- std over trials; x: no trial tracked", {left, H - 40 + 0},
-              cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(90, 90, 90), 1, cv::LINE_AA);
-  if (!cv::imwrite(file.string(), img)) throw Error("cannot write " + file.string());
+  MetricPlotStyle style;
+  style.ymax = std::ceil(ymax / tick) * tick;
+  for (double v = 0; v <= style.ymax + tick / 2; v += tick) style.ticks.push_back(v);
+  style.mark_empty = true;  // no trial tracked
+  style.footer = "mean +- std over trials; x: no trial tracked";
+  PlotMetricVsCondition(spec, world, label, SeriesByMethod(spec, lines, world, metric), style,
+                        file);
 }
 
 }  // namespace

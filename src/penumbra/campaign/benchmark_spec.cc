@@ -90,6 +90,17 @@ std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text) {
   }
 }
 
+// a world's `file`: relative to the spec's folder `dir`, canonical; fails at the field when
+// no such file exists
+std::string WorldFile(const YamlReader& file, const std::string& dir) {
+  fs::path p = file.String();
+  if (p.is_relative()) p = fs::path(dir) / p;
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec))
+    file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
+  return fs::weakly_canonical(p).string();
+}
+
 void CheckCamera(const BenchmarkWorld& w, const YamlReader& camera);
 void ReadCamera(const YamlReader& cam, BenchmarkWorld* world);
 
@@ -98,13 +109,7 @@ BenchmarkWorld ReadWorld(const YamlReader& r, const std::string& dir) {
   BenchmarkWorld w;
   w.line = r.line();
   w.name = Name(r.Child("name"));
-  const YamlReader file = r.Child("file");
-  fs::path p = file.String();
-  if (p.is_relative()) p = fs::path(dir) / p;
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
-    file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
-  w.file = fs::weakly_canonical(p).string();
+  w.file = WorldFile(r.Child("file"), dir);
   if (r.Has("duration_sec")) w.duration_sec = Positive(r.Child("duration_sec"), 3600);
   ReadCamera(r.Child("camera"), &w);
   return w;
@@ -229,13 +234,7 @@ BenchmarkWorld ReadNavWorld(const YamlReader& r, const std::string& dir) {
   BenchmarkWorld w;
   w.line = r.line();
   w.name = Name(r.Child("name"));
-  const YamlReader file = r.Child("file");
-  fs::path p = file.String();
-  if (p.is_relative()) p = fs::path(dir) / p;
-  std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
-    file.Fail("world file '" + p.string() + "' not found; expected a world file (.yaml)");
-  w.file = fs::weakly_canonical(p).string();
+  w.file = WorldFile(r.Child("file"), dir);
   if (r.Has("profile")) {
     std::vector<std::string_view> names;
     for (const std::string& n : NavProfileNames()) names.push_back(n);

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "penumbra/campaign/benchmark_text.h"
+#include "penumbra/campaign/metric_plot.h"
 #include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
@@ -22,63 +23,17 @@ namespace {
 
 using namespace benchmark_text;  // NOLINT: module-internal helpers
 
-const cv::Scalar kColours[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
-                               {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
-
-// metric vs condition, one line per method (mean, std error bars), y from 0 to ymax
+// metric vs condition, one line per method (mean, std error bars), y from 0 to ymax in fifths
 void PlotMetric(const BenchmarkSpec& spec, const std::vector<NavSummaryLine>& lines,
                 const std::string& world, const std::string& label,
                 SummaryCell NavSummaryLine::*metric, double ymax, const fs::path& file) {
-  const int W = 900, H = 560, left = 90, right = 220, top = 50, bottom = 70;
-  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
-  const int pw = W - left - right, ph = H - top - bottom;
-  const size_t nc = spec.conditions.size();
-  auto X = [&](size_t c) {
-    return left + static_cast<int>(std::lround(pw * (nc == 1 ? 0.5 : (c + 0.5) / nc)));
-  };
-  auto Y = [&](double v) {
-    return top + ph - static_cast<int>(std::lround(ph * std::clamp(v / ymax, 0.0, 1.05)));
-  };
-  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
-  for (int k = 0; k <= 5; ++k) {
-    const double v = ymax * k / 5;
-    cv::line(img, {left, Y(v)}, {left + pw, Y(v)}, grey, 1, cv::LINE_AA);
-    cv::putText(img, fmt::format("{:g}", v), {8, Y(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, black,
-                1, cv::LINE_AA);
-  }
-  cv::rectangle(img, {left, top}, {left + pw, top + ph}, black, 1);
-  for (size_t c = 0; c < nc; ++c)
-    cv::putText(img, spec.conditions[c].name, {X(c) - 20, top + ph + 25}, cv::FONT_HERSHEY_SIMPLEX,
-                0.55, black, 1, cv::LINE_AA);
-  cv::putText(img, "adversity condition", {left + pw / 2 - 80, H - 15}, cv::FONT_HERSHEY_SIMPLEX,
-              0.55, black, 1, cv::LINE_AA);
-  cv::putText(img, spec.name + " / " + world + ": " + label, {left, 30}, cv::FONT_HERSHEY_SIMPLEX,
-              0.65, black, 1, cv::LINE_AA);
-  for (size_t m = 0; m < spec.methods.size(); ++m) {
-    const cv::Scalar col = kColours[m % 6];
-    std::vector<cv::Point> pts;
-    for (size_t c = 0; c < nc; ++c)
-      for (const NavSummaryLine& l : lines) {
-        if (l.world != world || l.condition != spec.conditions[c].name ||
-            l.method != spec.methods[m].name)
-          continue;
-        const SummaryCell& v = l.*metric;
-        if (v.n == 0) continue;
-        const cv::Point p(X(c) + static_cast<int>(m) * 4, Y(v.mean));
-        pts.push_back(p);
-        cv::line(img, {p.x, Y(std::max(0.0, v.mean - v.std))}, {p.x, Y(v.mean + v.std)}, col, 1,
-                 cv::LINE_AA);
-        cv::circle(img, p, 4, col, cv::FILLED, cv::LINE_AA);
-      }
-    if (pts.size() > 1) cv::polylines(img, pts, false, col, 2, cv::LINE_AA);
-    const int ly = top + 20 + 24 * static_cast<int>(m);
-    cv::line(img, {left + pw + 15, ly - 4}, {left + pw + 40, ly - 4}, col, 2, cv::LINE_AA);
-    cv::putText(img, spec.methods[m].name, {left + pw + 46, ly}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                black, 1, cv::LINE_AA);
-  }
-  cv::putText(img, "mean +- std over trials", {left, H - 40}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
-              cv::Scalar(90, 90, 90), 1, cv::LINE_AA);
-  if (!cv::imwrite(file.string(), img)) throw Error("cannot write " + file.string());
+  MetricPlotStyle style;
+  style.ymax = ymax;
+  for (int k = 0; k <= 5; ++k) style.ticks.push_back(ymax * k / 5);
+  style.clamp = true;
+  style.footer = "mean +- std over trials";
+  PlotMetricVsCondition(spec, world, label, SeriesByMethod(spec, lines, world, metric), style,
+                        file);
 }
 
 // top view of every trial's base path of one (world, episode, condition, method): the start
@@ -118,7 +73,7 @@ void PlotPaths(const std::string& title, const std::vector<const NavRow*>& rows,
     cv::drawMarker(img, P(r0.goal_x, r0.goal_y), cv::Scalar(0, 160, 0), cv::MARKER_CROSS, 14, 2);
   }
   for (size_t i = 0; i < rows.size(); ++i) {
-    const cv::Scalar col = kColours[i % 6];
+    const cv::Scalar col = PlotColour(i);
     std::vector<cv::Point> pts;
     for (const auto& [x, y] : rows[i]->path_xy) pts.push_back(P(x, y));
     if (pts.empty()) continue;

@@ -6,18 +6,10 @@
 #include <set>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/number_text.h"
 #include "penumbra/core/text_match.h"
 
 namespace penumbra {
-namespace {
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
-}  // namespace
 
 const char* AgentKindName(AgentKind kind) {
   switch (kind) {
@@ -93,16 +85,16 @@ void AgentConfig::ValidateOrThrow(const std::string& file, const std::string& ke
       waypoints.size() == 2)
     fail("waypoints", "a loop of two equal points; expected distinct waypoints");
   if (!(std::isfinite(speed_m_s) && speed_m_s > 0 && speed_m_s <= 20))
-    fail("speed_m_s", "got " + Num(speed_m_s) + "; expected (0, 20] m/s");
+    fail("speed_m_s", "got " + FormatG(speed_m_s) + "; expected (0, 20] m/s");
   if (!(std::isfinite(pause_sec) && pause_sec >= 0 && pause_sec <= 3600))
-    fail("pause_sec", "got " + Num(pause_sec) + "; expected [0, 3600] s");
+    fail("pause_sec", "got " + FormatG(pause_sec) + "; expected [0, 3600] s");
   if (!(std::isfinite(start_delay_sec) && start_delay_sec >= 0 && start_delay_sec <= 3600))
-    fail("start_delay_sec", "got " + Num(start_delay_sec) + "; expected [0, 3600] s");
+    fail("start_delay_sec", "got " + FormatG(start_delay_sec) + "; expected [0, 3600] s");
   if (!std::isfinite(floor_z)) fail("floor_z", "not finite; expected a height in m");
   if (!(std::isfinite(height_m) && height_m >= 0.5 && height_m <= 2.5))
-    fail("height_m", "got " + Num(height_m) + "; expected [0.5, 2.5] m");
+    fail("height_m", "got " + FormatG(height_m) + "; expected [0.5, 2.5] m");
   if (!(std::isfinite(clearance_m) && clearance_m >= 0 && clearance_m <= 10))
-    fail("clearance_m", "got " + Num(clearance_m) + "; expected [0, 10] m");
+    fail("clearance_m", "got " + FormatG(clearance_m) + "; expected [0, 10] m");
 }
 
 void ValidateAgentsOrThrow(const std::vector<AgentConfig>& agents, const std::string& file) {

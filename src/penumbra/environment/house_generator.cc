@@ -40,11 +40,6 @@ struct Palette {
                                           {0.45f, 0.36f, 0.22f}, {0.55f, 0.52f, 0.48f}};
 };
 
-template <typename T>
-const T& Pick(PlanRandom* r, const std::vector<T>& v) {
-  return v[static_cast<size_t>(r->Int(0, static_cast<int>(v.size()) - 1))];
-}
-
 // the house while it is built: the MJCF, the plan, the random streams and what comes out.
 class House : public EnvironmentBuilder {
  public:
@@ -97,17 +92,17 @@ class House : public EnvironmentBuilder {
   void Materials() {
     PlanRandom r(seed_, kMaterials);
     const Palette p;
-    Procedural("floor_wood", "wood", r.Bits(), Pick(&r, p.woods), 0, {0.55, 0.4, 0.28});
-    Procedural("floor_tiles", "tiles", r.Bits(), Pick(&r, p.tiles), 0, {0.7, 0.7, 0.68});
-    Procedural("wall_living", "plaster", r.Bits(), Pick(&r, p.walls), 0, {0.9, 0.9, 0.86});
-    Procedural("wall_kitchen", "plaster", r.Bits(), Pick(&r, p.walls), 0, {0.9, 0.9, 0.86});
-    Procedural("wall_private", "plaster", r.Bits(), Pick(&r, p.walls), 0, {0.9, 0.9, 0.86});
+    Procedural("floor_wood", "wood", r.Bits(), r.Pick(p.woods), 0, {0.55, 0.4, 0.28});
+    Procedural("floor_tiles", "tiles", r.Bits(), r.Pick(p.tiles), 0, {0.7, 0.7, 0.68});
+    Procedural("wall_living", "plaster", r.Bits(), r.Pick(p.walls), 0, {0.9, 0.9, 0.86});
+    Procedural("wall_kitchen", "plaster", r.Bits(), r.Pick(p.walls), 0, {0.9, 0.9, 0.86});
+    Procedural("wall_private", "plaster", r.Bits(), r.Pick(p.walls), 0, {0.9, 0.9, 0.86});
     Procedural("ceiling", "plaster", r.Bits(), Eigen::Vector3f(0.95f, 0.95f, 0.94f), 0,
                {0.95, 0.95, 0.94});
-    Procedural("furniture_wood", "wood", r.Bits(), Pick(&r, p.woods), 0.8, {0.5, 0.36, 0.24});
-    Procedural("upholstery", "fabric", r.Bits(), Pick(&r, p.fabrics), 0, {0.4, 0.2, 0.2});
-    Procedural("bedding", "fabric", r.Bits(), Pick(&r, p.fabrics), 0, {0.6, 0.6, 0.6});
-    Procedural("rug", "fabric", r.Bits(), Pick(&r, p.fabrics), 0.3, {0.4, 0.3, 0.3});
+    Procedural("furniture_wood", "wood", r.Bits(), r.Pick(p.woods), 0.8, {0.5, 0.36, 0.24});
+    Procedural("upholstery", "fabric", r.Bits(), r.Pick(p.fabrics), 0, {0.4, 0.2, 0.2});
+    Procedural("bedding", "fabric", r.Bits(), r.Pick(p.fabrics), 0, {0.6, 0.6, 0.6});
+    Procedural("rug", "fabric", r.Bits(), r.Pick(p.fabrics), 0.3, {0.4, 0.3, 0.3});
     Procedural("cardboard", "cardboard", r.Bits(), std::nullopt, 0, {0.66, 0.5, 0.32});
     Procedural("appliance", "painted_metal", r.Bits(), Eigen::Vector3f(0.86f, 0.86f, 0.85f), 0,
                {0.9, 0.9, 0.9});

@@ -27,6 +27,11 @@ class PlanRandom {
   bool Chance(double p) { return rng_.UniformD() < p; }
   /// a 64-bit value (seeds of procedural materials).
   uint64_t Bits() { return rng_.NextU64(); }
+  /// one element of `v` (not empty), each equally likely; draws one Int.
+  template <typename T>
+  const T& Pick(const std::vector<T>& v) {
+    return v[static_cast<size_t>(Int(0, static_cast<int>(v.size()) - 1))];
+  }
 
  private:
   Rng rng_;

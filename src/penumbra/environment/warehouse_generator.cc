@@ -14,9 +14,9 @@ namespace {
 
 constexpr double kWarehouseHalfX = 15, kWarehouseHalfY = 10;  // interior half extents, m
 constexpr double kWarehouseHeight = 8;                        // floor to roof, m
-constexpr double kWall = 0.25;              // wall thickness, m
-constexpr double kBay = 2.7;                // rack bay width (upright centres), m
-constexpr double kRackDepth = 1.1;          // one rack's depth, m
+constexpr double kWall = 0.25;                                // wall thickness, m
+constexpr double kBay = 2.7;                                  // rack bay width (upright centres), m
+constexpr double kRackDepth = 1.1;                            // one rack's depth, m
 constexpr int kBays = 6;
 constexpr double kRackX0 = -11.0;  // west end of every rack row, m
 // beam tops of the elevated levels, m (level 0 is the floor)
@@ -84,17 +84,15 @@ class Warehouse : public EnvironmentBuilder {
     const std::vector<Eigen::Vector3f> uprights = {
         {0.05f, 0.12f, 0.45f}, {0.08f, 0.3f, 0.12f}, {0.5f, 0.5f, 0.52f}};
     const std::vector<Eigen::Vector3f> beams = {{0.8f, 0.25f, 0.02f}, {0.85f, 0.6f, 0.02f}};
-    const auto pick = [&r](const std::vector<Eigen::Vector3f>& v) {
-      return v[static_cast<size_t>(r.Int(0, static_cast<int>(v.size()) - 1))];
-    };
     Procedural("floor_concrete", "concrete", r.Bits(),
                Eigen::Vector3f::Constant(static_cast<float>(r.Uniform(0.8, 1.05))), 0,
                {0.55, 0.55, 0.53});
-    Procedural("wall_metal", "painted_metal", r.Bits(), pick(walls), 2.0, {0.75, 0.77, 0.78});
+    Procedural("wall_metal", "painted_metal", r.Bits(), r.Pick(walls), 2.0, {0.75, 0.77, 0.78});
     Procedural("roof", "painted_metal", r.Bits(), Eigen::Vector3f(0.6f, 0.6f, 0.6f), 2.0,
                {0.6, 0.6, 0.6});
-    Procedural("rack_upright", "painted_metal", r.Bits(), pick(uprights), 0.5, {0.05, 0.12, 0.45});
-    Procedural("rack_beam", "painted_metal", r.Bits(), pick(beams), 0.5, {0.8, 0.25, 0.02});
+    Procedural("rack_upright", "painted_metal", r.Bits(), r.Pick(uprights), 0.5,
+               {0.05, 0.12, 0.45});
+    Procedural("rack_beam", "painted_metal", r.Bits(), r.Pick(beams), 0.5, {0.8, 0.25, 0.02});
     Procedural("pallet_wood", "wood", r.Bits(), Eigen::Vector3f(1.15f, 1.05f, 0.9f), 0.6,
                {0.7, 0.58, 0.42});
     Procedural("carton", "cardboard", r.Bits(), std::nullopt, 0, {0.66, 0.5, 0.32});

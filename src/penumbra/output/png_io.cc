@@ -228,14 +228,14 @@ void AddPngTimes(PngWriteTimes* times, std::chrono::steady_clock::time_point t0,
   times->encode_sec += std::chrono::duration<double>(t1 - t0).count();
   times->write_sec += std::chrono::duration<double>(t2 - t1).count();
 }
-}  // namespace
 
-std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
-                                  const PngEncodeOptions& options, PngWriteTimes* times) {
+// `encode()`'s PNG bytes written to `path`; the encode and write times added to `times`
+template <typename Encode>
+std::vector<uint8_t> EncodeAndWrite(const std::string& path, PngWriteTimes* times, Encode encode) {
   std::vector<uint8_t> bytes;
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    bytes = EncodePngRgb8(image, options);
+    bytes = encode();
   } catch (const Error& e) {
     throw Error("cannot write PNG '" + path + "': " + e.what());
   }
@@ -244,20 +244,16 @@ std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
   AddPngTimes(times, t0, t1);
   return bytes;
 }
+}  // namespace
+
+std::vector<uint8_t> WritePngRgb8(const std::string& path, const ImageU8& image,
+                                  const PngEncodeOptions& options, PngWriteTimes* times) {
+  return EncodeAndWrite(path, times, [&] { return EncodePngRgb8(image, options); });
+}
 
 std::vector<uint8_t> WritePngGray16(const std::string& path, const ImageU16& image,
                                     const PngEncodeOptions& options, PngWriteTimes* times) {
-  std::vector<uint8_t> bytes;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    bytes = EncodePngGray16(image, options);
-  } catch (const Error& e) {
-    throw Error("cannot write PNG '" + path + "': " + e.what());
-  }
-  const auto t1 = std::chrono::steady_clock::now();
-  WriteFileBytes(path, bytes);
-  AddPngTimes(times, t0, t1);
-  return bytes;
+  return EncodeAndWrite(path, times, [&] { return EncodePngGray16(image, options); });
 }
 
 PngImage ReadPng(const std::string& path) {

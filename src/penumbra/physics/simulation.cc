@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/number_text.h"
 #include "penumbra/physics/mujoco_runtime.h"
 #include "penumbra/physics/mujoco_state.h"
 #include "penumbra/physics/scene_extractor.h"
@@ -199,12 +200,6 @@ ModelInfo BuildModelInfo(const mjModel* m) {
     info.keys.push_back(std::move(key));
   }
   return info;
-}
-
-std::string FormatSeconds(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
 }
 
 // true if any value is NaN or infinite (x * 0 is NaN exactly for those)
@@ -447,9 +442,8 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
                                                        std::optional<double> timestep_sec) {
   if (timestep_sec && !(*timestep_sec >= kMinTimestepSec && *timestep_sec <= kMaxTimestepSec))
     throw ConfigError(source, 0, "timestep_sec",
-                      "got " + FormatSeconds(*timestep_sec) + "; expected seconds in [" +
-                          FormatSeconds(kMinTimestepSec) + ", " + FormatSeconds(kMaxTimestepSec) +
-                          "]");
+                      "got " + FormatG(*timestep_sec) + "; expected seconds in [" +
+                          FormatG(kMinTimestepSec) + ", " + FormatG(kMaxTimestepSec) + "]");
   InstallMujocoHandlers();
   auto impl = std::make_unique<Simulation::Impl>();
   impl->source = source;
@@ -463,9 +457,9 @@ std::unique_ptr<Simulation::Impl> Simulation::LoadImpl(const std::string& loader
   // the model's own timestep (no override): 0 would never advance, < 0 runs backwards
   if (!(m->opt.timestep >= kMinTimestepSec && m->opt.timestep <= kMaxTimestepSec))
     throw ConfigError(source, 0, "option.timestep",
-                      "the model's timestep is " + FormatSeconds(m->opt.timestep) +
-                          " s; expected seconds in [" + FormatSeconds(kMinTimestepSec) + ", " +
-                          FormatSeconds(kMaxTimestepSec) + "]");
+                      "the model's timestep is " + FormatG(m->opt.timestep) +
+                          " s; expected seconds in [" + FormatG(kMinTimestepSec) + ", " +
+                          FormatG(kMaxTimestepSec) + "]");
   try {
     impl->d = mj_makeData(m);
     impl->snap_d = mj_makeData(m);
@@ -660,9 +654,9 @@ void Simulation::SetState(const SimState& s) {
       StateSizeMismatch(s, MujocoStateDims(m, static_cast<int64_t>(impl.schedule.size())));
   if (!bad.empty()) throw Error(impl.source + ": SetState: " + bad + " for this model");
   if (s.step < 0 || s.time_sec != SimTimeOfStep(s.step, m->opt.timestep))
-    throw Error(impl.source + ": SetState: time_sec " + FormatSeconds(s.time_sec) +
+    throw Error(impl.source + ": SetState: time_sec " + FormatG(s.time_sec) +
                 " is not the time of step " + std::to_string(s.step) + " (" +
-                FormatSeconds(SimTimeOfStep(s.step, m->opt.timestep)) + " s)");
+                FormatG(SimTimeOfStep(s.step, m->opt.timestep)) + " s)");
   d->time = s.time_sec;
   ForEachStateField(
       [&](const StateFieldInfo& f, const auto& v) {

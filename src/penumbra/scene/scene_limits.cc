@@ -2,28 +2,25 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include "penumbra/core/number_text.h"
 
 namespace penumbra {
 namespace {
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
+std::string SizeRange() {
+  return "[" + FormatG(kMinGeomSizeM) + ", " + FormatG(kMaxGeomSizeM) + "] m";
 }
 
-std::string SizeRange() { return "[" + Num(kMinGeomSizeM) + ", " + Num(kMaxGeomSizeM) + "] m"; }
-
 std::string PositionRange() {
-  return "each coordinate in [" + Num(-kMaxPositionM) + ", " + Num(kMaxPositionM) + "] m";
+  return "each coordinate in [" + FormatG(-kMaxPositionM) + ", " + FormatG(kMaxPositionM) + "] m";
 }
 
 // first coordinate of p outside +-kMaxPositionM (or NaN), as a message.
 std::optional<std::string> PositionProblem(const std::string& what, const Eigen::Vector3d& p) {
   for (int i = 0; i < 3; ++i) {
     if (!(std::abs(p[i]) <= kMaxPositionM)) {
-      return what + " " + "xyz"[i] + " is " + Num(p[i]) + " m at the initial pose; expected " +
+      return what + " " + "xyz"[i] + " is " + FormatG(p[i]) + " m at the initial pose; expected " +
              PositionRange();
     }
   }
@@ -56,7 +53,7 @@ std::optional<std::string> GeomSizeProblem(const SceneDescription& scene, const 
     const double s = g.size[i];
     if (g.shape == GeomShape::kPlane && s == 0) continue;  // 0 = infinite plane
     if (!(s >= kMinGeomSizeM && s <= kMaxGeomSizeM)) {
-      return "size[" + std::to_string(i) + "] is " + Num(s) + " m; expected " + SizeRange() +
+      return "size[" + std::to_string(i) + "] is " + FormatG(s) + " m; expected " + SizeRange() +
              (g.shape == GeomShape::kPlane ? " or 0 (infinite plane)" : "");
     }
   }
@@ -66,8 +63,9 @@ std::optional<std::string> GeomSizeProblem(const SceneDescription& scene, const 
     for (const Eigen::Vector3f& v : mesh.vertices) {
       const float a = v.cwiseAbs().maxCoeff();
       if (!(a <= kMaxGeomSizeM)) {
-        return "mesh '" + mesh.name + "' has a vertex coordinate of " + Num(a) +
-               " m (after the MJCF scale); expected |coordinates| <= " + Num(kMaxGeomSizeM) + " m";
+        return "mesh '" + mesh.name + "' has a vertex coordinate of " + FormatG(a) +
+               " m (after the MJCF scale); expected |coordinates| <= " + FormatG(kMaxGeomSizeM) +
+               " m";
       }
     }
   }
@@ -77,8 +75,8 @@ std::optional<std::string> GeomSizeProblem(const SceneDescription& scene, const 
     const double sizes[4] = {h.size_x, h.size_y, h.size_z, h.size_base};
     for (int i = 0; i < 4; ++i) {
       if (!(std::abs(sizes[i]) <= kMaxGeomSizeM)) {
-        return "height field '" + h.name + "' size[" + std::to_string(i) + "] is " + Num(sizes[i]) +
-               " m; expected |size| <= " + Num(kMaxGeomSizeM) + " m";
+        return "height field '" + h.name + "' size[" + std::to_string(i) + "] is " +
+               FormatG(sizes[i]) + " m; expected |size| <= " + FormatG(kMaxGeomSizeM) + " m";
       }
     }
   }
@@ -88,38 +86,39 @@ std::optional<std::string> GeomSizeProblem(const SceneDescription& scene, const 
 }  // namespace
 
 std::optional<std::string> FindIntrinsicsProblem(const CameraIntrinsics& k) {
-  if (!(std::isfinite(k.fx) && k.fx > 0)) return "fx is " + Num(k.fx) + "; expected > 0 (px)";
-  if (!(std::isfinite(k.fy) && k.fy > 0)) return "fy is " + Num(k.fy) + "; expected > 0 (px)";
-  if (!std::isfinite(k.cx)) return "cx is " + Num(k.cx) + "; expected a finite number (px)";
-  if (!std::isfinite(k.cy)) return "cy is " + Num(k.cy) + "; expected a finite number (px)";
+  if (!(std::isfinite(k.fx) && k.fx > 0)) return "fx is " + FormatG(k.fx) + "; expected > 0 (px)";
+  if (!(std::isfinite(k.fy) && k.fy > 0)) return "fy is " + FormatG(k.fy) + "; expected > 0 (px)";
+  if (!std::isfinite(k.cx)) return "cx is " + FormatG(k.cx) + "; expected a finite number (px)";
+  if (!std::isfinite(k.cy)) return "cy is " + FormatG(k.cy) + "; expected a finite number (px)";
   const double tan_max = std::tan(0.5 * kMaxFovyDeg * M_PI / 180.0);
   const double reach_x = std::max(std::abs(k.cx), std::abs(k.width - 1 - k.cx));
   const double reach_y = std::max(std::abs(k.cy), std::abs(k.height - 1 - k.cy));
   const auto wide = [&](const char* f, double fv, const char* c, double reach, int size) {
     return std::string("the ") + (f[1] == 'x' ? "horizontal" : "vertical") +
-           " field of view reaches " + Num(2 * std::atan(reach / fv) * 180.0 / M_PI) + " deg (" +
-           f + " " + Num(fv) + ", " + c + " " + Num(f[1] == 'x' ? k.cx : k.cy) + " for " +
-           std::to_string(size) + " px); expected every pixel within " + Num(0.5 * kMaxFovyDeg) +
-           " deg of the optical axis, i.e. " + f + " >= max(|" + c + "|, |" +
-           std::to_string(size - 1) + " - " + c + "|) / " + Num(tan_max);
+           " field of view reaches " + FormatG(2 * std::atan(reach / fv) * 180.0 / M_PI) +
+           " deg (" + f + " " + FormatG(fv) + ", " + c + " " + FormatG(f[1] == 'x' ? k.cx : k.cy) +
+           " for " + std::to_string(size) + " px); expected every pixel within " +
+           FormatG(0.5 * kMaxFovyDeg) + " deg of the optical axis, i.e. " + f + " >= max(|" + c +
+           "|, |" + std::to_string(size - 1) + " - " + c + "|) / " + FormatG(tan_max);
   };
   if (reach_x > tan_max * k.fx) return wide("fx", k.fx, "cx", reach_x, k.width);
   if (reach_y > tan_max * k.fy) return wide("fy", k.fy, "cy", reach_y, k.height);
   const auto centre = [&](const char* c, double v, int size) -> std::optional<std::string> {
     const double margin = kMaxPrincipalPointOffset * size;
     if (v >= -margin && v <= size + margin) return std::nullopt;
-    return std::string(c) + " is " + Num(v) + " for " + std::to_string(size) + " px; expected [" +
-           Num(-margin) + ", " + Num(size + margin) + "] (px: the principal point within " +
-           Num(kMaxPrincipalPointOffset) + " image sizes of the image)";
+    return std::string(c) + " is " + FormatG(v) + " for " + std::to_string(size) +
+           " px; expected [" + FormatG(-margin) + ", " + FormatG(size + margin) +
+           "] (px: the principal point within " + FormatG(kMaxPrincipalPointOffset) +
+           " image sizes of the image)";
   };
   if (auto p = centre("cx", k.cx, k.width)) return p;
   if (auto p = centre("cy", k.cy, k.height)) return p;
   const double tan_min = std::tan(0.5 * kMinFovyDeg * M_PI / 180.0);
   const auto narrow = [&](const char* f, double fv, int size) {
     return std::string("the ") + (f[1] == 'x' ? "horizontal" : "vertical") + " field of view is " +
-           Num(2 * std::atan(0.5 * size / fv) * 180.0 / M_PI) + " deg (" + f + " " + Num(fv) +
-           " for " + std::to_string(size) + " px); expected at least " + Num(kMinFovyDeg) +
-           " deg, i.e. " + f + " <= " + Num(0.5 * size / tan_min);
+           FormatG(2 * std::atan(0.5 * size / fv) * 180.0 / M_PI) + " deg (" + f + " " +
+           FormatG(fv) + " for " + std::to_string(size) + " px); expected at least " +
+           FormatG(kMinFovyDeg) + " deg, i.e. " + f + " <= " + FormatG(0.5 * size / tan_min);
   };
   if (k.fx > 0.5 * k.width / tan_min) return narrow("fx", k.fx, k.width);
   if (k.fy > 0.5 * k.height / tan_min) return narrow("fy", k.fy, k.height);
@@ -152,8 +151,9 @@ std::optional<SceneLimitProblem> FindSceneLimitProblem(const SceneDescription& s
     if (!(std::isfinite(c.intrinsics.fy) && c.intrinsics.fy > 0 && fovy >= kMinFovyDeg &&
           fovy < kMaxFovyDeg)) {
       return SceneLimitProblem{what, body,
-                               "fovy is " + Num(fovy) + " deg; expected [" + Num(kMinFovyDeg) +
-                                   ", " + Num(kMaxFovyDeg) + ") deg, as for world-file cameras"};
+                               "fovy is " + FormatG(fovy) + " deg; expected [" +
+                                   FormatG(kMinFovyDeg) + ", " + FormatG(kMaxFovyDeg) +
+                                   ") deg, as for world-file cameras"};
     }
     if (c.mjcf_camera < static_cast<int>(initial.X_W_mjcam.size())) {
       if (auto p = PositionProblem("position", initial.X_W_mjcam[c.mjcf_camera].translation()))

@@ -117,6 +117,38 @@ class FrameInjector : public Sink {
   int64_t frames_ = 0;
 };
 
+// a Live world stepped by a SimLoop (not started): the RunControl's BeforeStep before every
+// step, its stop flag, and as sinks the RunControl, a FrameInjector (publishing through the
+// bridge when there is one) and the bridge
+struct LiveLoop {
+  Live live;
+  FrameInjector injector;
+  PhysicsSource physics;
+  SimLoop loop;
+
+  LiveLoop(const WorldConfig& world, bool paused, bool with_bridge, int hwm, int width, int height)
+      : live(world, paused, with_bridge, hwm),
+        injector(live.bridge.get(), width, height),
+        physics(&live.session->sim(), PhysicsOptions(live.control.get())),
+        loop(&physics, LoopOptions(live.control.get())) {
+    loop.AddSink(live.control.get());
+    loop.AddSink(&injector);
+    if (live.bridge) loop.AddSink(live.bridge.get());
+  }
+
+ private:
+  static PhysicsSourceOptions PhysicsOptions(RunControl* control) {
+    PhysicsSourceOptions po;
+    po.before_step = [control](Simulation& s) { return control->BeforeStep(s); };
+    return po;
+  }
+  static SimLoopOptions LoopOptions(RunControl* control) {
+    SimLoopOptions lo;
+    lo.stop_request = control->stop_flag();
+    return lo;
+  }
+};
+
 // a REQ + SUB client of the bridge in this process
 struct Client {
   zmq::context_t ctx{1};
@@ -229,17 +261,9 @@ int BenchBridge(const BenchBridgeOptions& o) {
   // 1. lockstep round trip: step n=1 + one 640x480 RGB frame, against the dispatcher alone
   std::vector<double> rt, base;
   {
-    Live live(world, true, false, 1000);
-    FrameInjector injector(nullptr, kWidth, kHeight);
-    PhysicsSourceOptions po;
-    po.before_step = [&live](Simulation& s) { return live.control->BeforeStep(s); };
-    PhysicsSource physics(&live.session->sim(), po);
-    SimLoopOptions lo;
-    lo.stop_request = live.control->stop_flag();
-    SimLoop loop(&physics, lo);
-    loop.AddSink(live.control.get());
-    loop.AddSink(&injector);
-    loop.Start();
+    LiveLoop l(world, true, false, 1000, kWidth, kHeight);
+    Live& live = l.live;
+    l.loop.Start();
     const json step = {{"cmd", "step"}, {"n", 1}};
     live.dispatcher->Call(step);
     for (int i = 0; i < o.trips; ++i) {
@@ -249,21 +273,12 @@ int BenchBridge(const BenchBridgeOptions& o) {
       if (!r.value("ok", false)) throw Error("bench bridge: " + r.dump());
     }
     live.dispatcher->Call({{"cmd", "stop"}});
-    loop.Wait();
+    l.loop.Wait();
   }
   {
-    Live live(world, true, true, 1000);
-    FrameInjector injector(live.bridge.get(), kWidth, kHeight);
-    PhysicsSourceOptions po;
-    po.before_step = [&live](Simulation& s) { return live.control->BeforeStep(s); };
-    PhysicsSource physics(&live.session->sim(), po);
-    SimLoopOptions lo;
-    lo.stop_request = live.control->stop_flag();
-    SimLoop loop(&physics, lo);
-    loop.AddSink(live.control.get());
-    loop.AddSink(&injector);
-    loop.AddSink(live.bridge.get());
-    loop.Start();
+    LiveLoop l(world, true, true, 1000, kWidth, kHeight);
+    Live& live = l.live;
+    l.loop.Start();
     Client client(live.endpoint);
     const json step = {{"cmd", "step"}, {"n", 1}};
     client.Call(step);  // steps 0 and 1: two frames
@@ -280,7 +295,7 @@ int BenchBridge(const BenchBridgeOptions& o) {
         throw Error(fmt::format("bench bridge: unexpected {} of {} bytes", topic, bytes));
     }
     client.Call({{"cmd", "stop"}});
-    loop.Wait();
+    l.loop.Wait();
   }
   const double rt_med = Median(rt), base_med = Median(base);
   fmt::print(
@@ -292,19 +307,10 @@ int BenchBridge(const BenchBridgeOptions& o) {
 
   // 2. free-running: a pre-rendered frame at every physics step, frames/s one subscriber gets
   {
-    Live live(world, false, true, 16);
-    FrameInjector injector(live.bridge.get(), kWidth, kHeight);
-    PhysicsSourceOptions po;
-    po.before_step = [&live](Simulation& s) { return live.control->BeforeStep(s); };
-    PhysicsSource physics(&live.session->sim(), po);
-    SimLoopOptions lo;
-    lo.stop_request = live.control->stop_flag();
-    SimLoop loop(&physics, lo);
-    loop.AddSink(live.control.get());
-    loop.AddSink(&injector);
-    loop.AddSink(live.bridge.get());
+    LiveLoop l(world, false, true, 16, kWidth, kHeight);
+    Live& live = l.live;
     Client client(live.endpoint);  // subscribed before the loop starts
-    loop.Start();
+    l.loop.Start();
     size_t bytes = 0;
     client.Receive(&bytes);
     int64_t frames = 0;
@@ -318,7 +324,7 @@ int BenchBridge(const BenchBridgeOptions& o) {
     const double wall = Seconds(t0, Clock::now());
     const int64_t steps = live.control->boundary_step() - steps0;
     live.control->RequestStop();
-    loop.Wait();
+    l.loop.Wait();
     fmt::print(
         "free-running 640x480 rgb8: {:.0f} frames/s received by one subscriber (target >= 300); "
         "{:.0f} physics steps/s publishing a frame each ({:.0f} % of them delivered, the rest "
