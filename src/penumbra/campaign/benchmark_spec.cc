@@ -90,6 +90,15 @@ std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text) {
   }
 }
 
+// a method's `command` template: not blank, only `known` placeholders; its words
+void ReadCommand(const YamlReader& c, const std::vector<std::string>& known, BenchmarkMethod* m) {
+  m->command = c.String();
+  if (m->command.find_first_not_of(" \t") == std::string::npos)
+    c.Fail("empty; expected a command line");
+  CheckTemplate(c, m->command, known);
+  m->command_words = SplitAt(c, m->command);
+}
+
 // a world's `file`: relative to the spec's folder `dir`, canonical; fails at the field when
 // no such file exists
 std::string WorldFile(const YamlReader& file, const std::string& dir) {
@@ -172,12 +181,7 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
         "{penumbra} slam " + m.bundled + " {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}";
     m.command_words = SplitCommandTemplate(m.command);
   } else {
-    const YamlReader c = r.Child("command");
-    m.command = c.String();
-    if (m.command.find_first_not_of(" \t") == std::string::npos)
-      c.Fail("empty; expected a command line");
-    CheckTemplate(c, m.command, MethodPlaceholders());
-    m.command_words = SplitAt(c, m.command);
+    ReadCommand(r.Child("command"), MethodPlaceholders(), &m);
   }
   if (r.Has("dataset")) m.dataset = r.Child("dataset").Enum({"tum", "euroc"});
   if (r.Has("trajectory")) {
@@ -277,12 +281,7 @@ BenchmarkMethod ReadNavMethod(const YamlReader& r) {
     m.command = BundledNavCommand();
     m.command_words = SplitCommandTemplate(m.command);
   } else {
-    const YamlReader c = r.Child("command");
-    m.command = c.String();
-    if (m.command.find_first_not_of(" \t") == std::string::npos)
-      c.Fail("empty; expected a command line");
-    CheckTemplate(c, m.command, NavMethodPlaceholders());
-    m.command_words = SplitAt(c, m.command);
+    ReadCommand(r.Child("command"), NavMethodPlaceholders(), &m);
   }
   if (r.Has("timeout_sec")) m.timeout_sec = Positive(r.Child("timeout_sec"), 7 * 24 * 3600.0);
   return m;

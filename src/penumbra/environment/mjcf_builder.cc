@@ -53,26 +53,27 @@ std::string MjcfBuilder::UniqueName(const std::string& name) {
   }
 }
 
-void MjcfBuilder::AddGeom(GeomRecord g) {
+std::string MjcfBuilder::AddGeom(const std::string& name, const std::string& type,
+                                 const std::string& material, bool collide, GeomRecord g) {
+  g.name = UniqueName(name);
+  g.type = type;
+  g.material = material;
+  g.collide = collide;
   if (g.collide) ++colliding_;
   geoms_.push_back(std::move(g));
+  return geoms_.back().name;
 }
 
 std::string MjcfBuilder::AddBox(const std::string& name, const PlanFrame& frame,
                                 const Eigen::Vector3d& center, const Eigen::Vector3d& half,
                                 const std::string& material, bool collide, double yaw_rad) {
   GeomRecord g;
-  g.name = UniqueName(name);
-  g.type = "box";
   g.size = Vec(half);
   g.pos = frame.Apply(center);
   g.yaw_deg = std::remainder((frame.yaw_rad + yaw_rad) * 180.0 / M_PI, 360.0);
   if (std::abs(g.yaw_deg) < 1e-9) g.yaw_deg = 0;
   g.plan_half_extent = std::hypot(half.x(), half.y());
-  g.material = material;
-  g.collide = collide;
-  AddGeom(g);
-  return g.name;
+  return AddGeom(name, "box", material, collide, std::move(g));
 }
 
 std::string MjcfBuilder::AddCylinder(const std::string& name, const PlanFrame& frame,
@@ -80,44 +81,29 @@ std::string MjcfBuilder::AddCylinder(const std::string& name, const PlanFrame& f
                                      double half_height, const std::string& material,
                                      bool collide) {
   GeomRecord g;
-  g.name = UniqueName(name);
-  g.type = "cylinder";
   g.size = Num(radius) + " " + Num(half_height);
   g.pos = frame.Apply(center);
   g.plan_half_extent = radius;
-  g.material = material;
-  g.collide = collide;
-  AddGeom(g);
-  return g.name;
+  return AddGeom(name, "cylinder", material, collide, std::move(g));
 }
 
 std::string MjcfBuilder::AddSphere(const std::string& name, const PlanFrame& frame,
                                    const Eigen::Vector3d& center, double radius,
                                    const std::string& material, bool collide) {
   GeomRecord g;
-  g.name = UniqueName(name);
-  g.type = "sphere";
   g.size = Num(radius);
   g.pos = frame.Apply(center);
   g.plan_half_extent = radius;
-  g.material = material;
-  g.collide = collide;
-  AddGeom(g);
-  return g.name;
+  return AddGeom(name, "sphere", material, collide, std::move(g));
 }
 
 std::string MjcfBuilder::AddPlane(const std::string& name, const Eigen::Vector3d& center, double hx,
                                   double hy, const std::string& material, bool collide) {
   GeomRecord g;
-  g.name = UniqueName(name);
-  g.type = "plane";
   g.size = Num(hx) + " " + Num(hy) + " 0.1";
   g.pos = center;
   g.plan_half_extent = std::numeric_limits<double>::infinity();
-  g.material = material;
-  g.collide = collide;
-  AddGeom(g);
-  return g.name;
+  return AddGeom(name, "plane", material, collide, std::move(g));
 }
 
 std::string MjcfBuilder::AddHeightField(const std::string& name, const std::string& file,
@@ -126,15 +112,10 @@ std::string MjcfBuilder::AddHeightField(const std::string& name, const std::stri
   assets_.push_back(
       fmt::format(R"(    <hfield name="{}" file="{}" size="{}"/>)", name, file, size));
   GeomRecord g;
-  g.name = UniqueName(name);
-  g.type = "hfield";
   g.hfield = name;
   g.pos = pos;
   g.plan_half_extent = std::numeric_limits<double>::infinity();
-  g.material = material;
-  g.collide = collide;
-  AddGeom(g);
-  return g.name;
+  return AddGeom(name, "hfield", material, collide, std::move(g));
 }
 
 std::string MjcfBuilder::BodyOf(const GeomRecord& g) const {

@@ -88,7 +88,10 @@ class MjcfBuilder {
     bool collide = true;
   };
   std::string UniqueName(const std::string& name);
-  void AddGeom(GeomRecord g);
+  /// keeps `g` (its shape fields set) as a geom of `type` named UniqueName(name), with
+  /// `material` and `collide`; returns the name.
+  std::string AddGeom(const std::string& name, const std::string& type, const std::string& material,
+                      bool collide, GeomRecord g);
   /// the body of `g`: "" = the world body.
   std::string BodyOf(const GeomRecord& g) const;
   static std::string GeomXml(const GeomRecord& g, const Eigen::Vector3d& body_pos);

@@ -1,5 +1,7 @@
 #include "penumbra/replay/recorded_world.h"
 
+#include <fmt/format.h>
+
 #include <sstream>
 
 #include "penumbra/core/error.h"
@@ -82,6 +84,16 @@ std::vector<std::string> ChangedAssets(const RunLogHeader& header) {
                     a.sha256.substr(0, 12) + "... in the log, " + now.substr(0, 12) + "... now)");
   }
   return out;
+}
+
+nlohmann::json RecordedLiveChange(const EventRecord& e, const std::string& log_path) {
+  nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
+  if (change.is_discarded())
+    throw ConfigError(log_path, 0, "live",
+                      fmt::format("the live change at step {} is not JSON; expected the "
+                                  "payload docs/run-log.md describes",
+                                  e.step));
+  return change;
 }
 
 }  // namespace penumbra

@@ -6,6 +6,7 @@
 // model file. the run's command-line changes to its world come back too: the seed from the
 // header, and --adversity, --tier, --spp and --outputs from its recorded command line.
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,11 @@ RecordedRunFlags ParseRecordedRunFlags(const std::string& command_line);
 /// @throws ConfigError naming the recorded world file and line (as `run` would) when the
 ///         recorded text no longer loads, e.g. a model file it names is gone.
 WorldConfig RecordedWorld(const RunLogHeader& header);
+
+/// the change a "live" event of the log carries (live/live_effects.h: what
+/// LiveEffects::ScheduleRecorded takes): its payload parsed as JSON.
+/// @throws ConfigError naming `log_path` and the event's step when the payload is not JSON.
+nlohmann::json RecordedLiveChange(const EventRecord& e, const std::string& log_path);
 
 /// one line per recorded asset whose content differs today from its hash in the log (or that
 /// cannot be read): "model /abs/quadruped.xml changed since the run was recorded (sha256

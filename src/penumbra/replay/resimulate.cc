@@ -322,13 +322,7 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   LiveEffects live(session);
   for (const EventRecord& e : reader.Events()) {
     if (e.kind != "live") continue;
-    const nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
-    if (change.is_discarded())
-      throw ConfigError(options.log_path, 0, "live",
-                        fmt::format("the live change at step {} is not JSON; expected the "
-                                    "payload docs/run-log.md describes",
-                                    e.step));
-    live.ScheduleRecorded(e.step, change);
+    live.ScheduleRecorded(e.step, RecordedLiveChange(e, options.log_path));
   }
 
   // ctrl mode: the ctrl of the initial state as logged (the controllers' first update, which

@@ -149,13 +149,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     if (e.kind != "live") continue;
     ++live_changes;
     if (!options.adversity.empty()) continue;
-    nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
-    if (change.is_discarded())
-      throw ConfigError(options.log_path, 0, "live",
-                        fmt::format("the live change at step {} is not JSON; expected the "
-                                    "payload docs/run-log.md describes",
-                                    e.step));
-    live.ScheduleRecorded(e.step, change);
+    live.ScheduleRecorded(e.step, RecordedLiveChange(e, options.log_path));
   }
   if (live_changes > 0 && !options.adversity.empty())
     Warn(&warnings, fmt::format("--adversity replaces the recorded conditions: the log's {} live "
