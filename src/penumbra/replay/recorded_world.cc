@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/live/live_effects.h"
 
 namespace penumbra {
 
@@ -86,14 +87,15 @@ std::vector<std::string> ChangedAssets(const RunLogHeader& header) {
   return out;
 }
 
-nlohmann::json RecordedLiveChange(const EventRecord& e, const std::string& log_path) {
-  nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
+void ScheduleRecordedLiveChange(const EventRecord& e, const std::string& log_path,
+                                LiveEffects* live) {
+  const nlohmann::json change = nlohmann::json::parse(e.payload, nullptr, false);
   if (change.is_discarded())
     throw ConfigError(log_path, 0, "live",
                       fmt::format("the live change at step {} is not JSON; expected the "
                                   "payload docs/run-log.md describes",
                                   e.step));
-  return change;
+  live->ScheduleRecorded(e.step, change);
 }
 
 }  // namespace penumbra

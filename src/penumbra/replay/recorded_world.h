@@ -6,7 +6,6 @@
 // model file. the run's command-line changes to its world come back too: the seed from the
 // header, and --adversity, --tier, --spp and --outputs from its recorded command line.
 
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +14,8 @@
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
+
+class LiveEffects;
 
 /// the flags of a recorded `penumbra run` command line that change what its outputs show
 /// (the seed is the header's own field).
@@ -41,10 +42,11 @@ RecordedRunFlags ParseRecordedRunFlags(const std::string& command_line);
 ///         recorded text no longer loads, e.g. a model file it names is gone.
 WorldConfig RecordedWorld(const RunLogHeader& header);
 
-/// the change a "live" event of the log carries (live/live_effects.h: what
-/// LiveEffects::ScheduleRecorded takes): its payload parsed as JSON.
+/// schedules the change a "live" event of the log carries (its JSON payload) at the event's
+/// step: LiveEffects::ScheduleRecorded (live/live_effects.h).
 /// @throws ConfigError naming `log_path` and the event's step when the payload is not JSON.
-nlohmann::json RecordedLiveChange(const EventRecord& e, const std::string& log_path);
+void ScheduleRecordedLiveChange(const EventRecord& e, const std::string& log_path,
+                                LiveEffects* live);
 
 /// one line per recorded asset whose content differs today from its hash in the log (or that
 /// cannot be read): "model /abs/quadruped.xml changed since the run was recorded (sha256

@@ -322,7 +322,7 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   LiveEffects live(session);
   for (const EventRecord& e : reader.Events()) {
     if (e.kind != "live") continue;
-    live.ScheduleRecorded(e.step, RecordedLiveChange(e, options.log_path));
+    ScheduleRecordedLiveChange(e, options.log_path, &live);
   }
 
   // ctrl mode: the ctrl of the initial state as logged (the controllers' first update, which

@@ -4,11 +4,11 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "penumbra/config/param_reader.h"
-#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
-#include "penumbra/core/input_file.h"
+#include "penumbra/world/world_file_document.h"
 
 namespace penumbra {
 namespace {
@@ -119,13 +119,9 @@ MeshImportConfig MeshImportConfigOf(const std::string& world_file, const std::st
   const std::string list = key.substr(0, open);
   const size_t index = std::stoul(key.substr(open + 1, close - open - 1));
   // a world whose file is gone (a replay's recorded world): the format defaults
-  ConfigValue root;
-  try {
-    root = ParseYaml(ReadInputFile(world_file, "world file"), world_file);
-  } catch (const ConfigError&) {
-    return out;
-  }
-  const ParamReader doc(root, world_file, nullptr);
+  const std::optional<ConfigValue> root = ReadWorldFileDocument(world_file);
+  if (!root) return out;
+  const ParamReader doc(*root, world_file, nullptr);
   doc.ExpectMapAnyKeys();
   if (!doc.Has(list)) return out;
   const ParamReader entries = doc.Child(list);

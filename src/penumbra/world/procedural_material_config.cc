@@ -1,9 +1,8 @@
 #include "penumbra/world/procedural_material_config.h"
 
 #include "penumbra/config/param_reader.h"
-#include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
-#include "penumbra/core/input_file.h"
+#include "penumbra/world/world_file_document.h"
 
 namespace penumbra {
 
@@ -55,13 +54,9 @@ std::vector<ProceduralMaterialEntry> ProceduralMaterialsOf(const std::string& wo
   std::vector<ProceduralMaterialEntry> out;
   if (world_file.empty()) return out;
   // a world whose file is gone (a replay's recorded world): none
-  ConfigValue root;
-  try {
-    root = ParseYaml(ReadInputFile(world_file, "world file"), world_file);
-  } catch (const ConfigError&) {
-    return out;
-  }
-  const ParamReader doc(root, world_file, nullptr);
+  const std::optional<ConfigValue> root = ReadWorldFileDocument(world_file);
+  if (!root) return out;
+  const ParamReader doc(*root, world_file, nullptr);
   doc.ExpectMapAnyKeys();
   if (!doc.Has("materials")) return out;
   for (auto& [name, entry] : doc.Child("materials").Entries()) {

@@ -149,7 +149,7 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
     if (e.kind != "live") continue;
     ++live_changes;
     if (!options.adversity.empty()) continue;
-    live.ScheduleRecorded(e.step, RecordedLiveChange(e, options.log_path));
+    ScheduleRecordedLiveChange(e, options.log_path, &live);
   }
   if (live_changes > 0 && !options.adversity.empty())
     Warn(&warnings, fmt::format("--adversity replaces the recorded conditions: the log's {} live "
