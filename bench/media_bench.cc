@@ -44,8 +44,7 @@ const World& DefaultWorld() {
     out->snapshot = sim.Snapshot();
     out->scene = session.scene();
     const CameraSpec& cam = out->scene.cameras.front();
-    const double fovy =
-        2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180 / M_PI;
+    const double fovy = cam.intrinsics.fovy_deg();
     out->view.intrinsics = CameraIntrinsics::FromFovy(640, 480, fovy);
     out->view.outputs[ImageKind::kRgb] = true;
     out->view.outputs[ImageKind::kDepth] = true;

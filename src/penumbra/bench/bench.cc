@@ -166,8 +166,7 @@ int BenchRender(const RenderBenchOptions& options) {
   Renderer* const renderer = session.renderer();
   if (!options.ablate.empty() && !SetRenderAblation(renderer, ablation))
     throw ConfigError(world.file, 0, "--ablate", "needs the cpu backend (--backend cpu)");
-  const double fovy_deg =
-      2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+  const double fovy_deg = cam.intrinsics.fovy_deg();
 
   // let the robot get going so the frames show a moving world
   const int steps_per_frame =

@@ -44,8 +44,7 @@ RenderedFrame PresetScene::Render(int camera, int width, int height, RenderTimin
   view.X_WO = CameraPoseInWorld(cam, snap);
   view.intrinsics = cam.intrinsics;
   if (width > 0 && height > 0) {
-    const double fovy_deg =
-        2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+    const double fovy_deg = cam.intrinsics.fovy_deg();
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
   }
   view.outputs[ImageKind::kRgb] = true;

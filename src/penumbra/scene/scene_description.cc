@@ -16,6 +16,10 @@ CameraIntrinsics CameraIntrinsics::FromFovy(int width, int height, double fovy_d
   return k;
 }
 
+double CameraIntrinsics::fovy_deg() const {
+  return 2.0 * std::atan(0.5 * height / fy) * 180.0 / M_PI;
+}
+
 namespace {
 template <typename V>
 int FindByName(const V& v, const std::string& name) {
@@ -25,9 +29,13 @@ int FindByName(const V& v, const std::string& name) {
 }
 }  // namespace
 
-int SceneDescription::FindMaterial(const std::string& name) const { return FindByName(materials, name); }
+int SceneDescription::FindMaterial(const std::string& name) const {
+  return FindByName(materials, name);
+}
 int SceneDescription::FindBody(const std::string& name) const { return FindByName(bodies, name); }
-int SceneDescription::FindCamera(const std::string& name) const { return FindByName(cameras, name); }
+int SceneDescription::FindCamera(const std::string& name) const {
+  return FindByName(cameras, name);
+}
 
 TextureMemory CountTextureMemory(const std::vector<Texture>& textures) {
   TextureMemory m;

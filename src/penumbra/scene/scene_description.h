@@ -86,10 +86,10 @@ struct Material {
   /// MuJoCo's `reflectance` in [0, 1]: weight of a mirror layer over the surface, on planes
   /// and the local +z faces of boxes only, as MuJoCo draws it (render/material_eval.h).
   float reflectance = 0.0f;
-  Eigen::Vector3f emission{0, 0, 0};             ///< emitted radiance, cd/m^2 (nits) per channel
-  int texture = -1;                              ///< index into SceneDescription::textures, -1 none
-  Eigen::Vector2f texrepeat{1, 1};               ///< MJCF texrepeat for 2d mapping
-  bool texuniform = false;  ///< MJCF texuniform: repeat per metre, not per face
+  Eigen::Vector3f emission{0, 0, 0};  ///< emitted radiance, cd/m^2 (nits) per channel
+  int texture = -1;                   ///< index into SceneDescription::textures, -1 none
+  Eigen::Vector2f texrepeat{1, 1};    ///< MJCF texrepeat for 2d mapping
+  bool texuniform = false;            ///< MJCF texuniform: repeat per metre, not per face
 };
 
 /// one piece of geometry attached to a body.
@@ -180,6 +180,9 @@ struct CameraIntrinsics {
 
   /// square pixels, principal point at the image centre, vertical field of view fovy_deg.
   static CameraIntrinsics FromFovy(int width, int height, double fovy_deg);
+  /// vertical field of view (deg) of these intrinsics, 2 atan(height / (2 fy)): FromFovy's
+  /// inverse; infinite or NaN when fy is not positive.
+  double fovy_deg() const;
 };
 
 /// which images a camera produces, one flag per ImageKind (scene/image_kind.h): rgb only unless

@@ -147,7 +147,7 @@ std::optional<SceneLimitProblem> FindSceneLimitProblem(const SceneDescription& s
     const std::string what = "MJCF camera '" + c.name + "'";
     const std::string body = body_name(c.body);
     // MJCF cameras carry MuJoCo's fovy as intrinsics of the extraction size
-    const double fovy = 2 * std::atan(0.5 * c.intrinsics.height / c.intrinsics.fy) * 180 / M_PI;
+    const double fovy = c.intrinsics.fovy_deg();
     if (!(std::isfinite(c.intrinsics.fy) && c.intrinsics.fy > 0 && fovy >= kMinFovyDeg &&
           fovy < kMaxFovyDeg)) {
       return SceneLimitProblem{what, body,

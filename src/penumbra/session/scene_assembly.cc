@@ -204,17 +204,13 @@ CameraIntrinsics IntrinsicsFor(const CameraConfig& c, double fallback_fovy_deg) 
   return CameraIntrinsics::FromFovy(c.width, c.height, c.fovy_deg.value_or(fallback_fovy_deg));
 }
 
-double FovyOf(const CameraIntrinsics& k) {
-  return 2.0 * std::atan(0.5 * k.height / k.fy) * 180.0 / M_PI;
-}
-
 void AssembleCameras(SceneDescription& scene, const WorldConfig& world,
                      const WorldSnapshot& initial) {
   std::vector<CameraSpec> cameras;
   // mjcf cameras: defaults, then per-camera overrides
   if (world.mjcf_cameras.enabled) {
     for (CameraSpec cam : scene.cameras) {
-      const double fovy = FovyOf(cam.intrinsics);
+      const double fovy = cam.intrinsics.fovy_deg();
       cam.intrinsics =
           CameraIntrinsics::FromFovy(world.mjcf_cameras.width, world.mjcf_cameras.height, fovy);
       cam.rate_hz = world.mjcf_cameras.rate_hz;
@@ -235,7 +231,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world,
                                   (known.empty() ? std::string("(none)") : known)
                             : "mjcf_cameras.enabled is false; expected no overrides");
     }
-    it->intrinsics = IntrinsicsFor(o, o.fovy_deg.value_or(FovyOf(it->intrinsics)));
+    it->intrinsics = IntrinsicsFor(o, o.fovy_deg.value_or(it->intrinsics.fovy_deg()));
     it->rate_hz = o.rate_hz;
     it->outputs = o.outputs;
     ApplyCameraConfig(o, &*it, world.file, "mjcf_cameras.overrides." + o.name);

@@ -49,8 +49,7 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   const CameraSpec& cam = scene.cameras.front();
   CameraView view;
   view.X_WO = CameraPoseInWorld(cam, snap);
-  const double fovy_deg =
-      2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+  const double fovy_deg = cam.intrinsics.fovy_deg();
   view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
   view.near_m = cam.near_m;
   view.exposure_time_sec = cam.exposure_time_sec;

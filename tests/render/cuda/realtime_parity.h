@@ -33,8 +33,7 @@ inline CameraView RgbDepthView(const SceneDescription& scene, const WorldSnapsho
   const CameraSpec& cam = scene.cameras.front();
   CameraView view;
   view.X_WO = CameraPoseInWorld(cam, snap);
-  const double fovy_deg =
-      2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+  const double fovy_deg = cam.intrinsics.fovy_deg();
   view.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
   view.near_m = cam.near_m;
   view.outputs[ImageKind::kRgb] = true;

@@ -85,8 +85,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     const CameraSpec& cam = scene.cameras.front();
     const std::string name = file.substr(file.find_last_of('/') + 1);
     const std::string size = fmt::format("{}x{}", width, height);
-    const double fovy_deg =
-        2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+    const double fovy_deg = cam.intrinsics.fovy_deg();
     CameraView view;
     view.X_WO = CameraPoseInWorld(cam, snap);
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, fovy_deg);
@@ -314,8 +313,7 @@ int Main(int argc, char** argv) {
     const SceneDescription& scene = session.scene();
     const CameraSpec& cam = scene.cameras.front();
     const std::string name = file.substr(file.find_last_of('/') + 1);
-    const double fovy_deg =
-        2.0 * std::atan(0.5 * cam.intrinsics.height / cam.intrinsics.fy) * 180.0 / M_PI;
+    const double fovy_deg = cam.intrinsics.fovy_deg();
     RenderSettings cpu_settings;
     cpu_settings.backend = RenderSettings::Backend::kEmbree;
     cpu_settings.threads = 0;

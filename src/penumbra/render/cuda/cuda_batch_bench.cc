@@ -100,10 +100,8 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       std::vector<CameraView> views = BatchBenchViews(worlds, count, &world_of);
       std::vector<BatchCamera> cams;
       for (int k = 0; k < count; ++k) {
-        views[k].intrinsics = CameraIntrinsics::FromFovy(
-            width, height,
-            2.0 * std::atan(0.5 * views[k].intrinsics.height / views[k].intrinsics.fy) * 180.0 /
-                M_PI);
+        views[k].intrinsics =
+            CameraIntrinsics::FromFovy(width, height, views[k].intrinsics.fovy_deg());
         cams.push_back(BatchRenderer::CameraOf(world_of[k], views[k]));
       }
       double kernel_ms = 0;
@@ -126,10 +124,8 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     RenderedFrame f;
     const int cpu_batches = std::max(1, std::min(batches, 2048 / count));
     for (int k = 0; k < count; ++k) {
-      views[k].intrinsics = CameraIntrinsics::FromFovy(
-          width, height,
-          2.0 * std::atan(0.5 * views[k].intrinsics.height / views[k].intrinsics.fy) * 180.0 /
-              M_PI);
+      views[k].intrinsics =
+          CameraIntrinsics::FromFovy(width, height, views[k].intrinsics.fovy_deg());
       views[k].outputs[ImageKind::kRgb] = false;
       views[k].outputs[ImageKind::kDepth] = outputs.depth;
       views[k].outputs[ImageKind::kSegmentation] = outputs.segmentation;
