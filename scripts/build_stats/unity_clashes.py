@@ -24,7 +24,7 @@ KINDS = "fvdtcsgeu"  # functions, variables, macros, typedefs, classes, structs,
 
 def tags(path):
     out = subprocess.run(["ctags", "--output-format=json", "--language-force=c++",
-                          "--fields=+sZSE", "--extras=-q", f"--c++-kinds={KINDS}", "-o", "-",
+                          "--fields=+sZSEt", "--extras=-q", f"--c++-kinds={KINDS}", "-o", "-",
                           path], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                          check=False).stdout
     for line in out.splitlines():
@@ -44,6 +44,39 @@ def file_local(tag):
     return "static" in props and tag.get("scopeKind") in (None, "namespace")
 
 
+def param_types(signature):
+    """a ctags signature without parameter names and default arguments, so that two copies of a
+    helper whose parameters are named differently (OctDecode(double u, double v) and
+    OctDecode(double s, double t)) compare equal: "(double, double)"."""
+    inner = signature.strip()
+    if inner.startswith("(") and inner.endswith(")"):
+        inner = inner[1:-1]
+    params, depth, cur = [], 0, ""
+    for ch in inner:
+        if ch in "<([{":
+            depth += 1
+        elif ch in ">)]}":
+            depth -= 1
+        if ch == "," and depth == 0:
+            params.append(cur)
+            cur = ""
+        else:
+            cur += ch
+    params.append(cur)
+    out = []
+    for p in params:
+        p = p.split("=")[0].strip()
+        # a trailing identifier after a type (and not the type's only word) is the name
+        m = re.match(r"^(.*[\w>&*\]])\s*[&*]*\s*\b([A-Za-z_]\w*)$", p)
+        if m and re.search(r"[\w>]", m.group(1)) and m.group(1).strip() not in ("const",
+                                                                              "unsigned",
+                                                                              "signed", "long",
+                                                                              "short"):
+            p = p[:m.start(2)].strip()
+        out.append(re.sub(r"\s+", " ", p))
+    return "(" + ", ".join(x for x in out if x) + ")"
+
+
 def main():
     build = sys.argv[1]
     module_wide = "--module-wide" in sys.argv[2:]
@@ -57,15 +90,20 @@ def main():
     clashes = 0
     for unity, files in sorted(groups.items()):
         seen = collections.defaultdict(set)
+        aliased = collections.defaultdict(set)  # what each file-local alias names
         for path in files:
             for t in tags(path):
                 if not file_local(t):
                     continue
                 scope = re.sub(r"__anon\w+", "<anon>", t.get("scope", ""))
-                sig = t.get("signature", "") if t["kind"] in ("function",) else ""
+                sig = param_types(t.get("signature", "")) if t["kind"] in ("function",) else ""
                 seen[(scope, t["name"], sig, t["kind"])].add(path)
+                if t["kind"] == "typedef":
+                    aliased[(scope, t["name"])].add(t.get("typeref", path))
         for (scope, name, sig, kind), paths in sorted(seen.items()):
-            if len(paths) > 1:
+            # the same alias of the same type twice is a valid redeclaration (using Clock = ...)
+            same_alias = kind == "typedef" and len(aliased[(scope, name)]) == 1
+            if len(paths) > 1 and not same_alias:
                 clashes += 1
                 batch = os.path.relpath(unity, build)
                 print(f"{batch}: {kind} {scope}::{name}{sig} in "

@@ -11,7 +11,7 @@ constexpr float kPi = 3.14159265358979323846f;
 constexpr float kInvPi = 1.0f / kPi;
 
 // Rec. 709 luminance weights (IEC 61966-2-1).
-inline float Luminance(const Eigen::Vector3f& c) {
+inline float BsdfLuminance(const Eigen::Vector3f& c) {
   return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z();
 }
 
@@ -83,8 +83,8 @@ Bsdf::Bsdf(const PbrParams& params, const Eigen::Vector3f& ns_W, const Eigen::Ve
   // lobe selection from the Fresnel reflectance at the viewing angle.
   const float cos_o = std::max(wo_.z(), 0.0f);
   const Eigen::Vector3f F = Schlick(f0_, cos_o);
-  const float ws = Luminance(F);
-  const float wd = Luminance(c_diff_.cwiseProduct(Eigen::Vector3f::Ones() - F));
+  const float ws = BsdfLuminance(F);
+  const float wd = BsdfLuminance(c_diff_.cwiseProduct(Eigen::Vector3f::Ones() - F));
   if (wd <= 0) {
     p_spec_ = 1.0f;
   } else {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -9,9 +10,7 @@
 namespace penumbra {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-double Luminance(const Eigen::Vector3f& c) {
+double EmitterLuminance(const Eigen::Vector3f& c) {
   return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
 }
 
@@ -49,7 +48,7 @@ void Basis(const Eigen::Vector3d& n, Eigen::Vector3d* t, Eigen::Vector3d* b) {
 Eigen::Vector3d UniformSphere(double u1, double u2) {
   const double z = 1 - 2 * u1;
   const double r = std::sqrt(std::max(0.0, 1 - z * z));
-  const double phi = 2 * kPi * u2;
+  const double phi = 2 * std::numbers::pi * u2;
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
@@ -97,17 +96,19 @@ EmitterSampler::EmitterSampler(const SceneDescription& scene)
     std::vector<double> parts;
     switch (g.shape) {
       case GeomShape::kSphere:
-        e.area = 4 * kPi * s.x() * s.x();
+        e.area = 4 * std::numbers::pi * s.x() * s.x();
         break;
       case GeomShape::kBox:  // faces +x, -x, +y, -y, +z, -z
         parts = {4 * s.y() * s.z(), 4 * s.y() * s.z(), 4 * s.x() * s.z(),
                  4 * s.x() * s.z(), 4 * s.x() * s.y(), 4 * s.x() * s.y()};
         break;
       case GeomShape::kCylinder:  // side, top cap, bottom cap
-        parts = {4 * kPi * s.x() * s.y(), kPi * s.x() * s.x(), kPi * s.x() * s.x()};
+        parts = {4 * std::numbers::pi * s.x() * s.y(), std::numbers::pi * s.x() * s.x(),
+                 std::numbers::pi * s.x() * s.x()};
         break;
       case GeomShape::kCapsule:  // side, top hemisphere, bottom hemisphere
-        parts = {4 * kPi * s.x() * s.y(), 2 * kPi * s.x() * s.x(), 2 * kPi * s.x() * s.x()};
+        parts = {4 * std::numbers::pi * s.x() * s.y(), 2 * std::numbers::pi * s.x() * s.x(),
+                 2 * std::numbers::pi * s.x() * s.x()};
         break;
       case GeomShape::kPlane:
         e.area = 4 * s.x() * s.y();
@@ -132,7 +133,7 @@ EmitterSampler::EmitterSampler(const SceneDescription& scene)
     if (!parts.empty()) e.area = BuildCdf(parts, &e.part_cdf);
     if (!(e.area > 0) || !std::isfinite(e.area)) continue;
     emitter_of_geom_[gi] = static_cast<int>(emitters_.size());
-    power.push_back(Luminance(e.Le) * e.area);
+    power.push_back(EmitterLuminance(e.Le) * e.area);
     emitters_.push_back(std::move(e));
   }
   BuildCdf(power, &pick_cdf_);
@@ -178,18 +179,18 @@ void EmitterSampler::SampleArea(const Emitter& e, float u_part, float u1, float 
     case GeomShape::kCapsule: {
       const double r = s.x(), h = s.y();
       if (part == 0) {  // side
-        const double phi = 2 * kPi * u1;
+        const double phi = 2 * std::numbers::pi * u1;
         *n = Eigen::Vector3d(std::cos(phi), std::sin(phi), 0);
         *p = Eigen::Vector3d(r * n->x(), r * n->y(), (2 * u2 - 1) * h);
       } else {
         const double sign = part == 1 ? 1.0 : -1.0;
         if (e.shape == GeomShape::kCylinder) {  // cap disc
-          const double rr = r * std::sqrt(static_cast<double>(u1)), phi = 2 * kPi * u2;
+          const double rr = r * std::sqrt(static_cast<double>(u1)), phi = 2 * std::numbers::pi * u2;
           *p = Eigen::Vector3d(rr * std::cos(phi), rr * std::sin(phi), sign * h);
           *n = Eigen::Vector3d(0, 0, sign);
         } else {  // hemisphere: uniform on the half sphere z * sign >= 0
           const double z = static_cast<double>(u1);
-          const double rr = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * kPi * u2;
+          const double rr = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * std::numbers::pi * u2;
           *n = Eigen::Vector3d(rr * std::cos(phi), rr * std::sin(phi), sign * z);
           *p = r * *n + Eigen::Vector3d(0, 0, sign * h);
         }
@@ -239,7 +240,7 @@ bool EmitterSampler::Sample(const std::vector<Pose>& X_WB, const Eigen::Vector3f
       const double one_minus_cos_max = OneMinusCosCone(r, dc);
       const double cos_t = 1 - u1 * one_minus_cos_max;
       const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
-      const double phi = 2 * kPi * u2;
+      const double phi = 2 * std::numbers::pi * u2;
       const Eigen::Vector3d w = to_c / dc;
       Eigen::Vector3d t, b;
       Basis(w, &t, &b);
@@ -252,7 +253,7 @@ bool EmitterSampler::Sample(const std::vector<Pose>& X_WB, const Eigen::Vector3f
       s->n_W = (hit - c).normalized().cast<float>();
       s->wi = wi.cast<float>();
       s->distance = static_cast<float>(dist);
-      s->pdf = static_cast<float>(p_pick / (2 * kPi * one_minus_cos_max));
+      s->pdf = static_cast<float>(p_pick / (2 * std::numbers::pi * one_minus_cos_max));
       return s->pdf > 0 && dist > 0;
     }
   }
@@ -288,7 +289,8 @@ float EmitterSampler::Pdf(const std::vector<Pose>& X_WB, int geom, const Eigen::
     const double r = scene_.geoms[e.geom].size.x();
     const double dc2 = (GeomPose(X_WB, e).translation() - p).squaredNorm();
     if (dc2 > kOutsideFactor * r * r)
-      return static_cast<float>(p_pick / (2 * kPi * OneMinusCosCone(r, std::sqrt(dc2))));
+      return static_cast<float>(p_pick /
+                                (2 * std::numbers::pi * OneMinusCosCone(r, std::sqrt(dc2))));
   }
   const Eigen::Vector3d d = p_hit_W.cast<double>() - p;
   const double dist2 = d.squaredNorm();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -10,8 +11,6 @@
 
 namespace penumbra {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // cubic smoothstep from e0 (0) to e1 (1); a hard step where e0 == e1.
 inline float SmoothStep(float e0, float e1, float x) {
@@ -49,11 +48,11 @@ PosedLight Unposed(const Light& l) {
   p.intensity_rgb = l.color.cwiseMax(0.0f) * l.intensity;
   const float outer = std::clamp(l.spot_outer_deg, 0.0f, 180.0f);
   const float inner = std::clamp(l.spot_inner_deg, 0.0f, outer);
-  p.cos_outer = static_cast<float>(std::cos(outer * kPi / 180.0));
-  p.cos_inner = static_cast<float>(std::cos(inner * kPi / 180.0));
+  p.cos_outer = static_cast<float>(std::cos(outer * std::numbers::pi / 180.0));
+  p.cos_inner = static_cast<float>(std::cos(inner * std::numbers::pi / 180.0));
   p.radius_m = std::max(l.radius_m, 0.0f);
-  p.cos_angular_radius =
-      static_cast<float>(std::cos(std::clamp(l.angular_radius_deg, 0.0f, 90.0f) * kPi / 180.0));
+  p.cos_angular_radius = static_cast<float>(
+      std::cos(std::clamp(l.angular_radius_deg, 0.0f, 90.0f) * std::numbers::pi / 180.0));
   p.cast_shadow = l.cast_shadow;
   return p;
 }

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <span>
 #include <string>
 #include <utility>
@@ -23,7 +24,6 @@
 namespace penumbra {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kNumSh = 9;  // real SH up to l = 2
 constexpr int kShFloats = kNumSh * 3;
 // a probe's irradiance SH padded to 28 floats (7 4-lane packets): coefficient k (RGB) at floats
@@ -50,8 +50,10 @@ inline void ShBasis(T x, T y, T z, T* out) {
 }
 
 // clamped-cosine convolution weight of band l (Ramamoorthi and Hanrahan 2001, eq. 8-9).
-constexpr double kBandWeight[kNumSh] = {kPi,     2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
-                                        kPi / 4, kPi / 4,     kPi / 4,     kPi / 4};
+constexpr double kBandWeight[kNumSh] = {
+    std::numbers::pi,         2 * std::numbers::pi / 3, 2 * std::numbers::pi / 3,
+    2 * std::numbers::pi / 3, std::numbers::pi / 4,     std::numbers::pi / 4,
+    std::numbers::pi / 4,     std::numbers::pi / 4,     std::numbers::pi / 4};
 
 // octahedral map: (u, v) in [-1, 1]^2 to a direction of L1 norm 1 (not unit): the upper
 // hemisphere is the diamond |u| + |v| <= 1, the lower one folded into the corners.
@@ -798,7 +800,7 @@ Eigen::Vector3f SkyIrradianceVolume::ProbeAmbient(int probe) const {
   // the irradiance SH's l = 0 coefficient is A0 L00 = pi L00; the mean radiance over the
   // sphere is L00 Y00.
   const float* c = &sh_[static_cast<size_t>(probe) * kShStride + 3 * kShSlot[0]];
-  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / kPi);
+  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / std::numbers::pi);
   return Eigen::Vector3f(c[0], c[1], c[2]) * kY00OverPi;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,6 @@
 
 namespace penumbra {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // a diffuse ground of this albedo is seen below the horizon of a daylight sky.
 constexpr double kGroundAlbedo = 0.2;
@@ -30,7 +29,7 @@ constexpr int kQuadCols = 128;
 constexpr int kIrrSide = 49;  // irradiance nodes per side (odd: the axes are nodes)
 
 // Rec. 709 / sRGB luminance weights (row Y of the RGB -> XYZ matrix, D65 white), IEC 61966-2-1.
-double Luminance(const Eigen::Vector3d& rgb) {
+double SkyRgbLuminance(const Eigen::Vector3d& rgb) {
   return 0.2126729 * rgb.x() + 0.7151522 * rgb.y() + 0.0721750 * rgb.z();
 }
 
@@ -206,10 +205,10 @@ void SkyModel::Impl::BuildSampling() {
   std::vector<double> lum(static_cast<size_t>(kSampleRows) * kSampleCols);
   double max_lum = 0;
   for (int r = 0; r < kSampleRows; ++r) {
-    const double theta = (r + 0.5) * kPi / kSampleRows;
+    const double theta = (r + 0.5) * std::numbers::pi / kSampleRows;
     for (int c = 0; c < kSampleCols; ++c) {
-      const double phi = (c + 0.5) * 2 * kPi / kSampleCols;
-      const double l = std::max(Luminance(Eval(DirectionFromAngles(theta, phi))), 0.0);
+      const double phi = (c + 0.5) * 2 * std::numbers::pi / kSampleCols;
+      const double l = std::max(SkyRgbLuminance(Eval(DirectionFromAngles(theta, phi))), 0.0);
       lum[static_cast<size_t>(r) * kSampleCols + c] = l;
       max_lum = std::max(max_lum, l);
     }
@@ -219,7 +218,7 @@ void SkyModel::Impl::BuildSampling() {
   std::vector<double> row_integrals(kSampleRows);
   conditional.reserve(kSampleRows);
   for (int r = 0; r < kSampleRows; ++r) {
-    const double sin_theta = std::sin((r + 0.5) * kPi / kSampleRows);
+    const double sin_theta = std::sin((r + 0.5) * std::numbers::pi / kSampleRows);
     std::vector<double> f(kSampleCols);
     double sum = 0;
     for (int c = 0; c < kSampleCols; ++c) {
@@ -238,9 +237,10 @@ void SkyModel::Impl::BuildSampling() {
 void SkyModel::Impl::BuildIrradiance() {
   const int cells = kQuadRows * kQuadCols;
   std::vector<float> dx(cells), dy(cells), dz(cells), lr(cells), lg(cells), lb(cells);
-  const double dphi = 2 * kPi / kQuadCols;
+  const double dphi = 2 * std::numbers::pi / kQuadCols;
   for (int r = 0; r < kQuadRows; ++r) {
-    const double t0 = r * 0.5 * kPi / kQuadRows, t1 = (r + 1) * 0.5 * kPi / kQuadRows;
+    const double t0 = r * 0.5 * std::numbers::pi / kQuadRows,
+                 t1 = (r + 1) * 0.5 * std::numbers::pi / kQuadRows;
     const double theta = 0.5 * (t0 + t1);
     const double d_omega = dphi * (std::cos(t0) - std::cos(t1));
     for (int c = 0; c < kQuadCols; ++c) {
@@ -276,7 +276,8 @@ void SkyModel::Impl::BuildIrradiance() {
         eg += sg;
         eb += sb;
       }
-      const Eigen::Vector3d e = Eigen::Vector3d(er, eg, eb) + g * (kPi * 0.5 * (1 - n.z()));
+      const Eigen::Vector3d e =
+          Eigen::Vector3d(er, eg, eb) + g * (std::numbers::pi * 0.5 * (1 - n.z()));
       irradiance[static_cast<size_t>(r) * kIrrSide + c] = e.cast<float>();
     }
   }
@@ -337,9 +338,10 @@ void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
   // G = albedo / pi * E_up, with E_up the sky irradiance on an upward-facing surface.
   // constant over the lower hemisphere, it darkens the horizon value as a ground bounce.
   double e_up[3] = {0, 0, 0};
-  const double dphi = 2 * kPi / kSampleCols;
+  const double dphi = 2 * std::numbers::pi / kSampleCols;
   for (int r = 0; r < kSampleRows; ++r) {
-    const double t0 = r * 0.5 * kPi / kSampleRows, t1 = (r + 1) * 0.5 * kPi / kSampleRows;
+    const double t0 = r * 0.5 * std::numbers::pi / kSampleRows,
+                 t1 = (r + 1) * 0.5 * std::numbers::pi / kSampleRows;
     const double theta = 0.5 * (t0 + t1);
     // integral of cos(theta) d omega over the cell.
     const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
@@ -348,7 +350,7 @@ void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
       for (int k = 0; k < 3; ++k) e_up[k] += l[k] * w;
     }
   }
-  this->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / kPi);
+  this->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / std::numbers::pi);
 }
 
 SkyboxBackground MjcfSkyboxOf(const SceneDescription& scene) {
@@ -396,8 +398,8 @@ SkyModel::SkyModel(const Sky& sky, SkyboxBackground skybox) {
   if (impl->skybox.image != nullptr) {
     // a white Lambertian surface facing up under the sky and the sun.
     const Eigen::Vector3f e = OctLookup(impl->irradiance, kIrrSide, Eigen::Vector3f(0, 0, 1));
-    const double e_up = Luminance(e.cast<double>()) + impl->skybox.sun_horizontal_lux;
-    impl->skybox_white = e_up / kPi;
+    const double e_up = SkyRgbLuminance(e.cast<double>()) + impl->skybox.sun_horizontal_lux;
+    impl->skybox_white = e_up / std::numbers::pi;
   }
   impl_ = std::move(impl);
 }
@@ -412,10 +414,11 @@ double SkyModel::HorizontalIlluminancePerZenithLuminance(const Sky& sky) {
   // luminance Y (the Perez function of Y scaled to the zenith) times cos(theta) over the upper
   // hemisphere, midpoint rule.
   constexpr int kRows = 256, kCols = 512;
-  const double dphi = 2 * kPi / kCols;
+  const double dphi = 2 * std::numbers::pi / kCols;
   double e = 0;
   for (int r = 0; r < kRows; ++r) {
-    const double t0 = r * 0.5 * kPi / kRows, t1 = (r + 1) * 0.5 * kPi / kRows;
+    const double t0 = r * 0.5 * std::numbers::pi / kRows,
+                 t1 = (r + 1) * 0.5 * std::numbers::pi / kRows;
     const double theta = 0.5 * (t0 + t1);
     // integral of cos(theta) d omega over the cell.
     const double w = dphi * 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
@@ -434,7 +437,7 @@ float SkyModel::PhysicalZenithLuminance(const Sky& sky) {
   const double per_zenith = HorizontalIlluminancePerZenithLuminance(sky);
   const Eigen::Vector3d sun = sky.sun_direction_W.normalized();
   const float elevation_deg =
-      static_cast<float>(std::asin(std::clamp(sun.z(), -1.0, 1.0)) * 180.0 / kPi);
+      static_cast<float>(std::asin(std::clamp(sun.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi);
   const double diffuse = SkyDiffuseHorizontalIlluminance(elevation_deg, sky.turbidity);
   return per_zenith > 0 ? static_cast<float>(diffuse / per_zenith) : 0.0f;
 }
@@ -478,7 +481,7 @@ Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
   const Impl& m = *impl_;
-  constexpr float kPiF = static_cast<float>(kPi);
+  constexpr float kPiF = static_cast<float>(std::numbers::pi);
   float pdf_v = 0, pdf_u = 0;
   int row = 0, col = 0;
   const float v = m.marginal->Sample(u2, &pdf_v, &row);
@@ -491,7 +494,7 @@ Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
 
 float SkyModel::Pdf(const Eigen::Vector3f& dir_W) const {
   const Impl& m = *impl_;
-  constexpr float kPiF = static_cast<float>(kPi);
+  constexpr float kPiF = static_cast<float>(std::numbers::pi);
   // theta and sin(theta) from atan2 / hypot stay accurate near the poles.
   const float rho = std::hypot(dir_W.x(), dir_W.y());
   const float len = std::hypot(rho, dir_W.z());

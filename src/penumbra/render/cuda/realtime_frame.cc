@@ -15,7 +15,7 @@ namespace penumbra::cuda {
 namespace {
 
 Float3 ToFloat3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
-F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+F3 FrameToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 
 MaterialPod PodOf(const Material& m, const std::vector<int>& texture_slot) {
   MaterialPod p;
@@ -40,10 +40,10 @@ PinholeCamera PinholeCameraOf(const CameraView& view) {
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   const Camera::PinholeTerms t = camera.pinhole_terms();
   PinholeCamera c;
-  c.o = ToF3(t.o_W);
-  c.ex = ToF3(t.ex_W);
-  c.ey = ToF3(t.ey_W);
-  c.ez = ToF3(t.ez_W);
+  c.o = FrameToF3(t.o_W);
+  c.ex = FrameToF3(t.ex_W);
+  c.ey = FrameToF3(t.ey_W);
+  c.ez = FrameToF3(t.ez_W);
   c.cx = t.cx;
   c.cy = t.cy;
   c.inv_fx = t.inv_fx;
