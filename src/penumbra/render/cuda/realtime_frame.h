@@ -20,6 +20,7 @@
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
@@ -68,6 +69,12 @@ class RealtimeFrameData {
   /// parallel loop over pairs of rows (the same bits as the two calls). @throws as SkyTerms.
   void FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror, int64_t n,
                      Float3* sky, Float3* mirror_sky, ThreadPool* pool, int row0, int row1) const;
+
+  /// the sky model's and the sky volume's plain data (host arrays) for the device copies
+  /// (DeviceRealtime::UploadSky); current while sky_generation() is unchanged.
+  RealtimeSky SkyData() const;
+  /// changes whenever Prepare rebuilt or relit the sky volume.
+  uint64_t sky_generation() const { return volume_.generation(); }
 
   /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
   /// skip the layer's kernels and its part of the host's sky pass.
