@@ -70,9 +70,6 @@ constexpr int kMaxSkyBands = 16;
 /// radiance and depth; only the order of a row's log-luminance sum (rows_per_warp) could move
 /// the exposure's last bits.
 struct RealtimeKernelOptions {
-  /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
-  /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
-  bool device_sky = true;
   /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
   /// again).
   bool reuse_hit = true;
@@ -91,6 +88,9 @@ struct RealtimeKernelOptions {
   /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
   /// warps in flight, maybe spills). with reuse_hit only.
   int min_blocks = 0;
+  /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
+  /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
+  bool device_sky = true;
 };
 
 /// the time of Render()'s stages, milliseconds (benchmarks). geometry + sky + shade + film =

@@ -355,8 +355,7 @@ void DeviceRealtime::Upload(const RealtimeStatic& d) {
 void DeviceRealtime::UploadSky(const RealtimeSky& d) {
   Impl& m = *impl_;
   SkyModelPod sky = d.sky;
-  m.sky_irradiance.Upload(d.sky.irradiance, sizeof(float) * 3 * kSkyIrrSide * kSkyIrrSide,
-                          nullptr);
+  m.sky_irradiance.Upload(d.sky.irradiance, sizeof(float) * 3 * kSkyIrrSide * kSkyIrrSide, nullptr);
   sky.irradiance = m.sky_irradiance.as<float>();
   if (d.sky.skybox != nullptr) {
     const size_t w = static_cast<size_t>(d.sky.skybox_width);
@@ -522,7 +521,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
   }
   const int bands = o.device_sky ? 0 : o.pinned ? std::clamp(o.sky_bands, 1, kMaxSkyBands) : 1;
-  const int band_rows = bands == 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
+  const int band_rows = bands <= 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
   auto band_row = [&](int k) { return std::min(H, k * band_rows); };
   for (int k = 0; k < bands; ++k) {
     const int r0 = band_row(k), r1 = band_row(k + 1);
