@@ -2,13 +2,11 @@
 // the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
 // materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
-// key; the per-pixel sky terms from the primary rays' geometry (SkyModel::Radiance where a ray
-// escapes; where it hits, the occluded sky irradiance of the realtime tier's
-// SkyIrradianceVolume, or SkyModel::Irradiance without one: the CPU backend's own code, run on
-// the host); the sky terms of the mirror layer's reflected rays (MirrorSkyTerms: the occluded
-// sky irradiance at their hits, SkyIrradianceVolume::Irradiance at the shading normal as
-// render/cpu/mirror_layer.cc, or the sky's Background where they escape); and the film's
-// exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// key; the sky model and sky volume (SkyData, for DeviceRealtime::UploadSky) and, for the
+// host path, the per-pixel sky terms from the primary rays' geometry (QuadSkyTerms of
+// realtime_shading.h: the shared lookups of render/sky_eval_math.h, which the device's sky
+// kernel runs too) and those of the mirror layer's reflected rays (MirrorSkyTerms); and the
+// film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
 // path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
 // GPU). no CUDA runtime here: this file builds on machines without nvcc.
 

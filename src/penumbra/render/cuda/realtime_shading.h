@@ -16,12 +16,13 @@
 // the same negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total)
 // and shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal,
 // one probe blend per flat 2x2 quad as the CPU) and the sky radiance of rays that escape come
-// per pixel from the host (SkyModel and SkyIrradianceVolume's own code,
+// per pixel from QuadSkyTerms, the shared lookups of render/sky_eval_math.h that SkyModel and
+// SkyIrradianceVolume call on the CPU (a kernel of their own, or the host's
 // RealtimeFrameData::SkyTerms). the mirror layer (SurfaceMaterial::mirror, weight r: L becomes
 // (1 - r) L + r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray traced on the layer's
 // grid (render/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
-// light and a shadow ray and the occluded sky irradiance at the hit, which the host computes
-// with the primary sky terms (RealtimeFrameData::MirrorSkyTerms; ShadeMirrorHit), the other
+// light and a shadow ray and the occluded sky irradiance at the hit (MirrorSkyTerm, beside the
+// primary sky terms; ShadeMirrorHit), the other
 // layer pixels interpolated from the grid and blended (ApplyMirrorLayer). what the GPU path
 // does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
 // untextured), cube textures on geoms (untextured), MJCF skyboxes, and interpolated shading
@@ -145,8 +146,8 @@ struct RealtimeFrameView {
   float* area_fraction = nullptr;
   /// the mirror layer (any_mirror: some material has one), per pixel: the mirrored ray's
   /// geometry (hit -1 where the pixel traces none; TraceMirrorRay) and closest hit, its sky
-  /// term from the host (E_sky at the hit, or the sky's Background where it escapes;
-  /// RealtimeFrameData::MirrorSkyTerms) and the reflected radiance L_m (ShadeMirrorHit).
+  /// term (MirrorSkyTerm: E_sky at the hit, or the sky's Background where it escapes) and the
+  /// reflected radiance L_m (ShadeMirrorHit).
   int32_t any_mirror = 0;
   PixelGeometry* mirror_geometry = nullptr;
   TraceHit* mirror_hits = nullptr;
