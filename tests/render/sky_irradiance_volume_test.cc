@@ -466,6 +466,52 @@ TEST(SkyIrradianceVolumeTest, BlendThenEvaluateMatchesIrradiance) {
   EXPECT_GT(Lum(flat), 0.0);
 }
 
+TEST(SkyIrradianceVolumeTest, SharedScalarLookupIsBitIdenticalToTheCpus) {
+  // the GPU's one-corner-at-a-time lookup over pod() (render/sky_eval_math.h) against the CPU's
+  // 4-lane one, bit for bit, inside the grid (axis-aligned normals too: the CPU's packet
+  // shortcuts), in cells no probe lights and outside it; and the sky's shared functions against
+  // SkyModel's methods.
+  ForEachWindowRoomSky([](const SkyModel& sky, const SkyIrradianceVolume& vol, const RayScene&) {
+    const SkyVolumePod v = vol.pod();
+    const SkyModelPod& m = sky.pod();
+    Rng rng(HashKeys(6, 8));
+    int lit = 0;
+    SkyIrradianceVolume::ShBlend blend;
+    for (int i = 0; i < 4000; ++i) {
+      const Eigen::Vector3f p(8.0f * rng.Uniform() - 4.0f, 8.0f * rng.Uniform() - 4.0f,
+                              5.0f * rng.Uniform() - 1.0f);
+      Eigen::Vector3f n(2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1);
+      if (!(n.norm() > 0.1f)) continue;
+      n.normalize();
+      if (i % 4 == 0) n = Eigen::Vector3f::Unit(i / 4 % 3) * (i % 8 == 0 ? 1.0f : -1.0f);
+      Eigen::Vector3f e_gpu, eb_gpu, r_gpu, bg_gpu, sky_gpu;
+      SkyVolumeIrradiance(v, m, p.data(), n.data(), e_gpu.data());
+      const Eigen::Vector3f e = vol.Irradiance(p, n, sky);
+      ASSERT_EQ(0, std::memcmp(e.data(), e_gpu.data(), sizeof e)) << p.transpose();
+      float c[kSkyShStride];
+      bool open_sky;
+      SkyVolumeBlend(v, p.data(), n.data(), c, &open_sky);
+      vol.Blend(p, n, &blend);
+      ASSERT_EQ(open_sky, blend.open_sky);
+      ASSERT_EQ(0, std::memcmp(c, blend.c, sizeof c)) << p.transpose();
+      SkyVolumeIrradianceAt(m, c, open_sky, n.data(), eb_gpu.data());
+      const Eigen::Vector3f eb = vol.IrradianceAt(blend, n, sky);
+      ASSERT_EQ(0, std::memcmp(eb.data(), eb_gpu.data(), sizeof eb));
+      lit += !open_sky && e.maxCoeff() > 0;
+      SkyRadiance(m, n.x(), n.y(), n.z(), r_gpu.data());
+      const Eigen::Vector3f r = sky.Radiance(n);
+      ASSERT_EQ(0, std::memcmp(r.data(), r_gpu.data(), sizeof r));
+      SkyBackground(m, n.x(), n.y(), n.z(), bg_gpu.data());
+      const Eigen::Vector3f bg = sky.Background(n);
+      ASSERT_EQ(0, std::memcmp(bg.data(), bg_gpu.data(), sizeof bg));
+      SkyIrradiance(m, n.x(), n.y(), n.z(), sky_gpu.data());
+      const Eigen::Vector3f si = sky.Irradiance(n);
+      ASSERT_EQ(0, std::memcmp(si.data(), sky_gpu.data(), sizeof si));
+    }
+    EXPECT_GT(lit, 300);
+  });
+}
+
 TEST(SkyIrradianceVolumeTest, BitIdenticalForAnyThreadCount) {
   const SceneDescription s = RoomWithWindow(DaylightSky());
   const SkyModel sky(s.sky);

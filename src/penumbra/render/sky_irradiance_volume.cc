@@ -7,7 +7,6 @@
 #include <cstring>
 #include <limits>
 #include <memory>
-#include <numbers>
 #include <span>
 #include <string>
 #include <utility>
@@ -24,36 +23,19 @@
 namespace penumbra {
 namespace {
 
-constexpr int kNumSh = 9;  // real SH up to l = 2
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kNumSh = kSkyNumSh;
 constexpr int kShFloats = kNumSh * 3;
 // a probe's irradiance SH padded to 28 floats (7 4-lane packets): coefficient k (RGB) at floats
-// 3 kShSlot[k] .. 3 kShSlot[k] + 2. the order puts together the coefficients that do not
-// vanish for an axis-aligned normal (the basis at +-x is non-zero for k = 0, 3, 6, 8 only, at
-// +-z for 0, 2, 6, at +-y for 0, 1, 6, 8), so that a lookup on an axis-aligned face (most of
-// them indoors) accumulates 3 to 5 packets instead of 7.
-constexpr int kShStride = 28;
-constexpr int kShSlot[9] = {2, 5, 4, 0, 6, 7, 3, 8, 1};  // storage order 3 8 0 6 2 1 4 5 7
-
-// real spherical harmonics y_lm of a unit vector, l <= 2, in the order (0,0), (1,-1), (1,0),
-// (1,1), (2,-2), (2,-1), (2,0), (2,1), (2,2) (Ramamoorthi and Hanrahan 2001, eq. 3).
-template <typename T>
-inline void ShBasis(T x, T y, T z, T* out) {
-  out[0] = T(0.282094791773878);
-  out[1] = T(0.488602511902920) * y;
-  out[2] = T(0.488602511902920) * z;
-  out[3] = T(0.488602511902920) * x;
-  out[4] = T(1.092548430592079) * x * y;
-  out[5] = T(1.092548430592079) * y * z;
-  out[6] = T(0.315391565252520) * (T(3) * z * z - T(1));
-  out[7] = T(1.092548430592079) * x * z;
-  out[8] = T(0.546274215296040) * (x * x - y * y);
-}
+// 3 SkyShSlot(k) .. 3 SkyShSlot(k) + 2 (render/sky_eval_math.h). the order puts together the
+// coefficients that do not vanish for an axis-aligned normal (the basis at +-x is non-zero for
+// k = 0, 3, 6, 8 only, at +-z for 0, 2, 6, at +-y for 0, 1, 6, 8), so that a lookup on an
+// axis-aligned face (most of them indoors) accumulates 3 to 5 packets instead of 7.
+constexpr int kShStride = kSkyShStride;
 
 // clamped-cosine convolution weight of band l (Ramamoorthi and Hanrahan 2001, eq. 8-9).
-constexpr double kBandWeight[kNumSh] = {
-    std::numbers::pi,         2 * std::numbers::pi / 3, 2 * std::numbers::pi / 3,
-    2 * std::numbers::pi / 3, std::numbers::pi / 4,     std::numbers::pi / 4,
-    std::numbers::pi / 4,     std::numbers::pi / 4,     std::numbers::pi / 4};
+constexpr double kBandWeight[kNumSh] = {kPi,     2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4,
+                                        kPi / 4, kPi / 4,     kPi / 4,     kPi / 4};
 
 // octahedral map: (u, v) in [-1, 1]^2 to a direction of L1 norm 1 (not unit): the upper
 // hemisphere is the diamond |u| + |v| <= 1, the lower one folded into the corners.
@@ -190,12 +172,24 @@ inline F4 Max4(F4 a, F4 b) {
   return Select4(a > b, a, b);
 #endif
 }
-// std::clamp(static_cast<int>(t), 0, kOctSide - 1) per lane (clamping first in float gives the
-// same integers; NaN lanes give 0).
-inline I4 TexelIndex4(F4 t) {
-  constexpr float kMax = SkyIrradianceVolume::kOctSide - 1;
-  return __builtin_convertvector(Min4(Max4(t, Splat4(0.0f)), Splat4(kMax)), I4);
-}
+// the lane type of the CPU's lookup (4 corners at a time) for the per-lane functions of
+// render/sky_eval_math.h.
+struct F4Lanes {
+  using F = F4;
+  using I = I4;
+  using M = I4;
+  static constexpr int kWidth = 4;
+  static F Splat(float a) { return Splat4(a); }
+  static F Load(const float* p) { return Load4(p); }
+  static F Abs(F a) { return Abs4(a); }
+  static F CopySign(F mag, F sgn) { return CopySign4(mag, sgn); }
+  static F Select(M m, F a, F b) { return Select4(m, a, b); }
+  static F Min(F a, F b) { return Min4(a, b); }
+  static F Max(F a, F b) { return Max4(a, b); }
+  static F Sqrt(F a) { return Sqrt4(a); }
+  static I ToInt(F a) { return __builtin_convertvector(a, I4); }
+  static F ToFloat(I a) { return __builtin_convertvector(a, F4); }
+};
 
 // the lookup's weighted mean of the probes' irradiance SH at the basis values y, for the
 // active corners (bits of `active`, in increasing order, weight w[c], probe base + corner[c])
@@ -203,44 +197,24 @@ inline I4 TexelIndex4(F4 t) {
 // coefficient k with y[k] != 0; kK... are those k in increasing order. the terms with y[k] = 0
 // that this leaves out would add an exact 0 to each channel, so the sum is bit for bit the
 // full one.
-// the weighted sum of packets kLo .. kHi - 1 of the active corners' SH (bits of `active`, in
-// increasing order, weight w[c], probe base + corner[c]) into acc[0 .. kHi - kLo); returns the
-// sum of the weights.
-template <int kLo, int kHi>
-__attribute__((always_inline)) inline float AccumulateSh(const float* sh_base,
-                                                         const int32_t* corner, const float* w,
-                                                         unsigned active, F4* acc) {
-  for (int i = 0; i < kHi - kLo; ++i) acc[i] = Splat4(0.0f);
-  float wsum = 0;
-  for (unsigned bits = active; bits != 0; bits &= bits - 1) {
-    const int c = std::countr_zero(bits);
-    const float* sh = sh_base + corner[c] * kShStride;
-    const F4 wc = Splat4(w[c]);
-    for (int i = 0; i < kHi - kLo; ++i) acc[i] += wc * Load4(sh + 4 * (kLo + i));
-    wsum += w[c];
-  }
-  return wsum;
-}
-
 template <int kLo, int kHi, int... kK>
 __attribute__((always_inline)) inline Eigen::Vector3f WeightedSh(const float* sh_base,
                                                                  const int32_t* corner,
                                                                  const float* w, unsigned active,
                                                                  const float* y) {
   F4 acc[kHi - kLo];
-  const float wsum = AccumulateSh<kLo, kHi>(sh_base, corner, w, active, acc);
-  // packets kLo .. kHi - 1 of the sum at their place, zeros around them (one lane beyond a
-  // coefficient is read).
+  const float wsum = SkyAccumulateSh<F4Lanes, kLo, kHi>(sh_base, corner, w, active, acc);
+  // packets kLo .. kHi - 1 of the sum at their place, zeros around them.
   alignas(16) float a[kShStride + 4] = {};
   for (int i = 0; i < kHi - kLo; ++i) Store4(a + 4 * (kLo + i), acc[i]);
-  F4 sum = Splat4(0.0f);
-  ((sum += (y[kK] / wsum) * Load4(a + 3 * kShSlot[kK])), ...);
-  return {sum[0], sum[1], sum[2]};
+  Eigen::Vector3f e;
+  SkyShSumOver<kK...>(a, y, wsum, e.data());
+  return e;
 }
 
 // octahedral texel of a non-zero direction (SkyIrradianceVolume::TexelOf), inlined into lookups.
 inline int OctTexel(const Eigen::Vector3f& w) {
-  constexpr int kOctSide = SkyIrradianceVolume::kOctSide;
+  constexpr int kOctSide = kSkyOctSide;
   const float inv_l1 = 1.0f / (std::abs(w.x()) + std::abs(w.y()) + std::abs(w.z()));
   float u = w.x() * inv_l1, v = w.y() * inv_l1;
   if (w.z() < 0) {
@@ -280,6 +254,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
                 " body poses, scene has " + std::to_string(scene.bodies.size()) + " bodies");
   max_probes = std::clamp(max_probes, 8, 65536);
   built_ = true;
+  ++generation_;
   built_static_poses_ = X_WB;
   lit_sky_ = nullptr;
   dims_ = {0, 0, 0};
@@ -531,6 +506,7 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
 
 void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
   lit_sky_ = &sky;
+  ++generation_;
   if (empty()) return;
   // per sub-cell of each texel: the integral of sky radiance x y_lm over its solid angle (one
   // sample at its centre), times the band's convolution weight, so that a probe's irradiance SH
@@ -551,7 +527,7 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
       const Eigen::Vector3d w = x / len;
       const Eigen::Vector3d L = sky.Radiance(w.cast<float>()).cast<double>();
       double y[kNumSh];
-      ShBasis(w.x(), w.y(), w.z(), y);
+      SkyShBasis(w.x(), w.y(), w.z(), y);
       double* sub = &sub_sh[(static_cast<size_t>(t) * kSubRays + c) * kShFloats];
       for (int k = 0; k < kNumSh; ++k)
         for (int ch = 0; ch < 3; ++ch) sub[k * 3 + ch] = L[ch] * y[k] * dw * kBandWeight[k];
@@ -581,7 +557,7 @@ void SkyIrradianceVolume::Relight(const SkyModel& sky, ThreadPool* pool) {
       }
       float* out = &sh_[static_cast<size_t>(p) * kShStride];
       for (int k = 0; k < kNumSh; ++k)
-        for (int c = 0; c < 3; ++c) out[3 * kShSlot[k] + c] = static_cast<float>(acc[3 * k + c]);
+        for (int c = 0; c < 3; ++c) out[3 * SkyShSlot(k) + c] = static_cast<float>(acc[3 * k + c]);
     }
   };
   const int64_t chunks = (num + kChunk - 1) / kChunk;
@@ -621,13 +597,25 @@ void SkyIrradianceVolume::Update(const SceneDescription& scene, const WorldSnaps
 }
 
 Eigen::Vector3f SkyIrradianceVolume::ProbeIrradiance(int probe, const Eigen::Vector3f& n_W) const {
-  float y[kNumSh];
-  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
-  const float* c = &sh_[static_cast<size_t>(probe) * kShStride];
-  Eigen::Vector3f e = Eigen::Vector3f::Zero();
-  for (int k = 0; k < kNumSh; ++k)
-    e += y[k] * Eigen::Vector3f(c[3 * kShSlot[k]], c[3 * kShSlot[k] + 1], c[3 * kShSlot[k] + 2]);
+  Eigen::Vector3f e;
+  SkyProbeIrradiance(pod(), probe, n_W.x(), n_W.y(), n_W.z(), e.data());
   return e;
+}
+
+SkyVolumePod SkyIrradianceVolume::pod() const {
+  SkyVolumePod v;
+  for (int a = 0; a < 3; ++a) {
+    v.dims[a] = dims_[a];
+    v.origin[a] = origin_[a];
+  }
+  v.spacing = spacing_;
+  v.inv_spacing = inv_spacing_;
+  v.depth_scale = depth_scale_;
+  for (int c = 0; c < 8; ++c) v.corner_offset[c] = corner_offset_[c];
+  v.sh = sh_.data();
+  v.cell_pos = cell_pos_.data();
+  v.depth_q = depth_q_.data();
+  return v;
 }
 
 bool SkyIrradianceVolume::LookupWeights(const Eigen::Vector3f& p_W, const Eigen::Vector3f& n_W,
@@ -666,24 +654,14 @@ bool SkyIrradianceVolume::LookupWeights(const Eigen::Vector3f& p_W, const Eigen:
     const F4 dx = Load4(cell + 4 * h) - qx, dy = Load4(cell + 8 + 4 * h) - qy,
              dz = Load4(cell + 16 + 4 * h) - qz;
     // probes behind the surface's tangent plane at p never light it (invalid probes sit at
-    // NaN, which fails the test too).
-    const F4 d_n = dx * n_W.x() + (dy * n_W.y() + dz * n_W.z());
-    front |= MoveMask4(d_n + bias > 0.0f) << (4 * h);
-    r[h] = Sqrt4(dx * dx + (dy * dy + dz * dz));
-    d_n_r[h] = d_n / r[h];
+    // NaN, which fails the test too); the octahedral texel of -d.
+    I4 in_front, tex;
+    SkyCornerGeometry<F4Lanes>(dx, dy, dz, n_W.x(), n_W.y(), n_W.z(), bias, &in_front, &r[h],
+                               &d_n_r[h], &tex);
+    front |= MoveMask4(in_front) << (4 * h);
     tri[h] = wxy_tri * (h ? fz : 1 - fz);
-    // the octahedral texel of -d (OctTexel without branches; NaN lanes land in texel 0).
-    const F4 ux = -dx, uy = -dy, uz = -dz;
-    const F4 inv_l1 = 1.0f / (Abs4(ux) + Abs4(uy) + Abs4(uz));
-    F4 u = ux * inv_l1, v = uy * inv_l1;
-    const I4 lower = uz < 0.0f;
-    const F4 u_fold = CopySign4(1.0f - Abs4(v), ux), v_fold = CopySign4(1.0f - Abs4(u), uy);
-    u = Select4(lower, u_fold, u);
-    v = Select4(lower, v_fold, v);
-    const I4 ix = TexelIndex4((u + 1.0f) * (0.5f * kOctSide));
-    const I4 iy = TexelIndex4((v + 1.0f) * (0.5f * kOctSide));
     // offset of the texel in depth_q_ from the cell's first probe.
-    Store4(texel + 4 * h, (ix + kOctSide * iy) + kNumTexels * Load4(corner + 4 * h));
+    Store4(texel + 4 * h, tex + kNumTexels * Load4(corner + 4 * h));
   }
   out->active = 0;
   if (front == 0) return true;
@@ -701,11 +679,8 @@ bool SkyIrradianceVolume::LookupWeights(const Eigen::Vector3f& p_W, const Eigen:
   for (int h = 0; h < 2; ++h) {
     // the probe sees q if its ray towards q (nearest texel) goes at least r far; the weight
     // ramps down to 0 over tol beyond that. r <= 1e-6: q on the probe, trilinear weight only.
-    const F4 back = 0.5f * (1.0f + d_n_r[h]);
-    const F4 depth = depth_scale_ * __builtin_convertvector(Load4(depth_q + 4 * h), F4);
-    // std::clamp(x, 0, 1) = Min4(1, Max4(0, x)), lane by lane (x for x = -0 or NaN too).
-    const F4 vis = Min4(Splat4(1.0f), Max4(Splat4(0.0f), ((depth + tol) - r[h]) * inv_tol));
-    const F4 wh = Select4(r[h] > 1e-6f, tri[h] * (back * back * vis), tri[h]);
+    const F4 wh = SkyCornerWeight<F4Lanes>(r[h], d_n_r[h], tri[h], Load4(depth_q + 4 * h),
+                                           depth_scale_, tol, inv_tol);
     Store4(w + 4 * h, wh);
     active |= MoveMask4(wh > 0.0f) << (4 * h);
   }
@@ -726,7 +701,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
   const unsigned active = pw.active;
   Eigen::Vector3f e = Eigen::Vector3f::Zero();
   float y[kNumSh];
-  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
+  SkyShBasis(n_W.x(), n_W.y(), n_W.z(), y);
   if (active != 0) {
     // the weighted sum of the probes' irradiance SH, evaluated once at the end. on a face
     // whose normal is an axis (exact zeros in n), y[k] = 0 exactly for every k but 0, 3, 6, 8
@@ -749,16 +724,7 @@ Eigen::Vector3f SkyIrradianceVolume::Irradiance(const Eigen::Vector3f& p_W,
 
 int SkyIrradianceVolume::DarkestFrontCorner(const ProbeWeights& pw,
                                             const Eigen::Vector3f& n_W) const {
-  const int32_t* corner = corner_offset_.data();
-  float dark_lum = std::numeric_limits<float>::infinity();
-  int dark = -1;
-  for (unsigned bits = pw.front; bits != 0; bits &= bits - 1) {
-    const int c = std::countr_zero(bits);
-    const Eigen::Vector3f ej = ProbeIrradiance(pw.base + corner[c], n_W);
-    const float lum = 0.2126f * ej.x() + 0.7152f * ej.y() + 0.0722f * ej.z();
-    if (lum < dark_lum) dark_lum = lum, dark = c;
-  }
-  return dark;
+  return SkyDarkestFrontCorner(pod(), pw.base, pw.front, n_W.x(), n_W.y(), n_W.z());
 }
 
 void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3f& ng_W,
@@ -776,7 +742,8 @@ void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3
   if (pw.active != 0) {
     // the weighted mean of the probes' SH, all 7 packets.
     F4 acc[kShStride / 4];
-    const float wsum = AccumulateSh<0, kShStride / 4>(sh_base, corner, pw.w, pw.active, acc);
+    const float wsum =
+        SkyAccumulateSh<F4Lanes, 0, kShStride / 4>(sh_base, corner, pw.w, pw.active, acc);
     const F4 inv = Splat4(1.0f / wsum);
     for (int i = 0; i < kShStride / 4; ++i) Store4(out->c + 4 * i, acc[i] * inv);
     return;
@@ -788,19 +755,16 @@ void SkyIrradianceVolume::Blend(const Eigen::Vector3f& p_W, const Eigen::Vector3
 
 Eigen::Vector3f SkyIrradianceVolume::IrradianceAt(const ShBlend& blend, const Eigen::Vector3f& n_W,
                                                   const SkyModel& sky) const {
-  if (blend.open_sky) return sky.Irradiance(n_W);
-  float y[kNumSh];
-  ShBasis(n_W.x(), n_W.y(), n_W.z(), y);
-  F4 sum = Splat4(0.0f);
-  for (int k = 0; k < kNumSh; ++k) sum += y[k] * Load4(blend.c + 3 * kShSlot[k]);
-  return Eigen::Vector3f(sum[0], sum[1], sum[2]).cwiseMax(0.0f);
+  Eigen::Vector3f e;
+  SkyVolumeIrradianceAt(sky.pod(), blend.c, blend.open_sky, n_W.data(), e.data());
+  return e;
 }
 
 Eigen::Vector3f SkyIrradianceVolume::ProbeAmbient(int probe) const {
   // the irradiance SH's l = 0 coefficient is A0 L00 = pi L00; the mean radiance over the
   // sphere is L00 Y00.
-  const float* c = &sh_[static_cast<size_t>(probe) * kShStride + 3 * kShSlot[0]];
-  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / std::numbers::pi);
+  const float* c = &sh_[static_cast<size_t>(probe) * kShStride + 3 * SkyShSlot(0)];
+  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / kPi);
   return Eigen::Vector3f(c[0], c[1], c[2]) * kY00OverPi;
 }
 

@@ -69,6 +69,7 @@
 #include "penumbra/core/pose.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/ray_query.h"
+#include "penumbra/render/sky_eval_math.h"
 #include "penumbra/render/sky_model.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -78,8 +79,8 @@ namespace penumbra {
 /// occluded sky irradiance of the static scene on a probe grid (see the file comment).
 class SkyIrradianceVolume {
  public:
-  static constexpr int kOctSide =
-      16;  // a multiple of 4      ///< octahedral texels per side (256 texels)
+  /// octahedral texels per side (256 texels; a multiple of 4).
+  static constexpr int kOctSide = kSkyOctSide;
   static constexpr int kNumTexels = kOctSide * kOctSide;
   static constexpr int kRaysPerProbe = kNumTexels;  ///< first pass: one ray per texel (256)
   static constexpr int kSubSide = 4;  ///< sub-cells per texel side (refinement and lighting)
@@ -90,8 +91,8 @@ class SkyIrradianceVolume {
   static constexpr int kDefaultMaxProbes = 4096;  ///< default cap on the probe count
   static constexpr float kMaxBackfaceFraction = 0.25f;
   /// a probe's visibility weight falls from 1 to 0 over this many spacings beyond its depth.
-  static constexpr float kVisibilityTolerance = 0.1f;
-  static constexpr float kNormalBias = 0.25f;  ///< lookup offset along n, in spacings
+  static constexpr float kVisibilityTolerance = kSkyVisibilityTolerance;
+  static constexpr float kNormalBias = kSkyNormalBias;  ///< lookup offset along n, in spacings
   /// a relocated probe is put this far (in spacings) past the back face it left through.
   static constexpr float kRelocateMargin = 0.05f;
   static constexpr uint64_t kDirectionSeed = 0x5ca1ab1e5c1e5ULL;
@@ -198,6 +199,14 @@ class SkyIrradianceVolume {
   /// texels refined in the last Build, over all valid probes (for tests and tools).
   int64_t num_refined_texels() const { return num_refined_; }
 
+  /// the volume as plain data for the shared host/device lookup (render/sky_eval_math.h:
+  /// SkyVolumeBlend, SkyVolumeIrradianceAt and SkyVolumeIrradiance give Blend, IrradianceAt and
+  /// Irradiance; on the CPU bit for bit). its pointers stay valid until the next Build or
+  /// Relight (generation() changes).
+  SkyVolumePod pod() const;
+  /// counts the Builds and Relights: a copy of pod()'s arrays is current while it is unchanged.
+  uint64_t generation() const { return generation_; }
+
   /// the octahedral texel of unit direction w, in [0, kNumTexels).
   static int TexelOf(const Eigen::Vector3f& w);
 
@@ -239,6 +248,7 @@ class SkyIrradianceVolume {
   alignas(16) std::array<int32_t, 8> corner_offset_{};
   std::vector<Pose> built_static_poses_;  // X_WB of the last Build (static bodies only)
   bool built_ = false;
+  uint64_t generation_ = 0;
   const SkyModel* lit_sky_ = nullptr;
 };
 

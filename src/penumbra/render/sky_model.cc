@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/sky_eval_math.h"
 #include "penumbra/render/sky_math.h"
+#include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
 namespace {
@@ -26,10 +28,10 @@ constexpr int kQuadCols = 128;
 // Hoppe, "Spherical parametrization and remeshing", SIGGRAPH 2003; Cigolle et al., "A survey
 // of efficient representations for independent unit vectors", JCGT 2014), bilinear between
 // nodes: looking up a direction needs no trigonometry.
-constexpr int kIrrSide = 49;  // irradiance nodes per side (odd: the axes are nodes)
+constexpr int kIrrSide = kSkyIrrSide;
 
 // Rec. 709 / sRGB luminance weights (row Y of the RGB -> XYZ matrix, D65 white), IEC 61966-2-1.
-double SkyRgbLuminance(const Eigen::Vector3d& rgb) {
+double Luminance(const Eigen::Vector3d& rgb) {
   return 0.2126729 * rgb.x() + 0.7151522 * rgb.y() + 0.0721750 * rgb.z();
 }
 
@@ -101,30 +103,8 @@ class Distribution1D {
   double integral_ = 0;
 };
 
-// Perez et al. 1993 sky luminance distribution with the five coefficients of one quantity.
-struct Perez {
-  double a, b, c, d, e;
-  /// F(theta, gamma): theta from the zenith, gamma from the sun.
-  double operator()(double cos_theta, double gamma, double cos_gamma) const {
-    const double ct = std::max(cos_theta, 1e-4);
-    return (1 + a * std::exp(b / ct)) * (1 + c * std::exp(d * gamma) + e * cos_gamma * cos_gamma);
-  }
-};
-
-// octahedral map of a unit direction to [0, 1]^2 (continuous over the sphere).
-inline void OctEncode(const Eigen::Vector3f& d, float* s, float* t) {
-  const float inv = 1.0f / (std::abs(d.x()) + std::abs(d.y()) + std::abs(d.z()));
-  float x = d.x() * inv, y = d.y() * inv;
-  if (d.z() < 0) {
-    const float fx = (1 - std::abs(y)) * (x >= 0 ? 1.0f : -1.0f);
-    const float fy = (1 - std::abs(x)) * (y >= 0 ? 1.0f : -1.0f);
-    x = fx, y = fy;
-  }
-  *s = x * 0.5f + 0.5f;
-  *t = y * 0.5f + 0.5f;
-}
-
-// inverse of OctEncode: the unit direction of (s, t) in [0, 1]^2.
+// the unit direction of octahedral coordinates (s, t) in [0, 1]^2 (the inverse of
+// SkyIrradiance's encoding, render/sky_eval_math.h).
 Eigen::Vector3d OctDecode(double s, double t) {
   double x = 2 * s - 1, y = 2 * t - 1;
   const double z = 1 - std::abs(x) - std::abs(y);
@@ -136,31 +116,14 @@ Eigen::Vector3d OctDecode(double s, double t) {
   return Eigen::Vector3d(x, y, z).normalized();
 }
 
-// bilinear interpolation of a (side x side) node table at the octahedral coordinates of d.
-template <typename T>
-T OctLookup(const std::vector<T>& table, int side, const Eigen::Vector3f& d) {
-  float s, t;
-  OctEncode(d, &s, &t);
-  const float fs = s * (side - 1), ft = t * (side - 1);
-  const int c0 = std::clamp(static_cast<int>(fs), 0, side - 2);
-  const int r0 = std::clamp(static_cast<int>(ft), 0, side - 2);
-  const float a = std::clamp(ft - r0, 0.0f, 1.0f), b = std::clamp(fs - c0, 0.0f, 1.0f);
-  const T* row0 = table.data() + static_cast<size_t>(r0) * side + c0;
-  const T* row1 = row0 + side;
-  return (1 - a) * ((1 - b) * row0[0] + b * row0[1]) + a * ((1 - b) * row1[0] + b * row1[1]);
-}
-
 }  // namespace
 
 struct SkyModel::Impl {
   Sky::Type type = Sky::Type::kUniform;
-  Eigen::Vector3d uniform{0, 0, 0};
-  // daylight model state.
-  Eigen::Vector3d sun{0, 0, 1};
+  // the uniform radiance or the daylight model's state, the irradiance table and the skybox
+  // as the shared functions take them (render/sky_eval_math.h); its pointers into this Impl.
+  SkyModelPod pod;
   double theta_sun = 0;
-  Perez perez_y{}, perez_x{}, perez_yc{};
-  double y_scale = 0, x_scale = 0, yc_scale = 0;  // zenith value / F(0, theta_sun)
-  Eigen::Vector3d ground{0, 0, 0};
 
   // sampling: marginal over rows (theta), conditionals per row over phi.
   std::vector<Distribution1D> conditional;
@@ -168,11 +131,18 @@ struct SkyModel::Impl {
   // irradiance table (kIrrSide x kIrrSide octahedral nodes), per channel.
   std::vector<Eigen::Vector3f> irradiance;
 
-  Eigen::Vector3d Upper(const Eigen::Vector3d& d) const;
-  Eigen::Vector3d Eval(const Eigen::Vector3d& d) const {
-    if (type == Sky::Type::kUniform) return uniform;
-    return d.z() < 0 ? ground : Upper(d);
+  Eigen::Vector3d Upper(const Eigen::Vector3d& d) const {
+    Eigen::Vector3d out;
+    SkyUpperRadiance(pod, d.data(), out.data());
+    return out;
   }
+  Eigen::Vector3d Eval(const Eigen::Vector3d& d) const {
+    Eigen::Vector3d out;
+    SkyRadianceD(pod, d.data(), out.data());
+    return out;
+  }
+  Eigen::Vector3d ground() const { return {pod.ground[0], pod.ground[1], pod.ground[2]}; }
+  Eigen::Vector3d uniform() const { return {pod.uniform[0], pod.uniform[1], pod.uniform[2]}; }
   // MJCF skybox seen by camera and mirror rays (null: none), and the radiance of a white texel.
   SkyboxBackground skybox;
   double skybox_white = 0;
@@ -182,24 +152,6 @@ struct SkyModel::Impl {
   void BuildIrradiance();
 };
 
-// Preetham, Shirley, Smits 1999: Y, x, y each follow the Perez function normalised at the
-// zenith; xyY -> CIE XYZ -> linear sRGB (Rec. 709 primaries, D65 white, IEC 61966-2-1).
-Eigen::Vector3d SkyModel::Impl::Upper(const Eigen::Vector3d& d) const {
-  const double cos_theta = std::clamp(d.z(), 0.0, 1.0);
-  const double cos_gamma = std::clamp(d.dot(sun), -1.0, 1.0);
-  const double gamma = std::acos(cos_gamma);
-  const double lum = y_scale * perez_y(cos_theta, gamma, cos_gamma);
-  const double x = x_scale * perez_x(cos_theta, gamma, cos_gamma);
-  const double y = yc_scale * perez_yc(cos_theta, gamma, cos_gamma);
-  if (!(y > 1e-6) || !(lum > 0)) return {0, 0, 0};
-  const double cx = x / y * lum;
-  const double cz = (1 - x - y) / y * lum;
-  Eigen::Vector3d rgb(3.2404542 * cx - 1.5371385 * lum - 0.4985314 * cz,
-                      -0.9692660 * cx + 1.8760108 * lum + 0.0415560 * cz,
-                      0.0556434 * cx - 0.2040259 * lum + 1.0572252 * cz);
-  return rgb.cwiseMax(0.0);
-}
-
 void SkyModel::Impl::BuildSampling() {
   // luminance x sin(theta) at cell centres: pbrt's environment-map sampling (sec. 14.2.4).
   std::vector<double> lum(static_cast<size_t>(kSampleRows) * kSampleCols);
@@ -208,7 +160,7 @@ void SkyModel::Impl::BuildSampling() {
     const double theta = (r + 0.5) * std::numbers::pi / kSampleRows;
     for (int c = 0; c < kSampleCols; ++c) {
       const double phi = (c + 0.5) * 2 * std::numbers::pi / kSampleCols;
-      const double l = std::max(SkyRgbLuminance(Eval(DirectionFromAngles(theta, phi))), 0.0);
+      const double l = std::max(Luminance(Eval(DirectionFromAngles(theta, phi))), 0.0);
       lum[static_cast<size_t>(r) * kSampleCols + c] = l;
       max_lum = std::max(max_lum, l);
     }
@@ -255,7 +207,7 @@ void SkyModel::Impl::BuildIrradiance() {
       lb[i] = static_cast<float>(l.z());
     }
   }
-  const Eigen::Vector3d g = type == Sky::Type::kUniform ? uniform : ground;
+  const Eigen::Vector3d g = type == Sky::Type::kUniform ? uniform() : ground();
   irradiance.resize(static_cast<size_t>(kIrrSide) * kIrrSide);
   for (int r = 0; r < kIrrSide; ++r) {
     for (int c = 0; c < kIrrSide; ++c) {
@@ -301,16 +253,16 @@ void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
     sun.z() = 0;
     sun = sun.norm() > 1e-9 ? Eigen::Vector3d(sun.normalized()) : Eigen::Vector3d(1, 0, 0);
   }
-  this->sun = sun;
+  for (int k = 0; k < 3; ++k) pod.sun[k] = sun[k];
   const double ts = std::acos(std::clamp(sun.z(), 0.0, 1.0));
   this->theta_sun = ts;
   // Perez coefficients as linear functions of turbidity (Preetham et al. 1999, appendix A.2).
-  this->perez_y = {0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251,
-                   0.1206 * t - 2.5771, -0.0670 * t + 0.3703};
-  this->perez_x = {-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125,
-                   -0.0641 * t - 0.8989, -0.0033 * t + 0.0452};
-  this->perez_yc = {-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102,
-                    -0.0441 * t - 1.6537, -0.0109 * t + 0.0529};
+  pod.perez_y = {0.1787 * t - 1.4630, -0.3554 * t + 0.4275, -0.0227 * t + 5.3251,
+                 0.1206 * t - 2.5771, -0.0670 * t + 0.3703};
+  pod.perez_x = {-0.0193 * t - 0.2592, -0.0665 * t + 0.0008, -0.0004 * t + 0.2125,
+                 -0.0641 * t - 0.8989, -0.0033 * t + 0.0452};
+  pod.perez_yc = {-0.0167 * t - 0.2608, -0.0950 * t + 0.0092, -0.0079 * t + 0.2102,
+                  -0.0441 * t - 1.6537, -0.0109 * t + 0.0529};
   // zenith chromaticity (appendix A.2): [T^2 T 1] M [ts^3 ts^2 ts 1]^T.
   const double t_vec[3] = {t * t, t, 1};
   const double s_vec[4] = {ts * ts * ts, ts * ts, ts, 1};
@@ -330,9 +282,9 @@ void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
   // kcd/m^2, is replaced by the configured Sky::zenith_luminance (the overall scale of the
   // model's luminance is only a fit; its angular distribution is kept).
   const double cos_ts = std::cos(ts);
-  this->y_scale = sky.zenith_luminance / this->perez_y(1.0, ts, cos_ts);
-  this->x_scale = xz / this->perez_x(1.0, ts, cos_ts);
-  this->yc_scale = yz / this->perez_yc(1.0, ts, cos_ts);
+  pod.y_scale = sky.zenith_luminance / pod.perez_y(1.0, ts, cos_ts);
+  pod.x_scale = xz / pod.perez_x(1.0, ts, cos_ts);
+  pod.yc_scale = yz / pod.perez_yc(1.0, ts, cos_ts);
   // below the horizon: a Lambertian ground of albedo kGroundAlbedo lit by this sky alone
   // (the sun is a separate Light; its bounce is not included), radiance
   // G = albedo / pi * E_up, with E_up the sky irradiance on an upward-facing surface.
@@ -350,7 +302,9 @@ void SkyModel::Impl::SetUpDaylight(const Sky& sky) {
       for (int k = 0; k < 3; ++k) e_up[k] += l[k] * w;
     }
   }
-  this->ground = Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / std::numbers::pi);
+  const Eigen::Vector3d ground =
+      Eigen::Vector3d(e_up[0], e_up[1], e_up[2]) * (kGroundAlbedo / std::numbers::pi);
+  for (int k = 0; k < 3; ++k) pod.ground[k] = ground[k];
 }
 
 SkyboxBackground MjcfSkyboxOf(const SceneDescription& scene) {
@@ -377,11 +331,12 @@ SkyboxBackground MjcfSkyboxOf(const SceneDescription& scene) {
 SkyModel::SkyModel(const Sky& sky, SkyboxBackground skybox) {
   auto impl = std::make_shared<Impl>();
   impl->type = sky.type;
+  impl->pod.daylight = sky.type == Sky::Type::kUniform ? 0 : 1;
   if (sky.type == Sky::Type::kUniform) {
     if (!sky.radiance.allFinite() || sky.radiance.minCoeff() < 0)
       throw ConfigError("", 0, "sky.radiance",
                         "uniform sky radiance must be finite and >= 0 per channel");
-    impl->uniform = sky.radiance.cast<double>();
+    for (int k = 0; k < 3; ++k) impl->pod.uniform[k] = static_cast<double>(sky.radiance[k]);
   } else {
     impl->SetUpDaylight(sky);
   }
@@ -395,11 +350,18 @@ SkyModel::SkyModel(const Sky& sky, SkyboxBackground skybox) {
   impl->skybox = std::move(skybox);
   impl->BuildSampling();
   impl->BuildIrradiance();
+  impl->pod.irradiance = impl->irradiance.data()->data();
   if (impl->skybox.image != nullptr) {
     // a white Lambertian surface facing up under the sky and the sun.
-    const Eigen::Vector3f e = OctLookup(impl->irradiance, kIrrSide, Eigen::Vector3f(0, 0, 1));
-    const double e_up = SkyRgbLuminance(e.cast<double>()) + impl->skybox.sun_horizontal_lux;
+    Eigen::Vector3f e;
+    SkyIrradiance(impl->pod, 0.0f, 0.0f, 1.0f, e.data());
+    const double e_up = Luminance(e.cast<double>()) + impl->skybox.sun_horizontal_lux;
     impl->skybox_white = e_up / std::numbers::pi;
+    const TextureLevel& level = impl->skybox.image->level(0);
+    impl->pod.skybox = level.rgb_srgb.data();
+    impl->pod.skybox_width = level.width;
+    impl->pod.srgb_decode = SrgbDecodeTable();
+    impl->pod.skybox_white = impl->skybox_white;
   }
   impl_ = std::move(impl);
 }
@@ -410,7 +372,9 @@ double SkyModel::HorizontalIlluminancePerZenithLuminance(const Sky& sky) {
   unit.zenith_luminance = 1.0f;
   Impl m;
   m.type = Sky::Type::kDaylight;
+  m.pod.daylight = 1;
   m.SetUpDaylight(unit);
+  const Eigen::Vector3d sun(m.pod.sun[0], m.pod.sun[1], m.pod.sun[2]);
   // luminance Y (the Perez function of Y scaled to the zenith) times cos(theta) over the upper
   // hemisphere, midpoint rule.
   constexpr int kRows = 256, kCols = 512;
@@ -425,8 +389,9 @@ double SkyModel::HorizontalIlluminancePerZenithLuminance(const Sky& sky) {
     double row = 0;
     for (int c = 0; c < kCols; ++c) {
       const Eigen::Vector3d d = DirectionFromAngles(theta, (c + 0.5) * dphi);
-      const double cos_gamma = std::clamp(d.dot(m.sun), -1.0, 1.0);
-      row += m.y_scale * m.perez_y(std::clamp(d.z(), 0.0, 1.0), std::acos(cos_gamma), cos_gamma);
+      const double cos_gamma = std::clamp(d.dot(sun), -1.0, 1.0);
+      row += m.pod.y_scale *
+             m.pod.perez_y(std::clamp(d.z(), 0.0, 1.0), std::acos(cos_gamma), cos_gamma);
     }
     e += row * w;
   }
@@ -447,28 +412,9 @@ Eigen::Vector3f SkyModel::Radiance(const Eigen::Vector3f& dir_W) const {
 }
 
 Eigen::Vector3f SkyModel::Background(const Eigen::Vector3f& dir_W) const {
-  const Impl& m = *impl_;
-  if (m.skybox.image == nullptr) return Radiance(dir_W);
-  float qx, qy, qz, s, t;
-  int face = 0;
-  SkyboxLookupDirection(dir_W.x(), dir_W.y(), dir_W.z(), &qx, &qy, &qz);
-  if (!CubeFaceCoords(qx, qy, qz, &face, &s, &t)) return Eigen::Vector3f::Zero();
-  // bilinear between the texel centres of level 0, clamped to the face.
-  const TextureLevel& level = m.skybox.image->level(0);
-  const int w = level.width;
-  const float* decode = SrgbDecodeTable();
-  const float fx = std::clamp(s * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const float fy = std::clamp(t * w - 0.5f, 0.0f, static_cast<float>(w - 1));
-  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, w - 1);
-  const float ax = fx - x0, ay = fy - y0;
-  const auto texel = [&](int x, int y) {
-    const uint8_t* p = level.rgb_srgb.data() + 3 * ((static_cast<size_t>(face) * w + y) * w + x);
-    return Eigen::Vector3f(decode[p[0]], decode[p[1]], decode[p[2]]);
-  };
-  const Eigen::Vector3f c = (1 - ay) * ((1 - ax) * texel(x0, y0) + ax * texel(x1, y0)) +
-                            ay * ((1 - ax) * texel(x0, y1) + ax * texel(x1, y1));
-  return c * static_cast<float>(m.skybox_white);
+  Eigen::Vector3f out;
+  SkyBackground(impl_->pod, dir_W.x(), dir_W.y(), dir_W.z(), out.data());
+  return out;
 }
 
 const SkyboxBackground& SkyModel::skybox() const { return impl_->skybox; }
@@ -476,8 +422,12 @@ const SkyboxBackground& SkyModel::skybox() const { return impl_->skybox; }
 float SkyModel::skybox_white_luminance() const { return static_cast<float>(impl_->skybox_white); }
 
 Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
-  return OctLookup(impl_->irradiance, kIrrSide, n_W);
+  Eigen::Vector3f out;
+  SkyIrradiance(impl_->pod, n_W.x(), n_W.y(), n_W.z(), out.data());
+  return out;
 }
+
+const SkyModelPod& SkyModel::pod() const { return impl_->pod; }
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
   const Impl& m = *impl_;

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <memory>
 
+#include "penumbra/render/sky_eval_math.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -81,6 +82,12 @@ class SkyModel {
 
   /// solid-angle pdf of Sample() producing `dir_W`.
   float Pdf(const Eigen::Vector3f& dir_W) const;
+
+  /// this sky as plain data for the shared host/device functions (render/sky_eval_math.h:
+  /// SkyRadiance, SkyIrradiance, SkyBackground give Radiance, Irradiance and Background bit for
+  /// bit); its pointers (irradiance table, skybox texels) live as long as this SkyModel's state
+  /// (copies of a SkyModel share it).
+  const SkyModelPod& pod() const;
 
  private:
   struct Impl;

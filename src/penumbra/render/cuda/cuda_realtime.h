@@ -5,14 +5,16 @@
 // every function throws penumbra::Error naming the CUDA call when the runtime reports an error.
 //
 // a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth;
-// (2) the host turns the geometry into sky terms (`sky`: SkyModel and SkyIrradianceVolume run on
-// the CPU, realtime_frame.h) which are uploaded; with a mirror layer in the scene, (1) also
-// traces the mirrored rays (TraceMirrorRay), whose geometry makes the same round trip for its
-// sky terms. with pinned copies the round trip runs in bands of rows (4 by default,
-// RealtimeKernelOptions::sky_bands): band k's geometry comes
-// back while the host computes band k - 1's sky terms, and band k's shading kernel runs on the
-// GPU while the host computes band k + 1's; (3) the shading kernel (ShadeRealtimePixel, per
-// band), the shared visibility's kernels and
+// with a mirror layer in the scene it also traces the mirrored rays (TraceMirrorRay);
+// (2) a kernel turns the geometry into sky terms, one thread per 2x2 quad (QuadSkyTerms) and,
+// with a mirror layer, one per mirrored ray (MirrorSkyTerm): the shared lookups of
+// render/sky_eval_math.h over the device copies of the SkyModel's and SkyIrradianceVolume's
+// arrays (UploadSky), the functions the CPU backend calls. the sky terms can still be made on
+// the host instead (RealtimeKernelOptions::device_sky false, the benchmark's ablation: `sky`
+// runs the same functions on the CPU, realtime_frame.h, in bands of rows with pinned copies,
+// RealtimeKernelOptions::sky_bands: band k's geometry comes back while the host computes band
+// k - 1's sky terms, and band k's shading kernel runs while the host computes band k + 1's);
+// (3) the shading kernel (ShadeRealtimePixel), the shared visibility's kernels and
 // the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which the
 // host (`exposure`) turns into the frame's EV100 and exposures; (5) the film kernel (DevelopPixel).
 // every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
@@ -50,6 +52,16 @@ struct RealtimeStatic {
   const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries
 };
 
+/// the sky's and the sky volume's arrays (host pointers in the pods; realtime_frame.h's
+/// SkyData), copied by UploadSky: the irradiance table (kSkyIrrSide^2 x 3 floats), the skybox's
+/// level 0 (6 x skybox_width^2 x 3 bytes, if any), and per probe its SH (kSkyShStride floats),
+/// its cell's corner positions (24 floats) and its texels' depths (kSkyNumTexels bytes).
+struct RealtimeSky {
+  SkyModelPod sky;
+  SkyVolumePod volume;
+  int64_t num_probes = 0;
+};
+
 /// the most bands of rows RealtimeKernelOptions::sky_bands may ask for.
 constexpr int kMaxSkyBands = 16;
 
@@ -68,27 +80,37 @@ struct RealtimeKernelOptions {
   /// the row sums, and the outputs, which are then copied into the frame's images; the depth
   /// and radiance on a second stream, overlapped); else to and from pageable memory directly.
   bool pinned = true;
-  /// with pinned copies, Render()'s bands of rows (1 to kMaxSkyBands): band k's geometry goes
-  /// to the host, its sky terms come back and it is shaded while the host computes band
-  /// k + 1's (1: the whole frame at once). pageable copies: always 1.
+  /// with pinned copies and host sky terms (device_sky false), Render()'s bands of rows (1 to
+  /// kMaxSkyBands): band k's geometry goes to the host, its sky terms come back and it is shaded
+  /// while the host computes band k + 1's (1: the whole frame at once). pageable copies: always 1.
   int sky_bands = 4;
   /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
   /// warps in flight, maybe spills). with reuse_hit only.
   int min_blocks = 0;
+  /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
+  /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
+  bool device_sky = true;
 };
 
-/// the host clock's time of Render()'s stages, milliseconds (benchmarks).
-/// geometry + sky + shade + film = total.
+/// the time of Render()'s stages, milliseconds (benchmarks). geometry + sky + shade + film =
+/// total. with device_sky the first three are CUDA-event times on the GPU's stream (no
+/// synchronisation between them) and film is the rest of the host clock's total; else all are
+/// host clock times.
 struct RealtimeStageTimes {
-  /// upload of geoms and lights, geometry (and mirrored-ray) kernels, the first band's
-  /// geometry on the host
+  /// device_sky: the geoms' and lights' upload and the geometry (and mirrored-ray) kernels;
+  /// else those and the first band's geometry on the host
   double geometry = 0;
-  double sky = 0;  ///< the host's sky terms, all bands (RealtimeFrameData::SkyTerms)
-  /// the rest until the row sums are on the host: waiting for the other bands' geometry, sky
-  /// terms up, shading, shared-visibility, mirror-layer and row-sum kernels, row sums back
+  /// device_sky: the sky-term kernels; else the host's sky terms, all bands
+  /// (RealtimeFrameData::FrameSkyTerms)
+  double sky = 0;
+  /// device_sky: the shading, shared-visibility, mirror-layer and row-sum kernels and the row
+  /// sums' copy; else the rest until the row sums are on the host: waiting for the other
+  /// bands' geometry, sky terms up, those kernels, row sums back
   double shade = 0;
-  double film = 0;  ///< exposure, film kernel, the outputs copied to the frame's images
+  /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
+  /// host's launch and wait overheads)
+  double film = 0;
   double total = 0;
 };
 
@@ -102,6 +124,11 @@ class DeviceRealtime {
 
   /// copies the scene-constant data to the device.
   void Upload(const RealtimeStatic& data);
+
+  /// copies the sky's and the sky volume's arrays to the device (after Upload: the skybox is
+  /// decoded through its sRGB table); Render's device_sky path needs it once, and again
+  /// whenever they change (RealtimeFrameData::sky_generation).
+  void UploadSky(const RealtimeSky& data);
 
   /// host sky pass: the sky terms of the pixels of rows [row0, row1) from their primary
   /// geometry, and of their mirrored rays from theirs (mirror and mirror_sky null when the

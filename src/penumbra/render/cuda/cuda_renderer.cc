@@ -114,6 +114,13 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
     realtime_uploaded_ = true;
   }
   realtime_->Prepare(snapshot, view, pool_.get());
+  // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
+  // the sky change: its device copy follows
+  if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {
+    device_realtime_->UploadSky(realtime_->SkyData());
+    sky_generation_ = realtime_->sky_generation();
+    sky_uploaded_ = true;
+  }
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;

@@ -68,6 +68,9 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<DeviceRealtime> device_realtime_;
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
   bool realtime_uploaded_ = false;
+  // the sky volume generation whose arrays the device holds (RealtimeFrameData::sky_generation)
+  bool sky_uploaded_ = false;
+  uint64_t sky_generation_ = 0;
   int64_t gpu_frames_ = 0;
   int64_t cpu_frames_ = 0;
   bool told_cpu_ = false;

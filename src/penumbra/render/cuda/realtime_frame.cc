@@ -162,85 +162,26 @@ int RealtimeFrameData::CheckRows(const char* what, int64_t n, int row0, int row1
 
 void RealtimeFrameData::SkyQuadRow(const PixelGeometry* geometry, Float3* out, int q,
                                    int row1) const {
-  const int W = camera_.width;
-  const bool occluded = !volume_.empty();
-  // the probes' blend at the point and geometric normal, evaluated at the shading normal.
-  auto single = [&](int64_t i) {
-    const PixelGeometry& g = geometry[i];
-    const Eigen::Vector3f v(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
-    Eigen::Vector3f e;
-    if (g.hit == 0) {
-      e = sky_.Radiance(v);
-    } else {
-      const Eigen::Vector3f ng(g.ng.x, g.ng.y, g.ng.z), ns(g.ns.x, g.ns.y, g.ns.z);
-      if (occluded) {
-        SkyIrradianceVolume::ShBlend blend;
-        volume_.Blend(v, ng, &blend);
-        e = volume_.IrradianceAt(blend, ns, sky_);
-      } else {
-        e = sky_.Irradiance(ns);
-      }
-    }
-    out[i] = ToFloat3(e);
-  };
-  // as RealtimeIntegrator's TileSkyIrradiance: a 2x2 quad at even (u, v) (tiles start at
-  // multiples of 16) whose pixels see one flat face (one geom, bitwise equal geometric
-  // normals, points on one plane within 1 mm and within a quarter probe spacing of each other)
-  // shares one blend at the quad's mean point; other pixels blend on their own.
-  const float max_extent = occluded ? 0.25f * volume_.spacing() : 0.0f;
-  constexpr float kPlaneTolM = 1e-3f;
-  auto shared = [&](const int64_t* quad) {
-    const PixelGeometry& g0 = geometry[quad[0]];
-    for (int c = 0; c < 4; ++c) {
-      const PixelGeometry& g = geometry[quad[c]];
-      if (!(g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
-            g.ng.z == g0.ng.z))
-        return false;
-    }
-    const Eigen::Vector3f n0(g0.ng.x, g0.ng.y, g0.ng.z);
-    const Eigen::Vector3f p0(g0.p_or_d.x, g0.p_or_d.y, g0.p_or_d.z);
-    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-    for (int c = 0; c < 4; ++c) {
-      const PixelGeometry& g = geometry[quad[c]];
-      const Eigen::Vector3f p(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
-      const Eigen::Vector3f dp = p - p0;
-      if (!(std::abs(n0.dot(dp)) <= kPlaneTolM && dp.cwiseAbs().maxCoeff() <= max_extent))
-        return false;
-      mean += 0.25f * p;
-    }
-    SkyIrradianceVolume::ShBlend blend;
-    volume_.Blend(mean, n0, &blend);
-    for (int c = 0; c < 4; ++c) {
-      const PixelGeometry& g = geometry[quad[c]];
-      out[quad[c]] =
-          ToFloat3(volume_.IrradianceAt(blend, Eigen::Vector3f(g.ns.x, g.ns.y, g.ns.z), sky_));
-    }
-    return true;
-  };
-  const int v0 = 2 * q;
-  for (int u0 = 0; u0 < W; u0 += 2) {
-    const int64_t i00 = static_cast<int64_t>(v0) * W + u0;
-    const int64_t quad[4] = {i00, i00 + 1, i00 + W, i00 + W + 1};
-    if (occluded && u0 + 1 < W && v0 + 1 < row1 && shared(quad)) continue;
-    for (int c = 0; c < 4; ++c)
-      if (u0 + (c & 1) < W && v0 + (c >> 1) < row1) single(quad[c]);
-  }
+  const SkyModelPod& sky = sky_.pod();
+  const SkyVolumePod volume = volume_.pod();
+  for (int u0 = 0; u0 < camera_.width; u0 += 2)
+    QuadSkyTerms(sky, volume, geometry, camera_.width, row1, u0, 2 * q, out);
 }
 
 void RealtimeFrameData::MirrorSkyRow(const PixelGeometry* mirror, Float3* out, int v) const {
+  const SkyModelPod& sky = sky_.pod();
+  const SkyVolumePod volume = volume_.pod();
   const int W = camera_.width;
-  const bool occluded = !volume_.empty();
-  for (int64_t i = static_cast<int64_t>(v) * W; i < static_cast<int64_t>(v + 1) * W; ++i) {
-    const PixelGeometry& g = mirror[i];
-    if (g.hit < 0) continue;
-    const Eigen::Vector3f x(g.p_or_d.x, g.p_or_d.y, g.p_or_d.z);
-    if (g.hit == 0) {
-      out[i] = ToFloat3(sky_.Background(x));
-      continue;
-    }
-    const Eigen::Vector3f ns(g.ns.x, g.ns.y, g.ns.z);
-    out[i] = ToFloat3(occluded ? volume_.Irradiance(x, ns, sky_) : sky_.Irradiance(ns));
-  }
+  for (int64_t i = static_cast<int64_t>(v) * W; i < static_cast<int64_t>(v + 1) * W; ++i)
+    MirrorSkyTerm(sky, volume, mirror[i], &out[i]);
+}
+
+RealtimeSky RealtimeFrameData::SkyData() const {
+  RealtimeSky d;
+  d.sky = sky_.pod();
+  d.volume = volume_.pod();
+  d.num_probes = volume_.num_probes();
+  return d;
 }
 
 void RealtimeFrameData::SkyTerms(const PixelGeometry* geometry, int64_t n, Float3* out,
@@ -286,6 +227,8 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.max_anisotropy = settings_.max_anisotropy < 1 ? 1 : settings_.max_anisotropy;
   f.frame_key = frame_key_;
   f.sky_term = sky;
+  f.sky = sky_.pod();
+  f.volume = volume_.pod();
   f.any_mirror = any_mirror_ ? 1 : 0;
   return f;
 }

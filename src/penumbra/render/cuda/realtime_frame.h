@@ -2,13 +2,11 @@
 // the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
 // materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
-// key; the per-pixel sky terms from the primary rays' geometry (SkyModel::Radiance where a ray
-// escapes; where it hits, the occluded sky irradiance of the realtime tier's
-// SkyIrradianceVolume, or SkyModel::Irradiance without one: the CPU backend's own code, run on
-// the host); the sky terms of the mirror layer's reflected rays (MirrorSkyTerms: the occluded
-// sky irradiance at their hits, SkyIrradianceVolume::Irradiance at the shading normal as
-// render/cpu/mirror_layer.cc, or the sky's Background where they escape); and the film's
-// exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// key; the sky model and sky volume (SkyData, for DeviceRealtime::UploadSky) and, for the
+// host path, the per-pixel sky terms from the primary rays' geometry (QuadSkyTerms of
+// realtime_shading.h: the shared lookups of render/sky_eval_math.h, which the device's sky
+// kernel runs too) and those of the mirror layer's reflected rays (MirrorSkyTerms); and the
+// film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
 // path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
 // GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
@@ -20,6 +18,7 @@
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
@@ -68,6 +67,12 @@ class RealtimeFrameData {
   /// parallel loop over pairs of rows (the same bits as the two calls). @throws as SkyTerms.
   void FrameSkyTerms(const PixelGeometry* geometry, const PixelGeometry* mirror, int64_t n,
                      Float3* sky, Float3* mirror_sky, ThreadPool* pool, int row0, int row1) const;
+
+  /// the sky model's and the sky volume's plain data (host arrays) for the device copies
+  /// (DeviceRealtime::UploadSky); current while sky_generation() is unchanged.
+  RealtimeSky SkyData() const;
+  /// changes whenever Prepare rebuilt or relit the sky volume.
+  uint64_t sky_generation() const { return volume_.generation(); }
 
   /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
   /// skip the layer's kernels and its part of the host's sky pass.

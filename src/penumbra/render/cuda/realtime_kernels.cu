@@ -54,6 +54,24 @@ __global__ void MirrorBlendKernel(RealtimeFrameView f, Float3* radiance) {
   radiance[i] = ApplyMirrorLayer(f, u, v, radiance[i]);
 }
 
+// the sky terms (realtime_shading.h): one thread per 2x2 quad of primary geometry (the quads
+// that share one probe blend), and one per mirrored ray.
+__global__ void SkyQuadKernel(RealtimeFrameView f, Float3* sky) {
+  const int qu = blockIdx.x * blockDim.x + threadIdx.x;
+  const int qv = blockIdx.y * blockDim.y + threadIdx.y;
+  const int W = f.camera.width, H = f.camera.height;
+  if (2 * qu >= W || 2 * qv >= H) return;
+  QuadSkyTerms(f.sky, f.volume, f.geometry, W, H, 2 * qu, 2 * qv, sky);
+}
+
+__global__ void MirrorSkyKernel(RealtimeFrameView f, Float3* mirror_sky) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  MirrorSkyTerm(f.sky, f.volume, f.mirror_geometry[i], &mirror_sky[i]);
+}
+
 // kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
 // threads each SM must hold (__launch_bounds__: at most 65536 / (128 kMinBlocks) registers).
 // rows [row0, row1) of the frame (Render shades the image band by band as the bands' sky terms
@@ -203,6 +221,13 @@ struct DeviceRealtime::Impl {
   Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   // the mirror layer's buffers (RealtimeFrameView)
   Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
+  // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
+  Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
+  SkyModelPod device_sky;
+  SkyVolumePod device_volume;
+  bool sky_uploaded = false;
+  // the device_sky path's stage times (CUDA events with timing)
+  cudaEvent_t stage[4] = {};
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
@@ -233,6 +258,17 @@ struct DeviceRealtime::Impl {
     if (f.any_mirror != 0) {
       MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(f);
       Check(cudaGetLastError(), "MirrorTraceKernel");
+    }
+  }
+  // the sky terms of frame f (its geometry and mirrored rays traced) on `stream`.
+  void LaunchSky(const RealtimeFrameView& f, cudaStream_t stream) {
+    const int W = f.camera.width, H = f.camera.height;
+    SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
+        f, sky.as<Float3>());
+    Check(cudaGetLastError(), "SkyQuadKernel");
+    if (f.any_mirror != 0) {
+      MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(f, mirror_sky.as<Float3>());
+      Check(cudaGetLastError(), "MirrorSkyKernel");
     }
   }
   // the shading kernel of rows [row0, row1) of frame f on `stream` as `o` says.
@@ -294,6 +330,8 @@ struct DeviceRealtime::Impl {
     if (radiance_done) cudaEventDestroy(radiance_done);
     for (cudaEvent_t e : band_done)
       if (e) cudaEventDestroy(e);
+    for (cudaEvent_t e : stage)
+      if (e) cudaEventDestroy(e);
   }
 };
 
@@ -314,6 +352,35 @@ void DeviceRealtime::Upload(const RealtimeStatic& d) {
   Check(cudaDeviceSynchronize(), "uploading the realtime scene");
 }
 
+void DeviceRealtime::UploadSky(const RealtimeSky& d) {
+  Impl& m = *impl_;
+  SkyModelPod sky = d.sky;
+  m.sky_irradiance.Upload(d.sky.irradiance, sizeof(float) * 3 * kSkyIrrSide * kSkyIrrSide, nullptr);
+  sky.irradiance = m.sky_irradiance.as<float>();
+  if (d.sky.skybox != nullptr) {
+    const size_t w = static_cast<size_t>(d.sky.skybox_width);
+    m.skybox.Upload(d.sky.skybox, 6 * w * w * 3, nullptr);
+    sky.skybox = m.skybox.as<uint8_t>();
+    sky.srgb_decode = m.decode.as<float>();
+  }
+  SkyVolumePod v = d.volume;
+  if (!v.empty() && d.num_probes > 0) {
+    const size_t n = static_cast<size_t>(d.num_probes);
+    m.volume_sh.Upload(d.volume.sh, sizeof(float) * kSkyShStride * n, nullptr);
+    m.volume_cells.Upload(d.volume.cell_pos, sizeof(float) * 24 * n, nullptr);
+    m.volume_depth.Upload(d.volume.depth_q, static_cast<size_t>(kSkyNumTexels) * n, nullptr);
+    v.sh = m.volume_sh.as<float>();
+    v.cell_pos = m.volume_cells.as<float>();
+    v.depth_q = m.volume_depth.as<uint8_t>();
+  } else {
+    v = SkyVolumePod();
+  }
+  Check(cudaDeviceSynchronize(), "uploading the realtime sky");
+  m.device_sky = sky;
+  m.device_volume = v;
+  m.sky_uploaded = true;
+}
+
 double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_frame,
                               int64_t num_geoms, bool filmic, const SkyFn& sky,
                               const ExposureFn& exposure, const RealtimeOutputs& out) {
@@ -327,7 +394,11 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.stage) Check(cudaEventCreate(&e), "cudaEventCreate");
   }
+  if (o.device_sky && !m.sky_uploaded)
+    throw Error("DeviceRealtime::Render: device sky terms without UploadSky");
+  if (o.device_sky) Check(cudaEventRecord(m.stage[0], stream), "cudaEventRecord");
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -379,6 +450,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.geoms = m.geoms.as<GeomPod>();
   f.lights = m.lights.as<LightPod>();
   f.sky_term = m.sky.as<Float3>();
+  if (m.sky_uploaded) {
+    f.sky = m.device_sky;
+    f.volume = m.device_volume;
+  }
   f.geometry = m.geometry.as<PixelGeometry>();
   f.window = m.window.as<uint32_t>();
   f.total = m.total.as<float>();
@@ -430,17 +505,23 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       host_mirror_sky = m.host_mirror_sky.data();
     }
   }
-  // (1) primary geometry (materials and normal maps included) and depth, then the geometry
-  // back to the host in bands of rows (even row counts: the sky terms' 2x2 quads stay in one
-  // band); pinned: the bands and the depth go back on the copy stream
+  // (1) primary geometry (materials and normal maps included) and depth; device_sky: (2) the
+  // sky-term kernels; else the geometry back to the host in bands of rows (even row counts:
+  // the sky terms' 2x2 quads stay in one band); pinned: the bands and the depth go back on the
+  // copy stream
   m.LaunchGeometry(f, o, stream);
+  if (o.device_sky) {
+    Check(cudaEventRecord(m.stage[1], stream), "cudaEventRecord");
+    m.LaunchSky(f, stream);
+    Check(cudaEventRecord(m.stage[2], stream), "cudaEventRecord");
+  }
   cudaStream_t down = o.pinned ? m.copy_stream : stream;
   if (o.pinned) {
     Check(cudaEventRecord(m.geometry_done, stream), "cudaEventRecord");
     Check(cudaStreamWaitEvent(m.copy_stream, m.geometry_done, 0), "cudaStreamWaitEvent");
   }
-  const int bands = o.pinned ? std::clamp(o.sky_bands, 1, kMaxSkyBands) : 1;
-  const int band_rows = bands == 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
+  const int bands = o.device_sky ? 0 : o.pinned ? std::clamp(o.sky_bands, 1, kMaxSkyBands) : 1;
+  const int band_rows = bands <= 1 ? H : ((H + bands - 1) / bands + 1) / 2 * 2;
   auto band_row = [&](int k) { return std::min(H, k * band_rows); };
   for (int k = 0; k < bands; ++k) {
     const int r0 = band_row(k), r1 = band_row(k + 1);
@@ -485,6 +566,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
             "cudaMemcpyAsync");
     m.LaunchShade(f, o, stream, r0, r1);
   }
+  if (o.device_sky) m.LaunchShade(f, o, stream, 0, H);
   // the shared visibility, the mirror layer and (4) the rows' log-luminance sums; pinned: the
   // radiance goes back on the copy stream while the host computes the exposure and the film
   // kernel runs
@@ -495,6 +577,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
   }
   m.rows.Download(host_rows, sizeof(double) * H, stream);
+  if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
   const auto t3 = Clock::now();
   if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
@@ -516,11 +599,21 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
   }
-  m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
-  m.times.sky = sky_ms;
-  m.times.shade = std::chrono::duration<double, std::milli>(t3 - t1).count() - sky_ms;
-  m.times.film = MsSince(t3);
   m.times.total = MsSince(t0);
+  if (o.device_sky) {
+    float ms[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      Check(cudaEventElapsedTime(&ms[k], m.stage[k], m.stage[k + 1]), "cudaEventElapsedTime");
+    m.times.geometry = ms[0];
+    m.times.sky = ms[1];
+    m.times.shade = ms[2];
+    m.times.film = m.times.total - (m.times.geometry + m.times.sky + m.times.shade);
+  } else {
+    m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    m.times.sky = sky_ms;
+    m.times.shade = std::chrono::duration<double, std::milli>(t3 - t1).count() - sky_ms;
+    m.times.film = m.times.total - (m.times.geometry + m.times.sky + m.times.shade);
+  }
   m.frame = f;
   m.exposure = e;
   m.filmic = filmic ? 1 : 0;
@@ -542,6 +635,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   if (options.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
   // one untimed run (first launch of a kernel variant)
   m.LaunchGeometry(f, options, stream);
+  if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
   m.LaunchShading(f, options, stream);
   m.LaunchFilm(n, m.exposure, m.filmic, stream);
   Check(cudaStreamSynchronize(stream), "realtime kernels");
@@ -551,6 +645,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   Check(cudaEventRecord(start, stream), "cudaEventRecord");
   for (int k = 0; k < count; ++k) {
     m.LaunchGeometry(f, options, stream);
+    if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
     m.LaunchShading(f, options, stream);
     m.LaunchFilm(n, m.exposure, m.filmic, stream);
   }

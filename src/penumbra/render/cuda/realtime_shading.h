@@ -16,12 +16,13 @@
 // the same negligible-light rule (no shadow ray below kNegligibleLight of the unshadowed total)
 // and shadow rays from OffsetRayOrigin. E_sky (occluded sky irradiance on the surface normal,
 // one probe blend per flat 2x2 quad as the CPU) and the sky radiance of rays that escape come
-// per pixel from the host (SkyModel and SkyIrradianceVolume's own code,
+// per pixel from QuadSkyTerms, the shared lookups of render/sky_eval_math.h that SkyModel and
+// SkyIrradianceVolume call on the CPU (a kernel of their own, or the host's
 // RealtimeFrameData::SkyTerms). the mirror layer (SurfaceMaterial::mirror, weight r: L becomes
 // (1 - r) L + r L_m) as render/cpu/mirror_layer.cc: the mirrored view ray traced on the layer's
 // grid (render/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
-// light and a shadow ray and the occluded sky irradiance at the hit, which the host computes
-// with the primary sky terms (RealtimeFrameData::MirrorSkyTerms; ShadeMirrorHit), the other
+// light and a shadow ray and the occluded sky irradiance at the hit (MirrorSkyTerm, beside the
+// primary sky terms; ShadeMirrorHit), the other
 // layer pixels interpolated from the grid and blended (ApplyMirrorLayer). what the GPU path
 // does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
 // untextured), cube textures on geoms (untextured), MJCF skyboxes, and interpolated shading
@@ -40,6 +41,7 @@
 #include "penumbra/render/mirror_math.h"
 #include "penumbra/render/shading_math.h"
 #include "penumbra/render/shadow_window_math.h"
+#include "penumbra/render/sky_eval_math.h"
 #include "penumbra/render/texture_math.h"
 
 namespace penumbra::cuda {
@@ -118,8 +120,12 @@ struct RealtimeFrameView {
   int32_t max_anisotropy = 1;
   uint64_t frame_key = 0;  ///< FrameContext::FrameKey()
   /// per pixel: E_sky on the surface the pixel's ray hits, or the sky radiance where it
-  /// escapes (RealtimeSkyTerms).
+  /// escapes (QuadSkyTerms).
   const Float3* sky_term = nullptr;
+  /// the sky and the occluded sky volume (render/sky_eval_math.h) whose lookups make the sky
+  /// terms (QuadSkyTerms, MirrorSkyTerm): device copies in the kernels, host arrays on the host.
+  SkyModelPod sky;
+  SkyVolumePod volume;
   /// the shared visibility of lights with an extent (render/shadow_window_math.h), per pixel i
   /// of the n = width x height image: its primary geometry (PrimaryGeometry) and its 5x5
   /// window's same-surface mask (SharedVisibilityRays), the luminance of its radiance with
@@ -140,8 +146,8 @@ struct RealtimeFrameView {
   float* area_fraction = nullptr;
   /// the mirror layer (any_mirror: some material has one), per pixel: the mirrored ray's
   /// geometry (hit -1 where the pixel traces none; TraceMirrorRay) and closest hit, its sky
-  /// term from the host (E_sky at the hit, or the sky's Background where it escapes;
-  /// RealtimeFrameData::MirrorSkyTerms) and the reflected radiance L_m (ShadeMirrorHit).
+  /// term (MirrorSkyTerm: E_sky at the hit, or the sky's Background where it escapes) and the
+  /// reflected radiance L_m (ShadeMirrorHit).
   int32_t any_mirror = 0;
   PixelGeometry* mirror_geometry = nullptr;
   TraceHit* mirror_hits = nullptr;
@@ -436,7 +442,103 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
   return sp;
 }
 
-/// the geometry of pixel (u, v)'s primary ray for the host's sky pass; *t_hit: its hit's t
+/// the sky term of one pixel from its primary geometry g: SkyRadiance where the ray escapes;
+/// where it hits, the occluded sky irradiance (the volume's blend at the point and geometric
+/// normal, evaluated at the shading normal; SkyIrradiance of the shading normal outside the
+/// grid or with an empty volume).
+PB_HOST_DEVICE inline Float3 PixelSkyTerm(const SkyModelPod& sky, const SkyVolumePod& volume,
+                                          const PixelGeometry& g) {
+  float e[3];
+  if (g.hit == 0) {
+    SkyRadiance(sky, g.p_or_d.x, g.p_or_d.y, g.p_or_d.z, e);
+  } else {
+    const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
+    if (!volume.empty()) {
+      const float p[3] = {g.p_or_d.x, g.p_or_d.y, g.p_or_d.z}, ng[3] = {g.ng.x, g.ng.y, g.ng.z};
+      float c[kSkyShStride];
+      bool open_sky;
+      SkyVolumeBlend(volume, p, ng, c, &open_sky);
+      SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
+    } else {
+      SkyIrradiance(sky, ns[0], ns[1], ns[2], e);
+    }
+  }
+  return Float3{e[0], e[1], e[2]};
+}
+
+/// the sky terms (RealtimeFrameView::sky_term) of the 2x2 quad at even (u0, v0) of a
+/// width-pixel image (pixels at or below row1 and right of the image left out), as
+/// RealtimeIntegrator's TileSkyIrradiance: with a sky volume, a quad whose pixels see one flat
+/// face (one geom, bitwise equal geometric normals, points on one plane within 1 mm and within
+/// a quarter probe spacing of each other) shares one blend at the quad's mean point; other
+/// pixels take PixelSkyTerm.
+PB_HOST_DEVICE inline void QuadSkyTerms(const SkyModelPod& sky, const SkyVolumePod& volume,
+                                        const PixelGeometry* geometry, int width, int row1, int u0,
+                                        int v0, Float3* out) {
+  const int64_t i00 = static_cast<int64_t>(v0) * width + u0;
+  const int64_t quad[4] = {i00, i00 + 1, i00 + width, i00 + width + 1};
+  const bool occluded = !volume.empty();
+  bool shared = occluded && u0 + 1 < width && v0 + 1 < row1;
+  if (shared) {
+    const PixelGeometry& g0 = geometry[quad[0]];
+    for (int c = 0; c < 4 && shared; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      shared = g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
+               g.ng.z == g0.ng.z;
+    }
+    const float max_extent = 0.25f * volume.spacing;
+    constexpr float kPlaneTolM = 1e-3f;
+    float mean[3] = {0, 0, 0};
+    for (int c = 0; c < 4 && shared; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      const float dp[3] = {g.p_or_d.x - g0.p_or_d.x, g.p_or_d.y - g0.p_or_d.y,
+                           g.p_or_d.z - g0.p_or_d.z};
+      const float n_dp = g0.ng.x * dp[0] + (g0.ng.y * dp[1] + g0.ng.z * dp[2]);
+      shared = fabsf(n_dp) <= kPlaneTolM && fabsf(dp[0]) <= max_extent &&
+               fabsf(dp[1]) <= max_extent && fabsf(dp[2]) <= max_extent;
+      mean[0] += 0.25f * g.p_or_d.x;
+      mean[1] += 0.25f * g.p_or_d.y;
+      mean[2] += 0.25f * g.p_or_d.z;
+    }
+    if (shared) {
+      const float n0[3] = {g0.ng.x, g0.ng.y, g0.ng.z};
+      float c[kSkyShStride];
+      bool open_sky;
+      SkyVolumeBlend(volume, mean, n0, c, &open_sky);
+      for (int k = 0; k < 4; ++k) {
+        const PixelGeometry& g = geometry[quad[k]];
+        const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
+        float e[3];
+        SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
+        out[quad[k]] = Float3{e[0], e[1], e[2]};
+      }
+      return;
+    }
+  }
+  for (int c = 0; c < 4; ++c)
+    if (u0 + (c & 1) < width && v0 + (c >> 1) < row1)
+      out[quad[c]] = PixelSkyTerm(sky, volume, geometry[quad[c]]);
+}
+
+/// the sky term of a mirrored ray (RealtimeFrameView::mirror_sky) from its geometry g
+/// (TraceMirrorRay): where it hits, the occluded sky irradiance at the hit's shading normal
+/// (SkyVolumeIrradiance, no shared blends: render/cpu/mirror_layer.cc's MirrorRadiance), where
+/// it escapes SkyBackground; false (out unchanged) where the pixel traced none (hit -1).
+PB_HOST_DEVICE inline bool MirrorSkyTerm(const SkyModelPod& sky, const SkyVolumePod& volume,
+                                         const PixelGeometry& g, Float3* out) {
+  if (g.hit < 0) return false;
+  float e[3];
+  if (g.hit == 0) {
+    SkyBackground(sky, g.p_or_d.x, g.p_or_d.y, g.p_or_d.z, e);
+  } else {
+    const float p[3] = {g.p_or_d.x, g.p_or_d.y, g.p_or_d.z}, ns[3] = {g.ns.x, g.ns.y, g.ns.z};
+    SkyVolumeIrradiance(volume, sky, p, ns, e);
+  }
+  *out = Float3{e[0], e[1], e[2]};
+  return true;
+}
+
+/// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
 /// (0 on a miss).
 PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
                                                     float* t_hit, TraceHit* hit_out = nullptr) {
