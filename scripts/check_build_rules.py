@@ -240,7 +240,7 @@ def check_preprocessed(compile_commands, rules, jobs):
     import preprocessed_lines  # noqa: E402
 
     budget = rules["preprocessed_lines"]
-    records = preprocessed_lines.run(compile_commands, jobs)
+    records = preprocessed_lines.run(compile_commands, jobs, headers=False)
     errors = []
     per_unit = int(budget["per_unit"])
     for r in sorted(records, key=lambda r: -r["lines"]):

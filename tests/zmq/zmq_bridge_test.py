@@ -615,8 +615,9 @@ def test_subscriptions(binary, source):
 def test_unsubscribe(binary, source):
     """40,000 subscriptions of 500 bytes, then their subscribers leave: the command socket
     keeps answering (each request within a generous bound of 2 s) while the server removes
-    them. (before the fix it stopped answering for about 9 s here: every unsubscribe searched
-    a list of all subscriptions)"""
+    them: a request every 50 ms for 3 s after they left. (before the fix it stopped answering
+    for about 9 s here, 9.0 s without a reply in commit 285ab6a's measurement against 0.03 s
+    worst after it: every unsubscribe searched a list of all subscriptions)"""
     with tempfile.TemporaryDirectory() as tmp:
         world = write_world(tmp, source)
         server = Server(binary, world, os.path.join(tmp, "out"), ["--lockstep"])
@@ -637,7 +638,7 @@ def test_unsubscribe(binary, source):
             for s in subs:
                 s.close()
             c.req.setsockopt(zmq.RCVTIMEO, 2000)
-            t_end = time.time() + 8
+            t_end = time.time() + 3
             n = 0
             while time.time() < t_end:
                 c.req.send(msgpack.packb({"cmd": "get_state"}, use_bin_type=True))
