@@ -210,6 +210,71 @@ TEST(CrowdTest, BlockPeopleOfAPresetReachTheStandingRobotsPathInBothWorlds) {
   }
 }
 
+TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8s) {
+  // `behaviour: block` people start where the robot is about to go (effects_stage.h "npcs"):
+  // each on a walkable cell 2-6 m from the robot within 60 deg of its start heading, apart
+  // from each other, and each stands in the robot's path (as above) within 8 s. the same
+  // preset with `avoid` keeps its places at the points of interest and lanes
+  for (const std::string world_file : {"house.yaml", "warehouse.yaml", "default.yaml"}) {
+    for (const std::string behaviour : {"block", "avoid"}) {
+      const testing::TempDir dir;
+      const Session session(LoadWorldFile(CrowdWorldPath(world_file)),
+                            CrowdSessionOptions(CrowdPresetFile(
+                                dir, "{people: 4, speed_m_s: 0.8, behaviour: " + behaviour + "}")));
+      std::vector<AgentConfig> crowd;
+      for (const AgentConfig& a : session.effects().agents())
+        if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+      ASSERT_EQ(crowd.size(), 4u) << world_file << " " << behaviour;
+      const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
+      ASSERT_TRUE(map);
+      CrowdRobot robot;
+      for (const ModelConfig& m : session.world().models)
+        if (m.is_robot) {
+          robot.position_W = m.pose.xyz.head<2>();
+          robot.yaw = m.pose.rpy_deg.z() * M_PI / 180;
+          robot.radius_m = 0.45;
+          break;
+        }
+      const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
+      const Eigen::Vector2d left(-heading.y(), heading.x());
+      int in_front = 0;
+      for (size_t i = 0; i < crowd.size(); ++i) {
+        const Eigen::Vector2d d = crowd[i].waypoints[0] - robot.position_W;
+        const bool front = d.norm() >= 2.0 && d.norm() <= 6.0 &&
+                           d.dot(heading) >= d.norm() * std::cos(M_PI / 3) - 1e-9;
+        in_front += front;
+        if (behaviour == "block") {
+          EXPECT_TRUE(front) << world_file << ": " << crowd[i].name << " starts at "
+                             << crowd[i].waypoints[0].transpose() << ", not 2-6 m ahead";
+          EXPECT_TRUE(map->person()->Walkable(crowd[i].waypoints[0])) << crowd[i].name;
+          for (size_t j = 0; j < i; ++j)
+            EXPECT_GT((crowd[i].waypoints[0] - crowd[j].waypoints[0]).norm(), 0.8);
+        }
+      }
+      if (behaviour == "avoid") {
+        // points of interest and lanes: not all of them ahead of the robot
+        EXPECT_LT(in_front, 4) << world_file;
+        continue;
+      }
+      CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
+      const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+      std::vector<double> reached(crowd.size(), -1);
+      for (int k = 0; k < 160; ++k) {  // 8 s
+        sim.Step({robot});
+        for (size_t i = 0; i < crowd.size(); ++i) {
+          const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
+          const double ahead = d.dot(heading), side = std::abs(d.dot(left));
+          if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
+            reached[i] = sim.time_sec();
+        }
+      }
+      for (size_t i = 0; i < crowd.size(); ++i)
+        EXPECT_GE(reached[i], 0.0)
+            << world_file << ": " << crowd[i].name << " not in the robot's path within 8 s";
+    }
+  }
+}
+
 // every agent body's mocap pose over `steps` physics steps of a session with a crowd
 std::vector<double> CrowdTrajectory(uint64_t seed, int steps) {
   const testing::TempDir dir;

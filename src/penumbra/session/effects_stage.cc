@@ -26,6 +26,20 @@ std::vector<Eigen::Vector3d> RobotStarts(const WorldConfig& world) {
   return out;
 }
 
+}  // namespace
+
+std::vector<double> RobotStartYaws(const WorldConfig& world) {
+  std::vector<double> out;
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) {
+      const Eigen::Matrix3d R = m.pose.ToPose().linear();
+      out.push_back(std::atan2(R(1, 0), R(0, 0)));
+    }
+  return out;
+}
+
+namespace {
+
 // the longest stretch of `lane` (vertices snapped to `region` within 0.3 m, consecutive ones
 // joined by walkable segments), or nothing when shorter than 3 m
 std::vector<Eigen::Vector2d> DrivableStretch(const WalkableGrid& region,
@@ -66,9 +80,32 @@ std::optional<Eigen::Vector2d> DrawWalkable(const WalkableGrid& region, Rng* rng
   return std::nullopt;
 }
 
+// a `block` person's start: a walkable cell (of `people`, the area reachable from the robots)
+// in front of the robot at `robot_W` facing `yaw` (rad about +z, 0 = +x), drawn from `rng`:
+// first 2-6 m from it within 60 deg of its heading, else 1.5-8 m from it in its forward
+// half-space; nothing when no draw is `free`. the person then starts where the robot is
+// about to go instead of behind its route, where avoidance keeps it from passing the robot
+template <typename Free>
+std::optional<Eigen::Vector2d> BlockerStart(const WalkableGrid& people,
+                                            const Eigen::Vector2d& robot_W, double yaw, Rng* rng,
+                                            const Free& free) {
+  struct Band {
+    double min_m, max_m, half_angle;
+  };
+  for (const Band band : {Band{2.0, 6.0, M_PI / 3}, Band{1.5, 8.0, M_PI / 2}})
+    for (int k = 0; k < 300; ++k) {
+      const double d = band.min_m + (band.max_m - band.min_m) * rng->UniformD();
+      const double a = yaw + band.half_angle * (2 * rng->UniformD() - 1);
+      const Eigen::Vector2d p = robot_W + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+      if (people.Walkable(p) && free(p)) return p;
+    }
+  return std::nullopt;
+}
+
 // the preset's crowd (see the header's "npcs")
 void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const CrowdSites& sites,
-                    const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                    const std::vector<Eigen::Vector3d>& robot_starts,
+                    const std::vector<double>& robot_yaws, uint64_t seed,
                     std::vector<AgentConfig>* agents) {
   const WalkableGrid& people = *map.person();
   const WalkableGrid& vehicles = *map.vehicle();
@@ -133,7 +170,8 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     // the preset's own spread of heights (the walkers' bodies read height_m only when given)
     a.height_m = 1.55 + 0.4 * rng.UniformD();
     a.height_given = true;
-    if (i % 2 == 1 && !walk_lanes.empty()) {
+    const bool blocks = preset.npc_behaviour == AgentBehaviour::kBlock && !robot_starts.empty();
+    if (i % 2 == 1 && !walk_lanes.empty() && !blocks) {
       std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
       if ((i / 2 / walk_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
       if (!free_start(lane.front(), person_r, 1.5)) std::reverse(lane.begin(), lane.end());
@@ -151,9 +189,21 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
                    name);
       continue;
     }
-    // the start: a free point of interest (from a drawn offset), else a free walkable cell
+    // the start: a free point of interest (from a drawn offset), else a free walkable cell;
+    // a blocker's: in front of a robot (BlockerStart), else as the others'
     const size_t offset = rng.NextU64() % pois.size();
     std::optional<Eigen::Vector2d> start;
+    if (blocks) {
+      const size_t r = static_cast<size_t>(i) % robot_starts.size();
+      const double yaw = r < robot_yaws.size() ? robot_yaws[r] : 0.0;
+      start = BlockerStart(people, robot_starts[r].head<2>(), yaw, &rng,
+                           [&](const Eigen::Vector2d& p) { return free_start(p, person_r, 1.5); });
+      if (!start)
+        spdlog::warn(
+            "adversity preset '{}': no free walkable cell in front of the robot for {}; "
+            "it starts at a point of interest",
+            preset.name, name);
+    }
     for (size_t k = 0; k < pois.size() && !start; ++k)
       if (free_start(pois[(offset + k) % pois.size()], person_r, 1.5))
         start = pois[(offset + k) % pois.size()];
@@ -257,7 +307,8 @@ P& AppendEffect(std::vector<EffectConfig>* effects, std::string name) {
 
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
                          const std::vector<Pose>& X_WB,
-                         const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                         const std::vector<Eigen::Vector3d>& robot_starts,
+                         const std::vector<double>& robot_yaws, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
                          const CrowdSites& sites) {
   Eigen::Vector2d centre(0, 0);
@@ -330,7 +381,7 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
     // the NPCs' floor also knows floor slabs (a generated building's floor box)
     const NpcMap npc_map(scene, X_WB, NpcFloorHeight(scene, X_WB, robot_starts), centre,
                          person_seeds, vehicle_seeds);
-    PlanPresetNpcs(preset, npc_map, sites, robot_starts, seed, agents);
+    PlanPresetNpcs(preset, npc_map, sites, robot_starts, robot_yaws, seed, agents);
   }
 }
 
@@ -353,6 +404,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
       world_file_(world.file),
       world_agents_(world.agents.size()),
       robot_starts_(RobotStarts(world)),
+      robot_yaws_(RobotStartYaws(world)),
       sites_(std::move(sites)) {
   for (const ModelConfig& m : world.models)
     if (m.is_robot) robots_.push_back(m);
@@ -381,8 +433,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   // the run's model in Attach.
   if (preset_ && !preset_->empty()) {
     const Simulation probe = Simulation::LoadFromString(composed->Xml(), world.timestep_sec);
-    PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, world.seed,
-                        &effects_, &agents_, sites_);
+    PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, robot_yaws_,
+                        world.seed, &effects_, &agents_, sites_);
   }
   ValidateEffectsOrThrow(effects_, world.file);
   ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too
