@@ -102,6 +102,44 @@ std::optional<Eigen::Vector2d> BlockerStart(const WalkableGrid& people,
   return std::nullopt;
 }
 
+// a `block` person's start when the robots' goal is known: a walkable cell (of `people`) near
+// the route from the robot at `robot_W` to `goal_W` (the A* path on `people`, else the straight
+// segment): the route's point at an arc length drawn in [min(2, L), min(6, L)] m (L the route's
+// length), moved sideways by up to 1 m, drawn from `rng`; nothing when no draw is `free`.
+// the person then starts where the robot is about to go, whichever way its goal lies
+template <typename Free>
+std::optional<Eigen::Vector2d> BlockerStartOnRoute(const WalkableGrid& people,
+                                                   const Eigen::Vector2d& robot_W,
+                                                   const Eigen::Vector2d& goal_W, Rng* rng,
+                                                   const Free& free) {
+  std::vector<Eigen::Vector2d> route = {robot_W, goal_W};
+  if (std::optional<std::vector<Eigen::Vector2d>> path = people.Plan(robot_W, goal_W);
+      path && path->size() >= 2)
+    route = std::move(*path);
+  double length = 0;
+  for (size_t k = 1; k < route.size(); ++k) length += (route[k] - route[k - 1]).norm();
+  if (length <= 0) return std::nullopt;
+  const double max_m = std::min(6.0, length), min_m = std::min(2.0, max_m);
+  for (int k = 0; k < 300; ++k) {
+    double s = min_m + (max_m - min_m) * rng->UniformD();
+    const double side = 2 * rng->UniformD() - 1;
+    for (size_t j = 1; j < route.size(); ++j) {
+      const Eigen::Vector2d seg = route[j] - route[j - 1];
+      const double n = seg.norm();
+      if (n <= 0 || (s > n && j + 1 < route.size())) {
+        s -= n;
+        continue;
+      }
+      const Eigen::Vector2d along = seg / n;
+      const Eigen::Vector2d p = route[j - 1] + std::min(s, n) * along +
+                                side * Eigen::Vector2d(-along.y(), along.x());
+      if (people.Walkable(p) && free(p)) return p;
+      break;
+    }
+  }
+  return std::nullopt;
+}
+
 // the preset's crowd (see the header's "npcs")
 void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const CrowdSites& sites,
                     const std::vector<Eigen::Vector3d>& robot_starts,
@@ -196,8 +234,17 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     if (blocks) {
       const size_t r = static_cast<size_t>(i) % robot_starts.size();
       const double yaw = r < robot_yaws.size() ? robot_yaws[r] : 0.0;
-      start = BlockerStart(people, robot_starts[r].head<2>(), yaw, &rng,
-                           [&](const Eigen::Vector2d& p) { return free_start(p, person_r, 1.5); });
+      const auto free = [&](const Eigen::Vector2d& p) { return free_start(p, person_r, 1.5); };
+      if (preset.npc_block_goal) {
+        start = BlockerStartOnRoute(people, robot_starts[r].head<2>(), *preset.npc_block_goal,
+                                    &rng, free);
+        if (!start)
+          spdlog::warn(
+              "adversity preset '{}': no free walkable cell near the robot's route to its goal "
+              "for {}; it starts in front of the robot",
+              preset.name, name);
+      }
+      if (!start) start = BlockerStart(people, robot_starts[r].head<2>(), yaw, &rng, free);
       if (!start)
         spdlog::warn(
             "adversity preset '{}': no free walkable cell in front of the robot for {}; "

@@ -40,7 +40,11 @@
 //              person (no lane patrols) starts in front of robot i mod robots instead: a
 //              walkable cell 2-6 m from its start within 60 deg of its start heading, else
 //              1.5-8 m in its forward half-space, >= 1.5 m from every robot start (drawn
-//              from the seed; a point of interest when none is free, logged). vehicles (forklifts
+//              from the seed; a point of interest when none is free, logged). with the
+//              preset's npcs.block_goal (the robots' goal) a blocker starts near the robot's
+//              route to it instead: the A* path on the people's walkable cells (else the
+//              straight segment), at an arc length drawn in [min(2, L), min(6, L)] m (L the
+//              route's length), up to 1 m to its side; failing that, by the heading rule. vehicles (forklifts
 //              at 1.5x speed) drive a lane (its longest drivable stretch, >= 3 m) there and back;
 //              without lanes in the world, a straight drivable lane of 3-12 m drawn from the seed;
 //              a world whose lanes no forklift fits (the house) gets none (logged). behaviour and
