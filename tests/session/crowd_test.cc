@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/core/error.h"
 #include "penumbra/effects/crowd_sim.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/adversity_preset.h"
@@ -282,9 +283,9 @@ double DistanceToRoute(const std::vector<Eigen::Vector2d>& route, const Eigen::V
   double best = 1e9;
   for (size_t k = 1; k < route.size(); ++k) {
     const Eigen::Vector2d ab = route[k] - route[k - 1];
-    const double t =
-        ab.squaredNorm() > 0 ? std::clamp((p - route[k - 1]).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
-                             : 0.0;
+    const double t = ab.squaredNorm() > 0
+                         ? std::clamp((p - route[k - 1]).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                         : 0.0;
     best = std::min(best, (p - route[k - 1] - t * ab).norm());
   }
   return best;
@@ -293,8 +294,9 @@ double DistanceToRoute(const std::vector<Eigen::Vector2d>& route, const Eigen::V
 TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPathWithin8s) {
   // npcs.block_goal (effects_stage.h "npcs"): with the goal behind the robot (the room of
   // default.yaml and rover.yaml), block people start within 1 m of the robot's route to it
-  // (A* on the people's walkable cells), 1.5-7 m from the robot, behind its start heading; once the robot has turned to its route,
-  // each stands in its path within 8 s. without the goal the same preset puts them ahead
+  // (A* on the people's walkable cells), 1.5-7 m from the robot, behind its start heading; once the
+  // robot has turned to its route, each stands in its path within 8 s. without the goal the same
+  // preset puts them ahead
   for (const std::string world_file : {"rover.yaml", "default.yaml"}) {
     const WorldConfig world = LoadWorldFile(CrowdWorldPath(world_file));
     Eigen::Vector2d start(0, 0);
@@ -310,9 +312,10 @@ TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPath
     // 107 deg off the start heading
     const Eigen::Vector2d goal(-2.5, 0.1);
     const testing::TempDir dir;
-    const Session session(world, CrowdSessionOptions(CrowdPresetFile(
-                                     dir, "{people: 3, speed_m_s: 0.8, behaviour: block, "
-                                          "block_goal: [-2.5, 0.1]}")));
+    const Session session(
+        world, CrowdSessionOptions(CrowdPresetFile(dir,
+                                                   "{people: 3, speed_m_s: 0.8, behaviour: block, "
+                                                   "block_goal: [-2.5, 0.1]}")));
     std::vector<AgentConfig> crowd;
     for (const AgentConfig& a : session.effects().agents())
       if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
@@ -350,8 +353,8 @@ TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPath
       }
     }
     for (size_t i = 0; i < crowd.size(); ++i)
-      EXPECT_GE(reached[i], 0.0)
-          << world_file << ": " << crowd[i].name << " not in the robot's path within 8 s";
+      EXPECT_GE(reached[i], 0.0) << world_file << ": " << crowd[i].name
+                                 << " not in the robot's path within 8 s";
   }
 }
 
@@ -359,8 +362,9 @@ TEST(CrowdTest, AdversityPresetFileTextReadsBackTheSamePresetWithItsBlockGoal) {
   // what penumbra benchmark writes for a nav episode (campaign/nav_job.h)
   const testing::TempDir dir;
   AdversityPreset p = LoadAdversityPreset(
-      CrowdPresetFile(dir, "{people: 2, speed_m_s: 0.7, behaviour: block, block_goal: [-2.5, "
-                           "0.1]}"));
+      CrowdPresetFile(dir,
+                      "{people: 2, speed_m_s: 0.7, behaviour: block, block_goal: [-2.5, "
+                      "0.1]}"));
   ASSERT_TRUE(p.npc_block_goal);
   EXPECT_EQ(*p.npc_block_goal, Eigen::Vector2d(-2.5, 0.1));
   p.npc_block_goal = Eigen::Vector2d(0.1 + 0.2, -1.0 / 3);

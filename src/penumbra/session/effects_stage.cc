@@ -131,8 +131,8 @@ std::optional<Eigen::Vector2d> BlockerStartOnRoute(const WalkableGrid& people,
         continue;
       }
       const Eigen::Vector2d along = seg / n;
-      const Eigen::Vector2d p = route[j - 1] + std::min(s, n) * along +
-                                side * Eigen::Vector2d(-along.y(), along.x());
+      const Eigen::Vector2d p =
+          route[j - 1] + std::min(s, n) * along + side * Eigen::Vector2d(-along.y(), along.x());
       if (people.Walkable(p) && free(p)) return p;
       break;
     }
@@ -236,8 +236,8 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
       const double yaw = r < robot_yaws.size() ? robot_yaws[r] : 0.0;
       const auto free = [&](const Eigen::Vector2d& p) { return free_start(p, person_r, 1.5); };
       if (preset.npc_block_goal) {
-        start = BlockerStartOnRoute(people, robot_starts[r].head<2>(), *preset.npc_block_goal,
-                                    &rng, free);
+        start = BlockerStartOnRoute(people, robot_starts[r].head<2>(), *preset.npc_block_goal, &rng,
+                                    free);
         if (!start)
           spdlog::warn(
               "adversity preset '{}': no free walkable cell near the robot's route to its goal "

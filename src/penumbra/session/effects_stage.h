@@ -44,11 +44,11 @@
 //              preset's npcs.block_goal (the robots' goal) a blocker starts near the robot's
 //              route to it instead: the A* path on the people's walkable cells (else the
 //              straight segment), at an arc length drawn in [min(2, L), min(6, L)] m (L the
-//              route's length), up to 1 m to its side; failing that, by the heading rule. vehicles (forklifts
-//              at 1.5x speed) drive a lane (its longest drivable stretch, >= 3 m) there and back;
-//              without lanes in the world, a straight drivable lane of 3-12 m drawn from the seed;
-//              a world whose lanes no forklift fits (the house) gets none (logged). behaviour and
-//              clearance from the preset.
+//              route's length), up to 1 m to its side; failing that, by the heading rule. vehicles
+//              (forklifts at 1.5x speed) drive a lane (its longest drivable stretch, >= 3 m) there
+//              and back; without lanes in the world, a straight drivable lane of 3-12 m drawn from
+//              the seed; a world whose lanes no forklift fits (the house) gets none (logged).
+//              behaviour and clearance from the preset.
 // preset effects and agents are named "adversity_<what>" and follow the world's own.
 
 #include <Eigen/Core>

@@ -95,8 +95,8 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
   }
   if (r.Has("npcs")) {
     const ParamReader s = r.Child("npcs");
-    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m",
-                 "block_goal"});
+    s.ExpectMap(
+        {"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m", "block_goal"});
     if (const auto found = s.Find("people")) p.npc_people = RangedInt(*found, 0, 100);
     if (const auto found = s.Find("vehicles")) p.npc_vehicles = RangedInt(*found, 0, 20);
     if (const auto found = s.Find("speed_m_s")) p.npc_speed_m_s = Ranged(*found, 0, 5, true, "m/s");
@@ -111,8 +111,9 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
       p.npc_clearance_m = Ranged(*found, 0, 10, false, "m");
     if (const auto found = s.Find("block_goal")) {
       if (p.npc_behaviour != AgentBehaviour::kBlock)
-        found->Fail("a goal only for behaviour: block; expected behaviour: block or no "
-                    "block_goal");
+        found->Fail(
+            "a goal only for behaviour: block; expected behaviour: block or no "
+            "block_goal");
       const std::vector<double> g = found->Doubles(2);
       if (std::abs(g[0]) > 1e5 || std::abs(g[1]) > 1e5)
         found->Fail("expected a world point [x, y] with |x|, |y| <= 1e5 m");
