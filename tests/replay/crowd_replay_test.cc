@@ -15,6 +15,7 @@
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/replay/log_source.h"
+#include "penumbra/replay/recorded_world.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/session/session.h"
 
@@ -91,6 +92,37 @@ TEST(CrowdReplayTest, ReplayPosesTheCrowdAsTheRunDid) {
   } while (source.Advance());
   EXPECT_EQ(compared, 751);  // steps 0..750 at 2 ms
   EXPECT_GT(moved, 0.5);     // the first person walked during the 1.5 s
+}
+
+TEST(CrowdReplayTest, ARecordedCommandLinesBlockGoalPresetPlacesTheSameCrowd) {
+  // what penumbra benchmark runs (campaign/nav_job.h): --adversity FILE#NAME of a block preset
+  // with the episode's goal; a replay reads the spec back from the recorded command line and
+  // plans the same people, which the goal moved (here to the rover's route behind its start)
+  const testing::TempDir dir;
+  const std::string file = (dir.path() / "adversity.yaml").string();
+  std::ofstream(file) << "presets:\n  major:\n    npcs: {people: 4, speed_m_s: 0.8, behaviour: "
+                         "block, block_goal: [-2.5, 0.1]}\n  ahead:\n    npcs: {people: 4, "
+                         "speed_m_s: 0.8, behaviour: block}\n";
+  const std::string spec = file + "#major";
+  const RecordedRunFlags flags = ParseRecordedRunFlags(
+      "penumbra run worlds/rover.yaml --out run --lockstep --adversity " + spec + " --seed 2");
+  EXPECT_EQ(flags.adversity, spec);
+  WorldConfig world = LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/rover.yaml");
+  world.seed = 2;
+  const auto starts = [&](const std::string& adversity) {
+    SessionOptions o;
+    o.build_renderer = false;
+    o.adversity = adversity;
+    const Session session(world, o);
+    std::vector<double> out;
+    for (const AgentConfig& a : session.effects().agents())
+      out.insert(out.end(), {a.waypoints[0].x(), a.waypoints[0].y()});
+    return out;
+  };
+  const std::vector<double> run = starts(spec), replay = starts(flags.adversity);
+  ASSERT_EQ(run.size(), 8u);
+  EXPECT_EQ(run, replay);                   // bit for bit
+  EXPECT_NE(run, starts(file + "#ahead"));  // the goal changed where they start
 }
 
 }  // namespace

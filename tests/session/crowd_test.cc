@@ -6,13 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <filesystem>
 #include <fstream>
 
 #include "common/temp_dir.h"
+#include "penumbra/core/error.h"
 #include "penumbra/effects/crowd_sim.h"
 #include "penumbra/session/session.h"
+#include "penumbra/world/adversity_preset.h"
 
 namespace penumbra {
 namespace {
@@ -208,6 +211,174 @@ TEST(CrowdTest, BlockPeopleOfAPresetReachTheStandingRobotsPathInBothWorlds) {
                                  << "robot's path";
     }
   }
+}
+
+TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8s) {
+  // `behaviour: block` people start where the robot is about to go (effects_stage.h "npcs"):
+  // each on a walkable cell 2-6 m from the robot within 60 deg of its start heading, apart
+  // from each other, and each stands in the robot's path (as above) within 8 s. the same
+  // preset with `avoid` keeps its places at the points of interest and lanes
+  for (const std::string world_file : {"house.yaml", "warehouse.yaml", "default.yaml"}) {
+    for (const std::string behaviour : {"block", "avoid"}) {
+      const testing::TempDir dir;
+      const Session session(LoadWorldFile(CrowdWorldPath(world_file)),
+                            CrowdSessionOptions(CrowdPresetFile(
+                                dir, "{people: 4, speed_m_s: 0.8, behaviour: " + behaviour + "}")));
+      std::vector<AgentConfig> crowd;
+      for (const AgentConfig& a : session.effects().agents())
+        if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+      ASSERT_EQ(crowd.size(), 4u) << world_file << " " << behaviour;
+      const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
+      ASSERT_TRUE(map);
+      CrowdRobot robot;
+      for (const ModelConfig& m : session.world().models)
+        if (m.is_robot) {
+          robot.position_W = m.pose.xyz.head<2>();
+          robot.yaw = m.pose.rpy_deg.z() * M_PI / 180;
+          robot.radius_m = 0.45;
+          break;
+        }
+      const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
+      const Eigen::Vector2d left(-heading.y(), heading.x());
+      int in_front = 0;
+      for (size_t i = 0; i < crowd.size(); ++i) {
+        const Eigen::Vector2d d = crowd[i].waypoints[0] - robot.position_W;
+        const bool front = d.norm() >= 2.0 && d.norm() <= 6.0 &&
+                           d.dot(heading) >= d.norm() * std::cos(M_PI / 3) - 1e-9;
+        in_front += front;
+        if (behaviour == "block") {
+          EXPECT_TRUE(front) << world_file << ": " << crowd[i].name << " starts at "
+                             << crowd[i].waypoints[0].transpose() << ", not 2-6 m ahead";
+          EXPECT_TRUE(map->person()->Walkable(crowd[i].waypoints[0])) << crowd[i].name;
+          for (size_t j = 0; j < i; ++j)
+            EXPECT_GT((crowd[i].waypoints[0] - crowd[j].waypoints[0]).norm(), 0.8);
+        }
+      }
+      if (behaviour == "avoid") {
+        // points of interest and lanes: not all of them ahead of the robot
+        EXPECT_LT(in_front, 4) << world_file;
+        continue;
+      }
+      CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
+      const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+      std::vector<double> reached(crowd.size(), -1);
+      for (int k = 0; k < 160; ++k) {  // 8 s
+        sim.Step({robot});
+        for (size_t i = 0; i < crowd.size(); ++i) {
+          const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
+          const double ahead = d.dot(heading), side = std::abs(d.dot(left));
+          if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
+            reached[i] = sim.time_sec();
+        }
+      }
+      for (size_t i = 0; i < crowd.size(); ++i)
+        EXPECT_GE(reached[i], 0.0)
+            << world_file << ": " << crowd[i].name << " not in the robot's path within 8 s";
+    }
+  }
+}
+
+// distance from p to the polyline `route`, m
+double DistanceToRoute(const std::vector<Eigen::Vector2d>& route, const Eigen::Vector2d& p) {
+  double best = 1e9;
+  for (size_t k = 1; k < route.size(); ++k) {
+    const Eigen::Vector2d ab = route[k] - route[k - 1];
+    const double t = ab.squaredNorm() > 0
+                         ? std::clamp((p - route[k - 1]).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                         : 0.0;
+    best = std::min(best, (p - route[k - 1] - t * ab).norm());
+  }
+  return best;
+}
+
+TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPathWithin8s) {
+  // npcs.block_goal (effects_stage.h "npcs"): with the goal behind the robot (the room of
+  // default.yaml and rover.yaml), block people start within 1 m of the robot's route to it
+  // (A* on the people's walkable cells), 1.5-7 m from the robot, behind its start heading; once the
+  // robot has turned to its route, each stands in its path within 8 s. without the goal the same
+  // preset puts them ahead
+  for (const std::string world_file : {"rover.yaml", "default.yaml"}) {
+    const WorldConfig world = LoadWorldFile(CrowdWorldPath(world_file));
+    Eigen::Vector2d start(0, 0);
+    double yaw = 0;
+    for (const ModelConfig& m : world.models)
+      if (m.is_robot) {
+        start = m.pose.xyz.head<2>();
+        yaw = m.pose.rpy_deg.z() * M_PI / 180;
+        break;
+      }
+    const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
+    // the nav benchmark's rover episode behind_start (benchmarks/nav.yaml): 2.8 m away,
+    // 107 deg off the start heading
+    const Eigen::Vector2d goal(-2.5, 0.1);
+    const testing::TempDir dir;
+    const Session session(
+        world, CrowdSessionOptions(CrowdPresetFile(dir,
+                                                   "{people: 3, speed_m_s: 0.8, behaviour: block, "
+                                                   "block_goal: [-2.5, 0.1]}")));
+    std::vector<AgentConfig> crowd;
+    for (const AgentConfig& a : session.effects().agents())
+      if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+    ASSERT_EQ(crowd.size(), 3u) << world_file;
+    const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
+    ASSERT_TRUE(map);
+    const std::optional<std::vector<Eigen::Vector2d>> route = map->person()->Plan(start, goal);
+    ASSERT_TRUE(route && route->size() >= 2) << world_file;
+    for (const AgentConfig& a : crowd) {
+      const Eigen::Vector2d d = a.waypoints[0] - start;
+      EXPECT_LE(DistanceToRoute(*route, a.waypoints[0]), 1.0 + 1e-6)
+          << world_file << ": " << a.name << " starts at " << a.waypoints[0].transpose();
+      EXPECT_GE(d.norm(), 1.5) << a.name;
+      EXPECT_LE(d.norm(), 7.0) << a.name;
+      EXPECT_LT(d.dot(heading), 0.0) << world_file << ": " << a.name << " starts ahead";
+      EXPECT_TRUE(map->person()->Walkable(a.waypoints[0])) << a.name;
+    }
+    // the robot turned to its route's first leg
+    CrowdRobot robot;
+    robot.position_W = start;
+    const Eigen::Vector2d leg = ((*route)[1] - (*route)[0]).normalized();
+    robot.yaw = std::atan2(leg.y(), leg.x());
+    robot.radius_m = 0.45;
+    const Eigen::Vector2d left(-leg.y(), leg.x());
+    const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+    CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
+    std::vector<double> reached(crowd.size(), -1);
+    for (int k = 0; k < 160; ++k) {  // 8 s
+      sim.Step({robot});
+      for (size_t i = 0; i < crowd.size(); ++i) {
+        const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
+        const double ahead = d.dot(leg), side = std::abs(d.dot(left));
+        if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
+          reached[i] = sim.time_sec();
+      }
+    }
+    for (size_t i = 0; i < crowd.size(); ++i)
+      EXPECT_GE(reached[i], 0.0) << world_file << ": " << crowd[i].name
+                                 << " not in the robot's path within 8 s";
+  }
+}
+
+TEST(CrowdTest, AdversityPresetFileTextReadsBackTheSamePresetWithItsBlockGoal) {
+  // what penumbra benchmark writes for a nav episode (campaign/nav_job.h)
+  const testing::TempDir dir;
+  AdversityPreset p = LoadAdversityPreset(
+      CrowdPresetFile(dir,
+                      "{people: 2, speed_m_s: 0.7, behaviour: block, block_goal: [-2.5, "
+                      "0.1]}"));
+  ASSERT_TRUE(p.npc_block_goal);
+  EXPECT_EQ(*p.npc_block_goal, Eigen::Vector2d(-2.5, 0.1));
+  p.npc_block_goal = Eigen::Vector2d(0.1 + 0.2, -1.0 / 3);
+  const std::string path = (dir.path() / "again.yaml").string();
+  std::ofstream(path) << AdversityPresetFileText(p);
+  const AdversityPreset q = LoadAdversityPreset(path + "#crowd");
+  ASSERT_TRUE(q.npc_block_goal);
+  EXPECT_EQ(*q.npc_block_goal, *p.npc_block_goal);  // bit-exact
+  EXPECT_EQ(q.npc_people, 2);
+  EXPECT_EQ(q.npc_speed_m_s, 0.7);
+  EXPECT_EQ(q.npc_behaviour, AgentBehaviour::kBlock);
+  // a goal without block is refused
+  EXPECT_THROW(LoadAdversityPreset(CrowdPresetFile(dir, "{people: 2, block_goal: [1, 2]}")),
+               ConfigError);
 }
 
 // every agent body's mocap pose over `steps` physics steps of a session with a crowd

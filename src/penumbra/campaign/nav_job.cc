@@ -26,6 +26,7 @@
 #include "penumbra/campaign/nav_metrics.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/yaml_reader.h"
 
 namespace penumbra {
@@ -244,6 +245,16 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
   fs::remove_all(dir);
   fs::create_directories(dir);
   WriteText(dir / "override.yaml", OverrideYaml(spec, w));
+  // a preset whose people block the robot: the same preset with the episode's goal
+  // (npcs.block_goal), so that they start near the robot's route to it; the run's command
+  // line names that file, so its log (and a replay) carries it
+  std::string adversity = cond.adversity;
+  if (AdversityPreset preset = LoadAdversityPreset(cond.adversity);
+      preset.npc_behaviour == AgentBehaviour::kBlock && preset.npc_people > 0) {
+    preset.npc_block_goal = Eigen::Vector2d(ep.goal_x, ep.goal_y);
+    WriteText(dir / "adversity.yaml", AdversityPresetFileText(preset));
+    adversity = (dir / "adversity.yaml").string() + "#" + preset.name;
+  }
 
   NavRow row;
   row.world = w.name;
@@ -279,7 +290,7 @@ NavRow RunNavJob(const BenchmarkSpec& spec, const BenchmarkJob& job,
                                      endpoint,
                                      "--lockstep",
                                      "--adversity",
-                                     cond.adversity,
+                                     adversity,
                                      "--seed",
                                      std::to_string(job.seed),
                                      "--duration",

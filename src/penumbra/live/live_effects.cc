@@ -9,8 +9,8 @@
 
 #include "penumbra/compose/agent_bodies.h"
 #include "penumbra/core/error.h"
-#include "penumbra/physics/simulation.h"
 #include "penumbra/live/json_effect_reader.h"
+#include "penumbra/physics/simulation.h"
 
 namespace penumbra {
 namespace {
@@ -107,8 +107,8 @@ LiveEffects::Change LiveEffects::Plan(const State& s) const {
   c.preset = s.preset;
   if (s.preset && !s.preset->empty())
     PlanAdversityPreset(*s.preset, session_.scene(), X_WB_start_, robot_starts_,
-                        session_.effects().seed(), &c.effects, &c.agents,
-                        session_.effects().sites());
+                        RobotStartYaws(session_.world()), session_.effects().seed(), &c.effects,
+                        &c.agents, session_.effects().sites());
   const std::vector<std::string>& bodies = session_.effects().agent_bodies();
   for (const AgentConfig& a : c.agents)
     if (std::find(bodies.begin(), bodies.end(), a.name) == bodies.end())

@@ -26,6 +26,20 @@ std::vector<Eigen::Vector3d> RobotStarts(const WorldConfig& world) {
   return out;
 }
 
+}  // namespace
+
+std::vector<double> RobotStartYaws(const WorldConfig& world) {
+  std::vector<double> out;
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) {
+      const Eigen::Matrix3d R = m.pose.ToPose().linear();
+      out.push_back(std::atan2(R(1, 0), R(0, 0)));
+    }
+  return out;
+}
+
+namespace {
+
 // the longest stretch of `lane` (vertices snapped to `region` within 0.3 m, consecutive ones
 // joined by walkable segments), or nothing when shorter than 3 m
 std::vector<Eigen::Vector2d> DrivableStretch(const WalkableGrid& region,
@@ -66,9 +80,70 @@ std::optional<Eigen::Vector2d> DrawWalkable(const WalkableGrid& region, Rng* rng
   return std::nullopt;
 }
 
+// a `block` person's start: a walkable cell (of `people`, the area reachable from the robots)
+// in front of the robot at `robot_W` facing `yaw` (rad about +z, 0 = +x), drawn from `rng`:
+// first 2-6 m from it within 60 deg of its heading, else 1.5-8 m from it in its forward
+// half-space; nothing when no draw is `free`. the person then starts where the robot is
+// about to go instead of behind its route, where avoidance keeps it from passing the robot
+template <typename Free>
+std::optional<Eigen::Vector2d> BlockerStart(const WalkableGrid& people,
+                                            const Eigen::Vector2d& robot_W, double yaw, Rng* rng,
+                                            const Free& free) {
+  struct Band {
+    double min_m, max_m, half_angle;
+  };
+  for (const Band band : {Band{2.0, 6.0, M_PI / 3}, Band{1.5, 8.0, M_PI / 2}})
+    for (int k = 0; k < 300; ++k) {
+      const double d = band.min_m + (band.max_m - band.min_m) * rng->UniformD();
+      const double a = yaw + band.half_angle * (2 * rng->UniformD() - 1);
+      const Eigen::Vector2d p = robot_W + d * Eigen::Vector2d(std::cos(a), std::sin(a));
+      if (people.Walkable(p) && free(p)) return p;
+    }
+  return std::nullopt;
+}
+
+// a `block` person's start when the robots' goal is known: a walkable cell (of `people`) near
+// the route from the robot at `robot_W` to `goal_W` (the A* path on `people`, else the straight
+// segment): the route's point at an arc length drawn in [min(2, L), min(6, L)] m (L the route's
+// length), moved sideways by up to 1 m, drawn from `rng`; nothing when no draw is `free`.
+// the person then starts where the robot is about to go, whichever way its goal lies
+template <typename Free>
+std::optional<Eigen::Vector2d> BlockerStartOnRoute(const WalkableGrid& people,
+                                                   const Eigen::Vector2d& robot_W,
+                                                   const Eigen::Vector2d& goal_W, Rng* rng,
+                                                   const Free& free) {
+  std::vector<Eigen::Vector2d> route = {robot_W, goal_W};
+  if (std::optional<std::vector<Eigen::Vector2d>> path = people.Plan(robot_W, goal_W);
+      path && path->size() >= 2)
+    route = std::move(*path);
+  double length = 0;
+  for (size_t k = 1; k < route.size(); ++k) length += (route[k] - route[k - 1]).norm();
+  if (length <= 0) return std::nullopt;
+  const double max_m = std::min(6.0, length), min_m = std::min(2.0, max_m);
+  for (int k = 0; k < 300; ++k) {
+    double s = min_m + (max_m - min_m) * rng->UniformD();
+    const double side = 2 * rng->UniformD() - 1;
+    for (size_t j = 1; j < route.size(); ++j) {
+      const Eigen::Vector2d seg = route[j] - route[j - 1];
+      const double n = seg.norm();
+      if (n <= 0 || (s > n && j + 1 < route.size())) {
+        s -= n;
+        continue;
+      }
+      const Eigen::Vector2d along = seg / n;
+      const Eigen::Vector2d p =
+          route[j - 1] + std::min(s, n) * along + side * Eigen::Vector2d(-along.y(), along.x());
+      if (people.Walkable(p) && free(p)) return p;
+      break;
+    }
+  }
+  return std::nullopt;
+}
+
 // the preset's crowd (see the header's "npcs")
 void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const CrowdSites& sites,
-                    const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                    const std::vector<Eigen::Vector3d>& robot_starts,
+                    const std::vector<double>& robot_yaws, uint64_t seed,
                     std::vector<AgentConfig>* agents) {
   const WalkableGrid& people = *map.person();
   const WalkableGrid& vehicles = *map.vehicle();
@@ -133,7 +208,8 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     // the preset's own spread of heights (the walkers' bodies read height_m only when given)
     a.height_m = 1.55 + 0.4 * rng.UniformD();
     a.height_given = true;
-    if (i % 2 == 1 && !walk_lanes.empty()) {
+    const bool blocks = preset.npc_behaviour == AgentBehaviour::kBlock && !robot_starts.empty();
+    if (i % 2 == 1 && !walk_lanes.empty() && !blocks) {
       std::vector<Eigen::Vector2d> lane = walk_lanes[(i / 2) % walk_lanes.size()];
       if ((i / 2 / walk_lanes.size()) % 2 == 1) std::reverse(lane.begin(), lane.end());
       if (!free_start(lane.front(), person_r, 1.5)) std::reverse(lane.begin(), lane.end());
@@ -151,9 +227,30 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
                    name);
       continue;
     }
-    // the start: a free point of interest (from a drawn offset), else a free walkable cell
+    // the start: a free point of interest (from a drawn offset), else a free walkable cell;
+    // a blocker's: in front of a robot (BlockerStart), else as the others'
     const size_t offset = rng.NextU64() % pois.size();
     std::optional<Eigen::Vector2d> start;
+    if (blocks) {
+      const size_t r = static_cast<size_t>(i) % robot_starts.size();
+      const double yaw = r < robot_yaws.size() ? robot_yaws[r] : 0.0;
+      const auto free = [&](const Eigen::Vector2d& p) { return free_start(p, person_r, 1.5); };
+      if (preset.npc_block_goal) {
+        start = BlockerStartOnRoute(people, robot_starts[r].head<2>(), *preset.npc_block_goal, &rng,
+                                    free);
+        if (!start)
+          spdlog::warn(
+              "adversity preset '{}': no free walkable cell near the robot's route to its goal "
+              "for {}; it starts in front of the robot",
+              preset.name, name);
+      }
+      if (!start) start = BlockerStart(people, robot_starts[r].head<2>(), yaw, &rng, free);
+      if (!start)
+        spdlog::warn(
+            "adversity preset '{}': no free walkable cell in front of the robot for {}; "
+            "it starts at a point of interest",
+            preset.name, name);
+    }
     for (size_t k = 0; k < pois.size() && !start; ++k)
       if (free_start(pois[(offset + k) % pois.size()], person_r, 1.5))
         start = pois[(offset + k) % pois.size()];
@@ -257,7 +354,8 @@ P& AppendEffect(std::vector<EffectConfig>* effects, std::string name) {
 
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
                          const std::vector<Pose>& X_WB,
-                         const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                         const std::vector<Eigen::Vector3d>& robot_starts,
+                         const std::vector<double>& robot_yaws, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
                          const CrowdSites& sites) {
   Eigen::Vector2d centre(0, 0);
@@ -330,7 +428,7 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
     // the NPCs' floor also knows floor slabs (a generated building's floor box)
     const NpcMap npc_map(scene, X_WB, NpcFloorHeight(scene, X_WB, robot_starts), centre,
                          person_seeds, vehicle_seeds);
-    PlanPresetNpcs(preset, npc_map, sites, robot_starts, seed, agents);
+    PlanPresetNpcs(preset, npc_map, sites, robot_starts, robot_yaws, seed, agents);
   }
 }
 
@@ -353,6 +451,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
       world_file_(world.file),
       world_agents_(world.agents.size()),
       robot_starts_(RobotStarts(world)),
+      robot_yaws_(RobotStartYaws(world)),
       sites_(std::move(sites)) {
   for (const ModelConfig& m : world.models)
     if (m.is_robot) robots_.push_back(m);
@@ -381,8 +480,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   // the run's model in Attach.
   if (preset_ && !preset_->empty()) {
     const Simulation probe = Simulation::LoadFromString(composed->Xml(), world.timestep_sec);
-    PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, world.seed,
-                        &effects_, &agents_, sites_);
+    PlanAdversityPreset(*preset_, probe.scene(), probe.Snapshot().X_WB, robot_starts_, robot_yaws_,
+                        world.seed, &effects_, &agents_, sites_);
   }
   ValidateEffectsOrThrow(effects_, world.file);
   ValidateAgentsOrThrow(agents_, world.file);  // the preset's agents too

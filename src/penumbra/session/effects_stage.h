@@ -36,11 +36,19 @@
 //              from a generated environment's rooms and walkways), else 6 walkable points
 //              drawn from the seed. person i: odd i patrol a lane there and back when
 //              one is walkable, else random goals among the points of interest; it starts
-//              at one >= 1.5 m from every robot start. vehicles (forklifts at 1.5x speed) drive
-//              a lane (its longest drivable stretch, >= 3 m) there and back; without lanes
-//              in the world, a straight drivable lane of 3-12 m drawn from the seed; a world
-//              whose lanes no forklift fits (the house) gets none (logged). behaviour and
-//              clearance from the preset.
+//              at one >= 1.5 m from every robot start. with behaviour `block` every
+//              person (no lane patrols) starts in front of robot i mod robots instead: a
+//              walkable cell 2-6 m from its start within 60 deg of its start heading, else
+//              1.5-8 m in its forward half-space, >= 1.5 m from every robot start (drawn
+//              from the seed; a point of interest when none is free, logged). with the
+//              preset's npcs.block_goal (the robots' goal) a blocker starts near the robot's
+//              route to it instead: the A* path on the people's walkable cells (else the
+//              straight segment), at an arc length drawn in [min(2, L), min(6, L)] m (L the
+//              route's length), up to 1 m to its side; failing that, by the heading rule. vehicles
+//              (forklifts at 1.5x speed) drive a lane (its longest drivable stretch, >= 3 m) there
+//              and back; without lanes in the world, a straight drivable lane of 3-12 m drawn from
+//              the seed; a world whose lanes no forklift fits (the house) gets none (logged).
+//              behaviour and clearance from the preset.
 // preset effects and agents are named "adversity_<what>" and follow the world's own.
 
 #include <Eigen/Core>
@@ -148,6 +156,7 @@ class EffectsStage {
   std::string world_file_;
   size_t world_agents_ = 0;  // agents_[0, world_agents_) are the world's, then the preset's
   std::vector<Eigen::Vector3d> robot_starts_;
+  std::vector<double> robot_yaws_;
   std::unique_ptr<EffectsEngine> engine_;
   // the path each attached agent body follows (null = parked), shared with its mocap driver;
   // crowd agents follow the crowd instead
@@ -187,13 +196,21 @@ std::pair<int, int> LiveNpcReserve();
 /// floor.
 Pose AgentParkedPose(const AgentConfig& agent);
 
+/// the start heading of each robot of `world` (in the order of its models): the yaw (rad
+/// about +z, 0 = +x) of its pose's x axis projected on the floor.
+std::vector<double> RobotStartYaws(const WorldConfig& world);
+
 /// the preset's effects and agents for a world whose scene at the start is (scene, X_WB),
 /// as described in the file header. pure and deterministic in (preset, world, seed).
 /// @param robot_starts start positions (world xy) of the robots' root bodies
+/// @param robot_yaws   their start headings (rad about +z, 0 = +x; RobotStartYaws), in the
+///                     same order; a missing one counts as 0. `block` people start in front
+///                     of a robot (the header's "npcs")
 /// @param sites        the world's areas and lanes (empty: points drawn from the seed)
 void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& scene,
                          const std::vector<Pose>& X_WB,
-                         const std::vector<Eigen::Vector3d>& robot_starts, uint64_t seed,
+                         const std::vector<Eigen::Vector3d>& robot_starts,
+                         const std::vector<double>& robot_yaws, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
                          const CrowdSites& sites = {});
 

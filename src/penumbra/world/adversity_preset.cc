@@ -95,7 +95,8 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
   }
   if (r.Has("npcs")) {
     const ParamReader s = r.Child("npcs");
-    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m"});
+    s.ExpectMap(
+        {"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m", "block_goal"});
     if (const auto found = s.Find("people")) p.npc_people = RangedInt(*found, 0, 100);
     if (const auto found = s.Find("vehicles")) p.npc_vehicles = RangedInt(*found, 0, 20);
     if (const auto found = s.Find("speed_m_s")) p.npc_speed_m_s = Ranged(*found, 0, 5, true, "m/s");
@@ -108,6 +109,16 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
     }
     if (const auto found = s.Find("clearance_m"))
       p.npc_clearance_m = Ranged(*found, 0, 10, false, "m");
+    if (const auto found = s.Find("block_goal")) {
+      if (p.npc_behaviour != AgentBehaviour::kBlock)
+        found->Fail(
+            "a goal only for behaviour: block; expected behaviour: block or no "
+            "block_goal");
+      const std::vector<double> g = found->Doubles(2);
+      if (std::abs(g[0]) > 1e5 || std::abs(g[1]) > 1e5)
+        found->Fail("expected a world point [x, y] with |x|, |y| <= 1e5 m");
+      p.npc_block_goal = Eigen::Vector2d(g[0], g[1]);
+    }
   }
   return p;
 }
@@ -155,6 +166,11 @@ ConfigValue PresetNode(const AdversityPreset& p) {
                    {"pause_sec", PresetNumber(p.npc_pause_sec)},
                    {"behaviour", ConfigValue::Scalar(AgentBehaviourName(p.npc_behaviour))},
                    {"clearance_m", PresetNumber(p.npc_clearance_m)}}));
+  if (p.npc_block_goal) {
+    const std::string goal = "[" + FormatNumber(p.npc_block_goal->x()) + ", " +
+                             FormatNumber(p.npc_block_goal->y()) + "]";
+    n = WithEntry(n, "npcs", WithEntry(n["npcs"], "block_goal", ParseYaml(goal, "")));
+  }
   return n;
 }
 
@@ -197,6 +213,13 @@ std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
     if (out.empty()) presets.Fail("no presets; expected a mapping of preset names to presets");
   }
   return out;
+}
+
+std::string AdversityPresetFileText(const AdversityPreset& preset) {
+  ConfigValue node = PresetNode(preset);
+  if (!preset.description.empty())
+    node = WithEntry(node, "description", ConfigValue::Scalar(preset.description));
+  return "presets:\n  " + preset.name + ": " + EmitYamlFlow(node) + "\n";
 }
 
 std::vector<std::string> BundledAdversityPresetNames() {

@@ -17,7 +17,8 @@
 //       snow:   {rate_mm_h: R}
 //       lights: {scale: K, flicker_depth: D, flicker_hz: F}
 //       npcs:   {people: N, vehicles: V, speed_m_s: S, pause_sec: P,
-//                behaviour: avoid | ignore | block, clearance_m: C}
+//                behaviour: avoid | ignore | block, clearance_m: C,
+//                block_goal: [X, Y]}                # block only: the robots' goal
 // every block is optional; MOR is the meteorological optical range (WMO No. 8, 2018;
 // sigma_t = 2.996 / MOR, Koschmieder), rain and snow rates are water-equivalent mm/h.
 //
@@ -68,6 +69,10 @@ struct AdversityPreset {
   /// what the NPCs do about the robots (effects/agent_path.h AgentBehaviour)
   AgentBehaviour npc_behaviour = AgentBehaviour::kAvoid;
   double npc_clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m
+  /// block: where the robots are going (world x, y in m, |x|, |y| <= 1e5; `npcs.block_goal`,
+  /// only with behaviour block). block people then start near each robot's route to it
+  /// instead of ahead of its start heading (session/effects_stage.h "npcs").
+  std::optional<Eigen::Vector2d> npc_block_goal;
 
   /// true when the preset changes nothing (e.g. `none`).
   bool empty() const;
@@ -86,6 +91,12 @@ std::vector<AdversityPreset> LoadAdversityPresetFile(const std::string& path);
 /// @throws ConfigError as LoadAdversityPresetFile.
 std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
                                                    const std::string& path);
+
+/// the text of a preset file holding `preset` alone (under its name, with its description):
+/// LoadAdversityPreset of it (FILE or FILE#NAME) gives back an equal preset. what a caller
+/// writes to run a preset with a changed field (e.g. `penumbra benchmark` adds the episode's
+/// goal as npcs.block_goal, campaign/nav_job.h).
+std::string AdversityPresetFileText(const AdversityPreset& preset);
 
 /// the names of the bundled presets ("none", "minor", "major").
 std::vector<std::string> BundledAdversityPresetNames();
