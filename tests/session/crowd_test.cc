@@ -213,6 +213,25 @@ TEST(CrowdTest, BlockPeopleOfAPresetReachTheStandingRobotsPathInBothWorlds) {
   }
 }
 
+// the first time (s) each agent of `sim` stands in `robot`'s path (ahead of it along `heading`
+// by less than 2 m, within the discs' radii sideways) over 8 s of crowd steps; -1 when never
+std::vector<double> TimesInRobotsPath(CrowdSim* sim, const CrowdRobot& robot,
+                                      const Eigen::Vector2d& heading) {
+  const Eigen::Vector2d left(-heading.y(), heading.x());
+  const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
+  std::vector<double> reached(sim->states().size(), -1);
+  for (int k = 0; k < 160; ++k) {  // 8 s
+    sim->Step({robot});
+    for (size_t i = 0; i < reached.size(); ++i) {
+      const Eigen::Vector2d d = sim->states()[i].position_W - robot.position_W;
+      const double ahead = d.dot(heading), side = std::abs(d.dot(left));
+      if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
+        reached[i] = sim->time_sec();
+    }
+  }
+  return reached;
+}
+
 TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8s) {
   // `behaviour: block` people start where the robot is about to go (effects_stage.h "npcs"):
   // each on a walkable cell 2-6 m from the robot within 60 deg of its start heading, apart
@@ -239,7 +258,6 @@ TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8
           break;
         }
       const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
-      const Eigen::Vector2d left(-heading.y(), heading.x());
       int in_front = 0;
       for (size_t i = 0; i < crowd.size(); ++i) {
         const Eigen::Vector2d d = crowd[i].waypoints[0] - robot.position_W;
@@ -260,17 +278,7 @@ TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8
         continue;
       }
       CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
-      const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
-      std::vector<double> reached(crowd.size(), -1);
-      for (int k = 0; k < 160; ++k) {  // 8 s
-        sim.Step({robot});
-        for (size_t i = 0; i < crowd.size(); ++i) {
-          const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
-          const double ahead = d.dot(heading), side = std::abs(d.dot(left));
-          if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
-            reached[i] = sim.time_sec();
-        }
-      }
+      const std::vector<double> reached = TimesInRobotsPath(&sim, robot, heading);
       for (size_t i = 0; i < crowd.size(); ++i)
         EXPECT_GE(reached[i], 0.0)
             << world_file << ": " << crowd[i].name << " not in the robot's path within 8 s";
@@ -339,19 +347,8 @@ TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPath
     const Eigen::Vector2d leg = ((*route)[1] - (*route)[0]).normalized();
     robot.yaw = std::atan2(leg.y(), leg.x());
     robot.radius_m = 0.45;
-    const Eigen::Vector2d left(-leg.y(), leg.x());
-    const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
     CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
-    std::vector<double> reached(crowd.size(), -1);
-    for (int k = 0; k < 160; ++k) {  // 8 s
-      sim.Step({robot});
-      for (size_t i = 0; i < crowd.size(); ++i) {
-        const Eigen::Vector2d d = sim.states()[i].position_W - robot.position_W;
-        const double ahead = d.dot(leg), side = std::abs(d.dot(left));
-        if (reached[i] < 0 && ahead > 0 && ahead < 2.0 && side < robot.radius_m + person_r)
-          reached[i] = sim.time_sec();
-      }
-    }
+    const std::vector<double> reached = TimesInRobotsPath(&sim, robot, leg);
     for (size_t i = 0; i < crowd.size(); ++i)
       EXPECT_GE(reached[i], 0.0) << world_file << ": " << crowd[i].name
                                  << " not in the robot's path within 8 s";
