@@ -31,6 +31,28 @@ std::string CrowdPresetFile(const testing::TempDir& dir, const std::string& npcs
   return path;
 }
 
+// the session's crowd agents (motion: crowd), in the stage's order
+std::vector<AgentConfig> CrowdAgentsOf(const Session& session) {
+  std::vector<AgentConfig> crowd;
+  for (const AgentConfig& a : session.effects().agents())
+    if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+  return crowd;
+}
+
+// every robot of `world` standing at its start pose, as the crowd sees it (a 0.45 m disc)
+std::vector<CrowdRobot> StandingRobotsOf(const WorldConfig& world) {
+  std::vector<CrowdRobot> robots;
+  for (const ModelConfig& m : world.models)
+    if (m.is_robot) {
+      CrowdRobot r;
+      r.position_W = m.pose.xyz.head<2>();
+      r.radius_m = 0.45;
+      r.yaw = m.pose.rpy_deg.z() * M_PI / 180;
+      robots.push_back(r);
+    }
+  return robots;
+}
+
 struct CrowdRunStats {
   int steps = 0;
   int off_region = 0;
@@ -43,23 +65,12 @@ struct CrowdRunStats {
 
 // the session's crowd stepped alone for `seconds` beside its standing robots
 CrowdRunStats RunCrowdAlone(const Session& session, double seconds) {
-  const EffectsStage& effects = session.effects();
-  std::vector<AgentConfig> crowd;
-  for (const AgentConfig& a : effects.agents())
-    if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
-  const std::shared_ptr<const NpcMap> map = effects.npc_map();
+  const std::vector<AgentConfig> crowd = CrowdAgentsOf(session);
+  const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
   CrowdRunStats st;
   if (!map) return st;
   CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
-  std::vector<CrowdRobot> robots;
-  for (const ModelConfig& m : session.world().models)
-    if (m.is_robot) {
-      CrowdRobot r;
-      r.position_W = m.pose.xyz.head<2>();
-      r.radius_m = 0.45;
-      r.yaw = m.pose.rpy_deg.z() * M_PI / 180;
-      robots.push_back(r);
-    }
+  const std::vector<CrowdRobot> robots = StandingRobotsOf(session.world());
   st.agents = crowd.size();
   for (const AgentConfig& a : crowd) st.vehicles += IsVehicle(a.kind);
   const int steps = static_cast<int>(seconds / sim.dt());
@@ -134,8 +145,11 @@ TEST(CrowdTest, WarehouseForkliftsDriveTheAisleAmongPeopleFor60s) {
   EXPECT_GE(st.least_robot_gap_m, -0.01);
   EXPECT_GT(st.travelled_m, 7 * 15.0);
   // the forklifts' lanes lie on the walkway of the aisle (the warehouse's lane)
-  for (const AgentConfig& a : session.effects().agents())
-    if (a.kind == AgentKind::kForklift) EXPECT_GE(a.waypoints.size(), 2u);
+  for (const AgentConfig& a : session.effects().agents()) {
+    if (a.kind == AgentKind::kForklift) {
+      EXPECT_GE(a.waypoints.size(), 2u);
+    }
+  }
 }
 
 TEST(CrowdTest, PresetPeopleAreAsTallAsThePresetDrewThem) {
@@ -176,21 +190,14 @@ TEST(CrowdTest, BlockPeopleOfAPresetReachTheStandingRobotsPathInBothWorlds) {
     const Session session(
         LoadWorldFile(CrowdWorldPath(world_file)),
         CrowdSessionOptions(CrowdPresetFile(dir, "{people: 3, behaviour: block}")));
-    std::vector<AgentConfig> crowd;
-    for (const AgentConfig& a : session.effects().agents())
-      if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+    const std::vector<AgentConfig> crowd = CrowdAgentsOf(session);
     ASSERT_EQ(crowd.size(), 3u) << world_file;
     const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
     ASSERT_TRUE(map);
     CrowdSim sim(crowd, map->person(), map->vehicle(), session.world().seed);
-    CrowdRobot robot;
-    for (const ModelConfig& m : session.world().models)
-      if (m.is_robot) {
-        robot.position_W = m.pose.xyz.head<2>();
-        robot.yaw = m.pose.rpy_deg.z() * M_PI / 180;
-        robot.radius_m = 0.45;
-        break;
-      }
+    const std::vector<CrowdRobot> robots = StandingRobotsOf(session.world());
+    ASSERT_FALSE(robots.empty());
+    const CrowdRobot robot = robots.front();
     const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
     const Eigen::Vector2d left(-heading.y(), heading.x());
     const double person_r = KindModel(AgentKind::kPerson).disc_radius_m;
@@ -243,20 +250,13 @@ TEST(CrowdTest, BlockPeopleOfAPresetStartInFrontOfTheRobotAndReachItsPathWithin8
       const Session session(LoadWorldFile(CrowdWorldPath(world_file)),
                             CrowdSessionOptions(CrowdPresetFile(
                                 dir, "{people: 4, speed_m_s: 0.8, behaviour: " + behaviour + "}")));
-      std::vector<AgentConfig> crowd;
-      for (const AgentConfig& a : session.effects().agents())
-        if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+      const std::vector<AgentConfig> crowd = CrowdAgentsOf(session);
       ASSERT_EQ(crowd.size(), 4u) << world_file << " " << behaviour;
       const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
       ASSERT_TRUE(map);
-      CrowdRobot robot;
-      for (const ModelConfig& m : session.world().models)
-        if (m.is_robot) {
-          robot.position_W = m.pose.xyz.head<2>();
-          robot.yaw = m.pose.rpy_deg.z() * M_PI / 180;
-          robot.radius_m = 0.45;
-          break;
-        }
+      const std::vector<CrowdRobot> robots = StandingRobotsOf(session.world());
+      ASSERT_FALSE(robots.empty());
+      const CrowdRobot robot = robots.front();
       const Eigen::Vector2d heading(std::cos(robot.yaw), std::sin(robot.yaw));
       int in_front = 0;
       for (size_t i = 0; i < crowd.size(); ++i) {
@@ -307,15 +307,10 @@ TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPath
   // preset puts them ahead
   for (const std::string world_file : {"rover.yaml", "default.yaml"}) {
     const WorldConfig world = LoadWorldFile(CrowdWorldPath(world_file));
-    Eigen::Vector2d start(0, 0);
-    double yaw = 0;
-    for (const ModelConfig& m : world.models)
-      if (m.is_robot) {
-        start = m.pose.xyz.head<2>();
-        yaw = m.pose.rpy_deg.z() * M_PI / 180;
-        break;
-      }
-    const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
+    const std::vector<CrowdRobot> robots = StandingRobotsOf(world);
+    ASSERT_FALSE(robots.empty()) << world_file;
+    const Eigen::Vector2d start = robots.front().position_W;
+    const Eigen::Vector2d heading(std::cos(robots.front().yaw), std::sin(robots.front().yaw));
     // the nav benchmark's rover episode behind_start (benchmarks/nav.yaml): 2.8 m away,
     // 107 deg off the start heading
     const Eigen::Vector2d goal(-2.5, 0.1);
@@ -324,9 +319,7 @@ TEST(CrowdTest, BlockPeopleWithAGoalBehindTheRobotStartOnItsRouteAndReachItsPath
         world, CrowdSessionOptions(CrowdPresetFile(dir,
                                                    "{people: 3, speed_m_s: 0.8, behaviour: block, "
                                                    "block_goal: [-2.5, 0.1]}")));
-    std::vector<AgentConfig> crowd;
-    for (const AgentConfig& a : session.effects().agents())
-      if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
+    const std::vector<AgentConfig> crowd = CrowdAgentsOf(session);
     ASSERT_EQ(crowd.size(), 3u) << world_file;
     const std::shared_ptr<const NpcMap> map = session.effects().npc_map();
     ASSERT_TRUE(map);
