@@ -138,6 +138,18 @@ Eigen::Vector3d ReferenceIrradiance(const RayScene& rays, const SkyModel& sky,
 double Lum(const Eigen::Vector3f& e) { return 0.2126 * e.x() + 0.7152 * e.y() + 0.0722 * e.z(); }
 double Lum(const Eigen::Vector3d& e) { return 0.2126 * e.x() + 0.7152 * e.y() + 0.0722 * e.z(); }
 
+// a point in the 8 x 8 x 5 m box around the window room (outside the volume's grid too) and a
+// unit normal, drawn from `rng` (point first, then normal); false for a normal too short to
+// normalize (the draw is spent either way)
+bool DrawRoomPointAndNormal(Rng* rng, Eigen::Vector3f* p, Eigen::Vector3f* n) {
+  *p = Eigen::Vector3f(8.0f * rng->Uniform() - 4.0f, 8.0f * rng->Uniform() - 4.0f,
+                       5.0f * rng->Uniform() - 1.0f);
+  *n = Eigen::Vector3f(2 * rng->Uniform() - 1, 2 * rng->Uniform() - 1, 2 * rng->Uniform() - 1);
+  if (!(n->norm() > 0.1f)) return false;
+  n->normalize();
+  return true;
+}
+
 TEST(SkyIrradianceVolumeTest, NoFiniteGeometryLeavesTheVolumeEmpty) {
   SceneDescription s = EmptyScene();
   s.sky = UniformSky();
@@ -432,11 +444,8 @@ TEST(SkyIrradianceVolumeTest, BlendThenEvaluateMatchesIrradiance) {
   SkyIrradianceVolume::ShBlend blend;
   for (int i = 0; i < 2000; ++i) {
     // points in the room and around it (outside the grid too).
-    const Eigen::Vector3f p(8.0f * rng.Uniform() - 4.0f, 8.0f * rng.Uniform() - 4.0f,
-                            5.0f * rng.Uniform() - 1.0f);
-    Eigen::Vector3f n(2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1);
-    if (!(n.norm() > 0.1f)) continue;
-    n.normalize();
+    Eigen::Vector3f p, n;
+    if (!DrawRoomPointAndNormal(&rng, &p, &n)) continue;
     vol.Blend(p, n, &blend);
     const Eigen::Vector3f e = vol.Irradiance(p, n, sky);
     const Eigen::Vector3f eb = vol.IrradianceAt(blend, n, sky);
@@ -478,11 +487,8 @@ TEST(SkyIrradianceVolumeTest, SharedScalarLookupIsBitIdenticalToTheCpus) {
     int lit = 0;
     SkyIrradianceVolume::ShBlend blend;
     for (int i = 0; i < 4000; ++i) {
-      const Eigen::Vector3f p(8.0f * rng.Uniform() - 4.0f, 8.0f * rng.Uniform() - 4.0f,
-                              5.0f * rng.Uniform() - 1.0f);
-      Eigen::Vector3f n(2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1, 2 * rng.Uniform() - 1);
-      if (!(n.norm() > 0.1f)) continue;
-      n.normalize();
+      Eigen::Vector3f p, n;
+      if (!DrawRoomPointAndNormal(&rng, &p, &n)) continue;
       if (i % 4 == 0) n = Eigen::Vector3f::Unit(i / 4 % 3) * (i % 8 == 0 ? 1.0f : -1.0f);
       Eigen::Vector3f e_gpu, eb_gpu, r_gpu, bg_gpu, sky_gpu;
       SkyVolumeIrradiance(v, m, p.data(), n.data(), e_gpu.data());
