@@ -197,6 +197,52 @@ TEST(CrowdSimTest, BlockAgentsStepIntoTheRobotsPath) {
   }
 }
 
+TEST(CrowdSimTest, BlockAgentsStandTheirGroundInTheRobotsPathAndStepInFrontWhenItTurns) {
+  AgentConfig a = Walker("blocker", {{-3, 1.0}, {-2, 1.0}});
+  a.behaviour = AgentBehaviour::kBlock;
+  CrowdSim sim({a}, RoomsFor(0.3), RoomsFor(0.7), 5);
+  // the robot stands at (-5.5, 1) facing east: the blocker walks to its block point and holds
+  CrowdRobot robot;
+  robot.radius_m = 0.4;
+  robot.position_W = {-5.5, 1.0};
+  bool held = false;
+  for (int k = 0; k < 200 && !held; ++k) {
+    sim.Step({robot});
+    for (const CrowdDecision& d : sim.TakeDecisions()) held = held || d.what == "hold";
+  }
+  ASSERT_TRUE(held);
+  const Eigen::Vector2d hold_at = sim.states()[0].position_W;
+  EXPECT_GT(hold_at.x(), robot.position_W.x());
+  EXPECT_LE(std::abs(hold_at.y() - 1.0), 0.4 + 0.25);
+  // the robot drives at it (0.3 m/s east): the blocker does not give way, so the robot's disc
+  // reaches its disc (the robot walks into a standing person)
+  robot.velocity_W = {0.3, 0};
+  const double t0 = sim.time_sec();
+  double least_gap = 1e9;
+  while (robot.position_W.x() < hold_at.x() - 0.3) {  // until its centre is 0.3 m short of it
+    robot.position_W = {-5.5 + 0.3 * (sim.time_sec() - t0), 1.0};
+    sim.Step({robot});
+    ASSERT_EQ(sim.states()[0].position_W, hold_at) << "at t = " << sim.time_sec();
+    least_gap =
+        std::min(least_gap, (sim.states()[0].position_W - robot.position_W).norm() - 0.4 - 0.25);
+  }
+  EXPECT_LT(least_gap, 0.0);
+  // the robot backs off and turns north: the blocker leaves its place and steps in front of it
+  // again within 4 s
+  robot.position_W = {-5.5, 1.0};
+  robot.velocity_W = {0, 0.3};
+  const double t1 = sim.time_sec();
+  bool in_path = false;
+  for (int k = 0; k < 80 && !in_path; ++k) {
+    robot.position_W = {-5.5, 1.0 + 0.3 * (sim.time_sec() - t1)};
+    sim.Step({robot});
+    const Eigen::Vector2d p = sim.states()[0].position_W;
+    in_path = std::abs(p.x() - robot.position_W.x()) <= 0.4 + 0.25 &&
+              p.y() > robot.position_W.y() && p.y() - robot.position_W.y() < 1.65;
+  }
+  EXPECT_TRUE(in_path);
+}
+
 // a 16 x 16 m hall with walls round it
 OccupancyGrid OpenHallGrid() {
   OccupancyGrid g;
@@ -293,7 +339,7 @@ TEST(CrowdSimTest, AForkliftsWheelsSteerAsItsBicycleModelTurns) {
     ++compared;
   }
   EXPECT_GE(compared, 5);  // steady stretches of its corners
-  EXPECT_LT(worst, 0.01);   // rad
+  EXPECT_LT(worst, 0.01);  // rad
 }
 
 // every agent's pose over 30 s of a mixed crowd (random goals) as raw bits

@@ -20,7 +20,15 @@ constexpr double kTurnRate = 6.0;         // people's heading rate limit, rad/s
 constexpr double kLookAheadM = 1.5;       // pure pursuit look-ahead, m
 constexpr double kVehicleAccel = 1.5;     // vehicles' speed change limit, m/s^2
 constexpr double kSafetyM = 0.02;         // added to every combined radius, m
-constexpr double kBlockReplanSec = 1.0;
+constexpr double kBlockReplanSec = 1.0;   // a `block` agent's new block point, s
+constexpr double kBlockAheadM = 0.5;      // block point: this far beyond the discs' contact, m
+constexpr double kBlockHoldM = 0.5;       // holds while no farther than the block point + this, m
+
+// the direction a robot is going: its velocity when moving, else its yaw
+Eigen::Vector2d RobotHeading(const CrowdRobot& robot) {
+  return robot.velocity_W.norm() > 0.1 ? Eigen::Vector2d(robot.velocity_W.normalized())
+                                       : Eigen::Vector2d(std::cos(robot.yaw), std::sin(robot.yaw));
+}
 
 double WrapAngle(double a) { return std::remainder(a, 2 * M_PI); }
 
@@ -65,6 +73,7 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   patrol_dir_.assign(n, 1);
   pause_until_.resize(n);
   replan_at_.assign(n, 0);
+  holding_.assign(n, 0);
   gear_.assign(n, 1);
   speed_.assign(n, 0);
   slow_since_.assign(n, 0);
@@ -130,19 +139,11 @@ void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
   const AgentConfig& a = agents_[i];
   const int n = static_cast<int>(a.waypoints.size());
   if (a.behaviour == AgentBehaviour::kBlock && !robots.empty()) {
-    // the point 0.5 m beyond the discs' contact ahead of the nearest robot along its heading (its
-    // velocity when moving)
-    size_t best = 0;
-    for (size_t r = 1; r < robots.size(); ++r)
-      if ((robots[r].position_W - states_[i].position_W).squaredNorm() <
-          (robots[best].position_W - states_[i].position_W).squaredNorm())
-        best = r;
-    const CrowdRobot& robot = robots[best];
-    const Eigen::Vector2d heading = robot.velocity_W.norm() > 0.1
-                                        ? Eigen::Vector2d(robot.velocity_W.normalized())
-                                        : Eigen::Vector2d(std::cos(robot.yaw), std::sin(robot.yaw));
-    const double ahead = robot.radius_m + KindModel(a.kind).disc_radius_m + 0.5;
-    MakePlan(i, robot.position_W + ahead * heading, "block", robots);
+    // the point kBlockAheadM beyond the discs' contact ahead of the nearest robot along its
+    // heading
+    const CrowdRobot& robot = NearestRobot(i, robots);
+    const double ahead = robot.radius_m + KindModel(a.kind).disc_radius_m + kBlockAheadM;
+    MakePlan(i, robot.position_W + ahead * RobotHeading(robot), "block", robots);
     replan_at_[i] = time_ + kBlockReplanSec;
     return;
   }
@@ -163,6 +164,26 @@ void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
   }
   goal_index_[i] = next;
   MakePlan(i, a.waypoints[next], "goal", robots);
+}
+
+const CrowdRobot& CrowdSim::NearestRobot(size_t i, const std::vector<CrowdRobot>& robots) const {
+  size_t best = 0;
+  for (size_t r = 1; r < robots.size(); ++r)
+    if ((robots[r].position_W - states_[i].position_W).squaredNorm() <
+        (robots[best].position_W - states_[i].position_W).squaredNorm())
+      best = r;
+  return robots[best];
+}
+
+bool CrowdSim::InRobotsPath(size_t i, const std::vector<CrowdRobot>& robots) const {
+  const CrowdRobot& robot = NearestRobot(i, robots);
+  const Eigen::Vector2d h = RobotHeading(robot);
+  const Eigen::Vector2d rel = states_[i].position_W - robot.position_W;
+  const double own = KindModel(agents_[i].kind).disc_radius_m;
+  const double along = rel.dot(h);
+  const double lateral = std::abs(h.x() * rel.y() - h.y() * rel.x());
+  return along > 0 && along <= robot.radius_m + own + kBlockAheadM + kBlockHoldM &&
+         lateral <= robot.radius_m + own;
 }
 
 Eigen::Vector2d CrowdSim::Preferred(size_t i) {
@@ -201,7 +222,23 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     const AgentConfig& a = agents_[i];
     Plan& plan = plans_[i];
     if (a.behaviour == AgentBehaviour::kBlock && !robots.empty()) {
-      if (time_ >= replan_at_[i] && time_ >= pause_until_[i]) ChooseGoal(i, robots);
+      // a blocker that reached its block point stands its ground while it stays in the robot's
+      // path: it neither replans nor yields to the robot (a robot that keeps coming walks into
+      // it); out of the path, it steps in front again
+      const bool at_point = !plan.active || (states_[i].position_W - plan.goal).norm() < kReachedM;
+      const bool hold =
+          time_ >= pause_until_[i] && (holding_[i] || at_point) && InRobotsPath(i, robots);
+      if (hold && !holding_[i]) {
+        plan.active = false;
+        CrowdDecision d;
+        d.time_sec = time_;
+        d.agent = static_cast<int>(i);
+        d.what = "hold";
+        d.goal_W = states_[i].position_W;
+        decisions_.push_back(d);
+      }
+      holding_[i] = hold ? 1 : 0;
+      if (!hold && time_ >= replan_at_[i] && time_ >= pause_until_[i]) ChooseGoal(i, robots);
     } else if (plan.active && (states_[i].position_W - plan.goal).norm() <
                                   (IsVehicle(a.kind) ? kVehicleReachedM : kReachedM)) {
       plan.active = false;
@@ -238,6 +275,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     const CrowdAgentState& s = states_[i];
     lines.clear();
     const bool vehicle = IsVehicle(a.kind);
+    if (holding_[i]) continue;  // stands still: velocity 0
     for (size_t j = 0; j < n; ++j) {
       if (j == i || !active_[j]) continue;
       Eigen::Vector2d rel = states_[j].position_W - s.position_W;

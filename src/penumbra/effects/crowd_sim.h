@@ -95,8 +95,10 @@ struct CrowdRobot {
 /// one decision of the crowd (what a run log records as an "npc" event).
 struct CrowdDecision {
   double time_sec = 0;
-  int agent = 0;     ///< index into the agents
-  std::string what;  ///< "goal", "replan", "pause", "blocked" (no plan to the goal)
+  int agent = 0;  ///< index into the agents
+  ///< "goal", "block" (a new block point), "hold" (a `block` agent stands its ground in a
+  ///< robot's path), "pause", "stuck", "blocked" (no plan to the goal)
+  std::string what;
   Eigen::Vector2d goal_W{0, 0};
   int plan_points = 0;  ///< points of the plan made (0 = none)
 };
@@ -151,6 +153,12 @@ class CrowdSim {
   Eigen::Vector2d Preferred(size_t i);
   void AddRobotLines(size_t i, const std::vector<CrowdRobot>& robots, double own_radius,
                      const Eigen::Vector2d& v_a, std::vector<OrcaLine>* lines) const;
+  /// the robot nearest agent i (robots not empty).
+  const CrowdRobot& NearestRobot(size_t i, const std::vector<CrowdRobot>& robots) const;
+  /// whether `block` agent i stands in the nearest robot's path: ahead of it, inside its swept
+  /// corridor (robot radius + agent radius either side of its heading), no farther than its
+  /// block point plus kBlockHoldM.
+  bool InRobotsPath(size_t i, const std::vector<CrowdRobot>& robots) const;
 
   std::vector<AgentConfig> agents_;
   std::shared_ptr<const WalkableGrid> person_region_, vehicle_region_;
@@ -163,6 +171,7 @@ class CrowdSim {
   std::vector<int> patrol_dir_;  // pingpong: +1 / -1
   std::vector<double> pause_until_;
   std::vector<double> replan_at_;  // block: the time of the next replan
+  std::vector<uint8_t> holding_;   // block: standing its ground in a robot's path
   std::vector<int> gear_;          // vehicles: +1 forward, -1 reverse
   std::vector<double> speed_;      // vehicles: signed speed along the heading, m/s
   std::vector<double> slow_since_;
