@@ -73,6 +73,10 @@ struct RealtimeKernelOptions {
   /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
   /// again).
   bool reuse_hit = true;
+  /// with reuse_hit: the geometry kernel keeps each hit's material terms (SurfaceTerms, 40 bytes
+  /// a pixel) and the shading kernel shades from them and the primary geometry
+  /// (ShadeRealtimeStored) instead of evaluating the surface (textures, normal map) again.
+  bool reuse_surface = true;
   /// one warp sums a row's log-luminance terms (32 strided partial sums, then a fixed tree);
   /// else one thread sums the row in column order.
   bool rows_per_warp = true;
@@ -88,6 +92,10 @@ struct RealtimeKernelOptions {
   /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
   /// warps in flight, maybe spills). with reuse_hit only.
   int min_blocks = 0;
+  /// the shared visibility's penumbra rays: a warp's rays spread over its 32 lanes
+  /// (VisibilityRaysWarpKernel, the same integer counts); else each pixel traces its own in
+  /// turn (SharedVisibilityRays).
+  bool warp_penumbra = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;
@@ -111,6 +119,9 @@ struct RealtimeStageTimes {
   /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
   /// host's launch and wait overheads)
   double film = 0;
+  /// of film: the host's copies of the radiance and rgb into the frame's images (pinned), from
+  /// the copy stream's end to the last copy (the depth is copied while the GPU shades)
+  double outputs = 0;
   double total = 0;
 };
 
