@@ -5,7 +5,7 @@
 # pack's, interleaved (--realtime, default and house at 640x480), the realtime `gpu` tests, and
 # Nsight Compute on one frame's realtime kernels of each if ncu is there; the logs go to RESULTS
 # (default $OUT or /tmp/ab-out), a summary to stdout. steps stop starting after AB_BUDGET_S
-# (default 380) seconds.
+# (default 380) seconds; AB_TESTS=0 skips the tests, AB_NCU="new" profiles this pack's alone.
 #
 #   scripts/gpu/ab.sh PACK.tar.xz BASELINE_render_cuda_bench.xz [repeats]
 set -u
@@ -38,10 +38,10 @@ for k in $(seq 1 "$repeats"); do
   step base_$k 70 "$B/base_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"
   step new_$k 70 "$B/render_cuda_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"
 done
-step tests 150 "$B/render_cuda_gpu_tests" --gtest_filter='*RealtimeSpeedUps*:*RealtimeRgbGpu*'
+[ "${AB_TESTS:-1}" = 1 ] && step tests 150 "$B/render_cuda_gpu_tests" --gtest_filter='*RealtimeSpeedUps*:*RealtimeRgbGpu*'
 NCU=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null | head -1)
 if [ -n "$NCU" ]; then
-  for who in new base; do
+  for who in ${AB_NCU:-new base}; do
     bin=$B/render_cuda_bench; [ $who = base ] && bin=$B/base_bench
     step ncu_$who 60 "$NCU" --kernel-name regex:'Kernel' --launch-count 12 \
       --section SpeedOfLight --section Occupancy --section LaunchStats \
@@ -55,7 +55,7 @@ for f in "$R"/base_*.txt "$R"/new_*.txt; do
   echo "-- $(basename "$f")"
   grep -E '^\| (default|house)' "$f" | grep -E 'device sky|kernels|bit-identical' | grep -v 'host sky'
 done
-echo; echo "== tests"; grep -E '^\[ +(OK|FAILED) +\]|radiance|PSNR|psnr|dB' "$R/tests.txt" | head -40
+[ -f "$R/tests.txt" ] && echo && echo "== tests" && grep -E '^\[ +(OK|FAILED) +\]|radiance|PSNR|psnr|dB' "$R/tests.txt" | head -40
 for who in new base; do
   [ -f "$R/ncu_$who.txt" ] || continue
   echo; echo "== ncu $who"

@@ -20,9 +20,12 @@ namespace {
 constexpr unsigned kFullWarp = 0xffffffffu;
 
 // hits, surfaces: null, or where the primary hits and their material terms are kept for the
-// shading kernel.
-__global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth,
-                               TraceHit* hits, SurfaceTerms* surfaces) {
+// shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
+// threads an SM).
+template <int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth, TraceHit* hits,
+                   SurfaceTerms* surfaces) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
@@ -322,6 +325,8 @@ struct DeviceRealtime::Impl {
   cudaEvent_t depth_copied = nullptr;   // the depth is in its pinned buffer
   // band k's geometry is on the host (Render's bands)
   cudaEvent_t band_done[kMaxSkyBands] = {};
+  // band k of the radiance is in its pinned buffer (RealtimeKernelOptions::output_bands)
+  cudaEvent_t radiance_band[kMaxSkyBands] = {};
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -332,10 +337,15 @@ struct DeviceRealtime::Impl {
 
   void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
                       cudaStream_t stream) {
-    GeometryKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
-        f, geometry.as<PixelGeometry>(), depth.as<float>(),
-        o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr,
-        o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr);
+    const dim3 grid = PixelGrid(f.camera.width, f.camera.height);
+    TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
+    SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
+    if (o.geometry_min_blocks >= 5)
+      GeometryKernel<5><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
+                                                          depth.as<float>(), h, st);
+    else
+      GeometryKernel<1><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
+                                                          depth.as<float>(), h, st);
     Check(cudaGetLastError(), "GeometryKernel");
     if (f.any_mirror != 0) {
       MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(f);
@@ -421,6 +431,8 @@ struct DeviceRealtime::Impl {
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (radiance_done) cudaEventDestroy(radiance_done);
     if (depth_copied) cudaEventDestroy(depth_copied);
+    for (cudaEvent_t e : radiance_band)
+      if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : band_done)
       if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : stage)
@@ -486,6 +498,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.depth_copied, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.radiance_band)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.stage) Check(cudaEventCreate(&e), "cudaEventCreate");
@@ -667,10 +681,23 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // radiance goes back on the copy stream while the host computes the exposure and the film
   // kernel runs
   m.LaunchAfterShade(f, o, stream);
+  // the radiance goes back in bands of rows, each behind an event, so that the host copies band
+  // k into the frame's image while band k + 1 comes back
+  const int out_bands = std::clamp(o.output_bands, 1, kMaxSkyBands);
+  const int out_rows = (H + out_bands - 1) / out_bands;
+  auto out_row = [&](int k) { return std::min(H, k * out_rows); };
   if (out.radiance && o.pinned) {
     Check(cudaEventRecord(m.radiance_done, stream), "cudaEventRecord");
     Check(cudaStreamWaitEvent(m.copy_stream, m.radiance_done, 0), "cudaStreamWaitEvent");
-    m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
+    for (int k = 0; k < out_bands; ++k) {
+      const size_t off = static_cast<size_t>(out_row(k)) * W;
+      const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+      if (count > 0)
+        Check(cudaMemcpyAsync(m.pin_radiance.as<Float3>() + off, m.radiance.as<Float3>() + off,
+                              sizeof(Float3) * count, cudaMemcpyDeviceToHost, m.copy_stream),
+              "cudaMemcpyAsync");
+      Check(cudaEventRecord(m.radiance_band[k], m.copy_stream), "cudaEventRecord");
+    }
   }
   m.rows.Download(host_rows, sizeof(double) * H, stream);
   if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
@@ -690,10 +717,16 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   if (o.pinned) {
     // the radiance into the frame's image while the film kernel runs, then the rgb
     if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
-    Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
     const auto tc = Clock::now();
     if (out.radiance)
-      ParallelCopy(out.parallel, {{out.radiance, m.pin_radiance.p, sizeof(Float3) * n}});
+      for (int k = 0; k < out_bands; ++k) {
+        Check(cudaEventSynchronize(m.radiance_band[k]), "copying the realtime radiance");
+        const size_t off = static_cast<size_t>(out_row(k)) * W;
+        const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+        ParallelCopy(out.parallel, {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
+                                     sizeof(Float3) * count}});
+      }
+    Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
     if (out.rgb) ParallelCopy(out.parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}});
     m.times.outputs = MsSince(tc);

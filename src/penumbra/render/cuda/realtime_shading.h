@@ -774,8 +774,9 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
   const int64_t k = j * n + i;
   PenumbraRays job;
   f.area_own[k] = 0;
+  if (!IsExtendedLightPod(f.lights[j])) return job;
   const int8_t vis = f.area_vis[k];
-  if (vis < 0 || !IsExtendedLightPod(f.lights[j])) return job;
+  if (vis < 0) return job;
   job.active = 1;
   job.visible = static_cast<float>(vis);
   bool seen[2] = {false, false};
@@ -858,7 +859,7 @@ PB_HOST_DEVICE inline void SharedVisibilityFraction(const RealtimeFrameView& f, 
   const int64_t i = static_cast<int64_t>(v) * W + u;
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
-    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
     if (f.area_own[k] != 0) {
       f.area_fraction[k] = f.area_visible[k] / f.area_rays[k];
       continue;
@@ -890,7 +891,7 @@ PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f,
   const int x = u - tile.x0, y = v - tile.y0;
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
-    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
     float V = f.area_fraction[k];
     if (f.lights[j].kind != LightKind::kDirectional && f.area_own[k] == 0) {
       float sum = 0;
