@@ -62,6 +62,33 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPath,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml",
                                            "outdoor.yaml", "effects/walkers.yaml"));
 
+// the kernels shade from the material terms the geometry pass kept (ShadeRealtimeStored,
+// RealtimeKernelOptions::reuse_surface) instead of evaluating the surface again: the same
+// radiance, rgb and depth bits, in the default room (planar textures, mirror floor) and the
+// house (textured floors and walls, normal maps).
+TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
+  for (const char* world : {"default.yaml", "house.yaml"}) {
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(world);
+    const SceneDescription& scene = session->scene();
+    const WorldSnapshot snap = session->sim().Snapshot();
+    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+    cuda::BvhScene bvh(scene);
+    bvh.Update(snap);
+    cuda::RealtimeFrameData data(scene, RenderSettings());
+    ThreadPool pool(0);
+    data.Prepare(snap, view, &pool);
+    RenderedFrame evaluated, stored;
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &evaluated, /*stored_surface=*/false);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &stored, /*stored_surface=*/true);
+    int64_t lit = 0;
+    for (float x : stored.radiance.data) lit += x > 0;
+    EXPECT_GT(lit, 0) << world;
+    EXPECT_EQ(stored.radiance.data, evaluated.radiance.data) << world;
+    EXPECT_EQ(stored.rgb.data, evaluated.rgb.data) << world;
+    EXPECT_EQ(stored.depth_m.data, evaluated.depth_m.data) << world;
+  }
+}
+
 // the GPU's Render() asks for the sky terms band by band (rows [r0, r1)): every pixel's bits are
 // those of the whole frame's pass, primary and mirrored; odd bounds before the last row are
 // refused (a 2x2 quad would be split).

@@ -1,9 +1,11 @@
 // the realtime kernels' speed-ups (cuda_realtime.h, RealtimeKernelOptions) change no pixel
 // (ctest label `gpu`): on the default room (lamps) and the house (the sun through windows) at
 // 640x480, the radiance and depth with every speed-up are the same bits as with each one turned
-// off (the primary hit traced again by the shading kernel, one thread per row sum, pageable
-// copies); the rgb too, except that the row sums' order can move the exposure's last bits
-// (then the EV100 agrees to 1e-9). without a device every test prints "skipped: no CUDA device".
+// off (the primary hit traced again by the shading kernel, the surface evaluated again by it,
+// one thread per row sum, pageable copies, each pixel tracing its own penumbra rays, the
+// kernels' registers uncapped, the radiance copied back in 1 or 5 bands); the rgb too, except that
+// the row sums' order can move the exposure's last bits (then the EV100 agrees to 1e-9). without a
+// device every test prints "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -40,16 +42,35 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     cuda::RealtimeKernelOptions o;
   };
   std::vector<Variant> variants;
-  const char* names[] = {"reuse_hit off", "rows_per_warp off", "pinned off",
-                         "all off",       "min_blocks 4",      "min_blocks 6"};
-  for (int k = 0; k < 6; ++k) {
+  const char* names[] = {"reuse_hit off",
+                         "rows_per_warp off",
+                         "pinned off",
+                         "all off",
+                         "min_blocks 1",
+                         "min_blocks 6",
+                         "warp_penumbra off",
+                         "reuse_surface off",
+                         "reuse_surface off, min_blocks 1",
+                         "geometry_min_blocks 1",
+                         "output_bands 1",
+                         "output_bands 5"};
+  for (int k = 0; k < 12; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
     if (k == 2) o.pinned = false;
-    if (k == 3) o = {false, false, false, 0};
-    if (k == 4) o.min_blocks = 4;
+    if (k == 3) {
+      o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
+      o.min_blocks = o.geometry_min_blocks = 0;
+      o.output_bands = 1;
+    }
+    if (k == 4 || k == 8) o.min_blocks = 1;
     if (k == 5) o.min_blocks = 6;
+    if (k == 6) o.warp_penumbra = false;
+    if (k == 7 || k == 8) o.reuse_surface = false;
+    if (k == 9) o.geometry_min_blocks = 1;
+    if (k == 10) o.output_bands = 1;
+    if (k == 11) o.output_bands = 5;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -74,7 +74,8 @@ int PositiveArg(const std::string& s) {
 int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, int frames) {
   fmt::print(
       "\n| world | size | variant | frames/s | ms/frame | geometry ms | sky ms | shade ms "
-      "| film+copies ms | rgb as default |\n|---|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+      "| film+copies ms (copies after the row sums) | rgb as default "
+      "|\n|---|---|---|---:|---:|---:|---:|---:|---:|---|\n");
   for (const std::string& file : worlds) {
     SessionOptions so;
     so.build_renderer = false;
@@ -115,6 +116,10 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     }
     copy_variants.push_back(fast);
     copy_variants.back().pinned = false;
+    for (const int bands : {1, 4}) {
+      copy_variants.push_back(fast);
+      copy_variants.back().output_bands = bands;
+    }
     for (const cuda::RealtimeKernelOptions& o : copy_variants) {
       const bool pinned = o.pinned;
       rt.set_options(o);
@@ -126,18 +131,22 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
         gpu->Render(snap, view, &f);
         const cuda::RealtimeStageTimes& t = rt.last_stage_times();
         sum.geometry += t.geometry, sum.sky += t.sky, sum.shade += t.shade, sum.film += t.film;
+        sum.outputs += t.outputs;
       }
       const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
       fmt::print(
           "| {} | {} | cuda Render(), {} copies | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
-          "{:.3f} | {:.3f} | {} |\n",
+          "{:.3f} | {:.3f} ({:.3f}) | {} |\n",
           name, size,
-          fmt::format("{}, {}", pinned ? "pinned" : "pageable",
-                      o.device_sky ? std::string("device sky")
-                                   : fmt::format("host sky in {} band{}", o.sky_bands,
-                                                 o.sky_bands == 1 ? "" : "s")),
+          fmt::format(
+              "{}, {}", pinned ? "pinned" : "pageable",
+              o.device_sky
+                  ? (pinned ? fmt::format("device sky, radiance in {} band{}", o.output_bands,
+                                          o.output_bands == 1 ? "" : "s")
+                            : std::string("device sky"))
+                  : fmt::format("host sky in {} band{}", o.sky_bands, o.sky_bands == 1 ? "" : "s")),
           1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
-          sum.film / frames, f.rgb.data == want.rgb.data ? "yes" : "NO");
+          sum.film / frames, sum.outputs / frames, f.rgb.data == want.rgb.data ? "yes" : "NO");
     }
     rt.set_options(fast);
     // the kernels alone: the default, each speed-up off, all off
@@ -150,14 +159,26 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_hit = false;
     variants.push_back({"kernels, primary ray traced twice", o});
     o = fast;
-    o.min_blocks = 4;
-    variants.push_back({"kernels, shading <= 128 registers", o});
+    o.min_blocks = 1;
+    variants.push_back({"kernels, shading registers uncapped", o});
     o.min_blocks = 6;
     variants.push_back({"kernels, shading <= 85 registers", o});
+    o = fast;
+    o.geometry_min_blocks = 1;
+    variants.push_back({"kernels, geometry registers uncapped", o});
+    o = fast;
+    o.warp_penumbra = false;
+    variants.push_back({"kernels, penumbra rays per pixel", o});
+    o = fast;
+    o.reuse_surface = false;
+    variants.push_back({"kernels, surface evaluated twice", o});
     o = fast;
     o.rows_per_warp = false;
     variants.push_back({"kernels, row sums per thread", o});
     o.reuse_hit = false;
+    o.reuse_surface = false;
+    o.warp_penumbra = false;
+    o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);
     for (const Variant& var : variants) {

@@ -4,7 +4,8 @@
 // implemented in realtime_kernels.cu; plain structs only here (no Eigen, no CUDA headers).
 // every function throws penumbra::Error naming the CUDA call when the runtime reports an error.
 //
-// a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth;
+// a frame: (1) a kernel traces every pixel's primary ray and writes its geometry and depth
+// (and, by default, the hit's material terms, SurfaceTerms, for the shading kernel);
 // with a mirror layer in the scene it also traces the mirrored rays (TraceMirrorRay);
 // (2) a kernel turns the geometry into sky terms, one thread per 2x2 quad (QuadSkyTerms) and,
 // with a mirror layer, one per mirrored ray (MirrorSkyTerm): the shared lookups of
@@ -14,7 +15,8 @@
 // runs the same functions on the CPU, realtime_frame.h, in bands of rows with pinned copies,
 // RealtimeKernelOptions::sky_bands: band k's geometry comes back while the host computes band
 // k - 1's sky terms, and band k's shading kernel runs while the host computes band k + 1's);
-// (3) the shading kernel (ShadeRealtimePixel), the shared visibility's kernels and
+// (3) the shading kernel (ShadeRealtimeStored, or ShadeRealtimePixel), the shared visibility's
+// kernels (a warp's penumbra rays spread over its lanes) and
 // the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which the
 // host (`exposure`) turns into the frame's EV100 and exposures; (5) the film kernel (DevelopPixel).
 // every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
@@ -73,6 +75,10 @@ struct RealtimeKernelOptions {
   /// the shading kernel takes the primary hit the geometry kernel traced (else it traces it
   /// again).
   bool reuse_hit = true;
+  /// with reuse_hit: the geometry kernel keeps each hit's material terms (SurfaceTerms, 40 bytes
+  /// a pixel) and the shading kernel shades from them and the primary geometry
+  /// (ShadeRealtimeStored) instead of evaluating the surface (textures, normal map) again.
+  bool reuse_surface = true;
   /// one warp sums a row's log-luminance terms (32 strided partial sums, then a fixed tree);
   /// else one thread sums the row in column order.
   bool rows_per_warp = true;
@@ -85,9 +91,20 @@ struct RealtimeKernelOptions {
   /// while the host computes band k + 1's (1: the whole frame at once). pageable copies: always 1.
   int sky_bands = 4;
   /// the shading kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
-  /// 0 or 1 leaves the registers to the compiler; 4 caps them at 128 a thread, 6 at 85 (more
-  /// warps in flight, maybe spills). with reuse_hit only.
-  int min_blocks = 0;
+  /// 0 or 1 leaves the registers to the compiler (130); 4 caps them at 128 a thread (4 blocks an
+  /// SM instead of 3, no spills), 6 at 85 (more warps in flight, spills). with reuse_hit only.
+  int min_blocks = 4;
+  /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
+  /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
+  /// reuse_surface), below 5 leaves them to the compiler.
+  int geometry_min_blocks = 5;
+  /// with pinned copies, the radiance goes back in this many bands of rows (1 to
+  /// kMaxSkyBands), each copied into the frame's image while the next one comes back.
+  int output_bands = 2;
+  /// the shared visibility's penumbra rays: a warp's rays spread over its 32 lanes
+  /// (VisibilityRaysWarpKernel, the same integer counts); else each pixel traces its own in
+  /// turn (SharedVisibilityRays).
+  bool warp_penumbra = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;
@@ -111,6 +128,9 @@ struct RealtimeStageTimes {
   /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
   /// host's launch and wait overheads)
   double film = 0;
+  /// of film: the host's copies of the radiance and rgb into the frame's images (pinned), from
+  /// the copy stream's end to the last copy (the depth is copied while the GPU shades)
+  double outputs = 0;
   double total = 0;
 };
 

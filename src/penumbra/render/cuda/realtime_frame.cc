@@ -246,19 +246,21 @@ double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pix
 }
 
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out) {
+                          RenderedFrame* out, bool stored_surface) {
   const PinholeCamera& c = data.camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
   const SceneView scene = bvh.view();
   const RealtimeFrameView geo_view = data.View(scene, nullptr);
   std::vector<PixelGeometry> geometry(n);
+  std::vector<SurfaceTerms> surfaces(stored_surface ? n : 0);
   if (out->depth_m.width != W || out->depth_m.height != H || out->depth_m.channels != 1)
     out->depth_m = ImageF(W, H, 1);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     for (int u = 0; u < W; ++u) {
       const int64_t i = v * W + u;
-      geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i]);
+      geometry[i] = PrimaryGeometry(geo_view, u, static_cast<int>(v), &out->depth_m.data[i],
+                                    nullptr, stored_surface ? &surfaces[i] : nullptr);
     }
   });
   // the mirror layer's rays, traced from the primary geometry (on the GPU their geometry
@@ -306,7 +308,12 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   f.area_fraction = area_fraction.data();
   std::vector<Float3> radiance(n);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) radiance[v * W + u] = ShadeRealtimePixel(f, u, static_cast<int>(v));
+    for (int u = 0; u < W; ++u) {
+      const int64_t i = v * W + u;
+      radiance[i] = stored_surface
+                        ? ShadeRealtimeStored(f, u, static_cast<int>(v), geometry[i], surfaces[i])
+                        : ShadeRealtimePixel(f, u, static_cast<int>(v));
+    }
   });
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));

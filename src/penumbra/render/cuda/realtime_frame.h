@@ -124,7 +124,10 @@ PinholeCamera PinholeCameraOf(const CameraView& view);
 /// renders a realtime frame (rgb, radiance, depth) with the GPU path's per-pixel functions on
 /// the CPU over `bvh` (posed for the frame) and `data` (Prepared for it): the parity of the GPU
 /// path with the CPU backend can be checked on machines without a GPU. rows over `pool`.
+/// `stored_surface`: shade each pixel from the material terms its primary geometry kept
+/// (ShadeRealtimeStored, the kernels' default) instead of evaluating the surface again
+/// (ShadeRealtimePixel); the two give the same bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out);
+                          RenderedFrame* out, bool stored_surface = false);
 
 }  // namespace penumbra::cuda

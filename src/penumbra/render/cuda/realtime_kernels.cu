@@ -19,14 +19,20 @@ namespace {
 
 constexpr unsigned kFullWarp = 0xffffffffu;
 
-__global__ void GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth,
-                               TraceHit* hits) {
+// hits, surfaces: null, or where the primary hits and their material terms are kept for the
+// shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
+// threads an SM).
+template <int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth, TraceHit* hits,
+                   SurfaceTerms* surfaces) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   float t;
-  geometry[i] = PrimaryGeometry(f, u, v, &t, hits ? &hits[i] : nullptr);
+  geometry[i] =
+      PrimaryGeometry(f, u, v, &t, hits ? &hits[i] : nullptr, surfaces ? &surfaces[i] : nullptr);
   depth[i] = t;
 }
 
@@ -92,6 +98,19 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
 }
 
+// ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
+// ShadeRealtimeStored): no second surface evaluation.
+template <int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    ShadeStoredKernel(RealtimeFrameView f, const SurfaceTerms* surfaces, Float3* radiance, int row0,
+                      int row1) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (u >= f.camera.width || v >= row1) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  radiance[i] = ShadeRealtimeStored(f, u, v, f.geometry[i], surfaces[i]);
+}
+
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
 // each reads its neighbours' results of the step before.
 __global__ void VisibilityRaysKernel(RealtimeFrameView f) {
@@ -99,6 +118,70 @@ __global__ void VisibilityRaysKernel(RealtimeFrameView f) {
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
   SharedVisibilityRays(f, u, v);
+}
+
+// VisibilityRaysKernel with a warp's penumbra rays spread over its 32 lanes: per light, the
+// lanes' rays (pixel l's rays 1 .. extra_l - 1) are numbered in lane order (an inclusive scan),
+// lane t of round b traces ray b 32 + t of the pixel whose range holds it, and each pixel sums
+// its rays' verdicts (ballots): the same integer counts as one thread per pixel, so the same
+// bits, without the warp waiting on the one ring pixel that traces 63 rays. whole warps run
+// every step (pixels outside the image take part with no rays).
+__global__ void VisibilityRaysWarpKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  const int W = f.camera.width, H = f.camera.height;
+  const bool inside = u < W && v < H;
+  const int lane = static_cast<int>((threadIdx.y * blockDim.x + threadIdx.x) & 31u);
+  const uint32_t bits = inside ? SharedVisibilityWindow(f, u, v) : 0u;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int64_t i = static_cast<int64_t>(v) * W + u;
+  for (int j = 0; j < f.num_lights; ++j) {
+    PenumbraRays job;
+    if (inside) job = SharedVisibilityPenumbra(f, u, v, j, bits);
+    const int count = job.active != 0 && job.extra > 1 ? job.extra - 1 : 0;
+    int end = count;  // inclusive scan: this lane's rays are [end - count, end)
+    for (int d = 1; d < 32; d *= 2) {
+      const int x = __shfl_up_sync(kFullWarp, end, d);
+      if (lane >= d) end += x;
+    }
+    const int begin = end - count;
+    const int total = __shfl_sync(kFullWarp, end, 31);
+    int traced = 0, visible = 0;
+    for (int base = 0; base < total; base += 32) {
+      const int t = base + lane;
+      // the owner: the lowest lane whose range ends beyond t
+      int owner = 0;
+      for (int step = 16; step > 0; step /= 2) {
+        const int e = __shfl_sync(kFullWarp, end, owner + step - 1);
+        if (e <= t) owner += step;
+      }
+      PenumbraRays o;
+      o.p.x = __shfl_sync(kFullWarp, job.p.x, owner);
+      o.p.y = __shfl_sync(kFullWarp, job.p.y, owner);
+      o.p.z = __shfl_sync(kFullWarp, job.p.z, owner);
+      o.ng.x = __shfl_sync(kFullWarp, job.ng.x, owner);
+      o.ng.y = __shfl_sync(kFullWarp, job.ng.y, owner);
+      o.ng.z = __shfl_sync(kFullWarp, job.ng.z, owner);
+      o.first = __shfl_sync(kFullWarp, job.first, owner);
+      o.points = __shfl_sync(kFullWarp, job.points, owner);
+      o.own = __shfl_sync(kFullWarp, job.own, owner);
+      const int owner_begin = __shfl_sync(kFullWarp, begin, owner);
+      const int verdict = t < total ? PenumbraRayVerdict(f, j, o, t - owner_begin + 1) : -1;
+      const uint32_t traced_lanes = __ballot_sync(kFullWarp, verdict >= 0);
+      const uint32_t visible_lanes = __ballot_sync(kFullWarp, verdict > 0);
+      // this lane's rays among this round's lanes
+      const int lo = max(begin, base) - base, hi = min(end, base + 32) - base;
+      if (hi > lo) {
+        const uint32_t mine = (hi - lo == 32 ? kFullWarp : ((1u << (hi - lo)) - 1u)) << lo;
+        traced += __popc(traced_lanes & mine);
+        visible += __popc(visible_lanes & mine);
+      }
+    }
+    if (inside && job.active != 0) {
+      f.area_visible[j * n + i] = job.visible + static_cast<float>(visible);
+      f.area_rays[j * n + i] = 1.0f + static_cast<float>(traced);
+    }
+  }
 }
 
 __global__ void VisibilityFractionKernel(RealtimeFrameView f) {
@@ -216,7 +299,7 @@ dim3 PixelGrid(int W, int H) {
 
 struct DeviceRealtime::Impl {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
-  Buffer geometry, depth, sky, radiance, rows, rgb, hits;
+  Buffer geometry, depth, sky, radiance, rows, rgb, hits, surfaces;
   // the shared visibility's buffers (RealtimeFrameView)
   Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   // the mirror layer's buffers (RealtimeFrameView)
@@ -239,8 +322,11 @@ struct DeviceRealtime::Impl {
   cudaStream_t copy_stream = nullptr;
   cudaEvent_t geometry_done = nullptr;
   cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
+  cudaEvent_t depth_copied = nullptr;   // the depth is in its pinned buffer
   // band k's geometry is on the host (Render's bands)
   cudaEvent_t band_done[kMaxSkyBands] = {};
+  // band k of the radiance is in its pinned buffer (RealtimeKernelOptions::output_bands)
+  cudaEvent_t radiance_band[kMaxSkyBands] = {};
   RealtimeKernelOptions options;
   RealtimeStageTimes times;
   // the last frame, for TimeKernels.
@@ -251,9 +337,15 @@ struct DeviceRealtime::Impl {
 
   void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
                       cudaStream_t stream) {
-    GeometryKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
-        f, geometry.as<PixelGeometry>(), depth.as<float>(),
-        o.reuse_hit ? hits.as<TraceHit>() : nullptr);
+    const dim3 grid = PixelGrid(f.camera.width, f.camera.height);
+    TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
+    SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
+    if (o.geometry_min_blocks >= 5)
+      GeometryKernel<5><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
+                                                          depth.as<float>(), h, st);
+    else
+      GeometryKernel<1><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
+                                                          depth.as<float>(), h, st);
     Check(cudaGetLastError(), "GeometryKernel");
     if (f.any_mirror != 0) {
       MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(f);
@@ -278,8 +370,15 @@ struct DeviceRealtime::Impl {
     const dim3 grid = PixelGrid(f.camera.width, row1 - row0);
     TraceHit* h = hits.as<TraceHit>();
     Float3* L = radiance.as<Float3>();
+    SurfaceTerms* st = surfaces.as<SurfaceTerms>();
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 6)
+      ShadeStoredKernel<6><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 4)
+      ShadeStoredKernel<4><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
+    else if (o.reuse_surface)
+      ShadeStoredKernel<1><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
     else if (o.min_blocks >= 6)
       ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     else if (o.min_blocks >= 4)
@@ -299,7 +398,10 @@ struct DeviceRealtime::Impl {
                         cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
     const dim3 grid = PixelGrid(W, H);
-    VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    if (o.warp_penumbra)
+      VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    else
+      VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
     Check(cudaGetLastError(), "VisibilityRaysKernel");
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(f);
     Check(cudaGetLastError(), "VisibilityFractionKernel");
@@ -328,6 +430,9 @@ struct DeviceRealtime::Impl {
     if (copy_stream) cudaStreamDestroy(copy_stream);
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (radiance_done) cudaEventDestroy(radiance_done);
+    if (depth_copied) cudaEventDestroy(depth_copied);
+    for (cudaEvent_t e : radiance_band)
+      if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : band_done)
       if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : stage)
@@ -392,6 +497,9 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
+    Check(cudaEventCreateWithFlags(&m.depth_copied, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.radiance_band)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.stage) Check(cudaEventCreate(&e), "cudaEventCreate");
@@ -424,6 +532,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
   if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
+  if (o.reuse_hit && o.reuse_surface) m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
   const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
   m.window.Reserve(sizeof(uint32_t) * n);
   m.total.Reserve(sizeof(float) * n);
@@ -539,9 +648,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventRecord(m.band_done[k], down), "cudaEventRecord");
   }
   if (out.depth) {
-    if (o.pinned)
+    if (o.pinned) {
       m.depth.Download(m.pin_depth.p, sizeof(float) * n, m.copy_stream);
-    else
+      Check(cudaEventRecord(m.depth_copied, m.copy_stream), "cudaEventRecord");
+    } else
       m.depth.Download(out.depth, sizeof(float) * n, stream);
   }
   // (2) per band: its sky terms on the host, up to the device, and (3) its shading kernel,
@@ -571,13 +681,31 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // radiance goes back on the copy stream while the host computes the exposure and the film
   // kernel runs
   m.LaunchAfterShade(f, o, stream);
+  // the radiance goes back in bands of rows, each behind an event, so that the host copies band
+  // k into the frame's image while band k + 1 comes back
+  const int out_bands = std::clamp(o.output_bands, 1, kMaxSkyBands);
+  const int out_rows = (H + out_bands - 1) / out_bands;
+  auto out_row = [&](int k) { return std::min(H, k * out_rows); };
   if (out.radiance && o.pinned) {
     Check(cudaEventRecord(m.radiance_done, stream), "cudaEventRecord");
     Check(cudaStreamWaitEvent(m.copy_stream, m.radiance_done, 0), "cudaStreamWaitEvent");
-    m.radiance.Download(m.pin_radiance.p, sizeof(Float3) * n, m.copy_stream);
+    for (int k = 0; k < out_bands; ++k) {
+      const size_t off = static_cast<size_t>(out_row(k)) * W;
+      const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+      if (count > 0)
+        Check(cudaMemcpyAsync(m.pin_radiance.as<Float3>() + off, m.radiance.as<Float3>() + off,
+                              sizeof(Float3) * count, cudaMemcpyDeviceToHost, m.copy_stream),
+              "cudaMemcpyAsync");
+      Check(cudaEventRecord(m.radiance_band[k], m.copy_stream), "cudaEventRecord");
+    }
   }
   m.rows.Download(host_rows, sizeof(double) * H, stream);
   if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
+  // pinned: the depth into the frame's image while the GPU shades
+  if (out.depth && o.pinned) {
+    Check(cudaEventSynchronize(m.depth_copied), "copying the realtime depth");
+    ParallelCopy(out.parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}});
+  }
   Check(cudaStreamSynchronize(stream), "ShadeKernel");
   const auto t3 = Clock::now();
   if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
@@ -585,15 +713,23 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   const double ev100 = exposure(m.host_rows, e.e);
   // (5) film
   m.LaunchFilm(n, e, filmic ? 1 : 0, stream);
+  m.times.outputs = 0;
   if (o.pinned) {
+    // the radiance into the frame's image while the film kernel runs, then the rgb
     if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
-    Check(cudaStreamSynchronize(stream), "DevelopKernel");
+    const auto tc = Clock::now();
+    if (out.radiance)
+      for (int k = 0; k < out_bands; ++k) {
+        Check(cudaEventSynchronize(m.radiance_band[k]), "copying the realtime radiance");
+        const size_t off = static_cast<size_t>(out_row(k)) * W;
+        const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+        ParallelCopy(out.parallel, {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
+                                     sizeof(Float3) * count}});
+      }
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
-    std::vector<HostCopy> copies;
-    if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)});
-    if (out.radiance) copies.push_back({out.radiance, m.pin_radiance.p, sizeof(Float3) * n});
-    if (out.depth) copies.push_back({out.depth, m.pin_depth.p, sizeof(float) * n});
-    ParallelCopy(out.parallel, copies);
+    Check(cudaStreamSynchronize(stream), "DevelopKernel");
+    if (out.rgb) ParallelCopy(out.parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}});
+    m.times.outputs = MsSince(tc);
   } else {
     if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
     if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
@@ -633,6 +769,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   const RealtimeFrameView& f = m.frame;
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
   if (options.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
+  if (options.reuse_hit && options.reuse_surface) m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
   // one untimed run (first launch of a kernel variant)
   m.LaunchGeometry(f, options, stream);
   if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);

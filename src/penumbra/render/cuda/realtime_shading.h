@@ -163,6 +163,14 @@ struct ShadingPoint {
   float mirror = 0;  ///< the mirror layer's weight r (MaterialPod::mirror where it applies)
 };
 
+/// the material terms of a ShadingPoint that PixelGeometry does not hold (40 bytes): the
+/// geometry kernel keeps them so that the shading kernel need not evaluate the surface again
+/// (ShadeRealtimeStored).
+struct SurfaceTerms {
+  Float3 base, emission;
+  float roughness = 0.5f, metallic = 0, specular = 0.5f, occlusion = 1;
+};
+
 PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
 PB_HOST_DEVICE inline F3 ToF3(const Float3& v) { return F3{v.x, v.y, v.z}; }
 
@@ -539,9 +547,11 @@ PB_HOST_DEVICE inline bool MirrorSkyTerm(const SkyModelPod& sky, const SkyVolume
 }
 
 /// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
-/// (0 on a miss).
+/// (0 on a miss); *hit_out (if given): the closest hit; *surface_out (if given, where the ray
+/// hits): the shading point's material terms (ShadeRealtimeStored).
 PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
-                                                    float* t_hit, TraceHit* hit_out = nullptr) {
+                                                    float* t_hit, TraceHit* hit_out = nullptr,
+                                                    SurfaceTerms* surface_out = nullptr) {
   const TraceRay r = PrimaryRay(f.camera, u, v);
   TraceHit h;
   TraceClosest(f.scene, r, &h);
@@ -562,6 +572,14 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
   g.ng = sp.ng;
   g.ns = sp.n;
   g.mirror = sp.mirror;
+  if (surface_out) {
+    surface_out->base = sp.base;
+    surface_out->emission = sp.emission;
+    surface_out->roughness = sp.roughness;
+    surface_out->metallic = sp.metallic;
+    surface_out->specular = sp.specular;
+    surface_out->occlusion = sp.occlusion;
+  }
   return g;
 }
 
@@ -569,19 +587,14 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
 /// others are evaluated twice).
 constexpr int kShadeCachedLights = 16;
 
-/// ShadeRealtimePixel of pixel (u, v) whose primary ray r (PrimaryRay) has the closest hit h
-/// (TraceClosest; the CUDA kernels take it from the geometry pass instead of tracing it again).
-/// every light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
-PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
-                                              const TraceRay& r, const TraceHit& h) {
+/// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
+/// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
+/// their shadow rays.
+PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
+                                                const ShadingPoint& sp, const Float3& sky) {
   const SceneView& s = f.scene;
   const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
-  const Float3 sky = f.sky_term[pixel];
-  if (h.instance < 0) return sky;
-  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
-  const ShadingPoint sp = EvaluateSurface(f, r, h, d_len);
   const Float3& p = sp.p;
   const Float3& ng = sp.ng;
   const Float3& n = sp.n;
@@ -648,6 +661,48 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
   return L;
 }
 
+/// ShadeRealtimePixel of pixel (u, v) whose primary ray r (PrimaryRay) has the closest hit h
+/// (TraceClosest; the CUDA kernels take it from the geometry pass instead of tracing it again).
+/// every light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
+PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
+                                              const TraceRay& r, const TraceHit& h) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
+  const Float3 sky = f.sky_term[pixel];
+  if (h.instance < 0) return sky;
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  return ShadeRealtimePoint(f, u, v, EvaluateSurface(f, r, h, d_len), sky);
+}
+
+/// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point: its
+/// primary geometry g and material terms t (PrimaryGeometry's surface_out; the view direction
+/// from PrimaryRay as EvaluateSurface): the same shading point, so the same radiance, without
+/// evaluating the surface (textures, normal map) a second time.
+PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
+                                                 const PixelGeometry& g, const SurfaceTerms& t) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
+  const Float3 sky = f.sky_term[pixel];
+  if (g.hit == 0) return sky;
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  ShadingPoint sp;
+  sp.wo = -Float3{r.d.x / d_len, r.d.y / d_len, r.d.z / d_len};
+  sp.p = g.p_or_d;
+  sp.ng = g.ng;
+  sp.n = g.ns;
+  sp.base = t.base;
+  sp.emission = t.emission;
+  sp.roughness = t.roughness;
+  sp.metallic = t.metallic;
+  sp.specular = t.specular;
+  sp.occlusion = t.occlusion;
+  sp.mirror = g.mirror;
+  return ShadeRealtimePoint(f, u, v, sp, sky);
+}
+
 /// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
 /// escapes) without the shadowed light of lights with an extent: their unshadowed contribution
 /// and the pixel's own shadow ray's verdict go to f.area_c and f.area_vis, resolved by
@@ -660,18 +715,23 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePixel(const RealtimeFrameView& f, int 
   return ShadeRealtimeHit(f, u, v, r, h);
 }
 
-/// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
-/// v)'s window mask (f.window: the pixels of its 5x5 window, cut at its tile's edges, on its
-/// surface, ShadowWindowBit) and, per light with an extent whose verdicts in the window
-/// disagree (a penumbra), more shadow rays through points of the kLightStrata
-/// kLightPenumbraRays lattice, as many as the light's share of the pixel's unshadowed luminance
-/// asks for (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility):
-/// points - 1 more of the pixel's own points (PenumbraLatticeIndex) on a tile's outer ring
-/// (f.area_own: that pixel keeps its own fraction), else max(1, points / kLightStrata) - 1 more
-/// after its first; f.area_visible, f.area_rays: the pixel's visible and traced rays.
-PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
+/// one light's penumbra rays at one pixel (SharedVisibilityRays): the pixel's own verdict and
+/// the lattice points of its extra shadow rays r = 1 .. extra - 1.
+struct PenumbraRays {
+  Float3 p, ng;        ///< the pixel's hit point and unit geometric normal (PixelGeometry)
+  int32_t first = 0;   ///< the pixel's first lattice point, kLightPenumbraRays LightStratum(u, v)
+  int32_t points = 0;  ///< PenumbraLatticePoints of the light's share of the pixel's luminance
+  int32_t extra = 0;   ///< rays r = 1 .. extra - 1 are traced (extra <= 1: none)
+  int32_t own = 0;     ///< 1: a tile's outer ring (the pixel's own points, PenumbraLatticeIndex)
+  int32_t active = 0;  ///< 1: the pixel traced a verdict towards a light with an extent
+  float visible = 0;   ///< the pixel's own verdict (f.area_vis: 1 visible, 0 occluded)
+};
+
+/// the shared visibility, step 1 of 3, first part: pixel (u, v)'s window mask (the pixels of
+/// its 5x5 window, cut at its tile's edges, on its surface, ShadowWindowBit), written to
+/// f.window and returned.
+PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f, int u, int v) {
   const int W = f.camera.width, H = f.camera.height;
-  const int64_t n = static_cast<int64_t>(W) * H;
   const int64_t i = static_cast<int64_t>(v) * W + u;
   const ShadowTile tile = ShadowTileOf(u, v, W, H);
   const int x = u - tile.x0, y = v - tile.y0;
@@ -696,48 +756,96 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
     }
   }
   f.window[i] = bits;
+  return bits;
+}
+
+/// the shared visibility, step 1 of 3, second part: light j's penumbra rays at pixel (u, v)
+/// whose window mask is `bits` (SharedVisibilityWindow). inactive (active 0) where the pixel
+/// traced no verdict towards j or j has no extent; where the verdicts in the window disagree (a
+/// penumbra), as many rays as the light's share of the pixel's unshadowed luminance asks for
+/// (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility): on a
+/// tile's outer ring the pixel's own points - 1 more (f.area_own set: that pixel keeps its own
+/// fraction), else max(1, points / kLightStrata) - 1 more after its first. writes f.area_own.
+PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
+                                                            int v, int j, uint32_t bits) {
+  const int W = f.camera.width, H = f.camera.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int64_t i = static_cast<int64_t>(v) * W + u;
+  const int64_t k = j * n + i;
+  PenumbraRays job;
+  f.area_own[k] = 0;
+  if (!IsExtendedLightPod(f.lights[j])) return job;
+  const int8_t vis = f.area_vis[k];
+  if (vis < 0) return job;
+  job.active = 1;
+  job.visible = static_cast<float>(vis);
+  bool seen[2] = {false, false};
+  for (uint32_t b = bits; b != 0; b &= b - 1) {
+    const int bit = LowestSetBit(b);
+    const int64_t ii = i + static_cast<int64_t>(bit / 5 - 2) * W + (bit % 5 - 2);
+    const int8_t w = f.area_vis[j * n + ii];
+    if (w >= 0) seen[w] = true;
+  }
+  if (!(seen[0] && seen[1])) return job;
+  const ShadowTile tile = ShadowTileOf(u, v, W, H);
+  const bool own = OnShadowTileRing(u - tile.x0, v - tile.y0, tile);
+  f.area_own[k] = own ? 1 : 0;
+  const Float3 c = f.area_c[k];
+  const int points = PenumbraLatticePoints(pbm::Luminance709(c.x, c.y, c.z) / f.total[i]);
+  const int shared = points / kLightStrata > 1 ? points / kLightStrata : 1;
+  const PixelGeometry& gi = f.geometry[i];
+  job.p = gi.p_or_d;
+  job.ng = gi.ng;
+  job.first = kLightPenumbraRays * LightStratum(u, v);
+  job.points = points;
+  job.extra = own ? points : shared;
+  job.own = own ? 1 : 0;
+  return job;
+}
+
+/// penumbra ray r (1 <= r < job.extra) of light j (SharedVisibilityPenumbra): -1 where no ray
+/// is traced (the light sends nothing to the point, or the direction lies below its geometric
+/// surface), else 1 visible, 0 occluded.
+PB_HOST_DEVICE inline int PenumbraRayVerdict(const RealtimeFrameView& f, int j,
+                                             const PenumbraRays& job, int r) {
+  constexpr int kAll = kLightStrata * kLightPenumbraRays;
+  float u1, u2, d_r;
+  Float3 w_r, E_r;
+  bool ok;
+  LightStratumUniforms(
+      job.own != 0 ? PenumbraLatticeIndex(job.first, r, job.points) : job.first + r, kAll, &u1,
+      &u2);
+  SampleLight<float, Float3, bool>(f.lights[j], job.p, u1, u2, &w_r, &d_r, &E_r, &ok);
+  if (!ok || !(pbm::Dot<float>(w_r, job.ng) > 0)) return -1;
+  TraceRay sr;
+  sr.o = OffsetOrigin(job.p, job.ng);
+  sr.tmin = 0;
+  sr.d = ToF3(w_r);
+  sr.tmax = d_r * (1.0f - 1e-4f);  // +inf stays +inf
+  return TraceOccluded(f.scene, sr) ? 0 : 1;
+}
+
+/// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
+/// v)'s window mask (SharedVisibilityWindow) and, per light with an extent, its penumbra rays
+/// in order (SharedVisibilityPenumbra, PenumbraRayVerdict); f.area_visible, f.area_rays: the
+/// pixel's visible and traced rays (its own verdict included). the GPU's VisibilityRaysKernel
+/// spreads a warp's penumbra rays over its lanes and sums the same integer counts.
+PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
+  const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const uint32_t bits = SharedVisibilityWindow(f, u, v);
   for (int j = 0; j < f.num_lights; ++j) {
-    const int64_t k = j * n + i;
-    f.area_own[k] = 0;
-    const int8_t vis = f.area_vis[k];
-    if (vis < 0 || !IsExtendedLightPod(f.lights[j])) continue;
-    float visible = static_cast<float>(vis), rays = 1;
-    bool seen[2] = {false, false};
-    for (uint32_t b = bits; b != 0; b &= b - 1) {
-      const int bit = LowestSetBit(b);
-      const int64_t ii = i + static_cast<int64_t>(bit / 5 - 2) * W + (bit % 5 - 2);
-      const int8_t w = f.area_vis[j * n + ii];
-      if (w >= 0) seen[w] = true;
+    const PenumbraRays job = SharedVisibilityPenumbra(f, u, v, j, bits);
+    if (job.active == 0) continue;
+    float visible = job.visible, rays = 1;
+    for (int r = 1; r < job.extra; ++r) {
+      const int verdict = PenumbraRayVerdict(f, j, job, r);
+      if (verdict < 0) continue;
+      rays += 1;
+      if (verdict > 0) visible += 1;
     }
-    if (seen[0] && seen[1]) {
-      const bool own = OnShadowTileRing(x, y, tile);
-      f.area_own[k] = own ? 1 : 0;
-      constexpr int kAll = kLightStrata * kLightPenumbraRays;
-      const Float3 c = f.area_c[k];
-      const int points = PenumbraLatticePoints(pbm::Luminance709(c.x, c.y, c.z) / f.total[i]);
-      const int shared = points / kLightStrata > 1 ? points / kLightStrata : 1;
-      const int extra = own ? points : shared;
-      const int first = kLightPenumbraRays * LightStratum(u, v);
-      const Float3 p = gi.p_or_d, ng = gi.ng;
-      TraceRay sr;
-      sr.o = OffsetOrigin(p, ng);
-      sr.tmin = 0;
-      for (int r = 1; r < extra; ++r) {
-        float u1, u2, d_r;
-        Float3 w_r, E_r;
-        bool ok;
-        LightStratumUniforms(own ? PenumbraLatticeIndex(first, r, points) : first + r, kAll, &u1,
-                             &u2);
-        SampleLight<float, Float3, bool>(f.lights[j], p, u1, u2, &w_r, &d_r, &E_r, &ok);
-        if (!ok || !(pbm::Dot<float>(w_r, ng) > 0)) continue;
-        sr.d = ToF3(w_r);
-        sr.tmax = d_r * (1.0f - 1e-4f);  // +inf stays +inf
-        rays += 1;
-        if (!TraceOccluded(f.scene, sr)) visible += 1;
-      }
-    }
-    f.area_visible[k] = visible;
-    f.area_rays[k] = rays;
+    f.area_visible[j * n + i] = visible;
+    f.area_rays[j * n + i] = rays;
   }
 }
 
@@ -751,7 +859,7 @@ PB_HOST_DEVICE inline void SharedVisibilityFraction(const RealtimeFrameView& f, 
   const int64_t i = static_cast<int64_t>(v) * W + u;
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
-    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
     if (f.area_own[k] != 0) {
       f.area_fraction[k] = f.area_visible[k] / f.area_rays[k];
       continue;
@@ -783,7 +891,7 @@ PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f,
   const int x = u - tile.x0, y = v - tile.y0;
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
-    if (f.area_vis[k] < 0 || !IsExtendedLightPod(f.lights[j])) continue;
+    if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
     float V = f.area_fraction[k];
     if (f.lights[j].kind != LightKind::kDirectional && f.area_own[k] == 0) {
       float sum = 0;
