@@ -10,6 +10,7 @@
 #include "penumbra/render/brdf_math.h"
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
+#include "penumbra/render/cpu/light_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/lamp_math.h"
@@ -76,13 +77,12 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
   const Lanes cos_t = bsdf.n.Dot(w);
   const Lanes sin_sigma = sin2.max(0.0f).sqrt();
   // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
-  // a light straddling it (few lanes; LightStraddlesHorizon's comparisons as lane masks, a NaN
-  // lane straddling as there) goes through ExtendedLightShading.
+  // a light straddling it (few lanes; render/cpu/light_lanes.h) goes through
+  // ExtendedLightShading.
   Vec3Lanes wi_rep = w;
   Lanes scale = Where(on, (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero()));
-  const LaneMask wholly = (GreaterEqual(cos_t * cos_t, sin2) || !GreaterThan(sin2, 0.0f)) &&
-                          !(GreaterThan(cos_t, 0.0f) && GreaterThan(sin_sigma, cos_t));
-  for (uint32_t bits = (on && !wholly).bits(); bits != 0; bits &= bits - 1) {
+  const LaneMask straddles = on && LightStraddlesHorizonLanes(cos_t, sin2, sin_sigma);
+  for (uint32_t bits = straddles.bits(); bits != 0; bits &= bits - 1) {
     const int k = std::countr_zero(bits);
     const float wk[3] = {w.x[k], w.y[k], w.z[k]};
     const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
