@@ -49,17 +49,22 @@ bool IsExtendedLight(const PosedLight& l) {
   return HasLightExtent(l.type == Light::Type::kDirectional, l.cos_angular_radius, l.radius_m);
 }
 
-// the unshadowed contribution f(wo, wi) E_i of extended light `l`, sampled as `s` (stratum
-// direction, illuminance I / d^2 or E_sun), for every lane in `on`: the BRDF at the direction to
-// the light's centre (tilted above the horizon where the light straddles it) times the
-// horizon-clipped illuminance of the sphere or disc (SphereLightCosine). lanes whose stratum
-// direction is below the geometric surface get that tilted direction for their shadow ray
-// (written to s->wi, s->distance).
-Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, const BsdfLanes& bsdf,
-                                    const LaneMask& on, LightSampleLanes* s) {
-  // the axis, sin^2 sigma and near distance of every lane (SphereLightAxis's arithmetic).
+// where extended light `l` lies seen from every lane's point p: the unit axis w towards its
+// centre, sin^2 sigma of its angular radius, the distance to its near surface (SphereLightAxis's
+// arithmetic), cos_t = n . w on the shading normal and sin sigma; the lanes where the light
+// straddles the horizon (render/cpu/light_lanes.h), and those it may reach: above the horizon
+// (cos_t > 1e-6) or straddling it. a lane outside `reaches` gets exactly 0 from
+// ExtendedLightContribution (scale 0 times a finite BRDF and illuminance).
+struct ExtendedAxisLanes {
   Vec3Lanes w;
-  Lanes sin2, dist_near;
+  Lanes sin2, dist_near, cos_t, sin_sigma;
+  LaneMask straddles, reaches;
+};
+ExtendedAxisLanes ExtendedLightAxis(const PosedLight& l, const Vec3Lanes& p,
+                                    const BsdfLanes& bsdf) {
+  ExtendedAxisLanes a;
+  Vec3Lanes& w = a.w;
+  Lanes &sin2 = a.sin2, &dist_near = a.dist_near;
   if (l.type == Light::Type::kDirectional) {
     w = {Lanes::Constant(-l.direction_W.x()), Lanes::Constant(-l.direction_W.y()),
          Lanes::Constant(-l.direction_W.z())};
@@ -74,15 +79,29 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
     sin2 = (d2 > 0.0f).select((l.radius_m * l.radius_m / d2).min(1.0f), 1.0f);
     dist_near = (d - l.radius_m).max(0.0f);
   }
-  const Lanes cos_t = bsdf.n.Dot(w);
-  const Lanes sin_sigma = sin2.max(0.0f).sqrt();
+  a.cos_t = bsdf.n.Dot(w);
+  a.sin_sigma = sin2.max(0.0f).sqrt();
+  a.straddles = LightStraddlesHorizonLanes(a.cos_t, sin2, a.sin_sigma);
+  a.reaches = GreaterThan(a.cos_t, 1e-6f) || a.straddles;
+  return a;
+}
+
+// the unshadowed contribution f(wo, wi) E_i of extended light `l` with axis `a`
+// (ExtendedLightAxis), sampled as `s` (stratum direction, illuminance I / d^2 or E_sun), for
+// every lane in `on`: the BRDF at the direction to the light's centre (tilted above the horizon
+// where the light straddles it) times the horizon-clipped illuminance of the sphere or disc
+// (SphereLightCosine). lanes whose stratum direction is below the geometric surface get that
+// tilted direction for their shadow ray (written to s->wi, s->distance).
+Vec3Lanes ExtendedLightContribution(const ExtendedAxisLanes& a, const BsdfLanes& bsdf,
+                                    const LaneMask& on, LightSampleLanes* s) {
+  const Vec3Lanes& w = a.w;
+  const Lanes &sin2 = a.sin2, &dist_near = a.dist_near, &cos_t = a.cos_t;
   // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
   // a light straddling it (few lanes; render/cpu/light_lanes.h) goes through
   // ExtendedLightShading.
   Vec3Lanes wi_rep = w;
   Lanes scale = Where(on, (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero()));
-  const LaneMask straddles = on && LightStraddlesHorizonLanes(cos_t, sin2, sin_sigma);
-  for (uint32_t bits = straddles.bits(); bits != 0; bits &= bits - 1) {
+  for (uint32_t bits = (on && a.straddles).bits(); bits != 0; bits &= bits - 1) {
     const int k = std::countr_zero(bits);
     const float wk[3] = {w.x[k], w.y[k], w.z[k]};
     const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
@@ -646,11 +665,23 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     for (int j = 0; j < num_lights; ++j) {
       LightSampleLanes& s = scratch.samples[j];
       Vec3Lanes& c = scratch.contrib[j];
+      const PosedLight& light = ctx.lights->lights()[j];
+      const bool extended = IsExtendedLight(light);
+      ExtendedAxisLanes axis;
+      if (extended) {
+        axis = ExtendedLightAxis(light, p, bsdf);
+        // every hit lane below the light's horizon (e.g. a run of a wall facing away from a
+        // lamp): the contribution is exactly 0 in every lane, so the light's sample, BRDF and
+        // media terms are skipped (nothing reads them where c is 0) and the total stays as it is.
+        if (!(hit && axis.reaches).any()) {
+          c = Vec3Lanes{Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+          continue;
+        }
+      }
       ctx.lights->SampleLanes(j, p, stratum_u1, stratum_u2, &s);
       const LaneMask on = hit && s.valid;
-      const PosedLight& light = ctx.lights->lights()[j];
-      if (IsExtendedLight(light)) {
-        c = ExtendedLightContribution(light, p, bsdf, on, &s);
+      if (extended) {
+        c = ExtendedLightContribution(axis, bsdf, on, &s);
       } else {
         const Vec3Lanes f = bsdf.Eval(s.wi);
         c = Where(on, Vec3Lanes{f.x * s.E.x, f.y * s.E.y, f.z * s.E.z});
