@@ -1,7 +1,9 @@
 // the realtime tier's light from lamps with an extent (issue 36, item 5): a white ceiling next
 // to a small spherical lamp without per-pixel noise at one frame, the same picture every frame,
-// the analytic horizon-clipped sphere irradiance (render/lamp_math.h), and no sky light leaking
-// into the foot of a box standing on a floor slab.
+// the analytic horizon-clipped sphere irradiance (render/lamp_math.h), no sky light leaking
+// into the foot of a box standing on a floor slab, and the tile loop's skip of a light wholly
+// below a run's horizon: a lamp straddling the floor's horizon still lights it, a lamp behind a
+// wall adds exactly nothing to it.
 
 #include <gtest/gtest.h>
 
@@ -277,6 +279,94 @@ TEST(LampLightingTest, NoSkyLightLeaksIntoTheFootOfABoxOnAFloorSlab) {
   ASSERT_GT(floor_pixels, 500);
   // the open sky would give 1000 x 0.7 / 2 = 350 on the box's vertical face.
   EXPECT_LT(brightest, 1.0f);
+}
+
+}  // namespace
+}  // namespace penumbra
+
+namespace penumbra {
+namespace {
+
+using namespace penumbra::testing;
+
+// a white floor slab (top at z = 0) and a spherical lamp of radius 5 cm at `lamp_z`.
+SceneDescription LampTestFloor(double lamp_z) {
+  SceneDescription s = EmptyScene();
+  const int white = AddMaterial(&s, Eigen::Vector3f::Constant(0.8f));
+  AddGeom(&s, GeomShape::kBox, {3, 3, 0.05}, Translation(0, 0, -0.05), 0, white);
+  Light lamp;
+  lamp.type = Light::Type::kPoint;
+  lamp.position_B = {0, 0, lamp_z};
+  lamp.intensity = 400;
+  lamp.radius_m = 0.05;
+  s.lights.push_back(lamp);
+  return s;
+}
+
+TEST(LampLightingTest, ALampStraddlingTheFloorsHorizonLightsIt) {
+  // the lamp's centre 2 cm below the floor's top: every floor point sees it below its horizon
+  // (n . w < 0) but the top of the sphere above it, so the light straddles the horizon there.
+  // the tile loop skips a light only for runs of pixels where it is wholly below the horizon;
+  // straddling pixels must keep their (small, positive) share.
+  const SceneDescription s = LampTestFloor(-0.02);
+  auto r = MakeRenderer(s, TestSettings());
+  const CameraView view = MakeView(CameraLookingDown({0, 0, 1.0}), 64, 64, 90);
+  RenderedFrame f;
+  r->Render(IdentitySnapshot(s), view, &f);
+  // the floor points more than 10 cm from the lamp's axis (those nearer lie inside the sphere)
+  const CameraIntrinsics& k = view.intrinsics;
+  int lit = 0, floor = 0;
+  for (int v = 0; v < f.radiance.height; ++v)
+    for (int u = 0; u < f.radiance.width; ++u) {
+      const double x = (u - k.cx) / k.fx, y = (v - k.cy) / k.fy;  // at 1 m below the camera
+      if (*f.geom_id.at(u, v) != 100 || std::hypot(x, y) < 0.1) continue;
+      ++floor;
+      lit += f.radiance.at(u, v)[1] > 0;
+    }
+  ASSERT_GT(floor, 3500);
+  EXPECT_EQ(lit, floor);
+}
+
+TEST(LampLightingTest, ALampBehindAWallAddsExactlyNothingToIt) {
+  // a wall facing away from lamp B (every pixel of it below B's horizon: the tile loop skips B
+  // there) and lit by lamp A: its radiance is bit for bit that of the scene without B, and A's
+  // light is there.
+  auto scene = [](bool with_b) {
+    SceneDescription s = EmptyScene();
+    const int white = AddMaterial(&s, Eigen::Vector3f::Constant(0.8f));
+    AddGeom(&s, GeomShape::kBox, {0.05, 2, 2}, Translation(1.05, 0, 0), 0, white);  // x 1..1.1
+    Light a;
+    a.type = Light::Type::kPoint;
+    a.position_B = {2.0, 0.3, 0.2};
+    a.intensity = 400;
+    a.radius_m = 0.05;
+    s.lights.push_back(a);
+    if (with_b) {
+      Light b = a;
+      b.position_B = {0.5, -0.2, 0.1};
+      s.lights.push_back(b);
+    }
+    return s;
+  };
+  // from x = 2.5 looking along -x at the wall's face x = 1.1 (normal +x)
+  Pose X = CameraLookingAlongX({2.5, 0, 0});
+  X.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix() * X.linear();
+  const CameraView view = MakeView(X, 48, 48, 60);
+  RenderedFrame with_b, without_b;
+  const SceneDescription s_b = scene(true), s_0 = scene(false);
+  MakeRenderer(s_b, TestSettings())->Render(IdentitySnapshot(s_b), view, &with_b);
+  MakeRenderer(s_0, TestSettings())->Render(IdentitySnapshot(s_0), view, &without_b);
+  int wall = 0, lit = 0;
+  for (int v = 0; v < with_b.radiance.height; ++v)
+    for (int u = 0; u < with_b.radiance.width; ++u) {
+      if (*with_b.geom_id.at(u, v) != 100) continue;
+      ++wall;
+      lit += with_b.radiance.at(u, v)[1] > 0;
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(with_b.radiance.at(u, v)[c], without_b.radiance.at(u, v)[c]) << u << " " << v;
+    }
+  ASSERT_GT(wall, 2000);
+  EXPECT_EQ(lit, wall);
 }
 
 }  // namespace

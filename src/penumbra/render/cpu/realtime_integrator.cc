@@ -1,13 +1,16 @@
 #include "penumbra/render/cpu/realtime_integrator.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
 #include "penumbra/render/brdf_math.h"
 #include "penumbra/render/bsdf.h"
 #include "penumbra/render/cpu/bsdf_lanes.h"
+#include "penumbra/render/cpu/light_lanes.h"
 #include "penumbra/render/cpu/mirror_layer.h"
 #include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/lamp_math.h"
@@ -31,6 +34,8 @@ struct Scratch {
   // pixel's own shadow ray's verdict (1 visible, 0 occluded, -1 none traced).
   std::vector<Eigen::Vector3f> area_c;
   std::vector<int8_t> area_vis;
+  // per light: the verdicts in area_vis of the tile, bit 0 an occluded one, bit 1 a visible one.
+  std::vector<uint8_t> area_seen;
   std::vector<float> mirror;  // per tile pixel: SurfaceMaterial::mirror, 0 = none
   std::vector<float> total;   // per tile pixel: luminance of the radiance, all lights unshadowed
 };
@@ -44,17 +49,22 @@ bool IsExtendedLight(const PosedLight& l) {
   return HasLightExtent(l.type == Light::Type::kDirectional, l.cos_angular_radius, l.radius_m);
 }
 
-// the unshadowed contribution f(wo, wi) E_i of extended light `l`, sampled as `s` (stratum
-// direction, illuminance I / d^2 or E_sun), for every lane in `on`: the BRDF at the direction to
-// the light's centre (tilted above the horizon where the light straddles it) times the
-// horizon-clipped illuminance of the sphere or disc (SphereLightCosine). lanes whose stratum
-// direction is below the geometric surface get that tilted direction for their shadow ray
-// (written to s->wi, s->distance).
-Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, const BsdfLanes& bsdf,
-                                    const LaneMask& on, LightSampleLanes* s) {
-  // the axis, sin^2 sigma and near distance of every lane (SphereLightAxis's arithmetic).
+// where extended light `l` lies seen from every lane's point p: the unit axis w towards its
+// centre, sin^2 sigma of its angular radius, the distance to its near surface (SphereLightAxis's
+// arithmetic), cos_t = n . w on the shading normal and sin sigma; the lanes where the light
+// straddles the horizon (render/cpu/light_lanes.h), and those it may reach: above the horizon
+// (cos_t > 1e-6) or straddling it. a lane outside `reaches` gets exactly 0 from
+// ExtendedLightContribution (scale 0 times a finite BRDF and illuminance).
+struct ExtendedAxisLanes {
   Vec3Lanes w;
-  Lanes sin2, dist_near;
+  Lanes sin2, dist_near, cos_t, sin_sigma;
+  LaneMask straddles, reaches;
+};
+ExtendedAxisLanes ExtendedLightAxis(const PosedLight& l, const Vec3Lanes& p,
+                                    const BsdfLanes& bsdf) {
+  ExtendedAxisLanes a;
+  Vec3Lanes& w = a.w;
+  Lanes &sin2 = a.sin2, &dist_near = a.dist_near;
   if (l.type == Light::Type::kDirectional) {
     w = {Lanes::Constant(-l.direction_W.x()), Lanes::Constant(-l.direction_W.y()),
          Lanes::Constant(-l.direction_W.z())};
@@ -69,18 +79,30 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
     sin2 = (d2 > 0.0f).select((l.radius_m * l.radius_m / d2).min(1.0f), 1.0f);
     dist_near = (d - l.radius_m).max(0.0f);
   }
-  const Lanes cos_t = bsdf.n.Dot(w);
-  const Lanes sin_sigma = sin2.max(0.0f).sqrt();
+  a.cos_t = bsdf.n.Dot(w);
+  a.sin_sigma = sin2.max(0.0f).sqrt();
+  a.straddles = LightStraddlesHorizonLanes(a.cos_t, sin2, a.sin_sigma);
+  a.reaches = GreaterThan(a.cos_t, 1e-6f) || a.straddles;
+  return a;
+}
+
+// the unshadowed contribution f(wo, wi) E_i of extended light `l` with axis `a`
+// (ExtendedLightAxis), sampled as `s` (stratum direction, illuminance I / d^2 or E_sun), for
+// every lane in `on`: the BRDF at the direction to the light's centre (tilted above the horizon
+// where the light straddles it) times the horizon-clipped illuminance of the sphere or disc
+// (SphereLightCosine). lanes whose stratum direction is below the geometric surface get that
+// tilted direction for their shadow ray (written to s->wi, s->distance).
+Vec3Lanes ExtendedLightContribution(const ExtendedAxisLanes& a, const BsdfLanes& bsdf,
+                                    const LaneMask& on, LightSampleLanes* s) {
+  const Vec3Lanes& w = a.w;
+  const Lanes &sin2 = a.sin2, &dist_near = a.dist_near, &cos_t = a.cos_t;
   // wholly above or below the horizon: wi = w, factor 1 above (ExtendedLightShading exactly);
-  // a light straddling it (few lanes) goes through ExtendedLightShading.
+  // a light straddling it (few lanes; render/cpu/light_lanes.h) goes through
+  // ExtendedLightShading.
   Vec3Lanes wi_rep = w;
-  Lanes scale = (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero());
-  for (int k = 0; k < kLanes; ++k) {
-    if (!on[k]) {
-      scale[k] = 0;
-      continue;
-    }
-    if (!LightStraddlesHorizon(cos_t[k], sin2[k], sin_sigma[k])) continue;
+  Lanes scale = Where(on, (cos_t > 1e-6f).select(Lanes::Ones(), Lanes::Zero()));
+  for (uint32_t bits = (on && a.straddles).bits(); bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
     const float wk[3] = {w.x[k], w.y[k], w.z[k]};
     const float n[3] = {bsdf.n.x[k], bsdf.n.y[k], bsdf.n.z[k]};
     float r[3];
@@ -89,9 +111,9 @@ Vec3Lanes ExtendedLightContribution(const PosedLight& l, const Vec3Lanes& p, con
   }
   // the shadow ray: the lane's lattice point, or the shading direction where that point lies
   // below the geometric surface (it would test the surface itself, not the occluders).
-  const Lanes ng_wi = bsdf.ng.Dot(s->wi);
-  for (int k = 0; k < kLanes; ++k) {
-    if (ng_wi[k] > 0) continue;
+  const LaneMask below = !GreaterThan(bsdf.ng.Dot(s->wi), 0.0f);
+  for (uint32_t bits = below.bits(); bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
     s->wi.x[k] = wi_rep.x[k], s->wi.y[k] = wi_rep.y[k], s->wi.z[k] = wi_rep.z[k];
     s->distance[k] = dist_near[k];
   }
@@ -247,13 +269,11 @@ void ResolveSharedVisibility(const FrameContext& ctx, const PrimaryHits& primary
     auto first_point = [&](int i) {
       return kPenumbraRays * LightStratum(tile.x0 + xs[i], tile.y0 + ys[i]);
     };
-    bool seen_in_tile[2] = {false, false};
-    for (int i = 0; i < n; ++i)
-      if (vis[i] >= 0) seen_in_tile[vis[i]] = true;
-    if (!(seen_in_tile[0] && seen_in_tile[1])) {
+    const uint8_t seen_in_tile = scratch.area_seen[j];
+    if (seen_in_tile != 3) {
       // every verdict towards j in the tile agrees (most tiles): every window's fraction is that
       // verdict, exactly.
-      if (!seen_in_tile[1]) continue;
+      if ((seen_in_tile & 2) == 0) continue;
       for (int i = 0; i < n; ++i) {
         if (vis[i] < 0) continue;
         float* Lp = out.radiance->at(tile.x0 + xs[i], tile.y0 + ys[i]);
@@ -425,8 +445,18 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
       mean += 0.25f * primary.hits[quad[c]].p_W;
     }
     volume->Blend(mean, n0, &blend);
-    for (int c = 0; c < 4; ++c)
-      scratch->sky_E[quad[c]] = volume->IrradianceAt(blend, scratch->n_s[quad[c]], *ctx.sky);
+    // IrradianceAt is a function of the blend and the normal: pixels whose shading normals are
+    // bitwise equal to the first's (a flat face without a normal map: every quad of the default
+    // room) take its value instead of evaluating the SH again.
+    const Eigen::Vector3f& ns0 = scratch->n_s[i00];
+    const Eigen::Vector3f E0 = volume->IrradianceAt(blend, ns0, *ctx.sky);
+    scratch->sky_E[i00] = E0;
+    for (int c = 1; c < 4; ++c) {
+      const Eigen::Vector3f& ns = scratch->n_s[quad[c]];
+      scratch->sky_E[quad[c]] = std::memcmp(ns.data(), ns0.data(), sizeof(float) * 3) == 0
+                                    ? E0
+                                    : volume->IrradianceAt(blend, ns, *ctx.sky);
+    }
     return true;
   };
   auto single = [&](int i) {
@@ -520,6 +550,7 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   scratch.contrib.resize(num_lights);
   scratch.area_c.resize(static_cast<size_t>(num_lights) * n);
   scratch.area_vis.assign(static_cast<size_t>(num_lights) * n, -1);
+  scratch.area_seen.assign(num_lights, 0);
   TileSkyIrradiance(ctx, primary, &scratch);
   scratch.mirror.assign(n, 0.0f);
   scratch.total.resize(n);
@@ -527,8 +558,6 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
   static const RenderAblation kAllOn;
   const RenderAblation& ablation = ctx.ablation != nullptr ? *ctx.ablation : kAllOn;
   int64_t traced = 0;
-  const uint64_t frame_key = ctx.FrameKey();
-  const uint64_t width = static_cast<uint64_t>(ctx.camera->width());
   const MediaFrame* fx = ctx.effects;
   const RealtimeMedia* rm = fx != nullptr ? fx->realtime_media() : nullptr;
   const float wetness = fx != nullptr ? fx->surface_wetness() : 0.0f;
@@ -636,11 +665,23 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
     for (int j = 0; j < num_lights; ++j) {
       LightSampleLanes& s = scratch.samples[j];
       Vec3Lanes& c = scratch.contrib[j];
+      const PosedLight& light = ctx.lights->lights()[j];
+      const bool extended = IsExtendedLight(light);
+      ExtendedAxisLanes axis;
+      if (extended) {
+        axis = ExtendedLightAxis(light, p, bsdf);
+        // every hit lane below the light's horizon (e.g. a run of a wall facing away from a
+        // lamp): the contribution is exactly 0 in every lane, so the light's sample, BRDF and
+        // media terms are skipped (nothing reads them where c is 0) and the total stays as it is.
+        if (!(hit && axis.reaches).any()) {
+          c = Vec3Lanes{Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+          continue;
+        }
+      }
       ctx.lights->SampleLanes(j, p, stratum_u1, stratum_u2, &s);
       const LaneMask on = hit && s.valid;
-      const PosedLight& light = ctx.lights->lights()[j];
-      if (IsExtendedLight(light)) {
-        c = ExtendedLightContribution(light, p, bsdf, on, &s);
+      if (extended) {
+        c = ExtendedLightContribution(axis, bsdf, on, &s);
       } else {
         const Vec3Lanes f = bsdf.Eval(s.wi);
         c = Where(on, Vec3Lanes{f.x * s.E.x, f.y * s.E.y, f.z * s.E.z});
@@ -691,11 +732,15 @@ int64_t RealtimeIntegrator::RenderTile(const FrameContext& ctx, const PrimaryHit
         // the verdict waits for its neighbours' (ResolveSharedVisibility); a lane the sun-occluder
         // map skipped is occluded (the map's verdict is exact for that ray).
         const size_t base = static_cast<size_t>(j) * n + static_cast<size_t>(i0);
+        uint8_t seen = 0;
         for (int k = 0; k < m; ++k) {
           if (!shadowed[k]) continue;
-          scratch.area_vis[base + k] = skipped[k] || occluded[k] ? 0 : 1;
+          const int8_t v = skipped[k] || occluded[k] ? 0 : 1;
+          scratch.area_vis[base + k] = v;
+          seen |= static_cast<uint8_t>(1 + v);
           scratch.area_c[base + k] = Eigen::Vector3f(c.x[k], c.y[k], c.z[k]);
         }
+        scratch.area_seen[j] |= seen;
         continue;
       }
       const LaneMask visible = to_trace && !occluded;
