@@ -165,7 +165,9 @@ TEST(LampLightingTest, PenumbraBudgetFollowsTheLightsShare) {
         const int index = PenumbraLatticeIndex(first, r, points);
         ASSERT_GE(index, 0);
         ASSERT_LT(index, kLightStrata * kLightPenumbraRays);
-        if (r == 0) EXPECT_EQ(index, first);
+        if (r == 0) {
+          EXPECT_EQ(index, first);
+        }
         EXPECT_EQ(seen[index]++, 0) << points << " " << stratum;
         float u1, u2;
         LightStratumUniforms(index, kLightStrata * kLightPenumbraRays, &u1, &u2);
