@@ -661,15 +661,21 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   return L;
 }
 
+/// starts the shading of pixel (u, v): no light's shared visibility is known yet (its area_vis
+/// entries set to -1), and returns the pixel's sky term.
+PB_HOST_DEVICE inline Float3 BeginRealtimePixel(const RealtimeFrameView& f, int u, int v) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
+  return f.sky_term[pixel];
+}
+
 /// ShadeRealtimePixel of pixel (u, v) whose primary ray r (PrimaryRay) has the closest hit h
 /// (TraceClosest; the CUDA kernels take it from the geometry pass instead of tracing it again).
 /// every light's unshadowed contribution is evaluated once (kShadeCachedLights of them).
 PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u, int v,
                                               const TraceRay& r, const TraceHit& h) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
-  const Float3 sky = f.sky_term[pixel];
+  const Float3 sky = BeginRealtimePixel(f, u, v);
   if (h.instance < 0) return sky;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   return ShadeRealtimePoint(f, u, v, EvaluateSurface(f, r, h, d_len), sky);
@@ -681,10 +687,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
 /// evaluating the surface (textures, normal map) a second time.
 PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
                                                  const PixelGeometry& g, const SurfaceTerms& t) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  for (int j = 0; j < f.num_lights; ++j) f.area_vis[j * n_pixels + pixel] = -1;
-  const Float3 sky = f.sky_term[pixel];
+  const Float3 sky = BeginRealtimePixel(f, u, v);
   if (g.hit == 0) return sky;
   const TraceRay r = PrimaryRay(f.camera, u, v);
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
