@@ -108,10 +108,6 @@ std::vector<CrowdDecision> CrowdSim::TakeDecisions() {
 void CrowdSim::MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
                         const std::vector<CrowdRobot>& robots) {
   Plan& plan = plans_[i];
-  CrowdDecision d;
-  d.time_sec = time_;
-  d.agent = static_cast<int>(i);
-  d.goal_W = goal;
   std::vector<std::pair<Eigen::Vector2d, double>> keep_out;
   if (agents_[i].behaviour == AgentBehaviour::kAvoid)
     for (const CrowdRobot& r : robots)
@@ -121,18 +117,24 @@ void CrowdSim::MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
   slow_since_[i] = time_;
   if (!points) {
     plan.active = false;
-    d.what = "blocked";
-    decisions_.push_back(d);
+    Decide(i, "blocked", goal);
     return;
   }
   plan.points = std::move(*points);
   plan.next = plan.points.size() > 1 ? 1 : 0;
   plan.goal = plan.points.back();
   plan.active = true;
+  Decide(i, what, plan.goal, static_cast<int>(plan.points.size()));
+}
+
+void CrowdSim::Decide(size_t i, const char* what, const Eigen::Vector2d& goal_W, int plan_points) {
+  CrowdDecision d;
+  d.time_sec = time_;
+  d.agent = static_cast<int>(i);
   d.what = what;
-  d.goal_W = plan.goal;
-  d.plan_points = static_cast<int>(plan.points.size());
-  decisions_.push_back(d);
+  d.goal_W = goal_W;
+  d.plan_points = plan_points;
+  decisions_.push_back(std::move(d));
 }
 
 void CrowdSim::ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots) {
@@ -230,12 +232,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
           time_ >= pause_until_[i] && (holding_[i] || at_point) && InRobotsPath(i, robots);
       if (hold && !holding_[i]) {
         plan.active = false;
-        CrowdDecision d;
-        d.time_sec = time_;
-        d.agent = static_cast<int>(i);
-        d.what = "hold";
-        d.goal_W = states_[i].position_W;
-        decisions_.push_back(d);
+        Decide(i, "hold", states_[i].position_W);
       }
       holding_[i] = hold ? 1 : 0;
       if (!hold && time_ >= replan_at_[i] && time_ >= pause_until_[i]) ChooseGoal(i, robots);
@@ -243,21 +240,11 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
                                   (IsVehicle(a.kind) ? kVehicleReachedM : kReachedM)) {
       plan.active = false;
       pause_until_[i] = time_ + a.pause_sec;
-      CrowdDecision d;
-      d.time_sec = time_;
-      d.agent = static_cast<int>(i);
-      d.what = "pause";
-      d.goal_W = plan.goal;
-      decisions_.push_back(d);
+      Decide(i, "pause", plan.goal);
     }
     if (plan.active && a.behaviour != AgentBehaviour::kBlock && time_ - slow_since_[i] > 4.0) {
       // stuck: give the goal up for the next
-      CrowdDecision d;
-      d.time_sec = time_;
-      d.agent = static_cast<int>(i);
-      d.what = "stuck";
-      d.goal_W = plan.goal;
-      decisions_.push_back(d);
+      Decide(i, "stuck", plan.goal);
       plan.active = false;
     }
     if (!plan.active && time_ >= pause_until_[i] && a.behaviour != AgentBehaviour::kBlock)

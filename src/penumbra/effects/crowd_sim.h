@@ -150,6 +150,8 @@ class CrowdSim {
   void ChooseGoal(size_t i, const std::vector<CrowdRobot>& robots);
   void MakePlan(size_t i, const Eigen::Vector2d& goal, const char* what,
                 const std::vector<CrowdRobot>& robots);
+  /// records a decision of agent i at the current time (TakeDecisions).
+  void Decide(size_t i, const char* what, const Eigen::Vector2d& goal_W, int plan_points = 0);
   Eigen::Vector2d Preferred(size_t i);
   void AddRobotLines(size_t i, const std::vector<CrowdRobot>& robots, double own_radius,
                      const Eigen::Vector2d& v_a, std::vector<OrcaLine>* lines) const;
