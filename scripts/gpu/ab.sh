@@ -17,10 +17,8 @@ mkdir -p "$R"
 work=$(mktemp -d)
 tar -C "$work" -xJf "$pack"
 pkg=$work/penumbra-gpu
-export LD_LIBRARY_PATH=$pkg/lib
-for d in "$(cat "$pkg/source-dir.txt")" /work/main; do
-  [ -e "$d/worlds" ] || { mkdir -p "$d" && ln -sfn "$pkg/src/worlds" "$d/worlds"; }
-done
+. "$(dirname "$0")/use-pack.sh"
+use_pack "$pkg" /work/main
 xz -dc "$baseline" > "$pkg/bin/base_bench" && chmod +x "$pkg/bin/base_bench"
 B=$pkg/bin
 W=$pkg/src/worlds

@@ -28,7 +28,7 @@ ldd "$build/penumbra" | awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
     strip --strip-unneeded "$stage/penumbra-full/lib/$(basename "$lib")" 2>/dev/null || true
   done
 cp -r "$root/worlds" "$stage/penumbra-full/src/"
-cp "$root/scripts/gpu/run-breakdown.sh" "$stage/penumbra-full/"
+cp "$root/scripts/gpu/run-breakdown.sh" "$root/scripts/gpu/use-pack.sh" "$stage/penumbra-full/"
 grep -m1 '^CMAKE_HOME_DIRECTORY:' "$build/CMakeCache.txt" | cut -d= -f2 > "$stage/penumbra-full/source-dir.txt"
 mkdir -p "$(dirname "$out")"
 rm -f "$out".part*

@@ -27,9 +27,8 @@ if [ -n "${PENUMBRA_BIN:-}" ]; then
   esac
   chmod +x "$pkg/bin/penumbra"
 fi
-export LD_LIBRARY_PATH=$pkg/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-src=$(cat "$pkg/source-dir.txt")
-[ -e "$src/worlds" ] || { mkdir -p "$src" && ln -sfn "$pkg/src/worlds" "$src/worlds"; }
+. "$(dirname "$0")/use-pack.sh"
+use_pack "$pkg"
 mkdir -p "$out"
 card=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo none)
 echo "card: $card; CPU: $(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)"

@@ -20,10 +20,8 @@ OUT=$work/logs  # the step logs, packed into one file of $RESULTS at the end (8 
 mkdir -p "$OUT"
 tar -C "$work" -xJf "$pack"
 pkg=$work/penumbra-gpu
-export LD_LIBRARY_PATH=$pkg/lib
-for d in "$(cat "$pkg/source-dir.txt")" /work/main; do
-  [ -e "$d/worlds" ] || { mkdir -p "$d" && ln -sfn "$pkg/src/worlds" "$d/worlds"; }
-done
+. "$(dirname "$0")/use-pack.sh"
+use_pack "$pkg" /work/main
 if [ -n "$baseline" ]; then
   xz -dc "$baseline" > "$pkg/bin/baseline_render_cuda_bench"
   chmod +x "$pkg/bin/baseline_render_cuda_bench"
