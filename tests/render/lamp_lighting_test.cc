@@ -42,12 +42,7 @@ SceneDescription LampTestCeiling(bool housing) {
   AddGeom(&s, GeomShape::kBox, {3, 3, 0.05}, Translation(0, 0, 2.75), 0, white);
   if (housing)
     AddGeom(&s, GeomShape::kCylinder, {0.25, 0.01, 0}, Translation(0, 0, 2.65), 0, white);
-  Light lamp;
-  lamp.type = Light::Type::kPoint;
-  lamp.position_B = {0, 0, 2.58};
-  lamp.intensity = 400;
-  lamp.radius_m = 0.05;
-  s.lights.push_back(lamp);
+  AddPointLamp(&s, {0, 0, 2.58}, 400, 0.05);
   return s;
 }
 
@@ -296,12 +291,7 @@ SceneDescription LampTestFloor(double lamp_z) {
   SceneDescription s = EmptyScene();
   const int white = AddMaterial(&s, Eigen::Vector3f::Constant(0.8f));
   AddGeom(&s, GeomShape::kBox, {3, 3, 0.05}, Translation(0, 0, -0.05), 0, white);
-  Light lamp;
-  lamp.type = Light::Type::kPoint;
-  lamp.position_B = {0, 0, lamp_z};
-  lamp.intensity = 400;
-  lamp.radius_m = 0.05;
-  s.lights.push_back(lamp);
+  AddPointLamp(&s, {0, 0, lamp_z}, 400, 0.05);
   return s;
 }
 
@@ -337,17 +327,8 @@ TEST(LampLightingTest, ALampBehindAWallAddsExactlyNothingToIt) {
     SceneDescription s = EmptyScene();
     const int white = AddMaterial(&s, Eigen::Vector3f::Constant(0.8f));
     AddGeom(&s, GeomShape::kBox, {0.05, 2, 2}, Translation(1.05, 0, 0), 0, white);  // x 1..1.1
-    Light a;
-    a.type = Light::Type::kPoint;
-    a.position_B = {2.0, 0.3, 0.2};
-    a.intensity = 400;
-    a.radius_m = 0.05;
-    s.lights.push_back(a);
-    if (with_b) {
-      Light b = a;
-      b.position_B = {0.5, -0.2, 0.1};
-      s.lights.push_back(b);
-    }
+    AddPointLamp(&s, {2.0, 0.3, 0.2}, 400, 0.05);                                   // lamp A
+    if (with_b) AddPointLamp(&s, {0.5, -0.2, 0.1}, 400, 0.05);                      // lamp B
     return s;
   };
   // from x = 2.5 looking along -x at the wall's face x = 1.1 (normal +x)

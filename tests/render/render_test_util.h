@@ -41,6 +41,19 @@ inline int AddMaterial(SceneDescription* s, const Eigen::Vector3f& color, float 
   return static_cast<int>(s->materials.size()) - 1;
 }
 
+/// adds a point lamp fixed to the world at p_W (intensity in candela, emitter radius in m for
+/// soft shadows; 0 = hard) and returns its index.
+inline int AddPointLamp(SceneDescription* s, const Eigen::Vector3d& p_W, float intensity,
+                        float radius_m) {
+  Light lamp;
+  lamp.type = Light::Type::kPoint;
+  lamp.position_B = p_W;
+  lamp.intensity = intensity;
+  lamp.radius_m = radius_m;
+  s->lights.push_back(lamp);
+  return static_cast<int>(s->lights.size()) - 1;
+}
+
 /// adds a geom and returns its index; its MuJoCo id is 100 + index (so ids differ from indices).
 inline int AddGeom(SceneDescription* s, GeomShape shape, const Eigen::Vector3d& size,
                    const Pose& X_BG, int body = 0, int material = -1) {

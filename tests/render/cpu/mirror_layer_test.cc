@@ -31,12 +31,7 @@ SceneDescription MirrorLayerScene(float r) {
   AddGeom(&s, GeomShape::kPlane, {0, 0, 1}, Pose::Identity(), 0, floor);
   AddGeom(&s, GeomShape::kBox, {0.3, 0.5, 0.5}, Translation(3, 0, 0.5), 0, red);
   AddGeom(&s, GeomShape::kBox, {0.1, 3, 1.5}, Translation(5, 0, 1.5), 0, white);
-  Light lamp;
-  lamp.type = Light::Type::kPoint;
-  lamp.position_B = Eigen::Vector3d(1.5, 1, 2);
-  lamp.intensity = 40;
-  lamp.radius_m = 0.05f;
-  s.lights.push_back(lamp);
+  AddPointLamp(&s, {1.5, 1, 2}, 40, 0.05f);
   s.sky.type = Sky::Type::kUniform;
   s.sky.radiance = Eigen::Vector3f::Constant(2);
   return s;
