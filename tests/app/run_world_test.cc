@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "common/temp_dir.h"
@@ -131,6 +132,17 @@ TEST_F(RunWorldTest, WritesEveryOutputAtTheCameraRates) {
     last = line;
   }
   EXPECT_EQ(rows, 100);
+
+  // run.json's render time and its parts: the first frames (renderer set-up on first use) and
+  // the time inside Renderer::Render are parts of it
+  const nlohmann::json t = nlohmann::json::parse(ReadAll(out / "run.json")).at("timings_sec");
+  const double render = t.at("render_sec").get<double>();
+  const double first = t.at("render_first_frames_sec").get<double>();
+  const double renderer = t.at("render_renderer_sec").get<double>();
+  EXPECT_GT(first, 0.0);
+  EXPECT_GT(renderer, 0.0);
+  EXPECT_LE(first, render);
+  EXPECT_LE(renderer, render);
 }
 
 TEST_F(RunWorldTest, SameSeedGivesByteIdenticalOutputsForAnyThreadCount) {

@@ -36,6 +36,11 @@ struct CameraView {
   /// camera's own housing, whose bounding box holds the optical centre, out of every primary
   /// ray's traversal. >= 0.
   double near_m = 0.01;
+  /// white balance gains (linear rgb, render/white_balance.h) multiplied into the exposure of
+  /// each channel when rgb is developed (Film::Develop's wb_gains); ones = none. CameraImager
+  /// sets them when they are known before the frame (modes daylight, kelvin) so that the
+  /// renderer's rgb is the camera's and is not developed a second time.
+  Eigen::Vector3f white_balance_gains = Eigen::Vector3f::Ones();
 };
 
 /// images of one frame; the ones not requested are left empty.

@@ -123,10 +123,15 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       internal[k] = true;
   }
   const bool want_rgb = spec_.outputs[ImageKind::kRgb];
-  if (want_rgb) {
+  if (want_rgb && n > 1) {
     if (accum_.width != W || accum_.height != H || accum_.channels != 3) accum_ = ImageF(W, H, 3);
     std::fill(accum_.data.begin(), accum_.data.end(), 0.0f);
   }
+  // white balance known before the frame (not gray world): the renderer develops with it, so
+  // that a frame without sub-frames, noise or adaptation is developed once
+  const Eigen::Vector3f wb_before = c.white_balance.mode == WhiteBalance::Mode::kAuto
+                                        ? Eigen::Vector3f::Ones()
+                                        : GainsForFrame(c.white_balance, daylight_white_, ImageF());
   RenderedFrame sub;
   for (int k = 0; k < n; ++k) {
     const double s = (k + 0.5) * T / n;
@@ -137,6 +142,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.frame_index = frame_index * n + k;
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;
+    view.white_balance_gains = wb_before;
     view.outputs = internal;
     if (k != truth_k) {
       view.outputs = CameraOutputs::None();
@@ -155,10 +161,13 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       snap = &interp;
     }
     RenderedFrame* target = k == truth_k ? &out->truth : &sub;
+    const auto t0 = std::chrono::steady_clock::now();
     renderer->Render(*snap, effects, view, target);
+    renderer_sec_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out->stopped = target->stopped;
     if (out->stopped) return;  // unfinished: the auto-exposure state is left as it was
-    if (want_rgb) {
+    if (want_rgb && n > 1) {
       const std::vector<float>& r = target->radiance.data;
       for (size_t i = 0; i < r.size(); ++i) accum_.data[i] += r[i];
     }
@@ -171,10 +180,18 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   out->time_sec = start.time_sec;
 
   if (want_rgb) {
-    for (float& v : accum_.data) v /= static_cast<float>(n);
-    out->radiance = accum_;
-    // exposure with adaptation over sim time
-    double ev = film_.Ev100(accum_, pool_.get());
+    // the mean over the sub-frames; one frame is the renderer's radiance as it is
+    if (n > 1) {
+      for (float& v : accum_.data) v /= static_cast<float>(n);
+      out->radiance = accum_;
+    } else {
+      out->radiance = out->truth.radiance;
+    }
+    const ImageF& radiance = out->radiance;
+    // exposure with adaptation over sim time; one frame's metering is the renderer's (Film::Ev100
+    // of this very radiance)
+    const bool developed = n == 1 && !out->truth.rgb.empty();
+    double ev = developed ? out->truth.ev100 : film_.Ev100(radiance, pool_.get());
     if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
       const double dt = std::max(0.0, start.time_sec - *last_time_);
       ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
@@ -182,22 +199,21 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     last_ev_ = ev;
     last_time_ = start.time_sec;
     out->ev100 = ev;
-    const Eigen::Vector3f wb_gains = GainsForFrame(c.white_balance, daylight_white_, accum_);
+    const Eigen::Vector3f wb_gains = GainsForFrame(c.white_balance, daylight_white_, radiance);
     if (c.noise.enabled) {
       const float h = static_cast<float>(ExposureFromEv100(ev));
       if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
         exposed_ = ImageF(W, H, 3);
-      for (size_t i = 0; i < accum_.data.size(); ++i) exposed_.data[i] = accum_.data[i] * h;
+      for (size_t i = 0; i < radiance.data.size(); ++i) exposed_.data[i] = radiance.data[i] * h;
       ApplyImageNoise(exposed_, c.noise, HashKeys(settings_.seed, camera_index_, frame_index, 1),
                       &dn_, pool_.get());
       const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
       for (float& v : dn_.data) v *= inv_max;
       film_.Develop(dn_, -std::log2(1.2), pool_.get(), &out->rgb, wb_gains);  // exposure H = 1
-    } else if (n == 1 && ev == out->truth.ev100 && !out->truth.rgb.empty() &&
-               wb_gains == Eigen::Vector3f::Ones()) {
-      out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV
+    } else if (developed && ev == out->truth.ev100 && wb_gains == wb_before) {
+      out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV and gains
     } else {
-      film_.Develop(accum_, ev, pool_.get(), &out->rgb, wb_gains);
+      film_.Develop(radiance, ev, pool_.get(), &out->rgb, wb_gains);
     }
     if (c.lens_droplets) {
       // drops land only while the camera is under open sky in the rain (the shelter map of

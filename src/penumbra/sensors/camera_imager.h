@@ -84,6 +84,10 @@ class CameraImager {
 
   const CameraSpec& spec() const { return spec_; }
   const CameraSensorConfig& config() const { return config_; }
+  /// wall time spent inside Renderer::Render by this imager's captures so far, s (the rest of
+  /// a capture is the camera model: exposure, noise, develop, copies). a run timing only: it
+  /// never reaches an image.
+  double renderer_sec() const { return renderer_sec_; }
 
  private:
   CameraSpec spec_;
@@ -101,6 +105,7 @@ class CameraImager {
   std::optional<double> last_ev_, last_time_;
   std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;
+  double renderer_sec_ = 0;
 };
 
 /// frames per second of CameraImager::Capture for a small scene (a box room, 320 x 240, realtime

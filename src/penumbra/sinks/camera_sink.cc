@@ -118,6 +118,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
       worker_(static_cast<size_t>(std::max(1, options_.render_queue))) {
   selected_.assign(scene.cameras.size(), options_.cameras.empty() ? 1 : 0);
   warned_black_.assign(scene.cameras.size(), 0);
+  rendered_once_.assign(scene.cameras.size(), 0);
   for (const std::string& name : options_.cameras) {
     const int c = scene.FindCamera(name);
     if (c < 0) {
@@ -207,6 +208,12 @@ void CameraSink::OnFinish(const LoopFinish& finish) {
   writer_.Flush();
 }
 
+double CameraSink::renderer_sec() const {
+  double sec = 0;
+  for (const CameraImager& imager : imagers_) sec += imager.renderer_sec();
+  return sec;
+}
+
 void CameraSink::Render(const std::shared_ptr<const WorldSnapshot>& snapshot,
                         const Capture& capture,
                         const std::vector<std::shared_ptr<const EffectsFrame>>& effects) {
@@ -241,7 +248,12 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   CameraImages img;
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
-  render_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  render_sec_ += sec;
+  if (!rendered_once_[p.camera]) {
+    rendered_once_[p.camera] = 1;
+    render_first_frames_sec_ += sec;
+  }
   if (img.stopped) {
     // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
     spdlog::info(

@@ -139,6 +139,12 @@ class CameraSink : public Sink {
   std::map<std::string, int64_t> FramesWritten() const { return writer_.FramesWritten(); }
   /// wall time spent rendering and forming images, s (read after OnFinish).
   double render_sec() const { return render_sec_; }
+  /// the part of render_sec() spent on each camera's first frame, s: the renderer's set-up on
+  /// first use (textures, scene upload, device context) falls there (read after OnFinish).
+  double render_first_frames_sec() const { return render_first_frames_sec_; }
+  /// the part of render_sec() spent inside Renderer::Render, s; the rest is the camera model
+  /// (CameraImager: exposure, noise, develop, copies) (read after OnFinish).
+  double renderer_sec() const;
   /// the writer threads' PNG encoding and file writing, s (read after OnFinish).
   PngWriteTimes png_times() const { return writer_.PngTimes(); }
 
@@ -181,6 +187,8 @@ class CameraSink : public Sink {
   std::deque<Pending> pending_;
   std::shared_ptr<const WorldSnapshot> last_;
   double render_sec_ = 0;
+  double render_first_frames_sec_ = 0;
+  std::vector<char> rendered_once_;  // per scene camera: its first frame was captured
   int64_t frames_ = 0;
   SinkWorker worker_;
 };

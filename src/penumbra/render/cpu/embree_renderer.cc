@@ -260,7 +260,7 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
       std::swap(out->radiance, denoised_);
     }
     out->ev100 = film_.Ev100(out->radiance, &pool_);
-    film_.Develop(out->radiance, out->ev100, &pool_, &out->rgb);
+    film_.Develop(out->radiance, out->ev100, &pool_, &out->rgb, view.white_balance_gains);
   }
 }
 

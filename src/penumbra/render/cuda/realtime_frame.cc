@@ -139,6 +139,7 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
     }
   }
   camera_ = PinholeCameraOf(view);
+  white_balance_gains_ = view.white_balance_gains;
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   spread_rad_ = camera.pixel_spread_rad();
   // FrameContext::FrameKey() (render/cpu/integrator.h).
@@ -241,7 +242,7 @@ double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pix
                                         : static_cast<double>(kMinLuminance);
   const double ev100 = film_.Ev100FromLogAverage(log_average);
   const float e = static_cast<float>(ExposureFromEv100(ev100));
-  exposure[0] = exposure[1] = exposure[2] = e;
+  for (int c = 0; c < 3; ++c) exposure[c] = e * white_balance_gains_[c];
   return ev100;
 }
 

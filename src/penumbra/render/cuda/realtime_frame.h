@@ -82,7 +82,8 @@ class RealtimeFrameData {
   RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
 
   /// the EV100 of a frame whose rows' log-luminance sums are `row_sums` (film.h's auto
-  /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop.
+  /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop
+  /// (the exposure times the prepared view's white_balance_gains, as Film::Develop).
   double Ev100(const std::vector<double>& row_sums, int64_t pixels, float exposure[3]) const;
 
   const std::vector<MaterialPod>& materials() const { return materials_; }
@@ -107,6 +108,7 @@ class RealtimeFrameData {
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;
+  Eigen::Vector3f white_balance_gains_ = Eigen::Vector3f::Ones();  // the prepared view's
   // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
   int CheckRows(const char* what, int64_t n, int row0, int row1) const;
   // the sky terms of the pixels of rows 2 q and 2 q + 1 below row1 (SkyTerms' 2x2 quads).

@@ -67,6 +67,8 @@ void RunOutputs::Finish(std::map<std::string, double>* timings) {
   progress_->Finish();
   for (const auto& [kind, sec] : sensors_->busy_sec()) (*timings)["sensors_" + kind + "_sec"] = sec;
   (*timings)["render_sec"] = cameras_->render_sec();
+  (*timings)["render_first_frames_sec"] = cameras_->render_first_frames_sec();
+  (*timings)["render_renderer_sec"] = cameras_->renderer_sec();
   const PngWriteTimes png = cameras_->png_times();
   (*timings)["png_encode_sec"] = png.encode_sec;
   (*timings)["png_write_sec"] = png.write_sec;

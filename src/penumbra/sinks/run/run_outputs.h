@@ -79,8 +79,11 @@ class RunOutputs {
   void AddTo(SimLoop* loop);
 
   /// on the loop's finish (from the ManifestSink's describe callback, after every other
-  /// sink's OnFinish): ends the progress bar and adds "sensors_<kind>_sec", "render_sec",
-  /// "png_encode_sec" and "png_write_sec" (the frame writer's threads) to `timings`.
+  /// sink's OnFinish): ends the progress bar and adds "sensors_<kind>_sec", "render_sec"
+  /// with its parts "render_first_frames_sec" (each camera's first frame: the renderer's
+  /// set-up on first use) and "render_renderer_sec" (inside Renderer::Render; the rest is the
+  /// camera model), "png_encode_sec" and "png_write_sec" (the frame writer's threads) to
+  /// `timings`.
   void Finish(std::map<std::string, double>* timings);
 
   /// run.json's shared fields: `world_file`, seed, the versions, `command_line`, the sim
