@@ -30,8 +30,8 @@ class BenchRenderCommand : public Command {
         ->check(CLI::IsMember({"realtime", "pathtraced"}));
     backend_.Add(verb);
     AddInteger(verb, "--batch", &options_.batch, 1, 65535,
-               "batch rendering: N cameras per launch on the CUDA backend (depth+seg; "
-               "docs/gpu.md)");
+               "batch rendering: N cameras per launch on the CUDA backend (depth+seg, then "
+               "realtime rgb+depth; docs/gpu.md)");
     verb->add_option("--size", size_, "WxH of each camera in --batch (default 128x128)")
         ->check(CLI::Validator(
             [](std::string& v) -> std::string {

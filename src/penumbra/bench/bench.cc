@@ -62,6 +62,7 @@ int BenchRenderBatch(const WorldConfig& world, const RenderBenchOptions& options
       throw ConfigError(world.file, 0, "cameras", "bench render needs a camera");
     cuda::BatchBenchWorld w;
     w.scene = &scene;
+    w.settings = world.render;
     w.snapshot = sim.Snapshot();
     const CameraSpec& cam = scene.cameras.front();
     w.view.X_WO = CameraPoseInWorld(cam, w.snapshot);
@@ -78,13 +79,23 @@ int BenchRenderBatch(const WorldConfig& world, const RenderBenchOptions& options
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("penumbra bench render --batch {}: world {}, {} session(s), device {}\n",
              options.batch, world.file, options.sessions, dev.name);
-  const cuda::BatchOutputs outputs;
+  // depth + segmentation, then (realtime tier) rgb + depth
+  cuda::BatchOutputs truth, rgb;
+  rgb.segmentation = false;
+  rgb.rgb = true;
+  std::vector<cuda::BatchOutputs> sets = {truth};
+  if (world.render.tier == RenderSettings::Tier::kRealtime)
+    sets.push_back(rgb);
+  else
+    fmt::print("rgb batches: the realtime tier only (this world renders pathtraced)\n");
   const int counts[] = {options.batch};
-  const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
-      worlds, options.batch_width, options.batch_height, counts, options.frames, outputs);
   const std::string name = world.file.substr(world.file.find_last_of('/') + 1);
-  fmt::print(
-      "{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height, outputs, rows));
+  for (const cuda::BatchOutputs& outputs : sets) {
+    const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
+        worlds, options.batch_width, options.batch_height, counts, options.frames, outputs);
+    fmt::print("{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height,
+                                            outputs, rows));
+  }
   return 0;
 #else
   throw ConfigError("", 0, "--batch",

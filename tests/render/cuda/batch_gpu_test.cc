@@ -2,8 +2,10 @@
 // of two worlds (the default room and the house, two sessions) in one launch give the same
 // bits as each camera in a batch of its own and agree with the single-camera CudaRenderer;
 // two renderers render the same bits (determinism); overlapped batches keep their own images;
-// the copy modes give the same images; a ticket whose slot was reused is refused. without a
-// device every test prints "skipped: no CUDA device".
+// the copy modes give the same images; a ticket whose slot was reused is refused; the realtime
+// rgb of a batch (both worlds, frame keys of their own) is CudaRenderer's rgb and depth of each
+// camera alone, bit for bit, run to run. without a device every test prints "skipped: no CUDA
+// device".
 
 #include <gtest/gtest.h>
 
@@ -213,6 +215,67 @@ TEST_F(BatchRendering, DeviceOnlyBatchesAreNotCopiedBack) {
   EXPECT_EQ(r.Wait(t).base, nullptr);
   EXPECT_NE(r.DeviceImages(t).base, nullptr);
   EXPECT_GT(r.kernel_ms(t), 0.0);
+}
+
+TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
+  std::vector<CameraView> views;
+  std::vector<cuda::BatchCamera> cams = Cameras(&views);
+  // cameras of other frames (their random numbers are keyed by camera and frame)
+  for (int k = 0; k < 8; ++k) {
+    views[k].frame_index = 3 * k;
+    views[k].outputs[ImageKind::kRgb] = views[k].outputs[ImageKind::kDepth] = true;
+    views[k].outputs[ImageKind::kSegmentation] = views[k].outputs[ImageKind::kRange] = false;
+    views[k].outputs[ImageKind::kInstanceSegmentation] =
+        views[k].outputs[ImageKind::kSemanticSegmentation] = false;
+    cams[k] = cuda::BatchRenderer::CameraOf(k % 2, views[k]);
+  }
+  cuda::BatchConfig config;
+  config.width = kBatchW;
+  config.height = kBatchH;
+  config.max_cameras = 8;
+  config.outputs.segmentation = false;
+  config.outputs.rgb = true;
+  std::vector<uint8_t> first;
+  for (int run = 0; run < 2; ++run) {
+    cuda::BatchRenderer r(config);
+    AddWorlds(&r);
+    const cuda::BatchImages img = r.Wait(r.Submit(cams));
+    ASSERT_EQ(img.cameras, 8);
+    ASSERT_NE(img.rgb(7), nullptr);
+    ASSERT_EQ(img.geom_id(0), nullptr);
+    const cuda::RealtimeBatchTimes t = r.stage_ms(0);
+    EXPECT_GT(t.total, 0.0);
+    const std::vector<uint8_t> bytes = BatchBytes(img);
+    if (run == 1) {
+      EXPECT_TRUE(bytes == first) << "two runs of the same rgb batch differ";
+      break;
+    }
+    first = bytes;
+    RenderSettings gpu_settings;
+    gpu_settings.backend = RenderSettings::Backend::kCuda;
+    const int n = kBatchW * kBatchH;
+    for (int k = 0; k < 8; ++k) {
+      SCOPED_TRACE("camera " + std::to_string(k));
+      const BatchWorld& w = worlds_[k % 2];
+      const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
+      RenderedFrame f;
+      single->Render(w.snap, views[k], &f);
+      ASSERT_EQ(f.rgb.data.size(), static_cast<size_t>(3 * n));
+      int rgb_diff = 0, depth_diff = 0, lit = 0;
+      for (int i = 0; i < 3 * n; ++i) {
+        rgb_diff += f.rgb.data[i] != img.rgb(k)[i];
+        lit += img.rgb(k)[i] > 8;
+      }
+      for (int i = 0; i < n; ++i)
+        depth_diff += std::memcmp(&f.depth_m.data[i], img.depth(k) + i, 4) != 0;
+      std::printf("rgb camera %d (%s): %d of %d rgb bytes and %d of %d depth values differ from "
+                  "CudaRenderer's; %d bytes > 8\n",
+                  k, k % 2 ? "house" : "default", rgb_diff, 3 * n, depth_diff, n, lit);
+      EXPECT_EQ(rgb_diff, 0);
+      EXPECT_EQ(depth_diff, 0);
+      EXPECT_GT(lit, n / 10);
+    }
+  }
 }
 
 }  // namespace

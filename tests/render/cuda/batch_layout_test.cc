@@ -74,6 +74,32 @@ TEST(BatchLayout, PlanesArePackedCameraMajorForTheBatchSize) {
   EXPECT_THROW(l.plane_offset(cuda::BatchPlane::kSegmentation, 2), Error);
 }
 
+// rgb is 3 bytes a pixel, after the 4-byte planes (they stay 4-byte aligned).
+TEST(BatchLayout, RgbIsThreeBytesAPixelAfterTheOtherPlanes) {
+  cuda::BatchOutputs o;
+  o.segmentation = false;
+  o.rgb = true;
+  const cuda::BatchLayout l(4, 3, 10, o);
+  EXPECT_EQ(l.planes(), 2);
+  EXPECT_TRUE(l.has(cuda::BatchPlane::kRgb));
+  // a batch of 5: depth [0, 240), rgb [240, 420)
+  EXPECT_EQ(l.bytes(5), 420);
+  EXPECT_EQ(l.capacity_bytes(), 840);
+  EXPECT_EQ(l.plane_offset(cuda::BatchPlane::kRgb, 5), 240);
+  EXPECT_EQ(l.image_offset(cuda::BatchPlane::kRgb, 5, 2), 240 + 2 * 36);
+  EXPECT_EQ(l.image_offset(cuda::BatchPlane::kDepth, 5, 2), 2 * 48);
+  o.depth = false;
+  o.range = true;
+  const cuda::BatchLayout r(4, 3, 10, o);
+  EXPECT_EQ(r.plane_offset(cuda::BatchPlane::kRange, 2), 0);
+  EXPECT_EQ(r.plane_offset(cuda::BatchPlane::kRgb, 2), 96);
+  EXPECT_EQ(r.bytes(2), 96 + 72);
+  cuda::BatchOutputs rgb_only;
+  rgb_only.depth = rgb_only.segmentation = false;
+  rgb_only.rgb = true;
+  EXPECT_EQ(cuda::BatchLayout(4, 3, 1, rgb_only).bytes(1), 36);
+}
+
 TEST(BatchLayout, BadConfigsAreRefused) {
   cuda::BatchOutputs none;
   none.depth = none.segmentation = false;

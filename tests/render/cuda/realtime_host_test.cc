@@ -14,6 +14,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "realtime_parity.h"
@@ -86,6 +87,47 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     EXPECT_EQ(stored.radiance.data, evaluated.radiance.data) << world;
     EXPECT_EQ(stored.rgb.data, evaluated.rgb.data) << world;
     EXPECT_EQ(stored.depth_m.data, evaluated.depth_m.data) << world;
+  }
+}
+
+// batch rendering poses a world once (PoseWorld) and sets each camera of a batch in turn
+// (SetCamera, FrameKey): a camera set after another one renders the bits of Prepare of that
+// camera alone, in the default room and the house.
+TEST(RealtimeHostPathFrames, PoseWorldThenSetCameraIsPrepare) {
+  for (const char* world : {"default.yaml", "house.yaml"}) {
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(world);
+    const SceneDescription& scene = session->scene();
+    const WorldSnapshot snap = session->sim().Snapshot();
+    CameraView view = realtime_parity::RgbDepthView(scene, snap, 64, 48);
+    view.frame_index = 5;
+    CameraView other = view;
+    other.X_WO.translation().z() += 0.3;
+    other.frame_index = 2;
+    cuda::BvhScene bvh(scene);
+    bvh.Update(snap);
+    ThreadPool pool(0);
+    cuda::RealtimeFrameData alone(scene, RenderSettings());
+    alone.Prepare(snap, view, &pool);
+    cuda::RealtimeFrameData batch(scene, RenderSettings());
+    batch.PoseWorld(snap, &pool);
+    for (const CameraView* v : {&other, &view}) {
+      const Camera c(v->X_WO, v->intrinsics, v->motion);
+      batch.SetCamera(cuda::PinholeCameraOf(*v), c.pixel_spread_rad(), v->camera_index,
+                      v->frame_index);
+    }
+    const cuda::RealtimeFrameView fa = alone.View(bvh.view(), nullptr);
+    const cuda::RealtimeFrameView fb = batch.View(bvh.view(), nullptr);
+    EXPECT_EQ(fa.frame_key, fb.frame_key) << world;
+    EXPECT_EQ(fb.frame_key, batch.FrameKey(view.camera_index, view.frame_index)) << world;
+    EXPECT_NE(fb.frame_key, batch.FrameKey(other.camera_index, other.frame_index)) << world;
+    EXPECT_EQ(fa.spread_rad, fb.spread_rad) << world;
+    EXPECT_EQ(0, std::memcmp(&fa.camera, &fb.camera, sizeof(fa.camera))) << world;
+    RenderedFrame a, b;
+    cuda::RenderRealtimeOnHost(alone, bvh, &pool, &a, /*stored_surface=*/true);
+    cuda::RenderRealtimeOnHost(batch, bvh, &pool, &b, /*stored_surface=*/true);
+    EXPECT_EQ(a.rgb.data, b.rgb.data) << world;
+    EXPECT_EQ(a.depth_m.data, b.depth_m.data) << world;
+    EXPECT_EQ(a.ev100, b.ev100) << world;
   }
 }
 

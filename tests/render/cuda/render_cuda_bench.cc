@@ -236,13 +236,18 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
     }
     if (sessions > 1)
       for (cuda::BatchBenchWorld& w : bench_worlds) w.cpu = cpus.front().get();
-    cuda::BatchOutputs outputs;
-    const std::vector<cuda::BatchBenchRow> rows =
-        cuda::RunBatchBench(bench_worlds, width, height, counts, frames, outputs);
-    const std::string name = file.substr(file.find_last_of('/') + 1);
-    fmt::print("\n{}", cuda::FormatBatchBench(
-                           sessions > 1 ? fmt::format("{} x{} sessions", name, sessions) : name,
-                           width, height, outputs, rows));
+    // depth + segmentation, then the realtime tier's rgb + depth
+    cuda::BatchOutputs truth, rgb;
+    rgb.segmentation = false;
+    rgb.rgb = true;
+    for (const cuda::BatchOutputs& outputs : {truth, rgb}) {
+      const std::vector<cuda::BatchBenchRow> rows =
+          cuda::RunBatchBench(bench_worlds, width, height, counts, frames, outputs);
+      const std::string name = file.substr(file.find_last_of('/') + 1);
+      fmt::print("\n{}", cuda::FormatBatchBench(
+                             sessions > 1 ? fmt::format("{} x{} sessions", name, sessions) : name,
+                             width, height, outputs, rows));
+    }
   }
   fmt::print("\n| copy back, device to host | MiB | GB/s |\n|---|---:|---:|\n");
   for (const int64_t mib : {1, 16, 128}) {

@@ -24,20 +24,27 @@ BatchLayout::BatchLayout(int width, int height, int max_cameras, const BatchOutp
   if (max_cameras < 1 || max_cameras > 65535)
     throw Error(
         fmt::format("batch rendering: {} cameras per batch; expected 1 to 65535", max_cameras));
-  const bool on[kBatchPlaneCount] = {outputs.depth, outputs.segmentation,
-                                     outputs.instance_segmentation, outputs.semantic_segmentation,
-                                     outputs.range};
-  for (int p = 0; p < kBatchPlaneCount; ++p) index_[p] = on[p] ? planes_++ : -1;
+  const bool on[kBatchPlaneCount] = {outputs.depth,
+                                     outputs.segmentation,
+                                     outputs.instance_segmentation,
+                                     outputs.semantic_segmentation,
+                                     outputs.range,
+                                     outputs.rgb};
+  for (int p = 0; p < kBatchPlaneCount; ++p) {
+    before_[p] = pixel_bytes_;
+    index_[p] = on[p] ? planes_++ : -1;
+    if (on[p]) pixel_bytes_ += BatchPlaneBytes(static_cast<BatchPlane>(p));
+  }
   if (planes_ == 0)
     throw Error(
         "batch rendering: no output; expected at least one of depth, segmentation, "
-        "instance_segmentation, semantic_segmentation, range");
+        "instance_segmentation, semantic_segmentation, range, rgb");
 }
 
 int64_t BatchLayout::plane_offset(BatchPlane p, int cameras) const {
-  const int i = index_[static_cast<int>(p)];
-  if (i < 0) throw Error("batch rendering: plane not rendered by this batch");
-  return 4 * pixels() * cameras * i;
+  if (index_[static_cast<int>(p)] < 0)
+    throw Error("batch rendering: plane not rendered by this batch");
+  return static_cast<int64_t>(before_[static_cast<int>(p)]) * pixels() * cameras;
 }
 
 void BatchLayout::Check(const BatchCamera* cameras, int count, int num_worlds) const {

@@ -12,33 +12,45 @@
 
 namespace penumbra::cuda {
 
-/// the images a batch renders: the ground truth of the pixel-centre ray (rgb is not on the
-/// GPU yet, docs/gpu.md). each is one 4-byte value per pixel: depth and range float metres,
-/// segmentation (MuJoCo geom id), instance (body id) and semantic class int32, as
-/// RenderedFrame's depth_m, geom_id, body_id, semantic_class and range_m.
+/// the images a batch renders: the ground truth of the pixel-centre ray, each one 4-byte value
+/// per pixel: depth and range float metres, segmentation (MuJoCo geom id), instance (body id)
+/// and semantic class int32, as RenderedFrame's depth_m, geom_id, body_id, semantic_class and
+/// range_m; and the realtime tier's rgb, 3 bytes a pixel (sRGB, as RenderedFrame::rgb), whose
+/// depth is then the realtime path's (the same as CudaRenderer's with rgb on).
 struct BatchOutputs {
   bool depth = true;
   bool segmentation = true;
   bool instance_segmentation = false;
   bool semantic_segmentation = false;
   bool range = false;
+  bool rgb = false;
 };
 
 /// one camera of a batch: the world it looks at (the index BatchRenderer::AddWorld returned)
 /// and its pinhole camera (CudaRenderer::PinholeOf); its width and height must be the batch's.
+/// the rgb's per-pixel random numbers are keyed by camera_index and frame_index (as
+/// CameraView's), and its texture filtering's ray cones start at spread_rad
+/// (Camera::pixel_spread_rad); BatchRenderer::CameraOf fills all of them.
 struct BatchCamera {
   int32_t world = 0;
+  int32_t camera_index = 0;  ///< CameraView::camera_index
+  int64_t frame_index = 0;   ///< CameraView::frame_index
+  float spread_rad = 0;      ///< Camera::pixel_spread_rad, radians
   PinholeCamera camera;
 };
 
 /// the planes of a batch's buffer, in buffer order.
-enum class BatchPlane { kDepth = 0, kSegmentation, kInstance, kSemantic, kRange };
-inline constexpr int kBatchPlaneCount = 5;
+enum class BatchPlane { kDepth = 0, kSegmentation, kInstance, kSemantic, kRange, kRgb };
+inline constexpr int kBatchPlaneCount = 6;
+
+/// bytes per pixel of plane p: 3 for rgb, else 4.
+inline constexpr int BatchPlaneBytes(BatchPlane p) { return p == BatchPlane::kRgb ? 3 : 4; }
 
 /// where a batch's images lie in its one buffer: the planes that are on (BatchOutputs), in
-/// BatchPlane order, each `cameras` x height x width 4-byte values, camera-major then row-major
-/// (camera k's pixel (u, v) at k * width * height + v * width + u). a batch of k cameras uses
-/// the first bytes(k) bytes, so it is copied back in one transfer.
+/// BatchPlane order, each `cameras` x height x width values of BatchPlaneBytes bytes,
+/// camera-major then row-major (camera k's pixel (u, v) at k * width * height + v * width + u;
+/// rgb last, so every 4-byte plane stays 4-byte aligned). a batch of k cameras uses the first
+/// bytes(k) bytes, so it is copied back in one transfer.
 class BatchLayout {
  public:
   /// @throws Error if width or height is not in [1, 16384], max_cameras not in [1, 65535] (the
@@ -59,10 +71,10 @@ class BatchLayout {
   int64_t plane_offset(BatchPlane p, int cameras) const;
   /// byte offset of camera k's image of plane p in the buffer of a batch of `cameras`.
   int64_t image_offset(BatchPlane p, int cameras, int k) const {
-    return plane_offset(p, cameras) + 4 * pixels() * k;
+    return plane_offset(p, cameras) + BatchPlaneBytes(p) * pixels() * k;
   }
   /// bytes of the images of a batch of `cameras` cameras.
-  int64_t bytes(int cameras) const { return 4 * pixels() * planes_ * cameras; }
+  int64_t bytes(int cameras) const { return pixel_bytes_ * pixels() * cameras; }
   /// bytes of the largest batch (each slot's buffer).
   int64_t capacity_bytes() const { return bytes(max_cameras_); }
 
@@ -75,7 +87,9 @@ class BatchLayout {
   int width_, height_, max_cameras_;
   BatchOutputs outputs_;
   std::array<int, kBatchPlaneCount> index_{};  // position among the planes that are on, -1 off
+  std::array<int, kBatchPlaneCount> before_{};  // bytes per pixel of the planes before p
   int planes_ = 0;
+  int pixel_bytes_ = 0;  // bytes per pixel of all planes
 };
 
 /// the ring of kSlots buffer slots batches rotate through: ticket t (the t-th batch

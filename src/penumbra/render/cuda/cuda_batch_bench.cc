@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "penumbra/render/cuda/cuda_batch_renderer.h"
 
@@ -29,29 +30,44 @@ std::string OutputsLabel(const BatchOutputs& o) {
   add(o.instance_segmentation, "instance");
   add(o.semantic_segmentation, "semantic");
   add(o.range, "range");
+  add(o.rgb, "rgb");
   return s;
 }
 
 // wall seconds per batch of `batches` batches of `cams`, each Submit overlapping the previous
-// batch's copy back; *kernel_ms: the kernels' mean (CUDA events)
+// batch's copy back; *kernel_ms: the kernels' mean (CUDA events); *stages (rgb batches, may be
+// null): the realtime stages' means
 double TimePipeline(BatchRenderer* r, std::span<const BatchCamera> cams, int batches,
-                    double* kernel_ms) {
+                    double* kernel_ms, RealtimeBatchTimes* stages) {
   for (int i = 0; i < 2; ++i) r->Wait(r->Submit(cams));  // warm-up
   double kernel_sum = 0;
+  RealtimeBatchTimes st;
+  const bool rgb = r->layout().outputs().rgb;
+  const auto waited = [&](int64_t t) {
+    r->Wait(t);
+    kernel_sum += r->kernel_ms(t);
+    if (!rgb) return;
+    const RealtimeBatchTimes x = r->stage_ms(t);
+    st.geometry += x.geometry, st.sky += x.sky, st.shade += x.shade;
+    st.visibility += x.visibility, st.mirror += x.mirror, st.row_sums += x.row_sums;
+    st.exposure += x.exposure, st.film += x.film, st.total += x.total;
+  };
   const auto t0 = BenchClock::now();
   int64_t previous = -1;
   for (int i = 0; i < batches; ++i) {
     const int64_t t = r->Submit(cams);
-    if (previous >= 0) {
-      r->Wait(previous);
-      kernel_sum += r->kernel_ms(previous);
-    }
+    if (previous >= 0) waited(previous);
     previous = t;
   }
-  r->Wait(previous);
-  kernel_sum += r->kernel_ms(previous);
+  waited(previous);
   const double s = SecondsSince(t0) / batches;
   if (kernel_ms) *kernel_ms = kernel_sum / batches;
+  if (stages) {
+    for (double* x : {&st.geometry, &st.sky, &st.shade, &st.visibility, &st.mirror, &st.row_sums,
+                      &st.exposure, &st.film, &st.total})
+      *x /= batches;
+    *stages = st;
+  }
   return s;
 }
 
@@ -92,7 +108,7 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     config.copy = copy;
     BatchRenderer r(config);
     for (const BatchBenchWorld& w : worlds) {
-      const int i = r.AddWorld(*w.scene);
+      const int i = r.AddWorld(*w.scene, w.settings);
       r.UpdateWorld(i, w.snapshot);
     }
     for (int count : camera_counts) {
@@ -105,13 +121,24 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
         cams.push_back(BatchRenderer::CameraOf(world_of[k], views[k]));
       }
       double kernel_ms = 0;
-      const double s = TimePipeline(&r, cams, batches, &kernel_ms);
+      RealtimeBatchTimes st;
+      const double s = TimePipeline(&r, cams, batches, &kernel_ms, &st);
       const bool pinned = copy == BatchCopy::kPinned;
       rows.push_back({count, "cuda",
                       pinned ? "batch, pinned copy overlapped" : "batch, pageable copy", count / s,
                       1e3 * s});
       if (pinned)
         rows.push_back({count, "cuda", "kernel only", count / (kernel_ms * 1e-3), kernel_ms});
+      // where an rgb batch's GPU time goes: frames/s if the batch were that stage alone
+      if (pinned && outputs.rgb) {
+        const std::pair<const char*, double> stages[] = {
+            {"stage: geometry", st.geometry},     {"stage: sky terms", st.sky},
+            {"stage: shading", st.shade},         {"stage: shared visibility", st.visibility},
+            {"stage: mirror layer", st.mirror},   {"stage: row sums", st.row_sums},
+            {"stage: exposure round trip", st.exposure}, {"stage: film", st.film}};
+        for (const auto& [what, ms] : stages)
+          rows.push_back({count, "cuda", what, ms > 0 ? count / (ms * 1e-3) : 0.0, ms});
+      }
     }
   }
   // the CPU backend: the same views one after another (each Render on all its threads)
@@ -126,7 +153,7 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     for (int k = 0; k < count; ++k) {
       views[k].intrinsics =
           CameraIntrinsics::FromFovy(width, height, views[k].intrinsics.fovy_deg());
-      views[k].outputs[ImageKind::kRgb] = false;
+      views[k].outputs[ImageKind::kRgb] = outputs.rgb;
       views[k].outputs[ImageKind::kDepth] = outputs.depth;
       views[k].outputs[ImageKind::kSegmentation] = outputs.segmentation;
       views[k].outputs[ImageKind::kInstanceSegmentation] = outputs.instance_segmentation;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "penumbra/render/cuda/batch_layout.h"
+#include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -20,6 +21,9 @@ namespace penumbra::cuda {
 /// OrbitView) and, optionally, a CPU renderer of the same scene to time beside the GPU.
 struct BatchBenchWorld {
   const SceneDescription* scene = nullptr;
+  /// the realtime rgb's settings (BatchRenderer::AddWorld; rgb batches only): film, seed,
+  /// anisotropy, as the world's renderer has them
+  RenderSettings settings;
   WorldSnapshot snapshot;
   CameraView view;
   Renderer* cpu = nullptr;  ///< null: no CPU row for this world
@@ -44,8 +48,11 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 
 /// times batches of each count of `camera_counts` (width x height, `outputs`): `batches`
 /// batches each with pinned copies overlapped with the next kernel (wall clock from the first
-/// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events),
-/// and the CPU renderers rendering the same views one at a time (at least one batch).
+/// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events;
+/// with rgb all the batch's kernels and its exposure's round trip), with rgb each realtime
+/// stage's GPU time (rows "stage: ..."; RealtimeBatchTimes), and the CPU renderers rendering
+/// the same views one at a time (at least one batch; with rgb the realtime tier's rgb and
+/// depth).
 /// @throws Error if the CUDA runtime fails.
 std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds, int width,
                                          int height, std::span<const int> camera_counts,

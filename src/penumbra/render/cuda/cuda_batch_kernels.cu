@@ -125,7 +125,7 @@ void BatchDevice::WaitForKernels() {
 }
 
 void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
-                         const BatchCamera* cameras, int count) {
+                         const BatchCamera* cameras, int count, const MoreWork& more) {
   Impl& m = *impl_;
   const BatchLayout& l = m.layout;
   // the slot's device buffer is free once its previous copy back has run
@@ -153,7 +153,8 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
     return l.has(p) ? base + l.plane_offset(p, count) : nullptr;
   };
   BatchPlanes out;
-  out.depth = static_cast<float*>(plane(BatchPlane::kDepth));
+  // with rgb the depth is the realtime path's (`more`)
+  out.depth = l.outputs().rgb ? nullptr : static_cast<float*>(plane(BatchPlane::kDepth));
   out.geom_id = static_cast<int32_t*>(plane(BatchPlane::kSegmentation));
   out.body_id = static_cast<int32_t*>(plane(BatchPlane::kInstance));
   out.semantic = static_cast<int32_t*>(plane(BatchPlane::kSemantic));
@@ -161,9 +162,12 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
   const dim3 block(8, 8);
   const dim3 grid((l.width() + 7) / 8, (l.height() + 7) / 8, count);
   CheckBatch(cudaEventRecord(m.started[slot], m.compute), "cudaEventRecord");
-  BatchPrimaryKernel<<<grid, block, 0, m.compute>>>(m.views[slot], m.cameras[slot], l.width(),
-                                                    l.height(), out);
-  CheckBatch(cudaGetLastError(), "BatchPrimaryKernel launch");
+  if (out.depth || out.geom_id || out.body_id || out.semantic || out.range) {
+    BatchPrimaryKernel<<<grid, block, 0, m.compute>>>(m.views[slot], m.cameras[slot], l.width(),
+                                                      l.height(), out);
+    CheckBatch(cudaGetLastError(), "BatchPrimaryKernel launch");
+  }
+  if (more) more(m.compute, base);
   CheckBatch(cudaEventRecord(m.done[slot], m.compute), "cudaEventRecord");
   m.used[slot] = true;
   if (m.copy == BatchCopy::kNone) return;

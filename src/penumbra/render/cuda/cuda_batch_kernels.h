@@ -7,6 +7,7 @@
 // the CUDA call and its message when the runtime reports an error.
 
 #include <cstdint>
+#include <functional>
 
 #include "penumbra/render/cuda/batch_layout.h"
 #include "penumbra/render/cuda/bvh_types.h"
@@ -34,12 +35,17 @@ class BatchDevice {
   /// blocks until every kernel submitted so far has finished (their copies may still run):
   /// call before a world's device arrays change (DeviceScene::Sync).
   void WaitForKernels();
+  /// more work of a batch, enqueued on the kernel stream (a cudaStream_t, as void*) after the
+  /// ground-truth kernel and before the batch's end event, writing into the slot's device
+  /// buffer (`buffer`): the realtime rgb and its depth (RealtimeBatch).
+  using MoreWork = std::function<void(void* stream, uint8_t* buffer)>;
   /// renders `cameras[0 .. count)` (host array, checked by BatchLayout::Check) of the worlds
   /// `views[0 .. num_views)` (host array of device-pointer SceneViews) into `slot`'s device
-  /// buffer, after that slot's previous copy back; then starts the copy back (unless kNone).
-  /// returns at once.
+  /// buffer, after that slot's previous copy back: the ground-truth kernel (the planes other
+  /// than rgb; with rgb, depth is `more`'s), then `more` (if set); then starts the copy back
+  /// (unless kNone). returns at once.
   void Submit(int slot, const SceneView* views, int num_views, const BatchCamera* cameras,
-              int count);
+              int count, const MoreWork& more = {});
   /// blocks until `slot`'s last batch is on the host (kNone: its kernel finished); returns
   /// the host buffer (null for kNone).
   const uint8_t* Wait(int slot);

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 
@@ -17,12 +18,29 @@ BatchRenderer::BatchRenderer(const BatchConfig& config)
 
 BatchRenderer::~BatchRenderer() = default;
 
-int BatchRenderer::AddWorld(const SceneDescription& scene) {
+int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings& settings) {
   auto w = std::make_unique<World>();
   w->scene = scene;
   w->bvh = std::make_unique<BvhScene>(w->scene);
   w->device = std::make_unique<DeviceScene>();
   SyncDevice(*w->bvh, w->device.get());
+  if (layout_.outputs().rgb) {
+    // the scene-constant arrays, as CudaRenderer uploads them
+    w->realtime = std::make_unique<RealtimeFrameData>(w->scene, settings);
+    w->device_realtime = std::make_unique<DeviceRealtime>();
+    const RealtimeFrameData& d = *w->realtime;
+    RealtimeStatic st;
+    st.materials = d.materials().data();
+    st.num_materials = static_cast<int64_t>(d.materials().size());
+    st.textures = d.textures().data();
+    st.num_textures = static_cast<int64_t>(d.textures().size());
+    st.texels = d.texels().data();
+    st.num_texel_bytes = static_cast<int64_t>(d.texels().size());
+    st.srgb_decode = SrgbDecodeTable();
+    st.oetf_lut = d.film().oetf_lut().data();
+    w->device_realtime->Upload(st);
+    if (!pool_) pool_ = std::make_unique<ThreadPool>(settings.threads);
+  }
   views_.push_back(w->device->device_view());
   worlds_.push_back(std::move(w));
   return static_cast<int>(worlds_.size()) - 1;
@@ -38,15 +56,87 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot) {
   device_->WaitForKernels();
   SyncDevice(*w.bvh, w.device.get());
   views_[world] = w.device->device_view();
+  if (!w.realtime) return;
+  w.realtime->PoseWorld(snapshot, pool_.get());
+  if (!w.sky_uploaded || w.realtime->sky_generation() != w.sky_generation) {
+    w.device_realtime->UploadSky(w.realtime->SkyData());
+    w.sky_generation = w.realtime->sky_generation();
+    w.sky_uploaded = true;
+  }
+  w.frame = w.device_realtime->DeviceFrame(w.realtime->View(views_[world], nullptr),
+                                           static_cast<int64_t>(w.realtime->geoms().size()));
+  w.posed = true;
+}
+
+void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, void* stream,
+                              uint8_t* buffer) {
+  const int count = static_cast<int>(cameras.size());
+  frames_.resize(count);
+  films_.resize(count);
+  std::vector<const RealtimeFrameData*> data(count);
+  for (int k = 0; k < count; ++k) {
+    const BatchCamera& c = cameras[k];
+    const World& w = *worlds_[c.world];
+    RealtimeFrameView& f = frames_[k];
+    f = w.frame;
+    f.camera = c.camera;
+    f.spread_rad = c.spread_rad;
+    f.frame_key = w.realtime->FrameKey(c.camera_index, c.frame_index);
+    films_[k].filmic = w.realtime->film().filmic() ? 1 : 0;
+    films_[k].lut = w.device_realtime->device_lut();
+    data[k] = w.realtime.get();
+  }
+  const int64_t n = layout_.pixels();
+  RealtimeBatch::ExposureFn exposure = [data = std::move(data), n](
+                                           int k, const std::vector<double>& rows, float e[3]) {
+    data[k]->Ev100(rows, n, e);
+  };
+  float* depth = layout_.has(BatchPlane::kDepth)
+                     ? reinterpret_cast<float*>(buffer + layout_.plane_offset(BatchPlane::kDepth,
+                                                                              count))
+                     : nullptr;
+  uint8_t* rgb = buffer + layout_.plane_offset(BatchPlane::kRgb, count);
+  realtime_->Launch(frames_.data(), films_.data(), count, std::move(exposure), depth, rgb, slot,
+                    stream);
 }
 
 int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
   const int count = static_cast<int>(std::min<size_t>(cameras.size(), 1 << 30));
   layout_.Check(cameras.data(), count, num_worlds());
+  const std::span<const BatchCamera> batch = cameras.first(count);
+  BatchDevice::MoreWork rgb;
+  if (layout_.outputs().rgb) {
+    for (int k = 0; k < count; ++k)
+      if (!worlds_[batch[k].world]->posed)
+        throw Error(fmt::format(
+            "batch rendering: camera {}: world {} has no pose yet; expected UpdateWorld before "
+            "its first rgb batch",
+            k, batch[k].world));
+    // the stages' buffers fit the most lights and the mirror layer of the worlds
+    int lights = 0;
+    bool mirror = false;
+    for (const auto& w : worlds_) {
+      lights = std::max(lights, static_cast<int>(w->realtime->lights().size()));
+      mirror = mirror || w->realtime->any_mirror();
+    }
+    if (!realtime_ || lights > realtime_lights_ || (mirror && !realtime_mirror_)) {
+      device_->WaitForKernels();
+      realtime_.reset();
+      realtime_ = std::make_unique<RealtimeBatch>(layout_.width(), layout_.height(),
+                                                  layout_.max_cameras(), lights, mirror,
+                                                  BatchTickets::kSlots);
+      realtime_lights_ = lights;
+      realtime_mirror_ = mirror;
+    }
+  }
   const int64_t t = tickets_.Take();
   const int slot = BatchTickets::SlotOf(t);
   counts_[slot] = count;
-  device_->Submit(slot, views_.data(), num_worlds(), cameras.data(), count);
+  if (layout_.outputs().rgb)
+    rgb = [this, batch, slot](void* stream, uint8_t* buffer) {
+      LaunchRgb(batch, slot, stream, buffer);
+    };
+  device_->Submit(slot, views_.data(), num_worlds(), cameras.data(), count, rgb);
   return t;
 }
 
@@ -89,6 +179,12 @@ double BatchRenderer::kernel_ms(int64_t ticket) const {
   return device_->kernel_ms(BatchTickets::SlotOf(ticket));
 }
 
+RealtimeBatchTimes BatchRenderer::stage_ms(int64_t ticket) const {
+  CheckTicket(ticket);
+  if (!realtime_) throw Error("batch rendering: stage times of a batch without rgb");
+  return realtime_->times(BatchTickets::SlotOf(ticket));
+}
+
 BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
   if (view.intrinsics.has_distortion() || view.motion.moving())
     throw Error(
@@ -96,6 +192,9 @@ BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
         "(distortion and motion are not on the GPU yet, docs/gpu.md)");
   BatchCamera b;
   b.world = world;
+  b.camera_index = view.camera_index;
+  b.frame_index = view.frame_index;
+  b.spread_rad = Camera(view.X_WO, view.intrinsics, view.motion).pixel_spread_rad();
   b.camera = CudaRenderer::PinholeOf(view);
   return b;
 }

@@ -4,8 +4,10 @@
 // one kernel launch into one device buffer; the images copied back in one pinned transfer per
 // batch on a second stream, overlapped with the next batch's kernel, or left on the device for
 // a consumer on the GPU (the device-pointer API below). the images are the ground truth of each
-// pixel-centre ray (depth, segmentation, instance and semantic segmentation, range; rgb is not
-// on the GPU yet), the same bits as the same camera in a batch of its own.
+// pixel-centre ray (depth, segmentation, instance and semantic segmentation, range) and the
+// realtime tier's rgb (BatchOutputs::rgb: each realtime stage launched once over all cameras,
+// RealtimeBatch; its depth is the realtime path's), the same bits as the same camera in a batch
+// of its own and as CudaRenderer rendering that camera alone.
 //
 //   BatchRenderer batch({.width = 128, .height = 128, .max_cameras = 1024});
 //   const int house = batch.AddWorld(session.scene());
@@ -26,7 +28,11 @@
 #include "penumbra/render/cuda/batch_layout.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -51,12 +57,14 @@ struct BatchImages {
   int cameras = 0;         ///< cameras in the batch
   bool on_device = false;  ///< base is a device pointer
   /// camera k's depth (m, 0 = miss) / range (m) / segmentation (geom id, -1 = miss) /
-  /// instance (body id) / semantic class; null if not rendered.
+  /// instance (body id) / semantic class / rgb (width x height x 3 sRGB bytes, row-major, as
+  /// RenderedFrame::rgb); null if not rendered.
   const float* depth(int k) const { return Plane<float>(BatchPlane::kDepth, k); }
   const float* range(int k) const { return Plane<float>(BatchPlane::kRange, k); }
   const int32_t* geom_id(int k) const { return Plane<int32_t>(BatchPlane::kSegmentation, k); }
   const int32_t* body_id(int k) const { return Plane<int32_t>(BatchPlane::kInstance, k); }
   const int32_t* semantic(int k) const { return Plane<int32_t>(BatchPlane::kSemantic, k); }
+  const uint8_t* rgb(int k) const { return Plane<uint8_t>(BatchPlane::kRgb, k); }
 
  private:
   template <typename T>
@@ -76,21 +84,26 @@ class BatchRenderer {
 
   /// adds a world (one session's scene, copied) and builds its BVH on the host and the
   /// device; returns its index for BatchCamera::world (0, 1, ...). bodies are at the
-  /// identity until UpdateWorld.
-  /// @throws Error as BvhScene, or if the CUDA runtime fails.
-  int AddWorld(const SceneDescription& scene);
+  /// identity until UpdateWorld. with rgb, `settings` are its realtime frames' (film, seed,
+  /// anisotropy; as CudaRenderer's) and its materials and textures go to the device; a world's
+  /// cameras need an UpdateWorld before their first Submit.
+  /// @throws Error as BvhScene or RealtimeFrameData, or if the CUDA runtime fails.
+  int AddWorld(const SceneDescription& scene, const RenderSettings& settings = RenderSettings());
   /// worlds added.
   int num_worlds() const { return static_cast<int>(worlds_.size()); }
   /// poses world `world`'s bodies from `snapshot` (its instances' transforms; the static BVH is
-  /// rebuilt only if a static body moved). waits for the kernels already submitted (they read
-  /// the transforms), not for their copies back.
+  /// rebuilt only if a static body moved; with rgb also its lights, geoms and sky volume,
+  /// RealtimeFrameData::PoseWorld). waits for the kernels already submitted (they read the
+  /// transforms), not for their copies back.
   /// @throws Error for a bad index or snapshot (BvhScene::Update).
   void UpdateWorld(int world, const WorldSnapshot& snapshot);
 
-  /// renders `cameras` (BatchLayout::Check) in one kernel launch and starts the copy back
-  /// (BatchCopy); returns the batch's ticket (0, 1, ...) at once. the images of ticket t stay
-  /// readable until ticket t + 2 is submitted.
-  /// @throws Error for bad cameras (naming the camera), or if the CUDA runtime fails.
+  /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each
+  /// realtime stage, and a host function on the stream that computes each camera's exposure
+  /// from its row sums) and starts the copy back (BatchCopy); returns the batch's ticket (0, 1,
+  /// ...) at once. the images of ticket t stay readable until ticket t + 2 is submitted.
+  /// @throws Error for bad cameras (naming the camera), with rgb for a camera of a world not
+  ///         yet updated, or if the CUDA runtime fails.
   int64_t Submit(std::span<const BatchCamera> cameras);
   /// blocks until batch `ticket` is on the host and returns its host images (with
   /// BatchCopy::kNone: until its kernel finished; the images' base is then null).
@@ -108,14 +121,19 @@ class BatchRenderer {
   void* ready_event(int64_t ticket) const;
   /// the cudaStream_t (as void*) the kernels run on.
   void* stream() const { return device_->stream(); }
-  /// milliseconds batch `ticket`'s kernel took (CUDA events; call after Wait(ticket)).
+  /// milliseconds batch `ticket`'s kernel took (CUDA events; call after Wait(ticket)); with
+  /// rgb all its kernels, the exposure's round trip included.
   double kernel_ms(int64_t ticket) const;
+  /// with rgb: the GPU time of batch `ticket`'s realtime stages (call after Wait(ticket)).
+  /// @throws Error as Wait, or if the batch renders no rgb.
+  RealtimeBatchTimes stage_ms(int64_t ticket) const;
 
   const BatchLayout& layout() const { return layout_; }
   /// world `world`'s BVH on the host (tests, build times).
   const BvhScene& bvh(int world) const { return *worlds_.at(world)->bvh; }
 
-  /// the batch camera of `view` (a pinhole camera: no distortion, no motion) in world `world`.
+  /// the batch camera of `view` (a pinhole camera: no distortion, no motion) in world `world`,
+  /// with its camera_index, frame_index and pixel spread.
   /// @throws Error if the view has lens distortion or motion (not on the GPU yet).
   static BatchCamera CameraOf(int world, const CameraView& view);
 
@@ -124,8 +142,18 @@ class BatchRenderer {
     SceneDescription scene;
     std::unique_ptr<BvhScene> bvh;
     std::unique_ptr<DeviceScene> device;
+    // with rgb: the realtime frames' host data and device arrays, and the frame (device
+    // pointers) of the last UpdateWorld, its camera set per batch camera
+    std::unique_ptr<RealtimeFrameData> realtime;
+    std::unique_ptr<DeviceRealtime> device_realtime;
+    RealtimeFrameView frame;
+    bool posed = false;
+    uint64_t sky_generation = 0;
+    bool sky_uploaded = false;
   };
   void CheckTicket(int64_t ticket) const;
+  // the realtime rgb of `cameras` into `buffer` (the slot's device buffer) on `stream`.
+  void LaunchRgb(std::span<const BatchCamera> cameras, int slot, void* stream, uint8_t* buffer);
 
   BatchLayout layout_;
   std::unique_ptr<BatchDevice> device_;
@@ -133,6 +161,14 @@ class BatchRenderer {
   std::vector<SceneView> views_;  // each world's device arrays, as the kernel reads them
   std::vector<int> counts_;       // cameras of the batch in each slot
   BatchTickets tickets_;
+  // with rgb: the stages' working buffers, sized for the most lights and the mirror layer of
+  // the worlds, and the pool of the sky volume's updates
+  std::unique_ptr<RealtimeBatch> realtime_;
+  int realtime_lights_ = -1;
+  bool realtime_mirror_ = false;
+  std::unique_ptr<ThreadPool> pool_;
+  std::vector<RealtimeFrameView> frames_;  // one batch's frames (LaunchRgb)
+  std::vector<RealtimeBatchFilm> films_;
 };
 
 }  // namespace penumbra::cuda

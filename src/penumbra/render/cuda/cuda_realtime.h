@@ -134,6 +134,71 @@ struct RealtimeStageTimes {
   double total = 0;
 };
 
+/// one camera's film in a batch (RealtimeBatch): its per-channel exposures (set by the batch
+/// from the camera's row sums), its tone map and its world's encoding table (device pointer,
+/// DeviceRealtime::device_lut).
+struct RealtimeBatchFilm {
+  float exposure[3] = {1, 1, 1};
+  int32_t filmic = 1;
+  const uint8_t* lut = nullptr;
+};
+
+/// the GPU time of a batch's realtime stages, milliseconds (CUDA events around each stage's
+/// launches on the stream; benchmarks).
+struct RealtimeBatchTimes {
+  double geometry = 0;    ///< primary geometry, depth, material terms (and mirrored rays)
+  double sky = 0;         ///< the sky-term kernels
+  double shade = 0;       ///< the shading kernel (ShadeRealtimeStored)
+  double visibility = 0;  ///< the shared visibility: penumbra rays, fraction, resolve
+  double mirror = 0;      ///< the mirror layer's shading and blend (0 without one)
+  double row_sums = 0;    ///< the rows' log-luminance sums
+  /// the row sums back to the host, the host's exposures (a host function on the stream),
+  /// the exposures up
+  double exposure = 0;
+  double film = 0;  ///< the film kernel (DevelopPixel)
+  double total = 0;
+};
+
+/// the realtime tier over a batch of cameras of the same size (cuda_batch_renderer.h): each
+/// stage of Render's default path (device sky terms, stored surfaces, warp-shared penumbra rays,
+/// a warp per row's sum) launched once over every camera of the batch, camera k in the grid's
+/// z (the row sums' and film's y); camera k's images are the same bits as Render of that camera
+/// alone. the exposure is computed on the host from each camera's row sums (its world's
+/// RealtimeFrameData::Ev100, summed in row order: no atomics) by a host function enqueued on
+/// the stream (cudaLaunchHostFunc), so Launch returns at once.
+class RealtimeBatch {
+ public:
+  /// camera k's EV100-based per-channel exposures from its rows' log-luminance sums (height
+  /// values in row order); called on a CUDA runtime thread, cameras in order, one batch at a
+  /// time; must not call the CUDA runtime.
+  using ExposureFn = std::function<void(int k, const std::vector<double>& rows, float exposure[3])>;
+
+  /// working buffers for batches of up to max_cameras cameras of width x height pixels and
+  /// `max_lights` lights, with the mirror layer's if `mirror`, and `slots` sets of stage events.
+  /// @throws Error if the CUDA runtime fails.
+  RealtimeBatch(int width, int height, int max_cameras, int max_lights, bool mirror, int slots);
+  ~RealtimeBatch();
+  RealtimeBatch(const RealtimeBatch&) = delete;
+  RealtimeBatch& operator=(const RealtimeBatch&) = delete;
+
+  /// enqueues on `stream` (a cudaStream_t) the realtime frames of cameras[0 .. count):
+  /// frames[k] (host array) is camera k's frame with device pointers (DeviceRealtime::DeviceFrame
+  /// of its world, its camera, spread and frame key; its per-pixel arrays are set here) and
+  /// film[k] its film (the exposure is set here). writes each camera's depth (m; `depth` may be
+  /// null) and rgb (3 bytes a pixel; may be null) camera-major into the device arrays given.
+  /// the stage times go to slot `slot`'s events. every camera's num_lights must be at most
+  /// max_lights, and any_mirror 0 unless the batch was made with `mirror`.
+  /// @throws Error for a bad count, slot or camera, or if the CUDA runtime fails.
+  void Launch(const RealtimeFrameView* frames, const RealtimeBatchFilm* film, int count,
+              ExposureFn exposure, float* depth, uint8_t* rgb, int slot, void* stream);
+  /// the stage times of slot `slot`'s last Launch (call after its stream passed it).
+  RealtimeBatchTimes times(int slot) const;
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
 /// the device side of the realtime path.
 class DeviceRealtime {
  public:
@@ -171,6 +236,15 @@ class DeviceRealtime {
   double TimeKernels(DeviceScene* scene, int count);
   /// TimeKernels with the kernels run as `options` says (Render's options are unchanged).
   double TimeKernels(DeviceScene* scene, int count, const RealtimeKernelOptions& options);
+
+  /// `host_frame` with this scene's device arrays in place of its host ones: the materials,
+  /// textures, texels, sRGB table and sky of Upload and UploadSky, and its posed geoms and lights,
+  /// which are copied to the device now (the call blocks until they are there; they stay until
+  /// the next DeviceFrame or Render). the per-pixel arrays and the scene are left as they are.
+  /// batch rendering makes each world's frame with it (RealtimeBatch).
+  RealtimeFrameView DeviceFrame(const RealtimeFrameView& host_frame, int64_t num_geoms);
+  /// the device copy of the film's encoding table (Upload's oetf_lut).
+  const uint8_t* device_lut() const;
 
   /// the options of the next Render calls.
   void set_options(const RealtimeKernelOptions& options);

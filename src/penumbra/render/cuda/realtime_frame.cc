@@ -128,6 +128,13 @@ std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
 
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
                                 ThreadPool* pool) {
+  PoseWorld(snapshot, pool);
+  const Camera camera(view.X_WO, view.intrinsics, view.motion);
+  SetCamera(PinholeCameraOf(view), camera.pixel_spread_rad(), view.camera_index, view.frame_index,
+            view.white_balance_gains);
+}
+
+void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool) {
   lights_.Update(snapshot, nullptr);
   for (size_t g = 0; g < scene_.geoms.size(); ++g) {
     const Geom& geom = scene_.geoms[g];
@@ -138,14 +145,21 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
       m[4 * r + 3] = static_cast<float>(X_GW.translation()(r));
     }
   }
-  camera_ = PinholeCameraOf(view);
-  white_balance_gains_ = view.white_balance_gains;
-  const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  spread_rad_ = camera.pixel_spread_rad();
-  // FrameContext::FrameKey() (render/cpu/integrator.h).
-  frame_key_ = HashKeys(HashKeys(settings_.seed, static_cast<uint64_t>(view.camera_index)),
-                        static_cast<uint64_t>(view.frame_index));
   volume_.Update(scene_, snapshot, sky_, pool);
+}
+
+void RealtimeFrameData::SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,
+                                  int64_t frame_index, const Eigen::Vector3f& white_balance_gains) {
+  camera_ = camera;
+  white_balance_gains_ = white_balance_gains;
+  spread_rad_ = spread_rad;
+  frame_key_ = FrameKey(camera_index, frame_index);
+}
+
+uint64_t RealtimeFrameData::FrameKey(int camera_index, int64_t frame_index) const {
+  // FrameContext::FrameKey() (render/cpu/integrator.h).
+  return HashKeys(HashKeys(settings_.seed, static_cast<uint64_t>(camera_index)),
+                  static_cast<uint64_t>(frame_index));
 }
 
 int RealtimeFrameData::CheckRows(const char* what, int64_t n, int row0, int row1) const {
@@ -236,13 +250,19 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
 
 double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
                                 float exposure[3]) const {
+  return Ev100(row_sums, pixels, white_balance_gains_, exposure);
+}
+
+double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
+                                const Eigen::Vector3f& white_balance_gains,
+                                float exposure[3]) const {
   double total = 0;
   for (double s : row_sums) total += s;  // row order: independent of the launch
   const double log_average = pixels > 0 ? std::exp(total / static_cast<double>(pixels))
                                         : static_cast<double>(kMinLuminance);
   const double ev100 = film_.Ev100FromLogAverage(log_average);
   const float e = static_cast<float>(ExposureFromEv100(ev100));
-  for (int c = 0; c < 3; ++c) exposure[c] = e * white_balance_gains_[c];
+  for (int c = 0; c < 3; ++c) exposure[c] = e * white_balance_gains[c];
   return ev100;
 }
 

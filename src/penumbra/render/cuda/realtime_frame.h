@@ -42,8 +42,20 @@ class RealtimeFrameData {
   std::string Unsupported(const EffectsFrame* effects, const CameraView& view) const;
 
   /// poses the lights and geoms from `snapshot`, sets the camera and frame key of `view`, and
-  /// updates the sky volume (built on the first call and when the static bodies move).
+  /// updates the sky volume (built on the first call and when the static bodies move): PoseWorld,
+  /// then SetCamera.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
+  /// the camera-independent part of Prepare: the lights, the geoms and the sky volume.
+  void PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool);
+  /// the camera part of Prepare: the pinhole camera, its pixel spread (radians), the frame's
+  /// random-number key (FrameContext::FrameKey of the settings' seed, camera_index and
+  /// frame_index) and the view's white-balance gains (Ev100's exposures).
+  void SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,
+                 int64_t frame_index,
+                 const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones());
+  /// the random-number key of a frame of camera `camera_index`, frame `frame_index`
+  /// (FrameContext::FrameKey, render/cpu/integrator.h) under these settings' seed.
+  uint64_t FrameKey(int camera_index, int64_t frame_index) const;
 
   /// the sky term of every pixel (RealtimeFrameView::sky_term) from its primary geometry, n =
   /// the Prepared camera's width x height pixels, row-major; with a sky volume a 2x2 quad on one
@@ -85,6 +97,10 @@ class RealtimeFrameData {
   /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop
   /// (the exposure times the prepared view's white_balance_gains, as Film::Develop).
   double Ev100(const std::vector<double>& row_sums, int64_t pixels, float exposure[3]) const;
+  /// Ev100 with the white-balance gains given (CameraView::white_balance_gains) instead of the
+  /// prepared view's: batch rendering's per-camera exposures.
+  double Ev100(const std::vector<double>& row_sums, int64_t pixels,
+               const Eigen::Vector3f& white_balance_gains, float exposure[3]) const;
 
   const std::vector<MaterialPod>& materials() const { return materials_; }
   const std::vector<TexturePod>& textures() const { return textures_; }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,17 +20,34 @@ namespace {
 
 constexpr unsigned kFullWarp = 0xffffffffu;
 
+// where a kernel finds its frame: one frame passed by value (Render), or camera blockIdx.z's of
+// a batch's array of frames in device memory (RealtimeBatch). a kernel's per-pixel arrays that
+// are not in the frame hold every camera's image in turn (camera z at z * width * height), so
+// Pixels(f) is the offset of this block's camera (0 for one frame).
+struct OneFrame {
+  RealtimeFrameView f;
+  __device__ const RealtimeFrameView& get() const { return f; }
+};
+struct BatchFrames {
+  const RealtimeFrameView* __restrict__ f;
+  __device__ const RealtimeFrameView& get() const { return f[blockIdx.z]; }
+};
+__device__ inline int64_t CameraOffset(const RealtimeFrameView& f) {
+  return static_cast<int64_t>(blockIdx.z) * f.camera.width * f.camera.height;
+}
+
 // hits, surfaces: null, or where the primary hits and their material terms are kept for the
 // shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
 // threads an SM).
-template <int kMinBlocks>
+template <class Frames, int kMinBlocks>
 __global__ void __launch_bounds__(128, kMinBlocks)
-    GeometryKernel(RealtimeFrameView f, PixelGeometry* geometry, float* depth, TraceHit* hits,
+    GeometryKernel(Frames frames, PixelGeometry* geometry, float* depth, TraceHit* hits,
                    SurfaceTerms* surfaces) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
   float t;
   geometry[i] =
       PrimaryGeometry(f, u, v, &t, hits ? &hits[i] : nullptr, surfaces ? &surfaces[i] : nullptr);
@@ -38,44 +56,56 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
 // shading and the blend after the shared visibility.
-__global__ void MirrorTraceKernel(RealtimeFrameView f) {
+// they run only where the frame has a mirror layer (a batch launches them for every camera
+// when one of its worlds has one).
+template <class Frames>
+__global__ void MirrorTraceKernel(Frames frames) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
+  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
   TraceMirrorRay(f, u, v);
 }
 
-__global__ void MirrorShadeKernel(RealtimeFrameView f) {
+template <class Frames>
+__global__ void MirrorShadeKernel(Frames frames) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
+  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
   ShadeMirrorHit(f, u, v);
 }
 
-__global__ void MirrorBlendKernel(RealtimeFrameView f, Float3* radiance) {
+template <class Frames>
+__global__ void MirrorBlendKernel(Frames frames, Float3* radiance) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
+  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
   radiance[i] = ApplyMirrorLayer(f, u, v, radiance[i]);
 }
 
 // the sky terms (realtime_shading.h): one thread per 2x2 quad of primary geometry (the quads
 // that share one probe blend), and one per mirrored ray.
-__global__ void SkyQuadKernel(RealtimeFrameView f, Float3* sky) {
+template <class Frames>
+__global__ void SkyQuadKernel(Frames frames, Float3* sky) {
+  const RealtimeFrameView& f = frames.get();
   const int qu = blockIdx.x * blockDim.x + threadIdx.x;
   const int qv = blockIdx.y * blockDim.y + threadIdx.y;
   const int W = f.camera.width, H = f.camera.height;
   if (2 * qu >= W || 2 * qv >= H) return;
-  QuadSkyTerms(f.sky, f.volume, f.geometry, W, H, 2 * qu, 2 * qv, sky);
+  QuadSkyTerms(f.sky, f.volume, f.geometry, W, H, 2 * qu, 2 * qv, sky + CameraOffset(f));
 }
 
-__global__ void MirrorSkyKernel(RealtimeFrameView f, Float3* mirror_sky) {
+template <class Frames>
+__global__ void MirrorSkyKernel(Frames frames, Float3* mirror_sky) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
+  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  MirrorSkyTerm(f.sky, f.volume, f.mirror_geometry[i], &mirror_sky[i]);
+  MirrorSkyTerm(f.sky, f.volume, f.mirror_geometry[i], &mirror_sky[CameraOffset(f) + i]);
 }
 
 // kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
@@ -100,15 +130,17 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
 // ShadeRealtimeStored): no second surface evaluation.
-template <int kMinBlocks>
+template <class Frames, int kMinBlocks>
 __global__ void __launch_bounds__(128, kMinBlocks)
-    ShadeStoredKernel(RealtimeFrameView f, const SurfaceTerms* surfaces, Float3* radiance, int row0,
+    ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
                       int row1) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
   if (u >= f.camera.width || v >= row1) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  radiance[i] = ShadeRealtimeStored(f, u, v, f.geometry[i], surfaces[i]);
+  const int64_t k = CameraOffset(f) + i;
+  radiance[k] = ShadeRealtimeStored(f, u, v, f.geometry[i], surfaces[k]);
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
@@ -126,7 +158,9 @@ __global__ void VisibilityRaysKernel(RealtimeFrameView f) {
 // its rays' verdicts (ballots): the same integer counts as one thread per pixel, so the same
 // bits, without the warp waiting on the one ring pixel that traces 63 rays. whole warps run
 // every step (pixels outside the image take part with no rays).
-__global__ void VisibilityRaysWarpKernel(RealtimeFrameView f) {
+template <class Frames>
+__global__ void VisibilityRaysWarpKernel(Frames frames) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   const int W = f.camera.width, H = f.camera.height;
@@ -184,18 +218,22 @@ __global__ void VisibilityRaysWarpKernel(RealtimeFrameView f) {
   }
 }
 
-__global__ void VisibilityFractionKernel(RealtimeFrameView f) {
+template <class Frames>
+__global__ void VisibilityFractionKernel(Frames frames) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
   SharedVisibilityFraction(f, u, v);
 }
 
-__global__ void VisibilityResolveKernel(RealtimeFrameView f, Float3* radiance) {
+template <class Frames>
+__global__ void VisibilityResolveKernel(Frames frames, Float3* radiance) {
+  const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= f.camera.width || v >= f.camera.height) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
   radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
 }
 
@@ -206,10 +244,13 @@ __global__ void RowSumKernel(const Float3* radiance, int width, int height, doub
 }
 
 // one warp per row: lane k sums columns k, k + 32, ... in order, then a fixed butterfly.
+// camera blockIdx.y of a batch (radiance and rows hold every camera's in turn).
 __global__ void RowSumWarpKernel(const Float3* radiance, int width, int height, double* rows) {
   const int lane = threadIdx.x & 31;
   const int v = blockIdx.x * (blockDim.x / 32) + threadIdx.x / 32;
   if (v >= height) return;  // whole warps leave together
+  radiance += static_cast<int64_t>(blockIdx.y) * width * height;
+  rows += static_cast<int64_t>(blockIdx.y) * height;
   double sum = 0;
   for (int u = lane; u < width; u += 32) {
     const Float3& c = radiance[static_cast<int64_t>(v) * width + u];
@@ -229,6 +270,16 @@ __global__ void DevelopKernel(const Float3* radiance, int64_t n, Exposure exposu
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   DevelopPixel(radiance[i], exposure.e, filmic != 0, lut, rgb + 3 * i);
+}
+
+// DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film.
+__global__ void BatchDevelopKernel(const Float3* radiance, int64_t n, const RealtimeBatchFilm* film,
+                                   uint8_t* rgb) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  const RealtimeBatchFilm& c = film[blockIdx.y];
+  const int64_t k = static_cast<int64_t>(blockIdx.y) * n + i;
+  DevelopPixel(radiance[k], c.exposure, c.filmic != 0, c.lut, rgb + 3 * k);
 }
 
 // page-locked host memory that grows (never shrinks).
@@ -341,14 +392,15 @@ struct DeviceRealtime::Impl {
     TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
     SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
     if (o.geometry_min_blocks >= 5)
-      GeometryKernel<5><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
-                                                          depth.as<float>(), h, st);
+      GeometryKernel<OneFrame, 5><<<grid, kPixelBlock, 0, stream>>>(
+          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     else
-      GeometryKernel<1><<<grid, kPixelBlock, 0, stream>>>(f, geometry.as<PixelGeometry>(),
-                                                          depth.as<float>(), h, st);
+      GeometryKernel<OneFrame, 1><<<grid, kPixelBlock, 0, stream>>>(
+          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     Check(cudaGetLastError(), "GeometryKernel");
     if (f.any_mirror != 0) {
-      MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(f);
+      MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
+          OneFrame{f});
       Check(cudaGetLastError(), "MirrorTraceKernel");
     }
   }
@@ -356,10 +408,11 @@ struct DeviceRealtime::Impl {
   void LaunchSky(const RealtimeFrameView& f, cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
     SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
-        f, sky.as<Float3>());
+        OneFrame{f}, sky.as<Float3>());
     Check(cudaGetLastError(), "SkyQuadKernel");
     if (f.any_mirror != 0) {
-      MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(f, mirror_sky.as<Float3>());
+      MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(OneFrame{f},
+                                                                    mirror_sky.as<Float3>());
       Check(cudaGetLastError(), "MirrorSkyKernel");
     }
   }
@@ -374,11 +427,14 @@ struct DeviceRealtime::Impl {
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 6)
-      ShadeStoredKernel<6><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
+      ShadeStoredKernel<OneFrame, 6><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
+                                                                        row1);
     else if (o.reuse_surface && o.min_blocks >= 4)
-      ShadeStoredKernel<4><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
+      ShadeStoredKernel<OneFrame, 4><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
+                                                                        row1);
     else if (o.reuse_surface)
-      ShadeStoredKernel<1><<<grid, kPixelBlock, 0, stream>>>(f, st, L, row0, row1);
+      ShadeStoredKernel<OneFrame, 1><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
+                                                                        row1);
     else if (o.min_blocks >= 6)
       ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     else if (o.min_blocks >= 4)
@@ -399,18 +455,18 @@ struct DeviceRealtime::Impl {
     const int W = f.camera.width, H = f.camera.height;
     const dim3 grid = PixelGrid(W, H);
     if (o.warp_penumbra)
-      VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+      VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
     else
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
     Check(cudaGetLastError(), "VisibilityRaysKernel");
-    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
     Check(cudaGetLastError(), "VisibilityFractionKernel");
-    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
+    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
     Check(cudaGetLastError(), "VisibilityResolveKernel");
     if (f.any_mirror != 0) {
-      MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(f);
+      MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
       Check(cudaGetLastError(), "MirrorShadeKernel");
-      MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(f, radiance.as<Float3>());
+      MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
       Check(cudaGetLastError(), "MirrorBlendKernel");
     }
     if (o.rows_per_warp)
@@ -420,6 +476,19 @@ struct DeviceRealtime::Impl {
       RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
     Check(cudaGetLastError(), "RowSumKernel");
+  }
+  // f's scene-wide arrays: the device copies of Upload, UploadSky and the posed geoms and lights
+  void WithDeviceArrays(RealtimeFrameView* f) const {
+    f->materials = materials.as<MaterialPod>();
+    f->textures = textures.as<TexturePod>();
+    f->texels = texels.as<uint8_t>();
+    f->srgb_decode = decode.as<float>();
+    f->geoms = geoms.as<GeomPod>();
+    f->lights = lights.as<LightPod>();
+    if (sky_uploaded) {
+      f->sky = device_sky;
+      f->volume = device_volume;
+    }
   }
   void LaunchFilm(int64_t n, const Exposure& e, int film, cudaStream_t stream) {
     DevelopKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
@@ -485,6 +554,19 @@ void DeviceRealtime::UploadSky(const RealtimeSky& d) {
   m.device_volume = v;
   m.sky_uploaded = true;
 }
+
+RealtimeFrameView DeviceRealtime::DeviceFrame(const RealtimeFrameView& host_frame,
+                                              int64_t num_geoms) {
+  Impl& m = *impl_;
+  m.geoms.Upload(host_frame.geoms, sizeof(GeomPod) * num_geoms, nullptr);
+  m.lights.Upload(host_frame.lights, sizeof(LightPod) * host_frame.num_lights, nullptr);
+  Check(cudaStreamSynchronize(nullptr), "uploading the realtime geoms and lights");
+  RealtimeFrameView f = host_frame;
+  m.WithDeviceArrays(&f);
+  return f;
+}
+
+const uint8_t* DeviceRealtime::device_lut() const { return impl_->lut.as<uint8_t>(); }
 
 double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_frame,
                               int64_t num_geoms, bool filmic, const SkyFn& sky,
@@ -552,17 +634,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
-  f.materials = m.materials.as<MaterialPod>();
-  f.textures = m.textures.as<TexturePod>();
-  f.texels = m.texels.as<uint8_t>();
-  f.srgb_decode = m.decode.as<float>();
-  f.geoms = m.geoms.as<GeomPod>();
-  f.lights = m.lights.as<LightPod>();
+  m.WithDeviceArrays(&f);
   f.sky_term = m.sky.as<Float3>();
-  if (m.sky_uploaded) {
-    f.sky = m.device_sky;
-    f.volume = m.device_volume;
-  }
   f.geometry = m.geometry.as<PixelGeometry>();
   f.window = m.window.as<uint32_t>();
   f.total = m.total.as<float>();
@@ -794,6 +867,240 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   cudaEventDestroy(start);
   cudaEventDestroy(stop);
   return static_cast<double>(ms) / count;
+}
+
+namespace {
+
+// the stage events of RealtimeBatch: start, then the end of each RealtimeBatchTimes stage
+constexpr int kBatchStages = 8;
+
+// a batch's exposures, made by a host function on the stream (RealtimeBatch::Launch): the row
+// sums are in rows (pinned, count x height), the films go to film (pinned) and are copied up
+// after the function returns.
+struct BatchExposureJob {
+  RealtimeBatch::ExposureFn exposure;
+  std::vector<RealtimeBatchFilm> films;
+  const double* rows = nullptr;
+  RealtimeBatchFilm* film = nullptr;
+  int height = 0;
+};
+
+void CUDART_CB RunBatchExposure(void* data) {
+  std::unique_ptr<BatchExposureJob> job(static_cast<BatchExposureJob*>(data));
+  std::vector<double> rows(job->height);
+  for (size_t k = 0; k < job->films.size(); ++k) {
+    const double* r = job->rows + k * job->height;
+    rows.assign(r, r + job->height);
+    RealtimeBatchFilm c = job->films[k];
+    job->exposure(static_cast<int>(k), rows, c.exposure);
+    job->film[k] = c;
+  }
+}
+
+}  // namespace
+
+struct RealtimeBatch::Impl {
+  int width = 0, height = 0, max_cameras = 0, lights = 1, slots = 0;
+  bool mirror = false;
+  Buffer frames, film, geometry, depth, sky, radiance, rows, surfaces;
+  Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
+  Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
+  PinnedBuffer pin_rows, pin_film;
+  std::vector<RealtimeFrameView> host_frames;
+  std::vector<std::vector<cudaEvent_t>> events;  // [slot][kBatchStages + 1]
+  ~Impl() {
+    for (auto& slot : events)
+      for (cudaEvent_t e : slot)
+        if (e) cudaEventDestroy(e);
+  }
+};
+
+RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lights, bool mirror,
+                             int slots)
+    : impl_(new Impl) {
+  Impl& m = *impl_;
+  try {
+    if (width < 1 || height < 1 || max_cameras < 1 || max_cameras > 65535 || max_lights < 0 ||
+        slots < 1)
+      throw Error("RealtimeBatch: " + std::to_string(width) + "x" + std::to_string(height) + ", " +
+                  std::to_string(max_cameras) + " cameras, " + std::to_string(max_lights) +
+                  " lights, " + std::to_string(slots) +
+                  " slots; expected a size >= 1x1, 1 to 65535 cameras, lights >= 0, slots >= 1");
+    m.width = width;
+    m.height = height;
+    m.max_cameras = max_cameras;
+    m.lights = max_lights > 0 ? max_lights : 1;
+    m.mirror = mirror;
+    m.slots = slots;
+    const size_t n = static_cast<size_t>(width) * height * max_cameras;
+    const size_t nl = n * m.lights;
+    m.frames.Reserve(sizeof(RealtimeFrameView) * max_cameras);
+    m.film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
+    m.geometry.Reserve(sizeof(PixelGeometry) * n);
+    m.depth.Reserve(sizeof(float) * n);
+    m.sky.Reserve(sizeof(Float3) * n);
+    m.radiance.Reserve(sizeof(Float3) * n);
+    m.rows.Reserve(sizeof(double) * height * max_cameras);
+    m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
+    m.window.Reserve(sizeof(uint32_t) * n);
+    m.total.Reserve(sizeof(float) * n);
+    m.area_c.Reserve(sizeof(Float3) * nl);
+    m.area_vis.Reserve(sizeof(int8_t) * nl);
+    m.area_visible.Reserve(sizeof(float) * nl);
+    m.area_rays.Reserve(sizeof(float) * nl);
+    m.area_own.Reserve(sizeof(uint8_t) * nl);
+    m.area_fraction.Reserve(sizeof(float) * nl);
+    if (mirror) {
+      m.mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
+      m.mirror_hits.Reserve(sizeof(TraceHit) * n);
+      m.mirror_sky.Reserve(sizeof(Float3) * n);
+      m.mirror_radiance.Reserve(sizeof(Float3) * n);
+    }
+    m.pin_rows.Reserve(sizeof(double) * height * max_cameras);
+    m.pin_film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
+    m.events.assign(slots, std::vector<cudaEvent_t>(kBatchStages + 1, nullptr));
+    for (auto& slot : m.events)
+      for (cudaEvent_t& e : slot) Check(cudaEventCreate(&e), "cudaEventCreate");
+  } catch (...) {
+    delete impl_;
+    throw;
+  }
+}
+
+RealtimeBatch::~RealtimeBatch() { delete impl_; }
+
+void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchFilm* film,
+                           int count, ExposureFn exposure, float* depth, uint8_t* rgb, int slot,
+                           void* stream_ptr) {
+  Impl& m = *impl_;
+  if (count < 1 || count > m.max_cameras || slot < 0 || slot >= m.slots)
+    throw Error("RealtimeBatch::Launch: " + std::to_string(count) + " cameras, slot " +
+                std::to_string(slot) + "; expected 1 to " + std::to_string(m.max_cameras) +
+                " cameras and a slot in [0, " + std::to_string(m.slots) + ")");
+  cudaStream_t stream = static_cast<cudaStream_t>(stream_ptr);
+  const int W = m.width, H = m.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int64_t nl = n * m.lights;
+  // each camera's frame with its part of the per-pixel arrays
+  m.host_frames.assign(frames, frames + count);
+  for (int k = 0; k < count; ++k) {
+    RealtimeFrameView& f = m.host_frames[k];
+    if (f.camera.width != W || f.camera.height != H || f.num_lights > m.lights ||
+        (f.any_mirror != 0 && !m.mirror))
+      throw Error("RealtimeBatch::Launch: camera " + std::to_string(k) + ": " +
+                  std::to_string(f.camera.width) + "x" + std::to_string(f.camera.height) + ", " +
+                  std::to_string(f.num_lights) + " lights" +
+                  (f.any_mirror != 0 ? ", a mirror layer" : "") + "; expected " +
+                  std::to_string(W) + "x" + std::to_string(H) + ", at most " +
+                  std::to_string(m.lights) + " lights" + (m.mirror ? "" : ", no mirror layer"));
+    f.sky_term = m.sky.as<Float3>() + k * n;
+    f.geometry = m.geometry.as<PixelGeometry>() + k * n;
+    f.window = m.window.as<uint32_t>() + k * n;
+    f.total = m.total.as<float>() + k * n;
+    f.area_c = m.area_c.as<Float3>() + k * nl;
+    f.area_vis = m.area_vis.as<int8_t>() + k * nl;
+    f.area_visible = m.area_visible.as<float>() + k * nl;
+    f.area_rays = m.area_rays.as<float>() + k * nl;
+    f.area_own = m.area_own.as<uint8_t>() + k * nl;
+    f.area_fraction = m.area_fraction.as<float>() + k * nl;
+    if (m.mirror) {
+      f.mirror_geometry = m.mirror_geometry.as<PixelGeometry>() + k * n;
+      f.mirror_hits = m.mirror_hits.as<TraceHit>() + k * n;
+      f.mirror_sky = m.mirror_sky.as<Float3>() + k * n;
+      f.mirror_radiance = m.mirror_radiance.as<Float3>() + k * n;
+    }
+  }
+  // from pageable memory: staged before the call returns
+  m.frames.Upload(m.host_frames.data(), sizeof(RealtimeFrameView) * count, stream);
+  const BatchFrames fr{m.frames.as<RealtimeFrameView>()};
+  cudaEvent_t* ev = m.events[slot].data();
+  const auto stage = [&](int i) { Check(cudaEventRecord(ev[i], stream), "cudaEventRecord"); };
+  dim3 grid = PixelGrid(W, H);
+  grid.z = count;
+  Float3* L = m.radiance.as<Float3>();
+  stage(0);
+  GeometryKernel<BatchFrames, 5><<<grid, kPixelBlock, 0, stream>>>(
+      fr, m.geometry.as<PixelGeometry>(), depth ? depth : m.depth.as<float>(), nullptr,
+      m.surfaces.as<SurfaceTerms>());
+  Check(cudaGetLastError(), "GeometryKernel (batch)");
+  if (m.mirror) {
+    MirrorTraceKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
+    Check(cudaGetLastError(), "MirrorTraceKernel (batch)");
+  }
+  stage(1);
+  dim3 quads = PixelGrid((W + 1) / 2, (H + 1) / 2);
+  quads.z = count;
+  SkyQuadKernel<<<quads, kPixelBlock, 0, stream>>>(fr, m.sky.as<Float3>());
+  Check(cudaGetLastError(), "SkyQuadKernel (batch)");
+  if (m.mirror) {
+    MirrorSkyKernel<<<grid, kPixelBlock, 0, stream>>>(fr, m.mirror_sky.as<Float3>());
+    Check(cudaGetLastError(), "MirrorSkyKernel (batch)");
+  }
+  stage(2);
+  ShadeStoredKernel<BatchFrames, 4>
+      <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
+  Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
+  stage(3);
+  VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
+  Check(cudaGetLastError(), "VisibilityRaysWarpKernel (batch)");
+  VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
+  Check(cudaGetLastError(), "VisibilityFractionKernel (batch)");
+  VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(fr, L);
+  Check(cudaGetLastError(), "VisibilityResolveKernel (batch)");
+  stage(4);
+  if (m.mirror) {
+    MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
+    Check(cudaGetLastError(), "MirrorShadeKernel (batch)");
+    MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(fr, L);
+    Check(cudaGetLastError(), "MirrorBlendKernel (batch)");
+  }
+  stage(5);
+  RowSumWarpKernel<<<dim3((H + 3) / 4, count), 128, 0, stream>>>(L, W, H, m.rows.as<double>());
+  Check(cudaGetLastError(), "RowSumWarpKernel (batch)");
+  stage(6);
+  // the exposures: row sums down, the host's Ev100 per camera, the films up
+  m.rows.Download(m.pin_rows.p, sizeof(double) * H * count, stream);
+  auto job = std::make_unique<BatchExposureJob>();
+  job->exposure = std::move(exposure);
+  job->films.assign(film, film + count);
+  job->rows = m.pin_rows.as<double>();
+  job->film = m.pin_film.as<RealtimeBatchFilm>();
+  job->height = H;
+  Check(cudaLaunchHostFunc(stream, RunBatchExposure, job.get()), "cudaLaunchHostFunc");
+  job.release();  // RunBatchExposure owns it now
+  Check(cudaMemcpyAsync(m.film.p, m.pin_film.p, sizeof(RealtimeBatchFilm) * count,
+                        cudaMemcpyHostToDevice, stream),
+        "cudaMemcpyAsync");
+  stage(7);
+  if (rgb) {
+    BatchDevelopKernel<<<dim3(static_cast<unsigned>((n + 255) / 256), count), 256, 0, stream>>>(
+        L, n, m.film.as<RealtimeBatchFilm>(), rgb);
+    Check(cudaGetLastError(), "BatchDevelopKernel");
+  }
+  stage(8);
+}
+
+RealtimeBatchTimes RealtimeBatch::times(int slot) const {
+  const Impl& m = *impl_;
+  RealtimeBatchTimes t;
+  if (slot < 0 || slot >= m.slots) return t;
+  double ms[kBatchStages] = {};
+  for (int i = 0; i < kBatchStages; ++i) {
+    float x = 0;
+    Check(cudaEventElapsedTime(&x, m.events[slot][i], m.events[slot][i + 1]),
+          "cudaEventElapsedTime");
+    ms[i] = x;
+  }
+  t.geometry = ms[0];
+  t.sky = ms[1];
+  t.shade = ms[2];
+  t.visibility = ms[3];
+  t.mirror = ms[4];
+  t.row_sums = ms[5];
+  t.exposure = ms[6];
+  t.film = ms[7];
+  for (double x : ms) t.total += x;
+  return t;
 }
 
 }  // namespace penumbra::cuda
