@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # on a GPU machine: unpacks scripts/gpu/pack.sh's tarball, names the card, runs the CUDA
 # backend's tests (the `gpu` tests and the host tests) and its benchmarks beside the CPU
-# backend (single camera; batches of 1, 64 and 1024 cameras at 128x128 in the house; copy
-# rates), the parity table (parity.sh), and prints one summary table, then the measurements
-# (docs/gpu.md).
+# backend (single camera; batches of 1, 64 and 1024 cameras at 128x128 in the house, depth+seg
+# and realtime rgb+depth with its stages' GPU times; copy rates), the parity table (parity.sh),
+# and prints one summary table, then the measurements (docs/gpu.md).
 #
 #   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
 #                                           (default .gpu/penumbra-gpu.tar.xz, 50)

@@ -268,9 +268,10 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
       }
       for (int i = 0; i < n; ++i)
         depth_diff += std::memcmp(&f.depth_m.data[i], img.depth(k) + i, 4) != 0;
-      std::printf("rgb camera %d (%s): %d of %d rgb bytes and %d of %d depth values differ from "
-                  "CudaRenderer's; %d bytes > 8\n",
-                  k, k % 2 ? "house" : "default", rgb_diff, 3 * n, depth_diff, n, lit);
+      std::printf(
+          "rgb camera %d (%s): %d of %d rgb bytes and %d of %d depth values differ from "
+          "CudaRenderer's; %d bytes > 8\n",
+          k, k % 2 ? "house" : "default", rgb_diff, 3 * n, depth_diff, n, lit);
       EXPECT_EQ(rgb_diff, 0);
       EXPECT_EQ(depth_diff, 0);
       EXPECT_GT(lit, n / 10);

@@ -86,7 +86,7 @@ class BatchLayout {
  private:
   int width_, height_, max_cameras_;
   BatchOutputs outputs_;
-  std::array<int, kBatchPlaneCount> index_{};  // position among the planes that are on, -1 off
+  std::array<int, kBatchPlaneCount> index_{};   // position among the planes that are on, -1 off
   std::array<int, kBatchPlaneCount> before_{};  // bytes per pixel of the planes before p
   int planes_ = 0;
   int pixel_bytes_ = 0;  // bytes per pixel of all planes

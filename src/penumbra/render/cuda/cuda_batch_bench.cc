@@ -25,12 +25,12 @@ std::string OutputsLabel(const BatchOutputs& o) {
     if (!s.empty()) s += "+";
     s += name;
   };
+  add(o.rgb, "rgb");
   add(o.depth, "depth");
   add(o.segmentation, "seg");
   add(o.instance_segmentation, "instance");
   add(o.semantic_segmentation, "semantic");
   add(o.range, "range");
-  add(o.rgb, "rgb");
   return s;
 }
 
@@ -132,10 +132,14 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       // where an rgb batch's GPU time goes: frames/s if the batch were that stage alone
       if (pinned && outputs.rgb) {
         const std::pair<const char*, double> stages[] = {
-            {"stage: geometry", st.geometry},     {"stage: sky terms", st.sky},
-            {"stage: shading", st.shade},         {"stage: shared visibility", st.visibility},
-            {"stage: mirror layer", st.mirror},   {"stage: row sums", st.row_sums},
-            {"stage: exposure round trip", st.exposure}, {"stage: film", st.film}};
+            {"stage: geometry", st.geometry},
+            {"stage: sky terms", st.sky},
+            {"stage: shading", st.shade},
+            {"stage: shared visibility", st.visibility},
+            {"stage: mirror layer", st.mirror},
+            {"stage: row sums", st.row_sums},
+            {"stage: exposure round trip", st.exposure},
+            {"stage: film", st.film}};
         for (const auto& [what, ms] : stages)
           rows.push_back({count, "cuda", what, ms > 0 ? count / (ms * 1e-3) : 0.0, ms});
       }

@@ -91,10 +91,10 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
                                            int k, const std::vector<double>& rows, float e[3]) {
     data[k]->Ev100(rows, n, e);
   };
-  float* depth = layout_.has(BatchPlane::kDepth)
-                     ? reinterpret_cast<float*>(buffer + layout_.plane_offset(BatchPlane::kDepth,
-                                                                              count))
-                     : nullptr;
+  float* depth =
+      layout_.has(BatchPlane::kDepth)
+          ? reinterpret_cast<float*>(buffer + layout_.plane_offset(BatchPlane::kDepth, count))
+          : nullptr;
   uint8_t* rgb = buffer + layout_.plane_offset(BatchPlane::kRgb, count);
   realtime_->Launch(frames_.data(), films_.data(), count, std::move(exposure), depth, rgb, slot,
                     stream);
@@ -122,9 +122,9 @@ int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
     if (!realtime_ || lights > realtime_lights_ || (mirror && !realtime_mirror_)) {
       device_->WaitForKernels();
       realtime_.reset();
-      realtime_ = std::make_unique<RealtimeBatch>(layout_.width(), layout_.height(),
-                                                  layout_.max_cameras(), lights, mirror,
-                                                  BatchTickets::kSlots);
+      realtime_ =
+          std::make_unique<RealtimeBatch>(layout_.width(), layout_.height(), layout_.max_cameras(),
+                                          lights, mirror, BatchTickets::kSlots);
       realtime_lights_ = lights;
       realtime_mirror_ = mirror;
     }

@@ -25,10 +25,10 @@
 #include <span>
 #include <vector>
 
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/batch_layout.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
-#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_frame.h"

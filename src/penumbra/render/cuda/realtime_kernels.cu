@@ -346,15 +346,62 @@ dim3 PixelGrid(int W, int H) {
   return dim3((W + kPixelBlock.x - 1) / kPixelBlock.x, (H + kPixelBlock.y - 1) / kPixelBlock.y);
 }
 
-}  // namespace
-
-struct DeviceRealtime::Impl {
-  Buffer materials, textures, texels, decode, lut, geoms, lights;
-  Buffer geometry, depth, sky, radiance, rows, rgb, hits, surfaces;
+// the per-pixel device arrays of `cameras` frames of n pixels and `lights` lights each (one
+// frame: Render; a batch: RealtimeBatch), camera k's at k n (k n lights for the per-light ones).
+struct PixelBuffers {
+  Buffer geometry, sky, radiance, surfaces;
   // the shared visibility's buffers (RealtimeFrameView)
   Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
   // the mirror layer's buffers (RealtimeFrameView)
   Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
+  // room for n pixels (all cameras) and nl = n x lights (lights >= 1); the material terms if
+  // `with_surfaces`, the mirror layer's if `mirror`
+  void Reserve(int64_t n, int64_t nl, bool with_surfaces, bool mirror) {
+    geometry.Reserve(sizeof(PixelGeometry) * n);
+    sky.Reserve(sizeof(Float3) * n);
+    radiance.Reserve(sizeof(Float3) * n);
+    if (with_surfaces) surfaces.Reserve(sizeof(SurfaceTerms) * n);
+    window.Reserve(sizeof(uint32_t) * n);
+    total.Reserve(sizeof(float) * n);
+    area_c.Reserve(sizeof(Float3) * nl);
+    area_vis.Reserve(sizeof(int8_t) * nl);
+    area_visible.Reserve(sizeof(float) * nl);
+    area_rays.Reserve(sizeof(float) * nl);
+    area_own.Reserve(sizeof(uint8_t) * nl);
+    area_fraction.Reserve(sizeof(float) * nl);
+    if (mirror) {
+      mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
+      mirror_hits.Reserve(sizeof(TraceHit) * n);
+      mirror_sky.Reserve(sizeof(Float3) * n);
+      mirror_radiance.Reserve(sizeof(Float3) * n);
+    }
+  }
+  // f's per-pixel arrays: the part at pixel `at` and, per light, at `at_l`
+  void Point(RealtimeFrameView* f, int64_t at, int64_t at_l, bool mirror) const {
+    f->sky_term = sky.as<Float3>() + at;
+    f->geometry = geometry.as<PixelGeometry>() + at;
+    f->window = window.as<uint32_t>() + at;
+    f->total = total.as<float>() + at;
+    f->area_c = area_c.as<Float3>() + at_l;
+    f->area_vis = area_vis.as<int8_t>() + at_l;
+    f->area_visible = area_visible.as<float>() + at_l;
+    f->area_rays = area_rays.as<float>() + at_l;
+    f->area_own = area_own.as<uint8_t>() + at_l;
+    f->area_fraction = area_fraction.as<float>() + at_l;
+    if (mirror) {
+      f->mirror_geometry = mirror_geometry.as<PixelGeometry>() + at;
+      f->mirror_hits = mirror_hits.as<TraceHit>() + at;
+      f->mirror_sky = mirror_sky.as<Float3>() + at;
+      f->mirror_radiance = mirror_radiance.as<Float3>() + at;
+    }
+  }
+};
+
+}  // namespace
+
+struct DeviceRealtime::Impl : PixelBuffers {
+  Buffer materials, textures, texels, decode, lut, geoms, lights;
+  Buffer depth, rows, rgb, hits;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
   Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
   SkyModelPod device_sky;
@@ -412,7 +459,7 @@ struct DeviceRealtime::Impl {
     Check(cudaGetLastError(), "SkyQuadKernel");
     if (f.any_mirror != 0) {
       MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(OneFrame{f},
-                                                                    mirror_sky.as<Float3>());
+                                                                   mirror_sky.as<Float3>());
       Check(cudaGetLastError(), "MirrorSkyKernel");
     }
   }
@@ -427,14 +474,14 @@ struct DeviceRealtime::Impl {
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 6)
-      ShadeStoredKernel<OneFrame, 6><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
-                                                                        row1);
+      ShadeStoredKernel<OneFrame, 6>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4)
-      ShadeStoredKernel<OneFrame, 4><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
-                                                                        row1);
+      ShadeStoredKernel<OneFrame, 4>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface)
-      ShadeStoredKernel<OneFrame, 1><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0,
-                                                                        row1);
+      ShadeStoredKernel<OneFrame, 1>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.min_blocks >= 6)
       ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
     else if (o.min_blocks >= 4)
@@ -607,50 +654,18 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.geoms.Upload(host_frame.geoms, geom_bytes, stream);
     m.lights.Upload(host_frame.lights, light_bytes, stream);
   }
-  m.geometry.Reserve(sizeof(PixelGeometry) * n);
   m.depth.Reserve(sizeof(float) * n);
-  m.sky.Reserve(sizeof(Float3) * n);
-  m.radiance.Reserve(sizeof(Float3) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
   if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
-  if (o.reuse_hit && o.reuse_surface) m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
   const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
-  m.window.Reserve(sizeof(uint32_t) * n);
-  m.total.Reserve(sizeof(float) * n);
-  m.area_c.Reserve(sizeof(Float3) * nl);
-  m.area_vis.Reserve(sizeof(int8_t) * nl);
-  m.area_visible.Reserve(sizeof(float) * nl);
-  m.area_rays.Reserve(sizeof(float) * nl);
-  m.area_own.Reserve(sizeof(uint8_t) * nl);
-  m.area_fraction.Reserve(sizeof(float) * nl);
   const bool mirror = host_frame.any_mirror != 0;
-  if (mirror) {
-    m.mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
-    m.mirror_hits.Reserve(sizeof(TraceHit) * n);
-    m.mirror_sky.Reserve(sizeof(Float3) * n);
-    m.mirror_radiance.Reserve(sizeof(Float3) * n);
-  }
+  m.PixelBuffers::Reserve(n, nl, o.reuse_hit && o.reuse_surface, mirror);
   // the frame with the device copies
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
   m.WithDeviceArrays(&f);
-  f.sky_term = m.sky.as<Float3>();
-  f.geometry = m.geometry.as<PixelGeometry>();
-  f.window = m.window.as<uint32_t>();
-  f.total = m.total.as<float>();
-  f.area_c = m.area_c.as<Float3>();
-  f.area_vis = m.area_vis.as<int8_t>();
-  f.area_visible = m.area_visible.as<float>();
-  f.area_rays = m.area_rays.as<float>();
-  f.area_own = m.area_own.as<uint8_t>();
-  f.area_fraction = m.area_fraction.as<float>();
-  if (mirror) {
-    f.mirror_geometry = m.mirror_geometry.as<PixelGeometry>();
-    f.mirror_hits = m.mirror_hits.as<TraceHit>();
-    f.mirror_sky = m.mirror_sky.as<Float3>();
-    f.mirror_radiance = m.mirror_radiance.as<Float3>();
-  }
+  m.Point(&f, 0, 0, mirror);
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;
@@ -899,12 +914,10 @@ void CUDART_CB RunBatchExposure(void* data) {
 
 }  // namespace
 
-struct RealtimeBatch::Impl {
+struct RealtimeBatch::Impl : PixelBuffers {
   int width = 0, height = 0, max_cameras = 0, lights = 1, slots = 0;
   bool mirror = false;
-  Buffer frames, film, geometry, depth, sky, radiance, rows, surfaces;
-  Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
-  Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
+  Buffer frames, film, depth, rows;
   PinnedBuffer pin_rows, pin_film;
   std::vector<RealtimeFrameView> host_frames;
   std::vector<std::vector<cudaEvent_t>> events;  // [slot][kBatchStages + 1]
@@ -936,26 +949,9 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
     const size_t nl = n * m.lights;
     m.frames.Reserve(sizeof(RealtimeFrameView) * max_cameras);
     m.film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
-    m.geometry.Reserve(sizeof(PixelGeometry) * n);
     m.depth.Reserve(sizeof(float) * n);
-    m.sky.Reserve(sizeof(Float3) * n);
-    m.radiance.Reserve(sizeof(Float3) * n);
     m.rows.Reserve(sizeof(double) * height * max_cameras);
-    m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
-    m.window.Reserve(sizeof(uint32_t) * n);
-    m.total.Reserve(sizeof(float) * n);
-    m.area_c.Reserve(sizeof(Float3) * nl);
-    m.area_vis.Reserve(sizeof(int8_t) * nl);
-    m.area_visible.Reserve(sizeof(float) * nl);
-    m.area_rays.Reserve(sizeof(float) * nl);
-    m.area_own.Reserve(sizeof(uint8_t) * nl);
-    m.area_fraction.Reserve(sizeof(float) * nl);
-    if (mirror) {
-      m.mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
-      m.mirror_hits.Reserve(sizeof(TraceHit) * n);
-      m.mirror_sky.Reserve(sizeof(Float3) * n);
-      m.mirror_radiance.Reserve(sizeof(Float3) * n);
-    }
+    m.Reserve(n, nl, /*with_surfaces=*/true, mirror);
     m.pin_rows.Reserve(sizeof(double) * height * max_cameras);
     m.pin_film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
     m.events.assign(slots, std::vector<cudaEvent_t>(kBatchStages + 1, nullptr));
@@ -993,22 +989,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
                   (f.any_mirror != 0 ? ", a mirror layer" : "") + "; expected " +
                   std::to_string(W) + "x" + std::to_string(H) + ", at most " +
                   std::to_string(m.lights) + " lights" + (m.mirror ? "" : ", no mirror layer"));
-    f.sky_term = m.sky.as<Float3>() + k * n;
-    f.geometry = m.geometry.as<PixelGeometry>() + k * n;
-    f.window = m.window.as<uint32_t>() + k * n;
-    f.total = m.total.as<float>() + k * n;
-    f.area_c = m.area_c.as<Float3>() + k * nl;
-    f.area_vis = m.area_vis.as<int8_t>() + k * nl;
-    f.area_visible = m.area_visible.as<float>() + k * nl;
-    f.area_rays = m.area_rays.as<float>() + k * nl;
-    f.area_own = m.area_own.as<uint8_t>() + k * nl;
-    f.area_fraction = m.area_fraction.as<float>() + k * nl;
-    if (m.mirror) {
-      f.mirror_geometry = m.mirror_geometry.as<PixelGeometry>() + k * n;
-      f.mirror_hits = m.mirror_hits.as<TraceHit>() + k * n;
-      f.mirror_sky = m.mirror_sky.as<Float3>() + k * n;
-      f.mirror_radiance = m.mirror_radiance.as<Float3>() + k * n;
-    }
+    m.Point(&f, k * n, k * nl, m.mirror);
   }
   // from pageable memory: staged before the call returns
   m.frames.Upload(m.host_frames.data(), sizeof(RealtimeFrameView) * count, stream);
