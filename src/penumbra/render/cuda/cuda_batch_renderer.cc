@@ -16,7 +16,14 @@ BatchRenderer::BatchRenderer(const BatchConfig& config)
       device_(std::make_unique<BatchDevice>(layout_, config.copy)),
       counts_(BatchTickets::kSlots, 0) {}
 
-BatchRenderer::~BatchRenderer() = default;
+BatchRenderer::~BatchRenderer() {
+  // the kernels and the exposures' host functions read the worlds and the realtime buffers
+  try {
+    device_->WaitForKernels();
+  } catch (const Error&) {
+    // a failed device: nothing left to wait for
+  }
+}
 
 int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings& settings) {
   auto w = std::make_unique<World>();
