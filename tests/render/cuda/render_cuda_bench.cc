@@ -12,8 +12,9 @@
 // and the BVH build time. prints one markdown table.
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
 // batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
-// depth+seg, pinned and pageable copies, the kernel alone and the CPU backend; then the
-// device-to-host copy rates, pinned and pageable.
+// depth+seg and then realtime rgb+depth (with each realtime stage's GPU time), pinned and
+// pageable copies, the kernels alone and the CPU backend; then the device-to-host copy rates,
+// pinned and pageable.
 // --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
 // Render() with the sky terms on the device (default), on the host (the geometry's round trip
 // in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky) and with pageable copies, and

@@ -50,7 +50,7 @@ struct BatchConfig {
 
 /// the images of one batch, on the host (BatchRenderer::Wait) or on the device
 /// (BatchRenderer::DeviceImages): camera k's image of an output is width x height row-major
-/// 4-byte values (BatchLayout), null if that output is off.
+/// values of BatchPlaneBytes bytes (4; rgb 3) (BatchLayout), null if that output is off.
 struct BatchImages {
   const uint8_t* base = nullptr;  ///< the batch's buffer (host or device pointer)
   const BatchLayout* layout = nullptr;
