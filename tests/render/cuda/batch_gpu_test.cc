@@ -220,9 +220,11 @@ TEST_F(BatchRendering, DeviceOnlyBatchesAreNotCopiedBack) {
 TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
   std::vector<CameraView> views;
   std::vector<cuda::BatchCamera> cams = Cameras(&views);
-  // cameras of other frames (their random numbers are keyed by camera and frame)
+  // cameras of other frames (their random numbers are keyed by camera and frame), some with
+  // white balance gains of their own
   for (int k = 0; k < 8; ++k) {
     views[k].frame_index = 3 * k;
+    if (k % 3 == 1) views[k].white_balance_gains = Eigen::Vector3f(1.15f, 1.0f, 0.8f);
     views[k].outputs[ImageKind::kRgb] = views[k].outputs[ImageKind::kDepth] = true;
     views[k].outputs[ImageKind::kSegmentation] = views[k].outputs[ImageKind::kRange] = false;
     views[k].outputs[ImageKind::kInstanceSegmentation] =

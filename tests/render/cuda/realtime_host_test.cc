@@ -100,7 +100,9 @@ TEST(RealtimeHostPathFrames, PoseWorldThenSetCameraIsPrepare) {
     const WorldSnapshot snap = session->sim().Snapshot();
     CameraView view = realtime_parity::RgbDepthView(scene, snap, 64, 48);
     view.frame_index = 5;
+    view.white_balance_gains = Eigen::Vector3f(0.9f, 1.0f, 1.2f);
     CameraView other = view;
+    other.white_balance_gains = Eigen::Vector3f::Ones();
     other.X_WO.translation().z() += 0.3;
     other.frame_index = 2;
     cuda::BvhScene bvh(scene);
@@ -113,7 +115,7 @@ TEST(RealtimeHostPathFrames, PoseWorldThenSetCameraIsPrepare) {
     for (const CameraView* v : {&other, &view}) {
       const Camera c(v->X_WO, v->intrinsics, v->motion);
       batch.SetCamera(cuda::PinholeCameraOf(*v), c.pixel_spread_rad(), v->camera_index,
-                      v->frame_index);
+                      v->frame_index, v->white_balance_gains);
     }
     const cuda::RealtimeFrameView fa = alone.View(bvh.view(), nullptr);
     const cuda::RealtimeFrameView fb = batch.View(bvh.view(), nullptr);

@@ -29,13 +29,15 @@ struct BatchOutputs {
 /// one camera of a batch: the world it looks at (the index BatchRenderer::AddWorld returned)
 /// and its pinhole camera (CudaRenderer::PinholeOf); its width and height must be the batch's.
 /// the rgb's per-pixel random numbers are keyed by camera_index and frame_index (as
-/// CameraView's), and its texture filtering's ray cones start at spread_rad
-/// (Camera::pixel_spread_rad); BatchRenderer::CameraOf fills all of them.
+/// CameraView's), its texture filtering's ray cones start at spread_rad
+/// (Camera::pixel_spread_rad) and its exposure is multiplied by white_balance (linear rgb
+/// gains, CameraView::white_balance_gains); BatchRenderer::CameraOf fills all of them.
 struct BatchCamera {
   int32_t world = 0;
-  int32_t camera_index = 0;  ///< CameraView::camera_index
-  int64_t frame_index = 0;   ///< CameraView::frame_index
-  float spread_rad = 0;      ///< Camera::pixel_spread_rad, radians
+  int32_t camera_index = 0;            ///< CameraView::camera_index
+  int64_t frame_index = 0;             ///< CameraView::frame_index
+  float spread_rad = 0;                ///< Camera::pixel_spread_rad, radians
+  float white_balance[3] = {1, 1, 1};  ///< CameraView::white_balance_gains
   PinholeCamera camera;
 };
 

@@ -81,6 +81,7 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
   frames_.resize(count);
   films_.resize(count);
   std::vector<const RealtimeFrameData*> data(count);
+  std::vector<Eigen::Vector3f> gains(count);
   for (int k = 0; k < count; ++k) {
     const BatchCamera& c = cameras[k];
     const World& w = *worlds_[c.world];
@@ -92,11 +93,12 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
     films_[k].filmic = w.realtime->film().filmic() ? 1 : 0;
     films_[k].lut = w.device_realtime->device_lut();
     data[k] = w.realtime.get();
+    gains[k] = Eigen::Vector3f(c.white_balance[0], c.white_balance[1], c.white_balance[2]);
   }
   const int64_t n = layout_.pixels();
-  RealtimeBatch::ExposureFn exposure = [data = std::move(data), n](
+  RealtimeBatch::ExposureFn exposure = [data = std::move(data), gains = std::move(gains), n](
                                            int k, const std::vector<double>& rows, float e[3]) {
-    data[k]->Ev100(rows, n, e);
+    data[k]->Ev100(rows, n, gains[k], e);
   };
   float* depth =
       layout_.has(BatchPlane::kDepth)
@@ -202,6 +204,7 @@ BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
   b.camera_index = view.camera_index;
   b.frame_index = view.frame_index;
   b.spread_rad = Camera(view.X_WO, view.intrinsics, view.motion).pixel_spread_rad();
+  for (int c = 0; c < 3; ++c) b.white_balance[c] = view.white_balance_gains[c];
   b.camera = CudaRenderer::PinholeOf(view);
   return b;
 }
