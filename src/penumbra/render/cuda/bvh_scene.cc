@@ -171,10 +171,10 @@ void BvhScene::BuildAll() {
       g.blas = -1;
       continue;
     }
+    std::vector<BvhNode> tree;
+    BuildBvh(boxes, prim_base, &tree, &prim_index_);
     Blas blas;
-    blas.node_offset = static_cast<int32_t>(nodes_.size());
-    BuildBvh(boxes, prim_base, &nodes_, &prim_index_);
-    blas.num_nodes = static_cast<int32_t>(nodes_.size()) - blas.node_offset;
+    WidenBvh(tree, &nodes_, &blas);
     g.blas = static_cast<int>(blases_.size());
     blases_.push_back(blas);
   }
@@ -195,7 +195,7 @@ void BvhScene::SetInstances() {
     ToRowMajor(g.X_WI, in.X_WI);
     ToRowMajor(g.X_WI.inverse(), in.X_IW);
     // world box of the posed root box
-    const BvhNode& root = nodes_[blases_[g.blas].node_offset];
+    const Blas& root = blases_[g.blas];
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d corner((c & 1) ? root.hi[0] : root.lo[0],

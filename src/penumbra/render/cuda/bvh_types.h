@@ -28,6 +28,19 @@ struct alignas(16) BvhNode {
   int32_t count = 0;
 };
 
+/// the traversal's node (BuildBvh's binary tree with each inner node's two children's boxes
+/// and references stored in it, WidenBvh): child c's box box[c] (lo x, y, z, hi x, y, z) and
+/// either a leaf (count[c] >= 0: primitives prim_index[first[c] .. first[c] + count[c])) or an
+/// inner node (count[c] == -1: the node at first[c], relative to its BLAS's node_offset). 64
+/// bytes, 64-aligned: a node visit tests both children from one cache-line load (four 16-byte
+/// loads on the GPU) instead of the node's own 32 bytes and its two children's 64.
+struct alignas(64) BvhWideNode {
+  float box[2][6];
+  int32_t first[2];
+  int32_t count[2];
+};
+static_assert(sizeof(BvhWideNode) == 64, "BvhWideNode is one 64-byte line");
+
 /// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them).
 struct Triangle {
   F3 v0, e1, e2;
@@ -51,10 +64,15 @@ struct PrimRef {
   int32_t face = 0;    ///< triangle: face index in its geom's mesh
 };
 
-/// a bottom-level BVH: its nodes at nodes[node_offset ..], node 0 the root.
+/// a bottom-level BVH: its inner nodes at nodes[node_offset ..] (SceneView::nodes), the root's
+/// box and reference (root_count >= 0: the root is a leaf of root_count primitives at
+/// prim_index[root_first ..]; -1: the root is inner node root_first, i.e. 0).
 struct Blas {
   int32_t node_offset = 0;
   int32_t num_nodes = 0;
+  int32_t root_first = 0;
+  int32_t root_count = 0;
+  float lo[3] = {1, 1, 1}, hi[3] = {-1, -1, -1};
 };
 
 /// an instance of a BLAS posed in the world: X_WI and its inverse as row-major 3x4 floats,
@@ -78,7 +96,7 @@ struct Record {
 
 /// the arrays of one scene (host or device pointers) as the traversal reads them.
 struct SceneView {
-  const BvhNode* nodes = nullptr;
+  const BvhWideNode* nodes = nullptr;   ///< every BLAS's inner nodes (Blas::node_offset)
   const int32_t* prim_index = nullptr;  ///< leaf ranges index this, it indexes prims
   const PrimRef* prims = nullptr;
   const Triangle* triangles = nullptr;
