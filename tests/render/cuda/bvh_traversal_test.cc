@@ -167,9 +167,13 @@ TEST(CudaBvhTraversal, BuilderKeepsEveryPrimitiveOnceAndBoxesHoldChildren) {
 }
 
 // the binary tree's traversal as it was before WidenBvh (one node a visit, its children's
-// boxes loaded from the children): the reference the widened traversal must match bit for bit.
-bool ReferenceTraverse(const std::vector<cuda::BvhNode>& nodes, const cuda::SceneView& s,
-                       cuda::F3 o, cuda::F3 d, float tmin, bool any_hit, cuda::TraceHit* hit) {
+// boxes loaded from the children; leaves index the primitives through BuildBvh's prim_index):
+// the reference the widened traversal must match bit for bit. hit->prim: into prims.
+bool ReferenceTraverse(const std::vector<cuda::BvhNode>& nodes,
+                       const std::vector<int32_t>& prim_index,
+                       const std::vector<cuda::PrimRef>& prims,
+                       const std::vector<cuda::Triangle>& triangles, cuda::F3 o, cuda::F3 d,
+                       float tmin, bool any_hit, cuda::TraceHit* hit) {
   const cuda::F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
   std::vector<int> stack;
   std::vector<float> stack_t;
@@ -180,10 +184,9 @@ bool ReferenceTraverse(const std::vector<cuda::BvhNode>& nodes, const cuda::Scen
     const cuda::BvhNode& n = nodes[node];
     if (n.count > 0) {
       for (int k = 0; k < n.count; ++k) {
-        const int pi = s.prim_index[n.first + k];
+        const int pi = prim_index[n.first + k];
         float t, u = 0, v = 0;
-        if (!cuda::IntersectTriangle(s.triangles[s.prims[pi].index], o, d, tmin, hit->t, &t, &u,
-                                     &v))
+        if (!cuda::IntersectTriangle(triangles[prims[pi].index], o, d, tmin, hit->t, &t, &u, &v))
           continue;
         hit->t = t, hit->u = u, hit->v = v, hit->part = 0, hit->prim = pi, hit->instance = 0;
         found = true;
@@ -222,7 +225,8 @@ bool ReferenceTraverse(const std::vector<cuda::BvhNode>& nodes, const cuda::Scen
 }
 
 // random triangle soups (a leaf root and a deep tree): TraceClosest and TraceOccluded over the
-// widened BVH give the same bits as the binary tree's traversal on random rays.
+// widened BVH with the primitives in leaf order (as BvhScene keeps them) give the same bits as
+// the binary tree's traversal on random rays.
 TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
   for (const int num_triangles : {3, 4000}) {
     std::mt19937 rng(11);
@@ -254,10 +258,11 @@ TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
     cuda::Instance in;
     for (int k = 0; k < 12; ++k) in.X_WI[k] = in.X_IW[k] = (k % 5 == 0) ? 1.0f : 0.0f;
     for (int a = 0; a < 3; ++a) in.lo[a] = -100, in.hi[a] = 100;
+    std::vector<cuda::PrimRef> leaf_prims;
+    for (int32_t i : prim_index) leaf_prims.push_back(prims[i]);
     cuda::SceneView s;
     s.nodes = wide.data();
-    s.prim_index = prim_index.data();
-    s.prims = prims.data();
+    s.prims = leaf_prims.data();
     s.triangles = triangles.data();
     s.blases = &blas;
     s.instances = &in;
@@ -275,17 +280,18 @@ TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
       cuda::TraceHit got, want;
       cuda::TraceClosest(s, ray, &got);
       want.t = ray.tmax;
-      ReferenceTraverse(tree, s, ray.o, ray.d, ray.tmin, false, &want);
+      ReferenceTraverse(tree, prim_index, prims, triangles, ray.o, ray.d, ray.tmin, false, &want);
       ASSERT_EQ(got.instance, want.instance) << r;
       if (want.instance < 0) continue;
       ++hits;
-      EXPECT_EQ(got.prim, want.prim) << r;
+      EXPECT_EQ(leaf_prims[got.prim].index, prims[want.prim].index) << r;
       EXPECT_EQ(std::memcmp(&got.t, &want.t, sizeof(float)), 0) << r;
       EXPECT_EQ(std::memcmp(&got.u, &want.u, sizeof(float)), 0) << r;
       EXPECT_EQ(std::memcmp(&got.v, &want.v, sizeof(float)), 0) << r;
       cuda::TraceHit any;
       any.t = ray.tmax;
-      const bool blocked = ReferenceTraverse(tree, s, ray.o, ray.d, ray.tmin, true, &any);
+      const bool blocked =
+          ReferenceTraverse(tree, prim_index, prims, triangles, ray.o, ray.d, ray.tmin, true, &any);
       EXPECT_EQ(cuda::TraceOccluded(s, ray), blocked) << r;
       occluded += blocked ? 1 : 0;
     }

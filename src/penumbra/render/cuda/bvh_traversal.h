@@ -146,7 +146,7 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
   while (true) {
     if (count >= 0) {
       for (int k = 0; k < count; ++k) {
-        const int pi = s.prim_index[first + k];
+        const int pi = first + k;
         const PrimRef& pr = s.prims[pi];
         float t, u = 0, v = 0;
         int part = 0;

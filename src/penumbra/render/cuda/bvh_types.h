@@ -30,7 +30,7 @@ struct alignas(16) BvhNode {
 
 /// the traversal's node (BuildBvh's binary tree with each inner node's two children's boxes
 /// and references stored in it, WidenBvh): child c's box box[c] (lo x, y, z, hi x, y, z) and
-/// either a leaf (count[c] >= 0: primitives prim_index[first[c] .. first[c] + count[c])) or an
+/// either a leaf (count[c] >= 0: primitives prims[first[c] .. first[c] + count[c])) or an
 /// inner node (count[c] == -1: the node at first[c], relative to its BLAS's node_offset). 64
 /// bytes, 64-aligned: a node visit tests both children from one cache-line load (four 16-byte
 /// loads on the GPU) instead of the node's own 32 bytes and its two children's 64.
@@ -66,7 +66,7 @@ struct PrimRef {
 
 /// a bottom-level BVH: its inner nodes at nodes[node_offset ..] (SceneView::nodes), the root's
 /// box and reference (root_count >= 0: the root is a leaf of root_count primitives at
-/// prim_index[root_first ..]; -1: the root is inner node root_first, i.e. 0).
+/// prims[root_first ..]; -1: the root is inner node root_first, i.e. 0).
 struct Blas {
   int32_t node_offset = 0;
   int32_t num_nodes = 0;
@@ -96,8 +96,10 @@ struct Record {
 
 /// the arrays of one scene (host or device pointers) as the traversal reads them.
 struct SceneView {
-  const BvhWideNode* nodes = nullptr;   ///< every BLAS's inner nodes (Blas::node_offset)
-  const int32_t* prim_index = nullptr;  ///< leaf ranges index this, it indexes prims
+  const BvhWideNode* nodes = nullptr;  ///< every BLAS's inner nodes (Blas::node_offset)
+  /// leaf ranges index this directly: each BLAS's primitives in its leaves' order (BvhScene
+  /// sorts them so, and the triangles and analytic shapes in the primitives' order), so the
+  /// traversal reads a leaf's primitives and their shapes from consecutive memory.
   const PrimRef* prims = nullptr;
   const Triangle* triangles = nullptr;
   const AnalyticPrim* analytics = nullptr;
