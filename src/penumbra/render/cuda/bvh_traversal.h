@@ -125,6 +125,29 @@ PB_HOST_DEVICE inline BvhWideNode LoadWideNode(const BvhWideNode* p) {
 #endif
 }
 
+/// triangle *p: on the GPU in three 16-byte read-only loads.
+PB_HOST_DEVICE inline Triangle LoadTriangle(const Triangle* p) {
+#if defined(__CUDA_ARCH__)
+  const float4* q = reinterpret_cast<const float4*>(p);
+  const float4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2);
+  Triangle t;
+  t.v0 = {a.x, a.y, a.z}, t.e1 = {a.w, b.x, b.y}, t.e2 = {b.z, b.w, c.x};
+  return t;
+#else
+  return *p;
+#endif
+}
+
+/// the kind and shape index of primitive *p (PrimRef): on the GPU in one 8-byte read-only load.
+PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index) {
+#if defined(__CUDA_ARCH__)
+  const int2 k = __ldg(reinterpret_cast<const int2*>(p));
+  *kind = k.x, *index = k.y;
+#else
+  *kind = p->kind, *index = p->index;
+#endif
+}
+
 /// traverses one BLAS with the ray in its frame; any_hit: stop at the first hit (occlusion).
 /// updates *hit (t shrinks) and returns whether it hit. a visit of an inner node tests its two
 /// children's boxes (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
@@ -147,13 +170,14 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     if (count >= 0) {
       for (int k = 0; k < count; ++k) {
         const int pi = first + k;
-        const PrimRef& pr = s.prims[pi];
+        int kind, index;
+        LoadPrimShape(s.prims + pi, &kind, &index);
         float t, u = 0, v = 0;
         int part = 0;
         const bool h =
-            pr.kind == 0
-                ? IntersectTriangle(s.triangles[pr.index], o, d, tmin, hit->t, &t, &u, &v)
-                : IntersectAnalyticPrim(s.analytics[pr.index], o, d, tmin, hit->t, &t, &part);
+            kind == 0 ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin, hit->t, &t,
+                                          &u, &v)
+                      : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t, &part);
         if (!h) continue;
         hit->t = t, hit->u = u, hit->v = v, hit->part = part;
         hit->prim = pi, hit->instance = instance;

@@ -41,10 +41,12 @@ struct alignas(64) BvhWideNode {
 };
 static_assert(sizeof(BvhWideNode) == 64, "BvhWideNode is one 64-byte line");
 
-/// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them).
-struct Triangle {
+/// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them). 48 bytes,
+/// 16-aligned (12 bytes of padding): the GPU loads it in three 16-byte loads (LoadTriangle).
+struct alignas(16) Triangle {
   F3 v0, e1, e2;
 };
+static_assert(sizeof(Triangle) == 48, "Triangle is three 16-byte loads");
 
 /// an analytic shape (render/analytic_shapes.h) and the map from its group's frame to its own:
 /// p_G = R_GI p_I + p_GI (double, as RayScene).
@@ -56,8 +58,8 @@ struct AnalyticPrim {
 };
 
 /// a primitive: a triangle (kind 0) or an analytic shape (kind 1), with the record (geom) it
-/// belongs to and its index in that geom's mesh (triangles) for normals.
-struct PrimRef {
+/// belongs to and its index in that geom's mesh (triangles) for normals. 16 bytes, 16-aligned.
+struct alignas(16) PrimRef {
   int32_t kind = 0;    ///< 0 = triangle, 1 = analytic
   int32_t index = 0;   ///< into triangles or analytics
   int32_t record = 0;  ///< into the scene's records
