@@ -148,48 +148,6 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 #endif
 }
 
-/// blas *p: on the GPU in three 16-byte read-only loads.
-PB_HOST_DEVICE inline Blas LoadBlas(const Blas* p) {
-#if defined(__CUDA_ARCH__)
-  const float4* q = reinterpret_cast<const float4*>(p);
-  const float4 a = __ldg(q), b = __ldg(q + 1);
-  const int4 c = __ldg(reinterpret_cast<const int4*>(p) + 2);
-  Blas x;
-  x.lo[0] = a.x, x.lo[1] = a.y, x.lo[2] = a.z, x.root_first = __float_as_int(a.w);
-  x.hi[0] = b.x, x.hi[1] = b.y, x.hi[2] = b.z, x.root_count = __float_as_int(b.w);
-  x.node_offset = c.x, x.num_nodes = c.y;
-  return x;
-#else
-  return *p;
-#endif
-}
-
-/// instance *p's world box and BLAS: on the GPU in two 16-byte read-only loads.
-PB_HOST_DEVICE inline void LoadInstanceBox(const Instance* p, float lo[3], float hi[3], int* blas) {
-#if defined(__CUDA_ARCH__)
-  const float4* q = reinterpret_cast<const float4*>(p);
-  const float4 a = __ldg(q), b = __ldg(q + 1);
-  lo[0] = a.x, lo[1] = a.y, lo[2] = a.z, *blas = __float_as_int(a.w);
-  hi[0] = b.x, hi[1] = b.y, hi[2] = b.z;
-#else
-  for (int k = 0; k < 3; ++k) lo[k] = p->lo[k], hi[k] = p->hi[k];
-  *blas = p->blas;
-#endif
-}
-
-/// instance *p's X_IW (row-major 3x4): on the GPU in three 16-byte read-only loads.
-PB_HOST_DEVICE inline void LoadInstanceMap(const Instance* p, float m[12]) {
-#if defined(__CUDA_ARCH__)
-  const float4* q = reinterpret_cast<const float4*>(p->X_IW);
-  for (int k = 0; k < 3; ++k) {
-    const float4 a = __ldg(q + k);
-    m[4 * k] = a.x, m[4 * k + 1] = a.y, m[4 * k + 2] = a.z, m[4 * k + 3] = a.w;
-  }
-#else
-  for (int k = 0; k < 12; ++k) m[k] = p->X_IW[k];
-#endif
-}
-
 /// traverses one BLAS with the ray in its frame; any_hit: stop at the first hit (occlusion).
 /// updates *hit (t shrinks) and returns whether it hit. a visit of an inner node tests its two
 /// children's boxes (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
@@ -271,13 +229,10 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   hit->prim = -1;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
   for (int i = 0; i < s.num_instances; ++i) {
-    float lo[3], hi[3], X_IW[12];
-    int blas;
-    LoadInstanceBox(s.instances + i, lo, hi, &blas);
-    if (SlabEntry(lo, hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
-    LoadInstanceMap(s.instances + i, X_IW);
-    const F3 o = TransformPoint(X_IW, r.o), d = TransformVector(X_IW, r.d);
-    TraverseBlas(s, LoadBlas(s.blases + blas), i, o, d, r.tmin, false, hit);
+    const Instance& in = s.instances[i];
+    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, false, hit);
   }
 }
 
@@ -287,13 +242,10 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
   hit.t = r.tmax;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
   for (int i = 0; i < s.num_instances; ++i) {
-    float lo[3], hi[3], X_IW[12];
-    int blas;
-    LoadInstanceBox(s.instances + i, lo, hi, &blas);
-    if (SlabEntry(lo, hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
-    LoadInstanceMap(s.instances + i, X_IW);
-    const F3 o = TransformPoint(X_IW, r.o), d = TransformVector(X_IW, r.d);
-    if (TraverseBlas(s, LoadBlas(s.blases + blas), i, o, d, r.tmin, true, &hit)) return true;
+    const Instance& in = s.instances[i];
+    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    if (TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit)) return true;
   }
   return false;
 }

@@ -68,31 +68,24 @@ struct alignas(16) PrimRef {
 
 /// a bottom-level BVH: its inner nodes at nodes[node_offset ..] (SceneView::nodes), the root's
 /// box and reference (root_count >= 0: the root is a leaf of root_count primitives at
-/// prims[root_first ..]; -1: the root is inner node root_first, i.e. 0). 48 bytes,
-/// 16-aligned, what the traversal reads first (LoadBlas: three 16-byte loads on the GPU).
-struct alignas(16) Blas {
-  float lo[3] = {1, 1, 1};
-  int32_t root_first = 0;
-  float hi[3] = {-1, -1, -1};
-  int32_t root_count = 0;
+/// prims[root_first ..]; -1: the root is inner node root_first, i.e. 0).
+struct Blas {
   int32_t node_offset = 0;
   int32_t num_nodes = 0;
+  int32_t root_first = 0;
+  int32_t root_count = 0;
+  float lo[3] = {1, 1, 1}, hi[3] = {-1, -1, -1};
 };
-static_assert(sizeof(Blas) == 48, "Blas is three 16-byte loads");
 
-/// an instance of a BLAS posed in the world: the world-frame box of the posed BLAS (for the top
-/// level), X_WI and its inverse as row-major 3x4 floats. 128 bytes, 16-aligned, the box and
-/// BLAS first (LoadInstanceBox: two 16-byte loads on the GPU), then X_IW (LoadInstanceMap:
-/// three).
-struct alignas(16) Instance {
-  float lo[3];
+/// an instance of a BLAS posed in the world: X_WI and its inverse as row-major 3x4 floats,
+/// and the world-frame box of the posed BLAS (for the top level).
+struct Instance {
   int32_t blas = 0;
-  float hi[3];
   int32_t group = 0;
-  float X_IW[12];
   float X_WI[12];  ///< row-major [R | p]
+  float X_IW[12];
+  float lo[3], hi[3];
 };
-static_assert(sizeof(Instance) == 128, "Instance is eight 16-byte loads");
 
 /// what a primitive's record stands for.
 struct Record {
