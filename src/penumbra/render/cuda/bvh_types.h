@@ -19,9 +19,9 @@ struct F3 {
   float x = 0, y = 0, z = 0;
 };
 
-/// a BVH node: a box and either two children (count == 0: children at `first` and
-/// `first + 1`) or a leaf of `count` primitives prim_index[first .. first + count). 32 bytes,
-/// 16-aligned: the GPU loads a node in two 16-byte loads.
+/// a node of the builder's binary BVH (BuildBvh): a box and either two children (count == 0:
+/// children at `first` and `first + 1`) or a leaf of `count` primitives prim_index[first ..
+/// first + count). 32 bytes, 16-aligned. the traversal reads BvhWideNode (WidenBvh) instead.
 struct alignas(16) BvhNode {
   float lo[3], hi[3];
   int32_t first = 0;
