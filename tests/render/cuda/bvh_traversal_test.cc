@@ -9,7 +9,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -161,6 +163,140 @@ TEST(CudaBvhTraversal, BuilderKeepsEveryPrimitiveOnceAndBoxesHoldChildren) {
           EXPECT_GE(n.hi[a], nodes[c].hi[a]);
         }
     }
+  }
+}
+
+// the binary tree's traversal as it was before WidenBvh (one node a visit, its children's
+// boxes loaded from the children; leaves index the primitives through BuildBvh's prim_index):
+// the reference the widened traversal must match bit for bit. hit->prim: into prims.
+bool ReferenceTraverse(const std::vector<cuda::BvhNode>& nodes,
+                       const std::vector<int32_t>& prim_index,
+                       const std::vector<cuda::PrimRef>& prims,
+                       const std::vector<cuda::Triangle>& triangles, cuda::F3 o, cuda::F3 d,
+                       float tmin, bool any_hit, cuda::TraceHit* hit) {
+  const cuda::F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
+  std::vector<int> stack;
+  std::vector<float> stack_t;
+  bool found = false;
+  int node = 0;
+  if (cuda::SlabEntry(nodes[0].lo, nodes[0].hi, o, inv, tmin, hit->t) == INFINITY) return false;
+  while (true) {
+    const cuda::BvhNode& n = nodes[node];
+    if (n.count > 0) {
+      for (int k = 0; k < n.count; ++k) {
+        const int pi = prim_index[n.first + k];
+        float t, u = 0, v = 0;
+        if (!cuda::IntersectTriangle(triangles[prims[pi].index], o, d, tmin, hit->t, &t, &u, &v))
+          continue;
+        hit->t = t, hit->u = u, hit->v = v, hit->part = 0, hit->prim = pi, hit->instance = 0;
+        found = true;
+        if (any_hit) return true;
+      }
+    } else {
+      const int a = n.first, b = n.first + 1;
+      const float ta = cuda::SlabEntry(nodes[a].lo, nodes[a].hi, o, inv, tmin, hit->t);
+      const float tb = cuda::SlabEntry(nodes[b].lo, nodes[b].hi, o, inv, tmin, hit->t);
+      const bool ha = ta != INFINITY, hb = tb != INFINITY;
+      if (ha && hb) {
+        stack.push_back(ta <= tb ? b : a);
+        stack_t.push_back(ta <= tb ? tb : ta);
+        node = ta <= tb ? a : b;
+        continue;
+      }
+      if (ha || hb) {
+        node = ha ? a : b;
+        continue;
+      }
+    }
+    bool next = false;
+    while (!stack.empty()) {
+      const int m = stack.back();
+      const float t = stack_t.back();
+      stack.pop_back(), stack_t.pop_back();
+      if (t <= hit->t) {
+        node = m;
+        next = true;
+        break;
+      }
+    }
+    if (!next) break;
+  }
+  return found;
+}
+
+// random triangle soups (a leaf root and a deep tree): TraceClosest and TraceOccluded over the
+// widened BVH with the primitives in leaf order (as BvhScene keeps them) give the same bits as
+// the binary tree's traversal on random rays.
+TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
+  for (const int num_triangles : {3, 4000}) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-5, 5), e(-0.6f, 0.6f);
+    std::vector<cuda::Triangle> triangles(num_triangles);
+    std::vector<cuda::PrimRef> prims(num_triangles);
+    std::vector<cuda::PrimBox> boxes(num_triangles);
+    for (int i = 0; i < num_triangles; ++i) {
+      cuda::Triangle& t = triangles[i];
+      t.v0 = {u(rng), u(rng), u(rng)};
+      t.e1 = {e(rng), e(rng), e(rng)};
+      t.e2 = {e(rng), e(rng), e(rng)};
+      prims[i].kind = 0, prims[i].index = i;
+      const float x[3] = {t.v0.x, t.v0.x + t.e1.x, t.v0.x + t.e2.x};
+      const float y[3] = {t.v0.y, t.v0.y + t.e1.y, t.v0.y + t.e2.y};
+      const float z[3] = {t.v0.z, t.v0.z + t.e1.z, t.v0.z + t.e2.z};
+      boxes[i] = {{std::min({x[0], x[1], x[2]}), std::min({y[0], y[1], y[2]}),
+                   std::min({z[0], z[1], z[2]})},
+                  {std::max({x[0], x[1], x[2]}), std::max({y[0], y[1], y[2]}),
+                   std::max({z[0], z[1], z[2]})}};
+    }
+    std::vector<cuda::BvhNode> tree;
+    std::vector<int32_t> prim_index;
+    cuda::BuildBvh(boxes, 0, &tree, &prim_index);
+    std::vector<cuda::BvhWideNode> wide;
+    cuda::Blas blas;
+    cuda::WidenBvh(tree, &wide, &blas);
+    EXPECT_EQ(blas.root_count, num_triangles == 3 ? 3 : -1);
+    cuda::Instance in;
+    for (int k = 0; k < 12; ++k) in.X_WI[k] = in.X_IW[k] = (k % 5 == 0) ? 1.0f : 0.0f;
+    for (int a = 0; a < 3; ++a) in.lo[a] = -100, in.hi[a] = 100;
+    std::vector<cuda::PrimRef> leaf_prims;
+    for (int32_t i : prim_index) leaf_prims.push_back(prims[i]);
+    cuda::SceneView s;
+    s.nodes = wide.data();
+    s.prims = leaf_prims.data();
+    s.triangles = triangles.data();
+    s.blases = &blas;
+    s.instances = &in;
+    s.num_instances = 1;
+    int hits = 0, occluded = 0;
+    for (int r = 0; r < 20000; ++r) {
+      cuda::TraceRay ray;
+      ray.o = {1.5f * u(rng), 1.5f * u(rng), 1.5f * u(rng)};
+      // towards a random triangle's corner, give or take
+      const cuda::F3 c = triangles[rng() % num_triangles].v0;
+      ray.d = {c.x + e(rng) - ray.o.x, c.y + e(rng) - ray.o.y, c.z + e(rng) - ray.o.z};
+      if (r % 7 == 0) ray.d.x = 0;  // axis-parallel slabs
+      ray.tmin = 0;
+      ray.tmax = r % 2 ? INFINITY : 4.0f;
+      cuda::TraceHit got, want;
+      cuda::TraceClosest(s, ray, &got);
+      want.t = ray.tmax;
+      ReferenceTraverse(tree, prim_index, prims, triangles, ray.o, ray.d, ray.tmin, false, &want);
+      ASSERT_EQ(got.instance, want.instance) << r;
+      if (want.instance < 0) continue;
+      ++hits;
+      EXPECT_EQ(leaf_prims[got.prim].index, prims[want.prim].index) << r;
+      EXPECT_EQ(std::memcmp(&got.t, &want.t, sizeof(float)), 0) << r;
+      EXPECT_EQ(std::memcmp(&got.u, &want.u, sizeof(float)), 0) << r;
+      EXPECT_EQ(std::memcmp(&got.v, &want.v, sizeof(float)), 0) << r;
+      cuda::TraceHit any;
+      any.t = ray.tmax;
+      const bool blocked =
+          ReferenceTraverse(tree, prim_index, prims, triangles, ray.o, ray.d, ray.tmin, true, &any);
+      EXPECT_EQ(cuda::TraceOccluded(s, ray), blocked) << r;
+      occluded += blocked ? 1 : 0;
+    }
+    EXPECT_GT(hits, 100);
+    EXPECT_GT(occluded, 100);
   }
 }
 

@@ -9,6 +9,8 @@
 //     shading, exposure, film, rgb, radiance and depth copied back), and its kernels alone
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
+//   - with --realtime, the FNV-1a hashes of the default options' rgb and depth (to compare
+//     builds: a change of the traversal or the kernels that keeps the images keeps them);
 // and the BVH build time. prints one markdown table.
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
 // batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
@@ -35,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/core/output_file.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_batch_bench.h"
@@ -202,6 +205,12 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
                1 / cpu_s, 1e3 * cpu_s);
     fmt::print("| {} | {} | cuda, two renders bit-identical | {} | | | | | | |\n", name, size,
                repeatable ? "yes" : "NO");
+    // the default options' images, to compare builds (a traversal change must keep these)
+    const auto bytes = [](const auto& v) {
+      return std::string_view(reinterpret_cast<const char*>(v.data()), sizeof(v[0]) * v.size());
+    };
+    fmt::print("| {} | {} | cuda, FNV-1a of rgb / depth | {:016x} / {:016x} | | | | | | |\n", name,
+               size, Fnv1a64(bytes(want.rgb.data)), Fnv1a64(bytes(want.depth_m.data)));
   }
   return 0;
 }

@@ -135,4 +135,34 @@ void BuildBvh(const std::vector<PrimBox>& boxes, int32_t prim_base, std::vector<
   nodes->insert(nodes->end(), local.begin(), local.end());
 }
 
+void WidenBvh(const std::vector<BvhNode>& nodes, std::vector<BvhWideNode>* wide, Blas* blas) {
+  // inner nodes: count 0 and children after themselves (an empty BVH's root leaf has first 0)
+  auto inner = [&](size_t i) { return nodes[i].count == 0 && nodes[i].first > 0; };
+  std::vector<int32_t> wide_index(nodes.size(), -1);
+  int32_t next = 0;
+  for (size_t i = 0; i < nodes.size(); ++i)
+    if (inner(i)) wide_index[i] = next++;
+  blas->node_offset = static_cast<int32_t>(wide->size());
+  blas->num_nodes = next;
+  if (nodes.empty()) {
+    blas->root_first = 0, blas->root_count = 0;
+    return;
+  }
+  for (int a = 0; a < 3; ++a) blas->lo[a] = nodes[0].lo[a], blas->hi[a] = nodes[0].hi[a];
+  blas->root_first = inner(0) ? 0 : nodes[0].first;
+  blas->root_count = inner(0) ? -1 : nodes[0].count;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (!inner(i)) continue;
+    BvhWideNode w;
+    for (int c = 0; c < 2; ++c) {
+      const size_t k = static_cast<size_t>(nodes[i].first) + c;
+      const BvhNode& child = nodes[k];
+      for (int a = 0; a < 3; ++a) w.box[c][a] = child.lo[a], w.box[c][3 + a] = child.hi[a];
+      w.first[c] = inner(k) ? wide_index[k] : child.first;
+      w.count[c] = inner(k) ? -1 : child.count;
+    }
+    wide->push_back(w);
+  }
+}
+
 }  // namespace penumbra::cuda

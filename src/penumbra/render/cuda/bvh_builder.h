@@ -23,4 +23,11 @@ struct PrimBox {
 void BuildBvh(const std::vector<PrimBox>& boxes, int32_t prim_base, std::vector<BvhNode>* nodes,
               std::vector<int32_t>* prim_index);
 
+/// the traversal's form of one BVH that BuildBvh wrote (`nodes`: its nodes alone, root first):
+/// its inner nodes appended to *wide in their order in `nodes` (the root first, if inner),
+/// each with its children's boxes and references (BvhWideNode), and *blas's root box and
+/// reference; blas->node_offset is wide's size before the call, blas->num_nodes the count
+/// appended. the traversal over it visits the same nodes in the same order as over `nodes`.
+void WidenBvh(const std::vector<BvhNode>& nodes, std::vector<BvhWideNode>* wide, Blas* blas);
+
 }  // namespace penumbra::cuda

@@ -140,7 +140,8 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
 void BvhScene::BuildAll() {
   const auto start = std::chrono::steady_clock::now();
   nodes_.clear();
-  prim_index_.clear();
+  // BuildBvh's primitive order of every group so far (one element per primitive)
+  std::vector<int32_t> prim_index;
   prims_.clear();
   triangles_.clear();
   analytics_.clear();
@@ -171,13 +172,35 @@ void BvhScene::BuildAll() {
       g.blas = -1;
       continue;
     }
+    std::vector<BvhNode> tree;
+    BuildBvh(boxes, prim_base, &tree, &prim_index);
+    // the group's primitives in its leaves' order: leaf ranges index prims_ directly (the leaves
+    // index prim_index from prim_base on, as prim_index holds one element per primitive)
+    std::vector<PrimRef> leaf_order;
+    leaf_order.reserve(boxes.size());
+    for (size_t k = prim_base; k < prims_.size(); ++k) leaf_order.push_back(prims_[prim_index[k]]);
+    std::copy(leaf_order.begin(), leaf_order.end(), prims_.begin() + prim_base);
     Blas blas;
-    blas.node_offset = static_cast<int32_t>(nodes_.size());
-    BuildBvh(boxes, prim_base, &nodes_, &prim_index_);
-    blas.num_nodes = static_cast<int32_t>(nodes_.size()) - blas.node_offset;
+    WidenBvh(tree, &nodes_, &blas);
     g.blas = static_cast<int>(blases_.size());
     blases_.push_back(blas);
   }
+  // the triangles and analytic shapes in the primitives' order (a leaf's shapes consecutive)
+  std::vector<Triangle> triangles;
+  std::vector<AnalyticPrim> analytics;
+  triangles.reserve(triangles_.size());
+  analytics.reserve(analytics_.size());
+  for (PrimRef& p : prims_) {
+    if (p.kind == 0) {
+      triangles.push_back(triangles_[p.index]);
+      p.index = static_cast<int32_t>(triangles.size()) - 1;
+    } else {
+      analytics.push_back(analytics_[p.index]);
+      p.index = static_cast<int32_t>(analytics.size()) - 1;
+    }
+  }
+  triangles_ = std::move(triangles);
+  analytics_ = std::move(analytics);
   ++geometry_version_;
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SetInstances();
@@ -195,7 +218,7 @@ void BvhScene::SetInstances() {
     ToRowMajor(g.X_WI, in.X_WI);
     ToRowMajor(g.X_WI.inverse(), in.X_IW);
     // world box of the posed root box
-    const BvhNode& root = nodes_[blases_[g.blas].node_offset];
+    const Blas& root = blases_[g.blas];
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d corner((c & 1) ? root.hi[0] : root.lo[0],
@@ -236,7 +259,6 @@ void BvhScene::Update(const WorldSnapshot& snapshot) {
 SceneView BvhScene::view() const {
   SceneView v;
   v.nodes = nodes_.data();
-  v.prim_index = prim_index_.data();
   v.prims = prims_.data();
   v.triangles = triangles_.data();
   v.analytics = analytics_.data();

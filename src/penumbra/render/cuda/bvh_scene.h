@@ -40,8 +40,7 @@ class BvhScene {
   void FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) const;
 
   const SceneDescription& scene() const { return scene_; }
-  const std::vector<BvhNode>& nodes() const { return nodes_; }
-  const std::vector<int32_t>& prim_index() const { return prim_index_; }
+  const std::vector<BvhWideNode>& nodes() const { return nodes_; }
   const std::vector<PrimRef>& prims() const { return prims_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
   const std::vector<AnalyticPrim>& analytics() const { return analytics_; }
@@ -69,8 +68,7 @@ class BvhScene {
   std::vector<Group> groups_;
   std::vector<Pose> X_WB_;
   std::vector<Pose> static_poses_;
-  std::vector<BvhNode> nodes_;
-  std::vector<int32_t> prim_index_;
+  std::vector<BvhWideNode> nodes_;  // every BLAS's inner nodes (WidenBvh)
   std::vector<PrimRef> prims_;
   std::vector<Triangle> triangles_;
   std::vector<AnalyticPrim> analytics_;

@@ -5,7 +5,8 @@
 //
 // top level: every instance whose world box the ray enters, nearest box first not needed (a
 // handful of instances); the ray is taken to the instance frame in float (as Embree's
-// instancing). bottom level: a stack traversal, the nearer child first, slab tests of
+// instancing). bottom level: a stack traversal over nodes that hold their children's boxes
+// (BvhWideNode: one 64-byte load per visit), the nearer child first, slab tests of
 // Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
 // triangles: Moller and Trumbore, "Fast, minimum storage ray/triangle intersection" (JGT
 // 1997), in float; analytic shapes: IntersectAnalyticArrays (render/analytic_shapes.h) in
@@ -107,34 +108,76 @@ PB_HOST_DEVICE inline bool IntersectAnalyticPrim(const AnalyticPrim& a, F3 o, F3
   return true;
 }
 
+/// inner node *p (BvhWideNode): on the GPU in four 16-byte read-only loads of its 64-byte line.
+PB_HOST_DEVICE inline BvhWideNode LoadWideNode(const BvhWideNode* p) {
+#if defined(__CUDA_ARCH__)
+  const float4* q = reinterpret_cast<const float4*>(p);
+  const float4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2);
+  const int4 e = __ldg(reinterpret_cast<const int4*>(p) + 3);
+  BvhWideNode n;
+  n.box[0][0] = a.x, n.box[0][1] = a.y, n.box[0][2] = a.z, n.box[0][3] = a.w;
+  n.box[0][4] = b.x, n.box[0][5] = b.y, n.box[1][0] = b.z, n.box[1][1] = b.w;
+  n.box[1][2] = c.x, n.box[1][3] = c.y, n.box[1][4] = c.z, n.box[1][5] = c.w;
+  n.first[0] = e.x, n.first[1] = e.y, n.count[0] = e.z, n.count[1] = e.w;
+  return n;
+#else
+  return *p;
+#endif
+}
+
+/// triangle *p: on the GPU in three 16-byte read-only loads.
+PB_HOST_DEVICE inline Triangle LoadTriangle(const Triangle* p) {
+#if defined(__CUDA_ARCH__)
+  const float4* q = reinterpret_cast<const float4*>(p);
+  const float4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2);
+  Triangle t;
+  t.v0 = {a.x, a.y, a.z}, t.e1 = {a.w, b.x, b.y}, t.e2 = {b.z, b.w, c.x};
+  return t;
+#else
+  return *p;
+#endif
+}
+
+/// the kind and shape index of primitive *p (PrimRef): on the GPU in one 8-byte read-only load.
+PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index) {
+#if defined(__CUDA_ARCH__)
+  const int2 k = __ldg(reinterpret_cast<const int2*>(p));
+  *kind = k.x, *index = k.y;
+#else
+  *kind = p->kind, *index = p->index;
+#endif
+}
+
 /// traverses one BLAS with the ray in its frame; any_hit: stop at the first hit (occlusion).
-/// updates *hit (t shrinks) and returns whether it hit.
+/// updates *hit (t shrinks) and returns whether it hit. a visit of an inner node tests its two
+/// children's boxes (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
 PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
                                         F3 d, float tmin, bool any_hit, TraceHit* hit) {
   const F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
-  const BvhNode* nodes = s.nodes + blas.node_offset;
-  // the farther children still to visit, with their boxes' entry distances: a popped node is
-  // visited if its entry is not beyond the closest hit found since (the entry does not depend
-  // on the ray's far end, so this is the slab test against the shorter ray, without reloading
-  // the box).
-  int stack[kMaxBvhDepth];
+  const BvhWideNode* nodes = s.nodes + blas.node_offset;
+  // the farther children still to visit (their references), with their boxes' entry distances:
+  // a popped child is visited if its entry is not beyond the closest hit found since (the entry
+  // does not depend on the ray's far end, so this is the slab test against the shorter ray,
+  // without reloading the box).
+  int stack_first[kMaxBvhDepth], stack_count[kMaxBvhDepth];
   float stack_t[kMaxBvhDepth];
   int top = 0;
   bool found = false;
-  int node = 0;
-  if (SlabEntry(nodes[0].lo, nodes[0].hi, o, inv, tmin, hit->t) == INFINITY) return false;
+  // the node in hand: a leaf (count >= 0) or inner node `first` (count -1)
+  int first = blas.root_first, count = blas.root_count;
+  if (SlabEntry(blas.lo, blas.hi, o, inv, tmin, hit->t) == INFINITY) return false;
   while (true) {
-    const BvhNode& n = nodes[node];
-    if (n.count > 0) {
-      for (int k = 0; k < n.count; ++k) {
-        const int pi = s.prim_index[n.first + k];
-        const PrimRef& pr = s.prims[pi];
+    if (count >= 0) {
+      for (int k = 0; k < count; ++k) {
+        const int pi = first + k;
+        int kind, index;
+        LoadPrimShape(s.prims + pi, &kind, &index);
         float t, u = 0, v = 0;
         int part = 0;
         const bool h =
-            pr.kind == 0
-                ? IntersectTriangle(s.triangles[pr.index], o, d, tmin, hit->t, &t, &u, &v)
-                : IntersectAnalyticPrim(s.analytics[pr.index], o, d, tmin, hit->t, &t, &part);
+            kind == 0 ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin, hit->t, &t,
+                                          &u, &v)
+                      : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t, &part);
         if (!h) continue;
         hit->t = t, hit->u = u, hit->v = v, hit->part = part;
         hit->prim = pi, hit->instance = instance;
@@ -142,30 +185,34 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
         if (any_hit) return true;
       }
     } else {
-      const int a = n.first, b = n.first + 1;
-      const float ta = SlabEntry(nodes[a].lo, nodes[a].hi, o, inv, tmin, hit->t);
-      const float tb = SlabEntry(nodes[b].lo, nodes[b].hi, o, inv, tmin, hit->t);
+      const BvhWideNode n = LoadWideNode(nodes + first);
+      const float ta = SlabEntry(n.box[0], n.box[0] + 3, o, inv, tmin, hit->t);
+      const float tb = SlabEntry(n.box[1], n.box[1] + 3, o, inv, tmin, hit->t);
       const bool ha = ta != INFINITY, hb = tb != INFINITY;
       if (ha && hb) {
-        const int nearer = ta <= tb ? a : b, farther = ta <= tb ? b : a;
+        const bool a_first = ta <= tb;
         if (top < kMaxBvhDepth) {
-          stack[top] = farther;
-          stack_t[top++] = ta <= tb ? tb : ta;
+          stack_first[top] = a_first ? n.first[1] : n.first[0];
+          stack_count[top] = a_first ? n.count[1] : n.count[0];
+          stack_t[top++] = a_first ? tb : ta;
         }
-        node = nearer;
+        first = a_first ? n.first[0] : n.first[1];
+        count = a_first ? n.count[0] : n.count[1];
         continue;
       }
       if (ha || hb) {
-        node = ha ? a : b;
+        first = ha ? n.first[0] : n.first[1];
+        count = ha ? n.count[0] : n.count[1];
         continue;
       }
     }
-    // pop, skipping nodes now farther than the closest hit
+    // pop, skipping children now farther than the closest hit
     bool next = false;
     while (top > 0) {
       --top;
       if (stack_t[top] <= hit->t) {
-        node = stack[top];
+        first = stack_first[top];
+        count = stack_count[top];
         next = true;
         break;
       }

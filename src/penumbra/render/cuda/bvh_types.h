@@ -19,19 +19,34 @@ struct F3 {
   float x = 0, y = 0, z = 0;
 };
 
-/// a BVH node: a box and either two children (count == 0: children at `first` and
-/// `first + 1`) or a leaf of `count` primitives prim_index[first .. first + count). 32 bytes,
-/// 16-aligned: the GPU loads a node in two 16-byte loads.
+/// a node of the builder's binary BVH (BuildBvh): a box and either two children (count == 0:
+/// children at `first` and `first + 1`) or a leaf of `count` primitives prim_index[first ..
+/// first + count). 32 bytes, 16-aligned. the traversal reads BvhWideNode (WidenBvh) instead.
 struct alignas(16) BvhNode {
   float lo[3], hi[3];
   int32_t first = 0;
   int32_t count = 0;
 };
 
-/// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them).
-struct Triangle {
+/// the traversal's node (BuildBvh's binary tree with each inner node's two children's boxes
+/// and references stored in it, WidenBvh): child c's box box[c] (lo x, y, z, hi x, y, z) and
+/// either a leaf (count[c] >= 0: primitives prims[first[c] .. first[c] + count[c])) or an
+/// inner node (count[c] == -1: the node at first[c], relative to its BLAS's node_offset). 64
+/// bytes, 64-aligned: a node visit tests both children from one cache-line load (four 16-byte
+/// loads on the GPU) instead of the node's own 32 bytes and its two children's 64.
+struct alignas(64) BvhWideNode {
+  float box[2][6];
+  int32_t first[2];
+  int32_t count[2];
+};
+static_assert(sizeof(BvhWideNode) == 64, "BvhWideNode is one 64-byte line");
+
+/// one triangle in its group's frame (edges from v0, as Moller-Trumbore takes them). 48 bytes,
+/// 16-aligned (12 bytes of padding): the GPU loads it in three 16-byte loads (LoadTriangle).
+struct alignas(16) Triangle {
   F3 v0, e1, e2;
 };
+static_assert(sizeof(Triangle) == 48, "Triangle is three 16-byte loads");
 
 /// an analytic shape (render/analytic_shapes.h) and the map from its group's frame to its own:
 /// p_G = R_GI p_I + p_GI (double, as RayScene).
@@ -43,18 +58,23 @@ struct AnalyticPrim {
 };
 
 /// a primitive: a triangle (kind 0) or an analytic shape (kind 1), with the record (geom) it
-/// belongs to and its index in that geom's mesh (triangles) for normals.
-struct PrimRef {
+/// belongs to and its index in that geom's mesh (triangles) for normals. 16 bytes, 16-aligned.
+struct alignas(16) PrimRef {
   int32_t kind = 0;    ///< 0 = triangle, 1 = analytic
   int32_t index = 0;   ///< into triangles or analytics
   int32_t record = 0;  ///< into the scene's records
   int32_t face = 0;    ///< triangle: face index in its geom's mesh
 };
 
-/// a bottom-level BVH: its nodes at nodes[node_offset ..], node 0 the root.
+/// a bottom-level BVH: its inner nodes at nodes[node_offset ..] (SceneView::nodes), the root's
+/// box and reference (root_count >= 0: the root is a leaf of root_count primitives at
+/// prims[root_first ..]; -1: the root is inner node root_first, i.e. 0).
 struct Blas {
   int32_t node_offset = 0;
   int32_t num_nodes = 0;
+  int32_t root_first = 0;
+  int32_t root_count = 0;
+  float lo[3] = {1, 1, 1}, hi[3] = {-1, -1, -1};
 };
 
 /// an instance of a BLAS posed in the world: X_WI and its inverse as row-major 3x4 floats,
@@ -78,8 +98,10 @@ struct Record {
 
 /// the arrays of one scene (host or device pointers) as the traversal reads them.
 struct SceneView {
-  const BvhNode* nodes = nullptr;
-  const int32_t* prim_index = nullptr;  ///< leaf ranges index this, it indexes prims
+  const BvhWideNode* nodes = nullptr;  ///< every BLAS's inner nodes (Blas::node_offset)
+  /// leaf ranges index this directly: each BLAS's primitives in its leaves' order (BvhScene
+  /// sorts them so, and the triangles and analytic shapes in the primitives' order), so the
+  /// traversal reads a leaf's primitives and their shapes from consecutive memory.
   const PrimRef* prims = nullptr;
   const Triangle* triangles = nullptr;
   const AnalyticPrim* analytics = nullptr;

@@ -93,7 +93,7 @@ bool ProbeDevice(std::string* name, std::string* why) {
 
 struct DeviceScene::Impl {
   cudaStream_t stream = nullptr;
-  Buffer nodes, prim_index, prims, triangles, analytics, blases, records, instances;
+  Buffer nodes, prims, triangles, analytics, blases, records, instances;
   Buffer rays, hits, out[6];
   int64_t geometry_version = -1;
   SceneView view;
@@ -119,8 +119,7 @@ DeviceScene::~DeviceScene() {
 void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version, bool wait) {
   Impl& m = *impl_;
   if (geometry_version != m.geometry_version) {
-    m.nodes.Upload(v.nodes, n.nodes * sizeof(BvhNode), m.stream);
-    m.prim_index.Upload(v.prim_index, n.prim_index * sizeof(int32_t), m.stream);
+    m.nodes.Upload(v.nodes, n.nodes * sizeof(BvhWideNode), m.stream);
     m.prims.Upload(v.prims, n.prims * sizeof(PrimRef), m.stream);
     m.triangles.Upload(v.triangles, n.triangles * sizeof(Triangle), m.stream);
     m.analytics.Upload(v.analytics, n.analytics * sizeof(AnalyticPrim), m.stream);
@@ -129,8 +128,7 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
     m.geometry_version = geometry_version;
   }
   m.instances.Upload(v.instances, v.num_instances * sizeof(Instance), m.stream);
-  m.view.nodes = static_cast<const BvhNode*>(m.nodes.p);
-  m.view.prim_index = static_cast<const int32_t*>(m.prim_index.p);
+  m.view.nodes = static_cast<const BvhWideNode*>(m.nodes.p);
   m.view.prims = static_cast<const PrimRef*>(m.prims.p);
   m.view.triangles = static_cast<const Triangle*>(m.triangles.p);
   m.view.analytics = static_cast<const AnalyticPrim*>(m.analytics.p);

@@ -11,7 +11,6 @@ namespace penumbra::cuda {
 void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   DeviceScene::Sizes n;
   n.nodes = static_cast<int64_t>(scene.nodes().size());
-  n.prim_index = static_cast<int64_t>(scene.prim_index().size());
   n.prims = static_cast<int64_t>(scene.prims().size());
   n.triangles = static_cast<int64_t>(scene.triangles().size());
   n.analytics = static_cast<int64_t>(scene.analytics().size());
