@@ -163,8 +163,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     RenderedFrame* target = k == truth_k ? &out->truth : &sub;
     const auto t0 = std::chrono::steady_clock::now();
     renderer->Render(*snap, effects, view, target);
-    renderer_sec_ +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    renderer_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out->stopped = target->stopped;
     if (out->stopped) return;  // unfinished: the auto-exposure state is left as it was
     if (want_rgb && n > 1) {
@@ -199,7 +198,10 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     last_ev_ = ev;
     last_time_ = start.time_sec;
     out->ev100 = ev;
-    const Eigen::Vector3f wb_gains = GainsForFrame(c.white_balance, daylight_white_, radiance);
+    // gray world needs this frame's radiance; the other modes' gains were known before it
+    const Eigen::Vector3f wb_gains = c.white_balance.mode == WhiteBalance::Mode::kAuto
+                                         ? GainsForFrame(c.white_balance, daylight_white_, radiance)
+                                         : wb_before;
     if (c.noise.enabled) {
       const float h = static_cast<float>(ExposureFromEv100(ev));
       if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
