@@ -127,6 +127,27 @@ TEST(BenchRender, TheTargetLineSaysWhetherItWasMet) {
   EXPECT_EQ(target[1].str(), std::stod(fps[1].str()) >= 30 ? "met" : "NOT met");
 }
 
+TEST(BenchRender, PresetTimesOnlyTheNamedPresetsLines) {
+  testing::TempDir dir;
+  dir.Write("box.xml", kOcBoxMjcf);
+  const std::string world = dir.Write("world.yaml", kOcBoxWorld);
+  const testing::ProcessResult r = RunPenumbra(
+      {"bench", "render", "--world", world, "--frames", "1", "--preset", "minor", "--threads", "1"},
+      dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // the one preset line, no resolution table, no other preset, no major target line
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  minor +[0-9]+\.[0-9] frames/s"))) << r.out;
+  EXPECT_EQ(r.out.find("\n640x480 rgb+depth realtime:"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("  none "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("  major "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("major >="), std::string::npos) << r.out;
+  // an unknown preset is refused by name
+  const testing::ProcessResult bad = RunPenumbra(
+      {"bench", "render", "--world", world, "--frames", "1", "--preset", "heavy"}, dir.path());
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE((bad.out + bad.err).find("heavy"), std::string::npos) << bad.out << bad.err;
+}
+
 TEST(FallDetection, ARobotOnItsBackIsReportedFallenInRunJsonAndOnStderr) {
   testing::TempDir dir;
   // upside down, 0.5 m above the floor: it lands on its back and stays there

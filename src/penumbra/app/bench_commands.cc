@@ -48,6 +48,12 @@ class BenchRenderCommand : public Command {
     AddInteger(verb, "--sessions", &options_.sessions, 1, 64,
                "--batch: spread the cameras over this many sessions of the world (default 1)");
     verb->add_flag("--no-adversity", no_adversity_, "skip the none/minor/major preset lines");
+    verb->add_option("--preset", options_.presets,
+                     "time only these adversity presets' lines (none, minor, major; e.g. "
+                     "--preset major to profile one condition) and skip the plain lines")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"none", "minor", "major"}))
+        ->excludes("--no-adversity");
     verb->add_option("--ablate", options_.ablate,
                      "switch parts of the CPU renderer off to time what they cost: mirror, "
                      "mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, "

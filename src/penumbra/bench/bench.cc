@@ -189,6 +189,10 @@ int BenchRender(const RenderBenchOptions& options) {
              cam.name, options.tier, options.threads, options.frames);
   if (!options.ablate.empty())
     fmt::print("ablated (switched off): {}\n", fmt::join(options.ablate, ", "));
+  if (!options.presets.empty()) {
+    BenchRenderAdversity(options);  // bench/effects_bench.h: only the presets named
+    return 0;
+  }
   double fps_640x480 = 0;
   for (auto [w, h] : {std::pair{640, 480}, std::pair{800, 800}}) {
     if (options.only_640x480 && w != 640) continue;

@@ -27,6 +27,10 @@ struct RenderBenchOptions {
   int batch_height = 128;
   int sessions = 1;       ///< --sessions S: the batch's cameras spread over S sessions of the world
   bool adversity = true;  ///< also time the presets none/minor/major (bench/effects_bench.h)
+  /// --preset NAME: time only these presets' lines (of none, minor, major; a profile of one
+  /// condition) and skip the plain 640x480 / 800x800 lines; empty = the plain lines, then all
+  /// three presets (unless adversity is false).
+  std::vector<std::string> presets;
   /// parts of the renderer to switch off (RenderAblation's fields by their --ablate names:
   /// mirror, mirror-sparse, sky-volume, texture-filter, shadows, sun-occluder, film); the
   /// frames/s then say what the part costs (docs/performance.md, "What costs what").
