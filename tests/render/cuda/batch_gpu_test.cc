@@ -58,7 +58,7 @@ BatchWorld LoadBatchWorld(const std::string& name) {
   w.view.outputs[ImageKind::kDepth] = w.view.outputs[ImageKind::kSegmentation] = true;
   w.view.outputs[ImageKind::kInstanceSegmentation] =
       w.view.outputs[ImageKind::kSemanticSegmentation] = true;
-  w.view.outputs[ImageKind::kRange] = true;
+  w.view.outputs[ImageKind::kRange] = w.view.outputs[ImageKind::kNormals] = true;
   return w;
 }
 
@@ -68,6 +68,7 @@ cuda::BatchConfig AllTruth(int max_cameras, cuda::BatchCopy copy = cuda::BatchCo
   c.height = kBatchH;
   c.max_cameras = max_cameras;
   c.outputs.instance_segmentation = c.outputs.semantic_segmentation = c.outputs.range = true;
+  c.outputs.normals = true;
   c.copy = copy;
   return c;
 }
@@ -89,6 +90,8 @@ std::vector<uint8_t> CameraBytes(const cuda::BatchImages& img, int k) {
     const uint8_t* b = static_cast<const uint8_t*>(p);
     out.insert(out.end(), b, b + n);
   }
+  const uint8_t* normals = reinterpret_cast<const uint8_t*>(img.normal_O(k));
+  out.insert(out.end(), normals, normals + 3 * n);
   return out;
 }
 
@@ -140,6 +143,8 @@ TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
     single->Render(w.snap, views[k], &f);
     const int n = kBatchW * kBatchH;
     int same_bits = 0, depth_bad = 0, seg_bad = 0, hits = 0;
+    // the normals come from the same TracePixelTruth as CudaRenderer's: the same bits
+    EXPECT_EQ(std::memcmp(f.normal_O.data.data(), one.normal_O(0), 12 * n), 0);
     for (int i = 0; i < n; ++i) {
       same_bits += std::memcmp(&f.depth_m.data[i], one.depth(0) + i, 4) == 0;
       depth_bad += std::abs(f.depth_m.data[i] - one.depth(0)[i]) > 1e-6f * (1 + f.depth_m.data[i]);

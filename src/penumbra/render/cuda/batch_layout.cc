@@ -29,6 +29,7 @@ BatchLayout::BatchLayout(int width, int height, int max_cameras, const BatchOutp
                                      outputs.instance_segmentation,
                                      outputs.semantic_segmentation,
                                      outputs.range,
+                                     outputs.normals,
                                      outputs.rgb};
   for (int p = 0; p < kBatchPlaneCount; ++p) {
     before_[p] = pixel_bytes_;
@@ -38,7 +39,7 @@ BatchLayout::BatchLayout(int width, int height, int max_cameras, const BatchOutp
   if (planes_ == 0)
     throw Error(
         "batch rendering: no output; expected at least one of depth, segmentation, "
-        "instance_segmentation, semantic_segmentation, range, rgb");
+        "instance_segmentation, semantic_segmentation, range, normals, rgb");
 }
 
 int64_t BatchLayout::plane_offset(BatchPlane p, int cameras) const {

@@ -15,14 +15,17 @@ namespace penumbra::cuda {
 /// the images a batch renders: the ground truth of the pixel-centre ray, each one 4-byte value
 /// per pixel: depth and range float metres, segmentation (MuJoCo geom id), instance (body id)
 /// and semantic class int32, as RenderedFrame's depth_m, geom_id, body_id, semantic_class and
-/// range_m; and the realtime tier's rgb, 3 bytes a pixel (sRGB, as RenderedFrame::rgb), whose
-/// depth is then the realtime path's (the same as CudaRenderer's with rgb on).
+/// range_m; normals, 3 floats a pixel (the unit geometric normal facing the camera in the
+/// camera's optical frame, 0 0 0 = miss, as RenderedFrame::normal_O); and the realtime tier's
+/// rgb, 3 bytes a pixel (sRGB, as RenderedFrame::rgb), whose depth is then the realtime path's
+/// (the same as CudaRenderer's with rgb on).
 struct BatchOutputs {
   bool depth = true;
   bool segmentation = true;
   bool instance_segmentation = false;
   bool semantic_segmentation = false;
   bool range = false;
+  bool normals = false;
   bool rgb = false;
 };
 
@@ -42,11 +45,13 @@ struct BatchCamera {
 };
 
 /// the planes of a batch's buffer, in buffer order.
-enum class BatchPlane { kDepth = 0, kSegmentation, kInstance, kSemantic, kRange, kRgb };
-inline constexpr int kBatchPlaneCount = 6;
+enum class BatchPlane { kDepth = 0, kSegmentation, kInstance, kSemantic, kRange, kNormal, kRgb };
+inline constexpr int kBatchPlaneCount = 7;
 
-/// bytes per pixel of plane p: 3 for rgb, else 4.
-inline constexpr int BatchPlaneBytes(BatchPlane p) { return p == BatchPlane::kRgb ? 3 : 4; }
+/// bytes per pixel of plane p: 3 for rgb, 12 for normals (3 floats), else 4.
+inline constexpr int BatchPlaneBytes(BatchPlane p) {
+  return p == BatchPlane::kRgb ? 3 : p == BatchPlane::kNormal ? 12 : 4;
+}
 
 /// where a batch's images lie in its one buffer: the planes that are on (BatchOutputs), in
 /// BatchPlane order, each `cameras` x height x width values of BatchPlaneBytes bytes,

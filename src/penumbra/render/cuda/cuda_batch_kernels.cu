@@ -27,6 +27,7 @@ struct BatchPlanes {
   int32_t* body_id;
   int32_t* semantic;
   float* range;
+  float* normal_O;  // 3 floats a pixel
 };
 
 // one thread per pixel of every camera: block (8, 8), grid z = the camera.
@@ -40,13 +41,20 @@ __global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* ca
   const PinholeCamera& c = b.camera;
   const TraceRay r =
       PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
-  const PixelTruth p = TracePixelTruth(views[b.world], r);
+  const F3 axes_W[3] = {c.ex, c.ey, c.ez};
+  const PixelTruth p = TracePixelTruth(views[b.world], r, out.normal_O ? axes_W : nullptr);
   const int64_t i = static_cast<int64_t>(k) * width * height + static_cast<int64_t>(v) * width + u;
   if (out.depth) out.depth[i] = p.depth;
   if (out.geom_id) out.geom_id[i] = p.geom_id;
   if (out.body_id) out.body_id[i] = p.body_id;
   if (out.semantic) out.semantic[i] = p.semantic;
   if (out.range) out.range[i] = p.range;
+  if (out.normal_O) {
+    float* n = out.normal_O + 3 * i;
+    n[0] = p.normal_O.x;
+    n[1] = p.normal_O.y;
+    n[2] = p.normal_O.z;
+  }
 }
 
 }  // namespace
@@ -159,10 +167,11 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
   out.body_id = static_cast<int32_t*>(plane(BatchPlane::kInstance));
   out.semantic = static_cast<int32_t*>(plane(BatchPlane::kSemantic));
   out.range = static_cast<float*>(plane(BatchPlane::kRange));
+  out.normal_O = static_cast<float*>(plane(BatchPlane::kNormal));
   const dim3 block(8, 8);
   const dim3 grid((l.width() + 7) / 8, (l.height() + 7) / 8, count);
   CheckBatch(cudaEventRecord(m.started[slot], m.compute), "cudaEventRecord");
-  if (out.depth || out.geom_id || out.body_id || out.semantic || out.range) {
+  if (out.depth || out.geom_id || out.body_id || out.semantic || out.range || out.normal_O) {
     BatchPrimaryKernel<<<grid, block, 0, m.compute>>>(m.views[slot], m.cameras[slot], l.width(),
                                                       l.height(), out);
     CheckBatch(cudaGetLastError(), "BatchPrimaryKernel launch");

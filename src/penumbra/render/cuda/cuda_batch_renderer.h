@@ -4,8 +4,8 @@
 // one kernel launch into one device buffer; the images copied back in one pinned transfer per
 // batch on a second stream, overlapped with the next batch's kernel, or left on the device for
 // a consumer on the GPU (the device-pointer API below). the images are the ground truth of each
-// pixel-centre ray (depth, segmentation, instance and semantic segmentation, range) and the
-// realtime tier's rgb (BatchOutputs::rgb: each realtime stage launched once over all cameras,
+// pixel-centre ray (depth, segmentation, instance and semantic segmentation, range, normals) and
+// the realtime tier's rgb (BatchOutputs::rgb: each realtime stage launched once over all cameras,
 // RealtimeBatch; its depth is the realtime path's), the same bits as the same camera in a batch
 // of its own and as CudaRenderer rendering that camera alone.
 //
@@ -50,20 +50,24 @@ struct BatchConfig {
 
 /// the images of one batch, on the host (BatchRenderer::Wait) or on the device
 /// (BatchRenderer::DeviceImages): camera k's image of an output is width x height row-major
-/// values of BatchPlaneBytes bytes (4; rgb 3) (BatchLayout), null if that output is off.
+/// values of BatchPlaneBytes bytes (4; normals 12, rgb 3) (BatchLayout), null if that output
+/// is off.
 struct BatchImages {
   const uint8_t* base = nullptr;  ///< the batch's buffer (host or device pointer)
   const BatchLayout* layout = nullptr;
   int cameras = 0;         ///< cameras in the batch
   bool on_device = false;  ///< base is a device pointer
   /// camera k's depth (m, 0 = miss) / range (m) / segmentation (geom id, -1 = miss) /
-  /// instance (body id) / semantic class / rgb (width x height x 3 sRGB bytes, row-major, as
-  /// RenderedFrame::rgb); null if not rendered.
+  /// instance (body id) / semantic class / normals (width x height x 3 floats, the unit
+  /// normal facing the camera in its optical frame, 0 0 0 = miss, as RenderedFrame::normal_O) /
+  /// rgb (width x height x 3 sRGB bytes, row-major, as RenderedFrame::rgb); null if not
+  /// rendered.
   const float* depth(int k) const { return Plane<float>(BatchPlane::kDepth, k); }
   const float* range(int k) const { return Plane<float>(BatchPlane::kRange, k); }
   const int32_t* geom_id(int k) const { return Plane<int32_t>(BatchPlane::kSegmentation, k); }
   const int32_t* body_id(int k) const { return Plane<int32_t>(BatchPlane::kInstance, k); }
   const int32_t* semantic(int k) const { return Plane<int32_t>(BatchPlane::kSemantic, k); }
+  const float* normal_O(int k) const { return Plane<float>(BatchPlane::kNormal, k); }
   const uint8_t* rgb(int k) const { return Plane<uint8_t>(BatchPlane::kRgb, k); }
 
  private:

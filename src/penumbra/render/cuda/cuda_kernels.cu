@@ -11,6 +11,7 @@
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 
 namespace penumbra::cuda {
@@ -39,32 +40,24 @@ struct DevicePrimary {
   int32_t* semantic;
 };
 
+// one thread per pixel: primary_pixel.h's TracePixelTruth, as the batch kernel.
 __global__ void PrimaryKernel(SceneView s, PinholeCamera c, DevicePrimary out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= c.width || v >= c.height) return;
-  const TraceRay r = PrimaryRay(c, u, v);
-  TraceHit h;
-  TraceClosest(s, r, &h);
-  const bool hit = h.instance >= 0;
-  const Record* rec = hit ? &s.records[s.prims[h.prim].record] : nullptr;
+  const F3 axes_W[3] = {c.ex, c.ey, c.ez};
+  const PixelTruth p = TracePixelTruth(s, PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr);
   const int64_t i = static_cast<int64_t>(v) * c.width + u;
-  if (out.depth) out.depth[i] = hit ? h.t : 0.0f;
-  if (out.geom_id) out.geom_id[i] = rec && rec->geom >= 0 ? rec->mujoco_id : -1;
-  if (out.range)
-    out.range[i] = hit ? h.t * sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z) : 0.0f;
-  if (out.body_id) out.body_id[i] = rec ? rec->body : -1;
-  if (out.semantic) out.semantic[i] = rec ? rec->semantic_class : 0;
+  if (out.depth) out.depth[i] = p.depth;
+  if (out.geom_id) out.geom_id[i] = p.geom_id;
+  if (out.range) out.range[i] = p.range;
+  if (out.body_id) out.body_id[i] = p.body_id;
+  if (out.semantic) out.semantic[i] = p.semantic;
   if (out.normal_O) {
     float* n = out.normal_O + 3 * i;
-    if (hit) {
-      const F3 w = HitNormal(s, r, h);
-      n[0] = c.ex.x * w.x + c.ex.y * w.y + c.ex.z * w.z;
-      n[1] = c.ey.x * w.x + c.ey.y * w.y + c.ey.z * w.z;
-      n[2] = c.ez.x * w.x + c.ez.y * w.y + c.ez.z * w.z;
-    } else {
-      n[0] = n[1] = n[2] = 0.0f;
-    }
+    n[0] = p.normal_O.x;
+    n[1] = p.normal_O.y;
+    n[2] = p.normal_O.z;
   }
 }
 

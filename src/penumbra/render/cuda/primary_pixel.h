@@ -18,13 +18,16 @@ namespace penumbra::cuda {
 /// the ground truth of one pixel: depth along the optical axis (m; 0 = miss), range along the
 /// ray (m; 0 = miss), the MuJoCo geom id (-1 = miss or no geom), the body (instance) id (-1 =
 /// miss) and the semantic class (0 = miss), as RenderedFrame's depth_m, range_m, geom_id,
-/// body_id and semantic_class.
+/// body_id and semantic_class; with the camera's axes given (TracePixelTruth), the unit
+/// surface normal facing the camera in the camera frame O (x right, y down, z forward; 0 0 0 =
+/// miss), as RenderedFrame's normal_O.
 struct PixelTruth {
   float depth = 0;
   float range = 0;
   int32_t geom_id = -1;
   int32_t body_id = -1;
   int32_t semantic = 0;
+  F3 normal_O{0, 0, 0};
 };
 
 /// the world ray of pixel (u, v) of a pinhole camera given as origin o, axes ex, ey, ez (W),
@@ -43,8 +46,46 @@ PB_HOST_DEVICE inline TraceRay PinholePixelRay(F3 o, F3 ex, F3 ey, F3 ez, float 
   return r;
 }
 
-/// traces ray r (PinholePixelRay's) through scene s and returns the pixel's ground truth.
-PB_HOST_DEVICE inline PixelTruth TracePixelTruth(const SceneView& s, const TraceRay& r) {
+/// the unit world normal of hit h of world ray r (the geometric normal of the triangle or
+/// analytic shape), facing the ray; *front_face (if given): the ray hit the outward side.
+PB_HOST_DEVICE inline F3 HitNormal(const SceneView& s, const TraceRay& r, const TraceHit& h,
+                                   bool* front_face = nullptr) {
+  const Instance& in = s.instances[h.instance];
+  const PrimRef& pr = s.prims[h.prim];
+  F3 n_I;
+  if (pr.kind == 0) {
+    const Triangle& t = s.triangles[pr.index];
+    n_I = {t.e1.y * t.e2.z - t.e1.z * t.e2.y, t.e1.z * t.e2.x - t.e1.x * t.e2.z,
+           t.e1.x * t.e2.y - t.e1.y * t.e2.x};
+  } else {
+    const AnalyticPrim& a = s.analytics[pr.index];
+    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
+    const double p_I[3] = {o.x + static_cast<double>(h.t) * d.x,
+                           o.y + static_cast<double>(h.t) * d.y,
+                           o.z + static_cast<double>(h.t) * d.z};
+    double p_G[3], n_G[3];
+    for (int k = 0; k < 3; ++k)
+      p_G[k] = a.R_GI[3 * k] * p_I[0] + a.R_GI[3 * k + 1] * p_I[1] + a.R_GI[3 * k + 2] * p_I[2] +
+               a.p_GI[k];
+    AnalyticNormalArrays(a.kind, a.size, p_G, h.part, n_G);
+    // n_I = R_GI^T n_G
+    n_I = {static_cast<float>(a.R_GI[0] * n_G[0] + a.R_GI[3] * n_G[1] + a.R_GI[6] * n_G[2]),
+           static_cast<float>(a.R_GI[1] * n_G[0] + a.R_GI[4] * n_G[1] + a.R_GI[7] * n_G[2]),
+           static_cast<float>(a.R_GI[2] * n_G[0] + a.R_GI[5] * n_G[1] + a.R_GI[8] * n_G[2])};
+  }
+  F3 n = TransformVector(in.X_WI, n_I);
+  const float len = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
+  n = len > 0 ? F3{n.x / len, n.y / len, n.z / len} : F3{0, 0, 1};
+  const bool front = !(n.x * r.d.x + n.y * r.d.y + n.z * r.d.z > 0);
+  if (!front) n = {-n.x, -n.y, -n.z};
+  if (front_face) *front_face = front;
+  return n;
+}
+
+/// traces ray r (PinholePixelRay's) through scene s and returns the pixel's ground truth; with
+/// axes_W (the camera's ex, ey, ez in W, 3 values) also its normal in the camera frame.
+PB_HOST_DEVICE inline PixelTruth TracePixelTruth(const SceneView& s, const TraceRay& r,
+                                                 const F3* axes_W = nullptr) {
   TraceHit h;
   TraceClosest(s, r, &h);
   PixelTruth p;
@@ -55,6 +96,12 @@ PB_HOST_DEVICE inline PixelTruth TracePixelTruth(const SceneView& s, const Trace
   p.geom_id = rec.geom >= 0 ? rec.mujoco_id : -1;
   p.body_id = rec.body;
   p.semantic = rec.semantic_class;
+  if (axes_W) {
+    const F3 w = HitNormal(s, r, h);
+    const F3 &ex = axes_W[0], &ey = axes_W[1], &ez = axes_W[2];
+    p.normal_O = {ex.x * w.x + ex.y * w.y + ex.z * w.z, ey.x * w.x + ey.y * w.y + ey.z * w.z,
+                  ez.x * w.x + ez.y * w.y + ez.z * w.z};
+  }
   return p;
 }
 

@@ -35,6 +35,7 @@
 #include "penumbra/render/brdf_math.h"
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
@@ -182,53 +183,9 @@ PB_HOST_DEVICE inline F3 OffsetOrigin(const Float3& p, const Float3& n) {
   return F3{p.x + off * n.x, p.y + off * n.y, p.z + off * n.z};
 }
 
-/// the pixel-centre ray of pixel (u, v) (PinholeCamera's formula).
+/// the pixel-centre ray of pixel (u, v) of camera c (primary_pixel.h's PinholePixelRay).
 PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
-  const float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
-  const float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
-  TraceRay r;
-  r.o = c.o;
-  r.d = {x * c.ex.x + y * c.ey.x + c.ez.x, x * c.ex.y + y * c.ey.y + c.ez.y,
-         x * c.ex.z + y * c.ey.z + c.ez.z};
-  r.tmin = c.near;
-  r.tmax = INFINITY;
-  return r;
-}
-
-/// the unit world normal of hit h of world ray r (the geometric normal of the triangle or
-/// analytic shape), facing the ray; *front_face (if given): the ray hit the outward side.
-PB_HOST_DEVICE inline F3 HitNormal(const SceneView& s, const TraceRay& r, const TraceHit& h,
-                                   bool* front_face = nullptr) {
-  const Instance& in = s.instances[h.instance];
-  const PrimRef& pr = s.prims[h.prim];
-  F3 n_I;
-  if (pr.kind == 0) {
-    const Triangle& t = s.triangles[pr.index];
-    n_I = {t.e1.y * t.e2.z - t.e1.z * t.e2.y, t.e1.z * t.e2.x - t.e1.x * t.e2.z,
-           t.e1.x * t.e2.y - t.e1.y * t.e2.x};
-  } else {
-    const AnalyticPrim& a = s.analytics[pr.index];
-    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    const double p_I[3] = {o.x + static_cast<double>(h.t) * d.x,
-                           o.y + static_cast<double>(h.t) * d.y,
-                           o.z + static_cast<double>(h.t) * d.z};
-    double p_G[3], n_G[3];
-    for (int k = 0; k < 3; ++k)
-      p_G[k] = a.R_GI[3 * k] * p_I[0] + a.R_GI[3 * k + 1] * p_I[1] + a.R_GI[3 * k + 2] * p_I[2] +
-               a.p_GI[k];
-    AnalyticNormalArrays(a.kind, a.size, p_G, h.part, n_G);
-    // n_I = R_GI^T n_G
-    n_I = {static_cast<float>(a.R_GI[0] * n_G[0] + a.R_GI[3] * n_G[1] + a.R_GI[6] * n_G[2]),
-           static_cast<float>(a.R_GI[1] * n_G[0] + a.R_GI[4] * n_G[1] + a.R_GI[7] * n_G[2]),
-           static_cast<float>(a.R_GI[2] * n_G[0] + a.R_GI[5] * n_G[1] + a.R_GI[8] * n_G[2])};
-  }
-  F3 n = TransformVector(in.X_WI, n_I);
-  const float len = sqrtf(n.x * n.x + n.y * n.y + n.z * n.z);
-  n = len > 0 ? F3{n.x / len, n.y / len, n.z / len} : F3{0, 0, 1};
-  const bool front = !(n.x * r.d.x + n.y * r.d.y + n.z * r.d.z > 0);
-  if (!front) n = {-n.x, -n.y, -n.z};
-  if (front_face) *front_face = front;
-  return n;
+  return PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
 }
 
 /// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
