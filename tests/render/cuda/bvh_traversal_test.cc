@@ -132,6 +132,68 @@ TEST(CudaBvhTraversal, EveryShapeStaticAndMovingMatchesEmbree) {
   EXPECT_FALSE(bvh.Occluded(clear));
 }
 
+// visible spatial tendons: capsules around the snapshot's wrap-point paths, as RayScene draws
+// them (geom -1, the tendon's material), beside a moving body; the tendon group's BLAS is rebuilt
+// when, and only when, the paths move.
+TEST(CudaBvhTraversal, TendonsMatchEmbreeAndFollowTheirPaths) {
+  SceneDescription scene = testing::EmptyScene();
+  testing::AddGeom(&scene, GeomShape::kPlane, {0, 0, 1}, testing::Translation(0, 0, -1));
+  const int body = testing::AddBody(&scene, "mover");
+  testing::AddGeom(&scene, GeomShape::kSphere, {0.2, 0, 0}, Pose::Identity(), body);
+  Tendon rope;
+  rope.name = "rope";
+  rope.width_m = 0.04;
+  rope.material = testing::AddMaterial(&scene, {0, 1, 0});
+  scene.tendons.push_back(rope);
+  rope.name = "cable";
+  rope.width_m = 0.02;
+  scene.tendons.push_back(rope);
+  WorldSnapshot snap = testing::IdentitySnapshot(scene);
+  snap.X_WB[body] = testing::Translation(3, 0.5, 0.1);
+  // rope: two segments and a repeated point (a sphere); cable: one segment
+  snap.tendon_paths = {{0, {{3, -0.3, -0.8}, {3, -0.3, 0.3}, {3, 0.2, 0.6}, {3, 0.2, 0.6}}},
+                       {1, {{2.5, -0.8, 0.2}, {3.5, -0.6, 0.2}}}};
+  RayScene embree(scene);
+  cuda::BvhRayQuery bvh(scene);
+  const auto trace = [&](const WorldSnapshot& s, const std::string& what) {
+    embree.Update(s);
+    bvh.Update(s);
+    const std::vector<Ray> rays = RayFan({0, 0, 0}, {1, 0, 0}, 200, 200, 0.3f);
+    const Agreement a = CompareQueries(embree, bvh, rays);
+    ExpectAgree(a, what);
+    // the tendons are seen: hits with geom -1 and the tendon's material
+    std::vector<SurfaceHit> hits(rays.size());
+    std::unique_ptr<bool[]> did(new bool[rays.size()]);
+    bvh.Intersect(rays, hits, std::span<bool>(did.get(), rays.size()));
+    int tendon_hits = 0;
+    for (size_t i = 0; i < rays.size(); ++i)
+      tendon_hits += did[i] && hits[i].geom == -1 && hits[i].material == rope.material;
+    EXPECT_GT(tendon_hits, 100) << what;
+  };
+  trace(snap, "first paths");
+  const int64_t version = bvh.bvh().geometry_version();
+  // a new body pose alone rebuilds nothing
+  snap.X_WB[body] = testing::Translation(3, 0.6, 0.1);
+  bvh.Update(snap);
+  EXPECT_EQ(bvh.bvh().geometry_version(), version);
+  // moved paths rebuild the tendons' BLAS: the rope's old place is clear, its new one blocked
+  Ray old_place;
+  old_place.o = {2, -0.3f, 0};
+  old_place.d = {1, 0, 0};
+  old_place.tmax = 2;
+  EXPECT_TRUE(bvh.Occluded(old_place));
+  snap.tendon_paths[0].p_W = {{3, 0.9, -0.8}, {3, 0.9, 0.3}};
+  trace(snap, "moved paths");
+  EXPECT_GT(bvh.bvh().geometry_version(), version);
+  EXPECT_FALSE(bvh.Occluded(old_place));
+  Ray new_place = old_place;
+  new_place.o = {2, 0.9f, 0};
+  EXPECT_TRUE(bvh.Occluded(new_place));
+  // a path of a missing tendon is refused by name
+  snap.tendon_paths.push_back({7, {{0, 0, 0}, {1, 0, 0}}});
+  EXPECT_THROW(bvh.Update(snap), Error);
+}
+
 TEST(CudaBvhTraversal, BuilderKeepsEveryPrimitiveOnceAndBoxesHoldChildren) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-10, 10);

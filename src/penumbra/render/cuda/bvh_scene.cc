@@ -66,6 +66,18 @@ BvhScene::BvhScene(const SceneDescription& scene) : scene_(scene) {
       groups_[k].geoms.push_back(gi);
     }
   }
+  for (const Tendon& tendon : scene.tendons) {
+    if (tendon.material < 0 || tendon.material >= static_cast<int>(scene.materials.size()))
+      throw Error("BvhScene: tendon '" + tendon.name + "' refers to missing material " +
+                  std::to_string(tendon.material));
+    if (!(tendon.width_m > 0) || !std::isfinite(tendon.width_m))
+      throw Error("BvhScene: tendon '" + tendon.name + "' has a width that is not positive");
+  }
+  if (!scene.tendons.empty()) {
+    tendon_group_ = static_cast<int>(groups_.size());
+    groups_.emplace_back();
+    groups_.back().tendons = true;
+  }
   BuildAll();
 }
 
@@ -99,12 +111,18 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
     }
     return;
   }
+  const double size[3] = {geom.size.x(), geom.size.y(), geom.size.z()};
+  AddAnalytic(KindOf(geom.shape), size, X_IG, "geom '" + geom.name + "'", boxes, record);
+}
+
+void BvhScene::AddAnalytic(AnalyticKind kind, const double size[3], const Pose& X_IG,
+                           const std::string& what, std::vector<PrimBox>* boxes, int record) {
   AnalyticPrim a;
-  a.kind = KindOf(geom.shape);
-  a.size[0] = geom.size.x(), a.size[1] = geom.size.y(), a.size[2] = geom.size.z();
+  a.kind = kind;
+  a.size[0] = size[0], a.size[1] = size[1], a.size[2] = size[2];
   if (a.kind == AnalyticKind::kPlane) {
-    a.size[0] = geom.size.x() > 0 ? geom.size.x() : kInfinitePlane;
-    a.size[1] = geom.size.y() > 0 ? geom.size.y() : kInfinitePlane;
+    a.size[0] = size[0] > 0 ? size[0] : kInfinitePlane;
+    a.size[1] = size[1] > 0 ? size[1] : kInfinitePlane;
     a.size[2] = 0;
   }
   const Pose X_GI = X_IG.inverse();
@@ -118,7 +136,7 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
   const Eigen::Vector3d h = AnalyticHalfExtents(shape);
   if (!(h.minCoeff() >= 0) || !h.allFinite() ||
       (a.kind != AnalyticKind::kPlane && !(h.minCoeff() > 0)))
-    throw Error("BvhScene: geom '" + geom.name + "' has a non-positive size for its shape");
+    throw Error("BvhScene: " + what + " has a non-positive size for its shape");
   // group-frame box of the rotated geom box, padded as RayScene's AnalyticBounds
   const Eigen::Vector3d c = X_IG.translation();
   const Eigen::Vector3d e = X_IG.linear().cwiseAbs() * h;
@@ -150,40 +168,10 @@ void BvhScene::BuildAll() {
   record_group_.clear();
   X_GI_.clear();
   for (size_t k = 0; k < groups_.size(); ++k) {
-    Group& g = groups_[k];
-    std::vector<PrimBox> boxes;
-    const int32_t prim_base = static_cast<int32_t>(prims_.size());
-    for (int gi : g.geoms) {
-      const Geom& geom = scene_.geoms[gi];
-      const Pose X_IG = g.body < 0 ? Pose(static_poses_[geom.body] * geom.X_BG) : geom.X_BG;
-      Record rec;
-      rec.geom = gi;
-      rec.material = geom.material;
-      rec.mujoco_id = geom.id;
-      rec.body = geom.body;
-      rec.semantic_class = geom.semantic_class;
-      const int record = static_cast<int>(records_.size());
-      records_.push_back(rec);
-      record_group_.push_back(static_cast<int>(k));
-      X_GI_.push_back(X_IG.inverse());
-      AddGeom(gi, X_IG, &boxes, record);
-    }
-    if (boxes.empty()) {
-      g.blas = -1;
-      continue;
-    }
-    std::vector<BvhNode> tree;
-    BuildBvh(boxes, prim_base, &tree, &prim_index);
-    // the group's primitives in its leaves' order: leaf ranges index prims_ directly (the leaves
-    // index prim_index from prim_base on, as prim_index holds one element per primitive)
-    std::vector<PrimRef> leaf_order;
-    leaf_order.reserve(boxes.size());
-    for (size_t k = prim_base; k < prims_.size(); ++k) leaf_order.push_back(prims_[prim_index[k]]);
-    std::copy(leaf_order.begin(), leaf_order.end(), prims_.begin() + prim_base);
-    Blas blas;
-    WidenBvh(tree, &nodes_, &blas);
-    g.blas = static_cast<int>(blases_.size());
-    blases_.push_back(blas);
+    if (static_cast<int>(k) == tendon_group_)
+      tendon_start_ = {nodes_.size(), prims_.size(), analytics_.size(), records_.size(),
+                       blases_.size()};
+    BuildGroup(static_cast<int>(k), &prim_index);
   }
   // the triangles and analytic shapes in the primitives' order (a leaf's shapes consecutive)
   std::vector<Triangle> triangles;
@@ -204,6 +192,103 @@ void BvhScene::BuildAll() {
   ++geometry_version_;
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   SetInstances();
+}
+
+void BvhScene::BuildGroup(int k, std::vector<int32_t>* prim_index) {
+  Group& g = groups_[k];
+  std::vector<PrimBox> boxes;
+  const int32_t prim_base = static_cast<int32_t>(prims_.size());
+  if (g.tendons) {
+    AddTendons(k, &boxes);
+  } else {
+    for (int gi : g.geoms) {
+      const Geom& geom = scene_.geoms[gi];
+      const Pose X_IG = g.body < 0 ? Pose(static_poses_[geom.body] * geom.X_BG) : geom.X_BG;
+      Record rec;
+      rec.geom = gi;
+      rec.material = geom.material;
+      rec.mujoco_id = geom.id;
+      rec.body = geom.body;
+      rec.semantic_class = geom.semantic_class;
+      const int record = static_cast<int>(records_.size());
+      records_.push_back(rec);
+      record_group_.push_back(k);
+      X_GI_.push_back(X_IG.inverse());
+      AddGeom(gi, X_IG, &boxes, record);
+    }
+  }
+  if (boxes.empty()) {
+    g.blas = -1;
+    return;
+  }
+  std::vector<BvhNode> tree;
+  BuildBvh(boxes, prim_base, &tree, prim_index);
+  // the group's primitives in its leaves' order: leaf ranges index prims_ directly (the leaves
+  // index prim_index from prim_base on, as prim_index holds one element per primitive)
+  std::vector<PrimRef> leaf_order;
+  leaf_order.reserve(boxes.size());
+  for (size_t i = prim_base; i < prims_.size(); ++i) leaf_order.push_back(prims_[(*prim_index)[i]]);
+  std::copy(leaf_order.begin(), leaf_order.end(), prims_.begin() + prim_base);
+  Blas blas;
+  WidenBvh(tree, &nodes_, &blas);
+  g.blas = static_cast<int>(blases_.size());
+  blases_.push_back(blas);
+}
+
+void BvhScene::AddTendons(int k, std::vector<PrimBox>* boxes) {
+  for (const WorldSnapshot::TendonPath& path : tendon_paths_) {
+    const Tendon& tendon = scene_.tendons[path.tendon];
+    for (size_t i = 0; i + 1 < path.p_W.size(); ++i) {
+      const Eigen::Vector3d& a = path.p_W[i];
+      const Eigen::Vector3d& b = path.p_W[i + 1];
+      if (!a.allFinite() || !b.allFinite()) continue;
+      const double length = (b - a).norm();
+      const bool capsule = length > 1e-9;
+      // geom frame: origin at the segment's midpoint, z along it (RayScene's frame)
+      Pose X_IG = Pose::Identity();
+      if (capsule) {
+        const Eigen::Vector3d z = (b - a) / length;
+        const Eigen::Vector3d x = z.unitOrthogonal();
+        X_IG.linear().col(0) = x;
+        X_IG.linear().col(1) = z.cross(x);
+        X_IG.linear().col(2) = z;
+      }
+      X_IG.translation() = 0.5 * (a + b);
+      Record rec;
+      rec.geom = -1;
+      rec.material = tendon.material;
+      const int record = static_cast<int>(records_.size());
+      records_.push_back(rec);
+      record_group_.push_back(k);
+      X_GI_.push_back(X_IG.inverse());
+      const double size[3] = {tendon.width_m, 0.5 * length, 0};
+      AddAnalytic(capsule ? AnalyticKind::kCapsule : AnalyticKind::kSphere, size, X_IG,
+                  "a segment of tendon '" + tendon.name + "'", boxes, record);
+    }
+  }
+}
+
+void BvhScene::RebuildTendons() {
+  const TendonStart& t = tendon_start_;
+  nodes_.resize(t.nodes);
+  prims_.resize(t.prims);
+  analytics_.resize(t.analytics);
+  records_.resize(t.records);
+  record_group_.resize(t.records);
+  X_GI_.resize(t.records);
+  blases_.resize(t.blases);
+  // BuildBvh appends the group's order after one element per primitive before it
+  std::vector<int32_t> prim_index(t.prims, 0);
+  BuildGroup(tendon_group_, &prim_index);
+  // the group's capsules in its primitives' (leaf) order, as BuildAll orders every group's
+  std::vector<AnalyticPrim> capsules;
+  capsules.reserve(prims_.size() - t.prims);
+  for (size_t i = t.prims; i < prims_.size(); ++i) {
+    capsules.push_back(analytics_[prims_[i].index]);
+    prims_[i].index = static_cast<int32_t>(t.analytics + capsules.size() - 1);
+  }
+  std::copy(capsules.begin(), capsules.end(), analytics_.begin() + t.analytics);
+  ++geometry_version_;
 }
 
 void BvhScene::SetInstances() {
@@ -248,11 +333,24 @@ void BvhScene::Update(const WorldSnapshot& snapshot) {
     const int b = scene_.geoms[gi].body;
     if (snapshot.X_WB[b].matrix() != static_poses_[b].matrix()) static_moved = true;
   }
+  bool tendons_moved = false;
+  if (tendon_group_ >= 0) {
+    for (const WorldSnapshot::TendonPath& path : snapshot.tendon_paths)
+      if (path.tendon < 0 || path.tendon >= static_cast<int>(scene_.tendons.size()))
+        throw Error("BvhScene::Update: a tendon path refers to missing tendon " +
+                    std::to_string(path.tendon));
+    tendons_moved = snapshot.tendon_paths.size() != tendon_paths_.size();
+    for (size_t k = 0; !tendons_moved && k < tendon_paths_.size(); ++k)
+      tendons_moved = snapshot.tendon_paths[k].tendon != tendon_paths_[k].tendon ||
+                      snapshot.tendon_paths[k].p_W != tendon_paths_[k].p_W;
+    if (tendons_moved) tendon_paths_ = snapshot.tendon_paths;
+  }
   if (static_moved) {
     static_poses_ = snapshot.X_WB;
     BuildAll();
     return;
   }
+  if (tendons_moved) RebuildTendons();
   SetInstances();
 }
 

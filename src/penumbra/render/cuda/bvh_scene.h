@@ -5,11 +5,16 @@
 // ellipsoids and cylinders analytic (render/analytic_shapes.h), grouped as RayScene groups
 // them: the static bodies merged in the world frame, every moving body on its own. Update
 // rewrites the instances' transforms from a snapshot (the BLASes are built once; the static one
-// again only if a static body moved, normally once, at the first Update). tendons are not
-// traced yet (docs/gpu.md).
+// again only if a static body moved, normally once, at the first Update). visible spatial
+// tendons (SceneDescription::tendons) are a last group in the world frame, as RayScene draws
+// them: a capsule of the tendon's width around each segment of the snapshot's wrap-point paths
+// (a sphere where a segment is shorter than 1e-9 m), records with geom -1 (segmentation:
+// background), the tendon's material; Update rebuilds that group's BLAS alone when the paths
+// changed.
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "penumbra/core/pose.h"
@@ -25,11 +30,14 @@ namespace penumbra::cuda {
 class BvhScene {
  public:
   /// builds every group's BLAS, bodies at the identity pose until Update. `scene` is referenced.
-  /// @throws Error if a traced geom refers to a missing body, mesh, height field or material.
+  /// @throws Error if a traced geom refers to a missing body, mesh, height field or material,
+  ///         or a tendon to a missing material or has a width that is not positive.
   explicit BvhScene(const SceneDescription& scene);
 
-  /// poses the instances with snapshot.X_WB (rebuilding the static BLAS if a static body moved).
-  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies.
+  /// poses the instances with snapshot.X_WB (rebuilding the static BLAS if a static body moved)
+  /// and the tendons' capsules with snapshot.tendon_paths (rebuilding their BLAS if they moved).
+  /// @throws Error if snapshot.X_WB.size() differs from the number of bodies, or a tendon path
+  ///         names a missing tendon.
   void Update(const WorldSnapshot& snapshot);
 
   /// the arrays as host pointers.
@@ -55,13 +63,27 @@ class BvhScene {
 
  private:
   struct Group {
-    int body = -1;  // -1: the static group
+    int body = -1;         // -1: the static group (or the tendons')
+    bool tendons = false;  // the tendons' capsules (world frame; the last group)
     std::vector<int> geoms;
     int blas = -1;  // -1: no primitives
     Pose X_WI = Pose::Identity();
   };
+  // where the tendon group's arrays start (it is last in every array)
+  struct TendonStart {
+    size_t nodes = 0, prims = 0, analytics = 0, records = 0, blases = 0;
+  };
   void BuildAll();
+  // appends group k's records, primitives, BLAS nodes and Blas (prim_index: BuildBvh's order of
+  // every primitive so far; the group's primitives are then in its leaves' order)
+  void BuildGroup(int k, std::vector<int32_t>* prim_index);
   void AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, int record);
+  void AddAnalytic(AnalyticKind kind, const double size[3], const Pose& X_IG,
+                   const std::string& what, std::vector<PrimBox>* boxes, int record);
+  // the tendon group's records and capsules from tendon_paths_
+  void AddTendons(int k, std::vector<PrimBox>* boxes);
+  // rebuilds the tendon group alone (the arrays' tails from tendon_start_)
+  void RebuildTendons();
   void SetInstances();
 
   const SceneDescription& scene_;
@@ -79,6 +101,9 @@ class BvhScene {
   std::vector<Pose> X_GI_;         // by record: its group frame to its geom frame
   int64_t geometry_version_ = 0;
   double build_seconds_ = 0;
+  int tendon_group_ = -1;                                // index into groups_, -1 without tendons
+  std::vector<WorldSnapshot::TendonPath> tendon_paths_;  // as the tendon group was built
+  TendonStart tendon_start_;
 };
 
 }  // namespace penumbra::cuda
