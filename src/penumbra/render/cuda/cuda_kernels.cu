@@ -88,6 +88,8 @@ struct DeviceScene::Impl {
   cudaStream_t stream = nullptr;
   Buffer nodes, prims, triangles, analytics, blases, records, instances;
   Buffer rays, hits, out[6];
+  Buffer camera_xy, camera_rows;
+  int64_t camera_xy_version = -1;
   int64_t geometry_version = -1;
   SceneView view;
 };
@@ -99,6 +101,19 @@ DeviceScene::DeviceScene() : impl_(new Impl) {
     delete impl_;
     throw;
   }
+}
+
+void DeviceScene::UploadCameraRays(const float* xy, int64_t xy_floats, int64_t xy_version,
+                                   const float* rows, int64_t row_floats, const float** xy_device,
+                                   const float** rows_device) {
+  Impl& m = *impl_;
+  if (xy_floats > 0 && xy_version != m.camera_xy_version) {
+    m.camera_xy.Upload(xy, sizeof(float) * xy_floats, m.stream);
+    m.camera_xy_version = xy_version;
+  }
+  if (row_floats > 0) m.camera_rows.Upload(rows, sizeof(float) * row_floats, m.stream);
+  *xy_device = xy_floats > 0 ? m.camera_xy.as<const float>() : nullptr;
+  *rows_device = row_floats > 0 ? m.camera_rows.as<const float>() : nullptr;
 }
 
 const SceneView& DeviceScene::device_view() const { return impl_->view; }

@@ -25,6 +25,13 @@ struct PinholeCamera {
   float cx = 0, cy = 0, inv_fx = 1, inv_fy = 1;
   float near = 0;
   int width = 0, height = 0;
+  /// a camera with lens distortion: (height x width x 2) undistorted normalised coordinates
+  /// (x, y) of the pixel centres, used instead of ((u - cx) inv_fx, (v - cy) inv_fy); null = a
+  /// pinhole. a moving camera (rolling shutter): (height x 12) per row o, ex, ey, ez, used
+  /// instead of the fields above; null = one pose. both in the memory the reader runs in (host
+  /// or device); render/cuda/camera_rays.h fills them.
+  const float* xy = nullptr;
+  const float* rows = nullptr;
 };
 
 /// host buffers a primary render fills (null = not wanted), each width x height (x 3 for
@@ -65,6 +72,12 @@ class DeviceScene {
   /// `count` renders of `camera` into device memory only (no copy back), timed with CUDA
   /// events: the mean milliseconds per frame (benchmarks).
   double TimePrimary(const PinholeCamera& camera, int count, bool depth_and_seg_only);
+  /// device copies of a camera's ray tables (camera_rays.h; host arrays of xy_floats and
+  /// row_floats floats, either may be 0) on stream(): xy again only when xy_version differs from
+  /// the last call's, rows every call; *xy_device and *rows_device get the device arrays (null
+  /// for an empty table), valid until the next call.
+  void UploadCameraRays(const float* xy, int64_t xy_floats, int64_t xy_version, const float* rows,
+                        int64_t row_floats, const float** xy_device, const float** rows_device);
   /// the device arrays as the kernels read them (after Sync), and the stream every copy and
   /// kernel of this scene runs on (a cudaStream_t).
   const SceneView& device_view() const;

@@ -43,8 +43,8 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
 CudaRenderer::~CudaRenderer() = default;
 
 bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
-  return (effects == nullptr || effects->empty()) && !view.intrinsics.has_distortion() &&
-         !view.motion.moving();
+  (void)view;  // every pinhole, distorted or moving camera renders on the GPU (camera_rays.h)
+  return effects == nullptr || effects->empty();
 }
 
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
@@ -59,8 +59,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   if (!OnGpu(effects, view) || !rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(
-          "renderer: cuda backend: {} not on the GPU yet (effects, lens distortion, camera "
-          "motion, pathtraced rgb); such frames are rendered by the CPU renderer (docs/gpu.md)",
+          "renderer: cuda backend: {} not on the GPU yet (effects, pathtraced rgb); such frames "
+          "are rendered by the CPU renderer (docs/gpu.md)",
           rgb_why.empty() ? std::string("this frame's camera or effects are") : rgb_why + " is");
       told_cpu_ = true;
     }
@@ -72,12 +72,19 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   bvh_->Update(snapshot);
   // the frame's kernels run on the device scene's stream, after the copies: no wait here
   SyncDevice(*bvh_, device_.get(), /*wait=*/false);
-  const PinholeCamera c = PinholeOf(view);
+  // a camera with lens distortion or motion: its ray tables on the device (camera_rays.h)
+  camera_rays_.Prepare(view, pool_.get());
+  const float *xy = nullptr, *rows = nullptr;
+  device_->UploadCameraRays(camera_rays_.xy().data(),
+                            static_cast<int64_t>(camera_rays_.xy().size()),
+                            camera_rays_.xy_version(), camera_rays_.rows().data(),
+                            static_cast<int64_t>(camera_rays_.rows().size()), &xy, &rows);
+  const PinholeCamera c = camera_rays_.Point(PinholeOf(view), xy, rows);
   const CameraOutputs& want = view.outputs;
   const int W = c.width, H = c.height;
   out->ev100 = 0;
   if (want[ImageKind::kRgb]) {
-    RenderRgb(snapshot, view, out);
+    RenderRgb(snapshot, view, c, out);
   } else {
     out->radiance = ImageF();
     out->rgb = ImageU8();
@@ -99,7 +106,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
 }
 
 void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& view,
-                             RenderedFrame* out) {
+                             const PinholeCamera& camera, RenderedFrame* out) {
   if (!realtime_uploaded_) {
     RealtimeStatic st;
     st.materials = realtime_->materials().data();
@@ -133,7 +140,10 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   o.parallel = [this](int64_t count, const std::function<void(int64_t)>& body) {
     ParallelForOrSerial(pool_.get(), count, body);
   };
-  const RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
+  RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
+  // the camera's ray tables: the device copies, not Prepare's host arrays
+  frame.camera.xy = camera.xy;
+  frame.camera.rows = camera.rows;
   out->ev100 = device_realtime_->Render(
       device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
       realtime_->film().filmic(),

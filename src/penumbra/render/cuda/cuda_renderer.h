@@ -14,6 +14,7 @@
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_frame.h"
@@ -53,12 +54,15 @@ class CudaRenderer final : public Renderer {
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
 
-  /// the GPU's pinhole form of `view` (view must be OnGpu).
+  /// the GPU's pinhole form of `view` (without the ray tables a camera with lens distortion or
+  /// motion needs: Render adds them, camera_rays.h).
   static PinholeCamera PinholeOf(const CameraView& view);
 
  private:
-  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h).
-  void RenderRgb(const WorldSnapshot& snapshot, const CameraView& view, RenderedFrame* out);
+  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h); `camera`: the
+  // view's camera with its ray tables on the device.
+  void RenderRgb(const WorldSnapshot& snapshot, const CameraView& view, const PinholeCamera& camera,
+                 RenderedFrame* out);
 
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
@@ -67,6 +71,8 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<RealtimeFrameData> realtime_;
   std::unique_ptr<DeviceRealtime> device_realtime_;
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
+  CameraRayTables camera_rays_;       // the frame's camera's ray tables (their device copies:
+                                      // DeviceScene::UploadCameraRays)
   bool realtime_uploaded_ = false;
   // the sky volume generation whose arrays the device holds (RealtimeFrameData::sky_generation)
   bool sky_uploaded_ = false;

@@ -121,8 +121,6 @@ std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
                                            const CameraView& view) const {
   if (settings_.tier != RenderSettings::Tier::kRealtime) return "the pathtraced tier";
   if (effects != nullptr && !effects->empty()) return "effects";
-  if (view.intrinsics.has_distortion()) return "lens distortion";
-  if (view.motion.moving()) return "camera motion";
   return "";
 }
 
@@ -130,7 +128,10 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
                                 ThreadPool* pool) {
   PoseWorld(snapshot, pool);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  SetCamera(PinholeCameraOf(view), camera.pixel_spread_rad(), view.camera_index, view.frame_index,
+  camera_rays_.Prepare(view, pool);
+  SetCamera(camera_rays_.Point(PinholeCameraOf(view), camera_rays_.xy().data(),
+                               camera_rays_.rows().data()),
+            camera.pixel_spread_rad(), view.camera_index, view.frame_index,
             view.white_balance_gains);
 }
 

@@ -18,6 +18,7 @@
 #include "penumbra/core/image.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/film.h"
@@ -38,12 +39,13 @@ class RealtimeFrameData {
   RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings);
 
   /// why a frame of `view` cannot be rendered by the GPU realtime path ("" if it can): not
-  /// the realtime tier, a camera that is not a pinhole, or effects.
+  /// the realtime tier, or effects. (lens distortion and camera motion are: camera_rays.h.)
   std::string Unsupported(const EffectsFrame* effects, const CameraView& view) const;
 
   /// poses the lights and geoms from `snapshot`, sets the camera and frame key of `view`, and
   /// updates the sky volume (built on the first call and when the static bodies move): PoseWorld,
-  /// then SetCamera.
+  /// then SetCamera. a camera with lens distortion or motion gets its ray tables
+  /// (camera_rays.h), the camera() pointing to their host arrays.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
   /// the camera-independent part of Prepare: the lights, the geoms and the sky volume.
   void PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool);
@@ -124,6 +126,7 @@ class RealtimeFrameData {
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;
+  CameraRayTables camera_rays_;  // Prepare's view's tables (host), camera_ points to them
   Eigen::Vector3f white_balance_gains_ = Eigen::Vector3f::Ones();  // the prepared view's
   // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
   int CheckRows(const char* what, int64_t n, int row0, int row1) const;

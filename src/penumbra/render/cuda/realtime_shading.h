@@ -183,9 +183,23 @@ PB_HOST_DEVICE inline F3 OffsetOrigin(const Float3& p, const Float3& n) {
   return F3{p.x + off * n.x, p.y + off * n.y, p.z + off * n.z};
 }
 
-/// the pixel-centre ray of pixel (u, v) of camera c (primary_pixel.h's PinholePixelRay).
+/// the pixel-centre ray of pixel (u, v) of camera c: primary_pixel.h's PinholePixelRay, or with
+/// c's tables (lens distortion, a moving camera; camera_rays.h) the pixel's undistorted
+/// coordinates and its row's pose, as Camera::GenerateRay.
 PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
-  return PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
+  if (!c.xy && !c.rows)
+    return PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
+  float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
+  float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
+  if (c.xy) {
+    const float* p = c.xy + 2 * (static_cast<int64_t>(v) * c.width + u);
+    x = p[0];
+    y = p[1];
+  }
+  if (!c.rows) return NormalizedPixelRay(c.o, c.ex, c.ey, c.ez, x, y, c.near);
+  const float* r = c.rows + 12 * static_cast<int64_t>(v);
+  return NormalizedPixelRay(F3{r[0], r[1], r[2]}, F3{r[3], r[4], r[5]}, F3{r[6], r[7], r[8]},
+                            F3{r[9], r[10], r[11]}, x, y, c.near);
 }
 
 /// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
