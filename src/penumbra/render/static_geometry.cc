@@ -1,7 +1,9 @@
 #include "penumbra/render/static_geometry.h"
 
+#include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
@@ -93,6 +95,37 @@ void ValidateRayGeom(const SceneDescription& scene, const Geom& geom, const std:
         throw Error(what + "has a non-positive size for its shape");
     }
   }
+}
+
+std::vector<RayGeomGroup> GroupRayGeoms(const SceneDescription& scene, const std::string& who) {
+  std::vector<RayGeomGroup> groups(1);
+  std::vector<int> group_of_body(scene.bodies.size(), -1);
+  for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
+    const Geom& g = scene.geoms[gi];
+    if (!IsRayVisible(scene, g, who)) continue;
+    ValidateRayGeom(scene, g, who);
+    if (g.body == 0 || scene.bodies[g.body].is_static) {
+      groups[0].geoms.push_back(gi);
+      continue;
+    }
+    int& k = group_of_body[g.body];
+    if (k < 0) {
+      k = static_cast<int>(groups.size());
+      groups.emplace_back();
+      groups.back().body = g.body;
+    }
+    groups[k].geoms.push_back(gi);
+  }
+  return groups;
+}
+
+void ValidateRayTendon(const SceneDescription& scene, const Tendon& tendon,
+                       const std::string& who) {
+  if (tendon.material < 0 || tendon.material >= static_cast<int>(scene.materials.size()))
+    throw Error(who + ": tendon '" + tendon.name + "' refers to missing material " +
+                std::to_string(tendon.material));
+  if (!(tendon.width_m > 0) || !std::isfinite(tendon.width_m))
+    throw Error(who + ": tendon '" + tendon.name + "' has a non-positive width");
 }
 
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g) {

@@ -25,6 +25,20 @@ bool IsRayVisible(const SceneDescription& scene, const Geom& g, const std::strin
 /// analytic sizes, non-negative plane size). @throws Error "<who>: geom 'name' ..." naming it.
 void ValidateRayGeom(const SceneDescription& scene, const Geom& g, const std::string& who);
 
+/// checks a visible spatial tendon (SceneDescription::tendons): its material exists and its width
+/// is positive and finite. @throws Error "<who>: tendon 'name' ..." naming it.
+void ValidateRayTendon(const SceneDescription& scene, const Tendon& tendon, const std::string& who);
+
+/// the traced geoms of a scene as the ray queries group them (RayScene, the CUDA BvhScene): the
+/// first group holds every geom of the world body and of static bodies (body -1), then one group
+/// per moving body in the order of its first geom. each geom is checked (IsRayVisible,
+/// ValidateRayGeom). @throws Error as those, naming `who`.
+struct RayGeomGroup {
+  int body = -1;           ///< the moving body; -1 for the static group
+  std::vector<int> geoms;  ///< indices into SceneDescription::geoms, ascending
+};
+std::vector<RayGeomGroup> GroupRayGeoms(const SceneDescription& scene, const std::string& who);
+
 /// g is traced by a RayQuery (group <= 2, material alpha >= 0.5) and belongs to a static body.
 bool IsStaticVisible(const SceneDescription& scene, const Geom& g);
 

@@ -48,31 +48,12 @@ BvhScene::BvhScene(const SceneDescription& scene) : scene_(scene) {
   const int num_bodies = static_cast<int>(scene.bodies.size());
   X_WB_.assign(num_bodies, Pose::Identity());
   static_poses_ = X_WB_;
-  groups_.resize(1);
-  std::vector<int> group_of_body(num_bodies, -1);
-  for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
-    const Geom& g = scene.geoms[gi];
-    if (!IsRayVisible(scene, g, "BvhScene")) continue;
-    ValidateRayGeom(scene, g, "BvhScene");
-    if (g.body == 0 || scene.bodies[g.body].is_static) {
-      groups_[0].geoms.push_back(gi);
-    } else {
-      int& k = group_of_body[g.body];
-      if (k < 0) {
-        k = static_cast<int>(groups_.size());
-        groups_.emplace_back();
-        groups_.back().body = g.body;
-      }
-      groups_[k].geoms.push_back(gi);
-    }
+  for (const RayGeomGroup& rg : GroupRayGeoms(scene, "BvhScene")) {
+    groups_.emplace_back();
+    groups_.back().body = rg.body;
+    groups_.back().geoms = rg.geoms;
   }
-  for (const Tendon& tendon : scene.tendons) {
-    if (tendon.material < 0 || tendon.material >= static_cast<int>(scene.materials.size()))
-      throw Error("BvhScene: tendon '" + tendon.name + "' refers to missing material " +
-                  std::to_string(tendon.material));
-    if (!(tendon.width_m > 0) || !std::isfinite(tendon.width_m))
-      throw Error("BvhScene: tendon '" + tendon.name + "' has a width that is not positive");
-  }
+  for (const Tendon& tendon : scene.tendons) ValidateRayTendon(scene, tendon, "BvhScene");
   if (!scene.tendons.empty()) {
     tendon_group_ = static_cast<int>(groups_.size());
     groups_.emplace_back();

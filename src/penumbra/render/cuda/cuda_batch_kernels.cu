@@ -20,19 +20,9 @@ void CheckBatch(cudaError_t e, const char* what) {
     throw Error(std::string("CUDA batch rendering: ") + what + ": " + cudaGetErrorString(e));
 }
 
-// the planes of one batch (device pointers; null = off)
-struct BatchPlanes {
-  float* depth;
-  int32_t* geom_id;
-  int32_t* body_id;
-  int32_t* semantic;
-  float* range;
-  float* normal_O;  // 3 floats a pixel
-};
-
 // one thread per pixel of every camera: block (8, 8), grid z = the camera.
 __global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* cameras, int width,
-                                   int height, BatchPlanes out) {
+                                   int height, PixelTruthPlanes out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= width || v >= height) return;
@@ -42,19 +32,8 @@ __global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* ca
   const TraceRay r =
       PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
   const F3 axes_W[3] = {c.ex, c.ey, c.ez};
-  const PixelTruth p = TracePixelTruth(views[b.world], r, out.normal_O ? axes_W : nullptr);
-  const int64_t i = static_cast<int64_t>(k) * width * height + static_cast<int64_t>(v) * width + u;
-  if (out.depth) out.depth[i] = p.depth;
-  if (out.geom_id) out.geom_id[i] = p.geom_id;
-  if (out.body_id) out.body_id[i] = p.body_id;
-  if (out.semantic) out.semantic[i] = p.semantic;
-  if (out.range) out.range[i] = p.range;
-  if (out.normal_O) {
-    float* n = out.normal_O + 3 * i;
-    n[0] = p.normal_O.x;
-    n[1] = p.normal_O.y;
-    n[2] = p.normal_O.z;
-  }
+  out.Write(TracePixelTruth(views[b.world], r, out.normal_O ? axes_W : nullptr),
+            static_cast<int64_t>(k) * width * height + static_cast<int64_t>(v) * width + u);
 }
 
 }  // namespace
@@ -160,7 +139,7 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
   const auto plane = [&](BatchPlane p) -> void* {
     return l.has(p) ? base + l.plane_offset(p, count) : nullptr;
   };
-  BatchPlanes out;
+  PixelTruthPlanes out;
   // with rgb the depth is the realtime path's (`more`)
   out.depth = l.outputs().rgb ? nullptr : static_cast<float*>(plane(BatchPlane::kDepth));
   out.geom_id = static_cast<int32_t*>(plane(BatchPlane::kSegmentation));
@@ -171,7 +150,7 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
   const dim3 block(8, 8);
   const dim3 grid((l.width() + 7) / 8, (l.height() + 7) / 8, count);
   CheckBatch(cudaEventRecord(m.started[slot], m.compute), "cudaEventRecord");
-  if (out.depth || out.geom_id || out.body_id || out.semantic || out.range || out.normal_O) {
+  if (out.any()) {
     BatchPrimaryKernel<<<grid, block, 0, m.compute>>>(m.views[slot], m.cameras[slot], l.width(),
                                                       l.height(), out);
     CheckBatch(cudaGetLastError(), "BatchPrimaryKernel launch");

@@ -31,34 +31,14 @@ __global__ void OccludedKernel(SceneView s, const TraceRay* rays, int64_t n, uin
   occ[i] = TraceOccluded(s, rays[i]) ? 1 : 0;
 }
 
-struct DevicePrimary {
-  float* depth;
-  int32_t* geom_id;
-  float* range;
-  float* normal_O;
-  int32_t* body_id;
-  int32_t* semantic;
-};
-
 // one thread per pixel: primary_pixel.h's TracePixelTruth, as the batch kernel.
-__global__ void PrimaryKernel(SceneView s, PinholeCamera c, DevicePrimary out) {
+__global__ void PrimaryKernel(SceneView s, PinholeCamera c, PixelTruthPlanes out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
   if (u >= c.width || v >= c.height) return;
   const F3 axes_W[3] = {c.ex, c.ey, c.ez};
-  const PixelTruth p = TracePixelTruth(s, PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr);
-  const int64_t i = static_cast<int64_t>(v) * c.width + u;
-  if (out.depth) out.depth[i] = p.depth;
-  if (out.geom_id) out.geom_id[i] = p.geom_id;
-  if (out.range) out.range[i] = p.range;
-  if (out.body_id) out.body_id[i] = p.body_id;
-  if (out.semantic) out.semantic[i] = p.semantic;
-  if (out.normal_O) {
-    float* n = out.normal_O + 3 * i;
-    n[0] = p.normal_O.x;
-    n[1] = p.normal_O.y;
-    n[2] = p.normal_O.z;
-  }
+  out.Write(TracePixelTruth(s, PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr),
+            static_cast<int64_t>(v) * c.width + u);
 }
 
 }  // namespace
@@ -177,8 +157,8 @@ void DeviceScene::Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded) {
 
 namespace {
 
-DevicePrimary Reserve(Buffer* out, int64_t pixels, const PrimaryOutputs& want) {
-  DevicePrimary d{};
+PixelTruthPlanes Reserve(Buffer* out, int64_t pixels, const PrimaryOutputs& want) {
+  PixelTruthPlanes d;
   auto take = [&](int k, bool on, size_t bytes) -> void* {
     if (!on) return nullptr;
     out[k].Reserve(bytes);
@@ -199,7 +179,7 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   Impl& m = *impl_;
   const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
   if (pixels <= 0) return;
-  const DevicePrimary d = Reserve(m.out, pixels, want);
+  const PixelTruthPlanes d = Reserve(m.out, pixels, want);
   const dim3 block(8, 8);
   const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
   PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
@@ -232,7 +212,7 @@ double DeviceScene::TimePrimary(const PinholeCamera& c, int count, bool depth_an
     want.body_id = &i;
     want.semantic = &i;
   }
-  const DevicePrimary d = Reserve(m.out, pixels, want);
+  const PixelTruthPlanes d = Reserve(m.out, pixels, want);
   const dim3 block(8, 8);
   const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
   PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);  // warm-up

@@ -30,6 +30,34 @@ struct PixelTruth {
   F3 normal_O{0, 0, 0};
 };
 
+/// where a pixel's ground truth goes (each plane row-major, null = not wanted): depth, range
+/// (float m), geom id, body id, semantic class (int32), normal_O (3 floats).
+struct PixelTruthPlanes {
+  float* depth = nullptr;
+  int32_t* geom_id = nullptr;
+  int32_t* body_id = nullptr;
+  int32_t* semantic = nullptr;
+  float* range = nullptr;
+  float* normal_O = nullptr;
+  /// writes p as pixel i of every plane that is wanted.
+  PB_HOST_DEVICE void Write(const PixelTruth& p, int64_t i) const {
+    if (depth) depth[i] = p.depth;
+    if (geom_id) geom_id[i] = p.geom_id;
+    if (body_id) body_id[i] = p.body_id;
+    if (semantic) semantic[i] = p.semantic;
+    if (range) range[i] = p.range;
+    if (normal_O) {
+      normal_O[3 * i] = p.normal_O.x;
+      normal_O[3 * i + 1] = p.normal_O.y;
+      normal_O[3 * i + 2] = p.normal_O.z;
+    }
+  }
+  /// true if any plane is wanted.
+  PB_HOST_DEVICE bool any() const {
+    return depth || geom_id || body_id || semantic || range || normal_O;
+  }
+};
+
 /// the world ray o + t (x ex + y ey + ez) of normalised image coordinates (x, y) of a camera at
 /// o with axes ex, ey, ez (W) and near plane `near` (m): tmin = near, tmax = infinity; d is not
 /// unit (its z along ez is 1, so t is depth), as Camera::GenerateRay.

@@ -644,36 +644,18 @@ RayScene::RayScene(const SceneDescription& scene) : impl_(std::make_unique<Impl>
   m.static_poses = X_WB_;
 
   // visible geoms, grouped: static bodies (the world body and Body::is_static) together,
-  // every other body on its own.
-  m.groups.resize(1);
+  // every other body on its own (static_geometry.h)
+  const std::vector<RayGeomGroup> groups = GroupRayGeoms(scene, "RayScene");
+  m.groups.resize(groups.size());
   m.groups[0].is_static = true;
-  std::vector<int> group_of_body(num_bodies, -1);
-  for (int gi = 0; gi < static_cast<int>(scene.geoms.size()); ++gi) {
-    const Geom& geom = scene.geoms[gi];
-    if (!IsRayVisible(scene, geom, "RayScene")) continue;
-    ValidateRayGeom(scene, geom, "RayScene");
-    if (geom.body == 0 || scene.bodies[geom.body].is_static) {
-      m.groups[0].geoms.push_back(gi);
-    } else {
-      int& g = group_of_body[geom.body];
-      if (g < 0) {
-        g = static_cast<int>(m.groups.size());
-        m.groups.emplace_back();
-        m.groups.back().body = geom.body;
-      }
-      m.groups[g].geoms.push_back(gi);
-    }
-    ++num_visible_geoms_;
+  for (size_t k = 0; k < groups.size(); ++k) {
+    m.groups[k].body = groups[k].body;
+    m.groups[k].geoms = groups[k].geoms;
+    num_visible_geoms_ += static_cast<int>(groups[k].geoms.size());
   }
 
   // the tendons' capsules: one group of their own, rebuilt by Update
-  for (const Tendon& tendon : scene.tendons) {
-    if (tendon.material < 0 || tendon.material >= static_cast<int>(scene.materials.size()))
-      throw Error("RayScene: tendon '" + tendon.name + "' refers to missing material " +
-                  std::to_string(tendon.material));
-    if (!(tendon.width_m > 0) || !std::isfinite(tendon.width_m))
-      throw Error("RayScene: tendon '" + tendon.name + "' has a non-positive width");
-  }
+  for (const Tendon& tendon : scene.tendons) ValidateRayTendon(scene, tendon, "RayScene");
   if (!scene.tendons.empty()) {
     m.tendon_group = static_cast<int>(m.groups.size());
     m.groups.emplace_back();
