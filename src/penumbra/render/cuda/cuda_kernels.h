@@ -9,6 +9,7 @@
 #include <string>
 
 #include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/cuda/primary_pixel.h"
 
 namespace penumbra::cuda {
 
@@ -36,15 +37,8 @@ struct PinholeCamera {
 
 /// host buffers a primary render fills (null = not wanted), each width x height (x 3 for
 /// normals), row-major: as RenderedFrame's depth_m, geom_id, range_m, normal_O, body_id,
-/// semantic_class.
-struct PrimaryOutputs {
-  float* depth = nullptr;
-  int32_t* geom_id = nullptr;
-  float* range = nullptr;
-  float* normal_O = nullptr;
-  int32_t* body_id = nullptr;
-  int32_t* semantic = nullptr;
-};
+/// semantic_class (primary_pixel.h's planes, here in host memory).
+using PrimaryOutputs = PixelTruthPlanes;
 
 /// the device copy of a BvhScene, its staging buffers and a stream.
 class DeviceScene {
