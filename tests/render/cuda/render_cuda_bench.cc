@@ -139,6 +139,13 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     copy_variants.back().device_exposure = copy_variants.back().upload_changed_only = false;
     copy_variants.push_back(fast);
     copy_variants.back().parallel_copies = false;
+    for (const int kib : {64, 1024}) {
+      copy_variants.push_back(fast);
+      copy_variants.back().copy_chunk_kib = kib;
+    }
+    copy_variants.push_back(fast);
+    copy_variants.back().copy_chunk_kib = 64;
+    copy_variants.back().output_bands = 4;
     double prepare_ms = 0;  // the default's host preparation before the kernels
     for (size_t v = 0; v < copy_variants.size(); ++v) {
       const cuda::RealtimeKernelOptions& o = copy_variants[v];
@@ -164,6 +171,8 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       if (!o.device_exposure) extra += ", host exposure";
       if (!o.upload_changed_only) extra += ", uploads every frame";
       if (!o.parallel_copies) extra += ", host copies on one thread";
+      if (o.copy_chunk_kib != fast.copy_chunk_kib)
+        extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
       fmt::print(
           "| {} | {} | cuda Render(), {} copies{} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} ({:.3f}) | {} |\n",

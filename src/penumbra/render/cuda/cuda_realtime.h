@@ -143,6 +143,8 @@ struct RealtimeKernelOptions {
   /// with pinned copies, the host copies the outputs into the frame's images in chunks over
   /// RealtimeOutputs::parallel (else on the calling thread alone).
   bool parallel_copies = true;
+  /// the size of those chunks, KiB (at least 4).
+  int copy_chunk_kib = 256;
 };
 
 /// the most rows whose sums the device's exposure takes (its block keeps them in shared

@@ -355,10 +355,11 @@ struct HostCopy {
   size_t n;
 };
 
-// the copies, in chunks of 256 KiB, in one loop through `parallel` (serially if it is empty).
-void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel,
-                  const std::vector<HostCopy>& copies) {
-  constexpr size_t kChunk = size_t{256} << 10;
+// the copies, in chunks of `chunk` bytes, in one loop through `parallel` (serially if it is
+// empty).
+void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, const std::vector<HostCopy>& copies,
+                  size_t chunk) {
+  const size_t kChunk = std::max<size_t>(chunk, 4096);
   struct Chunk {
     char* dst;
     const char* src;
@@ -732,6 +733,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // the host's copies of the outputs into the frame's images: over the caller's threads or one
   const RealtimeOutputs::ParallelFn no_threads;
   const RealtimeOutputs::ParallelFn& parallel = o.parallel_copies ? out.parallel : no_threads;
+  const size_t chunk = static_cast<size_t>(std::max(o.copy_chunk_kib, 4)) << 10;
   m.depth.Reserve(sizeof(float) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
@@ -884,7 +886,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // pinned: the depth into the frame's image while the GPU shades
   if (out.depth && o.pinned) {
     Check(cudaEventSynchronize(m.depth_copied), "copying the realtime depth");
-    ParallelCopy(parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}});
+    ParallelCopy(parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}}, chunk);
   }
   // the radiance into the frame's image, band by band as it comes back
   const auto copy_radiance = [&] {
@@ -893,8 +895,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       Check(cudaEventSynchronize(m.radiance_band[k]), "copying the realtime radiance");
       const size_t off = static_cast<size_t>(out_row(k)) * W;
       const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
-      ParallelCopy(parallel, {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
-                               sizeof(Float3) * count}});
+      ParallelCopy(
+          parallel,
+          {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off, sizeof(Float3) * count}},
+          chunk);
     }
   };
   Exposure e;
@@ -920,7 +924,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       Check(cudaStreamSynchronize(stream), "DevelopKernel");
     }
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
-    if (out.rgb) ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}});
+    if (out.rgb)
+      ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
     m.times.outputs = MsSince(tc);
   } else {
     Check(cudaStreamSynchronize(stream), "ShadeKernel");
@@ -936,7 +941,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       copy_radiance();
       Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
       Check(cudaStreamSynchronize(stream), "DevelopKernel");
-      if (out.rgb) ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}});
+      if (out.rgb)
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
       m.times.outputs = MsSince(tc);
     } else {
       if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
