@@ -6,7 +6,8 @@
 // - Render() with the exposure on the device gives the radiance, depth, rgb and EV100 of the
 //   host's exposure round trip (RealtimeKernelOptions::device_exposure off, the path before),
 //   with auto and manual exposure, compensation and white-balance gains, in the default room and
-//   the house at 640x480, and two renders are bit-identical;
+//   the house at 640x480, and two renders are bit-identical; without the radiance asked for
+//   (CudaRenderer::set_radiance_output) the rgb, depth and EV100 are the same;
 // - a renderer that skipped the unchanged uploads and transforms of earlier frames
 //   (upload_changed_only, RealtimeFrameData::PoseWorld) renders a later snapshot, after the
 //   bodies moved, with the bits of a renderer made for that snapshot alone.
@@ -114,6 +115,14 @@ TEST_P(RealtimeExposureRender, DeviceExposureGivesTheHostPathsBits) {
     EXPECT_EQ(again.radiance.data, got.radiance.data) << s;
     EXPECT_EQ(again.depth_m.data, got.depth_m.data) << s;
     EXPECT_EQ(again.ev100, got.ev100) << s;
+    // without the radiance asked for: the same rgb, depth and EV100, no radiance
+    g->set_radiance_output(false);
+    RenderedFrame lean;
+    gpu->Render(snap, view, &lean);
+    EXPECT_TRUE(lean.radiance.empty()) << s;
+    EXPECT_EQ(lean.rgb.data, want.rgb.data) << s;
+    EXPECT_EQ(lean.depth_m.data, want.depth_m.data) << s;
+    EXPECT_EQ(lean.ev100, want.ev100) << s;
   }
 }
 

@@ -22,8 +22,9 @@
 // in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky), with pageable copies, with
 // the radiance in 1 or 4 bands, with the exposure's round trip through the host
 // (device_exposure off) and with the posed geoms and lights uploaded every frame
-// (upload_changed_only off) or the host's copies on one thread (parallel_copies off), and where its
-// time goes (RealtimeStageTimes; the host's preparation before the kernels,
+// (upload_changed_only off), the host's copies on one thread (parallel_copies off) or in other
+// chunks (copy_chunk_kib), and without the radiance (CudaRenderer::set_radiance_output), and where
+// its time goes (RealtimeStageTimes; the host's preparation before the kernels,
 // CudaRenderer::last_prepare_ms), the kernels alone as they run by default and with each speed-up
 // of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with the default's),
 // the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
@@ -146,10 +147,14 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     copy_variants.push_back(fast);
     copy_variants.back().copy_chunk_kib = 64;
     copy_variants.back().output_bands = 4;
+    // last: the default without the radiance (CudaRenderer::set_radiance_output)
+    copy_variants.push_back(fast);
     double prepare_ms = 0;  // the default's host preparation before the kernels
     for (size_t v = 0; v < copy_variants.size(); ++v) {
       const cuda::RealtimeKernelOptions& o = copy_variants[v];
       const bool pinned = o.pinned;
+      const bool no_radiance = v + 1 == copy_variants.size();
+      g->set_radiance_output(!no_radiance);
       rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
@@ -173,6 +178,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       if (!o.parallel_copies) extra += ", host copies on one thread";
       if (o.copy_chunk_kib != fast.copy_chunk_kib)
         extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
+      if (no_radiance) extra += ", no radiance asked for";
       fmt::print(
           "| {} | {} | cuda Render(), {} copies{} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} ({:.3f}) | {} |\n",
@@ -187,6 +193,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
           extra, 1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
           sum.film / frames, sum.outputs / frames, same ? "yes" : "NO");
     }
+    g->set_radiance_output(true);
     fmt::print(
         "| {} | {} | cuda Render(), host preparation before the kernels (default) | | {:.3f} "
         "| | | | | |\n",

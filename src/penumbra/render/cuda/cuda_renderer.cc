@@ -126,10 +126,10 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
-  Shape(&out->radiance, true, W, H, 3);
+  float* radiance = Shape(&out->radiance, radiance_output_, W, H, 3);
   Shape(&out->rgb, true, W, H, 3);
   RealtimeOutputs o;
-  o.radiance = out->radiance.data.data();
+  o.radiance = radiance;
   o.rgb = out->rgb.data.data();
   o.depth = Shape(&out->depth_m, view.outputs[ImageKind::kDepth], W, H, 1);
   o.parallel = [this](int64_t count, const std::function<void(int64_t)>& body) {
