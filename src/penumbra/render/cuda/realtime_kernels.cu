@@ -353,10 +353,11 @@ struct HostCopy {
   void* dst;
   const void* src;
   size_t n;
+  cudaEvent_t ready = nullptr;  // src is complete once this event passed (null: now)
 };
 
 // the copies, in chunks of `chunk` bytes, in one loop through `parallel` (serially if it is
-// empty).
+// empty); a chunk waits for its copy's `ready` event before it is copied.
 void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, const std::vector<HostCopy>& copies,
                   size_t chunk) {
   const size_t kChunk = std::max<size_t>(chunk, 4096);
@@ -364,13 +365,18 @@ void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, const std::vector
     char* dst;
     const char* src;
     size_t n;
+    cudaEvent_t ready;
   };
   std::vector<Chunk> chunks;
   for (const HostCopy& c : copies)
     for (size_t a = 0; a < c.n; a += kChunk)
       chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
-                        std::min(kChunk, c.n - a)});
-  auto copy = [&](int64_t i) { std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n); };
+                        std::min(kChunk, c.n - a), c.ready});
+  // chunks are taken in order: a thread waits for its chunk's source only
+  auto copy = [&](int64_t i) {
+    if (chunks[i].ready) Check(cudaEventSynchronize(chunks[i].ready), "copying a realtime output");
+    std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n);
+  };
   const int64_t count = static_cast<int64_t>(chunks.size());
   if (parallel && count > 1)
     parallel(count, copy);
@@ -467,6 +473,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   cudaEvent_t geometry_done = nullptr;
   cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
   cudaEvent_t depth_copied = nullptr;   // the depth is in its pinned buffer
+  cudaEvent_t rgb_copied = nullptr;     // device_exposure: the rgb is in its pinned buffer
   // band k's geometry is on the host (Render's bands)
   cudaEvent_t band_done[kMaxSkyBands] = {};
   // band k of the radiance is in its pinned buffer (RealtimeKernelOptions::output_bands)
@@ -632,6 +639,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (radiance_done) cudaEventDestroy(radiance_done);
     if (depth_copied) cudaEventDestroy(depth_copied);
+    if (rgb_copied) cudaEventDestroy(rgb_copied);
     for (cudaEvent_t e : radiance_band)
       if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : band_done)
@@ -714,6 +722,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.depth_copied, cudaEventDisableTiming), "cudaEventCreate");
+    Check(cudaEventCreateWithFlags(&m.rgb_copied, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.radiance_band)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
@@ -879,6 +888,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.rows.Download(host_rows, sizeof(double) * H, stream);
     m.device_exposure.Download(m.pin_exposure.p, sizeof(DeviceExposure), stream);
     if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+    Check(cudaEventRecord(m.rgb_copied, stream), "cudaEventRecord");
   } else {
     m.rows.Download(host_rows, sizeof(double) * H, stream);
     if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
@@ -906,10 +916,21 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.times.outputs = 0;
   Clock::time_point t3 = t0;  // the row sums on the host
   if (device_exposure) {
-    // the radiance while the row sums, exposure and film run, then the host's exposure from the
-    // same row sums: where the device's differs, the film again with the host's
+    // the radiance bands and the rgb in one loop over the host's threads, each chunk as soon as
+    // its band or the rgb is back (the radiance while the row sums, exposure and film run);
+    // then the host's exposure from the same row sums: where the device's differs, the film
+    // again with the host's, and its rgb copied over the device exposure's
     const auto tc = Clock::now();
-    copy_radiance();
+    std::vector<HostCopy> copies;
+    if (out.radiance)
+      for (int k = 0; k < out_bands; ++k) {
+        const size_t off = static_cast<size_t>(out_row(k)) * W;
+        const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+        copies.push_back({out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
+                          sizeof(Float3) * count, m.radiance_band[k]});
+      }
+    if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n), m.rgb_copied});
+    ParallelCopy(parallel, copies, chunk);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
     t3 = Clock::now();
     m.host_rows.assign(host_rows, host_rows + H);
@@ -922,10 +943,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       m.LaunchFilm(n, e, filmic, stream);
       if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
       Check(cudaStreamSynchronize(stream), "DevelopKernel");
+      if (out.rgb)
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
     }
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
-    if (out.rgb)
-      ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
     m.times.outputs = MsSince(tc);
   } else {
     Check(cudaStreamSynchronize(stream), "ShadeKernel");
