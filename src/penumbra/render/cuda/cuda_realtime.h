@@ -167,10 +167,12 @@ struct RealtimeStageTimes {
   /// bands' geometry, sky terms up, those kernels, row sums back
   double shade = 0;
   /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
-  /// host's launch and wait overheads)
+  /// host's launch and wait overheads; with device_exposure the shade stage ends at the row
+  /// sums, and this is the rest)
   double film = 0;
   /// of film: the host's copies of the radiance and rgb into the frame's images (pinned), from
-  /// the copy stream's end to the last copy (the depth is copied while the GPU shades)
+  /// the copy stream's end to the last copy (the depth is copied while the GPU shades); with
+  /// device_exposure from the end of the launches, so it includes waiting for the kernels
   double outputs = 0;
   double total = 0;
 };
