@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace penumbra {
 namespace {
@@ -28,6 +29,41 @@ TEST(FilmTest, ExposureFromEv100) {
   EXPECT_DOUBLE_EQ(ExposureFromEv100(0), 1.0 / 1.2);
   EXPECT_DOUBLE_EQ(ExposureFromEv100(1), 0.5 / 1.2);
   EXPECT_DOUBLE_EQ(ExposureFromEv100(-2), 4.0 / 1.2);
+}
+
+// film_math.h's FrameExposure (the CUDA backend's auto exposure, on the host and in its
+// exposure kernel) gives the bits of the formula written out: the rows added in row order, the
+// exp of their mean, log2 against the key (Film::Ev100FromLogAverage), the float exposure times
+// each gain; for auto and manual exposure, with and without compensation.
+TEST(FilmTest, FrameExposureIsTheFilmsEv100BitForBit) {
+  const int W = 640, H = 480;
+  const int64_t pixels = static_cast<int64_t>(W) * H;
+  std::vector<double> rows(H);
+  for (int v = 0; v < H; ++v)
+    rows[v] = W * (-2.5 + 3.0 * std::sin(0.37 * v) + 0.001 * v);  // ln L of W pixels
+  const float gains[3] = {1.25f, 1.0f, 0.8125f};
+  for (int k = 0; k < 4; ++k) {
+    RenderSettings s;
+    s.auto_exposure = k < 3;
+    s.exposure_compensation_ev = k == 1 ? 1.3 : k == 3 ? -0.7 : 0;
+    s.ev100 = 7.25;
+    if (k == 2) rows.assign(H, std::log(kMinLuminance) * W);  // a black frame
+    const Film film(s);
+    double total = 0;
+    for (double r : rows) total += r;
+    const double log_average = std::exp(total / static_cast<double>(pixels));
+    const double want_ev = (s.auto_exposure ? std::log2(log_average / (0.18 * 1.2)) : s.ev100) -
+                           s.exposure_compensation_ev;
+    const float e = static_cast<float>(1.0 / (1.2 * std::exp2(want_ev)));
+    float got[3];
+    const double ev =
+        FrameExposure(film.exposure_pod(), rows.data(), H, pixels, kMinLuminance, gains, got);
+    EXPECT_EQ(ev, want_ev) << k;
+    EXPECT_EQ(film.Ev100FromLogAverage(log_average), want_ev) << k;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(got[c], e * gains[c]) << k << " " << c;
+  }
+  // no pixels: the minimum luminance
+  EXPECT_EQ(LogAverageFromRowSums(rows.data(), 0, 0, kMinLuminance), kMinLuminance);
 }
 
 TEST(FilmTest, SrgbOetfMatchesTheStandard) {

@@ -90,9 +90,8 @@ double Film::LogAverageLuminance(const ImageF& radiance, ThreadPool* pool) const
   const int w = radiance.width, h = radiance.height;
   std::vector<double> row_sum(h, 0.0);
   ParallelForOrSerial(pool, h, [&](int v) { row_sum[v] = SumLog(radiance.at(0, v), w); });
-  double total = 0;
-  for (double s : row_sum) total += s;  // fixed order: independent of the thread count
-  return std::exp(total / (static_cast<double>(w) * h));
+  // row order: independent of the thread count
+  return LogAverageFromRowSums(row_sum.data(), h, static_cast<int64_t>(w) * h, kMinLuminance);
 }
 
 double Film::Ev100(const ImageF& radiance, ThreadPool* pool) const {
@@ -101,9 +100,15 @@ double Film::Ev100(const ImageF& radiance, ThreadPool* pool) const {
 }
 
 double Film::Ev100FromLogAverage(double log_average) const {
-  const double base =
-      settings_.auto_exposure ? std::log2(log_average / (0.18 * 1.2)) : settings_.ev100;
-  return base - settings_.exposure_compensation_ev;
+  return FilmEv100(exposure_pod(), log_average);
+}
+
+FilmExposurePod Film::exposure_pod() const {
+  FilmExposurePod p;
+  p.auto_exposure = settings_.auto_exposure ? 1 : 0;
+  p.ev100 = settings_.ev100;
+  p.compensation_ev = settings_.exposure_compensation_ev;
+  return p;
 }
 
 void Film::Develop(const ImageF& radiance, double ev100, ThreadPool* pool, ImageU8* rgb,

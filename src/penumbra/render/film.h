@@ -37,9 +37,7 @@
 
 namespace penumbra {
 
-/// pixels darker than this (cd/m^2) count as this in the log-average (keeps black pixels from
-/// driving the exposure to infinity).
-constexpr double kMinLuminance = 1e-4;
+// kMinLuminance: render/film_math.h.
 
 // ExposureFromEv100, AcesFilmic, HuePreservingFilmic and SrgbOetf: render/film_math.h (shared
 // with the CUDA backend).
@@ -60,6 +58,9 @@ class Film {
   /// the EV100 used for an image whose log-average luminance is `log_average` (cd/m^2): as
   /// Ev100, for a log-average computed elsewhere (the CUDA backend's).
   double Ev100FromLogAverage(double log_average) const;
+  /// the exposure settings (auto or manual EV100, compensation) as plain data: film_math.h's
+  /// FilmEv100 of them is Ev100FromLogAverage.
+  FilmExposurePod exposure_pod() const;
 
   /// the sRGB encoding table (kFilmLutSize 8-bit codes of i / (kFilmLutSize - 1)).
   const std::vector<uint8_t>& oetf_lut() const { return oetf_lut_; }

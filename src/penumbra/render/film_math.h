@@ -67,10 +67,55 @@ PB_HOST_DEVICE inline void DevelopPixelIndices(const float rgb[3], const float e
   }
 }
 
+/// pixels darker than this (cd/m^2) count as this in the log-average (keeps black pixels from
+/// driving the exposure to infinity).
+constexpr double kMinLuminance = 1e-4;
+
 /// ln(max(L, min_luminance)) of a pixel's Rec. 709 luminance L (the log-average's term).
 PB_HOST_DEVICE inline double LogLuminanceTerm(const float rgb[3], double min_luminance) {
   const double L = static_cast<double>(pbm::Luminance709(rgb[0], rgb[1], rgb[2]));
   return log(L < min_luminance ? min_luminance : L);
+}
+
+/// the exposure settings of a film (RenderSettings: auto_exposure, ev100,
+/// exposure_compensation_ev) as plain data, for FilmEv100 on either processor.
+struct FilmExposurePod {
+  int32_t auto_exposure = 1;   ///< 1: from the image's log-average luminance; 0: manual
+  double ev100 = 10;           ///< the manual EV100
+  double compensation_ev = 0;  ///< stops subtracted from the (auto or manual) EV100
+};
+
+/// the log-average luminance exp(total / pixels) of an image of `pixels` pixels whose
+/// `count` rows' log-luminance sums (LogLuminanceTerm over each row) are rows[0 .. count),
+/// added in row order (so the result does not depend on how the rows were summed in
+/// parallel); `min_luminance` when pixels <= 0.
+PB_HOST_DEVICE inline double LogAverageFromRowSums(const double* rows, int count, int64_t pixels,
+                                                   double min_luminance) {
+  double total = 0;
+  for (int v = 0; v < count; ++v) total += rows[v];
+  return pixels > 0 ? exp(total / static_cast<double>(pixels)) : min_luminance;
+}
+
+/// the EV100 of an image whose log-average luminance is `log_average` (cd/m^2; render/film.h):
+/// auto, log2(L_avg / (0.18 x 1.2)) (the key 0.18, Reinhard et al. 2002), else the manual
+/// EV100; minus the compensation.
+PB_HOST_DEVICE inline double FilmEv100(const FilmExposurePod& film, double log_average) {
+  const double base = film.auto_exposure != 0 ? log2(log_average / (0.18 * 1.2)) : film.ev100;
+  return base - film.compensation_ev;
+}
+
+/// a frame's EV100 from its rows' log-luminance sums (LogAverageFromRowSums, FilmEv100), and
+/// the per-channel exposures of DevelopPixelIndices: float(ExposureFromEv100) times each
+/// white-balance gain (as Film::Develop). the CUDA backend's auto exposure, on the host and
+/// on the device (the device's exp, log2 and exp2 in double need not round as the host's C
+/// library does; its caller checks the device's result against the host's).
+PB_HOST_DEVICE inline double FrameExposure(const FilmExposurePod& film, const double* rows,
+                                           int count, int64_t pixels, double min_luminance,
+                                           const float white_balance_gains[3], float exposure[3]) {
+  const double ev100 = FilmEv100(film, LogAverageFromRowSums(rows, count, pixels, min_luminance));
+  const float e = static_cast<float>(ExposureFromEv100(ev100));
+  for (int c = 0; c < 3; ++c) exposure[c] = e * white_balance_gains[c];
+  return ev100;
 }
 
 }  // namespace penumbra

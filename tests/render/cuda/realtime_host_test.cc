@@ -230,6 +230,46 @@ TEST(RealtimeHostPathFrames, PoseWorldThenSetCameraIsPrepare) {
   }
 }
 
+// PoseWorld poses again only the geoms of bodies that moved since its last call: frames
+// prepared one after the other hold the geoms, lights and rendered bits of data prepared for
+// the last snapshot alone; a body moved by hand (every geom of the world's last moving body)
+// is followed too.
+TEST(RealtimeHostPathFrames, PoseWorldFollowsMovedBodiesOnly) {
+  for (const char* world : {"default.yaml", "house.yaml"}) {
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(world);
+    const SceneDescription& scene = session->scene();
+    const WorldSnapshot first = session->sim().Snapshot();
+    while (session->sim().time() < 1.5) session->sim().Step();
+    WorldSnapshot later = session->sim().Snapshot();
+    // one more body moved by hand: the last geom's body (not the world's)
+    const int b = scene.geoms.back().body;
+    if (b > 0) later.X_WB[b].translation().x() += 0.05;
+    const CameraView view = realtime_parity::RgbDepthView(scene, later, 64, 48);
+    ThreadPool pool(0);
+    cuda::RealtimeFrameData reused(scene, RenderSettings());
+    reused.Prepare(first, view, &pool);
+    reused.Prepare(first, view, &pool);
+    reused.Prepare(later, view, &pool);
+    cuda::RealtimeFrameData fresh(scene, RenderSettings());
+    fresh.Prepare(later, view, &pool);
+    ASSERT_EQ(reused.geoms().size(), fresh.geoms().size());
+    EXPECT_EQ(0, std::memcmp(reused.geoms().data(), fresh.geoms().data(),
+                             sizeof(fresh.geoms()[0]) * fresh.geoms().size()))
+        << world;
+    ASSERT_EQ(reused.lights().size(), fresh.lights().size());
+    EXPECT_EQ(0, std::memcmp(reused.lights().data(), fresh.lights().data(),
+                             sizeof(fresh.lights()[0]) * fresh.lights().size()))
+        << world;
+    cuda::BvhScene bvh(scene);
+    bvh.Update(later);
+    RenderedFrame a, c;
+    cuda::RenderRealtimeOnHost(reused, bvh, &pool, &a, /*stored_surface=*/true);
+    cuda::RenderRealtimeOnHost(fresh, bvh, &pool, &c, /*stored_surface=*/true);
+    EXPECT_EQ(a.rgb.data, c.rgb.data) << world;
+    EXPECT_EQ(a.radiance.data, c.radiance.data) << world;
+  }
+}
+
 // the GPU's Render() asks for the sky terms band by band (rows [r0, r1)): every pixel's bits are
 // those of the whole frame's pass, primary and mirrored; odd bounds before the last row are
 // refused (a 2x2 quad would be split).

@@ -19,10 +19,16 @@
 // pinned and pageable.
 // --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
 // Render() with the sky terms on the device (default), on the host (the geometry's round trip
-// in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky) and with pageable copies, and
-// where its time goes (RealtimeStageTimes), the kernels alone as they run by default and with
-// each speed-up of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with
-// the default's), and the CPU backend.
+// in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky), with pageable copies, with
+// the radiance in 1 or 4 bands, with the exposure's round trip through the host
+// (device_exposure off) and with the posed geoms and lights uploaded every frame
+// (upload_changed_only off), the host's copies on one thread (parallel_copies off) or in other
+// chunks (copy_chunk_kib), and without the radiance (CudaRenderer::set_radiance_output), and where
+// its time goes (RealtimeStageTimes; the host's preparation before the kernels,
+// CudaRenderer::last_prepare_ms), the kernels alone as they run by default and with each speed-up
+// of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with the default's),
+// the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
+// the device's exposure differed from the host's (RealtimeExposureChecks).
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh). usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
@@ -124,22 +130,56 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       copy_variants.push_back(fast);
       copy_variants.back().output_bands = bands;
     }
-    for (const cuda::RealtimeKernelOptions& o : copy_variants) {
+    // the exposure's round trip through the host, the posed geoms and lights uploaded every
+    // frame, both (as before branch gpu7)
+    copy_variants.push_back(fast);
+    copy_variants.back().device_exposure = false;
+    copy_variants.push_back(fast);
+    copy_variants.back().upload_changed_only = false;
+    copy_variants.push_back(fast);
+    copy_variants.back().device_exposure = copy_variants.back().upload_changed_only = false;
+    copy_variants.push_back(fast);
+    copy_variants.back().parallel_copies = false;
+    for (const int kib : {64, 1024}) {
+      copy_variants.push_back(fast);
+      copy_variants.back().copy_chunk_kib = kib;
+    }
+    copy_variants.push_back(fast);
+    copy_variants.back().copy_chunk_kib = 64;
+    copy_variants.back().output_bands = 4;
+    // last: the default without the radiance (CudaRenderer::set_radiance_output)
+    copy_variants.push_back(fast);
+    double prepare_ms = 0;  // the default's host preparation before the kernels
+    for (size_t v = 0; v < copy_variants.size(); ++v) {
+      const cuda::RealtimeKernelOptions& o = copy_variants[v];
       const bool pinned = o.pinned;
+      const bool no_radiance = v + 1 == copy_variants.size();
+      g->set_radiance_output(!no_radiance);
       rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
       cuda::RealtimeStageTimes sum;
+      double prepare = 0;
       const auto t0 = Clock::now();
       for (int i = 0; i < frames; ++i) {
         gpu->Render(snap, view, &f);
         const cuda::RealtimeStageTimes& t = rt.last_stage_times();
         sum.geometry += t.geometry, sum.sky += t.sky, sum.shade += t.shade, sum.film += t.film;
         sum.outputs += t.outputs;
+        prepare += g->last_prepare_ms();
       }
       const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
+      const bool same = f.rgb.data == want.rgb.data;
+      if (v == 0) prepare_ms = prepare / frames;
+      std::string extra;
+      if (!o.device_exposure) extra += ", host exposure";
+      if (!o.upload_changed_only) extra += ", uploads every frame";
+      if (!o.parallel_copies) extra += ", host copies on one thread";
+      if (o.copy_chunk_kib != fast.copy_chunk_kib)
+        extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
+      if (no_radiance) extra += ", no radiance asked for";
       fmt::print(
-          "| {} | {} | cuda Render(), {} copies | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
+          "| {} | {} | cuda Render(), {} copies{} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} ({:.3f}) | {} |\n",
           name, size,
           fmt::format(
@@ -149,9 +189,14 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
                                           o.output_bands == 1 ? "" : "s")
                             : std::string("device sky"))
                   : fmt::format("host sky in {} band{}", o.sky_bands, o.sky_bands == 1 ? "" : "s")),
-          1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
-          sum.film / frames, sum.outputs / frames, f.rgb.data == want.rgb.data ? "yes" : "NO");
+          extra, 1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
+          sum.film / frames, sum.outputs / frames, same ? "yes" : "NO");
     }
+    g->set_radiance_output(true);
+    fmt::print(
+        "| {} | {} | cuda Render(), host preparation before the kernels (default) | | {:.3f} "
+        "| | | | | |\n",
+        name, size, prepare_ms);
     rt.set_options(fast);
     // the kernels alone: the default, each speed-up off, all off
     struct Variant {
@@ -211,6 +256,13 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     };
     fmt::print("| {} | {} | cuda, FNV-1a of rgb / depth | {:016x} / {:016x} | | | | | | |\n", name,
                size, Fnv1a64(bytes(want.rgb.data)), Fnv1a64(bytes(want.depth_m.data)));
+    fmt::print("| {} | {} | cuda, FNV-1a of radiance, EV100 | {:016x}, {:.17g} | | | | | | |\n",
+               name, size, Fnv1a64(bytes(want.radiance.data)), want.ev100);
+    const cuda::RealtimeExposureChecks& x = rt.exposure_checks();
+    fmt::print(
+        "| {} | {} | cuda, device exposures: frames, EV100 differs, developed again | {}, "
+        "{}, {} | | | | | | |\n",
+        name, size, x.frames, x.ev100_differs, x.redeveloped);
   }
   return 0;
 }

@@ -4,7 +4,10 @@
 #include <cuda_runtime.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shape_math.h"
@@ -72,6 +75,8 @@ struct DeviceScene::Impl {
   int64_t camera_xy_version = -1;
   int64_t geometry_version = -1;
   SceneView view;
+  // the bytes of the instances the device holds (Sync uploads them only when they change)
+  std::vector<uint8_t> uploaded_instances;
 };
 
 DeviceScene::DeviceScene() : impl_(new Impl) {
@@ -115,7 +120,16 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
     m.records.Upload(v.records, n.records * sizeof(Record), m.stream);
     m.geometry_version = geometry_version;
   }
-  m.instances.Upload(v.instances, v.num_instances * sizeof(Instance), m.stream);
+  // the instances' transforms: only when their bytes changed (a frame of static bodies
+  // uploads nothing)
+  const size_t instance_bytes = static_cast<size_t>(v.num_instances) * sizeof(Instance);
+  const auto* instances = reinterpret_cast<const uint8_t*>(v.instances);
+  if (m.instances.p == nullptr || m.uploaded_instances.size() != instance_bytes ||
+      (instance_bytes > 0 &&
+       std::memcmp(m.uploaded_instances.data(), instances, instance_bytes) != 0)) {
+    m.instances.Upload(v.instances, instance_bytes, m.stream);
+    m.uploaded_instances.assign(instances, instances + instance_bytes);
+  }
   m.view.nodes = static_cast<const BvhWideNode*>(m.nodes.p);
   m.view.prims = static_cast<const PrimRef*>(m.prims.p);
   m.view.triangles = static_cast<const Triangle*>(m.triangles.p);

@@ -17,8 +17,13 @@
 // k - 1's sky terms, and band k's shading kernel runs while the host computes band k + 1's);
 // (3) the shading kernel (ShadeRealtimeStored, or ShadeRealtimePixel), the shared visibility's
 // kernels (a warp's penumbra rays spread over its lanes) and
-// the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which the
-// host (`exposure`) turns into the frame's EV100 and exposures; (5) the film kernel (DevelopPixel).
+// the mirror layer's (ShadeMirrorHit, ApplyMirrorLayer); (4) per-row log-luminance sums, which
+// one thread block turns into the frame's EV100 and exposures (film_math.h's FrameExposure, the
+// rows added in row order: RealtimeKernelOptions::device_exposure; else the host, `exposure`,
+// between the row sums and the film kernel); (5) the film kernel (DevelopPixel). the host
+// computes the exposure from the same row sums too and, in the rare frame where the device's
+// double exp, log2 and exp2 gave other float exposures than its C library, develops the frame
+// again with its own: the rgb and EV100 are always the host path's bits.
 // every sum runs in a fixed order and no atomics touch an output: frames are bit-identical run to
 // run on one GPU.
 
@@ -28,6 +33,7 @@
 
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/film_math.h"
 
 namespace penumbra::cuda {
 
@@ -40,6 +46,22 @@ struct RealtimeOutputs {
   float* depth = nullptr;
   /// copies the pinned outputs into these buffers in chunks through it (empty: one thread).
   ParallelFn parallel;
+};
+
+/// the film of a frame of DeviceRealtime::Render: its tone map and what its exposure is made
+/// of (film_math.h's FrameExposure).
+struct RealtimeFilm {
+  bool filmic = true;        ///< the hue-preserving filmic map (else a clamp)
+  FilmExposurePod exposure;  ///< auto or manual EV100 and compensation (Film::exposure_pod)
+  float white_balance_gains[3] = {1, 1, 1};  ///< the view's (CameraView::white_balance_gains)
+};
+
+/// how Render's exposures on the device compared with the host's, over the frames so far
+/// (RealtimeKernelOptions::device_exposure).
+struct RealtimeExposureChecks {
+  int64_t frames = 0;         ///< frames whose exposure the device computed
+  int64_t ev100_differs = 0;  ///< of them, frames whose device EV100 differed in some bit
+  int64_t redeveloped = 0;    ///< of them, frames developed again with the host's exposures
 };
 
 /// the scene-constant data of the realtime path (host arrays, copied once by Upload).
@@ -108,7 +130,26 @@ struct RealtimeKernelOptions {
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;
+  /// with pinned copies and at most kMaxDeviceExposureRows rows: the exposure is computed on
+  /// the device after the row sums (one block, FrameExposure) and the film kernel reads it there,
+  /// so Render synchronises once, at the end (the host checks the device's exposures against
+  /// its own, Render's `exposure`, and develops again in the rare frame where they differ);
+  /// else the row sums go to the host, which computes the exposure and then launches the film
+  /// kernel.
+  bool device_exposure = true;
+  /// Render uploads the posed geoms and lights only when their bytes differ from the last
+  /// upload's (else every frame).
+  bool upload_changed_only = true;
+  /// with pinned copies, the host copies the outputs into the frame's images in chunks over
+  /// RealtimeOutputs::parallel (else on the calling thread alone).
+  bool parallel_copies = true;
+  /// the size of those chunks, KiB (at least 4).
+  int copy_chunk_kib = 256;
 };
+
+/// the most rows whose sums the device's exposure takes (its block keeps them in shared
+/// memory); taller frames take the host's.
+constexpr int kMaxDeviceExposureRows = 6144;
 
 /// the time of Render()'s stages, milliseconds (benchmarks). geometry + sky + shade + film =
 /// total. with device_sky the first three are CUDA-event times on the GPU's stream (no
@@ -126,10 +167,12 @@ struct RealtimeStageTimes {
   /// bands' geometry, sky terms up, those kernels, row sums back
   double shade = 0;
   /// exposure, film kernel, the outputs copied to the frame's images (device_sky: and the
-  /// host's launch and wait overheads)
+  /// host's launch and wait overheads; with device_exposure the shade stage ends at the row
+  /// sums, and this is the rest)
   double film = 0;
   /// of film: the host's copies of the radiance and rgb into the frame's images (pinned), from
-  /// the copy stream's end to the last copy (the depth is copied while the GPU shades)
+  /// the copy stream's end to the last copy (the depth is copied while the GPU shades); with
+  /// device_exposure from the end of the launches, so it includes waiting for the kernels
   double outputs = 0;
   double total = 0;
 };
@@ -158,6 +201,13 @@ struct RealtimeBatchTimes {
   double film = 0;  ///< the film kernel (DevelopPixel)
   double total = 0;
 };
+
+/// film_math.h's FrameExposure of `rows` (row-major sums of a frame of `pixels` pixels, at
+/// most kMaxDeviceExposureRows) computed on the device as Render's device_exposure does it
+/// (tests: the device's EV100 and exposures against the host's).
+/// @throws Error for too many rows, or if the CUDA runtime fails.
+double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double>& rows,
+                           int64_t pixels, const float white_balance_gains[3], float exposure[3]);
 
 /// the realtime tier over a batch of cameras of the same size (cuda_batch_renderer.h): each
 /// stage of Render's default path (device sky terms, stored surfaces, warp-shared penumbra rays,
@@ -226,9 +276,11 @@ class DeviceRealtime {
 
   /// renders one frame of `frame` (host pointers for its geoms and lights; the scene arrays,
   /// materials and textures are replaced by the device copies of `scene` and Upload) with
-  /// `num_geoms` geoms; returns the EV100. `filmic`: the film's tone map.
-  double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms, bool filmic,
-                const SkyFn& sky, const ExposureFn& exposure, const RealtimeOutputs& out);
+  /// `num_geoms` geoms; returns the EV100 (`exposure`'s, the host's). `film`: the tone map, and
+  /// the exposure's settings for the device (which must make what `exposure` makes).
+  double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms,
+                const RealtimeFilm& film, const SkyFn& sky, const ExposureFn& exposure,
+                const RealtimeOutputs& out);
 
   /// `count` runs of the frame's device work as Render left it (geometry, shading, row sums
   /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with
@@ -251,6 +303,8 @@ class DeviceRealtime {
   const RealtimeKernelOptions& options() const;
   /// the stages of the last Render.
   const RealtimeStageTimes& last_stage_times() const;
+  /// the device's exposures against the host's over the Renders so far.
+  const RealtimeExposureChecks& exposure_checks() const;
 
  private:
   struct Impl;

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -68,6 +69,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
     cpu_->Render(snapshot, effects, view, out);
     return;
   }
+  const auto t0 = std::chrono::steady_clock::now();
   CheckRenderInputs(scene_.bodies.size(), snapshot, view);
   bvh_->Update(snapshot);
   // the frame's kernels run on the device scene's stream, after the copies: no wait here
@@ -84,7 +86,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const int W = c.width, H = c.height;
   out->ev100 = 0;
   if (want[ImageKind::kRgb]) {
-    RenderRgb(snapshot, view, c, out);
+    RenderRgb(snapshot, view, c, t0, out);
   } else {
     out->radiance = ImageF();
     out->rgb = ImageU8();
@@ -106,7 +108,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
 }
 
 void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& view,
-                             const PinholeCamera& camera, RenderedFrame* out) {
+                             const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
+                             RenderedFrame* out) {
   if (!realtime_uploaded_) {
     RealtimeStatic st;
     st.materials = realtime_->materials().data();
@@ -131,10 +134,10 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
-  Shape(&out->radiance, true, W, H, 3);
+  float* radiance = Shape(&out->radiance, radiance_output_, W, H, 3);
   Shape(&out->rgb, true, W, H, 3);
   RealtimeOutputs o;
-  o.radiance = out->radiance.data.data();
+  o.radiance = radiance;
   o.rgb = out->rgb.data.data();
   o.depth = Shape(&out->depth_m, view.outputs[ImageKind::kDepth], W, H, 1);
   o.parallel = [this](int64_t count, const std::function<void(int64_t)>& body) {
@@ -144,9 +147,15 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
   // the camera's ray tables: the device copies, not Prepare's host arrays
   frame.camera.xy = camera.xy;
   frame.camera.rows = camera.rows;
+  // the film's tone map and exposure (the device's, checked against the host's Ev100 below)
+  RealtimeFilm film;
+  film.filmic = realtime_->film().filmic();
+  film.exposure = realtime_->film().exposure_pod();
+  for (int k = 0; k < 3; ++k) film.white_balance_gains[k] = view.white_balance_gains[k];
+  prepare_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   out->ev100 = device_realtime_->Render(
-      device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()),
-      realtime_->film().filmic(),
+      device_.get(), frame, static_cast<int64_t>(realtime_->geoms().size()), film,
       [&](const PixelGeometry* g, const PixelGeometry* mirror, int64_t count, int row0, int row1,
           Float3* sky, Float3* mirror_sky) {
         realtime_->FrameSkyTerms(g, mirror, count, sky, mirror_sky, pool_.get(), row0, row1);

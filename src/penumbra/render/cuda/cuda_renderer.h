@@ -9,6 +9,7 @@
 // so every output exists and equals the CPU backend's for those frames; docs/gpu.md lists what
 // is where.
 
+#include <chrono>
 #include <memory>
 #include <string>
 
@@ -54,15 +55,26 @@ class CudaRenderer final : public Renderer {
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
 
+  /// whether Render fills RenderedFrame::radiance beside the rgb (default true); off, a
+  /// consumer that reads only the rgb and depth saves its copy back (3.7 MB at 640x480) and
+  /// the radiance is left empty.
+  void set_radiance_output(bool on) { radiance_output_ = on; }
+  bool radiance_output() const { return radiance_output_; }
+
+  /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
+  /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
+  /// upload (benchmarks).
+  double last_prepare_ms() const { return prepare_ms_; }
+
   /// the GPU's pinhole form of `view` (without the ray tables a camera with lens distortion or
   /// motion needs: Render adds them, camera_rays.h).
   static PinholeCamera PinholeOf(const CameraView& view);
 
  private:
   // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h); `camera`: the
-  // view's camera with its ray tables on the device.
+  // view's camera with its ray tables on the device; t0: when Render began (last_prepare_ms).
   void RenderRgb(const WorldSnapshot& snapshot, const CameraView& view, const PinholeCamera& camera,
-                 RenderedFrame* out);
+                 std::chrono::steady_clock::time_point t0, RenderedFrame* out);
 
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
@@ -77,6 +89,8 @@ class CudaRenderer final : public Renderer {
   // the sky volume generation whose arrays the device holds (RealtimeFrameData::sky_generation)
   bool sky_uploaded_ = false;
   uint64_t sky_generation_ = 0;
+  double prepare_ms_ = 0;
+  bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;
   int64_t cpu_frames_ = 0;
   bool told_cpu_ = false;

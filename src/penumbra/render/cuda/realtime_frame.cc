@@ -137,8 +137,16 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
 
 void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool) {
   lights_.Update(snapshot, nullptr);
+  // only the geoms of bodies that moved since the last call (the others keep their bits)
+  const size_t bodies = snapshot.X_WB.size();
+  const bool all = posed_X_WB_.size() != bodies;
+  body_moved_.assign(bodies, 1);
+  for (size_t b = 0; !all && b < bodies; ++b)
+    body_moved_[b] = snapshot.X_WB[b].matrix() != posed_X_WB_[b].matrix() ? 1 : 0;
+  posed_X_WB_ = snapshot.X_WB;
   for (size_t g = 0; g < scene_.geoms.size(); ++g) {
     const Geom& geom = scene_.geoms[g];
+    if (body_moved_[geom.body] == 0) continue;
     const Pose X_GW = (snapshot.X_WB[geom.body] * geom.X_BG).inverse();
     float* m = geoms_[g].X_GW;
     for (int r = 0; r < 3; ++r) {
@@ -257,14 +265,10 @@ double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pix
 double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
                                 const Eigen::Vector3f& white_balance_gains,
                                 float exposure[3]) const {
-  double total = 0;
-  for (double s : row_sums) total += s;  // row order: independent of the launch
-  const double log_average = pixels > 0 ? std::exp(total / static_cast<double>(pixels))
-                                        : static_cast<double>(kMinLuminance);
-  const double ev100 = film_.Ev100FromLogAverage(log_average);
-  const float e = static_cast<float>(ExposureFromEv100(ev100));
-  for (int c = 0; c < 3; ++c) exposure[c] = e * white_balance_gains[c];
-  return ev100;
+  // the rows in row order: independent of the launch (film_math.h, shared with the device)
+  const float gains[3] = {white_balance_gains[0], white_balance_gains[1], white_balance_gains[2]};
+  return FrameExposure(film_.exposure_pod(), row_sums.data(), static_cast<int>(row_sums.size()),
+                       pixels, kMinLuminance, gains, exposure);
 }
 
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,

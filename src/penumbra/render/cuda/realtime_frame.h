@@ -47,7 +47,8 @@ class RealtimeFrameData {
   /// then SetCamera. a camera with lens distortion or motion gets its ray tables
   /// (camera_rays.h), the camera() pointing to their host arrays.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
-  /// the camera-independent part of Prepare: the lights, the geoms and the sky volume.
+  /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
+  /// again only for bodies whose pose changed since the last call) and the sky volume.
   void PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool);
   /// the camera part of Prepare: the pinhole camera, its pixel spread (radians), the frame's
   /// random-number key (FrameContext::FrameKey of the settings' seed, camera_index and
@@ -137,6 +138,10 @@ class RealtimeFrameData {
   float spread_rad_ = 0;
   uint64_t frame_key_ = 0;
   bool any_mirror_ = false;
+  // the body poses of the last PoseWorld (geoms_' transforms are theirs) and, per body, whether
+  // it moved since (PoseWorld poses only those bodies' geoms)
+  std::vector<Pose> posed_X_WB_;
+  std::vector<uint8_t> body_moved_;
 };
 
 /// the pinhole camera of `view` as the kernels take it (view must be a projective camera).

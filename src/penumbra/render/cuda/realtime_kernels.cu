@@ -265,11 +265,48 @@ struct Exposure {
   float e[3];
 };
 
+// the device's exposure of a frame (ExposureKernel): the per-channel exposures and the EV100.
+struct DeviceExposure {
+  float e[3];
+  double ev100;
+};
+
+// film_math.h's FrameExposure of a frame's `height` row sums (height <= kMaxDeviceExposureRows)
+// by one block: its threads bring the rows into shared memory, one thread adds them in row order.
+__global__ void ExposureKernel(const double* rows, int height, int64_t pixels, FilmExposurePod film,
+                               Exposure gains, DeviceExposure* out) {
+  extern __shared__ double shared_rows[];
+  for (int v = threadIdx.x; v < height; v += blockDim.x) shared_rows[v] = rows[v];
+  __syncthreads();
+  if (threadIdx.x != 0) return;
+  DeviceExposure d;
+  d.ev100 = FrameExposure(film, shared_rows, height, pixels, kMinLuminance, gains.e, d.e);
+  *out = d;
+}
+
+// ExposureKernel on `stream`: the exposure of the `height` row sums at `rows` into `out`.
+void LaunchExposure(const double* rows, int height, int64_t pixels, const FilmExposurePod& film,
+                    const float gains[3], DeviceExposure* out, cudaStream_t stream) {
+  const Exposure g{{gains[0], gains[1], gains[2]}};
+  ExposureKernel<<<1, 256, sizeof(double) * height, stream>>>(rows, height, pixels, film, g, out);
+  Check(cudaGetLastError(), "ExposureKernel");
+}
+
 __global__ void DevelopKernel(const Float3* radiance, int64_t n, Exposure exposure, int filmic,
                               const uint8_t* lut, uint8_t* rgb) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   DevelopPixel(radiance[i], exposure.e, filmic != 0, lut, rgb + 3 * i);
+}
+
+// DevelopKernel with the exposure the device computed (ExposureKernel).
+__global__ void DevelopDeviceExposureKernel(const Float3* radiance, int64_t n,
+                                            const DeviceExposure* exposure, int filmic,
+                                            const uint8_t* lut, uint8_t* rgb) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i >= n) return;
+  const float e[3] = {exposure->e[0], exposure->e[1], exposure->e[2]};
+  DevelopPixel(radiance[i], e, filmic != 0, lut, rgb + 3 * i);
 }
 
 // DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film.
@@ -316,23 +353,30 @@ struct HostCopy {
   void* dst;
   const void* src;
   size_t n;
+  cudaEvent_t ready = nullptr;  // src is complete once this event passed (null: now)
 };
 
-// the copies, in chunks of 256 KiB, in one loop through `parallel` (serially if it is empty).
-void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel,
-                  const std::vector<HostCopy>& copies) {
-  constexpr size_t kChunk = size_t{256} << 10;
+// the copies, in chunks of `chunk` bytes, in one loop through `parallel` (serially if it is
+// empty); a chunk waits for its copy's `ready` event before it is copied.
+void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, const std::vector<HostCopy>& copies,
+                  size_t chunk) {
+  const size_t kChunk = std::max<size_t>(chunk, 4096);
   struct Chunk {
     char* dst;
     const char* src;
     size_t n;
+    cudaEvent_t ready;
   };
   std::vector<Chunk> chunks;
   for (const HostCopy& c : copies)
     for (size_t a = 0; a < c.n; a += kChunk)
       chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
-                        std::min(kChunk, c.n - a)});
-  auto copy = [&](int64_t i) { std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n); };
+                        std::min(kChunk, c.n - a), c.ready});
+  // chunks are taken in order: a thread waits for its chunk's source only
+  auto copy = [&](int64_t i) {
+    if (chunks[i].ready) Check(cudaEventSynchronize(chunks[i].ready), "copying a realtime output");
+    std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n);
+  };
   const int64_t count = static_cast<int64_t>(chunks.size());
   if (parallel && count > 1)
     parallel(count, copy);
@@ -414,6 +458,14 @@ struct DeviceRealtime::Impl : PixelBuffers {
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
   // pinned staging of the per-frame uploads (posed geoms, lights)
   PinnedBuffer pin_geoms, pin_lights;
+  // the bytes of the geoms and lights the device holds (upload_changed_only); `uploaded`
+  // false when they are not known (DeviceFrame uploaded others)
+  std::vector<uint8_t> uploaded_geoms, uploaded_lights;
+  bool uploaded = false;
+  // device_exposure: the device's exposure, and its pinned copy for the host's check
+  Buffer device_exposure;
+  PinnedBuffer pin_exposure;
+  RealtimeExposureChecks checks;
   std::vector<PixelGeometry> host_geometry, host_mirror_geometry;
   std::vector<Float3> host_sky, host_mirror_sky;
   std::vector<double> host_rows;
@@ -421,6 +473,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   cudaEvent_t geometry_done = nullptr;
   cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
   cudaEvent_t depth_copied = nullptr;   // the depth is in its pinned buffer
+  cudaEvent_t rgb_copied = nullptr;     // device_exposure: the rgb is in its pinned buffer
   // band k's geometry is on the host (Render's bands)
   cudaEvent_t band_done[kMaxSkyBands] = {};
   // band k of the radiance is in its pinned buffer (RealtimeKernelOptions::output_bands)
@@ -430,8 +483,47 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the last frame, for TimeKernels.
   RealtimeFrameView frame;
   Exposure exposure{{1, 1, 1}};
+  RealtimeFilm film;
   int filmic = 1;
   bool rendered = false;
+
+  // the posed geoms and lights of `f` (host arrays, num_geoms geoms) to the device on `stream`:
+  // pinned, asynchronous (the last frame's copies are done: it ended with a synchronisation);
+  // with upload_changed_only only when their bytes differ from the last upload's
+  void UploadPosed(const RealtimeFrameView& f, int64_t num_geoms, const RealtimeKernelOptions& o,
+                   cudaStream_t stream) {
+    const size_t geom_bytes = sizeof(GeomPod) * num_geoms;
+    const size_t light_bytes = sizeof(LightPod) * f.num_lights;
+    const auto* g = reinterpret_cast<const uint8_t*>(f.geoms);
+    const auto* l = reinterpret_cast<const uint8_t*>(f.lights);
+    const auto same = [](const std::vector<uint8_t>& a, const uint8_t* b, size_t n) {
+      return a.size() == n && (n == 0 || std::memcmp(a.data(), b, n) == 0);
+    };
+    if (o.upload_changed_only && uploaded && same(uploaded_geoms, g, geom_bytes) &&
+        same(uploaded_lights, l, light_bytes))
+      return;
+    if (o.pinned) {
+      pin_geoms.Reserve(geom_bytes > 0 ? geom_bytes : 1);
+      pin_lights.Reserve(light_bytes > 0 ? light_bytes : 1);
+      if (geom_bytes > 0) std::memcpy(pin_geoms.p, f.geoms, geom_bytes);
+      if (light_bytes > 0) std::memcpy(pin_lights.p, f.lights, light_bytes);
+      geoms.Upload(pin_geoms.p, geom_bytes, stream);
+      lights.Upload(pin_lights.p, light_bytes, stream);
+    } else {
+      geoms.Upload(f.geoms, geom_bytes, stream);
+      lights.Upload(f.lights, light_bytes, stream);
+    }
+    uploaded_geoms.assign(g, g + geom_bytes);
+    uploaded_lights.assign(l, l + light_bytes);
+    uploaded = true;
+  }
+  // the film kernel with the exposure the device computed (LaunchExposure)
+  void LaunchFilmDeviceExposure(int64_t n, int tone_map, cudaStream_t stream) {
+    DevelopDeviceExposureKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
+        radiance.as<Float3>(), n, device_exposure.as<DeviceExposure>(), tone_map, lut.as<uint8_t>(),
+        rgb.as<uint8_t>());
+    Check(cudaGetLastError(), "DevelopKernel");
+  }
 
   void LaunchGeometry(const RealtimeFrameView& f, const RealtimeKernelOptions& o,
                       cudaStream_t stream) {
@@ -547,6 +639,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (radiance_done) cudaEventDestroy(radiance_done);
     if (depth_copied) cudaEventDestroy(depth_copied);
+    if (rgb_copied) cudaEventDestroy(rgb_copied);
     for (cudaEvent_t e : radiance_band)
       if (e) cudaEventDestroy(e);
     for (cudaEvent_t e : band_done)
@@ -562,6 +655,7 @@ DeviceRealtime::~DeviceRealtime() { delete impl_; }
 void DeviceRealtime::set_options(const RealtimeKernelOptions& options) { impl_->options = options; }
 const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->options; }
 const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
+const RealtimeExposureChecks& DeviceRealtime::exposure_checks() const { return impl_->checks; }
 
 void DeviceRealtime::Upload(const RealtimeStatic& d) {
   Impl& m = *impl_;
@@ -605,6 +699,7 @@ void DeviceRealtime::UploadSky(const RealtimeSky& d) {
 RealtimeFrameView DeviceRealtime::DeviceFrame(const RealtimeFrameView& host_frame,
                                               int64_t num_geoms) {
   Impl& m = *impl_;
+  m.uploaded = false;  // Render's next frame uploads its own
   m.geoms.Upload(host_frame.geoms, sizeof(GeomPod) * num_geoms, nullptr);
   m.lights.Upload(host_frame.lights, sizeof(LightPod) * host_frame.num_lights, nullptr);
   Check(cudaStreamSynchronize(nullptr), "uploading the realtime geoms and lights");
@@ -616,7 +711,7 @@ RealtimeFrameView DeviceRealtime::DeviceFrame(const RealtimeFrameView& host_fram
 const uint8_t* DeviceRealtime::device_lut() const { return impl_->lut.as<uint8_t>(); }
 
 double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_frame,
-                              int64_t num_geoms, bool filmic, const SkyFn& sky,
+                              int64_t num_geoms, const RealtimeFilm& film, const SkyFn& sky,
                               const ExposureFn& exposure, const RealtimeOutputs& out) {
   Impl& m = *impl_;
   const RealtimeKernelOptions o = m.options;
@@ -627,6 +722,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.geometry_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.radiance_done, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.depth_copied, cudaEventDisableTiming), "cudaEventCreate");
+    Check(cudaEventCreateWithFlags(&m.rgb_copied, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.radiance_band)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
@@ -639,21 +735,14 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   const PinholeCamera& c = host_frame.camera;
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
-  // the posed geoms and lights: pinned, asynchronous (the last frame's copies are done: it
-  // ended with a synchronisation)
-  const size_t geom_bytes = sizeof(GeomPod) * num_geoms;
-  const size_t light_bytes = sizeof(LightPod) * host_frame.num_lights;
-  if (o.pinned) {
-    m.pin_geoms.Reserve(geom_bytes > 0 ? geom_bytes : 1);
-    m.pin_lights.Reserve(light_bytes > 0 ? light_bytes : 1);
-    if (geom_bytes > 0) std::memcpy(m.pin_geoms.p, host_frame.geoms, geom_bytes);
-    if (light_bytes > 0) std::memcpy(m.pin_lights.p, host_frame.lights, light_bytes);
-    m.geoms.Upload(m.pin_geoms.p, geom_bytes, stream);
-    m.lights.Upload(m.pin_lights.p, light_bytes, stream);
-  } else {
-    m.geoms.Upload(host_frame.geoms, geom_bytes, stream);
-    m.lights.Upload(host_frame.lights, light_bytes, stream);
-  }
+  const int filmic = film.filmic ? 1 : 0;
+  // the exposure on the device: the film kernel follows the row sums without the host
+  const bool device_exposure = o.device_exposure && o.pinned && H <= kMaxDeviceExposureRows;
+  m.UploadPosed(host_frame, num_geoms, o, stream);
+  // the host's copies of the outputs into the frame's images: over the caller's threads or one
+  const RealtimeOutputs::ParallelFn no_threads;
+  const RealtimeOutputs::ParallelFn& parallel = o.parallel_copies ? out.parallel : no_threads;
+  const size_t chunk = static_cast<size_t>(std::max(o.copy_chunk_kib, 4)) << 10;
   m.depth.Reserve(sizeof(float) * n);
   m.rows.Reserve(sizeof(double) * H);
   m.rgb.Reserve(3 * n);
@@ -676,6 +765,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.pin_geometry.Reserve(sizeof(PixelGeometry) * n);
     m.pin_sky.Reserve(sizeof(Float3) * n);
     m.pin_rows.Reserve(sizeof(double) * H);
+    m.pin_exposure.Reserve(sizeof(DeviceExposure));
+    m.device_exposure.Reserve(sizeof(DeviceExposure));
     host_geometry = m.pin_geometry.as<PixelGeometry>();
     host_sky = m.pin_sky.as<Float3>();
     host_rows = m.pin_rows.as<double>();
@@ -787,41 +878,98 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       Check(cudaEventRecord(m.radiance_band[k], m.copy_stream), "cudaEventRecord");
     }
   }
-  m.rows.Download(host_rows, sizeof(double) * H, stream);
-  if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
+  if (device_exposure) {
+    // (5) the exposure and the film on the device, the row sums, the device's exposure and the
+    // rgb back on the same stream: the host waits once, at the end
+    if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
+    LaunchExposure(m.rows.as<double>(), H, n, film.exposure, film.white_balance_gains,
+                   m.device_exposure.as<DeviceExposure>(), stream);
+    m.LaunchFilmDeviceExposure(n, filmic, stream);
+    m.rows.Download(host_rows, sizeof(double) * H, stream);
+    m.device_exposure.Download(m.pin_exposure.p, sizeof(DeviceExposure), stream);
+    if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+    Check(cudaEventRecord(m.rgb_copied, stream), "cudaEventRecord");
+  } else {
+    m.rows.Download(host_rows, sizeof(double) * H, stream);
+    if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
+  }
   // pinned: the depth into the frame's image while the GPU shades
   if (out.depth && o.pinned) {
     Check(cudaEventSynchronize(m.depth_copied), "copying the realtime depth");
-    ParallelCopy(out.parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}});
+    ParallelCopy(parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}}, chunk);
   }
-  Check(cudaStreamSynchronize(stream), "ShadeKernel");
-  const auto t3 = Clock::now();
-  if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
+  // the radiance into the frame's image, band by band as it comes back
+  const auto copy_radiance = [&] {
+    if (!out.radiance) return;
+    for (int k = 0; k < out_bands; ++k) {
+      Check(cudaEventSynchronize(m.radiance_band[k]), "copying the realtime radiance");
+      const size_t off = static_cast<size_t>(out_row(k)) * W;
+      const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+      ParallelCopy(
+          parallel,
+          {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off, sizeof(Float3) * count}},
+          chunk);
+    }
+  };
   Exposure e;
-  const double ev100 = exposure(m.host_rows, e.e);
-  // (5) film
-  m.LaunchFilm(n, e, filmic ? 1 : 0, stream);
+  double ev100 = 0;
   m.times.outputs = 0;
-  if (o.pinned) {
-    // the radiance into the frame's image while the film kernel runs, then the rgb
-    if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+  Clock::time_point t3 = t0;  // the row sums on the host
+  if (device_exposure) {
+    // the radiance bands and the rgb in one loop over the host's threads, each chunk as soon as
+    // its band or the rgb is back (the radiance while the row sums, exposure and film run);
+    // then the host's exposure from the same row sums: where the device's differs, the film
+    // again with the host's, and its rgb copied over the device exposure's
     const auto tc = Clock::now();
+    std::vector<HostCopy> copies;
     if (out.radiance)
       for (int k = 0; k < out_bands; ++k) {
-        Check(cudaEventSynchronize(m.radiance_band[k]), "copying the realtime radiance");
         const size_t off = static_cast<size_t>(out_row(k)) * W;
         const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
-        ParallelCopy(out.parallel, {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
-                                     sizeof(Float3) * count}});
+        copies.push_back({out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off,
+                          sizeof(Float3) * count, m.radiance_band[k]});
       }
-    Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
+    if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n), m.rgb_copied});
+    ParallelCopy(parallel, copies, chunk);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
-    if (out.rgb) ParallelCopy(out.parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}});
+    t3 = Clock::now();
+    m.host_rows.assign(host_rows, host_rows + H);
+    ev100 = exposure(m.host_rows, e.e);
+    const DeviceExposure& d = *m.pin_exposure.as<DeviceExposure>();
+    ++m.checks.frames;
+    if (std::memcmp(&d.ev100, &ev100, sizeof(double)) != 0) ++m.checks.ev100_differs;
+    if (std::memcmp(d.e, e.e, sizeof(e.e)) != 0) {
+      ++m.checks.redeveloped;
+      m.LaunchFilm(n, e, filmic, stream);
+      if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+      Check(cudaStreamSynchronize(stream), "DevelopKernel");
+      if (out.rgb)
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
+    }
+    Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
     m.times.outputs = MsSince(tc);
   } else {
-    if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
-    if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
-    Check(cudaStreamSynchronize(stream), "DevelopKernel");
+    Check(cudaStreamSynchronize(stream), "ShadeKernel");
+    t3 = Clock::now();
+    if (o.pinned) m.host_rows.assign(host_rows, host_rows + H);
+    ev100 = exposure(m.host_rows, e.e);
+    // (5) film
+    m.LaunchFilm(n, e, filmic, stream);
+    if (o.pinned) {
+      // the radiance into the frame's image while the film kernel runs, then the rgb
+      if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+      const auto tc = Clock::now();
+      copy_radiance();
+      Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
+      Check(cudaStreamSynchronize(stream), "DevelopKernel");
+      if (out.rgb)
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
+      m.times.outputs = MsSince(tc);
+    } else {
+      if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
+      if (out.radiance) m.radiance.Download(out.radiance, sizeof(Float3) * n, stream);
+      Check(cudaStreamSynchronize(stream), "DevelopKernel");
+    }
   }
   m.times.total = MsSince(t0);
   if (o.device_sky) {
@@ -840,7 +988,8 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   }
   m.frame = f;
   m.exposure = e;
-  m.filmic = filmic ? 1 : 0;
+  m.film = film;
+  m.filmic = filmic;
   m.rendered = true;
   return ev100;
 }
@@ -858,11 +1007,25 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
   if (options.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
   if (options.reuse_hit && options.reuse_surface) m.surfaces.Reserve(sizeof(SurfaceTerms) * n);
+  // the exposure as Render makes it: on the device (its kernel, then the film reading it) or
+  // the host's of the last Render
+  const int H = f.camera.height;
+  const bool device_exposure = options.device_exposure && H <= kMaxDeviceExposureRows;
+  if (device_exposure) m.device_exposure.Reserve(sizeof(DeviceExposure));
+  const auto film = [&] {
+    if (device_exposure) {
+      LaunchExposure(m.rows.as<double>(), H, n, m.film.exposure, m.film.white_balance_gains,
+                     m.device_exposure.as<DeviceExposure>(), stream);
+      m.LaunchFilmDeviceExposure(n, m.filmic, stream);
+    } else {
+      m.LaunchFilm(n, m.exposure, m.filmic, stream);
+    }
+  };
   // one untimed run (first launch of a kernel variant)
   m.LaunchGeometry(f, options, stream);
   if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
   m.LaunchShading(f, options, stream);
-  m.LaunchFilm(n, m.exposure, m.filmic, stream);
+  film();
   Check(cudaStreamSynchronize(stream), "realtime kernels");
   cudaEvent_t start, stop;
   Check(cudaEventCreate(&start), "cudaEventCreate");
@@ -872,7 +1035,7 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
     m.LaunchGeometry(f, options, stream);
     if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
     m.LaunchShading(f, options, stream);
-    m.LaunchFilm(n, m.exposure, m.filmic, stream);
+    film();
   }
   Check(cudaGetLastError(), "realtime kernels");
   Check(cudaEventRecord(stop, stream), "cudaEventRecord");
@@ -882,6 +1045,24 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   cudaEventDestroy(start);
   cudaEventDestroy(stop);
   return static_cast<double>(ms) / count;
+}
+
+double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double>& rows,
+                           int64_t pixels, const float white_balance_gains[3], float exposure[3]) {
+  const int height = static_cast<int>(rows.size());
+  if (rows.size() > static_cast<size_t>(kMaxDeviceExposureRows))
+    throw Error("DeviceFrameExposure: " + std::to_string(rows.size()) + " rows, at most " +
+                std::to_string(kMaxDeviceExposureRows));
+  Buffer device_rows, out;
+  device_rows.Upload(rows.data(), sizeof(double) * rows.size(), nullptr);
+  out.Reserve(sizeof(DeviceExposure));
+  LaunchExposure(device_rows.as<double>(), height, pixels, film, white_balance_gains,
+                 out.as<DeviceExposure>(), nullptr);
+  DeviceExposure d;
+  out.Download(&d, sizeof(d), nullptr);
+  Check(cudaStreamSynchronize(nullptr), "ExposureKernel");
+  for (int c = 0; c < 3; ++c) exposure[c] = d.e[c];
+  return d.ev100;
 }
 
 namespace {
