@@ -43,7 +43,7 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
 CudaRenderer::~CudaRenderer() = default;
 
 bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
-  return (effects == nullptr || effects->empty()) && !view.intrinsics.has_distortion() &&
+  return EffectsNotOnGpu(effects).empty() && !view.intrinsics.has_distortion() &&
          !view.motion.moving();
 }
 
@@ -58,10 +58,16 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
   if (!OnGpu(effects, view) || !rgb_why.empty()) {
     if (!told_cpu_) {
+      // what is not on the GPU: the rgb's reason, else the effects', else the camera's
+      const std::string fx_why = EffectsNotOnGpu(effects);
+      const std::string what = !rgb_why.empty()  ? rgb_why
+                               : !fx_why.empty() ? "effects with " + fx_why
+                                                 : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {} not on the GPU yet (effects, lens distortion, camera "
-          "motion, pathtraced rgb); such frames are rendered by the CPU renderer (docs/gpu.md)",
-          rgb_why.empty() ? std::string("this frame's camera or effects are") : rgb_why + " is");
+          "renderer: cuda backend: {}: not on the GPU yet (media, particles, lens distortion, "
+          "camera motion, pathtraced rgb); such frames are rendered by the CPU renderer "
+          "(docs/gpu.md)",
+          what);
       told_cpu_ = true;
     }
     ++cpu_frames_;
@@ -77,7 +83,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const int W = c.width, H = c.height;
   out->ev100 = 0;
   if (want[ImageKind::kRgb]) {
-    RenderRgb(snapshot, view, out);
+    RenderRgb(snapshot, effects, view, out);
   } else {
     out->radiance = ImageF();
     out->rgb = ImageU8();
@@ -98,8 +104,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   ++gpu_frames_;
 }
 
-void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& view,
-                             RenderedFrame* out) {
+void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                             const CameraView& view, RenderedFrame* out) {
   if (!realtime_uploaded_) {
     RealtimeStatic st;
     st.materials = realtime_->materials().data();
@@ -113,7 +119,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
     device_realtime_->Upload(st);
     realtime_uploaded_ = true;
   }
-  realtime_->Prepare(snapshot, view, pool_.get());
+  realtime_->Prepare(snapshot, view, pool_.get(), effects);
   // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
   // the sky change: its device copy follows
   if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {
