@@ -21,17 +21,6 @@
 namespace penumbra {
 namespace {
 
-// bundled world `name` after `t_sec` of simulation, without its renderer.
-std::unique_ptr<Session> LoadEffectsWorldAt(const std::string& name, double t_sec) {
-  SessionOptions so;
-  so.build_renderer = false;
-  so.add_controllers = false;
-  auto session = std::make_unique<Session>(
-      LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + name), so);
-  while (session->sim().time() < t_sec) session->sim().Step();
-  return session;
-}
-
 std::unique_ptr<Renderer> EffectsBackend(const SceneDescription& scene, RenderSettings::Backend b) {
   RenderSettings settings;
   settings.backend = b;
@@ -48,7 +37,7 @@ class RealtimeEffectsGpu : public ::testing::TestWithParam<GpuEffectsWorld> {};
 TEST_P(RealtimeEffectsGpu, MatchesCpuBackendAndRepeatsBitForBit) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   const GpuEffectsWorld& w = GetParam();
-  const std::unique_ptr<Session> session = LoadEffectsWorldAt(w.file, w.t_sec);
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, w.t_sec);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
@@ -85,7 +74,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeEffectsGpu,
 
 TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session = LoadEffectsWorldAt("effects/sun.yaml", 1.0);
+  const std::unique_ptr<Session> session =
+      realtime_parity::LoadSimulatedAt("effects/sun.yaml", 1.0);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
@@ -111,7 +101,8 @@ TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
 
 TEST(RealtimeEffectsGpuFrames, MediaFramesGoToTheCpuRenderer) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session = LoadEffectsWorldAt("effects/fog.yaml", 1.0);
+  const std::unique_ptr<Session> session =
+      realtime_parity::LoadSimulatedAt("effects/fog.yaml", 1.0);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);

@@ -27,17 +27,6 @@
 namespace penumbra {
 namespace {
 
-// bundled world `name` after `t_sec` of simulation, without its renderer.
-std::unique_ptr<Session> LoadHostEffectsWorldAt(const std::string& name, double t_sec) {
-  SessionOptions so;
-  so.build_renderer = false;
-  so.add_controllers = false;
-  auto session = std::make_unique<Session>(
-      LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + name), so);
-  while (session->sim().time() < t_sec) session->sim().Step();
-  return session;
-}
-
 struct HostCompared {
   double psnr = 0, depth_bad = 1;
   RenderedFrame cpu, host, again;
@@ -73,7 +62,7 @@ class RealtimeHostPathEffects : public ::testing::TestWithParam<HostEffectsWorld
 
 TEST_P(RealtimeHostPathEffects, MatchesCpuBackend) {
   const HostEffectsWorld& w = GetParam();
-  const std::unique_ptr<Session> session = LoadHostEffectsWorldAt(w.file, w.t_sec);
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, w.t_sec);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
@@ -106,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathEffects,
 // every lighting field at once on the default room (its window lets the sun and sky in): a
 // lamp scaled, the sun moved and the sky dimmed, a spot light added, the floor wet.
 TEST(RealtimeHostPathEffectsFrames, EveryLightingFieldMatchesCpuBackend) {
-  const std::unique_ptr<Session> session = LoadHostEffectsWorldAt("default.yaml", 1.0);
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt("default.yaml", 1.0);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
@@ -174,10 +163,13 @@ TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
                 {"effects/height_fog.yaml", "homogeneous media"},
                 {"effects/dust.yaml", "homogeneous media"},
                 {"effects/smoke_plume.yaml", "grid media"},
+                {"effects/vdb_smoke.yaml", "grid media"},
+                {"effects/fire.yaml", "grid media"},
                 {"effects/rain.yaml", "particles"},
+                {"effects/snow.yaml", "particles"},
                 {"effects/adversity_major.yaml", "media"}};
   for (const auto& w : worlds) {
-    const std::unique_ptr<Session> session = LoadHostEffectsWorldAt(w.file, 1.0);
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, 1.0);
     const WorldSnapshot snap = session->sim().Snapshot();
     const CameraView view = realtime_parity::RgbDepthView(session->scene(), snap, 32, 24);
     const std::shared_ptr<const EffectsFrame> fx =
