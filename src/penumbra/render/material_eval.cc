@@ -12,6 +12,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/texture_lanes.h"
 #include "penumbra/render/texture_math.h"
+#include "penumbra/render/wetness_math.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
@@ -258,14 +259,12 @@ Eigen::Vector3f MaterialEvaluator::SampleCube(int tex, const Eigen::Vector3f& q,
 }
 
 void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr) {
-  const float facing = std::clamp((n_W.z() - 0.3f) / 0.4f, 0.0f, 1.0f);
-  const float w = std::clamp(wetness, 0.0f, 1.0f) * facing;
-  if (!(w > 0)) return;
-  const float darken = 1.0f + (0.3f - 1.0f) * w;
-  const float m = std::clamp(pbr->metallic, 0.0f, 1.0f);
-  pbr->base_color *= (1.0f - m) * darken + m;
-  const float gloss = std::min(1.0f, (1.0f - pbr->roughness) * (1.0f + 1.5f * w));
-  pbr->roughness = 1.0f - gloss;
+  // the shared formula (render/wetness_math.h; the CUDA realtime path calls it too).
+  float scale, roughness;
+  if (!SurfaceWetnessTerms(wetness, n_W.z(), pbr->metallic, pbr->roughness, &scale, &roughness))
+    return;
+  pbr->base_color *= scale;
+  pbr->roughness = roughness;
 }
 
 // the 2d mapping of a material at a hit (render/material_eval.h, "texture mapping"): texture

@@ -108,7 +108,8 @@ struct SurfaceMaterial {
 /// gloss = 1 - roughness x lerp(1, 2.5, w') capped at 1). w' = w s, with s the facing weight
 /// clamp((n_z - 0.3) / 0.4, 0, 1) of the unit shading normal n_W (world z up): vertical and
 /// downward-facing surfaces stay dry. metals keep their albedo (only their gloss changes).
-/// whether a surface is sheltered from the rain is not tested.
+/// whether a surface is sheltered from the rain is not tested. the formula is
+/// SurfaceWetnessTerms (render/wetness_math.h), shared with the CUDA backend.
 void ApplySurfaceWetness(float wetness, const Eigen::Vector3f& n_W, PbrParams* pbr);
 
 /// where a ray cone meets a surface (file comment, "filtering").

@@ -4,8 +4,9 @@
 // depth within 1 mm and segmentation equal are counted on the clear frame (no effects: the
 // geometry both backends trace); whether the frame with the world's effects and the rgb image
 // render on the GPU (CudaRenderer::OnGpu) is reported, with the rgb PSNR where rgb is on the
-// GPU, else "cpu fallback". shared by render_cuda_bench --parity (scripts/gpu/parity.sh) and
-// the `gpu` test CudaParity. header-only: both link the same libraries.
+// GPU, else "cpu fallback" (frames with lighting effects only render on the GPU since branch
+// gpu6; media and particles do not yet). shared by render_cuda_bench --parity
+// (scripts/gpu/parity.sh) and the `gpu` test CudaParity. header-only: both link the same libraries.
 
 #include <fmt/format.h>
 
@@ -34,6 +35,7 @@ struct ParityRow {
   bool effects = false;         ///< the world has effects at 1 s
   bool effects_on_gpu = false;  ///< the frame with them renders on the GPU
   std::string rgb;              ///< "PSNR x dB" or "cpu fallback"
+  double rgb_psnr = -1;         ///< the rgb PSNR (dB; 99 equal) where rgb is on the GPU, else -1
 };
 
 /// measures `world_file` (see the file comment). needs a CUDA device.
@@ -100,6 +102,7 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
       se += d * d;
     }
     const double mse = se / std::max<size_t>(1, ca.rgb.data.size());
+    row.rgb_psnr = mse == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
     row.rgb = mse == 0 ? "PSNR inf (equal)"
                        : fmt::format("PSNR {:.1f} dB", 10 * std::log10(255.0 * 255.0 / mse));
   }

@@ -2,7 +2,9 @@
 // the worlds cuda_backend_gpu_test.cc does not cover: the outdoor world and every
 // worlds/effects/*.yaml (cuda_parity.h, as scripts/gpu/parity.sh prints them): on the clear
 // frame depth within 1 mm on >= 99.9 % of pixels and segmentation equal on >= 99.9 % (same-depth
-// ties of coplanar geoms counted apart). without a device: "skipped: no CUDA device".
+// ties of coplanar geoms counted apart); where the frame with the world's effects renders on the
+// GPU (lighting effects only: blackout, flashlight, sun), its rgb PSNR >= 40 dB against the CPU
+// backend. without a device: "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -31,15 +33,22 @@ std::vector<std::string> ParityWorldFiles() {
 TEST(CudaParity, OutdoorAndEffectsWorldsMatchTheCpuBackend) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   std::vector<cuda_parity::ParityRow> rows;
+  int gpu_effects = 0;
   for (const std::string& file : ParityWorldFiles()) {
     SCOPED_TRACE(file);
     const cuda_parity::ParityRow r = cuda_parity::MeasureParity(file, 160, 120);
     EXPECT_GE(r.depth_within_1mm, 99.9);
     EXPECT_GE(r.seg_equal + 100.0 * r.ties / r.pixels, 99.9);
+    if (r.effects_on_gpu) {
+      EXPECT_GE(r.rgb_psnr, 40.0);
+    }
+    gpu_effects += r.effects && r.effects_on_gpu;
     rows.push_back(r);
   }
   std::printf("%s", cuda_parity::FormatParity(rows, 160, 120).c_str());
   EXPECT_GE(rows.size(), 10u);
+  // blackout, flashlight and sun (lighting effects only) render their effects frames on the GPU
+  EXPECT_GE(gpu_effects, 3);
 }
 
 }  // namespace

@@ -16,15 +16,20 @@
 
 namespace penumbra::realtime_parity {
 
-/// bundled world `name` (worlds/<name>) after 1 s of simulation, without its renderer.
-inline std::unique_ptr<Session> LoadSimulated(const std::string& name) {
+/// bundled world `name` (worlds/<name>) after `t_sec` of simulation, without its renderer.
+inline std::unique_ptr<Session> LoadSimulatedAt(const std::string& name, double t_sec) {
   SessionOptions so;
   so.build_renderer = false;
   so.add_controllers = false;
   auto session = std::make_unique<Session>(
       LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + name), so);
-  while (session->sim().time() < 1.0) session->sim().Step();
+  while (session->sim().time() < t_sec) session->sim().Step();
   return session;
+}
+
+/// bundled world `name` (worlds/<name>) after 1 s of simulation, without its renderer.
+inline std::unique_ptr<Session> LoadSimulated(const std::string& name) {
+  return LoadSimulatedAt(name, 1.0);
 }
 
 /// the first camera of `scene` at w x h (its vertical field of view), rgb and depth.

@@ -9,6 +9,9 @@
 //     shading, exposure, film, rgb, radiance and depth copied back), and its kernels alone
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
+//   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
+//     them, cuda Render() (on the GPU for lighting effects; else the CPU renderer inside the
+//     CUDA backend, "cpu fallback") and cpu Render();
 //   - with --realtime, the FNV-1a hashes of the default options' rgb and depth (to compare
 //     builds: a change of the traversal or the kernels that keeps the images keeps them);
 // and the BVH build time. prints one markdown table.
@@ -64,12 +67,14 @@ struct Row {
   double fps = 0;
 };
 
-// mean seconds per Render of `view` over `frames` frames after 3 warm-up frames.
-double TimeRenders(Renderer* r, const WorldSnapshot& snap, const CameraView& view, int frames) {
+// mean seconds per Render of `view` under `fx` (null: none) over `frames` frames after 3
+// warm-up frames.
+double TimeRenders(Renderer* r, const WorldSnapshot& snap, const CameraView& view, int frames,
+                   const EffectsFrame* fx = nullptr) {
   RenderedFrame f;
-  for (int i = 0; i < 3; ++i) r->Render(snap, view, &f);
+  for (int i = 0; i < 3; ++i) r->Render(snap, fx, view, &f);
   const auto t0 = Clock::now();
-  for (int i = 0; i < frames; ++i) r->Render(snap, view, &f);
+  for (int i = 0; i < frames; ++i) r->Render(snap, fx, view, &f);
   return std::chrono::duration<double>(Clock::now() - t0).count() / frames;
 }
 
@@ -440,6 +445,15 @@ int Main(int argc, char** argv) {
       rgb.outputs[ImageKind::kRgb] = true;
       rgb.outputs[ImageKind::kSegmentation] = false;
       const int n = w * h < 100000 ? frames * 10 : frames;
+      const std::shared_ptr<const EffectsFrame> fx =
+          session.effects().Evaluate(snap, view.X_WO.translation());
+      const bool with_fx = fx && !fx->empty();
+      const std::string fx_outputs = cuda::CudaRenderer::OnGpu(fx.get(), rgb)
+                                         ? "rgb+depth realtime + effects (on GPU)"
+                                         : "rgb+depth realtime + effects (cpu fallback)";
+      if (gpu && with_fx)
+        rows.push_back({name, size, fx_outputs, "cuda", "Render()",
+                        1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
       if (gpu) {
         auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
         rows.push_back({name, size, "depth+seg", "cuda", "Render()",
@@ -460,6 +474,9 @@ int Main(int argc, char** argv) {
                       1 / TimeRenders(cpu.get(), snap, all, nc)});
       rows.push_back({name, size, "rgb+depth realtime", "cpu", "Render()",
                       1 / TimeRenders(cpu.get(), snap, rgb, nc)});
+      if (with_fx)
+        rows.push_back({name, size, "rgb+depth realtime + effects", "cpu", "Render()",
+                        1 / TimeRenders(cpu.get(), snap, rgb, nc, fx.get())});
     }
   }
   fmt::print("\n| world | size | outputs | backend | timed | frames/s | ms/frame |\n");

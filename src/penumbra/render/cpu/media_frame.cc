@@ -34,31 +34,11 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
     particles_.Build(nullptr, camera, 0, false);
     return;
   }
-  if (!(fx->sky_luminance_scale >= 0) || !std::isfinite(fx->sky_luminance_scale))
-    throw ConfigError("", 0, "effects.sky_luminance_scale", "expected a finite value >= 0");
-  if (!(fx->surface_wetness >= 0 && fx->surface_wetness <= 1))
-    throw ConfigError("", 0, "effects.surface_wetness", "expected a value in [0, 1]");
-  wetness_ = fx->surface_wetness;
-
-  // sky: moved sun and luminance scale.
-  const bool sky_changed = fx->sun_direction_W.has_value() || fx->sky_luminance_scale != 1.0f;
-  if (sky_changed) {
-    bool rebuild = !effects_sky_ || effects_sky_scale_ != fx->sky_luminance_scale ||
-                   effects_sky_sun_.has_value() != fx->sun_direction_W.has_value();
-    if (!rebuild && fx->sun_direction_W) {
-      const double c = effects_sky_sun_->normalized().dot(fx->sun_direction_W->normalized());
-      rebuild = c < std::cos(kSkyRebuildDeg * M_PI / 180.0);
-    }
-    if (rebuild) {
-      Sky sky = scene_.sky;
-      if (fx->sun_direction_W) sky.sun_direction_W = *fx->sun_direction_W;
-      sky.radiance *= fx->sky_luminance_scale;
-      sky.zenith_luminance *= fx->sky_luminance_scale;
-      effects_sky_ = std::make_unique<SkyModel>(sky, base_sky.skybox());
-      effects_sky_sun_ = fx->sun_direction_W;
-      effects_sky_scale_ = fx->sky_luminance_scale;
-    }
-    sky_ = effects_sky_.get();
+  // sky: moved sun and luminance scale (render/effects_sky.h, shared with the CUDA backend).
+  const SkyModel& sky = effects_sky_.Update(scene_.sky, base_sky, fx);
+  wetness_ = SurfaceWetnessOf(fx);
+  if (&sky != &base_sky) {
+    sky_ = &sky;
     sky_ambient_ = SkyAmbientRadiance(*sky_);
   } else {
     if (base_sky_seen_ != &base_sky) {

@@ -6,11 +6,9 @@
 //  - media (MediaScene; both tiers) and the realtime tier's light volumes (RealtimeMedia);
 //  - particle streaks for the frame's camera and exposure (ParticleScene), without the
 //    rain and snow that static geometry covers from above (ShelterMap);
-//  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale: a new
-//    SkyModel is built when the sun moved by more than kSkyRebuildDeg since the last one or
-//    the scale changed (building SkyModel's tables is not free, docs/performance.md; the sun
-//    moves slowly);
-//  - surface wetness (ApplySurfaceWetness, material_eval.h).
+//  - the sky moved to EffectsFrame::sun_direction_W and scaled by sky_luminance_scale, and the
+//    surface wetness (ApplySurfaceWetness, material_eval.h): render/effects_sky.h, which the
+//    CUDA backend's realtime path shares.
 // light intensity scales and extra lights are applied by LightSampler::Update.
 
 #include <Eigen/Core>
@@ -20,6 +18,7 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cpu/media_realtime.h"
+#include "penumbra/render/effects_sky.h"
 #include "penumbra/render/embree/particle_scene.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
@@ -33,9 +32,6 @@
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
-
-/// the sun must move by more than this (degrees) before the sky tables are rebuilt.
-constexpr double kSkyRebuildDeg = 0.1;
 
 /// sphere-average radiance of a sky (cd/m^2 per channel): the mean of its irradiance on the
 /// six axis-aligned normals divided by pi (exact for radiance that is linear in direction).
@@ -84,9 +80,7 @@ class MediaFrame {
   Eigen::Vector3f sky_ambient_{0, 0, 0};
   Eigen::Vector3f base_sky_ambient_{0, 0, 0};
   const SkyModel* base_sky_seen_ = nullptr;
-  std::unique_ptr<SkyModel> effects_sky_;
-  std::optional<Eigen::Vector3d> effects_sky_sun_;
-  float effects_sky_scale_ = 1.0f;
+  EffectsSky effects_sky_;
   MediaScene media_;
   RealtimeMedia realtime_;
   bool realtime_ok_ = false;

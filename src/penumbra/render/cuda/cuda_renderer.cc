@@ -45,7 +45,7 @@ CudaRenderer::~CudaRenderer() = default;
 
 bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
   (void)view;  // every pinhole, distorted or moving camera renders on the GPU (camera_rays.h)
-  return effects == nullptr || effects->empty();
+  return EffectsNotOnGpu(effects).empty();
 }
 
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
@@ -59,10 +59,15 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
   if (!OnGpu(effects, view) || !rgb_why.empty()) {
     if (!told_cpu_) {
+      // what is not on the GPU: the rgb's reason, else the effects', else the camera's
+      const std::string fx_why = EffectsNotOnGpu(effects);
+      const std::string what = !rgb_why.empty()  ? rgb_why
+                               : !fx_why.empty() ? "effects with " + fx_why
+                                                 : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {} not on the GPU yet (effects, pathtraced rgb); such frames "
-          "are rendered by the CPU renderer (docs/gpu.md)",
-          rgb_why.empty() ? std::string("this frame's camera or effects are") : rgb_why + " is");
+          "renderer: cuda backend: {}: not on the GPU yet (media, particles, pathtraced rgb); "
+          "such frames are rendered by the CPU renderer (docs/gpu.md)",
+          what);
       told_cpu_ = true;
     }
     ++cpu_frames_;
@@ -86,7 +91,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const int W = c.width, H = c.height;
   out->ev100 = 0;
   if (want[ImageKind::kRgb]) {
-    RenderRgb(snapshot, view, c, t0, out);
+    RenderRgb(snapshot, effects, view, c, t0, out);
   } else {
     out->radiance = ImageF();
     out->rgb = ImageU8();
@@ -107,9 +112,9 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   ++gpu_frames_;
 }
 
-void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& view,
-                             const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
-                             RenderedFrame* out) {
+void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                             const CameraView& view, const PinholeCamera& camera,
+                             std::chrono::steady_clock::time_point t0, RenderedFrame* out) {
   if (!realtime_uploaded_) {
     RealtimeStatic st;
     st.materials = realtime_->materials().data();
@@ -123,7 +128,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const CameraView& vi
     device_realtime_->Upload(st);
     realtime_uploaded_ = true;
   }
-  realtime_->Prepare(snapshot, view, pool_.get());
+  realtime_->Prepare(snapshot, view, pool_.get(), effects);
   // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
   // the sky change: its device copy follows
   if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {

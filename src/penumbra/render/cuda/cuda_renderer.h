@@ -1,13 +1,14 @@
 #pragma once
-// the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (no lens
-// distortion, no motion) under clear conditions: the images of the pixel centre's primary ray
-// (depth, segmentation (geom ids), instance (body) and semantic segmentation, range and normals,
-// traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the realtime tier, rgb and
-// radiance (realtime_shading.h's functions in realtime_kernels.cu; the sky terms on the host,
-// realtime_frame.h). everything else (the pathtraced tier, distorted or moving cameras, effects)
-// is not on the GPU yet: such a frame is rendered whole by the CPU renderer handed in (`cpu`),
-// so every output exists and equals the CPU backend's for those frames; docs/gpu.md lists what
-// is where.
+// the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (with
+// lens distortion or motion too: camera_rays.h) under clear conditions or lighting effects only
+// (light scales, extra lights, a moved or scaled sky, surface wetness: EffectsNotOnGpu): the images
+// of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
+// segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
+// realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the sky
+// terms on the host, realtime_frame.h). everything else (the pathtraced tier, media and particles)
+// is not on the GPU yet: such a frame is rendered whole by the CPU renderer handed in (`cpu`), so
+// every output exists and equals the CPU backend's for those frames; docs/gpu.md lists what is
+// where.
 
 #include <chrono>
 #include <memory>
@@ -40,7 +41,7 @@ class CudaRenderer final : public Renderer {
               RenderedFrame* out) override;
 
   /// true if `view`'s ground-truth images under `effects` render on the GPU (else on the CPU
-  /// renderer).
+  /// renderer): a pinhole camera, and effects that are on the GPU (EffectsNotOnGpu).
   static bool OnGpu(const EffectsFrame* effects, const CameraView& view);
   /// "" if `view`'s rgb under `effects` renders on the GPU, else why not.
   std::string RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const;
@@ -71,10 +72,12 @@ class CudaRenderer final : public Renderer {
   static PinholeCamera PinholeOf(const CameraView& view);
 
  private:
-  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h); `camera`: the
-  // view's camera with its ray tables on the device; t0: when Render began (last_prepare_ms).
-  void RenderRgb(const WorldSnapshot& snapshot, const CameraView& view, const PinholeCamera& camera,
-                 std::chrono::steady_clock::time_point t0, RenderedFrame* out);
+  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h) under `effects`
+  // (lighting effects only: EffectsNotOnGpu); `camera`: the view's camera with its ray tables
+  // on the device; t0: when Render began (last_prepare_ms).
+  void RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
+                 const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
+                 RenderedFrame* out);
 
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;

@@ -117,16 +117,29 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
   }
 }
 
+std::string EffectsNotOnGpu(const EffectsFrame* effects) {
+  if (effects == nullptr) return "";
+  std::string why;
+  auto add = [&](bool set, const char* what) {
+    if (set) why += (why.empty() ? "" : ", ") + std::string(what);
+  };
+  add(!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust)");
+  add(!effects->grid_media.empty(), "grid media (smoke, fire, VDB)");
+  add(!effects->particles.empty(), "particles (rain, snow, sparks)");
+  return why;
+}
+
 std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
                                            const CameraView& view) const {
   if (settings_.tier != RenderSettings::Tier::kRealtime) return "the pathtraced tier";
-  if (effects != nullptr && !effects->empty()) return "effects";
+  const std::string fx = EffectsNotOnGpu(effects);
+  if (!fx.empty()) return "effects with " + fx;
   return "";
 }
 
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
-                                ThreadPool* pool) {
-  PoseWorld(snapshot, pool);
+                                ThreadPool* pool, const EffectsFrame* effects) {
+  PoseWorld(snapshot, pool, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   camera_rays_.Prepare(view, pool);
   SetCamera(camera_rays_.Point(PinholeCameraOf(view), camera_rays_.xy().data(),
@@ -135,8 +148,17 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
             view.white_balance_gains);
 }
 
-void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool) {
-  lights_.Update(snapshot, nullptr);
+void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool,
+                                  const EffectsFrame* effects) {
+  // the lighting effects as the CPU backend applies them (EmbreeRenderer::Render, MediaFrame):
+  // an empty frame is none.
+  const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
+  if (!EffectsNotOnGpu(fx).empty())
+    throw Error("RealtimeFrameData: effects with " + EffectsNotOnGpu(fx) +
+                " are not on the GPU (Unsupported)");
+  lights_.Update(snapshot, fx);
+  frame_sky_ = &effects_sky_.Update(scene_.sky, sky_, fx);
+  wetness_ = SurfaceWetnessOf(fx);
   // only the geoms of bodies that moved since the last call (the others keep their bits)
   const size_t bodies = snapshot.X_WB.size();
   const bool all = posed_X_WB_.size() != bodies;
@@ -154,7 +176,7 @@ void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* poo
       m[4 * r + 3] = static_cast<float>(X_GW.translation()(r));
     }
   }
-  volume_.Update(scene_, snapshot, sky_, pool);
+  volume_.Update(scene_, snapshot, *frame_sky_, pool);
 }
 
 void RealtimeFrameData::SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,
@@ -186,14 +208,14 @@ int RealtimeFrameData::CheckRows(const char* what, int64_t n, int row0, int row1
 
 void RealtimeFrameData::SkyQuadRow(const PixelGeometry* geometry, Float3* out, int q,
                                    int row1) const {
-  const SkyModelPod& sky = sky_.pod();
+  const SkyModelPod& sky = frame_sky_->pod();
   const SkyVolumePod volume = volume_.pod();
   for (int u0 = 0; u0 < camera_.width; u0 += 2)
     QuadSkyTerms(sky, volume, geometry, camera_.width, row1, u0, 2 * q, out);
 }
 
 void RealtimeFrameData::MirrorSkyRow(const PixelGeometry* mirror, Float3* out, int v) const {
-  const SkyModelPod& sky = sky_.pod();
+  const SkyModelPod& sky = frame_sky_->pod();
   const SkyVolumePod volume = volume_.pod();
   const int W = camera_.width;
   for (int64_t i = static_cast<int64_t>(v) * W; i < static_cast<int64_t>(v + 1) * W; ++i)
@@ -202,7 +224,7 @@ void RealtimeFrameData::MirrorSkyRow(const PixelGeometry* mirror, Float3* out, i
 
 RealtimeSky RealtimeFrameData::SkyData() const {
   RealtimeSky d;
-  d.sky = sky_.pod();
+  d.sky = frame_sky_->pod();
   d.volume = volume_.pod();
   d.num_probes = volume_.num_probes();
   return d;
@@ -251,7 +273,8 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.max_anisotropy = settings_.max_anisotropy < 1 ? 1 : settings_.max_anisotropy;
   f.frame_key = frame_key_;
   f.sky_term = sky;
-  f.sky = sky_.pod();
+  f.sky = frame_sky_->pod();
+  f.wetness = wetness_;
   f.volume = volume_.pod();
   f.any_mirror = any_mirror_ ? 1 : 0;
   return f;

@@ -2,11 +2,13 @@
 // the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
 // materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
-// key; the sky model and sky volume (SkyData, for DeviceRealtime::UploadSky) and, for the
-// host path, the per-pixel sky terms from the primary rays' geometry (QuadSkyTerms of
-// realtime_shading.h: the shared lookups of render/sky_eval_math.h, which the device's sky
-// kernel runs too) and those of the mirror layer's reflected rays (MirrorSkyTerms); and the
-// film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// key; the frame's lighting effects (EffectsNotOnGpu: light scales and extra lights through
+// LightSampler::Update, the moved or scaled sky and the surface wetness through
+// render/effects_sky.h, as the CPU backend's MediaFrame); the sky model and sky volume (SkyData,
+// for DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary
+// rays' geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h,
+// which the device's sky kernel runs too) and those of the mirror layer's reflected rays
+// (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
 // path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
 // GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
@@ -21,6 +23,7 @@
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/effects_sky.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/render_settings.h"
@@ -30,6 +33,13 @@
 
 namespace penumbra::cuda {
 
+/// why a frame under `effects` cannot be rendered on the GPU ("" if it can: none, or only
+/// lighting effects: EffectsFrame::light_intensity_scale, extra_lights, sun_direction_W,
+/// sky_luminance_scale and surface_wetness). otherwise names what is not on the GPU yet:
+/// "homogeneous media (fog, haze, dust)", "grid media (smoke, fire, VDB)", "particles (rain,
+/// snow, sparks)", joined by ", " where several are set.
+std::string EffectsNotOnGpu(const EffectsFrame* effects);
+
 /// the plain data of a scene's realtime frames (file comment). not thread-safe.
 class RealtimeFrameData {
  public:
@@ -38,18 +48,25 @@ class RealtimeFrameData {
   /// @throws Error if a texture has more than kMaxTextureLevels levels.
   RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings);
 
-  /// why a frame of `view` cannot be rendered by the GPU realtime path ("" if it can): not
-  /// the realtime tier, or effects. (lens distortion and camera motion are: camera_rays.h.)
+  /// why a frame of `view` under `effects` cannot be rendered by the GPU realtime path ("" if
+  /// it can): not the realtime tier, or effects not on the GPU (EffectsNotOnGpu). (lens
+  /// distortion and camera motion are: camera_rays.h.)
   std::string Unsupported(const EffectsFrame* effects, const CameraView& view) const;
 
-  /// poses the lights and geoms from `snapshot`, sets the camera and frame key of `view`, and
-  /// updates the sky volume (built on the first call and when the static bodies move): PoseWorld,
-  /// then SetCamera. a camera with lens distortion or motion gets its ray tables
-  /// (camera_rays.h), the camera() pointing to their host arrays.
-  void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool);
+  /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none;
+  /// they must be on the GPU, EffectsNotOnGpu), sets the camera and frame key of `view`, and
+  /// updates the sky volume (built on the first call and when the static bodies move, relit
+  /// when the effects change the sky): PoseWorld, then SetCamera. a camera with lens distortion
+  /// or motion gets its ray tables (camera_rays.h), the camera() pointing to their host arrays.
+  /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
+  /// outside [0, 1]), as the CPU backend.
+  void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
+               const EffectsFrame* effects = nullptr);
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
-  /// again only for bodies whose pose changed since the last call) and the sky volume.
-  void PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool);
+  /// again only for bodies whose pose changed since the last call), the effects' sky and
+  /// wetness and the sky volume. @throws as Prepare.
+  void PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool,
+                 const EffectsFrame* effects = nullptr);
   /// the camera part of Prepare: the pinhole camera, its pixel spread (radians), the frame's
   /// random-number key (FrameContext::FrameKey of the settings' seed, camera_index and
   /// frame_index) and the view's white-balance gains (Ev100's exposures).
@@ -86,7 +103,8 @@ class RealtimeFrameData {
   /// the sky model's and the sky volume's plain data (host arrays) for the device copies
   /// (DeviceRealtime::UploadSky); current while sky_generation() is unchanged.
   RealtimeSky SkyData() const;
-  /// changes whenever Prepare rebuilt or relit the sky volume.
+  /// changes whenever Prepare rebuilt or relit the sky volume (also when the effects changed
+  /// the sky: the volume is relit with it).
   uint64_t sky_generation() const { return volume_.generation(); }
 
   /// whether some material has a mirror layer (MaterialPod::mirror > 0): frames without one
@@ -123,7 +141,10 @@ class RealtimeFrameData {
   std::vector<uint8_t> texels_;
   std::vector<GeomPod> geoms_;
   LightSampler lights_;
-  SkyModel sky_;
+  SkyModel sky_;                       // the scene's sky
+  EffectsSky effects_sky_;             // the effects' sky (moved sun, scaled luminance)
+  const SkyModel* frame_sky_ = &sky_;  // the frame's: sky_ or effects_sky_'s
+  float wetness_ = 0;                  // EffectsFrame::surface_wetness of the frame
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;

@@ -23,8 +23,10 @@
 // grid (render/mirror_math.h; TraceMirrorRay), its hit shaded with one random sample of every
 // light and a shadow ray and the occluded sky irradiance at the hit (MirrorSkyTerm, beside the
 // primary sky terms; ShadeMirrorHit), the other
-// layer pixels interpolated from the grid and blended (ApplyMirrorLayer). what the GPU path
-// does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
+// layer pixels interpolated from the grid and blended (ApplyMirrorLayer). the lighting effects
+// reach it as the CPU's: the lights (scaled, extra) and the sky (moved sun, scaled) through
+// the frame's data, the surface wetness in EvaluateSurface (render/wetness_math.h). what the GPU
+// path does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
 // untextured), cube textures on geoms (untextured), MJCF skyboxes, and interpolated shading
 // normals (the geometric normal shades).
 
@@ -44,6 +46,7 @@
 #include "penumbra/render/shadow_window_math.h"
 #include "penumbra/render/sky_eval_math.h"
 #include "penumbra/render/texture_math.h"
+#include "penumbra/render/wetness_math.h"
 
 namespace penumbra::cuda {
 
@@ -119,6 +122,8 @@ struct RealtimeFrameView {
   const LightPod* lights = nullptr;
   int32_t num_lights = 0;
   int32_t max_anisotropy = 1;
+  /// EffectsFrame::surface_wetness of the frame in [0, 1] (0: dry; EvaluateSurface).
+  float wetness = 0;
   uint64_t frame_key = 0;  ///< FrameContext::FrameKey()
   /// per pixel: E_sky on the surface the pixel's ray hits, or the sky radiance where it
   /// escapes (QuadSkyTerms).
@@ -416,6 +421,14 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
       Float3 bent;
       if (BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent)) ns = bent;
     }
+  }
+  // rain wetness (render/wetness_math.h) at the (bent) shading normal, after the PBR maps: the
+  // CPU's ApplySurfaceWetness at SurfaceHit::ns_W, in its primary shading and mirror layer.
+  float wet_scale, wet_roughness;
+  if (f.wetness > 0 &&
+      SurfaceWetnessTerms(f.wetness, ns.z, sp.metallic, sp.roughness, &wet_scale, &wet_roughness)) {
+    sp.base = sp.base * wet_scale;
+    sp.roughness = wet_roughness;
   }
   sp.n = pbm::Dot<float>(ns, sp.wo) > 0 ? ns : ng;
   return sp;

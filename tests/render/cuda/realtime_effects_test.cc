@@ -1,0 +1,213 @@
+// the lighting effects (light intensity scales, extra lights, the moved or scaled sky, surface
+// wetness; issue 35 item 5) on the CUDA backend's realtime rgb path, run on the CPU
+// (RenderRealtimeOnHost: the PB_HOST_DEVICE functions the kernels run), against the CPU
+// backend rendering the same EffectsFrame: the bundled worlds whose effects are only lighting
+// (effects/blackout.yaml at 1 s and in its power cut at 4 s, effects/flashlight.yaml,
+// effects/sun.yaml) and a hand-made frame with every lighting field set on the default room, at
+// 160x120: rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, two renders
+// bit-identical, and the effects change the image. the effects the GPU does not draw yet (media,
+// particles) are named by EffectsNotOnGpu. no GPU needed.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/cuda_renderer.h"
+#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/material_eval.h"
+#include "penumbra/render/wetness_math.h"
+#include "realtime_parity.h"
+
+namespace penumbra {
+namespace {
+
+struct HostCompared {
+  double psnr = 0, depth_bad = 1;
+  RenderedFrame cpu, host, again;
+};
+
+// the CPU backend and the GPU path on the host render `view` of `scene` at `snap` under `fx`.
+HostCompared CompareWithCpu(const SceneDescription& scene, const WorldSnapshot& snap,
+                            const CameraView& view, const EffectsFrame* fx) {
+  RenderSettings settings;
+  settings.backend = RenderSettings::Backend::kEmbree;
+  const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, settings);
+  HostCompared c;
+  cpu->Render(snap, fx, view, &c.cpu);
+  cuda::BvhScene bvh(scene);
+  bvh.Update(snap);
+  cuda::RealtimeFrameData data(scene, settings);
+  ThreadPool pool(0);
+  EXPECT_EQ(data.Unsupported(fx, view), "");
+  data.Prepare(snap, view, &pool, fx);
+  cuda::RenderRealtimeOnHost(data, bvh, &pool, &c.host, /*stored_surface=*/true);
+  cuda::RenderRealtimeOnHost(data, bvh, &pool, &c.again, /*stored_surface=*/true);
+  c.psnr = realtime_parity::Psnr(c.cpu.rgb, c.host.rgb);
+  c.depth_bad = realtime_parity::DepthMismatch(c.cpu.depth_m, c.host.depth_m);
+  return c;
+}
+
+struct HostEffectsWorld {
+  const char* file;
+  double t_sec;
+};
+
+class RealtimeHostPathEffects : public ::testing::TestWithParam<HostEffectsWorld> {};
+
+TEST_P(RealtimeHostPathEffects, MatchesCpuBackend) {
+  const HostEffectsWorld& w = GetParam();
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, w.t_sec);
+  const SceneDescription& scene = session->scene();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+  const std::shared_ptr<const EffectsFrame> fx =
+      session->effects().Evaluate(snap, view.X_WO.translation());
+  ASSERT_TRUE(fx && !fx->empty()) << w.file;
+  EXPECT_EQ(cuda::EffectsNotOnGpu(fx.get()), "") << w.file;
+  EXPECT_TRUE(cuda::CudaRenderer::OnGpu(fx.get(), view)) << w.file;
+  const HostCompared c = CompareWithCpu(scene, snap, view, fx.get());
+  // the clear frame of the same instant: the effects must change the GPU path's image.
+  const HostCompared clear = CompareWithCpu(scene, snap, view, nullptr);
+  std::printf(
+      "%s at %.1f s 160x120: rgb PSNR %.2f dB (clear frame %.2f dB), ev100 cpu %.4f "
+      "host-gpu-path %.4f (clear %.4f), depth > 1 mm on %.4f %% of pixels\n",
+      w.file, w.t_sec, c.psnr, clear.psnr, c.cpu.ev100, c.host.ev100, clear.host.ev100,
+      100 * c.depth_bad);
+  EXPECT_GE(c.psnr, 40.0) << w.file;
+  EXPECT_LE(c.depth_bad, 0.001) << w.file;
+  EXPECT_EQ(c.host.rgb.data, c.again.rgb.data) << w.file;
+  EXPECT_EQ(c.host.radiance.data, c.again.radiance.data) << w.file;
+  EXPECT_NE(c.host.radiance.data, clear.host.radiance.data) << w.file;
+}
+
+INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathEffects,
+                         ::testing::Values(HostEffectsWorld{"effects/blackout.yaml", 1.0},
+                                           HostEffectsWorld{"effects/blackout.yaml", 4.0},
+                                           HostEffectsWorld{"effects/flashlight.yaml", 1.0},
+                                           HostEffectsWorld{"effects/sun.yaml", 1.0}));
+
+// every lighting field at once on the default room (its window lets the sun and sky in): a
+// lamp scaled, the sun moved and the sky dimmed, a spot light added, the floor wet.
+TEST(RealtimeHostPathEffectsFrames, EveryLightingFieldMatchesCpuBackend) {
+  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt("default.yaml", 1.0);
+  const SceneDescription& scene = session->scene();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+  EffectsFrame fx;
+  fx.light_intensity_scale.assign(scene.lights.size(), 0.5f);
+  fx.sun_direction_W = Eigen::Vector3d(0.3, -0.5, 0.6);
+  fx.sky_luminance_scale = 0.4f;
+  fx.surface_wetness = 0.8f;
+  Light spot;
+  spot.type = Light::Type::kSpot;
+  spot.position_B = view.X_WO.translation() + Eigen::Vector3d(0, 0, 0.2);
+  spot.direction_B = view.X_WO.linear().col(2);
+  spot.intensity = 300;
+  spot.spot_inner_deg = 15;
+  spot.spot_outer_deg = 30;
+  fx.extra_lights.push_back(spot);
+  ASSERT_EQ(cuda::EffectsNotOnGpu(&fx), "");
+  const HostCompared c = CompareWithCpu(scene, snap, view, &fx);
+  const HostCompared clear = CompareWithCpu(scene, snap, view, nullptr);
+  std::printf("default + every lighting field 160x120: rgb PSNR %.2f dB, ev100 cpu %.4f / %.4f\n",
+              c.psnr, c.cpu.ev100, c.host.ev100);
+  EXPECT_GE(c.psnr, 40.0);
+  EXPECT_LE(c.depth_bad, 0.001);
+  EXPECT_EQ(c.host.rgb.data, c.again.rgb.data);
+  EXPECT_NE(c.host.radiance.data, clear.host.radiance.data);
+  // out of range, as the CPU backend: a ConfigError naming the key.
+  fx.surface_wetness = 1.5f;
+  cuda::RealtimeFrameData data(scene, RenderSettings());
+  ThreadPool pool(0);
+  EXPECT_THROW(data.Prepare(snap, view, &pool, &fx), ConfigError);
+  fx.surface_wetness = 0;
+  fx.sky_luminance_scale = -1;
+  EXPECT_THROW(data.Prepare(snap, view, &pool, &fx), ConfigError);
+}
+
+// the effects the GPU does not draw yet are named (the CUDA backend's log line and fallback).
+TEST(RealtimeHostPathEffectsFrames, MediaAndParticlesAreNamed) {
+  EffectsFrame fx;
+  fx.surface_wetness = 0.5f;
+  fx.extra_lights.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(nullptr), "");
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
+  fx.homogeneous_media.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "homogeneous media (fog, haze, dust)");
+  fx.grid_media.emplace_back();
+  fx.particles.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx),
+            "homogeneous media (fog, haze, dust), grid media (smoke, fire, VDB), particles (rain, "
+            "snow, sparks)");
+  CameraView view;
+  view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
+  EXPECT_FALSE(cuda::CudaRenderer::OnGpu(&fx, view));
+}
+
+// which bundled effects worlds' frames at 1 s render on the GPU (docs/gpu.md lists them): the
+// lighting-only ones do, those with media or particles name them.
+TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
+  const struct {
+    const char* file;
+    const char* not_on_gpu;  // "" on the GPU; else a part of EffectsNotOnGpu's answer
+  } worlds[] = {{"effects/blackout.yaml", ""},
+                {"effects/flashlight.yaml", ""},
+                {"effects/sun.yaml", ""},
+                {"effects/fog.yaml", "homogeneous media"},
+                {"effects/height_fog.yaml", "homogeneous media"},
+                {"effects/dust.yaml", "homogeneous media"},
+                {"effects/smoke_plume.yaml", "grid media"},
+                {"effects/vdb_smoke.yaml", "grid media"},
+                {"effects/fire.yaml", "grid media"},
+                {"effects/rain.yaml", "particles"},
+                {"effects/snow.yaml", "particles"},
+                {"effects/adversity_major.yaml", "media"}};
+  for (const auto& w : worlds) {
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, 1.0);
+    const WorldSnapshot snap = session->sim().Snapshot();
+    const CameraView view = realtime_parity::RgbDepthView(session->scene(), snap, 32, 24);
+    const std::shared_ptr<const EffectsFrame> fx =
+        session->effects().Evaluate(snap, view.X_WO.translation());
+    ASSERT_TRUE(fx && !fx->empty()) << w.file;
+    const std::string why = cuda::EffectsNotOnGpu(fx.get());
+    std::printf("%s at 1 s: %s\n", w.file, why.empty() ? "on the GPU" : why.c_str());
+    if (std::string(w.not_on_gpu).empty()) {
+      EXPECT_EQ(why, "") << w.file;
+    } else {
+      EXPECT_NE(why.find(w.not_on_gpu), std::string::npos) << w.file << ": " << why;
+    }
+  }
+}
+
+// the shared wetness formula: dry where the surface is vertical or faces down, albedo x 0.3 and
+// gloss x 2.5 (capped) fully wet facing up, metals keep their albedo; ApplySurfaceWetness (the
+// CPU's) is it.
+TEST(RealtimeHostPathEffectsFrames, SharedWetnessFormula) {
+  float scale = -1, rough = -1;
+  EXPECT_FALSE(SurfaceWetnessTerms(1.0f, 0.0f, 0.0f, 0.5f, &scale, &rough));
+  EXPECT_FALSE(SurfaceWetnessTerms(1.0f, -1.0f, 0.0f, 0.5f, &scale, &rough));
+  EXPECT_FALSE(SurfaceWetnessTerms(0.0f, 1.0f, 0.0f, 0.5f, &scale, &rough));
+  ASSERT_TRUE(SurfaceWetnessTerms(1.0f, 1.0f, 0.0f, 0.8f, &scale, &rough));
+  EXPECT_FLOAT_EQ(scale, 0.3f);
+  EXPECT_FLOAT_EQ(rough, 1.0f - 0.2f * 2.5f);
+  ASSERT_TRUE(SurfaceWetnessTerms(1.0f, 1.0f, 1.0f, 0.2f, &scale, &rough));
+  EXPECT_FLOAT_EQ(scale, 1.0f);
+  EXPECT_FLOAT_EQ(rough, 0.0f);
+  PbrParams pbr;
+  pbr.base_color = Eigen::Vector3f(0.5f, 0.25f, 1.0f);
+  pbr.roughness = 0.6f;
+  ApplySurfaceWetness(0.7f, Eigen::Vector3f(0, 0.6f, 0.8f), &pbr);
+  ASSERT_TRUE(SurfaceWetnessTerms(0.7f, 0.8f, 0.0f, 0.6f, &scale, &rough));
+  EXPECT_EQ(pbr.base_color.x(), 0.5f * scale);
+  EXPECT_EQ(pbr.base_color.y(), 0.25f * scale);
+  EXPECT_EQ(pbr.roughness, rough);
+}
+
+}  // namespace
+}  // namespace penumbra
