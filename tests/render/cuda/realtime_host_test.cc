@@ -24,6 +24,28 @@
 namespace penumbra {
 namespace {
 
+// the CPU backend's frame of `view` (want) and the GPU path's run on the host (got, and a second
+// render: again).
+struct HostPathFrames {
+  RenderedFrame want, got, again;
+};
+HostPathFrames RenderCpuAndHostPath(const SceneDescription& scene, const WorldSnapshot& snap,
+                                    const CameraView& view) {
+  RenderSettings settings;
+  settings.backend = RenderSettings::Backend::kEmbree;
+  HostPathFrames f;
+  MakeRenderer(scene, settings)->Render(snap, view, &f.want);
+  cuda::BvhScene bvh(scene);
+  bvh.Update(snap);
+  cuda::RealtimeFrameData data(scene, settings);
+  ThreadPool pool(0);
+  EXPECT_EQ(data.Unsupported(nullptr, view), "");
+  data.Prepare(snap, view, &pool);
+  cuda::RenderRealtimeOnHost(data, bvh, &pool, &f.got);
+  cuda::RenderRealtimeOnHost(data, bvh, &pool, &f.again);
+  return f;
+}
+
 class RealtimeHostPath : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealtimeHostPath, MatchesCpuBackend) {
@@ -31,21 +53,7 @@ TEST_P(RealtimeHostPath, MatchesCpuBackend) {
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
-  RenderSettings settings;
-  settings.backend = RenderSettings::Backend::kEmbree;
-  const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, settings);
-  RenderedFrame want;
-  cpu->Render(snap, view, &want);
-
-  cuda::BvhScene bvh(scene);
-  bvh.Update(snap);
-  cuda::RealtimeFrameData data(scene, settings);
-  ThreadPool pool(0);
-  ASSERT_EQ(data.Unsupported(nullptr, view), "");
-  data.Prepare(snap, view, &pool);
-  RenderedFrame got, again;
-  cuda::RenderRealtimeOnHost(data, bvh, &pool, &got);
-  cuda::RenderRealtimeOnHost(data, bvh, &pool, &again);
+  const auto [want, got, again] = RenderCpuAndHostPath(scene, snap, view);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
   std::printf(
@@ -138,18 +146,7 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
   snap.tendon_paths = {{0, {{3, -0.3, 0.05}, {3, -0.3, 0.6}, {3, 0.3, 0.9}}}};
   CameraView view = testing::MakeView(testing::CameraLookingAlongX({0, 0, 0.6}), 160, 120, 60);
   view.outputs[ImageKind::kSegmentation] = true;
-  RenderSettings settings;
-  settings.backend = RenderSettings::Backend::kEmbree;
-  const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, settings);
-  RenderedFrame want;
-  cpu->Render(snap, view, &want);
-  cuda::BvhScene bvh(scene);
-  bvh.Update(snap);
-  cuda::RealtimeFrameData data(scene, settings);
-  ThreadPool pool(0);
-  data.Prepare(snap, view, &pool);
-  RenderedFrame got;
-  cuda::RenderRealtimeOnHost(data, bvh, &pool, &got);
+  const auto [want, got, again] = RenderCpuAndHostPath(scene, snap, view);
   int tendon_pixels = 0;
   for (size_t i = 0; i < want.geom_id.data.size(); ++i)
     tendon_pixels += want.geom_id.data[i] == -1 && want.depth_m.data[i] > 0;

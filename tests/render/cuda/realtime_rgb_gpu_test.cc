@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cstdio>
 #include <string>
 
@@ -19,6 +18,31 @@
 namespace penumbra {
 namespace {
 
+// the CPU backend's frame of `view` (want) and two CudaRenderer renders of it (got, again), with
+// how many frames the GPU and the CPU renderer inside it rendered.
+struct GpuFrames {
+  RenderedFrame want, got, again;
+  int64_t gpu_frames = 0, cpu_frames = 0;
+};
+GpuFrames RenderCpuAndGpuTwice(const SceneDescription& scene, const WorldSnapshot& snap,
+                               const CameraView& view) {
+  RenderSettings cpu_settings;
+  cpu_settings.backend = RenderSettings::Backend::kEmbree;
+  RenderSettings gpu_settings;
+  gpu_settings.backend = RenderSettings::Backend::kCuda;
+  GpuFrames f;
+  MakeRenderer(scene, cpu_settings)->Render(snap, view, &f.want);
+  const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
+  auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
+  EXPECT_NE(g, nullptr);
+  if (g == nullptr) return f;
+  gpu->Render(snap, view, &f.got);
+  gpu->Render(snap, view, &f.again);
+  f.gpu_frames = g->gpu_frames();
+  f.cpu_frames = g->cpu_frames();
+  return f;
+}
+
 class RealtimeRgbGpu : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealtimeRgbGpu, MatchesCpuBackendAndRepeatsBitForBit) {
@@ -27,20 +51,9 @@ TEST_P(RealtimeRgbGpu, MatchesCpuBackendAndRepeatsBitForBit) {
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
-  RenderSettings cpu_settings;
-  cpu_settings.backend = RenderSettings::Backend::kEmbree;
-  RenderSettings gpu_settings;
-  gpu_settings.backend = RenderSettings::Backend::kCuda;
-  const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
-  const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
-  auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
-  ASSERT_NE(g, nullptr);
-  RenderedFrame want, got, again;
-  cpu->Render(snap, view, &want);
-  gpu->Render(snap, view, &got);
-  gpu->Render(snap, view, &again);
-  EXPECT_EQ(g->gpu_frames(), 2);
-  EXPECT_EQ(g->cpu_frames(), 0);
+  const auto [want, got, again, gpu_frames, cpu_frames] = RenderCpuAndGpuTwice(scene, snap, view);
+  EXPECT_EQ(gpu_frames, 2);
+  EXPECT_EQ(cpu_frames, 0);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
   std::printf(
@@ -80,20 +93,9 @@ TEST(RealtimeRgbGpuCameras, DistortedRollingShutterCameraRendersOnTheGpu) {
   view.motion.line_time_sec = 0.03 / 480;
   view.motion.X_WO_end = view.X_WO;
   view.motion.X_WO_end.translation() += Eigen::Vector3d(0.15, 0.05, 0);
-  RenderSettings cpu_settings;
-  cpu_settings.backend = RenderSettings::Backend::kEmbree;
-  RenderSettings gpu_settings;
-  gpu_settings.backend = RenderSettings::Backend::kCuda;
-  const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
-  const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
-  auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
-  ASSERT_NE(g, nullptr);
-  RenderedFrame want, got, again;
-  cpu->Render(snap, view, &want);
-  gpu->Render(snap, view, &got);
-  gpu->Render(snap, view, &again);
-  EXPECT_EQ(g->gpu_frames(), 2);
-  EXPECT_EQ(g->cpu_frames(), 0);
+  const auto [want, got, again, gpu_frames, cpu_frames] = RenderCpuAndGpuTwice(scene, snap, view);
+  EXPECT_EQ(gpu_frames, 2);
+  EXPECT_EQ(cpu_frames, 0);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
   int64_t seg_bad = 0;
