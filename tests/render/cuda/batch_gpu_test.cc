@@ -24,6 +24,7 @@
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
+#include "realtime_parity.h"
 
 namespace penumbra {
 namespace {
@@ -284,6 +285,61 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
       EXPECT_GT(lit, n / 10);
     }
   }
+}
+
+// a world's lighting effects (UpdateWorld's EffectsFrame: the flashlight world's flashlight and
+// light events at 1 s) reach every rgb camera of that world in a batch: the same rgb and depth
+// bytes as CudaRenderer rendering each camera alone under the same effects, and a visible change
+// from the clear frame; a frame with media is refused for rgb and taken for the ground truth.
+TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
+  PB_REQUIRE_CUDA_DEVICE_FOR_BATCH();
+  const std::unique_ptr<Session> session =
+      realtime_parity::LoadSimulatedAt("effects/flashlight.yaml", 1.0);
+  const SceneDescription& scene = session->scene();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  CameraView base = realtime_parity::RgbDepthView(scene, snap, kBatchW, kBatchH);
+  const std::shared_ptr<const EffectsFrame> fx =
+      session->effects().Evaluate(snap, base.X_WO.translation());
+  ASSERT_TRUE(fx && !fx->empty());
+  std::vector<CameraView> views;
+  std::vector<cuda::BatchCamera> cams;
+  for (int k = 0; k < 4; ++k) {
+    views.push_back(cuda::OrbitView(base, 2 * M_PI * k / 4));
+    views.back().frame_index = k;
+    cams.push_back(cuda::BatchRenderer::CameraOf(0, views.back()));
+  }
+  cuda::BatchConfig config;
+  config.width = kBatchW;
+  config.height = kBatchH;
+  config.max_cameras = 4;
+  config.outputs.segmentation = false;
+  config.outputs.rgb = true;
+  cuda::BatchRenderer r(config);
+  r.AddWorld(scene);
+  r.UpdateWorld(0, snap);
+  const std::vector<uint8_t> clear = BatchBytes(r.Wait(r.Submit(cams)));
+  r.UpdateWorld(0, snap, fx.get());
+  const cuda::BatchImages img = r.Wait(r.Submit(cams));
+  EXPECT_FALSE(BatchBytes(img) == clear) << "the effects changed nothing";
+  RenderSettings gpu_settings;
+  gpu_settings.backend = RenderSettings::Backend::kCuda;
+  const int n = kBatchW * kBatchH;
+  for (int k = 0; k < 4; ++k) {
+    SCOPED_TRACE("camera " + std::to_string(k));
+    const std::unique_ptr<Renderer> single = MakeRenderer(scene, gpu_settings);
+    RenderedFrame f;
+    single->Render(snap, fx.get(), views[k], &f);
+    ASSERT_EQ(f.rgb.data.size(), static_cast<size_t>(3 * n));
+    EXPECT_EQ(std::memcmp(f.rgb.data.data(), img.rgb(k), 3 * n), 0);
+    EXPECT_EQ(std::memcmp(f.depth_m.data.data(), img.depth(k), 4 * n), 0);
+  }
+  EffectsFrame fog = *fx;
+  fog.homogeneous_media.emplace_back();
+  fog.homogeneous_media.back().sigma_t_per_m = Eigen::Vector3f::Constant(0.1f);
+  EXPECT_THROW(r.UpdateWorld(0, snap, &fog), Error);
+  cuda::BatchRenderer truth(AllTruth(4));
+  truth.AddWorld(scene);
+  EXPECT_NO_THROW(truth.UpdateWorld(0, snap, &fog));
 }
 
 }  // namespace

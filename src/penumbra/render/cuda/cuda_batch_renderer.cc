@@ -53,10 +53,16 @@ int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings&
   return static_cast<int>(worlds_.size()) - 1;
 }
 
-void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot) {
+void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
+                                const EffectsFrame* effects) {
   if (world < 0 || world >= num_worlds())
     throw Error(
         fmt::format("batch rendering: world {}; expected a world in [0, {})", world, num_worlds()));
+  // the ground truth does not see effects; the rgb takes the lighting ones only
+  const std::string not_on_gpu = layout_.outputs().rgb ? EffectsNotOnGpu(effects) : "";
+  if (!not_on_gpu.empty())
+    throw Error(fmt::format("batch rendering: world {}: effects with {} are not on the GPU yet",
+                            world, not_on_gpu));
   World& w = *worlds_[world];
   w.bvh->Update(snapshot);
   // the submitted kernels read this world's transforms (and, after a rebuild, its arrays)
@@ -64,7 +70,7 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot) {
   SyncDevice(*w.bvh, w.device.get());
   views_[world] = w.device->device_view();
   if (!w.realtime) return;
-  w.realtime->PoseWorld(snapshot, pool_.get());
+  w.realtime->PoseWorld(snapshot, pool_.get(), effects);
   if (!w.sky_uploaded || w.realtime->sky_generation() != w.sky_generation) {
     w.device_realtime->UploadSky(w.realtime->SkyData());
     w.sky_generation = w.realtime->sky_generation();

@@ -97,10 +97,14 @@ class BatchRenderer {
   int num_worlds() const { return static_cast<int>(worlds_.size()); }
   /// poses world `world`'s bodies from `snapshot` (its instances' transforms; the static BVH is
   /// rebuilt only if a static body moved; with rgb also its lights, geoms and sky volume,
-  /// RealtimeFrameData::PoseWorld). waits for the kernels already submitted (they read the
-  /// transforms), not for their copies back.
-  /// @throws Error for a bad index or snapshot (BvhScene::Update).
-  void UpdateWorld(int world, const WorldSnapshot& snapshot);
+  /// RealtimeFrameData::PoseWorld) under the lighting `effects` of that instant (null: none;
+  /// light scales, extra lights, a moved or scaled sky, surface wetness; they apply to the rgb of
+  /// every camera of this world until the next UpdateWorld). waits for the kernels already
+  /// submitted (they read the transforms), not for their copies back.
+  /// @throws Error for a bad index or snapshot (BvhScene::Update), or, in a batch with rgb,
+  ///         effects with media or particles (not on the GPU yet: EffectsNotOnGpu names them;
+  ///         the ground-truth images do not depend on effects).
+  void UpdateWorld(int world, const WorldSnapshot& snapshot, const EffectsFrame* effects = nullptr);
 
   /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each
   /// realtime stage, and a host function on the stream that computes each camera's exposure
