@@ -74,6 +74,17 @@ cuda::BatchConfig AllTruth(int max_cameras, cuda::BatchCopy copy = cuda::BatchCo
   return c;
 }
 
+// a batch of the realtime rgb (and its depth) only, up to max_cameras cameras.
+cuda::BatchConfig RgbOnly(int max_cameras) {
+  cuda::BatchConfig c;
+  c.width = kBatchW;
+  c.height = kBatchH;
+  c.max_cameras = max_cameras;
+  c.outputs.segmentation = false;
+  c.outputs.rgb = true;
+  return c;
+}
+
 // the host bytes of a batch (every plane)
 std::vector<uint8_t> BatchBytes(const cuda::BatchImages& img) {
   const int64_t n = img.layout->bytes(img.cameras);
@@ -237,12 +248,7 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
         views[k].outputs[ImageKind::kSemanticSegmentation] = false;
     cams[k] = cuda::BatchRenderer::CameraOf(k % 2, views[k]);
   }
-  cuda::BatchConfig config;
-  config.width = kBatchW;
-  config.height = kBatchH;
-  config.max_cameras = 8;
-  config.outputs.segmentation = false;
-  config.outputs.rgb = true;
+  const cuda::BatchConfig config = RgbOnly(8);
   std::vector<uint8_t> first;
   for (int run = 0; run < 2; ++run) {
     cuda::BatchRenderer r(config);
@@ -308,12 +314,7 @@ TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
     views.back().frame_index = k;
     cams.push_back(cuda::BatchRenderer::CameraOf(0, views.back()));
   }
-  cuda::BatchConfig config;
-  config.width = kBatchW;
-  config.height = kBatchH;
-  config.max_cameras = 4;
-  config.outputs.segmentation = false;
-  config.outputs.rgb = true;
+  const cuda::BatchConfig config = RgbOnly(4);
   cuda::BatchRenderer r(config);
   r.AddWorld(scene);
   r.UpdateWorld(0, snap);

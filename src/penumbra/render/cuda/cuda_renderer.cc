@@ -128,7 +128,8 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
     device_realtime_->Upload(st);
     realtime_uploaded_ = true;
   }
-  realtime_->Prepare(snapshot, view, pool_.get(), effects);
+  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again
+  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_);
   // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
   // the sky change: its device copy follows
   if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {

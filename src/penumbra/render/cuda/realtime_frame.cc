@@ -138,12 +138,15 @@ std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
 }
 
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
-                                ThreadPool* pool, const EffectsFrame* effects) {
+                                ThreadPool* pool, const EffectsFrame* effects,
+                                const CameraRayTables* rays) {
   PoseWorld(snapshot, pool, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
-  camera_rays_.Prepare(view, pool);
-  SetCamera(camera_rays_.Point(PinholeCameraOf(view), camera_rays_.xy().data(),
-                               camera_rays_.rows().data()),
+  if (rays == nullptr) {
+    camera_rays_.Prepare(view, pool);
+    rays = &camera_rays_;
+  }
+  SetCamera(rays->Point(PinholeCameraOf(view), rays->xy().data(), rays->rows().data()),
             camera.pixel_spread_rad(), view.camera_index, view.frame_index,
             view.white_balance_gains);
 }

@@ -57,11 +57,13 @@ class RealtimeFrameData {
   /// they must be on the GPU, EffectsNotOnGpu), sets the camera and frame key of `view`, and
   /// updates the sky volume (built on the first call and when the static bodies move, relit
   /// when the effects change the sky): PoseWorld, then SetCamera. a camera with lens distortion
-  /// or motion gets its ray tables (camera_rays.h), the camera() pointing to their host arrays.
+  /// or motion gets its ray tables (camera_rays.h), the camera() pointing to their host arrays:
+  /// `rays` if given (the caller Prepared them for `view` and keeps them alive), else tables
+  /// this object fills.
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
   /// outside [0, 1]), as the CPU backend.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
-               const EffectsFrame* effects = nullptr);
+               const EffectsFrame* effects = nullptr, const CameraRayTables* rays = nullptr);
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
   /// again only for bodies whose pose changed since the last call), the effects' sky and
   /// wetness and the sky volume. @throws as Prepare.
@@ -148,7 +150,7 @@ class RealtimeFrameData {
   SkyIrradianceVolume volume_;
   Film film_;
   PinholeCamera camera_;
-  CameraRayTables camera_rays_;  // Prepare's view's tables (host), camera_ points to them
+  CameraRayTables camera_rays_;  // Prepare's view's tables when the caller gives none
   Eigen::Vector3f white_balance_gains_ = Eigen::Vector3f::Ones();  // the prepared view's
   // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
   int CheckRows(const char* what, int64_t n, int row0, int row1) const;
