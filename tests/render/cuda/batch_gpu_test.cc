@@ -114,14 +114,20 @@ class BatchRendering : public ::testing::Test {
     worlds_.push_back(LoadBatchWorld("default.yaml"));
     worlds_.push_back(LoadBatchWorld("house.yaml"));
   }
-  // 8 cameras over both worlds: camera k in world k % 2, turned by 2 pi k / 8
-  std::vector<cuda::BatchCamera> Cameras(std::vector<CameraView>* views) const {
+  // 8 views over both worlds: view k in world k % 2, turned by 2 pi k / 8
+  std::vector<CameraView> Views() const {
+    std::vector<CameraView> views;
+    for (int k = 0; k < 8; ++k)
+      views.push_back(cuda::OrbitView(worlds_[k % 2].view, 2 * M_PI * k / 8));
+    return views;
+  }
+  // their pinhole cameras (they name no ray tables, so any renderer renders them)
+  std::vector<cuda::BatchCamera> Cameras(cuda::BatchRenderer& r,
+                                         std::vector<CameraView>* views) const {
     std::vector<cuda::BatchCamera> cams;
-    for (int k = 0; k < 8; ++k) {
-      const CameraView v = cuda::OrbitView(worlds_[k % 2].view, 2 * M_PI * k / 8);
-      if (views) views->push_back(v);
-      cams.push_back(cuda::BatchRenderer::CameraOf(k % 2, v));
-    }
+    const std::vector<CameraView> v = Views();
+    for (int k = 0; k < 8; ++k) cams.push_back(r.CameraOf(k % 2, v[k]));
+    if (views) *views = v;
     return cams;
   }
   void AddWorlds(cuda::BatchRenderer* r) const {
@@ -132,9 +138,9 @@ class BatchRendering : public ::testing::Test {
 
 TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
   std::vector<CameraView> views;
-  const std::vector<cuda::BatchCamera> cams = Cameras(&views);
   cuda::BatchRenderer r(AllTruth(8));
   AddWorlds(&r);
+  const std::vector<cuda::BatchCamera> cams = Cameras(r, &views);
   ASSERT_EQ(r.num_worlds(), 2);
   const cuda::BatchImages all = r.Wait(r.Submit(cams));
   ASSERT_EQ(all.cameras, 8);
@@ -173,11 +179,12 @@ TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
 }
 
 TEST_F(BatchRendering, TwoRunsGiveTheSameBits) {
-  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
+  std::vector<cuda::BatchCamera> cams;
   std::vector<uint8_t> first;
   for (int run = 0; run < 2; ++run) {
     cuda::BatchRenderer r(AllTruth(8));
     AddWorlds(&r);
+    if (run == 0) cams = Cameras(r, nullptr);
     const std::vector<uint8_t> bytes = BatchBytes(r.Wait(r.Submit(cams)));
     if (run == 0)
       first = bytes;
@@ -191,9 +198,9 @@ TEST_F(BatchRendering, TwoRunsGiveTheSameBits) {
 }
 
 TEST_F(BatchRendering, OverlappedBatchesKeepTheirOwnImages) {
-  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
   cuda::BatchRenderer r(AllTruth(8));
   AddWorlds(&r);
+  const std::vector<cuda::BatchCamera> cams = Cameras(r, nullptr);
   // reference: each half alone, waited at once
   const std::vector<uint8_t> a = BatchBytes(r.Wait(r.Submit(std::span(cams).first(4))));
   const std::vector<uint8_t> b = BatchBytes(r.Wait(r.Submit(std::span(cams).last(4))));
@@ -225,20 +232,34 @@ TEST_F(BatchRendering, OverlappedBatchesKeepTheirOwnImages) {
 }
 
 TEST_F(BatchRendering, DeviceOnlyBatchesAreNotCopiedBack) {
-  const std::vector<cuda::BatchCamera> cams = Cameras(nullptr);
   cuda::BatchRenderer r(AllTruth(8, cuda::BatchCopy::kNone));
   AddWorlds(&r);
+  const std::vector<cuda::BatchCamera> cams = Cameras(r, nullptr);
   const int64_t t = r.Submit(cams);
   EXPECT_EQ(r.Wait(t).base, nullptr);
   EXPECT_NE(r.DeviceImages(t).base, nullptr);
   EXPECT_GT(r.kernel_ms(t), 0.0);
 }
 
+// cameras with lens distortion and moving cameras (rolling shutter) in a batch: the ray tables
+// CameraOf makes, copied to the device with the batch (camera k % 4 == 2 distorted, k % 4 == 3
+// distorted and moving)
+void DistortOrMove(int k, CameraView* view) {
+  if (k % 4 < 2) return;
+  view->intrinsics.k1 = -0.28;
+  view->intrinsics.k2 = 0.07;
+  view->intrinsics.p1 = 0.002;
+  if (k % 4 == 2) return;
+  view->motion.end_sec = 0.03;
+  view->motion.line_time_sec = 0.03 / kBatchH;
+  view->motion.X_WO_end = view->X_WO;
+  view->motion.X_WO_end.translation() += Eigen::Vector3d(0.15, 0.05, 0);
+}
+
 TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
-  std::vector<CameraView> views;
-  std::vector<cuda::BatchCamera> cams = Cameras(&views);
+  std::vector<CameraView> views = Views();
   // cameras of other frames (their random numbers are keyed by camera and frame), some with
-  // white balance gains of their own
+  // white balance gains of their own, some with lens distortion or motion
   for (int k = 0; k < 8; ++k) {
     views[k].frame_index = 3 * k;
     if (k % 3 == 1) views[k].white_balance_gains = Eigen::Vector3f(1.15f, 1.0f, 0.8f);
@@ -246,13 +267,20 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
     views[k].outputs[ImageKind::kSegmentation] = views[k].outputs[ImageKind::kRange] = false;
     views[k].outputs[ImageKind::kInstanceSegmentation] =
         views[k].outputs[ImageKind::kSemanticSegmentation] = false;
-    cams[k] = cuda::BatchRenderer::CameraOf(k % 2, views[k]);
+    DistortOrMove(k, &views[k]);
   }
   const cuda::BatchConfig config = RgbOnly(8);
   std::vector<uint8_t> first;
   for (int run = 0; run < 2; ++run) {
     cuda::BatchRenderer r(config);
     AddWorlds(&r);
+    std::vector<cuda::BatchCamera> cams;
+    for (int k = 0; k < 8; ++k) cams.push_back(r.CameraOf(k % 2, views[k]));
+    EXPECT_GE(cams[2].xy_table, 0);
+    EXPECT_EQ(cams[2].rows_table, -1);
+    EXPECT_GE(cams[3].rows_table, 0);
+    // one undistortion table per intrinsics: cameras 2, 3, 6, 7 share it
+    EXPECT_EQ(cams[6].xy_table, cams[2].xy_table);
     const cuda::BatchImages img = r.Wait(r.Submit(cams));
     ASSERT_EQ(img.cameras, 8);
     ASSERT_NE(img.rgb(7), nullptr);
@@ -293,6 +321,66 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
   }
 }
 
+// the ground truth of distorted and moving cameras in a batch: the same depth, ids and normals
+// as CudaRenderer's for the same view (whose rays come from the same tables), different from
+// the pinhole camera's; a camera's tables belong to its renderer and a moving camera's rows to
+// one frame.
+TEST_F(BatchRendering, DistortedAndMovingCamerasTraceTheirOwnRays) {
+  std::vector<CameraView> views;
+  cuda::BatchRenderer r(AllTruth(8));
+  AddWorlds(&r);
+  const std::vector<cuda::BatchCamera> pinholes = Cameras(r, &views);
+  std::vector<cuda::BatchCamera> cams;
+  for (int k = 0; k < 8; ++k) {
+    DistortOrMove(k, &views[k]);
+    cams.push_back(r.CameraOf(k % 2, views[k]));
+  }
+  const std::vector<uint8_t> pinhole_bytes = BatchBytes(r.Wait(r.Submit(pinholes)));
+  const int64_t t = r.Submit(cams);
+  // a batch may go again before the next CameraOf: the same bits
+  const std::vector<uint8_t> bytes = BatchBytes(r.Wait(t));
+  EXPECT_TRUE(BatchBytes(r.Wait(r.Submit(cams))) == bytes);
+  cuda::BatchImages img = r.Wait(t);
+  img.base = bytes.data();
+  cuda::BatchImages pin = img;
+  pin.base = pinhole_bytes.data();
+  RenderSettings gpu_settings;
+  gpu_settings.backend = RenderSettings::Backend::kCuda;
+  const int n = kBatchW * kBatchH;
+  for (int k = 0; k < 8; ++k) {
+    SCOPED_TRACE("camera " + std::to_string(k));
+    const BatchWorld& w = worlds_[k % 2];
+    const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
+    RenderedFrame f;
+    single->Render(w.snap, views[k], &f);
+    EXPECT_EQ(std::memcmp(f.depth_m.data.data(), img.depth(k), 4 * n), 0);
+    EXPECT_EQ(std::memcmp(f.geom_id.data.data(), img.geom_id(k), 4 * n), 0);
+    EXPECT_EQ(std::memcmp(f.normal_O.data.data(), img.normal_O(k), 12 * n), 0);
+    const bool moved = k % 4 >= 2;
+    int differ = 0;
+    for (int i = 0; i < n; ++i) differ += img.depth(k)[i] != pin.depth(k)[i];
+    std::printf("camera %d (%s): %d of %d depth values differ from the pinhole camera's\n", k,
+                moved ? "distorted or moving" : "pinhole", differ, n);
+    if (moved)
+      EXPECT_GT(differ, n / 4);
+    else
+      EXPECT_EQ(differ, 0);
+  }
+  // a new frame's CameraOf retires the last frame's rows; another renderer's tables are refused
+  const cuda::BatchCamera next = r.CameraOf(1, views[3]);
+  EXPECT_THROW(r.Submit(std::span(&cams[3], 1)), Error);
+  EXPECT_NO_THROW(r.Wait(r.Submit(std::span(&next, 1))));
+  EXPECT_NO_THROW(r.Wait(r.Submit(std::span(&cams[2], 1))));
+  cuda::BatchRenderer other(AllTruth(8));
+  AddWorlds(&other);
+  EXPECT_THROW(other.Submit(std::span(&cams[2], 1)), Error);
+  EXPECT_NO_THROW(other.Wait(other.Submit(std::span(&pinholes[2], 1))));
+  // the table pointers are the renderer's to set
+  cuda::BatchCamera bad = pinholes[0];
+  bad.camera.xy = reinterpret_cast<const float*>(bytes.data());
+  EXPECT_THROW(r.Submit(std::span(&bad, 1)), Error);
+}
+
 // a world's lighting effects (UpdateWorld's EffectsFrame: the flashlight world's flashlight and
 // light events at 1 s) reach every rgb camera of that world in a batch: the same rgb and depth
 // bytes as CudaRenderer rendering each camera alone under the same effects, and a visible change
@@ -312,11 +400,11 @@ TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   for (int k = 0; k < 4; ++k) {
     views.push_back(cuda::OrbitView(base, 2 * M_PI * k / 4));
     views.back().frame_index = k;
-    cams.push_back(cuda::BatchRenderer::CameraOf(0, views.back()));
   }
   const cuda::BatchConfig config = RgbOnly(4);
   cuda::BatchRenderer r(config);
   r.AddWorld(scene);
+  for (const CameraView& v : views) cams.push_back(r.CameraOf(0, v));
   r.UpdateWorld(0, snap);
   const std::vector<uint8_t> clear = BatchBytes(r.Wait(r.Submit(cams)));
   r.UpdateWorld(0, snap, fx.get());

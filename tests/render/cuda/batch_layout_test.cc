@@ -153,6 +153,12 @@ TEST(BatchLayout, CheckNamesTheCameraAndTheField) {
   cams[1] = ValidBatchCamera(8, 6);
   cams[1].camera.inv_fx = 0;
   EXPECT_NE(BatchErrorOf(l, cams, 1).find("camera 1: intrinsics"), std::string::npos);
+  // ray tables are named by the renderer's CameraOf, not pointed to by the caller
+  cams[1] = ValidBatchCamera(8, 6);
+  const float table[2] = {0, 0};
+  cams[1].camera.rows = table;
+  EXPECT_NE(BatchErrorOf(l, cams, 1).find("camera 1: ray table pointers set; expected null"),
+            std::string::npos);
 }
 
 TEST(BatchTickets, SlotsRotateAndTheLastTwoStayReadable) {

@@ -68,6 +68,10 @@ void BatchLayout::Check(const BatchCamera* cameras, int count, int num_worlds) c
     if (!std::isfinite(c.cx) || !std::isfinite(c.cy) || !std::isfinite(c.near) || c.near < 0 ||
         !(c.inv_fx > 0) || !(c.inv_fy > 0) || !std::isfinite(c.inv_fx) || !std::isfinite(c.inv_fy))
       throw bad("intrinsics; expected finite cx, cy, near >= 0 and finite inv_fx, inv_fy > 0");
+    if (c.xy || c.rows)
+      throw bad(
+          "ray table pointers set; expected null (BatchRenderer::CameraOf names the tables of a "
+          "camera with lens distortion or motion, and Submit points to them)");
   }
 }
 

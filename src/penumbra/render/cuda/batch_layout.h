@@ -34,7 +34,10 @@ struct BatchOutputs {
 /// the rgb's per-pixel random numbers are keyed by camera_index and frame_index (as
 /// CameraView's), its texture filtering's ray cones start at spread_rad
 /// (Camera::pixel_spread_rad) and its exposure is multiplied by white_balance (linear rgb
-/// gains, CameraView::white_balance_gains); BatchRenderer::CameraOf fills all of them.
+/// gains, CameraView::white_balance_gains); BatchRenderer::CameraOf fills all of them. a camera
+/// with lens distortion or motion (rolling shutter) also names the ray tables
+/// (render/cuda/camera_rays.h) its renderer keeps for it: camera.xy and camera.rows stay null
+/// here and Submit points them to the tables' device copies.
 struct BatchCamera {
   int32_t world = 0;
   int32_t camera_index = 0;            ///< CameraView::camera_index
@@ -42,6 +45,14 @@ struct BatchCamera {
   float spread_rad = 0;                ///< Camera::pixel_spread_rad, radians
   float white_balance[3] = {1, 1, 1};  ///< CameraView::white_balance_gains
   PinholeCamera camera;
+  /// the renderer's undistortion table of this camera's intrinsics (-1: no lens distortion).
+  int32_t xy_table = -1;
+  /// the renderer's per-row poses of this moving camera (-1: the camera does not move).
+  int32_t rows_table = -1;
+  /// the renderer whose tables xy_table and rows_table index (0: none).
+  uint64_t tables_owner = 0;
+  /// the generation of the renderer's row tables that rows_table indexes.
+  int64_t rows_generation = 0;
 };
 
 /// the planes of a batch's buffer, in buffer order.
@@ -86,7 +97,8 @@ class BatchLayout {
   int64_t capacity_bytes() const { return bytes(max_cameras_); }
 
   /// checks a batch cameras[0 .. count): 1 to max_cameras cameras, each of a world in [0,
-  /// num_worlds), the batch's width and height, finite pose and intrinsics, inv_fx and inv_fy > 0.
+  /// num_worlds), the batch's width and height, finite pose and intrinsics, inv_fx and inv_fy > 0,
+  /// camera.xy and camera.rows null.
   /// @throws Error naming the camera's index and the field.
   void Check(const BatchCamera* cameras, int count, int num_worlds) const;
 

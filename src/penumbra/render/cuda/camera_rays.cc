@@ -1,15 +1,12 @@
 #include "penumbra/render/cuda/camera_rays.h"
 
 namespace penumbra::cuda {
-namespace {
 
 bool SameIntrinsics(const CameraIntrinsics& a, const CameraIntrinsics& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
          a.cx == b.cx && a.cy == b.cy && a.k1 == b.k1 && a.k2 == b.k2 && a.p1 == b.p1 &&
          a.p2 == b.p2 && a.k3 == b.k3;
 }
-
-}  // namespace
 
 void CameraRayTables::Prepare(const CameraView& view, ThreadPool* pool) {
   const Camera camera(view.X_WO, view.intrinsics, view.motion);

@@ -17,6 +17,10 @@
 
 namespace penumbra::cuda {
 
+/// true if a and b are the same camera model (size, fx fy cx cy, k1 k2 p1 p2 k3): their xy
+/// tables are the same.
+bool SameIntrinsics(const CameraIntrinsics& a, const CameraIntrinsics& b);
+
 /// a camera's ray tables (see the file comment).
 class CameraRayTables {
  public:

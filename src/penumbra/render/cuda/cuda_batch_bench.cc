@@ -118,7 +118,7 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       for (int k = 0; k < count; ++k) {
         views[k].intrinsics =
             CameraIntrinsics::FromFovy(width, height, views[k].intrinsics.fovy_deg());
-        cams.push_back(BatchRenderer::CameraOf(world_of[k], views[k]));
+        cams.push_back(r.CameraOf(world_of[k], views[k]));
       }
       double kernel_ms = 0;
       RealtimeBatchTimes st;

@@ -11,6 +11,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/primary_pixel.h"
+#include "penumbra/render/cuda/realtime_shading.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -20,7 +21,8 @@ void CheckBatch(cudaError_t e, const char* what) {
     throw Error(std::string("CUDA batch rendering: ") + what + ": " + cudaGetErrorString(e));
 }
 
-// one thread per pixel of every camera: block (8, 8), grid z = the camera.
+// one thread per pixel of every camera: block (8, 8), grid z = the camera; the pixel's ray is
+// CudaRenderer's PrimaryKernel's (PrimaryRay: with the camera's ray tables where it has them).
 __global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* cameras, int width,
                                    int height, PixelTruthPlanes out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
@@ -29,10 +31,8 @@ __global__ void BatchPrimaryKernel(const SceneView* views, const BatchCamera* ca
   const int k = blockIdx.z;
   const BatchCamera& b = cameras[k];
   const PinholeCamera& c = b.camera;
-  const TraceRay r =
-      PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
   const F3 axes_W[3] = {c.ex, c.ey, c.ez};
-  out.Write(TracePixelTruth(views[b.world], r, out.normal_O ? axes_W : nullptr),
+  out.Write(TracePixelTruth(views[b.world], PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr),
             static_cast<int64_t>(k) * width * height + static_cast<int64_t>(v) * width + u);
 }
 
@@ -48,6 +48,8 @@ struct BatchDevice::Impl {
   BatchCamera* cameras[BatchTickets::kSlots] = {};
   SceneView* views[BatchTickets::kSlots] = {};
   int views_capacity[BatchTickets::kSlots] = {};
+  float* tables[BatchTickets::kSlots] = {};
+  int64_t tables_capacity[BatchTickets::kSlots] = {};
   cudaEvent_t started[BatchTickets::kSlots] = {}, done[BatchTickets::kSlots] = {},
               copied[BatchTickets::kSlots] = {};
   bool pending_copy[BatchTickets::kSlots] = {};
@@ -58,6 +60,7 @@ struct BatchDevice::Impl {
       if (device[s]) cudaFree(device[s]);
       if (cameras[s]) cudaFree(cameras[s]);
       if (views[s]) cudaFree(views[s]);
+      if (tables[s]) cudaFree(tables[s]);
       if (host[s]) {
         if (copy == BatchCopy::kPinned)
           cudaFreeHost(host[s]);
@@ -166,6 +169,26 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
              "copying the images back");
   CheckBatch(cudaEventRecord(m.copied[slot], m.copier), "cudaEventRecord");
   m.pending_copy[slot] = true;
+}
+
+const float* BatchDevice::UploadCameraTables(int slot, const float* tables, int64_t n) {
+  Impl& m = *impl_;
+  if (n > m.tables_capacity[slot]) {
+    // the slot's earlier kernels may still read the old buffer
+    CheckBatch(cudaStreamSynchronize(m.compute), "waiting for the batch kernels");
+    if (m.tables[slot]) cudaFree(m.tables[slot]);
+    m.tables[slot] = nullptr;
+    m.tables_capacity[slot] = 0;
+    CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.tables[slot]), sizeof(float) * n),
+               "cudaMalloc (camera ray tables)");
+    m.tables_capacity[slot] = n;
+  }
+  // from pageable memory, as the cameras: staged before the call returns, ordered on the stream
+  if (n > 0)
+    CheckBatch(cudaMemcpyAsync(m.tables[slot], tables, sizeof(float) * n, cudaMemcpyHostToDevice,
+                               m.compute),
+               "copying the camera ray tables");
+  return m.tables[slot];
 }
 
 const uint8_t* BatchDevice::Wait(int slot) {

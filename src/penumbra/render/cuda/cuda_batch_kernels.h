@@ -46,6 +46,12 @@ class BatchDevice {
   /// (unless kNone). returns at once.
   void Submit(int slot, const SceneView* views, int num_views, const BatchCamera* cameras,
               int count, const MoreWork& more = {});
+  /// copies `n` floats of ray tables (host array; camera_rays.h's, one batch's, end to end) to
+  /// `slot`'s table buffer on the kernel stream, ordered before the slot's next Submit and after
+  /// every kernel submitted so far (the buffer grows as needed); returns the buffer's device
+  /// address, for the batch's cameras' PinholeCamera::xy and rows. the host array may change
+  /// once it returns.
+  const float* UploadCameraTables(int slot, const float* tables, int64_t n);
   /// blocks until `slot`'s last batch is on the host (kNone: its kernel finished); returns
   /// the host buffer (null for kNone).
   const uint8_t* Wait(int slot);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
@@ -10,11 +11,21 @@
 #include "penumbra/render/cuda/cuda_renderer.h"
 
 namespace penumbra::cuda {
+namespace {
+
+// the renderers' identities (BatchCamera::tables_owner): a camera's tables are its renderer's
+uint64_t NextRendererId() {
+  static std::atomic<uint64_t> next{1};
+  return next.fetch_add(1);
+}
+
+}  // namespace
 
 BatchRenderer::BatchRenderer(const BatchConfig& config)
     : layout_(config.width, config.height, config.max_cameras, config.outputs),
       device_(std::make_unique<BatchDevice>(layout_, config.copy)),
-      counts_(BatchTickets::kSlots, 0) {}
+      counts_(BatchTickets::kSlots, 0),
+      id_(NextRendererId()) {}
 
 BatchRenderer::~BatchRenderer() {
   // the kernels and the exposures' host functions read the worlds and the realtime buffers
@@ -144,15 +155,66 @@ int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
       realtime_mirror_ = mirror;
     }
   }
+  for (int k = 0; k < count; ++k) {
+    const BatchCamera& c = batch[k];
+    if (c.xy_table < 0 && c.rows_table < 0) continue;
+    if (c.tables_owner != id_)
+      throw Error(fmt::format(
+          "batch rendering: camera {}: ray tables of another BatchRenderer; expected the "
+          "CameraOf of the renderer that renders it (cameras with lens distortion or motion)",
+          k));
+    if (c.xy_table >= static_cast<int>(xy_tables_.size()) ||
+        c.rows_table >= static_cast<int>(rows_tables_.size()) ||
+        (c.rows_table >= 0 && c.rows_generation != rows_generation_))
+      throw Error(fmt::format(
+          "batch rendering: camera {}: row tables of an earlier frame; expected a moving "
+          "camera's CameraOf again after the CameraOf calls that followed a Submit",
+          k));
+  }
   const int64_t t = tickets_.Take();
   const int slot = BatchTickets::SlotOf(t);
   counts_[slot] = count;
+  const std::span<const BatchCamera> submitted = WithRayTables(batch, slot);
   if (layout_.outputs().rgb)
-    rgb = [this, batch, slot](void* stream, uint8_t* buffer) {
-      LaunchRgb(batch, slot, stream, buffer);
+    rgb = [this, submitted, slot](void* stream, uint8_t* buffer) {
+      LaunchRgb(submitted, slot, stream, buffer);
     };
-  device_->Submit(slot, views_.data(), num_worlds(), cameras.data(), count, rgb);
+  device_->Submit(slot, views_.data(), num_worlds(), submitted.data(), count, rgb);
+  submitted_since_rows_ = true;
   return t;
+}
+
+std::span<const BatchCamera> BatchRenderer::WithRayTables(std::span<const BatchCamera> batch,
+                                                          int slot) {
+  bool any = false;
+  for (const BatchCamera& c : batch) any = any || c.xy_table >= 0 || c.rows_table >= 0;
+  if (!any) return batch;
+  // each xy table used once, then each camera's rows, end to end
+  table_floats_.clear();
+  std::vector<int64_t> xy_at(xy_tables_.size(), -1);
+  std::vector<int64_t> rows_at(batch.size(), -1);
+  for (size_t k = 0; k < batch.size(); ++k) {
+    const BatchCamera& c = batch[k];
+    if (c.xy_table >= 0 && xy_at[c.xy_table] < 0) {
+      xy_at[c.xy_table] = static_cast<int64_t>(table_floats_.size());
+      const std::vector<float>& xy = xy_tables_[c.xy_table].xy;
+      table_floats_.insert(table_floats_.end(), xy.begin(), xy.end());
+    }
+    if (c.rows_table >= 0) {
+      rows_at[k] = static_cast<int64_t>(table_floats_.size());
+      const std::vector<float>& rows = rows_tables_[c.rows_table];
+      table_floats_.insert(table_floats_.end(), rows.begin(), rows.end());
+    }
+  }
+  const float* d = device_->UploadCameraTables(slot, table_floats_.data(),
+                                               static_cast<int64_t>(table_floats_.size()));
+  patched_.assign(batch.begin(), batch.end());
+  for (size_t k = 0; k < batch.size(); ++k) {
+    BatchCamera& c = patched_[k];
+    if (c.xy_table >= 0) c.camera.xy = d + xy_at[c.xy_table];
+    if (rows_at[k] >= 0) c.camera.rows = d + rows_at[k];
+  }
+  return patched_;
 }
 
 void BatchRenderer::CheckTicket(int64_t ticket) const {
@@ -201,10 +263,6 @@ RealtimeBatchTimes BatchRenderer::stage_ms(int64_t ticket) const {
 }
 
 BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
-  if (view.intrinsics.has_distortion() || view.motion.moving())
-    throw Error(
-        "batch rendering: a camera with lens distortion or motion; expected a pinhole camera "
-        "(distortion and motion are not on the GPU yet, docs/gpu.md)");
   BatchCamera b;
   b.world = world;
   b.camera_index = view.camera_index;
@@ -212,6 +270,31 @@ BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
   b.spread_rad = Camera(view.X_WO, view.intrinsics, view.motion).pixel_spread_rad();
   for (int c = 0; c < 3; ++c) b.white_balance[c] = view.white_balance_gains[c];
   b.camera = CudaRenderer::PinholeOf(view);
+  if (!view.intrinsics.has_distortion() && !view.motion.moving()) return b;
+  // the first camera after a Submit starts a new frame's row tables
+  if (submitted_since_rows_) {
+    rows_tables_.clear();
+    ++rows_generation_;
+    submitted_since_rows_ = false;
+  }
+  b.tables_owner = id_;
+  ray_tables_.Prepare(view, pool_.get());
+  if (view.intrinsics.has_distortion()) {
+    const auto same = [&](const XyTable& t) {
+      return SameIntrinsics(t.intrinsics, view.intrinsics);
+    };
+    auto it = std::find_if(xy_tables_.begin(), xy_tables_.end(), same);
+    if (it == xy_tables_.end()) {
+      xy_tables_.push_back({view.intrinsics, ray_tables_.xy()});
+      it = xy_tables_.end() - 1;
+    }
+    b.xy_table = static_cast<int32_t>(it - xy_tables_.begin());
+  }
+  if (view.motion.moving()) {
+    rows_tables_.push_back(ray_tables_.rows());
+    b.rows_table = static_cast<int32_t>(rows_tables_.size() - 1);
+    b.rows_generation = rows_generation_;
+  }
   return b;
 }
 

@@ -12,7 +12,7 @@
 //   BatchRenderer batch({.width = 128, .height = 128, .max_cameras = 1024});
 //   const int house = batch.AddWorld(session.scene());
 //   batch.UpdateWorld(house, session.sim().Snapshot());
-//   std::vector<BatchCamera> cams = ...;               // BatchRenderer::CameraOf(house, view)
+//   std::vector<BatchCamera> cams = ...;               // batch.CameraOf(house, view)
 //   const int64_t t = batch.Submit(cams);              // returns at once
 //   ... step the worlds, UpdateWorld, Submit(t + 1) ... // overlaps t's copy back
 //   const BatchImages img = batch.Wait(t);             // host images of batch t
@@ -28,6 +28,7 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/batch_layout.h"
 #include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
@@ -109,9 +110,12 @@ class BatchRenderer {
   /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each
   /// realtime stage, and a host function on the stream that computes each camera's exposure
   /// from its row sums) and starts the copy back (BatchCopy); returns the batch's ticket (0, 1,
-  /// ...) at once. the images of ticket t stay readable until ticket t + 2 is submitted.
-  /// @throws Error for bad cameras (naming the camera), with rgb for a camera of a world not
-  ///         yet updated, or if the CUDA runtime fails.
+  /// ...) at once. the images of ticket t stay readable until ticket t + 2 is submitted. the
+  /// ray tables the cameras name (CameraOf) are copied to the device with the batch.
+  /// @throws Error for bad cameras (naming the camera; a camera whose tables are another
+  ///         renderer's, or whose row tables are older than a CameraOf call made after a
+  ///         Submit), with rgb for a camera of a world not yet updated, or if the CUDA runtime
+  ///         fails.
   int64_t Submit(std::span<const BatchCamera> cameras);
   /// blocks until batch `ticket` is on the host and returns its host images (with
   /// BatchCopy::kNone: until its kernel finished; the images' base is then null).
@@ -140,10 +144,16 @@ class BatchRenderer {
   /// world `world`'s BVH on the host (tests, build times).
   const BvhScene& bvh(int world) const { return *worlds_.at(world)->bvh; }
 
-  /// the batch camera of `view` (a pinhole camera: no distortion, no motion) in world `world`,
-  /// with its camera_index, frame_index and pixel spread.
-  /// @throws Error if the view has lens distortion or motion (not on the GPU yet).
-  static BatchCamera CameraOf(int world, const CameraView& view);
+  /// the batch camera of `view` in world `world`, with its camera_index, frame_index, pixel
+  /// spread and white balance. a camera with lens distortion or motion gets ray tables
+  /// (camera_rays.h, the CPU backend's camera model) kept by this renderer and named in the
+  /// BatchCamera: the undistortion table of its intrinsics for the renderer's lifetime (one per
+  /// distinct intrinsics: 8 bytes a pixel), a moving camera's per-row poses (48 bytes a row)
+  /// until the first CameraOf call after a Submit (so make a moving camera's BatchCamera again
+  /// for each frame; a batch may be submitted again before that). a pinhole camera that does
+  /// not move names no tables and serves any BatchRenderer.
+  /// @throws ConfigError as Camera for bad intrinsics or motion.
+  BatchCamera CameraOf(int world, const CameraView& view);
 
  private:
   struct World {
@@ -160,6 +170,9 @@ class BatchRenderer {
     bool sky_uploaded = false;
   };
   void CheckTicket(int64_t ticket) const;
+  // `batch` with its cameras' ray tables copied to `slot`'s device buffer and their xy and
+  // rows pointing there (in patched_); `batch` itself when no camera has tables.
+  std::span<const BatchCamera> WithRayTables(std::span<const BatchCamera> batch, int slot);
   // the realtime rgb of `cameras` into `buffer` (the slot's device buffer) on `stream`.
   void LaunchRgb(std::span<const BatchCamera> cameras, int slot, void* stream, uint8_t* buffer);
 
@@ -177,6 +190,21 @@ class BatchRenderer {
   std::unique_ptr<ThreadPool> pool_;
   std::vector<RealtimeFrameView> frames_;  // one batch's frames (LaunchRgb)
   std::vector<RealtimeBatchFilm> films_;
+  // the ray tables of cameras with lens distortion or motion (CameraOf): the xy tables by
+  // intrinsics, the row tables of the current generation; a batch's tables end to end and
+  // its cameras pointing to their device copy (Submit)
+  struct XyTable {
+    CameraIntrinsics intrinsics;
+    std::vector<float> xy;
+  };
+  uint64_t id_;  // tables_owner of this renderer's cameras
+  CameraRayTables ray_tables_;
+  std::vector<XyTable> xy_tables_;
+  std::vector<std::vector<float>> rows_tables_;
+  int64_t rows_generation_ = 1;
+  bool submitted_since_rows_ = false;
+  std::vector<float> table_floats_;
+  std::vector<BatchCamera> patched_;
 };
 
 }  // namespace penumbra::cuda
