@@ -32,6 +32,16 @@ const SkyModel& EffectsSky::Update(const Sky& scene_sky, const SkyModel& base_sk
   return *sky_;
 }
 
+Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Vector3f n = Eigen::Vector3f::Zero();
+    n[k] = 1;
+    sum += sky.Irradiance(n) + sky.Irradiance(-n);
+  }
+  return sum * static_cast<float>(1.0 / (6.0 * M_PI));
+}
+
 float SurfaceWetnessOf(const EffectsFrame* effects) {
   if (effects == nullptr) return 0.0f;
   if (!(effects->surface_wetness >= 0 && effects->surface_wetness <= 1))

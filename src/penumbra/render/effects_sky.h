@@ -44,6 +44,11 @@ class EffectsSky {
   float scale_ = 1.0f;
 };
 
+/// sphere-average radiance of a sky (cd/m^2 per channel): the mean of its irradiance on the
+/// six axis-aligned normals divided by pi (exact for radiance that is linear in direction). the
+/// open sky's ambient term of the media and the particles.
+Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
+
 /// EffectsFrame::surface_wetness of `effects` (0 for null).
 /// @throws ConfigError (key effects.surface_wetness) for a value outside [0, 1] or NaN.
 float SurfaceWetnessOf(const EffectsFrame* effects);

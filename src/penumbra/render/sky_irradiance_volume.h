@@ -165,7 +165,7 @@ class SkyIrradianceVolume {
   /// Irradiance (no normal: no tangent-plane test and no normal bias); when no probe passes, the
   /// darkest valid probe of the cell, and 0 when none is valid (inside thick geometry). outside
   /// the grid, or when empty, `open_sky` (the caller's unoccluded sphere-average radiance, e.g.
-  /// SkyAmbientRadiance of media_frame.h). in a closed room it is 0; in the open it is the sky's
+  /// SkyAmbientRadiance of effects_sky.h). in a closed room it is 0; in the open it is the sky's
   /// (up to the ground plane, which the probes do not see: planes are not in the bounds but
   /// they are traced). requires Relight after Build.
   Eigen::Vector3f AmbientRadiance(const Eigen::Vector3f& p_W,

@@ -1,11 +1,11 @@
-// the lighting effects on the GPU (ctest label `gpu`; issue 35 item 5): the frames of
-// effects/blackout.yaml (in its power cut at 4 s), effects/flashlight.yaml and effects/sun.yaml
-// render on the GPU (no frame goes to the CPU renderer) at 640x480 with rgb PSNR >= 40 dB and
-// depth within 1 mm on >= 99.9 % of pixels against the CPU backend under the same EffectsFrame,
-// two GPU renders bit-identical; one renderer alternating the sun world's clear frame and its
-// effects frame (the sky rebuilt, the sky volume relit, the device sky uploaded again) gives each
-// frame's bits every time; a fog frame goes to the CPU renderer and equals the CPU backend's.
-// without a device every test prints "skipped: no CUDA device".
+// the lighting effects and particles on the GPU (ctest label `gpu`; issue 35 item 5): the frames
+// of effects/blackout.yaml (in its power cut at 4 s), effects/flashlight.yaml, effects/sun.yaml,
+// effects/rain.yaml and effects/snow.yaml render on the GPU (no frame goes to the CPU renderer) at
+// 640x480 with rgb PSNR >= 40 dB and depth within 1 mm on >= 99.9 % of pixels against the CPU
+// backend under the same EffectsFrame, two GPU renders bit-identical; one renderer alternating the
+// sun world's clear frame and its effects frame (the sky rebuilt, the sky volume relit, the device
+// sky uploaded again) gives each frame's bits every time; a fog frame goes to the CPU renderer and
+// equals the CPU backend's. without a device every test prints "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -70,7 +70,9 @@ TEST_P(RealtimeEffectsGpu, MatchesCpuBackendAndRepeatsBitForBit) {
 INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeEffectsGpu,
                          ::testing::Values(GpuEffectsWorld{"effects/blackout.yaml", 4.0},
                                            GpuEffectsWorld{"effects/flashlight.yaml", 1.0},
-                                           GpuEffectsWorld{"effects/sun.yaml", 1.0}));
+                                           GpuEffectsWorld{"effects/sun.yaml", 1.0},
+                                           GpuEffectsWorld{"effects/rain.yaml", 1.0},
+                                           GpuEffectsWorld{"effects/snow.yaml", 1.0}));
 
 TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";

@@ -5,11 +5,14 @@
 // (effects/blackout.yaml at 1 s and in its power cut at 4 s, effects/flashlight.yaml,
 // effects/sun.yaml) and a hand-made frame with every lighting field set on the default room, at
 // 160x120: rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, two renders
-// bit-identical, and the effects change the image. the effects the GPU does not draw yet (media,
-// particles) are named by EffectsNotOnGpu. no GPU needed.
+// bit-identical, and the effects change the image; the particle streaks of the rain and snow
+// worlds. the effects the GPU does not draw yet (media; particles seen through media) are named
+// by EffectsNotOnGpu. no GPU needed.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -92,6 +95,51 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathEffects,
                                            HostEffectsWorld{"effects/flashlight.yaml", 1.0},
                                            HostEffectsWorld{"effects/sun.yaml", 1.0}));
 
+// the particles of the rain and snow worlds at 1 s (the rover's camera, 160x120; rain also
+// wets the ground): each pixel's nearest streak found and shaded on the host by the CPU's
+// ParticleStreaks and drawn over the GPU path's radiance (ApplyStreak) gives the CPU backend's
+// image (PSNR >= 40 dB); on the streaks' pixels the GPU path without them is far from it.
+TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
+  for (const char* file : {"effects/rain.yaml", "effects/snow.yaml"}) {
+    SCOPED_TRACE(file);
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const SceneDescription& scene = session->scene();
+    const WorldSnapshot snap = session->sim().Snapshot();
+    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+    const std::shared_ptr<const EffectsFrame> fx =
+        session->effects().Evaluate(snap, view.X_WO.translation());
+    ASSERT_TRUE(fx && !fx->particles.empty());
+    const HostCompared c = CompareWithCpu(scene, snap, view, fx.get());
+    EffectsFrame no_particles = *fx;
+    no_particles.particles.clear();
+    const HostCompared bare = CompareWithCpu(scene, snap, view, &no_particles);
+    // the streak pixels of the frame
+    RenderSettings settings;
+    cuda::RealtimeFrameData data(scene, settings);
+    ThreadPool pool(0);
+    data.Prepare(snap, view, &pool, fx.get());
+    const std::vector<cuda::StreakPixel>& streaks = data.streaks();
+    double err = 0, bare_err = 0;
+    for (const cuda::StreakPixel& s : streaks)
+      for (int k = 0; k < 3; ++k) {
+        const int64_t i = 3 * s.pixel + k;
+        err += std::abs(c.cpu.radiance.data[i] - c.host.radiance.data[i]);
+        bare_err += std::abs(c.cpu.radiance.data[i] - bare.host.radiance.data[i]);
+      }
+    std::printf(
+        "%s at 1 s 160x120: %zu streak pixels, rgb PSNR %.2f dB (without the streaks %.2f dB), "
+        "mean |radiance - cpu| on them %.4g (without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
+        file, streaks.size(), c.psnr, realtime_parity::Psnr(c.cpu.rgb, bare.host.rgb),
+        err / std::max<size_t>(1, 3 * streaks.size()),
+        bare_err / std::max<size_t>(1, 3 * streaks.size()), 100 * c.depth_bad);
+    EXPECT_GT(streaks.size(), 50u);
+    EXPECT_GE(c.psnr, 40.0);
+    EXPECT_LE(c.depth_bad, 0.001);
+    EXPECT_LT(err, 0.1 * bare_err);
+    EXPECT_EQ(c.host.rgb.data, c.again.rgb.data);
+  }
+}
+
 // every lighting field at once on the default room (its window lets the sun and sky in): a
 // lamp scaled, the sun moved and the sky dimmed, a spot light added, the floor wet.
 TEST(RealtimeHostPathEffectsFrames, EveryLightingFieldMatchesCpuBackend) {
@@ -144,14 +192,18 @@ TEST(RealtimeHostPathEffectsFrames, MediaAndParticlesAreNamed) {
   fx.particles.emplace_back();
   EXPECT_EQ(cuda::EffectsNotOnGpu(&fx),
             "homogeneous media (fog, haze, dust), grid media (smoke, fire, VDB), particles (rain, "
-            "snow, sparks)");
+            "snow, sparks) with media");
+  // particles without media are drawn on the GPU
+  EffectsFrame rain;
+  rain.particles.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&rain), "");
   CameraView view;
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
   EXPECT_FALSE(cuda::CudaRenderer::OnGpu(&fx, view));
 }
 
 // which bundled effects worlds' frames at 1 s render on the GPU (docs/gpu.md lists them): the
-// lighting-only ones do, those with media or particles name them.
+// lighting-only ones and those with particles alone do, those with media name them.
 TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
   const struct {
     const char* file;
@@ -165,8 +217,8 @@ TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
                 {"effects/smoke_plume.yaml", "grid media"},
                 {"effects/vdb_smoke.yaml", "grid media"},
                 {"effects/fire.yaml", "grid media"},
-                {"effects/rain.yaml", "particles"},
-                {"effects/snow.yaml", "particles"},
+                {"effects/rain.yaml", ""},
+                {"effects/snow.yaml", ""},
                 {"effects/adversity_major.yaml", "media"}};
   for (const auto& w : worlds) {
     const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, 1.0);

@@ -6,16 +6,6 @@
 
 namespace penumbra {
 
-Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky) {
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  for (int k = 0; k < 3; ++k) {
-    Eigen::Vector3f n = Eigen::Vector3f::Zero();
-    n[k] = 1;
-    sum += sky.Irradiance(n) + sky.Irradiance(-n);
-  }
-  return sum * static_cast<float>(1.0 / (6.0 * M_PI));
-}
-
 MediaFrame::MediaFrame(const SceneDescription& scene, RayQueryFactory make_query)
     : scene_(scene), shelter_(std::move(make_query)) {}
 

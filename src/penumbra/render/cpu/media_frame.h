@@ -33,10 +33,6 @@
 
 namespace penumbra {
 
-/// sphere-average radiance of a sky (cd/m^2 per channel): the mean of its irradiance on the
-/// six axis-aligned normals divided by pi (exact for radiance that is linear in direction).
-Eigen::Vector3f SkyAmbientRadiance(const SkyModel& sky);
-
 /// per-frame effects state of one renderer. not thread-safe; the accessors are, after Prepare.
 class MediaFrame {
  public:

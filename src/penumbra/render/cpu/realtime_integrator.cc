@@ -15,6 +15,7 @@
 #include "penumbra/render/cpu/shadow_window_lanes.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/particle_math.h"
 #include "penumbra/render/shadow_window_math.h"
 
 namespace penumbra {
@@ -469,7 +470,7 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
-// alpha-composited over it (render/cpu/media_realtime.h, render/embree/particle_scene.h). no random
+// alpha-composited over it (render/cpu/media_realtime.h, render/particle_streaks.h). no random
 // numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
 // shared froxel lookups of the pixel's 2x2 quad, or null.
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,
@@ -496,7 +497,7 @@ Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool h
       const MediaSegment front = rm->IntegrateView(*ctx.lights, ray.o, d, t_p, u, v, quad);
       Lp = front.T.cwiseProduct(Lp) + front.L_add;
     }
-    L = ph.alpha * Lp + (1.0f - ph.alpha) * L;
+    for (int c = 0; c < 3; ++c) L[c] = StreakOver(ph.alpha, Lp[c], L[c]);
   }
   return L;
 }

@@ -39,7 +39,7 @@
 // surface and the light; the pixel's radiance L (surface or sky) becomes T L + L_media along the
 // camera ray (render/cpu/media_realtime.h: closed-form fog, froxel volumes for grids and for fog
 // light in-scatter, isotropic unoccluded sky in-scatter), and the nearest particle streak is
-// alpha-composited over it (render/embree/particle_scene.h). without effects nothing changes.
+// alpha-composited over it (render/particle_streaks.h). without effects nothing changes.
 //
 // speed: a tile row of kLanes (16) pixels is shaded at once as SIMD lanes (BsdfLanes,
 // LightSampler::SampleLanes) and its first shadow rays towards one light form one Embree packet

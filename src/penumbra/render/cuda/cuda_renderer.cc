@@ -65,7 +65,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                : !fx_why.empty() ? "effects with " + fx_why
                                                  : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (media, particles, pathtraced rgb); "
+          "renderer: cuda backend: {}: not on the GPU yet (media, pathtraced rgb); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;

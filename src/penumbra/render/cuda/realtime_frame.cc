@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -60,6 +61,9 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
       lights_(scene),
       sky_(scene.sky),
       volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+        return std::make_unique<BvhRayQuery>(statics);
+      }),
+      shelter_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
         return std::make_unique<BvhRayQuery>(statics);
       }),
       film_(settings) {
@@ -125,7 +129,11 @@ std::string EffectsNotOnGpu(const EffectsFrame* effects) {
   };
   add(!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust)");
   add(!effects->grid_media.empty(), "grid media (smoke, fire, VDB)");
-  add(!effects->particles.empty(), "particles (rain, snow, sparks)");
+  // particles alone are (their streaks found and shaded on the host: PrepareStreaks); seen
+  // through media they are not
+  add(!effects->particles.empty() &&
+          (!effects->homogeneous_media.empty() || !effects->grid_media.empty()),
+      "particles (rain, snow, sparks) with media");
   return why;
 }
 
@@ -149,6 +157,56 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
   SetCamera(rays->Point(PinholeCameraOf(view), rays->xy().data(), rays->rows().data()),
             camera.pixel_spread_rad(), view.camera_index, view.frame_index,
             view.white_balance_gains);
+  PrepareStreaks(snapshot, effects, camera, view, pool);
+}
+
+void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                                       const Camera& camera, const CameraView& view,
+                                       ThreadPool* pool) {
+  streaks_.clear();
+  const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
+  if (fx == nullptr || fx->particles.empty()) {
+    particles_.Build(nullptr, camera, 0, false);
+    return;
+  }
+  // as the CPU's MediaFrame::Prepare (no media here: EffectsNotOnGpu): the sheltered drops
+  // left out, the streaks splatted per pixel, the rain shaded once per streak
+  bool sheltered = false;
+  for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
+  if (sheltered) shelter_.Update(scene_, snapshot, pool);
+  particles_.Build(fx, camera, view.exposure_time_sec, true, pool, nullptr,
+                   sheltered ? &shelter_ : nullptr);
+  if (particles_.empty()) return;
+  const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
+  particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
+  // every pixel's nearest streak, shaded as RealtimeIntegrator's view effects shade it (for
+  // the CPU's pixel ray: the streak's t does not depend on the surface behind it, which the
+  // kernel compares), row by row, concatenated in row order
+  const int W = camera.width(), H = camera.height();
+  streak_rows_.resize(H);
+  const float inf = std::numeric_limits<float>::infinity();
+  ParallelForOrSerial(pool, H, [&](int64_t v) {
+    std::vector<StreakPixel>& row = streak_rows_[v];
+    row.clear();
+    for (int u = 0; u < W; ++u) {
+      if (!particles_.PixelHasStreak(u, static_cast<int>(v))) continue;
+      const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+      ParticleHit ph;
+      if (!particles_.PixelHit(ray, u, static_cast<int>(v), inf, &ph)) continue;
+      const float d_len = ray.d.norm();
+      const Eigen::Vector3f d = ray.d / d_len;
+      const Eigen::Vector3f Lp =
+          particles_.Shade(ph, ray.o + (ph.t * d_len) * d, lights_, sky_ambient);
+      StreakPixel s;
+      s.pixel = v * W + u;
+      s.t = ph.t;
+      s.alpha = ph.alpha;
+      s.L = Float3{Lp.x(), Lp.y(), Lp.z()};
+      row.push_back(s);
+    }
+  });
+  for (const std::vector<StreakPixel>& row : streak_rows_)
+    streaks_.insert(streaks_.end(), row.begin(), row.end());
 }
 
 void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool,
@@ -280,6 +338,8 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.wetness = wetness_;
   f.volume = volume_.pod();
   f.any_mirror = any_mirror_ ? 1 : 0;
+  f.streaks = streaks_.empty() ? nullptr : streaks_.data();
+  f.num_streaks = static_cast<int64_t>(streaks_.size());
   return f;
 }
 
@@ -389,6 +449,11 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
         L = ApplyMirrorLayer(f, u, static_cast<int>(v), L);
       }
     });
+  }
+  // the particle streaks over the final radiance, as StreakKernel
+  for (int64_t k = 0; k < f.num_streaks; ++k) {
+    const StreakPixel& s = f.streaks[k];
+    radiance[s.pixel] = ApplyStreak(s, out->depth_m.data[s.pixel], radiance[s.pixel]);
   }
   std::vector<double> rows(H);
   ParallelForOrSerial(pool, H, [&](int64_t v) {

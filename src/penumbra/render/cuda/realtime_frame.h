@@ -4,13 +4,15 @@
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
 // key; the frame's lighting effects (EffectsNotOnGpu: light scales and extra lights through
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
-// render/effects_sky.h, as the CPU backend's MediaFrame); the sky model and sky volume (SkyData,
-// for DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary
-// rays' geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h,
-// which the device's sky kernel runs too) and those of the mirror layer's reflected rays
-// (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
-// path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a
-// GPU). no CUDA runtime here: this file builds on machines without nvcc.
+// render/effects_sky.h, as the CPU backend's MediaFrame) and particles (rain, snow, sparks
+// without media: each pixel's nearest streak found and shaded on the host with the CPU's
+// render/particle_streaks.h, StreakPixel; the kernels draw it over the pixel); the sky model and
+// sky volume (SkyData, for DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky
+// terms from the primary rays' geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of
+// render/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror layer's
+// reflected rays (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost
+// runs the GPU path's per-pixel functions on the CPU over the host BVH (tests; the parity check
+// without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
 
 #include <cstdint>
 #include <memory>
@@ -26,18 +28,20 @@
 #include "penumbra/render/effects_sky.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/particle_streaks.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/render/sky_model.h"
 
 namespace penumbra::cuda {
 
-/// why a frame under `effects` cannot be rendered on the GPU ("" if it can: none, or only
-/// lighting effects: EffectsFrame::light_intensity_scale, extra_lights, sun_direction_W,
-/// sky_luminance_scale and surface_wetness). otherwise names what is not on the GPU yet:
-/// "homogeneous media (fog, haze, dust)", "grid media (smoke, fire, VDB)", "particles (rain,
-/// snow, sparks)", joined by ", " where several are set.
+/// why a frame under `effects` cannot be rendered on the GPU ("" if it can: none, lighting
+/// effects (EffectsFrame::light_intensity_scale, extra_lights, sun_direction_W,
+/// sky_luminance_scale, surface_wetness) and particles without media). otherwise names what is
+/// not on the GPU yet: "homogeneous media (fog, haze, dust)", "grid media (smoke, fire, VDB)",
+/// "particles (rain, snow, sparks) with media", joined by ", " where several are set.
 std::string EffectsNotOnGpu(const EffectsFrame* effects);
 
 /// the plain data of a scene's realtime frames (file comment). not thread-safe.
@@ -56,10 +60,10 @@ class RealtimeFrameData {
   /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none;
   /// they must be on the GPU, EffectsNotOnGpu), sets the camera and frame key of `view`, and
   /// updates the sky volume (built on the first call and when the static bodies move, relit
-  /// when the effects change the sky): PoseWorld, then SetCamera. a camera with lens distortion
-  /// or motion gets its ray tables (camera_rays.h), the camera() pointing to their host arrays:
-  /// `rays` if given (the caller Prepared them for `view` and keeps them alive), else tables
-  /// this object fills.
+  /// when the effects change the sky): PoseWorld, then SetCamera, then PrepareStreaks. a camera
+  /// with lens distortion or motion gets its ray tables (camera_rays.h), the camera() pointing to
+  /// their host arrays: `rays` if given (the caller Prepared them for `view` and keeps them alive),
+  /// else tables this object fills.
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
   /// outside [0, 1]), as the CPU backend.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
@@ -75,6 +79,17 @@ class RealtimeFrameData {
   void SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,
                  int64_t frame_index,
                  const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones());
+  /// the particle streaks of the frame (View's streaks): with particles in `effects` (null or
+  /// none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
+  /// particle_streaks.h: the drops a ShelterMap shelters left out, the streaks splatted per
+  /// pixel over `pool`, rain shaded once per streak), then each pixel's nearest streak shaded by
+  /// ParticleStreaks::Shade as RealtimeIntegrator does (the frame's lights and sky, the occluded
+  /// sky volume), in pixel order. call after PoseWorld (Prepare does).
+  /// @throws ConfigError for malformed particle sets (ParticleStreaks::Build).
+  void PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                      const Camera& camera, const CameraView& view, ThreadPool* pool);
+  /// the streak pixels of the last PrepareStreaks.
+  const std::vector<StreakPixel>& streaks() const { return streaks_; }
   /// the random-number key of a frame of camera `camera_index`, frame `frame_index`
   /// (FrameContext::FrameKey, render/cpu/integrator.h) under these settings' seed.
   uint64_t FrameKey(int camera_index, int64_t frame_index) const;
@@ -148,6 +163,10 @@ class RealtimeFrameData {
   const SkyModel* frame_sky_ = &sky_;  // the frame's: sky_ or effects_sky_'s
   float wetness_ = 0;                  // EffectsFrame::surface_wetness of the frame
   SkyIrradianceVolume volume_;
+  ShelterMap shelter_;         // where rain and snow do not fall (PrepareStreaks)
+  ParticleStreaks particles_;  // the frame's streaks (PrepareStreaks)
+  std::vector<StreakPixel> streaks_;
+  std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   Film film_;
   PinholeCamera camera_;
   CameraRayTables camera_rays_;  // Prepare's view's tables when the caller gives none

@@ -54,6 +54,16 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   depth[i] = t;
 }
 
+// the particle streaks over the final radiance (ApplyStreak): one thread per streak pixel, each
+// pixel at most once.
+__global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const float* depth,
+                             Float3* radiance) {
+  const int64_t k = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (k >= count) return;
+  const StreakPixel s = streaks[k];
+  radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
+}
+
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
 // shading and the blend after the shared visibility.
 // they run only where the frame has a mirror layer (a batch launches them for every camera
@@ -445,7 +455,7 @@ struct PixelBuffers {
 
 struct DeviceRealtime::Impl : PixelBuffers {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
-  Buffer depth, rows, rgb, hits;
+  Buffer depth, rows, rgb, hits, streaks;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
   Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
   SkyModelPod device_sky;
@@ -608,6 +618,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
       MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
       Check(cudaGetLastError(), "MirrorBlendKernel");
     }
+    if (f.num_streaks > 0) {
+      StreakKernel<<<static_cast<unsigned>((f.num_streaks + 255) / 256), 256, 0, stream>>>(
+          f.streaks, f.num_streaks, depth.as<float>(), radiance.as<Float3>());
+      Check(cudaGetLastError(), "StreakKernel");
+    }
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
                                                         rows.as<double>());
@@ -755,6 +770,11 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.scene = scene->device_view();
   m.WithDeviceArrays(&f);
   m.Point(&f, 0, 0, mirror);
+  if (f.num_streaks > 0) {
+    // the streaks found and shaded on the host (from pageable memory: staged before it returns)
+    m.streaks.Upload(host_frame.streaks, sizeof(StreakPixel) * f.num_streaks, stream);
+    f.streaks = m.streaks.as<StreakPixel>();
+  }
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;

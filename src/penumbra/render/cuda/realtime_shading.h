@@ -42,6 +42,7 @@
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
 #include "penumbra/render/mirror_math.h"
+#include "penumbra/render/particle_math.h"
 #include "penumbra/render/shading_math.h"
 #include "penumbra/render/shadow_window_math.h"
 #include "penumbra/render/sky_eval_math.h"
@@ -108,6 +109,17 @@ struct PixelGeometry {
   float mirror = 0;   ///< the hit surface's mirror weight r (ShadingPoint::mirror), 0 none
 };
 
+/// a pixel's nearest particle streak (EffectsFrame::particles), found and shaded on the host
+/// by the CPU backend's functions (ParticleStreaks::PixelHit and Shade,
+/// render/particle_streaks.h) for the pixel's ray: drawn over the pixel's radiance where it lies
+/// in front of the primary hit (ApplyStreak).
+struct StreakPixel {
+  int64_t pixel = 0;  ///< row-major pixel index
+  float t = 0;        ///< ray parameter of the streak (the primary ray's units: as the depth)
+  float alpha = 0;    ///< coverage in (0, 1]
+  Float3 L;           ///< radiance of the streak, cd/m^2 (media none: not on the GPU with them)
+};
+
 /// everything a realtime frame reads, as device (or host) pointers.
 struct RealtimeFrameView {
   SceneView scene;
@@ -159,6 +171,9 @@ struct RealtimeFrameView {
   TraceHit* mirror_hits = nullptr;
   const Float3* mirror_sky = nullptr;
   Float3* mirror_radiance = nullptr;
+  /// the frame's particle streaks, num_streaks of them in pixel order (none: no particles).
+  const StreakPixel* streaks = nullptr;
+  int64_t num_streaks = 0;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -179,6 +194,15 @@ struct SurfaceTerms {
 
 PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
 PB_HOST_DEVICE inline F3 ToF3(const Float3& v) { return F3{v.x, v.y, v.z}; }
+
+/// the radiance of a pixel with streak s over its radiance L (after the surface, the shared
+/// visibility and the mirror layer), as RealtimeIntegrator's view effects: s drawn over L
+/// (StreakOver) unless it lies beyond the primary hit at depth `depth` (m, 0: the ray escapes).
+PB_HOST_DEVICE inline Float3 ApplyStreak(const StreakPixel& s, float depth, const Float3& L) {
+  if (depth > 0 && !(s.t <= depth)) return L;
+  return Float3{StreakOver(s.alpha, s.L.x, L.x), StreakOver(s.alpha, s.L.y, L.y),
+                StreakOver(s.alpha, s.L.z, L.z)};
+}
 
 /// the origin of rays leaving point p on the side of unit normal n: p pushed off the surface by
 /// kGpuRayOffsetScale (1 + |p|_inf) along n (render/ray.h's OffsetRayOrigin).

@@ -1,163 +1,37 @@
 #pragma once
-// particles (EffectsFrame::particles) as motion streaks seen by one camera exposure.
-//
-// geometry: a particle of radius r moving at v during the exposure time T sweeps the capsule
-// around the segment p + [0, T] v. for the pathtraced tier (jittered camera rays) every
-// particle of the frame is one Embree round linear curve (a capsule: cone segment with
-// spherical ends) in this class's own RTCScene, built per frame (BVH over all streaks). for the
-// realtime tier (pixel-centre camera rays) the streaks are splatted instead: each capsule's
-// projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
-// (Quilez's ray-capsule test), keeping the nearest streak per pixel (ties: lower index), which
-// costs the streaks' screen area rather than a BVH traversal per pixel. with a pinhole camera
-// that does not move, drops whose widened capsule lies wholly outside the pyramid of the pixel
-// rays are skipped first (no streak, not counted as culled; they could not be drawn).
-// streaks thinner than half a pixel at their distance are widened to half a pixel (radius
-// 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel drops keep
-// their average contribution instead of aliasing away with one ray per pixel.
-//
-// coverage: a point on the streak is covered for 2r / |v| of the exposure, so a streak is
-// drawn with opacity alpha = 2r / (|v| T + 2r) (1 for a still particle), times the widening
-// factor; the caller alpha-composites the nearest streak over what lies behind it.
-//
-// shading (approximations, documented in the report):
-//  - rain: a drop refracts a wide-angle view of its surroundings (Garg and Nayar, "Vision and
-//    rain", IJCV 2007: a drop's radiance is close to the mean environment radiance over a
-//    ~165 degree field of view); drawn as colour x (sphere-average sky radiance + sum_j E_j /
-//    (4 pi)), i.e. the mean environment radiance times the transmission tint `color`.
-//  - snow: Lambertian of albedo `color` on the capsule's normal, lit by every light
-//    (unshadowed) and the sphere-average sky radiance.
-//  the sphere-average sky radiance is the one the static geometry lets through at the particle
-//  (SkyIrradianceVolume::AmbientRadiance) when the renderer hands a sky volume over (both
-//  tiers), else the open sky's.
-//  - sparks: emit ParticleSet::emission.
-// culling (realtime tier only, rain only): a rain streak is not drawn when its coverage times
-// an upper bound of the homogeneous media's transmittance from the camera to the streak's
-// nearest point (smallest sigma_t channel, smallest density of the segment's ends, media that
-// hold the whole segment; grid media ignored) is below kRainCullContrast. the streak's radiance
-// (the mean environment radiance, see shading) and what lies behind it are both within the
-// displayed range for most pixels, so their difference after exposure is at most display white and
-// the streak changes the display-linear pixel value by less than one 8-bit step (1/255). this is an
-// approximation: against a background or drop brighter than white the bound does not hold
-// (both clip, so the change is small there too), and the sRGB curve magnifies display-linear
-// steps near black (slope up to 12.92), so a culled streak over a very dark pixel could have
-// changed it by a few codes; a culled streak also no longer hides the streaks behind it.
-// culling concerns sub-pixel drops far from the lens (coverage falls with distance as
-// r^2 fx / (d |v| T) once widened to half a pixel) and drops deep in fog; drops near the lens
-// have coverage near 1 and are always drawn. sparks (emissive) and snow are never culled.
-// particles cast no shadows and are not seen by secondary rays (reflections, shadow rays);
-// they do not change the depth or segmentation images.
+// the particles' streaks (render/particle_streaks.h) as an Embree scene, for the pathtraced
+// tier's jittered camera rays: every streak of the frame is one Embree round linear curve (a
+// capsule: cone segment with spherical ends) in this class's own RTCScene, built per frame (BVH
+// over all streaks). the realtime tier splats the same streaks per pixel instead
+// (ParticleStreaks::PixelHit) and builds no Embree scene.
 
-#include <Eigen/Core>
-#include <cstdint>
-#include <limits>
 #include <memory>
-#include <vector>
 
-#include "penumbra/core/thread_pool.h"
-#include "penumbra/render/camera.h"
-#include "penumbra/render/light_sampler.h"
-#include "penumbra/render/media_scene.h"
-#include "penumbra/render/shelter_map.h"
-#include "penumbra/render/sky_irradiance_volume.h"
-#include "penumbra/scene/effects_frame.h"
+#include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/ray.h"
 
 namespace penumbra {
 
-/// rain streaks whose coverage times media transmittance from the camera is below this are
-/// not drawn in the realtime tier (one 8-bit step of display-linear contrast; see above).
-constexpr float kRainCullContrast = 1.0f / 255.0f;
-
-/// the nearest streak along a ray.
-struct ParticleHit {
-  float t = 0;                    ///< ray parameter (units of |ray.d|)
-  Eigen::Vector3f ng_W{0, 0, 1};  ///< unit normal of the capsule, facing the ray
-  float alpha = 0;                ///< coverage in (0, 1]
-  ParticleKind kind = ParticleKind::kRain;
-  int set = 0;    ///< index into EffectsFrame::particles
-  int prim = -1;  ///< streak index in the ParticleScene
-};
-
-/// the streak scene of one frame and camera. Build, then Intersect is thread-safe.
-class ParticleScene {
+/// the streaks of one frame and camera, traceable. Build, then Intersect is thread-safe.
+class ParticleScene : public ParticleStreaks {
  public:
   ParticleScene();
   ~ParticleScene();
-  ParticleScene(const ParticleScene&) = delete;
-  ParticleScene& operator=(const ParticleScene&) = delete;
 
-  /// builds the streaks of `fx` (null = none) for `camera` and an exposure of
-  /// exposure_time_sec (>= 0). the frame must outlive this object until the next Build.
-  /// @throws ConfigError if a set's arrays differ in length or hold non-finite values
-  /// (key effects.particles[i]).
-  /// pixel_hits: build the per-pixel nearest streaks of the camera's pixel-centre rays
-  /// (PixelHit) instead of the Embree scene (Intersect), in bands of rows over `pool` (may be
-  /// null). with pixel_hits, invisible rain streaks are culled (kRainCullContrast) using the
-  /// homogeneous media of `media` (may be null: coverage alone).
-  /// `shelter` (may be null): rain drops and snowflakes that it shelters (static geometry
-  /// above them) are not drawn unless their set says otherwise (ParticleSet::sheltered);
-  /// sparks always are.
+  /// ParticleStreaks::Build; without pixel_hits also the Embree scene of the streaks
+  /// (Intersect).
+  /// @throws as ParticleStreaks::Build; Error if the Embree device cannot be created.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
              bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
              const ShelterMap* shelter = nullptr);
-
-  bool empty() const { return count_ == 0; }
-  int size() const { return count_; }
-  /// rain streaks culled as invisible by the last Build.
-  int culled() const { return culled_; }
-
-  /// the nearest streak of the pixel-centre camera ray `ray` of pixel (u, v) within (0, tmax]
-  /// (Build with pixel_hits); false if none.
-  bool PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const;
 
   /// nearest streak along `ray` within [ray.tmin, tmax] (Build without pixel_hits); false if
   /// none.
   bool Intersect(const Ray& ray, float tmax, ParticleHit* hit) const;
 
-  /// evaluates every rain streak's radiance once, at its centre (rain shading does not depend
-  /// on the hit point's normal), so that Shade looks it up; spread over `pool` (may be null).
-  /// `sky_volume` (may be null; must outlive this object until the next call) occludes the
-  /// sky light of every particle from here on (Shade): the sky term is then
-  /// SkyIrradianceVolume::AmbientRadiance at the particle instead of `sky_ambient`.
-  void PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
-                      const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
-
-  /// radiance (cd/m^2) of the streak at `hit`, point p_W, seen from direction wo (unit,
-  /// towards the viewer); `sky_ambient` is the open sky's sphere-average radiance (occluded at
-  /// p_W by the sky volume of the last PrecomputeRain, if any).
-  Eigen::Vector3f Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
-                        const LightSampler& lights, const Eigen::Vector3f& sky_ambient) const;
-
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  const EffectsFrame* fx_ = nullptr;
-  int count_ = 0;
-  int culled_ = 0;
-  std::vector<float> alpha_;           // per primitive
-  std::vector<int> set_;               // per primitive
-  std::vector<Eigen::Vector4f> ends_;  // per primitive: both ends (x, y, z, widened radius)
-  int pixel_w_ = 0;
-  struct PixelStreak {
-    float t = std::numeric_limits<float>::infinity();  // nearest streak t (ray units), +inf none
-    int prim = -1;                                     // its primitive, -1 none
-  };
-  std::vector<PixelStreak> pixel_;                   // per pixel (one load per PixelHit)
-  std::vector<Eigen::Vector3f> rain_radiance_;       // per primitive (PrecomputeRain), or empty
-  const SkyIrradianceVolume* sky_volume_ = nullptr;  // occluded sky (PrecomputeRain), or null
-  std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
-  bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
-  // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
-  // capacity).
-  struct DropChunk {
-    std::vector<float> alpha;
-    std::vector<int> set;
-    std::vector<Eigen::Vector4f> ends;  // both ends per streak
-    int culled = 0;
-    size_t bad = 0;  // index of the chunk's first non-finite particle, or the particle count
-  };
-  std::vector<DropChunk> drop_chunks_;
-
-  void BuildPixelHits(const Camera& camera, ThreadPool* pool);
 };
 
 }  // namespace penumbra

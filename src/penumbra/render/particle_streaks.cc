@@ -1,0 +1,478 @@
+#include "penumbra/render/particle_streaks.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/media_common.h"
+#include "penumbra/render/ray.h"
+
+namespace penumbra {
+
+namespace {
+
+// near plane (m, optical-frame depth) of the realtime tier's streak splatting.
+constexpr float kPixelNear = 0.01f;
+
+// per frame, per homogeneous medium: what RainInvisible needs of it that does not depend on
+// the streak.
+struct RainCullMedium {
+  bool bounded;       // has a box
+  bool cam_in;        // the camera is in its box (or it is unbounded)
+  float sigma_t_min;  // smallest channel of sigma_t, 1/m
+  float cam_density;  // density at the camera's height
+  Eigen::Vector3f box_min, box_max;
+  const AnalyticMedium* m;
+};
+
+std::vector<RainCullMedium> RainCullMedia(const Eigen::Vector3f& cam_o, const MediaScene* media) {
+  std::vector<RainCullMedium> out;
+  if (media == nullptr) return out;
+  for (const AnalyticMedium& m : media->analytic()) {
+    const bool cam_in = !m.bounded || ((cam_o.array() >= m.box_min.array()).all() &&
+                                       (cam_o.array() <= m.box_max.array()).all());
+    out.push_back(RainCullMedium{m.bounded, cam_in, m.sigma_t.minCoeff(), m.Density(cam_o.z()),
+                                 m.box_min, m.box_max, &m});
+  }
+  return out;
+}
+
+// true when a rain streak of coverage alpha whose nearest point to the camera is p_W cannot
+// change a displayed pixel by kRainCullContrast (particle_scene.h): alpha times an upper bound
+// of the transmittance of the homogeneous media between the camera and p_W. the bound uses a
+// lower bound of the optical depth: per medium that holds the whole segment (unbounded, or both
+// ends in its box, which is convex), its smallest channel of sigma_t times the length times the
+// smaller density of the two ends (the density is monotonic in height, so along a segment its
+// minimum is at an end). grid media are ignored. both only keep more streaks than exact.
+// media: RainCullMedia(cam_o, ...) of this frame.
+bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vector3f& p_W,
+                   const std::vector<RainCullMedium>& media) {
+  if (alpha < kRainCullContrast) return true;
+  if (media.empty()) return false;
+  const float dist = (p_W - cam_o).norm();
+  float tau = 0;
+  for (const RainCullMedium& m : media) {
+    if (m.bounded && !(m.cam_in && (p_W.array() >= m.box_min.array()).all() &&
+                       (p_W.array() <= m.box_max.array()).all()))
+      continue;
+    tau += m.sigma_t_min * dist * std::min(m.cam_density, m.m->Density(p_W.z()));
+  }
+  return alpha * std::exp(-tau) < kRainCullContrast;
+}
+
+}  // namespace
+void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
+                            bool pixel_hits, ThreadPool* pool, const MediaScene* media,
+                            const ShelterMap* shelter) {
+  fx_ = fx;
+  count_ = 0;
+  culled_ = 0;
+  alpha_.clear();
+  set_.clear();
+  ends_.clear();
+  rain_radiance_.clear();
+  visible_.clear();
+  pixel_hits_built_ = false;
+  if (fx == nullptr) return;
+  for (size_t s = 0; s < fx->particles.size(); ++s) {
+    const ParticleSet& ps = fx->particles[s];
+    if (ps.velocity_W.size() != ps.position_W.size() || ps.radius_m.size() != ps.position_W.size())
+      throw ConfigError("", 0, "effects.particles[" + std::to_string(s) + "]",
+                        "expected position_W, velocity_W and radius_m of equal length (got " +
+                            std::to_string(ps.position_W.size()) + ", " +
+                            std::to_string(ps.velocity_W.size()) + ", " +
+                            std::to_string(ps.radius_m.size()) + ")");
+  }
+  const float T = static_cast<float>(std::max(0.0, exposure_time_sec));
+  const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
+  const float fx_px = static_cast<float>(camera.intrinsics().fx);
+  // every drop's check for finite values, streak and cull flag in parallel chunks (each drop
+  // only reads its own input), each chunk keeping its drawn streaks in (set, index) order in its
+  // own buffers (reused between frames), which are then concatenated in chunk order, so the
+  // output (and the first non-finite particle reported) does not depend on the thread count.
+  std::vector<size_t> first(fx->particles.size() + 1, 0);
+  for (size_t s = 0; s < fx->particles.size(); ++s)
+    first[s + 1] = first[s] + fx->particles[s].position_W.size();
+  const size_t n_all = first.back();
+  if (n_all == 0) return;
+  const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
+  // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
+  // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
+  // would give them an empty pixel box: it clips at kPixelNear + radius >= kPixelNear).
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+  auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
+  // realtime with a pinhole camera: the outward unit normals (world) of the four side planes of
+  // the pyramid of the pixel-centre rays widened by half a pixel (at the pose X_WO), to skip
+  // the drops no pixel ray can meet (`outside` below).
+  const bool frustum = pixel_hits && !camera.intrinsics().has_distortion();
+  Eigen::Vector3f side_W[4];
+  // a moving camera (camera.h: pose slerped / lerped at a = (time_sec + line_time_sec v) /
+  // end_sec for row v) sees row v from o(a), turned by |a| theta from X_WO (theta the rotation
+  // from X_WO to X_WO_end): the planes then move by at most turn |x - cam_o| + shift at a
+  // point x, with turn and shift the largest |a| over the rows times theta and times the
+  // translation (1 % and 1e-6 to spare).
+  float turn = 0, shift = 0;
+  const bool moving = camera.motion().moving();
+  if (frustum) {
+    const CameraIntrinsics& k = camera.intrinsics();
+    const double l = (-0.5 - k.cx) / k.fx, rt = (k.width - 0.5 - k.cx) / k.fx;
+    const double tp = (-0.5 - k.cy) / k.fy, bt = (k.height - 0.5 - k.cy) / k.fy;
+    // optical frame: x right, y down, z forward; outside the left side where x < l z, etc.
+    const Eigen::Vector3d side_O[4] = {{-1, 0, l}, {1, 0, -rt}, {0, -1, tp}, {0, 1, -bt}};
+    for (int i = 0; i < 4; ++i)
+      side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
+    if (moving) {
+      const CameraMotion& m = camera.motion();
+      const double a_max =
+          std::max(std::abs(m.time_sec), std::abs(m.time_sec + m.line_time_sec * k.height)) /
+          m.end_sec;
+      const Eigen::Quaterniond q0(camera.X_WO().linear()), q1(m.X_WO_end.linear());
+      const double theta =
+          2.0 * std::acos(std::min(1.0, std::abs(q0.normalized().dot(q1.normalized()))));
+      const double move = (m.X_WO_end.translation() - camera.X_WO().translation()).norm();
+      turn = static_cast<float>(1.01 * a_max * theta + 1e-6);
+      shift = static_cast<float>(1.01 * a_max * move + 1e-6);
+    }
+  }
+  const float four_fx2 = 4.0f * fx_px * fx_px;
+  // true when the capsule around [p, q] widened to r_wide = max(r, 0.5 dist / fx) (dist <= the
+  // larger distance D of p and q from the camera) lies wholly beyond one side plane: both ends
+  // farther than r and 0.5 D / fx from it (0.1 % to spare for rounding) and, for a moving
+  // camera, than the planes' motion. then no pixel ray meets it (its hits would be none).
+  auto outside = [&](const Eigen::Vector3f& p, const Eigen::Vector3f& q, float r) {
+    const Eigen::Vector3f dp = p - cam_o, dq = q - cam_o;
+    const float D2 = std::max(dp.squaredNorm(), dq.squaredNorm());
+    if (!moving) {
+      for (const Eigen::Vector3f& n : side_W) {
+        const float s = std::min(n.dot(dp), n.dot(dq));
+        if (s > 1.001f * r && four_fx2 * s * s > 1.002f * D2) return true;
+      }
+      return false;
+    }
+    const float D = std::sqrt(D2);
+    const float R = 1.001f * std::max(r, 0.5f * D / fx_px);
+    const float margin = R + turn * (D + R) + shift;
+    for (const Eigen::Vector3f& n : side_W)
+      if (std::min(n.dot(dp), n.dot(dq)) > margin) return true;
+    return false;
+  };
+  // one drop: nothing (radius <= 0; realtime: wholly behind the near plane or outside the
+  // image), culled (counted) or a streak appended to `out`.
+  auto drop = [&](size_t s, size_t i, DropChunk* out) {
+    const ParticleSet& ps = fx->particles[s];
+    const Eigen::Vector3f& p = ps.position_W[i];
+    const Eigen::Vector3f& v = ps.velocity_W[i];
+    const float r = ps.radius_m[i];
+    if (!(r > 0)) return;
+    if (shelter != nullptr && ShelterApplies(ps) && shelter->Sheltered(p))
+      return;  // rain or snow under a roof
+    Eigen::Vector3f q = p + T * v;
+    // a still particle: a capsule of negligible length (Embree needs two distinct ends).
+    if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
+    if (pixel_hits && depth(p) < kPixelNear && depth(q) < kPixelNear) return;  // never drawn
+    if (frustum && outside(p, q, r)) return;                                   // never drawn
+    const float len = T * v.norm();  // the motion, not the widened capsule
+    // widen to half a pixel at the streak's nearest distance to the camera.
+    const Eigen::Vector3f seg = q - p;
+    const float l2 = seg.squaredNorm();
+    const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
+    const float dist = (p + w * seg - cam_o).norm();
+    const float r_wide = std::max(r, 0.5f * dist / fx_px);
+    const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
+    // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
+    if (pixel_hits && ps.kind == ParticleKind::kRain &&
+        RainInvisible(alpha, cam_o, p + w * seg, cull_media)) {
+      ++out->culled;
+      return;
+    }
+    out->alpha.push_back(alpha);
+    out->set.push_back(static_cast<int>(s));
+    out->ends.emplace_back(p.x(), p.y(), p.z(), r_wide);
+    out->ends.emplace_back(q.x(), q.y(), q.z(), r_wide);
+  };
+  constexpr size_t kDropChunk = 4096;
+  const size_t drop_chunks = (n_all + kDropChunk - 1) / kDropChunk;
+  if (drop_chunks_.size() < drop_chunks) drop_chunks_.resize(drop_chunks);
+  auto drop_chunk = [&](int64_t c) {
+    DropChunk& out = drop_chunks_[c];
+    out.alpha.clear();
+    out.set.clear();
+    out.ends.clear();
+    out.culled = 0;
+    out.bad = n_all;
+    const size_t g0 = static_cast<size_t>(c) * kDropChunk;
+    const size_t g1 = std::min(n_all, g0 + kDropChunk);
+    size_t s =
+        static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g0) - first.begin()) - 1;
+    for (size_t g = g0; g < g1; ++g) {
+      while (g >= first[s + 1]) ++s;
+      const ParticleSet& ps = fx->particles[s];
+      const size_t i = g - first[s];
+      if (!ps.position_W[i].allFinite() || !ps.velocity_W[i].allFinite() ||
+          !std::isfinite(ps.radius_m[i])) {
+        out.bad = g;  // its first non-finite particle
+        return;
+      }
+      drop(s, i, &out);
+    }
+  };
+  ParallelForOrSerial(pool, static_cast<int64_t>(drop_chunks), drop_chunk);
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    const size_t g = drop_chunks_[c].bad;
+    if (g == n_all) continue;
+    const size_t s =
+        static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g) - first.begin()) - 1;
+    throw ConfigError("", 0, "effects.particles[" + std::to_string(s) + "]",
+                      "particle " + std::to_string(g - first[s]) + " has a non-finite value");
+  }
+  size_t total = 0;
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    total += drop_chunks_[c].alpha.size();
+    culled_ += drop_chunks_[c].culled;
+  }
+  alpha_.reserve(total);
+  set_.reserve(total);
+  ends_.reserve(2 * total);
+  for (size_t c = 0; c < drop_chunks; ++c) {
+    const DropChunk& dc = drop_chunks_[c];
+    alpha_.insert(alpha_.end(), dc.alpha.begin(), dc.alpha.end());
+    set_.insert(set_.end(), dc.set.begin(), dc.set.end());
+    ends_.insert(ends_.end(), dc.ends.begin(), dc.ends.end());
+  }
+  count_ = static_cast<int>(alpha_.size());
+  if (count_ == 0) return;
+  if (pixel_hits) BuildPixelHits(camera, pool);
+}
+
+namespace {
+
+// what the ray-capsule test needs of a capsule around [a, b] of radius r and a ray origin o
+// that does not depend on the ray's direction (the realtime tier's pixel-centre rays share o
+// when the camera neither distorts nor moves).
+struct CapsuleOrigin {
+  Eigen::Vector3f ba, oa, ob;
+  float baba, baoa, qc, sc_a, sc_b;
+  CapsuleOrigin(const Eigen::Vector3f& o, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                float r)
+      : ba(b - a), oa(o - a), ob(o - b) {
+    baba = ba.dot(ba);
+    baoa = ba.dot(oa);
+    const float oaoa = oa.dot(oa);
+    qc = baba * oaoa - baoa * baoa - r * r * baba;
+    sc_a = oa.dot(oa) - r * r;
+    sc_b = ob.dot(ob) - r * r;
+  }
+};
+
+// nearest t > 0 where the ray o + t d (d unit, o that of `c`) meets the capsule, or -1 (Quilez,
+// "Capsule - intersection", 2014: cylinder body, then the nearer end sphere).
+float IntersectCapsule(const CapsuleOrigin& c, const Eigen::Vector3f& d) {
+  const float bard = c.ba.dot(d), rdoa = d.dot(c.oa);
+  const float qa = c.baba - bard * bard;
+  const float qb = c.baba * rdoa - c.baoa * bard;
+  float h = qb * qb - qa * c.qc;
+  float y;
+  if (qa > 1e-12f) {
+    if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
+    const float t = (-qb - std::sqrt(h)) / qa;
+    y = c.baoa + t * bard;
+    if (y > 0 && y < c.baba) return t > 0 ? t : -1.0f;
+  } else {
+    y = bard > 0 ? -1.0f : c.baba + 1.0f;  // along the axis: the nearer end
+  }
+  const bool at_a = y <= 0;
+  const float sb = d.dot(at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
+  h = sb * sb - sc;
+  if (h <= 0) return -1.0f;
+  const float t = -sb - std::sqrt(h);
+  return t > 0 ? t : -1.0f;
+}
+
+}  // namespace
+
+void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
+  const int W = camera.width(), H = camera.height();
+  pixel_w_ = W;
+  // (filled band by band below, in parallel)
+  pixel_.resize(static_cast<size_t>(W) * H);
+  pixel_hits_built_ = true;
+  const CameraIntrinsics& k = camera.intrinsics();
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+  constexpr float kNear = kPixelNear;
+  // pixel box and projected segment (ua, va, ub, vb, rp) of every streak, in parallel chunks
+  // (empty box when behind the camera or outside the image).
+  std::vector<Eigen::Vector4i> box(count_, Eigen::Vector4i(0, -1, 0, -1));
+  std::vector<std::array<float, 5>> seg2(count_);
+  auto project = [&](int n) {
+    const float r = ends_[2 * n].w();
+    // the segment in the optical frame, clipped to z >= kNear + r.
+    Eigen::Vector3f ao = R_OW * ends_[2 * n].head<3>() + p_OW;
+    Eigen::Vector3f bo = R_OW * ends_[2 * n + 1].head<3>() + p_OW;
+    const float zmin = kNear + r;
+    if (ao.z() < zmin && bo.z() < zmin) return;
+    if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
+    if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
+    // pinhole projection with a margin of 1 px (rounding; lens distortion moves pixels by more
+    // only far from the centre, where a streak may then be clipped).
+    const float z_near = std::min(ao.z(), bo.z()) - r;
+    const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 1.0f;
+    const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
+    const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
+    const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
+    const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
+    seg2[n] = {ua, va, ub, vb, rp};
+    box[n] = Eigen::Vector4i(std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp))),
+                             std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp))),
+                             std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp))),
+                             std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp))));
+  };
+  constexpr int kChunk = 4096;
+  const int chunks = (count_ + kChunk - 1) / kChunk;
+  auto chunk = [&](int64_t c) {
+    const int n1 = std::min(count_, static_cast<int>(c + 1) * kChunk);
+    for (int n = static_cast<int>(c) * kChunk; n < n1; ++n) project(n);
+  };
+  ParallelForOrSerial(pool, chunks, chunk);
+  // bands of rows in parallel; within a band streaks in index order (nearest wins, ties keep
+  // the lower index), so the result does not depend on the thread count.
+  constexpr int kBand = 16;
+  const int bands = (H + kBand - 1) / kBand;
+  // the streaks of every band, in index order; streaks outside the image are culled.
+  std::vector<std::vector<int>> in_band(bands);
+  visible_.assign(count_, 0);
+  for (int n = 0; n < count_; ++n) {
+    const Eigen::Vector4i& bx = box[n];
+    if (bx[0] > bx[1] || bx[2] > bx[3]) continue;
+    visible_[n] = 1;
+    for (int bi = bx[2] / kBand; bi <= bx[3] / kBand; ++bi) in_band[bi].push_back(n);
+  }
+  const Eigen::Vector3f o_shared = camera.GenerateRay(0.0f, 0.0f).o;
+  auto band = [&](int64_t bi) {
+    const int r0 = static_cast<int>(bi) * kBand, r1 = std::min(H - 1, r0 + kBand - 1);
+    const size_t p0 = static_cast<size_t>(r0) * W, p1 = static_cast<size_t>(r1 + 1) * W;
+    std::fill(pixel_.begin() + p0, pixel_.begin() + p1, PixelStreak());
+    for (int n : in_band[bi]) {
+      const Eigen::Vector4i& bx = box[n];
+      const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
+      if (v0 > v1 || bx[0] > bx[1]) continue;
+      const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
+      const float r = ends_[2 * n].w();
+      // the origin-dependent terms once per streak for the camera centre (every pixel's ray
+      // origin unless the camera moves during the exposure: then per pixel).
+      const CapsuleOrigin shared(o_shared, a, b, r);
+      const auto& [ua, va, ub, vb, rp] = seg2[n];
+      const float du = ub - ua, dv = vb - va;
+      for (int v = v0; v <= v1; ++v) {
+        // the columns within rp of the projected segment's part near this row.
+        float s0 = 0, s1 = 1;
+        if (std::abs(dv) > 1e-6f) {
+          s0 = std::clamp((v - rp - va) / dv, 0.0f, 1.0f);
+          s1 = std::clamp((v + rp - va) / dv, 0.0f, 1.0f);
+          if (s0 > s1) std::swap(s0, s1);
+        }
+        const float ul = std::min(ua + s0 * du, ua + s1 * du) - rp;
+        const float uh = std::max(ua + s0 * du, ua + s1 * du) + rp;
+        const int c0 = std::max(bx[0], static_cast<int>(std::floor(ul)));
+        const int c1 = std::min(bx[1], static_cast<int>(std::ceil(uh)));
+        for (int u = c0; u <= c1; ++u) {
+          const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+          const float len = ray.d.norm();
+          const float t = ray.o == o_shared
+                              ? IntersectCapsule(shared, ray.d / len)
+                              : IntersectCapsule(CapsuleOrigin(ray.o, a, b, r), ray.d / len);
+          if (!(t > 0)) continue;
+          const size_t at = static_cast<size_t>(v) * W + u;
+          const float t_ray = t / len;
+          if (t_ray < pixel_[at].t) pixel_[at] = PixelStreak{t_ray, n};
+        }
+      }
+    }
+  };
+  ParallelForOrSerial(pool, bands, band);
+}
+
+bool ParticleStreaks::PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const {
+  if (!pixel_hits_built_) return false;
+  const size_t at = static_cast<size_t>(v) * pixel_w_ + u;
+  const PixelStreak px = pixel_[at];
+  const int n = px.prim;
+  if (n < 0 || !(px.t <= tmax)) return false;
+  hit->t = px.t;
+  const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
+  const Eigen::Vector3f p = ray.o + hit->t * ray.d;
+  const Eigen::Vector3f ba = b - a;
+  const float w = std::clamp((p - a).dot(ba) / std::max(ba.squaredNorm(), 1e-20f), 0.0f, 1.0f);
+  Eigen::Vector3f nrm = p - (a + w * ba);
+  const float nn = nrm.norm();
+  nrm = nn > 0 ? Eigen::Vector3f(nrm / nn) : Eigen::Vector3f(-ray.d.normalized());
+  if (nrm.dot(ray.d) > 0) nrm = -nrm;
+  hit->ng_W = nrm;
+  hit->alpha = alpha_[n];
+  hit->prim = n;
+  hit->set = set_[n];
+  hit->kind = fx_->particles[hit->set].kind;
+  return true;
+}
+
+void ParticleStreaks::PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
+                                     const SkyIrradianceVolume* sky_volume, ThreadPool* pool) {
+  rain_radiance_.clear();
+  sky_volume_ = sky_volume;
+  bool any = false;
+  const bool culled = !visible_.empty();  // realtime: only streaks in the image are drawn
+  for (int n = 0; n < count_ && !any; ++n)
+    any = fx_->particles[set_[n]].kind == ParticleKind::kRain;
+  if (!any) return;
+  std::vector<Eigen::Vector3f> L(count_, Eigen::Vector3f::Zero());
+  auto one = [&](int64_t n) {
+    if (fx_->particles[set_[n]].kind != ParticleKind::kRain || (culled && !visible_[n])) return;
+    ParticleHit h;
+    h.kind = ParticleKind::kRain;
+    h.set = set_[n];
+    h.prim = -1;
+    const Eigen::Vector3f c = 0.5f * (ends_[2 * n].head<3>() + ends_[2 * n + 1].head<3>());
+    L[n] = Shade(h, c, lights, sky_ambient);
+  };
+  // chunks of streaks per task (one task per streak costs more in scheduling than shading).
+  constexpr int kChunk = 1024;
+  const int chunks = (count_ + kChunk - 1) / kChunk;
+  auto chunk = [&](int64_t c) {
+    const int64_t n1 = std::min<int64_t>(count_, (c + 1) * kChunk);
+    for (int64_t n = c * kChunk; n < n1; ++n) one(n);
+  };
+  ParallelForOrSerial(pool, chunks, chunk);
+  rain_radiance_ = std::move(L);
+}
+
+Eigen::Vector3f ParticleStreaks::Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
+                                       const LightSampler& lights,
+                                       const Eigen::Vector3f& sky_ambient) const {
+  const ParticleSet& ps = fx_->particles[hit.set];
+  if (hit.kind == ParticleKind::kSpark) return ps.emission;
+  if (hit.kind == ParticleKind::kRain && hit.prim >= 0 &&
+      hit.prim < static_cast<int>(rain_radiance_.size()))
+    return rain_radiance_[hit.prim];
+  Eigen::Vector3f E = Eigen::Vector3f::Zero();
+  for (int j = 0; j < lights.size(); ++j) {
+    LightSample ls;
+    if (!lights.Sample(j, p_W, 0.5f, 0.5f, &ls)) continue;
+    if (hit.kind == ParticleKind::kSnow) {
+      E += ls.E * (std::max(0.0f, hit.ng_W.dot(ls.wi)) * 0.318309886f);
+    } else {
+      E += ls.E * kInv4Pi;
+    }
+  }
+  const Eigen::Vector3f sky =
+      sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient) : sky_ambient;
+  return ps.color.cwiseProduct(sky + E) + ps.emission;
+}
+
+}  // namespace penumbra
