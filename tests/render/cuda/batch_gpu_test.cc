@@ -130,6 +130,16 @@ class BatchRendering : public ::testing::Test {
     if (views) *views = v;
     return cams;
   }
+  // camera k's view (world k % 2) rendered by CudaRenderer alone
+  RenderedFrame CudaRendererAlone(int k, const CameraView& view) const {
+    RenderSettings gpu_settings;
+    gpu_settings.backend = RenderSettings::Backend::kCuda;
+    const BatchWorld& w = worlds_[k % 2];
+    const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
+    RenderedFrame f;
+    single->Render(w.snap, view, &f);
+    return f;
+  }
   void AddWorlds(cuda::BatchRenderer* r) const {
     for (const BatchWorld& w : worlds_) r->UpdateWorld(r->AddWorld(w.session->scene()), w.snap);
   }
@@ -145,8 +155,6 @@ TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
   const cuda::BatchImages all = r.Wait(r.Submit(cams));
   ASSERT_EQ(all.cameras, 8);
   const std::vector<uint8_t> batched = BatchBytes(all);
-  RenderSettings gpu_settings;
-  gpu_settings.backend = RenderSettings::Backend::kCuda;
   for (int k = 0; k < 8; ++k) {
     SCOPED_TRACE("camera " + std::to_string(k));
     const cuda::BatchImages one = r.Wait(r.Submit(std::span(&cams[k], 1)));
@@ -155,10 +163,7 @@ TEST_F(BatchRendering, BatchedImagesEqualSingleCameraOnesBitForBit) {
     again.base = batched.data();
     EXPECT_TRUE(CameraBytes(one, 0) == CameraBytes(again, k));
     // the single-camera renderer (CudaRenderer) of the same view: same depth, same ids
-    const BatchWorld& w = worlds_[k % 2];
-    const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
-    RenderedFrame f;
-    single->Render(w.snap, views[k], &f);
+    const RenderedFrame f = CudaRendererAlone(k, views[k]);
     const int n = kBatchW * kBatchH;
     int same_bits = 0, depth_bad = 0, seg_bad = 0, hits = 0;
     // the normals come from the same TracePixelTruth as CudaRenderer's: the same bits
@@ -293,15 +298,10 @@ TEST_F(BatchRendering, RgbEqualsCudaRendererAloneBitForBit) {
       break;
     }
     first = bytes;
-    RenderSettings gpu_settings;
-    gpu_settings.backend = RenderSettings::Backend::kCuda;
     const int n = kBatchW * kBatchH;
     for (int k = 0; k < 8; ++k) {
       SCOPED_TRACE("camera " + std::to_string(k));
-      const BatchWorld& w = worlds_[k % 2];
-      const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
-      RenderedFrame f;
-      single->Render(w.snap, views[k], &f);
+      const RenderedFrame f = CudaRendererAlone(k, views[k]);
       ASSERT_EQ(f.rgb.data.size(), static_cast<size_t>(3 * n));
       int rgb_diff = 0, depth_diff = 0, lit = 0;
       for (int i = 0; i < 3 * n; ++i) {
@@ -344,15 +344,10 @@ TEST_F(BatchRendering, DistortedAndMovingCamerasTraceTheirOwnRays) {
   img.base = bytes.data();
   cuda::BatchImages pin = img;
   pin.base = pinhole_bytes.data();
-  RenderSettings gpu_settings;
-  gpu_settings.backend = RenderSettings::Backend::kCuda;
   const int n = kBatchW * kBatchH;
   for (int k = 0; k < 8; ++k) {
     SCOPED_TRACE("camera " + std::to_string(k));
-    const BatchWorld& w = worlds_[k % 2];
-    const std::unique_ptr<Renderer> single = MakeRenderer(w.session->scene(), gpu_settings);
-    RenderedFrame f;
-    single->Render(w.snap, views[k], &f);
+    const RenderedFrame f = CudaRendererAlone(k, views[k]);
     EXPECT_EQ(std::memcmp(f.depth_m.data.data(), img.depth(k), 4 * n), 0);
     EXPECT_EQ(std::memcmp(f.geom_id.data.data(), img.geom_id(k), 4 * n), 0);
     EXPECT_EQ(std::memcmp(f.normal_O.data.data(), img.normal_O(k), 12 * n), 0);

@@ -47,9 +47,22 @@ struct BatchDevice::Impl {
   uint8_t* host[BatchTickets::kSlots] = {};
   BatchCamera* cameras[BatchTickets::kSlots] = {};
   SceneView* views[BatchTickets::kSlots] = {};
-  int views_capacity[BatchTickets::kSlots] = {};
+  int64_t views_capacity[BatchTickets::kSlots] = {};
   float* tables[BatchTickets::kSlots] = {};
   int64_t tables_capacity[BatchTickets::kSlots] = {};
+
+  // *p holds at least n elements afterwards: a new buffer once the slot's earlier kernels, which
+  // may read the old one, are done
+  template <typename T>
+  void Grow(T** p, int64_t* capacity, int64_t n, const char* what) {
+    if (n <= *capacity) return;
+    CheckBatch(cudaStreamSynchronize(compute), "waiting for the batch kernels");
+    if (*p) cudaFree(*p);
+    *p = nullptr;
+    *capacity = 0;
+    CheckBatch(cudaMalloc(reinterpret_cast<void**>(p), sizeof(T) * n), what);
+    *capacity = n;
+  }
   cudaEvent_t started[BatchTickets::kSlots] = {}, done[BatchTickets::kSlots] = {},
               copied[BatchTickets::kSlots] = {};
   bool pending_copy[BatchTickets::kSlots] = {};
@@ -121,15 +134,7 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
   // the slot's device buffer is free once its previous copy back has run
   if (m.pending_copy[slot])
     CheckBatch(cudaStreamWaitEvent(m.compute, m.copied[slot], 0), "cudaStreamWaitEvent");
-  if (num_views > m.views_capacity[slot]) {
-    CheckBatch(cudaStreamSynchronize(m.compute), "waiting for the batch kernels");
-    if (m.views[slot]) cudaFree(m.views[slot]);
-    m.views[slot] = nullptr;
-    m.views_capacity[slot] = 0;
-    CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.views[slot]), sizeof(SceneView) * num_views),
-               "cudaMalloc (worlds)");
-    m.views_capacity[slot] = num_views;
-  }
+  m.Grow(&m.views[slot], &m.views_capacity[slot], num_views, "cudaMalloc (worlds)");
   // from pageable memory: the call returns once the source is staged, so the host arrays may
   // change after it; the kernel below is ordered after the copies on the same stream
   CheckBatch(cudaMemcpyAsync(m.views[slot], views, sizeof(SceneView) * num_views,
@@ -173,16 +178,7 @@ void BatchDevice::Submit(int slot, const SceneView* views, int num_views,
 
 const float* BatchDevice::UploadCameraTables(int slot, const float* tables, int64_t n) {
   Impl& m = *impl_;
-  if (n > m.tables_capacity[slot]) {
-    // the slot's earlier kernels may still read the old buffer
-    CheckBatch(cudaStreamSynchronize(m.compute), "waiting for the batch kernels");
-    if (m.tables[slot]) cudaFree(m.tables[slot]);
-    m.tables[slot] = nullptr;
-    m.tables_capacity[slot] = 0;
-    CheckBatch(cudaMalloc(reinterpret_cast<void**>(&m.tables[slot]), sizeof(float) * n),
-               "cudaMalloc (camera ray tables)");
-    m.tables_capacity[slot] = n;
-  }
+  m.Grow(&m.tables[slot], &m.tables_capacity[slot], n, "cudaMalloc (camera ray tables)");
   // from pageable memory, as the cameras: staged before the call returns, ordered on the stream
   if (n > 0)
     CheckBatch(cudaMemcpyAsync(m.tables[slot], tables, sizeof(float) * n, cudaMemcpyHostToDevice,
