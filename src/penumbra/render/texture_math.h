@@ -334,8 +334,9 @@ PB_HOST_DEVICE inline float TexcoordRho(float uv_per_m, float w, float th) {
 /// the rows with j0, j1 at the face axes and zeros elsewhere).
 PB_HOST_DEVICE inline void TexcoordAxis(const float j_s[3], const float j_t[3], const float a[3],
                                         float* s, float* t) {
-  *s = j_s[0] * a[0] + j_s[1] * a[1] + j_s[2] * a[2];
-  *t = j_t[0] * a[0] + j_t[1] * a[1] + j_t[2] * a[2];
+  // summed as Eigen's 2 x 3 by 3 product sums them (x0 + (x1 + x2)): the CPU's bits
+  *s = j_s[0] * a[0] + (j_s[1] * a[1] + j_s[2] * a[2]);
+  *t = j_t[0] * a[0] + (j_t[1] * a[1] + j_t[2] * a[2]);
 }
 
 /// the tangent t_G (increasing s) and bitangent b_G (towards the image's top row: decreasing
