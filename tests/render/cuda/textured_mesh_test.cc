@@ -1,6 +1,6 @@
 // meshes' vertex normals and texture coordinates in the CUDA backend, run on the CPU (no GPU
 // needed), on the generated world of textured_mesh_world.h (a coarse sphere mesh with vertex
-// normals and texcoords, a 2d checker texture, a skybox):
+// normals and texcoords, a 2d checker texture and normal map, a cube-textured box, a skybox):
 // - BvhRayQuery's hits (the PB_HOST_DEVICE HitShadingNormal / HitTexcoords the GPU runs) carry
 //   the shading normal, texcoords, uv_per_m and duv_dp_G of Embree's RayScene;
 // - the realtime rgb of the GPU path on the host (RenderRealtimeOnHost) matches the CPU backend
@@ -23,6 +23,8 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/material_eval.h"
+#include "penumbra/render/sky_model.h"
 #include "realtime_parity.h"
 #include "textured_mesh_world.h"
 
@@ -44,17 +46,25 @@ RenderedFrame HostPathFrame(const SceneDescription& gpu_scene, const WorldSnapsh
   return f;
 }
 
-TEST(TexturedMeshWorld, MeshHasNormalsTexcoordsAndATexturedMaterial) {
+TEST(TexturedMeshWorld, HasTheTexturedNormalMappedMeshTheCubeTexturedBoxAndTheSkybox) {
   Simulation sim = textured_mesh::Load();
   const SceneDescription& scene = sim.scene();
   ASSERT_EQ(scene.meshes.size(), 1u);
   EXPECT_EQ(scene.meshes[0].normals.size(), scene.meshes[0].vertices.size());
   EXPECT_EQ(scene.meshes[0].texcoords.size(), scene.meshes[0].vertices.size());
-  int textured = 0;
-  for (const Geom& g : scene.geoms)
-    if (g.shape == GeomShape::kMesh && g.material >= 0 && scene.materials[g.material].texture >= 0)
-      ++textured;
+  const MaterialEvaluator materials(scene);
+  int textured = 0, normal_mapped = 0, cube = 0;
+  for (const Geom& g : scene.geoms) {
+    if (g.material < 0 || scene.materials[g.material].texture < 0) continue;
+    const Texture& t = scene.textures[scene.materials[g.material].texture];
+    textured += g.shape == GeomShape::kMesh && t.kind == Texture::Kind::k2D;
+    normal_mapped += g.shape == GeomShape::kMesh && materials.pbr_maps(g.material).normal >= 0;
+    cube += g.shape == GeomShape::kBox && t.kind == Texture::Kind::kCube;
+  }
   EXPECT_EQ(textured, 1);
+  EXPECT_EQ(normal_mapped, 1);
+  EXPECT_EQ(cube, 1);
+  EXPECT_NE(MjcfSkyboxOf(scene).image, nullptr);
 }
 
 // every pixel-centre ray of the camera at 160x120 through both queries: where both hit the

@@ -3,9 +3,11 @@
 // carries vertex normals (smooth shading: the outward unit normal at each vertex, far from the
 // flat facets' normals at 6 x 10 segments) and texture coordinates (u = 2 (x + y) + 0.5, v =
 // 3 z: neither a planar projection along one axis nor the untextured colour), a 2d checker
-// texture on it (MuJoCo's builtin, 64 x 64 texels), a box wrapped in a cube texture, a floor, a
-// lamp, a gradient skybox (the background of escaping rays) and a camera that sees all of them
-// (docs/gpu.md, "Textured meshes and smooth normals on the GPU").
+// texture on it (MuJoCo's builtin, 64 x 64 texels) with a checker normal map (texture
+// "checker/normal", the material's PBR map by name: flat and tilted squares, bent in the
+// texcoords' tangent frame), a box wrapped in a cube texture, a floor, a lamp, a gradient skybox
+// (the background of escaping rays) and a camera that sees all of them (docs/gpu.md, "Textured
+// meshes, smooth normals, cube textures and skyboxes on the GPU").
 
 #include <cmath>
 #include <sstream>
@@ -57,6 +59,8 @@ inline std::string Mjcf() {
              rgb2="0.1 0.2 0.8" width="64" height="64"/>
     <texture name="crate" type="cube" builtin="checker" rgb1="0.8 0.3 0.2" rgb2="0.95 0.95 0.9"
              width="32" height="32"/>
+    <texture name="checker/normal" type="2d" builtin="checker" rgb1="0.5 0.5 1"
+             rgb2="0.75 0.6 0.9" width="64" height="64"/>
     <material name="checker" texture="checker" specular="0.3"/>
     <material name="crate" texture="crate"/>
     <mesh name="ball" vertex=")"
@@ -94,11 +98,13 @@ inline CameraView View(const SceneDescription& scene, const WorldSnapshot& snap,
 }
 
 /// `scene` as the GPU path drew it before branch gpu9: the mesh's vertex normals, texture
-/// coordinates, the ball's and the box's textures dropped (flat, untextured), for tests that
-/// check their threshold tells the two apart.
+/// coordinates, the ball's and the box's textures and the normal map dropped (flat,
+/// untextured), for tests that check their threshold tells the two apart.
 inline SceneDescription FlatUntextured(const SceneDescription& scene) {
   SceneDescription s = scene;
   for (TriangleMesh& m : s.meshes) m.normals.clear(), m.texcoords.clear();
+  for (Texture& t : s.textures)
+    if (t.name == "checker/normal") t.name = "unused";
   for (Material& m : s.materials)
     if (m.name == "checker" || m.name == "crate") m.texture = -1;
   return s;
