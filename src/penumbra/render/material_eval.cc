@@ -284,7 +284,7 @@ struct MaterialEvaluator::Mapping2D {
 
   // texels per metre of surface for a w x h image (the expressions of the isotropic lookup).
   float Rho(float w, float th) const {
-    if (kind == Kind::kTexcoords) return uv_per_m * std::sqrt(w * th);
+    if (kind == Kind::kTexcoords) return TexcoordRho(uv_per_m, w, th);
     return planar.rho(w, th);
   }
 };
@@ -338,10 +338,13 @@ MaterialEvaluator::FilterPlan MaterialEvaluator::PlanFilter(
   FilterPlan plan;
   if (aniso) {
     // the axes in texture units, then the taps (texture_math.h, shared with the GPU).
-    const Eigen::Vector2f major_st = map.J * major_G;
-    const Eigen::Vector2f minor_st = map.J * minor_G;
-    const PlanarFilterPlan p = PlanAnisotropic(major_st.x(), major_st.y(), minor_st.x(),
-                                               minor_st.y(), w, th, max_anisotropy_);
+    const float j_s[3] = {map.J(0, 0), map.J(0, 1), map.J(0, 2)};
+    const float j_t[3] = {map.J(1, 0), map.J(1, 1), map.J(1, 2)};
+    float major_s, major_t, minor_s, minor_t;
+    TexcoordAxis(j_s, j_t, major_G.data(), &major_s, &major_t);
+    TexcoordAxis(j_s, j_t, minor_G.data(), &minor_s, &minor_t);
+    const PlanarFilterPlan p =
+        PlanAnisotropic(major_s, major_t, minor_s, minor_t, w, th, max_anisotropy_);
     if (p.ok) {
       plan.lod = p.lod;
       plan.n = p.n;
@@ -431,13 +434,14 @@ SurfaceMaterial MaterialEvaluator::Evaluate(const SurfaceHit& hit,
     } else {
       const Eigen::Vector3f& h = half_extent_G_[hit.geom];
       const float w = static_cast<float>(tex.image->width());
+      // the lookup direction and texels per metre (texture_math.h, shared with the GPU)
       auto q_of = [&](const Eigen::Vector3f& p_G) {
-        return Eigen::Vector3f(h.x() > 0 ? p_G.x() / h.x() : hit.n_G.x(),
-                               h.y() > 0 ? p_G.y() / h.y() : hit.n_G.y(),
-                               h.z() > 0 ? p_G.z() / h.z() : hit.n_G.z());
+        const Float3 q = CubeLookupDirection(Float3{p_G.x(), p_G.y(), p_G.z()},
+                                             Float3{hit.n_G.x(), hit.n_G.y(), hit.n_G.z()},
+                                             Float3{h.x(), h.y(), h.z()});
+        return Eigen::Vector3f(q.x, q.y, q.z);
       };
-      const float h_max = h.maxCoeff();
-      const float rho = h_max > 0 ? w / (2 * h_max) : 0.0f;
+      const float rho = CubeRho(w, h.maxCoeff());
       if (aniso && rho > 0) {
         const float rho2 = rho * rho;
         const AnisoTaps taps =
@@ -500,12 +504,10 @@ void MaterialEvaluator::BendNormal(const Mapping2D& map, const Eigen::Vector3f& 
     t_G[map.a0] = map.J(0, map.a0) >= 0 ? 1.0f : -1.0f;
     b_G[map.a1] = map.J(1, map.a1) >= 0 ? -1.0f : 1.0f;
   } else {
-    const Eigen::Matrix2f JJt = map.J * map.J.transpose();
-    const float det = JJt.determinant();
-    if (!(std::abs(det) > 1e-20f)) return;
-    const Eigen::Matrix<float, 3, 2> P = map.J.transpose() * JJt.inverse();
-    t_G = P.col(0);
-    b_G = -P.col(1);
+    // the texcoords' tangent frame (texture_math.h, shared with the GPU)
+    const float j_s[3] = {map.J(0, 0), map.J(0, 1), map.J(0, 2)};
+    const float j_t[3] = {map.J(1, 0), map.J(1, 1), map.J(1, 2)};
+    if (!TexcoordTangents(j_s, j_t, t_G.data(), b_G.data())) return;
   }
   // the GPU's BendNormal (texture_math.h) is this arithmetic on Float3; here Eigen's vectorised
   // dot and cross products round differently in the last bit (docs/gpu.md).

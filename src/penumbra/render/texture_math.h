@@ -218,6 +218,22 @@ PB_HOST_DEVICE inline bool CubeFaceCoords(const Float3& q, int* face, float* s, 
   return true;
 }
 
+/// the direction a geom's cube texture is looked up by at geom-frame point p_G
+/// (render/material_eval.h, "cube texture"): q = p_G / h per axis, h the half extents of the
+/// geom's local bounding box, and along a flat axis (h = 0) the outward geom-frame normal n_G's
+/// component.
+PB_HOST_DEVICE inline Float3 CubeLookupDirection(const Float3& p_G, const Float3& n_G,
+                                                 const Float3& h) {
+  return Float3{h.x > 0 ? p_G.x / h.x : n_G.x, h.y > 0 ? p_G.y / h.y : n_G.y,
+                h.z > 0 ? p_G.z / h.z : n_G.z};
+}
+
+/// texels per metre of a cube texture w texels wide on a geom whose largest half extent is
+/// h_max: w / (2 h_max) (each face spans the geom); 0 when h_max is not positive.
+PB_HOST_DEVICE inline float CubeRho(float w, float h_max) {
+  return h_max > 0 ? w / (2 * h_max) : 0.0f;
+}
+
 /// a planar texture mapping at a point (render/material_eval.h, "texture mapping"): texture
 /// coordinates (s, t) in images, their derivatives ds / dp_a0 and dt / dp_a1 along the face
 /// axes a0, a1 (the only non-zero entries of the mapping's gradient), and its texels per metre.
@@ -304,6 +320,45 @@ PB_HOST_DEVICE inline PlanarFilterPlan PlanPlanarFilter(const PlanarMap& map, fl
                                                         int max_anisotropy) {
   return PlanAnisotropic(map.j0 * major_a0, map.j1 * major_a1, map.j0 * minor_a0, map.j1 * minor_a1,
                          w, th, max_anisotropy);
+}
+
+/// texels per metre of surface of a mesh's texcoords on a w x th image (the isotropic lookup's
+/// rho, render/material_eval.h "filtering"): uv_per_m sqrt(w th), uv_per_m the hit triangle's
+/// SurfaceHit::uv_per_m.
+PB_HOST_DEVICE inline float TexcoordRho(float uv_per_m, float w, float th) {
+  return uv_per_m * sqrtf(w * th);
+}
+
+/// a geom-frame vector a (a footprint axis) in texture units: (s, t) = J a, J the 2 x 3
+/// texcoord gradient given by its rows j_s, j_t (SurfaceHit::duv_dp_G; for a planar mapping
+/// the rows with j0, j1 at the face axes and zeros elsewhere).
+PB_HOST_DEVICE inline void TexcoordAxis(const float j_s[3], const float j_t[3], const float a[3],
+                                        float* s, float* t) {
+  // summed as Eigen's 2 x 3 by 3 product sums them (x0 + (x1 + x2)): the CPU's bits
+  *s = j_s[0] * a[0] + (j_s[1] * a[1] + j_s[2] * a[2]);
+  *t = j_t[0] * a[0] + (j_t[1] * a[1] + j_t[2] * a[2]);
+}
+
+/// the tangent t_G (increasing s) and bitangent b_G (towards the image's top row: decreasing
+/// t) of a mesh's texcoord mapping, geom frame: the columns of the pseudo-inverse
+/// P = J^T (J J^T)^-1 of its gradient J (rows j_s, j_t), t_G = P e_s, b_G = -P e_t (normal
+/// mapping, MaterialEvaluator::ApplyNormalMap). false where J J^T is singular
+/// (|det| <= 1e-20).
+PB_HOST_DEVICE inline bool TexcoordTangents(const float j_s[3], const float j_t[3], float t_G[3],
+                                            float b_G[3]) {
+  const float a = j_s[0] * j_s[0] + j_s[1] * j_s[1] + j_s[2] * j_s[2];
+  const float b = j_s[0] * j_t[0] + j_s[1] * j_t[1] + j_s[2] * j_t[2];
+  const float d = j_t[0] * j_t[0] + j_t[1] * j_t[1] + j_t[2] * j_t[2];
+  const float det = a * d - b * b;
+  if (!(fabsf(det) > 1e-20f)) return false;
+  const float inv = 1.0f / det;
+  // (J J^T)^-1 = [d -b; -b a] / det
+  const float i00 = d * inv, i01 = -b * inv, i11 = a * inv;
+  for (int k = 0; k < 3; ++k) {
+    t_G[k] = j_s[k] * i00 + j_t[k] * i01;
+    b_G[k] = -(j_s[k] * i01 + j_t[k] * i11);
+  }
+  return true;
 }
 
 /// normal mapping (render/material_eval.h, MaterialEvaluator::ApplyNormalMap; the CPU keeps its

@@ -1,6 +1,8 @@
 #include "penumbra/render/triangle_shapes.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -107,6 +109,39 @@ TriangleShape HeightFieldTriangles(const HeightField& hf) {
   AddQuad(&s, {-sx, -sy, base}, {-sx, sy, base}, {sx, sy, base}, {sx, -sy, base},
           -Eigen::Vector3f::UnitZ());
   return s;
+}
+
+TriangleShadingTerms ShadingTermsOf(const TriangleShape& shape, const Eigen::Matrix3f& R_IG) {
+  TriangleShadingTerms out;
+  out.normals_I.reserve(shape.normals.size());
+  for (const Eigen::Vector3f& n : shape.normals) out.normals_I.push_back((R_IG * n).normalized());
+  if (shape.texcoords.empty()) return out;
+  const std::vector<Eigen::Vector3f>& vertices_G = shape.vertices;
+  out.uv_per_m.reserve(shape.faces.size());
+  out.duv_dp_G.reserve(shape.faces.size());
+  for (const Eigen::Vector3i& f : shape.faces) {
+    const Eigen::Vector3f& p0 = vertices_G[f[0]];
+    const float area = (vertices_G[f[1]] - p0).cross(vertices_G[f[2]] - p0).norm();
+    const Eigen::Vector2f& t0 = shape.texcoords[f[0]];
+    const Eigen::Vector2f e1 = shape.texcoords[f[1]] - t0, e2 = shape.texcoords[f[2]] - t0;
+    const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    out.uv_per_m.push_back(area > 0 ? std::sqrt(uv_area / area) : 0.0f);
+    // J with J e1 = duv1, J e2 = duv2, J n = 0: J = [duv1 duv2 0] [e1 e2 n]^-1.
+    const Eigen::Vector3f p1 = vertices_G[f[1]] - p0, p2 = vertices_G[f[2]] - p0;
+    const Eigen::Vector3f n = p1.cross(p2);
+    Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
+    if (area > 0 && uv_area > 0) {
+      Eigen::Matrix3f E;
+      E << p1, p2, n / area;
+      Eigen::Matrix<float, 2, 3> F = Eigen::Matrix<float, 2, 3>::Zero();
+      F.col(0) = e1;
+      F.col(1) = e2;
+      J = F * E.inverse();
+      if (!J.allFinite()) J.setZero();
+    }
+    out.duv_dp_G.push_back(J);
+  }
+  return out;
 }
 
 }  // namespace penumbra

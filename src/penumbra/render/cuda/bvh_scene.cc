@@ -8,6 +8,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/static_geometry.h"
 #include "penumbra/render/triangle_shapes.h"
 
@@ -74,6 +75,9 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
     const Eigen::Vector3f p = X_IG.translation().cast<float>();
     std::vector<Eigen::Vector3f> v_I(shape.vertices.size());
     for (size_t i = 0; i < v_I.size(); ++i) v_I[i] = R * shape.vertices[i] + p;
+    // vertex normals and texcoords as RayScene keeps them (render/triangle_shapes.h)
+    const TriangleShadingTerms terms = ShadingTermsOf(shape, R);
+    const bool normals = !terms.normals_I.empty(), uv = !shape.texcoords.empty();
     for (size_t f = 0; f < shape.faces.size(); ++f) {
       const Eigen::Vector3i& face = shape.faces[f];
       const Eigen::Vector3f &a = v_I[face[0]], &b = v_I[face[1]], &c = v_I[face[2]];
@@ -82,7 +86,23 @@ void BvhScene::AddGeom(int gi, const Pose& X_IG, std::vector<PrimBox>* boxes, in
       ref.kind = 0;
       ref.index = static_cast<int32_t>(triangles_.size());
       ref.record = record;
-      ref.face = static_cast<int32_t>(f);
+      if (normals || uv) {
+        TriangleShading ts{};
+        for (int k = 0; k < 3; ++k) {
+          if (normals) ts.n[k] = ToF3(terms.normals_I[face[k]]);
+          if (uv)
+            ts.uv[k][0] = shape.texcoords[face[k]].x(), ts.uv[k][1] = shape.texcoords[face[k]].y();
+        }
+        if (uv) {
+          for (int r = 0; r < 2; ++r)
+            for (int col = 0; col < 3; ++col) ts.duv_dp_G[3 * r + col] = terms.duv_dp_G[f](r, col);
+          ts.uv_per_m = terms.uv_per_m[f];
+        }
+        ts.has_normals = normals ? 1 : 0;
+        ts.has_uv = uv ? 1 : 0;
+        ref.shading = static_cast<int32_t>(shading_.size());
+        shading_.push_back(ts);
+      }
       triangles_.push_back(tri);
       prims_.push_back(ref);
       PrimBox box;
@@ -143,6 +163,7 @@ void BvhScene::BuildAll() {
   std::vector<int32_t> prim_index;
   prims_.clear();
   triangles_.clear();
+  shading_.clear();
   analytics_.clear();
   blases_.clear();
   records_.clear();
@@ -345,6 +366,7 @@ SceneView BvhScene::view() const {
   v.instances = instances_.data();
   v.num_instances = static_cast<int32_t>(instances_.size());
   v.records = records_.data();
+  v.shading = shading_.empty() ? nullptr : shading_.data();
   return v;
 }
 
@@ -384,6 +406,19 @@ void BvhScene::FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) co
   if (!hit->front_face) ng_W = -ng_W;
   hit->ng_W = ng_W;
   hit->ns_W = ng_W;
+  if (pr.kind != 0) return;
+  // smooth shading and texcoords (render/cuda/primary_pixel.h, as the GPU shades them)
+  const SceneView v = view();
+  Float3 ns;
+  if (HitShadingNormal(v, th, hit->front_face, &ns)) hit->ns_W = Eigen::Vector3f(ns.x, ns.y, ns.z);
+  float u = 0, w = 0;
+  if (const TriangleShading* ts = HitTexcoords(v, th, &u, &w)) {
+    hit->has_uv = true;
+    hit->uv = Eigen::Vector2f(u, w);
+    hit->uv_per_m = ts->uv_per_m;
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 3; ++c) hit->duv_dp_G(r, c) = ts->duv_dp_G[3 * r + c];
+  }
 }
 
 }  // namespace penumbra::cuda

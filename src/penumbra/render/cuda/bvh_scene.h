@@ -43,8 +43,10 @@ class BvhScene {
   /// the arrays as host pointers.
   SceneView view() const;
 
-  /// fills a SurfaceHit (t, p_W, ng_W, ns_W = ng_W, front_face, p_G, n_G, d_G, geom, material;
-  /// no texcoords yet) from a traversal hit of world ray `ray`.
+  /// fills a SurfaceHit (t, p_W, ng_W, ns_W, front_face, p_G, n_G, d_G, geom, material, and on
+  /// a triangle with texcoords uv, has_uv, uv_per_m, duv_dp_G) from a traversal hit of world
+  /// ray `ray`: ns_W the vertex normals' mix where the triangle has them (HitShadingNormal,
+  /// primary_pixel.h, as the GPU shades it), else ng_W; uv from HitTexcoords; as RayScene.
   void FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) const;
 
   const SceneDescription& scene() const { return scene_; }
@@ -55,6 +57,9 @@ class BvhScene {
   const std::vector<Blas>& blases() const { return blases_; }
   const std::vector<Instance>& instances() const { return instances_; }
   const std::vector<Record>& records() const { return records_; }
+  /// the shading attributes of the triangles that have vertex normals or texcoords
+  /// (PrimRef::shading).
+  const std::vector<TriangleShading>& shading() const { return shading_; }
   /// counts of Update calls that changed the BLAS arrays (a device copy must be refreshed).
   int64_t geometry_version() const { return geometry_version_; }
   int64_t num_triangles() const { return static_cast<int64_t>(triangles_.size()); }
@@ -93,6 +98,7 @@ class BvhScene {
   std::vector<BvhWideNode> nodes_;  // every BLAS's inner nodes (WidenBvh)
   std::vector<PrimRef> prims_;
   std::vector<Triangle> triangles_;
+  std::vector<TriangleShading> shading_;  // by PrimRef::shading
   std::vector<AnalyticPrim> analytics_;
   std::vector<Blas> blases_;
   std::vector<Instance> instances_;

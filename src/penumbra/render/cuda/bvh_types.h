@@ -58,13 +58,32 @@ struct AnalyticPrim {
 };
 
 /// a primitive: a triangle (kind 0) or an analytic shape (kind 1), with the record (geom) it
-/// belongs to and its index in that geom's mesh (triangles) for normals. 16 bytes, 16-aligned.
+/// belongs to and its triangle's shading attributes. 16 bytes, 16-aligned.
 struct alignas(16) PrimRef {
-  int32_t kind = 0;    ///< 0 = triangle, 1 = analytic
-  int32_t index = 0;   ///< into triangles or analytics
-  int32_t record = 0;  ///< into the scene's records
-  int32_t face = 0;    ///< triangle: face index in its geom's mesh
+  int32_t kind = 0;      ///< 0 = triangle, 1 = analytic
+  int32_t index = 0;     ///< into triangles or analytics
+  int32_t record = 0;    ///< into the scene's records
+  int32_t shading = -1;  ///< triangle: into SceneView::shading; -1: none (flat, untextured)
 };
+
+/// the shading attributes of a triangle of a mesh or height field with vertex normals or
+/// texture coordinates (RayScene's TriangleGeom per face, render/embree/ray_scene.cc): read for
+/// the closest hit only (HitShadingNormal, HitTexcoords in primary_pixel.h), never by the
+/// traversal, which reads the 48-byte Triangle alone. 96 bytes.
+struct TriangleShading {
+  /// the vertices' unit normals in the group frame (TriangleShadingTerms::normals_I), in the
+  /// triangle's vertex order (v0, v0 + e1, v0 + e2); unused without has_normals.
+  F3 n[3];
+  /// the vertices' texture coordinates (u, v), as n; unused without has_uv.
+  float uv[3][2];
+  /// the triangle's texcoord gradient in its geom frame, row-major 2 x 3 (SurfaceHit::duv_dp_G).
+  float duv_dp_G[6];
+  /// texcoord units per metre of surface (SurfaceHit::uv_per_m).
+  float uv_per_m;
+  int32_t has_normals;  ///< 1: n holds vertex normals (smooth shading)
+  int32_t has_uv;       ///< 1: uv holds texture coordinates
+};
+static_assert(sizeof(TriangleShading) == 96, "TriangleShading is 96 bytes");
 
 /// a bottom-level BVH: its inner nodes at nodes[node_offset ..] (SceneView::nodes), the root's
 /// box and reference (root_count >= 0: the root is a leaf of root_count primitives at
@@ -108,7 +127,8 @@ struct SceneView {
   const Blas* blases = nullptr;
   const Instance* instances = nullptr;
   int32_t num_instances = 0;
-  const Record* records = nullptr;  ///< by PrimRef::record
+  const Record* records = nullptr;           ///< by PrimRef::record
+  const TriangleShading* shading = nullptr;  ///< by PrimRef::shading (closest hits only)
 };
 
 /// a ray in the traversal's form (world frame; d not necessarily unit).

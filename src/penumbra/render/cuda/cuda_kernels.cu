@@ -69,7 +69,7 @@ bool ProbeDevice(std::string* name, std::string* why) {
 
 struct DeviceScene::Impl {
   cudaStream_t stream = nullptr;
-  Buffer nodes, prims, triangles, analytics, blases, records, instances;
+  Buffer nodes, prims, triangles, shading, analytics, blases, records, instances;
   Buffer rays, hits, out[6];
   Buffer camera_xy, camera_rows;
   int64_t camera_xy_version = -1;
@@ -118,6 +118,7 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
     m.analytics.Upload(v.analytics, n.analytics * sizeof(AnalyticPrim), m.stream);
     m.blases.Upload(v.blases, n.blases * sizeof(Blas), m.stream);
     m.records.Upload(v.records, n.records * sizeof(Record), m.stream);
+    if (n.shading > 0) m.shading.Upload(v.shading, n.shading * sizeof(TriangleShading), m.stream);
     m.geometry_version = geometry_version;
   }
   // the instances' transforms: only when their bytes changed (a frame of static bodies
@@ -136,6 +137,7 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
   m.view.analytics = static_cast<const AnalyticPrim*>(m.analytics.p);
   m.view.blases = static_cast<const Blas*>(m.blases.p);
   m.view.records = static_cast<const Record*>(m.records.p);
+  m.view.shading = n.shading > 0 ? static_cast<const TriangleShading*>(m.shading.p) : nullptr;
   m.view.instances = static_cast<const Instance*>(m.instances.p);
   m.view.num_instances = v.num_instances;
   if (wait) Check(cudaStreamSynchronize(m.stream), "uploading the scene");

@@ -51,6 +51,7 @@ class DeviceScene {
   /// the sizes of a SceneView's arrays.
   struct Sizes {
     int64_t nodes = 0, prims = 0, triangles = 0, analytics = 0, blases = 0, records = 0;
+    int64_t shading = 0;  ///< TriangleShading records (0: none, SceneView::shading null)
   };
   /// copies the arrays of `view` (host pointers) to the device: all of them when
   /// geometry_version differs from the last call's, else the instances only. `wait`: returns

@@ -16,6 +16,7 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   n.analytics = static_cast<int64_t>(scene.analytics().size());
   n.blases = static_cast<int64_t>(scene.blases().size());
   n.records = static_cast<int64_t>(scene.records().size());
+  n.shading = static_cast<int64_t>(scene.shading().size());
   device->Sync(scene.view(), n, scene.geometry_version(), wait);
 }
 

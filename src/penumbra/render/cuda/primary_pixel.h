@@ -12,6 +12,8 @@
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/mesh_shading_math.h"
+#include "penumbra/render/shading_math.h"
 
 namespace penumbra::cuda {
 
@@ -116,6 +118,48 @@ PB_HOST_DEVICE inline F3 HitNormal(const SceneView& s, const TraceRay& r, const 
   if (!front) n = {-n.x, -n.y, -n.z};
   if (front_face) *front_face = front;
   return n;
+}
+
+/// the shading attributes of hit h (a triangle's TriangleShading), or null where the hit
+/// primitive has none (an analytic shape, a box, a mesh without normals and texcoords).
+PB_HOST_DEVICE inline const TriangleShading* HitShading(const SceneView& s, const TraceHit& h) {
+  const PrimRef& pr = s.prims[h.prim];
+  return pr.kind == 0 && pr.shading >= 0 && s.shading ? s.shading + pr.shading : nullptr;
+}
+
+/// the unit shading normal of hit h, world frame, facing as its geometric normal does
+/// (front_face: HitNormal's): the triangle's vertex normals mixed at the hit's barycentrics
+/// (BarycentricMix, as RayScene::FinishHit), normalised and posed by the hit's instance. false
+/// (no change) where the triangle has no vertex normals or their mix is zero: the geometric
+/// normal shades there.
+PB_HOST_DEVICE inline bool HitShadingNormal(const SceneView& s, const TraceHit& h, bool front_face,
+                                            Float3* ns_W) {
+  const TriangleShading* ts = HitShading(s, h);
+  if (!ts || ts->has_normals == 0) return false;
+  const Float3 ns_I = BarycentricMix(Float3{ts->n[0].x, ts->n[0].y, ts->n[0].z},
+                                     Float3{ts->n[1].x, ts->n[1].y, ts->n[1].z},
+                                     Float3{ts->n[2].x, ts->n[2].y, ts->n[2].z}, h.u, h.v);
+  const float ls = sqrtf(ns_I.x * ns_I.x + ns_I.y * ns_I.y + ns_I.z * ns_I.z);
+  if (!(ls > 0)) return false;
+  const F3 n =
+      TransformVector(s.instances[h.instance].X_WI, F3{ns_I.x / ls, ns_I.y / ls, ns_I.z / ls});
+  *ns_W = front_face ? Float3{n.x, n.y, n.z} : Float3{-n.x, -n.y, -n.z};
+  return true;
+}
+
+/// the texture coordinates (u, v) of hit h: the triangle's vertex texcoords mixed at the hit's
+/// barycentrics (BarycentricMix, as RayScene::FinishHit), and the triangle's shading record
+/// (its uv_per_m and duv_dp_G); null where the triangle has no texcoords (planar mapping).
+PB_HOST_DEVICE inline const TriangleShading* HitTexcoords(const SceneView& s, const TraceHit& h,
+                                                          float* uv_u, float* uv_v) {
+  const TriangleShading* ts = HitShading(s, h);
+  if (!ts || ts->has_uv == 0) return nullptr;
+  const Float3 uv =
+      BarycentricMix(Float3{ts->uv[0][0], ts->uv[0][1], 0}, Float3{ts->uv[1][0], ts->uv[1][1], 0},
+                     Float3{ts->uv[2][0], ts->uv[2][1], 0}, h.u, h.v);
+  *uv_u = uv.x;
+  *uv_v = uv.y;
+  return ts;
 }
 
 /// traces ray r (PinholePixelRay's) through scene s and returns the pixel's ground truth; with

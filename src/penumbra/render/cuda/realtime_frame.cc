@@ -59,7 +59,7 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
     : scene_(scene),
       settings_(settings),
       lights_(scene),
-      sky_(scene.sky),
+      sky_(scene.sky, MjcfSkyboxOf(scene)),
       volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
         return std::make_unique<BvhRayQuery>(statics);
       }),
@@ -67,11 +67,19 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
         return std::make_unique<BvhRayQuery>(statics);
       }),
       film_(settings) {
-  // 2d textures with one face: every level's texels, one after the other.
+  // 2d textures with one face and cube (or skybox) textures with six: every level's texels,
+  // one after the other.
+  // (cube textures only where a material wraps a geom in one: an MJCF skybox is the sky's.)
   std::vector<int> slot(scene.textures.size(), -1);
+  std::vector<bool> on_material(scene.textures.size(), false);
+  for (const Material& m : scene.materials)
+    if (m.texture >= 0 && m.texture < static_cast<int>(on_material.size()))
+      on_material[m.texture] = true;
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const Texture& t = scene.textures[i];
-    if (t.kind != Texture::Kind::k2D || !t.image || t.image->faces() != 1) continue;
+    if (!t.image) continue;
+    const bool cube = t.kind != Texture::Kind::k2D;
+    if (t.image->faces() != (cube ? 6 : 1) || (cube && !on_material[i])) continue;
     const TextureImage& im = *t.image;
     if (im.num_levels() > kMaxTextureLevels)
       throw Error("texture '" + t.name + "': " + std::to_string(im.num_levels()) +
@@ -79,6 +87,7 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
                   std::to_string(kMaxTextureLevels));
     TexturePod pod;
     pod.num_levels = im.num_levels();
+    pod.cube = cube ? 1 : 0;
     for (int l = 0; l < im.num_levels(); ++l) {
       const TextureLevel& L = im.level(l);
       pod.width[l] = L.width;
@@ -113,11 +122,6 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
     pod.half_extent = ToFloat3(GeomHalfExtents(scene, geom));
     pod.plane = geom.shape == GeomShape::kPlane ? 1 : 0;
     pod.box = geom.shape == GeomShape::kBox ? 1 : 0;
-    pod.untextured = geom.shape == GeomShape::kMesh && geom.mesh >= 0 &&
-                             geom.mesh < static_cast<int>(scene.meshes.size()) &&
-                             !scene.meshes[geom.mesh].texcoords.empty()
-                         ? 1
-                         : 0;
   }
 }
 

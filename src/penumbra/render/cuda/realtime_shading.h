@@ -25,10 +25,10 @@
 // primary sky terms; ShadeMirrorHit), the other
 // layer pixels interpolated from the grid and blended (ApplyMirrorLayer). the lighting effects
 // reach it as the CPU's: the lights (scaled, extra) and the sky (moved sun, scaled) through
-// the frame's data, the surface wetness in EvaluateSurface (render/wetness_math.h). what the GPU
-// path does not model yet (docs/gpu.md): texture coordinates of meshes (such materials are
-// untextured), cube textures on geoms (untextured), MJCF skyboxes, and interpolated shading
-// normals (the geometric normal shades).
+// the frame's data, the surface wetness in EvaluateSurface (render/wetness_math.h). meshes and
+// height fields shade with their vertex normals mixed at the hit and map their textures by their
+// texcoords (HitShadingNormal, HitTexcoords: primary_pixel.h), escaping rays see the MJCF
+// skybox (SkyBackground), and cube textures wrap geoms (FilterCube), as the CPU.
 
 #include <cstdint>
 
@@ -78,9 +78,12 @@ struct MaterialPod {
   }
 };
 
-/// a 2d texture: its mip levels' texels at texels[level_offset[l]] (bytes).
+/// a 2d texture, or a cube texture (cube 1: each level holds the six faces of width[l]^2
+/// texels, face after face, as TextureLevel): its mip levels' texels at texels[level_offset[l]]
+/// (bytes).
 struct TexturePod {
   int32_t num_levels = 0;
+  int32_t cube = 0;
   int32_t width[kMaxTextureLevels] = {};
   int32_t height[kMaxTextureLevels] = {};
   int64_t level_offset[kMaxTextureLevels] = {};
@@ -93,7 +96,6 @@ struct GeomPod {
   int32_t infinite_plane = 0;  ///< a plane without finite size in the face's axes
   int32_t plane = 0;           ///< GeomShape::kPlane
   int32_t box = 0;             ///< GeomShape::kBox (its top face, n_G.z > 0.5, takes a mirror)
-  int32_t untextured = 0;      ///< a mesh with texture coordinates (not mapped on the GPU yet)
 };
 
 /// what a pixel's primary ray (or its mirrored ray, TraceMirrorRay) hits, for the host's sky
@@ -240,6 +242,10 @@ struct PlanarFootprint {
   bool axes = false;
   float major[3] = {0, 0, 0}, minor[3] = {0, 0, 0};
   float width_m = 0, cos_incidence = 1;
+  /// a mesh triangle's texcoords (HitTexcoords) instead of the planar mapping: map.s, map.t
+  /// are the hit's (u, v), rho is TexcoordRho of its uv_per_m and the axes are mapped by its
+  /// duv_dp_G (MaterialEvaluator's kTexcoords mapping); null: planar.
+  const TriangleShading* texcoords = nullptr;
 };
 
 /// the footprint of material m on geom g at geom-frame point p_G, normal n_G and ray direction
@@ -292,16 +298,26 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
   float lod = 0, ds = 0, dt = 0;
   int n = 1;
   bool planned = false;
+  const TriangleShading* tc = fp.texcoords;
   if (fp.axes) {
-    const PlanarFilterPlan plan =
-        PlanPlanarFilter(fp.map, fp.major[fp.a0], fp.major[fp.a1], fp.minor[fp.a0], fp.minor[fp.a1],
-                         w, th, f.max_anisotropy);
+    PlanarFilterPlan plan;
+    if (tc) {
+      float ms, mt, ns, nt;
+      TexcoordAxis(tc->duv_dp_G, tc->duv_dp_G + 3, fp.major, &ms, &mt);
+      TexcoordAxis(tc->duv_dp_G, tc->duv_dp_G + 3, fp.minor, &ns, &nt);
+      plan = PlanAnisotropic(ms, mt, ns, nt, w, th, f.max_anisotropy);
+    } else {
+      plan = PlanPlanarFilter(fp.map, fp.major[fp.a0], fp.major[fp.a1], fp.minor[fp.a0],
+                              fp.minor[fp.a1], w, th, f.max_anisotropy);
+    }
     if (plan.ok) {
       lod = plan.lod, n = plan.n, ds = plan.ds, dt = plan.dt;
       planned = true;
     }
   }
-  if (!planned) lod = TextureLod(fp.width_m, fp.cos_incidence, fp.map.rho(w, th));
+  if (!planned)
+    lod = TextureLod(fp.width_m, fp.cos_incidence,
+                     tc ? TexcoordRho(tc->uv_per_m, w, th) : fp.map.rho(w, th));
   if (n > 1) {
     const int l = TapLevel(tex.num_levels, lod);
     const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
@@ -317,6 +333,56 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
     c = c + weight[i] * BilinearWrap(L, f.srgb_decode, fp.map.s, fp.map.t);
   }
   return c;
+}
+
+/// the linear rgb of cube texture `slot` in direction q (any length > 0), trilinear at `lod`,
+/// clamped to the face (MaterialEvaluator::SampleCube); white where q is 0.
+PB_HOST_DEVICE inline Float3 SampleCubeTexture(const RealtimeFrameView& f, int slot,
+                                               const Float3& q, float lod) {
+  int face;
+  float s, t;
+  if (!CubeFaceCoords(q, &face, &s, &t)) return Float3{1, 1, 1};
+  const TexturePod& tex = f.textures[slot];
+  int level[2];
+  float weight[2];
+  const int count = TrilinearLevels(tex.num_levels, lod, level, weight);
+  Float3 c{0, 0, 0};
+  for (int i = 0; i < count; ++i) {
+    const int l = level[i];
+    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
+    c = c + weight[i] * BilinearFace(L, f.srgb_decode, face, s, t);
+  }
+  return c;
+}
+
+/// the linear rgb of cube texture `slot` on geom g at geom-frame point p_G of outward
+/// geom-frame normal n_G over footprint fp (MaterialEvaluator::Evaluate's cube branch: the
+/// lookup direction CubeLookupDirection, rho CubeRho; anisotropic taps along the footprint's
+/// major axis, each a cube lookup of the displaced point, where fp has axes).
+PB_HOST_DEVICE inline Float3 FilterCube(const RealtimeFrameView& f, int slot, const GeomPod& g,
+                                        const Float3& p_G, const Float3& n_G,
+                                        const PlanarFootprint& fp) {
+  const Float3& h = g.half_extent;
+  const float rho =
+      CubeRho(static_cast<float>(f.textures[slot].width[0]), pbm::Max(pbm::Max(h.x, h.y), h.z));
+  if (fp.axes && rho > 0) {
+    const float rho2 = rho * rho;
+    const float* a = fp.major;
+    const float* b = fp.minor;
+    const AnisoTaps taps =
+        TapsFor((a[0] * a[0] + a[1] * a[1] + a[2] * a[2]) * rho2,
+                (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) * rho2, f.max_anisotropy);
+    Float3 c{0, 0, 0};
+    for (int k = 0; k < taps.n; ++k) {
+      const float o = TapOffset(k, taps.n);
+      const Float3 p{p_G.x + o * a[0], p_G.y + o * a[1], p_G.z + o * a[2]};
+      c = c + SampleCubeTexture(f, slot, CubeLookupDirection(p, n_G, h), taps.lod);
+    }
+    const float n = static_cast<float>(taps.n);
+    return Float3{c.x / n, c.y / n, c.z / n};
+  }
+  return SampleCubeTexture(f, slot, CubeLookupDirection(p_G, n_G, h),
+                           TextureLod(fp.width_m, fp.cos_incidence, rho));
 }
 
 /// whether light l has an extent: a sphere lamp (radius > 0) or the sun's disc (as the CPU
@@ -410,8 +476,10 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
     const float nz = R[8] * ng.x + R[9] * ng.y + R[10] * ng.z;
     if (g.plane != 0 || (g.box != 0 && (front_face ? nz : -nz) > 0.5f)) sp.mirror = m.mirror;
   }
+  // smooth shading: a mesh's (or height field's) vertex normals mixed at the hit
   Float3 ns = ng;
-  if (m.any_map() && rec.geom >= 0 && f.geoms[rec.geom].untextured == 0) {
+  HitShadingNormal(s, h, front_face, &ns);
+  if (m.any_map() && rec.geom >= 0) {
     const GeomPod& g = f.geoms[rec.geom];
     const Float3 p_G = ToFloat3(TransformPoint(g.X_GW, ToF3(p)));
     const Float3 n_G = ToFloat3(TransformVector(g.X_GW, ToF3(ng)));
@@ -419,10 +487,14 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
     const float cos_inc = pbm::Min(1.0f, fabsf(ng.x * d.x + ng.y * d.y + ng.z * d.z));
     const float width_m =
         path_m > 0 ? f.spread_rad * (path_m + h.t * d_len) : f.spread_rad * h.t * d_len;
-    const PlanarFootprint fp =
-        PlanarFootprintAt(m, g, p_G, n_G, d_G, width_m, cos_inc, f.max_anisotropy);
+    PlanarFootprint fp = PlanarFootprintAt(m, g, p_G, n_G, d_G, width_m, cos_inc, f.max_anisotropy);
+    // a mesh's texcoords replace the planar mapping (MaterialEvaluator::MapAt)
+    fp.texcoords = HitTexcoords(s, h, &fp.map.s, &fp.map.t);
     if (m.texture >= 0) {
-      const Float3 c = FilterPlanar(f, m.texture, fp);
+      // a cube texture by the geom's box (the outward normal along flat axes), else 2d
+      const Float3 c = f.textures[m.texture].cube != 0
+                           ? FilterCube(f, m.texture, g, p_G, front_face ? n_G : -n_G, fp)
+                           : FilterPlanar(f, m.texture, fp);
       sp.base = Float3{sp.base.x * c.x, sp.base.y * c.y, sp.base.z * c.z};
     }
     if (m.metallic_roughness_map >= 0) {
@@ -437,13 +509,28 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
       sp.emission = Float3{sp.emission.x * c.x, sp.emission.y * c.y, sp.emission.z * c.z};
     }
     if (m.normal_map >= 0) {
-      // the planar mapping's tangent (+-a0) and bitangent (-+a1) in the world: rows of R_GW.
-      const float st = fp.map.j0 >= 0 ? 1.0f : -1.0f, sb = fp.map.j1 >= 0 ? -1.0f : 1.0f;
       const float* R = g.X_GW;
-      const Float3 t_W{st * R[4 * fp.a0], st * R[4 * fp.a0 + 1], st * R[4 * fp.a0 + 2]};
-      const Float3 b_W{sb * R[4 * fp.a1], sb * R[4 * fp.a1 + 1], sb * R[4 * fp.a1 + 2]};
+      Float3 t_W, b_W;
+      bool frame = true;
+      if (fp.texcoords) {
+        // the texcoords' tangent frame (TexcoordTangents) rotated to the world by R_GW^T.
+        float t_G[3], b_G[3];
+        frame = TexcoordTangents(fp.texcoords->duv_dp_G, fp.texcoords->duv_dp_G + 3, t_G, b_G);
+        t_W = Float3{R[0] * t_G[0] + R[4] * t_G[1] + R[8] * t_G[2],
+                     R[1] * t_G[0] + R[5] * t_G[1] + R[9] * t_G[2],
+                     R[2] * t_G[0] + R[6] * t_G[1] + R[10] * t_G[2]};
+        b_W = Float3{R[0] * b_G[0] + R[4] * b_G[1] + R[8] * b_G[2],
+                     R[1] * b_G[0] + R[5] * b_G[1] + R[9] * b_G[2],
+                     R[2] * b_G[0] + R[6] * b_G[1] + R[10] * b_G[2]};
+      } else {
+        // the planar mapping's tangent (+-a0) and bitangent (-+a1) in the world: rows of R_GW.
+        const float st = fp.map.j0 >= 0 ? 1.0f : -1.0f, sb = fp.map.j1 >= 0 ? -1.0f : 1.0f;
+        t_W = Float3{st * R[4 * fp.a0], st * R[4 * fp.a0 + 1], st * R[4 * fp.a0 + 2]};
+        b_W = Float3{sb * R[4 * fp.a1], sb * R[4 * fp.a1 + 1], sb * R[4 * fp.a1 + 2]};
+      }
       Float3 bent;
-      if (BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent)) ns = bent;
+      if (frame && BendNormal(ns, front_face, t_W, b_W, FilterPlanar(f, m.normal_map, fp), &bent))
+        ns = bent;
     }
   }
   // rain wetness (render/wetness_math.h) at the (bent) shading normal, after the PBR maps: the
@@ -458,15 +545,16 @@ PB_HOST_DEVICE inline ShadingPoint EvaluateSurface(const RealtimeFrameView& f, c
   return sp;
 }
 
-/// the sky term of one pixel from its primary geometry g: SkyRadiance where the ray escapes;
-/// where it hits, the occluded sky irradiance (the volume's blend at the point and geometric
-/// normal, evaluated at the shading normal; SkyIrradiance of the shading normal outside the
-/// grid or with an empty volume).
+/// the sky term of one pixel from its primary geometry g: SkyBackground (the MJCF skybox, else
+/// SkyRadiance) where the ray escapes; where it hits, the occluded sky irradiance (the volume's
+/// blend at the point and geometric normal, evaluated at the shading normal; SkyIrradiance of the
+/// shading normal outside the grid or with an empty volume).
 PB_HOST_DEVICE inline Float3 PixelSkyTerm(const SkyModelPod& sky, const SkyVolumePod& volume,
                                           const PixelGeometry& g) {
   float e[3];
   if (g.hit == 0) {
-    SkyRadiance(sky, g.p_or_d.x, g.p_or_d.y, g.p_or_d.z, e);
+    // the MJCF skybox where there is one (SkyRadiance without), as the CPU's Background
+    SkyBackground(sky, g.p_or_d.x, g.p_or_d.y, g.p_or_d.z, e);
   } else {
     const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
     if (!volume.empty()) {

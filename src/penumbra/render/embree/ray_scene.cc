@@ -11,6 +11,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
 #include "penumbra/render/embree/analytic_lanes.h"
+#include "penumbra/render/mesh_shading_math.h"
 #include "penumbra/render/moving_bounds.h"
 #include "penumbra/render/ray_cone.h"
 #include "penumbra/render/static_geometry.h"
@@ -284,8 +285,10 @@ struct RayScene::Impl {
       tg->vertices_I.reserve(shape.vertices.size() + 1);
       for (const Eigen::Vector3f& v : shape.vertices) tg->vertices_I.push_back(R_IG * v + p_IG);
       tg->vertices_I.push_back(Eigen::Vector3f::Zero());  // padding for Embree's 16-byte loads
-      for (const Eigen::Vector3f& n : shape.normals)
-        tg->normals_I.push_back((R_IG * n).normalized());
+      TriangleShadingTerms terms = ShadingTermsOf(shape, R_IG);
+      tg->normals_I = std::move(terms.normals_I);
+      tg->uv_per_m = std::move(terms.uv_per_m);
+      tg->duv_dp_G = std::move(terms.duv_dp_G);
       tg->texcoords = std::move(shape.texcoords);
       tg->faces = std::move(shape.faces);
       tg->vertices_G = std::move(shape.vertices);
@@ -297,31 +300,6 @@ struct RayScene::Impl {
         const float len = n_I.norm();
         n_I = len > 0 ? Eigen::Vector3f(n_I / len) : Eigen::Vector3f::UnitZ();
         tg->face_normals.push_back({n_I, R_GI * n_I});
-      }
-      if (!tg->texcoords.empty()) {
-        tg->uv_per_m.reserve(tg->faces.size());
-        for (const Eigen::Vector3i& f : tg->faces) {
-          const Eigen::Vector3f& p0 = tg->vertices_G[f[0]];
-          const float area = (tg->vertices_G[f[1]] - p0).cross(tg->vertices_G[f[2]] - p0).norm();
-          const Eigen::Vector2f& t0 = tg->texcoords[f[0]];
-          const Eigen::Vector2f e1 = tg->texcoords[f[1]] - t0, e2 = tg->texcoords[f[2]] - t0;
-          const float uv_area = std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-          tg->uv_per_m.push_back(area > 0 ? std::sqrt(uv_area / area) : 0.0f);
-          // J with J e1 = duv1, J e2 = duv2, J n = 0: J = [duv1 duv2 0] [e1 e2 n]^-1.
-          const Eigen::Vector3f p1 = tg->vertices_G[f[1]] - p0, p2 = tg->vertices_G[f[2]] - p0;
-          const Eigen::Vector3f n = p1.cross(p2);
-          Eigen::Matrix<float, 2, 3> J = Eigen::Matrix<float, 2, 3>::Zero();
-          if (area > 0 && uv_area > 0) {
-            Eigen::Matrix3f E;
-            E << p1, p2, n / area;
-            Eigen::Matrix<float, 2, 3> F = Eigen::Matrix<float, 2, 3>::Zero();
-            F.col(0) = e1;
-            F.col(1) = e2;
-            J = F * E.inverse();
-            if (!J.allFinite()) J.setZero();
-          }
-          tg->duv_dp_G.push_back(J);
-        }
       }
       tg->R_GI = R_GI;
       eg = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -524,12 +502,12 @@ struct RayScene::Impl {
       ns_W = ng_W;
       if (!g.normals_I.empty()) {
         const Eigen::Vector3f ns_I =
-            w * g.normals_I[f[0]] + u * g.normals_I[f[1]] + v * g.normals_I[f[2]];
+            BarycentricMix(g.normals_I[f[0]], g.normals_I[f[1]], g.normals_I[f[2]], u, v);
         const float ls = ns_I.norm();
         if (ls > 0) ns_W = group.rotated ? Eigen::Vector3f(group.R_WI_f * (ns_I / ls)) : ns_I / ls;
       }
       if (!g.texcoords.empty()) {
-        hit->uv = w * g.texcoords[f[0]] + u * g.texcoords[f[1]] + v * g.texcoords[f[2]];
+        hit->uv = BarycentricMix(g.texcoords[f[0]], g.texcoords[f[1]], g.texcoords[f[2]], u, v);
         hit->has_uv = true;
         hit->uv_per_m = g.uv_per_m[rh.hit.primID];
         hit->duv_dp_G = g.duv_dp_G[rh.hit.primID];
