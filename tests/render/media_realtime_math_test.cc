@@ -9,16 +9,20 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <vector>
 
 #include "media_test_util.h"
 #include "penumbra/core/rng.h"
+#include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/sky_irradiance_volume.h"
+#include "penumbra/render/sky_model.h"
 
 namespace penumbra::testing {
 namespace {
@@ -92,6 +96,98 @@ TEST(MediaRealtimeMathTest, SseLightVolumeLookupIsTheSharedOneBitForBit) {
   EXPECT_GT(inside, 2000);
   EXPECT_GT(outside, 2000);
   EXPECT_GT(occluded_entries, 100);  // the pillar and the wall shadow some of the lights
+}
+
+bool SameF3(const Eigen::Vector3f& a, const Float3& b) {
+  return SameBits(a.x(), b.x) && SameBits(a.y(), b.y) && SameBits(a.z(), b.z);
+}
+
+// MediaViewSegment and MediaLightTransmittance over RealtimeMedia::HostView against the CPU's
+// IntegrateView (no quad) and its surface loop's transmittance, in the lit room with a sky
+// volume (the sky at the in-scatter median point), non-grey height fog and a boxed haze.
+TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+  SceneDescription s = LitRoom();
+  Sky sky_desc;
+  sky_desc.type = Sky::Type::kDaylight;
+  sky_desc.sun_direction_W = Eigen::Vector3d(-0.28, -0.77, 0.57).normalized();
+  sky_desc.turbidity = 3;
+  sky_desc.zenith_luminance = 8000;
+  s.sky = sky_desc;
+  EffectsFrame fx;
+  HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
+  fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);  // not grey
+  fog.height_falloff_per_m = 0.4f;
+  fog.base_height_m = 0.5f;
+  fx.homogeneous_media.push_back(fog);
+  HomogeneousMedium haze = Fog(0.3f, 0.7f, 0.0f);
+  haze.region = BoxRegion{Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(2, 2, 1.5)};
+  fx.homogeneous_media.push_back(haze);
+  const WorldSnapshot snap = IdentitySnapshot(s);
+  LightSampler lights(s);
+  lights.Update(snap);
+  RayScene rays(s);
+  rays.Update(snap);
+  const SkyModel sky(s.sky);
+  ThreadPool pool(2);
+  SkyIrradianceVolume volume([](const SceneDescription& sc) {
+    return MakeRayQuery(sc, RenderSettings::Backend::kEmbree);
+  });
+  volume.Update(s, snap, sky, &pool);
+  ASSERT_FALSE(volume.empty());
+  constexpr int W = 96, H = 72;
+  const CameraView view = MakeView(CameraLookingAlongX({-3, 0.2f, 1.2}), W, H, 70.0);
+  const Camera camera(view.X_WO, view.intrinsics);
+  MediaScene media;
+  media.Build(&fx);
+  RealtimeMedia rm;
+  rm.Build(media, lights, rays, camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
+           Eigen::Vector3f(0.3f, 0.4f, 0.6f), &volume, &pool);
+  std::vector<Rgb4> fog_records;
+  SkyVolumePod sky_pod;
+  const RealtimeMediaView mv = rm.HostView(&fog_records, &sky_pod);
+  ASSERT_NE(mv.fog_S, nullptr);
+  ASSERT_NE(mv.sky_volume, nullptr);
+  ASSERT_NE(mv.light_trans, nullptr);
+  const float inf = std::numeric_limits<float>::infinity();
+  int segments = 0, lit = 0;
+  for (int v = -1; v <= H; v += 2) {  // the image's border rows and columns and beyond
+    for (int u = -1; u <= W; u += 2) {
+      const Ray r = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+      const Eigen::Vector3f d = r.d.normalized();
+      for (const float t_end : {inf, 25.0f, 3.7f, 0.2f}) {
+        const MediaSegment cpu = rm.IntegrateView(lights, r.o, d, t_end, u, v);
+        Float3 T, L;
+        MediaViewSegment(mv, u, v, r.o.data(), d.data(), t_end, &T, &L);
+        ASSERT_TRUE(SameF3(cpu.T, T)) << u << " " << v << " " << t_end;
+        ASSERT_TRUE(SameF3(cpu.L_add, L)) << u << " " << v << " " << t_end;
+        ++segments;
+        lit += cpu.L_add.maxCoeff() > 0 ? 1 : 0;
+      }
+    }
+  }
+  // surface points: the CPU's loop takes the volume's lookup where it holds the point and the
+  // light (LightTransmittances), else LightTransmittance.
+  Rng rng(9);
+  int located = 0, closed = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Eigen::Vector3f p(-6 + 12 * rng.Uniform(), -6 + 12 * rng.Uniform(), 4 * rng.Uniform());
+    float vol_T[kMaxVolumeLights];
+    const bool in = rm.LightTransmittances(p, vol_T);
+    for (int j = 0; j < lights.size(); ++j) {
+      LightSample ls;
+      if (!lights.Sample(j, p, 0.5f, 0.5f, &ls)) continue;
+      const Eigen::Vector3f cpu = in && j < rm.num_volume_lights()
+                                      ? Eigen::Vector3f::Constant(vol_T[j])
+                                      : rm.LightTransmittance(j, p, ls.wi, ls.distance);
+      const Float3 shared = MediaLightTransmittance(mv, j, p.data(), ls.wi.data(), ls.distance);
+      ASSERT_TRUE(SameF3(cpu, shared)) << i << " light " << j;
+      (in && j < rm.num_volume_lights() ? located : closed) += 1;
+    }
+  }
+  EXPECT_GT(segments, 3000);
+  EXPECT_GT(lit, segments / 2);
+  EXPECT_GT(located, 1000);
+  EXPECT_GT(closed, 1000);
 }
 
 // froxel records of a few columns with rgb in lanes 0..2, as both record types.

@@ -550,6 +550,40 @@ Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
                          fr.inv_log_far.data(), t, Eigen::Array4f::Zero().eval());
 }
 
+RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
+                                          SkyVolumePod* sky_pod) const {
+  RealtimeMediaView m;
+  m.media = pods_.data();
+  m.num_media = static_cast<int>(pods_.size());
+  m.camera_height = h_cam_oz_;
+  m.grey = grey_t_ ? 1 : 0;
+  for (int k = 0; k < 3; ++k) m.sky_ambient[k] = sky_ambient_[k];
+  if (sky_volume_ != nullptr) {
+    *sky_pod = sky_volume_->pod();
+    m.sky_volume = sky_pod;
+  }
+  const FogFroxels& ff = fog_froxels_;
+  if (!ff.S.empty()) {
+    fog_records->resize(ff.S.size());
+    for (size_t i = 0; i < ff.S.size(); ++i)
+      (*fog_records)[i] = Rgb4{ff.S[i][0], ff.S[i][1], ff.S[i][2], ff.S[i][3]};
+    m.fog_nx = ff.nx;
+    m.fog_ny = ff.ny;
+    m.width = static_cast<int>(ff.ax.size());
+    m.height = static_cast<int>(ff.ay.size());
+    m.fog_S = fog_records->data();
+    m.fog_inv_log_far = ff.inv_log_far.data();
+    m.fog_ax = ff.ax.data();
+    m.fog_ay = ff.ay.data();
+  }
+  if (vol_.active) {
+    m.light_volume = cl_pod_;
+    m.light_trans = vol_.trans_cl.data();
+    m.num_volume_lights = num_lights_;
+  }
+  return m;
+}
+
 Eigen::Vector3f RealtimeMedia::SkyAmbientAt(const Eigen::Vector3f& p_W) const {
   return sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient_) : sky_ambient_;
 }

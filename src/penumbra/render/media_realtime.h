@@ -176,6 +176,13 @@ class RealtimeMedia {
   const CellLightsPod& light_volume_pod() const { return cl_pod_; }
   const std::vector<float>& light_volume_visibility() const { return vol_.vis_cl; }
   const std::vector<float>& light_volume_transmittance() const { return vol_.trans_cl; }
+  /// this frame's homogeneous media as a RealtimeMediaView (media_realtime_math.h) over this
+  /// object's arrays (host pointers, valid until the next Build), with the fog froxels'
+  /// records copied to *fog_records (as Rgb4) and the sky volume's plain data to *sky_pod; both
+  /// must outlive the view. MediaViewSegment over it is IntegrateView without a quad for frames
+  /// without grids, MediaLightTransmittance the surface loop's transmittance (bit for bit:
+  /// tests/render/media_realtime_math_test.cc); a GPU path uploads the same arrays.
+  RealtimeMediaView HostView(std::vector<Rgb4>* fog_records, SkyVolumePod* sky_pod) const;
   /// CellLightsLookup on the CPU (SSE; the shared function's arithmetic, tested against it)
   /// of the world light volume's visibility (V Th Tgrid) at p_W into T[0 .. stride); false
   /// outside the volume or without it.

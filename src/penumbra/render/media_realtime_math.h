@@ -17,7 +17,11 @@
 //  - MediaAxisAt / MediaColumnsFrom / MediaColumnsAt: the four froxel columns around an image
 //    position and their bilinear weights; FogSlice, FogFroxelLookup: the light in-scatter
 //    froxels' lookup at a distance; FogQuadPrepare / FogQuadValue: the 2x2 quads' shared fog
-//    lookups.
+//    lookups;
+//  - RealtimeMediaView, MediaViewSegment, MediaLightTransmittance: a frame's homogeneous media
+//    as plain data (RealtimeMedia::HostView; device copies for a GPU path) and, composed of the
+//    functions above, a pixel's view segment (IntegrateView without grids, per-pixel lookups)
+//    and a surface point's transmittance to a light (the CPU realtime surface loop's).
 // operation order: the CPU code's before the move (bit-for-bit rule of shading_math.h); the
 // CPU's images did not change (docs/gpu.md, "Homogeneous media (branch gpu8)").
 //
@@ -29,6 +33,7 @@
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/shading_math.h"
+#include "penumbra/render/sky_eval_math.h"
 
 namespace penumbra {
 
@@ -591,6 +596,82 @@ PB_HOST_DEVICE inline bool FogQuadValue(const FogQuad<R>& q, float t, R* out) {
   const float dl = log_t == q.log_c ? 0.0f : log_t - q.log_c;
   *out = q.fS + dl * q.fS_dlog;
   return true;
+}
+
+/// a frame's homogeneous media (no grids) as the per-pixel view functions read them:
+/// RealtimeMedia's arrays (RealtimeMedia::HostView), on the host or copied to a device.
+struct RealtimeMediaView {
+  const MediumPod* media = nullptr;  ///< the homogeneous media (h_cam set for the camera)
+  int num_media = 0;
+  float camera_height = 0;  ///< world z of the camera's rays (MediumPod::h_cam holds there)
+  int grey = 0;             ///< every sigma_t grey (MediaViewClosedForm's `grey`)
+  float sky_ambient[3] = {0, 0, 0};  ///< the open sky's sphere-average radiance (cd/m^2)
+  /// the sky volume that occludes it (SkyAlongRay), or null (then sky_ambient lights the media)
+  const SkyVolumePod* sky_volume = nullptr;
+  /// the light in-scatter froxels: fog_nx x fog_ny columns of kFogFroxelSlices + 1 records,
+  /// 1 / log(t_far / near) per column, and the per-pixel axis tables of a width x height image
+  /// (MediaAxisAt at every pixel centre); fog_S null: none (no lights)
+  int fog_nx = 0, fog_ny = 0, width = 0, height = 0;
+  const Rgb4* fog_S = nullptr;
+  const float* fog_inv_log_far = nullptr;
+  const MediaAxis* fog_ax = nullptr;  ///< [width]
+  const MediaAxis* fog_ay = nullptr;  ///< [height]
+  /// the world light volume (stride 0: none): Th per light in [cell][light] layout, for the
+  /// first num_volume_lights lights
+  CellLightsPod light_volume;
+  const float* light_trans = nullptr;
+  int num_volume_lights = 0;
+};
+
+/// the four fog froxel columns of pixel (u, v) (RealtimeMedia's PixelColumns: the axis tables
+/// inside the image, MediaColumnsAt outside).
+PB_HOST_DEVICE inline MediaColumns MediaPixelColumns(const RealtimeMediaView& m, int u, int v) {
+  if (u >= 0 && v >= 0 && u < m.width && v < m.height)
+    return MediaColumnsFrom(m.fog_ax[u], m.fog_ay[v], m.fog_nx);
+  return MediaColumnsAt(static_cast<float>(u), static_cast<float>(v), kFogFroxelBlock, m.fog_nx,
+                        m.fog_ny);
+}
+
+/// what the homogeneous media do to the radiance L behind the view segment o + t d (o the
+/// camera centre, d unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::
+/// IntegrateView for frames without grids, each pixel its own froxel lookups): the closed-form
+/// transmittance and sky in-scatter (the sky at the ray's in-scatter median point through the
+/// sky volume) and the light in-scatter of the fog froxels.
+PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, int v,
+                                            const float* o, const float* d, float t_end, Float3* T,
+                                            Float3* L_add) {
+  Float3 tau_t, tau_s, tau_a;
+  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, false, INFINITY, m.camera_height, &tau_t,
+                        &tau_s, &tau_a);
+  float sky[3] = {m.sky_ambient[0], m.sky_ambient[1], m.sky_ambient[2]};
+  float t_med;
+  if (m.sky_volume != nullptr && SkyMedianDistance(m.media, m.num_media, o, d, t_end, &t_med)) {
+    const float p[3] = {o[0] + t_med * d[0], o[1] + t_med * d[1], o[2] + t_med * d[2]};
+    SkyVolumeAmbientRadiance(*m.sky_volume, p, m.sky_ambient, sky);
+  }
+  Float3 L;
+  MediaViewClosedForm(tau_t, tau_s, tau_a, false, m.grey != 0, Float3{1, 1, 1},
+                      Float3{sky[0], sky[1], sky[2]}, T, &L);
+  if (m.fog_S != nullptr) {
+    const Rgb4 f =
+        FogFroxelLookup(MediaPixelColumns(m, u, v), m.fog_S, m.fog_inv_log_far, t_end, Rgb4{});
+    L = {L.x + f.x, L.y + f.y, L.z + f.z};
+  }
+  *L_add = L;
+}
+
+/// the homogeneous media's transmittance from surface point p towards light j (unit direction
+/// wi, distance dist, +inf for directional lights), as the CPU's realtime surface loop takes it:
+/// inside the world light volume, for the lights it holds, the volume's channel-mean value
+/// (CellLightsLookup); elsewhere the closed form e^-tau of AnalyticOpticalDepthOf.
+PB_HOST_DEVICE inline Float3 MediaLightTransmittance(const RealtimeMediaView& m, int j,
+                                                     const float* p, const float* wi, float dist) {
+  if (m.light_trans != nullptr && j < m.num_volume_lights) {
+    float T[kMaxVolumeLights];
+    if (CellLightsLookup(m.light_volume, m.light_trans, p, T)) return {T[j], T[j], T[j]};
+  }
+  if (m.num_media == 0) return {1, 1, 1};
+  return MediaExpNeg(AnalyticOpticalDepthOf(m.media, m.num_media, p, wi, 0.0f, dist), false);
 }
 
 }  // namespace penumbra
