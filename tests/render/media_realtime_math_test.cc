@@ -102,9 +102,10 @@ bool SameF3(const Eigen::Vector3f& a, const Float3& b) {
   return SameBits(a.x(), b.x) && SameBits(a.y(), b.y) && SameBits(a.z(), b.z);
 }
 
-// MediaViewSegment and MediaLightTransmittance over RealtimeMedia::HostView against the CPU's
-// IntegrateView (no quad) and its surface loop's transmittance, in the lit room with a sky
-// volume (the sky at the in-scatter median point), non-grey height fog and a boxed haze.
+// MediaViewSegment (per pixel, and with MediaPrepareQuad's shared quad lookups) and
+// MediaLightTransmittance over RealtimeMedia::HostView against the CPU's IntegrateView (without
+// and with PrepareQuad's MediaQuad) and its surface loop's transmittance, in the lit room with a
+// sky volume (the sky at the in-scatter median point), non-grey height fog and a boxed haze.
 TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
   SceneDescription s = LitRoom();
   Sky sky_desc;
@@ -165,6 +166,44 @@ TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit)
       }
     }
   }
+  // 2x2 quads sharing their lookups (the realtime integrator's MediaQuads): surfaces at
+  // distances that vary over the image, and sky quads.
+  int quad_pixels = 0;
+  for (int v0 = 0; v0 < H; v0 += 2) {
+    for (int u0 = 0; u0 < W; u0 += 2) {
+      const bool sky_quad = (u0 / 2 + v0 / 2) % 5 == 0;
+      Eigen::Vector3f o[4], d[4];
+      float t[4];
+      Eigen::Vector3f d_sum = Eigen::Vector3f::Zero();
+      for (int c = 0; c < 4; ++c) {
+        const Ray r =
+            camera.GenerateRay(static_cast<float>(u0 + (c & 1)), static_cast<float>(v0 + (c >> 1)));
+        o[c] = r.o;
+        d[c] = r.d.normalized();
+        d_sum += d[c];
+        t[c] = sky_quad ? inf : 2.0f + 0.1f * (u0 + (c & 1)) + 0.05f * (v0 + (c >> 1));
+      }
+      const float t_c = sky_quad ? inf : 0.25f * (t[0] + t[1] + t[2] + t[3]);
+      const Eigen::Vector3f d_c = d_sum.normalized();
+      MediaQuad cpu_q;
+      rm.PrepareQuad(u0, v0, t_c, o[0], d_c, &cpu_q);
+      MediaQuadShared q;
+      MediaPrepareQuad(mv, u0, v0, t_c, o[0].data(), d_c.data(), &q);
+      for (int c = 0; c < 4; ++c) {
+        const int u = u0 + (c & 1), v = v0 + (c >> 1);
+        for (const float te :
+             {t[c], sky_quad ? 1.0f : 1.01f * t_c, sky_quad ? 3.0f : 0.5f * t[c]}) {
+          const MediaSegment cpu = rm.IntegrateView(lights, o[c], d[c], te, u, v, &cpu_q);
+          Float3 T, L;
+          MediaViewSegment(mv, u, v, o[c].data(), d[c].data(), te, &T, &L, &q);
+          ASSERT_TRUE(SameF3(cpu.T, T)) << u << " " << v << " " << te;
+          ASSERT_TRUE(SameF3(cpu.L_add, L)) << u << " " << v << " " << te;
+          ++quad_pixels;
+        }
+      }
+    }
+  }
+  EXPECT_GT(quad_pixels, 15000);
   // surface points: the CPU's loop takes the volume's lookup where it holds the point and the
   // light (LightTransmittances), else LightTransmittance.
   Rng rng(9);

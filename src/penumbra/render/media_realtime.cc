@@ -575,6 +575,8 @@ RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
     m.fog_inv_log_far = ff.inv_log_far.data();
     m.fog_ax = ff.ax.data();
     m.fog_ay = ff.ay.data();
+    m.fog_ax_half = ff.ax_half.data();
+    m.fog_ay_half = ff.ay_half.data();
   }
   if (vol_.active) {
     m.light_volume = cl_pod_;

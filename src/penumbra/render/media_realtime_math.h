@@ -614,8 +614,10 @@ struct RealtimeMediaView {
   int fog_nx = 0, fog_ny = 0, width = 0, height = 0;
   const Rgb4* fog_S = nullptr;
   const float* fog_inv_log_far = nullptr;
-  const MediaAxis* fog_ax = nullptr;  ///< [width]
-  const MediaAxis* fog_ay = nullptr;  ///< [height]
+  const MediaAxis* fog_ax = nullptr;       ///< [width]
+  const MediaAxis* fog_ay = nullptr;       ///< [height]
+  const MediaAxis* fog_ax_half = nullptr;  ///< [width]: at u + 0.5, the 2x2 quads' centres
+  const MediaAxis* fog_ay_half = nullptr;  ///< [height]
   /// the world light volume (stride 0: none): Th per light in [cell][light] layout, for the
   /// first num_volume_lights lights
   CellLightsPod light_volume;
@@ -632,29 +634,73 @@ PB_HOST_DEVICE inline MediaColumns MediaPixelColumns(const RealtimeMediaView& m,
                         m.fog_ny);
 }
 
-/// what the homogeneous media do to the radiance L behind the view segment o + t d (o the
-/// camera centre, d unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::
-/// IntegrateView for frames without grids, each pixel its own froxel lookups): the closed-form
-/// transmittance and sky in-scatter (the sky at the ray's in-scatter median point through the
-/// sky volume) and the light in-scatter of the fog froxels.
-PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, int v,
-                                            const float* o, const float* d, float t_end, Float3* T,
-                                            Float3* L_add) {
-  Float3 tau_t, tau_s, tau_a;
-  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, false, INFINITY, m.camera_height, &tau_t,
-                        &tau_s, &tau_a);
-  float sky[3] = {m.sky_ambient[0], m.sky_ambient[1], m.sky_ambient[2]};
+/// a 2x2 pixel quad's shared lookups (RealtimeMedia::PrepareQuad for frames without grids;
+/// MediaPrepareQuad): the fog froxels' at the quad's centre and reference distance, and the sky
+/// lighting the media along the quad's mean direction.
+struct MediaQuadShared {
+  FogQuad<Rgb4> fog;
+  int has_sky = 0;  ///< sky holds the quad's SkyAlongRay
+  float sky[3] = {0, 0, 0};
+};
+
+/// the sky radiance lighting the media along o + t d, t in [0, t_end] (RealtimeMedia::
+/// SkyAlongRay): the sky volume's at the in-scatter median point, else the open sky's.
+PB_HOST_DEVICE inline void MediaSkyAlongRay(const RealtimeMediaView& m, const float* o,
+                                            const float* d, float t_end, float* sky) {
+  for (int k = 0; k < 3; ++k) sky[k] = m.sky_ambient[k];
   float t_med;
   if (m.sky_volume != nullptr && SkyMedianDistance(m.media, m.num_media, o, d, t_end, &t_med)) {
     const float p[3] = {o[0] + t_med * d[0], o[1] + t_med * d[1], o[2] + t_med * d[2]};
     SkyVolumeAmbientRadiance(*m.sky_volume, p, m.sky_ambient, sky);
   }
+}
+
+/// the shared lookups of the 2x2 quad of pixels (u0, v0) .. (u0 + 1, v0 + 1) at its reference
+/// distance t_c (m, the mean of its pixels' distances; +inf for sky pixels) and the sky along
+/// the ray from the camera centre o in the quad's mean direction d_c (unit) (RealtimeMedia::
+/// PrepareQuad without grids).
+PB_HOST_DEVICE inline void MediaPrepareQuad(const RealtimeMediaView& m, int u0, int v0, float t_c,
+                                            const float* o, const float* d_c, MediaQuadShared* q) {
+  *q = MediaQuadShared();
+  if (m.sky_volume != nullptr && m.num_media > 0) {
+    MediaSkyAlongRay(m, o, d_c, t_c, q->sky);
+    q->has_sky = 1;
+  }
+  if (m.fog_S != nullptr && t_c > kFogFroxelNear) {
+    const MediaColumns cb =
+        u0 >= 0 && v0 >= 0 && u0 < m.width && v0 < m.height
+            ? MediaColumnsFrom(m.fog_ax_half[u0], m.fog_ay_half[v0], m.fog_nx)
+            : MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, m.fog_nx, m.fog_ny);
+    FogQuadPrepare(cb, m.fog_S, m.fog_inv_log_far, t_c, &q->fog);
+  }
+}
+
+/// what the homogeneous media do to the radiance L behind the view segment o + t d (o the
+/// camera centre, d unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::
+/// IntegrateView for frames without grids): the closed-form transmittance and sky in-scatter
+/// (the sky at the ray's in-scatter median point through the sky volume) and the light
+/// in-scatter of the fog froxels. with `quad` (MediaPrepareQuad of the 2x2 quad holding the
+/// pixel; may be null) the quad's sky, and its fog lookup where it holds t_end, as IntegrateView
+/// with a MediaQuad; else each pixel its own lookups.
+PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, int v,
+                                            const float* o, const float* d, float t_end, Float3* T,
+                                            Float3* L_add, const MediaQuadShared* quad = nullptr) {
+  Float3 tau_t, tau_s, tau_a;
+  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, false, INFINITY, m.camera_height, &tau_t,
+                        &tau_s, &tau_a);
+  float sky[3];
+  if (m.sky_volume != nullptr && quad != nullptr && quad->has_sky) {
+    for (int k = 0; k < 3; ++k) sky[k] = quad->sky[k];
+  } else {
+    MediaSkyAlongRay(m, o, d, t_end, sky);
+  }
   Float3 L;
   MediaViewClosedForm(tau_t, tau_s, tau_a, false, m.grey != 0, Float3{1, 1, 1},
                       Float3{sky[0], sky[1], sky[2]}, T, &L);
   if (m.fog_S != nullptr) {
-    const Rgb4 f =
-        FogFroxelLookup(MediaPixelColumns(m, u, v), m.fog_S, m.fog_inv_log_far, t_end, Rgb4{});
+    Rgb4 f;
+    if (quad == nullptr || !FogQuadValue(quad->fog, t_end, &f))
+      f = FogFroxelLookup(MediaPixelColumns(m, u, v), m.fog_S, m.fog_inv_log_far, t_end, Rgb4{});
     L = {L.x + f.x, L.y + f.y, L.z + f.z};
   }
   *L_add = L;
