@@ -10,7 +10,7 @@
 
 #include "media_test_util.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/cpu/media_realtime.h"
+#include "penumbra/render/media_realtime.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"

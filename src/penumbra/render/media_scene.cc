@@ -7,73 +7,17 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/media_realtime_math.h"
 
 namespace penumbra {
 namespace {
 
-constexpr double kInfD = std::numeric_limits<double>::infinity();
 constexpr float kInfF = std::numeric_limits<float>::infinity();
 
 // ray-box overlap by the slab method (Kay and Kajiya 1986) clipped to [t0, t1].
 bool SlabInterval(const Eigen::Vector3f& o, const Eigen::Vector3f& d, const Eigen::Vector3f& lo_b,
                   const Eigen::Vector3f& hi_b, float t0, float t1, float* a, float* b) {
-  float lo = t0, hi = t1;
-  for (int k = 0; k < 3; ++k) {
-    if (std::abs(d[k]) < 1e-12f) {
-      if (o[k] < lo_b[k] || o[k] > hi_b[k]) return false;
-      continue;
-    }
-    const float inv = 1.0f / d[k];
-    float ta = (lo_b[k] - o[k]) * inv, tb = (hi_b[k] - o[k]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    lo = std::max(lo, ta);
-    hi = std::min(hi, tb);
-  }
-  if (!(lo < hi)) return false;
-  *a = lo;
-  *b = hi;
-  return true;
-}
-
-// one piece of a height-fog ray: density h_s * exp(-rate (t - s)) on [s, e] (rate 0: constant).
-struct Piece {
-  double s, e, h_s, rate;
-  // integral over [s, e].
-  double Integral() const {
-    const double len = e - s;
-    if (rate == 0 || std::abs(rate) * len < 1e-9) return h_s * len;
-    if (std::isinf(len)) return rate > 0 ? h_s / rate : kInfD;
-    return h_s * -std::expm1(-rate * len) / rate;
-  }
-  // the t in [s, e] where the integral from s reaches tau (tau <= Integral()).
-  double Invert(double tau) const {
-    if (rate == 0 || std::abs(rate) * std::min(e - s, 1e30) < 1e-9) return s + tau / h_s;
-    const double x = tau * rate / h_s;
-    if (x >= 1) return kInfD;
-    return s - std::log1p(-x) / rate;
-  }
-};
-
-// splits [a, b] of z(t) = oz + dz t into the parts below and above the base height.
-int Pieces(const AnalyticMedium& m, double oz, double dz, double a, double b, Piece out[2]) {
-  const double k = m.falloff, zb = m.base;
-  auto h = [&](double t) { return std::exp(-k * std::max(0.0, oz + dz * t - zb)); };
-  if (k <= 0 || std::abs(dz) < 1e-9) {
-    out[0] = {a, b, k <= 0 ? 1.0 : h(a), 0.0};
-    return 1;
-  }
-  const double tc = (zb - oz) / dz;  // where z crosses the base
-  int n = 0;
-  if (dz > 0) {
-    if (a < tc) out[n++] = {a, std::min(b, tc), 1.0, 0.0};
-    const double s = std::max(a, tc);
-    if (s < b) out[n++] = {s, b, h(s), k * dz};
-  } else {
-    if (a < tc) out[n++] = {a, std::min(b, tc), h(a), k * dz};
-    const double s = std::max(a, tc);
-    if (s < b) out[n++] = {s, b, 1.0, 0.0};
-  }
-  return n;
+  return MediaSlabInterval(o.data(), d.data(), lo_b.data(), hi_b.data(), t0, t1, a, b);
 }
 
 void CheckCoefficients(const Eigen::Vector3f& sigma_t, const Eigen::Vector3f& albedo, float g,
@@ -99,25 +43,26 @@ bool AnalyticMedium::Interval(const Eigen::Vector3f& o, const Eigen::Vector3f& d
 }
 
 double AnalyticMedium::DensityIntegral(double oz, double dz, double a, double b) const {
-  if (!(a < b)) return 0;
-  Piece p[2];
-  const int n = Pieces(*this, oz, dz, a, b, p);
-  double sum = 0;
-  for (int i = 0; i < n; ++i) sum += p[i].Integral();
-  return sum;
+  return MediaDensityIntegral(falloff, base, oz, dz, a, b);
 }
 
 double AnalyticMedium::InvertDensityIntegral(double oz, double dz, double a, double b,
                                              double tau) const {
-  if (!(a < b)) return kInfD;
-  Piece p[2];
-  const int n = Pieces(*this, oz, dz, a, b, p);
-  for (int i = 0; i < n; ++i) {
-    const double I = p[i].Integral();
-    if (tau <= I) return std::min(p[i].Invert(tau), p[i].e);
-    tau -= I;
+  return MediaInvertDensityIntegral(falloff, base, oz, dz, a, b, tau);
+}
+
+MediumPod PodOf(const AnalyticMedium& m) {
+  MediumPod pod;
+  for (int c = 0; c < 3; ++c) {
+    pod.sigma_t[c] = m.sigma_t[c];
+    pod.sigma_s[c] = m.sigma_s[c];
+    pod.box_min[c] = m.box_min[c];
+    pod.box_max[c] = m.box_max[c];
   }
-  return kInfD;
+  pod.falloff = m.falloff;
+  pod.base = m.base;
+  pod.bounded = m.bounded ? 1 : 0;
+  return pod;
 }
 
 bool GridVolume::TrilinearCell(const Eigen::Vector3f& x_G, int i0[3], int i1[3], float w[3]) const {
@@ -201,6 +146,7 @@ Eigen::Vector3f MediumPoint::SamplePhase(const Eigen::Vector3f& wo, float u0, fl
 
 void MediaScene::Build(const EffectsFrame* fx) {
   analytic_.clear();
+  pods_.clear();
   grids_.clear();
   if (fx == nullptr) return;
   for (size_t i = 0; i < fx->homogeneous_media.size(); ++i) {
@@ -228,7 +174,10 @@ void MediaScene::Build(const EffectsFrame* fx) {
       m.box_max = Eigen::Vector3f(kInfF, kInfF, h.layer_top_m);
     }
     m.sigma_bar = m.sigma_t.maxCoeff();
-    if (m.sigma_bar > 0) analytic_.push_back(m);
+    if (m.sigma_bar > 0) {
+      analytic_.push_back(m);
+      pods_.push_back(PodOf(m));
+    }
   }
   for (size_t i = 0; i < fx->grid_media.size(); ++i) {
     const GridMedium& gm = fx->grid_media[i];
@@ -283,14 +232,9 @@ void MediaScene::Build(const EffectsFrame* fx) {
 
 Eigen::Vector3f MediaScene::AnalyticOpticalDepth(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                                                  float t0, float t1) const {
-  Eigen::Vector3f tau = Eigen::Vector3f::Zero();
-  for (const AnalyticMedium& m : analytic_) {
-    float a, b;
-    if (!m.Interval(o, d, t0, t1, &a, &b)) continue;
-    const double I = m.DensityIntegral(o.z(), d.z(), a, b);
-    tau += m.sigma_t * static_cast<float>(std::min(I, 1e30));
-  }
-  return tau;
+  const Float3 tau = AnalyticOpticalDepthOf(pods_.data(), static_cast<int>(pods_.size()), o.data(),
+                                            d.data(), t0, t1);
+  return {tau.x, tau.y, tau.z};
 }
 
 MediumPoint MediaScene::At(const Eigen::Vector3f& p) const {

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "penumbra/core/rng.h"
+#include "penumbra/render/media_realtime_math.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
@@ -62,6 +63,10 @@ struct AnalyticMedium {
   /// (inverse of DensityIntegral, closed form).
   double InvertDensityIntegral(double oz, double dz, double a, double b, double tau) const;
 };
+
+/// medium m as the shared formulas of render/media_realtime_math.h read it (h_cam 1: set it for
+/// a camera's height).
+MediumPod PodOf(const AnalyticMedium& m);
 
 /// a GridMedium prepared for tracing (the frame's density arrays are shared, not copied).
 struct GridVolume {
@@ -126,10 +131,12 @@ class MediaScene {
 
   bool empty() const { return analytic_.empty() && grids_.empty(); }
   const std::vector<AnalyticMedium>& analytic() const { return analytic_; }
+  /// analytic() as the shared formulas read them (PodOf, same order).
+  const std::vector<MediumPod>& analytic_pods() const { return pods_; }
   const std::vector<GridVolume>& grids() const { return grids_; }
 
   /// rgb optical depth of the homogeneous media along o + t d (d unit), t in [t0, t1] (t1 may
-  /// be +inf). closed form.
+  /// be +inf). closed form (AnalyticOpticalDepthOf of media_realtime_math.h).
   Eigen::Vector3f AnalyticOpticalDepth(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float t0,
                                        float t1) const;
 
@@ -149,6 +156,7 @@ class MediaScene {
 
  private:
   std::vector<AnalyticMedium> analytic_;
+  std::vector<MediumPod> pods_;
   std::vector<GridVolume> grids_;
 };
 

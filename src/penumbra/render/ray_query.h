@@ -3,9 +3,10 @@
 // geometry the cameras see, posed from a WorldSnapshot. the LiDAR (sensors/lidar_scanner.h) and
 // the sky irradiance volume (render/sky_irradiance_volume.h) trace only through it, so that a
 // new backend (e.g. a GPU ray tracer) implements RayQuery next to its Renderer and the sensors
-// stay untouched. the shape follows pbrt-v4's Primitive::Intersect, batched as wavefront and
-// GPU tracers consume rays; it holds only what its users call (closest hits of ray batches,
-// posing, the scene), and grows when a user needs more (e.g. batched occlusion).
+// stay untouched. the shape follows pbrt-v4's Primitive::Intersect / IntersectP, batched as
+// wavefront and GPU tracers consume rays; it holds only what its users call (closest hits and
+// occlusion of ray batches, posing, the scene). the realtime media's light volumes
+// (render/media_realtime.h) trace their shadow rays through Occluded.
 //
 // implementations: RayScene (Embree 3, render/embree/ray_scene.h). MakeRayQuery
 // (render/backends/renderer_factory.h) builds the one RenderSettings::backend names.
@@ -27,8 +28,8 @@
 
 namespace penumbra {
 
-/// closest-hit queries of one SceneDescription (see the file comment). Intersect is
-/// thread-safe between Update calls; Update must not run concurrently with it.
+/// closest-hit and occlusion queries of one SceneDescription (see the file comment). Intersect
+/// and Occluded are thread-safe between Update calls; Update must not run concurrently with them.
 class RayQuery {
  public:
   virtual ~RayQuery() = default;
@@ -49,10 +50,20 @@ class RayQuery {
   void Intersect(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                  std::span<bool> did_hit) const;
 
+  /// occlusion of `rays`: occluded[i] is whether anything blocks rays[i] within its [tmin,
+  /// tmax] (the same geometry Intersect traces; an untraceable ray is not occluded). the
+  /// verdict of a ray does not depend on its batch (as Intersect's hits).
+  /// @throws Error if occluded is shorter than rays.
+  void Occluded(std::span<const Ray> rays, std::span<bool> occluded) const;
+
  protected:
   /// Intersect after its size check: hits and did_hit hold at least rays.size() elements.
   virtual void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                               std::span<bool> did_hit) const = 0;
+  /// Occluded after its size check (occluded holds at least rays.size() elements). this
+  /// default asks IntersectBatch for the closest hits (a ray is occluded iff it has one);
+  /// backends with an any-hit traversal override it (Embree's rtcOccluded1, the CUDA kernel).
+  virtual void OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const;
 };
 
 /// builds a RayQuery over `scene`, which is referenced, not copied: it must outlive the query.

@@ -475,4 +475,92 @@ PB_HOST_DEVICE inline void SkyVolumeIrradiance(const SkyVolumePod& v, const SkyM
   for (int k = 0; k < 3; ++k) out[k] = out[k] < 0.0f ? 0.0f : out[k];
 }
 
+/// the octahedral texel of a non-zero direction w (SkyIrradianceVolume::TexelOf): w over its
+/// L1 norm, the lower hemisphere folded, then clamp(trunc((u + 1) kSkyOctSide / 2), 0,
+/// kSkyOctSide - 1) per axis.
+PB_HOST_DEVICE inline int SkyOctTexel(float wx, float wy, float wz) {
+  const float inv_l1 = 1.0f / (fabsf(wx) + fabsf(wy) + fabsf(wz));
+  float u = wx * inv_l1, v = wy * inv_l1;
+  if (wz < 0) {
+    const float au = fabsf(u), av = fabsf(v);
+    u = copysignf(1.0f - av, wx);
+    v = copysignf(1.0f - au, wy);
+  }
+  const int tu = static_cast<int>((u + 1.0f) * (0.5f * kSkyOctSide));
+  const int tv = static_cast<int>((v + 1.0f) * (0.5f * kSkyOctSide));
+  const int ix = tu < 0 ? 0 : (kSkyOctSide - 1 < tu ? kSkyOctSide - 1 : tu);
+  const int iy = tv < 0 ? 0 : (kSkyOctSide - 1 < tv ? kSkyOctSide - 1 : tv);
+  return ix + kSkyOctSide * iy;
+}
+
+/// SkyIrradianceVolume::AmbientRadiance: the occluded sphere-average sky radiance at p (world,
+/// m) into out[3]: the trilinear blend over the valid probes of p's cell (those whose
+/// cell_pos corner is not NaN) of their mean radiance (the irradiance SH's l = 0 term over pi,
+/// times Y00), each weighted by its trilinear weight times the visibility ramp clamp((depth +
+/// tol - r) / tol, 0, 1) of p seen from the probe (r its distance, depth the probe's depth
+/// map in p's direction; 1 where r <= 1e-6), clamped to >= 0; where no probe has a positive
+/// weight the darkest valid probe's (0 if none is valid); `open_sky` outside the grid or when
+/// the volume is empty.
+PB_HOST_DEVICE inline void SkyVolumeAmbientRadiance(const SkyVolumePod& v, const float* p,
+                                                    const float* open_sky, float* out) {
+  if (v.empty()) {
+    for (int k = 0; k < 3; ++k) out[k] = open_sky[k];
+    return;
+  }
+  float g[3];
+  for (int k = 0; k < 3; ++k) g[k] = (p[k] - v.origin[k]) * v.inv_spacing;
+  const int nx = v.dims[0], ny = v.dims[1], nz = v.dims[2];
+  if (!(g[0] >= 0 && g[1] >= 0 && g[2] >= 0 && g[0] <= nx - 1 && g[1] <= ny - 1 &&
+        g[2] <= nz - 1)) {
+    for (int k = 0; k < 3; ++k) out[k] = open_sky[k];
+    return;
+  }
+  // std::max(0, std::min(trunc(g), n - 2)) per axis (n >= 2: the cell's corners exist)
+  int i[3];
+  for (int k = 0; k < 3; ++k) {
+    const int t = static_cast<int>(g[k]), hi = v.dims[k] - 2;
+    const int m = hi < t ? hi : t;
+    i[k] = m < 0 ? 0 : m;
+  }
+  const float f[3] = {g[0] - i[0], g[1] - i[1], g[2] - i[2]};
+  const float tol = kSkyVisibilityTolerance * v.spacing;
+  const int base = i[0] + nx * (i[1] + ny * i[2]);
+  const float* cell = v.cell_pos + static_cast<int64_t>(base) * 24;
+  float sum[3] = {0, 0, 0}, dark[3] = {0, 0, 0};
+  float wsum = 0, dark_lum = INFINITY;
+  constexpr float kY00OverPi = static_cast<float>(0.282094791773878 / 3.14159265358979323846);
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+    if (!(cell[c] == cell[c])) continue;  // an invalid probe (NaN position)
+    const int probe = base + v.corner_offset[c];
+    const float* sh = v.sh + static_cast<int64_t>(probe) * kSkyShStride + 3 * SkyShSlot(0);
+    const float a[3] = {sh[0] * kY00OverPi, sh[1] * kY00OverPi, sh[2] * kY00OverPi};
+    const float lum = 0.2126f * a[0] + 0.7152f * a[1] + 0.0722f * a[2];
+    if (lum < dark_lum) {
+      dark_lum = lum;
+      for (int k = 0; k < 3; ++k) dark[k] = a[k];
+    }
+    const float tri = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
+    const float to_p[3] = {p[0] - cell[c], p[1] - cell[8 + c], p[2] - cell[16 + c]};
+    // Eigen's norm of a 3-vector: sqrt(x^2 + (y^2 + z^2))
+    const float r = sqrtf(to_p[0] * to_p[0] + (to_p[1] * to_p[1] + to_p[2] * to_p[2]));
+    float vis = 1;
+    if (r > 1e-6f) {
+      const int texel = SkyOctTexel(to_p[0] / r, to_p[1] / r, to_p[2] / r);
+      const float depth =
+          v.depth_scale * v.depth_q[static_cast<int64_t>(probe) * kSkyNumTexels + texel];
+      const float x = (depth + tol - r) / tol;
+      vis = x < 0.0f ? 0.0f : (1.0f < x ? 1.0f : x);
+    }
+    const float w = tri * vis;
+    if (!(w > 0)) continue;
+    for (int k = 0; k < 3; ++k) sum[k] = sum[k] + w * a[k];
+    wsum += w;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const float x = wsum > 0 ? sum[k] / wsum : dark[k];
+    out[k] = x < 0.0f ? 0.0f : x;  // cwiseMax(0)
+  }
+}
+
 }  // namespace penumbra

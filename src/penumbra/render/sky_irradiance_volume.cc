@@ -770,43 +770,9 @@ Eigen::Vector3f SkyIrradianceVolume::ProbeAmbient(int probe) const {
 
 Eigen::Vector3f SkyIrradianceVolume::AmbientRadiance(const Eigen::Vector3f& p_W,
                                                      const Eigen::Vector3f& open_sky) const {
-  if (empty()) return open_sky;
-  const Eigen::Vector3f g = (p_W - origin_) * inv_spacing_;
-  const int nx = dims_[0], ny = dims_[1], nz = dims_[2];
-  if (!(g.x() >= 0 && g.y() >= 0 && g.z() >= 0 && g.x() <= nx - 1 && g.y() <= ny - 1 &&
-        g.z() <= nz - 1))
-    return open_sky;
-  const int i0 = std::max(0, std::min(static_cast<int>(g.x()), nx - 2));
-  const int j0 = std::max(0, std::min(static_cast<int>(g.y()), ny - 2));
-  const int k0 = std::max(0, std::min(static_cast<int>(g.z()), nz - 2));
-  const float f[3] = {g.x() - i0, g.y() - j0, g.z() - k0};
-  const float tol = kVisibilityTolerance * spacing_;
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero(), dark = Eigen::Vector3f::Zero();
-  float wsum = 0, dark_lum = std::numeric_limits<float>::infinity();
-  for (int c = 0; c < 8; ++c) {
-    const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
-    if (i0 + dx >= nx || j0 + dy >= ny || k0 + dz >= nz) continue;
-    const int p = ProbeIndex(i0 + dx, j0 + dy, k0 + dz);
-    if (!valid_[p]) continue;
-    const Eigen::Vector3f a = ProbeAmbient(p);
-    const float lum = 0.2126f * a.x() + 0.7152f * a.y() + 0.0722f * a.z();
-    if (lum < dark_lum) dark_lum = lum, dark = a;
-    const float tri = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
-    const Eigen::Vector3f to_p = p_W - position_[p];
-    const float r = to_p.norm();
-    float vis = 1;
-    if (r > 1e-6f) {
-      const float depth =
-          depth_scale_ * depth_q_[static_cast<size_t>(p) * kNumTexels + OctTexel(to_p / r)];
-      vis = std::clamp((depth + tol - r) / tol, 0.0f, 1.0f);
-    }
-    const float w = tri * vis;
-    if (!(w > 0)) continue;
-    sum += w * a;
-    wsum += w;
-  }
-  if (wsum > 0) return (sum / wsum).cwiseMax(0.0f);
-  return dark.cwiseMax(0.0f);
+  Eigen::Vector3f out;
+  SkyVolumeAmbientRadiance(pod(), p_W.data(), open_sky.data(), out.data());
+  return out;
 }
 
 }  // namespace penumbra

@@ -11,7 +11,9 @@
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
 //     them, cuda Render() (on the GPU for lighting effects; else the CPU renderer inside the
-//     CUDA backend, "cpu fallback") and cpu Render();
+//     CUDA backend, "cpu fallback") and cpu Render(); with homogeneous media, the time of their
+//     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays and
+//     with CudaRayQuery's;
 //   - with --realtime, the FNV-1a hashes of the default options' rgb and depth (to compare
 //     builds: a change of the traversal or the kernels that keeps the images keeps them);
 // and the BVH build time. prints one markdown table.
@@ -51,7 +53,12 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/cuda_batch_bench.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
+#include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
+#include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/media_scene.h"
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
@@ -76,6 +83,29 @@ double TimeRenders(Renderer* r, const WorldSnapshot& snap, const CameraView& vie
   const auto t0 = Clock::now();
   for (int i = 0; i < frames; ++i) r->Render(snap, fx, view, &f);
   return std::chrono::duration<double>(Clock::now() - t0).count() / frames;
+}
+
+// mean milliseconds of RealtimeMedia::Build for `view` under `fx` (its homogeneous and grid
+// media) with its shadow rays through `query`, over `frames` builds after one warm-up, the
+// cells and batches over all cores; the same volumes the CPU renderer builds each media frame.
+double TimeMediaBuild(const SceneDescription& scene, const WorldSnapshot& snap,
+                      const CameraView& view, const EffectsFrame& fx, const RayQuery& query,
+                      int frames) {
+  MediaScene media;
+  media.Build(&fx);
+  LightSampler lights(scene);
+  lights.Update(snap, &fx);
+  const Camera camera(view.X_WO, view.intrinsics);
+  ThreadPool pool(0);
+  RealtimeMedia rm;
+  auto build = [&] {
+    rm.Build(media, lights, query, camera, 1, scene.center_W.cast<float>(), scene.extent_m,
+             Eigen::Vector3f::Constant(0.5f), nullptr, &pool);
+  };
+  build();
+  const auto t0 = Clock::now();
+  for (int i = 0; i < frames; ++i) build();
+  return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count() / frames;
 }
 
 // a positive integer argument, or 0
@@ -454,6 +484,21 @@ int Main(int argc, char** argv) {
       if (gpu && with_fx)
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+      // the media volumes' build over Embree and over the GPU's RayQuery (docs/gpu.md,
+      // "Homogeneous media: the shared part")
+      if (dev.available && with_fx && !fx->homogeneous_media.empty() && w == 640) {
+        RayScene embree(scene);
+        embree.Update(snap);
+        cuda::CudaRayQuery query(scene);
+        query.Update(snap);
+        const int nb = std::max(3, frames / 5);
+        const double ms_cpu = TimeMediaBuild(scene, snap, rgb, *fx, embree, nb);
+        const double ms_gpu = TimeMediaBuild(scene, snap, rgb, *fx, query, nb);
+        builds.push_back(fmt::format(
+            "{}: media volumes (RealtimeMedia::Build, {}x{} camera, all cores): {:.2f} ms with "
+            "Embree's shadow rays, {:.2f} ms with CudaRayQuery's ({} builds each)",
+            name, w, h, ms_cpu, ms_gpu, nb));
+      }
       if (gpu) {
         auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
         rows.push_back({name, size, "depth+seg", "cuda", "Render()",

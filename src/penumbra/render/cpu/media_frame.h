@@ -17,7 +17,7 @@
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/cpu/media_realtime.h"
+#include "penumbra/render/media_realtime.h"
 #include "penumbra/render/effects_sky.h"
 #include "penumbra/render/embree/particle_scene.h"
 #include "penumbra/render/embree/ray_scene.h"

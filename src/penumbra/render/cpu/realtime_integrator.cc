@@ -470,7 +470,7 @@ void TileSkyIrradiance(const FrameContext& ctx, const PrimaryHits& primary, Scra
 
 // what the effects do to the radiance L seen through pixel `pixel` along the camera ray:
 // the media along the ray attenuate and add to it, and the nearest particle streak is
-// alpha-composited over it (render/cpu/media_realtime.h, render/particle_streaks.h). no random
+// alpha-composited over it (render/media_realtime.h, render/particle_streaks.h). no random
 // numbers here (the froxel volumes are jittered per column when they are built). `quad`: the
 // shared froxel lookups of the pixel's 2x2 quad, or null.
 Eigen::Vector3f ApplyViewEffects(const FrameContext& ctx, const Ray& ray, bool hit, float t_hit,

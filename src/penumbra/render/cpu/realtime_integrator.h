@@ -37,7 +37,7 @@
 // adverse conditions (FrameContext::effects): surface wetness changes the material of
 // upward-facing surfaces; each light's contribution is attenuated by the media between the
 // surface and the light; the pixel's radiance L (surface or sky) becomes T L + L_media along the
-// camera ray (render/cpu/media_realtime.h: closed-form fog, froxel volumes for grids and for fog
+// camera ray (render/media_realtime.h: closed-form fog, froxel volumes for grids and for fog
 // light in-scatter, isotropic unoccluded sky in-scatter), and the nearest particle streak is
 // alpha-composited over it (render/particle_streaks.h). without effects nothing changes.
 //

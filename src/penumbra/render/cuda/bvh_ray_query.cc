@@ -23,4 +23,8 @@ bool BvhRayQuery::Occluded(const Ray& ray) const {
   return TraceOccluded(bvh_.view(), ToTraceRay(ray));
 }
 
+void BvhRayQuery::OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const {
+  for (size_t i = 0; i < rays.size(); ++i) occluded[i] = Occluded(rays[i]);
+}
+
 }  // namespace penumbra::cuda

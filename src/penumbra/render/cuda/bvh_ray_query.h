@@ -20,11 +20,14 @@ class BvhRayQuery final : public RayQuery {
   void Update(const WorldSnapshot& snapshot) override { bvh_.Update(snapshot); }
   /// true if anything blocks `ray` in (tmin, tmax); untraceable rays are not occluded.
   bool Occluded(const Ray& ray) const;
+  /// RayQuery's batched occlusion: Occluded(ray) (TraceOccluded on the host) for each ray.
+  using RayQuery::Occluded;
   const BvhScene& bvh() const { return bvh_; }
 
  private:
   void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                       std::span<bool> did_hit) const override;
+  void OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const override;
   BvhScene bvh_;
 };
 

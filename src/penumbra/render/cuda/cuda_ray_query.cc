@@ -47,10 +47,7 @@ void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHi
   }
 }
 
-void CudaRayQuery::Occluded(std::span<const Ray> rays, std::span<bool> occluded) const {
-  if (occluded.size() < rays.size())
-    throw Error("CudaRayQuery::Occluded: " + std::to_string(occluded.size()) + " results for " +
-                std::to_string(rays.size()) + " rays");
+void CudaRayQuery::OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const {
   std::vector<TraceRay> in(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     in[i] = ToTraceRay(rays[i]);

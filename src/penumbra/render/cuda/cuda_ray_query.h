@@ -25,13 +25,13 @@ class CudaRayQuery final : public RayQuery {
   explicit CudaRayQuery(const SceneDescription& scene);
   const SceneDescription& scene() const override { return bvh_.scene(); }
   void Update(const WorldSnapshot& snapshot) override;
-  /// occlusion of rays[i] in (tmin, tmax) for every i (untraceable rays are not occluded).
-  /// @throws Error if occluded is shorter than rays.
-  void Occluded(std::span<const Ray> rays, std::span<bool> occluded) const;
 
  private:
   void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                       std::span<bool> did_hit) const override;
+  /// RayQuery::Occluded: the batch's verdicts in one kernel launch (TraceOccluded in
+  /// (tmin, tmax); untraceable rays are not occluded).
+  void OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const override;
   BvhScene bvh_;
   std::unique_ptr<DeviceScene> device_;
   // Intersect is thread-safe (RayQuery): one batch at a time on the device

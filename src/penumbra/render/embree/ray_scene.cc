@@ -760,6 +760,12 @@ bool RayScene::Occluded(const Ray& ray) const {
   return r.tfar < 0;
 }
 
+// one ray at a time (rtcOccluded1): the verdicts of Occluded(ray), which the CPU's images are
+// made with, whatever the batch.
+void RayScene::OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const {
+  for (size_t i = 0; i < rays.size(); ++i) occluded[i] = Occluded(rays[i]);
+}
+
 // packets of kPacket rays (rtcIntersect16, Impl::IntersectPacket) for coherent rays;
 // incoherent rays go one by one (rtcIntersect1), as Embree recommends.
 void RayScene::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,

@@ -91,6 +91,8 @@ class RayScene final : public RayQuery {
 
   /// true if anything blocks `ray` in [tmin, tmax].
   bool Occluded(const Ray& ray) const;
+  /// RayQuery's batched occlusion: Occluded(ray) (rtcOccluded1) for each ray in turn.
+  using RayQuery::Occluded;
 
   /// closest hits of `n` rays: `coherent` rays (e.g. camera rays of neighbouring pixels) are
   /// traced in packets of 16, others one by one. hit[i] is valid iff did_hit[i].
@@ -134,6 +136,7 @@ class RayScene final : public RayQuery {
  private:
   void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                       std::span<bool> did_hit) const override;
+  void OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const override;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,99 +1,56 @@
-#include "penumbra/render/cpu/media_realtime.h"
+#include "penumbra/render/media_realtime.h"
 
 #include <emmintrin.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
+#include <vector>
 
 #include "penumbra/render/media_common.h"
 
 namespace penumbra {
 namespace {
 
-constexpr float kInfF = std::numeric_limits<float>::infinity();
+constexpr float kInfView = std::numeric_limits<float>::infinity();
 
-// the four froxel columns around image position (x, y) in pixels (column centres at the centres
-// of blocks of `block` pixels, clamped to the nx x ny columns) and their bilinear weights.
-struct ColumnBilerp {
-  int cols[4];
-  float w[4];
-};
-ColumnBilerp ColumnsAt(float x, float y, int block, int nx, int ny) {
-  const float fx =
-      std::clamp((x - block / 2) / static_cast<float>(block), 0.0f, static_cast<float>(nx - 1));
-  const float fy =
-      std::clamp((y - block / 2) / static_cast<float>(block), 0.0f, static_cast<float>(ny - 1));
-  const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
-  const int x1 = std::min(x0 + 1, nx - 1), y1 = std::min(y0 + 1, ny - 1);
-  const float wx = fx - x0, wy = fy - y0;
-  return {{y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1},
-          {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
-}
+using ColumnBilerp = MediaColumns;
 
-// ColumnsAt's per-axis part at every pixel centre u and every quad centre u + 0.5 of an axis of
-// n pixels (the same arithmetic, so ColumnsFrom gives ColumnsAt's result bit for bit).
+// MediaAxisAt at every pixel centre u and every quad centre u + 0.5 of an axis of n pixels
+// (so MediaColumnsFrom of two table entries is MediaColumnsAt of the position bit for bit).
 void BuildAxisTables(int n, int block, int columns, std::vector<RealtimeMedia::AxisBilerp>* at,
                      std::vector<RealtimeMedia::AxisBilerp>* at_half) {
-  auto one = [&](float x) {
-    const float f = std::clamp((x - block / 2) / static_cast<float>(block), 0.0f,
-                               static_cast<float>(columns - 1));
-    const int i0 = static_cast<int>(f);
-    return RealtimeMedia::AxisBilerp{i0, std::min(i0 + 1, columns - 1), f - i0};
-  };
   at->resize(n);
   at_half->resize(n);
   for (int u = 0; u < n; ++u) {
-    (*at)[u] = one(static_cast<float>(u));
-    (*at_half)[u] = one(u + 0.5f);
+    (*at)[u] = MediaAxisAt(static_cast<float>(u), block, columns);
+    (*at_half)[u] = MediaAxisAt(u + 0.5f, block, columns);
   }
 }
 
-// ColumnsAt from the per-axis parts of x and y.
-ColumnBilerp ColumnsFrom(const RealtimeMedia::AxisBilerp& x, const RealtimeMedia::AxisBilerp& y,
-                         int nx) {
-  const float wx = x.w, wy = y.w;
-  return {{y.i0 * nx + x.i0, y.i0 * nx + x.i1, y.i1 * nx + x.i0, y.i1 * nx + x.i1},
-          {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
-}
-
-// ColumnsAt(u, v) of pixel (u, v) (from the tables inside the image).
+// MediaColumnsAt(u, v) of pixel (u, v) (from the tables inside the image).
 template <typename F>
 ColumnBilerp PixelColumns(const F& fr, int u, int v, int block) {
   if (u >= 0 && v >= 0 && u < static_cast<int>(fr.ax.size()) && v < static_cast<int>(fr.ay.size()))
-    return ColumnsFrom(fr.ax[u], fr.ay[v], fr.nx);
-  return ColumnsAt(static_cast<float>(u), static_cast<float>(v), block, fr.nx, fr.ny);
+    return MediaColumnsFrom(fr.ax[u], fr.ay[v], fr.nx);
+  return MediaColumnsAt(static_cast<float>(u), static_cast<float>(v), block, fr.nx, fr.ny);
 }
 
-// ColumnsAt(u0 + 0.5, v0 + 0.5) of the quad at (u0, v0).
+// MediaColumnsAt(u0 + 0.5, v0 + 0.5) of the quad at (u0, v0).
 template <typename F>
 ColumnBilerp QuadColumns(const F& fr, int u0, int v0, int block) {
   if (u0 >= 0 && v0 >= 0 && u0 < static_cast<int>(fr.ax_half.size()) &&
       v0 < static_cast<int>(fr.ay_half.size()))
-    return ColumnsFrom(fr.ax_half[u0], fr.ay_half[v0], fr.nx);
-  return ColumnsAt(u0 + 0.5f, v0 + 0.5f, block, fr.nx, fr.ny);
+    return MediaColumnsFrom(fr.ax_half[u0], fr.ay_half[v0], fr.nx);
+  return MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, block, fr.nx, fr.ny);
 }
 
-// trilinear lookup in a cell-centred (r0 x r1 x r2) array at continuous index f (cell centre
-// i at f = i), clamped to the outermost centres.
+// MediaTrilinear (media_realtime_math.h) at continuous index f.
 template <typename T>
 T Trilinear(const T* a, const int r[3], const Eigen::Vector3f& f) {
-  int i0[3], i1[3];
-  float w[3];
-  for (int k = 0; k < 3; ++k) {
-    const float c = std::clamp(f[k], 0.0f, static_cast<float>(r[k] - 1));
-    i0[k] = std::min(static_cast<int>(c), std::max(r[k] - 2, 0));
-    i1[k] = std::min(i0[k] + 1, r[k] - 1);
-    w[k] = c - static_cast<float>(i0[k]);
-  }
-  auto at = [&](int i, int j, int k) { return a[(static_cast<size_t>(k) * r[1] + j) * r[0] + i]; };
-  const T c00 = at(i0[0], i0[1], i0[2]) * (1 - w[0]) + at(i1[0], i0[1], i0[2]) * w[0];
-  const T c10 = at(i0[0], i1[1], i0[2]) * (1 - w[0]) + at(i1[0], i1[1], i0[2]) * w[0];
-  const T c01 = at(i0[0], i0[1], i1[2]) * (1 - w[0]) + at(i1[0], i0[1], i1[2]) * w[0];
-  const T c11 = at(i0[0], i1[1], i1[2]) * (1 - w[0]) + at(i1[0], i1[1], i1[2]) * w[0];
-  const T c0 = c00 * (1 - w[1]) + c10 * w[1];
-  const T c1 = c01 * (1 - w[1]) + c11 * w[1];
-  return c0 * (1 - w[2]) + c1 * w[2];
+  return MediaTrilinear(a, r, f.x(), f.y(), f.z());
 }
 
 // e^x per channel; one exponential when the channels are equal (grey media).
@@ -105,40 +62,35 @@ Eigen::Vector3f Exp(const Eigen::Vector3f& x) {
 // rgb in lanes 0..2 of a 4-lane array (lane 3 = 0), for vectorised lookups.
 Eigen::Array4f To4(const Eigen::Vector3f& v) { return Eigen::Array4f(v.x(), v.y(), v.z(), 0.0f); }
 
-// AnalyticMedium::DensityIntegral in single precision for camera rays (the same pieces below and
-// above the base height, closed form per piece): the integral of h(z(t)) dt over [a, b] for
-// z(t) = oz + dz t (d unit); b may be +inf. float keeps the relative error near 1e-6 (the
-// optical depths it yields are used as exp(-tau) for display radiance).
-// h_0: h(0) of this ray (the camera's h, RealtimeMedia::h_cam_) when oz is the camera's height,
-// else NaN (then computed here); h(+-0) does not depend on dz, so it is the same value bit for
-// bit.
-float DensityIntegralF(const AnalyticMedium& m, float oz, float dz, float a, float b,
-                       float h_0 = std::numeric_limits<float>::quiet_NaN()) {
-  if (!(a < b)) return 0.0f;
-  auto piece = [](float s, float e, float h_s, float rate) {
-    const float len = e - s;
-    if (rate == 0.0f || std::abs(rate) * len < 1e-6f) return h_s * len;
-    if (std::isinf(len)) return rate > 0 ? h_s / rate : kInfF;
-    return h_s * -std::expm1(-rate * len) / rate;
-  };
-  const float k = m.falloff, zb = m.base;
-  auto h = [&](float t) {
-    if (t == 0.0f && h_0 == h_0) return h_0;
-    return std::exp(-k * std::max(0.0f, oz + dz * t - zb));
-  };
-  if (k <= 0 || std::abs(dz) < 1e-9f) return piece(a, b, k <= 0 ? 1.0f : h(a), 0.0f);
-  const float tc = (zb - oz) / dz;  // where z crosses the base
-  float sum = 0.0f;
-  if (dz > 0) {
-    if (a < tc) sum += piece(a, std::min(b, tc), 1.0f, 0.0f);
-    const float s = std::max(a, tc);
-    if (s < b) sum += piece(s, b, h(s), k * dz);
-  } else {
-    if (a < tc) sum += piece(a, std::min(b, tc), h(a), k * dz);
-    const float s = std::max(a, tc);
-    if (s < b) sum += piece(s, b, 1.0f, 0.0f);
-  }
-  return sum;
+// Float3 <-> the CPU's 4-lane and 3-vector forms.
+Float3 ToF3(const Eigen::Array4f& a) { return {a[0], a[1], a[2]}; }
+Eigen::Vector3f FromF3(const Float3& a) { return {a.x, a.y, a.z}; }
+
+// what a light-volume cell asks of a light's visibility: nothing (the light adds nothing
+// there), none (the light casts no shadows: seen), or its shadow ray's verdict.
+constexpr uint8_t kNone = 0, kLit = 1, kTrace = 2;
+
+// (*blocked)[i] = query.Occluded(rays[i]) for every i with want[i] == kTrace (others
+// untouched but sized): the noted rays gathered in order, in batches of kShadowRayBatch
+// spread over `pool`.
+void TraceShadowRays(const RayQuery& query, const std::vector<Ray>& rays,
+                     const std::vector<uint8_t>& want, std::vector<uint8_t>* blocked,
+                     ThreadPool* pool) {
+  blocked->assign(rays.size(), 0);
+  std::vector<size_t> traced;
+  for (size_t i = 0; i < want.size(); ++i)
+    if (want[i] == kTrace) traced.push_back(i);
+  const int64_t batches =
+      (static_cast<int64_t>(traced.size()) + kShadowRayBatch - 1) / kShadowRayBatch;
+  ParallelForOrSerial(pool, batches, [&](int64_t b) {
+    const size_t lo = static_cast<size_t>(b) * kShadowRayBatch;
+    const size_t n = std::min(traced.size() - lo, static_cast<size_t>(kShadowRayBatch));
+    std::vector<Ray> batch(n);
+    for (size_t i = 0; i < n; ++i) batch[i] = rays[traced[lo + i]];
+    const std::unique_ptr<bool[]> occluded(new bool[n]);
+    query.Occluded(batch, std::span<bool>(occluded.get(), n));
+    for (size_t i = 0; i < n; ++i) (*blocked)[traced[lo + i]] = occluded[i] ? 1 : 0;
+  });
 }
 
 bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
@@ -149,7 +101,7 @@ bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
 }  // namespace
 
 void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
-                          const RayScene& scene, const Camera& camera, uint64_t frame_key,
+                          const RayQuery& scene, const Camera& camera, uint64_t frame_key,
                           const Eigen::Vector3f& bounds_center_W, double bounds_extent_m,
                           const Eigen::Vector3f& sky_ambient, const SkyIrradianceVolume* sky_volume,
                           ThreadPool* pool) {
@@ -157,31 +109,39 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   sky_ambient_ = sky_ambient;
   sky_volume_ = sky_volume != nullptr && !sky_volume->empty() ? sky_volume : nullptr;
   sky_ambient4_ = To4(sky_ambient);
-  sigma_t4_.clear();
-  sigma_s4_.clear();
-  for (const AnalyticMedium& m : media.analytic()) {
-    sigma_t4_.push_back(To4(m.sigma_t));
-    sigma_s4_.push_back(To4(m.sigma_s));
-  }
-  // the camera's h(0) per medium (DensityIntegralF), and whether every sigma_t is grey.
+  // the media for the shared per-pixel formulas, with the camera's h(0) per medium
+  // (DensityIntegralF), and whether every sigma_t is grey.
   h_cam_oz_ = camera.GenerateRay(0.0f, 0.0f).o.z();
-  h_cam_.clear();
+  pods_.clear();
   grey_t_ = true;
   for (const AnalyticMedium& m : media.analytic()) {
+    MediumPod pod = PodOf(m);
     const float k = m.falloff, zb = m.base;
-    h_cam_.push_back(std::exp(-k * std::max(0.0f, h_cam_oz_ + 0.0f * 0.0f - zb)));
+    pod.h_cam = std::exp(-k * std::max(0.0f, h_cam_oz_ + 0.0f * 0.0f - zb));
+    pods_.push_back(pod);
     grey_t_ = grey_t_ && m.sigma_t.x() == m.sigma_t.y() && m.sigma_t.y() == m.sigma_t.z();
   }
   num_lights_ = std::min(lights.size(), kMaxVolumeLights);
   const int nl = num_lights_;
-  // geometric visibility of light l from p (one shadow ray).
-  auto visible = [&](const Eigen::Vector3f& p, const LightSample& ls) {
-    if (!ls.cast_shadow) return true;
-    Ray sr;
+  // the geometric visibility of light l from p takes one shadow ray where the light casts
+  // shadows: each volume notes, per cell and light, whether it asks for the light's
+  // visibility (kLit: no ray, kTrace: rays[slot]), then the noted rays are traced in batches
+  // (TraceShadowRays) and the cells finished with the verdicts.
+  std::vector<Ray> rays;
+  std::vector<uint8_t> want, blocked;
+  auto note = [&](size_t slot, const Eigen::Vector3f& p, const LightSample& ls) {
+    if (!ls.cast_shadow) {
+      want[slot] = kLit;
+      return;
+    }
+    Ray& sr = rays[slot];
     sr.o = p;
     sr.d = ls.wi;
-    sr.tmax = std::isinf(ls.distance) ? kInfF : ls.distance * (1.0f - 1e-4f);
-    return !scene.Occluded(sr);
+    sr.tmax = std::isinf(ls.distance) ? kInfView : ls.distance * (1.0f - 1e-4f);
+    want[slot] = kTrace;
+  };
+  auto seen = [&](size_t slot) {
+    return want[slot] == kLit || (want[slot] == kTrace && blocked[slot] == 0);
   };
 
   // grid light volumes.
@@ -202,14 +162,19 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     gl.source.assign(cells, sky_ambient);
     const Eigen::Matrix3f R_WG = v.R_GW.transpose();
     const float sigma = Mean3(v.sigma_t);
-    ParallelForOrSerial(pool, cells, [&](int64_t c) {
+    auto centre = [&](int64_t c) {
       const int i = static_cast<int>(c % gl.r[0]);
       const int j = static_cast<int>((c / gl.r[0]) % gl.r[1]);
       const int k = static_cast<int>(c / (static_cast<int64_t>(gl.r[0]) * gl.r[1]));
       const Eigen::Vector3f x_G =
           -v.half + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(gl.cells_per_m);
-      const Eigen::Vector3f p = R_WG * (x_G - v.p_GW);
-      Eigen::Vector3f src = SkyAmbientAt(p);
+      return Eigen::Vector3f(R_WG * (x_G - v.p_GW));
+    };
+    rays.assign(static_cast<size_t>(cells) * nl, Ray());
+    want.assign(static_cast<size_t>(cells) * nl, kNone);
+    // the grid's transmittance to each light, and the shadow rays of the lit cells.
+    ParallelForOrSerial(pool, cells, [&](int64_t c) {
+      const Eigen::Vector3f p = centre(c);
       for (int l = 0; l < nl; ++l) {
         LightSample ls;
         if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
@@ -227,7 +192,19 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
           Tg = std::exp(-tau * sigma * ds);
         }
         gl.T[static_cast<size_t>(l) * cells + c] = Tg;
-        if (!(Tg > 1e-4f) || !visible(p, ls)) continue;
+        if (Tg > 1e-4f) note(static_cast<size_t>(c) * nl + l, p, ls);
+      }
+    });
+    TraceShadowRays(scene, rays, want, &blocked, pool);
+    // the in-scatter source: the sky, and each light the cell sees (its sample again).
+    ParallelForOrSerial(pool, cells, [&](int64_t c) {
+      const Eigen::Vector3f p = centre(c);
+      Eigen::Vector3f src = SkyAmbientAt(p);
+      for (int l = 0; l < nl; ++l) {
+        if (!seen(static_cast<size_t>(c) * nl + l)) continue;
+        LightSample ls;
+        lights.Sample(l, p, 0.5f, 0.5f, &ls);
+        const float Tg = gl.T[static_cast<size_t>(l) * cells + c];
         const float Th =
             media.analytic().empty()
                 ? 1.0f
@@ -241,11 +218,13 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   // world light volume: transmittance to every light (all media), and for homogeneous media
   // also times the geometric visibility (their in-scatter).
   vol_ = LightVolume();
+  cl_pod_ = CellLightsPod();
   if (nl > 0) {
     Eigen::Vector3f lo = bounds_center_W - Eigen::Vector3f::Constant(bounds_extent_m);
     Eigen::Vector3f hi = bounds_center_W + Eigen::Vector3f::Constant(bounds_extent_m);
     bool all_bounded = true;
-    Eigen::Vector3f ulo = Eigen::Vector3f::Constant(kInfF), uhi = Eigen::Vector3f::Constant(-kInfF);
+    Eigen::Vector3f ulo = Eigen::Vector3f::Constant(kInfView),
+                    uhi = Eigen::Vector3f::Constant(-kInfView);
     for (const AnalyticMedium& m : media.analytic()) {
       if (!m.bounded) {
         all_bounded = false;
@@ -278,7 +257,11 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       }
       const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
       vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
-      if (vol_.with_visibility) vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
+      if (vol_.with_visibility) {
+        vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
+        rays.assign(static_cast<size_t>(cells) * nl, Ray());
+        want.assign(static_cast<size_t>(cells) * nl, kNone);
+      }
       ParallelForOrSerial(pool, cells, [&](int64_t c) {
         const int i = static_cast<int>(c % vol_.r[0]);
         const int j = static_cast<int>((c / vol_.r[0]) % vol_.r[1]);
@@ -299,11 +282,28 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
           for (size_t g = 0; g < grid_light_.size(); ++g)
             T *= GridLightT(static_cast<int>(g), l, p, ls.wi, ls.distance);
           vol_.trans[at] = T;
-          if (vol_.with_visibility) vol_.vis[at] = T > 1e-4f && visible(p, ls) ? T : 0.0f;
+          if (vol_.with_visibility && T > 1e-4f) note(static_cast<size_t>(c) * nl + l, p, ls);
         }
       });
+      // V Th Tgrid: the transmittance where the light is seen, else 0.
+      if (vol_.with_visibility) {
+        TraceShadowRays(scene, rays, want, &blocked, pool);
+        ParallelForOrSerial(pool, cells, [&](int64_t c) {
+          for (int l = 0; l < nl; ++l) {
+            const size_t at = static_cast<size_t>(l) * cells + c;
+            vol_.vis[at] = seen(static_cast<size_t>(c) * nl + l) ? vol_.trans[at] : 0.0f;
+          }
+        });
+      }
       // the same values with the lights of a cell adjacent (LightTransmittances).
       vol_.stride = (nl + 3) / 4 * 4;
+      for (int k = 0; k < 3; ++k) {
+        cl_pod_.lo[k] = vol_.lo[k];
+        cl_pod_.hi[k] = vol_.hi[k];
+        cl_pod_.cells_per_m[k] = vol_.cells_per_m[k];
+        cl_pod_.r[k] = vol_.r[k];
+      }
+      cl_pod_.stride = vol_.stride;
       vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
       if (vol_.with_visibility) vol_.vis_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
       for (int l = 0; l < nl; ++l) {
@@ -344,10 +344,10 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
     const int vc = std::min(cy * kFroxelBlock + kFroxelBlock / 2, H - 1);
     const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
     const Eigen::Vector3f o = r.o, d = r.d.normalized();
-    float a = kInfF, b = -kInfF;
+    float a = kInfView, b = -kInfView;
     for (const GridVolume& v : media.grids()) {
       float ga, gb;
-      if (!v.Interval(o, d, 0.0f, kInfF, &ga, &gb)) continue;
+      if (!v.Interval(o, d, 0.0f, kInfView, &ga, &gb)) continue;
       a = std::min(a, ga);
       b = std::max(b, gb);
     }
@@ -401,7 +401,7 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
   const ColumnBilerp cb = PixelColumns(fr, u, v, kFroxelBlock);
   const int* cols = cb.cols;
   // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
-  float t_enter = kInfF;
+  float t_enter = kInfView;
   for (int q = 0; q < 4; ++q)
     if (fr.t0[cols[q]] < fr.t1[cols[q]]) t_enter = std::min(t_enter, fr.t0[cols[q]]);
   S->setZero();
@@ -433,17 +433,7 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
 
 namespace {
 
-// slice coordinate in [0, Z] of distance t for exponentially spaced boundaries
-// 0, near, ..., t_far (boundary k >= 1 at near (t_far / near)^((k - 1) / (Z - 1))).
-// log_t = log(t / near) (shared by the columns of a lookup), inv_log_far = 1 / log(t_far / near).
-float FogSlice(float t, float log_t, float inv_log_far) {
-  constexpr int Z = kFogFroxelSlices;
-  if (!(t > 0)) return 0.0f;
-  if (t < kFogFroxelNear) return t / kFogFroxelNear;
-  const float s = 1.0f + (Z - 1) * log_t * inv_log_far;
-  return std::min(s, static_cast<float>(Z));
-}
-
+// boundary k of a light in-scatter column reaching t_far (FogSlice's boundaries).
 float FogBoundary(int k, float t_far) {
   if (k == 0) return 0.0f;
   return kFogFroxelNear *
@@ -486,7 +476,7 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
     float t_far = 2 * kFogFroxelNear;
     for (const AnalyticMedium& m : media.analytic()) {
       float a, b;
-      if (!m.Interval(o, d, 0.0f, kInfF, &a, &b)) continue;
+      if (!m.Interval(o, d, 0.0f, kInfView, &a, &b)) continue;
       const double tt = m.InvertDensityIntegral(o.z(), d.z(), a, b, 4.6 / Mean3(m.sigma_t));
       t_far = std::max(t_far, static_cast<float>(std::min(std::isfinite(tt) ? tt : b, 2000.0)));
     }
@@ -516,7 +506,8 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
       Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
       // the visibility of every light with a volume in one lookup where x is in the volume.
       float vis_all[kMaxVolumeLights];
-      const bool located = vol_.with_visibility && CellLightsLookup(vol_.vis_cl.data(), x, vis_all);
+      const bool located =
+          vol_.with_visibility && CellLightsLookupSse(vol_.vis_cl.data(), x, vis_all);
       for (int j = 0; j < lights.size(); ++j) {
         // a light without visibility here adds nothing: skip its sample.
         if (located && j < num_lights_ && !(vis_all[j] > 0)) continue;
@@ -555,23 +546,44 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
 
 Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
   const FogFroxels& fr = fog_froxels_;
-  constexpr int Z = kFogFroxelSlices;
-  const ColumnBilerp cb = PixelColumns(fr, u, v, kFogFroxelBlock);
-  const int* cols = cb.cols;
-  const float* w = cb.w;
-  Eigen::Array4f out = Eigen::Array4f::Zero();
-  const float log_t = t > kFogFroxelNear ? std::log(t / kFogFroxelNear) : 0.0f;
-  for (int q = 0; q < 4; ++q) {
-    if (!(w[q] > 0)) continue;  // as in LookupFroxels
-    const int c = cols[q];
-    const float s = FogSlice(t, log_t, fr.inv_log_far[c]);
-    const int k = std::min(static_cast<int>(s), Z - 1);
-    const float f = s - k;
-    const Eigen::Array4f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1) + k;
-    const float w0 = w[q] * (1 - f), w1 = w[q] * f;
-    out += w0 * rec[0] + w1 * rec[1];
+  return FogFroxelLookup(PixelColumns(fr, u, v, kFogFroxelBlock), fr.S.data(),
+                         fr.inv_log_far.data(), t, Eigen::Array4f::Zero().eval());
+}
+
+RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
+                                          SkyVolumePod* sky_pod) const {
+  RealtimeMediaView m;
+  m.media = pods_.data();
+  m.num_media = static_cast<int>(pods_.size());
+  m.camera_height = h_cam_oz_;
+  m.grey = grey_t_ ? 1 : 0;
+  for (int k = 0; k < 3; ++k) m.sky_ambient[k] = sky_ambient_[k];
+  if (sky_volume_ != nullptr) {
+    *sky_pod = sky_volume_->pod();
+    m.sky_volume = sky_pod;
   }
-  return out;
+  const FogFroxels& ff = fog_froxels_;
+  if (!ff.S.empty()) {
+    fog_records->resize(ff.S.size());
+    for (size_t i = 0; i < ff.S.size(); ++i)
+      (*fog_records)[i] = Rgb4{ff.S[i][0], ff.S[i][1], ff.S[i][2], ff.S[i][3]};
+    m.fog_nx = ff.nx;
+    m.fog_ny = ff.ny;
+    m.width = static_cast<int>(ff.ax.size());
+    m.height = static_cast<int>(ff.ay.size());
+    m.fog_S = fog_records->data();
+    m.fog_inv_log_far = ff.inv_log_far.data();
+    m.fog_ax = ff.ax.data();
+    m.fog_ay = ff.ay.data();
+    m.fog_ax_half = ff.ax_half.data();
+    m.fog_ay_half = ff.ay_half.data();
+  }
+  if (vol_.active) {
+    m.light_volume = cl_pod_;
+    m.light_trans = vol_.trans_cl.data();
+    m.num_volume_lights = num_lights_;
+  }
+  return m;
 }
 
 Eigen::Vector3f RealtimeMedia::SkyAmbientAt(const Eigen::Vector3f& p_W) const {
@@ -581,23 +593,11 @@ Eigen::Vector3f RealtimeMedia::SkyAmbientAt(const Eigen::Vector3f& p_W) const {
 Eigen::Array4f RealtimeMedia::SkyAlongRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                                           float t_end) const {
   if (sky_volume_ == nullptr) return sky_ambient4_;
-  // the medium with the largest optical depth along the ray, and the point where half of its
-  // in-scatter weight 1 - T has accrued: T(t_med) = (1 + T(t_end)) / 2.
-  const AnalyticMedium* best = nullptr;
-  float best_tau = 0, best_a = 0, best_b = 0;
-  for (const AnalyticMedium& m : media_->analytic()) {
-    float a, b;
-    if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
-    const float sigma = Mean3(m.sigma_t);
-    const float tau = sigma * std::min(DensityIntegralF(m, o.z(), d.z(), a, b), 1e30f);
-    if (best == nullptr || tau > best_tau) best = &m, best_tau = tau, best_a = a, best_b = b;
-  }
-  if (best == nullptr || !(best_tau > 0)) return sky_ambient4_;
-  const float tau_med = -std::log1p(std::exp(-best_tau)) + std::log(2.0f);  // -ln((1 + T) / 2)
-  const double t =
-      best->InvertDensityIntegral(o.z(), d.z(), best_a, best_b, tau_med / Mean3(best->sigma_t));
-  const float t_med = std::isfinite(t) ? static_cast<float>(t) : 0.5f * (best_a + best_b);
-  if (!std::isfinite(t_med)) return sky_ambient4_;
+  // the in-scatter median point of the medium of largest optical depth (media_realtime_math.h)
+  float t_med;
+  if (!SkyMedianDistance(pods_.data(), static_cast<int>(pods_.size()), o.data(), d.data(), t_end,
+                         &t_med))
+    return sky_ambient4_;
   return To4(sky_volume_->AmbientRadiance(o + t_med * d, sky_ambient_));
 }
 
@@ -619,13 +619,13 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f
     q.t_c = t;
     const ColumnBilerp cb = QuadColumns(fr, u0, v0, kFroxelBlock);
     const int* cols = cb.cols;
-    float t_enter = kInfF;
+    float t_enter = kInfView;
     for (int k = 0; k < 4; ++k)
       if (fr.t0[cols[k]] < fr.t1[cols[k]]) t_enter = std::min(t_enter, fr.t0[cols[k]]);
     q.g_enter = t_enter;
     if (t > t_enter) {
       const float* w = cb.w;
-      float lo = t_enter, hi = kInfF;
+      float lo = t_enter, hi = kInfView;
       for (int k = 0; k < 4; ++k) {
         if (!(w[k] > 0)) continue;
         const int c = cols[k];
@@ -663,36 +663,9 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f
   // light in-scatter froxels: the same in log distance (slices are spaced exponentially),
   // beyond the first slice boundary only.
   const FogFroxels& ff = fog_froxels_;
-  if (!ff.S.empty() && t_c > kFogFroxelNear) {
-    constexpr int Z = kFogFroxelSlices;
-    const ColumnBilerp cb = QuadColumns(ff, u0, v0, kFogFroxelBlock);
-    const int* cols = cb.cols;
-    const float* w = cb.w;
-    const float log_t = std::log(t_c / kFogFroxelNear);
-    q.log_c = log_t;
-    float lo = 0.0f, hi = kInfF;
-    for (int k = 0; k < 4; ++k) {
-      if (!(w[k] > 0)) continue;
-      const int c = cols[k];
-      const float ilf = ff.inv_log_far[c];
-      const float s = 1.0f + (Z - 1) * log_t * ilf;
-      const Eigen::Array4f* rec = ff.S.data() + static_cast<size_t>(c) * (Z + 1);
-      if (!(s < Z)) {  // beyond the last boundary: record Z
-        lo = std::max(lo, 1.0f / ilf);
-        q.fS += w[k] * rec[Z];
-        continue;
-      }
-      const int i = std::min(static_cast<int>(s), Z - 1);
-      const float f = s - i;
-      const float per_slice = 1.0f / ((Z - 1) * ilf);  // log distance per slice
-      lo = std::max(lo, (i - 1) * per_slice);
-      hi = std::min(hi, i * per_slice);
-      q.fS += w[k] * ((1 - f) * rec[i] + f * rec[i + 1]);
-      q.fS_dlog += (w[k] * (Z - 1) * ilf) * (rec[i + 1] - rec[i]);
-    }
-    q.f_lo = lo;
-    q.f_hi = hi;
-  }
+  if (!ff.S.empty() && t_c > kFogFroxelNear)
+    FogQuadPrepare(QuadColumns(ff, u0, v0, kFogFroxelBlock), ff.S.data(), ff.inv_log_far.data(),
+                   t_c, &q.fog);
 }
 
 float RealtimeMedia::QuadFroxels(const MediaQuad& q, int u, int v, float t, Eigen::Array4f* S,
@@ -710,11 +683,9 @@ float RealtimeMedia::QuadFroxels(const MediaQuad& q, int u, int v, float t, Eige
 }
 
 Eigen::Array4f RealtimeMedia::QuadFogFroxels(const MediaQuad& q, int u, int v, float t) const {
-  if (!(t > kFogFroxelNear)) return LookupFogFroxels(u, v, t);
-  const float log_t = std::log(t / kFogFroxelNear);
-  if (!(log_t >= q.f_lo && log_t <= q.f_hi)) return LookupFogFroxels(u, v, t);
-  const float dl = log_t == q.log_c ? 0.0f : log_t - q.log_c;
-  return q.fS + dl * q.fS_dlog;
+  Eigen::Array4f out;
+  if (FogQuadValue(q.fog, t, &out)) return out;
+  return LookupFogFroxels(u, v, t);
 }
 
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -745,16 +716,23 @@ float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eige
   return T;
 }
 
-bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) const {
-  if (!vol_.active) return false;
-  return CellLightsLookup(vol_.trans_cl.data(), p_W, T);
+bool RealtimeMedia::LightVisibilities(const Eigen::Vector3f& p_W, float* T) const {
+  if (!vol_.with_visibility) return false;
+  return CellLightsLookupSse(vol_.vis_cl.data(), p_W, T);
 }
 
-bool RealtimeMedia::CellLightsLookup(const float* cl, const Eigen::Vector3f& p_W, float* T) const {
-  // the three axes in SSE lanes 0..2 (lane 3 is a dummy inside [0, 0]): the same IEEE
-  // operations as the scalar form clamp((x - lo) cells_per_m - 0.5, 0, r - 1), i0 =
-  // min(trunc(c), max(r - 2, 0)), step = min(i0 + 1, r - 1) - i0, w = c - i0 (the clamp's input
-  // is never -0 or NaN here, where max/min and std::clamp agree).
+bool RealtimeMedia::LightTransmittances(const Eigen::Vector3f& p_W, float* T) const {
+  if (!vol_.active) return false;
+  return CellLightsLookupSse(vol_.trans_cl.data(), p_W, T);
+}
+
+bool RealtimeMedia::CellLightsLookupSse(const float* cl, const Eigen::Vector3f& p_W,
+                                        float* T) const {
+  // CellLightsLookup of media_realtime_math.h restated in SSE (tested bit for bit against it,
+  // tests/render/media_realtime_math_test.cc). the three axes in SSE lanes 0..2 (lane 3 is a
+  // dummy inside [0, 0]): the same IEEE operations as the scalar form clamp((x - lo) cells_per_m -
+  // 0.5, 0, r - 1), i0 = min(trunc(c), max(r - 2, 0)), step = min(i0 + 1, r - 1) - i0, w = c - i0
+  // (the clamp's input is never -0 or NaN here, where max/min and std::clamp agree).
   const __m128 x = _mm_set_ps(0.0f, p_W.z(), p_W.y(), p_W.x());
   const __m128 inside = _mm_and_ps(_mm_cmpge_ps(x, _mm_loadu_ps(vol_.lo4.data())),
                                    _mm_cmple_ps(x, _mm_loadu_ps(vol_.hi4.data())));
@@ -829,7 +807,7 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
 
   // grids: the froxel volume at the pixel's distance.
   Eigen::Array4f L_add = Eigen::Array4f::Zero(), Tg(1, 1, 1, 0);
-  float first_a = kInfF;
+  float first_a = kInfView;
   if (!froxels_.records.empty()) {
     const float t = std::min(t_end, 1e30f);
     first_a = quad != nullptr ? QuadFroxels(*quad, u, v, t, &L_add, &Tg)
@@ -844,46 +822,21 @@ MediaSegment RealtimeMedia::IntegrateView(const LightSampler& lights, const Eige
   }
 
   // homogeneous media: closed-form transmittance and sky in-scatter (single precision), to the
-  // end and, when the ray enters a grid before it, to the grid's entry.
+  // end and, when the ray enters a grid before it, to the grid's entry (media_realtime_math.h).
   const bool to_grid = first_a < t_end;
-  Eigen::Array4f tau_t = Eigen::Array4f::Zero(), tau_s = Eigen::Array4f::Zero();
-  Eigen::Array4f tau_a = Eigen::Array4f::Zero();
-  for (size_t i = 0; i < media.analytic().size(); ++i) {
-    const AnalyticMedium& m = media.analytic()[i];
-    float a, b;
-    if (!m.Interval(o, d, 0.0f, t_end, &a, &b)) continue;
-    const float h_0 = o.z() == h_cam_oz_ ? h_cam_[i] : std::numeric_limits<float>::quiet_NaN();
-    const float I = std::min(DensityIntegralF(m, o.z(), d.z(), a, b, h_0), 1e30f);
-    const Eigen::Array4f& st = sigma_t4_[i];
-    tau_t += st * I;
-    tau_s += sigma_s4_[i] * I;
-    if (to_grid && a < first_a)
-      tau_a +=
-          st * std::min(DensityIntegralF(m, o.z(), d.z(), a, std::min(b, first_a), h_0), 1e30f);
-  }
-  // grey media give equal channels (the same operations on equal values), so the test is
-  // skipped for them.
-  const bool grey = grey_t_;
-  auto exp_neg = [grey](const Eigen::Array4f& tau) -> Eigen::Array4f {
-    if (grey || (tau[0] == tau[1] && tau[1] == tau[2]))
-      return Eigen::Array4f::Constant(std::exp(-tau[0]));  // grey: one exponential
-    return Eigen::Array4f(std::exp(-tau[0]), std::exp(-tau[1]), std::exp(-tau[2]), 1.0f);
-  };
-  const Eigen::Array4f Th_end = exp_neg(tau_t);
-  const Eigen::Array4f albedo = (tau_t > 0.0f).select(tau_s / tau_t, 0.0f);
-  Eigen::Array4f sky_w = 1.0f - Th_end;
-  if (to_grid) {
-    const Eigen::Array4f Th_a = exp_neg(tau_a);
-    sky_w = (1.0f - Th_a) + (Th_a - Th_end) * Tg;
-  }
+  Float3 tau_t, tau_s, tau_a;
+  HomogeneousViewDepths(pods_.data(), static_cast<int>(pods_.size()), o.data(), d.data(), t_end,
+                        to_grid, first_a, h_cam_oz_, &tau_t, &tau_s, &tau_a);
   const Eigen::Array4f sky = sky_volume_ == nullptr             ? sky_ambient4_
                              : quad != nullptr && quad->has_sky ? quad->sky
                                                                 : SkyAlongRay(o, d, t_end);
-  L_add += albedo * sky_w * sky;
+  Float3 T3, L3 = ToF3(L_add);
+  MediaViewClosedForm(tau_t, tau_s, tau_a, to_grid, grey_t_, ToF3(Tg), ToF3(sky), &T3, &L3);
+  L_add = To4(FromF3(L3));
   // light in-scatter from the froxel columns.
   if (!fog_froxels_.S.empty())
     L_add += quad != nullptr ? QuadFogFroxels(*quad, u, v, t_end) : LookupFogFroxels(u, v, t_end);
-  out.T = (Th_end * Tg).head<3>().matrix();
+  out.T = FromF3(T3);
   out.L_add = L_add.head<3>().matrix();
   return out;
 }

@@ -61,9 +61,10 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/ray_query.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 
 namespace penumbra {
@@ -74,18 +75,11 @@ constexpr int kGridLightCells = 1024;
 constexpr int kGridLightSteps = 16;
 /// cells of the world light volume.
 constexpr int kLightVolumeCells = 4096;
-/// pixels per side of the square pixel block of one froxel column.
-constexpr int kFroxelBlock = 12;
-/// depth slices of a froxel column.
-constexpr int kFroxelSlices = 24;
-/// pixels per side of the block of one light in-scatter column of the homogeneous media.
-constexpr int kFogFroxelBlock = 24;
-/// slices of a light in-scatter column of the homogeneous media.
-constexpr int kFogFroxelSlices = 40;
-/// distance (m) of the first exponentially spaced slice boundary.
-constexpr float kFogFroxelNear = 0.25f;
-/// lights with light volumes; further lights are unshadowed in media and unattenuated by grids.
-constexpr int kMaxVolumeLights = 16;
+// kFroxelBlock, kFroxelSlices, kFogFroxelBlock, kFogFroxelSlices, kFogFroxelNear and
+// kMaxVolumeLights: render/media_realtime_math.h (the per-pixel formulas read them).
+/// shadow rays of the light volumes per RayQuery::Occluded call (the batches of a frame are
+/// traced in parallel; a ray's verdict does not depend on its batch).
+constexpr int kShadowRayBatch = 4096;
 
 /// what a camera-ray segment through media does to the radiance L behind it: T L + L_add.
 struct MediaSegment {
@@ -104,12 +98,11 @@ struct MediaQuad {
   float g_lo = 1, g_hi = 0;  ///< grid: distances (m) where gS, gT hold (empty: none)
   Eigen::Array4f gS = Eigen::Array4f::Zero(), gT = Eigen::Array4f::Zero();        ///< at t_c
   Eigen::Array4f gS_dt = Eigen::Array4f::Zero(), gT_dt = Eigen::Array4f::Zero();  ///< per m
-  float log_c = 0;                             ///< fog: log(t_c / kFogFroxelNear)
-  float f_lo = 1, f_hi = 0;                    ///< fog: log distances where fS holds (empty: none)
-  Eigen::Array4f fS = Eigen::Array4f::Zero();  ///< fog in-scatter at t_c
-  Eigen::Array4f fS_dlog = Eigen::Array4f::Zero();  ///< its change per unit of log distance
-  bool has_sky = false;                             ///< sky holds SkyAlongRay of the quad
-  Eigen::Array4f sky = Eigen::Array4f::Zero();      ///< occluded sky radiance of the media
+  /// fog: the light in-scatter at t_c, its slope in log distance and where they hold
+  /// (FogQuadPrepare of media_realtime_math.h; empty range: none)
+  FogQuad<Eigen::Array4f> fog{0, 1, 0, Eigen::Array4f::Zero(), Eigen::Array4f::Zero()};
+  bool has_sky = false;                         ///< sky holds SkyAlongRay of the quad
+  Eigen::Array4f sky = Eigen::Array4f::Zero();  ///< occluded sky radiance of the media
 };
 
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
@@ -119,9 +112,12 @@ class RealtimeMedia {
   /// Build) for the posed `lights`; `sky_ambient` is the sphere-average sky radiance (cd/m^2)
   /// of the open sky; `sky_volume` (may be null or empty: the sky then lights the media
   /// unoccluded) occludes it by the static geometry and must outlive this object likewise.
-  /// shadow rays go through `scene`; the cells are spread over `pool` (may be null).
-  /// the froxel volume is built for `camera`; `frame_key` is FrameContext::FrameKey().
-  void Build(const MediaScene& media, const LightSampler& lights, const RayScene& scene,
+  /// shadow rays go through `scene` (any backend's RayQuery: the CPU renderer passes its
+  /// Embree RayScene, whose Occluded is rtcOccluded1 ray by ray; the CUDA backend its
+  /// CudaRayQuery), in batches of kShadowRayBatch; the cells and the batches are spread over
+  /// `pool` (may be null). the froxel volume is built for `camera`; `frame_key` is
+  /// FrameContext::FrameKey().
+  void Build(const MediaScene& media, const LightSampler& lights, const RayQuery& scene,
              const Camera& camera, uint64_t frame_key, const Eigen::Vector3f& bounds_center_W,
              double bounds_extent_m, const Eigen::Vector3f& sky_ambient,
              const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
@@ -165,12 +161,32 @@ class RealtimeMedia {
   /// (rgb, 4th lane 0): SkyAmbientAt at the ray's in-scatter median point (file comment).
   Eigen::Array4f SkyAlongRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float t_end) const;
 
-  /// one axis of the bilinear interpolation between froxel columns at an image position:
-  /// columns i0 and i1 along the axis and the weight w of i1 (tables per frame).
-  struct AxisBilerp {
-    int i0 = 0, i1 = 0;
-    float w = 0;
-  };
+  /// one axis of the bilinear interpolation between froxel columns at an image position
+  /// (MediaAxisAt of media_realtime_math.h; tables per frame).
+  using AxisBilerp = MediaAxis;
+
+  /// the homogeneous media as the shared per-pixel formulas read them (MediumPod: h_cam for
+  /// this frame's camera), in MediaScene::analytic() order; and the camera's height.
+  const std::vector<MediumPod>& medium_pods() const { return pods_; }
+  float camera_height() const { return h_cam_oz_; }
+  /// every homogeneous medium's sigma_t is grey (MediaViewClosedForm's `grey`).
+  bool grey_extinction() const { return grey_t_; }
+  /// the world light volume's layout (stride 0: no volume) and its [cell][light] arrays of
+  /// V Th Tgrid (empty without homogeneous media) and Th Tgrid, for CellLightsLookup.
+  const CellLightsPod& light_volume_pod() const { return cl_pod_; }
+  const std::vector<float>& light_volume_visibility() const { return vol_.vis_cl; }
+  const std::vector<float>& light_volume_transmittance() const { return vol_.trans_cl; }
+  /// this frame's homogeneous media as a RealtimeMediaView (media_realtime_math.h) over this
+  /// object's arrays (host pointers, valid until the next Build), with the fog froxels'
+  /// records copied to *fog_records (as Rgb4) and the sky volume's plain data to *sky_pod; both
+  /// must outlive the view. MediaViewSegment over it is IntegrateView without a quad for frames
+  /// without grids, MediaLightTransmittance the surface loop's transmittance (bit for bit:
+  /// tests/render/media_realtime_math_test.cc); a GPU path uploads the same arrays.
+  RealtimeMediaView HostView(std::vector<Rgb4>* fog_records, SkyVolumePod* sky_pod) const;
+  /// CellLightsLookup on the CPU (SSE; the shared function's arithmetic, tested against it)
+  /// of the world light volume's visibility (V Th Tgrid) at p_W into T[0 .. stride); false
+  /// outside the volume or without it.
+  bool LightVisibilities(const Eigen::Vector3f& p_W, float* T) const;
 
  private:
   struct GridLight {
@@ -229,8 +245,9 @@ class RealtimeMedia {
                     ThreadPool* pool);
 
   /// trilinear lookup at p_W of every light's value in a [cell][light] array of the world light
-  /// volume (trans_cl or vis_cl) into out[0 .. stride); false outside the volume.
-  bool CellLightsLookup(const float* cl, const Eigen::Vector3f& p_W, float* out) const;
+  /// volume (trans_cl or vis_cl) into out[0 .. stride); false outside the volume: the shared
+  /// CellLightsLookup (media_realtime_math.h) in SSE, with its bits.
+  bool CellLightsLookupSse(const float* cl, const Eigen::Vector3f& p_W, float* out) const;
   float GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                    float dist) const;
   float FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
@@ -239,14 +256,13 @@ class RealtimeMedia {
   const MediaScene* media_ = nullptr;
   Eigen::Vector3f sky_ambient_{0, 0, 0};
   const SkyIrradianceVolume* sky_volume_ = nullptr;  // non-empty, or null
-  // per homogeneous medium sigma_t and sigma_s, and the sky ambient, as 4-lane arrays (rgb, 0)
-  // built once per frame (assembling them per pixel stalls on store forwarding).
-  std::vector<Eigen::Array4f> sigma_t4_, sigma_s4_;
+  // the sky ambient as a 4-lane array (rgb, 0) built once per frame.
   Eigen::Array4f sky_ambient4_ = Eigen::Array4f::Zero();
   // relative density h(0) per homogeneous medium for rays from height h_cam_oz_ (the camera's
-  // pixel rays), and whether every homogeneous medium's sigma_t is grey.
+  // pixel rays; in pods_), and whether every homogeneous medium's sigma_t is grey.
   float h_cam_oz_ = 0;
-  std::vector<float> h_cam_;
+  std::vector<MediumPod> pods_;
+  CellLightsPod cl_pod_;
   bool grey_t_ = false;
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;

@@ -1,0 +1,723 @@
+#pragma once
+// the realtime tier's per-pixel media formulas (render/media_realtime.h) as PB_HOST_DEVICE
+// functions (docs/gpu.md, "One shading code"): the CPU's RealtimeMedia calls them for its
+// images, and a device path can call the same definitions over the frame's volumes.
+//  - MediaSlabInterval: the part of a ray inside a box (AnalyticMedium::Interval,
+//    GridVolume::Interval); MediaDensityIntegral / MediaInvertDensityIntegral (double): a
+//    height-falloff density's closed-form integral and its inverse (AnalyticMedium's, both
+//    tiers), AnalyticOpticalDepthOf: the media's optical depth (MediaScene::AnalyticOpticalDepth);
+//  - DensityIntegralF: the closed-form integral of a height-falloff density along a camera ray
+//    in single precision; HomogeneousViewDepths sums the optical depths of a ray through every
+//    homogeneous medium (to its end and to a grid's entry), MediaViewClosedForm turns them into
+//    the ray's transmittance and sky in-scatter (IntegrateView's homogeneous part);
+//  - MediaTrilinear: the cell-centred trilinear lookup of the light volumes
+//    (LightTransmittance, the grids' light volumes); CellLightsLookup: the world light volume's
+//    lookup of every light at once in its [cell][light] layout (the CPU keeps an SSE
+//    restatement, RealtimeMedia::CellLightsLookup, tested bit for bit against it);
+//  - MediaAxisAt / MediaColumnsFrom / MediaColumnsAt: the four froxel columns around an image
+//    position and their bilinear weights; FogSlice, FogFroxelLookup: the light in-scatter
+//    froxels' lookup at a distance; FogQuadPrepare / FogQuadValue: the 2x2 quads' shared fog
+//    lookups;
+//  - RealtimeMediaView, MediaViewSegment, MediaLightTransmittance: a frame's homogeneous media
+//    as plain data (RealtimeMedia::HostView; device copies for a GPU path) and, composed of the
+//    functions above, a pixel's view segment (IntegrateView without grids, per-pixel lookups)
+//    and a surface point's transmittance to a light (the CPU realtime surface loop's).
+// operation order: the CPU code's before the move (bit-for-bit rule of shading_math.h); the
+// CPU's images did not change (docs/gpu.md, "Homogeneous media (branch gpu8)").
+//
+// record types: the froxel lookups are templates over their record type R, an rgb value with a
+// 4th lane that is 0 (Eigen::Array4f on the CPU, whose SSE lanes round as the scalar
+// operations; Rgb4 here for scalar and device code), needing R + R, R - R, float * R, R += R.
+
+#include <math.h>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/render/shading_math.h"
+#include "penumbra/render/sky_eval_math.h"
+
+namespace penumbra {
+
+/// pixels per side of the square pixel block of one grid froxel column.
+constexpr int kFroxelBlock = 12;
+/// depth slices of a grid froxel column.
+constexpr int kFroxelSlices = 24;
+/// pixels per side of the block of one light in-scatter column of the homogeneous media.
+constexpr int kFogFroxelBlock = 24;
+/// slices of a light in-scatter column of the homogeneous media.
+constexpr int kFogFroxelSlices = 40;
+/// distance (m) of the first exponentially spaced slice boundary.
+constexpr float kFogFroxelNear = 0.25f;
+/// lights with light volumes; further lights are unshadowed in media and unattenuated by grids.
+constexpr int kMaxVolumeLights = 16;
+
+/// an rgb value and a 4th lane (0) for scalar and device code: the froxel records' type there.
+struct Rgb4 {
+  float x = 0, y = 0, z = 0, w = 0;
+};
+PB_HOST_DEVICE inline Rgb4 operator+(const Rgb4& a, const Rgb4& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w};
+}
+PB_HOST_DEVICE inline Rgb4 operator-(const Rgb4& a, const Rgb4& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z, a.w - b.w};
+}
+PB_HOST_DEVICE inline Rgb4 operator*(float s, const Rgb4& a) {
+  return {s * a.x, s * a.y, s * a.z, s * a.w};
+}
+PB_HOST_DEVICE inline Rgb4& operator+=(Rgb4& a, const Rgb4& b) {
+  a = a + b;
+  return a;
+}
+
+/// x is +inf or -inf (std::isinf).
+PB_HOST_DEVICE inline bool MediaIsInf(float x) {
+#if defined(__CUDA_ARCH__)
+  return isinf(x);
+#else
+  return __builtin_isinf(x);
+#endif
+}
+
+/// std::min / std::max of two ints.
+PB_HOST_DEVICE inline int MediaMinI(int a, int b) { return b < a ? b : a; }
+PB_HOST_DEVICE inline int MediaMaxI(int a, int b) { return a < b ? b : a; }
+
+/// the part [a, b] of [t0, t1] where o + t d lies in the box [lo_b, hi_b] (3 floats each;
+/// slabs, an axis with |d| < 1e-12 tested by o alone); false if empty.
+PB_HOST_DEVICE inline bool MediaSlabInterval(const float* o, const float* d, const float* lo_b,
+                                             const float* hi_b, float t0, float t1, float* a,
+                                             float* b) {
+  float lo = t0, hi = t1;
+  for (int k = 0; k < 3; ++k) {
+    if (fabsf(d[k]) < 1e-12f) {
+      if (o[k] < lo_b[k] || o[k] > hi_b[k]) return false;
+      continue;
+    }
+    const float inv = 1.0f / d[k];
+    float ta = (lo_b[k] - o[k]) * inv, tb = (hi_b[k] - o[k]) * inv;
+    if (ta > tb) {
+      const float s = ta;
+      ta = tb;
+      tb = s;
+    }
+    lo = pbm::Max(lo, ta);
+    hi = pbm::Min(hi, tb);
+  }
+  if (!(lo < hi)) return false;
+  *a = lo;
+  *b = hi;
+  return true;
+}
+
+/// the integral of a density h_s exp(-rate (t - s)) over [s, e] (rate 0: constant; e may be
+/// +inf), DensityIntegralF's piece.
+PB_HOST_DEVICE inline float MediaDensityPiece(float s, float e, float h_s, float rate) {
+  const float len = e - s;
+  if (rate == 0.0f || fabsf(rate) * len < 1e-6f) return h_s * len;
+  if (MediaIsInf(len)) return rate > 0 ? h_s / rate : INFINITY;
+  return h_s * -expm1f(-rate * len) / rate;
+}
+
+/// the relative density h(z(t)) = exp(-k max(0, oz + dz t - zb)) of DensityIntegralF, h_0 at
+/// t = 0 when h_0 is not NaN.
+PB_HOST_DEVICE inline float MediaDensityAlong(float k, float zb, float oz, float dz, float t,
+                                              float h_0) {
+  if (t == 0.0f && h_0 == h_0) return h_0;
+  return expf(-k * pbm::Max(0.0f, oz + dz * t - zb));
+}
+
+/// AnalyticMedium::DensityIntegral in single precision for camera rays (the same pieces below
+/// and above the base height, closed form per piece): the integral of h(z(t)) dt over [a, b]
+/// for z(t) = oz + dz t (d unit) of a medium of height falloff k (1/m, 0 uniform) and base
+/// height zb (m); b may be +inf. float keeps the relative error near 1e-6 (the optical depths
+/// it yields are used as exp(-tau) for display radiance). h_0: h(0) of this ray (the camera's h,
+/// MediumPod::h_cam) when oz is the camera's height, else NaN (then computed here); h(+-0)
+/// does not depend on dz, so it is the same value bit for bit.
+PB_HOST_DEVICE inline float DensityIntegralF(float k, float zb, float oz, float dz, float a,
+                                             float b, float h_0) {
+  if (!(a < b)) return 0.0f;
+  if (k <= 0 || fabsf(dz) < 1e-9f)
+    return MediaDensityPiece(a, b, k <= 0 ? 1.0f : MediaDensityAlong(k, zb, oz, dz, a, h_0), 0.0f);
+  const float tc = (zb - oz) / dz;  // where z crosses the base
+  float sum = 0.0f;
+  if (dz > 0) {
+    if (a < tc) sum += MediaDensityPiece(a, pbm::Min(b, tc), 1.0f, 0.0f);
+    const float s = pbm::Max(a, tc);
+    if (s < b) sum += MediaDensityPiece(s, b, MediaDensityAlong(k, zb, oz, dz, s, h_0), k * dz);
+  } else {
+    if (a < tc)
+      sum +=
+          MediaDensityPiece(a, pbm::Min(b, tc), MediaDensityAlong(k, zb, oz, dz, a, h_0), k * dz);
+    const float s = pbm::Max(a, tc);
+    if (s < b) sum += MediaDensityPiece(s, b, 1.0f, 0.0f);
+  }
+  return sum;
+}
+
+/// one homogeneous medium (AnalyticMedium) as the per-pixel formulas read it.
+struct MediumPod {
+  float sigma_t[3] = {0, 0, 0};  ///< 1/m at full density
+  float sigma_s[3] = {0, 0, 0};  ///< sigma_t * albedo, 1/m
+  float falloff = 0;             ///< height falloff k, 1/m (0 = uniform)
+  float base = 0;                ///< world z below which the density is 1
+  int bounded = 0;               ///< confined to [box_min, box_max]
+  float box_min[3] = {0, 0, 0}, box_max[3] = {0, 0, 0};
+  float h_cam = 1;  ///< h(0) for rays from the camera's height (DensityIntegralF's h_0)
+};
+
+/// one piece of a height-fog ray in double precision: density h_s exp(-rate (t - s)) on
+/// [s, e] (rate 0: constant); AnalyticMedium::DensityIntegral / InvertDensityIntegral (both
+/// tiers' exact optical depths and free-flight sampling) are sums of these.
+struct MediaPiece {
+  double s, e, h_s, rate;
+};
+
+/// x is +inf or -inf (double).
+PB_HOST_DEVICE inline bool MediaIsInfD(double x) {
+#if defined(__CUDA_ARCH__)
+  return isinf(x);
+#else
+  return __builtin_isinf(x);
+#endif
+}
+
+/// the integral of piece p over [s, e] (+inf for an infinite piece whose density does not
+/// vanish).
+PB_HOST_DEVICE inline double MediaPieceIntegral(const MediaPiece& p) {
+  const double len = p.e - p.s;
+  if (p.rate == 0 || fabs(p.rate) * len < 1e-9) return p.h_s * len;
+  if (MediaIsInfD(len)) return p.rate > 0 ? p.h_s / p.rate : static_cast<double>(INFINITY);
+  return p.h_s * -expm1(-p.rate * len) / p.rate;
+}
+
+/// the t in [s, e] of piece p where its integral from s reaches tau (tau <= the integral);
+/// +inf where a decaying density never reaches it.
+PB_HOST_DEVICE inline double MediaPieceInvert(const MediaPiece& p, double tau) {
+  const double len = p.e - p.s;
+  if (p.rate == 0 || fabs(p.rate) * (1e30 < len ? 1e30 : len) < 1e-9) return p.s + tau / p.h_s;
+  const double x = tau * p.rate / p.h_s;
+  if (x >= 1) return static_cast<double>(INFINITY);
+  return p.s - log1p(-x) / p.rate;
+}
+
+/// splits [a, b] of z(t) = oz + dz t into the pieces below and above the base height zb of a
+/// medium of height falloff k (1/m; 0 uniform); returns their number (1 or 2, 0 if none).
+PB_HOST_DEVICE inline int MediaPieces(double k, double zb, double oz, double dz, double a, double b,
+                                      MediaPiece out[2]) {
+  if (k <= 0 || fabs(dz) < 1e-9) {
+    const double z = oz + dz * a - zb;
+    out[0] = {a, b, k <= 0 ? 1.0 : exp(-k * (0.0 < z ? z : 0.0)), 0.0};
+    return 1;
+  }
+  const double tc = (zb - oz) / dz;  // where z crosses the base
+  int n = 0;
+  if (dz > 0) {
+    if (a < tc) out[n++] = {a, tc < b ? tc : b, 1.0, 0.0};
+    const double s = a < tc ? tc : a;
+    const double z = oz + dz * s - zb;
+    if (s < b) out[n++] = {s, b, exp(-k * (0.0 < z ? z : 0.0)), k * dz};
+  } else {
+    const double z = oz + dz * a - zb;
+    if (a < tc) out[n++] = {a, tc < b ? tc : b, exp(-k * (0.0 < z ? z : 0.0)), k * dz};
+    const double s = a < tc ? tc : a;
+    if (s < b) out[n++] = {s, b, 1.0, 0.0};
+  }
+  return n;
+}
+
+/// AnalyticMedium::DensityIntegral: the integral of the relative density over [a, b] of
+/// z(t) = oz + dz t (d unit; b may be +inf), closed form per piece.
+PB_HOST_DEVICE inline double MediaDensityIntegral(double k, double zb, double oz, double dz,
+                                                  double a, double b) {
+  if (!(a < b)) return 0;
+  MediaPiece p[2];
+  const int n = MediaPieces(k, zb, oz, dz, a, b, p);
+  double sum = 0;
+  for (int i = 0; i < n; ++i) sum += MediaPieceIntegral(p[i]);
+  return sum;
+}
+
+/// AnalyticMedium::InvertDensityIntegral: the t in [a, b] where MediaDensityIntegral from a
+/// reaches tau, or +inf if it does not.
+PB_HOST_DEVICE inline double MediaInvertDensityIntegral(double k, double zb, double oz, double dz,
+                                                        double a, double b, double tau) {
+  if (!(a < b)) return static_cast<double>(INFINITY);
+  MediaPiece p[2];
+  const int n = MediaPieces(k, zb, oz, dz, a, b, p);
+  for (int i = 0; i < n; ++i) {
+    const double I = MediaPieceIntegral(p[i]);
+    if (tau <= I) {
+      const double t = MediaPieceInvert(p[i], tau);
+      return p[i].e < t ? p[i].e : t;
+    }
+    tau -= I;
+  }
+  return static_cast<double>(INFINITY);
+}
+
+/// the part [a, b] of [t0, t1] where o + t d is inside medium m; false if empty
+/// (AnalyticMedium::Interval).
+PB_HOST_DEVICE inline bool MediumInterval(const MediumPod& m, const float* o, const float* d,
+                                          float t0, float t1, float* a, float* b) {
+  if (!m.bounded) {
+    if (!(t0 < t1)) return false;
+    *a = t0;
+    *b = t1;
+    return true;
+  }
+  return MediaSlabInterval(o, d, m.box_min, m.box_max, t0, t1, a, b);
+}
+
+/// the rgb optical depth of the n homogeneous media along o + t d (d unit), t in [t0, t1] (t1
+/// may be +inf), in double-precision closed form per medium, each capped at 1e30 before the
+/// product (MediaScene::AnalyticOpticalDepth; summed in media order from 0).
+PB_HOST_DEVICE inline Float3 AnalyticOpticalDepthOf(const MediumPod* media, int n, const float* o,
+                                                    const float* d, float t0, float t1) {
+  Float3 tau;
+  for (int i = 0; i < n; ++i) {
+    const MediumPod& m = media[i];
+    float a, b;
+    if (!MediumInterval(m, o, d, t0, t1, &a, &b)) continue;
+    const double I = MediaDensityIntegral(m.falloff, m.base, o[2], d[2], a, b);
+    const float If = static_cast<float>(1e30 < I ? 1e30 : I);  // std::min(I, 1e30)
+    tau.x = tau.x + m.sigma_t[0] * If;
+    tau.y = tau.y + m.sigma_t[1] * If;
+    tau.z = tau.z + m.sigma_t[2] * If;
+  }
+  return tau;
+}
+
+/// the optical depths of the view ray o + t d (d unit, o at height o[2]), t in [0, t_end],
+/// through the n homogeneous media: tau_t and tau_s (sigma_t and sigma_s times the density
+/// integral, summed in media order), and with to_grid the extinction depth tau_a to first_a,
+/// where the ray enters a grid. h_cam_oz: the camera's height (the media's h_cam hold there).
+PB_HOST_DEVICE inline void HomogeneousViewDepths(const MediumPod* media, int n, const float* o,
+                                                 const float* d, float t_end, bool to_grid,
+                                                 float first_a, float h_cam_oz, Float3* tau_t,
+                                                 Float3* tau_s, Float3* tau_a) {
+  for (int i = 0; i < n; ++i) {
+    const MediumPod& m = media[i];
+    float a, b;
+    if (!MediumInterval(m, o, d, 0.0f, t_end, &a, &b)) continue;
+    const float h_0 = o[2] == h_cam_oz ? m.h_cam : NAN;
+    const float I = pbm::Min(DensityIntegralF(m.falloff, m.base, o[2], d[2], a, b, h_0), 1e30f);
+    tau_t->x = tau_t->x + m.sigma_t[0] * I;
+    tau_t->y = tau_t->y + m.sigma_t[1] * I;
+    tau_t->z = tau_t->z + m.sigma_t[2] * I;
+    tau_s->x = tau_s->x + m.sigma_s[0] * I;
+    tau_s->y = tau_s->y + m.sigma_s[1] * I;
+    tau_s->z = tau_s->z + m.sigma_s[2] * I;
+    if (to_grid && a < first_a) {
+      const float Ia = pbm::Min(
+          DensityIntegralF(m.falloff, m.base, o[2], d[2], a, pbm::Min(b, first_a), h_0), 1e30f);
+      tau_a->x = tau_a->x + m.sigma_t[0] * Ia;
+      tau_a->y = tau_a->y + m.sigma_t[1] * Ia;
+      tau_a->z = tau_a->z + m.sigma_t[2] * Ia;
+    }
+  }
+}
+
+/// the channel mean (x + y + z) / 3 of an rgb triple (Mean3 of media_common.h).
+PB_HOST_DEVICE inline float MediaMean3(const float* v) {
+  return (v[0] + v[1] + v[2]) * (1.0f / 3.0f);
+}
+
+/// where SkyAlongRay samples the sky that lights the media along the view ray o + t d (d unit),
+/// t in [0, t_end]: in the medium of the largest optical depth along the ray, the distance
+/// t_med where half of its in-scatter weight 1 - T has accrued, T(t_med) = (1 + T(t_end)) / 2
+/// (channel-mean sigma_t). false where no medium has optical depth > 0 there (or t_med is not
+/// finite): then the open sky's ambient radiance lights the media.
+PB_HOST_DEVICE inline bool SkyMedianDistance(const MediumPod* media, int n, const float* o,
+                                             const float* d, float t_end, float* t_med) {
+  int best = -1;
+  float best_tau = 0, best_a = 0, best_b = 0;
+  for (int i = 0; i < n; ++i) {
+    const MediumPod& m = media[i];
+    float a, b;
+    if (!MediumInterval(m, o, d, 0.0f, t_end, &a, &b)) continue;
+    const float sigma = MediaMean3(m.sigma_t);
+    const float tau =
+        sigma * pbm::Min(DensityIntegralF(m.falloff, m.base, o[2], d[2], a, b, NAN), 1e30f);
+    if (best < 0 || tau > best_tau) best = i, best_tau = tau, best_a = a, best_b = b;
+  }
+  if (best < 0 || !(best_tau > 0)) return false;
+  const MediumPod& m = media[best];
+  const float tau_med = -log1pf(expf(-best_tau)) + logf(2.0f);  // -ln((1 + T) / 2)
+  const double t = MediaInvertDensityIntegral(m.falloff, m.base, o[2], d[2], best_a, best_b,
+                                              tau_med / MediaMean3(m.sigma_t));
+  const bool finite = t == t && !MediaIsInfD(t);  // std::isfinite(t)
+  const float tm = finite ? static_cast<float>(t) : 0.5f * (best_a + best_b);
+  if (!pbm::IsFinite(tm)) return false;
+  *t_med = tm;
+  return true;
+}
+
+/// e^-tau per channel; one exponential when the channels are equal or the media are `grey`
+/// (every sigma_t grey: equal channels, the same operations on equal values).
+PB_HOST_DEVICE inline Float3 MediaExpNeg(const Float3& tau, bool grey) {
+  if (grey || (tau.x == tau.y && tau.y == tau.z)) {
+    const float e = expf(-tau.x);
+    return {e, e, e};
+  }
+  return {expf(-tau.x), expf(-tau.y), expf(-tau.z)};
+}
+
+/// the homogeneous media's part of a view segment (IntegrateView): from the optical depths of
+/// HomogeneousViewDepths, the grids' transmittance Tg over the segment (1 without grids) and
+/// the sky radiance lighting the media `sky` (SkyAlongRay): *T = e^-tau_t Tg and *L_add +=
+/// albedo w sky, the sky in-scatter in closed form (albedo = tau_s / tau_t, w = 1 - e^-tau_t,
+/// or with to_grid (1 - e^-tau_a) + (e^-tau_a - e^-tau_t) Tg: behind a grid's entry its
+/// transmittance attenuates it). the light in-scatter (FogFroxelLookup) is added apart.
+PB_HOST_DEVICE inline void MediaViewClosedForm(const Float3& tau_t, const Float3& tau_s,
+                                               const Float3& tau_a, bool to_grid, bool grey,
+                                               const Float3& Tg, const Float3& sky, Float3* T,
+                                               Float3* L_add) {
+  const Float3 Th_end = MediaExpNeg(tau_t, grey);
+  const Float3 albedo = {tau_t.x > 0.0f ? tau_s.x / tau_t.x : 0.0f,
+                         tau_t.y > 0.0f ? tau_s.y / tau_t.y : 0.0f,
+                         tau_t.z > 0.0f ? tau_s.z / tau_t.z : 0.0f};
+  Float3 sky_w = {1.0f - Th_end.x, 1.0f - Th_end.y, 1.0f - Th_end.z};
+  if (to_grid) {
+    const Float3 Th_a = MediaExpNeg(tau_a, grey);
+    sky_w = {(1.0f - Th_a.x) + (Th_a.x - Th_end.x) * Tg.x,
+             (1.0f - Th_a.y) + (Th_a.y - Th_end.y) * Tg.y,
+             (1.0f - Th_a.z) + (Th_a.z - Th_end.z) * Tg.z};
+  }
+  L_add->x = L_add->x + albedo.x * sky_w.x * sky.x;
+  L_add->y = L_add->y + albedo.y * sky_w.y * sky.y;
+  L_add->z = L_add->z + albedo.z * sky_w.z * sky.z;
+  *T = {Th_end.x * Tg.x, Th_end.y * Tg.y, Th_end.z * Tg.z};
+}
+
+/// trilinear lookup in a cell-centred (r[0] x r[1] x r[2]) array `a` (x fastest) at continuous
+/// index (f0, f1, f2) (cell centre i at f = i), clamped to the outermost centres. T: float, or
+/// any value type with T * float and T + T (the CPU's rgb sources).
+template <typename T>
+PB_HOST_DEVICE inline T MediaTrilinear(const T* a, const int r[3], float f0, float f1, float f2) {
+  const float f[3] = {f0, f1, f2};
+  int i0[3], i1[3];
+  float w[3];
+  for (int k = 0; k < 3; ++k) {
+    const float c = pbm::Clamp(f[k], 0.0f, static_cast<float>(r[k] - 1));
+    i0[k] = MediaMinI(static_cast<int>(c), MediaMaxI(r[k] - 2, 0));
+    i1[k] = MediaMinI(i0[k] + 1, r[k] - 1);
+    w[k] = c - static_cast<float>(i0[k]);
+  }
+  const size_t nx = static_cast<size_t>(r[0]), ny = static_cast<size_t>(r[1]);
+  const T* z0 = a + static_cast<size_t>(i0[2]) * ny * nx;
+  const T* z1 = a + static_cast<size_t>(i1[2]) * ny * nx;
+  const size_t y0 = static_cast<size_t>(i0[1]) * nx, y1 = static_cast<size_t>(i1[1]) * nx;
+  const T c00 = z0[y0 + i0[0]] * (1 - w[0]) + z0[y0 + i1[0]] * w[0];
+  const T c10 = z0[y1 + i0[0]] * (1 - w[0]) + z0[y1 + i1[0]] * w[0];
+  const T c01 = z1[y0 + i0[0]] * (1 - w[0]) + z1[y0 + i1[0]] * w[0];
+  const T c11 = z1[y1 + i0[0]] * (1 - w[0]) + z1[y1 + i1[0]] * w[0];
+  const T c0 = c00 * (1 - w[1]) + c10 * w[1];
+  const T c1 = c01 * (1 - w[1]) + c11 * w[1];
+  return c0 * (1 - w[2]) + c1 * w[2];
+}
+
+/// the world light volume's layout for CellLightsLookup: the box [lo, hi] (m, world frame),
+/// cells per m and cells per axis r, and `stride` lights per cell (a multiple of 4).
+struct CellLightsPod {
+  float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, cells_per_m[3] = {1, 1, 1};
+  int r[3] = {1, 1, 1};
+  int stride = 0;
+};
+
+/// trilinear lookup at p (world, m) of every light's value in a [cell][light] array `cl` of
+/// the world light volume into out[0 .. stride); false outside the box (out untouched). per
+/// axis c = clamp((p - lo) cells_per_m - 0.5, 0, r - 1), i0 = min(trunc(c), max(r - 2, 0)),
+/// the upper corner i0 + 1 where that is <= r - 1 (else i0), w = c - i0; the eight corners
+/// (+1 along x, y, z for bits 0, 1, 2 of the corner index) weighted by the products of their
+/// axis weights and summed in corner order.
+PB_HOST_DEVICE inline bool CellLightsLookup(const CellLightsPod& v, const float* cl, const float* p,
+                                            float* out) {
+  for (int k = 0; k < 3; ++k)
+    if (!(p[k] >= v.lo[k] && p[k] <= v.hi[k])) return false;
+  int base[3], step[3];
+  float w[3];
+  for (int k = 0; k < 3; ++k) {
+    const float rmax = static_cast<float>(v.r[k] - 1);
+    float c = (p[k] - v.lo[k]) * v.cells_per_m[k] - 0.5f;
+    c = c > 0.0f ? c : 0.0f;  // _mm_max_ps(c, 0): c is never NaN here
+    c = c < rmax ? c : rmax;
+    const float imax = static_cast<float>(MediaMaxI(v.r[k] - 2, 0));
+    float i0 = static_cast<float>(static_cast<int>(c));
+    i0 = i0 < imax ? i0 : imax;
+    w[k] = c - i0;
+    base[k] = static_cast<int>(i0);
+    step[k] = i0 + 1.0f <= rmax ? 1 : 0;
+  }
+  const size_t S = static_cast<size_t>(v.stride);
+  const size_t nx = static_cast<size_t>(v.r[0]), nxy = nx * static_cast<size_t>(v.r[1]);
+  const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
+  const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
+  const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
+  const float w0 = ux * uy * uz, w1 = w[0] * uy * uz, w2 = ux * w[1] * uz, w3 = w[0] * w[1] * uz;
+  const float w4 = ux * uy * w[2], w5 = w[0] * uy * w[2], w6 = ux * w[1] * w[2],
+              w7 = w[0] * w[1] * w[2];
+  for (size_t j = 0; j < S; ++j) {
+    const float* c = c0 + j;
+    float sum = w0 * c[0];
+    sum += w1 * c[ox];
+    sum += w2 * c[oy];
+    sum += w3 * c[ox + oy];
+    sum += w4 * c[oz];
+    sum += w5 * c[ox + oz];
+    sum += w6 * c[oy + oz];
+    sum += w7 * c[ox + oy + oz];
+    out[j] = sum;
+  }
+  return true;
+}
+
+/// one axis of the bilinear interpolation between froxel columns at an image position:
+/// columns i0 and i1 along the axis and the weight w of i1.
+struct MediaAxis {
+  int i0 = 0, i1 = 0;
+  float w = 0;
+};
+
+/// the four froxel columns around an image position (indices into an nx-wide column grid)
+/// and their bilinear weights.
+struct MediaColumns {
+  int cols[4];
+  float w[4];
+};
+
+/// the axis part of the columns at position x (pixels) of columns centred on blocks of
+/// `block` pixels, `columns` of them along the axis: f = clamp((x - block / 2) / block, 0,
+/// columns - 1), i0 = trunc(f), i1 = min(i0 + 1, columns - 1), w = f - i0.
+PB_HOST_DEVICE inline MediaAxis MediaAxisAt(float x, int block, int columns) {
+  const float f = pbm::Clamp((x - block / 2) / static_cast<float>(block), 0.0f,
+                             static_cast<float>(columns - 1));
+  const int i0 = static_cast<int>(f);
+  return MediaAxis{i0, MediaMinI(i0 + 1, columns - 1), f - i0};
+}
+
+/// the columns and weights from the axis parts x and y (nx columns per row).
+PB_HOST_DEVICE inline MediaColumns MediaColumnsFrom(const MediaAxis& x, const MediaAxis& y,
+                                                    int nx) {
+  const float wx = x.w, wy = y.w;
+  return {{y.i0 * nx + x.i0, y.i0 * nx + x.i1, y.i1 * nx + x.i0, y.i1 * nx + x.i1},
+          {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy}};
+}
+
+/// the four columns around image position (x, y) of an nx x ny column grid of blocks of
+/// `block` pixels.
+PB_HOST_DEVICE inline MediaColumns MediaColumnsAt(float x, float y, int block, int nx, int ny) {
+  return MediaColumnsFrom(MediaAxisAt(x, block, nx), MediaAxisAt(y, block, ny), nx);
+}
+
+/// slice coordinate in [0, Z] of distance t for the exponentially spaced boundaries 0, near,
+/// ..., t_far of a light in-scatter column (boundary k >= 1 at near (t_far / near)^((k - 1) /
+/// (Z - 1))); log_t = log(t / near) (shared by the columns of a lookup), inv_log_far =
+/// 1 / log(t_far / near).
+PB_HOST_DEVICE inline float FogSlice(float t, float log_t, float inv_log_far) {
+  constexpr int Z = kFogFroxelSlices;
+  if (!(t > 0)) return 0.0f;
+  if (t < kFogFroxelNear) return t / kFogFroxelNear;
+  const float s = 1.0f + (Z - 1) * log_t * inv_log_far;
+  return pbm::Min(s, static_cast<float>(Z));
+}
+
+/// the light in-scatter of the homogeneous media from the camera to distance t (m) at the
+/// columns `cb`: per column linear between its slice boundaries, bilinear between the columns
+/// (columns of weight 0 skipped). S: [column][boundary 0..kFogFroxelSlices] records,
+/// inv_log_far: [column]; `zero` is R's 0.
+template <typename R>
+PB_HOST_DEVICE inline R FogFroxelLookup(const MediaColumns& cb, const R* S,
+                                        const float* inv_log_far, float t, const R& zero) {
+  constexpr int Z = kFogFroxelSlices;
+  R out = zero;
+  const float log_t = t > kFogFroxelNear ? logf(t / kFogFroxelNear) : 0.0f;
+  for (int q = 0; q < 4; ++q) {
+    if (!(cb.w[q] > 0)) continue;
+    const int c = cb.cols[q];
+    const float s = FogSlice(t, log_t, inv_log_far[c]);
+    const int k = MediaMinI(static_cast<int>(s), Z - 1);
+    const float f = s - k;
+    const R* rec = S + static_cast<size_t>(c) * (Z + 1) + k;
+    const float w0 = cb.w[q] * (1 - f), w1 = cb.w[q] * f;
+    out += w0 * rec[0] + w1 * rec[1];
+  }
+  return out;
+}
+
+/// a 2x2 quad's shared light in-scatter lookup (FogQuadPrepare), read by its pixels with
+/// FogQuadValue.
+template <typename R>
+struct FogQuad {
+  float log_c = 0;       ///< log(t_c / kFogFroxelNear)
+  float lo = 1, hi = 0;  ///< log distances where fS holds (empty: none)
+  R fS, fS_dlog;         ///< in-scatter at t_c and its change per unit of log distance
+};
+
+/// the fog lookups of a 2x2 quad at its centre's columns `cb` and reference distance t_c (m,
+/// > kFogFroxelNear): the value at t_c and its slope in log distance within the range of log
+/// distances where every column stays in one slice (beyond the last boundary: constant). q's
+/// fS and fS_dlog must hold R's 0 on entry.
+template <typename R>
+PB_HOST_DEVICE inline void FogQuadPrepare(const MediaColumns& cb, const R* S,
+                                          const float* inv_log_far, float t_c, FogQuad<R>* q) {
+  constexpr int Z = kFogFroxelSlices;
+  const float log_t = logf(t_c / kFogFroxelNear);
+  q->log_c = log_t;
+  float lo = 0.0f, hi = INFINITY;
+  for (int k = 0; k < 4; ++k) {
+    if (!(cb.w[k] > 0)) continue;
+    const int c = cb.cols[k];
+    const float ilf = inv_log_far[c];
+    const float s = 1.0f + (Z - 1) * log_t * ilf;
+    const R* rec = S + static_cast<size_t>(c) * (Z + 1);
+    if (!(s < Z)) {  // beyond the last boundary: record Z
+      lo = pbm::Max(lo, 1.0f / ilf);
+      q->fS += cb.w[k] * rec[Z];
+      continue;
+    }
+    const int i = MediaMinI(static_cast<int>(s), Z - 1);
+    const float f = s - i;
+    const float per_slice = 1.0f / ((Z - 1) * ilf);  // log distance per slice
+    lo = pbm::Max(lo, (i - 1) * per_slice);
+    hi = pbm::Min(hi, i * per_slice);
+    q->fS += cb.w[k] * ((1 - f) * rec[i] + f * rec[i + 1]);
+    q->fS_dlog += (cb.w[k] * (Z - 1) * ilf) * (rec[i + 1] - rec[i]);
+  }
+  q->lo = lo;
+  q->hi = hi;
+}
+
+/// the quad's fog in-scatter at a pixel's distance t (m): true with *out where q holds t,
+/// false where the pixel must look it up itself (FogFroxelLookup).
+template <typename R>
+PB_HOST_DEVICE inline bool FogQuadValue(const FogQuad<R>& q, float t, R* out) {
+  if (!(t > kFogFroxelNear)) return false;
+  const float log_t = logf(t / kFogFroxelNear);
+  if (!(log_t >= q.lo && log_t <= q.hi)) return false;
+  const float dl = log_t == q.log_c ? 0.0f : log_t - q.log_c;
+  *out = q.fS + dl * q.fS_dlog;
+  return true;
+}
+
+/// a frame's homogeneous media (no grids) as the per-pixel view functions read them:
+/// RealtimeMedia's arrays (RealtimeMedia::HostView), on the host or copied to a device.
+struct RealtimeMediaView {
+  const MediumPod* media = nullptr;  ///< the homogeneous media (h_cam set for the camera)
+  int num_media = 0;
+  float camera_height = 0;  ///< world z of the camera's rays (MediumPod::h_cam holds there)
+  int grey = 0;             ///< every sigma_t grey (MediaViewClosedForm's `grey`)
+  float sky_ambient[3] = {0, 0, 0};  ///< the open sky's sphere-average radiance (cd/m^2)
+  /// the sky volume that occludes it (SkyAlongRay), or null (then sky_ambient lights the media)
+  const SkyVolumePod* sky_volume = nullptr;
+  /// the light in-scatter froxels: fog_nx x fog_ny columns of kFogFroxelSlices + 1 records,
+  /// 1 / log(t_far / near) per column, and the per-pixel axis tables of a width x height image
+  /// (MediaAxisAt at every pixel centre); fog_S null: none (no lights)
+  int fog_nx = 0, fog_ny = 0, width = 0, height = 0;
+  const Rgb4* fog_S = nullptr;
+  const float* fog_inv_log_far = nullptr;
+  const MediaAxis* fog_ax = nullptr;       ///< [width]
+  const MediaAxis* fog_ay = nullptr;       ///< [height]
+  const MediaAxis* fog_ax_half = nullptr;  ///< [width]: at u + 0.5, the 2x2 quads' centres
+  const MediaAxis* fog_ay_half = nullptr;  ///< [height]
+  /// the world light volume (stride 0: none): Th per light in [cell][light] layout, for the
+  /// first num_volume_lights lights
+  CellLightsPod light_volume;
+  const float* light_trans = nullptr;
+  int num_volume_lights = 0;
+};
+
+/// the four fog froxel columns of pixel (u, v) (RealtimeMedia's PixelColumns: the axis tables
+/// inside the image, MediaColumnsAt outside).
+PB_HOST_DEVICE inline MediaColumns MediaPixelColumns(const RealtimeMediaView& m, int u, int v) {
+  if (u >= 0 && v >= 0 && u < m.width && v < m.height)
+    return MediaColumnsFrom(m.fog_ax[u], m.fog_ay[v], m.fog_nx);
+  return MediaColumnsAt(static_cast<float>(u), static_cast<float>(v), kFogFroxelBlock, m.fog_nx,
+                        m.fog_ny);
+}
+
+/// a 2x2 pixel quad's shared lookups (RealtimeMedia::PrepareQuad for frames without grids;
+/// MediaPrepareQuad): the fog froxels' at the quad's centre and reference distance, and the sky
+/// lighting the media along the quad's mean direction.
+struct MediaQuadShared {
+  FogQuad<Rgb4> fog;
+  int has_sky = 0;  ///< sky holds the quad's SkyAlongRay
+  float sky[3] = {0, 0, 0};
+};
+
+/// the sky radiance lighting the media along o + t d, t in [0, t_end] (RealtimeMedia::
+/// SkyAlongRay): the sky volume's at the in-scatter median point, else the open sky's.
+PB_HOST_DEVICE inline void MediaSkyAlongRay(const RealtimeMediaView& m, const float* o,
+                                            const float* d, float t_end, float* sky) {
+  for (int k = 0; k < 3; ++k) sky[k] = m.sky_ambient[k];
+  float t_med;
+  if (m.sky_volume != nullptr && SkyMedianDistance(m.media, m.num_media, o, d, t_end, &t_med)) {
+    const float p[3] = {o[0] + t_med * d[0], o[1] + t_med * d[1], o[2] + t_med * d[2]};
+    SkyVolumeAmbientRadiance(*m.sky_volume, p, m.sky_ambient, sky);
+  }
+}
+
+/// the shared lookups of the 2x2 quad of pixels (u0, v0) .. (u0 + 1, v0 + 1) at its reference
+/// distance t_c (m, the mean of its pixels' distances; +inf for sky pixels) and the sky along
+/// the ray from the camera centre o in the quad's mean direction d_c (unit) (RealtimeMedia::
+/// PrepareQuad without grids).
+PB_HOST_DEVICE inline void MediaPrepareQuad(const RealtimeMediaView& m, int u0, int v0, float t_c,
+                                            const float* o, const float* d_c, MediaQuadShared* q) {
+  *q = MediaQuadShared();
+  if (m.sky_volume != nullptr && m.num_media > 0) {
+    MediaSkyAlongRay(m, o, d_c, t_c, q->sky);
+    q->has_sky = 1;
+  }
+  if (m.fog_S != nullptr && t_c > kFogFroxelNear) {
+    const MediaColumns cb =
+        u0 >= 0 && v0 >= 0 && u0 < m.width && v0 < m.height
+            ? MediaColumnsFrom(m.fog_ax_half[u0], m.fog_ay_half[v0], m.fog_nx)
+            : MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, m.fog_nx, m.fog_ny);
+    FogQuadPrepare(cb, m.fog_S, m.fog_inv_log_far, t_c, &q->fog);
+  }
+}
+
+/// what the homogeneous media do to the radiance L behind the view segment o + t d (o the
+/// camera centre, d unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::
+/// IntegrateView for frames without grids): the closed-form transmittance and sky in-scatter
+/// (the sky at the ray's in-scatter median point through the sky volume) and the light
+/// in-scatter of the fog froxels. with `quad` (MediaPrepareQuad of the 2x2 quad holding the
+/// pixel; may be null) the quad's sky, and its fog lookup where it holds t_end, as IntegrateView
+/// with a MediaQuad; else each pixel its own lookups.
+PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, int v,
+                                            const float* o, const float* d, float t_end, Float3* T,
+                                            Float3* L_add, const MediaQuadShared* quad = nullptr) {
+  Float3 tau_t, tau_s, tau_a;
+  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, false, INFINITY, m.camera_height, &tau_t,
+                        &tau_s, &tau_a);
+  float sky[3];
+  if (m.sky_volume != nullptr && quad != nullptr && quad->has_sky) {
+    for (int k = 0; k < 3; ++k) sky[k] = quad->sky[k];
+  } else {
+    MediaSkyAlongRay(m, o, d, t_end, sky);
+  }
+  Float3 L;
+  MediaViewClosedForm(tau_t, tau_s, tau_a, false, m.grey != 0, Float3{1, 1, 1},
+                      Float3{sky[0], sky[1], sky[2]}, T, &L);
+  if (m.fog_S != nullptr) {
+    Rgb4 f;
+    if (quad == nullptr || !FogQuadValue(quad->fog, t_end, &f))
+      f = FogFroxelLookup(MediaPixelColumns(m, u, v), m.fog_S, m.fog_inv_log_far, t_end, Rgb4{});
+    L = {L.x + f.x, L.y + f.y, L.z + f.z};
+  }
+  *L_add = L;
+}
+
+/// the homogeneous media's transmittance from surface point p towards light j (unit direction
+/// wi, distance dist, +inf for directional lights), as the CPU's realtime surface loop takes it:
+/// inside the world light volume, for the lights it holds, the volume's channel-mean value
+/// (CellLightsLookup); elsewhere the closed form e^-tau of AnalyticOpticalDepthOf.
+PB_HOST_DEVICE inline Float3 MediaLightTransmittance(const RealtimeMediaView& m, int j,
+                                                     const float* p, const float* wi, float dist) {
+  if (m.light_trans != nullptr && j < m.num_volume_lights) {
+    float T[kMaxVolumeLights];
+    if (CellLightsLookup(m.light_volume, m.light_trans, p, T)) return {T[j], T[j], T[j]};
+  }
+  if (m.num_media == 0) return {1, 1, 1};
+  return MediaExpNeg(AnalyticOpticalDepthOf(m.media, m.num_media, p, wi, 0.0f, dist), false);
+}
+
+}  // namespace penumbra

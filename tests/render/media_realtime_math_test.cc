@@ -1,0 +1,340 @@
+// the realtime media's shared per-pixel formulas (render/media_realtime_math.h): the CPU's SSE
+// restatement of the world light volume's lookup against the shared CellLightsLookup, the
+// froxel lookups of the device's record type (Rgb4) against the CPU's (Eigen::Array4f), and
+// RayQuery's batched occlusion (its default through closest hits and Embree's rtcOccluded1)
+// that the light volumes trace their shadow rays with.
+
+#include "penumbra/render/media_realtime_math.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "media_test_util.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/media_scene.h"
+#include "penumbra/render/sky_irradiance_volume.h"
+#include "penumbra/render/sky_model.h"
+
+namespace penumbra::testing {
+namespace {
+
+bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; }
+
+// a floor, a wall and a pillar under five point lights (a stride of 8 lights per cell).
+SceneDescription LitRoom() {
+  SceneDescription s = EmptyScene();
+  const int m = AddMaterial(&s, Eigen::Vector3f::Constant(0.5f));
+  AddGeom(&s, GeomShape::kBox, {6, 6, 0.05}, Translation(0, 0, -0.05), 0, m);
+  AddGeom(&s, GeomShape::kBox, {0.1, 6, 2}, Translation(3, 0, 2), 0, m);
+  AddGeom(&s, GeomShape::kBox, {0.3, 0.3, 1.5}, Translation(0.5, 0.5, 1.5), 0, m);
+  for (int i = 0; i < 5; ++i) {
+    Light l;
+    l.type = Light::Type::kPoint;
+    l.position_B = {-2.0 + i, -1.0 + 0.5 * i, 2.5};
+    l.intensity = 100;
+    s.lights.push_back(l);
+  }
+  return s;
+}
+
+TEST(MediaRealtimeMathTest, SseLightVolumeLookupIsTheSharedOneBitForBit) {
+  const SceneDescription s = LitRoom();
+  EffectsFrame fx;
+  HomogeneousMedium fog = Fog(0.2f, 0.9f, 0.3f);
+  fog.height_falloff_per_m = 0.3f;
+  fx.homogeneous_media.push_back(fog);
+  const WorldSnapshot snap = IdentitySnapshot(s);
+  LightSampler lights(s);
+  lights.Update(snap);
+  RayScene rays(s);
+  rays.Update(snap);
+  const CameraView view = MakeView(CameraLookingAlongX({-3, 0, 1.2}), 96, 72, 60.0);
+  const Camera camera(view.X_WO, view.intrinsics);
+  MediaScene media;
+  media.Build(&fx);
+  RealtimeMedia rm;
+  rm.Build(media, lights, rays, camera, 99, Eigen::Vector3f(0, 0, 2), 4.0,
+           Eigen::Vector3f::Constant(0.3f), nullptr, nullptr);
+  const CellLightsPod& pod = rm.light_volume_pod();
+  ASSERT_EQ(pod.stride, 8);
+  ASSERT_FALSE(rm.light_volume_visibility().empty());
+  Rng rng(7);
+  int inside = 0, outside = 0, occluded_entries = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // points over and beyond the volume's box, and some on its faces and cell centres.
+    Eigen::Vector3f p(-5 + 10 * rng.Uniform(), -5 + 10 * rng.Uniform(), -1 + 8 * rng.Uniform());
+    if (i % 10 == 0) p.x() = pod.lo[0];
+    if (i % 10 == 1) p.z() = pod.hi[2];
+    float sse_t[kMaxVolumeLights], shared_t[kMaxVolumeLights];
+    float sse_v[kMaxVolumeLights], shared_v[kMaxVolumeLights];
+    const bool in_sse = rm.LightTransmittances(p, sse_t);
+    const bool in_shared =
+        CellLightsLookup(pod, rm.light_volume_transmittance().data(), p.data(), shared_t);
+    ASSERT_EQ(in_sse, in_shared) << i;
+    ASSERT_EQ(rm.LightVisibilities(p, sse_v),
+              CellLightsLookup(pod, rm.light_volume_visibility().data(), p.data(), shared_v));
+    if (!in_sse) {
+      ++outside;
+      continue;
+    }
+    ++inside;
+    for (int j = 0; j < pod.stride; ++j) {
+      ASSERT_TRUE(SameBits(sse_t[j], shared_t[j])) << i << " light " << j;
+      ASSERT_TRUE(SameBits(sse_v[j], shared_v[j])) << i << " light " << j;
+      occluded_entries += j < 5 && shared_v[j] < shared_t[j] ? 1 : 0;
+    }
+  }
+  EXPECT_GT(inside, 2000);
+  EXPECT_GT(outside, 2000);
+  EXPECT_GT(occluded_entries, 100);  // the pillar and the wall shadow some of the lights
+}
+
+bool SameF3(const Eigen::Vector3f& a, const Float3& b) {
+  return SameBits(a.x(), b.x) && SameBits(a.y(), b.y) && SameBits(a.z(), b.z);
+}
+
+// MediaViewSegment (per pixel, and with MediaPrepareQuad's shared quad lookups) and
+// MediaLightTransmittance over RealtimeMedia::HostView against the CPU's IntegrateView (without
+// and with PrepareQuad's MediaQuad) and its surface loop's transmittance, in the lit room with a
+// sky volume (the sky at the in-scatter median point), non-grey height fog and a boxed haze.
+TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+  SceneDescription s = LitRoom();
+  Sky sky_desc;
+  sky_desc.type = Sky::Type::kDaylight;
+  sky_desc.sun_direction_W = Eigen::Vector3d(-0.28, -0.77, 0.57).normalized();
+  sky_desc.turbidity = 3;
+  sky_desc.zenith_luminance = 8000;
+  s.sky = sky_desc;
+  EffectsFrame fx;
+  HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
+  fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);  // not grey
+  fog.height_falloff_per_m = 0.4f;
+  fog.base_height_m = 0.5f;
+  fx.homogeneous_media.push_back(fog);
+  HomogeneousMedium haze = Fog(0.3f, 0.7f, 0.0f);
+  haze.region = BoxRegion{Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(2, 2, 1.5)};
+  fx.homogeneous_media.push_back(haze);
+  const WorldSnapshot snap = IdentitySnapshot(s);
+  LightSampler lights(s);
+  lights.Update(snap);
+  RayScene rays(s);
+  rays.Update(snap);
+  const SkyModel sky(s.sky);
+  ThreadPool pool(2);
+  SkyIrradianceVolume volume([](const SceneDescription& sc) {
+    return MakeRayQuery(sc, RenderSettings::Backend::kEmbree);
+  });
+  volume.Update(s, snap, sky, &pool);
+  ASSERT_FALSE(volume.empty());
+  constexpr int W = 96, H = 72;
+  const CameraView view = MakeView(CameraLookingAlongX({-3, 0.2f, 1.2}), W, H, 70.0);
+  const Camera camera(view.X_WO, view.intrinsics);
+  MediaScene media;
+  media.Build(&fx);
+  RealtimeMedia rm;
+  rm.Build(media, lights, rays, camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
+           Eigen::Vector3f(0.3f, 0.4f, 0.6f), &volume, &pool);
+  std::vector<Rgb4> fog_records;
+  SkyVolumePod sky_pod;
+  const RealtimeMediaView mv = rm.HostView(&fog_records, &sky_pod);
+  ASSERT_NE(mv.fog_S, nullptr);
+  ASSERT_NE(mv.sky_volume, nullptr);
+  ASSERT_NE(mv.light_trans, nullptr);
+  const float inf = std::numeric_limits<float>::infinity();
+  int segments = 0, lit = 0;
+  for (int v = -1; v <= H; v += 2) {  // the image's border rows and columns and beyond
+    for (int u = -1; u <= W; u += 2) {
+      const Ray r = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+      const Eigen::Vector3f d = r.d.normalized();
+      for (const float t_end : {inf, 25.0f, 3.7f, 0.2f}) {
+        const MediaSegment cpu = rm.IntegrateView(lights, r.o, d, t_end, u, v);
+        Float3 T, L;
+        MediaViewSegment(mv, u, v, r.o.data(), d.data(), t_end, &T, &L);
+        ASSERT_TRUE(SameF3(cpu.T, T)) << u << " " << v << " " << t_end;
+        ASSERT_TRUE(SameF3(cpu.L_add, L)) << u << " " << v << " " << t_end;
+        ++segments;
+        lit += cpu.L_add.maxCoeff() > 0 ? 1 : 0;
+      }
+    }
+  }
+  // 2x2 quads sharing their lookups (the realtime integrator's MediaQuads): surfaces at
+  // distances that vary over the image, and sky quads.
+  int quad_pixels = 0;
+  for (int v0 = 0; v0 < H; v0 += 2) {
+    for (int u0 = 0; u0 < W; u0 += 2) {
+      const bool sky_quad = (u0 / 2 + v0 / 2) % 5 == 0;
+      Eigen::Vector3f o[4], d[4];
+      float t[4];
+      Eigen::Vector3f d_sum = Eigen::Vector3f::Zero();
+      for (int c = 0; c < 4; ++c) {
+        const Ray r =
+            camera.GenerateRay(static_cast<float>(u0 + (c & 1)), static_cast<float>(v0 + (c >> 1)));
+        o[c] = r.o;
+        d[c] = r.d.normalized();
+        d_sum += d[c];
+        t[c] = sky_quad ? inf : 2.0f + 0.1f * (u0 + (c & 1)) + 0.05f * (v0 + (c >> 1));
+      }
+      const float t_c = sky_quad ? inf : 0.25f * (t[0] + t[1] + t[2] + t[3]);
+      const Eigen::Vector3f d_c = d_sum.normalized();
+      MediaQuad cpu_q;
+      rm.PrepareQuad(u0, v0, t_c, o[0], d_c, &cpu_q);
+      MediaQuadShared q;
+      MediaPrepareQuad(mv, u0, v0, t_c, o[0].data(), d_c.data(), &q);
+      for (int c = 0; c < 4; ++c) {
+        const int u = u0 + (c & 1), v = v0 + (c >> 1);
+        for (const float te :
+             {t[c], sky_quad ? 1.0f : 1.01f * t_c, sky_quad ? 3.0f : 0.5f * t[c]}) {
+          const MediaSegment cpu = rm.IntegrateView(lights, o[c], d[c], te, u, v, &cpu_q);
+          Float3 T, L;
+          MediaViewSegment(mv, u, v, o[c].data(), d[c].data(), te, &T, &L, &q);
+          ASSERT_TRUE(SameF3(cpu.T, T)) << u << " " << v << " " << te;
+          ASSERT_TRUE(SameF3(cpu.L_add, L)) << u << " " << v << " " << te;
+          ++quad_pixels;
+        }
+      }
+    }
+  }
+  EXPECT_GT(quad_pixels, 15000);
+  // surface points: the CPU's loop takes the volume's lookup where it holds the point and the
+  // light (LightTransmittances), else LightTransmittance.
+  Rng rng(9);
+  int located = 0, closed = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Eigen::Vector3f p(-6 + 12 * rng.Uniform(), -6 + 12 * rng.Uniform(), 4 * rng.Uniform());
+    float vol_T[kMaxVolumeLights];
+    const bool in = rm.LightTransmittances(p, vol_T);
+    for (int j = 0; j < lights.size(); ++j) {
+      LightSample ls;
+      if (!lights.Sample(j, p, 0.5f, 0.5f, &ls)) continue;
+      const Eigen::Vector3f cpu = in && j < rm.num_volume_lights()
+                                      ? Eigen::Vector3f::Constant(vol_T[j])
+                                      : rm.LightTransmittance(j, p, ls.wi, ls.distance);
+      const Float3 shared = MediaLightTransmittance(mv, j, p.data(), ls.wi.data(), ls.distance);
+      ASSERT_TRUE(SameF3(cpu, shared)) << i << " light " << j;
+      (in && j < rm.num_volume_lights() ? located : closed) += 1;
+    }
+  }
+  EXPECT_GT(segments, 3000);
+  EXPECT_GT(lit, segments / 2);
+  EXPECT_GT(located, 1000);
+  EXPECT_GT(closed, 1000);
+}
+
+// froxel records of a few columns with rgb in lanes 0..2, as both record types.
+struct Records {
+  std::vector<Eigen::Array4f> eigen;
+  std::vector<Rgb4> rgb4;
+  std::vector<float> inv_log_far;
+};
+Records MakeRecords(int columns) {
+  Records r;
+  Rng rng(3);
+  for (int c = 0; c < columns; ++c) {
+    r.inv_log_far.push_back(1.0f / std::log((2.0f + 60 * rng.Uniform()) / kFogFroxelNear));
+    Eigen::Array4f S = Eigen::Array4f::Zero();
+    r.eigen.push_back(S);
+    r.rgb4.push_back({0, 0, 0, 0});
+    for (int k = 0; k < kFogFroxelSlices; ++k) {
+      S += Eigen::Array4f(rng.Uniform(), 0.5f * rng.Uniform(), 2 * rng.Uniform(), 0);
+      r.eigen.push_back(S);
+      r.rgb4.push_back({S[0], S[1], S[2], S[3]});
+    }
+  }
+  return r;
+}
+
+bool SameRgb(const Eigen::Array4f& a, const Rgb4& b) {
+  return SameBits(a[0], b.x) && SameBits(a[1], b.y) && SameBits(a[2], b.z);
+}
+
+TEST(MediaRealtimeMathTest, FogFroxelLookupsOfBothRecordTypesAgreeBitForBit) {
+  constexpr int nx = 5, ny = 4, W = nx * kFogFroxelBlock, H = ny * kFogFroxelBlock;
+  const Records r = MakeRecords(nx * ny);
+  Rng rng(11);
+  int quad_hits = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const float x = W * rng.Uniform(), y = H * rng.Uniform();
+    const MediaColumns cb = MediaColumnsAt(x, y, kFogFroxelBlock, nx, ny);
+    // distances before the first boundary, inside the slices and beyond the last one.
+    const float t = i % 7 == 0 ? 0.2f * rng.Uniform() : 0.1f + 200 * rng.Uniform() * rng.Uniform();
+    const Eigen::Array4f a =
+        FogFroxelLookup(cb, r.eigen.data(), r.inv_log_far.data(), t, Eigen::Array4f::Zero().eval());
+    const Rgb4 b = FogFroxelLookup(cb, r.rgb4.data(), r.inv_log_far.data(), t, Rgb4{});
+    ASSERT_TRUE(SameRgb(a, b)) << i;
+    if (!(t > kFogFroxelNear)) continue;
+    FogQuad<Eigen::Array4f> qa{0, 1, 0, Eigen::Array4f::Zero(), Eigen::Array4f::Zero()};
+    FogQuad<Rgb4> qb;
+    FogQuadPrepare(cb, r.eigen.data(), r.inv_log_far.data(), t, &qa);
+    FogQuadPrepare(cb, r.rgb4.data(), r.inv_log_far.data(), t, &qb);
+    ASSERT_TRUE(SameRgb(qa.fS, qb.fS) && SameRgb(qa.fS_dlog, qb.fS_dlog)) << i;
+    ASSERT_TRUE(SameBits(qa.lo, qb.lo) && SameBits(qa.hi, qb.hi)) << i;
+    for (const float te : {t, 1.01f * t, 0.98f * t}) {
+      Eigen::Array4f va;
+      Rgb4 vb;
+      const bool ha = FogQuadValue(qa, te, &va), hb = FogQuadValue(qb, te, &vb);
+      ASSERT_EQ(ha, hb);
+      if (ha) {
+        ASSERT_TRUE(SameRgb(va, vb)) << i;
+      }
+      quad_hits += ha ? 1 : 0;
+    }
+  }
+  EXPECT_GT(quad_hits, 1000);
+}
+
+// a RayQuery that has closest hits only (RayQuery's default Occluded).
+class ClosestHitsOnly final : public RayQuery {
+ public:
+  explicit ClosestHitsOnly(const RayScene& inner) : inner_(inner) {}
+  const SceneDescription& scene() const override { return inner_.scene(); }
+  void Update(const WorldSnapshot&) override {}
+
+ private:
+  void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                      std::span<bool> did_hit) const override {
+    inner_.Intersect(rays, hits, did_hit);
+  }
+  const RayScene& inner_;
+};
+
+TEST(MediaRealtimeMathTest, BatchedOcclusionMatchesEmbreesOneRayVerdicts) {
+  const SceneDescription s = LitRoom();
+  RayScene rays(s);
+  rays.Update(IdentitySnapshot(s));
+  const ClosestHitsOnly closest(rays);
+  Rng rng(5);
+  std::vector<Ray> batch(4000);
+  for (Ray& r : batch) {
+    r.o = Eigen::Vector3f(-4 + 8 * rng.Uniform(), -4 + 8 * rng.Uniform(), 0.1f + 3 * rng.Uniform());
+    r.d = Eigen::Vector3f(rng.Uniform() - 0.5f, rng.Uniform() - 0.5f, rng.Uniform() - 0.5f)
+              .normalized();
+    r.tmax = 0.5f + 6 * rng.Uniform();
+  }
+  const std::unique_ptr<bool[]> a(new bool[batch.size()]), b(new bool[batch.size()]);
+  rays.Occluded(batch, std::span<bool>(a.get(), batch.size()));
+  closest.Occluded(batch, std::span<bool>(b.get(), batch.size()));
+  int blocked = 0, differ = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    EXPECT_EQ(a[i], rays.Occluded(batch[i])) << i;  // the batch is rtcOccluded1 ray by ray
+    differ += a[i] != b[i] ? 1 : 0;
+    blocked += a[i] ? 1 : 0;
+  }
+  EXPECT_GT(blocked, 400);
+  EXPECT_LT(blocked, 3600);
+  // closest hits and any-hit traversal agree but for rays that graze an edge (float rounding)
+  EXPECT_LE(differ, 4);
+  // too few verdicts for the rays
+  EXPECT_THROW(rays.Occluded(batch, std::span<bool>(a.get(), 10)), Error);
+}
+
+}  // namespace
+}  // namespace penumbra::testing
