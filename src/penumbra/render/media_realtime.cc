@@ -762,21 +762,19 @@ bool RealtimeMedia::CellLightsLookupSse(const float* cl, const Eigen::Vector3f& 
   const size_t nx = static_cast<size_t>(vol_.r[0]), nxy = nx * static_cast<size_t>(vol_.r[1]);
   const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
   const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
-  const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
-  const float w0 = ux * uy * uz, w1 = w[0] * uy * uz, w2 = ux * w[1] * uz, w3 = w[0] * w[1] * uz;
-  const float w4 = ux * uy * w[2], w5 = w[0] * uy * w[2], w6 = ux * w[1] * w[2],
-              w7 = w[0] * w[1] * w[2];
+  float wc[8];
+  TrilinearCornerWeights(w, wc);
   using A4 = Eigen::Map<const Eigen::Array4f>;
   for (size_t j0 = 0; j0 < S; j0 += 4) {
     const float* c = c0 + j0;
-    Eigen::Array4f sum = w0 * A4(c);
-    sum += w1 * A4(c + ox);
-    sum += w2 * A4(c + oy);
-    sum += w3 * A4(c + ox + oy);
-    sum += w4 * A4(c + oz);
-    sum += w5 * A4(c + ox + oz);
-    sum += w6 * A4(c + oy + oz);
-    sum += w7 * A4(c + ox + oy + oz);
+    Eigen::Array4f sum = wc[0] * A4(c);
+    sum += wc[1] * A4(c + ox);
+    sum += wc[2] * A4(c + oy);
+    sum += wc[3] * A4(c + ox + oy);
+    sum += wc[4] * A4(c + oz);
+    sum += wc[5] * A4(c + ox + oz);
+    sum += wc[6] * A4(c + oy + oz);
+    sum += wc[7] * A4(c + ox + oy + oz);
     Eigen::Map<Eigen::Array4f>(T + j0) = sum;
   }
   return true;

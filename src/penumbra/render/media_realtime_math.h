@@ -423,6 +423,20 @@ struct CellLightsPod {
   int stride = 0;
 };
 
+/// the eight trilinear weights of the fractions w (x, y, z in [0, 1]) of a cell's corners, corner
+/// k at +1 along x, y, z for bits 0, 1, 2 of k: the products (1 - w) or w, x first.
+PB_HOST_DEVICE inline void TrilinearCornerWeights(const float w[3], float out[8]) {
+  const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
+  out[0] = ux * uy * uz;
+  out[1] = w[0] * uy * uz;
+  out[2] = ux * w[1] * uz;
+  out[3] = w[0] * w[1] * uz;
+  out[4] = ux * uy * w[2];
+  out[5] = w[0] * uy * w[2];
+  out[6] = ux * w[1] * w[2];
+  out[7] = w[0] * w[1] * w[2];
+}
+
 /// trilinear lookup at p (world, m) of every light's value in a [cell][light] array `cl` of
 /// the world light volume into out[0 .. stride); false outside the box (out untouched). per
 /// axis c = clamp((p - lo) cells_per_m - 0.5, 0, r - 1), i0 = min(trunc(c), max(r - 2, 0)),
@@ -451,20 +465,18 @@ PB_HOST_DEVICE inline bool CellLightsLookup(const CellLightsPod& v, const float*
   const size_t nx = static_cast<size_t>(v.r[0]), nxy = nx * static_cast<size_t>(v.r[1]);
   const float* c0 = cl + (base[2] * nxy + base[1] * nx + base[0]) * S;
   const size_t ox = step[0] * S, oy = step[1] * nx * S, oz = step[2] * nxy * S;
-  const float ux = 1 - w[0], uy = 1 - w[1], uz = 1 - w[2];
-  const float w0 = ux * uy * uz, w1 = w[0] * uy * uz, w2 = ux * w[1] * uz, w3 = w[0] * w[1] * uz;
-  const float w4 = ux * uy * w[2], w5 = w[0] * uy * w[2], w6 = ux * w[1] * w[2],
-              w7 = w[0] * w[1] * w[2];
+  float wc[8];
+  TrilinearCornerWeights(w, wc);
   for (size_t j = 0; j < S; ++j) {
     const float* c = c0 + j;
-    float sum = w0 * c[0];
-    sum += w1 * c[ox];
-    sum += w2 * c[oy];
-    sum += w3 * c[ox + oy];
-    sum += w4 * c[oz];
-    sum += w5 * c[ox + oz];
-    sum += w6 * c[oy + oz];
-    sum += w7 * c[ox + oy + oz];
+    float sum = wc[0] * c[0];
+    sum += wc[1] * c[ox];
+    sum += wc[2] * c[oy];
+    sum += wc[3] * c[ox + oy];
+    sum += wc[4] * c[oz];
+    sum += wc[5] * c[ox + oz];
+    sum += wc[6] * c[oy + oz];
+    sum += wc[7] * c[ox + oy + oz];
     out[j] = sum;
   }
   return true;
