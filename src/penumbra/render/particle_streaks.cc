@@ -42,7 +42,7 @@ std::vector<RainCullMedium> RainCullMedia(const Eigen::Vector3f& cam_o, const Me
 }
 
 // true when a rain streak of coverage alpha whose nearest point to the camera is p_W cannot
-// change a displayed pixel by kRainCullContrast (particle_scene.h): alpha times an upper bound
+// change a displayed pixel by kRainCullContrast (particle_streaks.h): alpha times an upper bound
 // of the transmittance of the homogeneous media between the camera and p_W. the bound uses a
 // lower bound of the optical depth: per medium that holds the whole segment (unbounded, or both
 // ends in its box, which is convex), its smallest channel of sigma_t times the length times the
