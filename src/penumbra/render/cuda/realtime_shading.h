@@ -289,6 +289,26 @@ PB_HOST_DEVICE inline PlanarFootprint PlanarFootprintAt(const MaterialPod& m, co
   return fp;
 }
 
+/// mip level l of texture `tex` in the frame's texels.
+PB_HOST_DEVICE inline TextureLevelView LevelView(const RealtimeFrameView& f, const TexturePod& tex,
+                                                 int l) {
+  return TextureLevelView{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
+}
+
+/// the trilinear filter of `tex` at `lod`: tap(level) (a level's bilinear value) of the one or
+/// two levels TrilinearLevels picks, weighted and summed in level order (MaterialEvaluator's
+/// trilinear lookups, planar and cube).
+template <class Tap>
+PB_HOST_DEVICE inline Float3 TrilinearMix(const RealtimeFrameView& f, const TexturePod& tex,
+                                          float lod, const Tap& tap) {
+  int level[2];
+  float weight[2];
+  const int count = TrilinearLevels(tex.num_levels, lod, level, weight);
+  Float3 c{0, 0, 0};
+  for (int i = 0; i < count; ++i) c = c + weight[i] * tap(LevelView(f, tex, level[i]));
+  return c;
+}
+
 /// the linear rgb of texture `slot` over footprint fp (material_eval.h's filtering: anisotropic
 /// taps in one level, else trilinear over the isotropic level of detail).
 PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
@@ -318,21 +338,12 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
   if (!planned)
     lod = TextureLod(fp.width_m, fp.cos_incidence,
                      tc ? TexcoordRho(tc->uv_per_m, w, th) : fp.map.rho(w, th));
-  if (n > 1) {
-    const int l = TapLevel(tex.num_levels, lod);
-    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
-    return BilinearWrapTaps(L, f.srgb_decode, fp.map.s, fp.map.t, ds, dt, n);
-  }
-  int level[2];
-  float weight[2];
-  const int count = TrilinearLevels(tex.num_levels, lod, level, weight);
-  Float3 c{0, 0, 0};
-  for (int i = 0; i < count; ++i) {
-    const int l = level[i];
-    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
-    c = c + weight[i] * BilinearWrap(L, f.srgb_decode, fp.map.s, fp.map.t);
-  }
-  return c;
+  if (n > 1)
+    return BilinearWrapTaps(LevelView(f, tex, TapLevel(tex.num_levels, lod)), f.srgb_decode,
+                            fp.map.s, fp.map.t, ds, dt, n);
+  return TrilinearMix(f, tex, lod, [&](const TextureLevelView& L) {
+    return BilinearWrap(L, f.srgb_decode, fp.map.s, fp.map.t);
+  });
 }
 
 /// the linear rgb of cube texture `slot` in direction q (any length > 0), trilinear at `lod`,
@@ -342,17 +353,9 @@ PB_HOST_DEVICE inline Float3 SampleCubeTexture(const RealtimeFrameView& f, int s
   int face;
   float s, t;
   if (!CubeFaceCoords(q, &face, &s, &t)) return Float3{1, 1, 1};
-  const TexturePod& tex = f.textures[slot];
-  int level[2];
-  float weight[2];
-  const int count = TrilinearLevels(tex.num_levels, lod, level, weight);
-  Float3 c{0, 0, 0};
-  for (int i = 0; i < count; ++i) {
-    const int l = level[i];
-    const TextureLevelView L{f.texels + tex.level_offset[l], tex.width[l], tex.height[l]};
-    c = c + weight[i] * BilinearFace(L, f.srgb_decode, face, s, t);
-  }
-  return c;
+  return TrilinearMix(f, f.textures[slot], lod, [&](const TextureLevelView& L) {
+    return BilinearFace(L, f.srgb_decode, face, s, t);
+  });
 }
 
 /// the linear rgb of cube texture `slot` on geom g at geom-frame point p_G of outward
