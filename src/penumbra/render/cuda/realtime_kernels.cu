@@ -148,8 +148,9 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 }
 
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
-// ShadeRealtimeStored): no second surface evaluation.
-template <class Frames, int kMinBlocks>
+// ShadeRealtimeStored): no second surface evaluation. kMedia false: frames without media only
+// (the default variant of frames without media and batches; ShadeRealtimePoint).
+template <class Frames, int kMinBlocks, bool kMedia = true>
 __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
                       int row1) {
@@ -159,7 +160,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   if (u >= f.camera.width || v >= row1) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t k = CameraOffset(f) + i;
-  radiance[k] = ShadeRealtimeStored(f, u, v, f.geometry[i], surfaces[k]);
+  radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
@@ -628,8 +629,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 6)
       ShadeStoredKernel<OneFrame, 6>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 4 && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 4, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4)
-      ShadeStoredKernel<OneFrame, 4>
+      ShadeStoredKernel<OneFrame, 4, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface)
       ShadeStoredKernel<OneFrame, 1>
@@ -1276,7 +1280,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
     Check(cudaGetLastError(), "MirrorSkyKernel (batch)");
   }
   stage(2);
-  ShadeStoredKernel<BatchFrames, 4>
+  // batches hold no media (BatchRenderer::UpdateWorld refuses them)
+  ShadeStoredKernel<BatchFrames, 4, false>
       <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
   Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
   stage(3);

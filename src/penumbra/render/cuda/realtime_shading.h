@@ -690,18 +690,14 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
 
 /// light j's contribution c at surface point p (shadow ray direction wi, distance dist:
 /// LightContribution's) attenuated by the frame's homogeneous media on the way to the light, as
-/// RealtimeIntegrator's surface loop: c as it is where it is 0; where p lies in the media's
-/// world light volume (`located`, with every light's channel-mean transmittance in vol_T:
-/// CellLightsLookup) and the volume holds light j, c vol_T[j]; else c times the closed-form
-/// transmittance (MediaLightTransmittance).
+/// RealtimeIntegrator's surface loop: c as it is where it is 0, else c times
+/// MediaLightTransmittance (the world light volume's channel-mean value where p lies in it and
+/// it holds light j, else the closed form). the CPU looks every light up at once per point
+/// (LightTransmittances): the same values; here one light at a time, so that nothing stays live
+/// across the light loop.
 PB_HOST_DEVICE inline Float3 MediaAttenuated(const RealtimeFrameView& f, int j, const Float3& p,
-                                             const Float3& wi, float dist, bool located,
-                                             const float* vol_T, const Float3& c) {
+                                             const Float3& wi, float dist, const Float3& c) {
   if (c.x == 0 && c.y == 0 && c.z == 0) return c;
-  if (located && j < f.media.num_volume_lights) {
-    const float T = vol_T[j];
-    return Float3{c.x * T, c.y * T, c.z * T};
-  }
   const float pp[3] = {p.x, p.y, p.z}, ww[3] = {wi.x, wi.y, wi.z};
   const Float3 T = MediaLightTransmittance(f.media, j, pp, ww, dist);
   return Float3{c.x * T.x, c.y * T.y, c.z * T.z};
@@ -713,7 +709,10 @@ constexpr int kShadeCachedLights = 16;
 
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
-/// their shadow rays.
+/// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
+/// false: for frames known to have none (f.has_media must be 0): the media's code is left out,
+/// so the kernels of frames without media keep their registers.
+template <bool kMedia = true>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky) {
   const SceneView& s = f.scene;
@@ -743,14 +742,6 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
            emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
   // shadow rays start off the surface on the lit side.
   const F3 origin = OffsetOrigin(p, ng);
-  // with media: where the point lies in their world light volume (every light's transmittance
-  // looked up once, as RealtimeIntegrator's LightTransmittances).
-  float vol_T[kMaxVolumeLights];
-  bool located = false;
-  if (f.has_media != 0 && f.media.light_trans != nullptr) {
-    const float pp[3] = {p.x, p.y, p.z};
-    located = CellLightsLookup(f.media.light_volume, f.media.light_trans, pp, vol_T);
-  }
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
   float total = pbm::Luminance709(L.x, L.y, L.z);
   Float3 cached_c[kShadeCachedLights], cached_wi[kShadeCachedLights];
@@ -759,7 +750,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
     Float3 wi;
     float dist;
     Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-    if (f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, located, vol_T, c);
+    if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
     if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
@@ -773,7 +764,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
       c = cached_c[j], wi = cached_wi[j], dist = cached_dist[j];
     } else {
       c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-      if (f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, located, vol_T, c);
+      if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
     }
     const float lum = pbm::Luminance709(c.x, c.y, c.z);
     if (!(lum > 0)) continue;
@@ -819,7 +810,8 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
 /// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point: its
 /// primary geometry g and material terms t (PrimaryGeometry's surface_out; the view direction
 /// from PrimaryRay as EvaluateSurface): the same shading point, so the same radiance, without
-/// evaluating the surface (textures, normal map) a second time.
+/// evaluating the surface (textures, normal map) a second time. kMedia: ShadeRealtimePoint's.
+template <bool kMedia = true>
 PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
                                                  const PixelGeometry& g, const SurfaceTerms& t) {
   const Float3 sky = BeginRealtimePixel(f, u, v);
@@ -838,7 +830,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int
   sp.specular = t.specular;
   sp.occlusion = t.occlusion;
   sp.mirror = g.mirror;
-  return ShadeRealtimePoint(f, u, v, sp, sky);
+  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky);
 }
 
 /// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
