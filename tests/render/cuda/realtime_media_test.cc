@@ -5,11 +5,13 @@
 // >= 40 dB, depth within 1 mm on >= 99.9 % of pixels and the same bits twice; the same path
 // without the media (their light transmittances and view pass) is far from the CPU's image.
 // the media's volumes are built by RealtimeFrameData::PrepareMedia (the CPU's RealtimeMedia over
-// the host BVH's RayQuery). no GPU needed.
+// the host BVH's RayQuery). PENUMBRA_PARITY_SIZE=WxH changes the bundled worlds' 160x120 (e.g.
+// 640x480, or an odd size whose last quads are cut by the image's edge). no GPU needed.
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -40,6 +42,16 @@ RenderedFrame HostPathFrame(const SceneDescription& scene, const WorldSnapshot& 
   return out;
 }
 
+// the image size of the bundled worlds' comparison: PENUMBRA_PARITY_SIZE=WxH, else 160x120.
+void ParitySize(int* w, int* h) {
+  *w = 160, *h = 120;
+  const char* e = std::getenv("PENUMBRA_PARITY_SIZE");
+  int ew = 0, eh = 0;
+  if (e != nullptr && std::sscanf(e, "%dx%d", &ew, &eh) == 2 && ew > 0 && eh > 0 && ew <= 4096 &&
+      eh <= 4096)
+    *w = ew, *h = eh;
+}
+
 class RealtimeHostPathMedia : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(RealtimeHostPathMedia, MatchesCpuBackend) {
@@ -47,7 +59,9 @@ TEST_P(RealtimeHostPathMedia, MatchesCpuBackend) {
   const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+  int w, h;
+  ParitySize(&w, &h);
+  const CameraView view = realtime_parity::RgbDepthView(scene, snap, w, h);
   const std::shared_ptr<const EffectsFrame> fx =
       session->effects().Evaluate(snap, view.X_WO.translation());
   ASSERT_TRUE(fx && !fx->homogeneous_media.empty()) << file;
@@ -70,9 +84,9 @@ TEST_P(RealtimeHostPathMedia, MatchesCpuBackend) {
   const double bare_psnr = realtime_parity::Psnr(want.rgb, without.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
   std::printf(
-      "%s at 1 s 160x120: rgb PSNR %.2f dB (without the media %.2f dB), ev100 cpu %.4f "
+      "%s at 1 s %dx%d: rgb PSNR %.2f dB (without the media %.2f dB), ev100 cpu %.4f "
       "host-gpu-path %.4f, depth > 1 mm on %.4f %% of pixels\n",
-      file, psnr, bare_psnr, want.ev100, got.ev100, 100 * depth_bad);
+      file, w, h, psnr, bare_psnr, want.ev100, got.ev100, 100 * depth_bad);
   EXPECT_TRUE(has_media) << file;
   EXPECT_FALSE(bare_media) << file;
   EXPECT_GE(psnr, 40.0) << file;
