@@ -57,14 +57,17 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "reuse_surface off, min_blocks 1",
                          "geometry_min_blocks 1",
                          "output_bands 1",
-                         "output_bands 5"};
-  for (int k = 0; k < 12; ++k) {
+                         "output_bands 5",
+                         "queue_penumbra off",
+                         "queue_penumbra off, warp_penumbra off"};
+  for (int k = 0; k < 14; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
     if (k == 2) o.pinned = false;
     if (k == 3) {
       o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
+      o.queue_penumbra = false;
       o.min_blocks = o.geometry_min_blocks = 0;
       o.output_bands = 1;
     }
@@ -75,6 +78,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 9) o.geometry_min_blocks = 1;
     if (k == 10) o.output_bands = 1;
     if (k == 11) o.output_bands = 5;
+    if (k == 12 || k == 13) o.queue_penumbra = false;
+    if (k == 13) o.warp_penumbra = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -253,6 +253,8 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.geometry_min_blocks = 1;
     variants.push_back({"kernels, geometry registers uncapped", o});
     o = fast;
+    o.queue_penumbra = false;
+    variants.push_back({"kernels, penumbra rays per warp (no queue)", o});
     o.warp_penumbra = false;
     variants.push_back({"kernels, penumbra rays per pixel", o});
     o = fast;
@@ -264,6 +266,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_hit = false;
     o.reuse_surface = false;
     o.warp_penumbra = false;
+    o.queue_penumbra = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

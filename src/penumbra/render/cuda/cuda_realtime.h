@@ -127,6 +127,12 @@ struct RealtimeKernelOptions {
   /// (VisibilityRaysWarpKernel, the same integer counts); else each pixel traces its own in
   /// turn (SharedVisibilityRays).
   bool warp_penumbra = true;
+  /// the shared visibility's long penumbra jobs (more than 8 rays: a tile's ring traces up to
+  /// 63) through one queue for the whole frame (or batch): their rays go into chunks of 4 that
+  /// every thread of the device takes from, the pixels' integer counts summed with integer
+  /// atomics (the same counts, so the same bits), so no warp waits on its ring pixels; the
+  /// short ones spread over their warp's lanes (as warp_penumbra, which this implies).
+  bool queue_penumbra = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

@@ -1,6 +1,8 @@
 // the realtime tier's kernels (cuda_realtime.h): each runs the PB_HOST_DEVICE per-pixel
 // functions of realtime_shading.h, which RenderRealtimeOnHost runs on the CPU.
 
+#include <cooperative_groups.h>
+#include <cooperative_groups/scan.h>
 #include <cuda_runtime.h>
 
 #include <algorithm>
@@ -18,6 +20,8 @@
 namespace penumbra::cuda {
 namespace {
 
+namespace cg = cooperative_groups;
+
 constexpr unsigned kFullWarp = 0xffffffffu;
 
 // where a kernel finds its frame: one frame passed by value (Render), or camera blockIdx.z's of
@@ -27,10 +31,12 @@ constexpr unsigned kFullWarp = 0xffffffffu;
 struct OneFrame {
   RealtimeFrameView f;
   __device__ const RealtimeFrameView& get() const { return f; }
+  __device__ const RealtimeFrameView& at(int) const { return f; }
 };
 struct BatchFrames {
   const RealtimeFrameView* __restrict__ f;
   __device__ const RealtimeFrameView& get() const { return f[blockIdx.z]; }
+  __device__ const RealtimeFrameView& at(int camera) const { return f[camera]; }
 };
 __device__ inline int64_t CameraOffset(const RealtimeFrameView& f) {
   return static_cast<int64_t>(blockIdx.z) * f.camera.width * f.camera.height;
@@ -172,14 +178,146 @@ __global__ void VisibilityRaysKernel(RealtimeFrameView f) {
   SharedVisibilityRays(f, u, v);
 }
 
+// the shared visibility's penumbra rays with a queue (RealtimeKernelOptions::queue_penumbra):
+// VisibilityRaysWarpKernel spreads a warp's short jobs over its lanes as before, but queues the
+// long ones (more than kPenumbraQueueRays rays: a tile's ring in a penumbra traces up to 63) in
+// chunks of kPenumbraChunkRays; VisibilityChunkKernel traces the chunks, all threads of the
+// device sharing them, and adds each chunk's integer counts to its pixel's (integer atomics:
+// the sums do not depend on the order); the chunk that completes a pixel's job writes its
+// totals. the same integer counts as SharedVisibilityRays, so the same bits, without a warp
+// waiting on its ring pixels while the rest of the device is idle.
+constexpr int kPenumbraChunkRays = 4;
+constexpr int kPenumbraQueueRays = 8;
+
+// rays [r0, r0 + rays) of light `light` at pixel `pixel` of camera `camera`, one of the job's
+// `chunks` (rays 0: an unused entry).
+struct PenumbraChunk {
+  int32_t camera;
+  int32_t pixel;
+  int16_t points;  // PenumbraRays::points
+  uint8_t light;
+  uint8_t own;  // PenumbraRays::own
+  uint8_t r0;
+  uint8_t rays;
+  uint8_t chunks;
+  uint8_t pad;
+};
+static_assert(sizeof(PenumbraChunk) == 16, "PenumbraChunk: 16 bytes");
+
+// a queued job's count: chunks done (bits 24-31), rays traced (12-23), rays visible (0-11).
+__device__ inline uint32_t PackChunkCounts(int traced, int visible) {
+  return (1u << 24) | (static_cast<uint32_t>(traced) << 12) | static_cast<uint32_t>(visible);
+}
+
+// the queue's room: chunks for a quarter of every light's pixels, at least 1 Mi entries, at
+// most 16 Mi (256 MiB); a job that does not fit is spread over its warp's lanes.
+inline int64_t PenumbraQueueCapacity(int64_t nl) {
+  return std::min<int64_t>(std::max<int64_t>(nl / 4, int64_t{1} << 20), int64_t{1} << 24);
+}
+
+// where VisibilityRaysWarpKernel queues its long jobs (queue null: it queues none).
+struct PenumbraQueue {
+  PenumbraChunk* queue = nullptr;
+  unsigned long long* queued = nullptr;  // chunks queued (may pass capacity: those are not)
+  int64_t capacity = 0;
+  uint32_t* counts = nullptr;  // (camera, light, pixel) at camera nl + light n + pixel
+  int64_t nl = 0;              // a camera's per-light entries
+};
+
+// queues light j's rays 1 .. extra - 1 of `job` at pixel i of camera `camera` (n pixels) if
+// they fit: the lanes that call it at once take their room with one atomic add.
+__device__ inline bool QueuePenumbraJob(const PenumbraQueue& q, const PenumbraRays& job, int j,
+                                        int64_t i, int64_t n, int camera) {
+  const int rays = job.extra - 1;
+  const int chunks = (rays + kPenumbraChunkRays - 1) / kPenumbraChunkRays;
+  const cg::coalesced_group g = cg::coalesced_threads();
+  const int before = cg::exclusive_scan(g, chunks);
+  const int all = g.shfl(before + chunks, g.size() - 1);
+  unsigned long long base = 0;
+  if (g.thread_rank() == 0) base = atomicAdd(q.queued, static_cast<unsigned long long>(all));
+  const unsigned long long at = g.shfl(base, 0) + before;
+  const auto capacity = static_cast<unsigned long long>(q.capacity);
+  const bool fits = at + chunks <= capacity;
+  if (fits) q.counts[static_cast<int64_t>(camera) * q.nl + j * n + i] = 0;
+  for (int c = 0; c < chunks && at + c < capacity; ++c) {
+    PenumbraChunk e;
+    e.camera = camera;
+    e.pixel = static_cast<int32_t>(i);
+    e.points = static_cast<int16_t>(job.points);
+    e.light = static_cast<uint8_t>(j);
+    e.own = static_cast<uint8_t>(job.own);
+    e.r0 = static_cast<uint8_t>(1 + c * kPenumbraChunkRays);
+    e.rays = fits ? static_cast<uint8_t>(min(kPenumbraChunkRays, rays - c * kPenumbraChunkRays))
+                  : uint8_t{0};
+    e.chunks = static_cast<uint8_t>(chunks);
+    e.pad = 0;
+    q.queue[at + c] = e;
+  }
+  return fits;
+}
+
+template <class Frames>
+__global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
+  const int64_t total = min(static_cast<int64_t>(*q.queued), q.capacity);
+  const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
+  for (int64_t at = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; at < total;
+       at += stride) {
+    const PenumbraChunk e = q.queue[at];
+    if (e.rays == 0) continue;
+    const RealtimeFrameView& f = frames.at(e.camera);
+    const int W = f.camera.width;
+    const int64_t n = static_cast<int64_t>(W) * f.camera.height;
+    const int u = e.pixel % W, v = e.pixel / W;
+    const PixelGeometry& g = f.geometry[e.pixel];
+    PenumbraRays job;
+    job.p = g.p_or_d;
+    job.ng = g.ng;
+    job.first = kLightPenumbraRays * LightStratum(u, v);
+    job.points = e.points;
+    job.own = e.own;
+    int traced = 0, visible = 0;
+    for (int r = e.r0; r < e.r0 + e.rays; ++r) {
+      const int verdict = PenumbraRayVerdict(f, e.light, job, r);
+      if (verdict < 0) continue;
+      ++traced;
+      if (verdict > 0) ++visible;
+    }
+    const int64_t k = e.light * n + e.pixel;
+    const uint32_t add = PackChunkCounts(traced, visible);
+    const uint32_t sum = atomicAdd(q.counts + static_cast<int64_t>(e.camera) * q.nl + k, add) + add;
+    // the job's last chunk: its totals after the pixel's own verdict (area_visible holds it)
+    if ((sum >> 24) == e.chunks) {
+      f.area_visible[k] = f.area_visible[k] + static_cast<float>(sum & 0xfffu);
+      f.area_rays[k] = 1.0f + static_cast<float>((sum >> 12) & 0xfffu);
+    }
+  }
+}
+
+// VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
+template <class Frames>
+unsigned ChunkBlocks() {
+  static const unsigned blocks = [] {
+    int device = 0, sms = 0, per_sm = 0;
+    Check(cudaGetDevice(&device), "cudaGetDevice");
+    Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
+          "cudaDeviceGetAttribute");
+    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, VisibilityChunkKernel<Frames>, 128,
+                                                        0),
+          "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
+    return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
+  }();
+  return blocks;
+}
+
 // VisibilityRaysKernel with a warp's penumbra rays spread over its 32 lanes: per light, the
 // lanes' rays (pixel l's rays 1 .. extra_l - 1) are numbered in lane order (an inclusive scan),
 // lane t of round b traces ray b 32 + t of the pixel whose range holds it, and each pixel sums
 // its rays' verdicts (ballots): the same integer counts as one thread per pixel, so the same
 // bits, without the warp waiting on the one ring pixel that traces 63 rays. whole warps run
 // every step (pixels outside the image take part with no rays).
+// at most 128 registers (4 blocks an SM: the queue's code would otherwise take it to 131, 3).
 template <class Frames>
-__global__ void VisibilityRaysWarpKernel(Frames frames) {
+__global__ void __launch_bounds__(128, 4) VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
   const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = blockIdx.y * blockDim.y + threadIdx.y;
@@ -192,7 +330,12 @@ __global__ void VisibilityRaysWarpKernel(Frames frames) {
   for (int j = 0; j < f.num_lights; ++j) {
     PenumbraRays job;
     if (inside) job = SharedVisibilityPenumbra(f, u, v, j, bits);
-    const int count = job.active != 0 && job.extra > 1 ? job.extra - 1 : 0;
+    int count = job.active != 0 && job.extra > 1 ? job.extra - 1 : 0;
+    // a long job to the queue (VisibilityChunkKernel writes its totals), if it fits
+    bool queued = false;
+    if (q.queue != nullptr && count > kPenumbraQueueRays)
+      queued = QueuePenumbraJob(q, job, j, i, n, static_cast<int>(blockIdx.z));
+    if (queued) count = 0;
     int end = count;  // inclusive scan: this lane's rays are [end - count, end)
     for (int d = 1; d < 32; d *= 2) {
       const int x = __shfl_up_sync(kFullWarp, end, d);
@@ -416,6 +559,8 @@ struct PixelBuffers {
   Buffer geometry, sky, radiance, surfaces;
   // the shared visibility's buffers (RealtimeFrameView)
   Buffer window, total, area_c, area_vis, area_visible, area_rays, area_own, area_fraction;
+  // the penumbra rays' queue (queue_penumbra): the chunks, their count, each pixel's counts
+  Buffer penumbra_queue, penumbra_queued, penumbra_counts;
   // the mirror layer's buffers (RealtimeFrameView)
   Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
   // room for n pixels (all cameras) and nl = n x lights (lights >= 1); the material terms if
@@ -433,12 +578,37 @@ struct PixelBuffers {
     area_rays.Reserve(sizeof(float) * nl);
     area_own.Reserve(sizeof(uint8_t) * nl);
     area_fraction.Reserve(sizeof(float) * nl);
+    penumbra_queue.Reserve(sizeof(PenumbraChunk) * PenumbraQueueCapacity(nl));
+    penumbra_queued.Reserve(sizeof(unsigned long long));
+    penumbra_counts.Reserve(sizeof(uint32_t) * nl);
     if (mirror) {
       mirror_geometry.Reserve(sizeof(PixelGeometry) * n);
       mirror_hits.Reserve(sizeof(TraceHit) * n);
       mirror_sky.Reserve(sizeof(Float3) * n);
       mirror_radiance.Reserve(sizeof(Float3) * n);
     }
+  }
+  // the penumbra rays of `cameras` frames (grid: their pixels, z the camera) of nl per-light
+  // entries each on `stream`: spread over each warp's lanes (VisibilityRaysWarpKernel), the
+  // long jobs through the queue (VisibilityChunkKernel) if `queue`.
+  template <class Frames>
+  void LaunchPenumbraRays(Frames frames, dim3 grid, int64_t nl, int cameras, bool queue,
+                          cudaStream_t stream) const {
+    PenumbraQueue q;
+    if (queue) {
+      q.queue = penumbra_queue.as<PenumbraChunk>();
+      q.queued = penumbra_queued.as<unsigned long long>();
+      q.capacity = PenumbraQueueCapacity(nl * cameras);
+      q.counts = penumbra_counts.as<uint32_t>();
+      q.nl = nl;
+      Check(cudaMemsetAsync(q.queued, 0, sizeof(unsigned long long), stream), "cudaMemsetAsync");
+    }
+    VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(frames, q);
+    Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
+    if (!queue) return;
+    // one wave of resident blocks strides over the chunks (their number stays on the device)
+    VisibilityChunkKernel<<<ChunkBlocks<Frames>(), 128, 0, stream>>>(frames, q);
+    Check(cudaGetLastError(), "VisibilityChunkKernel");
   }
   // f's per-pixel arrays: the part at pixel `at` and, per light, at `at_l`
   void Point(RealtimeFrameView* f, int64_t at, int64_t at_l, bool mirror) const {
@@ -657,11 +827,13 @@ struct DeviceRealtime::Impl : PixelBuffers {
                         cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
     const dim3 grid = PixelGrid(W, H);
-    if (o.warp_penumbra)
-      VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
-    else
+    if (o.warp_penumbra || o.queue_penumbra) {
+      LaunchPenumbraRays(OneFrame{f}, grid, static_cast<int64_t>(W) * H * f.num_lights, 1,
+                         o.queue_penumbra, stream);
+    } else {
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
-    Check(cudaGetLastError(), "VisibilityRaysKernel");
+      Check(cudaGetLastError(), "VisibilityRaysKernel");
+    }
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
     Check(cudaGetLastError(), "VisibilityFractionKernel");
     VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
@@ -1285,8 +1457,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
       <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
   Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
   stage(3);
-  VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
-  Check(cudaGetLastError(), "VisibilityRaysWarpKernel (batch)");
+  m.LaunchPenumbraRays(fr, grid, nl, count, /*queue=*/true, stream);
   VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
   Check(cudaGetLastError(), "VisibilityFractionKernel (batch)");
   VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(fr, L);
