@@ -3,9 +3,10 @@
 # parity table of the CUDA backend against the CPU backend (issue 35, item 7; docs/gpu.md
 # "Parity") for the default, house, warehouse and outdoor worlds and every worlds/effects/*.yaml:
 # the first camera at 320x240 after 1 s, depth within 1 mm %, segmentation equal %, same-depth
-# ties, whether the frame with the world's effects is on the GPU (lighting effects only:
-# blackout, flashlight, sun; media and particles are not yet), and the rgb PSNR of that frame
-# where it renders on the GPU, else "cpu fallback".
+# ties, whether the frame with the world's effects is on the GPU (lighting effects, particles
+# without media, homogeneous media: blackout, flashlight, sun, rain, snow, fog, height_fog, dust;
+# grid media and particles seen through media are not yet), and the rgb PSNR of that frame where
+# it renders on the GPU, else "cpu fallback".
 #
 #   scripts/gpu/parity.sh BENCH_BINARY WORLDS_DIR [WxH]
 set -uo pipefail

@@ -1,11 +1,14 @@
-// the lighting effects and particles on the GPU (ctest label `gpu`; issue 35 item 5): the frames
-// of effects/blackout.yaml (in its power cut at 4 s), effects/flashlight.yaml, effects/sun.yaml,
-// effects/rain.yaml and effects/snow.yaml render on the GPU (no frame goes to the CPU renderer) at
+// the lighting effects, particles and homogeneous media on the GPU (ctest label `gpu`; issue 35
+// item 5): the frames of effects/blackout.yaml (in its power cut at 4 s), effects/flashlight.yaml,
+// effects/sun.yaml, effects/rain.yaml, effects/snow.yaml and the media of effects/fog.yaml,
+// effects/height_fog.yaml and effects/dust.yaml render on the GPU (no frame goes to the CPU
+// renderer) at
 // 640x480 with rgb PSNR >= 40 dB and depth within 1 mm on >= 99.9 % of pixels against the CPU
 // backend under the same EffectsFrame, two GPU renders bit-identical; one renderer alternating the
 // sun world's clear frame and its effects frame (the sky rebuilt, the sky volume relit, the device
-// sky uploaded again) gives each frame's bits every time; a fog frame goes to the CPU renderer and
-// equals the CPU backend's. without a device every test prints "skipped: no CUDA device".
+// sky uploaded again) gives each frame's bits every time; a frame with grid media (smoke) goes to
+// the CPU renderer and equals the CPU backend's. without a device every test prints "skipped: no
+// CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -72,7 +75,10 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeEffectsGpu,
                                            GpuEffectsWorld{"effects/flashlight.yaml", 1.0},
                                            GpuEffectsWorld{"effects/sun.yaml", 1.0},
                                            GpuEffectsWorld{"effects/rain.yaml", 1.0},
-                                           GpuEffectsWorld{"effects/snow.yaml", 1.0}));
+                                           GpuEffectsWorld{"effects/snow.yaml", 1.0},
+                                           GpuEffectsWorld{"effects/fog.yaml", 1.0},
+                                           GpuEffectsWorld{"effects/height_fog.yaml", 1.0},
+                                           GpuEffectsWorld{"effects/dust.yaml", 1.0}));
 
 TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
@@ -101,10 +107,10 @@ TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
   EXPECT_EQ(first.rgb.data, effects.rgb.data);
 }
 
-TEST(RealtimeEffectsGpuFrames, MediaFramesGoToTheCpuRenderer) {
+TEST(RealtimeEffectsGpuFrames, GridMediaFramesGoToTheCpuRenderer) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulatedAt("effects/fog.yaml", 1.0);
+      realtime_parity::LoadSimulatedAt("effects/smoke_plume.yaml", 1.0);
   const SceneDescription& scene = session->scene();
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);

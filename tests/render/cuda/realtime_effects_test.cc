@@ -6,8 +6,8 @@
 // effects/sun.yaml) and a hand-made frame with every lighting field set on the default room, at
 // 160x120: rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, two renders
 // bit-identical, and the effects change the image; the particle streaks of the rain and snow
-// worlds. the effects the GPU does not draw yet (media; particles seen through media) are named
-// by EffectsNotOnGpu. no GPU needed.
+// worlds (the media: realtime_media_test.cc). the effects the GPU does not draw yet (grid media;
+// particles seen through media) are named by EffectsNotOnGpu. no GPU needed.
 
 #include <gtest/gtest.h>
 
@@ -186,13 +186,17 @@ TEST(RealtimeHostPathEffectsFrames, MediaAndParticlesAreNamed) {
   fx.extra_lights.emplace_back();
   EXPECT_EQ(cuda::EffectsNotOnGpu(nullptr), "");
   EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
+  // homogeneous media alone are drawn on the GPU
   fx.homogeneous_media.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "homogeneous media (fog, haze, dust)");
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
+  EffectsFrame fog_rain = fx;
+  fog_rain.particles.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fog_rain), "particles (rain, snow, sparks) with media");
   fx.grid_media.emplace_back();
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "grid media (smoke, fire, VDB)");
   fx.particles.emplace_back();
   EXPECT_EQ(cuda::EffectsNotOnGpu(&fx),
-            "homogeneous media (fog, haze, dust), grid media (smoke, fire, VDB), particles (rain, "
-            "snow, sparks) with media");
+            "grid media (smoke, fire, VDB), particles (rain, snow, sparks) with media");
   // particles without media are drawn on the GPU
   EffectsFrame rain;
   rain.particles.emplace_back();
@@ -203,7 +207,8 @@ TEST(RealtimeHostPathEffectsFrames, MediaAndParticlesAreNamed) {
 }
 
 // which bundled effects worlds' frames at 1 s render on the GPU (docs/gpu.md lists them): the
-// lighting-only ones and those with particles alone do, those with media name them.
+// lighting-only ones, those with particles alone and those with homogeneous media alone do,
+// those with grid media or particles seen through media name them.
 TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
   const struct {
     const char* file;
@@ -211,9 +216,9 @@ TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
   } worlds[] = {{"effects/blackout.yaml", ""},
                 {"effects/flashlight.yaml", ""},
                 {"effects/sun.yaml", ""},
-                {"effects/fog.yaml", "homogeneous media"},
-                {"effects/height_fog.yaml", "homogeneous media"},
-                {"effects/dust.yaml", "homogeneous media"},
+                {"effects/fog.yaml", ""},
+                {"effects/height_fog.yaml", ""},
+                {"effects/dust.yaml", ""},
                 {"effects/smoke_plume.yaml", "grid media"},
                 {"effects/vdb_smoke.yaml", "grid media"},
                 {"effects/fire.yaml", "grid media"},

@@ -12,8 +12,9 @@
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
 //     them, cuda Render() (on the GPU for lighting effects; else the CPU renderer inside the
 //     CUDA backend, "cpu fallback") and cpu Render(); with homogeneous media, the time of their
-//     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays and
-//     with CudaRayQuery's;
+//     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
+//     CudaRayQuery's and with BvhRayQuery's (the host traversal), and the CUDA backend's host
+//     preparation of such a frame (CudaRenderer::last_prepare_ms, the build included);
 //   - with --realtime, the FNV-1a hashes of the default options' rgb and depth (to compare
 //     builds: a change of the traversal or the kernels that keeps the images keeps them);
 // and the BVH build time. prints one markdown table.
@@ -51,6 +52,7 @@
 #include "penumbra/core/output_file.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_batch_bench.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
@@ -484,9 +486,15 @@ int Main(int argc, char** argv) {
       const std::string fx_outputs = cuda::CudaRenderer::OnGpu(fx.get(), rgb)
                                          ? "rgb+depth realtime + effects (on GPU)"
                                          : "rgb+depth realtime + effects (cpu fallback)";
-      if (gpu && with_fx)
+      if (gpu && with_fx) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+        if (!fx->homogeneous_media.empty() && cuda::CudaRenderer::OnGpu(fx.get(), rgb))
+          builds.push_back(fmt::format(
+              "{} {}: effects frame with media on the GPU: host preparation {:.2f} ms a frame "
+              "(the last of the timed frames; RealtimeFrameData::Prepare, media volumes included)",
+              name, size, static_cast<cuda::CudaRenderer*>(gpu.get())->last_prepare_ms()));
+      }
       // the media volumes' build over Embree and over the GPU's RayQuery (docs/gpu.md,
       // "Homogeneous media: the shared part")
       if (dev.available && with_fx && !fx->homogeneous_media.empty() && w == 640) {
@@ -497,10 +505,14 @@ int Main(int argc, char** argv) {
         const int nb = std::max(3, frames / 5);
         const double ms_cpu = TimeMediaBuild(scene, snap, rgb, *fx, embree, nb);
         const double ms_gpu = TimeMediaBuild(scene, snap, rgb, *fx, query, nb);
+        cuda::BvhRayQuery host_query(scene);
+        host_query.Update(snap);
+        const double ms_host = TimeMediaBuild(scene, snap, rgb, *fx, host_query, nb);
         builds.push_back(fmt::format(
             "{}: media volumes (RealtimeMedia::Build, {}x{} camera, all cores): {:.2f} ms with "
-            "Embree's shadow rays, {:.2f} ms with CudaRayQuery's ({} builds each)",
-            name, w, h, ms_cpu, ms_gpu, nb));
+            "Embree's shadow rays, {:.2f} ms with CudaRayQuery's, {:.2f} ms with BvhRayQuery's "
+            "(host traversal) ({} builds each)",
+            name, w, h, ms_cpu, ms_gpu, ms_host, nb));
       }
       if (gpu) {
         auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());

@@ -70,11 +70,15 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
     throw Error(
         fmt::format("batch rendering: world {}; expected a world in [0, {})", world, num_worlds()));
   // the ground truth does not see effects; the rgb takes the lighting ones only (a batch's
-  // cameras would each need their own particle streaks: CudaRenderer draws them)
+  // cameras would each need their own particle streaks and media froxels: CudaRenderer draws
+  // them)
   std::string not_on_gpu = layout_.outputs().rgb ? EffectsNotOnGpu(effects) : "";
   if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
       !effects->particles.empty())
     not_on_gpu = "particles (rain, snow, sparks) in a batch";
+  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
+      !effects->homogeneous_media.empty())
+    not_on_gpu = "homogeneous media (fog, haze, dust) in a batch";
   if (!not_on_gpu.empty())
     throw Error(fmt::format("batch rendering: world {}: effects with {} are not on the GPU yet",
                             world, not_on_gpu));

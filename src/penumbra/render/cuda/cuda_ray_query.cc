@@ -21,13 +21,21 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
 }
 
 CudaRayQuery::CudaRayQuery(const SceneDescription& scene)
-    : bvh_(scene), device_(std::make_unique<DeviceScene>()) {
-  SyncDevice(bvh_, device_.get());
+    : own_bvh_(std::make_unique<BvhScene>(scene)),
+      own_device_(std::make_unique<DeviceScene>()),
+      bvh_(own_bvh_.get()),
+      device_(own_device_.get()) {
+  SyncDevice(*bvh_, device_);
 }
 
+CudaRayQuery::CudaRayQuery(const BvhScene& bvh, DeviceScene* device)
+    : bvh_(&bvh), device_(device) {}
+
 void CudaRayQuery::Update(const WorldSnapshot& snapshot) {
-  bvh_.Update(snapshot);
-  SyncDevice(bvh_, device_.get());
+  if (!own_bvh_)
+    throw Error("CudaRayQuery::Update: a query over another's BVH is posed by its owner");
+  own_bvh_->Update(snapshot);
+  SyncDevice(*own_bvh_, device_);
 }
 
 void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
@@ -43,7 +51,7 @@ void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHi
   device_->Trace(in.data(), static_cast<int64_t>(in.size()), out.data());
   for (size_t i = 0; i < rays.size(); ++i) {
     did_hit[i] = out[i].instance >= 0;
-    if (did_hit[i]) bvh_.FinishHit(rays[i], out[i], &hits[i]);
+    if (did_hit[i]) bvh_->FinishHit(rays[i], out[i], &hits[i]);
   }
 }
 

@@ -23,7 +23,12 @@ class CudaRayQuery final : public RayQuery {
   /// @throws Error as BvhScene, or if the CUDA runtime fails (no device: check ProbeDevice
   /// first). `scene` is referenced: it must outlive the query.
   explicit CudaRayQuery(const SceneDescription& scene);
-  const SceneDescription& scene() const override { return bvh_.scene(); }
+  /// a query over another's BVH and its device copy (CudaRenderer's: the media's shadow rays
+  /// of its frames), both referenced: they must outlive the query, and their owner poses them
+  /// (Update throws). its batches run on device's stream, after what was queued there.
+  CudaRayQuery(const BvhScene& bvh, DeviceScene* device);
+  const SceneDescription& scene() const override { return bvh_->scene(); }
+  /// @throws Error for a query over another's BVH (its owner poses it).
   void Update(const WorldSnapshot& snapshot) override;
 
  private:
@@ -32,8 +37,10 @@ class CudaRayQuery final : public RayQuery {
   /// RayQuery::Occluded: the batch's verdicts in one kernel launch (TraceOccluded in
   /// (tmin, tmax); untraceable rays are not occluded).
   void OccludedBatch(std::span<const Ray> rays, std::span<bool> occluded) const override;
-  BvhScene bvh_;
-  std::unique_ptr<DeviceScene> device_;
+  std::unique_ptr<BvhScene> own_bvh_;        // null for a query over another's BVH
+  std::unique_ptr<DeviceScene> own_device_;  // likewise
+  const BvhScene* bvh_;
+  DeviceScene* device_;
   // Intersect is thread-safe (RayQuery): one batch at a time on the device
   mutable std::mutex mutex_;
 };

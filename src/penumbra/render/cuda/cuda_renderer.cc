@@ -65,7 +65,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                : !fx_why.empty() ? "effects with " + fx_why
                                                  : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (media, pathtraced rgb); "
+          "renderer: cuda backend: {}: not on the GPU yet (grid media, pathtraced rgb); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;
@@ -128,8 +128,10 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
     device_realtime_->Upload(st);
     realtime_uploaded_ = true;
   }
-  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again
-  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_);
+  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again; the
+  // media volumes' shadow rays on the GPU, over the BVH Render posed
+  if (!media_query_) media_query_ = std::make_unique<CudaRayQuery>(*bvh_, device_.get());
+  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get());
   // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
   // the sky change: its device copy follows
   if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {

@@ -1,14 +1,15 @@
 #pragma once
 // the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (with
-// lens distortion or motion too: camera_rays.h) under clear conditions or lighting effects only
-// (light scales, extra lights, a moved or scaled sky, surface wetness: EffectsNotOnGpu): the images
+// lens distortion or motion too: camera_rays.h) under clear conditions, lighting effects (light
+// scales, extra lights, a moved or scaled sky, surface wetness), particles without media and
+// homogeneous media without grids or particles (EffectsNotOnGpu): the images
 // of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
-// realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the sky
-// terms on the host, realtime_frame.h). everything else (the pathtraced tier, media and particles)
-// is not on the GPU yet: such a frame is rendered whole by the CPU renderer handed in (`cpu`), so
-// every output exists and equals the CPU backend's for those frames; docs/gpu.md lists what is
-// where.
+// realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
+// frame's preparation on the host, realtime_frame.h). everything else (the pathtraced tier, grid
+// media, particles seen through media) is not on the GPU yet: such a frame is rendered whole by the
+// CPU renderer handed in (`cpu`), so every output exists and equals the CPU backend's for those
+// frames; docs/gpu.md lists what is where.
 
 #include <chrono>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
@@ -86,8 +88,10 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<RealtimeFrameData> realtime_;
   std::unique_ptr<DeviceRealtime> device_realtime_;
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
-  CameraRayTables camera_rays_;       // the frame's camera's ray tables (their device copies:
-                                      // DeviceScene::UploadCameraRays)
+  // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
+  std::unique_ptr<CudaRayQuery> media_query_;
+  CameraRayTables camera_rays_;  // the frame's camera's ray tables (their device copies:
+                                 // DeviceScene::UploadCameraRays)
   bool realtime_uploaded_ = false;
   // the sky volume generation whose arrays the device holds (RealtimeFrameData::sky_generation)
   bool sky_uploaded_ = false;

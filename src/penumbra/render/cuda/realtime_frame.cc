@@ -1,6 +1,7 @@
 #include "penumbra/render/cuda/realtime_frame.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -131,7 +132,7 @@ std::string EffectsNotOnGpu(const EffectsFrame* effects) {
   auto add = [&](bool set, const char* what) {
     if (set) why += (why.empty() ? "" : ", ") + std::string(what);
   };
-  add(!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust)");
+  // homogeneous media alone are (their volumes built on the host, PrepareMedia); grids are not
   add(!effects->grid_media.empty(), "grid media (smoke, fire, VDB)");
   // particles alone are (their streaks found and shaded on the host: PrepareStreaks); seen
   // through media they are not
@@ -151,7 +152,7 @@ std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
 
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
                                 ThreadPool* pool, const EffectsFrame* effects,
-                                const CameraRayTables* rays) {
+                                const CameraRayTables* rays, const RayQuery* media_rays) {
   PoseWorld(snapshot, pool, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   if (rays == nullptr) {
@@ -162,6 +163,34 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
             camera.pixel_spread_rad(), view.camera_index, view.frame_index,
             view.white_balance_gains);
   PrepareStreaks(snapshot, effects, camera, view, pool);
+  PrepareMedia(snapshot, effects, camera, view, pool, media_rays);
+}
+
+void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                                     const Camera& camera, const CameraView& view, ThreadPool* pool,
+                                     const RayQuery* media_rays) {
+  media_ready_ = false;
+  media_build_ms_ = 0;
+  const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
+  if (fx == nullptr || fx->homogeneous_media.empty()) return;
+  // as the CPU's MediaFrame::Prepare (no grids here: EffectsNotOnGpu): the media of the frame,
+  // lit by the frame's lights and sky through the occluded sky volume, for this camera
+  media_.Build(fx);
+  if (media_.empty()) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (media_rays == nullptr) {
+    if (!media_query_) media_query_ = std::make_unique<BvhRayQuery>(scene_);
+    media_query_->Update(snapshot);
+    media_rays = media_query_.get();
+  }
+  realtime_media_.Build(
+      media_, lights_, *media_rays, camera, FrameKey(view.camera_index, view.frame_index),
+      scene_.center_W.cast<float>(), scene_.extent_m, SkyAmbientRadiance(*frame_sky_),
+      volume_.empty() ? nullptr : &volume_, pool);
+  media_view_ = realtime_media_.HostView(&media_fog_, &media_sky_);
+  media_build_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  media_ready_ = true;
 }
 
 void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
@@ -221,6 +250,7 @@ void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* poo
   if (!EffectsNotOnGpu(fx).empty())
     throw Error("RealtimeFrameData: effects with " + EffectsNotOnGpu(fx) +
                 " are not on the GPU (Unsupported)");
+  media_ready_ = false;  // PrepareMedia builds the frame's media for its camera
   lights_.Update(snapshot, fx);
   frame_sky_ = &effects_sky_.Update(scene_.sky, sky_, fx);
   wetness_ = SurfaceWetnessOf(fx);
@@ -344,6 +374,10 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.any_mirror = any_mirror_ ? 1 : 0;
   f.streaks = streaks_.empty() ? nullptr : streaks_.data();
   f.num_streaks = static_cast<int64_t>(streaks_.size());
+  if (media_ready_) {
+    f.has_media = 1;
+    f.media = media_view_;
+  }
   return f;
 }
 
@@ -452,6 +486,13 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
         Float3& L = radiance[v * W + u];
         L = ApplyMirrorLayer(f, u, static_cast<int>(v), L);
       }
+    });
+  }
+  // the homogeneous media over the final radiance, per 2x2 quad, as MediaViewKernel
+  if (f.has_media != 0) {
+    ParallelForOrSerial(pool, (H + 1) / 2, [&](int64_t q) {
+      for (int u0 = 0; u0 < W; u0 += 2)
+        MediaViewQuad(f, u0, 2 * static_cast<int>(q), out->depth_m.data.data(), radiance.data());
     });
   }
   // the particle streaks over the final radiance, as StreakKernel

@@ -28,7 +28,10 @@
 #include "penumbra/render/effects_sky.h"
 #include "penumbra/render/film.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
+#include "penumbra/render/media_scene.h"
 #include "penumbra/render/particle_streaks.h"
+#include "penumbra/render/ray_query.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/render/shelter_map.h"
@@ -39,9 +42,10 @@ namespace penumbra::cuda {
 
 /// why a frame under `effects` cannot be rendered on the GPU ("" if it can: none, lighting
 /// effects (EffectsFrame::light_intensity_scale, extra_lights, sun_direction_W,
-/// sky_luminance_scale, surface_wetness) and particles without media). otherwise names what is
-/// not on the GPU yet: "homogeneous media (fog, haze, dust)", "grid media (smoke, fire, VDB)",
-/// "particles (rain, snow, sparks) with media", joined by ", " where several are set.
+/// sky_luminance_scale, surface_wetness), particles without media, and homogeneous media (fog,
+/// haze, dust) without grids or particles). otherwise names what is not on the GPU yet: "grid
+/// media (smoke, fire, VDB)", "particles (rain, snow, sparks) with media", joined by ", " where
+/// both are set.
 std::string EffectsNotOnGpu(const EffectsFrame* effects);
 
 /// the plain data of a scene's realtime frames (file comment). not thread-safe.
@@ -60,14 +64,30 @@ class RealtimeFrameData {
   /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none;
   /// they must be on the GPU, EffectsNotOnGpu), sets the camera and frame key of `view`, and
   /// updates the sky volume (built on the first call and when the static bodies move, relit
-  /// when the effects change the sky): PoseWorld, then SetCamera, then PrepareStreaks. a camera
-  /// with lens distortion or motion gets its ray tables (camera_rays.h), the camera() pointing to
-  /// their host arrays: `rays` if given (the caller Prepared them for `view` and keeps them alive),
-  /// else tables this object fills.
+  /// when the effects change the sky): PoseWorld, then SetCamera, then PrepareStreaks, then
+  /// PrepareMedia. a camera with lens distortion or motion gets its ray tables (camera_rays.h),
+  /// the camera() pointing to their host arrays: `rays` if given (the caller Prepared them for
+  /// `view` and keeps them alive), else tables this object fills. `media_rays`: PrepareMedia's
+  /// shadow rays (see there).
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
   /// outside [0, 1]), as the CPU backend.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
-               const EffectsFrame* effects = nullptr, const CameraRayTables* rays = nullptr);
+               const EffectsFrame* effects = nullptr, const CameraRayTables* rays = nullptr,
+               const RayQuery* media_rays = nullptr);
+  /// the homogeneous media of the frame (View's media, has_media): with homogeneous media in
+  /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
+  /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
+  /// `view`, with the frame's lights, sky and occluded sky volume: the world light volume's
+  /// shadow rays through `media_rays` (any RayQuery posed for `snapshot`: CudaRenderer passes
+  /// one over its device scene), or, if null, through a BvhRayQuery (the kernels' traversal on
+  /// the host) this object keeps and poses. call after PoseWorld (Prepare does).
+  void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                    const Camera& camera, const CameraView& view, ThreadPool* pool,
+                    const RayQuery* media_rays = nullptr);
+  /// whether the last Prepare built media (View's has_media), and host milliseconds its
+  /// RealtimeMedia::Build took (benchmarks).
+  bool has_media() const { return media_ready_; }
+  double media_build_ms() const { return media_build_ms_; }
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
   /// again only for bodies whose pose changed since the last call), the effects' sky and
   /// wetness and the sky volume. @throws as Prepare.
@@ -167,6 +187,17 @@ class RealtimeFrameData {
   ParticleStreaks particles_;  // the frame's streaks (PrepareStreaks)
   std::vector<StreakPixel> streaks_;
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
+  // the frame's homogeneous media (PrepareMedia): the scene's media, their realtime volumes and
+  // their host view (the fog froxels as Rgb4 records, the sky volume's pod); media_ready_ false
+  // until PrepareMedia built them for the frame (PoseWorld clears it)
+  MediaScene media_;
+  RealtimeMedia realtime_media_;
+  std::unique_ptr<RayQuery> media_query_;  // PrepareMedia's own shadow rays (BvhRayQuery)
+  std::vector<Rgb4> media_fog_;
+  SkyVolumePod media_sky_;
+  RealtimeMediaView media_view_;
+  bool media_ready_ = false;
+  double media_build_ms_ = 0;
   Film film_;
   PinholeCamera camera_;
   CameraRayTables camera_rays_;  // Prepare's view's tables when the caller gives none

@@ -70,6 +70,15 @@ __global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const fl
   radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
 }
 
+// the homogeneous media over the final radiance (MediaViewQuad): one thread per 2x2 quad, each
+// writing its own pixels.
+__global__ void MediaViewKernel(RealtimeFrameView f, const float* depth, Float3* radiance) {
+  const int qu = blockIdx.x * blockDim.x + threadIdx.x;
+  const int qv = blockIdx.y * blockDim.y + threadIdx.y;
+  if (2 * qu >= f.camera.width || 2 * qv >= f.camera.height) return;
+  MediaViewQuad(f, 2 * qu, 2 * qv, depth, radiance);
+}
+
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
 // shading and the blend after the shared visibility.
 // they run only where the frame has a mirror layer (a batch launches them for every camera
@@ -145,8 +154,9 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 }
 
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
-// ShadeRealtimeStored): no second surface evaluation.
-template <class Frames, int kMinBlocks>
+// ShadeRealtimeStored): no second surface evaluation. kMedia false: frames without media only
+// (the default variant of frames without media and batches; ShadeRealtimePoint).
+template <class Frames, int kMinBlocks, bool kMedia = true>
 __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
                       int row1) {
@@ -156,7 +166,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   if (u >= f.camera.width || v >= row1) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t k = CameraOffset(f) + i;
-  radiance[k] = ShadeRealtimeStored(f, u, v, f.geometry[i], surfaces[k]);
+  radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
@@ -626,6 +636,8 @@ struct PixelBuffers {
 struct DeviceRealtime::Impl : PixelBuffers {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
   Buffer depth, rows, rgb, hits, streaks;
+  // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
+  Buffer media_pods, media_fog, media_inv_log_far, media_axes, media_trans, volume_pod;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
   Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
   SkyModelPod device_sky;
@@ -697,6 +709,45 @@ struct DeviceRealtime::Impl : PixelBuffers {
     uploaded_lights.assign(l, l + light_bytes);
     uploaded = true;
   }
+  // the frame's homogeneous media (host arrays of `h`, RealtimeFrameData::View) to the device on
+  // `stream` (pageable: staged before the calls return), *d pointing to them; the media's sky
+  // volume is the frame's (UploadSky's copy of its pod)
+  void UploadMedia(const RealtimeMediaView& h, RealtimeMediaView* d, cudaStream_t stream) {
+    *d = h;
+    media_pods.Upload(h.media, sizeof(MediumPod) * h.num_media, stream);
+    d->media = h.num_media > 0 ? media_pods.as<MediumPod>() : nullptr;
+    if (h.sky_volume != nullptr) {
+      if (!sky_uploaded || device_volume.empty())
+        throw Error("DeviceRealtime::Render: media lit by a sky volume the device does not hold");
+      d->sky_volume = volume_pod.as<SkyVolumePod>();
+    }
+    if (h.fog_S != nullptr) {
+      const size_t columns = static_cast<size_t>(h.fog_nx) * h.fog_ny;
+      media_fog.Upload(h.fog_S, sizeof(Rgb4) * columns * (kFogFroxelSlices + 1), stream);
+      media_inv_log_far.Upload(h.fog_inv_log_far, sizeof(float) * columns, stream);
+      // the four axis tables end to end: ax, ax_half [width], ay, ay_half [height]
+      const size_t w = static_cast<size_t>(h.width), hh = static_cast<size_t>(h.height);
+      std::vector<MediaAxis> axes(2 * w + 2 * hh);
+      std::copy(h.fog_ax, h.fog_ax + w, axes.begin());
+      std::copy(h.fog_ax_half, h.fog_ax_half + w, axes.begin() + w);
+      std::copy(h.fog_ay, h.fog_ay + hh, axes.begin() + 2 * w);
+      std::copy(h.fog_ay_half, h.fog_ay_half + hh, axes.begin() + 2 * w + hh);
+      media_axes.Upload(axes.data(), sizeof(MediaAxis) * axes.size(), stream);
+      d->fog_S = media_fog.as<Rgb4>();
+      d->fog_inv_log_far = media_inv_log_far.as<float>();
+      const MediaAxis* a = media_axes.as<MediaAxis>();
+      d->fog_ax = a;
+      d->fog_ax_half = a + w;
+      d->fog_ay = a + 2 * w;
+      d->fog_ay_half = a + 2 * w + hh;
+    }
+    if (h.light_trans != nullptr) {
+      const CellLightsPod& v = h.light_volume;
+      const size_t n = static_cast<size_t>(v.r[0]) * v.r[1] * v.r[2] * v.stride;
+      media_trans.Upload(h.light_trans, sizeof(float) * n, stream);
+      d->light_trans = media_trans.as<float>();
+    }
+  }
   // the film kernel with the exposure the device computed (LaunchExposure)
   void LaunchFilmDeviceExposure(int64_t n, int tone_map, cudaStream_t stream) {
     DevelopDeviceExposureKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
@@ -748,8 +799,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 6)
       ShadeStoredKernel<OneFrame, 6>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 4 && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 4, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4)
-      ShadeStoredKernel<OneFrame, 4>
+      ShadeStoredKernel<OneFrame, 4, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface)
       ShadeStoredKernel<OneFrame, 1>
@@ -789,6 +843,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
       Check(cudaGetLastError(), "MirrorShadeKernel");
       MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
       Check(cudaGetLastError(), "MirrorBlendKernel");
+    }
+    if (f.has_media != 0) {
+      MediaViewKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
+          f, depth.as<float>(), radiance.as<Float3>());
+      Check(cudaGetLastError(), "MediaViewKernel");
     }
     if (f.num_streaks > 0) {
       StreakKernel<<<static_cast<unsigned>((f.num_streaks + 255) / 256), 256, 0, stream>>>(
@@ -877,6 +936,7 @@ void DeviceRealtime::UploadSky(const RealtimeSky& d) {
   } else {
     v = SkyVolumePod();
   }
+  if (!v.empty()) m.volume_pod.Upload(&v, sizeof(SkyVolumePod), nullptr);
   Check(cudaDeviceSynchronize(), "uploading the realtime sky");
   m.device_sky = sky;
   m.device_volume = v;
@@ -947,6 +1007,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.streaks.Upload(host_frame.streaks, sizeof(StreakPixel) * f.num_streaks, stream);
     f.streaks = m.streaks.as<StreakPixel>();
   }
+  if (f.has_media != 0) m.UploadMedia(host_frame.media, &f.media, stream);
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;
@@ -1391,7 +1452,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
     Check(cudaGetLastError(), "MirrorSkyKernel (batch)");
   }
   stage(2);
-  ShadeStoredKernel<BatchFrames, 4>
+  // batches hold no media (BatchRenderer::UpdateWorld refuses them)
+  ShadeStoredKernel<BatchFrames, 4, false>
       <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
   Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
   stage(3);

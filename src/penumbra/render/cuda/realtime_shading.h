@@ -41,6 +41,7 @@
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
+#include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/mirror_math.h"
 #include "penumbra/render/particle_math.h"
 #include "penumbra/render/shading_math.h"
@@ -176,6 +177,11 @@ struct RealtimeFrameView {
   /// the frame's particle streaks, num_streaks of them in pixel order (none: no particles).
   const StreakPixel* streaks = nullptr;
   int64_t num_streaks = 0;
+  /// the frame's homogeneous media (fog, haze, dust; has_media 1), their arrays as device or
+  /// host pointers (render/media_realtime_math.h, RealtimeMedia::HostView): the light
+  /// transmittances of the surface loop (ShadeRealtimePoint) and the view pass (MediaViewQuad).
+  int32_t has_media = 0;
+  RealtimeMediaView media;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -682,13 +688,31 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
   return g;
 }
 
+/// light j's contribution c at surface point p (shadow ray direction wi, distance dist:
+/// LightContribution's) attenuated by the frame's homogeneous media on the way to the light, as
+/// RealtimeIntegrator's surface loop: c as it is where it is 0, else c times
+/// MediaLightTransmittance (the world light volume's channel-mean value where p lies in it and
+/// it holds light j, else the closed form). the CPU looks every light up at once per point
+/// (LightTransmittances): the same values; here one light at a time, so that nothing stays live
+/// across the light loop.
+PB_HOST_DEVICE inline Float3 MediaAttenuated(const RealtimeFrameView& f, int j, const Float3& p,
+                                             const Float3& wi, float dist, const Float3& c) {
+  if (c.x == 0 && c.y == 0 && c.z == 0) return c;
+  const float pp[3] = {p.x, p.y, p.z}, ww[3] = {wi.x, wi.y, wi.z};
+  const Float3 T = MediaLightTransmittance(f.media, j, pp, ww, dist);
+  return Float3{c.x * T.x, c.y * T.y, c.z * T.z};
+}
+
 /// lights whose unshadowed contribution ShadeRealtimeHit keeps between its two loops (the
 /// others are evaluated twice).
 constexpr int kShadeCachedLights = 16;
 
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
-/// their shadow rays.
+/// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
+/// false: for frames known to have none (f.has_media must be 0): the media's code is left out,
+/// so the kernels of frames without media keep their registers.
+template <bool kMedia = true>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky) {
   const SceneView& s = f.scene;
@@ -725,7 +749,8 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi;
     float dist;
-    const Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+    if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
     if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
@@ -735,10 +760,12 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi, c;
     float dist;
-    if (j < kShadeCachedLights)
+    if (j < kShadeCachedLights) {
       c = cached_c[j], wi = cached_wi[j], dist = cached_dist[j];
-    else
+    } else {
       c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
+      if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
+    }
     const float lum = pbm::Luminance709(c.x, c.y, c.z);
     if (!(lum > 0)) continue;
     if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
@@ -783,7 +810,8 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
 /// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point: its
 /// primary geometry g and material terms t (PrimaryGeometry's surface_out; the view direction
 /// from PrimaryRay as EvaluateSurface): the same shading point, so the same radiance, without
-/// evaluating the surface (textures, normal map) a second time.
+/// evaluating the surface (textures, normal map) a second time. kMedia: ShadeRealtimePoint's.
+template <bool kMedia = true>
 PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
                                                  const PixelGeometry& g, const SurfaceTerms& t) {
   const Float3 sky = BeginRealtimePixel(f, u, v);
@@ -802,7 +830,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int
   sp.specular = t.specular;
   sp.occlusion = t.occlusion;
   sp.mirror = g.mirror;
-  return ShadeRealtimePoint(f, u, v, sp, sky);
+  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky);
 }
 
 /// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
@@ -1211,6 +1239,61 @@ PB_HOST_DEVICE inline Float3 ApplyMirrorLayer(const RealtimeFrameView& f, int u,
     Lm = Float3{acc.x / wsum, acc.y / wsum, acc.z / wsum};
   }
   return Float3{MirrorBlend(L.x, Lm.x, r), MirrorBlend(L.y, Lm.y, r), MirrorBlend(L.z, Lm.z, r)};
+}
+
+/// the homogeneous media over the radiance of the pixels of the 2x2 quad (u0, v0) .. (u0 + 1,
+/// v0 + 1) (u0, v0 even; pixels outside the image are skipped) once it is final (after the
+/// shared visibility and the mirror layer, before the particle streaks), as RealtimeIntegrator's
+/// ApplyTileViewEffects: L becomes T L + L_add (MediaViewSegment of f.media) along the pixel's
+/// ray (PrimaryRay, unit direction) to its primary hit, t_end = depth[i] |d| (depth: the
+/// primary hits' t, f.geometry[i].hit 0: the ray escapes, t_end = +inf). a quad inside the
+/// image whose four pixels all hit or all escape shares the lookups of MediaPrepareQuad at the
+/// mean of their t_end (+inf for escaping rays) and the normalised sum of their unit directions
+/// from the first pixel's origin; the others look up per pixel. the CPU walks the quads of its
+/// 16x16 tiles, which start at even pixels, so its quads are these.
+PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int v0,
+                                         const float* depth, Float3* radiance) {
+  const int W = f.camera.width, H = f.camera.height;
+  float o[4][3], d[4][3], t_end[4];
+  int hit[4] = {0, 0, 0, 0};
+  bool inside[4];
+  for (int c = 0; c < 4; ++c) {
+    const int u = u0 + (c & 1), v = v0 + (c >> 1);
+    inside[c] = u < W && v < H;
+    if (!inside[c]) continue;
+    const int64_t i = static_cast<int64_t>(v) * W + u;
+    const TraceRay r = PrimaryRay(f.camera, u, v);
+    const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+    o[c][0] = r.o.x, o[c][1] = r.o.y, o[c][2] = r.o.z;
+    d[c][0] = r.d.x / d_len, d[c][1] = r.d.y / d_len, d[c][2] = r.d.z / d_len;
+    hit[c] = f.geometry[i].hit != 0 ? 1 : 0;
+    t_end[c] = hit[c] != 0 ? depth[i] * d_len : INFINITY;
+  }
+  const bool shared =
+      u0 + 1 < W && v0 + 1 < H && hit[1] == hit[0] && hit[2] == hit[0] && hit[3] == hit[0];
+  MediaQuadShared q;
+  if (shared) {
+    float t_c = INFINITY;
+    if (hit[0] != 0) {
+      t_c = 0;
+      for (int c = 0; c < 4; ++c) t_c += 0.25f * t_end[c];
+    }
+    float dc[3] = {0, 0, 0};
+    for (int c = 0; c < 4; ++c)
+      for (int k = 0; k < 3; ++k) dc[k] += d[c][k];
+    const float dc_len = sqrtf(dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2]);
+    for (int k = 0; k < 3; ++k) dc[k] = dc[k] / dc_len;
+    MediaPrepareQuad(f.media, u0, v0, t_c, o[0], dc, &q);
+  }
+  for (int c = 0; c < 4; ++c) {
+    if (!inside[c]) continue;
+    const int u = u0 + (c & 1), v = v0 + (c >> 1);
+    const int64_t i = static_cast<int64_t>(v) * W + u;
+    Float3 T, L_add;
+    MediaViewSegment(f.media, u, v, o[c], d[c], t_end[c], &T, &L_add, shared ? &q : nullptr);
+    const Float3 L = radiance[i];
+    radiance[i] = Float3{T.x * L.x + L_add.x, T.y * L.y + L_add.y, T.z * L.z + L_add.z};
+  }
 }
 
 /// the sum over row v of the log-luminance terms (film_math.h's LogLuminanceTerm), in column
