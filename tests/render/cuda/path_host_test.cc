@@ -149,8 +149,8 @@ TEST(PathtracedHostPath, SampleRunsAddUpToThePixelsEstimate) {
       cuda::PathPartial runs;
       for (int k = 0; k < 5; ++k) {
         // runs of 3 samples, the last one empty (as the kernel's)
-        const cuda::PathPartial q = cuda::PathSampleRange(pf, u, v, std::min(3 * k, 12),
-                                                          std::min(3 * k + 3, 12));
+        const cuda::PathPartial q =
+            cuda::PathSampleRange(pf, u, v, std::min(3 * k, 12), std::min(3 * k + 3, 12));
         for (int c = 0; c < 3; ++c) runs.L[c] += q.L[c], runs.albedo[c] += q.albedo[c];
         runs.albedo_count += q.albedo_count;
       }

@@ -42,8 +42,8 @@
 // samples (one frame), the radiance's mean relative difference (path_parity.h: 8x8 blocks, and
 // the image mean) and whether two GPU renders are bit-identical. usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
-//                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]]
-//                     [world.yaml ...]
+//                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
+//                     [--seed-floor]] [world.yaml ...]
 
 #include <fmt/format.h>
 
@@ -366,12 +366,13 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
 
 // --pathtraced: the pathtraced tier on the GPU beside the CPU backend (file comment)
 int PathtracedMain(const std::vector<std::string>& worlds, int width, int height, int spp,
-                   int frames) {
+                   int frames, bool seed_floor) {
   fmt::print(
       "\n| world | size | spp | cuda Render() ms | cuda path kernel ms | cpu Render() ms ({} "
       "threads) | speed-up | radiance mean rel. diff (8x8 blocks) | image mean | cuda repeats "
       "bits |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
       std::thread::hardware_concurrency());
+  std::vector<std::string> floors;
   for (const std::string& file : worlds) {
     SessionOptions so;
     so.build_renderer = false;
@@ -404,6 +405,18 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     const auto t0 = Clock::now();
     cpu->Render(snap, view, &want);
     const double cpu_ms = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+    if (seed_floor) {
+      RenderSettings other = cpu_settings;
+      other.seed = cpu_settings.seed + 1;
+      RenderedFrame c;
+      MakeRenderer(scene, other)->Render(snap, view, &c);
+      floors.push_back(fmt::format(
+          "{}: two CPU renders with seeds {} and {}: mean relative difference {:.3f} % (8x8 "
+          "blocks), {:.3f} % (image mean)",
+          name, cpu_settings.seed, other.seed,
+          100 * path_parity::TileRelativeDifference(c.radiance, want.radiance),
+          100 * path_parity::MeanRelativeDifference(c.radiance, want.radiance)));
+    }
     fmt::print(
         "| {} | {}x{} | {} | {:.1f}{} | {:.1f} | {:.0f} | {:.1f}x | {:.3f} % | {:.3f} % | {} |\n",
         name, width, height, spp, gpu_ms, on_gpu ? "" : " (cpu fallback)", kernel_ms, cpu_ms,
@@ -411,13 +424,14 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
         100 * path_parity::MeanRelativeDifference(a.radiance, want.radiance),
         repeats ? "yes" : "NO");
   }
+  for (const std::string& f : floors) fmt::print("{}\n", f);
   return 0;
 }
 
 int Main(int argc, char** argv) {
   int frames = 50;
   int width = 0, height = 0, sessions = 1;
-  bool parity = false, realtime = false, pathtraced = false;
+  bool parity = false, realtime = false, pathtraced = false, seed_floor = false;
   int spp = 64;
   std::vector<int> batch;
   std::vector<std::string> worlds;
@@ -461,6 +475,8 @@ int Main(int argc, char** argv) {
       parity = true;
     } else if (a == "--pathtraced") {
       pathtraced = true;
+    } else if (a == "--seed-floor") {
+      seed_floor = true;
     } else if (a == "--spp" && has_value) {
       spp = PositiveArg(argv[++i]);
       if (spp == 0) return usage("--spp: expected a positive integer");
@@ -483,7 +499,7 @@ int Main(int argc, char** argv) {
   }
   if (pathtraced) {
     if (width == 0) width = 320, height = 240;
-    return PathtracedMain(worlds, width, height, spp, std::min(frames, 5));
+    return PathtracedMain(worlds, width, height, spp, std::min(frames, 5), seed_floor);
   }
   if (realtime) {
     if (width == 0) width = 640, height = 480;
