@@ -13,6 +13,9 @@
 // ellipsoids, height fields and infinite planes are not sampled: they are found only by
 // BSDF sampling, whose multiple-importance weight is then 1 (Pdf() returns 0 for them).
 //
+// the sampling arithmetic is the shared PB_HOST_DEVICE code of render/emitter_math.h (in double,
+// rounded as the Eigen code it replaced); the geom's pose is composed here (Pose).
+//
 // visibility matches RayScene: geoms in MJCF groups > 2 or with material alpha < 0.5 are
 // left out. emitters move with their bodies: every call takes the body poses X_WB.
 
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/render/emitter_math.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -65,11 +69,9 @@ class EmitterSampler {
     Eigen::Vector3f Le{0, 0, 0};
     double area = 0;               // m^2
     std::vector<double> part_cdf;  // box faces / cylinder parts / mesh triangles, by area
+    EmitterPod pod;                // the above as the shared functions take it
   };
   Pose GeomPose(const std::vector<Pose>& X_WB, const Emitter& e) const;
-  // uniform point on the surface in the geom frame, with its outward normal.
-  void SampleArea(const Emitter& e, float u_part, float u1, float u2, Eigen::Vector3d* p,
-                  Eigen::Vector3d* n) const;
 
   const SceneDescription& scene_;
   std::vector<Emitter> emitters_;
