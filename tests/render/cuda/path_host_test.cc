@@ -18,6 +18,7 @@
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/path_frame.h"
+#include "penumbra/render/emitter_sampler.h"
 #include "realtime_parity.h"
 
 namespace penumbra {
@@ -49,6 +50,8 @@ HostPathtraced RenderBoth(const std::string& world) {
   bvh.Update(snap);
   cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
+  // the bundled worlds have no emissive geom (their frames are on the GPU: PathNotOnGpu)
+  EXPECT_TRUE(EmitterSampler(scene).empty());
   EXPECT_EQ(cuda::PathNotOnGpu(nullptr, view, false), "");
   data.Prepare(snap, view, &pool);
   const cuda::PathFrameView pf =
