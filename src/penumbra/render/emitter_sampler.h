@@ -62,6 +62,20 @@ class EmitterSampler {
   float Pdf(const std::vector<Pose>& X_WB, int geom, const Eigen::Vector3f& p_W,
             const Eigen::Vector3f& p_hit_W, const Eigen::Vector3f& n_hit_W) const;
 
+  /// emitter k (0 .. size() - 1, in pick order) as the shared functions take it (its pointers
+  /// into this sampler's part cdf and the scene's mesh), its emitted radiance and its geom.
+  const EmitterPod& pod(int k) const { return emitters_[k].pod; }
+  const Eigen::Vector3f& Le(int k) const { return emitters_[k].Le; }
+  int geom(int k) const { return emitters_[k].geom; }
+  /// the cdf of the emitters' pick by power (size() + 1 values).
+  const std::vector<double>& pick_cdf() const { return pick_cdf_; }
+  /// per SceneDescription geom: its emitter index, or -1.
+  const std::vector<int>& emitter_of_geom() const { return emitter_of_geom_; }
+  /// the world pose of emitter k's geom for body poses X_WB.
+  Pose EmitterPose(const std::vector<Pose>& X_WB, int k) const {
+    return GeomPose(X_WB, emitters_[k]);
+  }
+
  private:
   struct Emitter {
     int geom = -1;

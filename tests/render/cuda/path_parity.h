@@ -8,6 +8,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/render/render_settings.h"
+#include "penumbra/scene/scene_description.h"
 
 namespace penumbra::path_parity {
 
@@ -21,6 +22,18 @@ inline RenderSettings PathSettings(RenderSettings::Backend backend, int spp) {
   s.max_bounces = 4;
   s.denoise = false;
   return s;
+}
+
+/// `scene` with the default room's lamp diffusers glowing (material "room/lamp_diffuser" at
+/// emission (2000, 1900, 1700) cd/m^2): emissive cylinders, so that the path samples emitters.
+/// false if the scene has no such material.
+inline bool MakeDiffusersEmissive(SceneDescription* scene) {
+  for (Material& m : scene->materials) {
+    if (m.name != "room/lamp_diffuser") continue;
+    m.emission = Eigen::Vector3f(2000, 1900, 1700);
+    return true;
+  }
+  return false;
 }
 
 /// the mean relative difference of two radiance images (H x W x 3) of one size, at the scale of

@@ -30,6 +30,13 @@ class DevicePath {
   /// frame's sky changes (RealtimeFrameData::sky_generation). returns the device copy's pod.
   const SkySamplingPod& UploadSkySampling(const SkySamplingPod& host);
 
+  /// copies the emissive geoms of `host` (host pointers; not its poses) to the device; returns
+  /// their device view, whose poses UploadEmitterPoses sets.
+  const PathEmitters& UploadEmitters(const PathEmitters& host);
+  /// copies a frame's emitter poses (12 doubles an emitter, UploadEmitters' count) and returns
+  /// the device view with them (after UploadEmitters).
+  const PathEmitters& UploadEmitterPoses(const double* poses);
+
   /// renders the frame `pf` (device pointers everywhere but the outputs, which are set here)
   /// on `scene`'s stream and copies its radiance, albedo, normal and depth into `out` (resized
   /// to the camera's pixels); waits for the copies.

@@ -41,7 +41,8 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
   device_realtime_ = std::make_unique<DeviceRealtime>();
   device_path_ = std::make_unique<DevicePath>();
   if (settings.tier == RenderSettings::Tier::kPathtraced) {
-    has_emitters_ = !EmitterSampler(scene_).empty();
+    emitters_ = std::make_unique<EmitterSampler>(scene_);
+    emitter_host_ = std::make_unique<PathEmitterHost>(*emitters_);
     if (settings.denoise) denoiser_ = std::make_unique<Denoiser>();
   }
   pool_ = std::make_unique<ThreadPool>(settings.threads);
@@ -56,7 +57,7 @@ bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
 
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
   if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced)
-    return PathNotOnGpu(effects, view, has_emitters_);
+    return PathNotOnGpu(effects, view);
   return realtime_->Unsupported(effects, view);
 }
 
@@ -74,7 +75,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                                  : std::string("this frame's camera");
       spdlog::info(
           "renderer: cuda backend: {}: not on the GPU yet (media; pathtraced particles, "
-          "emissive geoms, distorted or moving cameras); "
+          "distorted or moving cameras); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;
@@ -202,7 +203,14 @@ void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const Effects
   const RealtimeFrameView frame =
       device_realtime_->DeviceFrame(realtime_->View(device_->device_view(), nullptr),
                                     static_cast<int64_t>(realtime_->geoms().size()));
-  const PathFrameView pf = PathView(*realtime_, frame, sky_sampling_);
+  PathFrameView pf = PathView(*realtime_, frame, sky_sampling_);
+  // the emissive geoms: their tables once, their poses every frame
+  if (!emitters_->empty()) {
+    if (!emitters_uploaded_) device_path_->UploadEmitters(emitter_host_->View());
+    emitters_uploaded_ = true;
+    emitter_host_->SetPoses(*emitters_, snapshot.X_WB);
+    pf.emitters = device_path_->UploadEmitterPoses(emitter_host_->poses.data());
+  }
   prepare_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   device_path_->Render(device_.get(), pf, &path_buffers_);

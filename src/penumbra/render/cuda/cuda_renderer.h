@@ -99,8 +99,10 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<RealtimeFrameData> realtime_;
   std::unique_ptr<DeviceRealtime> device_realtime_;
   std::unique_ptr<DevicePath> device_path_;
-  std::unique_ptr<Denoiser> denoiser_;      // the pathtraced tier's, when its settings denoise
-  bool has_emitters_ = false;               // emissive geoms (their frames stay on the CPU)
+  std::unique_ptr<Denoiser> denoiser_;        // the pathtraced tier's, when its settings denoise
+  std::unique_ptr<EmitterSampler> emitters_;  // the pathtraced tier's emissive geoms
+  std::unique_ptr<PathEmitterHost> emitter_host_;  // as the path kernels take them
+  bool emitters_uploaded_ = false;
   const SkyModel* sampling_sky_ = nullptr;  // the sky whose sampling tables the device holds
   uint64_t sampling_generation_ = 0;
   SkySamplingPod sky_sampling_;       // their device copy

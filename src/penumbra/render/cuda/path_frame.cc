@@ -5,15 +5,48 @@
 
 namespace penumbra::cuda {
 
-std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view, bool has_emitters) {
+std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view) {
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   const std::string media = EffectsNotOnGpu(fx);
   if (!media.empty()) return "the pathtraced tier with effects with " + media;
   if (fx != nullptr && !fx->particles.empty()) return "the pathtraced tier with particles";
-  if (has_emitters) return "the pathtraced tier with emissive geoms";
   if (view.intrinsics.has_distortion() || view.motion.moving())
     return "the pathtraced tier with a distorted or moving camera";
   return "";
+}
+
+PathEmitterHost::PathEmitterHost(const EmitterSampler& sampler) : pick_cdf(&sampler.pick_cdf()) {
+  for (int k = 0; k < sampler.size(); ++k) {
+    pods.push_back(sampler.pod(k));
+    const Eigen::Vector3f& le = sampler.Le(k);
+    Le.push_back(Float3{le.x(), le.y(), le.z()});
+  }
+  emitter_of_geom.assign(sampler.emitter_of_geom().begin(), sampler.emitter_of_geom().end());
+}
+
+void PathEmitterHost::SetPoses(const EmitterSampler& sampler, const std::vector<Pose>& X_WB) {
+  poses.resize(12 * pods.size());
+  for (int k = 0; k < sampler.size(); ++k) {
+    const Pose X = sampler.EmitterPose(X_WB, k);
+    double* o = poses.data() + 12 * k;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) o[3 * r + c] = X.linear()(r, c);
+      o[9 + r] = X.translation()[r];
+    }
+  }
+}
+
+PathEmitters PathEmitterHost::View() const {
+  PathEmitters e;
+  e.num = static_cast<int32_t>(pods.size());
+  if (e.num == 0) return e;
+  e.pods = pods.data();
+  e.Le = Le.data();
+  e.pick_cdf = pick_cdf->data();
+  e.emitter_of_geom = emitter_of_geom.data();
+  e.num_geoms = static_cast<int32_t>(emitter_of_geom.size());
+  e.poses = poses.empty() ? nullptr : poses.data();
+  return e;
 }
 
 PathFrameView PathView(const RealtimeFrameData& data, const RealtimeFrameView& frame,
@@ -87,10 +120,13 @@ void TracePathtracedOnHost(const PathFrameView& frame, ThreadPool* pool, PathBuf
 }
 
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                            RenderedFrame* out, const Eigen::Vector3f& white_balance_gains) {
+                            RenderedFrame* out, const Eigen::Vector3f& white_balance_gains,
+                            const PathEmitters* emitters) {
   PathBuffers b;
-  TracePathtracedOnHost(
-      PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod()), pool, &b);
+  PathFrameView pf =
+      PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
+  if (emitters != nullptr) pf.emitters = *emitters;
+  TracePathtracedOnHost(pf, pool, &b);
   std::unique_ptr<Denoiser> denoiser;
   if (data.settings().denoise) denoiser = std::make_unique<Denoiser>();
   FinishPathFrame(data, b, denoiser.get(), white_balance_gains, true, pool, out);

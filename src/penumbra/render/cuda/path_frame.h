@@ -18,15 +18,33 @@
 #include "penumbra/render/cuda/path_shading.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/denoiser.h"
+#include "penumbra/render/emitter_sampler.h"
 #include "penumbra/render/renderer.h"
 
 namespace penumbra::cuda {
 
 /// why a pathtraced frame of `view` under `effects` cannot be traced on the GPU ("" if it can):
 /// effects not on the GPU (EffectsNotOnGpu), particles (the CPU's camera rays stop at streaks
-/// with a random draw), emissive geoms (`has_emitters`: EmitterSampler is not on the GPU yet),
-/// or a camera with lens distortion or motion (the jittered rays need Camera::Unproject).
-std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view, bool has_emitters);
+/// with a random draw), or a camera with lens distortion or motion (the jittered rays need
+/// Camera::Unproject).
+std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view);
+
+/// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
+/// host arrays: the pods and pick cdf point into the sampler, which must outlive this) and the
+/// frame's poses (SetPoses).
+struct PathEmitterHost {
+  std::vector<EmitterPod> pods;
+  std::vector<Float3> Le;
+  std::vector<int32_t> emitter_of_geom;
+  std::vector<double> poses;  ///< 12 an emitter: rotation row-major, translation
+  const std::vector<double>* pick_cdf = nullptr;
+  /// the sampler's emitters (poses: none yet).
+  explicit PathEmitterHost(const EmitterSampler& sampler);
+  /// every emitter's geom pose for body poses X_WB (EmitterSampler::EmitterPose).
+  void SetPoses(const EmitterSampler& sampler, const std::vector<Pose>& X_WB);
+  /// the view over these arrays (num 0 without emitters).
+  PathEmitters View() const;
+};
 
 /// the pathtraced frame of `data` (Prepared for the view; its settings' samples_per_pixel and
 /// max_bounces) as the path kernels read it, with the output arrays left null: `frame` is
@@ -50,8 +68,10 @@ void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffer
 /// max_bounces) rendered by PathTracePixel on the CPU over `bvh` (Updated for the snapshot),
 /// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
 /// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
+/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none).
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                             RenderedFrame* out,
-                            const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones());
+                            const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),
+                            const PathEmitters* emitters = nullptr);
 
 }  // namespace penumbra::cuda

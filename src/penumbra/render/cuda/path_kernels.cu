@@ -4,6 +4,9 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_path.h"
@@ -61,6 +64,8 @@ struct DevicePath::Impl {
   Buffer marginal_pdf, marginal_cdf, marginal_guide, cond_pdf, cond_cdf, cond_guide;
   SkySamplingPod sky;
   Buffer radiance, albedo, normal, depth, partial;
+  Buffer em_pods, em_le, em_pick, em_of_geom, em_cdf, em_vertices, em_faces, em_poses;
+  PathEmitters emitters;
   PathFrameView last;  // the last Render's frame and sample runs (TimeKernel)
   int runs = 1;
   bool rendered = false;
@@ -87,6 +92,59 @@ const SkySamplingPod& DevicePath::UploadSkySampling(const SkySamplingPod& h) {
   m.sky.cond_cdf = m.cond_cdf.as<float>();
   m.sky.cond_guide = m.cond_guide.as<int32_t>();
   return m.sky;
+}
+
+const PathEmitters& DevicePath::UploadEmitters(const PathEmitters& h) {
+  Impl& m = *impl_;
+  // the part cdfs and meshes of every emitter in one array each, the pods pointing into them
+  std::vector<EmitterPod> pods(h.pods, h.pods + h.num);
+  std::vector<double> cdf;
+  std::vector<float> vertices;
+  std::vector<int32_t> faces;
+  std::vector<int64_t> cdf_at(h.num, -1), vertex_at(h.num, -1), face_at(h.num, -1);
+  for (int k = 0; k < h.num; ++k) {
+    const EmitterPod& e = h.pods[k];
+    if (e.num_parts > 0 && e.part_cdf != nullptr) {
+      cdf_at[k] = static_cast<int64_t>(cdf.size());
+      cdf.insert(cdf.end(), e.part_cdf, e.part_cdf + e.num_parts + 1);
+    }
+    if (e.faces != nullptr && e.vertices != nullptr && e.num_parts > 0) {
+      int32_t max_vertex = 0;
+      for (int i = 0; i < 3 * e.num_parts; ++i) max_vertex = std::max(max_vertex, e.faces[i]);
+      face_at[k] = static_cast<int64_t>(faces.size());
+      faces.insert(faces.end(), e.faces, e.faces + 3 * e.num_parts);
+      vertex_at[k] = static_cast<int64_t>(vertices.size());
+      vertices.insert(vertices.end(), e.vertices, e.vertices + 3 * (max_vertex + 1));
+    }
+  }
+  m.em_cdf.Upload(cdf.data(), sizeof(double) * cdf.size(), nullptr);
+  m.em_vertices.Upload(vertices.data(), sizeof(float) * vertices.size(), nullptr);
+  m.em_faces.Upload(faces.data(), sizeof(int32_t) * faces.size(), nullptr);
+  for (int k = 0; k < h.num; ++k) {
+    pods[k].part_cdf = cdf_at[k] >= 0 ? m.em_cdf.as<double>() + cdf_at[k] : nullptr;
+    pods[k].vertices = vertex_at[k] >= 0 ? m.em_vertices.as<float>() + vertex_at[k] : nullptr;
+    pods[k].faces = face_at[k] >= 0 ? m.em_faces.as<int32_t>() + face_at[k] : nullptr;
+  }
+  m.em_pods.Upload(pods.data(), sizeof(EmitterPod) * pods.size(), nullptr);
+  m.em_le.Upload(h.Le, sizeof(Float3) * h.num, nullptr);
+  m.em_pick.Upload(h.pick_cdf, sizeof(double) * (h.num + 1), nullptr);
+  m.em_of_geom.Upload(h.emitter_of_geom, sizeof(int32_t) * h.num_geoms, nullptr);
+  Check(cudaStreamSynchronize(nullptr), "uploading the emitters");
+  m.emitters = h;
+  m.emitters.pods = m.em_pods.as<EmitterPod>();
+  m.emitters.Le = m.em_le.as<Float3>();
+  m.emitters.pick_cdf = m.em_pick.as<double>();
+  m.emitters.emitter_of_geom = m.em_of_geom.as<int32_t>();
+  m.emitters.poses = nullptr;
+  return m.emitters;
+}
+
+const PathEmitters& DevicePath::UploadEmitterPoses(const double* poses) {
+  Impl& m = *impl_;
+  m.em_poses.Upload(poses, sizeof(double) * 12 * m.emitters.num, nullptr);
+  Check(cudaStreamSynchronize(nullptr), "uploading the emitter poses");
+  m.emitters.poses = m.em_poses.as<double>();
+  return m.emitters;
 }
 
 void DevicePath::Render(DeviceScene* scene, const PathFrameView& frame, PathBuffers* out) {

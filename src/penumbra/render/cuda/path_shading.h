@@ -4,7 +4,7 @@
 // pixel then summed in run order: PathSampleRange, PathFinishPixel) and RenderPathtracedOnHost
 // (path_frame.h) runs the same functions on the CPU over the host BVH (tests, machines without
 // a GPU). the path is the CPU's PathIntegrator (render/cpu/path_integrator.h, where the model is
-// documented) step for step, for frames without media, particles or emissive geoms:
+// documented) step for step, for frames without media or particles:
 //
 //   per sample s of pixel (u, v): Rng(PixelStream(u, v, s)) (core/rng.h, the same draws in the
 //   same order), a camera ray jittered over the pixel (two draws); at each vertex the lamp
@@ -12,12 +12,13 @@
 //   ray escapes (MIS-weighted against the previous vertex's BSDF density; the camera and mirrors
 //   see the MJCF skybox), the surface's emission, the mirror layer (one draw, where it applies),
 //   next-event estimation (one sample of every light: two draws each, MIS for lamp spheres and
-//   sun discs; the sky: two draws, MIS), Russian roulette from kPathRussianRouletteStartVertex
-//   (one draw) and the BSDF's sample (three draws);
+//   sun discs; the sky: two draws, MIS; one emissive geom: three draws, MIS), Russian roulette from
+//   kPathRussianRouletteStartVertex (one draw) and the BSDF's sample (three draws);
 //
 // with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
 // with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
-// (path_math.h), the sky's radiance and background (sky_eval_math.h) and sampling
+// (path_math.h), the emissive geoms' sampling (emitter_math.h), the sky's radiance and
+// background (sky_eval_math.h) and sampling
 // (sky_sampling_math.h), dot products summed as the CPU's Eigen code sums them (EigenDot),
 // and the materials with their textures over the path's ray cone as the
 // realtime tier evaluates them (EvaluateSurface, realtime_shading.h). the GPU contracts
@@ -31,6 +32,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/render/bsdf_math.h"
 #include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/emitter_math.h"
 #include "penumbra/render/light_math.h"
 #include "penumbra/render/path_math.h"
 #include "penumbra/render/shading_math.h"
@@ -45,6 +47,34 @@ constexpr int kPathRussianRouletteStartVertex = 3;
 /// shadow rays towards a point at distance d stop this fraction short of it (the CPU's).
 constexpr float kPathShadowShorten = 1e-4f;
 
+/// the scene's emissive geoms as the path samples them (EmitterSampler's, render/emitter_math.h):
+/// num emitters in pick order, their plain data, emitted radiance (cd/m^2) and pick cdf (num + 1
+/// values), per SceneDescription geom (num_geoms) its emitter or -1, and per emitter its geom's
+/// world pose for the frame, 12 doubles (rotation row-major, translation). num 0: none.
+struct PathEmitters {
+  int32_t num = 0;
+  const EmitterPod* pods = nullptr;
+  const Float3* Le = nullptr;
+  const double* pick_cdf = nullptr;
+  const int32_t* emitter_of_geom = nullptr;
+  int32_t num_geoms = 0;
+  const double* poses = nullptr;
+};
+
+/// EmitterSampler::Pdf: the solid-angle density with which the emitter sampling at p returns
+/// the direction to point p_hit (unit normal n_hit) on geom `geom`; 0 for geoms it never samples.
+PB_HOST_DEVICE inline float PathEmitterPdf(const PathEmitters& em, int geom, const Float3& p,
+                                           const Float3& p_hit, const Float3& n_hit) {
+  if (geom < 0 || geom >= em.num_geoms) return 0.0f;
+  const int k = em.emitter_of_geom[geom];
+  if (k < 0) return 0.0f;
+  const double p_pick = em.pick_cdf[k + 1] - em.pick_cdf[k];
+  if (!(p_pick > 0)) return 0.0f;
+  const double pd[3] = {p.x, p.y, p.z}, hd[3] = {p_hit.x, p_hit.y, p_hit.z},
+               nd[3] = {n_hit.x, n_hit.y, n_hit.z};
+  return EmitterPointPdf(em.pods[k], p_pick, em.poses + 12 * k + 9, pd, hd, nd);
+}
+
 /// everything a pathtraced frame reads and writes, as device (or host) pointers.
 struct PathFrameView {
   /// the scene, camera (a pinhole without distortion or motion), materials, textures, posed
@@ -54,6 +84,7 @@ struct PathFrameView {
   int32_t sky_active = 0;       ///< the sky sends light (its irradiance up or down is > 0)
   int32_t spp = 1;              ///< samples per pixel (>= 1)
   int32_t max_bounces = 1;      ///< >= 1
+  PathEmitters emitters;        ///< the emissive geoms (none: num 0)
   /// per pixel (row-major, width x height): the mean radiance, the mean base colour of the
   /// first surface over the samples that hit one (the denoiser's albedo), and the pixel-centre
   /// hit's usable shading normal (0 where it escapes) and z-depth (0 where it escapes).
@@ -159,6 +190,40 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingP
       }
     }
   }
+  // one emissive geom (EmitterSampler::Sample), its shadow ray towards the sampled point.
+  const PathEmitters& em = pf.emitters;
+  if (em.num > 0) {
+    const float u0 = rng->Uniform(), u1 = rng->Uniform(), u2 = rng->Uniform();
+    double u_rest = 0;
+    const int k = EmitterPickFromCdf(em.pick_cdf, em.num, u0, &u_rest);
+    const double p_pick = em.pick_cdf[k + 1] - em.pick_cdf[k];
+    const double pd[3] = {p.x, p.y, p.z};
+    EmitterPoint ep;
+    if (p_pick > 0 && EmitterSamplePoint(em.pods[k], p_pick, em.poses + 12 * k,
+                                         em.poses + 12 * k + 9, pd, u_rest, u1, u2, &ep)) {
+      const Float3 q{static_cast<float>(ep.q[0]), static_cast<float>(ep.q[1]),
+                     static_cast<float>(ep.q[2])};
+      const Float3 wi{static_cast<float>(ep.wi[0]), static_cast<float>(ep.wi[1]),
+                      static_cast<float>(ep.wi[2])};
+      const Float3 fv = BsdfEval(b, wi);
+      const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+      if (PathMax3(fv) > 0) {
+        // render/ray.h's SpawnRayTo: off the surface on the point's side, d = q - origin,
+        // stopping 1e-4 of the way short.
+        TraceRay sr = PathSpawnRay(p, sp.ng, Float3{q.x - p.x, q.y - p.y, q.z - p.z});
+        const Float3 o = ToFloat3(sr.o);
+        const Float3 dq{q.x - o.x, q.y - o.y, q.z - o.z};
+        sr.d = ToF3(dq);
+        sr.tmax = 1.0f - kPathShadowShorten;
+        const float dist = sqrtf(EigenDot(dq, dq)) * sr.tmax;
+        float t;
+        if (!TraceOccluded(f.scene, sr) && PathNearestLamp(f, o, wi, 0.0f, dist, &t) < 0) {
+          const float w = PowerHeuristic(ep.pdf, f_pdf);
+          *L = *L + PathMul(beta, PathMul(fv, em.Le[k])) * (w / ep.pdf);
+        }
+      }
+    }
+  }
 }
 
 /// one path of sample s of pixel (u, v): its radiance (non-finite values are the caller's to
@@ -243,9 +308,13 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
       *hit_first = true;
     }
     if (PathMax3(sp.emission) > 0) {
-      // no emissive geom is sampled on this path (such frames stay on the CPU): the emission
-      // found by BSDF sampling counts with EmitterSampler::Pdf's weight for unsampled geoms.
-      const float w = from_camera ? 1.0f : PowerHeuristic(prev_pdf, 0.0f);
+      // MIS-weighted against the emitter sampling of the previous vertex (0 for geoms it does
+      // not sample: weight 1).
+      const int geom = f.scene.records[f.scene.prims[h.prim].record].geom;
+      const float w =
+          from_camera
+              ? 1.0f
+              : PowerHeuristic(prev_pdf, PathEmitterPdf(pf.emitters, geom, prev_p, sp.p, sp.ng));
       L = L + PathMul(beta, sp.emission) * w;
     }
     if (vertex >= pf.max_bounces) break;
