@@ -165,9 +165,10 @@ TEST_P(CudaBackendWorlds, GroundTruthImagesMatchCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBackendWorlds,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml"));
 
-// the pathtraced tier's frames render on the GPU (path_shading.h), but not those of a scene with
-// emissive geoms (PathNotOnGpu): those go to the CPU renderer inside the backend.
-TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessEmissive) {
+// the pathtraced tier's frames render on the GPU (path_shading.h), emissive geoms included, but
+// not those of a camera with lens distortion (PathNotOnGpu): those go to the CPU renderer inside
+// the backend.
+TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessDistorted) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("default.yaml");
   RenderSettings settings;
@@ -179,17 +180,21 @@ TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessEmissive) {
   view.X_WO = CameraPoseInWorld(session->scene().cameras.front(), snap);
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
   view.outputs[ImageKind::kRgb] = true;
+  CameraView distorted = view;
+  distorted.intrinsics.k1 = 0.1;
   SceneDescription emissive = session->scene();
   for (Material& m : emissive.materials) m.emission = Eigen::Vector3f(1, 1, 1);
-  const SceneDescription* both[] = {&session->scene(), &emissive};
-  for (const SceneDescription* scene : both) {
+  const SceneDescription* scenes[] = {&session->scene(), &emissive};
+  for (const SceneDescription* scene : scenes) {
     const std::unique_ptr<Renderer> gpu = MakeRenderer(*scene, settings);
     RenderedFrame f;
     gpu->Render(snap, view, &f);
     EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
+    gpu->Render(snap, distorted, &f);
+    EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
     const auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
-    EXPECT_EQ(g->gpu_frames(), scene == &emissive ? 0 : 1);
-    EXPECT_EQ(g->cpu_frames(), scene == &emissive ? 1 : 0);
+    EXPECT_EQ(g->gpu_frames(), 1);
+    EXPECT_EQ(g->cpu_frames(), 1);
   }
 }
 
