@@ -4,14 +4,15 @@
 # backend (single camera, and the flashlight, rain and fog worlds' effects frames on the GPU and
 # the CPU;
 # batches of 1, 64 and 1024 cameras at 128x128 in the house, depth+seg
-# and realtime rgb+depth with its stages' GPU times; copy rates), the parity table (parity.sh),
-# and prints one summary table, then the measurements (docs/gpu.md).
+# and realtime rgb+depth with its stages' GPU times; copy rates), the pathtraced tier's frame
+# time beside the CPU backend's (default and house, 320x240, 64 samples per pixel), the parity
+# table (parity.sh), and prints one summary table, then the measurements (docs/gpu.md).
 #
 #   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
 #                                           (default .gpu/penumbra-gpu.tar.xz, 50)
 #   CHECK_LOG_DIR=DIR CHECK_LIMIT_S=60 scripts/gpu/check.sh ...  (logs kept in DIR; the steps'
 #   limits are multiples of CHECK_LIMIT_S: gpu tests 3x, batch 1.5x, parity 2x, bench 1.5x,
-#   sessions 0.75x, host tests 1x)
+#   sessions 0.75x, pathtraced bench 1x, host tests 1x)
 set -uo pipefail
 tarball=${1:-.gpu/penumbra-gpu.tar.xz}
 frames=${2:-50}
@@ -56,6 +57,9 @@ bench_rc=$?
 timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 64 \
   --size 128x128 --sessions 4 "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1
 sessions_rc=$?
+timeout "$limit" "$pkg/bin/render_cuda_bench" --pathtraced --spp 64 --size 320x240 --frames 3 \
+  "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" > "$log/pathtraced.txt" 2>&1
+path_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
 host_rc=$?
 verdict() { [ "$1" -eq 0 ] && echo "pass" || echo "FAIL (rc $1)"; }
@@ -69,6 +73,7 @@ echo "| single-camera bench | $(verdict $bench_rc) |"
 echo "| batch bench (house, 128x128) | $(verdict $batch_rc) |"
 echo "| batch bench, 4 sessions | $(verdict $sessions_rc) |"
 echo "| parity table | $(verdict $parity_rc) |"
+echo "| pathtraced bench (320x240, 64 spp) | $(verdict $path_rc) |"
 # the benchmark rows, cuda beside cpu: single camera (world, size, outputs, backend, timed,
 # frames/s) and batches (world, size, outputs, cameras, backend, timed, frames/s)
 awk -F'|' 'NF == 9 && $2 ~ /yaml/ {
@@ -78,6 +83,10 @@ awk -F'|' 'NF == 9 && $2 ~ /yaml/ {
              gsub(/^ +| +$/, "", $8);
              printf "| bench:%s%s%s%s cameras,%s,%s | %s frames/s |\n", $2, $3, $4, $5, $6, $7, $8 }' \
   "$log/bench.txt" "$log/batch.txt" "$log/sessions.txt"
+# the pathtraced rows: world, size, spp, cuda Render() ms, kernel ms, cpu ms, speed-up
+awk -F'|' 'NF == 12 && $2 ~ /yaml/ {
+             printf "| pathtraced:%s%s, %s spp | cuda%s ms (kernel%s ms), cpu%s ms, speed-up%s |\n",
+               $2, $3, $4, $5, $6, $7, $8 }' "$log/pathtraced.txt"
 awk -F'|' '$2 ~ /pinned|pageable/ { gsub(/^ +| +$/, "", $4);
              printf "| copy back:%s%s MiB | %s GB/s |\n", $2, $3, $4 }' "$log/batch.txt"
 echo
@@ -90,5 +99,7 @@ echo "== batch"; grep -v '^\[20' "$log/batch.txt"
 echo
 echo "== batch, sessions"; grep -v '^\[20' "$log/sessions.txt"
 echo
+echo "== pathtraced"; grep -v '^\[20' "$log/pathtraced.txt"
+echo
 echo "== parity"; cat "$log/parity.txt"
-exit $(( host_rc | gpu_rc | bench_rc | batch_rc | sessions_rc | parity_rc ))
+exit $(( host_rc | gpu_rc | bench_rc | batch_rc | sessions_rc | parity_rc | path_rc ))

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "media_test_util.h"
+#include "penumbra/core/error.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"

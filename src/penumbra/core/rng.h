@@ -2,10 +2,14 @@
 // counter-based random numbers: every draw is a pure function of its keys, so
 // results never depend on thread count, scheduling or call order.
 //
+// host and device (PB_HOST_DEVICE): the CUDA kernels draw the CPU's streams bit for bit.
+//
 // hash: the 64-bit finaliser of SplitMix64 (Steele, Lea, Flood, "Fast splittable
 // pseudorandom number generators", OOPSLA 2014).
 
 #include <cstdint>
+
+#include "penumbra/core/host_device.h"
 
 namespace penumbra {
 
@@ -34,35 +38,35 @@ constexpr uint64_t HashKeys(uint64_t a, uint64_t b, uint64_t c, uint64_t d) {
 /// a small deterministic stream seeded by keys, e.g. Rng(HashKeys(seed, frame, pixel, sample)).
 class Rng {
  public:
-  explicit constexpr Rng(uint64_t stream) : state_(stream) {}
+  PB_HOST_DEVICE explicit constexpr Rng(uint64_t stream) : state_(stream) {}
   /// next 64 random bits.
-  constexpr uint64_t NextU64() {
+  PB_HOST_DEVICE constexpr uint64_t NextU64() {
     state_ += kGamma;
     return Finalize(state_);
   }
   /// the n-th output (n = 0, 1, ...) of Rng(stream).NextU64() without drawing the ones before
   /// it: SplitMix64 is counter-based, its state after n + 1 draws is stream + (n + 1) gamma.
   /// branch-free, so loops over many streams vectorise.
-  static constexpr uint64_t DrawAt(uint64_t stream, uint64_t n) {
+  PB_HOST_DEVICE static constexpr uint64_t DrawAt(uint64_t stream, uint64_t n) {
     return Finalize(stream + (n + 1) * kGamma);
   }
   /// uniform float in [0, 1).
-  float Uniform() { return static_cast<float>(NextU64() >> 40) * 0x1.0p-24f; }
+  PB_HOST_DEVICE float Uniform() { return static_cast<float>(NextU64() >> 40) * 0x1.0p-24f; }
   /// two uniform floats in [0, 1) from one 64-bit draw: *a from its top 24 bits (the value
   /// Uniform() would return for that draw), *b from the 24 bits below them.
-  void Uniform2(float* a, float* b) { Uniform2Of(NextU64(), a, b); }
+  PB_HOST_DEVICE void Uniform2(float* a, float* b) { Uniform2Of(NextU64(), a, b); }
   /// the two floats Uniform2 makes of the 64-bit draw z (via 32-bit integers, exact for
   /// 24-bit values, so that loops over lanes vectorise).
-  static constexpr void Uniform2Of(uint64_t z, float* a, float* b) {
+  PB_HOST_DEVICE static constexpr void Uniform2Of(uint64_t z, float* a, float* b) {
     *a = static_cast<float>(static_cast<int32_t>(z >> 40)) * 0x1.0p-24f;
     *b = static_cast<float>(static_cast<int32_t>((z >> 16) & 0xffffffULL)) * 0x1.0p-24f;
   }
   /// uniform double in [0, 1).
-  double UniformD() { return static_cast<double>(NextU64() >> 11) * 0x1.0p-53; }
+  PB_HOST_DEVICE double UniformD() { return static_cast<double>(NextU64() >> 11) * 0x1.0p-53; }
 
  private:
   static constexpr uint64_t kGamma = rng_detail::kGamma;
-  static constexpr uint64_t Finalize(uint64_t z) { return rng_detail::Finalize(z); }
+  PB_HOST_DEVICE static constexpr uint64_t Finalize(uint64_t z) { return rng_detail::Finalize(z); }
   uint64_t state_;
 };
 

@@ -18,11 +18,13 @@
 //
 // all directions are unit vectors in the world frame pointing away from the surface
 // (wo towards the viewer, wi towards the light). reflection only: f = 0 unless both wo
-// and wi are above the shading and geometric surfaces.
+// and wi are above the shading and geometric surfaces. the arithmetic is written once, as the
+// PB_HOST_DEVICE functions of render/bsdf_math.h that the CUDA backend's path kernels call too.
 
 #include <Eigen/Core>
 
 #include "penumbra/render/brdf_math.h"
+#include "penumbra/render/bsdf_math.h"
 
 namespace penumbra {
 
@@ -87,26 +89,15 @@ class Bsdf {
   /// the shading normal actually used (world).
   const Eigen::Vector3f& shading_normal() const { return n_; }
   /// GGX alpha = max(roughness^2, kMinAlpha).
-  float alpha() const { return alpha_; }
+  float alpha() const { return pod_.alpha; }
   /// probability with which Sample() picks the specular lobe.
-  float specular_probability() const { return p_spec_; }
+  float specular_probability() const { return pod_.p_spec; }
+  /// this BSDF as plain data (render/bsdf_math.h, whose functions Eval, Pdf and Sample call).
+  const BsdfPod& pod() const { return pod_; }
 
  private:
-  // local shading frame: t_, b_, n_ orthonormal (n_ = shading normal).
-  Eigen::Vector3f ToLocal(const Eigen::Vector3f& v) const {
-    return {v.dot(t_), v.dot(b_), v.dot(n_)};
-  }
-  Eigen::Vector3f FromLocal(const Eigen::Vector3f& v) const {
-    return v.x() * t_ + v.y() * b_ + v.z() * n_;
-  }
-  Eigen::Vector3f EvalLocal(const Eigen::Vector3f& wi, bool with_specular) const;
-  float PdfLocal(const Eigen::Vector3f& wi) const;
-
-  Eigen::Vector3f c_diff_, f0_;
-  Eigen::Vector3f t_, b_, n_, ng_;
-  Eigen::Vector3f wo_;  // local frame
-  float alpha_ = 0.25f;
-  float p_spec_ = 0.5f;
+  BsdfPod pod_;
+  Eigen::Vector3f c_diff_, f0_, n_;
 };
 
 }  // namespace penumbra

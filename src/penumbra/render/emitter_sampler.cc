@@ -6,23 +6,13 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/emitter_math.h"
 
 namespace penumbra {
 namespace {
 
 double EmitterLuminance(const Eigen::Vector3f& c) {
   return 0.2126 * c.x() + 0.7152 * c.y() + 0.0722 * c.z();
-}
-
-// index of the cdf interval holding u, and u rescaled to [0, 1) within it.
-int PickFromCdf(const std::vector<double>& cdf, double u, double* u_rest) {
-  const int n = static_cast<int>(cdf.size()) - 1;
-  int i = static_cast<int>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1;
-  i = std::clamp(i, 0, n - 1);
-  while (i < n - 1 && cdf[i + 1] <= cdf[i]) ++i;
-  const double width = cdf[i + 1] - cdf[i];
-  *u_rest = width > 0 ? std::clamp((u - cdf[i]) / width, 0.0, 1.0 - 1e-12) : 0.5;
-  return i;
 }
 
 // normalised cdf from non-negative weights; returns the total.
@@ -35,21 +25,31 @@ double BuildCdf(const std::vector<double>& w, std::vector<double>* cdf) {
   return total;
 }
 
-// an orthonormal basis around unit n (Duff et al., "Building an orthonormal basis,
-// revisited", JCGT 2017).
-void Basis(const Eigen::Vector3d& n, Eigen::Vector3d* t, Eigen::Vector3d* b) {
-  const double sign = std::copysign(1.0, n.z());
-  const double a = -1.0 / (sign + n.z());
-  const double bb = n.x() * n.y() * a;
-  *t = Eigen::Vector3d(1 + sign * n.x() * n.x() * a, sign * bb, -sign * n.x());
-  *b = Eigen::Vector3d(bb, sign + n.y() * n.y() * a, -n.y());
+EmitterShape ShapeOf(GeomShape s) {
+  switch (s) {
+    case GeomShape::kSphere:
+      return EmitterShape::kSphere;
+    case GeomShape::kPlane:
+      return EmitterShape::kPlane;
+    case GeomShape::kBox:
+      return EmitterShape::kBox;
+    case GeomShape::kCylinder:
+      return EmitterShape::kCylinder;
+    case GeomShape::kCapsule:
+      return EmitterShape::kCapsule;
+    case GeomShape::kMesh:
+      return EmitterShape::kMesh;
+    default:
+      return EmitterShape::kOther;
+  }
 }
 
-Eigen::Vector3d UniformSphere(double u1, double u2) {
-  const double z = 1 - 2 * u1;
-  const double r = std::sqrt(std::max(0.0, 1 - z * z));
-  const double phi = 2 * std::numbers::pi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), z};
+// the rotation (row-major) and translation of a pose, as the shared functions take them.
+void PoseArrays(const Pose& X, double R[9], double t[3]) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R[3 * r + c] = X.linear()(r, c);
+    t[r] = X.translation()[r];
+  }
 }
 
 bool IsSampledShape(const Geom& g) {
@@ -66,16 +66,6 @@ bool IsSampledShape(const Geom& g) {
       return false;
   }
 }
-
-// 1 - cos(theta_max) of the cone a sphere of radius r subtends at distance dc > r, stable for
-// small cones.
-double OneMinusCosCone(double r, double dc) {
-  const double sin2 = std::min(1.0, r * r / (dc * dc));
-  return sin2 / (1 + std::sqrt(std::max(0.0, 1 - sin2)));
-}
-
-// a point counts as outside a sphere (cone sampling) beyond this factor of r^2.
-constexpr double kOutsideFactor = 1.0001;
 
 }  // namespace
 
@@ -135,6 +125,20 @@ EmitterSampler::EmitterSampler(const SceneDescription& scene)
     emitter_of_geom_[gi] = static_cast<int>(emitters_.size());
     power.push_back(EmitterLuminance(e.Le) * e.area);
     emitters_.push_back(std::move(e));
+    // the plain data of the shared functions (render/emitter_math.h), pointing into the
+    // emitter's part cdf and the scene's mesh
+    Emitter& added = emitters_.back();
+    EmitterPod& pod = added.pod;
+    pod.shape = ShapeOf(g.shape);
+    for (int k = 0; k < 3; ++k) pod.size[k] = g.size[k];
+    pod.area = added.area;
+    pod.part_cdf = added.part_cdf.empty() ? nullptr : added.part_cdf.data();
+    pod.num_parts = added.part_cdf.empty() ? 0 : static_cast<int32_t>(added.part_cdf.size()) - 1;
+    if (g.shape == GeomShape::kMesh) {
+      const TriangleMesh& mesh = scene.meshes[g.mesh];
+      pod.vertices = mesh.vertices.empty() ? nullptr : mesh.vertices.front().data();
+      pod.faces = mesh.faces.empty() ? nullptr : mesh.faces.front().data();
+    }
   }
   BuildCdf(power, &pick_cdf_);
 }
@@ -146,134 +150,28 @@ Pose EmitterSampler::GeomPose(const std::vector<Pose>& X_WB, const Emitter& e) c
   return X_WBody * g.X_BG;
 }
 
-void EmitterSampler::SampleArea(const Emitter& e, float u_part, float u1, float u2,
-                                Eigen::Vector3d* p, Eigen::Vector3d* n) const {
-  const Geom& g = scene_.geoms[e.geom];
-  const Eigen::Vector3d s = g.size;
-  double ur = u_part;
-  int part = 0;
-  if (!e.part_cdf.empty()) part = PickFromCdf(e.part_cdf, u_part, &ur);
-  switch (e.shape) {
-    case GeomShape::kSphere:
-      *n = UniformSphere(u1, u2);
-      *p = s.x() * *n;
-      break;
-    case GeomShape::kPlane:
-      *p = Eigen::Vector3d((2 * u1 - 1) * s.x(), (2 * u2 - 1) * s.y(), 0);
-      *n = Eigen::Vector3d(0, 0, 1);
-      break;
-    case GeomShape::kBox: {
-      const int axis = part / 2;
-      const double sign = (part % 2 == 0) ? 1.0 : -1.0;
-      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-      Eigen::Vector3d q;
-      q[axis] = sign * s[axis];
-      q[a1] = (2 * u1 - 1) * s[a1];
-      q[a2] = (2 * u2 - 1) * s[a2];
-      *p = q;
-      *n = Eigen::Vector3d::Zero();
-      (*n)[axis] = sign;
-      break;
-    }
-    case GeomShape::kCylinder:
-    case GeomShape::kCapsule: {
-      const double r = s.x(), h = s.y();
-      if (part == 0) {  // side
-        const double phi = 2 * std::numbers::pi * u1;
-        *n = Eigen::Vector3d(std::cos(phi), std::sin(phi), 0);
-        *p = Eigen::Vector3d(r * n->x(), r * n->y(), (2 * u2 - 1) * h);
-      } else {
-        const double sign = part == 1 ? 1.0 : -1.0;
-        if (e.shape == GeomShape::kCylinder) {  // cap disc
-          const double rr = r * std::sqrt(static_cast<double>(u1)), phi = 2 * std::numbers::pi * u2;
-          *p = Eigen::Vector3d(rr * std::cos(phi), rr * std::sin(phi), sign * h);
-          *n = Eigen::Vector3d(0, 0, sign);
-        } else {  // hemisphere: uniform on the half sphere z * sign >= 0
-          const double z = static_cast<double>(u1);
-          const double rr = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * std::numbers::pi * u2;
-          *n = Eigen::Vector3d(rr * std::cos(phi), rr * std::sin(phi), sign * z);
-          *p = r * *n + Eigen::Vector3d(0, 0, sign * h);
-        }
-      }
-      break;
-    }
-    case GeomShape::kMesh: {
-      const TriangleMesh& mesh = scene_.meshes[g.mesh];
-      const Eigen::Vector3i& f = mesh.faces[part];
-      const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>();
-      const Eigen::Vector3d b = mesh.vertices[f[1]].cast<double>();
-      const Eigen::Vector3d c = mesh.vertices[f[2]].cast<double>();
-      const double su = std::sqrt(static_cast<double>(u1));
-      const double b0 = 1 - su, b1 = static_cast<double>(u2) * su;
-      *p = b0 * a + b1 * b + (1 - b0 - b1) * c;
-      *n = (b - a).cross(c - a).normalized();
-      break;
-    }
-    default:
-      *p = Eigen::Vector3d::Zero();
-      *n = Eigen::Vector3d::UnitZ();
-      break;
-  }
-}
-
 bool EmitterSampler::Sample(const std::vector<Pose>& X_WB, const Eigen::Vector3f& p_W, float u_pick,
                             float u1, float u2, EmitterSample* s) const {
   if (emitters_.empty()) return false;
   double u_rest = 0;
-  const int k = PickFromCdf(pick_cdf_, u_pick, &u_rest);
+  const int k =
+      EmitterPickFromCdf(pick_cdf_.data(), static_cast<int>(pick_cdf_.size()) - 1, u_pick, &u_rest);
   const double p_pick = pick_cdf_[k + 1] - pick_cdf_[k];
   if (!(p_pick > 0)) return false;
   const Emitter& e = emitters_[k];
-  const Pose X_WG = GeomPose(X_WB, e);
-  const Eigen::Vector3d p = p_W.cast<double>();
+  double R[9], t[3];
+  PoseArrays(GeomPose(X_WB, e), R, t);
+  const double p[3] = {p_W.x(), p_W.y(), p_W.z()};
   s->geom = e.geom;
   s->Le = e.Le;
-
-  if (e.shape == GeomShape::kSphere) {
-    const double r = scene_.geoms[e.geom].size.x();
-    const Eigen::Vector3d c = X_WG.translation();
-    const Eigen::Vector3d to_c = c - p;
-    const double dc2 = to_c.squaredNorm();
-    if (dc2 > kOutsideFactor * r * r) {
-      // uniform direction in the subtended cone, then the nearer intersection with the sphere.
-      const double dc = std::sqrt(dc2);
-      const double one_minus_cos_max = OneMinusCosCone(r, dc);
-      const double cos_t = 1 - u1 * one_minus_cos_max;
-      const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
-      const double phi = 2 * std::numbers::pi * u2;
-      const Eigen::Vector3d w = to_c / dc;
-      Eigen::Vector3d t, b;
-      Basis(w, &t, &b);
-      const Eigen::Vector3d wi = sin_t * std::cos(phi) * t + sin_t * std::sin(phi) * b + cos_t * w;
-      // distance along wi to the sphere: dc cos_t - sqrt(r^2 - dc^2 sin_t^2) (clamped at tangency).
-      const double disc = std::max(0.0, r * r - dc2 * sin_t * sin_t);
-      const double dist = dc * cos_t - std::sqrt(disc);
-      const Eigen::Vector3d hit = p + dist * wi;
-      s->p_W = hit.cast<float>();
-      s->n_W = (hit - c).normalized().cast<float>();
-      s->wi = wi.cast<float>();
-      s->distance = static_cast<float>(dist);
-      s->pdf = static_cast<float>(p_pick / (2 * std::numbers::pi * one_minus_cos_max));
-      return s->pdf > 0 && dist > 0;
-    }
-  }
-  Eigen::Vector3d q_G, n_G;
-  SampleArea(e, static_cast<float>(u_rest), u1, u2, &q_G, &n_G);
-  const Eigen::Vector3d q = X_WG * q_G;
-  const Eigen::Vector3d n = X_WG.linear() * n_G;
-  const Eigen::Vector3d d = q - p;
-  const double dist2 = d.squaredNorm();
-  if (!(dist2 > 0)) return false;
-  const double dist = std::sqrt(dist2);
-  const Eigen::Vector3d wi = d / dist;
-  const double cos_l = std::abs(n.dot(wi));
-  if (!(cos_l > 1e-7)) return false;
-  s->p_W = q.cast<float>();
-  s->n_W = n.cast<float>();
-  s->wi = wi.cast<float>();
-  s->distance = static_cast<float>(dist);
-  s->pdf = static_cast<float>(p_pick * dist2 / (e.area * cos_l));
-  return std::isfinite(s->pdf) && s->pdf > 0;
+  EmitterPoint ep;
+  const bool ok = EmitterSamplePoint(e.pod, p_pick, R, t, p, u_rest, u1, u2, &ep);
+  s->p_W = Eigen::Vector3d(ep.q[0], ep.q[1], ep.q[2]).cast<float>();
+  s->n_W = Eigen::Vector3d(ep.n[0], ep.n[1], ep.n[2]).cast<float>();
+  s->wi = Eigen::Vector3d(ep.wi[0], ep.wi[1], ep.wi[2]).cast<float>();
+  s->distance = static_cast<float>(ep.distance);
+  s->pdf = ep.pdf;
+  return ok;
 }
 
 float EmitterSampler::Pdf(const std::vector<Pose>& X_WB, int geom, const Eigen::Vector3f& p_W,
@@ -284,20 +182,13 @@ float EmitterSampler::Pdf(const std::vector<Pose>& X_WB, int geom, const Eigen::
   const Emitter& e = emitters_[k];
   const double p_pick = pick_cdf_[k + 1] - pick_cdf_[k];
   if (!(p_pick > 0)) return 0.0f;
-  const Eigen::Vector3d p = p_W.cast<double>();
-  if (e.shape == GeomShape::kSphere) {
-    const double r = scene_.geoms[e.geom].size.x();
-    const double dc2 = (GeomPose(X_WB, e).translation() - p).squaredNorm();
-    if (dc2 > kOutsideFactor * r * r)
-      return static_cast<float>(p_pick /
-                                (2 * std::numbers::pi * OneMinusCosCone(r, std::sqrt(dc2))));
-  }
-  const Eigen::Vector3d d = p_hit_W.cast<double>() - p;
-  const double dist2 = d.squaredNorm();
-  if (!(dist2 > 0)) return 0.0f;
-  const double cos_l = std::abs(n_hit_W.cast<double>().normalized().dot(d / std::sqrt(dist2)));
-  if (!(cos_l > 1e-7)) return 0.0f;
-  return static_cast<float>(p_pick * dist2 / (e.area * cos_l));
+  const Eigen::Vector3d c = e.pod.shape == EmitterShape::kSphere
+                                ? Eigen::Vector3d(GeomPose(X_WB, e).translation())
+                                : Eigen::Vector3d::Zero();
+  const double p[3] = {p_W.x(), p_W.y(), p_W.z()};
+  const double hit[3] = {p_hit_W.x(), p_hit_W.y(), p_hit_W.z()};
+  const double n[3] = {n_hit_W.x(), n_hit_W.y(), n_hit_W.z()};
+  return EmitterPointPdf(e.pod, p_pick, c.data(), p, hit, n);
 }
 
 }  // namespace penumbra

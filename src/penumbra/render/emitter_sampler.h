@@ -13,6 +13,9 @@
 // ellipsoids, height fields and infinite planes are not sampled: they are found only by
 // BSDF sampling, whose multiple-importance weight is then 1 (Pdf() returns 0 for them).
 //
+// the sampling arithmetic is the shared PB_HOST_DEVICE code of render/emitter_math.h (in double,
+// rounded as the Eigen code it replaced); the geom's pose is composed here (Pose).
+//
 // visibility matches RayScene: geoms in MJCF groups > 2 or with material alpha < 0.5 are
 // left out. emitters move with their bodies: every call takes the body poses X_WB.
 
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include "penumbra/core/pose.h"
+#include "penumbra/render/emitter_math.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -58,6 +62,20 @@ class EmitterSampler {
   float Pdf(const std::vector<Pose>& X_WB, int geom, const Eigen::Vector3f& p_W,
             const Eigen::Vector3f& p_hit_W, const Eigen::Vector3f& n_hit_W) const;
 
+  /// emitter k (0 .. size() - 1, in pick order) as the shared functions take it (its pointers
+  /// into this sampler's part cdf and the scene's mesh), its emitted radiance and its geom.
+  const EmitterPod& pod(int k) const { return emitters_[k].pod; }
+  const Eigen::Vector3f& Le(int k) const { return emitters_[k].Le; }
+  int geom(int k) const { return emitters_[k].geom; }
+  /// the cdf of the emitters' pick by power (size() + 1 values).
+  const std::vector<double>& pick_cdf() const { return pick_cdf_; }
+  /// per SceneDescription geom: its emitter index, or -1.
+  const std::vector<int>& emitter_of_geom() const { return emitter_of_geom_; }
+  /// the world pose of emitter k's geom for body poses X_WB.
+  Pose EmitterPose(const std::vector<Pose>& X_WB, int k) const {
+    return GeomPose(X_WB, emitters_[k]);
+  }
+
  private:
   struct Emitter {
     int geom = -1;
@@ -65,11 +83,9 @@ class EmitterSampler {
     Eigen::Vector3f Le{0, 0, 0};
     double area = 0;               // m^2
     std::vector<double> part_cdf;  // box faces / cylinder parts / mesh triangles, by area
+    EmitterPod pod;                // the above as the shared functions take it
   };
   Pose GeomPose(const std::vector<Pose>& X_WB, const Emitter& e) const;
-  // uniform point on the surface in the geom frame, with its outward normal.
-  void SampleArea(const Emitter& e, float u_part, float u1, float u2, Eigen::Vector3d* p,
-                  Eigen::Vector3d* n) const;
 
   const SceneDescription& scene_;
   std::vector<Emitter> emitters_;

@@ -27,12 +27,27 @@ struct LightPod {
   int32_t cast_shadow = 1;             ///< 1: trace a shadow ray
 };
 
+/// a . b of two 3-vectors of scalar type T: summed (x + y) + z (pbm::Dot, the lanes' and the
+/// kernels' order), or with kEigen x + (y + z), as Eigen's fixed-size reduction sums a Vector3f's
+/// dot product and squared norm (Eigen 3.4, Redux.h: the terms split in halves).
+template <bool kEigen, typename T, typename V>
+PB_HOST_DEVICE inline T DotAs(const V& a, const V& b) {
+  if constexpr (kEigen) {
+    return a.x * b.x + (a.y * b.y + a.z * b.z);
+  } else {
+    return pbm::Dot<T>(a, b);
+  }
+}
+
 /// a unit direction sampled uniformly in the cone of cosine `cos_max` around the unit axis w
 /// (Pharr, Jakob, Humphreys, "Physically Based Rendering", 4th ed., sec. A.5.4) with the basis
 /// of Duff et al. ("Building an orthonormal basis, revisited", JCGT 2017). the axis may be
 /// per point (A = T, AV = V) or one for all lanes (A = float, AV = Float3: the basis is then
-/// computed once).
-template <typename T, typename V, typename A, typename AV>
+/// computed once). the direction is normalised by its inverse norm (the lanes' way), or with
+/// kEigen (float only) as Eigen's normalized() of a Vector3f: each component divided by the norm
+/// where the squared norm (DotAs) is > 0 (the scalar LightSampler::Sample, which the pathtraced
+/// tier calls).
+template <typename T, typename V, typename A, typename AV, bool kEigen = false>
 PB_HOST_DEVICE inline V SampleConeDirection(const AV& w, const A& cos_max, const T& u1,
                                             const T& u2) {
   const T cos_t = 1.0f - u1 * (1.0f - cos_max);
@@ -47,8 +62,15 @@ PB_HOST_DEVICE inline V SampleConeDirection(const AV& w, const A& cos_max, const
   const T sc = sin_t * cp, ss = sin_t * sp;
   const V d{sc * t.x + ss * bt.x + cos_t * w.x, sc * t.y + ss * bt.y + cos_t * w.y,
             sc * t.z + ss * bt.z + cos_t * w.z};
-  const T inv = 1.0f / pbm::Sqrt(pbm::Dot<T>(d, d));
-  return V{d.x * inv, d.y * inv, d.z * inv};
+  if constexpr (kEigen) {
+    const T z = DotAs<true, T>(d, d);
+    if (!(z > 0.0f)) return d;
+    const T n = pbm::Sqrt(z);
+    return V{d.x / n, d.y / n, d.z / n};
+  } else {
+    const T inv = 1.0f / pbm::Sqrt(pbm::Dot<T>(d, d));
+    return V{d.x * inv, d.y * inv, d.z * inv};
+  }
 }
 
 /// one sample of light `l` at world point p_W with uniform numbers u1, u2 in [0, 1) (used by
@@ -56,14 +78,17 @@ PB_HOST_DEVICE inline V SampleConeDirection(const AV& w, const A& cos_max, const
 /// emitter point (+inf for directional lights), illuminance *E (lux per channel) on a surface
 /// facing wi, and *valid: false where the light sends nothing to p_W (outside a spot cone,
 /// p_W inside the emitter; the other outputs are then unspecified). the model: light_sampler.h.
-/// M is bool for float and LaneMask for lanes.
-template <typename T, typename V, typename M>
+/// M is bool for float and LaneMask for lanes. kEigen (float only): dot products and the cone
+/// direction's normalisation rounded as the Eigen code of the scalar LightSampler::Sample (DotAs,
+/// SampleConeDirection), whose bits it then gives; else as the lanes' code.
+template <typename T, typename V, typename M, bool kEigen = false>
 PB_HOST_DEVICE inline void SampleLight(const LightPod& l, const V& p_W, const T& u1, const T& u2,
                                        V* wi, T* distance, V* E, M* valid) {
   if (l.kind == LightKind::kDirectional) {
     const Float3 to_light = -l.direction_W;
     if (l.cos_angular_radius < 1.0f) {
-      *wi = SampleConeDirection<T, V, float, Float3>(to_light, l.cos_angular_radius, u1, u2);
+      *wi =
+          SampleConeDirection<T, V, float, Float3, kEigen>(to_light, l.cos_angular_radius, u1, u2);
     } else {
       *wi = V{pbm::Splat<T>(to_light.x), pbm::Splat<T>(to_light.y), pbm::Splat<T>(to_light.z)};
     }
@@ -74,14 +99,21 @@ PB_HOST_DEVICE inline void SampleLight(const LightPod& l, const V& p_W, const T&
     return;
   }
   const V to_light{l.position_W.x - p_W.x, l.position_W.y - p_W.y, l.position_W.z - p_W.z};
-  const T d2 = pbm::Dot<T>(to_light, to_light);
+  const T d2 = DotAs<kEigen, T>(to_light, to_light);
   const T d = pbm::Sqrt(d2);
   *valid = pbm::GreaterThan(d, l.radius_m);
   T atten = pbm::Splat<T>(1.0f);
   if (l.kind == LightKind::kSpot) {
-    const T cos_axis = -(to_light.x * l.direction_W.x + to_light.y * l.direction_W.y +
-                         to_light.z * l.direction_W.z) /
-                       d;
+    T cos_axis;
+    if constexpr (kEigen) {
+      cos_axis = -(to_light.x * l.direction_W.x +
+                   (to_light.y * l.direction_W.y + to_light.z * l.direction_W.z)) /
+                 d;
+    } else {
+      cos_axis = -(to_light.x * l.direction_W.x + to_light.y * l.direction_W.y +
+                   to_light.z * l.direction_W.z) /
+                 d;
+    }
     if (l.cos_inner <= l.cos_outer) {
       // a hard step where the cone has no soft edge.
       atten = pbm::StepGreaterEqual(cos_axis, l.cos_outer);
@@ -101,9 +133,9 @@ PB_HOST_DEVICE inline void SampleLight(const LightPod& l, const V& p_W, const T&
     // sphere of uniform radiance I / (pi r^2) each direction carries the full I / d^2.
     const T sin2 = (l.radius_m * l.radius_m) / d2;
     const T cos_max = pbm::Sqrt(pbm::Max(1.0f - sin2, 0.0f));
-    *wi = SampleConeDirection<T, V, T, V>(w, cos_max, u1, u2);
+    *wi = SampleConeDirection<T, V, T, V, kEigen>(w, cos_max, u1, u2);
     // distance to the sphere along wi: the nearer root of |p + t wi - c|^2 = r^2.
-    const T b = pbm::Dot<T>(*wi, to_light);
+    const T b = DotAs<kEigen, T>(*wi, to_light);
     const T disc = pbm::Max(b * b - (d2 - l.radius_m * l.radius_m), 0.0f);
     *distance = pbm::Max(b - pbm::Sqrt(disc), 0.0f);
   } else {

@@ -12,35 +12,6 @@
 namespace penumbra {
 namespace {
 
-// cubic smoothstep from e0 (0) to e1 (1); a hard step where e0 == e1.
-inline float SmoothStep(float e0, float e1, float x) {
-  if (e1 <= e0) return x >= e0 ? 1.0f : 0.0f;
-  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
-
-// tangent t and bitangent bt completing unit w to an orthonormal basis (Duff et al., "Building
-// an orthonormal basis, revisited", JCGT 2017).
-inline void ConeBasis(const Eigen::Vector3f& w, Eigen::Vector3f* t, Eigen::Vector3f* bt) {
-  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
-  const float a = -1.0f / (sign + w.z());
-  const float b = w.x() * w.y() * a;
-  *t = Eigen::Vector3f(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
-  *bt = Eigen::Vector3f(b, sign + w.y() * w.y() * a, -w.y());
-}
-
-// unit direction sampled uniformly in the cone of half-angle acos(cos_max) around unit axis
-// w (Pharr, Jakob, Humphreys, "Physically Based Rendering", 4th ed., sec. A.5.4).
-inline Eigen::Vector3f SampleCone(const Eigen::Vector3f& w, float cos_max, float u1, float u2) {
-  const float cos_t = 1.0f - u1 * (1.0f - cos_max);
-  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-  float sp, cp;
-  SinCos2Pi(u2, &sp, &cp);
-  Eigen::Vector3f t, bt;
-  ConeBasis(w, &t, &bt);
-  return (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
-}
-
 // the pose-independent part of a light.
 PosedLight Unposed(const Light& l) {
   PosedLight p;
@@ -131,42 +102,19 @@ void LightSampler::Update(const WorldSnapshot& snapshot, const EffectsFrame* eff
 
 bool LightSampler::Sample(int i, const Eigen::Vector3f& p_W, float u1, float u2,
                           LightSample* s) const {
-  const PosedLight& l = lights_[i];
-  s->cast_shadow = l.cast_shadow;
-  if (l.type == Light::Type::kDirectional) {
-    const Eigen::Vector3f to_light = -l.direction_W;
-    s->wi =
-        l.cos_angular_radius < 1.0f ? SampleCone(to_light, l.cos_angular_radius, u1, u2) : to_light;
-    s->distance = std::numeric_limits<float>::infinity();
-    s->E = l.intensity_rgb;
-    return true;
-  }
-  const Eigen::Vector3f to_light = l.position_W - p_W;
-  const float d2 = to_light.squaredNorm();
-  const float d = std::sqrt(d2);
-  if (!(d > l.radius_m)) return false;  // inside the emitter (or at a point light)
-  float atten = 1.0f;
-  if (l.type == Light::Type::kSpot) {
-    const float cos_axis = -to_light.dot(l.direction_W) / d;
-    atten = SmoothStep(l.cos_outer, l.cos_inner, cos_axis);
-    if (atten <= 0) return false;
-  }
-  s->E = l.intensity_rgb * (atten / d2);
-  const Eigen::Vector3f w = to_light * (1.0f / d);
-  if (l.radius_m > 0) {
-    // uniform direction in the cone the sphere subtends, ending on its near surface: for a
-    // sphere of uniform radiance I / (pi r^2) each direction carries the full I / d^2.
-    const float sin2 = (l.radius_m * l.radius_m) / d2;
-    const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sin2));
-    s->wi = SampleCone(w, cos_max, u1, u2);
-    // distance to the sphere along wi: the nearer root of |p + t wi - c|^2 = r^2.
-    const float b = s->wi.dot(to_light);
-    const float disc = std::max(0.0f, b * b - (d2 - l.radius_m * l.radius_m));
-    s->distance = std::max(b - std::sqrt(disc), 0.0f);
-  } else {
-    s->wi = w;
-    s->distance = d;
-  }
+  // the shared SampleLight (render/light_math.h) with Eigen's normalisation of the cone
+  // direction, which this scalar form has always used.
+  const LightPod& l = pods_[i];
+  s->cast_shadow = l.cast_shadow != 0;
+  Float3 wi, E;
+  float distance = 0;
+  bool valid = false;
+  SampleLight<float, Float3, bool, true>(l, Float3{p_W.x(), p_W.y(), p_W.z()}, u1, u2, &wi,
+                                         &distance, &E, &valid);
+  if (!valid) return false;
+  s->wi = Eigen::Vector3f(wi.x, wi.y, wi.z);
+  s->distance = distance;
+  s->E = Eigen::Vector3f(E.x, E.y, E.z);
   return true;
 }
 

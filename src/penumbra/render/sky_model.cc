@@ -10,6 +10,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/sky_eval_math.h"
 #include "penumbra/render/sky_math.h"
+#include "penumbra/render/sky_sampling_math.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra {
@@ -73,28 +74,11 @@ class Distribution1D {
 
   int count() const { return static_cast<int>(pdf_.size()); }
   double integral() const { return integral_; }
-  /// samples keep this fraction of a cell away from its edges, so that float rounding of
-  /// the direction never moves Pdf() into a neighbouring cell; densities scale to match.
-  static constexpr float kCellMargin = 1e-4f;
-
-  /// density on [0, 1] in cell i.
-  float Pdf(int i) const { return pdf_[i] / (1 - 2 * kCellMargin); }
-
-  /// maps u in [0, 1) to x in [0, 1); writes the density at x and the cell index.
-  float Sample(float u, float* pdf, int* cell) const {
-    const int n = count();
-    // the cell with cdf[i] <= u < cdf[i + 1], searched forward from the guide entry.
-    int i = guide_[std::clamp(static_cast<int>(u * n), 0, n - 1)];
-    while (i < n - 1 && cdf_[i + 1] <= u) ++i;
-    // skip zero-width cells the search may land on.
-    while (i < n - 1 && pdf_[i] <= 0) ++i;
-    const float width = cdf_[i + 1] - cdf_[i];
-    float du = width > 0 ? (u - cdf_[i]) / width : 0.5f;
-    du = kCellMargin + std::clamp(du, 0.0f, 1.0f) * (1 - 2 * kCellMargin);
-    *pdf = Pdf(i);
-    *cell = i;
-    return (i + du) / n;
-  }
+  /// densities, cdf and guide table as SkyDistributionPod takes them (sampled by the shared
+  /// SkyDistributionSample, render/sky_sampling_math.h).
+  const std::vector<float>& pdf() const { return pdf_; }
+  const std::vector<float>& cdf() const { return cdf_; }
+  const std::vector<int>& guide() const { return guide_; }
 
  private:
   std::vector<float> pdf_;
@@ -125,9 +109,11 @@ struct SkyModel::Impl {
   SkyModelPod pod;
   double theta_sun = 0;
 
-  // sampling: marginal over rows (theta), conditionals per row over phi.
-  std::vector<Distribution1D> conditional;
-  std::unique_ptr<Distribution1D> marginal;
+  // sampling: marginal over rows (theta), conditionals per row over phi, flattened for the
+  // shared functions (render/sky_sampling_math.h) and pointed to by `sampling`.
+  std::vector<float> marginal_pdf, marginal_cdf, cond_pdf, cond_cdf;
+  std::vector<int32_t> marginal_guide, cond_guide;
+  SkySamplingPod sampling;
   // irradiance table (kIrrSide x kIrrSide octahedral nodes), per channel.
   std::vector<Eigen::Vector3f> irradiance;
 
@@ -168,7 +154,6 @@ void SkyModel::Impl::BuildSampling() {
   // a black sky samples the sphere (almost) uniformly so that Sample/Pdf stay valid.
   if (!(max_lum > 0)) std::fill(lum.begin(), lum.end(), 1.0);
   std::vector<double> row_integrals(kSampleRows);
-  conditional.reserve(kSampleRows);
   for (int r = 0; r < kSampleRows; ++r) {
     const double sin_theta = std::sin((r + 0.5) * std::numbers::pi / kSampleRows);
     std::vector<double> f(kSampleCols);
@@ -178,9 +163,24 @@ void SkyModel::Impl::BuildSampling() {
       sum += f[c];
     }
     row_integrals[r] = sum / kSampleCols;
-    conditional.emplace_back(std::move(f));
+    const Distribution1D conditional(std::move(f));
+    cond_pdf.insert(cond_pdf.end(), conditional.pdf().begin(), conditional.pdf().end());
+    cond_cdf.insert(cond_cdf.end(), conditional.cdf().begin(), conditional.cdf().end());
+    cond_guide.insert(cond_guide.end(), conditional.guide().begin(), conditional.guide().end());
   }
-  marginal = std::make_unique<Distribution1D>(std::move(row_integrals));
+  const Distribution1D marginal(std::move(row_integrals));
+  marginal_pdf = marginal.pdf();
+  marginal_cdf = marginal.cdf();
+  marginal_guide.assign(marginal.guide().begin(), marginal.guide().end());
+  sampling.rows = kSampleRows;
+  sampling.cols = kSampleCols;
+  sampling.marginal.pdf = marginal_pdf.data();
+  sampling.marginal.cdf = marginal_cdf.data();
+  sampling.marginal.guide = marginal_guide.data();
+  sampling.marginal.n = kSampleRows;
+  sampling.cond_pdf = cond_pdf.data();
+  sampling.cond_cdf = cond_cdf.data();
+  sampling.cond_guide = cond_guide.data();
 }
 
 // irradiance E(n) = integral of L(w) max(0, n.w) dw, tabulated over normals. the upper
@@ -430,32 +430,15 @@ Eigen::Vector3f SkyModel::Irradiance(const Eigen::Vector3f& n_W) const {
 const SkyModelPod& SkyModel::pod() const { return impl_->pod; }
 
 Eigen::Vector3f SkyModel::Sample(float u1, float u2, float* pdf) const {
-  const Impl& m = *impl_;
-  constexpr float kPiF = static_cast<float>(std::numbers::pi);
-  float pdf_v = 0, pdf_u = 0;
-  int row = 0, col = 0;
-  const float v = m.marginal->Sample(u2, &pdf_v, &row);
-  const float u = m.conditional[row].Sample(u1, &pdf_u, &col);
-  const float theta = v * kPiF, phi = u * 2 * kPiF;
-  const float sin_theta = std::sin(theta);
-  *pdf = sin_theta > 0 ? pdf_v * pdf_u / (2 * kPiF * kPiF * sin_theta) : 0.0f;
-  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), std::cos(theta)};
+  Eigen::Vector3f d;
+  SkySampleDirection(impl_->sampling, u1, u2, pdf, d.data());
+  return d;
 }
 
 float SkyModel::Pdf(const Eigen::Vector3f& dir_W) const {
-  const Impl& m = *impl_;
-  constexpr float kPiF = static_cast<float>(std::numbers::pi);
-  // theta and sin(theta) from atan2 / hypot stay accurate near the poles.
-  const float rho = std::hypot(dir_W.x(), dir_W.y());
-  const float len = std::hypot(rho, dir_W.z());
-  if (!(len > 0) || !(rho > 0)) return 0.0f;
-  const float theta = std::atan2(rho, dir_W.z());
-  const float sin_theta = rho / len;
-  float phi = std::atan2(dir_W.y(), dir_W.x());
-  if (phi < 0) phi += 2 * kPiF;
-  const int row = std::clamp(static_cast<int>(theta / kPiF * kSampleRows), 0, kSampleRows - 1);
-  const int col = std::clamp(static_cast<int>(phi / (2 * kPiF) * kSampleCols), 0, kSampleCols - 1);
-  return m.marginal->Pdf(row) * m.conditional[row].Pdf(col) / (2 * kPiF * kPiF * sin_theta);
+  return SkyDirectionPdf(impl_->sampling, dir_W.x(), dir_W.y(), dir_W.z());
 }
+
+const SkySamplingPod& SkyModel::sampling_pod() const { return impl_->sampling; }
 
 }  // namespace penumbra

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "penumbra/render/sky_eval_math.h"
+#include "penumbra/render/sky_sampling_math.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra {
@@ -77,11 +78,16 @@ class SkyModel {
   Eigen::Vector3f Irradiance(const Eigen::Vector3f& n_W) const;
 
   /// samples a direction with density roughly proportional to radiance from two
-  /// uniform numbers in [0, 1); returns the direction and writes its solid-angle pdf.
+  /// uniform numbers in [0, 1); returns the direction and writes its solid-angle pdf
+  /// (the shared SkySampleDirection, render/sky_sampling_math.h).
   Eigen::Vector3f Sample(float u1, float u2, float* pdf) const;
 
-  /// solid-angle pdf of Sample() producing `dir_W`.
+  /// solid-angle pdf of Sample() producing `dir_W` (the shared SkyDirectionPdf).
   float Pdf(const Eigen::Vector3f& dir_W) const;
+
+  /// the sampling tables as plain data for the shared functions of render/sky_sampling_math.h
+  /// (pointers into this SkyModel's state, as pod()).
+  const SkySamplingPod& sampling_pod() const;
 
   /// this sky as plain data for the shared host/device functions (render/sky_eval_math.h:
   /// SkyRadiance, SkyIrradiance, SkyBackground give Radiance, Irradiance and Background bit for

@@ -165,23 +165,37 @@ TEST_P(CudaBackendWorlds, GroundTruthImagesMatchCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBackendWorlds,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml"));
 
-TEST(CudaBackend, PathtracedRgbFramesGoToTheCpuRenderer) {
+// the pathtraced tier's frames render on the GPU (path_shading.h), emissive geoms included, but
+// not those of a camera with lens distortion (PathNotOnGpu): those go to the CPU renderer inside
+// the backend.
+TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessDistorted) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("default.yaml");
   RenderSettings settings;
   settings.backend = RenderSettings::Backend::kCuda;
   settings.tier = RenderSettings::Tier::kPathtraced;
   settings.samples_per_pixel = 1;
-  const std::unique_ptr<Renderer> gpu = MakeRenderer(session->scene(), settings);
   const WorldSnapshot snap = session->sim().Snapshot();
   CameraView view;
   view.X_WO = CameraPoseInWorld(session->scene().cameras.front(), snap);
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
   view.outputs[ImageKind::kRgb] = true;
-  RenderedFrame f;
-  gpu->Render(snap, view, &f);
-  EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
-  EXPECT_EQ(static_cast<cuda::CudaRenderer*>(gpu.get())->cpu_frames(), 1);
+  CameraView distorted = view;
+  distorted.intrinsics.k1 = 0.1;
+  SceneDescription emissive = session->scene();
+  for (Material& m : emissive.materials) m.emission = Eigen::Vector3f(1, 1, 1);
+  const SceneDescription* scenes[] = {&session->scene(), &emissive};
+  for (const SceneDescription* scene : scenes) {
+    const std::unique_ptr<Renderer> gpu = MakeRenderer(*scene, settings);
+    RenderedFrame f;
+    gpu->Render(snap, view, &f);
+    EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
+    gpu->Render(snap, distorted, &f);
+    EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
+    const auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+    EXPECT_EQ(g->gpu_frames(), 1);
+    EXPECT_EQ(g->cpu_frames(), 1);
+  }
 }
 
 }  // namespace

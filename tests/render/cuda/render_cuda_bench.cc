@@ -36,17 +36,25 @@
 // the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
 // the device's exposure differed from the host's (RealtimeExposureChecks).
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
-// 320x240; scripts/gpu/parity.sh). usage:
+// 320x240; scripts/gpu/parity.sh).
+// --pathtraced [--size WxH] [--spp N]: the pathtraced tier (default 320x240, 64 samples per
+// pixel, 4 bounces, no denoiser): cuda Render() ms a frame (paths on the GPU, film on the host)
+// and the path kernel alone (CUDA events), the CPU backend's Render() on all cores with the same
+// samples (one frame), the radiance's mean relative difference (path_parity.h: 8x8 blocks, and
+// the image mean) and whether two GPU renders are bit-identical. usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
-//                     --realtime [--size WxH]] [world.yaml ...]
+//                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
+//                     [--seed-floor]] [world.yaml ...]
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "penumbra/core/output_file.h"
@@ -65,6 +73,7 @@
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 #include "render/cuda/cuda_parity.h"
+#include "render/cuda/path_parity.h"
 
 namespace penumbra {
 namespace {
@@ -360,16 +369,82 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
   return 0;
 }
 
+// --pathtraced: the pathtraced tier on the GPU beside the CPU backend (file comment)
+int PathtracedMain(const std::vector<std::string>& worlds, int width, int height, int spp,
+                   int frames, bool seed_floor) {
+  fmt::print(
+      "\n| world | size | spp | cuda Render() ms | cuda path kernel ms | cpu Render() ms ({} "
+      "threads) | speed-up | radiance mean rel. diff (8x8 blocks) | image mean | cuda repeats "
+      "bits |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+      std::thread::hardware_concurrency());
+  std::vector<std::string> floors;
+  for (const std::string& file : worlds) {
+    SessionOptions so;
+    so.build_renderer = false;
+    Session session(LoadWorldFile(file), so);
+    Simulation& sim = session.sim();
+    while (sim.time() < 1.0) sim.Step();
+    const WorldSnapshot snap = sim.Snapshot();
+    const SceneDescription& scene = session.scene();
+    const CameraSpec& cam = scene.cameras.front();
+    const std::string name = file.substr(file.find_last_of('/') + 1);
+    CameraView view;
+    view.X_WO = CameraPoseInWorld(cam, snap);
+    view.intrinsics = CameraIntrinsics::FromFovy(width, height, cam.intrinsics.fovy_deg());
+    view.near_m = cam.near_m;
+    view.outputs[ImageKind::kRgb] = view.outputs[ImageKind::kDepth] = true;
+    RenderSettings cpu_settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, spp);
+    cpu_settings.threads = 0;
+    const RenderSettings gpu_settings =
+        path_parity::PathSettings(RenderSettings::Backend::kCuda, spp);
+    const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
+    auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+    RenderedFrame a, b, want;
+    gpu->Render(snap, view, &a);
+    gpu->Render(snap, view, &b);
+    const bool repeats = a.radiance.data == b.radiance.data && a.rgb.data == b.rgb.data;
+    const bool on_gpu = g->cpu_frames() == 0;
+    const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames);
+    const double kernel_ms = on_gpu ? g->device_path().TimeKernel(&g->device(), frames) : 0.0;
+    const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
+    const auto t0 = Clock::now();
+    cpu->Render(snap, view, &want);
+    const double cpu_ms = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+    if (seed_floor) {
+      RenderSettings other = cpu_settings;
+      other.seed = cpu_settings.seed + 1;
+      RenderedFrame c;
+      MakeRenderer(scene, other)->Render(snap, view, &c);
+      floors.push_back(fmt::format(
+          "{}: two CPU renders with seeds {} and {}: mean relative difference {:.3f} % (8x8 "
+          "blocks), {:.3f} % (image mean)",
+          name, cpu_settings.seed, other.seed,
+          100 * path_parity::TileRelativeDifference(c.radiance, want.radiance),
+          100 * path_parity::MeanRelativeDifference(c.radiance, want.radiance)));
+    }
+    fmt::print(
+        "| {} | {}x{} | {} | {:.1f}{} | {:.1f} | {:.0f} | {:.1f}x | {:.3f} % | {:.3f} % | {} |\n",
+        name, width, height, spp, gpu_ms, on_gpu ? "" : " (cpu fallback)", kernel_ms, cpu_ms,
+        cpu_ms / gpu_ms, 100 * path_parity::TileRelativeDifference(a.radiance, want.radiance),
+        100 * path_parity::MeanRelativeDifference(a.radiance, want.radiance),
+        repeats ? "yes" : "NO");
+  }
+  for (const std::string& f : floors) fmt::print("{}\n", f);
+  return 0;
+}
+
 int Main(int argc, char** argv) {
   int frames = 50;
   int width = 0, height = 0, sessions = 1;
-  bool parity = false, realtime = false;
+  bool parity = false, realtime = false, pathtraced = false, seed_floor = false;
+  int spp = 64;
   std::vector<int> batch;
   std::vector<std::string> worlds;
   const auto usage = [](const std::string& why) {
     fmt::print(stderr,
                "render_cuda_bench: {}\nusage: render_cuda_bench [--frames N] [--batch N,... "
-               "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH]] "
+               "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH] | "
+               "--pathtraced [--size WxH] [--spp N]] "
                "[world.yaml ...]\n",
                why);
     return 2;
@@ -403,6 +478,13 @@ int Main(int argc, char** argv) {
       realtime = true;
     } else if (a == "--parity") {
       parity = true;
+    } else if (a == "--pathtraced") {
+      pathtraced = true;
+    } else if (a == "--seed-floor") {
+      seed_floor = true;
+    } else if (a == "--spp" && has_value) {
+      spp = PositiveArg(argv[++i]);
+      if (spp == 0) return usage("--spp: expected a positive integer");
     } else if (a.rfind("--", 0) == 0) {
       return usage("unknown option '" + a + "'");
     } else {
@@ -414,9 +496,15 @@ int Main(int argc, char** argv) {
               std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml"};
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("device: {}\n", dev.available ? dev.name : "none (" + dev.why + ")");
-  if ((parity || realtime || !batch.empty()) && !dev.available) {
-    fmt::print(stderr, "render_cuda_bench: --batch, --parity and --realtime need a CUDA device\n");
+  if ((parity || realtime || pathtraced || !batch.empty()) && !dev.available) {
+    fmt::print(stderr,
+               "render_cuda_bench: --batch, --parity, --realtime and --pathtraced need a CUDA "
+               "device\n");
     return 1;
+  }
+  if (pathtraced) {
+    if (width == 0) width = 320, height = 240;
+    return PathtracedMain(worlds, width, height, spp, std::min(frames, 5), seed_floor);
   }
   if (realtime) {
     if (width == 0) width = 640, height = 480;

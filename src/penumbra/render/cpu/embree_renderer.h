@@ -13,7 +13,7 @@
 #include <string>
 
 #include "penumbra/core/thread_pool.h"
-#include "penumbra/render/cpu/denoiser.h"
+#include "penumbra/render/denoiser.h"
 #include "penumbra/render/cpu/integrator.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/film.h"

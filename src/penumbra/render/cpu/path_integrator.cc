@@ -6,78 +6,34 @@
 #include <vector>
 
 #include "penumbra/render/bsdf.h"
+#include "penumbra/render/path_math.h"
 
 namespace penumbra {
 namespace {
 
-constexpr float kPi = 3.14159265358979323846f;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // shadow rays towards a point at distance d stop this fraction short of it.
 constexpr float kShadowShorten = 1e-4f;
 
-// power heuristic with beta = 2 (Veach 1997, eq. 9.13) for a sample drawn with density
-// pdf_a, the other strategy having density pdf_b.
-inline float PowerHeuristic(float pdf_a, float pdf_b) {
-  if (!(pdf_a > 0)) return 0.0f;
-  if (std::isinf(pdf_a)) return 1.0f;
-  const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-  if (std::isinf(b)) return 0.0f;
-  return a / (a + b);
-}
+Float3 F3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
+Eigen::Vector3f E3(const Float3& v) { return Eigen::Vector3f(v.x, v.y, v.z); }
 
-// 1 - cos(theta_max) of the cone a sphere of radius r subtends at centre distance d > r.
-inline float OneMinusCosCone(float r, float d) {
-  const float sin2 = std::min(1.0f, (r * r) / (d * d));
-  return sin2 / (1.0f + std::sqrt(std::max(0.0f, 1.0f - sin2)));
-}
-
-// cubic smoothstep from e0 (0) to e1 (1), as LightSampler's spot factor.
-inline float SmoothStep(float e0, float e1, float x) {
-  if (e1 <= e0) return x >= e0 ? 1.0f : 0.0f;
-  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
-
-// a point or spot light with a radius that casts shadows: a sphere that rays can hit.
+// a point or spot light with a radius that casts shadows: a sphere that rays can hit (the
+// shared terms of render/path_math.h).
 struct Lamp {
   int light = -1;  // index into LightSampler::lights()
-  Eigen::Vector3f c{0, 0, 0};
-  float r = 0;
-  const PosedLight* posed = nullptr;
+  const LightPod* pod = nullptr;
 
   // radiance (cd/m^2) the sphere sends towards world point p: I s / (pi r^2).
   Eigen::Vector3f RadianceTowards(const Eigen::Vector3f& p) const {
-    float atten = 1.0f;
-    if (posed->type == Light::Type::kSpot) {
-      const Eigen::Vector3f d = p - c;
-      const float n = d.norm();
-      if (!(n > 0)) return Eigen::Vector3f::Zero();
-      atten = SmoothStep(posed->cos_outer, posed->cos_inner, d.dot(posed->direction_W) / n);
-    }
-    return posed->intensity_rgb * (atten / (kPi * r * r));
+    return E3(LampRadianceTowards(*pod, F3(p)));
   }
   // solid angle of the sphere seen from p (outside), 0 from inside.
-  float SolidAngle(const Eigen::Vector3f& p) const {
-    const float d = (c - p).norm();
-    if (!(d > r)) return 0.0f;
-    return 2 * kPi * OneMinusCosCone(r, d);
-  }
+  float SolidAngle(const Eigen::Vector3f& p) const { return LampSolidAngle(*pod, F3(p)); }
   // nearest t in (tmin, tmax) where o + t d (d unit) meets the sphere from outside.
   bool Intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmin, float tmax,
                  float* t) const {
-    const Eigen::Vector3f oc = o - c;
-    const float c2 = oc.squaredNorm() - r * r;
-    if (c2 <= 0) return false;  // origin inside the lamp
-    const float b = oc.dot(d);
-    if (b >= 0) return false;  // sphere behind
-    // discriminant from the closest approach (Pharr, Jakob, Humphreys, PBR 4th ed., 6.8.1).
-    const Eigen::Vector3f q = oc - b * d;
-    const float disc = r * r - q.squaredNorm();
-    if (disc < 0) return false;
-    const float root = -b - std::sqrt(disc);
-    if (!(root > tmin && root < tmax)) return false;
-    *t = root;
-    return true;
+    return LampIntersect(*pod, F3(o), F3(d), tmin, tmax, t);
   }
 };
 
@@ -98,29 +54,25 @@ struct FrameLights {
   bool sky_active = false;
 
   explicit FrameLights(const FrameContext& ctx) {
-    const std::vector<PosedLight>& pl = ctx.lights->lights();
+    const std::vector<LightPod>& pl = ctx.lights->pods();
     lamp_of_light.assign(pl.size(), -1);
     sun_of_light.assign(pl.size(), -1);
     for (size_t i = 0; i < pl.size(); ++i) {
-      const PosedLight& l = pl[i];
-      if (!l.cast_shadow) continue;
-      if (l.type == Light::Type::kDirectional) {
-        if (!(l.cos_angular_radius < 1.0f)) continue;
+      const LightPod& l = pl[i];
+      SunDiscPod disc;
+      if (SunDiscOf(l, &disc)) {
         SunDisc s;
         s.light = static_cast<int>(i);
-        s.to_sun = -l.direction_W;
-        s.cos_max = l.cos_angular_radius;
-        s.solid_angle = 2 * kPi * (1.0f - l.cos_angular_radius);
-        if (!(s.solid_angle > 0)) continue;
-        s.L = l.intensity_rgb / s.solid_angle;
+        s.to_sun = E3(disc.to_sun);
+        s.cos_max = disc.cos_max;
+        s.solid_angle = disc.solid_angle;
+        s.L = E3(disc.L);
         sun_of_light[i] = static_cast<int>(suns.size());
         suns.push_back(s);
-      } else if (l.radius_m > 0) {
+      } else if (IsLampSphere(l)) {
         Lamp lamp;
         lamp.light = static_cast<int>(i);
-        lamp.c = l.position_W;
-        lamp.r = l.radius_m;
-        lamp.posed = &l;
+        lamp.pod = &l;
         lamp_of_light[i] = static_cast<int>(lamps.size());
         lamps.push_back(lamp);
       }

@@ -9,6 +9,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
+#include "penumbra/render/emitter_sampler.h"
 #include "penumbra/scene/texture_image.h"
 
 namespace penumbra::cuda {
@@ -38,6 +39,12 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
   SyncDevice(*bvh_, device_.get());
   realtime_ = std::make_unique<RealtimeFrameData>(scene_, settings);
   device_realtime_ = std::make_unique<DeviceRealtime>();
+  device_path_ = std::make_unique<DevicePath>();
+  if (settings.tier == RenderSettings::Tier::kPathtraced) {
+    emitters_ = std::make_unique<EmitterSampler>(scene_);
+    emitter_host_ = std::make_unique<PathEmitterHost>(*emitters_);
+    if (settings.denoise) denoiser_ = std::make_unique<Denoiser>();
+  }
   pool_ = std::make_unique<ThreadPool>(settings.threads);
 }
 
@@ -49,6 +56,8 @@ bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
 }
 
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
+  if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced)
+    return PathNotOnGpu(effects, view);
   return realtime_->Unsupported(effects, view);
 }
 
@@ -65,7 +74,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                : !fx_why.empty() ? "effects with " + fx_why
                                                  : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (grid media, pathtraced rgb); "
+          "renderer: cuda backend: {}: not on the GPU yet (grid media; in the pathtraced tier "
+          "media, particles and distorted or moving cameras); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;
@@ -90,7 +100,9 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const CameraOutputs& want = view.outputs;
   const int W = c.width, H = c.height;
   out->ev100 = 0;
-  if (want[ImageKind::kRgb]) {
+  if (want[ImageKind::kRgb] && realtime_->settings().tier == RenderSettings::Tier::kPathtraced) {
+    RenderPathtraced(snapshot, effects, view, t0, out);
+  } else if (want[ImageKind::kRgb]) {
     RenderRgb(snapshot, effects, view, c, t0, out);
   } else {
     out->radiance = ImageF();
@@ -115,30 +127,11 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
 void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                              const CameraView& view, const PinholeCamera& camera,
                              std::chrono::steady_clock::time_point t0, RenderedFrame* out) {
-  if (!realtime_uploaded_) {
-    RealtimeStatic st;
-    st.materials = realtime_->materials().data();
-    st.num_materials = static_cast<int64_t>(realtime_->materials().size());
-    st.textures = realtime_->textures().data();
-    st.num_textures = static_cast<int64_t>(realtime_->textures().size());
-    st.texels = realtime_->texels().data();
-    st.num_texel_bytes = static_cast<int64_t>(realtime_->texels().size());
-    st.srgb_decode = SrgbDecodeTable();
-    st.oetf_lut = realtime_->film().oetf_lut().data();
-    device_realtime_->Upload(st);
-    realtime_uploaded_ = true;
-  }
   // the camera's ray tables were Prepared by Render (camera_rays_): not computed again; the
   // media volumes' shadow rays on the GPU, over the BVH Render posed
   if (!media_query_) media_query_ = std::make_unique<CudaRayQuery>(*bvh_, device_.get());
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get());
-  // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
-  // the sky change: its device copy follows
-  if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {
-    device_realtime_->UploadSky(realtime_->SkyData());
-    sky_generation_ = realtime_->sky_generation();
-    sky_uploaded_ = true;
-  }
+  UploadRealtime();
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -172,6 +165,60 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
         return realtime_->Ev100(rows, n, exposure);
       },
       o);
+}
+
+void CudaRenderer::UploadRealtime() {
+  if (!realtime_uploaded_) {
+    RealtimeStatic st;
+    st.materials = realtime_->materials().data();
+    st.num_materials = static_cast<int64_t>(realtime_->materials().size());
+    st.textures = realtime_->textures().data();
+    st.num_textures = static_cast<int64_t>(realtime_->textures().size());
+    st.texels = realtime_->texels().data();
+    st.num_texel_bytes = static_cast<int64_t>(realtime_->texels().size());
+    st.srgb_decode = SrgbDecodeTable();
+    st.oetf_lut = realtime_->film().oetf_lut().data();
+    device_realtime_->Upload(st);
+    realtime_uploaded_ = true;
+  }
+  // the sky volume is built on the first frame and rebuilt or relit when the static bodies or
+  // the sky change: its device copy follows
+  if (!sky_uploaded_ || realtime_->sky_generation() != sky_generation_) {
+    device_realtime_->UploadSky(realtime_->SkyData());
+    sky_generation_ = realtime_->sky_generation();
+    sky_uploaded_ = true;
+  }
+}
+
+void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                                    const CameraView& view,
+                                    std::chrono::steady_clock::time_point t0, RenderedFrame* out) {
+  // a pinhole camera without distortion or motion (PathNotOnGpu): no ray tables
+  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_);
+  UploadRealtime();
+  // the frame sky's sampling tables, again when the sky changes (the effects' sun or scale)
+  if (sampling_sky_ != &realtime_->frame_sky() || sampling_generation_ != sky_generation_) {
+    sampling_sky_ = &realtime_->frame_sky();
+    sampling_generation_ = sky_generation_;
+    sky_sampling_ = device_path_->UploadSkySampling(realtime_->frame_sky().sampling_pod());
+  }
+  const RealtimeFrameView frame =
+      device_realtime_->DeviceFrame(realtime_->View(device_->device_view(), nullptr),
+                                    static_cast<int64_t>(realtime_->geoms().size()));
+  PathFrameView pf = PathView(*realtime_, frame, sky_sampling_);
+  // the emissive geoms: their tables once, their poses every frame
+  if (!emitters_->empty()) {
+    if (!emitters_uploaded_) device_path_->UploadEmitters(emitter_host_->View());
+    emitters_uploaded_ = true;
+    emitter_host_->SetPoses(*emitters_, snapshot.X_WB);
+    pf.emitters = device_path_->UploadEmitterPoses(emitter_host_->poses.data());
+  }
+  prepare_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  device_path_->Render(device_.get(), pf, &path_buffers_);
+  FinishPathFrame(*realtime_, path_buffers_, denoiser_.get(), view.white_balance_gains,
+                  view.outputs[ImageKind::kDepth], pool_.get(), out);
+  if (!radiance_output_) out->radiance = ImageF();
 }
 
 }  // namespace penumbra::cuda

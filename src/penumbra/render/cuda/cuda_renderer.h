@@ -19,8 +19,10 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/path_frame.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
 
@@ -57,6 +59,9 @@ class CudaRenderer final : public Renderer {
   DeviceScene& device() { return *device_; }
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
+  /// the pathtraced tier's device side (after a first pathtraced frame on the GPU), for
+  /// benchmarks.
+  DevicePath& device_path() { return *device_path_; }
 
   /// whether Render fills RenderedFrame::radiance beside the rgb (default true); off, a
   /// consumer that reads only the rgb and depth saves its copy back (3.7 MB at 640x480) and
@@ -80,6 +85,14 @@ class CudaRenderer final : public Renderer {
   void RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
                  const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
                  RenderedFrame* out);
+  // the pathtraced tier's rgb, radiance and depth: the paths on the GPU (cuda_path.h), the
+  // denoiser and film on the host (path_frame.h's FinishPathFrame).
+  void RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                        const CameraView& view, std::chrono::steady_clock::time_point t0,
+                        RenderedFrame* out);
+  // the scene-constant realtime data (materials, textures) and the sky's arrays on the device
+  // (once, and the sky again when it changes): both tiers' rgb read them.
+  void UploadRealtime();
 
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
@@ -87,6 +100,15 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<Renderer> cpu_;
   std::unique_ptr<RealtimeFrameData> realtime_;
   std::unique_ptr<DeviceRealtime> device_realtime_;
+  std::unique_ptr<DevicePath> device_path_;
+  std::unique_ptr<Denoiser> denoiser_;        // the pathtraced tier's, when its settings denoise
+  std::unique_ptr<EmitterSampler> emitters_;  // the pathtraced tier's emissive geoms
+  std::unique_ptr<PathEmitterHost> emitter_host_;  // as the path kernels take them
+  bool emitters_uploaded_ = false;
+  const SkyModel* sampling_sky_ = nullptr;  // the sky whose sampling tables the device holds
+  uint64_t sampling_generation_ = 0;
+  SkySamplingPod sky_sampling_;       // their device copy
+  PathBuffers path_buffers_;          // the pathtraced frame's outputs on the host
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;

@@ -168,6 +168,8 @@ class RealtimeFrameData {
   const PinholeCamera& camera() const { return camera_; }
   const Film& film() const { return film_; }
   const RenderSettings& settings() const { return settings_; }
+  /// the sky of the prepared frame (the scene's, or the effects' moved and scaled one).
+  const SkyModel& frame_sky() const { return *frame_sky_; }
 
  private:
   const SceneDescription& scene_;

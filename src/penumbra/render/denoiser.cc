@@ -1,4 +1,4 @@
-#include "penumbra/render/cpu/denoiser.h"
+#include "penumbra/render/denoiser.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +19,7 @@ constexpr float kAlbedoEps = 1e-3f;
 constexpr float kDepthRelativeTolerance = 0.01f;
 constexpr float kDepthSlopeTolerance = 0.1f;
 
-float Luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+float DenoiseLuminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 // x^e for e >= 0 by repeated squaring when e is a power of two (the default 128), else pow.
 float PowCos(float x, float e, int squarings) {
@@ -140,7 +140,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
   // surface (geometry-weighted), which bounds the noise from above.
   if (guides.variance) {
     for (size_t i = 0; i < n; ++i) {
-      const float a = std::max(Luminance(albedo + i * 3), kAlbedoEps);
+      const float a = std::max(DenoiseLuminance(albedo + i * 3), kAlbedoEps);
       var[i] = std::max(0.0f, guides.variance->data[i]) / (a * a);
     }
   } else {
@@ -158,7 +158,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
             if (!has_surface(j)) continue;
             float dt = 0;
             const float wg = geometry_weight(i, j, du, dv, &dt) * std::exp(-dt);
-            const double l = Luminance(&cur[j * 3]);
+            const double l = DenoiseLuminance(&cur[j * 3]);
             sw += wg;
             s1 += wg * l;
             s2 += wg * l * l;
@@ -193,7 +193,7 @@ void Denoiser::Denoise(const ImageF& radiance, const DenoiserGuides& guides, Thr
             gw += k;
           }
         }
-        const float li = Luminance(&cur[i * 3]);
+        const float li = DenoiseLuminance(&cur[i * 3]);
         const float lum_scale =
             settings_.sigma_luminance * static_cast<float>(std::sqrt(std::max(0.0, gv / gw))) +
             1e-6f * std::abs(li) + 1e-30f;

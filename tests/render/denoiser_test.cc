@@ -1,4 +1,4 @@
-#include "penumbra/render/cpu/denoiser.h"
+#include "penumbra/render/denoiser.h"
 
 #include <gtest/gtest.h>
 

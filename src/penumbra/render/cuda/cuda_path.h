@@ -1,0 +1,54 @@
+#pragma once
+// the pathtraced tier on the GPU (path_shading.h per pixel, path_frame.h on the host): the
+// device copy of the sky's sampling tables and the path kernels. a frame of n pixels splits each
+// pixel's samples into PathRunsPerPixel(n, spp, 2^18) runs of consecutive samples, so that about
+// 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples); one thread a
+// run sums its samples in sample order in double (PathSampleRange), then one thread a pixel adds
+// its runs in run order and writes the pixel (PathFinishPixel). no atomics: frames are
+// bit-identical run to run on one GPU (the run split moves the double sums' last bits against
+// the host path's single run). implemented in path_kernels.cu; plain structs
+// only here (no Eigen, no CUDA headers). every function throws penumbra::Error naming the CUDA
+// call when the runtime reports an error.
+
+#include <cstdint>
+
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/path_buffers.h"
+#include "penumbra/render/cuda/path_shading.h"
+
+namespace penumbra::cuda {
+
+/// the device side of the pathtraced tier.
+class DevicePath {
+ public:
+  DevicePath();
+  ~DevicePath();
+  DevicePath(const DevicePath&) = delete;
+  DevicePath& operator=(const DevicePath&) = delete;
+
+  /// copies the sky's sampling tables (host pointers) to the device; call again whenever the
+  /// frame's sky changes (RealtimeFrameData::sky_generation). returns the device copy's pod.
+  const SkySamplingPod& UploadSkySampling(const SkySamplingPod& host);
+
+  /// copies the emissive geoms of `host` (host pointers; not its poses) to the device; returns
+  /// their device view, whose poses UploadEmitterPoses sets.
+  const PathEmitters& UploadEmitters(const PathEmitters& host);
+  /// copies a frame's emitter poses (12 doubles an emitter, UploadEmitters' count) and returns
+  /// the device view with them (after UploadEmitters).
+  const PathEmitters& UploadEmitterPoses(const double* poses);
+
+  /// renders the frame `pf` (device pointers everywhere but the outputs, which are set here)
+  /// on `scene`'s stream and copies its radiance, albedo, normal and depth into `out` (resized
+  /// to the camera's pixels); waits for the copies.
+  void Render(DeviceScene* scene, const PathFrameView& pf, PathBuffers* out);
+
+  /// `count` runs of the last Render's kernel (no copies), timed with CUDA events: mean
+  /// milliseconds per frame (benchmarks).
+  double TimeKernel(DeviceScene* scene, int count);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace penumbra::cuda

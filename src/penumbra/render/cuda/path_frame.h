@@ -1,0 +1,77 @@
+#pragma once
+// the host side of the pathtraced tier on the GPU (path_shading.h per pixel, path_kernels.cu on
+// the device): which frames it takes, the frame's plain data (PathFrameView over a prepared
+// RealtimeFrameData: the same posed scene, materials, textures, lights and sky), and the finish
+// every pathtraced frame gets on the host, as the CPU backend's EmbreeRenderer gives it: the
+// a-trous denoiser (render/denoiser.h, guided by the albedo, normal and depth) when the settings
+// ask for it, then the film's auto exposure and development (render/film.h).
+// RenderPathtracedOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH
+// (tests; the parity check without a GPU). no CUDA runtime here.
+
+#include <string>
+#include <vector>
+
+#include "penumbra/core/image.h"
+#include "penumbra/core/thread_pool.h"
+#include "penumbra/render/cuda/bvh_scene.h"
+#include "penumbra/render/cuda/path_buffers.h"
+#include "penumbra/render/cuda/path_shading.h"
+#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/denoiser.h"
+#include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/renderer.h"
+
+namespace penumbra::cuda {
+
+/// why a pathtraced frame of `view` under `effects` cannot be traced on the GPU ("" if it can):
+/// effects not on the GPU (EffectsNotOnGpu), particles (the CPU's camera rays stop at streaks
+/// with a random draw), or a camera with lens distortion or motion (the jittered rays need
+/// Camera::Unproject).
+std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view);
+
+/// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
+/// host arrays: the pods and pick cdf point into the sampler, which must outlive this) and the
+/// frame's poses (SetPoses).
+struct PathEmitterHost {
+  std::vector<EmitterPod> pods;
+  std::vector<Float3> Le;
+  std::vector<int32_t> emitter_of_geom;
+  std::vector<double> poses;  ///< 12 an emitter: rotation row-major, translation
+  const std::vector<double>* pick_cdf = nullptr;
+  /// the sampler's emitters (poses: none yet).
+  explicit PathEmitterHost(const EmitterSampler& sampler);
+  /// every emitter's geom pose for body poses X_WB (EmitterSampler::EmitterPose).
+  void SetPoses(const EmitterSampler& sampler, const std::vector<Pose>& X_WB);
+  /// the view over these arrays (num 0 without emitters).
+  PathEmitters View() const;
+};
+
+/// the pathtraced frame of `data` (Prepared for the view; its settings' samples_per_pixel and
+/// max_bounces) as the path kernels read it, with the output arrays left null: `frame` is
+/// data's View (host arrays) or its device copy (DeviceRealtime::DeviceFrame), `sky_sampling`
+/// the frame sky's sampling tables in the same memory.
+PathFrameView PathView(const RealtimeFrameData& data, const RealtimeFrameView& frame,
+                       const SkySamplingPod& sky_sampling);
+
+/// the finish of a pathtraced frame: out->radiance from b.radiance, denoised with the albedo,
+/// normal and depth guides when `denoiser` is given, out->ev100 and out->rgb from data's film
+/// (the view's white-balance gains), and out->depth_m from b.depth when `want_depth`.
+void FinishPathFrame(const RealtimeFrameData& data, const PathBuffers& b, const Denoiser* denoiser,
+                     const Eigen::Vector3f& white_balance_gains, bool want_depth, ThreadPool* pool,
+                     RenderedFrame* out);
+
+/// the paths of frame `pf` (host arrays; its outputs are set here) traced by PathTracePixel on
+/// the CPU, rows over `pool`, into `out` (resized to the camera's pixels).
+void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffers* out);
+
+/// a pathtraced frame of `data` (Prepared for the view; its settings' samples_per_pixel and
+/// max_bounces) rendered by PathTracePixel on the CPU over `bvh` (Updated for the snapshot),
+/// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
+/// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
+/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none).
+void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
+                            RenderedFrame* out,
+                            const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),
+                            const PathEmitters* emitters = nullptr);
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,435 @@
+#pragma once
+// the CUDA backend's pathtraced tier, per pixel, as PB_HOST_DEVICE functions over plain data:
+// path_kernels.cu runs them on the GPU (one thread a run of one pixel's samples, the runs of a
+// pixel then summed in run order: PathSampleRange, PathFinishPixel) and RenderPathtracedOnHost
+// (path_frame.h) runs the same functions on the CPU over the host BVH (tests, machines without
+// a GPU). the path is the CPU's PathIntegrator (render/cpu/path_integrator.h, where the model is
+// documented) step for step, for frames without media or particles:
+//
+//   per sample s of pixel (u, v): Rng(PixelStream(u, v, s)) (core/rng.h, the same draws in the
+//   same order), a camera ray jittered over the pixel (two draws); at each vertex the lamp
+//   spheres in front of the surface (a hit ends the path), the sky and the sun discs where the
+//   ray escapes (MIS-weighted against the previous vertex's BSDF density; the camera and mirrors
+//   see the MJCF skybox), the surface's emission, the mirror layer (one draw, where it applies),
+//   next-event estimation (one sample of every light: two draws each, MIS for lamp spheres and
+//   sun discs; the sky: two draws, MIS; one emissive geom: three draws, MIS), Russian roulette from
+//   kPathRussianRouletteStartVertex (one draw) and the BSDF's sample (three draws);
+//
+// with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
+// with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
+// (path_math.h), the emissive geoms' sampling (emitter_math.h), the sky's radiance and
+// background (sky_eval_math.h) and sampling
+// (sky_sampling_math.h), dot products summed as the CPU's Eigen code sums them (EigenDot),
+// and the materials with their textures over the path's ray cone as the
+// realtime tier evaluates them (EvaluateSurface, realtime_shading.h). the GPU contracts
+// multiply-adds, so its paths differ from the CPU's by float rounding, which a path's branches
+// (Russian roulette, lobe choice) can turn into other paths: the estimates agree in the mean
+// (docs/gpu.md, "The pathtraced tier on the GPU").
+
+#include <cstdint>
+
+#include "penumbra/core/host_device.h"
+#include "penumbra/core/rng.h"
+#include "penumbra/render/bsdf_math.h"
+#include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/emitter_math.h"
+#include "penumbra/render/light_math.h"
+#include "penumbra/render/path_math.h"
+#include "penumbra/render/shading_math.h"
+#include "penumbra/render/sky_eval_math.h"
+#include "penumbra/render/sky_sampling_math.h"
+
+namespace penumbra::cuda {
+
+/// Russian roulette starts at this path vertex (render/cpu/path_integrator.h's
+/// kRussianRouletteStartVertex).
+constexpr int kPathRussianRouletteStartVertex = 3;
+/// shadow rays towards a point at distance d stop this fraction short of it (the CPU's).
+constexpr float kPathShadowShorten = 1e-4f;
+
+/// the scene's emissive geoms as the path samples them (EmitterSampler's, render/emitter_math.h):
+/// num emitters in pick order, their plain data, emitted radiance (cd/m^2) and pick cdf (num + 1
+/// values), per SceneDescription geom (num_geoms) its emitter or -1, and per emitter its geom's
+/// world pose for the frame, 12 doubles (rotation row-major, translation). num 0: none.
+struct PathEmitters {
+  int32_t num = 0;
+  const EmitterPod* pods = nullptr;
+  const Float3* Le = nullptr;
+  const double* pick_cdf = nullptr;
+  const int32_t* emitter_of_geom = nullptr;
+  int32_t num_geoms = 0;
+  const double* poses = nullptr;
+};
+
+/// EmitterSampler::Pdf: the solid-angle density with which the emitter sampling at p returns
+/// the direction to point p_hit (unit normal n_hit) on geom `geom`; 0 for geoms it never samples.
+PB_HOST_DEVICE inline float PathEmitterPdf(const PathEmitters& em, int geom, const Float3& p,
+                                           const Float3& p_hit, const Float3& n_hit) {
+  if (geom < 0 || geom >= em.num_geoms) return 0.0f;
+  const int k = em.emitter_of_geom[geom];
+  if (k < 0) return 0.0f;
+  const double p_pick = em.pick_cdf[k + 1] - em.pick_cdf[k];
+  if (!(p_pick > 0)) return 0.0f;
+  const double pd[3] = {p.x, p.y, p.z}, hd[3] = {p_hit.x, p_hit.y, p_hit.z},
+               nd[3] = {n_hit.x, n_hit.y, n_hit.z};
+  return EmitterPointPdf(em.pods[k], p_pick, em.poses + 12 * k + 9, pd, hd, nd);
+}
+
+/// everything a pathtraced frame reads and writes, as device (or host) pointers.
+struct PathFrameView {
+  /// the scene, camera (a pinhole without distortion or motion), materials, textures, posed
+  /// geoms and lights, the sky (pod) and the frame key: RealtimeFrameData::View's.
+  RealtimeFrameView rt;
+  SkySamplingPod sky_sampling;  ///< the frame sky's sampling tables (SkyModel::sampling_pod)
+  int32_t sky_active = 0;       ///< the sky sends light (its irradiance up or down is > 0)
+  int32_t spp = 1;              ///< samples per pixel (>= 1)
+  int32_t max_bounces = 1;      ///< >= 1
+  PathEmitters emitters;        ///< the emissive geoms (none: num 0)
+  /// per pixel (row-major, width x height): the mean radiance, the mean base colour of the
+  /// first surface over the samples that hit one (the denoiser's albedo), and the pixel-centre
+  /// hit's usable shading normal (0 where it escapes) and z-depth (0 where it escapes).
+  Float3* radiance = nullptr;
+  Float3* albedo = nullptr;
+  Float3* normal = nullptr;
+  float* depth = nullptr;
+};
+
+/// the lamp sphere nearest along o + t d (d unit) for t in (tmin, tmax), skipping light `skip`:
+/// its light index (or -1) and *t_out its t (tmax where none).
+PB_HOST_DEVICE inline int PathNearestLamp(const RealtimeFrameView& f, const Float3& o,
+                                          const Float3& d, float tmin, float tmax, float* t_out,
+                                          int skip = -1) {
+  int best = -1;
+  float best_t = tmax;
+  for (int j = 0; j < f.num_lights; ++j) {
+    if (j == skip || !IsLampSphere(f.lights[j])) continue;
+    float t;
+    if (LampIntersect(f.lights[j], o, d, tmin, best_t, &t)) best = j, best_t = t;
+  }
+  *t_out = best_t;
+  return best;
+}
+
+/// the origin of a ray leaving surface point p (unit geometric normal ng facing the arriving
+/// ray) in direction d: pushed off the surface on d's side (render/ray.h's SpawnRay).
+PB_HOST_DEVICE inline TraceRay PathSpawnRay(const Float3& p, const Float3& ng, const Float3& d) {
+  const float side = EigenDot(d, ng) >= 0 ? 1.0f : -1.0f;
+  TraceRay r;
+  r.o = OffsetOrigin(p, Float3{side * ng.x, side * ng.y, side * ng.z});
+  r.d = ToF3(d);
+  r.tmin = 0;
+  r.tmax = INFINITY;
+  return r;
+}
+
+/// max(c.x, c.y, c.z) as Eigen's maxCoeff.
+PB_HOST_DEVICE inline float PathMax3(const Float3& c) { return pbm::Max(pbm::Max(c.x, c.y), c.z); }
+PB_HOST_DEVICE inline Float3 PathMul(const Float3& a, const Float3& b) {
+  return Float3{a.x * b.x, a.y * b.y, a.z * b.z};
+}
+
+/// next-event estimation at surface point sp with BSDF b and path throughput beta, drawing from
+/// rng as the CPU's next_event: one sample of every light, then the sky. adds to *L.
+PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingPoint& sp,
+                                         const BsdfPod& b, const Float3& beta, Rng* rng,
+                                         Float3* L) {
+  const RealtimeFrameView& f = pf.rt;
+  const Float3& p = sp.p;
+  for (int j = 0; j < f.num_lights; ++j) {
+    const float u1 = rng->Uniform(), u2 = rng->Uniform();
+    const LightPod& l = f.lights[j];
+    Float3 wi, E;
+    float dist;
+    bool valid;
+    SampleLight<float, Float3, bool, true>(l, p, u1, u2, &wi, &dist, &E, &valid);
+    if (!valid) continue;
+    const Float3 fv = BsdfEval(b, wi);
+    const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+    if (!(PathMax3(fv) > 0)) continue;
+    Float3 c;
+    SunDiscPod sun;
+    const bool lamp = IsLampSphere(l);
+    if (SunDiscOf(l, &sun)) {
+      // uniform in the disc's cone: f E = f L Omega, weighted against BSDF sampling.
+      c = PathMul(fv, E) * PowerHeuristic(1.0f / sun.solid_angle, f_pdf);
+    } else if (lamp) {
+      const float omega = LampSolidAngle(l, p);
+      if (!(omega > 0)) continue;
+      c = PathMul(fv, LampRadianceTowards(l, p)) * (omega * PowerHeuristic(1.0f / omega, f_pdf));
+    } else {
+      c = PathMul(fv, E);
+    }
+    if (!(PathMax3(c) > 0)) continue;
+    if (l.cast_shadow != 0) {
+      TraceRay sr = PathSpawnRay(p, sp.ng, wi);
+      sr.tmax = dist == INFINITY ? INFINITY : dist * (1.0f - kPathShadowShorten);
+      if (TraceOccluded(f.scene, sr)) continue;
+      float t;
+      if (PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, sr.tmax, &t, lamp ? j : -1) >= 0) continue;
+    }
+    *L = *L + PathMul(beta, c);
+  }
+  if (pf.sky_active != 0) {
+    const float u1 = rng->Uniform(), u2 = rng->Uniform();
+    float pdf = 0, d[3];
+    SkySampleDirection(pf.sky_sampling, u1, u2, &pdf, d);
+    if (pdf > 0) {
+      const Float3 wi{d[0], d[1], d[2]};
+      const Float3 fv = BsdfEval(b, wi);
+      const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+      if (PathMax3(fv) > 0) {
+        const TraceRay sr = PathSpawnRay(p, sp.ng, wi);
+        float t;
+        if (!TraceOccluded(f.scene, sr) &&
+            PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, INFINITY, &t) < 0) {
+          const float w = PowerHeuristic(pdf, f_pdf);
+          float sky[3];
+          SkyRadiance(f.sky, wi.x, wi.y, wi.z, sky);
+          *L = *L + PathMul(beta, PathMul(fv, Float3{sky[0], sky[1], sky[2]})) * (w / pdf);
+        }
+      }
+    }
+  }
+  // one emissive geom (EmitterSampler::Sample), its shadow ray towards the sampled point.
+  const PathEmitters& em = pf.emitters;
+  if (em.num > 0) {
+    const float u0 = rng->Uniform(), u1 = rng->Uniform(), u2 = rng->Uniform();
+    double u_rest = 0;
+    const int k = EmitterPickFromCdf(em.pick_cdf, em.num, u0, &u_rest);
+    const double p_pick = em.pick_cdf[k + 1] - em.pick_cdf[k];
+    const double pd[3] = {p.x, p.y, p.z};
+    EmitterPoint ep;
+    if (p_pick > 0 && EmitterSamplePoint(em.pods[k], p_pick, em.poses + 12 * k,
+                                         em.poses + 12 * k + 9, pd, u_rest, u1, u2, &ep)) {
+      const Float3 q{static_cast<float>(ep.q[0]), static_cast<float>(ep.q[1]),
+                     static_cast<float>(ep.q[2])};
+      const Float3 wi{static_cast<float>(ep.wi[0]), static_cast<float>(ep.wi[1]),
+                      static_cast<float>(ep.wi[2])};
+      const Float3 fv = BsdfEval(b, wi);
+      const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+      if (PathMax3(fv) > 0) {
+        // render/ray.h's SpawnRayTo: off the surface on the point's side, d = q - origin,
+        // stopping 1e-4 of the way short.
+        TraceRay sr = PathSpawnRay(p, sp.ng, Float3{q.x - p.x, q.y - p.y, q.z - p.z});
+        const Float3 o = ToFloat3(sr.o);
+        const Float3 dq{q.x - o.x, q.y - o.y, q.z - o.z};
+        sr.d = ToF3(dq);
+        sr.tmax = 1.0f - kPathShadowShorten;
+        const float dist = sqrtf(EigenDot(dq, dq)) * sr.tmax;
+        float t;
+        if (!TraceOccluded(f.scene, sr) && PathNearestLamp(f, o, wi, 0.0f, dist, &t) < 0) {
+          const float w = PowerHeuristic(ep.pdf, f_pdf);
+          *L = *L + PathMul(beta, PathMul(fv, em.Le[k])) * (w / ep.pdf);
+        }
+      }
+    }
+  }
+}
+
+/// one path of sample s of pixel (u, v): its radiance (non-finite values are the caller's to
+/// drop) and, where its camera ray meets a surface, that surface's base colour (*albedo,
+/// *hit_first true).
+PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, int s, Float3* albedo,
+                                       bool* hit_first) {
+  const RealtimeFrameView& f = pf.rt;
+  const PinholeCamera& c = f.camera;
+  const uint64_t pixel =
+      static_cast<uint64_t>(v) * static_cast<uint64_t>(c.width) + static_cast<uint64_t>(u);
+  Rng rng(HashKeys(HashKeys(f.frame_key, pixel), static_cast<uint64_t>(s)));
+  const float jx = rng.Uniform(), jy = rng.Uniform();
+  // Camera::GenerateRay of a pinhole at (u + jx - 0.5, v + jy - 0.5), normalised
+  const float x = (static_cast<float>(u) + jx - 0.5f - c.cx) * c.inv_fx;
+  const float y = (static_cast<float>(v) + jy - 0.5f - c.cy) * c.inv_fy;
+  const Float3 d0{x * c.ex.x + y * c.ey.x + c.ez.x, x * c.ex.y + y * c.ey.y + c.ez.y,
+                  x * c.ex.z + y * c.ey.z + c.ez.z};
+  TraceRay ray;
+  ray.o = c.o;
+  ray.d = ToF3(bsdf_detail::Normalized(d0));
+  ray.tmin = 0;
+  ray.tmax = INFINITY;
+
+  Float3 L{0, 0, 0}, beta{1, 1, 1};
+  float prev_pdf = 0;
+  Float3 prev_p{0, 0, 0};
+  bool from_camera = true;
+  float path_m = 0;
+  *hit_first = false;
+  for (int vertex = 0;; ++vertex) {
+    TraceHit h;
+    TraceClosest(f.scene, ray, &h);
+    const bool found = h.instance >= 0;
+    const float t_surface = found ? h.t : INFINITY;
+    const Float3 o = ToFloat3(ray.o), d = ToFloat3(ray.d);
+
+    // a lamp sphere in front of the surface ends the path.
+    float t_lamp;
+    const int lamp = PathNearestLamp(f, o, d, ray.tmin, t_surface, &t_lamp);
+    if (lamp >= 0) {
+      float w = 1.0f;
+      if (!from_camera) {
+        const float omega = LampSolidAngle(f.lights[lamp], prev_p);
+        w = PowerHeuristic(prev_pdf, omega > 0 ? 1.0f / omega : 0.0f);
+      }
+      L = L + PathMul(beta, LampRadianceTowards(f.lights[lamp], o)) * w;
+      break;
+    }
+
+    if (!found) {
+      // the ray leaves the scene: sky and sun discs.
+      if (pf.sky_active != 0) {
+        const float w =
+            from_camera ? 1.0f
+                        : PowerHeuristic(prev_pdf, SkyDirectionPdf(pf.sky_sampling, d.x, d.y, d.z));
+        // the camera and mirrors see the MJCF skybox where there is one (Background).
+        const bool seen = from_camera || prev_pdf == INFINITY;
+        float sky[3];
+        if (seen) {
+          SkyBackground(f.sky, d.x, d.y, d.z, sky);
+        } else {
+          SkyRadiance(f.sky, d.x, d.y, d.z, sky);
+        }
+        L = L + PathMul(beta, Float3{sky[0], sky[1], sky[2]}) * w;
+      }
+      for (int j = 0; j < f.num_lights; ++j) {
+        SunDiscPod sun;
+        if (!SunDiscOf(f.lights[j], &sun)) continue;
+        if (EigenDot(d, sun.to_sun) < sun.cos_max) continue;
+        const float w = from_camera ? 1.0f : PowerHeuristic(prev_pdf, 1.0f / sun.solid_angle);
+        L = L + PathMul(beta, sun.L) * w;
+      }
+      break;
+    }
+
+    const float d_len = sqrtf(EigenDot(d, d));
+    const float hit_path_m = path_m + h.t * d_len;
+    const ShadingPoint sp = EvaluateSurface(f, ray, h, d_len, path_m);
+    if (vertex == 0) {
+      *albedo = sp.base;
+      *hit_first = true;
+    }
+    if (PathMax3(sp.emission) > 0) {
+      // MIS-weighted against the emitter sampling of the previous vertex (0 for geoms it does
+      // not sample: weight 1).
+      const int geom = f.scene.records[f.scene.prims[h.prim].record].geom;
+      const float w =
+          from_camera
+              ? 1.0f
+              : PowerHeuristic(prev_pdf, PathEmitterPdf(pf.emitters, geom, prev_p, sp.p, sp.ng));
+      L = L + PathMul(beta, sp.emission) * w;
+    }
+    if (vertex >= pf.max_bounces) break;
+
+    // the mirror layer (weight r), picked with probability r: the path goes on along the
+    // mirrored ray with its throughput unchanged; no draw without a mirror.
+    if (sp.mirror > 0 && rng.Uniform() < sp.mirror) {
+      const Float3 du{d.x / d_len, d.y / d_len, d.z / d_len};
+      const Float3& n = sp.ng;  // faces the ray
+      const float k = 2.0f * EigenDot(du, n);
+      const Float3 wi{du.x - k * n.x, du.y - k * n.y, du.z - k * n.z};
+      prev_pdf = INFINITY;
+      prev_p = sp.p;
+      from_camera = false;
+      path_m = hit_path_m;
+      ray = PathSpawnRay(sp.p, sp.ng, wi);
+      continue;
+    }
+
+    Float3 c_diff, f0;
+    float alpha;
+    BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff, &f0,
+                                      &alpha);
+    const BsdfPod b = MakeBsdf(c_diff, f0, alpha, sp.n, sp.ng, Float3{-d.x, -d.y, -d.z});
+    PathNextEvent(pf, sp, b, beta, &rng, &L);
+
+    // Russian roulette, then continue along a BSDF sample.
+    if (vertex >= kPathRussianRouletteStartVertex) {
+      const float q = pbm::Min(1.0f, PathMax3(beta));
+      if (!(rng.Uniform() < q)) break;
+      beta = Float3{beta.x / q, beta.y / q, beta.z / q};
+    }
+    const float ul = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+    Float3 wi, f_cos;
+    float pdf;
+    if (!SampleBsdf(b, ul, u1, u2, &wi, &f_cos, &pdf)) break;
+    beta = Float3{beta.x * f_cos.x / pdf, beta.y * f_cos.y / pdf, beta.z * f_cos.z / pdf};
+    if (!(PathMax3(beta) > 0) || !pbm::IsFinite(beta.x) || !pbm::IsFinite(beta.y) ||
+        !pbm::IsFinite(beta.z))
+      break;
+    prev_pdf = pdf;
+    prev_p = sp.p;
+    from_camera = false;
+    path_m = hit_path_m;
+    ray = PathSpawnRay(sp.p, sp.ng, wi);
+  }
+  return L;
+}
+
+/// the sums of a run of one pixel's samples: radiance (non-finite paths dropped) and the base
+/// colour of the first surface over the samples whose camera ray met one, in double.
+struct PathPartial {
+  double L[3] = {0, 0, 0};
+  double albedo[3] = {0, 0, 0};
+  int32_t albedo_count = 0;
+};
+
+/// samples [s0, s1) of pixel (u, v) (TracePath), summed in sample order.
+PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, int u, int v, int s0,
+                                                  int s1) {
+  PathPartial p;
+  for (int s = s0; s < s1; ++s) {
+    Float3 albedo;
+    bool hit = false;
+    const Float3 L = TracePath(pf, u, v, s, &albedo, &hit);
+    if (hit) {
+      p.albedo[0] += albedo.x, p.albedo[1] += albedo.y, p.albedo[2] += albedo.z;
+      ++p.albedo_count;
+    }
+    if (!pbm::IsFinite(L.x) || !pbm::IsFinite(L.y) || !pbm::IsFinite(L.z)) continue;
+    p.L[0] += L.x, p.L[1] += L.y, p.L[2] += L.z;
+  }
+  return p;
+}
+
+/// pixel (u, v)'s outputs from the sums of all its pf.spp samples: the mean radiance and
+/// albedo, and the pixel-centre ray's depth and usable shading normal (the CPU's denoiser
+/// guides: its depth image's ray, and its normal rule).
+PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v,
+                                           const PathPartial& p) {
+  const int64_t i = static_cast<int64_t>(v) * pf.rt.camera.width + u;
+  const double spp = static_cast<double>(pf.spp);
+  pf.radiance[i] = Float3{static_cast<float>(p.L[0] / spp), static_cast<float>(p.L[1] / spp),
+                          static_cast<float>(p.L[2] / spp)};
+  pf.albedo[i] = p.albedo_count > 0 ? Float3{static_cast<float>(p.albedo[0] / p.albedo_count),
+                                             static_cast<float>(p.albedo[1] / p.albedo_count),
+                                             static_cast<float>(p.albedo[2] / p.albedo_count)}
+                                    : Float3{};
+  const TraceRay r = PrimaryRay(pf.rt.camera, u, v);
+  TraceHit h;
+  TraceClosest(pf.rt.scene, r, &h);
+  if (h.instance < 0) {
+    pf.depth[i] = 0;
+    pf.normal[i] = Float3{};
+    return;
+  }
+  const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  const ShadingPoint sp = EvaluateSurface(pf.rt, r, h, d_len);
+  pf.depth[i] = h.t;
+  pf.normal[i] = sp.n;
+}
+
+/// pixel (u, v) of a pathtraced frame in one run: all pf.spp samples (PathSampleRange) summed in
+/// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel.
+PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, int u, int v) {
+  PathFinishPixel(pf, u, v, PathSampleRange(pf, u, v, 0, pf.spp));
+}
+
+/// the sample runs of a frame of n pixels and spp samples on a processor that wants about
+/// `threads` threads at once: runs = clamp(ceil(threads / n), 1, spp) runs a pixel of
+/// ceil(spp / runs) samples each (the last may be shorter or, for run counts that do not divide
+/// spp, empty).
+PB_HOST_DEVICE inline int PathRunsPerPixel(int64_t n, int spp, int64_t threads) {
+  const int64_t r = n > 0 ? (threads + n - 1) / n : 1;
+  return static_cast<int>(r < 1 ? 1 : (r > spp ? spp : r));
+}
+
+}  // namespace penumbra::cuda
