@@ -275,13 +275,8 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
     job.first = kLightPenumbraRays * LightStratum(u, v);
     job.points = e.points;
     job.own = e.own;
-    int traced = 0, visible = 0;
-    for (int r = e.r0; r < e.r0 + e.rays; ++r) {
-      const int verdict = PenumbraRayVerdict(f, e.light, job, r);
-      if (verdict < 0) continue;
-      ++traced;
-      if (verdict > 0) ++visible;
-    }
+    int traced, visible;
+    CountPenumbraRays(f, e.light, job, e.r0, e.r0 + e.rays, &traced, &visible);
     const int64_t k = e.light * n + e.pixel;
     const uint32_t add = PackChunkCounts(traced, visible);
     const uint32_t sum = atomicAdd(q.counts + static_cast<int64_t>(e.camera) * q.nl + k, add) + add;

@@ -955,6 +955,20 @@ PB_HOST_DEVICE inline int PenumbraRayVerdict(const RealtimeFrameView& f, int j,
   return TraceOccluded(f.scene, sr) ? 0 : 1;
 }
 
+/// light j's penumbra rays r0 .. r1 - 1 of `job` in turn (PenumbraRayVerdict): *traced, how
+/// many were traced, and *visible, how many of those reached the light.
+PB_HOST_DEVICE inline void CountPenumbraRays(const RealtimeFrameView& f, int j,
+                                             const PenumbraRays& job, int r0, int r1, int* traced,
+                                             int* visible) {
+  *traced = *visible = 0;
+  for (int r = r0; r < r1; ++r) {
+    const int verdict = PenumbraRayVerdict(f, j, job, r);
+    if (verdict < 0) continue;
+    ++*traced;
+    if (verdict > 0) ++*visible;
+  }
+}
+
 /// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
 /// v)'s window mask (SharedVisibilityWindow) and, per light with an extent, its penumbra rays
 /// in order (SharedVisibilityPenumbra, PenumbraRayVerdict); f.area_visible, f.area_rays: the
@@ -967,15 +981,11 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
   for (int j = 0; j < f.num_lights; ++j) {
     const PenumbraRays job = SharedVisibilityPenumbra(f, u, v, j, bits);
     if (job.active == 0) continue;
-    float visible = job.visible, rays = 1;
-    for (int r = 1; r < job.extra; ++r) {
-      const int verdict = PenumbraRayVerdict(f, j, job, r);
-      if (verdict < 0) continue;
-      rays += 1;
-      if (verdict > 0) visible += 1;
-    }
-    f.area_visible[j * n + i] = visible;
-    f.area_rays[j * n + i] = rays;
+    int traced, visible;
+    CountPenumbraRays(f, j, job, 1, job.extra, &traced, &visible);
+    // integer counts: the same sums as one ray at a time in float
+    f.area_visible[j * n + i] = job.visible + static_cast<float>(visible);
+    f.area_rays[j * n + i] = 1.0f + static_cast<float>(traced);
   }
 }
 
