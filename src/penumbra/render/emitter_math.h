@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
+#include "penumbra/render/shading_math.h"
 
 namespace penumbra {
 
@@ -42,12 +43,6 @@ namespace emitter_detail {
 constexpr double kPi = 3.14159265358979323846;
 /// a point counts as outside a sphere (cone sampling) beyond this factor of r^2.
 constexpr double kOutsideFactor = 1.0001;
-
-PB_HOST_DEVICE inline double Min(double a, double b) { return b < a ? b : a; }
-PB_HOST_DEVICE inline double Max(double a, double b) { return a < b ? b : a; }
-PB_HOST_DEVICE inline double Clamp(double x, double lo, double hi) {
-  return x < lo ? lo : (hi < x ? hi : x);
-}
 
 }  // namespace emitter_detail
 
@@ -100,15 +95,15 @@ PB_HOST_DEVICE inline int EmitterPickFromCdf(const double* cdf, int n, double u,
   i = i < 0 ? 0 : (n - 1 < i ? n - 1 : i);
   while (i < n - 1 && cdf[i + 1] <= cdf[i]) ++i;
   const double width = cdf[i + 1] - cdf[i];
-  *u_rest = width > 0 ? emitter_detail::Clamp((u - cdf[i]) / width, 0.0, 1.0 - 1e-12) : 0.5;
+  *u_rest = width > 0 ? pbm::Clamp((u - cdf[i]) / width, 0.0, 1.0 - 1e-12) : 0.5;
   return i;
 }
 
 /// 1 - cos(theta_max) of the cone a sphere of radius r subtends at distance dc > r (stable for
 /// small cones).
 PB_HOST_DEVICE inline double EmitterOneMinusCosCone(double r, double dc) {
-  const double sin2 = emitter_detail::Min(1.0, r * r / (dc * dc));
-  return sin2 / (1 + sqrt(emitter_detail::Max(0.0, 1 - sin2)));
+  const double sin2 = pbm::Min(1.0, r * r / (dc * dc));
+  return sin2 / (1 + sqrt(pbm::Max(0.0, 1 - sin2)));
 }
 
 /// a uniform point on emitter e's surface in the geom frame and its outward unit normal, from
@@ -124,7 +119,7 @@ PB_HOST_DEVICE inline void EmitterSampleArea(const EmitterPod& e, float u_part, 
     case EmitterShape::kSphere: {
       // uniform on the sphere (Archimedes): z uniform in [-1, 1]
       const double z = 1 - 2 * static_cast<double>(u1);
-      const double r = sqrt(emitter_detail::Max(0.0, 1 - z * z));
+      const double r = sqrt(pbm::Max(0.0, 1 - z * z));
       const double phi = 2 * kPi * static_cast<double>(u2);
       n[0] = r * cos(phi), n[1] = r * sin(phi), n[2] = z;
       for (int k = 0; k < 3; ++k) p[k] = s[0] * n[k];
@@ -160,7 +155,7 @@ PB_HOST_DEVICE inline void EmitterSampleArea(const EmitterPod& e, float u_part, 
           n[0] = 0, n[1] = 0, n[2] = sign;
         } else {  // hemisphere: uniform on the half sphere z * sign >= 0
           const double z = static_cast<double>(u1);
-          const double rr = sqrt(emitter_detail::Max(0.0, 1 - z * z)), phi = 2 * kPi * u2;
+          const double rr = sqrt(pbm::Max(0.0, 1 - z * z)), phi = 2 * kPi * u2;
           n[0] = rr * cos(phi), n[1] = rr * sin(phi), n[2] = sign * z;
           p[0] = r * n[0] + 0.0, p[1] = r * n[1] + 0.0, p[2] = r * n[2] + sign * h;
         }
@@ -218,7 +213,7 @@ PB_HOST_DEVICE inline bool EmitterSamplePoint(const EmitterPod& e, double p_pick
       const double dc = sqrt(dc2);
       const double one_minus_cos_max = EmitterOneMinusCosCone(r, dc);
       const double cos_t = 1 - u1 * one_minus_cos_max;
-      const double sin_t = sqrt(emitter_detail::Max(0.0, 1 - cos_t * cos_t));
+      const double sin_t = sqrt(pbm::Max(0.0, 1 - cos_t * cos_t));
       const double phi = 2 * kPi * u2;
       const double w[3] = {to_c[0] / dc, to_c[1] / dc, to_c[2] / dc};
       // the basis of Duff et al. ("Building an orthonormal basis, revisited", JCGT 2017)
@@ -231,7 +226,7 @@ PB_HOST_DEVICE inline bool EmitterSamplePoint(const EmitterPod& e, double p_pick
       for (int k = 0; k < 3; ++k) s->wi[k] = sc * t[k] + ss * b[k] + cos_t * w[k];
       // distance along wi to the sphere: dc cos_t - sqrt(r^2 - dc^2 sin_t^2) (clamped at
       // tangency).
-      const double disc = emitter_detail::Max(0.0, r * r - dc2 * sin_t * sin_t);
+      const double disc = pbm::Max(0.0, r * r - dc2 * sin_t * sin_t);
       const double dist = dc * cos_t - sqrt(disc);
       for (int k = 0; k < 3; ++k) s->q[k] = p[k] + dist * s->wi[k];
       const double hc[3] = {s->q[0] - c[0], s->q[1] - c[1], s->q[2] - c[2]};

@@ -46,6 +46,20 @@ struct SurfaceHit {
   int material = -1;             ///< index into SceneDescription::materials, -1 = default material
 };
 
+/// starts every backend's SurfaceHit of `ray` at parameter t on (geom, material): t, p_W = o +
+/// t d, the indices, and no mesh texcoords (has_uv false, uv, uv_per_m and duv_dp_G zero); the
+/// backend sets the normals, frames and texcoords after.
+inline void BeginSurfaceHit(const Ray& ray, float t, int geom, int material, SurfaceHit* hit) {
+  hit->t = t;
+  hit->p_W = ray.o + t * ray.d;
+  hit->geom = geom;
+  hit->material = material;
+  hit->has_uv = false;
+  hit->uv.setZero();
+  hit->uv_per_m = 0;
+  hit->duv_dp_G.setZero();
+}
+
 /// scale of the offset that moves secondary-ray origins off a surface (relative to 1 + |p|_inf).
 constexpr float kRayOffsetScale = 5e-5f;
 

@@ -47,11 +47,19 @@ namespace pbm {
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kInvPi = 0.318309886183790671538f;
 
-/// the smaller / larger of a and b as std::min / std::max take them (b < a ? b : a).
-PB_HOST_DEVICE inline float Min(float a, float b) { return b < a ? b : a; }
-PB_HOST_DEVICE inline float Max(float a, float b) { return a < b ? b : a; }
+/// the smaller / larger of a and b as std::min / std::max take them (b < a ? b : a); float or
+/// double, both arguments of one type (no conversion hidden in a call).
+template <typename T>
+PB_HOST_DEVICE inline T Min(T a, T b) {
+  return b < a ? b : a;
+}
+template <typename T>
+PB_HOST_DEVICE inline T Max(T a, T b) {
+  return a < b ? b : a;
+}
 /// std::clamp(x, lo, hi): x < lo ? lo : (hi < x ? hi : x).
-PB_HOST_DEVICE inline float Clamp(float x, float lo, float hi) {
+template <typename T>
+PB_HOST_DEVICE inline T Clamp(T x, T lo, T hi) {
   return x < lo ? lo : (hi < x ? hi : x);
 }
 PB_HOST_DEVICE inline float Sqrt(float x) { return sqrtf(x); }

@@ -375,14 +375,7 @@ void BvhScene::FinishHit(const Ray& ray, const TraceHit& th, SurfaceHit* hit) co
   const Record& rec = records_[pr.record];
   const Group& g = groups_[record_group_[pr.record]];
   const Pose& X_GI = X_GI_[pr.record];
-  hit->t = th.t;
-  hit->p_W = ray.o + th.t * ray.d;
-  hit->geom = rec.geom;
-  hit->material = rec.material;
-  hit->has_uv = false;
-  hit->uv.setZero();
-  hit->uv_per_m = 0;
-  hit->duv_dp_G.setZero();
+  BeginSurfaceHit(ray, th.t, rec.geom, rec.material, hit);
   const Eigen::Vector3d p_W =
       ray.o.cast<double>() + static_cast<double>(th.t) * ray.d.cast<double>();
   const Eigen::Vector3d p_G = X_GI * (g.X_WI.inverse() * p_W);

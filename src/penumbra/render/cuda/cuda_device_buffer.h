@@ -1,6 +1,6 @@
 #pragma once
-// the CUDA backend's runtime helpers for its .cu files: error checks and a growing device
-// buffer. includes the CUDA runtime header: only .cu files include this.
+// the CUDA backend's runtime helpers for its .cu files: error checks, a growing device buffer
+// and event timing. includes the CUDA runtime header: only .cu files include this.
 
 #include <cuda_runtime.h>
 
@@ -49,5 +49,31 @@ struct Buffer {
     if (p) cudaFree(p);
   }
 };
+
+/// the mean device time (ms) of one of `count` runs of `launch` (a callable that queues work on
+/// stream s), from CUDA events recorded on s before the first run and after the last (the
+/// caller warms up first where the first launch of a kernel costs more). 0 for count <= 0.
+/// @throws Error when an event call fails or the work fails.
+template <typename Launch>
+double TimeOnStream(cudaStream_t s, int count, Launch&& launch) {
+  if (count <= 0) return 0.0;
+  struct Events {
+    cudaEvent_t start = nullptr, stop = nullptr;
+    ~Events() {
+      if (start) cudaEventDestroy(start);
+      if (stop) cudaEventDestroy(stop);
+    }
+  } e;
+  Check(cudaEventCreate(&e.start), "cudaEventCreate");
+  Check(cudaEventCreate(&e.stop), "cudaEventCreate");
+  Check(cudaEventRecord(e.start, s), "cudaEventRecord");
+  for (int k = 0; k < count; ++k) launch();
+  Check(cudaGetLastError(), "timed launches");
+  Check(cudaEventRecord(e.stop, s), "cudaEventRecord");
+  Check(cudaEventSynchronize(e.stop), "timed work");
+  float ms = 0;
+  Check(cudaEventElapsedTime(&ms, e.start, e.stop), "cudaEventElapsedTime");
+  return static_cast<double>(ms) / count;
+}
 
 }  // namespace penumbra::cuda

@@ -232,18 +232,8 @@ double DeviceScene::TimePrimary(const PinholeCamera& c, int count, bool depth_an
   const dim3 block(8, 8);
   const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
   PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);  // warm-up
-  cudaEvent_t a, b;
-  Check(cudaEventCreate(&a), "cudaEventCreate");
-  Check(cudaEventCreate(&b), "cudaEventCreate");
-  Check(cudaEventRecord(a, m.stream), "cudaEventRecord");
-  for (int k = 0; k < count; ++k) PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
-  Check(cudaEventRecord(b, m.stream), "cudaEventRecord");
-  Check(cudaEventSynchronize(b), "PrimaryKernel (timed)");
-  float ms = 0;
-  cudaEventElapsedTime(&ms, a, b);
-  cudaEventDestroy(a);
-  cudaEventDestroy(b);
-  return ms / count;
+  return TimeOnStream(m.stream, count,
+                      [&] { PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d); });
 }
 
 }  // namespace penumbra::cuda

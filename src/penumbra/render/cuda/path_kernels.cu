@@ -179,18 +179,8 @@ double DevicePath::TimeKernel(DeviceScene* scene, int count) {
   Impl& m = *impl_;
   if (!m.rendered) throw Error("DevicePath::TimeKernel: no frame rendered yet");
   cudaStream_t stream = static_cast<cudaStream_t>(scene->stream());
-  cudaEvent_t e0, e1;
-  Check(cudaEventCreate(&e0), "cudaEventCreate");
-  Check(cudaEventCreate(&e1), "cudaEventCreate");
-  Check(cudaEventRecord(e0, stream), "cudaEventRecord");
-  for (int k = 0; k < count; ++k) LaunchPath(m.last, m.partial.as<PathPartial>(), m.runs, stream);
-  Check(cudaEventRecord(e1, stream), "cudaEventRecord");
-  Check(cudaEventSynchronize(e1), "cudaEventSynchronize");
-  float ms = 0;
-  Check(cudaEventElapsedTime(&ms, e0, e1), "cudaEventElapsedTime");
-  cudaEventDestroy(e0);
-  cudaEventDestroy(e1);
-  return count > 0 ? ms / count : 0.0;
+  return TimeOnStream(stream, count,
+                      [&] { LaunchPath(m.last, m.partial.as<PathPartial>(), m.runs, stream); });
 }
 
 }  // namespace penumbra::cuda

@@ -1275,24 +1275,12 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   m.LaunchShading(f, options, stream);
   film();
   Check(cudaStreamSynchronize(stream), "realtime kernels");
-  cudaEvent_t start, stop;
-  Check(cudaEventCreate(&start), "cudaEventCreate");
-  Check(cudaEventCreate(&stop), "cudaEventCreate");
-  Check(cudaEventRecord(start, stream), "cudaEventRecord");
-  for (int k = 0; k < count; ++k) {
+  return TimeOnStream(stream, count, [&] {
     m.LaunchGeometry(f, options, stream);
     if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
     m.LaunchShading(f, options, stream);
     film();
-  }
-  Check(cudaGetLastError(), "realtime kernels");
-  Check(cudaEventRecord(stop, stream), "cudaEventRecord");
-  Check(cudaEventSynchronize(stop), "cudaEventSynchronize");
-  float ms = 0;
-  Check(cudaEventElapsedTime(&ms, start, stop), "cudaEventElapsedTime");
-  cudaEventDestroy(start);
-  cudaEventDestroy(stop);
-  return static_cast<double>(ms) / count;
+  });
 }
 
 double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double>& rows,

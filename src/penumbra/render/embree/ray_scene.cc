@@ -466,14 +466,7 @@ struct RayScene::Impl {
     const GeomRecord& rec = group.records[rh.hit.geomID];
     const float t = rh.ray.tfar;
     const ShapePart part = static_cast<ShapePart>(static_cast<int>(rh.hit.u));
-    hit->t = t;
-    hit->p_W = ray.o + t * ray.d;
-    hit->geom = rec.geom;
-    hit->material = rec.material;
-    hit->has_uv = false;
-    hit->uv.setZero();
-    hit->uv_per_m = 0;
-    hit->duv_dp_G.setZero();
+    BeginSurfaceHit(ray, t, rec.geom, rec.material, hit);
     Eigen::Vector3f ng_W, ns_W;
     if (rec.analytic) {
       const AnalyticGeom& g = *rec.analytic;
