@@ -36,13 +36,11 @@ __global__ void OccludedKernel(SceneView s, const TraceRay* rays, int64_t n, uin
   occ[i] = TraceOccluded(s, rays[i]) ? 1 : 0;
 }
 
-// one thread per pixel of rows [row0, row1): primary_pixel.h's TracePixelTruth, as the batch
-// kernel.
-__global__ void PrimaryKernel(SceneView s, PinholeCamera c, PixelTruthPlanes out, int row0,
-                              int row1) {
+// one thread per pixel: primary_pixel.h's TracePixelTruth, as the batch kernel.
+__global__ void PrimaryKernel(SceneView s, PinholeCamera c, PixelTruthPlanes out) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= c.width || v >= row1) return;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= c.width || v >= c.height) return;
   const F3 axes_W[3] = {c.ex, c.ey, c.ez};
   out.Write(TracePixelTruth(s, PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr),
             static_cast<int64_t>(v) * c.width + u);
@@ -75,11 +73,10 @@ struct DeviceScene::Impl {
   cudaStream_t stream = nullptr;
   Buffer nodes, prims, triangles, shading, analytics, blases, records, instances;
   Buffer rays, hits, out[6];
-  // RenderPrimary's pinned copies: the staging buffers, a copy stream, band k's kernel done
-  // and its images staged, and the stage events (timing)
+  // RenderPrimary's pinned copies: the staging buffers, band k's images staged, and the stage
+  // events (timing)
   PinnedBuffer pin_out[6];
-  cudaStream_t copy_stream = nullptr;
-  cudaEvent_t band_traced[kMaxPrimaryBands] = {}, band_staged[kMaxPrimaryBands] = {};
+  cudaEvent_t band_staged[kMaxPrimaryBands] = {};
   cudaEvent_t primary_start = nullptr, primary_traced = nullptr, primary_copied = nullptr;
   PrimaryCopyOptions primary_options;
   PrimaryTimes primary_times;
@@ -118,11 +115,8 @@ void* DeviceScene::stream() const { return impl_->stream; }
 
 DeviceScene::~DeviceScene() {
   Impl& m = *impl_;
-  if (m.copy_stream) cudaStreamDestroy(m.copy_stream);
-  for (int k = 0; k < kMaxPrimaryBands; ++k) {
-    if (m.band_traced[k]) cudaEventDestroy(m.band_traced[k]);
-    if (m.band_staged[k]) cudaEventDestroy(m.band_staged[k]);
-  }
+  for (cudaEvent_t e : m.band_staged)
+    if (e) cudaEventDestroy(e);
   for (cudaEvent_t e : {m.primary_start, m.primary_traced, m.primary_copied})
     if (e) cudaEventDestroy(e);
   if (m.stream) cudaStreamDestroy(m.stream);
@@ -224,12 +218,9 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
   if (pixels <= 0) return;
   const PrimaryCopyOptions& o = m.primary_options;
-  if (!m.copy_stream) {
-    Check(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking), "cudaStreamCreate");
-    for (int k = 0; k < kMaxPrimaryBands; ++k) {
-      Check(cudaEventCreateWithFlags(&m.band_traced[k], cudaEventDisableTiming), "cudaEventCreate");
-      Check(cudaEventCreateWithFlags(&m.band_staged[k], cudaEventDisableTiming), "cudaEventCreate");
-    }
+  if (!m.primary_start) {
+    for (cudaEvent_t& e : m.band_staged)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t* e : {&m.primary_start, &m.primary_traced, &m.primary_copied})
       Check(cudaEventCreate(e), "cudaEventCreate");
   }
@@ -247,49 +238,48 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
   if (pinned)
     for (int p = 0; p < 6; ++p)
       if (planes[p].host) m.pin_out[p].Reserve(planes[p].px * pixels);
-  // pinned: the kernel in bands of rows; band k's images go back on the copy stream (behind
-  // its kernel's event) while band k + 1 is traced, and the host copies them into the caller's
-  // buffers as each band lands
-  const int bands = pinned ? std::clamp(o.bands, 1, kMaxPrimaryBands) : 1;
+  // the kernel over the whole frame (bands of it would each end on their slowest rays); pinned:
+  // the images go back in bands of rows, band k behind its event, so that the host copies band
+  // k into the caller's buffers while band k + 1 comes back (a small frame in one band)
+  size_t frame_bytes = 0;
+  for (const Plane& p : planes)
+    if (p.host) frame_bytes += p.px * pixels;
+  const size_t serial = static_cast<size_t>(std::max(o.serial_copy_kib, 0)) << 10;
+  const int bands = !pinned || frame_bytes <= serial ? 1 : std::clamp(o.bands, 1, kMaxPrimaryBands);
   const int band_rows = (c.height + bands - 1) / bands;
   const dim3 block(8, 8);
-  std::vector<HostCopy> copies;
   Check(cudaEventRecord(m.primary_start, m.stream), "cudaEventRecord");
-  for (int k = 0; k < bands; ++k) {
-    const int r0 = std::min(c.height, k * band_rows), r1 = std::min(c.height, (k + 1) * band_rows);
-    if (r1 <= r0) continue;
-    const dim3 grid((c.width + 7) / 8, (r1 - r0 + 7) / 8);
-    PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d, r0, r1);
-    Check(cudaGetLastError(), "PrimaryKernel launch");
-    if (!pinned) continue;
-    Check(cudaEventRecord(m.band_traced[k], m.stream), "cudaEventRecord");
-    Check(cudaStreamWaitEvent(m.copy_stream, m.band_traced[k], 0), "cudaStreamWaitEvent");
-    const size_t first = static_cast<size_t>(r0) * c.width,
-                 count = static_cast<size_t>(r1 - r0) * c.width;
-    for (int p = 0; p < 6; ++p) {
-      if (!planes[p].host) continue;
-      const size_t off = first * planes[p].px, bytes = count * planes[p].px;
-      char* staged = m.pin_out[p].as<char>() + off;
-      Check(cudaMemcpyAsync(staged, static_cast<const char*>(planes[p].dev) + off, bytes,
-                            cudaMemcpyDeviceToHost, m.copy_stream),
-            "copying an image back");
-      copies.push_back({static_cast<char*>(planes[p].host) + off, staged, bytes, m.band_staged[k]});
-    }
-    Check(cudaEventRecord(m.band_staged[k], m.copy_stream), "cudaEventRecord");
-  }
+  PrimaryKernel<<<dim3((c.width + 7) / 8, (c.height + 7) / 8), block, 0, m.stream>>>(m.view, c, d);
+  Check(cudaGetLastError(), "PrimaryKernel launch");
   Check(cudaEventRecord(m.primary_traced, m.stream), "cudaEventRecord");
   if (pinned) {
-    Check(cudaEventRecord(m.primary_copied, m.copy_stream), "cudaEventRecord");
-    ParallelCopy(o.parallel_copies ? parallel : ParallelFn(), copies, size_t{256} << 10,
-                 static_cast<size_t>(std::max(o.serial_copy_kib, 0)) << 10);
-    Check(cudaEventSynchronize(m.primary_copied), "PrimaryKernel");
+    std::vector<HostCopy> copies;
+    for (int k = 0; k < bands; ++k) {
+      const int r0 = std::min(c.height, k * band_rows);
+      const int r1 = std::min(c.height, (k + 1) * band_rows);
+      if (r1 <= r0) continue;
+      const size_t first = static_cast<size_t>(r0) * c.width;
+      const size_t count = static_cast<size_t>(r1 - r0) * c.width;
+      for (int p = 0; p < 6; ++p) {
+        if (!planes[p].host) continue;
+        const size_t off = first * planes[p].px, bytes = count * planes[p].px;
+        char* staged = m.pin_out[p].as<char>() + off;
+        Check(cudaMemcpyAsync(staged, static_cast<const char*>(planes[p].dev) + off, bytes,
+                              cudaMemcpyDeviceToHost, m.stream),
+              "copying an image back");
+        copies.push_back(
+            {static_cast<char*>(planes[p].host) + off, staged, bytes, m.band_staged[k]});
+      }
+      Check(cudaEventRecord(m.band_staged[k], m.stream), "cudaEventRecord");
+    }
+    Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
+    ParallelCopy(o.parallel_copies ? parallel : ParallelFn(), copies, size_t{256} << 10, serial);
   } else {
     for (const Plane& p : planes)
       if (p.host)
         Check(cudaMemcpyAsync(p.host, p.dev, p.px * pixels, cudaMemcpyDeviceToHost, m.stream),
               "copying an image back");
     Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
-    Check(cudaStreamSynchronize(m.stream), "PrimaryKernel");
   }
   Check(cudaStreamSynchronize(m.stream), "PrimaryKernel");
   float kernel_ms = 0, copies_ms = 0;
@@ -320,13 +310,12 @@ double DeviceScene::TimePrimary(const PinholeCamera& c, int count, bool depth_an
   const PixelTruthPlanes d = Reserve(m.out, pixels, want);
   const dim3 block(8, 8);
   const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
-  PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d, 0, c.height);  // warm-up
+  PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);  // warm-up
   cudaEvent_t a, b;
   Check(cudaEventCreate(&a), "cudaEventCreate");
   Check(cudaEventCreate(&b), "cudaEventCreate");
   Check(cudaEventRecord(a, m.stream), "cudaEventRecord");
-  for (int k = 0; k < count; ++k)
-    PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d, 0, c.height);
+  for (int k = 0; k < count; ++k) PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
   Check(cudaEventRecord(b, m.stream), "cudaEventRecord");
   Check(cudaEventSynchronize(b), "PrimaryKernel (timed)");
   float ms = 0;

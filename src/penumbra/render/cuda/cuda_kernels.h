@@ -47,24 +47,27 @@ constexpr int kMaxPrimaryBands = 16;
 /// others stay for the benchmark's rows, render_cuda_bench --realtime). every variant writes
 /// the same bytes.
 struct PrimaryCopyOptions {
-  /// the images go back to page-locked staging buffers on a copy stream and the host copies
-  /// them into the caller's buffers in 256 KiB chunks (over `parallel`); else the device copies
-  /// them into the caller's (pageable) buffers directly, one after the other, after the kernel.
+  /// the images go back to page-locked staging buffers and the host copies them into the
+  /// caller's buffers in 256 KiB chunks (over `parallel`); else the device copies them into the
+  /// caller's (pageable) buffers directly, one after the other, after the kernel.
   bool pinned = true;
-  /// with pinned copies: the kernel runs in this many bands of rows (1 to kMaxPrimaryBands),
-  /// band k's images going back (and into the caller's buffers) while band k + 1 is traced.
+  /// with pinned copies: the images go back in this many bands of rows (1 to
+  /// kMaxPrimaryBands), the host copying band k into the caller's buffers while band k + 1
+  /// comes back; a frame whose images hold at most serial_copy_kib goes back in one. the
+  /// kernel traces the whole frame at once.
   int bands = 4;
   /// with pinned copies: the host's copies over RenderPrimary's `parallel` (else on the calling
   /// thread alone).
   bool parallel_copies = true;
-  /// with parallel_copies: a frame whose images hold at most this many KiB is copied on the
-  /// calling thread alone (waking the pool costs more than such copies).
+  /// with pinned copies: a frame whose images hold at most this many KiB goes back in one
+  /// band and is copied on the calling thread alone (waking the pool costs more than such
+  /// copies).
   int serial_copy_kib = 512;
 };
 
 /// where RenderPrimary's time went, milliseconds (benchmarks).
 struct PrimaryTimes {
-  double kernel = 0;  ///< CUDA events: from before the first band's kernel to the last's end
+  double kernel = 0;  ///< CUDA events: from before the kernel to its end
   double copies = 0;  ///< CUDA events: from the same start to the last copy's end
   double total = 0;   ///< host clock: the whole call, the host's copies included
 };
