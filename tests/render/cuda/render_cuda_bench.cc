@@ -34,7 +34,11 @@
 // CudaRenderer::last_prepare_ms), the kernels alone as they run by default and with each speed-up
 // of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with the default's),
 // the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
-// the device's exposure differed from the host's (RealtimeExposureChecks).
+// the device's exposure differed from the host's (RealtimeExposureChecks); then a table of where
+// Render()'s time goes (the host's preparation, the launches, the kernels' and the copies' end
+// by CUDA events, the host's work after the last transfer; also into a new RenderedFrame every
+// frame, as the camera sink renders) and the same for depth+seg with each of RenderPrimary's
+// ways of copying back (cuda::PrimaryCopyOptions: bands, one thread, pageable).
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh).
 // --pathtraced [--size WxH] [--spp N]: the pathtraced tier (default 320x240, 64 samples per
