@@ -225,7 +225,7 @@ void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& wa
       Check(cudaEventCreate(e), "cudaEventCreate");
   }
   const PixelTruthPlanes d = Reserve(m.out, pixels, want);
-  // the planes: the caller's buffer, the device's, the staging buffer, bytes a pixel
+  // the planes: the caller's buffer, the device's, bytes a pixel (pin_out[p]: the staging)
   struct Plane {
     void* host;
     void* dev;
