@@ -165,6 +165,58 @@ TEST_P(CudaBackendWorlds, GroundTruthImagesMatchCpuBackend) {
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBackendWorlds,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml"));
 
+// RenderPrimary's ways of bringing the ground truth back (pinned staging in bands of rows over
+// the pool or one thread, or pageable copies) write the same bytes into every image, also where
+// the frame's shape changes between calls (a frame reused, one resized) and where the rows do
+// not split evenly into the bands.
+TEST(CudaBackend, PrimaryCopyVariantsWriteTheSameBytes) {
+  PB_REQUIRE_CUDA_DEVICE();
+  const std::unique_ptr<Session> session = LoadBundled("house.yaml");
+  RenderSettings settings;
+  settings.backend = RenderSettings::Backend::kCuda;
+  const std::unique_ptr<Renderer> gpu = MakeRenderer(session->scene(), settings);
+  auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+  const WorldSnapshot snap = session->sim().Snapshot();
+  CameraView view;
+  view.X_WO = CameraPoseInWorld(session->scene().cameras.front(), snap);
+  view.outputs[ImageKind::kRgb] = false;
+  for (ImageKind k :
+       {ImageKind::kDepth, ImageKind::kSegmentation, ImageKind::kRange, ImageKind::kNormals,
+        ImageKind::kInstanceSegmentation, ImageKind::kSemanticSegmentation})
+    view.outputs[k] = true;
+  const auto same = [](const RenderedFrame& a, const RenderedFrame& b) {
+    return a.depth_m.data == b.depth_m.data && a.geom_id.data == b.geom_id.data &&
+           a.range_m.data == b.range_m.data && a.normal_O.data == b.normal_O.data &&
+           a.body_id.data == b.body_id.data && a.semantic_class.data == b.semantic_class.data;
+  };
+  std::vector<cuda::PrimaryCopyOptions> variants(5);
+  variants[1].bands = 1;
+  variants[2].bands = 7;
+  variants[3].parallel_copies = false;
+  variants[4].pinned = false;
+  for (const auto& [w, h] : {std::pair{97, 61}, std::pair{320, 240}}) {
+    view.intrinsics = CameraIntrinsics::FromFovy(w, h, 60);
+    RenderedFrame want;
+    g->device().set_primary_options(variants[4]);
+    gpu->Render(snap, view, &want);
+    ASSERT_EQ(want.normal_O.data.size(), static_cast<size_t>(3 * w * h));
+    int hits = 0;
+    for (float d : want.depth_m.data) hits += d > 0;
+    EXPECT_GT(hits, w * h / 2);
+    RenderedFrame reused;  // one frame through every variant (its images reused, then resized)
+    for (size_t v = 0; v < variants.size(); ++v) {
+      SCOPED_TRACE("variant " + std::to_string(v) + ", " + std::to_string(w) + "x" +
+                   std::to_string(h));
+      g->device().set_primary_options(variants[v]);
+      RenderedFrame fresh;
+      gpu->Render(snap, view, &fresh);
+      gpu->Render(snap, view, &reused);
+      EXPECT_TRUE(same(fresh, want));
+      EXPECT_TRUE(same(reused, want));
+    }
+  }
+}
+
 // the pathtraced tier's frames render on the GPU (path_shading.h), emissive geoms included, but
 // not those of a camera with lens distortion (PathNotOnGpu): those go to the CPU renderer inside
 // the backend.

@@ -34,7 +34,11 @@
 // CudaRenderer::last_prepare_ms), the kernels alone as they run by default and with each speed-up
 // of RealtimeKernelOptions turned off (ablations; each variant's rgb compared with the default's),
 // the CPU backend, the FNV-1a hashes of the rgb, depth and radiance and the EV100, and how often
-// the device's exposure differed from the host's (RealtimeExposureChecks).
+// the device's exposure differed from the host's (RealtimeExposureChecks); then a table of where
+// Render()'s time goes (the host's preparation, the launches, the kernels' and the copies' end
+// by CUDA events, the host's work after the last transfer; also into a new RenderedFrame every
+// frame, as the camera sink renders) and the same for depth+seg with each of RenderPrimary's
+// ways of copying back (cuda::PrimaryCopyOptions: bands, one thread, pageable).
 // --parity [--size WxH]: the parity table against the CPU backend (cuda_parity.h, default
 // 320x240; scripts/gpu/parity.sh).
 // --pathtraced [--size WxH] [--spp N]: the pathtraced tier (default 320x240, 64 samples per
@@ -132,6 +136,9 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       "\n| world | size | variant | frames/s | ms/frame | geometry ms | sky ms | shade ms "
       "| film+copies ms (copies after the row sums) | rgb as default "
       "|\n|---|---|---|---:|---:|---:|---:|---:|---:|---|\n");
+  // where Render()'s host time goes (RealtimeStageTimes, CudaRenderer::last_prepare_ms;
+  // device_sky with device_exposure): printed after the variants' table
+  std::vector<std::string> host_rows;
   for (const std::string& file : worlds) {
     SessionOptions so;
     so.build_renderer = false;
@@ -193,25 +200,35 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     copy_variants.push_back(fast);
     copy_variants.back().copy_chunk_kib = 64;
     copy_variants.back().output_bands = 4;
-    // last: the default without the radiance (CudaRenderer::set_radiance_output)
+    // the host's copies over the pool whatever their size (before branch gpu13)
+    copy_variants.push_back(fast);
+    copy_variants.back().serial_copy_kib = 0;
+    // second to last: the default into a new RenderedFrame every frame (as the camera sink's
+    // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
+    // default without the radiance (CudaRenderer::set_radiance_output)
+    copy_variants.push_back(fast);
     copy_variants.push_back(fast);
     double prepare_ms = 0;  // the default's host preparation before the kernels
     for (size_t v = 0; v < copy_variants.size(); ++v) {
       const cuda::RealtimeKernelOptions& o = copy_variants[v];
       const bool pinned = o.pinned;
       const bool no_radiance = v + 1 == copy_variants.size();
+      const bool fresh = v + 2 == copy_variants.size();
       g->set_radiance_output(!no_radiance);
       rt.set_options(o);
       RenderedFrame f;
       for (int i = 0; i < 3; ++i) gpu->Render(snap, view, &f);
       cuda::RealtimeStageTimes sum;
-      double prepare = 0;
+      double prepare = 0, total = 0;
       const auto t0 = Clock::now();
       for (int i = 0; i < frames; ++i) {
+        if (fresh) f = RenderedFrame();
         gpu->Render(snap, view, &f);
         const cuda::RealtimeStageTimes& t = rt.last_stage_times();
         sum.geometry += t.geometry, sum.sky += t.sky, sum.shade += t.shade, sum.film += t.film;
         sum.outputs += t.outputs;
+        sum.launched += t.launched, sum.kernels_end += t.kernels_end;
+        sum.copies_end += t.copies_end, total += t.total;
         prepare += g->last_prepare_ms();
       }
       const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
@@ -223,7 +240,10 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       if (!o.parallel_copies) extra += ", host copies on one thread";
       if (o.copy_chunk_kib != fast.copy_chunk_kib)
         extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
+      if (o.serial_copy_kib != fast.serial_copy_kib)
+        extra += fmt::format(", host copies over the pool above {} KiB", o.serial_copy_kib);
       if (no_radiance) extra += ", no radiance asked for";
+      if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
           "| {} | {} | cuda Render(), {} copies{} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | "
           "{:.3f} | {:.3f} ({:.3f}) | {} |\n",
@@ -237,12 +257,68 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
                   : fmt::format("host sky in {} band{}", o.sky_bands, o.sky_bands == 1 ? "" : "s")),
           extra, 1 / s, 1e3 * s, sum.geometry / frames, sum.sky / frames, sum.shade / frames,
           sum.film / frames, sum.outputs / frames, same ? "yes" : "NO");
+      if (o.device_sky && o.device_exposure && o.pinned) {
+        const double wall = 1e3 * s, inside = total / frames;
+        host_rows.push_back(fmt::format(
+            "| {} | {} | {}{} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
+            "{:.3f} |",
+            name, size,
+            fmt::format("radiance in {} band{}", o.output_bands, o.output_bands == 1 ? "" : "s"),
+            extra, wall, prepare / frames, wall - inside, sum.launched / frames,
+            sum.kernels_end / frames, sum.copies_end / frames, inside - sum.copies_end / frames,
+            sum.outputs / frames));
+      }
     }
     g->set_radiance_output(true);
     fmt::print(
         "| {} | {} | cuda Render(), host preparation before the kernels (default) | | {:.3f} "
         "| | | | | |\n",
         name, size, prepare_ms);
+    // depth + segmentation (the ground-truth kernel): its copies as PrimaryCopyOptions says
+    {
+      CameraView truth = view;
+      truth.outputs = CameraOutputs::None();
+      truth.outputs[ImageKind::kDepth] = truth.outputs[ImageKind::kSegmentation] = true;
+      const cuda::PrimaryCopyOptions primary = g->device().primary_options();
+      std::vector<std::pair<std::string, cuda::PrimaryCopyOptions>> pv;
+      pv.push_back({fmt::format("pinned, {} bands (default)", primary.bands), primary});
+      for (const int bands : {1, 2, 8}) {
+        cuda::PrimaryCopyOptions q = primary;
+        q.bands = bands;
+        pv.push_back({fmt::format("pinned, {} band{}", bands, bands == 1 ? "" : "s"), q});
+      }
+      pv.push_back({"pinned, host copies on one thread", primary});
+      pv.back().second.parallel_copies = false;
+      pv.push_back({"pinned, host copies over the pool at any size", primary});
+      pv.back().second.serial_copy_kib = 0;
+      pv.push_back({"pageable copies (as before branch gpu13)", primary});
+      pv.back().second.pinned = false;
+      pv.push_back({"pinned (default), a new RenderedFrame every frame", primary});
+      RenderedFrame ref;
+      gpu->Render(snap, truth, &ref);
+      for (const auto& [what, q] : pv) {
+        g->device().set_primary_options(q);
+        RenderedFrame f;
+        for (int i = 0; i < 3; ++i) gpu->Render(snap, truth, &f);
+        cuda::PrimaryTimes sum;
+        const int pf = std::max(10, frames * 4);
+        const auto t0 = Clock::now();
+        const bool fresh_frames = what.find("new RenderedFrame") != std::string::npos;
+        for (int i = 0; i < pf; ++i) {
+          if (fresh_frames) f = RenderedFrame();
+          gpu->Render(snap, truth, &f);
+          const cuda::PrimaryTimes& t = g->device().last_primary_times();
+          sum.kernel += t.kernel, sum.copies += t.copies, sum.total += t.total;
+        }
+        const double s = std::chrono::duration<double>(Clock::now() - t0).count() / pf;
+        const bool same = f.depth_m.data == ref.depth_m.data && f.geom_id.data == ref.geom_id.data;
+        host_rows.push_back(fmt::format(
+            "| {} | {} | depth+seg, {} | {:.3f} | | {:.3f} | | {:.3f} | {:.3f} | {:.3f} | {} |",
+            name, size, what, 1e3 * s, 1e3 * s - sum.total / pf, sum.kernel / pf, sum.copies / pf,
+            (sum.total - sum.copies) / pf, same ? "same bytes" : "DIFFER"));
+      }
+      g->device().set_primary_options(primary);
+    }
     rt.set_options(fast);
     // the kernels alone: the default, each speed-up off, all off
     struct Variant {
@@ -313,6 +389,20 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
         "{}, {} | | | | | | |\n",
         name, size, x.frames, x.ev100_differs, x.redeveloped);
   }
+  fmt::print(
+      "\nWhere Render()'s time goes, ms a frame (host clock: wall = the benchmark's clock around "
+      "Render(), prepare = CudaRenderer's host work before the kernels are queued, outside = "
+      "wall minus DeviceRealtime::Render's own clock (the renderer's work around it), launched = "
+      "DeviceRealtime::Render's start until everything is queued; CUDA events from the frame's "
+      "first event: kernels end, copies end (the last transfer to page-locked memory); after "
+      "copies = DeviceRealtime::Render's total minus copies end: the host's copies, waits and "
+      "checks after the last transfer; host copies = from the launches' end to the last copy, "
+      "waits included). depth+seg rows: wall, outside = wall minus RenderPrimary, kernel and "
+      "copies end (events), after copies = RenderPrimary's host clock minus copies end.\n\n"
+      "| world | size | variant | wall | prepare | outside | launched | kernels end | copies "
+      "end | after copies | host copies / images "
+      "|\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n");
+  for (const std::string& r : host_rows) fmt::print("{}\n", r);
   return 0;
 }
 

@@ -1,13 +1,19 @@
 #pragma once
-// the CUDA backend's runtime helpers for its .cu files: error checks, a growing device buffer
-// and event timing. includes the CUDA runtime header: only .cu files include this.
+// the CUDA backend's runtime helpers for its .cu files: error checks, a growing device
+// buffer, a growing page-locked host buffer, the host's copies of page-locked outputs into the
+// caller's images and event timing. includes the CUDA runtime header: only .cu files include
+// this.
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
 
 namespace penumbra::cuda {
 
@@ -49,6 +55,70 @@ struct Buffer {
     if (p) cudaFree(p);
   }
 };
+
+/// page-locked host memory that grows (never shrinks).
+struct PinnedBuffer {
+  void* p = nullptr;
+  size_t bytes = 0;
+  PinnedBuffer() = default;
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+  void Reserve(size_t n) {
+    if (n <= bytes) return;
+    if (p) cudaFreeHost(p);
+    p = nullptr;
+    bytes = 0;
+    Check(cudaMallocHost(&p, n), "cudaMallocHost");
+    bytes = n;
+  }
+  template <typename T>
+  T* as() const {
+    return static_cast<T*>(p);
+  }
+  ~PinnedBuffer() {
+    if (p) cudaFreeHost(p);
+  }
+};
+
+/// one host copy of ParallelCopy.
+struct HostCopy {
+  void* dst;
+  const void* src;
+  size_t n;
+  cudaEvent_t ready = nullptr;  ///< src is complete once this event passed (null: now)
+};
+
+/// the copies, in chunks of `chunk` bytes (at least 4 KiB), in one loop through `parallel`
+/// (serially if it is empty, or if the copies hold at most `serial_bytes` bytes: a small frame's
+/// copies cost less than waking a pool); a chunk waits for its copy's `ready` event before it
+/// is copied.
+inline void ParallelCopy(const ParallelFn& parallel, const std::vector<HostCopy>& copies,
+                         size_t chunk, size_t serial_bytes = 0) {
+  const size_t kChunk = std::max<size_t>(chunk, 4096);
+  struct Chunk {
+    char* dst;
+    const char* src;
+    size_t n;
+    cudaEvent_t ready;
+  };
+  std::vector<Chunk> chunks;
+  for (const HostCopy& c : copies)
+    for (size_t a = 0; a < c.n; a += kChunk)
+      chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
+                        std::min(kChunk, c.n - a), c.ready});
+  // chunks are taken in order: a thread waits for its chunk's source only
+  auto copy = [&](int64_t i) {
+    if (chunks[i].ready) Check(cudaEventSynchronize(chunks[i].ready), "copying an output");
+    std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n);
+  };
+  size_t bytes = 0;
+  for (const HostCopy& c : copies) bytes += c.n;
+  const int64_t count = static_cast<int64_t>(chunks.size());
+  if (parallel && count > 1 && bytes > serial_bytes)
+    parallel(count, copy);
+  else
+    for (int64_t i = 0; i < count; ++i) copy(i);
+}
 
 /// the mean device time (ms) of one of `count` runs of `launch` (a callable that queues work on
 /// stream s), from CUDA events recorded on s before the first run and after the last (the

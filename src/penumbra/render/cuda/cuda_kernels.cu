@@ -3,6 +3,8 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -71,6 +73,13 @@ struct DeviceScene::Impl {
   cudaStream_t stream = nullptr;
   Buffer nodes, prims, triangles, shading, analytics, blases, records, instances;
   Buffer rays, hits, out[6];
+  // RenderPrimary's pinned copies: the staging buffers, band k's images staged, and the stage
+  // events (timing)
+  PinnedBuffer pin_out[6];
+  cudaEvent_t band_staged[kMaxPrimaryBands] = {};
+  cudaEvent_t primary_start = nullptr, primary_traced = nullptr, primary_copied = nullptr;
+  PrimaryCopyOptions primary_options;
+  PrimaryTimes primary_times;
   Buffer camera_xy, camera_rows;
   int64_t camera_xy_version = -1;
   int64_t geometry_version = -1;
@@ -105,9 +114,20 @@ const SceneView& DeviceScene::device_view() const { return impl_->view; }
 void* DeviceScene::stream() const { return impl_->stream; }
 
 DeviceScene::~DeviceScene() {
-  if (impl_->stream) cudaStreamDestroy(impl_->stream);
+  Impl& m = *impl_;
+  for (cudaEvent_t e : m.band_staged)
+    if (e) cudaEventDestroy(e);
+  for (cudaEvent_t e : {m.primary_start, m.primary_traced, m.primary_copied})
+    if (e) cudaEventDestroy(e);
+  if (m.stream) cudaStreamDestroy(m.stream);
   delete impl_;
 }
+
+void DeviceScene::set_primary_options(const PrimaryCopyOptions& options) {
+  impl_->primary_options = options;
+}
+const PrimaryCopyOptions& DeviceScene::primary_options() const { return impl_->primary_options; }
+const PrimaryTimes& DeviceScene::last_primary_times() const { return impl_->primary_times; }
 
 void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_version, bool wait) {
   Impl& m = *impl_;
@@ -191,27 +211,86 @@ PixelTruthPlanes Reserve(Buffer* out, int64_t pixels, const PrimaryOutputs& want
 
 }  // namespace
 
-void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& want) {
+void DeviceScene::RenderPrimary(const PinholeCamera& c, const PrimaryOutputs& want,
+                                const ParallelFn& parallel) {
   Impl& m = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
   const int64_t pixels = static_cast<int64_t>(c.width) * c.height;
   if (pixels <= 0) return;
+  const PrimaryCopyOptions& o = m.primary_options;
+  if (!m.primary_start) {
+    for (cudaEvent_t& e : m.band_staged)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t* e : {&m.primary_start, &m.primary_traced, &m.primary_copied})
+      Check(cudaEventCreate(e), "cudaEventCreate");
+  }
   const PixelTruthPlanes d = Reserve(m.out, pixels, want);
-  const dim3 block(8, 8);
-  const dim3 grid((c.width + 7) / 8, (c.height + 7) / 8);
-  PrimaryKernel<<<grid, block, 0, m.stream>>>(m.view, c, d);
-  Check(cudaGetLastError(), "PrimaryKernel launch");
-  auto back = [&](void* host, const void* dev, size_t bytes) {
-    if (host)
-      Check(cudaMemcpyAsync(host, dev, bytes, cudaMemcpyDeviceToHost, m.stream),
-            "copying an image back");
+  // the planes: the caller's buffer, the device's, bytes a pixel (pin_out[p]: the staging)
+  struct Plane {
+    void* host;
+    void* dev;
+    size_t px;
   };
-  back(want.depth, d.depth, pixels * 4);
-  back(want.geom_id, d.geom_id, pixels * 4);
-  back(want.range, d.range, pixels * 4);
-  back(want.normal_O, d.normal_O, pixels * 12);
-  back(want.body_id, d.body_id, pixels * 4);
-  back(want.semantic, d.semantic, pixels * 4);
+  const Plane planes[6] = {{want.depth, d.depth, 4},     {want.geom_id, d.geom_id, 4},
+                           {want.range, d.range, 4},     {want.normal_O, d.normal_O, 12},
+                           {want.body_id, d.body_id, 4}, {want.semantic, d.semantic, 4}};
+  const bool pinned = o.pinned;
+  if (pinned)
+    for (int p = 0; p < 6; ++p)
+      if (planes[p].host) m.pin_out[p].Reserve(planes[p].px * pixels);
+  // the kernel over the whole frame (bands of it would each end on their slowest rays); pinned:
+  // the images go back in bands of rows, band k behind its event, so that the host copies band
+  // k into the caller's buffers while band k + 1 comes back (a small frame in one band)
+  size_t frame_bytes = 0;
+  for (const Plane& p : planes)
+    if (p.host) frame_bytes += p.px * pixels;
+  const size_t serial = static_cast<size_t>(std::max(o.serial_copy_kib, 0)) << 10;
+  const int bands = !pinned || frame_bytes <= serial ? 1 : std::clamp(o.bands, 1, kMaxPrimaryBands);
+  const int band_rows = (c.height + bands - 1) / bands;
+  const dim3 block(8, 8);
+  Check(cudaEventRecord(m.primary_start, m.stream), "cudaEventRecord");
+  PrimaryKernel<<<dim3((c.width + 7) / 8, (c.height + 7) / 8), block, 0, m.stream>>>(m.view, c, d);
+  Check(cudaGetLastError(), "PrimaryKernel launch");
+  Check(cudaEventRecord(m.primary_traced, m.stream), "cudaEventRecord");
+  if (pinned) {
+    std::vector<HostCopy> copies;
+    for (int k = 0; k < bands; ++k) {
+      const int r0 = std::min(c.height, k * band_rows);
+      const int r1 = std::min(c.height, (k + 1) * band_rows);
+      if (r1 <= r0) continue;
+      const size_t first = static_cast<size_t>(r0) * c.width;
+      const size_t count = static_cast<size_t>(r1 - r0) * c.width;
+      for (int p = 0; p < 6; ++p) {
+        if (!planes[p].host) continue;
+        const size_t off = first * planes[p].px, bytes = count * planes[p].px;
+        char* staged = m.pin_out[p].as<char>() + off;
+        Check(cudaMemcpyAsync(staged, static_cast<const char*>(planes[p].dev) + off, bytes,
+                              cudaMemcpyDeviceToHost, m.stream),
+              "copying an image back");
+        copies.push_back(
+            {static_cast<char*>(planes[p].host) + off, staged, bytes, m.band_staged[k]});
+      }
+      Check(cudaEventRecord(m.band_staged[k], m.stream), "cudaEventRecord");
+    }
+    Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
+    ParallelCopy(o.parallel_copies ? parallel : ParallelFn(), copies, size_t{256} << 10, serial);
+  } else {
+    for (const Plane& p : planes)
+      if (p.host)
+        Check(cudaMemcpyAsync(p.host, p.dev, p.px * pixels, cudaMemcpyDeviceToHost, m.stream),
+              "copying an image back");
+    Check(cudaEventRecord(m.primary_copied, m.stream), "cudaEventRecord");
+  }
   Check(cudaStreamSynchronize(m.stream), "PrimaryKernel");
+  float kernel_ms = 0, copies_ms = 0;
+  Check(cudaEventElapsedTime(&kernel_ms, m.primary_start, m.primary_traced),
+        "cudaEventElapsedTime");
+  Check(cudaEventElapsedTime(&copies_ms, m.primary_start, m.primary_copied),
+        "cudaEventElapsedTime");
+  m.primary_times.kernel = kernel_ms;
+  m.primary_times.copies = copies_ms;
+  m.primary_times.total =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 double DeviceScene::TimePrimary(const PinholeCamera& c, int count, bool depth_and_seg_only) {

@@ -6,6 +6,7 @@
 // and its message when the runtime reports an error.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "penumbra/render/cuda/bvh_types.h"
@@ -35,6 +36,42 @@ struct PinholeCamera {
   const float* rows = nullptr;
 };
 
+/// runs body(0) .. body(count - 1), in any order and possibly at once (a thread pool); the
+/// renderers pass their pool's ParallelFor so that the host copies outputs on all its threads.
+using ParallelFn = std::function<void(int64_t count, const std::function<void(int64_t)>& body)>;
+
+/// the most bands of rows PrimaryCopyOptions::bands may ask for.
+constexpr int kMaxPrimaryBands = 16;
+
+/// how DeviceScene::RenderPrimary brings its images back (the defaults are the fast ones; the
+/// others stay for the benchmark's rows, render_cuda_bench --realtime). every variant writes
+/// the same bytes.
+struct PrimaryCopyOptions {
+  /// the images go back to page-locked staging buffers and the host copies them into the
+  /// caller's buffers in 256 KiB chunks (over `parallel`); else the device copies them into the
+  /// caller's (pageable) buffers directly, one after the other, after the kernel.
+  bool pinned = true;
+  /// with pinned copies: the images go back in this many bands of rows (1 to
+  /// kMaxPrimaryBands), the host copying band k into the caller's buffers while band k + 1
+  /// comes back; a frame whose images hold at most serial_copy_kib goes back in one. the
+  /// kernel traces the whole frame at once.
+  int bands = 4;
+  /// with pinned copies: the host's copies over RenderPrimary's `parallel` (else on the calling
+  /// thread alone).
+  bool parallel_copies = true;
+  /// with pinned copies: a frame whose images hold at most this many KiB goes back in one
+  /// band and is copied on the calling thread alone (waking the pool costs more than such
+  /// copies).
+  int serial_copy_kib = 512;
+};
+
+/// where RenderPrimary's time went, milliseconds (benchmarks).
+struct PrimaryTimes {
+  double kernel = 0;  ///< CUDA events: from before the kernel to its end
+  double copies = 0;  ///< CUDA events: from the same start to the last copy's end
+  double total = 0;   ///< host clock: the whole call, the host's copies included
+};
+
 /// host buffers a primary render fills (null = not wanted), each width x height (x 3 for
 /// normals), row-major: as RenderedFrame's depth_m, geom_id, range_m, normal_O, body_id,
 /// semantic_class (primary_pixel.h's planes, here in host memory).
@@ -62,8 +99,14 @@ class DeviceScene {
   void Trace(const TraceRay* rays, int64_t n, TraceHit* hits);
   /// occlusion of n rays (host arrays): occluded[i] = 1 if blocked.
   void Occluded(const TraceRay* rays, int64_t n, uint8_t* occluded);
-  /// one camera's primary rays: the ground-truth images of `out` (copied back to the host).
-  void RenderPrimary(const PinholeCamera& camera, const PrimaryOutputs& out);
+  /// one camera's primary rays: the ground-truth images of `out` (copied back to the host, as
+  /// primary_options() says; the host's copies over `parallel` when it is given).
+  void RenderPrimary(const PinholeCamera& camera, const PrimaryOutputs& out,
+                     const ParallelFn& parallel = {});
+  /// the options of the next RenderPrimary calls, and the stages of the last one.
+  void set_primary_options(const PrimaryCopyOptions& options);
+  const PrimaryCopyOptions& primary_options() const;
+  const PrimaryTimes& last_primary_times() const;
   /// `count` renders of `camera` into device memory only (no copy back), timed with CUDA
   /// events: the mean milliseconds per frame (benchmarks).
   double TimePrimary(const PinholeCamera& camera, int count, bool depth_and_seg_only);

@@ -40,7 +40,7 @@ namespace penumbra::cuda {
 /// a frame's host buffers (width x height pixels; radiance and rgb x 3), each may be null.
 struct RealtimeOutputs {
   /// runs body(0) .. body(count - 1), in any order and possibly at once (a thread pool).
-  using ParallelFn = std::function<void(int64_t count, const std::function<void(int64_t)>& body)>;
+  using ParallelFn = cuda::ParallelFn;
   float* radiance = nullptr;
   uint8_t* rgb = nullptr;
   float* depth = nullptr;
@@ -151,6 +151,9 @@ struct RealtimeKernelOptions {
   bool parallel_copies = true;
   /// the size of those chunks, KiB (at least 4).
   int copy_chunk_kib = 256;
+  /// with parallel_copies: a loop of copies of at most this many KiB (a small frame's) runs on
+  /// the calling thread alone (waking the pool costs more than such copies).
+  int serial_copy_kib = 512;
 };
 
 /// the most rows whose sums the device's exposure takes (its block keeps them in shared
@@ -181,6 +184,17 @@ struct RealtimeStageTimes {
   /// device_exposure from the end of the launches, so it includes waiting for the kernels
   double outputs = 0;
   double total = 0;
+  /// host clock: from the start until every kernel and copy of the frame is queued (the host's
+  /// waits for the outputs come after)
+  double launched = 0;
+  /// device_sky with device_exposure (else 0), CUDA events from the frame's first event on the
+  /// stream (before the geoms' upload): the film kernel's end, and the end of the last copy to
+  /// page-locked memory (the rgb's, row sums' and exposure's, or the radiance's last band); the
+  /// host's clock total minus copies_end is what the host adds after the device: its
+  /// preparation before the first event, its copies into the frame's images after the last
+  /// transfer, its waits and checks
+  double kernels_end = 0;
+  double copies_end = 0;
 };
 
 /// one camera's film in a batch (RealtimeBatch): its per-channel exposures (set by the batch

@@ -118,7 +118,9 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   o.body_id = Shape(&out->body_id, want[ImageKind::kInstanceSegmentation], W, H, 1);
   o.semantic = Shape(&out->semantic_class, want[ImageKind::kSemanticSegmentation], W, H, 1);
   if (o.depth || o.geom_id || o.range || o.normal_O || o.body_id || o.semantic)
-    device_->RenderPrimary(c, o);
+    device_->RenderPrimary(c, o, [this](int64_t count, const std::function<void(int64_t)>& body) {
+      ParallelForOrSerial(pool_.get(), count, body);
+    });
   out->rays = static_cast<int64_t>(W) * H;
   out->stopped = false;
   ++gpu_frames_;

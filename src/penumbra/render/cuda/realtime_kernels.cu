@@ -477,69 +477,9 @@ __global__ void BatchDevelopKernel(const Float3* radiance, int64_t n, const Real
   DevelopPixel(radiance[k], c.exposure, c.filmic != 0, c.lut, rgb + 3 * k);
 }
 
-// page-locked host memory that grows (never shrinks).
-struct PinnedBuffer {
-  void* p = nullptr;
-  size_t bytes = 0;
-  PinnedBuffer() = default;
-  PinnedBuffer(const PinnedBuffer&) = delete;
-  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
-  void Reserve(size_t n) {
-    if (n <= bytes) return;
-    if (p) cudaFreeHost(p);
-    p = nullptr;
-    bytes = 0;
-    Check(cudaMallocHost(&p, n), "cudaMallocHost (realtime frame)");
-    bytes = n;
-  }
-  template <typename T>
-  T* as() const {
-    return static_cast<T*>(p);
-  }
-  ~PinnedBuffer() {
-    if (p) cudaFreeHost(p);
-  }
-};
-
 using Clock = std::chrono::steady_clock;
 double MsSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
-// one host copy of ParallelCopy.
-struct HostCopy {
-  void* dst;
-  const void* src;
-  size_t n;
-  cudaEvent_t ready = nullptr;  // src is complete once this event passed (null: now)
-};
-
-// the copies, in chunks of `chunk` bytes, in one loop through `parallel` (serially if it is
-// empty); a chunk waits for its copy's `ready` event before it is copied.
-void ParallelCopy(const RealtimeOutputs::ParallelFn& parallel, const std::vector<HostCopy>& copies,
-                  size_t chunk) {
-  const size_t kChunk = std::max<size_t>(chunk, 4096);
-  struct Chunk {
-    char* dst;
-    const char* src;
-    size_t n;
-    cudaEvent_t ready;
-  };
-  std::vector<Chunk> chunks;
-  for (const HostCopy& c : copies)
-    for (size_t a = 0; a < c.n; a += kChunk)
-      chunks.push_back({static_cast<char*>(c.dst) + a, static_cast<const char*>(c.src) + a,
-                        std::min(kChunk, c.n - a), c.ready});
-  // chunks are taken in order: a thread waits for its chunk's source only
-  auto copy = [&](int64_t i) {
-    if (chunks[i].ready) Check(cudaEventSynchronize(chunks[i].ready), "copying a realtime output");
-    std::memcpy(chunks[i].dst, chunks[i].src, chunks[i].n);
-  };
-  const int64_t count = static_cast<int64_t>(chunks.size());
-  if (parallel && count > 1)
-    parallel(count, copy);
-  else
-    for (int64_t i = 0; i < count; ++i) copy(i);
 }
 
 // the grid of the per-pixel kernels (whole warps of 16 x 2 pixels).
@@ -630,7 +570,12 @@ struct PixelBuffers {
 
 struct DeviceRealtime::Impl : PixelBuffers {
   Buffer materials, textures, texels, decode, lut, geoms, lights;
-  Buffer depth, rows, rgb, hits, streaks;
+  // rgb: the frame's tail, one device buffer copied back at once with device_exposure: the rgb
+  // (3 n bytes), then, 16-byte aligned, the row sums (H doubles) and the device's exposure
+  // (TailRows, rows, exposure); pin_rgb holds its copy
+  Buffer depth, rgb, hits, streaks;
+  double* rows = nullptr;
+  DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
   Buffer media_pods, media_fog, media_inv_log_far, media_axes, media_trans, volume_pod;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
@@ -638,8 +583,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
   SkyModelPod device_sky;
   SkyVolumePod device_volume;
   bool sky_uploaded = false;
-  // the device_sky path's stage times (CUDA events with timing)
-  cudaEvent_t stage[4] = {};
+  // the device_sky path's stage times (CUDA events with timing): start, geometry, sky terms, row
+  // sums, film (device_exposure), the tail on the host, the radiance on the host
+  cudaEvent_t stage[7] = {};
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
@@ -649,9 +595,6 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // false when they are not known (DeviceFrame uploaded others)
   std::vector<uint8_t> uploaded_geoms, uploaded_lights;
   bool uploaded = false;
-  // device_exposure: the device's exposure, and its pinned copy for the host's check
-  Buffer device_exposure;
-  PinnedBuffer pin_exposure;
   RealtimeExposureChecks checks;
   std::vector<PixelGeometry> host_geometry, host_mirror_geometry;
   std::vector<Float3> host_sky, host_mirror_sky;
@@ -673,6 +616,18 @@ struct DeviceRealtime::Impl : PixelBuffers {
   RealtimeFilm film;
   int filmic = 1;
   bool rendered = false;
+
+  // the tail's layout (rgb above): the row sums' offset, and its bytes
+  static size_t TailRows(int64_t n) { return (static_cast<size_t>(3 * n) + 15) / 16 * 16; }
+  static size_t TailBytes(int64_t n, int H) {
+    return TailRows(n) + sizeof(double) * H + sizeof(DeviceExposure);
+  }
+  // the tail for frames of n pixels and H rows on the device (rows and exposure_out into it)
+  void ReserveTail(int64_t n, int H) {
+    rgb.Reserve(TailBytes(n, H));
+    rows = reinterpret_cast<double*>(rgb.as<char>() + TailRows(n));
+    exposure_out = reinterpret_cast<DeviceExposure*>(rows + H);
+  }
 
   // the posed geoms and lights of `f` (host arrays, num_geoms geoms) to the device on `stream`:
   // pinned, asynchronous (the last frame's copies are done: it ended with a synchronisation);
@@ -746,8 +701,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the film kernel with the exposure the device computed (LaunchExposure)
   void LaunchFilmDeviceExposure(int64_t n, int tone_map, cudaStream_t stream) {
     DevelopDeviceExposureKernel<<<static_cast<unsigned>((n + 255) / 256), 256, 0, stream>>>(
-        radiance.as<Float3>(), n, device_exposure.as<DeviceExposure>(), tone_map, lut.as<uint8_t>(),
-        rgb.as<uint8_t>());
+        radiance.as<Float3>(), n, exposure_out, tone_map, lut.as<uint8_t>(), rgb.as<uint8_t>());
     Check(cudaGetLastError(), "DevelopKernel");
   }
 
@@ -850,11 +804,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
       Check(cudaGetLastError(), "StreakKernel");
     }
     if (o.rows_per_warp)
-      RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
-                                                        rows.as<double>());
+      RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H, rows);
     else
-      RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H,
-                                                        rows.as<double>());
+      RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H, rows);
     Check(cudaGetLastError(), "RowSumKernel");
   }
   // f's scene-wide arrays: the device copies of Upload, UploadSky and the posed geoms and lights
@@ -985,9 +937,9 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   const RealtimeOutputs::ParallelFn no_threads;
   const RealtimeOutputs::ParallelFn& parallel = o.parallel_copies ? out.parallel : no_threads;
   const size_t chunk = static_cast<size_t>(std::max(o.copy_chunk_kib, 4)) << 10;
+  const size_t serial = static_cast<size_t>(std::max(o.serial_copy_kib, 0)) << 10;
   m.depth.Reserve(sizeof(float) * n);
-  m.rows.Reserve(sizeof(double) * H);
-  m.rgb.Reserve(3 * n);
+  m.ReserveTail(n, H);
   if (o.reuse_hit) m.hits.Reserve(sizeof(TraceHit) * n);
   const int64_t nl = n * (host_frame.num_lights > 0 ? host_frame.num_lights : 1);
   const bool mirror = host_frame.any_mirror != 0;
@@ -1012,13 +964,16 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   if (o.pinned) {
     m.pin_geometry.Reserve(sizeof(PixelGeometry) * n);
     m.pin_sky.Reserve(sizeof(Float3) * n);
-    m.pin_rows.Reserve(sizeof(double) * H);
-    m.pin_exposure.Reserve(sizeof(DeviceExposure));
-    m.device_exposure.Reserve(sizeof(DeviceExposure));
     host_geometry = m.pin_geometry.as<PixelGeometry>();
     host_sky = m.pin_sky.as<Float3>();
-    host_rows = m.pin_rows.as<double>();
-    if (out.rgb) m.pin_rgb.Reserve(3 * n);
+    // device_exposure: the row sums come back in the tail's copy
+    m.pin_rgb.Reserve(Impl::TailBytes(n, H));
+    if (device_exposure) {
+      host_rows = reinterpret_cast<double*>(m.pin_rgb.as<char>() + Impl::TailRows(n));
+    } else {
+      m.pin_rows.Reserve(sizeof(double) * H);
+      host_rows = m.pin_rows.as<double>();
+    }
     if (out.radiance) m.pin_radiance.Reserve(sizeof(Float3) * n);
     if (out.depth) m.pin_depth.Reserve(sizeof(float) * n);
     if (mirror) {
@@ -1125,26 +1080,33 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
               "cudaMemcpyAsync");
       Check(cudaEventRecord(m.radiance_band[k], m.copy_stream), "cudaEventRecord");
     }
+    if (o.device_sky) Check(cudaEventRecord(m.stage[6], m.copy_stream), "cudaEventRecord");
   }
   if (device_exposure) {
     // (5) the exposure and the film on the device, the row sums, the device's exposure and the
     // rgb back on the same stream: the host waits once, at the end
     if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
-    LaunchExposure(m.rows.as<double>(), H, n, film.exposure, film.white_balance_gains,
-                   m.device_exposure.as<DeviceExposure>(), stream);
+    LaunchExposure(m.rows, H, n, film.exposure, film.white_balance_gains, m.exposure_out, stream);
     m.LaunchFilmDeviceExposure(n, filmic, stream);
-    m.rows.Download(host_rows, sizeof(double) * H, stream);
-    m.device_exposure.Download(m.pin_exposure.p, sizeof(DeviceExposure), stream);
-    if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
+    if (o.device_sky) Check(cudaEventRecord(m.stage[4], stream), "cudaEventRecord");
+    // the rgb, the row sums and the device's exposure: one copy (the rows' part alone without
+    // the rgb)
+    const size_t from = out.rgb ? 0 : Impl::TailRows(n);
+    Check(cudaMemcpyAsync(m.pin_rgb.as<char>() + from, m.rgb.as<char>() + from,
+                          Impl::TailBytes(n, H) - from, cudaMemcpyDeviceToHost, stream),
+          "cudaMemcpyAsync");
     Check(cudaEventRecord(m.rgb_copied, stream), "cudaEventRecord");
+    if (o.device_sky) Check(cudaEventRecord(m.stage[5], stream), "cudaEventRecord");
   } else {
-    m.rows.Download(host_rows, sizeof(double) * H, stream);
+    Check(cudaMemcpyAsync(host_rows, m.rows, sizeof(double) * H, cudaMemcpyDeviceToHost, stream),
+          "cudaMemcpyAsync");
     if (o.device_sky) Check(cudaEventRecord(m.stage[3], stream), "cudaEventRecord");
   }
+  m.times.launched = MsSince(t0);
   // pinned: the depth into the frame's image while the GPU shades
   if (out.depth && o.pinned) {
     Check(cudaEventSynchronize(m.depth_copied), "copying the realtime depth");
-    ParallelCopy(parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}}, chunk);
+    ParallelCopy(parallel, {{out.depth, m.pin_depth.p, sizeof(float) * n}}, chunk, serial);
   }
   // the radiance into the frame's image, band by band as it comes back
   const auto copy_radiance = [&] {
@@ -1156,7 +1118,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       ParallelCopy(
           parallel,
           {{out.radiance + 3 * off, m.pin_radiance.as<Float3>() + off, sizeof(Float3) * count}},
-          chunk);
+          chunk, serial);
     }
   };
   Exposure e;
@@ -1178,12 +1140,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
                           sizeof(Float3) * count, m.radiance_band[k]});
       }
     if (out.rgb) copies.push_back({out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n), m.rgb_copied});
-    ParallelCopy(parallel, copies, chunk);
+    ParallelCopy(parallel, copies, chunk, serial);
     Check(cudaStreamSynchronize(stream), "DevelopKernel");
     t3 = Clock::now();
     m.host_rows.assign(host_rows, host_rows + H);
     ev100 = exposure(m.host_rows, e.e);
-    const DeviceExposure& d = *m.pin_exposure.as<DeviceExposure>();
+    const DeviceExposure& d = *reinterpret_cast<const DeviceExposure*>(host_rows + H);
     ++m.checks.frames;
     if (std::memcmp(&d.ev100, &ev100, sizeof(double)) != 0) ++m.checks.ev100_differs;
     if (std::memcmp(d.e, e.e, sizeof(e.e)) != 0) {
@@ -1192,7 +1154,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       if (out.rgb) m.rgb.Download(m.pin_rgb.p, 3 * n, stream);
       Check(cudaStreamSynchronize(stream), "DevelopKernel");
       if (out.rgb)
-        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk, serial);
     }
     Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
     m.times.outputs = MsSince(tc);
@@ -1211,7 +1173,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
       Check(cudaStreamSynchronize(m.copy_stream), "copying the realtime outputs");
       Check(cudaStreamSynchronize(stream), "DevelopKernel");
       if (out.rgb)
-        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk);
+        ParallelCopy(parallel, {{out.rgb, m.pin_rgb.p, static_cast<size_t>(3 * n)}}, chunk, serial);
       m.times.outputs = MsSince(tc);
     } else {
       if (out.rgb) m.rgb.Download(out.rgb, 3 * n, stream);
@@ -1228,6 +1190,19 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.times.sky = ms[1];
     m.times.shade = ms[2];
     m.times.film = m.times.total - (m.times.geometry + m.times.sky + m.times.shade);
+    // the device's end of the kernels and of the copies back (device_exposure)
+    m.times.kernels_end = m.times.copies_end = 0;
+    if (device_exposure) {
+      float end = 0;
+      Check(cudaEventElapsedTime(&end, m.stage[0], m.stage[4]), "cudaEventElapsedTime");
+      m.times.kernels_end = end;
+      Check(cudaEventElapsedTime(&end, m.stage[0], m.stage[5]), "cudaEventElapsedTime");
+      m.times.copies_end = end;
+      if (out.radiance) {
+        Check(cudaEventElapsedTime(&end, m.stage[0], m.stage[6]), "cudaEventElapsedTime");
+        m.times.copies_end = std::max<double>(m.times.copies_end, end);
+      }
+    }
   } else {
     m.times.geometry = std::chrono::duration<double, std::milli>(t1 - t0).count();
     m.times.sky = sky_ms;
@@ -1259,11 +1234,10 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   // the host's of the last Render
   const int H = f.camera.height;
   const bool device_exposure = options.device_exposure && H <= kMaxDeviceExposureRows;
-  if (device_exposure) m.device_exposure.Reserve(sizeof(DeviceExposure));
   const auto film = [&] {
     if (device_exposure) {
-      LaunchExposure(m.rows.as<double>(), H, n, m.film.exposure, m.film.white_balance_gains,
-                     m.device_exposure.as<DeviceExposure>(), stream);
+      LaunchExposure(m.rows, H, n, m.film.exposure, m.film.white_balance_gains, m.exposure_out,
+                     stream);
       m.LaunchFilmDeviceExposure(n, m.filmic, stream);
     } else {
       m.LaunchFilm(n, m.exposure, m.filmic, stream);
