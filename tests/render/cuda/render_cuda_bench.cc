@@ -123,6 +123,26 @@ double TimeMediaBuild(const SceneDescription& scene, const WorldSnapshot& snap,
   return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count() / frames;
 }
 
+// a world for a benchmark row: its session (no renderer) stepped to 1 s, the snapshot there
+// and the file's name.
+struct BenchWorld {
+  std::unique_ptr<Session> session;
+  WorldSnapshot snap;
+  std::string name;
+};
+
+BenchWorld LoadBenchWorld(const std::string& file) {
+  SessionOptions so;
+  so.build_renderer = false;
+  BenchWorld w;
+  w.session = std::make_unique<Session>(LoadWorldFile(file), so);
+  Simulation& sim = w.session->sim();
+  while (sim.time() < 1.0) sim.Step();
+  w.snap = sim.Snapshot();
+  w.name = file.substr(file.find_last_of('/') + 1);
+  return w;
+}
+
 // a positive integer argument, or 0
 int PositiveArg(const std::string& s) {
   char* end = nullptr;
@@ -140,15 +160,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
   // device_sky with device_exposure): printed after the variants' table
   std::vector<std::string> host_rows;
   for (const std::string& file : worlds) {
-    SessionOptions so;
-    so.build_renderer = false;
-    Session session(LoadWorldFile(file), so);
-    Simulation& sim = session.sim();
-    while (sim.time() < 1.0) sim.Step();
-    const WorldSnapshot snap = sim.Snapshot();
-    const SceneDescription& scene = session.scene();
+    const BenchWorld world = LoadBenchWorld(file);
+    const WorldSnapshot& snap = world.snap;
+    const SceneDescription& scene = world.session->scene();
     const CameraSpec& cam = scene.cameras.front();
-    const std::string name = file.substr(file.find_last_of('/') + 1);
+    const std::string& name = world.name;
     const std::string size = fmt::format("{}x{}", width, height);
     const double fovy_deg = cam.intrinsics.fovy_deg();
     CameraView view;
@@ -469,15 +485,11 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
       std::thread::hardware_concurrency());
   std::vector<std::string> floors;
   for (const std::string& file : worlds) {
-    SessionOptions so;
-    so.build_renderer = false;
-    Session session(LoadWorldFile(file), so);
-    Simulation& sim = session.sim();
-    while (sim.time() < 1.0) sim.Step();
-    const WorldSnapshot snap = sim.Snapshot();
-    const SceneDescription& scene = session.scene();
+    const BenchWorld world = LoadBenchWorld(file);
+    const WorldSnapshot& snap = world.snap;
+    const SceneDescription& scene = world.session->scene();
     const CameraSpec& cam = scene.cameras.front();
-    const std::string name = file.substr(file.find_last_of('/') + 1);
+    const std::string& name = world.name;
     CameraView view;
     view.X_WO = CameraPoseInWorld(cam, snap);
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, cam.intrinsics.fovy_deg());
@@ -615,15 +627,11 @@ int Main(int argc, char** argv) {
   std::vector<Row> rows;
   std::vector<std::string> builds;
   for (const std::string& file : worlds) {
-    SessionOptions so;
-    so.build_renderer = false;
-    Session session(LoadWorldFile(file), so);
-    Simulation& sim = session.sim();
-    while (sim.time() < 1.0) sim.Step();
-    const WorldSnapshot snap = sim.Snapshot();
-    const SceneDescription& scene = session.scene();
+    const BenchWorld world = LoadBenchWorld(file);
+    const WorldSnapshot& snap = world.snap;
+    const SceneDescription& scene = world.session->scene();
     const CameraSpec& cam = scene.cameras.front();
-    const std::string name = file.substr(file.find_last_of('/') + 1);
+    const std::string& name = world.name;
     const double fovy_deg = cam.intrinsics.fovy_deg();
     RenderSettings cpu_settings;
     cpu_settings.backend = RenderSettings::Backend::kEmbree;
@@ -659,7 +667,7 @@ int Main(int argc, char** argv) {
       rgb.outputs[ImageKind::kSegmentation] = false;
       const int n = w * h < 100000 ? frames * 10 : frames;
       const std::shared_ptr<const EffectsFrame> fx =
-          session.effects().Evaluate(snap, view.X_WO.translation());
+          world.session->effects().Evaluate(snap, view.X_WO.translation());
       const bool with_fx = fx && !fx->empty();
       const std::string fx_outputs = cuda::CudaRenderer::OnGpu(fx.get(), rgb)
                                          ? "rgb+depth realtime + effects (on GPU)"
