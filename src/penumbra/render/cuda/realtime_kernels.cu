@@ -832,8 +832,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     SurfaceTerms* st = surfaces.as<SurfaceTerms>();
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 6 && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 6, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 6)
-      ShadeStoredKernel<OneFrame, 6>
+      ShadeStoredKernel<OneFrame, 6, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4 && f.has_media != 0)
       ShadeStoredKernel<OneFrame, 4, true>
@@ -841,8 +844,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 4)
       ShadeStoredKernel<OneFrame, 4, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
+    else if (o.reuse_surface && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 1, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface)
-      ShadeStoredKernel<OneFrame, 1>
+      ShadeStoredKernel<OneFrame, 1, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.min_blocks >= 6)
       ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
