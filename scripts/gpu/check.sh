@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # on a GPU machine: unpacks scripts/gpu/pack.sh's tarball, names the card, runs the CUDA
 # backend's tests (the `gpu` tests and the host tests) and its benchmarks beside the CPU
-# backend (single camera, and the flashlight, rain and fog worlds' effects frames on the GPU and
-# the CPU;
+# backend (single camera, and the flashlight, rain, fog and smoke_plume worlds' effects frames on
+# the GPU and the CPU;
 # batches of 1, 64 and 1024 cameras at 128x128 in the house, depth+seg
 # and realtime rgb+depth with its stages' GPU times; copy rates), the pathtraced tier's frame
 # time beside the CPU backend's (default and house, 320x240, 64 samples per pixel), the parity
@@ -52,7 +52,8 @@ parity_rc=$?
 timeout $((limit * 3 / 2)) "$pkg/bin/render_cuda_bench" --frames "$frames" \
   "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" \
   "$pkg/src/worlds/effects/flashlight.yaml" "$pkg/src/worlds/effects/rain.yaml" \
-  "$pkg/src/worlds/effects/fog.yaml" > "$log/bench.txt" 2>&1
+  "$pkg/src/worlds/effects/fog.yaml" "$pkg/src/worlds/effects/smoke_plume.yaml" \
+  > "$log/bench.txt" 2>&1
 bench_rc=$?
 timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --batch 64 \
   --size 128x128 --sessions 4 "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1

@@ -157,6 +157,13 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       gl.cells_per_m[k] = gl.r[k] / size[k];
     }
     gl.cell_m = (1.0f / gl.cells_per_m.array()).minCoeff();
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) gl.pod.R_GW[3 * i + k] = v.R_GW(i, k);
+      gl.pod.p_GW[i] = v.p_GW[i];
+      gl.pod.half[i] = v.half[i];
+      gl.pod.cells_per_m[i] = gl.cells_per_m[i];
+      gl.pod.r[i] = gl.r[i];
+    }
     const int cells = gl.r[0] * gl.r[1] * gl.r[2];
     gl.T.assign(static_cast<size_t>(nl) * cells, 1.0f);
     gl.source.assign(cells, sky_ambient);
@@ -397,38 +404,9 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
 float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
                                    Eigen::Array4f* T) const {
   const Froxels& fr = froxels_;
-  constexpr int Z = kFroxelSlices;
-  const ColumnBilerp cb = PixelColumns(fr, u, v, kFroxelBlock);
-  const int* cols = cb.cols;
-  // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
-  float t_enter = kInfView;
-  for (int q = 0; q < 4; ++q)
-    if (fr.t0[cols[q]] < fr.t1[cols[q]]) t_enter = std::min(t_enter, fr.t0[cols[q]]);
-  S->setZero();
-  if (!(t > t_enter)) {
-    *T = Eigen::Array4f(1, 1, 1, 0);
-    return t_enter;
-  }
-  T->setZero();
-  const float* w = cb.w;
-  // columns of weight 0 (pixels on a column's centre row or column) are skipped.
-  for (int q = 0; q < 4; ++q) {
-    if (!(w[q] > 0)) continue;
-    const int c = cols[q];
-    const float a = fr.t0[c], b = fr.t1[c];
-    if (!(a < b)) {
-      *T += Eigen::Array4f::Constant(w[q]);  // lane 3 is unused
-      continue;
-    }
-    const float s = std::clamp((t - a) * fr.slices_per_m[c], 0.0f, static_cast<float>(Z));
-    const int k = std::min(static_cast<int>(s), Z - 1);
-    const float f = s - k;
-    const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1) + k;
-    const float w0 = w[q] * (1 - f), w1 = w[q] * f;
-    *S += w0 * rec[0].S + w1 * rec[1].S;
-    *T += w0 * rec[0].T + w1 * rec[1].T;
-  }
-  return t_enter;
+  return GridFroxelLookup(PixelColumns(fr, u, v, kFroxelBlock), fr.t0.data(), fr.t1.data(),
+                          fr.slices_per_m.data(), fr.records.data(), t,
+                          Eigen::Array4f::Zero().eval(), Eigen::Array4f(1, 1, 1, 0), S, T);
 }
 
 namespace {
@@ -550,8 +528,7 @@ Eigen::Array4f RealtimeMedia::LookupFogFroxels(int u, int v, float t) const {
                          fr.inv_log_far.data(), t, Eigen::Array4f::Zero().eval());
 }
 
-RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
-                                          SkyVolumePod* sky_pod) const {
+RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const {
   RealtimeMediaView m;
   m.media = pods_.data();
   m.num_media = static_cast<int>(pods_.size());
@@ -559,19 +536,20 @@ RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
   m.grey = grey_t_ ? 1 : 0;
   for (int k = 0; k < 3; ++k) m.sky_ambient[k] = sky_ambient_[k];
   if (sky_volume_ != nullptr) {
-    *sky_pod = sky_volume_->pod();
-    m.sky_volume = sky_pod;
+    arrays->sky_pod = sky_volume_->pod();
+    m.sky_volume = &arrays->sky_pod;
   }
+  auto rgb4 = [](const Eigen::Array4f& a) { return Rgb4{a[0], a[1], a[2], a[3]}; };
   const FogFroxels& ff = fog_froxels_;
+  arrays->fog_records.clear();
   if (!ff.S.empty()) {
-    fog_records->resize(ff.S.size());
-    for (size_t i = 0; i < ff.S.size(); ++i)
-      (*fog_records)[i] = Rgb4{ff.S[i][0], ff.S[i][1], ff.S[i][2], ff.S[i][3]};
+    arrays->fog_records.resize(ff.S.size());
+    for (size_t i = 0; i < ff.S.size(); ++i) arrays->fog_records[i] = rgb4(ff.S[i]);
     m.fog_nx = ff.nx;
     m.fog_ny = ff.ny;
     m.width = static_cast<int>(ff.ax.size());
     m.height = static_cast<int>(ff.ay.size());
-    m.fog_S = fog_records->data();
+    m.fog_S = arrays->fog_records.data();
     m.fog_inv_log_far = ff.inv_log_far.data();
     m.fog_ax = ff.ax.data();
     m.fog_ay = ff.ay.data();
@@ -582,6 +560,40 @@ RealtimeMediaView RealtimeMedia::HostView(std::vector<Rgb4>* fog_records,
     m.light_volume = cl_pod_;
     m.light_trans = vol_.trans_cl.data();
     m.num_volume_lights = num_lights_;
+  }
+  const Froxels& fr = froxels_;
+  arrays->grid_records.clear();
+  if (!fr.records.empty()) {
+    arrays->grid_records.resize(fr.records.size());
+    for (size_t i = 0; i < fr.records.size(); ++i)
+      arrays->grid_records[i] = {rgb4(fr.records[i].S), rgb4(fr.records[i].T)};
+    m.grid_nx = fr.nx;
+    m.grid_ny = fr.ny;
+    m.width = static_cast<int>(fr.ax.size());
+    m.height = static_cast<int>(fr.ay.size());
+    m.grid_t0 = fr.t0.data();
+    m.grid_t1 = fr.t1.data();
+    m.grid_slices_per_m = fr.slices_per_m.data();
+    m.grid_records = arrays->grid_records.data();
+    m.grid_ax = fr.ax.data();
+    m.grid_ay = fr.ay.data();
+    m.grid_ax_half = fr.ax_half.data();
+    m.grid_ay_half = fr.ay_half.data();
+  }
+  // the grids' light volumes end to end, each pod's offset where its own starts
+  arrays->grid_light_T.clear();
+  arrays->grid_pods.clear();
+  for (const GridLight& gl : grid_light_) {
+    GridLightPod pod = gl.pod;
+    pod.offset = arrays->grid_light_T.size();
+    arrays->grid_light_T.insert(arrays->grid_light_T.end(), gl.T.begin(), gl.T.end());
+    arrays->grid_pods.push_back(pod);
+  }
+  if (!arrays->grid_pods.empty()) {
+    m.num_grids = static_cast<int>(arrays->grid_pods.size());
+    m.grids = arrays->grid_pods.data();
+    m.grid_light_T = arrays->grid_light_T.data();
+    m.num_grid_lights = num_lights_;
   }
   return m;
 }
@@ -610,56 +622,12 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f
     q.has_sky = true;
   }
   // grid froxels: the columns and weights of the quad's centre, then per column the slice that
-  // holds t and the distances where that stays so (constant before the column's entry and
-  // after its exit).
+  // holds t and the distances where that stays so (media_realtime_math.h).
   const Froxels& fr = froxels_;
-  if (!fr.records.empty()) {
-    constexpr int Z = kFroxelSlices;
-    const float t = std::min(t_c, 1e30f);
-    q.t_c = t;
-    const ColumnBilerp cb = QuadColumns(fr, u0, v0, kFroxelBlock);
-    const int* cols = cb.cols;
-    float t_enter = kInfView;
-    for (int k = 0; k < 4; ++k)
-      if (fr.t0[cols[k]] < fr.t1[cols[k]]) t_enter = std::min(t_enter, fr.t0[cols[k]]);
-    q.g_enter = t_enter;
-    if (t > t_enter) {
-      const float* w = cb.w;
-      float lo = t_enter, hi = kInfView;
-      for (int k = 0; k < 4; ++k) {
-        if (!(w[k] > 0)) continue;
-        const int c = cols[k];
-        const float a = fr.t0[c], b = fr.t1[c];
-        if (!(a < b)) {
-          q.gT += Eigen::Array4f::Constant(w[k]);
-          continue;
-        }
-        const FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
-        const float spm = fr.slices_per_m[c];
-        const float s = (t - a) * spm;
-        if (!(s > 0)) {  // before the column's entry: record 0
-          hi = std::min(hi, a);
-          q.gS += w[k] * rec[0].S;
-          q.gT += w[k] * rec[0].T;
-        } else if (!(s < Z)) {  // after its exit: record Z
-          lo = std::max(lo, b);
-          q.gS += w[k] * rec[Z].S;
-          q.gT += w[k] * rec[Z].T;
-        } else {
-          const int i = std::min(static_cast<int>(s), Z - 1);
-          const float f = s - i;
-          lo = std::max(lo, a + i / spm);
-          hi = std::min(hi, a + (i + 1) / spm);
-          q.gS += w[k] * ((1 - f) * rec[i].S + f * rec[i + 1].S);
-          q.gT += w[k] * ((1 - f) * rec[i].T + f * rec[i + 1].T);
-          q.gS_dt += (w[k] * spm) * (rec[i + 1].S - rec[i].S);
-          q.gT_dt += (w[k] * spm) * (rec[i + 1].T - rec[i].T);
-        }
-      }
-      q.g_lo = lo;
-      q.g_hi = hi;
-    }
-  }
+  if (!fr.records.empty())
+    GridQuadPrepare(QuadColumns(fr, u0, v0, kFroxelBlock), fr.t0.data(), fr.t1.data(),
+                    fr.slices_per_m.data(), fr.records.data(), t_c, Eigen::Array4f(1, 1, 1, 0),
+                    &q.grid);
   // light in-scatter froxels: the same in log distance (slices are spaced exponentially),
   // beyond the first slice boundary only.
   const FogFroxels& ff = fog_froxels_;
@@ -670,16 +638,11 @@ void RealtimeMedia::PrepareQuad(int u0, int v0, float t_c, const Eigen::Vector3f
 
 float RealtimeMedia::QuadFroxels(const MediaQuad& q, int u, int v, float t, Eigen::Array4f* S,
                                  Eigen::Array4f* T) const {
-  if (!(t > q.g_enter)) {
-    S->setZero();
-    *T = Eigen::Array4f(1, 1, 1, 0);
-    return q.g_enter;
-  }
-  if (!(t >= q.g_lo && t <= q.g_hi)) return LookupFroxels(u, v, t, S, T);
-  const float dt = t == q.t_c ? 0.0f : t - q.t_c;
-  *S = q.gS + dt * q.gS_dt;
-  *T = q.gT + dt * q.gT_dt;
-  return q.g_enter;
+  float t_enter;
+  if (GridQuadValue(q.grid, t, Eigen::Array4f::Zero().eval(), Eigen::Array4f(1, 1, 1, 0), S, T,
+                    &t_enter) != 0)
+    return t_enter;
+  return LookupFroxels(u, v, t, S, T);
 }
 
 Eigen::Array4f RealtimeMedia::QuadFogFroxels(const MediaQuad& q, int u, int v, float t) const {
@@ -690,15 +653,8 @@ Eigen::Array4f RealtimeMedia::QuadFogFroxels(const MediaQuad& q, int u, int v, f
 
 float RealtimeMedia::GridLightT(int g, int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,
                                 float dist) const {
-  if (j >= num_lights_) return 1.0f;
-  const GridVolume& v = media_->grids()[g];
-  float a, b;
-  if (!v.Interval(p_W, wi, 0.0f, dist, &a, &b)) return 1.0f;
   const GridLight& gl = grid_light_[g];
-  const Eigen::Vector3f f = (v.ToGrid(p_W + a * wi) + v.half).cwiseProduct(gl.cells_per_m) -
-                            Eigen::Vector3f::Constant(0.5f);
-  const size_t cells = static_cast<size_t>(gl.r[0]) * gl.r[1] * gl.r[2];
-  return Trilinear(gl.T.data() + j * cells, gl.r, f);
+  return GridLightTransmittance(gl.pod, gl.T.data(), num_lights_, j, p_W.data(), wi.data(), dist);
 }
 
 float RealtimeMedia::FogVisibility(int j, const Eigen::Vector3f& p_W, const Eigen::Vector3f& wi,

@@ -93,16 +93,32 @@ struct MediaSegment {
 /// reference distance t_c, within the distance ranges where the lookups stay in one slice of
 /// every column; a pixel whose distance lies outside a range looks that volume up itself.
 struct MediaQuad {
-  float t_c = 0;             ///< reference distance of the grid values (m)
-  float g_enter = 0;         ///< grid: smallest entry distance of the columns (m)
-  float g_lo = 1, g_hi = 0;  ///< grid: distances (m) where gS, gT hold (empty: none)
-  Eigen::Array4f gS = Eigen::Array4f::Zero(), gT = Eigen::Array4f::Zero();        ///< at t_c
-  Eigen::Array4f gS_dt = Eigen::Array4f::Zero(), gT_dt = Eigen::Array4f::Zero();  ///< per m
+  /// grid: the in-scatter and transmittance at t_c, their slopes in distance and where they
+  /// hold (GridQuadPrepare of media_realtime_math.h; empty range: none)
+  GridQuad<Eigen::Array4f> grid{0,
+                                0,
+                                1,
+                                0,
+                                Eigen::Array4f::Zero(),
+                                Eigen::Array4f::Zero(),
+                                Eigen::Array4f::Zero(),
+                                Eigen::Array4f::Zero()};
   /// fog: the light in-scatter at t_c, its slope in log distance and where they hold
   /// (FogQuadPrepare of media_realtime_math.h; empty range: none)
   FogQuad<Eigen::Array4f> fog{0, 1, 0, Eigen::Array4f::Zero(), Eigen::Array4f::Zero()};
   bool has_sky = false;                         ///< sky holds SkyAlongRay of the quad
   Eigen::Array4f sky = Eigen::Array4f::Zero();  ///< occluded sky radiance of the media
+};
+
+/// host copies of RealtimeMedia's arrays in the plain types of RealtimeMediaView (HostView): the
+/// fog and grid froxels' records as Rgb4, the grids' boxes and light volumes (pods, their
+/// transmittances end to end), the sky volume's plain data.
+struct RealtimeMediaHostArrays {
+  std::vector<Rgb4> fog_records;
+  std::vector<GridFroxelRecord<Rgb4>> grid_records;
+  std::vector<GridLightPod> grid_pods;
+  std::vector<float> grid_light_T;
+  SkyVolumePod sky_pod;
 };
 
 /// the realtime tier's per-frame media structures. Build, then the queries are thread-safe.
@@ -176,13 +192,13 @@ class RealtimeMedia {
   const CellLightsPod& light_volume_pod() const { return cl_pod_; }
   const std::vector<float>& light_volume_visibility() const { return vol_.vis_cl; }
   const std::vector<float>& light_volume_transmittance() const { return vol_.trans_cl; }
-  /// this frame's homogeneous media as a RealtimeMediaView (media_realtime_math.h) over this
-  /// object's arrays (host pointers, valid until the next Build), with the fog froxels'
-  /// records copied to *fog_records (as Rgb4) and the sky volume's plain data to *sky_pod; both
-  /// must outlive the view. MediaViewSegment over it is IntegrateView without a quad for frames
-  /// without grids, MediaLightTransmittance the surface loop's transmittance (bit for bit:
+  /// this frame's media as a RealtimeMediaView (media_realtime_math.h) over this object's
+  /// arrays (host pointers, valid until the next Build), with the froxels' records, the grids'
+  /// light volumes and the sky volume's plain data copied to *arrays, which must outlive the
+  /// view. MediaViewSegment over it is IntegrateView (MediaPrepareQuad's quads PrepareQuad's),
+  /// MediaLightTransmittance the surface loop's transmittance (bit for bit:
   /// tests/render/media_realtime_math_test.cc); a GPU path uploads the same arrays.
-  RealtimeMediaView HostView(std::vector<Rgb4>* fog_records, SkyVolumePod* sky_pod) const;
+  RealtimeMediaView HostView(RealtimeMediaHostArrays* arrays) const;
   /// CellLightsLookup on the CPU (SSE; the shared function's arithmetic, tested against it)
   /// of the world light volume's visibility (V Th Tgrid) at p_W into T[0 .. stride); false
   /// outside the volume or without it.
@@ -195,6 +211,7 @@ class RealtimeMedia {
     float cell_m = 1;                     // smallest cell size
     std::vector<float> T;                 // [light][cell] grid transmittance to the light
     std::vector<Eigen::Vector3f> source;  // [cell] isotropic in-scatter source, cd/m^2
+    GridLightPod pod;  // the grid's box and this volume for GridLightTransmittance (offset 0)
   };
   struct LightVolume {
     bool active = false;
@@ -209,10 +226,8 @@ class RealtimeMedia {
     // lo, hi, cells_per_m, r - 1 and max(r - 2, 0) per axis, 4th lane 0 (CellLightsLookup).
     std::array<float, 4> lo4{}, hi4{}, cpm4{}, rmax4{}, imax4{};
   };
-  struct FroxelRecord {
-    // in-scatter and transmittance (rgb, 4th lane 0) from the camera to a slice boundary.
-    Eigen::Array4f S, T;
-  };
+  // in-scatter and transmittance (rgb, 4th lane 0) from the camera to a slice boundary.
+  using FroxelRecord = GridFroxelRecord<Eigen::Array4f>;
   struct Froxels {
     int nx = 0, ny = 0;
     std::vector<float> t0, t1;          // [column] overlap of the column ray with the grids

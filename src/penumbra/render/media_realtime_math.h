@@ -18,10 +18,14 @@
 //    position and their bilinear weights; FogSlice, FogFroxelLookup: the light in-scatter
 //    froxels' lookup at a distance; FogQuadPrepare / FogQuadValue: the 2x2 quads' shared fog
 //    lookups;
-//  - RealtimeMediaView, MediaViewSegment, MediaLightTransmittance: a frame's homogeneous media
-//    as plain data (RealtimeMedia::HostView; device copies for a GPU path) and, composed of the
-//    functions above, a pixel's view segment (IntegrateView without grids, per-pixel lookups)
-//    and a surface point's transmittance to a light (the CPU realtime surface loop's).
+//  - GridFroxelLookup, GridQuadPrepare / GridQuadValue: the grid froxels' lookup at a distance
+//    and the 2x2 quads' shared one (with slopes in distance); GridToFrame, GridRotate and
+//    GridLightTransmittance: a grid's light volume at a shadow ray's entry into its box;
+//  - RealtimeMediaView, MediaViewSegment, MediaLightTransmittance: a frame's media (homogeneous
+//    and grids) as plain data (RealtimeMedia::HostView; device copies for a GPU path) and,
+//    composed of the functions above, a pixel's view segment (IntegrateView, per pixel or with a
+//    quad's shared lookups) and a surface point's transmittance to a light (the CPU realtime
+//    surface loop's); RealtimeMedia's member functions call these (branch gpu12).
 // operation order: the CPU code's before the move (bit-for-bit rule of shading_math.h); the
 // CPU's images did not change (docs/gpu.md, "Homogeneous media (branch gpu8)").
 //
@@ -610,7 +614,193 @@ PB_HOST_DEVICE inline bool FogQuadValue(const FogQuad<R>& q, float t, R* out) {
   return true;
 }
 
-/// a frame's homogeneous media (no grids) as the per-pixel view functions read them:
+/// a grid froxel column's record at a slice boundary: the grids' in-scatter S and
+/// transmittance T (rgb, 4th lane 0) from the camera to it (RealtimeMedia's grid froxels).
+template <typename R>
+struct GridFroxelRecord {
+  R S, T;
+};
+
+/// the grid froxel volume's lookup at distance t (m) at the columns `cb` (RealtimeMedia::
+/// LookupFroxels): per column linear between its slice boundaries (kFroxelSlices slices over the
+/// column's overlap [t0, t1] with the grid boxes, slices_per_m of them per m), bilinear between
+/// the columns (columns of weight 0 skipped; a column that meets no grid adds weight w to T).
+/// *S and *T get the in-scatter and transmittance (`zero` and `unit`: R's 0 and (1, 1, 1, 0));
+/// returns the smallest entry distance of the four columns (+inf if none meets a grid; then S =
+/// 0, T = unit). records: [column][boundary 0..kFroxelSlices].
+template <typename R>
+PB_HOST_DEVICE inline float GridFroxelLookup(const MediaColumns& cb, const float* t0,
+                                             const float* t1, const float* slices_per_m,
+                                             const GridFroxelRecord<R>* records, float t,
+                                             const R& zero, const R& unit, R* S, R* T) {
+  constexpr int Z = kFroxelSlices;
+  const int* cols = cb.cols;
+  // nothing before the nearest column entry (every record 0 there is {0, 1}): no grid.
+  float t_enter = INFINITY;
+  for (int q = 0; q < 4; ++q)
+    if (t0[cols[q]] < t1[cols[q]]) t_enter = pbm::Min(t_enter, t0[cols[q]]);
+  *S = zero;
+  if (!(t > t_enter)) {
+    *T = unit;
+    return t_enter;
+  }
+  *T = zero;
+  const float* w = cb.w;
+  for (int q = 0; q < 4; ++q) {
+    if (!(w[q] > 0)) continue;
+    const int c = cols[q];
+    const float a = t0[c], b = t1[c];
+    if (!(a < b)) {
+      *T += w[q] * unit;
+      continue;
+    }
+    const float s = pbm::Clamp((t - a) * slices_per_m[c], 0.0f, static_cast<float>(Z));
+    const int k = MediaMinI(static_cast<int>(s), Z - 1);
+    const float f = s - k;
+    const GridFroxelRecord<R>* rec = records + static_cast<size_t>(c) * (Z + 1) + k;
+    const float w0 = w[q] * (1 - f), w1 = w[q] * f;
+    *S += w0 * rec[0].S + w1 * rec[1].S;
+    *T += w0 * rec[0].T + w1 * rec[1].T;
+  }
+  return t_enter;
+}
+
+/// a 2x2 quad's shared grid froxel lookup (GridQuadPrepare), read by its pixels with
+/// GridQuadValue: the values at the reference distance t_c and their slopes in distance, within
+/// [g_lo, g_hi] where every column stays in one slice.
+template <typename R>
+struct GridQuad {
+  float t_c = 0;             ///< reference distance of the values (m)
+  float g_enter = 0;         ///< smallest entry distance of the columns (m)
+  float g_lo = 1, g_hi = 0;  ///< distances (m) where gS, gT hold (empty: none)
+  R gS, gT, gS_dt, gT_dt;    ///< at t_c, and per m
+};
+
+/// the grid froxel lookups of a 2x2 quad at its centre's columns `cb` and reference distance
+/// t_c (m, +inf for sky quads; RealtimeMedia::PrepareQuad's grid part): per column the slice
+/// that holds t_c and the distances where that stays so (constant before the column's entry and
+/// after its exit). q's gS, gT, gS_dt and gT_dt must hold R's 0 on entry; `unit` is R's (1, 1, 1,
+/// 0).
+template <typename R>
+PB_HOST_DEVICE inline void GridQuadPrepare(const MediaColumns& cb, const float* t0, const float* t1,
+                                           const float* slices_per_m,
+                                           const GridFroxelRecord<R>* records, float t_c,
+                                           const R& unit, GridQuad<R>* q) {
+  constexpr int Z = kFroxelSlices;
+  const float t = pbm::Min(t_c, 1e30f);
+  q->t_c = t;
+  const int* cols = cb.cols;
+  float t_enter = INFINITY;
+  for (int k = 0; k < 4; ++k)
+    if (t0[cols[k]] < t1[cols[k]]) t_enter = pbm::Min(t_enter, t0[cols[k]]);
+  q->g_enter = t_enter;
+  if (!(t > t_enter)) return;
+  const float* w = cb.w;
+  float lo = t_enter, hi = INFINITY;
+  for (int k = 0; k < 4; ++k) {
+    if (!(w[k] > 0)) continue;
+    const int c = cols[k];
+    const float a = t0[c], b = t1[c];
+    if (!(a < b)) {
+      q->gT += w[k] * unit;
+      continue;
+    }
+    const GridFroxelRecord<R>* rec = records + static_cast<size_t>(c) * (Z + 1);
+    const float spm = slices_per_m[c];
+    const float s = (t - a) * spm;
+    if (!(s > 0)) {  // before the column's entry: record 0
+      hi = pbm::Min(hi, a);
+      q->gS += w[k] * rec[0].S;
+      q->gT += w[k] * rec[0].T;
+    } else if (!(s < Z)) {  // after its exit: record Z
+      lo = pbm::Max(lo, b);
+      q->gS += w[k] * rec[Z].S;
+      q->gT += w[k] * rec[Z].T;
+    } else {
+      const int i = MediaMinI(static_cast<int>(s), Z - 1);
+      const float f = s - i;
+      lo = pbm::Max(lo, a + i / spm);
+      hi = pbm::Min(hi, a + (i + 1) / spm);
+      q->gS += w[k] * ((1 - f) * rec[i].S + f * rec[i + 1].S);
+      q->gT += w[k] * ((1 - f) * rec[i].T + f * rec[i + 1].T);
+      q->gS_dt += (w[k] * spm) * (rec[i + 1].S - rec[i].S);
+      q->gT_dt += (w[k] * spm) * (rec[i + 1].T - rec[i].T);
+    }
+  }
+  q->g_lo = lo;
+  q->g_hi = hi;
+}
+
+/// the quad's grid values at a pixel's distance t (m; RealtimeMedia::QuadFroxels): 1 with *S,
+/// *T (no grid before the columns' entry: S = zero, T = unit) where q holds t, 0 where the pixel
+/// must look them up itself (GridFroxelLookup); *t_enter: the columns' entry distance.
+template <typename R>
+PB_HOST_DEVICE inline int GridQuadValue(const GridQuad<R>& q, float t, const R& zero, const R& unit,
+                                        R* S, R* T, float* t_enter) {
+  *t_enter = q.g_enter;
+  if (!(t > q.g_enter)) {
+    *S = zero;
+    *T = unit;
+    return 1;
+  }
+  if (!(t >= q.g_lo && t <= q.g_hi)) return 0;
+  const float dt = t == q.t_c ? 0.0f : t - q.t_c;
+  *S = q.gS + dt * q.gS_dt;
+  *T = q.gT + dt * q.gT_dt;
+  return 1;
+}
+
+/// a grid medium's box and coarse light volume as LightTransmittance reads them (RealtimeMedia's
+/// grid light volumes): the world-to-grid transform x_G = R_GW x_W + p_GW (R_GW row-major), the
+/// box half extents, the light volume's r[0] x r[1] x r[2] cells (x fastest) and cells per m,
+/// and where its [light][cell] transmittances start in RealtimeMediaView::grid_light_T.
+struct GridLightPod {
+  float R_GW[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  float p_GW[3] = {0, 0, 0};
+  float half[3] = {0.5f, 0.5f, 0.5f};
+  float cells_per_m[3] = {1, 1, 1};
+  int r[3] = {1, 1, 1};
+  size_t offset = 0;  ///< index of light 0's cell 0 in grid_light_T
+};
+
+/// x_G = R_GW x + p_GW (GridVolume::ToGrid; the operation order of Eigen's 3x3 product:
+/// r0 x0 + (r1 x1 + r2 x2) per row, tested bit for bit against it).
+PB_HOST_DEVICE inline void GridToFrame(const GridLightPod& g, const float* x, float* out) {
+  for (int i = 0; i < 3; ++i)
+    out[i] =
+        g.R_GW[3 * i] * x[0] + (g.R_GW[3 * i + 1] * x[1] + g.R_GW[3 * i + 2] * x[2]) + g.p_GW[i];
+}
+
+/// R_GW d (a direction into the grid frame, as GridVolume::Interval rotates it).
+PB_HOST_DEVICE inline void GridRotate(const GridLightPod& g, const float* d, float* out) {
+  for (int i = 0; i < 3; ++i)
+    out[i] = g.R_GW[3 * i] * d[0] + (g.R_GW[3 * i + 1] * d[1] + g.R_GW[3 * i + 2] * d[2]);
+}
+
+/// a grid's transmittance from p (world, m) towards light j (unit direction wi, distance dist,
+/// +inf for directional lights) through its light volume `T` ([light][cell], this grid's;
+/// RealtimeMedia::GridLightT): 1 for lights without volumes (j >= num_lights) and for shadow
+/// rays that miss the box, else the volume's trilinear value at the ray's entry into the box.
+PB_HOST_DEVICE inline float GridLightTransmittance(const GridLightPod& g, const float* T,
+                                                   int num_lights, int j, const float* p,
+                                                   const float* wi, float dist) {
+  if (j >= num_lights) return 1.0f;
+  float o_G[3], d_G[3];
+  GridToFrame(g, p, o_G);
+  GridRotate(g, wi, d_G);
+  const float lo[3] = {-g.half[0], -g.half[1], -g.half[2]};
+  float a, b;
+  if (!MediaSlabInterval(o_G, d_G, lo, g.half, 0.0f, dist, &a, &b)) return 1.0f;
+  const float x[3] = {p[0] + a * wi[0], p[1] + a * wi[1], p[2] + a * wi[2]};
+  float x_G[3];
+  GridToFrame(g, x, x_G);
+  float f[3];
+  for (int k = 0; k < 3; ++k) f[k] = (x_G[k] + g.half[k]) * g.cells_per_m[k] - 0.5f;
+  const size_t cells = static_cast<size_t>(g.r[0]) * g.r[1] * g.r[2];
+  return MediaTrilinear(T + static_cast<size_t>(j) * cells, g.r, f[0], f[1], f[2]);
+}
+
+/// a frame's media (homogeneous and grids) as the per-pixel view functions read them:
 /// RealtimeMedia's arrays (RealtimeMedia::HostView), on the host or copied to a device.
 struct RealtimeMediaView {
   const MediumPod* media = nullptr;  ///< the homogeneous media (h_cam set for the camera)
@@ -620,10 +810,13 @@ struct RealtimeMediaView {
   float sky_ambient[3] = {0, 0, 0};  ///< the open sky's sphere-average radiance (cd/m^2)
   /// the sky volume that occludes it (SkyAlongRay), or null (then sky_ambient lights the media)
   const SkyVolumePod* sky_volume = nullptr;
+  /// the image the froxel volumes' per-pixel axis tables cover (MediaAxisAt at every pixel
+  /// centre, and at u + 0.5 for the 2x2 quads' centres)
+  int width = 0, height = 0;
   /// the light in-scatter froxels: fog_nx x fog_ny columns of kFogFroxelSlices + 1 records,
-  /// 1 / log(t_far / near) per column, and the per-pixel axis tables of a width x height image
-  /// (MediaAxisAt at every pixel centre); fog_S null: none (no lights)
-  int fog_nx = 0, fog_ny = 0, width = 0, height = 0;
+  /// 1 / log(t_far / near) per column, and their axis tables; fog_S null: none (no lights or no
+  /// homogeneous media)
+  int fog_nx = 0, fog_ny = 0;
   const Rgb4* fog_S = nullptr;
   const float* fog_inv_log_far = nullptr;
   const MediaAxis* fog_ax = nullptr;       ///< [width]
@@ -635,6 +828,25 @@ struct RealtimeMediaView {
   CellLightsPod light_volume;
   const float* light_trans = nullptr;
   int num_volume_lights = 0;
+  /// the grid froxels (grid_records null: no grids): grid_nx x grid_ny columns, per column the
+  /// overlap [t0, t1] of its ray with the grid boxes and kFroxelSlices / (t1 - t0) (0 without
+  /// overlap), kFroxelSlices + 1 records, and their axis tables
+  int grid_nx = 0, grid_ny = 0;
+  const float* grid_t0 = nullptr;
+  const float* grid_t1 = nullptr;
+  const float* grid_slices_per_m = nullptr;
+  const GridFroxelRecord<Rgb4>* grid_records = nullptr;
+  const MediaAxis* grid_ax = nullptr;       ///< [width]
+  const MediaAxis* grid_ay = nullptr;       ///< [height]
+  const MediaAxis* grid_ax_half = nullptr;  ///< [width]
+  const MediaAxis* grid_ay_half = nullptr;  ///< [height]
+  /// the grids' boxes and light volumes (LightTransmittance's grid factor outside the world
+  /// light volume), their [light][cell] transmittances end to end (GridLightPod::offset), for
+  /// the first num_grid_lights lights (RealtimeMedia::num_volume_lights)
+  int num_grids = 0;
+  const GridLightPod* grids = nullptr;
+  const float* grid_light_T = nullptr;
+  int num_grid_lights = 0;
 };
 
 /// the four fog froxel columns of pixel (u, v) (RealtimeMedia's PixelColumns: the axis tables
@@ -646,10 +858,11 @@ PB_HOST_DEVICE inline MediaColumns MediaPixelColumns(const RealtimeMediaView& m,
                         m.fog_ny);
 }
 
-/// a 2x2 pixel quad's shared lookups (RealtimeMedia::PrepareQuad for frames without grids;
-/// MediaPrepareQuad): the fog froxels' at the quad's centre and reference distance, and the sky
-/// lighting the media along the quad's mean direction.
+/// a 2x2 pixel quad's shared lookups (RealtimeMedia::PrepareQuad; MediaPrepareQuad): the grid
+/// and fog froxels' at the quad's centre and reference distance, and the sky lighting the media
+/// along the quad's mean direction.
 struct MediaQuadShared {
+  GridQuad<Rgb4> grid;
   FogQuad<Rgb4> fog;
   int has_sky = 0;  ///< sky holds the quad's SkyAlongRay
   float sky[3] = {0, 0, 0};
@@ -667,10 +880,18 @@ PB_HOST_DEVICE inline void MediaSkyAlongRay(const RealtimeMediaView& m, const fl
   }
 }
 
+/// the four grid froxel columns of pixel (u, v), as MediaPixelColumns.
+PB_HOST_DEVICE inline MediaColumns MediaGridPixelColumns(const RealtimeMediaView& m, int u, int v) {
+  if (u >= 0 && v >= 0 && u < m.width && v < m.height)
+    return MediaColumnsFrom(m.grid_ax[u], m.grid_ay[v], m.grid_nx);
+  return MediaColumnsAt(static_cast<float>(u), static_cast<float>(v), kFroxelBlock, m.grid_nx,
+                        m.grid_ny);
+}
+
 /// the shared lookups of the 2x2 quad of pixels (u0, v0) .. (u0 + 1, v0 + 1) at its reference
 /// distance t_c (m, the mean of its pixels' distances; +inf for sky pixels) and the sky along
 /// the ray from the camera centre o in the quad's mean direction d_c (unit) (RealtimeMedia::
-/// PrepareQuad without grids).
+/// PrepareQuad).
 PB_HOST_DEVICE inline void MediaPrepareQuad(const RealtimeMediaView& m, int u0, int v0, float t_c,
                                             const float* o, const float* d_c, MediaQuadShared* q) {
   *q = MediaQuadShared();
@@ -678,36 +899,62 @@ PB_HOST_DEVICE inline void MediaPrepareQuad(const RealtimeMediaView& m, int u0, 
     MediaSkyAlongRay(m, o, d_c, t_c, q->sky);
     q->has_sky = 1;
   }
+  const bool in = u0 >= 0 && v0 >= 0 && u0 < m.width && v0 < m.height;
+  if (m.grid_records != nullptr) {
+    const MediaColumns cb =
+        in ? MediaColumnsFrom(m.grid_ax_half[u0], m.grid_ay_half[v0], m.grid_nx)
+           : MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, kFroxelBlock, m.grid_nx, m.grid_ny);
+    GridQuadPrepare(cb, m.grid_t0, m.grid_t1, m.grid_slices_per_m, m.grid_records, t_c,
+                    Rgb4{1, 1, 1, 0}, &q->grid);
+  }
   if (m.fog_S != nullptr && t_c > kFogFroxelNear) {
     const MediaColumns cb =
-        u0 >= 0 && v0 >= 0 && u0 < m.width && v0 < m.height
-            ? MediaColumnsFrom(m.fog_ax_half[u0], m.fog_ay_half[v0], m.fog_nx)
-            : MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, m.fog_nx, m.fog_ny);
+        in ? MediaColumnsFrom(m.fog_ax_half[u0], m.fog_ay_half[v0], m.fog_nx)
+           : MediaColumnsAt(u0 + 0.5f, v0 + 0.5f, kFogFroxelBlock, m.fog_nx, m.fog_ny);
     FogQuadPrepare(cb, m.fog_S, m.fog_inv_log_far, t_c, &q->fog);
   }
 }
 
-/// what the homogeneous media do to the radiance L behind the view segment o + t d (o the
-/// camera centre, d unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::
-/// IntegrateView for frames without grids): the closed-form transmittance and sky in-scatter
-/// (the sky at the ray's in-scatter median point through the sky volume) and the light
+/// what the media do to the radiance L behind the view segment o + t d (o the camera centre, d
+/// unit), t in [0, t_end], of pixel (u, v): *T L + *L_add (RealtimeMedia::IntegrateView): the
+/// grid froxels' in-scatter and transmittance at t_end; the homogeneous media's closed-form
+/// transmittance and sky in-scatter (the sky at the ray's in-scatter median point through the
+/// sky volume; behind a grid's entry attenuated by the grids' transmittance) and the light
 /// in-scatter of the fog froxels. with `quad` (MediaPrepareQuad of the 2x2 quad holding the
-/// pixel; may be null) the quad's sky, and its fog lookup where it holds t_end, as IntegrateView
-/// with a MediaQuad; else each pixel its own lookups.
+/// pixel; may be null) the quad's sky, and its froxel lookups where they hold t_end, as
+/// IntegrateView with a MediaQuad; else each pixel its own lookups.
 PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, int v,
                                             const float* o, const float* d, float t_end, Float3* T,
                                             Float3* L_add, const MediaQuadShared* quad = nullptr) {
+  // grids: the froxel volume at the pixel's distance.
+  Rgb4 gS{0, 0, 0, 0}, gT{1, 1, 1, 0};
+  float first_a = INFINITY;
+  if (m.grid_records != nullptr) {
+    const float t = pbm::Min(t_end, 1e30f);
+    const Rgb4 zero{0, 0, 0, 0}, unit{1, 1, 1, 0};
+    if (quad == nullptr || GridQuadValue(quad->grid, t, zero, unit, &gS, &gT, &first_a) == 0)
+      first_a = GridFroxelLookup(MediaGridPixelColumns(m, u, v), m.grid_t0, m.grid_t1,
+                                 m.grid_slices_per_m, m.grid_records, t, zero, unit, &gS, &gT);
+  }
+  if (m.num_media == 0) {
+    *T = Float3{gT.x, gT.y, gT.z};
+    *L_add = Float3{gS.x, gS.y, gS.z};
+    return;
+  }
+  // homogeneous media: closed-form transmittance and sky in-scatter, to the end and, when the
+  // ray enters a grid before it, to the grid's entry.
+  const bool to_grid = first_a < t_end;
   Float3 tau_t, tau_s, tau_a;
-  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, false, INFINITY, m.camera_height, &tau_t,
-                        &tau_s, &tau_a);
+  HomogeneousViewDepths(m.media, m.num_media, o, d, t_end, to_grid, first_a, m.camera_height,
+                        &tau_t, &tau_s, &tau_a);
   float sky[3];
   if (m.sky_volume != nullptr && quad != nullptr && quad->has_sky) {
     for (int k = 0; k < 3; ++k) sky[k] = quad->sky[k];
   } else {
     MediaSkyAlongRay(m, o, d, t_end, sky);
   }
-  Float3 L;
-  MediaViewClosedForm(tau_t, tau_s, tau_a, false, m.grey != 0, Float3{1, 1, 1},
+  Float3 L{gS.x, gS.y, gS.z};
+  MediaViewClosedForm(tau_t, tau_s, tau_a, to_grid, m.grey != 0, Float3{gT.x, gT.y, gT.z},
                       Float3{sky[0], sky[1], sky[2]}, T, &L);
   if (m.fog_S != nullptr) {
     Rgb4 f;
@@ -718,18 +965,26 @@ PB_HOST_DEVICE inline void MediaViewSegment(const RealtimeMediaView& m, int u, i
   *L_add = L;
 }
 
-/// the homogeneous media's transmittance from surface point p towards light j (unit direction
-/// wi, distance dist, +inf for directional lights), as the CPU's realtime surface loop takes it:
-/// inside the world light volume, for the lights it holds, the volume's channel-mean value
-/// (CellLightsLookup); elsewhere the closed form e^-tau of AnalyticOpticalDepthOf.
+/// the media's transmittance from surface point p towards light j (unit direction wi, distance
+/// dist, +inf for directional lights), as the CPU's realtime surface loop takes it: inside the
+/// world light volume, for the lights it holds, the volume's channel-mean value
+/// (CellLightsLookup); elsewhere the closed form e^-tau of AnalyticOpticalDepthOf times each
+/// grid's GridLightTransmittance (RealtimeMedia::LightTransmittance).
 PB_HOST_DEVICE inline Float3 MediaLightTransmittance(const RealtimeMediaView& m, int j,
                                                      const float* p, const float* wi, float dist) {
   if (m.light_trans != nullptr && j < m.num_volume_lights) {
     float T[kMaxVolumeLights];
     if (CellLightsLookup(m.light_volume, m.light_trans, p, T)) return {T[j], T[j], T[j]};
   }
-  if (m.num_media == 0) return {1, 1, 1};
-  return MediaExpNeg(AnalyticOpticalDepthOf(m.media, m.num_media, p, wi, 0.0f, dist), false);
+  Float3 T{1, 1, 1};
+  if (m.num_media > 0)
+    T = MediaExpNeg(AnalyticOpticalDepthOf(m.media, m.num_media, p, wi, 0.0f, dist), false);
+  for (int g = 0; g < m.num_grids; ++g) {
+    const float Tg = GridLightTransmittance(m.grids[g], m.grid_light_T + m.grids[g].offset,
+                                            m.num_grid_lights, j, p, wi, dist);
+    T = {T.x * Tg, T.y * Tg, T.z * Tg};
+  }
+  return T;
 }
 
 }  // namespace penumbra

@@ -421,9 +421,13 @@ TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   fog.homogeneous_media.emplace_back();
   fog.homogeneous_media.back().sigma_t_per_m = Eigen::Vector3f::Constant(0.1f);
   EXPECT_THROW(r.UpdateWorld(0, snap, &fog), Error);
+  EffectsFrame smoke = *fx;
+  smoke.grid_media.emplace_back();
+  EXPECT_THROW(r.UpdateWorld(0, snap, &smoke), Error);
   cuda::BatchRenderer truth(AllTruth(4));
   truth.AddWorld(scene);
   EXPECT_NO_THROW(truth.UpdateWorld(0, snap, &fog));
+  EXPECT_NO_THROW(truth.UpdateWorld(0, snap, &smoke));
 }
 
 }  // namespace

@@ -5,8 +5,8 @@
 // geometry both backends trace); whether the frame with the world's effects and the rgb image
 // render on the GPU (CudaRenderer::OnGpu) is reported, with the rgb PSNR where rgb is on the
 // GPU, else "cpu fallback" (frames with lighting effects render on the GPU since branch gpu6,
-// particles without media and homogeneous media since gpu10; grid media and particles seen
-// through media do not yet). shared by render_cuda_bench --parity
+// particles without media and homogeneous media since gpu10, grid media and particles seen
+// through media since gpu12). shared by render_cuda_bench --parity
 // (scripts/gpu/parity.sh) and the `gpu` test CudaParity. header-only: both link the same libraries.
 
 #include <fmt/format.h>

@@ -6,8 +6,8 @@
 // effects/sun.yaml) and a hand-made frame with every lighting field set on the default room, at
 // 160x120: rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels, two renders
 // bit-identical, and the effects change the image; the particle streaks of the rain and snow
-// worlds (the media: realtime_media_test.cc). the effects the GPU does not draw yet (grid media;
-// particles seen through media) are named by EffectsNotOnGpu. no GPU needed.
+// worlds (the media: realtime_media_test.cc). every effect is on the GPU since branch gpu12
+// (EffectsNotOnGpu names none). no GPU needed.
 
 #include <gtest/gtest.h>
 
@@ -179,52 +179,40 @@ TEST(RealtimeHostPathEffectsFrames, EveryLightingFieldMatchesCpuBackend) {
   EXPECT_THROW(data.Prepare(snap, view, &pool, &fx), ConfigError);
 }
 
-// the effects the GPU does not draw yet are named (the CUDA backend's log line and fallback).
-TEST(RealtimeHostPathEffectsFrames, MediaAndParticlesAreNamed) {
+// every effect is on the GPU: EffectsNotOnGpu names none (the CUDA backend's log line and
+// fallback would name one the GPU lacked).
+TEST(RealtimeHostPathEffectsFrames, EveryEffectIsOnTheGpu) {
   EffectsFrame fx;
   fx.surface_wetness = 0.5f;
   fx.extra_lights.emplace_back();
   EXPECT_EQ(cuda::EffectsNotOnGpu(nullptr), "");
   EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
-  // homogeneous media alone are drawn on the GPU
   fx.homogeneous_media.emplace_back();
   EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
   EffectsFrame fog_rain = fx;
   fog_rain.particles.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fog_rain), "particles (rain, snow, sparks) with media");
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fog_rain), "");
   fx.grid_media.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "grid media (smoke, fire, VDB)");
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
   fx.particles.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx),
-            "grid media (smoke, fire, VDB), particles (rain, snow, sparks) with media");
-  // particles without media are drawn on the GPU
-  EffectsFrame rain;
-  rain.particles.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&rain), "");
+  EXPECT_EQ(cuda::EffectsNotOnGpu(&fx), "");
   CameraView view;
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
-  EXPECT_FALSE(cuda::CudaRenderer::OnGpu(&fx, view));
+  EXPECT_TRUE(cuda::CudaRenderer::OnGpu(&fx, view));
 }
 
-// which bundled effects worlds' frames at 1 s render on the GPU (docs/gpu.md lists them): the
-// lighting-only ones, those with particles alone and those with homogeneous media alone do,
-// those with grid media or particles seen through media name them.
+// which bundled effects worlds' frames at 1 s render on the GPU (docs/gpu.md lists them): all of
+// them since branch gpu12 (grid media and particles seen through media included).
 TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
   const struct {
     const char* file;
     const char* not_on_gpu;  // "" on the GPU; else a part of EffectsNotOnGpu's answer
-  } worlds[] = {{"effects/blackout.yaml", ""},
-                {"effects/flashlight.yaml", ""},
-                {"effects/sun.yaml", ""},
-                {"effects/fog.yaml", ""},
-                {"effects/height_fog.yaml", ""},
-                {"effects/dust.yaml", ""},
-                {"effects/smoke_plume.yaml", "grid media"},
-                {"effects/vdb_smoke.yaml", "grid media"},
-                {"effects/fire.yaml", "grid media"},
-                {"effects/rain.yaml", ""},
-                {"effects/snow.yaml", ""},
-                {"effects/adversity_major.yaml", "media"}};
+  } worlds[] = {{"effects/blackout.yaml", ""},    {"effects/flashlight.yaml", ""},
+                {"effects/sun.yaml", ""},         {"effects/fog.yaml", ""},
+                {"effects/height_fog.yaml", ""},  {"effects/dust.yaml", ""},
+                {"effects/smoke_plume.yaml", ""}, {"effects/vdb_smoke.yaml", ""},
+                {"effects/fire.yaml", ""},        {"effects/rain.yaml", ""},
+                {"effects/snow.yaml", ""},        {"effects/adversity_major.yaml", ""}};
   for (const auto& w : worlds) {
     const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, 1.0);
     const WorldSnapshot snap = session->sim().Snapshot();

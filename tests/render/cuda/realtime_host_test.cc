@@ -321,7 +321,7 @@ TEST(RealtimeHostPathFrames, SkyTermsInBandsEqualTheWholeFrame) {
   EXPECT_THROW(data.SkyTerms(geometry.data(), n, banded.data(), &pool, 0, 31), Error);
 }
 
-TEST(RealtimeHostPathFrames, PathtracedAndEffectsAreNotOnTheGpuPath) {
+TEST(RealtimeHostPathFrames, PathtracedIsNotOnTheRealtimeGpuPath) {
   const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
   RenderSettings settings;
   settings.tier = RenderSettings::Tier::kPathtraced;
@@ -330,13 +330,17 @@ TEST(RealtimeHostPathFrames, PathtracedAndEffectsAreNotOnTheGpuPath) {
   EXPECT_EQ(pt.Unsupported(nullptr, view), "the pathtraced tier");
   const cuda::RealtimeFrameData rt(session->scene(), RenderSettings());
   EXPECT_EQ(rt.Unsupported(nullptr, view), "");
-  // lens distortion and camera motion are on the GPU path (camera_rays.h); effects are not
+  // lens distortion and camera motion are on the GPU path (camera_rays.h), and so are the
+  // effects (grid media, particles seen through media: since branch gpu12)
   view.intrinsics.k1 = 0.1;
   view.motion.end_sec = 0.02;
   EXPECT_EQ(rt.Unsupported(nullptr, view), "");
   EffectsFrame fx;
   fx.grid_media.emplace_back();
-  EXPECT_NE(rt.Unsupported(&fx, view), "");
+  fx.homogeneous_media.emplace_back();
+  fx.particles.emplace_back();
+  EXPECT_EQ(rt.Unsupported(&fx, view), "");
+  EXPECT_EQ(pt.Unsupported(&fx, view), "the pathtraced tier");
 }
 
 }  // namespace

@@ -10,8 +10,9 @@
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
-//     them, cuda Render() (on the GPU for lighting effects; else the CPU renderer inside the
-//     CUDA backend, "cpu fallback") and cpu Render(); with homogeneous media, the time of their
+//     them, cuda Render() (on the GPU for every effect since branch gpu12; else the CPU
+//     renderer inside the CUDA backend, "cpu fallback") and cpu Render(); with media
+//     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
 //     CudaRayQuery's and with BvhRayQuery's (the host traversal), and the CUDA backend's host
 //     preparation of such a frame (CudaRenderer::last_prepare_ms, the build included);
@@ -675,7 +676,8 @@ int Main(int argc, char** argv) {
       if (gpu && with_fx) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-        if (!fx->homogeneous_media.empty() && cuda::CudaRenderer::OnGpu(fx.get(), rgb))
+        if ((!fx->homogeneous_media.empty() || !fx->grid_media.empty()) &&
+            cuda::CudaRenderer::OnGpu(fx.get(), rgb))
           builds.push_back(fmt::format(
               "{} {}: effects frame with media on the GPU: host preparation {:.2f} ms a frame "
               "(the last of the timed frames; RealtimeFrameData::Prepare, media volumes included)",
@@ -683,7 +685,8 @@ int Main(int argc, char** argv) {
       }
       // the media volumes' build over Embree and over the GPU's RayQuery (docs/gpu.md,
       // "Homogeneous media: the shared part")
-      if (dev.available && with_fx && !fx->homogeneous_media.empty() && w == 640) {
+      if (dev.available && with_fx && (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) &&
+          w == 640) {
         RayScene embree(scene);
         embree.Update(snap);
         cuda::CudaRayQuery query(scene);

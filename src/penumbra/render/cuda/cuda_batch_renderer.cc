@@ -79,6 +79,9 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
       !effects->homogeneous_media.empty())
     not_on_gpu = "homogeneous media (fog, haze, dust) in a batch";
+  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
+      !effects->grid_media.empty())
+    not_on_gpu = "grid media (smoke, fire, VDB) in a batch";
   if (!not_on_gpu.empty())
     throw Error(fmt::format("batch rendering: world {}: effects with {} are not on the GPU yet",
                             world, not_on_gpu));

@@ -103,9 +103,9 @@ class BatchRenderer {
   /// every camera of this world until the next UpdateWorld). waits for the kernels already
   /// submitted (they read the transforms), not for their copies back.
   /// @throws Error for a bad index or snapshot (BvhScene::Update), or, in a batch with rgb,
-  ///         effects with grid media (not on the GPU yet: EffectsNotOnGpu names them),
-  ///         homogeneous media or particles (drawn by CudaRenderer, not in batches yet); the
-  ///         ground-truth images do not depend on effects.
+  ///         effects with homogeneous or grid media or particles (drawn by CudaRenderer, not in
+  ///         batches yet: each camera would need its own froxels and streaks); the ground-truth
+  ///         images do not depend on effects.
   void UpdateWorld(int world, const WorldSnapshot& snapshot, const EffectsFrame* effects = nullptr);
 
   /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each

@@ -74,8 +74,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                : !fx_why.empty() ? "effects with " + fx_why
                                                  : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (grid media; in the pathtraced tier "
-          "media, particles and distorted or moving cameras); "
+          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier media, "
+          "particles and distorted or moving cameras); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;

@@ -1,13 +1,13 @@
 #pragma once
 // the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (with
 // lens distortion or motion too: camera_rays.h) under clear conditions, lighting effects (light
-// scales, extra lights, a moved or scaled sky, surface wetness), particles without media and
-// homogeneous media without grids or particles (EffectsNotOnGpu): the images
+// scales, extra lights, a moved or scaled sky, surface wetness), particles, homogeneous and grid
+// media and particles seen through them (EffectsNotOnGpu): the images
 // of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
 // realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
-// frame's preparation on the host, realtime_frame.h). everything else (the pathtraced tier, grid
-// media, particles seen through media) is not on the GPU yet: such a frame is rendered whole by the
+// frame's preparation on the host, realtime_frame.h). everything else (the pathtraced tier's
+// media and particles) is not on the GPU yet: such a frame is rendered whole by the
 // CPU renderer handed in (`cpu`), so every output exists and equals the CPU backend's for those
 // frames; docs/gpu.md lists what is where.
 

@@ -127,19 +127,12 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
 }
 
 std::string EffectsNotOnGpu(const EffectsFrame* effects) {
-  if (effects == nullptr) return "";
-  std::string why;
-  auto add = [&](bool set, const char* what) {
-    if (set) why += (why.empty() ? "" : ", ") + std::string(what);
-  };
-  // homogeneous media alone are (their volumes built on the host, PrepareMedia); grids are not
-  add(!effects->grid_media.empty(), "grid media (smoke, fire, VDB)");
-  // particles alone are (their streaks found and shaded on the host: PrepareStreaks); seen
-  // through media they are not
-  add(!effects->particles.empty() &&
-          (!effects->homogeneous_media.empty() || !effects->grid_media.empty()),
-      "particles (rain, snow, sparks) with media");
-  return why;
+  // every effect is: the lighting ones through the frame's lights and sky (PoseWorld), the
+  // particles' streaks found and shaded on the host (PrepareStreaks), the media's volumes
+  // (homogeneous and grids) built on the host (PrepareMedia) and the streaks seen through them
+  // in the view pass (MediaViewQuad)
+  (void)effects;
+  return "";
 }
 
 std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
@@ -172,10 +165,10 @@ void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const Effect
   media_ready_ = false;
   media_build_ms_ = 0;
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
-  if (fx == nullptr || fx->homogeneous_media.empty()) return;
-  // as the CPU's MediaFrame::Prepare (no grids here: EffectsNotOnGpu): the media of the frame,
+  if (fx == nullptr || (fx->homogeneous_media.empty() && fx->grid_media.empty())) return;
+  // as the CPU's MediaFrame::Prepare: the media of the frame (homogeneous and grids),
   // lit by the frame's lights and sky through the occluded sky volume, for this camera
-  media_.Build(fx);
+  BuildMediaScene(fx);
   if (media_.empty()) return;
   const auto t0 = std::chrono::steady_clock::now();
   if (media_rays == nullptr) {
@@ -187,10 +180,16 @@ void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const Effect
       media_, lights_, *media_rays, camera, FrameKey(view.camera_index, view.frame_index),
       scene_.center_W.cast<float>(), scene_.extent_m, SkyAmbientRadiance(*frame_sky_),
       volume_.empty() ? nullptr : &volume_, pool);
-  media_view_ = realtime_media_.HostView(&media_fog_, &media_sky_);
+  media_view_ = realtime_media_.HostView(&media_arrays_);
   media_build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   media_ready_ = true;
+}
+
+void RealtimeFrameData::BuildMediaScene(const EffectsFrame* fx) {
+  if (media_scene_built_) return;
+  media_.Build(fx);
+  media_scene_built_ = true;
 }
 
 void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
@@ -202,12 +201,15 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
     particles_.Build(nullptr, camera, 0, false);
     return;
   }
-  // as the CPU's MediaFrame::Prepare (no media here: EffectsNotOnGpu): the sheltered drops
-  // left out, the streaks splatted per pixel, the rain shaded once per streak
+  // as the CPU's MediaFrame::Prepare: the sheltered drops left out, the rain streaks the
+  // frame's homogeneous media hide culled, the streaks splatted per pixel, the rain shaded once
+  // per streak
   bool sheltered = false;
   for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
-  particles_.Build(fx, camera, view.exposure_time_sec, true, pool, nullptr,
+  if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
+  const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
+  particles_.Build(fx, camera, view.exposure_time_sec, true, pool, media,
                    sheltered ? &shelter_ : nullptr);
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
@@ -251,6 +253,7 @@ void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* poo
     throw Error("RealtimeFrameData: effects with " + EffectsNotOnGpu(fx) +
                 " are not on the GPU (Unsupported)");
   media_ready_ = false;  // PrepareMedia builds the frame's media for its camera
+  media_scene_built_ = false;
   lights_.Update(snapshot, fx);
   frame_sky_ = &effects_sky_.Update(scene_.sky, sky_, fx);
   wetness_ = SurfaceWetnessOf(fx);
@@ -488,15 +491,16 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       }
     });
   }
-  // the homogeneous media over the final radiance, per 2x2 quad, as MediaViewKernel
+  // the media (and the streaks seen through them) over the final radiance, per 2x2 quad, as
+  // MediaViewKernel
   if (f.has_media != 0) {
     ParallelForOrSerial(pool, (H + 1) / 2, [&](int64_t q) {
       for (int u0 = 0; u0 < W; u0 += 2)
         MediaViewQuad(f, u0, 2 * static_cast<int>(q), out->depth_m.data.data(), radiance.data());
     });
   }
-  // the particle streaks over the final radiance, as StreakKernel
-  for (int64_t k = 0; k < f.num_streaks; ++k) {
+  // the particle streaks over the final radiance, as StreakKernel (with media: MediaViewQuad)
+  for (int64_t k = 0; f.has_media == 0 && k < f.num_streaks; ++k) {
     const StreakPixel& s = f.streaks[k];
     radiance[s.pixel] = ApplyStreak(s, out->depth_m.data[s.pixel], radiance[s.pixel]);
   }

@@ -4,15 +4,17 @@
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
 // key; the frame's lighting effects (EffectsNotOnGpu: light scales and extra lights through
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
-// render/effects_sky.h, as the CPU backend's MediaFrame) and particles (rain, snow, sparks
-// without media: each pixel's nearest streak found and shaded on the host with the CPU's
-// render/particle_streaks.h, StreakPixel; the kernels draw it over the pixel); the sky model and
-// sky volume (SkyData, for DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky
-// terms from the primary rays' geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of
-// render/sky_eval_math.h, which the device's sky kernel runs too) and those of the mirror layer's
-// reflected rays (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost
-// runs the GPU path's per-pixel functions on the CPU over the host BVH (tests; the parity check
-// without a GPU). no CUDA runtime here: this file builds on machines without nvcc.
+// render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: each
+// pixel's nearest streak found and shaded on the host with the CPU's render/particle_streaks.h,
+// StreakPixel; the kernels draw it over the pixel) and media (homogeneous and grids:
+// PrepareMedia, RealtimeMedia's volumes built on the host; the kernels' view pass draws them and
+// the streaks seen through them); the sky model and sky volume (SkyData, for
+// DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
+// geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h, which
+// the device's sky kernel runs too) and those of the mirror layer's reflected rays
+// (MirrorSkyTerms); and the film's exposure and encoding table. RenderRealtimeOnHost runs the GPU
+// path's per-pixel functions on the CPU over the host BVH (tests; the parity check without a GPU).
+// no CUDA runtime here: this file builds on machines without nvcc.
 
 #include <cstdint>
 #include <memory>
@@ -40,12 +42,11 @@
 
 namespace penumbra::cuda {
 
-/// why a frame under `effects` cannot be rendered on the GPU ("" if it can: none, lighting
-/// effects (EffectsFrame::light_intensity_scale, extra_lights, sun_direction_W,
-/// sky_luminance_scale, surface_wetness), particles without media, and homogeneous media (fog,
-/// haze, dust) without grids or particles). otherwise names what is not on the GPU yet: "grid
-/// media (smoke, fire, VDB)", "particles (rain, snow, sparks) with media", joined by ", " where
-/// both are set.
+/// why a frame under `effects` cannot be rendered on the GPU ("" if it can). every effect is
+/// since branch gpu12: lighting effects (EffectsFrame::light_intensity_scale, extra_lights,
+/// sun_direction_W, sky_luminance_scale, surface_wetness), particles, homogeneous media (fog,
+/// haze, dust), grid media (smoke, fire, VDB) and particles seen through media; so this is ""
+/// for every frame (the callers keep asking it: a later effect the GPU lacks is named here).
 std::string EffectsNotOnGpu(const EffectsFrame* effects);
 
 /// the plain data of a scene's realtime frames (file comment). not thread-safe.
@@ -74,13 +75,14 @@ class RealtimeFrameData {
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
                const EffectsFrame* effects = nullptr, const CameraRayTables* rays = nullptr,
                const RayQuery* media_rays = nullptr);
-  /// the homogeneous media of the frame (View's media, has_media): with homogeneous media in
+  /// the media of the frame (View's media, has_media): with homogeneous or grid media in
   /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
   /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
   /// `view`, with the frame's lights, sky and occluded sky volume: the world light volume's
   /// shadow rays through `media_rays` (any RayQuery posed for `snapshot`: CudaRenderer passes
   /// one over its device scene), or, if null, through a BvhRayQuery (the kernels' traversal on
-  /// the host) this object keeps and poses. call after PoseWorld (Prepare does).
+  /// the host) this object keeps and poses; RealtimeMedia::HostView's arrays for the view (the
+  /// grids' froxels and light volumes too). call after PoseWorld (Prepare does).
   void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                     const Camera& camera, const CameraView& view, ThreadPool* pool,
                     const RayQuery* media_rays = nullptr);
@@ -101,10 +103,12 @@ class RealtimeFrameData {
                  const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones());
   /// the particle streaks of the frame (View's streaks): with particles in `effects` (null or
   /// none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
-  /// particle_streaks.h: the drops a ShelterMap shelters left out, the streaks splatted per
-  /// pixel over `pool`, rain shaded once per streak), then each pixel's nearest streak shaded by
-  /// ParticleStreaks::Shade as RealtimeIntegrator does (the frame's lights and sky, the occluded
-  /// sky volume), in pixel order. call after PoseWorld (Prepare does).
+  /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
+  /// media hide culled, the streaks splatted per pixel over `pool`, rain shaded once per
+  /// streak), then each pixel's nearest streak shaded by ParticleStreaks::Shade as
+  /// RealtimeIntegrator does (the frame's lights and sky, the occluded sky volume), in pixel
+  /// order; the media in front of a streak are applied in the view pass (MediaViewQuad). call
+  /// after PoseWorld (Prepare does).
   /// @throws ConfigError for malformed particle sets (ParticleStreaks::Build).
   void PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                       const Camera& camera, const CameraView& view, ThreadPool* pool);
@@ -189,14 +193,17 @@ class RealtimeFrameData {
   ParticleStreaks particles_;  // the frame's streaks (PrepareStreaks)
   std::vector<StreakPixel> streaks_;
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
-  // the frame's homogeneous media (PrepareMedia): the scene's media, their realtime volumes and
-  // their host view (the fog froxels as Rgb4 records, the sky volume's pod); media_ready_ false
-  // until PrepareMedia built them for the frame (PoseWorld clears it)
+  // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
+  // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);
+  // media_ready_ false until PrepareMedia built them for the frame (PoseWorld clears it)
   MediaScene media_;
   RealtimeMedia realtime_media_;
   std::unique_ptr<RayQuery> media_query_;  // PrepareMedia's own shadow rays (BvhRayQuery)
-  std::vector<Rgb4> media_fog_;
-  SkyVolumePod media_sky_;
+  RealtimeMediaHostArrays media_arrays_;
+  bool media_scene_built_ = false;  // media_ holds the frame's effects (BuildMediaScene)
+  // media_ built from the frame's effects `fx`, once per PoseWorld (PrepareStreaks' rain culling
+  // and PrepareMedia read it)
+  void BuildMediaScene(const EffectsFrame* fx);
   RealtimeMediaView media_view_;
   bool media_ready_ = false;
   double media_build_ms_ = 0;

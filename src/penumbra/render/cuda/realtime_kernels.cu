@@ -70,8 +70,8 @@ __global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const fl
   radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
 }
 
-// the homogeneous media over the final radiance (MediaViewQuad): one thread per 2x2 quad, each
-// writing its own pixels.
+// the media (homogeneous and grids) and the particle streaks seen through them over the final
+// radiance (MediaViewQuad): one thread per 2x2 quad, each writing its own pixels.
 __global__ void MediaViewKernel(RealtimeFrameView f, const float* depth, Float3* radiance) {
   const int qu = blockIdx.x * blockDim.x + threadIdx.x;
   const int qv = blockIdx.y * blockDim.y + threadIdx.y;
@@ -578,6 +578,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
   DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
   Buffer media_pods, media_fog, media_inv_log_far, media_axes, media_trans, volume_pod;
+  // the grids' froxels (records; t0, t1 and slices per m end to end; axis tables), their boxes
+  // and light volumes (branch gpu12)
+  Buffer media_grid_records, media_grid_columns, media_grid_axes, media_grid_pods, media_grid_T;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
   Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
   SkyModelPod device_sky;
@@ -697,6 +700,44 @@ struct DeviceRealtime::Impl : PixelBuffers {
       media_trans.Upload(h.light_trans, sizeof(float) * n, stream);
       d->light_trans = media_trans.as<float>();
     }
+    if (h.grid_records != nullptr) {
+      const size_t columns = static_cast<size_t>(h.grid_nx) * h.grid_ny;
+      media_grid_records.Upload(
+          h.grid_records, sizeof(GridFroxelRecord<Rgb4>) * columns * (kFroxelSlices + 1), stream);
+      // t0, t1, slices per m [columns] end to end, then the four axis tables as the fog's
+      std::vector<float> cols(3 * columns);
+      std::copy(h.grid_t0, h.grid_t0 + columns, cols.begin());
+      std::copy(h.grid_t1, h.grid_t1 + columns, cols.begin() + columns);
+      std::copy(h.grid_slices_per_m, h.grid_slices_per_m + columns, cols.begin() + 2 * columns);
+      media_grid_columns.Upload(cols.data(), sizeof(float) * cols.size(), stream);
+      const size_t w = static_cast<size_t>(h.width), hh = static_cast<size_t>(h.height);
+      std::vector<MediaAxis> axes(2 * w + 2 * hh);
+      std::copy(h.grid_ax, h.grid_ax + w, axes.begin());
+      std::copy(h.grid_ax_half, h.grid_ax_half + w, axes.begin() + w);
+      std::copy(h.grid_ay, h.grid_ay + hh, axes.begin() + 2 * w);
+      std::copy(h.grid_ay_half, h.grid_ay_half + hh, axes.begin() + 2 * w + hh);
+      media_grid_axes.Upload(axes.data(), sizeof(MediaAxis) * axes.size(), stream);
+      d->grid_records = media_grid_records.as<GridFroxelRecord<Rgb4>>();
+      const float* c = media_grid_columns.as<float>();
+      d->grid_t0 = c;
+      d->grid_t1 = c + columns;
+      d->grid_slices_per_m = c + 2 * columns;
+      const MediaAxis* a = media_grid_axes.as<MediaAxis>();
+      d->grid_ax = a;
+      d->grid_ax_half = a + w;
+      d->grid_ay = a + 2 * w;
+      d->grid_ay_half = a + 2 * w + hh;
+    }
+    if (h.num_grids > 0) {
+      media_grid_pods.Upload(h.grids, sizeof(GridLightPod) * h.num_grids, stream);
+      d->grids = media_grid_pods.as<GridLightPod>();
+      // every grid's [light][cell] transmittances, end to end (the last pod's offset + its own)
+      const GridLightPod& last = h.grids[h.num_grids - 1];
+      const size_t n =
+          last.offset + static_cast<size_t>(h.num_grid_lights) * last.r[0] * last.r[1] * last.r[2];
+      media_grid_T.Upload(h.grid_light_T, sizeof(float) * (n > 0 ? n : 1), stream);
+      d->grid_light_T = media_grid_T.as<float>();
+    }
   }
   // the film kernel with the exposure the device computed (LaunchExposure)
   void LaunchFilmDeviceExposure(int64_t n, int tone_map, cudaStream_t stream) {
@@ -745,8 +786,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     SurfaceTerms* st = surfaces.as<SurfaceTerms>();
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 6 && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 6, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 6)
-      ShadeStoredKernel<OneFrame, 6>
+      ShadeStoredKernel<OneFrame, 6, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4 && f.has_media != 0)
       ShadeStoredKernel<OneFrame, 4, true>
@@ -754,8 +798,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 4)
       ShadeStoredKernel<OneFrame, 4, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
+    else if (o.reuse_surface && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 1, true>
+          <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface)
-      ShadeStoredKernel<OneFrame, 1>
+      ShadeStoredKernel<OneFrame, 1, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.min_blocks >= 6)
       ShadeKernel<true, 6><<<grid, kPixelBlock, 0, stream>>>(f, h, L, row0, row1);
@@ -798,7 +845,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
           f, depth.as<float>(), radiance.as<Float3>());
       Check(cudaGetLastError(), "MediaViewKernel");
     }
-    if (f.num_streaks > 0) {
+    if (f.num_streaks > 0 && f.has_media == 0) {  // with media: in MediaViewKernel
       StreakKernel<<<static_cast<unsigned>((f.num_streaks + 255) / 256), 256, 0, stream>>>(
           f.streaks, f.num_streaks, depth.as<float>(), radiance.as<Float3>());
       Check(cudaGetLastError(), "StreakKernel");

@@ -120,7 +120,7 @@ struct StreakPixel {
   int64_t pixel = 0;  ///< row-major pixel index
   float t = 0;        ///< ray parameter of the streak (the primary ray's units: as the depth)
   float alpha = 0;    ///< coverage in (0, 1]
-  Float3 L;           ///< radiance of the streak, cd/m^2 (media none: not on the GPU with them)
+  Float3 L;           ///< radiance of the streak, cd/m^2 (before the media in front of it)
 };
 
 /// everything a realtime frame reads, as device (or host) pointers.
@@ -1251,20 +1251,37 @@ PB_HOST_DEVICE inline Float3 ApplyMirrorLayer(const RealtimeFrameView& f, int u,
   return Float3{MirrorBlend(L.x, Lm.x, r), MirrorBlend(L.y, Lm.y, r), MirrorBlend(L.z, Lm.z, r)};
 }
 
-/// the homogeneous media over the radiance of the pixels of the 2x2 quad (u0, v0) .. (u0 + 1,
-/// v0 + 1) (u0, v0 even; pixels outside the image are skipped) once it is final (after the
-/// shared visibility and the mirror layer, before the particle streaks), as RealtimeIntegrator's
-/// ApplyTileViewEffects: L becomes T L + L_add (MediaViewSegment of f.media) along the pixel's
-/// ray (PrimaryRay, unit direction) to its primary hit, t_end = depth[i] |d| (depth: the
-/// primary hits' t, f.geometry[i].hit 0: the ray escapes, t_end = +inf). a quad inside the
-/// image whose four pixels all hit or all escape shares the lookups of MediaPrepareQuad at the
-/// mean of their t_end (+inf for escaping rays) and the normalised sum of their unit directions
-/// from the first pixel's origin; the others look up per pixel. the CPU walks the quads of its
-/// 16x16 tiles, which start at even pixels, so its quads are these.
+/// the index in f.streaks (sorted by pixel) of pixel i's streak, -1 if it has none (binary
+/// search).
+PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) {
+  int64_t lo = 0, hi = f.num_streaks;
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;
+    if (f.streaks[mid].pixel < i)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
+}
+
+/// the media (homogeneous and grids) over the radiance of the pixels of the 2x2 quad (u0, v0) ..
+/// (u0 + 1, v0 + 1) (u0, v0 even; pixels outside the image are skipped) once it is final (after
+/// the shared visibility and the mirror layer), as RealtimeIntegrator's ApplyTileViewEffects: L
+/// becomes T L + L_add (MediaViewSegment of f.media) along the pixel's ray (PrimaryRay, unit
+/// direction) to its primary hit, t_end = depth[i] |d| (depth: the primary hits' t,
+/// f.geometry[i].hit 0: the ray escapes, t_end = +inf). a quad inside the image whose four
+/// pixels all hit or all escape shares the lookups of MediaPrepareQuad at the mean of their
+/// t_end (+inf for escaping rays) and the normalised sum of their unit directions from the
+/// first pixel's origin; the others look up per pixel. the CPU walks the quads of its 16x16
+/// tiles, which start at even pixels, so its quads are these. a pixel with a particle streak in
+/// front of its hit (FindStreak) then gets it over L (ApplyStreak) with the streak's radiance
+/// seen through the media up to it (MediaViewSegment to s.t |d|, the same quad lookups), as
+/// the CPU's ApplyViewEffects; StreakKernel does not run for frames with media.
 PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int v0,
                                          const float* depth, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;
-  float o[4][3], d[4][3], t_end[4];
+  float o[4][3], d[4][3], t_end[4], d_len[4];
   int hit[4] = {0, 0, 0, 0};
   bool inside[4];
   for (int c = 0; c < 4; ++c) {
@@ -1273,11 +1290,11 @@ PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int
     if (!inside[c]) continue;
     const int64_t i = static_cast<int64_t>(v) * W + u;
     const TraceRay r = PrimaryRay(f.camera, u, v);
-    const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+    d_len[c] = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
     o[c][0] = r.o.x, o[c][1] = r.o.y, o[c][2] = r.o.z;
-    d[c][0] = r.d.x / d_len, d[c][1] = r.d.y / d_len, d[c][2] = r.d.z / d_len;
+    d[c][0] = r.d.x / d_len[c], d[c][1] = r.d.y / d_len[c], d[c][2] = r.d.z / d_len[c];
     hit[c] = f.geometry[i].hit != 0 ? 1 : 0;
-    t_end[c] = hit[c] != 0 ? depth[i] * d_len : INFINITY;
+    t_end[c] = hit[c] != 0 ? depth[i] * d_len[c] : INFINITY;
   }
   const bool shared =
       u0 + 1 < W && v0 + 1 < H && hit[1] == hit[0] && hit[2] == hit[0] && hit[3] == hit[0];
@@ -1303,6 +1320,15 @@ PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int
     MediaViewSegment(f.media, u, v, o[c], d[c], t_end[c], &T, &L_add, shared ? &q : nullptr);
     const Float3 L = radiance[i];
     radiance[i] = Float3{T.x * L.x + L_add.x, T.y * L.y + L_add.y, T.z * L.z + L_add.z};
+    // the pixel's streak over it, seen through the media in front of it: alpha (media to the
+    // streak, then the streak) + (1 - alpha) (media to the end, then the surface)
+    const int64_t k = FindStreak(f, i);
+    if (k < 0 || (depth[i] > 0 && !(f.streaks[k].t <= depth[i]))) continue;
+    StreakPixel s = f.streaks[k];
+    Float3 T_f, L_f;
+    MediaViewSegment(f.media, u, v, o[c], d[c], s.t * d_len[c], &T_f, &L_f, shared ? &q : nullptr);
+    s.L = Float3{T_f.x * s.L.x + L_f.x, T_f.y * s.L.y + L_f.y, T_f.z * s.L.z + L_f.z};
+    radiance[i] = ApplyStreak(s, depth[i], radiance[i]);
   }
 }
 
