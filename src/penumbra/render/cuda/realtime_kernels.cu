@@ -665,6 +665,23 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the frame's homogeneous media (host arrays of `h`, RealtimeFrameData::View) to the device on
   // `stream` (pageable: staged before the calls return), *d pointing to them; the media's sky
   // volume is the frame's (UploadSky's copy of its pod)
+  // a froxel volume's four axis tables, ax and ax_half [width], ay and ay_half [height], into
+  // `b` end to end; *d_tables[k] points at table k on the device.
+  static void UploadAxes(const MediaAxis* const tables[4], int width, int height, Buffer* b,
+                         cudaStream_t stream, const MediaAxis** const d_tables[4]) {
+    const size_t len[4] = {static_cast<size_t>(width), static_cast<size_t>(width),
+                           static_cast<size_t>(height), static_cast<size_t>(height)};
+    std::vector<MediaAxis> axes(len[0] + len[1] + len[2] + len[3]);
+    size_t at[4], off = 0;
+    for (int k = 0; k < 4; ++k) {
+      std::copy(tables[k], tables[k] + len[k], axes.begin() + off);
+      at[k] = off;
+      off += len[k];
+    }
+    b->Upload(axes.data(), sizeof(MediaAxis) * axes.size(), stream);
+    for (int k = 0; k < 4; ++k) *d_tables[k] = b->as<MediaAxis>() + at[k];
+  }
+
   void UploadMedia(const RealtimeMediaView& h, RealtimeMediaView* d, cudaStream_t stream) {
     *d = h;
     media_pods.Upload(h.media, sizeof(MediumPod) * h.num_media, stream);
@@ -678,21 +695,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
       const size_t columns = static_cast<size_t>(h.fog_nx) * h.fog_ny;
       media_fog.Upload(h.fog_S, sizeof(Rgb4) * columns * (kFogFroxelSlices + 1), stream);
       media_inv_log_far.Upload(h.fog_inv_log_far, sizeof(float) * columns, stream);
-      // the four axis tables end to end: ax, ax_half [width], ay, ay_half [height]
-      const size_t w = static_cast<size_t>(h.width), hh = static_cast<size_t>(h.height);
-      std::vector<MediaAxis> axes(2 * w + 2 * hh);
-      std::copy(h.fog_ax, h.fog_ax + w, axes.begin());
-      std::copy(h.fog_ax_half, h.fog_ax_half + w, axes.begin() + w);
-      std::copy(h.fog_ay, h.fog_ay + hh, axes.begin() + 2 * w);
-      std::copy(h.fog_ay_half, h.fog_ay_half + hh, axes.begin() + 2 * w + hh);
-      media_axes.Upload(axes.data(), sizeof(MediaAxis) * axes.size(), stream);
       d->fog_S = media_fog.as<Rgb4>();
       d->fog_inv_log_far = media_inv_log_far.as<float>();
-      const MediaAxis* a = media_axes.as<MediaAxis>();
-      d->fog_ax = a;
-      d->fog_ax_half = a + w;
-      d->fog_ay = a + 2 * w;
-      d->fog_ay_half = a + 2 * w + hh;
+      const MediaAxis* const fog[4] = {h.fog_ax, h.fog_ax_half, h.fog_ay, h.fog_ay_half};
+      const MediaAxis** const fog_d[4] = {&d->fog_ax, &d->fog_ax_half, &d->fog_ay, &d->fog_ay_half};
+      UploadAxes(fog, h.width, h.height, &media_axes, stream, fog_d);
     }
     if (h.light_trans != nullptr) {
       const CellLightsPod& v = h.light_volume;
@@ -710,23 +717,15 @@ struct DeviceRealtime::Impl : PixelBuffers {
       std::copy(h.grid_t1, h.grid_t1 + columns, cols.begin() + columns);
       std::copy(h.grid_slices_per_m, h.grid_slices_per_m + columns, cols.begin() + 2 * columns);
       media_grid_columns.Upload(cols.data(), sizeof(float) * cols.size(), stream);
-      const size_t w = static_cast<size_t>(h.width), hh = static_cast<size_t>(h.height);
-      std::vector<MediaAxis> axes(2 * w + 2 * hh);
-      std::copy(h.grid_ax, h.grid_ax + w, axes.begin());
-      std::copy(h.grid_ax_half, h.grid_ax_half + w, axes.begin() + w);
-      std::copy(h.grid_ay, h.grid_ay + hh, axes.begin() + 2 * w);
-      std::copy(h.grid_ay_half, h.grid_ay_half + hh, axes.begin() + 2 * w + hh);
-      media_grid_axes.Upload(axes.data(), sizeof(MediaAxis) * axes.size(), stream);
       d->grid_records = media_grid_records.as<GridFroxelRecord<Rgb4>>();
       const float* c = media_grid_columns.as<float>();
       d->grid_t0 = c;
       d->grid_t1 = c + columns;
       d->grid_slices_per_m = c + 2 * columns;
-      const MediaAxis* a = media_grid_axes.as<MediaAxis>();
-      d->grid_ax = a;
-      d->grid_ax_half = a + w;
-      d->grid_ay = a + 2 * w;
-      d->grid_ay_half = a + 2 * w + hh;
+      const MediaAxis* const grid[4] = {h.grid_ax, h.grid_ax_half, h.grid_ay, h.grid_ay_half};
+      const MediaAxis** const grid_d[4] = {&d->grid_ax, &d->grid_ax_half, &d->grid_ay,
+                                           &d->grid_ay_half};
+      UploadAxes(grid, h.width, h.height, &media_grid_axes, stream, grid_d);
     }
     if (h.num_grids > 0) {
       media_grid_pods.Upload(h.grids, sizeof(GridLightPod) * h.num_grids, stream);
