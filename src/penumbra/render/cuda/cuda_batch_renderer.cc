@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <utility>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
@@ -73,15 +74,14 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   // cameras would each need their own particle streaks and media froxels: CudaRenderer draws
   // them)
   std::string not_on_gpu = layout_.outputs().rgb ? EffectsNotOnGpu(effects) : "";
-  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
-      !effects->particles.empty())
-    not_on_gpu = "particles (rain, snow, sparks) in a batch";
-  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
-      !effects->homogeneous_media.empty())
-    not_on_gpu = "homogeneous media (fog, haze, dust) in a batch";
-  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr &&
-      !effects->grid_media.empty())
-    not_on_gpu = "grid media (smoke, fire, VDB) in a batch";
+  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr) {
+    const std::pair<bool, const char*> per_camera[] = {
+        {!effects->particles.empty(), "particles (rain, snow, sparks) in a batch"},
+        {!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust) in a batch"},
+        {!effects->grid_media.empty(), "grid media (smoke, fire, VDB) in a batch"}};
+    for (const auto& [present, what] : per_camera)
+      if (present && not_on_gpu.empty()) not_on_gpu = what;
+  }
   if (!not_on_gpu.empty())
     throw Error(fmt::format("batch rendering: world {}: effects with {} are not on the GPU yet",
                             world, not_on_gpu));

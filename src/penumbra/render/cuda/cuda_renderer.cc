@@ -63,6 +63,12 @@ std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraV
 
 PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
 
+ParallelFn CudaRenderer::HostParallel() {
+  return [this](int64_t count, const std::function<void(int64_t)>& body) {
+    ParallelForOrSerial(pool_.get(), count, body);
+  };
+}
+
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
   const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
@@ -118,9 +124,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   o.body_id = Shape(&out->body_id, want[ImageKind::kInstanceSegmentation], W, H, 1);
   o.semantic = Shape(&out->semantic_class, want[ImageKind::kSemanticSegmentation], W, H, 1);
   if (o.depth || o.geom_id || o.range || o.normal_O || o.body_id || o.semantic)
-    device_->RenderPrimary(c, o, [this](int64_t count, const std::function<void(int64_t)>& body) {
-      ParallelForOrSerial(pool_.get(), count, body);
-    });
+    device_->RenderPrimary(c, o, HostParallel());
   out->rays = static_cast<int64_t>(W) * H;
   out->stopped = false;
   ++gpu_frames_;
@@ -143,9 +147,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   o.radiance = radiance;
   o.rgb = out->rgb.data.data();
   o.depth = Shape(&out->depth_m, view.outputs[ImageKind::kDepth], W, H, 1);
-  o.parallel = [this](int64_t count, const std::function<void(int64_t)>& body) {
-    ParallelForOrSerial(pool_.get(), count, body);
-  };
+  o.parallel = HostParallel();
   RealtimeFrameView frame = realtime_->View(device_->device_view(), nullptr);
   // the camera's ray tables: the device copies, not Prepare's host arrays
   frame.camera.xy = camera.xy;

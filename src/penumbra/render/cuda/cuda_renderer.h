@@ -93,6 +93,8 @@ class CudaRenderer final : public Renderer {
   // the scene-constant realtime data (materials, textures) and the sky's arrays on the device
   // (once, and the sky again when it changes): both tiers' rgb read them.
   void UploadRealtime();
+  // the host's share of a frame's work (the output copies) over pool_, or serially.
+  ParallelFn HostParallel();
 
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
