@@ -29,7 +29,9 @@ TEST_P(PathtracedGpu, MatchesCpuBackendAt1024SppAndRepeatsBitForBit) {
   const std::unique_ptr<Session> session =
       realtime_parity::LoadSimulated(emissive ? "default.yaml" : GetParam());
   SceneDescription scene = session->scene();
-  if (emissive) ASSERT_TRUE(path_parity::MakeDiffusersEmissive(&scene));
+  if (emissive) {
+    ASSERT_TRUE(path_parity::MakeDiffusersEmissive(&scene));
+  }
   const WorldSnapshot snap = session->sim().Snapshot();
   const CameraView view = realtime_parity::RgbDepthView(scene, snap, 128, 96);
   RenderSettings cpu_settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 1024);
