@@ -205,6 +205,35 @@ ViewCounts CheckViewAgainstCpu(const RealtimeMedia& rm, const LightSampler& ligh
   return n;
 }
 
+// the two view tests' frame of scene s at rest: its lights, Embree scene, sky irradiance
+// volume and a 96 x 72 camera at (-3, 0.2, 1.2) looking along +x (70 deg vertical field).
+struct LitFrame {
+  static constexpr int kWidth = 96, kHeight = 72;
+  explicit LitFrame(const SceneDescription& s)
+      : snap(IdentitySnapshot(s)),
+        lights(s),
+        rays(s),
+        sky(s.sky),
+        pool(2),
+        volume([](const SceneDescription& sc) {
+          return MakeRayQuery(sc, RenderSettings::Backend::kEmbree);
+        }),
+        view(MakeView(CameraLookingAlongX({-3, 0.2f, 1.2}), kWidth, kHeight, 70.0)),
+        camera(view.X_WO, view.intrinsics) {
+    lights.Update(snap);
+    rays.Update(snap);
+    volume.Update(s, snap, sky, &pool);
+  }
+  const WorldSnapshot snap;
+  LightSampler lights;
+  RayScene rays;
+  const SkyModel sky;
+  ThreadPool pool;
+  SkyIrradianceVolume volume;
+  const CameraView view;
+  const Camera camera;
+};
+
 // in the lit room with a sky volume (the sky at the in-scatter median point), non-grey height
 // fog and a boxed haze.
 TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
@@ -224,33 +253,21 @@ TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit)
   HomogeneousMedium haze = Fog(0.3f, 0.7f, 0.0f);
   haze.region = BoxRegion{Eigen::Vector3d(-1, -2, 0), Eigen::Vector3d(2, 2, 1.5)};
   fx.homogeneous_media.push_back(haze);
-  const WorldSnapshot snap = IdentitySnapshot(s);
-  LightSampler lights(s);
-  lights.Update(snap);
-  RayScene rays(s);
-  rays.Update(snap);
-  const SkyModel sky(s.sky);
-  ThreadPool pool(2);
-  SkyIrradianceVolume volume([](const SceneDescription& sc) {
-    return MakeRayQuery(sc, RenderSettings::Backend::kEmbree);
-  });
-  volume.Update(s, snap, sky, &pool);
-  ASSERT_FALSE(volume.empty());
-  constexpr int W = 96, H = 72;
-  const CameraView view = MakeView(CameraLookingAlongX({-3, 0.2f, 1.2}), W, H, 70.0);
-  const Camera camera(view.X_WO, view.intrinsics);
+  LitFrame f(s);
+  ASSERT_FALSE(f.volume.empty());
   MediaScene media;
   media.Build(&fx);
   RealtimeMedia rm;
-  rm.Build(media, lights, rays, camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
-           Eigen::Vector3f(0.3f, 0.4f, 0.6f), &volume, &pool);
+  rm.Build(media, f.lights, f.rays, f.camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
+           Eigen::Vector3f(0.3f, 0.4f, 0.6f), &f.volume, &f.pool);
   RealtimeMediaHostArrays arrays;
   const RealtimeMediaView mv = rm.HostView(&arrays);
   ASSERT_NE(mv.fog_S, nullptr);
   ASSERT_NE(mv.sky_volume, nullptr);
   ASSERT_NE(mv.light_trans, nullptr);
   ASSERT_EQ(mv.grid_records, nullptr);
-  const ViewCounts n = CheckViewAgainstCpu(rm, lights, camera, W, H);
+  const ViewCounts n =
+      CheckViewAgainstCpu(rm, f.lights, f.camera, LitFrame::kWidth, LitFrame::kHeight);
   EXPECT_GT(n.segments, 3000);
   EXPECT_GT(n.lit, n.segments / 2);
   EXPECT_GT(n.quad_pixels, 15000);
@@ -280,27 +297,14 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
   for (size_t i = 0; i < e->size(); ++i) (*e)[i] = 40.0f + 5.0f * static_cast<float>(i % 7);
   fire.emission = e;
   grids.grid_media.push_back(fire);
-  const WorldSnapshot snap = IdentitySnapshot(s);
-  LightSampler lights(s);
-  lights.Update(snap);
-  RayScene rays(s);
-  rays.Update(snap);
-  const SkyModel sky(s.sky);
-  ThreadPool pool(2);
-  SkyIrradianceVolume volume([](const SceneDescription& sc) {
-    return MakeRayQuery(sc, RenderSettings::Backend::kEmbree);
-  });
-  volume.Update(s, snap, sky, &pool);
-  constexpr int W = 96, H = 72;
-  const CameraView view = MakeView(CameraLookingAlongX({-3, 0.2f, 1.2}), W, H, 70.0);
-  const Camera camera(view.X_WO, view.intrinsics);
+  LitFrame f(s);
   // ToGrid's product restated: the same bits
   MediaScene probe;
   probe.Build(&grids);
   ASSERT_EQ(probe.grids().size(), 2u);
   RealtimeMedia probe_rm;
-  probe_rm.Build(probe, lights, rays, camera, 3, Eigen::Vector3f(0, 0, 2), 4.0,
-                 Eigen::Vector3f::Constant(0.3f), nullptr, &pool);
+  probe_rm.Build(probe, f.lights, f.rays, f.camera, 3, Eigen::Vector3f(0, 0, 2), 4.0,
+                 Eigen::Vector3f::Constant(0.3f), nullptr, &f.pool);
   RealtimeMediaHostArrays probe_arrays;
   const RealtimeMediaView pv = probe_rm.HostView(&probe_arrays);
   ASSERT_EQ(pv.num_grids, 2);
@@ -328,14 +332,15 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
     MediaScene media;
     media.Build(&fx);
     RealtimeMedia rm;
-    rm.Build(media, lights, rays, camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
-             Eigen::Vector3f(0.3f, 0.4f, 0.6f), with_fog ? &volume : nullptr, &pool);
+    rm.Build(media, f.lights, f.rays, f.camera, 5, Eigen::Vector3f(0, 0, 2), 4.0,
+             Eigen::Vector3f(0.3f, 0.4f, 0.6f), with_fog ? &f.volume : nullptr, &f.pool);
     RealtimeMediaHostArrays arrays;
     const RealtimeMediaView mv = rm.HostView(&arrays);
     ASSERT_NE(mv.grid_records, nullptr);
     ASSERT_EQ(mv.num_grids, 2);
     ASSERT_EQ(mv.fog_S != nullptr, with_fog);
-    const ViewCounts n = CheckViewAgainstCpu(rm, lights, camera, W, H);
+    const ViewCounts n =
+        CheckViewAgainstCpu(rm, f.lights, f.camera, LitFrame::kWidth, LitFrame::kHeight);
     std::printf(
         "grids%s: %d segments (%d lit), %d quad pixels, %d + %d light transmittances "
         "(%d lowered by a grid outside the world light volume)\n",
