@@ -23,15 +23,10 @@ xz -dc "$baseline" > "$pkg/bin/base_bench" && chmod +x "$pkg/bin/base_bench"
 B=$pkg/bin
 W=$pkg/src/worlds
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu --format=csv | tee "$R/card.txt"
-T0=$(date +%s)
-budget=${AB_BUDGET_S:-380}
-step() { local name=$1 limit=$2; shift 2
-  local left=$(( budget - ($(date +%s) - T0) ))
-  if [ "$left" -lt 15 ]; then echo "== $name skipped (time)"; return; fi
-  [ "$limit" -gt "$left" ] && limit=$left
-  local t0=$(date +%s%N)
-  timeout "$limit" "$@" > "$R/$name.txt" 2>&1; local rc=$?
-  echo "== $name rc=$rc $(( ($(date +%s%N) - t0) / 1000000 )) ms"; }
+STEP_T0=$(date +%s)
+STEP_BUDGET_S=${AB_BUDGET_S:-380}
+STEP_MIN_LEFT_S=15
+STEP_LOGS=$R
 for k in $(seq 1 "$repeats"); do
   step base_$k 70 "$B/base_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"
   step new_$k 70 "$B/render_cuda_bench" --realtime --frames 30 "$W/default.yaml" "$W/house.yaml"

@@ -28,15 +28,10 @@ B=$pkg/bin
 W=$pkg/src/worlds
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu --format=csv > "$L/card.txt" 2>&1
 echo "CPU: $(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)" >> "$L/card.txt"
-T0=$(date +%s)
-budget=${OVERHEAD_BUDGET_S:-280}
-step() { local name=$1 limit=$2; shift 2
-  local left=$(( budget - ($(date +%s) - T0) ))
-  if [ "$left" -lt 10 ]; then echo "== $name skipped (time)"; return; fi
-  [ "$limit" -gt "$left" ] && limit=$left
-  local t0=$(date +%s%N)
-  timeout "$limit" "$@" > "$L/$name.txt" 2>&1; local rc=$?
-  echo "== $name rc=$rc $(( ($(date +%s%N) - t0) / 1000000 )) ms"; }
+STEP_T0=$(date +%s)
+STEP_BUDGET_S=${OVERHEAD_BUDGET_S:-280}
+STEP_MIN_LEFT_S=10
+STEP_LOGS=$L
 two="$W/default.yaml $W/house.yaml"
 for k in $(seq 1 "$repeats"); do
   step std_base_$k 45 "$B/base_bench" --frames 100 $two

@@ -31,14 +31,10 @@ B=$pkg/bin
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu,utilization.gpu --format=csv > "$OUT/card.txt" 2>&1
 echo "CPU: $(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)" >> "$OUT/card.txt"
 cat "$OUT/card.txt"
-T0=$(date +%s)
-step() { local name=$1 limit=$2; shift 2
-  local left=$(( 500 - ($(date +%s) - T0) ))
-  if [ "$left" -lt 20 ]; then echo "== $name skipped (time)"; return; fi
-  [ "$limit" -gt "$left" ] && limit=$left
-  local t0=$(date +%s%N)
-  timeout "$limit" "$@" > "$OUT/$name.txt" 2>&1; local rc=$?
-  echo "== $name rc=$rc $(( ($(date +%s%N) - t0) / 1000000 )) ms"; }
+STEP_T0=$(date +%s)
+STEP_BUDGET_S=500
+STEP_MIN_LEFT_S=20
+STEP_LOGS=$OUT
 # the realtime tier in detail (Render stages, kernel ablations, cpu), 640x480
 step realtime_1 120 "$B/render_cuda_bench" --realtime --frames 50 "$W/default.yaml" "$W/house.yaml"
 # the standard single-camera table: the baseline (if given) and this build

@@ -1,4 +1,5 @@
-# sourced by the scripts that run a pack on the GPU machine (ab.sh, speed.sh, run-breakdown.sh):
+# sourced by the scripts that run a pack on the GPU machine (ab.sh, speed.sh, overhead.sh,
+# run-breakdown.sh):
 #
 #   use_pack PKG [DIR...]
 #
@@ -13,4 +14,21 @@ use_pack() {
   for d in "$(cat "$pkg/source-dir.txt")" "$@"; do
     [ -e "$d/worlds" ] || { mkdir -p "$d" && ln -sfn "$pkg/src/worlds" "$d/worlds"; }
   done
+}
+
+# step NAME LIMIT_S CMD...: runs CMD with its output in $STEP_LOGS/NAME.txt under a time limit
+# of LIMIT_S, cut to what is left of STEP_BUDGET_S seconds since STEP_T0 (date +%s); once fewer
+# than STEP_MIN_LEFT_S seconds are left it starts nothing. prints "== NAME rc=RC N ms" (or
+# "== NAME skipped (time)"). the caller sets the four STEP_ variables.
+step() {
+  local name=$1 limit=$2
+  shift 2
+  local left=$((STEP_BUDGET_S - ($(date +%s) - STEP_T0)))
+  if [ "$left" -lt "$STEP_MIN_LEFT_S" ]; then echo "== $name skipped (time)"; return; fi
+  [ "$limit" -gt "$left" ] && limit=$left
+  local t0 rc
+  t0=$(date +%s%N)
+  timeout "$limit" "$@" > "$STEP_LOGS/$name.txt" 2>&1
+  rc=$?
+  echo "== $name rc=$rc $((($(date +%s%N) - t0) / 1000000)) ms"
 }
