@@ -203,11 +203,16 @@ struct SurfaceTerms {
 PB_HOST_DEVICE inline Float3 ToFloat3(const F3& v) { return Float3{v.x, v.y, v.z}; }
 PB_HOST_DEVICE inline F3 ToF3(const Float3& v) { return F3{v.x, v.y, v.z}; }
 
+/// streak s is not beyond the pixel's primary hit at depth `depth` (m, 0: the ray escapes).
+PB_HOST_DEVICE inline bool StreakInFront(const StreakPixel& s, float depth) {
+  return !(depth > 0 && !(s.t <= depth));
+}
+
 /// the radiance of a pixel with streak s over its radiance L (after the surface, the shared
 /// visibility and the mirror layer), as RealtimeIntegrator's view effects: s drawn over L
-/// (StreakOver) unless it lies beyond the primary hit at depth `depth` (m, 0: the ray escapes).
+/// (StreakOver) where it lies in front of the primary hit (StreakInFront), else L.
 PB_HOST_DEVICE inline Float3 ApplyStreak(const StreakPixel& s, float depth, const Float3& L) {
-  if (depth > 0 && !(s.t <= depth)) return L;
+  if (!StreakInFront(s, depth)) return L;
   return Float3{StreakOver(s.alpha, s.L.x, L.x), StreakOver(s.alpha, s.L.y, L.y),
                 StreakOver(s.alpha, s.L.z, L.z)};
 }
@@ -1323,7 +1328,7 @@ PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int
     // the pixel's streak over it, seen through the media in front of it: alpha (media to the
     // streak, then the streak) + (1 - alpha) (media to the end, then the surface)
     const int64_t k = FindStreak(f, i);
-    if (k < 0 || (depth[i] > 0 && !(f.streaks[k].t <= depth[i]))) continue;
+    if (k < 0 || !StreakInFront(f.streaks[k], depth[i])) continue;
     StreakPixel s = f.streaks[k];
     Float3 T_f, L_f;
     MediaViewSegment(f.media, u, v, o[c], d[c], s.t * d_len[c], &T_f, &L_f, shared ? &q : nullptr);
