@@ -24,9 +24,9 @@
 namespace penumbra::cuda {
 
 /// why a pathtraced frame of `view` under `effects` cannot be traced on the GPU ("" if it can):
-/// effects not on the GPU (EffectsNotOnGpu), particles (the CPU's camera rays stop at streaks
-/// with a random draw), or a camera with lens distortion or motion (the jittered rays need
-/// Camera::Unproject).
+/// particles (the CPU's camera rays stop at streaks with a random draw), or a camera with lens
+/// distortion or motion (the jittered rays need Camera::Unproject). media (homogeneous and
+/// grids) are traced on the GPU since branch gpu14 (PathFrameView::media).
 std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view);
 
 /// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
@@ -68,10 +68,17 @@ void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffer
 /// max_bounces) rendered by PathTracePixel on the CPU over `bvh` (Updated for the snapshot),
 /// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
 /// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
-/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none).
+/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none); `media`: the
+/// frame's media (MediaScene::View; null: none).
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                             RenderedFrame* out,
                             const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),
-                            const PathEmitters* emitters = nullptr);
+                            const PathEmitters* emitters = nullptr,
+                            const MediaSceneView* media = nullptr);
+
+/// `effects` without its media (null where nothing else is left): what the pathtraced tier's
+/// RealtimeFrameData::Prepare takes (the paths trace the media themselves, so the realtime
+/// tier's media volumes are not built).
+const EffectsFrame* EffectsWithoutMedia(const EffectsFrame* effects, EffectsFrame* storage);
 
 }  // namespace penumbra::cuda
