@@ -37,6 +37,10 @@ struct AsyncFrameWriterOptions {
   /// receives every image file written (output/camera_frame.h), on the worker threads; may
   /// be empty.
   CameraImageCallback on_image;
+  /// receives each frame back after its files were written (or failed), with its images, on
+  /// the worker thread and without the writer's lock, so that the caller can reuse the image
+  /// buffers (sinks/frame_buffer_pool.h); must not throw. may be empty (the images are freed).
+  std::function<void(CameraFrame&& frame)> on_written;
 
   /// @throws ConfigError for a capacity < 1 or a thread count outside 1..8.
   void ValidateOrThrow() const;
