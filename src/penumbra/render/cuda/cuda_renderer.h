@@ -87,9 +87,10 @@ class CudaRenderer final : public Renderer {
                  RenderedFrame* out);
   // the pathtraced tier's rgb, radiance and depth: the paths on the GPU (cuda_path.h), the
   // denoiser and film on the host (path_frame.h's FinishPathFrame).
+  // `camera`: the view's camera with its ray tables on the device (Render's).
   void RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
-                        const CameraView& view, std::chrono::steady_clock::time_point t0,
-                        RenderedFrame* out);
+                        const CameraView& view, const PinholeCamera& camera,
+                        std::chrono::steady_clock::time_point t0, RenderedFrame* out);
   // the scene-constant realtime data (materials, textures) and the sky's arrays on the device
   // (once, and the sky again when it changes): both tiers' rgb read them.
   void UploadRealtime();

@@ -5,15 +5,13 @@
 
 namespace penumbra::cuda {
 
-std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view) {
+std::string PathNotOnGpu(const EffectsFrame* effects) {
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   // the path kernels trace no medium (the realtime tier's homogeneous media are on the GPU,
   // EffectsNotOnGpu, the pathtraced tier's delta tracking is not)
   if (fx != nullptr && (!fx->homogeneous_media.empty() || !fx->grid_media.empty()))
     return "the pathtraced tier with media (fog, haze, dust, smoke, fire, VDB)";
   if (fx != nullptr && !fx->particles.empty()) return "the pathtraced tier with particles";
-  if (view.intrinsics.has_distortion() || view.motion.moving())
-    return "the pathtraced tier with a distorted or moving camera";
   return "";
 }
 
