@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <mutex>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "common/temp_dir.h"
@@ -174,8 +175,29 @@ TEST(AsyncFrameWriter, BadOptionsAreConfigErrors) {
   opt.queue_capacity = 0;
   EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
   opt.queue_capacity = 8;
-  opt.num_threads = 0;
+  opt.num_threads = -1;
   EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
+  opt.num_threads = 9;
+  EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
+}
+
+// 0 threads: half the machine's cores, at least 2 and at most 8; a count given is kept
+TEST(AsyncFrameWriter, ZeroThreadsIsHalfTheCoresFromTwoToEight) {
+  AsyncFrameWriterOptions opt;
+  opt.num_threads = 0;
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  EXPECT_EQ(opt.ResolvedThreads(), std::clamp(cores / 2, 2, 8));
+  EXPECT_GE(opt.ResolvedThreads(), 2);
+  EXPECT_LE(opt.ResolvedThreads(), 8);
+  opt.num_threads = 3;
+  EXPECT_EQ(opt.ResolvedThreads(), 3);
+  TempDir dir;
+  opt.num_threads = 0;
+  AsyncFrameWriter writer(dir.str(), opt);
+  writer.AddCamera("cam", CameraIntrinsics::FromFovy(32, 24, 70), AllOutputs());
+  for (int i = 0; i < 4; ++i) writer.Submit(Frame("cam", i, 32, 24));
+  writer.Flush();
+  EXPECT_EQ(CsvLines(dir.path() / "cam" / "frames.csv").size(), 5u);
 }
 
 TEST(AsyncFrameWriter, HandsEachWrittenFrameBackWithItsImages) {
