@@ -41,6 +41,7 @@
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
+#include "penumbra/render/media_build_math.h"
 #include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/mirror_math.h"
 #include "penumbra/render/particle_math.h"
@@ -182,6 +183,10 @@ struct RealtimeFrameView {
   /// transmittances of the surface loop (ShadeRealtimePoint) and the view pass (MediaViewQuad).
   int32_t has_media = 0;
   RealtimeMediaView media;
+  /// the media volumes this frame builds itself before its first kernel reads them
+  /// (MediaLightVolumeCell, MediaFogColumn; RealtimeMedia::Build's device_volumes): their
+  /// layouts are in `media`, their arrays (light_trans, fog_S, fog_inv_log_far) filled then.
+  MediaVolumesToBuild media_build;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -1268,6 +1273,90 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
       hi = mid;
   }
   return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
+}
+
+/// cell c of the world light volume that frame f builds itself (f.media_build.light_volume;
+/// layout f.media.light_volume): per light l < stride its [cell][light] transmittance
+/// trans_cl[c stride + l] (LightVolumeCellLight; 0 past the volume's lights) and, where vis_cl
+/// is not null (f.media_build.with_visibility), the visibility V Th Tgrid, each asked shadow ray
+/// traced here through f.scene, as RealtimeMedia::Build's cells (whose rays go through a
+/// RayQuery: the same TraceRay, o at the cell centre, tmin 0).
+PB_HOST_DEVICE inline void MediaLightVolumeCell(const RealtimeFrameView& f, int64_t c,
+                                                float* trans_cl, float* vis_cl) {
+  const RealtimeMediaView& m = f.media;
+  LightVolumeBuild b;
+  b.layout = m.light_volume;
+  b.num_lights = m.num_volume_lights;
+  b.with_visibility = vis_cl != nullptr ? 1 : 0;
+  b.lights = f.lights;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  b.grids = m.grids;
+  b.grid_light_T = m.grid_light_T;
+  b.num_grids = m.num_grids;
+  float p[3];
+  LightVolumeCellCentre(b.layout, c, p);
+  const int S = b.layout.stride;
+  for (int l = 0; l < S; ++l) {
+    const int64_t at = c * S + l;
+    if (l >= b.num_lights) {
+      trans_cl[at] = 0.0f;
+      if (vis_cl != nullptr) vis_cl[at] = 0.0f;
+      continue;
+    }
+    float T, d[3], tmax;
+    const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
+    trans_cl[at] = T;
+    if (vis_cl == nullptr) continue;
+    bool seen = w == kMediaRayLit;
+    if (w == kMediaRayTrace) {
+      TraceRay r;
+      r.o = F3{p[0], p[1], p[2]};
+      r.d = F3{d[0], d[1], d[2]};
+      r.tmin = 0.0f;
+      r.tmax = tmax;
+      seen = !TraceOccluded(f.scene, r);
+    }
+    vis_cl[at] = seen ? T : 0.0f;
+  }
+}
+
+/// fog froxel column c of frame f (f.media_build.fog; f.media.fog_nx x fog_ny columns): its
+/// centre pixel's ray (PrimaryRay, unit direction), FogFroxelColumn over f's media, lights,
+/// grid froxels and the visibility volume vis_cl (null: none) into the column's
+/// kFogFroxelSlices + 1 records S[c (kFogFroxelSlices + 1) ..] and inv_log_far[c], as
+/// RealtimeMedia::BuildFogFroxels (whose column ray is Camera::GenerateRay's).
+PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, const float* vis_cl,
+                                          Rgb4* S, float* inv_log_far) {
+  const RealtimeMediaView& m = f.media;
+  const int W = f.camera.width, H = f.camera.height;
+  const int cx = c % m.fog_nx, cy = c / m.fog_nx;
+  const int uc = MediaMinI(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
+  const int vc = MediaMinI(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
+  const TraceRay r = PrimaryRay(f.camera, uc, vc);
+  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  const float o[3] = {r.o.x, r.o.y, r.o.z};
+  const float d[3] = {r.d.x / len, r.d.y / len, r.d.z / len};
+  FogFroxelBuild<Rgb4> b;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  b.lights = f.lights;
+  b.num_lights = f.num_lights;
+  b.num_volume_lights = m.num_volume_lights;
+  b.vis_layout = m.light_volume;
+  b.vis_cl = vis_cl;
+  b.grids = m.grids;
+  b.grid_light_T = m.grid_light_T;
+  b.num_grids = m.num_grids;
+  b.grid_t0 = m.grid_t0;
+  b.grid_t1 = m.grid_t1;
+  b.grid_slices_per_m = m.grid_slices_per_m;
+  b.grid_records = m.grid_records;
+  const MediaColumns grid_cols =
+      m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
+  FogFroxelColumn(b, o, d, FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3), grid_cols,
+                  Rgb4{0, 0, 0, 0}, Rgb4{1, 1, 1, 0}, inv_log_far + c,
+                  reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
 }
 
 /// the media (homogeneous and grids) over the radiance of the pixels of the 2x2 quad (u0, v0) ..
