@@ -48,6 +48,11 @@ struct LightVolumeBuild {
   int num_grids = 0;
 };
 
+/// the number of cells of the volume `v` (r[0] r[1] r[2]).
+PB_HOST_DEVICE inline int64_t LightVolumeCells(const CellLightsPod& v) {
+  return static_cast<int64_t>(v.r[0]) * v.r[1] * v.r[2];
+}
+
 /// the world position (m) of cell c (x fastest) of the volume `v`: lo + (i + 0.5) / cells_per_m
 /// per axis.
 PB_HOST_DEVICE inline void LightVolumeCellCentre(const CellLightsPod& v, int64_t c, float p[3]) {

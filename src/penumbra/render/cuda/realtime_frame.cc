@@ -405,11 +405,11 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
   RealtimeMediaView& m = f->media;
   float* vis = nullptr;
   if (b.light_volume != 0) {
-    const CellLightsPod& v = m.light_volume;
-    const int64_t cells = static_cast<int64_t>(v.r[0]) * v.r[1] * v.r[2];
-    out->trans.assign(static_cast<size_t>(cells) * v.stride, 0.0f);
-    out->vis.assign(b.with_visibility != 0 ? static_cast<size_t>(cells) * v.stride : 0, 0.0f);
-    vis = b.with_visibility != 0 ? out->vis.data() : nullptr;
+    const int64_t cells = LightVolumeCells(m.light_volume);
+    const size_t values = static_cast<size_t>(cells) * m.light_volume.stride;
+    out->trans.assign(values, 0.0f);
+    out->vis.assign(b.with_visibility != 0 ? values : 0, 0.0f);
+    if (b.with_visibility != 0) vis = out->vis.data();
     ParallelForOrSerial(pool, cells,
                         [&](int64_t c) { MediaLightVolumeCell(*f, c, out->trans.data(), vis); });
     m.light_trans = out->trans.data();

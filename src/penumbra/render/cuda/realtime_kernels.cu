@@ -764,9 +764,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
     RealtimeMediaView& m = f->media;
     float* vis = nullptr;
     if (b.light_volume != 0) {
-      const CellLightsPod& v = m.light_volume;
-      const int64_t cells = static_cast<int64_t>(v.r[0]) * v.r[1] * v.r[2];
-      const size_t bytes = sizeof(float) * static_cast<size_t>(cells) * v.stride;
+      const int64_t cells = LightVolumeCells(m.light_volume);
+      const size_t bytes = sizeof(float) * static_cast<size_t>(cells) * m.light_volume.stride;
       media_trans.Reserve(bytes > 0 ? bytes : 4);
       if (b.with_visibility != 0) {
         media_vis.Reserve(bytes > 0 ? bytes : 4);
