@@ -234,52 +234,70 @@ PB_HOST_DEVICE inline Float3 FogSliceInScatter(const FogFroxelBuild<R>& b, const
   return Ls;
 }
 
-/// one fog froxel column along o + t d (o the camera centre, d unit) through the column's centre
-/// pixel, whose grid froxel columns are `grid_cols` (read where b.grid_records is set), with the
-/// slice jitter `jitter` (FroxelColumnJitter stream 3): *inv_log_far = 1 / log(t_far / near)
-/// and the kFogFroxelSlices + 1 records rec[k] (4 floats each: rgb, 0), the accumulated
-/// in-scatter from the camera to boundary k (rec[0] = 0): per slice [lo, hi) the in-scatter at
-/// lo + jitter (hi - lo) times the transmittance from the camera (the media's closed form, the
-/// grid froxels') times hi - lo, in slice order.
+/// slice k (0 .. kFogFroxelSlices - 1) of a fog froxel column along o + t d (o the camera
+/// centre, d unit) reaching t_far (FogColumnFar), with the slice jitter `jitter`
+/// (FroxelColumnJitter stream 3) and the column's grid froxel columns `grid_cols` (read where
+/// b.grid_records is set): its in-scatter increment, the in-scatter at lo + jitter (hi - lo)
+/// (FogSliceInScatter) times the transmittance from the camera there (the media's closed form,
+/// the grid froxels') times hi - lo; 0 where no light scatters there.
 template <typename R>
-PB_HOST_DEVICE inline void FogFroxelColumn(const FogFroxelBuild<R>& b, const float o[3],
-                                           const float d[3], float jitter,
-                                           const MediaColumns& grid_cols, const R& zero,
-                                           const R& unit, float* inv_log_far, float* rec) {
-  constexpr int Z = kFogFroxelSlices;
-  const float t_far = FogColumnFar(b.media, b.num_media, o, d);
-  *inv_log_far = 1.0f / logf(t_far / kFogFroxelNear);
+PB_HOST_DEVICE inline Float3 FogFroxelSlice(const FogFroxelBuild<R>& b, const float o[3],
+                                            const float d[3], float jitter, float t_far, int k,
+                                            const MediaColumns& grid_cols, const R& zero,
+                                            const R& unit) {
+  const float lo = FogBoundary(k, t_far), hi = FogBoundary(k + 1, t_far);
+  const float t = lo + jitter * (hi - lo);
+  const float x[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
   const float wo[3] = {-d[0], -d[1], -d[2]};
+  const Float3 Ls = FogSliceInScatter(b, x, wo);
+  if (!(pbm::Max(pbm::Max(Ls.x, Ls.y), Ls.z) > 0)) return Float3{0, 0, 0};
+  const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, o, d, 0.0f, t);
+  Float3 T_cam = MediaExpNeg(tau, false);
+  if (b.grid_records != nullptr) {
+    R gS = zero, gT = unit;
+    GridFroxelLookup(grid_cols, b.grid_t0, b.grid_t1, b.grid_slices_per_m, b.grid_records, t, zero,
+                     unit, &gS, &gT);
+    const float* g = reinterpret_cast<const float*>(&gT);  // R: 4 floats, rgb first
+    T_cam = {T_cam.x * g[0], T_cam.y * g[1], T_cam.z * g[2]};
+  }
+  const float w = hi - lo;
+  return {T_cam.x * Ls.x * w, T_cam.y * Ls.y * w, T_cam.z * Ls.z * w};
+}
+
+/// a fog froxel column's kFogFroxelSlices + 1 records rec[k] (4 floats each: rgb, 0) from its
+/// slices' increments inc[0 .. kFogFroxelSlices) (FogFroxelSlice): rec[0] = 0, rec[k + 1] =
+/// rec[k] + inc[k], summed in slice order.
+PB_HOST_DEVICE inline void FogFroxelRecords(const Float3* inc, float* rec) {
   float S[3] = {0, 0, 0};
   for (int c = 0; c < 4; ++c) rec[c] = 0.0f;
-  float lo = FogBoundary(0, t_far);
-  for (int k = 0; k < Z; ++k) {
-    const float hi = FogBoundary(k + 1, t_far);
-    const float t = lo + jitter * (hi - lo);
-    const float x[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
-    const Float3 Ls = FogSliceInScatter(b, x, wo);
-    if (pbm::Max(pbm::Max(Ls.x, Ls.y), Ls.z) > 0) {
-      const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, o, d, 0.0f, t);
-      Float3 T_cam = MediaExpNeg(tau, false);
-      if (b.grid_records != nullptr) {
-        R gS = zero, gT = unit;
-        GridFroxelLookup(grid_cols, b.grid_t0, b.grid_t1, b.grid_slices_per_m, b.grid_records, t,
-                         zero, unit, &gS, &gT);
-        const float* g = reinterpret_cast<const float*>(&gT);  // R: 4 floats, rgb first
-        T_cam = {T_cam.x * g[0], T_cam.y * g[1], T_cam.z * g[2]};
-      }
-      const float w = hi - lo;
-      S[0] = S[0] + T_cam.x * Ls.x * w;
-      S[1] = S[1] + T_cam.y * Ls.y * w;
-      S[2] = S[2] + T_cam.z * Ls.z * w;
-    }
+  for (int k = 0; k < kFogFroxelSlices; ++k) {
+    S[0] = S[0] + inc[k].x;
+    S[1] = S[1] + inc[k].y;
+    S[2] = S[2] + inc[k].z;
     float* r = rec + 4 * (k + 1);
     r[0] = S[0];
     r[1] = S[1];
     r[2] = S[2];
     r[3] = 0.0f;
-    lo = hi;
   }
+}
+
+/// one fog froxel column along o + t d (o the camera centre, d unit) through the column's centre
+/// pixel, whose grid froxel columns are `grid_cols`, with the slice jitter `jitter`:
+/// *inv_log_far = 1 / log(t_far / near) (FogColumnFar) and the kFogFroxelSlices + 1 records
+/// rec[k] (4 floats each: rgb, 0), the accumulated in-scatter from the camera to boundary k:
+/// FogFroxelRecords of the slices' FogFroxelSlice.
+template <typename R>
+PB_HOST_DEVICE inline void FogFroxelColumn(const FogFroxelBuild<R>& b, const float o[3],
+                                           const float d[3], float jitter,
+                                           const MediaColumns& grid_cols, const R& zero,
+                                           const R& unit, float* inv_log_far, float* rec) {
+  const float t_far = FogColumnFar(b.media, b.num_media, o, d);
+  *inv_log_far = 1.0f / logf(t_far / kFogFroxelNear);
+  Float3 inc[kFogFroxelSlices];
+  for (int k = 0; k < kFogFroxelSlices; ++k)
+    inc[k] = FogFroxelSlice(b, o, d, jitter, t_far, k, grid_cols, zero, unit);
+  FogFroxelRecords(inc, rec);
 }
 
 }  // namespace penumbra

@@ -86,7 +86,7 @@ class RealtimeFrameData {
   /// poses; RealtimeMedia::HostView's arrays for the view (the grids' froxels and light volumes
   /// too). with device_media (the default) the world light volume's cells and the fog froxels
   /// are left to the frame (View's media_build: the device's MediaLightVolumeKernel and
-  /// MediaFogColumnKernel, or BuildMediaVolumesOnHost). call after PoseWorld (Prepare does).
+  /// MediaFogSliceKernel, or BuildMediaVolumesOnHost). call after PoseWorld (Prepare does).
   void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                     const Camera& camera, const CameraView& view, ThreadPool* pool,
                     const RayQuery* media_rays = nullptr);

@@ -81,18 +81,36 @@ __global__ void MediaViewKernel(RealtimeFrameView f, const float* depth, Float3*
 
 // the media volumes a frame builds itself (RealtimeFrameView::media_build), before the kernels
 // that read them: one thread per cell of the world light volume (its shadow rays traced in the
-// thread), then one per fog froxel column (which reads the light volume's visibility).
+// thread), then the fog froxels (which read the light volume's visibility).
 __global__ void MediaLightVolumeKernel(RealtimeFrameView f, int64_t cells, float* trans_cl,
                                        float* vis_cl) {
   const int64_t c = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (c >= cells) return;
   MediaLightVolumeCell(f, c, trans_cl, vis_cl);
 }
-__global__ void MediaFogColumnKernel(RealtimeFrameView f, int columns, const float* vis_cl, Rgb4* S,
-                                     float* inv_log_far) {
-  const int c = blockIdx.x * blockDim.x + threadIdx.x;
-  if (c >= columns) return;
-  MediaFogColumn(f, c, vis_cl, S, inv_log_far);
+// one block per fog froxel column, one thread per slice (kFogFroxelSlices of kFogSliceBlock),
+// then the column's records summed in slice order by its first thread (FogFroxelRecords: the
+// bits of MediaFogColumn's serial loop).
+constexpr int kFogSliceBlock = 64;
+static_assert(kFogFroxelSlices <= kFogSliceBlock, "one block holds a column's slices");
+__global__ void MediaFogSliceKernel(RealtimeFrameView f, const float* vis_cl, Rgb4* S,
+                                    float* inv_log_far) {
+  // the increments as plain floats (a __shared__ array takes no initialisers: Float3 has them)
+  __shared__ float inc[3 * kFogFroxelSlices];
+  const int c = blockIdx.x, k = threadIdx.x;
+  if (k < kFogFroxelSlices) {
+    const Float3 v = MediaFogSlice(f, c, k, vis_cl, inv_log_far);
+    inc[3 * k] = v.x;
+    inc[3 * k + 1] = v.y;
+    inc[3 * k + 2] = v.z;
+  }
+  __syncthreads();
+  if (k != 0) return;
+  Float3 column[kFogFroxelSlices];
+  for (int i = 0; i < kFogFroxelSlices; ++i)
+    column[i] = Float3{inc[3 * i], inc[3 * i + 1], inc[3 * i + 2]};
+  FogFroxelRecords(column,
+                   reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
 }
 
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
@@ -758,7 +776,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     }
   }
   // the media volumes frame f builds itself (f->media_build), on `stream` after UploadMedia:
-  // MediaLightVolumeKernel, then MediaFogColumnKernel; f->media pointed at their buffers
+  // MediaLightVolumeKernel, then MediaFogSliceKernel; f->media pointed at their buffers
   void BuildMedia(RealtimeFrameView* f, cudaStream_t stream) {
     const MediaVolumesToBuild& b = f->media_build;
     RealtimeMediaView& m = f->media;
@@ -780,9 +798,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
       const int columns = m.fog_nx * m.fog_ny;
       media_fog.Reserve(sizeof(Rgb4) * static_cast<size_t>(columns) * (kFogFroxelSlices + 1));
       media_inv_log_far.Reserve(sizeof(float) * static_cast<size_t>(columns));
-      MediaFogColumnKernel<<<static_cast<unsigned>((columns + 63) / 64), 64, 0, stream>>>(
-          *f, columns, vis, media_fog.as<Rgb4>(), media_inv_log_far.as<float>());
-      Check(cudaGetLastError(), "MediaFogColumnKernel");
+      MediaFogSliceKernel<<<static_cast<unsigned>(columns), kFogSliceBlock, 0, stream>>>(
+          *f, vis, media_fog.as<Rgb4>(), media_inv_log_far.as<float>());
+      Check(cudaGetLastError(), "MediaFogSliceKernel");
       m.fog_S = media_fog.as<Rgb4>();
       m.fog_inv_log_far = media_inv_log_far.as<float>();
     }

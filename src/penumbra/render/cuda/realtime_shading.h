@@ -1321,13 +1321,18 @@ PB_HOST_DEVICE inline void MediaLightVolumeCell(const RealtimeFrameView& f, int6
   }
 }
 
-/// fog froxel column c of frame f (f.media_build.fog; f.media.fog_nx x fog_ny columns): its
-/// centre pixel's ray (PrimaryRay, unit direction), FogFroxelColumn over f's media, lights,
-/// grid froxels and the visibility volume vis_cl (null: none) into the column's
-/// kFogFroxelSlices + 1 records S[c (kFogFroxelSlices + 1) ..] and inv_log_far[c], as
-/// RealtimeMedia::BuildFogFroxels (whose column ray is Camera::GenerateRay's).
-PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, const float* vis_cl,
-                                          Rgb4* S, float* inv_log_far) {
+/// the inputs of fog froxel column c of frame f (f.media_build.fog; f.media.fog_nx x fog_ny
+/// columns): the build over f's media, lights, grid froxels and the visibility volume vis_cl
+/// (null: none), its centre pixel's ray o + t d (PrimaryRay, unit direction; RealtimeMedia::
+/// BuildFogFroxels takes Camera::GenerateRay's), its slice jitter and grid froxel columns.
+struct MediaFogColumnInputs {
+  FogFroxelBuild<Rgb4> b;
+  float o[3], d[3];
+  float jitter;
+  MediaColumns grid_cols;
+};
+PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameView& f, int c,
+                                                            const float* vis_cl) {
   const RealtimeMediaView& m = f.media;
   const int W = f.camera.width, H = f.camera.height;
   const int cx = c % m.fog_nx, cy = c / m.fog_nx;
@@ -1335,9 +1340,10 @@ PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, con
   const int vc = MediaMinI(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
   const TraceRay r = PrimaryRay(f.camera, uc, vc);
   const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
-  const float o[3] = {r.o.x, r.o.y, r.o.z};
-  const float d[3] = {r.d.x / len, r.d.y / len, r.d.z / len};
-  FogFroxelBuild<Rgb4> b;
+  MediaFogColumnInputs in;
+  in.o[0] = r.o.x, in.o[1] = r.o.y, in.o[2] = r.o.z;
+  in.d[0] = r.d.x / len, in.d[1] = r.d.y / len, in.d[2] = r.d.z / len;
+  FogFroxelBuild<Rgb4>& b = in.b;
   b.media = m.media;
   b.num_media = m.num_media;
   b.lights = f.lights;
@@ -1352,11 +1358,32 @@ PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, con
   b.grid_t1 = m.grid_t1;
   b.grid_slices_per_m = m.grid_slices_per_m;
   b.grid_records = m.grid_records;
-  const MediaColumns grid_cols =
-      m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
-  FogFroxelColumn(b, o, d, FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3), grid_cols,
-                  Rgb4{0, 0, 0, 0}, Rgb4{1, 1, 1, 0}, inv_log_far + c,
+  in.grid_cols = m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3);
+  return in;
+}
+
+/// fog froxel column c of frame f (MediaFogColumnOf): FogFroxelColumn into the column's
+/// kFogFroxelSlices + 1 records S[c (kFogFroxelSlices + 1) ..] and inv_log_far[c], as
+/// RealtimeMedia::BuildFogFroxels (whose column ray is Camera::GenerateRay's). the device runs
+/// its slices in parallel (MediaFogSlice, then FogFroxelRecords: the same bits).
+PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, const float* vis_cl,
+                                          Rgb4* S, float* inv_log_far) {
+  const MediaFogColumnInputs in = MediaFogColumnOf(f, c, vis_cl);
+  FogFroxelColumn(in.b, in.o, in.d, in.jitter, in.grid_cols, Rgb4{0, 0, 0, 0}, Rgb4{1, 1, 1, 0},
+                  inv_log_far + c,
                   reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
+}
+
+/// slice k of fog froxel column c of frame f: its increment (FogFroxelSlice of
+/// MediaFogColumnOf), and for k = 0 the column's inv_log_far[c].
+PB_HOST_DEVICE inline Float3 MediaFogSlice(const RealtimeFrameView& f, int c, int k,
+                                           const float* vis_cl, float* inv_log_far) {
+  const MediaFogColumnInputs in = MediaFogColumnOf(f, c, vis_cl);
+  const float t_far = FogColumnFar(in.b.media, in.b.num_media, in.o, in.d);
+  if (k == 0) inv_log_far[c] = 1.0f / logf(t_far / kFogFroxelNear);
+  return FogFroxelSlice(in.b, in.o, in.d, in.jitter, t_far, k, in.grid_cols, Rgb4{0, 0, 0, 0},
+                        Rgb4{1, 1, 1, 0});
 }
 
 /// the media (homogeneous and grids) over the radiance of the pixels of the 2x2 quad (u0, v0) ..
