@@ -7,11 +7,12 @@
 //    with homogeneous media, the shadow ray its visibility asks (none, lit, or traced). the CPU
 //    gathers the rays and traces them in batches through its RayQuery; a kernel traces each
 //    one where it is made, against the device BVH;
-//  - the fog (light in-scatter) froxels, one column at a time (FogFroxelColumn): the slices'
-//    far end (where the media's transmittance falls to 1 %), then per slice the in-scatter of
-//    every light (the visibility volume, or the closed form outside it, times the mixture of
-//    the media's Henyey-Greenstein lobes), times the transmittance from the camera (media and
-//    grid froxels), accumulated in slice order.
+//  - the fog (light in-scatter) froxels, one column at a time (FogFroxelColumn) or one slice
+//    at a time (FogFroxelSlice, then FogFroxelRecords): the slices' far end (where the media's
+//    transmittance falls to 1 %), then per slice the in-scatter of every light (the visibility
+//    volume, or the closed form outside it, times the mixture of the media's Henyey-Greenstein
+//    lobes), times the transmittance from the camera (media and grid froxels), accumulated in
+//    slice order.
 // the grids' parts (their light volumes' march and the grid froxels) stay on the host: their
 // density lookups are GridVolume's (render/media_scene.h).
 // operation order: the CPU code's before the move (the bit-for-bit rule of shading_math.h);
