@@ -59,6 +59,10 @@ class CudaRenderer final : public Renderer {
   DeviceScene& device() { return *device_; }
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
+  /// the realtime rgb path's host side (after a first rgb frame on the GPU), for benchmarks:
+  /// where its media volumes are built (RealtimeFrameData::set_device_media) and how long the
+  /// host's part took (media_build_ms, media_build_times).
+  RealtimeFrameData& realtime_frame() { return *realtime_; }
   /// the pathtraced tier's device side (after a first pathtraced frame on the GPU), for
   /// benchmarks.
   DevicePath& device_path() { return *device_path_; }
