@@ -14,14 +14,8 @@ baseline=${2:?usage: ab.sh PACK.tar.xz BASELINE.xz [repeats]}
 repeats=${3:-2}
 R=${OUT:-/tmp/ab-out}
 mkdir -p "$R"
-work=$(mktemp -d)
-tar -C "$work" -xJf "$pack"
-pkg=$work/penumbra-gpu
 . "$(dirname "$0")/use-pack.sh"
-use_pack "$pkg" /work/main
-xz -dc "$baseline" > "$pkg/bin/base_bench" && chmod +x "$pkg/bin/base_bench"
-B=$pkg/bin
-W=$pkg/src/worlds
+unpack_pack "$pack" "$baseline"
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu --format=csv | tee "$R/card.txt"
 STEP_T0=$(date +%s)
 STEP_BUDGET_S=${AB_BUDGET_S:-380}

@@ -16,16 +16,10 @@ baseline=${2:?usage: overhead.sh PACK.tar.xz BASELINE.xz [repeats]}
 repeats=${3:-3}
 R=${OUT:-/tmp/overhead-out}
 mkdir -p "$R"
-work=$(mktemp -d)
+. "$(dirname "$0")/use-pack.sh"
+unpack_pack "$pack" "$baseline"
 L=$work/logs
 mkdir -p "$L"
-tar -C "$work" -xJf "$pack"
-pkg=$work/penumbra-gpu
-. "$(dirname "$0")/use-pack.sh"
-use_pack "$pkg" /work/main
-xz -dc "$baseline" > "$pkg/bin/base_bench" && chmod +x "$pkg/bin/base_bench"
-B=$pkg/bin
-W=$pkg/src/worlds
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu --format=csv > "$L/card.txt" 2>&1
 echo "CPU: $(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)" >> "$L/card.txt"
 STEP_T0=$(date +%s)

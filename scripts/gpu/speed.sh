@@ -15,19 +15,10 @@ pack=${1:?usage: speed.sh PACK.tar.xz [BASELINE_render_cuda_bench.xz]}
 baseline=${2:-}
 RESULTS=${OUT:-/tmp/speed-out}
 mkdir -p "$RESULTS"
-work=$(mktemp -d)
+. "$(dirname "$0")/use-pack.sh"
+unpack_pack "$pack" "$baseline"
 OUT=$work/logs  # the step logs, packed into one file of $RESULTS at the end (8 files come back)
 mkdir -p "$OUT"
-tar -C "$work" -xJf "$pack"
-pkg=$work/penumbra-gpu
-. "$(dirname "$0")/use-pack.sh"
-use_pack "$pkg" /work/main
-if [ -n "$baseline" ]; then
-  xz -dc "$baseline" > "$pkg/bin/baseline_render_cuda_bench"
-  chmod +x "$pkg/bin/baseline_render_cuda_bench"
-fi
-W=$pkg/src/worlds
-B=$pkg/bin
 nvidia-smi --query-gpu=name,driver_version,memory.total,compute_cap,clocks.sm,clocks.max.sm,temperature.gpu,utilization.gpu --format=csv > "$OUT/card.txt" 2>&1
 echo "CPU: $(nproc) cores,$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2)" >> "$OUT/card.txt"
 cat "$OUT/card.txt"
@@ -38,7 +29,7 @@ STEP_LOGS=$OUT
 # the realtime tier in detail (Render stages, kernel ablations, cpu), 640x480
 step realtime_1 120 "$B/render_cuda_bench" --realtime --frames 50 "$W/default.yaml" "$W/house.yaml"
 # the standard single-camera table: the baseline (if given) and this build
-[ -n "$baseline" ] && step bench_base 120 "$B/baseline_render_cuda_bench" --frames 30 "$W/default.yaml" "$W/house.yaml"
+[ -n "$baseline" ] && step bench_base 120 "$B/base_bench" --frames 30 "$W/default.yaml" "$W/house.yaml"
 step bench_new 120 "$B/render_cuda_bench" --frames 30 "$W/default.yaml" "$W/house.yaml"
 # the gpu tests (RealtimeSpeedUps first)
 step gpu_speed_tests 90 "$B/render_cuda_gpu_tests" --gtest_filter='*RealtimeSpeedUps*'

@@ -2,6 +2,7 @@
 # run-breakdown.sh):
 #
 #   use_pack PKG [DIR...]
+#   unpack_pack PACK [BASELINE]
 #
 # makes the unpacked pack PKG usable: its libraries come first on LD_LIBRARY_PATH (the libraries
 # its executables' libraries load), and its worlds appear at the source folder its executables
@@ -14,6 +15,20 @@ use_pack() {
   for d in "$(cat "$pkg/source-dir.txt")" "$@"; do
     [ -e "$d/worlds" ] || { mkdir -p "$d" && ln -sfn "$pkg/src/worlds" "$d/worlds"; }
   done
+}
+
+# unpack_pack PACK [BASELINE]: unpacks scripts/gpu/pack.sh's tarball PACK into a new temporary
+# folder and makes it usable (use_pack, with /work/main as a further folder); with BASELINE (an
+# xz-compressed render_cuda_bench of another commit) also puts that at $B/base_bench. sets work
+# (the temporary folder), pkg (the unpacked pack), B (its bin folder) and W (its worlds).
+unpack_pack() {
+  work=$(mktemp -d)
+  tar -C "$work" -xJf "$1"
+  pkg=$work/penumbra-gpu
+  B=$pkg/bin
+  W=$pkg/src/worlds
+  use_pack "$pkg" /work/main
+  if [ -n "${2:-}" ]; then xz -dc "$2" > "$B/base_bench" && chmod +x "$B/base_bench"; fi
 }
 
 # step NAME LIMIT_S CMD...: runs CMD with its output in $STEP_LOGS/NAME.txt under a time limit

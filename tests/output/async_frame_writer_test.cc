@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <mutex>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
@@ -171,8 +175,66 @@ TEST(AsyncFrameWriter, BadOptionsAreConfigErrors) {
   opt.queue_capacity = 0;
   EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
   opt.queue_capacity = 8;
-  opt.num_threads = 0;
+  opt.num_threads = -1;
   EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
+  opt.num_threads = 9;
+  EXPECT_THROW(AsyncFrameWriter(dir.str(), opt), ConfigError);
+}
+
+// 0 threads: half the machine's cores, at least 2 and at most 8; a count given is kept
+TEST(AsyncFrameWriter, ZeroThreadsIsHalfTheCoresFromTwoToEight) {
+  AsyncFrameWriterOptions opt;
+  opt.num_threads = 0;
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  EXPECT_EQ(opt.ResolvedThreads(), std::clamp(cores / 2, 2, 8));
+  EXPECT_GE(opt.ResolvedThreads(), 2);
+  EXPECT_LE(opt.ResolvedThreads(), 8);
+  opt.num_threads = 3;
+  EXPECT_EQ(opt.ResolvedThreads(), 3);
+  TempDir dir;
+  opt.num_threads = 0;
+  AsyncFrameWriter writer(dir.str(), opt);
+  writer.AddCamera("cam", CameraIntrinsics::FromFovy(32, 24, 70), AllOutputs());
+  for (int i = 0; i < 4; ++i) writer.Submit(Frame("cam", i, 32, 24));
+  writer.Flush();
+  EXPECT_EQ(CsvLines(dir.path() / "cam" / "frames.csv").size(), 5u);
+}
+
+TEST(AsyncFrameWriter, HandsEachWrittenFrameBackWithItsImages) {
+  TempDir dir;
+  AsyncFrameWriterOptions opt;
+  opt.num_threads = 2;
+  std::mutex mu;
+  std::vector<CameraFrame> back;
+  opt.on_written = [&](CameraFrame&& f) {
+    std::lock_guard<std::mutex> lock(mu);
+    back.push_back(std::move(f));
+  };
+  const int kFrames = 6;
+  {
+    AsyncFrameWriter writer(dir.str(), opt);
+    writer.AddCamera("front", CameraIntrinsics::FromFovy(64, 48, 70), AllOutputs());
+    for (int i = 0; i < kFrames; ++i) writer.Submit(Frame("front", i, 64, 48));
+    writer.Flush();
+    // the rows are written from what the writer kept, not from the images it gave back
+    EXPECT_EQ(CsvLines(dir.path() / "front" / "frames.csv").size(), 1u + kFrames);
+  }
+  ASSERT_EQ(back.size(), static_cast<size_t>(kFrames));
+  std::vector<int> seen;
+  for (const CameraFrame& f : back) {
+    EXPECT_EQ(f.camera, "front");
+    ASSERT_EQ(f.rgb.width, 64);
+    ASSERT_EQ(f.rgb.data.size(), 64u * 48 * 3);
+    ASSERT_EQ(f.depth_m.data.size(), 64u * 48);
+    ASSERT_EQ(f.geom_id.data.size(), 64u * 48);
+    // the pixels are the submitted frame's (Frame: geom id = index)
+    const int index = f.geom_id.data[0];
+    seen.push_back(index);
+    EXPECT_EQ(f.rgb.data, Frame("front", index, 64, 48).rgb.data);
+    EXPECT_FLOAT_EQ(f.depth_m.data[5], 1.0f + 0.001f * static_cast<float>(index));
+  }
+  std::sort(seen.begin(), seen.end());
+  for (int i = 0; i < kFrames; ++i) EXPECT_EQ(seen[i], i);
 }
 
 }  // namespace

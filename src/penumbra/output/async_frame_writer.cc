@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <thread>
+
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -12,18 +15,25 @@ void AsyncFrameWriterOptions::ValidateOrThrow() const {
     throw ConfigError("", 0, "output.queue_capacity",
                       fmt::format("got {}; expected >= 1", queue_capacity));
   }
-  if (num_threads < 1 || num_threads > 8) {
+  if (num_threads < 0 || num_threads > 8) {
     throw ConfigError("", 0, "output.writer_threads",
-                      fmt::format("got {}; expected 1..8", num_threads));
+                      fmt::format("got {}; expected 1..8, or 0 for half the cores", num_threads));
   }
   png.ValidateOrThrow();
+}
+
+int AsyncFrameWriterOptions::ResolvedThreads() const {
+  if (num_threads > 0) return num_threads;
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(cores / 2, 2, 8);
 }
 
 AsyncFrameWriter::AsyncFrameWriter(std::string output_dir, AsyncFrameWriterOptions options)
     : output_dir_(std::move(output_dir)), options_(std::move(options)) {
   options_.ValidateOrThrow();
-  workers_.reserve(options_.num_threads);
-  for (int i = 0; i < options_.num_threads; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+  const int threads = options_.ResolvedThreads();
+  workers_.reserve(threads);
+  for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { WorkerLoop(); });
 }
 
 AsyncFrameWriter::~AsyncFrameWriter() {
@@ -120,7 +130,16 @@ void AsyncFrameWriter::WorkerLoop() {
     } catch (...) {
       failure = std::current_exception();
     }
-    // keep only what the frames.csv row needs
+    // keep only what the frames.csv row needs; the images go back to the caller, or are freed
+    CameraFrame images;
+    images.camera = job.frame.camera;
+    images.rgb = std::move(job.frame.rgb);
+    images.depth_m = std::move(job.frame.depth_m);
+    images.geom_id = std::move(job.frame.geom_id);
+    images.range_m = std::move(job.frame.range_m);
+    images.normal_O = std::move(job.frame.normal_O);
+    images.body_id = std::move(job.frame.body_id);
+    images.semantic_class = std::move(job.frame.semantic_class);
     job.frame.rgb = {};
     job.frame.depth_m = {};
     job.frame.geom_id = {};
@@ -128,6 +147,7 @@ void AsyncFrameWriter::WorkerLoop() {
     job.frame.normal_O = {};
     job.frame.body_id = {};
     job.frame.semantic_class = {};
+    if (options_.on_written) options_.on_written(std::move(images));
 
     lock.lock();
     if (failure) {

@@ -27,8 +27,13 @@ namespace penumbra {
 struct AsyncFrameWriterOptions {
   /// frames submitted but not yet written (queued or being encoded) before Submit blocks.
   int queue_capacity = 8;
-  /// encoder/writer threads, 1..8.
-  int num_threads = 2;
+  /// encoder/writer threads, 1..8; 0 = ResolvedThreads's default (half the machine's cores,
+  /// 2 to 8): with a GPU renderer PNG encoding is most of a run's work (about 20 ms a 640x480
+  /// rgb+depth frame on one thread, docs/gpu.md "Where a run's time goes"). the files do not
+  /// depend on the count.
+  int num_threads = 0;
+  /// num_threads, or for 0 half of std::thread::hardware_concurrency() clamped to 2..8.
+  int ResolvedThreads() const;
   PngEncodeOptions png;
   /// called with each write error as it happens, on the worker thread (with the writer's
   /// lock held: do not call back into the writer), before Submit/Flush rethrow it; lets a
@@ -37,8 +42,12 @@ struct AsyncFrameWriterOptions {
   /// receives every image file written (output/camera_frame.h), on the worker threads; may
   /// be empty.
   CameraImageCallback on_image;
+  /// receives each frame back after its files were written (or failed), with its images, on
+  /// the worker thread and without the writer's lock, so that the caller can reuse the image
+  /// buffers (sinks/frame_buffer_pool.h); must not throw. may be empty (the images are freed).
+  std::function<void(CameraFrame&& frame)> on_written;
 
-  /// @throws ConfigError for a capacity < 1 or a thread count outside 1..8.
+  /// @throws ConfigError for a capacity < 1 or a thread count outside 0..8.
   void ValidateOrThrow() const;
 };
 

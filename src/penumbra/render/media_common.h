@@ -6,12 +6,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/media_scene_math.h"
 #include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {
-
-// kInv4Pi (1 / (4 pi)): render/media_scene_math.h.
 
 /// extinction coefficient sigma_t (1/m) of a homogeneous medium whose meteorological optical
 /// range is mor_m (m): MOR is the distance at which the transmittance of a collimated beam
@@ -24,14 +23,9 @@ inline double SigmaTFromMorM(double mor_m) { return std::log(20.0) / mor_m; }
 /// the MOR (m) of extinction sigma_t (1/m), the inverse of SigmaTFromMorM (+inf for 0).
 inline double MorMFromSigmaT(double sigma_t_per_m) { return std::log(20.0) / sigma_t_per_m; }
 
-/// Henyey-Greenstein phase function (Henyey and Greenstein, "Diffuse radiation in the
-/// galaxy", ApJ 93, 1941; Pharr, Jakob, Humphreys, PBR 4th ed., sec. 11.3.1), normalised
-/// over the sphere (1/sr): p(cos_theta) = (1 - g^2) / (4 pi (1 + g^2 + 2 g cos_theta)^1.5),
-/// where cos_theta = dot(wo, wi) with wo pointing back along the incoming ray (PBRT's
-/// convention), so g > 0 scatters forward.
-inline float HenyeyGreenstein(float cos_theta, float g) {
-  return HenyeyGreensteinPhase(cos_theta, g);
-}
+/// Henyey-Greenstein phase function: MediaPhaseHG (render/media_realtime_math.h, shared with
+/// the CUDA backend), with kInv4Pi.
+inline float HenyeyGreenstein(float cos_theta, float g) { return MediaPhaseHG(cos_theta, g); }
 
 /// samples wi from the Henyey-Greenstein distribution around wo (unit, pointing back along the
 /// incoming ray) with two uniform numbers in [0, 1); the pdf of wi is HenyeyGreenstein(dot(wo,

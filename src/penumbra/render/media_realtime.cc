@@ -3,6 +3,7 @@
 #include <emmintrin.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -66,11 +67,7 @@ Eigen::Array4f To4(const Eigen::Vector3f& v) { return Eigen::Array4f(v.x(), v.y(
 Float3 ToF3(const Eigen::Array4f& a) { return {a[0], a[1], a[2]}; }
 Eigen::Vector3f FromF3(const Float3& a) { return {a.x, a.y, a.z}; }
 
-// what a light-volume cell asks of a light's visibility: nothing (the light adds nothing
-// there), none (the light casts no shadows: seen), or its shadow ray's verdict.
-constexpr uint8_t kNone = 0, kLit = 1, kTrace = 2;
-
-// (*blocked)[i] = query.Occluded(rays[i]) for every i with want[i] == kTrace (others
+// (*blocked)[i] = query.Occluded(rays[i]) for every i with want[i] == kMediaRayTrace (others
 // untouched but sized): the noted rays gathered in order, in batches of kShadowRayBatch
 // spread over `pool`.
 void TraceShadowRays(const RayQuery& query, const std::vector<Ray>& rays,
@@ -79,7 +76,7 @@ void TraceShadowRays(const RayQuery& query, const std::vector<Ray>& rays,
   blocked->assign(rays.size(), 0);
   std::vector<size_t> traced;
   for (size_t i = 0; i < want.size(); ++i)
-    if (want[i] == kTrace) traced.push_back(i);
+    if (want[i] == kMediaRayTrace) traced.push_back(i);
   const int64_t batches =
       (static_cast<int64_t>(traced.size()) + kShadowRayBatch - 1) / kShadowRayBatch;
   ParallelForOrSerial(pool, batches, [&](int64_t b) {
@@ -93,18 +90,20 @@ void TraceShadowRays(const RayQuery& query, const std::vector<Ray>& rays,
   });
 }
 
-bool Inside(const AnalyticMedium& m, const Eigen::Vector3f& p) {
-  return !m.bounded ||
-         ((p.array() >= m.box_min.array()).all() && (p.array() <= m.box_max.array()).all());
-}
-
 }  // namespace
 
 void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
                           const RayQuery& scene, const Camera& camera, uint64_t frame_key,
                           const Eigen::Vector3f& bounds_center_W, double bounds_extent_m,
                           const Eigen::Vector3f& sky_ambient, const SkyIrradianceVolume* sky_volume,
-                          ThreadPool* pool) {
+                          ThreadPool* pool, bool device_volumes) {
+  using Clock = std::chrono::steady_clock;
+  auto ms_since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  build_times_ = BuildTimes();
+  device_build_ = MediaVolumesToBuild();
+  auto stage = Clock::now();
   media_ = &media;
   sky_ambient_ = sky_ambient;
   sky_volume_ = sky_volume != nullptr && !sky_volume->empty() ? sky_volume : nullptr;
@@ -118,6 +117,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     MediumPod pod = PodOf(m);
     const float k = m.falloff, zb = m.base;
     pod.h_cam = std::exp(-k * std::max(0.0f, h_cam_oz_ + 0.0f * 0.0f - zb));
+    pod.g = m.g;
     pods_.push_back(pod);
     grey_t_ = grey_t_ && m.sigma_t.x() == m.sigma_t.y() && m.sigma_t.y() == m.sigma_t.z();
   }
@@ -125,23 +125,24 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   const int nl = num_lights_;
   // the geometric visibility of light l from p takes one shadow ray where the light casts
   // shadows: each volume notes, per cell and light, whether it asks for the light's
-  // visibility (kLit: no ray, kTrace: rays[slot]), then the noted rays are traced in batches
+  // visibility (kMediaRayLit: no ray, kMediaRayTrace: rays[slot]), then the noted rays are
+  // traced in batches
   // (TraceShadowRays) and the cells finished with the verdicts.
   std::vector<Ray> rays;
   std::vector<uint8_t> want, blocked;
   auto note = [&](size_t slot, const Eigen::Vector3f& p, const LightSample& ls) {
     if (!ls.cast_shadow) {
-      want[slot] = kLit;
+      want[slot] = kMediaRayLit;
       return;
     }
     Ray& sr = rays[slot];
     sr.o = p;
     sr.d = ls.wi;
     sr.tmax = std::isinf(ls.distance) ? kInfView : ls.distance * (1.0f - 1e-4f);
-    want[slot] = kTrace;
+    want[slot] = kMediaRayTrace;
   };
   auto seen = [&](size_t slot) {
-    return want[slot] == kLit || (want[slot] == kTrace && blocked[slot] == 0);
+    return want[slot] == kMediaRayLit || (want[slot] == kMediaRayTrace && blocked[slot] == 0);
   };
 
   // grid light volumes.
@@ -178,7 +179,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       return Eigen::Vector3f(R_WG * (x_G - v.p_GW));
     };
     rays.assign(static_cast<size_t>(cells) * nl, Ray());
-    want.assign(static_cast<size_t>(cells) * nl, kNone);
+    want.assign(static_cast<size_t>(cells) * nl, kMediaRayNone);
     // the grid's transmittance to each light, and the shadow rays of the lit cells.
     ParallelForOrSerial(pool, cells, [&](int64_t c) {
       const Eigen::Vector3f p = centre(c);
@@ -222,6 +223,18 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
     });
   }
 
+  // every grid's light volume end to end (the shared build functions and HostView read them)
+  grid_pods_.clear();
+  grid_light_T_.clear();
+  for (const GridLight& gl : grid_light_) {
+    GridLightPod pod = gl.pod;
+    pod.offset = grid_light_T_.size();
+    grid_light_T_.insert(grid_light_T_.end(), gl.T.begin(), gl.T.end());
+    grid_pods_.push_back(pod);
+  }
+  build_times_.grid_light = ms_since(stage);
+  stage = Clock::now();
+
   // world light volume: transmittance to every light (all media), and for homogeneous media
   // also times the geometric visibility (their in-scatter).
   vol_ = LightVolume();
@@ -263,46 +276,6 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
         vol_.imax4[k] = static_cast<float>(std::max(vol_.r[k] - 2, 0));
       }
       const int cells = vol_.r[0] * vol_.r[1] * vol_.r[2];
-      vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
-      if (vol_.with_visibility) {
-        vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
-        rays.assign(static_cast<size_t>(cells) * nl, Ray());
-        want.assign(static_cast<size_t>(cells) * nl, kNone);
-      }
-      ParallelForOrSerial(pool, cells, [&](int64_t c) {
-        const int i = static_cast<int>(c % vol_.r[0]);
-        const int j = static_cast<int>((c / vol_.r[0]) % vol_.r[1]);
-        const int k = static_cast<int>(c / (static_cast<int64_t>(vol_.r[0]) * vol_.r[1]));
-        const Eigen::Vector3f p =
-            lo + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(vol_.cells_per_m);
-        for (int l = 0; l < nl; ++l) {
-          const size_t at = static_cast<size_t>(l) * cells + c;
-          LightSample ls;
-          if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
-            vol_.trans[at] = 0.0f;
-            if (vol_.with_visibility) vol_.vis[at] = 0.0f;
-            continue;
-          }
-          float T = media.analytic().empty()
-                        ? 1.0f
-                        : std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
-          for (size_t g = 0; g < grid_light_.size(); ++g)
-            T *= GridLightT(static_cast<int>(g), l, p, ls.wi, ls.distance);
-          vol_.trans[at] = T;
-          if (vol_.with_visibility && T > 1e-4f) note(static_cast<size_t>(c) * nl + l, p, ls);
-        }
-      });
-      // V Th Tgrid: the transmittance where the light is seen, else 0.
-      if (vol_.with_visibility) {
-        TraceShadowRays(scene, rays, want, &blocked, pool);
-        ParallelForOrSerial(pool, cells, [&](int64_t c) {
-          for (int l = 0; l < nl; ++l) {
-            const size_t at = static_cast<size_t>(l) * cells + c;
-            vol_.vis[at] = seen(static_cast<size_t>(c) * nl + l) ? vol_.trans[at] : 0.0f;
-          }
-        });
-      }
-      // the same values with the lights of a cell adjacent (LightTransmittances).
       vol_.stride = (nl + 3) / 4 * 4;
       for (int k = 0; k < 3; ++k) {
         cl_pod_.lo[k] = vol_.lo[k];
@@ -311,19 +284,81 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
         cl_pod_.r[k] = vol_.r[k];
       }
       cl_pod_.stride = vol_.stride;
-      vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
-      if (vol_.with_visibility) vol_.vis_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
-      for (int l = 0; l < nl; ++l) {
-        for (int c = 0; c < cells; ++c) {
-          const size_t at = static_cast<size_t>(c) * vol_.stride + l;
-          vol_.trans_cl[at] = vol_.trans[static_cast<size_t>(l) * cells + c];
-          if (vol_.with_visibility) vol_.vis_cl[at] = vol_.vis[static_cast<size_t>(l) * cells + c];
+      if (device_volumes) {
+        device_build_.light_volume = 1;
+        device_build_.with_visibility = vol_.with_visibility ? 1 : 0;
+      } else {
+        LightVolumeBuild b;
+        b.layout = cl_pod_;
+        b.num_lights = nl;
+        b.with_visibility = vol_.with_visibility ? 1 : 0;
+        b.lights = lights.pods().data();
+        b.media = pods_.data();
+        b.num_media = static_cast<int>(pods_.size());
+        b.grids = grid_pods_.data();
+        b.grid_light_T = grid_light_T_.data();
+        b.num_grids = static_cast<int>(grid_pods_.size());
+        vol_.trans.assign(static_cast<size_t>(nl) * cells, 1.0f);
+        if (vol_.with_visibility) {
+          vol_.vis.assign(static_cast<size_t>(nl) * cells, 1.0f);
+          rays.assign(static_cast<size_t>(cells) * nl, Ray());
+          want.assign(static_cast<size_t>(cells) * nl, kMediaRayNone);
+        }
+        // per cell and light the transmittance and what its visibility asks
+        // (LightVolumeCellLight), the shadow rays gathered
+        ParallelForOrSerial(pool, cells, [&](int64_t c) {
+          float p[3];
+          LightVolumeCellCentre(cl_pod_, c, p);
+          for (int l = 0; l < nl; ++l) {
+            float T, d[3], tmax;
+            const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
+            vol_.trans[static_cast<size_t>(l) * cells + c] = T;
+            if (!vol_.with_visibility) continue;
+            const size_t slot = static_cast<size_t>(c) * nl + l;
+            want[slot] = w;
+            if (w != kMediaRayTrace) continue;
+            Ray& sr = rays[slot];
+            sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
+            sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
+            sr.tmax = tmax;
+          }
+        });
+        // V Th Tgrid: the transmittance where the light is seen, else 0.
+        if (vol_.with_visibility) {
+          TraceShadowRays(scene, rays, want, &blocked, pool);
+          ParallelForOrSerial(pool, cells, [&](int64_t c) {
+            for (int l = 0; l < nl; ++l) {
+              const size_t at = static_cast<size_t>(l) * cells + c;
+              vol_.vis[at] = seen(static_cast<size_t>(c) * nl + l) ? vol_.trans[at] : 0.0f;
+            }
+          });
+        }
+        // the same values with the lights of a cell adjacent (LightTransmittances).
+        vol_.trans_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+        if (vol_.with_visibility)
+          vol_.vis_cl.assign(static_cast<size_t>(cells) * vol_.stride, 0.0f);
+        for (int l = 0; l < nl; ++l) {
+          for (int c = 0; c < cells; ++c) {
+            const size_t at = static_cast<size_t>(c) * vol_.stride + l;
+            vol_.trans_cl[at] = vol_.trans[static_cast<size_t>(l) * cells + c];
+            if (vol_.with_visibility)
+              vol_.vis_cl[at] = vol_.vis[static_cast<size_t>(l) * cells + c];
+          }
         }
       }
     }
   }
+  build_times_.light_volume = ms_since(stage);
+  stage = Clock::now();
   BuildFroxels(lights, camera, frame_key, pool);
-  BuildFogFroxels(lights, camera, frame_key, pool);
+  build_times_.grid_froxels = ms_since(stage);
+  stage = Clock::now();
+  BuildFogFroxels(lights, camera, frame_key, pool, device_volumes);
+  if (device_volumes && !fog_froxels_.inv_log_far.empty()) {
+    device_build_.fog = 1;
+    device_build_.frame_key = frame_key;
+  }
+  build_times_.fog_froxels = ms_since(stage);
 }
 
 void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camera,
@@ -363,9 +398,7 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
     fr.t1[c] = b;
     fr.slices_per_m[c] = std::min(Z / (b - a), 1e30f);
     // jitter of the slice samples from the column's centre pixel stream 2.
-    const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
-    Rng rng(HashKeys(HashKeys(frame_key, pixel), 2));
-    const float jitter = rng.Uniform();
+    const float jitter = FroxelColumnJitter(frame_key, uc, vc, W, 2);
     const float ds = (b - a) / Z;
     FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
     Eigen::Vector3f S = Eigen::Vector3f::Zero(), T = Eigen::Vector3f::Ones();
@@ -409,19 +442,8 @@ float RealtimeMedia::LookupFroxels(int u, int v, float t, Eigen::Array4f* S,
                           Eigen::Array4f::Zero().eval(), Eigen::Array4f(1, 1, 1, 0), S, T);
 }
 
-namespace {
-
-// boundary k of a light in-scatter column reaching t_far (FogSlice's boundaries).
-float FogBoundary(int k, float t_far) {
-  if (k == 0) return 0.0f;
-  return kFogFroxelNear *
-         std::pow(t_far / kFogFroxelNear, static_cast<float>(k - 1) / (kFogFroxelSlices - 1));
-}
-
-}  // namespace
-
 void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& camera,
-                                    uint64_t frame_key, ThreadPool* pool) {
+                                    uint64_t frame_key, ThreadPool* pool, bool device) {
   fog_froxels_ = FogFroxels();
   const MediaScene& media = *media_;
   if (media.analytic().empty() || lights.size() == 0) return;
@@ -434,90 +456,39 @@ void RealtimeMedia::BuildFogFroxels(const LightSampler& lights, const Camera& ca
   BuildAxisTables(W, kFogFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
   BuildAxisTables(H, kFogFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
   fr.inv_log_far.assign(columns, 1.0f / std::log(2.0f));
+  if (device) return;  // the layout only: the columns are the device's
   fr.S.assign(static_cast<size_t>(columns) * (Z + 1), Eigen::Array4f::Zero());
-  const int nm = static_cast<int>(media.analytic().size());
-  // a directional light's sample (u1 = u2 = 0.5) is the same at every point: taken once.
-  const int nl = lights.size();
-  std::vector<uint8_t> directional(nl, 0);
-  std::vector<LightSample> sun_sample(nl);
-  for (int j = 0; j < nl; ++j) {
-    if (lights.lights()[j].type != Light::Type::kDirectional) continue;
-    directional[j] = lights.Sample(j, Eigen::Vector3f::Zero(), 0.5f, 0.5f, &sun_sample[j]) ? 1 : 0;
+  // the shared column (media_build_math.h) over this frame's arrays
+  FogFroxelBuild<Eigen::Array4f> b;
+  b.media = pods_.data();
+  b.num_media = static_cast<int>(pods_.size());
+  b.lights = lights.pods().data();
+  b.num_lights = lights.size();
+  b.num_volume_lights = num_lights_;
+  b.vis_layout = cl_pod_;
+  b.vis_cl = vol_.with_visibility ? vol_.vis_cl.data() : nullptr;
+  b.grids = grid_pods_.data();
+  b.grid_light_T = grid_light_T_.data();
+  b.num_grids = static_cast<int>(grid_pods_.size());
+  const Froxels& gf = froxels_;
+  if (!gf.records.empty()) {
+    b.grid_t0 = gf.t0.data();
+    b.grid_t1 = gf.t1.data();
+    b.grid_slices_per_m = gf.slices_per_m.data();
+    b.grid_records = gf.records.data();
   }
+  const Eigen::Array4f zero = Eigen::Array4f::Zero(), unit(1, 1, 1, 0);
   auto column = [&](int64_t c) {
     const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
     const int uc = std::min(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
     const int vc = std::min(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
     const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
     const Eigen::Vector3f o = r.o, d = r.d.normalized();
-    // the slices reach where the media's transmittance falls to 1 % (or they end).
-    float t_far = 2 * kFogFroxelNear;
-    for (const AnalyticMedium& m : media.analytic()) {
-      float a, b;
-      if (!m.Interval(o, d, 0.0f, kInfView, &a, &b)) continue;
-      const double tt = m.InvertDensityIntegral(o.z(), d.z(), a, b, 4.6 / Mean3(m.sigma_t));
-      t_far = std::max(t_far, static_cast<float>(std::min(std::isfinite(tt) ? tt : b, 2000.0)));
-    }
-    t_far = std::min(t_far, 2000.0f);
-    fr.inv_log_far[c] = 1.0f / std::log(t_far / kFogFroxelNear);
-    const uint64_t pixel = static_cast<uint64_t>(vc) * static_cast<uint64_t>(W) + uc;
-    Rng rng(HashKeys(HashKeys(frame_key, pixel), 3));
-    const float jitter = rng.Uniform();
-    const Eigen::Vector3f wo = -d;
-    Eigen::Array4f* rec = fr.S.data() + static_cast<size_t>(c) * (Z + 1);
-    Eigen::Vector3f S = Eigen::Vector3f::Zero();
-    float boundary[Z + 1];
-    for (int k = 0; k <= Z; ++k) boundary[k] = FogBoundary(k, t_far);
-    // per medium at the slice point: inside it, and its relative density (the same for every
-    // light).
-    std::vector<float> density(nm);
-    std::vector<uint8_t> inside(nm);
-    for (int k = 0; k < Z; ++k) {
-      const float lo = boundary[k], hi = boundary[k + 1];
-      const float t = lo + jitter * (hi - lo);
-      const Eigen::Vector3f x = o + t * d;
-      for (int i = 0; i < nm; ++i) {
-        const AnalyticMedium& m = media.analytic()[i];
-        inside[i] = Inside(m, x);
-        if (inside[i]) density[i] = m.Density(x.z());
-      }
-      Eigen::Vector3f Ls = Eigen::Vector3f::Zero();
-      // the visibility of every light with a volume in one lookup where x is in the volume.
-      float vis_all[kMaxVolumeLights];
-      const bool located =
-          vol_.with_visibility && CellLightsLookupSse(vol_.vis_cl.data(), x, vis_all);
-      for (int j = 0; j < lights.size(); ++j) {
-        // a light without visibility here adds nothing: skip its sample.
-        if (located && j < num_lights_ && !(vis_all[j] > 0)) continue;
-        LightSample ls;
-        if (directional[j]) {
-          ls = sun_sample[j];
-        } else if (!lights.Sample(j, x, 0.5f, 0.5f, &ls)) {
-          continue;
-        }
-        const float vis =
-            located && j < num_lights_ ? vis_all[j] : FogVisibility(j, x, ls.wi, ls.distance);
-        if (!(vis > 0)) continue;
-        const float cos_t = wo.dot(ls.wi);
-        Eigen::Vector3f ph = Eigen::Vector3f::Zero();
-        for (int i = 0; i < nm; ++i) {
-          if (!inside[i]) continue;
-          const AnalyticMedium& m = media.analytic()[i];
-          ph += m.sigma_s * (density[i] * HenyeyGreenstein(cos_t, m.g));
-        }
-        Ls += ls.E.cwiseProduct(ph) * vis;
-      }
-      if (Ls.maxCoeff() > 0) {
-        Eigen::Vector3f T_cam = Exp(-media.AnalyticOpticalDepth(o, d, 0, t));
-        if (!froxels_.records.empty()) {
-          Eigen::Array4f S_g, T_g;
-          LookupFroxels(uc, vc, t, &S_g, &T_g);
-          T_cam = T_cam.cwiseProduct(T_g.head<3>().matrix());
-        }
-        S += T_cam.cwiseProduct(Ls) * (hi - lo);
-      }
-      rec[k + 1] = To4(S);
-    }
+    const MediaColumns grid_cols =
+        gf.records.empty() ? MediaColumns{} : PixelColumns(gf, uc, vc, kFroxelBlock);
+    FogFroxelColumn(b, o.data(), d.data(), FroxelColumnJitter(frame_key, uc, vc, W, 3), grid_cols,
+                    zero, unit, &fr.inv_log_far[c],
+                    reinterpret_cast<float*>(fr.S.data() + static_cast<size_t>(c) * (Z + 1)));
   };
   ParallelForOrSerial(pool, columns, column);
 }
@@ -542,15 +513,16 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
   auto rgb4 = [](const Eigen::Array4f& a) { return Rgb4{a[0], a[1], a[2], a[3]}; };
   const FogFroxels& ff = fog_froxels_;
   arrays->fog_records.clear();
-  if (!ff.S.empty()) {
+  if (ff.nx > 0) {
+    // the layout; the records unless left to a device (device_build().fog)
     arrays->fog_records.resize(ff.S.size());
     for (size_t i = 0; i < ff.S.size(); ++i) arrays->fog_records[i] = rgb4(ff.S[i]);
     m.fog_nx = ff.nx;
     m.fog_ny = ff.ny;
     m.width = static_cast<int>(ff.ax.size());
     m.height = static_cast<int>(ff.ay.size());
-    m.fog_S = arrays->fog_records.data();
-    m.fog_inv_log_far = ff.inv_log_far.data();
+    m.fog_S = ff.S.empty() ? nullptr : arrays->fog_records.data();
+    m.fog_inv_log_far = ff.S.empty() ? nullptr : ff.inv_log_far.data();
     m.fog_ax = ff.ax.data();
     m.fog_ay = ff.ay.data();
     m.fog_ax_half = ff.ax_half.data();
@@ -558,7 +530,7 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
   }
   if (vol_.active) {
     m.light_volume = cl_pod_;
-    m.light_trans = vol_.trans_cl.data();
+    m.light_trans = vol_.trans_cl.empty() ? nullptr : vol_.trans_cl.data();
     m.num_volume_lights = num_lights_;
   }
   const Froxels& fr = froxels_;
@@ -580,15 +552,9 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
     m.grid_ax_half = fr.ax_half.data();
     m.grid_ay_half = fr.ay_half.data();
   }
-  // the grids' light volumes end to end, each pod's offset where its own starts
-  arrays->grid_light_T.clear();
-  arrays->grid_pods.clear();
-  for (const GridLight& gl : grid_light_) {
-    GridLightPod pod = gl.pod;
-    pod.offset = arrays->grid_light_T.size();
-    arrays->grid_light_T.insert(arrays->grid_light_T.end(), gl.T.begin(), gl.T.end());
-    arrays->grid_pods.push_back(pod);
-  }
+  // the grids' light volumes end to end, each pod's offset where its own starts (Build's)
+  arrays->grid_light_T = grid_light_T_;
+  arrays->grid_pods = grid_pods_;
   if (!arrays->grid_pods.empty()) {
     m.num_grids = static_cast<int>(arrays->grid_pods.size());
     m.grids = arrays->grid_pods.data();

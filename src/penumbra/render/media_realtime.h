@@ -53,6 +53,10 @@
 // volume; outside it: closed form for the homogeneous media times the grid's light volume at
 // the shadow ray's entry into the grid box).
 // random numbers: the froxel columns' jitter, from their centre pixels' streams 2 and 3.
+// written once for a device (render/media_build_math.h, branch gpu15): the world light volume's
+// cells (LightVolumeCellLight) and the fog froxels' columns (FogFroxelColumn); Build's
+// device_volumes leaves those two to the CUDA backend's kernels, which run the same functions
+// with the shadow rays traced in the cell's thread.
 
 #include <Eigen/Core>
 #include <array>
@@ -62,6 +66,7 @@
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_build_math.h"
 #include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/ray_query.h"
@@ -132,11 +137,25 @@ class RealtimeMedia {
   /// Embree RayScene, whose Occluded is rtcOccluded1 ray by ray; the CUDA backend its
   /// CudaRayQuery), in batches of kShadowRayBatch; the cells and the batches are spread over
   /// `pool` (may be null). the froxel volume is built for `camera`; `frame_key` is
-  /// FrameContext::FrameKey().
+  /// FrameContext::FrameKey(). the world light volume's cells and the fog froxels are made by
+  /// render/media_build_math.h's LightVolumeCellLight and FogFroxelColumn. `device_volumes`:
+  /// those two are left to a device (their layouts set, their arrays empty: device_build() says
+  /// which; the CUDA backend's kernels run the same functions); the queries that read them
+  /// (LightTransmittance, LightTransmittances, LightVisibilities, IntegrateView, PrepareQuad)
+  /// must then not be called, HostView's pointers to them are null.
   void Build(const MediaScene& media, const LightSampler& lights, const RayQuery& scene,
              const Camera& camera, uint64_t frame_key, const Eigen::Vector3f& bounds_center_W,
              double bounds_extent_m, const Eigen::Vector3f& sky_ambient,
-             const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
+             const SkyIrradianceVolume* sky_volume, ThreadPool* pool, bool device_volumes = false);
+  /// what the last Build left to a device (all 0 unless device_volumes).
+  const MediaVolumesToBuild& device_build() const { return device_build_; }
+  /// milliseconds of the last Build's stages (host clock; benchmarks): the grids' light volumes
+  /// (their march, shadow rays and sources), the world light volume (cells and shadow rays),
+  /// the grid froxels, the fog froxels.
+  struct BuildTimes {
+    double grid_light = 0, light_volume = 0, grid_froxels = 0, fog_froxels = 0;
+  };
+  const BuildTimes& build_times() const { return build_times_; }
 
   /// rgb transmittance from p_W towards light j (unit direction wi, distance dist, +inf for
   /// directional lights) through every medium.
@@ -254,8 +273,9 @@ class RealtimeMedia {
   /// light in-scatter of the homogeneous media from the camera to distance t, pixel (u, v)
   /// (rgb in lanes 0..2).
   Eigen::Array4f LookupFogFroxels(int u, int v, float t) const;
+  // the fog froxels' layout and, unless `device`, their columns (FogFroxelColumn)
   void BuildFogFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
-                       ThreadPool* pool);
+                       ThreadPool* pool, bool device);
   void BuildFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
                     ThreadPool* pool);
 
@@ -281,6 +301,12 @@ class RealtimeMedia {
   bool grey_t_ = false;
   int num_lights_ = 0;  // lights with volumes
   std::vector<GridLight> grid_light_;
+  // every grid's pod (offset into grid_light_T_) and light volume end to end (the shared build
+  // functions and HostView read them)
+  std::vector<GridLightPod> grid_pods_;
+  std::vector<float> grid_light_T_;
+  MediaVolumesToBuild device_build_;
+  BuildTimes build_times_;
   LightVolume vol_;
   Froxels froxels_;
   FogFroxels fog_froxels_;

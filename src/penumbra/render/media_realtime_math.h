@@ -166,6 +166,7 @@ struct MediumPod {
   int bounded = 0;               ///< confined to [box_min, box_max]
   float box_min[3] = {0, 0, 0}, box_max[3] = {0, 0, 0};
   float h_cam = 1;  ///< h(0) for rays from the camera's height (DensityIntegralF's h_0)
+  float g = 0;      ///< Henyey-Greenstein asymmetry (the fog froxels' build reads it)
 };
 
 /// one piece of a height-fog ray in double precision: density h_s exp(-rate (t - s)) on
@@ -174,6 +175,19 @@ struct MediumPod {
 struct MediaPiece {
   double s, e, h_s, rate;
 };
+
+/// 1 / (4 pi).
+constexpr float kInv4Pi = 0.0795774715459476679f;
+
+/// Henyey-Greenstein phase function (Henyey and Greenstein, "Diffuse radiation in the
+/// galaxy", ApJ 93, 1941; Pharr, Jakob, Humphreys, PBR 4th ed., sec. 11.3.1), normalised
+/// over the sphere (1/sr): p(cos_theta) = (1 - g^2) / (4 pi (1 + g^2 + 2 g cos_theta)^1.5),
+/// where cos_theta = dot(wo, wi) with wo pointing back along the incoming ray (PBRT's
+/// convention), so g > 0 scatters forward. (media_common.h's HenyeyGreenstein.)
+PB_HOST_DEVICE inline float MediaPhaseHG(float cos_theta, float g) {
+  const float denom = 1.0f + g * g + 2.0f * g * cos_theta;
+  return kInv4Pi * (1.0f - g * g) / (denom * sqrtf(pbm::Max(denom, 1e-12f)));
+}
 
 /// x is +inf or -inf (double).
 PB_HOST_DEVICE inline bool MediaIsInfD(double x) {

@@ -5,8 +5,8 @@
 // and SamplePhase, GridVolume's DensityAt / EmissionAt / Interval), and the CUDA backend's path
 // kernels (render/cuda/path_shading.h) call the same definitions over device copies of the
 // arrays (branch gpu14).
-//  - HenyeyGreensteinPhase / SampleHenyeyGreensteinDir: the phase function and its sampling
-//    (render/media_common.h's HenyeyGreenstein and SampleHenyeyGreenstein call them);
+//  - SampleHenyeyGreensteinDir: the Henyey-Greenstein phase function's sampling (render/
+//    media_common.h's SampleHenyeyGreenstein calls it; the function itself is MediaPhaseHG);
 //  - MediumHeightDensity: a homogeneous medium's relative density at a height
 //    (AnalyticMedium::Density);
 //  - MediaGridPod, MediaGridCell / MediaGridDensity / MediaGridEmission / MediaGridInterval: a
@@ -33,21 +33,10 @@
 
 namespace penumbra {
 
-/// 1 / (4 pi).
-constexpr float kInv4Pi = 0.0795774715459476679f;
-
-/// Henyey-Greenstein phase function (Henyey and Greenstein, "Diffuse radiation in the galaxy",
-/// ApJ 93, 1941; Pharr, Jakob, Humphreys, PBR 4th ed., sec. 11.3.1), normalised over the sphere
-/// (1/sr): p(cos_theta) = (1 - g^2) / (4 pi (1 + g^2 + 2 g cos_theta)^1.5), where cos_theta =
-/// dot(wo, wi) with wo pointing back along the incoming ray (PBRT's convention), so g > 0
-/// scatters forward.
-PB_HOST_DEVICE inline float HenyeyGreensteinPhase(float cos_theta, float g) {
-  const float denom = 1.0f + g * g + 2.0f * g * cos_theta;
-  return kInv4Pi * (1.0f - g * g) / (denom * sqrtf(pbm::Max(denom, 1e-12f)));
-}
+// kInv4Pi and the Henyey-Greenstein phase function MediaPhaseHG: render/media_realtime_math.h.
 
 /// samples wi (unit) from the Henyey-Greenstein distribution around wo (unit, pointing back
-/// along the incoming ray) with two uniform numbers in [0, 1); *pdf = HenyeyGreensteinPhase(
+/// along the incoming ray) with two uniform numbers in [0, 1); *pdf = MediaPhaseHG(
 /// dot(wo, wi), g) (PBR 4th ed., eq. 11.17 and SampleHenyeyGreenstein; the orthonormal basis
 /// of Duff et al., JCGT 2017).
 PB_HOST_DEVICE inline Float3 SampleHenyeyGreensteinDir(const Float3& wo, float g, float u1,
@@ -74,7 +63,7 @@ PB_HOST_DEVICE inline Float3 SampleHenyeyGreensteinDir(const Float3& wo, float g
   const Float3 wi = bsdf_detail::Normalized(Float3{kt * t.x + kb * bt.x + cos_t * w.x,
                                                    kt * t.y + kb * bt.y + cos_t * w.y,
                                                    kt * t.z + kb * bt.z + cos_t * w.z});
-  *pdf = HenyeyGreensteinPhase(EigenDot(wo, wi), g);
+  *pdf = MediaPhaseHG(EigenDot(wo, wi), g);
   return wi;
 }
 
@@ -262,7 +251,7 @@ PB_HOST_DEVICE inline MediumPointPod MediaPointAt(const MediaSceneView& s, const
 PB_HOST_DEVICE inline float MediaPhase(const MediumPointPod& mp, float cos_theta) {
   float sum = 0, wsum = 0;
   for (int i = 0; i < mp.lobes; ++i) {
-    sum += mp.weight[i] * HenyeyGreensteinPhase(cos_theta, mp.g[i]);
+    sum += mp.weight[i] * MediaPhaseHG(cos_theta, mp.g[i]);
     wsum += mp.weight[i];
   }
   return wsum > 0 ? sum / wsum : kInv4Pi;

@@ -111,6 +111,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
                 w.on_error = [this](std::exception_ptr e) {
                   if (report_error_) report_error_(e);
                 };
+                w.on_written = [this](CameraFrame&& f) { buffers_.Return(std::move(f)); };
                 return w;
               }()),
       schedule_(timestep_sec),
@@ -119,6 +120,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
   selected_.assign(scene.cameras.size(), options_.cameras.empty() ? 1 : 0);
   warned_black_.assign(scene.cameras.size(), 0);
   rendered_once_.assign(scene.cameras.size(), 0);
+  scratch_.resize(scene.cameras.size());
   for (const std::string& name : options_.cameras) {
     const int c = scene.FindCamera(name);
     if (c < 0) {
@@ -245,7 +247,15 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   const CameraSpec& spec = scene_.cameras[p.camera];
   const Pose X0 = CameraPoseInWorld(spec, *p.start);
   const Pose X1 = end ? CameraPoseInWorld(spec, *end) : X0;
+  // the images of this camera's earlier frames, overwritten in place (FrameBufferPool)
   CameraImages img;
+  CameraImages& scratch = scratch_[p.camera];
+  img.truth.radiance = std::move(scratch.truth.radiance);
+  img.truth.rgb = std::move(scratch.truth.rgb);
+  img.truth.depth_m = std::move(scratch.truth.depth_m);
+  img.radiance = std::move(scratch.radiance);
+  scratch = CameraImages();
+  buffers_.Take(spec.name, &img);
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
   const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -254,7 +264,15 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
     rendered_once_[p.camera] = 1;
     render_first_frames_sec_ += sec;
   }
+  // what the writer does not get stays for the next frame
+  const auto keep_scratch = [&] {
+    scratch.truth.radiance = std::move(img.truth.radiance);
+    scratch.truth.rgb = std::move(img.truth.rgb);
+    scratch.truth.depth_m = std::move(img.truth.depth_m);
+    scratch.radiance = std::move(img.radiance);
+  };
   if (img.stopped) {
+    keep_scratch();
     // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
     spdlog::info(
         "camera '{}': frame {} at {:.6g} s was being rendered when the run was stopped; "
@@ -282,6 +300,7 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   cf.normal_O = std::move(img.truth.normal_O);
   cf.body_id = std::move(img.truth.body_id);
   cf.semantic_class = std::move(img.truth.semantic_class);
+  keep_scratch();
   ++frames_;
   if (options_.on_frame) {
     auto shared = std::make_shared<const CameraFrame>(cf);

@@ -51,6 +51,7 @@
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/sensors/camera_imager.h"
 #include "penumbra/sensors/sensor_schedule.h"
+#include "penumbra/sinks/frame_buffer_pool.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -173,6 +174,9 @@ class CameraSink : public Sink {
   ViewerEffects effects_;
   CameraSinkOptions options_;
   std::function<void(std::exception_ptr)> report_error_;
+  // the written frames' images, reused by the next frames (declared before the writer, whose
+  // threads return frames into it until the writer is destroyed)
+  FrameBufferPool buffers_;
   AsyncFrameWriter writer_;
   // loop thread
   SensorSchedule schedule_;
@@ -182,6 +186,9 @@ class CameraSink : public Sink {
   std::optional<Capture> capture_;
   // render thread
   std::vector<CameraImager> imagers_;
+  // per scene camera: the last frame's images that are not handed to the writer (the renderer's
+  // radiance, rgb and depth, the imager's radiance), reused by the camera's next frame
+  std::vector<CameraImages> scratch_;
   std::vector<char> warned_black_;  // per scene camera: its black-frame warning was logged
   std::vector<double> span_;
   std::deque<Pending> pending_;

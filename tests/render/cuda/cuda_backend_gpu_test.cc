@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "path_parity.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
@@ -217,10 +218,10 @@ TEST(CudaBackend, PrimaryCopyVariantsWriteTheSameBytes) {
   }
 }
 
-// the pathtraced tier's frames render on the GPU (path_shading.h), emissive geoms included, but
-// not those of a camera with lens distortion (PathNotOnGpu): those go to the CPU renderer inside
-// the backend.
-TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessDistorted) {
+// the pathtraced tier's frames render on the GPU (path_shading.h), emissive geoms included, and
+// those of a camera with lens distortion and a rolling shutter over a moving camera too (its
+// ray tables, JitteredCameraRay): none goes to the CPU renderer inside the backend.
+TEST(CudaBackend, PathtracedFramesWithDistortedOrMovingCamerasRenderOnTheGpu) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("default.yaml");
   RenderSettings settings;
@@ -233,7 +234,7 @@ TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessDistorted) {
   view.intrinsics = CameraIntrinsics::FromFovy(64, 48, 60);
   view.outputs[ImageKind::kRgb] = true;
   CameraView distorted = view;
-  distorted.intrinsics.k1 = 0.1;
+  path_parity::DistortAndMove(&distorted);
   SceneDescription emissive = session->scene();
   for (Material& m : emissive.materials) m.emission = Eigen::Vector3f(1, 1, 1);
   const SceneDescription* scenes[] = {&session->scene(), &emissive};
@@ -245,8 +246,8 @@ TEST(CudaBackend, PathtracedFramesRenderOnTheGpuUnlessDistorted) {
     gpu->Render(snap, distorted, &f);
     EXPECT_EQ(f.rgb.data.size(), 64u * 48u * 3u);
     const auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
-    EXPECT_EQ(g->gpu_frames(), 1);
-    EXPECT_EQ(g->cpu_frames(), 1);
+    EXPECT_EQ(g->gpu_frames(), 2);
+    EXPECT_EQ(g->cpu_frames(), 0);
   }
 }
 

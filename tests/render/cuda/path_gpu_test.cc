@@ -1,5 +1,6 @@
 // the pathtraced tier on the GPU (ctest label `gpu`) against the CPU backend on the bundled
-// default and house worlds, and the default room with emissive lamp diffusers (issue 35, item 7:
+// default and house worlds, the default room with emissive lamp diffusers and with a distorted,
+// moving camera (issue 35, item 7:
 // pathtraced at 1024 spp, mean relative difference
 // <= 1 %): the first camera at 128x96 after 1 s, 1024 samples per pixel, 4 bounces, no denoiser;
 // the radiance's mean relative difference at the scale of 8x8 blocks and of the image mean
@@ -26,16 +27,20 @@ class PathtracedGpu : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(PathtracedGpu, MatchesCpuBackendAt1024SppAndRepeatsBitForBit) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  // "default-emissive.yaml": the default room with its lamp diffusers glowing (path_parity.h)
+  // "default-emissive.yaml": the default room with its lamp diffusers glowing;
+  // "default-distorted-moving.yaml": its camera with lens distortion and a rolling shutter over
+  // a moving, turning camera (path_parity.h)
   const bool emissive = GetParam() == "default-emissive.yaml";
+  const bool distorted = GetParam() == "default-distorted-moving.yaml";
   const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulated(emissive ? "default.yaml" : GetParam());
+      realtime_parity::LoadSimulated(emissive || distorted ? "default.yaml" : GetParam());
   SceneDescription scene = session->scene();
   if (emissive) {
     ASSERT_TRUE(path_parity::MakeDiffusersEmissive(&scene));
   }
   const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 128, 96);
+  CameraView view = realtime_parity::RgbDepthView(scene, snap, 128, 96);
+  if (distorted) path_parity::DistortAndMove(&view);
   RenderSettings cpu_settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 1024);
   cpu_settings.threads = 0;
   const RenderSettings gpu_settings =
@@ -64,7 +69,8 @@ TEST_P(PathtracedGpu, MatchesCpuBackendAt1024SppAndRepeatsBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, PathtracedGpu,
-                         ::testing::Values("default.yaml", "house.yaml", "default-emissive.yaml"));
+                         ::testing::Values("default.yaml", "house.yaml", "default-emissive.yaml",
+                                           "default-distorted-moving.yaml"));
 
 // the pathtraced tier's media on the GPU (branch gpu14; path_shading.h's TracePath<true> over
 // the shared formulas of render/media_scene_math.h): worlds/effects/fog.yaml (homogeneous fog,

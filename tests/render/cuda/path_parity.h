@@ -8,6 +8,7 @@
 
 #include "penumbra/core/image.h"
 #include "penumbra/render/render_settings.h"
+#include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
 
 namespace penumbra::path_parity {
@@ -34,6 +35,24 @@ inline bool MakeDiffusersEmissive(SceneDescription* scene) {
     return true;
   }
   return false;
+}
+
+/// `view` with lens distortion (k1 -0.28, k2 0.07, p1 0.002) and a rolling shutter over a
+/// camera that moves 0.15 m sideways and turns 4 degrees about its vertical axis within the
+/// frame: the camera the CPU's Camera::GenerateRay undistorts and poses per row exactly, and the
+/// GPU's path traces from its ray tables (JitteredCameraRay).
+inline void DistortAndMove(CameraView* view) {
+  view->intrinsics.k1 = -0.28;
+  view->intrinsics.k2 = 0.07;
+  view->intrinsics.p1 = 0.002;
+  view->motion.end_sec = 0.03;
+  view->motion.time_sec = 0.0;
+  view->motion.line_time_sec = 0.03 / view->intrinsics.height;
+  view->motion.X_WO_end = view->X_WO;
+  view->motion.X_WO_end.translation() += view->X_WO.linear() * Eigen::Vector3d(0.15, 0, 0);
+  view->motion.X_WO_end.linear() =
+      view->X_WO.linear() *
+      Eigen::AngleAxisd(4.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
 }
 
 /// the mean relative difference of two radiance images (H x W x 3) of one size, at the scale of

@@ -7,11 +7,16 @@
 // same bits twice; the same path without the media (their light transmittances and view pass)
 // is far from the CPU's image.
 // the media's volumes are built by RealtimeFrameData::PrepareMedia (the CPU's RealtimeMedia over
-// the host BVH's RayQuery). PENUMBRA_PARITY_SIZE=WxH changes the bundled worlds' 160x120 (e.g.
-// 640x480, or an odd size whose last quads are cut by the image's edge). no GPU needed.
+// the host BVH's RayQuery), the world light volume and the fog froxels by the kernels' functions
+// on the host (BuildMediaVolumesOnHost, branch gpu15), which must give the host build's light
+// volume bit for bit and its fog froxels up to the column rays' rounding. PENUMBRA_PARITY_SIZE=WxH
+// changes the bundled worlds' 160x120 (e.g. 640x480, or an odd size whose last quads are cut by the
+// image's edge). no GPU needed.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -137,6 +142,75 @@ TEST(RealtimeHostPathMediaFrames, MediaRaysAndShadingPathsGiveTheSameBits) {
   cuda::RenderRealtimeOnHost(data, bvh, &pool, &evaluated, /*stored_surface=*/false);
   EXPECT_EQ(stored.radiance.data, evaluated.radiance.data);
   EXPECT_EQ(stored.radiance.data, own.radiance.data);
+}
+
+// the world light volume and the fog froxels built as the device builds them (RealtimeFrameData's
+// device_media, BuildMediaVolumesOnHost: MediaLightVolumeCell with its shadow rays traced in the
+// cell, MediaFogColumn) against RealtimeMedia::Build's on the host (set_device_media(false)):
+// the light volume's transmittances bit for bit (the same functions and shadow rays), the fog
+// froxels within 1e-4 of their largest value (the column rays are PrimaryRay's, not
+// Camera::GenerateRay's), the two frames' rgb within 50 dB; fog (visibility rays), smoke (grids
+// only) and the major preset (both).
+TEST(RealtimeHostPathMediaFrames, DeviceBuiltVolumesMatchTheHostBuild) {
+  for (const char* file :
+       {"effects/fog.yaml", "effects/smoke_plume.yaml", "effects/adversity_major.yaml"}) {
+    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const SceneDescription& scene = session->scene();
+    const WorldSnapshot snap = session->sim().Snapshot();
+    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
+    const std::shared_ptr<const EffectsFrame> fx =
+        session->effects().Evaluate(snap, view.X_WO.translation());
+    ASSERT_TRUE(fx && (!fx->homogeneous_media.empty() || !fx->grid_media.empty())) << file;
+    cuda::BvhScene bvh(scene);
+    bvh.Update(snap);
+    ThreadPool pool(0);
+    cuda::RealtimeFrameData data(scene, RenderSettings());
+    EXPECT_TRUE(data.device_media());
+    data.set_device_media(false);
+    data.Prepare(snap, view, &pool, fx.get());
+    const cuda::RealtimeFrameView host = data.View(bvh.view(), nullptr);
+    ASSERT_EQ(host.media_build.light_volume + host.media_build.fog, 0) << file;
+    const CellLightsPod& v = host.media.light_volume;
+    const size_t cells = static_cast<size_t>(v.r[0]) * v.r[1] * v.r[2] * v.stride;
+    const std::vector<float> host_trans(host.media.light_trans,
+                                        host.media.light_trans + (v.stride > 0 ? cells : 0));
+    const size_t fog_n = static_cast<size_t>(host.media.fog_nx) * host.media.fog_ny;
+    std::vector<Rgb4> host_fog;
+    if (host.media.fog_S != nullptr)
+      host_fog.assign(host.media.fog_S, host.media.fog_S + fog_n * (kFogFroxelSlices + 1));
+    RenderedFrame host_frame;
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &host_frame, true);
+
+    data.set_device_media(true);
+    data.Prepare(snap, view, &pool, fx.get());
+    cuda::RealtimeFrameView dev = data.View(bvh.view(), nullptr);
+    EXPECT_EQ(dev.media_build.light_volume, v.stride > 0 ? 1 : 0) << file;
+    EXPECT_EQ(dev.media_build.fog, host.media.fog_S != nullptr ? 1 : 0) << file;
+    EXPECT_EQ(dev.media.light_trans, nullptr) << file;
+    EXPECT_EQ(dev.media.fog_S, nullptr) << file;
+    cuda::MediaVolumeArrays built;
+    cuda::BuildMediaVolumesOnHost(&dev, &pool, &built);
+    EXPECT_EQ(built.trans, host_trans) << file;
+    ASSERT_EQ(built.fog.size(), host_fog.size()) << file;
+    float peak = 0, worst = 0;
+    for (size_t i = 0; i < host_fog.size(); ++i) {
+      const Rgb4& a = host_fog[i];
+      const Rgb4& b = built.fog[i];
+      peak = std::max({peak, a.x, a.y, a.z});
+      worst = std::max({worst, std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+    }
+    RenderedFrame dev_frame;
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &dev_frame, true);
+    const double psnr = realtime_parity::Psnr(host_frame.rgb, dev_frame.rgb);
+    std::printf(
+        "%s: light volume %zu values (%s), fog froxels %zu records, largest difference %.3g of "
+        "peak %.3g; rgb PSNR device-built against host-built %.2f dB\n",
+        file, host_trans.size(), built.trans == host_trans ? "equal" : "DIFFERENT", host_fog.size(),
+        worst, peak, psnr);
+    EXPECT_LE(worst, 1e-4f * peak) << file;
+    EXPECT_GE(psnr, 50.0) << file;
+    EXPECT_EQ(host_frame.depth_m.data, dev_frame.depth_m.data) << file;
+  }
 }
 
 }  // namespace

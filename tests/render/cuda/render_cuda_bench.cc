@@ -24,6 +24,15 @@
 // depth+seg and then realtime rgb+depth (with each realtime stage's GPU time), pinned and
 // pageable copies, the kernels alone and the CPU backend; then the device-to-host copy rates,
 // pinned and pageable.
+// --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
+// default 640x480), Render() of rgb+depth with the media volumes' world light volume and fog
+// froxels built by the device's kernels (the default since branch gpu15) and on the host
+// (RealtimeFrameData::set_device_media(false), as before), interleaved three times: frames/s,
+// the host's preparation (CudaRenderer::last_prepare_ms), RealtimeMedia::Build's host time and
+// its stages (RealtimeMedia::BuildTimes), the device's first stage by CUDA events (the media's
+// uploads, with device-built volumes their kernels, and the geometry kernel:
+// RealtimeStageTimes::geometry); whether two device-built renders give the same bits
+// and the rgb PSNR of the device-built frame against the host-built one.
 // --realtime [--size WxH]: the realtime tier's rgb+depth at WxH (default 640x480) in detail:
 // Render() with the sky terms on the device (default), on the host (the geometry's round trip
 // in 4 bands of rows and in 1; RealtimeKernelOptions::device_sky), with pageable copies, with
@@ -71,6 +80,7 @@
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
+#include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_realtime.h"
@@ -150,6 +160,98 @@ int PositiveArg(const std::string& s) {
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
   return end && *end == '\0' && v > 0 && v < (1 << 30) ? static_cast<int>(v) : 0;
+}
+
+// --media: the effects frames' media volumes built on the device and on the host (file comment)
+int MediaMain(const std::vector<std::string>& worlds, int width, int height, int frames) {
+  fmt::print(
+      "\n| world | size | media volumes built | frames/s | ms/frame | host preparation ms | "
+      "RealtimeMedia::Build ms | grid light volumes | world light volume | grid froxels | fog "
+      "froxels | device: uploads, media kernels and geometry ms |\n"
+      "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::vector<std::string> notes;
+  for (const std::string& file : worlds) {
+    const BenchWorld world = LoadBenchWorld(file);
+    const WorldSnapshot& snap = world.snap;
+    const SceneDescription& scene = world.session->scene();
+    const CameraSpec& cam = scene.cameras.front();
+    const std::string size = fmt::format("{}x{}", width, height);
+    CameraView view;
+    view.X_WO = CameraPoseInWorld(cam, snap);
+    view.intrinsics = CameraIntrinsics::FromFovy(width, height, cam.intrinsics.fovy_deg());
+    view.near_m = cam.near_m;
+    view.outputs[ImageKind::kRgb] = view.outputs[ImageKind::kDepth] = true;
+    const std::shared_ptr<const EffectsFrame> fx =
+        world.session->effects().Evaluate(snap, view.X_WO.translation());
+    if (!fx || (fx->homogeneous_media.empty() && fx->grid_media.empty())) {
+      notes.push_back(world.name + ": no media in the effects frame at 1 s");
+      continue;
+    }
+    RenderSettings gpu_settings;
+    gpu_settings.backend = RenderSettings::Backend::kCuda;
+    const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
+    auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+    RenderedFrame dev_a, dev_b, host_f;
+    gpu->Render(snap, fx.get(), view, &dev_a);
+    cuda::RealtimeFrameData& data = g->realtime_frame();
+    gpu->Render(snap, fx.get(), view, &dev_b);
+    data.set_device_media(false);
+    gpu->Render(snap, fx.get(), view, &host_f);
+    const bool repeat = dev_a.rgb.data == dev_b.rgb.data &&
+                        dev_a.radiance.data == dev_b.radiance.data &&
+                        dev_a.depth_m.data == dev_b.depth_m.data;
+    double se = 0;
+    for (size_t i = 0; i < dev_a.rgb.data.size(); ++i) {
+      const double e = static_cast<double>(dev_a.rgb.data[i]) - host_f.rgb.data[i];
+      se += e * e;
+    }
+    const double mse = se / std::max<size_t>(1, dev_a.rgb.data.size());
+    notes.push_back(fmt::format(
+        "{} {}: device-built volumes: two renders bit-identical (rgb, radiance, depth): {}; rgb "
+        "PSNR against the host-built frame {} ({} of {} bytes differ)",
+        world.name, size, repeat ? "yes" : "NO",
+        mse == 0 ? std::string("inf (equal)")
+                 : fmt::format("{:.2f} dB", 10 * std::log10(255.0 * 255.0 / mse)),
+        [&] {
+          size_t k = 0;
+          for (size_t i = 0; i < dev_a.rgb.data.size(); ++i)
+            k += dev_a.rgb.data[i] != host_f.rgb.data[i];
+          return k;
+        }(),
+        dev_a.rgb.data.size()));
+    for (int round = 0; round < 3; ++round) {
+      for (const bool device : {false, true}) {
+        data.set_device_media(device);
+        RenderedFrame f;
+        for (int i = 0; i < 3; ++i) gpu->Render(snap, fx.get(), view, &f);
+        double prepare = 0, build = 0, geometry = 0;
+        RealtimeMedia::BuildTimes st;
+        const auto t0 = Clock::now();
+        for (int i = 0; i < frames; ++i) {
+          gpu->Render(snap, fx.get(), view, &f);
+          prepare += g->last_prepare_ms();
+          build += data.media_build_ms();
+          geometry += g->device_realtime().last_stage_times().geometry;
+          const RealtimeMedia::BuildTimes& t = data.media_build_times();
+          st.grid_light += t.grid_light, st.light_volume += t.light_volume;
+          st.grid_froxels += t.grid_froxels, st.fog_froxels += t.fog_froxels;
+        }
+        const double s = std::chrono::duration<double>(Clock::now() - t0).count() / frames;
+        fmt::print(
+            "| {} | {} | {} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
+            "{:.3f} | {:.3f} |\n",
+            world.name, size,
+            device ? "device (light volume and fog froxels as kernels)" : "host (as before)", 1 / s,
+            1e3 * s, prepare / frames, build / frames, st.grid_light / frames,
+            st.light_volume / frames, st.grid_froxels / frames, st.fog_froxels / frames,
+            geometry / frames);
+      }
+    }
+    data.set_device_media(true);
+  }
+  for (const std::string& n : notes) fmt::print("\n{}", n);
+  fmt::print("\n");
+  return 0;
 }
 
 // --realtime: the realtime tier's Render() stages and kernel ablations (file comment)
@@ -544,7 +646,7 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
 int Main(int argc, char** argv) {
   int frames = 50;
   int width = 0, height = 0, sessions = 1;
-  bool parity = false, realtime = false, pathtraced = false, seed_floor = false;
+  bool parity = false, realtime = false, pathtraced = false, seed_floor = false, media = false;
   int spp = 64;
   std::vector<int> batch;
   std::vector<std::string> worlds;
@@ -552,6 +654,7 @@ int Main(int argc, char** argv) {
     fmt::print(stderr,
                "render_cuda_bench: {}\nusage: render_cuda_bench [--frames N] [--batch N,... "
                "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH] | "
+               "--media [--size WxH] | "
                "--pathtraced [--size WxH] [--spp N]] "
                "[world.yaml ...]\n",
                why);
@@ -584,6 +687,8 @@ int Main(int argc, char** argv) {
       }
     } else if (a == "--realtime") {
       realtime = true;
+    } else if (a == "--media") {
+      media = true;
     } else if (a == "--parity") {
       parity = true;
     } else if (a == "--pathtraced") {
@@ -604,7 +709,7 @@ int Main(int argc, char** argv) {
               std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml"};
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("device: {}\n", dev.available ? dev.name : "none (" + dev.why + ")");
-  if ((parity || realtime || pathtraced || !batch.empty()) && !dev.available) {
+  if ((parity || realtime || media || pathtraced || !batch.empty()) && !dev.available) {
     fmt::print(stderr,
                "render_cuda_bench: --batch, --parity, --realtime and --pathtraced need a CUDA "
                "device\n");
@@ -617,6 +722,10 @@ int Main(int argc, char** argv) {
   if (realtime) {
     if (width == 0) width = 640, height = 480;
     return RealtimeMain(worlds, width, height, frames);
+  }
+  if (media) {
+    if (width == 0) width = 640, height = 480;
+    return MediaMain(worlds, width, height, frames);
   }
   if (parity) {
     if (width == 0) width = 320, height = 240;

@@ -261,6 +261,8 @@ void EmbreeRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* e
     }
     out->ev100 = film_.Ev100(out->radiance, &pool_);
     film_.Develop(out->radiance, out->ev100, &pool_, &out->rgb, view.white_balance_gains);
+  } else {
+    out->rgb = ImageU8();  // not developed (the film ablation): no rgb left from an earlier frame
   }
 }
 

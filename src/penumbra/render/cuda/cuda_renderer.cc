@@ -56,8 +56,7 @@ bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
 }
 
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
-  if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced)
-    return PathNotOnGpu(effects, view);
+  if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced) return PathNotOnGpu(effects);
   return realtime_->Unsupported(effects, view);
 }
 
@@ -80,8 +79,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
                                : !fx_why.empty() ? "effects with " + fx_why
                                                  : std::string("this frame's camera");
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier particles "
-          "and distorted or moving cameras); "
+          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier "
+          "particles); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           what);
       told_cpu_ = true;
@@ -107,7 +106,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   const int W = c.width, H = c.height;
   out->ev100 = 0;
   if (want[ImageKind::kRgb] && realtime_->settings().tier == RenderSettings::Tier::kPathtraced) {
-    RenderPathtraced(snapshot, effects, view, t0, out);
+    RenderPathtraced(snapshot, effects, view, c, t0, out);
   } else if (want[ImageKind::kRgb]) {
     RenderRgb(snapshot, effects, view, c, t0, out);
   } else {
@@ -195,10 +194,10 @@ void CudaRenderer::UploadRealtime() {
 }
 
 void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
-                                    const CameraView& view,
+                                    const CameraView& view, const PinholeCamera& camera,
                                     std::chrono::steady_clock::time_point t0, RenderedFrame* out) {
-  // a pinhole camera without distortion or motion (PathNotOnGpu): no ray tables. the media are
-  // the paths' own (path_media_), not the realtime tier's volumes
+  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again. the
+  // media are the paths' own (path_media_), not the realtime tier's volumes
   realtime_->Prepare(snapshot, view, pool_.get(), EffectsWithoutMedia(effects, &path_effects_),
                      &camera_rays_);
   path_media_.Build(effects != nullptr && !effects->empty() ? effects : nullptr);
@@ -209,9 +208,12 @@ void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const Effects
     sampling_generation_ = sky_generation_;
     sky_sampling_ = device_path_->UploadSkySampling(realtime_->frame_sky().sampling_pod());
   }
+  RealtimeFrameView host_frame = realtime_->View(device_->device_view(), nullptr);
+  // the camera's ray tables: the device copies, not Prepare's host arrays
+  host_frame.camera.xy = camera.xy;
+  host_frame.camera.rows = camera.rows;
   const RealtimeFrameView frame =
-      device_realtime_->DeviceFrame(realtime_->View(device_->device_view(), nullptr),
-                                    static_cast<int64_t>(realtime_->geoms().size()));
+      device_realtime_->DeviceFrame(host_frame, static_cast<int64_t>(realtime_->geoms().size()));
   PathFrameView pf = PathView(*realtime_, frame, sky_sampling_);
   // the emissive geoms: their tables once, their poses every frame
   if (!emitters_->empty()) {

@@ -61,6 +61,10 @@ class CudaRenderer final : public Renderer {
   DeviceScene& device() { return *device_; }
   /// the realtime rgb path's device side (after a first rgb frame on the GPU), for benchmarks.
   DeviceRealtime& device_realtime() { return *device_realtime_; }
+  /// the realtime rgb path's host side (after a first rgb frame on the GPU), for benchmarks:
+  /// where its media volumes are built (RealtimeFrameData::set_device_media) and how long the
+  /// host's part took (media_build_ms, media_build_times).
+  RealtimeFrameData& realtime_frame() { return *realtime_; }
   /// the pathtraced tier's device side (after a first pathtraced frame on the GPU), for
   /// benchmarks.
   DevicePath& device_path() { return *device_path_; }
@@ -89,9 +93,10 @@ class CudaRenderer final : public Renderer {
                  RenderedFrame* out);
   // the pathtraced tier's rgb, radiance and depth: the paths on the GPU (cuda_path.h), the
   // denoiser and film on the host (path_frame.h's FinishPathFrame).
+  // `camera`: the view's camera with its ray tables on the device (Render's).
   void RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
-                        const CameraView& view, std::chrono::steady_clock::time_point t0,
-                        RenderedFrame* out);
+                        const CameraView& view, const PinholeCamera& camera,
+                        std::chrono::steady_clock::time_point t0, RenderedFrame* out);
   // the scene-constant realtime data (materials, textures) and the sky's arrays on the device
   // (once, and the sky again when it changes): both tiers' rgb read them.
   void UploadRealtime();

@@ -5,12 +5,10 @@
 
 namespace penumbra::cuda {
 
-std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view) {
+std::string PathNotOnGpu(const EffectsFrame* effects) {
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   // media are traced by the path kernels (media_scene_math.h; branch gpu14)
   if (fx != nullptr && !fx->particles.empty()) return "the pathtraced tier with particles";
-  if (view.intrinsics.has_distortion() || view.motion.moving())
-    return "the pathtraced tier with a distorted or moving camera";
   return "";
 }
 

@@ -23,11 +23,13 @@
 
 namespace penumbra::cuda {
 
-/// why a pathtraced frame of `view` under `effects` cannot be traced on the GPU ("" if it can):
-/// particles (the CPU's camera rays stop at streaks with a random draw), or a camera with lens
-/// distortion or motion (the jittered rays need Camera::Unproject). media (homogeneous and
-/// grids) are traced on the GPU since branch gpu14 (PathFrameView::media).
-std::string PathNotOnGpu(const EffectsFrame* effects, const CameraView& view);
+/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can): particles
+/// (the CPU's camera rays stop at streaks with a random draw). media (homogeneous and grids)
+/// are traced on the GPU since branch gpu14 (PathFrameView::media); a camera with lens
+/// distortion or motion (rolling shutter, or the exposure's motion that every frame of a run
+/// has) is on the GPU: its jittered rays come from its ray tables (JitteredCameraRay,
+/// path_shading.h).
+std::string PathNotOnGpu(const EffectsFrame* effects);
 
 /// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
 /// host arrays: the pods and pick cdf point into the sampler, which must outlive this) and the

@@ -179,7 +179,7 @@ void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const Effect
   realtime_media_.Build(
       media_, lights_, *media_rays, camera, FrameKey(view.camera_index, view.frame_index),
       scene_.center_W.cast<float>(), scene_.extent_m, SkyAmbientRadiance(*frame_sky_),
-      volume_.empty() ? nullptr : &volume_, pool);
+      volume_.empty() ? nullptr : &volume_, pool, device_media_);
   media_view_ = realtime_media_.HostView(&media_arrays_);
   media_build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -380,6 +380,7 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   if (media_ready_) {
     f.has_media = 1;
     f.media = media_view_;
+    f.media_build = realtime_media_.device_build();
   }
   return f;
 }
@@ -396,6 +397,33 @@ double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pix
   const float gains[3] = {white_balance_gains[0], white_balance_gains[1], white_balance_gains[2]};
   return FrameExposure(film_.exposure_pod(), row_sums.data(), static_cast<int>(row_sums.size()),
                        pixels, kMinLuminance, gains, exposure);
+}
+
+void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolumeArrays* out) {
+  if (f->has_media == 0) return;
+  const MediaVolumesToBuild& b = f->media_build;
+  RealtimeMediaView& m = f->media;
+  float* vis = nullptr;
+  if (b.light_volume != 0) {
+    const int64_t cells = LightVolumeCells(m.light_volume);
+    const size_t values = static_cast<size_t>(cells) * m.light_volume.stride;
+    out->trans.assign(values, 0.0f);
+    out->vis.assign(b.with_visibility != 0 ? values : 0, 0.0f);
+    if (b.with_visibility != 0) vis = out->vis.data();
+    ParallelForOrSerial(pool, cells,
+                        [&](int64_t c) { MediaLightVolumeCell(*f, c, out->trans.data(), vis); });
+    m.light_trans = out->trans.data();
+  }
+  if (b.fog != 0) {
+    const int columns = m.fog_nx * m.fog_ny;
+    out->fog.assign(static_cast<size_t>(columns) * (kFogFroxelSlices + 1), Rgb4{});
+    out->inv_log_far.assign(columns, 0.0f);
+    ParallelForOrSerial(pool, columns, [&](int64_t c) {
+      MediaFogColumn(*f, static_cast<int>(c), vis, out->fog.data(), out->inv_log_far.data());
+    });
+    m.fog_S = out->fog.data();
+    m.fog_inv_log_far = out->inv_log_far.data();
+  }
 }
 
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
@@ -438,6 +466,9 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   std::vector<Float3> sky(n);
   data.SkyTerms(geometry.data(), n, sky.data(), pool);
   RealtimeFrameView f = data.View(scene, sky.data());
+  // the media volumes the frame builds itself, as the device's kernels (before the shading)
+  MediaVolumeArrays media_volumes;
+  BuildMediaVolumesOnHost(&f, pool, &media_volumes);
   f.mirror_geometry = mirror_geometry.data();
   f.mirror_hits = mirror_hits.data();
   f.mirror_sky = mirror_sky.data();

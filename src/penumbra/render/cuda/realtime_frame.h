@@ -7,7 +7,8 @@
 // render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: each
 // pixel's nearest streak found and shaded on the host with the CPU's render/particle_streaks.h,
 // StreakPixel; the kernels draw it over the pixel) and media (homogeneous and grids:
-// PrepareMedia, RealtimeMedia's volumes built on the host; the kernels' view pass draws them and
+// PrepareMedia, RealtimeMedia's volumes built on the host but for the world light volume and the
+// fog froxels, which the frame builds itself on the device; the kernels' view pass draws them and
 // the streaks seen through them); the sky model and sky volume (SkyData, for
 // DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
 // geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h, which
@@ -78,18 +79,29 @@ class RealtimeFrameData {
   /// the media of the frame (View's media, has_media): with homogeneous or grid media in
   /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
   /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
-  /// `view`, with the frame's lights, sky and occluded sky volume: the world light volume's
-  /// shadow rays through `media_rays` (any RayQuery posed for `snapshot`: CudaRenderer passes
-  /// one over its device scene), or, if null, through a BvhRayQuery (the kernels' traversal on
-  /// the host) this object keeps and poses; RealtimeMedia::HostView's arrays for the view (the
-  /// grids' froxels and light volumes too). call after PoseWorld (Prepare does).
+  /// `view`, with the frame's lights, sky and occluded sky volume: the shadow rays of the grids'
+  /// light volumes (and, without device_media, of the world light volume) through `media_rays`
+  /// (any RayQuery posed for `snapshot`: CudaRenderer passes one over its device scene), or, if
+  /// null, through a BvhRayQuery (the kernels' traversal on the host) this object keeps and
+  /// poses; RealtimeMedia::HostView's arrays for the view (the grids' froxels and light volumes
+  /// too). with device_media (the default) the world light volume's cells and the fog froxels
+  /// are left to the frame (View's media_build: the device's MediaLightVolumeKernel and
+  /// MediaFogSliceKernel, or BuildMediaVolumesOnHost). call after PoseWorld (Prepare does).
   void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                     const Camera& camera, const CameraView& view, ThreadPool* pool,
                     const RayQuery* media_rays = nullptr);
   /// whether the last Prepare built media (View's has_media), and host milliseconds its
-  /// RealtimeMedia::Build took (benchmarks).
+  /// RealtimeMedia::Build took (benchmarks), and its stages'.
   bool has_media() const { return media_ready_; }
   double media_build_ms() const { return media_build_ms_; }
+  const RealtimeMedia::BuildTimes& media_build_times() const {
+    return realtime_media_.build_times();
+  }
+  /// whether PrepareMedia leaves the world light volume's cells and the fog froxels to the frame
+  /// (View's media_build: the device's kernels, or BuildMediaVolumesOnHost; default true) or
+  /// builds them on the host with the rest of RealtimeMedia (false: as before branch gpu15).
+  void set_device_media(bool on) { device_media_ = on; }
+  bool device_media() const { return device_media_; }
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
   /// again only for bodies whose pose changed since the last call), the effects' sky and
   /// wetness and the sky volume. @throws as Prepare.
@@ -206,6 +218,7 @@ class RealtimeFrameData {
   void BuildMediaScene(const EffectsFrame* fx);
   RealtimeMediaView media_view_;
   bool media_ready_ = false;
+  bool device_media_ = true;
   double media_build_ms_ = 0;
   Film film_;
   PinholeCamera camera_;
@@ -228,6 +241,18 @@ class RealtimeFrameData {
 
 /// the pinhole camera of `view` as the kernels take it (view must be a projective camera).
 PinholeCamera PinholeCameraOf(const CameraView& view);
+
+/// the host arrays of the media volumes a frame builds itself (BuildMediaVolumesOnHost).
+struct MediaVolumeArrays {
+  std::vector<float> trans, vis;  // the world light volume, [cell][light]
+  std::vector<Rgb4> fog;          // the fog froxels' records
+  std::vector<float> inv_log_far;
+};
+
+/// the media volumes that frame f leaves to itself (f->media_build) built on the CPU with the
+/// kernels' functions (MediaLightVolumeCell, its shadow rays through f->scene; MediaFogColumn)
+/// over `pool` into *out, and f->media pointed at them. nothing without media or such volumes.
+void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolumeArrays* out);
 
 /// renders a realtime frame (rgb, radiance, depth) with the GPU path's per-pixel functions on
 /// the CPU over `bvh` (posed for the frame) and `data` (Prepared for it): the parity of the GPU

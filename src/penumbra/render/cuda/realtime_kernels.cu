@@ -79,6 +79,40 @@ __global__ void MediaViewKernel(RealtimeFrameView f, const float* depth, Float3*
   MediaViewQuad(f, 2 * qu, 2 * qv, depth, radiance);
 }
 
+// the media volumes a frame builds itself (RealtimeFrameView::media_build), before the kernels
+// that read them: one thread per cell of the world light volume (its shadow rays traced in the
+// thread), then the fog froxels (which read the light volume's visibility).
+__global__ void MediaLightVolumeKernel(RealtimeFrameView f, int64_t cells, float* trans_cl,
+                                       float* vis_cl) {
+  const int64_t c = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (c >= cells) return;
+  MediaLightVolumeCell(f, c, trans_cl, vis_cl);
+}
+// one block per fog froxel column, one thread per slice (kFogFroxelSlices of kFogSliceBlock),
+// then the column's records summed in slice order by its first thread (FogFroxelRecords: the
+// bits of MediaFogColumn's serial loop).
+constexpr int kFogSliceBlock = 64;
+static_assert(kFogFroxelSlices <= kFogSliceBlock, "one block holds a column's slices");
+__global__ void MediaFogSliceKernel(RealtimeFrameView f, const float* vis_cl, Rgb4* S,
+                                    float* inv_log_far) {
+  // the increments as plain floats (a __shared__ array takes no initialisers: Float3 has them)
+  __shared__ float inc[3 * kFogFroxelSlices];
+  const int c = blockIdx.x, k = threadIdx.x;
+  if (k < kFogFroxelSlices) {
+    const Float3 v = MediaFogSlice(f, c, k, vis_cl, inv_log_far);
+    inc[3 * k] = v.x;
+    inc[3 * k + 1] = v.y;
+    inc[3 * k + 2] = v.z;
+  }
+  __syncthreads();
+  if (k != 0) return;
+  Float3 column[kFogFroxelSlices];
+  for (int i = 0; i < kFogFroxelSlices; ++i)
+    column[i] = Float3{inc[3 * i], inc[3 * i + 1], inc[3 * i + 2]};
+  FogFroxelRecords(column,
+                   reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
+}
+
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
 // shading and the blend after the shared visibility.
 // they run only where the frame has a mirror layer (a batch launches them for every camera
@@ -578,6 +612,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
   Buffer media_pods, media_fog, media_inv_log_far, media_axes, media_trans, volume_pod;
+  Buffer media_vis;  // the world light volume's visibility when the frame builds it
   // the grids' froxels (records; t0, t1 and slices per m end to end; axis tables), their boxes
   // and light volumes (branch gpu12)
   Buffer media_grid_records, media_grid_columns, media_grid_axes, media_grid_pods, media_grid_T;
@@ -697,6 +732,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
       media_inv_log_far.Upload(h.fog_inv_log_far, sizeof(float) * columns, stream);
       d->fog_S = media_fog.as<Rgb4>();
       d->fog_inv_log_far = media_inv_log_far.as<float>();
+    }
+    if (h.fog_ax != nullptr) {
       const MediaAxis* const fog[4] = {h.fog_ax, h.fog_ax_half, h.fog_ay, h.fog_ay_half};
       const MediaAxis** const fog_d[4] = {&d->fog_ax, &d->fog_ax_half, &d->fog_ay, &d->fog_ay_half};
       UploadAxes(fog, h.width, h.height, &media_axes, stream, fog_d);
@@ -736,6 +773,36 @@ struct DeviceRealtime::Impl : PixelBuffers {
           last.offset + static_cast<size_t>(h.num_grid_lights) * last.r[0] * last.r[1] * last.r[2];
       media_grid_T.Upload(h.grid_light_T, sizeof(float) * (n > 0 ? n : 1), stream);
       d->grid_light_T = media_grid_T.as<float>();
+    }
+  }
+  // the media volumes frame f builds itself (f->media_build), on `stream` after UploadMedia:
+  // MediaLightVolumeKernel, then MediaFogSliceKernel; f->media pointed at their buffers
+  void BuildMedia(RealtimeFrameView* f, cudaStream_t stream) {
+    const MediaVolumesToBuild& b = f->media_build;
+    RealtimeMediaView& m = f->media;
+    float* vis = nullptr;
+    if (b.light_volume != 0) {
+      const int64_t cells = LightVolumeCells(m.light_volume);
+      const size_t bytes = sizeof(float) * static_cast<size_t>(cells) * m.light_volume.stride;
+      media_trans.Reserve(bytes > 0 ? bytes : 4);
+      if (b.with_visibility != 0) {
+        media_vis.Reserve(bytes > 0 ? bytes : 4);
+        vis = media_vis.as<float>();
+      }
+      MediaLightVolumeKernel<<<static_cast<unsigned>((cells + 127) / 128), 128, 0, stream>>>(
+          *f, cells, media_trans.as<float>(), vis);
+      Check(cudaGetLastError(), "MediaLightVolumeKernel");
+      m.light_trans = media_trans.as<float>();
+    }
+    if (b.fog != 0) {
+      const int columns = m.fog_nx * m.fog_ny;
+      media_fog.Reserve(sizeof(Rgb4) * static_cast<size_t>(columns) * (kFogFroxelSlices + 1));
+      media_inv_log_far.Reserve(sizeof(float) * static_cast<size_t>(columns));
+      MediaFogSliceKernel<<<static_cast<unsigned>(columns), kFogSliceBlock, 0, stream>>>(
+          *f, vis, media_fog.as<Rgb4>(), media_inv_log_far.as<float>());
+      Check(cudaGetLastError(), "MediaFogSliceKernel");
+      m.fog_S = media_fog.as<Rgb4>();
+      m.fog_inv_log_far = media_inv_log_far.as<float>();
     }
   }
   // the film kernel with the exposure the device computed (LaunchExposure)
@@ -1000,7 +1067,10 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.streaks.Upload(host_frame.streaks, sizeof(StreakPixel) * f.num_streaks, stream);
     f.streaks = m.streaks.as<StreakPixel>();
   }
-  if (f.has_media != 0) m.UploadMedia(host_frame.media, &f.media, stream);
+  if (f.has_media != 0) {
+    m.UploadMedia(host_frame.media, &f.media, stream);
+    m.BuildMedia(&f, stream);
+  }
   // host buffers of the round trips and outputs
   PixelGeometry* host_geometry;
   Float3* host_sky;

@@ -41,6 +41,7 @@
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
 #include "penumbra/render/light_math.h"
+#include "penumbra/render/media_build_math.h"
 #include "penumbra/render/media_realtime_math.h"
 #include "penumbra/render/mirror_math.h"
 #include "penumbra/render/particle_math.h"
@@ -182,6 +183,10 @@ struct RealtimeFrameView {
   /// transmittances of the surface loop (ShadeRealtimePoint) and the view pass (MediaViewQuad).
   int32_t has_media = 0;
   RealtimeMediaView media;
+  /// the media volumes this frame builds itself before its first kernel reads them
+  /// (MediaLightVolumeCell, MediaFogColumn; RealtimeMedia::Build's device_volumes): their
+  /// layouts are in `media`, their arrays (light_trans, fog_S, fog_inv_log_far) filled then.
+  MediaVolumesToBuild media_build;
 };
 
 /// a surface point as the realtime tier shades it: the textured material and the frame.
@@ -1268,6 +1273,117 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
       hi = mid;
   }
   return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
+}
+
+/// cell c of the world light volume that frame f builds itself (f.media_build.light_volume;
+/// layout f.media.light_volume): per light l < stride its [cell][light] transmittance
+/// trans_cl[c stride + l] (LightVolumeCellLight; 0 past the volume's lights) and, where vis_cl
+/// is not null (f.media_build.with_visibility), the visibility V Th Tgrid, each asked shadow ray
+/// traced here through f.scene, as RealtimeMedia::Build's cells (whose rays go through a
+/// RayQuery: the same TraceRay, o at the cell centre, tmin 0).
+PB_HOST_DEVICE inline void MediaLightVolumeCell(const RealtimeFrameView& f, int64_t c,
+                                                float* trans_cl, float* vis_cl) {
+  const RealtimeMediaView& m = f.media;
+  LightVolumeBuild b;
+  b.layout = m.light_volume;
+  b.num_lights = m.num_volume_lights;
+  b.with_visibility = vis_cl != nullptr ? 1 : 0;
+  b.lights = f.lights;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  b.grids = m.grids;
+  b.grid_light_T = m.grid_light_T;
+  b.num_grids = m.num_grids;
+  float p[3];
+  LightVolumeCellCentre(b.layout, c, p);
+  const int S = b.layout.stride;
+  for (int l = 0; l < S; ++l) {
+    const int64_t at = c * S + l;
+    if (l >= b.num_lights) {
+      trans_cl[at] = 0.0f;
+      if (vis_cl != nullptr) vis_cl[at] = 0.0f;
+      continue;
+    }
+    float T, d[3], tmax;
+    const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
+    trans_cl[at] = T;
+    if (vis_cl == nullptr) continue;
+    bool seen = w == kMediaRayLit;
+    if (w == kMediaRayTrace) {
+      TraceRay r;
+      r.o = F3{p[0], p[1], p[2]};
+      r.d = F3{d[0], d[1], d[2]};
+      r.tmin = 0.0f;
+      r.tmax = tmax;
+      seen = !TraceOccluded(f.scene, r);
+    }
+    vis_cl[at] = seen ? T : 0.0f;
+  }
+}
+
+/// the inputs of fog froxel column c of frame f (f.media_build.fog; f.media.fog_nx x fog_ny
+/// columns): the build over f's media, lights, grid froxels and the visibility volume vis_cl
+/// (null: none), its centre pixel's ray o + t d (PrimaryRay, unit direction; RealtimeMedia::
+/// BuildFogFroxels takes Camera::GenerateRay's), its slice jitter and grid froxel columns.
+struct MediaFogColumnInputs {
+  FogFroxelBuild<Rgb4> b;
+  float o[3], d[3];
+  float jitter;
+  MediaColumns grid_cols;
+};
+PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameView& f, int c,
+                                                            const float* vis_cl) {
+  const RealtimeMediaView& m = f.media;
+  const int W = f.camera.width, H = f.camera.height;
+  const int cx = c % m.fog_nx, cy = c / m.fog_nx;
+  const int uc = MediaMinI(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
+  const int vc = MediaMinI(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
+  const TraceRay r = PrimaryRay(f.camera, uc, vc);
+  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  MediaFogColumnInputs in;
+  in.o[0] = r.o.x, in.o[1] = r.o.y, in.o[2] = r.o.z;
+  in.d[0] = r.d.x / len, in.d[1] = r.d.y / len, in.d[2] = r.d.z / len;
+  FogFroxelBuild<Rgb4>& b = in.b;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  b.lights = f.lights;
+  b.num_lights = f.num_lights;
+  b.num_volume_lights = m.num_volume_lights;
+  b.vis_layout = m.light_volume;
+  b.vis_cl = vis_cl;
+  b.grids = m.grids;
+  b.grid_light_T = m.grid_light_T;
+  b.num_grids = m.num_grids;
+  b.grid_t0 = m.grid_t0;
+  b.grid_t1 = m.grid_t1;
+  b.grid_slices_per_m = m.grid_slices_per_m;
+  b.grid_records = m.grid_records;
+  in.grid_cols = m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3);
+  return in;
+}
+
+/// fog froxel column c of frame f (MediaFogColumnOf): FogFroxelColumn into the column's
+/// kFogFroxelSlices + 1 records S[c (kFogFroxelSlices + 1) ..] and inv_log_far[c], as
+/// RealtimeMedia::BuildFogFroxels (whose column ray is Camera::GenerateRay's). the device runs
+/// its slices in parallel (MediaFogSlice, then FogFroxelRecords: the same bits).
+PB_HOST_DEVICE inline void MediaFogColumn(const RealtimeFrameView& f, int c, const float* vis_cl,
+                                          Rgb4* S, float* inv_log_far) {
+  const MediaFogColumnInputs in = MediaFogColumnOf(f, c, vis_cl);
+  FogFroxelColumn(in.b, in.o, in.d, in.jitter, in.grid_cols, Rgb4{0, 0, 0, 0}, Rgb4{1, 1, 1, 0},
+                  inv_log_far + c,
+                  reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
+}
+
+/// slice k of fog froxel column c of frame f: its increment (FogFroxelSlice of
+/// MediaFogColumnOf), and for k = 0 the column's inv_log_far[c].
+PB_HOST_DEVICE inline Float3 MediaFogSlice(const RealtimeFrameView& f, int c, int k,
+                                           const float* vis_cl, float* inv_log_far) {
+  const MediaFogColumnInputs in = MediaFogColumnOf(f, c, vis_cl);
+  const float t_far = FogColumnFar(in.b.media, in.b.num_media, in.o, in.d);
+  if (k == 0) inv_log_far[c] = 1.0f / logf(t_far / kFogFroxelNear);
+  return FogFroxelSlice(in.b, in.o, in.d, in.jitter, t_far, k, in.grid_cols, Rgb4{0, 0, 0, 0},
+                        Rgb4{1, 1, 1, 0});
 }
 
 /// the media (homogeneous and grids) over the radiance of the pixels of the 2x2 quad (u0, v0) ..
