@@ -186,7 +186,6 @@ TEST(PathNotOnGpu, MediaAndParticlesGoToTheCpu) {
   EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fog), "");
   EXPECT_NE(cuda::PathNotOnGpu(&fog).find("media"), std::string::npos);
   EffectsFrame smoke;
   smoke.grid_media.emplace_back();
