@@ -88,15 +88,18 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   row.depth_within_1mm = 100.0 * depth_ok / n;
   row.seg_equal = 100.0 * seg_ok / n;
   row.effects = fx && !fx->empty();
-  row.effects_on_gpu = cuda::CudaRenderer::OnGpu(fx.get(), view);
   CameraView rgb_view = view;
   rgb_view.outputs[ImageKind::kRgb] = true;
-  if (!cuda::CudaRenderer::OnGpu(fx.get(), rgb_view)) {
+  RenderedFrame ca, cb;
+  cpu->Render(snap, fx.get(), rgb_view, &ca);
+  // on the GPU unless the CUDA backend handed the frame to its CPU renderer
+  const auto* g = dynamic_cast<const cuda::CudaRenderer*>(gpu.get());
+  const int64_t cpu_frames = g != nullptr ? g->cpu_frames() : 0;
+  gpu->Render(snap, fx.get(), rgb_view, &cb);
+  row.effects_on_gpu = g != nullptr && g->cpu_frames() == cpu_frames;
+  if (!row.effects_on_gpu) {
     row.rgb = "cpu fallback";
   } else {
-    RenderedFrame ca, cb;
-    cpu->Render(snap, fx.get(), rgb_view, &ca);
-    gpu->Render(snap, fx.get(), rgb_view, &cb);
     double se = 0;
     for (size_t i = 0; i < ca.rgb.data.size(); ++i) {
       const double d = static_cast<double>(ca.rgb.data[i]) - cb.rgb.data[i];

@@ -265,7 +265,6 @@ TEST(PathNotOnGpu, ParticlesGoToTheCpuMediaDoNot) {
   EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();
-  EXPECT_EQ(cuda::EffectsNotOnGpu(&fog), "");
   EXPECT_EQ(cuda::PathNotOnGpu(&fog), "");
   EffectsFrame smoke;
   smoke.grid_media.emplace_back();

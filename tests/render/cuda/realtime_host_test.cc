@@ -39,7 +39,6 @@ HostPathFrames RenderCpuAndHostPath(const SceneDescription& scene, const WorldSn
   bvh.Update(snap);
   cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
-  EXPECT_EQ(data.Unsupported(nullptr, view), "");
   data.Prepare(snap, view, &pool);
   cuda::RenderRealtimeOnHost(data, bvh, &pool, &f.got);
   cuda::RenderRealtimeOnHost(data, bvh, &pool, &f.again);
@@ -114,7 +113,6 @@ TEST(RealtimeHostPathFrames, DistortedAndRollingShutterCamerasMatchTheCpuBackend
     RenderedFrame want;
     cpu->Render(snap, view, &want);
     cuda::RealtimeFrameData data(scene, settings);
-    ASSERT_EQ(data.Unsupported(nullptr, view), "");
     data.Prepare(snap, view, &pool);
     RenderedFrame got;
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &got);
@@ -319,28 +317,6 @@ TEST(RealtimeHostPathFrames, SkyTermsInBandsEqualTheWholeFrame) {
   EXPECT_GT(mirrored, 0);
   EXPECT_THROW(data.SkyTerms(geometry.data(), n, banded.data(), &pool, 1, 30), Error);
   EXPECT_THROW(data.SkyTerms(geometry.data(), n, banded.data(), &pool, 0, 31), Error);
-}
-
-TEST(RealtimeHostPathFrames, PathtracedIsNotOnTheRealtimeGpuPath) {
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
-  RenderSettings settings;
-  settings.tier = RenderSettings::Tier::kPathtraced;
-  const cuda::RealtimeFrameData pt(session->scene(), settings);
-  CameraView view;
-  EXPECT_EQ(pt.Unsupported(nullptr, view), "the pathtraced tier");
-  const cuda::RealtimeFrameData rt(session->scene(), RenderSettings());
-  EXPECT_EQ(rt.Unsupported(nullptr, view), "");
-  // lens distortion and camera motion are on the GPU path (camera_rays.h), and so are the
-  // effects (grid media, particles seen through media: since branch gpu12)
-  view.intrinsics.k1 = 0.1;
-  view.motion.end_sec = 0.02;
-  EXPECT_EQ(rt.Unsupported(nullptr, view), "");
-  EffectsFrame fx;
-  fx.grid_media.emplace_back();
-  fx.homogeneous_media.emplace_back();
-  fx.particles.emplace_back();
-  EXPECT_EQ(rt.Unsupported(&fx, view), "");
-  EXPECT_EQ(pt.Unsupported(&fx, view), "the pathtraced tier");
 }
 
 }  // namespace

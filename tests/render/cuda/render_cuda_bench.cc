@@ -784,14 +784,15 @@ int Main(int argc, char** argv) {
       const std::shared_ptr<const EffectsFrame> fx =
           world.session->effects().Evaluate(snap, view.X_WO.translation());
       const bool with_fx = fx && !fx->empty();
-      const std::string fx_outputs = cuda::CudaRenderer::OnGpu(fx.get(), rgb)
-                                         ? "rgb+depth realtime + effects (on GPU)"
-                                         : "rgb+depth realtime + effects (cpu fallback)";
+      // the CUDA backend's own verdict (its CPU renderer takes what is not on the GPU)
+      const bool fx_on_gpu =
+          gpu && static_cast<cuda::CudaRenderer*>(gpu.get())->RgbNotOnGpu(fx.get(), rgb).empty();
+      const std::string fx_outputs = fx_on_gpu ? "rgb+depth realtime + effects (on GPU)"
+                                               : "rgb+depth realtime + effects (cpu fallback)";
       if (gpu && with_fx) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-        if ((!fx->homogeneous_media.empty() || !fx->grid_media.empty()) &&
-            cuda::CudaRenderer::OnGpu(fx.get(), rgb))
+        if ((!fx->homogeneous_media.empty() || !fx->grid_media.empty()) && fx_on_gpu)
           builds.push_back(fmt::format(
               "{} {}: effects frame with media on the GPU: host preparation {:.2f} ms a frame "
               "(the last of the timed frames; RealtimeFrameData::Prepare, media volumes included)",

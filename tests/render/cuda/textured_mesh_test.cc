@@ -39,7 +39,6 @@ RenderedFrame HostPathFrame(const SceneDescription& gpu_scene, const WorldSnapsh
   bvh.Update(snap);
   cuda::RealtimeFrameData data(gpu_scene, settings);
   ThreadPool pool(0);
-  EXPECT_EQ(data.Unsupported(nullptr, view), "");
   data.Prepare(snap, view, &pool);
   RenderedFrame f;
   cuda::RenderRealtimeOnHost(data, bvh, &pool, &f);

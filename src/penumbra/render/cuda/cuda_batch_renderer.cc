@@ -73,8 +73,8 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   // the ground truth does not see effects; the rgb takes the lighting ones only (a batch's
   // cameras would each need their own particle streaks and media froxels: CudaRenderer draws
   // them)
-  std::string not_on_gpu = layout_.outputs().rgb ? EffectsNotOnGpu(effects) : "";
-  if (layout_.outputs().rgb && not_on_gpu.empty() && effects != nullptr) {
+  std::string not_on_gpu;
+  if (layout_.outputs().rgb && effects != nullptr) {
     const std::pair<bool, const char*> per_camera[] = {
         {!effects->particles.empty(), "particles (rain, snow, sparks) in a batch"},
         {!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust) in a batch"},

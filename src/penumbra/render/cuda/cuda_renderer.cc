@@ -50,14 +50,10 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
 
 CudaRenderer::~CudaRenderer() = default;
 
-bool CudaRenderer::OnGpu(const EffectsFrame* effects, const CameraView& view) {
-  (void)view;  // every pinhole, distorted or moving camera renders on the GPU (camera_rays.h)
-  return EffectsNotOnGpu(effects).empty();
-}
-
 std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
+  (void)view;  // every pinhole, distorted or moving camera renders on the GPU (camera_rays.h)
   if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced) return PathNotOnGpu(effects);
-  return realtime_->Unsupported(effects, view);
+  return "";
 }
 
 PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
@@ -71,18 +67,13 @@ ParallelFn CudaRenderer::HostParallel() {
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
   const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
-  if (!OnGpu(effects, view) || !rgb_why.empty()) {
+  if (!rgb_why.empty()) {
     if (!told_cpu_) {
-      // what is not on the GPU: the rgb's reason, else the effects', else the camera's
-      const std::string fx_why = EffectsNotOnGpu(effects);
-      const std::string what = !rgb_why.empty()  ? rgb_why
-                               : !fx_why.empty() ? "effects with " + fx_why
-                                                 : std::string("this frame's camera");
       spdlog::info(
           "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier "
           "particles); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
-          what);
+          rgb_why);
       told_cpu_ = true;
     }
     ++cpu_frames_;

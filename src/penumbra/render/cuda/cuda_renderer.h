@@ -2,7 +2,7 @@
 // the CUDA backend's Renderer (render/renderer.h). on the GPU now, for a pinhole camera (with
 // lens distortion or motion too: camera_rays.h) under clear conditions, lighting effects (light
 // scales, extra lights, a moved or scaled sky, surface wetness), particles, homogeneous and grid
-// media and particles seen through them (EffectsNotOnGpu): the images
+// media and particles seen through them: the images
 // of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
 // realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
@@ -46,10 +46,8 @@ class CudaRenderer final : public Renderer {
   void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
               RenderedFrame* out) override;
 
-  /// true if `view`'s ground-truth images under `effects` render on the GPU (else on the CPU
-  /// renderer): a pinhole camera, and effects that are on the GPU (EffectsNotOnGpu).
-  static bool OnGpu(const EffectsFrame* effects, const CameraView& view);
-  /// "" if `view`'s rgb under `effects` renders on the GPU, else why not.
+  /// "" if `view`'s rgb under `effects` renders on the GPU, else why not (the pathtraced tier's
+  /// PathNotOnGpu; every realtime frame and every frame's ground truth render on the GPU).
   std::string RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const;
 
   /// frames rendered on the GPU and on the CPU renderer so far.
@@ -85,8 +83,8 @@ class CudaRenderer final : public Renderer {
   static PinholeCamera PinholeOf(const CameraView& view);
 
  private:
-  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h) under `effects`
-  // (lighting effects only: EffectsNotOnGpu); `camera`: the view's camera with its ray tables
+  // the realtime tier's rgb, radiance and depth on the GPU (cuda_realtime.h) under `effects`;
+  // `camera`: the view's camera with its ray tables
   // on the device; t0: when Render began (last_prepare_ms).
   void RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
                  const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,

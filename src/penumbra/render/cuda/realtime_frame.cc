@@ -126,23 +126,6 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
   }
 }
 
-std::string EffectsNotOnGpu(const EffectsFrame* effects) {
-  // every effect is: the lighting ones through the frame's lights and sky (PoseWorld), the
-  // particles' streaks found and shaded on the host (PrepareStreaks), the media's volumes
-  // (homogeneous and grids) built on the host (PrepareMedia) and the streaks seen through them
-  // in the view pass (MediaViewQuad)
-  (void)effects;
-  return "";
-}
-
-std::string RealtimeFrameData::Unsupported(const EffectsFrame* effects,
-                                           const CameraView& view) const {
-  if (settings_.tier != RenderSettings::Tier::kRealtime) return "the pathtraced tier";
-  const std::string fx = EffectsNotOnGpu(effects);
-  if (!fx.empty()) return "effects with " + fx;
-  return "";
-}
-
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
                                 ThreadPool* pool, const EffectsFrame* effects,
                                 const CameraRayTables* rays, const RayQuery* media_rays) {
@@ -249,9 +232,6 @@ void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* poo
   // the lighting effects as the CPU backend applies them (EmbreeRenderer::Render, MediaFrame):
   // an empty frame is none.
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
-  if (!EffectsNotOnGpu(fx).empty())
-    throw Error("RealtimeFrameData: effects with " + EffectsNotOnGpu(fx) +
-                " are not on the GPU (Unsupported)");
   media_ready_ = false;  // PrepareMedia builds the frame's media for its camera
   media_scene_built_ = false;
   lights_.Update(snapshot, fx);

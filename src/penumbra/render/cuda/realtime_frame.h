@@ -2,7 +2,7 @@
 // the host side of the CUDA backend's realtime tier (realtime_shading.h): the scene's
 // materials, 2d textures (every mip level) and geoms as plain data, made once; per frame the
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
-// key; the frame's lighting effects (EffectsNotOnGpu: light scales and extra lights through
+// key; the frame's effects (light scales and extra lights through
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
 // render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: each
 // pixel's nearest streak found and shaded on the host with the CPU's render/particle_streaks.h,
@@ -43,13 +43,6 @@
 
 namespace penumbra::cuda {
 
-/// why a frame under `effects` cannot be rendered on the GPU ("" if it can). every effect is
-/// since branch gpu12: lighting effects (EffectsFrame::light_intensity_scale, extra_lights,
-/// sun_direction_W, sky_luminance_scale, surface_wetness), particles, homogeneous media (fog,
-/// haze, dust), grid media (smoke, fire, VDB) and particles seen through media; so this is ""
-/// for every frame (the callers keep asking it: a later effect the GPU lacks is named here).
-std::string EffectsNotOnGpu(const EffectsFrame* effects);
-
 /// the plain data of a scene's realtime frames (file comment). not thread-safe.
 class RealtimeFrameData {
  public:
@@ -58,13 +51,8 @@ class RealtimeFrameData {
   /// @throws Error if a texture has more than kMaxTextureLevels levels.
   RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings);
 
-  /// why a frame of `view` under `effects` cannot be rendered by the GPU realtime path ("" if
-  /// it can): not the realtime tier, or effects not on the GPU (EffectsNotOnGpu). (lens
-  /// distortion and camera motion are: camera_rays.h.)
-  std::string Unsupported(const EffectsFrame* effects, const CameraView& view) const;
-
-  /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none;
-  /// they must be on the GPU, EffectsNotOnGpu), sets the camera and frame key of `view`, and
+  /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none),
+  /// sets the camera and frame key of `view`, and
   /// updates the sky volume (built on the first call and when the static bodies move, relit
   /// when the effects change the sky): PoseWorld, then SetCamera, then PrepareStreaks, then
   /// PrepareMedia. a camera with lens distortion or motion gets its ray tables (camera_rays.h),
