@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "penumbra/render/media_realtime_math.h"
+#include "penumbra/render/media_scene_math.h"
 #include "penumbra/render/shading_lanes.h"
 
 namespace penumbra {
@@ -28,31 +29,12 @@ inline float HenyeyGreenstein(float cos_theta, float g) { return MediaPhaseHG(co
 
 /// samples wi from the Henyey-Greenstein distribution around wo (unit, pointing back along the
 /// incoming ray) with two uniform numbers in [0, 1); the pdf of wi is HenyeyGreenstein(dot(wo,
-/// wi), g) (PBR 4th ed., eq. 11.17 and SampleHenyeyGreenstein).
+/// wi), g) (PBR 4th ed., eq. 11.17 and SampleHenyeyGreenstein; SampleHenyeyGreensteinDir of
+/// render/media_scene_math.h).
 inline Eigen::Vector3f SampleHenyeyGreenstein(const Eigen::Vector3f& wo, float g, float u1,
                                               float u2, float* pdf) {
-  // cos of the angle between wi and -wo (the propagation direction).
-  float cos_t;
-  if (std::abs(g) < 1e-3f) {
-    cos_t = 1.0f - 2.0f * u1;
-  } else {
-    const float s = (1.0f - g * g) / (1.0f + g - 2.0f * g * u1);
-    cos_t = (1.0f + g * g - s * s) / (2.0f * g);
-  }
-  cos_t = std::clamp(cos_t, -1.0f, 1.0f);
-  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-  float sp, cp;
-  SinCos2Pi(u2, &sp, &cp);
-  const Eigen::Vector3f w = -wo;
-  // orthonormal basis around w (Duff et al., JCGT 2017).
-  const float sign = w.z() >= 0 ? 1.0f : -1.0f;
-  const float a = -1.0f / (sign + w.z());
-  const float b = w.x() * w.y() * a;
-  const Eigen::Vector3f t(1.0f + sign * w.x() * w.x() * a, sign * b, -sign * w.x());
-  const Eigen::Vector3f bt(b, sign + w.y() * w.y() * a, -w.y());
-  const Eigen::Vector3f wi = (sin_t * cp * t + sin_t * sp * bt + cos_t * w).normalized();
-  *pdf = HenyeyGreenstein(wo.dot(wi), g);
-  return wi;
+  const Float3 wi = SampleHenyeyGreensteinDir(Float3{wo.x(), wo.y(), wo.z()}, g, u1, u2, pdf);
+  return {wi.x, wi.y, wi.z};
 }
 
 /// mean of the three channels.

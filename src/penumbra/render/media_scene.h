@@ -24,14 +24,17 @@
 //  - transmittance: exact exp(-tau) for homogeneous media times ratio tracking (Novak, Selle,
 //    Jarosz, "Residual ratio tracking for estimating attenuation in participating media",
 //    SIGGRAPH Asia 2014, sec. 3) inside every grid box.
+//
+// the formulas are the PB_HOST_DEVICE functions of render/media_scene_math.h over View(): the
+// members below call them, and the CUDA backend's pathtraced tier calls the same ones.
 
 #include <Eigen/Core>
-#include <array>
 #include <memory>
 #include <vector>
 
 #include "penumbra/core/rng.h"
 #include "penumbra/render/media_realtime_math.h"
+#include "penumbra/render/media_scene_math.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
@@ -49,10 +52,8 @@ struct AnalyticMedium {
   Eigen::Vector3f box_min{0, 0, 0}, box_max{0, 0, 0};
   float sigma_bar = 0;  ///< majorant rate at full density: max channel of sigma_t
 
-  /// relative density h(z) = exp(-falloff max(0, z - base)) in (0, 1].
-  float Density(float z) const {
-    return falloff > 0 && z > base ? std::exp(-falloff * (z - base)) : 1.0f;
-  }
+  /// relative density h(z) = exp(-falloff max(0, z - base)) in (0, 1] (MediumHeightDensity).
+  float Density(float z) const { return MediumHeightDensity(falloff, base, z); }
   /// the part [a, b] of [t0, t1] where o + t d is inside the medium; false if empty.
   bool Interval(const Eigen::Vector3f& o, const Eigen::Vector3f& d, float t0, float t1, float* a,
                 float* b) const;
@@ -82,6 +83,9 @@ struct GridVolume {
   float g = 0;
   float max_density = 0;  ///< largest voxel value (recomputed from the data)
   float majorant = 0;     ///< max channel of sigma_t * max_density (> 0 when emissive), 1/m
+  /// these fields as the shared functions read them (MediaScene::Build sets it; its arrays
+  /// point into density / emission).
+  MediaGridPod pod;
 
   Eigen::Vector3f ToGrid(const Eigen::Vector3f& p_W) const { return R_GW * p_W + p_GW; }
   /// trilinear density at grid-frame point x_G (clamped to the outermost voxel centres inside
@@ -97,28 +101,19 @@ struct GridVolume {
                 float* b) const;
 };
 
-/// coefficients of all media at one point, with the mixture of their phase functions.
-struct MediumPoint {
-  static constexpr int kMaxLobes = 8;
-  Eigen::Vector3f sigma_t{0, 0, 0}, sigma_s{0, 0, 0};
-  Eigen::Vector3f emission{0, 0, 0};  ///< cd/m^2 per m
-  float sigma_bar = 0;                ///< the majorant rate at the point (>= max sigma_t)
-  int lobes = 0;                      ///< Henyey-Greenstein lobes, weight ~ mean sigma_s
-  std::array<float, kMaxLobes> weight{}, g{};
+/// coefficients of all media at one point (sigma_t, sigma_s, emission, the majorant rate
+/// sigma_bar), with the mixture of their phase functions (MediumPointPod's fields).
+struct MediumPoint : MediumPointPod {
+  static constexpr int kMaxLobes = kMediumMaxLobes;
 
-  /// the mixture phase function sum_i w_i HG(cos_theta, g_i) / sum_i w_i.
-  float Phase(float cos_theta) const;
-  /// samples a lobe with u0, then wi from it; pdf = Phase(dot(wo, wi)).
+  /// the mixture phase function sum_i w_i HG(cos_theta, g_i) / sum_i w_i (MediaPhase).
+  float Phase(float cos_theta) const { return MediaPhase(*this, cos_theta); }
+  /// samples a lobe with u0, then wi from it; pdf = Phase(dot(wo, wi)) (MediaSamplePhase).
   Eigen::Vector3f SamplePhase(const Eigen::Vector3f& wo, float u0, float u1, float u2,
                               float* pdf) const;
 };
 
-/// outcome of MediaScene::Track.
-enum class TrackEvent {
-  kNone,     ///< the ray reached t1 (throughput reweighted by the null collisions)
-  kScatter,  ///< a real scattering event at *t
-  kAbsorb,   ///< the path was absorbed (its throughput is 0)
-};
+// TrackEvent (the outcome of MediaScene::Track): render/media_scene_math.h.
 
 /// the media of one frame. Build once per frame; the queries are thread-safe.
 class MediaScene {
@@ -134,6 +129,9 @@ class MediaScene {
   /// analytic() as the shared formulas read them (PodOf, same order).
   const std::vector<MediumPod>& analytic_pods() const { return pods_; }
   const std::vector<GridVolume>& grids() const { return grids_; }
+  /// the media as the shared functions of render/media_scene_math.h read them: pointers into
+  /// this object's arrays (valid until the next Build).
+  MediaSceneView View() const;
 
   /// rgb optical depth of the homogeneous media along o + t d (d unit), t in [t0, t1] (t1 may
   /// be +inf). closed form (AnalyticOpticalDepthOf of media_realtime_math.h).
@@ -157,7 +155,9 @@ class MediaScene {
  private:
   std::vector<AnalyticMedium> analytic_;
   std::vector<MediumPod> pods_;
+  std::vector<MediumTracePod> terms_;  // per analytic medium: g, sigma_bar
   std::vector<GridVolume> grids_;
+  std::vector<MediaGridPod> grid_pods_;  // grids_[i].pod
 };
 
 }  // namespace penumbra

@@ -12,7 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <utility>
 
 #include "path_parity.h"
 #include "penumbra/core/rng.h"
@@ -22,6 +24,7 @@
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/path_frame.h"
 #include "penumbra/render/emitter_sampler.h"
+#include "penumbra/render/media_scene.h"
 #include "realtime_parity.h"
 
 namespace penumbra {
@@ -179,17 +182,102 @@ TEST(JitteredCameraRay, FollowsCameraGenerateRay) {
   }
 }
 
-// pathtraced frames with media or particles go to the CPU renderer (the path kernels trace
-// neither media nor streaks): homogeneous fog included, which the realtime tier's kernels do
-// render.
-TEST(PathNotOnGpu, MediaAndParticlesGoToTheCpu) {
+// worlds/effects/<world> at 1 s through camera `camera` at w x h (rgb and depth) with its effects
+// frame: the pathtraced tier's media on the GPU path (fog: homogeneous; smoke_plume: a grid).
+struct MediaFrameCase {
+  std::unique_ptr<Session> session;
+  WorldSnapshot snap;
+  CameraView view;
+  std::shared_ptr<const EffectsFrame> fx;
+};
+
+MediaFrameCase LoadMediaFrame(const std::string& world, int camera, int w, int h) {
+  MediaFrameCase c;
+  c.session = realtime_parity::LoadSimulatedAt("effects/" + world, 1.0);
+  const SceneDescription& scene = c.session->scene();
+  c.snap = c.session->sim().Snapshot();
+  c.view = realtime_parity::RgbDepthView(scene, c.snap, w, h);
+  const CameraSpec& cam = scene.cameras.at(camera);
+  c.view.X_WO = CameraPoseInWorld(cam, c.snap);
+  c.view.intrinsics = CameraIntrinsics::FromFovy(w, h, cam.intrinsics.fovy_deg());
+  c.fx = c.session->effects().Evaluate(c.snap, c.view.X_WO.translation());
+  return c;
+}
+
+// the GPU path with media (TracePath<true>: the free flights' delta tracking, the phase
+// function's next events and samples, the media's transmittance on every shadow ray; the shared
+// formulas of render/media_scene_math.h), run on the CPU, against the CPU backend's
+// PathIntegrator: fog (homogeneous; the rover's camera) and smoke_plume (a grid; the overview
+// camera, which sees the plume), 64x48, 16 spp. the paths draw the CPU's random numbers, so
+// they track its estimate closely; without the media (the paths of clear air) the difference
+// is far larger (the metric can fail).
+class PathtracedHostMedia : public ::testing::TestWithParam<std::pair<std::string, int>> {};
+
+TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
+  const std::string world = GetParam().first;
+  const MediaFrameCase c = LoadMediaFrame(world, GetParam().second, 64, 48);
+  ASSERT_TRUE(c.fx);
+  ASSERT_FALSE(c.fx->homogeneous_media.empty() && c.fx->grid_media.empty());
+  EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
+  const SceneDescription& scene = c.session->scene();
+  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
+  RenderedFrame want;
+  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &want);
+  cuda::BvhScene bvh(scene);
+  bvh.Update(c.snap);
+  cuda::RealtimeFrameData data(scene, settings);
+  ThreadPool pool(0);
+  EffectsFrame storage;
+  data.Prepare(c.snap, c.view, &pool, cuda::EffectsWithoutMedia(c.fx.get(), &storage));
+  EXPECT_FALSE(data.has_media());  // the realtime tier's media volumes are not built
+  MediaScene media;
+  media.Build(c.fx.get());
+  cuda::PathFrameView pf =
+      cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
+  pf.media = media.View();
+  cuda::PathBuffers got, again, clear;
+  cuda::TracePathtracedOnHost(pf, &pool, &got);
+  cuda::TracePathtracedOnHost(pf, &pool, &again);
+  pf.media = MediaSceneView();
+  cuda::TracePathtracedOnHost(pf, &pool, &clear);
+  const double tile = path_parity::TileRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
+  const double mean = path_parity::MeanRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
+  const double tile_clear =
+      path_parity::TileRelativeDifference(RadianceOf(clear, 64, 48), want.radiance);
+  std::printf(
+      "%s 64x48 16 spp (%zu homogeneous, %zu grids): radiance mean relative difference %.4f %% "
+      "(8x8 blocks), %.4f %% (image mean); without the media %.2f %%\n",
+      world.c_str(), media.analytic().size(), media.grids().size(), 100 * tile, 100 * mean,
+      100 * tile_clear);
+  EXPECT_LE(tile, kHostTileTolerance);
+  EXPECT_GT(tile_clear, 5 * kHostTileTolerance);
+  EXPECT_EQ(0, std::memcmp(got.radiance.data(), again.radiance.data(),
+                           sizeof(Float3) * got.radiance.size()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
+                         ::testing::Values(std::make_pair(std::string("fog.yaml"), 0),
+                                           std::make_pair(std::string("smoke_plume.yaml"), 1)));
+
+// pathtraced frames with particles go to the CPU renderer (the path kernels trace no streaks);
+// frames with media (homogeneous or grids) stay on the GPU since branch gpu14.
+TEST(PathNotOnGpu, ParticlesGoToTheCpuMediaDoNot) {
   EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();
-  EXPECT_NE(cuda::PathNotOnGpu(&fog).find("media"), std::string::npos);
+  EXPECT_EQ(cuda::PathNotOnGpu(&fog), "");
   EffectsFrame smoke;
   smoke.grid_media.emplace_back();
-  EXPECT_NE(cuda::PathNotOnGpu(&smoke).find("media"), std::string::npos);
+  EXPECT_EQ(cuda::PathNotOnGpu(&smoke), "");
+  // the realtime tier's media volumes are not built for the paths: Prepare gets the effects
+  // without their media
+  EffectsFrame storage;
+  EXPECT_EQ(cuda::EffectsWithoutMedia(&fog, &storage), nullptr);
+  fog.surface_wetness = 0.5f;
+  const EffectsFrame* lit = cuda::EffectsWithoutMedia(&fog, &storage);
+  ASSERT_NE(lit, nullptr);
+  EXPECT_TRUE(lit->homogeneous_media.empty());
+  EXPECT_EQ(lit->surface_wetness, 0.5f);
   EffectsFrame rain;
   rain.particles.emplace_back();
   EXPECT_NE(cuda::PathNotOnGpu(&rain).find("particles"), std::string::npos);

@@ -55,7 +55,8 @@
 // pixel, 4 bounces, no denoiser): cuda Render() ms a frame (paths on the GPU, film on the host)
 // and the path kernel alone (CUDA events), the CPU backend's Render() on all cores with the same
 // samples (one frame), the radiance's mean relative difference (path_parity.h: 8x8 blocks, and
-// the image mean) and whether two GPU renders are bit-identical. usage:
+// the image mean) and whether two GPU renders are bit-identical; a world's effects at 1 s (media
+// included) in both. usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
 //                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
 //                     [--seed-floor]] [world.yaml ...]
@@ -598,6 +599,10 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     view.intrinsics = CameraIntrinsics::FromFovy(width, height, cam.intrinsics.fovy_deg());
     view.near_m = cam.near_m;
     view.outputs[ImageKind::kRgb] = view.outputs[ImageKind::kDepth] = true;
+    // the world's effects at the snapshot (media included: on the GPU since branch gpu14)
+    const std::shared_ptr<const EffectsFrame> effects =
+        world.session->effects().Evaluate(snap, view.X_WO.translation());
+    const EffectsFrame* fx = effects.get();
     RenderSettings cpu_settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, spp);
     cpu_settings.threads = 0;
     const RenderSettings gpu_settings =
@@ -605,21 +610,21 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);
     auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
     RenderedFrame a, b, want;
-    gpu->Render(snap, view, &a);
-    gpu->Render(snap, view, &b);
+    gpu->Render(snap, fx, view, &a);
+    gpu->Render(snap, fx, view, &b);
     const bool repeats = a.radiance.data == b.radiance.data && a.rgb.data == b.rgb.data;
     const bool on_gpu = g->cpu_frames() == 0;
-    const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames);
+    const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames, fx);
     const double kernel_ms = on_gpu ? g->device_path().TimeKernel(&g->device(), frames) : 0.0;
     const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
     const auto t0 = Clock::now();
-    cpu->Render(snap, view, &want);
+    cpu->Render(snap, fx, view, &want);
     const double cpu_ms = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
     if (seed_floor) {
       RenderSettings other = cpu_settings;
       other.seed = cpu_settings.seed + 1;
       RenderedFrame c;
-      MakeRenderer(scene, other)->Render(snap, view, &c);
+      MakeRenderer(scene, other)->Render(snap, fx, view, &c);
       floors.push_back(fmt::format(
           "{}: two CPU renders with seeds {} and {}: mean relative difference {:.3f} % (8x8 "
           "blocks), {:.3f} % (image mean)",

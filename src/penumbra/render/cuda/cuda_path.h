@@ -2,7 +2,8 @@
 // the pathtraced tier on the GPU (path_shading.h per pixel, path_frame.h on the host): the
 // device copy of the sky's sampling tables and the path kernels. a frame of n pixels splits each
 // pixel's samples into PathRunsPerPixel(n, spp, 2^18) runs of consecutive samples, so that about
-// 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples); one thread a
+// 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples; frames with
+// media run the kernel's TracePath<true> instance, frames without the one of before); one thread a
 // run sums its samples in sample order in double (PathSampleRange), then one thread a pixel adds
 // its runs in run order and writes the pixel (PathFinishPixel). no atomics: frames are
 // bit-identical run to run on one GPU (the run split moves the double sums' last bits against
@@ -36,6 +37,11 @@ class DevicePath {
   /// copies a frame's emitter poses (12 doubles an emitter, UploadEmitters' count) and returns
   /// the device view with them (after UploadEmitters).
   const PathEmitters& UploadEmitterPoses(const double* poses);
+
+  /// copies a frame's media (MediaScene::View: host pointers; the grids' density and emission
+  /// arrays end to end) to the device and returns their device view (valid until the next
+  /// call). call it every frame with media (the grids' arrays change with the effects' time).
+  const MediaSceneView& UploadMedia(const MediaSceneView& host);
 
   /// renders the frame `pf` (device pointers everywhere but the outputs, which are set here)
   /// on `scene`'s stream and copies its radiance, albedo, normal and depth into `out` (resized

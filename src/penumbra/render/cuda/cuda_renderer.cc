@@ -70,7 +70,7 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   if (!rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier media and "
+          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier "
           "particles); "
           "such frames are rendered by the CPU renderer (docs/gpu.md)",
           rgb_why);
@@ -187,8 +187,11 @@ void CudaRenderer::UploadRealtime() {
 void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                                     const CameraView& view, const PinholeCamera& camera,
                                     std::chrono::steady_clock::time_point t0, RenderedFrame* out) {
-  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again
-  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_);
+  // the camera's ray tables were Prepared by Render (camera_rays_): not computed again. the
+  // media are the paths' own (path_media_), not the realtime tier's volumes
+  realtime_->Prepare(snapshot, view, pool_.get(), EffectsWithoutMedia(effects, &path_effects_),
+                     &camera_rays_);
+  path_media_.Build(effects != nullptr && !effects->empty() ? effects : nullptr);
   UploadRealtime();
   // the frame sky's sampling tables, again when the sky changes (the effects' sun or scale)
   if (sampling_sky_ != &realtime_->frame_sky() || sampling_generation_ != sky_generation_) {
@@ -210,6 +213,7 @@ void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const Effects
     emitter_host_->SetPoses(*emitters_, snapshot.X_WB);
     pf.emitters = device_path_->UploadEmitterPoses(emitter_host_->poses.data());
   }
+  if (!path_media_.empty()) pf.media = device_path_->UploadMedia(path_media_.View());
   prepare_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   device_path_->Render(device_.get(), pf, &path_buffers_);

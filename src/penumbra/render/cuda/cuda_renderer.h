@@ -6,8 +6,10 @@
 // of the pixel centre's primary ray (depth, segmentation (geom ids), instance (body) and semantic
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
 // realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
-// frame's preparation on the host, realtime_frame.h). everything else (the pathtraced tier's
-// media and particles) is not on the GPU yet: such a frame is rendered whole by the
+// frame's preparation on the host, realtime_frame.h), and in the pathtraced tier rgb and
+// radiance with media too (path_shading.h, since branch gpu14). everything else (the pathtraced
+// tier's particles, distorted or moving cameras) is not on the GPU yet: such a frame is
+// rendered whole by the
 // CPU renderer handed in (`cpu`), so every output exists and equals the CPU backend's for those
 // frames; docs/gpu.md lists what is where.
 
@@ -114,6 +116,9 @@ class CudaRenderer final : public Renderer {
   uint64_t sampling_generation_ = 0;
   SkySamplingPod sky_sampling_;       // their device copy
   PathBuffers path_buffers_;          // the pathtraced frame's outputs on the host
+  MediaScene path_media_;             // the pathtraced frame's media (their device copy:
+                                      // DevicePath::UploadMedia)
+  EffectsFrame path_effects_;         // the frame's effects without media (EffectsWithoutMedia)
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;

@@ -7,12 +7,18 @@ namespace penumbra::cuda {
 
 std::string PathNotOnGpu(const EffectsFrame* effects) {
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
-  // the path kernels trace no medium (the realtime tier's homogeneous media are on the GPU,
-  // EffectsNotOnGpu, the pathtraced tier's delta tracking is not)
-  if (fx != nullptr && (!fx->homogeneous_media.empty() || !fx->grid_media.empty()))
-    return "the pathtraced tier with media (fog, haze, dust, smoke, fire, VDB)";
+  // media are traced by the path kernels (media_scene_math.h; branch gpu14)
   if (fx != nullptr && !fx->particles.empty()) return "the pathtraced tier with particles";
   return "";
+}
+
+const EffectsFrame* EffectsWithoutMedia(const EffectsFrame* effects, EffectsFrame* storage) {
+  if (effects == nullptr || (effects->homogeneous_media.empty() && effects->grid_media.empty()))
+    return effects;
+  *storage = *effects;
+  storage->homogeneous_media.clear();
+  storage->grid_media.clear();
+  return storage->empty() ? nullptr : storage;
 }
 
 PathEmitterHost::PathEmitterHost(const EmitterSampler& sampler) : pick_cdf(&sampler.pick_cdf()) {
@@ -121,11 +127,12 @@ void TracePathtracedOnHost(const PathFrameView& frame, ThreadPool* pool, PathBuf
 
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                             RenderedFrame* out, const Eigen::Vector3f& white_balance_gains,
-                            const PathEmitters* emitters) {
+                            const PathEmitters* emitters, const MediaSceneView* media) {
   PathBuffers b;
   PathFrameView pf =
       PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
   if (emitters != nullptr) pf.emitters = *emitters;
+  if (media != nullptr) pf.media = *media;
   TracePathtracedOnHost(pf, pool, &b);
   std::unique_ptr<Denoiser> denoiser;
   if (data.settings().denoise) denoiser = std::make_unique<Denoiser>();

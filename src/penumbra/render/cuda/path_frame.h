@@ -23,11 +23,12 @@
 
 namespace penumbra::cuda {
 
-/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can):
-/// effects not on the GPU (EffectsNotOnGpu), media, or particles (the CPU's camera rays stop at
-/// streaks with a random draw). a camera with lens distortion or motion (rolling shutter, or
-/// the exposure's motion that every frame of a run has) is on the GPU: its jittered rays come
-/// from its ray tables (JitteredCameraRay, path_shading.h).
+/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can): particles
+/// (the CPU's camera rays stop at streaks with a random draw). media (homogeneous and grids)
+/// are traced on the GPU since branch gpu14 (PathFrameView::media); a camera with lens
+/// distortion or motion (rolling shutter, or the exposure's motion that every frame of a run
+/// has) is on the GPU: its jittered rays come from its ray tables (JitteredCameraRay,
+/// path_shading.h).
 std::string PathNotOnGpu(const EffectsFrame* effects);
 
 /// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
@@ -69,10 +70,17 @@ void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffer
 /// max_bounces) rendered by PathTracePixel on the CPU over `bvh` (Updated for the snapshot),
 /// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
 /// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
-/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none).
+/// `emitters`: the scene's emissive geoms posed for the snapshot (null: none); `media`: the
+/// frame's media (MediaScene::View; null: none).
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                             RenderedFrame* out,
                             const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),
-                            const PathEmitters* emitters = nullptr);
+                            const PathEmitters* emitters = nullptr,
+                            const MediaSceneView* media = nullptr);
+
+/// `effects` without its media (null where nothing else is left): what the pathtraced tier's
+/// RealtimeFrameData::Prepare takes (the paths trace the media themselves, so the realtime
+/// tier's media volumes are not built).
+const EffectsFrame* EffectsWithoutMedia(const EffectsFrame* effects, EffectsFrame* storage);
 
 }  // namespace penumbra::cuda

@@ -21,6 +21,8 @@ constexpr int64_t kPathThreads = 1 << 18;
 
 // run k of pixel (u, v) a thread (threadIdx.x over 64 pixels of a row, blockIdx.z the run):
 // samples [k c, min((k + 1) c, spp)) with c = ceil(spp / runs), summed into partial[k n + i].
+// kMedia: the frame has media (TracePath<true>); frames without keep the kernel of before.
+template <bool kMedia>
 __global__ void __launch_bounds__(64)
     PathRunKernel(PathFrameView pf, int runs, PathPartial* partial) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
@@ -31,7 +33,7 @@ __global__ void __launch_bounds__(64)
   const int s0 = k * c, s1 = s0 + c < pf.spp ? s0 + c : pf.spp;
   const int64_t n = static_cast<int64_t>(pf.rt.camera.width) * pf.rt.camera.height;
   const int64_t i = static_cast<int64_t>(v) * pf.rt.camera.width + u;
-  partial[k * n + i] = s0 < s1 ? PathSampleRange(pf, u, v, s0, s1) : PathPartial{};
+  partial[k * n + i] = s0 < s1 ? PathSampleRange<kMedia>(pf, u, v, s0, s1) : PathPartial{};
 }
 
 // a pixel a thread: its runs' sums added in run order (no atomics), then its outputs.
@@ -52,7 +54,11 @@ __global__ void PathFinishKernel(PathFrameView pf, int runs, const PathPartial* 
 
 void LaunchPath(const PathFrameView& pf, PathPartial* partial, int runs, cudaStream_t stream) {
   const int W = pf.rt.camera.width, H = pf.rt.camera.height;
-  PathRunKernel<<<dim3((W + 63) / 64, H, runs), 64, 0, stream>>>(pf, runs, partial);
+  if (MediaAny(pf.media)) {
+    PathRunKernel<true><<<dim3((W + 63) / 64, H, runs), 64, 0, stream>>>(pf, runs, partial);
+  } else {
+    PathRunKernel<false><<<dim3((W + 63) / 64, H, runs), 64, 0, stream>>>(pf, runs, partial);
+  }
   Check(cudaGetLastError(), "PathRunKernel");
   PathFinishKernel<<<dim3((W + 7) / 8, (H + 7) / 8), dim3(8, 8), 0, stream>>>(pf, runs, partial);
   Check(cudaGetLastError(), "PathFinishKernel");
@@ -66,6 +72,8 @@ struct DevicePath::Impl {
   Buffer radiance, albedo, normal, depth, partial;
   Buffer em_pods, em_le, em_pick, em_of_geom, em_cdf, em_vertices, em_faces, em_poses;
   PathEmitters emitters;
+  Buffer media_pods, media_terms, grid_pods, grid_density, grid_emission;
+  MediaSceneView media;
   PathFrameView last;  // the last Render's frame and sample runs (TimeKernel)
   int runs = 1;
   bool rendered = false;
@@ -145,6 +153,45 @@ const PathEmitters& DevicePath::UploadEmitterPoses(const double* poses) {
   Check(cudaStreamSynchronize(nullptr), "uploading the emitter poses");
   m.emitters.poses = m.em_poses.as<double>();
   return m.emitters;
+}
+
+const MediaSceneView& DevicePath::UploadMedia(const MediaSceneView& h) {
+  Impl& m = *impl_;
+  // every grid's density (and emission) in one array each, the grid pods pointing into them
+  std::vector<MediaGridPod> grids(h.grids, h.grids + h.num_grids);
+  size_t density_n = 0, emission_n = 0;
+  for (const MediaGridPod& g : grids) {
+    const size_t cells = static_cast<size_t>(g.n[0]) * g.n[1] * g.n[2];
+    density_n += cells;
+    if (g.emission != nullptr) emission_n += 3 * cells;
+  }
+  m.grid_density.Reserve(sizeof(float) * density_n);
+  m.grid_emission.Reserve(sizeof(float) * emission_n);
+  size_t density_at = 0, emission_at = 0;
+  for (MediaGridPod& g : grids) {
+    const size_t cells = static_cast<size_t>(g.n[0]) * g.n[1] * g.n[2];
+    float* dd = m.grid_density.as<float>() + density_at;
+    Check(cudaMemcpy(dd, g.density, sizeof(float) * cells, cudaMemcpyHostToDevice),
+          "uploading a grid's density");
+    g.density = dd;
+    density_at += cells;
+    if (g.emission != nullptr) {
+      float* de = m.grid_emission.as<float>() + emission_at;
+      Check(cudaMemcpy(de, g.emission, sizeof(float) * 3 * cells, cudaMemcpyHostToDevice),
+            "uploading a grid's emission");
+      g.emission = de;
+      emission_at += 3 * cells;
+    }
+  }
+  m.media_pods.Upload(h.media, sizeof(MediumPod) * h.num_media, nullptr);
+  m.media_terms.Upload(h.terms, sizeof(MediumTracePod) * h.num_media, nullptr);
+  m.grid_pods.Upload(grids.data(), sizeof(MediaGridPod) * grids.size(), nullptr);
+  Check(cudaStreamSynchronize(nullptr), "uploading the media");
+  m.media = h;
+  m.media.media = h.num_media > 0 ? m.media_pods.as<MediumPod>() : nullptr;
+  m.media.terms = h.num_media > 0 ? m.media_terms.as<MediumTracePod>() : nullptr;
+  m.media.grids = h.num_grids > 0 ? m.grid_pods.as<MediaGridPod>() : nullptr;
+  return m.media;
 }
 
 void DevicePath::Render(DeviceScene* scene, const PathFrameView& frame, PathBuffers* out) {

@@ -4,7 +4,7 @@
 // pixel then summed in run order: PathSampleRange, PathFinishPixel) and RenderPathtracedOnHost
 // (path_frame.h) runs the same functions on the CPU over the host BVH (tests, machines without
 // a GPU). the path is the CPU's PathIntegrator (render/cpu/path_integrator.h, where the model is
-// documented) step for step, for frames without media or particles:
+// documented) step for step, for frames without particles (with media since branch gpu14):
 //
 //   per sample s of pixel (u, v): Rng(PixelStream(u, v, s)) (core/rng.h, the same draws in the
 //   same order), a camera ray jittered over the pixel (two draws); at each vertex the lamp
@@ -14,12 +14,17 @@
 //   next-event estimation (one sample of every light: two draws each, MIS for lamp spheres and
 //   sun discs; the sky: two draws, MIS; one emissive geom: three draws, MIS), Russian roulette from
 //   kPathRussianRouletteStartVertex (one draw) and the BSDF's sample (three draws);
+//   with media (TracePath<true>): before each surface the free flight's spectral delta tracking
+//   (MediaTrackOf; its draws), at a real scattering event next-event estimation through the
+//   phase function, Russian roulette and the phase function's sample (three draws), and on every
+//   shadow ray the media's transmittance (MediaTransmittanceOf; draws inside grid boxes);
 //
 // with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
 // with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
 // (path_math.h), the emissive geoms' sampling (emitter_math.h), the sky's radiance and
 // background (sky_eval_math.h) and sampling
-// (sky_sampling_math.h), dot products summed as the CPU's Eigen code sums them (EigenDot),
+// (sky_sampling_math.h), the media (media_scene_math.h: MediaScene's tracking, transmittance and
+// phase functions), dot products summed as the CPU's Eigen code sums them (EigenDot),
 // and the materials with their textures over the path's ray cone as the
 // realtime tier evaluates them (EvaluateSurface, realtime_shading.h). the GPU contracts
 // multiply-adds, so its paths differ from the CPU's by float rounding, which a path's branches
@@ -34,6 +39,7 @@
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/emitter_math.h"
 #include "penumbra/render/light_math.h"
+#include "penumbra/render/media_scene_math.h"
 #include "penumbra/render/path_math.h"
 #include "penumbra/render/shading_math.h"
 #include "penumbra/render/sky_eval_math.h"
@@ -85,6 +91,9 @@ struct PathFrameView {
   int32_t spp = 1;              ///< samples per pixel (>= 1)
   int32_t max_bounces = 1;      ///< >= 1
   PathEmitters emitters;        ///< the emissive geoms (none: num 0)
+  /// the frame's participating media (MediaScene::View's or its device copy; none: empty, and
+  /// the paths run TracePath<false>)
+  MediaSceneView media;
   /// per pixel (row-major, width x height): the mean radiance, the mean base colour of the
   /// first surface over the samples that hit one (the denoiser's albedo), and the pixel-centre
   /// hit's usable shading normal (0 where it escapes) and z-depth (0 where it escapes).
@@ -128,13 +137,72 @@ PB_HOST_DEVICE inline Float3 PathMul(const Float3& a, const Float3& b) {
   return Float3{a.x * b.x, a.y * b.y, a.z * b.z};
 }
 
-/// next-event estimation at surface point sp with BSDF b and path throughput beta, drawing from
-/// rng as the CPU's next_event: one sample of every light, then the sky. adds to *L.
-PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingPoint& sp,
-                                         const BsdfPod& b, const Float3& beta, Rng* rng,
-                                         Float3* L) {
+/// a surface vertex of a path as PathNextEvent reads it: the BSDF's value times |cos| and its
+/// density (Eval), the shadow ray in a direction off the surface (Spawn, render/ray.h's SpawnRay)
+/// and towards a point (SpawnTo, SpawnRayTo: d = q - origin, stopping kPathShadowShorten short).
+struct PathSurfaceVertex {
+  const ShadingPoint* sp;
+  const BsdfPod* b;
+  PB_HOST_DEVICE Float3 Point() const { return sp->p; }
+  PB_HOST_DEVICE void Eval(const Float3& wi, Float3* f, float* pdf) const {
+    *f = BsdfEval(*b, wi);
+    *pdf = PathMax3(*f) > 0 ? BsdfPdf(*b, wi) : 0.0f;
+  }
+  PB_HOST_DEVICE TraceRay Spawn(const Float3& wi) const { return PathSpawnRay(sp->p, sp->ng, wi); }
+  PB_HOST_DEVICE TraceRay SpawnTo(const Float3& q) const {
+    const Float3& p = sp->p;
+    TraceRay sr = PathSpawnRay(p, sp->ng, Float3{q.x - p.x, q.y - p.y, q.z - p.z});
+    const Float3 o = ToFloat3(sr.o);
+    sr.d = ToF3(Float3{q.x - o.x, q.y - o.y, q.z - o.z});
+    sr.tmax = 1.0f - kPathShadowShorten;
+    return sr;
+  }
+};
+
+/// a medium vertex (a real scattering event at p, wo back along the arriving ray, the media's
+/// point mp): the phase function as value and density (the CPU's lambda), rays from p itself.
+struct PathMediumVertex {
+  Float3 p, wo;
+  const MediumPointPod* mp;
+  PB_HOST_DEVICE Float3 Point() const { return p; }
+  PB_HOST_DEVICE void Eval(const Float3& wi, Float3* f, float* pdf) const {
+    *pdf = MediaPhase(*mp, EigenDot(wo, wi));
+    *f = Float3{*pdf, *pdf, *pdf};
+  }
+  PB_HOST_DEVICE TraceRay Spawn(const Float3& wi) const {
+    TraceRay r;
+    r.o = ToF3(p);
+    r.d = ToF3(wi);
+    r.tmin = 0;
+    r.tmax = INFINITY;
+    return r;
+  }
+  PB_HOST_DEVICE TraceRay SpawnTo(const Float3& q) const {
+    TraceRay r = Spawn(Float3{q.x - p.x, q.y - p.y, q.z - p.z});
+    r.tmax = 1.0f - 1e-4f;
+    return r;
+  }
+};
+
+/// the media's transmittance along o + t d, t in [0, dist] (MediaTransmittanceOf), or 1 where
+/// the frame has no media (kMedia false: no call).
+template <bool kMedia>
+PB_HOST_DEVICE inline Float3 PathMediaT(const PathFrameView& pf, const Float3& o, const Float3& d,
+                                        float dist, Rng* rng) {
+  if (!kMedia) return Float3{1, 1, 1};
+  const float o3[3] = {o.x, o.y, o.z}, d3[3] = {d.x, d.y, d.z};
+  return MediaTransmittanceOf(pf.media, o3, d3, 0.0f, dist, rng);
+}
+
+/// next-event estimation at vertex `vx` (PathSurfaceVertex or PathMediumVertex) with path
+/// throughput beta, drawing from rng as the CPU's next_event: one sample of every light, then
+/// the sky, then one emissive geom; with kMedia every unoccluded shadow ray's contribution
+/// times the media's transmittance. adds to *L.
+template <bool kMedia, typename Vertex>
+PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const Vertex& vx,
+                                         const Float3& beta, Rng* rng, Float3* L) {
   const RealtimeFrameView& f = pf.rt;
-  const Float3& p = sp.p;
+  const Float3 p = vx.Point();
   for (int j = 0; j < f.num_lights; ++j) {
     const float u1 = rng->Uniform(), u2 = rng->Uniform();
     const LightPod& l = f.lights[j];
@@ -143,8 +211,9 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingP
     bool valid;
     SampleLight<float, Float3, bool, true>(l, p, u1, u2, &wi, &dist, &E, &valid);
     if (!valid) continue;
-    const Float3 fv = BsdfEval(b, wi);
-    const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+    Float3 fv;
+    float f_pdf;
+    vx.Eval(wi, &fv, &f_pdf);
     if (!(PathMax3(fv) > 0)) continue;
     Float3 c;
     SunDiscPod sun;
@@ -161,11 +230,14 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingP
     }
     if (!(PathMax3(c) > 0)) continue;
     if (l.cast_shadow != 0) {
-      TraceRay sr = PathSpawnRay(p, sp.ng, wi);
+      TraceRay sr = vx.Spawn(wi);
       sr.tmax = dist == INFINITY ? INFINITY : dist * (1.0f - kPathShadowShorten);
       if (TraceOccluded(f.scene, sr)) continue;
       float t;
       if (PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, sr.tmax, &t, lamp ? j : -1) >= 0) continue;
+      if (kMedia) c = PathMul(c, PathMediaT<kMedia>(pf, ToFloat3(sr.o), wi, sr.tmax, rng));
+    } else if (kMedia) {
+      c = PathMul(c, PathMediaT<kMedia>(pf, p, wi, dist, rng));
     }
     *L = *L + PathMul(beta, c);
   }
@@ -175,17 +247,20 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingP
     SkySampleDirection(pf.sky_sampling, u1, u2, &pdf, d);
     if (pdf > 0) {
       const Float3 wi{d[0], d[1], d[2]};
-      const Float3 fv = BsdfEval(b, wi);
-      const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+      Float3 fv;
+      float f_pdf;
+      vx.Eval(wi, &fv, &f_pdf);
       if (PathMax3(fv) > 0) {
-        const TraceRay sr = PathSpawnRay(p, sp.ng, wi);
+        const TraceRay sr = vx.Spawn(wi);
         float t;
         if (!TraceOccluded(f.scene, sr) &&
             PathNearestLamp(f, ToFloat3(sr.o), wi, 0.0f, INFINITY, &t) < 0) {
           const float w = PowerHeuristic(pdf, f_pdf);
           float sky[3];
           SkyRadiance(f.sky, wi.x, wi.y, wi.z, sky);
-          *L = *L + PathMul(beta, PathMul(fv, Float3{sky[0], sky[1], sky[2]})) * (w / pdf);
+          Float3 c = PathMul(beta, PathMul(fv, Float3{sky[0], sky[1], sky[2]})) * (w / pdf);
+          if (kMedia) c = PathMul(c, PathMediaT<kMedia>(pf, ToFloat3(sr.o), wi, INFINITY, rng));
+          *L = *L + c;
         }
       }
     }
@@ -205,21 +280,19 @@ PB_HOST_DEVICE inline void PathNextEvent(const PathFrameView& pf, const ShadingP
                      static_cast<float>(ep.q[2])};
       const Float3 wi{static_cast<float>(ep.wi[0]), static_cast<float>(ep.wi[1]),
                       static_cast<float>(ep.wi[2])};
-      const Float3 fv = BsdfEval(b, wi);
-      const float f_pdf = PathMax3(fv) > 0 ? BsdfPdf(b, wi) : 0.0f;
+      Float3 fv;
+      float f_pdf;
+      vx.Eval(wi, &fv, &f_pdf);
       if (PathMax3(fv) > 0) {
-        // render/ray.h's SpawnRayTo: off the surface on the point's side, d = q - origin,
-        // stopping 1e-4 of the way short.
-        TraceRay sr = PathSpawnRay(p, sp.ng, Float3{q.x - p.x, q.y - p.y, q.z - p.z});
-        const Float3 o = ToFloat3(sr.o);
-        const Float3 dq{q.x - o.x, q.y - o.y, q.z - o.z};
-        sr.d = ToF3(dq);
-        sr.tmax = 1.0f - kPathShadowShorten;
+        const TraceRay sr = vx.SpawnTo(q);
+        const Float3 o = ToFloat3(sr.o), dq = ToFloat3(sr.d);
         const float dist = sqrtf(EigenDot(dq, dq)) * sr.tmax;
         float t;
         if (!TraceOccluded(f.scene, sr) && PathNearestLamp(f, o, wi, 0.0f, dist, &t) < 0) {
           const float w = PowerHeuristic(ep.pdf, f_pdf);
-          *L = *L + PathMul(beta, PathMul(fv, em.Le[k])) * (w / ep.pdf);
+          Float3 c = PathMul(beta, PathMul(fv, em.Le[k])) * (w / ep.pdf);
+          if (kMedia) c = PathMul(c, PathMediaT<kMedia>(pf, o, wi, dist, rng));
+          *L = *L + c;
         }
       }
     }
@@ -267,7 +340,8 @@ PB_HOST_DEVICE inline TraceRay JitteredCameraRay(const PinholeCamera& c, int u, 
 
 /// one path of sample s of pixel (u, v): its radiance (non-finite values are the caller's to
 /// drop) and, where its camera ray meets a surface, that surface's base colour (*albedo,
-/// *hit_first true).
+/// *hit_first true). kMedia: the frame has media (pf.media not empty).
+template <bool kMedia>
 PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, int s, Float3* albedo,
                                        bool* hit_first) {
   const RealtimeFrameView& f = pf.rt;
@@ -296,6 +370,46 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
     // a lamp sphere in front of the surface ends the path.
     float t_lamp;
     const int lamp = PathNearestLamp(f, o, d, ray.tmin, t_surface, &t_lamp);
+
+    if (kMedia) {
+      // the free flight through the media up to the lamp or surface: absorbed, scattered (a
+      // medium vertex: next events through the phase function, then its sample), or through.
+      const float t_end = lamp >= 0 ? t_lamp : t_surface;
+      const float o3[3] = {o.x, o.y, o.z}, d3[3] = {d.x, d.y, d.z};
+      float t_scatter;
+      MediumPointPod mp;
+      const TrackEvent ev =
+          MediaTrackOf(pf.media, o3, d3, ray.tmin, t_end, &rng, &beta, &L, &t_scatter, &mp);
+      if (ev == TrackEvent::kAbsorb) break;
+      if (ev == TrackEvent::kScatter) {
+        if (vertex >= pf.max_bounces) break;
+        const Float3 p{o.x + t_scatter * d.x, o.y + t_scatter * d.y, o.z + t_scatter * d.z};
+        const Float3 wo{-d.x, -d.y, -d.z};
+        PathNextEvent<kMedia>(pf, PathMediumVertex{p, wo, &mp}, beta, &rng, &L);
+        if (vertex >= kPathRussianRouletteStartVertex) {
+          const float q = pbm::Min(1.0f, PathMax3(beta));
+          if (!(rng.Uniform() < q)) break;
+          beta = Float3{beta.x / q, beta.y / q, beta.z / q};
+        }
+        const float u0 = rng.Uniform(), u1 = rng.Uniform(), u2 = rng.Uniform();
+        float pdf;
+        const Float3 wi = MediaSamplePhase(mp, wo, u0, u1, u2, &pdf);
+        if (!(pdf > 0) || !(PathMax3(beta) > 0) || !pbm::IsFinite(beta.x) ||
+            !pbm::IsFinite(beta.y) || !pbm::IsFinite(beta.z))
+          break;
+        // phase sampling is exact: f / pdf = 1.
+        prev_pdf = pdf;
+        prev_p = p;
+        from_camera = false;
+        path_m += t_scatter * sqrtf(EigenDot(d, d));
+        ray.o = ToF3(p);
+        ray.d = ToF3(wi);
+        ray.tmin = 0;
+        ray.tmax = INFINITY;
+        continue;
+      }
+    }
+
     if (lamp >= 0) {
       float w = 1.0f;
       if (!from_camera) {
@@ -371,7 +485,7 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
     BrdfCoefficientsOf<float, Float3>(sp.base, sp.roughness, sp.metallic, sp.specular, &c_diff, &f0,
                                       &alpha);
     const BsdfPod b = MakeBsdf(c_diff, f0, alpha, sp.n, sp.ng, Float3{-d.x, -d.y, -d.z});
-    PathNextEvent(pf, sp, b, beta, &rng, &L);
+    PathNextEvent<kMedia>(pf, PathSurfaceVertex{&sp, &b}, beta, &rng, &L);
 
     // Russian roulette, then continue along a BSDF sample.
     if (vertex >= kPathRussianRouletteStartVertex) {
@@ -404,14 +518,15 @@ struct PathPartial {
   int32_t albedo_count = 0;
 };
 
-/// samples [s0, s1) of pixel (u, v) (TracePath), summed in sample order.
+/// samples [s0, s1) of pixel (u, v) (TracePath<kMedia>), summed in sample order.
+template <bool kMedia>
 PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, int u, int v, int s0,
                                                   int s1) {
   PathPartial p;
   for (int s = s0; s < s1; ++s) {
     Float3 albedo;
     bool hit = false;
-    const Float3 L = TracePath(pf, u, v, s, &albedo, &hit);
+    const Float3 L = TracePath<kMedia>(pf, u, v, s, &albedo, &hit);
     if (hit) {
       p.albedo[0] += albedo.x, p.albedo[1] += albedo.y, p.albedo[2] += albedo.z;
       ++p.albedo_count;
@@ -450,9 +565,12 @@ PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v
 }
 
 /// pixel (u, v) of a pathtraced frame in one run: all pf.spp samples (PathSampleRange) summed in
-/// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel.
+/// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel
+/// (TracePath<true> where the frame has media).
 PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, int u, int v) {
-  PathFinishPixel(pf, u, v, PathSampleRange(pf, u, v, 0, pf.spp));
+  PathFinishPixel(pf, u, v,
+                  MediaAny(pf.media) ? PathSampleRange<true>(pf, u, v, 0, pf.spp)
+                                     : PathSampleRange<false>(pf, u, v, 0, pf.spp));
 }
 
 /// the sample runs of a frame of n pixels and spp samples on a processor that wants about
