@@ -5,7 +5,7 @@
 # the GPU and the CPU;
 # batches of 1, 64 and 1024 cameras at 128x128 in the house, depth+seg
 # and realtime rgb+depth with its stages' GPU times; copy rates), the pathtraced tier's frame
-# time beside the CPU backend's (default and house, 320x240, 64 samples per pixel), the parity
+# time beside the CPU backend's (default, house and fog, 320x240, 64 samples per pixel), the parity
 # table (parity.sh), and prints one summary table, then the measurements (docs/gpu.md).
 #
 #   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
@@ -59,7 +59,8 @@ timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --bat
   --size 128x128 --sessions 4 "$pkg/src/worlds/house.yaml" > "$log/sessions.txt" 2>&1
 sessions_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_bench" --pathtraced --spp 64 --size 320x240 --frames 3 \
-  "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" > "$log/pathtraced.txt" 2>&1
+  "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" \
+  "$pkg/src/worlds/effects/fog.yaml" > "$log/pathtraced.txt" 2>&1
 path_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
 host_rc=$?
