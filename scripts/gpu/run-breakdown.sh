@@ -44,8 +44,9 @@ done
 python3 - "$out" "${worlds[@]}" <<'PY'
 import json, os, sys
 out, worlds = sys.argv[1], sys.argv[2:]
-keys = ["total_sec", "physics_sec", "render_sec", "png_encode_sec", "png_write_sec",
-        "scene_build_sec", "compose_sec", "load_sec", "sensors_lidar_effects_sec"]
+keys = ["total_sec", "physics_sec", "render_sec", "render_first_frames_sec",
+        "render_renderer_sec", "png_encode_sec", "png_write_sec", "scene_build_sec",
+        "compose_sec", "load_sec", "sensors_lidar_effects_sec"]
 print("| world | backend | round | frames | " + " | ".join(k[:-4] for k in keys) + " |")
 print("|---|---|---|---|" + "---|" * len(keys))
 for w in worlds:
