@@ -131,22 +131,7 @@ void AsyncFrameWriter::WorkerLoop() {
       failure = std::current_exception();
     }
     // keep only what the frames.csv row needs; the images go back to the caller, or are freed
-    CameraFrame images;
-    images.camera = job.frame.camera;
-    images.rgb = std::move(job.frame.rgb);
-    images.depth_m = std::move(job.frame.depth_m);
-    images.geom_id = std::move(job.frame.geom_id);
-    images.range_m = std::move(job.frame.range_m);
-    images.normal_O = std::move(job.frame.normal_O);
-    images.body_id = std::move(job.frame.body_id);
-    images.semantic_class = std::move(job.frame.semantic_class);
-    job.frame.rgb = {};
-    job.frame.depth_m = {};
-    job.frame.geom_id = {};
-    job.frame.range_m = {};
-    job.frame.normal_O = {};
-    job.frame.body_id = {};
-    job.frame.semantic_class = {};
+    CameraFrame images = TakeImages(&job.frame);
     if (options_.on_written) options_.on_written(std::move(images));
 
     lock.lock();

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "penumbra/core/image.h"
@@ -29,6 +30,22 @@ struct CameraFrame {
   ImageI32 body_id;  ///< (H x W x 1) body index of the hit, -1 = background
   ImageI32 semantic_class;  ///< (H x W x 1) semantic class id of the hit, 0 = none
 };
+
+/// moves `frame`'s images (rgb, depth_m and the ground-truth images) into a new frame of the same
+/// camera, leaving `frame` with empty images (width and height 0) and its name, index, step,
+/// time and pose.
+inline CameraFrame TakeImages(CameraFrame* frame) {
+  CameraFrame images;
+  images.camera = frame->camera;
+  images.rgb = std::exchange(frame->rgb, {});
+  images.depth_m = std::exchange(frame->depth_m, {});
+  images.geom_id = std::exchange(frame->geom_id, {});
+  images.range_m = std::exchange(frame->range_m, {});
+  images.normal_O = std::exchange(frame->normal_O, {});
+  images.body_id = std::exchange(frame->body_id, {});
+  images.semantic_class = std::exchange(frame->semantic_class, {});
+  return images;
+}
 
 /// calls `fn(image)` with the frame's image of `kind` (scene/image_kind.h): an ImageU8 (rgb), an
 /// ImageF (depth_m, range_m, normal_O) or an ImageI32 (geom_id, body_id, semantic_class); returns

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
@@ -67,6 +68,15 @@ std::string BlackFrameCause(const SceneDescription& scene, const RenderSettings&
       "at this frame is [{:.3g}, {:.3g}, {:.3g}] m) or see only unlit surfaces; expected the "
       "camera outside every model, facing something lit",
       img.X_WO.translation().x(), img.X_WO.translation().y(), img.X_WO.translation().z());
+}
+
+// moves the images of a frame that the writer never gets (the renderer's radiance, rgb and
+// depth, the imager's radiance) from `from` to `to`, leaving them empty in `from`.
+void MoveUnwrittenImages(CameraImages* from, CameraImages* to) {
+  to->truth.radiance = std::exchange(from->truth.radiance, {});
+  to->truth.rgb = std::exchange(from->truth.rgb, {});
+  to->truth.depth_m = std::exchange(from->truth.depth_m, {});
+  to->radiance = std::exchange(from->radiance, {});
 }
 
 }  // namespace
@@ -249,12 +259,7 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   const Pose X1 = end ? CameraPoseInWorld(spec, *end) : X0;
   // the images of this camera's earlier frames, overwritten in place (FrameBufferPool)
   CameraImages img;
-  CameraImages& scratch = scratch_[p.camera];
-  img.truth.radiance = std::move(scratch.truth.radiance);
-  img.truth.rgb = std::move(scratch.truth.rgb);
-  img.truth.depth_m = std::move(scratch.truth.depth_m);
-  img.radiance = std::move(scratch.radiance);
-  scratch = CameraImages();
+  MoveUnwrittenImages(&scratch_[p.camera], &img);
   buffers_.Take(spec.name, &img);
   const auto t0 = std::chrono::steady_clock::now();
   imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
@@ -264,15 +269,8 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
     rendered_once_[p.camera] = 1;
     render_first_frames_sec_ += sec;
   }
-  // what the writer does not get stays for the next frame
-  const auto keep_scratch = [&] {
-    scratch.truth.radiance = std::move(img.truth.radiance);
-    scratch.truth.rgb = std::move(img.truth.rgb);
-    scratch.truth.depth_m = std::move(img.truth.depth_m);
-    scratch.radiance = std::move(img.radiance);
-  };
   if (img.stopped) {
-    keep_scratch();
+    MoveUnwrittenImages(&img, &scratch_[p.camera]);
     // the stop request (SIGINT / SIGTERM) ended the render: the frame is not written
     spdlog::info(
         "camera '{}': frame {} at {:.6g} s was being rendered when the run was stopped; "
@@ -300,7 +298,7 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   cf.normal_O = std::move(img.truth.normal_O);
   cf.body_id = std::move(img.truth.body_id);
   cf.semantic_class = std::move(img.truth.semantic_class);
-  keep_scratch();
+  MoveUnwrittenImages(&img, &scratch_[p.camera]);  // for the camera's next frame
   ++frames_;
   if (options_.on_frame) {
     auto shared = std::make_shared<const CameraFrame>(cf);

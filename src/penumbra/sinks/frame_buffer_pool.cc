@@ -5,21 +5,14 @@
 namespace penumbra {
 
 void FrameBufferPool::Return(CameraFrame&& frame) noexcept {
-  // images only: the name, pose and times are the next frame's to set
-  CameraFrame images;
-  images.rgb = std::move(frame.rgb);
-  images.depth_m = std::move(frame.depth_m);
-  images.geom_id = std::move(frame.geom_id);
-  images.range_m = std::move(frame.range_m);
-  images.normal_O = std::move(frame.normal_O);
-  images.body_id = std::move(frame.body_id);
-  images.semantic_class = std::move(frame.semantic_class);
   try {
+    // images only: the pose and times are the next frame's to set
+    CameraFrame images = TakeImages(&frame);
     std::lock_guard<std::mutex> lock(mu_);
     std::vector<CameraFrame>& list = kept_[frame.camera];
     if (static_cast<int>(list.size()) < max_per_camera_) list.push_back(std::move(images));
   } catch (...) {
-    // out of memory for the list itself: the images are freed with `images`
+    // out of memory for the name or the list: the images are freed
   }
 }
 

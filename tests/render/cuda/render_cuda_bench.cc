@@ -786,7 +786,7 @@ int Main(int argc, char** argv) {
       const bool with_fx = fx && !fx->empty();
       // the CUDA backend's own verdict (its CPU renderer takes what is not on the GPU)
       const bool fx_on_gpu =
-          gpu && static_cast<cuda::CudaRenderer*>(gpu.get())->RgbNotOnGpu(fx.get(), rgb).empty();
+          gpu && static_cast<cuda::CudaRenderer*>(gpu.get())->RgbNotOnGpu(fx.get()).empty();
       const std::string fx_outputs = fx_on_gpu ? "rgb+depth realtime + effects (on GPU)"
                                                : "rgb+depth realtime + effects (cpu fallback)";
       if (gpu && with_fx) {

@@ -50,8 +50,7 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
 
 CudaRenderer::~CudaRenderer() = default;
 
-std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const {
-  (void)view;  // every pinhole, distorted or moving camera renders on the GPU (camera_rays.h)
+std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects) const {
   if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced) return PathNotOnGpu(effects);
   return "";
 }
@@ -66,7 +65,7 @@ ParallelFn CudaRenderer::HostParallel() {
 
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
-  const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects, view) : "";
+  const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects) : "";
   if (!rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(

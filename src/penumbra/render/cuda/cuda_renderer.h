@@ -46,9 +46,10 @@ class CudaRenderer final : public Renderer {
   void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
               RenderedFrame* out) override;
 
-  /// "" if `view`'s rgb under `effects` renders on the GPU, else why not (the pathtraced tier's
-  /// PathNotOnGpu; every realtime frame and every frame's ground truth render on the GPU).
-  std::string RgbNotOnGpu(const EffectsFrame* effects, const CameraView& view) const;
+  /// "" if a frame's rgb under `effects` renders on the GPU, else why not (the pathtraced tier's
+  /// PathNotOnGpu; every realtime frame, every camera model and every frame's ground truth
+  /// render on the GPU).
+  std::string RgbNotOnGpu(const EffectsFrame* effects) const;
 
   /// frames rendered on the GPU and on the CPU renderer so far.
   int64_t gpu_frames() const { return gpu_frames_; }
