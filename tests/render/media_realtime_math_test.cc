@@ -281,17 +281,20 @@ TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit)
   EXPECT_GT(n.closed, 1000);
 }
 
-// a smoke grid turned about z and y (GridVolume::ToGrid's 3x3 product) with a density ramp and
-// an emissive grid (fire), in the lit room: alone (smoke_plume's and fire's case: no homogeneous
-// media, no sky volume) and with height fog and a sky volume (adversity_major's: the
-// homogeneous in-scatter behind a grid's entry attenuated by it).
-TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+// LitRoom under a daylight sky.
+SceneDescription SkyLitRoom() {
   SceneDescription s = LitRoom();
   Sky sky_desc;
   sky_desc.type = Sky::Type::kDaylight;
   sky_desc.sun_direction_W = Eigen::Vector3d(-0.28, -0.77, 0.57).normalized();
   sky_desc.zenith_luminance = 8000;
   s.sky = sky_desc;
+  return s;
+}
+
+// two grids in LitRoom: a smoke grid with a density ramp turned about z and y, and an emissive
+// grid.
+EffectsFrame TwoGrids() {
   EffectsFrame grids;
   GridMedium smoke = RampGrid({1, 0.3, 1.2}, {1.2, 0.9, 1.0}, 20, 1.0f, 0.4f, 1.2f, 0.8f);
   smoke.X_WG.linear() = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
@@ -303,6 +306,25 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
   for (size_t i = 0; i < e->size(); ++i) (*e)[i] = 40.0f + 5.0f * static_cast<float>(i % 7);
   fire.emission = e;
   grids.grid_media.push_back(fire);
+  return grids;
+}
+
+// `fx` with non-grey height fog added.
+EffectsFrame WithHeightFog(EffectsFrame fx) {
+  HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
+  fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);
+  fog.height_falloff_per_m = 0.4f;
+  fx.homogeneous_media.push_back(fog);
+  return fx;
+}
+
+// a smoke grid turned about z and y (GridVolume::ToGrid's 3x3 product) with a density ramp and
+// an emissive grid (fire), in the lit room: alone (smoke_plume's and fire's case: no homogeneous
+// media, no sky volume) and with height fog and a sky volume (adversity_major's: the
+// homogeneous in-scatter behind a grid's entry attenuated by it).
+TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+  SceneDescription s = SkyLitRoom();
+  const EffectsFrame grids = TwoGrids();
   LitFrame f(s);
   // ToGrid's product restated: the same bits
   MediaScene probe;
@@ -328,13 +350,7 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
     }
   }
   for (const bool with_fog : {false, true}) {
-    EffectsFrame fx = grids;
-    if (with_fog) {
-      HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
-      fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);
-      fog.height_falloff_per_m = 0.4f;
-      fx.homogeneous_media.push_back(fog);
-    }
+    const EffectsFrame fx = with_fog ? WithHeightFog(grids) : grids;
     MediaScene media;
     media.Build(&fx);
     RealtimeMedia rm;
@@ -546,32 +562,11 @@ FormerGridVolumes FormerGridBuild(const MediaScene& media, const LightSampler& l
 // GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit (one turned about z and y, one
 // emissive) in the lit room, alone and with non-grey height fog and the sky volume.
 TEST(MediaRealtimeMathTest, GridVolumesAreTheFormerEigenCodesBitForBit) {
-  SceneDescription s = LitRoom();
-  Sky sky_desc;
-  sky_desc.type = Sky::Type::kDaylight;
-  sky_desc.sun_direction_W = Eigen::Vector3d(-0.28, -0.77, 0.57).normalized();
-  sky_desc.zenith_luminance = 8000;
-  s.sky = sky_desc;
-  EffectsFrame grids;
-  GridMedium smoke = RampGrid({1, 0.3, 1.2}, {1.2, 0.9, 1.0}, 20, 1.0f, 0.4f, 1.2f, 0.8f);
-  smoke.X_WG.linear() = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
-                         Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()))
-                            .toRotationMatrix();
-  grids.grid_media.push_back(smoke);
-  GridMedium fire = RampGrid({-0.5, -1.0, 0.6}, {0.4, 0.4, 0.6}, 8, 0.6f, 0.2f, 2.0f, 0.3f);
-  auto e = std::make_shared<std::vector<float>>(static_cast<size_t>(8) * 2 * 2 * 3);
-  for (size_t i = 0; i < e->size(); ++i) (*e)[i] = 40.0f + 5.0f * static_cast<float>(i % 7);
-  fire.emission = e;
-  grids.grid_media.push_back(fire);
+  SceneDescription s = SkyLitRoom();
+  const EffectsFrame grids = TwoGrids();
   LitFrame f(s);
   for (const bool with_fog : {false, true}) {
-    EffectsFrame fx = grids;
-    if (with_fog) {
-      HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
-      fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);
-      fog.height_falloff_per_m = 0.4f;
-      fx.homogeneous_media.push_back(fog);
-    }
+    const EffectsFrame fx = with_fog ? WithHeightFog(grids) : grids;
     MediaScene media;
     media.Build(&fx);
     const Eigen::Vector3f ambient(0.3f, 0.4f, 0.6f);

@@ -70,6 +70,43 @@ PB_HOST_DEVICE inline void LightVolumeCellCentre(const CellLightsPod& v, int64_t
   p[2] = v.lo[2] + (k + 0.5f) / v.cells_per_m[2];
 }
 
+/// a light's sample at the centre of its area (u = v = 0.5) seen from p: the unit direction
+/// to it, its distance (+inf for directional lights), its illuminance, and whether it sends
+/// anything to p (SampleLight of light_math.h, Eigen's normalisation order).
+struct MediaLightAt {
+  Float3 wi, E;
+  float dist = 0;
+  bool valid = false;
+};
+PB_HOST_DEVICE inline MediaLightAt MediaSampleLightAt(const LightPod& light, const float p[3]) {
+  MediaLightAt s;
+  SampleLight<float, Float3, bool, true>(light, Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &s.wi,
+                                         &s.dist, &s.E, &s.valid);
+  return s;
+}
+
+/// e^-mean(tau) of the n homogeneous media along p + t w, t in [0, dist] (1 for n = 0): the
+/// channel-mean transmittance the volumes keep.
+PB_HOST_DEVICE inline float MediaMeanTransmittance(const MediumPod* media, int n, const float p[3],
+                                                   const float w[3], float dist) {
+  if (n <= 0) return 1.0f;
+  const Float3 tau = AnalyticOpticalDepthOf(media, n, p, w, 0.0f, dist);
+  const float t3[3] = {tau.x, tau.y, tau.z};
+  return expf(-MediaMean3(t3));
+}
+
+/// what a volume cell whose transmittance to light `light` is T asks of its visibility:
+/// nothing where T <= 1e-4, lit where the light casts no shadows, else one shadow ray along
+/// *d = w (unit) to *tmax (the light's distance less 1e-4 of it; +inf for directional lights).
+PB_HOST_DEVICE inline uint8_t MediaShadowAsk(const LightPod& light, float T, const float w[3],
+                                             float dist, float d[3], float* tmax) {
+  if (!(T > 1e-4f)) return kMediaRayNone;
+  if (light.cast_shadow == 0) return kMediaRayLit;
+  for (int k = 0; k < 3; ++k) d[k] = w[k];
+  *tmax = MediaIsInf(dist) ? INFINITY : dist * (1.0f - 1e-4f);
+  return kMediaRayTrace;
+}
+
 /// light l at cell centre p: *T the channel-mean transmittance Th Tgrid (0 where the light
 /// sends nothing to p); returns what the visibility asks (kMediaRayNone without visibility or
 /// where T <= 1e-4), and for kMediaRayTrace the shadow ray from p along *d (unit) to *tmax
@@ -77,31 +114,19 @@ PB_HOST_DEVICE inline void LightVolumeCellCentre(const CellLightsPod& v, int64_t
 /// value is T where the light is seen (kMediaRayLit, or a traced ray not occluded), else 0.
 PB_HOST_DEVICE inline uint8_t LightVolumeCellLight(const LightVolumeBuild& b, const float p[3],
                                                    int l, float* T, float d[3], float* tmax) {
-  Float3 wi, E;
-  float dist = 0;
-  bool valid = false;
-  SampleLight<float, Float3, bool, true>(b.lights[l], Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &wi,
-                                         &dist, &E, &valid);
-  if (!valid) {
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  if (!s.valid) {
     *T = 0.0f;
     return kMediaRayNone;
   }
-  const float w[3] = {wi.x, wi.y, wi.z};
-  float t = 1.0f;
-  if (b.num_media > 0) {
-    const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, p, w, 0.0f, dist);
-    const float v[3] = {tau.x, tau.y, tau.z};
-    t = expf(-MediaMean3(v));
-  }
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
+  float t = MediaMeanTransmittance(b.media, b.num_media, p, w, s.dist);
   for (int g = 0; g < b.num_grids; ++g)
     t *= GridLightTransmittance(b.grids[g], b.grid_light_T + b.grids[g].offset, b.num_lights, l, p,
-                                w, dist);
+                                w, s.dist);
   *T = t;
-  if (b.with_visibility == 0 || !(t > 1e-4f)) return kMediaRayNone;
-  if (b.lights[l].cast_shadow == 0) return kMediaRayLit;
-  for (int k = 0; k < 3; ++k) d[k] = w[k];
-  *tmax = MediaIsInf(dist) ? INFINITY : dist * (1.0f - 1e-4f);
-  return kMediaRayTrace;
+  if (b.with_visibility == 0) return kMediaRayNone;
+  return MediaShadowAsk(b.lights[l], t, w, s.dist, d, tmax);
 }
 
 /// the parts of a frame's media volumes that RealtimeMedia::Build left to a device (Build's
@@ -217,23 +242,19 @@ PB_HOST_DEVICE inline Float3 FogSliceInScatter(const FogFroxelBuild<R>& b, const
   for (int j = 0; j < b.num_lights; ++j) {
     // a light without visibility here adds nothing: skip its sample
     if (located && j < b.num_volume_lights && !(vis_all[j] > 0)) continue;
-    Float3 wi, E;
-    float dist = 0;
-    bool valid = false;
-    SampleLight<float, Float3, bool, true>(b.lights[j], Float3{x[0], x[1], x[2]}, 0.5f, 0.5f, &wi,
-                                           &dist, &E, &valid);
-    if (!valid) continue;
+    const MediaLightAt at = MediaSampleLightAt(b.lights[j], x);
+    if (!at.valid) continue;
+    const Float3 &wi = at.wi, &E = at.E;
     float vis;
     if (located && j < b.num_volume_lights) {
       vis = vis_all[j];
     } else {
+      // (the fog froxels exist only with homogeneous media: num_media > 0)
       const float w[3] = {wi.x, wi.y, wi.z};
-      const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, x, w, 0.0f, dist);
-      const float t3[3] = {tau.x, tau.y, tau.z};
-      vis = expf(-MediaMean3(t3));
+      vis = MediaMeanTransmittance(b.media, b.num_media, x, w, at.dist);
       for (int g = 0; g < b.num_grids; ++g)
         vis *= GridLightTransmittance(b.grids[g], b.grid_light_T + b.grids[g].offset,
-                                      b.num_volume_lights, j, x, w, dist);
+                                      b.num_volume_lights, j, x, w, at.dist);
     }
     if (!(vis > 0)) continue;
     const float cos_t = DotAs<true, float>(w_o, wi);
@@ -376,20 +397,16 @@ PB_HOST_DEVICE inline void GridLightCellCentre(const GridLightPod& gl, int64_t c
 /// light's distance less 1e-4 of it; +inf for directional lights).
 PB_HOST_DEVICE inline uint8_t GridLightCellLight(const GridLightBuild& b, int g, const float p[3],
                                                  int l, float* Tg, float d[3], float* tmax) {
-  Float3 wi, E;
-  float dist = 0;
-  bool valid = false;
-  SampleLight<float, Float3, bool, true>(b.lights[l], Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &wi,
-                                         &dist, &E, &valid);
-  if (!valid) {
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  if (!s.valid) {
     *Tg = 0.0f;
     return kMediaRayNone;
   }
   const MediaGridPod& v = b.grids[g];
   const GridLightPod& gl = b.layouts[g];
-  const float w[3] = {wi.x, wi.y, wi.z};
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
   float T = 1.0f, a, e;
-  if (MediaGridInterval(v, p, w, 0.0f, dist, &a, &e)) {
+  if (MediaGridInterval(v, p, w, 0.0f, s.dist, &a, &e)) {
     const float cell_m = pbm::Min(pbm::Min(1.0f / gl.cells_per_m[0], 1.0f / gl.cells_per_m[1]),
                                   1.0f / gl.cells_per_m[2]);
     const int steps =
@@ -399,19 +416,15 @@ PB_HOST_DEVICE inline uint8_t GridLightCellLight(const GridLightBuild& b, int g,
     GridToFrame(v.box, p, o_G);
     GridRotate(v.box, w, d_G);
     float tau = 0;
-    for (int s = 0; s < steps; ++s) {
-      const float t = a + (s + 0.5f) * ds;
+    for (int k = 0; k < steps; ++k) {
+      const float t = a + (k + 0.5f) * ds;
       const float x[3] = {o_G[0] + t * d_G[0], o_G[1] + t * d_G[1], o_G[2] + t * d_G[2]};
       tau += MediaGridDensity(v, x);
     }
     T = expf(-tau * MediaMean3(v.sigma_t) * ds);
   }
   *Tg = T;
-  if (!(T > 1e-4f)) return kMediaRayNone;
-  if (b.lights[l].cast_shadow == 0) return kMediaRayLit;
-  for (int k = 0; k < 3; ++k) d[k] = w[k];
-  *tmax = MediaIsInf(dist) ? INFINITY : dist * (1.0f - 1e-4f);
-  return kMediaRayTrace;
+  return MediaShadowAsk(b.lights[l], T, w, s.dist, d, tmax);
 }
 
 /// the sky's part of a grid light volume cell's in-scatter source at p: the sky volume's ambient
@@ -428,20 +441,11 @@ PB_HOST_DEVICE inline Float3 GridLightCellSky(const GridLightBuild& b, const flo
 /// sources are summed in light order after the sky's (GridLightCellSky).
 PB_HOST_DEVICE inline Float3 GridLightCellSource(const GridLightBuild& b, const float p[3], int l,
                                                  float Tg, const Float3& src) {
-  Float3 wi, E;
-  float dist = 0;
-  bool valid = false;
-  SampleLight<float, Float3, bool, true>(b.lights[l], Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &wi,
-                                         &dist, &E, &valid);
-  float Th = 1.0f;
-  if (b.num_media > 0) {
-    const float w[3] = {wi.x, wi.y, wi.z};
-    const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, p, w, 0.0f, dist);
-    const float t3[3] = {tau.x, tau.y, tau.z};
-    Th = expf(-MediaMean3(t3));
-  }
-  const float s = Tg * Th * kInv4Pi;
-  return Float3{src.x + E.x * s, src.y + E.y * s, src.z + E.z * s};
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
+  const float Th = MediaMeanTransmittance(b.media, b.num_media, p, w, s.dist);
+  const float k = Tg * Th * kInv4Pi;
+  return Float3{src.x + s.E.x * k, src.y + s.E.y * k, src.z + s.E.z * k};
 }
 
 /// the inputs of the grid froxels' columns: the grids (densities, emission, coefficients), their

@@ -131,6 +131,15 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   // (TraceShadowRays) and the cells finished with the verdicts.
   std::vector<Ray> rays;
   std::vector<uint8_t> want, blocked;
+  // what slot asks (want), and its shadow ray from p along d to tmax where it traces one
+  auto note = [&](size_t slot, uint8_t w, const float p[3], const float d[3], float tmax) {
+    want[slot] = w;
+    if (w != kMediaRayTrace) return;
+    Ray& sr = rays[slot];
+    sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
+    sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
+    sr.tmax = tmax;
+  };
   auto seen = [&](size_t slot) {
     return want[slot] == kMediaRayLit || (want[slot] == kMediaRayTrace && blocked[slot] == 0);
   };
@@ -212,13 +221,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
         float Tg, d[3], tmax;
         const uint8_t w = GridLightCellLight(gb, static_cast<int>(g), p, l, &Tg, d, &tmax);
         gl.T[static_cast<size_t>(l) * cells + c] = Tg;
-        const size_t slot = static_cast<size_t>(c) * nl + l;
-        want[slot] = w;
-        if (w != kMediaRayTrace) continue;
-        Ray& sr = rays[slot];
-        sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
-        sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
-        sr.tmax = tmax;
+        note(static_cast<size_t>(c) * nl + l, w, p, d, tmax);
       }
     });
     TraceShadowRays(scene, rays, want, &blocked, pool);
@@ -328,13 +331,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
             const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
             vol_.trans[static_cast<size_t>(l) * cells + c] = T;
             if (!vol_.with_visibility) continue;
-            const size_t slot = static_cast<size_t>(c) * nl + l;
-            want[slot] = w;
-            if (w != kMediaRayTrace) continue;
-            Ray& sr = rays[slot];
-            sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
-            sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
-            sr.tmax = tmax;
+            note(static_cast<size_t>(c) * nl + l, w, p, d, tmax);
           }
         });
         // V Th Tgrid: the transmittance where the light is seen, else 0.

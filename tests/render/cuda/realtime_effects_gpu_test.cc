@@ -130,11 +130,12 @@ TEST(RealtimeEffectsGpuFrames, DeviceBuiltMediaVolumesMatchTheHostBuilt) {
 
 // the grids' light volumes and froxels the device built (MediaGridLightKernel,
 // MediaGridFroxelKernel; DownloadGridVolumes) against RealtimeMedia::Build's on the host for the
-// same frame (set_device_media(false)), 640x480: the light volumes' transmittances within 1e-5
+// same frame (set_device_media(false)), 640x480: the light volumes' transmittances within 5e-5
 // (the march's arithmetic: the device contracts products and sums into fused multiply-adds and
-// has its own expf), their sources and the froxels' records within 1e-3 of their largest value
-// but for at most 0.5 % of them (a shadow ray that grazes an edge may change its verdict), the
-// froxel columns' spans within 1e-4 m + 1e-5 t (the column rays are PrimaryRay's there,
+// has its own expf; on an H100 2.1e-5 at most, fire), the froxels' records within 1e-4 of the
+// largest in-scatter (measured 3e-6) and 1e-4 in transmittance (2.2e-6), and within 1e-3 but
+// for at most 0.5 % of them (a shadow ray that grazes an edge may change its verdict: none did),
+// the froxel columns' spans within 1e-4 m + 1e-5 t (the column rays are PrimaryRay's there,
 // Camera::GenerateRay's here); a second render's volumes are the same bits.
 TEST(RealtimeEffectsGpuFrames, DeviceBuiltGridVolumesMatchTheHostBuild) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
@@ -214,7 +215,9 @@ TEST(RealtimeEffectsGpuFrames, DeviceBuiltGridVolumesMatchTheHostBuild) {
         file, values, worst_T, columns, met, spans_off, records, worst_S, peak, worst_Tr, off,
         dev.T == again.T ? "equal" : "DIFFERENT");
     EXPECT_GT(met, 0) << file;
-    EXPECT_LE(worst_T, 1e-5f) << file;
+    EXPECT_LE(worst_T, 5e-5f) << file;
+    EXPECT_LE(worst_S, 1e-4f * peak) << file;
+    EXPECT_LE(worst_Tr, 1e-4f) << file;
     EXPECT_LE(spans_off, static_cast<int>(columns / 200)) << file;
     EXPECT_LE(off, static_cast<int>(records / 200)) << file;
   }

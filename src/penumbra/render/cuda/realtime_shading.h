@@ -1275,6 +1275,20 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
   return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
 }
 
+/// whether a media volume cell at p sees a light whose visibility asks `w` (LightVolumeCellLight,
+/// GridLightCellLight): lit, or a shadow ray along d to tmax traced here through f.scene and
+/// not occluded, as RealtimeMedia::Build's rays (a RayQuery's: the same TraceRay, tmin 0).
+PB_HOST_DEVICE inline bool MediaCellSees(const RealtimeFrameView& f, uint8_t w, const float p[3],
+                                         const float d[3], float tmax) {
+  if (w != kMediaRayTrace) return w == kMediaRayLit;
+  TraceRay r;
+  r.o = F3{p[0], p[1], p[2]};
+  r.d = F3{d[0], d[1], d[2]};
+  r.tmin = 0.0f;
+  r.tmax = tmax;
+  return !TraceOccluded(f.scene, r);
+}
+
 /// cell c of the world light volume that frame f builds itself (f.media_build.light_volume;
 /// layout f.media.light_volume): per light l < stride its [cell][light] transmittance
 /// trans_cl[c stride + l] (LightVolumeCellLight; 0 past the volume's lights) and, where vis_cl
@@ -1308,17 +1322,23 @@ PB_HOST_DEVICE inline void MediaLightVolumeCell(const RealtimeFrameView& f, int6
     const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
     trans_cl[at] = T;
     if (vis_cl == nullptr) continue;
-    bool seen = w == kMediaRayLit;
-    if (w == kMediaRayTrace) {
-      TraceRay r;
-      r.o = F3{p[0], p[1], p[2]};
-      r.d = F3{d[0], d[1], d[2]};
-      r.tmin = 0.0f;
-      r.tmax = tmax;
-      seen = !TraceOccluded(f.scene, r);
-    }
+    const bool seen = MediaCellSees(f, w, p, d, tmax);
     vis_cl[at] = seen ? T : 0.0f;
   }
+}
+
+/// the ray o + t d (PrimaryRay, d normalised) through the centre pixel (*uc, *vc) of froxel
+/// column c of a volume of nx columns of block x block pixels in frame f (RealtimeMedia's
+/// columns take Camera::GenerateRay's).
+PB_HOST_DEVICE inline void MediaColumnRay(const RealtimeFrameView& f, int c, int nx, int block,
+                                          int* uc, int* vc, float o[3], float d[3]) {
+  const int W = f.camera.width, H = f.camera.height;
+  *uc = MediaMinI((c % nx) * block + block / 2, W - 1);
+  *vc = MediaMinI((c / nx) * block + block / 2, H - 1);
+  const TraceRay r = PrimaryRay(f.camera, *uc, *vc);
+  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  o[0] = r.o.x, o[1] = r.o.y, o[2] = r.o.z;
+  d[0] = r.d.x / len, d[1] = r.d.y / len, d[2] = r.d.z / len;
 }
 
 /// the inputs of the grids' light volumes of frame f (f.media_build.grids): the grids' arrays
@@ -1361,15 +1381,7 @@ PB_HOST_DEVICE inline void MediaGridLightCell(const RealtimeFrameView& f, int64_
     float Tg, d[3], tmax;
     const uint8_t w = GridLightCellLight(b, g, p, l, &Tg, d, &tmax);
     grid_T[gl.offset + l * cells + i] = Tg;
-    bool seen = w == kMediaRayLit;
-    if (w == kMediaRayTrace) {
-      TraceRay r;
-      r.o = F3{p[0], p[1], p[2]};
-      r.d = F3{d[0], d[1], d[2]};
-      r.tmin = 0.0f;
-      r.tmax = tmax;
-      seen = !TraceOccluded(f.scene, r);
-    }
+    const bool seen = MediaCellSees(f, w, p, d, tmax);
     if (seen) src = GridLightCellSource(b, p, l, Tg, src);
   }
   source[c] = src;
@@ -1390,15 +1402,9 @@ struct MediaGridColumnInputs {
 PB_HOST_DEVICE inline MediaGridColumnInputs MediaGridColumnOf(const RealtimeFrameView& f, int c,
                                                               const Float3* source) {
   const RealtimeMediaView& m = f.media;
-  const int W = f.camera.width, H = f.camera.height;
-  const int cx = c % m.grid_nx, cy = c / m.grid_nx;
-  const int uc = MediaMinI(cx * kFroxelBlock + kFroxelBlock / 2, W - 1);
-  const int vc = MediaMinI(cy * kFroxelBlock + kFroxelBlock / 2, H - 1);
-  const TraceRay r = PrimaryRay(f.camera, uc, vc);
-  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   MediaGridColumnInputs in;
-  in.o[0] = r.o.x, in.o[1] = r.o.y, in.o[2] = r.o.z;
-  in.d[0] = r.d.x / len, in.d[1] = r.d.y / len, in.d[2] = r.d.z / len;
+  int uc, vc;
+  MediaColumnRay(f, c, m.grid_nx, kFroxelBlock, &uc, &vc, in.o, in.d);
   GridFroxelBuild& b = in.b;
   b.grids = f.media_build.grid_media;
   b.layouts = m.grids;
@@ -1406,7 +1412,7 @@ PB_HOST_DEVICE inline MediaGridColumnInputs MediaGridColumnOf(const RealtimeFram
   b.num_grids = m.num_grids;
   b.media = m.media;
   b.num_media = m.num_media;
-  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 2);
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, f.camera.width, 2);
   in.hit = GridFroxelColumnInterval(b, in.o, in.d, &in.t0, &in.t1) ? 1 : 0;
   return in;
 }
@@ -1455,15 +1461,9 @@ struct MediaFogColumnInputs {
 PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameView& f, int c,
                                                             const float* vis_cl) {
   const RealtimeMediaView& m = f.media;
-  const int W = f.camera.width, H = f.camera.height;
-  const int cx = c % m.fog_nx, cy = c / m.fog_nx;
-  const int uc = MediaMinI(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
-  const int vc = MediaMinI(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
-  const TraceRay r = PrimaryRay(f.camera, uc, vc);
-  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   MediaFogColumnInputs in;
-  in.o[0] = r.o.x, in.o[1] = r.o.y, in.o[2] = r.o.z;
-  in.d[0] = r.d.x / len, in.d[1] = r.d.y / len, in.d[2] = r.d.z / len;
+  int uc, vc;
+  MediaColumnRay(f, c, m.fog_nx, kFogFroxelBlock, &uc, &vc, in.o, in.d);
   FogFroxelBuild<Rgb4>& b = in.b;
   b.media = m.media;
   b.num_media = m.num_media;
@@ -1480,7 +1480,7 @@ PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameV
   b.grid_slices_per_m = m.grid_slices_per_m;
   b.grid_records = m.grid_records;
   in.grid_cols = m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
-  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3);
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, f.camera.width, 3);
   return in;
 }
 
