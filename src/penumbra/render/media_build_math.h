@@ -12,7 +12,7 @@
 //    transmittance falls to 1 %), then per slice the in-scatter of every light (the visibility
 //    volume, or the closed form outside it, times the mixture of the media's Henyey-Greenstein
 //    lobes), times the transmittance from the camera (media and grid froxels), accumulated in
-//    slice order.
+//    slice order;
 //  - the grids' light volumes, one cell at a time (GridLightCellCentre, GridLightCellLight,
 //    GridLightCellSource; branch gpu17): per light the transmittance through the grid from the
 //    cell centre (kGridLightSteps steps of MediaGridDensity, render/media_scene_math.h) and the
@@ -20,7 +20,8 @@
 //  - the grid froxels, one column at a time (GridFroxelColumnInterval, then per slice
 //    GridFroxelSlice and GridFroxelRecords, which accumulates the slices in slice order).
 // operation order: the CPU code's before the move (the bit-for-bit rule of shading_math.h);
-// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU").
+// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU" and
+// "Grid media volumes built on the GPU (branch gpu17)").
 
 #include <stdint.h>
 
