@@ -241,9 +241,8 @@ int MediaMain(const std::vector<std::string>& worlds, int width, int height, int
         fmt::print(
             "| {} | {} | {} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
             "{:.3f} | {:.3f} |\n",
-            world.name, size,
-            device ? "device (the volumes as kernels)" : "host (as before)", 1 / s,
-            1e3 * s, prepare / frames, build / frames, st.grid_light / frames,
+            world.name, size, device ? "device (the volumes as kernels)" : "host (as before)",
+            1 / s, 1e3 * s, prepare / frames, build / frames, st.grid_light / frames,
             st.light_volume / frames, st.grid_froxels / frames, st.fog_froxels / frames,
             geometry / frames);
       }
