@@ -2,7 +2,9 @@
 // restatement of the world light volume's lookup against the shared CellLightsLookup, the
 // froxel lookups of the device's record type (Rgb4) against the CPU's (Eigen::Array4f), a
 // frame's view segments and light transmittances over RealtimeMedia::HostView against the CPU's
-// IntegrateView and surface loop (homogeneous media, grids, both), and RayQuery's batched
+// IntegrateView and surface loop (homogeneous media, grids, both), the grids' light volumes and
+// froxels that Build makes with media_build_math.h against the former Eigen code's, and
+// RayQuery's batched
 // occlusion (its default through closest hits and Embree's rtcOccluded1) that the light volumes
 // trace their shadow rays with.
 
@@ -10,10 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "media_test_util.h"
@@ -23,6 +28,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_common.h"
 #include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
 #include "penumbra/render/sky_irradiance_volume.h"
@@ -275,17 +281,20 @@ TEST(MediaRealtimeMathTest, ViewSegmentAndLightTransmittanceAreTheCpusBitForBit)
   EXPECT_GT(n.closed, 1000);
 }
 
-// a smoke grid turned about z and y (GridVolume::ToGrid's 3x3 product) with a density ramp and
-// an emissive grid (fire), in the lit room: alone (smoke_plume's and fire's case: no homogeneous
-// media, no sky volume) and with height fog and a sky volume (adversity_major's: the
-// homogeneous in-scatter behind a grid's entry attenuated by it).
-TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+// LitRoom under a daylight sky.
+SceneDescription SkyLitRoom() {
   SceneDescription s = LitRoom();
   Sky sky_desc;
   sky_desc.type = Sky::Type::kDaylight;
   sky_desc.sun_direction_W = Eigen::Vector3d(-0.28, -0.77, 0.57).normalized();
   sky_desc.zenith_luminance = 8000;
   s.sky = sky_desc;
+  return s;
+}
+
+// two grids in LitRoom: a smoke grid with a density ramp turned about z and y, and an emissive
+// grid.
+EffectsFrame TwoGrids() {
   EffectsFrame grids;
   GridMedium smoke = RampGrid({1, 0.3, 1.2}, {1.2, 0.9, 1.0}, 20, 1.0f, 0.4f, 1.2f, 0.8f);
   smoke.X_WG.linear() = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
@@ -297,6 +306,25 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
   for (size_t i = 0; i < e->size(); ++i) (*e)[i] = 40.0f + 5.0f * static_cast<float>(i % 7);
   fire.emission = e;
   grids.grid_media.push_back(fire);
+  return grids;
+}
+
+// `fx` with non-grey height fog added.
+EffectsFrame WithHeightFog(EffectsFrame fx) {
+  HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
+  fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);
+  fog.height_falloff_per_m = 0.4f;
+  fx.homogeneous_media.push_back(fog);
+  return fx;
+}
+
+// a smoke grid turned about z and y (GridVolume::ToGrid's 3x3 product) with a density ramp and
+// an emissive grid (fire), in the lit room: alone (smoke_plume's and fire's case: no homogeneous
+// media, no sky volume) and with height fog and a sky volume (adversity_major's: the
+// homogeneous in-scatter behind a grid's entry attenuated by it).
+TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit) {
+  SceneDescription s = SkyLitRoom();
+  const EffectsFrame grids = TwoGrids();
   LitFrame f(s);
   // ToGrid's product restated: the same bits
   MediaScene probe;
@@ -322,13 +350,7 @@ TEST(MediaRealtimeMathTest, GridViewSegmentAndLightTransmittanceAreTheCpusBitFor
     }
   }
   for (const bool with_fog : {false, true}) {
-    EffectsFrame fx = grids;
-    if (with_fog) {
-      HomogeneousMedium fog = Fog(0.15f, 0.9f, 0.4f);
-      fog.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.15f, 0.2f);
-      fog.height_falloff_per_m = 0.4f;
-      fx.homogeneous_media.push_back(fog);
-    }
+    const EffectsFrame fx = with_fog ? WithHeightFog(grids) : grids;
     MediaScene media;
     media.Build(&fx);
     RealtimeMedia rm;
@@ -380,6 +402,221 @@ Records MakeRecords(int columns) {
 
 bool SameRgb(const Eigen::Array4f& a, const Rgb4& b) {
   return SameBits(a[0], b.x) && SameBits(a[1], b.y) && SameBits(a[2], b.z);
+}
+
+// RealtimeMedia's grid light volumes and grid froxels as Build and BuildFroxels made them before
+// branch gpu17 moved them to media_build_math.h's shared functions (the Eigen code, serial, one
+// shadow ray at a time): the reference of GridVolumesAreTheFormerEigenCodesBitForBit.
+struct FormerGridVolumes {
+  std::vector<float> T;                 // [grid][light][cell] end to end
+  std::vector<Eigen::Vector3f> source;  // [grid][cell] end to end
+  std::vector<float> t0, t1, slices_per_m;
+  std::vector<Eigen::Array4f> S, Tr;  // [column][boundary]
+};
+FormerGridVolumes FormerGridBuild(const MediaScene& media, const LightSampler& lights,
+                                  const RayQuery& scene, const Camera& camera, uint64_t frame_key,
+                                  const Eigen::Vector3f& sky_ambient,
+                                  const SkyIrradianceVolume* sky_volume) {
+  FormerGridVolumes out;
+  const int nl = std::min(lights.size(), kMaxVolumeLights);
+  auto sky_at = [&](const Eigen::Vector3f& p) {
+    return sky_volume != nullptr ? sky_volume->AmbientRadiance(p, sky_ambient) : sky_ambient;
+  };
+  auto exp3 = [](const Eigen::Vector3f& x) -> Eigen::Vector3f {
+    if (x.x() == x.y() && x.y() == x.z()) return Eigen::Vector3f::Constant(std::exp(x.x()));
+    return x.array().exp().matrix();
+  };
+  struct GridLightRef {
+    int r[3];
+    Eigen::Vector3f cells_per_m;
+    std::vector<Eigen::Vector3f> source;
+  };
+  std::vector<GridLightRef> gls;
+  for (const GridVolume& v : media.grids()) {
+    GridLightRef gl;
+    const int n[3] = {v.nx, v.ny, v.nz};
+    const Eigen::Vector3f size = 2 * v.half;
+    const float cell = std::cbrt(size.prod() / kGridLightCells);
+    for (int k = 0; k < 3; ++k) {
+      gl.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, n[k]);
+      gl.cells_per_m[k] = gl.r[k] / size[k];
+    }
+    const float cell_m = (1.0f / gl.cells_per_m.array()).minCoeff();
+    const int cells = gl.r[0] * gl.r[1] * gl.r[2];
+    std::vector<float> T(static_cast<size_t>(nl) * cells, 1.0f);
+    const Eigen::Matrix3f R_WG = v.R_GW.transpose();
+    const float sigma = Mean3(v.sigma_t);
+    for (int c = 0; c < cells; ++c) {
+      const int i = c % gl.r[0], j = (c / gl.r[0]) % gl.r[1], k = c / (gl.r[0] * gl.r[1]);
+      const Eigen::Vector3f x_G =
+          -v.half + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(gl.cells_per_m);
+      const Eigen::Vector3f p = R_WG * (x_G - v.p_GW);
+      Eigen::Vector3f src = sky_at(p);
+      for (int l = 0; l < nl; ++l) {
+        LightSample ls;
+        if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
+          T[static_cast<size_t>(l) * cells + c] = 0.0f;
+          continue;
+        }
+        float a, b, Tg = 1.0f;
+        if (v.Interval(p, ls.wi, 0.0f, ls.distance, &a, &b)) {
+          const int steps =
+              std::clamp(static_cast<int>(std::ceil((b - a) / cell_m)), 1, kGridLightSteps);
+          const float ds = (b - a) / steps;
+          const Eigen::Vector3f o_G = v.ToGrid(p), d_G = v.R_GW * ls.wi;
+          float tau = 0;
+          for (int s = 0; s < steps; ++s) tau += v.DensityAt(o_G + (a + (s + 0.5f) * ds) * d_G);
+          Tg = std::exp(-tau * sigma * ds);
+        }
+        T[static_cast<size_t>(l) * cells + c] = Tg;
+        if (!(Tg > 1e-4f)) continue;
+        if (ls.cast_shadow) {
+          Ray sr;
+          sr.o = p;
+          sr.d = ls.wi;
+          sr.tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity()
+                                            : ls.distance * (1.0f - 1e-4f);
+          bool blocked = false;
+          scene.Occluded(std::span<const Ray>(&sr, 1), std::span<bool>(&blocked, 1));
+          if (blocked) continue;
+        }
+        const float Th =
+            media.analytic().empty()
+                ? 1.0f
+                : std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
+        src += ls.E * (Tg * Th * kInv4Pi);
+      }
+      gl.source.push_back(src);
+    }
+    out.T.insert(out.T.end(), T.begin(), T.end());
+    out.source.insert(out.source.end(), gl.source.begin(), gl.source.end());
+    gls.push_back(gl);
+  }
+  const int W = camera.width(), H = camera.height();
+  const int nx = (W + kFroxelBlock - 1) / kFroxelBlock, ny = (H + kFroxelBlock - 1) / kFroxelBlock;
+  constexpr int Z = kFroxelSlices;
+  const bool analytic = !media.analytic().empty();
+  for (int c = 0; c < nx * ny; ++c) {
+    const int uc = std::min((c % nx) * kFroxelBlock + kFroxelBlock / 2, W - 1);
+    const int vc = std::min((c / nx) * kFroxelBlock + kFroxelBlock / 2, H - 1);
+    const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
+    const Eigen::Vector3f o = r.o, d = r.d.normalized();
+    float a = std::numeric_limits<float>::infinity(), b = -a;
+    for (const GridVolume& v : media.grids()) {
+      float ga, gb;
+      if (!v.Interval(o, d, 0.0f, std::numeric_limits<float>::infinity(), &ga, &gb)) continue;
+      a = std::min(a, ga);
+      b = std::max(b, gb);
+    }
+    Eigen::Vector3f S = Eigen::Vector3f::Zero(), T = Eigen::Vector3f::Ones();
+    auto put = [&] {
+      out.S.emplace_back(S.x(), S.y(), S.z(), 0.0f);
+      out.Tr.emplace_back(T.x(), T.y(), T.z(), 0.0f);
+    };
+    put();
+    if (!(a < b)) {
+      for (int k = 0; k < Z; ++k) put();
+      out.t0.push_back(0), out.t1.push_back(0), out.slices_per_m.push_back(0);
+      continue;
+    }
+    out.t0.push_back(a), out.t1.push_back(b),
+        out.slices_per_m.push_back(std::min(Z / (b - a), 1e30f));
+    const float jitter = FroxelColumnJitter(frame_key, uc, vc, W, 2);
+    const float ds = (b - a) / Z;
+    for (int k = 0; k < Z; ++k) {
+      const float t = a + (k + jitter) * ds;
+      const Eigen::Vector3f p = o + t * d;
+      Eigen::Vector3f sig_t = Eigen::Vector3f::Zero(), src = Eigen::Vector3f::Zero();
+      for (size_t g = 0; g < media.grids().size(); ++g) {
+        const GridVolume& v = media.grids()[g];
+        const Eigen::Vector3f x = v.ToGrid(p);
+        const float dens = v.DensityAt(x);
+        if (dens > 0) {
+          const GridLightRef& gl = gls[g];
+          const Eigen::Vector3f f =
+              (x + v.half).cwiseProduct(gl.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
+          sig_t += dens * v.sigma_t;
+          src += (dens * v.sigma_s)
+                     .cwiseProduct(MediaTrilinear(gl.source.data(), gl.r, f.x(), f.y(), f.z()));
+        }
+        if (v.emission) src += v.EmissionAt(x);
+      }
+      if (sig_t.maxCoeff() > 0 || src.maxCoeff() > 0) {
+        if (analytic) src = src.cwiseProduct(exp3(-media.AnalyticOpticalDepth(o, d, 0, t)));
+        const Eigen::Vector3f step_T = exp3(-sig_t * ds);
+        Eigen::Vector3f factor;
+        for (int ch = 0; ch < 3; ++ch)
+          factor[ch] = sig_t[ch] * ds > 1e-5f ? (1.0f - step_T[ch]) / sig_t[ch] : ds;
+        S += T.cwiseProduct(src).cwiseProduct(factor);
+        T = T.cwiseProduct(step_T);
+      }
+      put();
+    }
+  }
+  return out;
+}
+
+// the grids' light volumes (transmittances and in-scatter sources) and the grid froxels
+// (columns and records) that RealtimeMedia::Build makes with media_build_math.h's shared
+// functions against the former Eigen code's (FormerGridBuild), bit for bit: the two grids of
+// GridViewSegmentAndLightTransmittanceAreTheCpusBitForBit (one turned about z and y, one
+// emissive) in the lit room, alone and with non-grey height fog and the sky volume.
+TEST(MediaRealtimeMathTest, GridVolumesAreTheFormerEigenCodesBitForBit) {
+  SceneDescription s = SkyLitRoom();
+  const EffectsFrame grids = TwoGrids();
+  LitFrame f(s);
+  for (const bool with_fog : {false, true}) {
+    const EffectsFrame fx = with_fog ? WithHeightFog(grids) : grids;
+    MediaScene media;
+    media.Build(&fx);
+    const Eigen::Vector3f ambient(0.3f, 0.4f, 0.6f);
+    const SkyIrradianceVolume* volume = with_fog ? &f.volume : nullptr;
+    RealtimeMedia rm;
+    rm.Build(media, f.lights, f.rays, f.camera, 5, Eigen::Vector3f(0, 0, 2), 4.0, ambient, volume,
+             &f.pool);
+    RealtimeMediaHostArrays arrays;
+    const RealtimeMediaView mv = rm.HostView(&arrays);
+    const FormerGridVolumes want =
+        FormerGridBuild(media, f.lights, f.rays, f.camera, 5, ambient, volume);
+    ASSERT_EQ(mv.num_grids, 2);
+    ASSERT_EQ(arrays.grid_light_T.size(), want.T.size());
+    int shadowed = 0;
+    for (size_t i = 0; i < want.T.size(); ++i) {
+      ASSERT_TRUE(SameBits(arrays.grid_light_T[i], want.T[i])) << i;
+      shadowed += want.T[i] < 0.9f ? 1 : 0;
+    }
+    ASSERT_EQ(rm.grid_light_source().size(), want.source.size());
+    for (size_t i = 0; i < want.source.size(); ++i) {
+      const Float3& got = rm.grid_light_source()[i];
+      ASSERT_TRUE(SameBits(got.x, want.source[i].x()) && SameBits(got.y, want.source[i].y()) &&
+                  SameBits(got.z, want.source[i].z()))
+          << i;
+    }
+    const size_t columns = want.t0.size();
+    ASSERT_EQ(static_cast<size_t>(mv.grid_nx) * mv.grid_ny, columns);
+    int met = 0, lit = 0;
+    for (size_t c = 0; c < columns; ++c) {
+      ASSERT_TRUE(SameBits(mv.grid_t0[c], want.t0[c]) && SameBits(mv.grid_t1[c], want.t1[c]) &&
+                  SameBits(mv.grid_slices_per_m[c], want.slices_per_m[c]))
+          << c;
+      met += want.t0[c] < want.t1[c] ? 1 : 0;
+    }
+    for (size_t i = 0; i < want.S.size(); ++i) {
+      const GridFroxelRecord<Rgb4>& r = mv.grid_records[i];
+      ASSERT_TRUE(SameRgb(want.S[i], r.S) && SameRgb(want.Tr[i], r.T)) << i;
+      ASSERT_EQ(r.S.w, 0.0f);
+      ASSERT_EQ(r.T.w, 0.0f);
+      lit += want.S[i][0] > 0 ? 1 : 0;
+    }
+    std::printf(
+        "grids%s: %zu light-volume transmittances (%d below 0.9), %zu sources, %zu columns (%d "
+        "meet a grid), %zu records (%d with in-scatter): equal\n",
+        with_fog ? " and fog" : "", want.T.size(), shadowed, want.source.size(), columns, met,
+        want.S.size(), lit);
+    EXPECT_GT(shadowed, 100);
+    EXPECT_GT(met, 10);
+    EXPECT_GT(lit, 100);
+  }
 }
 
 TEST(MediaRealtimeMathTest, FogFroxelLookupsOfBothRecordTypesAgreeBitForBit) {

@@ -12,11 +12,16 @@
 //    transmittance falls to 1 %), then per slice the in-scatter of every light (the visibility
 //    volume, or the closed form outside it, times the mixture of the media's Henyey-Greenstein
 //    lobes), times the transmittance from the camera (media and grid froxels), accumulated in
-//    slice order.
-// the grids' parts (their light volumes' march and the grid froxels) stay on the host: their
-// density lookups are GridVolume's (render/media_scene.h).
+//    slice order;
+//  - the grids' light volumes, one cell at a time (GridLightCellCentre, GridLightCellLight,
+//    GridLightCellSource; branch gpu17): per light the transmittance through the grid from the
+//    cell centre (kGridLightSteps steps of MediaGridDensity, render/media_scene_math.h) and the
+//    shadow ray its in-scatter source asks, then the source (the sky, and each light seen);
+//  - the grid froxels, one column at a time (GridFroxelColumnInterval, then per slice
+//    GridFroxelSlice and GridFroxelRecords, which accumulates the slices in slice order).
 // operation order: the CPU code's before the move (the bit-for-bit rule of shading_math.h);
-// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU").
+// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU" and
+// "Grid media volumes built on the GPU (branch gpu17)").
 
 #include <stdint.h>
 
@@ -24,6 +29,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/render/light_math.h"
 #include "penumbra/render/media_realtime_math.h"
+#include "penumbra/render/media_scene_math.h"
 
 namespace penumbra {
 
@@ -65,6 +71,43 @@ PB_HOST_DEVICE inline void LightVolumeCellCentre(const CellLightsPod& v, int64_t
   p[2] = v.lo[2] + (k + 0.5f) / v.cells_per_m[2];
 }
 
+/// a light's sample at the centre of its area (u = v = 0.5) seen from p: the unit direction
+/// to it, its distance (+inf for directional lights), its illuminance, and whether it sends
+/// anything to p (SampleLight of light_math.h, Eigen's normalisation order).
+struct MediaLightAt {
+  Float3 wi, E;
+  float dist = 0;
+  bool valid = false;
+};
+PB_HOST_DEVICE inline MediaLightAt MediaSampleLightAt(const LightPod& light, const float p[3]) {
+  MediaLightAt s;
+  SampleLight<float, Float3, bool, true>(light, Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &s.wi,
+                                         &s.dist, &s.E, &s.valid);
+  return s;
+}
+
+/// e^-mean(tau) of the n homogeneous media along p + t w, t in [0, dist] (1 for n = 0): the
+/// channel-mean transmittance the volumes keep.
+PB_HOST_DEVICE inline float MediaMeanTransmittance(const MediumPod* media, int n, const float p[3],
+                                                   const float w[3], float dist) {
+  if (n <= 0) return 1.0f;
+  const Float3 tau = AnalyticOpticalDepthOf(media, n, p, w, 0.0f, dist);
+  const float t3[3] = {tau.x, tau.y, tau.z};
+  return expf(-MediaMean3(t3));
+}
+
+/// what a volume cell whose transmittance to light `light` is T asks of its visibility:
+/// nothing where T <= 1e-4, lit where the light casts no shadows, else one shadow ray along
+/// *d = w (unit) to *tmax (the light's distance less 1e-4 of it; +inf for directional lights).
+PB_HOST_DEVICE inline uint8_t MediaShadowAsk(const LightPod& light, float T, const float w[3],
+                                             float dist, float d[3], float* tmax) {
+  if (!(T > 1e-4f)) return kMediaRayNone;
+  if (light.cast_shadow == 0) return kMediaRayLit;
+  for (int k = 0; k < 3; ++k) d[k] = w[k];
+  *tmax = MediaIsInf(dist) ? INFINITY : dist * (1.0f - 1e-4f);
+  return kMediaRayTrace;
+}
+
 /// light l at cell centre p: *T the channel-mean transmittance Th Tgrid (0 where the light
 /// sends nothing to p); returns what the visibility asks (kMediaRayNone without visibility or
 /// where T <= 1e-4), and for kMediaRayTrace the shadow ray from p along *d (unit) to *tmax
@@ -72,31 +115,19 @@ PB_HOST_DEVICE inline void LightVolumeCellCentre(const CellLightsPod& v, int64_t
 /// value is T where the light is seen (kMediaRayLit, or a traced ray not occluded), else 0.
 PB_HOST_DEVICE inline uint8_t LightVolumeCellLight(const LightVolumeBuild& b, const float p[3],
                                                    int l, float* T, float d[3], float* tmax) {
-  Float3 wi, E;
-  float dist = 0;
-  bool valid = false;
-  SampleLight<float, Float3, bool, true>(b.lights[l], Float3{p[0], p[1], p[2]}, 0.5f, 0.5f, &wi,
-                                         &dist, &E, &valid);
-  if (!valid) {
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  if (!s.valid) {
     *T = 0.0f;
     return kMediaRayNone;
   }
-  const float w[3] = {wi.x, wi.y, wi.z};
-  float t = 1.0f;
-  if (b.num_media > 0) {
-    const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, p, w, 0.0f, dist);
-    const float v[3] = {tau.x, tau.y, tau.z};
-    t = expf(-MediaMean3(v));
-  }
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
+  float t = MediaMeanTransmittance(b.media, b.num_media, p, w, s.dist);
   for (int g = 0; g < b.num_grids; ++g)
     t *= GridLightTransmittance(b.grids[g], b.grid_light_T + b.grids[g].offset, b.num_lights, l, p,
-                                w, dist);
+                                w, s.dist);
   *T = t;
-  if (b.with_visibility == 0 || !(t > 1e-4f)) return kMediaRayNone;
-  if (b.lights[l].cast_shadow == 0) return kMediaRayLit;
-  for (int k = 0; k < 3; ++k) d[k] = w[k];
-  *tmax = MediaIsInf(dist) ? INFINITY : dist * (1.0f - 1e-4f);
-  return kMediaRayTrace;
+  if (b.with_visibility == 0) return kMediaRayNone;
+  return MediaShadowAsk(b.lights[l], t, w, s.dist, d, tmax);
 }
 
 /// the parts of a frame's media volumes that RealtimeMedia::Build left to a device (Build's
@@ -104,11 +135,21 @@ PB_HOST_DEVICE inline uint8_t LightVolumeCellLight(const LightVolumeBuild& b, co
 /// stride lights per cell; with_visibility: also its visibility, with one shadow ray per cell
 /// and light traced where LightVolumeCellLight asks) and the fog froxels (fog_nx x fog_ny
 /// columns with their axis tables; jitter FroxelColumnJitter of frame_key, stream 3).
+/// grids (branch gpu17): the grids' light volumes (layouts RealtimeMediaView::grids, their
+/// [light][cell] transmittances end to end at GridLightPod::offset, their in-scatter sources
+/// [cell] end to end in grid order) and the grid froxels (grid_nx x grid_ny columns with their
+/// axis tables; jitter stream 2), over the grids' densities `grid_media` (num_grids of them,
+/// RealtimeMediaView::num_grids; host pointers from RealtimeMedia, device copies once a device
+/// holds them); grid_generation changes whenever the grids' arrays do (a device keeps its copy
+/// while it is unchanged).
 struct MediaVolumesToBuild {
   int light_volume = 0;
   int with_visibility = 0;
   int fog = 0;
   uint64_t frame_key = 0;
+  int grids = 0;
+  const MediaGridPod* grid_media = nullptr;
+  uint64_t grid_generation = 0;
 };
 
 /// the inputs of the fog froxels' columns: the homogeneous media (their MediumPod::g read), all
@@ -202,23 +243,19 @@ PB_HOST_DEVICE inline Float3 FogSliceInScatter(const FogFroxelBuild<R>& b, const
   for (int j = 0; j < b.num_lights; ++j) {
     // a light without visibility here adds nothing: skip its sample
     if (located && j < b.num_volume_lights && !(vis_all[j] > 0)) continue;
-    Float3 wi, E;
-    float dist = 0;
-    bool valid = false;
-    SampleLight<float, Float3, bool, true>(b.lights[j], Float3{x[0], x[1], x[2]}, 0.5f, 0.5f, &wi,
-                                           &dist, &E, &valid);
-    if (!valid) continue;
+    const MediaLightAt at = MediaSampleLightAt(b.lights[j], x);
+    if (!at.valid) continue;
+    const Float3 &wi = at.wi, &E = at.E;
     float vis;
     if (located && j < b.num_volume_lights) {
       vis = vis_all[j];
     } else {
+      // (the fog froxels exist only with homogeneous media: num_media > 0)
       const float w[3] = {wi.x, wi.y, wi.z};
-      const Float3 tau = AnalyticOpticalDepthOf(b.media, b.num_media, x, w, 0.0f, dist);
-      const float t3[3] = {tau.x, tau.y, tau.z};
-      vis = expf(-MediaMean3(t3));
+      vis = MediaMeanTransmittance(b.media, b.num_media, x, w, at.dist);
       for (int g = 0; g < b.num_grids; ++g)
         vis *= GridLightTransmittance(b.grids[g], b.grid_light_T + b.grids[g].offset,
-                                      b.num_volume_lights, j, x, w, dist);
+                                      b.num_volume_lights, j, x, w, at.dist);
     }
     if (!(vis > 0)) continue;
     const float cos_t = DotAs<true, float>(w_o, wi);
@@ -299,6 +336,228 @@ PB_HOST_DEVICE inline void FogFroxelColumn(const FogFroxelBuild<R>& b, const flo
   for (int k = 0; k < kFogFroxelSlices; ++k)
     inc[k] = FogFroxelSlice(b, o, d, jitter, t_far, k, grid_cols, zero, unit);
   FogFroxelRecords(inc, rec);
+}
+
+/// cells of a grid medium's light volume (at most the grid's own resolution per axis).
+constexpr int kGridLightCells = 1024;
+/// most march steps from a light-volume cell to a light through its grid.
+constexpr int kGridLightSteps = 16;
+
+/// the inputs of the grids' light volumes (RealtimeMedia's GridLight): per grid its densities
+/// (`grids`, MediaGridPod: transform, half extents, arrays) and its light volume's layout
+/// (`layouts`: r, cells_per_m, offset of its [light][cell] transmittances), the first num_lights
+/// lights (at most kMaxVolumeLights), the homogeneous media (their transmittance to a light
+/// lowers the in-scatter source) and the sky lighting the media (the sky volume's, or
+/// sky_ambient without one).
+struct GridLightBuild {
+  const MediaGridPod* grids = nullptr;
+  const GridLightPod* layouts = nullptr;
+  int num_grids = 0;
+  const LightPod* lights = nullptr;
+  int num_lights = 0;
+  const MediumPod* media = nullptr;
+  int num_media = 0;
+  float sky_ambient[3] = {0, 0, 0};
+  const SkyVolumePod* sky_volume = nullptr;
+};
+
+/// the number of cells of a grid's light volume `gl` (r[0] r[1] r[2]).
+PB_HOST_DEVICE inline int64_t GridLightCells(const GridLightPod& gl) {
+  return static_cast<int64_t>(gl.r[0]) * gl.r[1] * gl.r[2];
+}
+
+/// where grid g's in-scatter sources start in the grids' sources end to end (the cells of the
+/// grids before it).
+PB_HOST_DEVICE inline int64_t GridSourceOffset(const GridLightPod* layouts, int g) {
+  int64_t at = 0;
+  for (int i = 0; i < g; ++i) at += GridLightCells(layouts[i]);
+  return at;
+}
+
+/// the world position (m) of cell c (x fastest) of the grid light volume `gl` (its grid's
+/// transform and half extents, its cells): x_G = -half + (i + 0.5) / cells_per_m per axis, then
+/// R_GW^T (x_G - p_GW) in the operation order of Eigen's 3x3 product (GridToFrame's).
+PB_HOST_DEVICE inline void GridLightCellCentre(const GridLightPod& gl, int64_t c, float p[3]) {
+  const int i = static_cast<int>(c % gl.r[0]);
+  const int j = static_cast<int>((c / gl.r[0]) % gl.r[1]);
+  const int k = static_cast<int>(c / (static_cast<int64_t>(gl.r[0]) * gl.r[1]));
+  const int idx[3] = {i, j, k};
+  float y[3];
+  for (int a = 0; a < 3; ++a)
+    y[a] = (-gl.half[a] + (idx[a] + 0.5f) / gl.cells_per_m[a]) - gl.p_GW[a];
+  const float* R = gl.R_GW;  // row-major R_GW: R_WG(a, k) = R[3 k + a]
+  for (int a = 0; a < 3; ++a) p[a] = R[a] * y[0] + (R[3 + a] * y[1] + R[6 + a] * y[2]);
+}
+
+/// light l at cell centre p of grid g's light volume: *Tg the grid's transmittance towards the
+/// light (exp(-sigma ds sum of the densities at the midpoints of at most kGridLightSteps steps
+/// over the light ray's part inside the box, one step per cell size at least; sigma the
+/// channel-mean sigma_t; 1 where the ray misses the box; 0 where the light sends nothing to p).
+/// returns what its source asks of the light's visibility: nothing (Tg <= 1e-4 or no light),
+/// lit (the light casts no shadows), or one shadow ray from p along *d (unit) to *tmax (the
+/// light's distance less 1e-4 of it; +inf for directional lights).
+PB_HOST_DEVICE inline uint8_t GridLightCellLight(const GridLightBuild& b, int g, const float p[3],
+                                                 int l, float* Tg, float d[3], float* tmax) {
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  if (!s.valid) {
+    *Tg = 0.0f;
+    return kMediaRayNone;
+  }
+  const MediaGridPod& v = b.grids[g];
+  const GridLightPod& gl = b.layouts[g];
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
+  float T = 1.0f, a, e;
+  if (MediaGridInterval(v, p, w, 0.0f, s.dist, &a, &e)) {
+    const float cell_m = pbm::Min(pbm::Min(1.0f / gl.cells_per_m[0], 1.0f / gl.cells_per_m[1]),
+                                  1.0f / gl.cells_per_m[2]);
+    const int steps =
+        pbm::Clamp(static_cast<int>(ceilf((e - a) / cell_m)), 1, static_cast<int>(kGridLightSteps));
+    const float ds = (e - a) / steps;
+    float o_G[3], d_G[3];
+    GridToFrame(v.box, p, o_G);
+    GridRotate(v.box, w, d_G);
+    float tau = 0;
+    for (int k = 0; k < steps; ++k) {
+      const float t = a + (k + 0.5f) * ds;
+      const float x[3] = {o_G[0] + t * d_G[0], o_G[1] + t * d_G[1], o_G[2] + t * d_G[2]};
+      tau += MediaGridDensity(v, x);
+    }
+    T = expf(-tau * MediaMean3(v.sigma_t) * ds);
+  }
+  *Tg = T;
+  return MediaShadowAsk(b.lights[l], T, w, s.dist, d, tmax);
+}
+
+/// the sky's part of a grid light volume cell's in-scatter source at p: the sky volume's ambient
+/// radiance there, or sky_ambient without one (RealtimeMedia::SkyAmbientAt).
+PB_HOST_DEVICE inline Float3 GridLightCellSky(const GridLightBuild& b, const float p[3]) {
+  float s[3] = {b.sky_ambient[0], b.sky_ambient[1], b.sky_ambient[2]};
+  if (b.sky_volume != nullptr) SkyVolumeAmbientRadiance(*b.sky_volume, p, b.sky_ambient, s);
+  return Float3{s[0], s[1], s[2]};
+}
+
+/// the in-scatter source `src` at cell centre p plus light l's part where the cell sees it
+/// (GridLightCellLight asked nothing of it and Tg > 1e-4, or its shadow ray was not blocked):
+/// E Tg Th / (4 pi), Th = e^-mean(tau) of the homogeneous media towards the light (1 without).
+/// sources are summed in light order after the sky's (GridLightCellSky).
+PB_HOST_DEVICE inline Float3 GridLightCellSource(const GridLightBuild& b, const float p[3], int l,
+                                                 float Tg, const Float3& src) {
+  const MediaLightAt s = MediaSampleLightAt(b.lights[l], p);
+  const float w[3] = {s.wi.x, s.wi.y, s.wi.z};
+  const float Th = MediaMeanTransmittance(b.media, b.num_media, p, w, s.dist);
+  const float k = Tg * Th * kInv4Pi;
+  return Float3{src.x + s.E.x * k, src.y + s.E.y * k, src.z + s.E.z * k};
+}
+
+/// the inputs of the grid froxels' columns: the grids (densities, emission, coefficients), their
+/// light volumes' layouts and in-scatter sources ([cell] per grid end to end, GridSourceOffset),
+/// and the homogeneous media (their transmittance from the camera lowers each slice's source).
+struct GridFroxelBuild {
+  const MediaGridPod* grids = nullptr;
+  const GridLightPod* layouts = nullptr;
+  const Float3* source = nullptr;
+  int num_grids = 0;
+  const MediumPod* media = nullptr;
+  int num_media = 0;
+};
+
+/// the overlap [*t0, *t1] of a grid froxel column's ray o + t d (d unit, t >= 0) with the grids'
+/// boxes (the smallest entry to the largest exit); false where it meets none.
+PB_HOST_DEVICE inline bool GridFroxelColumnInterval(const GridFroxelBuild& b, const float o[3],
+                                                    const float d[3], float* t0, float* t1) {
+  float a = INFINITY, e = -INFINITY;
+  for (int g = 0; g < b.num_grids; ++g) {
+    float ga, gb;
+    if (!MediaGridInterval(b.grids[g], o, d, 0.0f, INFINITY, &ga, &gb)) continue;
+    a = pbm::Min(a, ga);
+    e = pbm::Max(e, gb);
+  }
+  *t0 = a;
+  *t1 = e;
+  return a < e;
+}
+
+/// one slice of a grid froxel column: the in-scatter source at its sample (times the
+/// homogeneous media's transmittance from the camera), its transmittance e^-sigma_t ds and the
+/// in-scatter's integration factor (1 - e^-sigma_t ds) / sigma_t (ds where sigma_t ds <= 1e-5);
+/// `any` 0 where the sample has neither extinction nor source (the slice changes nothing).
+struct GridFroxelStep {
+  Float3 src, step_T, factor;
+  int any = 0;
+};
+
+/// slice k (0 .. kFroxelSlices - 1) of a grid froxel column along o + t d (o the camera centre,
+/// d unit) over its overlap [t0, t1] with the grid boxes (GridFroxelColumnInterval) with jitter
+/// `jitter` (FroxelColumnJitter stream 2): the sample at t = t0 + (k + jitter) ds, ds = (t1 -
+/// t0) / kFroxelSlices; per grid its density's sigma_t and sigma_s times the trilinear source
+/// of its light volume, plus its emission.
+PB_HOST_DEVICE inline GridFroxelStep GridFroxelSlice(const GridFroxelBuild& b, const float o[3],
+                                                     const float d[3], float t0, float t1,
+                                                     float jitter, int k) {
+  const float ds = (t1 - t0) / kFroxelSlices;
+  const float t = t0 + (k + jitter) * ds;
+  const float p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+  Float3 sig_t{0, 0, 0}, src{0, 0, 0};
+  for (int g = 0; g < b.num_grids; ++g) {
+    const MediaGridPod& v = b.grids[g];
+    float x[3];
+    GridToFrame(v.box, p, x);
+    const float dens = MediaGridDensity(v, x);
+    if (dens > 0) {
+      const GridLightPod& gl = b.layouts[g];
+      const Float3 s = MediaTrilinear(b.source + GridSourceOffset(b.layouts, g), gl.r,
+                                      (x[0] + v.box.half[0]) * gl.cells_per_m[0] - 0.5f,
+                                      (x[1] + v.box.half[1]) * gl.cells_per_m[1] - 0.5f,
+                                      (x[2] + v.box.half[2]) * gl.cells_per_m[2] - 0.5f);
+      sig_t = Float3{sig_t.x + dens * v.sigma_t[0], sig_t.y + dens * v.sigma_t[1],
+                     sig_t.z + dens * v.sigma_t[2]};
+      src = Float3{src.x + dens * v.sigma_s[0] * s.x, src.y + dens * v.sigma_s[1] * s.y,
+                   src.z + dens * v.sigma_s[2] * s.z};
+    }
+    if (v.emission != nullptr) src = src + MediaGridEmission(v, x);
+  }
+  GridFroxelStep out;
+  if (!(MediaMax3(sig_t) > 0 || MediaMax3(src) > 0)) return out;
+  out.any = 1;
+  if (b.num_media > 0) {
+    const Float3 T =
+        MediaExpNeg(AnalyticOpticalDepthOf(b.media, b.num_media, o, d, 0.0f, t), false);
+    src = Float3{src.x * T.x, src.y * T.y, src.z * T.z};
+  }
+  out.src = src;
+  out.step_T = Float3{expf(-sig_t.x * ds), expf(-sig_t.y * ds), expf(-sig_t.z * ds)};
+  const float s3[3] = {sig_t.x, sig_t.y, sig_t.z},
+              T3[3] = {out.step_T.x, out.step_T.y, out.step_T.z};
+  float f[3];
+  for (int ch = 0; ch < 3; ++ch) f[ch] = s3[ch] * ds > 1e-5f ? (1.0f - T3[ch]) / s3[ch] : ds;
+  out.factor = Float3{f[0], f[1], f[2]};
+  return out;
+}
+
+/// a grid froxel column's kFroxelSlices + 1 records (8 floats each: S rgb 0, T rgb 0) from its
+/// slices (GridFroxelSlice): rec[0] = (0, 1), then in slice order S += T src factor and
+/// T *= step_T where the slice has any, rec[k + 1] = (S, T).
+PB_HOST_DEVICE inline void GridFroxelRecords(const GridFroxelStep* steps, float* rec) {
+  float S[3] = {0, 0, 0}, T[3] = {1, 1, 1};
+  auto put = [&](int k) {
+    float* r = rec + 8 * k;
+    r[0] = S[0], r[1] = S[1], r[2] = S[2], r[3] = 0.0f;
+    r[4] = T[0], r[5] = T[1], r[6] = T[2], r[7] = 0.0f;
+  };
+  put(0);
+  for (int k = 0; k < kFroxelSlices; ++k) {
+    const GridFroxelStep& s = steps[k];
+    if (s.any != 0) {
+      const float src[3] = {s.src.x, s.src.y, s.src.z};
+      const float f[3] = {s.factor.x, s.factor.y, s.factor.z};
+      const float st[3] = {s.step_T.x, s.step_T.y, s.step_T.z};
+      for (int c = 0; c < 3; ++c) {
+        S[c] = S[c] + T[c] * src[c] * f[c];
+        T[c] = T[c] * st[c];
+      }
+    }
+    put(k + 1);
+  }
 }
 
 }  // namespace penumbra

@@ -3,6 +3,7 @@
 #include <emmintrin.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -130,23 +131,25 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   // (TraceShadowRays) and the cells finished with the verdicts.
   std::vector<Ray> rays;
   std::vector<uint8_t> want, blocked;
-  auto note = [&](size_t slot, const Eigen::Vector3f& p, const LightSample& ls) {
-    if (!ls.cast_shadow) {
-      want[slot] = kMediaRayLit;
-      return;
-    }
+  // what slot asks (want), and its shadow ray from p along d to tmax where it traces one
+  auto note = [&](size_t slot, uint8_t w, const float p[3], const float d[3], float tmax) {
+    want[slot] = w;
+    if (w != kMediaRayTrace) return;
     Ray& sr = rays[slot];
-    sr.o = p;
-    sr.d = ls.wi;
-    sr.tmax = std::isinf(ls.distance) ? kInfView : ls.distance * (1.0f - 1e-4f);
-    want[slot] = kMediaRayTrace;
+    sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
+    sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
+    sr.tmax = tmax;
   };
   auto seen = [&](size_t slot) {
     return want[slot] == kMediaRayLit || (want[slot] == kMediaRayTrace && blocked[slot] == 0);
   };
 
-  // grid light volumes.
+  // grid light volumes: per grid its layout, then per cell and light the grid's transmittance
+  // and the shadow ray the cell's source asks (GridLightCellLight), the rays traced in batches,
+  // and the sources (GridLightCellSky, GridLightCellSource in light order; media_build_math.h).
   grid_light_.assign(media.grids().size(), GridLight());
+  grid_media_.clear();
+  std::vector<GridLightPod> layouts;
   for (size_t g = 0; g < media.grids().size(); ++g) {
     const GridVolume& v = media.grids()[g];
     GridLight& gl = grid_light_[g];
@@ -157,7 +160,6 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       gl.r[k] = std::clamp(static_cast<int>(std::ceil(size[k] / cell)), 1, n[k]);
       gl.cells_per_m[k] = gl.r[k] / size[k];
     }
-    gl.cell_m = (1.0f / gl.cells_per_m.array()).minCoeff();
     for (int i = 0; i < 3; ++i) {
       for (int k = 0; k < 3; ++k) gl.pod.R_GW[3 * i + k] = v.R_GW(i, k);
       gl.pod.p_GW[i] = v.p_GW[i];
@@ -165,70 +167,85 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
       gl.pod.cells_per_m[i] = gl.cells_per_m[i];
       gl.pod.r[i] = gl.r[i];
     }
+    grid_media_.push_back(v.pod);
+    layouts.push_back(gl.pod);
+  }
+  GridLightBuild gb;
+  gb.grids = grid_media_.data();
+  gb.layouts = layouts.data();
+  gb.num_grids = static_cast<int>(grid_media_.size());
+  gb.lights = lights.pods().data();
+  gb.num_lights = nl;
+  gb.media = pods_.data();
+  gb.num_media = static_cast<int>(pods_.size());
+  for (int k = 0; k < 3; ++k) gb.sky_ambient[k] = sky_ambient[k];
+  if (sky_volume_ != nullptr) {
+    grid_sky_pod_ = sky_volume_->pod();
+    gb.sky_volume = &grid_sky_pod_;
+  }
+  grid_source_.clear();
+  if (device_volumes && !grid_media_.empty()) {
+    // the layouts only: the grids' arrays go to the device, which builds the volumes
+    device_build_.grids = 1;
+    device_build_.grid_media = grid_media_.data();
+    bool same = held_grid_arrays_.size() == 2 * media.grids().size();
+    for (size_t g = 0; same && g < media.grids().size(); ++g)
+      same = held_grid_arrays_[2 * g] == media.grids()[g].density &&
+             held_grid_arrays_[2 * g + 1] == media.grids()[g].emission;
+    if (!same) {
+      // a new generation (unique in the process: the arrays held keep their addresses unique)
+      static std::atomic<uint64_t> next_generation{1};
+      grid_generation_ = next_generation.fetch_add(1);
+      held_grid_arrays_.clear();
+      for (const GridVolume& v : media.grids()) {
+        held_grid_arrays_.push_back(v.density);
+        held_grid_arrays_.push_back(v.emission);
+      }
+    }
+    device_build_.grid_generation = grid_generation_;
+    device_build_.frame_key = frame_key;
+  }
+  for (size_t g = 0; g < media.grids().size() && !device_build_.grids; ++g) {
+    GridLight& gl = grid_light_[g];
     const int cells = gl.r[0] * gl.r[1] * gl.r[2];
     gl.T.assign(static_cast<size_t>(nl) * cells, 1.0f);
-    gl.source.assign(cells, sky_ambient);
-    const Eigen::Matrix3f R_WG = v.R_GW.transpose();
-    const float sigma = Mean3(v.sigma_t);
-    auto centre = [&](int64_t c) {
-      const int i = static_cast<int>(c % gl.r[0]);
-      const int j = static_cast<int>((c / gl.r[0]) % gl.r[1]);
-      const int k = static_cast<int>(c / (static_cast<int64_t>(gl.r[0]) * gl.r[1]));
-      const Eigen::Vector3f x_G =
-          -v.half + Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f).cwiseQuotient(gl.cells_per_m);
-      return Eigen::Vector3f(R_WG * (x_G - v.p_GW));
-    };
+    const size_t src_at = grid_source_.size();
+    grid_source_.resize(src_at + cells);
     rays.assign(static_cast<size_t>(cells) * nl, Ray());
     want.assign(static_cast<size_t>(cells) * nl, kMediaRayNone);
     // the grid's transmittance to each light, and the shadow rays of the lit cells.
     ParallelForOrSerial(pool, cells, [&](int64_t c) {
-      const Eigen::Vector3f p = centre(c);
+      float p[3];
+      GridLightCellCentre(gl.pod, c, p);
       for (int l = 0; l < nl; ++l) {
-        LightSample ls;
-        if (!lights.Sample(l, p, 0.5f, 0.5f, &ls)) {
-          gl.T[static_cast<size_t>(l) * cells + c] = 0.0f;
-          continue;
-        }
-        float a, b, Tg = 1.0f;
-        if (v.Interval(p, ls.wi, 0.0f, ls.distance, &a, &b)) {
-          const int steps =
-              std::clamp(static_cast<int>(std::ceil((b - a) / gl.cell_m)), 1, kGridLightSteps);
-          const float ds = (b - a) / steps;
-          const Eigen::Vector3f o_G = v.ToGrid(p), d_G = v.R_GW * ls.wi;
-          float tau = 0;
-          for (int s = 0; s < steps; ++s) tau += v.DensityAt(o_G + (a + (s + 0.5f) * ds) * d_G);
-          Tg = std::exp(-tau * sigma * ds);
-        }
+        float Tg, d[3], tmax;
+        const uint8_t w = GridLightCellLight(gb, static_cast<int>(g), p, l, &Tg, d, &tmax);
         gl.T[static_cast<size_t>(l) * cells + c] = Tg;
-        if (Tg > 1e-4f) note(static_cast<size_t>(c) * nl + l, p, ls);
+        note(static_cast<size_t>(c) * nl + l, w, p, d, tmax);
       }
     });
     TraceShadowRays(scene, rays, want, &blocked, pool);
-    // the in-scatter source: the sky, and each light the cell sees (its sample again).
+    // the in-scatter source: the sky, and each light the cell sees.
     ParallelForOrSerial(pool, cells, [&](int64_t c) {
-      const Eigen::Vector3f p = centre(c);
-      Eigen::Vector3f src = SkyAmbientAt(p);
-      for (int l = 0; l < nl; ++l) {
-        if (!seen(static_cast<size_t>(c) * nl + l)) continue;
-        LightSample ls;
-        lights.Sample(l, p, 0.5f, 0.5f, &ls);
-        const float Tg = gl.T[static_cast<size_t>(l) * cells + c];
-        const float Th =
-            media.analytic().empty()
-                ? 1.0f
-                : std::exp(-Mean3(media.AnalyticOpticalDepth(p, ls.wi, 0, ls.distance)));
-        src += ls.E * (Tg * Th * kInv4Pi);
-      }
-      gl.source[c] = src;
+      float p[3];
+      GridLightCellCentre(gl.pod, c, p);
+      Float3 src = GridLightCellSky(gb, p);
+      for (int l = 0; l < nl; ++l)
+        if (seen(static_cast<size_t>(c) * nl + l))
+          src = GridLightCellSource(gb, p, l, gl.T[static_cast<size_t>(l) * cells + c], src);
+      grid_source_[src_at + c] = src;
     });
   }
 
   // every grid's light volume end to end (the shared build functions and HostView read them)
   grid_pods_.clear();
   grid_light_T_.clear();
+  // (or, left to a device, their offsets only)
+  size_t grid_T_at = 0;
   for (const GridLight& gl : grid_light_) {
     GridLightPod pod = gl.pod;
-    pod.offset = grid_light_T_.size();
+    pod.offset = grid_T_at;
+    grid_T_at += static_cast<size_t>(nl) * gl.r[0] * gl.r[1] * gl.r[2];
     grid_light_T_.insert(grid_light_T_.end(), gl.T.begin(), gl.T.end());
     grid_pods_.push_back(pod);
   }
@@ -314,13 +331,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
             const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
             vol_.trans[static_cast<size_t>(l) * cells + c] = T;
             if (!vol_.with_visibility) continue;
-            const size_t slot = static_cast<size_t>(c) * nl + l;
-            want[slot] = w;
-            if (w != kMediaRayTrace) continue;
-            Ray& sr = rays[slot];
-            sr.o = Eigen::Vector3f(p[0], p[1], p[2]);
-            sr.d = Eigen::Vector3f(d[0], d[1], d[2]);
-            sr.tmax = tmax;
+            note(static_cast<size_t>(c) * nl + l, w, p, d, tmax);
           }
         });
         // V Th Tgrid: the transmittance where the light is seen, else 0.
@@ -350,7 +361,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
   }
   build_times_.light_volume = ms_since(stage);
   stage = Clock::now();
-  BuildFroxels(lights, camera, frame_key, pool);
+  BuildFroxels(lights, camera, frame_key, pool, device_build_.grids != 0);
   build_times_.grid_froxels = ms_since(stage);
   stage = Clock::now();
   BuildFogFroxels(lights, camera, frame_key, pool, device_volumes);
@@ -362,7 +373,7 @@ void RealtimeMedia::Build(const MediaScene& media, const LightSampler& lights,
 }
 
 void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camera,
-                                 uint64_t frame_key, ThreadPool* pool) {
+                                 uint64_t frame_key, ThreadPool* pool, bool device) {
   froxels_ = Froxels();
   const MediaScene& media = *media_;
   if (media.grids().empty()) return;
@@ -374,62 +385,38 @@ void RealtimeMedia::BuildFroxels(const LightSampler& lights, const Camera& camer
   constexpr int Z = kFroxelSlices;
   BuildAxisTables(W, kFroxelBlock, fr.nx, &fr.ax, &fr.ax_half);
   BuildAxisTables(H, kFroxelBlock, fr.ny, &fr.ay, &fr.ay_half);
+  if (device) return;  // the layout only: the columns are the device's
   fr.t0.assign(columns, 0.0f);
   fr.t1.assign(columns, 0.0f);
   fr.slices_per_m.assign(columns, 0.0f);
   fr.records.assign(static_cast<size_t>(columns) * (Z + 1),
                     FroxelRecord{To4(Eigen::Vector3f::Zero()), To4(Eigen::Vector3f::Ones())});
-  const bool analytic = !media.analytic().empty();
+  // the shared column (media_build_math.h) over this frame's arrays
+  GridFroxelBuild b;
+  b.grids = grid_media_.data();
+  b.layouts = grid_pods_.data();
+  b.source = grid_source_.data();
+  b.num_grids = static_cast<int>(grid_media_.size());
+  b.media = pods_.data();
+  b.num_media = static_cast<int>(pods_.size());
+  static_assert(sizeof(FroxelRecord) == 8 * sizeof(float), "records of 8 floats");
   auto column = [&](int64_t c) {
     const int cx = static_cast<int>(c % fr.nx), cy = static_cast<int>(c / fr.nx);
     const int uc = std::min(cx * kFroxelBlock + kFroxelBlock / 2, W - 1);
     const int vc = std::min(cy * kFroxelBlock + kFroxelBlock / 2, H - 1);
     const Ray r = camera.GenerateRay(static_cast<float>(uc), static_cast<float>(vc));
     const Eigen::Vector3f o = r.o, d = r.d.normalized();
-    float a = kInfView, b = -kInfView;
-    for (const GridVolume& v : media.grids()) {
-      float ga, gb;
-      if (!v.Interval(o, d, 0.0f, kInfView, &ga, &gb)) continue;
-      a = std::min(a, ga);
-      b = std::max(b, gb);
-    }
-    if (!(a < b)) return;
+    float a, e;
+    if (!GridFroxelColumnInterval(b, o.data(), d.data(), &a, &e)) return;
     fr.t0[c] = a;
-    fr.t1[c] = b;
-    fr.slices_per_m[c] = std::min(Z / (b - a), 1e30f);
+    fr.t1[c] = e;
+    fr.slices_per_m[c] = std::min(Z / (e - a), 1e30f);
     // jitter of the slice samples from the column's centre pixel stream 2.
     const float jitter = FroxelColumnJitter(frame_key, uc, vc, W, 2);
-    const float ds = (b - a) / Z;
-    FroxelRecord* rec = fr.records.data() + static_cast<size_t>(c) * (Z + 1);
-    Eigen::Vector3f S = Eigen::Vector3f::Zero(), T = Eigen::Vector3f::Ones();
-    for (int k = 0; k < Z; ++k) {
-      const float t = a + (k + jitter) * ds;
-      const Eigen::Vector3f p = o + t * d;
-      Eigen::Vector3f sig_t = Eigen::Vector3f::Zero(), src = Eigen::Vector3f::Zero();
-      for (size_t g = 0; g < media.grids().size(); ++g) {
-        const GridVolume& v = media.grids()[g];
-        const Eigen::Vector3f x = v.ToGrid(p);
-        const float dens = v.DensityAt(x);
-        if (dens > 0) {
-          const GridLight& gl = grid_light_[g];
-          const Eigen::Vector3f f =
-              (x + v.half).cwiseProduct(gl.cells_per_m) - Eigen::Vector3f::Constant(0.5f);
-          sig_t += dens * v.sigma_t;
-          src += (dens * v.sigma_s).cwiseProduct(Trilinear(gl.source.data(), gl.r, f));
-        }
-        if (v.emission) src += v.EmissionAt(x);
-      }
-      if (sig_t.maxCoeff() > 0 || src.maxCoeff() > 0) {
-        if (analytic) src = src.cwiseProduct(Exp(-media.AnalyticOpticalDepth(o, d, 0, t)));
-        const Eigen::Vector3f step_T = Exp(-sig_t * ds);
-        Eigen::Vector3f factor;
-        for (int ch = 0; ch < 3; ++ch)
-          factor[ch] = sig_t[ch] * ds > 1e-5f ? (1.0f - step_T[ch]) / sig_t[ch] : ds;
-        S += T.cwiseProduct(src).cwiseProduct(factor);
-        T = T.cwiseProduct(step_T);
-      }
-      rec[k + 1] = FroxelRecord{To4(S), To4(T)};
-    }
+    GridFroxelStep steps[Z];
+    for (int k = 0; k < Z; ++k) steps[k] = GridFroxelSlice(b, o.data(), d.data(), a, e, jitter, k);
+    GridFroxelRecords(
+        steps, reinterpret_cast<float*>(fr.records.data() + static_cast<size_t>(c) * (Z + 1)));
   };
   ParallelForOrSerial(pool, columns, column);
 }
@@ -535,7 +522,8 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
   }
   const Froxels& fr = froxels_;
   arrays->grid_records.clear();
-  if (!fr.records.empty()) {
+  if (fr.nx > 0) {
+    // the layout; the columns and records unless left to a device (device_build().grids)
     arrays->grid_records.resize(fr.records.size());
     for (size_t i = 0; i < fr.records.size(); ++i)
       arrays->grid_records[i] = {rgb4(fr.records[i].S), rgb4(fr.records[i].T)};
@@ -543,10 +531,12 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
     m.grid_ny = fr.ny;
     m.width = static_cast<int>(fr.ax.size());
     m.height = static_cast<int>(fr.ay.size());
-    m.grid_t0 = fr.t0.data();
-    m.grid_t1 = fr.t1.data();
-    m.grid_slices_per_m = fr.slices_per_m.data();
-    m.grid_records = arrays->grid_records.data();
+    if (!fr.records.empty()) {
+      m.grid_t0 = fr.t0.data();
+      m.grid_t1 = fr.t1.data();
+      m.grid_slices_per_m = fr.slices_per_m.data();
+      m.grid_records = arrays->grid_records.data();
+    }
     m.grid_ax = fr.ax.data();
     m.grid_ay = fr.ay.data();
     m.grid_ax_half = fr.ax_half.data();
@@ -558,7 +548,7 @@ RealtimeMediaView RealtimeMedia::HostView(RealtimeMediaHostArrays* arrays) const
   if (!arrays->grid_pods.empty()) {
     m.num_grids = static_cast<int>(arrays->grid_pods.size());
     m.grids = arrays->grid_pods.data();
-    m.grid_light_T = arrays->grid_light_T.data();
+    m.grid_light_T = arrays->grid_light_T.empty() ? nullptr : arrays->grid_light_T.data();
     m.num_grid_lights = num_lights_;
   }
   return m;

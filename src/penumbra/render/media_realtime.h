@@ -53,13 +53,16 @@
 // volume; outside it: closed form for the homogeneous media times the grid's light volume at
 // the shadow ray's entry into the grid box).
 // random numbers: the froxel columns' jitter, from their centre pixels' streams 2 and 3.
-// written once for a device (render/media_build_math.h, branch gpu15): the world light volume's
-// cells (LightVolumeCellLight) and the fog froxels' columns (FogFroxelColumn); Build's
-// device_volumes leaves those two to the CUDA backend's kernels, which run the same functions
-// with the shadow rays traced in the cell's thread.
+// written once for a device (render/media_build_math.h, branches gpu15 and gpu17): the world
+// light volume's cells (LightVolumeCellLight), the fog froxels' columns (FogFroxelColumn), the
+// grids' light volumes' cells (GridLightCellLight, GridLightCellSource) and the grid froxels'
+// columns (GridFroxelSlice, GridFroxelRecords); Build's device_volumes leaves all four to the
+// CUDA backend's kernels, which run the same functions with the shadow rays traced in the
+// cell's thread.
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "penumbra/core/rng.h"
@@ -74,10 +77,7 @@
 
 namespace penumbra {
 
-/// cells of a grid medium's light volume (at most the grid's own resolution per axis).
-constexpr int kGridLightCells = 1024;
-/// most march steps from a light-volume cell to a light through its grid.
-constexpr int kGridLightSteps = 16;
+// kGridLightCells and kGridLightSteps (the grids' light volumes): media_build_math.h.
 /// cells of the world light volume.
 constexpr int kLightVolumeCells = 4096;
 // kFroxelBlock, kFroxelSlices, kFogFroxelBlock, kFogFroxelSlices, kFogFroxelNear and
@@ -137,10 +137,12 @@ class RealtimeMedia {
   /// Embree RayScene, whose Occluded is rtcOccluded1 ray by ray; the CUDA backend its
   /// CudaRayQuery), in batches of kShadowRayBatch; the cells and the batches are spread over
   /// `pool` (may be null). the froxel volume is built for `camera`; `frame_key` is
-  /// FrameContext::FrameKey(). the world light volume's cells and the fog froxels are made by
-  /// render/media_build_math.h's LightVolumeCellLight and FogFroxelColumn. `device_volumes`:
-  /// those two are left to a device (their layouts set, their arrays empty: device_build() says
-  /// which; the CUDA backend's kernels run the same functions); the queries that read them
+  /// FrameContext::FrameKey(). the volumes are made by render/media_build_math.h's functions
+  /// (the world light volume's cells LightVolumeCellLight, the fog froxels FogFroxelColumn, the
+  /// grids' light volumes GridLightCellLight / GridLightCellSource, the grid froxels
+  /// GridFroxelSlice / GridFroxelRecords). `device_volumes`: the four are left to a device
+  /// (their layouts set, their arrays empty: device_build() says which, with the grids' arrays;
+  /// the CUDA backend's kernels run the same functions); the queries that read them
   /// (LightTransmittance, LightTransmittances, LightVisibilities, IntegrateView, PrepareQuad)
   /// must then not be called, HostView's pointers to them are null.
   void Build(const MediaScene& media, const LightSampler& lights, const RayQuery& scene,
@@ -211,6 +213,9 @@ class RealtimeMedia {
   const CellLightsPod& light_volume_pod() const { return cl_pod_; }
   const std::vector<float>& light_volume_visibility() const { return vol_.vis_cl; }
   const std::vector<float>& light_volume_transmittance() const { return vol_.trans_cl; }
+  /// the grids' light volumes' isotropic in-scatter sources (cd/m^2), [cell] per grid end to end
+  /// (GridSourceOffset of media_build_math.h; empty when left to a device).
+  const std::vector<Float3>& grid_light_source() const { return grid_source_; }
   /// this frame's media as a RealtimeMediaView (media_realtime_math.h) over this object's
   /// arrays (host pointers, valid until the next Build), with the froxels' records, the grids'
   /// light volumes and the sky volume's plain data copied to *arrays, which must outlive the
@@ -227,10 +232,8 @@ class RealtimeMedia {
   struct GridLight {
     int r[3] = {1, 1, 1};
     Eigen::Vector3f cells_per_m{1, 1, 1};
-    float cell_m = 1;                     // smallest cell size
-    std::vector<float> T;                 // [light][cell] grid transmittance to the light
-    std::vector<Eigen::Vector3f> source;  // [cell] isotropic in-scatter source, cd/m^2
-    GridLightPod pod;  // the grid's box and this volume for GridLightTransmittance (offset 0)
+    std::vector<float> T;  // [light][cell] grid transmittance to the light
+    GridLightPod pod;      // the grid's box and this volume for GridLightTransmittance (offset 0)
   };
   struct LightVolume {
     bool active = false;
@@ -276,8 +279,10 @@ class RealtimeMedia {
   // the fog froxels' layout and, unless `device`, their columns (FogFroxelColumn)
   void BuildFogFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
                        ThreadPool* pool, bool device);
+  // the grid froxels' layout and, unless `device`, their columns (GridFroxelColumnInterval,
+  // GridFroxelSlice, GridFroxelRecords)
   void BuildFroxels(const LightSampler& lights, const Camera& camera, uint64_t frame_key,
-                    ThreadPool* pool);
+                    ThreadPool* pool, bool device);
 
   /// trilinear lookup at p_W of every light's value in a [cell][light] array of the world light
   /// volume (trans_cl or vis_cl) into out[0 .. stride); false outside the volume: the shared
@@ -305,6 +310,16 @@ class RealtimeMedia {
   // functions and HostView read them)
   std::vector<GridLightPod> grid_pods_;
   std::vector<float> grid_light_T_;
+  // every grid's light volume's in-scatter source ([cell], cd/m^2) end to end (GridSourceOffset)
+  std::vector<Float3> grid_source_;
+  // the grids as the shared build functions read them (MediaScene's pods: host pointers), and the
+  // sky volume's plain data for GridLightCellSky
+  std::vector<MediaGridPod> grid_media_;
+  SkyVolumePod grid_sky_pod_;
+  // device builds: the grids' arrays of grid_generation_ (held so that their addresses stay
+  // unique while compared)
+  std::vector<std::shared_ptr<const std::vector<float>>> held_grid_arrays_;
+  uint64_t grid_generation_ = 0;
   MediaVolumesToBuild device_build_;
   BuildTimes build_times_;
   LightVolume vol_;

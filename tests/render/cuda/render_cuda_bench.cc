@@ -25,8 +25,9 @@
 // pageable copies, the kernels alone and the CPU backend; then the device-to-host copy rates,
 // pinned and pageable.
 // --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
-// default 640x480), Render() of rgb+depth with the media volumes' world light volume and fog
-// froxels built by the device's kernels (the default since branch gpu15) and on the host
+// default 640x480), Render() of rgb+depth with the media volumes (the world light volume and fog
+// froxels since branch gpu15, the grids' light volumes and froxels since gpu17) built by the
+// device's kernels (the default) and on the host
 // (RealtimeFrameData::set_device_media(false), as before), interleaved three times: frames/s,
 // the host's preparation (CudaRenderer::last_prepare_ms), RealtimeMedia::Build's host time and
 // its stages (RealtimeMedia::BuildTimes), the device's first stage by CUDA events (the media's
@@ -240,9 +241,8 @@ int MediaMain(const std::vector<std::string>& worlds, int width, int height, int
         fmt::print(
             "| {} | {} | {} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
             "{:.3f} | {:.3f} |\n",
-            world.name, size,
-            device ? "device (light volume and fog froxels as kernels)" : "host (as before)", 1 / s,
-            1e3 * s, prepare / frames, build / frames, st.grid_light / frames,
+            world.name, size, device ? "device (the volumes as kernels)" : "host (as before)",
+            1 / s, 1e3 * s, prepare / frames, build / frames, st.grid_light / frames,
             st.light_volume / frames, st.grid_froxels / frames, st.fog_froxels / frames,
             geometry / frames);
       }

@@ -270,6 +270,16 @@ class RealtimeBatch {
 };
 
 /// the device side of the realtime path.
+/// the grids' light volumes and froxels of a frame (RealtimeFrameView::media_build.grids) as
+/// host arrays: the built by BuildMediaVolumesOnHost (realtime_frame.h), or the device's copied
+/// back (DeviceRealtime::DownloadGridVolumes).
+struct GridVolumeArrays {
+  std::vector<float> T;        ///< the light volumes' [light][cell], end to end (pod offsets)
+  std::vector<Float3> source;  ///< their in-scatter sources [cell], end to end
+  std::vector<float> t0, t1, slices_per_m;      ///< the froxel columns' spans [column]
+  std::vector<GridFroxelRecord<Rgb4>> records;  ///< [column][boundary 0 .. kFroxelSlices]
+};
+
 class DeviceRealtime {
  public:
   DeviceRealtime();
@@ -325,6 +335,10 @@ class DeviceRealtime {
   const RealtimeStageTimes& last_stage_times() const;
   /// the device's exposures against the host's over the Renders so far.
   const RealtimeExposureChecks& exposure_checks() const;
+  /// the grids' light volumes and froxels the last Render built on the device (its frame's
+  /// media_build.grids) copied into *out (tests); false (*out untouched) if it built none.
+  /// @throws Error on a CUDA failure.
+  bool DownloadGridVolumes(GridVolumeArrays* out) const;
 
  private:
   struct Impl;

@@ -10,6 +10,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_path.h"
+#include "penumbra/render/cuda/media_grid_upload.h"
 #include "penumbra/render/cuda/path_shading.h"
 
 namespace penumbra::cuda {
@@ -158,39 +159,15 @@ const PathEmitters& DevicePath::UploadEmitterPoses(const double* poses) {
 const MediaSceneView& DevicePath::UploadMedia(const MediaSceneView& h) {
   Impl& m = *impl_;
   // every grid's density (and emission) in one array each, the grid pods pointing into them
-  std::vector<MediaGridPod> grids(h.grids, h.grids + h.num_grids);
-  size_t density_n = 0, emission_n = 0;
-  for (const MediaGridPod& g : grids) {
-    const size_t cells = static_cast<size_t>(g.n[0]) * g.n[1] * g.n[2];
-    density_n += cells;
-    if (g.emission != nullptr) emission_n += 3 * cells;
-  }
-  m.grid_density.Reserve(sizeof(float) * density_n);
-  m.grid_emission.Reserve(sizeof(float) * emission_n);
-  size_t density_at = 0, emission_at = 0;
-  for (MediaGridPod& g : grids) {
-    const size_t cells = static_cast<size_t>(g.n[0]) * g.n[1] * g.n[2];
-    float* dd = m.grid_density.as<float>() + density_at;
-    Check(cudaMemcpy(dd, g.density, sizeof(float) * cells, cudaMemcpyHostToDevice),
-          "uploading a grid's density");
-    g.density = dd;
-    density_at += cells;
-    if (g.emission != nullptr) {
-      float* de = m.grid_emission.as<float>() + emission_at;
-      Check(cudaMemcpy(de, g.emission, sizeof(float) * 3 * cells, cudaMemcpyHostToDevice),
-            "uploading a grid's emission");
-      g.emission = de;
-      emission_at += 3 * cells;
-    }
-  }
+  const MediaGridPod* grids = UploadMediaGrids(h.grids, h.num_grids, &m.grid_density,
+                                               &m.grid_emission, &m.grid_pods, nullptr);
   m.media_pods.Upload(h.media, sizeof(MediumPod) * h.num_media, nullptr);
   m.media_terms.Upload(h.terms, sizeof(MediumTracePod) * h.num_media, nullptr);
-  m.grid_pods.Upload(grids.data(), sizeof(MediaGridPod) * grids.size(), nullptr);
   Check(cudaStreamSynchronize(nullptr), "uploading the media");
   m.media = h;
   m.media.media = h.num_media > 0 ? m.media_pods.as<MediumPod>() : nullptr;
   m.media.terms = h.num_media > 0 ? m.media_terms.as<MediumTracePod>() : nullptr;
-  m.media.grids = h.num_grids > 0 ? m.grid_pods.as<MediaGridPod>() : nullptr;
+  m.media.grids = grids;
   return m.media;
 }
 

@@ -383,6 +383,34 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
   if (f->has_media == 0) return;
   const MediaVolumesToBuild& b = f->media_build;
   RealtimeMediaView& m = f->media;
+  if (b.grids != 0 && m.num_grids > 0) {
+    const GridLightPod& last = m.grids[m.num_grids - 1];
+    out->grids.T.assign(last.offset + static_cast<size_t>(m.num_grid_lights) * GridLightCells(last),
+                        0.0f);
+    const int64_t cells = GridSourceOffset(m.grids, m.num_grids);
+    out->grids.source.assign(cells, Float3{});
+    ParallelForOrSerial(pool, cells, [&](int64_t c) {
+      MediaGridLightCell(*f, c, out->grids.T.data(), out->grids.source.data());
+    });
+    m.grid_light_T = out->grids.T.data();
+    const int columns = m.grid_nx * m.grid_ny;
+    out->grids.t0.assign(columns, 0.0f);
+    out->grids.t1.assign(columns, 0.0f);
+    out->grids.slices_per_m.assign(columns, 0.0f);
+    out->grids.records.assign(static_cast<size_t>(columns) * (kFroxelSlices + 1),
+                              GridFroxelRecord<Rgb4>{});
+    ParallelForOrSerial(pool, columns, [&](int64_t c) {
+      MediaGridFroxelColumn(*f, static_cast<int>(c), out->grids.source.data(), out->grids.t0.data(),
+                            out->grids.t1.data(), out->grids.slices_per_m.data(),
+                            out->grids.records.data());
+    });
+    if (columns > 0) {
+      m.grid_t0 = out->grids.t0.data();
+      m.grid_t1 = out->grids.t1.data();
+      m.grid_slices_per_m = out->grids.slices_per_m.data();
+      m.grid_records = out->grids.records.data();
+    }
+  }
   float* vis = nullptr;
   if (b.light_volume != 0) {
     const int64_t cells = LightVolumeCells(m.light_volume);

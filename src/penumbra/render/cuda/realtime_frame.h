@@ -7,8 +7,9 @@
 // render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: each
 // pixel's nearest streak found and shaded on the host with the CPU's render/particle_streaks.h,
 // StreakPixel; the kernels draw it over the pixel) and media (homogeneous and grids:
-// PrepareMedia, RealtimeMedia's volumes built on the host but for the world light volume and the
-// fog froxels, which the frame builds itself on the device; the kernels' view pass draws them and
+// PrepareMedia, RealtimeMedia's layouts built on the host and its four volumes (the grids' light
+// volumes and froxels, the world light volume, the fog froxels) by the frame itself on the
+// device; the kernels' view pass draws them and
 // the streaks seen through them); the sky model and sky volume (SkyData, for
 // DeviceRealtime::UploadSky) and, for the host path, the per-pixel sky terms from the primary rays'
 // geometry (QuadSkyTerms of realtime_shading.h: the shared lookups of render/sky_eval_math.h, which
@@ -67,14 +68,15 @@ class RealtimeFrameData {
   /// the media of the frame (View's media, has_media): with homogeneous or grid media in
   /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
   /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
-  /// `view`, with the frame's lights, sky and occluded sky volume: the shadow rays of the grids'
-  /// light volumes (and, without device_media, of the world light volume) through `media_rays`
+  /// `view`, with the frame's lights, sky and occluded sky volume: without device_media the
+  /// shadow rays of the grids' light volumes and of the world light volume through `media_rays`
   /// (any RayQuery posed for `snapshot`: CudaRenderer passes one over its device scene), or, if
   /// null, through a BvhRayQuery (the kernels' traversal on the host) this object keeps and
   /// poses; RealtimeMedia::HostView's arrays for the view (the grids' froxels and light volumes
-  /// too). with device_media (the default) the world light volume's cells and the fog froxels
-  /// are left to the frame (View's media_build: the device's MediaLightVolumeKernel and
-  /// MediaFogSliceKernel, or BuildMediaVolumesOnHost). call after PoseWorld (Prepare does).
+  /// too). with device_media (the default) the grids' light volumes and froxels, the world light
+  /// volume's cells and the fog froxels are left to the frame (View's media_build: the device's
+  /// MediaGridLightKernel, MediaGridFroxelKernel, MediaLightVolumeKernel and MediaFogSliceKernel,
+  /// or BuildMediaVolumesOnHost), with the grids' arrays. call after PoseWorld (Prepare does).
   void PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                     const Camera& camera, const CameraView& view, ThreadPool* pool,
                     const RayQuery* media_rays = nullptr);
@@ -85,9 +87,10 @@ class RealtimeFrameData {
   const RealtimeMedia::BuildTimes& media_build_times() const {
     return realtime_media_.build_times();
   }
-  /// whether PrepareMedia leaves the world light volume's cells and the fog froxels to the frame
-  /// (View's media_build: the device's kernels, or BuildMediaVolumesOnHost; default true) or
-  /// builds them on the host with the rest of RealtimeMedia (false: as before branch gpu15).
+  /// whether PrepareMedia leaves the media volumes (the grids' light volumes and froxels, the
+  /// world light volume's cells, the fog froxels) to the frame (View's media_build: the
+  /// device's kernels, or BuildMediaVolumesOnHost; default true) or builds them on the host with
+  /// the rest of RealtimeMedia (false: as before branch gpu15).
   void set_device_media(bool on) { device_media_ = on; }
   bool device_media() const { return device_media_; }
   /// the camera-independent part of Prepare: the lights, the geoms (their transforms made
@@ -235,11 +238,14 @@ struct MediaVolumeArrays {
   std::vector<float> trans, vis;  // the world light volume, [cell][light]
   std::vector<Rgb4> fog;          // the fog froxels' records
   std::vector<float> inv_log_far;
+  GridVolumeArrays grids;  // the grids' light volumes and froxels
 };
 
 /// the media volumes that frame f leaves to itself (f->media_build) built on the CPU with the
-/// kernels' functions (MediaLightVolumeCell, its shadow rays through f->scene; MediaFogColumn)
-/// over `pool` into *out, and f->media pointed at them. nothing without media or such volumes.
+/// kernels' functions over `pool` into *out, and f->media pointed at them, in the device's
+/// order: the grids' light volumes (MediaGridLightCell, its shadow rays through f->scene), the
+/// grid froxels (MediaGridFroxelColumn), the world light volume (MediaLightVolumeCell), the fog
+/// froxels (MediaFogColumn). nothing without media or such volumes.
 void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolumeArrays* out);
 
 /// renders a realtime frame (rgb, radiance, depth) with the GPU path's per-pixel functions on

@@ -15,6 +15,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/media_grid_upload.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 
 namespace penumbra::cuda {
@@ -111,6 +112,51 @@ __global__ void MediaFogSliceKernel(RealtimeFrameView f, const float* vis_cl, Rg
     column[i] = Float3{inc[3 * i], inc[3 * i + 1], inc[3 * i + 2]};
   FogFroxelRecords(column,
                    reinterpret_cast<float*>(S + static_cast<int64_t>(c) * (kFogFroxelSlices + 1)));
+}
+
+// the grids' light volumes a frame builds itself (f.media_build.grids), before the kernels
+// that read them: one thread per cell of every grid's volume, counted end to end (its shadow
+// rays traced in the thread; MediaGridLightCell).
+__global__ void MediaGridLightKernel(RealtimeFrameView f, int64_t cells, float* grid_T,
+                                     Float3* source) {
+  const int64_t c = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (c >= cells) return;
+  MediaGridLightCell(f, c, grid_T, source);
+}
+// the grid froxels (after the grids' light volumes, whose sources they read): one block per
+// column, one thread per slice (kFroxelSlices of kGridSliceBlock; MediaGridSlice), then the
+// column's records accumulated in slice order by its first thread (GridFroxelRecords: the bits of
+// MediaGridFroxelColumn's serial loop).
+constexpr int kGridSliceBlock = 32;
+static_assert(kFroxelSlices <= kGridSliceBlock, "one block holds a column's slices");
+__global__ void MediaGridFroxelKernel(RealtimeFrameView f, const Float3* source, float* t0,
+                                      float* t1, float* slices_per_m,
+                                      GridFroxelRecord<Rgb4>* records) {
+  // each slice's step as 10 plain floats (a __shared__ array takes no initialisers)
+  __shared__ float step[10 * kFroxelSlices];
+  const int c = blockIdx.x, k = threadIdx.x;
+  const MediaGridColumnInputs in = MediaGridColumnOf(f, c, source);
+  if (k < kFroxelSlices) {
+    const GridFroxelStep s = MediaGridSlice(in, k);
+    float* o = step + 10 * k;
+    o[0] = s.src.x, o[1] = s.src.y, o[2] = s.src.z;
+    o[3] = s.step_T.x, o[4] = s.step_T.y, o[5] = s.step_T.z;
+    o[6] = s.factor.x, o[7] = s.factor.y, o[8] = s.factor.z;
+    o[9] = static_cast<float>(s.any);
+  }
+  __syncthreads();
+  if (k != 0) return;
+  MediaGridColumnSpan(in, c, t0, t1, slices_per_m);
+  GridFroxelStep column[kFroxelSlices];
+  for (int i = 0; i < kFroxelSlices; ++i) {
+    const float* o = step + 10 * i;
+    column[i].src = Float3{o[0], o[1], o[2]};
+    column[i].step_T = Float3{o[3], o[4], o[5]};
+    column[i].factor = Float3{o[6], o[7], o[8]};
+    column[i].any = o[9] != 0.0f ? 1 : 0;
+  }
+  GridFroxelRecords(
+      column, reinterpret_cast<float*>(records + static_cast<int64_t>(c) * (kFroxelSlices + 1)));
 }
 
 // the mirror layer (realtime_shading.h): the mirrored rays after the geometry kernel; their
@@ -616,6 +662,16 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the grids' froxels (records; t0, t1 and slices per m end to end; axis tables), their boxes
   // and light volumes (branch gpu12)
   Buffer media_grid_records, media_grid_columns, media_grid_axes, media_grid_pods, media_grid_T;
+  // the grids' arrays when the frame builds their volumes (branch gpu17): densities, emission,
+  // their MediaGridPods (the arrays of grid_generation, uploaded again when it changes), and
+  // the light volumes' in-scatter sources
+  Buffer media_grid_density, media_grid_emission, media_grid_media, media_grid_source;
+  bool grid_arrays_held = false;
+  uint64_t grid_generation = 0;
+  // what the last frame built there (DownloadGridVolumes): T values, cells, froxel columns
+  size_t grid_built_values = 0;
+  int64_t grid_built_cells = 0;
+  int grid_built_columns = 0;
   // the sky's and the sky volume's arrays (UploadSky) and their pods with these pointers
   Buffer sky_irradiance, skybox, volume_sh, volume_cells, volume_depth;
   SkyModelPod device_sky;
@@ -744,7 +800,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
       media_trans.Upload(h.light_trans, sizeof(float) * n, stream);
       d->light_trans = media_trans.as<float>();
     }
-    if (h.grid_records != nullptr) {
+    if (h.grid_records != nullptr) {  // built on the host (else BuildGridMedia's)
       const size_t columns = static_cast<size_t>(h.grid_nx) * h.grid_ny;
       media_grid_records.Upload(
           h.grid_records, sizeof(GridFroxelRecord<Rgb4>) * columns * (kFroxelSlices + 1), stream);
@@ -759,6 +815,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
       d->grid_t0 = c;
       d->grid_t1 = c + columns;
       d->grid_slices_per_m = c + 2 * columns;
+    }
+    if (h.grid_ax != nullptr) {
       const MediaAxis* const grid[4] = {h.grid_ax, h.grid_ax_half, h.grid_ay, h.grid_ay_half};
       const MediaAxis** const grid_d[4] = {&d->grid_ax, &d->grid_ax_half, &d->grid_ay,
                                            &d->grid_ay_half};
@@ -767,13 +825,65 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (h.num_grids > 0) {
       media_grid_pods.Upload(h.grids, sizeof(GridLightPod) * h.num_grids, stream);
       d->grids = media_grid_pods.as<GridLightPod>();
-      // every grid's [light][cell] transmittances, end to end (the last pod's offset + its own)
-      const GridLightPod& last = h.grids[h.num_grids - 1];
-      const size_t n =
-          last.offset + static_cast<size_t>(h.num_grid_lights) * last.r[0] * last.r[1] * last.r[2];
-      media_grid_T.Upload(h.grid_light_T, sizeof(float) * (n > 0 ? n : 1), stream);
-      d->grid_light_T = media_grid_T.as<float>();
+      if (h.grid_light_T != nullptr) {  // built on the host (else BuildGridMedia's)
+        // every grid's [light][cell] transmittances, end to end (the last pod's offset + its own)
+        media_grid_T.Upload(h.grid_light_T, sizeof(float) * GridLightValues(h), stream);
+        d->grid_light_T = media_grid_T.as<float>();
+      }
     }
+  }
+  // the values of every grid's [light][cell] transmittances end to end in view m (the last
+  // pod's offset + its own; at least 1)
+  static size_t GridLightValues(const RealtimeMediaView& m) {
+    const GridLightPod& last = m.grids[m.num_grids - 1];
+    const size_t n =
+        last.offset + static_cast<size_t>(m.num_grid_lights) * last.r[0] * last.r[1] * last.r[2];
+    return n > 0 ? n : 1;
+  }
+  // the grids' volumes frame f builds itself (f->media_build.grids), on `stream` after
+  // UploadMedia and before the world light volume and fog froxels (which read them): the grids'
+  // arrays uploaded when their generation changed, MediaGridLightKernel, then
+  // MediaGridFroxelKernel; f->media pointed at their buffers
+  void BuildGridMedia(const RealtimeMediaView& h, RealtimeFrameView* f, cudaStream_t stream) {
+    MediaVolumesToBuild& b = f->media_build;
+    RealtimeMediaView& m = f->media;
+    grid_built_values = grid_built_cells = grid_built_columns = 0;
+    if (b.grids == 0 || m.num_grids <= 0) return;
+    // the densities and emission when their generation changed; the pods (transforms and
+    // coefficients, which may change over the same arrays) every frame
+    const bool arrays = !grid_arrays_held || b.grid_generation != grid_generation;
+    b.grid_media = UploadMediaGrids(b.grid_media, m.num_grids, &media_grid_density,
+                                    &media_grid_emission, &media_grid_media, stream, arrays);
+    grid_generation = b.grid_generation;
+    grid_arrays_held = true;
+    int64_t cells = 0;
+    for (int g = 0; g < h.num_grids; ++g) cells += GridLightCells(h.grids[g]);
+    media_grid_T.Reserve(sizeof(float) * GridLightValues(h));
+    media_grid_source.Reserve(sizeof(Float3) * static_cast<size_t>(cells > 0 ? cells : 1));
+    if (cells > 0) {
+      MediaGridLightKernel<<<static_cast<unsigned>((cells + 63) / 64), 64, 0, stream>>>(
+          *f, cells, media_grid_T.as<float>(), media_grid_source.as<Float3>());
+      Check(cudaGetLastError(), "MediaGridLightKernel");
+    }
+    m.grid_light_T = media_grid_T.as<float>();
+    const GridLightPod& last = h.grids[h.num_grids - 1];
+    grid_built_values = last.offset + static_cast<size_t>(h.num_grid_lights) * GridLightCells(last);
+    grid_built_cells = cells;
+    const int columns = m.grid_nx * m.grid_ny;
+    grid_built_columns = columns > 0 ? columns : 0;
+    if (columns <= 0) return;
+    media_grid_columns.Reserve(sizeof(float) * 3 * static_cast<size_t>(columns));
+    media_grid_records.Reserve(sizeof(GridFroxelRecord<Rgb4>) * static_cast<size_t>(columns) *
+                               (kFroxelSlices + 1));
+    float* cols = media_grid_columns.as<float>();
+    MediaGridFroxelKernel<<<static_cast<unsigned>(columns), kGridSliceBlock, 0, stream>>>(
+        *f, media_grid_source.as<Float3>(), cols, cols + columns, cols + 2 * columns,
+        media_grid_records.as<GridFroxelRecord<Rgb4>>());
+    Check(cudaGetLastError(), "MediaGridFroxelKernel");
+    m.grid_t0 = cols;
+    m.grid_t1 = cols + columns;
+    m.grid_slices_per_m = cols + 2 * columns;
+    m.grid_records = media_grid_records.as<GridFroxelRecord<Rgb4>>();
   }
   // the media volumes frame f builds itself (f->media_build), on `stream` after UploadMedia:
   // MediaLightVolumeKernel, then MediaFogSliceKernel; f->media pointed at their buffers
@@ -963,6 +1073,33 @@ const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->opt
 const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
 const RealtimeExposureChecks& DeviceRealtime::exposure_checks() const { return impl_->checks; }
 
+bool DeviceRealtime::DownloadGridVolumes(GridVolumeArrays* out) const {
+  const Impl& m = *impl_;
+  if (m.grid_built_cells <= 0 && m.grid_built_columns <= 0) return false;
+  Check(cudaDeviceSynchronize(), "DownloadGridVolumes");
+  auto get = [](const Buffer& b, void* dst, size_t bytes) {
+    if (bytes > 0)
+      Check(cudaMemcpy(dst, b.p, bytes, cudaMemcpyDeviceToHost), "DownloadGridVolumes");
+  };
+  const size_t columns = static_cast<size_t>(m.grid_built_columns);
+  out->T.assign(m.grid_built_values, 0.0f);
+  out->source.assign(static_cast<size_t>(m.grid_built_cells), Float3{});
+  out->t0.assign(columns, 0.0f);
+  out->t1.assign(columns, 0.0f);
+  out->slices_per_m.assign(columns, 0.0f);
+  out->records.assign(columns * (kFroxelSlices + 1), GridFroxelRecord<Rgb4>{});
+  get(m.media_grid_T, out->T.data(), sizeof(float) * out->T.size());
+  get(m.media_grid_source, out->source.data(), sizeof(Float3) * out->source.size());
+  std::vector<float> cols(3 * columns);
+  get(m.media_grid_columns, cols.data(), sizeof(float) * cols.size());
+  std::copy(cols.begin(), cols.begin() + columns, out->t0.begin());
+  std::copy(cols.begin() + columns, cols.begin() + 2 * columns, out->t1.begin());
+  std::copy(cols.begin() + 2 * columns, cols.end(), out->slices_per_m.begin());
+  get(m.media_grid_records, out->records.data(),
+      sizeof(GridFroxelRecord<Rgb4>) * out->records.size());
+  return true;
+}
+
 void DeviceRealtime::Upload(const RealtimeStatic& d) {
   Impl& m = *impl_;
   m.materials.Upload(d.materials, sizeof(MaterialPod) * d.num_materials, nullptr);
@@ -1069,6 +1206,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   }
   if (f.has_media != 0) {
     m.UploadMedia(host_frame.media, &f.media, stream);
+    m.BuildGridMedia(host_frame.media, &f, stream);
     m.BuildMedia(&f, stream);
   }
   // host buffers of the round trips and outputs

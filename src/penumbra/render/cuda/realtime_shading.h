@@ -1275,6 +1275,20 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
   return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
 }
 
+/// whether a media volume cell at p sees a light whose visibility asks `w` (LightVolumeCellLight,
+/// GridLightCellLight): lit, or a shadow ray along d to tmax traced here through f.scene and
+/// not occluded, as RealtimeMedia::Build's rays (a RayQuery's: the same TraceRay, tmin 0).
+PB_HOST_DEVICE inline bool MediaCellSees(const RealtimeFrameView& f, uint8_t w, const float p[3],
+                                         const float d[3], float tmax) {
+  if (w != kMediaRayTrace) return w == kMediaRayLit;
+  TraceRay r;
+  r.o = F3{p[0], p[1], p[2]};
+  r.d = F3{d[0], d[1], d[2]};
+  r.tmin = 0.0f;
+  r.tmax = tmax;
+  return !TraceOccluded(f.scene, r);
+}
+
 /// cell c of the world light volume that frame f builds itself (f.media_build.light_volume;
 /// layout f.media.light_volume): per light l < stride its [cell][light] transmittance
 /// trans_cl[c stride + l] (LightVolumeCellLight; 0 past the volume's lights) and, where vis_cl
@@ -1308,17 +1322,130 @@ PB_HOST_DEVICE inline void MediaLightVolumeCell(const RealtimeFrameView& f, int6
     const uint8_t w = LightVolumeCellLight(b, p, l, &T, d, &tmax);
     trans_cl[at] = T;
     if (vis_cl == nullptr) continue;
-    bool seen = w == kMediaRayLit;
-    if (w == kMediaRayTrace) {
-      TraceRay r;
-      r.o = F3{p[0], p[1], p[2]};
-      r.d = F3{d[0], d[1], d[2]};
-      r.tmin = 0.0f;
-      r.tmax = tmax;
-      seen = !TraceOccluded(f.scene, r);
-    }
+    const bool seen = MediaCellSees(f, w, p, d, tmax);
     vis_cl[at] = seen ? T : 0.0f;
   }
+}
+
+/// the ray o + t d (PrimaryRay, d normalised) through the centre pixel (*uc, *vc) of froxel
+/// column c of a volume of nx columns of block x block pixels in frame f (RealtimeMedia's
+/// columns take Camera::GenerateRay's).
+PB_HOST_DEVICE inline void MediaColumnRay(const RealtimeFrameView& f, int c, int nx, int block,
+                                          int* uc, int* vc, float o[3], float d[3]) {
+  const int W = f.camera.width, H = f.camera.height;
+  *uc = MediaMinI((c % nx) * block + block / 2, W - 1);
+  *vc = MediaMinI((c / nx) * block + block / 2, H - 1);
+  const TraceRay r = PrimaryRay(f.camera, *uc, *vc);
+  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
+  o[0] = r.o.x, o[1] = r.o.y, o[2] = r.o.z;
+  d[0] = r.d.x / len, d[1] = r.d.y / len, d[2] = r.d.z / len;
+}
+
+/// the inputs of the grids' light volumes of frame f (f.media_build.grids): the grids' arrays
+/// (f.media_build.grid_media), their layouts (f.media.grids), the volume lights, the homogeneous
+/// media and the sky lighting them.
+PB_HOST_DEVICE inline GridLightBuild MediaGridLightBuildOf(const RealtimeFrameView& f) {
+  const RealtimeMediaView& m = f.media;
+  GridLightBuild b;
+  b.grids = f.media_build.grid_media;
+  b.layouts = m.grids;
+  b.num_grids = m.num_grids;
+  b.lights = f.lights;
+  b.num_lights = m.num_grid_lights;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  for (int k = 0; k < 3; ++k) b.sky_ambient[k] = m.sky_ambient[k];
+  b.sky_volume = m.sky_volume;
+  return b;
+}
+
+/// cell c of the grids' light volumes of frame f counted end to end (grid g's cells follow those
+/// of the grids before it, GridSourceOffset): per light l its transmittance grid_T[offset + l
+/// cells + i] (GridLightCellLight; i the cell within its grid) and the cell's in-scatter source
+/// source[c] (GridLightCellSky, then GridLightCellSource of each light seen, in light order),
+/// each asked shadow ray traced here through f.scene, as RealtimeMedia::Build's cells (whose
+/// rays go through a RayQuery: the same TraceRay, o at the cell centre, tmin 0).
+PB_HOST_DEVICE inline void MediaGridLightCell(const RealtimeFrameView& f, int64_t c, float* grid_T,
+                                              Float3* source) {
+  const GridLightBuild b = MediaGridLightBuildOf(f);
+  int g = 0;
+  int64_t i = c;
+  while (g < b.num_grids && i >= GridLightCells(b.layouts[g])) i -= GridLightCells(b.layouts[g++]);
+  if (g >= b.num_grids) return;
+  const GridLightPod& gl = b.layouts[g];
+  const int64_t cells = GridLightCells(gl);
+  float p[3];
+  GridLightCellCentre(gl, i, p);
+  Float3 src = GridLightCellSky(b, p);
+  for (int l = 0; l < b.num_lights; ++l) {
+    float Tg, d[3], tmax;
+    const uint8_t w = GridLightCellLight(b, g, p, l, &Tg, d, &tmax);
+    grid_T[gl.offset + l * cells + i] = Tg;
+    const bool seen = MediaCellSees(f, w, p, d, tmax);
+    if (seen) src = GridLightCellSource(b, p, l, Tg, src);
+  }
+  source[c] = src;
+}
+
+/// the inputs of grid froxel column c of frame f (f.media_build.grids; f.media.grid_nx x grid_ny
+/// columns): the build over f's grids, their light volumes' sources `source` and the homogeneous
+/// media, the column's centre pixel's ray o + t d (PrimaryRay, unit direction; RealtimeMedia::
+/// BuildFroxels takes Camera::GenerateRay's), its slice jitter (stream 2) and its overlap
+/// [t0, t1] with the grid boxes (`hit` 0: none).
+struct MediaGridColumnInputs {
+  GridFroxelBuild b;
+  float o[3], d[3];
+  float jitter;
+  float t0, t1;
+  int hit;
+};
+PB_HOST_DEVICE inline MediaGridColumnInputs MediaGridColumnOf(const RealtimeFrameView& f, int c,
+                                                              const Float3* source) {
+  const RealtimeMediaView& m = f.media;
+  MediaGridColumnInputs in;
+  int uc, vc;
+  MediaColumnRay(f, c, m.grid_nx, kFroxelBlock, &uc, &vc, in.o, in.d);
+  GridFroxelBuild& b = in.b;
+  b.grids = f.media_build.grid_media;
+  b.layouts = m.grids;
+  b.source = source;
+  b.num_grids = m.num_grids;
+  b.media = m.media;
+  b.num_media = m.num_media;
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, f.camera.width, 2);
+  in.hit = GridFroxelColumnInterval(b, in.o, in.d, &in.t0, &in.t1) ? 1 : 0;
+  return in;
+}
+
+/// the grid froxel column c's overlap as RealtimeMedia::BuildFroxels keeps it: t0[c], t1[c] and
+/// slices_per_m[c] = min(kFroxelSlices / (t1 - t0), 1e30) where the column meets a grid, else 0.
+PB_HOST_DEVICE inline void MediaGridColumnSpan(const MediaGridColumnInputs& in, int c, float* t0,
+                                               float* t1, float* slices_per_m) {
+  t0[c] = in.hit != 0 ? in.t0 : 0.0f;
+  t1[c] = in.hit != 0 ? in.t1 : 0.0f;
+  slices_per_m[c] =
+      in.hit != 0 ? pbm::Min(static_cast<float>(kFroxelSlices) / (in.t1 - in.t0), 1e30f) : 0.0f;
+}
+
+/// slice k of grid froxel column `in` (GridFroxelSlice; nothing where the column meets no grid).
+PB_HOST_DEVICE inline GridFroxelStep MediaGridSlice(const MediaGridColumnInputs& in, int k) {
+  if (in.hit == 0) return GridFroxelStep();
+  return GridFroxelSlice(in.b, in.o, in.d, in.t0, in.t1, in.jitter, k);
+}
+
+/// grid froxel column c of frame f whole (the host path; the device runs its slices in parallel,
+/// MediaGridSlice, then GridFroxelRecords: the same bits): its span (MediaGridColumnSpan) and its
+/// kFroxelSlices + 1 records at records[c (kFroxelSlices + 1) ..].
+PB_HOST_DEVICE inline void MediaGridFroxelColumn(const RealtimeFrameView& f, int c,
+                                                 const Float3* source, float* t0, float* t1,
+                                                 float* slices_per_m,
+                                                 GridFroxelRecord<Rgb4>* records) {
+  const MediaGridColumnInputs in = MediaGridColumnOf(f, c, source);
+  MediaGridColumnSpan(in, c, t0, t1, slices_per_m);
+  GridFroxelStep steps[kFroxelSlices];
+  for (int k = 0; k < kFroxelSlices; ++k) steps[k] = MediaGridSlice(in, k);
+  GridFroxelRecords(
+      steps, reinterpret_cast<float*>(records + static_cast<int64_t>(c) * (kFroxelSlices + 1)));
 }
 
 /// the inputs of fog froxel column c of frame f (f.media_build.fog; f.media.fog_nx x fog_ny
@@ -1334,15 +1461,9 @@ struct MediaFogColumnInputs {
 PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameView& f, int c,
                                                             const float* vis_cl) {
   const RealtimeMediaView& m = f.media;
-  const int W = f.camera.width, H = f.camera.height;
-  const int cx = c % m.fog_nx, cy = c / m.fog_nx;
-  const int uc = MediaMinI(cx * kFogFroxelBlock + kFogFroxelBlock / 2, W - 1);
-  const int vc = MediaMinI(cy * kFogFroxelBlock + kFogFroxelBlock / 2, H - 1);
-  const TraceRay r = PrimaryRay(f.camera, uc, vc);
-  const float len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   MediaFogColumnInputs in;
-  in.o[0] = r.o.x, in.o[1] = r.o.y, in.o[2] = r.o.z;
-  in.d[0] = r.d.x / len, in.d[1] = r.d.y / len, in.d[2] = r.d.z / len;
+  int uc, vc;
+  MediaColumnRay(f, c, m.fog_nx, kFogFroxelBlock, &uc, &vc, in.o, in.d);
   FogFroxelBuild<Rgb4>& b = in.b;
   b.media = m.media;
   b.num_media = m.num_media;
@@ -1359,7 +1480,7 @@ PB_HOST_DEVICE inline MediaFogColumnInputs MediaFogColumnOf(const RealtimeFrameV
   b.grid_slices_per_m = m.grid_slices_per_m;
   b.grid_records = m.grid_records;
   in.grid_cols = m.grid_records != nullptr ? MediaGridPixelColumns(m, uc, vc) : MediaColumns{};
-  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, W, 3);
+  in.jitter = FroxelColumnJitter(f.media_build.frame_key, uc, vc, f.camera.width, 3);
   return in;
 }
 
