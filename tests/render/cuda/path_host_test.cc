@@ -270,6 +270,13 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
 // the streaks differ by far more (the metric can fail). the streaks' BVH is checked against a
 // test of every streak (same nearest streak and t, bit for bit) on the camera's rays, and its
 // host build time is printed.
+// the streaks change these 64x48 frames by 0.23 % (fire's few sparks) to 0.80 % (snow) at the
+// block scale, below issue 35's 1 %: the tolerance here is the host path's own, 0.05 % (measured
+// 0.003 % to 0.007 %: the host path rounds as the CPU and draws its random numbers, so only
+// where Embree's round curves and the capsule test, or Embree and the BVH, round a hit apart do
+// the paths differ), which the same paths without the streaks exceed four times over.
+constexpr double kHostParticleTolerance = 0.0005;
+
 class PathtracedHostParticles : public ::testing::TestWithParam<std::pair<std::string, int>> {};
 
 TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
@@ -342,9 +349,9 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
       world.c_str(), streaks.num, data.path_streaks().build_ms(), hits, 64 * 48 * 4, 100 * tile,
       100 * mean, 100 * tile_clear);
   EXPECT_GT(hits, 0);
-  EXPECT_LE(tile, kHostTileTolerance);
-  EXPECT_LE(mean, kHostTileTolerance);
-  EXPECT_GT(tile_clear, 3 * tile);
+  EXPECT_LE(tile, kHostParticleTolerance);
+  EXPECT_LE(mean, kHostParticleTolerance);
+  EXPECT_GT(tile_clear, 4 * kHostParticleTolerance);
   EXPECT_EQ(0, std::memcmp(got.radiance.data(), again.radiance.data(),
                            sizeof(Float3) * got.radiance.size()));
 }
