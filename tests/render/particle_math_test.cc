@@ -240,22 +240,22 @@ TEST(ParticleMathTest, ShadeEqualsTheOldCodeBitForBit) {
     hit.ng_W = RandomUnit(&rng);
     const Eigen::Vector3f p = RandomIn(&rng, -6, 6);
     const bool pre = hit.kind == ParticleKind::kRain && hit.prim >= 0 && hit.prim < streaks.size();
-    const Eigen::Vector3f want =
-        OldShade(hit.kind, fx.particles[hit.set], pre ? &streaks.rain_radiance()[hit.prim] : nullptr,
-                 p, hit.ng_W, lights, sky_ambient);
+    const Eigen::Vector3f want = OldShade(hit.kind, fx.particles[hit.set],
+                                          pre ? &streaks.rain_radiance()[hit.prim] : nullptr, p,
+                                          hit.ng_W, lights, sky_ambient);
     const Eigen::Vector3f got = streaks.Shade(hit, p, lights, sky_ambient);
     ASSERT_TRUE(SameBits(AsFloat3(got), want)) << "case " << i;
     // the shared function called directly (as the paths call it)
     const StreakSetPod set = streaks.SetPod(hit.set);
     const Float3 rain = pre ? AsFloat3(streaks.rain_radiance()[hit.prim]) : Float3{};
     const Float3 direct =
-        ShadeStreak(set, pre ? &rain : nullptr, AsFloat3(p), AsFloat3(hit.ng_W), lights.pods().data(),
-                    lights.size(), SkyVolumePod(), AsFloat3(sky_ambient));
+        ShadeStreak(set, pre ? &rain : nullptr, AsFloat3(p), AsFloat3(hit.ng_W),
+                    lights.pods().data(), lights.size(), SkyVolumePod(), AsFloat3(sky_ambient));
     ASSERT_TRUE(SameBits(direct, want)) << "case " << i;
-    if (hit.kind == ParticleKind::kSnow && (want - fx.particles[hit.set].color.cwiseProduct(
-                                                        sky_ambient) -
-                                            fx.particles[hit.set].emission)
-                                                   .maxCoeff() > 0)
+    if (hit.kind == ParticleKind::kSnow &&
+        (want - fx.particles[hit.set].color.cwiseProduct(sky_ambient) -
+         fx.particles[hit.set].emission)
+                .maxCoeff() > 0)
       ++lit;
   }
   EXPECT_GT(lit, 1000);  // snow lit by the lights, not only the sky

@@ -328,7 +328,8 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
       const float r = ends_[2 * n].w();
       // the origin-dependent terms once per streak for the camera centre (every pixel's ray
       // origin unless the camera moves during the exposure: then per pixel).
-      const CapsuleOrigin shared = MakeCapsuleOrigin(StreakF3(o_shared), StreakF3(a), StreakF3(b), r);
+      const CapsuleOrigin shared =
+          MakeCapsuleOrigin(StreakF3(o_shared), StreakF3(a), StreakF3(b), r);
       const auto& [ua, va, ub, vb, rp] = seg2[n];
       const float du = ub - ua, dv = vb - va;
       for (int v = v0; v <= v1; ++v) {
@@ -350,7 +351,8 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
           const float t =
               ray.o == o_shared
                   ? IntersectCapsule(shared, d)
-                  : IntersectCapsule(MakeCapsuleOrigin(StreakF3(ray.o), StreakF3(a), StreakF3(b), r), d);
+                  : IntersectCapsule(
+                        MakeCapsuleOrigin(StreakF3(ray.o), StreakF3(a), StreakF3(b), r), d);
           if (!(t > 0)) continue;
           const size_t at = static_cast<size_t>(v) * W + u;
           const float t_ray = t / len;
@@ -433,8 +435,8 @@ Eigen::Vector3f ParticleStreaks::Shade(const ParticleHit& hit, const Eigen::Vect
   const bool precomputed = hit.kind == ParticleKind::kRain && hit.prim >= 0 &&
                            hit.prim < static_cast<int>(rain_radiance_.size());
   if (precomputed) rain = StreakF3(rain_radiance_[hit.prim]);
-  const Float3 L = ShadeStreak(set, precomputed ? &rain : nullptr, StreakF3(p_W), StreakF3(hit.ng_W),
-                               lights.pods().data(), lights.size(),
+  const Float3 L = ShadeStreak(set, precomputed ? &rain : nullptr, StreakF3(p_W),
+                               StreakF3(hit.ng_W), lights.pods().data(), lights.size(),
                                sky_volume_ != nullptr ? sky_volume_->pod() : SkyVolumePod(),
                                StreakF3(sky_ambient));
   return Eigen::Vector3f(L.x, L.y, L.z);

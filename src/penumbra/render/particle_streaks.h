@@ -8,13 +8,13 @@
 // around the segment p + [0, T] v. this class makes the frame's streaks, and for the realtime
 // tier (pixel-centre camera rays) splats them: each capsule's
 // projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
-// (Quilez's ray-capsule test, render/particle_math.h's IntersectCapsule), keeping the nearest streak per pixel (ties: lower index), which
-// costs the streaks' screen area rather than a BVH traversal per pixel. with a pinhole camera
-// that does not move, drops whose widened capsule lies wholly outside the pyramid of the pixel
-// rays are skipped first (no streak, not counted as culled; they could not be drawn).
-// streaks thinner than half a pixel at their distance are widened to half a pixel (radius
-// 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel drops keep
-// their average contribution instead of aliasing away with one ray per pixel.
+// (Quilez's ray-capsule test, render/particle_math.h's IntersectCapsule), keeping the nearest
+// streak per pixel (ties: lower index), which costs the streaks' screen area rather than a BVH
+// traversal per pixel. with a pinhole camera that does not move, drops whose widened capsule lies
+// wholly outside the pyramid of the pixel rays are skipped first (no streak, not counted as culled;
+// they could not be drawn). streaks thinner than half a pixel at their distance are widened to half
+// a pixel (radius 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel
+// drops keep their average contribution instead of aliasing away with one ray per pixel.
 //
 // coverage: a point on the streak is covered for 2r / |v| of the exposure, so a streak is
 // drawn with opacity alpha = 2r / (|v| T + 2r) (1 for a still particle), times the widening

@@ -330,10 +330,9 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
     int best = -1;
     for (int j = 0; j < streaks.num; ++j) {
       const cuda::StreakPod& sp = streaks.streaks[j];
-      const float tm = IntersectCapsule(
-          MakeCapsuleOrigin(o, Float3{sp.a[0], sp.a[1], sp.a[2]}, Float3{sp.b[0], sp.b[1], sp.b[2]},
-                            sp.r),
-          du);
+      const float tm = IntersectCapsule(MakeCapsuleOrigin(o, Float3{sp.a[0], sp.a[1], sp.a[2]},
+                                                          Float3{sp.b[0], sp.b[1], sp.b[2]}, sp.r),
+                                        du);
       if (tm > 0 && tm / len < best_t) best_t = tm / len, best = j;
     }
     ASSERT_EQ(hit, best >= 0) << "ray " << i;

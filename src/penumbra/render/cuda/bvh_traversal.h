@@ -225,10 +225,10 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     LoadPrimShape(s.prims + pi, &kind, &index);
     float t, u = 0, v = 0;
     int part = 0;
-    const bool h = kind == 0 ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin,
-                                                 hit->t, &t, &u, &v)
-                             : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t,
-                                                     &part);
+    const bool h =
+        kind == 0
+            ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin, hit->t, &t, &u, &v)
+            : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t, &part);
     if (!h) return false;
     hit->t = t, hit->u = u, hit->v = v, hit->part = part;
     hit->prim = pi, hit->instance = instance;

@@ -50,7 +50,8 @@ void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3
   }
   const int num_sets = static_cast<int>(streaks.frame()->particles.size());
   for (int s = 0; s < num_sets; ++s) sets_.push_back(streaks.SetPod(s));
-  for (const Eigen::Vector3f& L : streaks.rain_radiance()) rain_.push_back(Float3{L.x(), L.y(), L.z()});
+  for (const Eigen::Vector3f& L : streaks.rain_radiance())
+    rain_.push_back(Float3{L.x(), L.y(), L.z()});
   build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -6,9 +6,8 @@
 // particle sets and the rain's radiance, as the path kernels read them (PathStreaks over these
 // host arrays; DevicePath::UploadStreaks copies them).
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "penumbra/render/cuda/bvh_builder.h"
 #include "penumbra/render/cuda/bvh_types.h"

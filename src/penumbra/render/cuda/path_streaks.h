@@ -62,8 +62,8 @@ PB_HOST_DEVICE inline bool PathStreakHit(const PathStreaks& ps, const Float3& o,
   int best = -1;
   auto leaf = [&](int k) {
     const StreakPod& s = ps.streaks[k];
-    const CapsuleOrigin c = MakeCapsuleOrigin(o, Float3{s.a[0], s.a[1], s.a[2]},
-                                              Float3{s.b[0], s.b[1], s.b[2]}, s.r);
+    const CapsuleOrigin c =
+        MakeCapsuleOrigin(o, Float3{s.a[0], s.a[1], s.a[2]}, Float3{s.b[0], s.b[1], s.b[2]}, s.r);
     const float t_m = IntersectCapsule(c, du);
     if (!(t_m > 0)) return false;
     const float t = t_m / len;
@@ -72,8 +72,8 @@ PB_HOST_DEVICE inline bool PathStreakHit(const PathStreaks& ps, const Float3& o,
     best = k;
     return true;
   };
-  if (!TraverseWideBvh(ps.nodes, ps.root, F3{o.x, o.y, o.z}, F3{d.x, d.y, d.z}, tmin, &t_max,
-                       false, leaf))
+  if (!TraverseWideBvh(ps.nodes, ps.root, F3{o.x, o.y, o.z}, F3{d.x, d.y, d.z}, tmin, &t_max, false,
+                       leaf))
     return false;
   *t_hit = t_max;
   *index = best;
