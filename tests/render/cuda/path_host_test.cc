@@ -206,6 +206,32 @@ MediaFrameCase LoadMediaFrame(const std::string& world, int camera, int w, int h
   return c;
 }
 
+// a MediaFrameCase's pathtraced frame (16 spp, 4 bounces, no denoiser) on the CPU backend (want)
+// and as the GPU path takes it on the host (pf: the host BVH, the frame data Prepared with the
+// effects without media, the media's own MediaScene; no streaks set), `pool` all cores.
+struct EffectsPathFrame {
+  RenderedFrame want;
+  std::unique_ptr<cuda::BvhScene> bvh;
+  std::unique_ptr<cuda::RealtimeFrameData> data;
+  EffectsFrame storage;
+  MediaScene media;
+  cuda::PathFrameView pf;
+};
+
+void PrepareEffectsPath(const MediaFrameCase& c, ThreadPool* pool, EffectsPathFrame* e) {
+  const SceneDescription& scene = c.session->scene();
+  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
+  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &e->want);
+  e->bvh = std::make_unique<cuda::BvhScene>(scene);
+  e->bvh->Update(c.snap);
+  e->data = std::make_unique<cuda::RealtimeFrameData>(scene, settings);
+  e->data->Prepare(c.snap, c.view, pool, cuda::EffectsWithoutMedia(c.fx.get(), &e->storage));
+  e->media.Build(c.fx.get());
+  e->pf = cuda::PathView(*e->data, e->data->View(e->bvh->view(), nullptr),
+                         e->data->frame_sky().sampling_pod());
+  e->pf.media = e->media.View();
+}
+
 // the GPU path with media (TracePath<true>: the free flights' delta tracking, the phase
 // function's next events and samples, the media's transmittance on every shadow ray; the shared
 // formulas of render/media_scene_math.h), run on the CPU, against the CPU backend's
@@ -221,22 +247,13 @@ TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
   ASSERT_TRUE(c.fx);
   ASSERT_FALSE(c.fx->homogeneous_media.empty() && c.fx->grid_media.empty());
   EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
-  const SceneDescription& scene = c.session->scene();
-  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
-  RenderedFrame want;
-  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &want);
-  cuda::BvhScene bvh(scene);
-  bvh.Update(c.snap);
-  cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
-  EffectsFrame storage;
-  data.Prepare(c.snap, c.view, &pool, cuda::EffectsWithoutMedia(c.fx.get(), &storage));
-  EXPECT_FALSE(data.has_media());  // the realtime tier's media volumes are not built
-  MediaScene media;
-  media.Build(c.fx.get());
-  cuda::PathFrameView pf =
-      cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
-  pf.media = media.View();
+  EffectsPathFrame e;
+  PrepareEffectsPath(c, &pool, &e);
+  EXPECT_FALSE(e.data->has_media());  // the realtime tier's media volumes are not built
+  const RenderedFrame& want = e.want;
+  const MediaScene& media = e.media;
+  cuda::PathFrameView pf = e.pf;
   cuda::PathBuffers got, again, clear;
   cuda::TracePathtracedOnHost(pf, &pool, &got);
   cuda::TracePathtracedOnHost(pf, &pool, &again);
@@ -285,24 +302,15 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
   ASSERT_TRUE(c.fx);
   ASSERT_FALSE(c.fx->particles.empty());
   EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
-  const SceneDescription& scene = c.session->scene();
-  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
-  RenderedFrame want;
-  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &want);
-  cuda::BvhScene bvh(scene);
-  bvh.Update(c.snap);
-  cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
-  EffectsFrame storage;
-  data.Prepare(c.snap, c.view, &pool, cuda::EffectsWithoutMedia(c.fx.get(), &storage));
+  EffectsPathFrame e;
+  PrepareEffectsPath(c, &pool, &e);
+  const cuda::RealtimeFrameData& data = *e.data;
   EXPECT_TRUE(data.streaks().empty());  // no realtime streak pixels for the paths
   const cuda::PathStreaks streaks = data.path_streaks().View();
   ASSERT_GT(streaks.num, 0);
-  MediaScene media;
-  media.Build(c.fx.get());
-  cuda::PathFrameView pf =
-      cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
-  pf.media = media.View();
+  const RenderedFrame& want = e.want;
+  cuda::PathFrameView pf = e.pf;
   pf.streaks = streaks;
   cuda::PathBuffers got, again, clear;
   cuda::TracePathtracedOnHost(pf, &pool, &got);
