@@ -16,7 +16,7 @@
 // the grids' parts (their light volumes' march and the grid froxels) stay on the host: their
 // density lookups are GridVolume's (render/media_scene.h).
 // operation order: the CPU code's before the move (the bit-for-bit rule of shading_math.h);
-// the CPU's images did not change (docs/gpu.md, "Media volumes built on the GPU").
+// the CPU's images did not change (docs/gpu-notes.md, "Media volumes built on the GPU").
 
 #include <stdint.h>
 

@@ -27,7 +27,7 @@
 //    quad's shared lookups) and a surface point's transmittance to a light (the CPU realtime
 //    surface loop's); RealtimeMedia's member functions call these (branch gpu12).
 // operation order: the CPU code's before the move (bit-for-bit rule of shading_math.h); the
-// CPU's images did not change (docs/gpu.md, "Homogeneous media (branch gpu8)").
+// CPU's images did not change (docs/gpu-notes.md, "Homogeneous media (branch gpu8)").
 //
 // record types: the froxel lookups are templates over their record type R, an rgb value with a
 // 4th lane that is 0 (Eigen::Array4f on the CPU, whose SSE lanes round as the scalar

@@ -18,7 +18,7 @@
 //    flight (MediaScene::Track). models and sources: render/media_scene.h.
 // operation order: the CPU code's before the move (Eigen's per-coefficient order, its 3x3
 // product as GridToFrame, its maxCoeff as max(max(x, y), z)); the CPU's images did not change
-// (docs/gpu.md, "Media in the pathtraced tier on the GPU (branch gpu14)"), and
+// (docs/gpu-notes.md, "Media in the pathtraced tier on the GPU (branch gpu14)"), and
 // tests/render/media_scene_math_test.cc checks the functions bit for bit against the Eigen code
 // they replaced. random numbers: the caller's Rng, drawn in the CPU's order.
 

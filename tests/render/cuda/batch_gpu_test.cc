@@ -382,13 +382,9 @@ TEST_F(BatchRendering, DistortedAndMovingCamerasTraceTheirOwnRays) {
 // from the clear frame; a frame with media is refused for rgb and taken for the ground truth.
 TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   PB_REQUIRE_CUDA_DEVICE_FOR_BATCH();
-  const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulatedAt("effects/flashlight.yaml", 1.0);
+  auto [session, snap, base, fx] =
+      realtime_parity::LoadFrameAt("effects/flashlight.yaml", 1.0, kBatchW, kBatchH);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  CameraView base = realtime_parity::RgbDepthView(scene, snap, kBatchW, kBatchH);
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, base.X_WO.translation());
   ASSERT_TRUE(fx && !fx->empty());
   std::vector<CameraView> views;
   std::vector<cuda::BatchCamera> cams;

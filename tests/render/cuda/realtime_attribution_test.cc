@@ -1,17 +1,18 @@
 // where the CUDA realtime rgb path (run on the CPU: RenderRealtimeOnHost) differs from the CPU
-// backend, by feature (docs/gpu.md, "Where the realtime rgb differs"). for the bundled default,
-// house, warehouse and outdoor worlds and effects/walkers.yaml (whose frames have no effects:
-// the GPU renders them; its rover's materials have mirror layers), the first camera after 1 s
-// is rendered by the CPU backend with every part on, with the mirror layer off and with shadows off
-// (RenderAblation), and by the GPU path; the per-feature masks are the pixels that see the sky (CPU
-// depth 0), that a mirror layer changes (mirror on vs off), that lie in a shadow's penumbra (within
-// 2 px of the boundary of the pixels shadows change) and the rest; the squared rgb error is split
-// over them (the shares sum to the whole, asserted) and printed, with the PSNR each feature would
-// leave if it matched, and the PSNR the GPU path's radiance would reach with the CPU's exposure.
-// the GPU path, mirror layer included, against the CPU backend must reach 55 dB (the PSNR against
-// the CPU without its mirror layer is printed too). with PENUMBRA_PARITY_DUMP=<dir> the images are
-// written there as raw arrays (scripts/gpu/parity_attribution.py turns them into difference
-// images and a per-material table); PENUMBRA_PARITY_SIZE=WxH changes the 160x120 default.
+// backend, by feature (docs/gpu-notes.md, "Where the realtime rgb differs"). for the bundled
+// default, house, warehouse and outdoor worlds and effects/walkers.yaml (whose frames have no
+// effects: the GPU renders them; its rover's materials have mirror layers), the first camera after
+// 1 s is rendered by the CPU backend with every part on, with the mirror layer off and with shadows
+// off (RenderAblation), and by the GPU path; the per-feature masks are the pixels that see the sky
+// (CPU depth 0), that a mirror layer changes (mirror on vs off), that lie in a shadow's penumbra
+// (within 2 px of the boundary of the pixels shadows change) and the rest; the squared rgb error is
+// split over them (the shares sum to the whole, asserted) and printed, with the PSNR each feature
+// would leave if it matched, and the PSNR the GPU path's radiance would reach with the CPU's
+// exposure. the GPU path, mirror layer included, against the CPU backend must reach 55 dB (the PSNR
+// against the CPU without its mirror layer is printed too). with PENUMBRA_PARITY_DUMP=<dir> the
+// images are written there as raw arrays (scripts/gpu/parity_attribution.py turns them into
+// difference images and a per-material table); PENUMBRA_PARITY_SIZE=WxH changes the 160x120
+// default.
 
 #include <gtest/gtest.h>
 
@@ -74,10 +75,9 @@ class RealtimeParityAttribution : public ::testing::TestWithParam<std::string> {
 
 TEST_P(RealtimeParityAttribution, SplitsTheRgbErrorByFeature) {
   const AttributionSize size = AttributionSizeFromEnv();
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(GetParam());
+  auto [session, snap, view, fx] =
+      realtime_parity::LoadFrameAt(GetParam(), 1.0, size.width, size.height);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  CameraView view = realtime_parity::RgbDepthView(scene, snap, size.width, size.height);
   view.outputs[ImageKind::kSegmentation] = true;
   const RenderedFrame cpu = RenderCpuWith(scene, snap, view, RenderAblation());
   RenderAblation no_mirror;

@@ -44,12 +44,8 @@ class RealtimeEffectsGpu : public ::testing::TestWithParam<GpuEffectsWorld> {};
 TEST_P(RealtimeEffectsGpu, MatchesCpuBackendAndRepeatsBitForBit) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   const GpuEffectsWorld& w = GetParam();
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, w.t_sec);
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(w.file, w.t_sec, 640, 480);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, view.X_WO.translation());
   ASSERT_TRUE(fx && !fx->empty()) << w.file;
   const std::unique_ptr<Renderer> cpu = EffectsBackend(scene, RenderSettings::Backend::kEmbree);
   const std::unique_ptr<Renderer> gpu = EffectsBackend(scene, RenderSettings::Backend::kCuda);
@@ -92,12 +88,8 @@ TEST(RealtimeEffectsGpuFrames, DeviceBuiltMediaVolumesMatchTheHostBuilt) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   for (const char* file : {"effects/fog.yaml", "effects/height_fog.yaml",
                            "effects/smoke_plume.yaml", "effects/adversity_major.yaml"}) {
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 640, 480);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
-    const std::shared_ptr<const EffectsFrame> fx =
-        session->effects().Evaluate(snap, view.X_WO.translation());
     ASSERT_TRUE(fx && !fx->empty()) << file;
     const std::unique_ptr<Renderer> gpu = EffectsBackend(scene, RenderSettings::Backend::kCuda);
     auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
@@ -122,13 +114,9 @@ TEST(RealtimeEffectsGpuFrames, DeviceBuiltMediaVolumesMatchTheHostBuilt) {
 
 TEST(RealtimeEffectsGpuFrames, SkyChangesUploadTheSkyAgain) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulatedAt("effects/sun.yaml", 1.0);
+  const auto [session, snap, view, fx] =
+      realtime_parity::LoadFrameAt("effects/sun.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, view.X_WO.translation());
   ASSERT_TRUE(fx && fx->sun_direction_W.has_value());
   const std::unique_ptr<Renderer> gpu = EffectsBackend(scene, RenderSettings::Backend::kCuda);
   RenderedFrame clear, effects, clear_again, effects_again;

@@ -64,12 +64,8 @@ class RealtimeHostPathEffects : public ::testing::TestWithParam<HostEffectsWorld
 
 TEST_P(RealtimeHostPathEffects, MatchesCpuBackend) {
   const HostEffectsWorld& w = GetParam();
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(w.file, w.t_sec);
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(w.file, w.t_sec, 160, 120);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, view.X_WO.translation());
   ASSERT_TRUE(fx && !fx->empty()) << w.file;
   const HostCompared c = CompareWithCpu(scene, snap, view, fx.get());
   // the clear frame of the same instant: the effects must change the GPU path's image.
@@ -99,12 +95,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathEffects,
 TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
   for (const char* file : {"effects/rain.yaml", "effects/snow.yaml"}) {
     SCOPED_TRACE(file);
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 160, 120);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
-    const std::shared_ptr<const EffectsFrame> fx =
-        session->effects().Evaluate(snap, view.X_WO.translation());
     ASSERT_TRUE(fx && !fx->particles.empty());
     const HostCompared c = CompareWithCpu(scene, snap, view, fx.get());
     EffectsFrame no_particles = *fx;
@@ -185,12 +177,8 @@ TEST(RealtimeHostPathEffectsFrames, BundledEffectsWorldsAtOneSecond) {
       "effects/smoke_plume.yaml", "effects/vdb_smoke.yaml",  "effects/fire.yaml",
       "effects/rain.yaml",        "effects/snow.yaml",       "effects/adversity_major.yaml"};
   for (const char* file : worlds) {
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 32, 24);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 32, 24);
-    const std::shared_ptr<const EffectsFrame> fx =
-        session->effects().Evaluate(snap, view.X_WO.translation());
     ASSERT_TRUE(fx && !fx->empty()) << file;
     cuda::BvhScene bvh(scene);
     bvh.Update(snap);

@@ -48,10 +48,8 @@ HostPathFrames RenderCpuAndHostPath(const SceneDescription& scene, const WorldSn
 class RealtimeHostPath : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealtimeHostPath, MatchesCpuBackend) {
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(GetParam());
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(GetParam(), 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
   const auto [want, got, again] = RenderCpuAndHostPath(scene, snap, view);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
@@ -59,7 +57,7 @@ TEST_P(RealtimeHostPath, MatchesCpuBackend) {
       "%s 160x120: rgb PSNR %.2f dB, ev100 cpu %.4f host-gpu-path %.4f, depth > 1 mm on "
       "%.4f %% of pixels\n",
       GetParam().c_str(), psnr, want.ev100, got.ev100, 100 * depth_bad);
-  // measured with the mirror layer on the GPU path (docs/gpu.md, "Where the realtime rgb
+  // measured with the mirror layer on the GPU path (docs/gpu-notes.md, "Where the realtime rgb
   // differs"): default 95.7 dB, house 81.4, warehouse 61.6, outdoor 66.8, walkers 92.7 (48.8
   // and 29.8 without it).
   EXPECT_GE(psnr, 40.0);
@@ -78,10 +76,9 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPath,
 // (rgb PSNR >= 40 dB, depth within 1 mm on >= 99.9 % of pixels); without the tables (the plain
 // pinhole rays) it does not.
 TEST(RealtimeHostPathFrames, DistortedAndRollingShutterCamerasMatchTheCpuBackend) {
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
+  const auto [session, snap, pinhole, fx] =
+      realtime_parity::LoadFrameAt("default.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView pinhole = realtime_parity::RgbDepthView(scene, snap, 160, 120);
   CameraView distorted = pinhole;
   distorted.intrinsics.k1 = -0.28;
   distorted.intrinsics.k2 = 0.07;
@@ -161,10 +158,8 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
 // house (textured floors and walls, normal maps).
 TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(world);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
     cuda::BvhScene bvh(scene);
     bvh.Update(snap);
     cuda::RealtimeFrameData data(scene, RenderSettings());
@@ -187,10 +182,8 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
 // camera alone, in the default room and the house.
 TEST(RealtimeHostPathFrames, PoseWorldThenSetCameraIsPrepare) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(world);
+    auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 64, 48);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    CameraView view = realtime_parity::RgbDepthView(scene, snap, 64, 48);
     view.frame_index = 5;
     view.white_balance_gains = Eigen::Vector3f(0.9f, 1.0f, 1.2f);
     CameraView other = view;
@@ -270,10 +263,9 @@ TEST(RealtimeHostPathFrames, PoseWorldFollowsMovedBodiesOnly) {
 // refused (a 2x2 quad would be split).
 TEST(RealtimeHostPathFrames, SkyTermsInBandsEqualTheWholeFrame) {
   // the default room: a sky volume (its walls) and a mirror layer (the floor's reflectance)
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
+  const auto [session, snap, view, fx] =
+      realtime_parity::LoadFrameAt("default.yaml", 1.0, 160, 119);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 119);
   cuda::BvhScene bvh(scene);
   bvh.Update(snap);
   cuda::RealtimeFrameData data(scene, RenderSettings());

@@ -115,13 +115,9 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeHostPathMedia,
 // bits; and the surface evaluated again in the shading pass (ShadeRealtimePixel) gives the stored
 // terms' bits with media too.
 TEST(RealtimeHostPathMediaFrames, MediaRaysAndShadingPathsGiveTheSameBits) {
-  const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulatedAt("effects/height_fog.yaml", 1.0);
+  const auto [session, snap, view, fx] =
+      realtime_parity::LoadFrameAt("effects/height_fog.yaml", 1.0, 96, 72);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 96, 72);
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, view.X_WO.translation());
   ASSERT_TRUE(fx && !fx->homogeneous_media.empty());
   cuda::BvhRayQuery rays(scene);
   rays.Update(snap);
@@ -152,12 +148,8 @@ TEST(RealtimeHostPathMediaFrames, MediaRaysAndShadingPathsGiveTheSameBits) {
 TEST(RealtimeHostPathMediaFrames, DeviceBuiltVolumesMatchTheHostBuild) {
   for (const char* file :
        {"effects/fog.yaml", "effects/smoke_plume.yaml", "effects/adversity_major.yaml"}) {
-    const std::unique_ptr<Session> session = realtime_parity::LoadSimulatedAt(file, 1.0);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 160, 120);
     const SceneDescription& scene = session->scene();
-    const WorldSnapshot snap = session->sim().Snapshot();
-    const CameraView view = realtime_parity::RgbDepthView(scene, snap, 160, 120);
-    const std::shared_ptr<const EffectsFrame> fx =
-        session->effects().Evaluate(snap, view.X_WO.translation());
     ASSERT_TRUE(fx && (!fx->homogeneous_media.empty() || !fx->grid_media.empty())) << file;
     cuda::BvhScene bvh(scene);
     bvh.Update(snap);

@@ -32,10 +32,11 @@ inline std::unique_ptr<Session> LoadSimulated(const std::string& name) {
   return LoadSimulatedAt(name, 1.0);
 }
 
-/// the first camera of `scene` at w x h (its vertical field of view), rgb and depth.
+/// camera `camera` (default the first) of `scene` at w x h (its vertical field of view), rgb and
+/// depth. @throws std::out_of_range if the scene has no such camera.
 inline CameraView RgbDepthView(const SceneDescription& scene, const WorldSnapshot& snap, int w,
-                               int h) {
-  const CameraSpec& cam = scene.cameras.front();
+                               int h, int camera = 0) {
+  const CameraSpec& cam = scene.cameras.at(camera);
   CameraView view;
   view.X_WO = CameraPoseInWorld(cam, snap);
   const double fovy_deg = cam.intrinsics.fovy_deg();
@@ -45,6 +46,26 @@ inline CameraView RgbDepthView(const SceneDescription& scene, const WorldSnapsho
   view.outputs[ImageKind::kDepth] = true;
   view.outputs[ImageKind::kSegmentation] = false;
   return view;
+}
+
+/// a bundled world's frame as the parity tests render it: the world after `t_sec` of
+/// simulation, its snapshot, a camera's rgb+depth view and the effects at that camera.
+struct WorldFrame {
+  std::unique_ptr<Session> session;
+  WorldSnapshot snap;
+  CameraView view;
+  std::shared_ptr<const EffectsFrame> fx;  ///< the world's effects at the camera, or null
+};
+
+/// bundled world `name` after `t_sec` of simulation, camera `camera` at w x h (RgbDepthView) and
+/// its effects frame (EffectsStage::Evaluate at the camera's position).
+inline WorldFrame LoadFrameAt(const std::string& name, double t_sec, int w, int h, int camera = 0) {
+  WorldFrame f;
+  f.session = LoadSimulatedAt(name, t_sec);
+  f.snap = f.session->sim().Snapshot();
+  f.view = RgbDepthView(f.session->scene(), f.snap, w, h, camera);
+  f.fx = f.session->effects().Evaluate(f.snap, f.view.X_WO.translation());
+  return f;
 }
 
 /// PSNR (dB) of two 8-bit images of one size: 10 log10(255^2 / MSE); 99 when equal.

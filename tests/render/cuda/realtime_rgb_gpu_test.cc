@@ -47,10 +47,8 @@ class RealtimeRgbGpu : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealtimeRgbGpu, MatchesCpuBackendAndRepeatsBitForBit) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(GetParam());
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(GetParam(), 1.0, 640, 480);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
   const auto [want, got, again, gpu_frames, cpu_frames] = RenderCpuAndGpuTwice(scene, snap, view);
   EXPECT_EQ(gpu_frames, 2);
   EXPECT_EQ(cpu_frames, 0);
@@ -81,10 +79,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeRgbGpu,
 // bit-identical.
 TEST(RealtimeRgbGpuCameras, DistortedRollingShutterCameraRendersOnTheGpu) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated("default.yaml");
+  auto [session, snap, view, fx] = realtime_parity::LoadFrameAt("default.yaml", 1.0, 640, 480);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
   view.outputs[ImageKind::kSegmentation] = true;
   view.intrinsics.k1 = -0.28;
   view.intrinsics.k2 = 0.07;

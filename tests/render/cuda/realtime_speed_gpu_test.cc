@@ -28,10 +28,8 @@ class RealtimeSpeedUps : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session = realtime_parity::LoadSimulated(GetParam());
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(GetParam(), 1.0, 640, 480);
   const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  const CameraView view = realtime_parity::RgbDepthView(scene, snap, 640, 480);
   RenderSettings gpu_settings;
   gpu_settings.backend = RenderSettings::Backend::kCuda;
   const std::unique_ptr<Renderer> gpu = MakeRenderer(scene, gpu_settings);

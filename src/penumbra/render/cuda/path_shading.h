@@ -32,7 +32,7 @@
 // realtime tier evaluates them (EvaluateSurface, realtime_shading.h). the GPU contracts
 // multiply-adds, so its paths differ from the CPU's by float rounding, which a path's branches
 // (Russian roulette, lobe choice) can turn into other paths: the estimates agree in the mean
-// (docs/gpu.md, "The pathtraced tier on the GPU").
+// (docs/gpu-notes.md, "The pathtraced tier on the GPU").
 
 #include <cstdint>
 
