@@ -128,22 +128,17 @@ class PathtracedGpuParticles : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(PathtracedGpuParticles, MatchesCpuBackendAt1024SppAndRepeatsBitForBit) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
-  const std::unique_ptr<Session> session =
-      realtime_parity::LoadSimulatedAt("effects/" + GetParam(), 1.0);
-  const SceneDescription& scene = session->scene();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  CameraView view = realtime_parity::RgbDepthView(scene, snap, 128, 96);
-  const CameraSpec& cam = scene.cameras.at(0);
-  view.X_WO = CameraPoseInWorld(cam, snap);
-  view.intrinsics = CameraIntrinsics::FromFovy(128, 96, cam.intrinsics.fovy_deg());
-  const std::shared_ptr<const EffectsFrame> fx =
-      session->effects().Evaluate(snap, view.X_WO.translation());
-  ASSERT_TRUE(fx);
-  ASSERT_FALSE(fx->particles.empty());
+  const realtime_parity::WorldFrame f =
+      realtime_parity::LoadFrameAt("effects/" + GetParam(), 1.0, 128, 96);
+  const SceneDescription& scene = f.session->scene();
+  const WorldSnapshot& snap = f.snap;
+  const CameraView& view = f.view;
+  ASSERT_TRUE(f.fx);
+  ASSERT_FALSE(f.fx->particles.empty());
   RenderedFrame want, clear;
   double tile = 1;
-  ExpectGpuTracksCpu(GetParam(), scene, snap, fx.get(), view, &want, &tile);
-  EffectsFrame no_particles = *fx;
+  ExpectGpuTracksCpu(GetParam(), scene, snap, f.fx.get(), view, &want, &tile);
+  EffectsFrame no_particles = *f.fx;
   no_particles.particles.clear();
   const RenderSettings gpu_settings =
       path_parity::PathSettings(RenderSettings::Backend::kCuda, 1024);
