@@ -9,6 +9,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/media_common.h"
+#include "penumbra/render/particle_math.h"
 #include "penumbra/render/ray.h"
 
 namespace penumbra {
@@ -252,47 +253,7 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
 
 namespace {
 
-// what the ray-capsule test needs of a capsule around [a, b] of radius r and a ray origin o
-// that does not depend on the ray's direction (the realtime tier's pixel-centre rays share o
-// when the camera neither distorts nor moves).
-struct CapsuleOrigin {
-  Eigen::Vector3f ba, oa, ob;
-  float baba, baoa, qc, sc_a, sc_b;
-  CapsuleOrigin(const Eigen::Vector3f& o, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
-                float r)
-      : ba(b - a), oa(o - a), ob(o - b) {
-    baba = ba.dot(ba);
-    baoa = ba.dot(oa);
-    const float oaoa = oa.dot(oa);
-    qc = baba * oaoa - baoa * baoa - r * r * baba;
-    sc_a = oa.dot(oa) - r * r;
-    sc_b = ob.dot(ob) - r * r;
-  }
-};
-
-// nearest t > 0 where the ray o + t d (d unit, o that of `c`) meets the capsule, or -1 (Quilez,
-// "Capsule - intersection", 2014: cylinder body, then the nearer end sphere).
-float IntersectCapsule(const CapsuleOrigin& c, const Eigen::Vector3f& d) {
-  const float bard = c.ba.dot(d), rdoa = d.dot(c.oa);
-  const float qa = c.baba - bard * bard;
-  const float qb = c.baba * rdoa - c.baoa * bard;
-  float h = qb * qb - qa * c.qc;
-  float y;
-  if (qa > 1e-12f) {
-    if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
-    const float t = (-qb - std::sqrt(h)) / qa;
-    y = c.baoa + t * bard;
-    if (y > 0 && y < c.baba) return t > 0 ? t : -1.0f;
-  } else {
-    y = bard > 0 ? -1.0f : c.baba + 1.0f;  // along the axis: the nearer end
-  }
-  const bool at_a = y <= 0;
-  const float sb = d.dot(at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
-  h = sb * sb - sc;
-  if (h <= 0) return -1.0f;
-  const float t = -sb - std::sqrt(h);
-  return t > 0 ? t : -1.0f;
-}
+Float3 StreakF3(const Eigen::Vector3f& v) { return Float3{v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
@@ -367,7 +328,8 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
       const float r = ends_[2 * n].w();
       // the origin-dependent terms once per streak for the camera centre (every pixel's ray
       // origin unless the camera moves during the exposure: then per pixel).
-      const CapsuleOrigin shared(o_shared, a, b, r);
+      const CapsuleOrigin shared =
+          MakeCapsuleOrigin(StreakF3(o_shared), StreakF3(a), StreakF3(b), r);
       const auto& [ua, va, ub, vb, rp] = seg2[n];
       const float du = ub - ua, dv = vb - va;
       for (int v = v0; v <= v1; ++v) {
@@ -385,9 +347,12 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
         for (int u = c0; u <= c1; ++u) {
           const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
           const float len = ray.d.norm();
-          const float t = ray.o == o_shared
-                              ? IntersectCapsule(shared, ray.d / len)
-                              : IntersectCapsule(CapsuleOrigin(ray.o, a, b, r), ray.d / len);
+          const Float3 d = StreakF3(ray.d / len);
+          const float t =
+              ray.o == o_shared
+                  ? IntersectCapsule(shared, d)
+                  : IntersectCapsule(
+                        MakeCapsuleOrigin(StreakF3(ray.o), StreakF3(a), StreakF3(b), r), d);
           if (!(t > 0)) continue;
           const size_t at = static_cast<size_t>(v) * W + u;
           const float t_ray = t / len;
@@ -408,13 +373,8 @@ bool ParticleStreaks::PixelHit(const Ray& ray, int u, int v, float tmax, Particl
   hit->t = px.t;
   const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
   const Eigen::Vector3f p = ray.o + hit->t * ray.d;
-  const Eigen::Vector3f ba = b - a;
-  const float w = std::clamp((p - a).dot(ba) / std::max(ba.squaredNorm(), 1e-20f), 0.0f, 1.0f);
-  Eigen::Vector3f nrm = p - (a + w * ba);
-  const float nn = nrm.norm();
-  nrm = nn > 0 ? Eigen::Vector3f(nrm / nn) : Eigen::Vector3f(-ray.d.normalized());
-  if (nrm.dot(ray.d) > 0) nrm = -nrm;
-  hit->ng_W = nrm;
+  const Float3 nrm = CapsuleNormal(StreakF3(p), StreakF3(a), StreakF3(b), StreakF3(ray.d));
+  hit->ng_W = Eigen::Vector3f(nrm.x, nrm.y, nrm.z);
   hit->alpha = alpha_[n];
   hit->prim = n;
   hit->set = set_[n];
@@ -452,27 +412,34 @@ void ParticleStreaks::PrecomputeRain(const LightSampler& lights, const Eigen::Ve
   rain_radiance_ = std::move(L);
 }
 
+StreakSetPod ParticleStreaks::SetPod(int set) const {
+  const ParticleSet& ps = fx_->particles[set];
+  StreakSetPod pod;
+  pod.kind = ps.kind == ParticleKind::kSpark  ? StreakKind::kSpark
+             : ps.kind == ParticleKind::kSnow ? StreakKind::kSnow
+                                              : StreakKind::kRain;
+  pod.color = StreakF3(ps.color);
+  pod.emission = StreakF3(ps.emission);
+  return pod;
+}
+
 Eigen::Vector3f ParticleStreaks::Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
                                        const LightSampler& lights,
                                        const Eigen::Vector3f& sky_ambient) const {
-  const ParticleSet& ps = fx_->particles[hit.set];
-  if (hit.kind == ParticleKind::kSpark) return ps.emission;
-  if (hit.kind == ParticleKind::kRain && hit.prim >= 0 &&
-      hit.prim < static_cast<int>(rain_radiance_.size()))
-    return rain_radiance_[hit.prim];
-  Eigen::Vector3f E = Eigen::Vector3f::Zero();
-  for (int j = 0; j < lights.size(); ++j) {
-    LightSample ls;
-    if (!lights.Sample(j, p_W, 0.5f, 0.5f, &ls)) continue;
-    if (hit.kind == ParticleKind::kSnow) {
-      E += ls.E * (std::max(0.0f, hit.ng_W.dot(ls.wi)) * 0.318309886f);
-    } else {
-      E += ls.E * kInv4Pi;
-    }
-  }
-  const Eigen::Vector3f sky =
-      sky_volume_ != nullptr ? sky_volume_->AmbientRadiance(p_W, sky_ambient) : sky_ambient;
-  return ps.color.cwiseProduct(sky + E) + ps.emission;
+  // the shared ShadeStreak (render/particle_math.h), with the hit's kind
+  StreakSetPod set = SetPod(hit.set);
+  set.kind = hit.kind == ParticleKind::kSpark  ? StreakKind::kSpark
+             : hit.kind == ParticleKind::kSnow ? StreakKind::kSnow
+                                               : StreakKind::kRain;
+  Float3 rain;
+  const bool precomputed = hit.kind == ParticleKind::kRain && hit.prim >= 0 &&
+                           hit.prim < static_cast<int>(rain_radiance_.size());
+  if (precomputed) rain = StreakF3(rain_radiance_[hit.prim]);
+  const Float3 L = ShadeStreak(set, precomputed ? &rain : nullptr, StreakF3(p_W),
+                               StreakF3(hit.ng_W), lights.pods().data(), lights.size(),
+                               sky_volume_ != nullptr ? sky_volume_->pod() : SkyVolumePod(),
+                               StreakF3(sky_ambient));
+  return Eigen::Vector3f(L.x, L.y, L.z);
 }
 
 }  // namespace penumbra

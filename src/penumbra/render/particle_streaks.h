@@ -8,13 +8,13 @@
 // around the segment p + [0, T] v. this class makes the frame's streaks, and for the realtime
 // tier (pixel-centre camera rays) splats them: each capsule's
 // projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
-// (Quilez's ray-capsule test), keeping the nearest streak per pixel (ties: lower index), which
-// costs the streaks' screen area rather than a BVH traversal per pixel. with a pinhole camera
-// that does not move, drops whose widened capsule lies wholly outside the pyramid of the pixel
-// rays are skipped first (no streak, not counted as culled; they could not be drawn).
-// streaks thinner than half a pixel at their distance are widened to half a pixel (radius
-// 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel drops keep
-// their average contribution instead of aliasing away with one ray per pixel.
+// (Quilez's ray-capsule test, render/particle_math.h's IntersectCapsule), keeping the nearest
+// streak per pixel (ties: lower index), which costs the streaks' screen area rather than a BVH
+// traversal per pixel. with a pinhole camera that does not move, drops whose widened capsule lies
+// wholly outside the pyramid of the pixel rays are skipped first (no streak, not counted as culled;
+// they could not be drawn). streaks thinner than half a pixel at their distance are widened to half
+// a pixel (radius 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel
+// drops keep their average contribution instead of aliasing away with one ray per pixel.
 //
 // coverage: a point on the streak is covered for 2r / |v| of the exposure, so a streak is
 // drawn with opacity alpha = 2r / (|v| T + 2r) (1 for a still particle), times the widening
@@ -57,6 +57,7 @@
 #include "penumbra/render/camera.h"
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/particle_math.h"
 #include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/scene/effects_frame.h"
@@ -121,11 +122,29 @@ class ParticleStreaks {
   void PrecomputeRain(const LightSampler& lights, const Eigen::Vector3f& sky_ambient,
                       const SkyIrradianceVolume* sky_volume, ThreadPool* pool);
 
-  /// radiance (cd/m^2) of the streak at `hit`, point p_W, seen from direction wo (unit,
-  /// towards the viewer); `sky_ambient` is the open sky's sphere-average radiance (occluded at
-  /// p_W by the sky volume of the last PrecomputeRain, if any).
+  /// radiance (cd/m^2) of the streak at `hit`, point p_W; `sky_ambient` is the open sky's
+  /// sphere-average radiance (occluded at p_W by the sky volume of the last PrecomputeRain, if
+  /// any). the shared ShadeStreak of render/particle_math.h (the CUDA backend's paths call it
+  /// too).
   Eigen::Vector3f Shade(const ParticleHit& hit, const Eigen::Vector3f& p_W,
                         const LightSampler& lights, const Eigen::Vector3f& sky_ambient) const;
+
+  /// particle set `set` of the frame (an index into EffectsFrame::particles) as ShadeStreak
+  /// takes it.
+  StreakSetPod SetPod(int set) const;
+  /// the frame of the last Build (null: none).
+  const EffectsFrame* frame() const { return fx_; }
+  /// per streak (size() of them): its coverage alpha in (0, 1] and its particle set.
+  const std::vector<float>& alpha() const { return alpha_; }
+  const std::vector<int>& set_of() const { return set_; }
+  /// per streak both ends of its axis (x, y, z in world m; w the widened radius in m, equal at
+  /// both ends): streak n is ends()[2 n] to ends()[2 n + 1].
+  const std::vector<Eigen::Vector4f>& ends() const { return ends_; }
+  /// per streak the rain radiance of the last PrecomputeRain (cd/m^2; size() entries, 0 for
+  /// other kinds), or empty (no rain, or not precomputed).
+  const std::vector<Eigen::Vector3f>& rain_radiance() const { return rain_radiance_; }
+  /// the sky volume of the last PrecomputeRain (null: the open sky's radiance).
+  const SkyIrradianceVolume* sky_volume() const { return sky_volume_; }
 
  protected:
   const EffectsFrame* fx_ = nullptr;

@@ -23,8 +23,10 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/path_frame.h"
+#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/emitter_sampler.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/particle_math.h"
 #include "realtime_parity.h"
 
 namespace penumbra {
@@ -204,6 +206,32 @@ MediaFrameCase LoadMediaFrame(const std::string& world, int camera, int w, int h
   return c;
 }
 
+// a MediaFrameCase's pathtraced frame (16 spp, 4 bounces, no denoiser) on the CPU backend (want)
+// and as the GPU path takes it on the host (pf: the host BVH, the frame data Prepared with the
+// effects without media, the media's own MediaScene; no streaks set), `pool` all cores.
+struct EffectsPathFrame {
+  RenderedFrame want;
+  std::unique_ptr<cuda::BvhScene> bvh;
+  std::unique_ptr<cuda::RealtimeFrameData> data;
+  EffectsFrame storage;
+  MediaScene media;
+  cuda::PathFrameView pf;
+};
+
+void PrepareEffectsPath(const MediaFrameCase& c, ThreadPool* pool, EffectsPathFrame* e) {
+  const SceneDescription& scene = c.session->scene();
+  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
+  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &e->want);
+  e->bvh = std::make_unique<cuda::BvhScene>(scene);
+  e->bvh->Update(c.snap);
+  e->data = std::make_unique<cuda::RealtimeFrameData>(scene, settings);
+  e->data->Prepare(c.snap, c.view, pool, cuda::EffectsWithoutMedia(c.fx.get(), &e->storage));
+  e->media.Build(c.fx.get());
+  e->pf = cuda::PathView(*e->data, e->data->View(e->bvh->view(), nullptr),
+                         e->data->frame_sky().sampling_pod());
+  e->pf.media = e->media.View();
+}
+
 // the GPU path with media (TracePath<true>: the free flights' delta tracking, the phase
 // function's next events and samples, the media's transmittance on every shadow ray; the shared
 // formulas of render/media_scene_math.h), run on the CPU, against the CPU backend's
@@ -219,22 +247,13 @@ TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
   ASSERT_TRUE(c.fx);
   ASSERT_FALSE(c.fx->homogeneous_media.empty() && c.fx->grid_media.empty());
   EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
-  const SceneDescription& scene = c.session->scene();
-  const RenderSettings settings = path_parity::PathSettings(RenderSettings::Backend::kEmbree, 16);
-  RenderedFrame want;
-  MakeRenderer(scene, settings)->Render(c.snap, c.fx.get(), c.view, &want);
-  cuda::BvhScene bvh(scene);
-  bvh.Update(c.snap);
-  cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
-  EffectsFrame storage;
-  data.Prepare(c.snap, c.view, &pool, cuda::EffectsWithoutMedia(c.fx.get(), &storage));
-  EXPECT_FALSE(data.has_media());  // the realtime tier's media volumes are not built
-  MediaScene media;
-  media.Build(c.fx.get());
-  cuda::PathFrameView pf =
-      cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
-  pf.media = media.View();
+  EffectsPathFrame e;
+  PrepareEffectsPath(c, &pool, &e);
+  EXPECT_FALSE(e.data->has_media());  // the realtime tier's media volumes are not built
+  const RenderedFrame& want = e.want;
+  const MediaScene& media = e.media;
+  cuda::PathFrameView pf = e.pf;
   cuda::PathBuffers got, again, clear;
   cuda::TracePathtracedOnHost(pf, &pool, &got);
   cuda::TracePathtracedOnHost(pf, &pool, &again);
@@ -259,9 +278,99 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostMedia,
                          ::testing::Values(std::make_pair(std::string("fog.yaml"), 0),
                                            std::make_pair(std::string("smoke_plume.yaml"), 1)));
 
-// pathtraced frames with particles go to the CPU renderer (the path kernels trace no streaks);
-// frames with media (homogeneous or grids) stay on the GPU since branch gpu14.
-TEST(PathNotOnGpu, ParticlesGoToTheCpuMediaDoNot) {
+// the GPU path with particles (TracePath<..., true>: a camera ray that meets a streak of the
+// frame's BVH (path_streaks.h) stops there with probability alpha, one draw, before the media's
+// free flight, and adds the streak's radiance, ShadeStreak), run on the CPU, against the CPU
+// backend's PathIntegrator (Embree's round curves): rain and snow (the rover's camera) and fire
+// (sparks over a fire grid: TracePath<true, true>; the overview camera) at 1 s, 64x48, 16 spp.
+// the paths draw the CPU's random numbers, so the estimates agree closely; the same paths without
+// the streaks differ by far more (the metric can fail). the streaks' BVH is checked against a
+// test of every streak (same nearest streak and t, bit for bit) on the camera's rays, and its
+// host build time is printed.
+// the streaks change these 64x48 frames by 0.23 % (fire's few sparks) to 0.80 % (snow) at the
+// block scale, below issue 35's 1 %: the tolerance here is the host path's own, 0.05 % (measured
+// 0.003 % to 0.007 %: the host path rounds as the CPU and draws its random numbers, so only
+// where Embree's round curves and the capsule test, or Embree and the BVH, round a hit apart do
+// the paths differ), which the same paths without the streaks exceed four times over.
+constexpr double kHostParticleTolerance = 0.0005;
+
+class PathtracedHostParticles : public ::testing::TestWithParam<std::pair<std::string, int>> {};
+
+TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
+  const std::string world = GetParam().first;
+  const MediaFrameCase c = LoadMediaFrame(world, GetParam().second, 64, 48);
+  ASSERT_TRUE(c.fx);
+  ASSERT_FALSE(c.fx->particles.empty());
+  EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
+  ThreadPool pool(0);
+  EffectsPathFrame e;
+  PrepareEffectsPath(c, &pool, &e);
+  const cuda::RealtimeFrameData& data = *e.data;
+  EXPECT_TRUE(data.streaks().empty());  // no realtime streak pixels for the paths
+  const cuda::PathStreaks streaks = data.path_streaks().View();
+  ASSERT_GT(streaks.num, 0);
+  const RenderedFrame& want = e.want;
+  cuda::PathFrameView pf = e.pf;
+  pf.streaks = streaks;
+  cuda::PathBuffers got, again, clear;
+  cuda::TracePathtracedOnHost(pf, &pool, &got);
+  cuda::TracePathtracedOnHost(pf, &pool, &again);
+  pf.streaks = cuda::PathStreaks();
+  cuda::TracePathtracedOnHost(pf, &pool, &clear);
+  const double tile = path_parity::TileRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
+  const double mean = path_parity::MeanRelativeDifference(RadianceOf(got, 64, 48), want.radiance);
+  const double tile_clear =
+      path_parity::TileRelativeDifference(RadianceOf(clear, 64, 48), want.radiance);
+  // the BVH against every streak on 64x48x4 jittered camera rays
+  const Camera camera(c.view.X_WO, c.view.intrinsics, c.view.motion);
+  Rng rng(35);
+  int hits = 0;
+  for (int i = 0; i < 64 * 48 * 4; ++i) {
+    const Ray ray = camera.GenerateRay(64 * rng.Uniform() - 0.5f, 48 * rng.Uniform() - 0.5f);
+    const Float3 o{ray.o.x(), ray.o.y(), ray.o.z()}, d{ray.d.x(), ray.d.y(), ray.d.z()};
+    float t = 0;
+    int k = -1;
+    const bool hit = cuda::PathStreakHit(streaks, o, d, 0.0f, INFINITY, &t, &k);
+    // every streak: the nearest hit in [0, inf), ties to the first in leaf order
+    const float len = std::sqrt(EigenDot(d, d));
+    const Float3 du{d.x / len, d.y / len, d.z / len};
+    float best_t = INFINITY;
+    int best = -1;
+    for (int j = 0; j < streaks.num; ++j) {
+      const cuda::StreakPod& sp = streaks.streaks[j];
+      const float tm = IntersectCapsule(MakeCapsuleOrigin(o, Float3{sp.a[0], sp.a[1], sp.a[2]},
+                                                          Float3{sp.b[0], sp.b[1], sp.b[2]}, sp.r),
+                                        du);
+      if (tm > 0 && tm / len < best_t) best_t = tm / len, best = j;
+    }
+    ASSERT_EQ(hit, best >= 0) << "ray " << i;
+    if (!hit) continue;
+    ++hits;
+    EXPECT_EQ(t, best_t) << "ray " << i;
+    EXPECT_EQ(streaks.streaks[k].prim, streaks.streaks[best].prim) << "ray " << i;
+  }
+  std::printf(
+      "%s 64x48 16 spp (%d streaks, BVH built in %.2f ms on the host, %d of %d camera rays meet "
+      "one): radiance mean relative difference %.4f %% (8x8 blocks), %.4f %% (image mean); "
+      "without the streaks %.2f %%\n",
+      world.c_str(), streaks.num, data.path_streaks().build_ms(), hits, 64 * 48 * 4, 100 * tile,
+      100 * mean, 100 * tile_clear);
+  EXPECT_GT(hits, 0);
+  EXPECT_LE(tile, kHostParticleTolerance);
+  EXPECT_LE(mean, kHostParticleTolerance);
+  EXPECT_GT(tile_clear, 4 * kHostParticleTolerance);
+  EXPECT_EQ(0, std::memcmp(got.radiance.data(), again.radiance.data(),
+                           sizeof(Float3) * got.radiance.size()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostParticles,
+                         ::testing::Values(std::make_pair(std::string("rain.yaml"), 0),
+                                           std::make_pair(std::string("snow.yaml"), 0),
+                                           std::make_pair(std::string("fire.yaml"), 1)));
+
+// no effect sends a pathtraced frame to the CPU renderer: media (homogeneous or grids) are on
+// the GPU since branch gpu14, particles since branch gpu16.
+TEST(PathNotOnGpu, ParticlesAndMediaStayOnTheGpu) {
   EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();
@@ -280,7 +389,7 @@ TEST(PathNotOnGpu, ParticlesGoToTheCpuMediaDoNot) {
   EXPECT_EQ(lit->surface_wetness, 0.5f);
   EffectsFrame rain;
   rain.particles.emplace_back();
-  EXPECT_NE(cuda::PathNotOnGpu(&rain).find("particles"), std::string::npos);
+  EXPECT_EQ(cuda::PathNotOnGpu(&rain), "");
 }
 
 }  // namespace

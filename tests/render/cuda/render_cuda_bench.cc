@@ -57,7 +57,8 @@
 // and the path kernel alone (CUDA events), the CPU backend's Render() on all cores with the same
 // samples (one frame), the radiance's mean relative difference (path_parity.h: 8x8 blocks, and
 // the image mean) and whether two GPU renders are bit-identical; a world's effects at 1 s (media
-// included) in both. usage:
+// and particles included) in both; for particles a line with the streaks' count and the host's
+// BVH build time. usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
 //                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
 //                     [--seed-floor]] [world.yaml ...]
@@ -616,6 +617,14 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     const bool on_gpu = g->cpu_frames() == 0;
     const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames, fx);
     const double kernel_ms = on_gpu ? g->device_path().TimeKernel(&g->device(), frames) : 0.0;
+    // the particle streaks (branch gpu16): their count, the host's BVH build of the last frame
+    // and the host's whole preparation of it
+    const cuda::PathStreakBuild& streaks = g->realtime_frame().path_streaks();
+    if (on_gpu && !streaks.empty())
+      floors.push_back(fmt::format(
+          "{}: {} particle streaks, their BVH built on the host in {:.2f} ms; the frame's host "
+          "preparation {:.2f} ms",
+          name, streaks.View().num, streaks.build_ms(), g->last_prepare_ms()));
     const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
     const auto t0 = Clock::now();
     cpu->Render(snap, fx, view, &want);

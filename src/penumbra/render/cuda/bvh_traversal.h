@@ -148,13 +148,17 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 #endif
 }
 
-/// traverses one BLAS with the ray in its frame; any_hit: stop at the first hit (occlusion).
-/// updates *hit (t shrinks) and returns whether it hit. a visit of an inner node tests its two
-/// children's boxes (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
-PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
-                                        F3 d, float tmin, bool any_hit, TraceHit* hit) {
+/// the stack traversal of one BVH in the traversal's form (WidenBvh: `nodes` its inner nodes,
+/// `blas` its root's box and reference) along o + t d for t in [tmin, *t_max]: leaf(pi) is
+/// called for every primitive index pi of every leaf the ray reaches and returns whether it
+/// hit (it then shrinks *t_max to the hit's t); any_hit: stop at the first hit (occlusion).
+/// returns whether any primitive hit. a visit of an inner node tests its two children's boxes
+/// (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
+template <typename Leaf>
+PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas& blas, F3 o, F3 d,
+                                           float tmin, const float* t_max, bool any_hit,
+                                           Leaf& leaf) {
   const F3 inv{1.0f / d.x, 1.0f / d.y, 1.0f / d.z};
-  const BvhWideNode* nodes = s.nodes + blas.node_offset;
   // the farther children still to visit (their references), with their boxes' entry distances:
   // a popped child is visited if its entry is not beyond the closest hit found since (the entry
   // does not depend on the ray's far end, so this is the slab test against the shorter ray,
@@ -165,29 +169,18 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
   bool found = false;
   // the node in hand: a leaf (count >= 0) or inner node `first` (count -1)
   int first = blas.root_first, count = blas.root_count;
-  if (SlabEntry(blas.lo, blas.hi, o, inv, tmin, hit->t) == INFINITY) return false;
+  if (SlabEntry(blas.lo, blas.hi, o, inv, tmin, *t_max) == INFINITY) return false;
   while (true) {
     if (count >= 0) {
       for (int k = 0; k < count; ++k) {
-        const int pi = first + k;
-        int kind, index;
-        LoadPrimShape(s.prims + pi, &kind, &index);
-        float t, u = 0, v = 0;
-        int part = 0;
-        const bool h =
-            kind == 0 ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin, hit->t, &t,
-                                          &u, &v)
-                      : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t, &part);
-        if (!h) continue;
-        hit->t = t, hit->u = u, hit->v = v, hit->part = part;
-        hit->prim = pi, hit->instance = instance;
+        if (!leaf(first + k)) continue;
         found = true;
         if (any_hit) return true;
       }
     } else {
       const BvhWideNode n = LoadWideNode(nodes + first);
-      const float ta = SlabEntry(n.box[0], n.box[0] + 3, o, inv, tmin, hit->t);
-      const float tb = SlabEntry(n.box[1], n.box[1] + 3, o, inv, tmin, hit->t);
+      const float ta = SlabEntry(n.box[0], n.box[0] + 3, o, inv, tmin, *t_max);
+      const float tb = SlabEntry(n.box[1], n.box[1] + 3, o, inv, tmin, *t_max);
       const bool ha = ta != INFINITY, hb = tb != INFINITY;
       if (ha && hb) {
         const bool a_first = ta <= tb;
@@ -210,7 +203,7 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     bool next = false;
     while (top > 0) {
       --top;
-      if (stack_t[top] <= hit->t) {
+      if (stack_t[top] <= *t_max) {
         first = stack_first[top];
         count = stack_count[top];
         next = true;
@@ -220,6 +213,28 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     if (!next) break;
   }
   return found;
+}
+
+/// traverses one BLAS with the ray in its frame (TraverseWideBvh over its triangles and
+/// analytic shapes); any_hit: stop at the first hit (occlusion). updates *hit (t shrinks) and
+/// returns whether it hit.
+PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
+                                        F3 d, float tmin, bool any_hit, TraceHit* hit) {
+  auto leaf = [&](int pi) {
+    int kind, index;
+    LoadPrimShape(s.prims + pi, &kind, &index);
+    float t, u = 0, v = 0;
+    int part = 0;
+    const bool h =
+        kind == 0
+            ? IntersectTriangle(LoadTriangle(s.triangles + index), o, d, tmin, hit->t, &t, &u, &v)
+            : IntersectAnalyticPrim(s.analytics[index], o, d, tmin, hit->t, &t, &part);
+    if (!h) return false;
+    hit->t = t, hit->u = u, hit->v = v, hit->part = part;
+    hit->prim = pi, hit->instance = instance;
+    return true;
+  };
+  return TraverseWideBvh(s.nodes + blas.node_offset, blas, o, d, tmin, &hit->t, any_hit, leaf);
 }
 
 /// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.

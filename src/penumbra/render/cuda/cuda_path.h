@@ -3,7 +3,8 @@
 // device copy of the sky's sampling tables and the path kernels. a frame of n pixels splits each
 // pixel's samples into PathRunsPerPixel(n, spp, 2^18) runs of consecutive samples, so that about
 // 2^18 threads trace at once (a 128x96 frame at 1024 spp: 22 runs of 47 samples; frames with
-// media run the kernel's TracePath<true> instance, frames without the one of before); one thread a
+// media run the kernel's TracePath<true> instance, frames with particle streaks its
+// TracePath<..., true> instances, frames with neither the one of before); one thread a
 // run sums its samples in sample order in double (PathSampleRange), then one thread a pixel adds
 // its runs in run order and writes the pixel (PathFinishPixel). no atomics: frames are
 // bit-identical run to run on one GPU (the run split moves the double sums' last bits against
@@ -42,6 +43,11 @@ class DevicePath {
   /// arrays end to end) to the device and returns their device view (valid until the next
   /// call). call it every frame with media (the grids' arrays change with the effects' time).
   const MediaSceneView& UploadMedia(const MediaSceneView& host);
+
+  /// copies a frame's particle streaks (PathStreakBuild::View: host pointers) to the device
+  /// and returns their device view (valid until the next call; num 0: none, nothing copied).
+  /// call it every frame with particles (the streaks move with the effects' time).
+  const PathStreaks& UploadStreaks(const PathStreaks& host);
 
   /// renders the frame `pf` (device pointers everywhere but the outputs, which are set here)
   /// on `scene`'s stream and copies its radiance, albedo, normal and depth into `out` (resized

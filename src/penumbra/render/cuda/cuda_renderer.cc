@@ -69,9 +69,8 @@ void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* eff
   if (!rgb_why.empty()) {
     if (!told_cpu_) {
       spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet (in the pathtraced tier "
-          "particles); "
-          "such frames are rendered by the CPU renderer (docs/gpu.md)",
+          "renderer: cuda backend: {}: not on the GPU yet; such frames are rendered by the "
+          "CPU renderer (docs/gpu.md)",
           rgb_why);
       told_cpu_ = true;
     }
@@ -213,6 +212,8 @@ void CudaRenderer::RenderPathtraced(const WorldSnapshot& snapshot, const Effects
     pf.emitters = device_path_->UploadEmitterPoses(emitter_host_->poses.data());
   }
   if (!path_media_.empty()) pf.media = device_path_->UploadMedia(path_media_.View());
+  // the particle streaks of Prepare (pathtraced: their BVH for the paths) every frame
+  pf.streaks = device_path_->UploadStreaks(realtime_->path_streaks().View());
   prepare_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   device_path_->Render(device_.get(), pf, &path_buffers_);

@@ -7,11 +7,10 @@
 // segmentation, range and normals, traced by bvh_traversal.h's code in cuda_kernels.cu) and, in the
 // realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
 // frame's preparation on the host, realtime_frame.h), and in the pathtraced tier rgb and
-// radiance with media too (path_shading.h, since branch gpu14). everything else (the pathtraced
-// tier's particles, distorted or moving cameras) is not on the GPU yet: such a frame is
-// rendered whole by the
-// CPU renderer handed in (`cpu`), so every output exists and equals the CPU backend's for those
-// frames; docs/gpu.md lists what is where.
+// radiance with media (path_shading.h, since branch gpu14) and particles (path_streaks.h, since
+// branch gpu16) too. a frame the GPU cannot render (RgbNotOnGpu names why; none at present) is
+// rendered whole by the CPU renderer handed in (`cpu`), so every output exists and equals the
+// CPU backend's for those frames; docs/gpu.md lists what is where.
 
 #include <chrono>
 #include <memory>

@@ -6,9 +6,9 @@
 namespace penumbra::cuda {
 
 std::string PathNotOnGpu(const EffectsFrame* effects) {
-  const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
-  // media are traced by the path kernels (media_scene_math.h; branch gpu14)
-  if (fx != nullptr && !fx->particles.empty()) return "the pathtraced tier with particles";
+  // media are traced by the path kernels (media_scene_math.h; branch gpu14), and so are
+  // particles (path_streaks.h; branch gpu16): no effect sends a frame to the CPU now
+  (void)effects;
   return "";
 }
 
@@ -133,6 +133,7 @@ void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, 
       PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
   if (emitters != nullptr) pf.emitters = *emitters;
   if (media != nullptr) pf.media = *media;
+  pf.streaks = data.path_streaks().View();
   TracePathtracedOnHost(pf, pool, &b);
   std::unique_ptr<Denoiser> denoiser;
   if (data.settings().denoise) denoiser = std::make_unique<Denoiser>();

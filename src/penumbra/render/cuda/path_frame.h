@@ -23,9 +23,10 @@
 
 namespace penumbra::cuda {
 
-/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can): particles
-/// (the CPU's camera rays stop at streaks with a random draw). media (homogeneous and grids)
-/// are traced on the GPU since branch gpu14 (PathFrameView::media); a camera with lens
+/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can): no effect
+/// now. media (homogeneous and grids) are traced on the GPU since branch gpu14
+/// (PathFrameView::media), particles since branch gpu16 (PathFrameView::streaks, the camera
+/// rays' streaks with the CPU's random draw: path_streaks.h); a camera with lens
 /// distortion or motion (rolling shutter, or the exposure's motion that every frame of a run
 /// has) is on the GPU: its jittered rays come from its ray tables (JitteredCameraRay,
 /// path_shading.h).
@@ -71,7 +72,8 @@ void TracePathtracedOnHost(const PathFrameView& pf, ThreadPool* pool, PathBuffer
 /// rows over `pool`, finished by FinishPathFrame (denoised when the settings ask for it): the
 /// GPU path's radiance, depth and rgb, computed on the host (`white_balance_gains`: the view's).
 /// `emitters`: the scene's emissive geoms posed for the snapshot (null: none); `media`: the
-/// frame's media (MediaScene::View; null: none).
+/// frame's media (MediaScene::View; null: none); the particle streaks are data's own
+/// (path_streaks(), Prepared with the effects).
 void RenderPathtracedOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                             RenderedFrame* out,
                             const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones(),

@@ -22,8 +22,9 @@ constexpr int64_t kPathThreads = 1 << 18;
 
 // run k of pixel (u, v) a thread (threadIdx.x over 64 pixels of a row, blockIdx.z the run):
 // samples [k c, min((k + 1) c, spp)) with c = ceil(spp / runs), summed into partial[k n + i].
-// kMedia: the frame has media (TracePath<true>); frames without keep the kernel of before.
-template <bool kMedia>
+// kMedia: the frame has media (TracePath<true>); kParticles: it has particle streaks
+// (TracePath<..., true>); frames with neither keep the kernel of before.
+template <bool kMedia, bool kParticles>
 __global__ void __launch_bounds__(64)
     PathRunKernel(PathFrameView pf, int runs, PathPartial* partial) {
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
@@ -34,7 +35,8 @@ __global__ void __launch_bounds__(64)
   const int s0 = k * c, s1 = s0 + c < pf.spp ? s0 + c : pf.spp;
   const int64_t n = static_cast<int64_t>(pf.rt.camera.width) * pf.rt.camera.height;
   const int64_t i = static_cast<int64_t>(v) * pf.rt.camera.width + u;
-  partial[k * n + i] = s0 < s1 ? PathSampleRange<kMedia>(pf, u, v, s0, s1) : PathPartial{};
+  partial[k * n + i] =
+      s0 < s1 ? PathSampleRange<kMedia, kParticles>(pf, u, v, s0, s1) : PathPartial{};
 }
 
 // a pixel a thread: its runs' sums added in run order (no atomics), then its outputs.
@@ -55,10 +57,16 @@ __global__ void PathFinishKernel(PathFrameView pf, int runs, const PathPartial* 
 
 void LaunchPath(const PathFrameView& pf, PathPartial* partial, int runs, cudaStream_t stream) {
   const int W = pf.rt.camera.width, H = pf.rt.camera.height;
-  if (MediaAny(pf.media)) {
-    PathRunKernel<true><<<dim3((W + 63) / 64, H, runs), 64, 0, stream>>>(pf, runs, partial);
+  const dim3 grid((W + 63) / 64, H, runs);
+  const bool media = MediaAny(pf.media), particles = pf.streaks.num > 0;
+  if (particles && media) {
+    PathRunKernel<true, true><<<grid, 64, 0, stream>>>(pf, runs, partial);
+  } else if (particles) {
+    PathRunKernel<false, true><<<grid, 64, 0, stream>>>(pf, runs, partial);
+  } else if (media) {
+    PathRunKernel<true, false><<<grid, 64, 0, stream>>>(pf, runs, partial);
   } else {
-    PathRunKernel<false><<<dim3((W + 63) / 64, H, runs), 64, 0, stream>>>(pf, runs, partial);
+    PathRunKernel<false, false><<<grid, 64, 0, stream>>>(pf, runs, partial);
   }
   Check(cudaGetLastError(), "PathRunKernel");
   PathFinishKernel<<<dim3((W + 7) / 8, (H + 7) / 8), dim3(8, 8), 0, stream>>>(pf, runs, partial);
@@ -75,6 +83,8 @@ struct DevicePath::Impl {
   PathEmitters emitters;
   Buffer media_pods, media_terms, grid_pods, grid_density, grid_emission;
   MediaSceneView media;
+  Buffer streak_nodes, streak_pods, streak_sets, streak_rain;
+  PathStreaks streaks;
   PathFrameView last;  // the last Render's frame and sample runs (TimeKernel)
   int runs = 1;
   bool rendered = false;
@@ -169,6 +179,22 @@ const MediaSceneView& DevicePath::UploadMedia(const MediaSceneView& h) {
   m.media.terms = h.num_media > 0 ? m.media_terms.as<MediumTracePod>() : nullptr;
   m.media.grids = grids;
   return m.media;
+}
+
+const PathStreaks& DevicePath::UploadStreaks(const PathStreaks& h) {
+  Impl& m = *impl_;
+  m.streaks = h;
+  if (h.num <= 0) return m.streaks;
+  m.streak_nodes.Upload(h.nodes, sizeof(BvhWideNode) * h.root.num_nodes, nullptr);
+  m.streak_pods.Upload(h.streaks, sizeof(StreakPod) * h.num, nullptr);
+  m.streak_sets.Upload(h.sets, sizeof(StreakSetPod) * h.num_sets, nullptr);
+  m.streak_rain.Upload(h.rain, sizeof(Float3) * h.num_rain, nullptr);
+  Check(cudaStreamSynchronize(nullptr), "uploading the particle streaks");
+  m.streaks.nodes = h.root.num_nodes > 0 ? m.streak_nodes.as<BvhWideNode>() : nullptr;
+  m.streaks.streaks = m.streak_pods.as<StreakPod>();
+  m.streaks.sets = m.streak_sets.as<StreakSetPod>();
+  m.streaks.rain = h.num_rain > 0 ? m.streak_rain.as<Float3>() : nullptr;
+  return m.streaks;
 }
 
 void DevicePath::Render(DeviceScene* scene, const PathFrameView& frame, PathBuffers* out) {

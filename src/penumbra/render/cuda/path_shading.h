@@ -4,7 +4,7 @@
 // pixel then summed in run order: PathSampleRange, PathFinishPixel) and RenderPathtracedOnHost
 // (path_frame.h) runs the same functions on the CPU over the host BVH (tests, machines without
 // a GPU). the path is the CPU's PathIntegrator (render/cpu/path_integrator.h, where the model is
-// documented) step for step, for frames without particles (with media since branch gpu14):
+// documented) step for step (with media since branch gpu14, particles since branch gpu16):
 //
 //   per sample s of pixel (u, v): Rng(PixelStream(u, v, s)) (core/rng.h, the same draws in the
 //   same order), a camera ray jittered over the pixel (two draws); at each vertex the lamp
@@ -18,6 +18,9 @@
 //   (MediaTrackOf; its draws), at a real scattering event next-event estimation through the
 //   phase function, Russian roulette and the phase function's sample (three draws), and on every
 //   shadow ray the media's transmittance (MediaTransmittanceOf; draws inside grid boxes);
+//   with particles (TracePath<..., true>): a camera ray that meets a streak (path_streaks.h)
+//   in front of the lamp or surface stops there with probability alpha (one draw, before the
+//   free flight, which then ends at the streak), adding the streak's radiance (ShadeStreak);
 //
 // with the shared formulas of render/: the BSDF (bsdf_math.h), the light samples (light_math.h,
 // with LightSampler::Sample's normalisation), the lamp and sun terms and the power heuristic
@@ -36,6 +39,7 @@
 #include "penumbra/core/host_device.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/bsdf_math.h"
+#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/emitter_math.h"
 #include "penumbra/render/light_math.h"
@@ -94,6 +98,9 @@ struct PathFrameView {
   /// the frame's participating media (MediaScene::View's or its device copy; none: empty, and
   /// the paths run TracePath<false>)
   MediaSceneView media;
+  /// the frame's particle streaks (path_streaks.h: PathStreakBuild::View or its device copy;
+  /// none: num 0, and the paths run TracePath<kMedia, false>)
+  PathStreaks streaks;
   /// per pixel (row-major, width x height): the mean radiance, the mean base colour of the
   /// first surface over the samples that hit one (the denoiser's albedo), and the pixel-centre
   /// hit's usable shading normal (0 where it escapes) and z-depth (0 where it escapes).
@@ -340,8 +347,9 @@ PB_HOST_DEVICE inline TraceRay JitteredCameraRay(const PinholeCamera& c, int u, 
 
 /// one path of sample s of pixel (u, v): its radiance (non-finite values are the caller's to
 /// drop) and, where its camera ray meets a surface, that surface's base colour (*albedo,
-/// *hit_first true). kMedia: the frame has media (pf.media not empty).
-template <bool kMedia>
+/// *hit_first true). kMedia: the frame has media (pf.media not empty); kParticles: it has
+/// particle streaks (pf.streaks.num > 0).
+template <bool kMedia, bool kParticles = false>
 PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, int s, Float3* albedo,
                                        bool* hit_first) {
   const RealtimeFrameView& f = pf.rt;
@@ -371,15 +379,30 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
     float t_lamp;
     const int lamp = PathNearestLamp(f, o, d, ray.tmin, t_surface, &t_lamp);
 
+    // camera rays see the particle streaks, each covering the pixel with probability alpha
+    // (one draw where a streak lies in front of the lamp or surface); the free flight then
+    // stops at the streak.
+    const float t_end = lamp >= 0 ? t_lamp : t_surface;
+    float t_stop = t_end;
+    int streak = -1;
+    if (kParticles && from_camera) {
+      float t_streak;
+      int k;
+      if (PathStreakHit(pf.streaks, o, d, ray.tmin, t_end, &t_streak, &k) &&
+          rng.Uniform() < pf.streaks.streaks[k].alpha) {
+        streak = k;
+        t_stop = t_streak;
+      }
+    }
     if (kMedia) {
-      // the free flight through the media up to the lamp or surface: absorbed, scattered (a
-      // medium vertex: next events through the phase function, then its sample), or through.
-      const float t_end = lamp >= 0 ? t_lamp : t_surface;
+      // the free flight through the media up to the streak, lamp or surface: absorbed,
+      // scattered (a medium vertex: next events through the phase function, then its sample),
+      // or through.
       const float o3[3] = {o.x, o.y, o.z}, d3[3] = {d.x, d.y, d.z};
       float t_scatter;
       MediumPointPod mp;
       const TrackEvent ev =
-          MediaTrackOf(pf.media, o3, d3, ray.tmin, t_end, &rng, &beta, &L, &t_scatter, &mp);
+          MediaTrackOf(pf.media, o3, d3, ray.tmin, t_stop, &rng, &beta, &L, &t_scatter, &mp);
       if (ev == TrackEvent::kAbsorb) break;
       if (ev == TrackEvent::kScatter) {
         if (vertex >= pf.max_bounces) break;
@@ -408,6 +431,13 @@ PB_HOST_DEVICE inline Float3 TracePath(const PathFrameView& pf, int u, int v, in
         ray.tmax = INFINITY;
         continue;
       }
+    }
+    if (kParticles && streak >= 0) {
+      // the streak's radiance ends the path
+      const Float3 p{o.x + t_stop * d.x, o.y + t_stop * d.y, o.z + t_stop * d.z};
+      L = L + PathMul(beta, PathStreakRadiance(pf.streaks, pf.streaks.streaks[streak], p, d,
+                                               f.lights, f.num_lights, f.volume));
+      break;
     }
 
     if (lamp >= 0) {
@@ -518,15 +548,15 @@ struct PathPartial {
   int32_t albedo_count = 0;
 };
 
-/// samples [s0, s1) of pixel (u, v) (TracePath<kMedia>), summed in sample order.
-template <bool kMedia>
+/// samples [s0, s1) of pixel (u, v) (TracePath<kMedia, kParticles>), summed in sample order.
+template <bool kMedia, bool kParticles = false>
 PB_HOST_DEVICE inline PathPartial PathSampleRange(const PathFrameView& pf, int u, int v, int s0,
                                                   int s1) {
   PathPartial p;
   for (int s = s0; s < s1; ++s) {
     Float3 albedo;
     bool hit = false;
-    const Float3 L = TracePath<kMedia>(pf, u, v, s, &albedo, &hit);
+    const Float3 L = TracePath<kMedia, kParticles>(pf, u, v, s, &albedo, &hit);
     if (hit) {
       p.albedo[0] += albedo.x, p.albedo[1] += albedo.y, p.albedo[2] += albedo.z;
       ++p.albedo_count;
@@ -566,11 +596,14 @@ PB_HOST_DEVICE inline void PathFinishPixel(const PathFrameView& pf, int u, int v
 
 /// pixel (u, v) of a pathtraced frame in one run: all pf.spp samples (PathSampleRange) summed in
 /// sample order in double, as the CPU's PathIntegrator sums them, then PathFinishPixel
-/// (TracePath<true> where the frame has media).
+/// (TracePath<true, ...> where the frame has media, TracePath<..., true> where it has streaks).
 PB_HOST_DEVICE inline void PathTracePixel(const PathFrameView& pf, int u, int v) {
+  const bool media = MediaAny(pf.media), particles = pf.streaks.num > 0;
   PathFinishPixel(pf, u, v,
-                  MediaAny(pf.media) ? PathSampleRange<true>(pf, u, v, 0, pf.spp)
-                                     : PathSampleRange<false>(pf, u, v, 0, pf.spp));
+                  particles ? (media ? PathSampleRange<true, true>(pf, u, v, 0, pf.spp)
+                                     : PathSampleRange<false, true>(pf, u, v, 0, pf.spp))
+                            : (media ? PathSampleRange<true>(pf, u, v, 0, pf.spp)
+                                     : PathSampleRange<false>(pf, u, v, 0, pf.spp)));
 }
 
 /// the sample runs of a frame of n pixels and spp samples on a processor that wants about

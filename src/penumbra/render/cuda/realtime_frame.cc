@@ -179,11 +179,13 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
                                        const Camera& camera, const CameraView& view,
                                        ThreadPool* pool) {
   streaks_.clear();
+  path_streaks_.Clear();
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   if (fx == nullptr || fx->particles.empty()) {
     particles_.Build(nullptr, camera, 0, false);
     return;
   }
+  const bool realtime = settings_.tier == RenderSettings::Tier::kRealtime;
   // as the CPU's MediaFrame::Prepare: the sheltered drops left out, the rain streaks the
   // frame's homogeneous media hide culled, the streaks splatted per pixel, the rain shaded once
   // per streak
@@ -192,11 +194,16 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
-  particles_.Build(fx, camera, view.exposure_time_sec, true, pool, media,
+  particles_.Build(fx, camera, view.exposure_time_sec, realtime, pool, media,
                    sheltered ? &shelter_ : nullptr);
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
+  if (!realtime) {
+    // the pathtraced tier: the paths trace the streaks themselves (path_streaks.h)
+    path_streaks_.Build(particles_, sky_ambient);
+    return;
+  }
   // every pixel's nearest streak, shaded as RealtimeIntegrator's view effects shade it (for
   // the CPU's pixel ray: the streak's t does not depend on the surface behind it, which the
   // kernel compares), row by row, concatenated in row order

@@ -28,6 +28,7 @@
 #include "penumbra/render/cuda/bvh_scene.h"
 #include "penumbra/render/cuda/camera_rays.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/path_streak_build.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 #include "penumbra/render/effects_sky.h"
 #include "penumbra/render/film.h"
@@ -111,12 +112,18 @@ class RealtimeFrameData {
   /// streak), then each pixel's nearest streak shaded by ParticleStreaks::Shade as
   /// RealtimeIntegrator does (the frame's lights and sky, the occluded sky volume), in pixel
   /// order; the media in front of a streak are applied in the view pass (MediaViewQuad). call
-  /// after PoseWorld (Prepare does).
+  /// after PoseWorld (Prepare does). under the pathtraced tier's settings instead, as the CPU's
+  /// MediaFrame::Prepare for that tier: the streaks without the per-pixel splat and culling,
+  /// every rain streak shaded once, and their BVH for the paths (path_streaks(); no streak
+  /// pixels).
   /// @throws ConfigError for malformed particle sets (ParticleStreaks::Build).
   void PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                       const Camera& camera, const CameraView& view, ThreadPool* pool);
   /// the streak pixels of the last PrepareStreaks.
   const std::vector<StreakPixel>& streaks() const { return streaks_; }
+  /// the pathtraced tier's streaks of the last PrepareStreaks (empty under the realtime tier's
+  /// settings or without particles); PathStreakBuild::View gives the paths' PathStreaks.
+  const PathStreakBuild& path_streaks() const { return path_streaks_; }
   /// the random-number key of a frame of camera `camera_index`, frame `frame_index`
   /// (FrameContext::FrameKey, render/cpu/integrator.h) under these settings' seed.
   uint64_t FrameKey(int camera_index, int64_t frame_index) const;
@@ -195,6 +202,7 @@ class RealtimeFrameData {
   ShelterMap shelter_;         // where rain and snow do not fall (PrepareStreaks)
   ParticleStreaks particles_;  // the frame's streaks (PrepareStreaks)
   std::vector<StreakPixel> streaks_;
+  PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
   // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);

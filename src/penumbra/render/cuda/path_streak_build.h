@@ -1,0 +1,47 @@
+#pragma once
+// the host side of the pathtraced tier's particle streaks on the GPU (path_streaks.h): per frame,
+// the streaks of the CPU's ParticleStreaks (built for the camera without the realtime tier's
+// per-pixel splat, rain precomputed: RealtimeFrameData::PrepareStreaks) as StreakPods in the
+// leaf order of a BVH over their capsules' boxes (bvh_builder.h's binned SAH, WidenBvh), their
+// particle sets and the rain's radiance, as the path kernels read them (PathStreaks over these
+// host arrays; DevicePath::UploadStreaks copies them).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "penumbra/render/cuda/bvh_builder.h"
+#include "penumbra/render/cuda/bvh_types.h"
+#include "penumbra/render/cuda/path_streaks.h"
+#include "penumbra/render/particle_streaks.h"
+
+namespace penumbra::cuda {
+
+/// a frame's streaks and their BVH on the host.
+class PathStreakBuild {
+ public:
+  /// builds from `streaks` (Built for the frame, PrecomputeRain called; empty: none) and the
+  /// open sky's sphere-average radiance `sky_ambient` (cd/m^2); records the time it took.
+  void Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
+  /// no streaks (View's num 0).
+  void Clear();
+  /// the streaks over this object's arrays (valid until the next Build or Clear).
+  PathStreaks View() const;
+  bool empty() const { return pods_.empty(); }
+  /// wall-clock milliseconds of the last Build (the pods, boxes, BVH and widening).
+  double build_ms() const { return build_ms_; }
+
+ private:
+  std::vector<StreakPod> pods_;  // leaf order
+  std::vector<StreakSetPod> sets_;
+  std::vector<Float3> rain_;
+  std::vector<BvhWideNode> nodes_;
+  Blas root_;
+  Float3 sky_ambient_;
+  double build_ms_ = 0;
+  // reused between frames for their capacity
+  std::vector<PrimBox> boxes_;
+  std::vector<BvhNode> binary_;
+  std::vector<int32_t> order_;
+};
+
+}  // namespace penumbra::cuda
