@@ -60,7 +60,8 @@ timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --frames "$frames" --bat
 sessions_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_bench" --pathtraced --spp 64 --size 320x240 --frames 3 \
   "$pkg/src/worlds/default.yaml" "$pkg/src/worlds/house.yaml" \
-  "$pkg/src/worlds/effects/fog.yaml" > "$log/pathtraced.txt" 2>&1
+  "$pkg/src/worlds/effects/fog.yaml" "$pkg/src/worlds/effects/rain.yaml" \
+  "$pkg/src/worlds/effects/snow.yaml" > "$log/pathtraced.txt" 2>&1
 path_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
 host_rc=$?

@@ -6,9 +6,13 @@
 #include <cstdint>
 #include <vector>
 
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_types.h"
 
 namespace penumbra::cuda {
+
+/// BuildBvh builds over its pool from this many primitives on (fewer: on the calling thread).
+constexpr int kParallelBuildMinPrims = 16384;
 
 /// an axis-aligned box of one primitive.
 struct PrimBox {
@@ -19,9 +23,12 @@ struct PrimBox {
 /// node adjacent; node indices relative to the first appended node) and the primitive order to
 /// *prim_index (leaf ranges index *prim_index from `prim_base`'s first appended element; each
 /// element is `prim_base` + a box index). an empty `boxes` gives one empty leaf with an empty
-/// box. deterministic (no threads, no unordered containers).
+/// box. `pool` (may be null): with at least kParallelBuildMinPrims boxes and two threads, the
+/// splits near the root are made on the calling thread and the subtrees below them are built
+/// over the pool, then laid out as the one-thread build lays them out: the same nodes and
+/// order, bit for bit, with any pool (no unordered containers, no shared counters).
 void BuildBvh(const std::vector<PrimBox>& boxes, int32_t prim_base, std::vector<BvhNode>* nodes,
-              std::vector<int32_t>* prim_index);
+              std::vector<int32_t>* prim_index, ThreadPool* pool = nullptr);
 
 /// the traversal's form of one BVH that BuildBvh wrote (`nodes`: its nodes alone, root first):
 /// its inner nodes appended to *wide in their order in `nodes` (the root first, if inner),

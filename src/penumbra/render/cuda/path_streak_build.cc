@@ -15,7 +15,8 @@ void PathStreakBuild::Clear() {
   build_ms_ = 0;
 }
 
-void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient) {
+void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient,
+                            ThreadPool* pool) {
   const auto t0 = std::chrono::steady_clock::now();
   Clear();
   sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
@@ -36,7 +37,7 @@ void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3
   }
   binary_.clear();
   order_.clear();
-  BuildBvh(boxes_, 0, &binary_, &order_);
+  BuildBvh(boxes_, 0, &binary_, &order_, pool);
   WidenBvh(binary_, &nodes_, &root_);
   pods_.resize(n);
   for (int k = 0; k < n; ++k) {

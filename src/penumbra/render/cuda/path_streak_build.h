@@ -20,8 +20,10 @@ namespace penumbra::cuda {
 class PathStreakBuild {
  public:
   /// builds from `streaks` (Built for the frame, PrecomputeRain called; empty: none) and the
-  /// open sky's sphere-average radiance `sky_ambient` (cd/m^2); records the time it took.
-  void Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
+  /// open sky's sphere-average radiance `sky_ambient` (cd/m^2); records the time it took. the
+  /// BVH is built over `pool` (may be null; BuildBvh: the same bits either way).
+  void Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient,
+             ThreadPool* pool = nullptr);
   /// no streaks (View's num 0).
   void Clear();
   /// the streaks over this object's arrays (valid until the next Build or Clear).

@@ -201,7 +201,7 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
   if (!realtime) {
     // the pathtraced tier: the paths trace the streaks themselves (path_streaks.h)
-    path_streaks_.Build(particles_, sky_ambient);
+    path_streaks_.Build(particles_, sky_ambient, pool);
     return;
   }
   // every pixel's nearest streak, shaded as RealtimeIntegrator's view effects shade it (for
