@@ -5,7 +5,7 @@
 # the first camera at 320x240 after 1 s, depth within 1 mm %, segmentation equal %, same-depth
 # ties, whether the frame with the world's effects is on the GPU (every effect since branch
 # gpu12: lighting effects, particles, homogeneous and grid media, particles seen through media),
-# and the rgb PSNR of that frame where it renders on the GPU, else "cpu fallback"; then the pathtraced tier's row (issue 35:
+# and the rgb PSNR of that frame (every frame renders on the GPU); then the pathtraced tier's row (issue 35:
 # pathtraced at 1024 spp, mean relative difference <= 1 %): the default and house worlds' first
 # camera at 128x96 after 1 s, 1024 samples per pixel, the radiance's mean relative difference
 # between the GPU's and the CPU backend's (8x8 blocks and the image mean; render_cuda_bench

@@ -2,11 +2,11 @@
 // the CUDA backend against the CPU backend on one world (issue 35, item 7): the world's first
 // camera at `width` x `height` after 1 s of simulation, both backends built by MakeRenderer.
 // depth within 1 mm and segmentation equal are counted on the clear frame (no effects: the
-// geometry both backends trace); whether the frame with the world's effects and the rgb image
-// render on the GPU (CudaRenderer::OnGpu) is reported, with the rgb PSNR where rgb is on the
-// GPU, else "cpu fallback" (frames with lighting effects render on the GPU since branch gpu6,
-// particles without media and homogeneous media since gpu10, grid media and particles seen
-// through media since gpu12). shared by render_cuda_bench --parity
+// geometry both backends trace); the rgb PSNR is that of the frame with the world's effects, if
+// it has any (every frame renders on the GPU: lighting effects since branch gpu6, particles
+// without media and homogeneous media since gpu10, grid media and particles seen through media
+// since gpu12, the pathtraced tier's media and particles since gpu14 and gpu16). shared by
+// render_cuda_bench --parity
 // (scripts/gpu/parity.sh) and the `gpu` test CudaParity. header-only: both link the same libraries.
 
 #include <fmt/format.h>
@@ -34,8 +34,7 @@ struct ParityRow {
   double seg_equal = 0;         ///< % of pixels
   int ties = 0;                 ///< of the differing ids: same depth within 1e-5 (coplanar)
   bool effects = false;         ///< the world has effects at 1 s
-  bool effects_on_gpu = false;  ///< the frame with them renders on the GPU
-  std::string rgb;              ///< "PSNR x dB" or "cpu fallback"
+  std::string rgb;              ///< "PSNR x dB"
   double rgb_psnr = -1;         ///< the rgb PSNR (dB; 99 equal) where rgb is on the GPU, else -1
 };
 
@@ -92,24 +91,16 @@ inline ParityRow MeasureParity(const std::string& world_file, int width, int hei
   rgb_view.outputs[ImageKind::kRgb] = true;
   RenderedFrame ca, cb;
   cpu->Render(snap, fx.get(), rgb_view, &ca);
-  // on the GPU unless the CUDA backend handed the frame to its CPU renderer
-  const auto* g = dynamic_cast<const cuda::CudaRenderer*>(gpu.get());
-  const int64_t cpu_frames = g != nullptr ? g->cpu_frames() : 0;
   gpu->Render(snap, fx.get(), rgb_view, &cb);
-  row.effects_on_gpu = g != nullptr && g->cpu_frames() == cpu_frames;
-  if (!row.effects_on_gpu) {
-    row.rgb = "cpu fallback";
-  } else {
-    double se = 0;
-    for (size_t i = 0; i < ca.rgb.data.size(); ++i) {
-      const double d = static_cast<double>(ca.rgb.data[i]) - cb.rgb.data[i];
-      se += d * d;
-    }
-    const double mse = se / std::max<size_t>(1, ca.rgb.data.size());
-    row.rgb_psnr = mse == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
-    row.rgb = mse == 0 ? "PSNR inf (equal)"
-                       : fmt::format("PSNR {:.1f} dB", 10 * std::log10(255.0 * 255.0 / mse));
+  double se = 0;
+  for (size_t i = 0; i < ca.rgb.data.size(); ++i) {
+    const double d = static_cast<double>(ca.rgb.data[i]) - cb.rgb.data[i];
+    se += d * d;
   }
+  const double mse = se / std::max<size_t>(1, ca.rgb.data.size());
+  row.rgb_psnr = mse == 0 ? 99.0 : 10 * std::log10(255.0 * 255.0 / mse);
+  row.rgb = mse == 0 ? "PSNR inf (equal)"
+                     : fmt::format("PSNR {:.1f} dB", 10 * std::log10(255.0 * 255.0 / mse));
   return row;
 }
 
@@ -123,8 +114,7 @@ inline std::string FormatParity(const std::vector<ParityRow>& rows, int width, i
   for (const ParityRow& r : rows)
     s += fmt::format("| {} | {} of {} | {:.3f} % | {:.3f} % | {} | {:.3f} % | {} | {} |\n", r.world,
                      r.hit, r.pixels, r.depth_within_1mm, r.seg_equal, r.ties,
-                     r.seg_equal + 100.0 * r.ties / r.pixels,
-                     !r.effects ? "none" : (r.effects_on_gpu ? "on GPU" : "cpu fallback"), r.rgb);
+                     r.seg_equal + 100.0 * r.ties / r.pixels, r.effects ? "on GPU" : "none", r.rgb);
   return s;
 }
 

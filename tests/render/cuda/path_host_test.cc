@@ -61,9 +61,8 @@ HostPathtraced RenderBoth(const std::string& world, bool distorted = false) {
   bvh.Update(snap);
   cuda::RealtimeFrameData data(scene, settings);
   ThreadPool pool(0);
-  // the bundled worlds have no emissive geom (their frames are on the GPU: PathNotOnGpu)
+  // the bundled worlds have no emissive geom
   EXPECT_TRUE(EmitterSampler(scene).empty());
-  EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
   data.Prepare(snap, view, &pool);
   const cuda::PathFrameView pf =
       cuda::PathView(data, data.View(bvh.view(), nullptr), data.frame_sky().sampling_pod());
@@ -246,7 +245,6 @@ TEST_P(PathtracedHostMedia, TracksTheCpuBackendsEstimate) {
   const MediaFrameCase c = LoadMediaFrame(world, GetParam().second, 64, 48);
   ASSERT_TRUE(c.fx);
   ASSERT_FALSE(c.fx->homogeneous_media.empty() && c.fx->grid_media.empty());
-  EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
   ThreadPool pool(0);
   EffectsPathFrame e;
   PrepareEffectsPath(c, &pool, &e);
@@ -301,7 +299,6 @@ TEST_P(PathtracedHostParticles, TracksTheCpuBackendsEstimate) {
   const MediaFrameCase c = LoadMediaFrame(world, GetParam().second, 64, 48);
   ASSERT_TRUE(c.fx);
   ASSERT_FALSE(c.fx->particles.empty());
-  EXPECT_EQ(cuda::PathNotOnGpu(c.fx.get()), "");
   ThreadPool pool(0);
   EffectsPathFrame e;
   PrepareEffectsPath(c, &pool, &e);
@@ -368,19 +365,15 @@ INSTANTIATE_TEST_SUITE_P(Effects, PathtracedHostParticles,
                                            std::make_pair(std::string("snow.yaml"), 0),
                                            std::make_pair(std::string("fire.yaml"), 1)));
 
-// no effect sends a pathtraced frame to the CPU renderer: media (homogeneous or grids) are on
-// the GPU since branch gpu14, particles since branch gpu16.
-TEST(PathNotOnGpu, ParticlesAndMediaStayOnTheGpu) {
-  EXPECT_EQ(cuda::PathNotOnGpu(nullptr), "");
+// the realtime tier's media volumes are not built for the paths: Prepare gets the effects
+// without their media (the path kernels trace the media themselves, since branch gpu14).
+TEST(EffectsWithoutMedia, DropsTheMediaAndKeepsTheRest) {
   EffectsFrame fog;
   fog.homogeneous_media.emplace_back();
-  EXPECT_EQ(cuda::PathNotOnGpu(&fog), "");
   EffectsFrame smoke;
   smoke.grid_media.emplace_back();
-  EXPECT_EQ(cuda::PathNotOnGpu(&smoke), "");
-  // the realtime tier's media volumes are not built for the paths: Prepare gets the effects
-  // without their media
   EffectsFrame storage;
+  EXPECT_EQ(cuda::EffectsWithoutMedia(&smoke, &storage), nullptr);
   EXPECT_EQ(cuda::EffectsWithoutMedia(&fog, &storage), nullptr);
   fog.surface_wetness = 0.5f;
   const EffectsFrame* lit = cuda::EffectsWithoutMedia(&fog, &storage);
@@ -389,7 +382,7 @@ TEST(PathNotOnGpu, ParticlesAndMediaStayOnTheGpu) {
   EXPECT_EQ(lit->surface_wetness, 0.5f);
   EffectsFrame rain;
   rain.particles.emplace_back();
-  EXPECT_EQ(cuda::PathNotOnGpu(&rain), "");
+  EXPECT_EQ(cuda::EffectsWithoutMedia(&rain, &storage), &rain);
 }
 
 }  // namespace

@@ -10,8 +10,8 @@
 //     (CUDA events, no copies);
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
-//     them, cuda Render() (on the GPU for every effect since branch gpu12; else the CPU
-//     renderer inside the CUDA backend, "cpu fallback") and cpu Render(); with media
+//     them, cuda Render() (on the GPU for every effect since branch gpu12) and cpu Render();
+//     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
 //     CudaRayQuery's and with BvhRayQuery's (the host traversal), and the CUDA backend's host
@@ -614,13 +614,12 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
     gpu->Render(snap, fx, view, &a);
     gpu->Render(snap, fx, view, &b);
     const bool repeats = a.radiance.data == b.radiance.data && a.rgb.data == b.rgb.data;
-    const bool on_gpu = g->cpu_frames() == 0;
     const double gpu_ms = 1e3 * TimeRenders(gpu.get(), snap, view, frames, fx);
-    const double kernel_ms = on_gpu ? g->device_path().TimeKernel(&g->device(), frames) : 0.0;
+    const double kernel_ms = g->device_path().TimeKernel(&g->device(), frames);
     // the particle streaks (branch gpu16): their count, the host's BVH build of the last frame
     // and the host's whole preparation of it
     const cuda::PathStreakBuild& streaks = g->realtime_frame().path_streaks();
-    if (on_gpu && !streaks.empty())
+    if (!streaks.empty())
       floors.push_back(fmt::format(
           "{}: {} particle streaks, their BVH built on the host in {:.2f} ms; the frame's host "
           "preparation {:.2f} ms",
@@ -642,9 +641,9 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
           100 * path_parity::MeanRelativeDifference(c.radiance, want.radiance)));
     }
     fmt::print(
-        "| {} | {}x{} | {} | {:.1f}{} | {:.1f} | {:.0f} | {:.1f}x | {:.3f} % | {:.3f} % | {} |\n",
-        name, width, height, spp, gpu_ms, on_gpu ? "" : " (cpu fallback)", kernel_ms, cpu_ms,
-        cpu_ms / gpu_ms, 100 * path_parity::TileRelativeDifference(a.radiance, want.radiance),
+        "| {} | {}x{} | {} | {:.1f} | {:.1f} | {:.0f} | {:.1f}x | {:.3f} % | {:.3f} % | {} |\n",
+        name, width, height, spp, gpu_ms, kernel_ms, cpu_ms, cpu_ms / gpu_ms,
+        100 * path_parity::TileRelativeDifference(a.radiance, want.radiance),
         100 * path_parity::MeanRelativeDifference(a.radiance, want.radiance),
         repeats ? "yes" : "NO");
   }
@@ -793,15 +792,11 @@ int Main(int argc, char** argv) {
       const std::shared_ptr<const EffectsFrame> fx =
           world.session->effects().Evaluate(snap, view.X_WO.translation());
       const bool with_fx = fx && !fx->empty();
-      // the CUDA backend's own verdict (its CPU renderer takes what is not on the GPU)
-      const bool fx_on_gpu =
-          gpu && static_cast<cuda::CudaRenderer*>(gpu.get())->RgbNotOnGpu(fx.get()).empty();
-      const std::string fx_outputs = fx_on_gpu ? "rgb+depth realtime + effects (on GPU)"
-                                               : "rgb+depth realtime + effects (cpu fallback)";
+      const std::string fx_outputs = "rgb+depth realtime + effects (on GPU)";
       if (gpu && with_fx) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-        if ((!fx->homogeneous_media.empty() || !fx->grid_media.empty()) && fx_on_gpu)
+        if (!fx->homogeneous_media.empty() || !fx->grid_media.empty())
           builds.push_back(fmt::format(
               "{} {}: effects frame with media on the GPU: host preparation {:.2f} ms a frame "
               "(the last of the timed frames; RealtimeFrameData::Prepare, media volumes included)",

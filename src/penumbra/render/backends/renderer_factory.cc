@@ -79,9 +79,7 @@ std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,
     case RenderSettings::Backend::kCuda: {
       RequireCuda();
 #if PENUMBRA_WITH_CUDA
-      RenderSettings cpu = settings;
-      cpu.backend = RenderSettings::Backend::kEmbree;
-      return std::make_unique<cuda::CudaRenderer>(scene, MakeEmbreeRenderer(scene, cpu), settings);
+      return std::make_unique<cuda::CudaRenderer>(scene, settings);
 #else
       break;
 #endif

@@ -27,13 +27,10 @@ T* Shape(Image<T>* img, bool want, int w, int h, int c) {
 
 }  // namespace
 
-CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu)
-    : CudaRenderer(scene, std::move(cpu), RenderSettings()) {}
+CudaRenderer::CudaRenderer(const SceneDescription& scene) : CudaRenderer(scene, RenderSettings()) {}
 
-CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu,
-                           const RenderSettings& settings)
-    : scene_(scene), cpu_(std::move(cpu)) {
-  if (!cpu_) throw Error("CudaRenderer: no CPU renderer for the frames the GPU cannot render");
+CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& settings)
+    : scene_(scene) {
   bvh_ = std::make_unique<BvhScene>(scene_);
   device_ = std::make_unique<DeviceScene>();
   SyncDevice(*bvh_, device_.get());
@@ -50,11 +47,6 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, std::unique_ptr<Render
 
 CudaRenderer::~CudaRenderer() = default;
 
-std::string CudaRenderer::RgbNotOnGpu(const EffectsFrame* effects) const {
-  if (realtime_->settings().tier == RenderSettings::Tier::kPathtraced) return PathNotOnGpu(effects);
-  return "";
-}
-
 PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
 
 ParallelFn CudaRenderer::HostParallel() {
@@ -65,19 +57,6 @@ ParallelFn CudaRenderer::HostParallel() {
 
 void CudaRenderer::Render(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                           const CameraView& view, RenderedFrame* out) {
-  const std::string rgb_why = view.outputs[ImageKind::kRgb] ? RgbNotOnGpu(effects) : "";
-  if (!rgb_why.empty()) {
-    if (!told_cpu_) {
-      spdlog::info(
-          "renderer: cuda backend: {}: not on the GPU yet; such frames are rendered by the "
-          "CPU renderer (docs/gpu.md)",
-          rgb_why);
-      told_cpu_ = true;
-    }
-    ++cpu_frames_;
-    cpu_->Render(snapshot, effects, view, out);
-    return;
-  }
   const auto t0 = std::chrono::steady_clock::now();
   CheckRenderInputs(scene_.bodies.size(), snapshot, view);
   bvh_->Update(snapshot);

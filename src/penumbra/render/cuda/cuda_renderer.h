@@ -8,9 +8,8 @@
 // realtime tier, rgb and radiance (realtime_shading.h's functions in realtime_kernels.cu; the
 // frame's preparation on the host, realtime_frame.h), and in the pathtraced tier rgb and
 // radiance with media (path_shading.h, since branch gpu14) and particles (path_streaks.h, since
-// branch gpu16) too. a frame the GPU cannot render (RgbNotOnGpu names why; none at present) is
-// rendered whole by the CPU renderer handed in (`cpu`), so every output exists and equals the
-// CPU backend's for those frames; docs/gpu.md lists what is where.
+// branch gpu16) too: every frame of both tiers renders on the GPU (the host prepares each frame
+// and, in the pathtraced tier, denoises and develops it); docs/gpu.md lists what is where.
 
 #include <chrono>
 #include <memory>
@@ -32,27 +31,19 @@ namespace penumbra::cuda {
 /// Renderer on the GPU (see the file comment).
 class CudaRenderer final : public Renderer {
  public:
-  /// copies `scene` and builds its BVH on the host and device. `cpu` renders the frames the GPU
-  /// cannot yet (not null).
+  /// copies `scene` and builds its BVH on the host and device.
   /// @throws Error as BvhScene, or if the CUDA runtime fails.
-  CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu);
+  explicit CudaRenderer(const SceneDescription& scene);
   /// as above, with the render settings of the GPU's rgb (tier, film, anisotropy, seed; the
-  /// two-argument form takes the default RenderSettings).
-  CudaRenderer(const SceneDescription& scene, std::unique_ptr<Renderer> cpu,
-               const RenderSettings& settings);
+  /// one-argument form takes the default RenderSettings).
+  CudaRenderer(const SceneDescription& scene, const RenderSettings& settings);
   ~CudaRenderer() override;
 
   void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
               RenderedFrame* out) override;
 
-  /// "" if a frame's rgb under `effects` renders on the GPU, else why not (the pathtraced tier's
-  /// PathNotOnGpu; every realtime frame, every camera model and every frame's ground truth
-  /// render on the GPU).
-  std::string RgbNotOnGpu(const EffectsFrame* effects) const;
-
-  /// frames rendered on the GPU and on the CPU renderer so far.
+  /// frames rendered so far (every one on the GPU).
   int64_t gpu_frames() const { return gpu_frames_; }
-  int64_t cpu_frames() const { return cpu_frames_; }
 
   /// the scene's BVH (host side) and device copy, for benchmarks.
   const BvhScene& bvh() const { return *bvh_; }
@@ -104,7 +95,6 @@ class CudaRenderer final : public Renderer {
   SceneDescription scene_;
   std::unique_ptr<BvhScene> bvh_;
   std::unique_ptr<DeviceScene> device_;
-  std::unique_ptr<Renderer> cpu_;
   std::unique_ptr<RealtimeFrameData> realtime_;
   std::unique_ptr<DeviceRealtime> device_realtime_;
   std::unique_ptr<DevicePath> device_path_;
@@ -131,9 +121,6 @@ class CudaRenderer final : public Renderer {
   double prepare_ms_ = 0;
   bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;
-  int64_t cpu_frames_ = 0;
-  bool told_cpu_ = false;
-  bool told_rgb_ = false;
 };
 
 }  // namespace penumbra::cuda

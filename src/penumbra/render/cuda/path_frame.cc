@@ -5,13 +5,6 @@
 
 namespace penumbra::cuda {
 
-std::string PathNotOnGpu(const EffectsFrame* effects) {
-  // media are traced by the path kernels (media_scene_math.h; branch gpu14), and so are
-  // particles (path_streaks.h; branch gpu16): no effect sends a frame to the CPU now
-  (void)effects;
-  return "";
-}
-
 const EffectsFrame* EffectsWithoutMedia(const EffectsFrame* effects, EffectsFrame* storage) {
   if (effects == nullptr || (effects->homogeneous_media.empty() && effects->grid_media.empty()))
     return effects;

@@ -23,15 +23,6 @@
 
 namespace penumbra::cuda {
 
-/// why a pathtraced frame under `effects` cannot be traced on the GPU ("" if it can): no effect
-/// now. media (homogeneous and grids) are traced on the GPU since branch gpu14
-/// (PathFrameView::media), particles since branch gpu16 (PathFrameView::streaks, the camera
-/// rays' streaks with the CPU's random draw: path_streaks.h); a camera with lens
-/// distortion or motion (rolling shutter, or the exposure's motion that every frame of a run
-/// has) is on the GPU: its jittered rays come from its ray tables (JitteredCameraRay,
-/// path_shading.h).
-std::string PathNotOnGpu(const EffectsFrame* effects);
-
 /// the emissive geoms of an EmitterSampler as the path kernels take them (PathEmitters over
 /// host arrays: the pods and pick cdf point into the sampler, which must outlive this) and the
 /// frame's poses (SetPoses).
