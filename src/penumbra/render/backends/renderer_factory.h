@@ -30,8 +30,8 @@ CudaDeviceStatus ProbeCudaDevice();
 RenderSettings::Backend ResolveBackend(RenderSettings::Backend backend);
 
 /// the Renderer of settings.backend over `scene` (copied) with `settings`.
-/// backend cuda: the CUDA backend (render/cuda/cuda_renderer.h), with a CPU renderer for the
-/// frames it does not render on the GPU yet.
+/// backend cuda: the CUDA backend (render/cuda/cuda_renderer.h), which renders every frame on
+/// the GPU.
 /// @throws ConfigError for bad settings (settings.ValidateOrThrow), or backend cuda without a
 /// usable CUDA device; Error if the backend
 /// cannot be initialised or the scene refers to missing meshes, height fields, materials or
