@@ -1,12 +1,8 @@
 #include "penumbra/render/cuda/cuda_renderer.h"
 
-#include <spdlog/spdlog.h>
-
 #include <chrono>
 #include <cmath>
-#include <string>
 
-#include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/emitter_sampler.h"

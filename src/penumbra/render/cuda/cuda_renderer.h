@@ -13,7 +13,6 @@
 
 #include <chrono>
 #include <memory>
-#include <string>
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"

@@ -8,7 +8,6 @@
 // RenderPathtracedOnHost runs the GPU path's per-pixel functions on the CPU over the host BVH
 // (tests; the parity check without a GPU). no CUDA runtime here.
 
-#include <string>
 #include <vector>
 
 #include "penumbra/core/image.h"
