@@ -12,10 +12,10 @@
 #include "media_test_util.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/camera.h"
-#include "penumbra/render/media_realtime.h"
 #include "penumbra/render/embree/particle_scene.h"
 #include "penumbra/render/embree/ray_scene.h"
 #include "penumbra/render/light_sampler.h"
+#include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
 
 namespace penumbra::testing {
@@ -176,14 +176,14 @@ TEST(EffectsRebuildTest, RebuiltParticleSceneMatchesFreshOne) {
   media_small.Build(&small);
   ThreadPool pool(2);
   ParticleScene reused;
-  reused.Build(&big, camera, 0.01, true, &pool, &media_big);
+  reused.Build(&big, camera, 0.01, StreakRays::kPixelCentres, &pool, &media_big);
   const int big_size = reused.size();
   EXPECT_GT(big_size, 200);
   EXPECT_GT(reused.culled(), 0);
-  reused.Build(&small, camera, 0.01, true, &pool, &media_small);
+  reused.Build(&small, camera, 0.01, StreakRays::kPixelCentres, &pool, &media_small);
   for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
     ParticleScene fresh;
-    fresh.Build(&small, camera, 0.01, true, p, &media_small);
+    fresh.Build(&small, camera, 0.01, StreakRays::kPixelCentres, p, &media_small);
     EXPECT_EQ(reused.size(), fresh.size());
     EXPECT_EQ(reused.culled(), fresh.culled());
     EXPECT_LE(reused.size() + reused.culled(), 5000);  // drops outside the view are skipped
@@ -205,7 +205,7 @@ TEST(EffectsRebuildTest, RebuiltParticleSceneMatchesFreshOne) {
     }
     EXPECT_GT(hits, 100);
   }
-  reused.Build(&none, camera, 0.01, true, &pool, nullptr);
+  reused.Build(&none, camera, 0.01, StreakRays::kPixelCentres, &pool, nullptr);
   EXPECT_TRUE(reused.empty());
   ParticleHit h;
   EXPECT_FALSE(reused.PixelHit(camera.GenerateRay(40, 30), 40, 30, 1e30f, &h));
@@ -255,8 +255,8 @@ void ExpectSkippedDropsChangeNoHit(bool moving) {
   MediaScene media;
   media.Build(&all);
   ParticleScene a, b;
-  a.Build(&all, camera, 0.01, true, nullptr, &media);
-  b.Build(&near, camera, 0.01, true, nullptr, &media);
+  a.Build(&all, camera, 0.01, StreakRays::kPixelCentres, nullptr, &media);
+  b.Build(&near, camera, 0.01, StreakRays::kPixelCentres, nullptr, &media);
   EXPECT_EQ(a.size(), b.size());
   EXPECT_EQ(a.culled(), b.culled());
   int hits = 0;
@@ -303,7 +303,7 @@ TEST(EffectsRebuildTest, DropJustOutsideTheImageStillCoversItsBorderPixels) {
   sparks.radius_m.push_back(static_cast<float>(3.0 * depth / k.fx));
   fx.particles.push_back(sparks);
   ParticleScene scene;
-  scene.Build(&fx, camera, 0.01, true, nullptr, nullptr);
+  scene.Build(&fx, camera, 0.01, StreakRays::kPixelCentres, nullptr, nullptr);
   ASSERT_EQ(scene.size(), 1);
   ParticleHit h;
   const int row = static_cast<int>(v);

@@ -213,7 +213,7 @@ TEST(ParticleMathTest, ShadeEqualsTheOldCodeBitForBit) {
   CameraIntrinsics k = CameraIntrinsics::FromFovy(64, 48, 60);
   const Camera camera(Pose::Identity(), k);
   ParticleStreaks streaks;
-  streaks.Build(&fx, camera, 0.01, false);
+  streaks.Build(&fx, camera, 0.01, StreakRays::kAny);
   ASSERT_EQ(streaks.size(), 900);
   const Eigen::Vector3f sky_ambient(2100, 2300, 2900);
   streaks.PrecomputeRain(lights, sky_ambient, nullptr, nullptr);

@@ -76,20 +76,20 @@ TEST(ParticleShelterTest, RainFallsOnlyUnderTheOpenSky) {
   fx.particles.push_back(rain);
   const Camera camera(CameraLookingDown({0, 0, 30}), CameraIntrinsics::FromFovy(64, 64, 60));
   ParticleScene open, covered;
-  open.Build(&fx, camera, 0.01, false, nullptr, nullptr, nullptr);
-  covered.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
+  open.Build(&fx, camera, 0.01, StreakRays::kAny, nullptr, nullptr, nullptr);
+  covered.Build(&fx, camera, 0.01, StreakRays::kAny, nullptr, nullptr, &map);
   EXPECT_EQ(open.size(), inside + outside);
   EXPECT_EQ(covered.size(), outside);
   // a set that opts out (the effect's `sheltered: false`) falls indoors too.
   fx.particles[0].sheltered = false;
   ParticleScene leaking;
-  leaking.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
+  leaking.Build(&fx, camera, 0.01, StreakRays::kAny, nullptr, nullptr, &map);
   EXPECT_EQ(leaking.size(), inside + outside);
   fx.particles[0].sheltered = true;
   // sparks are never sheltered.
   fx.particles[0].kind = ParticleKind::kSpark;
   ParticleScene sparks;
-  sparks.Build(&fx, camera, 0.01, false, nullptr, nullptr, &map);
+  sparks.Build(&fx, camera, 0.01, StreakRays::kAny, nullptr, nullptr, &map);
   EXPECT_EQ(sparks.size(), inside + outside);
 }
 

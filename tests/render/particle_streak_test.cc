@@ -133,10 +133,10 @@ TEST(ParticleSceneTest, FirstNonFiniteParticleIsReported) {
   const Camera camera(view.X_WO, view.intrinsics);
   ThreadPool pool(2);
   for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
-    for (bool pixel_hits : {false, true}) {
+    for (StreakRays rays : {StreakRays::kAny, StreakRays::kCamera, StreakRays::kPixelCentres}) {
       ParticleScene scene;
       try {
-        scene.Build(&fx, camera, 0.01, pixel_hits, p);
+        scene.Build(&fx, camera, 0.01, rays, p);
         ADD_FAILURE() << "expected a ConfigError";
       } catch (const ConfigError& e) {
         EXPECT_EQ(e.key(), "effects.particles[1]");
@@ -151,8 +151,75 @@ TEST(ParticleSceneTest, FirstNonFiniteParticleIsReported) {
   fx.particles[1].radius_m[6000] = 0.001f;
   fx.particles[2].position_W[10].x() = 5;
   ParticleScene scene;
-  scene.Build(&fx, camera, 0.01, true, &pool);
+  scene.Build(&fx, camera, 0.01, StreakRays::kPixelCentres, &pool);
   EXPECT_EQ(scene.size() + scene.culled(), 27000);
+}
+
+// the camera's rays (StreakRays::kCamera, the pathtraced tier's jittered samples) meet the
+// same nearest streak whether the drops outside the view pyramid were left out or not: a
+// still and a moving camera (turning and travelling during a rolling-shutter readout), rays
+// through random points of the image and along its edges and corners.
+TEST(ParticleSceneTest, CameraRaysMeetEveryStreakTheyWouldWithoutTheViewCull) {
+  EffectsFrame fx;
+  uint64_t state = 12345;
+  auto uniform = [&state] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state >> 40) / static_cast<float>(1 << 24);
+  };
+  // drops all around the camera (at the origin), 0.3 to 6 m away, some large and slow.
+  for (ParticleKind kind : {ParticleKind::kRain, ParticleKind::kSnow}) {
+    ParticleSet ps;
+    ps.kind = kind;
+    for (int i = 0; i < 20000; ++i) {
+      const float r = 0.3f + 5.7f * uniform();
+      Eigen::Vector3f dir(2 * uniform() - 1, 2 * uniform() - 1, 2 * uniform() - 1);
+      if (!(dir.norm() > 1e-3f)) dir = Eigen::Vector3f(1, 0, 0);
+      ps.position_W.push_back(r * dir.normalized());
+      ps.velocity_W.emplace_back(uniform() - 0.5f, uniform() - 0.5f, -2 - 6 * uniform());
+      ps.radius_m.push_back(i % 50 == 0 ? 0.05f : 0.0005f + 0.002f * uniform());
+    }
+    fx.particles.push_back(ps);
+  }
+  const CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60.0);
+  CameraMotion motion;
+  motion.end_sec = 0.03;
+  motion.time_sec = 0.002;
+  motion.line_time_sec = 0.0004;
+  motion.X_WO_end = view.X_WO;
+  motion.X_WO_end.linear() =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix() *
+      view.X_WO.linear();
+  motion.X_WO_end.translation() += Eigen::Vector3d(0.1, -0.2, 0.05);
+  const int W = view.intrinsics.width, H = view.intrinsics.height;
+  for (const Camera& camera :
+       {Camera(view.X_WO, view.intrinsics), Camera(view.X_WO, view.intrinsics, motion)}) {
+    ParticleScene all, seen;
+    all.Build(&fx, camera, 0.01, StreakRays::kAny);
+    seen.Build(&fx, camera, 0.01, StreakRays::kCamera);
+    // most drops lie outside the view (a 60 x 80 degree pyramid of the whole sphere).
+    EXPECT_LT(seen.size(), all.size() / 3) << "moving " << camera.motion().moving();
+    int hits = 0;
+    auto check = [&](float u, float v) {
+      const Ray ray = camera.GenerateRay(u, v);
+      ParticleHit a, b;
+      const bool ha = all.Intersect(ray, 1e9f, &a), hb = seen.Intersect(ray, 1e9f, &b);
+      ASSERT_EQ(ha, hb) << "ray through (" << u << ", " << v << ")";
+      if (!ha) return;
+      ++hits;
+      EXPECT_EQ(a.t, b.t);
+      EXPECT_EQ(all.ends()[2 * a.prim], seen.ends()[2 * b.prim]);
+    };
+    for (int i = 0; i < 200000; ++i) check(W * uniform() - 0.5f, H * uniform() - 0.5f);
+    // the image's edges and corners (u = -0.5, W - 0.5; v = -0.5, H - 0.5).
+    for (int i = 0; i <= 4000; ++i) {
+      const float a = static_cast<float>(i) / 4000;
+      check(-0.5f, H * a - 0.5f);
+      check(W - 0.5f, H * a - 0.5f);
+      check(W * a - 0.5f, -0.5f);
+      check(W * a - 0.5f, H - 0.5f);
+    }
+    EXPECT_GT(hits, 5000) << "moving " << camera.motion().moving();
+  }
 }
 
 }  // namespace

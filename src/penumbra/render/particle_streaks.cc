@@ -67,7 +67,7 @@ bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vecto
 
 }  // namespace
 void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-                            bool pixel_hits, ThreadPool* pool, const MediaScene* media,
+                            StreakRays rays, ThreadPool* pool, const MediaScene* media,
                             const ShelterMap* shelter) {
   fx_ = fx;
   count_ = 0;
@@ -101,6 +101,7 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   const size_t n_all = first.back();
   if (n_all == 0) return;
   const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
+  const bool pixel_hits = rays == StreakRays::kPixelCentres;
   // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
   // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
   // would give them an empty pixel box: it clips at kPixelNear + radius >= kPixelNear).
@@ -108,16 +109,18 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
   auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
-  // realtime with a pinhole camera: the outward unit normals (world) of the four side planes of
-  // the pyramid of the pixel-centre rays widened by half a pixel (at the pose X_WO), to skip
-  // the drops no pixel ray can meet (`outside` below).
-  const bool frustum = pixel_hits && !camera.intrinsics().has_distortion();
+  // a camera's rays through a lens without distortion: the outward unit normals (world) of the
+  // four side planes of the pyramid of the pixel-centre rays widened by half a pixel (at the
+  // pose X_WO), which holds every ray through the image (pixel samples jittered within their
+  // pixel too), to skip the drops no such ray can meet (`outside` below).
+  const bool frustum = rays != StreakRays::kAny && !camera.intrinsics().has_distortion();
   Eigen::Vector3f side_W[4];
   // a moving camera (camera.h: pose slerped / lerped at a = (time_sec + line_time_sec v) /
   // end_sec for row v) sees row v from o(a), turned by |a| theta from X_WO (theta the rotation
   // from X_WO to X_WO_end): the planes then move by at most turn |x - cam_o| + shift at a
-  // point x, with turn and shift the largest |a| over the rows times theta and times the
-  // translation (1 % and 1e-6 to spare).
+  // point x, with turn and shift the largest |a| over the rows (v in [-0.5, height]: jittered
+  // samples reach the image's edge) times theta and times the translation (1 % and 1e-6 to
+  // spare).
   float turn = 0, shift = 0;
   const bool moving = camera.motion().moving();
   if (frustum) {
@@ -130,9 +133,9 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
       side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
     if (moving) {
       const CameraMotion& m = camera.motion();
-      const double a_max =
-          std::max(std::abs(m.time_sec), std::abs(m.time_sec + m.line_time_sec * k.height)) /
-          m.end_sec;
+      const double a_max = std::max(std::abs(m.time_sec - 0.5 * m.line_time_sec),
+                                    std::abs(m.time_sec + m.line_time_sec * k.height)) /
+                           m.end_sec;
       const Eigen::Quaterniond q0(camera.X_WO().linear()), q1(m.X_WO_end.linear());
       const double theta =
           2.0 * std::acos(std::min(1.0, std::abs(q0.normalized().dot(q1.normalized()))));

@@ -10,9 +10,10 @@
 // projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
 // (Quilez's ray-capsule test, render/particle_math.h's IntersectCapsule), keeping the nearest
 // streak per pixel (ties: lower index), which costs the streaks' screen area rather than a BVH
-// traversal per pixel. with a pinhole camera that does not move, drops whose widened capsule lies
-// wholly outside the pyramid of the pixel rays are skipped first (no streak, not counted as culled;
-// they could not be drawn). streaks thinner than half a pixel at their distance are widened to half
+// traversal per pixel. for the camera's rays of either tier (StreakRays) and a lens without
+// distortion, drops whose widened capsule lies wholly outside the pyramid of the camera's rays
+// (still, or moving over the rows) are skipped first (no streak, not counted as culled; they
+// could not be drawn). streaks thinner than half a pixel at their distance are widened to half
 // a pixel (radius 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel
 // drops keep their average contribution instead of aliasing away with one ray per pixel.
 //
@@ -68,6 +69,22 @@ namespace penumbra {
 /// not drawn in the realtime tier (one 8-bit step of display-linear contrast; see above).
 constexpr float kRainCullContrast = 1.0f / 255.0f;
 
+/// which rays a ParticleStreaks::Build serves, and so which drops it may leave out.
+enum class StreakRays : uint8_t {
+  /// rays from anywhere: every drop with a positive radius (unsheltered) is a streak.
+  kAny,
+  /// the camera's rays through any point of its image (the pathtraced tier's camera rays, whose
+  /// pixel samples are jittered over the whole pixel): with a lens without distortion, the drops
+  /// whose widened capsule lies wholly outside the camera's view pyramid (every pixel's area,
+  /// widened by half a pixel at the drop's distance; for a moving camera, by the pyramid's
+  /// motion over the rows) are left out, since no such ray can meet them.
+  kCamera,
+  /// the pixel-centre rays of the realtime tier: as kCamera, and the drops wholly behind the
+  /// near plane and the invisible rain streaks (kRainCullContrast) are left out, and each
+  /// pixel's nearest streak is found (PixelHit).
+  kPixelCentres,
+};
+
 /// the nearest streak along a ray.
 struct ParticleHit {
   float t = 0;                    ///< ray parameter (units of |ray.d|)
@@ -89,15 +106,15 @@ class ParticleStreaks {
   /// exposure_time_sec (>= 0). the frame must outlive this object until the next Build.
   /// @throws ConfigError if a set's arrays differ in length or hold non-finite values
   /// (key effects.particles[i]).
-  /// pixel_hits: build the per-pixel nearest streaks of the camera's pixel-centre rays
-  /// (PixelHit; else the streaks only, e.g. for ParticleScene's ray tracing), in bands of rows
-  /// over `pool` (may be null). with pixel_hits, invisible rain streaks are culled
-  /// (kRainCullContrast) using the homogeneous media of `media` (may be null: coverage alone).
-  /// `shelter` (may be null): rain drops and snowflakes that it shelters (static geometry
+  /// `rays`: the rays the streaks serve (StreakRays), which decides the drops left out; with
+  /// kPixelCentres the per-pixel nearest streaks of the camera's pixel-centre rays are built
+  /// too (PixelHit), in bands of rows over `pool` (may be null), and invisible rain streaks are
+  /// culled (kRainCullContrast) using the homogeneous media of `media` (may be null: coverage
+  /// alone). `shelter` (may be null): rain drops and snowflakes that it shelters (static geometry
   /// above them) are not drawn unless their set says otherwise (ParticleSet::sheltered);
   /// sparks always are.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
+             StreakRays rays, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
              const ShelterMap* shelter = nullptr);
 
   bool empty() const { return count_ == 0; }
@@ -105,13 +122,13 @@ class ParticleStreaks {
   /// rain streaks culled as invisible by the last Build.
   int culled() const { return culled_; }
 
-  /// whether some streak meets pixel (u, v)'s pixel-centre ray (Build with pixel_hits; false
-  /// without): PixelHit with tmax = infinity would find it, without the ray.
+  /// whether some streak meets pixel (u, v)'s pixel-centre ray (Build with kPixelCentres;
+  /// false without): PixelHit with tmax = infinity would find it, without the ray.
   bool PixelHasStreak(int u, int v) const {
     return pixel_hits_built_ && pixel_[static_cast<size_t>(v) * pixel_w_ + u].prim >= 0;
   }
   /// the nearest streak of the pixel-centre camera ray `ray` of pixel (u, v) within (0, tmax]
-  /// (Build with pixel_hits); false if none.
+  /// (Build with kPixelCentres); false if none.
   bool PixelHit(const Ray& ray, int u, int v, float tmax, ParticleHit* hit) const;
 
   /// evaluates every rain streak's radiance once, at its centre (rain shading does not depend

@@ -21,7 +21,7 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
   wetness_ = 0;
   if (!active_) {
     media_.Build(nullptr);
-    particles_.Build(nullptr, camera, 0, false);
+    particles_.Build(nullptr, camera, 0, StreakRays::kAny);
     return;
   }
   // sky: moved sun and luminance scale (render/effects_sky.h, shared with the CUDA backend).
@@ -57,7 +57,8 @@ void MediaFrame::Prepare(const WorldSnapshot& snapshot, const EffectsFrame* effe
   bool sheltered = false;
   for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
-  particles_.Build(fx, camera, view.exposure_time_sec, realtime, pool,
+  particles_.Build(fx, camera, view.exposure_time_sec,
+                   realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool,
                    media_.empty() ? nullptr : &media_, sheltered ? &shelter_ : nullptr);
   if (!particles_.empty()) particles_.PrecomputeRain(lights, sky_ambient_, occluded_sky, pool);
 }

@@ -182,7 +182,7 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   path_streaks_.Clear();
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   if (fx == nullptr || fx->particles.empty()) {
-    particles_.Build(nullptr, camera, 0, false);
+    particles_.Build(nullptr, camera, 0, StreakRays::kAny);
     return;
   }
   const bool realtime = settings_.tier == RenderSettings::Tier::kRealtime;
@@ -194,7 +194,8 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
-  particles_.Build(fx, camera, view.exposure_time_sec, realtime, pool, media,
+  particles_.Build(fx, camera, view.exposure_time_sec,
+                   realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
                    sheltered ? &shelter_ : nullptr);
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);

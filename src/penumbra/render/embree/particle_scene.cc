@@ -20,14 +20,14 @@ ParticleScene::ParticleScene() : impl_(std::make_unique<Impl>()) {}
 ParticleScene::~ParticleScene() = default;
 
 void ParticleScene::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-                          bool pixel_hits, ThreadPool* pool, const MediaScene* media,
+                          StreakRays rays, ThreadPool* pool, const MediaScene* media,
                           const ShelterMap* shelter) {
   if (impl_->scene) {
     rtcReleaseScene(impl_->scene);
     impl_->scene = nullptr;
   }
-  ParticleStreaks::Build(fx, camera, exposure_time_sec, pixel_hits, pool, media, shelter);
-  if (count_ == 0 || pixel_hits) return;
+  ParticleStreaks::Build(fx, camera, exposure_time_sec, rays, pool, media, shelter);
+  if (count_ == 0 || rays == StreakRays::kPixelCentres) return;
   if (!impl_->device) {
     impl_->device = rtcNewDevice(nullptr);
     if (!impl_->device) throw Error("ParticleScene: cannot create the Embree device");

@@ -18,15 +18,15 @@ class ParticleScene : public ParticleStreaks {
   ParticleScene();
   ~ParticleScene();
 
-  /// ParticleStreaks::Build; without pixel_hits also the Embree scene of the streaks
-  /// (Intersect).
+  /// ParticleStreaks::Build; for rays other than kPixelCentres also the Embree scene of the
+  /// streaks (Intersect).
   /// @throws as ParticleStreaks::Build; Error if the Embree device cannot be created.
   void Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
-             bool pixel_hits, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
+             StreakRays rays, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
              const ShelterMap* shelter = nullptr);
 
-  /// nearest streak along `ray` within [ray.tmin, tmax] (Build without pixel_hits); false if
-  /// none.
+  /// nearest streak along `ray` within [ray.tmin, tmax] (Build for rays other than
+  /// kPixelCentres); false if none.
   bool Intersect(const Ray& ray, float tmax, ParticleHit* hit) const;
 
  private:
