@@ -5,14 +5,16 @@
 # the GPU and the CPU;
 # batches of 1, 64 and 1024 cameras at 128x128 in the house, depth+seg
 # and realtime rgb+depth with its stages' GPU times; copy rates), the pathtraced tier's frame
-# time beside the CPU backend's (default, house and fog, 320x240, 64 samples per pixel), the parity
-# table (parity.sh), and prints one summary table, then the measurements (docs/gpu.md).
+# time beside the CPU backend's (default, house, fog, rain and snow, 320x240, 64 samples per
+# pixel), the smoke_plume and fire grids' media frames as in a run (--media: a new grid every
+# frame), the parity table (parity.sh), and prints one summary table, then the measurements
+# (docs/gpu.md).
 #
 #   scripts/gpu/check.sh [tarball|unpacked-folder] [benchmark frames]
 #                                           (default .gpu/penumbra-gpu.tar.xz, 50)
 #   CHECK_LOG_DIR=DIR CHECK_LIMIT_S=60 scripts/gpu/check.sh ...  (logs kept in DIR; the steps'
 #   limits are multiples of CHECK_LIMIT_S: gpu tests 3x, batch 1.5x, parity 2x, bench 1.5x,
-#   sessions 0.75x, pathtraced bench 1x, host tests 1x)
+#   sessions 0.75x, pathtraced bench 1x, media bench 0.75x, host tests 1x)
 set -uo pipefail
 tarball=${1:-.gpu/penumbra-gpu.tar.xz}
 frames=${2:-50}
@@ -63,6 +65,11 @@ timeout "$limit" "$pkg/bin/render_cuda_bench" --pathtraced --spp 64 --size 320x2
   "$pkg/src/worlds/effects/fog.yaml" "$pkg/src/worlds/effects/rain.yaml" \
   "$pkg/src/worlds/effects/snow.yaml" > "$log/pathtraced.txt" 2>&1
 path_rc=$?
+# the grid media as in a run: a new smoke / fire grid every frame, uploaded every frame
+timeout $((limit * 3 / 4)) "$pkg/bin/render_cuda_bench" --media --frames 30 \
+  "$pkg/src/worlds/effects/smoke_plume.yaml" "$pkg/src/worlds/effects/fire.yaml" \
+  > "$log/media.txt" 2>&1
+media_rc=$?
 timeout "$limit" "$pkg/bin/render_cuda_tests" > "$log/host.txt" 2>&1
 host_rc=$?
 verdict() { [ "$1" -eq 0 ] && echo "pass" || echo "FAIL (rc $1)"; }
@@ -77,6 +84,7 @@ echo "| batch bench (house, 128x128) | $(verdict $batch_rc) |"
 echo "| batch bench, 4 sessions | $(verdict $sessions_rc) |"
 echo "| parity table | $(verdict $parity_rc) |"
 echo "| pathtraced bench (320x240, 64 spp) | $(verdict $path_rc) |"
+echo "| media bench (grids as in a run) | $(verdict $media_rc) |"
 # the benchmark rows, cuda beside cpu: single camera (world, size, outputs, backend, timed,
 # frames/s) and batches (world, size, outputs, cameras, backend, timed, frames/s)
 awk -F'|' 'NF == 9 && $2 ~ /yaml/ {
@@ -104,5 +112,8 @@ echo "== batch, sessions"; grep -v '^\[20' "$log/sessions.txt"
 echo
 echo "== pathtraced"; grep -v '^\[20' "$log/pathtraced.txt"
 echo
+echo "== media (device-built volumes; last row of each world: a new grid every frame)"
+grep -v '^\[20' "$log/media.txt"
+echo
 echo "== parity"; cat "$log/parity.txt"
-exit $(( host_rc | gpu_rc | bench_rc | batch_rc | sessions_rc | parity_rc | path_rc ))
+exit $(( host_rc | gpu_rc | bench_rc | batch_rc | sessions_rc | parity_rc | path_rc | media_rc ))
