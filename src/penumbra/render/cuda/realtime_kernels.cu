@@ -203,6 +203,19 @@ __global__ void SkyQuadKernel(Frames frames, Float3* sky) {
   QuadSkyTerms(f.sky, f.volume, f.geometry, W, H, 2 * qu, 2 * qv, sky + CameraOffset(f));
 }
 
+// one thread per pixel (RealtimeKernelOptions::sky_per_pixel): a quad's four pixels lie in one
+// warp (16 x 2 pixels from an even row).
+template <class Frames>
+__global__ void SkyPixelKernel(Frames frames, Float3* sky) {
+  const RealtimeFrameView& f = frames.get();
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  const int W = f.camera.width, H = f.camera.height;
+  if (u >= W || v >= H) return;
+  QuadPixelSkyTerm(f.sky, f.volume, f.geometry, W, H, u & ~1, v & ~1, (u & 1) | ((v & 1) << 1),
+                   sky + CameraOffset(f));
+}
+
 template <class Frames>
 __global__ void MirrorSkyKernel(Frames frames, Float3* mirror_sky) {
   const RealtimeFrameView& f = frames.get();
@@ -711,7 +724,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   cudaStream_t copy_stream = nullptr;
   // mirror_stream: the mirror layer's kernels' stream, the event it forks at (the primary
   // geometry traced) and the one it joins at (the mirrored radiance shaded)
-  cudaStream_t side_stream = nullptr;
+  cudaStream_t side_stream = nullptr, side_stream_high = nullptr;  // lowest, highest priority
   cudaEvent_t mirror_fork = nullptr, mirror_join = nullptr;
   // fuse_resolve: band k of the radiance is final (its copy back waits for it)
   cudaEvent_t resolved_band[kMaxSkyBands] = {};
@@ -959,9 +972,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
       // mirror_stream: the mirror layer forks here, beside the rest of the frame
       cudaStream_t s = stream;
       if (ForkMirror(f, o)) {
+        s = Side(o);
         Check(cudaEventRecord(mirror_fork, stream), "cudaEventRecord");
-        Check(cudaStreamWaitEvent(side_stream, mirror_fork, 0), "cudaStreamWaitEvent");
-        s = side_stream;
+        Check(cudaStreamWaitEvent(s, mirror_fork, 0), "cudaStreamWaitEvent");
       }
       MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, s>>>(
           OneFrame{f});
@@ -974,16 +987,23 @@ struct DeviceRealtime::Impl : PixelBuffers {
     return o.mirror_stream && o.device_sky && sky_uploaded && side_stream != nullptr &&
            f.any_mirror != 0;
   }
+  // the side stream as `o` says (mirror_low_priority)
+  cudaStream_t Side(const RealtimeKernelOptions& o) const {
+    return o.mirror_low_priority ? side_stream : side_stream_high;
+  }
   // the sky terms of frame f (its geometry and mirrored rays traced) on `stream`; mirror_stream:
   // the mirrored rays' sky terms and shading on the side stream, which then joins.
   void LaunchSky(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
-    SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
-        OneFrame{f}, sky.as<Float3>());
+    if (o.sky_per_pixel)
+      SkyPixelKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(OneFrame{f}, sky.as<Float3>());
+    else
+      SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
+          OneFrame{f}, sky.as<Float3>());
     Check(cudaGetLastError(), "SkyQuadKernel");
     if (f.any_mirror != 0) {
       const bool fork = ForkMirror(f, o);
-      cudaStream_t s = fork ? side_stream : stream;
+      cudaStream_t s = fork ? Side(o) : stream;
       MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, s>>>(OneFrame{f}, mirror_sky.as<Float3>());
       Check(cudaGetLastError(), "MirrorSkyKernel");
       if (fork) {
@@ -1134,6 +1154,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   ~Impl() {
     if (copy_stream) cudaStreamDestroy(copy_stream);
     if (side_stream) cudaStreamDestroy(side_stream);
+    if (side_stream_high) cudaStreamDestroy(side_stream_high);
     if (mirror_fork) cudaEventDestroy(mirror_fork);
     if (mirror_join) cudaEventDestroy(mirror_join);
     for (cudaEvent_t e : resolved_band)
@@ -1255,7 +1276,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.rgb_copied, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.radiance_band)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
-    Check(cudaStreamCreateWithFlags(&m.side_stream, cudaStreamNonBlocking), "cudaStreamCreate");
+    int least = 0, greatest = 0;
+    Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "cudaDeviceGetStreamPriorityRange");
+    Check(cudaStreamCreateWithPriority(&m.side_stream, cudaStreamNonBlocking, least),
+          "cudaStreamCreate");
+    Check(cudaStreamCreateWithPriority(&m.side_stream_high, cudaStreamNonBlocking, greatest),
+          "cudaStreamCreate");
     Check(cudaEventCreateWithFlags(&m.mirror_fork, cudaEventDisableTiming), "cudaEventCreate");
     Check(cudaEventCreateWithFlags(&m.mirror_join, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.resolved_band)
