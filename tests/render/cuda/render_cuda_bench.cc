@@ -332,7 +332,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     copy_variants.back().fuse_resolve = false;
     copy_variants.push_back(fast);
     copy_variants.back().mirror_stream = copy_variants.back().fuse_resolve = false;
-    copy_variants.back().sky_per_pixel = false;
     // second to last: the default into a new RenderedFrame every frame (as the camera sink's
     // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
     // default without the radiance (CudaRenderer::set_radiance_output)
@@ -374,7 +373,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
         extra += fmt::format(", host copies over the pool above {} KiB", o.serial_copy_kib);
       if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
       if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
-      if (!o.sky_per_pixel) extra += ", sky terms per quad";
       if (no_radiance) extra += ", no radiance asked for";
       if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
@@ -489,11 +487,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.mirror_low_priority = false;
     variants.push_back({"kernels, mirror layer's stream of the frame's priority", o});
-    o = fast;
-    o.sky_per_pixel = false;
-    variants.push_back({"kernels, sky terms one thread per quad", o});
-    o.mirror_stream = o.fuse_resolve = false;
-    variants.push_back({"kernels, gpu19's changes off (as before)", o});
+
     o = fast;
     o.rows_per_warp = false;
     variants.push_back({"kernels, row sums per thread", o});
@@ -501,7 +495,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_surface = false;
     o.warp_penumbra = false;
     o.queue_penumbra = false;
-    o.mirror_stream = o.fuse_resolve = o.sky_per_pixel = false;
+    o.mirror_stream = o.fuse_resolve = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

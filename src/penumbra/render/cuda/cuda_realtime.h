@@ -143,11 +143,6 @@ struct RealtimeKernelOptions {
   /// stream (DeviceScene's, the highest), so the mirror layer's blocks take the SMs the frame's
   /// own kernels leave; else the same priority as the frame's stream.
   bool mirror_low_priority = true;
-  /// the sky-term kernel runs one thread per pixel (QuadPixelSkyTerm: a flat quad's shared blend
-  /// made again by each of its four threads, the same values) instead of one per 2x2 quad
-  /// (QuadSkyTerms, four pixels in turn): four times the threads for a kernel whose time is one
-  /// thread's chain of lookups. with device_sky.
-  bool sky_per_pixel = true;
   /// the shared visibility's resolve and the mirror blend in one kernel (the mirrored radiance
   /// shaded before it), launched in the radiance's output_bands bands of rows, each band's copy
   /// back behind its own event (without media and streaks, which change the radiance after

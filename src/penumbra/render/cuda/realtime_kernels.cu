@@ -203,19 +203,6 @@ __global__ void SkyQuadKernel(Frames frames, Float3* sky) {
   QuadSkyTerms(f.sky, f.volume, f.geometry, W, H, 2 * qu, 2 * qv, sky + CameraOffset(f));
 }
 
-// one thread per pixel (RealtimeKernelOptions::sky_per_pixel): a quad's four pixels lie in one
-// warp (16 x 2 pixels from an even row).
-template <class Frames>
-__global__ void SkyPixelKernel(Frames frames, Float3* sky) {
-  const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  const int W = f.camera.width, H = f.camera.height;
-  if (u >= W || v >= H) return;
-  QuadPixelSkyTerm(f.sky, f.volume, f.geometry, W, H, u & ~1, v & ~1, (u & 1) | ((v & 1) << 1),
-                   sky + CameraOffset(f));
-}
-
 template <class Frames>
 __global__ void MirrorSkyKernel(Frames frames, Float3* mirror_sky) {
   const RealtimeFrameView& f = frames.get();
@@ -995,11 +982,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the mirrored rays' sky terms and shading on the side stream, which then joins.
   void LaunchSky(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
-    if (o.sky_per_pixel)
-      SkyPixelKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(OneFrame{f}, sky.as<Float3>());
-    else
-      SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
-          OneFrame{f}, sky.as<Float3>());
+    SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
+        OneFrame{f}, sky.as<Float3>());
     Check(cudaGetLastError(), "SkyQuadKernel");
     if (f.any_mirror != 0) {
       const bool fork = ForkMirror(f, o);

@@ -589,59 +589,6 @@ PB_HOST_DEVICE inline Float3 PixelSkyTerm(const SkyModelPod& sky, const SkyVolum
   return Float3{e[0], e[1], e[2]};
 }
 
-/// whether the 2x2 quad at even (u0, v0) shares one probe blend (QuadSkyTerms' test: a sky
-/// volume, the quad inside the image above row1, one flat face); *mean: the blend's point, the
-/// quad's mean hit point (set where it shares one).
-PB_HOST_DEVICE inline bool QuadSharesSkyBlend(const SkyVolumePod& volume,
-                                              const PixelGeometry* geometry, int width, int row1,
-                                              int u0, int v0, float mean[3]) {
-  const int64_t i00 = static_cast<int64_t>(v0) * width + u0;
-  const int64_t quad[4] = {i00, i00 + 1, i00 + width, i00 + width + 1};
-  const bool occluded = !volume.empty();
-  bool shared = occluded && u0 + 1 < width && v0 + 1 < row1;
-  if (!shared) return false;
-  const PixelGeometry& g0 = geometry[quad[0]];
-  for (int c = 0; c < 4 && shared; ++c) {
-    const PixelGeometry& g = geometry[quad[c]];
-    shared = g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
-             g.ng.z == g0.ng.z;
-  }
-  const float max_extent = 0.25f * volume.spacing;
-  constexpr float kPlaneTolM = 1e-3f;
-  mean[0] = mean[1] = mean[2] = 0;
-  for (int c = 0; c < 4 && shared; ++c) {
-    const PixelGeometry& g = geometry[quad[c]];
-    const float dp[3] = {g.p_or_d.x - g0.p_or_d.x, g.p_or_d.y - g0.p_or_d.y,
-                         g.p_or_d.z - g0.p_or_d.z};
-    const float n_dp = g0.ng.x * dp[0] + (g0.ng.y * dp[1] + g0.ng.z * dp[2]);
-    shared = fabsf(n_dp) <= kPlaneTolM && fabsf(dp[0]) <= max_extent &&
-             fabsf(dp[1]) <= max_extent && fabsf(dp[2]) <= max_extent;
-    mean[0] += 0.25f * g.p_or_d.x;
-    mean[1] += 0.25f * g.p_or_d.y;
-    mean[2] += 0.25f * g.p_or_d.z;
-  }
-  return shared;
-}
-
-/// a shared quad's blend (QuadSharesSkyBlend: at `mean`, the geometric normal of its first
-/// pixel g0) evaluated at the shading normal of each of `count` of its pixels into *out[k].
-PB_HOST_DEVICE inline void QuadSkyBlendTerm(const SkyModelPod& sky, const SkyVolumePod& volume,
-                                            const PixelGeometry& g0, const float mean[3],
-                                            const PixelGeometry* const* pixels, Float3* const* out,
-                                            int count) {
-  const float n0[3] = {g0.ng.x, g0.ng.y, g0.ng.z};
-  float c[kSkyShStride];
-  bool open_sky;
-  SkyVolumeBlend(volume, mean, n0, c, &open_sky);
-  for (int k = 0; k < count; ++k) {
-    const PixelGeometry& g = *pixels[k];
-    const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
-    float e[3];
-    SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
-    *out[k] = Float3{e[0], e[1], e[2]};
-  }
-}
-
 /// the sky terms (RealtimeFrameView::sky_term) of the 2x2 quad at even (u0, v0) of a
 /// width-pixel image (pixels at or below row1 and right of the image left out), as
 /// RealtimeIntegrator's TileSkyIrradiance: with a sky volume, a quad whose pixels see one flat
@@ -653,36 +600,47 @@ PB_HOST_DEVICE inline void QuadSkyTerms(const SkyModelPod& sky, const SkyVolumeP
                                         int v0, Float3* out) {
   const int64_t i00 = static_cast<int64_t>(v0) * width + u0;
   const int64_t quad[4] = {i00, i00 + 1, i00 + width, i00 + width + 1};
-  float mean[3];
-  if (QuadSharesSkyBlend(volume, geometry, width, row1, u0, v0, mean)) {
-    const PixelGeometry* const pixels[4] = {&geometry[quad[0]], &geometry[quad[1]],
-                                            &geometry[quad[2]], &geometry[quad[3]]};
-    Float3* const terms[4] = {&out[quad[0]], &out[quad[1]], &out[quad[2]], &out[quad[3]]};
-    QuadSkyBlendTerm(sky, volume, geometry[quad[0]], mean, pixels, terms, 4);
-    return;
+  const bool occluded = !volume.empty();
+  bool shared = occluded && u0 + 1 < width && v0 + 1 < row1;
+  if (shared) {
+    const PixelGeometry& g0 = geometry[quad[0]];
+    for (int c = 0; c < 4 && shared; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      shared = g.hit != 0 && g.geom == g0.geom && g.ng.x == g0.ng.x && g.ng.y == g0.ng.y &&
+               g.ng.z == g0.ng.z;
+    }
+    const float max_extent = 0.25f * volume.spacing;
+    constexpr float kPlaneTolM = 1e-3f;
+    float mean[3] = {0, 0, 0};
+    for (int c = 0; c < 4 && shared; ++c) {
+      const PixelGeometry& g = geometry[quad[c]];
+      const float dp[3] = {g.p_or_d.x - g0.p_or_d.x, g.p_or_d.y - g0.p_or_d.y,
+                           g.p_or_d.z - g0.p_or_d.z};
+      const float n_dp = g0.ng.x * dp[0] + (g0.ng.y * dp[1] + g0.ng.z * dp[2]);
+      shared = fabsf(n_dp) <= kPlaneTolM && fabsf(dp[0]) <= max_extent &&
+               fabsf(dp[1]) <= max_extent && fabsf(dp[2]) <= max_extent;
+      mean[0] += 0.25f * g.p_or_d.x;
+      mean[1] += 0.25f * g.p_or_d.y;
+      mean[2] += 0.25f * g.p_or_d.z;
+    }
+    if (shared) {
+      const float n0[3] = {g0.ng.x, g0.ng.y, g0.ng.z};
+      float c[kSkyShStride];
+      bool open_sky;
+      SkyVolumeBlend(volume, mean, n0, c, &open_sky);
+      for (int k = 0; k < 4; ++k) {
+        const PixelGeometry& g = geometry[quad[k]];
+        const float ns[3] = {g.ns.x, g.ns.y, g.ns.z};
+        float e[3];
+        SkyVolumeIrradianceAt(sky, c, open_sky, ns, e);
+        out[quad[k]] = Float3{e[0], e[1], e[2]};
+      }
+      return;
+    }
   }
   for (int c = 0; c < 4; ++c)
     if (u0 + (c & 1) < width && v0 + (c >> 1) < row1)
       out[quad[c]] = PixelSkyTerm(sky, volume, geometry[quad[c]]);
-}
-
-/// QuadSkyTerms' term of pixel k (0 to 3: (u0 + (k & 1), v0 + (k >> 1))) of the quad at even
-/// (u0, v0) alone, the quad's shared blend (if any) made again for it: the same values, for one
-/// thread per pixel on the device (RealtimeKernelOptions::sky_per_pixel). out as QuadSkyTerms'.
-PB_HOST_DEVICE inline void QuadPixelSkyTerm(const SkyModelPod& sky, const SkyVolumePod& volume,
-                                            const PixelGeometry* geometry, int width, int row1,
-                                            int u0, int v0, int k, Float3* out) {
-  if (u0 + (k & 1) >= width || v0 + (k >> 1) >= row1) return;
-  const int64_t i = static_cast<int64_t>(v0 + (k >> 1)) * width + u0 + (k & 1);
-  float mean[3];
-  if (QuadSharesSkyBlend(volume, geometry, width, row1, u0, v0, mean)) {
-    const PixelGeometry* const pixels[1] = {&geometry[i]};
-    Float3* const terms[1] = {&out[i]};
-    QuadSkyBlendTerm(sky, volume, geometry[static_cast<int64_t>(v0) * width + u0], mean, pixels,
-                     terms, 1);
-    return;
-  }
-  out[i] = PixelSkyTerm(sky, volume, geometry[i]);
 }
 
 /// the sky term of a mirrored ray (RealtimeFrameView::mirror_sky) from its geometry g
