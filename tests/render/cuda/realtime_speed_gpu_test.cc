@@ -2,12 +2,13 @@
 // (ctest label `gpu`): on the default room (lamps) and the house (the sun through windows) at
 // 640x480, the radiance and depth with every speed-up are the same bits as with each one turned
 // off (one thread per row sum, pageable copies, each pixel tracing its own penumbra rays, the
-// kernels' registers uncapped, the radiance copied back in 1 or 5 bands); the rgb too, except that
-// the row sums' order can move the exposure's last bits (then the EV100 agrees to 1e-9). with
-// the primary hit traced again or the surface evaluated again by the shading kernel, the
-// radiance may move in its last bits (nvcc's contraction of a second inlined copy of the
-// surface evaluation; see the test) and the depth keeps every bit. without a
-// device every test prints "skipped: no CUDA device".
+// kernels' registers uncapped, the radiance copied back in 1 or 5 bands, the mirror layer on the
+// frame's stream or on one of its priority, the resolve and mirror blend as two kernels); the rgb
+// too, except that the row sums' order can move the exposure's last bits (then the EV100 agrees
+// to 1e-9). with the primary hit traced again or the surface evaluated again by the shading
+// kernel, the radiance may move in its last bits (nvcc's contraction of a second inlined copy of
+// the surface evaluation; see the test) and the depth keeps every bit. without a device every
+// test prints "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -57,8 +58,14 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "output_bands 1",
                          "output_bands 5",
                          "queue_penumbra off",
-                         "queue_penumbra off, warp_penumbra off"};
-  for (int k = 0; k < 14; ++k) {
+                         "queue_penumbra off, warp_penumbra off",
+                         "mirror_stream off",
+                         "fuse_resolve off",
+                         "mirror_stream off, fuse_resolve off",
+                         "fuse_resolve, output_bands 3",
+                         "mirror_stream off, output_bands 1",
+                         "mirror_low_priority off"};
+  for (int k = 0; k < 20; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -66,6 +73,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 3) {
       o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
       o.queue_penumbra = false;
+      o.mirror_stream = o.fuse_resolve = false;
       o.min_blocks = o.geometry_min_blocks = 0;
       o.output_bands = 1;
     }
@@ -78,6 +86,11 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 11) o.output_bands = 5;
     if (k == 12 || k == 13) o.queue_penumbra = false;
     if (k == 13) o.warp_penumbra = false;
+    if (k == 14 || k == 16 || k == 18) o.mirror_stream = false;
+    if (k == 15 || k == 16) o.fuse_resolve = false;
+    if (k == 17) o.output_bands = 3;
+    if (k == 18) o.output_bands = 1;
+    if (k == 19) o.mirror_low_priority = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

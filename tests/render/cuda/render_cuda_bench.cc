@@ -370,6 +370,14 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     // the host's copies over the pool whatever their size (before branch gpu13)
     copy_variants.push_back(fast);
     copy_variants.back().serial_copy_kib = 0;
+    // the mirror layer on the frame's stream, the resolve and blend apart, both (before branch
+    // gpu19)
+    copy_variants.push_back(fast);
+    copy_variants.back().mirror_stream = false;
+    copy_variants.push_back(fast);
+    copy_variants.back().fuse_resolve = false;
+    copy_variants.push_back(fast);
+    copy_variants.back().mirror_stream = copy_variants.back().fuse_resolve = false;
     // second to last: the default into a new RenderedFrame every frame (as the camera sink's
     // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
     // default without the radiance (CudaRenderer::set_radiance_output)
@@ -409,6 +417,8 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
         extra += fmt::format(", host copies in {} KiB chunks", o.copy_chunk_kib);
       if (o.serial_copy_kib != fast.serial_copy_kib)
         extra += fmt::format(", host copies over the pool above {} KiB", o.serial_copy_kib);
+      if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
+      if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
       if (no_radiance) extra += ", no radiance asked for";
       if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
@@ -513,12 +523,25 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_surface = false;
     variants.push_back({"kernels, surface evaluated twice", o});
     o = fast;
+    o.mirror_stream = false;
+    variants.push_back({"kernels, mirror layer on the frame's stream", o});
+    o = fast;
+    o.fuse_resolve = false;
+    variants.push_back({"kernels, resolve and mirror blend apart", o});
+    o.mirror_stream = false;
+    variants.push_back({"kernels, both of those off", o});
+    o = fast;
+    o.mirror_low_priority = false;
+    variants.push_back({"kernels, mirror layer's stream of the frame's priority", o});
+
+    o = fast;
     o.rows_per_warp = false;
     variants.push_back({"kernels, row sums per thread", o});
     o.reuse_hit = false;
     o.reuse_surface = false;
     o.warp_penumbra = false;
     o.queue_penumbra = false;
+    o.mirror_stream = o.fuse_resolve = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

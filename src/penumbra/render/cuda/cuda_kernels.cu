@@ -90,7 +90,12 @@ struct DeviceScene::Impl {
 
 DeviceScene::DeviceScene() : impl_(new Impl) {
   try {
-    Check(cudaStreamCreate(&impl_->stream), "cudaStreamCreate");
+    // the highest priority: the realtime frame's side stream (RealtimeKernelOptions::
+    // mirror_low_priority) runs below it
+    int least = 0, greatest = 0;
+    Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "cudaDeviceGetStreamPriorityRange");
+    Check(cudaStreamCreateWithPriority(&impl_->stream, cudaStreamDefault, greatest),
+          "cudaStreamCreate");
   } catch (...) {
     delete impl_;
     throw;

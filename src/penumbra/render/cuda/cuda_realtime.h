@@ -133,6 +133,22 @@ struct RealtimeKernelOptions {
   /// atomics (the same counts, so the same bits), so no warp waits on its ring pixels; the
   /// short ones spread over their warp's lanes (as warp_penumbra, which this implies).
   bool queue_penumbra = true;
+  /// with device_sky, a frame with a mirror layer traces, sky-terms and shades its mirrored rays
+  /// (MirrorTraceKernel, MirrorSkyKernel, MirrorShadeKernel) on a second stream that forks from
+  /// the frame's stream after the geometry kernel and joins it before the mirror blend, so they
+  /// run beside the sky quads, the shading and the shared visibility (which neither read nor
+  /// write their arrays: the same bits); else after them on the frame's stream.
+  bool mirror_stream = true;
+  /// with mirror_stream: the side stream has the device's lowest priority, below the frame's
+  /// stream (DeviceScene's, the highest), so the mirror layer's blocks take the SMs the frame's
+  /// own kernels leave; else the same priority as the frame's stream.
+  bool mirror_low_priority = true;
+  /// the shared visibility's resolve and the mirror blend in one kernel (the mirrored radiance
+  /// shaded before it), launched in the radiance's output_bands bands of rows, each band's copy
+  /// back behind its own event (without media and streaks, which change the radiance after
+  /// it): band k goes back while band k + 1 is resolved and the row sums run. else the resolve,
+  /// then the blend over the whole frame, and the copies behind the row sums.
+  bool fuse_resolve = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

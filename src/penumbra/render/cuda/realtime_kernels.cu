@@ -475,6 +475,21 @@ __global__ void VisibilityResolveKernel(Frames frames, Float3* radiance) {
   radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
 }
 
+// VisibilityResolveKernel and, with kMirror, MirrorBlendKernel in one pass over rows [row0,
+// row1) (RealtimeKernelOptions::fuse_resolve; after MirrorShadeKernel): the same functions in
+// the same order on each pixel's own radiance, so the same bits.
+template <class Frames, bool kMirror>
+__global__ void ResolveBandKernel(Frames frames, Float3* radiance, int row0, int row1) {
+  const RealtimeFrameView& f = frames.get();
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (u >= f.camera.width || v >= row1) return;
+  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
+  Float3 L = SharedVisibilityResolve(f, u, v, radiance[i]);
+  if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, u, v, L);
+  radiance[i] = L;
+}
+
 __global__ void RowSumKernel(const Float3* radiance, int width, int height, double* rows) {
   const int v = blockIdx.x * blockDim.x + threadIdx.x;
   if (v >= height) return;
@@ -694,6 +709,12 @@ struct DeviceRealtime::Impl : PixelBuffers {
   std::vector<Float3> host_sky, host_mirror_sky;
   std::vector<double> host_rows;
   cudaStream_t copy_stream = nullptr;
+  // mirror_stream: the mirror layer's kernels' stream, the event it forks at (the primary
+  // geometry traced) and the one it joins at (the mirrored radiance shaded)
+  cudaStream_t side_stream = nullptr, side_stream_high = nullptr;  // lowest, highest priority
+  cudaEvent_t mirror_fork = nullptr, mirror_join = nullptr;
+  // fuse_resolve: band k of the radiance is final (its copy back waits for it)
+  cudaEvent_t resolved_band[kMaxSkyBands] = {};
   cudaEvent_t geometry_done = nullptr;
   cudaEvent_t radiance_done = nullptr;  // the radiance is final (before the film kernel)
   cudaEvent_t depth_copied = nullptr;   // the depth is in its pinned buffer
@@ -935,22 +956,51 @@ struct DeviceRealtime::Impl : PixelBuffers {
           OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     Check(cudaGetLastError(), "GeometryKernel");
     if (f.any_mirror != 0) {
-      MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, stream>>>(
+      // mirror_stream: the mirror layer forks here, beside the rest of the frame
+      cudaStream_t s = stream;
+      if (ForkMirror(f, o)) {
+        s = Side(o);
+        Check(cudaEventRecord(mirror_fork, stream), "cudaEventRecord");
+        Check(cudaStreamWaitEvent(s, mirror_fork, 0), "cudaStreamWaitEvent");
+      }
+      MirrorTraceKernel<<<PixelGrid(f.camera.width, f.camera.height), kPixelBlock, 0, s>>>(
           OneFrame{f});
       Check(cudaGetLastError(), "MirrorTraceKernel");
     }
   }
-  // the sky terms of frame f (its geometry and mirrored rays traced) on `stream`.
-  void LaunchSky(const RealtimeFrameView& f, cudaStream_t stream) {
+  // whether frame f's mirror layer runs on the side stream (RealtimeKernelOptions::
+  // mirror_stream; with the sky terms on the device, whose kernel queues its shading)
+  bool ForkMirror(const RealtimeFrameView& f, const RealtimeKernelOptions& o) const {
+    return o.mirror_stream && o.device_sky && sky_uploaded && side_stream != nullptr &&
+           f.any_mirror != 0;
+  }
+  // the side stream as `o` says (mirror_low_priority)
+  cudaStream_t Side(const RealtimeKernelOptions& o) const {
+    return o.mirror_low_priority ? side_stream : side_stream_high;
+  }
+  // the sky terms of frame f (its geometry and mirrored rays traced) on `stream`; mirror_stream:
+  // the mirrored rays' sky terms and shading on the side stream, which then joins.
+  void LaunchSky(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream) {
     const int W = f.camera.width, H = f.camera.height;
     SkyQuadKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
         OneFrame{f}, sky.as<Float3>());
     Check(cudaGetLastError(), "SkyQuadKernel");
     if (f.any_mirror != 0) {
-      MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(OneFrame{f},
-                                                                   mirror_sky.as<Float3>());
+      const bool fork = ForkMirror(f, o);
+      cudaStream_t s = fork ? Side(o) : stream;
+      MirrorSkyKernel<<<PixelGrid(W, H), kPixelBlock, 0, s>>>(OneFrame{f}, mirror_sky.as<Float3>());
       Check(cudaGetLastError(), "MirrorSkyKernel");
+      if (fork) {
+        MirrorShadeKernel<<<PixelGrid(W, H), kPixelBlock, 0, s>>>(OneFrame{f});
+        Check(cudaGetLastError(), "MirrorShadeKernel");
+        Check(cudaEventRecord(mirror_join, s), "cudaEventRecord");
+      }
     }
+  }
+  // row k of the radiance's `bands` bands of rows (Render's output bands) of a frame H rows high
+  static int OutputBandRow(int H, int bands, int k) {
+    const int rows = (H + bands - 1) / bands;
+    return std::min(H, k * rows);
   }
   // the shading kernel of rows [row0, row1) of frame f on `stream` as `o` says.
   void LaunchShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream,
@@ -1008,13 +1058,45 @@ struct DeviceRealtime::Impl : PixelBuffers {
     }
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
     Check(cudaGetLastError(), "VisibilityFractionKernel");
-    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
-    Check(cudaGetLastError(), "VisibilityResolveKernel");
-    if (f.any_mirror != 0) {
-      MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
-      Check(cudaGetLastError(), "MirrorShadeKernel");
-      MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
-      Check(cudaGetLastError(), "MirrorBlendKernel");
+    const bool mirror = f.any_mirror != 0;
+    const bool fork = ForkMirror(f, o);
+    if (o.fuse_resolve) {
+      // the mirrored radiance first (or the side stream's), then the resolve and blend in the
+      // output bands, each band final behind its event (one band where media or streaks follow)
+      if (mirror && !fork) {
+        MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
+        Check(cudaGetLastError(), "MirrorShadeKernel");
+      }
+      if (fork) Check(cudaStreamWaitEvent(stream, mirror_join, 0), "cudaStreamWaitEvent");
+      const bool after = f.has_media != 0 || f.num_streaks > 0;
+      const int bands = after ? 1 : std::clamp(o.output_bands, 1, kMaxSkyBands);
+      for (int k = 0; k < bands; ++k) {
+        const int r0 = OutputBandRow(H, bands, k), r1 = OutputBandRow(H, bands, k + 1);
+        if (r1 > r0) {
+          const dim3 band = PixelGrid(W, r1 - r0);
+          if (mirror)
+            ResolveBandKernel<OneFrame, true>
+                <<<band, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>(), r0, r1);
+          else
+            ResolveBandKernel<OneFrame, false>
+                <<<band, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>(), r0, r1);
+          Check(cudaGetLastError(), "ResolveBandKernel");
+        }
+        if (!after) Check(cudaEventRecord(resolved_band[k], stream), "cudaEventRecord");
+      }
+    } else {
+      VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
+      Check(cudaGetLastError(), "VisibilityResolveKernel");
+      if (mirror) {
+        if (fork) {
+          Check(cudaStreamWaitEvent(stream, mirror_join, 0), "cudaStreamWaitEvent");
+        } else {
+          MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
+          Check(cudaGetLastError(), "MirrorShadeKernel");
+        }
+        MirrorBlendKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
+        Check(cudaGetLastError(), "MirrorBlendKernel");
+      }
     }
     if (f.has_media != 0) {
       MediaViewKernel<<<PixelGrid((W + 1) / 2, (H + 1) / 2), kPixelBlock, 0, stream>>>(
@@ -1026,6 +1108,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
           f.streaks, f.num_streaks, depth.as<float>(), radiance.as<Float3>());
       Check(cudaGetLastError(), "StreakKernel");
     }
+    // fuse_resolve with media or streaks: every band final after them
+    if (o.fuse_resolve && (f.has_media != 0 || f.num_streaks > 0))
+      for (cudaEvent_t& e : resolved_band) Check(cudaEventRecord(e, stream), "cudaEventRecord");
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H, rows);
     else
@@ -1052,6 +1137,12 @@ struct DeviceRealtime::Impl : PixelBuffers {
   }
   ~Impl() {
     if (copy_stream) cudaStreamDestroy(copy_stream);
+    if (side_stream) cudaStreamDestroy(side_stream);
+    if (side_stream_high) cudaStreamDestroy(side_stream_high);
+    if (mirror_fork) cudaEventDestroy(mirror_fork);
+    if (mirror_join) cudaEventDestroy(mirror_join);
+    for (cudaEvent_t e : resolved_band)
+      if (e) cudaEventDestroy(e);
     if (geometry_done) cudaEventDestroy(geometry_done);
     if (radiance_done) cudaEventDestroy(radiance_done);
     if (depth_copied) cudaEventDestroy(depth_copied);
@@ -1169,6 +1260,16 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     Check(cudaEventCreateWithFlags(&m.rgb_copied, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.radiance_band)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
+    int least = 0, greatest = 0;
+    Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "cudaDeviceGetStreamPriorityRange");
+    Check(cudaStreamCreateWithPriority(&m.side_stream, cudaStreamNonBlocking, least),
+          "cudaStreamCreate");
+    Check(cudaStreamCreateWithPriority(&m.side_stream_high, cudaStreamNonBlocking, greatest),
+          "cudaStreamCreate");
+    Check(cudaEventCreateWithFlags(&m.mirror_fork, cudaEventDisableTiming), "cudaEventCreate");
+    Check(cudaEventCreateWithFlags(&m.mirror_join, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : m.resolved_band)
+      Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.band_done)
       Check(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
     for (cudaEvent_t& e : m.stage) Check(cudaEventCreate(&e), "cudaEventCreate");
@@ -1257,7 +1358,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   m.LaunchGeometry(f, o, stream);
   if (o.device_sky) {
     Check(cudaEventRecord(m.stage[1], stream), "cudaEventRecord");
-    m.LaunchSky(f, stream);
+    m.LaunchSky(f, o, stream);
     Check(cudaEventRecord(m.stage[2], stream), "cudaEventRecord");
   }
   cudaStream_t down = o.pinned ? m.copy_stream : stream;
@@ -1320,14 +1421,19 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   // the radiance goes back in bands of rows, each behind an event, so that the host copies band
   // k into the frame's image while band k + 1 comes back
   const int out_bands = std::clamp(o.output_bands, 1, kMaxSkyBands);
-  const int out_rows = (H + out_bands - 1) / out_bands;
-  auto out_row = [&](int k) { return std::min(H, k * out_rows); };
+  auto out_row = [&](int k) { return Impl::OutputBandRow(H, out_bands, k); };
   if (out.radiance && o.pinned) {
-    Check(cudaEventRecord(m.radiance_done, stream), "cudaEventRecord");
-    Check(cudaStreamWaitEvent(m.copy_stream, m.radiance_done, 0), "cudaStreamWaitEvent");
+    // fuse_resolve: band k as soon as it is resolved (the row sums still running); else after
+    // the row sums
+    if (!o.fuse_resolve) {
+      Check(cudaEventRecord(m.radiance_done, stream), "cudaEventRecord");
+      Check(cudaStreamWaitEvent(m.copy_stream, m.radiance_done, 0), "cudaStreamWaitEvent");
+    }
     for (int k = 0; k < out_bands; ++k) {
       const size_t off = static_cast<size_t>(out_row(k)) * W;
       const size_t count = static_cast<size_t>(out_row(k + 1) - out_row(k)) * W;
+      if (o.fuse_resolve)
+        Check(cudaStreamWaitEvent(m.copy_stream, m.resolved_band[k], 0), "cudaStreamWaitEvent");
       if (count > 0)
         Check(cudaMemcpyAsync(m.pin_radiance.as<Float3>() + off, m.radiance.as<Float3>() + off,
                               sizeof(Float3) * count, cudaMemcpyDeviceToHost, m.copy_stream),
@@ -1499,13 +1605,13 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
   };
   // one untimed run (first launch of a kernel variant)
   m.LaunchGeometry(f, options, stream);
-  if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
+  if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, options, stream);
   m.LaunchShading(f, options, stream);
   film();
   Check(cudaStreamSynchronize(stream), "realtime kernels");
   return TimeOnStream(stream, count, [&] {
     m.LaunchGeometry(f, options, stream);
-    if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, stream);
+    if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, options, stream);
     m.LaunchShading(f, options, stream);
     film();
   });
