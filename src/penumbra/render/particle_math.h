@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bsdf_math.h"
@@ -74,6 +75,16 @@ PB_HOST_DEVICE inline float IntersectCapsule(const CapsuleOrigin& c, const Float
   return t > 0 ? t : -1.0f;
 }
 
+/// the t (in units of |d|: the pixel's depth for a camera ray) where the ray o + t d (d any
+/// length, o that of `c`) meets the capsule, or -1: IntersectCapsule along d / |d| (|d| summed
+/// as Eigen's norm()), divided by |d|. the realtime splat's pixel test (ParticleStreaks and the
+/// CUDA backend's splat kernel).
+PB_HOST_DEVICE inline float IntersectCapsuleRay(const CapsuleOrigin& c, const Float3& d) {
+  const float len = sqrtf(EigenDot(d, d));
+  const float t = IntersectCapsule(c, Float3{d.x / len, d.y / len, d.z / len});
+  return t > 0 ? t / len : -1.0f;
+}
+
 /// the unit normal at point p (world) on the capsule around [a, b], facing the ray of
 /// direction d (any length): p minus its nearest point on the axis, normalised (-d normalised
 /// where p lies on the axis), flipped towards the ray's origin; Eigen's operation order.
@@ -97,6 +108,119 @@ PB_HOST_DEVICE inline Float3 CapsuleNormal(const Float3& p, const Float3& a, con
   }
   if (EigenDot(n, d) > 0) n = Float3{-n.x, -n.y, -n.z};
   return n;
+}
+
+/// near plane (m, optical-frame depth) of the realtime tier's streak splat: drops wholly in
+/// front of it are not drawn, and a streak's segment is clipped to kStreakNear + r.
+constexpr float kStreakNear = 0.01f;
+
+/// a streak as the realtime tier's splat sees it: the pixel box [u0, u1] x [v0, v1] whose
+/// pixel-centre rays are tested against its capsule (empty: u0 > u1 or v0 > v1) and its
+/// projected segment (ua, va) - (ub, vb) (px) with the capsule's projected radius rp (px, one
+/// pixel of margin included).
+struct StreakProjection {
+  int u0 = 0, u1 = -1, v0 = 0, v1 = -1;
+  float ua = 0, va = 0, ub = 0, vb = 0, rp = 0;
+  PB_HOST_DEVICE bool empty() const { return u0 > u1 || v0 > v1; }
+};
+
+/// world point p (m) in a camera's optical frame: R_OW p + p_OW (R_OW row-major), each row's
+/// dot product summed as Eigen's Matrix3f * Vector3f sums it (EigenDot), then the offset.
+PB_HOST_DEVICE inline Float3 StreakToOptical(const float R_OW[9], const Float3& p_OW,
+                                             const Float3& p) {
+  return Float3{EigenDot(Float3{R_OW[0], R_OW[1], R_OW[2]}, p) + p_OW.x,
+                EigenDot(Float3{R_OW[3], R_OW[4], R_OW[5]}, p) + p_OW.y,
+                EigenDot(Float3{R_OW[6], R_OW[7], R_OW[8]}, p) + p_OW.z};
+}
+
+/// the realtime splat's projection of the capsule around [ao, bo] (optical frame, m; z
+/// forward) of radius r (m) into a W x H image of pinhole intrinsics fx, fy, cx, cy (px, as
+/// CameraIntrinsics): the segment clipped to z >= kStreakNear + r (empty when both ends lie in
+/// front of that), both ends projected (in double, then rounded to float), rp = max(fx, fy) r /
+/// (nearest z - r) + 1 px, and the box of the projected segment widened by rp, clamped to the
+/// image (empty when outside it). lens distortion is ignored: it moves pixels by more than the
+/// margin only far from the centre, where a streak may then be clipped.
+/// (ParticleStreaks::BuildPixelHits and the CUDA backend's splat kernel.)
+PB_HOST_DEVICE inline StreakProjection ProjectStreak(Float3 ao, Float3 bo, float r, double fx,
+                                                     double fy, double cx, double cy, int W,
+                                                     int H) {
+  StreakProjection p;
+  const float zmin = kStreakNear + r;
+  if (ao.z < zmin && bo.z < zmin) return p;
+  if (ao.z < zmin) {
+    const float s = (bo.z - zmin) / (bo.z - ao.z);
+    ao = Float3{bo.x + (ao.x - bo.x) * s, bo.y + (ao.y - bo.y) * s, bo.z + (ao.z - bo.z) * s};
+  }
+  if (bo.z < zmin) {
+    const float s = (ao.z - zmin) / (ao.z - bo.z);
+    bo = Float3{ao.x + (bo.x - ao.x) * s, ao.y + (bo.y - ao.y) * s, ao.z + (bo.z - ao.z) * s};
+  }
+  const float z_near = (ao.z < bo.z ? ao.z : bo.z) - r;
+  const float f_max = static_cast<float>(fx < fy ? fy : fx);
+  p.rp = f_max * r / (z_near < kStreakNear ? kStreakNear : z_near) + 1.0f;
+  p.ua = static_cast<float>(fx * static_cast<double>(ao.x) / static_cast<double>(ao.z) + cx);
+  p.va = static_cast<float>(fy * static_cast<double>(ao.y) / static_cast<double>(ao.z) + cy);
+  p.ub = static_cast<float>(fx * static_cast<double>(bo.x) / static_cast<double>(bo.z) + cx);
+  p.vb = static_cast<float>(fy * static_cast<double>(bo.y) / static_cast<double>(bo.z) + cy);
+  const int u0 = static_cast<int>(floorf((p.ua < p.ub ? p.ua : p.ub) - p.rp));
+  const int u1 = static_cast<int>(ceilf((p.ua < p.ub ? p.ub : p.ua) + p.rp));
+  const int v0 = static_cast<int>(floorf((p.va < p.vb ? p.va : p.vb) - p.rp));
+  const int v1 = static_cast<int>(ceilf((p.va < p.vb ? p.vb : p.va) + p.rp));
+  p.u0 = u0 < 0 ? 0 : u0;
+  p.u1 = u1 < W - 1 ? u1 : W - 1;
+  p.v0 = v0 < 0 ? 0 : v0;
+  p.v1 = v1 < H - 1 ? v1 : H - 1;
+  return p;
+}
+
+/// the columns [*c0, *c1] of row v (within the box of `p`) whose pixel centres lie within rp of
+/// the part of the projected segment near that row: the segment's parameters where its v is
+/// v -+ rp (the whole segment when it is nearly horizontal), their u -+ rp. (the splat tests
+/// only these pixels of the row; empty: *c0 > *c1.)
+PB_HOST_DEVICE inline void StreakRowColumns(const StreakProjection& p, int v, int* c0, int* c1) {
+  const float du = p.ub - p.ua, dv = p.vb - p.va;
+  float s0 = 0, s1 = 1;
+  if (fabsf(dv) > 1e-6f) {
+    // std::clamp(x, 0, 1)
+    const float x0 = (static_cast<float>(v) - p.rp - p.va) / dv;
+    const float x1 = (static_cast<float>(v) + p.rp - p.va) / dv;
+    s0 = x0 < 0.0f ? 0.0f : (1.0f < x0 ? 1.0f : x0);
+    s1 = x1 < 0.0f ? 0.0f : (1.0f < x1 ? 1.0f : x1);
+    if (s0 > s1) {
+      const float t = s0;
+      s0 = s1;
+      s1 = t;
+    }
+  }
+  const float e0 = p.ua + s0 * du, e1 = p.ua + s1 * du;
+  const float ul = (e0 < e1 ? e0 : e1) - p.rp;
+  const float uh = (e0 < e1 ? e1 : e0) + p.rp;
+  const int l = static_cast<int>(floorf(ul)), h = static_cast<int>(ceilf(uh));
+  *c0 = p.u0 < l ? l : p.u0;
+  *c1 = h < p.u1 ? h : p.u1;
+}
+
+/// a pixel's StreakKey when no streak meets its ray (larger than every key).
+constexpr uint64_t kNoStreakKey = ~uint64_t{0};
+
+/// the nearest streak of a pixel as one 64-bit key: the float bits of its t (> 0, so they sort
+/// as unsigned integers) above its index, so that the smallest key is the nearest streak and,
+/// at equal t, the lower index (the host splat's rule). an integer minimum does not depend on
+/// the order the keys arrive in (the device's atomicMin), so the splat is deterministic.
+PB_HOST_DEVICE inline uint64_t StreakKey(float t, int32_t index) {
+  uint32_t bits;
+  std::memcpy(&bits, &t, sizeof(bits));
+  return (static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(index);
+}
+/// the t and index of a StreakKey.
+PB_HOST_DEVICE inline float StreakKeyT(uint64_t key) {
+  const uint32_t bits = static_cast<uint32_t>(key >> 32);
+  float t;
+  std::memcpy(&t, &bits, sizeof(t));
+  return t;
+}
+PB_HOST_DEVICE inline int32_t StreakKeyIndex(uint64_t key) {
+  return static_cast<int32_t>(static_cast<uint32_t>(key & 0xffffffffu));
 }
 
 /// a particle set's kind as the shared shading takes it (ParticleKind's values).
