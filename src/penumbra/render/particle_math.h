@@ -33,43 +33,55 @@ struct CapsuleOrigin {
   float baba = 0, baoa = 0, qc = 0, sc_a = 0, sc_b = 0;
 };
 
+/// a . b summed as Eigen sums it (EigenDot: x + (y + z)), every product and sum rounded on its
+/// own on both processors (MulRn, AddRn: no fused multiply-add on the device), so that the
+/// ray-capsule test below gives the CPU's bits on the GPU.
+PB_HOST_DEVICE inline float EigenDotRn(const Float3& a, const Float3& b) {
+  return AddRn(MulRn(a.x, b.x), AddRn(MulRn(a.y, b.y), MulRn(a.z, b.z)));
+}
+
 /// the CapsuleOrigin of origin o (world, m) and the capsule around [a, b] of radius r (m), dot
-/// products summed as Eigen's (EigenDot).
+/// products summed as Eigen's (EigenDotRn); each operation rounded on its own (the CPU's bits
+/// on the GPU too).
 PB_HOST_DEVICE inline CapsuleOrigin MakeCapsuleOrigin(const Float3& o, const Float3& a,
                                                       const Float3& b, float r) {
   CapsuleOrigin c;
   c.ba = b - a;
   c.oa = o - a;
   c.ob = o - b;
-  c.baba = EigenDot(c.ba, c.ba);
-  c.baoa = EigenDot(c.ba, c.oa);
-  const float oaoa = EigenDot(c.oa, c.oa);
-  c.qc = c.baba * oaoa - c.baoa * c.baoa - r * r * c.baba;
-  c.sc_a = EigenDot(c.oa, c.oa) - r * r;
-  c.sc_b = EigenDot(c.ob, c.ob) - r * r;
+  c.baba = EigenDotRn(c.ba, c.ba);
+  c.baoa = EigenDotRn(c.ba, c.oa);
+  const float oaoa = EigenDotRn(c.oa, c.oa);
+  const float rr = MulRn(r, r);
+  c.qc = SubRn(SubRn(MulRn(c.baba, oaoa), MulRn(c.baoa, c.baoa)), MulRn(rr, c.baba));
+  c.sc_a = SubRn(EigenDotRn(c.oa, c.oa), rr);
+  c.sc_b = SubRn(EigenDotRn(c.ob, c.ob), rr);
   return c;
 }
 
 /// nearest t > 0 (m) where the ray o + t d (d unit, o that of `c`) meets the capsule, or -1
 /// (Quilez, "Capsule - intersection", 2014: the infinite cylinder, then the nearer end sphere).
-/// a ray that starts inside the capsule misses it.
+/// a ray that starts inside the capsule misses it. each operation rounded on its own (MulRn,
+/// AddRn, SubRn): the test is ill-conditioned for thin capsules far away (the discriminant is a
+/// difference of nearly equal products), so a fused multiply-add would move the edge of a
+/// widened streak by a good part of its radius; this way the GPU gives the CPU's bits.
 PB_HOST_DEVICE inline float IntersectCapsule(const CapsuleOrigin& c, const Float3& d) {
-  const float bard = EigenDot(c.ba, d), rdoa = EigenDot(d, c.oa);
-  const float qa = c.baba - bard * bard;
-  const float qb = c.baba * rdoa - c.baoa * bard;
-  float h = qb * qb - qa * c.qc;
+  const float bard = EigenDotRn(c.ba, d), rdoa = EigenDotRn(d, c.oa);
+  const float qa = SubRn(c.baba, MulRn(bard, bard));
+  const float qb = SubRn(MulRn(c.baba, rdoa), MulRn(c.baoa, bard));
+  float h = SubRn(MulRn(qb, qb), MulRn(qa, c.qc));
   float y;
   if (qa > 1e-12f) {
     if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
     const float t = (-qb - sqrtf(h)) / qa;
-    y = c.baoa + t * bard;
+    y = AddRn(c.baoa, MulRn(t, bard));
     if (y > 0 && y < c.baba) return t > 0 ? t : -1.0f;
   } else {
     y = bard > 0 ? -1.0f : c.baba + 1.0f;  // along the axis: the nearer end
   }
   const bool at_a = y <= 0;
-  const float sb = EigenDot(d, at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
-  h = sb * sb - sc;
+  const float sb = EigenDotRn(d, at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
+  h = SubRn(MulRn(sb, sb), sc);
   if (h <= 0) return -1.0f;
   const float t = -sb - sqrtf(h);
   return t > 0 ? t : -1.0f;
@@ -80,7 +92,7 @@ PB_HOST_DEVICE inline float IntersectCapsule(const CapsuleOrigin& c, const Float
 /// as Eigen's norm()), divided by |d|. the realtime splat's pixel test (ParticleStreaks and the
 /// CUDA backend's splat kernel).
 PB_HOST_DEVICE inline float IntersectCapsuleRay(const CapsuleOrigin& c, const Float3& d) {
-  const float len = sqrtf(EigenDot(d, d));
+  const float len = sqrtf(EigenDotRn(d, d));
   const float t = IntersectCapsule(c, Float3{d.x / len, d.y / len, d.z / len});
   return t > 0 ? t / len : -1.0f;
 }
@@ -125,12 +137,13 @@ struct StreakProjection {
 };
 
 /// world point p (m) in a camera's optical frame: R_OW p + p_OW (R_OW row-major), each row's
-/// dot product summed as Eigen's Matrix3f * Vector3f sums it (EigenDot), then the offset.
+/// dot product summed as Eigen's Matrix3f * Vector3f sums it (EigenDotRn), then the offset;
+/// each operation rounded on its own (the CPU's bits on the GPU).
 PB_HOST_DEVICE inline Float3 StreakToOptical(const float R_OW[9], const Float3& p_OW,
                                              const Float3& p) {
-  return Float3{EigenDot(Float3{R_OW[0], R_OW[1], R_OW[2]}, p) + p_OW.x,
-                EigenDot(Float3{R_OW[3], R_OW[4], R_OW[5]}, p) + p_OW.y,
-                EigenDot(Float3{R_OW[6], R_OW[7], R_OW[8]}, p) + p_OW.z};
+  return Float3{AddRn(EigenDotRn(Float3{R_OW[0], R_OW[1], R_OW[2]}, p), p_OW.x),
+                AddRn(EigenDotRn(Float3{R_OW[3], R_OW[4], R_OW[5]}, p), p_OW.y),
+                AddRn(EigenDotRn(Float3{R_OW[6], R_OW[7], R_OW[8]}, p), p_OW.z)};
 }
 
 /// the realtime splat's projection of the capsule around [ao, bo] (optical frame, m; z
@@ -139,7 +152,8 @@ PB_HOST_DEVICE inline Float3 StreakToOptical(const float R_OW[9], const Float3& 
 /// front of that), both ends projected (in double, then rounded to float), rp = max(fx, fy) r /
 /// (nearest z - r) + 1 px, and the box of the projected segment widened by rp, clamped to the
 /// image (empty when outside it). lens distortion is ignored: it moves pixels by more than the
-/// margin only far from the centre, where a streak may then be clipped.
+/// margin only far from the centre, where a streak may then be clipped. products and sums
+/// rounded on their own (the CPU's bits on the GPU: the same pixels tested).
 /// (ParticleStreaks::BuildPixelHits and the CUDA backend's splat kernel.)
 PB_HOST_DEVICE inline StreakProjection ProjectStreak(Float3 ao, Float3 bo, float r, double fx,
                                                      double fy, double cx, double cy, int W,
@@ -149,11 +163,13 @@ PB_HOST_DEVICE inline StreakProjection ProjectStreak(Float3 ao, Float3 bo, float
   if (ao.z < zmin && bo.z < zmin) return p;
   if (ao.z < zmin) {
     const float s = (bo.z - zmin) / (bo.z - ao.z);
-    ao = Float3{bo.x + (ao.x - bo.x) * s, bo.y + (ao.y - bo.y) * s, bo.z + (ao.z - bo.z) * s};
+    ao = Float3{AddRn(bo.x, MulRn(ao.x - bo.x, s)), AddRn(bo.y, MulRn(ao.y - bo.y, s)),
+                AddRn(bo.z, MulRn(ao.z - bo.z, s))};
   }
   if (bo.z < zmin) {
     const float s = (ao.z - zmin) / (ao.z - bo.z);
-    bo = Float3{ao.x + (bo.x - ao.x) * s, ao.y + (bo.y - ao.y) * s, ao.z + (bo.z - ao.z) * s};
+    bo = Float3{AddRn(ao.x, MulRn(bo.x - ao.x, s)), AddRn(ao.y, MulRn(bo.y - ao.y, s)),
+                AddRn(ao.z, MulRn(bo.z - ao.z, s))};
   }
   const float z_near = (ao.z < bo.z ? ao.z : bo.z) - r;
   const float f_max = static_cast<float>(fx < fy ? fy : fx);
@@ -192,7 +208,7 @@ PB_HOST_DEVICE inline void StreakRowColumns(const StreakProjection& p, int v, in
       s1 = t;
     }
   }
-  const float e0 = p.ua + s0 * du, e1 = p.ua + s1 * du;
+  const float e0 = AddRn(p.ua, MulRn(s0, du)), e1 = AddRn(p.ua, MulRn(s1, du));
   const float ul = (e0 < e1 ? e0 : e1) - p.rp;
   const float uh = (e0 < e1 ? e1 : e0) + p.rp;
   const int l = static_cast<int>(floorf(ul)), h = static_cast<int>(ceilf(uh));

@@ -1128,6 +1128,18 @@ const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->opt
 const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
 const RealtimeExposureChecks& DeviceRealtime::exposure_checks() const { return impl_->checks; }
 
+bool DeviceRealtime::DownloadStreakKeys(std::vector<unsigned long long>* out) const {
+  const Impl& m = *impl_;
+  const StreakSplatView& sp = m.frame.splat;
+  if (!m.rendered || sp.streaks.num <= 0) return false;
+  Check(cudaDeviceSynchronize(), "DownloadStreakKeys");
+  out->assign(static_cast<size_t>(m.frame.camera.width) * m.frame.camera.height, 0);
+  Check(cudaMemcpy(out->data(), sp.nearest, sizeof(unsigned long long) * out->size(),
+                   cudaMemcpyDeviceToHost),
+        "DownloadStreakKeys");
+  return true;
+}
+
 bool DeviceRealtime::DownloadGridVolumes(GridVolumeArrays* out) const {
   const Impl& m = *impl_;
   if (m.grid_built_cells <= 0 && m.grid_built_columns <= 0) return false;

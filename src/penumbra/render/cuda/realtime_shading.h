@@ -262,10 +262,13 @@ PB_HOST_DEVICE inline F3 OffsetOrigin(const Float3& p, const Float3& n) {
 
 /// the pixel-centre ray of pixel (u, v) of camera c: primary_pixel.h's PinholePixelRay, or with
 /// c's tables (lens distortion, a moving camera; camera_rays.h) the pixel's undistorted
-/// coordinates and its row's pose, as Camera::GenerateRay.
+/// coordinates and its row's pose, as Camera::GenerateRay. kRn: the direction's products and
+/// sums rounded on their own (NormalizedPixelRay<true>: the realtime splat's rays).
+template <bool kRn = false>
 PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
   if (!c.xy && !c.rows)
-    return PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
+    return PinholePixelRay<kRn>(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u,
+                                v);
   float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
   float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
   if (c.xy) {
@@ -273,10 +276,10 @@ PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) 
     x = p[0];
     y = p[1];
   }
-  if (!c.rows) return NormalizedPixelRay(c.o, c.ex, c.ey, c.ez, x, y, c.near);
+  if (!c.rows) return NormalizedPixelRay<kRn>(c.o, c.ex, c.ey, c.ez, x, y, c.near);
   const float* r = c.rows + 12 * static_cast<int64_t>(v);
-  return NormalizedPixelRay(F3{r[0], r[1], r[2]}, F3{r[3], r[4], r[5]}, F3{r[6], r[7], r[8]},
-                            F3{r[9], r[10], r[11]}, x, y, c.near);
+  return NormalizedPixelRay<kRn>(F3{r[0], r[1], r[2]}, F3{r[3], r[4], r[5]}, F3{r[6], r[7], r[8]},
+                                 F3{r[9], r[10], r[11]}, x, y, c.near);
 }
 
 /// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
@@ -1329,7 +1332,9 @@ PB_HOST_DEVICE inline void KeepNearestStreak(unsigned long long* slot, unsigned 
 /// splat streak k (projection p, SplatProjection) on row v (inside p's box): every pixel of
 /// StreakRowColumns whose pixel-centre ray (PrimaryRay) meets the capsule (IntersectCapsuleRay,
 /// with the row's ray origin) keeps StreakKey(t, k) in f.splat.nearest if it is smaller, as
-/// ParticleStreaks::BuildPixelHits for the CPU's pixel rays.
+/// ParticleStreaks::BuildPixelHits for the CPU's pixel rays: every product and sum of the rays,
+/// the projection and the capsule test rounded on its own (PrimaryRay<true>, MulRn, AddRn), so
+/// the device finds the CPU's pixels and t to the bit.
 PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
                                           const StreakProjection& p, int v) {
   int c0, c1;
@@ -1337,10 +1342,10 @@ PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
   if (c0 > c1) return;
   const StreakPod& s = f.splat.streaks.streaks[k];
   const CapsuleOrigin c =
-      MakeCapsuleOrigin(ToFloat3(PrimaryRay(f.camera, c0, v).o), Float3{s.a[0], s.a[1], s.a[2]},
-                        Float3{s.b[0], s.b[1], s.b[2]}, s.r);
+      MakeCapsuleOrigin(ToFloat3(PrimaryRay<true>(f.camera, c0, v).o),
+                        Float3{s.a[0], s.a[1], s.a[2]}, Float3{s.b[0], s.b[1], s.b[2]}, s.r);
   for (int u = c0; u <= c1; ++u) {
-    const float t = IntersectCapsuleRay(c, ToFloat3(PrimaryRay(f.camera, u, v).d));
+    const float t = IntersectCapsuleRay(c, ToFloat3(PrimaryRay<true>(f.camera, u, v).d));
     if (!(t > 0)) continue;
     KeepNearestStreak(&f.splat.nearest[static_cast<int64_t>(v) * f.camera.width + u],
                       static_cast<unsigned long long>(StreakKey(t, k)));
@@ -1361,7 +1366,7 @@ PB_HOST_DEVICE inline void ShadeSplatPixel(const RealtimeFrameView& f, int u, in
   const StreakPod& s = f.splat.streaks.streaks[StreakKeyIndex(key)];
   const StreakSetPod& set = f.splat.streaks.sets[s.set];
   const Float3 a{s.a[0], s.a[1], s.a[2]}, b{s.b[0], s.b[1], s.b[2]};
-  const TraceRay r = PrimaryRay(f.camera, u, v);
+  const TraceRay r = PrimaryRay<true>(f.camera, u, v);
   const Float3 o = ToFloat3(r.o), d = ToFloat3(r.d);
   Float3 p, ng{0, 0, 1};
   if (set.kind == StreakKind::kRain) {
