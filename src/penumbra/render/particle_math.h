@@ -99,26 +99,28 @@ PB_HOST_DEVICE inline float IntersectCapsuleRay(const CapsuleOrigin& c, const Fl
 
 /// the unit normal at point p (world) on the capsule around [a, b], facing the ray of
 /// direction d (any length): p minus its nearest point on the axis, normalised (-d normalised
-/// where p lies on the axis), flipped towards the ray's origin; Eigen's operation order.
+/// where p lies on the axis), flipped towards the ray's origin; Eigen's operation order, each
+/// operation rounded on its own (EigenDotRn, MulRn, AddRn: the CPU's bits on the GPU).
 PB_HOST_DEVICE inline Float3 CapsuleNormal(const Float3& p, const Float3& a, const Float3& b,
                                            const Float3& d) {
   const Float3 ba = b - a;
-  const float l2 = EigenDot(ba, ba);
+  const float l2 = EigenDotRn(ba, ba);
   // std::clamp(x / std::max(l2, 1e-20f), 0, 1)
-  const float x = EigenDot(p - a, ba) / (l2 < 1e-20f ? 1e-20f : l2);
+  const float x = EigenDotRn(p - a, ba) / (l2 < 1e-20f ? 1e-20f : l2);
   const float w = x < 0.0f ? 0.0f : (1.0f < x ? 1.0f : x);
-  const Float3 q{a.x + w * ba.x, a.y + w * ba.y, a.z + w * ba.z};
+  const Float3 q{AddRn(a.x, MulRn(w, ba.x)), AddRn(a.y, MulRn(w, ba.y)),
+                 AddRn(a.z, MulRn(w, ba.z))};
   Float3 n = p - q;
-  const float nn = sqrtf(EigenDot(n, n));
+  const float nn = sqrtf(EigenDotRn(n, n));
   if (nn > 0) {
     n = Float3{n.x / nn, n.y / nn, n.z / nn};
   } else {
     // -(d normalised), as Eigen's normalized(): unchanged where its squared norm is 0
-    const float z = EigenDot(d, d);
+    const float z = EigenDotRn(d, d);
     const float s = z > 0 ? sqrtf(z) : 1.0f;
     n = z > 0 ? Float3{-(d.x / s), -(d.y / s), -(d.z / s)} : Float3{-d.x, -d.y, -d.z};
   }
-  if (EigenDot(n, d) > 0) n = Float3{-n.x, -n.y, -n.z};
+  if (EigenDotRn(n, d) > 0) n = Float3{-n.x, -n.y, -n.z};
   return n;
 }
 

@@ -1372,10 +1372,14 @@ PB_HOST_DEVICE inline void ShadeSplatPixel(const RealtimeFrameView& f, int u, in
   if (set.kind == StreakKind::kRain) {
     p = Float3{0.5f * (a.x + b.x), 0.5f * (a.y + b.y), 0.5f * (a.z + b.z)};
   } else {
-    ng = CapsuleNormal(Float3{o.x + t * d.x, o.y + t * d.y, o.z + t * d.z}, a, b, d);
-    const float d_len = sqrtf(EigenDot(d, d));
+    // the hit point and normal rounded as the CPU rounds them (AddRn, MulRn, EigenDotRn)
+    ng = CapsuleNormal(
+        Float3{AddRn(o.x, MulRn(t, d.x)), AddRn(o.y, MulRn(t, d.y)), AddRn(o.z, MulRn(t, d.z))}, a,
+        b, d);
+    const float d_len = sqrtf(EigenDotRn(d, d));
     const float td = t * d_len;
-    p = Float3{o.x + td * (d.x / d_len), o.y + td * (d.y / d_len), o.z + td * (d.z / d_len)};
+    p = Float3{AddRn(o.x, MulRn(td, d.x / d_len)), AddRn(o.y, MulRn(td, d.y / d_len)),
+               AddRn(o.z, MulRn(td, d.z / d_len))};
   }
   StreakPixel& out = f.splat.pixels[i];
   out.pixel = i;
