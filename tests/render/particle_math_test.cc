@@ -261,5 +261,151 @@ TEST(ParticleMathTest, ShadeEqualsTheOldCodeBitForBit) {
   EXPECT_GT(lit, 1000);  // snow lit by the lights, not only the sky
 }
 
+// ---- the realtime splat's projection before it moved to particle_math.h (branch gpu18), as
+// ParticleStreaks::BuildPixelHits ran it at main 58c0de3 ----
+
+struct OldProjection {
+  bool empty = true;
+  Eigen::Vector4i box{0, -1, 0, -1};
+  float ua = 0, va = 0, ub = 0, vb = 0, rp = 0;
+};
+
+OldProjection OldProject(const Eigen::Matrix3f& R_OW, const Eigen::Vector3f& p_OW,
+                         const CameraIntrinsics& k, const Eigen::Vector3f& a,
+                         const Eigen::Vector3f& b, float r) {
+  OldProjection out;
+  const int W = k.width, H = k.height;
+  constexpr float kNear = 0.01f;
+  Eigen::Vector3f ao = R_OW * a + p_OW;
+  Eigen::Vector3f bo = R_OW * b + p_OW;
+  const float zmin = kNear + r;
+  if (ao.z() < zmin && bo.z() < zmin) return out;
+  if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
+  if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
+  const float z_near = std::min(ao.z(), bo.z()) - r;
+  const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 1.0f;
+  const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
+  const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
+  const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
+  const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
+  out = OldProjection{
+      false,
+      Eigen::Vector4i(std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp))),
+                      std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp))),
+                      std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp))),
+                      std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp)))),
+      ua,
+      va,
+      ub,
+      vb,
+      rp};
+  return out;
+}
+
+void OldRowColumns(const OldProjection& p, int v, int* c0, int* c1) {
+  const float du = p.ub - p.ua, dv = p.vb - p.va;
+  float s0 = 0, s1 = 1;
+  if (std::abs(dv) > 1e-6f) {
+    s0 = std::clamp((v - p.rp - p.va) / dv, 0.0f, 1.0f);
+    s1 = std::clamp((v + p.rp - p.va) / dv, 0.0f, 1.0f);
+    if (s0 > s1) std::swap(s0, s1);
+  }
+  const float ul = std::min(p.ua + s0 * du, p.ua + s1 * du) - p.rp;
+  const float uh = std::max(p.ua + s0 * du, p.ua + s1 * du) + p.rp;
+  *c0 = std::max(p.box[0], static_cast<int>(std::floor(ul)));
+  *c1 = std::min(p.box[1], static_cast<int>(std::ceil(uh)));
+}
+
+// the realtime splat's projection (StreakToOptical, ProjectStreak, StreakRowColumns) and pixel
+// test (IntersectCapsuleRay), now shared by ParticleStreaks::BuildPixelHits and the CUDA
+// backend's splat kernel, against the code before the move, bit for bit: random pinhole cameras
+// (640x480 and 160x120, random poses) and streaks around them (in front, behind, crossing the
+// near plane, off the image; lengths up to 1 m, radii 0.1 mm to 5 cm), every row of every box,
+// and the pixel-centre rays of the first row's columns.
+TEST(ParticleMathTest, SplatProjectionEqualsTheOldCodeBitForBit) {
+  Rng rng(20261127);
+  int boxes = 0, clipped = 0, rows = 0, hits = 0;
+  constexpr int kCases = 100000;
+  for (int i = 0; i < kCases; ++i) {
+    CameraIntrinsics k = i % 2 == 0 ? CameraIntrinsics::FromFovy(640, 480, 40 + 40 * rng.Uniform())
+                                    : CameraIntrinsics::FromFovy(160, 120, 60);
+    k.cx += rng.Uniform() - 0.5;
+    const Eigen::Vector3d axis = RandomUnit(&rng).cast<double>();
+    Pose X_WO = Pose::Identity();
+    X_WO.linear() = Eigen::AngleAxisd(3 * rng.Uniform(), axis).toRotationMatrix();
+    X_WO.translation() = RandomIn(&rng, -5, 5).cast<double>();
+    const Camera camera(X_WO, k);
+    const Pose X_OW = X_WO.inverse();
+    const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+    const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_row = R_OW;
+    const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+    // a streak in the optical frame (z from -1 to 10 m), then in the world
+    const Eigen::Vector3f a_O(4 * (rng.Uniform() - 0.5f), 3 * (rng.Uniform() - 0.5f),
+                              -1 + 11 * rng.Uniform() * rng.Uniform());
+    const Eigen::Vector3f b_O = a_O + RandomIn(&rng, -0.5f, 0.5f);
+    const float r = 1e-4f + 0.05f * rng.Uniform() * rng.Uniform();
+    const Eigen::Vector3f a = (X_WO * a_O.cast<double>()).cast<float>();
+    const Eigen::Vector3f b = (X_WO * b_O.cast<double>()).cast<float>();
+    const Float3 ao = StreakToOptical(R_row.data(), AsFloat3(p_OW), AsFloat3(a));
+    ASSERT_TRUE(SameBits(ao, R_OW * a + p_OW)) << "case " << i;
+    const Float3 bo = StreakToOptical(R_row.data(), AsFloat3(p_OW), AsFloat3(b));
+    const StreakProjection now =
+        ProjectStreak(ao, bo, r, k.fx, k.fy, k.cx, k.cy, k.width, k.height);
+    const OldProjection old = OldProject(R_OW, p_OW, k, a, b, r);
+    if (old.empty) {
+      ASSERT_TRUE(now.empty()) << "case " << i;
+      continue;
+    }
+    ASSERT_TRUE(SameBits(now.ua, old.ua) && SameBits(now.va, old.va) && SameBits(now.ub, old.ub) &&
+                SameBits(now.vb, old.vb) && SameBits(now.rp, old.rp))
+        << "case " << i;
+    ASSERT_EQ(now.u0, old.box[0]) << "case " << i;
+    ASSERT_EQ(now.u1, old.box[1]) << "case " << i;
+    ASSERT_EQ(now.v0, old.box[2]) << "case " << i;
+    ASSERT_EQ(now.v1, old.box[3]) << "case " << i;
+    if (now.empty()) continue;
+    ++boxes;
+    clipped += (a_O.z() < 0.01f + r) != (b_O.z() < 0.01f + r) ? 1 : 0;
+    for (int v = now.v0; v <= now.v1; ++v) {
+      int c0, c1, o0, o1;
+      StreakRowColumns(now, v, &c0, &c1);
+      OldRowColumns(old, v, &o0, &o1);
+      ASSERT_EQ(c0, o0) << "case " << i << " row " << v;
+      ASSERT_EQ(c1, o1) << "case " << i << " row " << v;
+      ++rows;
+      if (v != now.v0) continue;
+      // the pixel test: t / |d| of the unit ray, as BuildPixelHits computed it
+      const CapsuleOrigin c =
+          MakeCapsuleOrigin(AsFloat3(camera.GenerateRay(0, 0).o), AsFloat3(a), AsFloat3(b), r);
+      for (int u = c0; u <= c1; ++u) {
+        const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+        const float len = ray.d.norm();
+        const float t = IntersectCapsule(c, AsFloat3(ray.d / len));
+        const float want = t > 0 ? t / len : -1.0f;
+        ASSERT_TRUE(SameBits(IntersectCapsuleRay(c, AsFloat3(ray.d)), want)) << "case " << i;
+        hits += t > 0 ? 1 : 0;
+      }
+    }
+  }
+  std::printf(
+      "%d projection cases: %d boxes in the image (%d clipped at the near plane), %d rows, "
+      "%d pixel hits\n",
+      kCases, boxes, clipped, rows, hits);
+  EXPECT_GT(boxes, kCases / 4);
+  EXPECT_GT(clipped, 100);
+  EXPECT_GT(hits, 1000);
+}
+
+// the splat's StreakKey: the smallest key is the nearest t, ties the lower index; its parts come
+// back unchanged.
+TEST(ParticleMathTest, StreakKeyOrdersByTThenIndex) {
+  EXPECT_LT(StreakKey(0.5f, 7), StreakKey(0.75f, 3));
+  EXPECT_LT(StreakKey(1e-30f, 100), StreakKey(2e-30f, 0));
+  EXPECT_LT(StreakKey(3.0f, 2), StreakKey(3.0f, 5));
+  EXPECT_LT(StreakKey(1e30f, 0x7ffffffe), kNoStreakKey);
+  EXPECT_EQ(StreakKeyT(StreakKey(1.25f, 123456)), 1.25f);
+  EXPECT_EQ(StreakKeyIndex(StreakKey(1.25f, 123456)), 123456);
+}
+
 }  // namespace
 }  // namespace penumbra

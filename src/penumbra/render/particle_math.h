@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/bsdf_math.h"
@@ -32,71 +33,212 @@ struct CapsuleOrigin {
   float baba = 0, baoa = 0, qc = 0, sc_a = 0, sc_b = 0;
 };
 
+/// a . b summed as Eigen sums it (EigenDot: x + (y + z)), every product and sum rounded on its
+/// own on both processors (MulRn, AddRn: no fused multiply-add on the device), so that the
+/// ray-capsule test below gives the CPU's bits on the GPU.
+PB_HOST_DEVICE inline float EigenDotRn(const Float3& a, const Float3& b) {
+  return AddRn(MulRn(a.x, b.x), AddRn(MulRn(a.y, b.y), MulRn(a.z, b.z)));
+}
+
 /// the CapsuleOrigin of origin o (world, m) and the capsule around [a, b] of radius r (m), dot
-/// products summed as Eigen's (EigenDot).
+/// products summed as Eigen's (EigenDotRn); each operation rounded on its own (the CPU's bits
+/// on the GPU too).
 PB_HOST_DEVICE inline CapsuleOrigin MakeCapsuleOrigin(const Float3& o, const Float3& a,
                                                       const Float3& b, float r) {
   CapsuleOrigin c;
   c.ba = b - a;
   c.oa = o - a;
   c.ob = o - b;
-  c.baba = EigenDot(c.ba, c.ba);
-  c.baoa = EigenDot(c.ba, c.oa);
-  const float oaoa = EigenDot(c.oa, c.oa);
-  c.qc = c.baba * oaoa - c.baoa * c.baoa - r * r * c.baba;
-  c.sc_a = EigenDot(c.oa, c.oa) - r * r;
-  c.sc_b = EigenDot(c.ob, c.ob) - r * r;
+  c.baba = EigenDotRn(c.ba, c.ba);
+  c.baoa = EigenDotRn(c.ba, c.oa);
+  const float oaoa = EigenDotRn(c.oa, c.oa);
+  const float rr = MulRn(r, r);
+  c.qc = SubRn(SubRn(MulRn(c.baba, oaoa), MulRn(c.baoa, c.baoa)), MulRn(rr, c.baba));
+  c.sc_a = SubRn(EigenDotRn(c.oa, c.oa), rr);
+  c.sc_b = SubRn(EigenDotRn(c.ob, c.ob), rr);
   return c;
 }
 
 /// nearest t > 0 (m) where the ray o + t d (d unit, o that of `c`) meets the capsule, or -1
 /// (Quilez, "Capsule - intersection", 2014: the infinite cylinder, then the nearer end sphere).
-/// a ray that starts inside the capsule misses it.
+/// a ray that starts inside the capsule misses it. each operation rounded on its own (MulRn,
+/// AddRn, SubRn): the test is ill-conditioned for thin capsules far away (the discriminant is a
+/// difference of nearly equal products), so a fused multiply-add would move the edge of a
+/// widened streak by a good part of its radius; this way the GPU gives the CPU's bits.
 PB_HOST_DEVICE inline float IntersectCapsule(const CapsuleOrigin& c, const Float3& d) {
-  const float bard = EigenDot(c.ba, d), rdoa = EigenDot(d, c.oa);
-  const float qa = c.baba - bard * bard;
-  const float qb = c.baba * rdoa - c.baoa * bard;
-  float h = qb * qb - qa * c.qc;
+  const float bard = EigenDotRn(c.ba, d), rdoa = EigenDotRn(d, c.oa);
+  const float qa = SubRn(c.baba, MulRn(bard, bard));
+  const float qb = SubRn(MulRn(c.baba, rdoa), MulRn(c.baoa, bard));
+  float h = SubRn(MulRn(qb, qb), MulRn(qa, c.qc));
   float y;
   if (qa > 1e-12f) {
     if (h < 0) return -1.0f;  // misses the infinite cylinder, so the capsule too
     const float t = (-qb - sqrtf(h)) / qa;
-    y = c.baoa + t * bard;
+    y = AddRn(c.baoa, MulRn(t, bard));
     if (y > 0 && y < c.baba) return t > 0 ? t : -1.0f;
   } else {
     y = bard > 0 ? -1.0f : c.baba + 1.0f;  // along the axis: the nearer end
   }
   const bool at_a = y <= 0;
-  const float sb = EigenDot(d, at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
-  h = sb * sb - sc;
+  const float sb = EigenDotRn(d, at_a ? c.oa : c.ob), sc = at_a ? c.sc_a : c.sc_b;
+  h = SubRn(MulRn(sb, sb), sc);
   if (h <= 0) return -1.0f;
   const float t = -sb - sqrtf(h);
   return t > 0 ? t : -1.0f;
 }
 
+/// the t (in units of |d|: the pixel's depth for a camera ray) where the ray o + t d (d any
+/// length, o that of `c`) meets the capsule, or -1: IntersectCapsule along d / |d| (|d| summed
+/// as Eigen's norm()), divided by |d|. the realtime splat's pixel test (ParticleStreaks and the
+/// CUDA backend's splat kernel).
+PB_HOST_DEVICE inline float IntersectCapsuleRay(const CapsuleOrigin& c, const Float3& d) {
+  const float len = sqrtf(EigenDotRn(d, d));
+  const float t = IntersectCapsule(c, Float3{d.x / len, d.y / len, d.z / len});
+  return t > 0 ? t / len : -1.0f;
+}
+
 /// the unit normal at point p (world) on the capsule around [a, b], facing the ray of
 /// direction d (any length): p minus its nearest point on the axis, normalised (-d normalised
-/// where p lies on the axis), flipped towards the ray's origin; Eigen's operation order.
+/// where p lies on the axis), flipped towards the ray's origin; Eigen's operation order, each
+/// operation rounded on its own (EigenDotRn, MulRn, AddRn: the CPU's bits on the GPU).
 PB_HOST_DEVICE inline Float3 CapsuleNormal(const Float3& p, const Float3& a, const Float3& b,
                                            const Float3& d) {
   const Float3 ba = b - a;
-  const float l2 = EigenDot(ba, ba);
+  const float l2 = EigenDotRn(ba, ba);
   // std::clamp(x / std::max(l2, 1e-20f), 0, 1)
-  const float x = EigenDot(p - a, ba) / (l2 < 1e-20f ? 1e-20f : l2);
+  const float x = EigenDotRn(p - a, ba) / (l2 < 1e-20f ? 1e-20f : l2);
   const float w = x < 0.0f ? 0.0f : (1.0f < x ? 1.0f : x);
-  const Float3 q{a.x + w * ba.x, a.y + w * ba.y, a.z + w * ba.z};
+  const Float3 q{AddRn(a.x, MulRn(w, ba.x)), AddRn(a.y, MulRn(w, ba.y)),
+                 AddRn(a.z, MulRn(w, ba.z))};
   Float3 n = p - q;
-  const float nn = sqrtf(EigenDot(n, n));
+  const float nn = sqrtf(EigenDotRn(n, n));
   if (nn > 0) {
     n = Float3{n.x / nn, n.y / nn, n.z / nn};
   } else {
     // -(d normalised), as Eigen's normalized(): unchanged where its squared norm is 0
-    const float z = EigenDot(d, d);
+    const float z = EigenDotRn(d, d);
     const float s = z > 0 ? sqrtf(z) : 1.0f;
     n = z > 0 ? Float3{-(d.x / s), -(d.y / s), -(d.z / s)} : Float3{-d.x, -d.y, -d.z};
   }
-  if (EigenDot(n, d) > 0) n = Float3{-n.x, -n.y, -n.z};
+  if (EigenDotRn(n, d) > 0) n = Float3{-n.x, -n.y, -n.z};
   return n;
+}
+
+/// near plane (m, optical-frame depth) of the realtime tier's streak splat: drops wholly in
+/// front of it are not drawn, and a streak's segment is clipped to kStreakNear + r.
+constexpr float kStreakNear = 0.01f;
+
+/// a streak as the realtime tier's splat sees it: the pixel box [u0, u1] x [v0, v1] whose
+/// pixel-centre rays are tested against its capsule (empty: u0 > u1 or v0 > v1) and its
+/// projected segment (ua, va) - (ub, vb) (px) with the capsule's projected radius rp (px, one
+/// pixel of margin included).
+struct StreakProjection {
+  int u0 = 0, u1 = -1, v0 = 0, v1 = -1;
+  float ua = 0, va = 0, ub = 0, vb = 0, rp = 0;
+  PB_HOST_DEVICE bool empty() const { return u0 > u1 || v0 > v1; }
+};
+
+/// world point p (m) in a camera's optical frame: R_OW p + p_OW (R_OW row-major), each row's
+/// dot product summed as Eigen's Matrix3f * Vector3f sums it (EigenDotRn), then the offset;
+/// each operation rounded on its own (the CPU's bits on the GPU).
+PB_HOST_DEVICE inline Float3 StreakToOptical(const float R_OW[9], const Float3& p_OW,
+                                             const Float3& p) {
+  return Float3{AddRn(EigenDotRn(Float3{R_OW[0], R_OW[1], R_OW[2]}, p), p_OW.x),
+                AddRn(EigenDotRn(Float3{R_OW[3], R_OW[4], R_OW[5]}, p), p_OW.y),
+                AddRn(EigenDotRn(Float3{R_OW[6], R_OW[7], R_OW[8]}, p), p_OW.z)};
+}
+
+/// the realtime splat's projection of the capsule around [ao, bo] (optical frame, m; z
+/// forward) of radius r (m) into a W x H image of pinhole intrinsics fx, fy, cx, cy (px, as
+/// CameraIntrinsics): the segment clipped to z >= kStreakNear + r (empty when both ends lie in
+/// front of that), both ends projected (in double, then rounded to float), rp = max(fx, fy) r /
+/// (nearest z - r) + 1 px, and the box of the projected segment widened by rp, clamped to the
+/// image (empty when outside it). lens distortion is ignored: it moves pixels by more than the
+/// margin only far from the centre, where a streak may then be clipped. products and sums
+/// rounded on their own (the CPU's bits on the GPU: the same pixels tested).
+/// (ParticleStreaks::BuildPixelHits and the CUDA backend's splat kernel.)
+PB_HOST_DEVICE inline StreakProjection ProjectStreak(Float3 ao, Float3 bo, float r, double fx,
+                                                     double fy, double cx, double cy, int W,
+                                                     int H) {
+  StreakProjection p;
+  const float zmin = kStreakNear + r;
+  if (ao.z < zmin && bo.z < zmin) return p;
+  if (ao.z < zmin) {
+    const float s = (bo.z - zmin) / (bo.z - ao.z);
+    ao = Float3{AddRn(bo.x, MulRn(ao.x - bo.x, s)), AddRn(bo.y, MulRn(ao.y - bo.y, s)),
+                AddRn(bo.z, MulRn(ao.z - bo.z, s))};
+  }
+  if (bo.z < zmin) {
+    const float s = (ao.z - zmin) / (ao.z - bo.z);
+    bo = Float3{AddRn(ao.x, MulRn(bo.x - ao.x, s)), AddRn(ao.y, MulRn(bo.y - ao.y, s)),
+                AddRn(ao.z, MulRn(bo.z - ao.z, s))};
+  }
+  const float z_near = (ao.z < bo.z ? ao.z : bo.z) - r;
+  const float f_max = static_cast<float>(fx < fy ? fy : fx);
+  p.rp = f_max * r / (z_near < kStreakNear ? kStreakNear : z_near) + 1.0f;
+  p.ua = static_cast<float>(fx * static_cast<double>(ao.x) / static_cast<double>(ao.z) + cx);
+  p.va = static_cast<float>(fy * static_cast<double>(ao.y) / static_cast<double>(ao.z) + cy);
+  p.ub = static_cast<float>(fx * static_cast<double>(bo.x) / static_cast<double>(bo.z) + cx);
+  p.vb = static_cast<float>(fy * static_cast<double>(bo.y) / static_cast<double>(bo.z) + cy);
+  const int u0 = static_cast<int>(floorf((p.ua < p.ub ? p.ua : p.ub) - p.rp));
+  const int u1 = static_cast<int>(ceilf((p.ua < p.ub ? p.ub : p.ua) + p.rp));
+  const int v0 = static_cast<int>(floorf((p.va < p.vb ? p.va : p.vb) - p.rp));
+  const int v1 = static_cast<int>(ceilf((p.va < p.vb ? p.vb : p.va) + p.rp));
+  p.u0 = u0 < 0 ? 0 : u0;
+  p.u1 = u1 < W - 1 ? u1 : W - 1;
+  p.v0 = v0 < 0 ? 0 : v0;
+  p.v1 = v1 < H - 1 ? v1 : H - 1;
+  return p;
+}
+
+/// the columns [*c0, *c1] of row v (within the box of `p`) whose pixel centres lie within rp of
+/// the part of the projected segment near that row: the segment's parameters where its v is
+/// v -+ rp (the whole segment when it is nearly horizontal), their u -+ rp. (the splat tests
+/// only these pixels of the row; empty: *c0 > *c1.)
+PB_HOST_DEVICE inline void StreakRowColumns(const StreakProjection& p, int v, int* c0, int* c1) {
+  const float du = p.ub - p.ua, dv = p.vb - p.va;
+  float s0 = 0, s1 = 1;
+  if (fabsf(dv) > 1e-6f) {
+    // std::clamp(x, 0, 1)
+    const float x0 = (static_cast<float>(v) - p.rp - p.va) / dv;
+    const float x1 = (static_cast<float>(v) + p.rp - p.va) / dv;
+    s0 = x0 < 0.0f ? 0.0f : (1.0f < x0 ? 1.0f : x0);
+    s1 = x1 < 0.0f ? 0.0f : (1.0f < x1 ? 1.0f : x1);
+    if (s0 > s1) {
+      const float t = s0;
+      s0 = s1;
+      s1 = t;
+    }
+  }
+  const float e0 = AddRn(p.ua, MulRn(s0, du)), e1 = AddRn(p.ua, MulRn(s1, du));
+  const float ul = (e0 < e1 ? e0 : e1) - p.rp;
+  const float uh = (e0 < e1 ? e1 : e0) + p.rp;
+  const int l = static_cast<int>(floorf(ul)), h = static_cast<int>(ceilf(uh));
+  *c0 = p.u0 < l ? l : p.u0;
+  *c1 = h < p.u1 ? h : p.u1;
+}
+
+/// a pixel's StreakKey when no streak meets its ray (larger than every key).
+constexpr uint64_t kNoStreakKey = ~uint64_t{0};
+
+/// the nearest streak of a pixel as one 64-bit key: the float bits of its t (> 0, so they sort
+/// as unsigned integers) above its index, so that the smallest key is the nearest streak and,
+/// at equal t, the lower index (the host splat's rule). an integer minimum does not depend on
+/// the order the keys arrive in (the device's atomicMin), so the splat is deterministic.
+PB_HOST_DEVICE inline uint64_t StreakKey(float t, int32_t index) {
+  uint32_t bits;
+  std::memcpy(&bits, &t, sizeof(bits));
+  return (static_cast<uint64_t>(bits) << 32) | static_cast<uint32_t>(index);
+}
+/// the t and index of a StreakKey.
+PB_HOST_DEVICE inline float StreakKeyT(uint64_t key) {
+  const uint32_t bits = static_cast<uint32_t>(key >> 32);
+  float t;
+  std::memcpy(&t, &bits, sizeof(t));
+  return t;
+}
+PB_HOST_DEVICE inline int32_t StreakKeyIndex(uint64_t key) {
+  return static_cast<int32_t>(static_cast<uint32_t>(key & 0xffffffffu));
 }
 
 /// a particle set's kind as the shared shading takes it (ParticleKind's values).

@@ -1,7 +1,6 @@
 #include "penumbra/render/particle_streaks.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -15,9 +14,6 @@
 namespace penumbra {
 
 namespace {
-
-// near plane (m, optical-frame depth) of the realtime tier's streak splatting.
-constexpr float kPixelNear = 0.01f;
 
 // per frame, per homogeneous medium: what RainInvisible needs of it that does not depend on
 // the streak.
@@ -104,7 +100,7 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   const bool pixel_hits = rays == StreakRays::kPixelCentres;
   // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
   // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
-  // would give them an empty pixel box: it clips at kPixelNear + radius >= kPixelNear).
+  // would give them an empty pixel box: it clips at kStreakNear + radius >= kStreakNear).
   const Pose X_OW = camera.X_WO().inverse();
   const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
   const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
@@ -179,8 +175,8 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
     Eigen::Vector3f q = p + T * v;
     // a still particle: a capsule of negligible length (Embree needs two distinct ends).
     if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
-    if (pixel_hits && depth(p) < kPixelNear && depth(q) < kPixelNear) return;  // never drawn
-    if (frustum && outside(p, q, r)) return;                                   // never drawn
+    if (pixel_hits && depth(p) < kStreakNear && depth(q) < kStreakNear) return;  // never drawn
+    if (frustum && outside(p, q, r)) return;                                     // never drawn
     const float len = T * v.norm();  // the motion, not the widened capsule
     // widen to half a pixel at the streak's nearest distance to the camera.
     const Eigen::Vector3f seg = q - p;
@@ -251,7 +247,7 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   }
   count_ = static_cast<int>(alpha_.size());
   if (count_ == 0) return;
-  if (pixel_hits) BuildPixelHits(camera, pool);
+  if (pixel_hits && host_splat_) BuildPixelHits(camera, pool);
 }
 
 namespace {
@@ -268,35 +264,16 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   pixel_hits_built_ = true;
   const CameraIntrinsics& k = camera.intrinsics();
   const Pose X_OW = camera.X_WO().inverse();
-  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
-  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
-  constexpr float kNear = kPixelNear;
-  // pixel box and projected segment (ua, va, ub, vb, rp) of every streak, in parallel chunks
+  const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
+  const Float3 p_OW = StreakF3(X_OW.translation().cast<float>());
+  // pixel box and projected segment of every streak (the shared ProjectStreak of
+  // render/particle_math.h, which the CUDA backend's splat calls too), in parallel chunks
   // (empty box when behind the camera or outside the image).
-  std::vector<Eigen::Vector4i> box(count_, Eigen::Vector4i(0, -1, 0, -1));
-  std::vector<std::array<float, 5>> seg2(count_);
+  std::vector<StreakProjection> box(count_);
   auto project = [&](int n) {
-    const float r = ends_[2 * n].w();
-    // the segment in the optical frame, clipped to z >= kNear + r.
-    Eigen::Vector3f ao = R_OW * ends_[2 * n].head<3>() + p_OW;
-    Eigen::Vector3f bo = R_OW * ends_[2 * n + 1].head<3>() + p_OW;
-    const float zmin = kNear + r;
-    if (ao.z() < zmin && bo.z() < zmin) return;
-    if (ao.z() < zmin) ao = bo + (ao - bo) * ((bo.z() - zmin) / (bo.z() - ao.z()));
-    if (bo.z() < zmin) bo = ao + (bo - ao) * ((ao.z() - zmin) / (ao.z() - bo.z()));
-    // pinhole projection with a margin of 1 px (rounding; lens distortion moves pixels by more
-    // only far from the centre, where a streak may then be clipped).
-    const float z_near = std::min(ao.z(), bo.z()) - r;
-    const float rp = static_cast<float>(std::max(k.fx, k.fy)) * r / std::max(z_near, kNear) + 1.0f;
-    const float ua = static_cast<float>(k.fx * ao.x() / ao.z() + k.cx);
-    const float va = static_cast<float>(k.fy * ao.y() / ao.z() + k.cy);
-    const float ub = static_cast<float>(k.fx * bo.x() / bo.z() + k.cx);
-    const float vb = static_cast<float>(k.fy * bo.y() / bo.z() + k.cy);
-    seg2[n] = {ua, va, ub, vb, rp};
-    box[n] = Eigen::Vector4i(std::max(0, static_cast<int>(std::floor(std::min(ua, ub) - rp))),
-                             std::min(W - 1, static_cast<int>(std::ceil(std::max(ua, ub) + rp))),
-                             std::max(0, static_cast<int>(std::floor(std::min(va, vb) - rp))),
-                             std::min(H - 1, static_cast<int>(std::ceil(std::max(va, vb) + rp))));
+    const Float3 ao = StreakToOptical(R_OW.data(), p_OW, StreakF3(ends_[2 * n].head<3>()));
+    const Float3 bo = StreakToOptical(R_OW.data(), p_OW, StreakF3(ends_[2 * n + 1].head<3>()));
+    box[n] = ProjectStreak(ao, bo, ends_[2 * n].w(), k.fx, k.fy, k.cx, k.cy, W, H);
   };
   constexpr int kChunk = 4096;
   const int chunks = (count_ + kChunk - 1) / kChunk;
@@ -313,10 +290,10 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   std::vector<std::vector<int>> in_band(bands);
   visible_.assign(count_, 0);
   for (int n = 0; n < count_; ++n) {
-    const Eigen::Vector4i& bx = box[n];
-    if (bx[0] > bx[1] || bx[2] > bx[3]) continue;
+    const StreakProjection& bx = box[n];
+    if (bx.empty()) continue;
     visible_[n] = 1;
-    for (int bi = bx[2] / kBand; bi <= bx[3] / kBand; ++bi) in_band[bi].push_back(n);
+    for (int bi = bx.v0 / kBand; bi <= bx.v1 / kBand; ++bi) in_band[bi].push_back(n);
   }
   const Eigen::Vector3f o_shared = camera.GenerateRay(0.0f, 0.0f).o;
   auto band = [&](int64_t bi) {
@@ -324,41 +301,29 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
     const size_t p0 = static_cast<size_t>(r0) * W, p1 = static_cast<size_t>(r1 + 1) * W;
     std::fill(pixel_.begin() + p0, pixel_.begin() + p1, PixelStreak());
     for (int n : in_band[bi]) {
-      const Eigen::Vector4i& bx = box[n];
-      const int v0 = std::max(bx[2], r0), v1 = std::min(bx[3], r1);
-      if (v0 > v1 || bx[0] > bx[1]) continue;
+      const StreakProjection& bx = box[n];
+      const int v0 = std::max(bx.v0, r0), v1 = std::min(bx.v1, r1);
+      if (v0 > v1 || bx.u0 > bx.u1) continue;
       const Eigen::Vector3f a = ends_[2 * n].head<3>(), b = ends_[2 * n + 1].head<3>();
       const float r = ends_[2 * n].w();
       // the origin-dependent terms once per streak for the camera centre (every pixel's ray
       // origin unless the camera moves during the exposure: then per pixel).
       const CapsuleOrigin shared =
           MakeCapsuleOrigin(StreakF3(o_shared), StreakF3(a), StreakF3(b), r);
-      const auto& [ua, va, ub, vb, rp] = seg2[n];
-      const float du = ub - ua, dv = vb - va;
       for (int v = v0; v <= v1; ++v) {
         // the columns within rp of the projected segment's part near this row.
-        float s0 = 0, s1 = 1;
-        if (std::abs(dv) > 1e-6f) {
-          s0 = std::clamp((v - rp - va) / dv, 0.0f, 1.0f);
-          s1 = std::clamp((v + rp - va) / dv, 0.0f, 1.0f);
-          if (s0 > s1) std::swap(s0, s1);
-        }
-        const float ul = std::min(ua + s0 * du, ua + s1 * du) - rp;
-        const float uh = std::max(ua + s0 * du, ua + s1 * du) + rp;
-        const int c0 = std::max(bx[0], static_cast<int>(std::floor(ul)));
-        const int c1 = std::min(bx[1], static_cast<int>(std::ceil(uh)));
+        int c0, c1;
+        StreakRowColumns(bx, v, &c0, &c1);
         for (int u = c0; u <= c1; ++u) {
           const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
-          const float len = ray.d.norm();
-          const Float3 d = StreakF3(ray.d / len);
-          const float t =
+          const Float3 d = StreakF3(ray.d);
+          const float t_ray =
               ray.o == o_shared
-                  ? IntersectCapsule(shared, d)
-                  : IntersectCapsule(
+                  ? IntersectCapsuleRay(shared, d)
+                  : IntersectCapsuleRay(
                         MakeCapsuleOrigin(StreakF3(ray.o), StreakF3(a), StreakF3(b), r), d);
-          if (!(t > 0)) continue;
+          if (!(t_ray > 0)) continue;
           const size_t at = static_cast<size_t>(v) * W + u;
-          const float t_ray = t / len;
           if (t_ray < pixel_[at].t) pixel_[at] = PixelStreak{t_ray, n};
         }
       }

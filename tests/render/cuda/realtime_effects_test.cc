@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 
@@ -102,9 +103,11 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
     EffectsFrame no_particles = *fx;
     no_particles.particles.clear();
     const HostCompared bare = CompareWithCpu(scene, snap, view, &no_particles);
-    // the streak pixels of the frame
+    // the streak pixels of the frame (the host splat's list: the device splat finds the same,
+    // DeviceSplatGivesTheHostSplatsImageByteForByte)
     RenderSettings settings;
     cuda::RealtimeFrameData data(scene, settings);
+    data.set_device_streaks(false);
     ThreadPool pool(0);
     data.Prepare(snap, view, &pool, fx.get());
     const std::vector<cuda::StreakPixel>& streaks = data.streaks();
@@ -126,6 +129,79 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
     EXPECT_LE(c.depth_bad, 0.001);
     EXPECT_LT(err, 0.1 * bare_err);
     EXPECT_EQ(c.host.rgb.data, c.again.rgb.data);
+  }
+}
+
+// the realtime particle streaks splatted and shaded by the frame itself (branch gpu18, the
+// default: StreakSplatView, here on the CPU by RenderRealtimeOnHost, the kernels' functions)
+// give the host splat's image (RealtimeFrameData::set_device_streaks(false): the CPU's
+// ParticleStreaks splat, PrecomputeRain and Shade, as before) byte for byte: rain and snow (the
+// rover's camera, shelter and rain culling) and fire (sparks seen through the fire's grid
+// media: MediaViewQuad) at 1 s, 160x120. the splat's keys give every pixel the host's nearest
+// streak (the same pixels, t and coverage); two renders are bit-identical; the frame without
+// its particles differs (so the comparison can fail).
+TEST(RealtimeHostPathEffectsFrames, DeviceSplatGivesTheHostSplatsImageByteForByte) {
+  for (const char* file : {"effects/rain.yaml", "effects/snow.yaml", "effects/fire.yaml"}) {
+    SCOPED_TRACE(file);
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 160, 120);
+    const SceneDescription& scene = session->scene();
+    ASSERT_TRUE(fx && !fx->particles.empty());
+    cuda::BvhScene bvh(scene);
+    bvh.Update(snap);
+    ThreadPool pool(0);
+    cuda::RealtimeFrameData data(scene, RenderSettings());
+    RenderedFrame host, device, again, bare;
+    data.set_device_streaks(false);
+    data.Prepare(snap, view, &pool, fx.get());
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &host, /*stored_surface=*/true);
+    const std::vector<cuda::StreakPixel> host_pixels = data.streaks();
+    ASSERT_EQ(data.splat_streaks().View().num, 0);
+    data.set_device_streaks(true);
+    data.Prepare(snap, view, &pool, fx.get());
+    EXPECT_TRUE(data.streaks().empty());
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &device, /*stored_surface=*/true);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &again, /*stored_surface=*/true);
+    // the splat's keys, as RenderRealtimeOnHost makes them
+    const int W = view.intrinsics.width, H = view.intrinsics.height;
+    cuda::RealtimeFrameView f = data.View(bvh.view(), nullptr);
+    const cuda::PathStreaks& list = f.splat.streaks;
+    ASSERT_GT(list.num, 0);
+    std::vector<unsigned long long> nearest(static_cast<size_t>(W) * H, kNoStreakKey);
+    f.splat.nearest = nearest.data();
+    for (int k = 0; k < list.num; ++k) {
+      const StreakProjection p = cuda::SplatProjection(f, list.streaks[k]);
+      for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) cuda::SplatStreakRow(f, k, p, v);
+    }
+    size_t keyed = 0;
+    for (unsigned long long key : nearest) keyed += key != kNoStreakKey ? 1 : 0;
+    EXPECT_EQ(keyed, host_pixels.size());
+    for (const cuda::StreakPixel& s : host_pixels) {
+      const unsigned long long key = nearest[s.pixel];
+      ASSERT_NE(key, kNoStreakKey) << "pixel " << s.pixel;
+      EXPECT_EQ(StreakKeyT(key), s.t) << "pixel " << s.pixel;
+      EXPECT_EQ(list.streaks[StreakKeyIndex(key)].alpha, s.alpha) << "pixel " << s.pixel;
+    }
+    EffectsFrame no_particles = *fx;
+    no_particles.particles.clear();
+    data.Prepare(snap, view, &pool, &no_particles);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &bare, /*stored_surface=*/true);
+    int64_t changed = 0;
+    for (size_t i = 0; i < bare.radiance.data.size(); i += 3)
+      changed += std::memcmp(&bare.radiance.data[i], &device.radiance.data[i], 12) != 0 ? 1 : 0;
+    std::printf(
+        "%s at 1 s 160x120: %d streaks after the host's culling, %zu streak pixels (host splat) "
+        "and %zu (device splat); rgb PSNR device splat vs host splat %.2f dB, without the "
+        "particles %.2f dB (%lld pixels' radiance changed by them)\n",
+        file, list.num, host_pixels.size(), keyed, realtime_parity::Psnr(host.rgb, device.rgb),
+        realtime_parity::Psnr(host.rgb, bare.rgb), static_cast<long long>(changed));
+    EXPECT_GT(host_pixels.size(), 0u);
+    EXPECT_EQ(device.rgb.data, host.rgb.data);
+    EXPECT_EQ(device.radiance.data, host.radiance.data);
+    EXPECT_EQ(device.depth_m.data, host.depth_m.data);
+    EXPECT_EQ(device.ev100, host.ev100);
+    EXPECT_EQ(device.radiance.data, again.radiance.data);
+    EXPECT_GT(changed, 0);
+    EXPECT_NE(bare.radiance.data, device.radiance.data);
   }
 }
 

@@ -11,6 +11,9 @@
 //   - cpu depth+seg and cpu rgb+depth (realtime tier), all cores;
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
 //     them, cuda Render() (on the GPU for every effect since branch gpu12) and cpu Render();
+//     with particles also cuda Render() with the streaks splatted on the host (as before branch
+//     gpu18: RealtimeFrameData::set_device_streaks(false)) and with the device splat again, and
+//     the host's preparation of both;
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
@@ -865,6 +868,28 @@ int Main(int argc, char** argv) {
       if (gpu && with_fx) {
         rows.push_back({name, size, fx_outputs, "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+        if (!fx->particles.empty()) {
+          // the particle streaks splatted on the device (the default, branch gpu18) against the
+          // host splat of before (RealtimeFrameData::set_device_streaks(false)), then the device
+          // again (drift)
+          auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+          const double prep_device = g->last_prepare_ms();
+          const int streaks = g->realtime_frame().splat_streaks().View().num;
+          g->realtime_frame().set_device_streaks(false);
+          const double host_fps = 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get());
+          const double prep_host = g->last_prepare_ms();
+          const size_t host_pixels = g->realtime_frame().streaks().size();
+          g->realtime_frame().set_device_streaks(true);
+          rows.push_back({name, size, "rgb+depth realtime + effects, streaks splatted on the host",
+                          "cuda", "Render()", host_fps});
+          rows.push_back({name, size, "rgb+depth realtime + effects (on GPU), again", "cuda",
+                          "Render()", 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+          builds.push_back(fmt::format(
+              "{} {}: particles: {} streaks after the host's culling, {} streak pixels; host "
+              "preparation {:.2f} ms a frame with the device splat, {:.2f} ms with the host splat "
+              "(CudaRenderer::last_prepare_ms of the last timed frame)",
+              name, size, streaks, host_pixels, prep_device, prep_host));
+        }
         if (!fx->homogeneous_media.empty() || !fx->grid_media.empty())
           builds.push_back(fmt::format(
               "{} {}: effects frame with media on the GPU: host preparation {:.2f} ms a frame "

@@ -355,6 +355,11 @@ class DeviceRealtime {
   /// media_build.grids) copied into *out (tests); false (*out untouched) if it built none.
   /// @throws Error on a CUDA failure.
   bool DownloadGridVolumes(GridVolumeArrays* out) const;
+  /// the realtime splat's per-pixel StreakKeys of the last Render (StreakSplatView::nearest,
+  /// width x height, row-major; render/particle_math.h's kNoStreakKey where no streak) copied
+  /// into *out (tests); false (*out untouched) if that frame splatted none.
+  /// @throws Error on a CUDA failure.
+  bool DownloadStreakKeys(std::vector<unsigned long long>* out) const;
 
  private:
   struct Impl;

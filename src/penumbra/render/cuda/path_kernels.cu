@@ -12,6 +12,7 @@
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/media_grid_upload.h"
 #include "penumbra/render/cuda/path_shading.h"
+#include "penumbra/render/cuda/streak_upload.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -83,7 +84,7 @@ struct DevicePath::Impl {
   PathEmitters emitters;
   Buffer media_pods, media_terms, grid_pods, grid_density, grid_emission;
   MediaSceneView media;
-  Buffer streak_nodes, streak_pods, streak_sets, streak_rain;
+  StreakBuffers streak_buffers;
   PathStreaks streaks;
   PathFrameView last;  // the last Render's frame and sample runs (TimeKernel)
   int runs = 1;
@@ -183,17 +184,8 @@ const MediaSceneView& DevicePath::UploadMedia(const MediaSceneView& h) {
 
 const PathStreaks& DevicePath::UploadStreaks(const PathStreaks& h) {
   Impl& m = *impl_;
-  m.streaks = h;
-  if (h.num <= 0) return m.streaks;
-  m.streak_nodes.Upload(h.nodes, sizeof(BvhWideNode) * h.root.num_nodes, nullptr);
-  m.streak_pods.Upload(h.streaks, sizeof(StreakPod) * h.num, nullptr);
-  m.streak_sets.Upload(h.sets, sizeof(StreakSetPod) * h.num_sets, nullptr);
-  m.streak_rain.Upload(h.rain, sizeof(Float3) * h.num_rain, nullptr);
-  Check(cudaStreamSynchronize(nullptr), "uploading the particle streaks");
-  m.streaks.nodes = h.root.num_nodes > 0 ? m.streak_nodes.as<BvhWideNode>() : nullptr;
-  m.streaks.streaks = m.streak_pods.as<StreakPod>();
-  m.streaks.sets = m.streak_sets.as<StreakSetPod>();
-  m.streaks.rain = h.num_rain > 0 ? m.streak_rain.as<Float3>() : nullptr;
+  m.streaks = m.streak_buffers.Upload(h, nullptr);
+  if (h.num > 0) Check(cudaStreamSynchronize(nullptr), "uploading the particle streaks");
   return m.streaks;
 }
 

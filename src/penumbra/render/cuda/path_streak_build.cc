@@ -39,9 +39,30 @@ void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3
   order_.clear();
   BuildBvh(boxes_, 0, &binary_, &order_, pool);
   WidenBvh(binary_, &nodes_, &root_);
+  FillPods(streaks, order_.data());
+  for (const Eigen::Vector3f& L : streaks.rain_radiance())
+    rain_.push_back(Float3{L.x(), L.y(), L.z()});
+  build_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void PathStreakBuild::BuildList(const ParticleStreaks& streaks,
+                                const Eigen::Vector3f& sky_ambient) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Clear();
+  sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
+  if (streaks.size() == 0 || streaks.frame() == nullptr) return;
+  FillPods(streaks, nullptr);
+  build_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void PathStreakBuild::FillPods(const ParticleStreaks& streaks, const int32_t* order) {
+  const int n = streaks.size();
+  const std::vector<Eigen::Vector4f>& ends = streaks.ends();
   pods_.resize(n);
   for (int k = 0; k < n; ++k) {
-    const int i = order_[k];
+    const int i = order != nullptr ? order[k] : k;
     StreakPod& p = pods_[k];
     for (int c = 0; c < 3; ++c) p.a[c] = ends[2 * i][c], p.b[c] = ends[2 * i + 1][c];
     p.r = ends[2 * i].w();
@@ -51,10 +72,6 @@ void PathStreakBuild::Build(const ParticleStreaks& streaks, const Eigen::Vector3
   }
   const int num_sets = static_cast<int>(streaks.frame()->particles.size());
   for (int s = 0; s < num_sets; ++s) sets_.push_back(streaks.SetPod(s));
-  for (const Eigen::Vector3f& L : streaks.rain_radiance())
-    rain_.push_back(Float3{L.x(), L.y(), L.z()});
-  build_ms_ =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 PathStreaks PathStreakBuild::View() const {

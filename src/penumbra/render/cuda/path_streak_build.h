@@ -4,7 +4,8 @@
 // per-pixel splat, rain precomputed: RealtimeFrameData::PrepareStreaks) as StreakPods in the
 // leaf order of a BVH over their capsules' boxes (bvh_builder.h's binned SAH, WidenBvh), their
 // particle sets and the rain's radiance, as the path kernels read them (PathStreaks over these
-// host arrays; DevicePath::UploadStreaks copies them).
+// host arrays; DevicePath::UploadStreaks copies them). the realtime tier's device splat takes
+// the same StreakPods in index order without a BVH (BuildList; StreakSplatView).
 
 #include <Eigen/Core>
 #include <vector>
@@ -24,6 +25,11 @@ class PathStreakBuild {
   /// BVH is built over `pool` (may be null; BuildBvh: the same bits either way).
   void Build(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient,
              ThreadPool* pool = nullptr);
+  /// the streaks of `streaks` (Built for the frame; empty: none) in their index order
+  /// (StreakPod::prim = the index), their particle sets and `sky_ambient`, without a BVH (View's
+  /// nodes null) or rain radiance (the realtime tier's device splat, StreakSplatView, shades
+  /// rain per pixel); records the time it took.
+  void BuildList(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
   /// no streaks (View's num 0).
   void Clear();
   /// the streaks over this object's arrays (valid until the next Build or Clear).
@@ -40,6 +46,8 @@ class PathStreakBuild {
   Blas root_;
   Float3 sky_ambient_;
   double build_ms_ = 0;
+  // the pods of streaks in the order order[k] (null: index order), their sets and rain
+  void FillPods(const ParticleStreaks& streaks, const int32_t* order);
   // reused between frames for their capacity
   std::vector<PrimBox> boxes_;
   std::vector<BvhNode> binary_;

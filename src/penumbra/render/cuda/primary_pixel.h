@@ -62,12 +62,20 @@ struct PixelTruthPlanes {
 
 /// the world ray o + t (x ex + y ey + ez) of normalised image coordinates (x, y) of a camera at
 /// o with axes ex, ey, ez (W) and near plane `near` (m): tmin = near, tmax = infinity; d is not
-/// unit (its z along ez is 1, so t is depth), as Camera::GenerateRay.
+/// unit (its z along ez is 1, so t is depth), as Camera::GenerateRay. kRn: each product and sum
+/// rounded on its own (MulRn, AddRn: Camera::GenerateRay's bits on the GPU too, for the
+/// realtime splat of particle streaks); else the device may fuse them.
+template <bool kRn = false>
 PB_HOST_DEVICE inline TraceRay NormalizedPixelRay(F3 o, F3 ex, F3 ey, F3 ez, float x, float y,
                                                   float near) {
   TraceRay r;
   r.o = o;
-  r.d = {x * ex.x + y * ey.x + ez.x, x * ex.y + y * ey.y + ez.y, x * ex.z + y * ey.z + ez.z};
+  if constexpr (kRn)
+    r.d = {AddRn(AddRn(MulRn(x, ex.x), MulRn(y, ey.x)), ez.x),
+           AddRn(AddRn(MulRn(x, ex.y), MulRn(y, ey.y)), ez.y),
+           AddRn(AddRn(MulRn(x, ex.z), MulRn(y, ey.z)), ez.z)};
+  else
+    r.d = {x * ex.x + y * ey.x + ez.x, x * ex.y + y * ey.y + ez.y, x * ex.z + y * ey.z + ez.z};
   r.tmin = near;
   r.tmax = INFINITY;
   return r;
@@ -75,13 +83,14 @@ PB_HOST_DEVICE inline TraceRay NormalizedPixelRay(F3 o, F3 ex, F3 ey, F3 ez, flo
 
 /// the world ray of pixel (u, v) of a pinhole camera given as origin o, axes ex, ey, ez (W),
 /// principal point (cx, cy) px, inverse focal lengths inv_fx, inv_fy (1/px) and near plane
-/// `near` (m): NormalizedPixelRay of ((u - cx) inv_fx, (v - cy) inv_fy).
+/// `near` (m): NormalizedPixelRay<kRn> of ((u - cx) inv_fx, (v - cy) inv_fy).
+template <bool kRn = false>
 PB_HOST_DEVICE inline TraceRay PinholePixelRay(F3 o, F3 ex, F3 ey, F3 ez, float cx, float cy,
                                                float inv_fx, float inv_fy, float near, int u,
                                                int v) {
   const float x = (static_cast<float>(u) - cx) * inv_fx;
   const float y = (static_cast<float>(v) - cy) * inv_fy;
-  return NormalizedPixelRay(o, ex, ey, ez, x, y, near);
+  return NormalizedPixelRay<kRn>(o, ex, ey, ez, x, y, near);
 }
 
 /// the unit world normal of hit h of world ray r (the geometric normal of the triangle or

@@ -180,6 +180,7 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
                                        ThreadPool* pool) {
   streaks_.clear();
   path_streaks_.Clear();
+  splat_streaks_.Clear();
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   if (fx == nullptr || fx->particles.empty()) {
     particles_.Build(nullptr, camera, 0, StreakRays::kAny);
@@ -187,18 +188,36 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   }
   const bool realtime = settings_.tier == RenderSettings::Tier::kRealtime;
   // as the CPU's MediaFrame::Prepare: the sheltered drops left out, the rain streaks the
-  // frame's homogeneous media hide culled, the streaks splatted per pixel, the rain shaded once
-  // per streak
+  // frame's homogeneous media hide culled, the streaks splatted per pixel (on the host, or by
+  // the frame itself: device_streaks), the rain shaded once per streak (device_streaks: per
+  // pixel by the frame)
   bool sheltered = false;
   for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
   if (sheltered) shelter_.Update(scene_, snapshot, pool);
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
+  const bool device_splat = realtime && device_streaks_;
+  particles_.set_host_splat(!device_splat);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
                    sheltered ? &shelter_ : nullptr);
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
+  if (device_splat) {
+    // the streaks in index order and the camera's projection for the frame's splat
+    // (StreakSplatView)
+    splat_streaks_.BuildList(particles_, sky_ambient);
+    const Pose X_OW = camera.X_WO().inverse();
+    const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
+    std::copy(R_OW.data(), R_OW.data() + 9, splat_camera_.R_OW);
+    splat_camera_.p_OW = ToFloat3(X_OW.translation().cast<float>());
+    const CameraIntrinsics& k = camera.intrinsics();
+    splat_camera_.fx = k.fx;
+    splat_camera_.fy = k.fy;
+    splat_camera_.cx = k.cx;
+    splat_camera_.cy = k.cy;
+    return;
+  }
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
   if (!realtime) {
     // the pathtraced tier: the paths trace the streaks themselves (path_streaks.h)
@@ -365,6 +384,10 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.any_mirror = any_mirror_ ? 1 : 0;
   f.streaks = streaks_.empty() ? nullptr : streaks_.data();
   f.num_streaks = static_cast<int64_t>(streaks_.size());
+  if (!splat_streaks_.empty()) {
+    f.splat = splat_camera_;
+    f.splat.streaks = splat_streaks_.View();
+  }
   if (media_ready_) {
     f.has_media = 1;
     f.media = media_view_;
@@ -482,6 +505,24 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   std::vector<Float3> sky(n);
   data.SkyTerms(geometry.data(), n, sky.data(), pool);
   RealtimeFrameView f = data.View(scene, sky.data());
+  // the frame's own splat of the particle streaks, as the device's kernels: every streak's
+  // rows (one streak at a time: a plain minimum per pixel), then the shading of every pixel
+  // that has a streak
+  std::vector<unsigned long long> splat_nearest;
+  std::vector<StreakPixel> splat_pixels;
+  if (f.splat.streaks.num > 0) {
+    splat_nearest.assign(n, kNoStreakKey);
+    splat_pixels.resize(n);
+    f.splat.nearest = splat_nearest.data();
+    f.splat.pixels = splat_pixels.data();
+    for (int k = 0; k < f.splat.streaks.num; ++k) {
+      const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
+      for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) SplatStreakRow(f, k, p, v);
+    }
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) ShadeSplatPixel(f, u, static_cast<int>(v));
+    });
+  }
   // the media volumes the frame builds itself, as the device's kernels (before the shading)
   MediaVolumeArrays media_volumes;
   BuildMediaVolumesOnHost(&f, pool, &media_volumes);
@@ -550,6 +591,10 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   for (int64_t k = 0; f.has_media == 0 && k < f.num_streaks; ++k) {
     const StreakPixel& s = f.streaks[k];
     radiance[s.pixel] = ApplyStreak(s, out->depth_m.data[s.pixel], radiance[s.pixel]);
+  }
+  for (int64_t i = 0; f.has_media == 0 && f.splat.streaks.num > 0 && i < n; ++i) {
+    StreakPixel s;
+    if (PixelStreakOf(f, i, &s)) radiance[i] = ApplyStreak(s, out->depth_m.data[i], radiance[i]);
   }
   std::vector<double> rows(H);
   ParallelForOrSerial(pool, H, [&](int64_t v) {

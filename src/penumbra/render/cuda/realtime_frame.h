@@ -4,9 +4,11 @@
 // posed lights (LightSampler), the geoms' poses, the pinhole camera and the frame's random-number
 // key; the frame's effects (light scales and extra lights through
 // LightSampler::Update, the moved or scaled sky and the surface wetness through
-// render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: each
-// pixel's nearest streak found and shaded on the host with the CPU's render/particle_streaks.h,
-// StreakPixel; the kernels draw it over the pixel) and media (homogeneous and grids:
+// render/effects_sky.h, as the CPU backend's MediaFrame), particles (rain, snow, sparks: the
+// drops culled on the host with the CPU's render/particle_streaks.h, the streaks then splatted,
+// shaded and drawn over each pixel by the frame itself, StreakSplatView; or, without
+// device_streaks, each pixel's nearest streak found and shaded on the host, StreakPixel) and
+// media (homogeneous and grids:
 // PrepareMedia, RealtimeMedia's layouts built on the host and its four volumes (the grids' light
 // volumes and froxels, the world light volume, the fog froxels) by the frame itself on the
 // device; the kernels' view pass draws them and
@@ -105,11 +107,13 @@ class RealtimeFrameData {
   void SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,
                  int64_t frame_index,
                  const Eigen::Vector3f& white_balance_gains = Eigen::Vector3f::Ones());
-  /// the particle streaks of the frame (View's streaks): with particles in `effects` (null or
-  /// none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
+  /// the particle streaks of the frame (View's splat, or streaks): with particles in `effects`
+  /// (null or none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
   /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
-  /// media hide culled, the streaks splatted per pixel over `pool`, rain shaded once per
-  /// streak), then each pixel's nearest streak shaded by ParticleStreaks::Shade as
+  /// media hide culled); with device_streaks (the default) the streaks in index order and the
+  /// camera's projection for the frame's own splat (splat_streaks(), View's splat); else
+  /// splatted per pixel over `pool`, rain shaded once per
+  /// streak, then each pixel's nearest streak shaded by ParticleStreaks::Shade as
   /// RealtimeIntegrator does (the frame's lights and sky, the occluded sky volume), in pixel
   /// order; the media in front of a streak are applied in the view pass (MediaViewQuad). call
   /// after PoseWorld (Prepare does). under the pathtraced tier's settings instead, as the CPU's
@@ -119,8 +123,19 @@ class RealtimeFrameData {
   /// @throws ConfigError for malformed particle sets (ParticleStreaks::Build).
   void PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                       const Camera& camera, const CameraView& view, ThreadPool* pool);
-  /// the streak pixels of the last PrepareStreaks.
+  /// the streak pixels of the last PrepareStreaks (the host splat; empty with device_streaks).
   const std::vector<StreakPixel>& streaks() const { return streaks_; }
+  /// whether the realtime tier's streaks are splatted and shaded per pixel by the frame itself
+  /// (default true, branch gpu18: PrepareStreaks culls the drops on the host as before, then
+  /// hands the streaks in index order to View's `splat`, StreakSplatView: the device's splat
+  /// kernels, or RenderRealtimeOnHost) or found and shaded on the host (false: the CPU's
+  /// ParticleStreaks splat, PrecomputeRain and Shade, View's `streaks`, as before; benchmarks
+  /// and tests compare the two).
+  void set_device_streaks(bool on) { device_streaks_ = on; }
+  bool device_streaks() const { return device_streaks_; }
+  /// the streaks the frame splats itself (device_streaks; empty without particles or under the
+  /// pathtraced tier's settings): PathStreakBuild::View as View's splat.streaks.
+  const PathStreakBuild& splat_streaks() const { return splat_streaks_; }
   /// the pathtraced tier's streaks of the last PrepareStreaks (empty under the realtime tier's
   /// settings or without particles); PathStreakBuild::View gives the paths' PathStreaks.
   const PathStreakBuild& path_streaks() const { return path_streaks_; }
@@ -204,6 +219,9 @@ class RealtimeFrameData {
   std::vector<StreakPixel> streaks_;
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
+  bool device_streaks_ = true;
+  PathStreakBuild splat_streaks_;  // the realtime streaks in index order (device_streaks)
+  StreakSplatView splat_camera_;   // their projection (R_OW, p_OW, intrinsics; no arrays)
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
   // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);
   // media_ready_ false until PrepareMedia built them for the frame (PoseWorld clears it)

@@ -17,6 +17,7 @@
 #include "penumbra/render/cuda/cuda_realtime.h"
 #include "penumbra/render/cuda/media_grid_upload.h"
 #include "penumbra/render/cuda/realtime_shading.h"
+#include "penumbra/render/cuda/streak_upload.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -69,6 +70,37 @@ __global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const fl
   if (k >= count) return;
   const StreakPixel s = streaks[k];
   radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
+}
+
+// the realtime particle streaks' splat (SplatStreakRow): one warp per streak, its lanes over the
+// rows of the streak's pixel box (rain falls: a streak is mostly taller than wide), every hit
+// kept by a 64-bit integer atomicMin of its StreakKey (order-independent: deterministic).
+__global__ void StreakSplatKernel(RealtimeFrameView f) {
+  const int64_t k = (blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x) / 32;
+  const int lane = static_cast<int>(threadIdx.x & 31);
+  if (k >= f.splat.streaks.num) return;
+  const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
+  if (p.empty()) return;
+  for (int v = p.v0 + lane; v <= p.v1; v += 32) SplatStreakRow(f, static_cast<int>(k), p, v);
+}
+
+// the splat's nearest streak of every pixel shaded (ShadeSplatPixel): one thread per pixel.
+__global__ void StreakShadeKernel(RealtimeFrameView f) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  ShadeSplatPixel(f, u, v);
+}
+
+// the splat's streaks over the final radiance (ApplyStreak; with media: MediaViewQuad): one
+// thread per pixel.
+__global__ void StreakSplatApplyKernel(RealtimeFrameView f, const float* depth, Float3* radiance) {
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  if (u >= f.camera.width || v >= f.camera.height) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  StreakPixel s;
+  if (PixelStreakOf(f, i, &s)) radiance[i] = ApplyStreak(s, depth[i], radiance[i]);
 }
 
 // the media (homogeneous and grids) and the particle streaks seen through them over the final
@@ -669,6 +701,10 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // (3 n bytes), then, 16-byte aligned, the row sums (H doubles) and the device's exposure
   // (TailRows, rows, exposure); pin_rgb holds its copy
   Buffer depth, rgb, hits, streaks;
+  // the realtime splat's streaks (shared with the pathtraced tier's upload) and per pixel its
+  // StreakKeys and shaded streaks (StreakSplatView)
+  StreakBuffers splat_streaks;
+  Buffer splat_nearest, splat_pixels;
   double* rows = nullptr;
   DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
@@ -974,6 +1010,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     return o.mirror_stream && o.device_sky && sky_uploaded && side_stream != nullptr &&
            f.any_mirror != 0;
   }
+  // whether kernels change frame f's radiance after the shared visibility's resolve (the media's
+  // view pass, the host's or the device's streak splat), so that no output band is final before
+  static bool AfterResolve(const RealtimeFrameView& f) {
+    return f.has_media != 0 || f.num_streaks > 0 || f.splat.streaks.num > 0;
+  }
   // the side stream as `o` says (mirror_low_priority)
   cudaStream_t Side(const RealtimeKernelOptions& o) const {
     return o.mirror_low_priority ? side_stream : side_stream_high;
@@ -1068,7 +1109,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
         Check(cudaGetLastError(), "MirrorShadeKernel");
       }
       if (fork) Check(cudaStreamWaitEvent(stream, mirror_join, 0), "cudaStreamWaitEvent");
-      const bool after = f.has_media != 0 || f.num_streaks > 0;
+      const bool after = AfterResolve(f);
       const int bands = after ? 1 : std::clamp(o.output_bands, 1, kMaxSkyBands);
       for (int k = 0; k < bands; ++k) {
         const int r0 = OutputBandRow(H, bands, k), r1 = OutputBandRow(H, bands, k + 1);
@@ -1108,14 +1149,33 @@ struct DeviceRealtime::Impl : PixelBuffers {
           f.streaks, f.num_streaks, depth.as<float>(), radiance.as<Float3>());
       Check(cudaGetLastError(), "StreakKernel");
     }
+    if (f.splat.streaks.num > 0 && f.has_media == 0) {
+      StreakSplatApplyKernel<<<grid, kPixelBlock, 0, stream>>>(f, depth.as<float>(),
+                                                               radiance.as<Float3>());
+      Check(cudaGetLastError(), "StreakSplatApplyKernel");
+    }
     // fuse_resolve with media or streaks: every band final after them
-    if (o.fuse_resolve && (f.has_media != 0 || f.num_streaks > 0))
+    if (o.fuse_resolve && AfterResolve(f))
       for (cudaEvent_t& e : resolved_band) Check(cudaEventRecord(e, stream), "cudaEventRecord");
     if (o.rows_per_warp)
       RowSumWarpKernel<<<(H + 3) / 4, 128, 0, stream>>>(radiance.as<Float3>(), W, H, rows);
     else
       RowSumKernel<<<(H + 127) / 128, 128, 0, stream>>>(radiance.as<Float3>(), W, H, rows);
     Check(cudaGetLastError(), "RowSumKernel");
+  }
+  // the splat of frame f's particle streaks (f.splat, its arrays on the device) on `stream`:
+  // every pixel's key cleared, the streaks splatted, the pixels with one shaded
+  void LaunchStreakSplat(const RealtimeFrameView& f, cudaStream_t stream) {
+    const StreakSplatView& sp = f.splat;
+    if (sp.streaks.num <= 0) return;
+    const int W = f.camera.width, H = f.camera.height;
+    Check(cudaMemsetAsync(sp.nearest, 0xff, sizeof(unsigned long long) * W * H, stream),
+          "cudaMemsetAsync");
+    const int64_t threads = 32 * static_cast<int64_t>(sp.streaks.num);
+    StreakSplatKernel<<<static_cast<unsigned>((threads + 127) / 128), 128, 0, stream>>>(f);
+    Check(cudaGetLastError(), "StreakSplatKernel");
+    StreakShadeKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(f);
+    Check(cudaGetLastError(), "StreakShadeKernel");
   }
   // f's scene-wide arrays: the device copies of Upload, UploadSky and the posed geoms and lights
   void WithDeviceArrays(RealtimeFrameView* f) const {
@@ -1163,6 +1223,18 @@ void DeviceRealtime::set_options(const RealtimeKernelOptions& options) { impl_->
 const RealtimeKernelOptions& DeviceRealtime::options() const { return impl_->options; }
 const RealtimeStageTimes& DeviceRealtime::last_stage_times() const { return impl_->times; }
 const RealtimeExposureChecks& DeviceRealtime::exposure_checks() const { return impl_->checks; }
+
+bool DeviceRealtime::DownloadStreakKeys(std::vector<unsigned long long>* out) const {
+  const Impl& m = *impl_;
+  const StreakSplatView& sp = m.frame.splat;
+  if (!m.rendered || sp.streaks.num <= 0) return false;
+  Check(cudaDeviceSynchronize(), "DownloadStreakKeys");
+  out->assign(static_cast<size_t>(m.frame.camera.width) * m.frame.camera.height, 0);
+  Check(cudaMemcpy(out->data(), sp.nearest, sizeof(unsigned long long) * out->size(),
+                   cudaMemcpyDeviceToHost),
+        "DownloadStreakKeys");
+  return true;
+}
 
 bool DeviceRealtime::DownloadGridVolumes(GridVolumeArrays* out) const {
   const Impl& m = *impl_;
@@ -1304,6 +1376,15 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     // the streaks found and shaded on the host (from pageable memory: staged before it returns)
     m.streaks.Upload(host_frame.streaks, sizeof(StreakPixel) * f.num_streaks, stream);
     f.streaks = m.streaks.as<StreakPixel>();
+  }
+  if (f.splat.streaks.num > 0) {
+    // the streaks the host culled (pageable: staged before it returns), then the splat
+    f.splat.streaks = m.splat_streaks.Upload(host_frame.splat.streaks, stream);
+    m.splat_nearest.Reserve(sizeof(unsigned long long) * n);
+    m.splat_pixels.Reserve(sizeof(StreakPixel) * n);
+    f.splat.nearest = m.splat_nearest.as<unsigned long long>();
+    f.splat.pixels = m.splat_pixels.as<StreakPixel>();
+    m.LaunchStreakSplat(f, stream);
   }
   if (f.has_media != 0) {
     m.UploadMedia(host_frame.media, &f.media, stream);
@@ -1604,12 +1685,14 @@ double DeviceRealtime::TimeKernels(DeviceScene* scene, int count,
     }
   };
   // one untimed run (first launch of a kernel variant)
+  m.LaunchStreakSplat(f, stream);
   m.LaunchGeometry(f, options, stream);
   if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, options, stream);
   m.LaunchShading(f, options, stream);
   film();
   Check(cudaStreamSynchronize(stream), "realtime kernels");
   return TimeOnStream(stream, count, [&] {
+    m.LaunchStreakSplat(f, stream);
     m.LaunchGeometry(f, options, stream);
     if (options.device_sky && m.sky_uploaded) m.LaunchSky(f, options, stream);
     m.LaunchShading(f, options, stream);

@@ -37,6 +37,7 @@
 #include "penumbra/render/brdf_math.h"
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/film_math.h"
 #include "penumbra/render/lamp_math.h"
@@ -113,15 +114,40 @@ struct PixelGeometry {
   float mirror = 0;   ///< the hit surface's mirror weight r (ShadingPoint::mirror), 0 none
 };
 
-/// a pixel's nearest particle streak (EffectsFrame::particles), found and shaded on the host
-/// by the CPU backend's functions (ParticleStreaks::PixelHit and Shade,
-/// render/particle_streaks.h) for the pixel's ray: drawn over the pixel's radiance where it lies
-/// in front of the primary hit (ApplyStreak).
+/// a pixel's nearest particle streak (EffectsFrame::particles), shaded: drawn over the pixel's
+/// radiance where it lies in front of the primary hit (ApplyStreak). made by the device's splat
+/// (StreakSplatView: SplatStreakRow, ShadeSplatPixel) or, with the host splat
+/// (RealtimeFrameData::set_device_streaks(false)), found and shaded on the host by the CPU
+/// backend's functions (ParticleStreaks::PixelHit and Shade, render/particle_streaks.h).
 struct StreakPixel {
   int64_t pixel = 0;  ///< row-major pixel index
   float t = 0;        ///< ray parameter of the streak (the primary ray's units: as the depth)
   float alpha = 0;    ///< coverage in (0, 1]
   Float3 L;           ///< radiance of the streak, cd/m^2 (before the media in front of it)
+};
+
+/// the realtime tier's particle streaks splatted per pixel by the frame itself (branch gpu18;
+/// render/particle_math.h's ProjectStreak, StreakRowColumns and IntersectCapsuleRay, which the
+/// CPU backend's ParticleStreaks::BuildPixelHits calls too): every streak's pixel box is
+/// scanned, each pixel-centre ray (PrimaryRay) met by the capsule keeps the smallest StreakKey
+/// (nearest t, then lower index: the host splat's rule) in `nearest`, and each pixel with a key
+/// is shaded into `pixels` (ShadeSplatPixel).
+struct StreakSplatView {
+  /// the frame's streaks in ParticleStreaks' index order (StreakPod::prim = the index; no BVH:
+  /// nodes null), their particle sets and the open sky's sphere-average radiance (sky_ambient);
+  /// rain radiance is shaded per pixel (rain null). num 0: no splat.
+  PathStreaks streaks;
+  /// the projection of the frame's camera (Camera::X_WO and its intrinsics, as BuildPixelHits):
+  /// world to optical frame, R_OW row-major, and the pinhole intrinsics (px).
+  float R_OW[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  Float3 p_OW{0, 0, 0};
+  double fx = 1, fy = 1, cx = 0, cy = 0;
+  /// per pixel (row-major, width x height): the nearest streak's StreakKey (kNoStreakKey: none;
+  /// all kNoStreakKey before the splat) and, where it has one, the shaded streak
+  /// (ShadeSplatPixel). arrays of the memory the reader runs in (device, or host for
+  /// RenderRealtimeOnHost); null when num is 0.
+  unsigned long long* nearest = nullptr;
+  StreakPixel* pixels = nullptr;
 };
 
 /// everything a realtime frame reads, as device (or host) pointers.
@@ -175,9 +201,13 @@ struct RealtimeFrameView {
   TraceHit* mirror_hits = nullptr;
   const Float3* mirror_sky = nullptr;
   Float3* mirror_radiance = nullptr;
-  /// the frame's particle streaks, num_streaks of them in pixel order (none: no particles).
+  /// the frame's particle streaks found and shaded on the host (the host splat,
+  /// RealtimeFrameData::set_device_streaks(false)), num_streaks of them in pixel order (none:
+  /// no particles, or the device splat's `splat`).
   const StreakPixel* streaks = nullptr;
   int64_t num_streaks = 0;
+  /// the frame's particle streaks for the splat the frame makes itself (streaks.num 0: none).
+  StreakSplatView splat;
   /// the frame's homogeneous media (fog, haze, dust; has_media 1), their arrays as device or
   /// host pointers (render/media_realtime_math.h, RealtimeMedia::HostView): the light
   /// transmittances of the surface loop (ShadeRealtimePoint) and the view pass (MediaViewQuad).
@@ -232,10 +262,13 @@ PB_HOST_DEVICE inline F3 OffsetOrigin(const Float3& p, const Float3& n) {
 
 /// the pixel-centre ray of pixel (u, v) of camera c: primary_pixel.h's PinholePixelRay, or with
 /// c's tables (lens distortion, a moving camera; camera_rays.h) the pixel's undistorted
-/// coordinates and its row's pose, as Camera::GenerateRay.
+/// coordinates and its row's pose, as Camera::GenerateRay. kRn: the direction's products and
+/// sums rounded on their own (NormalizedPixelRay<true>: the realtime splat's rays).
+template <bool kRn = false>
 PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) {
   if (!c.xy && !c.rows)
-    return PinholePixelRay(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u, v);
+    return PinholePixelRay<kRn>(c.o, c.ex, c.ey, c.ez, c.cx, c.cy, c.inv_fx, c.inv_fy, c.near, u,
+                                v);
   float x = (static_cast<float>(u) - c.cx) * c.inv_fx;
   float y = (static_cast<float>(v) - c.cy) * c.inv_fy;
   if (c.xy) {
@@ -243,10 +276,10 @@ PB_HOST_DEVICE inline TraceRay PrimaryRay(const PinholeCamera& c, int u, int v) 
     x = p[0];
     y = p[1];
   }
-  if (!c.rows) return NormalizedPixelRay(c.o, c.ex, c.ey, c.ez, x, y, c.near);
+  if (!c.rows) return NormalizedPixelRay<kRn>(c.o, c.ex, c.ey, c.ez, x, y, c.near);
   const float* r = c.rows + 12 * static_cast<int64_t>(v);
-  return NormalizedPixelRay(F3{r[0], r[1], r[2]}, F3{r[3], r[4], r[5]}, F3{r[6], r[7], r[8]},
-                            F3{r[9], r[10], r[11]}, x, y, c.near);
+  return NormalizedPixelRay<kRn>(F3{r[0], r[1], r[2]}, F3{r[3], r[4], r[5]}, F3{r[6], r[7], r[8]},
+                                 F3{r[9], r[10], r[11]}, x, y, c.near);
 }
 
 /// where a pixel's ray cone meets a surface, for planar texture lookups (MaterialEvaluator's
@@ -1275,6 +1308,101 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
   return lo < f.num_streaks && f.streaks[lo].pixel == i ? lo : -1;
 }
 
+/// the projection of splat streak s (ProjectStreak of its ends in the frame's optical frame,
+/// StreakToOptical).
+PB_HOST_DEVICE inline StreakProjection SplatProjection(const RealtimeFrameView& f,
+                                                       const StreakPod& s) {
+  const StreakSplatView& sp = f.splat;
+  const Float3 ao = StreakToOptical(sp.R_OW, sp.p_OW, Float3{s.a[0], s.a[1], s.a[2]});
+  const Float3 bo = StreakToOptical(sp.R_OW, sp.p_OW, Float3{s.b[0], s.b[1], s.b[2]});
+  return ProjectStreak(ao, bo, s.r, sp.fx, sp.fy, sp.cx, sp.cy, f.camera.width, f.camera.height);
+}
+
+/// keeps the smaller of *slot and key: atomicMin on the device (the keys of many streaks meet
+/// there; an integer minimum, so the result does not depend on their order), a plain minimum
+/// on the host (RenderRealtimeOnHost splats one streak at a time).
+PB_HOST_DEVICE inline void KeepNearestStreak(unsigned long long* slot, unsigned long long key) {
+#if defined(__CUDA_ARCH__)
+  atomicMin(slot, key);
+#else
+  if (key < *slot) *slot = key;
+#endif
+}
+
+/// splat streak k (projection p, SplatProjection) on row v (inside p's box): every pixel of
+/// StreakRowColumns whose pixel-centre ray (PrimaryRay) meets the capsule (IntersectCapsuleRay,
+/// with the row's ray origin) keeps StreakKey(t, k) in f.splat.nearest if it is smaller, as
+/// ParticleStreaks::BuildPixelHits for the CPU's pixel rays: every product and sum of the rays,
+/// the projection and the capsule test rounded on its own (PrimaryRay<true>, MulRn, AddRn), so
+/// the device finds the CPU's pixels and t to the bit.
+PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
+                                          const StreakProjection& p, int v) {
+  int c0, c1;
+  StreakRowColumns(p, v, &c0, &c1);
+  if (c0 > c1) return;
+  const StreakPod& s = f.splat.streaks.streaks[k];
+  const CapsuleOrigin c =
+      MakeCapsuleOrigin(ToFloat3(PrimaryRay<true>(f.camera, c0, v).o),
+                        Float3{s.a[0], s.a[1], s.a[2]}, Float3{s.b[0], s.b[1], s.b[2]}, s.r);
+  for (int u = c0; u <= c1; ++u) {
+    const float t = IntersectCapsuleRay(c, ToFloat3(PrimaryRay<true>(f.camera, u, v).d));
+    if (!(t > 0)) continue;
+    KeepNearestStreak(&f.splat.nearest[static_cast<int64_t>(v) * f.camera.width + u],
+                      static_cast<unsigned long long>(StreakKey(t, k)));
+  }
+}
+
+/// pixel (u, v)'s streak after the splat, shaded into f.splat.pixels where it has one, as the
+/// host splat shades it (RealtimeFrameData's host path: ParticleStreaks::PixelHit and Shade):
+/// ShadeStreak of the streak's set at the pixel ray's hit o + t |d| d / |d| with the capsule's
+/// normal at o + t d (CapsuleNormal), the frame's lights and its sky volume over the open sky's
+/// radiance; rain at the streak's centre (ParticleStreaks::PrecomputeRain's point; its normal
+/// unused). t is the primary ray's (the depth's units), alpha the streak's coverage.
+PB_HOST_DEVICE inline void ShadeSplatPixel(const RealtimeFrameView& f, int u, int v) {
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const unsigned long long key = f.splat.nearest[i];
+  if (key == kNoStreakKey) return;
+  const float t = StreakKeyT(key);
+  const StreakPod& s = f.splat.streaks.streaks[StreakKeyIndex(key)];
+  const StreakSetPod& set = f.splat.streaks.sets[s.set];
+  const Float3 a{s.a[0], s.a[1], s.a[2]}, b{s.b[0], s.b[1], s.b[2]};
+  const TraceRay r = PrimaryRay<true>(f.camera, u, v);
+  const Float3 o = ToFloat3(r.o), d = ToFloat3(r.d);
+  Float3 p, ng{0, 0, 1};
+  if (set.kind == StreakKind::kRain) {
+    p = Float3{0.5f * (a.x + b.x), 0.5f * (a.y + b.y), 0.5f * (a.z + b.z)};
+  } else {
+    // the hit point and normal rounded as the CPU rounds them (AddRn, MulRn, EigenDotRn)
+    ng = CapsuleNormal(
+        Float3{AddRn(o.x, MulRn(t, d.x)), AddRn(o.y, MulRn(t, d.y)), AddRn(o.z, MulRn(t, d.z))}, a,
+        b, d);
+    const float d_len = sqrtf(EigenDotRn(d, d));
+    const float td = t * d_len;
+    p = Float3{AddRn(o.x, MulRn(td, d.x / d_len)), AddRn(o.y, MulRn(td, d.y / d_len)),
+               AddRn(o.z, MulRn(td, d.z / d_len))};
+  }
+  StreakPixel& out = f.splat.pixels[i];
+  out.pixel = i;
+  out.t = t;
+  out.alpha = s.alpha;
+  out.L = ShadeStreak(set, nullptr, p, ng, f.lights, f.num_lights, f.volume,
+                      f.splat.streaks.sky_ambient);
+}
+
+/// pixel i's streak, shaded (*s), if it has one: the device splat's (f.splat) or the host
+/// splat's (FindStreak in f.streaks).
+PB_HOST_DEVICE inline bool PixelStreakOf(const RealtimeFrameView& f, int64_t i, StreakPixel* s) {
+  if (f.splat.streaks.num > 0) {
+    if (f.splat.nearest[i] == kNoStreakKey) return false;
+    *s = f.splat.pixels[i];
+    return true;
+  }
+  const int64_t k = FindStreak(f, i);
+  if (k < 0) return false;
+  *s = f.streaks[k];
+  return true;
+}
+
 /// whether a media volume cell at p sees a light whose visibility asks `w` (LightVolumeCellLight,
 /// GridLightCellLight): lit, or a shadow ray along d to tmax traced here through f.scene and
 /// not occluded, as RealtimeMedia::Build's rays (a RayQuery's: the same TraceRay, tmin 0).
@@ -1517,7 +1645,7 @@ PB_HOST_DEVICE inline Float3 MediaFogSlice(const RealtimeFrameView& f, int c, in
 /// t_end (+inf for escaping rays) and the normalised sum of their unit directions from the
 /// first pixel's origin; the others look up per pixel. the CPU walks the quads of its 16x16
 /// tiles, which start at even pixels, so its quads are these. a pixel with a particle streak in
-/// front of its hit (FindStreak) then gets it over L (ApplyStreak) with the streak's radiance
+/// front of its hit (PixelStreakOf) then gets it over L (ApplyStreak) with the streak's radiance
 /// seen through the media up to it (MediaViewSegment to s.t |d|, the same quad lookups), as
 /// the CPU's ApplyViewEffects; StreakKernel does not run for frames with media.
 PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int v0,
@@ -1564,9 +1692,8 @@ PB_HOST_DEVICE inline void MediaViewQuad(const RealtimeFrameView& f, int u0, int
     radiance[i] = Float3{T.x * L.x + L_add.x, T.y * L.y + L_add.y, T.z * L.z + L_add.z};
     // the pixel's streak over it, seen through the media in front of it: alpha (media to the
     // streak, then the streak) + (1 - alpha) (media to the end, then the surface)
-    const int64_t k = FindStreak(f, i);
-    if (k < 0 || !StreakInFront(f.streaks[k], depth[i])) continue;
-    StreakPixel s = f.streaks[k];
+    StreakPixel s;
+    if (!PixelStreakOf(f, i, &s) || !StreakInFront(s, depth[i])) continue;
     Float3 T_f, L_f;
     MediaViewSegment(f.media, u, v, o[c], d[c], s.t * d_len[c], &T_f, &L_f, shared ? &q : nullptr);
     s.L = Float3{T_f.x * s.L.x + L_f.x, T_f.y * s.L.y + L_f.y, T_f.z * s.L.z + L_f.z};
