@@ -66,9 +66,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "fuse_resolve, output_bands 3",
                          "mirror_stream off, output_bands 1",
                          "mirror_low_priority off",
-                         "shared_light_terms off",
-                         "min_blocks 5"};
-  for (int k = 0; k < 22; ++k) {
+                         "shared_light_terms off"};
+  for (int k = 0; k < 21; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -95,7 +94,6 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 18) o.output_bands = 1;
     if (k == 19) o.mirror_low_priority = false;
     if (k == 20) o.shared_light_terms = false;
-    if (k == 21) o.min_blocks = 5;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -540,9 +540,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.shared_light_terms = false;
     variants.push_back({"kernels, shading's light terms in local memory", o});
-    o = fast;
-    o.min_blocks = 5;
-    variants.push_back({"kernels, shading <= 102 registers (light terms shared)", o});
 
     o = fast;
     o.rows_per_warp = false;

@@ -1046,12 +1046,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
       Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 4, false, true>,
                                  cudaFuncAttributeMaxDynamicSharedMemorySize, most),
             "cudaFuncSetAttribute");
-      Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 5, true, true>,
-                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
-            "cudaFuncSetAttribute");
-      Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 5, false, true>,
-                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
-            "cudaFuncSetAttribute");
+
       shade_smem_set = true;
     }
     if (!o.reuse_hit)
@@ -1062,12 +1057,6 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 6)
       ShadeStoredKernel<OneFrame, 6, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
-    else if (o.reuse_surface && o.min_blocks == 5 && o.shared_light_terms && f.has_media != 0)
-      ShadeStoredKernel<OneFrame, 5, true, true>
-          <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
-    else if (o.reuse_surface && o.min_blocks == 5 && o.shared_light_terms)
-      ShadeStoredKernel<OneFrame, 5, false, true>
-          <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
     else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms && f.has_media != 0)
       ShadeStoredKernel<OneFrame, 4, true, true>
           <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
