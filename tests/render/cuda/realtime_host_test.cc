@@ -155,7 +155,8 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
 // the kernels shade from the material terms the geometry pass kept (ShadeRealtimeStored,
 // RealtimeKernelOptions::reuse_surface) instead of evaluating the surface again: the same
 // radiance, rgb and depth bits, in the default room (planar textures, mirror floor) and the
-// house (textured floors and walls, normal maps).
+// house (textured floors and walls, normal maps); so do the lights' terms kept in an array
+// interleaved over a row's pixels (StridedLightTerms, RealtimeKernelOptions::shared_light_terms).
 TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
@@ -165,15 +166,20 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     cuda::RealtimeFrameData data(scene, RenderSettings());
     ThreadPool pool(0);
     data.Prepare(snap, view, &pool);
-    RenderedFrame evaluated, stored;
+    RenderedFrame evaluated, stored, strided;
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &evaluated, /*stored_surface=*/false);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &stored, /*stored_surface=*/true);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &strided, /*stored_surface=*/true,
+                               /*strided_terms=*/true);
     int64_t lit = 0;
     for (float x : stored.radiance.data) lit += x > 0;
     EXPECT_GT(lit, 0) << world;
     EXPECT_EQ(stored.radiance.data, evaluated.radiance.data) << world;
     EXPECT_EQ(stored.rgb.data, evaluated.rgb.data) << world;
     EXPECT_EQ(stored.depth_m.data, evaluated.depth_m.data) << world;
+    // the lights' terms interleaved over the row's pixels (the kernels' shared memory)
+    EXPECT_EQ(strided.radiance.data, stored.radiance.data) << world;
+    EXPECT_EQ(strided.rgb.data, stored.rgb.data) << world;
   }
 }
 

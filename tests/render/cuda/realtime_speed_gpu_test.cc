@@ -3,7 +3,8 @@
 // 640x480, the radiance and depth with every speed-up are the same bits as with each one turned
 // off (one thread per row sum, pageable copies, each pixel tracing its own penumbra rays, the
 // kernels' registers uncapped, the radiance copied back in 1 or 5 bands, the mirror layer on the
-// frame's stream or on one of its priority, the resolve and mirror blend as two kernels); the rgb
+// frame's stream or on one of its priority, the resolve and mirror blend as two kernels, the
+// shading kernel's light terms in local instead of shared memory); the rgb
 // too, except that the row sums' order can move the exposure's last bits (then the EV100 agrees
 // to 1e-9). with the primary hit traced again or the surface evaluated again by the shading
 // kernel, the radiance may move in its last bits (nvcc's contraction of a second inlined copy of
@@ -64,8 +65,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "mirror_stream off, fuse_resolve off",
                          "fuse_resolve, output_bands 3",
                          "mirror_stream off, output_bands 1",
-                         "mirror_low_priority off"};
-  for (int k = 0; k < 20; ++k) {
+                         "mirror_low_priority off",
+                         "shared_light_terms off"};
+  for (int k = 0; k < 21; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -73,7 +75,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 3) {
       o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
       o.queue_penumbra = false;
-      o.mirror_stream = o.fuse_resolve = false;
+      o.mirror_stream = o.fuse_resolve = o.shared_light_terms = false;
       o.min_blocks = o.geometry_min_blocks = 0;
       o.output_bands = 1;
     }
@@ -91,6 +93,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 17) o.output_bands = 3;
     if (k == 18) o.output_bands = 1;
     if (k == 19) o.mirror_low_priority = false;
+    if (k == 20) o.shared_light_terms = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

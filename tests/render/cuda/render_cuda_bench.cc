@@ -381,6 +381,9 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     copy_variants.back().fuse_resolve = false;
     copy_variants.push_back(fast);
     copy_variants.back().mirror_stream = copy_variants.back().fuse_resolve = false;
+    // the shading's light terms in local memory (before branch gpu20)
+    copy_variants.push_back(fast);
+    copy_variants.back().shared_light_terms = false;
     // second to last: the default into a new RenderedFrame every frame (as the camera sink's
     // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
     // default without the radiance (CudaRenderer::set_radiance_output)
@@ -422,6 +425,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
         extra += fmt::format(", host copies over the pool above {} KiB", o.serial_copy_kib);
       if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
       if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
+      if (!o.shared_light_terms) extra += ", light terms in local memory";
       if (no_radiance) extra += ", no radiance asked for";
       if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
@@ -536,6 +540,9 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.mirror_low_priority = false;
     variants.push_back({"kernels, mirror layer's stream of the frame's priority", o});
+    o = fast;
+    o.shared_light_terms = false;
+    variants.push_back({"kernels, shading's light terms in local memory", o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -544,7 +551,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_surface = false;
     o.warp_penumbra = false;
     o.queue_penumbra = false;
-    o.mirror_stream = o.fuse_resolve = false;
+    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

@@ -116,6 +116,14 @@ struct RealtimeKernelOptions {
   /// 0 or 1 leaves the registers to the compiler (130); 4 caps them at 128 a thread (4 blocks an
   /// SM instead of 3, no spills), 6 at 85 (more warps in flight, spills). with reuse_hit only.
   int min_blocks = 4;
+  /// with reuse_surface and min_blocks 4 or 5 (the 128-register kernel, the default): the
+  /// shading kernel keeps the lights' unshadowed terms between its two light loops
+  /// (ShadeRealtimePoint: the first kShadeCachedLights lights' contribution, direction and
+  /// distance, 28 bytes a light and pixel) in its block's shared memory (StridedLightTerms:
+  /// 3.5 KiB a light for 128 threads, 31.5 KiB for the house's 9 lights) instead of each
+  /// thread's stack in local memory (LocalLightTerms; the stack goes from 1,280 to 832 bytes):
+  /// the same values, so the same bits.
+  bool shared_light_terms = true;
   /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
   /// reuse_surface), below 5 leaves them to the compiler.

@@ -466,7 +466,7 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 }
 
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out, bool stored_surface) {
+                          RenderedFrame* out, bool stored_surface, bool strided_terms) {
   const PinholeCamera& c = data.camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -548,12 +548,25 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   f.area_own = area_own.data();
   f.area_fraction = area_fraction.data();
   std::vector<Float3> radiance(n);
+  const int term_lights = std::min(std::max(f.num_lights, 0), kShadeCachedLights);
   ParallelForOrSerial(pool, H, [&](int64_t v) {
+    // strided_terms: the row's pixels share one array, interleaved as a block's threads
+    std::vector<float> row_terms;
+    if (strided_terms) row_terms.resize(StridedLightTerms::kLightTermFloats * term_lights * W);
     for (int u = 0; u < W; ++u) {
       const int64_t i = v * W + u;
-      radiance[i] = stored_surface
-                        ? ShadeRealtimeStored(f, u, static_cast<int>(v), geometry[i], surfaces[i])
-                        : ShadeRealtimePixel(f, u, static_cast<int>(v));
+      if (stored_surface && strided_terms) {
+        StridedLightTerms terms;
+        terms.at = row_terms.data() + u;
+        terms.stride = W;
+        terms.lights = term_lights;
+        radiance[i] =
+            ShadeRealtimeStored(f, u, static_cast<int>(v), geometry[i], surfaces[i], terms);
+      } else {
+        radiance[i] = stored_surface
+                          ? ShadeRealtimeStored(f, u, static_cast<int>(v), geometry[i], surfaces[i])
+                          : ShadeRealtimePixel(f, u, static_cast<int>(v));
+      }
     }
   });
   ParallelForOrSerial(pool, H, [&](int64_t v) {

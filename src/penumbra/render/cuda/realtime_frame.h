@@ -279,8 +279,13 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 /// path with the CPU backend can be checked on machines without a GPU. rows over `pool`.
 /// `stored_surface`: shade each pixel from the material terms its primary geometry kept
 /// (ShadeRealtimeStored, the kernels' default) instead of evaluating the surface again
-/// (ShadeRealtimePixel); the two give the same bits.
+/// (ShadeRealtimePixel); the two give the same bits. `strided_terms` (with stored_surface):
+/// the lights' terms wait between ShadeRealtimePoint's loops in a row's array interleaved over
+/// its pixels (StridedLightTerms, as the kernels' shared memory with
+/// RealtimeKernelOptions::shared_light_terms) instead of each pixel's own (LocalLightTerms);
+/// the same bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out, bool stored_surface = false);
+                          RenderedFrame* out, bool stored_surface = false,
+                          bool strided_terms = false);
 
 }  // namespace penumbra::cuda

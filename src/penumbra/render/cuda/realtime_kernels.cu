@@ -267,18 +267,40 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
 // ShadeRealtimeStored): no second surface evaluation. kMedia false: frames without media only
-// (the default variant of frames without media and batches; ShadeRealtimePoint).
-template <class Frames, int kMinBlocks, bool kMedia = true>
+// (the default variant of frames without media and batches; ShadeRealtimePoint). kSharedTerms
+// (RealtimeKernelOptions::shared_light_terms): the first `lights` lights' unshadowed terms wait
+// between the light loops in the block's dynamic shared memory (StridedLightTerms,
+// ShadeLightTermBytes of it), not in the thread's stack (LocalLightTerms).
+template <class Frames, int kMinBlocks, bool kMedia = true, bool kSharedTerms = false>
 __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
-                      int row1) {
+                      int row1, int lights = 0) {
   const RealtimeFrameView& f = frames.get();
   const int u = blockIdx.x * blockDim.x + threadIdx.x;
   const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
   if (u >= f.camera.width || v >= row1) return;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t k = CameraOffset(f) + i;
-  radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
+  if constexpr (kSharedTerms) {
+    extern __shared__ float light_terms[];
+    const int threads = static_cast<int>(blockDim.x * blockDim.y);
+    StridedLightTerms terms;
+    terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
+    terms.stride = threads;
+    terms.lights = lights;
+    radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms);
+  } else {
+    radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
+  }
+}
+
+// the lights whose terms ShadeStoredKernel<..., true> keeps in shared memory for a frame of
+// `num_lights` lights, and the bytes that takes for a block of `threads` threads.
+inline int ShadeSharedLights(int num_lights) {
+  return std::min(std::max(num_lights, 0), kShadeCachedLights);
+}
+inline size_t ShadeLightTermBytes(int lights, int threads) {
+  return sizeof(float) * StridedLightTerms::kLightTermFloats * lights * threads;
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
@@ -767,6 +789,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
   RealtimeFilm film;
   int filmic = 1;
   bool rendered = false;
+  // the shared-terms shading kernels may take kShadeCachedLights lights' shared memory
+  bool shade_smem_set = false;
 
   // the tail's layout (rgb above): the row sums' offset, and its bytes
   static size_t TailRows(int64_t n) { return (static_cast<size_t>(3 * n) + 15) / 16 * 16; }
@@ -1051,6 +1075,21 @@ struct DeviceRealtime::Impl : PixelBuffers {
     TraceHit* h = hits.as<TraceHit>();
     Float3* L = radiance.as<Float3>();
     SurfaceTerms* st = surfaces.as<SurfaceTerms>();
+    // shared_light_terms: the kernels may take up to kShadeCachedLights lights' terms (once)
+    const int threads = static_cast<int>(kPixelBlock.x * kPixelBlock.y);
+    const int lights = ShadeSharedLights(f.num_lights);
+    const size_t smem = ShadeLightTermBytes(lights, threads);
+    if (o.shared_light_terms && !shade_smem_set) {
+      const int most = static_cast<int>(ShadeLightTermBytes(kShadeCachedLights, threads));
+      Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 4, true, true>,
+                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
+            "cudaFuncSetAttribute");
+      Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 4, false, true>,
+                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
+            "cudaFuncSetAttribute");
+
+      shade_smem_set = true;
+    }
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 6 && f.has_media != 0)
@@ -1059,6 +1098,12 @@ struct DeviceRealtime::Impl : PixelBuffers {
     else if (o.reuse_surface && o.min_blocks >= 6)
       ShadeStoredKernel<OneFrame, 6, false>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
+    else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms && f.has_media != 0)
+      ShadeStoredKernel<OneFrame, 4, true, true>
+          <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
+    else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms)
+      ShadeStoredKernel<OneFrame, 4, false, true>
+          <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
     else if (o.reuse_surface && o.min_blocks >= 4 && f.has_media != 0)
       ShadeStoredKernel<OneFrame, 4, true>
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);

@@ -750,14 +750,64 @@ PB_HOST_DEVICE inline Float3 MediaAttenuated(const RealtimeFrameView& f, int j, 
 /// others are evaluated twice).
 constexpr int kShadeCachedLights = 16;
 
+/// where ShadeRealtimePoint keeps lights 0 .. capacity() - 1's unshadowed terms (contribution c,
+/// unit direction wi towards the light, distance dist, LightContribution's) between its two
+/// loops: the thread's own arrays (on the device, local memory: the shading kernel's stack).
+struct LocalLightTerms {
+  Float3 c[kShadeCachedLights], wi[kShadeCachedLights];
+  float dist[kShadeCachedLights];
+  /// the lights kept: kShadeCachedLights
+  PB_HOST_DEVICE int capacity() const { return kShadeCachedLights; }
+  /// keeps light j's terms (j < capacity())
+  PB_HOST_DEVICE void Put(int j, const Float3& cj, const Float3& wij, float dj) {
+    c[j] = cj, wi[j] = wij, dist[j] = dj;
+  }
+  /// light j's terms as Put kept them
+  PB_HOST_DEVICE void Get(int j, Float3* cj, Float3* wij, float* dj) const {
+    *cj = c[j], *wij = wi[j], *dj = dist[j];
+  }
+};
+
+/// LocalLightTerms in memory the caller owns, interleaved over `stride` threads (the shading
+/// kernel's shared memory, RealtimeKernelOptions::shared_light_terms): float k (0 .. 6: c, wi,
+/// dist) of light j at at[(kLightTermFloats j + k) stride], `at` the block's array plus the
+/// thread's index, so a warp's lanes touch consecutive words. the same values as
+/// LocalLightTerms, so the same bits.
+struct StridedLightTerms {
+  /// floats a light's terms take
+  static constexpr int kLightTermFloats = 7;
+  float* at = nullptr;  ///< the thread's first float
+  int stride = 0;       ///< the threads sharing the array (floats between two of a thread's)
+  int lights = 0;       ///< the lights kept (at most kShadeCachedLights)
+  /// the lights kept
+  PB_HOST_DEVICE int capacity() const { return lights; }
+  /// keeps light j's terms (j < capacity())
+  PB_HOST_DEVICE void Put(int j, const Float3& cj, const Float3& wij, float dj) {
+    float* q = at + kLightTermFloats * j * stride;
+    q[0] = cj.x, q[stride] = cj.y, q[2 * stride] = cj.z;
+    q[3 * stride] = wij.x, q[4 * stride] = wij.y, q[5 * stride] = wij.z;
+    q[6 * stride] = dj;
+  }
+  /// light j's terms as Put kept them
+  PB_HOST_DEVICE void Get(int j, Float3* cj, Float3* wij, float* dj) const {
+    const float* q = at + kLightTermFloats * j * stride;
+    *cj = Float3{q[0], q[stride], q[2 * stride]};
+    *wij = Float3{q[3 * stride], q[4 * stride], q[5 * stride]};
+    *dj = q[6 * stride];
+  }
+};
+
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
 /// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
 /// false: for frames known to have none (f.has_media must be 0): the media's code is left out,
-/// so the kernels of frames without media keep their registers.
-template <bool kMedia = true>
+/// so the kernels of frames without media keep their registers. terms: where the lights'
+/// unshadowed terms wait between the two loops (LocalLightTerms, StridedLightTerms); lights from
+/// terms.capacity() on are evaluated twice.
+template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
-                                                const ShadingPoint& sp, const Float3& sky) {
+                                                const ShadingPoint& sp, const Float3& sky,
+                                                Terms& terms) {
   const SceneView& s = f.scene;
   const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
@@ -787,14 +837,13 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   const F3 origin = OffsetOrigin(p, ng);
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
   float total = pbm::Luminance709(L.x, L.y, L.z);
-  Float3 cached_c[kShadeCachedLights], cached_wi[kShadeCachedLights];
-  float cached_dist[kShadeCachedLights];
+  const int cached = terms.capacity();
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi;
     float dist;
     Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
     if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
-    if (j < kShadeCachedLights) cached_c[j] = c, cached_wi[j] = wi, cached_dist[j] = dist;
+    if (j < cached) terms.Put(j, c, wi, dist);
     total += pbm::Luminance709(c.x, c.y, c.z);
   }
   f.total[pixel] = total;
@@ -803,8 +852,8 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   for (int j = 0; j < f.num_lights; ++j) {
     Float3 wi, c;
     float dist;
-    if (j < kShadeCachedLights) {
-      c = cached_c[j], wi = cached_wi[j], dist = cached_dist[j];
+    if (j < cached) {
+      terms.Get(j, &c, &wi, &dist);
     } else {
       c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
       if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
@@ -830,6 +879,14 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
   return L;
 }
 
+/// ShadeRealtimePoint with the lights' terms in the thread's own arrays (LocalLightTerms).
+template <bool kMedia = true>
+PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
+                                                const ShadingPoint& sp, const Float3& sky) {
+  LocalLightTerms terms;
+  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky, terms);
+}
+
 /// starts the shading of pixel (u, v): no light's shared visibility is known yet (its area_vis
 /// entries set to -1), and returns the pixel's sky term.
 PB_HOST_DEVICE inline Float3 BeginRealtimePixel(const RealtimeFrameView& f, int u, int v) {
@@ -853,10 +910,12 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
 /// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point: its
 /// primary geometry g and material terms t (PrimaryGeometry's surface_out; the view direction
 /// from PrimaryRay as EvaluateSurface): the same shading point, so the same radiance, without
-/// evaluating the surface (textures, normal map) a second time. kMedia: ShadeRealtimePoint's.
-template <bool kMedia = true>
+/// evaluating the surface (textures, normal map) a second time. kMedia and terms:
+/// ShadeRealtimePoint's.
+template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
-                                                 const PixelGeometry& g, const SurfaceTerms& t) {
+                                                 const PixelGeometry& g, const SurfaceTerms& t,
+                                                 Terms& terms) {
   const Float3 sky = BeginRealtimePixel(f, u, v);
   if (g.hit == 0) return sky;
   const TraceRay r = PrimaryRay(f.camera, u, v);
@@ -873,7 +932,15 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int
   sp.specular = t.specular;
   sp.occlusion = t.occlusion;
   sp.mirror = g.mirror;
-  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky);
+  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky, terms);
+}
+
+/// ShadeRealtimeStored with the lights' terms in the thread's own arrays (LocalLightTerms).
+template <bool kMedia = true>
+PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
+                                                 const PixelGeometry& g, const SurfaceTerms& t) {
+  LocalLightTerms terms;
+  return ShadeRealtimeStored<kMedia>(f, u, v, g, t, terms);
 }
 
 /// the linear radiance of pixel (u, v) (the file comment's L; the sky term where the ray
