@@ -175,7 +175,9 @@ TEST(RealtimeEffectsGpuFrames, DeviceSplatMatchesTheHostSplat) {
     EXPECT_EQ(same, host_pixels.size());
     EXPECT_GE(psnr, 60.0);
     EXPECT_LE(static_cast<double>(differ), 0.001 * static_cast<double>(keys.size()));
-    EXPECT_LE(static_cast<double>(differ_more), 0.0005 * static_cast<double>(keys.size()));
+    // since the snow's hit point and normal round as the CPU's (043891f) no pixel differs by
+    // more than 3 codes (H100, 15:42 UTC: 0 pixels differ in rain, snow and fire)
+    EXPECT_EQ(differ_more, 0);
     EXPECT_EQ(host.depth_m.data, dev.depth_m.data);
     EXPECT_EQ(dev.rgb.data, again.rgb.data);
     EXPECT_EQ(dev.radiance.data, again.radiance.data);
