@@ -117,9 +117,9 @@ class ParticleStreaks {
              StreakRays rays, ThreadPool* pool = nullptr, const MediaScene* media = nullptr,
              const ShelterMap* shelter = nullptr);
 
-  /// whether Build with pixel_hits also splats the streaks on the host (default true); false:
-  /// Build culls as for the realtime tier (near plane, frustum, kRainCullContrast) but leaves
-  /// the per-pixel splat to the caller (PixelHit finds nothing; the CUDA backend's splat kernel
+  /// whether Build with StreakRays::kPixelCentres also splats the streaks on the host (default
+  /// true); false: Build culls as for the realtime tier (near plane, frustum,
+  /// kRainCullContrast) but leaves the per-pixel splat to the caller (PixelHit finds nothing; the CUDA backend's splat kernel
   /// makes it from ends(), alpha() and set_of() with the shared functions of
   /// render/particle_math.h: ProjectStreak, StreakRowColumns, IntersectCapsuleRay).
   void set_host_splat(bool on) { host_splat_ = on; }
@@ -188,7 +188,7 @@ class ParticleStreaks {
   const SkyIrradianceVolume* sky_volume_ = nullptr;  // occluded sky (PrecomputeRain), or null
   std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
   bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
-  bool host_splat_ = true;         // Build with pixel_hits splats (BuildPixelHits)
+  bool host_splat_ = true;         // Build with kPixelCentres splats (BuildPixelHits)
   // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
   // capacity).
   struct DropChunk {
