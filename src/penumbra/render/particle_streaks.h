@@ -119,9 +119,9 @@ class ParticleStreaks {
 
   /// whether Build with StreakRays::kPixelCentres also splats the streaks on the host (default
   /// true); false: Build culls as for the realtime tier (near plane, frustum,
-  /// kRainCullContrast) but leaves the per-pixel splat to the caller (PixelHit finds nothing; the CUDA backend's splat kernel
-  /// makes it from ends(), alpha() and set_of() with the shared functions of
-  /// render/particle_math.h: ProjectStreak, StreakRowColumns, IntersectCapsuleRay).
+  /// kRainCullContrast) but leaves the per-pixel splat to the caller (PixelHit finds nothing; the
+  /// CUDA backend's splat kernel makes it from ends(), alpha() and set_of() with the shared
+  /// functions of render/particle_math.h: ProjectStreak, StreakRowColumns, IntersectCapsuleRay).
   void set_host_splat(bool on) { host_splat_ = on; }
   bool host_splat() const { return host_splat_; }
 
