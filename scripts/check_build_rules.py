@@ -24,8 +24,8 @@ scripts/check_module_deps.py. The rules and their allow-lists live in scripts/bu
                   allow-list "sensor_kind_literals" maps a file to the literals it may hold
                   with another meaning (an MJCF <mujoco> element, a CLI option); it may only
                   shrink
-  preprocessed    with --compile-commands: `g++ -E` of every C++ translation unit of the build;
-                  fails when one is above "preprocessed_lines.per_unit" or all together above
+  preprocessed    with --compile-commands: `g++ -E -fdirectives-only` of every C++ translation
+                  unit of the build; fails when one is above "preprocessed_lines.per_unit" or all together above
                   "preprocessed_lines.total" (scripts/build_stats/preprocessed_lines.py measures
                   them; raise the budget only with a reason in the commit)
 

@@ -47,12 +47,11 @@ AttributionSize AttributionSizeFromEnv() {
   return s;
 }
 
-RenderedFrame RenderCpuWith(const SceneDescription& scene, const WorldSnapshot& snap,
-                            const CameraView& view, const RenderAblation& ablation) {
-  RenderSettings settings;
-  settings.backend = RenderSettings::Backend::kEmbree;
-  const std::unique_ptr<Renderer> r = MakeRenderer(scene, settings);
-  auto* embree = dynamic_cast<EmbreeRenderer*>(r.get());
+// the CPU backend's frame of `view` with `ablation` (one renderer for the three ablations of
+// a world: each new one would build its scene and sky irradiance volume again).
+RenderedFrame RenderCpuWith(Renderer* r, const WorldSnapshot& snap, const CameraView& view,
+                            const RenderAblation& ablation) {
+  auto* embree = dynamic_cast<EmbreeRenderer*>(r);
   EXPECT_NE(embree, nullptr);
   if (embree != nullptr) embree->set_ablation(ablation);
   RenderedFrame f;
@@ -79,13 +78,16 @@ TEST_P(RealtimeParityAttribution, SplitsTheRgbErrorByFeature) {
       realtime_parity::LoadFrameAt(GetParam(), 1.0, size.width, size.height);
   const SceneDescription& scene = session->scene();
   view.outputs[ImageKind::kSegmentation] = true;
-  const RenderedFrame cpu = RenderCpuWith(scene, snap, view, RenderAblation());
+  RenderSettings cpu_settings;
+  cpu_settings.backend = RenderSettings::Backend::kEmbree;
+  const std::unique_ptr<Renderer> cpu_renderer = MakeRenderer(scene, cpu_settings);
   RenderAblation no_mirror;
   no_mirror.mirror = false;
-  const RenderedFrame cpu_nm = RenderCpuWith(scene, snap, view, no_mirror);
+  const RenderedFrame cpu_nm = RenderCpuWith(cpu_renderer.get(), snap, view, no_mirror);
   RenderAblation no_shadows;
   no_shadows.shadows = false;
-  const RenderedFrame cpu_ns = RenderCpuWith(scene, snap, view, no_shadows);
+  const RenderedFrame cpu_ns = RenderCpuWith(cpu_renderer.get(), snap, view, no_shadows);
+  const RenderedFrame cpu = RenderCpuWith(cpu_renderer.get(), snap, view, RenderAblation());
 
   RenderSettings settings;
   cuda::BvhScene bvh(scene);

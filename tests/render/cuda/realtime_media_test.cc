@@ -33,22 +33,33 @@
 namespace penumbra {
 namespace {
 
-// the GPU path on the host renders `view` of `scene` at `snap` under `fx` (stored surface
-// terms, the kernels' default), with the media's shadow rays through `media_rays` (null: the
-// frame data's own BvhRayQuery).
-RenderedFrame HostPathFrame(const SceneDescription& scene, const WorldSnapshot& snap,
-                            const CameraView& view, const EffectsFrame* fx, bool* has_media,
-                            const RayQuery* media_rays = nullptr) {
-  cuda::BvhScene bvh(scene);
-  bvh.Update(snap);
-  cuda::RealtimeFrameData data(scene, RenderSettings());
-  ThreadPool pool(0);
-  data.Prepare(snap, view, &pool, fx, nullptr, media_rays);
-  *has_media = data.has_media();
-  RenderedFrame out;
-  cuda::RenderRealtimeOnHost(data, bvh, &pool, &out, /*stored_surface=*/true);
-  return out;
-}
+// the GPU path on the host for one scene at one snapshot: its BVH and frame data built once
+// (the sky irradiance volume's build, through the host BVH, is most of a frame's time on the
+// CPU), then any number of frames of `view` under `fx` (stored surface terms, the kernels'
+// default), with the media's shadow rays through `media_rays` (null: the frame data's own
+// BvhRayQuery), as CudaRenderer renders frame after frame with one RealtimeFrameData.
+class HostPath {
+ public:
+  HostPath(const SceneDescription& scene, const WorldSnapshot& snap)
+      : snap_(snap), bvh_(scene), data_(scene, RenderSettings()) {
+    bvh_.Update(snap);
+  }
+
+  RenderedFrame Render(const CameraView& view, const EffectsFrame* fx, bool* has_media,
+                       const RayQuery* media_rays = nullptr) {
+    data_.Prepare(snap_, view, &pool_, fx, nullptr, media_rays);
+    *has_media = data_.has_media();
+    RenderedFrame out;
+    cuda::RenderRealtimeOnHost(data_, bvh_, &pool_, &out, /*stored_surface=*/true);
+    return out;
+  }
+
+ private:
+  const WorldSnapshot& snap_;
+  cuda::BvhScene bvh_;
+  cuda::RealtimeFrameData data_;
+  ThreadPool pool_{0};
+};
 
 // the image size of the bundled worlds' comparison: PENUMBRA_PARITY_SIZE=WxH, else 160x120.
 void ParitySize(int* w, int* h) {
@@ -75,13 +86,14 @@ TEST_P(RealtimeHostPathMedia, MatchesCpuBackend) {
   RenderedFrame want;
   cpu->Render(snap, fx.get(), view, &want);
   bool has_media = false, again_media = false, bare_media = true;
-  const RenderedFrame got = HostPathFrame(scene, snap, view, fx.get(), &has_media);
-  const RenderedFrame again = HostPathFrame(scene, snap, view, fx.get(), &again_media);
-  // the same frame without its media: what the media's terms bring
+  HostPath host(scene, snap);
+  const RenderedFrame got = host.Render(view, fx.get(), &has_media);
+  // the same frame without its media (what the media's terms bring), then the frame again
   EffectsFrame bare = *fx;
   bare.homogeneous_media.clear();
   bare.grid_media.clear();
-  const RenderedFrame without = HostPathFrame(scene, snap, view, &bare, &bare_media);
+  const RenderedFrame without = host.Render(view, &bare, &bare_media);
+  const RenderedFrame again = host.Render(view, fx.get(), &again_media);
   const double psnr = realtime_parity::Psnr(want.rgb, got.rgb);
   const double bare_psnr = realtime_parity::Psnr(want.rgb, without.rgb);
   const double depth_bad = realtime_parity::DepthMismatch(want.depth_m, got.depth_m);
@@ -119,8 +131,9 @@ TEST(RealtimeHostPathMediaFrames, MediaRaysAndShadingPathsGiveTheSameBits) {
   cuda::BvhRayQuery rays(scene);
   rays.Update(snap);
   bool own_media = false, given_media = false;
-  const RenderedFrame own = HostPathFrame(scene, snap, view, fx.get(), &own_media);
-  const RenderedFrame given = HostPathFrame(scene, snap, view, fx.get(), &given_media, &rays);
+  HostPath host(scene, snap);
+  const RenderedFrame own = host.Render(view, fx.get(), &own_media);
+  const RenderedFrame given = host.Render(view, fx.get(), &given_media, &rays);
   EXPECT_TRUE(own_media && given_media);
   EXPECT_EQ(own.radiance.data, given.radiance.data);
   cuda::BvhScene bvh(scene);
