@@ -26,7 +26,7 @@ const char* kReversedJoints =
     "base_body: trunk\n"
     "joints: [j11, j10, j9, j8, j7, j6, j5, j4, j3, j2, j1, j0]\n";
 
-std::string ErrorOf(const std::function<void()>& f) {
+std::string PolicyErrorOf(const std::function<void()>& f) {
   try {
     f();
   } catch (const Error& e) {
@@ -112,14 +112,14 @@ TEST(PolicyControllerTest, MotorsWithoutGainsAreRefusedForPositionTargets) {
   auto c = MakePolicy(std::string(kReversedJoints) +
                       "model: gemm_15x12.onnx\n"
                       "observations: [{term: velocity_command}, {term: joint_pos}]\n");
-  const std::string e = ErrorOf([&] { c->Initialize(m); });
+  const std::string e = PolicyErrorOf([&] { c->Initialize(m); });
   EXPECT_NE(e.find("robots[q].controller.joints[0]"), std::string::npos) << e;
   EXPECT_NE(e.find("actuator 'q/j11' is a motor"), std::string::npos) << e;
   EXPECT_NE(e.find("action.kp and action.kd"), std::string::npos) << e;
 }
 
 TEST(PolicyControllerTest, RefusesAMissingModelFile) {
-  const std::string e = ErrorOf([] {
+  const std::string e = PolicyErrorOf([] {
     MakePolicy(std::string(kReversedJoints) +
                "model: no_such_policy.onnx\n"
                "observations: [{term: joint_pos}]\n");
@@ -144,7 +144,7 @@ TEST(PolicyControllerTest, RefusesAGarbageFileNamingIt) {
                          "action: {kp: 20, kd: 0.5}\n");
   auto c = MakeController(cfg, "q", "/elsewhere/world.yaml");
   const ModelInfo m = QuadModel();
-  const std::string e = ErrorOf([&] { c->Initialize(m); });
+  const std::string e = PolicyErrorOf([&] { c->Initialize(m); });
   EXPECT_EQ(e.rfind(path, 0), 0u) << e;  // the message starts with the file
   EXPECT_NE(e.find("OpenCV dnn (4.6) cannot load this ONNX graph"), std::string::npos) << e;
   EXPECT_NE(e.find("expected an ONNX graph from [1, 15] float32 observations to [1, 12]"),
@@ -159,7 +159,7 @@ TEST(PolicyControllerTest, RefusesAGraphOfTheWrongInputSize) {
                       "model: gemm_15x12.onnx\n"
                       "observations: [{term: joint_pos}, {term: phase, period_sec: 1}]\n"
                       "action: {kp: 20, kd: 0.5}\n");
-  const std::string e = ErrorOf([&] { c->Initialize(m); });
+  const std::string e = PolicyErrorOf([&] { c->Initialize(m); });
   EXPECT_NE(e.find("gemm_15x12.onnx"), std::string::npos) << e;
   EXPECT_NE(e.find("the graph rejects an input of [1, 14]"), std::string::npos) << e;
 }
@@ -174,7 +174,7 @@ TEST(PolicyControllerTest, RefusesAGraphOfTheWrongOutputSize) {
       "observations: [{term: velocity_command}, {term: joint_pos}, "
       "{term: contact, sensors: [touch0]}]\n"
       "action: {kp: 20, kd: 0.5}\n");
-  const std::string e = ErrorOf([&] { c->Initialize(m); });
+  const std::string e = PolicyErrorOf([&] { c->Initialize(m); });
   EXPECT_NE(e.find("gemm_15x12.onnx"), std::string::npos) << e;
   EXPECT_NE(e.find("the graph returns 12 values for an input of [1, 15]"), std::string::npos) << e;
   EXPECT_NE(e.find("[1, 11] actions"), std::string::npos) << e;
@@ -186,34 +186,34 @@ TEST(PolicyControllerTest, RefusesAnOperatorOpenCvCannotServe) {
                       "model: unsupported_op.onnx\n"
                       "observations: [{term: joint_pos}]\n"
                       "action: {kp: 20, kd: 0.5}\n");
-  const std::string e = ErrorOf([&] { c->Initialize(m); });
+  const std::string e = PolicyErrorOf([&] { c->Initialize(m); });
   EXPECT_NE(e.find("unsupported_op.onnx"), std::string::npos) << e;
   EXPECT_NE(e.find("Loop"), std::string::npos) << e;
 }
 
 TEST(PolicyControllerTest, RefusesBadBlocksByKey) {
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(PolicyErrorOf([] {
               MakePolicy(std::string(kReversedJoints) +
                          "model: gemm_15x12.onnx\nobservations: [{term: joint_speed}]\n");
             }).find("observations[0].term: unknown term 'joint_speed'"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(PolicyErrorOf([] {
               MakePolicy(std::string(kReversedJoints) + "model: gemm_15x12.onnx\npreset: rsl\n");
             }).find("preset: unknown preset 'rsl'; expected one of: legged_gym"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(PolicyErrorOf([] {
               MakePolicy(std::string(kReversedJoints) +
                          "model: gemm_15x12.onnx\nobservations: [{term: joint_pos}]\n"
                          "rate_hz: 50\ndecimation: 4\n");
             }).find("decimation: given together with rate_hz"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(PolicyErrorOf([] {
               MakePolicy(std::string(kReversedJoints) +
                          "model: gemm_15x12.onnx\nobservations: [{term: joint_pos}]\n"
                          "action: {type: joint_torque, kp: 3}\n");
             }).find("action.kp: not used by joint_torque"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(PolicyErrorOf([] {
               MakePolicy(std::string(kReversedJoints) +
                          "model: gemm_15x12.onnx\nobservations: [{term: joint_pos, history: 0}]\n");
             }).find("observations[0].history"),
@@ -224,7 +224,7 @@ TEST(PolicyControllerTest, RefusesBadBlocksByKey) {
                       "model: gemm_15x12.onnx\nrate_hz: 30\n"
                       "observations: [{term: velocity_command}, {term: joint_pos}]\n"
                       "action: {kp: 20, kd: 0.5}\n");
-  EXPECT_NE(ErrorOf([&] { c->Initialize(m); }).find("not a whole number of physics steps"),
+  EXPECT_NE(PolicyErrorOf([&] { c->Initialize(m); }).find("not a whole number of physics steps"),
             std::string::npos);
 }
 

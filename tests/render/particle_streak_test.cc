@@ -15,7 +15,7 @@ namespace {
 
 using namespace penumbra::testing;
 
-constexpr int kW = 160, kH = 120;
+constexpr int kStreakW = 160, kStreakH = 120;
 
 // renders one spark at depth `depth` moving along world -y (image +u) at speed `speed` for
 // `exposure` seconds, centred on pixel row `row`; returns the lit pixel span in that row and
@@ -23,7 +23,7 @@ constexpr int kW = 160, kH = 120;
 int StreakSpan(double depth, double speed, double exposure, int row, double* expected_px,
                const ImageF** img_out = nullptr) {
   const SceneDescription s = EmptyScene();
-  CameraView view = MakeView(CameraLookingAlongX(), kW, kH, 30, true, false, false);
+  CameraView view = MakeView(CameraLookingAlongX(), kStreakW, kStreakH, 30, true, false, false);
   view.exposure_time_sec = exposure;
   const CameraIntrinsics& k = view.intrinsics;
   // world point seen at pixel (u0, row): image x = world -y, image y = world -z.
@@ -43,7 +43,7 @@ int StreakSpan(double depth, double speed, double exposure, int row, double* exp
   if (img_out) *img_out = &f.radiance;
   *expected_px = k.fx * speed * exposure / depth;
   int first = -1, last = -1;
-  for (int u = 0; u < kW; ++u)
+  for (int u = 0; u < kStreakW; ++u)
     if (f.radiance.at(u, row)[1] > 0) {
       if (first < 0) first = u;
       last = u;

@@ -12,9 +12,9 @@
 namespace penumbra {
 namespace {
 
-const std::string kWorlds = std::string(PENUMBRA_SOURCE_DIR) + "/worlds/";
+const std::string kOverrideWorlds = std::string(PENUMBRA_SOURCE_DIR) + "/worlds/";
 
-WorldConfig Recorded() { return LoadWorldFile(kWorlds + "sensors.yaml"); }
+WorldConfig Recorded() { return LoadWorldFile(kOverrideWorlds + "sensors.yaml"); }
 
 ConfigError OverrideError(const std::string& text, const testing::TempDir& dir) {
   const std::string path = dir.Write("override.yaml", text);

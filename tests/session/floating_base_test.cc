@@ -12,7 +12,7 @@
 namespace penumbra {
 namespace {
 
-const char* kUrdf =
+const char* kFloatingUrdf =
     "<robot name=\"bot\">\n"
     "  <link name=\"base\">\n"
     "    <inertial><origin xyz=\"0.01 0 0\" rpy=\"0 0 0\"/><mass value=\"2\"/>\n"
@@ -34,7 +34,7 @@ const char* kUrdf =
 struct Bot {
   penumbra::testing::TempDir dir;
   std::string world;
-  explicit Bot(const std::string& floating, const std::string& urdf = kUrdf) {
+  explicit Bot(const std::string& floating, const std::string& urdf = kFloatingUrdf) {
     dir.Write("bot.urdf", urdf);
     dir.Write("floor.xml",
               "<mujoco><worldbody><geom type=\"plane\" size=\"0 0 0.05\"/></worldbody></mujoco>\n");
@@ -77,7 +77,7 @@ TEST(FloatingBase, TheUrdfRootLinkBecomesAFreeBodyWithItsInertial) {
 // with the URDF's own <mujoco> extension fusing static links, MuJoCo's importer puts the root
 // link's geoms into the world body and drops its inertial: the composer rebuilds the body
 TEST(FloatingBase, AFusedRootLinkIsRebuiltWithTheUrdfInertial) {
-  std::string urdf = kUrdf;
+  std::string urdf = kFloatingUrdf;
   urdf.insert(urdf.find("  <link name=\"base\">"),
               "  <mujoco><compiler fusestatic=\"true\" discardvisual=\"false\"/></mujoco>\n");
   Bot bot(", floating_base: true", urdf);

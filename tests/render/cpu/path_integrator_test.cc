@@ -19,7 +19,7 @@ namespace {
 
 using namespace penumbra::testing;
 
-constexpr double kPi = M_PI;
+constexpr double kPathPi = M_PI;
 
 RenderSettings PathSettings(int spp, int max_bounces, int threads = 1) {
   RenderSettings r = TestSettings(threads);
@@ -119,13 +119,13 @@ TEST(PathIntegratorTest, LambertianPlaneUnderDirectionalLight) {
     AddGeom(&s, GeomShape::kPlane, {0, 0, 1}, Pose::Identity(), 0, m);
     Light sun;
     sun.type = Light::Type::kDirectional;
-    const double a = incidence_deg * kPi / 180;
+    const double a = incidence_deg * kPathPi / 180;
     sun.direction_B = Eigen::Vector3d(std::sin(a), 0, -std::cos(a));
     sun.intensity = E;
     s.lights.push_back(sun);
     const CameraView view = MakeView(CameraLookingDown({0, 0, 2}), 21, 21, 60);
     const RenderedFrame f = Render(s, PathSettings(4, 4), view);
-    const double expected = E * std::cos(a) * rho / kPi;
+    const double expected = E * std::cos(a) * rho / kPathPi;
     for (int v = 0; v < 21; v += 5)
       for (int u = 0; u < 21; u += 5)
         EXPECT_NEAR(f.radiance.at(u, v)[1], expected, 0.02 * expected) << u << "," << v;
@@ -256,11 +256,11 @@ TEST(PathIntegratorTest, SphereLampMatchesInverseSquareLaw) {
       if (std::hypot(seen_x, seen_y) < r * 1.3) {
         if (std::hypot(seen_x, seen_y) < r * 0.7) {
           ++lamp_pixels;
-          EXPECT_NEAR(f.radiance.at(u, v)[1], I / (kPi * r * r), 1e-3 * I / (kPi * r * r));
+          EXPECT_NEAR(f.radiance.at(u, v)[1], I / (kPathPi * r * r), 1e-3 * I / (kPathPi * r * r));
         }
         continue;
       }
-      const double expected = I * h / (r2 * std::sqrt(r2)) * rho / kPi;
+      const double expected = I * h / (r2 * std::sqrt(r2)) * rho / kPathPi;
       EXPECT_NEAR(f.radiance.at(u, v)[1], expected, 0.03 * expected) << u << "," << v;
     }
   EXPECT_GT(lamp_pixels, 0);
@@ -281,10 +281,10 @@ double GlossyReference(const PbrParams& params, const Eigen::Vector3f& p, const 
     const double c0 = 1 - (1 - cos_max) * i / nt, c1 = 1 - (1 - cos_max) * (i + 1) / nt;
     const double ct = 0.5 * (c0 + c1), st = std::sqrt(1 - ct * ct);
     for (int j = 0; j < np; ++j) {
-      const double phi = 2 * kPi * (j + 0.5) / np;
+      const double phi = 2 * kPathPi * (j + 0.5) / np;
       const Eigen::Vector3f wi =
           (st * std::cos(phi) * t + st * std::sin(phi) * b + ct * axis).cast<float>().normalized();
-      sum += bsdf.Eval(wi).y() * (c0 - c1) * 2 * kPi / np;
+      sum += bsdf.Eval(wi).y() * (c0 - c1) * 2 * kPathPi / np;
     }
   }
   return sum * le;
