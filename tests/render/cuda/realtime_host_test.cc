@@ -183,6 +183,33 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   }
 }
 
+// the shading's shadow rays apart in three passes (RealtimeKernelOptions::queue_shadow_rays:
+// ShadeQueuedStored, the rays traced from the queue's entries, SumQueuedLights) give the fused
+// shading's bits, in the default room (lamps) and the house (the sun and lamps); the sum keeps
+// light order, so a sum in another order would fail this (in the house, at least).
+TEST(RealtimeHostPathFrames, QueuedShadowRaysShadeTheSameBits) {
+  for (const char* world : {"default.yaml", "house.yaml"}) {
+    const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
+    const SceneDescription& scene = session->scene();
+    cuda::BvhScene bvh(scene);
+    bvh.Update(snap);
+    cuda::RealtimeFrameData data(scene, RenderSettings());
+    ThreadPool pool(0);
+    data.Prepare(snap, view, &pool);
+    RenderedFrame fused, queued;
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &fused, /*stored_surface=*/true);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &queued, /*stored_surface=*/true,
+                               /*strided_terms=*/false, /*queued_shadows=*/true);
+    int64_t lit = 0;
+    for (float x : queued.radiance.data) lit += x > 0;
+    EXPECT_GT(lit, 0) << world;
+    EXPECT_EQ(queued.radiance.data, fused.radiance.data) << world;
+    EXPECT_EQ(queued.rgb.data, fused.rgb.data) << world;
+    EXPECT_EQ(queued.depth_m.data, fused.depth_m.data) << world;
+    EXPECT_EQ(queued.ev100, fused.ev100) << world;
+  }
+}
+
 // batch rendering poses a world once (PoseWorld) and sets each camera of a batch in turn
 // (SetCamera, FrameKey): a camera set after another one renders the bits of Prepare of that
 // camera alone, in the default room and the house.

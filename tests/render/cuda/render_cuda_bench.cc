@@ -376,6 +376,10 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     // the shading's light terms in local memory (before branch gpu20)
     copy_variants.push_back(fast);
     copy_variants.back().shared_light_terms = false;
+    // the shadow rays through the queue or in the shading kernel, whichever is not the default
+    // (branch gpu22)
+    copy_variants.push_back(fast);
+    copy_variants.back().queue_shadow_rays = !fast.queue_shadow_rays;
     // second to last: the default into a new RenderedFrame every frame (as the camera sink's
     // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
     // default without the radiance (CudaRenderer::set_radiance_output)
@@ -418,6 +422,8 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
       if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
       if (!o.shared_light_terms) extra += ", light terms in local memory";
+      if (o.queue_shadow_rays != fast.queue_shadow_rays)
+        extra += o.queue_shadow_rays ? ", shadow rays queued" : ", shadow rays in the shading";
       if (no_radiance) extra += ", no radiance asked for";
       if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
@@ -535,6 +541,17 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.shared_light_terms = false;
     variants.push_back({"kernels, shading's light terms in local memory", o});
+    o.queue_shadow_rays = !fast.queue_shadow_rays;
+    variants.push_back({o.queue_shadow_rays
+                            ? "kernels, light terms in local memory, shadow rays queued"
+                            : "kernels, light terms in local memory, shadow rays in the shading",
+                        o});
+    o = fast;
+    o.queue_shadow_rays = !fast.queue_shadow_rays;
+    variants.push_back({o.queue_shadow_rays
+                            ? "kernels, shadow rays queued (three passes)"
+                            : "kernels, shadow rays in the shading kernel (no queue)",
+                        o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -543,7 +560,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_surface = false;
     o.warp_penumbra = false;
     o.queue_penumbra = false;
-    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = false;
+    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);
