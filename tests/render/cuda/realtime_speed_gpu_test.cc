@@ -69,8 +69,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "mirror_low_priority off",
                          "shared_light_terms off",
                          "queue_shadow_rays flipped",
-                         "queue_shadow_rays flipped, shared_light_terms off"};
-  for (int k = 0; k < 23; ++k) {
+                         "queue_shadow_rays flipped, shared_light_terms off",
+                         "queue_shadow_rays on, queue_trace_min_blocks 8"};
+  for (int k = 0; k < 24; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -98,6 +99,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 19) o.mirror_low_priority = false;
     if (k == 20 || k == 22) o.shared_light_terms = false;
     if (k == 21 || k == 22) o.queue_shadow_rays = !fast.queue_shadow_rays;
+    if (k == 23) o.queue_shadow_rays = true, o.queue_trace_min_blocks = 8;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

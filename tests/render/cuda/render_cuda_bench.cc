@@ -552,6 +552,10 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
                             ? "kernels, shadow rays queued (three passes)"
                             : "kernels, shadow rays in the shading kernel (no queue)",
                         o});
+    o = fast;
+    o.queue_shadow_rays = true;
+    o.queue_trace_min_blocks = 8;
+    variants.push_back({"kernels, shadow rays queued, their tracing at 64 registers", o});
 
     o = fast;
     o.rows_per_warp = false;

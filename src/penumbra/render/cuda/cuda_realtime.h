@@ -133,6 +133,10 @@ struct RealtimeKernelOptions {
   /// kernel does: the same bits. frames of more than kMaxQueuedShadowLights lights take the
   /// fused kernel.
   bool queue_shadow_rays = true;
+  /// with queue_shadow_rays: the queue's tracing kernel's __launch_bounds__ minimum of resident
+  /// blocks of 128 threads per SM: 8 caps its registers at 64, below 8 leaves them to the
+  /// compiler (94 with nvcc 13 for sm_90).
+  int queue_trace_min_blocks = 0;
   /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
   /// reuse_surface), below 5 leaves them to the compiler.

@@ -358,10 +358,11 @@ __global__ void __launch_bounds__(128)
 }
 
 // pass 2: the queued rays, one a thread, one wave of resident blocks striding over the queue;
-// `pixels`: a camera's (the ray's camera is its pixel / pixels).
-template <class Frames>
-__global__ void __launch_bounds__(128) TraceQueuedKernel(Frames frames, ShadowRayQueue q,
-                                                         int64_t pixels) {
+// `pixels`: a camera's (the ray's camera is its pixel / pixels). kMinBlocks 8: at most 64
+// registers (queue_trace_min_blocks), 1: the compiler's.
+template <class Frames, int kMinBlocks = 1>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    TraceQueuedKernel(Frames frames, ShadowRayQueue q, int64_t pixels) {
   const int64_t total = *q.count;
   const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
   for (int64_t at = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; at < total;
@@ -375,15 +376,15 @@ __global__ void __launch_bounds__(128) TraceQueuedKernel(Frames frames, ShadowRa
 }
 
 // TraceQueuedKernel's grid: as many blocks of 128 threads as the device holds at once.
-template <class Frames>
+template <class Frames, int kMinBlocks>
 unsigned TraceQueuedBlocks() {
   static const unsigned blocks = [] {
     int device = 0, sms = 0, per_sm = 0;
     Check(cudaGetDevice(&device), "cudaGetDevice");
     Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
           "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, TraceQueuedKernel<Frames>, 128,
-                                                        0),
+    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(
+              &per_sm, TraceQueuedKernel<Frames, kMinBlocks>, 128, 0),
           "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
     return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
   }();
@@ -809,12 +810,14 @@ struct PixelBuffers {
   }
   // the shading of rows [row0, row1) of `cameras` frames (grid: a camera's rows, z the camera)
   // of `pixels` pixels and `lights` lights each, their shadow rays through the queue, on
-  // `stream`: ShadeQueuedKernel, TraceQueuedKernel, SumQueuedKernel. smem: the light terms'
-  // shared memory (kSharedTerms) for `term_lights` lights. CanQueueShadowRays must hold.
+  // `stream`: ShadeQueuedKernel, TraceQueuedKernel (at trace_min_blocks), SumQueuedKernel.
+  // smem: the light terms' shared memory (kSharedTerms) for `term_lights` lights.
+  // CanQueueShadowRays must hold.
   template <class Frames, bool kMedia, bool kSharedTerms>
   void LaunchQueuedShade(Frames frames, dim3 grid, const SurfaceTerms* surfaces, Float3* L,
                          int row0, int row1, int64_t pixels, int cameras, int lights,
-                         int term_lights, size_t smem, cudaStream_t stream) {
+                         int term_lights, size_t smem, int trace_min_blocks,
+                         cudaStream_t stream) {
     const int64_t n = pixels * cameras;
     shadow_rays.Reserve(sizeof(QueuedShadowRay) * n * std::max(lights, 1));
     shadow_count.Reserve(sizeof(unsigned));
@@ -829,7 +832,12 @@ struct PixelBuffers {
     ShadeQueuedKernel<Frames, kMedia, kSharedTerms>
         <<<grid, kPixelBlock, smem, stream>>>(frames, surfaces, L, q, row0, row1, term_lights);
     Check(cudaGetLastError(), "ShadeQueuedKernel");
-    TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
+    if (trace_min_blocks >= 8)
+      TraceQueuedKernel<Frames, 8>
+          <<<TraceQueuedBlocks<Frames, 8>(), 128, 0, stream>>>(frames, q, pixels);
+    else
+      TraceQueuedKernel<Frames, 1>
+          <<<TraceQueuedBlocks<Frames, 1>(), 128, 0, stream>>>(frames, q, pixels);
     Check(cudaGetLastError(), "TraceQueuedKernel");
     SumQueuedKernel<<<grid, kPixelBlock, 0, stream>>>(frames, L, q, row0, row1);
     Check(cudaGetLastError(), "SumQueuedKernel");
@@ -1241,18 +1249,19 @@ struct DeviceRealtime::Impl : PixelBuffers {
         CanQueueShadowRays(pixels, f.num_lights)) {
       const OneFrame fr{f};
       const bool media = f.has_media != 0;
+      const int tb = o.queue_trace_min_blocks;
       if (o.shared_light_terms && media)
         LaunchQueuedShade<OneFrame, true, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                f.num_lights, lights, smem, stream);
+                                                f.num_lights, lights, smem, tb, stream);
       else if (o.shared_light_terms)
         LaunchQueuedShade<OneFrame, false, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, lights, smem, stream);
+                                                 f.num_lights, lights, smem, tb, stream);
       else if (media)
         LaunchQueuedShade<OneFrame, true, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, 0, 0, stream);
+                                                 f.num_lights, 0, 0, tb, stream);
       else
         LaunchQueuedShade<OneFrame, false, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                  f.num_lights, 0, 0, stream);
+                                                  f.num_lights, 0, 0, tb, stream);
       return;
     }
     if (!o.reuse_hit)
@@ -2066,7 +2075,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // batches hold no media (BatchRenderer::UpdateWorld refuses them)
   if (m.queue_shadow_rays && Impl::CanQueueShadowRays(n * count, m.lights)) {
     m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0,
-                                                   H, n, count, m.lights, 0, 0, stream);
+                                                   H, n, count, m.lights, 0, 0, 1, stream);
   } else {
     ShadeStoredKernel<BatchFrames, 4, false>
         <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
