@@ -68,9 +68,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "mirror_stream off, output_bands 1",
                          "mirror_low_priority off",
                          "shared_light_terms off",
-                         "queue_shadow_rays flipped",
-                         "queue_shadow_rays flipped, shared_light_terms off",
-                         "queue_shadow_rays on, queue_trace_min_blocks 8"};
+                         "queue_shadow_rays_always",
+                         "queue_shadow_rays_always, shared_light_terms off",
+                         "queue_shadow_rays off"};
   for (int k = 0; k < 24; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
@@ -98,8 +98,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 18) o.output_bands = 1;
     if (k == 19) o.mirror_low_priority = false;
     if (k == 20 || k == 22) o.shared_light_terms = false;
-    if (k == 21 || k == 22) o.queue_shadow_rays = !fast.queue_shadow_rays;
-    if (k == 23) o.queue_shadow_rays = true, o.queue_trace_min_blocks = 8;
+    if (k == 21 || k == 22) o.queue_shadow_rays_always = true;
+    if (k == 23) o.queue_shadow_rays = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -358,11 +358,11 @@ __global__ void __launch_bounds__(128)
 }
 
 // pass 2: the queued rays, one a thread, one wave of resident blocks striding over the queue;
-// `pixels`: a camera's (the ray's camera is its pixel / pixels). kMinBlocks 8: at most 64
-// registers (queue_trace_min_blocks), 1: the compiler's.
-template <class Frames, int kMinBlocks = 1>
-__global__ void __launch_bounds__(128, kMinBlocks)
-    TraceQueuedKernel(Frames frames, ShadowRayQueue q, int64_t pixels) {
+// `pixels`: a camera's (the ray's camera is its pixel / pixels). its registers are the
+// compiler's (98 with nvcc 13 for sm_90: 4 blocks an SM; capped at 64, 8 blocks, it was slower).
+template <class Frames>
+__global__ void __launch_bounds__(128) TraceQueuedKernel(Frames frames, ShadowRayQueue q,
+                                                         int64_t pixels) {
   const int64_t total = *q.count;
   const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
   for (int64_t at = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; at < total;
@@ -376,15 +376,15 @@ __global__ void __launch_bounds__(128, kMinBlocks)
 }
 
 // TraceQueuedKernel's grid: as many blocks of 128 threads as the device holds at once.
-template <class Frames, int kMinBlocks>
+template <class Frames>
 unsigned TraceQueuedBlocks() {
   static const unsigned blocks = [] {
     int device = 0, sms = 0, per_sm = 0;
     Check(cudaGetDevice(&device), "cudaGetDevice");
     Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
           "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(
-              &per_sm, TraceQueuedKernel<Frames, kMinBlocks>, 128, 0),
+    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, TraceQueuedKernel<Frames>, 128,
+                                                        0),
           "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
     return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
   }();
@@ -808,16 +808,33 @@ struct PixelBuffers {
     return lights <= kMaxQueuedShadowLights && n * kMaxQueuedShadowLights < most &&
            n * std::max(lights, 1) < most;
   }
+  // the pixels of one wave of the fused shading kernel (ShadeStoredKernel at its 4 blocks of
+  // 128 threads an SM) on the current device.
+  static int64_t ShadeWavePixels() {
+    static const int64_t pixels = [] {
+      int device = 0, sms = 0;
+      Check(cudaGetDevice(&device), "cudaGetDevice");
+      Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
+            "cudaDeviceGetAttribute");
+      return int64_t{4} * 128 * std::max(sms, 1);
+    }();
+    return pixels;
+  }
+  // whether frames of `n` pixels in all and `lights` lights take the queued shadow rays as `o`
+  // says (queue_shadow_rays, queue_shadow_rays_always).
+  static bool QueueShadowRays(const RealtimeKernelOptions& o, int64_t n, int lights) {
+    return o.queue_shadow_rays && o.reuse_hit && o.reuse_surface &&
+           (o.queue_shadow_rays_always || n <= ShadeWavePixels()) && CanQueueShadowRays(n, lights);
+  }
   // the shading of rows [row0, row1) of `cameras` frames (grid: a camera's rows, z the camera)
   // of `pixels` pixels and `lights` lights each, their shadow rays through the queue, on
-  // `stream`: ShadeQueuedKernel, TraceQueuedKernel (at trace_min_blocks), SumQueuedKernel.
+  // `stream`: ShadeQueuedKernel, TraceQueuedKernel, SumQueuedKernel.
   // smem: the light terms' shared memory (kSharedTerms) for `term_lights` lights.
   // CanQueueShadowRays must hold.
   template <class Frames, bool kMedia, bool kSharedTerms>
   void LaunchQueuedShade(Frames frames, dim3 grid, const SurfaceTerms* surfaces, Float3* L,
                          int row0, int row1, int64_t pixels, int cameras, int lights,
-                         int term_lights, size_t smem, int trace_min_blocks,
-                         cudaStream_t stream) {
+                         int term_lights, size_t smem, cudaStream_t stream) {
     const int64_t n = pixels * cameras;
     shadow_rays.Reserve(sizeof(QueuedShadowRay) * n * std::max(lights, 1));
     shadow_count.Reserve(sizeof(unsigned));
@@ -832,12 +849,7 @@ struct PixelBuffers {
     ShadeQueuedKernel<Frames, kMedia, kSharedTerms>
         <<<grid, kPixelBlock, smem, stream>>>(frames, surfaces, L, q, row0, row1, term_lights);
     Check(cudaGetLastError(), "ShadeQueuedKernel");
-    if (trace_min_blocks >= 8)
-      TraceQueuedKernel<Frames, 8>
-          <<<TraceQueuedBlocks<Frames, 8>(), 128, 0, stream>>>(frames, q, pixels);
-    else
-      TraceQueuedKernel<Frames, 1>
-          <<<TraceQueuedBlocks<Frames, 1>(), 128, 0, stream>>>(frames, q, pixels);
+    TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
     Check(cudaGetLastError(), "TraceQueuedKernel");
     SumQueuedKernel<<<grid, kPixelBlock, 0, stream>>>(frames, L, q, row0, row1);
     Check(cudaGetLastError(), "SumQueuedKernel");
@@ -1245,23 +1257,21 @@ struct DeviceRealtime::Impl : PixelBuffers {
     }
     // queue_shadow_rays: the shadow rays apart, through the queue (the same bits)
     const int64_t pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-    if (o.queue_shadow_rays && o.reuse_hit && o.reuse_surface &&
-        CanQueueShadowRays(pixels, f.num_lights)) {
+    if (QueueShadowRays(o, pixels, f.num_lights)) {
       const OneFrame fr{f};
       const bool media = f.has_media != 0;
-      const int tb = o.queue_trace_min_blocks;
       if (o.shared_light_terms && media)
         LaunchQueuedShade<OneFrame, true, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                f.num_lights, lights, smem, tb, stream);
+                                                f.num_lights, lights, smem, stream);
       else if (o.shared_light_terms)
         LaunchQueuedShade<OneFrame, false, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, lights, smem, tb, stream);
+                                                 f.num_lights, lights, smem, stream);
       else if (media)
         LaunchQueuedShade<OneFrame, true, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, 0, 0, tb, stream);
+                                                 f.num_lights, 0, 0, stream);
       else
         LaunchQueuedShade<OneFrame, false, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                  f.num_lights, 0, 0, tb, stream);
+                                                  f.num_lights, 0, 0, stream);
       return;
     }
     if (!o.reuse_hit)
@@ -1970,7 +1980,6 @@ void CUDART_CB RunBatchExposure(void* data) {
 struct RealtimeBatch::Impl : PixelBuffers {
   int width = 0, height = 0, max_cameras = 0, lights = 1, slots = 0;
   bool mirror = false;
-  bool queue_shadow_rays = RealtimeKernelOptions().queue_shadow_rays;
   Buffer frames, film, depth, rows;
   PinnedBuffer pin_rows, pin_film;
   std::vector<RealtimeFrameView> host_frames;
@@ -2073,9 +2082,10 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   }
   stage(2);
   // batches hold no media (BatchRenderer::UpdateWorld refuses them)
-  if (m.queue_shadow_rays && Impl::CanQueueShadowRays(n * count, m.lights)) {
+  // the batch's shading as a frame's with the default options (one wave or less: the queue)
+  if (Impl::QueueShadowRays(RealtimeKernelOptions(), n * count, m.lights)) {
     m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0,
-                                                   H, n, count, m.lights, 0, 0, 1, stream);
+                                                   H, n, count, m.lights, 0, 0, stream);
   } else {
     ShadeStoredKernel<BatchFrames, 4, false>
         <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
@@ -2119,8 +2129,6 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   }
   stage(8);
 }
-
-void RealtimeBatch::set_queue_shadow_rays(bool on) { impl_->queue_shadow_rays = on; }
 
 RealtimeBatchTimes RealtimeBatch::times(int slot) const {
   const Impl& m = *impl_;
