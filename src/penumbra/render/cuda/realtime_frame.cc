@@ -583,8 +583,8 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       if (!queued_masks.empty()) {
         const HostShadowPush push{queued_rays.data(), i, n};
         LocalLightTerms terms;
-        radiance[i] = ShadeQueuedStored<true>(f, u, static_cast<int>(v), geometry[i],
-                                              surfaces[i], terms, push, &queued_masks[i]);
+        radiance[i] = ShadeQueuedStored<true>(f, u, static_cast<int>(v), geometry[i], surfaces[i],
+                                              terms, push, &queued_masks[i]);
       } else if (stored_surface && strided_terms) {
         StridedLightTerms terms;
         terms.at = row_terms.data() + u;

@@ -361,8 +361,8 @@ __global__ void __launch_bounds__(128)
 // `pixels`: a camera's (the ray's camera is its pixel / pixels). its registers are the
 // compiler's (98 with nvcc 13 for sm_90: 4 blocks an SM; capped at 64, 8 blocks, it was slower).
 template <class Frames>
-__global__ void __launch_bounds__(128) TraceQueuedKernel(Frames frames, ShadowRayQueue q,
-                                                         int64_t pixels) {
+__global__ void __launch_bounds__(128)
+    TraceQueuedKernel(Frames frames, ShadowRayQueue q, int64_t pixels) {
   const int64_t total = *q.count;
   const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
   for (int64_t at = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; at < total;
@@ -383,8 +383,7 @@ unsigned TraceQueuedBlocks() {
     Check(cudaGetDevice(&device), "cudaGetDevice");
     Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
           "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, TraceQueuedKernel<Frames>, 128,
-                                                        0),
+    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, TraceQueuedKernel<Frames>, 128, 0),
           "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
     return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
   }();
@@ -2084,8 +2083,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // batches hold no media (BatchRenderer::UpdateWorld refuses them)
   // the batch's shading as a frame's with the default options (one wave or less: the queue)
   if (Impl::QueueShadowRays(RealtimeKernelOptions(), n * count, m.lights)) {
-    m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0,
-                                                   H, n, count, m.lights, 0, 0, stream);
+    m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0, H,
+                                                   n, count, m.lights, 0, 0, stream);
   } else {
     ShadeStoredKernel<BatchFrames, 4, false>
         <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);

@@ -817,13 +817,12 @@ PB_HOST_DEVICE inline ShadeSetup BeginShadePoint(const ShadingPoint& sp, const F
   // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
   // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
   float alpha;
-  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &s.c_diff,
-                                    &s.f0, &alpha);
+  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &s.c_diff, &s.f0,
+                                    &alpha);
   s.a2 = alpha * alpha;
   s.n_v = pbm::Dot<float>(sp.n, sp.wo);
   const Float3 spec = EnvBrdfApprox<float, Float3>(s.f0, pbm::Max(s.n_v, 0.0f), roughness);
-  const Float3 reflect{s.c_diff.x * (1.0f - spec.x) + spec.x,
-                       s.c_diff.y * (1.0f - spec.y) + spec.y,
+  const Float3 reflect{s.c_diff.x * (1.0f - spec.x) + spec.x, s.c_diff.y * (1.0f - spec.y) + spec.y,
                        s.c_diff.z * (1.0f - spec.z) + spec.z};
   const Float3 sky_E = occlusion * sky;
   s.L = Float3{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
@@ -1029,8 +1028,8 @@ PB_HOST_DEVICE inline Float3 ShadeQueuedLights(const RealtimeFrameView& f, int u
 /// ShadeRealtimePoint's second loop adds them (AddLitLight: the same operations in the same
 /// order, so the same bits).
 PB_HOST_DEVICE inline Float3 SumQueuedLights(const RealtimeFrameView& f, int64_t pixel,
-                                             int64_t n_pixels, Float3 L,
-                                             const QueuedLightMasks& m, uint32_t occluded) {
+                                             int64_t n_pixels, Float3 L, const QueuedLightMasks& m,
+                                             uint32_t occluded) {
   for (uint32_t b = m.lit; b != 0; b &= b - 1) {
     const int j = LowestSetBit(b);
     AddLitLight(f, j, pixel, n_pixels, f.area_c[j * n_pixels + pixel], (m.traced >> j & 1u) != 0,
