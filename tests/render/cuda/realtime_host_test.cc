@@ -186,7 +186,7 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
 // the shading's shadow rays apart in three passes (RealtimeKernelOptions::queue_shadow_rays:
 // ShadeQueuedStored, the rays traced from the queue's entries, SumQueuedLights) give the fused
 // shading's bits, in the default room (lamps) and the house (the sun and lamps); the sum keeps
-// light order, so a sum in another order would fail this (in the house, at least).
+// light order: summed from the last light to the first, the radiance and EV100 differ in both.
 TEST(RealtimeHostPathFrames, QueuedShadowRaysShadeTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
