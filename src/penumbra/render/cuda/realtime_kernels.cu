@@ -265,6 +265,17 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
 }
 
+// this thread's StridedLightTerms of `lights` lights in its block's dynamic shared memory
+// (ShadeLightTermBytes of it: the block's threads interleaved).
+__device__ inline StridedLightTerms BlockLightTerms(int lights) {
+  extern __shared__ float light_terms[];
+  StridedLightTerms terms;
+  terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
+  terms.stride = static_cast<int>(blockDim.x * blockDim.y);
+  terms.lights = lights;
+  return terms;
+}
+
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
 // ShadeRealtimeStored): no second surface evaluation. kMedia false: frames without media only
 // (the default variant of frames without media and batches; ShadeRealtimePoint). kSharedTerms
@@ -282,12 +293,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t k = CameraOffset(f) + i;
   if constexpr (kSharedTerms) {
-    extern __shared__ float light_terms[];
-    const int threads = static_cast<int>(blockDim.x * blockDim.y);
-    StridedLightTerms terms;
-    terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
-    terms.stride = threads;
-    terms.lights = lights;
+    StridedLightTerms terms = BlockLightTerms(lights);
     radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms);
   } else {
     radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
@@ -343,11 +349,7 @@ __global__ void __launch_bounds__(128)
   const DeviceShadowPush push{q.rays, q.count, static_cast<uint32_t>(k)};
   QueuedLightMasks m;
   if constexpr (kSharedTerms) {
-    extern __shared__ float light_terms[];
-    StridedLightTerms terms;
-    terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
-    terms.stride = static_cast<int>(blockDim.x * blockDim.y);
-    terms.lights = lights;
+    StridedLightTerms terms = BlockLightTerms(lights);
     radiance[k] = ShadeQueuedStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms, push, &m);
   } else {
     LocalLightTerms terms;
@@ -375,18 +377,28 @@ __global__ void __launch_bounds__(128)
   }
 }
 
-// TraceQueuedKernel's grid: as many blocks of 128 threads as the device holds at once.
+// the current device's SMs.
+inline int DeviceSms() {
+  int device = 0, sms = 0;
+  Check(cudaGetDevice(&device), "cudaGetDevice");
+  Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
+        "cudaDeviceGetAttribute");
+  return std::max(sms, 1);
+}
+
+// as many blocks of 128 threads of `kernel` as the current device holds at once (one wave).
+template <class Kernel>
+unsigned ResidentBlocks(Kernel* kernel) {
+  int per_sm = 0;
+  Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, kernel, 128, 0),
+        "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
+  return static_cast<unsigned>(DeviceSms() * std::max(1, per_sm));
+}
+
+// TraceQueuedKernel's grid: one wave of its blocks.
 template <class Frames>
 unsigned TraceQueuedBlocks() {
-  static const unsigned blocks = [] {
-    int device = 0, sms = 0, per_sm = 0;
-    Check(cudaGetDevice(&device), "cudaGetDevice");
-    Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
-          "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, TraceQueuedKernel<Frames>, 128, 0),
-          "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
-    return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
-  }();
+  static const unsigned blocks = ResidentBlocks(TraceQueuedKernel<Frames>);
   return blocks;
 }
 
@@ -528,16 +540,7 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
 template <class Frames>
 unsigned ChunkBlocks() {
-  static const unsigned blocks = [] {
-    int device = 0, sms = 0, per_sm = 0;
-    Check(cudaGetDevice(&device), "cudaGetDevice");
-    Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
-          "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, VisibilityChunkKernel<Frames>, 128,
-                                                        0),
-          "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
-    return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
-  }();
+  static const unsigned blocks = ResidentBlocks(VisibilityChunkKernel<Frames>);
   return blocks;
 }
 
@@ -810,13 +813,7 @@ struct PixelBuffers {
   // the pixels of one wave of the fused shading kernel (ShadeStoredKernel at its 4 blocks of
   // 128 threads an SM) on the current device.
   static int64_t ShadeWavePixels() {
-    static const int64_t pixels = [] {
-      int device = 0, sms = 0;
-      Check(cudaGetDevice(&device), "cudaGetDevice");
-      Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
-            "cudaDeviceGetAttribute");
-      return int64_t{4} * 128 * std::max(sms, 1);
-    }();
+    static const int64_t pixels = int64_t{4} * 128 * DeviceSms();
     return pixels;
   }
   // whether frames of `n` pixels in all and `lights` lights take the queued shadow rays as `o`
