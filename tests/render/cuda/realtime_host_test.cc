@@ -156,7 +156,10 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
 // RealtimeKernelOptions::reuse_surface) instead of evaluating the surface again: the same
 // radiance, rgb and depth bits, in the default room (planar textures, mirror floor) and the
 // house (textured floors and walls, normal maps); so do the lights' terms kept in an array
-// interleaved over a row's pixels (StridedLightTerms, RealtimeKernelOptions::shared_light_terms).
+// interleaved over a row's pixels (StridedLightTerms, RealtimeKernelOptions::shared_light_terms)
+// and the shadow rays apart in three passes (RealtimeKernelOptions::queue_shadow_rays:
+// ShadeQueuedStored, the rays traced from the queue's entries, SumQueuedLights), whose sum keeps
+// light order: summed from the last light to the first, the radiance and EV100 differ in both.
 TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
@@ -166,11 +169,13 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     cuda::RealtimeFrameData data(scene, RenderSettings());
     ThreadPool pool(0);
     data.Prepare(snap, view, &pool);
-    RenderedFrame evaluated, stored, strided;
+    RenderedFrame evaluated, stored, strided, queued;
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &evaluated, /*stored_surface=*/false);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &stored, /*stored_surface=*/true);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &strided, /*stored_surface=*/true,
                                /*strided_terms=*/true);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &queued, /*stored_surface=*/true,
+                               /*strided_terms=*/false, /*queued_shadows=*/true);
     int64_t lit = 0;
     for (float x : stored.radiance.data) lit += x > 0;
     EXPECT_GT(lit, 0) << world;
@@ -180,6 +185,11 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     // the lights' terms interleaved over the row's pixels (the kernels' shared memory)
     EXPECT_EQ(strided.radiance.data, stored.radiance.data) << world;
     EXPECT_EQ(strided.rgb.data, stored.rgb.data) << world;
+    // the shadow rays through the queue
+    EXPECT_EQ(queued.radiance.data, stored.radiance.data) << world;
+    EXPECT_EQ(queued.rgb.data, stored.rgb.data) << world;
+    EXPECT_EQ(queued.depth_m.data, stored.depth_m.data) << world;
+    EXPECT_EQ(queued.ev100, stored.ev100) << world;
   }
 }
 

@@ -4,7 +4,8 @@
 // off (one thread per row sum, pageable copies, each pixel tracing its own penumbra rays, the
 // kernels' registers uncapped, the radiance copied back in 1 or 5 bands, the mirror layer on the
 // frame's stream or on one of its priority, the resolve and mirror blend as two kernels, the
-// shading kernel's light terms in local instead of shared memory); the rgb
+// shading kernel's light terms in local instead of shared memory, the shadow rays through a
+// queue or in the shading kernel); the rgb
 // too, except that the row sums' order can move the exposure's last bits (then the EV100 agrees
 // to 1e-9). with the primary hit traced again or the surface evaluated again by the shading
 // kernel, the radiance may move in its last bits (nvcc's contraction of a second inlined copy of
@@ -66,8 +67,11 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "fuse_resolve, output_bands 3",
                          "mirror_stream off, output_bands 1",
                          "mirror_low_priority off",
-                         "shared_light_terms off"};
-  for (int k = 0; k < 21; ++k) {
+                         "shared_light_terms off",
+                         "queue_shadow_rays_always",
+                         "queue_shadow_rays_always, shared_light_terms off",
+                         "queue_shadow_rays off"};
+  for (int k = 0; k < 24; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -75,7 +79,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 3) {
       o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
       o.queue_penumbra = false;
-      o.mirror_stream = o.fuse_resolve = o.shared_light_terms = false;
+      o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
       o.min_blocks = o.geometry_min_blocks = 0;
       o.output_bands = 1;
     }
@@ -93,7 +97,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 17) o.output_bands = 3;
     if (k == 18) o.output_bands = 1;
     if (k == 19) o.mirror_low_priority = false;
-    if (k == 20) o.shared_light_terms = false;
+    if (k == 20 || k == 22) o.shared_light_terms = false;
+    if (k == 21 || k == 22) o.queue_shadow_rays_always = true;
+    if (k == 23) o.queue_shadow_rays = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

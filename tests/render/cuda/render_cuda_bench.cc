@@ -376,6 +376,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     // the shading's light terms in local memory (before branch gpu20)
     copy_variants.push_back(fast);
     copy_variants.back().shared_light_terms = false;
+    // the shadow rays through the queue whatever the frame's size, never (branch gpu22)
+    copy_variants.push_back(fast);
+    copy_variants.back().queue_shadow_rays_always = true;
+    copy_variants.push_back(fast);
+    copy_variants.back().queue_shadow_rays = false;
     // second to last: the default into a new RenderedFrame every frame (as the camera sink's
     // CameraImages: the images allocated, zero-filled and first touched each frame); last: the
     // default without the radiance (CudaRenderer::set_radiance_output)
@@ -418,6 +423,8 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
       if (!o.mirror_stream) extra += ", mirror layer on the frame's stream";
       if (!o.fuse_resolve) extra += ", resolve and mirror blend apart";
       if (!o.shared_light_terms) extra += ", light terms in local memory";
+      if (!o.queue_shadow_rays) extra += ", shadow rays never queued";
+      if (o.queue_shadow_rays && o.queue_shadow_rays_always) extra += ", shadow rays always queued";
       if (no_radiance) extra += ", no radiance asked for";
       if (fresh) extra += ", a new RenderedFrame every frame";
       fmt::print(
@@ -535,6 +542,14 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.shared_light_terms = false;
     variants.push_back({"kernels, shading's light terms in local memory", o});
+    o.queue_shadow_rays_always = true;
+    variants.push_back({"kernels, light terms in local memory, shadow rays always queued", o});
+    o = fast;
+    o.queue_shadow_rays_always = true;
+    variants.push_back({"kernels, shadow rays always queued (three passes)", o});
+    o = fast;
+    o.queue_shadow_rays = false;
+    variants.push_back({"kernels, shadow rays never queued (in the shading kernel)", o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -543,7 +558,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.reuse_surface = false;
     o.warp_penumbra = false;
     o.queue_penumbra = false;
-    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = false;
+    o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

@@ -124,6 +124,22 @@ struct RealtimeKernelOptions {
   /// thread's stack in local memory (LocalLightTerms; the stack goes from 1,280 to 832 bytes):
   /// the same values, so the same bits.
   bool shared_light_terms = true;
+  /// with reuse_surface: small frames shade with their shadow rays apart, in three passes
+  /// (branch gpu22; realtime_shading.h's ShadeQueuedStored, SumQueuedLights): a kernel evaluates
+  /// every light's unshadowed term, keeps the lit ones' contributions (area_c) and puts the
+  /// shadow rays worth tracing into one queue for the frame (32 bytes a ray, room for one per
+  /// pixel and light); a lean kernel traces the queue, each verdict a bit of its pixel's mask
+  /// (integer atomicOr); a third sums each pixel's lights in light order as the fused kernel
+  /// does: the same bits. small: the frame's pixels (a batch's: all its cameras') fit one wave
+  /// of the fused kernel's blocks (4 blocks of 128 threads an SM; 67,584 pixels on an H100's
+  /// 132 SMs), where that kernel leaves SMs idle and the queue spreads the rays over all of
+  /// them (128x128 on an H100: the house's kernels 0.267 ms instead of 0.305); larger frames
+  /// fill the device, and there the fused kernel, whose shading hides its rays' latency, is
+  /// faster (640x480: 0.722 against 0.757 ms). frames of more than kMaxQueuedShadowLights
+  /// lights take the fused kernel.
+  bool queue_shadow_rays = true;
+  /// with queue_shadow_rays: every frame's shadow rays through the queue, whatever its size.
+  bool queue_shadow_rays_always = false;
   /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
   /// reuse_surface), below 5 leaves them to the compiler.

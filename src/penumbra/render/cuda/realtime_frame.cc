@@ -465,8 +465,23 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
   }
 }
 
+namespace {
+
+// ShadeQueuedLights' queue on the host (RenderRealtimeOnHost's queued_shadows): light j's ray
+// of pixel `pixel` at rays[j n + pixel].
+struct HostShadowPush {
+  QueuedShadowRay* rays;
+  int64_t pixel, n;
+  void Push(int j, const TraceRay& r) const {
+    rays[j * n + pixel] = QueueEntryOf(r, static_cast<uint32_t>(pixel), j);
+  }
+};
+
+}  // namespace
+
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
-                          RenderedFrame* out, bool stored_surface, bool strided_terms) {
+                          RenderedFrame* out, bool stored_surface, bool strided_terms,
+                          bool queued_shadows) {
   const PinholeCamera& c = data.camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -549,13 +564,28 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
   f.area_fraction = area_fraction.data();
   std::vector<Float3> radiance(n);
   const int term_lights = std::min(std::max(f.num_lights, 0), kShadeCachedLights);
+  // queued_shadows: the kernels' three passes (ShadeQueuedKernel, TraceQueuedKernel,
+  // SumQueuedKernel), the rays at [light][pixel] in place of the device's queue
+  std::vector<QueuedShadowRay> queued_rays;
+  std::vector<QueuedLightMasks> queued_masks;
+  std::vector<uint32_t> queued_occluded;
+  if (stored_surface && queued_shadows && f.num_lights <= kMaxQueuedShadowLights) {
+    queued_rays.resize(nl);
+    queued_masks.resize(n);
+    queued_occluded.assign(n, 0);
+  }
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     // strided_terms: the row's pixels share one array, interleaved as a block's threads
     std::vector<float> row_terms;
     if (strided_terms) row_terms.resize(StridedLightTerms::kLightTermFloats * term_lights * W);
     for (int u = 0; u < W; ++u) {
       const int64_t i = v * W + u;
-      if (stored_surface && strided_terms) {
+      if (!queued_masks.empty()) {
+        const HostShadowPush push{queued_rays.data(), i, n};
+        LocalLightTerms terms;
+        radiance[i] = ShadeQueuedStored<true>(f, u, static_cast<int>(v), geometry[i], surfaces[i],
+                                              terms, push, &queued_masks[i]);
+      } else if (stored_surface && strided_terms) {
         StridedLightTerms terms;
         terms.at = row_terms.data() + u;
         terms.stride = W;
@@ -569,6 +599,20 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
       }
     }
   });
+  if (!queued_masks.empty()) {
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int64_t i = v * W; i < (v + 1) * W; ++i)
+        for (uint32_t b = queued_masks[i].traced; b != 0; b &= b - 1) {
+          const QueuedShadowRay& e = queued_rays[LowestSetBit(b) * n + i];
+          if (TraceOccluded(f.scene, QueuedRay(e)))
+            queued_occluded[i] |= 1u << (e.key % kMaxQueuedShadowLights);
+        }
+    });
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int64_t i = v * W; i < (v + 1) * W; ++i)
+        radiance[i] = SumQueuedLights(f, i, n, radiance[i], queued_masks[i], queued_occluded[i]);
+    });
+  }
   ParallelForOrSerial(pool, H, [&](int64_t v) {
     for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));
   });

@@ -283,9 +283,12 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 /// the lights' terms wait between ShadeRealtimePoint's loops in a row's array interleaved over
 /// its pixels (StridedLightTerms, as the kernels' shared memory with
 /// RealtimeKernelOptions::shared_light_terms) instead of each pixel's own (LocalLightTerms);
-/// the same bits.
+/// the same bits. `queued_shadows` (with stored_surface, at most kMaxQueuedShadowLights
+/// lights): the shadow rays apart in three passes as RealtimeKernelOptions::queue_shadow_rays
+/// (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the lights' terms in
+/// each pixel's own arrays); the same bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                           RenderedFrame* out, bool stored_surface = false,
-                          bool strided_terms = false);
+                          bool strided_terms = false, bool queued_shadows = false);
 
 }  // namespace penumbra::cuda

@@ -265,6 +265,17 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
 }
 
+// this thread's StridedLightTerms of `lights` lights in its block's dynamic shared memory
+// (ShadeLightTermBytes of it: the block's threads interleaved).
+__device__ inline StridedLightTerms BlockLightTerms(int lights) {
+  extern __shared__ float light_terms[];
+  StridedLightTerms terms;
+  terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
+  terms.stride = static_cast<int>(blockDim.x * blockDim.y);
+  terms.lights = lights;
+  return terms;
+}
+
 // ShadeKernel from the shading points GeometryKernel kept (their geometry and material terms,
 // ShadeRealtimeStored): no second surface evaluation. kMedia false: frames without media only
 // (the default variant of frames without media and batches; ShadeRealtimePoint). kSharedTerms
@@ -282,12 +293,7 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t k = CameraOffset(f) + i;
   if constexpr (kSharedTerms) {
-    extern __shared__ float light_terms[];
-    const int threads = static_cast<int>(blockDim.x * blockDim.y);
-    StridedLightTerms terms;
-    terms.at = light_terms + threadIdx.y * blockDim.x + threadIdx.x;
-    terms.stride = threads;
-    terms.lights = lights;
+    StridedLightTerms terms = BlockLightTerms(lights);
     radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms);
   } else {
     radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
@@ -301,6 +307,115 @@ inline int ShadeSharedLights(int num_lights) {
 }
 inline size_t ShadeLightTermBytes(int lights, int threads) {
   return sizeof(float) * StridedLightTerms::kLightTermFloats * lights * threads;
+}
+
+// the queued shadow rays (RealtimeKernelOptions::queue_shadow_rays): the device's queue and
+// each pixel's masks and verdicts (per pixel of the frame, or of the whole batch).
+struct ShadowRayQueue {
+  QueuedShadowRay* rays = nullptr;
+  unsigned* count = nullptr;  // rays queued (never more than the room: a ray per pixel and light)
+  QueuedLightMasks* masks = nullptr;
+  uint32_t* occluded = nullptr;  // bit j: light j's ray hit something (integer atomicOr)
+};
+
+// ShadeQueuedLights' queue on the device: the lanes that push at once take their room with one
+// atomic add (the order varies from run to run; each ray's verdict is its own).
+struct DeviceShadowPush {
+  QueuedShadowRay* rays;
+  unsigned* count;
+  uint32_t pixel;  // in the whole batch
+  __device__ void Push(int j, const TraceRay& r) const {
+    const cg::coalesced_group g = cg::coalesced_threads();
+    unsigned base = 0;
+    if (g.thread_rank() == 0) base = atomicAdd(count, g.size());
+    const unsigned at = g.shfl(base, 0) + g.thread_rank();
+    rays[at] = QueueEntryOf(r, pixel, j);
+  }
+};
+
+// pass 1 of the queued shadow rays (ShadeQueuedStored): rows [row0, row1), the ambient term to
+// `radiance`, the masks, the verdicts cleared, the shadow rays to the queue. kSharedTerms: the
+// lights' terms in the block's dynamic shared memory (as ShadeStoredKernel's).
+template <class Frames, bool kMedia, bool kSharedTerms>
+__global__ void __launch_bounds__(128)
+    ShadeQueuedKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance,
+                      ShadowRayQueue q, int row0, int row1, int lights) {
+  const RealtimeFrameView& f = frames.get();
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (u >= f.camera.width || v >= row1) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t k = CameraOffset(f) + i;
+  const DeviceShadowPush push{q.rays, q.count, static_cast<uint32_t>(k)};
+  QueuedLightMasks m;
+  if constexpr (kSharedTerms) {
+    StridedLightTerms terms = BlockLightTerms(lights);
+    radiance[k] = ShadeQueuedStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms, push, &m);
+  } else {
+    LocalLightTerms terms;
+    radiance[k] = ShadeQueuedStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms, push, &m);
+  }
+  q.masks[k] = m;
+  q.occluded[k] = 0;
+}
+
+// pass 2: the queued rays, one a thread, one wave of resident blocks striding over the queue;
+// `pixels`: a camera's (the ray's camera is its pixel / pixels). its registers are the
+// compiler's (98 with nvcc 13 for sm_90: 4 blocks an SM; capped at 64, 8 blocks, it was slower).
+template <class Frames>
+__global__ void __launch_bounds__(128)
+    TraceQueuedKernel(Frames frames, ShadowRayQueue q, int64_t pixels) {
+  const int64_t total = *q.count;
+  const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
+  for (int64_t at = static_cast<int64_t>(blockIdx.x) * blockDim.x + threadIdx.x; at < total;
+       at += stride) {
+    const QueuedShadowRay e = q.rays[at];
+    const uint32_t pixel = e.key / kMaxQueuedShadowLights;
+    const RealtimeFrameView& f = frames.at(static_cast<int>(pixel / pixels));
+    if (TraceOccluded(f.scene, QueuedRay(e)))
+      atomicOr(q.occluded + pixel, 1u << (e.key % kMaxQueuedShadowLights));
+  }
+}
+
+// the current device's SMs.
+inline int DeviceSms() {
+  int device = 0, sms = 0;
+  Check(cudaGetDevice(&device), "cudaGetDevice");
+  Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
+        "cudaDeviceGetAttribute");
+  return std::max(sms, 1);
+}
+
+// as many blocks of 128 threads of `kernel` as the current device holds at once (one wave).
+template <class Kernel>
+unsigned ResidentBlocks(Kernel* kernel) {
+  int per_sm = 0;
+  Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, kernel, 128, 0),
+        "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
+  return static_cast<unsigned>(DeviceSms() * std::max(1, per_sm));
+}
+
+// TraceQueuedKernel's grid: one wave of its blocks.
+template <class Frames>
+unsigned TraceQueuedBlocks() {
+  static const unsigned blocks = ResidentBlocks(TraceQueuedKernel<Frames>);
+  return blocks;
+}
+
+// pass 3 (SumQueuedLights): rows [row0, row1), each pixel's lights summed in light order.
+template <class Frames>
+__global__ void SumQueuedKernel(Frames frames, Float3* radiance, ShadowRayQueue q, int row0,
+                                int row1) {
+  const RealtimeFrameView& f = frames.get();
+  const int u = blockIdx.x * blockDim.x + threadIdx.x;
+  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (u >= f.camera.width || v >= row1) return;
+  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t k = CameraOffset(f) + i;
+  const QueuedLightMasks m = q.masks[k];
+  if (m.lit == 0) return;
+  const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  radiance[k] = SumQueuedLights(f, i, n, radiance[k], m, q.occluded[k]);
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
@@ -425,16 +540,7 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
 template <class Frames>
 unsigned ChunkBlocks() {
-  static const unsigned blocks = [] {
-    int device = 0, sms = 0, per_sm = 0;
-    Check(cudaGetDevice(&device), "cudaGetDevice");
-    Check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device),
-          "cudaDeviceGetAttribute");
-    Check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, VisibilityChunkKernel<Frames>, 128,
-                                                        0),
-          "cudaOccupancyMaxActiveBlocksPerMultiprocessor");
-    return static_cast<unsigned>(std::max(1, sms * std::max(1, per_sm)));
-  }();
+  static const unsigned blocks = ResidentBlocks(VisibilityChunkKernel<Frames>);
   return blocks;
 }
 
@@ -647,6 +753,9 @@ struct PixelBuffers {
   Buffer penumbra_queue, penumbra_queued, penumbra_counts;
   // the mirror layer's buffers (RealtimeFrameView)
   Buffer mirror_geometry, mirror_hits, mirror_sky, mirror_radiance;
+  // the queued shadow rays (queue_shadow_rays; reserved by the first frame that takes them):
+  // room for a ray per pixel and light, the count, each pixel's masks and verdicts
+  Buffer shadow_rays, shadow_count, shadow_masks, shadow_occluded;
   // room for n pixels (all cameras) and nl = n x lights (lights >= 1); the material terms if
   // `with_surfaces`, the mirror layer's if `mirror`
   void Reserve(int64_t n, int64_t nl, bool with_surfaces, bool mirror) {
@@ -693,6 +802,53 @@ struct PixelBuffers {
     // one wave of resident blocks strides over the chunks (their number stays on the device)
     VisibilityChunkKernel<<<ChunkBlocks<Frames>(), 128, 0, stream>>>(frames, q);
     Check(cudaGetLastError(), "VisibilityChunkKernel");
+  }
+  // whether frames of `n` pixels in all (every camera's) and `lights` lights can queue their
+  // shadow rays: the lights fit a pixel's masks, the rays' keys and count fit 32 bits.
+  static bool CanQueueShadowRays(int64_t n, int lights) {
+    const int64_t most = int64_t{1} << 32;
+    return lights <= kMaxQueuedShadowLights && n * kMaxQueuedShadowLights < most &&
+           n * std::max(lights, 1) < most;
+  }
+  // the pixels of one wave of the fused shading kernel (ShadeStoredKernel at its 4 blocks of
+  // 128 threads an SM) on the current device.
+  static int64_t ShadeWavePixels() {
+    static const int64_t pixels = int64_t{4} * 128 * DeviceSms();
+    return pixels;
+  }
+  // whether frames of `n` pixels in all and `lights` lights take the queued shadow rays as `o`
+  // says (queue_shadow_rays, queue_shadow_rays_always).
+  static bool QueueShadowRays(const RealtimeKernelOptions& o, int64_t n, int lights) {
+    return o.queue_shadow_rays && o.reuse_hit && o.reuse_surface &&
+           (o.queue_shadow_rays_always || n <= ShadeWavePixels()) && CanQueueShadowRays(n, lights);
+  }
+  // the shading of rows [row0, row1) of `cameras` frames (grid: a camera's rows, z the camera)
+  // of `pixels` pixels and `lights` lights each, their shadow rays through the queue, on
+  // `stream`: ShadeQueuedKernel, TraceQueuedKernel, SumQueuedKernel.
+  // smem: the light terms' shared memory (kSharedTerms) for `term_lights` lights.
+  // CanQueueShadowRays must hold.
+  template <class Frames, bool kMedia, bool kSharedTerms>
+  void LaunchQueuedShade(Frames frames, dim3 grid, const SurfaceTerms* surfaces, Float3* L,
+                         int row0, int row1, int64_t pixels, int cameras, int lights,
+                         int term_lights, size_t smem, cudaStream_t stream) {
+    const int64_t n = pixels * cameras;
+    shadow_rays.Reserve(sizeof(QueuedShadowRay) * n * std::max(lights, 1));
+    shadow_count.Reserve(sizeof(unsigned));
+    shadow_masks.Reserve(sizeof(QueuedLightMasks) * n);
+    shadow_occluded.Reserve(sizeof(uint32_t) * n);
+    ShadowRayQueue q;
+    q.rays = shadow_rays.as<QueuedShadowRay>();
+    q.count = shadow_count.as<unsigned>();
+    q.masks = shadow_masks.as<QueuedLightMasks>();
+    q.occluded = shadow_occluded.as<uint32_t>();
+    Check(cudaMemsetAsync(q.count, 0, sizeof(unsigned), stream), "cudaMemsetAsync");
+    ShadeQueuedKernel<Frames, kMedia, kSharedTerms>
+        <<<grid, kPixelBlock, smem, stream>>>(frames, surfaces, L, q, row0, row1, term_lights);
+    Check(cudaGetLastError(), "ShadeQueuedKernel");
+    TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
+    Check(cudaGetLastError(), "TraceQueuedKernel");
+    SumQueuedKernel<<<grid, kPixelBlock, 0, stream>>>(frames, L, q, row0, row1);
+    Check(cudaGetLastError(), "SumQueuedKernel");
   }
   // f's per-pixel arrays: the part at pixel `at` and, per light, at `at_l`
   void Point(RealtimeFrameView* f, int64_t at, int64_t at_l, bool mirror) const {
@@ -1087,8 +1243,32 @@ struct DeviceRealtime::Impl : PixelBuffers {
       Check(cudaFuncSetAttribute(ShadeStoredKernel<OneFrame, 4, false, true>,
                                  cudaFuncAttributeMaxDynamicSharedMemorySize, most),
             "cudaFuncSetAttribute");
-
+      Check(cudaFuncSetAttribute(ShadeQueuedKernel<OneFrame, true, true>,
+                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
+            "cudaFuncSetAttribute");
+      Check(cudaFuncSetAttribute(ShadeQueuedKernel<OneFrame, false, true>,
+                                 cudaFuncAttributeMaxDynamicSharedMemorySize, most),
+            "cudaFuncSetAttribute");
       shade_smem_set = true;
+    }
+    // queue_shadow_rays: the shadow rays apart, through the queue (the same bits)
+    const int64_t pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+    if (QueueShadowRays(o, pixels, f.num_lights)) {
+      const OneFrame fr{f};
+      const bool media = f.has_media != 0;
+      if (o.shared_light_terms && media)
+        LaunchQueuedShade<OneFrame, true, true>(fr, grid, st, L, row0, row1, pixels, 1,
+                                                f.num_lights, lights, smem, stream);
+      else if (o.shared_light_terms)
+        LaunchQueuedShade<OneFrame, false, true>(fr, grid, st, L, row0, row1, pixels, 1,
+                                                 f.num_lights, lights, smem, stream);
+      else if (media)
+        LaunchQueuedShade<OneFrame, true, false>(fr, grid, st, L, row0, row1, pixels, 1,
+                                                 f.num_lights, 0, 0, stream);
+      else
+        LaunchQueuedShade<OneFrame, false, false>(fr, grid, st, L, row0, row1, pixels, 1,
+                                                  f.num_lights, 0, 0, stream);
+      return;
     }
     if (!o.reuse_hit)
       ShadeKernel<false, 1><<<grid, kPixelBlock, 0, stream>>>(f, nullptr, L, row0, row1);
@@ -1898,9 +2078,15 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   }
   stage(2);
   // batches hold no media (BatchRenderer::UpdateWorld refuses them)
-  ShadeStoredKernel<BatchFrames, 4, false>
-      <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
-  Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
+  // the batch's shading as a frame's with the default options (one wave or less: the queue)
+  if (Impl::QueueShadowRays(RealtimeKernelOptions(), n * count, m.lights)) {
+    m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0, H,
+                                                   n, count, m.lights, 0, 0, stream);
+  } else {
+    ShadeStoredKernel<BatchFrames, 4, false>
+        <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
+    Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
+  }
   stage(3);
   m.LaunchPenumbraRays(fr, grid, nl, count, /*queue=*/true, stream);
   VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);

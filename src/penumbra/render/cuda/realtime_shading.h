@@ -797,84 +797,243 @@ struct StridedLightTerms {
   }
 };
 
+/// what ShadeRealtimePoint computes at a shading point before its lights: the BRDF's
+/// coefficients (BrdfCoefficientsOf: c_diff, f0, a2 = alpha^2), n . wo, the ambient radiance
+/// Le + E_sky / pi (c_diff (1 - S) + S) and the shadow rays' origin (OffsetOrigin off the
+/// geometric normal).
+struct ShadeSetup {
+  Float3 c_diff, f0;
+  float a2 = 0, n_v = 0;
+  Float3 L;
+  F3 origin;
+};
+
+/// ShadeSetup of shading point sp with sky term `sky` (E_sky where the pixel's ray hits).
+PB_HOST_DEVICE inline ShadeSetup BeginShadePoint(const ShadingPoint& sp, const Float3& sky) {
+  ShadeSetup s;
+  const float roughness = sp.roughness;
+  const Float3 emission = sp.emission;
+  const float occlusion = sp.occlusion;
+  // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
+  // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
+  float alpha;
+  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &s.c_diff, &s.f0,
+                                    &alpha);
+  s.a2 = alpha * alpha;
+  s.n_v = pbm::Dot<float>(sp.n, sp.wo);
+  const Float3 spec = EnvBrdfApprox<float, Float3>(s.f0, pbm::Max(s.n_v, 0.0f), roughness);
+  const Float3 reflect{s.c_diff.x * (1.0f - spec.x) + spec.x, s.c_diff.y * (1.0f - spec.y) + spec.y,
+                       s.c_diff.z * (1.0f - spec.z) + spec.z};
+  const Float3 sky_E = occlusion * sky;
+  s.L = Float3{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
+               emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
+               emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
+  // shadow rays start off the surface on the lit side.
+  s.origin = OffsetOrigin(sp.p, sp.ng);
+  return s;
+}
+
+/// light j's unshadowed contribution at shading point sp of pixel (u, v) (LightContribution,
+/// attenuated by the frame's media where kMedia and f.has_media), its shadow ray's unit
+/// direction *wi and distance *dist.
+template <bool kMedia>
+PB_HOST_DEVICE inline Float3 UnshadowedLight(const RealtimeFrameView& f, int j, int u, int v,
+                                             const ShadingPoint& sp, const ShadeSetup& s,
+                                             Float3* wi, float* dist) {
+  Float3 c = LightContribution(f, j, u, v, sp.p, sp.n, sp.ng, sp.wo, s.n_v, s.c_diff, s.f0, s.a2,
+                               wi, dist);
+  if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, sp.p, *wi, *dist, c);
+  return c;
+}
+
+/// ShadeRealtimePoint's first light loop: every light's unshadowed term (the first
+/// terms.capacity() kept in `terms`), returns the unshadowed total's luminance (the ambient
+/// term's and every light's), which decides the shadow rays worth tracing.
+template <bool kMedia, class Terms>
+PB_HOST_DEVICE inline float UnshadowedLights(const RealtimeFrameView& f, int u, int v,
+                                             const ShadingPoint& sp, const ShadeSetup& s,
+                                             Terms& terms) {
+  float total = pbm::Luminance709(s.L.x, s.L.y, s.L.z);
+  const int cached = terms.capacity();
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = UnshadowedLight<kMedia>(f, j, u, v, sp, s, &wi, &dist);
+    if (j < cached) terms.Put(j, c, wi, dist);
+    total += pbm::Luminance709(c.x, c.y, c.z);
+  }
+  return total;
+}
+
+/// light j's unshadowed terms for ShadeRealtimePoint's second loop: kept in `terms`, or
+/// evaluated again (UnshadowedLight) for lights from terms.capacity() on.
+template <bool kMedia, class Terms>
+PB_HOST_DEVICE inline Float3 KeptLight(const RealtimeFrameView& f, int j, int u, int v,
+                                       const ShadingPoint& sp, const ShadeSetup& s,
+                                       const Terms& terms, Float3* wi, float* dist) {
+  if (j < terms.capacity()) {
+    Float3 c;
+    terms.Get(j, &c, wi, dist);
+    return c;
+  }
+  return UnshadowedLight<kMedia>(f, j, u, v, sp, s, wi, dist);
+}
+
+/// a light of luminance lum (> 0) at a pixel whose unshadowed total is `total` gets a shadow
+/// ray: it casts shadows and is not negligible (kGpuNegligibleLight of the total).
+PB_HOST_DEVICE inline bool WantsShadowRay(const LightPod& l, float lum, float total) {
+  return l.cast_shadow != 0 && lum >= kGpuNegligibleLight * total;
+}
+
+/// the shadow ray from `origin` towards a light in unit direction wi at distance dist (stops
+/// just short of it; +inf stays +inf).
+PB_HOST_DEVICE inline TraceRay ShadowRayOf(const F3& origin, const Float3& wi, float dist) {
+  TraceRay sr;
+  sr.o = origin;
+  sr.d = ToF3(wi);
+  sr.tmin = 0;
+  sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
+  return sr;
+}
+
+/// ShadeRealtimePoint's second loop at light j (lit: luminance > 0) of pixel `pixel` of
+/// n_pixels, once its shadow ray's verdict is known (traced false: none traced, the light is
+/// added as it is): a light with an extent leaves its contribution c and the verdict to the
+/// shared visibility (f.area_c, f.area_vis); another adds c to *L unless occluded.
+PB_HOST_DEVICE inline void AddLitLight(const RealtimeFrameView& f, int j, int64_t pixel,
+                                       int64_t n_pixels, const Float3& c, bool traced,
+                                       bool occluded, Float3* L) {
+  if (traced) {
+    if (IsExtendedLightPod(f.lights[j])) {
+      f.area_vis[j * n_pixels + pixel] = occluded ? 0 : 1;
+      f.area_c[j * n_pixels + pixel] = c;
+      return;
+    }
+    if (occluded) return;
+  }
+  *L = *L + c;
+}
+
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
 /// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
 /// false: for frames known to have none (f.has_media must be 0): the media's code is left out,
 /// so the kernels of frames without media keep their registers. terms: where the lights'
 /// unshadowed terms wait between the two loops (LocalLightTerms, StridedLightTerms); lights from
-/// terms.capacity() on are evaluated twice.
+/// terms.capacity() on are evaluated twice. ShadeQueuedLights and SumQueuedLights do the same
+/// with the shadow rays traced apart (the same bits).
 template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky,
                                                 Terms& terms) {
-  const SceneView& s = f.scene;
   const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
   const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  const Float3& p = sp.p;
-  const Float3& ng = sp.ng;
-  const Float3& n = sp.n;
-  const Float3& wo = sp.wo;
-  const float roughness = sp.roughness;
-  const Float3 emission = sp.emission;
-  const float occlusion = sp.occlusion;
-  // the BRDF's coefficients and the ambient term E_sky / pi (c_diff (1 - S) + S); the shading
-  // normal where it faces the viewer, else the geometric one (UsableShadingNormal).
-  Float3 c_diff, f0;
-  float alpha;
-  BrdfCoefficientsOf<float, Float3>(sp.base, roughness, sp.metallic, sp.specular, &c_diff, &f0,
-                                    &alpha);
-  const float a2 = alpha * alpha;
-  const float n_v = pbm::Dot<float>(n, wo);
-  const Float3 spec = EnvBrdfApprox<float, Float3>(f0, pbm::Max(n_v, 0.0f), roughness);
-  const Float3 reflect{c_diff.x * (1.0f - spec.x) + spec.x, c_diff.y * (1.0f - spec.y) + spec.y,
-                       c_diff.z * (1.0f - spec.z) + spec.z};
-  const Float3 sky_E = occlusion * sky;
-  Float3 L{emission.x + (sky_E.x * pbm::kInvPi) * reflect.x,
-           emission.y + (sky_E.y * pbm::kInvPi) * reflect.y,
-           emission.z + (sky_E.z * pbm::kInvPi) * reflect.z};
-  // shadow rays start off the surface on the lit side.
-  const F3 origin = OffsetOrigin(p, ng);
+  const ShadeSetup s = BeginShadePoint(sp, sky);
+  Float3 L = s.L;
   // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
-  float total = pbm::Luminance709(L.x, L.y, L.z);
-  const int cached = terms.capacity();
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    Float3 c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-    if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
-    if (j < cached) terms.Put(j, c, wi, dist);
-    total += pbm::Luminance709(c.x, c.y, c.z);
-  }
+  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
   f.total[pixel] = total;
   // lights in order: negligible or shadowless contributions are added as they are, the others
   // after a shadow ray; those of lights with an extent wait for their neighbours' verdicts.
   for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi, c;
+    Float3 wi;
     float dist;
-    if (j < cached) {
-      terms.Get(j, &c, &wi, &dist);
-    } else {
-      c = LightContribution(f, j, u, v, p, n, ng, wo, n_v, c_diff, f0, a2, &wi, &dist);
-      if (kMedia && f.has_media != 0) c = MediaAttenuated(f, j, p, wi, dist, c);
-    }
+    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
     const float lum = pbm::Luminance709(c.x, c.y, c.z);
     if (!(lum > 0)) continue;
-    if (f.lights[j].cast_shadow != 0 && lum >= kGpuNegligibleLight * total) {
-      TraceRay sr;
-      sr.o = origin;
-      sr.d = ToF3(wi);
-      sr.tmin = 0;
-      sr.tmax = dist * (1.0f - 1e-4f);  // +inf stays +inf
-      const bool occluded = TraceOccluded(s, sr);
-      if (IsExtendedLightPod(f.lights[j])) {
-        f.area_vis[j * n_pixels + pixel] = occluded ? 0 : 1;
-        f.area_c[j * n_pixels + pixel] = c;
-        continue;
-      }
-      if (occluded) continue;
-    }
-    L = L + c;
+    const bool traced = WantsShadowRay(f.lights[j], lum, total);
+    const bool occluded = traced && TraceOccluded(f.scene, ShadowRayOf(s.origin, wi, dist));
+    AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
+  }
+  return L;
+}
+
+/// the most lights a frame may have for its shadow rays to go through a queue
+/// (RealtimeKernelOptions::queue_shadow_rays: a pixel's lights are bits of 32-bit masks).
+constexpr int kMaxQueuedShadowLights = 32;
+
+/// what ShadeQueuedLights leaves of a pixel for SumQueuedLights: the lights whose unshadowed
+/// contribution is lit (luminance > 0; kept in f.area_c) and, of those, the ones whose shadow
+/// ray went to the queue (bit j: light j).
+struct QueuedLightMasks {
+  uint32_t lit = 0;
+  uint32_t traced = 0;
+};
+
+/// a shadow ray in the queue: its origin, unit direction and tmax (ShadowRayOf; tmin 0), and
+/// key = pixel kMaxQueuedShadowLights + light (pixel: in the whole batch, camera-major).
+struct alignas(16) QueuedShadowRay {
+  F3 o, d;
+  float tmax = 0;
+  uint32_t key = 0;
+};
+
+/// the queue entry of shadow ray r (tmin 0) of light j at pixel `pixel` (in the whole batch).
+PB_HOST_DEVICE inline QueuedShadowRay QueueEntryOf(const TraceRay& r, uint32_t pixel, int j) {
+  QueuedShadowRay e;
+  e.o = r.o;
+  e.d = r.d;
+  e.tmax = r.tmax;
+  e.key = pixel * kMaxQueuedShadowLights + static_cast<uint32_t>(j);
+  return e;
+}
+
+/// the shadow ray of queue entry r (tmin 0).
+PB_HOST_DEVICE inline TraceRay QueuedRay(const QueuedShadowRay& r) {
+  TraceRay sr;
+  sr.o = r.o;
+  sr.d = r.d;
+  sr.tmin = 0;
+  sr.tmax = r.tmax;
+  return sr;
+}
+
+/// ShadeRealtimePoint up to its shadow rays (f.num_lights <= kMaxQueuedShadowLights), pass 1
+/// of 3 of the queued shadow rays (RealtimeKernelOptions::queue_shadow_rays): the unshadowed
+/// terms and total as there, every lit light's contribution kept in f.area_c at [j n + pixel],
+/// each shadow ray that ShadeRealtimePoint traces handed to queue.Push(j, ray) instead, in
+/// light order; returns the ambient term (the sum's start) and sets *masks. pass 2 traces the
+/// queue (TraceOccluded, any order: each verdict is the ray's own), pass 3 sums the lights
+/// (SumQueuedLights).
+template <bool kMedia, class Terms, class Queue>
+PB_HOST_DEVICE inline Float3 ShadeQueuedLights(const RealtimeFrameView& f, int u, int v,
+                                               const ShadingPoint& sp, const Float3& sky,
+                                               Terms& terms, Queue& queue,
+                                               QueuedLightMasks* masks) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  const ShadeSetup s = BeginShadePoint(sp, sky);
+  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
+  f.total[pixel] = total;
+  QueuedLightMasks m;
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
+    const float lum = pbm::Luminance709(c.x, c.y, c.z);
+    if (!(lum > 0)) continue;
+    m.lit |= 1u << j;
+    f.area_c[j * n_pixels + pixel] = c;
+    if (!WantsShadowRay(f.lights[j], lum, total)) continue;
+    m.traced |= 1u << j;
+    queue.Push(j, ShadowRayOf(s.origin, wi, dist));
+  }
+  *masks = m;
+  return s.L;
+}
+
+/// pass 3 of the queued shadow rays: pixel `pixel` (of n_pixels)'s radiance from the ambient
+/// term L (ShadeQueuedLights' return), its masks and the verdicts of its queued rays (bit j of
+/// `occluded`: light j's ray hit something): its lit lights added in light order as
+/// ShadeRealtimePoint's second loop adds them (AddLitLight: the same operations in the same
+/// order, so the same bits).
+PB_HOST_DEVICE inline Float3 SumQueuedLights(const RealtimeFrameView& f, int64_t pixel,
+                                             int64_t n_pixels, Float3 L, const QueuedLightMasks& m,
+                                             uint32_t occluded) {
+  for (uint32_t b = m.lit; b != 0; b &= b - 1) {
+    const int j = LowestSetBit(b);
+    AddLitLight(f, j, pixel, n_pixels, f.area_c[j * n_pixels + pixel], (m.traced >> j & 1u) != 0,
+                (occluded >> j & 1u) != 0, &L);
   }
   return L;
 }
@@ -907,17 +1066,13 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeHit(const RealtimeFrameView& f, int u,
   return ShadeRealtimePoint(f, u, v, EvaluateSurface(f, r, h, d_len), sky);
 }
 
-/// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point: its
-/// primary geometry g and material terms t (PrimaryGeometry's surface_out; the view direction
-/// from PrimaryRay as EvaluateSurface): the same shading point, so the same radiance, without
-/// evaluating the surface (textures, normal map) a second time. kMedia and terms:
-/// ShadeRealtimePoint's.
-template <bool kMedia = true, class Terms>
-PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
-                                                 const PixelGeometry& g, const SurfaceTerms& t,
-                                                 Terms& terms) {
-  const Float3 sky = BeginRealtimePixel(f, u, v);
-  if (g.hit == 0) return sky;
+/// the shading point of pixel (u, v) from what the geometry pass kept of it: its primary
+/// geometry g (a hit) and material terms t (PrimaryGeometry's surface_out; the view direction
+/// from PrimaryRay as EvaluateSurface): EvaluateSurface's shading point, without evaluating the
+/// surface (textures, normal map) a second time.
+PB_HOST_DEVICE inline ShadingPoint StoredShadingPoint(const RealtimeFrameView& f, int u, int v,
+                                                      const PixelGeometry& g,
+                                                      const SurfaceTerms& t) {
   const TraceRay r = PrimaryRay(f.camera, u, v);
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
   ShadingPoint sp;
@@ -932,7 +1087,34 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int
   sp.specular = t.specular;
   sp.occlusion = t.occlusion;
   sp.mirror = g.mirror;
-  return ShadeRealtimePoint<kMedia>(f, u, v, sp, sky, terms);
+  return sp;
+}
+
+/// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point
+/// (StoredShadingPoint of g and t): the same shading point, so the same radiance. kMedia and
+/// terms: ShadeRealtimePoint's.
+template <bool kMedia = true, class Terms>
+PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
+                                                 const PixelGeometry& g, const SurfaceTerms& t,
+                                                 Terms& terms) {
+  const Float3 sky = BeginRealtimePixel(f, u, v);
+  if (g.hit == 0) return sky;
+  return ShadeRealtimePoint<kMedia>(f, u, v, StoredShadingPoint(f, u, v, g, t), sky, terms);
+}
+
+/// ShadeRealtimeStored up to its shadow rays (pass 1 of the queued shadow rays,
+/// ShadeQueuedLights): the pixel's area_vis cleared, returns its sky term where its ray
+/// escapes (no lights: *masks empty), else ShadeQueuedLights' ambient term.
+template <bool kMedia, class Terms, class Queue>
+PB_HOST_DEVICE inline Float3 ShadeQueuedStored(const RealtimeFrameView& f, int u, int v,
+                                               const PixelGeometry& g, const SurfaceTerms& t,
+                                               Terms& terms, Queue& queue,
+                                               QueuedLightMasks* masks) {
+  const Float3 sky = BeginRealtimePixel(f, u, v);
+  *masks = QueuedLightMasks();
+  if (g.hit == 0) return sky;
+  return ShadeQueuedLights<kMedia>(f, u, v, StoredShadingPoint(f, u, v, g, t), sky, terms, queue,
+                                   masks);
 }
 
 /// ShadeRealtimeStored with the lights' terms in the thread's own arrays (LocalLightTerms).
