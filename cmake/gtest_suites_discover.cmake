@@ -6,7 +6,6 @@ execute_process(COMMAND "${TEST_EXECUTABLE}" --gtest_list_tests
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "${TEST_EXECUTABLE} --gtest_list_tests failed (${rc}): ${errors}")
 endif()
-set(cost_of)
 set(costs ${COSTS})
 set(content "")
 string(REPLACE "\n" ";" lines "${listing}")

@@ -18,6 +18,7 @@
 #include <memory>
 #include <string>
 
+#include "host_path.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/camera.h"
@@ -43,16 +44,14 @@ struct HostCompared {
 class HostAndCpu {
  public:
   HostAndCpu(const SceneDescription& scene, const WorldSnapshot& snap)
-      : snap_(snap), cpu_(MakeRenderer(scene, Settings())), bvh_(scene), data_(scene, Settings()) {
-    bvh_.Update(snap);
-  }
+      : snap_(snap), cpu_(MakeRenderer(scene, Settings())), host_(scene, snap, Settings()) {}
 
   // both render `view` under `fx`; the GPU path twice.
   HostCompared Compare(const CameraView& view, const EffectsFrame* fx) {
     HostCompared c;
     cpu_->Render(snap_, fx, view, &c.cpu);
-    c.host = RenderHost(view, fx);
-    c.again = RenderHost(view, fx);
+    c.host = host_.Render(view, fx);
+    c.again = host_.Render(view, fx);
     c.psnr = realtime_parity::Psnr(c.cpu.rgb, c.host.rgb);
     c.depth_bad = realtime_parity::DepthMismatch(c.cpu.depth_m, c.host.depth_m);
     return c;
@@ -60,14 +59,11 @@ class HostAndCpu {
 
   // the GPU path alone.
   RenderedFrame RenderHost(const CameraView& view, const EffectsFrame* fx) {
-    data_.Prepare(snap_, view, &pool_, fx);
-    RenderedFrame out;
-    cuda::RenderRealtimeOnHost(data_, bvh_, &pool_, &out, /*stored_surface=*/true);
-    return out;
+    return host_.Render(view, fx);
   }
 
-  cuda::RealtimeFrameData& data() { return data_; }
-  ThreadPool& pool() { return pool_; }
+  cuda::RealtimeFrameData& data() { return host_.data(); }
+  ThreadPool& pool() { return host_.pool(); }
 
  private:
   static RenderSettings Settings() {
@@ -78,9 +74,7 @@ class HostAndCpu {
 
   const WorldSnapshot& snap_;
   std::unique_ptr<Renderer> cpu_;
-  cuda::BvhScene bvh_;
-  cuda::RealtimeFrameData data_;
-  ThreadPool pool_{0};
+  host_path::HostPath host_;
 };
 
 struct HostEffectsWorld {

@@ -23,6 +23,7 @@
 #include <memory>
 #include <string>
 
+#include "host_path.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/bvh_scene.h"
@@ -33,33 +34,7 @@
 namespace penumbra {
 namespace {
 
-// the GPU path on the host for one scene at one snapshot: its BVH and frame data built once
-// (the sky irradiance volume's build, through the host BVH, is most of a frame's time on the
-// CPU), then any number of frames of `view` under `fx` (stored surface terms, the kernels'
-// default), with the media's shadow rays through `media_rays` (null: the frame data's own
-// BvhRayQuery), as CudaRenderer renders frame after frame with one RealtimeFrameData.
-class HostPath {
- public:
-  HostPath(const SceneDescription& scene, const WorldSnapshot& snap)
-      : snap_(snap), bvh_(scene), data_(scene, RenderSettings()) {
-    bvh_.Update(snap);
-  }
-
-  RenderedFrame Render(const CameraView& view, const EffectsFrame* fx, bool* has_media,
-                       const RayQuery* media_rays = nullptr) {
-    data_.Prepare(snap_, view, &pool_, fx, nullptr, media_rays);
-    *has_media = data_.has_media();
-    RenderedFrame out;
-    cuda::RenderRealtimeOnHost(data_, bvh_, &pool_, &out, /*stored_surface=*/true);
-    return out;
-  }
-
- private:
-  const WorldSnapshot& snap_;
-  cuda::BvhScene bvh_;
-  cuda::RealtimeFrameData data_;
-  ThreadPool pool_{0};
-};
+using host_path::HostPath;
 
 // the image size of the bundled worlds' comparison: PENUMBRA_PARITY_SIZE=WxH, else 160x120.
 void ParitySize(int* w, int* h) {
