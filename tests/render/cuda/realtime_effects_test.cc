@@ -284,14 +284,14 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
 }
 
 // a moving camera with a rolling shutter (realtime_parity::AddRollingShutter) in the rain world
-// at 1 s, 160x120, through the device splat's functions (the default; here on the CPU): every
-// row's rays come from the camera's ray tables (PrimaryRay<true> over its rows), and the splat
-// keys exactly the host splat's streak pixels (the CPU's ParticleStreaks, whose pixel rays are
-// Camera::GenerateRay's, each row at its own pose), with its t and coverage; the frame is the
+// at 1 s, 160x120, through the device splat's functions (the default; here on the CPU): the
+// splat's rays are the CPU's Camera::GenerateRay to the bit (SplatRay over the rows' double
+// poses, StreakSplatView::rows), so the splat keys exactly the host splat's streak pixels (the
+// CPU's ParticleStreaks, each row at its own pose) with its t and coverage; the frame is the
 // host splat's byte for byte and matches the CPU backend's (rgb PSNR >= 40 dB, depth within 1 mm
 // on >= 99.9 % of pixels, the streak pixels' radiance within a tenth of their error without the
-// streaks); with the still camera's rays (no row table) the keys are not the host's (the check
-// can fail).
+// streaks). with the camera's float ray tables instead (PrimaryRay<true>, as before branch
+// gpu23) or the still camera's rays the keys are not the host's (the check can fail).
 TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) {
   auto [session, snap, view, fx] = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
@@ -343,9 +343,15 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
     }
     return bad;
   };
-  size_t keyed = 0, keyed_still = 0;
+  size_t keyed = 0, keyed_float = 0, keyed_still = 0;
+  ASSERT_NE(f.splat.rows, nullptr);
   const size_t bad = mismatch(splat_keys(f), &keyed);
-  cuda::RealtimeFrameView still = f;
+  // the frame's float ray tables instead of the double row poses (as before branch gpu23), and
+  // the still camera's rays
+  cuda::RealtimeFrameView tables = f;
+  tables.splat.rows = nullptr;
+  const size_t bad_float = mismatch(splat_keys(tables), &keyed_float);
+  cuda::RealtimeFrameView still = tables;
   still.camera.rows = nullptr;
   const size_t bad_still = mismatch(splat_keys(still), &keyed_still);
   double err = 0, bare_err = 0;
@@ -357,15 +363,18 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
     }
   std::printf(
       "rain at 1 s 160x120, rolling shutter: %d streaks, %zu streak pixels (host splat), %zu keyed "
-      "by the splat (%zu not the host's), %zu with the still camera's rays (%zu not the host's); "
-      "rgb PSNR against the CPU backend %.2f dB (without the streaks %.2f dB), mean |radiance - "
-      "cpu| on the streak pixels %.4g (without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
-      list.num, host_pixels.size(), keyed, bad, keyed_still, bad_still, c.psnr,
-      realtime_parity::Psnr(c.cpu.rgb, bare.rgb), err / std::max<size_t>(1, 3 * host_pixels.size()),
+      "by the splat (%zu not the host's), %zu with the float ray tables (%zu not the host's), %zu "
+      "with the still camera's rays (%zu not the host's); rgb PSNR against the CPU backend %.2f "
+      "dB (without the streaks %.2f dB), mean |radiance - cpu| on the streak pixels %.4g "
+      "(without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
+      list.num, host_pixels.size(), keyed, bad, keyed_float, bad_float, keyed_still, bad_still,
+      c.psnr, realtime_parity::Psnr(c.cpu.rgb, bare.rgb),
+      err / std::max<size_t>(1, 3 * host_pixels.size()),
       bare_err / std::max<size_t>(1, 3 * host_pixels.size()), 100 * c.depth_bad);
   EXPECT_GT(host_pixels.size(), 50u);
   EXPECT_EQ(keyed, host_pixels.size());
   EXPECT_EQ(bad, 0u);
+  EXPECT_GT(bad_float, 0u);
   EXPECT_GT(bad_still, 0u);
   EXPECT_EQ(c.host.rgb.data, host.rgb.data);
   EXPECT_EQ(c.host.radiance.data, host.radiance.data);

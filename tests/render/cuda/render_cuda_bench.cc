@@ -12,8 +12,11 @@
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
 //     them, cuda Render() (on the GPU for every effect since branch gpu12) and cpu Render();
 //     with particles also cuda Render() with the streaks splatted on the host (as before branch
-//     gpu18: RealtimeFrameData::set_device_streaks(false)) and with the device splat again, and
-//     the host's preparation of both;
+//     gpu18: RealtimeFrameData::set_device_streaks(false)), then twice the device splat with its
+//     streaks made before the kernels (as before branch gpu23: CudaRenderer::set_late_streaks
+//     (false)) and late (the default: while the GPU shades), the host's preparation of each,
+//     and the FNV-1a hashes of the rgb, depth and radiance and the EV100 of a late-streaks frame
+//     and of one with the streaks before the kernels (whether they are bit-identical);
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with

@@ -229,8 +229,9 @@ class RealtimeFrameData {
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   bool device_streaks_ = true;
-  PathStreakBuild splat_streaks_;  // the realtime streaks in index order (device_streaks)
-  StreakSplatView splat_camera_;   // their projection (R_OW, p_OW, intrinsics; no arrays)
+  PathStreakBuild splat_streaks_;   // the realtime streaks in index order (device_streaks)
+  StreakSplatView splat_camera_;    // their projection (R_OW, p_OW, intrinsics; rows)
+  std::vector<double> splat_rows_;  // a moving camera's row poses (StreakSplatView::rows)
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
   // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);
   // media_ready_ false until PrepareMedia built them for the frame (PoseWorld clears it)

@@ -882,7 +882,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the realtime splat's streaks (shared with the pathtraced tier's upload) and per pixel its
   // StreakKeys and shaded streaks (StreakSplatView)
   StreakBuffers splat_streaks;
-  Buffer splat_nearest, splat_pixels;
+  Buffer splat_nearest, splat_pixels, splat_rows;
   double* rows = nullptr;
   DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
@@ -914,7 +914,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
   // pinned staging of the per-frame uploads (posed geoms, lights; the late streaks: the host
   // splat's pixels, the device splat's streaks)
-  PinnedBuffer pin_geoms, pin_lights, pin_streak_pixels, pin_splat;
+  PinnedBuffer pin_geoms, pin_lights, pin_streak_pixels, pin_splat, pin_splat_rows;
   // the bytes of the geoms and lights the device holds (upload_changed_only); `uploaded`
   // false when they are not known (DeviceFrame uploaded others)
   std::vector<uint8_t> uploaded_geoms, uploaded_lights;
@@ -1429,6 +1429,18 @@ struct DeviceRealtime::Impl : PixelBuffers {
       const PathStreaks list =
           staged ? StreakBuffers::Stage(h.splat.streaks, &pin_splat) : h.splat.streaks;
       f->splat.streaks = splat_streaks.Upload(list, stream);
+      if (h.splat.rows != nullptr) {
+        // a moving camera's row poses (StreakSplatView::rows)
+        const size_t bytes = sizeof(double) * 12 * f->camera.height;
+        const void* src = h.splat.rows;
+        if (staged) {
+          pin_splat_rows.Reserve(bytes);
+          std::memcpy(pin_splat_rows.p, h.splat.rows, bytes);
+          src = pin_splat_rows.p;
+        }
+        splat_rows.Upload(src, bytes, stream);
+        f->splat.rows = splat_rows.as<double>();
+      }
       splat_nearest.Reserve(sizeof(unsigned long long) * n);
       splat_pixels.Reserve(sizeof(StreakPixel) * n);
       f->splat.nearest = splat_nearest.as<unsigned long long>();
