@@ -188,8 +188,9 @@ TEST(RealtimeEffectsGpuFrames, DeviceSplatMatchesTheHostSplat) {
 // the late streaks (branch gpu23, the default: CudaRenderer culls the drops while the GPU
 // traces and shades, then uploads the streaks and queues the splat) against the streaks made
 // before any device work (CudaRenderer::set_late_streaks(false), as before) in one renderer:
-// rain, snow and fire (sparks through grid media) at 1 s, 640x480, with the still camera and
-// with a rolling shutter (realtime_parity::AddRollingShutter): rgb, radiance, depth, EV100 and
+// rain, snow and fire (sparks through grid media) at 1 s, 640x480, with the still camera, and
+// rain and snow with a rolling shutter (realtime_parity::AddRollingShutter; it turns the fire's
+// sparks out of view): rgb, radiance, depth, EV100 and
 // the splat's per-pixel keys equal to the bit; the frame without its particles differs (the
 // check can fail). the rolling shutter's device splat against the host splat
 // (set_device_streaks(false)): exactly the host's streak pixels, t and coverage, and the rgb
@@ -198,6 +199,8 @@ TEST(RealtimeEffectsGpuFrames, LateStreaksGiveTheSerialFramesBits) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   for (const char* file : {"effects/rain.yaml", "effects/snow.yaml", "effects/fire.yaml"}) {
     for (const bool rolling : {false, true}) {
+      // (the rolling shutter turns the fire's sparks out of view: no streak pixel to compare)
+      if (rolling && std::string(file) == "effects/fire.yaml") continue;
       SCOPED_TRACE(std::string(file) + (rolling ? ", rolling shutter" : ", still camera"));
       auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 640, 480);
       if (rolling) realtime_parity::AddRollingShutter(&view);
@@ -211,6 +214,7 @@ TEST(RealtimeEffectsGpuFrames, LateStreaksGiveTheSerialFramesBits) {
       std::vector<unsigned long long> late_keys, serial_keys;
       gpu->Render(snap, fx.get(), view, &late);
       const double late_ms = g->last_late_streaks_ms();
+      const int num = g->realtime_frame().splat_streaks().View().num;
       ASSERT_TRUE(g->device_realtime().DownloadStreakKeys(&late_keys));
       gpu->Render(snap, fx.get(), view, &again);
       g->set_late_streaks(false);
@@ -227,8 +231,7 @@ TEST(RealtimeEffectsGpuFrames, LateStreaksGiveTheSerialFramesBits) {
           "%s 640x480%s: %d streaks, %zu keyed pixels; late streaks (%.2f ms on the host while "
           "the GPU worked) against made before the kernels: the same bits %s, EV100 %.6f / "
           "%.6f; without the particles %.2f dB\n",
-          file, rolling ? ", rolling shutter" : "", g->realtime_frame().splat_streaks().View().num,
-          keyed, late_ms,
+          file, rolling ? ", rolling shutter" : "", num, keyed, late_ms,
           late.radiance.data == serial.radiance.data && late.rgb.data == serial.rgb.data ? "yes"
                                                                                          : "NO",
           late.ev100, serial.ev100, realtime_parity::Psnr(late.rgb, bare.rgb));

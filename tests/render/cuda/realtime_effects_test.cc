@@ -237,17 +237,15 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
   for (const char* file : {"effects/rain.yaml", "effects/snow.yaml", "effects/fire.yaml"}) {
     SCOPED_TRACE(file);
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(file, 1.0, 160, 120);
-    const SceneDescription& scene = session->scene();
     ASSERT_TRUE(fx && !fx->particles.empty());
-    cuda::BvhScene bvh(scene);
-    bvh.Update(snap);
-    ThreadPool pool(0);
-    cuda::RealtimeFrameData data(scene, RenderSettings());
+    host_path::HostPath path(session->scene(), snap);
+    cuda::RealtimeFrameData& data = path.data();
+    const cuda::BvhScene& bvh = path.bvh();
+    ThreadPool& pool = path.pool();
     ASSERT_TRUE(data.device_streaks());
-    RenderedFrame serial, late, none;
-    data.Prepare(snap, view, &pool, fx.get());
+    RenderedFrame late, none;
+    const RenderedFrame serial = path.Render(view, fx.get());
     const int num = data.splat_streaks().View().num;
-    cuda::RenderRealtimeOnHost(data, bvh, &pool, &serial, /*stored_surface=*/true);
     // without streaks: the last frame's are gone
     data.Prepare(snap, view, &pool, fx.get(), nullptr, nullptr, /*streaks=*/false);
     const cuda::RealtimeFrameView bare = data.View(bvh.view(), nullptr);
