@@ -62,6 +62,13 @@ class HostAndCpu {
     return host_.Render(view, fx);
   }
 
+  // the GPU path alone under fx without its particles.
+  RenderedFrame RenderWithoutParticles(const CameraView& view, const EffectsFrame& fx) {
+    EffectsFrame no_particles = fx;
+    no_particles.particles.clear();
+    return host_.Render(view, &no_particles);
+  }
+
   cuda::RealtimeFrameData& data() { return host_.data(); }
   ThreadPool& pool() { return host_.pool(); }
 
@@ -76,6 +83,18 @@ class HostAndCpu {
   std::unique_ptr<Renderer> cpu_;
   host_path::HostPath host_;
 };
+
+// the summed |radiance - CPU backend's| over the streak pixels `streaks` of the GPU path's frame
+// (c.host: *err) and of its frame without the particles (`bare`: *bare_err).
+void StreakPixelErrors(const std::vector<cuda::StreakPixel>& streaks, const HostCompared& c,
+                       const RenderedFrame& bare, double* err, double* bare_err) {
+  for (const cuda::StreakPixel& s : streaks)
+    for (int k = 0; k < 3; ++k) {
+      const int64_t i = 3 * s.pixel + k;
+      *err += std::abs(c.cpu.radiance.data[i] - c.host.radiance.data[i]);
+      *bare_err += std::abs(c.cpu.radiance.data[i] - bare.radiance.data[i]);
+    }
+}
 
 struct HostEffectsWorld {
   const char* file;
@@ -123,9 +142,7 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
     ASSERT_TRUE(fx && !fx->particles.empty());
     HostAndCpu rig(scene, snap);
     const HostCompared c = rig.Compare(view, fx.get());
-    EffectsFrame no_particles = *fx;
-    no_particles.particles.clear();
-    const RenderedFrame bare = rig.RenderHost(view, &no_particles);
+    const RenderedFrame bare = rig.RenderWithoutParticles(view, *fx);
     // the streak pixels of the frame (the host splat's list: the device splat finds the same,
     // DeviceSplatGivesTheHostSplatsImageByteForByte)
     cuda::RealtimeFrameData& data = rig.data();
@@ -133,12 +150,7 @@ TEST(RealtimeHostPathEffectsFrames, ParticleStreaksMatchCpuBackend) {
     data.Prepare(snap, view, &rig.pool(), fx.get());
     const std::vector<cuda::StreakPixel>& streaks = data.streaks();
     double err = 0, bare_err = 0;
-    for (const cuda::StreakPixel& s : streaks)
-      for (int k = 0; k < 3; ++k) {
-        const int64_t i = 3 * s.pixel + k;
-        err += std::abs(c.cpu.radiance.data[i] - c.host.radiance.data[i]);
-        bare_err += std::abs(c.cpu.radiance.data[i] - bare.radiance.data[i]);
-      }
+    StreakPixelErrors(streaks, c, bare, &err, &bare_err);
     std::printf(
         "%s at 1 s 160x120: %zu streak pixels, rgb PSNR %.2f dB (without the streaks %.2f dB), "
         "mean |radiance - cpu| on them %.4g (without %.4g) cd/m^2, depth > 1 mm on %.4f %%\n",
@@ -298,9 +310,7 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
   ASSERT_TRUE(view.motion.moving());
   HostAndCpu rig(scene, snap);
   const HostCompared c = rig.Compare(view, fx.get());
-  EffectsFrame no_particles = *fx;
-  no_particles.particles.clear();
-  const RenderedFrame bare = rig.RenderHost(view, &no_particles);
+  const RenderedFrame bare = rig.RenderWithoutParticles(view, *fx);
   // the host splat of the same frame: its streak pixels and image
   cuda::RealtimeFrameData& data = rig.data();
   data.set_device_streaks(false);
@@ -353,12 +363,7 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
   still.camera.rows = nullptr;
   const size_t bad_still = mismatch(splat_keys(still), &keyed_still);
   double err = 0, bare_err = 0;
-  for (const cuda::StreakPixel& s : host_pixels)
-    for (int k = 0; k < 3; ++k) {
-      const int64_t i = 3 * s.pixel + k;
-      err += std::abs(c.cpu.radiance.data[i] - c.host.radiance.data[i]);
-      bare_err += std::abs(c.cpu.radiance.data[i] - bare.radiance.data[i]);
-    }
+  StreakPixelErrors(host_pixels, c, bare, &err, &bare_err);
   std::printf(
       "rain at 1 s 160x120, rolling shutter: %d streaks, %zu streak pixels (host splat), %zu keyed "
       "by the splat (%zu not the host's), %zu with the float ray tables (%zu not the host's), %zu "
