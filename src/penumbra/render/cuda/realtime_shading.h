@@ -914,6 +914,33 @@ PB_HOST_DEVICE inline void AddLitLight(const RealtimeFrameView& f, int j, int64_
   *L = *L + c;
 }
 
+/// the part ShadeRealtimePoint and ShadeQueuedLights share, at the shading point sp of pixel
+/// (u, v) with sky term `sky`: sets *ambient to the ambient term (the sum's start) and
+/// f.total[pixel] to the lights' unshadowed total (UnshadowedLights into `terms`), then calls
+/// lit(j, pixel, n_pixels, c, traced, origin, wi, dist) for each light j in light order whose
+/// unshadowed contribution c (KeptLight) has a luminance > 0; traced: whether its shadow ray,
+/// ShadowRayOf(origin, wi, dist), is worth tracing (WantsShadowRay).
+template <bool kMedia, class Terms, class Lit>
+PB_HOST_DEVICE inline void ForEachLitLight(const RealtimeFrameView& f, int u, int v,
+                                           const ShadingPoint& sp, const Float3& sky, Terms& terms,
+                                           Float3* ambient, Lit&& lit) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  const ShadeSetup s = BeginShadePoint(sp, sky);
+  *ambient = s.L;
+  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
+  f.total[pixel] = total;
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
+    const float lum = pbm::Luminance709(c.x, c.y, c.z);
+    if (!(lum > 0)) continue;
+    lit(j, pixel, n_pixels, c, WantsShadowRay(f.lights[j], lum, total), s.origin, wi, dist);
+  }
+}
+
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
 /// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
@@ -926,25 +953,16 @@ template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky,
                                                 Terms& terms) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  const ShadeSetup s = BeginShadePoint(sp, sky);
-  Float3 L = s.L;
-  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
-  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
-  f.total[pixel] = total;
   // lights in order: negligible or shadowless contributions are added as they are, the others
   // after a shadow ray; those of lights with an extent wait for their neighbours' verdicts.
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
-    const float lum = pbm::Luminance709(c.x, c.y, c.z);
-    if (!(lum > 0)) continue;
-    const bool traced = WantsShadowRay(f.lights[j], lum, total);
-    const bool occluded = traced && TraceOccluded(f.scene, ShadowRayOf(s.origin, wi, dist));
-    AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
-  }
+  Float3 L;
+  ForEachLitLight<kMedia>(f, u, v, sp, sky, terms, &L,
+                          [&](int j, int64_t pixel, int64_t n_pixels, const Float3& c, bool traced,
+                              const F3& origin, const Float3& wi, float dist) {
+                            const bool occluded =
+                                traced && TraceOccluded(f.scene, ShadowRayOf(origin, wi, dist));
+                            AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
+                          });
   return L;
 }
 
@@ -1000,26 +1018,19 @@ PB_HOST_DEVICE inline Float3 ShadeQueuedLights(const RealtimeFrameView& f, int u
                                                const ShadingPoint& sp, const Float3& sky,
                                                Terms& terms, Queue& queue,
                                                QueuedLightMasks* masks) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  const ShadeSetup s = BeginShadePoint(sp, sky);
-  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
-  f.total[pixel] = total;
   QueuedLightMasks m;
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
-    const float lum = pbm::Luminance709(c.x, c.y, c.z);
-    if (!(lum > 0)) continue;
-    m.lit |= 1u << j;
-    f.area_c[j * n_pixels + pixel] = c;
-    if (!WantsShadowRay(f.lights[j], lum, total)) continue;
-    m.traced |= 1u << j;
-    queue.Push(j, ShadowRayOf(s.origin, wi, dist));
-  }
+  Float3 L;
+  ForEachLitLight<kMedia>(f, u, v, sp, sky, terms, &L,
+                          [&](int j, int64_t pixel, int64_t n_pixels, const Float3& c, bool traced,
+                              const F3& origin, const Float3& wi, float dist) {
+                            m.lit |= 1u << j;
+                            f.area_c[j * n_pixels + pixel] = c;
+                            if (!traced) return;
+                            m.traced |= 1u << j;
+                            queue.Push(j, ShadowRayOf(origin, wi, dist));
+                          });
   *masks = m;
-  return s.L;
+  return L;
 }
 
 /// pass 3 of the queued shadow rays: pixel `pixel` (of n_pixels)'s radiance from the ambient
