@@ -398,14 +398,9 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
 
 double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
                                 float exposure[3]) const {
-  return Ev100(row_sums, pixels, white_balance_gains_, exposure);
-}
-
-double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
-                                const Eigen::Vector3f& white_balance_gains,
-                                float exposure[3]) const {
   // the rows in row order: independent of the launch (film_math.h, shared with the device)
-  const float gains[3] = {white_balance_gains[0], white_balance_gains[1], white_balance_gains[2]};
+  const float gains[3] = {white_balance_gains_[0], white_balance_gains_[1],
+                          white_balance_gains_[2]};
   return FrameExposure(film_.exposure_pod(), row_sums.data(), static_cast<int>(row_sums.size()),
                        pixels, kMinLuminance, gains, exposure);
 }

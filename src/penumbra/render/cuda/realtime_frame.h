@@ -184,10 +184,6 @@ class RealtimeFrameData {
   /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop
   /// (the exposure times the prepared view's white_balance_gains, as Film::Develop).
   double Ev100(const std::vector<double>& row_sums, int64_t pixels, float exposure[3]) const;
-  /// Ev100 with the white-balance gains given (CameraView::white_balance_gains) instead of the
-  /// prepared view's: batch rendering's per-camera exposures.
-  double Ev100(const std::vector<double>& row_sums, int64_t pixels,
-               const Eigen::Vector3f& white_balance_gains, float exposure[3]) const;
 
   const std::vector<MaterialPod>& materials() const { return materials_; }
   const std::vector<TexturePod>& textures() const { return textures_; }

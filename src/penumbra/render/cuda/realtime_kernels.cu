@@ -685,16 +685,32 @@ struct DeviceExposure {
 };
 
 // film_math.h's FrameExposure of a frame's `height` row sums (height <= kMaxDeviceExposureRows)
-// by one block: its threads bring the rows into shared memory, one thread adds them in row order.
-__global__ void ExposureKernel(const double* rows, int height, int64_t pixels, FilmExposurePod film,
-                               Exposure gains, DeviceExposure* out) {
+// by the calling block: its threads bring the rows into shared memory (height doubles), one
+// thread adds them in row order.
+__device__ void BlockExposure(const double* rows, int height, int64_t pixels,
+                              const FilmExposurePod& film, const float gains[3],
+                              DeviceExposure* out) {
   extern __shared__ double shared_rows[];
   for (int v = threadIdx.x; v < height; v += blockDim.x) shared_rows[v] = rows[v];
   __syncthreads();
   if (threadIdx.x != 0) return;
   DeviceExposure d;
-  d.ev100 = FrameExposure(film, shared_rows, height, pixels, kMinLuminance, gains.e, d.e);
+  d.ev100 = FrameExposure(film, shared_rows, height, pixels, kMinLuminance, gains, d.e);
   *out = d;
+}
+
+__global__ void ExposureKernel(const double* rows, int height, int64_t pixels, FilmExposurePod film,
+                               Exposure gains, DeviceExposure* out) {
+  BlockExposure(rows, height, pixels, film, gains.e, out);
+}
+
+// ExposureKernel over a batch: block k makes camera k's exposure from its rows (camera-major,
+// `height` each) with its own film.
+__global__ void BatchExposureKernel(const double* rows, int height, int64_t pixels,
+                                    const RealtimeBatchFilm* film, DeviceExposure* out) {
+  const int k = blockIdx.x;
+  BlockExposure(rows + static_cast<int64_t>(k) * height, height, pixels, film[k].exposure,
+                film[k].white_balance_gains, out + k);
 }
 
 // ExposureKernel on `stream`: the exposure of the `height` row sums at `rows` into `out`.
@@ -722,14 +738,17 @@ __global__ void DevelopDeviceExposureKernel(const Float3* radiance, int64_t n,
   DevelopPixel(radiance[i], e, filmic != 0, lut, rgb + 3 * i);
 }
 
-// DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film.
+// DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film and the exposure
+// the device computed (BatchExposureKernel).
 __global__ void BatchDevelopKernel(const Float3* radiance, int64_t n, const RealtimeBatchFilm* film,
-                                   uint8_t* rgb) {
+                                   const DeviceExposure* exposure, uint8_t* rgb) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   const RealtimeBatchFilm& c = film[blockIdx.y];
+  const DeviceExposure& x = exposure[blockIdx.y];
+  const float e[3] = {x.e[0], x.e[1], x.e[2]};
   const int64_t k = static_cast<int64_t>(blockIdx.y) * n + i;
-  DevelopPixel(radiance[k], c.exposure, c.filmic != 0, c.lut, rgb + 3 * k);
+  DevelopPixel(radiance[k], e, c.filmic != 0, c.lut, rgb + 3 * k);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -1948,36 +1967,12 @@ namespace {
 // the stage events of RealtimeBatch: start, then the end of each RealtimeBatchTimes stage
 constexpr int kBatchStages = 8;
 
-// a batch's exposures, made by a host function on the stream (RealtimeBatch::Launch): the row
-// sums are in rows (pinned, count x height), the films go to film (pinned) and are copied up
-// after the function returns.
-struct BatchExposureJob {
-  RealtimeBatch::ExposureFn exposure;
-  std::vector<RealtimeBatchFilm> films;
-  const double* rows = nullptr;
-  RealtimeBatchFilm* film = nullptr;
-  int height = 0;
-};
-
-void CUDART_CB RunBatchExposure(void* data) {
-  std::unique_ptr<BatchExposureJob> job(static_cast<BatchExposureJob*>(data));
-  std::vector<double> rows(job->height);
-  for (size_t k = 0; k < job->films.size(); ++k) {
-    const double* r = job->rows + k * job->height;
-    rows.assign(r, r + job->height);
-    RealtimeBatchFilm c = job->films[k];
-    job->exposure(static_cast<int>(k), rows, c.exposure);
-    job->film[k] = c;
-  }
-}
-
 }  // namespace
 
 struct RealtimeBatch::Impl : PixelBuffers {
   int width = 0, height = 0, max_cameras = 0, lights = 1, slots = 0;
   bool mirror = false;
-  Buffer frames, film, depth, rows;
-  PinnedBuffer pin_rows, pin_film;
+  Buffer frames, film, exposure, depth, rows;
   std::vector<RealtimeFrameView> host_frames;
   std::vector<std::vector<cudaEvent_t>> events;  // [slot][kBatchStages + 1]
   ~Impl() {
@@ -1992,12 +1987,14 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
     : impl_(new Impl) {
   Impl& m = *impl_;
   try {
-    if (width < 1 || height < 1 || max_cameras < 1 || max_cameras > 65535 || max_lights < 0 ||
-        slots < 1)
+    if (width < 1 || height < 1 || height > kMaxDeviceExposureRows || max_cameras < 1 ||
+        max_cameras > 65535 || max_lights < 0 || slots < 1)
       throw Error("RealtimeBatch: " + std::to_string(width) + "x" + std::to_string(height) + ", " +
                   std::to_string(max_cameras) + " cameras, " + std::to_string(max_lights) +
                   " lights, " + std::to_string(slots) +
-                  " slots; expected a size >= 1x1, 1 to 65535 cameras, lights >= 0, slots >= 1");
+                  " slots; expected a size >= 1x1 with at most " +
+                  std::to_string(kMaxDeviceExposureRows) +
+                  " rows, 1 to 65535 cameras, lights >= 0, slots >= 1");
     m.width = width;
     m.height = height;
     m.max_cameras = max_cameras;
@@ -2008,11 +2005,10 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
     const size_t nl = n * m.lights;
     m.frames.Reserve(sizeof(RealtimeFrameView) * max_cameras);
     m.film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
+    m.exposure.Reserve(sizeof(DeviceExposure) * max_cameras);
     m.depth.Reserve(sizeof(float) * n);
     m.rows.Reserve(sizeof(double) * height * max_cameras);
     m.Reserve(n, nl, /*with_surfaces=*/true, mirror);
-    m.pin_rows.Reserve(sizeof(double) * height * max_cameras);
-    m.pin_film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
     m.events.assign(slots, std::vector<cudaEvent_t>(kBatchStages + 1, nullptr));
     for (auto& slot : m.events)
       for (cudaEvent_t& e : slot) Check(cudaEventCreate(&e), "cudaEventCreate");
@@ -2025,8 +2021,7 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
 RealtimeBatch::~RealtimeBatch() { delete impl_; }
 
 void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchFilm* film,
-                           int count, ExposureFn exposure, float* depth, uint8_t* rgb, int slot,
-                           void* stream_ptr) {
+                           int count, float* depth, uint8_t* rgb, int slot, void* stream_ptr) {
   Impl& m = *impl_;
   if (count < 1 || count > m.max_cameras || slot < 0 || slot >= m.slots)
     throw Error("RealtimeBatch::Launch: " + std::to_string(count) + " cameras, slot " +
@@ -2052,6 +2047,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   }
   // from pageable memory: staged before the call returns
   m.frames.Upload(m.host_frames.data(), sizeof(RealtimeFrameView) * count, stream);
+  m.film.Upload(film, sizeof(RealtimeBatchFilm) * count, stream);
   const BatchFrames fr{m.frames.as<RealtimeFrameView>()};
   cudaEvent_t* ev = m.events[slot].data();
   const auto stage = [&](int i) { Check(cudaEventRecord(ev[i], stream), "cudaEventRecord"); };
@@ -2104,23 +2100,14 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   RowSumWarpKernel<<<dim3((H + 3) / 4, count), 128, 0, stream>>>(L, W, H, m.rows.as<double>());
   Check(cudaGetLastError(), "RowSumWarpKernel (batch)");
   stage(6);
-  // the exposures: row sums down, the host's Ev100 per camera, the films up
-  m.rows.Download(m.pin_rows.p, sizeof(double) * H * count, stream);
-  auto job = std::make_unique<BatchExposureJob>();
-  job->exposure = std::move(exposure);
-  job->films.assign(film, film + count);
-  job->rows = m.pin_rows.as<double>();
-  job->film = m.pin_film.as<RealtimeBatchFilm>();
-  job->height = H;
-  Check(cudaLaunchHostFunc(stream, RunBatchExposure, job.get()), "cudaLaunchHostFunc");
-  job.release();  // RunBatchExposure owns it now
-  Check(cudaMemcpyAsync(m.film.p, m.pin_film.p, sizeof(RealtimeBatchFilm) * count,
-                        cudaMemcpyHostToDevice, stream),
-        "cudaMemcpyAsync");
+  // the exposures on the device, one block a camera
+  BatchExposureKernel<<<count, 256, sizeof(double) * H, stream>>>(
+      m.rows.as<double>(), H, n, m.film.as<RealtimeBatchFilm>(), m.exposure.as<DeviceExposure>());
+  Check(cudaGetLastError(), "BatchExposureKernel");
   stage(7);
   if (rgb) {
     BatchDevelopKernel<<<dim3(static_cast<unsigned>((n + 255) / 256), count), 256, 0, stream>>>(
-        L, n, m.film.as<RealtimeBatchFilm>(), rgb);
+        L, n, m.film.as<RealtimeBatchFilm>(), m.exposure.as<DeviceExposure>(), rgb);
     Check(cudaGetLastError(), "BatchDevelopKernel");
   }
   stage(8);
