@@ -676,19 +676,22 @@ __global__ void ResolveBandKernel(Frames frames, Float3* radiance, int row0, int
 
 // VisibilityFractionKernel and ResolveBandKernel in one pass (RealtimeKernelOptions::
 // tile_visibility): a block of kTilePixels threads per shadow tile of rows [row0, row1) (row0
-// a multiple of kShadowTileSize, row1 one or the image's last row + 1), light after light: the
-// tile's verdicts and ray counts into shared memory, each pixel's fraction from there
-// (SharedWindowFraction) into shared memory, then each pixel's V from its neighbours' there
-// (SharedLampFraction) added to its radiance (AddSharedVisibility), the lights in order; with
-// kMirror, then ApplyMirrorLayer (after MirrorShadeKernel). the same functions on the same
-// values in the same order as the two kernels, so the same bits; the windows never leave their
-// tile, so no neighbour is missing. the buffers alternate between lights, so one light's reads
-// and the next one's writes need no barrier between them.
+// a multiple of kShadowTileSize, row1 one or the image's last row + 1), kTileLightGroup lights
+// at a time: their verdicts, ray counts and own flags loaded together (every load issued before
+// the first use: one memory latency a group, not three a light) into shared memory, each
+// pixel's fractions from there (SharedWindowFraction) into shared memory, then each pixel's V
+// from its neighbours' there (SharedLampFraction) added to its radiance (AddSharedVisibility),
+// the lights in order; with kMirror, then ApplyMirrorLayer (after MirrorShadeKernel). the same
+// functions on the same values in the same order as the two kernels, so the same bits; the
+// windows never leave their tile, so no neighbour is missing.
+constexpr int kTileLightGroup = 8;
 template <class Frames, bool kMirror>
 __global__ void __launch_bounds__(kTilePixels)
     VisibilityTileKernel(Frames frames, Float3* radiance, int row0, int row1) {
-  __shared__ int8_t vis[2][kTilePixels];
-  __shared__ float visible[2][kTilePixels], rays[2][kTilePixels], fraction[2][kTilePixels];
+  __shared__ int8_t vis[kTileLightGroup][kTilePixels];
+  __shared__ uint8_t own[kTileLightGroup][kTilePixels];
+  __shared__ float visible[kTileLightGroup][kTilePixels], rays[kTileLightGroup][kTilePixels],
+      fraction[kTileLightGroup][kTilePixels];
   const RealtimeFrameView& f = frames.get();
   const FramePixel p = PixelOf(f, row0, row1);
   const int t = static_cast<int>(threadIdx.y * blockDim.x + threadIdx.x);
@@ -696,32 +699,62 @@ __global__ void __launch_bounds__(kTilePixels)
   const ShadowTile tile = ShadowTileOf(p.u, p.v, f.camera.width, f.camera.height);
   const uint32_t window = p ? f.window[p.i] : 0u;
   Float3 L = p ? radiance[p.k] : Float3{};
-  int s = 0;
-  for (int j = 0; j < f.num_lights; ++j) {
-    if (!IsExtendedLightPod(f.lights[j])) continue;  // the block's frame: every thread alike
-    const int64_t k = j * n + p.i;
-    const int8_t w = p ? f.area_vis[k] : int8_t{-1};
-    vis[s][t] = w;
-    if (w >= 0) {
-      visible[s][t] = f.area_visible[k];
-      rays[s][t] = f.area_rays[k];
+  for (int g = 0; g < f.num_lights; g += kTileLightGroup) {
+    const int lights = min(kTileLightGroup, f.num_lights - g);
+    // the group's arrays into registers (independent loads), then into shared memory; the
+    // counts of a pixel without a verdict are loaded but never read
+    int8_t w[kTileLightGroup];
+    uint8_t o[kTileLightGroup];
+    float a[kTileLightGroup], r[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      w[l] = -1;
+      o[l] = 0;
+      a[l] = r[l] = 0;
+      if (p && l < lights) {
+        const int64_t k = (g + l) * n + p.i;
+        w[l] = f.area_vis[k];
+        o[l] = f.area_own[k];
+        a[l] = f.area_visible[k];
+        r[l] = f.area_rays[k];
+      }
+    }
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      vis[l][t] = w[l];
+      own[l][t] = o[l];
+      visible[l][t] = a[l];
+      rays[l][t] = r[l];
     }
     __syncthreads();
-    VisibilityTaps taps;
-    taps.vis = vis[s];
-    taps.visible = visible[s];
-    taps.rays = rays[s];
-    taps.fraction = fraction[s];
-    taps.stride = kShadowTileSize;
-    const bool own = w >= 0 && f.area_own[k] != 0;
-    if (w >= 0) fraction[s][t] = SharedWindowFraction(taps, t, window, own);
-    __syncthreads();
-    if (w >= 0) {
-      const bool lamp = f.lights[j].kind != LightKind::kDirectional && !own;
-      const float V = SharedLampFraction(taps, t, window, lamp, p.u - tile.x0, p.v - tile.y0, tile);
-      L = AddSharedVisibility(L, V, f.area_c[k]);
+    VisibilityTaps taps[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      taps[l].vis = vis[l];
+      taps[l].visible = visible[l];
+      taps[l].rays = rays[l];
+      taps[l].fraction = fraction[l];
+      taps[l].stride = kShadowTileSize;
+      if (l < lights && w[l] >= 0 && IsExtendedLightPod(f.lights[g + l]))
+        fraction[l][t] = SharedWindowFraction(taps[l], t, window, o[l] != 0);
     }
-    s ^= 1;
+    __syncthreads();
+    // the contributions of the lights with a verdict (independent loads), then the resolve in
+    // light order
+    Float3 c[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l)
+      if (p && l < lights && w[l] >= 0) c[l] = f.area_c[(g + l) * n + p.i];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      if (l >= lights || w[l] < 0 || !IsExtendedLightPod(f.lights[g + l])) continue;
+      const bool lamp = f.lights[g + l].kind != LightKind::kDirectional && o[l] == 0;
+      const float V =
+          SharedLampFraction(taps[l], t, window, lamp, p.u - tile.x0, p.v - tile.y0, tile);
+      L = AddSharedVisibility(L, V, c[l]);
+    }
+    // the group's arrays are read before the next group's are written
+    __syncthreads();
   }
   if (!p) return;
   if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, p.u, p.v, L);
