@@ -515,12 +515,7 @@ void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3*
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
     int8_t vis[kTile];
     float visible[kTile], rays[kTile], fraction[kTile];
-    VisibilityTaps taps;
-    taps.vis = vis;
-    taps.visible = visible;
-    taps.rays = rays;
-    taps.fraction = fraction;
-    taps.stride = kShadowTileSize;
+    const VisibilityTaps taps{vis, visible, rays, fraction, kShadowTileSize};
     for (int j = 0; j < f.num_lights; ++j) {
       if (!IsExtendedLightPod(f.lights[j])) continue;
       for (int t = 0; t < kTile; ++t) {
