@@ -157,6 +157,12 @@ struct RealtimeKernelOptions {
   /// atomics (the same counts, so the same bits), so no warp waits on its ring pixels; the
   /// short ones spread over their warp's lanes (as warp_penumbra, which this implies).
   bool queue_penumbra = true;
+  /// with queue_penumbra: the rays of a queued chunk (1 to 8; a batch's chunks hold 4). a
+  /// thread of VisibilityChunkKernel traces its chunk's rays one after another, so where the
+  /// queue holds fewer chunks than the device has threads (the house's narrow penumbrae) the
+  /// kernel lasts as long as one chunk's rays; shorter chunks shorten it, at one integer atomic
+  /// a chunk. the same integer counts, so the same bits.
+  int penumbra_chunk_rays = 1;
   /// with device_sky, a frame with a mirror layer traces, sky-terms and shades its mirrored rays
   /// (MirrorTraceKernel, MirrorSkyKernel, MirrorShadeKernel) on a second stream that forks from
   /// the frame's stream after the geometry kernel and joins it before the mirror blend, so they
@@ -173,6 +179,19 @@ struct RealtimeKernelOptions {
   /// it): band k goes back while band k + 1 is resolved and the row sums run. else the resolve,
   /// then the blend over the whole frame, and the copies behind the row sums.
   bool fuse_resolve = true;
+  /// the shared visibility's fraction and resolve (with fuse_resolve also the mirror blend) in
+  /// one kernel of a block per 16x16 shadow tile (VisibilityTileKernel; a batch's too): the
+  /// tile's verdicts, ray counts and fractions of one light after another in shared memory,
+  /// where every pixel's window finds its neighbours (the windows never leave their tile), the
+  /// same functions on the same values (SharedWindowFraction, SharedLampFraction), so the same
+  /// bits; else VisibilityFractionKernel, then the resolve, each reading its neighbours from the
+  /// frame's arrays.
+  bool tile_visibility = true;
+  /// with warp_penumbra or queue_penumbra: the penumbra rays' kernel in blocks of one 16x16
+  /// shadow tile that copy every light's verdicts of their tile into shared memory first, where
+  /// each pixel's window looks for a penumbra (SharedVisibilityPenumbra; frames of at most 128
+  /// lights, a batch's too); else blocks of 16x8 pixels reading the frame's verdicts.
+  bool tile_penumbra = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

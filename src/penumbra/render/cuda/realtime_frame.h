@@ -282,9 +282,14 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 /// the same bits. `queued_shadows` (with stored_surface, at most kMaxQueuedShadowLights
 /// lights): the shadow rays apart in three passes as RealtimeKernelOptions::queue_shadow_rays
 /// (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the lights' terms in
-/// each pixel's own arrays); the same bits.
+/// each pixel's own arrays); the same bits. `tiled_visibility`: the shared visibility by 16x16
+/// shadow tiles, each tile's verdicts, ray counts and fractions copied into tile arrays where
+/// the windows find their neighbours, as the kernels' blocks do in shared memory with
+/// RealtimeKernelOptions::tile_penumbra and tile_visibility (SharedVisibilityRays' tile form,
+/// SharedWindowFraction, SharedLampFraction); the same bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                           RenderedFrame* out, bool stored_surface = false,
-                          bool strided_terms = false, bool queued_shadows = false);
+                          bool strided_terms = false, bool queued_shadows = false,
+                          bool tiled_visibility = false);
 
 }  // namespace penumbra::cuda
