@@ -12,11 +12,18 @@
 # xz-compressed tarball and fails if it is 64 MiB or more.
 #
 #   scripts/gpu/pack.sh [build-dir] [out.tar.xz]      (default: build, .gpu/penumbra-gpu.tar.xz)
+#   PACK_BINS="render_cuda_gpu_tests render_cuda_bench" scripts/gpu/pack.sh ...
+#                      (these executables only; check.sh reports the others as not packed)
+#   PACK_BASE=other-build/render_cuda_bench scripts/gpu/pack.sh ...
+#                      (another commit's benchmark as bin/base_bench, for A/B runs in one call:
+#                      it shares most bytes with render_cuda_bench, so xz adds 4-5 MiB, not the
+#                      7 of a tarball of its own; the call's working tree and carried files
+#                      must stay under 64 MiB together)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$root/build}
 out=${2:-$root/.gpu/penumbra-gpu.tar.xz}
-bins=(render_cuda_gpu_tests render_cuda_tests render_cuda_bench)
+read -r -a bins <<< "${PACK_BINS:-render_cuda_gpu_tests render_cuda_tests render_cuda_bench}"
 nice cmake --build "$build" -j2 --target "${bins[@]}"
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
@@ -25,6 +32,14 @@ for b in "${bins[@]}"; do
   cp "$build/$b" "$stage/penumbra-gpu/bin/"
   strip "$stage/penumbra-gpu/bin/$b"
 done
+if [ -n "${PACK_BASE:-}" ]; then
+  case "$PACK_BASE" in
+    *.xz) xz -dc "$PACK_BASE" > "$stage/penumbra-gpu/bin/base_bench" ;;
+    *) cp "$PACK_BASE" "$stage/penumbra-gpu/bin/base_bench" ;;
+  esac
+  chmod +x "$stage/penumbra-gpu/bin/base_bench"
+  strip "$stage/penumbra-gpu/bin/base_bench"
+fi
 # libraries: everything ldd resolves, less glibc's and the driver's
 for b in "${bins[@]}"; do ldd "$build/$b"; done |
   awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |

@@ -159,7 +159,10 @@ TEST(RealtimeHostPathFrames, TendonsAreDrawnAsTheCpuBackendDrawsThem) {
 // interleaved over a row's pixels (StridedLightTerms, RealtimeKernelOptions::shared_light_terms)
 // and the shadow rays apart in three passes (RealtimeKernelOptions::queue_shadow_rays:
 // ShadeQueuedStored, the rays traced from the queue's entries, SumQueuedLights), whose sum keeps
-// light order: summed from the last light to the first, the radiance and EV100 differ in both.
+// light order: summed from the last light to the first, the radiance and EV100 differ in both;
+// and so does the shared visibility worked by 16x16 shadow tiles, each tile's arrays copied as
+// the kernels copy them into shared memory (RealtimeKernelOptions::tile_penumbra and
+// tile_visibility; 120 rows: the last row of tiles is cut at 8).
 TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
   for (const char* world : {"default.yaml", "house.yaml"}) {
     const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(world, 1.0, 160, 120);
@@ -169,13 +172,16 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     cuda::RealtimeFrameData data(scene, RenderSettings());
     ThreadPool pool(0);
     data.Prepare(snap, view, &pool);
-    RenderedFrame evaluated, stored, strided, queued;
+    RenderedFrame evaluated, stored, strided, queued, tiled;
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &evaluated, /*stored_surface=*/false);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &stored, /*stored_surface=*/true);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &strided, /*stored_surface=*/true,
                                /*strided_terms=*/true);
     cuda::RenderRealtimeOnHost(data, bvh, &pool, &queued, /*stored_surface=*/true,
                                /*strided_terms=*/false, /*queued_shadows=*/true);
+    cuda::RenderRealtimeOnHost(data, bvh, &pool, &tiled, /*stored_surface=*/true,
+                               /*strided_terms=*/false, /*queued_shadows=*/false,
+                               /*tiled_visibility=*/true);
     int64_t lit = 0;
     for (float x : stored.radiance.data) lit += x > 0;
     EXPECT_GT(lit, 0) << world;
@@ -190,6 +196,9 @@ TEST(RealtimeHostPathFrames, StoredSurfaceShadesTheSameBits) {
     EXPECT_EQ(queued.rgb.data, stored.rgb.data) << world;
     EXPECT_EQ(queued.depth_m.data, stored.depth_m.data) << world;
     EXPECT_EQ(queued.ev100, stored.ev100) << world;
+    // the shared visibility by shadow tiles (the kernels' shared memory)
+    EXPECT_EQ(tiled.radiance.data, stored.radiance.data) << world;
+    EXPECT_EQ(tiled.rgb.data, stored.rgb.data) << world;
   }
 }
 

@@ -5,7 +5,9 @@
 // kernels' registers uncapped, the radiance copied back in 1 or 5 bands, the mirror layer on the
 // frame's stream or on one of its priority, the resolve and mirror blend as two kernels, the
 // shading kernel's light terms in local instead of shared memory, the shadow rays through a
-// queue or in the shading kernel); the rgb
+// queue or in the shading kernel, the shared visibility's kernels by shadow tile or by 16x8
+// pixels, also at a size whose edges cut the tiles, the penumbra queue's chunks of 1, 3 or 4
+// rays); the rgb
 // too, except that the row sums' order can move the exposure's last bits (then the EV100 agrees
 // to 1e-9). with the primary hit traced again or the surface evaluated again by the shading
 // kernel, the radiance may move in its last bits (nvcc's contraction of a second inlined copy of
@@ -70,8 +72,13 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "shared_light_terms off",
                          "queue_shadow_rays_always",
                          "queue_shadow_rays_always, shared_light_terms off",
-                         "queue_shadow_rays off"};
-  for (int k = 0; k < 24; ++k) {
+                         "queue_shadow_rays off",
+                         "tile_visibility off",
+                         "tile_penumbra off",
+                         "tile_visibility off, tile_penumbra off, fuse_resolve off",
+                         "penumbra_chunk_rays 4",
+                         "penumbra_chunk_rays 3"};
+  for (int k = 0; k < 29; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -80,6 +87,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
       o.reuse_hit = o.reuse_surface = o.rows_per_warp = o.pinned = o.warp_penumbra = false;
       o.queue_penumbra = false;
       o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
+      o.tile_visibility = o.tile_penumbra = false;
       o.min_blocks = o.geometry_min_blocks = 0;
       o.output_bands = 1;
     }
@@ -100,6 +108,11 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 20 || k == 22) o.shared_light_terms = false;
     if (k == 21 || k == 22) o.queue_shadow_rays_always = true;
     if (k == 23) o.queue_shadow_rays = false;
+    if (k == 24 || k == 26) o.tile_visibility = false;
+    if (k == 25 || k == 26) o.tile_penumbra = false;
+    if (k == 26) o.fuse_resolve = false;
+    if (k == 27) o.penumbra_chunk_rays = 4;
+    if (k == 28) o.penumbra_chunk_rays = 3;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {
@@ -155,6 +168,35 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
 
 INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeSpeedUps,
                          ::testing::Values("default.yaml", "house.yaml"));
+
+// the shadow-tile kernels (tile_visibility, tile_penumbra) where the image's edges cut tiles
+// (203 x 141 pixels: the last column and row of tiles 11 and 13 pixels) and the output bands
+// end mid-image: the same radiance, depth and rgb as the kernels of 16x8 pixels.
+TEST_P(RealtimeSpeedUps, TilesCutAtTheImageEdges) {
+  if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
+  const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(GetParam(), 1.0, 203, 141);
+  RenderSettings gpu_settings;
+  gpu_settings.backend = RenderSettings::Backend::kCuda;
+  const std::unique_ptr<Renderer> gpu = MakeRenderer(session->scene(), gpu_settings);
+  auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
+  ASSERT_NE(g, nullptr);
+  cuda::RealtimeKernelOptions o = g->device_realtime().options();
+  o.output_bands = 3;
+  ASSERT_TRUE(o.tile_visibility && o.tile_penumbra && o.fuse_resolve);
+  g->device_realtime().set_options(o);
+  RenderedFrame tiles;
+  gpu->Render(snap, view, &tiles);
+  o.tile_visibility = o.tile_penumbra = false;
+  g->device_realtime().set_options(o);
+  RenderedFrame rows;
+  gpu->Render(snap, view, &rows);
+  std::printf("%s 203x141 tiles: radiance %s, rgb %s\n", GetParam().c_str(),
+              tiles.radiance.data == rows.radiance.data ? "same" : "DIFFERENT",
+              tiles.rgb.data == rows.rgb.data ? "same" : "DIFFERENT");
+  EXPECT_EQ(tiles.radiance.data, rows.radiance.data);
+  EXPECT_EQ(tiles.depth_m.data, rows.depth_m.data);
+  EXPECT_EQ(tiles.rgb.data, rows.rgb.data);
+}
 
 }  // namespace
 }  // namespace penumbra

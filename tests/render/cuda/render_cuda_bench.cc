@@ -554,6 +554,19 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.queue_shadow_rays = false;
     variants.push_back({"kernels, shadow rays never queued (in the shading kernel)", o});
+    o = fast;
+    o.penumbra_chunk_rays = 4;
+    variants.push_back({"kernels, penumbra queue in chunks of 4 rays", o});
+    o.penumbra_chunk_rays = 2;
+    variants.push_back({"kernels, penumbra queue in chunks of 2 rays", o});
+    o = fast;
+    o.tile_visibility = false;
+    variants.push_back({"kernels, visibility fraction and resolve apart (no tiles)", o});
+    o = fast;
+    o.tile_penumbra = false;
+    variants.push_back({"kernels, penumbra rays in 16x8 blocks (no tiles)", o});
+    o.tile_visibility = false;
+    variants.push_back({"kernels, no shadow-tile kernels (both off)", o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -563,6 +576,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.warp_penumbra = false;
     o.queue_penumbra = false;
     o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
+    o.tile_visibility = o.tile_penumbra = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

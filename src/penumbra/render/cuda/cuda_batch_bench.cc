@@ -138,7 +138,7 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
             {"stage: shared visibility", st.visibility},
             {"stage: mirror layer", st.mirror},
             {"stage: row sums", st.row_sums},
-            {"stage: exposure round trip", st.exposure},
+            {"stage: exposure", st.exposure},
             {"stage: film", st.film}};
         for (const auto& [what, ms] : stages)
           rows.push_back({count, "cuda", what, ms > 0 ? count / (ms * 1e-3) : 0.0, ms});

@@ -49,7 +49,7 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 /// times batches of each count of `camera_counts` (width x height, `outputs`): `batches`
 /// batches each with pinned copies overlapped with the next kernel (wall clock from the first
 /// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events;
-/// with rgb all the batch's kernels and its exposure's round trip), with rgb each realtime
+/// with rgb all the batch's kernels, its exposures included), with rgb each realtime
 /// stage's GPU time (rows "stage: ..."; RealtimeBatchTimes), and the CPU renderers rendering
 /// the same views one at a time (at least one batch; with rgb the realtime tier's rgb and
 /// depth).

@@ -108,8 +108,6 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
   const int count = static_cast<int>(cameras.size());
   frames_.resize(count);
   films_.resize(count);
-  std::vector<const RealtimeFrameData*> data(count);
-  std::vector<Eigen::Vector3f> gains(count);
   for (int k = 0; k < count; ++k) {
     const BatchCamera& c = cameras[k];
     const World& w = *worlds_[c.world];
@@ -118,23 +116,18 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
     f.camera = c.camera;
     f.spread_rad = c.spread_rad;
     f.frame_key = w.realtime->FrameKey(c.camera_index, c.frame_index);
-    films_[k].filmic = w.realtime->film().filmic() ? 1 : 0;
-    films_[k].lut = w.device_realtime->device_lut();
-    data[k] = w.realtime.get();
-    gains[k] = Eigen::Vector3f(c.white_balance[0], c.white_balance[1], c.white_balance[2]);
+    RealtimeBatchFilm& film = films_[k];
+    film.exposure = w.realtime->film().exposure_pod();
+    for (int ch = 0; ch < 3; ++ch) film.white_balance_gains[ch] = c.white_balance[ch];
+    film.filmic = w.realtime->film().filmic() ? 1 : 0;
+    film.lut = w.device_realtime->device_lut();
   }
-  const int64_t n = layout_.pixels();
-  RealtimeBatch::ExposureFn exposure = [data = std::move(data), gains = std::move(gains), n](
-                                           int k, const std::vector<double>& rows, float e[3]) {
-    data[k]->Ev100(rows, n, gains[k], e);
-  };
   float* depth =
       layout_.has(BatchPlane::kDepth)
           ? reinterpret_cast<float*>(buffer + layout_.plane_offset(BatchPlane::kDepth, count))
           : nullptr;
   uint8_t* rgb = buffer + layout_.plane_offset(BatchPlane::kRgb, count);
-  realtime_->Launch(frames_.data(), films_.data(), count, std::move(exposure), depth, rgb, slot,
-                    stream);
+  realtime_->Launch(frames_.data(), films_.data(), count, depth, rgb, slot, stream);
 }
 
 int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {

@@ -109,8 +109,8 @@ class BatchRenderer {
   void UpdateWorld(int world, const WorldSnapshot& snapshot, const EffectsFrame* effects = nullptr);
 
   /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each
-  /// realtime stage, and a host function on the stream that computes each camera's exposure
-  /// from its row sums) and starts the copy back (BatchCopy); returns the batch's ticket (0, 1,
+  /// realtime stage, the cameras' exposures from their row sums included) and starts the copy
+  /// back (BatchCopy); returns the batch's ticket (0, 1,
   /// ...) at once. the images of ticket t stay readable until ticket t + 2 is submitted. the
   /// ray tables the cameras name (CameraOf) are copied to the device with the batch.
   /// @throws Error for bad cameras (naming the camera; a camera whose tables are another
@@ -135,7 +135,7 @@ class BatchRenderer {
   /// the cudaStream_t (as void*) the kernels run on.
   void* stream() const { return device_->stream(); }
   /// milliseconds batch `ticket`'s kernel took (CUDA events; call after Wait(ticket)); with
-  /// rgb all its kernels, the exposure's round trip included.
+  /// rgb all its kernels.
   double kernel_ms(int64_t ticket) const;
   /// with rgb: the GPU time of batch `ticket`'s realtime stages (call after Wait(ticket)).
   /// @throws Error as Wait, or if the batch renders no rgb.

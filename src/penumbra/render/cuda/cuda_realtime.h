@@ -157,6 +157,12 @@ struct RealtimeKernelOptions {
   /// atomics (the same counts, so the same bits), so no warp waits on its ring pixels; the
   /// short ones spread over their warp's lanes (as warp_penumbra, which this implies).
   bool queue_penumbra = true;
+  /// with queue_penumbra: the rays of a queued chunk (1 to 8; a batch's chunks hold 4). a
+  /// thread of VisibilityChunkKernel traces its chunk's rays one after another, so where the
+  /// queue holds fewer chunks than the device has threads (the house's narrow penumbrae) the
+  /// kernel lasts as long as one chunk's rays; shorter chunks shorten it, at one integer atomic
+  /// a chunk. the same integer counts, so the same bits.
+  int penumbra_chunk_rays = 1;
   /// with device_sky, a frame with a mirror layer traces, sky-terms and shades its mirrored rays
   /// (MirrorTraceKernel, MirrorSkyKernel, MirrorShadeKernel) on a second stream that forks from
   /// the frame's stream after the geometry kernel and joins it before the mirror blend, so they
@@ -173,6 +179,19 @@ struct RealtimeKernelOptions {
   /// it): band k goes back while band k + 1 is resolved and the row sums run. else the resolve,
   /// then the blend over the whole frame, and the copies behind the row sums.
   bool fuse_resolve = true;
+  /// the shared visibility's fraction and resolve (with fuse_resolve also the mirror blend) in
+  /// one kernel of a block per 16x16 shadow tile (VisibilityTileKernel; a batch's too): the
+  /// tile's verdicts, ray counts and fractions of one light after another in shared memory,
+  /// where every pixel's window finds its neighbours (the windows never leave their tile), the
+  /// same functions on the same values (SharedWindowFraction, SharedLampFraction), so the same
+  /// bits; else VisibilityFractionKernel, then the resolve, each reading its neighbours from the
+  /// frame's arrays.
+  bool tile_visibility = true;
+  /// with warp_penumbra or queue_penumbra: the penumbra rays' kernel in blocks of one 16x16
+  /// shadow tile that copy every light's verdicts of their tile into shared memory first, where
+  /// each pixel's window looks for a penumbra (SharedVisibilityPenumbra; frames of at most 128
+  /// lights, a batch's too); else blocks of 16x8 pixels reading the frame's verdicts.
+  bool tile_penumbra = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;
@@ -237,11 +256,14 @@ struct RealtimeStageTimes {
   double copies_end = 0;
 };
 
-/// one camera's film in a batch (RealtimeBatch): its per-channel exposures (set by the batch
-/// from the camera's row sums), its tone map and its world's encoding table (device pointer,
-/// DeviceRealtime::device_lut).
+/// one camera's film in a batch (RealtimeBatch): how its exposure is metered (its world's
+/// Film::exposure_pod) and white-balanced (linear rgb gains, ones = none), its tone map and its
+/// world's encoding table (device pointer, DeviceRealtime::device_lut). the batch computes the
+/// per-channel exposures from the camera's row sums on the device (film_math.h's
+/// FrameExposure, as Render's device_exposure).
 struct RealtimeBatchFilm {
-  float exposure[3] = {1, 1, 1};
+  FilmExposurePod exposure;
+  float white_balance_gains[3] = {1, 1, 1};
   int32_t filmic = 1;
   const uint8_t* lut = nullptr;
 };
@@ -255,10 +277,8 @@ struct RealtimeBatchTimes {
   double visibility = 0;  ///< the shared visibility: penumbra rays, fraction, resolve
   double mirror = 0;      ///< the mirror layer's shading and blend (0 without one)
   double row_sums = 0;    ///< the rows' log-luminance sums
-  /// the row sums back to the host, the host's exposures (a host function on the stream),
-  /// the exposures up
-  double exposure = 0;
-  double film = 0;  ///< the film kernel (DevelopPixel)
+  double exposure = 0;    ///< the exposure kernel (one block a camera, FrameExposure)
+  double film = 0;        ///< the film kernel (DevelopPixel)
   double total = 0;
 };
 
@@ -273,19 +293,15 @@ double DeviceFrameExposure(const FilmExposurePod& film, const std::vector<double
 /// stage of Render's default path (device sky terms, stored surfaces, warp-shared penumbra rays,
 /// a warp per row's sum) launched once over every camera of the batch, camera k in the grid's
 /// z (the row sums' and film's y); camera k's images are the same bits as Render of that camera
-/// alone. the exposure is computed on the host from each camera's row sums (its world's
-/// RealtimeFrameData::Ev100, summed in row order: no atomics) by a host function enqueued on
-/// the stream (cudaLaunchHostFunc), so Launch returns at once.
+/// alone. each camera's exposure is computed on the device from its row sums (one block a
+/// camera: film_math.h's FrameExposure over the rows in row order, the function the host's
+/// RealtimeFrameData::Ev100 calls; no atomics), so a batch never waits for the host.
 class RealtimeBatch {
  public:
-  /// camera k's EV100-based per-channel exposures from its rows' log-luminance sums (height
-  /// values in row order); called on a CUDA runtime thread, cameras in order, one batch at a
-  /// time; must not call the CUDA runtime.
-  using ExposureFn = std::function<void(int k, const std::vector<double>& rows, float exposure[3])>;
-
-  /// working buffers for batches of up to max_cameras cameras of width x height pixels and
-  /// `max_lights` lights, with the mirror layer's if `mirror`, and `slots` sets of stage events.
-  /// @throws Error if the CUDA runtime fails.
+  /// working buffers for batches of up to max_cameras cameras of width x height pixels
+  /// (height <= kMaxDeviceExposureRows) and `max_lights` lights, with the mirror layer's if
+  /// `mirror`, and `slots` sets of stage events.
+  /// @throws Error for a bad size or count, or if the CUDA runtime fails.
   RealtimeBatch(int width, int height, int max_cameras, int max_lights, bool mirror, int slots);
   ~RealtimeBatch();
   RealtimeBatch(const RealtimeBatch&) = delete;
@@ -294,13 +310,13 @@ class RealtimeBatch {
   /// enqueues on `stream` (a cudaStream_t) the realtime frames of cameras[0 .. count):
   /// frames[k] (host array) is camera k's frame with device pointers (DeviceRealtime::DeviceFrame
   /// of its world, its camera, spread and frame key; its per-pixel arrays are set here) and
-  /// film[k] its film (the exposure is set here). writes each camera's depth (m; `depth` may be
+  /// film[k] its film (host array). writes each camera's depth (m; `depth` may be
   /// null) and rgb (3 bytes a pixel; may be null) camera-major into the device arrays given.
   /// the stage times go to slot `slot`'s events. every camera's num_lights must be at most
   /// max_lights, and any_mirror 0 unless the batch was made with `mirror`.
   /// @throws Error for a bad count, slot or camera, or if the CUDA runtime fails.
   void Launch(const RealtimeFrameView* frames, const RealtimeBatchFilm* film, int count,
-              ExposureFn exposure, float* depth, uint8_t* rgb, int slot, void* stream);
+              float* depth, uint8_t* rgb, int slot, void* stream);
   /// the stage times of slot `slot`'s last Launch (call after its stream passed it).
   RealtimeBatchTimes times(int slot) const;
 

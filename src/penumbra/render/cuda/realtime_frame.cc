@@ -427,14 +427,9 @@ void RealtimeFrameData::StreakFields(RealtimeFrameView* f) const {
 
 double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
                                 float exposure[3]) const {
-  return Ev100(row_sums, pixels, white_balance_gains_, exposure);
-}
-
-double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,
-                                const Eigen::Vector3f& white_balance_gains,
-                                float exposure[3]) const {
   // the rows in row order: independent of the launch (film_math.h, shared with the device)
-  const float gains[3] = {white_balance_gains[0], white_balance_gains[1], white_balance_gains[2]};
+  const float gains[3] = {white_balance_gains_[0], white_balance_gains_[1],
+                          white_balance_gains_[2]};
   return FrameExposure(film_.exposure_pod(), row_sums.data(), static_cast<int>(row_sums.size()),
                        pixels, kMinLuminance, gains, exposure);
 }
@@ -508,9 +503,75 @@ struct HostShadowPush {
 
 }  // namespace
 
+namespace {
+
+// the shared visibility of frame f by shadow tiles, as the kernels' blocks with
+// RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
+// VisibilityTileKernel) do it in shared memory: per tile, every light's verdicts copied for the
+// penumbra rays (SharedVisibilityRays), then light after light its verdicts, ray counts and
+// fractions (SharedWindowFraction) for the resolve (SharedLampFraction, AddSharedVisibility).
+void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3* radiance) {
+  const int W = f.camera.width, H = f.camera.height;
+  const int64_t n = static_cast<int64_t>(W) * H;
+  const int tiles_x = (W + kShadowTileSize - 1) / kShadowTileSize;
+  const int tiles_y = (H + kShadowTileSize - 1) / kShadowTileSize;
+  constexpr int kTile = kShadowTileSize * kShadowTileSize;
+  // a tile's pixels (tile-local index t = y kShadowTileSize + x) in the image, -1 outside it
+  const auto tile_pixel = [&](int64_t tile, int t) -> int64_t {
+    const int u = static_cast<int>(tile % tiles_x) * kShadowTileSize + t % kShadowTileSize;
+    const int v = static_cast<int>(tile / tiles_x) * kShadowTileSize + t / kShadowTileSize;
+    return u < W && v < H ? static_cast<int64_t>(v) * W + u : -1;
+  };
+  ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
+    std::vector<int8_t> vis(static_cast<size_t>(kTile) * std::max(f.num_lights, 1));
+    for (int j = 0; j < f.num_lights; ++j)
+      for (int t = 0; t < kTile; ++t) {
+        const int64_t i = tile_pixel(tile, t);
+        vis[j * kTile + t] = i < 0 ? int8_t{-1} : f.area_vis[j * n + i];
+      }
+    for (int t = 0; t < kTile; ++t) {
+      const int64_t i = tile_pixel(tile, t);
+      if (i >= 0)
+        SharedVisibilityRays(f, static_cast<int>(i % W), static_cast<int>(i / W), vis.data(), kTile,
+                             t, kShadowTileSize);
+    }
+  });
+  ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
+    int8_t vis[kTile];
+    float visible[kTile], rays[kTile], fraction[kTile];
+    const VisibilityTaps taps{vis, visible, rays, fraction, kShadowTileSize};
+    for (int j = 0; j < f.num_lights; ++j) {
+      if (!IsExtendedLightPod(f.lights[j])) continue;
+      for (int t = 0; t < kTile; ++t) {
+        const int64_t i = tile_pixel(tile, t);
+        vis[t] = i < 0 ? int8_t{-1} : f.area_vis[j * n + i];
+        if (vis[t] < 0) continue;
+        visible[t] = f.area_visible[j * n + i];
+        rays[t] = f.area_rays[j * n + i];
+      }
+      for (int t = 0; t < kTile; ++t) {
+        const int64_t i = tile_pixel(tile, t);
+        if (vis[t] >= 0)
+          fraction[t] = SharedWindowFraction(taps, t, f.window[i], f.area_own[j * n + i] != 0);
+      }
+      for (int t = 0; t < kTile; ++t) {
+        const int64_t i = tile_pixel(tile, t);
+        if (vis[t] < 0) continue;
+        const int u = static_cast<int>(i % W), v = static_cast<int>(i / W);
+        const ShadowTile st = ShadowTileOf(u, v, W, H);
+        const bool lamp = f.lights[j].kind != LightKind::kDirectional && f.area_own[j * n + i] == 0;
+        const float V = SharedLampFraction(taps, t, f.window[i], lamp, u - st.x0, v - st.y0, st);
+        radiance[i] = AddSharedVisibility(radiance[i], V, f.area_c[j * n + i]);
+      }
+    }
+  });
+}
+
+}  // namespace
+
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                           RenderedFrame* out, bool stored_surface, bool strided_terms,
-                          bool queued_shadows) {
+                          bool queued_shadows, bool tiled_visibility) {
   const PinholeCamera& c = data.camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -642,18 +703,22 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
         radiance[i] = SumQueuedLights(f, i, n, radiance[i], queued_masks[i], queued_occluded[i]);
     });
   }
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));
-  });
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) SharedVisibilityFraction(f, u, static_cast<int>(v));
-  });
-  ParallelForOrSerial(pool, H, [&](int64_t v) {
-    for (int u = 0; u < W; ++u) {
-      Float3& L = radiance[v * W + u];
-      L = SharedVisibilityResolve(f, u, static_cast<int>(v), L);
-    }
-  });
+  if (tiled_visibility) {
+    TiledSharedVisibility(f, pool, radiance.data());
+  } else {
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) SharedVisibilityRays(f, u, static_cast<int>(v));
+    });
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) SharedVisibilityFraction(f, u, static_cast<int>(v));
+    });
+    ParallelForOrSerial(pool, H, [&](int64_t v) {
+      for (int u = 0; u < W; ++u) {
+        Float3& L = radiance[v * W + u];
+        L = SharedVisibilityResolve(f, u, static_cast<int>(v), L);
+      }
+    });
+  }
   if (f.any_mirror != 0) {
     ParallelForOrSerial(pool, H, [&](int64_t v) {
       for (int u = 0; u < W; ++u) ShadeMirrorHit(f, u, static_cast<int>(v));

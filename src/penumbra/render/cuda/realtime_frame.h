@@ -193,10 +193,6 @@ class RealtimeFrameData {
   /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop
   /// (the exposure times the prepared view's white_balance_gains, as Film::Develop).
   double Ev100(const std::vector<double>& row_sums, int64_t pixels, float exposure[3]) const;
-  /// Ev100 with the white-balance gains given (CameraView::white_balance_gains) instead of the
-  /// prepared view's: batch rendering's per-camera exposures.
-  double Ev100(const std::vector<double>& row_sums, int64_t pixels,
-               const Eigen::Vector3f& white_balance_gains, float exposure[3]) const;
 
   const std::vector<MaterialPod>& materials() const { return materials_; }
   const std::vector<TexturePod>& textures() const { return textures_; }
@@ -298,9 +294,14 @@ void BuildMediaVolumesOnHost(RealtimeFrameView* f, ThreadPool* pool, MediaVolume
 /// the same bits. `queued_shadows` (with stored_surface, at most kMaxQueuedShadowLights
 /// lights): the shadow rays apart in three passes as RealtimeKernelOptions::queue_shadow_rays
 /// (ShadeQueuedStored, each ray traced from QueuedRay, SumQueuedLights; the lights' terms in
-/// each pixel's own arrays); the same bits.
+/// each pixel's own arrays); the same bits. `tiled_visibility`: the shared visibility by 16x16
+/// shadow tiles, each tile's verdicts, ray counts and fractions copied into tile arrays where
+/// the windows find their neighbours, as the kernels' blocks do in shared memory with
+/// RealtimeKernelOptions::tile_penumbra and tile_visibility (SharedVisibilityRays' tile form,
+/// SharedWindowFraction, SharedLampFraction); the same bits.
 void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, ThreadPool* pool,
                           RenderedFrame* out, bool stored_surface = false,
-                          bool strided_terms = false, bool queued_shadows = false);
+                          bool strided_terms = false, bool queued_shadows = false,
+                          bool tiled_visibility = false);
 
 }  // namespace penumbra::cuda

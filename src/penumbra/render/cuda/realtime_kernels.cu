@@ -44,6 +44,34 @@ __device__ inline int64_t CameraOffset(const RealtimeFrameView& f) {
   return static_cast<int64_t>(blockIdx.z) * f.camera.width * f.camera.height;
 }
 
+// the pixel of a per-pixel kernel's thread (PixelOf): column u, row v, its index i in its
+// frame's image and k in the arrays of every camera (i + CameraOffset); false outside the image
+// or its rows.
+struct FramePixel {
+  int u = 0, v = 0;
+  int64_t i = 0, k = 0;
+  bool inside = false;
+  __device__ explicit operator bool() const { return inside; }
+};
+
+// the blocks of the kernels that work a shadow tile (render/shadow_window_math.h) at a time:
+// one thread a pixel of the tile (whose pixels' windows never leave it).
+constexpr int kTilePixels = kShadowTileSize * kShadowTileSize;
+const dim3 kTileBlock(kShadowTileSize, kShadowTileSize);
+
+// this thread's pixel of frame f in a grid over rows [row0, row1) (row1 < 0: to the last row),
+// one thread a pixel (blockIdx and threadIdx x and y).
+__device__ inline FramePixel PixelOf(const RealtimeFrameView& f, int row0 = 0, int row1 = -1) {
+  FramePixel p;
+  p.u = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+  p.v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+  if (p.u >= f.camera.width || p.v >= (row1 < 0 ? f.camera.height : row1)) return p;
+  p.i = static_cast<int64_t>(p.v) * f.camera.width + p.u;
+  p.k = CameraOffset(f) + p.i;
+  p.inside = true;
+  return p;
+}
+
 // hits, surfaces: null, or where the primary hits and their material terms are kept for the
 // shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
 // threads an SM).
@@ -52,14 +80,12 @@ __global__ void __launch_bounds__(128, kMinBlocks)
     GeometryKernel(Frames frames, PixelGeometry* geometry, float* depth, TraceHit* hits,
                    SurfaceTerms* surfaces) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
-  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
+  const FramePixel p = PixelOf(f);
+  if (!p) return;
   float t;
-  geometry[i] =
-      PrimaryGeometry(f, u, v, &t, hits ? &hits[i] : nullptr, surfaces ? &surfaces[i] : nullptr);
-  depth[i] = t;
+  geometry[p.k] = PrimaryGeometry(f, p.u, p.v, &t, hits ? &hits[p.k] : nullptr,
+                                  surfaces ? &surfaces[p.k] : nullptr);
+  depth[p.k] = t;
 }
 
 // the particle streaks over the final radiance (ApplyStreak): one thread per streak pixel, each
@@ -198,29 +224,22 @@ __global__ void MediaGridFroxelKernel(RealtimeFrameView f, const Float3* source,
 template <class Frames>
 __global__ void MirrorTraceKernel(Frames frames) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
-  TraceMirrorRay(f, u, v);
+  const FramePixel p = PixelOf(f);
+  if (p && f.any_mirror != 0) TraceMirrorRay(f, p.u, p.v);
 }
 
 template <class Frames>
 __global__ void MirrorShadeKernel(Frames frames) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
-  ShadeMirrorHit(f, u, v);
+  const FramePixel p = PixelOf(f);
+  if (p && f.any_mirror != 0) ShadeMirrorHit(f, p.u, p.v);
 }
 
 template <class Frames>
 __global__ void MirrorBlendKernel(Frames frames, Float3* radiance) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
-  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
-  radiance[i] = ApplyMirrorLayer(f, u, v, radiance[i]);
+  const FramePixel p = PixelOf(f);
+  if (p && f.any_mirror != 0) radiance[p.k] = ApplyMirrorLayer(f, p.u, p.v, radiance[p.k]);
 }
 
 // the sky terms (realtime_shading.h): one thread per 2x2 quad of primary geometry (the quads
@@ -238,11 +257,9 @@ __global__ void SkyQuadKernel(Frames frames, Float3* sky) {
 template <class Frames>
 __global__ void MirrorSkyKernel(Frames frames, Float3* mirror_sky) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height || f.any_mirror == 0) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  MirrorSkyTerm(f.sky, f.volume, f.mirror_geometry[i], &mirror_sky[CameraOffset(f) + i]);
+  const FramePixel p = PixelOf(f);
+  if (p && f.any_mirror != 0)
+    MirrorSkyTerm(f.sky, f.volume, f.mirror_geometry[p.i], &mirror_sky[p.k]);
 }
 
 // kReuse: the primary hit from GeometryKernel (else traced again); kMinBlocks: blocks of 128
@@ -252,17 +269,15 @@ __global__ void MirrorSkyKernel(Frames frames, Float3* mirror_sky) {
 template <bool kReuse, int kMinBlocks>
 __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeKernel(RealtimeFrameView f, const TraceHit* hits, Float3* radiance, int row0, int row1) {
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  if (u >= f.camera.width || v >= row1) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  const TraceRay r = PrimaryRay(f.camera, u, v);
+  const FramePixel p = PixelOf(f, row0, row1);
+  if (!p) return;
+  const TraceRay r = PrimaryRay(f.camera, p.u, p.v);
   TraceHit h;
   if (kReuse)
-    h = hits[i];
+    h = hits[p.i];
   else
     TraceClosest(f.scene, r, &h);
-  radiance[i] = ShadeRealtimeHit(f, u, v, r, h);
+  radiance[p.i] = ShadeRealtimeHit(f, p.u, p.v, r, h);
 }
 
 // this thread's StridedLightTerms of `lights` lights in its block's dynamic shared memory
@@ -287,16 +302,13 @@ __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
                       int row1, int lights = 0) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  if (u >= f.camera.width || v >= row1) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t k = CameraOffset(f) + i;
+  const FramePixel p = PixelOf(f, row0, row1);
+  if (!p) return;
   if constexpr (kSharedTerms) {
     StridedLightTerms terms = BlockLightTerms(lights);
-    radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms);
+    radiance[p.k] = ShadeRealtimeStored<kMedia>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k], terms);
   } else {
-    radiance[k] = ShadeRealtimeStored<kMedia>(f, u, v, f.geometry[i], surfaces[k]);
+    radiance[p.k] = ShadeRealtimeStored<kMedia>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k]);
   }
 }
 
@@ -341,22 +353,20 @@ __global__ void __launch_bounds__(128)
     ShadeQueuedKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance,
                       ShadowRayQueue q, int row0, int row1, int lights) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  if (u >= f.camera.width || v >= row1) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t k = CameraOffset(f) + i;
-  const DeviceShadowPush push{q.rays, q.count, static_cast<uint32_t>(k)};
+  const FramePixel p = PixelOf(f, row0, row1);
+  if (!p) return;
+  const DeviceShadowPush push{q.rays, q.count, static_cast<uint32_t>(p.k)};
+  const PixelGeometry& g = f.geometry[p.i];
   QueuedLightMasks m;
   if constexpr (kSharedTerms) {
     StridedLightTerms terms = BlockLightTerms(lights);
-    radiance[k] = ShadeQueuedStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms, push, &m);
+    radiance[p.k] = ShadeQueuedStored<kMedia>(f, p.u, p.v, g, surfaces[p.k], terms, push, &m);
   } else {
     LocalLightTerms terms;
-    radiance[k] = ShadeQueuedStored<kMedia>(f, u, v, f.geometry[i], surfaces[k], terms, push, &m);
+    radiance[p.k] = ShadeQueuedStored<kMedia>(f, p.u, p.v, g, surfaces[p.k], terms, push, &m);
   }
-  q.masks[k] = m;
-  q.occluded[k] = 0;
+  q.masks[p.k] = m;
+  q.occluded[p.k] = 0;
 }
 
 // pass 2: the queued rays, one a thread, one wave of resident blocks striding over the queue;
@@ -407,35 +417,32 @@ template <class Frames>
 __global__ void SumQueuedKernel(Frames frames, Float3* radiance, ShadowRayQueue q, int row0,
                                 int row1) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  if (u >= f.camera.width || v >= row1) return;
-  const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t k = CameraOffset(f) + i;
-  const QueuedLightMasks m = q.masks[k];
+  const FramePixel p = PixelOf(f, row0, row1);
+  if (!p) return;
+  const QueuedLightMasks m = q.masks[p.k];
   if (m.lit == 0) return;
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  radiance[k] = SumQueuedLights(f, i, n, radiance[k], m, q.occluded[k]);
+  radiance[p.k] = SumQueuedLights(f, p.i, n, radiance[p.k], m, q.occluded[p.k]);
 }
 
 // the shared visibility of lights with an extent (realtime_shading.h), one kernel per step:
 // each reads its neighbours' results of the step before.
 __global__ void VisibilityRaysKernel(RealtimeFrameView f) {
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
-  SharedVisibilityRays(f, u, v);
+  const FramePixel p = PixelOf(f);
+  if (p) SharedVisibilityRays(f, p.u, p.v);
 }
 
 // the shared visibility's penumbra rays with a queue (RealtimeKernelOptions::queue_penumbra):
 // VisibilityRaysWarpKernel spreads a warp's short jobs over its lanes as before, but queues the
 // long ones (more than kPenumbraQueueRays rays: a tile's ring in a penumbra traces up to 63) in
-// chunks of kPenumbraChunkRays; VisibilityChunkKernel traces the chunks, all threads of the
+// chunks of RealtimeKernelOptions::penumbra_chunk_rays (a batch's of kPenumbraChunkRays, at most
+// kMaxPenumbraChunkRays); VisibilityChunkKernel traces the chunks, all threads of the
 // device sharing them, and adds each chunk's integer counts to its pixel's (integer atomics:
 // the sums do not depend on the order); the chunk that completes a pixel's job writes its
 // totals. the same integer counts as SharedVisibilityRays, so the same bits, without a warp
 // waiting on its ring pixels while the rest of the device is idle.
 constexpr int kPenumbraChunkRays = 4;
+constexpr int kMaxPenumbraChunkRays = 8;
 constexpr int kPenumbraQueueRays = 8;
 
 // rays [r0, r0 + rays) of light `light` at pixel `pixel` of camera `camera`, one of the job's
@@ -458,10 +465,10 @@ __device__ inline uint32_t PackChunkCounts(int traced, int visible) {
   return (1u << 24) | (static_cast<uint32_t>(traced) << 12) | static_cast<uint32_t>(visible);
 }
 
-// the queue's room: chunks for a quarter of every light's pixels, at least 1 Mi entries, at
-// most 16 Mi (256 MiB); a job that does not fit is spread over its warp's lanes.
-inline int64_t PenumbraQueueCapacity(int64_t nl) {
-  return std::min<int64_t>(std::max<int64_t>(nl / 4, int64_t{1} << 20), int64_t{1} << 24);
+// the queue's room in chunks of `chunk_rays` rays: a ray for every light's pixel, at least 1 Mi
+// entries, at most 16 Mi (256 MiB); a job that does not fit is spread over its warp's lanes.
+inline int64_t PenumbraQueueCapacity(int64_t nl, int chunk_rays) {
+  return std::min<int64_t>(std::max<int64_t>(nl / chunk_rays, int64_t{1} << 20), int64_t{1} << 24);
 }
 
 // where VisibilityRaysWarpKernel queues its long jobs (queue null: it queues none).
@@ -469,8 +476,9 @@ struct PenumbraQueue {
   PenumbraChunk* queue = nullptr;
   unsigned long long* queued = nullptr;  // chunks queued (may pass capacity: those are not)
   int64_t capacity = 0;
-  uint32_t* counts = nullptr;  // (camera, light, pixel) at camera nl + light n + pixel
-  int64_t nl = 0;              // a camera's per-light entries
+  int chunk_rays = kPenumbraChunkRays;  // rays a chunk (1 to kMaxPenumbraChunkRays)
+  uint32_t* counts = nullptr;           // (camera, light, pixel) at camera nl + light n + pixel
+  int64_t nl = 0;                       // a camera's per-light entries
 };
 
 // queues light j's rays 1 .. extra - 1 of `job` at pixel i of camera `camera` (n pixels) if
@@ -478,7 +486,7 @@ struct PenumbraQueue {
 __device__ inline bool QueuePenumbraJob(const PenumbraQueue& q, const PenumbraRays& job, int j,
                                         int64_t i, int64_t n, int camera) {
   const int rays = job.extra - 1;
-  const int chunks = (rays + kPenumbraChunkRays - 1) / kPenumbraChunkRays;
+  const int chunks = (rays + q.chunk_rays - 1) / q.chunk_rays;
   const cg::coalesced_group g = cg::coalesced_threads();
   const int before = cg::exclusive_scan(g, chunks);
   const int all = g.shfl(before + chunks, g.size() - 1);
@@ -495,9 +503,8 @@ __device__ inline bool QueuePenumbraJob(const PenumbraQueue& q, const PenumbraRa
     e.points = static_cast<int16_t>(job.points);
     e.light = static_cast<uint8_t>(j);
     e.own = static_cast<uint8_t>(job.own);
-    e.r0 = static_cast<uint8_t>(1 + c * kPenumbraChunkRays);
-    e.rays = fits ? static_cast<uint8_t>(min(kPenumbraChunkRays, rays - c * kPenumbraChunkRays))
-                  : uint8_t{0};
+    e.r0 = static_cast<uint8_t>(1 + c * q.chunk_rays);
+    e.rays = fits ? static_cast<uint8_t>(min(q.chunk_rays, rays - c * q.chunk_rays)) : uint8_t{0};
     e.chunks = static_cast<uint8_t>(chunks);
     e.pad = 0;
     q.queue[at + c] = e;
@@ -537,6 +544,14 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
   }
 }
 
+// the most lights whose verdicts VisibilityRaysWarpKernel<..., true> keeps in shared memory
+// (TilePenumbraBytes: 32 KiB, under the 48 KiB a kernel gets without asking); frames with more
+// take the kernel of 128 threads a block.
+constexpr int kMaxTilePenumbraLights = 128;
+inline size_t TilePenumbraBytes(int lights) {
+  return static_cast<size_t>(std::max(lights, 1)) * kTilePixels;
+}
+
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
 template <class Frames>
 unsigned ChunkBlocks() {
@@ -551,20 +566,36 @@ unsigned ChunkBlocks() {
 // bits, without the warp waiting on the one ring pixel that traces 63 rays. whole warps run
 // every step (pixels outside the image take part with no rays).
 // at most 128 registers (4 blocks an SM: the queue's code would otherwise take it to 131, 3).
-template <class Frames>
-__global__ void __launch_bounds__(128, 4) VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
+// kTile (RealtimeKernelOptions::tile_penumbra): a block of kTilePixels threads per shadow tile
+// (kTileBlock, 2 blocks an SM at 128 registers) first copies every light's verdicts of its tile
+// into its dynamic shared memory (TilePenumbraBytes of it), where the pixels' windows, cut at the
+// tile's edges, find their neighbours' (SharedVisibilityPenumbra's vis_j: the same values).
+template <class Frames, bool kTile>
+__global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
+    VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
+  extern __shared__ int8_t tile_vis[];
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
+  const FramePixel p = PixelOf(f);
+  const int u = p.u, v = p.v;
   const int W = f.camera.width, H = f.camera.height;
-  const bool inside = u < W && v < H;
-  const int lane = static_cast<int>((threadIdx.y * blockDim.x + threadIdx.x) & 31u);
-  const uint32_t bits = inside ? SharedVisibilityWindow(f, u, v) : 0u;
+  const bool inside = p.inside;
+  const int t = static_cast<int>(threadIdx.y * blockDim.x + threadIdx.x);
+  const int lane = t & 31;
   const int64_t n = static_cast<int64_t>(W) * H;
-  const int64_t i = static_cast<int64_t>(v) * W + u;
+  const int64_t i = p.i;
+  if constexpr (kTile) {
+    for (int j = 0; j < f.num_lights; ++j)
+      tile_vis[j * kTilePixels + t] = inside ? f.area_vis[j * n + i] : int8_t{-1};
+    __syncthreads();
+  }
+  const uint32_t bits = inside ? SharedVisibilityWindow(f, u, v) : 0u;
   for (int j = 0; j < f.num_lights; ++j) {
     PenumbraRays job;
-    if (inside) job = SharedVisibilityPenumbra(f, u, v, j, bits);
+    if (inside && kTile)
+      job = SharedVisibilityPenumbra(f, u, v, j, bits, tile_vis + j * kTilePixels, t,
+                                     kShadowTileSize);
+    else if (inside)
+      job = SharedVisibilityPenumbra(f, u, v, j, bits);
     int count = job.active != 0 && job.extra > 1 ? job.extra - 1 : 0;
     // a long job to the queue (VisibilityChunkKernel writes its totals), if it fits
     bool queued = false;
@@ -619,20 +650,15 @@ __global__ void __launch_bounds__(128, 4) VisibilityRaysWarpKernel(Frames frames
 template <class Frames>
 __global__ void VisibilityFractionKernel(Frames frames) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
-  SharedVisibilityFraction(f, u, v);
+  const FramePixel p = PixelOf(f);
+  if (p) SharedVisibilityFraction(f, p.u, p.v);
 }
 
 template <class Frames>
 __global__ void VisibilityResolveKernel(Frames frames, Float3* radiance) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = blockIdx.y * blockDim.y + threadIdx.y;
-  if (u >= f.camera.width || v >= f.camera.height) return;
-  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
-  radiance[i] = SharedVisibilityResolve(f, u, v, radiance[i]);
+  const FramePixel p = PixelOf(f);
+  if (p) radiance[p.k] = SharedVisibilityResolve(f, p.u, p.v, radiance[p.k]);
 }
 
 // VisibilityResolveKernel and, with kMirror, MirrorBlendKernel in one pass over rows [row0,
@@ -641,13 +667,104 @@ __global__ void VisibilityResolveKernel(Frames frames, Float3* radiance) {
 template <class Frames, bool kMirror>
 __global__ void ResolveBandKernel(Frames frames, Float3* radiance, int row0, int row1) {
   const RealtimeFrameView& f = frames.get();
-  const int u = blockIdx.x * blockDim.x + threadIdx.x;
-  const int v = row0 + static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
-  if (u >= f.camera.width || v >= row1) return;
-  const int64_t i = CameraOffset(f) + static_cast<int64_t>(v) * f.camera.width + u;
-  Float3 L = SharedVisibilityResolve(f, u, v, radiance[i]);
-  if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, u, v, L);
-  radiance[i] = L;
+  const FramePixel p = PixelOf(f, row0, row1);
+  if (!p) return;
+  Float3 L = SharedVisibilityResolve(f, p.u, p.v, radiance[p.k]);
+  if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, p.u, p.v, L);
+  radiance[p.k] = L;
+}
+
+// VisibilityFractionKernel and ResolveBandKernel in one pass (RealtimeKernelOptions::
+// tile_visibility): a block of kTilePixels threads per shadow tile of rows [row0, row1) (row0
+// a multiple of kShadowTileSize, row1 one or the image's last row + 1), kTileLightGroup lights
+// at a time: their verdicts, ray counts and own flags loaded together (every load issued before
+// the first use: one memory latency a group, not three a light) into shared memory, each
+// pixel's fractions from there (SharedWindowFraction) into shared memory, then each pixel's V
+// from its neighbours' there (SharedLampFraction) added to its radiance (AddSharedVisibility),
+// the lights in order; with kMirror, then ApplyMirrorLayer (after MirrorShadeKernel). the same
+// functions on the same values in the same order as the two kernels, so the same bits; the
+// windows never leave their tile, so no neighbour is missing.
+constexpr int kTileLightGroup = 8;
+template <class Frames, bool kMirror>
+__global__ void __launch_bounds__(kTilePixels)
+    VisibilityTileKernel(Frames frames, Float3* radiance, int row0, int row1) {
+  __shared__ int8_t vis[kTileLightGroup][kTilePixels];
+  __shared__ uint8_t own[kTileLightGroup][kTilePixels];
+  __shared__ float visible[kTileLightGroup][kTilePixels], rays[kTileLightGroup][kTilePixels],
+      fraction[kTileLightGroup][kTilePixels];
+  const RealtimeFrameView& f = frames.get();
+  const FramePixel p = PixelOf(f, row0, row1);
+  const int t = static_cast<int>(threadIdx.y * blockDim.x + threadIdx.x);
+  const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  const ShadowTile tile = ShadowTileOf(p.u, p.v, f.camera.width, f.camera.height);
+  const uint32_t window = p ? f.window[p.i] : 0u;
+  Float3 L = p ? radiance[p.k] : Float3{};
+  for (int g = 0; g < f.num_lights; g += kTileLightGroup) {
+    const int lights = min(kTileLightGroup, f.num_lights - g);
+    // the group's arrays into registers (independent loads), then into shared memory; the
+    // counts of a pixel without a verdict are loaded but never read
+    int8_t w[kTileLightGroup];
+    uint8_t o[kTileLightGroup];
+    float a[kTileLightGroup], r[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      w[l] = -1;
+      o[l] = 0;
+      a[l] = r[l] = 0;
+      if (p && l < lights) {
+        const int64_t k = (g + l) * n + p.i;
+        w[l] = f.area_vis[k];
+        o[l] = f.area_own[k];
+        a[l] = f.area_visible[k];
+        r[l] = f.area_rays[k];
+      }
+    }
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      vis[l][t] = w[l];
+      own[l][t] = o[l];
+      visible[l][t] = a[l];
+      rays[l][t] = r[l];
+    }
+    __syncthreads();
+    VisibilityTaps taps[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      taps[l].vis = vis[l];
+      taps[l].visible = visible[l];
+      taps[l].rays = rays[l];
+      taps[l].fraction = fraction[l];
+      taps[l].stride = kShadowTileSize;
+      if (l < lights && w[l] >= 0 && IsExtendedLightPod(f.lights[g + l]))
+        fraction[l][t] = SharedWindowFraction(taps[l], t, window, o[l] != 0);
+    }
+    __syncthreads();
+    // the contributions of the lights with a verdict (independent loads), then the resolve in
+    // light order
+    Float3 c[kTileLightGroup];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l)
+      if (p && l < lights && w[l] >= 0) c[l] = f.area_c[(g + l) * n + p.i];
+#pragma unroll
+    for (int l = 0; l < kTileLightGroup; ++l) {
+      if (l >= lights || w[l] < 0 || !IsExtendedLightPod(f.lights[g + l])) continue;
+      const bool lamp = f.lights[g + l].kind != LightKind::kDirectional && o[l] == 0;
+      const float V =
+          SharedLampFraction(taps[l], t, window, lamp, p.u - tile.x0, p.v - tile.y0, tile);
+      L = AddSharedVisibility(L, V, c[l]);
+    }
+    // the group's arrays are read before the next group's are written
+    __syncthreads();
+  }
+  if (!p) return;
+  if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, p.u, p.v, L);
+  radiance[p.k] = L;
+}
+
+// the grid of VisibilityTileKernel over rows [row0, row1) of frames W pixels wide.
+dim3 TileGrid(int W, int row0, int row1) {
+  return dim3((W + kShadowTileSize - 1) / kShadowTileSize,
+              (row1 - row0 + kShadowTileSize - 1) / kShadowTileSize);
 }
 
 __global__ void RowSumKernel(const Float3* radiance, int width, int height, double* rows) {
@@ -685,16 +802,32 @@ struct DeviceExposure {
 };
 
 // film_math.h's FrameExposure of a frame's `height` row sums (height <= kMaxDeviceExposureRows)
-// by one block: its threads bring the rows into shared memory, one thread adds them in row order.
-__global__ void ExposureKernel(const double* rows, int height, int64_t pixels, FilmExposurePod film,
-                               Exposure gains, DeviceExposure* out) {
+// by the calling block: its threads bring the rows into shared memory (height doubles), one
+// thread adds them in row order.
+__device__ void BlockExposure(const double* rows, int height, int64_t pixels,
+                              const FilmExposurePod& film, const float gains[3],
+                              DeviceExposure* out) {
   extern __shared__ double shared_rows[];
   for (int v = threadIdx.x; v < height; v += blockDim.x) shared_rows[v] = rows[v];
   __syncthreads();
   if (threadIdx.x != 0) return;
   DeviceExposure d;
-  d.ev100 = FrameExposure(film, shared_rows, height, pixels, kMinLuminance, gains.e, d.e);
+  d.ev100 = FrameExposure(film, shared_rows, height, pixels, kMinLuminance, gains, d.e);
   *out = d;
+}
+
+__global__ void ExposureKernel(const double* rows, int height, int64_t pixels, FilmExposurePod film,
+                               Exposure gains, DeviceExposure* out) {
+  BlockExposure(rows, height, pixels, film, gains.e, out);
+}
+
+// ExposureKernel over a batch: block k makes camera k's exposure from its rows (camera-major,
+// `height` each) with its own film.
+__global__ void BatchExposureKernel(const double* rows, int height, int64_t pixels,
+                                    const RealtimeBatchFilm* film, DeviceExposure* out) {
+  const int k = blockIdx.x;
+  BlockExposure(rows + static_cast<int64_t>(k) * height, height, pixels, film[k].exposure,
+                film[k].white_balance_gains, out + k);
 }
 
 // ExposureKernel on `stream`: the exposure of the `height` row sums at `rows` into `out`.
@@ -722,14 +855,17 @@ __global__ void DevelopDeviceExposureKernel(const Float3* radiance, int64_t n,
   DevelopPixel(radiance[i], e, filmic != 0, lut, rgb + 3 * i);
 }
 
-// DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film.
+// DevelopKernel over a batch: camera blockIdx.y's n pixels with its own film and the exposure
+// the device computed (BatchExposureKernel).
 __global__ void BatchDevelopKernel(const Float3* radiance, int64_t n, const RealtimeBatchFilm* film,
-                                   uint8_t* rgb) {
+                                   const DeviceExposure* exposure, uint8_t* rgb) {
   const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
   if (i >= n) return;
   const RealtimeBatchFilm& c = film[blockIdx.y];
+  const DeviceExposure& x = exposure[blockIdx.y];
+  const float e[3] = {x.e[0], x.e[1], x.e[2]};
   const int64_t k = static_cast<int64_t>(blockIdx.y) * n + i;
-  DevelopPixel(radiance[k], c.exposure, c.filmic != 0, c.lut, rgb + 3 * k);
+  DevelopPixel(radiance[k], e, c.filmic != 0, c.lut, rgb + 3 * k);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -771,7 +907,7 @@ struct PixelBuffers {
     area_rays.Reserve(sizeof(float) * nl);
     area_own.Reserve(sizeof(uint8_t) * nl);
     area_fraction.Reserve(sizeof(float) * nl);
-    penumbra_queue.Reserve(sizeof(PenumbraChunk) * PenumbraQueueCapacity(nl));
+    penumbra_queue.Reserve(sizeof(PenumbraChunk) * PenumbraQueueCapacity(nl, 1));
     penumbra_queued.Reserve(sizeof(unsigned long long));
     penumbra_counts.Reserve(sizeof(uint32_t) * nl);
     if (mirror) {
@@ -781,22 +917,34 @@ struct PixelBuffers {
       mirror_radiance.Reserve(sizeof(Float3) * n);
     }
   }
-  // the penumbra rays of `cameras` frames (grid: their pixels, z the camera) of nl per-light
-  // entries each on `stream`: spread over each warp's lanes (VisibilityRaysWarpKernel), the
-  // long jobs through the queue (VisibilityChunkKernel) if `queue`.
+  // the penumbra rays of `cameras` frames of W x H pixels, at most `lights` lights and nl
+  // per-light entries each on `stream`: spread over each warp's lanes (VisibilityRaysWarpKernel),
+  // the long jobs through the queue (VisibilityChunkKernel) in chunks of `chunk_rays` rays if
+  // `queue`, a block per shadow tile with the verdicts in shared memory if `tile` (and the
+  // lights fit: kMaxTilePenumbraLights).
   template <class Frames>
-  void LaunchPenumbraRays(Frames frames, dim3 grid, int64_t nl, int cameras, bool queue,
-                          cudaStream_t stream) const {
+  void LaunchPenumbraRays(Frames frames, int W, int H, int lights, int64_t nl, int cameras,
+                          bool queue, int chunk_rays, bool tile, cudaStream_t stream) const {
     PenumbraQueue q;
     if (queue) {
       q.queue = penumbra_queue.as<PenumbraChunk>();
       q.queued = penumbra_queued.as<unsigned long long>();
-      q.capacity = PenumbraQueueCapacity(nl * cameras);
+      q.chunk_rays = std::clamp(chunk_rays, 1, kMaxPenumbraChunkRays);
+      q.capacity = PenumbraQueueCapacity(nl * cameras, q.chunk_rays);
       q.counts = penumbra_counts.as<uint32_t>();
       q.nl = nl;
       Check(cudaMemsetAsync(q.queued, 0, sizeof(unsigned long long), stream), "cudaMemsetAsync");
     }
-    VisibilityRaysWarpKernel<<<grid, kPixelBlock, 0, stream>>>(frames, q);
+    if (tile && lights <= kMaxTilePenumbraLights) {
+      dim3 grid = TileGrid(W, 0, H);
+      grid.z = cameras;
+      VisibilityRaysWarpKernel<Frames, true>
+          <<<grid, kTileBlock, TilePenumbraBytes(lights), stream>>>(frames, q);
+    } else {
+      dim3 grid = PixelGrid(W, H);
+      grid.z = cameras;
+      VisibilityRaysWarpKernel<Frames, false><<<grid, kPixelBlock, 0, stream>>>(frames, q);
+    }
     Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
     if (!queue) return;
     // one wave of resident blocks strides over the chunks (their number stays on the device)
@@ -1219,10 +1367,12 @@ struct DeviceRealtime::Impl : PixelBuffers {
       }
     }
   }
-  // row k of the radiance's `bands` bands of rows (Render's output bands) of a frame H rows high
+  // row k of the radiance's `bands` bands of rows (Render's output bands) of a frame H rows high:
+  // whole shadow tiles (VisibilityTileKernel resolves a tile at a time)
   static int OutputBandRow(int H, int bands, int k) {
     const int rows = (H + bands - 1) / bands;
-    return std::min(H, k * rows);
+    const int tiles = (rows + kShadowTileSize - 1) / kShadowTileSize;
+    return std::min(H, k * tiles * kShadowTileSize);
   }
   // the shading kernel of rows [row0, row1) of frame f on `stream` as `o` says.
   void LaunchShade(const RealtimeFrameView& f, const RealtimeKernelOptions& o, cudaStream_t stream,
@@ -1317,14 +1467,18 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const int W = f.camera.width, H = f.camera.height;
     const dim3 grid = PixelGrid(W, H);
     if (o.warp_penumbra || o.queue_penumbra) {
-      LaunchPenumbraRays(OneFrame{f}, grid, static_cast<int64_t>(W) * H * f.num_lights, 1,
-                         o.queue_penumbra, stream);
+      LaunchPenumbraRays(OneFrame{f}, W, H, f.num_lights,
+                         static_cast<int64_t>(W) * H * f.num_lights, 1, o.queue_penumbra,
+                         o.penumbra_chunk_rays, o.tile_penumbra, stream);
     } else {
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
       Check(cudaGetLastError(), "VisibilityRaysKernel");
     }
-    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
-    Check(cudaGetLastError(), "VisibilityFractionKernel");
+    // tile_visibility: the fraction in the resolve's kernel
+    if (!o.tile_visibility) {
+      VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f});
+      Check(cudaGetLastError(), "VisibilityFractionKernel");
+    }
     const bool mirror = f.any_mirror != 0;
     const bool fork = ForkMirror(f, o);
     if (o.fuse_resolve) {
@@ -1339,20 +1493,27 @@ struct DeviceRealtime::Impl : PixelBuffers {
       const int bands = after ? 1 : std::clamp(o.output_bands, 1, kMaxSkyBands);
       for (int k = 0; k < bands; ++k) {
         const int r0 = OutputBandRow(H, bands, k), r1 = OutputBandRow(H, bands, k + 1);
+        // tile_visibility: the fraction too, a block per shadow tile of the band
+        void (*kernel)(OneFrame, Float3*, int, int) =
+            o.tile_visibility
+                ? (mirror ? VisibilityTileKernel<OneFrame, true>
+                          : VisibilityTileKernel<OneFrame, false>)
+                : (mirror ? ResolveBandKernel<OneFrame, true> : ResolveBandKernel<OneFrame, false>);
         if (r1 > r0) {
-          const dim3 band = PixelGrid(W, r1 - r0);
-          if (mirror)
-            ResolveBandKernel<OneFrame, true>
-                <<<band, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>(), r0, r1);
-          else
-            ResolveBandKernel<OneFrame, false>
-                <<<band, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>(), r0, r1);
+          const dim3 band = o.tile_visibility ? TileGrid(W, r0, r1) : PixelGrid(W, r1 - r0);
+          kernel<<<band, o.tile_visibility ? kTileBlock : kPixelBlock, 0, stream>>>(
+              OneFrame{f}, radiance.as<Float3>(), r0, r1);
           Check(cudaGetLastError(), "ResolveBandKernel");
         }
         if (!after) Check(cudaEventRecord(resolved_band[k], stream), "cudaEventRecord");
       }
     } else {
-      VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, radiance.as<Float3>());
+      if (o.tile_visibility)
+        VisibilityTileKernel<OneFrame, false><<<TileGrid(W, 0, H), kTileBlock, 0, stream>>>(
+            OneFrame{f}, radiance.as<Float3>(), 0, H);
+      else
+        VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f},
+                                                                  radiance.as<Float3>());
       Check(cudaGetLastError(), "VisibilityResolveKernel");
       if (mirror) {
         if (fork) {
@@ -2001,36 +2162,12 @@ namespace {
 // the stage events of RealtimeBatch: start, then the end of each RealtimeBatchTimes stage
 constexpr int kBatchStages = 8;
 
-// a batch's exposures, made by a host function on the stream (RealtimeBatch::Launch): the row
-// sums are in rows (pinned, count x height), the films go to film (pinned) and are copied up
-// after the function returns.
-struct BatchExposureJob {
-  RealtimeBatch::ExposureFn exposure;
-  std::vector<RealtimeBatchFilm> films;
-  const double* rows = nullptr;
-  RealtimeBatchFilm* film = nullptr;
-  int height = 0;
-};
-
-void CUDART_CB RunBatchExposure(void* data) {
-  std::unique_ptr<BatchExposureJob> job(static_cast<BatchExposureJob*>(data));
-  std::vector<double> rows(job->height);
-  for (size_t k = 0; k < job->films.size(); ++k) {
-    const double* r = job->rows + k * job->height;
-    rows.assign(r, r + job->height);
-    RealtimeBatchFilm c = job->films[k];
-    job->exposure(static_cast<int>(k), rows, c.exposure);
-    job->film[k] = c;
-  }
-}
-
 }  // namespace
 
 struct RealtimeBatch::Impl : PixelBuffers {
   int width = 0, height = 0, max_cameras = 0, lights = 1, slots = 0;
   bool mirror = false;
-  Buffer frames, film, depth, rows;
-  PinnedBuffer pin_rows, pin_film;
+  Buffer frames, film, exposure, depth, rows;
   std::vector<RealtimeFrameView> host_frames;
   std::vector<std::vector<cudaEvent_t>> events;  // [slot][kBatchStages + 1]
   ~Impl() {
@@ -2045,12 +2182,14 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
     : impl_(new Impl) {
   Impl& m = *impl_;
   try {
-    if (width < 1 || height < 1 || max_cameras < 1 || max_cameras > 65535 || max_lights < 0 ||
-        slots < 1)
+    if (width < 1 || height < 1 || height > kMaxDeviceExposureRows || max_cameras < 1 ||
+        max_cameras > 65535 || max_lights < 0 || slots < 1)
       throw Error("RealtimeBatch: " + std::to_string(width) + "x" + std::to_string(height) + ", " +
                   std::to_string(max_cameras) + " cameras, " + std::to_string(max_lights) +
                   " lights, " + std::to_string(slots) +
-                  " slots; expected a size >= 1x1, 1 to 65535 cameras, lights >= 0, slots >= 1");
+                  " slots; expected a size >= 1x1 with at most " +
+                  std::to_string(kMaxDeviceExposureRows) +
+                  " rows, 1 to 65535 cameras, lights >= 0, slots >= 1");
     m.width = width;
     m.height = height;
     m.max_cameras = max_cameras;
@@ -2061,11 +2200,10 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
     const size_t nl = n * m.lights;
     m.frames.Reserve(sizeof(RealtimeFrameView) * max_cameras);
     m.film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
+    m.exposure.Reserve(sizeof(DeviceExposure) * max_cameras);
     m.depth.Reserve(sizeof(float) * n);
     m.rows.Reserve(sizeof(double) * height * max_cameras);
     m.Reserve(n, nl, /*with_surfaces=*/true, mirror);
-    m.pin_rows.Reserve(sizeof(double) * height * max_cameras);
-    m.pin_film.Reserve(sizeof(RealtimeBatchFilm) * max_cameras);
     m.events.assign(slots, std::vector<cudaEvent_t>(kBatchStages + 1, nullptr));
     for (auto& slot : m.events)
       for (cudaEvent_t& e : slot) Check(cudaEventCreate(&e), "cudaEventCreate");
@@ -2078,8 +2216,7 @@ RealtimeBatch::RealtimeBatch(int width, int height, int max_cameras, int max_lig
 RealtimeBatch::~RealtimeBatch() { delete impl_; }
 
 void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchFilm* film,
-                           int count, ExposureFn exposure, float* depth, uint8_t* rgb, int slot,
-                           void* stream_ptr) {
+                           int count, float* depth, uint8_t* rgb, int slot, void* stream_ptr) {
   Impl& m = *impl_;
   if (count < 1 || count > m.max_cameras || slot < 0 || slot >= m.slots)
     throw Error("RealtimeBatch::Launch: " + std::to_string(count) + " cameras, slot " +
@@ -2105,6 +2242,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   }
   // from pageable memory: staged before the call returns
   m.frames.Upload(m.host_frames.data(), sizeof(RealtimeFrameView) * count, stream);
+  m.film.Upload(film, sizeof(RealtimeBatchFilm) * count, stream);
   const BatchFrames fr{m.frames.as<RealtimeFrameView>()};
   cudaEvent_t* ev = m.events[slot].data();
   const auto stage = [&](int i) { Check(cudaEventRecord(ev[i], stream), "cudaEventRecord"); };
@@ -2141,11 +2279,22 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
     Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
   }
   stage(3);
-  m.LaunchPenumbraRays(fr, grid, nl, count, /*queue=*/true, stream);
-  VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
-  Check(cudaGetLastError(), "VisibilityFractionKernel (batch)");
-  VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(fr, L);
-  Check(cudaGetLastError(), "VisibilityResolveKernel (batch)");
+  // the shared visibility as a frame's with the default options, the queue's chunks of
+  // kPenumbraChunkRays rays (many cameras fill the device: fewer, longer chunks)
+  const RealtimeKernelOptions defaults;
+  m.LaunchPenumbraRays(fr, W, H, m.lights, nl, count, /*queue=*/true, kPenumbraChunkRays,
+                       defaults.tile_penumbra, stream);
+  if (defaults.tile_visibility) {
+    dim3 tiles = TileGrid(W, 0, H);
+    tiles.z = count;
+    VisibilityTileKernel<BatchFrames, false><<<tiles, kTileBlock, 0, stream>>>(fr, L, 0, H);
+    Check(cudaGetLastError(), "VisibilityTileKernel (batch)");
+  } else {
+    VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
+    Check(cudaGetLastError(), "VisibilityFractionKernel (batch)");
+    VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(fr, L);
+    Check(cudaGetLastError(), "VisibilityResolveKernel (batch)");
+  }
   stage(4);
   if (m.mirror) {
     MirrorShadeKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
@@ -2157,23 +2306,14 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   RowSumWarpKernel<<<dim3((H + 3) / 4, count), 128, 0, stream>>>(L, W, H, m.rows.as<double>());
   Check(cudaGetLastError(), "RowSumWarpKernel (batch)");
   stage(6);
-  // the exposures: row sums down, the host's Ev100 per camera, the films up
-  m.rows.Download(m.pin_rows.p, sizeof(double) * H * count, stream);
-  auto job = std::make_unique<BatchExposureJob>();
-  job->exposure = std::move(exposure);
-  job->films.assign(film, film + count);
-  job->rows = m.pin_rows.as<double>();
-  job->film = m.pin_film.as<RealtimeBatchFilm>();
-  job->height = H;
-  Check(cudaLaunchHostFunc(stream, RunBatchExposure, job.get()), "cudaLaunchHostFunc");
-  job.release();  // RunBatchExposure owns it now
-  Check(cudaMemcpyAsync(m.film.p, m.pin_film.p, sizeof(RealtimeBatchFilm) * count,
-                        cudaMemcpyHostToDevice, stream),
-        "cudaMemcpyAsync");
+  // the exposures on the device, one block a camera
+  BatchExposureKernel<<<count, 256, sizeof(double) * H, stream>>>(
+      m.rows.as<double>(), H, n, m.film.as<RealtimeBatchFilm>(), m.exposure.as<DeviceExposure>());
+  Check(cudaGetLastError(), "BatchExposureKernel");
   stage(7);
   if (rgb) {
     BatchDevelopKernel<<<dim3(static_cast<unsigned>((n + 255) / 256), count), 256, 0, stream>>>(
-        L, n, m.film.as<RealtimeBatchFilm>(), rgb);
+        L, n, m.film.as<RealtimeBatchFilm>(), m.exposure.as<DeviceExposure>(), rgb);
     Check(cudaGetLastError(), "BatchDevelopKernel");
   }
   stage(8);

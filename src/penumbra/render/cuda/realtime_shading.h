@@ -920,6 +920,33 @@ PB_HOST_DEVICE inline void AddLitLight(const RealtimeFrameView& f, int j, int64_
   *L = *L + c;
 }
 
+/// the part ShadeRealtimePoint and ShadeQueuedLights share, at the shading point sp of pixel
+/// (u, v) with sky term `sky`: sets *ambient to the ambient term (the sum's start) and
+/// f.total[pixel] to the lights' unshadowed total (UnshadowedLights into `terms`), then calls
+/// lit(j, pixel, n_pixels, c, traced, origin, wi, dist) for each light j in light order whose
+/// unshadowed contribution c (KeptLight) has a luminance > 0; traced: whether its shadow ray,
+/// ShadowRayOf(origin, wi, dist), is worth tracing (WantsShadowRay).
+template <bool kMedia, class Terms, class Lit>
+PB_HOST_DEVICE inline void ForEachLitLight(const RealtimeFrameView& f, int u, int v,
+                                           const ShadingPoint& sp, const Float3& sky, Terms& terms,
+                                           Float3* ambient, Lit&& lit) {
+  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
+  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  const ShadeSetup s = BeginShadePoint(sp, sky);
+  *ambient = s.L;
+  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
+  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
+  f.total[pixel] = total;
+  for (int j = 0; j < f.num_lights; ++j) {
+    Float3 wi;
+    float dist;
+    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
+    const float lum = pbm::Luminance709(c.x, c.y, c.z);
+    if (!(lum > 0)) continue;
+    lit(j, pixel, n_pixels, c, WantsShadowRay(f.lights[j], lum, total), s.origin, wi, dist);
+  }
+}
+
 /// ShadeRealtimeHit from the shading point sp of pixel (u, v)'s primary hit and its sky term
 /// (f.sky_term), after f.area_vis is cleared for the pixel: the ambient term, the lights and
 /// their shadow rays, each light attenuated by the frame's media where f.has_media. kMedia
@@ -932,25 +959,16 @@ template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky,
                                                 Terms& terms) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  const ShadeSetup s = BeginShadePoint(sp, sky);
-  Float3 L = s.L;
-  // one sample per light; the unshadowed total decides which shadow rays are worth tracing.
-  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
-  f.total[pixel] = total;
   // lights in order: negligible or shadowless contributions are added as they are, the others
   // after a shadow ray; those of lights with an extent wait for their neighbours' verdicts.
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
-    const float lum = pbm::Luminance709(c.x, c.y, c.z);
-    if (!(lum > 0)) continue;
-    const bool traced = WantsShadowRay(f.lights[j], lum, total);
-    const bool occluded = traced && TraceOccluded(f.scene, ShadowRayOf(s.origin, wi, dist));
-    AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
-  }
+  Float3 L;
+  ForEachLitLight<kMedia>(f, u, v, sp, sky, terms, &L,
+                          [&](int j, int64_t pixel, int64_t n_pixels, const Float3& c, bool traced,
+                              const F3& origin, const Float3& wi, float dist) {
+                            const bool occluded =
+                                traced && TraceOccluded(f.scene, ShadowRayOf(origin, wi, dist));
+                            AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
+                          });
   return L;
 }
 
@@ -1006,26 +1024,19 @@ PB_HOST_DEVICE inline Float3 ShadeQueuedLights(const RealtimeFrameView& f, int u
                                                const ShadingPoint& sp, const Float3& sky,
                                                Terms& terms, Queue& queue,
                                                QueuedLightMasks* masks) {
-  const int64_t pixel = static_cast<int64_t>(v) * f.camera.width + u;
-  const int64_t n_pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
-  const ShadeSetup s = BeginShadePoint(sp, sky);
-  const float total = UnshadowedLights<kMedia>(f, u, v, sp, s, terms);
-  f.total[pixel] = total;
   QueuedLightMasks m;
-  for (int j = 0; j < f.num_lights; ++j) {
-    Float3 wi;
-    float dist;
-    const Float3 c = KeptLight<kMedia>(f, j, u, v, sp, s, terms, &wi, &dist);
-    const float lum = pbm::Luminance709(c.x, c.y, c.z);
-    if (!(lum > 0)) continue;
-    m.lit |= 1u << j;
-    f.area_c[j * n_pixels + pixel] = c;
-    if (!WantsShadowRay(f.lights[j], lum, total)) continue;
-    m.traced |= 1u << j;
-    queue.Push(j, ShadowRayOf(s.origin, wi, dist));
-  }
+  Float3 L;
+  ForEachLitLight<kMedia>(f, u, v, sp, sky, terms, &L,
+                          [&](int j, int64_t pixel, int64_t n_pixels, const Float3& c, bool traced,
+                              const F3& origin, const Float3& wi, float dist) {
+                            m.lit |= 1u << j;
+                            f.area_c[j * n_pixels + pixel] = c;
+                            if (!traced) return;
+                            m.traced |= 1u << j;
+                            queue.Push(j, ShadowRayOf(origin, wi, dist));
+                          });
   *masks = m;
-  return s.L;
+  return L;
 }
 
 /// pass 3 of the queued shadow rays: pixel `pixel` (of n_pixels)'s radiance from the ambient
@@ -1194,8 +1205,13 @@ PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f
 /// (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility): on a
 /// tile's outer ring the pixel's own points - 1 more (f.area_own set: that pixel keeps its own
 /// fraction), else max(1, points / kLightStrata) - 1 more after its first. writes f.area_own.
+/// the window's verdicts of light j are read at vis[at + dy stride + dx] (the pixel's own at
+/// vis[at]): f.area_vis + j n with at the pixel's index and stride the image's width, or a
+/// tile's copy (the GPU's VisibilityRaysWarpKernel with tile_penumbra: shared memory).
 PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
-                                                            int v, int j, uint32_t bits) {
+                                                            int v, int j, uint32_t bits,
+                                                            const int8_t* vis_j, int64_t at,
+                                                            int64_t stride) {
   const int W = f.camera.width, H = f.camera.height;
   const int64_t n = static_cast<int64_t>(W) * H;
   const int64_t i = static_cast<int64_t>(v) * W + u;
@@ -1203,15 +1219,14 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
   PenumbraRays job;
   f.area_own[k] = 0;
   if (!IsExtendedLightPod(f.lights[j])) return job;
-  const int8_t vis = f.area_vis[k];
+  const int8_t vis = vis_j[at];
   if (vis < 0) return job;
   job.active = 1;
   job.visible = static_cast<float>(vis);
   bool seen[2] = {false, false};
   for (uint32_t b = bits; b != 0; b &= b - 1) {
     const int bit = LowestSetBit(b);
-    const int64_t ii = i + static_cast<int64_t>(bit / 5 - 2) * W + (bit % 5 - 2);
-    const int8_t w = f.area_vis[j * n + ii];
+    const int8_t w = vis_j[at + static_cast<int64_t>(bit / 5 - 2) * stride + (bit % 5 - 2)];
     if (w >= 0) seen[w] = true;
   }
   if (!(seen[0] && seen[1])) return job;
@@ -1229,6 +1244,14 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
   job.extra = own ? points : shared;
   job.own = own ? 1 : 0;
   return job;
+}
+
+/// SharedVisibilityPenumbra with the window's verdicts read from the frame's f.area_vis.
+PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
+                                                            int v, int j, uint32_t bits) {
+  const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
+  return SharedVisibilityPenumbra(f, u, v, j, bits, f.area_vis + j * n,
+                                  static_cast<int64_t>(v) * f.camera.width + u, f.camera.width);
 }
 
 /// penumbra ray r (1 <= r < job.extra) of light j (SharedVisibilityPenumbra): -1 where no ray
@@ -1270,14 +1293,19 @@ PB_HOST_DEVICE inline void CountPenumbraRays(const RealtimeFrameView& f, int j,
 /// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
 /// v)'s window mask (SharedVisibilityWindow) and, per light with an extent, its penumbra rays
 /// in order (SharedVisibilityPenumbra, PenumbraRayVerdict); f.area_visible, f.area_rays: the
-/// pixel's visible and traced rays (its own verdict included). the GPU's VisibilityRaysKernel
-/// spreads a warp's penumbra rays over its lanes and sums the same integer counts.
-PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
+/// pixel's visible and traced rays (its own verdict included). the window's verdicts of light j
+/// are read at vis + j light_stride (SharedVisibilityPenumbra's vis_j, at and stride): the
+/// frame's f.area_vis, or a tile's copy. the GPU's VisibilityRaysWarpKernel spreads a warp's
+/// penumbra rays over its lanes and sums the same integer counts.
+PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v,
+                                                const int8_t* vis, int64_t light_stride, int64_t at,
+                                                int64_t stride) {
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
   const uint32_t bits = SharedVisibilityWindow(f, u, v);
   for (int j = 0; j < f.num_lights; ++j) {
-    const PenumbraRays job = SharedVisibilityPenumbra(f, u, v, j, bits);
+    const PenumbraRays job =
+        SharedVisibilityPenumbra(f, u, v, j, bits, vis + j * light_stride, at, stride);
     if (job.active == 0) continue;
     int traced, visible;
     CountPenumbraRays(f, j, job, 1, job.extra, &traced, &visible);
@@ -1287,10 +1315,88 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
   }
 }
 
+/// SharedVisibilityRays with the window's verdicts read from the frame's f.area_vis.
+PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v) {
+  const int W = f.camera.width;
+  SharedVisibilityRays(f, u, v, f.area_vis, static_cast<int64_t>(W) * f.camera.height,
+                       static_cast<int64_t>(v) * W + u, W);
+}
+
+/// one light's shared-visibility arrays as SharedWindowFraction and SharedLampFraction read
+/// them: the pixel at `at` has its window neighbour (dx, dy) at at + dy stride + dx. the
+/// frame's arrays (f.area_* + j n, `at` the pixel's index, stride the image's width) or a
+/// shadow tile's copy (the GPU's VisibilityTileKernel: shared memory, stride kShadowTileSize).
+struct VisibilityTaps {
+  const int8_t* vis = nullptr;      ///< f.area_vis: 1 visible, 0 occluded, -1 none traced
+  const float* visible = nullptr;   ///< f.area_visible
+  const float* rays = nullptr;      ///< f.area_rays
+  const float* fraction = nullptr;  ///< f.area_fraction (SharedLampFraction)
+  int64_t stride = 0;
+};
+
+/// the fraction of visible rays at the pixel at `at` (which traced a verdict) with window mask
+/// `window`: its own (visible / rays) where `own` (a tile's outer ring in a penumbra), else the
+/// window's weighted sum of visible rays over its weighted sum of rays (ShadowWindowWeight,
+/// the window's bits in order, neighbours without a verdict left out).
+PB_HOST_DEVICE inline float SharedWindowFraction(const VisibilityTaps& t, int64_t at,
+                                                 uint32_t window, bool own) {
+  if (own) return t.visible[at] / t.rays[at];
+  float w_rays = 0, w_visible = 0;
+  for (uint32_t b = window; b != 0; b &= b - 1) {
+    const int bit = LowestSetBit(b);
+    const int dy = bit / 5 - 2, dx = bit % 5 - 2;
+    const int64_t kk = at + static_cast<int64_t>(dy) * t.stride + dx;
+    if (t.vis[kk] < 0) continue;
+    const float w = ShadowWindowWeight(dx, dy);
+    w_rays += w * t.rays[kk];
+    w_visible += w * t.visible[kk];
+  }
+  return w_visible / w_rays;
+}
+
+/// the visibility V the resolve gives the pixel at `at` (which traced a verdict), tile-local
+/// (x, y) of `tile`, window mask `window`: its fraction (SharedWindowFraction, t.fraction), for
+/// a lamp (`lamp`: not directional, and the pixel keeps no fraction of its own) the mean of
+/// the fractions of the 3x3 pixels around it in its tile that lie in its window and traced a
+/// verdict (a lamp's penumbrae are tens of pixels wide; the sun's stay as they are).
+PB_HOST_DEVICE inline float SharedLampFraction(const VisibilityTaps& t, int64_t at, uint32_t window,
+                                               bool lamp, int x, int y, const ShadowTile& tile) {
+  if (!lamp) return t.fraction[at];
+  float sum = 0;
+  int count = 0;
+  for (int yy = y - 1 < 0 ? 0 : y - 1; yy <= (y + 1 < tile.height ? y + 1 : tile.height - 1); ++yy)
+    for (int xx = x - 1 < 0 ? 0 : x - 1; xx <= (x + 1 < tile.width ? x + 1 : tile.width - 1);
+         ++xx) {
+      const int64_t kk = at + static_cast<int64_t>(yy - y) * t.stride + (xx - x);
+      if (t.vis[kk] < 0 || (window >> ShadowWindowBit(xx - x, yy - y) & 1u) == 0) continue;
+      sum += t.fraction[kk];
+      ++count;
+    }
+  return sum / static_cast<float>(count);
+}
+
+/// radiance L plus V times a light's unshadowed contribution c where V > 0 (the resolve).
+PB_HOST_DEVICE inline Float3 AddSharedVisibility(const Float3& L, float V, const Float3& c) {
+  if (!(V > 0)) return L;
+  return Float3{L.x + V * c.x, L.y + V * c.y, L.z + V * c.z};
+}
+
+/// frame f's shared-visibility arrays from entry k = j n + i on (light j at pixel i) as
+/// VisibilityTaps: pixel i's entry at 0, its neighbours around it (stride: the image's width).
+PB_HOST_DEVICE inline VisibilityTaps FrameVisibilityTaps(const RealtimeFrameView& f, int64_t k) {
+  VisibilityTaps t;
+  t.vis = f.area_vis + k;
+  t.visible = f.area_visible + k;
+  t.rays = f.area_rays + k;
+  t.fraction = f.area_fraction + k;
+  t.stride = f.camera.width;
+  return t;
+}
+
 /// the shared visibility, step 2 of 3 (after SharedVisibilityRays at every pixel): per light
 /// with an extent that pixel (u, v) traced a verdict towards, the weighted fraction of visible
 /// rays over its window (ShadowWindowWeight), or its own fraction on a tile's ring in a
-/// penumbra (f.area_fraction).
+/// penumbra (f.area_fraction; SharedWindowFraction).
 PB_HOST_DEVICE inline void SharedVisibilityFraction(const RealtimeFrameView& f, int u, int v) {
   const int W = f.camera.width;
   const int64_t n = static_cast<int64_t>(W) * f.camera.height;
@@ -1298,28 +1404,15 @@ PB_HOST_DEVICE inline void SharedVisibilityFraction(const RealtimeFrameView& f, 
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
     if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
-    if (f.area_own[k] != 0) {
-      f.area_fraction[k] = f.area_visible[k] / f.area_rays[k];
-      continue;
-    }
-    float w_rays = 0, w_visible = 0;
-    for (uint32_t b = f.window[i]; b != 0; b &= b - 1) {
-      const int bit = LowestSetBit(b);
-      const int dy = bit / 5 - 2, dx = bit % 5 - 2;
-      const int64_t kk = k + static_cast<int64_t>(dy) * W + dx;
-      if (f.area_vis[kk] < 0) continue;
-      const float w = ShadowWindowWeight(dx, dy);
-      w_rays += w * f.area_rays[kk];
-      w_visible += w * f.area_visible[kk];
-    }
-    f.area_fraction[k] = w_visible / w_rays;
+    f.area_fraction[k] =
+        SharedWindowFraction(FrameVisibilityTaps(f, k), 0, f.window[i], f.area_own[k] != 0);
   }
 }
 
 /// the shared visibility, step 3 of 3 (after SharedVisibilityFraction at every pixel): pixel
 /// (u, v)'s radiance L plus, per light with an extent, V times its unshadowed contribution, V
 /// the window's fraction, for a lamp once more averaged over the 3x3 pixels of its tile on the
-/// same surface (a lamp's penumbrae are tens of pixels wide; the sun's stay as they are).
+/// same surface (SharedLampFraction, AddSharedVisibility).
 PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f, int u, int v,
                                                      Float3 L) {
   const int W = f.camera.width, H = f.camera.height;
@@ -1330,25 +1423,9 @@ PB_HOST_DEVICE inline Float3 SharedVisibilityResolve(const RealtimeFrameView& f,
   for (int j = 0; j < f.num_lights; ++j) {
     const int64_t k = j * n + i;
     if (!IsExtendedLightPod(f.lights[j]) || f.area_vis[k] < 0) continue;
-    float V = f.area_fraction[k];
-    if (f.lights[j].kind != LightKind::kDirectional && f.area_own[k] == 0) {
-      float sum = 0;
-      int count = 0;
-      for (int yy = y - 1 < 0 ? 0 : y - 1; yy <= (y + 1 < tile.height ? y + 1 : tile.height - 1);
-           ++yy)
-        for (int xx = x - 1 < 0 ? 0 : x - 1; xx <= (x + 1 < tile.width ? x + 1 : tile.width - 1);
-             ++xx) {
-          const int64_t kk = k + static_cast<int64_t>(yy - y) * W + (xx - x);
-          if (f.area_vis[kk] < 0 || (f.window[i] >> ShadowWindowBit(xx - x, yy - y) & 1u) == 0)
-            continue;
-          sum += f.area_fraction[kk];
-          ++count;
-        }
-      V = sum / static_cast<float>(count);
-    }
-    if (!(V > 0)) continue;
-    const Float3& c = f.area_c[k];
-    L = Float3{L.x + V * c.x, L.y + V * c.y, L.z + V * c.z};
+    const bool lamp = f.lights[j].kind != LightKind::kDirectional && f.area_own[k] == 0;
+    const float V = SharedLampFraction(FrameVisibilityTaps(f, k), 0, f.window[i], lamp, x, y, tile);
+    L = AddSharedVisibility(L, V, f.area_c[k]);
   }
   return L;
 }
