@@ -35,6 +35,22 @@ PB_HOST_DEVICE inline float AddRn(float a, float b) {
   return a + b;
 #endif
 }
+// the same for doubles (the realtime splat's rays of a moving camera: Camera::GenerateRay's
+// double product).
+PB_HOST_DEVICE inline double MulRnD(double a, double b) {
+#if defined(__CUDA_ARCH__)
+  return __dmul_rn(a, b);
+#else
+  return a * b;
+#endif
+}
+PB_HOST_DEVICE inline double AddRnD(double a, double b) {
+#if defined(__CUDA_ARCH__)
+  return __dadd_rn(a, b);
+#else
+  return a + b;
+#endif
+}
 PB_HOST_DEVICE inline float SubRn(float a, float b) {
 #if defined(__CUDA_ARCH__)
   return __fsub_rn(a, b);

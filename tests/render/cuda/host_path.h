@@ -38,6 +38,8 @@ class HostPath {
 
   cuda::RealtimeFrameData& data() { return data_; }
   ThreadPool& pool() { return pool_; }
+  /// the host BVH posed for the snapshot (RenderRealtimeOnHost's).
+  const cuda::BvhScene& bvh() const { return bvh_; }
 
  private:
   const WorldSnapshot& snap_;

@@ -68,6 +68,18 @@ inline WorldFrame LoadFrameAt(const std::string& name, double t_sec, int w, int 
   return f;
 }
 
+/// gives *view a rolling shutter over a moving camera: rows read out over 30 ms while the camera
+/// moves by (0.15, 0.05, 0) m and turns by 0.25 rad about the world's z axis (camera.h's
+/// CameraMotion; the pose X_WO at the first row).
+inline void AddRollingShutter(CameraView* view) {
+  view->motion.end_sec = 0.03;
+  view->motion.line_time_sec = 0.03 / view->intrinsics.height;
+  view->motion.X_WO_end = view->X_WO;
+  view->motion.X_WO_end.translation() += Eigen::Vector3d(0.15, 0.05, 0);
+  view->motion.X_WO_end.linear() =
+      Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ()).toRotationMatrix() * view->X_WO.linear();
+}
+
 /// PSNR (dB) of two 8-bit images of one size: 10 log10(255^2 / MSE); 99 when equal.
 inline double Psnr(const ImageU8& a, const ImageU8& b) {
   if (a.data.size() != b.data.size() || a.data.empty()) return 0;

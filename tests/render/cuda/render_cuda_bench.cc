@@ -12,8 +12,11 @@
 //   - for a world with effects at 1 s (e.g. worlds/effects/flashlight.yaml), rgb+depth under
 //     them, cuda Render() (on the GPU for every effect since branch gpu12) and cpu Render();
 //     with particles also cuda Render() with the streaks splatted on the host (as before branch
-//     gpu18: RealtimeFrameData::set_device_streaks(false)) and with the device splat again, and
-//     the host's preparation of both;
+//     gpu18: RealtimeFrameData::set_device_streaks(false)), then twice the device splat with its
+//     streaks made before the kernels (as before branch gpu23: CudaRenderer::set_late_streaks
+//     (false)) and late (the default: while the GPU shades), the host's preparation of each,
+//     and the FNV-1a hashes of the rgb, depth and radiance and the EV100 of a late-streaks frame
+//     and of one with the streaks before the kernels (whether they are bit-identical);
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
@@ -76,6 +79,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <thread>
@@ -902,6 +906,7 @@ int Main(int argc, char** argv) {
           // again (drift)
           auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
           const double prep_device = g->last_prepare_ms();
+          const double late_ms = g->last_late_streaks_ms();
           const int streaks = g->realtime_frame().splat_streaks().View().num;
           g->realtime_frame().set_device_streaks(false);
           const double host_fps = 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get());
@@ -910,13 +915,66 @@ int Main(int argc, char** argv) {
           g->realtime_frame().set_device_streaks(true);
           rows.push_back({name, size, "rgb+depth realtime + effects, streaks splatted on the host",
                           "cuda", "Render()", host_fps});
-          rows.push_back({name, size, "rgb+depth realtime + effects (on GPU), again", "cuda",
-                          "Render()", 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+          // the device splat's streaks made before any device work (as before branch gpu23:
+          // CudaRenderer::set_late_streaks(false)) against late (the default: the drops culled
+          // while the GPU shades), interleaved, and the images of both
+          const auto serial_late = [&](const char* again) {
+            g->set_late_streaks(false);
+            rows.push_back({name, size,
+                            fmt::format("rgb+depth realtime + effects (on GPU), streaks made "
+                                        "before the kernels{}",
+                                        again),
+                            "cuda", "Render()",
+                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+            g->set_late_streaks(true);
+            rows.push_back(
+                {name, size,
+                 fmt::format("rgb+depth realtime + effects (on GPU), late streaks{}", again),
+                 "cuda", "Render()", 1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+          };
+          serial_late("");
+          const double prep_serial = [&] {
+            g->set_late_streaks(false);
+            RenderedFrame f;
+            gpu->Render(snap, fx.get(), rgb, &f);
+            g->set_late_streaks(true);
+            return g->last_prepare_ms();
+          }();
+          serial_late(", again");
           builds.push_back(fmt::format(
               "{} {}: particles: {} streaks after the host's culling, {} streak pixels; host "
-              "preparation {:.2f} ms a frame with the device splat, {:.2f} ms with the host splat "
-              "(CudaRenderer::last_prepare_ms of the last timed frame)",
-              name, size, streaks, host_pixels, prep_device, prep_host));
+              "preparation {:.2f} ms a frame with the device splat (late streaks: before the "
+              "kernels, and {:.2f} ms making the streaks while the GPU works; {:.2f} ms with the "
+              "streaks made before the kernels), {:.2f} ms with the host splat "
+              "(CudaRenderer::last_prepare_ms and last_late_streaks_ms of the last timed frame)",
+              name, size, streaks, host_pixels, prep_device, late_ms, prep_serial, prep_host));
+          // every output of a late-streaks frame and of a serial one, to the bit
+          RenderedFrame late_frame, serial_frame;
+          gpu->Render(snap, fx.get(), rgb, &late_frame);
+          g->set_late_streaks(false);
+          gpu->Render(snap, fx.get(), rgb, &serial_frame);
+          g->set_late_streaks(true);
+          const auto bytes = [](const auto& v) {
+            return std::string_view(reinterpret_cast<const char*>(v.data()),
+                                    sizeof(v[0]) * v.size());
+          };
+          for (const auto& [what, f] :
+               {std::pair<const char*, const RenderedFrame*>{"late streaks", &late_frame},
+                {"streaks before the kernels", &serial_frame}})
+            builds.push_back(fmt::format(
+                "{} {}: effects frame, {}: FNV-1a of rgb / depth / radiance {:016x} / {:016x} / "
+                "{:016x}, EV100 {:.17g}",
+                name, size, what, Fnv1a64(bytes(f->rgb.data)), Fnv1a64(bytes(f->depth_m.data)),
+                Fnv1a64(bytes(f->radiance.data)), f->ev100));
+          const bool same =
+              late_frame.rgb.data == serial_frame.rgb.data &&
+              late_frame.depth_m.data == serial_frame.depth_m.data &&
+              late_frame.radiance.data == serial_frame.radiance.data &&
+              std::memcmp(&late_frame.ev100, &serial_frame.ev100, sizeof(double)) == 0;
+          builds.push_back(
+              fmt::format("{} {}: late streaks and streaks before the kernels "
+                          "bit-identical (rgb, depth, radiance, EV100): {}",
+                          name, size, same ? "yes" : "NO"));
         }
         if (!fx->homogeneous_media.empty() || !fx->grid_media.empty())
           builds.push_back(fmt::format(

@@ -360,13 +360,28 @@ class DeviceRealtime {
   /// host exposure: the EV100 from the rows' log-luminance sums, and the per-channel exposures.
   using ExposureFn = std::function<double(const std::vector<double>& rows, float exposure[3])>;
 
+  /// the late streaks (Render's `streaks`, branch gpu23): sets the particle streak fields of
+  /// *frame (streaks and num_streaks, splat: host arrays that stay valid until Render returns;
+  /// RealtimeFrameData::StreakFields) and leaves the rest alone. called on Render's thread once
+  /// every kernel before the streaks' is queued, so the host makes the streaks while the GPU
+  /// traces and shades the frame.
+  using StreaksFn = std::function<void(RealtimeFrameView* frame)>;
+
   /// renders one frame of `frame` (host pointers for its geoms and lights; the scene arrays,
   /// materials and textures are replaced by the device copies of `scene` and Upload) with
   /// `num_geoms` geoms; returns the EV100 (`exposure`'s, the host's). `film`: the tone map, and
   /// the exposure's settings for the device (which must make what `exposure` makes).
+  /// `streaks` (may be empty): the frame's particle streaks are made late, and replace
+  /// `frame`'s (which should have none): Render queues the geoms' and lights' upload, the media
+  /// volumes and the geometry, sky-term and shading kernels (none of which reads the streaks),
+  /// then calls it, then uploads its streaks through page-locked staging (so the host does not
+  /// wait for the busy stream) and queues the splat (StreakSplatKernel, StreakShadeKernel) and
+  /// the rest (shared visibility, media view pass and streaks drawn over the radiance, row sums,
+  /// exposure, film): the same kernels on the same data as without it, where the splat runs
+  /// first, so the same bits. if it throws, Render waits for the queued work and rethrows.
   double Render(DeviceScene* scene, const RealtimeFrameView& frame, int64_t num_geoms,
                 const RealtimeFilm& film, const SkyFn& sky, const ExposureFn& exposure,
-                const RealtimeOutputs& out);
+                const RealtimeOutputs& out, const StreaksFn& streaks = StreaksFn());
 
   /// `count` runs of the frame's device work as Render left it (geometry, shading, row sums
   /// and film kernels; the sky terms and exposure of the last Render, no copies), timed with

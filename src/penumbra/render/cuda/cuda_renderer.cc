@@ -99,7 +99,12 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   // the camera's ray tables were Prepared by Render (camera_rays_): not computed again; the
   // media volumes' shadow rays on the GPU, over the BVH Render posed
   if (!media_query_) media_query_ = std::make_unique<CudaRayQuery>(*bvh_, device_.get());
-  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get());
+  // late streaks: the drops culled while the GPU traces and shades (set_late_streaks)
+  const bool late = late_streaks_ && realtime_->device_streaks() && effects != nullptr &&
+                    !effects->empty() && !effects->particles.empty();
+  late_streaks_ms_ = 0;
+  realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),
+                     /*streaks=*/!late);
   UploadRealtime();
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
@@ -131,7 +136,20 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);
       },
-      o);
+      o, late ? LateStreaks(snapshot, effects, view) : DeviceRealtime::StreaksFn());
+}
+
+DeviceRealtime::StreaksFn CudaRenderer::LateStreaks(const WorldSnapshot& snapshot,
+                                                    const EffectsFrame* effects,
+                                                    const CameraView& view) {
+  return [this, &snapshot, effects, &view](RealtimeFrameView* f) {
+    const auto ts = std::chrono::steady_clock::now();
+    const Camera camera(view.X_WO, view.intrinsics, view.motion);
+    realtime_->PrepareStreaks(snapshot, effects, camera, view, pool_.get());
+    realtime_->StreakFields(f);
+    late_streaks_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count();
+  };
 }
 
 void CudaRenderer::UploadRealtime() {

@@ -63,10 +63,22 @@ class CudaRenderer final : public Renderer {
   void set_radiance_output(bool on) { radiance_output_ = on; }
   bool radiance_output() const { return radiance_output_; }
 
+  /// whether a realtime rgb frame with particles whose streaks the frame splats itself
+  /// (RealtimeFrameData::device_streaks, the default) makes its streaks late (default true,
+  /// branch gpu23): Render prepares the frame without them (RealtimeFrameData::Prepare's
+  /// `streaks` false), queues the device's work up to the shading, and culls the drops
+  /// (RealtimeFrameData::PrepareStreaks: ParticleStreaks::Build) while the GPU traces and shades
+  /// (DeviceRealtime::Render's `streaks`); off, the streaks are made in Prepare, before any
+  /// device work (as before). both give the same bits (the same kernels on the same data).
+  void set_late_streaks(bool on) { late_streaks_ = on; }
+  bool late_streaks() const { return late_streaks_; }
   /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
   /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
-  /// upload (benchmarks).
+  /// upload (benchmarks); with late streaks without them (last_late_streaks_ms).
   double last_prepare_ms() const { return prepare_ms_; }
+  /// host milliseconds the last realtime rgb frame spent making its late streaks while the GPU
+  /// worked (RealtimeFrameData::PrepareStreaks; 0 without late streaks; benchmarks).
+  double last_late_streaks_ms() const { return late_streaks_ms_; }
 
   /// the GPU's pinhole form of `view` (without the ray tables a camera with lens distortion or
   /// motion needs: Render adds them, camera_rays.h).
@@ -79,6 +91,12 @@ class CudaRenderer final : public Renderer {
   void RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
                  const PinholeCamera& camera, std::chrono::steady_clock::time_point t0,
                  RenderedFrame* out);
+  // the late streaks of a realtime frame (set_late_streaks): PrepareStreaks of the frame's
+  // `snapshot`, `effects` and `view` (referenced: they outlive the Render that calls it), then
+  // their fields into the device's frame (RealtimeFrameData::StreakFields); times itself
+  // (last_late_streaks_ms).
+  DeviceRealtime::StreaksFn LateStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
+                                        const CameraView& view);
   // the pathtraced tier's rgb, radiance and depth: the paths on the GPU (cuda_path.h), the
   // denoiser and film on the host (path_frame.h's FinishPathFrame).
   // `camera`: the view's camera with its ray tables on the device (Render's).
@@ -118,6 +136,8 @@ class CudaRenderer final : public Renderer {
   bool sky_uploaded_ = false;
   uint64_t sky_generation_ = 0;
   double prepare_ms_ = 0;
+  double late_streaks_ms_ = 0;
+  bool late_streaks_ = true;
   bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;
 };

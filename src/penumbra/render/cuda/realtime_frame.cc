@@ -128,7 +128,8 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
 
 void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView& view,
                                 ThreadPool* pool, const EffectsFrame* effects,
-                                const CameraRayTables* rays, const RayQuery* media_rays) {
+                                const CameraRayTables* rays, const RayQuery* media_rays,
+                                bool streaks) {
   PoseWorld(snapshot, pool, effects);
   const Camera camera(view.X_WO, view.intrinsics, view.motion);
   if (rays == nullptr) {
@@ -138,8 +139,17 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
   SetCamera(rays->Point(PinholeCameraOf(view), rays->xy().data(), rays->rows().data()),
             camera.pixel_spread_rad(), view.camera_index, view.frame_index,
             view.white_balance_gains);
-  PrepareStreaks(snapshot, effects, camera, view, pool);
+  if (streaks)
+    PrepareStreaks(snapshot, effects, camera, view, pool);
+  else
+    ClearStreaks();
   PrepareMedia(snapshot, effects, camera, view, pool, media_rays);
+}
+
+void RealtimeFrameData::ClearStreaks() {
+  streaks_.clear();
+  path_streaks_.Clear();
+  splat_streaks_.Clear();
 }
 
 void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
@@ -178,9 +188,7 @@ void RealtimeFrameData::BuildMediaScene(const EffectsFrame* fx) {
 void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                                        const Camera& camera, const CameraView& view,
                                        ThreadPool* pool) {
-  streaks_.clear();
-  path_streaks_.Clear();
-  splat_streaks_.Clear();
+  ClearStreaks();
   const EffectsFrame* fx = effects != nullptr && !effects->empty() ? effects : nullptr;
   if (fx == nullptr || fx->particles.empty()) {
     particles_.Build(nullptr, camera, 0, StreakRays::kAny);
@@ -216,6 +224,22 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
     splat_camera_.fy = k.fy;
     splat_camera_.cx = k.cx;
     splat_camera_.cy = k.cy;
+    // a moving camera without lens distortion: every row's pose in double, as the CPU's rays
+    // take it (SplatRay)
+    splat_camera_.rows = nullptr;
+    if (camera.motion().moving() && !k.has_distortion()) {
+      const int H = camera.height();
+      splat_rows_.resize(12 * static_cast<size_t>(H));
+      for (int v = 0; v < H; ++v) {
+        const Pose X = camera.PoseAtRow(v);
+        double* r = &splat_rows_[12 * static_cast<size_t>(v)];
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) r[3 * i + j] = X.linear()(i, j);
+          r[9 + i] = X.translation()(i);
+        }
+      }
+      splat_camera_.rows = splat_rows_.data();
+    }
     return;
   }
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
@@ -382,18 +406,23 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   f.wetness = wetness_;
   f.volume = volume_.pod();
   f.any_mirror = any_mirror_ ? 1 : 0;
-  f.streaks = streaks_.empty() ? nullptr : streaks_.data();
-  f.num_streaks = static_cast<int64_t>(streaks_.size());
-  if (!splat_streaks_.empty()) {
-    f.splat = splat_camera_;
-    f.splat.streaks = splat_streaks_.View();
-  }
+  StreakFields(&f);
   if (media_ready_) {
     f.has_media = 1;
     f.media = media_view_;
     f.media_build = realtime_media_.device_build();
   }
   return f;
+}
+
+void RealtimeFrameData::StreakFields(RealtimeFrameView* f) const {
+  f->streaks = streaks_.empty() ? nullptr : streaks_.data();
+  f->num_streaks = static_cast<int64_t>(streaks_.size());
+  f->splat = StreakSplatView();
+  if (!splat_streaks_.empty()) {
+    f->splat = splat_camera_;
+    f->splat.streaks = splat_streaks_.View();
+  }
 }
 
 double RealtimeFrameData::Ev100(const std::vector<double>& row_sums, int64_t pixels,

@@ -62,12 +62,15 @@ class RealtimeFrameData {
   /// PrepareMedia. a camera with lens distortion or motion gets its ray tables (camera_rays.h),
   /// the camera() pointing to their host arrays: `rays` if given (the caller Prepared them for
   /// `view` and keeps them alive), else tables this object fills. `media_rays`: PrepareMedia's
-  /// shadow rays (see there).
+  /// shadow rays (see there). `streaks` false: PrepareStreaks is left out and the frame has no
+  /// streaks (those of an earlier frame are dropped) until the caller calls it, after PrepareMedia
+  /// (the same streaks: PrepareStreaks reads nothing PrepareMedia writes); CudaRenderer does so
+  /// while the GPU shades (CudaRenderer::set_late_streaks, branch gpu23).
   /// @throws ConfigError for effects out of range (a negative light or sky scale, a wetness
-  /// outside [0, 1]), as the CPU backend.
+  /// outside [0, 1]), as the CPU backend; with `streaks`, as PrepareStreaks.
   void Prepare(const WorldSnapshot& snapshot, const CameraView& view, ThreadPool* pool,
                const EffectsFrame* effects = nullptr, const CameraRayTables* rays = nullptr,
-               const RayQuery* media_rays = nullptr);
+               const RayQuery* media_rays = nullptr, bool streaks = true);
   /// the media of the frame (View's media, has_media): with homogeneous or grid media in
   /// `effects` (null or none: no media), the CPU backend's RealtimeMedia (render/
   /// media_realtime.h) built as its MediaFrame builds it, for `camera` and the frame key of
@@ -179,6 +182,12 @@ class RealtimeFrameData {
 
   /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).
   RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
+  /// sets the particle streak fields of *f (streaks and num_streaks: the host splat's pixels;
+  /// splat: the device splat's streaks, host arrays, and the camera's projection) to those of the
+  /// last PrepareStreaks (none after a Prepare without streaks), as View sets them: the late
+  /// streaks that CudaRenderer hands to DeviceRealtime::Render's `streaks`. the arrays stay
+  /// valid until the next Prepare or PrepareStreaks.
+  void StreakFields(RealtimeFrameView* f) const;
 
   /// the EV100 of a frame whose rows' log-luminance sums are `row_sums` (film.h's auto
   /// exposure on their mean, or the manual EV100), and the per-channel exposures of Develop
@@ -216,8 +225,9 @@ class RealtimeFrameData {
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   bool device_streaks_ = true;
-  PathStreakBuild splat_streaks_;  // the realtime streaks in index order (device_streaks)
-  StreakSplatView splat_camera_;   // their projection (R_OW, p_OW, intrinsics; no arrays)
+  PathStreakBuild splat_streaks_;   // the realtime streaks in index order (device_streaks)
+  StreakSplatView splat_camera_;    // their projection (R_OW, p_OW, intrinsics; rows)
+  std::vector<double> splat_rows_;  // a moving camera's row poses (StreakSplatView::rows)
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
   // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);
   // media_ready_ false until PrepareMedia built them for the frame (PoseWorld clears it)
@@ -237,6 +247,8 @@ class RealtimeFrameData {
   PinholeCamera camera_;
   CameraRayTables camera_rays_;  // Prepare's view's tables when the caller gives none
   Eigen::Vector3f white_balance_gains_ = Eigen::Vector3f::Ones();  // the prepared view's
+  // drops the streaks of an earlier frame (PrepareStreaks, and Prepare without streaks).
+  void ClearStreaks();
   // the checks of SkyTerms (n, row bounds); returns row1 resolved (< 0: the last row + 1).
   int CheckRows(const char* what, int64_t n, int row0, int row1) const;
   // the sky terms of the pixels of rows 2 q and 2 q + 1 below row1 (SkyTerms' 2x2 quads).

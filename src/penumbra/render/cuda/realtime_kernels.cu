@@ -1030,7 +1030,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // the realtime splat's streaks (shared with the pathtraced tier's upload) and per pixel its
   // StreakKeys and shaded streaks (StreakSplatView)
   StreakBuffers splat_streaks;
-  Buffer splat_nearest, splat_pixels;
+  Buffer splat_nearest, splat_pixels, splat_rows;
   double* rows = nullptr;
   DeviceExposure* exposure_out = nullptr;
   // the frame's homogeneous media (RealtimeMediaView's arrays) and the sky volume's pod
@@ -1060,8 +1060,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
   // pinned: the round trip of the geometry and sky terms, the row sums and the outputs
   PinnedBuffer pin_geometry, pin_sky, pin_rows, pin_rgb, pin_radiance, pin_depth;
   PinnedBuffer pin_mirror_geometry, pin_mirror_sky;
-  // pinned staging of the per-frame uploads (posed geoms, lights)
-  PinnedBuffer pin_geoms, pin_lights;
+  // pinned staging of the per-frame uploads (posed geoms, lights; the late streaks: the host
+  // splat's pixels, the device splat's streaks)
+  PinnedBuffer pin_geoms, pin_lights, pin_streak_pixels, pin_splat, pin_splat_rows;
   // the bytes of the geoms and lights the device holds (upload_changed_only); `uploaded`
   // false when they are not known (DeviceFrame uploaded others)
   std::vector<uint8_t> uploaded_geoms, uploaded_lights;
@@ -1563,6 +1564,51 @@ struct DeviceRealtime::Impl : PixelBuffers {
     StreakShadeKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(f);
     Check(cudaGetLastError(), "StreakShadeKernel");
   }
+  // the particle streaks of host frame h to the device on `stream`, f's streak fields pointing
+  // at them (n: the frame's pixels): the host splat's pixels (StreakKernel's), or the device
+  // splat's streaks, then their splat queued (LaunchStreakSplat). staged: through page-locked
+  // staging (the last frame's copies from it are done: it ended with a synchronisation), so
+  // that the host never waits for a busy stream (the late streaks); else from h's pageable
+  // arrays (staged by the runtime before the calls return)
+  void QueueStreaks(const RealtimeFrameView& h, RealtimeFrameView* f, int64_t n, bool staged,
+                    cudaStream_t stream) {
+    f->streaks = h.streaks;
+    f->num_streaks = h.num_streaks;
+    f->splat = h.splat;
+    if (h.num_streaks > 0) {
+      const size_t bytes = sizeof(StreakPixel) * h.num_streaks;
+      const void* src = h.streaks;
+      if (staged) {
+        pin_streak_pixels.Reserve(bytes);
+        std::memcpy(pin_streak_pixels.p, h.streaks, bytes);
+        src = pin_streak_pixels.p;
+      }
+      streaks.Upload(src, bytes, stream);
+      f->streaks = streaks.as<StreakPixel>();
+    }
+    if (h.splat.streaks.num > 0) {
+      const PathStreaks list =
+          staged ? StreakBuffers::Stage(h.splat.streaks, &pin_splat) : h.splat.streaks;
+      f->splat.streaks = splat_streaks.Upload(list, stream);
+      if (h.splat.rows != nullptr) {
+        // a moving camera's row poses (StreakSplatView::rows)
+        const size_t bytes = sizeof(double) * 12 * f->camera.height;
+        const void* src = h.splat.rows;
+        if (staged) {
+          pin_splat_rows.Reserve(bytes);
+          std::memcpy(pin_splat_rows.p, h.splat.rows, bytes);
+          src = pin_splat_rows.p;
+        }
+        splat_rows.Upload(src, bytes, stream);
+        f->splat.rows = splat_rows.as<double>();
+      }
+      splat_nearest.Reserve(sizeof(unsigned long long) * n);
+      splat_pixels.Reserve(sizeof(StreakPixel) * n);
+      f->splat.nearest = splat_nearest.as<unsigned long long>();
+      f->splat.pixels = splat_pixels.as<StreakPixel>();
+      LaunchStreakSplat(*f, stream);
+    }
+  }
   // f's scene-wide arrays: the device copies of Upload, UploadSky and the posed geoms and lights
   void WithDeviceArrays(RealtimeFrameView* f) const {
     f->materials = materials.as<MaterialPod>();
@@ -1705,7 +1751,8 @@ const uint8_t* DeviceRealtime::device_lut() const { return impl_->lut.as<uint8_t
 
 double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_frame,
                               int64_t num_geoms, const RealtimeFilm& film, const SkyFn& sky,
-                              const ExposureFn& exposure, const RealtimeOutputs& out) {
+                              const ExposureFn& exposure, const RealtimeOutputs& out,
+                              const StreaksFn& streaks) {
   Impl& m = *impl_;
   const RealtimeKernelOptions o = m.options;
   const auto t0 = Clock::now();
@@ -1758,20 +1805,12 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   f.scene = scene->device_view();
   m.WithDeviceArrays(&f);
   m.Point(&f, 0, 0, mirror);
-  if (f.num_streaks > 0) {
-    // the streaks found and shaded on the host (from pageable memory: staged before it returns)
-    m.streaks.Upload(host_frame.streaks, sizeof(StreakPixel) * f.num_streaks, stream);
-    f.streaks = m.streaks.as<StreakPixel>();
-  }
-  if (f.splat.streaks.num > 0) {
-    // the streaks the host culled (pageable: staged before it returns), then the splat
-    f.splat.streaks = m.splat_streaks.Upload(host_frame.splat.streaks, stream);
-    m.splat_nearest.Reserve(sizeof(unsigned long long) * n);
-    m.splat_pixels.Reserve(sizeof(StreakPixel) * n);
-    f.splat.nearest = m.splat_nearest.as<unsigned long long>();
-    f.splat.pixels = m.splat_pixels.as<StreakPixel>();
-    m.LaunchStreakSplat(f, stream);
-  }
+  // the particle streaks: the frame's now (the host splat's pixels, or the streaks the host
+  // culled and their splat, first), or late (`streaks`: none until the shading is queued)
+  if (streaks)
+    m.QueueStreaks(RealtimeFrameView(), &f, n, /*staged=*/false, stream);
+  else
+    m.QueueStreaks(host_frame, &f, n, /*staged=*/false, stream);
   if (f.has_media != 0) {
     m.UploadMedia(host_frame.media, &f.media, stream);
     m.BuildGridMedia(host_frame.media, &f, stream);
@@ -1881,6 +1920,20 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
     m.LaunchShade(f, o, stream, r0, r1);
   }
   if (o.device_sky) m.LaunchShade(f, o, stream, 0, H);
+  if (streaks) {
+    // the late streaks: made on the host while the GPU runs the kernels queued so far (none of
+    // which reads them), then uploaded (staged: the stream is busy) and splatted before the
+    // kernels that draw them (the media's view pass or StreakSplatApplyKernel); on a throw the
+    // queued work is waited for (the next frame reuses its pinned buffers)
+    RealtimeFrameView late;
+    try {
+      streaks(&late);
+    } catch (...) {
+      cudaDeviceSynchronize();
+      throw;
+    }
+    m.QueueStreaks(late, &f, n, /*staged=*/o.pinned, stream);
+  }
   // the shared visibility, the mirror layer and (4) the rows' log-luminance sums; pinned: the
   // radiance goes back on the copy stream while the host computes the exposure and the film
   // kernel runs

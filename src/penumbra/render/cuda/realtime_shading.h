@@ -142,6 +142,12 @@ struct StreakSplatView {
   float R_OW[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   Float3 p_OW{0, 0, 0};
   double fx = 1, fy = 1, cx = 0, cy = 0;
+  /// a moving camera without lens distortion: per row v (height of them, 12 doubles each) the
+  /// pose the CPU's rays take (Camera::PoseAtRow(v)): the rotation R_WO row-major, then the
+  /// origin (m); the splat's rays are then Camera::GenerateRay's to the bit (SplatRay). null:
+  /// the frame's camera rays (PrimaryRay<true>; a moving camera with lens distortion takes its
+  /// float tables, whose rays may differ from the CPU's in their last bits).
+  const double* rows = nullptr;
   /// per pixel (row-major, width x height): the nearest streak's StreakKey (kNoStreakKey: none;
   /// all kNoStreakKey before the splat) and, where it has one, the shaded streak
   /// (ShadeSplatPixel). arrays of the memory the reader runs in (device, or host for
@@ -1644,6 +1650,29 @@ PB_HOST_DEVICE inline StreakProjection SplatProjection(const RealtimeFrameView& 
   return ProjectStreak(ao, bo, s.r, sp.fx, sp.fy, sp.cx, sp.cy, f.camera.width, f.camera.height);
 }
 
+/// the ray of pixel (u, v) that the splat tests and shades (origin and direction as the CPU's
+/// Camera::GenerateRay, which ParticleStreaks' host splat traces): with f.splat.rows (a moving
+/// camera without lens distortion) the row's double pose times the pixel's double coordinates
+/// ((u - cx) / fx, (v - cy) / fy, 1), each product and sum rounded on its own (MulRnD, AddRnD:
+/// Eigen's order), then rounded to float, and the row's origin; else PrimaryRay<true>.
+PB_HOST_DEVICE inline TraceRay SplatRay(const RealtimeFrameView& f, int u, int v) {
+  if (f.splat.rows == nullptr) return PrimaryRay<true>(f.camera, u, v);
+  const StreakSplatView& sp = f.splat;
+  const double* r = sp.rows + 12 * static_cast<int64_t>(v);
+  const double x = (static_cast<double>(u) - sp.cx) / sp.fx;
+  const double y = (static_cast<double>(v) - sp.cy) / sp.fy;
+  float d[3];
+  for (int i = 0; i < 3; ++i)
+    d[i] = static_cast<float>(
+        AddRnD(AddRnD(MulRnD(r[3 * i], x), MulRnD(r[3 * i + 1], y)), MulRnD(r[3 * i + 2], 1.0)));
+  TraceRay ray;
+  ray.o = F3{static_cast<float>(r[9]), static_cast<float>(r[10]), static_cast<float>(r[11])};
+  ray.d = F3{d[0], d[1], d[2]};
+  ray.tmin = f.camera.near;
+  ray.tmax = INFINITY;
+  return ray;
+}
+
 /// keeps the smaller of *slot and key: atomicMin on the device (the keys of many streaks meet
 /// there; an integer minimum, so the result does not depend on their order), a plain minimum
 /// on the host (RenderRealtimeOnHost splats one streak at a time).
@@ -1656,10 +1685,10 @@ PB_HOST_DEVICE inline void KeepNearestStreak(unsigned long long* slot, unsigned 
 }
 
 /// splat streak k (projection p, SplatProjection) on row v (inside p's box): every pixel of
-/// StreakRowColumns whose pixel-centre ray (PrimaryRay) meets the capsule (IntersectCapsuleRay,
+/// StreakRowColumns whose pixel-centre ray (SplatRay) meets the capsule (IntersectCapsuleRay,
 /// with the row's ray origin) keeps StreakKey(t, k) in f.splat.nearest if it is smaller, as
 /// ParticleStreaks::BuildPixelHits for the CPU's pixel rays: every product and sum of the rays,
-/// the projection and the capsule test rounded on its own (PrimaryRay<true>, MulRn, AddRn), so
+/// the projection and the capsule test rounded on its own (SplatRay, MulRn, AddRn), so
 /// the device finds the CPU's pixels and t to the bit.
 PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
                                           const StreakProjection& p, int v) {
@@ -1668,10 +1697,10 @@ PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
   if (c0 > c1) return;
   const StreakPod& s = f.splat.streaks.streaks[k];
   const CapsuleOrigin c =
-      MakeCapsuleOrigin(ToFloat3(PrimaryRay<true>(f.camera, c0, v).o),
-                        Float3{s.a[0], s.a[1], s.a[2]}, Float3{s.b[0], s.b[1], s.b[2]}, s.r);
+      MakeCapsuleOrigin(ToFloat3(SplatRay(f, c0, v).o), Float3{s.a[0], s.a[1], s.a[2]},
+                        Float3{s.b[0], s.b[1], s.b[2]}, s.r);
   for (int u = c0; u <= c1; ++u) {
-    const float t = IntersectCapsuleRay(c, ToFloat3(PrimaryRay<true>(f.camera, u, v).d));
+    const float t = IntersectCapsuleRay(c, ToFloat3(SplatRay(f, u, v).d));
     if (!(t > 0)) continue;
     KeepNearestStreak(&f.splat.nearest[static_cast<int64_t>(v) * f.camera.width + u],
                       static_cast<unsigned long long>(StreakKey(t, k)));
@@ -1692,7 +1721,7 @@ PB_HOST_DEVICE inline void ShadeSplatPixel(const RealtimeFrameView& f, int u, in
   const StreakPod& s = f.splat.streaks.streaks[StreakKeyIndex(key)];
   const StreakSetPod& set = f.splat.streaks.sets[s.set];
   const Float3 a{s.a[0], s.a[1], s.a[2]}, b{s.b[0], s.b[1], s.b[2]};
-  const TraceRay r = PrimaryRay<true>(f.camera, u, v);
+  const TraceRay r = SplatRay(f, u, v);
   const Float3 o = ToFloat3(r.o), d = ToFloat3(r.d);
   Float3 p, ng{0, 0, 1};
   if (set.kind == StreakKind::kRain) {

@@ -7,6 +7,8 @@
 
 #include <cuda_runtime.h>
 
+#include <cstring>
+
 #include "penumbra/render/cuda/cuda_device_buffer.h"
 #include "penumbra/render/cuda/path_streaks.h"
 
@@ -31,6 +33,33 @@ struct StreakBuffers {
     d.streaks = pods.as<StreakPod>();
     d.sets = sets.as<StreakSetPod>();
     d.rain = h.num_rain > 0 ? rain.as<Float3>() : nullptr;
+    return d;
+  }
+
+  /// h with its arrays (nodes, streaks, sets, rain) copied end to end, each 16-byte aligned,
+  /// into the page-locked *pin (grown as needed), so that an Upload of the result does not wait
+  /// for a busy stream (DeviceRealtime::Render's late streaks). *pin must not be written again
+  /// before the copies from it are done. @throws Error on a CUDA failure (cudaMallocHost).
+  static PathStreaks Stage(const PathStreaks& h, PinnedBuffer* pin) {
+    PathStreaks d = h;
+    if (h.num <= 0) return d;
+    const size_t nodes_bytes = sizeof(BvhWideNode) * h.root.num_nodes;
+    const size_t bytes[4] = {nodes_bytes, sizeof(StreakPod) * h.num,
+                             sizeof(StreakSetPod) * h.num_sets, sizeof(Float3) * h.num_rain};
+    const void* src[4] = {h.nodes, h.streaks, h.sets, h.rain};
+    size_t at[4], total = 0;
+    for (int k = 0; k < 4; ++k) {
+      at[k] = total;
+      total += (bytes[k] + 15) / 16 * 16;
+    }
+    pin->Reserve(total > 0 ? total : 1);
+    char* base = pin->as<char>();
+    for (int k = 0; k < 4; ++k)
+      if (bytes[k] > 0 && src[k] != nullptr) std::memcpy(base + at[k], src[k], bytes[k]);
+    d.nodes = h.nodes != nullptr ? reinterpret_cast<const BvhWideNode*>(base + at[0]) : nullptr;
+    d.streaks = reinterpret_cast<const StreakPod*>(base + at[1]);
+    d.sets = h.sets != nullptr ? reinterpret_cast<const StreakSetPod*>(base + at[2]) : nullptr;
+    d.rain = h.rain != nullptr ? reinterpret_cast<const Float3*>(base + at[3]) : nullptr;
     return d;
   }
 };
