@@ -1575,15 +1575,16 @@ struct DeviceRealtime::Impl : PixelBuffers {
     f->streaks = h.streaks;
     f->num_streaks = h.num_streaks;
     f->splat = h.splat;
+    // src, or (staged) its copy in *pin
+    const auto source = [staged](const void* src, size_t bytes, PinnedBuffer* pin) {
+      if (!staged) return src;
+      pin->Reserve(bytes);
+      std::memcpy(pin->p, src, bytes);
+      return static_cast<const void*>(pin->p);
+    };
     if (h.num_streaks > 0) {
       const size_t bytes = sizeof(StreakPixel) * h.num_streaks;
-      const void* src = h.streaks;
-      if (staged) {
-        pin_streak_pixels.Reserve(bytes);
-        std::memcpy(pin_streak_pixels.p, h.streaks, bytes);
-        src = pin_streak_pixels.p;
-      }
-      streaks.Upload(src, bytes, stream);
+      streaks.Upload(source(h.streaks, bytes, &pin_streak_pixels), bytes, stream);
       f->streaks = streaks.as<StreakPixel>();
     }
     if (h.splat.streaks.num > 0) {
@@ -1593,13 +1594,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
       if (h.splat.rows != nullptr) {
         // a moving camera's row poses (StreakSplatView::rows)
         const size_t bytes = sizeof(double) * 12 * f->camera.height;
-        const void* src = h.splat.rows;
-        if (staged) {
-          pin_splat_rows.Reserve(bytes);
-          std::memcpy(pin_splat_rows.p, h.splat.rows, bytes);
-          src = pin_splat_rows.p;
-        }
-        splat_rows.Upload(src, bytes, stream);
+        splat_rows.Upload(source(h.splat.rows, bytes, &pin_splat_rows), bytes, stream);
         f->splat.rows = splat_rows.as<double>();
       }
       splat_nearest.Reserve(sizeof(unsigned long long) * n);
