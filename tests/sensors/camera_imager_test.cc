@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
+#include <tuple>
+#include <vector>
 
 #include "camera_sensor_test_util.h"
 #include "penumbra/core/error.h"
@@ -185,6 +189,75 @@ TEST(CameraImagerTest, AutoExposureAdaptsWithTimeConstant) {
   const double e1 = ev_bright + (ev_dim - ev_bright) * std::exp(-0.1 / 0.5);
   EXPECT_NEAR(f1.ev100, e1, 1e-4);
   EXPECT_NEAR(f2.ev100, ev_bright + (e1 - ev_bright) * std::exp(-0.5 / 0.5), 1e-4);
+}
+
+// a real renderer that, as CudaRenderer does, leaves the radiance out when the view does not
+// want it (CameraView::want_radiance), and records what each Render was asked for.
+class RadianceOnRequest : public Renderer {
+ public:
+  explicit RadianceOnRequest(std::unique_ptr<Renderer> inner) : inner_(std::move(inner)) {}
+  void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,
+              RenderedFrame* out) override {
+    inner_->Render(snapshot, effects, view, out);
+    asked.push_back(view.want_radiance);
+    if (!view.want_radiance) out->radiance = ImageF();
+  }
+  std::vector<bool> asked;  // want_radiance of every Render, in call order
+
+ private:
+  std::unique_ptr<Renderer> inner_;
+};
+
+TEST(CameraImagerTest, WithoutKeepRadianceTheRadianceIsAskedForOnlyWhenNeeded) {
+  const SceneDescription scene = Bar(0.1);
+  const Pose X = LookingAlongX(Eigen::Vector3d::Zero());
+  const WorldSnapshot snap = Snapshot(scene, 0.0);
+  CameraSensorConfig plain;
+  CameraImager keep(Spec(64, 32, 40), plain, Realtime(), 0, scene);
+  CameraImager lean(Spec(64, 32, 40), plain, Realtime(), 0, scene);
+  lean.set_keep_radiance(false);
+  RadianceOnRequest r_keep(MakeRenderer(scene, Realtime()));
+  RadianceOnRequest r_lean(MakeRenderer(scene, Realtime()));
+  CameraImages a, b;
+  keep.Capture(&r_keep, snap, nullptr, X, nullptr, X, 0, &a);
+  lean.Capture(&r_lean, snap, nullptr, X, nullptr, X, 0, &b);
+  // the same camera images; the lean one without the radiance, which it never asked for
+  ASSERT_FALSE(a.radiance.empty());
+  EXPECT_TRUE(b.radiance.empty());
+  EXPECT_EQ(b.rgb.data, a.rgb.data);
+  EXPECT_EQ(b.ev100, a.ev100);
+  EXPECT_EQ(r_keep.asked, std::vector<bool>{true});
+  EXPECT_EQ(r_lean.asked, std::vector<bool>{false});
+  // the black-frame warning's brightest value: the kept radiance's maximum, and the same
+  // value from the frame rendered again with the radiance
+  float brightest = 0;
+  for (float v : a.radiance.data) brightest = std::max(brightest, v);
+  ASSERT_GT(brightest, 0.0f);
+  EXPECT_EQ(keep.BrightestRadiance(&r_keep, snap, nullptr, a), brightest);
+  EXPECT_EQ(lean.BrightestRadiance(&r_lean, snap, nullptr, b), brightest);
+  EXPECT_EQ(r_keep.asked.size(), 1u);  // read from the frame, no render
+  EXPECT_EQ(r_lean.asked, (std::vector<bool>{false, true}));
+
+  // the camera model's stages that read the radiance still get it
+  CameraSensorConfig noisy = plain, gray = plain, adapting = plain, blurred = plain;
+  noisy.noise.enabled = true;
+  gray.white_balance.mode = WhiteBalance::Mode::kAuto;
+  adapting.auto_exposure_time_constant_sec = 0.5;
+  blurred.motion_blur_samples = 2;
+  RenderSettings auto_exposure = Realtime();
+  auto_exposure.auto_exposure = true;
+  for (const auto& [cfg, rs, moving] :
+       {std::tuple{noisy, Realtime(), false}, std::tuple{gray, Realtime(), false},
+        std::tuple{adapting, auto_exposure, false}, std::tuple{blurred, Realtime(), true}}) {
+    CameraImager imager(Spec(64, 32, 40), cfg, rs, 0, scene);
+    imager.set_keep_radiance(false);
+    RadianceOnRequest r(MakeRenderer(scene, rs));
+    const WorldSnapshot end = Snapshot(scene, 0.1);
+    CameraImages out;
+    imager.Capture(&r, snap, nullptr, X, moving ? &end : nullptr, X, 0, &out);
+    EXPECT_FALSE(out.radiance.empty());
+    for (bool asked : r.asked) EXPECT_TRUE(asked);
+  }
 }
 
 TEST(CameraImagerTest, NoiseJpegAndDropletsAreSeededAndLocal) {

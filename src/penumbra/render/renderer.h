@@ -41,6 +41,11 @@ struct CameraView {
   /// sets them when they are known before the frame (modes daylight, kelvin) so that the
   /// renderer's rgb is the camera's and is not developed a second time.
   Eigen::Vector3f white_balance_gains = Eigen::Vector3f::Ones();
+  /// whether the caller reads RenderedFrame::radiance. false lets a renderer that develops rgb
+  /// itself leave the radiance out (CudaRenderer then skips its copy from the device, 3.7 MB at
+  /// 640x480); rgb, ev100 and every other image are the same either way. a renderer may still
+  /// fill it (the CPU backends do: they develop rgb from it). default true: always filled.
+  bool want_radiance = true;
 };
 
 /// images of one frame; the ones not requested are left empty.

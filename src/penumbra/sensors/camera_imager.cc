@@ -1,5 +1,7 @@
 #include "penumbra/sensors/camera_imager.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -132,6 +134,13 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   const Eigen::Vector3f wb_before = c.white_balance.mode == WhiteBalance::Mode::kAuto
                                         ? Eigen::Vector3f::Ones()
                                         : GainsForFrame(c.white_balance, daylight_white_, ImageF());
+  // the camera model reads the radiance for sub-frames, noise, gray world and adaptation;
+  // otherwise the renderer's developed rgb is the camera's (set_keep_radiance)
+  const bool need_radiance = keep_radiance_ || n > 1 || c.noise.enabled ||
+                             c.white_balance.mode == WhiteBalance::Mode::kAuto ||
+                             (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0);
+  truth_view_.reset();
+  truth_moving_ = moving;
   RenderedFrame sub;
   for (int k = 0; k < n; ++k) {
     const double s = (k + 0.5) * T / n;
@@ -143,6 +152,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;
     view.white_balance_gains = wb_before;
+    view.want_radiance = want_rgb && need_radiance;
     view.outputs = internal;
     if (k != truth_k) {
       view.outputs = CameraOutputs::None();
@@ -154,11 +164,12 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       view.motion.time_sec = s;
       view.motion.line_time_sec = c.rolling_shutter_line_time_sec;
     }
+    // (interp_ keeps the last sub-frame's snapshot: the ground truth's when n = 1, the only
+    // case BrightestRadiance renders again)
     const WorldSnapshot* snap = &start;
-    WorldSnapshot interp;
     if (moving) {
-      interp = InterpolateSnapshot(start, *end, s / span);
-      snap = &interp;
+      interp_ = InterpolateSnapshot(start, *end, s / span);
+      snap = &interp_;
     }
     RenderedFrame* target = k == truth_k ? &out->truth : &sub;
     const auto t0 = std::chrono::steady_clock::now();
@@ -171,6 +182,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       for (size_t i = 0; i < r.size(); ++i) accum_.data[i] += r[i];
     }
     if (k == truth_k) {
+      truth_view_ = view;
       out->mid_exposure_time_sec = moving ? start.time_sec + s : start.time_sec;
       out->X_WO =
           moving ? Camera(X_WO_start, spec_.intrinsics, view.motion).PoseAtRow(0) : X_WO_start;
@@ -183,13 +195,20 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     if (n > 1) {
       for (float& v : accum_.data) v /= static_cast<float>(n);
       out->radiance = accum_;
-    } else {
+    } else if (need_radiance) {
       out->radiance = out->truth.radiance;
+    } else {
+      out->radiance = ImageF();
     }
     const ImageF& radiance = out->radiance;
     // exposure with adaptation over sim time; one frame's metering is the renderer's (Film::Ev100
     // of this very radiance)
     const bool developed = n == 1 && !out->truth.rgb.empty();
+    if (!developed && radiance.empty())
+      throw Error(fmt::format(
+          "camera '{}': frame {}: the renderer gave neither rgb nor radiance; expected the rgb "
+          "it was asked for (CameraOutputs rgb)",
+          spec_.name, frame_index));
     double ev = developed ? out->truth.ev100 : film_.Ev100(radiance, pool_.get());
     if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
       const double dt = std::max(0.0, start.time_sec - *last_time_);
@@ -288,6 +307,29 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   } else {
     out->depth_m = out->truth.depth_m;
   }
+}
+
+double CameraImager::BrightestRadiance(Renderer* renderer, const WorldSnapshot& start,
+                                       const EffectsFrame* effects, const CameraImages& last) {
+  auto brightest = [](const ImageF& img) {
+    float b = 0;
+    for (float v : img.data)
+      if (std::isfinite(v)) b = std::max(b, v);
+    return static_cast<double>(b);
+  };
+  if (!last.radiance.empty()) return brightest(last.radiance);
+  if (!last.truth.radiance.empty()) return brightest(last.truth.radiance);
+  if (!truth_view_) return 0;
+  // the ground-truth sub-frame again, its rgb with the radiance
+  CameraView view = *truth_view_;
+  view.outputs = CameraOutputs::None();
+  view.outputs[ImageKind::kRgb] = true;
+  view.want_radiance = true;
+  RenderedFrame frame;
+  const auto t0 = std::chrono::steady_clock::now();
+  renderer->Render(truth_moving_ ? interp_ : start, effects, view, &frame);
+  renderer_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return brightest(frame.radiance);
 }
 
 }  // namespace penumbra

@@ -82,6 +82,23 @@ class CameraImager {
                const Pose& X_WO_start, const WorldSnapshot* end, const Pose& X_WO_end,
                int64_t frame_index, CameraImages* out);
 
+  /// whether Capture always fills out->radiance (default true). off, it asks the renderer for
+  /// the radiance (CameraView::want_radiance) and fills out->radiance only when the camera
+  /// model reads it: motion-blur sub-frames, sensor noise, gray-world white balance or
+  /// exposure adaptation; otherwise out->radiance is left empty and out->rgb is the
+  /// renderer's developed rgb (the same bytes as with it on). CameraSink turns it off.
+  void set_keep_radiance(bool on) { keep_radiance_ = on; }
+  bool keep_radiance() const { return keep_radiance_; }
+
+  /// the largest finite radiance value (any channel, cd/m^2) of the frame the last Capture
+  /// formed, for the black-frame warning: the maximum of out->radiance when Capture filled it,
+  /// else its ground-truth sub-frame rendered again with the radiance (the same view, snapshot
+  /// and effects; renderers keep no state between frames, so this changes no later frame).
+  /// `start` and `effects` must be the last Capture's. 0 before any Capture.
+  /// @throws Error from the renderer.
+  double BrightestRadiance(Renderer* renderer, const WorldSnapshot& start,
+                           const EffectsFrame* effects, const CameraImages& last);
+
   const CameraSpec& spec() const { return spec_; }
   const CameraSensorConfig& config() const { return config_; }
   /// wall time spent inside Renderer::Render by this imager's captures so far, s (the rest of
@@ -106,6 +123,12 @@ class CameraImager {
   std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;
   double renderer_sec_ = 0;
+  bool keep_radiance_ = true;
+  // the last Capture's ground-truth sub-frame (BrightestRadiance renders it again): its view
+  // and, for a moving camera, its interpolated snapshot
+  std::optional<CameraView> truth_view_;
+  bool truth_moving_ = false;
+  WorldSnapshot interp_;
 };
 
 /// frames per second of CameraImager::Capture for a small scene (a box room, 320 x 240, realtime

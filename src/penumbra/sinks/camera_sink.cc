@@ -40,11 +40,9 @@ bool SceneHasNoLight(const SceneDescription& scene) {
 }
 
 // the likely cause of a black frame, for the warning.
+// `brightest` is the frame's largest radiance value (CameraImager::BrightestRadiance).
 std::string BlackFrameCause(const SceneDescription& scene, const RenderSettings& render,
-                            const CameraImages& img) {
-  float brightest = 0;
-  for (float v : img.radiance.data)
-    if (std::isfinite(v)) brightest = std::max(brightest, v);
+                            const CameraImages& img, double brightest) {
   if (brightest > 0) {
     return fmt::format(
         "at exposure EV100 {:.3g} ({} exposure{}, compensation_ev {:.3g}) although its brightest "
@@ -151,6 +149,8 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
   imagers_.reserve(scene.cameras.size());
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     imagers_.emplace_back(scene.cameras[i], cfg[i], world.render, static_cast<int>(i), scene);
+    // the writer never reads the radiance: the black-frame warning asks for it
+    imagers_.back().set_keep_radiance(false);
     span_.push_back(CaptureSpanSec(scene.cameras[i], cfg[i]));
   }
   WriteCameraInfo(output_dir, CameraInfosFor(selected));
@@ -283,7 +283,9 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
     warned_black_[p.camera] = 1;
     spdlog::warn("camera '{}': frame {} (t = {:.6g} s) is black (every pixel <= {} of 255) {}",
                  spec.name, p.frame, img.mid_exposure_time_sec, kBlackLevel,
-                 BlackFrameCause(scene_, render_, img));
+                 BlackFrameCause(scene_, render_, img,
+                                 imagers_[p.camera].BrightestRadiance(renderer_, *p.start,
+                                                                      p.effects.get(), img)));
   }
   CameraFrame cf;
   cf.camera = spec.name;

@@ -1012,6 +1012,11 @@ int Main(int argc, char** argv) {
                         1 / TimeRenders(gpu.get(), snap, all, n)});
         rows.push_back({name, size, "rgb+depth realtime", "cuda", "Render()",
                         1 / TimeRenders(gpu.get(), snap, rgb, n)});
+        // as the camera sink asks: the radiance left on the device (CameraView::want_radiance)
+        CameraView sink_view = rgb;
+        sink_view.want_radiance = false;
+        rows.push_back({name, size, "rgb+depth realtime, no radiance (as the camera sink asks)",
+                        "cuda", "Render()", 1 / TimeRenders(gpu.get(), snap, sink_view, n)});
         const double rgb_ms = g->device_realtime().TimeKernels(&g->device(), n);
         rows.push_back({name, size, "rgb+depth realtime", "cuda", "kernels only", 1e3 / rgb_ms});
       }

@@ -109,7 +109,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   const PinholeCamera& c = realtime_->camera();
   const int W = c.width, H = c.height;
   const int64_t n = static_cast<int64_t>(W) * H;
-  float* radiance = Shape(&out->radiance, radiance_output_, W, H, 3);
+  float* radiance = Shape(&out->radiance, radiance_output_ && view.want_radiance, W, H, 3);
   Shape(&out->rgb, true, W, H, 3);
   RealtimeOutputs o;
   o.radiance = radiance;

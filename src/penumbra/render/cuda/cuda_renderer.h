@@ -59,7 +59,8 @@ class CudaRenderer final : public Renderer {
 
   /// whether Render fills RenderedFrame::radiance beside the rgb (default true); off, a
   /// consumer that reads only the rgb and depth saves its copy back (3.7 MB at 640x480) and
-  /// the radiance is left empty.
+  /// the radiance is left empty. a realtime frame's radiance is also left out when the view
+  /// does not want it (CameraView::want_radiance); the pathtraced tier fills it either way.
   void set_radiance_output(bool on) { radiance_output_ = on; }
   bool radiance_output() const { return radiance_output_; }
 
