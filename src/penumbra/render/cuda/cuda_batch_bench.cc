@@ -165,6 +165,9 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     for (const BatchBenchWorld& w : worlds) any = any || w.cpu;
     if (!any) continue;
     RenderedFrame f;
+    // the effects with rgb only: the ground truth does not see them (the CPU would still build
+    // the media)
+    const auto effects_of = [&](int w) { return outputs.rgb ? worlds[w].effects : nullptr; };
     const int cpu_batches = std::max(1, std::min(batches, 2048 / count));
     for (int k = 0; k < count; ++k) {
       views[k].intrinsics =
@@ -179,13 +182,13 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     }
     for (int k = 0; k < std::min(count, 4); ++k)  // warm-up
       if (Renderer* cpu = worlds[world_of[k]].cpu)
-        cpu->Render(worlds[world_of[k]].snapshot, worlds[world_of[k]].effects, views[k], &f);
+        cpu->Render(worlds[world_of[k]].snapshot, effects_of(world_of[k]), views[k], &f);
     const auto t0 = BenchClock::now();
     int rendered = 0;
     for (int b = 0; b < cpu_batches; ++b)
       for (int k = 0; k < count; ++k)
         if (Renderer* cpu = worlds[world_of[k]].cpu) {
-          cpu->Render(worlds[world_of[k]].snapshot, worlds[world_of[k]].effects, views[k], &f);
+          cpu->Render(worlds[world_of[k]].snapshot, effects_of(world_of[k]), views[k], &f);
           ++rendered;
         }
     const double s = SecondsSince(t0);

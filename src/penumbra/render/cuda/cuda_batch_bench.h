@@ -26,8 +26,8 @@ struct BatchBenchWorld {
   RenderSettings settings;
   WorldSnapshot snapshot;
   /// the effects of the snapshot (null: none; BatchRenderer::UpdateWorld's: with particles or
-  /// media, PerCameraEffects, an rgb batch renders the world's cameras alone); the CPU rows
-  /// render them too. must outlive RunBatchBench.
+  /// media, PerCameraEffects, an rgb batch renders the world's cameras alone); the CPU rows of
+  /// rgb batches render them too. must outlive RunBatchBench.
   const EffectsFrame* effects = nullptr;
   CameraView view;
   Renderer* cpu = nullptr;  ///< null: no CPU row for this world
