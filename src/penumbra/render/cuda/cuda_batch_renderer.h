@@ -121,9 +121,10 @@ class BatchRenderer {
   /// readable until ticket t + 2 is submitted. the ray tables the cameras name (CameraOf) are
   /// copied to the device with the batch. with rgb, a camera whose world's last UpdateWorld had
   /// PerCameraEffects gets its rgb and depth from that world's CudaRenderer rendering its view
-  /// (view_table) alone, while the batch's kernels run: Submit returns once those cameras are
-  /// rendered (CudaRenderer::Render blocks) and their images are queued into the batch's buffer
-  /// (before ready_event; kernel_ms counts the wait); every other camera returns at once.
+  /// (view_table) alone, while the batch's kernels run: a batch with such cameras returns once
+  /// they are rendered (CudaRenderer::Render blocks) and their images are queued into the
+  /// batch's buffer (before ready_event; kernel_ms counts the wait); a batch without them
+  /// returns at once. if one of those renders throws, Submit throws (no ticket is returned).
   /// @throws Error for bad cameras (naming the camera; a camera whose tables are another
   ///         renderer's, or whose row tables are older than a CameraOf call made after a
   ///         Submit; with rgb, a camera of a world with PerCameraEffects without a view of this
