@@ -4,8 +4,9 @@
 // two renderers render the same bits (determinism); overlapped batches keep their own images;
 // the copy modes give the same images; a ticket whose slot was reused is refused; the realtime
 // rgb of a batch (both worlds, frame keys of their own) is CudaRenderer's rgb and depth of each
-// camera alone, bit for bit, run to run. without a device every test prints "skipped: no CUDA
-// device".
+// camera alone, bit for bit, run to run, also under effects: the lighting ones, and rain, fog
+// and smoke (those worlds' cameras rendered alone, PerCameraEffects) beside a clear world.
+// without a device every test prints "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -379,7 +380,8 @@ TEST_F(BatchRendering, DistortedAndMovingCamerasTraceTheirOwnRays) {
 // a world's lighting effects (UpdateWorld's EffectsFrame: the flashlight world's flashlight and
 // light events at 1 s) reach every rgb camera of that world in a batch: the same rgb and depth
 // bytes as CudaRenderer rendering each camera alone under the same effects, and a visible change
-// from the clear frame; a frame with media is refused for rgb and taken for the ground truth.
+// from the clear frame; a frame with fog (its cameras then rendered alone) gives CudaRenderer's
+// bits under the fog too, and a frame with media is taken for the ground truth.
 TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   PB_REQUIRE_CUDA_DEVICE_FOR_BATCH();
   auto [session, snap, base, fx] =
@@ -416,14 +418,120 @@ TEST(BatchRenderingEffects, LightingEffectsEqualCudaRendererAloneBitForBit) {
   EffectsFrame fog = *fx;
   fog.homogeneous_media.emplace_back();
   fog.homogeneous_media.back().sigma_t_per_m = Eigen::Vector3f::Constant(0.1f);
-  EXPECT_THROW(r.UpdateWorld(0, snap, &fog), Error);
+  // media were refused here before branch gpu26; now that world's cameras are rendered alone
+  r.UpdateWorld(0, snap, &fog);
+  const cuda::BatchImages foggy = r.Wait(r.Submit(cams));
+  {
+    const std::unique_ptr<Renderer> single = MakeRenderer(scene, gpu_settings);
+    RenderedFrame f;
+    single->Render(snap, &fog, views[1], &f);
+    EXPECT_EQ(std::memcmp(f.rgb.data.data(), foggy.rgb(1), 3 * n), 0);
+    EXPECT_EQ(std::memcmp(f.depth_m.data.data(), foggy.depth(1), 4 * n), 0);
+    EXPECT_NE(std::memcmp(img.rgb(1), foggy.rgb(1), 3 * n), 0) << "the fog changed nothing";
+  }
   EffectsFrame smoke = *fx;
   smoke.grid_media.emplace_back();
-  EXPECT_THROW(r.UpdateWorld(0, snap, &smoke), Error);
   cuda::BatchRenderer truth(AllTruth(4));
   truth.AddWorld(scene);
   EXPECT_NO_THROW(truth.UpdateWorld(0, snap, &fog));
   EXPECT_NO_THROW(truth.UpdateWorld(0, snap, &smoke));
+}
+
+// worlds whose effects have particles or media (rain, fog, smoke plume at 1 s) beside a clear
+// world (the default room) in one rgb batch of 8 cameras (camera k in world k % 4, one of the
+// rain's with a rolling shutter): each camera's rgb and depth are CudaRenderer's rendering it
+// alone under its world's effects, bit for bit, run to run; the effects worlds' cameras were
+// rendered alone (6 of 8) and their rgb differs from the same batch without effects (the clear
+// world's does not); the ground truth (segmentation) does not see the effects; a camera of such
+// a world without a view of this renderer's CameraOf, or with one of an earlier frame, is
+// refused, a clear world's is not.
+TEST(BatchRenderingEffects, RainFogAndSmokeEqualCudaRendererAloneBitForBit) {
+  PB_REQUIRE_CUDA_DEVICE_FOR_BATCH();
+  const char* names[] = {"effects/rain.yaml", "effects/fog.yaml", "effects/smoke_plume.yaml",
+                         "default.yaml"};
+  std::vector<realtime_parity::WorldFrame> worlds;
+  for (const char* name : names)
+    worlds.push_back(realtime_parity::LoadFrameAt(name, 1.0, kBatchW, kBatchH));
+  const auto effects_of = [&](int w) -> const EffectsFrame* {
+    const EffectsFrame* fx = worlds[w].fx.get();
+    return fx != nullptr && !fx->empty() ? fx : nullptr;
+  };
+  for (int w = 0; w < 4; ++w) ASSERT_EQ(cuda::PerCameraEffects(effects_of(w)), w < 3) << names[w];
+  std::vector<CameraView> views;
+  for (int k = 0; k < 8; ++k) {
+    views.push_back(cuda::OrbitView(worlds[k % 4].view, 0.3 * (k / 4)));
+    views.back().frame_index = k;
+  }
+  realtime_parity::AddRollingShutter(&views[4]);
+  cuda::BatchConfig config = RgbOnly(8);
+  config.outputs.segmentation = true;
+  const int n = kBatchW * kBatchH;
+  std::vector<uint8_t> first;
+  for (int run = 0; run < 2; ++run) {
+    cuda::BatchRenderer r(config);
+    for (int w = 0; w < 4; ++w)
+      r.UpdateWorld(r.AddWorld(worlds[w].session->scene()), worlds[w].snap, effects_of(w));
+    std::vector<cuda::BatchCamera> cams;
+    for (int k = 0; k < 8; ++k) cams.push_back(r.CameraOf(k % 4, views[k]));
+    const int64_t t = r.Submit(cams);
+    const cuda::BatchImages img = r.Wait(t);
+    EXPECT_EQ(r.alone_cameras(t), 6);
+    EXPECT_GT(r.alone_ms(t), 0.0);
+    const std::vector<uint8_t> bytes = BatchBytes(img);
+    if (run == 1) {
+      EXPECT_TRUE(bytes == first) << "two runs of the same effects batch differ";
+      break;
+    }
+    first = bytes;
+    // the same batch without effects: the rgb of the effects worlds' cameras changes, the
+    // clear world's and every camera's segmentation do not
+    cuda::BatchRenderer clear(config);
+    for (int w = 0; w < 4; ++w)
+      clear.UpdateWorld(clear.AddWorld(worlds[w].session->scene()), worlds[w].snap);
+    std::vector<cuda::BatchCamera> clear_cams;
+    for (int k = 0; k < 8; ++k) clear_cams.push_back(clear.CameraOf(k % 4, views[k]));
+    const cuda::BatchImages plain = clear.Wait(clear.Submit(clear_cams));
+    EXPECT_EQ(clear.alone_cameras(0), 0);
+    for (int k = 0; k < 8; ++k) {
+      SCOPED_TRACE(std::string("camera ") + std::to_string(k) + " in " + names[k % 4]);
+      RenderSettings gpu_settings;
+      gpu_settings.backend = RenderSettings::Backend::kCuda;
+      const std::unique_ptr<Renderer> single =
+          MakeRenderer(worlds[k % 4].session->scene(), gpu_settings);
+      CameraView v = views[k];
+      v.outputs[ImageKind::kRgb] = v.outputs[ImageKind::kDepth] = true;
+      RenderedFrame f;
+      single->Render(worlds[k % 4].snap, effects_of(k % 4), v, &f);
+      ASSERT_EQ(f.rgb.data.size(), static_cast<size_t>(3 * n));
+      int rgb_diff = 0, depth_diff = 0, by_effects = 0;
+      for (int i = 0; i < 3 * n; ++i) {
+        rgb_diff += f.rgb.data[i] != img.rgb(k)[i];
+        by_effects += plain.rgb(k)[i] != img.rgb(k)[i];
+      }
+      for (int i = 0; i < n; ++i)
+        depth_diff += std::memcmp(&f.depth_m.data[i], img.depth(k) + i, 4) != 0;
+      std::printf(
+          "effects camera %d (%s): %d of %d rgb bytes and %d of %d depth values differ from "
+          "CudaRenderer's; %d rgb bytes differ from the batch without effects\n",
+          k, names[k % 4], rgb_diff, 3 * n, depth_diff, n, by_effects);
+      EXPECT_EQ(rgb_diff, 0);
+      EXPECT_EQ(depth_diff, 0);
+      if (k % 4 < 3)
+        EXPECT_GT(by_effects, 3 * n / 100);
+      else
+        EXPECT_EQ(by_effects, 0);
+      EXPECT_EQ(std::memcmp(plain.geom_id(k), img.geom_id(k), 4 * n), 0);
+    }
+    // the views are the renderer's: a hand-made camera of an effects world, or one of an
+    // earlier frame's CameraOf, is refused; a clear world's camera is not
+    cuda::BatchCamera hand = cams[1];
+    hand.view_table = -1;
+    EXPECT_THROW(r.Submit(std::span(&hand, 1)), Error);
+    const cuda::BatchCamera next = r.CameraOf(0, views[0]);
+    EXPECT_THROW(r.Submit(std::span(&cams[2], 1)), Error);
+    EXPECT_NO_THROW(r.Wait(r.Submit(std::span(&cams[3], 1))));
+    EXPECT_NO_THROW(r.Wait(r.Submit(std::span(&next, 1))));
+  }
 }
 
 }  // namespace

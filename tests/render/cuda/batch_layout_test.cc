@@ -2,7 +2,9 @@
 // image of each output lies in a batch's buffer, the checks of a batch's cameras (errors name
 // the camera and the field), and the ring of slots whose images stay readable; and the pixel's
 // ground truth (render/cuda/primary_pixel.h, the PB_HOST_DEVICE code the batch kernel runs)
-// run on the CPU over the default world's BvhScene against the CPU backend's images.
+// run on the CPU over the default world's BvhScene against the CPU backend's images; which
+// worlds' effects make a batch render their rgb cameras alone (PerCameraEffects: particles and
+// media, not the lighting effects).
 
 #include "penumbra/render/cuda/batch_layout.h"
 
@@ -22,6 +24,7 @@
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
+#include "realtime_parity.h"
 
 namespace penumbra {
 namespace {
@@ -234,6 +237,34 @@ TEST(BatchPixelTruth, HostRunMatchesTheCpuBackend) {
   EXPECT_LE(bad_range, 96 * 72 / 1000);
   EXPECT_LE(bad_seg, 96 * 72 / 1000);
   EXPECT_LE(bad_normal, 96 * 72 / 1000);
+}
+
+// the bundled effects worlds at 1 s: rain, fog and smoke (particles, homogeneous and grid media:
+// each camera's own streaks and froxels) make a batch render their rgb cameras alone; the
+// flashlight's lighting effects, a clear world and no effects do not; each kind alone decides.
+TEST(BatchEffects, ParticlesAndMediaAreRenderedCameraByCamera) {
+  for (const char* name : {"effects/rain.yaml", "effects/fog.yaml", "effects/smoke_plume.yaml",
+                           "effects/flashlight.yaml", "house.yaml"}) {
+    SCOPED_TRACE(name);
+    const realtime_parity::WorldFrame f = realtime_parity::LoadFrameAt(name, 1.0, 32, 24);
+    const std::string n = name;
+    const bool per_camera = n.find("rain") != std::string::npos ||
+                            n.find("fog") != std::string::npos ||
+                            n.find("smoke") != std::string::npos;
+    EXPECT_EQ(cuda::PerCameraEffects(f.fx.get()), per_camera);
+  }
+  EXPECT_FALSE(cuda::PerCameraEffects(nullptr));
+  EffectsFrame fx;
+  fx.extra_lights.emplace_back();
+  fx.surface_wetness = 0.5f;
+  EXPECT_FALSE(cuda::PerCameraEffects(&fx));
+  EffectsFrame rain = fx, fog = fx, smoke = fx;
+  rain.particles.emplace_back();
+  fog.homogeneous_media.emplace_back();
+  smoke.grid_media.emplace_back();
+  EXPECT_TRUE(cuda::PerCameraEffects(&rain));
+  EXPECT_TRUE(cuda::PerCameraEffects(&fog));
+  EXPECT_TRUE(cuda::PerCameraEffects(&smoke));
 }
 
 }  // namespace

@@ -28,8 +28,9 @@
 // --batch N[,N...] [--size WxH] [--sessions S]: batch rendering instead (cuda_batch_bench.h):
 // batches of N cameras over S sessions of each world (default 1) at WxH (default 128x128),
 // depth+seg and then realtime rgb+depth (with each realtime stage's GPU time), pinned and
-// pageable copies, the kernels alone and the CPU backend; then the device-to-host copy rates,
-// pinned and pageable.
+// pageable copies, the kernels alone and the CPU backend, each world under its effects at 1 s
+// (a world with particles or media: its rgb cameras rendered alone, with their host time); then
+// the device-to-host copy rates, pinned and pageable.
 // --media [--size WxH]: for each world's effects frame with media (first camera at 1 s, WxH,
 // default 640x480), Render() of rgb+depth with the media volumes (the world light volume and fog
 // froxels since branch gpu15, the grids' light volumes and froxels since gpu17) built by the
@@ -637,6 +638,7 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
   for (const std::string& file : worlds) {
     std::vector<std::unique_ptr<Session>> owned;
     std::vector<std::unique_ptr<Renderer>> cpus;
+    std::vector<std::shared_ptr<const EffectsFrame>> effects;
     std::vector<cuda::BatchBenchWorld> bench_worlds;
     for (int s = 0; s < sessions; ++s) {
       SessionOptions so;
@@ -657,6 +659,10 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
       w.view.X_WO = CameraPoseInWorld(cam, w.snapshot);
       w.view.intrinsics = cam.intrinsics;
       w.view.near_m = cam.near_m;
+      // the world's effects at the snapshot (rain, fog, smoke: an rgb batch renders those
+      // cameras alone, PerCameraEffects); none for a clear world
+      effects.push_back(owned.back()->effects().Evaluate(w.snapshot, w.view.X_WO.translation()));
+      if (effects.back() && !effects.back()->empty()) w.effects = effects.back().get();
       w.cpu = s == 0 ? cpus.back().get() : nullptr;  // the CPU row: one session's renderer
       bench_worlds.push_back(w);
     }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/scene/effects_frame.h"
 
 namespace penumbra::cuda {
 namespace {
@@ -13,6 +14,12 @@ namespace {
 bool Finite3(const F3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace
+
+bool PerCameraEffects(const EffectsFrame* effects) {
+  return effects != nullptr &&
+         (!effects->particles.empty() || !effects->homogeneous_media.empty() ||
+          !effects->grid_media.empty());
+}
 
 BatchLayout::BatchLayout(int width, int height, int max_cameras, const BatchOutputs& outputs)
     : width_(width), height_(height), max_cameras_(max_cameras), outputs_(outputs) {

@@ -10,7 +10,18 @@
 
 #include "penumbra/render/cuda/cuda_kernels.h"
 
+namespace penumbra {
+struct EffectsFrame;
+}  // namespace penumbra
+
 namespace penumbra::cuda {
+
+/// whether `effects` (null: none) hold what a batch's rgb kernels do not draw: particles (rain,
+/// snow, sparks), homogeneous media (fog, haze, dust) or grid media (smoke, fire, VDB), whose
+/// streaks and froxels each camera needs of its own. a batch with rgb renders the rgb and depth
+/// of such a world's cameras through the single-frame pipeline (BatchRenderer: the world's
+/// CudaRenderer), camera by camera; lighting-only effects stay in the batch's kernels.
+bool PerCameraEffects(const EffectsFrame* effects);
 
 /// the images a batch renders: the ground truth of the pixel-centre ray, each one 4-byte value
 /// per pixel: depth and range float metres, segmentation (MuJoCo geom id), instance (body id)
@@ -49,10 +60,13 @@ struct BatchCamera {
   int32_t xy_table = -1;
   /// the renderer's per-row poses of this moving camera (-1: the camera does not move).
   int32_t rows_table = -1;
-  /// the renderer whose tables xy_table and rows_table index (0: none).
+  /// the renderer whose tables xy_table, rows_table and view_table index (0: none).
   uint64_t tables_owner = 0;
-  /// the generation of the renderer's row tables that rows_table indexes.
+  /// the generation of the renderer's row tables that rows_table indexes (and view_table).
   int64_t rows_generation = 0;
+  /// the renderer's copy of this camera's CameraView (BatchRenderer::CameraOf; -1: none): the
+  /// rgb of a camera whose world has particles or media is rendered from it alone.
+  int32_t view_table = -1;
 };
 
 /// the planes of a batch's buffer, in buffer order.

@@ -25,6 +25,10 @@ struct BatchBenchWorld {
   /// anisotropy, as the world's renderer has them
   RenderSettings settings;
   WorldSnapshot snapshot;
+  /// the effects of the snapshot (null: none; BatchRenderer::UpdateWorld's: with particles or
+  /// media, PerCameraEffects, an rgb batch renders the world's cameras alone); the CPU rows of
+  /// rgb batches render them too. must outlive RunBatchBench.
+  const EffectsFrame* effects = nullptr;
   CameraView view;
   Renderer* cpu = nullptr;  ///< null: no CPU row for this world
 };
@@ -50,7 +54,9 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 /// batches each with pinned copies overlapped with the next kernel (wall clock from the first
 /// Submit to the last Wait), the same with pageable copies, the kernel alone (CUDA events;
 /// with rgb all the batch's kernels, its exposures included), with rgb each realtime
-/// stage's GPU time (rows "stage: ..."; RealtimeBatchTimes), and the CPU renderers rendering
+/// stage's GPU time (rows "stage: ..."; RealtimeBatchTimes), with rgb and cameras rendered
+/// alone (worlds with PerCameraEffects) the host time of those (row "cameras rendered alone",
+/// frames/s of those cameras; BatchRenderer::alone_ms), and the CPU renderers rendering
 /// the same views one at a time (at least one batch; with rgb the realtime tier's rgb and
 /// depth).
 /// @throws Error if the CUDA runtime fails.

@@ -187,6 +187,13 @@ const float* BatchDevice::UploadCameraTables(int slot, const float* tables, int6
   return m.tables[slot];
 }
 
+void BatchDevice::CopyToDevice(void* stream, uint8_t* dst, const void* src, int64_t bytes) {
+  if (bytes <= 0) return;
+  CheckBatch(cudaMemcpyAsync(dst, src, static_cast<size_t>(bytes), cudaMemcpyHostToDevice,
+                             static_cast<cudaStream_t>(stream)),
+             "copying a camera's images rendered alone");
+}
+
 const uint8_t* BatchDevice::Wait(int slot) {
   Impl& m = *impl_;
   if (!m.used[slot]) return m.host[slot];

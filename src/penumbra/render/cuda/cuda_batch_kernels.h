@@ -52,6 +52,11 @@ class BatchDevice {
   /// address, for the batch's cameras' PinholeCamera::xy and rows. the host array may change
   /// once it returns.
   const float* UploadCameraTables(int slot, const float* tables, int64_t n);
+  /// copies `bytes` bytes of host memory `src` (pageable: staged before the call returns, so it
+  /// may change once it returns) to device address `dst` (inside a slot's buffer) on `stream`
+  /// (MoreWork's): the images of the cameras a batch renders alone (BatchRenderer: worlds with
+  /// particles or media) put into its buffer after its kernels, before its end event.
+  void CopyToDevice(void* stream, uint8_t* dst, const void* src, int64_t bytes);
   /// blocks until `slot`'s last batch is on the host (kNone: its kernel finished); returns
   /// the host buffer (null for kNone).
   const uint8_t* Wait(int slot);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <utility>
 
 #include "penumbra/core/error.h"
@@ -26,6 +27,8 @@ BatchRenderer::BatchRenderer(const BatchConfig& config)
     : layout_(config.width, config.height, config.max_cameras, config.outputs),
       device_(std::make_unique<BatchDevice>(layout_, config.copy)),
       counts_(BatchTickets::kSlots, 0),
+      alone_count_(BatchTickets::kSlots, 0),
+      alone_ms_(BatchTickets::kSlots, 0),
       id_(NextRendererId()) {}
 
 BatchRenderer::~BatchRenderer() {
@@ -40,6 +43,7 @@ BatchRenderer::~BatchRenderer() {
 int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings& settings) {
   auto w = std::make_unique<World>();
   w->scene = scene;
+  w->settings = settings;
   w->bvh = std::make_unique<BvhScene>(w->scene);
   w->device = std::make_unique<DeviceScene>();
   SyncDevice(*w->bvh, w->device.get());
@@ -70,21 +74,6 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   if (world < 0 || world >= num_worlds())
     throw Error(
         fmt::format("batch rendering: world {}; expected a world in [0, {})", world, num_worlds()));
-  // the ground truth does not see effects; the rgb takes the lighting ones only (a batch's
-  // cameras would each need their own particle streaks and media froxels: CudaRenderer draws
-  // them)
-  std::string not_on_gpu;
-  if (layout_.outputs().rgb && effects != nullptr) {
-    const std::pair<bool, const char*> per_camera[] = {
-        {!effects->particles.empty(), "particles (rain, snow, sparks) in a batch"},
-        {!effects->homogeneous_media.empty(), "homogeneous media (fog, haze, dust) in a batch"},
-        {!effects->grid_media.empty(), "grid media (smoke, fire, VDB) in a batch"}};
-    for (const auto& [present, what] : per_camera)
-      if (present && not_on_gpu.empty()) not_on_gpu = what;
-  }
-  if (!not_on_gpu.empty())
-    throw Error(fmt::format("batch rendering: world {}: effects with {} are not on the GPU yet",
-                            world, not_on_gpu));
   World& w = *worlds_[world];
   w.bvh->Update(snapshot);
   // the submitted kernels read this world's transforms (and, after a rebuild, its arrays)
@@ -92,6 +81,19 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
   SyncDevice(*w.bvh, w.device.get());
   views_[world] = w.device->device_view();
   if (!w.realtime) return;
+  // the ground truth does not see effects; with particles or media each camera needs its own
+  // streaks and froxels: the world's cameras are rendered alone (RenderAlone) from this frame
+  w.alone = PerCameraEffects(effects);
+  if (w.alone) {
+    if (!w.single) {
+      RenderSettings settings = w.settings;
+      settings.tier = RenderSettings::Tier::kRealtime;
+      w.single = std::make_unique<CudaRenderer>(w.scene, settings);
+      w.single->set_radiance_output(false);
+    }
+    w.snapshot = snapshot;
+    w.effects = *effects;
+  }
   w.realtime->PoseWorld(snapshot, pool_.get(), effects);
   if (!w.sky_uploaded || w.realtime->sky_generation() != w.sky_generation) {
     w.device_realtime->UploadSky(w.realtime->SkyData());
@@ -130,6 +132,56 @@ void BatchRenderer::LaunchRgb(std::span<const BatchCamera> cameras, int slot, vo
   realtime_->Launch(frames_.data(), films_.data(), count, depth, rgb, slot, stream);
 }
 
+void BatchRenderer::CheckAloneViews(std::span<const BatchCamera> cameras) const {
+  for (size_t k = 0; k < cameras.size(); ++k) {
+    const BatchCamera& c = cameras[k];
+    if (!worlds_[c.world]->alone) continue;
+    if (c.view_table < 0 || c.tables_owner != id_ ||
+        c.view_table >= static_cast<int>(camera_views_.size()) ||
+        c.rows_generation != rows_generation_)
+      throw Error(fmt::format(
+          "batch rendering: camera {}: world {} has particles or media (rendered camera by "
+          "camera) and the camera no view of this renderer's; expected a BatchCamera of this "
+          "renderer's CameraOf, made again after the CameraOf calls that followed a Submit",
+          k, c.world));
+  }
+}
+
+void BatchRenderer::RenderAlone(std::span<const BatchCamera> cameras, int slot, void* stream,
+                                uint8_t* buffer) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int count = static_cast<int>(cameras.size());
+  const bool depth = layout_.has(BatchPlane::kDepth);
+  const int64_t pixels = layout_.pixels();
+  // every such camera rendered first, then their copies queued: a copy from pageable memory
+  // may wait for the batch's kernels before it, the renders need not
+  std::vector<int> alone;
+  for (int k = 0; k < count; ++k) {
+    World& w = *worlds_[cameras[k].world];
+    if (!w.alone) continue;
+    if (alone_frames_.size() <= alone.size()) alone_frames_.emplace_back();
+    // the camera's view, asking for what the batch keeps of the realtime path (rgb, its depth)
+    CameraView view = camera_views_[cameras[k].view_table];
+    view.outputs = CameraOutputs::None();
+    view.outputs[ImageKind::kRgb] = true;
+    view.outputs[ImageKind::kDepth] = depth;
+    w.single->Render(w.snapshot, &w.effects, view, &alone_frames_[alone.size()]);
+    alone.push_back(k);
+  }
+  for (size_t i = 0; i < alone.size(); ++i) {
+    const RenderedFrame& f = alone_frames_[i];
+    device_->CopyToDevice(stream, buffer + layout_.image_offset(BatchPlane::kRgb, count, alone[i]),
+                          f.rgb.data.data(), 3 * pixels);
+    if (depth)
+      device_->CopyToDevice(stream,
+                            buffer + layout_.image_offset(BatchPlane::kDepth, count, alone[i]),
+                            f.depth_m.data.data(), 4 * pixels);
+  }
+  alone_count_[slot] = static_cast<int>(alone.size());
+  alone_ms_[slot] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
   const int count = static_cast<int>(std::min<size_t>(cameras.size(), 1 << 30));
   layout_.Check(cameras.data(), count, num_worlds());
@@ -158,6 +210,7 @@ int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
       realtime_lights_ = lights;
       realtime_mirror_ = mirror;
     }
+    CheckAloneViews(batch);
   }
   for (int k = 0; k < count; ++k) {
     const BatchCamera& c = batch[k];
@@ -178,10 +231,14 @@ int64_t BatchRenderer::Submit(std::span<const BatchCamera> cameras) {
   const int64_t t = tickets_.Take();
   const int slot = BatchTickets::SlotOf(t);
   counts_[slot] = count;
+  alone_count_[slot] = 0;
+  alone_ms_[slot] = 0;
   const std::span<const BatchCamera> submitted = WithRayTables(batch, slot);
+  // the cameras rendered alone while the batch's kernels run, then put over their places
   if (layout_.outputs().rgb)
     rgb = [this, submitted, slot](void* stream, uint8_t* buffer) {
       LaunchRgb(submitted, slot, stream, buffer);
+      RenderAlone(submitted, slot, stream, buffer);
     };
   device_->Submit(slot, views_.data(), num_worlds(), submitted.data(), count, rgb);
   submitted_since_rows_ = true;
@@ -260,6 +317,16 @@ double BatchRenderer::kernel_ms(int64_t ticket) const {
   return device_->kernel_ms(BatchTickets::SlotOf(ticket));
 }
 
+double BatchRenderer::alone_ms(int64_t ticket) const {
+  CheckTicket(ticket);
+  return alone_ms_[BatchTickets::SlotOf(ticket)];
+}
+
+int BatchRenderer::alone_cameras(int64_t ticket) const {
+  CheckTicket(ticket);
+  return alone_count_[BatchTickets::SlotOf(ticket)];
+}
+
 RealtimeBatchTimes BatchRenderer::stage_ms(int64_t ticket) const {
   CheckTicket(ticket);
   if (!realtime_) throw Error("batch rendering: stage times of a batch without rgb");
@@ -274,14 +341,18 @@ BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
   b.spread_rad = Camera(view.X_WO, view.intrinsics, view.motion).pixel_spread_rad();
   for (int c = 0; c < 3; ++c) b.white_balance[c] = view.white_balance_gains[c];
   b.camera = CudaRenderer::PinholeOf(view);
-  if (!view.intrinsics.has_distortion() && !view.motion.moving()) return b;
-  // the first camera after a Submit starts a new frame's row tables
+  // the first camera after a Submit starts a new frame's row tables and views
   if (submitted_since_rows_) {
     rows_tables_.clear();
+    camera_views_.clear();
     ++rows_generation_;
     submitted_since_rows_ = false;
   }
   b.tables_owner = id_;
+  b.rows_generation = rows_generation_;
+  b.view_table = static_cast<int32_t>(camera_views_.size());
+  camera_views_.push_back(view);
+  if (!view.intrinsics.has_distortion() && !view.motion.moving()) return b;
   ray_tables_.Prepare(view, pool_.get());
   if (view.intrinsics.has_distortion()) {
     const auto same = [&](const XyTable& t) {
@@ -297,7 +368,6 @@ BatchCamera BatchRenderer::CameraOf(int world, const CameraView& view) {
   if (view.motion.moving()) {
     rows_tables_.push_back(ray_tables_.rows());
     b.rows_table = static_cast<int32_t>(rows_tables_.size() - 1);
-    b.rows_generation = rows_generation_;
   }
   return b;
 }

@@ -7,7 +7,11 @@
 // pixel-centre ray (depth, segmentation, instance and semantic segmentation, range, normals) and
 // the realtime tier's rgb (BatchOutputs::rgb: each realtime stage launched once over all cameras,
 // RealtimeBatch; its depth is the realtime path's), the same bits as the same camera in a batch
-// of its own and as CudaRenderer rendering that camera alone.
+// of its own and as CudaRenderer rendering that camera alone. the rgb and depth of a camera of a
+// world whose effects have particles or media (PerCameraEffects: rain, snow, sparks, fog, haze,
+// dust, smoke, fire; their streaks and froxels are the camera's own) are rendered by that
+// world's CudaRenderer, camera by camera (the single-frame pipeline, RealtimeFrameData and
+// DeviceRealtime::Render), and copied into the batch's buffer after the batch's kernels.
 //
 //   BatchRenderer batch({.width = 128, .height = 128, .max_cameras = 1024});
 //   const int house = batch.AddWorld(session.scene());
@@ -32,9 +36,11 @@
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
 #include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
@@ -98,25 +104,32 @@ class BatchRenderer {
   int num_worlds() const { return static_cast<int>(worlds_.size()); }
   /// poses world `world`'s bodies from `snapshot` (its instances' transforms; the static BVH is
   /// rebuilt only if a static body moved; with rgb also its lights, geoms and sky volume,
-  /// RealtimeFrameData::PoseWorld) under the lighting `effects` of that instant (null: none;
-  /// light scales, extra lights, a moved or scaled sky, surface wetness; they apply to the rgb of
-  /// every camera of this world until the next UpdateWorld). waits for the kernels already
-  /// submitted (they read the transforms), not for their copies back.
-  /// @throws Error for a bad index or snapshot (BvhScene::Update), or, in a batch with rgb,
-  ///         effects with homogeneous or grid media or particles (drawn by CudaRenderer, not in
-  ///         batches yet: each camera would need its own froxels and streaks); the ground-truth
-  ///         images do not depend on effects.
+  /// RealtimeFrameData::PoseWorld) under the `effects` of that instant (null: none; light
+  /// scales, extra lights, a moved or scaled sky, surface wetness, particles, media; they apply
+  /// to the rgb of every camera of this world until the next UpdateWorld; the ground-truth
+  /// images do not depend on them). with rgb and PerCameraEffects, the snapshot and effects are
+  /// copied for the world's cameras rendered alone (Submit), the world's CudaRenderer (same
+  /// scene and settings, realtime tier) made on the first such frame. waits for the kernels
+  /// already submitted (they read the transforms), not for their copies back.
+  /// @throws Error for a bad index or snapshot (BvhScene::Update), or as CudaRenderer's
+  ///         constructor or RealtimeFrameData::PoseWorld (effects out of range).
   void UpdateWorld(int world, const WorldSnapshot& snapshot, const EffectsFrame* effects = nullptr);
 
   /// renders `cameras` (BatchLayout::Check) in one kernel launch (with rgb: one launch of each
   /// realtime stage, the cameras' exposures from their row sums included) and starts the copy
-  /// back (BatchCopy); returns the batch's ticket (0, 1,
-  /// ...) at once. the images of ticket t stay readable until ticket t + 2 is submitted. the
-  /// ray tables the cameras name (CameraOf) are copied to the device with the batch.
+  /// back (BatchCopy); returns the batch's ticket (0, 1, ...). the images of ticket t stay
+  /// readable until ticket t + 2 is submitted. the ray tables the cameras name (CameraOf) are
+  /// copied to the device with the batch. with rgb, a camera whose world's last UpdateWorld had
+  /// PerCameraEffects gets its rgb and depth from that world's CudaRenderer rendering its view
+  /// (view_table) alone, while the batch's kernels run: a batch with such cameras returns once
+  /// they are rendered (CudaRenderer::Render blocks) and their images are queued into the
+  /// batch's buffer (before ready_event; kernel_ms counts the wait); a batch without them
+  /// returns at once. if one of those renders throws, Submit throws (no ticket is returned).
   /// @throws Error for bad cameras (naming the camera; a camera whose tables are another
   ///         renderer's, or whose row tables are older than a CameraOf call made after a
-  ///         Submit), with rgb for a camera of a world not yet updated, or if the CUDA runtime
-  ///         fails.
+  ///         Submit; with rgb, a camera of a world with PerCameraEffects without a view of this
+  ///         renderer's CameraOf of the current generation), with rgb for a camera of a world
+  ///         not yet updated, as CudaRenderer::Render, or if the CUDA runtime fails.
   int64_t Submit(std::span<const BatchCamera> cameras);
   /// blocks until batch `ticket` is on the host and returns its host images (with
   /// BatchCopy::kNone: until its kernel finished; the images' base is then null).
@@ -137,6 +150,13 @@ class BatchRenderer {
   /// milliseconds batch `ticket`'s kernel took (CUDA events; call after Wait(ticket)); with
   /// rgb all its kernels.
   double kernel_ms(int64_t ticket) const;
+  /// host milliseconds Submit of batch `ticket` spent rendering the cameras of worlds with
+  /// PerCameraEffects alone (0 without such cameras; benchmarks).
+  /// @throws Error as Wait.
+  double alone_ms(int64_t ticket) const;
+  /// how many cameras of batch `ticket` were rendered alone (PerCameraEffects).
+  /// @throws Error as Wait.
+  int alone_cameras(int64_t ticket) const;
   /// with rgb: the GPU time of batch `ticket`'s realtime stages (call after Wait(ticket)).
   /// @throws Error as Wait, or if the batch renders no rgb.
   RealtimeBatchTimes stage_ms(int64_t ticket) const;
@@ -152,7 +172,9 @@ class BatchRenderer {
   /// distinct intrinsics: 8 bytes a pixel), a moving camera's per-row poses (48 bytes a row)
   /// until the first CameraOf call after a Submit (so make a moving camera's BatchCamera again
   /// for each frame; a batch may be submitted again before that). a pinhole camera that does
-  /// not move names no tables and serves any BatchRenderer.
+  /// not move names no tables and serves any BatchRenderer. every camera also names a copy of
+  /// `view` (view_table, kept as the row tables are), which a world with PerCameraEffects
+  /// renders alone: such a world's cameras must come from this renderer's CameraOf.
   /// @throws ConfigError as Camera for bad intrinsics or motion.
   BatchCamera CameraOf(int world, const CameraView& view);
 
@@ -169,6 +191,13 @@ class BatchRenderer {
     bool posed = false;
     uint64_t sky_generation = 0;
     bool sky_uploaded = false;
+    // with rgb and PerCameraEffects in the last UpdateWorld: that frame's snapshot and effects
+    // and the renderer that draws each of the world's cameras alone (made once, then kept)
+    RenderSettings settings;
+    bool alone = false;
+    WorldSnapshot snapshot;
+    EffectsFrame effects;
+    std::unique_ptr<CudaRenderer> single;
   };
   void CheckTicket(int64_t ticket) const;
   // `batch` with its cameras' ray tables copied to `slot`'s device buffer and their xy and
@@ -176,12 +205,23 @@ class BatchRenderer {
   std::span<const BatchCamera> WithRayTables(std::span<const BatchCamera> batch, int slot);
   // the realtime rgb of `cameras` into `buffer` (the slot's device buffer) on `stream`.
   void LaunchRgb(std::span<const BatchCamera> cameras, int slot, void* stream, uint8_t* buffer);
+  // the cameras of `cameras` whose worlds render them alone (PerCameraEffects) rendered by their
+  // worlds' CudaRenderer and their rgb and depth copied into `buffer` at their places on
+  // `stream`; their count and host milliseconds into `slot`'s alone_count_ and alone_ms_.
+  void RenderAlone(std::span<const BatchCamera> cameras, int slot, void* stream, uint8_t* buffer);
+  // throws for a camera of a world that renders alone without a view of this renderer's current
+  // generation (Submit's checks).
+  void CheckAloneViews(std::span<const BatchCamera> cameras) const;
 
   BatchLayout layout_;
   std::unique_ptr<BatchDevice> device_;
   std::vector<std::unique_ptr<World>> worlds_;
   std::vector<SceneView> views_;  // each world's device arrays, as the kernel reads them
   std::vector<int> counts_;       // cameras of the batch in each slot
+  std::vector<int> alone_count_;  // of them, rendered alone (RenderAlone), per slot
+  std::vector<double> alone_ms_;  // and the host milliseconds that took, per slot
+  // the images of the cameras rendered alone (RenderAlone's staging, one per camera)
+  std::vector<RenderedFrame> alone_frames_;
   BatchTickets tickets_;
   // with rgb: the stages' working buffers, sized for the most lights and the mirror layer of
   // the worlds, and the pool of the sky volume's updates
@@ -202,6 +242,7 @@ class BatchRenderer {
   CameraRayTables ray_tables_;
   std::vector<XyTable> xy_tables_;
   std::vector<std::vector<float>> rows_tables_;
+  std::vector<CameraView> camera_views_;  // the views of CameraOf, of the current generation
   int64_t rows_generation_ = 1;
   bool submitted_since_rows_ = false;
   std::vector<float> table_floats_;
