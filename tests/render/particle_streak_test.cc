@@ -4,11 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
 
 #include "media_test_util.h"
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
 #include "penumbra/render/embree/particle_scene.h"
+#include "penumbra/render/particle_math.h"
+#include "penumbra/render/particle_streaks.h"
 
 namespace penumbra {
 namespace {
@@ -113,6 +118,31 @@ TEST(ParticleStreakTest, RainAndSnowShading) {
   }
 }
 
+// uniform floats in [0, 1) from a 64-bit linear congruential generator (Knuth's MMIX constants).
+struct Lcg {
+  uint64_t state;
+  float operator()() {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state >> 40) / static_cast<float>(1 << 24);
+  }
+};
+
+// `view`'s camera still, and during a rolling-shutter readout (row 0 at 2 ms, line_time_sec per
+// row) in which it turns by `angle` (rad) about `axis` (world) and moves by `move` (m) in 30 ms.
+std::vector<Camera> StillAndRollingCameras(const CameraView& view, double line_time_sec,
+                                           double angle, const Eigen::Vector3d& axis,
+                                           const Eigen::Vector3d& move) {
+  CameraMotion motion;
+  motion.end_sec = 0.03;
+  motion.time_sec = 0.002;
+  motion.line_time_sec = line_time_sec;
+  motion.X_WO_end = view.X_WO;
+  motion.X_WO_end.linear() =
+      Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix() * view.X_WO.linear();
+  motion.X_WO_end.translation() += move;
+  return {Camera(view.X_WO, view.intrinsics), Camera(view.X_WO, view.intrinsics, motion)};
+}
+
 // the first non-finite particle in (set, index) order is reported, whatever the thread count
 // (the check runs in the parallel chunks of Build).
 TEST(ParticleSceneTest, FirstNonFiniteParticleIsReported) {
@@ -161,11 +191,7 @@ TEST(ParticleSceneTest, FirstNonFiniteParticleIsReported) {
 // through random points of the image and along its edges and corners.
 TEST(ParticleSceneTest, CameraRaysMeetEveryStreakTheyWouldWithoutTheViewCull) {
   EffectsFrame fx;
-  uint64_t state = 12345;
-  auto uniform = [&state] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<float>(state >> 40) / static_cast<float>(1 << 24);
-  };
+  Lcg uniform{12345};
   // drops all around the camera (at the origin), 0.3 to 6 m away, some large and slow.
   for (ParticleKind kind : {ParticleKind::kRain, ParticleKind::kSnow}) {
     ParticleSet ps;
@@ -181,18 +207,9 @@ TEST(ParticleSceneTest, CameraRaysMeetEveryStreakTheyWouldWithoutTheViewCull) {
     fx.particles.push_back(ps);
   }
   const CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60.0);
-  CameraMotion motion;
-  motion.end_sec = 0.03;
-  motion.time_sec = 0.002;
-  motion.line_time_sec = 0.0004;
-  motion.X_WO_end = view.X_WO;
-  motion.X_WO_end.linear() =
-      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix() *
-      view.X_WO.linear();
-  motion.X_WO_end.translation() += Eigen::Vector3d(0.1, -0.2, 0.05);
   const int W = view.intrinsics.width, H = view.intrinsics.height;
-  for (const Camera& camera :
-       {Camera(view.X_WO, view.intrinsics), Camera(view.X_WO, view.intrinsics, motion)}) {
+  for (const Camera& camera : StillAndRollingCameras(
+           view, 0.0004, 0.3, Eigen::Vector3d(0.2, 1, 0.1), Eigen::Vector3d(0.1, -0.2, 0.05))) {
     ParticleScene all, seen;
     all.Build(&fx, camera, 0.01, StreakRays::kAny);
     seen.Build(&fx, camera, 0.01, StreakRays::kCamera);
@@ -219,6 +236,105 @@ TEST(ParticleSceneTest, CameraRaysMeetEveryStreakTheyWouldWithoutTheViewCull) {
       check(W * a - 0.5f, H - 0.5f);
     }
     EXPECT_GT(hits, 5000) << "moving " << camera.motion().moving();
+  }
+}
+
+// the realtime splat of a rolling-shutter camera that turns and travels during the readout
+// (ParticleStreaks::Build with kPixelCentres, the CPU backend's realtime streaks): every pixel
+// whose pixel-centre ray, cast with its own row's pose (Camera::GenerateRay), meets a streak's
+// capsule gets the nearest such streak (brute force over every streak: the same streak and t),
+// and no other pixel has one. before the boxes were widened for the rows' motion (main before
+// branch gpu25) the splat took every streak's box and row columns in the first row's pose only,
+// which leave out 206 of the 344 pixels met here (counted below, so the check can fail). a
+// still camera is checked too.
+TEST(ParticleStreakTest, RollingShutterSplatFindsEveryStreakItsRowsMeet) {
+  EffectsFrame fx;
+  Lcg uniform{777};
+  // rain 0.5 to 6 m ahead of the camera (at the origin, looking along +x), spread over a
+  // cone wider than the view so that the turn brings drops into the lower rows.
+  ParticleSet rain;
+  rain.kind = ParticleKind::kRain;
+  for (int i = 0; i < 600; ++i) {
+    const float d = 0.5f + 5.5f * uniform();
+    rain.position_W.emplace_back(d, d * (2.4f * uniform() - 1.2f), d * (1.6f * uniform() - 0.8f));
+    rain.velocity_W.emplace_back(0.3f * (uniform() - 0.5f), 0.3f * (uniform() - 0.5f), -5.0f);
+    rain.radius_m.push_back(0.001f + 0.002f * uniform());
+  }
+  fx.particles.push_back(rain);
+  const CameraView view = MakeView(CameraLookingAlongX(), 64, 48, 60.0);
+  const int W = view.intrinsics.width, H = view.intrinsics.height;
+  for (const Camera& camera : StillAndRollingCameras(
+           view, 0.0006, 0.25, Eigen::Vector3d(0.3, 0.2, 1), Eigen::Vector3d(0.1, -0.15, 0.05))) {
+    SCOPED_TRACE(camera.motion().moving() ? "moving camera" : "still camera");
+    ParticleStreaks streaks;
+    streaks.Build(&fx, camera, 0.01, StreakRays::kPixelCentres);
+    ASSERT_GT(streaks.size(), 100);
+    // the first row's pose only (X_WO: the splat's boxes and row columns before branch gpu25),
+    // to show that the check can fail: the pixels met by a streak outside its box there
+    const Pose X_OW = camera.X_WO().inverse();
+    const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
+    const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+    const CameraIntrinsics& k = view.intrinsics;
+    const auto in_first_pose_box = [&](int n, int u, int v) {
+      const Eigen::Vector4f& a = streaks.ends()[2 * n];
+      const Eigen::Vector4f& b = streaks.ends()[2 * n + 1];
+      const Float3 po{p_OW.x(), p_OW.y(), p_OW.z()};
+      const StreakProjection q =
+          ProjectStreak(StreakToOptical(R_OW.data(), po, Float3{a.x(), a.y(), a.z()}),
+                        StreakToOptical(R_OW.data(), po, Float3{b.x(), b.y(), b.z()}), a.w(), k.fx,
+                        k.fy, k.cx, k.cy, W, H);
+      if (q.empty() || v < q.v0 || v > q.v1) return false;
+      int c0, c1;
+      StreakRowColumns(q, v, &c0, &c1);
+      return c0 <= u && u <= c1;
+    };
+    int met = 0, missed = 0, other = 0, outside_first_pose = 0;
+    for (int v = 0; v < H; ++v) {
+      for (int u = 0; u < W; ++u) {
+        const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
+        const Float3 o{ray.o.x(), ray.o.y(), ray.o.z()}, d{ray.d.x(), ray.d.y(), ray.d.z()};
+        // the nearest streak (ties: the lower index) by brute force
+        float t_best = std::numeric_limits<float>::infinity();
+        int best = -1;
+        for (int n = 0; n < streaks.size(); ++n) {
+          const Eigen::Vector4f& a = streaks.ends()[2 * n];
+          const Eigen::Vector4f& b = streaks.ends()[2 * n + 1];
+          const float t = IntersectCapsuleRay(
+              MakeCapsuleOrigin(o, Float3{a.x(), a.y(), a.z()}, Float3{b.x(), b.y(), b.z()}, a.w()),
+              d);
+          if (t > 0 && t < t_best) {
+            t_best = t;
+            best = n;
+          }
+        }
+        ParticleHit hit;
+        const bool has = streaks.PixelHit(ray, u, v, std::numeric_limits<float>::infinity(), &hit);
+        if (best < 0) {
+          other += has ? 1 : 0;
+          continue;
+        }
+        ++met;
+        outside_first_pose += in_first_pose_box(best, u, v) ? 0 : 1;
+        if (!has) {
+          ++missed;
+          continue;
+        }
+        EXPECT_EQ(hit.prim, best) << "pixel (" << u << ", " << v << ")";
+        EXPECT_EQ(hit.t, t_best) << "pixel (" << u << ", " << v << ")";
+      }
+    }
+    std::printf(
+        "%s: %d streaks, %d pixels meet one (brute force), %d of them missed by the "
+        "splat, %d others keyed; %d outside their streak's box in the first row's pose\n",
+        camera.motion().moving() ? "rolling shutter, moving" : "still", streaks.size(), met, missed,
+        other, outside_first_pose);
+    EXPECT_GT(met, 300);
+    EXPECT_EQ(missed, 0);
+    EXPECT_EQ(other, 0);
+    if (camera.motion().moving())
+      EXPECT_GT(outside_first_pose, met / 4);
+    else
+      EXPECT_EQ(outside_first_pose, 0);
   }
 }
 

@@ -135,6 +135,9 @@ constexpr float kStreakNear = 0.01f;
 struct StreakProjection {
   int u0 = 0, u1 = -1, v0 = 0, v1 = -1;
   float ua = 0, va = 0, ub = 0, vb = 0, rp = 0;
+  /// the depth (m) rp is taken at: the clipped segment's nearest end depth minus r, at least
+  /// kStreakNear (StreakMotionMarginPx).
+  float z_near = 0;
   PB_HOST_DEVICE bool empty() const { return u0 > u1 || v0 > v1; }
 };
 
@@ -175,7 +178,8 @@ PB_HOST_DEVICE inline StreakProjection ProjectStreak(Float3 ao, Float3 bo, float
   }
   const float z_near = (ao.z < bo.z ? ao.z : bo.z) - r;
   const float f_max = static_cast<float>(fx < fy ? fy : fx);
-  p.rp = f_max * r / (z_near < kStreakNear ? kStreakNear : z_near) + 1.0f;
+  p.z_near = z_near < kStreakNear ? kStreakNear : z_near;
+  p.rp = f_max * r / p.z_near + 1.0f;
   p.ua = static_cast<float>(fx * static_cast<double>(ao.x) / static_cast<double>(ao.z) + cx);
   p.va = static_cast<float>(fy * static_cast<double>(ao.y) / static_cast<double>(ao.z) + cy);
   p.ub = static_cast<float>(fx * static_cast<double>(bo.x) / static_cast<double>(bo.z) + cx);
@@ -216,6 +220,111 @@ PB_HOST_DEVICE inline void StreakRowColumns(const StreakProjection& p, int v, in
   const int l = static_cast<int>(floorf(ul)), h = static_cast<int>(ceilf(uh));
   *c0 = p.u0 < l ? l : p.u0;
   *c1 = h < p.u1 ? h : p.u1;
+}
+
+/// a moving camera's rows as the realtime splat bounds them (ParticleStreaks' StreakMotionOf
+/// makes it from a Camera; zero: a still camera): every row's pose (camera.h: slerped and lerped
+/// from X_WO at the row's time) is turned by at most `turn` (rad) from the pose X_WO that
+/// ProjectStreak's box is taken in, and its origin lies at most `shift` (m) from X_WO's;
+/// `tan_max` is the largest |(x, y)| of a pixel centre's normalised pinhole coordinates ((u -
+/// cx) / fx, (v - cy) / fy) over the image.
+struct StreakMotion {
+  float turn = 0, shift = 0, tan_max = 0;
+  PB_HOST_DEVICE bool moving() const { return turn > 0 || shift > 0; }
+};
+
+/// how far (px) a pixel centre whose ray, from any row's pose of motion `m`, meets a point p
+/// at depth >= z_near (m, in X_WO) can lie from p's projection in X_WO, for lenses of focal
+/// lengths up to f_max (px); -1 when the motion is too large to bound (the whole image).
+/// derivation: the ray leaves o(a) (|o(a) - o| <= shift) along R(a) d, d the pixel's direction
+/// in X_WO, turned from R d by <= turn; seen from o, p's direction differs from the ray's by <=
+/// asin(shift / |p - o|) <= asin(shift / z_near) (the angle opposite the shortest side of the
+/// triangle o, o(a), p), so from R d by delta <= turn + asin(shift / z_near). on the image
+/// plane z = 1 (the gnomonic map) an arc of delta between directions whose polar angles stay
+/// below phi moves the point by at most delta / cos^2(phi) = delta (1 + tan^2 phi); the pixel's
+/// polar angle is at most atan(tan_max), p's at most that plus delta (a cap below the horizon is
+/// convex on the sphere), so |(x, y) - p's| <= delta (1 + tan^2(atan(tan_max) + delta)), times
+/// f_max in pixels. asin(s) <= s / sqrt(1 - s^2) and tan(delta) <= delta / (1 - delta^2 / 2)
+/// (delta < 1) keep it to square roots; 1 % and 0.01 px to spare for rounding.
+PB_HOST_DEVICE inline float StreakMotionMarginPx(const StreakMotion& m, float z_near, float f_max) {
+  const float s = m.shift / z_near;
+  if (!(s < 0.5f)) return -1.0f;
+  const float delta = m.turn + s / sqrtf(1.0f - s * s);
+  if (!(delta < 1.0f)) return -1.0f;
+  const float tan_delta = delta / (1.0f - 0.5f * delta * delta);
+  const float den = 1.0f - m.tan_max * tan_delta;
+  if (!(den > 0.05f)) return -1.0f;
+  const float tan_phi = (m.tan_max + tan_delta) / den;
+  return 1.01f * f_max * delta * (1.0f + tan_phi * tan_phi) + 0.01f;
+}
+
+/// ProjectStreak's box p (a streak's projection in X_WO) widened for a moving camera's rows
+/// (motion m, StreakMotionMarginPx at p.z_near) so that it holds every pixel centre of a W x H
+/// image whose ray, from its own row's pose, meets the capsule at a point of depth >= p.z_near
+/// in X_WO (what ProjectStreak's box guarantees for a still camera): rp widened by the margin,
+/// the box remade from the segment (a box outside the image may so come into it); the whole
+/// image where the motion cannot be bounded. a p of a streak wholly behind X_WO's near plane
+/// (z_near 0) stays empty, and a still m leaves p as it is. fx, fy: the intrinsics' focal
+/// lengths (px).
+PB_HOST_DEVICE inline StreakProjection WidenStreakForMotion(StreakProjection p,
+                                                            const StreakMotion& m, double fx,
+                                                            double fy, int W, int H) {
+  if (!(p.z_near > 0) || !m.moving()) return p;
+  const float margin = StreakMotionMarginPx(m, p.z_near, static_cast<float>(fx < fy ? fy : fx));
+  if (margin < 0) {
+    p.u0 = 0;
+    p.u1 = W - 1;
+    p.v0 = 0;
+    p.v1 = H - 1;
+    return p;
+  }
+  const float rp = p.rp + margin;
+  const int u0 = static_cast<int>(floorf((p.ua < p.ub ? p.ua : p.ub) - rp));
+  const int u1 = static_cast<int>(ceilf((p.ua < p.ub ? p.ub : p.ua) + rp));
+  const int v0 = static_cast<int>(floorf((p.va < p.vb ? p.va : p.vb) - rp));
+  const int v1 = static_cast<int>(ceilf((p.va < p.vb ? p.vb : p.va) + rp));
+  p.u0 = u0 < 0 ? 0 : u0;
+  p.u1 = u1 < W - 1 ? u1 : W - 1;
+  p.v0 = v0 < 0 ? 0 : v0;
+  p.v1 = v1 < H - 1 ? v1 : H - 1;
+  return p;
+}
+
+/// a moving camera's row pose `row` (12 doubles: R_WO row-major, then the origin o in world m;
+/// Camera::PoseAtRow, as StreakSplatView::rows) as the world-to-optical transform
+/// StreakToOptical takes: R_OW = R_WO^T and p_OW = -R_OW o, in double, each product and sum
+/// rounded on its own (the CPU's bits on the GPU), then rounded to float.
+PB_HOST_DEVICE inline void StreakRowToOptical(const double row[12], float R_OW[9], Float3* p_OW) {
+  double p[3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) R_OW[3 * i + j] = static_cast<float>(row[3 * j + i]);
+    p[i] = -AddRnD(AddRnD(MulRnD(row[i], row[9]), MulRnD(row[3 + i], row[10])),
+                   MulRnD(row[6 + i], row[11]));
+  }
+  *p_OW = Float3{static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
+}
+
+/// the columns [*c0, *c1] of row v (empty: *c0 > *c1) that the splat tests for the capsule
+/// around [a, b] (world, m) of radius r (m) when row v is seen from its own pose `row`
+/// (StreakRowToOptical's layout; a moving camera): ProjectStreak of the ends in that row's
+/// optical frame, then StreakRowColumns at v, empty where v lies outside that projection's box.
+/// this holds every pixel of row v whose ray meets the capsule as ProjectStreak's box and
+/// StreakRowColumns do for a still camera (the row is a still pinhole camera at its pose).
+PB_HOST_DEVICE inline void StreakRowColumnsAtPose(const double row[12], const Float3& a,
+                                                  const Float3& b, float r, double fx, double fy,
+                                                  double cx, double cy, int W, int H, int v,
+                                                  int* c0, int* c1) {
+  float R_OW[9];
+  Float3 p_OW;
+  StreakRowToOptical(row, R_OW, &p_OW);
+  const StreakProjection q = ProjectStreak(StreakToOptical(R_OW, p_OW, a),
+                                           StreakToOptical(R_OW, p_OW, b), r, fx, fy, cx, cy, W, H);
+  if (q.empty() || v < q.v0 || v > q.v1) {
+    *c0 = 0;
+    *c1 = -1;
+    return;
+  }
+  StreakRowColumns(q, v, c0, c1);
 }
 
 /// a pixel's StreakKey when no streak meets its ray (larger than every key).

@@ -62,6 +62,50 @@ bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vecto
 }
 
 }  // namespace
+
+StreakMotion StreakMotionOf(const Camera& camera) {
+  StreakMotion out;
+  if (!camera.motion().moving()) return out;
+  // row v is seen from the pose slerped / lerped at a = (time_sec + line_time_sec v) / end_sec
+  // (camera.h): from o(a), turned by |a| theta from X_WO (theta the rotation from X_WO to
+  // X_WO_end); turn and shift are the largest |a| over the rows (v in [-0.5, height]: the
+  // pathtraced tier's jittered samples reach the image's edge) times theta and times the
+  // translation (1 % and 1e-6 to spare).
+  const CameraMotion& m = camera.motion();
+  const CameraIntrinsics& k = camera.intrinsics();
+  const double a_max = std::max(std::abs(m.time_sec - 0.5 * m.line_time_sec),
+                                std::abs(m.time_sec + m.line_time_sec * k.height)) /
+                       m.end_sec;
+  const Eigen::Quaterniond q0(camera.X_WO().linear()), q1(m.X_WO_end.linear());
+  const double theta =
+      2.0 * std::acos(std::min(1.0, std::abs(q0.normalized().dot(q1.normalized()))));
+  const double move = (m.X_WO_end.translation() - camera.X_WO().translation()).norm();
+  out.turn = static_cast<float>(1.01 * a_max * theta + 1e-6);
+  out.shift = static_cast<float>(1.01 * a_max * move + 1e-6);
+  // the image's corner pixel centres
+  double t2 = 0;
+  for (const double u : {0.0, k.width - 1.0})
+    for (const double v : {0.0, k.height - 1.0}) {
+      const double x = (u - k.cx) / k.fx, y = (v - k.cy) / k.fy;
+      t2 = std::max(t2, x * x + y * y);
+    }
+  out.tan_max = static_cast<float>(1.001 * std::sqrt(t2));
+  return out;
+}
+
+void StreakRowPoses(const Camera& camera, std::vector<double>* rows) {
+  const int H = camera.height();
+  rows->resize(12 * static_cast<size_t>(H));
+  for (int v = 0; v < H; ++v) {
+    const Pose X = camera.PoseAtRow(v);
+    double* r = &(*rows)[12 * static_cast<size_t>(v)];
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) r[3 * i + j] = X.linear()(i, j);
+      r[9 + i] = X.translation()(i);
+    }
+  }
+}
+
 void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
                             StreakRays rays, ThreadPool* pool, const MediaScene* media,
                             const ShelterMap* shelter) {
@@ -111,12 +155,8 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   // pixel too), to skip the drops no such ray can meet (`outside` below).
   const bool frustum = rays != StreakRays::kAny && !camera.intrinsics().has_distortion();
   Eigen::Vector3f side_W[4];
-  // a moving camera (camera.h: pose slerped / lerped at a = (time_sec + line_time_sec v) /
-  // end_sec for row v) sees row v from o(a), turned by |a| theta from X_WO (theta the rotation
-  // from X_WO to X_WO_end): the planes then move by at most turn |x - cam_o| + shift at a
-  // point x, with turn and shift the largest |a| over the rows (v in [-0.5, height]: jittered
-  // samples reach the image's edge) times theta and times the translation (1 % and 1e-6 to
-  // spare).
+  // a moving camera: the planes move by at most turn |x - cam_o| + shift at a point x
+  // (StreakMotionOf).
   float turn = 0, shift = 0;
   const bool moving = camera.motion().moving();
   if (frustum) {
@@ -128,16 +168,9 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
     for (int i = 0; i < 4; ++i)
       side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
     if (moving) {
-      const CameraMotion& m = camera.motion();
-      const double a_max = std::max(std::abs(m.time_sec - 0.5 * m.line_time_sec),
-                                    std::abs(m.time_sec + m.line_time_sec * k.height)) /
-                           m.end_sec;
-      const Eigen::Quaterniond q0(camera.X_WO().linear()), q1(m.X_WO_end.linear());
-      const double theta =
-          2.0 * std::acos(std::min(1.0, std::abs(q0.normalized().dot(q1.normalized()))));
-      const double move = (m.X_WO_end.translation() - camera.X_WO().translation()).norm();
-      turn = static_cast<float>(1.01 * a_max * theta + 1e-6);
-      shift = static_cast<float>(1.01 * a_max * move + 1e-6);
+      const StreakMotion m = StreakMotionOf(camera);
+      turn = m.turn;
+      shift = m.shift;
     }
   }
   const float four_fx2 = 4.0f * fx_px * fx_px;
@@ -269,11 +302,18 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
   // pixel box and projected segment of every streak (the shared ProjectStreak of
   // render/particle_math.h, which the CUDA backend's splat calls too), in parallel chunks
   // (empty box when behind the camera or outside the image).
+  // a moving camera: the boxes widened by the rows' motion (WidenStreakForMotion), and each
+  // row's columns taken in that row's own pose (StreakRowColumnsAtPose over StreakRowPoses),
+  // as the CUDA backend's splat (SplatStreakRow) takes them.
+  const StreakMotion motion = StreakMotionOf(camera);
+  const bool moving = motion.moving();
+  if (moving) StreakRowPoses(camera, &row_poses_);
   std::vector<StreakProjection> box(count_);
   auto project = [&](int n) {
     const Float3 ao = StreakToOptical(R_OW.data(), p_OW, StreakF3(ends_[2 * n].head<3>()));
     const Float3 bo = StreakToOptical(R_OW.data(), p_OW, StreakF3(ends_[2 * n + 1].head<3>()));
     box[n] = ProjectStreak(ao, bo, ends_[2 * n].w(), k.fx, k.fy, k.cx, k.cy, W, H);
+    if (moving) box[n] = WidenStreakForMotion(box[n], motion, k.fx, k.fy, W, H);
   };
   constexpr int kChunk = 4096;
   const int chunks = (count_ + kChunk - 1) / kChunk;
@@ -313,7 +353,11 @@ void ParticleStreaks::BuildPixelHits(const Camera& camera, ThreadPool* pool) {
       for (int v = v0; v <= v1; ++v) {
         // the columns within rp of the projected segment's part near this row.
         int c0, c1;
-        StreakRowColumns(bx, v, &c0, &c1);
+        if (moving)
+          StreakRowColumnsAtPose(&row_poses_[12 * static_cast<size_t>(v)], StreakF3(a), StreakF3(b),
+                                 r, k.fx, k.fy, k.cx, k.cy, W, H, v, &c0, &c1);
+        else
+          StreakRowColumns(bx, v, &c0, &c1);
         for (int u = c0; u <= c1; ++u) {
           const Ray ray = camera.GenerateRay(static_cast<float>(u), static_cast<float>(v));
           const Float3 d = StreakF3(ray.d);

@@ -10,12 +10,16 @@
 // projected pixel box is scanned and the pixel-centre ray intersected with the capsule exactly
 // (Quilez's ray-capsule test, render/particle_math.h's IntersectCapsule), keeping the nearest
 // streak per pixel (ties: lower index), which costs the streaks' screen area rather than a BVH
-// traversal per pixel. for the camera's rays of either tier (StreakRays) and a lens without
-// distortion, drops whose widened capsule lies wholly outside the pyramid of the camera's rays
-// (still, or moving over the rows) are skipped first (no streak, not counted as culled; they
-// could not be drawn). streaks thinner than half a pixel at their distance are widened to half
-// a pixel (radius 0.5 d / fx) and their coverage is scaled down by r / r_wide, so that sub-pixel
-// drops keep their average contribution instead of aliasing away with one ray per pixel.
+// traversal per pixel. a camera that moves during the exposure (camera.h) sees each row from
+// its own pose: the boxes are widened by a bound of the rows' motion (StreakMotionOf,
+// WidenStreakForMotion) and each row's pixels are taken in that row's pose
+// (StreakRowColumnsAtPose), so every pixel whose own ray meets a capsule is tested. for the
+// camera's rays of either tier (StreakRays) and a lens without distortion, drops whose widened
+// capsule lies wholly outside the pyramid of the camera's rays (still, or moving over the rows) are
+// skipped first (no streak, not counted as culled; they could not be drawn). streaks thinner than
+// half a pixel at their distance are widened to half a pixel (radius 0.5 d / fx) and their coverage
+// is scaled down by r / r_wide, so that sub-pixel drops keep their average contribution instead of
+// aliasing away with one ray per pixel.
 //
 // coverage: a point on the streak is covered for 2r / |v| of the exposure, so a streak is
 // drawn with opacity alpha = 2r / (|v| T + 2r) (1 for a still particle), times the widening
@@ -84,6 +88,17 @@ enum class StreakRays : uint8_t {
   /// pixel's nearest streak is found (PixelHit).
   kPixelCentres,
 };
+
+/// the motion of `camera`'s rows during its exposure as the streaks' culling and the realtime
+/// splat bound it (particle_math.h's StreakMotion: the largest turn and shift of any row's pose,
+/// rows v in [-0.5, height], from X_WO, 1 % and 1e-6 to spare, and the largest tan of a pixel
+/// centre's polar angle); zero for a still camera.
+StreakMotion StreakMotionOf(const Camera& camera);
+
+/// every row's pose of a moving `camera` (Camera::PoseAtRow(v), v = 0 .. height - 1) as 12
+/// doubles per row into *rows (resized to 12 x height): R_WO row-major, then the origin (world,
+/// m); the layout of StreakSplatView::rows and StreakRowColumnsAtPose.
+void StreakRowPoses(const Camera& camera, std::vector<double>* rows);
 
 /// the nearest streak along a ray.
 struct ParticleHit {
@@ -189,6 +204,7 @@ class ParticleStreaks {
   std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
   bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
   bool host_splat_ = true;         // Build with kPixelCentres splats (BuildPixelHits)
+  std::vector<double> row_poses_;  // a moving camera's row poses (BuildPixelHits)
   // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
   // capacity).
   struct DropChunk {

@@ -301,7 +301,10 @@ TEST(RealtimeHostPathEffectsFrames, LateStreaksGiveTheSameBits) {
 // host splat's byte for byte and matches the CPU backend's (rgb PSNR >= 40 dB, depth within 1 mm
 // on >= 99.9 % of pixels, the streak pixels' radiance within a tenth of their error without the
 // streaks). with the camera's float ray tables instead (PrimaryRay<true>, as before branch
-// gpu23) or the still camera's rays the keys are not the host's (the check can fail).
+// gpu23) or the still camera's rays the keys are not the host's (the check can fail). the
+// splat's keys equal a brute force over every pixel's ray and every streak (branch gpu25: the
+// boxes widened by the rows' motion, each row's columns in its own pose); with the first row's
+// pose only (StreakSplatView::poses null, as before) they differ on most streak pixels.
 TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) {
   auto [session, snap, view, fx] = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
   const SceneDescription& scene = session->scene();
@@ -353,7 +356,42 @@ TEST(RealtimeHostPathEffectsFrames, RollingShutterDeviceSplatMatchesCpuBackend) 
   };
   size_t keyed = 0, keyed_float = 0, keyed_still = 0;
   ASSERT_NE(f.splat.rows, nullptr);
-  const size_t bad = mismatch(splat_keys(f), &keyed);
+  ASSERT_NE(f.splat.poses, nullptr);
+  const std::vector<unsigned long long> keys = splat_keys(f);
+  const size_t bad = mismatch(keys, &keyed);
+  // every pixel's nearest streak by brute force (each pixel's ray, SplatRay, against every
+  // streak): the splat's keys exactly; the splat with the first row's pose only (no
+  // StreakSplatView::poses: its boxes and row columns before branch gpu25) misses some
+  std::vector<unsigned long long> brute(static_cast<size_t>(W) * H, kNoStreakKey);
+  for (int v = 0; v < H; ++v) {
+    for (int u = 0; u < W; ++u) {
+      const cuda::TraceRay ray = cuda::SplatRay(f, u, v);
+      unsigned long long& slot = brute[static_cast<size_t>(v) * W + u];
+      for (int k = 0; k < list.num; ++k) {
+        const cuda::StreakPod& s = list.streaks[k];
+        const float t = IntersectCapsuleRay(
+            MakeCapsuleOrigin(cuda::ToFloat3(ray.o), Float3{s.a[0], s.a[1], s.a[2]},
+                              Float3{s.b[0], s.b[1], s.b[2]}, s.r),
+            cuda::ToFloat3(ray.d));
+        if (t > 0) slot = std::min<unsigned long long>(slot, StreakKey(t, k));
+      }
+    }
+  }
+  cuda::RealtimeFrameView first_pose = f;
+  first_pose.splat.poses = nullptr;
+  const std::vector<unsigned long long> first_keys = splat_keys(first_pose);
+  size_t brute_keyed = 0, brute_differ = 0, first_differ = 0;
+  for (size_t i = 0; i < brute.size(); ++i) {
+    brute_keyed += brute[i] != kNoStreakKey ? 1 : 0;
+    brute_differ += brute[i] != keys[i] ? 1 : 0;
+    first_differ += brute[i] != first_keys[i] ? 1 : 0;
+  }
+  std::printf(
+      "rain at 1 s 160x120, rolling shutter: brute force keys %zu pixels; the splat differs on "
+      "%zu, with the first row's pose only on %zu\n",
+      brute_keyed, brute_differ, first_differ);
+  EXPECT_EQ(brute_differ, 0u);
+  EXPECT_GT(first_differ, brute_keyed / 4);
   // the frame's float ray tables instead of the double row poses (as before branch gpu23), and
   // the still camera's rays
   cuda::RealtimeFrameView tables = f;

@@ -16,7 +16,9 @@
 //     streaks made before the kernels (as before branch gpu23: CudaRenderer::set_late_streaks
 //     (false)) and late (the default: while the GPU shades), the host's preparation of each,
 //     and the FNV-1a hashes of the rgb, depth and radiance and the EV100 of a late-streaks frame
-//     and of one with the streaks before the kernels (whether they are bit-identical);
+//     and of one with the streaks before the kernels (whether they are bit-identical); then
+//     a rolling-shutter camera turning during the readout (realtime_parity::AddRollingShutter)
+//     with the device splat and the host splat, and the pixels each keys;
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
@@ -104,6 +106,7 @@
 #include "penumbra/world/world_config.h"
 #include "render/cuda/cuda_parity.h"
 #include "render/cuda/path_parity.h"
+#include "render/cuda/realtime_parity.h"
 
 namespace penumbra {
 namespace {
@@ -947,6 +950,35 @@ int Main(int argc, char** argv) {
             return g->last_prepare_ms();
           }();
           serial_late(", again");
+          // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
+          // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row
+          // columns follow the rows' poses since branch gpu25, and the host splat
+          CameraView rolling = rgb;
+          realtime_parity::AddRollingShutter(&rolling);
+          rows.push_back({name, size,
+                          "rgb+depth realtime + effects (on GPU), rolling shutter turning", "cuda",
+                          "Render()", 1 / TimeRenders(gpu.get(), snap, rolling, n, fx.get())});
+          std::vector<unsigned long long> rolling_keys;
+          size_t rolling_keyed = 0;
+          if (g->device_realtime().DownloadStreakKeys(&rolling_keys))
+            for (unsigned long long key : rolling_keys) rolling_keyed += key != kNoStreakKey;
+          const double rolling_prep = g->last_prepare_ms(),
+                       rolling_late = g->last_late_streaks_ms();
+          const int rolling_streaks = g->realtime_frame().splat_streaks().View().num;
+          g->realtime_frame().set_device_streaks(false);
+          rows.push_back({name, size,
+                          "rgb+depth realtime + effects, rolling shutter turning, streaks "
+                          "splatted on the host",
+                          "cuda", "Render()",
+                          1 / TimeRenders(gpu.get(), snap, rolling, n, fx.get())});
+          const size_t rolling_host = g->realtime_frame().streaks().size();
+          g->realtime_frame().set_device_streaks(true);
+          builds.push_back(fmt::format(
+              "{} {}: rolling shutter turning: {} streaks, {} pixels keyed by the device splat, "
+              "{} streak pixels of the host splat; host preparation {:.2f} ms a frame, {:.2f} ms "
+              "making the streaks while the GPU works (device splat)",
+              name, size, rolling_streaks, rolling_keyed, rolling_host, rolling_prep,
+              rolling_late));
           builds.push_back(fmt::format(
               "{} {}: particles: {} streaks after the host's culling, {} streak pixels; host "
               "preparation {:.2f} ms a frame with the device splat (late streaks: before the "

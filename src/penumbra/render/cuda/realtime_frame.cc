@@ -224,21 +224,16 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
     splat_camera_.fy = k.fy;
     splat_camera_.cx = k.cx;
     splat_camera_.cy = k.cy;
-    // a moving camera without lens distortion: every row's pose in double, as the CPU's rays
-    // take it (SplatRay)
+    // a moving camera: every row's pose in double, in which the splat takes the row's columns
+    // (StreakSplatView::poses) and, without lens distortion, as the CPU's rays take it
+    // (SplatRay), and the rows' motion, which widens the streaks' boxes (as BuildPixelHits)
     splat_camera_.rows = nullptr;
-    if (camera.motion().moving() && !k.has_distortion()) {
-      const int H = camera.height();
-      splat_rows_.resize(12 * static_cast<size_t>(H));
-      for (int v = 0; v < H; ++v) {
-        const Pose X = camera.PoseAtRow(v);
-        double* r = &splat_rows_[12 * static_cast<size_t>(v)];
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) r[3 * i + j] = X.linear()(i, j);
-          r[9 + i] = X.translation()(i);
-        }
-      }
-      splat_camera_.rows = splat_rows_.data();
+    splat_camera_.poses = nullptr;
+    splat_camera_.motion = StreakMotionOf(camera);
+    if (camera.motion().moving()) {
+      StreakRowPoses(camera, &splat_rows_);
+      splat_camera_.poses = splat_rows_.data();
+      if (!k.has_distortion()) splat_camera_.rows = splat_rows_.data();
     }
     return;
   }

@@ -1591,11 +1591,12 @@ struct DeviceRealtime::Impl : PixelBuffers {
       const PathStreaks list =
           staged ? StreakBuffers::Stage(h.splat.streaks, &pin_splat) : h.splat.streaks;
       f->splat.streaks = splat_streaks.Upload(list, stream);
-      if (h.splat.rows != nullptr) {
-        // a moving camera's row poses (StreakSplatView::rows)
+      if (h.splat.poses != nullptr) {
+        // a moving camera's row poses (StreakSplatView::poses, and rows where it has them)
         const size_t bytes = sizeof(double) * 12 * f->camera.height;
-        splat_rows.Upload(source(h.splat.rows, bytes, &pin_splat_rows), bytes, stream);
-        f->splat.rows = splat_rows.as<double>();
+        splat_rows.Upload(source(h.splat.poses, bytes, &pin_splat_rows), bytes, stream);
+        f->splat.poses = splat_rows.as<double>();
+        f->splat.rows = h.splat.rows != nullptr ? splat_rows.as<double>() : nullptr;
       }
       splat_nearest.Reserve(sizeof(unsigned long long) * n);
       splat_pixels.Reserve(sizeof(StreakPixel) * n);

@@ -148,6 +148,13 @@ struct StreakSplatView {
   /// the frame's camera rays (PrimaryRay<true>; a moving camera with lens distortion takes its
   /// float tables, whose rays may differ from the CPU's in their last bits).
   const double* rows = nullptr;
+  /// a moving camera (lens distortion or not): its rows' motion (StreakMotionOf), which widens
+  /// every streak's box (SplatProjection: WidenStreakForMotion), and per row v (height of them,
+  /// 12 doubles each, as `rows`) its pose, in which the row's columns are taken
+  /// (SplatStreakRow: StreakRowColumnsAtPose), as ParticleStreaks::BuildPixelHits takes them.
+  /// null poses: a still camera (motion zero).
+  StreakMotion motion;
+  const double* poses = nullptr;
   /// per pixel (row-major, width x height): the nearest streak's StreakKey (kNoStreakKey: none;
   /// all kNoStreakKey before the splat) and, where it has one, the shaded streak
   /// (ShadeSplatPixel). arrays of the memory the reader runs in (device, or host for
@@ -1641,13 +1648,16 @@ PB_HOST_DEVICE inline int64_t FindStreak(const RealtimeFrameView& f, int64_t i) 
 }
 
 /// the projection of splat streak s (ProjectStreak of its ends in the frame's optical frame,
-/// StreakToOptical).
+/// StreakToOptical), its box widened by a moving camera's rows (WidenStreakForMotion; nothing
+/// for a still camera).
 PB_HOST_DEVICE inline StreakProjection SplatProjection(const RealtimeFrameView& f,
                                                        const StreakPod& s) {
   const StreakSplatView& sp = f.splat;
   const Float3 ao = StreakToOptical(sp.R_OW, sp.p_OW, Float3{s.a[0], s.a[1], s.a[2]});
   const Float3 bo = StreakToOptical(sp.R_OW, sp.p_OW, Float3{s.b[0], s.b[1], s.b[2]});
-  return ProjectStreak(ao, bo, s.r, sp.fx, sp.fy, sp.cx, sp.cy, f.camera.width, f.camera.height);
+  const int W = f.camera.width, H = f.camera.height;
+  const StreakProjection p = ProjectStreak(ao, bo, s.r, sp.fx, sp.fy, sp.cx, sp.cy, W, H);
+  return sp.poses != nullptr ? WidenStreakForMotion(p, sp.motion, sp.fx, sp.fy, W, H) : p;
 }
 
 /// the ray of pixel (u, v) that the splat tests and shades (origin and direction as the CPU's
@@ -1685,17 +1695,24 @@ PB_HOST_DEVICE inline void KeepNearestStreak(unsigned long long* slot, unsigned 
 }
 
 /// splat streak k (projection p, SplatProjection) on row v (inside p's box): every pixel of
-/// StreakRowColumns whose pixel-centre ray (SplatRay) meets the capsule (IntersectCapsuleRay,
+/// StreakRowColumns (a moving camera, f.splat.poses: StreakRowColumnsAtPose, the columns in the
+/// row's own pose) whose pixel-centre ray (SplatRay) meets the capsule (IntersectCapsuleRay,
 /// with the row's ray origin) keeps StreakKey(t, k) in f.splat.nearest if it is smaller, as
 /// ParticleStreaks::BuildPixelHits for the CPU's pixel rays: every product and sum of the rays,
 /// the projection and the capsule test rounded on its own (SplatRay, MulRn, AddRn), so
 /// the device finds the CPU's pixels and t to the bit.
 PB_HOST_DEVICE inline void SplatStreakRow(const RealtimeFrameView& f, int k,
                                           const StreakProjection& p, int v) {
+  const StreakSplatView& sp = f.splat;
+  const StreakPod& s = sp.streaks.streaks[k];
   int c0, c1;
-  StreakRowColumns(p, v, &c0, &c1);
+  if (sp.poses != nullptr)
+    StreakRowColumnsAtPose(sp.poses + 12 * static_cast<int64_t>(v), Float3{s.a[0], s.a[1], s.a[2]},
+                           Float3{s.b[0], s.b[1], s.b[2]}, s.r, sp.fx, sp.fy, sp.cx, sp.cy,
+                           f.camera.width, f.camera.height, v, &c0, &c1);
+  else
+    StreakRowColumns(p, v, &c0, &c1);
   if (c0 > c1) return;
-  const StreakPod& s = f.splat.streaks.streaks[k];
   const CapsuleOrigin c =
       MakeCapsuleOrigin(ToFloat3(SplatRay(f, c0, v).o), Float3{s.a[0], s.a[1], s.a[2]},
                         Float3{s.b[0], s.b[1], s.b[2]}, s.r);
