@@ -129,16 +129,17 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     if (accum_.width != W || accum_.height != H || accum_.channels != 3) accum_ = ImageF(W, H, 3);
     std::fill(accum_.data.begin(), accum_.data.end(), 0.0f);
   }
+  // gray world (auto white balance) and exposure adaptation read this frame's radiance
+  const bool gray_world = c.white_balance.mode == WhiteBalance::Mode::kAuto;
+  const bool adapts = settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0;
   // white balance known before the frame (not gray world): the renderer develops with it, so
   // that a frame without sub-frames, noise or adaptation is developed once
-  const Eigen::Vector3f wb_before = c.white_balance.mode == WhiteBalance::Mode::kAuto
+  const Eigen::Vector3f wb_before = gray_world
                                         ? Eigen::Vector3f::Ones()
                                         : GainsForFrame(c.white_balance, daylight_white_, ImageF());
   // the camera model reads the radiance for sub-frames, noise, gray world and adaptation;
   // otherwise the renderer's developed rgb is the camera's (set_keep_radiance)
-  const bool need_radiance = keep_radiance_ || n > 1 || c.noise.enabled ||
-                             c.white_balance.mode == WhiteBalance::Mode::kAuto ||
-                             (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0);
+  const bool need_radiance = keep_radiance_ || n > 1 || c.noise.enabled || gray_world || adapts;
   truth_view_.reset();
   truth_moving_ = moving;
   RenderedFrame sub;
@@ -210,7 +211,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
           "it was asked for (CameraOutputs rgb)",
           spec_.name, frame_index));
     double ev = developed ? out->truth.ev100 : film_.Ev100(radiance, pool_.get());
-    if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
+    if (adapts && last_ev_) {
       const double dt = std::max(0.0, start.time_sec - *last_time_);
       ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
     }
@@ -218,9 +219,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     last_time_ = start.time_sec;
     out->ev100 = ev;
     // gray world needs this frame's radiance; the other modes' gains were known before it
-    const Eigen::Vector3f wb_gains = c.white_balance.mode == WhiteBalance::Mode::kAuto
-                                         ? GainsForFrame(c.white_balance, daylight_white_, radiance)
-                                         : wb_before;
+    const Eigen::Vector3f wb_gains =
+        gray_world ? GainsForFrame(c.white_balance, daylight_white_, radiance) : wb_before;
     if (c.noise.enabled) {
       const float h = static_cast<float>(ExposureFromEv100(ev));
       if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
