@@ -86,6 +86,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "penumbra/core/output_file.h"
@@ -113,20 +114,41 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// the spread of the last TimeRenders' frames (ms): its median and its slowest frame, so that a
+// mean moved by a few slow frames (a hiccup) can be told from a steadily slower run. a Row takes
+// it once (TakeSpread) and leaves it empty: rows not timed by TimeRenders show none.
+struct FrameSpread {
+  double median_ms = 0, max_ms = 0;
+};
+FrameSpread last_spread;
+
+FrameSpread TakeSpread() { return std::exchange(last_spread, FrameSpread()); }
+
 struct Row {
   std::string world, size, outputs, backend, how;
   double fps = 0;
+  // of the TimeRenders call that gave fps, when one did (initialised after fps)
+  FrameSpread spread = TakeSpread();
 };
 
 // mean seconds per Render of `view` under `fx` (null: none) over `frames` frames after 3
-// warm-up frames.
+// warm-up frames; each frame timed too (last_spread).
 double TimeRenders(Renderer* r, const WorldSnapshot& snap, const CameraView& view, int frames,
                    const EffectsFrame* fx = nullptr) {
   RenderedFrame f;
   for (int i = 0; i < 3; ++i) r->Render(snap, fx, view, &f);
+  std::vector<double> ms(frames);
   const auto t0 = Clock::now();
-  for (int i = 0; i < frames; ++i) r->Render(snap, fx, view, &f);
-  return std::chrono::duration<double>(Clock::now() - t0).count() / frames;
+  auto t = t0;
+  for (int i = 0; i < frames; ++i) {
+    r->Render(snap, fx, view, &f);
+    const auto now = Clock::now();
+    ms[i] = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+  }
+  std::sort(ms.begin(), ms.end());
+  last_spread = {ms[ms.size() / 2], ms.back()};
+  return std::chrono::duration<double>(t - t0).count() / frames;
 }
 
 // mean milliseconds of RealtimeMedia::Build for `view` under `fx` (its homogeneous and grid
@@ -1070,11 +1092,18 @@ int Main(int argc, char** argv) {
                         1 / TimeRenders(cpu.get(), snap, rgb, nc, fx.get())});
     }
   }
-  fmt::print("\n| world | size | outputs | backend | timed | frames/s | ms/frame |\n");
+  // ms/frame: the mean, then for Render() rows the median and the slowest frame
+  fmt::print(
+      "\n| world | size | outputs | backend | timed | frames/s | ms/frame (mean; median, max) "
+      "|\n");
   fmt::print("|---|---|---|---|---|---:|---:|\n");
-  for (const Row& r : rows)
-    fmt::print("| {} | {} | {} | {} | {} | {:.0f} | {:.3f} |\n", r.world, r.size, r.outputs,
-               r.backend, r.how, r.fps, 1e3 / r.fps);
+  for (const Row& r : rows) {
+    const std::string spread =
+        r.spread.max_ms > 0 ? fmt::format("; {:.3f}, {:.3f}", r.spread.median_ms, r.spread.max_ms)
+                            : std::string();
+    fmt::print("| {} | {} | {} | {} | {} | {:.0f} | {:.3f}{} |\n", r.world, r.size, r.outputs,
+               r.backend, r.how, r.fps, 1e3 / r.fps, spread);
+  }
   for (const std::string& b : builds) fmt::print("\n{}", b);
   fmt::print("\n");
   return 0;
