@@ -791,6 +791,10 @@ int Main(int argc, char** argv) {
   int width = 0, height = 0, sessions = 1;
   bool parity = false, realtime = false, pathtraced = false, seed_floor = false, media = false;
   int spp = 64;
+  // the single-camera rows: the CUDA renderer's host threads (RenderSettings::threads; 0 = all
+  // cores), and whether the CPU backend's rows run too
+  int host_threads = 0;
+  bool cpu_rows = true;
   std::vector<int> batch;
   std::vector<std::string> worlds;
   const auto usage = [](const std::string& why) {
@@ -799,7 +803,7 @@ int Main(int argc, char** argv) {
                "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH] | "
                "--media [--size WxH] | "
                "--pathtraced [--size WxH] [--spp N]] "
-               "[world.yaml ...]\n",
+               "[--host-threads N] [--no-cpu] [world.yaml ...]\n",
                why);
     return 2;
   };
@@ -809,6 +813,11 @@ int Main(int argc, char** argv) {
     if (a == "--frames" && has_value) {
       frames = PositiveArg(argv[++i]);
       if (frames == 0) return usage("--frames: expected a positive integer");
+    } else if (a == "--host-threads" && has_value) {
+      host_threads = PositiveArg(argv[++i]);
+      if (host_threads == 0) return usage("--host-threads: expected a positive integer");
+    } else if (a == "--no-cpu") {
+      cpu_rows = false;
     } else if (a == "--sessions" && has_value) {
       sessions = PositiveArg(argv[++i]);
       if (sessions == 0) return usage("--sessions: expected a positive integer");
@@ -894,11 +903,12 @@ int Main(int argc, char** argv) {
     RenderSettings cpu_settings;
     cpu_settings.backend = RenderSettings::Backend::kEmbree;
     cpu_settings.threads = 0;
-    const std::unique_ptr<Renderer> cpu = MakeRenderer(scene, cpu_settings);
+    const std::unique_ptr<Renderer> cpu = cpu_rows ? MakeRenderer(scene, cpu_settings) : nullptr;
     std::unique_ptr<Renderer> gpu;
     if (dev.available) {
       RenderSettings gpu_settings;
       gpu_settings.backend = RenderSettings::Backend::kCuda;
+      gpu_settings.threads = host_threads;
       const auto t0 = Clock::now();
       gpu = MakeRenderer(scene, gpu_settings);
       const double s = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -1081,6 +1091,7 @@ int Main(int argc, char** argv) {
         rows.push_back({name, size, "rgb+depth realtime", "cuda", "kernels only", 1e3 / rgb_ms});
       }
       const int nc = std::max(3, n / 10);
+      if (!cpu_rows) continue;
       rows.push_back(
           {name, size, "depth+seg", "cpu", "Render()", 1 / TimeRenders(cpu.get(), snap, view, nc)});
       rows.push_back({name, size, "all ground truth", "cpu", "Render()",
