@@ -359,9 +359,8 @@ TEST(RealtimeHostPathFrames, WindowSumsInIntegersGiveTheFloatSumsBits) {
       visible[k] = static_cast<float>(std::uniform_int_distribution<int>(0, r)(rng));
       counts[k] = ShadowWindowCounts(vis[k], visible[k], rays[k]);
     }
-    const uint32_t window =
-        (static_cast<uint32_t>(rng()) & ((1u << kShadowWindowTaps) - 1u)) |
-        1u << ShadowWindowBit(0, 0);
+    const uint32_t window = (static_cast<uint32_t>(rng()) & ((1u << kShadowWindowTaps) - 1u)) |
+                            1u << ShadowWindowBit(0, 0);
     float w_rays = 0, w_visible = 0;
     for (uint32_t b = window; b != 0; b &= b - 1) {
       const int bit = LowestSetBit(b);

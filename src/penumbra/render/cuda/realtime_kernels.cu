@@ -1528,9 +1528,9 @@ struct DeviceRealtime::Impl : PixelBuffers {
       }
     } else {
       if (o.tile_visibility)
-        TileKernel<OneFrame>(false, o.packed_window_counts)<<<TileGrid(W, 0, H), kTileBlock, 0,
-                                                             stream>>>(OneFrame{f},
-                                                                       radiance.as<Float3>(), 0, H);
+        TileKernel<OneFrame>(false,
+                             o.packed_window_counts)<<<TileGrid(W, 0, H), kTileBlock, 0, stream>>>(
+            OneFrame{f}, radiance.as<Float3>(), 0, H);
       else
         VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f},
                                                                   radiance.as<Float3>());
@@ -2303,8 +2303,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;
-    TileKernel<BatchFrames>(false, defaults.packed_window_counts)<<<tiles, kTileBlock, 0,
-                                                                   stream>>>(fr, L, 0, H);
+    TileKernel<BatchFrames>(false, defaults.packed_window_counts)<<<tiles, kTileBlock, 0, stream>>>(
+        fr, L, 0, H);
     Check(cudaGetLastError(), "VisibilityTileKernel (batch)");
   } else {
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
