@@ -528,10 +528,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.geometry_min_blocks = 1;
     variants.push_back({"kernels, geometry registers uncapped", o});
-    o.geometry_min_blocks = 6;
-    variants.push_back({"kernels, geometry <= 85 registers", o});
-    o.geometry_min_blocks = 8;
-    variants.push_back({"kernels, geometry <= 64 registers", o});
     o = fast;
     o.queue_penumbra = false;
     variants.push_back({"kernels, penumbra rays per warp (no queue)", o});

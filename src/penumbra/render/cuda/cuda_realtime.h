@@ -142,9 +142,7 @@ struct RealtimeKernelOptions {
   bool queue_shadow_rays_always = false;
   /// the geometry kernel's __launch_bounds__ minimum of resident blocks of 128 threads per SM:
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
-  /// reuse_surface), 6 to 7 at 85, 8 and more at 64 (more warps in flight to hide the node
-  /// fetches' latency, with spills), below 5 leaves them to the compiler. the same arithmetic,
-  /// so the same bits.
+  /// reuse_surface), below 5 leaves them to the compiler.
   int geometry_min_blocks = 5;
   /// with pinned copies, the radiance goes back in this many bands of rows (1 to
   /// kMaxSkyBands), each copied into the frame's image while the next one comes back.

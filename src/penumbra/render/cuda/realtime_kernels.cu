@@ -1333,13 +1333,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const dim3 grid = PixelGrid(f.camera.width, f.camera.height);
     TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
     SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
-    if (o.geometry_min_blocks >= 8)
-      GeometryKernel<OneFrame, 8><<<grid, kPixelBlock, 0, stream>>>(
-          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
-    else if (o.geometry_min_blocks >= 6)
-      GeometryKernel<OneFrame, 6><<<grid, kPixelBlock, 0, stream>>>(
-          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
-    else if (o.geometry_min_blocks >= 5)
+    if (o.geometry_min_blocks >= 5)
       GeometryKernel<OneFrame, 5><<<grid, kPixelBlock, 0, stream>>>(
           OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     else
