@@ -54,6 +54,35 @@ PB_HOST_DEVICE inline float ShadowWindowWeight(int dx, int dy) {
   return (dy == -2 || dy == 2 ? 0.5f : 1.0f) * (dx == -2 || dx == 2 ? 0.5f : 1.0f);
 }
 
+/// the taps of a window mask (bits 0 .. 24, ShadowWindowBit).
+constexpr int kShadowWindowTaps = (2 * kShadowWindowRadius + 1) * (2 * kShadowWindowRadius + 1);
+
+/// 4 ShadowWindowWeight(dx, dy) as an integer: 1 in the corners, 2 on the rest of the outer
+/// rows and columns, 4 inside (64 over the whole window).
+PB_HOST_DEVICE constexpr uint32_t ShadowWindowWeight4(int dx, int dy) {
+  return (dy == -2 || dy == 2 ? 1u : 2u) * (dx == -2 || dx == 2 ? 1u : 2u);
+}
+
+/// one pixel's shadow-ray counts towards a light as the window sums add them
+/// (ShadowWindowSumFraction): its traced rays `rays` (its own verdict and its penumbra rays: 1
+/// to 64, PenumbraLatticePoints) in bits 16-31, its visible ones `visible` (0 to rays) in bits
+/// 0-15; 0 for a pixel without a verdict (`vis` < 0), which the sums leave out. visible and
+/// rays are whole numbers held in floats (integer counts), so the conversion is exact.
+PB_HOST_DEVICE inline uint32_t ShadowWindowCounts(int vis, float visible, float rays) {
+  return vis < 0 ? 0u : static_cast<uint32_t>(rays) << 16 | static_cast<uint32_t>(visible);
+}
+
+/// the fraction of visible rays of a sum of ShadowWindowWeight4-weighted ShadowWindowCounts
+/// (or of one pixel's counts): visible over traced. why the integers give the bits of the float
+/// sums sum(w visible) / sum(w rays) (w = ShadowWindowWeight: 1/4, 1/2 or 1) in any order: every
+/// w rays is a multiple of 1/4 at most 64 and the weights total 16, so every partial sum is a
+/// multiple of 1/4 at most 1,024 (12 significant bits, exact in a float's 24), and each float
+/// sum is exactly the integer sum over 4; (A / 4) / (B / 4) rounds as A / B, and A, B <= 4,096
+/// convert exactly. the halves never carry into each other (4,096 < 2^16).
+PB_HOST_DEVICE inline float ShadowWindowSumFraction(uint32_t sum) {
+  return static_cast<float>(sum & 0xffffu) / static_cast<float>(sum >> 16);
+}
+
 /// whether the hit g (geom, unit normal ng_g facing the ray, point p_g) lies on the surface of
 /// hit i: the same geom, normals within 25 degrees (dot >= 0.9) and g within 5 % of its
 /// distance from i's tangent plane. points in m, world frame. the sums run x + (y + z), the

@@ -77,8 +77,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "tile_penumbra off",
                          "tile_visibility off, tile_penumbra off, fuse_resolve off",
                          "penumbra_chunk_rays 4",
-                         "penumbra_chunk_rays 3"};
-  for (int k = 0; k < 29; ++k) {
+                         "penumbra_chunk_rays 3",
+                         "packed_window_counts off"};
+  for (int k = 0; k < 30; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -113,6 +114,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 26) o.fuse_resolve = false;
     if (k == 27) o.penumbra_chunk_rays = 4;
     if (k == 28) o.penumbra_chunk_rays = 3;
+    if (k == 29) o.packed_window_counts = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

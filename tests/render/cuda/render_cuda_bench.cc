@@ -593,6 +593,9 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     variants.push_back({"kernels, penumbra rays in 16x8 blocks (no tiles)", o});
     o.tile_visibility = false;
     variants.push_back({"kernels, no shadow-tile kernels (both off)", o});
+    o = fast;
+    o.packed_window_counts = false;
+    variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
 
     o = fast;
     o.rows_per_warp = false;

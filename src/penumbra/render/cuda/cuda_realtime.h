@@ -187,6 +187,11 @@ struct RealtimeKernelOptions {
   /// bits; else VisibilityFractionKernel, then the resolve, each reading its neighbours from the
   /// frame's arrays.
   bool tile_visibility = true;
+  /// with tile_visibility: the tile kernel packs each pixel's two ray counts once into one word
+  /// of shared memory (ShadowWindowCounts, render/shadow_window_math.h), which the window's
+  /// integer sums read at each tap; else it keeps both floats there and packs them at each tap
+  /// (WindowTapCounts). the same integers, so the same bits.
+  bool packed_window_counts = true;
   /// with warp_penumbra or queue_penumbra: the penumbra rays' kernel in blocks of one 16x16
   /// shadow tile that copy every light's verdicts of their tile into shared memory first, where
   /// each pixel's window looks for a penumbra (SharedVisibilityPenumbra; frames of at most 128

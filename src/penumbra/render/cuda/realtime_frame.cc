@@ -503,7 +503,8 @@ namespace {
 // the shared visibility of frame f by shadow tiles, as the kernels' blocks with
 // RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
 // VisibilityTileKernel) do it in shared memory: per tile, every light's verdicts copied for the
-// penumbra rays (SharedVisibilityRays), then light after light its verdicts, ray counts and
+// penumbra rays (SharedVisibilityRays), then light after light its verdicts, ray counts (packed
+// once, ShadowWindowCounts, as RealtimeKernelOptions::packed_window_counts packs them) and
 // fractions (SharedWindowFraction) for the resolve (SharedLampFraction, AddSharedVisibility).
 void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;
@@ -533,16 +534,17 @@ void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3*
   });
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
     int8_t vis[kTile];
-    float visible[kTile], rays[kTile], fraction[kTile];
-    const VisibilityTaps taps{vis, visible, rays, fraction, kShadowTileSize};
+    uint32_t counts[kTile];
+    float fraction[kTile];
+    const VisibilityTaps taps{vis, nullptr, nullptr, fraction, kShadowTileSize, counts};
     for (int j = 0; j < f.num_lights; ++j) {
       if (!IsExtendedLightPod(f.lights[j])) continue;
       for (int t = 0; t < kTile; ++t) {
         const int64_t i = tile_pixel(tile, t);
         vis[t] = i < 0 ? int8_t{-1} : f.area_vis[j * n + i];
-        if (vis[t] < 0) continue;
-        visible[t] = f.area_visible[j * n + i];
-        rays[t] = f.area_rays[j * n + i];
+        counts[t] = vis[t] < 0 ? 0u
+                               : ShadowWindowCounts(vis[t], f.area_visible[j * n + i],
+                                                    f.area_rays[j * n + i]);
       }
       for (int t = 0; t < kTile; ++t) {
         const int64_t i = tile_pixel(tile, t);

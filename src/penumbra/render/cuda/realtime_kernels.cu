@@ -678,19 +678,24 @@ __global__ void ResolveBandKernel(Frames frames, Float3* radiance, int row0, int
 // tile_visibility): a block of kTilePixels threads per shadow tile of rows [row0, row1) (row0
 // a multiple of kShadowTileSize, row1 one or the image's last row + 1), kTileLightGroup lights
 // at a time: their verdicts, ray counts and own flags loaded together (every load issued before
-// the first use: one memory latency a group, not three a light) into shared memory, each
+// the first use: one memory latency a group, not three a light) into shared memory (with
+// kPacked, RealtimeKernelOptions::packed_window_counts, each pixel's two counts packed once into
+// one word, ShadowWindowCounts, instead of both floats), each
 // pixel's fractions from there (SharedWindowFraction) into shared memory, then each pixel's V
 // from its neighbours' there (SharedLampFraction) added to its radiance (AddSharedVisibility),
 // the lights in order; with kMirror, then ApplyMirrorLayer (after MirrorShadeKernel). the same
 // functions on the same values in the same order as the two kernels, so the same bits; the
 // windows never leave their tile, so no neighbour is missing.
 constexpr int kTileLightGroup = 8;
-template <class Frames, bool kMirror>
+template <class Frames, bool kMirror, bool kPacked>
 __global__ void __launch_bounds__(kTilePixels)
     VisibilityTileKernel(Frames frames, Float3* radiance, int row0, int row1) {
+  // the unpacked form's counts (kPacked: one element each, never read)
+  constexpr int kCountPixels = kPacked ? 1 : kTilePixels;
   __shared__ int8_t vis[kTileLightGroup][kTilePixels];
   __shared__ uint8_t own[kTileLightGroup][kTilePixels];
-  __shared__ float visible[kTileLightGroup][kTilePixels], rays[kTileLightGroup][kTilePixels],
+  __shared__ uint32_t counts[kTileLightGroup][kPacked ? kTilePixels : 1];
+  __shared__ float visible[kTileLightGroup][kCountPixels], rays[kTileLightGroup][kCountPixels],
       fraction[kTileLightGroup][kTilePixels];
   const RealtimeFrameView& f = frames.get();
   const FramePixel p = PixelOf(f, row0, row1);
@@ -723,8 +728,12 @@ __global__ void __launch_bounds__(kTilePixels)
     for (int l = 0; l < kTileLightGroup; ++l) {
       vis[l][t] = w[l];
       own[l][t] = o[l];
-      visible[l][t] = a[l];
-      rays[l][t] = r[l];
+      if (kPacked) {
+        counts[l][t] = ShadowWindowCounts(w[l], a[l], r[l]);
+      } else {
+        visible[l][t] = a[l];
+        rays[l][t] = r[l];
+      }
     }
     __syncthreads();
     VisibilityTaps taps[kTileLightGroup];
@@ -735,6 +744,7 @@ __global__ void __launch_bounds__(kTilePixels)
       taps[l].rays = rays[l];
       taps[l].fraction = fraction[l];
       taps[l].stride = kShadowTileSize;
+      if (kPacked) taps[l].counts = counts[l];
       if (l < lights && w[l] >= 0 && IsExtendedLightPod(f.lights[g + l]))
         fraction[l][t] = SharedWindowFraction(taps[l], t, window, o[l] != 0);
     }
@@ -759,6 +769,16 @@ __global__ void __launch_bounds__(kTilePixels)
   if (!p) return;
   if (kMirror && f.any_mirror != 0) L = ApplyMirrorLayer(f, p.u, p.v, L);
   radiance[p.k] = L;
+}
+
+// the VisibilityTileKernel of frames `Frames` with (kMirror) or without the mirror blend, the
+// counts packed in shared memory (RealtimeKernelOptions::packed_window_counts) or not.
+template <class Frames>
+auto TileKernel(bool mirror, bool packed) {
+  return mirror ? (packed ? VisibilityTileKernel<Frames, true, true>
+                          : VisibilityTileKernel<Frames, true, false>)
+                : (packed ? VisibilityTileKernel<Frames, false, true>
+                          : VisibilityTileKernel<Frames, false, false>);
 }
 
 // the grid of VisibilityTileKernel over rows [row0, row1) of frames W pixels wide.
@@ -1496,8 +1516,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
         // tile_visibility: the fraction too, a block per shadow tile of the band
         void (*kernel)(OneFrame, Float3*, int, int) =
             o.tile_visibility
-                ? (mirror ? VisibilityTileKernel<OneFrame, true>
-                          : VisibilityTileKernel<OneFrame, false>)
+                ? TileKernel<OneFrame>(mirror, o.packed_window_counts)
                 : (mirror ? ResolveBandKernel<OneFrame, true> : ResolveBandKernel<OneFrame, false>);
         if (r1 > r0) {
           const dim3 band = o.tile_visibility ? TileGrid(W, r0, r1) : PixelGrid(W, r1 - r0);
@@ -1509,7 +1528,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
       }
     } else {
       if (o.tile_visibility)
-        VisibilityTileKernel<OneFrame, false><<<TileGrid(W, 0, H), kTileBlock, 0, stream>>>(
+        TileKernel<OneFrame>(false,
+                             o.packed_window_counts)<<<TileGrid(W, 0, H), kTileBlock, 0, stream>>>(
             OneFrame{f}, radiance.as<Float3>(), 0, H);
       else
         VisibilityResolveKernel<<<grid, kPixelBlock, 0, stream>>>(OneFrame{f},
@@ -2283,7 +2303,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;
-    VisibilityTileKernel<BatchFrames, false><<<tiles, kTileBlock, 0, stream>>>(fr, L, 0, H);
+    TileKernel<BatchFrames>(false, defaults.packed_window_counts)<<<tiles, kTileBlock, 0, stream>>>(
+        fr, L, 0, H);
     Check(cudaGetLastError(), "VisibilityTileKernel (batch)");
   } else {
     VisibilityFractionKernel<<<grid, kPixelBlock, 0, stream>>>(fr);

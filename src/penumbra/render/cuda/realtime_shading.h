@@ -1339,26 +1339,37 @@ struct VisibilityTaps {
   const float* rays = nullptr;      ///< f.area_rays
   const float* fraction = nullptr;  ///< f.area_fraction (SharedLampFraction)
   int64_t stride = 0;
+  /// the pixels' ShadowWindowCounts of vis, visible and rays, packed once (a tile's copy), or
+  /// null: packed from them at each tap (WindowTapCounts)
+  const uint32_t* counts = nullptr;
 };
+
+/// the ShadowWindowCounts of the pixel at kk of t: t.counts's, or packed from t's arrays.
+PB_HOST_DEVICE inline uint32_t WindowTapCounts(const VisibilityTaps& t, int64_t kk) {
+  if (t.counts != nullptr) return t.counts[kk];
+  return ShadowWindowCounts(t.vis[kk], t.visible[kk], t.rays[kk]);
+}
 
 /// the fraction of visible rays at the pixel at `at` (which traced a verdict) with window mask
 /// `window`: its own (visible / rays) where `own` (a tile's outer ring in a penumbra), else the
 /// window's weighted sum of visible rays over its weighted sum of rays (ShadowWindowWeight,
-/// the window's bits in order, neighbours without a verdict left out).
+/// neighbours without a verdict left out). the sums in integers over the 25 taps, each tap's
+/// counts packed in one word (WindowTapCounts, ShadowWindowSumFraction: exactly the float sums
+/// in the window's bit order, whatever the order of the integer adds).
 PB_HOST_DEVICE inline float SharedWindowFraction(const VisibilityTaps& t, int64_t at,
                                                  uint32_t window, bool own) {
-  if (own) return t.visible[at] / t.rays[at];
-  float w_rays = 0, w_visible = 0;
-  for (uint32_t b = window; b != 0; b &= b - 1) {
-    const int bit = LowestSetBit(b);
+  if (own) return ShadowWindowSumFraction(WindowTapCounts(t, at));
+  uint32_t sum = 0;
+#if defined(__CUDA_ARCH__)
+#pragma unroll
+#endif
+  for (int bit = 0; bit < kShadowWindowTaps; ++bit) {
+    if ((window >> bit & 1u) == 0) continue;
     const int dy = bit / 5 - 2, dx = bit % 5 - 2;
-    const int64_t kk = at + static_cast<int64_t>(dy) * t.stride + dx;
-    if (t.vis[kk] < 0) continue;
-    const float w = ShadowWindowWeight(dx, dy);
-    w_rays += w * t.rays[kk];
-    w_visible += w * t.visible[kk];
+    sum += ShadowWindowWeight4(dx, dy) *
+           WindowTapCounts(t, at + static_cast<int64_t>(dy) * t.stride + dx);
   }
-  return w_visible / w_rays;
+  return ShadowWindowSumFraction(sum);
 }
 
 /// the visibility V the resolve gives the pixel at `at` (which traced a verdict), tile-local
