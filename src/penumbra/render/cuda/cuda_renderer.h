@@ -21,6 +21,7 @@
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/cuda_streak_cull.h"
 #include "penumbra/render/cuda/path_frame.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
@@ -73,6 +74,14 @@ class CudaRenderer final : public Renderer {
   /// device work (as before). both give the same bits (the same kernels on the same data).
   void set_late_streaks(bool on) { late_streaks_ = on; }
   bool late_streaks() const { return late_streaks_; }
+  /// whether a realtime frame whose streaks the frame splats itself culls its drops on the
+  /// device (default true, branch gpu27: RealtimeFrameData::set_drop_culler with
+  /// DeviceStreakCull, cuda_streak_cull.h: the drops uploaded, decided by the CPU's shared
+  /// StreakCullDrop one thread each on a high-priority stream, compacted in order and the
+  /// streaks read back; the same streaks and bits as the host's culling); off, the host culls
+  /// them (ParticleStreaks::Build over the pool, as before).
+  void set_device_culling(bool on);
+  bool device_culling() const { return device_culling_; }
   /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
   /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
   /// upload (benchmarks); with late streaks without them (last_late_streaks_ms).
@@ -128,6 +137,8 @@ class CudaRenderer final : public Renderer {
                                       // DevicePath::UploadMedia)
   EffectsFrame path_effects_;         // the frame's effects without media (EffectsWithoutMedia)
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
+  std::unique_ptr<DeviceStreakCull> drop_cull_;  // the device's drop culling (device_culling)
+  bool device_culling_ = false;
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;
   CameraRayTables camera_rays_;  // the frame's camera's ray tables (their device copies:
