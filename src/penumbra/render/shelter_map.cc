@@ -24,6 +24,7 @@ void ShelterMap::Build(const SceneDescription& scene, const std::vector<Pose>& X
     throw Error("ShelterMap::Build: " + std::to_string(X_WB.size()) + " body poses, scene has " +
                 std::to_string(scene.bodies.size()) + " bodies");
   built_ = true;
+  ++version_;
   built_static_poses_ = X_WB;
   roof_.clear();
   nx_ = ny_ = 0;
@@ -96,6 +97,7 @@ ShelterPod ShelterMap::pod() const {
   s.origin_y = origin_.y();
   s.inv_cell = inv_cell_;
   s.margin = kShelterMarginM;
+  s.version = version_;
   return s;
 }
 

@@ -83,6 +83,7 @@ class ShelterMap {
   std::vector<float> roof_;       // [ix + nx iy] roof z, -inf where nothing
   std::vector<Pose> built_static_poses_;
   bool built_ = false;
+  uint64_t version_ = 0;  // Build count (ShelterPod::version)
 };
 
 }  // namespace penumbra

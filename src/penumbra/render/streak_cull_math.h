@@ -34,6 +34,7 @@ struct ShelterPod {
   float origin_x = 0, origin_y = 0;  ///< plan position of cell 0's low corner, m
   float inv_cell = 0;                ///< 1 / cell size, 1/m
   float margin = 0;                  ///< sheltered below the roof by more than this, m
+  uint64_t version = 0;              ///< the map's build count: a new roof has a new version
 };
 
 /// roof height (world z, m) of the cell of `s` holding (x, y); -inf outside the grid

@@ -957,6 +957,7 @@ int Main(int argc, char** argv) {
           // culling (CudaRenderer::set_device_culling(false)), late streaks, interleaved twice;
           // the host's time making the streaks of each (last_late_streaks_ms)
           double cull_host_ms[2] = {0, 0}, cull_device_ms[2] = {0, 0};
+          double cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
           for (int round = 0; round < 2; ++round) {
             const char* again = round == 0 ? "" : ", again";
             g->set_device_culling(false);
@@ -975,12 +976,16 @@ int Main(int argc, char** argv) {
                             "cuda", "Render()",
                             1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
             cull_device_ms[round] = g->last_late_streaks_ms();
+            cull_run_ms[round] = g->device_drop_cull()->run_ms();
+            cull_stage_ms[round] = g->device_drop_cull()->stage_ms();
           }
           builds.push_back(fmt::format(
               "{} {}: late streaks' host time a frame (last timed frame, two rounds): drops "
-              "culled on the device {:.3f} / {:.3f} ms, on the host {:.3f} / {:.3f} ms; {} "
+              "culled on the device {:.3f} / {:.3f} ms (DeviceStreakCull::Run {:.3f} / {:.3f} ms, "
+              "of which staging {:.3f} / {:.3f} ms), on the host {:.3f} / {:.3f} ms; {} "
               "streaks, {} rain drops culled",
-              name, size, cull_device_ms[0], cull_device_ms[1], cull_host_ms[0], cull_host_ms[1],
+              name, size, cull_device_ms[0], cull_device_ms[1], cull_run_ms[0], cull_run_ms[1],
+              cull_stage_ms[0], cull_stage_ms[1], cull_host_ms[0], cull_host_ms[1],
               g->realtime_frame().splat_streaks().View().num,
               g->realtime_frame().streaks_culled()));
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms

@@ -61,7 +61,8 @@ void CudaRenderer::set_device_culling(bool on) {
       sets[s].r = ps.radius_m.data();
       sets[s].n = static_cast<int64_t>(ps.position_W.size());
     }
-    drop_cull_->Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data());
+    drop_cull_->Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data(),
+                    HostParallel());
     drop_cull_->Download(pods);
     *culled = drop_cull_->culled();
   });

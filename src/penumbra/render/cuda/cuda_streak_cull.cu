@@ -5,9 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
 #include <string>
+#include <utility>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
@@ -85,9 +87,15 @@ __global__ void CountKernel(const int32_t* kept, const int32_t* at, int32_t n, i
 
 struct DeviceStreakCull::Impl {
   cudaStream_t stream = nullptr;
-  Buffer p, v, r, first, sets, media, roof;
+  Buffer inputs, roof;
+  PinnedBuffer staged;  // the drops and the small inputs, copied in one transfer
+  // the roof on the device: of which map (pointer, size, version; ShelterPod)
+  const float* roof_of = nullptr;
+  int64_t roof_cells = 0;
+  uint64_t roof_version = 0;
   Buffer kept, culled, bad, at, out, set_of, pods, totals, temp;
   std::vector<int64_t> first_host;
+  std::vector<std::pair<int32_t, int64_t>> chunks;  // (set, first drop) of each staging chunk
   // the highest priority: the culling's blocks go before the waiting blocks of the frame's
   // shading kernels it overlaps (CudaRenderer's late streaks)
   Impl() {
@@ -116,7 +124,7 @@ void DeviceStreakCull::Download(std::vector<StreakPod>* out) const {
 }
 
 void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
-                           const StreakCullSet* flags) {
+                           const StreakCullSet* flags, const ParallelFn& parallel) {
   const auto t0 = std::chrono::steady_clock::now();
   count_ = 0;
   culled_ = 0;
@@ -126,48 +134,78 @@ void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCu
   for (int32_t s = 0; s < num_sets; ++s) m.first_host[s + 1] = m.first_host[s] + sets[s].n;
   const int64_t n64 = m.first_host.back();
   if (n64 == 0) {
-    run_ms_ = 0;
+    run_ms_ = stage_ms_ = 0;
     return;
   }
   if (n64 >= INT32_MAX) throw Error("DeviceStreakCull: more than 2^31 - 1 drops");
   const int32_t n = static_cast<int32_t>(n64);
-  // the drops, set by set, into one array each (pageable copies, staged by the driver)
-  m.p.Reserve(sizeof(float) * 3 * n);
-  m.v.Reserve(sizeof(float) * 3 * n);
-  m.r.Reserve(sizeof(float) * n);
-  for (int32_t s = 0; s < num_sets; ++s) {
-    const size_t k = static_cast<size_t>(sets[s].n), at = static_cast<size_t>(m.first_host[s]);
-    if (k == 0) continue;
-    Check(cudaMemcpyAsync(m.p.as<float>() + 3 * at, sets[s].p, sizeof(float) * 3 * k,
-                          cudaMemcpyHostToDevice, st),
-          "cudaMemcpyAsync");
-    Check(cudaMemcpyAsync(m.v.as<float>() + 3 * at, sets[s].v, sizeof(float) * 3 * k,
-                          cudaMemcpyHostToDevice, st),
-          "cudaMemcpyAsync");
-    Check(cudaMemcpyAsync(m.r.as<float>() + at, sets[s].r, sizeof(float) * k,
-                          cudaMemcpyHostToDevice, st),
-          "cudaMemcpyAsync");
+  // every input in one page-locked block, laid out as on the device (each part 16-byte aligned):
+  // the drops' positions, velocities and radii set after set (copied over `parallel`), then
+  // the sets' first drops and flags and the media; one asynchronous transfer
+  const auto align = [](size_t b) { return (b + 15) / 16 * 16; };
+  const size_t nn = static_cast<size_t>(n);
+  size_t at_part[6], total = 0;
+  const size_t part_bytes[6] = {sizeof(float) * 3 * nn,
+                                sizeof(float) * 3 * nn,
+                                sizeof(float) * nn,
+                                sizeof(int64_t) * (static_cast<size_t>(num_sets) + 1),
+                                sizeof(StreakCullSet) * static_cast<size_t>(num_sets),
+                                sizeof(StreakCullMedium) * static_cast<size_t>(frame.num_media)};
+  for (int k = 0; k < 6; ++k) {
+    at_part[k] = total;
+    total += align(part_bytes[k]);
   }
-  m.first.Upload(m.first_host.data(), sizeof(int64_t) * (num_sets + 1), st);
-  m.sets.Upload(flags, sizeof(StreakCullSet) * num_sets, st);
-  // the frame's pod with its media and roof on the device
+  m.staged.Reserve(total);
+  char* host = m.staged.as<char>();
+  float* hp = reinterpret_cast<float*>(host + at_part[0]);
+  float* hv = reinterpret_cast<float*>(host + at_part[1]);
+  float* hr = reinterpret_cast<float*>(host + at_part[2]);
+  // chunks of drops, each within one set
+  constexpr int64_t kChunk = 16384;
+  m.chunks.clear();
+  for (int32_t s = 0; s < num_sets; ++s)
+    for (int64_t i = 0; i < sets[s].n; i += kChunk) m.chunks.push_back({s, i});
+  const auto copy_chunk = [&](int64_t c) {
+    const int32_t s = m.chunks[c].first;
+    const int64_t i0 = m.chunks[c].second, k = std::min(kChunk, sets[s].n - i0);
+    const int64_t g = m.first_host[s] + i0;
+    std::memcpy(hp + 3 * g, sets[s].p + 3 * i0, sizeof(float) * 3 * k);
+    std::memcpy(hv + 3 * g, sets[s].v + 3 * i0, sizeof(float) * 3 * k);
+    std::memcpy(hr + g, sets[s].r + i0, sizeof(float) * k);
+  };
+  const int64_t num_chunks = static_cast<int64_t>(m.chunks.size());
+  if (parallel)
+    parallel(num_chunks, copy_chunk);
+  else
+    for (int64_t c = 0; c < num_chunks; ++c) copy_chunk(c);
+  std::memcpy(host + at_part[3], m.first_host.data(), part_bytes[3]);
+  if (num_sets > 0) std::memcpy(host + at_part[4], flags, part_bytes[4]);
+  if (frame.num_media > 0) std::memcpy(host + at_part[5], frame.media, part_bytes[5]);
+  m.inputs.Upload(host, total, st);
+  char* dev = m.inputs.as<char>();
   StreakCullFrame f = frame;
-  if (f.num_media > 0) {
-    m.media.Upload(f.media, sizeof(StreakCullMedium) * f.num_media, st);
-    f.media = m.media.as<StreakCullMedium>();
-  }
+  if (f.num_media > 0) f.media = reinterpret_cast<const StreakCullMedium*>(dev + at_part[5]);
+  // the shelter's roof: uploaded again only when the map changed (ShelterPod::version)
   if (f.shelter.roof != nullptr) {
-    const size_t cells = static_cast<size_t>(f.shelter.nx) * static_cast<size_t>(f.shelter.ny);
-    m.roof.Upload(f.shelter.roof, sizeof(float) * cells, st);
+    const int64_t cells = static_cast<int64_t>(f.shelter.nx) * f.shelter.ny;
+    if (m.roof_of != f.shelter.roof || m.roof_cells != cells ||
+        m.roof_version != f.shelter.version) {
+      m.roof.Upload(f.shelter.roof, sizeof(float) * static_cast<size_t>(cells), st);
+      m.roof_of = f.shelter.roof;
+      m.roof_cells = cells;
+      m.roof_version = f.shelter.version;
+    }
     f.shelter.roof = m.roof.as<float>();
   }
+  stage_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   DropArrays d;
-  d.p = m.p.as<float>();
-  d.v = m.v.as<float>();
-  d.r = m.r.as<float>();
-  d.first = m.first.as<int64_t>();
-  d.sets = m.sets.as<StreakCullSet>();
-  d.num_sets = static_cast<int32_t>(num_sets);
+  d.p = reinterpret_cast<const float*>(dev + at_part[0]);
+  d.v = reinterpret_cast<const float*>(dev + at_part[1]);
+  d.r = reinterpret_cast<const float*>(dev + at_part[2]);
+  d.first = reinterpret_cast<const int64_t*>(dev + at_part[3]);
+  d.sets = reinterpret_cast<const StreakCullSet*>(dev + at_part[4]);
+  d.num_sets = num_sets;
   d.n = n;
   m.kept.Reserve(sizeof(int32_t) * n);
   m.culled.Reserve(sizeof(int32_t) * n);

@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/path_streaks.h"
 #include "penumbra/render/streak_cull_math.h"
 
@@ -37,14 +38,16 @@ class DeviceStreakCull {
 
   /// decides every drop of the num_sets `sets` (host arrays; set s has the flags flags[s]) by
   /// `frame` (ParticleStreaks' StreakCullSetup of this frame: its media and shelter roof, host
-  /// arrays, are read here) on the device: the drops, the media and the roof are uploaded
-  /// (pageable copies), the decision and the compaction run, and the count of streaks, of culled
-  /// rain and the first non-finite drop are read back (the call waits for the device). the
-  /// streaks stay on the device (device_streaks(), size()); Download copies them.
+  /// arrays, are read here) on the device: the drops (copied into page-locked staging in chunks
+  /// over `parallel`, may be empty: serially), the sets' flags and the media go over in one
+  /// transfer, the roof only when the map changed (ShelterPod's pointer, size or version), the
+  /// decision and the compaction run, and the count of streaks, of culled rain and the first
+  /// non-finite drop are read back (the call waits for the device). the streaks stay on the
+  /// device (device_streaks(), size()); Download copies them.
   /// @throws ConfigError (key effects.particles[s]) as ParticleStreaks::Build when a drop has a
   /// non-finite value (naming the first such drop). @throws Error on a CUDA failure.
   void Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
-           const StreakCullSet* flags);
+           const StreakCullSet* flags, const ParallelFn& parallel = ParallelFn());
 
   /// streaks kept by the last Run.
   int size() const { return count_; }
@@ -57,6 +60,9 @@ class DeviceStreakCull {
   void Download(std::vector<StreakPod>* out) const;
   /// wall-clock milliseconds of the last Run (uploads, kernels, the count's read-back).
   double run_ms() const { return run_ms_; }
+  /// the part of run_ms before the kernels were queued: the staging copies and the transfers'
+  /// queuing.
+  double stage_ms() const { return stage_ms_; }
 
  private:
   struct Impl;
@@ -64,6 +70,7 @@ class DeviceStreakCull {
   int count_ = 0;
   int culled_ = 0;
   double run_ms_ = 0;
+  double stage_ms_ = 0;
 };
 
 }  // namespace penumbra::cuda
