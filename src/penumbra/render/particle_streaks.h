@@ -50,6 +50,9 @@
 // culling concerns sub-pixel drops far from the lens (coverage falls with distance as
 // r^2 fx / (d |v| T) once widened to half a pixel) and drops deep in fog; drops near the lens
 // have coverage near 1 and are always drawn. sparks (emissive) and snow are never culled.
+// every drop's decision (nothing, culled or a streak) is render/streak_cull_math.h's
+// StreakCullDrop, which the CUDA backend's device culling (render/cuda/cuda_streak_cull.h)
+// calls too.
 // particles cast no shadows and are not seen by secondary rays (reflections, shadow rays);
 // they do not change the depth or segmentation images.
 

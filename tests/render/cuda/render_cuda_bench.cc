@@ -958,24 +958,22 @@ int Main(int argc, char** argv) {
           // the host's time making the streaks of each (last_late_streaks_ms)
           double cull_host_ms[2] = {0, 0}, cull_device_ms[2] = {0, 0};
           double cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
+          // one timed row with the drops culled on the device (or the host); the host's time
+          // making the streaks of its last frame
+          const auto cull_row = [&](bool device, const char* again) {
+            g->set_device_culling(device);
+            rows.push_back({name, size,
+                            fmt::format("rgb+depth realtime + effects (on GPU), late streaks, "
+                                        "drops culled on the {}{}",
+                                        device ? "device" : "host", again),
+                            "cuda", "Render()",
+                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+            return g->last_late_streaks_ms();
+          };
           for (int round = 0; round < 2; ++round) {
             const char* again = round == 0 ? "" : ", again";
-            g->set_device_culling(false);
-            rows.push_back({name, size,
-                            fmt::format("rgb+depth realtime + effects (on GPU), late streaks, "
-                                        "drops culled on the host{}",
-                                        again),
-                            "cuda", "Render()",
-                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-            cull_host_ms[round] = g->last_late_streaks_ms();
-            g->set_device_culling(true);
-            rows.push_back({name, size,
-                            fmt::format("rgb+depth realtime + effects (on GPU), late streaks, "
-                                        "drops culled on the device{}",
-                                        again),
-                            "cuda", "Render()",
-                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
-            cull_device_ms[round] = g->last_late_streaks_ms();
+            cull_host_ms[round] = cull_row(false, again);
+            cull_device_ms[round] = cull_row(true, again);
             cull_run_ms[round] = g->device_drop_cull()->run_ms();
             cull_stage_ms[round] = g->device_drop_cull()->stage_ms();
           }

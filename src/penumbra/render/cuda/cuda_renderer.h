@@ -68,8 +68,9 @@ class CudaRenderer final : public Renderer {
   /// whether a realtime rgb frame with particles whose streaks the frame splats itself
   /// (RealtimeFrameData::device_streaks, the default) makes its streaks late (default true,
   /// branch gpu23): Render prepares the frame without them (RealtimeFrameData::Prepare's
-  /// `streaks` false), queues the device's work up to the shading, and culls the drops
-  /// (RealtimeFrameData::PrepareStreaks: ParticleStreaks::Build) while the GPU traces and shades
+  /// `streaks` false), queues the device's work up to the shading, and makes the streaks
+  /// (RealtimeFrameData::PrepareStreaks: the drops culled on the device, set_device_culling, or
+  /// by ParticleStreaks::Build) while the GPU traces and shades
   /// (DeviceRealtime::Render's `streaks`); off, the streaks are made in Prepare, before any
   /// device work (as before). both give the same bits (the same kernels on the same data).
   void set_late_streaks(bool on) { late_streaks_ = on; }

@@ -114,7 +114,8 @@ class RealtimeFrameData {
   /// the particle streaks of the frame (View's splat, or streaks): with particles in `effects`
   /// (null or none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
   /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
-  /// media hide culled); with device_streaks (the default) the streaks in index order and the
+  /// media hide culled; with a drop culler, set_drop_culler, the culler decides the drops); with
+  /// device_streaks (the default) the streaks in index order and the
   /// camera's projection for the frame's own splat (splat_streaks(), View's splat); else
   /// splatted per pixel over `pool`, rain shaded once per
   /// streak, then each pixel's nearest streak shaded by ParticleStreaks::Shade as
