@@ -50,9 +50,10 @@ void CudaRenderer::set_device_culling(bool on) {
     realtime_->set_drop_culler(RealtimeFrameData::DropCuller());
     return;
   }
-  if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
   realtime_->set_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup,
                                     std::vector<StreakPod>* pods, int* culled) {
+    // made at the first frame with drops (its stream and buffers)
+    if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
     std::vector<DropSet> sets(fx.particles.size());
     for (size_t s = 0; s < sets.size(); ++s) {
       const ParticleSet& ps = fx.particles[s];

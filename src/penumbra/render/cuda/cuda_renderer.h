@@ -83,8 +83,8 @@ class CudaRenderer final : public Renderer {
   /// them (ParticleStreaks::Build over the pool, as before).
   void set_device_culling(bool on);
   bool device_culling() const { return device_culling_; }
-  /// the device's drop culling (null until set_device_culling(true) made it; benchmarks read
-  /// its last Run's times, DeviceStreakCull::run_ms and stage_ms).
+  /// the device's drop culling (null until a frame with drops culled them on the device; benchmarks
+  /// read its last Run's times, DeviceStreakCull::run_ms and stage_ms).
   const DeviceStreakCull* device_drop_cull() const { return drop_cull_.get(); }
   /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
   /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
