@@ -7,61 +7,10 @@
 #include <string>
 
 #include "penumbra/core/error.h"
-#include "penumbra/render/media_common.h"
 #include "penumbra/render/particle_math.h"
 #include "penumbra/render/ray.h"
 
 namespace penumbra {
-
-namespace {
-
-// per frame, per homogeneous medium: what RainInvisible needs of it that does not depend on
-// the streak.
-struct RainCullMedium {
-  bool bounded;       // has a box
-  bool cam_in;        // the camera is in its box (or it is unbounded)
-  float sigma_t_min;  // smallest channel of sigma_t, 1/m
-  float cam_density;  // density at the camera's height
-  Eigen::Vector3f box_min, box_max;
-  const AnalyticMedium* m;
-};
-
-std::vector<RainCullMedium> RainCullMedia(const Eigen::Vector3f& cam_o, const MediaScene* media) {
-  std::vector<RainCullMedium> out;
-  if (media == nullptr) return out;
-  for (const AnalyticMedium& m : media->analytic()) {
-    const bool cam_in = !m.bounded || ((cam_o.array() >= m.box_min.array()).all() &&
-                                       (cam_o.array() <= m.box_max.array()).all());
-    out.push_back(RainCullMedium{m.bounded, cam_in, m.sigma_t.minCoeff(), m.Density(cam_o.z()),
-                                 m.box_min, m.box_max, &m});
-  }
-  return out;
-}
-
-// true when a rain streak of coverage alpha whose nearest point to the camera is p_W cannot
-// change a displayed pixel by kRainCullContrast (particle_streaks.h): alpha times an upper bound
-// of the transmittance of the homogeneous media between the camera and p_W. the bound uses a
-// lower bound of the optical depth: per medium that holds the whole segment (unbounded, or both
-// ends in its box, which is convex), its smallest channel of sigma_t times the length times the
-// smaller density of the two ends (the density is monotonic in height, so along a segment its
-// minimum is at an end). grid media are ignored. both only keep more streaks than exact.
-// media: RainCullMedia(cam_o, ...) of this frame.
-bool RainInvisible(float alpha, const Eigen::Vector3f& cam_o, const Eigen::Vector3f& p_W,
-                   const std::vector<RainCullMedium>& media) {
-  if (alpha < kRainCullContrast) return true;
-  if (media.empty()) return false;
-  const float dist = (p_W - cam_o).norm();
-  float tau = 0;
-  for (const RainCullMedium& m : media) {
-    if (m.bounded && !(m.cam_in && (p_W.array() >= m.box_min.array()).all() &&
-                       (p_W.array() <= m.box_max.array()).all()))
-      continue;
-    tau += m.sigma_t_min * dist * std::min(m.cam_density, m.m->Density(p_W.z()));
-  }
-  return alpha * std::exp(-tau) < kRainCullContrast;
-}
-
-}  // namespace
 
 StreakMotion StreakMotionOf(const Camera& camera) {
   StreakMotion out;
@@ -106,6 +55,76 @@ void StreakRowPoses(const Camera& camera, std::vector<double>* rows) {
   }
 }
 
+void StreakCullSetupOf(const EffectsFrame& fx, const Camera& camera, double exposure_time_sec,
+                       StreakRays rays, const MediaScene* media, const ShelterMap* shelter,
+                       StreakCullSetup* out) {
+  StreakCullFrame& f = out->frame;
+  f = StreakCullFrame();
+  const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
+  f.cam_o = Float3{cam_o.x(), cam_o.y(), cam_o.z()};
+  f.T = static_cast<float>(std::max(0.0, exposure_time_sec));
+  f.fx_px = static_cast<float>(camera.intrinsics().fx);
+  f.four_fx2 = 4.0f * f.fx_px * f.fx_px;
+  f.pixel_hits = rays == StreakRays::kPixelCentres ? 1 : 0;
+  // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
+  // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
+  // would give them an empty pixel box: it clips at kStreakNear + radius >= kStreakNear).
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  f.depth_row = Float3{R_OW(2, 0), R_OW(2, 1), R_OW(2, 2)};
+  f.depth_offset = X_OW.translation().cast<float>().z();
+  // a camera's rays through a lens without distortion: the outward unit normals (world) of the
+  // four side planes of the pyramid of the pixel-centre rays widened by half a pixel (at the
+  // pose X_WO), which holds every ray through the image (pixel samples jittered within their
+  // pixel too), to skip the drops no such ray can meet (StreakCullOutside).
+  f.frustum = rays != StreakRays::kAny && !camera.intrinsics().has_distortion() ? 1 : 0;
+  if (f.frustum != 0) {
+    const CameraIntrinsics& k = camera.intrinsics();
+    const double l = (-0.5 - k.cx) / k.fx, rt = (k.width - 0.5 - k.cx) / k.fx;
+    const double tp = (-0.5 - k.cy) / k.fy, bt = (k.height - 0.5 - k.cy) / k.fy;
+    // optical frame: x right, y down, z forward; outside the left side where x < l z, etc.
+    const Eigen::Vector3d side_O[4] = {{-1, 0, l}, {1, 0, -rt}, {0, -1, tp}, {0, 1, -bt}};
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector3f n = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
+      f.side_W[i] = Float3{n.x(), n.y(), n.z()};
+    }
+    // a moving camera: the planes move by at most turn |x - cam_o| + shift at a point x
+    // (StreakMotionOf).
+    if (camera.motion().moving()) {
+      const StreakMotion m = StreakMotionOf(camera);
+      f.moving = 1;
+      f.turn = m.turn;
+      f.shift = m.shift;
+    }
+  }
+  // the rain culling's media: per homogeneous medium what does not depend on the streak
+  out->media.clear();
+  if (media != nullptr)
+    for (const AnalyticMedium& m : media->analytic()) {
+      const bool cam_in = !m.bounded || ((cam_o.array() >= m.box_min.array()).all() &&
+                                         (cam_o.array() <= m.box_max.array()).all());
+      StreakCullMedium c;
+      c.bounded = m.bounded ? 1 : 0;
+      c.cam_in = cam_in ? 1 : 0;
+      c.sigma_t_min = m.sigma_t.minCoeff();
+      c.cam_density = m.Density(cam_o.z());
+      c.falloff = m.falloff;
+      c.base = m.base;
+      c.box_min = Float3{m.box_min.x(), m.box_min.y(), m.box_min.z()};
+      c.box_max = Float3{m.box_max.x(), m.box_max.y(), m.box_max.z()};
+      out->media.push_back(c);
+    }
+  f.media = out->media.empty() ? nullptr : out->media.data();
+  f.num_media = static_cast<int32_t>(out->media.size());
+  if (shelter != nullptr) f.shelter = shelter->pod();
+  out->sets.resize(fx.particles.size());
+  for (size_t s = 0; s < fx.particles.size(); ++s) {
+    const ParticleSet& ps = fx.particles[s];
+    out->sets[s].rain = ps.kind == ParticleKind::kRain ? 1 : 0;
+    out->sets[s].sheltered = shelter != nullptr && ShelterApplies(ps) ? 1 : 0;
+  }
+}
+
 void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double exposure_time_sec,
                             StreakRays rays, ThreadPool* pool, const MediaScene* media,
                             const ShelterMap* shelter) {
@@ -128,9 +147,6 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
                             std::to_string(ps.velocity_W.size()) + ", " +
                             std::to_string(ps.radius_m.size()) + ")");
   }
-  const float T = static_cast<float>(std::max(0.0, exposure_time_sec));
-  const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
-  const float fx_px = static_cast<float>(camera.intrinsics().fx);
   // every drop's check for finite values, streak and cull flag in parallel chunks (each drop
   // only reads its own input), each chunk keeping its drawn streaks in (set, index) order in its
   // own buffers (reused between frames), which are then concatenated in chunk order, so the
@@ -139,95 +155,26 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
   for (size_t s = 0; s < fx->particles.size(); ++s)
     first[s + 1] = first[s] + fx->particles[s].position_W.size();
   const size_t n_all = first.back();
-  if (n_all == 0) return;
-  const std::vector<RainCullMedium> cull_media = RainCullMedia(cam_o, media);
+  // the frame's inputs of the shared decision (render/streak_cull_math.h, which the CUDA
+  // backend's device culling calls too); without host culling the caller decides the drops
+  StreakCullSetupOf(*fx, camera, exposure_time_sec, rays, media, shelter, &cull_);
+  if (n_all == 0 || !host_culling_) return;
   const bool pixel_hits = rays == StreakRays::kPixelCentres;
-  // realtime: the optical-frame depth of a point (as BuildPixelHits computes it), to drop the
-  // streaks that lie wholly behind the camera's near plane before any other work (BuildPixelHits
-  // would give them an empty pixel box: it clips at kStreakNear + radius >= kStreakNear).
-  const Pose X_OW = camera.X_WO().inverse();
-  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
-  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
-  auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
-  // a camera's rays through a lens without distortion: the outward unit normals (world) of the
-  // four side planes of the pyramid of the pixel-centre rays widened by half a pixel (at the
-  // pose X_WO), which holds every ray through the image (pixel samples jittered within their
-  // pixel too), to skip the drops no such ray can meet (`outside` below).
-  const bool frustum = rays != StreakRays::kAny && !camera.intrinsics().has_distortion();
-  Eigen::Vector3f side_W[4];
-  // a moving camera: the planes move by at most turn |x - cam_o| + shift at a point x
-  // (StreakMotionOf).
-  float turn = 0, shift = 0;
-  const bool moving = camera.motion().moving();
-  if (frustum) {
-    const CameraIntrinsics& k = camera.intrinsics();
-    const double l = (-0.5 - k.cx) / k.fx, rt = (k.width - 0.5 - k.cx) / k.fx;
-    const double tp = (-0.5 - k.cy) / k.fy, bt = (k.height - 0.5 - k.cy) / k.fy;
-    // optical frame: x right, y down, z forward; outside the left side where x < l z, etc.
-    const Eigen::Vector3d side_O[4] = {{-1, 0, l}, {1, 0, -rt}, {0, -1, tp}, {0, 1, -bt}};
-    for (int i = 0; i < 4; ++i)
-      side_W[i] = (camera.X_WO().linear() * side_O[i].normalized()).cast<float>();
-    if (moving) {
-      const StreakMotion m = StreakMotionOf(camera);
-      turn = m.turn;
-      shift = m.shift;
-    }
-  }
-  const float four_fx2 = 4.0f * fx_px * fx_px;
-  // true when the capsule around [p, q] widened to r_wide = max(r, 0.5 dist / fx) (dist <= the
-  // larger distance D of p and q from the camera) lies wholly beyond one side plane: both ends
-  // farther than r and 0.5 D / fx from it (0.1 % to spare for rounding) and, for a moving
-  // camera, than the planes' motion. then no pixel ray meets it (its hits would be none).
-  auto outside = [&](const Eigen::Vector3f& p, const Eigen::Vector3f& q, float r) {
-    const Eigen::Vector3f dp = p - cam_o, dq = q - cam_o;
-    const float D2 = std::max(dp.squaredNorm(), dq.squaredNorm());
-    if (!moving) {
-      for (const Eigen::Vector3f& n : side_W) {
-        const float s = std::min(n.dot(dp), n.dot(dq));
-        if (s > 1.001f * r && four_fx2 * s * s > 1.002f * D2) return true;
-      }
-      return false;
-    }
-    const float D = std::sqrt(D2);
-    const float R = 1.001f * std::max(r, 0.5f * D / fx_px);
-    const float margin = R + turn * (D + R) + shift;
-    for (const Eigen::Vector3f& n : side_W)
-      if (std::min(n.dot(dp), n.dot(dq)) > margin) return true;
-    return false;
-  };
-  // one drop: nothing (radius <= 0; realtime: wholly behind the near plane or outside the
-  // image), culled (counted) or a streak appended to `out`.
+  // one drop: nothing (radius <= 0; sheltered; realtime: wholly behind the near plane or
+  // outside the image), culled (counted) or a streak appended to `out`.
   auto drop = [&](size_t s, size_t i, DropChunk* out) {
     const ParticleSet& ps = fx->particles[s];
     const Eigen::Vector3f& p = ps.position_W[i];
     const Eigen::Vector3f& v = ps.velocity_W[i];
-    const float r = ps.radius_m[i];
-    if (!(r > 0)) return;
-    if (shelter != nullptr && ShelterApplies(ps) && shelter->Sheltered(p))
-      return;  // rain or snow under a roof
-    Eigen::Vector3f q = p + T * v;
-    // a still particle: a capsule of negligible length (Embree needs two distinct ends).
-    if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
-    if (pixel_hits && depth(p) < kStreakNear && depth(q) < kStreakNear) return;  // never drawn
-    if (frustum && outside(p, q, r)) return;                                     // never drawn
-    const float len = T * v.norm();  // the motion, not the widened capsule
-    // widen to half a pixel at the streak's nearest distance to the camera.
-    const Eigen::Vector3f seg = q - p;
-    const float l2 = seg.squaredNorm();
-    const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
-    const float dist = (p + w * seg - cam_o).norm();
-    const float r_wide = std::max(r, 0.5f * dist / fx_px);
-    const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
-    // realtime: rain streaks that change no pixel by a visible step (kRainCullContrast).
-    if (pixel_hits && ps.kind == ParticleKind::kRain &&
-        RainInvisible(alpha, cam_o, p + w * seg, cull_media)) {
-      ++out->culled;
-      return;
-    }
-    out->alpha.push_back(alpha);
+    StreakCullOut o;
+    const int32_t verdict = StreakCullDrop(cull_.frame, cull_.sets[s], Float3{p.x(), p.y(), p.z()},
+                                           Float3{v.x(), v.y(), v.z()}, ps.radius_m[i], &o);
+    if (verdict == kStreakCulled) ++out->culled;
+    if (verdict != kStreakDrawn) return;
+    out->alpha.push_back(o.alpha);
     out->set.push_back(static_cast<int>(s));
-    out->ends.emplace_back(p.x(), p.y(), p.z(), r_wide);
-    out->ends.emplace_back(q.x(), q.y(), q.z(), r_wide);
+    out->ends.emplace_back(p.x(), p.y(), p.z(), o.r_wide);
+    out->ends.emplace_back(o.q.x, o.q.y, o.q.z, o.r_wide);
   };
   constexpr size_t kDropChunk = 4096;
   const size_t drop_chunks = (n_all + kDropChunk - 1) / kDropChunk;

@@ -50,6 +50,9 @@
 // culling concerns sub-pixel drops far from the lens (coverage falls with distance as
 // r^2 fx / (d |v| T) once widened to half a pixel) and drops deep in fog; drops near the lens
 // have coverage near 1 and are always drawn. sparks (emissive) and snow are never culled.
+// every drop's decision (nothing, culled or a streak) is render/streak_cull_math.h's
+// StreakCullDrop, which the CUDA backend's device culling (render/cuda/cuda_streak_cull.h)
+// calls too.
 // particles cast no shadows and are not seen by secondary rays (reflections, shadow rays);
 // they do not change the depth or segmentation images.
 
@@ -65,13 +68,10 @@
 #include "penumbra/render/particle_math.h"
 #include "penumbra/render/shelter_map.h"
 #include "penumbra/render/sky_irradiance_volume.h"
+#include "penumbra/render/streak_cull_math.h"
 #include "penumbra/scene/effects_frame.h"
 
 namespace penumbra {
-
-/// rain streaks whose coverage times media transmittance from the camera is below this are
-/// not drawn in the realtime tier (one 8-bit step of display-linear contrast; see above).
-constexpr float kRainCullContrast = 1.0f / 255.0f;
 
 /// which rays a ParticleStreaks::Build serves, and so which drops it may leave out.
 enum class StreakRays : uint8_t {
@@ -99,6 +99,24 @@ StreakMotion StreakMotionOf(const Camera& camera);
 /// doubles per row into *rows (resized to 12 x height): R_WO row-major, then the origin (world,
 /// m); the layout of StreakSplatView::rows and StreakRowColumnsAtPose.
 void StreakRowPoses(const Camera& camera, std::vector<double>* rows);
+
+/// a frame's inputs of the shared per-drop decision (render/streak_cull_math.h's StreakCullDrop,
+/// which ParticleStreaks::Build and the CUDA backend's device culling call): the camera and
+/// culling pod, the homogeneous media it points at and every particle set's flags.
+struct StreakCullSetup {
+  /// frame.media points into `media` and frame.shelter into the ShelterMap's roof: valid while
+  /// both live unchanged (copying this struct does not move them).
+  StreakCullFrame frame;
+  std::vector<StreakCullMedium> media;
+  std::vector<StreakCullSet> sets;  ///< per EffectsFrame::particles entry
+};
+
+/// fills *out for the drops of `fx` seen by `camera` over an exposure of exposure_time_sec
+/// (>= 0) serving `rays` (StreakRays: which tests apply), the homogeneous media of `media` (may
+/// be null: coverage alone) and `shelter` (may be null), as ParticleStreaks::Build decides them.
+void StreakCullSetupOf(const EffectsFrame& fx, const Camera& camera, double exposure_time_sec,
+                       StreakRays rays, const MediaScene* media, const ShelterMap* shelter,
+                       StreakCullSetup* out);
 
 /// the nearest streak along a ray.
 struct ParticleHit {
@@ -140,6 +158,13 @@ class ParticleStreaks {
   void set_host_splat(bool on) { host_splat_ = on; }
   bool host_splat() const { return host_splat_; }
 
+  /// whether Build decides the drops on the host (default true); false: Build checks the sets'
+  /// lengths and prepares the decision's inputs (cull_setup) but makes no streak (empty, and no
+  /// non-finite check): the CUDA backend's device culling decides the drops from cull_setup
+  /// (render/cuda/cuda_streak_cull.h).
+  void set_host_culling(bool on) { host_culling_ = on; }
+  bool host_culling() const { return host_culling_; }
+
   bool empty() const { return count_ == 0; }
   int size() const { return count_; }
   /// rain streaks culled as invisible by the last Build.
@@ -172,6 +197,9 @@ class ParticleStreaks {
   /// particle set `set` of the frame (an index into EffectsFrame::particles) as ShadeStreak
   /// takes it.
   StreakSetPod SetPod(int set) const;
+  /// the inputs of the last Build's per-drop decision (StreakCullSetupOf; unset when that
+  /// frame had no particles): the CUDA backend's device culling decides the same drops.
+  const StreakCullSetup& cull_setup() const { return cull_; }
   /// the frame of the last Build (null: none).
   const EffectsFrame* frame() const { return fx_; }
   /// per streak (size() of them): its coverage alpha in (0, 1] and its particle set.
@@ -204,6 +232,7 @@ class ParticleStreaks {
   std::vector<uint8_t> visible_;   // per primitive: in the image (BuildPixelHits), or empty
   bool pixel_hits_built_ = false;  // pixel_ holds this frame's hits
   bool host_splat_ = true;         // Build with kPixelCentres splats (BuildPixelHits)
+  bool host_culling_ = true;       // Build decides the drops
   std::vector<double> row_poses_;  // a moving camera's row poses (BuildPixelHits)
   // the streaks one chunk of drops keeps, in order (Build; kept between frames for their
   // capacity).
@@ -215,6 +244,7 @@ class ParticleStreaks {
     size_t bad = 0;  // index of the chunk's first non-finite particle, or the particle count
   };
   std::vector<DropChunk> drop_chunks_;
+  StreakCullSetup cull_;  // the last Build's decision inputs
 
  private:
   void BuildPixelHits(const Camera& camera, ThreadPool* pool);

@@ -24,6 +24,7 @@ void ShelterMap::Build(const SceneDescription& scene, const std::vector<Pose>& X
     throw Error("ShelterMap::Build: " + std::to_string(X_WB.size()) + " body poses, scene has " +
                 std::to_string(scene.bodies.size()) + " bodies");
   built_ = true;
+  ++version_;
   built_static_poses_ = X_WB;
   roof_.clear();
   nx_ = ny_ = 0;
@@ -78,14 +79,26 @@ void ShelterMap::Update(const SceneDescription& scene, const WorldSnapshot& snap
 }
 
 float ShelterMap::RoofHeight(float x, float y) const {
-  const float fx = (x - origin_.x()) * inv_cell_, fy = (y - origin_.y()) * inv_cell_;
-  if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return -std::numeric_limits<float>::infinity();
-  return roof_[static_cast<size_t>(fy) * nx_ + static_cast<size_t>(fx)];
+  if (roof_.empty()) return -std::numeric_limits<float>::infinity();
+  return ShelterRoofHeight(pod(), x, y);
 }
 
 bool ShelterMap::Sheltered(const Eigen::Vector3f& p_W) const {
-  if (roof_.empty()) return false;
-  return p_W.z() < RoofHeight(p_W.x(), p_W.y()) - kShelterMarginM;
+  return ShelterSheltered(pod(), Float3{p_W.x(), p_W.y(), p_W.z()});
+}
+
+ShelterPod ShelterMap::pod() const {
+  ShelterPod s;
+  if (roof_.empty()) return s;
+  s.roof = roof_.data();
+  s.nx = nx_;
+  s.ny = ny_;
+  s.origin_x = origin_.x();
+  s.origin_y = origin_.y();
+  s.inv_cell = inv_cell_;
+  s.margin = kShelterMarginM;
+  s.version = version_;
+  return s;
 }
 
 }  // namespace penumbra

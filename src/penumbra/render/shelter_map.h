@@ -27,6 +27,7 @@
 #include "penumbra/core/pose.h"
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/ray_query.h"
+#include "penumbra/render/streak_cull_math.h"
 #include "penumbra/scene/effects_frame.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
@@ -64,6 +65,11 @@ class ShelterMap {
   /// cell's ray met nothing.
   float RoofHeight(float x, float y) const;
 
+  /// the map as the shared test reads it (render/streak_cull_math.h: ShelterSheltered, which
+  /// Sheltered and the CUDA backend's drop culling call); its roof points into this map (valid
+  /// until the next Build). roof null when the map is empty.
+  ShelterPod pod() const;
+
   bool empty() const { return roof_.empty(); }
   int nx() const { return nx_; }
   int ny() const { return ny_; }
@@ -77,6 +83,7 @@ class ShelterMap {
   std::vector<float> roof_;       // [ix + nx iy] roof z, -inf where nothing
   std::vector<Pose> built_static_poses_;
   bool built_ = false;
+  uint64_t version_ = 0;  // Build count (ShelterPod::version)
 };
 
 }  // namespace penumbra

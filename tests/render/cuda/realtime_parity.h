@@ -80,6 +80,21 @@ inline void AddRollingShutter(CameraView* view) {
       Eigen::AngleAxisd(0.25, Eigen::Vector3d::UnitZ()).toRotationMatrix() * view->X_WO.linear();
 }
 
+/// adds two homogeneous media to *fx (rain in fog, branch gpu27's culling tests): a height fog
+/// over the whole world (sigma_t 0.3 / 0.35 / 0.4 per m below z = 0, falling off by 0.2 per m
+/// above) and a haze in the 20 m box around the world's origin (0.2 per m), so rain streaks a
+/// few metres away are culled as invisible (kRainCullContrast).
+inline void AddRainFog(EffectsFrame* fx) {
+  HomogeneousMedium fog;
+  fog.sigma_t_per_m = Eigen::Vector3f(0.3f, 0.35f, 0.4f);
+  fog.height_falloff_per_m = 0.2f;
+  fx->homogeneous_media.push_back(fog);
+  HomogeneousMedium haze;
+  haze.sigma_t_per_m = Eigen::Vector3f(0.2f, 0.2f, 0.2f);
+  haze.region = BoxRegion{Eigen::Vector3d(-10, -10, -10), Eigen::Vector3d(10, 10, 10)};
+  fx->homogeneous_media.push_back(haze);
+}
+
 /// PSNR (dB) of two 8-bit images of one size: 10 log10(255^2 / MSE); 99 when equal.
 inline double Psnr(const ImageU8& a, const ImageU8& b) {
   if (a.data.size() != b.data.size() || a.data.empty()) return 0;

@@ -18,7 +18,10 @@
 //     and the FNV-1a hashes of the rgb, depth and radiance and the EV100 of a late-streaks frame
 //     and of one with the streaks before the kernels (whether they are bit-identical); then
 //     a rolling-shutter camera turning during the readout (realtime_parity::AddRollingShutter)
-//     with the device splat and the host splat, and the pixels each keys;
+//     with the device splat and the host splat, and the pixels each keys; then the drops
+//     culled on the device (the default since branch gpu27) and on the host
+//     (CudaRenderer::set_device_culling(false)), late streaks, twice interleaved, with the
+//     host's time making the streaks of each and the hashes of a host-culled frame;
 //     with media
 //     (homogeneous or grids), the time of their
 //     realtime volumes' build (RealtimeMedia::Build at 640x480) with Embree's shadow rays, with
@@ -985,6 +988,39 @@ int Main(int argc, char** argv) {
             return g->last_prepare_ms();
           }();
           serial_late(", again");
+          // the drops culled on the device (the default, branch gpu27) against the host's
+          // culling (CudaRenderer::set_device_culling(false)), late streaks, interleaved twice;
+          // the host's time making the streaks of each (last_late_streaks_ms)
+          double cull_host_ms[2] = {0, 0}, cull_device_ms[2] = {0, 0};
+          double cull_run_ms[2] = {0, 0}, cull_stage_ms[2] = {0, 0};
+          // one timed row with the drops culled on the device (or the host); the host's time
+          // making the streaks of its last frame
+          const auto cull_row = [&](bool device, const char* again) {
+            g->set_device_culling(device);
+            rows.push_back({name, size,
+                            fmt::format("rgb+depth realtime + effects (on GPU), late streaks, "
+                                        "drops culled on the {}{}",
+                                        device ? "device" : "host", again),
+                            "cuda", "Render()",
+                            1 / TimeRenders(gpu.get(), snap, rgb, n, fx.get())});
+            return g->last_late_streaks_ms();
+          };
+          for (int round = 0; round < 2; ++round) {
+            const char* again = round == 0 ? "" : ", again";
+            cull_host_ms[round] = cull_row(false, again);
+            cull_device_ms[round] = cull_row(true, again);
+            cull_run_ms[round] = g->device_drop_cull()->run_ms();
+            cull_stage_ms[round] = g->device_drop_cull()->stage_ms();
+          }
+          builds.push_back(fmt::format(
+              "{} {}: late streaks' host time a frame (last timed frame, two rounds): drops "
+              "culled on the device {:.3f} / {:.3f} ms (DeviceStreakCull::Run {:.3f} / {:.3f} ms, "
+              "of which staging {:.3f} / {:.3f} ms), on the host {:.3f} / {:.3f} ms; {} "
+              "streaks, {} rain drops culled",
+              name, size, cull_device_ms[0], cull_device_ms[1], cull_run_ms[0], cull_run_ms[1],
+              cull_stage_ms[0], cull_stage_ms[1], cull_host_ms[0], cull_host_ms[1],
+              g->realtime_frame().splat_streaks().View().num,
+              g->realtime_frame().streaks_culled()));
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
           // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row
           // columns follow the rows' poses since branch gpu25, and the host splat
@@ -1039,6 +1075,24 @@ int Main(int argc, char** argv) {
                 "{:016x}, EV100 {:.17g}",
                 name, size, what, Fnv1a64(bytes(f->rgb.data)), Fnv1a64(bytes(f->depth_m.data)),
                 Fnv1a64(bytes(f->radiance.data)), f->ev100));
+          // and of a frame whose drops the host culled
+          RenderedFrame host_cull_frame;
+          g->set_device_culling(false);
+          gpu->Render(snap, fx.get(), rgb, &host_cull_frame);
+          g->set_device_culling(true);
+          builds.push_back(fmt::format(
+              "{} {}: effects frame, drops culled on the host: FNV-1a of rgb / depth / radiance "
+              "{:016x} / {:016x} / {:016x}, EV100 {:.17g}; the device culling's frame "
+              "bit-identical: {}",
+              name, size, Fnv1a64(bytes(host_cull_frame.rgb.data)),
+              Fnv1a64(bytes(host_cull_frame.depth_m.data)),
+              Fnv1a64(bytes(host_cull_frame.radiance.data)), host_cull_frame.ev100,
+              late_frame.rgb.data == host_cull_frame.rgb.data &&
+                      late_frame.depth_m.data == host_cull_frame.depth_m.data &&
+                      late_frame.radiance.data == host_cull_frame.radiance.data &&
+                      std::memcmp(&late_frame.ev100, &host_cull_frame.ev100, sizeof(double)) == 0
+                  ? "yes"
+                  : "NO"));
           const bool same =
               late_frame.rgb.data == serial_frame.rgb.data &&
               late_frame.depth_m.data == serial_frame.depth_m.data &&

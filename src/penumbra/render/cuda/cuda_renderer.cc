@@ -39,9 +39,35 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
     if (settings.denoise) denoiser_ = std::make_unique<Denoiser>();
   }
   pool_ = std::make_unique<ThreadPool>(settings.threads);
+  set_device_culling(true);
 }
 
 CudaRenderer::~CudaRenderer() = default;
+
+void CudaRenderer::set_device_culling(bool on) {
+  device_culling_ = on;
+  if (!on) {
+    realtime_->set_drop_culler(RealtimeFrameData::DropCuller());
+    return;
+  }
+  realtime_->set_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup,
+                                    std::vector<StreakPod>* pods, int* culled) {
+    // made at the first frame with drops (its stream and buffers)
+    if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
+    std::vector<DropSet> sets(fx.particles.size());
+    for (size_t s = 0; s < sets.size(); ++s) {
+      const ParticleSet& ps = fx.particles[s];
+      sets[s].p = ps.position_W.empty() ? nullptr : ps.position_W.data()->data();
+      sets[s].v = ps.velocity_W.empty() ? nullptr : ps.velocity_W.data()->data();
+      sets[s].r = ps.radius_m.data();
+      sets[s].n = static_cast<int64_t>(ps.position_W.size());
+    }
+    drop_cull_->Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data(),
+                    HostParallel());
+    drop_cull_->Download(pods);
+    *culled = drop_cull_->culled();
+  });
+}
 
 PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
 

@@ -21,6 +21,7 @@
 #include "penumbra/render/cuda/cuda_path.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_realtime.h"
+#include "penumbra/render/cuda/cuda_streak_cull.h"
 #include "penumbra/render/cuda/path_frame.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
@@ -67,12 +68,24 @@ class CudaRenderer final : public Renderer {
   /// whether a realtime rgb frame with particles whose streaks the frame splats itself
   /// (RealtimeFrameData::device_streaks, the default) makes its streaks late (default true,
   /// branch gpu23): Render prepares the frame without them (RealtimeFrameData::Prepare's
-  /// `streaks` false), queues the device's work up to the shading, and culls the drops
-  /// (RealtimeFrameData::PrepareStreaks: ParticleStreaks::Build) while the GPU traces and shades
+  /// `streaks` false), queues the device's work up to the shading, and makes the streaks
+  /// (RealtimeFrameData::PrepareStreaks: the drops culled on the device, set_device_culling, or
+  /// by ParticleStreaks::Build) while the GPU traces and shades
   /// (DeviceRealtime::Render's `streaks`); off, the streaks are made in Prepare, before any
   /// device work (as before). both give the same bits (the same kernels on the same data).
   void set_late_streaks(bool on) { late_streaks_ = on; }
   bool late_streaks() const { return late_streaks_; }
+  /// whether a realtime frame whose streaks the frame splats itself culls its drops on the
+  /// device (default true, branch gpu27: RealtimeFrameData::set_drop_culler with
+  /// DeviceStreakCull, cuda_streak_cull.h: the drops uploaded, decided by the CPU's shared
+  /// StreakCullDrop one thread each on a high-priority stream, compacted in order and the
+  /// streaks read back; the same streaks and bits as the host's culling); off, the host culls
+  /// them (ParticleStreaks::Build over the pool, as before).
+  void set_device_culling(bool on);
+  bool device_culling() const { return device_culling_; }
+  /// the device's drop culling (null until a frame with drops culled them on the device; benchmarks
+  /// read its last Run's times, DeviceStreakCull::run_ms and stage_ms).
+  const DeviceStreakCull* device_drop_cull() const { return drop_cull_.get(); }
   /// host milliseconds of the last rgb frame on the GPU before its device work was queued:
   /// the BVH's instances, the frame's preparation (RealtimeFrameData::Prepare) and any sky
   /// upload (benchmarks); with late streaks without them (last_late_streaks_ms).
@@ -128,6 +141,8 @@ class CudaRenderer final : public Renderer {
                                       // DevicePath::UploadMedia)
   EffectsFrame path_effects_;         // the frame's effects without media (EffectsWithoutMedia)
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
+  std::unique_ptr<DeviceStreakCull> drop_cull_;  // the device's drop culling (device_culling)
+  bool device_culling_ = false;
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;
   CameraRayTables camera_rays_;  // the frame's camera's ray tables (their device copies:

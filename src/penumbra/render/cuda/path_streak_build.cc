@@ -57,6 +57,19 @@ void PathStreakBuild::BuildList(const ParticleStreaks& streaks,
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+void PathStreakBuild::BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
+                                    const Eigen::Vector3f& sky_ambient) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Clear();
+  sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
+  if (pods->empty() || streaks.frame() == nullptr) return;
+  pods_.swap(*pods);
+  const int num_sets = static_cast<int>(streaks.frame()->particles.size());
+  for (int s = 0; s < num_sets; ++s) sets_.push_back(streaks.SetPod(s));
+  build_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void PathStreakBuild::FillPods(const ParticleStreaks& streaks, const int32_t* order) {
   const int n = streaks.size();
   const std::vector<Eigen::Vector4f>& ends = streaks.ends();

@@ -30,6 +30,12 @@ class PathStreakBuild {
   /// nodes null) or rain radiance (the realtime tier's device splat, StreakSplatView, shades
   /// rain per pixel); records the time it took.
   void BuildList(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
+  /// as BuildList, with the streaks already made: *pods (StreakPods in ParticleStreaks' index
+  /// order, prim = the index: the device culling's, cuda_streak_cull.h) swapped in (*pods gets
+  /// this object's old array, for its capacity), the particle sets those of `streaks` (Built
+  /// for the frame without host culling: ParticleStreaks::set_host_culling).
+  void BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
+                     const Eigen::Vector3f& sky_ambient);
   /// no streaks (View's num 0).
   void Clear();
   /// the streaks over this object's arrays (valid until the next Build or Clear).

@@ -147,6 +147,7 @@ void RealtimeFrameData::Prepare(const WorldSnapshot& snapshot, const CameraView&
 }
 
 void RealtimeFrameData::ClearStreaks() {
+  streaks_culled_ = 0;
   streaks_.clear();
   path_streaks_.Clear();
   splat_streaks_.Clear();
@@ -205,36 +206,28 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
   const bool device_splat = realtime && device_streaks_;
+  // the device's drop culling (drop_culler_): the host prepares its inputs only
+  const bool device_cull = device_splat && drop_culler_;
   particles_.set_host_splat(!device_splat);
+  particles_.set_host_culling(!device_cull);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
                    sheltered ? &shelter_ : nullptr);
+  streaks_culled_ = particles_.culled();
+  if (device_cull) {
+    drop_culler_(*fx, particles_.cull_setup(), &culled_pods_, &streaks_culled_);
+    if (culled_pods_.empty()) return;
+    splat_streaks_.BuildListFrom(&culled_pods_, particles_, SkyAmbientRadiance(*frame_sky_));
+    SetSplatCamera(camera);
+    return;
+  }
   if (particles_.empty()) return;
   const Eigen::Vector3f sky_ambient = SkyAmbientRadiance(*frame_sky_);
   if (device_splat) {
     // the streaks in index order and the camera's projection for the frame's splat
     // (StreakSplatView)
     splat_streaks_.BuildList(particles_, sky_ambient);
-    const Pose X_OW = camera.X_WO().inverse();
-    const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
-    std::copy(R_OW.data(), R_OW.data() + 9, splat_camera_.R_OW);
-    splat_camera_.p_OW = ToFloat3(X_OW.translation().cast<float>());
-    const CameraIntrinsics& k = camera.intrinsics();
-    splat_camera_.fx = k.fx;
-    splat_camera_.fy = k.fy;
-    splat_camera_.cx = k.cx;
-    splat_camera_.cy = k.cy;
-    // a moving camera: every row's pose in double, in which the splat takes the row's columns
-    // (StreakSplatView::poses) and, without lens distortion, as the CPU's rays take it
-    // (SplatRay), and the rows' motion, which widens the streaks' boxes (as BuildPixelHits)
-    splat_camera_.rows = nullptr;
-    splat_camera_.poses = nullptr;
-    splat_camera_.motion = StreakMotionOf(camera);
-    if (camera.motion().moving()) {
-      StreakRowPoses(camera, &splat_rows_);
-      splat_camera_.poses = splat_rows_.data();
-      if (!k.has_distortion()) splat_camera_.rows = splat_rows_.data();
-    }
+    SetSplatCamera(camera);
     return;
   }
   particles_.PrecomputeRain(lights_, sky_ambient, volume_.empty() ? nullptr : &volume_, pool);
@@ -271,6 +264,29 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   });
   for (const std::vector<StreakPixel>& row : streak_rows_)
     streaks_.insert(streaks_.end(), row.begin(), row.end());
+}
+
+void RealtimeFrameData::SetSplatCamera(const Camera& camera) {
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> R_OW = X_OW.linear().cast<float>();
+  std::copy(R_OW.data(), R_OW.data() + 9, splat_camera_.R_OW);
+  splat_camera_.p_OW = ToFloat3(X_OW.translation().cast<float>());
+  const CameraIntrinsics& k = camera.intrinsics();
+  splat_camera_.fx = k.fx;
+  splat_camera_.fy = k.fy;
+  splat_camera_.cx = k.cx;
+  splat_camera_.cy = k.cy;
+  // a moving camera: every row's pose in double, in which the splat takes the row's columns
+  // (StreakSplatView::poses) and, without lens distortion, as the CPU's rays take it
+  // (SplatRay), and the rows' motion, which widens the streaks' boxes (as BuildPixelHits)
+  splat_camera_.rows = nullptr;
+  splat_camera_.poses = nullptr;
+  splat_camera_.motion = StreakMotionOf(camera);
+  if (camera.motion().moving()) {
+    StreakRowPoses(camera, &splat_rows_);
+    splat_camera_.poses = splat_rows_.data();
+    if (!k.has_distortion()) splat_camera_.rows = splat_rows_.data();
+  }
 }
 
 void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* pool,

@@ -21,6 +21,7 @@
 // no CUDA runtime here: this file builds on machines without nvcc.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -113,7 +114,8 @@ class RealtimeFrameData {
   /// the particle streaks of the frame (View's splat, or streaks): with particles in `effects`
   /// (null or none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
   /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
-  /// media hide culled); with device_streaks (the default) the streaks in index order and the
+  /// media hide culled; with a drop culler, set_drop_culler, the culler decides the drops); with
+  /// device_streaks (the default) the streaks in index order and the
   /// camera's projection for the frame's own splat (splat_streaks(), View's splat); else
   /// splatted per pixel over `pool`, rain shaded once per
   /// streak, then each pixel's nearest streak shaded by ParticleStreaks::Shade as
@@ -139,6 +141,22 @@ class RealtimeFrameData {
   /// the streaks the frame splats itself (device_streaks; empty without particles or under the
   /// pathtraced tier's settings): PathStreakBuild::View as View's splat.streaks.
   const PathStreakBuild& splat_streaks() const { return splat_streaks_; }
+  /// the drops' culling on the device (branch gpu27; CudaRenderer::set_device_culling sets it):
+  /// with device_streaks under the realtime tier's settings, PrepareStreaks has ParticleStreaks
+  /// prepare the decision's inputs only (set_host_culling(false): the sets' lengths checked, no
+  /// drop decided) and calls it with the frame's effects and those inputs; it fills *pods with
+  /// the drawn streaks in index order (StreakPod, prim = the index) and *culled with the culled
+  /// rain, as ParticleStreaks::Build makes them (or throws its ConfigError), and the splat
+  /// takes them (splat_streaks). empty (the default): the host decides the drops.
+  using DropCuller = std::function<void(const EffectsFrame& fx, const StreakCullSetup& setup,
+                                        std::vector<StreakPod>* pods, int* culled)>;
+  void set_drop_culler(DropCuller culler) { drop_culler_ = std::move(culler); }
+  bool has_drop_culler() const { return static_cast<bool>(drop_culler_); }
+  /// rain streaks culled as invisible by the last PrepareStreaks (host or device culling).
+  int streaks_culled() const { return streaks_culled_; }
+  /// the frame's streaks of the last PrepareStreaks (ParticleStreaks: with the device culling
+  /// only its decision's inputs, cull_setup).
+  const ParticleStreaks& particles() const { return particles_; }
   /// the pathtraced tier's streaks of the last PrepareStreaks (empty under the realtime tier's
   /// settings or without particles); PathStreakBuild::View gives the paths' PathStreaks.
   const PathStreakBuild& path_streaks() const { return path_streaks_; }
@@ -225,9 +243,14 @@ class RealtimeFrameData {
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   bool device_streaks_ = true;
-  PathStreakBuild splat_streaks_;   // the realtime streaks in index order (device_streaks)
-  StreakSplatView splat_camera_;    // their projection (R_OW, p_OW, intrinsics; rows)
-  std::vector<double> splat_rows_;  // a moving camera's row poses (StreakSplatView::rows)
+  PathStreakBuild splat_streaks_;       // the realtime streaks in index order (device_streaks)
+  StreakSplatView splat_camera_;        // their projection (R_OW, p_OW, intrinsics; rows)
+  std::vector<double> splat_rows_;      // a moving camera's row poses (StreakSplatView::rows)
+  DropCuller drop_culler_;              // the device's drop culling (empty: the host's)
+  std::vector<StreakPod> culled_pods_;  // its streaks (swapped into splat_streaks_)
+  int streaks_culled_ = 0;              // rain culled by the last PrepareStreaks
+  // the camera's projection for the frame's splat (splat_camera_, splat_rows_)
+  void SetSplatCamera(const Camera& camera);
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host
   // view (the froxels' records as Rgb4, the grids' light volumes, the sky volume's pod);
   // media_ready_ false until PrepareMedia built them for the frame (PoseWorld clears it)

@@ -1,0 +1,76 @@
+#pragma once
+// the drops of a frame's particle sets culled on the device (branch gpu27): one thread per drop
+// runs the CPU's per-drop decision (render/streak_cull_math.h's StreakCullDrop, which
+// ParticleStreaks::Build calls too) and an order-keeping compaction (cub::DeviceScan's exclusive
+// sum over the kept flags, no atomics) writes the drawn streaks in the host's (set, index)
+// order as StreakPods (a = the drop's position, b = its streak end, r = the widened radius,
+// alpha, prim = the streak's index, set), so the streaks are the host culling's to the bit. the
+// culled rain is counted by cub::DeviceReduce::Sum and the first non-finite drop found by
+// cub::DeviceReduce::Min. the decision's file (streak_cull.cu) is compiled with -fmad=false and
+// the shared functions round every product and sum on their own (MulRn, AddRn) as well.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "penumbra/render/cuda/cuda_kernels.h"
+#include "penumbra/render/cuda/path_streaks.h"
+#include "penumbra/render/streak_cull_math.h"
+
+namespace penumbra::cuda {
+
+/// one particle set's drops as host arrays (ParticleSet's position_W, velocity_W, radius_m).
+struct DropSet {
+  const float* p = nullptr;  ///< 3 per drop: position, world m
+  const float* v = nullptr;  ///< 3 per drop: velocity, world m/s
+  const float* r = nullptr;  ///< per drop: radius, m
+  int64_t n = 0;             ///< drops
+};
+
+/// a frame's drop culling on the device; its buffers grow as needed and are kept between
+/// frames. not thread-safe.
+class DeviceStreakCull {
+ public:
+  DeviceStreakCull();
+  ~DeviceStreakCull();
+  DeviceStreakCull(const DeviceStreakCull&) = delete;
+  DeviceStreakCull& operator=(const DeviceStreakCull&) = delete;
+
+  /// decides every drop of the num_sets `sets` (host arrays; set s has the flags flags[s]) by
+  /// `frame` (ParticleStreaks' StreakCullSetup of this frame: its media and shelter roof, host
+  /// arrays, are read here) on the device: the drops (copied into page-locked staging in chunks
+  /// over `parallel`, may be empty: serially), the sets' flags and the media go over in one
+  /// transfer, the roof only when the map changed (ShelterPod's pointer, size or version), the
+  /// decision and the compaction run, and the count of streaks, of culled rain and the first
+  /// non-finite drop are read back (the call waits for the device). the streaks stay on the
+  /// device (device_streaks(), size()); Download copies them.
+  /// @throws ConfigError (key effects.particles[s]) as ParticleStreaks::Build when a drop has a
+  /// non-finite value (naming the first such drop). @throws Error on a CUDA failure.
+  void Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
+           const StreakCullSet* flags, const ParallelFn& parallel = ParallelFn());
+
+  /// streaks kept by the last Run.
+  int size() const { return count_; }
+  /// rain streaks culled as invisible by the last Run (ParticleStreaks::culled).
+  int culled() const { return culled_; }
+  /// the last Run's streaks on the device (size() of them, index order; null when none).
+  const StreakPod* device_streaks() const;
+  /// copies the last Run's streaks to *out (resized to size()).
+  /// @throws Error on a CUDA failure.
+  void Download(std::vector<StreakPod>* out) const;
+  /// wall-clock milliseconds of the last Run (uploads, kernels, the count's read-back).
+  double run_ms() const { return run_ms_; }
+  /// the part of run_ms before the kernels were queued: the staging copies and the transfers'
+  /// queuing.
+  double stage_ms() const { return stage_ms_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int count_ = 0;
+  int culled_ = 0;
+  double run_ms_ = 0;
+  double stage_ms_ = 0;
+};
+
+}  // namespace penumbra::cuda

@@ -1,0 +1,158 @@
+// the drops culled on the device (branch gpu27, ctest label `gpu`: CudaRenderer's default,
+// cuda_streak_cull.h) against the host's culling (CudaRenderer::set_device_culling(false)) in
+// one renderer: rain, snow and rain in fog (realtime_parity::AddRainFog: a height fog and a box
+// of haze, more rain culled as invisible) at 1 s, 640x480, with the still camera, and rain and
+// snow with a turning rolling-shutter camera (realtime_parity::AddRollingShutter), late streaks
+// and streaks made before the kernels: the
+// same streaks (count, order, sets, ends, widened radii, coverage: the splat's StreakPods byte
+// for byte) and culled count, and the same rgb, radiance, depth and EV100 bits. DeviceStreakCull
+// run alone on the frame's decision inputs with the exposure time changed by one part in a
+// thousand gives other streaks (the comparison can fail); a drop with a non-finite position
+// throws the host's ConfigError, naming it. without a device every test prints "skipped: no
+// CUDA device".
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "penumbra/core/error.h"
+#include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/render/cuda/cuda_renderer.h"
+#include "penumbra/render/cuda/cuda_streak_cull.h"
+#include "penumbra/render/cuda/realtime_frame.h"
+#include "realtime_parity.h"
+
+namespace penumbra {
+namespace {
+
+std::unique_ptr<Renderer> GpuRenderer(const SceneDescription& scene) {
+  RenderSettings settings;
+  settings.backend = RenderSettings::Backend::kCuda;
+  return MakeRenderer(scene, settings);
+}
+
+std::vector<cuda::StreakPod> SplatPods(cuda::CudaRenderer* g) {
+  const cuda::PathStreaks list = g->realtime_frame().splat_streaks().View();
+  return std::vector<cuda::StreakPod>(list.streaks, list.streaks + list.num);
+}
+
+bool SamePods(const std::vector<cuda::StreakPod>& a, const std::vector<cuda::StreakPod>& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(cuda::StreakPod) * a.size()) == 0;
+}
+
+std::vector<cuda::DropSet> DropSetsOf(const EffectsFrame& fx) {
+  std::vector<cuda::DropSet> sets(fx.particles.size());
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const ParticleSet& ps = fx.particles[s];
+    sets[s].p = ps.position_W.data()->data();
+    sets[s].v = ps.velocity_W.data()->data();
+    sets[s].r = ps.radius_m.data();
+    sets[s].n = static_cast<int64_t>(ps.position_W.size());
+  }
+  return sets;
+}
+
+TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
+  if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
+  struct Case {
+    const char* file;
+    bool rolling, fog;
+  };
+  for (const Case& k :
+       {Case{"effects/rain.yaml", false, false}, Case{"effects/rain.yaml", true, false},
+        Case{"effects/snow.yaml", false, false}, Case{"effects/snow.yaml", true, false},
+        Case{"effects/rain.yaml", false, true}}) {
+    {
+      const char* file = k.file;
+      const bool rolling = k.rolling;
+      SCOPED_TRACE(std::string(file) + (rolling ? ", rolling shutter" : ", still camera") +
+                   (k.fog ? ", in fog" : ""));
+      auto [session, snap, view, loaded] = realtime_parity::LoadFrameAt(file, 1.0, 640, 480);
+      ASSERT_TRUE(loaded && !loaded->particles.empty());
+      auto fx = std::make_shared<EffectsFrame>(*loaded);
+      if (k.fog) realtime_parity::AddRainFog(fx.get());
+      if (rolling) realtime_parity::AddRollingShutter(&view);
+      const std::unique_ptr<Renderer> gpu = GpuRenderer(session->scene());
+      auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
+      ASSERT_NE(g, nullptr);
+      EXPECT_TRUE(g->device_culling());
+      RenderedFrame device, host, device_serial, again;
+      gpu->Render(snap, fx.get(), view, &device);
+      const std::vector<cuda::StreakPod> device_pods = SplatPods(g);
+      const int device_culled = g->realtime_frame().streaks_culled();
+      const double device_ms = g->last_late_streaks_ms();
+      g->set_device_culling(false);
+      gpu->Render(snap, fx.get(), view, &host);
+      const std::vector<cuda::StreakPod> host_pods = SplatPods(g);
+      const int host_culled = g->realtime_frame().streaks_culled();
+      const double host_ms = g->last_late_streaks_ms();
+      g->set_device_culling(true);
+      g->set_late_streaks(false);
+      gpu->Render(snap, fx.get(), view, &device_serial);
+      g->set_late_streaks(true);
+      gpu->Render(snap, fx.get(), view, &again);
+      std::printf(
+          "%s 640x480%s%s: %zu streaks culled on the device, %zu on the host (the same: %s), rain "
+          "culled %d / %d; late streaks on the host %.3f ms (device culling) / %.3f ms (host); "
+          "frames bit-identical: %s\n",
+          file, rolling ? ", rolling shutter" : "", k.fog ? ", in fog" : "", device_pods.size(),
+          host_pods.size(), SamePods(device_pods, host_pods) ? "yes" : "NO", device_culled,
+          host_culled, device_ms, host_ms,
+          device.radiance.data == host.radiance.data && device.rgb.data == host.rgb.data ? "yes"
+                                                                                         : "NO");
+      EXPECT_GT(host_pods.size(), 0u);
+      EXPECT_TRUE(SamePods(device_pods, host_pods));
+      EXPECT_EQ(device_culled, host_culled);
+      if (std::string(file) == "effects/rain.yaml") {
+        EXPECT_GT(host_culled, 0);
+      }
+      EXPECT_EQ(device.rgb.data, host.rgb.data);
+      EXPECT_EQ(device.radiance.data, host.radiance.data);
+      EXPECT_EQ(device.depth_m.data, host.depth_m.data);
+      EXPECT_EQ(std::memcmp(&device.ev100, &host.ev100, sizeof(double)), 0);
+      EXPECT_EQ(device_serial.radiance.data, host.radiance.data);
+      EXPECT_EQ(again.radiance.data, device.radiance.data);
+      if (rolling) continue;
+      // DeviceStreakCull alone on the frame's inputs: the same streaks; another exposure time
+      // gives others
+      const StreakCullSetup setup = g->realtime_frame().particles().cull_setup();
+      const std::vector<cuda::DropSet> sets = DropSetsOf(*fx);
+      cuda::DeviceStreakCull cull;
+      cull.Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data());
+      std::vector<cuda::StreakPod> alone;
+      cull.Download(&alone);
+      EXPECT_TRUE(SamePods(alone, host_pods));
+      StreakCullFrame longer = setup.frame;
+      longer.T *= 1.001f;
+      cull.Run(sets.data(), static_cast<int32_t>(sets.size()), longer, setup.sets.data());
+      cull.Download(&alone);
+      EXPECT_FALSE(SamePods(alone, host_pods));
+      // a non-finite drop: the host's error, naming it
+      EffectsFrame bad = *fx;
+      const size_t s = bad.particles.size() - 1;
+      ASSERT_GT(bad.particles[s].position_W.size(), 7u);
+      bad.particles[s].position_W[7].y() = std::numeric_limits<float>::quiet_NaN();
+      const std::vector<cuda::DropSet> bad_sets = DropSetsOf(bad);
+      try {
+        cull.Run(bad_sets.data(), static_cast<int32_t>(bad_sets.size()), setup.frame,
+                 setup.sets.data());
+        ADD_FAILURE() << "no ConfigError for a non-finite drop";
+      } catch (const ConfigError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("effects.particles[" + std::to_string(s) + "]"), std::string::npos)
+            << what;
+        EXPECT_NE(what.find("particle 7 has a non-finite value"), std::string::npos) << what;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace penumbra

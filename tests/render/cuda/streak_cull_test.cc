@@ -1,0 +1,263 @@
+// the drops' shared culling decision (render/streak_cull_math.h's StreakCullDrop, branch gpu27),
+// which ParticleStreaks::Build and the CUDA backend's device culling (cuda_streak_cull.h) call,
+// on the CPU (no GPU needed): on every drop of the rain and snow frames at 1 s, 640x480, of the
+// rain frame in fog (realtime_parity::AddRainFog: a height fog and a box of haze, rain culled as
+// invisible) and of the rain frame seen by a turning rolling-shutter camera, it decides as Build's
+// per-drop code did before the move (kept below as the reference, in its Eigen expressions): the
+// same verdict and the same bits of the streak's end, widened radius and coverage; Build's streaks
+// are the drawn drops in (set, index) order and its culled count theirs. the bits depend on the
+// rounding forms (a distance summed (x + y) + z instead of Eigen's x + (y + z) changes some widened
+// radii), so the comparison can fail. RealtimeFrameData's drop culler (set_drop_culler:
+// PrepareStreaks hands the decision's inputs to it and splats what it returns) fed by a host run of
+// StreakCullDrop with an in-order compaction, as the device's kernels do, gives the host culling's
+// frame to the bit (rgb, radiance, depth, EV100).
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host_path.h"
+#include "penumbra/render/camera.h"
+#include "penumbra/render/cuda/realtime_frame.h"
+#include "penumbra/render/streak_cull_math.h"
+#include "realtime_parity.h"
+
+namespace penumbra {
+namespace {
+
+Eigen::Vector3f E(const Float3& f) { return Eigen::Vector3f(f.x, f.y, f.z); }
+
+// ParticleStreaks::Build's `drop` lambda (with its `outside` and RainInvisible) as it was
+// before branch gpu27, in Eigen, over the frame's decision inputs: the reference.
+int32_t ReferenceDrop(const StreakCullSetup& c, const Camera& camera, size_t s,
+                      const Eigen::Vector3f& p, const Eigen::Vector3f& v, float r,
+                      StreakCullOut* out) {
+  const StreakCullFrame& f = c.frame;
+  const Eigen::Vector3f cam_o = camera.X_WO().translation().cast<float>();
+  const float T = f.T, fx_px = f.fx_px, four_fx2 = 4.0f * fx_px * fx_px;
+  const Pose X_OW = camera.X_WO().inverse();
+  const Eigen::Matrix3f R_OW = X_OW.linear().cast<float>();
+  const Eigen::Vector3f p_OW = X_OW.translation().cast<float>();
+  auto depth = [&](const Eigen::Vector3f& x) { return (R_OW * x + p_OW).z(); };
+  auto outside = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, float rr) {
+    const Eigen::Vector3f dp = a - cam_o, dq = b - cam_o;
+    const float D2 = std::max(dp.squaredNorm(), dq.squaredNorm());
+    if (f.moving == 0) {
+      for (const Float3& n3 : f.side_W) {
+        const Eigen::Vector3f n = E(n3);
+        const float sd = std::min(n.dot(dp), n.dot(dq));
+        if (sd > 1.001f * rr && four_fx2 * sd * sd > 1.002f * D2) return true;
+      }
+      return false;
+    }
+    const float D = std::sqrt(D2);
+    const float R = 1.001f * std::max(rr, 0.5f * D / fx_px);
+    const float margin = R + f.turn * (D + R) + f.shift;
+    for (const Float3& n3 : f.side_W)
+      if (std::min(E(n3).dot(dp), E(n3).dot(dq)) > margin) return true;
+    return false;
+  };
+  auto invisible = [&](float alpha, const Eigen::Vector3f& p_W) {
+    if (alpha < kRainCullContrast) return true;
+    if (c.media.empty()) return false;
+    const float dist = (p_W - cam_o).norm();
+    float tau = 0;
+    for (const StreakCullMedium& m : c.media) {
+      if (m.bounded != 0 && !(m.cam_in != 0 && (p_W.array() >= E(m.box_min).array()).all() &&
+                              (p_W.array() <= E(m.box_max).array()).all()))
+        continue;
+      tau += m.sigma_t_min * dist *
+             std::min(m.cam_density, MediumHeightDensity(m.falloff, m.base, p_W.z()));
+    }
+    return alpha * std::exp(-tau) < kRainCullContrast;
+  };
+  if (!(r > 0)) return kStreakNone;
+  if (c.sets[s].sheltered != 0 && ShelterSheltered(f.shelter, Float3{p.x(), p.y(), p.z()}))
+    return kStreakNone;
+  Eigen::Vector3f q = p + T * v;
+  if (!((q - p).norm() > 1e-3f * r)) q = p + Eigen::Vector3f(1e-3f * r, 0, 0);
+  if (f.pixel_hits != 0 && depth(p) < kStreakNear && depth(q) < kStreakNear) return kStreakNone;
+  if (f.frustum != 0 && outside(p, q, r)) return kStreakNone;
+  const float len = T * v.norm();
+  const Eigen::Vector3f seg = q - p;
+  const float l2 = seg.squaredNorm();
+  const float w = l2 > 0 ? std::clamp((cam_o - p).dot(seg) / l2, 0.0f, 1.0f) : 0.0f;
+  const float dist = (p + w * seg - cam_o).norm();
+  const float r_wide = std::max(r, 0.5f * dist / fx_px);
+  const float alpha = std::min(1.0f, 2 * r / (len + 2 * r)) * (r / r_wide);
+  if (f.pixel_hits != 0 && c.sets[s].rain != 0 && invisible(alpha, p + w * seg))
+    return kStreakCulled;
+  out->q = Float3{q.x(), q.y(), q.z()};
+  out->r_wide = r_wide;
+  out->alpha = alpha;
+  return kStreakDrawn;
+}
+
+uint32_t Bits(float x) {
+  uint32_t u;
+  std::memcpy(&u, &x, 4);
+  return u;
+}
+
+struct CullCase {
+  const char* file;
+  bool rolling;
+  bool fog;  // realtime_parity::AddRainFog
+};
+
+// every drop of the frame: the shared decision against the reference and Build's streaks.
+TEST(StreakCullShared, DecidesEveryDropAsBuildDidBefore) {
+  int64_t fog_free_culled = -1;  // rain's culled drops without the fog
+  for (const CullCase& k :
+       {CullCase{"effects/rain.yaml", false, false}, CullCase{"effects/snow.yaml", false, false},
+        CullCase{"effects/rain.yaml", false, true}, CullCase{"effects/rain.yaml", true, false}}) {
+    SCOPED_TRACE(std::string(k.file) + (k.rolling ? " rolling shutter" : "") +
+                 (k.fog ? " in fog" : ""));
+    auto [session, snap, view, loaded] = realtime_parity::LoadFrameAt(k.file, 1.0, 640, 480);
+    ASSERT_TRUE(loaded && !loaded->particles.empty());
+    auto fx = std::make_shared<EffectsFrame>(*loaded);
+    if (k.fog) realtime_parity::AddRainFog(fx.get());
+    if (k.rolling) realtime_parity::AddRollingShutter(&view);
+    host_path::HostPath path(session->scene(), snap);
+    cuda::RealtimeFrameData& data = path.data();
+    data.Prepare(snap, view, &path.pool(), fx.get());
+    const ParticleStreaks& built = data.particles();
+    const StreakCullSetup& setup = built.cull_setup();
+    const Camera camera(view.X_WO, view.intrinsics, view.motion);
+    EXPECT_EQ(setup.frame.moving != 0, k.rolling);
+    EXPECT_EQ(setup.media.size(), k.fog ? 2u : 0u);
+    int64_t counts[3] = {0, 0, 0}, mismatched = 0, sum_form_differs = 0;
+    std::vector<float> alpha;
+    std::vector<int> set;
+    std::vector<Eigen::Vector4f> ends;
+    for (size_t s = 0; s < fx->particles.size(); ++s) {
+      const ParticleSet& ps = fx->particles[s];
+      for (size_t i = 0; i < ps.position_W.size(); ++i) {
+        const Eigen::Vector3f& p = ps.position_W[i];
+        const Eigen::Vector3f& v = ps.velocity_W[i];
+        StreakCullOut a, b;
+        const int32_t va = StreakCullDrop(setup.frame, setup.sets[s], Float3{p.x(), p.y(), p.z()},
+                                          Float3{v.x(), v.y(), v.z()}, ps.radius_m[i], &a);
+        const int32_t vb = ReferenceDrop(setup, camera, s, p, v, ps.radius_m[i], &b);
+        ++counts[va];
+        bool same = va == vb;
+        if (same && va == kStreakDrawn) {
+          same = Bits(a.q.x) == Bits(b.q.x) && Bits(a.q.y) == Bits(b.q.y) &&
+                 Bits(a.q.z) == Bits(b.q.z) && Bits(a.r_wide) == Bits(b.r_wide) &&
+                 Bits(a.alpha) == Bits(b.alpha);
+          alpha.push_back(a.alpha);
+          set.push_back(static_cast<int>(s));
+          ends.emplace_back(p.x(), p.y(), p.z(), a.r_wide);
+          ends.emplace_back(a.q.x, a.q.y, a.q.z, a.r_wide);
+          // the camera distance of p summed (x + y) + z: another rounding form
+          const Eigen::Vector3f d = p - camera.X_WO().translation().cast<float>();
+          const float other = std::sqrt((d.x() * d.x() + d.y() * d.y()) + d.z() * d.z());
+          sum_form_differs += Bits(other) != Bits(d.norm()) ? 1 : 0;
+        }
+        mismatched += same ? 0 : 1;
+      }
+    }
+    std::printf(
+        "%s%s%s: %lld drops: %lld none, %lld culled, %lld drawn; %lld differ from the "
+        "reference; %lld drawn drops' distance differs summed (x + y) + z\n",
+        k.file, k.rolling ? " (rolling shutter)" : "", k.fog ? " (in fog)" : "",
+        static_cast<long long>(counts[0] + counts[1] + counts[2]),
+        static_cast<long long>(counts[0]), static_cast<long long>(counts[1]),
+        static_cast<long long>(counts[2]), static_cast<long long>(mismatched),
+        static_cast<long long>(sum_form_differs));
+    EXPECT_EQ(mismatched, 0);
+    EXPECT_GT(counts[kStreakDrawn], 0);
+    EXPECT_GT(counts[kStreakNone], 0);
+    EXPECT_GT(sum_form_differs, 0);
+    if (k.fog) {
+      EXPECT_GT(counts[kStreakCulled], fog_free_culled);
+    } else if (std::string(k.file) == "effects/rain.yaml" && !k.rolling) {
+      fog_free_culled = counts[kStreakCulled];
+    }
+    // Build's streaks: the drawn drops in order
+    EXPECT_EQ(built.culled(), counts[kStreakCulled]);
+    ASSERT_EQ(built.size(), static_cast<int>(alpha.size()));
+    EXPECT_EQ(built.set_of(), set);
+    EXPECT_EQ(std::memcmp(built.alpha().data(), alpha.data(), sizeof(float) * alpha.size()), 0);
+    EXPECT_EQ(std::memcmp(built.ends().data(), ends.data(), sizeof(Eigen::Vector4f) * ends.size()),
+              0);
+  }
+}
+
+// a host culler (StreakCullDrop over every drop, kept ones compacted in order, as the device's
+// kernels) behind RealtimeFrameData::set_drop_culler: the same splat list and frame bits as the
+// host culling, still and rolling shutter; a culler that halves the streaks' coverage changes
+// them.
+TEST(StreakCullShared, DropCullerGivesTheHostCullingsBits) {
+  const auto host_culler = [](bool halve_alpha) {
+    return [halve_alpha](const EffectsFrame& fx, const StreakCullSetup& setup,
+                         std::vector<cuda::StreakPod>* pods, int* culled) {
+      pods->clear();
+      *culled = 0;
+      for (size_t s = 0; s < fx.particles.size(); ++s) {
+        const ParticleSet& ps = fx.particles[s];
+        for (size_t i = 0; i < ps.position_W.size(); ++i) {
+          const Eigen::Vector3f& p = ps.position_W[i];
+          const Eigen::Vector3f& v = ps.velocity_W[i];
+          StreakCullOut o;
+          const int32_t verdict =
+              StreakCullDrop(setup.frame, setup.sets[s], Float3{p.x(), p.y(), p.z()},
+                             Float3{v.x(), v.y(), v.z()}, ps.radius_m[i], &o);
+          *culled += verdict == kStreakCulled ? 1 : 0;
+          if (verdict != kStreakDrawn) continue;
+          cuda::StreakPod pod;
+          pod.a[0] = p.x(), pod.a[1] = p.y(), pod.a[2] = p.z();
+          pod.b[0] = o.q.x, pod.b[1] = o.q.y, pod.b[2] = o.q.z;
+          pod.r = o.r_wide;
+          pod.alpha = halve_alpha ? 0.5f * o.alpha : o.alpha;
+          pod.prim = static_cast<int32_t>(pods->size());
+          pod.set = static_cast<int32_t>(s);
+          pods->push_back(pod);
+        }
+      }
+    };
+  };
+  for (bool rolling : {false, true}) {
+    SCOPED_TRACE(rolling ? "rolling shutter" : "still");
+    auto [session, snap, view, fx] =
+        realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
+    if (rolling) realtime_parity::AddRollingShutter(&view);
+    host_path::HostPath path(session->scene(), snap);
+    cuda::RealtimeFrameData& data = path.data();
+    ASSERT_FALSE(data.has_drop_culler());
+    const RenderedFrame host = path.Render(view, fx.get());
+    const cuda::PathStreaks host_list = data.splat_streaks().View();
+    std::vector<cuda::StreakPod> host_pods(host_list.streaks, host_list.streaks + host_list.num);
+    const int host_culled = data.streaks_culled();
+    data.set_drop_culler(host_culler(false));
+    const RenderedFrame culled = path.Render(view, fx.get());
+    const cuda::PathStreaks list = data.splat_streaks().View();
+    EXPECT_FALSE(data.particles().host_culling());
+    EXPECT_EQ(data.particles().size(), 0);
+    ASSERT_GT(list.num, 0);
+    ASSERT_EQ(list.num, host_list.num);
+    EXPECT_EQ(std::memcmp(list.streaks, host_pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
+    EXPECT_EQ(data.streaks_culled(), host_culled);
+    EXPECT_EQ(culled.rgb.data, host.rgb.data);
+    EXPECT_EQ(culled.radiance.data, host.radiance.data);
+    EXPECT_EQ(culled.depth_m.data, host.depth_m.data);
+    EXPECT_EQ(std::memcmp(&culled.ev100, &host.ev100, sizeof(double)), 0);
+    data.set_drop_culler(host_culler(true));
+    const RenderedFrame short_one = path.Render(view, fx.get());
+    EXPECT_NE(short_one.radiance.data, host.radiance.data);
+    data.set_drop_culler(cuda::RealtimeFrameData::DropCuller());
+    const RenderedFrame again = path.Render(view, fx.get());
+    EXPECT_TRUE(data.particles().host_culling());
+    EXPECT_EQ(again.radiance.data, host.radiance.data);
+  }
+}
+
+}  // namespace
+}  // namespace penumbra
