@@ -163,8 +163,14 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
   // a popped child is visited if its entry is not beyond the closest hit found since (the entry
   // does not depend on the ray's far end, so this is the slab test against the shorter ray,
   // without reloading the box).
-  int stack_first[kMaxBvhDepth], stack_count[kMaxBvhDepth];
-  float stack_t[kMaxBvhDepth];
+  // one 16-byte entry a child (a single vector store and load on the GPU, whose stack lives in
+  // local memory, against three of 4 bytes)
+  struct alignas(16) Pending {
+    int first, count;
+    float t;
+    int unused;
+  };
+  Pending stack[kMaxBvhDepth];
   int top = 0;
   bool found = false;
   // the node in hand: a leaf (count >= 0) or inner node `first` (count -1)
@@ -184,11 +190,9 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
       const bool ha = ta != INFINITY, hb = tb != INFINITY;
       if (ha && hb) {
         const bool a_first = ta <= tb;
-        if (top < kMaxBvhDepth) {
-          stack_first[top] = a_first ? n.first[1] : n.first[0];
-          stack_count[top] = a_first ? n.count[1] : n.count[0];
-          stack_t[top++] = a_first ? tb : ta;
-        }
+        if (top < kMaxBvhDepth)
+          stack[top++] = Pending{a_first ? n.first[1] : n.first[0],
+                                 a_first ? n.count[1] : n.count[0], a_first ? tb : ta, 0};
         first = a_first ? n.first[0] : n.first[1];
         count = a_first ? n.count[0] : n.count[1];
         continue;
@@ -202,10 +206,10 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
     // pop, skipping children now farther than the closest hit
     bool next = false;
     while (top > 0) {
-      --top;
-      if (stack_t[top] <= *t_max) {
-        first = stack_first[top];
-        count = stack_count[top];
+      const Pending e = stack[--top];
+      if (e.t <= *t_max) {
+        first = e.first;
+        count = e.count;
         next = true;
         break;
       }
