@@ -6,7 +6,7 @@
 // order as StreakPods (a = the drop's position, b = its streak end, r = the widened radius,
 // alpha, prim = the streak's index, set), so the streaks are the host culling's to the bit. the
 // culled rain is counted by cub::DeviceReduce::Sum and the first non-finite drop found by
-// cub::DeviceReduce::Min. the decision's file (streak_cull.cu) is compiled with -fmad=false and
+// cub::DeviceReduce::Min. the decision's file (cuda_streak_cull.cu) is compiled with -fmad=false and
 // the shared functions round every product and sum on their own (MulRn, AddRn) as well.
 
 #include <cstdint>
