@@ -1,6 +1,6 @@
 #pragma once
 // the per-drop decision of ParticleStreaks::Build (render/particle_streaks.h) written once for
-// the CPU and the CUDA backend's device culling (render/cuda/streak_cull.h, branch gpu27): a
+// the CPU and the CUDA backend's device culling (render/cuda/cuda_streak_cull.h, branch gpu27): a
 // drop is nothing (no radius, sheltered, behind the near plane, outside the camera's view
 // pyramid), a rain streak culled as invisible (kRainCullContrast over the homogeneous media's
 // transmittance) or a streak (its far end, widened radius and coverage). plain data only (Float3,
@@ -71,8 +71,8 @@ struct StreakCullSet {
   int32_t sheltered = 0;  ///< ShelterApplies: the shelter map leaves its sheltered drops out
 };
 
-/// per frame: the camera, exposure and culling inputs of the decision (ParticleStreaks::
-/// CullFrameOf fills it).
+/// per frame: the camera, exposure and culling inputs of the decision (StreakCullSetupOf,
+/// particle_streaks.h, fills it).
 struct StreakCullFrame {
   Float3 cam_o;        ///< the camera's origin X_WO (world, m)
   float T = 0;         ///< exposure time, s (>= 0)
