@@ -208,8 +208,7 @@ void ParticleStreaks::Build(const EffectsFrame* fx, const Camera& camera, double
     if (g == n_all) continue;
     const size_t s =
         static_cast<size_t>(std::upper_bound(first.begin(), first.end(), g) - first.begin()) - 1;
-    throw ConfigError("", 0, "effects.particles[" + std::to_string(s) + "]",
-                      "particle " + std::to_string(g - first[s]) + " has a non-finite value");
+    throw NonFiniteParticleError(s, g - first[s]);
   }
   size_t total = 0;
   for (size_t c = 0; c < drop_chunks; ++c) {

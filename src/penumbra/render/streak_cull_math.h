@@ -14,7 +14,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
+#include "penumbra/core/error.h"
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/media_scene_math.h"
 #include "penumbra/render/particle_math.h"
@@ -26,6 +28,13 @@ namespace penumbra {
 /// not drawn in the realtime tier (one 8-bit step of display-linear contrast; see
 /// particle_streaks.h).
 constexpr float kRainCullContrast = 1.0f / 255.0f;
+
+/// the error ParticleStreaks::Build and the device culling report for the first drop with a
+/// non-finite position, velocity or radius: drop `index` of particle set `set` (host only).
+inline ConfigError NonFiniteParticleError(size_t set, size_t index) {
+  return ConfigError("", 0, "effects.particles[" + std::to_string(set) + "]",
+                     "particle " + std::to_string(index) + " has a non-finite value");
+}
 
 /// a ShelterMap as the shared test reads it (ShelterMap::pod): roof heights per plan cell.
 struct ShelterPod {

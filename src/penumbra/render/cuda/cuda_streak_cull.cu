@@ -253,9 +253,7 @@ void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCu
     const int64_t g = host_totals[2];
     int32_t s = 0;
     while (g >= m.first_host[s + 1]) ++s;
-    throw ConfigError(
-        "", 0, "effects.particles[" + std::to_string(s) + "]",
-        "particle " + std::to_string(g - m.first_host[s]) + " has a non-finite value");
+    throw NonFiniteParticleError(static_cast<size_t>(s), static_cast<size_t>(g - m.first_host[s]));
   }
   count_ = host_totals[0];
   culled_ = host_totals[1];
