@@ -25,6 +25,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "penumbra/core/exp_rn.h"
 #include "penumbra/core/host_device.h"
 #include "penumbra/core/rng.h"
 #include "penumbra/render/bsdf_math.h"
@@ -72,8 +73,13 @@ PB_HOST_DEVICE inline float MediaMax3(const Float3& c) { return pbm::Max(pbm::Ma
 
 /// the relative density h(z) = exp(-falloff max(0, z - base)) in (0, 1] of a homogeneous medium
 /// of height falloff `falloff` (1/m, 0 = uniform) above `base` (m) (AnalyticMedium::Density).
+/// kExactExp: the exponential by ExpRn (core/exp_rn.h: the same bits on both processors; the
+/// rain streaks' culling, streak_cull_math.h), else expf.
+template <bool kExactExp = false>
 PB_HOST_DEVICE inline float MediumHeightDensity(float falloff, float base, float z) {
-  return falloff > 0 && z > base ? expf(-falloff * (z - base)) : 1.0f;
+  if (!(falloff > 0 && z > base)) return 1.0f;
+  const float x = -falloff * (z - base);
+  return kExactExp ? ExpRn(x) : expf(x);
 }
 
 /// a homogeneous medium's tracing terms besides its MediumPod (AnalyticMedium's).

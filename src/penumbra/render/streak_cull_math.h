@@ -7,9 +7,9 @@
 // the pods below): no Eigen. every product and sum is rounded on its own (MulRn, AddRn, SubRn)
 // and dot products and squared norms are summed as Eigen sums a Vector3f's (EigenDotRn:
 // x + (y + z)), so that the device decides every drop as the CPU does, to the bit; division and
-// square root are IEEE on both processors (no fast math). the exponentials (the rain culling in
-// media) are expf on both, which may differ by an ulp between glibc and CUDA: a drop whose
-// attenuated coverage lies within that of kRainCullContrast could be decided otherwise.
+// square root are IEEE on both processors (no fast math), and the exponentials (the rain culling
+// in media) are ExpRn (core/exp_rn.h), whose bits are the same on both (expf's may differ by an
+// ulp between glibc and CUDA).
 
 #include <cmath>
 #include <cstddef>
@@ -17,6 +17,7 @@
 #include <string>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/exp_rn.h"
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/media_scene_math.h"
 #include "penumbra/render/particle_math.h"
@@ -165,10 +166,10 @@ PB_HOST_DEVICE inline bool StreakRainInvisible(const StreakCullFrame& f, float a
         !(m.cam_in != 0 && p_W.x >= m.box_min.x && p_W.y >= m.box_min.y && p_W.z >= m.box_min.z &&
           p_W.x <= m.box_max.x && p_W.y <= m.box_max.y && p_W.z <= m.box_max.z))
       continue;
-    const float h = pbm::Min(m.cam_density, MediumHeightDensity(m.falloff, m.base, p_W.z));
+    const float h = pbm::Min(m.cam_density, MediumHeightDensity<true>(m.falloff, m.base, p_W.z));
     tau = AddRn(tau, MulRn(MulRn(m.sigma_t_min, dist), h));
   }
-  return MulRn(alpha, expf(-tau)) < kRainCullContrast;
+  return MulRn(alpha, ExpRn(-tau)) < kRainCullContrast;
 }
 
 /// the decision of one drop at p (world, m) moving at v (m/s) of radius r (m; finite values) of

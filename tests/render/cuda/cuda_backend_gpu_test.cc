@@ -8,15 +8,19 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "path_parity.h"
+#include "penumbra/core/exp_rn.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 #include "penumbra/scene/camera_pose.h"
@@ -170,6 +174,29 @@ INSTANTIATE_TEST_SUITE_P(Bundled, CudaBackendWorlds,
 // the pool or one thread, or pageable copies) write the same bytes into every image, also where
 // the frame's shape changes between calls (a frame reused, one resized) and where the rows do
 // not split evenly into the bands.
+// the shared exponential (core/exp_rn.h) gives the host's bits on the device, where expf need
+// not (the rain streaks' culling decides drops with it on both processors).
+TEST(CudaBackend, SharedExponentialGivesTheHostsBits) {
+  PB_REQUIRE_CUDA_DEVICE();
+  std::vector<float> x;
+  const int n = 1 << 21;
+  for (int i = 0; i <= n; ++i) x.push_back(-104.0f + (88.7f + 104.0f) * static_cast<float>(i) / n);
+  for (float t = -20.0f; t <= 0.0f; t += 1.0f / 4096) x.push_back(t);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (float t : {0.0f, -0.0f, 1e-30f, 88.72f, 88.75f, -100.0f, -104.5f, inf, -inf})
+    x.push_back(t);
+  std::vector<float> device(x.size());
+  cuda::ExpRnOnDevice(x.data(), device.data(), static_cast<int64_t>(x.size()));
+  int differ = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const float host = ExpRn(x[i]);
+    if (std::memcmp(&host, &device[i], sizeof(float)) == 0) continue;
+    if (differ++ < 5)
+      ADD_FAILURE() << "ExpRn(" << x[i] << "): host " << host << ", device " << device[i];
+  }
+  EXPECT_EQ(differ, 0) << "of " << x.size() << " arguments";
+}
+
 TEST(CudaBackend, PrimaryCopyVariantsWriteTheSameBytes) {
   PB_REQUIRE_CUDA_DEVICE();
   const std::unique_ptr<Session> session = LoadBundled("house.yaml");

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/exp_rn.h"
 #include "penumbra/render/analytic_shape_math.h"
 #include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/cuda_device_buffer.h"
@@ -44,6 +45,11 @@ __global__ void PrimaryKernel(SceneView s, PinholeCamera c, PixelTruthPlanes out
   const F3 axes_W[3] = {c.ex, c.ey, c.ez};
   out.Write(TracePixelTruth(s, PrimaryRay(c, u, v), out.normal_O ? axes_W : nullptr),
             static_cast<int64_t>(v) * c.width + u);
+}
+
+__global__ void ExpRnKernel(const float* x, float* y, int64_t n) {
+  const int64_t i = blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x;
+  if (i < n) y[i] = ExpRn(x[i]);
 }
 
 }  // namespace
@@ -87,6 +93,19 @@ struct DeviceScene::Impl {
   // the bytes of the instances the device holds (Sync uploads them only when they change)
   std::vector<uint8_t> uploaded_instances;
 };
+
+void ExpRnOnDevice(const float* x, float* y, int64_t n) {
+  if (n <= 0) return;
+  Buffer dx, dy;
+  dx.Upload(x, n * sizeof(float), nullptr);
+  dy.Reserve(n * sizeof(float));
+  const int block = 256;
+  ExpRnKernel<<<static_cast<unsigned>((n + block - 1) / block), block>>>(dx.as<float>(),
+                                                                        dy.as<float>(), n);
+  Check(cudaGetLastError(), "ExpRnKernel launch");
+  dy.Download(y, n * sizeof(float), nullptr);
+  Check(cudaDeviceSynchronize(), "ExpRnKernel");
+}
 
 DeviceScene::DeviceScene() : impl_(new Impl) {
   try {

@@ -19,6 +19,11 @@ namespace penumbra::cuda {
 /// CUDA runtime version" on a machine without a GPU driver). *name: the first device's name.
 bool ProbeDevice(std::string* name, std::string* why);
 
+/// ExpRn (core/exp_rn.h) of the n floats x evaluated on the device into y (host arrays of n):
+/// the shared exponential's device bits, which the tests compare with the host's.
+/// @throws Error on a CUDA failure.
+void ExpRnOnDevice(const float* x, float* y, int64_t n);
+
 /// a pinhole camera as the primary-ray kernel takes it: world ray through pixel (u, v) (pixel
 /// centres are integers) is o + t (((u - cx) inv_fx) ex + ((v - cy) inv_fy) ey + ez), as
 /// Camera::GenerateRay (render/camera.h) for a camera without distortion or motion.
