@@ -21,7 +21,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -223,6 +225,31 @@ void CullOnHost(const EffectsFrame& fx, const StreakCullSetup& setup, bool halve
   }
 }
 
+// rain at 1 s, 160x120 (the turning rolling shutter of AddRollingShutter where `rolling`) on the
+// host path, and its frame with the host's culling: the splat's StreakPods and the culled rain.
+// path refers to w's snapshot: kept behind a pointer.
+struct HostCulledRain {
+  realtime_parity::WorldFrame w;
+  std::unique_ptr<host_path::HostPath> path;
+  RenderedFrame frame;
+  std::vector<cuda::StreakPod> pods;
+  int culled = 0;
+};
+
+std::unique_ptr<HostCulledRain> RenderHostCulledRain(bool rolling) {
+  auto r = std::make_unique<HostCulledRain>();
+  r->w = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
+  if (rolling) realtime_parity::AddRollingShutter(&r->w.view);
+  r->path = std::make_unique<host_path::HostPath>(r->w.session->scene(), r->w.snap);
+  cuda::RealtimeFrameData& data = r->path->data();
+  EXPECT_FALSE(data.has_drop_culler());
+  r->frame = r->path->Render(r->w.view, r->w.fx.get());
+  const cuda::PathStreaks list = data.splat_streaks().View();
+  r->pods.assign(list.streaks, list.streaks + list.num);
+  r->culled = data.streaks_culled();
+  return r;
+}
+
 // a host culler (StreakCullDrop over every drop, kept ones compacted in order, as the device's
 // kernels) behind RealtimeFrameData::set_drop_culler: the same splat list and frame bits as the
 // host culling, still and rolling shutter; a culler that halves the streaks' coverage changes
@@ -235,34 +262,30 @@ TEST(StreakCullShared, DropCullerGivesTheHostCullingsBits) {
   };
   for (bool rolling : {false, true}) {
     SCOPED_TRACE(rolling ? "rolling shutter" : "still");
-    auto [session, snap, view, fx] =
-        realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
-    if (rolling) realtime_parity::AddRollingShutter(&view);
-    host_path::HostPath path(session->scene(), snap);
+    const std::unique_ptr<HostCulledRain> rain = RenderHostCulledRain(rolling);
+    const CameraView& view = rain->w.view;
+    const EffectsFrame* fx = rain->w.fx.get();
+    host_path::HostPath& path = *rain->path;
     cuda::RealtimeFrameData& data = path.data();
-    ASSERT_FALSE(data.has_drop_culler());
-    const RenderedFrame host = path.Render(view, fx.get());
-    const cuda::PathStreaks host_list = data.splat_streaks().View();
-    std::vector<cuda::StreakPod> host_pods(host_list.streaks, host_list.streaks + host_list.num);
-    const int host_culled = data.streaks_culled();
+    const RenderedFrame& host = rain->frame;
     data.set_drop_culler(host_culler(false));
-    const RenderedFrame culled = path.Render(view, fx.get());
+    const RenderedFrame culled = path.Render(view, fx);
     const cuda::PathStreaks list = data.splat_streaks().View();
     EXPECT_FALSE(data.particles().host_culling());
     EXPECT_EQ(data.particles().size(), 0);
     ASSERT_GT(list.num, 0);
-    ASSERT_EQ(list.num, host_list.num);
-    EXPECT_EQ(std::memcmp(list.streaks, host_pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
-    EXPECT_EQ(data.streaks_culled(), host_culled);
+    ASSERT_EQ(static_cast<size_t>(list.num), rain->pods.size());
+    EXPECT_EQ(std::memcmp(list.streaks, rain->pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
+    EXPECT_EQ(data.streaks_culled(), rain->culled);
     EXPECT_EQ(culled.rgb.data, host.rgb.data);
     EXPECT_EQ(culled.radiance.data, host.radiance.data);
     EXPECT_EQ(culled.depth_m.data, host.depth_m.data);
     EXPECT_EQ(std::memcmp(&culled.ev100, &host.ev100, sizeof(double)), 0);
     data.set_drop_culler(host_culler(true));
-    const RenderedFrame short_one = path.Render(view, fx.get());
+    const RenderedFrame short_one = path.Render(view, fx);
     EXPECT_NE(short_one.radiance.data, host.radiance.data);
     data.set_drop_culler(cuda::RealtimeFrameData::DropCuller());
-    const RenderedFrame again = path.Render(view, fx.get());
+    const RenderedFrame again = path.Render(view, fx);
     EXPECT_TRUE(data.particles().host_culling());
     EXPECT_EQ(again.radiance.data, host.radiance.data);
   }
@@ -281,17 +304,13 @@ TEST(StreakCullShared, DropCullerGivesTheHostCullingsBits) {
 TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
   for (bool rolling : {false, true}) {
     SCOPED_TRACE(rolling ? "rolling shutter" : "still");
-    auto [session, snap, view, fx] =
-        realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
-    if (rolling) realtime_parity::AddRollingShutter(&view);
-    host_path::HostPath path(session->scene(), snap);
-    cuda::RealtimeFrameData& data = path.data();
-    const RenderedFrame host = path.Render(view, fx.get());
-    const cuda::PathStreaks host_list = data.splat_streaks().View();
-    const std::vector<cuda::StreakPod> host_pods(host_list.streaks,
-                                                 host_list.streaks + host_list.num);
-    const int host_culled = data.streaks_culled();
-    ASSERT_GT(host_list.num, 0);
+    // the host culling's frame, splat list and culled rain, and the world frame it renders
+    const std::unique_ptr<HostCulledRain> rain = RenderHostCulledRain(rolling);
+    const auto& [w, path, host, host_pods, host_culled] = *rain;
+    const CameraView& view = w.view;
+    const EffectsFrame* fx = w.fx.get();
+    cuda::RealtimeFrameData& data = path->data();
+    ASSERT_GT(host_pods.size(), 0u);
     ASSERT_GT(host_culled, 0);
     // the culler's "device" memory: bound places, count streaks
     std::vector<cuda::StreakPod> places;
@@ -321,7 +340,7 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     };
     data.set_device_drop_culler(culler(false));
     EXPECT_TRUE(data.has_drop_culler());
-    const RenderedFrame kept = path.Render(view, fx.get());
+    const RenderedFrame kept = path->Render(view, fx);
     EXPECT_GT(static_cast<int32_t>(places.size()), count);
     EXPECT_EQ(data.streaks_culled(), 0);
     data.FinishDeviceCulling(culled);
@@ -330,7 +349,7 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     const cuda::PathStreaks list = data.splat_streaks().View();
     data.splat_streaks();
     EXPECT_EQ(downloads, 1);
-    ASSERT_EQ(list.num, host_list.num);
+    ASSERT_EQ(static_cast<size_t>(list.num), host_pods.size());
     EXPECT_EQ(std::memcmp(list.streaks, host_pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
     EXPECT_EQ(kept.rgb.data, host.rgb.data);
     EXPECT_EQ(kept.radiance.data, host.radiance.data);
@@ -338,19 +357,19 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     EXPECT_EQ(std::memcmp(&kept.ev100, &host.ev100, sizeof(double)), 0);
     // every place drawn: other streaks, another frame
     data.set_device_drop_culler(culler(true));
-    const RenderedFrame all = path.Render(view, fx.get());
-    size_t differ = 0;
-    for (size_t i = 0; i < all.radiance.data.size(); ++i)
-      differ += all.radiance.data[i] != host.radiance.data[i];
+    const RenderedFrame all = path->Render(view, fx);
+    ASSERT_EQ(all.radiance.data.size(), host.radiance.data.size());
+    const size_t differ = std::inner_product(all.radiance.data.begin(), all.radiance.data.end(),
+                                             host.radiance.data.begin(), size_t{0}, std::plus<>(),
+                                             std::not_equal_to<>());
     std::printf(
-        "rain 160x120%s: %d streaks of %zu places, %d rain culled; every place drawn: %zu "
-        "radiance values differ\n",
-        rolling ? ", rolling shutter" : "", static_cast<int>(host_list.num), places.size(),
-        host_culled, differ);
+        "rain 160x120%s: %zu streaks of %zu places, %d rain culled; every place drawn: "
+        "%zu radiance values differ\n",
+        rolling ? ", rolling shutter" : "", host_pods.size(), places.size(), host_culled, differ);
     EXPECT_GT(differ, 0u);
     data.set_device_drop_culler(cuda::RealtimeFrameData::DeviceDropCuller());
     EXPECT_FALSE(data.has_drop_culler());
-    const RenderedFrame again = path.Render(view, fx.get());
+    const RenderedFrame again = path->Render(view, fx);
     EXPECT_EQ(again.radiance.data, host.radiance.data);
   }
 }
