@@ -1014,8 +1014,8 @@ int Main(int argc, char** argv) {
           }
           builds.push_back(fmt::format(
               "{} {}: late streaks' host time a frame (last timed frame, two rounds): drops "
-              "culled on the device {:.3f} / {:.3f} ms (DeviceStreakCull::Run {:.3f} / {:.3f} ms, "
-              "of which staging {:.3f} / {:.3f} ms), on the host {:.3f} / {:.3f} ms; {} "
+              "culled on the device {:.3f} / {:.3f} ms (DeviceStreakCull::Queue {:.3f} / {:.3f} "
+              "ms, of which staging {:.3f} / {:.3f} ms), on the host {:.3f} / {:.3f} ms; {} "
               "streaks, {} rain drops culled",
               name, size, cull_device_ms[0], cull_device_ms[1], cull_run_ms[0], cull_run_ms[1],
               cull_stage_ms[0], cull_stage_ms[1], cull_host_ms[0], cull_host_ms[1],

@@ -8,8 +8,10 @@
 // for byte) and culled count, and the same rgb, radiance, depth and EV100 bits. DeviceStreakCull
 // run alone on the frame's decision inputs with the exposure time changed by one part in a
 // thousand gives other streaks (the comparison can fail); a drop with a non-finite position
-// throws the host's ConfigError, naming it. without a device every test prints "skipped: no
-// CUDA device".
+// throws the host's ConfigError, naming it. since branch gpu30 the streaks stay on the device
+// and Render reads the culling's counts with the frame's outputs: a frame with a non-finite drop
+// still throws that ConfigError from its Render call, and the next frame is clean. without a
+// device every test prints "skipped: no CUDA device".
 
 #include <gtest/gtest.h>
 
@@ -152,6 +154,63 @@ TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
       }
     }
   }
+}
+
+// the device culling's counts come back with the frame's outputs (branch gpu30: Render queues
+// the culling and the splat reads the streaks and their count on the device): a frame with a
+// non-finite drop throws the host culling's ConfigError, naming the drop, from the same Render
+// call, late streaks or made before the kernels, and with the host culling; the next clean
+// frame is the clean frame of before to the bit, its culled rain the host culling's, and the
+// device culling's streaks the host's.
+TEST(StreakCullGpu, RenderThrowsTheHostCullingsErrorForANonFiniteDrop) {
+  if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
+  auto [session, snap, view, loaded] =
+      realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 640, 480);
+  ASSERT_TRUE(loaded && !loaded->particles.empty());
+  EffectsFrame bad = *loaded;
+  const size_t s = bad.particles.size() - 1;
+  ASSERT_GT(bad.particles[s].position_W.size(), 7u);
+  bad.particles[s].position_W[7].y() = std::numeric_limits<float>::quiet_NaN();
+  const std::unique_ptr<Renderer> gpu = GpuRenderer(session->scene());
+  auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
+  ASSERT_NE(g, nullptr);
+  RenderedFrame clean;
+  g->set_device_culling(false);
+  gpu->Render(snap, loaded.get(), view, &clean);
+  const int host_culled = g->realtime_frame().streaks_culled();
+  const std::vector<cuda::StreakPod> host_pods = SplatPods(g);
+  struct Case {
+    bool device, late;
+  };
+  for (const Case& k : {Case{true, true}, Case{true, false}, Case{false, true}}) {
+    SCOPED_TRACE(std::string(k.device ? "device" : "host") + " culling, " +
+                 (k.late ? "late streaks" : "streaks before the kernels"));
+    g->set_device_culling(k.device);
+    g->set_late_streaks(k.late);
+    // the error's message ("" when none was thrown: both checks fail)
+    const std::string what = [&] {
+      RenderedFrame out;
+      try {
+        gpu->Render(snap, &bad, view, &out);
+      } catch (const ConfigError& e) {
+        return std::string(e.what());
+      }
+      return std::string();
+    }();
+    EXPECT_NE(what.find("effects.particles[" + std::to_string(s) + "]"), std::string::npos)
+        << "message: '" << what << "'";
+    EXPECT_NE(what.find("particle 7 has a non-finite value"), std::string::npos)
+        << "message: '" << what << "'";
+    RenderedFrame after;
+    gpu->Render(snap, loaded.get(), view, &after);
+    EXPECT_EQ(g->realtime_frame().streaks_culled(), host_culled);
+    EXPECT_TRUE(SamePods(SplatPods(g), host_pods));
+    EXPECT_EQ(after.rgb.data, clean.rgb.data);
+    EXPECT_EQ(after.radiance.data, clean.radiance.data);
+    EXPECT_EQ(std::memcmp(&after.ev100, &clean.ev100, sizeof(double)), 0);
+  }
+  g->set_late_streaks(true);
+  g->set_device_culling(true);
 }
 
 }  // namespace

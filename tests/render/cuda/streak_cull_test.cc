@@ -10,7 +10,9 @@
 // radii), so the comparison can fail. RealtimeFrameData's drop culler (set_drop_culler:
 // PrepareStreaks hands the decision's inputs to it and splats what it returns) fed by a host run of
 // StreakCullDrop with an in-order compaction, as the device's kernels do, gives the host culling's
-// frame to the bit (rgb, radiance, depth, EV100).
+// frame to the bit (rgb, radiance, depth, EV100). a device drop culler (set_device_drop_culler,
+// branch gpu30: the streaks left where it made them, their count there too) whose memory is the
+// host's gives that frame too, though its list holds more places than streaks.
 
 #include <gtest/gtest.h>
 
@@ -19,7 +21,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -191,6 +195,61 @@ TEST(StreakCullShared, DecidesEveryDropAsBuildDidBefore) {
   }
 }
 
+// the drops of `fx` culled on the host as the device's kernels cull them: StreakCullDrop over
+// every drop, the kept ones compacted in (set, index) order into *pods (coverage halved where
+// halve_alpha), the culled rain counted into *culled.
+void CullOnHost(const EffectsFrame& fx, const StreakCullSetup& setup, bool halve_alpha,
+                std::vector<cuda::StreakPod>* pods, int* culled) {
+  pods->clear();
+  *culled = 0;
+  for (size_t s = 0; s < fx.particles.size(); ++s) {
+    const ParticleSet& ps = fx.particles[s];
+    for (size_t i = 0; i < ps.position_W.size(); ++i) {
+      const Eigen::Vector3f& p = ps.position_W[i];
+      const Eigen::Vector3f& v = ps.velocity_W[i];
+      StreakCullOut o;
+      const int32_t verdict =
+          StreakCullDrop(setup.frame, setup.sets[s], Float3{p.x(), p.y(), p.z()},
+                         Float3{v.x(), v.y(), v.z()}, ps.radius_m[i], &o);
+      *culled += verdict == kStreakCulled ? 1 : 0;
+      if (verdict != kStreakDrawn) continue;
+      cuda::StreakPod pod;
+      pod.a[0] = p.x(), pod.a[1] = p.y(), pod.a[2] = p.z();
+      pod.b[0] = o.q.x, pod.b[1] = o.q.y, pod.b[2] = o.q.z;
+      pod.r = o.r_wide;
+      pod.alpha = halve_alpha ? 0.5f * o.alpha : o.alpha;
+      pod.prim = static_cast<int32_t>(pods->size());
+      pod.set = static_cast<int32_t>(s);
+      pods->push_back(pod);
+    }
+  }
+}
+
+// rain at 1 s, 160x120 (the turning rolling shutter of AddRollingShutter where `rolling`) on the
+// host path, and its frame with the host's culling: the splat's StreakPods and the culled rain.
+// path refers to w's snapshot: kept behind a pointer.
+struct HostCulledRain {
+  realtime_parity::WorldFrame w;
+  std::unique_ptr<host_path::HostPath> path;
+  RenderedFrame frame;
+  std::vector<cuda::StreakPod> pods;
+  int culled = 0;
+};
+
+std::unique_ptr<HostCulledRain> RenderHostCulledRain(bool rolling) {
+  auto r = std::make_unique<HostCulledRain>();
+  r->w = realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
+  if (rolling) realtime_parity::AddRollingShutter(&r->w.view);
+  r->path = std::make_unique<host_path::HostPath>(r->w.session->scene(), r->w.snap);
+  cuda::RealtimeFrameData& data = r->path->data();
+  EXPECT_FALSE(data.has_drop_culler());
+  r->frame = r->path->Render(r->w.view, r->w.fx.get());
+  const cuda::PathStreaks list = data.splat_streaks().View();
+  r->pods.assign(list.streaks, list.streaks + list.num);
+  r->culled = data.streaks_culled();
+  return r;
+}
+
 // a host culler (StreakCullDrop over every drop, kept ones compacted in order, as the device's
 // kernels) behind RealtimeFrameData::set_drop_culler: the same splat list and frame bits as the
 // host culling, still and rolling shutter; a culler that halves the streaks' coverage changes
@@ -198,63 +257,119 @@ TEST(StreakCullShared, DecidesEveryDropAsBuildDidBefore) {
 TEST(StreakCullShared, DropCullerGivesTheHostCullingsBits) {
   const auto host_culler = [](bool halve_alpha) {
     return [halve_alpha](const EffectsFrame& fx, const StreakCullSetup& setup,
-                         std::vector<cuda::StreakPod>* pods, int* culled) {
-      pods->clear();
-      *culled = 0;
-      for (size_t s = 0; s < fx.particles.size(); ++s) {
-        const ParticleSet& ps = fx.particles[s];
-        for (size_t i = 0; i < ps.position_W.size(); ++i) {
-          const Eigen::Vector3f& p = ps.position_W[i];
-          const Eigen::Vector3f& v = ps.velocity_W[i];
-          StreakCullOut o;
-          const int32_t verdict =
-              StreakCullDrop(setup.frame, setup.sets[s], Float3{p.x(), p.y(), p.z()},
-                             Float3{v.x(), v.y(), v.z()}, ps.radius_m[i], &o);
-          *culled += verdict == kStreakCulled ? 1 : 0;
-          if (verdict != kStreakDrawn) continue;
-          cuda::StreakPod pod;
-          pod.a[0] = p.x(), pod.a[1] = p.y(), pod.a[2] = p.z();
-          pod.b[0] = o.q.x, pod.b[1] = o.q.y, pod.b[2] = o.q.z;
-          pod.r = o.r_wide;
-          pod.alpha = halve_alpha ? 0.5f * o.alpha : o.alpha;
-          pod.prim = static_cast<int32_t>(pods->size());
-          pod.set = static_cast<int32_t>(s);
-          pods->push_back(pod);
-        }
-      }
-    };
+                         std::vector<cuda::StreakPod>* pods,
+                         int* culled) { CullOnHost(fx, setup, halve_alpha, pods, culled); };
   };
   for (bool rolling : {false, true}) {
     SCOPED_TRACE(rolling ? "rolling shutter" : "still");
-    auto [session, snap, view, fx] =
-        realtime_parity::LoadFrameAt("effects/rain.yaml", 1.0, 160, 120);
-    if (rolling) realtime_parity::AddRollingShutter(&view);
-    host_path::HostPath path(session->scene(), snap);
+    const std::unique_ptr<HostCulledRain> rain = RenderHostCulledRain(rolling);
+    const CameraView& view = rain->w.view;
+    const EffectsFrame* fx = rain->w.fx.get();
+    host_path::HostPath& path = *rain->path;
     cuda::RealtimeFrameData& data = path.data();
-    ASSERT_FALSE(data.has_drop_culler());
-    const RenderedFrame host = path.Render(view, fx.get());
-    const cuda::PathStreaks host_list = data.splat_streaks().View();
-    std::vector<cuda::StreakPod> host_pods(host_list.streaks, host_list.streaks + host_list.num);
-    const int host_culled = data.streaks_culled();
+    const RenderedFrame& host = rain->frame;
     data.set_drop_culler(host_culler(false));
-    const RenderedFrame culled = path.Render(view, fx.get());
+    const RenderedFrame culled = path.Render(view, fx);
     const cuda::PathStreaks list = data.splat_streaks().View();
     EXPECT_FALSE(data.particles().host_culling());
     EXPECT_EQ(data.particles().size(), 0);
     ASSERT_GT(list.num, 0);
-    ASSERT_EQ(list.num, host_list.num);
-    EXPECT_EQ(std::memcmp(list.streaks, host_pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
-    EXPECT_EQ(data.streaks_culled(), host_culled);
+    ASSERT_EQ(static_cast<size_t>(list.num), rain->pods.size());
+    EXPECT_EQ(std::memcmp(list.streaks, rain->pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
+    EXPECT_EQ(data.streaks_culled(), rain->culled);
     EXPECT_EQ(culled.rgb.data, host.rgb.data);
     EXPECT_EQ(culled.radiance.data, host.radiance.data);
     EXPECT_EQ(culled.depth_m.data, host.depth_m.data);
     EXPECT_EQ(std::memcmp(&culled.ev100, &host.ev100, sizeof(double)), 0);
     data.set_drop_culler(host_culler(true));
-    const RenderedFrame short_one = path.Render(view, fx.get());
+    const RenderedFrame short_one = path.Render(view, fx);
     EXPECT_NE(short_one.radiance.data, host.radiance.data);
     data.set_drop_culler(cuda::RealtimeFrameData::DropCuller());
-    const RenderedFrame again = path.Render(view, fx.get());
+    const RenderedFrame again = path.Render(view, fx);
     EXPECT_TRUE(data.particles().host_culling());
+    EXPECT_EQ(again.radiance.data, host.radiance.data);
+  }
+}
+
+// the streaks left where the culler made them (RealtimeFrameData::set_device_drop_culler,
+// branch gpu30: the CUDA backend's default, with device memory): a culler that returns a list of
+// `bound` places (the device's: every drop's; here twice the streaks and one) of which only the
+// first *count are streaks, the rest other (wider, opaque) streaks, and its culled rain after
+// the frame (FinishDeviceCulling). here its
+// memory is the host's, which RenderRealtimeOnHost reads: the frame is the host culling's to the
+// bit (rgb, radiance, depth, EV100), splat_streaks() copies the streaks once (download) and they
+// are the host culling's StreakPods byte for byte, streaks_culled() is the host's once reported.
+// a list whose count is its bound (the reader drawing every place) changes the frame: the count
+// is what bounds the splat (SplatStreakCount), so the comparison can fail.
+TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
+  for (bool rolling : {false, true}) {
+    SCOPED_TRACE(rolling ? "rolling shutter" : "still");
+    // the host culling's frame, splat list and culled rain, and the world frame it renders
+    const std::unique_ptr<HostCulledRain> rain = RenderHostCulledRain(rolling);
+    const auto& [w, path, host, host_pods, host_culled] = *rain;
+    const CameraView& view = w.view;
+    const EffectsFrame* fx = w.fx.get();
+    cuda::RealtimeFrameData& data = path->data();
+    ASSERT_GT(host_pods.size(), 0u);
+    ASSERT_GT(host_culled, 0);
+    // the culler's "device" memory: bound places, count streaks
+    std::vector<cuda::StreakPod> places;
+    int32_t count = 0;
+    int culled = 0, downloads = 0;
+    const auto culler = [&](bool count_is_bound) {
+      return [&, count_is_bound](const EffectsFrame& frame, const StreakCullSetup& setup) {
+        CullOnHost(frame, setup, false, &places, &culled);
+        count = static_cast<int32_t>(places.size());
+        for (int32_t k = 0; k <= count && count > 0; ++k) {
+          cuda::StreakPod other = places[k % count];
+          other.r *= 3;
+          other.alpha = 1;
+          places.push_back(other);
+        }
+        if (count_is_bound) count = static_cast<int32_t>(places.size());
+        cuda::RealtimeFrameData::DeviceStreakList list;
+        list.streaks = places.data();
+        list.bound = static_cast<int32_t>(places.size());
+        list.count = &count;
+        list.download = [&](std::vector<cuda::StreakPod>* out) {
+          ++downloads;
+          out->assign(places.begin(), places.begin() + count);
+        };
+        return list;
+      };
+    };
+    data.set_device_drop_culler(culler(false));
+    EXPECT_TRUE(data.has_drop_culler());
+    const RenderedFrame kept = path->Render(view, fx);
+    EXPECT_GT(static_cast<int32_t>(places.size()), count);
+    EXPECT_EQ(data.streaks_culled(), 0);
+    data.FinishDeviceCulling(culled);
+    EXPECT_EQ(data.streaks_culled(), host_culled);
+    EXPECT_EQ(downloads, 0);
+    const cuda::PathStreaks list = data.splat_streaks().View();
+    data.splat_streaks();
+    EXPECT_EQ(downloads, 1);
+    ASSERT_EQ(static_cast<size_t>(list.num), host_pods.size());
+    EXPECT_EQ(std::memcmp(list.streaks, host_pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
+    EXPECT_EQ(kept.rgb.data, host.rgb.data);
+    EXPECT_EQ(kept.radiance.data, host.radiance.data);
+    EXPECT_EQ(kept.depth_m.data, host.depth_m.data);
+    EXPECT_EQ(std::memcmp(&kept.ev100, &host.ev100, sizeof(double)), 0);
+    // every place drawn: other streaks, another frame
+    data.set_device_drop_culler(culler(true));
+    const RenderedFrame all = path->Render(view, fx);
+    ASSERT_EQ(all.radiance.data.size(), host.radiance.data.size());
+    const size_t differ = std::inner_product(all.radiance.data.begin(), all.radiance.data.end(),
+                                             host.radiance.data.begin(), size_t{0}, std::plus<>(),
+                                             std::not_equal_to<>());
+    std::printf(
+        "rain 160x120%s: %zu streaks of %zu places, %d rain culled; every place drawn: "
+        "%zu radiance values differ\n",
+        rolling ? ", rolling shutter" : "", host_pods.size(), places.size(), host_culled, differ);
+    EXPECT_GT(differ, 0u);
+    data.set_device_drop_culler(cuda::RealtimeFrameData::DeviceDropCuller());
+    EXPECT_FALSE(data.has_drop_culler());
+    const RenderedFrame again = path->Render(view, fx);
     EXPECT_EQ(again.radiance.data, host.radiance.data);
   }
 }

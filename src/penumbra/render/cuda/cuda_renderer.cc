@@ -46,12 +46,12 @@ CudaRenderer::~CudaRenderer() = default;
 
 void CudaRenderer::set_device_culling(bool on) {
   device_culling_ = on;
+  realtime_->set_drop_culler(RealtimeFrameData::DropCuller());
   if (!on) {
-    realtime_->set_drop_culler(RealtimeFrameData::DropCuller());
+    realtime_->set_device_drop_culler(RealtimeFrameData::DeviceDropCuller());
     return;
   }
-  realtime_->set_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup,
-                                    std::vector<StreakPod>* pods, int* culled) {
+  realtime_->set_device_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup) {
     // made at the first frame with drops (its stream and buffers)
     if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
     std::vector<DropSet> sets(fx.particles.size());
@@ -62,11 +62,25 @@ void CudaRenderer::set_device_culling(bool on) {
       sets[s].r = ps.radius_m.data();
       sets[s].n = static_cast<int64_t>(ps.position_W.size());
     }
-    drop_cull_->Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data(),
-                    HostParallel());
-    drop_cull_->Download(pods);
-    *culled = drop_cull_->culled();
+    // queued only: the frame's stream waits for it on the device, the host does not (its
+    // counts are read once the frame is done: FinishDropCulling)
+    drop_cull_->Queue(sets.data(), static_cast<int32_t>(sets.size()), setup.frame,
+                      setup.sets.data(), HostParallel(), device_->stream());
+    cull_queued_ = true;
+    RealtimeFrameData::DeviceStreakList list;
+    list.streaks = drop_cull_->device_streaks();
+    list.bound = drop_cull_->bound();
+    list.count = drop_cull_->device_count();
+    list.download = [this](std::vector<StreakPod>* out) { drop_cull_->Download(out); };
+    return list;
   });
+}
+
+void CudaRenderer::FinishDropCulling() {
+  if (!cull_queued_) return;
+  cull_queued_ = false;
+  drop_cull_->Finish();
+  realtime_->FinishDeviceCulling(drop_cull_->culled());
 }
 
 PinholeCamera CudaRenderer::PinholeOf(const CameraView& view) { return PinholeCameraOf(view); }
@@ -129,6 +143,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   const bool late = late_streaks_ && realtime_->device_streaks() && effects != nullptr &&
                     !effects->empty() && !effects->particles.empty();
   late_streaks_ms_ = 0;
+  cull_queued_ = false;
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),
                      /*streaks=*/!late);
   UploadRealtime();
@@ -163,6 +178,9 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
         return realtime_->Ev100(rows, n, exposure);
       },
       o, late ? LateStreaks(snapshot, effects, view) : DeviceRealtime::StreaksFn());
+  // the device culling's counts, read back with the frame's outputs: the culled rain, or the
+  // host culling's ConfigError for a non-finite drop, before this frame is returned
+  FinishDropCulling();
 }
 
 DeviceRealtime::StreaksFn CudaRenderer::LateStreaks(const WorldSnapshot& snapshot,

@@ -76,11 +76,14 @@ class CudaRenderer final : public Renderer {
   void set_late_streaks(bool on) { late_streaks_ = on; }
   bool late_streaks() const { return late_streaks_; }
   /// whether a realtime frame whose streaks the frame splats itself culls its drops on the
-  /// device (default true, branch gpu27: RealtimeFrameData::set_drop_culler with
+  /// device (default true, branch gpu27: RealtimeFrameData::set_device_drop_culler with
   /// DeviceStreakCull, cuda_streak_cull.h: the drops uploaded, decided by the CPU's shared
-  /// StreakCullDrop one thread each on a high-priority stream, compacted in order and the
-  /// streaks read back; the same streaks and bits as the host's culling); off, the host culls
-  /// them (ParticleStreaks::Build over the pool, as before).
+  /// StreakCullDrop one thread each on a high-priority stream and compacted in order; since
+  /// branch gpu30 the streaks stay on the device, where the splat reads them and their count,
+  /// and the host does not wait: the culled rain (RealtimeFrameData::streaks_culled) and a
+  /// non-finite drop's ConfigError come once the frame's outputs are back, before Render
+  /// returns; the same streaks and bits as the host's culling); off, the host culls them
+  /// (ParticleStreaks::Build over the pool, as before).
   void set_device_culling(bool on);
   bool device_culling() const { return device_culling_; }
   /// the device's drop culling (null until a frame with drops culled them on the device; benchmarks
@@ -111,6 +114,9 @@ class CudaRenderer final : public Renderer {
   // (last_late_streaks_ms).
   DeviceRealtime::StreaksFn LateStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
                                         const CameraView& view);
+  // after a realtime frame whose drops DeviceStreakCull::Queue culled (cull_queued_): its
+  // counts read (DeviceStreakCull::Finish: the culled rain into realtime_, or its ConfigError)
+  void FinishDropCulling();
   // the pathtraced tier's rgb, radiance and depth: the paths on the GPU (cuda_path.h), the
   // denoiser and film on the host (path_frame.h's FinishPathFrame).
   // `camera`: the view's camera with its ray tables on the device (Render's).
@@ -143,6 +149,7 @@ class CudaRenderer final : public Renderer {
   std::unique_ptr<ThreadPool> pool_;  // the host's sky terms
   std::unique_ptr<DeviceStreakCull> drop_cull_;  // the device's drop culling (device_culling)
   bool device_culling_ = false;
+  bool cull_queued_ = false;  // the frame's drops queued on drop_cull_, not yet Finished
   // the media volumes' shadow rays (RealtimeFrameData::PrepareMedia) over bvh_ and device_
   std::unique_ptr<CudaRayQuery> media_query_;
   CameraRayTables camera_rays_;  // the frame's camera's ray tables (their device copies:

@@ -94,6 +94,12 @@ struct DeviceStreakCull::Impl {
   int64_t roof_cells = 0;
   uint64_t roof_version = 0;
   Buffer kept, culled, bad, at, out, set_of, pods, totals, temp;
+  // the counts' copy back (streaks, culled rain, first non-finite drop) and the event after
+  // the last Queue's work; pending: not yet Finished
+  PinnedBuffer totals_host;
+  cudaEvent_t done = nullptr;
+  bool pending = false;
+  int32_t n = 0;  // the last Queue's drops
   std::vector<int64_t> first_host;
   std::vector<std::pair<int32_t, int64_t>> chunks;  // (set, first drop) of each staging chunk
   // the highest priority: the culling's blocks go before the waiting blocks of the frame's
@@ -103,8 +109,11 @@ struct DeviceStreakCull::Impl {
     Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "cudaDeviceGetStreamPriorityRange");
     Check(cudaStreamCreateWithPriority(&stream, cudaStreamNonBlocking, greatest),
           "cudaStreamCreateWithPriority");
+    Check(cudaEventCreateWithFlags(&done, cudaEventDisableTiming), "cudaEventCreate");
+    totals_host.Reserve(sizeof(int32_t) * 4);
   }
   ~Impl() {
+    if (done != nullptr) cudaEventDestroy(done);
     if (stream != nullptr) cudaStreamDestroy(stream);
   }
 };
@@ -113,10 +122,15 @@ DeviceStreakCull::DeviceStreakCull() : impl_(std::make_unique<Impl>()) {}
 DeviceStreakCull::~DeviceStreakCull() = default;
 
 const StreakPod* DeviceStreakCull::device_streaks() const {
-  return count_ > 0 ? impl_->pods.as<StreakPod>() : nullptr;
+  return bound_ > 0 ? impl_->pods.as<StreakPod>() : nullptr;
 }
 
-void DeviceStreakCull::Download(std::vector<StreakPod>* out) const {
+const int32_t* DeviceStreakCull::device_count() const {
+  return bound_ > 0 ? impl_->totals.as<int32_t>() : nullptr;
+}
+
+void DeviceStreakCull::Download(std::vector<StreakPod>* out) {
+  Finish();
   out->resize(count_);
   if (count_ == 0) return;
   impl_->pods.Download(out->data(), sizeof(StreakPod) * count_, impl_->stream);
@@ -126,10 +140,43 @@ void DeviceStreakCull::Download(std::vector<StreakPod>* out) const {
 void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
                            const StreakCullSet* flags, const ParallelFn& parallel) {
   const auto t0 = std::chrono::steady_clock::now();
-  count_ = 0;
-  culled_ = 0;
+  Queue(sets, num_sets, frame, flags, parallel);
+  Finish();
+  run_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void DeviceStreakCull::Finish() {
+  Impl& m = *impl_;
+  if (!m.pending) return;
+  m.pending = false;
+  Check(cudaEventSynchronize(m.done), "cudaEventSynchronize");
+  const int32_t* totals = m.totals_host.as<int32_t>();
+  if (totals[2] < m.n) {
+    const int64_t g = totals[2];
+    int32_t s = 0;
+    while (g >= m.first_host[s + 1]) ++s;
+    throw NonFiniteParticleError(static_cast<size_t>(s), static_cast<size_t>(g - m.first_host[s]));
+  }
+  count_ = totals[0];
+  culled_ = totals[1];
+}
+
+void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
+                             const StreakCullSet* flags, const ParallelFn& parallel,
+                             void* wait_stream) {
+  const auto t0 = std::chrono::steady_clock::now();
   Impl& m = *impl_;
   const cudaStream_t st = m.stream;
+  // an earlier Queue's work done (its staging and counts are reused), without its counts
+  if (m.pending) {
+    m.pending = false;
+    Check(cudaEventSynchronize(m.done), "cudaEventSynchronize");
+  }
+  count_ = 0;
+  culled_ = 0;
+  bound_ = 0;
+  m.n = 0;
   m.first_host.assign(static_cast<size_t>(num_sets) + 1, 0);
   for (int32_t s = 0; s < num_sets; ++s) m.first_host[s + 1] = m.first_host[s] + sets[s].n;
   const int64_t n64 = m.first_host.back();
@@ -139,6 +186,7 @@ void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCu
   }
   if (n64 >= INT32_MAX) throw Error("DeviceStreakCull: more than 2^31 - 1 drops");
   const int32_t n = static_cast<int32_t>(n64);
+  m.n = n;
   // every input in one page-locked block, laid out as on the device (each part 16-byte aligned):
   // the drops' positions, velocities and radii set after set (copied over `parallel`), then
   // the sets' first drops and flags and the media; one asynchronous transfer
@@ -245,18 +293,16 @@ void DeviceStreakCull::Run(const DropSet* sets, int32_t num_sets, const StreakCu
                                                 m.out.as<StreakCullOut>(), m.set_of.as<int32_t>(),
                                                 m.pods.as<StreakPod>());
   Check(cudaGetLastError(), "WriteStreaksKernel");
-  int32_t host_totals[3] = {0, 0, 0};
-  Check(cudaMemcpyAsync(host_totals, totals, sizeof(host_totals), cudaMemcpyDeviceToHost, st),
+  // the counts back into page-locked memory (Finish reads them), then the event the frame's
+  // stream waits for
+  Check(cudaMemcpyAsync(m.totals_host.p, totals, sizeof(int32_t) * 3, cudaMemcpyDeviceToHost, st),
         "cudaMemcpyAsync");
-  Check(cudaStreamSynchronize(st), "cudaStreamSynchronize");
-  if (host_totals[2] < n) {
-    const int64_t g = host_totals[2];
-    int32_t s = 0;
-    while (g >= m.first_host[s + 1]) ++s;
-    throw NonFiniteParticleError(static_cast<size_t>(s), static_cast<size_t>(g - m.first_host[s]));
-  }
-  count_ = host_totals[0];
-  culled_ = host_totals[1];
+  Check(cudaEventRecord(m.done, st), "cudaEventRecord");
+  if (wait_stream != nullptr)
+    Check(cudaStreamWaitEvent(static_cast<cudaStream_t>(wait_stream), m.done, 0),
+          "cudaStreamWaitEvent");
+  m.pending = true;
+  bound_ = n;
   run_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

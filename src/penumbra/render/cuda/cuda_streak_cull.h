@@ -6,8 +6,10 @@
 // order as StreakPods (a = the drop's position, b = its streak end, r = the widened radius,
 // alpha, prim = the streak's index, set), so the streaks are the host culling's to the bit. the
 // culled rain is counted by cub::DeviceReduce::Sum and the first non-finite drop found by
-// cub::DeviceReduce::Min. the decision's file (cuda_streak_cull.cu) is compiled with -fmad=false and
-// the shared functions round every product and sum on their own (MulRn, AddRn) as well.
+// cub::DeviceReduce::Min. Queue leaves the streaks and their count on the device for the
+// frame's splat (branch gpu30) and Finish reads the counts back later. the decision's file
+// (cuda_streak_cull.cu) is compiled with -fmad=false and the shared functions round every
+// product and sum on their own (MulRn, AddRn) as well.
 
 #include <cstdint>
 #include <memory>
@@ -38,27 +40,51 @@ class DeviceStreakCull {
 
   /// decides every drop of the num_sets `sets` (host arrays; set s has the flags flags[s]) by
   /// `frame` (ParticleStreaks' StreakCullSetup of this frame: its media and shelter roof, host
-  /// arrays, are read here) on the device: the drops (copied into page-locked staging in chunks
-  /// over `parallel`, may be empty: serially), the sets' flags and the media go over in one
-  /// transfer, the roof only when the map changed (ShelterPod's pointer, size or version), the
-  /// decision and the compaction run, and the count of streaks, of culled rain and the first
-  /// non-finite drop are read back (the call waits for the device). the streaks stay on the
-  /// device (device_streaks(), size()); Download copies them.
+  /// arrays, are read here) on the device and waits for it: Queue, then Finish. the streaks
+  /// stay on the device (device_streaks(), size()); Download copies them.
   /// @throws ConfigError (key effects.particles[s]) as ParticleStreaks::Build when a drop has a
   /// non-finite value (naming the first such drop). @throws Error on a CUDA failure.
   void Run(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
            const StreakCullSet* flags, const ParallelFn& parallel = ParallelFn());
 
-  /// streaks kept by the last Run.
-  int size() const { return count_; }
-  /// rain streaks culled as invisible by the last Run (ParticleStreaks::culled).
-  int culled() const { return culled_; }
-  /// the last Run's streaks on the device (size() of them, index order; null when none).
-  const StreakPod* device_streaks() const;
-  /// copies the last Run's streaks to *out (resized to size()).
+  /// as Run without the wait (branch gpu30): the drops (copied into page-locked staging in
+  /// chunks over `parallel`, may be empty: serially), the sets' flags and the media go over in
+  /// one transfer, the roof only when the map changed (ShelterPod's pointer, size or version),
+  /// and the decision, the compaction and the copy back of the counts (streaks, culled rain,
+  /// first non-finite drop) are queued on this object's stream; `wait_stream` (a cudaStream_t,
+  /// may be null), if given, waits for them (cudaStreamWaitEvent: its work queued after this
+  /// call reads the streaks and their count). the streaks are then at device_streaks(), at most
+  /// bound() of them, their count at device_count(); size(), culled() and a non-finite drop's
+  /// error come with Finish. waits first for an earlier Queue's work (its staging is reused).
   /// @throws Error on a CUDA failure.
-  void Download(std::vector<StreakPod>* out) const;
-  /// wall-clock milliseconds of the last Run (uploads, kernels, the count's read-back).
+  void Queue(const DropSet* sets, int32_t num_sets, const StreakCullFrame& frame,
+             const StreakCullSet* flags, const ParallelFn& parallel = ParallelFn(),
+             void* wait_stream = nullptr);
+  /// waits for the last Queue's work (nothing when none is pending; a frame that waited for it
+  /// on its own stream finds it done) and reads its counts: size() and culled().
+  /// @throws ConfigError (key effects.particles[s]) as ParticleStreaks::Build when a drop has a
+  /// non-finite value (naming the first such drop; size() and culled() are then 0).
+  /// @throws Error on a CUDA failure.
+  void Finish();
+
+  /// streaks kept by the last Run or finished Queue.
+  int size() const { return count_; }
+  /// rain streaks culled as invisible by the last Run or finished Queue (ParticleStreaks::culled).
+  int culled() const { return culled_; }
+  /// the drops of the last Run or Queue: a bound of its streaks' count (0: no drops, nothing
+  /// queued).
+  int bound() const { return bound_; }
+  /// the last Run's or Queue's streaks on the device (index order; bound() places; null when
+  /// there were no drops): valid until the next Run or Queue.
+  const StreakPod* device_streaks() const;
+  /// device memory: the count of the last Run's or Queue's streaks, once its work is done
+  /// (null when there were no drops).
+  const int32_t* device_count() const;
+  /// copies the last Run's or Queue's streaks to *out (resized to size(); Finish first).
+  /// @throws as Finish.
+  void Download(std::vector<StreakPod>* out);
+  /// wall-clock milliseconds of the last Run (uploads, kernels, the count's read-back) or Queue
+  /// (uploads and the kernels' queuing, no wait).
   double run_ms() const { return run_ms_; }
   /// the part of run_ms before the kernels were queued: the staging copies and the transfers'
   /// queuing.
@@ -69,6 +95,7 @@ class DeviceStreakCull {
   std::unique_ptr<Impl> impl_;
   int count_ = 0;
   int culled_ = 0;
+  int bound_ = 0;
   double run_ms_ = 0;
   double stage_ms_ = 0;
 };

@@ -59,15 +59,36 @@ void PathStreakBuild::BuildList(const ParticleStreaks& streaks,
 
 void PathStreakBuild::BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
                                     const Eigen::Vector3f& sky_ambient) {
+  if (pods->empty() || streaks.frame() == nullptr) {
+    Clear();
+    sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
+    return;
+  }
+  BuildSets(streaks, sky_ambient);
+  pods_.swap(*pods);
+}
+
+void PathStreakBuild::BuildSets(const ParticleStreaks& streaks,
+                                const Eigen::Vector3f& sky_ambient) {
   const auto t0 = std::chrono::steady_clock::now();
   Clear();
   sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
-  if (pods->empty() || streaks.frame() == nullptr) return;
-  pods_.swap(*pods);
+  if (streaks.frame() == nullptr) return;
   const int num_sets = static_cast<int>(streaks.frame()->particles.size());
   for (int s = 0; s < num_sets; ++s) sets_.push_back(streaks.SetPod(s));
   build_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+PathStreaks PathStreakBuild::ViewOver(const StreakPod* streaks, int32_t num) const {
+  PathStreaks v;
+  if (num <= 0 || streaks == nullptr) return v;
+  v.num = num;
+  v.streaks = streaks;
+  v.sets = sets_.data();
+  v.num_sets = static_cast<int32_t>(sets_.size());
+  v.sky_ambient = sky_ambient_;
+  return v;
 }
 
 void PathStreakBuild::FillPods(const ParticleStreaks& streaks, const int32_t* order) {

@@ -36,6 +36,18 @@ class PathStreakBuild {
   /// for the frame without host culling: ParticleStreaks::set_host_culling).
   void BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
                      const Eigen::Vector3f& sky_ambient);
+  /// the particle sets of `streaks` (Built for the frame; none without a frame) and
+  /// `sky_ambient` without any streak (empty() stays true): for streaks that stay where they
+  /// were made (the device culling's, branch gpu30), which ViewOver points at. the sets do not
+  /// depend on the streaks (ParticleStreaks::SetPod reads the effects' particle sets only).
+  void BuildSets(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
+  /// this object's particle sets and sky_ambient over `num` StreakPods at `streaks` (index
+  /// order, no BVH, no rain radiance; any memory: the device culling's buffer in place, where
+  /// num may be a bound of their count, StreakSplatView::count).
+  PathStreaks ViewOver(const StreakPod* streaks, int32_t num) const;
+  /// *pods swapped in as the streaks, the sets kept (after BuildSets: the device culling's
+  /// streaks copied to the host for a reader of View; *pods gets the old array).
+  void SwapPods(std::vector<StreakPod>* pods) { pods_.swap(*pods); }
   /// no streaks (View's num 0).
   void Clear();
   /// the streaks over this object's arrays (valid until the next Build or Clear).

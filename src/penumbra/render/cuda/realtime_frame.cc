@@ -151,6 +151,8 @@ void RealtimeFrameData::ClearStreaks() {
   streaks_.clear();
   path_streaks_.Clear();
   splat_streaks_.Clear();
+  device_list_ = DeviceStreakList();
+  device_pods_copied_ = false;
 }
 
 void RealtimeFrameData::PrepareMedia(const WorldSnapshot& snapshot, const EffectsFrame* effects,
@@ -206,14 +208,24 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
   const bool device_splat = realtime && device_streaks_;
-  // the device's drop culling (drop_culler_): the host prepares its inputs only
-  const bool device_cull = device_splat && drop_culler_;
+  // the device's drop culling (device_drop_culler_ or drop_culler_): the host prepares its
+  // inputs only
+  const bool device_cull = device_splat && has_drop_culler();
   particles_.set_host_splat(!device_splat);
   particles_.set_host_culling(!device_cull);
   particles_.Build(fx, camera, view.exposure_time_sec,
                    realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
                    sheltered ? &shelter_ : nullptr);
   streaks_culled_ = particles_.culled();
+  if (device_cull && device_drop_culler_) {
+    // the streaks stay on the device: the splat reads them in place, with their count there;
+    // the sets do not depend on them (BuildSets)
+    device_list_ = device_drop_culler_(*fx, particles_.cull_setup());
+    if (device_list_.bound <= 0) return;
+    splat_streaks_.BuildSets(particles_, SkyAmbientRadiance(*frame_sky_));
+    SetSplatCamera(camera);
+    return;
+  }
   if (device_cull) {
     drop_culler_(*fx, particles_.cull_setup(), &culled_pods_, &streaks_culled_);
     if (culled_pods_.empty()) return;
@@ -426,10 +438,27 @@ RealtimeFrameView RealtimeFrameData::View(const SceneView& scene, const Float3* 
   return f;
 }
 
+const PathStreakBuild& RealtimeFrameData::splat_streaks() const {
+  if (device_list_.bound > 0 && !device_pods_copied_ && device_list_.download) {
+    std::vector<StreakPod> pods;
+    device_list_.download(&pods);
+    splat_streaks_.SwapPods(&pods);
+    device_pods_copied_ = true;
+  }
+  return splat_streaks_;
+}
+
 void RealtimeFrameData::StreakFields(RealtimeFrameView* f) const {
   f->streaks = streaks_.empty() ? nullptr : streaks_.data();
   f->num_streaks = static_cast<int64_t>(streaks_.size());
   f->splat = StreakSplatView();
+  if (device_list_.bound > 0) {
+    // the device culling's streaks in place: a bound here, their count on the device
+    f->splat = splat_camera_;
+    f->splat.streaks = splat_streaks_.ViewOver(device_list_.streaks, device_list_.bound);
+    f->splat.count = device_list_.count;
+    return;
+  }
   if (!splat_streaks_.empty()) {
     f->splat = splat_camera_;
     f->splat.streaks = splat_streaks_.View();
@@ -633,7 +662,8 @@ void RenderRealtimeOnHost(const RealtimeFrameData& data, const BvhScene& bvh, Th
     splat_pixels.resize(n);
     f.splat.nearest = splat_nearest.data();
     f.splat.pixels = splat_pixels.data();
-    for (int k = 0; k < f.splat.streaks.num; ++k) {
+    const int32_t num = SplatStreakCount(f.splat);
+    for (int k = 0; k < num; ++k) {
       const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
       for (int v = p.v0; v <= p.v1 && !p.empty(); ++v) SplatStreakRow(f, k, p, v);
     }

@@ -139,8 +139,11 @@ class RealtimeFrameData {
   void set_device_streaks(bool on) { device_streaks_ = on; }
   bool device_streaks() const { return device_streaks_; }
   /// the streaks the frame splats itself (device_streaks; empty without particles or under the
-  /// pathtraced tier's settings): PathStreakBuild::View as View's splat.streaks.
-  const PathStreakBuild& splat_streaks() const { return splat_streaks_; }
+  /// pathtraced tier's settings): PathStreakBuild::View as View's splat.streaks. with a device
+  /// drop culler (set_device_drop_culler) the streaks stay on the device for the frame's splat;
+  /// this call copies them to the host (DeviceStreakList::download: it waits for the culling)
+  /// the first time after a PrepareStreaks (tests and benchmarks).
+  const PathStreakBuild& splat_streaks() const;
   /// the drops' culling on the device (branch gpu27; CudaRenderer::set_device_culling sets it):
   /// with device_streaks under the realtime tier's settings, PrepareStreaks has ParticleStreaks
   /// prepare the decision's inputs only (set_host_culling(false): the sets' lengths checked, no
@@ -151,8 +154,40 @@ class RealtimeFrameData {
   using DropCuller = std::function<void(const EffectsFrame& fx, const StreakCullSetup& setup,
                                         std::vector<StreakPod>* pods, int* culled)>;
   void set_drop_culler(DropCuller culler) { drop_culler_ = std::move(culler); }
-  bool has_drop_culler() const { return static_cast<bool>(drop_culler_); }
-  /// rain streaks culled as invisible by the last PrepareStreaks (host or device culling).
+  /// whether a drop culler is set (set_drop_culler or set_device_drop_culler).
+  bool has_drop_culler() const {
+    return static_cast<bool>(drop_culler_) || static_cast<bool>(device_drop_culler_);
+  }
+  /// streaks a device drop culler made and keeps on the device (branch gpu30): the frame's
+  /// splat reads them in place (StreakSplatView: streaks.streaks, bound as streaks.num, count)
+  /// without the host waiting for the culling or copying them.
+  struct DeviceStreakList {
+    /// device memory: the drawn streaks in index order (StreakPod, prim = the index), as
+    /// ParticleStreaks::Build makes them; at most `bound` of them.
+    const StreakPod* streaks = nullptr;
+    /// a bound of their count the host knows without waiting (the drops'; 0: no streaks).
+    int32_t bound = 0;
+    /// device memory: their count, written by the culler's queued work, which the frame's
+    /// device work waits for (the culler's business).
+    const int32_t* count = nullptr;
+    /// copies the streaks to *out (resized to their count); waits for the culling. may throw
+    /// the culler's errors (ConfigError for a non-finite drop).
+    std::function<void(std::vector<StreakPod>* out)> download;
+  };
+  /// the drops' culling on the device without the host's wait (CudaRenderer::set_device_culling
+  /// sets it, branch gpu30): as set_drop_culler (the same inputs; where both are set, this
+  /// one culls; empty: none), but the culler only queues its work and returns where its
+  /// streaks will be (DeviceStreakList); the culled rain and any non-finite drop are known once
+  /// the frame's device work is done: the caller then reports the culled rain
+  /// (FinishDeviceCulling) or throws the culler's ConfigError.
+  using DeviceDropCuller =
+      std::function<DeviceStreakList(const EffectsFrame& fx, const StreakCullSetup& setup)>;
+  void set_device_drop_culler(DeviceDropCuller culler) { device_drop_culler_ = std::move(culler); }
+  /// after a frame whose streaks a device drop culler made: the rain it culled as invisible
+  /// (ParticleStreaks::culled), for streaks_culled.
+  void FinishDeviceCulling(int culled) { streaks_culled_ = culled; }
+  /// rain streaks culled as invisible by the last PrepareStreaks (host or device culling; a
+  /// device drop culler's once FinishDeviceCulling reported it, 0 before).
   int streaks_culled() const { return streaks_culled_; }
   /// the frame's streaks of the last PrepareStreaks (ParticleStreaks: with the device culling
   /// only its decision's inputs, cull_setup).
@@ -201,7 +236,8 @@ class RealtimeFrameData {
   /// the frame's view with host pointers (scene: the traversal's arrays; sky: per pixel).
   RealtimeFrameView View(const SceneView& scene, const Float3* sky) const;
   /// sets the particle streak fields of *f (streaks and num_streaks: the host splat's pixels;
-  /// splat: the device splat's streaks, host arrays, and the camera's projection) to those of the
+  /// splat: the device splat's streaks, host arrays, or with a device drop culler its device
+  /// array, a bound and the device count, and the camera's projection) to those of the
   /// last PrepareStreaks (none after a Prepare without streaks), as View sets them: the late
   /// streaks that CudaRenderer hands to DeviceRealtime::Render's `streaks`. the arrays stay
   /// valid until the next Prepare or PrepareStreaks.
@@ -243,12 +279,17 @@ class RealtimeFrameData {
   PathStreakBuild path_streaks_;  // the pathtraced tier's streaks and BVH (PrepareStreaks)
   std::vector<std::vector<StreakPixel>> streak_rows_;  // per row, then concatenated
   bool device_streaks_ = true;
-  PathStreakBuild splat_streaks_;       // the realtime streaks in index order (device_streaks)
-  StreakSplatView splat_camera_;        // their projection (R_OW, p_OW, intrinsics; rows)
-  std::vector<double> splat_rows_;      // a moving camera's row poses (StreakSplatView::rows)
-  DropCuller drop_culler_;              // the device's drop culling (empty: the host's)
-  std::vector<StreakPod> culled_pods_;  // its streaks (swapped into splat_streaks_)
-  int streaks_culled_ = 0;              // rain culled by the last PrepareStreaks
+  // the realtime streaks in index order (device_streaks); with a device drop culler only the
+  // sets, and the streaks once splat_streaks downloads them (device_pods_copied_)
+  mutable PathStreakBuild splat_streaks_;
+  StreakSplatView splat_camera_;             // their projection (R_OW, p_OW, intrinsics; rows)
+  std::vector<double> splat_rows_;           // a moving camera's row poses (StreakSplatView::rows)
+  DropCuller drop_culler_;                   // the device's drop culling (empty: the host's)
+  std::vector<StreakPod> culled_pods_;       // its streaks (swapped into splat_streaks_)
+  DeviceDropCuller device_drop_culler_;      // the device's culling, its streaks kept there
+  DeviceStreakList device_list_;             // their place (bound 0: none, or the host's list)
+  mutable bool device_pods_copied_ = false;  // splat_streaks_ holds them (splat_streaks)
+  int streaks_culled_ = 0;                   // rain culled by the last PrepareStreaks
   // the camera's projection for the frame's splat (splat_camera_, splat_rows_)
   void SetSplatCamera(const Camera& camera);
   // the frame's media (PrepareMedia): the scene's media, their realtime volumes and their host

@@ -98,16 +98,26 @@ __global__ void StreakKernel(const StreakPixel* streaks, int64_t count, const fl
   radiance[s.pixel] = ApplyStreak(s, depth[s.pixel], radiance[s.pixel]);
 }
 
-// the realtime particle streaks' splat (SplatStreakRow): one warp per streak, its lanes over the
+// the splat's warps at most when the streaks' count is on the device (StreakSplatView::count):
+// about as many as an H100 holds resident (132 SMs x 64), more than a rain frame's streaks.
+constexpr int64_t kSplatWarps = 8192;
+
+// the realtime particle streaks' splat (SplatStreakRow): a warp per streak, its lanes over the
 // rows of the streak's pixel box (rain falls: a streak is mostly taller than wide), every hit
-// kept by a 64-bit integer atomicMin of its StreakKey (order-independent: deterministic).
+// kept by a 64-bit integer atomicMin of its StreakKey (order-independent: deterministic). the
+// warps stride over the streaks, whose count is f.splat.streaks.num or, for the device
+// culling's streaks read in place, *f.splat.count (num then only a bound: LaunchStreakSplat
+// sizes the grid by it).
 __global__ void StreakSplatKernel(RealtimeFrameView f) {
-  const int64_t k = (blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x) / 32;
+  const int64_t warp = (blockIdx.x * static_cast<int64_t>(blockDim.x) + threadIdx.x) / 32;
+  const int64_t warps = gridDim.x * static_cast<int64_t>(blockDim.x) / 32;
   const int lane = static_cast<int>(threadIdx.x & 31);
-  if (k >= f.splat.streaks.num) return;
-  const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
-  if (p.empty()) return;
-  for (int v = p.v0 + lane; v <= p.v1; v += 32) SplatStreakRow(f, static_cast<int>(k), p, v);
+  const int64_t num = SplatStreakCount(f.splat);
+  for (int64_t k = warp; k < num; k += warps) {
+    const StreakProjection p = SplatProjection(f, f.splat.streaks.streaks[k]);
+    if (p.empty()) continue;
+    for (int v = p.v0 + lane; v <= p.v1; v += 32) SplatStreakRow(f, static_cast<int>(k), p, v);
+  }
 }
 
 // the splat's nearest streak of every pixel shaded (ShadeSplatPixel): one thread per pixel.
@@ -1578,7 +1588,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const int W = f.camera.width, H = f.camera.height;
     Check(cudaMemsetAsync(sp.nearest, 0xff, sizeof(unsigned long long) * W * H, stream),
           "cudaMemsetAsync");
-    const int64_t threads = 32 * static_cast<int64_t>(sp.streaks.num);
+    // a warp per streak; with the count on the device (the device culling's streaks, num a
+    // bound: the drops'), at most kSplatWarps warps striding over them
+    const int64_t warps = sp.count != nullptr ? std::min<int64_t>(sp.streaks.num, kSplatWarps)
+                                              : static_cast<int64_t>(sp.streaks.num);
+    const int64_t threads = 32 * warps;
     StreakSplatKernel<<<static_cast<unsigned>((threads + 127) / 128), 128, 0, stream>>>(f);
     Check(cudaGetLastError(), "StreakSplatKernel");
     StreakShadeKernel<<<PixelGrid(W, H), kPixelBlock, 0, stream>>>(f);
@@ -1586,10 +1600,11 @@ struct DeviceRealtime::Impl : PixelBuffers {
   }
   // the particle streaks of host frame h to the device on `stream`, f's streak fields pointing
   // at them (n: the frame's pixels): the host splat's pixels (StreakKernel's), or the device
-  // splat's streaks, then their splat queued (LaunchStreakSplat). staged: through page-locked
-  // staging (the last frame's copies from it are done: it ended with a synchronisation), so
-  // that the host never waits for a busy stream (the late streaks); else from h's pageable
-  // arrays (staged by the runtime before the calls return)
+  // splat's streaks (host arrays; or the device culling's, read in place: their sets only, the
+  // count on the device, StreakSplatView::count), then their splat queued (LaunchStreakSplat).
+  // staged: through page-locked staging (the last frame's copies from it are done: it ended
+  // with a synchronisation), so that the host never waits for a busy stream (the late
+  // streaks); else from h's pageable arrays (staged by the runtime before the calls return)
   void QueueStreaks(const RealtimeFrameView& h, RealtimeFrameView* f, int64_t n, bool staged,
                     cudaStream_t stream) {
     f->streaks = h.streaks;
@@ -1607,10 +1622,17 @@ struct DeviceRealtime::Impl : PixelBuffers {
       streaks.Upload(source(h.streaks, bytes, &pin_streak_pixels), bytes, stream);
       f->streaks = streaks.as<StreakPixel>();
     }
-    if (h.splat.streaks.num > 0) {
+    if (h.splat.streaks.num > 0 && h.splat.count != nullptr) {
+      // the device culling's streaks, read in place (their culler made `stream` wait for
+      // them): only their sets go over
+      f->splat.streaks =
+          splat_streaks.UploadSets(h.splat.streaks, staged ? &pin_splat : nullptr, stream);
+    } else if (h.splat.streaks.num > 0) {
       const PathStreaks list =
           staged ? StreakBuffers::Stage(h.splat.streaks, &pin_splat) : h.splat.streaks;
       f->splat.streaks = splat_streaks.Upload(list, stream);
+    }
+    if (h.splat.streaks.num > 0) {
       if (h.splat.poses != nullptr) {
         // a moving camera's row poses (StreakSplatView::poses, and rows where it has them)
         const size_t bytes = sizeof(double) * 12 * f->camera.height;

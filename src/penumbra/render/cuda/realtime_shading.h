@@ -137,6 +137,10 @@ struct StreakSplatView {
   /// nodes null), their particle sets and the open sky's sphere-average radiance (sky_ambient);
   /// rain radiance is shaded per pixel (rain null). num 0: no splat.
   PathStreaks streaks;
+  /// the streaks' count where streaks.num is only a bound of it (the device culling's streaks
+  /// read in place, RealtimeFrameData::DeviceStreakList, branch gpu30), in the memory the
+  /// reader runs in, as the streaks (SplatStreakCount); null: streaks.num is their count.
+  const int32_t* count = nullptr;
   /// the projection of the frame's camera (Camera::X_WO and its intrinsics, as BuildPixelHits):
   /// world to optical frame, R_OW row-major, and the pinhole intrinsics (px).
   float R_OW[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -1703,6 +1707,13 @@ PB_HOST_DEVICE inline void KeepNearestStreak(unsigned long long* slot, unsigned 
 #else
   if (key < *slot) *slot = key;
 #endif
+}
+
+/// the number of streaks the splat of f.splat draws: *count where the count is in the
+/// reader's memory (the device culling's streaks in place: streaks.num only a bound), else
+/// streaks.num.
+PB_HOST_DEVICE inline int32_t SplatStreakCount(const StreakSplatView& sp) {
+  return sp.count != nullptr ? *sp.count : sp.streaks.num;
 }
 
 /// splat streak k (projection p, SplatProjection) on row v (inside p's box): every pixel of

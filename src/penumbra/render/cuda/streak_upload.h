@@ -36,6 +36,27 @@ struct StreakBuffers {
     return d;
   }
 
+  /// h's particle sets copied on `stream`, its streaks already on the device (the device
+  /// culling's, read in place: StreakSplatView::count, branch gpu30; no BVH, no rain): through
+  /// the page-locked *pin (grown as needed; not written again before the copy is done) when
+  /// pin is not null, else from h's pageable array (staged before the call returns). returns h
+  /// with the sets' device pointer (num: h's, a bound).
+  /// @throws Error on a CUDA failure.
+  PathStreaks UploadSets(const PathStreaks& h, PinnedBuffer* pin, cudaStream_t stream) {
+    PathStreaks d = h;
+    if (h.num <= 0 || h.num_sets <= 0) return d;
+    const size_t bytes = sizeof(StreakSetPod) * h.num_sets;
+    const void* src = h.sets;
+    if (pin != nullptr) {
+      pin->Reserve(bytes);
+      std::memcpy(pin->p, h.sets, bytes);
+      src = pin->p;
+    }
+    sets.Upload(src, bytes, stream);
+    d.sets = sets.as<StreakSetPod>();
+    return d;
+  }
+
   /// h with its arrays (nodes, streaks, sets, rain) copied end to end, each 16-byte aligned,
   /// into the page-locked *pin (grown as needed), so that an Upload of the result does not wait
   /// for a busy stream (DeviceRealtime::Render's late streaks). *pin must not be written again
