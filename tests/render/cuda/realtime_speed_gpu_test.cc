@@ -79,13 +79,10 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "penumbra_chunk_rays 4",
                          "penumbra_chunk_rays 3",
                          "packed_window_counts off",
-                         "geometry_stack_top 0",
-                         "geometry_stack_top 16",
-                         "shadow_stack_top 0",
-                         "visibility_stack_top 0",
-                         "queue_shadow_rays_always, shadow_stack_top 0",
-                         "every stack top 0"};
-  for (int k = 0; k < 36; ++k) {
+                         "split_geometry",
+                         "split_geometry, trace_min_blocks 6",
+                         "split_geometry, trace_min_blocks 8"};
+  for (int k = 0; k < 33; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -96,7 +93,6 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
       o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
       o.tile_visibility = o.tile_penumbra = false;
       o.min_blocks = o.geometry_min_blocks = 0;
-      o.geometry_stack_top = o.shadow_stack_top = o.visibility_stack_top = 0;
       o.output_bands = 1;
     }
     if (k == 4 || k == 8) o.min_blocks = 1;
@@ -122,11 +118,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 27) o.penumbra_chunk_rays = 4;
     if (k == 28) o.penumbra_chunk_rays = 3;
     if (k == 29) o.packed_window_counts = false;
-    if (k == 30 || k == 35) o.geometry_stack_top = 0;
-    if (k == 31) o.geometry_stack_top = 16;
-    if (k == 32 || k == 34 || k == 35) o.shadow_stack_top = 0;
-    if (k == 33 || k == 35) o.visibility_stack_top = 0;
-    if (k == 34) o.queue_shadow_rays_always = true;
+    if (k >= 30) o.split_geometry = true;
+    if (k == 31) o.trace_min_blocks = 6;
+    if (k == 32) o.trace_min_blocks = 8;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -600,20 +600,12 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.packed_window_counts = false;
     variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
     o = fast;
-    o.geometry_stack_top = 0;
-    variants.push_back({"kernels, geometry kernel's traversal stack in local memory", o});
-    o.geometry_stack_top = 16;
-    variants.push_back({"kernels, geometry kernel's stack top of 16 in shared memory", o});
-    o = fast;
-    o.shadow_stack_top = 0;
-    variants.push_back({"kernels, shadow rays' traversal stack in local memory", o});
-    o.queue_shadow_rays_always = true;
-    variants.push_back({"kernels, shadow rays always queued, their stack in local memory", o});
-    o = fast;
-    o.visibility_stack_top = 0;
-    variants.push_back({"kernels, penumbra rays' traversal stack in local memory", o});
-    o.geometry_stack_top = o.shadow_stack_top = 0;
-    variants.push_back({"kernels, every traversal stack in local memory", o});
+    o.split_geometry = true;
+    variants.push_back({"kernels, geometry in two: trace kernel, then surface kernel", o});
+    o.trace_min_blocks = 6;
+    variants.push_back({"kernels, geometry in two, trace kernel <= 80 registers", o});
+    o.trace_min_blocks = 8;
+    variants.push_back({"kernels, geometry in two, trace kernel <= 64 registers", o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -625,7 +617,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
     o.tile_visibility = o.tile_penumbra = false;
     o.min_blocks = o.geometry_min_blocks = 1;
-    o.geometry_stack_top = o.shadow_stack_top = o.visibility_stack_top = 0;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);
     for (const Variant& var : variants) {

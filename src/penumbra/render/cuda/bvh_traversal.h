@@ -32,47 +32,17 @@ struct alignas(16) BvhPending {
   int unused;
 };
 
-/// TraverseWideBvh's stack on the host and, by default, on the device: all kMaxBvhDepth entries
-/// in the thread's own array (local memory on the GPU). a stack policy is default-constructible
-/// (one per traversal, empty) and has Put(i, e) and Get(i) for entry i in [0, kMaxBvhDepth); the
-/// traversal pushes and pops through it, so every policy visits the same nodes in the same
-/// order and gives the same hits, bit for bit.
+/// TraverseWideBvh's stack: all kMaxBvhDepth entries in the thread's own array (local memory on
+/// the GPU). a stack policy is default-constructible (one per traversal, empty) and has Put(i,
+/// e) and Get(i) for entry i in [0, kMaxBvhDepth); the traversal pushes and pops through it, so
+/// a policy that keeps the entries elsewhere visits the same nodes in the same order and gives
+/// the same hits, bit for bit (the tests count the stack's depth through one). a top of 8
+/// entries in shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local
+/// memory (branch gpu29)").
 struct LocalBvhStack {
   BvhPending entries[kMaxBvhDepth];
   PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
   PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
-};
-
-/// a stack policy whose first kTop entries (the ones nearly every pop reads) are in the block's
-/// shared memory, interleaved over the block's kThreads threads (entry i of thread t at
-/// [i * kThreads + t]: a warp's 16-byte accesses of one entry fall in distinct banks), and only
-/// deeper ones in the thread's local memory. the kernel that traces with it must run blocks of
-/// exactly kThreads threads, and takes kTop * kThreads * 16 bytes of static shared memory (8 x
-/// 128: 16 KiB a block). on the host (tests) the top entries are a thread_local array of the
-/// same layout, used by one thread. the same entries as LocalBvhStack, so the same bits.
-template <int kTop, int kThreads>
-struct SharedTopBvhStack {
-  static_assert(kTop > 0 && kTop < kMaxBvhDepth, "the top must be part of the stack");
-  BvhPending* top;
-  BvhPending rest[kMaxBvhDepth - kTop];
-  PB_HOST_DEVICE SharedTopBvhStack() {
-#if defined(__CUDA_ARCH__)
-    __shared__ BvhPending block_top[kTop * kThreads];
-    top = block_top + (threadIdx.y * blockDim.x + threadIdx.x);
-#else
-    thread_local BvhPending host_top[kTop * kThreads];
-    top = host_top;
-#endif
-  }
-  PB_HOST_DEVICE void Put(int i, const BvhPending& e) {
-    if (i < kTop)
-      top[i * kThreads] = e;
-    else
-      rest[i - kTop] = e;
-  }
-  PB_HOST_DEVICE BvhPending Get(int i) const {
-    return i < kTop ? top[i * kThreads] : rest[i - kTop];
-  }
 };
 
 /// p transformed by the row-major 3x4 matrix m (rotation and translation).
@@ -206,7 +176,7 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 /// hit (it then shrinks *t_max to the hit's t); any_hit: stop at the first hit (occlusion).
 /// returns whether any primitive hit. a visit of an inner node tests its two children's boxes
 /// (stored in it, BvhWideNode), goes on with the nearer and keeps the farther. Stack: where the
-/// farther children wait (LocalBvhStack, SharedTopBvhStack; the same visits either way).
+/// farther children wait (LocalBvhStack, or a test's).
 template <class Stack = LocalBvhStack, typename Leaf>
 PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas& blas, F3 o, F3 d,
                                            float tmin, const float* t_max, bool any_hit,
@@ -291,7 +261,7 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
 }
 
 /// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.
-/// Stack: TraverseWideBvh's (the same hit with any).
+/// Stack: TraverseWideBvh's.
 template <class Stack = LocalBvhStack>
 PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, TraceHit* hit) {
   hit->t = r.tmax;
@@ -306,8 +276,7 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   }
 }
 
-/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's (the same verdict
-/// with any).
+/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's.
 template <class Stack = LocalBvhStack>
 PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) {
   TraceHit hit;

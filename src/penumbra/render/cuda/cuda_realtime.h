@@ -144,20 +144,14 @@ struct RealtimeKernelOptions {
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
   /// reuse_surface), below 5 leaves them to the compiler.
   int geometry_min_blocks = 5;
-  /// with geometry_min_blocks 5: the geometry kernel's primary rays keep the top entries of
-  /// their traversal stack (bvh_traversal.h's SharedTopBvhStack; 8 or 16, 16 bytes an entry and
-  /// thread: 16 or 32 KiB a block of 128 threads) in the block's shared memory and only deeper
-  /// ones in the thread's local memory; 0 all in local memory (LocalBvhStack). the same nodes
-  /// visited in the same order, so the same bits.
-  int geometry_stack_top = 8;
-  /// the shadow rays' traversal stacks as geometry_stack_top's (0, else 8 entries in shared
-  /// memory): the fused shading kernel's (ShadeStoredKernel, with shared_light_terms and without
-  /// media; a batch's too) and the queued shadow rays' (TraceQueuedKernel). the same bits.
-  int shadow_stack_top = 8;
-  /// the shared visibility's penumbra rays' traversal stacks as shadow_stack_top's (with
-  /// tile_penumbra: VisibilityRaysWarpKernel's tiles, 32 KiB a block of 256 threads, and
-  /// VisibilityChunkKernel's queue). the same bits.
-  int visibility_stack_top = 8;
+  /// with reuse_hit: the geometry kernel in two, a lean kernel that only traces the primary
+  /// rays (PrimaryTraceKernel: the closest hits into the hits buffer, 24 bytes a pixel), then
+  /// the surface evaluation from the stored hits (PrimaryGeometryOfHit, geometry_min_blocks 5);
+  /// else one kernel does both. the same values, so the same bits.
+  bool split_geometry = false;
+  /// with split_geometry: the trace kernel's __launch_bounds__ minimum of resident blocks of
+  /// 128 threads an SM: 6 caps it at 80 registers, 8 at 64; below 6 the compiler's.
+  int trace_min_blocks = 1;
   /// with pinned copies, the radiance goes back in this many bands of rows (1 to
   /// kMaxSkyBands), each copied into the frame's image while the next one comes back.
   int output_bands = 2;

@@ -10,7 +10,6 @@
 #include <cstring>
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include "penumbra/core/error.h"
@@ -73,23 +72,11 @@ __device__ inline FramePixel PixelOf(const RealtimeFrameView& f, int row0 = 0, i
   return p;
 }
 
-// the traversal's stack of a kernel's rays (RealtimeKernelOptions::geometry_stack_top and
-// shadow_stack_top): kTop 0 all in the thread's local memory (LocalBvhStack), else the top kTop
-// entries in the block's shared memory for blocks of kThreads threads (SharedTopBvhStack). the
-// same visits either way, so the same bits.
-// the shared tops the options' nonzero geometry_stack_top (16 also compiled) and
-// shadow_stack_top and visibility_stack_top take.
-constexpr int kGeometryStackTop = 8;
-constexpr int kShadowStackTop = 8;
-
-template <int kTop, int kThreads = 128>
-using TraversalStack = std::conditional_t<kTop == 0, LocalBvhStack,
-                                          SharedTopBvhStack<(kTop > 0 ? kTop : 1), kThreads>>;
-
 // hits, surfaces: null, or where the primary hits and their material terms are kept for the
 // shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
-// threads an SM). kStackTop: the primary ray's traversal stack (TraversalStack).
-template <class Frames, int kMinBlocks, int kStackTop = 0>
+// threads an SM). kTraced (RealtimeKernelOptions::split_geometry): the hits were traced
+// before (PrimaryTraceKernel, into `hits`), this kernel evaluates them (PrimaryGeometryOfHit).
+template <class Frames, int kMinBlocks, bool kTraced = false>
 __global__ void __launch_bounds__(128, kMinBlocks)
     GeometryKernel(Frames frames, PixelGeometry* geometry, float* depth, TraceHit* hits,
                    SurfaceTerms* surfaces) {
@@ -97,9 +84,27 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   const FramePixel p = PixelOf(f);
   if (!p) return;
   float t;
-  geometry[p.k] = PrimaryGeometry<TraversalStack<kStackTop>>(
-      f, p.u, p.v, &t, hits ? &hits[p.k] : nullptr, surfaces ? &surfaces[p.k] : nullptr);
+  if constexpr (kTraced)
+    geometry[p.k] = PrimaryGeometryOfHit(f, PrimaryRay(f.camera, p.u, p.v), hits[p.k], &t,
+                                         surfaces ? &surfaces[p.k] : nullptr);
+  else
+    geometry[p.k] = PrimaryGeometry(f, p.u, p.v, &t, hits ? &hits[p.k] : nullptr,
+                                    surfaces ? &surfaces[p.k] : nullptr);
   depth[p.k] = t;
+}
+
+// the primary rays' closest hits alone, into `hits` (RealtimeKernelOptions::split_geometry),
+// for GeometryKernel<..., true>. kMinBlocks: __launch_bounds__'s minimum of resident blocks of
+// 128 threads an SM (1: the compiler's registers).
+template <class Frames, int kMinBlocks>
+__global__ void __launch_bounds__(128, kMinBlocks)
+    PrimaryTraceKernel(Frames frames, TraceHit* hits) {
+  const RealtimeFrameView& f = frames.get();
+  const FramePixel p = PixelOf(f);
+  if (!p) return;
+  TraceHit h;
+  TraceClosest(f.scene, PrimaryRay(f.camera, p.u, p.v), &h);
+  hits[p.k] = h;
 }
 
 // the particle streaks over the final radiance (ApplyStreak): one thread per streak pixel, each
@@ -310,25 +315,19 @@ __device__ inline StridedLightTerms BlockLightTerms(int lights) {
 // (the default variant of frames without media and batches; ShadeRealtimePoint). kSharedTerms
 // (RealtimeKernelOptions::shared_light_terms): the first `lights` lights' unshadowed terms wait
 // between the light loops in the block's dynamic shared memory (StridedLightTerms,
-// ShadeLightTermBytes of it), not in the thread's stack (LocalLightTerms). kStackTop: the
-// shadow rays' traversal stack (TraversalStack).
-template <class Frames, int kMinBlocks, bool kMedia = true, bool kSharedTerms = false,
-          int kStackTop = 0>
+// ShadeLightTermBytes of it), not in the thread's stack (LocalLightTerms).
+template <class Frames, int kMinBlocks, bool kMedia = true, bool kSharedTerms = false>
 __global__ void __launch_bounds__(128, kMinBlocks)
     ShadeStoredKernel(Frames frames, const SurfaceTerms* surfaces, Float3* radiance, int row0,
                       int row1, int lights = 0) {
-  using Stack = TraversalStack<kStackTop>;
   const RealtimeFrameView& f = frames.get();
   const FramePixel p = PixelOf(f, row0, row1);
   if (!p) return;
   if constexpr (kSharedTerms) {
     StridedLightTerms terms = BlockLightTerms(lights);
-    radiance[p.k] =
-        ShadeRealtimeStored<kMedia, Stack>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k], terms);
+    radiance[p.k] = ShadeRealtimeStored<kMedia>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k], terms);
   } else {
-    LocalLightTerms terms;
-    radiance[p.k] =
-        ShadeRealtimeStored<kMedia, Stack>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k], terms);
+    radiance[p.k] = ShadeRealtimeStored<kMedia>(f, p.u, p.v, f.geometry[p.i], surfaces[p.k]);
   }
 }
 
@@ -392,8 +391,7 @@ __global__ void __launch_bounds__(128)
 // pass 2: the queued rays, one a thread, one wave of resident blocks striding over the queue;
 // `pixels`: a camera's (the ray's camera is its pixel / pixels). its registers are the
 // compiler's (98 with nvcc 13 for sm_90: 4 blocks an SM; capped at 64, 8 blocks, it was slower).
-// kStackTop: the traversal stack (TraversalStack).
-template <class Frames, int kStackTop = 0>
+template <class Frames>
 __global__ void __launch_bounds__(128)
     TraceQueuedKernel(Frames frames, ShadowRayQueue q, int64_t pixels) {
   const int64_t total = *q.count;
@@ -403,7 +401,7 @@ __global__ void __launch_bounds__(128)
     const QueuedShadowRay e = q.rays[at];
     const uint32_t pixel = e.key / kMaxQueuedShadowLights;
     const RealtimeFrameView& f = frames.at(static_cast<int>(pixel / pixels));
-    if (TraceOccluded<TraversalStack<kStackTop>>(f.scene, QueuedRay(e)))
+    if (TraceOccluded(f.scene, QueuedRay(e)))
       atomicOr(q.occluded + pixel, 1u << (e.key % kMaxQueuedShadowLights));
   }
 }
@@ -427,9 +425,9 @@ unsigned ResidentBlocks(Kernel* kernel) {
 }
 
 // TraceQueuedKernel's grid: one wave of its blocks.
-template <class Frames, int kStackTop = 0>
+template <class Frames>
 unsigned TraceQueuedBlocks() {
-  static const unsigned blocks = ResidentBlocks(TraceQueuedKernel<Frames, kStackTop>);
+  static const unsigned blocks = ResidentBlocks(TraceQueuedKernel<Frames>);
   return blocks;
 }
 
@@ -533,8 +531,7 @@ __device__ inline bool QueuePenumbraJob(const PenumbraQueue& q, const PenumbraRa
   return fits;
 }
 
-// kStackTop: the rays' traversal stack (TraversalStack).
-template <class Frames, int kStackTop = 0>
+template <class Frames>
 __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
   const int64_t total = min(static_cast<int64_t>(*q.queued), q.capacity);
   const int64_t stride = static_cast<int64_t>(gridDim.x) * blockDim.x;
@@ -554,8 +551,7 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
     job.points = e.points;
     job.own = e.own;
     int traced, visible;
-    CountPenumbraRays<TraversalStack<kStackTop>>(f, e.light, job, e.r0, e.r0 + e.rays, &traced,
-                                                 &visible);
+    CountPenumbraRays(f, e.light, job, e.r0, e.r0 + e.rays, &traced, &visible);
     const int64_t k = e.light * n + e.pixel;
     const uint32_t add = PackChunkCounts(traced, visible);
     const uint32_t sum = atomicAdd(q.counts + static_cast<int64_t>(e.camera) * q.nl + k, add) + add;
@@ -576,9 +572,9 @@ inline size_t TilePenumbraBytes(int lights) {
 }
 
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
-template <class Frames, int kStackTop = 0>
+template <class Frames>
 unsigned ChunkBlocks() {
-  static const unsigned blocks = ResidentBlocks(VisibilityChunkKernel<Frames, kStackTop>);
+  static const unsigned blocks = ResidentBlocks(VisibilityChunkKernel<Frames>);
   return blocks;
 }
 
@@ -593,11 +589,9 @@ unsigned ChunkBlocks() {
 // (kTileBlock, 2 blocks an SM at 128 registers) first copies every light's verdicts of its tile
 // into its dynamic shared memory (TilePenumbraBytes of it), where the pixels' windows, cut at the
 // tile's edges, find their neighbours' (SharedVisibilityPenumbra's vis_j: the same values).
-// kStackTop: the rays' traversal stack (TraversalStack, for the block's threads).
-template <class Frames, bool kTile, int kStackTop = 0>
+template <class Frames, bool kTile>
 __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
     VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
-  using Stack = TraversalStack<kStackTop, kTile ? kTilePixels : 128>;
   extern __shared__ int8_t tile_vis[];
   const RealtimeFrameView& f = frames.get();
   const FramePixel p = PixelOf(f);
@@ -654,7 +648,7 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
       o.points = __shfl_sync(kFullWarp, job.points, owner);
       o.own = __shfl_sync(kFullWarp, job.own, owner);
       const int owner_begin = __shfl_sync(kFullWarp, begin, owner);
-      const int verdict = t < total ? PenumbraRayVerdict<Stack>(f, j, o, t - owner_begin + 1) : -1;
+      const int verdict = t < total ? PenumbraRayVerdict(f, j, o, t - owner_begin + 1) : -1;
       const uint32_t traced_lanes = __ballot_sync(kFullWarp, verdict >= 0);
       const uint32_t visible_lanes = __ballot_sync(kFullWarp, verdict > 0);
       // this lane's rays among this round's lanes
@@ -966,12 +960,10 @@ struct PixelBuffers {
   // per-light entries each on `stream`: spread over each warp's lanes (VisibilityRaysWarpKernel),
   // the long jobs through the queue (VisibilityChunkKernel) in chunks of `chunk_rays` rays if
   // `queue`, a block per shadow tile with the verdicts in shared memory if `tile` (and the
-  // lights fit: kMaxTilePenumbraLights); the rays' traversal stack with its top in shared memory
-  // if `shared_stack` (and `tile`: RealtimeKernelOptions::visibility_stack_top).
+  // lights fit: kMaxTilePenumbraLights).
   template <class Frames>
   void LaunchPenumbraRays(Frames frames, int W, int H, int lights, int64_t nl, int cameras,
-                          bool queue, int chunk_rays, bool tile, bool shared_stack,
-                          cudaStream_t stream) const {
+                          bool queue, int chunk_rays, bool tile, cudaStream_t stream) const {
     PenumbraQueue q;
     if (queue) {
       q.queue = penumbra_queue.as<PenumbraChunk>();
@@ -982,16 +974,11 @@ struct PixelBuffers {
       q.nl = nl;
       Check(cudaMemsetAsync(q.queued, 0, sizeof(unsigned long long), stream), "cudaMemsetAsync");
     }
-    shared_stack = shared_stack && tile;
     if (tile && lights <= kMaxTilePenumbraLights) {
       dim3 grid = TileGrid(W, 0, H);
       grid.z = cameras;
-      if (shared_stack)
-        VisibilityRaysWarpKernel<Frames, true, kShadowStackTop>
-            <<<grid, kTileBlock, TilePenumbraBytes(lights), stream>>>(frames, q);
-      else
-        VisibilityRaysWarpKernel<Frames, true>
-            <<<grid, kTileBlock, TilePenumbraBytes(lights), stream>>>(frames, q);
+      VisibilityRaysWarpKernel<Frames, true>
+          <<<grid, kTileBlock, TilePenumbraBytes(lights), stream>>>(frames, q);
     } else {
       dim3 grid = PixelGrid(W, H);
       grid.z = cameras;
@@ -1000,11 +987,7 @@ struct PixelBuffers {
     Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
     if (!queue) return;
     // one wave of resident blocks strides over the chunks (their number stays on the device)
-    if (shared_stack)
-      VisibilityChunkKernel<Frames, kShadowStackTop>
-          <<<ChunkBlocks<Frames, kShadowStackTop>(), 128, 0, stream>>>(frames, q);
-    else
-      VisibilityChunkKernel<<<ChunkBlocks<Frames>(), 128, 0, stream>>>(frames, q);
+    VisibilityChunkKernel<<<ChunkBlocks<Frames>(), 128, 0, stream>>>(frames, q);
     Check(cudaGetLastError(), "VisibilityChunkKernel");
   }
   // whether frames of `n` pixels in all (every camera's) and `lights` lights can queue their
@@ -1029,13 +1012,12 @@ struct PixelBuffers {
   // the shading of rows [row0, row1) of `cameras` frames (grid: a camera's rows, z the camera)
   // of `pixels` pixels and `lights` lights each, their shadow rays through the queue, on
   // `stream`: ShadeQueuedKernel, TraceQueuedKernel, SumQueuedKernel.
-  // smem: the light terms' shared memory (kSharedTerms) for `term_lights` lights. shared_stack:
-  // the queue's traversal stack with its top in shared memory (shadow_stack_top).
+  // smem: the light terms' shared memory (kSharedTerms) for `term_lights` lights.
   // CanQueueShadowRays must hold.
   template <class Frames, bool kMedia, bool kSharedTerms>
   void LaunchQueuedShade(Frames frames, dim3 grid, const SurfaceTerms* surfaces, Float3* L,
                          int row0, int row1, int64_t pixels, int cameras, int lights,
-                         int term_lights, size_t smem, bool shared_stack, cudaStream_t stream) {
+                         int term_lights, size_t smem, cudaStream_t stream) {
     const int64_t n = pixels * cameras;
     shadow_rays.Reserve(sizeof(QueuedShadowRay) * n * std::max(lights, 1));
     shadow_count.Reserve(sizeof(unsigned));
@@ -1050,11 +1032,7 @@ struct PixelBuffers {
     ShadeQueuedKernel<Frames, kMedia, kSharedTerms>
         <<<grid, kPixelBlock, smem, stream>>>(frames, surfaces, L, q, row0, row1, term_lights);
     Check(cudaGetLastError(), "ShadeQueuedKernel");
-    if (shared_stack)
-      TraceQueuedKernel<Frames, kShadowStackTop>
-          <<<TraceQueuedBlocks<Frames, kShadowStackTop>(), 128, 0, stream>>>(frames, q, pixels);
-    else
-      TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
+    TraceQueuedKernel<<<TraceQueuedBlocks<Frames>(), 128, 0, stream>>>(frames, q, pixels);
     Check(cudaGetLastError(), "TraceQueuedKernel");
     SumQueuedKernel<<<grid, kPixelBlock, 0, stream>>>(frames, L, q, row0, row1);
     Check(cudaGetLastError(), "SumQueuedKernel");
@@ -1374,13 +1352,19 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const dim3 grid = PixelGrid(f.camera.width, f.camera.height);
     TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
     SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
-    if (o.geometry_min_blocks >= 5 && o.geometry_stack_top >= 16)
-      GeometryKernel<OneFrame, 5, 16><<<grid, kPixelBlock, 0, stream>>>(
-          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
-    else if (o.geometry_min_blocks >= 5 && o.geometry_stack_top > 0)
-      GeometryKernel<OneFrame, 5, kGeometryStackTop><<<grid, kPixelBlock, 0, stream>>>(
-          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
-    else if (o.geometry_min_blocks >= 5)
+    if (o.split_geometry && o.reuse_hit) {
+      // the hits first (kept in `hits`, which the shading kernel may read too), then the rest
+      TraceHit* traced = hits.as<TraceHit>();
+      if (o.trace_min_blocks >= 8)
+        PrimaryTraceKernel<OneFrame, 8><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
+      else if (o.trace_min_blocks >= 6)
+        PrimaryTraceKernel<OneFrame, 6><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
+      else
+        PrimaryTraceKernel<OneFrame, 1><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
+      Check(cudaGetLastError(), "PrimaryTraceKernel");
+      GeometryKernel<OneFrame, 5, true><<<grid, kPixelBlock, 0, stream>>>(
+          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), traced, st);
+    } else if (o.geometry_min_blocks >= 5)
       GeometryKernel<OneFrame, 5><<<grid, kPixelBlock, 0, stream>>>(
           OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     else
@@ -1473,20 +1457,19 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const int64_t pixels = static_cast<int64_t>(f.camera.width) * f.camera.height;
     if (QueueShadowRays(o, pixels, f.num_lights)) {
       const OneFrame fr{f};
-      const bool shared_stack = o.shadow_stack_top > 0;
       const bool media = f.has_media != 0;
       if (o.shared_light_terms && media)
         LaunchQueuedShade<OneFrame, true, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                f.num_lights, lights, smem, shared_stack, stream);
+                                                f.num_lights, lights, smem, stream);
       else if (o.shared_light_terms)
         LaunchQueuedShade<OneFrame, false, true>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, lights, smem, shared_stack, stream);
+                                                 f.num_lights, lights, smem, stream);
       else if (media)
         LaunchQueuedShade<OneFrame, true, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                 f.num_lights, 0, 0, shared_stack, stream);
+                                                 f.num_lights, 0, 0, stream);
       else
         LaunchQueuedShade<OneFrame, false, false>(fr, grid, st, L, row0, row1, pixels, 1,
-                                                  f.num_lights, 0, 0, shared_stack, stream);
+                                                  f.num_lights, 0, 0, stream);
       return;
     }
     if (!o.reuse_hit)
@@ -1499,9 +1482,6 @@ struct DeviceRealtime::Impl : PixelBuffers {
           <<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, st, L, row0, row1);
     else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms && f.has_media != 0)
       ShadeStoredKernel<OneFrame, 4, true, true>
-          <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
-    else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms && o.shadow_stack_top > 0)
-      ShadeStoredKernel<OneFrame, 4, false, true, kShadowStackTop>
           <<<grid, kPixelBlock, smem, stream>>>(OneFrame{f}, st, L, row0, row1, lights);
     else if (o.reuse_surface && o.min_blocks >= 4 && o.shared_light_terms)
       ShadeStoredKernel<OneFrame, 4, false, true>
@@ -1540,8 +1520,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (o.warp_penumbra || o.queue_penumbra) {
       LaunchPenumbraRays(OneFrame{f}, W, H, f.num_lights,
                          static_cast<int64_t>(W) * H * f.num_lights, 1, o.queue_penumbra,
-                         o.penumbra_chunk_rays, o.tile_penumbra, o.visibility_stack_top > 0,
-                         stream);
+                         o.penumbra_chunk_rays, o.tile_penumbra, stream);
     } else {
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
       Check(cudaGetLastError(), "VisibilityRaysKernel");
@@ -2318,16 +2297,9 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   grid.z = count;
   Float3* L = m.radiance.as<Float3>();
   stage(0);
-  // the traversal stacks as a frame's with the default options
-  const RealtimeKernelOptions defaults;
-  if (defaults.geometry_stack_top > 0)
-    GeometryKernel<BatchFrames, 5, kGeometryStackTop><<<grid, kPixelBlock, 0, stream>>>(
-        fr, m.geometry.as<PixelGeometry>(), depth ? depth : m.depth.as<float>(), nullptr,
-        m.surfaces.as<SurfaceTerms>());
-  else
-    GeometryKernel<BatchFrames, 5><<<grid, kPixelBlock, 0, stream>>>(
-        fr, m.geometry.as<PixelGeometry>(), depth ? depth : m.depth.as<float>(), nullptr,
-        m.surfaces.as<SurfaceTerms>());
+  GeometryKernel<BatchFrames, 5><<<grid, kPixelBlock, 0, stream>>>(
+      fr, m.geometry.as<PixelGeometry>(), depth ? depth : m.depth.as<float>(), nullptr,
+      m.surfaces.as<SurfaceTerms>());
   Check(cudaGetLastError(), "GeometryKernel (batch)");
   if (m.mirror) {
     MirrorTraceKernel<<<grid, kPixelBlock, 0, stream>>>(fr);
@@ -2347,12 +2319,7 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // the batch's shading as a frame's with the default options (one wave or less: the queue)
   if (Impl::QueueShadowRays(RealtimeKernelOptions(), n * count, m.lights)) {
     m.LaunchQueuedShade<BatchFrames, false, false>(fr, grid, m.surfaces.as<SurfaceTerms>(), L, 0, H,
-                                                   n, count, m.lights, 0, 0,
-                                                   defaults.shadow_stack_top > 0, stream);
-  } else if (defaults.shadow_stack_top > 0) {
-    ShadeStoredKernel<BatchFrames, 4, false, false, kShadowStackTop>
-        <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
-    Check(cudaGetLastError(), "ShadeStoredKernel (batch)");
+                                                   n, count, m.lights, 0, 0, stream);
   } else {
     ShadeStoredKernel<BatchFrames, 4, false>
         <<<grid, kPixelBlock, 0, stream>>>(fr, m.surfaces.as<SurfaceTerms>(), L, 0, H);
@@ -2361,8 +2328,9 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   stage(3);
   // the shared visibility as a frame's with the default options, the queue's chunks of
   // kPenumbraChunkRays rays (many cameras fill the device: fewer, longer chunks)
+  const RealtimeKernelOptions defaults;
   m.LaunchPenumbraRays(fr, W, H, m.lights, nl, count, /*queue=*/true, kPenumbraChunkRays,
-                       defaults.tile_penumbra, defaults.visibility_stack_top > 0, stream);
+                       defaults.tile_penumbra, stream);
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;

@@ -707,18 +707,13 @@ PB_HOST_DEVICE inline bool MirrorSkyTerm(const SkyModelPod& sky, const SkyVolume
   return true;
 }
 
-/// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
-/// (0 on a miss); *hit_out (if given): the closest hit; *surface_out (if given, where the ray
-/// hits): the shading point's material terms (ShadeRealtimeStored). Stack: the traversal's
-/// stack (bvh_traversal.h's LocalBvhStack, SharedTopBvhStack: the same hit).
-template <class Stack = LocalBvhStack>
-PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
-                                                    float* t_hit, TraceHit* hit_out = nullptr,
-                                                    SurfaceTerms* surface_out = nullptr) {
-  const TraceRay r = PrimaryRay(f.camera, u, v);
-  TraceHit h;
-  TraceClosest<Stack>(f.scene, r, &h);
-  if (hit_out) *hit_out = h;
+/// PrimaryGeometry from the primary ray r (PrimaryRay) and its closest hit h (TraceClosest),
+/// traced before: the geometry kernel's second half where a lean kernel traced the hits
+/// (RealtimeKernelOptions::split_geometry). the same values as PrimaryGeometry.
+PB_HOST_DEVICE inline PixelGeometry PrimaryGeometryOfHit(const RealtimeFrameView& f,
+                                                         const TraceRay& r, const TraceHit& h,
+                                                         float* t_hit,
+                                                         SurfaceTerms* surface_out = nullptr) {
   PixelGeometry g;
   *t_hit = 0;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
@@ -744,6 +739,19 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, 
     surface_out->occlusion = sp.occlusion;
   }
   return g;
+}
+
+/// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
+/// (0 on a miss); *hit_out (if given): the closest hit; *surface_out (if given, where the ray
+/// hits): the shading point's material terms (ShadeRealtimeStored).
+PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
+                                                    float* t_hit, TraceHit* hit_out = nullptr,
+                                                    SurfaceTerms* surface_out = nullptr) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  if (hit_out) *hit_out = h;
+  return PrimaryGeometryOfHit(f, r, h, t_hit, surface_out);
 }
 
 /// light j's contribution c at surface point p (shadow ray direction wi, distance dist:
@@ -963,9 +971,8 @@ PB_HOST_DEVICE inline void ForEachLitLight(const RealtimeFrameView& f, int u, in
 /// so the kernels of frames without media keep their registers. terms: where the lights'
 /// unshadowed terms wait between the two loops (LocalLightTerms, StridedLightTerms); lights from
 /// terms.capacity() on are evaluated twice. ShadeQueuedLights and SumQueuedLights do the same
-/// with the shadow rays traced apart (the same bits). Stack: the shadow rays' traversal stack
-/// (the same verdicts with any).
-template <bool kMedia = true, class Stack = LocalBvhStack, class Terms>
+/// with the shadow rays traced apart (the same bits).
+template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int u, int v,
                                                 const ShadingPoint& sp, const Float3& sky,
                                                 Terms& terms) {
@@ -976,8 +983,7 @@ PB_HOST_DEVICE inline Float3 ShadeRealtimePoint(const RealtimeFrameView& f, int 
                           [&](int j, int64_t pixel, int64_t n_pixels, const Float3& c, bool traced,
                               const F3& origin, const Float3& wi, float dist) {
                             const bool occluded =
-                                traced &&
-                                TraceOccluded<Stack>(f.scene, ShadowRayOf(origin, wi, dist));
+                                traced && TraceOccluded(f.scene, ShadowRayOf(origin, wi, dist));
                             AddLitLight(f, j, pixel, n_pixels, c, traced, occluded, &L);
                           });
   return L;
@@ -1119,15 +1125,15 @@ PB_HOST_DEVICE inline ShadingPoint StoredShadingPoint(const RealtimeFrameView& f
 }
 
 /// ShadeRealtimeHit of pixel (u, v) from what the geometry pass kept of its shading point
-/// (StoredShadingPoint of g and t): the same shading point, so the same radiance. kMedia,
-/// Stack and terms: ShadeRealtimePoint's.
-template <bool kMedia = true, class Stack = LocalBvhStack, class Terms>
+/// (StoredShadingPoint of g and t): the same shading point, so the same radiance. kMedia and
+/// terms: ShadeRealtimePoint's.
+template <bool kMedia = true, class Terms>
 PB_HOST_DEVICE inline Float3 ShadeRealtimeStored(const RealtimeFrameView& f, int u, int v,
                                                  const PixelGeometry& g, const SurfaceTerms& t,
                                                  Terms& terms) {
   const Float3 sky = BeginRealtimePixel(f, u, v);
   if (g.hit == 0) return sky;
-  return ShadeRealtimePoint<kMedia, Stack>(f, u, v, StoredShadingPoint(f, u, v, g, t), sky, terms);
+  return ShadeRealtimePoint<kMedia>(f, u, v, StoredShadingPoint(f, u, v, g, t), sky, terms);
 }
 
 /// ShadeRealtimeStored up to its shadow rays (pass 1 of the queued shadow rays,
@@ -1267,8 +1273,7 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
 
 /// penumbra ray r (1 <= r < job.extra) of light j (SharedVisibilityPenumbra): -1 where no ray
 /// is traced (the light sends nothing to the point, or the direction lies below its geometric
-/// surface), else 1 visible, 0 occluded. Stack: the ray's traversal stack (the same verdict).
-template <class Stack = LocalBvhStack>
+/// surface), else 1 visible, 0 occluded.
 PB_HOST_DEVICE inline int PenumbraRayVerdict(const RealtimeFrameView& f, int j,
                                              const PenumbraRays& job, int r) {
   constexpr int kAll = kLightStrata * kLightPenumbraRays;
@@ -1285,19 +1290,17 @@ PB_HOST_DEVICE inline int PenumbraRayVerdict(const RealtimeFrameView& f, int j,
   sr.tmin = 0;
   sr.d = ToF3(w_r);
   sr.tmax = d_r * (1.0f - 1e-4f);  // +inf stays +inf
-  return TraceOccluded<Stack>(f.scene, sr) ? 0 : 1;
+  return TraceOccluded(f.scene, sr) ? 0 : 1;
 }
 
 /// light j's penumbra rays r0 .. r1 - 1 of `job` in turn (PenumbraRayVerdict): *traced, how
-/// many were traced, and *visible, how many of those reached the light. Stack: as
-/// PenumbraRayVerdict's.
-template <class Stack = LocalBvhStack>
+/// many were traced, and *visible, how many of those reached the light.
 PB_HOST_DEVICE inline void CountPenumbraRays(const RealtimeFrameView& f, int j,
                                              const PenumbraRays& job, int r0, int r1, int* traced,
                                              int* visible) {
   *traced = *visible = 0;
   for (int r = r0; r < r1; ++r) {
-    const int verdict = PenumbraRayVerdict<Stack>(f, j, job, r);
+    const int verdict = PenumbraRayVerdict(f, j, job, r);
     if (verdict < 0) continue;
     ++*traced;
     if (verdict > 0) ++*visible;
