@@ -406,16 +406,23 @@ TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
 
 // the bundled worlds, posed by their own simulations at time 0, seen from their cameras'
 // poses in fans of rays in four directions.
-class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {};
+class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {
+ protected:
+  // the bundled world GetParam() without renderer or controllers
+  std::unique_ptr<Session> LoadWorld() const {
+    SessionOptions so;
+    so.build_renderer = false;
+    so.add_controllers = false;
+    return std::make_unique<Session>(
+        LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
+  }
+};
 
 TEST_P(CudaBvhWorlds, MatchEmbreeOnBundledWorld) {
-  SessionOptions so;
-  so.build_renderer = false;
-  so.add_controllers = false;
-  Session session(LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
-  const WorldSnapshot snap = session.sim().Snapshot();
-  RayScene embree(session.scene());
-  cuda::BvhRayQuery bvh(session.scene());
+  const std::unique_ptr<Session> session = LoadWorld();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  RayScene embree(session->scene());
+  cuda::BvhRayQuery bvh(session->scene());
   embree.Update(snap);
   bvh.Update(snap);
   ASSERT_GT(bvh.bvh().num_triangles(), 0);
@@ -459,12 +466,9 @@ bool SameHit(const cuda::TraceHit& a, const cuda::TraceHit& b) {
 // it cannot push), and the counts (printed) size any shorter stack: a stack of 2 entries that
 // drops deeper ones changes hits, so the comparison with it can fail.
 TEST_P(CudaBvhWorlds, TraversalStackStaysShallow) {
-  SessionOptions so;
-  so.build_renderer = false;
-  so.add_controllers = false;
-  Session session(LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
-  const WorldSnapshot snap = session.sim().Snapshot();
-  cuda::BvhRayQuery bvh(session.scene());
+  const std::unique_ptr<Session> session = LoadWorld();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  cuda::BvhRayQuery bvh(session->scene());
   bvh.Update(snap);
   const cuda::SceneView s = bvh.bvh().view();
   DepthCountingStack::puts.fill(0);

@@ -78,11 +78,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "tile_visibility off, tile_penumbra off, fuse_resolve off",
                          "penumbra_chunk_rays 4",
                          "penumbra_chunk_rays 3",
-                         "packed_window_counts off",
-                         "split_geometry",
-                         "split_geometry, trace_min_blocks 6",
-                         "split_geometry, trace_min_blocks 8"};
-  for (int k = 0; k < 33; ++k) {
+                         "packed_window_counts off"};
+  for (int k = 0; k < 30; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -118,9 +115,6 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 27) o.penumbra_chunk_rays = 4;
     if (k == 28) o.penumbra_chunk_rays = 3;
     if (k == 29) o.packed_window_counts = false;
-    if (k >= 30) o.split_geometry = true;
-    if (k == 31) o.trace_min_blocks = 6;
-    if (k == 32) o.trace_min_blocks = 8;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -599,13 +599,6 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.packed_window_counts = false;
     variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
-    o = fast;
-    o.split_geometry = true;
-    variants.push_back({"kernels, geometry in two: trace kernel, then surface kernel", o});
-    o.trace_min_blocks = 6;
-    variants.push_back({"kernels, geometry in two, trace kernel <= 80 registers", o});
-    o.trace_min_blocks = 8;
-    variants.push_back({"kernels, geometry in two, trace kernel <= 64 registers", o});
 
     o = fast;
     o.rows_per_warp = false;

@@ -144,14 +144,6 @@ struct RealtimeKernelOptions {
   /// 5 caps its registers at 102 (five blocks an SM, as before it kept the material terms for
   /// reuse_surface), below 5 leaves them to the compiler.
   int geometry_min_blocks = 5;
-  /// with reuse_hit: the geometry kernel in two, a lean kernel that only traces the primary
-  /// rays (PrimaryTraceKernel: the closest hits into the hits buffer, 24 bytes a pixel), then
-  /// the surface evaluation from the stored hits (PrimaryGeometryOfHit, geometry_min_blocks 5);
-  /// else one kernel does both. the same values, so the same bits.
-  bool split_geometry = false;
-  /// with split_geometry: the trace kernel's __launch_bounds__ minimum of resident blocks of
-  /// 128 threads an SM: 6 caps it at 80 registers, 8 at 64; below 6 the compiler's.
-  int trace_min_blocks = 1;
   /// with pinned copies, the radiance goes back in this many bands of rows (1 to
   /// kMaxSkyBands), each copied into the frame's image while the next one comes back.
   int output_bands = 2;

@@ -74,9 +74,8 @@ __device__ inline FramePixel PixelOf(const RealtimeFrameView& f, int row0 = 0, i
 
 // hits, surfaces: null, or where the primary hits and their material terms are kept for the
 // shading kernel. kMinBlocks: as ShadeKernel's (5: at most 102 registers, 5 blocks of 128
-// threads an SM). kTraced (RealtimeKernelOptions::split_geometry): the hits were traced
-// before (PrimaryTraceKernel, into `hits`), this kernel evaluates them (PrimaryGeometryOfHit).
-template <class Frames, int kMinBlocks, bool kTraced = false>
+// threads an SM).
+template <class Frames, int kMinBlocks>
 __global__ void __launch_bounds__(128, kMinBlocks)
     GeometryKernel(Frames frames, PixelGeometry* geometry, float* depth, TraceHit* hits,
                    SurfaceTerms* surfaces) {
@@ -84,27 +83,9 @@ __global__ void __launch_bounds__(128, kMinBlocks)
   const FramePixel p = PixelOf(f);
   if (!p) return;
   float t;
-  if constexpr (kTraced)
-    geometry[p.k] = PrimaryGeometryOfHit(f, PrimaryRay(f.camera, p.u, p.v), hits[p.k], &t,
-                                         surfaces ? &surfaces[p.k] : nullptr);
-  else
-    geometry[p.k] = PrimaryGeometry(f, p.u, p.v, &t, hits ? &hits[p.k] : nullptr,
-                                    surfaces ? &surfaces[p.k] : nullptr);
+  geometry[p.k] = PrimaryGeometry(f, p.u, p.v, &t, hits ? &hits[p.k] : nullptr,
+                                  surfaces ? &surfaces[p.k] : nullptr);
   depth[p.k] = t;
-}
-
-// the primary rays' closest hits alone, into `hits` (RealtimeKernelOptions::split_geometry),
-// for GeometryKernel<..., true>. kMinBlocks: __launch_bounds__'s minimum of resident blocks of
-// 128 threads an SM (1: the compiler's registers).
-template <class Frames, int kMinBlocks>
-__global__ void __launch_bounds__(128, kMinBlocks)
-    PrimaryTraceKernel(Frames frames, TraceHit* hits) {
-  const RealtimeFrameView& f = frames.get();
-  const FramePixel p = PixelOf(f);
-  if (!p) return;
-  TraceHit h;
-  TraceClosest(f.scene, PrimaryRay(f.camera, p.u, p.v), &h);
-  hits[p.k] = h;
 }
 
 // the particle streaks over the final radiance (ApplyStreak): one thread per streak pixel, each
@@ -1352,19 +1333,7 @@ struct DeviceRealtime::Impl : PixelBuffers {
     const dim3 grid = PixelGrid(f.camera.width, f.camera.height);
     TraceHit* h = o.reuse_hit && !o.reuse_surface ? hits.as<TraceHit>() : nullptr;
     SurfaceTerms* st = o.reuse_hit && o.reuse_surface ? surfaces.as<SurfaceTerms>() : nullptr;
-    if (o.split_geometry && o.reuse_hit) {
-      // the hits first (kept in `hits`, which the shading kernel may read too), then the rest
-      TraceHit* traced = hits.as<TraceHit>();
-      if (o.trace_min_blocks >= 8)
-        PrimaryTraceKernel<OneFrame, 8><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
-      else if (o.trace_min_blocks >= 6)
-        PrimaryTraceKernel<OneFrame, 6><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
-      else
-        PrimaryTraceKernel<OneFrame, 1><<<grid, kPixelBlock, 0, stream>>>(OneFrame{f}, traced);
-      Check(cudaGetLastError(), "PrimaryTraceKernel");
-      GeometryKernel<OneFrame, 5, true><<<grid, kPixelBlock, 0, stream>>>(
-          OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), traced, st);
-    } else if (o.geometry_min_blocks >= 5)
+    if (o.geometry_min_blocks >= 5)
       GeometryKernel<OneFrame, 5><<<grid, kPixelBlock, 0, stream>>>(
           OneFrame{f}, geometry.as<PixelGeometry>(), depth.as<float>(), h, st);
     else

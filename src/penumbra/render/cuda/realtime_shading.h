@@ -707,13 +707,16 @@ PB_HOST_DEVICE inline bool MirrorSkyTerm(const SkyModelPod& sky, const SkyVolume
   return true;
 }
 
-/// PrimaryGeometry from the primary ray r (PrimaryRay) and its closest hit h (TraceClosest),
-/// traced before: the geometry kernel's second half where a lean kernel traced the hits
-/// (RealtimeKernelOptions::split_geometry). the same values as PrimaryGeometry.
-PB_HOST_DEVICE inline PixelGeometry PrimaryGeometryOfHit(const RealtimeFrameView& f,
-                                                         const TraceRay& r, const TraceHit& h,
-                                                         float* t_hit,
-                                                         SurfaceTerms* surface_out = nullptr) {
+/// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
+/// (0 on a miss); *hit_out (if given): the closest hit; *surface_out (if given, where the ray
+/// hits): the shading point's material terms (ShadeRealtimeStored).
+PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
+                                                    float* t_hit, TraceHit* hit_out = nullptr,
+                                                    SurfaceTerms* surface_out = nullptr) {
+  const TraceRay r = PrimaryRay(f.camera, u, v);
+  TraceHit h;
+  TraceClosest(f.scene, r, &h);
+  if (hit_out) *hit_out = h;
   PixelGeometry g;
   *t_hit = 0;
   const float d_len = sqrtf(r.d.x * r.d.x + r.d.y * r.d.y + r.d.z * r.d.z);
@@ -739,19 +742,6 @@ PB_HOST_DEVICE inline PixelGeometry PrimaryGeometryOfHit(const RealtimeFrameView
     surface_out->occlusion = sp.occlusion;
   }
   return g;
-}
-
-/// the geometry of pixel (u, v)'s primary ray for the sky terms; *t_hit: its hit's t
-/// (0 on a miss); *hit_out (if given): the closest hit; *surface_out (if given, where the ray
-/// hits): the shading point's material terms (ShadeRealtimeStored).
-PB_HOST_DEVICE inline PixelGeometry PrimaryGeometry(const RealtimeFrameView& f, int u, int v,
-                                                    float* t_hit, TraceHit* hit_out = nullptr,
-                                                    SurfaceTerms* surface_out = nullptr) {
-  const TraceRay r = PrimaryRay(f.camera, u, v);
-  TraceHit h;
-  TraceClosest(f.scene, r, &h);
-  if (hit_out) *hit_out = h;
-  return PrimaryGeometryOfHit(f, r, h, t_hit, surface_out);
 }
 
 /// light j's contribution c at surface point p (shadow ray direction wi, distance dist:
