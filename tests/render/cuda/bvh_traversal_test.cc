@@ -10,7 +10,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -404,16 +406,23 @@ TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
 
 // the bundled worlds, posed by their own simulations at time 0, seen from their cameras'
 // poses in fans of rays in four directions.
-class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {};
+class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {
+ protected:
+  // the bundled world GetParam() without renderer or controllers
+  std::unique_ptr<Session> LoadWorld() const {
+    SessionOptions so;
+    so.build_renderer = false;
+    so.add_controllers = false;
+    return std::make_unique<Session>(
+        LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
+  }
+};
 
 TEST_P(CudaBvhWorlds, MatchEmbreeOnBundledWorld) {
-  SessionOptions so;
-  so.build_renderer = false;
-  so.add_controllers = false;
-  Session session(LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
-  const WorldSnapshot snap = session.sim().Snapshot();
-  RayScene embree(session.scene());
-  cuda::BvhRayQuery bvh(session.scene());
+  const std::unique_ptr<Session> session = LoadWorld();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  RayScene embree(session->scene());
+  cuda::BvhRayQuery bvh(session->scene());
   embree.Update(snap);
   bvh.Update(snap);
   ASSERT_GT(bvh.bvh().num_triangles(), 0);
@@ -424,6 +433,105 @@ TEST_P(CudaBvhWorlds, MatchEmbreeOnBundledWorld) {
     const Agreement a = CompareQueries(embree, bvh, RayFan(eye, ahead, 96, 72));
     ExpectAgree(a, GetParam());
   }
+}
+
+// LocalBvhStack that counts the entries put at each depth (all traversals of the test).
+struct DepthCountingStack : cuda::LocalBvhStack {
+  static inline std::array<int64_t, cuda::kMaxBvhDepth> puts{};
+  void Put(int i, const cuda::BvhPending& e) {
+    ++puts[i];
+    LocalBvhStack::Put(i, e);
+  }
+};
+
+// a stack of kKeep entries that drops deeper ones (their subtrees skipped): what a short stack
+// with nowhere to put deeper entries would do, to show the comparison below sees a wrong
+// traversal.
+template <int kKeep>
+struct DroppingStack : cuda::LocalBvhStack {
+  void Put(int i, cuda::BvhPending e) {
+    if (i >= kKeep) e.t = INFINITY;
+    LocalBvhStack::Put(i, e);
+  }
+};
+
+bool SameHit(const cuda::TraceHit& a, const cuda::TraceHit& b) {
+  return std::memcmp(&a.t, &b.t, sizeof(float)) == 0 && a.u == b.u && a.v == b.v &&
+         a.prim == b.prim && a.instance == b.instance && a.part == b.part;
+}
+
+// how deep the traversal's stack gets in the bundled worlds (through a stack policy that counts
+// its entries, bvh_traversal.h): camera fans from four eyes and shadow rays between their hits.
+// the deepest entry must stay well inside the stack (kMaxBvhDepth; the traversal drops a child
+// it cannot push), and the counts (printed) size any shorter stack: a stack of 2 entries that
+// drops deeper ones changes hits, so the comparison with it can fail.
+TEST_P(CudaBvhWorlds, TraversalStackStaysShallow) {
+  const std::unique_ptr<Session> session = LoadWorld();
+  const WorldSnapshot snap = session->sim().Snapshot();
+  cuda::BvhRayQuery bvh(session->scene());
+  bvh.Update(snap);
+  const cuda::SceneView s = bvh.bvh().view();
+  DepthCountingStack::puts.fill(0);
+  int64_t rays = 0, hits = 0, occluded = 0, differ = 0, dropped_differ = 0;
+  std::vector<cuda::F3> points;  // the hits, pulled back a little towards the eye
+  for (const Eigen::Vector3f& eye :
+       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f),
+        Eigen::Vector3f(4, -3, 1.5f)})
+    for (const Eigen::Vector3f& ahead :
+         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
+          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)}) {
+      for (const Ray& ray : RayFan(eye, ahead, 64, 48)) {
+        const cuda::TraceRay r = cuda::ToTraceRay(ray);
+        cuda::TraceHit local, counted, dropped;
+        cuda::TraceClosest(s, r, &local);
+        cuda::TraceClosest<DepthCountingStack>(s, r, &counted);
+        cuda::TraceClosest<DroppingStack<2>>(s, r, &dropped);
+        ++rays;
+        differ += !SameHit(local, counted);
+        dropped_differ += !SameHit(local, dropped);
+        if (local.instance < 0) continue;
+        ++hits;
+        const float t = local.t * 0.99f;
+        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
+      }
+    }
+  // shadow rays between hits far apart in the fans' order (some blocked, some not)
+  const size_t n = points.size();
+  for (size_t k = 0; k < n; ++k) {
+    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
+    cuda::TraceRay sr;
+    sr.o = a;
+    sr.d = {b.x - a.x, b.y - a.y, b.z - a.z};
+    sr.tmin = 1e-4f;
+    sr.tmax = 1.0f;
+    const bool blocked = cuda::TraceOccluded(s, sr);
+    occluded += blocked;
+    differ += cuda::TraceOccluded<DepthCountingStack>(s, sr) != blocked;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(dropped_differ, 0);
+  EXPECT_GT(hits, rays / 2);
+  EXPECT_GT(occluded, 0);
+  EXPECT_LT(occluded, hits);
+  int64_t puts = 0, beyond_8 = 0, beyond_16 = 0;
+  int deepest = -1;
+  for (int i = 0; i < cuda::kMaxBvhDepth; ++i) {
+    const int64_t n = DepthCountingStack::puts[i];
+    puts += n;
+    if (i >= 8) beyond_8 += n;
+    if (i >= 16) beyond_16 += n;
+    if (n > 0) deepest = i;
+  }
+  std::printf(
+      "%s: %lld rays (%lld hits, %lld of as many shadow rays blocked), %lld pushes, "
+      "deepest entry %d, pushes at entry 8 or deeper %lld (%.4f %%), at 16 or deeper %lld; "
+      "a stack of 2 changed %lld hits\n",
+      GetParam().c_str(), static_cast<long long>(rays), static_cast<long long>(hits),
+      static_cast<long long>(occluded), static_cast<long long>(puts), deepest,
+      static_cast<long long>(beyond_8), 100.0 * beyond_8 / std::max<int64_t>(puts, 1),
+      static_cast<long long>(beyond_16), static_cast<long long>(dropped_differ));
+  // the bundled worlds reach entries 5 (default), 8 (house) and 9 (warehouse)
+  EXPECT_LT(deepest, 16);
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhWorlds,

@@ -23,6 +23,28 @@ namespace penumbra::cuda {
 /// deepest BLAS the traversal's stack holds (the builder keeps trees shallower).
 constexpr int kMaxBvhDepth = 64;
 
+/// a child TraverseWideBvh has still to visit: its reference (BvhWideNode::first and count) and
+/// its box's entry distance t. 16 bytes, so one vector store a push and one vector load a pop on
+/// the GPU.
+struct alignas(16) BvhPending {
+  int first, count;
+  float t;
+  int unused;
+};
+
+/// TraverseWideBvh's stack: all kMaxBvhDepth entries in the thread's own array (local memory on
+/// the GPU). a stack policy is default-constructible (one per traversal, empty) and has Put(i,
+/// e) and Get(i) for entry i in [0, kMaxBvhDepth); the traversal pushes and pops through it, so
+/// a policy that keeps the entries elsewhere visits the same nodes in the same order and gives
+/// the same hits, bit for bit (the tests count the stack's depth through one). a top of 8
+/// entries in shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local
+/// memory (branch gpu29)").
+struct LocalBvhStack {
+  BvhPending entries[kMaxBvhDepth];
+  PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
+  PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
+};
+
 /// p transformed by the row-major 3x4 matrix m (rotation and translation).
 PB_HOST_DEVICE inline F3 TransformPoint(const float m[12], F3 p) {
   return {m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
@@ -153,8 +175,9 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 /// called for every primitive index pi of every leaf the ray reaches and returns whether it
 /// hit (it then shrinks *t_max to the hit's t); any_hit: stop at the first hit (occlusion).
 /// returns whether any primitive hit. a visit of an inner node tests its two children's boxes
-/// (stored in it, BvhWideNode), goes on with the nearer and keeps the farther.
-template <typename Leaf>
+/// (stored in it, BvhWideNode), goes on with the nearer and keeps the farther. Stack: where the
+/// farther children wait (LocalBvhStack, or a test's).
+template <class Stack = LocalBvhStack, typename Leaf>
 PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas& blas, F3 o, F3 d,
                                            float tmin, const float* t_max, bool any_hit,
                                            Leaf& leaf) {
@@ -163,14 +186,8 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
   // a popped child is visited if its entry is not beyond the closest hit found since (the entry
   // does not depend on the ray's far end, so this is the slab test against the shorter ray,
   // without reloading the box).
-  // one 16-byte entry a child (a single vector store and load on the GPU, whose stack lives in
-  // local memory, against three of 4 bytes)
-  struct alignas(16) Pending {
-    int first, count;
-    float t;
-    int unused;
-  };
-  Pending stack[kMaxBvhDepth];
+  // one 16-byte entry a child (BvhPending)
+  Stack stack;
   int top = 0;
   bool found = false;
   // the node in hand: a leaf (count >= 0) or inner node `first` (count -1)
@@ -191,8 +208,8 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
       if (ha && hb) {
         const bool a_first = ta <= tb;
         if (top < kMaxBvhDepth)
-          stack[top++] = Pending{a_first ? n.first[1] : n.first[0],
-                                 a_first ? n.count[1] : n.count[0], a_first ? tb : ta, 0};
+          stack.Put(top++, BvhPending{a_first ? n.first[1] : n.first[0],
+                                      a_first ? n.count[1] : n.count[0], a_first ? tb : ta, 0});
         first = a_first ? n.first[0] : n.first[1];
         count = a_first ? n.count[0] : n.count[1];
         continue;
@@ -206,7 +223,7 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
     // pop, skipping children now farther than the closest hit
     bool next = false;
     while (top > 0) {
-      const Pending e = stack[--top];
+      const BvhPending e = stack.Get(--top);
       if (e.t <= *t_max) {
         first = e.first;
         count = e.count;
@@ -221,7 +238,8 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
 
 /// traverses one BLAS with the ray in its frame (TraverseWideBvh over its triangles and
 /// analytic shapes); any_hit: stop at the first hit (occlusion). updates *hit (t shrinks) and
-/// returns whether it hit.
+/// returns whether it hit. Stack: TraverseWideBvh's.
+template <class Stack = LocalBvhStack>
 PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
                                         F3 d, float tmin, bool any_hit, TraceHit* hit) {
   auto leaf = [&](int pi) {
@@ -238,10 +256,13 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     hit->prim = pi, hit->instance = instance;
     return true;
   };
-  return TraverseWideBvh(s.nodes + blas.node_offset, blas, o, d, tmin, &hit->t, any_hit, leaf);
+  return TraverseWideBvh<Stack>(s.nodes + blas.node_offset, blas, o, d, tmin, &hit->t, any_hit,
+                                leaf);
 }
 
 /// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.
+/// Stack: TraverseWideBvh's.
+template <class Stack = LocalBvhStack>
 PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, TraceHit* hit) {
   hit->t = r.tmax;
   hit->instance = -1;
@@ -251,11 +272,12 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
     const Instance& in = s.instances[i];
     if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
     const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, false, hit);
+    TraverseBlas<Stack>(s, s.blases[in.blas], i, o, d, r.tmin, false, hit);
   }
 }
 
-/// true if anything blocks ray r in (tmin, tmax).
+/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's.
+template <class Stack = LocalBvhStack>
 PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) {
   TraceHit hit;
   hit.t = r.tmax;
@@ -264,7 +286,7 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
     const Instance& in = s.instances[i];
     if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
     const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    if (TraverseBlas(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit)) return true;
+    if (TraverseBlas<Stack>(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit)) return true;
   }
   return false;
 }
