@@ -416,15 +416,29 @@ class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {
     return std::make_unique<Session>(
         LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
   }
+
+  // the world, Embree's RayScene and the BVH, both posed at the world's time-0 snapshot
+  struct Posed {
+    std::unique_ptr<Session> session;
+    std::unique_ptr<RayScene> embree;
+    std::unique_ptr<cuda::BvhRayQuery> bvh;
+  };
+  Posed LoadPosed() const {
+    Posed p;
+    p.session = LoadWorld();
+    const WorldSnapshot snap = p.session->sim().Snapshot();
+    p.embree = std::make_unique<RayScene>(p.session->scene());
+    p.bvh = std::make_unique<cuda::BvhRayQuery>(p.session->scene());
+    p.embree->Update(snap);
+    p.bvh->Update(snap);
+    return p;
+  }
 };
 
 TEST_P(CudaBvhWorlds, MatchEmbreeOnBundledWorld) {
-  const std::unique_ptr<Session> session = LoadWorld();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  RayScene embree(session->scene());
-  cuda::BvhRayQuery bvh(session->scene());
-  embree.Update(snap);
-  bvh.Update(snap);
+  const Posed posed = LoadPosed();
+  const RayScene& embree = *posed.embree;
+  const cuda::BvhRayQuery& bvh = *posed.bvh;
   ASSERT_GT(bvh.bvh().num_triangles(), 0);
   Eigen::Vector3f eye(0, 0, 1.2f);
   for (const Eigen::Vector3f& ahead :
@@ -550,13 +564,9 @@ struct EmptyingStack : cuda::LocalBvhStack {
 // ordered one does; a stack of 1 entry that empties deeper ones changes verdicts, so the
 // comparison can fail.
 TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
-  const std::unique_ptr<Session> session = LoadWorld();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  RayScene embree(session->scene());
-  cuda::BvhRayQuery bvh(session->scene());
-  embree.Update(snap);
-  bvh.Update(snap);
-  const cuda::SceneView s = bvh.bvh().view();
+  const Posed posed = LoadPosed();
+  const RayScene& embree = *posed.embree;
+  const cuda::SceneView s = posed.bvh->bvh().view();
   std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
   for (const Eigen::Vector3f& eye :
        {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
