@@ -6,8 +6,8 @@
 // top level: every instance whose world box the ray enters, nearest box first not needed (a
 // handful of instances); the ray is taken to the instance frame in float (as Embree's
 // instancing). bottom level: a stack traversal over nodes that hold their children's boxes
-// (BvhWideNode: one 64-byte load per visit), the nearer child first, slab tests of
-// Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
+// (BvhWideNode: one 64-byte load a visit), the nearer child first (occlusion: any order), slab
+// tests of Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
 // triangles: Moller and Trumbore, "Fast, minimum storage ray/triangle intersection" (JGT
 // 1997), in float; analytic shapes: IntersectAnalyticArrays (render/analytic_shapes.h) in
 // double in the geom frame, as RayScene.
