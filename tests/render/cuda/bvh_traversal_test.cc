@@ -416,15 +416,29 @@ class CudaBvhWorlds : public ::testing::TestWithParam<std::string> {
     return std::make_unique<Session>(
         LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + GetParam()), so);
   }
+
+  // the world, Embree's RayScene and the BVH, both posed at the world's time-0 snapshot
+  struct Posed {
+    std::unique_ptr<Session> session;
+    std::unique_ptr<RayScene> embree;
+    std::unique_ptr<cuda::BvhRayQuery> bvh;
+  };
+  Posed LoadPosed() const {
+    Posed p;
+    p.session = LoadWorld();
+    const WorldSnapshot snap = p.session->sim().Snapshot();
+    p.embree = std::make_unique<RayScene>(p.session->scene());
+    p.bvh = std::make_unique<cuda::BvhRayQuery>(p.session->scene());
+    p.embree->Update(snap);
+    p.bvh->Update(snap);
+    return p;
+  }
 };
 
 TEST_P(CudaBvhWorlds, MatchEmbreeOnBundledWorld) {
-  const std::unique_ptr<Session> session = LoadWorld();
-  const WorldSnapshot snap = session->sim().Snapshot();
-  RayScene embree(session->scene());
-  cuda::BvhRayQuery bvh(session->scene());
-  embree.Update(snap);
-  bvh.Update(snap);
+  const Posed posed = LoadPosed();
+  const RayScene& embree = *posed.embree;
+  const cuda::BvhRayQuery& bvh = *posed.bvh;
   ASSERT_GT(bvh.bvh().num_triangles(), 0);
   Eigen::Vector3f eye(0, 0, 1.2f);
   for (const Eigen::Vector3f& ahead :
@@ -532,6 +546,73 @@ TEST_P(CudaBvhWorlds, TraversalStackStaysShallow) {
       static_cast<long long>(beyond_16), static_cast<long long>(dropped_differ));
   // the bundled worlds reach entries 5 (default), 8 (house) and 9 (warehouse)
   EXPECT_LT(deepest, 16);
+}
+
+// a stack of kKeep entries whose deeper entries become empty leaves (their subtrees skipped in
+// either order): shows the verdicts' comparison below sees a wrong occlusion traversal.
+template <int kKeep>
+struct EmptyingStack : cuda::LocalBvhStack {
+  void Put(int i, cuda::BvhPending e) {
+    if (i >= kKeep) e.count = 0;
+    LocalBvhStack::Put(i, e);
+  }
+};
+
+// occlusion in any order (TraceOccluded's default, bvh_traversal.h: the children in their
+// stored order, no entry test on a pop) gives the nearer-child-first traversal's verdict on
+// every shadow ray between the camera fans' hits, and agrees with Embree's rtcOccluded1 as the
+// ordered one does; a stack of 1 entry that empties deeper ones changes verdicts, so the
+// comparison can fail.
+TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
+  const Posed posed = LoadPosed();
+  const RayScene& embree = *posed.embree;
+  const cuda::SceneView s = posed.bvh->bvh().view();
+  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
+  for (const Eigen::Vector3f& eye :
+       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
+    for (const Eigen::Vector3f& ahead :
+         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
+          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
+      for (const Ray& ray : RayFan(eye, ahead, 48, 36)) {
+        cuda::TraceHit hit;
+        const cuda::TraceRay r = cuda::ToTraceRay(ray);
+        cuda::TraceClosest(s, r, &hit);
+        if (hit.instance < 0) continue;
+        const float t = hit.t * 0.99f;
+        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
+      }
+  const size_t n = points.size();
+  ASSERT_GT(n, 1000u);
+  int64_t occluded = 0, differ = 0, embree_differ = 0, embree_differ_ordered = 0, emptied = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
+    Ray ray;
+    ray.o = {a.x, a.y, a.z};
+    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
+    ray.tmin = 1e-4f;
+    ray.tmax = 1.0f;
+    const cuda::TraceRay sr = cuda::ToTraceRay(ray);
+    const bool any = cuda::TraceOccluded<cuda::LocalBvhStack, true>(s, sr);
+    const bool ordered = cuda::TraceOccluded<cuda::LocalBvhStack, false>(s, sr);
+    const bool reference = embree.Occluded(ray);
+    occluded += any;
+    differ += any != ordered;
+    embree_differ += any != reference;
+    embree_differ_ordered += ordered != reference;
+    emptied += cuda::TraceOccluded<EmptyingStack<1>, true>(s, sr) != any;
+  }
+  std::printf(
+      "%s: %zu shadow rays, %lld blocked, %lld differ from Embree (ordered: %lld), "
+      "a stack of 1 changed %lld\n",
+      GetParam().c_str(), n, static_cast<long long>(occluded),
+      static_cast<long long>(embree_differ), static_cast<long long>(embree_differ_ordered),
+      static_cast<long long>(emptied));
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(embree_differ, embree_differ_ordered);
+  EXPECT_LE(embree_differ, static_cast<int64_t>(n / 1000));
+  EXPECT_GT(occluded, 0);
+  EXPECT_LT(occluded, static_cast<int64_t>(n));
+  EXPECT_GT(emptied, 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhWorlds,

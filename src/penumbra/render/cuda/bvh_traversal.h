@@ -6,8 +6,8 @@
 // top level: every instance whose world box the ray enters, nearest box first not needed (a
 // handful of instances); the ray is taken to the instance frame in float (as Embree's
 // instancing). bottom level: a stack traversal over nodes that hold their children's boxes
-// (BvhWideNode: one 64-byte load per visit), the nearer child first, slab tests of
-// Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
+// (BvhWideNode: one 64-byte load a visit), the nearer child first (occlusion: any order), slab
+// tests of Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
 // triangles: Moller and Trumbore, "Fast, minimum storage ray/triangle intersection" (JGT
 // 1997), in float; analytic shapes: IntersectAnalyticArrays (render/analytic_shapes.h) in
 // double in the geom frame, as RayScene.
@@ -176,8 +176,10 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 /// hit (it then shrinks *t_max to the hit's t); any_hit: stop at the first hit (occlusion).
 /// returns whether any primitive hit. a visit of an inner node tests its two children's boxes
 /// (stored in it, BvhWideNode), goes on with the nearer and keeps the farther. Stack: where the
-/// farther children wait (LocalBvhStack, or a test's).
-template <class Stack = LocalBvhStack, typename Leaf>
+/// farther children wait (LocalBvhStack, or a test's). kAnyOrder (only with any_hit): go on with
+/// the first child whose box the ray enters and keep the second, and visit every popped child
+/// without comparing its entry with *t_max; the verdict is the ordered traversal's (below).
+template <class Stack = LocalBvhStack, bool kAnyOrder = false, typename Leaf>
 PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas& blas, F3 o, F3 d,
                                            float tmin, const float* t_max, bool any_hit,
                                            Leaf& leaf) {
@@ -206,7 +208,13 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
       const float tb = SlabEntry(n.box[1], n.box[1] + 3, o, inv, tmin, *t_max);
       const bool ha = ta != INFINITY, hb = tb != INFINITY;
       if (ha && hb) {
-        const bool a_first = ta <= tb;
+        // any order: the same verdict. before its first hit an any_hit traversal never shrinks
+        // *t_max (it returns at that hit), so every box test and primitive test sees the ray's
+        // own tmax whatever the order; the set of leaves reached (the children whose boxes pass
+        // their tests, down from the root) and each primitive's verdict are the ordered
+        // traversal's, and the ray is occluded iff one of them hits. a popped entry's t was
+        // SlabEntry's t0 <= t1 <= *t_max, so its test would always pass.
+        const bool a_first = kAnyOrder || ta <= tb;
         if (top < kMaxBvhDepth)
           stack.Put(top++, BvhPending{a_first ? n.first[1] : n.first[0],
                                       a_first ? n.count[1] : n.count[0], a_first ? tb : ta, 0});
@@ -224,7 +232,7 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
     bool next = false;
     while (top > 0) {
       const BvhPending e = stack.Get(--top);
-      if (e.t <= *t_max) {
+      if (kAnyOrder || e.t <= *t_max) {
         first = e.first;
         count = e.count;
         next = true;
@@ -238,8 +246,8 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
 
 /// traverses one BLAS with the ray in its frame (TraverseWideBvh over its triangles and
 /// analytic shapes); any_hit: stop at the first hit (occlusion). updates *hit (t shrinks) and
-/// returns whether it hit. Stack: TraverseWideBvh's.
-template <class Stack = LocalBvhStack>
+/// returns whether it hit. Stack and kAnyOrder (only with any_hit): TraverseWideBvh's.
+template <class Stack = LocalBvhStack, bool kAnyOrder = false>
 PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, int instance, F3 o,
                                         F3 d, float tmin, bool any_hit, TraceHit* hit) {
   auto leaf = [&](int pi) {
@@ -256,8 +264,8 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
     hit->prim = pi, hit->instance = instance;
     return true;
   };
-  return TraverseWideBvh<Stack>(s.nodes + blas.node_offset, blas, o, d, tmin, &hit->t, any_hit,
-                                leaf);
+  return TraverseWideBvh<Stack, kAnyOrder>(s.nodes + blas.node_offset, blas, o, d, tmin, &hit->t,
+                                           any_hit, leaf);
 }
 
 /// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.
@@ -276,8 +284,10 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   }
 }
 
-/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's.
-template <class Stack = LocalBvhStack>
+/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's. kAnyOrder (the
+/// default): each BLAS in its children's stored order, no entry test on a pop (TraverseWideBvh;
+/// the same verdict as false, the nearer child first, which the tests compare).
+template <class Stack = LocalBvhStack, bool kAnyOrder = true>
 PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) {
   TraceHit hit;
   hit.t = r.tmax;
@@ -286,7 +296,8 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
     const Instance& in = s.instances[i];
     if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
     const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    if (TraverseBlas<Stack>(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit)) return true;
+    if (TraverseBlas<Stack, kAnyOrder>(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit))
+      return true;
   }
   return false;
 }
