@@ -7,12 +7,12 @@
 // same verdict and the same bits of the streak's end, widened radius and coverage; Build's streaks
 // are the drawn drops in (set, index) order and its culled count theirs. the bits depend on the
 // rounding forms (a distance summed (x + y) + z instead of Eigen's x + (y + z) changes some widened
-// radii), so the comparison can fail. RealtimeFrameData's drop culler (set_drop_culler:
-// PrepareStreaks hands the decision's inputs to it and splats what it returns) fed by a host run of
-// StreakCullDrop with an in-order compaction, as the device's kernels do, gives the host culling's
-// frame to the bit (rgb, radiance, depth, EV100). a device drop culler (set_device_drop_culler,
-// branch gpu30: the streaks left where it made them, their count there too) whose memory is the
-// host's gives that frame too, though its list holds more places than streaks.
+// radii), so the comparison can fail. RealtimeFrameData's device drop culler
+// (set_device_drop_culler: PrepareStreaks hands the decision's inputs to it and the splat reads
+// the streaks where it made them, their count there too, branch gpu30) fed by a host run of
+// StreakCullDrop with an in-order compaction, as the device's kernels do, in host memory, gives
+// the host culling's frame to the bit (rgb, radiance, depth, EV100), though its list holds more
+// places than streaks.
 
 #include <gtest/gtest.h>
 
@@ -196,9 +196,9 @@ TEST(StreakCullShared, DecidesEveryDropAsBuildDidBefore) {
 }
 
 // the drops of `fx` culled on the host as the device's kernels cull them: StreakCullDrop over
-// every drop, the kept ones compacted in (set, index) order into *pods (coverage halved where
-// halve_alpha), the culled rain counted into *culled.
-void CullOnHost(const EffectsFrame& fx, const StreakCullSetup& setup, bool halve_alpha,
+// every drop, the kept ones compacted in (set, index) order into *pods, the culled rain counted
+// into *culled.
+void CullOnHost(const EffectsFrame& fx, const StreakCullSetup& setup,
                 std::vector<cuda::StreakPod>* pods, int* culled) {
   pods->clear();
   *culled = 0;
@@ -217,7 +217,7 @@ void CullOnHost(const EffectsFrame& fx, const StreakCullSetup& setup, bool halve
       pod.a[0] = p.x(), pod.a[1] = p.y(), pod.a[2] = p.z();
       pod.b[0] = o.q.x, pod.b[1] = o.q.y, pod.b[2] = o.q.z;
       pod.r = o.r_wide;
-      pod.alpha = halve_alpha ? 0.5f * o.alpha : o.alpha;
+      pod.alpha = o.alpha;
       pod.prim = static_cast<int32_t>(pods->size());
       pod.set = static_cast<int32_t>(s);
       pods->push_back(pod);
@@ -250,47 +250,6 @@ std::unique_ptr<HostCulledRain> RenderHostCulledRain(bool rolling) {
   return r;
 }
 
-// a host culler (StreakCullDrop over every drop, kept ones compacted in order, as the device's
-// kernels) behind RealtimeFrameData::set_drop_culler: the same splat list and frame bits as the
-// host culling, still and rolling shutter; a culler that halves the streaks' coverage changes
-// them.
-TEST(StreakCullShared, DropCullerGivesTheHostCullingsBits) {
-  const auto host_culler = [](bool halve_alpha) {
-    return [halve_alpha](const EffectsFrame& fx, const StreakCullSetup& setup,
-                         std::vector<cuda::StreakPod>* pods,
-                         int* culled) { CullOnHost(fx, setup, halve_alpha, pods, culled); };
-  };
-  for (bool rolling : {false, true}) {
-    SCOPED_TRACE(rolling ? "rolling shutter" : "still");
-    const std::unique_ptr<HostCulledRain> rain = RenderHostCulledRain(rolling);
-    const CameraView& view = rain->w.view;
-    const EffectsFrame* fx = rain->w.fx.get();
-    host_path::HostPath& path = *rain->path;
-    cuda::RealtimeFrameData& data = path.data();
-    const RenderedFrame& host = rain->frame;
-    data.set_drop_culler(host_culler(false));
-    const RenderedFrame culled = path.Render(view, fx);
-    const cuda::PathStreaks list = data.splat_streaks().View();
-    EXPECT_FALSE(data.particles().host_culling());
-    EXPECT_EQ(data.particles().size(), 0);
-    ASSERT_GT(list.num, 0);
-    ASSERT_EQ(static_cast<size_t>(list.num), rain->pods.size());
-    EXPECT_EQ(std::memcmp(list.streaks, rain->pods.data(), sizeof(cuda::StreakPod) * list.num), 0);
-    EXPECT_EQ(data.streaks_culled(), rain->culled);
-    EXPECT_EQ(culled.rgb.data, host.rgb.data);
-    EXPECT_EQ(culled.radiance.data, host.radiance.data);
-    EXPECT_EQ(culled.depth_m.data, host.depth_m.data);
-    EXPECT_EQ(std::memcmp(&culled.ev100, &host.ev100, sizeof(double)), 0);
-    data.set_drop_culler(host_culler(true));
-    const RenderedFrame short_one = path.Render(view, fx);
-    EXPECT_NE(short_one.radiance.data, host.radiance.data);
-    data.set_drop_culler(cuda::RealtimeFrameData::DropCuller());
-    const RenderedFrame again = path.Render(view, fx);
-    EXPECT_TRUE(data.particles().host_culling());
-    EXPECT_EQ(again.radiance.data, host.radiance.data);
-  }
-}
-
 // the streaks left where the culler made them (RealtimeFrameData::set_device_drop_culler,
 // branch gpu30: the CUDA backend's default, with device memory): a culler that returns a list of
 // `bound` places (the device's: every drop's; here twice the streaks and one) of which only the
@@ -318,7 +277,7 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     int culled = 0, downloads = 0;
     const auto culler = [&](bool count_is_bound) {
       return [&, count_is_bound](const EffectsFrame& frame, const StreakCullSetup& setup) {
-        CullOnHost(frame, setup, false, &places, &culled);
+        CullOnHost(frame, setup, &places, &culled);
         count = static_cast<int32_t>(places.size());
         for (int32_t k = 0; k <= count && count > 0; ++k) {
           cuda::StreakPod other = places[k % count];
@@ -341,6 +300,8 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     data.set_device_drop_culler(culler(false));
     EXPECT_TRUE(data.has_drop_culler());
     const RenderedFrame kept = path->Render(view, fx);
+    EXPECT_FALSE(data.particles().host_culling());
+    EXPECT_EQ(data.particles().size(), 0);
     EXPECT_GT(static_cast<int32_t>(places.size()), count);
     EXPECT_EQ(data.streaks_culled(), 0);
     data.FinishDeviceCulling(culled);
@@ -370,6 +331,7 @@ TEST(StreakCullShared, DeviceStreakListGivesTheHostCullingsBits) {
     data.set_device_drop_culler(cuda::RealtimeFrameData::DeviceDropCuller());
     EXPECT_FALSE(data.has_drop_culler());
     const RenderedFrame again = path->Render(view, fx);
+    EXPECT_TRUE(data.particles().host_culling());
     EXPECT_EQ(again.radiance.data, host.radiance.data);
   }
 }

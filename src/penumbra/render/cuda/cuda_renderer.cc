@@ -46,7 +46,6 @@ CudaRenderer::~CudaRenderer() = default;
 
 void CudaRenderer::set_device_culling(bool on) {
   device_culling_ = on;
-  realtime_->set_drop_culler(RealtimeFrameData::DropCuller());
   if (!on) {
     realtime_->set_device_drop_culler(RealtimeFrameData::DeviceDropCuller());
     return;

@@ -57,17 +57,6 @@ void PathStreakBuild::BuildList(const ParticleStreaks& streaks,
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void PathStreakBuild::BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
-                                    const Eigen::Vector3f& sky_ambient) {
-  if (pods->empty() || streaks.frame() == nullptr) {
-    Clear();
-    sky_ambient_ = Float3{sky_ambient.x(), sky_ambient.y(), sky_ambient.z()};
-    return;
-  }
-  BuildSets(streaks, sky_ambient);
-  pods_.swap(*pods);
-}
-
 void PathStreakBuild::BuildSets(const ParticleStreaks& streaks,
                                 const Eigen::Vector3f& sky_ambient) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -30,12 +30,6 @@ class PathStreakBuild {
   /// nodes null) or rain radiance (the realtime tier's device splat, StreakSplatView, shades
   /// rain per pixel); records the time it took.
   void BuildList(const ParticleStreaks& streaks, const Eigen::Vector3f& sky_ambient);
-  /// as BuildList, with the streaks already made: *pods (StreakPods in ParticleStreaks' index
-  /// order, prim = the index: the device culling's, cuda_streak_cull.h) swapped in (*pods gets
-  /// this object's old array, for its capacity), the particle sets those of `streaks` (Built
-  /// for the frame without host culling: ParticleStreaks::set_host_culling).
-  void BuildListFrom(std::vector<StreakPod>* pods, const ParticleStreaks& streaks,
-                     const Eigen::Vector3f& sky_ambient);
   /// the particle sets of `streaks` (Built for the frame; none without a frame) and
   /// `sky_ambient` without any streak (empty() stays true): for streaks that stay where they
   /// were made (the device culling's, branch gpu30), which ViewOver points at. the sets do not

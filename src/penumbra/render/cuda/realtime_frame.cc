@@ -208,8 +208,7 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
   const bool device_splat = realtime && device_streaks_;
-  // the device's drop culling (device_drop_culler_ or drop_culler_): the host prepares its
-  // inputs only
+  // the device's drop culling (device_drop_culler_): the host prepares its inputs only
   const bool device_cull = device_splat && has_drop_culler();
   particles_.set_host_splat(!device_splat);
   particles_.set_host_culling(!device_cull);
@@ -217,19 +216,12 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
                    realtime ? StreakRays::kPixelCentres : StreakRays::kCamera, pool, media,
                    sheltered ? &shelter_ : nullptr);
   streaks_culled_ = particles_.culled();
-  if (device_cull && device_drop_culler_) {
+  if (device_cull) {
     // the streaks stay on the device: the splat reads them in place, with their count there;
     // the sets do not depend on them (BuildSets)
     device_list_ = device_drop_culler_(*fx, particles_.cull_setup());
     if (device_list_.bound <= 0) return;
     splat_streaks_.BuildSets(particles_, SkyAmbientRadiance(*frame_sky_));
-    SetSplatCamera(camera);
-    return;
-  }
-  if (device_cull) {
-    drop_culler_(*fx, particles_.cull_setup(), &culled_pods_, &streaks_culled_);
-    if (culled_pods_.empty()) return;
-    splat_streaks_.BuildListFrom(&culled_pods_, particles_, SkyAmbientRadiance(*frame_sky_));
     SetSplatCamera(camera);
     return;
   }

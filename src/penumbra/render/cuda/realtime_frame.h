@@ -114,7 +114,8 @@ class RealtimeFrameData {
   /// the particle streaks of the frame (View's splat, or streaks): with particles in `effects`
   /// (null or none: no streaks), the CPU backend's ParticleStreaks of `camera` (render/
   /// particle_streaks.h: the drops a ShelterMap shelters left out, rain the frame's homogeneous
-  /// media hide culled; with a drop culler, set_drop_culler, the culler decides the drops); with
+  /// media hide culled; with a device drop culler, set_device_drop_culler, the culler decides the
+  /// drops); with
   /// device_streaks (the default) the streaks in index order and the
   /// camera's projection for the frame's own splat (splat_streaks(), View's splat); else
   /// splatted per pixel over `pool`, rain shaded once per
@@ -144,20 +145,8 @@ class RealtimeFrameData {
   /// this call copies them to the host (DeviceStreakList::download: it waits for the culling)
   /// the first time after a PrepareStreaks (tests and benchmarks).
   const PathStreakBuild& splat_streaks() const;
-  /// the drops' culling on the device (branch gpu27; CudaRenderer::set_device_culling sets it):
-  /// with device_streaks under the realtime tier's settings, PrepareStreaks has ParticleStreaks
-  /// prepare the decision's inputs only (set_host_culling(false): the sets' lengths checked, no
-  /// drop decided) and calls it with the frame's effects and those inputs; it fills *pods with
-  /// the drawn streaks in index order (StreakPod, prim = the index) and *culled with the culled
-  /// rain, as ParticleStreaks::Build makes them (or throws its ConfigError), and the splat
-  /// takes them (splat_streaks). empty (the default): the host decides the drops.
-  using DropCuller = std::function<void(const EffectsFrame& fx, const StreakCullSetup& setup,
-                                        std::vector<StreakPod>* pods, int* culled)>;
-  void set_drop_culler(DropCuller culler) { drop_culler_ = std::move(culler); }
-  /// whether a drop culler is set (set_drop_culler or set_device_drop_culler).
-  bool has_drop_culler() const {
-    return static_cast<bool>(drop_culler_) || static_cast<bool>(device_drop_culler_);
-  }
+  /// whether a device drop culler is set (set_device_drop_culler).
+  bool has_drop_culler() const { return static_cast<bool>(device_drop_culler_); }
   /// streaks a device drop culler made and keeps on the device (branch gpu30): the frame's
   /// splat reads them in place (StreakSplatView: streaks.streaks, bound as streaks.num, count)
   /// without the host waiting for the culling or copying them.
@@ -174,12 +163,16 @@ class RealtimeFrameData {
     /// the culler's errors (ConfigError for a non-finite drop).
     std::function<void(std::vector<StreakPod>* out)> download;
   };
-  /// the drops' culling on the device without the host's wait (CudaRenderer::set_device_culling
-  /// sets it, branch gpu30): as set_drop_culler (the same inputs; where both are set, this
-  /// one culls; empty: none), but the culler only queues its work and returns where its
+  /// the drops' culling on the device (branch gpu27, without the host's wait since gpu30;
+  /// CudaRenderer::set_device_culling sets it): with device_streaks under the realtime tier's
+  /// settings, PrepareStreaks has ParticleStreaks prepare the decision's inputs only
+  /// (set_host_culling(false): the sets' lengths checked, no drop decided) and calls it with the
+  /// frame's effects and those inputs; it queues its work (the drawn streaks in index order,
+  /// StreakPod, prim = the index, as ParticleStreaks::Build makes them) and returns where its
   /// streaks will be (DeviceStreakList); the culled rain and any non-finite drop are known once
   /// the frame's device work is done: the caller then reports the culled rain
-  /// (FinishDeviceCulling) or throws the culler's ConfigError.
+  /// (FinishDeviceCulling) or throws the culler's ConfigError. empty (the default): the host
+  /// decides the drops.
   using DeviceDropCuller =
       std::function<DeviceStreakList(const EffectsFrame& fx, const StreakCullSetup& setup)>;
   void set_device_drop_culler(DeviceDropCuller culler) { device_drop_culler_ = std::move(culler); }
@@ -284,9 +277,7 @@ class RealtimeFrameData {
   mutable PathStreakBuild splat_streaks_;
   StreakSplatView splat_camera_;             // their projection (R_OW, p_OW, intrinsics; rows)
   std::vector<double> splat_rows_;           // a moving camera's row poses (StreakSplatView::rows)
-  DropCuller drop_culler_;                   // the device's drop culling (empty: the host's)
-  std::vector<StreakPod> culled_pods_;       // its streaks (swapped into splat_streaks_)
-  DeviceDropCuller device_drop_culler_;      // the device's culling, its streaks kept there
+  DeviceDropCuller device_drop_culler_;      // the device's culling (empty: the host's)
   DeviceStreakList device_list_;             // their place (bound 0: none, or the host's list)
   mutable bool device_pods_copied_ = false;  // splat_streaks_ holds them (splat_streaks)
   int streaks_culled_ = 0;                   // rain culled by the last PrepareStreaks
