@@ -185,9 +185,11 @@ TEST(LimitsRun, LidarColumnsExit2WithTheKey) {
               "expected at most 4194304 beams per scan");
 }
 
-// memory that runs out anyway (here: a 1 GiB address space for a 4096 x 4096 camera that the
+// memory that runs out anyway (here: a 1 GiB address space for an 8192 x 8192 camera that the
 // estimate allows on a machine with more memory) ends with a message, not a bare
-// "std::bad_alloc".
+// "std::bad_alloc". (a 4096 x 4096 camera needs about 340 MiB of it, so whether it ran out
+// depended on how much address space the run's threads had reserved by then: it once rendered
+// its frame in CI.)
 TEST(LimitsRun, OutOfMemoryIsReportedClearly) {
   penumbra::testing::TempDir dir;
   dir.Write("ball.xml", Ball());
@@ -196,7 +198,7 @@ TEST(LimitsRun, OutOfMemoryIsReportedClearly) {
                dir.Write("m.yaml",
                          "duration_sec: 0.01\nmodels: [{name: m, file: ball.xml}]\n"
                          "mjcf_cameras: {enabled: false}\n"
-                         "cameras: [{name: c, pose: {xyz: [-3, 0, 1]}, width: 4096, height: 4096,\n"
+                         "cameras: [{name: c, pose: {xyz: [-3, 0, 1]}, width: 8192, height: 8192,\n"
                          "           rate_hz: 1}]\n"),
                {}, rlim_t{1} << 30);
   EXPECT_EQ(r.code, 1) << r.output;
