@@ -85,8 +85,9 @@ TEST(AdversityPlan, NpcPathsAreClearOfFurnitureAndTheRobotAndDependOnTheSeed) {
     const double radius = agent.kind == AgentKind::kPerson ? 0.2 : 0.55;
     const auto& w = agent.waypoints;
     ASSERT_FALSE(w.empty()) << agent.name;
-    if (agent.kind == AgentKind::kPerson)
+    if (agent.kind == AgentKind::kPerson) {
       EXPECT_GE((w[0] - Eigen::Vector2d(-0.2, -1.45)).norm(), 1.5) << agent.name;
+    }
     for (size_t i = 0; i < w.size(); ++i) {
       EXPECT_TRUE(map.SegmentFree(w[i], w[i], radius)) << agent.name << " waypoint " << i;
       // inside the room's interior

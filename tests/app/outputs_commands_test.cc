@@ -136,7 +136,7 @@ TEST(BenchRender, PresetTimesOnlyTheNamedPresetsLines) {
       dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // the one preset line, no resolution table, no other preset, no major target line
-  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  minor +[0-9]+\.[0-9] frames/s"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  minor +[0-9]+\\.[0-9] frames/s"))) << r.out;
   EXPECT_EQ(r.out.find("\n640x480 rgb+depth realtime:"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("  none "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("  major "), std::string::npos) << r.out;

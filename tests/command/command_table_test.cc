@@ -72,7 +72,9 @@ TEST(CommandTable, IsSortedAndEveryRowHasAHandler) {
   ASSERT_EQ(table.size(), 18u);
   for (size_t i = 0; i < table.size(); ++i) {
     EXPECT_NE(table[i].handle, nullptr) << table[i].name;
-    if (i > 0) EXPECT_LT(table[i - 1].name, table[i].name);
+    if (i > 0) {
+      EXPECT_LT(table[i - 1].name, table[i].name);
+    }
     EXPECT_EQ(CommandDispatcher::FindCommand(table[i].name), &table[i]);
   }
   EXPECT_EQ(CommandDispatcher::FindCommand("sync"), nullptr);

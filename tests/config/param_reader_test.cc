@@ -96,7 +96,9 @@ TEST(ParamReader, ReportsUnusedKeysWithTheKeysAsked) {
       ParseYaml("physics:\n  timestep_sec: 0.002\n  integrater: RK4\n", "w.yaml");
   ParamReader r(doc, "w.yaml", nullptr);
   const ParamReader p = r.Child("physics");
-  if (auto t = p.Find("timestep_sec")) EXPECT_EQ(t->Double(), 0.002);
+  if (auto t = p.Find("timestep_sec")) {
+    EXPECT_EQ(t->Double(), 0.002);
+  }
   EXPECT_FALSE(p.Find("integrator").has_value());
   const ConfigError e = ParamReaderErrorOf([&] { p.ReportUnused(); });
   EXPECT_EQ(e.line(), 3);

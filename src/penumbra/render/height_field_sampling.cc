@@ -37,7 +37,7 @@ std::vector<std::optional<double>> CastDown(const RayQuery& query,
                                             const std::vector<Eigen::Vector2d>& points,
                                             double z_top) {
   std::vector<std::optional<double>> z = CastDownOnce(query, points, z_top);
-  for (const Eigen::Vector2d offset :
+  for (const Eigen::Vector2d& offset :
        {Eigen::Vector2d(1e-5, 0.618e-5), Eigen::Vector2d(-1.618e-5, -1e-5)}) {
     std::vector<size_t> missed;
     std::vector<Eigen::Vector2d> again;
