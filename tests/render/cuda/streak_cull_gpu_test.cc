@@ -49,18 +49,6 @@ bool SamePods(const std::vector<cuda::StreakPod>& a, const std::vector<cuda::Str
          std::memcmp(a.data(), b.data(), sizeof(cuda::StreakPod) * a.size()) == 0;
 }
 
-std::vector<cuda::DropSet> DropSetsOf(const EffectsFrame& fx) {
-  std::vector<cuda::DropSet> sets(fx.particles.size());
-  for (size_t s = 0; s < sets.size(); ++s) {
-    const ParticleSet& ps = fx.particles[s];
-    sets[s].p = ps.position_W.data()->data();
-    sets[s].v = ps.velocity_W.data()->data();
-    sets[s].r = ps.radius_m.data();
-    sets[s].n = static_cast<int64_t>(ps.position_W.size());
-  }
-  return sets;
-}
-
 TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   struct Case {
@@ -125,7 +113,7 @@ TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
       // DeviceStreakCull alone on the frame's inputs: the same streaks; another exposure time
       // gives others
       const StreakCullSetup setup = g->realtime_frame().particles().cull_setup();
-      const std::vector<cuda::DropSet> sets = DropSetsOf(*fx);
+      const std::vector<cuda::DropSet> sets = cuda::DropSetsOf(*fx);
       cuda::DeviceStreakCull cull;
       cull.Run(sets.data(), static_cast<int32_t>(sets.size()), setup.frame, setup.sets.data());
       std::vector<cuda::StreakPod> alone;
@@ -141,7 +129,7 @@ TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
       const size_t s = bad.particles.size() - 1;
       ASSERT_GT(bad.particles[s].position_W.size(), 7u);
       bad.particles[s].position_W[7].y() = std::numeric_limits<float>::quiet_NaN();
-      const std::vector<cuda::DropSet> bad_sets = DropSetsOf(bad);
+      const std::vector<cuda::DropSet> bad_sets = cuda::DropSetsOf(bad);
       try {
         cull.Run(bad_sets.data(), static_cast<int32_t>(bad_sets.size()), setup.frame,
                  setup.sets.data());

@@ -44,6 +44,18 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
 
 CudaRenderer::~CudaRenderer() = default;
 
+std::vector<DropSet> DropSetsOf(const EffectsFrame& fx) {
+  std::vector<DropSet> sets(fx.particles.size());
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const ParticleSet& ps = fx.particles[s];
+    sets[s].p = ps.position_W.empty() ? nullptr : ps.position_W.data()->data();
+    sets[s].v = ps.velocity_W.empty() ? nullptr : ps.velocity_W.data()->data();
+    sets[s].r = ps.radius_m.data();
+    sets[s].n = static_cast<int64_t>(ps.position_W.size());
+  }
+  return sets;
+}
+
 void CudaRenderer::set_device_culling(bool on) {
   device_culling_ = on;
   if (!on) {
@@ -53,14 +65,7 @@ void CudaRenderer::set_device_culling(bool on) {
   realtime_->set_device_drop_culler([this](const EffectsFrame& fx, const StreakCullSetup& setup) {
     // made at the first frame with drops (its stream and buffers)
     if (!drop_cull_) drop_cull_ = std::make_unique<DeviceStreakCull>();
-    std::vector<DropSet> sets(fx.particles.size());
-    for (size_t s = 0; s < sets.size(); ++s) {
-      const ParticleSet& ps = fx.particles[s];
-      sets[s].p = ps.position_W.empty() ? nullptr : ps.position_W.data()->data();
-      sets[s].v = ps.velocity_W.empty() ? nullptr : ps.velocity_W.data()->data();
-      sets[s].r = ps.radius_m.data();
-      sets[s].n = static_cast<int64_t>(ps.position_W.size());
-    }
+    const std::vector<DropSet> sets = DropSetsOf(fx);
     // queued only: the frame's stream waits for it on the device, the host does not (its
     // counts are read once the frame is done: FinishDropCulling)
     drop_cull_->Queue(sets.data(), static_cast<int32_t>(sets.size()), setup.frame,

@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <memory>
+#include <vector>
 
 #include "penumbra/core/thread_pool.h"
 #include "penumbra/render/cuda/bvh_scene.h"
@@ -25,8 +26,13 @@
 #include "penumbra/render/cuda/path_frame.h"
 #include "penumbra/render/cuda/realtime_frame.h"
 #include "penumbra/render/renderer.h"
+#include "penumbra/scene/effects_frame.h"
 
 namespace penumbra::cuda {
+
+/// the drops of fx's particle sets (ParticleSet's position_W, velocity_W, radius_m) as
+/// DeviceStreakCull takes them: one DropSet a set, pointing into fx (valid while fx is).
+std::vector<DropSet> DropSetsOf(const EffectsFrame& fx);
 
 /// Renderer on the GPU (see the file comment).
 class CudaRenderer final : public Renderer {
