@@ -78,6 +78,7 @@ TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
       const std::vector<cuda::StreakPod> device_pods = SplatPods(g);
       const int device_culled = g->realtime_frame().streaks_culled();
       const double device_ms = g->last_late_streaks_ms();
+      const double queue_ms = g->device_drop_cull()->run_ms();
       g->set_device_culling(false);
       gpu->Render(snap, fx.get(), view, &host);
       const std::vector<cuda::StreakPod> host_pods = SplatPods(g);
@@ -88,13 +89,15 @@ TEST(StreakCullGpu, DeviceCullingGivesTheHostCullingsStreaksAndBits) {
       gpu->Render(snap, fx.get(), view, &device_serial);
       g->set_late_streaks(true);
       gpu->Render(snap, fx.get(), view, &again);
+      const double again_ms = g->last_late_streaks_ms();
       std::printf(
           "%s 640x480%s%s: %zu streaks culled on the device, %zu on the host (the same: %s), rain "
-          "culled %d / %d; late streaks on the host %.3f ms (device culling) / %.3f ms (host); "
-          "frames bit-identical: %s\n",
+          "culled %d / %d; late streaks on the host %.3f ms (device culling, the renderer's first "
+          "frame; DeviceStreakCull::Queue %.3f ms of it) / %.3f ms (host) / %.3f ms (device "
+          "culling, its fourth frame); frames bit-identical: %s\n",
           file, rolling ? ", rolling shutter" : "", k.fog ? ", in fog" : "", device_pods.size(),
           host_pods.size(), SamePods(device_pods, host_pods) ? "yes" : "NO", device_culled,
-          host_culled, device_ms, host_ms,
+          host_culled, device_ms, queue_ms, host_ms, again_ms,
           device.radiance.data == host.radiance.data && device.rgb.data == host.rgb.data ? "yes"
                                                                                          : "NO");
       EXPECT_GT(host_pods.size(), 0u);
