@@ -204,7 +204,13 @@ void RealtimeFrameData::PrepareStreaks(const WorldSnapshot& snapshot, const Effe
   // pixel by the frame)
   bool sheltered = false;
   for (const ParticleSet& ps : fx->particles) sheltered = sheltered || ShelterApplies(ps);
-  if (sheltered) shelter_.Update(scene_, snapshot, pool);
+  shelter_update_ms_ = 0;
+  if (sheltered) {
+    const auto t0 = std::chrono::steady_clock::now();
+    shelter_.Update(scene_, snapshot, pool);
+    shelter_update_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
   if (!fx->homogeneous_media.empty() || !fx->grid_media.empty()) BuildMediaScene(fx);
   const MediaScene* media = media_scene_built_ && !media_.empty() ? &media_ : nullptr;
   const bool device_splat = realtime && device_streaks_;
@@ -320,7 +326,10 @@ void RealtimeFrameData::PoseWorld(const WorldSnapshot& snapshot, ThreadPool* poo
       m[4 * r + 3] = static_cast<float>(X_GW.translation()(r));
     }
   }
+  const auto t0 = std::chrono::steady_clock::now();
   volume_.Update(scene_, snapshot, *frame_sky_, pool);
+  volume_update_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void RealtimeFrameData::SetCamera(const PinholeCamera& camera, float spread_rad, int camera_index,

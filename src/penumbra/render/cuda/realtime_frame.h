@@ -91,6 +91,12 @@ class RealtimeFrameData {
   /// RealtimeMedia::Build took (benchmarks), and its stages'.
   bool has_media() const { return media_ready_; }
   double media_build_ms() const { return media_build_ms_; }
+  /// host milliseconds the last Prepare spent in the sky irradiance volume's Update (its build
+  /// or relight, on the host; about 0 when neither was due) and in the shelter map's Update
+  /// (its build; 0 without sheltered particles): a new renderer's first frame pays the builds
+  /// (benchmarks).
+  double volume_update_ms() const { return volume_update_ms_; }
+  double shelter_update_ms() const { return shelter_update_ms_; }
   const RealtimeMedia::BuildTimes& media_build_times() const {
     return realtime_media_.build_times();
   }
@@ -298,6 +304,8 @@ class RealtimeFrameData {
   bool media_ready_ = false;
   bool device_media_ = true;
   double media_build_ms_ = 0;
+  double volume_update_ms_ = 0;
+  double shelter_update_ms_ = 0;
   Film film_;
   PinholeCamera camera_;
   CameraRayTables camera_rays_;  // Prepare's view's tables when the caller gives none
