@@ -1043,6 +1043,41 @@ int Main(int argc, char** argv) {
               cull_stage_ms[0], cull_stage_ms[1], cull_host_ms[0], cull_host_ms[1],
               g->realtime_frame().splat_streaks().View().num,
               g->realtime_frame().streaks_culled()));
+          // where one rain frame's time goes (device culling, late streaks: the defaults), the
+          // median of 21 frames by wall time: the host's clock from Render's start, the frame's
+          // device stages from its first event, the drops' transfer and culling on their stream
+          {
+            struct Split {
+              double wall, prepare, late_start, late, stage, upload, cull, launched, kernels_end,
+                  copies_end;
+            };
+            std::vector<Split> splits;
+            RenderedFrame f;
+            for (int i = 0; i < 21; ++i) {
+              const auto t0 = Clock::now();
+              gpu->Render(snap, fx.get(), rgb, &f);
+              const double wall =
+                  std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+              const cuda::DeviceStreakCull* dc = g->device_drop_cull();
+              const cuda::RealtimeStageTimes& st = g->device_realtime().last_stage_times();
+              splits.push_back({wall, g->last_prepare_ms(), g->last_late_streaks_start_ms(),
+                                g->last_late_streaks_ms(), dc->stage_ms(), dc->device_upload_ms(),
+                                dc->device_cull_ms(), st.launched, st.kernels_end, st.copies_end});
+            }
+            std::sort(splits.begin(), splits.end(),
+                      [](const Split& a, const Split& b) { return a.wall < b.wall; });
+            const Split& m = splits[splits.size() / 2];
+            builds.push_back(fmt::format(
+                "{} {}: one rain frame (median of 21 by wall time) {:.3f} ms: host preparation "
+                "{:.3f} ms, DeviceRealtime::Render's queuing {:.3f} ms (late streaks included); "
+                "late "
+                "streaks from {:.3f} ms after Render's start for {:.3f} ms "
+                "(of which staging the drops {:.3f} ms); device, from the frame's first event: "
+                "kernels end {:.3f} ms, copies end {:.3f} ms; the drops' transfer {:.3f} ms and "
+                "their culling {:.3f} ms on the culling's stream",
+                name, size, m.wall, m.prepare, m.launched, m.late_start, m.late, m.stage, m.upload,
+                m.cull, m.kernels_end, m.copies_end));
+          }
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
           // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row
           // columns follow the rows' poses since branch gpu25, and the host splat

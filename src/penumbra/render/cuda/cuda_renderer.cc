@@ -146,7 +146,8 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   // late streaks: the drops culled while the GPU traces and shades (set_late_streaks)
   const bool late = late_streaks_ && realtime_->device_streaks() && effects != nullptr &&
                     !effects->empty() && !effects->particles.empty();
-  late_streaks_ms_ = 0;
+  late_streaks_ms_ = late_streaks_start_ms_ = 0;
+  render_t0_ = t0;
   cull_queued_ = false;
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),
                      /*streaks=*/!late);
@@ -192,6 +193,7 @@ DeviceRealtime::StreaksFn CudaRenderer::LateStreaks(const WorldSnapshot& snapsho
                                                     const CameraView& view) {
   return [this, &snapshot, effects, &view](RealtimeFrameView* f) {
     const auto ts = std::chrono::steady_clock::now();
+    late_streaks_start_ms_ = std::chrono::duration<double, std::milli>(ts - render_t0_).count();
     const Camera camera(view.X_WO, view.intrinsics, view.motion);
     realtime_->PrepareStreaks(snapshot, effects, camera, view, pool_.get());
     realtime_->StreakFields(f);

@@ -102,6 +102,9 @@ class CudaRenderer final : public Renderer {
   /// host milliseconds the last realtime rgb frame spent making its late streaks while the GPU
   /// worked (RealtimeFrameData::PrepareStreaks; 0 without late streaks; benchmarks).
   double last_late_streaks_ms() const { return late_streaks_ms_; }
+  /// host milliseconds from the start of the last realtime rgb frame's Render to the start of
+  /// its late streaks (0 without late streaks; benchmarks).
+  double last_late_streaks_start_ms() const { return late_streaks_start_ms_; }
 
   /// the GPU's pinhole form of `view` (without the ray tables a camera with lens distortion or
   /// motion needs: Render adds them, camera_rays.h).
@@ -166,6 +169,8 @@ class CudaRenderer final : public Renderer {
   uint64_t sky_generation_ = 0;
   double prepare_ms_ = 0;
   double late_streaks_ms_ = 0;
+  double late_streaks_start_ms_ = 0;
+  std::chrono::steady_clock::time_point render_t0_;  // the current Render's start
   bool late_streaks_ = true;
   bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;

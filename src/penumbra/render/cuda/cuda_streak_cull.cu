@@ -98,6 +98,8 @@ struct DeviceStreakCull::Impl {
   // the last Queue's work; pending: not yet Finished
   PinnedBuffer totals_host;
   cudaEvent_t done = nullptr;
+  // timing events of the last Queue: before the inputs' transfer, after it, after the counts
+  cudaEvent_t began = nullptr, uploaded = nullptr, counted = nullptr;
   bool pending = false;
   int32_t n = 0;  // the last Queue's drops
   std::vector<int64_t> first_host;
@@ -110,9 +112,13 @@ struct DeviceStreakCull::Impl {
     Check(cudaStreamCreateWithPriority(&stream, cudaStreamNonBlocking, greatest),
           "cudaStreamCreateWithPriority");
     Check(cudaEventCreateWithFlags(&done, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t* e : {&began, &uploaded, &counted})
+      Check(cudaEventCreate(e), "cudaEventCreate");
     totals_host.Reserve(sizeof(int32_t) * 4);
   }
   ~Impl() {
+    for (cudaEvent_t e : {began, uploaded, counted})
+      if (e != nullptr) cudaEventDestroy(e);
     if (done != nullptr) cudaEventDestroy(done);
     if (stream != nullptr) cudaStreamDestroy(stream);
   }
@@ -151,6 +157,11 @@ void DeviceStreakCull::Finish() {
   if (!m.pending) return;
   m.pending = false;
   Check(cudaEventSynchronize(m.done), "cudaEventSynchronize");
+  float upload = 0, cull = 0;
+  Check(cudaEventElapsedTime(&upload, m.began, m.uploaded), "cudaEventElapsedTime");
+  Check(cudaEventElapsedTime(&cull, m.uploaded, m.counted), "cudaEventElapsedTime");
+  device_upload_ms_ = upload;
+  device_cull_ms_ = cull;
   const int32_t* totals = m.totals_host.as<int32_t>();
   if (totals[2] < m.n) {
     const int64_t g = totals[2];
@@ -229,7 +240,9 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   std::memcpy(host + at_part[3], m.first_host.data(), part_bytes[3]);
   if (num_sets > 0) std::memcpy(host + at_part[4], flags, part_bytes[4]);
   if (frame.num_media > 0) std::memcpy(host + at_part[5], frame.media, part_bytes[5]);
+  Check(cudaEventRecord(m.began, st), "cudaEventRecord");
   m.inputs.Upload(host, total, st);
+  Check(cudaEventRecord(m.uploaded, st), "cudaEventRecord");
   char* dev = m.inputs.as<char>();
   StreakCullFrame f = frame;
   if (f.num_media > 0) f.media = reinterpret_cast<const StreakCullMedium*>(dev + at_part[5]);
@@ -297,6 +310,7 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   // stream waits for
   Check(cudaMemcpyAsync(m.totals_host.p, totals, sizeof(int32_t) * 3, cudaMemcpyDeviceToHost, st),
         "cudaMemcpyAsync");
+  Check(cudaEventRecord(m.counted, st), "cudaEventRecord");
   Check(cudaEventRecord(m.done, st), "cudaEventRecord");
   if (wait_stream != nullptr)
     Check(cudaStreamWaitEvent(static_cast<cudaStream_t>(wait_stream), m.done, 0),

@@ -89,6 +89,11 @@ class DeviceStreakCull {
   /// the part of run_ms before the kernels were queued: the staging copies and the transfers'
   /// queuing.
   double stage_ms() const { return stage_ms_; }
+  /// device milliseconds of the last finished Queue (CUDA events on its stream; 0 before one):
+  /// the inputs' transfer (from its queuing to its end, after any work queued before it on the
+  /// stream), and the decision, compaction and the counts' copy back after it (benchmarks).
+  double device_upload_ms() const { return device_upload_ms_; }
+  double device_cull_ms() const { return device_cull_ms_; }
 
  private:
   struct Impl;
@@ -98,6 +103,8 @@ class DeviceStreakCull {
   int bound_ = 0;
   double run_ms_ = 0;
   double stage_ms_ = 0;
+  double device_upload_ms_ = 0;
+  double device_cull_ms_ = 0;
 };
 
 }  // namespace penumbra::cuda
