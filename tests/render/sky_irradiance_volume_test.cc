@@ -518,6 +518,73 @@ TEST(SkyIrradianceVolumeTest, SharedScalarLookupIsBitIdenticalToTheCpus) {
   });
 }
 
+// Embree's query, counting its batches and their largest; with `alone` every ray is traced in a
+// batch of its own (a hit does not depend on its batch: RayQuery's contract).
+class BatchCountingQuery final : public RayQuery {
+ public:
+  BatchCountingQuery(const SceneDescription& scene, bool alone, std::atomic<int64_t>* batches,
+                     std::atomic<int64_t>* largest)
+      : inner_(DefaultQuery(scene)), alone_(alone), batches_(batches), largest_(largest) {}
+  const SceneDescription& scene() const override { return inner_->scene(); }
+  void Update(const WorldSnapshot& snapshot) override { inner_->Update(snapshot); }
+
+ private:
+  void IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
+                      std::span<bool> did_hit) const override {
+    ++*batches_;
+    int64_t seen = largest_->load();
+    const int64_t n = static_cast<int64_t>(rays.size());
+    while (n > seen && !largest_->compare_exchange_weak(seen, n)) {
+    }
+    if (!alone_) {
+      inner_->Intersect(rays, hits, did_hit);
+      return;
+    }
+    for (size_t i = 0; i < rays.size(); ++i)
+      inner_->Intersect(rays.subspan(i, 1), hits.subspan(i, 1), did_hit.subspan(i, 1));
+  }
+  std::unique_ptr<RayQuery> inner_;
+  bool alone_;
+  std::atomic<int64_t>* batches_;
+  std::atomic<int64_t>* largest_;
+};
+
+TEST(SkyIrradianceVolumeTest, TracesInFewLargeBatchesWithTheSameResult) {
+  // the build gives its query a chunk of 16 probes' rays at a time (a GPU query pays a launch
+  // and a round trip a batch), and the volume is the one whose rays are traced one by one
+  const SceneDescription s = RoomWithWindow(DaylightSky());
+  const SkyModel sky(s.sky);
+  std::atomic<int64_t> batches{0}, largest{0}, alone_batches{0}, alone_largest{0};
+  ThreadPool pool(2);
+  SkyIrradianceVolume a([&](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<BatchCountingQuery>(statics, false, &batches, &largest);
+  });
+  a.Update(s, IdentitySnapshot(s), sky, &pool);
+  SkyIrradianceVolume b([&](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<BatchCountingQuery>(statics, true, &alone_batches, &alone_largest);
+  });
+  b.Update(s, IdentitySnapshot(s), sky, &pool);
+  const int64_t chunks = (a.num_probes() + 15) / 16;
+  std::printf("%d probes (%d valid, %d refined texels): %lld batches, the largest %lld rays\n",
+              a.num_probes(), a.num_valid_probes(), static_cast<int>(a.num_refined_texels()),
+              static_cast<long long>(batches.load()), static_cast<long long>(largest.load()));
+  // a chunk's first pass (16 probes' rays), its relocated probes and its refined texels: at most
+  // 3 batches a chunk
+  EXPECT_LE(batches.load(), 3 * chunks);
+  EXPECT_GE(largest.load(), int64_t{16} * SkyIrradianceVolume::kRaysPerProbe);
+  EXPECT_GT(a.num_refined_texels(), 0);
+  ASSERT_EQ(a.num_probes(), b.num_probes());
+  ASSERT_EQ(a.num_refined_texels(), b.num_refined_texels());
+  for (int p = 0; p < a.num_probes(); ++p) {
+    ASSERT_EQ(a.probe_valid(p), b.probe_valid(p)) << p;
+    for (int t = 0; t < SkyIrradianceVolume::kNumTexels; ++t)
+      ASSERT_EQ(a.open_mask(p, t), b.open_mask(p, t)) << p << " " << t;
+    const Eigen::Vector3f n(0.3f, -0.5f, 0.81f);
+    const Eigen::Vector3f ea = a.ProbeIrradiance(p, n), eb = b.ProbeIrradiance(p, n);
+    ASSERT_EQ(0, std::memcmp(ea.data(), eb.data(), sizeof(float) * 3)) << p;
+  }
+}
+
 TEST(SkyIrradianceVolumeTest, BitIdenticalForAnyThreadCount) {
   const SceneDescription s = RoomWithWindow(DaylightSky());
   const SkyModel sky(s.sky);

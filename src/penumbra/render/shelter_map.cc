@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/static_geometry.h"
@@ -51,22 +54,28 @@ void ShelterMap::Build(const SceneDescription& scene, const std::vector<Pose>& X
   snap.X_WB = X_WB;
   query->Update(snap);
   roof_.assign(static_cast<size_t>(nx) * ny, -std::numeric_limits<float>::infinity());
-  // one row of cells per task (a coherent batch of parallel rays).
-  auto row = [&](int64_t iy) {
-    std::vector<Ray> rays(nx);
-    std::vector<SurfaceHit> hits(nx);
-    std::unique_ptr<bool[]> did(new bool[nx]);
-    for (int ix = 0; ix < nx; ++ix) {
-      Ray& r = rays[ix];
-      r.o = Eigen::Vector3f(origin_.x() + (ix + 0.5f) * cell_m_,
-                            origin_.y() + (static_cast<float>(iy) + 0.5f) * cell_m_, z_top);
-      r.d = Eigen::Vector3f(0, 0, -1);
-    }
-    query->Intersect(rays, std::span<SurfaceHit>(hits), std::span<bool>(did.get(), nx));
-    for (int ix = 0; ix < nx; ++ix)
-      if (did[ix]) roof_[static_cast<size_t>(iy) * nx + ix] = z_top - hits[ix].t;
+  // kRows rows of cells per task, their rays in one batch (a GPU query pays a launch and a round
+  // trip a batch; a ray's hit does not depend on its batch, RayQuery's contract), each row a
+  // coherent run of parallel rays.
+  constexpr int kRows = 16;
+  auto rows = [&](int64_t chunk) {
+    const int y0 = static_cast<int>(chunk) * kRows, y1 = std::min(ny, y0 + kRows);
+    const size_t count = static_cast<size_t>(y1 - y0) * nx;
+    std::vector<Ray> rays(count);
+    std::vector<SurfaceHit> hits(count);
+    std::unique_ptr<bool[]> did(new bool[count]);
+    for (int iy = y0; iy < y1; ++iy)
+      for (int ix = 0; ix < nx; ++ix) {
+        Ray& r = rays[static_cast<size_t>(iy - y0) * nx + ix];
+        r.o = Eigen::Vector3f(origin_.x() + (ix + 0.5f) * cell_m_,
+                              origin_.y() + (static_cast<float>(iy) + 0.5f) * cell_m_, z_top);
+        r.d = Eigen::Vector3f(0, 0, -1);
+      }
+    query->Intersect(rays, std::span<SurfaceHit>(hits), std::span<bool>(did.get(), count));
+    for (size_t k = 0; k < count; ++k)
+      if (did[k]) roof_[static_cast<size_t>(y0) * nx + k] = z_top - hits[k].t;
   };
-  ParallelForOrSerial(pool, ny, row);
+  ParallelForOrSerial(pool, (ny + kRows - 1) / kRows, rows);
 }
 
 void ShelterMap::Update(const SceneDescription& scene, const WorldSnapshot& snapshot,

@@ -102,6 +102,26 @@ int NeighbourTexel(int ix, int iy, int dx, int dy) {
 // one bit per texel.
 using TexelBits = std::bitset<SkyIrradianceVolume::kNumTexels>;
 
+// a batch of rays with its hits, traced through a RayQuery; its arrays grow and are reused. its
+// rays are Ray's defaults but for what the caller writes (o and d: the volume sets only those).
+struct RayBatch {
+  std::vector<Ray> rays;
+  std::vector<SurfaceHit> hits;
+  std::unique_ptr<bool[]> did_hit;
+  size_t capacity = 0;
+  void Resize(size_t n) {
+    rays.resize(n);
+    hits.resize(n);
+    if (n > capacity) {
+      did_hit.reset(new bool[n]);
+      capacity = n;
+    }
+  }
+  void Trace(const RayQuery& query) {
+    query.Intersect(rays, hits, std::span<bool>(did_hit.get(), rays.size()));
+  }
+};
+
 // the texels whose 3 x 3 neighbourhood on the sphere (NeighbourTexel) holds an open texel
 // (*near_open) and a closed one (*near_closed), of one probe's first pass.
 void NearOpenClosed(const uint16_t* open, TexelBits* near_open, TexelBits* near_closed) {
@@ -308,66 +328,40 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   depth_.assign(static_cast<size_t>(num) * kNumTexels, 0.0f);
   position_.resize(num);
   const float far = 2.0f * spacing_;
-  // traces one probe at x into its texels; returns the number of back-face hits and writes
-  // the closest back-face hit (distance, direction).
-  auto trace_probe = [&](const Eigen::Vector3f& x, float* m, uint16_t* open, float* t_back,
-                         Eigen::Vector3f* d_back) {
-    std::fill_n(m, kNumTexels, far);
-    std::fill_n(open, kNumTexels, uint16_t{0});
-    *t_back = std::numeric_limits<float>::infinity();
-    // one probe's rays as one batch, neighbouring texels next to each other (Embree: packets of
-    // 16, 4 x 4 neighbouring texels share one).
-    thread_local std::vector<Ray> ray(kRaysPerProbe);
-    thread_local std::vector<SurfaceHit> hit(kRaysPerProbe);
-    thread_local std::unique_ptr<bool[]> did_hit(new bool[kRaysPerProbe]);
+  // the rays of a chunk of probes go to the query as one batch (a GPU query pays a launch and a
+  // round trip a batch); a ray's hit does not depend on its batch (RayQuery's contract), so the
+  // volume is the same whatever the batching. a probe's rays lie next to each other, neighbouring
+  // texels next to each other (Embree: packets of 16, 4 x 4 neighbouring texels share one).
+  // probe x's first-pass rays into ray[0 .. kRaysPerProbe).
+  auto probe_rays = [&](const Eigen::Vector3f& x, Ray* ray) {
     for (int r = 0; r < kRaysPerProbe; ++r) {
       ray[r].o = x;
       ray[r].d = dirs.dir[r];
     }
-    rays->Intersect(ray, hit, std::span<bool>(did_hit.get(), kRaysPerProbe));
+  };
+  // a probe's texels from its first-pass rays' hits; returns the number of back-face hits and
+  // writes the closest back-face hit (distance, direction).
+  auto take_probe = [&](const RayBatch& b, size_t at, float* m, uint16_t* open, float* t_back,
+                        Eigen::Vector3f* d_back) {
+    std::fill_n(m, kNumTexels, far);
+    std::fill_n(open, kNumTexels, uint16_t{0});
+    *t_back = std::numeric_limits<float>::infinity();
     int backfaces = 0;
     for (int r = 0; r < kRaysPerProbe; ++r) {
+      const size_t i = at + static_cast<size_t>(r);
       float t = far;
-      if (did_hit[r]) {
-        if (!hit[r].front_face) {
+      if (b.did_hit[i]) {
+        if (!b.hits[i].front_face) {
           ++backfaces;
-          if (hit[r].t < *t_back) *t_back = hit[r].t, *d_back = ray[r].d;
+          if (b.hits[i].t < *t_back) *t_back = b.hits[i].t, *d_back = b.rays[i].d;
         }
-        t = std::min(hit[r].t, far);
+        t = std::min(b.hits[i].t, far);
       } else {
         open[dirs.texel[r]] = kAllOpen;
       }
       m[dirs.texel[r]] = std::min(m[dirs.texel[r]], t);
     }
     return backfaces;
-  };
-  // refines the texels `refine` of a probe at x (see the file comment): one ray per sub-cell, a
-  // texel's kSubRays rays as one packet; returns the number of refined texels.
-  auto refine_probe = [&](const Eigen::Vector3f& x, const TexelBits& refine, uint16_t* open) {
-    thread_local std::vector<int> texels;
-    thread_local std::vector<Ray> ray;
-    thread_local std::vector<SurfaceHit> hit;
-    thread_local std::unique_ptr<bool[]> did_hit(new bool[kNumTexels * kSubRays]);
-    texels.clear();
-    for (int t = 0; t < kNumTexels; ++t)
-      if (refine[t]) texels.push_back(t);
-    const size_t n_rays = texels.size() * kSubRays;
-    if (n_rays == 0) return 0;
-    ray.resize(n_rays);
-    hit.resize(n_rays);
-    for (size_t i = 0; i < texels.size(); ++i)
-      for (int c = 0; c < kSubRays; ++c) {
-        ray[i * kSubRays + c].o = x;
-        ray[i * kSubRays + c].d = dirs.sub[static_cast<size_t>(texels[i]) * kSubRays + c];
-      }
-    rays->Intersect(ray, hit, std::span<bool>(did_hit.get(), n_rays));
-    for (size_t i = 0; i < texels.size(); ++i) {
-      uint16_t mask = 0;
-      for (int c = 0; c < kSubRays; ++c)
-        if (!did_hit[i * kSubRays + c]) mask |= static_cast<uint16_t>(1u << c);
-      open[texels[i]] = mask;
-    }
-    return static_cast<int>(texels.size());
   };
   // a probe under the scene's floor: most of its upward rays hit geometry (the floor's underside)
   // and most of its downward rays escape (no ground below the floor: the scene stands over the
@@ -391,30 +385,51 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
     return 2 * up_blocked > up && 2 * down_open > down;
   };
   constexpr int kChunk = 16;
+  const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
   auto trace = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
+    thread_local RayBatch b;
+    thread_local std::vector<int> moved;
+    thread_local std::vector<Eigen::Vector3f> moved_to;
+    b.Resize(static_cast<size_t>(p1 - p0) * kRaysPerProbe);
+    for (int p = p0; p < p1; ++p) {
+      position_[p] = ProbePosition(p);
+      probe_rays(position_[p], &b.rays[static_cast<size_t>(p - p0) * kRaysPerProbe]);
+    }
+    b.Trace(*rays);
+    moved.clear();
+    moved_to.clear();
     for (int p = p0; p < p1; ++p) {
       float* m = &depth_[static_cast<size_t>(p) * kNumTexels];
       uint16_t* open = &open_[static_cast<size_t>(p) * kNumTexels];
-      const Eigen::Vector3f x = ProbePosition(p);
-      position_[p] = x;
       float t_back;
       Eigen::Vector3f d_back = Eigen::Vector3f::Zero();
-      const int max_back = static_cast<int>(kMaxBackfaceFraction * kRaysPerProbe);
-      if (trace_probe(x, m, open, &t_back, &d_back) <= max_back) {
+      if (take_probe(b, static_cast<size_t>(p - p0) * kRaysPerProbe, m, open, &t_back, &d_back) <=
+          max_back) {
         valid_[p] = under_floor(open) ? 0 : 1;
         continue;
       }
       // inside geometry: relocate just past the closest back face when that is within half a
       // spacing (Majercik et al. 2021, "Scaling probe-based real-time dynamic global
-      // illumination for production", sec. 5), and keep the probe if it is outside there.
+      // illumination for production", sec. 5), and keep the probe if it is outside there
+      // (traced again below, the chunk's moved probes in one batch).
       if (!(t_back < 0.5f * spacing_)) continue;
-      const Eigen::Vector3f y = x + (t_back + kRelocateMargin * spacing_) * d_back;
+      moved.push_back(p);
+      moved_to.push_back(position_[p] + (t_back + kRelocateMargin * spacing_) * d_back);
+    }
+    if (moved.empty()) return;
+    b.Resize(moved.size() * kRaysPerProbe);
+    for (size_t k = 0; k < moved.size(); ++k) probe_rays(moved_to[k], &b.rays[k * kRaysPerProbe]);
+    b.Trace(*rays);
+    for (size_t k = 0; k < moved.size(); ++k) {
+      const int p = moved[k];
+      float* m = &depth_[static_cast<size_t>(p) * kNumTexels];
+      uint16_t* open = &open_[static_cast<size_t>(p) * kNumTexels];
       float t2;
       Eigen::Vector3f d2;
-      if (trace_probe(y, m, open, &t2, &d2) <= max_back && !under_floor(open)) {
+      if (take_probe(b, k * kRaysPerProbe, m, open, &t2, &d2) <= max_back && !under_floor(open)) {
         valid_[p] = 1;
-        position_[p] = y;
+        position_[p] = moved_to[k];
       }
     }
   };
@@ -432,8 +447,13 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
   };
   ParallelForOrSerial(pool, num, dilate);
   std::vector<int> refined(num, 0);
+  // a chunk's refined texels (see the file comment): one ray per sub-cell, a texel's kSubRays
+  // rays next to each other (one packet), the chunk's rays in one batch
   auto refine = [&](int64_t chunk) {
     const int p0 = static_cast<int>(chunk) * kChunk, p1 = std::min(num, p0 + kChunk);
+    thread_local RayBatch b;
+    thread_local std::vector<std::pair<int, int>> texels;  // (probe, texel)
+    texels.clear();
     for (int p = p0; p < p1; ++p) {
       if (!valid_[p]) continue;
       const int c[3] = {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])};
@@ -448,8 +468,26 @@ void SkyIrradianceVolume::Build(const SceneDescription& scene, const std::vector
             any_open |= near_open[q];
             any_closed |= near_closed[q];
           }
-      refined[p] = refine_probe(position_[p], any_open & any_closed,
-                                &open_[static_cast<size_t>(p) * kNumTexels]);
+      const TexelBits refine = any_open & any_closed;
+      for (int t = 0; t < kNumTexels; ++t)
+        if (refine[t]) texels.push_back({p, t});
+    }
+    if (texels.empty()) return;
+    b.Resize(texels.size() * kSubRays);
+    for (size_t i = 0; i < texels.size(); ++i)
+      for (int c = 0; c < kSubRays; ++c) {
+        Ray& r = b.rays[i * kSubRays + c];
+        r.o = position_[texels[i].first];
+        r.d = dirs.sub[static_cast<size_t>(texels[i].second) * kSubRays + c];
+      }
+    b.Trace(*rays);
+    for (size_t i = 0; i < texels.size(); ++i) {
+      uint16_t mask = 0;
+      for (int c = 0; c < kSubRays; ++c)
+        if (!b.did_hit[i * kSubRays + c]) mask |= static_cast<uint16_t>(1u << c);
+      const auto [p, t] = texels[i];
+      open_[static_cast<size_t>(p) * kNumTexels + t] = mask;
+      ++refined[p];
     }
   };
   ParallelForOrSerial(pool, chunks, refine);

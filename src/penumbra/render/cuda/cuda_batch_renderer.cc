@@ -49,7 +49,7 @@ int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings&
   SyncDevice(*w->bvh, w->device.get());
   if (layout_.outputs().rgb) {
     // the scene-constant arrays, as CudaRenderer uploads them
-    w->realtime = std::make_unique<RealtimeFrameData>(w->scene, settings);
+    w->realtime = std::make_unique<RealtimeFrameData>(w->scene, settings, CudaRayQueryFactory());
     w->device_realtime = std::make_unique<DeviceRealtime>();
     const RealtimeFrameData& d = *w->realtime;
     RealtimeStatic st;

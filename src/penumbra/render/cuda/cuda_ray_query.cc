@@ -38,6 +38,12 @@ void CudaRayQuery::Update(const WorldSnapshot& snapshot) {
   SyncDevice(*own_bvh_, device_);
 }
 
+RayQueryFactory CudaRayQueryFactory() {
+  return [](const SceneDescription& scene) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<CudaRayQuery>(scene);
+  };
+}
+
 void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                                   std::span<bool> did_hit) const {
   // untraceable rays are misses: traced as empty segments (tmax < tmin)

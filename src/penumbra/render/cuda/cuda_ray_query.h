@@ -17,6 +17,11 @@ namespace penumbra::cuda {
 /// the arrays and sizes of `scene` as DeviceScene::Sync takes them (`wait` as there).
 void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait = true);
 
+/// makes a CudaRayQuery over the scene it is given (its own BVH and device copy): the
+/// factory through which CudaRenderer's and the batch's sky irradiance volume and shelter map
+/// trace their rays on the GPU.
+RayQueryFactory CudaRayQueryFactory();
+
 /// RayQuery on the GPU (see the file comment).
 class CudaRayQuery final : public RayQuery {
  public:

@@ -30,7 +30,7 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
   bvh_ = std::make_unique<BvhScene>(scene_);
   device_ = std::make_unique<DeviceScene>();
   SyncDevice(*bvh_, device_.get());
-  realtime_ = std::make_unique<RealtimeFrameData>(scene_, settings);
+  realtime_ = std::make_unique<RealtimeFrameData>(scene_, settings, CudaRayQueryFactory());
   device_realtime_ = std::make_unique<DeviceRealtime>();
   device_path_ = std::make_unique<DevicePath>();
   if (settings.tier == RenderSettings::Tier::kPathtraced) {

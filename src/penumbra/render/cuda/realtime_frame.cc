@@ -56,17 +56,26 @@ PinholeCamera PinholeCameraOf(const CameraView& view) {
   return c;
 }
 
-RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings)
+namespace {
+
+// the statics' ray queries RealtimeFrameData's constructor was given, else BvhRayQuery's
+RayQueryFactory StaticsQueryOr(RayQueryFactory given) {
+  if (given) return given;
+  return [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<BvhRayQuery>(statics);
+  };
+}
+
+}  // namespace
+
+RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings,
+                                     RayQueryFactory statics_query)
     : scene_(scene),
       settings_(settings),
       lights_(scene),
       sky_(scene.sky, MjcfSkyboxOf(scene)),
-      volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
-        return std::make_unique<BvhRayQuery>(statics);
-      }),
-      shelter_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
-        return std::make_unique<BvhRayQuery>(statics);
-      }),
+      volume_(StaticsQueryOr(statics_query)),
+      shelter_(StaticsQueryOr(statics_query)),
       film_(settings) {
   // 2d textures with one face and cube (or skybox) textures with six: every level's texels,
   // one after the other.

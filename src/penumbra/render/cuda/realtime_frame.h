@@ -52,9 +52,13 @@ namespace penumbra::cuda {
 class RealtimeFrameData {
  public:
   /// copies the materials, textures and geoms of `scene` (referenced: it must outlive this).
-  /// `settings`: the tier's film, anisotropy and seed.
+  /// `settings`: the tier's film, anisotropy and seed. `statics_query` makes the ray queries
+  /// over the static geoms that the sky irradiance volume and the shelter map trace when they
+  /// are built (empty: BvhRayQuery, the traversal on the CPU; CudaRenderer and the batch pass
+  /// CudaRayQuery's, so those rays run on the GPU).
   /// @throws Error if a texture has more than kMaxTextureLevels levels.
-  RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings);
+  RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings,
+                    RayQueryFactory statics_query = RayQueryFactory());
 
   /// poses the lights and geoms from `snapshot`, applies the lighting `effects` (null: none),
   /// sets the camera and frame key of `view`, and
