@@ -1075,8 +1075,8 @@ int Main(int argc, char** argv) {
                 "(of which staging the drops {:.3f} ms); device, from the frame's first event: "
                 "kernels end {:.3f} ms, copies end {:.3f} ms; the drops' transfer {:.3f} ms and "
                 "their culling {:.3f} ms on the culling's stream",
-                name, size, m.wall, m.prepare, m.launched, m.late_start, m.late, m.stage, m.upload,
-                m.cull, m.kernels_end, m.copies_end));
+                name, size, m.wall, m.prepare, m.launched, m.late_start, m.late, m.stage,
+                m.kernels_end, m.copies_end, m.upload, m.cull));
           }
           // a rolling-shutter camera that turns 0.25 rad and moves 16 cm during its 30 ms
           // readout (realtime_parity::AddRollingShutter): the device splat, whose boxes and row

@@ -204,5 +204,53 @@ TEST(StreakCullGpu, RenderThrowsTheHostCullingsErrorForANonFiniteDrop) {
   g->set_device_culling(true);
 }
 
+TEST(StreakCullGpu, SuccessiveFramesSendOnlyWhatChanged) {
+  // frames 1/30 s apart: a rain drop keeps its velocity and radius, so after the first frame
+  // only the positions (and the small parts) go over; snow drifts, so its velocities change and
+  // everything goes over. every frame's streaks and image equal the host culling's.
+  if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
+  for (const char* file : {"effects/rain.yaml", "effects/snow.yaml"}) {
+    SCOPED_TRACE(file);
+    auto [session, snap, view, loaded] = realtime_parity::LoadFrameAt(file, 1.0, 320, 240);
+    ASSERT_TRUE(loaded && !loaded->particles.empty());
+    const std::unique_ptr<Renderer> gpu = GpuRenderer(session->scene());
+    auto* g = dynamic_cast<cuda::CudaRenderer*>(gpu.get());
+    ASSERT_NE(g, nullptr);
+    size_t first_bytes = 0, later_bytes = 0;
+    for (int frame = 0; frame < 3; ++frame) {
+      if (frame > 0) {
+        const double t = session->sim().time() + 1.0 / 30;
+        while (session->sim().time() < t) session->sim().Step();
+        snap = session->sim().Snapshot();
+      }
+      const std::shared_ptr<const EffectsFrame> fx =
+          session->effects().Evaluate(snap, view.X_WO.translation());
+      RenderedFrame device, host;
+      g->set_device_culling(true);
+      gpu->Render(snap, fx.get(), view, &device);
+      const std::vector<cuda::StreakPod> device_pods = SplatPods(g);
+      const size_t bytes = g->device_drop_cull()->upload_bytes();
+      g->set_device_culling(false);
+      gpu->Render(snap, fx.get(), view, &host);
+      const std::vector<cuda::StreakPod> host_pods = SplatPods(g);
+      size_t drops = 0;
+      for (const ParticleSet& ps : fx->particles) drops += ps.position_W.size();
+      std::printf("%s frame %d: %zu drops, %zu bytes sent, %zu streaks, the same: %s\n", file,
+                  frame, drops, bytes, device_pods.size(),
+                  SamePods(device_pods, host_pods) ? "yes" : "NO");
+      EXPECT_GT(host_pods.size(), 0u);
+      EXPECT_TRUE(SamePods(device_pods, host_pods)) << frame;
+      EXPECT_EQ(device.rgb.data, host.rgb.data) << frame;
+      EXPECT_EQ(device.radiance.data, host.radiance.data) << frame;
+      (frame == 0 ? first_bytes : later_bytes) = bytes;
+      EXPECT_GE(bytes, sizeof(float) * 3 * drops);
+    }
+    if (std::string(file) == "effects/rain.yaml")
+      EXPECT_LT(later_bytes, first_bytes * 6 / 10);
+    else
+      EXPECT_EQ(later_bytes, first_bytes);
+  }
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -104,6 +104,13 @@ struct DeviceStreakCull::Impl {
   int32_t n = 0;  // the last Queue's drops
   std::vector<int64_t> first_host;
   std::vector<std::pair<int32_t, int64_t>> chunks;  // (set, first drop) of each staging chunk
+  std::vector<uint8_t> chunk_kept;  // per chunk: its velocities and radii were staged already
+  // the layout (sets' first drops, media, bytes) of the inputs on the device, and whether they
+  // hold a whole Queue's inputs (a grown buffer holds none)
+  std::vector<int64_t> device_first;
+  int32_t device_media = -1;
+  size_t device_total = 0;
+  bool device_whole = false;
   // the highest priority: the culling's blocks go before the waiting blocks of the frame's
   // shading kernels it overlaps (CudaRenderer's late streaks)
   Impl() {
@@ -224,15 +231,22 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   m.chunks.clear();
   for (int32_t s = 0; s < num_sets; ++s)
     for (int64_t i = 0; i < sets[s].n; i += kChunk) m.chunks.push_back({s, i});
+  // the velocities and radii are copied only where they differ from the staged ones (a rain
+  // drop keeps both from frame to frame; the staging always ends up holding this Queue's)
+  const int64_t num_chunks = static_cast<int64_t>(m.chunks.size());
+  m.chunk_kept.assign(static_cast<size_t>(num_chunks), 0);
   const auto copy_chunk = [&](int64_t c) {
     const int32_t s = m.chunks[c].first;
     const int64_t i0 = m.chunks[c].second, k = std::min(kChunk, sets[s].n - i0);
     const int64_t g = m.first_host[s] + i0;
     std::memcpy(hp + 3 * g, sets[s].p + 3 * i0, sizeof(float) * 3 * k);
-    std::memcpy(hv + 3 * g, sets[s].v + 3 * i0, sizeof(float) * 3 * k);
-    std::memcpy(hr + g, sets[s].r + i0, sizeof(float) * k);
+    const size_t v_bytes = sizeof(float) * 3 * k, r_bytes = sizeof(float) * k;
+    const bool v_kept = std::memcmp(hv + 3 * g, sets[s].v + 3 * i0, v_bytes) == 0;
+    if (!v_kept) std::memcpy(hv + 3 * g, sets[s].v + 3 * i0, v_bytes);
+    const bool r_kept = std::memcmp(hr + g, sets[s].r + i0, r_bytes) == 0;
+    if (!r_kept) std::memcpy(hr + g, sets[s].r + i0, r_bytes);
+    m.chunk_kept[c] = v_kept && r_kept ? 1 : 0;
   };
-  const int64_t num_chunks = static_cast<int64_t>(m.chunks.size());
   if (parallel)
     parallel(num_chunks, copy_chunk);
   else
@@ -240,8 +254,31 @@ void DeviceStreakCull::Queue(const DropSet* sets, int32_t num_sets, const Streak
   std::memcpy(host + at_part[3], m.first_host.data(), part_bytes[3]);
   if (num_sets > 0) std::memcpy(host + at_part[4], flags, part_bytes[4]);
   if (frame.num_media > 0) std::memcpy(host + at_part[5], frame.media, part_bytes[5]);
+  // the transfer: without the velocities and radii when the device holds them already (the
+  // last Queue's whole inputs in this layout, and every chunk's staged as they were)
+  const size_t grown_from = m.inputs.bytes;
+  m.inputs.Reserve(total);
+  const bool kept =
+      m.device_whole && m.inputs.bytes == grown_from && total == m.device_total &&
+      frame.num_media == m.device_media && m.first_host == m.device_first &&
+      std::all_of(m.chunk_kept.begin(), m.chunk_kept.end(), [](uint8_t k) { return k != 0; });
+  m.device_whole = false;  // until the transfer is queued
   Check(cudaEventRecord(m.began, st), "cudaEventRecord");
-  m.inputs.Upload(host, total, st);
+  if (kept) {
+    Check(cudaMemcpyAsync(m.inputs.p, host, part_bytes[0], cudaMemcpyHostToDevice, st),
+          "cudaMemcpyAsync");
+    Check(cudaMemcpyAsync(m.inputs.as<char>() + at_part[3], host + at_part[3], total - at_part[3],
+                          cudaMemcpyHostToDevice, st),
+          "cudaMemcpyAsync");
+    upload_bytes_ = part_bytes[0] + (total - at_part[3]);
+  } else {
+    m.inputs.Upload(host, total, st);
+    upload_bytes_ = total;
+  }
+  m.device_whole = true;
+  m.device_total = total;
+  m.device_media = frame.num_media;
+  m.device_first = m.first_host;
   Check(cudaEventRecord(m.uploaded, st), "cudaEventRecord");
   char* dev = m.inputs.as<char>();
   StreakCullFrame f = frame;

@@ -93,6 +93,10 @@ class DeviceStreakCull {
   /// the inputs' transfer (from its queuing to its end, after any work queued before it on the
   /// stream), and the decision, compaction and the counts' copy back after it (benchmarks).
   double device_upload_ms() const { return device_upload_ms_; }
+  /// bytes the last Queue sent to the device: all its inputs, or without the drops' velocities
+  /// and radii when they equal the previous Queue's (same sets and sizes: a rain drop keeps
+  /// both from frame to frame) and the device still holds those.
+  size_t upload_bytes() const { return upload_bytes_; }
   double device_cull_ms() const { return device_cull_ms_; }
 
  private:
@@ -104,6 +108,7 @@ class DeviceStreakCull {
   double run_ms_ = 0;
   double stage_ms_ = 0;
   double device_upload_ms_ = 0;
+  size_t upload_bytes_ = 0;
   double device_cull_ms_ = 0;
 };
 
