@@ -599,6 +599,9 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.packed_window_counts = false;
     variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
+    o = fast;
+    o.staged_window = false;
+    variants.push_back({"kernels, penumbra tiles' windows from global memory, verdicts bit by bit", o});
 
     o = fast;
     o.rows_per_warp = false;
