@@ -79,8 +79,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "penumbra_chunk_rays 4",
                          "penumbra_chunk_rays 3",
                          "packed_window_counts off",
-                         "staged_window off"};
-  for (int k = 0; k < 31; ++k) {
+                         "staged_window off",
+                         "window_verdict_rows off"};
+  for (int k = 0; k < 32; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -117,6 +118,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 28) o.penumbra_chunk_rays = 3;
     if (k == 29) o.packed_window_counts = false;
     if (k == 30) o.staged_window = false;
+    if (k == 31) o.window_verdict_rows = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {
@@ -187,7 +189,8 @@ TEST_P(RealtimeSpeedUps, TilesCutAtTheImageEdges) {
   ASSERT_NE(g, nullptr);
   cuda::RealtimeKernelOptions o = g->device_realtime().options();
   o.output_bands = 3;
-  ASSERT_TRUE(o.tile_visibility && o.tile_penumbra && o.fuse_resolve && o.staged_window);
+  ASSERT_TRUE(o.tile_visibility && o.tile_penumbra && o.fuse_resolve && o.staged_window &&
+              o.window_verdict_rows);
   g->device_realtime().set_options(o);
   RenderedFrame tiles;
   gpu->Render(snap, view, &tiles);

@@ -200,11 +200,13 @@ struct RealtimeKernelOptions {
   /// with tile_penumbra: the penumbra rays' tile blocks copy each pixel's surface (geom of a
   /// hit, normal, point: TileWindowSurfaces) into shared memory once, where the window masks
   /// read their neighbours' (SharedVisibilityWindow; else each pixel's PixelGeometry is read
-  /// from global memory by up to 25 threads), and keep every light's verdicts as the tile's bit
-  /// rows (two ballots a warp: RowWindowVerdicts, ShadowWindowVerdicts), where a window sees
-  /// both verdicts or not in five shifted rows (else an int8 read per set bit of the window,
-  /// StridedWindowVerdicts). the same masks and booleans, so the same bits.
+  /// from global memory by up to 25 threads). the same masks, so the same bits.
   bool staged_window = true;
+  /// with staged_window: those blocks keep every light's verdicts as the tile's bit rows (two
+  /// ballots a warp: RowWindowVerdicts, ShadowWindowVerdicts), where a window sees both
+  /// verdicts or not in five shifted rows; else as an int8 copy read at each set bit of the
+  /// window (StridedWindowVerdicts). the same booleans, so the same bits.
+  bool window_verdict_rows = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

@@ -559,10 +559,10 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
 // with more take the kernel of 128 threads a block.
 constexpr int kMaxTilePenumbraLights = 128;
 // the dynamic shared memory of the tile kernel: every light's int8 verdicts of the tile, or
-// with kStaged their bit rows (kShadowVerdictRows words a light, 80 bytes instead of 256).
-inline size_t TilePenumbraBytes(int lights, bool staged) {
+// with `rows` their bit rows (kShadowVerdictRows words a light, 80 bytes instead of 256).
+inline size_t TilePenumbraBytes(int lights, bool rows) {
   return static_cast<size_t>(std::max(lights, 1)) *
-         (staged ? sizeof(uint32_t) * kShadowVerdictRows : kTilePixels);
+         (rows ? sizeof(uint32_t) * kShadowVerdictRows : kTilePixels);
 }
 
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
@@ -586,14 +586,16 @@ unsigned ChunkBlocks() {
 // kStaged (with kTile; RealtimeKernelOptions::staged_window): each thread also copies its own
 // pixel's surface (TileWindowSurfaces: geom of a hit, normal, point) into shared memory, where
 // the window masks read their 24 neighbours' (instead of up to 25 threads reading each pixel's
-// PixelGeometry from global memory), and each warp (two tile rows of 16 pixels) puts a light's
-// verdicts into the tile's bit rows with two ballots (ShadowVerdictBits' layout), where a
+// PixelGeometry from global memory). kRows (with kStaged; RealtimeKernelOptions::
+// window_verdict_rows): each warp (two tile rows of 16 pixels) puts a light's verdicts into the
+// tile's bit rows with two ballots (ShadowVerdictBits' layout) instead of the int8 copy, where a
 // window's "both verdicts seen" is five shifted rows (RowWindowVerdicts) instead of a shared
-// int8 read per set bit: the same masks and booleans, so the same bits.
-template <class Frames, bool kTile, bool kStaged>
+// int8 read per set bit. the same masks and booleans, so the same bits.
+template <class Frames, bool kTile, bool kStaged, bool kRows>
 __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
     VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
   static_assert(kTile || !kStaged, "the staged window works a tile at a time");
+  static_assert(kStaged || !kRows, "the bit rows come with the staged window");
   extern __shared__ uint32_t tile_shared[];
   constexpr int kSurfaces = kStaged ? kTilePixels : 1;
   __shared__ int32_t key[kSurfaces];
@@ -611,8 +613,7 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
   const int64_t n = static_cast<int64_t>(W) * H;
   const int64_t i = p.i;
   if constexpr (kStaged) {
-    // this pixel's surface, then every light's verdicts as bit rows: warp w holds tile rows 2w
-    // (lanes 0-15) and 2w + 1 (lanes 16-31); the two words above and below the tile stay 0
+    // this pixel's surface
     key[t] = TileWindowSurfaces::kNoWindowSurface;
     if (inside) {
       const PixelGeometry& g = f.geometry[i];
@@ -620,6 +621,10 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
       ng_x[t] = g.ng.x, ng_y[t] = g.ng.y, ng_z[t] = g.ng.z;
       p_x[t] = g.p_or_d.x, p_y[t] = g.p_or_d.y, p_z[t] = g.p_or_d.z;
     }
+  }
+  if constexpr (kRows) {
+    // every light's verdicts as bit rows: warp w holds tile rows 2w (lanes 0-15) and 2w + 1
+    // (lanes 16-31); the two words above and below the tile stay 0
     const int row = kShadowWindowRadius + 2 * (t >> 5);
 #pragma unroll 4
     for (int j = 0; j < f.num_lights; ++j) {
@@ -651,7 +656,7 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
   }
   for (int j = 0; j < f.num_lights; ++j) {
     PenumbraRays job;
-    if (inside && kStaged)
+    if (inside && kRows)
       job = SharedVisibilityPenumbraOf(
           f, u, v, j, bits,
           RowWindowVerdicts{tile_rows + j * kShadowVerdictRows, static_cast<int>(threadIdx.x),
@@ -1009,7 +1014,7 @@ struct PixelBuffers {
   // lights fit: kMaxTilePenumbraLights).
   template <class Frames>
   void LaunchPenumbraRays(Frames frames, int W, int H, int lights, int64_t nl, int cameras,
-                          bool queue, int chunk_rays, bool tile, bool staged,
+                          bool queue, int chunk_rays, bool tile, bool staged, bool rows,
                           cudaStream_t stream) const {
     PenumbraQueue q;
     if (queue) {
@@ -1024,16 +1029,20 @@ struct PixelBuffers {
     if (tile && lights <= kMaxTilePenumbraLights) {
       dim3 grid = TileGrid(W, 0, H);
       grid.z = cameras;
-      if (staged)
-        VisibilityRaysWarpKernel<Frames, true, true>
+      if (staged && rows)
+        VisibilityRaysWarpKernel<Frames, true, true, true>
             <<<grid, kTileBlock, TilePenumbraBytes(lights, true), stream>>>(frames, q);
+      else if (staged)
+        VisibilityRaysWarpKernel<Frames, true, true, false>
+            <<<grid, kTileBlock, TilePenumbraBytes(lights, false), stream>>>(frames, q);
       else
-        VisibilityRaysWarpKernel<Frames, true, false>
+        VisibilityRaysWarpKernel<Frames, true, false, false>
             <<<grid, kTileBlock, TilePenumbraBytes(lights, false), stream>>>(frames, q);
     } else {
       dim3 grid = PixelGrid(W, H);
       grid.z = cameras;
-      VisibilityRaysWarpKernel<Frames, false, false><<<grid, kPixelBlock, 0, stream>>>(frames, q);
+      VisibilityRaysWarpKernel<Frames, false, false, false>
+          <<<grid, kPixelBlock, 0, stream>>>(frames, q);
     }
     Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
     if (!queue) return;
@@ -1559,7 +1568,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (o.warp_penumbra || o.queue_penumbra) {
       LaunchPenumbraRays(OneFrame{f}, W, H, f.num_lights,
                          static_cast<int64_t>(W) * H * f.num_lights, 1, o.queue_penumbra,
-                         o.penumbra_chunk_rays, o.tile_penumbra, o.staged_window, stream);
+                         o.penumbra_chunk_rays, o.tile_penumbra, o.staged_window,
+                         o.window_verdict_rows, stream);
     } else {
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
       Check(cudaGetLastError(), "VisibilityRaysKernel");
@@ -2381,7 +2391,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // kPenumbraChunkRays rays (many cameras fill the device: fewer, longer chunks)
   const RealtimeKernelOptions defaults;
   m.LaunchPenumbraRays(fr, W, H, m.lights, nl, count, /*queue=*/true, kPenumbraChunkRays,
-                       defaults.tile_penumbra, defaults.staged_window, stream);
+                       defaults.tile_penumbra, defaults.staged_window,
+                       defaults.window_verdict_rows, stream);
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;
