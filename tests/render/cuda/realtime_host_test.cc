@@ -9,9 +9,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <iterator>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -459,9 +459,8 @@ TEST(RealtimeHostPathFrames, StagedWindowGivesTheSameMasksAndVerdicts) {
             }
         }
         const uint32_t mask = cuda::ShadowWindowMask(staged, at, kSide, x, y, tile);
-        const uint32_t frame_mask =
-            cuda::ShadowWindowMask(cuda::FrameWindowSurfaces{geometry.data()}, at, kSide, x, y,
-                                   tile);
+        const uint32_t frame_mask = cuda::ShadowWindowMask(
+            cuda::FrameWindowSurfaces{geometry.data()}, at, kSide, x, y, tile);
         mask_differ += (mask != want_mask) + (frame_mask != want_mask);
         partial_masks += want_mask != 0 && want_mask != (1u << ShadowWindowBit(0, 0)) &&
                          __builtin_popcount(want_mask) < 9;
@@ -507,10 +506,11 @@ TEST(RealtimeHostPathFrames, StagedWindowGivesTheSameMasksAndVerdicts) {
   EXPECT_GT(one_only, checked / 10);
   EXPECT_GT(partial_masks, checked / 20);
   EXPECT_GT(wrong_differ, checked / 100);
-  std::printf("staged window: %lld windows, %lld see both verdicts, %lld one; shift off by one: "
-              "%lld differ\n",
-              static_cast<long long>(checked), static_cast<long long>(both),
-              static_cast<long long>(one_only), static_cast<long long>(wrong_differ));
+  std::printf(
+      "staged window: %lld windows, %lld see both verdicts, %lld one; shift off by one: "
+      "%lld differ\n",
+      static_cast<long long>(checked), static_cast<long long>(both),
+      static_cast<long long>(one_only), static_cast<long long>(wrong_differ));
 }
 
 }  // namespace

@@ -636,8 +636,7 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
         rows[row] = (ones & 0xffffu) | zeros << kShadowTileSize;
         rows[row + 1] = ones >> kShadowTileSize | (zeros & 0xffff0000u);
       }
-      if (t < 2 * kShadowWindowRadius)
-        rows[t < kShadowWindowRadius ? t : kShadowTileSize + t] = 0u;
+      if (t < 2 * kShadowWindowRadius) rows[t < kShadowWindowRadius ? t : kShadowTileSize + t] = 0u;
     }
     __syncthreads();
   } else if constexpr (kTile) {
@@ -648,9 +647,8 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
   uint32_t bits = 0;
   if (inside) {
     if constexpr (kStaged)
-      bits = SharedVisibilityWindow(f, u, v,
-                                    TileWindowSurfaces{key, ng_x, ng_y, ng_z, p_x, p_y, p_z}, t,
-                                    kShadowTileSize);
+      bits = SharedVisibilityWindow(
+          f, u, v, TileWindowSurfaces{key, ng_x, ng_y, ng_z, p_x, p_y, p_z}, t, kShadowTileSize);
     else
       bits = SharedVisibilityWindow(f, u, v);
   }
@@ -2391,8 +2389,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // kPenumbraChunkRays rays (many cameras fill the device: fewer, longer chunks)
   const RealtimeKernelOptions defaults;
   m.LaunchPenumbraRays(fr, W, H, m.lights, nl, count, /*queue=*/true, kPenumbraChunkRays,
-                       defaults.tile_penumbra, defaults.staged_window,
-                       defaults.window_verdict_rows, stream);
+                       defaults.tile_penumbra, defaults.staged_window, defaults.window_verdict_rows,
+                       stream);
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;
