@@ -540,8 +540,8 @@ namespace {
 // the shared visibility of frame f by shadow tiles, as the kernels' blocks with
 // RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
 // VisibilityTileKernel) do it in shared memory: per tile, its surfaces and every light's
-// verdicts as bit rows copied for the penumbra rays (RealtimeKernelOptions::staged_window:
-// TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light after light its
+// verdicts as bit rows copied for the penumbra rays (RealtimeKernelOptions::staged_window and
+// window_verdict_rows: TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light after light its
 // verdicts, ray counts (packed once, ShadowWindowCounts, as
 // RealtimeKernelOptions::packed_window_counts packs them) and fractions (SharedWindowFraction) for
 // the resolve (SharedLampFraction, AddSharedVisibility).
@@ -559,7 +559,8 @@ void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3*
   };
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
     // the tile's surfaces (TileWindowSurfaces) and every light's verdicts as bit rows
-    // (ShadowVerdictBits), as RealtimeKernelOptions::staged_window keeps them
+    // (ShadowVerdictBits), as RealtimeKernelOptions::staged_window and window_verdict_rows
+    // keep them
     std::vector<uint32_t> rows(static_cast<size_t>(kShadowVerdictRows) * std::max(f.num_lights, 1));
     int32_t key[kTile];
     float ng[3][kTile], p[3][kTile];

@@ -1288,8 +1288,8 @@ struct StridedWindowVerdicts {
 
 /// a light's verdicts of a shadow tile as bit rows (kShadowVerdictRows words,
 /// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel with
-/// RealtimeKernelOptions::staged_window: shared memory) around tile pixel (x, y): the same
-/// values as StridedWindowVerdicts over the tile.
+/// RealtimeKernelOptions::window_verdict_rows: shared memory) around tile pixel (x, y): the
+/// same values as StridedWindowVerdicts over the tile.
 struct RowWindowVerdicts {
   const uint32_t* rows = nullptr;
   int x = 0, y = 0;
