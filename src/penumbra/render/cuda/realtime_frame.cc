@@ -541,10 +541,10 @@ namespace {
 // RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
 // VisibilityTileKernel) do it in shared memory: per tile, its surfaces and every light's
 // verdicts as bit rows copied for the penumbra rays (RealtimeKernelOptions::staged_window and
-// window_verdict_rows: TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light after light its
-// verdicts, ray counts (packed once, ShadowWindowCounts, as
-// RealtimeKernelOptions::packed_window_counts packs them) and fractions (SharedWindowFraction) for
-// the resolve (SharedLampFraction, AddSharedVisibility).
+// window_verdict_rows: TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light
+// after light its verdicts, ray counts (packed once, ShadowWindowCounts, as
+// RealtimeKernelOptions::packed_window_counts packs them) and fractions (SharedWindowFraction)
+// for the resolve (SharedLampFraction, AddSharedVisibility).
 void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;
   const int64_t n = static_cast<int64_t>(W) * H;
