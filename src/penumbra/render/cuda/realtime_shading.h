@@ -1198,10 +1198,10 @@ struct FrameWindowSurfaces {
 /// entry a tile pixel, structure of arrays): key the geom of a hit, kNoWindowSurface where
 /// the pixel has none (a miss or outside the image); the normal and point of a hit.
 struct TileWindowSurfaces {
-  static constexpr int32_t kNoWindowSurface = INT32_MIN;
-  const int32_t* key = nullptr;
-  const float *ng_x = nullptr, *ng_y = nullptr, *ng_z = nullptr;
-  const float *p_x = nullptr, *p_y = nullptr, *p_z = nullptr;
+  static constexpr int32_t kNoWindowSurface = INT32_MIN;  ///< the key of a pixel without a hit
+  const int32_t* key = nullptr;                           ///< a key a tile pixel
+  const float *ng_x = nullptr, *ng_y = nullptr, *ng_z = nullptr;  ///< unit normals (world)
+  const float *p_x = nullptr, *p_y = nullptr, *p_z = nullptr;     ///< hit points, m (world)
   /// the key of `g` (its geom where it has a hit, else kNoWindowSurface).
   PB_HOST_DEVICE static int32_t KeyOf(const PixelGeometry& g) {
     return g.hit != 0 ? g.geom : kNoWindowSurface;
@@ -1270,8 +1270,9 @@ PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f
 /// vis[at], its window neighbour (dx, dy)'s at vis[at + dy stride + dx] (the frame's f.area_vis
 /// + j n, or a tile's int8 copy).
 struct StridedWindowVerdicts {
-  const int8_t* vis = nullptr;
-  int64_t at = 0, stride = 0;
+  const int8_t* vis = nullptr;  ///< 1 visible, 0 occluded, -1 none traced
+  int64_t at = 0;               ///< the pixel's own entry
+  int64_t stride = 0;           ///< the entries of one row (the image's width, or 16)
   /// the pixel's own verdict: 1, 0 or -1.
   PB_HOST_DEVICE int Own() const { return vis[at]; }
   /// whether the window mask `bits` holds a verdict 1 (seen[1]) and 0 (seen[0]): each set bit's
@@ -1291,8 +1292,8 @@ struct StridedWindowVerdicts {
 /// RealtimeKernelOptions::window_verdict_rows: shared memory) around tile pixel (x, y): the
 /// same values as StridedWindowVerdicts over the tile.
 struct RowWindowVerdicts {
-  const uint32_t* rows = nullptr;
-  int x = 0, y = 0;
+  const uint32_t* rows = nullptr;  ///< kShadowVerdictRows words (ShadowVerdictBits)
+  int x = 0, y = 0;                ///< the pixel in its tile (column, row)
   /// the pixel's own verdict: 1, 0 or -1 (ShadowRowVerdict).
   PB_HOST_DEVICE int Own() const { return ShadowRowVerdict(rows, x, y); }
   /// whether the window mask `bits` holds a verdict 1 (seen[1]) and 0 (seen[0])
