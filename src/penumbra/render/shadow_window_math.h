@@ -96,6 +96,47 @@ PB_HOST_DEVICE inline bool SameShadowSurface(int geom_i, const float ng_i[3], co
   return off * off <= 0.0025f * (dp[0] * dp[0] + (dp[1] * dp[1] + dp[2] * dp[2])) + 1e-10f;
 }
 
+/// a shadow tile's verdicts towards one light as bit rows (the GPU's VisibilityRaysWarpKernel
+/// builds them with two ballots a warp): word y + kShadowWindowRadius of kShadowVerdictRows holds
+/// tile row y, bit x set where pixel x's verdict is 1 (visible), bit kShadowTileSize + x where it
+/// is 0 (occluded), neither where it has none (-1) or lies outside the image; the first and last
+/// kShadowWindowRadius words stay 0, so that a window's rows above and below the tile read no
+/// verdict.
+constexpr int kShadowVerdictRows = kShadowTileSize + 2 * kShadowWindowRadius;
+
+/// the bits of verdict `vis` (1, 0 or -1) of tile column x in a ShadowVerdictRow word.
+PB_HOST_DEVICE inline uint32_t ShadowVerdictBits(int x, int vis) {
+  return vis > 0 ? 1u << x : vis == 0 ? 1u << (kShadowTileSize + x) : 0u;
+}
+
+/// the verdict of tile pixel (x, y) in its tile's bit rows `rows` (kShadowVerdictRows words):
+/// 1, 0 or -1.
+PB_HOST_DEVICE inline int ShadowRowVerdict(const uint32_t* rows, int x, int y) {
+  const uint32_t r = rows[y + kShadowWindowRadius];
+  return (r >> x & 1u) != 0 ? 1 : (r >> (kShadowTileSize + x) & 1u) != 0 ? 0 : -1;
+}
+
+/// whether the window mask `bits` (ShadowWindowBit; cut at the tile's edges) of tile pixel (x,
+/// y) holds a verdict 1 (seen[1]) and a verdict 0 (seen[0]), from the tile's bit rows `rows`:
+/// window row dy's five bits against tile row y + dy shifted so that column x + dx lands on bit
+/// dx + 2. the same booleans as testing the verdict of every set bit in turn.
+PB_HOST_DEVICE inline void ShadowWindowVerdicts(const uint32_t* rows, int x, int y, uint32_t bits,
+                                                bool seen[2]) {
+  constexpr uint32_t kHalf = (1u << kShadowTileSize) - 1u;
+  uint32_t ones = 0, zeros = 0;
+#if defined(__CUDA_ARCH__)
+#pragma unroll
+#endif
+  for (int r = 0; r <= 2 * kShadowWindowRadius; ++r) {
+    const uint32_t w = bits >> (5 * r) & 31u;
+    const uint32_t row = rows[y + r];  // tile row y + r - kShadowWindowRadius
+    ones |= ((row & kHalf) << kShadowWindowRadius >> x) & w;
+    zeros |= ((row >> kShadowTileSize) << kShadowWindowRadius >> x) & w;
+  }
+  seen[1] = ones != 0;
+  seen[0] = zeros != 0;
+}
+
 /// whether tile-local pixel (x, y) lies on its tile's outermost ring (its window lacks the next
 /// tile's half: in a penumbra it traces the whole lattice and keeps its own fraction).
 PB_HOST_DEVICE inline bool OnShadowTileRing(int x, int y, const ShadowTile& t) {

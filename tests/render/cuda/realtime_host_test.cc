@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -387,6 +389,128 @@ TEST(RealtimeHostPathFrames, WindowSumsInIntegersGiveTheFloatSumsBits) {
   EXPECT_EQ(differ_packed, 0);
   EXPECT_EQ(differ_own, 0);
   EXPECT_GT(fractions_seen, 100000);  // the fractions vary: not a comparison of constants
+}
+
+// the staged window of RealtimeKernelOptions::staged_window against main's forms written out
+// here (before branch gpu32): on random 16x16 tiles (cut to 9 .. 16 columns and rows, as the
+// image's edges cut them) of surfaces and of one light's verdicts (-1, 0, 1; a third of the
+// tiles all visible but for misses), every pixel's window mask over the tile's copied surfaces
+// (TileWindowSurfaces) is the mask read from the PixelGeometry records (the old loop:
+// SameShadowSurface on each in-tile neighbour with a hit), and its own verdict and "both
+// verdicts seen" from the tile's bit rows (RowWindowVerdicts: ShadowVerdictBits,
+// ShadowWindowVerdicts) are the old loop's over the int8 verdicts (each set bit in turn),
+// for random windows and for the pixels' own masks. the rows read with one window row's shift
+// off by one column give other booleans (the comparison can fail).
+TEST(RealtimeHostPathFrames, StagedWindowGivesTheSameMasksAndVerdicts) {
+  constexpr int kSide = kShadowTileSize, kPixels = kSide * kSide;
+  std::mt19937 rng(32);
+  std::uniform_int_distribution<int> side(9, kSide), quarter(0, 3), geom(-1, 1), normal(0, 2);
+  std::uniform_real_distribution<float> jitter(-0.05f, 0.05f);
+  std::vector<cuda::PixelGeometry> geometry(kPixels);
+  std::vector<int8_t> vis(kPixels);
+  int32_t key[kPixels];
+  float ng[3][kPixels], pt[3][kPixels];
+  uint32_t rows[kShadowVerdictRows];
+  int64_t mask_differ = 0, own_differ = 0, seen_differ = 0, wrong_differ = 0, both = 0,
+          one_only = 0, partial_masks = 0, checked = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const ShadowTile tile{0, 0, side(rng), side(rng)};
+    const bool all_visible = trial % 3 == 0;
+    for (int k = 0; k < kPixels; ++k) {
+      cuda::PixelGeometry& g = geometry[k];
+      const int x = k % kSide, y = k / kSide;
+      const bool in = x < tile.width && y < tile.height;
+      g.hit = in && quarter(rng) != 0 ? 1 : 0;
+      g.geom = geom(rng);
+      const int a = normal(rng);
+      g.ng = Float3{a == 0 ? 1.0f : jitter(rng), a == 1 ? 1.0f : jitter(rng) * 8,
+                    a == 2 ? 1.0f : jitter(rng)};
+      g.p_or_d = Float3{0.01f * x + jitter(rng) * 0.02f, 0.01f * y, jitter(rng) * 0.01f};
+      const int q = quarter(rng);
+      vis[k] = !in || q == 0 ? int8_t{-1} : all_visible ? int8_t{1} : static_cast<int8_t>(q & 1);
+      key[k] = cuda::TileWindowSurfaces::KeyOf(g);
+      ng[0][k] = g.ng.x, ng[1][k] = g.ng.y, ng[2][k] = g.ng.z;
+      pt[0][k] = g.p_or_d.x, pt[1][k] = g.p_or_d.y, pt[2][k] = g.p_or_d.z;
+    }
+    std::fill(std::begin(rows), std::end(rows), 0u);
+    for (int k = 0; k < kPixels; ++k)
+      rows[kShadowWindowRadius + k / kSide] |= ShadowVerdictBits(k % kSide, vis[k]);
+    const cuda::TileWindowSurfaces staged{key, ng[0], ng[1], ng[2], pt[0], pt[1], pt[2]};
+    for (int y = 0; y < tile.height; ++y)
+      for (int x = 0; x < tile.width; ++x) {
+        const int at = y * kSide + x;
+        // main's window mask: every in-tile neighbour with a hit on the same surface
+        uint32_t want_mask = 0;
+        const cuda::PixelGeometry& gi = geometry[at];
+        if (gi.hit != 0) {
+          const float ng_i[3] = {gi.ng.x, gi.ng.y, gi.ng.z},
+                      p_i[3] = {gi.p_or_d.x, gi.p_or_d.y, gi.p_or_d.z};
+          for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+              if (y + dy < 0 || y + dy >= tile.height || x + dx < 0 || x + dx >= tile.width)
+                continue;
+              const cuda::PixelGeometry& g = geometry[at + dy * kSide + dx];
+              const float ng_g[3] = {g.ng.x, g.ng.y, g.ng.z},
+                          p_g[3] = {g.p_or_d.x, g.p_or_d.y, g.p_or_d.z};
+              if ((dx != 0 || dy != 0) &&
+                  (g.hit == 0 || !SameShadowSurface(gi.geom, ng_i, p_i, g.geom, ng_g, p_g)))
+                continue;
+              want_mask |= 1u << ShadowWindowBit(dx, dy);
+            }
+        }
+        const uint32_t mask = cuda::ShadowWindowMask(staged, at, kSide, x, y, tile);
+        const uint32_t frame_mask = cuda::ShadowWindowMask(
+            cuda::FrameWindowSurfaces{geometry.data()}, at, kSide, x, y, tile);
+        mask_differ += (mask != want_mask) + (frame_mask != want_mask);
+        partial_masks += want_mask != 0 && want_mask != (1u << ShadowWindowBit(0, 0)) &&
+                         __builtin_popcount(want_mask) < 9;
+        // a random window cut to the tile, and the pixel's own mask
+        uint32_t cut = 0;
+        for (int dy = -2; dy <= 2; ++dy)
+          for (int dx = -2; dx <= 2; ++dx)
+            if (y + dy >= 0 && y + dy < tile.height && x + dx >= 0 && x + dx < tile.width)
+              cut |= 1u << ShadowWindowBit(dx, dy);
+        for (const uint32_t bits : {static_cast<uint32_t>(rng()) & cut, want_mask}) {
+          // main's test: each set bit's verdict in turn
+          bool want[2] = {false, false};
+          for (int bit = 0; bit < kShadowWindowTaps; ++bit) {
+            if ((bits >> bit & 1u) == 0) continue;
+            const int8_t w = vis[at + (bit / 5 - 2) * kSide + (bit % 5 - 2)];
+            if (w >= 0) want[w] = true;
+          }
+          const cuda::RowWindowVerdicts r{rows, x, y};
+          bool seen[2];
+          r.Seen(bits, seen);
+          own_differ += r.Own() != vis[at];
+          seen_differ += seen[0] != want[0] || seen[1] != want[1];
+          both += want[0] && want[1];
+          one_only += want[0] != want[1];
+          ++checked;
+          // window row 1 (dy = -1) shifted one column too far
+          uint32_t ones = 0, zeros = 0;
+          for (int wr = 0; wr < 5; ++wr) {
+            const uint32_t w = bits >> (5 * wr) & 31u, row = rows[y + wr];
+            const int shift = wr == 1 ? x + 1 : x;
+            ones |= ((row & 0xffffu) << 2 >> shift) & w;
+            zeros |= ((row >> 16) << 2 >> shift) & w;
+          }
+          wrong_differ += (zeros != 0) != want[0] || (ones != 0) != want[1];
+        }
+      }
+  }
+  EXPECT_EQ(mask_differ, 0);
+  EXPECT_EQ(own_differ, 0);
+  EXPECT_EQ(seen_differ, 0);
+  // not a comparison of constants: windows see both verdicts or one, masks are cut by surfaces
+  EXPECT_GT(both, checked / 10);
+  EXPECT_GT(one_only, checked / 10);
+  EXPECT_GT(partial_masks, checked / 20);
+  EXPECT_GT(wrong_differ, checked / 100);
+  std::printf(
+      "staged window: %lld windows, %lld see both verdicts, %lld one; shift off by one: "
+      "%lld differ\n",
+      static_cast<long long>(checked), static_cast<long long>(both),
+      static_cast<long long>(one_only), static_cast<long long>(wrong_differ));
 }
 
 }  // namespace

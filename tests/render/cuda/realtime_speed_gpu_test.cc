@@ -78,8 +78,10 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "tile_visibility off, tile_penumbra off, fuse_resolve off",
                          "penumbra_chunk_rays 4",
                          "penumbra_chunk_rays 3",
-                         "packed_window_counts off"};
-  for (int k = 0; k < 30; ++k) {
+                         "packed_window_counts off",
+                         "staged_window off",
+                         "window_verdict_rows off"};
+  for (int k = 0; k < 32; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -115,6 +117,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 27) o.penumbra_chunk_rays = 4;
     if (k == 28) o.penumbra_chunk_rays = 3;
     if (k == 29) o.packed_window_counts = false;
+    if (k == 30) o.staged_window = false;
+    if (k == 31) o.window_verdict_rows = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {
@@ -173,7 +177,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, RealtimeSpeedUps,
 
 // the shadow-tile kernels (tile_visibility, tile_penumbra) where the image's edges cut tiles
 // (203 x 141 pixels: the last column and row of tiles 11 and 13 pixels) and the output bands
-// end mid-image: the same radiance, depth and rgb as the kernels of 16x8 pixels.
+// end mid-image: the same radiance, depth and rgb as the kernels of 16x8 pixels (with the
+// staged window, RealtimeKernelOptions::staged_window: the cut tiles' surfaces and bit rows).
 TEST_P(RealtimeSpeedUps, TilesCutAtTheImageEdges) {
   if (!ProbeCudaDevice().available) GTEST_SKIP() << "skipped: no CUDA device";
   const auto [session, snap, view, fx] = realtime_parity::LoadFrameAt(GetParam(), 1.0, 203, 141);
@@ -184,7 +189,8 @@ TEST_P(RealtimeSpeedUps, TilesCutAtTheImageEdges) {
   ASSERT_NE(g, nullptr);
   cuda::RealtimeKernelOptions o = g->device_realtime().options();
   o.output_bands = 3;
-  ASSERT_TRUE(o.tile_visibility && o.tile_penumbra && o.fuse_resolve);
+  ASSERT_TRUE(o.tile_visibility && o.tile_penumbra && o.fuse_resolve && o.staged_window &&
+              o.window_verdict_rows);
   g->device_realtime().set_options(o);
   RenderedFrame tiles;
   gpu->Render(snap, view, &tiles);

@@ -599,6 +599,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.packed_window_counts = false;
     variants.push_back({"kernels, window counts packed at each tap (tile kernel)", o});
+    o = fast;
+    o.window_verdict_rows = false;
+    variants.push_back({"kernels, penumbra tiles' window verdicts bit by bit (no bit rows)", o});
+    o.staged_window = false;
+    variants.push_back({"kernels, penumbra tiles' windows from global memory (no staging)", o});
 
     o = fast;
     o.rows_per_warp = false;

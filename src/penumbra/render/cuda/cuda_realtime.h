@@ -197,6 +197,16 @@ struct RealtimeKernelOptions {
   /// each pixel's window looks for a penumbra (SharedVisibilityPenumbra; frames of at most 128
   /// lights, a batch's too); else blocks of 16x8 pixels reading the frame's verdicts.
   bool tile_penumbra = true;
+  /// with tile_penumbra: the penumbra rays' tile blocks copy each pixel's surface (geom of a
+  /// hit, normal, point: TileWindowSurfaces) into shared memory once, where the window masks
+  /// read their neighbours' (SharedVisibilityWindow; else each pixel's PixelGeometry is read
+  /// from global memory by up to 25 threads). the same masks, so the same bits.
+  bool staged_window = true;
+  /// with staged_window: those blocks keep every light's verdicts as the tile's bit rows (two
+  /// ballots a warp: RowWindowVerdicts, ShadowWindowVerdicts), where a window sees both
+  /// verdicts or not in five shifted rows; else as an int8 copy read at each set bit of the
+  /// window (StridedWindowVerdicts). the same booleans, so the same bits.
+  bool window_verdict_rows = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

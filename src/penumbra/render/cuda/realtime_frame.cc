@@ -557,10 +557,12 @@ namespace {
 
 // the shared visibility of frame f by shadow tiles, as the kernels' blocks with
 // RealtimeKernelOptions::tile_penumbra and tile_visibility (VisibilityRaysWarpKernel,
-// VisibilityTileKernel) do it in shared memory: per tile, every light's verdicts copied for the
-// penumbra rays (SharedVisibilityRays), then light after light its verdicts, ray counts (packed
-// once, ShadowWindowCounts, as RealtimeKernelOptions::packed_window_counts packs them) and
-// fractions (SharedWindowFraction) for the resolve (SharedLampFraction, AddSharedVisibility).
+// VisibilityTileKernel) do it in shared memory: per tile, its surfaces and every light's
+// verdicts as bit rows copied for the penumbra rays (RealtimeKernelOptions::staged_window and
+// window_verdict_rows: TileWindowSurfaces, RowLightVerdicts, SharedVisibilityRaysOf), then light
+// after light its verdicts, ray counts (packed once, ShadowWindowCounts, as
+// RealtimeKernelOptions::packed_window_counts packs them) and fractions (SharedWindowFraction)
+// for the resolve (SharedLampFraction, AddSharedVisibility).
 void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3* radiance) {
   const int W = f.camera.width, H = f.camera.height;
   const int64_t n = static_cast<int64_t>(W) * H;
@@ -574,17 +576,32 @@ void TiledSharedVisibility(const RealtimeFrameView& f, ThreadPool* pool, Float3*
     return u < W && v < H ? static_cast<int64_t>(v) * W + u : -1;
   };
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {
-    std::vector<int8_t> vis(static_cast<size_t>(kTile) * std::max(f.num_lights, 1));
-    for (int j = 0; j < f.num_lights; ++j)
-      for (int t = 0; t < kTile; ++t) {
-        const int64_t i = tile_pixel(tile, t);
-        vis[j * kTile + t] = i < 0 ? int8_t{-1} : f.area_vis[j * n + i];
-      }
+    // the tile's surfaces (TileWindowSurfaces) and every light's verdicts as bit rows
+    // (ShadowVerdictBits), as RealtimeKernelOptions::staged_window and window_verdict_rows
+    // keep them
+    std::vector<uint32_t> rows(static_cast<size_t>(kShadowVerdictRows) * std::max(f.num_lights, 1));
+    int32_t key[kTile];
+    float ng[3][kTile], p[3][kTile];
+    for (int t = 0; t < kTile; ++t) {
+      const int64_t i = tile_pixel(tile, t);
+      key[t] = TileWindowSurfaces::kNoWindowSurface;
+      ng[0][t] = ng[1][t] = ng[2][t] = p[0][t] = p[1][t] = p[2][t] = 0;
+      if (i < 0) continue;
+      const PixelGeometry& g = f.geometry[i];
+      key[t] = TileWindowSurfaces::KeyOf(g);
+      ng[0][t] = g.ng.x, ng[1][t] = g.ng.y, ng[2][t] = g.ng.z;
+      p[0][t] = g.p_or_d.x, p[1][t] = g.p_or_d.y, p[2][t] = g.p_or_d.z;
+      for (int j = 0; j < f.num_lights; ++j)
+        rows[j * kShadowVerdictRows + kShadowWindowRadius + t / kShadowTileSize] |=
+            ShadowVerdictBits(t % kShadowTileSize, f.area_vis[j * n + i]);
+    }
+    const TileWindowSurfaces surfaces{key, ng[0], ng[1], ng[2], p[0], p[1], p[2]};
     for (int t = 0; t < kTile; ++t) {
       const int64_t i = tile_pixel(tile, t);
       if (i >= 0)
-        SharedVisibilityRays(f, static_cast<int>(i % W), static_cast<int>(i / W), vis.data(), kTile,
-                             t, kShadowTileSize);
+        SharedVisibilityRaysOf(
+            f, static_cast<int>(i % W), static_cast<int>(i / W), surfaces, t, kShadowTileSize,
+            RowLightVerdicts{rows.data(), t % kShadowTileSize, t / kShadowTileSize});
     }
   });
   ParallelForOrSerial(pool, int64_t{tiles_x} * tiles_y, [&](int64_t tile) {

@@ -554,12 +554,15 @@ __global__ void VisibilityChunkKernel(Frames frames, PenumbraQueue q) {
   }
 }
 
-// the most lights whose verdicts VisibilityRaysWarpKernel<..., true> keeps in shared memory
-// (TilePenumbraBytes: 32 KiB, under the 48 KiB a kernel gets without asking); frames with more
-// take the kernel of 128 threads a block.
+// the most lights whose verdicts VisibilityRaysWarpKernel<..., true, ...> keeps in shared
+// memory (TilePenumbraBytes: 32 KiB, under the 48 KiB a kernel gets without asking); frames
+// with more take the kernel of 128 threads a block.
 constexpr int kMaxTilePenumbraLights = 128;
-inline size_t TilePenumbraBytes(int lights) {
-  return static_cast<size_t>(std::max(lights, 1)) * kTilePixels;
+// the dynamic shared memory of the tile kernel: every light's int8 verdicts of the tile, or
+// with `rows` their bit rows (kShadowVerdictRows words a light, 80 bytes instead of 256).
+inline size_t TilePenumbraBytes(int lights, bool rows) {
+  return static_cast<size_t>(std::max(lights, 1)) *
+         (rows ? sizeof(uint32_t) * kShadowVerdictRows : kTilePixels);
 }
 
 // VisibilityChunkKernel's grid: as many blocks of 128 threads as the device holds at once.
@@ -580,10 +583,26 @@ unsigned ChunkBlocks() {
 // (kTileBlock, 2 blocks an SM at 128 registers) first copies every light's verdicts of its tile
 // into its dynamic shared memory (TilePenumbraBytes of it), where the pixels' windows, cut at the
 // tile's edges, find their neighbours' (SharedVisibilityPenumbra's vis_j: the same values).
-template <class Frames, bool kTile>
+// kStaged (with kTile; RealtimeKernelOptions::staged_window): each thread also copies its own
+// pixel's surface (TileWindowSurfaces: geom of a hit, normal, point) into shared memory, where
+// the window masks read their 24 neighbours' (instead of up to 25 threads reading each pixel's
+// PixelGeometry from global memory). kRows (with kStaged; RealtimeKernelOptions::
+// window_verdict_rows): each warp (two tile rows of 16 pixels) puts a light's verdicts into the
+// tile's bit rows with two ballots (ShadowVerdictBits' layout) instead of the int8 copy, where a
+// window's "both verdicts seen" is five shifted rows (RowWindowVerdicts) instead of a shared
+// int8 read per set bit. the same masks and booleans, so the same bits.
+template <class Frames, bool kTile, bool kStaged, bool kRows>
 __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
     VisibilityRaysWarpKernel(Frames frames, PenumbraQueue q) {
-  extern __shared__ int8_t tile_vis[];
+  static_assert(kTile || !kStaged, "the staged window works a tile at a time");
+  static_assert(kStaged || !kRows, "the bit rows come with the staged window");
+  extern __shared__ uint32_t tile_shared[];
+  constexpr int kSurfaces = kStaged ? kTilePixels : 1;
+  __shared__ int32_t key[kSurfaces];
+  __shared__ float ng_x[kSurfaces], ng_y[kSurfaces], ng_z[kSurfaces], p_x[kSurfaces],
+      p_y[kSurfaces], p_z[kSurfaces];
+  int8_t* const tile_vis = reinterpret_cast<int8_t*>(tile_shared);
+  uint32_t* const tile_rows = tile_shared;
   const RealtimeFrameView& f = frames.get();
   const FramePixel p = PixelOf(f);
   const int u = p.u, v = p.v;
@@ -593,15 +612,54 @@ __global__ void __launch_bounds__(kTile ? kTilePixels : 128, kTile ? 2 : 4)
   const int lane = t & 31;
   const int64_t n = static_cast<int64_t>(W) * H;
   const int64_t i = p.i;
-  if constexpr (kTile) {
+  if constexpr (kStaged) {
+    // this pixel's surface
+    key[t] = TileWindowSurfaces::kNoWindowSurface;
+    if (inside) {
+      const PixelGeometry& g = f.geometry[i];
+      key[t] = TileWindowSurfaces::KeyOf(g);
+      ng_x[t] = g.ng.x, ng_y[t] = g.ng.y, ng_z[t] = g.ng.z;
+      p_x[t] = g.p_or_d.x, p_y[t] = g.p_or_d.y, p_z[t] = g.p_or_d.z;
+    }
+  }
+  if constexpr (kRows) {
+    // every light's verdicts as bit rows: warp w holds tile rows 2w (lanes 0-15) and 2w + 1
+    // (lanes 16-31); the two words above and below the tile stay 0
+    const int row = kShadowWindowRadius + 2 * (t >> 5);
+#pragma unroll 4
+    for (int j = 0; j < f.num_lights; ++j) {
+      const int vis = inside ? f.area_vis[j * n + i] : -1;
+      const uint32_t ones = __ballot_sync(kFullWarp, vis > 0);
+      const uint32_t zeros = __ballot_sync(kFullWarp, vis == 0);
+      uint32_t* const rows = tile_rows + j * kShadowVerdictRows;
+      if (lane == 0) {
+        rows[row] = (ones & 0xffffu) | zeros << kShadowTileSize;
+        rows[row + 1] = ones >> kShadowTileSize | (zeros & 0xffff0000u);
+      }
+      if (t < 2 * kShadowWindowRadius) rows[t < kShadowWindowRadius ? t : kShadowTileSize + t] = 0u;
+    }
+    __syncthreads();
+  } else if constexpr (kTile) {
     for (int j = 0; j < f.num_lights; ++j)
       tile_vis[j * kTilePixels + t] = inside ? f.area_vis[j * n + i] : int8_t{-1};
     __syncthreads();
   }
-  const uint32_t bits = inside ? SharedVisibilityWindow(f, u, v) : 0u;
+  uint32_t bits = 0;
+  if (inside) {
+    if constexpr (kStaged)
+      bits = SharedVisibilityWindow(
+          f, u, v, TileWindowSurfaces{key, ng_x, ng_y, ng_z, p_x, p_y, p_z}, t, kShadowTileSize);
+    else
+      bits = SharedVisibilityWindow(f, u, v);
+  }
   for (int j = 0; j < f.num_lights; ++j) {
     PenumbraRays job;
-    if (inside && kTile)
+    if (inside && kRows)
+      job = SharedVisibilityPenumbraOf(
+          f, u, v, j, bits,
+          RowWindowVerdicts{tile_rows + j * kShadowVerdictRows, static_cast<int>(threadIdx.x),
+                            static_cast<int>(threadIdx.y)});
+    else if (inside && kTile)
       job = SharedVisibilityPenumbra(f, u, v, j, bits, tile_vis + j * kTilePixels, t,
                                      kShadowTileSize);
     else if (inside)
@@ -954,7 +1012,8 @@ struct PixelBuffers {
   // lights fit: kMaxTilePenumbraLights).
   template <class Frames>
   void LaunchPenumbraRays(Frames frames, int W, int H, int lights, int64_t nl, int cameras,
-                          bool queue, int chunk_rays, bool tile, cudaStream_t stream) const {
+                          bool queue, int chunk_rays, bool tile, bool staged, bool rows,
+                          cudaStream_t stream) const {
     PenumbraQueue q;
     if (queue) {
       q.queue = penumbra_queue.as<PenumbraChunk>();
@@ -968,12 +1027,20 @@ struct PixelBuffers {
     if (tile && lights <= kMaxTilePenumbraLights) {
       dim3 grid = TileGrid(W, 0, H);
       grid.z = cameras;
-      VisibilityRaysWarpKernel<Frames, true>
-          <<<grid, kTileBlock, TilePenumbraBytes(lights), stream>>>(frames, q);
+      if (staged && rows)
+        VisibilityRaysWarpKernel<Frames, true, true, true>
+            <<<grid, kTileBlock, TilePenumbraBytes(lights, true), stream>>>(frames, q);
+      else if (staged)
+        VisibilityRaysWarpKernel<Frames, true, true, false>
+            <<<grid, kTileBlock, TilePenumbraBytes(lights, false), stream>>>(frames, q);
+      else
+        VisibilityRaysWarpKernel<Frames, true, false, false>
+            <<<grid, kTileBlock, TilePenumbraBytes(lights, false), stream>>>(frames, q);
     } else {
       dim3 grid = PixelGrid(W, H);
       grid.z = cameras;
-      VisibilityRaysWarpKernel<Frames, false><<<grid, kPixelBlock, 0, stream>>>(frames, q);
+      VisibilityRaysWarpKernel<Frames, false, false, false>
+          <<<grid, kPixelBlock, 0, stream>>>(frames, q);
     }
     Check(cudaGetLastError(), "VisibilityRaysWarpKernel");
     if (!queue) return;
@@ -1499,7 +1566,8 @@ struct DeviceRealtime::Impl : PixelBuffers {
     if (o.warp_penumbra || o.queue_penumbra) {
       LaunchPenumbraRays(OneFrame{f}, W, H, f.num_lights,
                          static_cast<int64_t>(W) * H * f.num_lights, 1, o.queue_penumbra,
-                         o.penumbra_chunk_rays, o.tile_penumbra, stream);
+                         o.penumbra_chunk_rays, o.tile_penumbra, o.staged_window,
+                         o.window_verdict_rows, stream);
     } else {
       VisibilityRaysKernel<<<grid, kPixelBlock, 0, stream>>>(f);
       Check(cudaGetLastError(), "VisibilityRaysKernel");
@@ -2321,7 +2389,8 @@ void RealtimeBatch::Launch(const RealtimeFrameView* frames, const RealtimeBatchF
   // kPenumbraChunkRays rays (many cameras fill the device: fewer, longer chunks)
   const RealtimeKernelOptions defaults;
   m.LaunchPenumbraRays(fr, W, H, m.lights, nl, count, /*queue=*/true, kPenumbraChunkRays,
-                       defaults.tile_penumbra, stream);
+                       defaults.tile_penumbra, defaults.staged_window, defaults.window_verdict_rows,
+                       stream);
   if (defaults.tile_visibility) {
     dim3 tiles = TileGrid(W, 0, H);
     tiles.z = count;

@@ -1177,37 +1177,131 @@ struct PenumbraRays {
   float visible = 0;   ///< the pixel's own verdict (f.area_vis: 1 visible, 0 occluded)
 };
 
-/// the shared visibility, step 1 of 3, first part: pixel (u, v)'s window mask (the pixels of
-/// its 5x5 window, cut at its tile's edges, on its surface, ShadowWindowBit), written to
-/// f.window and returned.
-PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f, int u, int v) {
-  const int W = f.camera.width, H = f.camera.height;
-  const int64_t i = static_cast<int64_t>(v) * W + u;
-  const ShadowTile tile = ShadowTileOf(u, v, W, H);
-  const int x = u - tile.x0, y = v - tile.y0;
-  const PixelGeometry& gi = f.geometry[i];
+/// the pixels' surfaces as the window masks read them (ShadowWindowMask): the frame's
+/// PixelGeometry records at k.
+struct FrameWindowSurfaces {
+  const PixelGeometry* geometry = nullptr;
+  /// whether the pixel at k has a hit.
+  PB_HOST_DEVICE bool Hit(int64_t k) const { return geometry[k].hit != 0; }
+  /// the geom of the pixel at k (which has a hit).
+  PB_HOST_DEVICE int Geom(int64_t k) const { return geometry[k].geom; }
+  /// the unit geometric normal and the hit point of the pixel at k (which has a hit).
+  PB_HOST_DEVICE void Surface(int64_t k, float ng[3], float p[3]) const {
+    const PixelGeometry& g = geometry[k];
+    ng[0] = g.ng.x, ng[1] = g.ng.y, ng[2] = g.ng.z;
+    p[0] = g.p_or_d.x, p[1] = g.p_or_d.y, p[2] = g.p_or_d.z;
+  }
+};
+
+/// a shadow tile's copy of the surfaces FrameWindowSurfaces reads (the GPU's
+/// VisibilityRaysWarpKernel with RealtimeKernelOptions::staged_window: shared memory, one
+/// entry a tile pixel, structure of arrays): key the geom of a hit, kNoWindowSurface where
+/// the pixel has none (a miss or outside the image); the normal and point of a hit.
+struct TileWindowSurfaces {
+  static constexpr int32_t kNoWindowSurface = INT32_MIN;  ///< the key of a pixel without a hit
+  const int32_t* key = nullptr;                           ///< a key a tile pixel
+  const float *ng_x = nullptr, *ng_y = nullptr, *ng_z = nullptr;  ///< unit normals (world)
+  const float *p_x = nullptr, *p_y = nullptr, *p_z = nullptr;     ///< hit points, m (world)
+  /// the key of `g` (its geom where it has a hit, else kNoWindowSurface).
+  PB_HOST_DEVICE static int32_t KeyOf(const PixelGeometry& g) {
+    return g.hit != 0 ? g.geom : kNoWindowSurface;
+  }
+  /// whether the pixel at k has a hit.
+  PB_HOST_DEVICE bool Hit(int64_t k) const { return key[k] != kNoWindowSurface; }
+  /// the geom of the pixel at k (which has a hit).
+  PB_HOST_DEVICE int Geom(int64_t k) const { return key[k]; }
+  /// the unit geometric normal and the hit point of the pixel at k (which has a hit).
+  PB_HOST_DEVICE void Surface(int64_t k, float ng[3], float p[3]) const {
+    ng[0] = ng_x[k], ng[1] = ng_y[k], ng[2] = ng_z[k];
+    p[0] = p_x[k], p[1] = p_y[k], p[2] = p_z[k];
+  }
+};
+
+/// the window mask of tile-local pixel (x, y) of `tile` (the pixels of its 5x5 window, cut at
+/// the tile's edges, on its surface: SameShadowSurface, ShadowWindowBit) whose surface is at
+/// `at` of `s` (FrameWindowSurfaces or TileWindowSurfaces: Hit, Geom, Surface), its neighbour
+/// (dx, dy) at at + dy stride + dx. 0 where the pixel has no hit.
+template <class Surfaces>
+PB_HOST_DEVICE inline uint32_t ShadowWindowMask(const Surfaces& s, int64_t at, int64_t stride,
+                                                int x, int y, const ShadowTile& tile) {
+  if (!s.Hit(at)) return 0;
+  float ng_i[3], p_i[3];
+  s.Surface(at, ng_i, p_i);
+  const int geom_i = s.Geom(at);
   uint32_t bits = 0;
-  if (gi.hit != 0) {
-    const float ng_i[3] = {gi.ng.x, gi.ng.y, gi.ng.z},
-                p_i[3] = {gi.p_or_d.x, gi.p_or_d.y, gi.p_or_d.z};
-    for (int dy = -kShadowWindowRadius; dy <= kShadowWindowRadius; ++dy) {
-      if (y + dy < 0 || y + dy >= tile.height) continue;
-      for (int dx = -kShadowWindowRadius; dx <= kShadowWindowRadius; ++dx) {
-        if (x + dx < 0 || x + dx >= tile.width) continue;
-        const int64_t ii = i + static_cast<int64_t>(dy) * W + dx;
-        if (ii != i) {
-          const PixelGeometry& g = f.geometry[ii];
-          const float ng_g[3] = {g.ng.x, g.ng.y, g.ng.z},
-                      p_g[3] = {g.p_or_d.x, g.p_or_d.y, g.p_or_d.z};
-          if (g.hit == 0 || !SameShadowSurface(gi.geom, ng_i, p_i, g.geom, ng_g, p_g)) continue;
-        }
-        bits |= 1u << ShadowWindowBit(dx, dy);
+  for (int dy = -kShadowWindowRadius; dy <= kShadowWindowRadius; ++dy) {
+    if (y + dy < 0 || y + dy >= tile.height) continue;
+    for (int dx = -kShadowWindowRadius; dx <= kShadowWindowRadius; ++dx) {
+      if (x + dx < 0 || x + dx >= tile.width) continue;
+      const int64_t kk = at + static_cast<int64_t>(dy) * stride + dx;
+      if (kk != at) {
+        if (!s.Hit(kk)) continue;
+        float ng_g[3], p_g[3];
+        s.Surface(kk, ng_g, p_g);
+        if (!SameShadowSurface(geom_i, ng_i, p_i, s.Geom(kk), ng_g, p_g)) continue;
       }
+      bits |= 1u << ShadowWindowBit(dx, dy);
     }
   }
-  f.window[i] = bits;
   return bits;
 }
+
+/// the shared visibility, step 1 of 3, first part: pixel (u, v)'s window mask (ShadowWindowMask)
+/// with its surface at `at` of `s` (a tile's copy: TileWindowSurfaces, stride
+/// kShadowTileSize), written to f.window and returned.
+template <class Surfaces>
+PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f, int u, int v,
+                                                      const Surfaces& s, int64_t at,
+                                                      int64_t stride) {
+  const int W = f.camera.width, H = f.camera.height;
+  const ShadowTile tile = ShadowTileOf(u, v, W, H);
+  const uint32_t bits = ShadowWindowMask(s, at, stride, u - tile.x0, v - tile.y0, tile);
+  f.window[static_cast<int64_t>(v) * W + u] = bits;
+  return bits;
+}
+
+/// SharedVisibilityWindow with the surfaces read from the frame's f.geometry.
+PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f, int u, int v) {
+  return SharedVisibilityWindow(f, u, v, FrameWindowSurfaces{f.geometry},
+                                static_cast<int64_t>(v) * f.camera.width + u, f.camera.width);
+}
+
+/// a light's verdicts around a pixel as SharedVisibilityPenumbra reads them: the pixel's own at
+/// vis[at], its window neighbour (dx, dy)'s at vis[at + dy stride + dx] (the frame's f.area_vis
+/// + j n, or a tile's int8 copy).
+struct StridedWindowVerdicts {
+  const int8_t* vis = nullptr;  ///< 1 visible, 0 occluded, -1 none traced
+  int64_t at = 0;               ///< the pixel's own entry
+  int64_t stride = 0;           ///< the entries of one row (the image's width, or 16)
+  /// the pixel's own verdict: 1, 0 or -1.
+  PB_HOST_DEVICE int Own() const { return vis[at]; }
+  /// whether the window mask `bits` holds a verdict 1 (seen[1]) and 0 (seen[0]): each set bit's
+  /// verdict in turn.
+  PB_HOST_DEVICE void Seen(uint32_t bits, bool seen[2]) const {
+    seen[0] = seen[1] = false;
+    for (uint32_t b = bits; b != 0; b &= b - 1) {
+      const int bit = LowestSetBit(b);
+      const int8_t w = vis[at + static_cast<int64_t>(bit / 5 - 2) * stride + (bit % 5 - 2)];
+      if (w >= 0) seen[w] = true;
+    }
+  }
+};
+
+/// a light's verdicts of a shadow tile as bit rows (kShadowVerdictRows words,
+/// render/shadow_window_math.h; the GPU's VisibilityRaysWarpKernel with
+/// RealtimeKernelOptions::window_verdict_rows: shared memory) around tile pixel (x, y): the
+/// same values as StridedWindowVerdicts over the tile.
+struct RowWindowVerdicts {
+  const uint32_t* rows = nullptr;  ///< kShadowVerdictRows words (ShadowVerdictBits)
+  int x = 0, y = 0;                ///< the pixel in its tile (column, row)
+  /// the pixel's own verdict: 1, 0 or -1 (ShadowRowVerdict).
+  PB_HOST_DEVICE int Own() const { return ShadowRowVerdict(rows, x, y); }
+  /// whether the window mask `bits` holds a verdict 1 (seen[1]) and 0 (seen[0])
+  /// (ShadowWindowVerdicts: five shifted rows).
+  PB_HOST_DEVICE void Seen(uint32_t bits, bool seen[2]) const {
+    ShadowWindowVerdicts(rows, x, y, bits, seen);
+  }
+};
 
 /// the shared visibility, step 1 of 3, second part: light j's penumbra rays at pixel (u, v)
 /// whose window mask is `bits` (SharedVisibilityWindow). inactive (active 0) where the pixel
@@ -1216,13 +1310,12 @@ PB_HOST_DEVICE inline uint32_t SharedVisibilityWindow(const RealtimeFrameView& f
 /// (PenumbraLatticePoints, render/lamp_math.h, as the CPU's ResolveSharedVisibility): on a
 /// tile's outer ring the pixel's own points - 1 more (f.area_own set: that pixel keeps its own
 /// fraction), else max(1, points / kLightStrata) - 1 more after its first. writes f.area_own.
-/// the window's verdicts of light j are read at vis[at + dy stride + dx] (the pixel's own at
-/// vis[at]): f.area_vis + j n with at the pixel's index and stride the image's width, or a
-/// tile's copy (the GPU's VisibilityRaysWarpKernel with tile_penumbra: shared memory).
-PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
-                                                            int v, int j, uint32_t bits,
-                                                            const int8_t* vis_j, int64_t at,
-                                                            int64_t stride) {
+/// the window's verdicts of light j come from `w` (Own, Seen): StridedWindowVerdicts over the
+/// frame's f.area_vis or a tile's copy, or RowWindowVerdicts over a tile's bit rows.
+template <class Verdicts>
+PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbraOf(const RealtimeFrameView& f, int u,
+                                                              int v, int j, uint32_t bits,
+                                                              const Verdicts& w) {
   const int W = f.camera.width, H = f.camera.height;
   const int64_t n = static_cast<int64_t>(W) * H;
   const int64_t i = static_cast<int64_t>(v) * W + u;
@@ -1230,16 +1323,12 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
   PenumbraRays job;
   f.area_own[k] = 0;
   if (!IsExtendedLightPod(f.lights[j])) return job;
-  const int8_t vis = vis_j[at];
+  const int vis = w.Own();
   if (vis < 0) return job;
   job.active = 1;
   job.visible = static_cast<float>(vis);
-  bool seen[2] = {false, false};
-  for (uint32_t b = bits; b != 0; b &= b - 1) {
-    const int bit = LowestSetBit(b);
-    const int8_t w = vis_j[at + static_cast<int64_t>(bit / 5 - 2) * stride + (bit % 5 - 2)];
-    if (w >= 0) seen[w] = true;
-  }
+  bool seen[2];
+  w.Seen(bits, seen);
   if (!(seen[0] && seen[1])) return job;
   const ShadowTile tile = ShadowTileOf(u, v, W, H);
   const bool own = OnShadowTileRing(u - tile.x0, v - tile.y0, tile);
@@ -1255,6 +1344,16 @@ PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameV
   job.extra = own ? points : shared;
   job.own = own ? 1 : 0;
   return job;
+}
+
+/// SharedVisibilityPenumbraOf with the window's verdicts of light j read at vis_j[at + dy stride
+/// + dx] (the pixel's own at vis_j[at]): f.area_vis + j n with at the pixel's index and stride
+/// the image's width, or a tile's copy (StridedWindowVerdicts).
+PB_HOST_DEVICE inline PenumbraRays SharedVisibilityPenumbra(const RealtimeFrameView& f, int u,
+                                                            int v, int j, uint32_t bits,
+                                                            const int8_t* vis_j, int64_t at,
+                                                            int64_t stride) {
+  return SharedVisibilityPenumbraOf(f, u, v, j, bits, StridedWindowVerdicts{vis_j, at, stride});
 }
 
 /// SharedVisibilityPenumbra with the window's verdicts read from the frame's f.area_vis.
@@ -1301,22 +1400,44 @@ PB_HOST_DEVICE inline void CountPenumbraRays(const RealtimeFrameView& f, int j,
   }
 }
 
+/// the window's verdicts of every light as SharedVisibilityRaysOf takes them: light j's at
+/// vis + j light_stride around `at` (StridedWindowVerdicts).
+struct StridedLightVerdicts {
+  const int8_t* vis = nullptr;
+  int64_t light_stride = 0, at = 0, stride = 0;
+  /// light j's verdicts.
+  PB_HOST_DEVICE StridedWindowVerdicts operator()(int j) const {
+    return StridedWindowVerdicts{vis + j * light_stride, at, stride};
+  }
+};
+
+/// every light's bit rows of a shadow tile (kShadowVerdictRows words each, light after light)
+/// around tile pixel (x, y) as SharedVisibilityRaysOf takes them (RowWindowVerdicts).
+struct RowLightVerdicts {
+  const uint32_t* rows = nullptr;
+  int x = 0, y = 0;
+  /// light j's verdicts.
+  PB_HOST_DEVICE RowWindowVerdicts operator()(int j) const {
+    return RowWindowVerdicts{rows + j * kShadowVerdictRows, x, y};
+  }
+};
+
 /// the shared visibility, step 1 of 3 (after ShadeRealtimePixel at every pixel): pixel (u,
-/// v)'s window mask (SharedVisibilityWindow) and, per light with an extent, its penumbra rays
-/// in order (SharedVisibilityPenumbra, PenumbraRayVerdict); f.area_visible, f.area_rays: the
-/// pixel's visible and traced rays (its own verdict included). the window's verdicts of light j
-/// are read at vis + j light_stride (SharedVisibilityPenumbra's vis_j, at and stride): the
-/// frame's f.area_vis, or a tile's copy. the GPU's VisibilityRaysWarpKernel spreads a warp's
-/// penumbra rays over its lanes and sums the same integer counts.
-PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v,
-                                                const int8_t* vis, int64_t light_stride, int64_t at,
-                                                int64_t stride) {
+/// v)'s window mask (SharedVisibilityWindow over the surfaces `s` at `at`, `stride`) and, per
+/// light with an extent, its penumbra rays in order (SharedVisibilityPenumbraOf over light j's
+/// verdicts `verdicts(j)`: StridedLightVerdicts or RowLightVerdicts; PenumbraRayVerdict);
+/// f.area_visible, f.area_rays: the pixel's visible and traced rays (its own verdict
+/// included). the GPU's VisibilityRaysWarpKernel spreads a warp's penumbra rays over its lanes
+/// and sums the same integer counts.
+template <class Surfaces, class LightVerdicts>
+PB_HOST_DEVICE inline void SharedVisibilityRaysOf(const RealtimeFrameView& f, int u, int v,
+                                                  const Surfaces& s, int64_t at, int64_t stride,
+                                                  const LightVerdicts& verdicts) {
   const int64_t n = static_cast<int64_t>(f.camera.width) * f.camera.height;
   const int64_t i = static_cast<int64_t>(v) * f.camera.width + u;
-  const uint32_t bits = SharedVisibilityWindow(f, u, v);
+  const uint32_t bits = SharedVisibilityWindow(f, u, v, s, at, stride);
   for (int j = 0; j < f.num_lights; ++j) {
-    const PenumbraRays job =
-        SharedVisibilityPenumbra(f, u, v, j, bits, vis + j * light_stride, at, stride);
+    const PenumbraRays job = SharedVisibilityPenumbraOf(f, u, v, j, bits, verdicts(j));
     if (job.active == 0) continue;
     int traced, visible;
     CountPenumbraRays(f, j, job, 1, job.extra, &traced, &visible);
@@ -1324,6 +1445,17 @@ PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int 
     f.area_visible[j * n + i] = job.visible + static_cast<float>(visible);
     f.area_rays[j * n + i] = 1.0f + static_cast<float>(traced);
   }
+}
+
+/// SharedVisibilityRaysOf with the surfaces of the frame's f.geometry and the window's verdicts
+/// of light j read at vis + j light_stride (SharedVisibilityPenumbra's vis_j, at and stride):
+/// the frame's f.area_vis, or a tile's copy.
+PB_HOST_DEVICE inline void SharedVisibilityRays(const RealtimeFrameView& f, int u, int v,
+                                                const int8_t* vis, int64_t light_stride, int64_t at,
+                                                int64_t stride) {
+  SharedVisibilityRaysOf(f, u, v, FrameWindowSurfaces{f.geometry},
+                         static_cast<int64_t>(v) * f.camera.width + u, f.camera.width,
+                         StridedLightVerdicts{vis, light_stride, at, stride});
 }
 
 /// SharedVisibilityRays with the window's verdicts read from the frame's f.area_vis.
