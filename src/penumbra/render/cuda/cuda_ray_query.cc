@@ -53,8 +53,12 @@ void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHi
     if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
   }
   std::vector<TraceHit> out(rays.size());
-  const std::lock_guard<std::mutex> lock(mutex_);
-  device_->Trace(in.data(), static_cast<int64_t>(in.size()), out.data());
+  // one batch at a time on the device; the hits are finished outside the lock, so that the
+  // threads of a parallel caller (the sky irradiance volume's build) finish theirs together
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    device_->Trace(in.data(), static_cast<int64_t>(in.size()), out.data());
+  }
   for (size_t i = 0; i < rays.size(); ++i) {
     did_hit[i] = out[i].instance >= 0;
     if (did_hit[i]) bvh_->FinishHit(rays[i], out[i], &hits[i]);
@@ -68,8 +72,10 @@ void CudaRayQuery::OccludedBatch(std::span<const Ray> rays, std::span<bool> occl
     if (!IsTraceableRay(rays[i])) in[i] = {{0, 0, 0}, {0, 0, 1}, 1, 0};
   }
   std::vector<uint8_t> out(rays.size());
-  const std::lock_guard<std::mutex> lock(mutex_);
-  device_->Occluded(in.data(), static_cast<int64_t>(in.size()), out.data());
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    device_->Occluded(in.data(), static_cast<int64_t>(in.size()), out.data());
+  }
   for (size_t i = 0; i < rays.size(); ++i) occluded[i] = out[i] != 0;
 }
 
