@@ -3,22 +3,16 @@
 // mixing of mip levels, ray-cone level of detail, anisotropic taps, cube-map faces), shared by
 // MaterialEvaluator on the CPU and the CUDA kernels. a level is read through a plain view of its
 // 8-bit sRGB texels; texels are decoded to linear through a 256-entry table (SrgbDecodeTable).
-// the lookups take the texel's size in bytes as a template argument: 3 (rgb, TextureLevel's
-// rgb_srgb: MaterialEvaluator) or 4 (rgb and one unused byte: the CUDA backend's texels,
-// RealtimeFrame, where the GPU reads a texel in one 32-bit load); the same decoded values, so
-// the same bits.
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 #include "penumbra/core/host_device.h"
 #include "penumbra/render/shading_math.h"
 
 namespace penumbra {
 
-/// one mip level of a texture: width x height (x faces) texels of 3 sRGB-encoded bytes (r, g, b;
-/// the lookups' kTexelBytes 3) or 4 (r, g, b and an unused byte; kTexelBytes 4, 4-aligned),
+/// one mip level of a texture: width x height (x faces) texels of 3 sRGB-encoded bytes,
 /// row-major (cube textures: the six faces stacked, each width x width).
 struct TextureLevelView {
   const uint8_t* rgb = nullptr;
@@ -57,48 +51,11 @@ PB_HOST_DEVICE inline WrappedTexels WrapTexels(float s, float t, int w, int h) {
   return q;
 }
 
-/// the sRGB bytes (r, g, b) of a texel.
-struct TexelBytes {
-  int r, g, b;
-};
-
-/// the texel at q, kTexelBytes (3 or 4) bytes a texel: a 4-byte texel in one 32-bit load (q
-/// 4-aligned; on the GPU through the read-only cache; r in the low byte: little-endian, as x86-64
-/// and the GPU), a 3-byte one byte by byte.
-template <int kTexelBytes>
-PB_HOST_DEVICE inline TexelBytes LoadTexel(const uint8_t* q) {
-  static_assert(kTexelBytes == 3 || kTexelBytes == 4, "texels are 3 or 4 bytes");
-  if constexpr (kTexelBytes == 4) {
-#if defined(__CUDA_ARCH__)
-    const unsigned int v = __ldg(reinterpret_cast<const unsigned int*>(q));
-#else
-    unsigned int v;
-    std::memcpy(&v, q, sizeof v);
-#endif
-    return TexelBytes{static_cast<int>(v & 0xffu), static_cast<int>((v >> 8) & 0xffu),
-                      static_cast<int>((v >> 16) & 0xffu)};
-  } else {
-    return TexelBytes{q[0], q[1], q[2]};
-  }
-}
-
-/// entry i of the 256-entry sRGB decode table: on the GPU through the read-only cache.
-PB_HOST_DEVICE inline float DecodeSrgb(const float* decode, int i) {
-#if defined(__CUDA_ARCH__)
-  return __ldg(decode + i);
-#else
-  return decode[i];
-#endif
-}
-
-/// the decoded linear rgb of texel (xi, yi) of a row-major level `w` texels wide, kTexelBytes
-/// bytes a texel.
-template <int kTexelBytes = 3>
+/// the decoded linear rgb of texel (xi, yi) of a row-major level `w` texels wide.
 PB_HOST_DEVICE inline Float3 DecodeTexel(const uint8_t* p, int w, const float* decode, int xi,
                                          int yi) {
-  const TexelBytes c =
-      LoadTexel<kTexelBytes>(p + (static_cast<int64_t>(yi) * w + xi) * kTexelBytes);
-  return Float3{DecodeSrgb(decode, c.r), DecodeSrgb(decode, c.g), DecodeSrgb(decode, c.b)};
+  const uint8_t* q = p + (static_cast<int64_t>(yi) * w + xi) * 3;
+  return Float3{decode[q[0]], decode[q[1]], decode[q[2]]};
 }
 
 /// bilinear mix of four texels by the fractions fx, fy.
@@ -107,22 +64,19 @@ PB_HOST_DEVICE inline Float3 BilinearMix(const Float3& a00, const Float3& a10, c
   return (1 - fy) * ((1 - fx) * a00 + fx * a10) + fy * ((1 - fx) * a01 + fx * a11);
 }
 
-/// bilinear lookup in one level, wrapped; (s, t) in images (1 = one image). kTexelBytes: the
-/// level's bytes a texel (TextureLevelView).
-template <int kTexelBytes = 3>
+/// bilinear lookup in one level, wrapped; (s, t) in images (1 = one image).
 PB_HOST_DEVICE inline Float3 BilinearWrap(const TextureLevelView& L, const float* decode, float s,
                                           float t) {
   const WrappedTexels q = WrapTexels(s, t, L.width, L.height);
   const int w = L.width;
-  return BilinearMix(DecodeTexel<kTexelBytes>(L.rgb, w, decode, q.x0, q.y0),
-                     DecodeTexel<kTexelBytes>(L.rgb, w, decode, q.x1, q.y0),
-                     DecodeTexel<kTexelBytes>(L.rgb, w, decode, q.x0, q.y1),
-                     DecodeTexel<kTexelBytes>(L.rgb, w, decode, q.x1, q.y1), q.fx, q.fy);
+  return BilinearMix(DecodeTexel(L.rgb, w, decode, q.x0, q.y0),
+                     DecodeTexel(L.rgb, w, decode, q.x1, q.y0),
+                     DecodeTexel(L.rgb, w, decode, q.x0, q.y1),
+                     DecodeTexel(L.rgb, w, decode, q.x1, q.y1), q.fx, q.fy);
 }
 
 /// bilinear lookup in face `face` of one level of a cube texture, clamped to the face; (s, t)
-/// in [0, 1]. kTexelBytes: BilinearWrap's.
-template <int kTexelBytes = 3>
+/// in [0, 1].
 PB_HOST_DEVICE inline Float3 BilinearFace(const TextureLevelView& L, const float* decode, int face,
                                           float s, float t) {
   const int w = L.width;
@@ -131,11 +85,9 @@ PB_HOST_DEVICE inline Float3 BilinearFace(const TextureLevelView& L, const float
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
   const int x1 = x0 + 1 < w - 1 ? x0 + 1 : w - 1, y1 = y0 + 1 < w - 1 ? y0 + 1 : w - 1;
   const float fx = x - x0, fy = y - y0;
-  const uint8_t* p = L.rgb + static_cast<int64_t>(face) * w * w * kTexelBytes;
-  return BilinearMix(DecodeTexel<kTexelBytes>(p, w, decode, x0, y0),
-                     DecodeTexel<kTexelBytes>(p, w, decode, x1, y0),
-                     DecodeTexel<kTexelBytes>(p, w, decode, x0, y1),
-                     DecodeTexel<kTexelBytes>(p, w, decode, x1, y1), fx, fy);
+  const uint8_t* p = L.rgb + static_cast<int64_t>(face) * w * w * 3;
+  return BilinearMix(DecodeTexel(p, w, decode, x0, y0), DecodeTexel(p, w, decode, x1, y0),
+                     DecodeTexel(p, w, decode, x0, y1), DecodeTexel(p, w, decode, x1, y1), fx, fy);
 }
 
 /// the mip level of a footprint `width_m` wide met at |cos| `cos_incidence` on a mapping of
@@ -211,8 +163,7 @@ PB_HOST_DEVICE inline float TapOffset(int k, int n) {
 }
 
 /// mean of n bilinear lookups in one level (wrapped) at (s, t) + o_k (ds, dt), o_k the tap
-/// offsets (footprint assembly along the major axis). kTexelBytes: BilinearWrap's.
-template <int kTexelBytes = 3>
+/// offsets (footprint assembly along the major axis).
 PB_HOST_DEVICE inline Float3 BilinearWrapTaps(const TextureLevelView& L, const float* decode,
                                               float s, float t, float ds, float dt, int n) {
   const int w = L.width, h = L.height;
@@ -224,18 +175,17 @@ PB_HOST_DEVICE inline Float3 BilinearWrapTaps(const TextureLevelView& L, const f
     const float o = o0 + static_cast<float>(k) * step;
     const float u = s + o * ds, v = t + o * dt;
     const WrappedTexels q = WrapTexels(u, v, w, h);
-    const uint8_t* r0 = p + static_cast<int64_t>(q.y0) * w * kTexelBytes;
-    const uint8_t* r1 = p + static_cast<int64_t>(q.y1) * w * kTexelBytes;
-    const TexelBytes a = LoadTexel<kTexelBytes>(r0 + q.x0 * kTexelBytes);
-    const TexelBytes bq = LoadTexel<kTexelBytes>(r0 + q.x1 * kTexelBytes);
-    const TexelBytes c = LoadTexel<kTexelBytes>(r1 + q.x0 * kTexelBytes);
-    const TexelBytes d = LoadTexel<kTexelBytes>(r1 + q.x1 * kTexelBytes);
+    const uint8_t* r0 = p + static_cast<int64_t>(q.y0) * w * 3;
+    const uint8_t* r1 = p + static_cast<int64_t>(q.y1) * w * 3;
+    const uint8_t* a = r0 + q.x0 * 3;
+    const uint8_t* bq = r0 + q.x1 * 3;
+    const uint8_t* c = r1 + q.x0 * 3;
+    const uint8_t* d = r1 + q.x1 * 3;
     const float w00 = (1 - q.fx) * (1 - q.fy), w10 = q.fx * (1 - q.fy);
     const float w01 = (1 - q.fx) * q.fy, w11 = q.fx * q.fy;
-    auto dec = [decode](int i) { return DecodeSrgb(decode, i); };
-    r += w00 * dec(a.r) + w10 * dec(bq.r) + w01 * dec(c.r) + w11 * dec(d.r);
-    g += w00 * dec(a.g) + w10 * dec(bq.g) + w01 * dec(c.g) + w11 * dec(d.g);
-    b += w00 * dec(a.b) + w10 * dec(bq.b) + w01 * dec(c.b) + w11 * dec(d.b);
+    r += w00 * decode[a[0]] + w10 * decode[bq[0]] + w01 * decode[c[0]] + w11 * decode[d[0]];
+    g += w00 * decode[a[1]] + w10 * decode[bq[1]] + w01 * decode[c[1]] + w11 * decode[d[1]];
+    b += w00 * decode[a[2]] + w10 * decode[bq[2]] + w01 * decode[c[2]] + w11 * decode[d[2]];
   }
   return Float3{r, g, b} * step;
 }

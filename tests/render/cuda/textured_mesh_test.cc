@@ -117,48 +117,6 @@ TEST(TexturedMeshBvh, HitsCarryEmbreesShadingNormalAndTexcoords) {
   EXPECT_EQ(terms_bad, 0);
 }
 
-// the realtime frame's texels (the GPU's copy) are every level's rgb in 4 bytes a texel
-// (kRealtimeTexelBytes: the GPU reads a texel in one 32-bit load), the fourth byte 0 and each
-// level 4-aligned: every level of the 2d texture, the normal map and the cube texture is found
-// there as the scene's TextureLevel holds it. texels kept in 3 bytes fail the size and the
-// layout checks.
-TEST(TexturedMeshWorld, RealtimeFrameKeepsEveryTexelInFourBytes) {
-  Simulation sim = textured_mesh::Load();
-  const SceneDescription& scene = sim.scene();
-  const cuda::RealtimeFrameData data(scene, RenderSettings{});
-  const std::vector<uint8_t>& texels = data.texels();
-  ASSERT_GE(data.textures().size(), 3u);
-  size_t expected_bytes = 0, levels = 0;
-  for (const cuda::TexturePod& pod : data.textures()) {
-    for (int l = 0; l < pod.num_levels; ++l) {
-      const int64_t faces = pod.cube ? 6 : 1;
-      const size_t n = static_cast<size_t>(faces * pod.width[l] * pod.height[l]);
-      expected_bytes += n * cuda::kRealtimeTexelBytes;
-      ASSERT_EQ(pod.level_offset[l] % 4, 0);
-      ASSERT_LE(pod.level_offset[l] + static_cast<int64_t>(4 * n),
-                static_cast<int64_t>(texels.size()));
-      std::vector<uint8_t> rgb(3 * n);
-      int pad_set = 0;
-      for (size_t k = 0; k < n; ++k) {
-        const uint8_t* q = texels.data() + pod.level_offset[l] + 4 * k;
-        for (int c = 0; c < 3; ++c) rgb[3 * k + c] = q[c];
-        pad_set += q[3] != 0;
-      }
-      EXPECT_EQ(pad_set, 0);
-      bool found = false;
-      for (const Texture& t : scene.textures)
-        if (t.image && t.image->num_levels() > l && t.image->faces() == faces &&
-            t.image->level(l).width == pod.width[l] && t.image->level(l).rgb_srgb == rgb)
-          found = true;
-      EXPECT_TRUE(found) << "level " << l << " of a " << pod.width[l] << "x" << pod.height[l]
-                         << " texture";
-      ++levels;
-    }
-  }
-  EXPECT_EQ(texels.size(), expected_bytes);
-  std::printf("realtime frame: %zu texture levels, %zu texel bytes\n", levels, texels.size());
-}
-
 // the realtime rgb of the GPU path (on the host) against the CPU backend: >= 40 dB with the
 // mesh's normals, texcoords and texture and the skybox; the flat, untextured path of before
 // (the same scene without them, against the same CPU frame) stays below 30 dB.

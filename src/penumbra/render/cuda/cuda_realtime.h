@@ -70,7 +70,7 @@ struct RealtimeStatic {
   int64_t num_materials = 0;
   const TexturePod* textures = nullptr;
   int64_t num_textures = 0;
-  const uint8_t* texels = nullptr;  ///< kRealtimeTexelBytes a texel (RealtimeFrame::texels)
+  const uint8_t* texels = nullptr;
   int64_t num_texel_bytes = 0;
   const float* srgb_decode = nullptr;  ///< 256 entries
   const uint8_t* oetf_lut = nullptr;   ///< kFilmLutSize entries

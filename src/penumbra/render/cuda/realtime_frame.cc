@@ -94,13 +94,7 @@ RealtimeFrameData::RealtimeFrameData(const SceneDescription& scene, const Render
       pod.width[l] = L.width;
       pod.height[l] = L.height;
       pod.level_offset[l] = static_cast<int64_t>(texels_.size());
-      // rgb and an unused byte a texel (kRealtimeTexelBytes)
-      const size_t n = L.rgb_srgb.size() / 3;
-      const size_t at = texels_.size();
-      texels_.resize(at + n * kRealtimeTexelBytes, 0);
-      for (size_t k = 0; k < n; ++k)
-        for (int c = 0; c < 3; ++c)
-          texels_[at + k * kRealtimeTexelBytes + c] = L.rgb_srgb[3 * k + c];
+      texels_.insert(texels_.end(), L.rgb_srgb.begin(), L.rgb_srgb.end());
     }
     slot[i] = static_cast<int>(textures_.size());
     textures_.push_back(pod);

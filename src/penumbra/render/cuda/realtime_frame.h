@@ -243,7 +243,6 @@ class RealtimeFrameData {
 
   const std::vector<MaterialPod>& materials() const { return materials_; }
   const std::vector<TexturePod>& textures() const { return textures_; }
-  /// every texture's levels' texels, kRealtimeTexelBytes a texel (TexturePod::level_offset).
   const std::vector<uint8_t>& texels() const { return texels_; }
   const std::vector<GeomPod>& geoms() const { return geoms_; }
   const std::vector<LightPod>& lights() const { return lights_.pods(); }

@@ -81,14 +81,9 @@ struct MaterialPod {
   }
 };
 
-/// bytes a texel in a realtime frame's texels (RealtimeFrameView::texels): r, g, b (sRGB, as
-/// TextureLevel::rgb_srgb) and an unused 0, so the GPU reads a texel in one 32-bit load
-/// (texture_math.h's lookups with kTexelBytes 4).
-constexpr int kRealtimeTexelBytes = 4;
-
 /// a 2d texture, or a cube texture (cube 1: each level holds the six faces of width[l]^2
 /// texels, face after face, as TextureLevel): its mip levels' texels at texels[level_offset[l]]
-/// (bytes; kRealtimeTexelBytes a texel, each level 4-aligned).
+/// (bytes).
 struct TexturePod {
   int32_t num_levels = 0;
   int32_t cube = 0;
@@ -181,7 +176,7 @@ struct RealtimeFrameView {
   MaterialPod default_material;            ///< for material -1
   const GeomPod* geoms = nullptr;          ///< by SceneDescription geom index
   const TexturePod* textures = nullptr;
-  const uint8_t* texels = nullptr;     ///< kRealtimeTexelBytes a texel (TexturePod)
+  const uint8_t* texels = nullptr;
   const float* srgb_decode = nullptr;  ///< 256 entries (SrgbDecodeTable)
   const LightPod* lights = nullptr;
   int32_t num_lights = 0;
@@ -410,10 +405,10 @@ PB_HOST_DEVICE inline Float3 FilterPlanar(const RealtimeFrameView& f, int slot,
     lod = TextureLod(fp.width_m, fp.cos_incidence,
                      tc ? TexcoordRho(tc->uv_per_m, w, th) : fp.map.rho(w, th));
   if (n > 1)
-    return BilinearWrapTaps<kRealtimeTexelBytes>(LevelView(f, tex, TapLevel(tex.num_levels, lod)),
-                                                 f.srgb_decode, fp.map.s, fp.map.t, ds, dt, n);
+    return BilinearWrapTaps(LevelView(f, tex, TapLevel(tex.num_levels, lod)), f.srgb_decode,
+                            fp.map.s, fp.map.t, ds, dt, n);
   return TrilinearMix(f, tex, lod, [&](const TextureLevelView& L) {
-    return BilinearWrap<kRealtimeTexelBytes>(L, f.srgb_decode, fp.map.s, fp.map.t);
+    return BilinearWrap(L, f.srgb_decode, fp.map.s, fp.map.t);
   });
 }
 
@@ -425,7 +420,7 @@ PB_HOST_DEVICE inline Float3 SampleCubeTexture(const RealtimeFrameView& f, int s
   float s, t;
   if (!CubeFaceCoords(q, &face, &s, &t)) return Float3{1, 1, 1};
   return TrilinearMix(f, f.textures[slot], lod, [&](const TextureLevelView& L) {
-    return BilinearFace<kRealtimeTexelBytes>(L, f.srgb_decode, face, s, t);
+    return BilinearFace(L, f.srgb_decode, face, s, t);
   });
 }
 
