@@ -170,6 +170,49 @@ PB_HOST_DEVICE inline void LoadPrimShape(const PrimRef* p, int* kind, int* index
 #endif
 }
 
+/// an instance's world box and BLAS (Instance::lo, hi, blas), as the top level tests it.
+struct InstanceBox {
+  float lo[3], hi[3];
+  int32_t blas;
+};
+
+/// the box and BLAS of instance *p: on the GPU in two 16-byte read-only loads (Instance's first
+/// two words), where the fields one by one were six scalar loads a box test.
+PB_HOST_DEVICE inline InstanceBox LoadInstanceBox(const Instance* p) {
+  InstanceBox b;
+#if defined(__CUDA_ARCH__)
+  const float4* q = reinterpret_cast<const float4*>(p);
+  const float4 x = __ldg(q), y = __ldg(q + 1);
+  b.lo[0] = x.x, b.lo[1] = x.y, b.lo[2] = x.z, b.hi[0] = x.w;
+  b.hi[1] = y.x, b.hi[2] = y.y, b.blas = __float_as_int(y.z);
+#else
+  for (int a = 0; a < 3; ++a) b.lo[a] = p->lo[a], b.hi[a] = p->hi[a];
+  b.blas = p->blas;
+#endif
+  return b;
+}
+
+/// a row-major 3x4 transform (Instance::X_IW) in registers.
+struct InstanceTransform {
+  float m[12];
+};
+
+/// the world-to-instance transform X_IW of instance *p: on the GPU in three 16-byte read-only
+/// loads.
+PB_HOST_DEVICE inline InstanceTransform LoadInstanceInverse(const Instance* p) {
+  InstanceTransform t;
+#if defined(__CUDA_ARCH__)
+  const float4* q = reinterpret_cast<const float4*>(p->X_IW);
+  const float4 a = __ldg(q), b = __ldg(q + 1), c = __ldg(q + 2);
+  t.m[0] = a.x, t.m[1] = a.y, t.m[2] = a.z, t.m[3] = a.w;
+  t.m[4] = b.x, t.m[5] = b.y, t.m[6] = b.z, t.m[7] = b.w;
+  t.m[8] = c.x, t.m[9] = c.y, t.m[10] = c.z, t.m[11] = c.w;
+#else
+  for (int k = 0; k < 12; ++k) t.m[k] = p->X_IW[k];
+#endif
+  return t;
+}
+
 /// the stack traversal of one BVH in the traversal's form (WidenBvh: `nodes` its inner nodes,
 /// `blas` its root's box and reference) along o + t d for t in [tmin, *t_max]: leaf(pi) is
 /// called for every primitive index pi of every leaf the ray reaches and returns whether it
@@ -277,10 +320,11 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   hit->prim = -1;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
   for (int i = 0; i < s.num_instances; ++i) {
-    const Instance& in = s.instances[i];
-    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
-    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    TraverseBlas<Stack>(s, s.blases[in.blas], i, o, d, r.tmin, false, hit);
+    const InstanceBox box = LoadInstanceBox(s.instances + i);
+    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
+    const InstanceTransform X_IW = LoadInstanceInverse(s.instances + i);
+    const F3 o = TransformPoint(X_IW.m, r.o), d = TransformVector(X_IW.m, r.d);
+    TraverseBlas<Stack>(s, s.blases[box.blas], i, o, d, r.tmin, false, hit);
   }
 }
 
@@ -293,10 +337,11 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
   hit.t = r.tmax;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
   for (int i = 0; i < s.num_instances; ++i) {
-    const Instance& in = s.instances[i];
-    if (SlabEntry(in.lo, in.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
-    const F3 o = TransformPoint(in.X_IW, r.o), d = TransformVector(in.X_IW, r.d);
-    if (TraverseBlas<Stack, kAnyOrder>(s, s.blases[in.blas], i, o, d, r.tmin, true, &hit))
+    const InstanceBox box = LoadInstanceBox(s.instances + i);
+    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
+    const InstanceTransform X_IW = LoadInstanceInverse(s.instances + i);
+    const F3 o = TransformPoint(X_IW.m, r.o), d = TransformVector(X_IW.m, r.d);
+    if (TraverseBlas<Stack, kAnyOrder>(s, s.blases[box.blas], i, o, d, r.tmin, true, &hit))
       return true;
   }
   return false;

@@ -7,6 +7,7 @@
 // transforms rewritten from every snapshot (no rebuild). no Eigen and no standard containers
 // here: device code reads these through raw pointers (render/cuda/bvh_traversal.h).
 
+#include <cstddef>
 #include <cstdint>
 
 #include "penumbra/core/host_device.h"
@@ -96,15 +97,22 @@ struct Blas {
   float lo[3] = {1, 1, 1}, hi[3] = {-1, -1, -1};
 };
 
-/// an instance of a BLAS posed in the world: X_WI and its inverse as row-major 3x4 floats,
-/// and the world-frame box of the posed BLAS (for the top level).
-struct Instance {
+/// an instance of a BLAS posed in the world: the world-frame box of the posed BLAS (for the top
+/// level), X_WI and its inverse as row-major 3x4 floats. 128 bytes, 16-aligned, laid out for
+/// the traversal's loads (LoadInstanceBox, LoadInstanceInverse in bvh_traversal.h): the box with
+/// the BLAS and group in the first two 16-byte words (lo x, y, z, hi x; hi y, z, blas, group),
+/// then X_IW and X_WI in three 16-byte words each.
+struct alignas(16) Instance {
+  float lo[3], hi[3];
   int32_t blas = 0;
   int32_t group = 0;
-  float X_WI[12];  ///< row-major [R | p]
   float X_IW[12];
-  float lo[3], hi[3];
+  float X_WI[12];  ///< row-major [R | p]
 };
+static_assert(sizeof(Instance) == 128, "Instance is eight 16-byte words");
+static_assert(offsetof(Instance, blas) == 24 && offsetof(Instance, X_IW) == 32 &&
+                  offsetof(Instance, X_WI) == 80,
+              "LoadInstanceBox and LoadInstanceInverse read Instance by these offsets");
 
 /// what a primitive's record stands for.
 struct Record {
