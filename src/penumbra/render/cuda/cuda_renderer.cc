@@ -147,7 +147,6 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
   const bool late = late_streaks_ && realtime_->device_streaks() && effects != nullptr &&
                     !effects->empty() && !effects->particles.empty();
   late_streaks_ms_ = late_streaks_start_ms_ = 0;
-  render_t0_ = t0;
   cull_queued_ = false;
   realtime_->Prepare(snapshot, view, pool_.get(), effects, &camera_rays_, media_query_.get(),
                      /*streaks=*/!late);
@@ -182,7 +181,7 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
       [&](const std::vector<double>& rows, float exposure[3]) {
         return realtime_->Ev100(rows, n, exposure);
       },
-      o, late ? LateStreaks(snapshot, effects, view) : DeviceRealtime::StreaksFn());
+      o, late ? LateStreaks(snapshot, effects, view, t0) : DeviceRealtime::StreaksFn());
   // the device culling's counts, read back with the frame's outputs: the culled rain, or the
   // host culling's ConfigError for a non-finite drop, before this frame is returned
   FinishDropCulling();
@@ -190,10 +189,11 @@ void CudaRenderer::RenderRgb(const WorldSnapshot& snapshot, const EffectsFrame* 
 
 DeviceRealtime::StreaksFn CudaRenderer::LateStreaks(const WorldSnapshot& snapshot,
                                                     const EffectsFrame* effects,
-                                                    const CameraView& view) {
-  return [this, &snapshot, effects, &view](RealtimeFrameView* f) {
+                                                    const CameraView& view,
+                                                    std::chrono::steady_clock::time_point t0) {
+  return [this, &snapshot, effects, &view, t0](RealtimeFrameView* f) {
     const auto ts = std::chrono::steady_clock::now();
-    late_streaks_start_ms_ = std::chrono::duration<double, std::milli>(ts - render_t0_).count();
+    late_streaks_start_ms_ = std::chrono::duration<double, std::milli>(ts - t0).count();
     const Camera camera(view.X_WO, view.intrinsics, view.motion);
     realtime_->PrepareStreaks(snapshot, effects, camera, view, pool_.get());
     realtime_->StreakFields(f);

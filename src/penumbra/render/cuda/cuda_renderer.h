@@ -120,9 +120,10 @@ class CudaRenderer final : public Renderer {
   // the late streaks of a realtime frame (set_late_streaks): PrepareStreaks of the frame's
   // `snapshot`, `effects` and `view` (referenced: they outlive the Render that calls it), then
   // their fields into the device's frame (RealtimeFrameData::StreakFields); times itself
-  // (last_late_streaks_ms).
+  // (last_late_streaks_ms) and its start from t0, when Render began (last_late_streaks_start_ms).
   DeviceRealtime::StreaksFn LateStreaks(const WorldSnapshot& snapshot, const EffectsFrame* effects,
-                                        const CameraView& view);
+                                        const CameraView& view,
+                                        std::chrono::steady_clock::time_point t0);
   // after a realtime frame whose drops DeviceStreakCull::Queue culled (cull_queued_): its
   // counts read (DeviceStreakCull::Finish: the culled rain into realtime_, or its ConfigError)
   void FinishDropCulling();
@@ -170,7 +171,6 @@ class CudaRenderer final : public Renderer {
   double prepare_ms_ = 0;
   double late_streaks_ms_ = 0;
   double late_streaks_start_ms_ = 0;
-  std::chrono::steady_clock::time_point render_t0_;  // the current Render's start
   bool late_streaks_ = true;
   bool radiance_output_ = true;
   int64_t gpu_frames_ = 0;
