@@ -331,6 +331,55 @@ TEST(CudaBvhTraversal, PoolBuildIsTheOneThreadBuildBitForBit) {
   }
 }
 
+// byte-wise equality of two arrays of records without padding
+template <typename T>
+bool SameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+// the same triangles, bit for bit (a Triangle's last 12 bytes are padding)
+bool SameTriangles(const std::vector<cuda::Triangle>& a, const std::vector<cuda::Triangle>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], 3 * sizeof(cuda::F3)) != 0) return false;
+  return true;
+}
+
+// the same analytic shapes, bit for bit (field by field: AnalyticPrim has padding)
+bool SameAnalytics(const std::vector<cuda::AnalyticPrim>& a,
+                   const std::vector<cuda::AnalyticPrim>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].kind != b[i].kind || std::memcmp(a[i].size, b[i].size, sizeof(a[i].size)) != 0 ||
+        std::memcmp(a[i].R_GI, b[i].R_GI, sizeof(a[i].R_GI)) != 0 ||
+        std::memcmp(a[i].p_GI, b[i].p_GI, sizeof(a[i].p_GI)) != 0)
+      return false;
+  return true;
+}
+
+// BvhScene over a pool (as CudaRenderer and the statics' maps build it) has the one-thread
+// scene's arrays byte for byte, built and then posed by the world's snapshot (the static BLAS
+// rebuilt): the outdoor world, whose static group is large enough for BuildBvh's parallel path.
+TEST(CudaBvhTraversal, SceneBuiltOverAPoolIsTheOneThreadScene) {
+  SessionOptions so;
+  so.build_renderer = false;
+  so.add_controllers = false;
+  Session session(LoadWorldFile(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/outdoor.yaml"), so);
+  const WorldSnapshot snap = session.sim().Snapshot();
+  cuda::BvhScene want(session.scene());
+  want.Update(snap);
+  ASSERT_GE(want.num_triangles(), cuda::kParallelBuildMinPrims);
+  ThreadPool pool(4);
+  cuda::BvhScene got(session.scene(), &pool);
+  got.Update(snap);
+  EXPECT_TRUE(SameBytes(got.nodes(), want.nodes()));
+  EXPECT_TRUE(SameBytes(got.prims(), want.prims()));
+  EXPECT_TRUE(SameTriangles(got.triangles(), want.triangles()));
+  EXPECT_TRUE(SameAnalytics(got.analytics(), want.analytics()));
+  EXPECT_TRUE(SameBytes(got.blases(), want.blases()));
+  EXPECT_TRUE(SameBytes(got.instances(), want.instances()));
+}
+
 TEST(CudaBvhTraversal, WidenedNodesTraceTheSameBitsAsTheBinaryTree) {
   for (const int num_triangles : {3, 4000}) {
     std::mt19937 rng(11);

@@ -1,8 +1,16 @@
 #include "penumbra/render/cuda/bvh_ray_query.h"
 
+#include <memory>
+
 #include "penumbra/render/cuda/bvh_traversal.h"
 
 namespace penumbra::cuda {
+
+RayQueryFactory BvhRayQueryFactory(ThreadPool* pool) {
+  return [pool](const SceneDescription& scene) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<BvhRayQuery>(scene, pool);
+  };
+}
 
 void BvhRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,
                                  std::span<bool> did_hit) const {

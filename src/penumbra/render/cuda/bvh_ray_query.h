@@ -11,11 +11,19 @@
 
 namespace penumbra::cuda {
 
+/// makes a BvhRayQuery over the scene it is given, its BVH built over `pool` (may be null; it
+/// must outlive the queries, and the factory and the queries' Update must not be called inside
+/// one of its loops): the statics' queries of CudaRenderer's and the batch's sky irradiance
+/// volume and shelter map (RealtimeFrameData).
+RayQueryFactory BvhRayQueryFactory(ThreadPool* pool = nullptr);
+
 /// RayQuery over a BvhScene, traversed on the host (see the file comment).
 class BvhRayQuery final : public RayQuery {
  public:
-  /// @throws Error as BvhScene. `scene` is referenced: it must outlive the query.
-  explicit BvhRayQuery(const SceneDescription& scene) : bvh_(scene) {}
+  /// @throws Error as BvhScene. `scene` is referenced: it must outlive the query. `pool` (may
+  /// be null) builds the BVH as BvhScene's.
+  explicit BvhRayQuery(const SceneDescription& scene, ThreadPool* pool = nullptr)
+      : bvh_(scene, pool) {}
   const SceneDescription& scene() const override { return bvh_.scene(); }
   void Update(const WorldSnapshot& snapshot) override { bvh_.Update(snapshot); }
   /// true if anything blocks `ray` in (tmin, tmax); untraceable rays are not occluded.

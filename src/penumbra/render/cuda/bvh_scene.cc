@@ -45,7 +45,7 @@ F3 ToF3(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
-BvhScene::BvhScene(const SceneDescription& scene) : scene_(scene) {
+BvhScene::BvhScene(const SceneDescription& scene, ThreadPool* pool) : scene_(scene), pool_(pool) {
   const int num_bodies = static_cast<int>(scene.bodies.size());
   X_WB_.assign(num_bodies, Pose::Identity());
   static_poses_ = X_WB_;
@@ -224,7 +224,7 @@ void BvhScene::BuildGroup(int k, std::vector<int32_t>* prim_index) {
     return;
   }
   std::vector<BvhNode> tree;
-  BuildBvh(boxes, prim_base, &tree, prim_index);
+  BuildBvh(boxes, prim_base, &tree, prim_index, pool_);
   // the group's primitives in its leaves' order: leaf ranges index prims_ directly (the leaves
   // index prim_index from prim_base on, as prim_index holds one element per primitive)
   std::vector<PrimRef> leaf_order;

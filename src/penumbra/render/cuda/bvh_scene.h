@@ -30,9 +30,12 @@ namespace penumbra::cuda {
 class BvhScene {
  public:
   /// builds every group's BLAS, bodies at the identity pose until Update. `scene` is referenced.
+  /// `pool` (may be null; referenced, it must outlive the scene): the BLAS builds of the
+  /// constructor and of Update run over it (BuildBvh: the same nodes and order, bit for bit, with
+  /// any pool or none); neither may be called from inside one of the pool's ParallelFor loops.
   /// @throws Error if a traced geom refers to a missing body, mesh, height field or material,
   ///         or a tendon to a missing material or has a width that is not positive.
-  explicit BvhScene(const SceneDescription& scene);
+  explicit BvhScene(const SceneDescription& scene, ThreadPool* pool = nullptr);
 
   /// poses the instances with snapshot.X_WB (rebuilding the static BLAS if a static body moved)
   /// and the tendons' capsules with snapshot.tendon_paths (rebuilding their BLAS if they moved).
@@ -92,6 +95,7 @@ class BvhScene {
   void SetInstances();
 
   const SceneDescription& scene_;
+  ThreadPool* pool_ = nullptr;  // the BLAS builds' (may be null)
   std::vector<Group> groups_;
   std::vector<Pose> X_WB_;
   std::vector<Pose> static_poses_;

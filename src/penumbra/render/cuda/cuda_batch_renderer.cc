@@ -9,6 +9,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/camera.h"
+#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/cuda/cuda_renderer.h"
 
@@ -44,12 +45,15 @@ int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings&
   auto w = std::make_unique<World>();
   w->scene = scene;
   w->settings = settings;
-  w->bvh = std::make_unique<BvhScene>(w->scene);
+  // the host's pool (the first world's threads) also builds the worlds' BVHs
+  if (!pool_) pool_ = std::make_unique<ThreadPool>(settings.threads);
+  w->bvh = std::make_unique<BvhScene>(w->scene, pool_.get());
   w->device = std::make_unique<DeviceScene>();
   SyncDevice(*w->bvh, w->device.get());
   if (layout_.outputs().rgb) {
     // the scene-constant arrays, as CudaRenderer uploads them
-    w->realtime = std::make_unique<RealtimeFrameData>(w->scene, settings, CudaRayQueryFactory());
+    w->realtime =
+        std::make_unique<RealtimeFrameData>(w->scene, settings, BvhRayQueryFactory(pool_.get()));
     w->device_realtime = std::make_unique<DeviceRealtime>();
     const RealtimeFrameData& d = *w->realtime;
     RealtimeStatic st;
@@ -62,7 +66,6 @@ int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings&
     st.srgb_decode = SrgbDecodeTable();
     st.oetf_lut = d.film().oetf_lut().data();
     w->device_realtime->Upload(st);
-    if (!pool_) pool_ = std::make_unique<ThreadPool>(settings.threads);
   }
   views_.push_back(w->device->device_view());
   worlds_.push_back(std::move(w));

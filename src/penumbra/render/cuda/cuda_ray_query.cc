@@ -20,8 +20,8 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   device->Sync(scene.view(), n, scene.geometry_version(), wait);
 }
 
-CudaRayQuery::CudaRayQuery(const SceneDescription& scene)
-    : own_bvh_(std::make_unique<BvhScene>(scene)),
+CudaRayQuery::CudaRayQuery(const SceneDescription& scene, ThreadPool* pool)
+    : own_bvh_(std::make_unique<BvhScene>(scene, pool)),
       own_device_(std::make_unique<DeviceScene>()),
       bvh_(own_bvh_.get()),
       device_(own_device_.get()) {
@@ -36,12 +36,6 @@ void CudaRayQuery::Update(const WorldSnapshot& snapshot) {
     throw Error("CudaRayQuery::Update: a query over another's BVH is posed by its owner");
   own_bvh_->Update(snapshot);
   SyncDevice(*own_bvh_, device_);
-}
-
-RayQueryFactory CudaRayQueryFactory() {
-  return [](const SceneDescription& scene) -> std::unique_ptr<RayQuery> {
-    return std::make_unique<CudaRayQuery>(scene);
-  };
 }
 
 void CudaRayQuery::IntersectBatch(std::span<const Ray> rays, std::span<SurfaceHit> hits,

@@ -17,17 +17,13 @@ namespace penumbra::cuda {
 /// the arrays and sizes of `scene` as DeviceScene::Sync takes them (`wait` as there).
 void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait = true);
 
-/// makes a CudaRayQuery over the scene it is given (its own BVH and device copy): the
-/// factory through which CudaRenderer's and the batch's sky irradiance volume and shelter map
-/// trace their rays on the GPU.
-RayQueryFactory CudaRayQueryFactory();
-
 /// RayQuery on the GPU (see the file comment).
 class CudaRayQuery final : public RayQuery {
  public:
   /// @throws Error as BvhScene, or if the CUDA runtime fails (no device: check ProbeDevice
-  /// first). `scene` is referenced: it must outlive the query.
-  explicit CudaRayQuery(const SceneDescription& scene);
+  /// first). `scene` is referenced: it must outlive the query. `pool` (may be null) builds the
+  /// BVH as BvhScene's.
+  explicit CudaRayQuery(const SceneDescription& scene, ThreadPool* pool = nullptr);
   /// a query over another's BVH and its device copy (CudaRenderer's: the media's shadow rays
   /// of its frames), both referenced: they must outlive the query, and their owner poses them
   /// (Update throws). its batches run on device's stream, after what was queued there.

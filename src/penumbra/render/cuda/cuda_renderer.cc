@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "penumbra/render/camera.h"
+#include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/cuda/cuda_ray_query.h"
 #include "penumbra/render/emitter_sampler.h"
 #include "penumbra/scene/texture_image.h"
@@ -27,10 +28,16 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene) : CudaRenderer(scene, 
 
 CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& settings)
     : scene_(scene) {
-  bvh_ = std::make_unique<BvhScene>(scene_);
+  // the pool first: the BVHs (the scene's and the statics' maps') are built over it
+  pool_ = std::make_unique<ThreadPool>(settings.threads);
+  bvh_ = std::make_unique<BvhScene>(scene_, pool_.get());
   device_ = std::make_unique<DeviceScene>();
   SyncDevice(*bvh_, device_.get());
-  realtime_ = std::make_unique<RealtimeFrameData>(scene_, settings, CudaRayQueryFactory());
+  // the statics' maps trace on the host: their rays on the GPU made the first frame shorter, but
+  // a second device copy of the geometry made every later frame's kernels 2-7 % slower
+  // ("A new renderer's first frame" in docs/gpu.md)
+  realtime_ =
+      std::make_unique<RealtimeFrameData>(scene_, settings, BvhRayQueryFactory(pool_.get()));
   device_realtime_ = std::make_unique<DeviceRealtime>();
   device_path_ = std::make_unique<DevicePath>();
   if (settings.tier == RenderSettings::Tier::kPathtraced) {
@@ -38,7 +45,6 @@ CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& 
     emitter_host_ = std::make_unique<PathEmitterHost>(*emitters_);
     if (settings.denoise) denoiser_ = std::make_unique<Denoiser>();
   }
-  pool_ = std::make_unique<ThreadPool>(settings.threads);
   set_device_culling(true);
 }
 

@@ -60,10 +60,7 @@ namespace {
 
 // the statics' ray queries RealtimeFrameData's constructor was given, else BvhRayQuery's
 RayQueryFactory StaticsQueryOr(RayQueryFactory given) {
-  if (given) return given;
-  return [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
-    return std::make_unique<BvhRayQuery>(statics);
-  };
+  return given ? given : BvhRayQueryFactory();
 }
 
 }  // namespace
