@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "penumbra/core/error.h"
@@ -332,6 +333,13 @@ void BvhScene::BuildTlas() {
   for (size_t i = 0; i < instances_.size(); ++i)
     for (int a = 0; a < 3; ++a)
       boxes[i].lo[a] = instances_[i].lo[a], boxes[i].hi[a] = instances_[i].hi[a];
+  // the same boxes give the same top level (a frame whose bodies did not move)
+  if (tlas_built_ && boxes.size() == tlas_boxes_.size() &&
+      (boxes.empty() ||
+       std::memcmp(boxes.data(), tlas_boxes_.data(), boxes.size() * sizeof(PrimBox)) == 0))
+    return;
+  tlas_boxes_ = boxes;
+  tlas_built_ = true;
   std::vector<BvhNode> tree;
   tlas_instances_.clear();
   BuildBvh(boxes, 0, &tree, &tlas_instances_);

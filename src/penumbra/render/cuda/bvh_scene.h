@@ -57,8 +57,8 @@ class BvhScene {
   const std::vector<AnalyticPrim>& analytics() const { return analytics_; }
   const std::vector<Blas>& blases() const { return blases_; }
   const std::vector<Instance>& instances() const { return instances_; }
-  /// the top level over the instances' world boxes (rebuilt by every Update, BuildBvh and
-  /// WidenBvh over Instance::lo, hi): its inner nodes, its leaves' instance indices
+  /// the top level over the instances' world boxes (BuildBvh and WidenBvh over Instance::lo,
+  /// hi; rebuilt by an Update that changes them): its inner nodes, its leaves' instance indices
   /// (SceneView::tlas_instances) and its root. view() leaves it out where it is deeper than
   /// the occlusion traversal's stack (tlas_depth() >= kMaxTlasDepth, bvh_traversal.h).
   const std::vector<BvhWideNode>& tlas_nodes() const { return tlas_nodes_; }
@@ -118,6 +118,8 @@ class BvhScene {
   std::vector<int32_t> tlas_instances_;  // its leaves' instances (BuildBvh's order)
   Blas tlas_;
   int tlas_depth_ = 0;
+  std::vector<PrimBox> tlas_boxes_;  // the instances' boxes it was built over
+  bool tlas_built_ = false;
   std::vector<Record> records_;
   std::vector<int> record_group_;  // group of each record
   std::vector<Pose> X_GI_;         // by record: its group frame to its geom frame
