@@ -549,6 +549,37 @@ TEST_P(CudaBvhWorlds, TraversalStackStaysShallow) {
   EXPECT_LT(deepest, 16);
 }
 
+// shadow rays between the hits of camera fans from three eyes in four directions (w x h rays
+// each), far apart in the fans' order.
+std::vector<Ray> ShadowRaysBetweenHits(const cuda::SceneView& s, int w, int h) {
+  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
+  for (const Eigen::Vector3f& eye :
+       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
+    for (const Eigen::Vector3f& ahead :
+         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
+          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
+      for (const Ray& ray : RayFan(eye, ahead, w, h)) {
+        cuda::TraceHit hit;
+        const cuda::TraceRay r = cuda::ToTraceRay(ray);
+        cuda::TraceClosest(s, r, &hit);
+        if (hit.instance < 0) continue;
+        const float t = hit.t * 0.99f;
+        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
+      }
+  std::vector<Ray> rays;
+  const size_t n = points.size();
+  for (size_t k = 0; k < n; ++k) {
+    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
+    Ray ray;
+    ray.o = {a.x, a.y, a.z};
+    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
+    ray.tmin = 1e-4f;
+    ray.tmax = 1.0f;
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
 // a stack of kKeep entries whose deeper entries become empty leaves (their subtrees skipped in
 // either order): shows the verdicts' comparison below sees a wrong occlusion traversal.
 template <int kKeep>
@@ -568,30 +599,11 @@ TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
   const Posed posed = LoadPosed();
   const RayScene& embree = *posed.embree;
   const cuda::SceneView s = posed.bvh->bvh().view();
-  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
-  for (const Eigen::Vector3f& eye :
-       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
-    for (const Eigen::Vector3f& ahead :
-         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
-          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
-      for (const Ray& ray : RayFan(eye, ahead, 48, 36)) {
-        cuda::TraceHit hit;
-        const cuda::TraceRay r = cuda::ToTraceRay(ray);
-        cuda::TraceClosest(s, r, &hit);
-        if (hit.instance < 0) continue;
-        const float t = hit.t * 0.99f;
-        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
-      }
-  const size_t n = points.size();
+  const std::vector<Ray> rays = ShadowRaysBetweenHits(s, 48, 36);
+  const size_t n = rays.size();
   ASSERT_GT(n, 1000u);
   int64_t occluded = 0, differ = 0, embree_differ = 0, embree_differ_ordered = 0, emptied = 0;
-  for (size_t k = 0; k < n; ++k) {
-    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
-    Ray ray;
-    ray.o = {a.x, a.y, a.z};
-    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
-    ray.tmin = 1e-4f;
-    ray.tmax = 1.0f;
+  for (const Ray& ray : rays) {
     const cuda::TraceRay sr = cuda::ToTraceRay(ray);
     const bool any = cuda::TraceOccluded<cuda::LocalBvhStack, true>(s, sr);
     const bool ordered = cuda::TraceOccluded<cuda::LocalBvhStack, false>(s, sr);
@@ -616,37 +628,6 @@ TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
   EXPECT_GT(emptied, 0);
 }
 
-// shadow rays between the hits of camera fans from three eyes in four directions (64 x 48
-// rays each), far apart in the fans' order.
-std::vector<Ray> ShadowRaysBetweenHits(const cuda::SceneView& s) {
-  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
-  for (const Eigen::Vector3f& eye :
-       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
-    for (const Eigen::Vector3f& ahead :
-         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
-          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
-      for (const Ray& ray : RayFan(eye, ahead, 64, 48)) {
-        cuda::TraceHit hit;
-        const cuda::TraceRay r = cuda::ToTraceRay(ray);
-        cuda::TraceClosest(s, r, &hit);
-        if (hit.instance < 0) continue;
-        const float t = hit.t * 0.99f;
-        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
-      }
-  std::vector<Ray> rays;
-  const size_t n = points.size();
-  for (size_t k = 0; k < n; ++k) {
-    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
-    Ray ray;
-    ray.o = {a.x, a.y, a.z};
-    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
-    ray.tmin = 1e-4f;
-    ray.tmax = 1.0f;
-    rays.push_back(ray);
-  }
-  return rays;
-}
-
 // occlusion rays through the top level over the instances (SceneView::tlas, TraceOccluded's
 // default) give the flat instance list's verdict on every shadow ray between the camera fans'
 // hits, and agree with Embree's rtcOccluded1 as the list does; then again with every moving
@@ -669,7 +650,7 @@ TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
     stale.tlas_nodes = old_nodes.empty() ? nullptr : old_nodes.data();
     stale.tlas_instances = old_instances.data();
     stale.tlas = old_tlas;
-    const std::vector<Ray> rays = ShadowRaysBetweenHits(s);
+    const std::vector<Ray> rays = ShadowRaysBetweenHits(s, 64, 48);
     ASSERT_GT(rays.size(), 20000u);
     int64_t occluded = 0, differ = 0, ordered_differ = 0, embree_differ = 0, flat_embree_differ = 0,
             stale_differ = 0;
