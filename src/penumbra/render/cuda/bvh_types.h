@@ -4,8 +4,10 @@
 // RayScene's Embree scenes (render/embree/ray_scene.h). bottom level: one BVH per instanced
 // group (the static bodies merged in the world frame, built once and again only if a static
 // body moves; each moving body in its body frame, built once); top level: the instances, their
-// transforms rewritten from every snapshot (no rebuild). no Eigen and no standard containers
-// here: device code reads these through raw pointers (render/cuda/bvh_traversal.h).
+// transforms rewritten from every snapshot (no BLAS rebuild), and a small BVH over their world
+// boxes, rebuilt on the host when the boxes change (occlusion rays walk it). no Eigen and no
+// standard containers here: device code reads these through raw pointers
+// (render/cuda/bvh_traversal.h).
 
 #include <cstddef>
 #include <cstdint>

@@ -170,6 +170,7 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
   // (the instances, then the top level's nodes, 64-aligned as an Instance is 128 bytes, then its
   // leaves' instance indices): only when their bytes changed (a frame of static bodies uploads
   // nothing)
+  static_assert(sizeof(Instance) % alignof(BvhWideNode) == 0, "the top level's nodes stay aligned");
   const size_t instance_bytes = static_cast<size_t>(v.num_instances) * sizeof(Instance);
   const bool tlas = v.tlas_instances != nullptr;
   const size_t tlas_node_bytes =
