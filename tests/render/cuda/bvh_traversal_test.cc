@@ -23,6 +23,7 @@
 #include "penumbra/render/cuda/bvh_builder.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
 #include "penumbra/render/embree/ray_scene.h"
+#include "penumbra/render/static_geometry.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
 #include "render/render_test_util.h"
@@ -597,6 +598,37 @@ TEST_P(CudaBvhWorlds, TraversalStackStaysShallow) {
   EXPECT_LT(deepest, 16);
 }
 
+// shadow rays between the hits of camera fans from three eyes in four directions (w x h rays
+// each), far apart in the fans' order.
+std::vector<Ray> ShadowRaysBetweenHits(const cuda::SceneView& s, int w, int h) {
+  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
+  for (const Eigen::Vector3f& eye :
+       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
+    for (const Eigen::Vector3f& ahead :
+         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
+          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
+      for (const Ray& ray : RayFan(eye, ahead, w, h)) {
+        cuda::TraceHit hit;
+        const cuda::TraceRay r = cuda::ToTraceRay(ray);
+        cuda::TraceClosest(s, r, &hit);
+        if (hit.instance < 0) continue;
+        const float t = hit.t * 0.99f;
+        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
+      }
+  std::vector<Ray> rays;
+  const size_t n = points.size();
+  for (size_t k = 0; k < n; ++k) {
+    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
+    Ray ray;
+    ray.o = {a.x, a.y, a.z};
+    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
+    ray.tmin = 1e-4f;
+    ray.tmax = 1.0f;
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
 // a stack of kKeep entries whose deeper entries become empty leaves (their subtrees skipped in
 // either order): shows the verdicts' comparison below sees a wrong occlusion traversal.
 template <int kKeep>
@@ -616,30 +648,11 @@ TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
   const Posed posed = LoadPosed();
   const RayScene& embree = *posed.embree;
   const cuda::SceneView s = posed.bvh->bvh().view();
-  std::vector<cuda::F3> points;  // the fans' hits, pulled back a little towards the eye
-  for (const Eigen::Vector3f& eye :
-       {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f), Eigen::Vector3f(-2, -1.5f, 0.6f)})
-    for (const Eigen::Vector3f& ahead :
-         {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
-          Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
-      for (const Ray& ray : RayFan(eye, ahead, 48, 36)) {
-        cuda::TraceHit hit;
-        const cuda::TraceRay r = cuda::ToTraceRay(ray);
-        cuda::TraceClosest(s, r, &hit);
-        if (hit.instance < 0) continue;
-        const float t = hit.t * 0.99f;
-        points.push_back({r.o.x + t * r.d.x, r.o.y + t * r.d.y, r.o.z + t * r.d.z});
-      }
-  const size_t n = points.size();
+  const std::vector<Ray> rays = ShadowRaysBetweenHits(s, 48, 36);
+  const size_t n = rays.size();
   ASSERT_GT(n, 1000u);
   int64_t occluded = 0, differ = 0, embree_differ = 0, embree_differ_ordered = 0, emptied = 0;
-  for (size_t k = 0; k < n; ++k) {
-    const cuda::F3 a = points[k], b = points[(k * 7919 + n / 3) % n];
-    Ray ray;
-    ray.o = {a.x, a.y, a.z};
-    ray.d = {b.x - a.x, b.y - a.y, b.z - a.z};
-    ray.tmin = 1e-4f;
-    ray.tmax = 1.0f;
+  for (const Ray& ray : rays) {
     const cuda::TraceRay sr = cuda::ToTraceRay(ray);
     const bool any = cuda::TraceOccluded<cuda::LocalBvhStack, true>(s, sr);
     const bool ordered = cuda::TraceOccluded<cuda::LocalBvhStack, false>(s, sr);
@@ -662,6 +675,81 @@ TEST_P(CudaBvhWorlds, OcclusionInAnyOrderGivesTheOrderedVerdicts) {
   EXPECT_GT(occluded, 0);
   EXPECT_LT(occluded, static_cast<int64_t>(n));
   EXPECT_GT(emptied, 0);
+}
+
+// occlusion rays through the top level over the instances (SceneView::tlas, TraceOccluded's
+// default) give the flat instance list's verdict on every shadow ray between the camera fans'
+// hits, and agree with Embree's rtcOccluded1 as the list does; then again with every moving
+// body moved and turned (BvhScene::Update rebuilds the top level). a top level left from the
+// first pose (stale boxes) misses occluders that moved out of them, so the comparison can fail.
+TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
+  Posed posed = LoadPosed();
+  const cuda::BvhScene& bvh = posed.bvh->bvh();
+  WorldSnapshot snap = posed.session->sim().Snapshot();
+  // the top level of the first pose (host arrays), for the stale control
+  const std::vector<cuda::BvhWideNode> old_nodes = bvh.tlas_nodes();
+  const std::vector<int32_t> old_instances = bvh.tlas_instances();
+  const cuda::Blas old_tlas = bvh.tlas();
+  for (int pose = 0; pose < 2; ++pose) {
+    const cuda::SceneView s = bvh.view();
+    ASSERT_NE(s.tlas_instances, nullptr);
+    cuda::SceneView flat = s;
+    flat.occlusion_tlas = 0;
+    cuda::SceneView stale = s;
+    stale.tlas_nodes = old_nodes.empty() ? nullptr : old_nodes.data();
+    stale.tlas_instances = old_instances.data();
+    stale.tlas = old_tlas;
+    const std::vector<Ray> rays = ShadowRaysBetweenHits(s, 64, 48);
+    ASSERT_GT(rays.size(), 20000u);
+    int64_t occluded = 0, differ = 0, ordered_differ = 0, embree_differ = 0, flat_embree_differ = 0,
+            stale_differ = 0;
+    for (const Ray& ray : rays) {
+      const cuda::TraceRay sr = cuda::ToTraceRay(ray);
+      const bool tlas = cuda::TraceOccluded(s, sr);
+      const bool listed = cuda::TraceOccluded(flat, sr);
+      const bool reference = posed.embree->Occluded(ray);
+      occluded += tlas;
+      differ += tlas != listed;
+      ordered_differ += cuda::TraceOccluded<cuda::LocalBvhStack, false>(s, sr) != listed;
+      embree_differ += tlas != reference;
+      flat_embree_differ += listed != reference;
+      stale_differ += cuda::TraceOccluded(stale, sr) != listed;
+    }
+    std::printf(
+        "%s, pose %d: %d instances, top level of %d inner nodes (deepest %d); %zu shadow rays, "
+        "%lld blocked, %lld differ from Embree (flat list: %lld), the first pose's top level "
+        "changed %lld\n",
+        GetParam().c_str(), pose, s.num_instances, s.tlas.num_nodes, bvh.tlas_depth(), rays.size(),
+        static_cast<long long>(occluded), static_cast<long long>(embree_differ),
+        static_cast<long long>(flat_embree_differ), static_cast<long long>(stale_differ));
+    EXPECT_EQ(differ, 0);
+    EXPECT_EQ(ordered_differ, 0);
+    EXPECT_EQ(embree_differ, flat_embree_differ);
+    EXPECT_LE(embree_differ, static_cast<int64_t>(rays.size() / 1000));
+    EXPECT_GT(occluded, 0);
+    EXPECT_LT(occluded, static_cast<int64_t>(rays.size()));
+    if (pose == 0) {
+      EXPECT_EQ(stale_differ, 0);
+    } else {
+      EXPECT_GT(stale_differ, 0);
+    }
+    // every moving body turned 0.5 rad about z and put in front of the first eye, along the
+    // fans' directions 0.8 to 2 m away (where the fans and the shadow rays meet it)
+    int moved = 0;
+    const Eigen::Vector3d aheads[4] = {
+        {1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
+    for (const RayGeomGroup& g : GroupRayGeoms(posed.session->scene(), "test")) {
+      if (g.body < 0) continue;
+      Pose& X = snap.X_WB[g.body];
+      X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+      X.translation() = Eigen::Vector3d(0, 0, 1.2) +
+                        (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
+      ++moved;
+    }
+    ASSERT_GT(moved, 0);
+    posed.embree->Update(snap);
+    posed.bvh->Update(snap);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhWorlds,

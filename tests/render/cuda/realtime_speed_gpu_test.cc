@@ -80,8 +80,9 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "penumbra_chunk_rays 3",
                          "packed_window_counts off",
                          "staged_window off",
-                         "window_verdict_rows off"};
-  for (int k = 0; k < 32; ++k) {
+                         "window_verdict_rows off",
+                         "occlusion_tlas off"};
+  for (int k = 0; k < 33; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -119,6 +120,7 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 29) o.packed_window_counts = false;
     if (k == 30) o.staged_window = false;
     if (k == 31) o.window_verdict_rows = false;
+    if (k == 32) o.occlusion_tlas = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

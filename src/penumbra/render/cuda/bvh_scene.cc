@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/analytic_shapes.h"
+#include "penumbra/render/cuda/bvh_traversal.h"
 #include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/static_geometry.h"
 #include "penumbra/render/triangle_shapes.h"
@@ -323,6 +325,35 @@ void BvhScene::SetInstances() {
     }
     instances_.push_back(in);
   }
+  BuildTlas();
+}
+
+void BvhScene::BuildTlas() {
+  std::vector<PrimBox> boxes(instances_.size());
+  for (size_t i = 0; i < instances_.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      boxes[i].lo[a] = instances_[i].lo[a], boxes[i].hi[a] = instances_[i].hi[a];
+  // the same boxes give the same top level (a frame whose bodies did not move)
+  if (tlas_built_ && boxes.size() == tlas_boxes_.size() &&
+      (boxes.empty() ||
+       std::memcmp(boxes.data(), tlas_boxes_.data(), boxes.size() * sizeof(PrimBox)) == 0))
+    return;
+  tlas_boxes_ = boxes;
+  tlas_built_ = true;
+  std::vector<BvhNode> tree;
+  tlas_instances_.clear();
+  BuildBvh(boxes, 0, &tree, &tlas_instances_);
+  tlas_nodes_.clear();
+  WidenBvh(tree, &tlas_nodes_, &tlas_);
+  // the deepest inner node's depth (root 0) bounds the traversal's pending entries
+  std::vector<int> depth(tree.size(), 0);
+  int deepest = 0;
+  for (size_t k = 0; k < tree.size(); ++k) {
+    if (tree[k].count > 0 || tree.size() == 1) continue;
+    deepest = std::max(deepest, depth[k]);
+    depth[tree[k].first] = depth[tree[k].first + 1] = depth[k] + 1;
+  }
+  tlas_depth_ = deepest;
 }
 
 void BvhScene::Update(const WorldSnapshot& snapshot) {
@@ -365,6 +396,12 @@ SceneView BvhScene::view() const {
   v.blases = blases_.data();
   v.instances = instances_.data();
   v.num_instances = static_cast<int32_t>(instances_.size());
+  // a top level deeper than the traversal's stack is left out (every instance in turn)
+  if (tlas_depth_ < kMaxTlasDepth) {
+    v.tlas_nodes = tlas_nodes_.empty() ? nullptr : tlas_nodes_.data();
+    v.tlas_instances = tlas_instances_.data();
+    v.tlas = tlas_;
+  }
   v.records = records_.data();
   v.shading = shading_.empty() ? nullptr : shading_.data();
   return v;

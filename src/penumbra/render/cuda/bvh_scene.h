@@ -4,8 +4,9 @@
 // meshes and height fields are triangles (render/triangle_shapes.h), planes, spheres, capsules,
 // ellipsoids and cylinders analytic (render/analytic_shapes.h), grouped as RayScene groups
 // them: the static bodies merged in the world frame, every moving body on its own. Update
-// rewrites the instances' transforms from a snapshot (the BLASes are built once; the static one
-// again only if a static body moved, normally once, at the first Update). visible spatial
+// rewrites the instances' transforms from a snapshot and rebuilds the top level over their world
+// boxes (a few hundred at most; the BLASes are built once, the static one again only if a
+// static body moved, normally once, at the first Update). visible spatial
 // tendons (SceneDescription::tendons) are a last group in the world frame, as RayScene draws
 // them: a capsule of the tendon's width around each segment of the snapshot's wrap-point paths
 // (a sphere where a segment is shorter than 1e-9 m), records with geom -1 (segmentation:
@@ -59,6 +60,15 @@ class BvhScene {
   const std::vector<AnalyticPrim>& analytics() const { return analytics_; }
   const std::vector<Blas>& blases() const { return blases_; }
   const std::vector<Instance>& instances() const { return instances_; }
+  /// the top level over the instances' world boxes (BuildBvh and WidenBvh over Instance::lo,
+  /// hi; rebuilt by an Update that changes them): its inner nodes, its leaves' instance indices
+  /// (SceneView::tlas_instances) and its root. view() leaves it out where it is deeper than
+  /// the occlusion traversal's stack (tlas_depth() >= kMaxTlasDepth, bvh_traversal.h).
+  const std::vector<BvhWideNode>& tlas_nodes() const { return tlas_nodes_; }
+  const std::vector<int32_t>& tlas_instances() const { return tlas_instances_; }
+  const Blas& tlas() const { return tlas_; }
+  /// the deepest inner node's depth in the top level (the root's is 0; 0 also for a leaf root).
+  int tlas_depth() const { return tlas_depth_; }
   const std::vector<Record>& records() const { return records_; }
   /// the shading attributes of the triangles that have vertex normals or texcoords
   /// (PrimRef::shading).
@@ -93,6 +103,8 @@ class BvhScene {
   // rebuilds the tendon group alone (the arrays' tails from tendon_start_)
   void RebuildTendons();
   void SetInstances();
+  // the top level over instances_' boxes
+  void BuildTlas();
 
   const SceneDescription& scene_;
   ThreadPool* pool_ = nullptr;  // the BLAS builds' (may be null)
@@ -106,6 +118,12 @@ class BvhScene {
   std::vector<AnalyticPrim> analytics_;
   std::vector<Blas> blases_;
   std::vector<Instance> instances_;
+  std::vector<BvhWideNode> tlas_nodes_;  // the top level's inner nodes (WidenBvh)
+  std::vector<int32_t> tlas_instances_;  // its leaves' instances (BuildBvh's order)
+  Blas tlas_;
+  int tlas_depth_ = 0;
+  std::vector<PrimBox> tlas_boxes_;  // the instances' boxes it was built over
+  bool tlas_built_ = false;
   std::vector<Record> records_;
   std::vector<int> record_group_;  // group of each record
   std::vector<Pose> X_GI_;         // by record: its group frame to its geom frame

@@ -3,14 +3,15 @@
 // PB_HOST_DEVICE functions: BvhRayQuery runs them on the CPU (and the tests check them there
 // against Embree), the CUDA kernels (cuda_kernels.cu) on the GPU.
 //
-// top level: every instance whose world box the ray enters, nearest box first not needed (a
-// handful of instances); the ray is taken to the instance frame in float (as Embree's
-// instancing). bottom level: a stack traversal over nodes that hold their children's boxes
-// (BvhWideNode: one 64-byte load a visit), the nearer child first (occlusion: any order), slab
-// tests of Williams et al., "An efficient and robust ray-box intersection algorithm" (JGT 2005).
-// triangles: Moller and Trumbore, "Fast, minimum storage ray/triangle intersection" (JGT
-// 1997), in float; analytic shapes: IntersectAnalyticArrays (render/analytic_shapes.h) in
-// double in the geom frame, as RayScene.
+// top level: closest hits test every instance whose world box the ray enters, in index order
+// (the lower instance wins a tie); occlusion rays walk a BVH over the instances' world boxes
+// (SceneView::tlas, any order) down to the instances whose boxes they enter. the ray is taken
+// to the instance frame in float (as Embree's instancing). bottom level: a stack traversal over
+// nodes that hold their children's boxes (BvhWideNode: one 64-byte load a visit), the nearer child
+// first (occlusion: any order), slab tests of Williams et al., "An efficient and robust ray-box
+// intersection algorithm" (JGT 2005). triangles: Moller and Trumbore, "Fast, minimum storage
+// ray/triangle intersection" (JGT 1997), in float; analytic shapes: IntersectAnalyticArrays
+// (render/analytic_shapes.h) in double in the geom frame, as RayScene.
 
 #include <cmath>
 
@@ -40,7 +41,22 @@ struct alignas(16) BvhPending {
 /// entries in shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local
 /// memory (branch gpu29)").
 struct LocalBvhStack {
+  /// the entries the traversal may put (deeper children are dropped: the builder keeps trees
+  /// shallower).
+  static constexpr int kCapacity = kMaxBvhDepth;
   BvhPending entries[kMaxBvhDepth];
+  PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
+  PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
+};
+
+/// deepest top level (SceneView::tlas) the occlusion traversal's stack holds: BvhScene leaves a
+/// deeper one out (TraceOccluded then tests every instance in turn).
+constexpr int kMaxTlasDepth = 16;
+
+/// the top level's stack (TraceOccluded): kMaxTlasDepth entries in the thread's own array.
+struct TlasStack {
+  static constexpr int kCapacity = kMaxTlasDepth;
+  BvhPending entries[kMaxTlasDepth];
   PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
   PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
 };
@@ -192,6 +208,16 @@ PB_HOST_DEVICE inline InstanceBox LoadInstanceBox(const Instance* p) {
   return b;
 }
 
+/// the instance index *p of a top-level leaf (SceneView::tlas_instances): on the GPU a read-only
+/// load.
+PB_HOST_DEVICE inline int LoadTlasInstance(const int32_t* p) {
+#if defined(__CUDA_ARCH__)
+  return __ldg(p);
+#else
+  return *p;
+#endif
+}
+
 /// a row-major 3x4 transform (Instance::X_IW) in registers.
 struct InstanceTransform {
   float m[12];
@@ -258,7 +284,7 @@ PB_HOST_DEVICE inline bool TraverseWideBvh(const BvhWideNode* nodes, const Blas&
         // traversal's, and the ray is occluded iff one of them hits. a popped entry's t was
         // SlabEntry's t0 <= t1 <= *t_max, so its test would always pass.
         const bool a_first = kAnyOrder || ta <= tb;
-        if (top < kMaxBvhDepth)
+        if (top < Stack::kCapacity)
           stack.Put(top++, BvhPending{a_first ? n.first[1] : n.first[0],
                                       a_first ? n.count[1] : n.count[0], a_first ? tb : ta, 0});
         first = a_first ? n.first[0] : n.first[1];
@@ -328,23 +354,40 @@ PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, T
   }
 }
 
-/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's. kAnyOrder (the
-/// default): each BLAS in its children's stored order, no entry test on a pop (TraverseWideBvh;
-/// the same verdict as false, the nearer child first, which the tests compare).
+/// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's, for each BLAS.
+/// kAnyOrder (the default): the top level and each BLAS in their children's stored order, no
+/// entry test on a pop (TraverseWideBvh; the same verdict as false, the nearer child first,
+/// which the tests compare). the top level (s.tlas, with s.occlusion_tlas and tlas_instances)
+/// is walked as a BLAS whose leaves hold instances: each instance of a leaf the ray reaches is
+/// tested as the flat list tests it (its own box, then its BLAS). the same verdict as the flat
+/// list: an any-hit traversal's verdict does not depend on its order (TraverseWideBvh), and a
+/// node's box holds its instances' boxes (BuildBvh: float min / max of them), so a ray that
+/// enters an instance's box enters every box above it (the slab test is monotonic in the box's
+/// planes). without a top level: one leaf of every instance in index order under a box of all
+/// space.
 template <class Stack = LocalBvhStack, bool kAnyOrder = true>
 PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) {
   TraceHit hit;
   hit.t = r.tmax;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
-  for (int i = 0; i < s.num_instances; ++i) {
+  const bool tree = s.occlusion_tlas != 0 && s.tlas_instances != nullptr;
+  Blas top = s.tlas;
+  if (!tree) {
+    top.root_first = 0;
+    top.root_count = s.num_instances;
+    for (int a = 0; a < 3; ++a) top.lo[a] = -3.4e38f, top.hi[a] = 3.4e38f;
+  }
+  auto leaf = [&](int k) {
+    const int i = tree ? LoadTlasInstance(s.tlas_instances + k) : k;
     const InstanceBox box = LoadInstanceBox(s.instances + i);
-    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, hit.t) == INFINITY) continue;
+    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, hit.t) == INFINITY) return false;
     const InstanceTransform X_IW = LoadInstanceInverse(s.instances + i);
     const F3 o = TransformPoint(X_IW.m, r.o), d = TransformVector(X_IW.m, r.d);
-    if (TraverseBlas<Stack, kAnyOrder>(s, s.blases[box.blas], i, o, d, r.tmin, true, &hit))
-      return true;
-  }
-  return false;
+    return TraverseBlas<Stack, kAnyOrder>(s, s.blases[box.blas], i, o, d, r.tmin, true, &hit);
+  };
+  const float tmax = r.tmax;
+  return TraverseWideBvh<TlasStack, kAnyOrder>(s.tlas_nodes, top, r.o, r.d, r.tmin, &tmax, true,
+                                               leaf);
 }
 
 }  // namespace penumbra::cuda

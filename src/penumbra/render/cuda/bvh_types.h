@@ -4,8 +4,10 @@
 // RayScene's Embree scenes (render/embree/ray_scene.h). bottom level: one BVH per instanced
 // group (the static bodies merged in the world frame, built once and again only if a static
 // body moves; each moving body in its body frame, built once); top level: the instances, their
-// transforms rewritten from every snapshot (no rebuild). no Eigen and no standard containers
-// here: device code reads these through raw pointers (render/cuda/bvh_traversal.h).
+// transforms rewritten from every snapshot (no BLAS rebuild), and a small BVH over their world
+// boxes, rebuilt on the host when the boxes change (occlusion rays walk it). no Eigen and no
+// standard containers here: device code reads these through raw pointers
+// (render/cuda/bvh_traversal.h).
 
 #include <cstddef>
 #include <cstdint>
@@ -135,6 +137,19 @@ struct SceneView {
   const Blas* blases = nullptr;
   const Instance* instances = nullptr;
   int32_t num_instances = 0;
+  /// the top level over the instances' world boxes (BvhScene builds it whenever the instances
+  /// change: BuildBvh and WidenBvh over Instance::lo, hi): its inner nodes (tlas.node_offset 0,
+  /// tlas.num_nodes of them; null when the root is a leaf) and its root. TraceOccluded walks it.
+  const BvhWideNode* tlas_nodes = nullptr;
+  /// the top level's leaves' instances: a leaf's reference (first, count) indexes this array
+  /// (num_instances entries, each an index into instances). null: no top level (TraceOccluded
+  /// tests every instance in index order).
+  const int32_t* tlas_instances = nullptr;
+  Blas tlas;
+  /// 1: TraceOccluded walks the top level (where there is one); 0: it tests every instance in
+  /// index order (the benchmark's ablation, RealtimeKernelOptions::occlusion_tlas). the same
+  /// verdicts either way.
+  int32_t occlusion_tlas = 1;
   const Record* records = nullptr;           ///< by PrimRef::record
   const TriangleShading* shading = nullptr;  ///< by PrimRef::shading (closest hits only)
 };

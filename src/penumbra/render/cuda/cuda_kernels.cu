@@ -90,8 +90,9 @@ struct DeviceScene::Impl {
   int64_t camera_xy_version = -1;
   int64_t geometry_version = -1;
   SceneView view;
-  // the bytes of the instances the device holds (Sync uploads them only when they change)
-  std::vector<uint8_t> uploaded_instances;
+  // the bytes of the instances and the top level the device holds (Sync uploads them only when
+  // they change), and Sync's staging of the next ones
+  std::vector<uint8_t> uploaded_instances, staged_instances;
 };
 
 void ExpRnOnDevice(const float* x, float* y, int64_t n) {
@@ -165,15 +166,25 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
     if (n.shading > 0) m.shading.Upload(v.shading, n.shading * sizeof(TriangleShading), m.stream);
     m.geometry_version = geometry_version;
   }
-  // the instances' transforms: only when their bytes changed (a frame of static bodies
-  // uploads nothing)
+  // the instances' transforms and the top level over their boxes, in one array and one copy
+  // (the instances, then the top level's nodes, 64-aligned as an Instance is 128 bytes, then its
+  // leaves' instance indices): only when their bytes changed (a frame of static bodies uploads
+  // nothing)
+  static_assert(sizeof(Instance) % alignof(BvhWideNode) == 0, "the top level's nodes stay aligned");
   const size_t instance_bytes = static_cast<size_t>(v.num_instances) * sizeof(Instance);
-  const auto* instances = reinterpret_cast<const uint8_t*>(v.instances);
-  if (m.instances.p == nullptr || m.uploaded_instances.size() != instance_bytes ||
-      (instance_bytes > 0 &&
-       std::memcmp(m.uploaded_instances.data(), instances, instance_bytes) != 0)) {
-    m.instances.Upload(v.instances, instance_bytes, m.stream);
-    m.uploaded_instances.assign(instances, instances + instance_bytes);
+  const bool tlas = v.tlas_instances != nullptr;
+  const size_t tlas_node_bytes =
+      tlas ? static_cast<size_t>(v.tlas.num_nodes) * sizeof(BvhWideNode) : 0;
+  const size_t tlas_index_bytes = tlas ? static_cast<size_t>(v.num_instances) * sizeof(int32_t) : 0;
+  m.staged_instances.resize(instance_bytes + tlas_node_bytes + tlas_index_bytes);
+  uint8_t* staged = m.staged_instances.data();
+  if (instance_bytes > 0) std::memcpy(staged, v.instances, instance_bytes);
+  if (tlas_node_bytes > 0) std::memcpy(staged + instance_bytes, v.tlas_nodes, tlas_node_bytes);
+  if (tlas_index_bytes > 0)
+    std::memcpy(staged + instance_bytes + tlas_node_bytes, v.tlas_instances, tlas_index_bytes);
+  if (m.instances.p == nullptr || m.uploaded_instances != m.staged_instances) {
+    m.instances.Upload(staged, m.staged_instances.size(), m.stream);
+    m.uploaded_instances = m.staged_instances;
   }
   m.view.nodes = static_cast<const BvhWideNode*>(m.nodes.p);
   m.view.prims = static_cast<const PrimRef*>(m.prims.p);
@@ -184,6 +195,15 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
   m.view.shading = n.shading > 0 ? static_cast<const TriangleShading*>(m.shading.p) : nullptr;
   m.view.instances = static_cast<const Instance*>(m.instances.p);
   m.view.num_instances = v.num_instances;
+  const uint8_t* device_instances = static_cast<const uint8_t*>(m.instances.p);
+  m.view.tlas_nodes = tlas_node_bytes > 0
+                          ? reinterpret_cast<const BvhWideNode*>(device_instances + instance_bytes)
+                          : nullptr;
+  m.view.tlas_instances =
+      tlas ? reinterpret_cast<const int32_t*>(device_instances + instance_bytes + tlas_node_bytes)
+           : nullptr;
+  m.view.tlas = v.tlas;
+  m.view.occlusion_tlas = v.occlusion_tlas;
   if (wait) Check(cudaStreamSynchronize(m.stream), "uploading the scene");
 }
 

@@ -207,6 +207,10 @@ struct RealtimeKernelOptions {
   /// verdicts or not in five shifted rows; else as an int8 copy read at each set bit of the
   /// window (StridedWindowVerdicts). the same booleans, so the same bits.
   bool window_verdict_rows = true;
+  /// occlusion rays (the lights' shadow rays, the penumbra rays) walk the top level over the
+  /// instances' world boxes (SceneView::tlas, TraceOccluded in bvh_traversal.h); else they test
+  /// every instance's box in turn. the same verdicts, so the same bits.
+  bool occlusion_tlas = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;
