@@ -51,6 +51,10 @@ class CudaRenderer final : public Renderer {
   /// frames rendered so far (every one on the GPU).
   int64_t gpu_frames() const { return gpu_frames_; }
 
+  /// the host threads of the renderer's pool (RenderSettings::threads, 0 = every core),
+  /// calling thread included: its BVH builds, copies and host shading run over them.
+  int host_threads() const { return pool_->num_threads(); }
+
   /// the scene's BVH (host side) and device copy, for benchmarks.
   const BvhScene& bvh() const { return *bvh_; }
   DeviceScene& device() { return *device_; }
