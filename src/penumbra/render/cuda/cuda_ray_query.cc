@@ -20,8 +20,8 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait) {
   device->Sync(scene.view(), n, scene.geometry_version(), wait);
 }
 
-CudaRayQuery::CudaRayQuery(const SceneDescription& scene, ThreadPool* pool)
-    : own_bvh_(std::make_unique<BvhScene>(scene, pool)),
+CudaRayQuery::CudaRayQuery(const SceneDescription& scene)
+    : own_bvh_(std::make_unique<BvhScene>(scene)),
       own_device_(std::make_unique<DeviceScene>()),
       bvh_(own_bvh_.get()),
       device_(own_device_.get()) {

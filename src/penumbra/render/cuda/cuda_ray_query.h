@@ -21,9 +21,8 @@ void SyncDevice(const BvhScene& scene, DeviceScene* device, bool wait = true);
 class CudaRayQuery final : public RayQuery {
  public:
   /// @throws Error as BvhScene, or if the CUDA runtime fails (no device: check ProbeDevice
-  /// first). `scene` is referenced: it must outlive the query. `pool` (may be null) builds the
-  /// BVH as BvhScene's.
-  explicit CudaRayQuery(const SceneDescription& scene, ThreadPool* pool = nullptr);
+  /// first). `scene` is referenced: it must outlive the query.
+  explicit CudaRayQuery(const SceneDescription& scene);
   /// a query over another's BVH and its device copy (CudaRenderer's: the media's shadow rays
   /// of its frames), both referenced: they must outlive the query, and their owner poses them
   /// (Update throws). its batches run on device's stream, after what was queued there.
