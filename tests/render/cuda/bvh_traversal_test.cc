@@ -504,7 +504,7 @@ struct DepthCountingStack : cuda::LocalBvhStack {
   static inline std::array<int64_t, cuda::kMaxBvhDepth> puts{};
   void Put(int i, const cuda::BvhPending& e) {
     ++puts[i];
-    LocalBvhStack::Put(i, e);
+    cuda::LocalBvhStack::Put(i, e);
   }
 };
 
@@ -515,7 +515,7 @@ template <int kKeep>
 struct DroppingStack : cuda::LocalBvhStack {
   void Put(int i, cuda::BvhPending e) {
     if (i >= kKeep) e.t = INFINITY;
-    LocalBvhStack::Put(i, e);
+    cuda::LocalBvhStack::Put(i, e);
   }
 };
 
@@ -635,7 +635,7 @@ template <int kKeep>
 struct EmptyingStack : cuda::LocalBvhStack {
   void Put(int i, cuda::BvhPending e) {
     if (i >= kKeep) e.count = 0;
-    LocalBvhStack::Put(i, e);
+    cuda::LocalBvhStack::Put(i, e);
   }
 };
 

@@ -33,33 +33,31 @@ struct alignas(16) BvhPending {
   int unused;
 };
 
-/// TraverseWideBvh's stack: all kMaxBvhDepth entries in the thread's own array (local memory on
-/// the GPU). a stack policy is default-constructible (one per traversal, empty) and has Put(i,
-/// e) and Get(i) for entry i in [0, kMaxBvhDepth); the traversal pushes and pops through it, so
-/// a policy that keeps the entries elsewhere visits the same nodes in the same order and gives
-/// the same hits, bit for bit (the tests count the stack's depth through one). a top of 8
-/// entries in shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local
-/// memory (branch gpu29)").
-struct LocalBvhStack {
-  /// the entries the traversal may put (deeper children are dropped: the builder keeps trees
-  /// shallower).
-  static constexpr int kCapacity = kMaxBvhDepth;
-  BvhPending entries[kMaxBvhDepth];
+/// a traversal stack of kEntries entries in the thread's own array (local memory on the GPU).
+/// a stack policy is default-constructible (one per traversal, empty), names kCapacity and has
+/// Put(i, e) and Get(i) for entry i in [0, kCapacity) (TraverseWideBvh drops a child it cannot
+/// push: the builders keep trees shallower); the traversal pushes and pops through it, so a
+/// policy that keeps the entries elsewhere visits the same nodes in the same order and gives the
+/// same hits, bit for bit (the tests count the stack's depth through one). a top of 8 entries in
+/// shared memory was slower on an H100 (docs/gpu-notes.md, "The traversal's local memory (branch
+/// gpu29)").
+template <int kEntries>
+struct ArrayBvhStack {
+  static constexpr int kCapacity = kEntries;
+  BvhPending entries[kEntries];
   PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
   PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
 };
+
+/// TraverseWideBvh's stack for a BLAS: kMaxBvhDepth entries.
+using LocalBvhStack = ArrayBvhStack<kMaxBvhDepth>;
 
 /// deepest top level (SceneView::tlas) the occlusion traversal's stack holds: BvhScene leaves a
 /// deeper one out (TraceOccluded then tests every instance in turn).
 constexpr int kMaxTlasDepth = 16;
 
-/// the top level's stack (TraceOccluded): kMaxTlasDepth entries in the thread's own array.
-struct TlasStack {
-  static constexpr int kCapacity = kMaxTlasDepth;
-  BvhPending entries[kMaxTlasDepth];
-  PB_HOST_DEVICE void Put(int i, const BvhPending& e) { entries[i] = e; }
-  PB_HOST_DEVICE BvhPending Get(int i) const { return entries[i]; }
-};
+/// the top level's stack (TraceOccluded): kMaxTlasDepth entries.
+using TlasStack = ArrayBvhStack<kMaxTlasDepth>;
 
 /// p transformed by the row-major 3x4 matrix m (rotation and translation).
 PB_HOST_DEVICE inline F3 TransformPoint(const float m[12], F3 p) {
