@@ -91,8 +91,9 @@ int BenchRenderBatch(const WorldConfig& world, const RenderBenchOptions& options
   const int counts[] = {options.batch};
   const std::string name = world.file.substr(world.file.find_last_of('/') + 1);
   for (const cuda::BatchOutputs& outputs : sets) {
-    const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
-        worlds, options.batch_width, options.batch_height, counts, options.frames, outputs);
+    const std::vector<cuda::BatchBenchRow> rows =
+        cuda::RunBatchBench(worlds, options.batch_width, options.batch_height, counts,
+                            options.frames, outputs, StaticMapsQueryFactory());
     fmt::print("{}", cuda::FormatBatchBench(name, options.batch_width, options.batch_height,
                                             outputs, rows));
   }

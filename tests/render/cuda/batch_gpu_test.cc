@@ -75,7 +75,8 @@ cuda::BatchConfig AllTruth(int max_cameras, cuda::BatchCopy copy = cuda::BatchCo
   return c;
 }
 
-// a batch of the realtime rgb (and its depth) only, up to max_cameras cameras.
+// a batch of the realtime rgb (and its depth) only, up to max_cameras cameras; its static maps
+// traced as MakeRenderer's CudaRenderer traces them, so each camera can equal that renderer.
 cuda::BatchConfig RgbOnly(int max_cameras) {
   cuda::BatchConfig c;
   c.width = kBatchW;
@@ -83,6 +84,7 @@ cuda::BatchConfig RgbOnly(int max_cameras) {
   c.max_cameras = max_cameras;
   c.outputs.segmentation = false;
   c.outputs.rgb = true;
+  c.statics_query = StaticMapsQueryFactory();
   return c;
 }
 

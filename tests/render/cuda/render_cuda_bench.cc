@@ -75,6 +75,10 @@
 // the image mean) and whether two GPU renders are bit-identical; a world's effects at 1 s (media
 // and particles included) in both; for particles a line with the streaks' count and the host's
 // BVH build time. usage:
+// --lidar (the default rows; name one world): the realtime kernels alone before and after a
+// LiDAR's CudaRayQuery of the scene traced a scan in the process, 3 rounds at each size.
+// --statics [--frames N]: the static maps' build through our host traversal and through Embree,
+// N rounds interleaved (default 2; no GPU needed).
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
 //                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
 //                     [--seed-floor]] [world.yaml ...]
@@ -93,6 +97,7 @@
 #include <vector>
 
 #include "penumbra/core/output_file.h"
+#include "penumbra/core/thread_pool.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cuda/bvh_ray_query.h"
@@ -105,6 +110,8 @@
 #include "penumbra/render/light_sampler.h"
 #include "penumbra/render/media_realtime.h"
 #include "penumbra/render/media_scene.h"
+#include "penumbra/render/shelter_map.h"
+#include "penumbra/render/sky_irradiance_volume.h"
 #include "penumbra/scene/camera_pose.h"
 #include "penumbra/session/session.h"
 #include "penumbra/world/world_config.h"
@@ -712,8 +719,8 @@ int BatchMain(const std::vector<std::string>& worlds, const std::vector<int>& co
     rgb.segmentation = false;
     rgb.rgb = true;
     for (const cuda::BatchOutputs& outputs : {truth, rgb}) {
-      const std::vector<cuda::BatchBenchRow> rows =
-          cuda::RunBatchBench(bench_worlds, width, height, counts, frames, outputs);
+      const std::vector<cuda::BatchBenchRow> rows = cuda::RunBatchBench(
+          bench_worlds, width, height, counts, frames, outputs, StaticMapsQueryFactory());
       const std::string name = file.substr(file.find_last_of('/') + 1);
       fmt::print("\n{}", cuda::FormatBatchBench(
                              sessions > 1 ? fmt::format("{} x{} sessions", name, sessions) : name,
@@ -800,6 +807,41 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
   return 0;
 }
 
+// --statics: the static maps a new realtime renderer builds before its first frame (the sky
+// irradiance volume and, for worlds with particles, the shelter map), traced through our
+// traversal on the host's threads (BvhRayQuery, CudaRenderer's default) and through Embree
+// (RayScene, the CPU backend's and MakeRenderer's), interleaved `rounds` times: build ms and
+// the valid probes of each. needs no GPU.
+int StaticsMain(const std::vector<std::string>& worlds, int rounds, int host_threads) {
+  ThreadPool pool(host_threads);
+  fmt::print(
+      "\nhost threads: {}\n\n| world | query | sky volume build ms | valid probes | "
+      "shelter map build ms |\n|---|---|---:|---:|---:|\n",
+      pool.num_threads());
+  for (const std::string& file : worlds) {
+    const BenchWorld world = LoadBenchWorld(file);
+    const SceneDescription& scene = world.session->scene();
+    const std::pair<const char*, RayQueryFactory> queries[] = {
+        {"BvhRayQuery (host traversal)", cuda::BvhRayQueryFactory(&pool)},
+        {"Embree (RayScene)", StaticMapsQueryFactory()}};
+    for (int r = 0; r < rounds; ++r)
+      for (const auto& [label, make] : queries) {
+        SkyIrradianceVolume volume(make);
+        const auto t0 = Clock::now();
+        volume.Build(scene, world.snap.X_WB, &pool);
+        const auto t1 = Clock::now();
+        ShelterMap shelter(make);
+        shelter.Build(scene, world.snap.X_WB, &pool);
+        const auto t2 = Clock::now();
+        fmt::print("| {} | {} | {:.1f} | {} of {} | {:.1f} |\n", world.name, label,
+                   std::chrono::duration<double, std::milli>(t1 - t0).count(),
+                   volume.num_valid_probes(), volume.num_probes(),
+                   std::chrono::duration<double, std::milli>(t2 - t1).count());
+      }
+  }
+  return 0;
+}
+
 int Main(int argc, char** argv) {
   int frames = 50;
   int width = 0, height = 0, sessions = 1;
@@ -808,7 +850,7 @@ int Main(int argc, char** argv) {
   // the single-camera rows: the CUDA renderer's host threads (RenderSettings::threads; 0 = all
   // cores), and whether the CPU backend's rows run too
   int host_threads = 0;
-  bool cpu_rows = true;
+  bool cpu_rows = true, statics = false, frames_given = false, lidar_rows = false;
   std::vector<int> batch;
   std::vector<std::string> worlds;
   const auto usage = [](const std::string& why) {
@@ -816,8 +858,8 @@ int Main(int argc, char** argv) {
                "render_cuda_bench: {}\nusage: render_cuda_bench [--frames N] [--batch N,... "
                "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH] | "
                "--media [--size WxH] | "
-               "--pathtraced [--size WxH] [--spp N]] "
-               "[--host-threads N] [--no-cpu] [world.yaml ...]\n",
+               "--pathtraced [--size WxH] [--spp N] | --statics] "
+               "[--host-threads N] [--no-cpu] [--lidar] [world.yaml ...]\n",
                why);
     return 2;
   };
@@ -826,10 +868,15 @@ int Main(int argc, char** argv) {
     const bool has_value = i + 1 < argc;
     if (a == "--frames" && has_value) {
       frames = PositiveArg(argv[++i]);
+      frames_given = true;
       if (frames == 0) return usage("--frames: expected a positive integer");
     } else if (a == "--host-threads" && has_value) {
       host_threads = PositiveArg(argv[++i]);
       if (host_threads == 0) return usage("--host-threads: expected a positive integer");
+    } else if (a == "--lidar") {
+      lidar_rows = true;
+    } else if (a == "--statics") {
+      statics = true;
     } else if (a == "--no-cpu") {
       cpu_rows = false;
     } else if (a == "--sessions" && has_value) {
@@ -873,6 +920,7 @@ int Main(int argc, char** argv) {
   if (worlds.empty())
     worlds = {std::string(PENUMBRA_SOURCE_DIR) + "/worlds/default.yaml",
               std::string(PENUMBRA_SOURCE_DIR) + "/worlds/house.yaml"};
+  if (statics) return StaticsMain(worlds, frames_given ? frames : 2, host_threads);
   const CudaDeviceStatus dev = ProbeCudaDevice();
   fmt::print("device: {}\n", dev.available ? dev.name : "none (" + dev.why + ")");
   if ((parity || realtime || media || pathtraced || !batch.empty()) && !dev.available) {
@@ -1226,6 +1274,51 @@ int Main(int argc, char** argv) {
       if (with_fx)
         rows.push_back({name, size, "rgb+depth realtime + effects", "cpu", "Render()",
                         1 / TimeRenders(cpu.get(), snap, rgb, nc, fx.get())});
+    }
+    if (gpu && lidar_rows) {
+      // the realtime kernels alone at both sizes, 3 rounds, then a LiDAR's CudaRayQuery (its own
+      // BVH and device copy of the scene, as MakeRayQuery makes for a LiDAR on backend cuda)
+      // traces one 32 x 1800 scan and stays alive, then the same 3 rounds: a second device copy
+      // of the geometry slowed the realtime kernels 2-7 % even once freed ("Taken back: the
+      // statics' rays on the GPU", docs/gpu.md), so the rows before it come first, and a run
+      // should name one world.
+      auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+      auto time_kernels = [&](const char* label) {
+        for (int round = 0; round < 3; ++round)
+          for (auto [w, h] : {std::pair{640, 480}, std::pair{128, 128}}) {
+            CameraView rgb;
+            rgb.X_WO = CameraPoseInWorld(cam, snap);
+            rgb.intrinsics = CameraIntrinsics::FromFovy(w, h, fovy_deg);
+            rgb.near_m = cam.near_m;
+            rgb.outputs[ImageKind::kRgb] = rgb.outputs[ImageKind::kDepth] = true;
+            RenderedFrame f;
+            gpu->Render(snap, rgb, &f);
+            const int n = w * h < 100000 ? frames * 10 : frames;
+            const double ms = g->device_realtime().TimeKernels(&g->device(), n);
+            rows.push_back(
+                {name, fmt::format("{}x{}", w, h), label, "cuda", "kernels only", 1e3 / ms});
+          }
+      };
+      time_kernels("rgb+depth realtime, no LiDAR query yet");
+      cuda::CudaRayQuery lidar(scene);
+      lidar.Update(snap);
+      std::vector<Ray> scan;
+      const Eigen::Vector3f o = CameraPoseInWorld(cam, snap).translation().cast<float>();
+      for (int e = 0; e < 32; ++e)
+        for (int a = 0; a < 1800; ++a) {
+          const float el = static_cast<float>((-15.0 + e * (30.0 / 31)) * M_PI / 180),
+                      az = static_cast<float>(a * (2 * M_PI / 1800));
+          Ray r;
+          r.o = o;
+          r.d = Eigen::Vector3f(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                                std::sin(el));
+          r.tmax = 100;
+          scan.push_back(r);
+        }
+      std::vector<SurfaceHit> hits(scan.size());
+      std::unique_ptr<bool[]> did(new bool[scan.size()]);
+      lidar.Intersect(scan, hits, std::span<bool>(did.get(), scan.size()));
+      time_kernels("rgb+depth realtime, a LiDAR's CudaRayQuery alive");
     }
   }
   // ms/frame: the mean, then for Render() rows the median and the slowest frame

@@ -79,7 +79,7 @@ std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,
     case RenderSettings::Backend::kCuda: {
       RequireCuda();
 #if PENUMBRA_WITH_CUDA
-      return std::make_unique<cuda::CudaRenderer>(scene, settings);
+      return std::make_unique<cuda::CudaRenderer>(scene, settings, StaticMapsQueryFactory());
 #else
       break;
 #endif
@@ -89,6 +89,8 @@ std::unique_ptr<Renderer> MakeRenderer(const SceneDescription& scene,
   }
   ThrowUnknownBackend(settings.backend);
 }
+
+RayQueryFactory StaticMapsQueryFactory() { return RaySceneFactory(); }
 
 std::unique_ptr<RayQuery> MakeRayQuery(const SceneDescription& scene,
                                        RenderSettings::Backend backend) {

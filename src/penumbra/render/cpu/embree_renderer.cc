@@ -41,13 +41,8 @@ EmbreeRenderer::EmbreeRenderer(const SceneDescription& scene, const RenderSettin
       materials_(scene_, settings_.max_anisotropy),
       lights_(scene_),
       sky_(scene_.sky, MjcfSkyboxOf(scene_)),
-      effects_(scene_,
-               [](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
-                 return std::make_unique<RayScene>(statics);
-               }),
-      sky_volume_([](const SceneDescription& statics) -> std::unique_ptr<RayQuery> {
-        return std::make_unique<RayScene>(statics);
-      }),
+      effects_(scene_, RaySceneFactory()),
+      sky_volume_(RaySceneFactory()),
       film_(settings_),
       pool_(settings_.threads),
       integrator_(MakeIntegrator(settings_, scene_)) {

@@ -102,7 +102,8 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 
 std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds, int width,
                                          int height, std::span<const int> camera_counts,
-                                         int batches, const BatchOutputs& outputs) {
+                                         int batches, const BatchOutputs& outputs,
+                                         const RayQueryFactory& statics_query) {
   std::vector<BatchBenchRow> rows;
   int max_cameras = 1;
   for (int k : camera_counts) max_cameras = std::max(max_cameras, k);
@@ -113,6 +114,7 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
     config.max_cameras = max_cameras;
     config.outputs = outputs;
     config.copy = copy;
+    config.statics_query = statics_query;
     BatchRenderer r(config);
     for (const BatchBenchWorld& w : worlds) {
       const int i = r.AddWorld(*w.scene, w.settings);
@@ -140,14 +142,10 @@ std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds
       // where an rgb batch's GPU time goes: frames/s if the batch were that stage alone
       if (pinned && outputs.rgb) {
         const std::pair<const char*, double> stages[] = {
-            {"stage: geometry", st.geometry},
-            {"stage: sky terms", st.sky},
-            {"stage: shading", st.shade},
-            {"stage: shared visibility", st.visibility},
-            {"stage: mirror layer", st.mirror},
-            {"stage: row sums", st.row_sums},
-            {"stage: exposure", st.exposure},
-            {"stage: film", st.film}};
+            {"stage: geometry", st.geometry},   {"stage: sky terms", st.sky},
+            {"stage: shading", st.shade},       {"stage: shared visibility", st.visibility},
+            {"stage: mirror layer", st.mirror}, {"stage: row sums", st.row_sums},
+            {"stage: exposure", st.exposure},   {"stage: film", st.film}};
         for (const auto& [what, ms] : stages)
           rows.push_back({count, "cuda", what, ms > 0 ? count / (ms * 1e-3) : 0.0, ms});
         // the cameras of worlds with particles or media, rendered one by one (host wall time)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "penumbra/render/cuda/batch_layout.h"
+#include "penumbra/render/ray_query.h"
 #include "penumbra/render/render_settings.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
@@ -58,11 +59,13 @@ std::vector<CameraView> BatchBenchViews(std::span<const BatchBenchWorld> worlds,
 /// alone (worlds with PerCameraEffects) the host time of those (row "cameras rendered alone",
 /// frames/s of those cameras; BatchRenderer::alone_ms), and the CPU renderers rendering
 /// the same views one at a time (at least one batch; with rgb the realtime tier's rgb and
-/// depth).
+/// depth). `statics_query`: BatchConfig::statics_query (the bench passes MakeRenderer's,
+/// StaticMapsQueryFactory).
 /// @throws Error if the CUDA runtime fails.
 std::vector<BatchBenchRow> RunBatchBench(std::span<const BatchBenchWorld> worlds, int width,
                                          int height, std::span<const int> camera_counts,
-                                         int batches, const BatchOutputs& outputs);
+                                         int batches, const BatchOutputs& outputs,
+                                         const RayQueryFactory& statics_query = RayQueryFactory());
 
 /// the rows as a markdown table (world label in the first column).
 std::string FormatBatchBench(const std::string& label, int width, int height,

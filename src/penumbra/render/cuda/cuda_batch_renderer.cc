@@ -30,6 +30,7 @@ BatchRenderer::BatchRenderer(const BatchConfig& config)
       counts_(BatchTickets::kSlots, 0),
       alone_count_(BatchTickets::kSlots, 0),
       alone_ms_(BatchTickets::kSlots, 0),
+      statics_query_(config.statics_query),
       id_(NextRendererId()) {}
 
 BatchRenderer::~BatchRenderer() {
@@ -52,8 +53,8 @@ int BatchRenderer::AddWorld(const SceneDescription& scene, const RenderSettings&
   SyncDevice(*w->bvh, w->device.get());
   if (layout_.outputs().rgb) {
     // the scene-constant arrays, as CudaRenderer uploads them
-    w->realtime =
-        std::make_unique<RealtimeFrameData>(w->scene, settings, BvhRayQueryFactory(pool_.get()));
+    w->realtime = std::make_unique<RealtimeFrameData>(
+        w->scene, settings, statics_query_ ? statics_query_ : BvhRayQueryFactory(pool_.get()));
     w->device_realtime = std::make_unique<DeviceRealtime>();
     const RealtimeFrameData& d = *w->realtime;
     RealtimeStatic st;
@@ -91,7 +92,7 @@ void BatchRenderer::UpdateWorld(int world, const WorldSnapshot& snapshot,
     if (!w.single) {
       RenderSettings settings = w.settings;
       settings.tier = RenderSettings::Tier::kRealtime;
-      w.single = std::make_unique<CudaRenderer>(w.scene, settings);
+      w.single = std::make_unique<CudaRenderer>(w.scene, settings, statics_query_);
       w.single->set_radiance_output(false);
     }
     w.snapshot = snapshot;

@@ -53,6 +53,12 @@ struct BatchConfig {
   int max_cameras = 1024;  ///< most cameras in one batch (sizes the buffers), 1 to 65535
   BatchOutputs outputs;    ///< default depth and segmentation
   BatchCopy copy = BatchCopy::kPinned;
+  /// the ray queries the rgb worlds' static maps (sky irradiance volume, shelter map) are
+  /// traced through (CudaRenderer's `statics_query`); empty: BvhRayQuery over the batch's host
+  /// threads. a batch camera gives CudaRenderer's bits for the same view when both take the
+  /// same: StaticMapsQueryFactory() (render/backends/renderer_factory.h) for a renderer made by
+  /// MakeRenderer.
+  RayQueryFactory statics_query;
 };
 
 /// the images of one batch, on the host (BatchRenderer::Wait) or on the device
@@ -238,7 +244,8 @@ class BatchRenderer {
     CameraIntrinsics intrinsics;
     std::vector<float> xy;
   };
-  uint64_t id_;  // tables_owner of this renderer's cameras
+  RayQueryFactory statics_query_;  // BatchConfig::statics_query
+  uint64_t id_;                    // tables_owner of this renderer's cameras
   CameraRayTables ray_tables_;
   std::vector<XyTable> xy_tables_;
   std::vector<std::vector<float>> rows_tables_;

@@ -26,18 +26,20 @@ T* Shape(Image<T>* img, bool want, int w, int h, int c) {
 
 CudaRenderer::CudaRenderer(const SceneDescription& scene) : CudaRenderer(scene, RenderSettings()) {}
 
-CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& settings)
+CudaRenderer::CudaRenderer(const SceneDescription& scene, const RenderSettings& settings,
+                           RayQueryFactory statics_query)
     : scene_(scene) {
   // the pool first: the BVHs (the scene's and the statics' maps') are built over it
   pool_ = std::make_unique<ThreadPool>(settings.threads);
   bvh_ = std::make_unique<BvhScene>(scene_, pool_.get());
   device_ = std::make_unique<DeviceScene>();
   SyncDevice(*bvh_, device_.get());
-  // the statics' maps trace on the host: their rays on the GPU made the first frame shorter, but
-  // a second device copy of the geometry made every later frame's kernels 2-7 % slower
-  // ("A new renderer's first frame" in docs/gpu.md)
-  realtime_ =
-      std::make_unique<RealtimeFrameData>(scene_, settings, BvhRayQueryFactory(pool_.get()));
+  // the statics' maps trace on the host (MakeRenderer's renderer through Embree, as the CPU
+  // backend's): their rays on the GPU made the first frame shorter, but a second device copy of
+  // the geometry made every later frame's kernels 2-7 % slower ("A new renderer's first frame"
+  // in docs/gpu.md)
+  realtime_ = std::make_unique<RealtimeFrameData>(
+      scene_, settings, statics_query ? std::move(statics_query) : BvhRayQueryFactory(pool_.get()));
   device_realtime_ = std::make_unique<DeviceRealtime>();
   device_path_ = std::make_unique<DevicePath>();
   if (settings.tier == RenderSettings::Tier::kPathtraced) {

@@ -41,8 +41,13 @@ class CudaRenderer final : public Renderer {
   /// @throws Error as BvhScene, or if the CUDA runtime fails.
   explicit CudaRenderer(const SceneDescription& scene);
   /// as above, with the render settings of the GPU's rgb (tier, film, anisotropy, seed; the
-  /// one-argument form takes the default RenderSettings).
-  CudaRenderer(const SceneDescription& scene, const RenderSettings& settings);
+  /// one-argument form takes the default RenderSettings). `statics_query` makes the ray queries
+  /// the realtime tier's static maps (sky irradiance volume, shelter map) are traced through
+  /// before the first frame and when a static body moves (RealtimeFrameData); empty: BvhRayQuery
+  /// over the renderer's host threads. MakeRenderer passes Embree's (StaticMapsQueryFactory,
+  /// render/backends/renderer_factory.h), the CPU backend's.
+  CudaRenderer(const SceneDescription& scene, const RenderSettings& settings,
+               RayQueryFactory statics_query = RayQueryFactory());
   ~CudaRenderer() override;
 
   void Render(const WorldSnapshot& snapshot, const EffectsFrame* effects, const CameraView& view,

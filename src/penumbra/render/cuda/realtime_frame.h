@@ -54,8 +54,8 @@ class RealtimeFrameData {
   /// copies the materials, textures and geoms of `scene` (referenced: it must outlive this).
   /// `settings`: the tier's film, anisotropy and seed. `statics_query` makes the ray queries
   /// over the static geoms that the sky irradiance volume and the shelter map trace when they
-  /// are built (empty: BvhRayQuery, the traversal on the CPU; CudaRenderer and the batch pass
-  /// CudaRayQuery's, so those rays run on the GPU).
+  /// are built (empty: BvhRayQuery, our traversal on the CPU; CudaRenderer and the batch pass
+  /// theirs: MakeRenderer's renderer Embree's, as the CPU backend's maps).
   /// @throws Error if a texture has more than kMaxTextureLevels levels.
   RealtimeFrameData(const SceneDescription& scene, const RenderSettings& settings,
                     RayQueryFactory statics_query = RayQueryFactory());

@@ -853,4 +853,10 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
   return static_only;
 }
 
+RayQueryFactory RaySceneFactory() {
+  return [](const SceneDescription& scene) -> std::unique_ptr<RayQuery> {
+    return std::make_unique<RayScene>(scene);
+  };
+}
+
 }  // namespace penumbra

@@ -147,4 +147,8 @@ class RayScene final : public RayQuery {
   int64_t num_top_level_commits_ = 0;
 };
 
+/// a RayQueryFactory (render/ray_query.h) of RayScenes: what the realtime tiers' static maps
+/// (sky irradiance volume, shelter map) and the CPU backend's effects trace through.
+RayQueryFactory RaySceneFactory();
+
 }  // namespace penumbra
