@@ -77,6 +77,8 @@
 // BVH build time. usage:
 // --lidar (the default rows; name one world): the realtime kernels alone before and after a
 // LiDAR's CudaRayQuery of the scene traced a scan in the process, 3 rounds at each size.
+// --lidar-first (the default rows): a LiDAR's CudaRayQuery made and tracing a scan right after
+// the CUDA renderer, before its first frame (as a run's LiDAR sink), alive for the world's rows.
 // --statics [--frames N]: the static maps' build through our host traversal and through Embree,
 // N rounds interleaved (default 2; no GPU needed).
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
@@ -807,6 +809,26 @@ int PathtracedMain(const std::vector<std::string>& worlds, int width, int height
   return 0;
 }
 
+// a LiDAR's scan through `query` posed at `snap`: 32 x 1800 rays from `origin_W`, elevations
+// -15..15 deg, every azimuth, up to 100 m (the hits are not kept).
+void TraceLidarScan(RayQuery* query, const WorldSnapshot& snap, const Eigen::Vector3d& origin_W) {
+  query->Update(snap);
+  std::vector<Ray> scan;
+  for (int e = 0; e < 32; ++e)
+    for (int a = 0; a < 1800; ++a) {
+      const float el = static_cast<float>((-15.0 + e * (30.0 / 31)) * M_PI / 180),
+                  az = static_cast<float>(a * (2 * M_PI / 1800));
+      Ray r;
+      r.o = origin_W.cast<float>();
+      r.d = Eigen::Vector3f(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      r.tmax = 100;
+      scan.push_back(r);
+    }
+  std::vector<SurfaceHit> hits(scan.size());
+  std::unique_ptr<bool[]> did(new bool[scan.size()]);
+  query->Intersect(scan, hits, std::span<bool>(did.get(), scan.size()));
+}
+
 // --statics: the static maps a new realtime renderer builds before its first frame (the sky
 // irradiance volume and, for worlds with particles, the shelter map), traced through our
 // traversal on the host's threads (BvhRayQuery, CudaRenderer's default) and through Embree
@@ -850,7 +872,8 @@ int Main(int argc, char** argv) {
   // the single-camera rows: the CUDA renderer's host threads (RenderSettings::threads; 0 = all
   // cores), and whether the CPU backend's rows run too
   int host_threads = 0;
-  bool cpu_rows = true, statics = false, frames_given = false, lidar_rows = false;
+  bool cpu_rows = true, statics = false, frames_given = false, lidar_rows = false,
+       lidar_first = false;
   std::vector<int> batch;
   std::vector<std::string> worlds;
   const auto usage = [](const std::string& why) {
@@ -859,7 +882,7 @@ int Main(int argc, char** argv) {
                "[--size WxH] [--sessions S] | --parity [--size WxH] | --realtime [--size WxH] | "
                "--media [--size WxH] | "
                "--pathtraced [--size WxH] [--spp N] | --statics] "
-               "[--host-threads N] [--no-cpu] [--lidar] [world.yaml ...]\n",
+               "[--host-threads N] [--no-cpu] [--lidar | --lidar-first] [world.yaml ...]\n",
                why);
     return 2;
   };
@@ -875,6 +898,8 @@ int Main(int argc, char** argv) {
       if (host_threads == 0) return usage("--host-threads: expected a positive integer");
     } else if (a == "--lidar") {
       lidar_rows = true;
+    } else if (a == "--lidar-first") {
+      lidar_first = true;
     } else if (a == "--statics") {
       statics = true;
     } else if (a == "--no-cpu") {
@@ -967,6 +992,7 @@ int Main(int argc, char** argv) {
     cpu_settings.threads = 0;
     const std::unique_ptr<Renderer> cpu = cpu_rows ? MakeRenderer(scene, cpu_settings) : nullptr;
     std::unique_ptr<Renderer> gpu;
+    std::unique_ptr<cuda::CudaRayQuery> lidar_query;  // --lidar-first
     if (dev.available) {
       RenderSettings gpu_settings;
       gpu_settings.backend = RenderSettings::Backend::kCuda;
@@ -975,6 +1001,12 @@ int Main(int argc, char** argv) {
       gpu = MakeRenderer(scene, gpu_settings);
       const double s = std::chrono::duration<double>(Clock::now() - t0).count();
       auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
+      // --lidar-first: a LiDAR's CudaRayQuery made and tracing before the renderer's first frame
+      // (as a run's LiDAR sink makes it at set-up), alive for all the world's rows
+      if (lidar_first) {
+        lidar_query = std::make_unique<cuda::CudaRayQuery>(scene);
+        TraceLidarScan(lidar_query.get(), snap, CameraPoseInWorld(cam, snap).translation());
+      }
       // the renderer's BVH is built over its pool; the same scene on one thread beside it
       const cuda::BvhScene serial(scene);
       builds.push_back(fmt::format(
@@ -1301,23 +1333,7 @@ int Main(int argc, char** argv) {
       };
       time_kernels("rgb+depth realtime, no LiDAR query yet");
       cuda::CudaRayQuery lidar(scene);
-      lidar.Update(snap);
-      std::vector<Ray> scan;
-      const Eigen::Vector3f o = CameraPoseInWorld(cam, snap).translation().cast<float>();
-      for (int e = 0; e < 32; ++e)
-        for (int a = 0; a < 1800; ++a) {
-          const float el = static_cast<float>((-15.0 + e * (30.0 / 31)) * M_PI / 180),
-                      az = static_cast<float>(a * (2 * M_PI / 1800));
-          Ray r;
-          r.o = o;
-          r.d = Eigen::Vector3f(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
-                                std::sin(el));
-          r.tmax = 100;
-          scan.push_back(r);
-        }
-      std::vector<SurfaceHit> hits(scan.size());
-      std::unique_ptr<bool[]> did(new bool[scan.size()]);
-      lidar.Intersect(scan, hits, std::span<bool>(did.get(), scan.size()));
+      TraceLidarScan(&lidar, snap, CameraPoseInWorld(cam, snap).translation());
       time_kernels("rgb+depth realtime, a LiDAR's CudaRayQuery alive");
     }
   }
