@@ -629,6 +629,29 @@ std::vector<Ray> ShadowRaysBetweenHits(const cuda::SceneView& s, int w, int h) {
   return rays;
 }
 
+// every moving body of `scene` in *snap turned 0.5 rad about z and put in front of the first
+// eye, along the fans' directions 0.8 to 2 m away (where the fans and the shadow rays meet it);
+// piles: instead four piles of them, each body of a pile at one pose, 1.2 m along each direction
+// (equal shapes there hit rays at equal t). returns how many bodies moved.
+int MoveBodiesBeforeTheFirstEye(const SceneDescription& scene, WorldSnapshot* snap, bool piles) {
+  int moved = 0;
+  const Eigen::Vector3d aheads[4] = {{1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
+  for (const RayGeomGroup& g : GroupRayGeoms(scene, "test")) {
+    if (g.body < 0) continue;
+    Pose& X = snap->X_WB[g.body];
+    if (piles) {
+      X = Pose(Eigen::AngleAxisd(0.5 * (moved % 4), Eigen::Vector3d::UnitZ()));
+      X.translation() = Eigen::Vector3d(0, 0, 1.2) + 1.2 * aheads[moved % 4].normalized();
+    } else {
+      X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+      X.translation() = Eigen::Vector3d(0, 0, 1.2) +
+                        (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
+    }
+    ++moved;
+  }
+  return moved;
+}
+
 // a stack of kKeep entries whose deeper entries become empty leaves (their subtrees skipped in
 // either order): shows the verdicts' comparison below sees a wrong occlusion traversal.
 template <int kKeep>
@@ -733,20 +756,7 @@ TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
     } else {
       EXPECT_GT(stale_differ, 0);
     }
-    // every moving body turned 0.5 rad about z and put in front of the first eye, along the
-    // fans' directions 0.8 to 2 m away (where the fans and the shadow rays meet it)
-    int moved = 0;
-    const Eigen::Vector3d aheads[4] = {
-        {1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
-    for (const RayGeomGroup& g : GroupRayGeoms(posed.session->scene(), "test")) {
-      if (g.body < 0) continue;
-      Pose& X = snap.X_WB[g.body];
-      X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
-      X.translation() = Eigen::Vector3d(0, 0, 1.2) +
-                        (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
-      ++moved;
-    }
-    ASSERT_GT(moved, 0);
+    ASSERT_GT(MoveBodiesBeforeTheFirstEye(posed.session->scene(), &snap, false), 0);
     posed.embree->Update(snap);
     posed.bvh->Update(snap);
   }
@@ -873,26 +883,8 @@ TEST_P(CudaBvhClosestWorlds, ClosestThroughTheTopLevelGivesTheFlatLoopsHits) {
     EXPECT_GT(c.hits, c.rays / 2);
     ties += c.ties;
     no_rule_differ += c.no_rule_differ;
-    // pose 1: every moving body turned 0.5 rad about z and put in front of the first eye, along
-    // the fans' directions 0.8 to 2 m away; pose 2: four piles of them, each body of a pile at
-    // the same pose, 1.2 m along each direction
-    int moved = 0;
-    const Eigen::Vector3d aheads[4] = {
-        {1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
-    for (const RayGeomGroup& g : GroupRayGeoms(posed.session->scene(), "test")) {
-      if (g.body < 0) continue;
-      Pose& X = snap.X_WB[g.body];
-      if (pose == 0) {
-        X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
-        X.translation() = Eigen::Vector3d(0, 0, 1.2) +
-                          (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
-      } else {
-        X = Pose(Eigen::AngleAxisd(0.5 * (moved % 4), Eigen::Vector3d::UnitZ()));
-        X.translation() = Eigen::Vector3d(0, 0, 1.2) + 1.2 * aheads[moved % 4].normalized();
-      }
-      ++moved;
-    }
-    ASSERT_GT(moved, 0);
+    // pose 1: the moving bodies in front of the first eye; pose 2: piled up there
+    ASSERT_GT(MoveBodiesBeforeTheFirstEye(posed.session->scene(), &snap, pose > 0), 0);
     posed.bvh->Update(snap);
   }
   // the ties are there in some worlds only; where they are, no tie rule changes hits

@@ -410,6 +410,7 @@ PB_HOST_DEVICE inline float ClosestTieBound(float t, float tmax) {
 /// same point may differ by a few floats either way: hence the margin (kMargin), so an equal-t
 /// instance below the best one finds its hit when its box's t0 is beyond t* by up to 2^-12 of
 /// t* (kNextUp, one float, and kNone miss such ties: tests/render/cuda/bvh_traversal_test.cc,
+/// ClosestThroughTheTopLevelKeepsTheLowerInstanceOnATie and
 /// ClosestThroughTheTopLevelGivesTheFlatLoopsHits). the loop itself culls with t0 in the same
 /// way; a hit of instance i hidden behind a box t0 beyond the best t by more than the margin is
 /// missed by both when searched with a bound below that t0, and by one of them only where the
