@@ -629,6 +629,29 @@ std::vector<Ray> ShadowRaysBetweenHits(const cuda::SceneView& s, int w, int h) {
   return rays;
 }
 
+// every moving body of `scene` in *snap turned 0.5 rad about z and put in front of the first
+// eye, along the fans' directions 0.8 to 2 m away (where the fans and the shadow rays meet it);
+// piles: instead four piles of them, each body of a pile at one pose, 1.2 m along each direction
+// (equal shapes there hit rays at equal t). returns how many bodies moved.
+int MoveBodiesBeforeTheFirstEye(const SceneDescription& scene, WorldSnapshot* snap, bool piles) {
+  int moved = 0;
+  const Eigen::Vector3d aheads[4] = {{1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
+  for (const RayGeomGroup& g : GroupRayGeoms(scene, "test")) {
+    if (g.body < 0) continue;
+    Pose& X = snap->X_WB[g.body];
+    if (piles) {
+      X = Pose(Eigen::AngleAxisd(0.5 * (moved % 4), Eigen::Vector3d::UnitZ()));
+      X.translation() = Eigen::Vector3d(0, 0, 1.2) + 1.2 * aheads[moved % 4].normalized();
+    } else {
+      X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+      X.translation() = Eigen::Vector3d(0, 0, 1.2) +
+                        (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
+    }
+    ++moved;
+  }
+  return moved;
+}
+
 // a stack of kKeep entries whose deeper entries become empty leaves (their subtrees skipped in
 // either order): shows the verdicts' comparison below sees a wrong occlusion traversal.
 template <int kKeep>
@@ -733,20 +756,7 @@ TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
     } else {
       EXPECT_GT(stale_differ, 0);
     }
-    // every moving body turned 0.5 rad about z and put in front of the first eye, along the
-    // fans' directions 0.8 to 2 m away (where the fans and the shadow rays meet it)
-    int moved = 0;
-    const Eigen::Vector3d aheads[4] = {
-        {1, 0, -0.2}, {0, 1, -0.2}, {-1, 0.3, -0.1}, {0.2, -1, -0.4}};
-    for (const RayGeomGroup& g : GroupRayGeoms(posed.session->scene(), "test")) {
-      if (g.body < 0) continue;
-      Pose& X = snap.X_WB[g.body];
-      X = Pose(X * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
-      X.translation() = Eigen::Vector3d(0, 0, 1.2) +
-                        (0.8 + 0.3 * ((moved / 4) % 5)) * aheads[moved % 4].normalized();
-      ++moved;
-    }
-    ASSERT_GT(moved, 0);
+    ASSERT_GT(MoveBodiesBeforeTheFirstEye(posed.session->scene(), &snap, false), 0);
     posed.embree->Update(snap);
     posed.bvh->Update(snap);
   }
@@ -754,6 +764,216 @@ TEST_P(CudaBvhWorlds, OcclusionThroughTheTopLevelGivesTheFlatListsVerdicts) {
 
 INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhWorlds,
                          ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml"));
+
+// the top level `s.tlas` with each leaf's instances in reverse order (the arrays it points to
+// kept in *nodes, *instances): a top level as valid as BuildBvh's, which visits the instances of
+// a leaf the other way round, so a tie between two instances of one leaf is met in both orders.
+cuda::SceneView ReversedLeaves(const cuda::SceneView& s, std::vector<cuda::BvhWideNode>* nodes,
+                               std::vector<int32_t>* instances) {
+  nodes->assign(s.tlas_nodes, s.tlas_nodes + s.tlas.num_nodes);
+  instances->assign(s.tlas_instances, s.tlas_instances + s.num_instances);
+  std::vector<std::array<int, 2>> todo = {{s.tlas.root_first, s.tlas.root_count}};
+  while (!todo.empty()) {
+    const auto [first, count] = todo.back();
+    todo.pop_back();
+    if (count >= 0) {
+      std::reverse(instances->begin() + first, instances->begin() + first + count);
+      continue;
+    }
+    const cuda::BvhWideNode& n = (*nodes)[first];
+    for (int c = 0; c < 2; ++c) todo.push_back({n.first[c], n.count[c]});
+  }
+  cuda::SceneView r = s;
+  r.tlas_nodes = nodes->empty() ? nullptr : nodes->data();
+  r.tlas_instances = instances->data();
+  return r;
+}
+
+// how many instances, each searched alone as the flat loop searches it (its box, its BLAS, no
+// bound but the ray's), hit ray r at exactly t: 2 or more is a tie the loop decides by index.
+int InstancesHittingAt(const cuda::SceneView& s, const cuda::TraceRay& r, float t) {
+  int n = 0;
+  for (int i = 0; i < s.num_instances; ++i) {
+    cuda::SceneView one = s;
+    one.instances = s.instances + i;
+    one.num_instances = 1;
+    one.closest_tlas = 0;
+    cuda::TraceHit h;
+    cuda::TraceClosest(one, r, &h);
+    n += h.instance == 0 && std::memcmp(&h.t, &t, sizeof(float)) == 0;
+  }
+  return n;
+}
+
+// TraceClosest through the top level (BuildBvh's and the one with reversed leaves) against the
+// flat loop (closest_tlas 0), and the variants of its tie rule (ClosestTies).
+struct ClosestComparison {
+  int64_t rays = 0, hits = 0, ties = 0;
+  int64_t differ = 0, reversed_differ = 0;         // must stay 0
+  int64_t next_up_differ = 0, no_rule_differ = 0;  // either top level, the variants
+
+  void Add(const cuda::SceneView& s, const cuda::SceneView& reversed, const cuda::TraceRay& r) {
+    cuda::SceneView flat = s;
+    flat.closest_tlas = 0;
+    cuda::TraceHit want, got, rev, next_up[2], no_rule[2];
+    cuda::TraceClosest(flat, r, &want);
+    cuda::TraceClosest(s, r, &got);
+    cuda::TraceClosest(reversed, r, &rev);
+    using cuda::ClosestTies;
+    cuda::TraceClosest<cuda::LocalBvhStack, ClosestTies::kNextUp>(s, r, &next_up[0]);
+    cuda::TraceClosest<cuda::LocalBvhStack, ClosestTies::kNextUp>(reversed, r, &next_up[1]);
+    cuda::TraceClosest<cuda::LocalBvhStack, ClosestTies::kNone>(s, r, &no_rule[0]);
+    cuda::TraceClosest<cuda::LocalBvhStack, ClosestTies::kNone>(reversed, r, &no_rule[1]);
+    ++rays;
+    differ += !SameHit(got, want);
+    reversed_differ += !SameHit(rev, want);
+    next_up_differ += !SameHit(next_up[0], want) || !SameHit(next_up[1], want);
+    no_rule_differ += !SameHit(no_rule[0], want) || !SameHit(no_rule[1], want);
+    if (want.instance < 0) return;
+    ++hits;
+    ties += InstancesHittingAt(s, r, want.t) >= 2;
+  }
+  void Print(const std::string& what) const {
+    std::printf(
+        "%s: %lld rays, %lld hits, %lld ties between instances; differ from the flat loop: "
+        "%lld (reversed leaves %lld), one float above the best t %lld, no tie rule %lld\n",
+        what.c_str(), static_cast<long long>(rays), static_cast<long long>(hits),
+        static_cast<long long>(ties), static_cast<long long>(differ),
+        static_cast<long long>(reversed_differ), static_cast<long long>(next_up_differ),
+        static_cast<long long>(no_rule_differ));
+  }
+};
+
+// the bundled worlds (and one with agents) for the closest-hit comparison.
+class CudaBvhClosestWorlds : public CudaBvhWorlds {};
+
+// closest hits through the top level over the instances (TraceClosest's default) are the flat
+// index-order loop's, every field bit for bit, on camera fans from four eyes and on segments
+// between their hits; again with every moving body moved and turned (BvhScene::Update rebuilds
+// the top level), and with the moving bodies piled up four by four at one pose each, where
+// equal shapes (the crowd's people) and the bodies' shared planes give ties between instances;
+// also through a top level whose leaves list their instances the other way round. the variants
+// of the tie rule show the comparison can fail (the counts are in docs/gpu.md, "Closest hits
+// through the top level (branch gpu36)").
+TEST_P(CudaBvhClosestWorlds, ClosestThroughTheTopLevelGivesTheFlatLoopsHits) {
+  Posed posed = LoadPosed();
+  const cuda::BvhScene& bvh = posed.bvh->bvh();
+  WorldSnapshot snap = posed.session->sim().Snapshot();
+  int64_t ties = 0, no_rule_differ = 0;
+  for (int pose = 0; pose < 3; ++pose) {
+    const cuda::SceneView s = bvh.view();
+    ASSERT_NE(s.tlas_instances, nullptr);
+    std::vector<cuda::BvhWideNode> nodes;
+    std::vector<int32_t> instances;
+    const cuda::SceneView reversed = ReversedLeaves(s, &nodes, &instances);
+    ClosestComparison c;
+    for (const Eigen::Vector3f& eye :
+         {Eigen::Vector3f(0, 0, 1.2f), Eigen::Vector3f(2, 1, 1.2f),
+          Eigen::Vector3f(-2, -1.5f, 0.6f), Eigen::Vector3f(4, -3, 1.5f)})
+      for (const Eigen::Vector3f& ahead :
+           {Eigen::Vector3f(1, 0, -0.2f), Eigen::Vector3f(0, 1, -0.2f),
+            Eigen::Vector3f(-1, 0.3f, -0.1f), Eigen::Vector3f(0.2f, -1, -0.4f)})
+        for (const Ray& ray : RayFan(eye, ahead, 48, 36)) c.Add(s, reversed, cuda::ToTraceRay(ray));
+    for (const Ray& ray : ShadowRaysBetweenHits(s, 32, 24))
+      c.Add(s, reversed, cuda::ToTraceRay(ray));
+    c.Print(GetParam() + ", pose " + std::to_string(pose) + " (" + std::to_string(s.num_instances) +
+            " instances, top level of " + std::to_string(s.tlas.num_nodes) + " inner nodes)");
+    EXPECT_EQ(c.differ, 0);
+    EXPECT_EQ(c.reversed_differ, 0);
+    EXPECT_GT(c.hits, c.rays / 2);
+    ties += c.ties;
+    no_rule_differ += c.no_rule_differ;
+    // pose 1: the moving bodies in front of the first eye; pose 2: piled up there
+    ASSERT_GT(MoveBodiesBeforeTheFirstEye(posed.session->scene(), &snap, pose > 0), 0);
+    posed.bvh->Update(snap);
+  }
+  // the ties are there in some worlds only; where they are, no tie rule changes hits
+  std::printf("%s: %lld ties, no tie rule changed %lld hits\n", GetParam().c_str(),
+              static_cast<long long>(ties), static_cast<long long>(no_rule_differ));
+  if (ties > 0) {
+    EXPECT_GT(no_rule_differ, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Bundled, CudaBvhClosestWorlds,
+                         ::testing::Values("default.yaml", "house.yaml", "warehouse.yaml",
+                                           "effects/crowd.yaml"));
+
+// ties by construction: pairs of equal shapes (every kind) on two bodies at one pose, so two
+// instances give the same bits; boxes stacked and side by side on their own bodies, sharing
+// faces, with rays in the shared planes (the edges' hits of two instances a few floats apart).
+// through the top level (BuildBvh's, and with its leaves reversed) every hit is the flat loop's;
+// without the tie rule (ClosestTies::kNone) and with a bound one float above the best t
+// (kNextUp) hits differ (the counts are in docs/gpu.md, "Closest hits through the top level
+// (branch gpu36)").
+TEST(CudaBvhTraversal, ClosestThroughTheTopLevelKeepsTheLowerInstanceOnATie) {
+  SceneDescription scene = testing::EmptyScene();
+  using testing::AddGeom;
+  using testing::Translation;
+  AddGeom(&scene, GeomShape::kPlane, {5, 5, 0.1}, Translation(0, 0, 0));
+  AddGeom(&scene, GeomShape::kBox, {0.2, 2, 1}, Translation(4, 0, 1));
+  const struct {
+    GeomShape shape;
+    Eigen::Vector3d size;
+  } shapes[] = {{GeomShape::kBox, {0.2, 0.15, 0.1}},        {GeomShape::kSphere, {0.15, 0, 0}},
+                {GeomShape::kCapsule, {0.1, 0.15, 0}},      {GeomShape::kCylinder, {0.12, 0.1, 0}},
+                {GeomShape::kEllipsoid, {0.15, 0.1, 0.12}}, {GeomShape::kBox, {0.1, 0.1, 0.1}}};
+  WorldSnapshot snap;
+  std::vector<Pose> poses;
+  for (int k = 0; k < 6; ++k) {
+    Pose X = Translation(2, -1.25 + 0.5 * k, 0.25);
+    X.linear() =
+        Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    for (int twin = 0; twin < 2; ++twin) {
+      const int b =
+          testing::AddBody(&scene, "pair" + std::to_string(k) + "_" + std::to_string(twin));
+      AddGeom(&scene, shapes[k].shape, shapes[k].size, Pose::Identity(), b);
+      poses.push_back(X);
+    }
+  }
+  // three boxes of 0.25 m: two stacked (faces at z = 0.25), one beside the lower (y = 1.875)
+  for (const Eigen::Vector3d& p :
+       {Eigen::Vector3d(2.5, 1.75, 0.125), Eigen::Vector3d(2.5, 1.75, 0.375),
+        Eigen::Vector3d(2.5, 2.0, 0.125)}) {
+    const int b = testing::AddBody(&scene, "stack" + std::to_string(poses.size()));
+    AddGeom(&scene, GeomShape::kBox, {0.125, 0.125, 0.125}, Pose::Identity(), b);
+    poses.push_back(Translation(p.x(), p.y(), p.z()));
+  }
+  snap = testing::IdentitySnapshot(scene);
+  for (size_t k = 0; k < poses.size(); ++k) snap.X_WB[k + 1] = poses[k];
+  cuda::BvhRayQuery query(scene);
+  query.Update(snap);
+  const cuda::SceneView s = query.bvh().view();
+  ASSERT_EQ(s.num_instances, 16);
+  ASSERT_NE(s.tlas_instances, nullptr);
+  ASSERT_GT(s.tlas.num_nodes, 1);
+  std::vector<cuda::BvhWideNode> nodes;
+  std::vector<int32_t> instances;
+  const cuda::SceneView reversed = ReversedLeaves(s, &nodes, &instances);
+  ClosestComparison c;
+  // fans at the pairs from three eyes, and fans in the shared planes z = 0.25 and y = 1.875
+  for (const Eigen::Vector3f& eye : {Eigen::Vector3f(0, 0, 0.6f), Eigen::Vector3f(1, -2, 1.2f),
+                                     Eigen::Vector3f(1.2f, 2.5f, 0.9f)})
+    for (const Ray& ray : RayFan(eye, Eigen::Vector3f(2, 0, 0.25f) - eye, 96, 72, 0.7f))
+      c.Add(s, reversed, cuda::ToTraceRay(ray));
+  for (int k = 0; k < 4000; ++k) {
+    const float a = -0.9f + 1.8f * k / 3999;
+    cuda::TraceRay r;
+    r.tmin = 0.01f;
+    r.tmax = INFINITY;
+    r.o = {0.5f, 1.875f + std::sin(a), 0.25f};  // in the plane z = 0.25
+    r.d = {std::cos(a), -std::sin(a) * 0.9f, 0};
+    c.Add(s, reversed, r);
+    r.o = {0.5f + std::sin(a), 1.875f, 0.05f + 0.4f * k / 3999};  // in the plane y = 1.875
+    r.d = {std::cos(a) * 1.5f, 0, std::sin(a) * 0.1f};
+    c.Add(s, reversed, r);
+  }
+  c.Print("pairs and stacked boxes");
+  EXPECT_EQ(c.differ, 0);
+  EXPECT_EQ(c.reversed_differ, 0);
+  EXPECT_GT(c.ties, 1000);
+  EXPECT_GT(c.no_rule_differ, 100);
+}
 
 }  // namespace
 }  // namespace penumbra

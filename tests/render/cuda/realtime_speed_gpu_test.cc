@@ -81,8 +81,10 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
                          "packed_window_counts off",
                          "staged_window off",
                          "window_verdict_rows off",
-                         "occlusion_tlas off"};
-  for (int k = 0; k < 33; ++k) {
+                         "occlusion_tlas off",
+                         "closest_tlas off",
+                         "closest_tlas off, occlusion_tlas off"};
+  for (int k = 0; k < 35; ++k) {
     cuda::RealtimeKernelOptions o = fast;
     if (k == 0) o.reuse_hit = false;
     if (k == 1) o.rows_per_warp = false;
@@ -120,7 +122,8 @@ TEST_P(RealtimeSpeedUps, ChangeNoPixel) {
     if (k == 29) o.packed_window_counts = false;
     if (k == 30) o.staged_window = false;
     if (k == 31) o.window_verdict_rows = false;
-    if (k == 32) o.occlusion_tlas = false;
+    if (k == 32 || k == 34) o.occlusion_tlas = false;
+    if (k == 33 || k == 34) o.closest_tlas = false;
     variants.push_back({names[k], o});
   }
   for (const Variant& var : variants) {

@@ -616,6 +616,11 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o = fast;
     o.occlusion_tlas = false;
     variants.push_back({"kernels, occlusion rays through every instance (no top level)", o});
+    o = fast;
+    o.closest_tlas = false;
+    variants.push_back({"kernels, closest hits through every instance (no top level)", o});
+    o.occlusion_tlas = false;
+    variants.push_back({"kernels, no top level (closest and occlusion)", o});
 
     o = fast;
     o.rows_per_warp = false;
@@ -625,7 +630,7 @@ int RealtimeMain(const std::vector<std::string>& worlds, int width, int height, 
     o.warp_penumbra = false;
     o.queue_penumbra = false;
     o.mirror_stream = o.fuse_resolve = o.shared_light_terms = o.queue_shadow_rays = false;
-    o.tile_visibility = o.tile_penumbra = o.occlusion_tlas = false;
+    o.tile_visibility = o.tile_penumbra = o.occlusion_tlas = o.closest_tlas = false;
     o.min_blocks = o.geometry_min_blocks = 1;
     variants.push_back({"kernels, all speed-ups off", o});
     const int kernel_frames = std::max(10, frames * 4);

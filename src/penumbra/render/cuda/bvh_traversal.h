@@ -3,9 +3,10 @@
 // PB_HOST_DEVICE functions: BvhRayQuery runs them on the CPU (and the tests check them there
 // against Embree), the CUDA kernels (cuda_kernels.cu) on the GPU.
 //
-// top level: closest hits test every instance whose world box the ray enters, in index order
-// (the lower instance wins a tie); occlusion rays walk a BVH over the instances' world boxes
-// (SceneView::tlas, any order) down to the instances whose boxes they enter. the ray is taken
+// top level: a BVH over the instances' world boxes (SceneView::tlas), walked by closest hits
+// nearer child first (the hit of the flat index-order loop, the lower instance winning a tie:
+// TraceClosest) and by occlusion rays in any order, down to the instances whose boxes they
+// enter; without it (or with the switches off) every instance in index order. the ray is taken
 // to the instance frame in float (as Embree's instancing). bottom level: a stack traversal over
 // nodes that hold their children's boxes (BvhWideNode: one 64-byte load a visit), the nearer child
 // first (occlusion: any order), slab tests of Williams et al., "An efficient and robust ray-box
@@ -52,11 +53,11 @@ struct ArrayBvhStack {
 /// TraverseWideBvh's stack for a BLAS: kMaxBvhDepth entries.
 using LocalBvhStack = ArrayBvhStack<kMaxBvhDepth>;
 
-/// deepest top level (SceneView::tlas) the occlusion traversal's stack holds: BvhScene leaves a
-/// deeper one out (TraceOccluded then tests every instance in turn).
+/// deepest top level (SceneView::tlas) the top-level traversal's stack holds: BvhScene leaves a
+/// deeper one out (TraceClosest and TraceOccluded then test every instance in turn).
 constexpr int kMaxTlasDepth = 16;
 
-/// the top level's stack (TraceOccluded): kMaxTlasDepth entries.
+/// the top level's stack (TraceClosest, TraceOccluded): kMaxTlasDepth entries.
 using TlasStack = ArrayBvhStack<kMaxTlasDepth>;
 
 /// p transformed by the row-major 3x4 matrix m (rotation and translation).
@@ -335,21 +336,120 @@ PB_HOST_DEVICE inline bool TraverseBlas(const SceneView& s, const Blas& blas, in
                                            any_hit, leaf);
 }
 
-/// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none.
-/// Stack: TraverseWideBvh's.
-template <class Stack = LocalBvhStack>
+/// the root TraceClosest and TraceOccluded walk the instances from: the top level s.tlas where
+/// `tree` (a view with one, its switch on), else one leaf of every instance in index order under
+/// a box of all space (the flat loop, through the same traversal).
+PB_HOST_DEVICE inline Blas TopLevelRoot(const SceneView& s, bool tree) {
+  Blas top = s.tlas;
+  if (!tree) {
+    top.root_first = 0;
+    top.root_count = s.num_instances;
+    for (int a = 0; a < 3; ++a) top.lo[a] = -3.4e38f, top.hi[a] = 3.4e38f;
+  }
+  return top;
+}
+
+/// how TraceClosest bounds an instance below the best hit's (its tie rule): the shipped
+/// kMargin, and two variants that the tests show differ from the flat loop (kNextUp: a bound
+/// one float above the best t; kNone: no tie rule, the best t itself).
+enum class ClosestTies { kMargin, kNextUp, kNone };
+
+/// TraceClosest's relative margin (kMargin): an instance below the best hit's searches up to
+/// t (1 + 2^-12), about 2,000 floats beyond t, where the BLAS's unpadded triangle boxes and
+/// Moller-Trumbore's t of the same point differ by a few floats.
+constexpr float kClosestTieMargin = 1.0f / 4096.0f;
+
+/// the bound TraceClosest gives an instance below the best hit's (best t `t`, the ray's tmax):
+/// above t (so an equal t of that instance is found), at most tmax.
+template <ClosestTies kTies>
+PB_HOST_DEVICE inline float ClosestTieBound(float t, float tmax) {
+  if constexpr (kTies == ClosestTies::kNone) {
+    return t;
+  } else {
+    float b = nextafterf(t, INFINITY);
+    if constexpr (kTies == ClosestTies::kMargin) b = SlabMax(b, t + fabsf(t) * kClosestTieMargin);
+    return b < tmax ? b : tmax;
+  }
+}
+
+/// closest hit of ray r in [tmin, tmax] over every instance; hit->instance == -1 if none: the
+/// flat loop's hit bit for bit (t, u, v, part, prim, instance), the loop that tests every
+/// instance in index order (its world box against the best t so far, then its BLAS with that
+/// t as the bound, a hit kept if strictly nearer), so the lower instance wins a tie and within
+/// a BLAS the first primitive in its traversal's order. with s.closest_tlas and a top level
+/// (s.tlas) it walks the top level nearer child first (TraverseWideBvh; a popped entry is
+/// skipped when beyond the bound below) and tests each instance of a leaf as the loop does; its
+/// switch off (or no top level) it is that loop (TopLevelRoot). Stack: TraverseWideBvh's, for
+/// each BLAS; kTies: ClosestTies (the tests' variants).
+///
+/// why the loop's hit. the instances come in another order, so an instance i is tested
+/// against the best hit (t*, j) of those visited before it, not of those below it. i > j:
+/// bound t* (a hit of i kept if t < t*, as the loop's order would keep it). i < j: bound
+/// ClosestTieBound(t*) > t*, and a hit kept if t <= t* (the loop would have found i's equal-t
+/// hit before j's), else dropped (t* unchanged). so the hit kept is the least (t, instance) over
+/// the instances' own hits, the loop's hit, provided an instance's hit (t, u, v, part, prim)
+/// does not depend on the bound it is searched with as long as the bound exceeds its t:
+/// - the primitive tests: IntersectTriangle's t does not depend on tmin / tmax and is kept if
+///   tmin < t < bound; IntersectAnalyticPrim takes the least root in (tmin, bound) in double
+///   (analytic_detail::Closest: strict, the first part offered among equal roots) and keeps it
+///   if its float is < bound, and float(x) < bound implies x < bound, so with any bound above
+///   the float of the least root it gives that root and part, else nothing;
+/// - TraverseWideBvh's choices: SlabEntry's entry t0 = max(slab entries, tmin) does not depend
+///   on the bound, which only decides `t0 <= min(t1, bound)` (a box is entered or culled); the
+///   nearer child first compares the two t0 (ta <= tb: the first child on a tie), so the order
+///   of the boxes entered does not depend on the bound, and a pop visits an entry if
+///   t0 <= the best t. a box whose t0 <= the hit's t is entered and popped with every bound
+///   above it (the best t never drops below the hit's), so the hit's leaf and every leaf with
+///   an equal-t primitive are reached in the same order, and the first such primitive is kept
+///   (IntersectTriangle and Closest accept only a strictly nearer t);
+/// - the instance's world box (BvhScene pads it by 1e-5 relative), tested as the loop tests it
+///   against its own bound.
+/// so the argument holds where every box on the way to a hit has t0 <= the hit's t; the BLASes'
+/// triangle boxes are the vertices' float min / max, unpadded, and where a triangle lies in its
+/// box's face (walls, a box's sides) SlabEntry's t0 of the face and Moller-Trumbore's t of the
+/// same point may differ by a few floats either way: hence the margin (kMargin), so an equal-t
+/// instance below the best one finds its hit when its box's t0 is beyond t* by up to 2^-12 of
+/// t* (kNextUp, one float, and kNone miss such ties: tests/render/cuda/bvh_traversal_test.cc,
+/// ClosestThroughTheTopLevelKeepsTheLowerInstanceOnATie and
+/// ClosestThroughTheTopLevelGivesTheFlatLoopsHits). the loop itself culls with t0 in the same
+/// way; a hit of instance i hidden behind a box t0 beyond the best t by more than the margin is
+/// missed by both when searched with a bound below that t0, and by one of them only where the
+/// two search i with bounds on either side of it (not seen in the tests).
+///
+/// the top level: its boxes are the float min / max of the instances' boxes below them
+/// (BuildBvh), so a ray that enters an instance's box within a bound enters every box above it
+/// within that bound (the slab test is monotonic in the box's planes: a larger box, a t0 no
+/// larger and a t1 no smaller); the top level is walked with the bound `below`
+/// (ClosestTieBound of the best t, or tmax before a hit), no less than any instance's bound,
+/// so every instance whose own box test would pass is reached.
+template <class Stack = LocalBvhStack, ClosestTies kTies = ClosestTies::kMargin>
 PB_HOST_DEVICE inline void TraceClosest(const SceneView& s, const TraceRay& r, TraceHit* hit) {
   hit->t = r.tmax;
   hit->instance = -1;
   hit->prim = -1;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
-  for (int i = 0; i < s.num_instances; ++i) {
+  const bool tree = s.closest_tlas != 0 && s.tlas_instances != nullptr;
+  const Blas top = TopLevelRoot(s, tree);
+  // the bound of an instance below the best hit's and of the top level's boxes
+  float below = r.tmax;
+  auto leaf = [&](int k) {
+    const int i = tree ? LoadTlasInstance(s.tlas_instances + k) : k;
+    const float best = hit->t;
+    const float bound = i < hit->instance ? below : best;
     const InstanceBox box = LoadInstanceBox(s.instances + i);
-    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, hit->t) == INFINITY) continue;
+    if (SlabEntry(box.lo, box.hi, r.o, inv, r.tmin, bound) == INFINITY) return false;
     const InstanceTransform X_IW = LoadInstanceInverse(s.instances + i);
     const F3 o = TransformPoint(X_IW.m, r.o), d = TransformVector(X_IW.m, r.d);
-    TraverseBlas<Stack>(s, s.blases[box.blas], i, o, d, r.tmin, false, hit);
-  }
+    TraceHit h;
+    h.t = bound;
+    if (!TraverseBlas<Stack>(s, s.blases[box.blas], i, o, d, r.tmin, false, &h)) return false;
+    // below the best instance: its hits in (t*, bound) are farther than the best
+    if (h.t > best) return false;
+    *hit = h;
+    below = ClosestTieBound<kTies>(h.t, r.tmax);
+    return true;
+  };
+  TraverseWideBvh<TlasStack>(s.tlas_nodes, top, r.o, r.d, r.tmin, &below, false, leaf);
 }
 
 /// true if anything blocks ray r in (tmin, tmax). Stack: TraverseWideBvh's, for each BLAS.
@@ -369,12 +469,7 @@ PB_HOST_DEVICE inline bool TraceOccluded(const SceneView& s, const TraceRay& r) 
   hit.t = r.tmax;
   const F3 inv{1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z};
   const bool tree = s.occlusion_tlas != 0 && s.tlas_instances != nullptr;
-  Blas top = s.tlas;
-  if (!tree) {
-    top.root_first = 0;
-    top.root_count = s.num_instances;
-    for (int a = 0; a < 3; ++a) top.lo[a] = -3.4e38f, top.hi[a] = 3.4e38f;
-  }
+  const Blas top = TopLevelRoot(s, tree);
   auto leaf = [&](int k) {
     const int i = tree ? LoadTlasInstance(s.tlas_instances + k) : k;
     const InstanceBox box = LoadInstanceBox(s.instances + i);

@@ -139,17 +139,22 @@ struct SceneView {
   int32_t num_instances = 0;
   /// the top level over the instances' world boxes (BvhScene builds it whenever the instances
   /// change: BuildBvh and WidenBvh over Instance::lo, hi): its inner nodes (tlas.node_offset 0,
-  /// tlas.num_nodes of them; null when the root is a leaf) and its root. TraceOccluded walks it.
+  /// tlas.num_nodes of them; null when the root is a leaf) and its root. TraceClosest and
+  /// TraceOccluded walk it.
   const BvhWideNode* tlas_nodes = nullptr;
   /// the top level's leaves' instances: a leaf's reference (first, count) indexes this array
-  /// (num_instances entries, each an index into instances). null: no top level (TraceOccluded
-  /// tests every instance in index order).
+  /// (num_instances entries, each an index into instances). null: no top level (TraceClosest
+  /// and TraceOccluded test every instance in index order).
   const int32_t* tlas_instances = nullptr;
   Blas tlas;
   /// 1: TraceOccluded walks the top level (where there is one); 0: it tests every instance in
   /// index order (the benchmark's ablation, RealtimeKernelOptions::occlusion_tlas). the same
   /// verdicts either way.
   int32_t occlusion_tlas = 1;
+  /// 1: TraceClosest walks the top level (where there is one), nearer child first; 0: it tests
+  /// every instance in index order (the benchmark's ablation, RealtimeKernelOptions::
+  /// closest_tlas). the same hits either way, bit for bit.
+  int32_t closest_tlas = 1;
   const Record* records = nullptr;           ///< by PrimRef::record
   const TriangleShading* shading = nullptr;  ///< by PrimRef::shading (closest hits only)
 };

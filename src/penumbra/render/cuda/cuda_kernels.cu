@@ -204,6 +204,7 @@ void DeviceScene::Sync(const SceneView& v, const Sizes& n, int64_t geometry_vers
            : nullptr;
   m.view.tlas = v.tlas;
   m.view.occlusion_tlas = v.occlusion_tlas;
+  m.view.closest_tlas = v.closest_tlas;
   if (wait) Check(cudaStreamSynchronize(m.stream), "uploading the scene");
 }
 

@@ -211,6 +211,10 @@ struct RealtimeKernelOptions {
   /// instances' world boxes (SceneView::tlas, TraceOccluded in bvh_traversal.h); else they test
   /// every instance's box in turn. the same verdicts, so the same bits.
   bool occlusion_tlas = true;
+  /// closest hits (the camera's rays, the mirror's) walk the same top level nearer child first
+  /// (TraceClosest); else they test every instance in index order. the same hits, so the same
+  /// bits.
+  bool closest_tlas = true;
   /// the sky terms come from a kernel (QuadSkyTerms, MirrorSkyTerm over UploadSky's copies);
   /// else from the host (Render's `sky`, in sky_bands bands with pinned copies).
   bool device_sky = true;

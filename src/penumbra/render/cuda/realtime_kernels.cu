@@ -1910,6 +1910,7 @@ double DeviceRealtime::Render(DeviceScene* scene, const RealtimeFrameView& host_
   RealtimeFrameView f = host_frame;
   f.scene = scene->device_view();
   f.scene.occlusion_tlas = o.occlusion_tlas ? 1 : 0;
+  f.scene.closest_tlas = o.closest_tlas ? 1 : 0;
   m.WithDeviceArrays(&f);
   m.Point(&f, 0, 0, mirror);
   // the particle streaks: the frame's now (the host splat's pixels, or the streaks the host
