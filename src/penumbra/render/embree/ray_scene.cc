@@ -830,24 +830,35 @@ bool RayScene::OccludedLanes(const Vec3Lanes& o, const Vec3Lanes& d, const Lanes
       }
     }
   }
-  // lanes that are not traced may hold any values: Embree reads only the valid ones
+  // lanes that are not traced repeat a traced lane's ray (harmless values, as IntersectPacket's
+  // idle lanes): Embree's 8-wide (AVX2) packet path asserts that the rays of the lanes it
+  // traces are valid, and it was seen to take lanes marked invalid for such (a NaN origin in
+  // an untraced lane aborted UntraceableRay.PacketsTraceTheGoodLanesAndMissTheBadOnes)
+  int fill = -1;
+  for (int k = 0; k < kPacket && fill < 0; ++k)
+    if (traced[k]) fill = k;
+  const bool static_only =
+      impl_->tendon_group < 0 && !impl_->moving.SegmentsMayHit(o, d, tmax, traced).any();
+  if (fill < 0) {
+    *occluded = LaneMask::Constant(false);
+    return static_only;
+  }
   for (int k = 0; k < kPacket; ++k) {
+    const int f = traced[k] ? k : fill;
     valid[k] = traced[k] ? -1 : 0;
-    p.org_x[k] = o.x[k];
-    p.org_y[k] = o.y[k];
-    p.org_z[k] = o.z[k];
-    p.dir_x[k] = d.x[k];
-    p.dir_y[k] = d.y[k];
-    p.dir_z[k] = d.z[k];
+    p.org_x[k] = o.x[f];
+    p.org_y[k] = o.y[f];
+    p.org_z[k] = o.z[f];
+    p.dir_x[k] = d.x[f];
+    p.dir_y[k] = d.y[f];
+    p.dir_z[k] = d.z[f];
     p.tnear[k] = 0;
-    p.tfar[k] = tmax[k];
+    p.tfar[k] = tmax[f];
     p.time[k] = 0;
     p.mask[k] = 0xffffffffu;
     p.id[k] = 0;
     p.flags[k] = 0;
   }
-  const bool static_only =
-      impl_->tendon_group < 0 && !impl_->moving.SegmentsMayHit(o, d, tmax, traced).any();
   rtcOccluded16(valid, static_only ? impl_->groups[0].scene : impl_->top, &ctx, &p);
   for (int k = 0; k < kPacket; ++k) (*occluded)[k] = traced[k] && p.tfar[k] < 0;
   return static_only;
