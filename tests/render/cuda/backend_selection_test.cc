@@ -4,15 +4,32 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/render/cpu/embree_renderer.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
 #include "render/render_test_util.h"
 
 namespace penumbra {
 namespace {
+
+// the process's first CUDA call (InitRuntime, here through ProbeDevice) sets the module loading
+// mode only while it starts the runtime: the environment after it is the one before, so child
+// processes do not inherit EAGER (and a mode the user named stays).
+TEST(CudaModuleLoading, TheFirstCudaCallLeavesTheEnvironmentAsItWas) {
+  const char* before = std::getenv("CUDA_MODULE_LOADING");
+  const std::string want = before ? before : "(unset)";
+  std::string name, why;
+  const bool device = cuda::ProbeDevice(&name, &why);
+  const char* after = std::getenv("CUDA_MODULE_LOADING");
+  std::printf("device %s; CUDA_MODULE_LOADING before %s, after %s\n",
+              device ? name.c_str() : why.c_str(), want.c_str(), after ? after : "(unset)");
+  EXPECT_EQ(after ? std::string(after) : std::string("(unset)"), want);
+}
 
 TEST(CudaBackendSelection, AutoIsCudaExactlyWhenADeviceIsPresent) {
   const CudaDeviceStatus s = ProbeCudaDevice();

@@ -10,6 +10,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/render/cuda/cuda_batch_kernels.h"
+#include "penumbra/render/cuda/cuda_kernels.h"
 #include "penumbra/render/cuda/primary_pixel.h"
 #include "penumbra/render/cuda/realtime_shading.h"
 
@@ -89,6 +90,7 @@ struct BatchDevice::Impl {
 };
 
 BatchDevice::BatchDevice(const BatchLayout& layout, BatchCopy copy) : impl_(new Impl(layout)) {
+  InitRuntime();
   Impl& m = *impl_;
   m.copy = copy;
   try {

@@ -7,7 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -54,7 +56,22 @@ __global__ void ExpRnKernel(const float* x, float* y, int64_t n) {
 
 }  // namespace
 
+void InitRuntime() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const bool set = std::getenv("CUDA_MODULE_LOADING") == nullptr;
+    if (set) setenv("CUDA_MODULE_LOADING", "EAGER", 1);
+    // the runtime and the driver read the mode when they start; the context made here loads
+    // every module (cudaFree(nullptr): the usual way to make the primary context)
+    int count = 0;
+    if (cudaGetDeviceCount(&count) == cudaSuccess && count > 0) cudaFree(nullptr);
+    cudaGetLastError();  // no device: the error is ProbeDevice's to report
+    if (set) unsetenv("CUDA_MODULE_LOADING");
+  });
+}
+
 bool ProbeDevice(std::string* name, std::string* why) {
+  InitRuntime();
   int count = 0;
   const cudaError_t e = cudaGetDeviceCount(&count);
   if (e != cudaSuccess) {
@@ -102,13 +119,14 @@ void ExpRnOnDevice(const float* x, float* y, int64_t n) {
   dy.Reserve(n * sizeof(float));
   const int block = 256;
   ExpRnKernel<<<static_cast<unsigned>((n + block - 1) / block), block>>>(dx.as<float>(),
-                                                                        dy.as<float>(), n);
+                                                                         dy.as<float>(), n);
   Check(cudaGetLastError(), "ExpRnKernel launch");
   dy.Download(y, n * sizeof(float), nullptr);
   Check(cudaDeviceSynchronize(), "ExpRnKernel");
 }
 
 DeviceScene::DeviceScene() : impl_(new Impl) {
+  InitRuntime();
   try {
     // the highest priority: the realtime frame's side stream (RealtimeKernelOptions::
     // mirror_low_priority) runs below it

@@ -14,6 +14,19 @@
 
 namespace penumbra::cuda {
 
+/// the process's first CUDA call, once (std::call_once): initialises the runtime and, where a
+/// device is present, makes its context with every kernel of the process loaded in one order
+/// (module loading EAGER: NVIDIA's CUDA Programming Guide, "Lazy Loading"), then leaves the
+/// environment as it was. with lazy loading (the runtime's default since CUDA 12.2) a LiDAR's
+/// CudaRayQuery, or a terrain ray caster, that traced before a renderer's first frame made
+/// that renderer's realtime kernels 3-7 % slower for the whole run (about 17 us a frame;
+/// docs/gpu.md, "Eager module loading"). CUDA_MODULE_LOADING set in the environment is kept as
+/// it is (the user's choice); otherwise it is set to EAGER only during this call, so child
+/// processes (e.g. a campaign's SLAM methods) do not inherit it. ProbeDevice and the device
+/// classes' constructors (DeviceScene, the batch's device) call it; call it before any other
+/// CUDA call of the process (from one thread: it changes the environment). never throws.
+void InitRuntime();
+
 /// true if a CUDA device can be used (cudaGetDeviceCount succeeds with >= 1 device); else
 /// false, with the runtime's message in *why (e.g. "CUDA driver version is insufficient for
 /// CUDA runtime version" on a machine without a GPU driver). *name: the first device's name.
