@@ -74,13 +74,14 @@
 // samples (one frame), the radiance's mean relative difference (path_parity.h: 8x8 blocks, and
 // the image mean) and whether two GPU renders are bit-identical; a world's effects at 1 s (media
 // and particles included) in both; for particles a line with the streaks' count and the host's
-// BVH build time. usage:
+// BVH build time.
 // --lidar (the default rows; name one world): the realtime kernels alone before and after a
 // LiDAR's CudaRayQuery of the scene traced a scan in the process, 3 rounds at each size.
 // --lidar-first (the default rows): a LiDAR's CudaRayQuery made and tracing a scan right after
 // the CUDA renderer, before its first frame (as a run's LiDAR sink), alive for the world's rows.
 // --statics [--frames N]: the static maps' build through our host traversal and through Embree,
 // N rounds interleaved (default 2; no GPU needed).
+// usage:
 //   render_cuda_bench [--frames N] [--batch N,... [--size WxH] [--sessions S] | --parity |
 //                     --realtime [--size WxH] | --pathtraced [--size WxH] [--spp N]
 //                     [--seed-floor]] [world.yaml ...]
@@ -1315,10 +1316,10 @@ int Main(int argc, char** argv) {
     if (gpu && lidar_rows) {
       // the realtime kernels alone at both sizes, 3 rounds, then a LiDAR's CudaRayQuery (its own
       // BVH and device copy of the scene, as MakeRayQuery makes for a LiDAR on backend cuda)
-      // traces one 32 x 1800 scan and stays alive, then the same 3 rounds: a second device copy
-      // of the geometry slowed the realtime kernels 2-7 % even once freed ("Taken back: the
-      // statics' rays on the GPU", docs/gpu.md), so the rows before it come first, and a run
-      // should name one world.
+      // traces one 32 x 1800 scan and stays alive, then the same 3 rounds. what the process did
+      // before stays with it (under lazy module loading a query made before the first frame
+      // slowed the kernels for good: "Eager module loading", docs/gpu.md), so the rows before
+      // the query come first, and a run should name one world.
       auto* g = static_cast<cuda::CudaRenderer*>(gpu.get());
       auto time_kernels = [&](const char* label) {
         for (int round = 0; round < 3; ++round)
