@@ -269,12 +269,38 @@ def viewer_seeds():
     write("viewer_messages", "text_array.txt", "[1, 2, 3]")
 
 
+# ---- method command templates ----------------------------------------------------------------
+def template_seeds():
+    """fuzz/template_fuzz.cc's layout: the template, then NUL-separated placeholder values."""
+    bundled = "{penumbra} slam opencv_rgbd {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}"
+    nav = ("/usr/bin/env PYTHONPATH={pythonpath} /usr/bin/python3 -m penumbra_nav --endpoint "
+           "{endpoint} --goal {goal_x} {goal_y} --out {out_dir}/episode.json")
+    hostile = "\0/tmp/o $(touch X) `touch Y`\0a b\tc\0{dataset}"
+    for name, text in [
+            ("bundled.txt", bundled + hostile),
+            ("nav.txt", nav),
+            ("sh_positional.txt", "sh -c 'slam \"$1\" > \"$2\"' sh {dataset} {output}" + hostile),
+            ("python_argv.txt", "/usr/bin/python3 -c 'import sys; print(sys.argv[1])' {dataset}"),
+            ("sh_c_dashdash.txt", "sh -c -- 'true {output}'"),
+            ("timeit.txt", "python3 -m timeit -s 'os.system(\"cat {dataset} > {output}\")'"),
+            ("env_nice_sh.txt", "/usr/bin/env A=1 nice -n 5 bash -ec 'x {seed}' bash"),
+            ("perl_e.txt", "perl -lne 'print' {dataset}/x.txt"),
+            ("quotes.txt", "/opt/x/run 'a b' \"{output}\" x{seed}y {{z}} --k={fx},{fy}"),
+            ("merged.txt", "run {dataset}{output}"),
+            ("operators.txt", "run {dataset}; touch X | y > z $(a) `b`"),
+            ("ssh.txt", "ssh host slam {output}"),
+            ("braces.txt", "run {dataset } }{ {{{seed}}}"),
+    ]:
+        write("template", name, text)
+
+
 if __name__ == "__main__":
     runlog_seeds()
     tum_seeds()
     world_seeds()
     request_seeds()
     viewer_seeds()
+    template_seeds()
     for t in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, t))
         size = sum(os.path.getsize(os.path.join(CORPUS, t, f)) for f in files)
