@@ -1,10 +1,17 @@
 #include "penumbra/control/onnx_policy_network.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
 #include <system_error>
 
+#include "penumbra/control/onnx_model_check.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -66,12 +73,51 @@ std::unique_ptr<PolicyNetwork> LoadOnnxPolicy(const std::string& path, int input
     throw ConfigError(path, 0, "",
                       "no such ONNX file; expected a policy network exported to ONNX "
                       "(docs/policies.md)");
+  // O_NONBLOCK: a FIFO swapped in after the check does not block the open
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    throw ConfigError(path, 0, "",
+                      std::string("cannot open the ONNX file: ") + std::strerror(errno));
+  std::string bytes;
+  struct stat st {};
+  const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+  const bool fits = regular && st.st_size <= kOnnxMaxFileBytes;
+  if (fits) {
+    bytes.resize(static_cast<size_t>(st.st_size));
+    size_t got = 0;
+    while (got < bytes.size()) {
+      const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
+      if (r < 0 && errno == EINTR) continue;
+      if (r <= 0) break;
+      got += static_cast<size_t>(r);
+    }
+    bytes.resize(got);
+  }
+  const int read_errno = errno;
+  ::close(fd);
+  if (!regular) throw ConfigError(path, 0, "", "not a regular file; expected an ONNX file");
+  if (!fits)
+    throw ConfigError(path, 0, "",
+                      "the file has " + std::to_string(st.st_size) + " bytes; expected at most " +
+                          std::to_string(kOnnxMaxFileBytes) + " (kOnnxMaxFileBytes)");
+  if (static_cast<off_t>(bytes.size()) != st.st_size)
+    throw ConfigError(path, 0, "",
+                      "could not read the whole file (" + std::to_string(bytes.size()) + " of " +
+                          std::to_string(st.st_size) + " bytes): " + std::strerror(read_errno));
+  return LoadOnnxPolicyFromBytes(bytes, path, input_size, output_size);
+}
+
+std::unique_ptr<PolicyNetwork> LoadOnnxPolicyFromBytes(std::string_view bytes,
+                                                       const std::string& path, int input_size,
+                                                       int output_size) {
+  // every size and shape checked before OpenCV's importer sees a byte
+  CheckOnnxModel(bytes, path, input_size, output_size);
   const std::string expected = "expected an ONNX graph from [1, " + std::to_string(input_size) +
                                "] float32 observations to [1, " + std::to_string(output_size) +
                                "] actions";
   cv::dnn::Net net;
   try {
-    net = cv::dnn::readNetFromONNX(path);
+    net = cv::dnn::readNetFromONNX(bytes.data(), bytes.size());
   } catch (const cv::Exception& e) {
     throw ConfigError(path, 0, "",
                       "OpenCV dnn (4.6) cannot load this ONNX graph: " + CvReason(e) + "; " +

@@ -18,19 +18,30 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "penumbra/control/policy_network.h"
 
 namespace penumbra {
 
-/// loads the ONNX graph at `path` and checks that it takes one float input of
-/// `input_size` values (shape [1, input_size] or [input_size]) and returns one output of
-/// `output_size` values, by running it once on zeros.
-/// @throws ConfigError(path, ...) when the file is missing or unreadable, is not an ONNX graph
-///         OpenCV can import (e.g. an unsupported operator; OpenCV's message is included),
+/// loads the ONNX graph at `path` (a regular file of at most kOnnxMaxFileBytes, read once)
+/// and checks that it takes one float input of `input_size` values (shape [1, input_size] or
+/// [input_size]) and returns one output of `output_size` values: first the file's protobuf
+/// by CheckOnnxModel (control/onnx_model_check.h: tensor sizes against their data, caps on
+/// weights and activations, opset and operators, input/output shapes), only then OpenCV's
+/// importer on the checked bytes, and a run on zeros.
+/// @throws ConfigError(path, ...) when the file is missing, not a regular file, unreadable or
+///         too large, fails CheckOnnxModel (the message names the tensor, node or field and
+///         the limit), is not an ONNX graph OpenCV can import (OpenCV's message is included),
 ///         has more than one output, rejects an input of `input_size` values, or returns a
 ///         different number of values than `output_size`; each message says what was expected.
 std::unique_ptr<PolicyNetwork> LoadOnnxPolicy(const std::string& path, int input_size,
                                               int output_size);
+
+/// LoadOnnxPolicy on the file contents `bytes`; `path` names them in errors.
+/// @throws ConfigError as LoadOnnxPolicy.
+std::unique_ptr<PolicyNetwork> LoadOnnxPolicyFromBytes(std::string_view bytes,
+                                                       const std::string& path, int input_size,
+                                                       int output_size);
 
 }  // namespace penumbra

@@ -1,12 +1,13 @@
 #include "penumbra/control/policy_action.h"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "penumbra/config/config_value.h"
+#include "penumbra/core/error.h"
 
 namespace penumbra {
-namespace {}  // namespace
-
 const char* PolicyActionKindName(PolicyActionKind kind) {
   switch (kind) {
     case PolicyActionKind::kJointPosition:
@@ -44,11 +45,12 @@ void PolicyActionParams::ParseOver(ControllerParams& p, const ConfigValue& n,
                                 "; expected joint_position, joint_velocity or joint_torque");
   }
   if (n["scale"])
-    scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a finite number",
-                           [](double) { return true; });
+    scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a number with |scale| <= 1e4",
+                           [](double v) { return std::abs(v) <= kPolicyMaxActionScale; });
   if (n["clip"]) {
-    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number > 0");
-    if (!(c > 0)) p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number > 0");
+    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number in (0, 1e6]");
+    if (!(c > 0) || c > kPolicyMaxAbsAction)
+      p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number in (0, 1e6]");
     clip = c;
   }
   if (n["kp"])
@@ -69,6 +71,26 @@ void PolicyActionParams::ParseOver(ControllerParams& p, const ConfigValue& n,
                "got " + DescribeParamNode(a[i]) + "; expected an actuator name");
       actuators.push_back(prefix + a[i].Scalar());
     }
+  }
+}
+
+void ProcessPolicyOutputs(std::span<const float> raw, const std::optional<double>& clip,
+                          int64_t step, double time_sec, const std::vector<std::string>& joints,
+                          const std::string& label, std::span<double> action) {
+  if (raw.size() != action.size())
+    throw Error(label + ": the policy returned " + std::to_string(raw.size()) +
+                " outputs; expected " + std::to_string(action.size()));
+  for (size_t j = 0; j < raw.size(); ++j) {
+    const double v = raw[j];
+    if (!(std::abs(v) <= kPolicyMaxAbsAction)) {
+      std::ostringstream m;
+      m << label << ": policy step " << step << " (t = " << time_sec << " s): output " << j;
+      if (j < joints.size()) m << " (joint '" << joints[j] << "')";
+      m << " is " << v << "; expected a finite value with |value| <= " << kPolicyMaxAbsAction
+        << " (kPolicyMaxAbsAction, docs/policies.md)";
+      throw Error(m.str());
+    }
+    action[j] = clip ? std::clamp(v, -*clip, *clip) : v;
   }
 }
 

@@ -3,8 +3,9 @@
 // world-file form (inside the policy controller block):
 //   action:
 //     type: joint_position   # joint_position | joint_velocity | joint_torque
-//     scale: 0.25            # one number or one per joint
-//     clip: 100              # > 0: the raw output is clamped to [-clip, clip] first (optional)
+//     scale: 0.25            # one number or one per joint, |scale| <= 1e4
+//     clip: 100              # 0 < clip <= 1e6: the raw output is clamped to [-clip, clip]
+//                            # first (optional)
 //     kp: 20                 # N m/rad (N/m), one or per joint: PD through any actuator
 //     kd: 0.5                # N m s/rad (N s/m), one or per joint
 //     actuators: [FR_hip, ...]   # one per policy joint (default: the joint names)
@@ -21,8 +22,12 @@
 //                   actuator; without: velocity servos (MJCF <velocity>), ctrl = gear qd*_j.
 //   joint_torque    tau_j = scale_j a_j through the actuator (kp, kd not allowed).
 // every ctrl is clamped to the actuator's forcerange / ctrlrange (control/actuator_drive.h).
+// a raw output that is not finite or exceeds kPolicyMaxAbsAction in magnitude stops the run
+// (ProcessPolicyOutputs), naming the policy step and the output.
 
+#include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,6 +35,12 @@
 #include "penumbra/control/controller_params.h"
 
 namespace penumbra {
+
+/// the largest |raw output| a policy may return (before its clip): a network whose output
+/// reaches it (or is not finite) is broken, and the run stops naming the step and output.
+inline constexpr double kPolicyMaxAbsAction = 1e6;
+/// the largest |scale| of an action (rad, rad/s or N m per output unit), checked at load.
+inline constexpr double kPolicyMaxActionScale = 1e4;
 
 /// what the policy's outputs are.
 enum class PolicyActionKind { kJointPosition, kJointVelocity, kJointTorque };
@@ -51,5 +62,15 @@ struct PolicyActionParams {
   void ParseOver(ControllerParams& params, const ConfigValue& node, const std::string& key,
                  const std::string& name_prefix);
 };
+
+/// checks and clips one policy update's raw outputs: `action[j]` = `raw[j]` clamped to
+/// [-clip, clip] when `clip` is set. `step` (the policy update's physics step), `time_sec` and
+/// `joints` (names, one per output) only name the failure.
+/// @throws Error "<label>: policy step <step> (t = <time> s): output <j> (joint '<name>') is
+///         <value>; expected a finite value with |value| <= kPolicyMaxAbsAction" for the first
+///         non-finite or too large output; `action` is then partly written.
+void ProcessPolicyOutputs(std::span<const float> raw, const std::optional<double>& clip,
+                          int64_t step, double time_sec, const std::vector<std::string>& joints,
+                          const std::string& label, std::span<double> action);
 
 }  // namespace penumbra

@@ -309,17 +309,19 @@ void PolicyController::Compute(const ControlInput& in, std::span<double> ctrl) {
     ctx.command = command_;
     ctx.last_action = action_;
     observation_.Assemble(ctx, obs_);
+    // a non-finite observation (a diverged state, a term's scale) stops the run naming its term
+    for (size_t i = 0; i < obs_.size(); ++i)
+      if (!std::isfinite(obs_[i]))
+        throw Error(label() + ": policy step " + std::to_string(step_) + " (t = " +
+                    std::to_string(in.time_sec()) + " s): observation " + std::to_string(i) + ", " +
+                    DescribeObservationElement(observation_.terms(), observation_.term_sizes(),
+                                               static_cast<int64_t>(i)) +
+                    ", is " + std::to_string(obs_[i]) + "; expected a finite value");
     network_->Run(obs_, out_);
-    for (int j = 0; j < n; ++j) {
-      double v = out_[j];
-      if (!std::isfinite(v))
-        throw Error(label() + ": the policy returned a non-finite action " + std::to_string(v) +
-                    " for joint '" + params_.joints[j] + "'");
-      if (a.clip) v = std::clamp(v, -*a.clip, *a.clip);
-      action_[j] = v;
-      target_[j] =
-          (a.kind == PolicyActionKind::kJointPosition ? default_q_[j] : 0.0) + scale_[j] * v;
-    }
+    ProcessPolicyOutputs(out_, a.clip, step_, in.time_sec(), params_.joints, label(), action_);
+    for (int j = 0; j < n; ++j)
+      target_[j] = (a.kind == PolicyActionKind::kJointPosition ? default_q_[j] : 0.0) +
+                   scale_[j] * action_[j];
     // tracking error: the command minus the base's velocity in its heading frame
     const Eigen::Matrix3d R = X_WB.linear();
     const double yaw = std::atan2(R(1, 0), R(0, 0));

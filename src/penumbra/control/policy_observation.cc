@@ -422,4 +422,22 @@ void PolicyObservation::Assemble(const ObservationContext& ctx, std::span<float>
   }
 }
 
+std::string DescribeObservationElement(const std::vector<ObservationTermConfig>& terms,
+                                       const std::vector<int>& term_sizes, int64_t index) {
+  int64_t pos = 0;
+  for (size_t i = 0; i < terms.size() && i < term_sizes.size(); ++i) {
+    const int64_t dim = std::max(term_sizes[i], 0);
+    const int64_t n = dim * std::max(terms[i].history, 1);
+    if (index >= pos && index < pos + n) {
+      const int64_t k = index - pos;
+      return "observations[" + std::to_string(i) + "] (" + ObservationTermName(terms[i].kind) +
+             ") element " + std::to_string(k % dim) + ", history frame " + std::to_string(k / dim) +
+             " of " + std::to_string(terms[i].history);
+    }
+    pos += n;
+  }
+  return "element " + std::to_string(index) + " (past the terms' " + std::to_string(pos) +
+         " values)";
+}
+
 }  // namespace penumbra

@@ -111,6 +111,12 @@ struct ObservationTermConfig {
                                      const std::string& key, const std::string& name_prefix);
 };
 
+/// names element `index` of an assembled observation vector whose terms are `terms` with
+/// (per term, before history) `term_sizes`, e.g. "observations[2] (joint_vel) element 3,
+/// history frame 0 of 1"; "element <index> (past the terms' N values)" when out of range.
+std::string DescribeObservationElement(const std::vector<ObservationTermConfig>& terms,
+                                       const std::vector<int>& term_sizes, int64_t index);
+
 /// what an observation update reads besides the ControlInput.
 struct ObservationContext {
   const ControlInput* input = nullptr;
