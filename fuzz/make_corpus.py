@@ -294,12 +294,38 @@ def template_seeds():
         write("template", name, text)
 
 
+# ---- rollout arguments -----------------------------------------------------------------------
+def rollout_seed(copies, threads, substeps, mode, per_copy=4096, cap=1 << 30, values=()):
+    """fuzz/rollout_fuzz.cc's layout: three int64 counts, a mode byte (bit 0: counts raw, else
+    folded to -1..4; bit 1: joint PD), bytes per copy and cap (uint64), float64 values."""
+    return (struct.pack("<qqqB", copies, threads, substeps, mode) + struct.pack("<QQ", per_copy, cap)
+            + b"".join(struct.pack("<d", v) for v in values))
+
+
+def rollout_seeds():
+    nan, inf = float("nan"), float("inf")
+    small = [0.1, -0.2, 0.3, 0.0] * 8
+    write("rollout", "direct_two_copies.bin", rollout_seed(3, 3, 3, 0, values=small))
+    write("rollout", "joint_pd.bin", rollout_seed(2, 2, 4, 2, values=[20, 5, 0.5, 0.1] + small))
+    write("rollout", "threads_100000.bin", rollout_seed(1, 100000, 1, 1))
+    write("rollout", "copies_1e7.bin", rollout_seed(10 ** 7, 1, 1, 1, per_copy=1 << 20))
+    write("rollout", "substeps_2_31.bin", rollout_seed(1, 1, 2 ** 31 - 1, 1))
+    write("rollout", "negative_counts.bin", rollout_seed(-1, -(2 ** 63), -5, 1))
+    write("rollout", "nan_inputs.bin", rollout_seed(3, 2, 2, 0, values=[nan, 0, inf, -inf] * 4))
+    write("rollout", "nan_gains.bin", rollout_seed(2, 2, 2, 2, values=[nan, 1, inf, 1] + small))
+    write("rollout", "huge_inputs.bin", rollout_seed(2, 2, 5, 2, values=[1e9, 1e9, 1e9, 1e9]
+                                                     + [1e308, -1e308] * 8))
+    write("rollout", "memory_overflow.bin", rollout_seed(2 ** 40, 1, 1, 1, per_copy=2 ** 63,
+                                                         cap=2 ** 64 - 1))
+
+
 if __name__ == "__main__":
     runlog_seeds()
     tum_seeds()
     world_seeds()
     request_seeds()
     viewer_seeds()
+    rollout_seeds()
     template_seeds()
     for t in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, t))

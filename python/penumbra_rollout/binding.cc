@@ -1,6 +1,9 @@
 // _penumbra_rollout: the pybind11 module of penumbra::BatchStepper (src/penumbra/rollout/).
 // arrays cross as NumPy float64, row-major, one row per copy; Step releases the GIL while the
-// copies are stepped on the stepper's thread pool.
+// copies are stepped on the stepper's thread pool. every argument is checked before anything is
+// allocated or started (src/penumbra/rollout/rollout_args.h): a bad one raises ValueError naming
+// it and its bound (penumbra::ConfigError), a MuJoCo or thread failure RuntimeError; nothing
+// exits the process.
 
 #include <mujoco/mujoco.h>
 #include <pybind11/numpy.h>
@@ -10,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/core/error.h"
 #include "penumbra/rollout/batch_stepper.h"
+#include "penumbra/rollout/rollout_args.h"
 
 namespace py = pybind11;
 using penumbra::BatchActuation;
@@ -53,14 +58,35 @@ DoubleArray Rows(int rows, int cols) { return DoubleArray({rows, cols}); }
 
 PYBIND11_MODULE(_penumbra_rollout, m) {
   m.doc() = "N copies of one MuJoCo model stepped in C++ on a thread pool (penumbra::BatchStepper)";
+  // bad arguments are ValueError; other penumbra errors stay RuntimeError (std::runtime_error)
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const penumbra::ConfigError& e) {
+      // an argument's error names the argument ("num_threads: got ..."), a file's the file
+      const std::string text =
+          e.file().empty() ? penumbra::SanitizeForMessage(e.key() + ": " + e.problem(), 2048)
+                           : std::string(e.what());
+      PyErr_SetString(PyExc_ValueError, text.c_str());
+    }
+  });
+  m.attr("max_threads") = penumbra::MaxRolloutThreads();
+  m.attr("max_substeps") = penumbra::kMaxRolloutSubsteps;
+  m.attr("max_copies") = penumbra::kMaxRolloutCopies;
+  m.attr("max_model_file_bytes") = penumbra::kMaxRolloutModelFileBytes;
+  m.def("memory_cap_bytes", &penumbra::RolloutMemoryCap,
+        "bytes the copies of one stepper may take together now: the physical memory, or the "
+        "room left under the address-space limit (RLIMIT_AS)");
   py::class_<BatchStepper>(m, "BatchStepper")
-      .def(py::init([](const std::string& model_path, int num_copies, int num_threads, int substeps,
-                       const std::string& actuation, std::vector<double> kp,
+      .def(py::init([](const std::string& model_path, int64_t num_copies, int64_t num_threads,
+                       int64_t substeps, const std::string& actuation, std::vector<double> kp,
                        std::vector<double> kd) {
+             // before narrowing to int, opening the file or starting a thread
+             penumbra::ValidateRolloutCounts(num_copies, num_threads, substeps);
              BatchStepperConfig c;
-             c.num_copies = num_copies;
-             c.num_threads = num_threads;
-             c.substeps = substeps;
+             c.num_copies = static_cast<int>(num_copies);
+             c.num_threads = static_cast<int>(num_threads);
+             c.substeps = static_cast<int>(substeps);
              if (actuation == "direct") {
                c.actuation = BatchActuation::kDirect;
              } else if (actuation == "joint_pd") {
@@ -76,9 +102,12 @@ PYBIND11_MODULE(_penumbra_rollout, m) {
            py::arg("model_path"), py::arg("num_copies") = 1, py::arg("num_threads") = 0,
            py::arg("substeps") = 1, py::arg("actuation") = "direct",
            py::arg("kp") = std::vector<double>{}, py::arg("kd") = std::vector<double>{},
-           "loads the MJCF file and makes num_copies copies of its initial state. actuation "
-           "'direct': step's input is ctrl; 'joint_pd': one joint position target per actuator, "
-           "ctrl = kp (target - q) - kd qdot every substep")
+           "loads the MJCF file (a regular file) and makes num_copies copies of its initial "
+           "state. actuation 'direct': step's input is ctrl; 'joint_pd': one joint position "
+           "target per actuator, ctrl = kp (target - q) - kd qdot every substep. ValueError "
+           "names a bad argument and its bound (num_threads <= max_threads, substeps <= "
+           "max_substeps, num_copies <= max_copies and num_copies x copy_bytes <= "
+           "memory_cap_bytes())")
       .def(
           "step",
           [](BatchStepper& s, const DoubleArray& input) {
@@ -87,20 +116,23 @@ PYBIND11_MODULE(_penumbra_rollout, m) {
             py::gil_scoped_release release;
             s.Step(p);
           },
-          py::arg("input"), "advances every copy by `substeps` physics steps; input (N, nu)")
+          py::arg("input"),
+          "advances every copy by `substeps` physics steps; input (N, nu), finite (else "
+          "ValueError naming input[i, j])")
       .def(
           "reset",
-          [](BatchStepper& s, int index, const DoubleArray& qpos, const DoubleArray& qvel) {
+          [](BatchStepper& s, int64_t index, const DoubleArray& qpos, const DoubleArray& qvel) {
             if (index < 0 || index >= s.num_copies()) {
               throw py::index_error("index " + std::to_string(index) + " out of range [0, " +
                                     std::to_string(s.num_copies()) + ")");
             }
             CheckShape(qpos, "qpos", 1, s.nq());
             CheckShape(qvel, "qvel", 1, s.nv());
-            s.Reset(index, qpos.data(), qvel.data());
+            s.Reset(static_cast<int>(index), qpos.data(), qvel.data());
           },
           py::arg("index"), py::arg("qpos"), py::arg("qvel"),
-          "sets copy `index` to (qpos, qvel) at time 0 with ctrl 0, then mj_forward")
+          "sets copy `index` to (qpos, qvel) at time 0 with ctrl 0, then mj_forward; values "
+          "finite (else ValueError naming qpos[i] or qvel[i])")
       .def(
           "read_state",
           [](const BatchStepper& s) {
@@ -121,6 +153,8 @@ PYBIND11_MODULE(_penumbra_rollout, m) {
       .def_property_readonly("nu", &BatchStepper::nu)
       .def_property_readonly("nsensordata", &BatchStepper::nsensordata)
       .def_property_readonly("timestep", &BatchStepper::timestep)
+      .def_property_readonly("copy_bytes", &BatchStepper::copy_bytes,
+                             "memory one copy takes (bytes), checked against memory_cap_bytes()")
       .def_property_readonly(
           "qpos0",
           [](const BatchStepper& s) {

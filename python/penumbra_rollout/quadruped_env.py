@@ -19,10 +19,13 @@ legged_robot_config.py, A1 config a1_config.py); train/README.md lists them exac
 from __future__ import annotations
 
 import dataclasses
+import math
+import operator
 import os
 
 import numpy as np
 
+import _penumbra_rollout
 from _penumbra_rollout import BatchStepper
 
 from .spaces import Box
@@ -100,6 +103,56 @@ class QuadrupedEnvConfig:
     min_base_height: float = 0.15
 
 
+# settings that must be > 0, and the one that may be -inf (every other number must be finite)
+_POSITIVE = ("clip_actions", "clip_observations", "episode_length_s", "resampling_time_s",
+             "tracking_sigma", "spawn_height")
+_NON_NEGATIVE = ("kp", "kd", "action_scale", "noise_level")
+_MAY_BE_MINUS_INF = ("min_base_height",)
+_RANGES = ("lin_vel_x_range", "lin_vel_y_range", "ang_vel_yaw_range")
+
+
+def _finite_index(name, a):
+    """Raises ValueError naming the first non-finite value of array `a` as name[i, j]."""
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):
+        idx = tuple(int(i) for i in bad[0])
+        where = ", ".join(str(i) for i in idx)
+        raise ValueError(f"{name}[{where}]: got {a[idx]!r}; expected a finite number")
+
+
+def check_config(c):
+    """Raises ValueError naming the first setting of QuadrupedEnvConfig `c` out of range: every
+    number finite (min_base_height may be -inf), gains, scales and noise >= 0, clips, times,
+    tracking_sigma and spawn_height > 0, command ranges (low, high) with low <= high,
+    decimation and num_threads integers (their bounds: BatchStepper's substeps and
+    num_threads)."""
+    for f in dataclasses.fields(c):
+        v = getattr(c, f.name)
+        if isinstance(v, bool) or isinstance(v, str):
+            continue
+        if f.name in _RANGES:
+            r = tuple(v) if isinstance(v, (tuple, list)) else ()
+            if (len(r) != 2 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in r)
+                    or r[0] > r[1]):
+                raise ValueError(f"config.{f.name}: got {v!r}; expected (low, high), finite, "
+                                 "low <= high")
+            continue
+        if f.name in ("decimation", "num_threads"):
+            try:
+                operator.index(v)
+            except TypeError:
+                raise ValueError(f"config.{f.name}: got {v!r}; expected an integer") from None
+            continue
+        if not isinstance(v, (int, float)):
+            raise ValueError(f"config.{f.name}: got {v!r}; expected a number")
+        if math.isnan(v) or (math.isinf(v) and not (f.name in _MAY_BE_MINUS_INF and v < 0)):
+            raise ValueError(f"config.{f.name}: got {v!r}; expected a finite number")
+        if f.name in _POSITIVE and not v > 0:
+            raise ValueError(f"config.{f.name}: got {v!r}; expected a number > 0")
+        if f.name in _NON_NEGATIVE and not v >= 0:
+            raise ValueError(f"config.{f.name}: got {v!r}; expected a number >= 0")
+
+
 def quat_rotate_inverse(q, v):
     """v (N, 3) in the world frame expressed in the frame of unit quaternions q (N, 4; w x y z)."""
     w = q[:, 0:1]
@@ -126,7 +179,15 @@ class QuadrupedVelocityEnv:
     def __init__(self, num_envs: int, config: QuadrupedEnvConfig | None = None, seed: int = 0):
         self.cfg = config or QuadrupedEnvConfig()
         c = self.cfg
-        self.num_envs = int(num_envs)
+        check_config(c)
+        try:
+            n = operator.index(num_envs)
+        except TypeError:
+            raise ValueError(f"num_envs: got {num_envs!r}; expected an integer") from None
+        if isinstance(num_envs, bool) or not 1 <= n <= _penumbra_rollout.max_copies:
+            raise ValueError(f"num_envs: got {num_envs!r}; expected an integer in "
+                             f"[1, {_penumbra_rollout.max_copies}]")
+        self.num_envs = n
         self.stepper = BatchStepper(c.model_path, self.num_envs, c.num_threads, c.decimation,
                                     "joint_pd", [c.kp] * 12, [c.kd] * 12)
         s = self.stepper
@@ -263,14 +324,24 @@ class QuadrupedVelocityEnv:
 
         ``seed`` reseeds the environment's generator (numpy PCG64). ``options`` may hold
         ``commands``: an (N, 3) array of fixed (vx m/s, vy m/s, wz rad/s) commands used
-        instead of sampled ones until a later reset passes ``commands=None``.
+        instead of sampled ones until a later reset passes ``commands=None``; they must be
+        finite (else ValueError naming ``options['commands'][i, j]``, nothing changed).
         """
-        if seed is not None:
-            self._seed(seed)
         if options is not None and "commands" in options:
             fc = options["commands"]
-            self.fixed_commands = None if fc is None else \
-                np.broadcast_to(np.asarray(fc, dtype=np.float64), (self.num_envs, 3)).copy()
+            if fc is None:
+                self.fixed_commands = None
+            else:
+                try:
+                    arr = np.broadcast_to(np.asarray(fc, dtype=np.float64),
+                                          (self.num_envs, 3)).copy()
+                except (ValueError, TypeError) as e:
+                    raise ValueError(f"options['commands']: {e}; expected numbers broadcastable "
+                                     f"to ({self.num_envs}, 3)") from None
+                _finite_index("options['commands']", arr)
+                self.fixed_commands = arr
+        if seed is not None:
+            self._seed(seed)
         self._alloc()
         self._reset_envs(np.arange(self.num_envs))
         self._read()
@@ -282,11 +353,14 @@ class QuadrupedVelocityEnv:
         Returns (obs, rewards (N,) float32, terminations (N,) bool, truncations (N,) bool,
         infos) with infos["final_observation"], infos["_final_observation"], and
         infos["episode"] = {"r": return, "l": length} arrays for the environments that ended.
+        Actions must be finite: NaN or infinity raises ValueError naming ``actions[i, j]``
+        before anything moves.
         """
         c = self.cfg
         a = np.asarray(actions, dtype=np.float64)
         if a.shape != (self.num_envs, ACT_DIM):
             raise ValueError(f"actions: got shape {a.shape}; expected ({self.num_envs}, 12)")
+        _finite_index("actions", a)
         a = np.clip(a, -c.clip_actions, c.clip_actions)
         self.actions = a
         targets = self.default_q + c.action_scale * a

@@ -5,10 +5,20 @@ namespace penumbra {
 ThreadPool::ThreadPool(int num_threads) {
   int n = num_threads > 0 ? num_threads : static_cast<int>(std::thread::hardware_concurrency());
   if (n < 1) n = 1;
-  for (int i = 0; i < n - 1; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+  try {
+    workers_.reserve(n - 1);
+    for (int i = 0; i < n - 1; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+  } catch (...) {
+    // a thread that cannot start (out of memory, thread limit): stop and join those that did,
+    // so none outlives the pool
+    Stop();
+    throw;
+  }
 }
 
-ThreadPool::~ThreadPool() {
+ThreadPool::~ThreadPool() { Stop(); }
+
+void ThreadPool::Stop() {
   {
     std::lock_guard<std::mutex> lock(mu_);
     stop_ = true;

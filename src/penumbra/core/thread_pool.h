@@ -16,6 +16,8 @@ namespace penumbra {
 class ThreadPool {
  public:
   /// @param num_threads total threads including the caller; 0 = hardware concurrency.
+  /// @throws std::system_error when a thread cannot be started (the threads already started
+  ///         are stopped and joined first), std::bad_alloc.
   explicit ThreadPool(int num_threads = 0);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
@@ -30,6 +32,7 @@ class ThreadPool {
 
  private:
   void WorkerLoop();
+  void Stop();
   void RunItems();
 
   std::vector<std::thread> workers_;
