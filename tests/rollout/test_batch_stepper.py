@@ -312,6 +312,11 @@ class HostileArgumentsTest(unittest.TestCase):
                       "(a directory)", out)
         self.assertIn("dev ValueError /dev/zero: model_path: model file is not a regular file "
                       "(a character device)", out)
+        # open() would stop at the NUL and load train/go1_flat.xml
+        with self.assertRaisesRegex(ValueError, "model path is empty or holds a NUL byte"):
+            BatchStepper(MODEL + "\0.extra", 1)
+        with self.assertRaisesRegex(ValueError, "model path is empty"):
+            BatchStepper("", 1)
 
     def test_bad_models_raise_and_warnings_stay_quiet(self):
         # MuJoCo's default handlers exit() on errors and print warnings and append them to

@@ -124,6 +124,9 @@ std::string ReadRolloutModelFile(const std::string& path, size_t max_bytes) {
   auto fail = [&](const std::string& problem) {
     throw ConfigError(path, 0, "model_path", problem);
   };
+  // open() would stop at a NUL and open another file
+  if (path.empty() || path.find('\0') != std::string::npos)
+    fail("model path is empty or holds a NUL byte; expected a file name");
   Fd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (fd.get() < 0) {
     const int err = errno;

@@ -57,6 +57,7 @@ void CheckFiniteValues(const double* values, size_t count, size_t cols, const st
 /// @throws ConfigError(path, 0, "model_path", problem) with problem "model file not found;
 ///         expected an MJCF file", "model file is not a regular file (a FIFO); expected a
 ///         regular MJCF file" (likewise a directory, a character or block device, a socket),
+///         "model path is empty or holds a NUL byte; expected a file name",
 ///         "model file is N bytes; expected at most M bytes" or "cannot read the model file:
 ///         <reason>".
 std::string ReadRolloutModelFile(const std::string& path,
