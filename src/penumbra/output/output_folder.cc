@@ -173,26 +173,26 @@ void RefuseOutputFolderHoldingLog(const std::string& out_dir, const std::string&
                           "); expected another output folder");
 }
 
-void PrepareOutputFolder(const fs::path& out, bool force, const std::string& key) {
+OutputLock PrepareOutputFolder(const fs::path& out, bool force, const std::string& key) {
   auto fail = [&](const std::string& what) {
     return ConfigError("", 0, key, "output folder '" + out.string() + "' " + what);
   };
   std::error_code ec;
-  const fs::file_status st = fs::status(out, ec);
-  if (!fs::exists(st)) {
+  if (!fs::exists(fs::status(out, ec))) {
     try {
       CreateOutputFolder(out);
     } catch (const Error& e) {
       throw fail(std::string("cannot be created: ") + e.what());
     }
-    return;
   }
-  if (!fs::is_directory(st)) throw fail("exists and is not a folder");
+  if (!fs::is_directory(fs::status(out, ec))) throw fail("exists and is not a folder");
+  // one run per folder: locked before anything in it is looked at or removed
+  OutputLock lock = LockOutputFolder(out, key);
   std::vector<std::string> entries;
   for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec))
     entries.push_back(it->path().filename().string());
   if (ec) throw fail("cannot be listed: " + ec.message());
-  if (entries.empty()) return;
+  if (entries.empty()) return lock;
   if (!force) {
     std::sort(entries.begin(), entries.end());
     const size_t n = entries.size();
@@ -217,6 +217,7 @@ void PrepareOutputFolder(const fs::path& out, bool force, const std::string& key
     fs::remove_all(p, ec);
     if (ec) throw fail("cannot be cleared: '" + p.string() + "': " + ec.message());
   }
+  return lock;
 }
 
 SetupRollback::SetupRollback(std::filesystem::path out, bool created)

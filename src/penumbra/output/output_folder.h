@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/output/output_lock.h"
+
 namespace penumbra {
 
 /// paths (relative to `out`) under `out` that are not outputs of a Penumbra run, and
@@ -22,14 +24,18 @@ namespace penumbra {
 /// @throws Error if `out` cannot be listed.
 std::vector<std::string> ForeignOutputEntries(const std::filesystem::path& out, size_t limit = 10);
 
-/// makes `out` ready for a run: creates it if missing; an empty folder is used as is; a
-/// non-empty one is refused unless `force`, which removes the outputs of an earlier run
-/// when everything in it is one (ForeignOutputEntries is empty) and refuses otherwise.
+/// makes `out` ready for a run: creates it if missing and locks it (LockOutputFolder: one run
+/// per folder); an empty folder is used as is; a non-empty one is refused unless `force`, which
+/// removes the outputs of an earlier run when everything in it is one (ForeignOutputEntries is
+/// empty) and refuses otherwise. the lock is taken before anything is removed, so a folder a
+/// live run holds is never emptied.
 /// @param key  where `out` came from, named in errors: "--out" or the world file's "output.dir"
-/// @throws ConfigError (key `key`) if `out` is not a folder, cannot be created, is not
-///         empty without `force`, or holds anything but Penumbra outputs (named, up to 10).
-void PrepareOutputFolder(const std::filesystem::path& out, bool force,
-                         const std::string& key = "--out");
+/// @returns the folder's lock: hold it for the whole run
+/// @throws ConfigError (key `key`) if `out` is not a folder, cannot be created, is in use by
+///         another run (naming its PID), is not empty without `force`, or holds anything but
+///         Penumbra outputs (named, up to 10).
+OutputLock PrepareOutputFolder(const std::filesystem::path& out, bool force,
+                               const std::string& key = "--out");
 
 /// refuses an output folder (`out_dir`, --out) of a replay or resimulation that holds the
 /// run log it reads (`log_path`) (or is its folder's parent): --force would empty it.

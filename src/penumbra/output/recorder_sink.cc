@@ -1,9 +1,15 @@
 #include "penumbra/output/recorder_sink.h"
 
+#include <utility>
+
 namespace penumbra {
 RecorderSink::RecorderSink(const std::string& path, const RunLogHeader& header,
                            const RunLogWriterOptions& options)
     : writer_(std::make_unique<RunLogWriter>(path, header, options)) {}
+
+RecorderSink::RecorderSink(UniqueFd fd, const std::string& name, const RunLogHeader& header,
+                           const RunLogWriterOptions& options)
+    : writer_(std::make_unique<RunLogWriter>(std::move(fd), name, header, options)) {}
 
 RecorderSink::~RecorderSink() = default;
 

@@ -22,6 +22,12 @@ class RecorderSink : public Sink {
   /// @throws RunLogError naming the path when it cannot be created or written.
   RecorderSink(const std::string& path, const RunLogHeader& header,
                const RunLogWriterOptions& options = {});
+  /// as above, into a file the caller opened (output/output_lock.h OpenRunLogFile,
+  /// core/output_path_policy.h OpenNewFileInside); the writer owns `fd` from here on. `name`
+  /// stands for the file in errors and stats.
+  /// @throws RunLogError naming `name` when the header cannot be written.
+  RecorderSink(UniqueFd fd, const std::string& name, const RunLogHeader& header,
+               const RunLogWriterOptions& options = {});
   ~RecorderSink() override;
 
   /// kState at every step from the loop's first (step 0 of a fresh run).
