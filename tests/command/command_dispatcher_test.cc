@@ -205,5 +205,41 @@ TEST_F(CommandDispatcherTest, StartRecordingAfterAStopIsRefusedWithStopping) {
   EXPECT_EQ(r.at("id"), 9);
 }
 
+// waypoints from a client are finite and inside the scene's bounds (scene/scene_limits.h
+// kMaxPositionM): 1e300 used to be accepted
+TEST_F(CommandDispatcherTest, WaypointsOutsideTheSceneAreRefusedNamingThePoint) {
+  const std::string world = dir_.Write("rover.yaml", std::string("seed: 1\n"
+                                                                 "robots:\n"
+                                                                 "  - name: rover\n"
+                                                                 "    file: ") +
+                                                         PENUMBRA_SOURCE_DIR +
+                                                         "/worlds/models/rover.xml\n"
+                                                         "    controller:\n"
+                                                         "      type: waypoint_follower\n"
+                                                         "      base_body: chassis\n"
+                                                         "      left_actuator: left_wheel\n"
+                                                         "      right_actuator: right_wheel\n"
+                                                         "      wheel_radius_m: 0.05\n"
+                                                         "      track_width_m: 0.3\n"
+                                                         "      speed_m_s: 0.5\n"
+                                                         "      waypoints: [[3.0, 0.0]]\n");
+  LiveLoop live(world);
+  const json far = {{"cmd", "waypoints"}, {"points", json::array({{1.0, 2.0}, {1e300, 0.0}})}};
+  const json r = live.Call(far);
+  ASSERT_FALSE(r.at("ok").get<bool>()) << r.dump();
+  EXPECT_EQ(r.at("error").at("code"), "bad_field") << r.dump();
+  EXPECT_EQ(r.at("error").at("field"), "points[1][0]") << r.dump();
+  EXPECT_NE(r.at("error").at("message").get<std::string>().find("expected a coordinate in "
+                                                                "[-100000, 100000] m"),
+            std::string::npos)
+      << r.dump();
+  ExpectError(live, {{"cmd", "waypoints"}, {"points", json::array({{0.0, -2e5}})}}, "bad_field",
+              "points[0][1]");
+  EXPECT_TRUE(live.Call({{"cmd", "waypoints"}, {"points", json::array({{1e5, -1e5}})}})
+                  .at("ok")
+                  .get<bool>());
+  live.Stop();
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -152,5 +152,46 @@ TEST(RecordingPathTest, StartRecordingWritesOnlyNewFilesInsideTheOutputFolder) {
   EXPECT_EQ(testing::ReadAll(out / "live.plog"), log);
 }
 
+// set_effect's vdb_smoke `file` from a client: an existing regular .vdb inside the world file's
+// folder, reached without following a link; anything else is refused as bad_field
+// "params.file" naming the path as given and the rule, in the same words whether or not a file
+// exists outside (an absolute path was read, and its error told what was there)
+TEST(RecordingPathTest, SetEffectReadsVdbFilesOnlyInsideTheWorldFilesFolder) {
+  penumbra::testing::TempDir tmp, outside;
+  tmp.Write("pendulum.xml", RecordingPendulum());
+  const std::string world =
+      tmp.Write("world.yaml", "seed: 4\nmodels:\n  - {name: a, file: pendulum.xml}\n");
+  outside.Write("real.vdb", "not a grid");
+  fs::create_symlink(outside.path() / "real.vdb", tmp.path() / "link.vdb");
+  fs::create_directory_symlink(outside.path(), tmp.path() / "escape");
+  fs::create_directory(tmp.path() / "folder.vdb");
+  RecordingLoop loop(world, tmp.path() / "out");
+  auto refused = [&](const std::string& path, const std::string& words) {
+    const json r = loop.Call({{"cmd", "set_effect"},
+                              {"effect", "plume"},
+                              {"params", {{"type", "vdb_smoke"}, {"file", path}}}});
+    EXPECT_FALSE(r.at("ok").get<bool>()) << r.dump();
+    if (r.at("ok").get<bool>()) return std::string();
+    EXPECT_EQ(r.at("error").at("code"), "bad_field") << r.dump();
+    EXPECT_EQ(r.at("error").at("field"), "params.file") << r.dump();
+    std::string message = r.at("error").at("message");
+    EXPECT_NE(message.find("file '" + path + "': " + words), std::string::npos) << message;
+    EXPECT_NE(message.find("the world file's folder"), std::string::npos) << message;
+    EXPECT_TRUE(loop.Call({{"cmd", "get_state"}}).at("ok").get<bool>());
+    message.erase(message.find(path), path.size());
+    return message;
+  };
+  // an existing and a missing file outside get the same answer
+  EXPECT_EQ(refused((outside.path() / "real.vdb").string(), "is absolute"),
+            refused((outside.path() / "none.vdb").string(), "is absolute"));
+  refused("/etc/passwd.vdb", "is absolute");
+  refused("../x/real.vdb", "has a '..' component");
+  refused("link.vdb", "is a symbolic link");
+  refused("escape/real.vdb", "folder 'escape' is a symbolic link");
+  refused("missing.vdb", "does not exist");
+  refused("folder.vdb", "is not a regular file");
+  refused("notes.txt", "does not end in .vdb");
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -1,10 +1,16 @@
 #include "penumbra/command/command_dispatcher.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <cmath>
+#include <filesystem>
 #include <future>
 #include <limits>
 #include <memory>
@@ -13,6 +19,8 @@
 #include "penumbra/control/controller_capabilities.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/output_path_policy.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -344,8 +352,17 @@ void CommandDispatcher::Waypoints(const CommandInfo& info, RequestReader& rd, co
     if (!pts[i].is_array() || pts[i].size() != 2)
       throw CommandError(command_code::kBadField, f,
                          fmt::format("'{}' is not [x, y]; expected two numbers (m)", f));
-    points.emplace_back(RequestReader::RealValue(pts[i][0], f + "[0]"),
-                        RequestReader::RealValue(pts[i][1], f + "[1]"));
+    // inside the scene's bounds (scene/scene_limits.h): 1e300 used to be accepted
+    Eigen::Vector2d p;
+    for (int a = 0; a < 2; ++a) {
+      const std::string fa = fmt::format("{}[{}]", f, a);
+      p[a] = RequestReader::RealValue(pts[i][a], fa);
+      if (std::abs(p[a]) > kMaxPositionM)
+        throw CommandError(command_code::kBadField, fa,
+                           fmt::format("'{}' is {}; expected a coordinate in [-{:g}, {:g}] m", fa,
+                                       p[a], kMaxPositionM, kMaxPositionM));
+    }
+    points.push_back(p);
   }
   const bool loop = rd.Bool("loop", false);
   Queue(info, rd, done, [t, points = std::move(points), loop](Simulation& sim) {
@@ -498,6 +515,52 @@ void CommandDispatcher::SetAdversity(const CommandInfo& info, RequestReader& rd,
   ReplyNow(done, {{"step", live.step()}, {"applies_from_step", live.step() + 1}});
 }
 
+namespace {
+// the absolute path of the existing regular file `client_path` (relative, no "..", ending in
+// .vdb) inside the folder of `world_file`, reached without following any symbolic link; the
+// errors name the path as given and the rule, never anything outside that folder
+std::string ClientVdbPath(const std::string& world_file, const std::string& client_path) {
+  constexpr std::string_view kExt = ".vdb";
+  constexpr std::string_view kFolder = "the world file's folder";
+  auto refuse = [&](const std::string& rule) {
+    return CommandError(command_code::kBadField, "params.file",
+                        InputPathError(client_path, rule, kExt, kFolder).what());
+  };
+  // the read side's words for the two rules that keep a path inside the folder
+  if (!client_path.empty() && client_path.front() == '/')
+    throw refuse("is absolute (starts with '/'); only files inside the folder are read");
+  if (client_path == ".." || client_path.rfind("../", 0) == 0 ||
+      client_path.find("/../") != std::string::npos ||
+      (client_path.size() >= 3 && client_path.compare(client_path.size() - 3, 3, "/..") == 0))
+    throw refuse("has a '..' component (it would leave the folder)");
+  std::vector<std::string> parts;
+  try {
+    parts = CheckClientPath(client_path, kExt);
+  } catch (const OutputPathError& e) {
+    throw refuse(e.rule());
+  }
+  if (world_file.empty()) throw refuse("cannot be read: this run has no world file");
+  std::error_code ec;
+  const std::filesystem::path root = std::filesystem::absolute(world_file, ec).parent_path();
+  UniqueFd top(::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (ec || top.get() < 0) throw refuse("cannot be read: the world file's folder cannot be opened");
+  const UniqueFd dir = OpenFoldersNoFollow(std::move(top), parts, [&](int, size_t i, int err) {
+    throw refuse(fmt::format("folder '{}' {}", SanitizeForMessage(parts[i], 256),
+                             err == ENOENT ? "does not exist"
+                                           : "is a symbolic link or not a folder (links are not "
+                                             "followed)"));
+  });
+  struct stat st {};
+  if (::fstatat(dir.get(), parts.back().c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0)
+    throw refuse(errno == ENOENT ? "does not exist" : "cannot be read");
+  if (S_ISLNK(st.st_mode)) throw refuse("is a symbolic link (links are not followed)");
+  if (!S_ISREG(st.st_mode)) throw refuse("is not a regular file");
+  std::filesystem::path p = root;
+  for (const std::string& part : parts) p /= part;
+  return p.string();
+}
+}  // namespace
+
 void CommandDispatcher::SetEffect(const CommandInfo& info, RequestReader& rd, const Done& done) {
   LiveControl& live = Live(info);
   const std::string effect = rd.String("effect");
@@ -512,8 +575,12 @@ void CommandDispatcher::SetEffect(const CommandInfo& info, RequestReader& rd, co
                        fmt::format("'params' is a {}; expected a map of the effect's "
                                    "parameters, or null to remove the effect",
                                    JsonTypeName(params)));
+  json checked = params;
+  // a file a client names (vdb_smoke's .vdb): inside the world file's folder only
+  if (checked.is_object() && checked.contains("file") && checked["file"].is_string())
+    checked["file"] = ClientVdbPath(world_.file, checked["file"].get<std::string>());
   try {
-    live.effects().SetEffect(effect, params);
+    live.effects().SetEffect(effect, checked);
   } catch (const ConfigError& e) {
     throw BadLiveField(e, "params");
   }

@@ -11,6 +11,7 @@
 #include "penumbra/config/yaml_document.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/input_file.h"
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
@@ -119,6 +120,14 @@ class WorldParser {
       // `record: {file: ""}` used to record nothing without a word
       if (w.record.file.empty())
         rec.Child("file").Fail("empty; expected a file name ending in .plog");
+      // a world file may come from anyone: its log goes inside the output folder only
+      try {
+        CheckClientPath(w.record.file, ".plog");
+      } catch (const OutputPathError& e) {
+        rec.Child("file").Fail("'" + SanitizeForMessage(w.record.file, 300) + "' " + e.rule() +
+                               "; expected a file name ending in .plog, relative to the output "
+                               "folder and inside it");
+      }
       if (const auto found = rec.Find("sensors")) w.record.sensors = found->Bool();
     }
     if (r.Has("semantic_classes"))
