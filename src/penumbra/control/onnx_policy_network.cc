@@ -1,11 +1,5 @@
 #include "penumbra/control/onnx_policy_network.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
@@ -13,6 +7,7 @@
 
 #include "penumbra/control/onnx_model_check.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -73,37 +68,9 @@ std::unique_ptr<PolicyNetwork> LoadOnnxPolicy(const std::string& path, int input
     throw ConfigError(path, 0, "",
                       "no such ONNX file; expected a policy network exported to ONNX "
                       "(docs/policies.md)");
-  // O_NONBLOCK: a FIFO swapped in after the check does not block the open
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0)
-    throw ConfigError(path, 0, "",
-                      std::string("cannot open the ONNX file: ") + std::strerror(errno));
-  std::string bytes;
-  struct stat st {};
-  const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
-  const bool fits = regular && st.st_size <= kOnnxMaxFileBytes;
-  if (fits) {
-    bytes.resize(static_cast<size_t>(st.st_size));
-    size_t got = 0;
-    while (got < bytes.size()) {
-      const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
-      if (r < 0 && errno == EINTR) continue;
-      if (r <= 0) break;
-      got += static_cast<size_t>(r);
-    }
-    bytes.resize(got);
-  }
-  const int read_errno = errno;
-  ::close(fd);
-  if (!regular) throw ConfigError(path, 0, "", "not a regular file; expected an ONNX file");
-  if (!fits)
-    throw ConfigError(path, 0, "",
-                      "the file has " + std::to_string(st.st_size) + " bytes; expected at most " +
-                          std::to_string(kOnnxMaxFileBytes) + " (kOnnxMaxFileBytes)");
-  if (static_cast<off_t>(bytes.size()) != st.st_size)
-    throw ConfigError(path, 0, "",
-                      "could not read the whole file (" + std::to_string(bytes.size()) + " of " +
-                          std::to_string(st.st_size) + " bytes): " + std::strerror(read_errno));
+  // a regular file only (a FIFO does not block), its size checked before it is read
+  const std::string bytes =
+      ReadInputFile(path, "ONNX policy file", static_cast<size_t>(kOnnxMaxFileBytes));
   return LoadOnnxPolicyFromBytes(bytes, path, input_size, output_size);
 }
 
