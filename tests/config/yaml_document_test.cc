@@ -66,5 +66,27 @@ TEST(YamlDocument, RefusesAnAliasBomb) {
   EXPECT_NE(e.problem().find("expands to more than"), std::string::npos) << e.what();
 }
 
+TEST(YamlDocument, NoLineLiesPastTheEndOfTheFile) {
+  // yaml-cpp marks the end of the input one line after the last one: an unclosed '[' or '{'
+  // in a 3-line file was reported at line 4 (a 127-line world file's at line 129)
+  ConfigError e = YamlDocumentErrorOf("a: 1\nb: [1,\n\n");
+  EXPECT_NE(e.problem().find("YAML syntax error"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 3) << e.what();
+  e = YamlDocumentErrorOf("a: 1\nb: {x: 1\n# the end\n\n");
+  EXPECT_EQ(e.line(), 4) << e.what();
+  // a last line without a newline counts
+  e = YamlDocumentErrorOf("a: 1\nb: [1,");
+  EXPECT_EQ(e.line(), 2) << e.what();
+  // a null value takes the mark of what follows it (the next key, or the end of the input):
+  // it has no line of its own, so readers name its key's line
+  const ConfigValue v = ParseYaml("a:\n# note\n\nb: 2\nc:\n\n\n", "f.yaml");
+  EXPECT_EQ(v["a"].line(), 0);
+  EXPECT_EQ(v["c"].line(), 0);
+  EXPECT_EQ(v.entries()[2].key_line, 5);
+  // a document of comments only is a null root without a line (it used to be the line after
+  // the file's last)
+  EXPECT_EQ(ParseYaml("# one\n# two\n\n", "f.yaml").line(), 0);
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "common/temp_dir.h"
 #include "penumbra/core/error.h"
 #include "penumbra/world/yaml_reader.h"
@@ -166,6 +168,29 @@ TEST(WorldOverride, LaterErrorsNameTheOverrideLineUnderItsKeys) {
   EXPECT_EQ(in_world.file(), recorded.file);
   EXPECT_EQ(in_world.line(), recorded.lines->Find("lights[1].name"));
   EXPECT_GT(in_world.line(), 0);
+}
+
+TEST(WorldOverride, ErrorsOfTheRecordedModelsNameTheRecordedWorldNotALinePastTheFragment) {
+  // the fragment is read with the recorded models appended after its last line: a recorded
+  // model file that has gone was reported at line 5 of this 3-line override
+  testing::TempDir dir;
+  const std::string model = dir.Write(
+      "m.xml",
+      "<mujoco><worldbody><body name=\"b\"><geom size=\"0.1\"/></body></worldbody></mujoco>");
+  const std::string world =
+      dir.Write("world.yaml", "duration_sec: 1\nmodels:\n  - name: box\n    file: m.xml\n");
+  const WorldConfig recorded = LoadWorldFile(world);
+  std::filesystem::remove(model);
+  const std::string path = dir.Write("override.yaml", "sky: {type: uniform}\n# one\n# two\n");
+  try {
+    ApplyWorldOverride(recorded, path);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.file(), world) << e.what();
+    EXPECT_EQ(e.line(), 4) << e.what();
+    EXPECT_EQ(e.key(), "models[0].file") << e.what();
+    EXPECT_NE(e.problem().find("file not found"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"{name: s, type: smoke, mode: noise, density_scale_per_m: -1, region: {min: [0, 0, "
                 "0], max: [1, 1, 1]}}",
                 "effects[1].density_scale_per_m", "expected (0, 1000]"},
-        BadCase{"{name: f, type: fog, mor_m: 0}", "effects[1].mor_m", "expected >= 0.001"},
+        BadCase{"{name: f, type: fog, mor_m: 0}", "effects[1].mor_m", "expected [0.001, 1e+05]"},
         BadCase{"{name: f, type: fog, sigma_t_per_m: -0.5}", "effects[1].sigma_t_per_m",
                 "expected (0, 1000]"},
         BadCase{"{name: t, type: tornado}", "effects[1].type",

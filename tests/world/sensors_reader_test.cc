@@ -111,7 +111,7 @@ TEST_F(SensorsReaderTest, InvalidSettingsNameSensorAndKey) {
       {"sensors:\n  - {name: s, type: imu, body: r/b, site: x}\n", "sensors[0].site",
        "both body and site"},
       {"sensors:\n  - {name: s, type: imu, body: r/b, latency_sec: -1}\n", "sensors[0].latency_sec",
-       ">= 0"},
+       "expected a number in [0, 3600]"},
       {"sensors:\n  - {name: s, type: sonar}\n", "sensors[0].type", "unknown value 'sonar'"},
       {"sensors:\n  - {name: s, type: mujoco, preset: x}\n", "sensors[0].preset", "unknown key"},
       {"sensors:\n  - {name: s, type: mujoco}\n  - {name: s, type: ground_truth}\n",

@@ -13,12 +13,29 @@ namespace {
 
 int YamlMarkLine(const YAML::Mark& mark) { return mark.is_null() ? 0 : mark.line + 1; }
 
+// the 1-based number of the last line of `text` (a final line without '\n' counts; an empty
+// text has line 1)
+int LastLine(const std::string& text) {
+  int lines = 1;
+  for (size_t i = 0; i + 1 < text.size(); ++i)
+    if (text[i] == '\n') ++lines;
+  return lines;
+}
+
+// a mark's line within the document: yaml-cpp marks the end of the input (an unclosed '[' or
+// quote, a null value before trailing blank or comment lines) one line after the last line
+// ends, so such errors cited line 129 of a 127-line file; they name the last line instead
+int YamlLineIn(const YAML::Mark& mark, int last_line) {
+  const int line = YamlMarkLine(mark);
+  return line > last_line ? last_line : line;
+}
+
 // the parser's events of a document, refusing the first node with a tag of its own. yaml-cpp
 // gives untagged nodes the non-specific tags "?" (plain scalars, mappings, lists) and "!"
 // (quoted scalars); anything else was written in the file.
 class YamlTagRefuser : public YAML::EventHandler {
  public:
-  explicit YamlTagRefuser(const std::string& file) : file_(file) {}
+  YamlTagRefuser(const std::string& file, int last_line) : file_(file), last_line_(last_line) {}
   void OnDocumentStart(const YAML::Mark&) override {}
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
@@ -45,12 +62,13 @@ class YamlTagRefuser : public YAML::EventHandler {
     const std::string kStandard = "tag:yaml.org,2002:";
     const std::string shown =
         tag.rfind(kStandard, 0) == 0 ? "!!" + tag.substr(kStandard.size()) : tag;
-    throw ConfigError(file_, YamlMarkLine(mark), "",
+    throw ConfigError(file_, YamlLineIn(mark, last_line_), "",
                       "YAML tag '" + shown +
                           "' is not supported; expected a plain value, list or mapping without a "
                           "tag (Penumbra reads no YAML tags: remove it)");
   }
   const std::string& file_;
+  int last_line_ = 1;
 };
 
 // counts the documents of a YAML stream without building nodes; a document that holds only a
@@ -93,19 +111,22 @@ class YamlDocumentCounter : public YAML::EventHandler {
 // yaml-cpp's node tree -> ConfigNode tree, counting nodes against kMaxYamlNodes
 class YamlTreeBuilder {
  public:
-  explicit YamlTreeBuilder(const std::string& file) : file_(file) {}
+  YamlTreeBuilder(const std::string& file, int last_line) : file_(file), last_line_(last_line) {}
 
   std::shared_ptr<const ConfigNode> Build(const YAML::Node& n) {
     if (++count_ > kMaxYamlNodes) {
-      throw ConfigError(file_, YamlMarkLine(n.Mark()), "",
+      throw ConfigError(file_, YamlLineIn(n.Mark(), last_line_), "",
                         "the document expands to more than " + std::to_string(kMaxYamlNodes) +
                             " values (aliases of aliases?); expected a smaller document");
     }
     auto out = std::make_shared<ConfigNode>();
-    out->line = YamlMarkLine(n.Mark());
+    out->line = YamlLineIn(n.Mark(), last_line_);
     switch (n.Type()) {
       case YAML::NodeType::Undefined:
       case YAML::NodeType::Null:
+        // a null's mark is that of the next token (the next key, or the end of the input):
+        // no line of its own; readers use its key's or its list's line
+        out->line = 0;
         out->kind = ConfigKind::kNull;
         break;
       case YAML::NodeType::Scalar:
@@ -126,7 +147,7 @@ class YamlTreeBuilder {
           ConfigEntry e;
           e.key_is_scalar = it->first.IsScalar();
           if (e.key_is_scalar) e.key = it->first.Scalar();
-          e.key_line = YamlMarkLine(it->first.Mark());
+          e.key_line = YamlLineIn(it->first.Mark(), last_line_);
           e.value = Build(it->second);
           out->entries.push_back(std::move(e));
         }
@@ -137,6 +158,7 @@ class YamlTreeBuilder {
 
  private:
   const std::string& file_;
+  int last_line_ = 1;
   size_t count_ = 0;
 };
 
@@ -175,13 +197,13 @@ void RefuseYamlTags(const std::string& text, const std::string& file) {
   try {
     std::istringstream in(text);
     YAML::Parser parser(in);
-    YamlTagRefuser refuser(file);
+    YamlTagRefuser refuser(file, LastLine(text));
     // at most kMaxYamlDocuments documents: yaml-cpp 0.7 yields empty documents for ever on some
     // short inputs (",sn\xd4 !:", found by fuzz/world_fuzz.cc)
     for (int d = 0; d < kMaxYamlDocuments; ++d)
       if (!parser.HandleNextDocument(refuser)) break;
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(file, YamlMarkLine(e.mark), "", "YAML syntax error: " + e.msg);
+    throw ConfigError(file, YamlLineIn(e.mark, LastLine(text)), "", "YAML syntax error: " + e.msg);
   }
 }
 
@@ -199,17 +221,18 @@ ConfigValue ParseYaml(const std::string& text, const std::string& file,
         if (!parser.HandleNextDocument(counter)) break;
       if (counter.marks.size() >= 2)
         throw ConfigError(
-            file, YamlMarkLine(counter.marks[1]), "",
+            file, YamlLineIn(counter.marks[1], LastLine(text)), "",
             "a second YAML document (after '---'); expected " + options.what + " in one document");
     }
     RefuseYamlTags(text, file);
     const YAML::Node root = YAML::Load(text);
-    return ConfigValue(YamlTreeBuilder(file).Build(root));
+    return ConfigValue(YamlTreeBuilder(file, LastLine(text)).Build(root));
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(file, YamlMarkLine(e.mark), "", "YAML syntax error: " + e.msg);
+    throw ConfigError(file, YamlLineIn(e.mark, LastLine(text)), "", "YAML syntax error: " + e.msg);
   } catch (const YAML::Exception& e) {
     // any other yaml-cpp failure still names the file (and line when yaml-cpp knows it)
-    throw ConfigError(file, YamlMarkLine(e.mark), "", "cannot read the YAML document: " + e.msg);
+    throw ConfigError(file, YamlLineIn(e.mark, LastLine(text)), "",
+                      "cannot read the YAML document: " + e.msg);
   }
 }
 

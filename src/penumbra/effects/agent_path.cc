@@ -8,6 +8,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/number_text.h"
 #include "penumbra/core/text_match.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 
@@ -74,8 +75,11 @@ void AgentConfig::ValidateOrThrow(const std::string& file, const std::string& ke
     fail("waypoints", "agent '" + name + "' has " + std::to_string(waypoints.size()) +
                           " waypoint(s); expected a list of at least 2 [x, y] points");
   for (size_t i = 0; i < waypoints.size(); ++i) {
-    if (!waypoints[i].allFinite())
-      fail("waypoints[" + std::to_string(i) + "]", "not finite; expected finite [x, y] in m");
+    if (!(waypoints[i].allFinite() && waypoints[i].cwiseAbs().maxCoeff() <= kMaxPositionM))
+      fail("waypoints[" + std::to_string(i) + "]",
+           "[" + FormatG(waypoints[i].x()) + ", " + FormatG(waypoints[i].y()) +
+               "] is out of range; expected [x, y] in m, each in [-" + FormatG(kMaxPositionM) +
+               ", " + FormatG(kMaxPositionM) + "]");
     if (i > 0 && (waypoints[i] - waypoints[i - 1]).norm() < 0.01)
       fail("waypoints[" + std::to_string(i) + "]",
            "closer than 1 cm to waypoints[" + std::to_string(i - 1) +
@@ -90,7 +94,9 @@ void AgentConfig::ValidateOrThrow(const std::string& file, const std::string& ke
     fail("pause_sec", "got " + FormatG(pause_sec) + "; expected [0, 3600] s");
   if (!(std::isfinite(start_delay_sec) && start_delay_sec >= 0 && start_delay_sec <= 3600))
     fail("start_delay_sec", "got " + FormatG(start_delay_sec) + "; expected [0, 3600] s");
-  if (!std::isfinite(floor_z)) fail("floor_z", "not finite; expected a height in m");
+  if (!(std::isfinite(floor_z) && std::abs(floor_z) <= kMaxPositionM))
+    fail("floor_z", "got " + FormatG(floor_z) + "; expected a height in [-" +
+                        FormatG(kMaxPositionM) + ", " + FormatG(kMaxPositionM) + "] m");
   if (!(std::isfinite(height_m) && height_m >= 0.5 && height_m <= 2.5))
     fail("height_m", "got " + FormatG(height_m) + "; expected [0.5, 2.5] m");
   if (!(std::isfinite(clearance_m) && clearance_m >= 0 && clearance_m <= 10))

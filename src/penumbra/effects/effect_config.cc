@@ -9,6 +9,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 
@@ -149,16 +150,18 @@ std::optional<EffectConfig::Problem> EffectConfig::Validate() const {
                        "' is not a valid effect name; expected a non-empty name of "
                        "the characters A-Z a-z 0-9 _ -");
   }
-  c.In("start_sec", start_sec, R::AtLeast(0));
+  c.In("start_sec", start_sec, R::Closed(0, kMaxDurationSec));
+  // stop_sec is infinite unless given; given, it is a time of a run (at most kMaxDurationSec)
+  if (c.ok() && std::isfinite(stop_sec)) c.In("stop_sec", stop_sec, R::Closed(0, kMaxDurationSec));
   if (c.ok() && !(stop_sec > start_sec)) {
     c.Fail("stop_sec", EffectChecker::Num(stop_sec) + " is out of range; expected > start_sec (" +
                            EffectChecker::Num(start_sec) + ")");
   }
-  c.In("fade_in_sec", fade_in_sec, R::AtLeast(0));
-  c.In("fade_out_sec", fade_out_sec, R::AtLeast(0));
+  c.In("fade_in_sec", fade_in_sec, R::Closed(0, kMaxDurationSec));
+  c.In("fade_out_sec", fade_out_sec, R::Closed(0, kMaxDurationSec));
   if (region) {
-    c.In3("region.min", region->min_W, R::Finite());
-    c.In3("region.max", region->max_W, R::Finite());
+    c.In3("region.min", region->min_W, R::Closed(-kMaxPositionM, kMaxPositionM));
+    c.In3("region.max", region->max_W, R::Closed(-kMaxPositionM, kMaxPositionM));
     if (c.ok() && (region->min_W.array() >= region->max_W.array()).any()) {
       c.Fail("region.min", "region min " + EffectChecker::Vec(region->min_W) +
                                " is not below max " + EffectChecker::Vec(region->max_W) +

@@ -91,8 +91,19 @@ WorldConfig ApplyWorldOverride(const WorldConfig& recorded, const std::string& p
   }
   std::string combined = text;
   if (!combined.empty() && combined.back() != '\n') combined += '\n';
+  const auto fragment_lines = std::count(combined.begin(), combined.end(), '\n');
   combined += models;
-  const WorldConfig o = ParseWorld(combined, path);
+  WorldConfig o;
+  try {
+    o = ParseWorld(combined, path);
+  } catch (const ConfigError& e) {
+    // the recorded models follow the fragment's last line: an error there (a model file that
+    // was moved) is the recorded world's, not a line of the fragment (it cited line 129 of a
+    // 127-line file)
+    if (e.file() != path || e.line() <= fragment_lines) throw;
+    throw ConfigError(recorded.file, recorded.lines ? recorded.lines->Find(e.key()) : 0, e.key(),
+                      e.problem());
+  }
 
   WorldConfig w = recorded;
   for (const std::string& key : result.keys) {

@@ -48,6 +48,26 @@ inline constexpr double kMaxLightPowerW = 1e7;
 inline constexpr double kMaxLuminanceCdM2 = 1e10;
 /// largest emitter radius of a point or spot light (m), as geom sizes.
 inline constexpr double kMaxLightRadiusM = 1e5;
+/// largest |k1|, |k2|, |k3| (radial) and |p1|, |p2| (tangential) Brown-Conrady distortion
+/// coefficients of a camera (world-file `distortion`). calibrations of real lenses give |k|
+/// below ~10 and |p| below ~0.1; k1 = 1e6 squeezed a 60 deg view into about 1 deg.
+inline constexpr double kMaxRadialDistortion = 100;
+inline constexpr double kMaxTangentialDistortion = 1;
+/// largest |component| of a direction vector given at load (lights, flashlights): its square
+/// must not overflow when it is normalised (a direction of [1e308, 0, 0] became zero).
+inline constexpr double kMaxDirectionComponent = 1e5;
+/// most cameras of a world: world-file `cameras` and the MJCF cameras `mjcf_cameras` enables,
+/// together. each camera is set up, given its own output folder and sink, and renders its
+/// first frame before the first physics step ends: 5000 cameras took more than 10 s before a
+/// SIGTERM was seen.
+inline constexpr int kMaxCameras = 256;
+/// most NPC agents of a run: the world file's `agents`, an adversity preset's people and
+/// vehicles and a live run's parked reserve together. each is a MuJoCo mocap body per part (a
+/// person 9, a vehicle 5), and MuJoCo 2.2.2's collision detection takes nbody (nbody - 1) / 2
+/// doubles of its stack every step: its automatic stack holds that up to about 1,650 bodies
+/// (200 people overflow it at load, "Stack overflow"), and beyond 46,341 bodies the count
+/// overflows an int (10,000 agents ran 339 s and 1 GB before "broadphase buffer full").
+inline constexpr int kMaxAgents = 150;
 /// physics timestep range (s), for physics.timestep_sec and the MJCF <option timestep>.
 /// the lower end keeps 1 s of simulated time at <= 1e6 steps.
 inline constexpr double kMinTimestepSec = 1e-6;

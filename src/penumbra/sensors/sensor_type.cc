@@ -10,9 +10,12 @@ std::string SensorNumber(double v) {
   return std::string(buf, r.ptr);
 }
 
-double SensorParamReader::NonNegative(std::string_view k, const std::string& unit) const {
+double SensorParamReader::NonNegative(std::string_view k, const std::string& unit,
+                                      double max) const {
   const double v = Double(k);
-  if (v < 0) Fail(k, "got " + SensorNumber(v) + "; expected a number >= 0 (" + unit + ")");
+  if (!(v >= 0 && v <= max))
+    Fail(k, "got " + SensorNumber(v) + "; expected a number in [0, " + SensorNumber(max) + "] (" +
+                unit + ")");
   return v;
 }
 

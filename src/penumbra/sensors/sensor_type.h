@@ -66,9 +66,9 @@ class SensorParamReader {
   ///         was expected).
   [[noreturn]] virtual void Fail(std::string_view k, const std::string& problem) const = 0;
 
-  /// a number >= 0 at `k` (`unit` names it in the message).
-  /// @throws ConfigError "got <v>; expected a number >= 0 (<unit>)".
-  double NonNegative(std::string_view k, const std::string& unit) const;
+  /// a number in [0, max] at `k` (`unit` names it in the message).
+  /// @throws ConfigError "got <v>; expected a number in [0, <max>] (<unit>)".
+  double NonNegative(std::string_view k, const std::string& unit, double max) const;
   /// a noise value at `k` of the `noise` map: in [0, kMaxSensorNoise].
   /// @throws ConfigError "got <v>; expected a noise value >= 0 and <= 1000".
   double Noise(std::string_view k) const;

@@ -10,6 +10,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/effects/agent_animation.h"
 #include "penumbra/physics/simulation.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/session/floor_map.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -507,6 +508,18 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
     std::vector<MocapBodySpec> parked = AgentBodySpecs(reserved_, seed_);
     for (size_t i = 0; i < parked.size(); ++i) parked[i].X_WB = AgentParkedPose(reserved_[i]);
     bodies.insert(bodies.end(), parked.begin(), parked.end());
+  }
+  // the world's agents were counted when read; with a preset's NPCs and a live reserve, here
+  // (scene/scene_limits.h)
+  if (bodies.size() > static_cast<size_t>(kMaxAgents)) {
+    const size_t added = bodies.size() - world_agents_;
+    throw ConfigError(
+        world.file, 0, spec.empty() || added == reserved_.size() ? "agents" : "adversity",
+        std::to_string(bodies.size()) + " agents (" + std::to_string(world_agents_) +
+            " in the world file, " + std::to_string(added - reserved_.size()) +
+            " from the adversity preset, " + std::to_string(reserved_.size()) +
+            " reserved for live presets); expected at most " + std::to_string(kMaxAgents) +
+            " (MuJoCo 2.2.2's collision detection runs out of its stack beyond that)");
   }
   AddAgentBodies(bodies, world.file, composed);
 }

@@ -236,6 +236,7 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world,
     it->outputs = o.outputs;
     ApplyCameraConfig(o, &*it, world.file, "mjcf_cameras.overrides." + o.name);
   }
+  const size_t mjcf_count = cameras.size();
   // world-file cameras
   for (size_t i = 0; i < world.cameras.size(); ++i) {
     const CameraConfig& c = world.cameras[i];
@@ -266,6 +267,15 @@ void AssembleCameras(SceneDescription& scene, const WorldConfig& world,
     }
     AppendWorldCamera(c, cam, &cameras, world.file, "cameras[" + std::to_string(i) + "]");
   }
+  // the world file's own list was counted when it was read; the MJCF cameras only now
+  if (cameras.size() > static_cast<size_t>(kMaxCameras))
+    throw ConfigError(world.file, 0, world.mjcf_cameras.enabled ? "mjcf_cameras" : "cameras",
+                      std::to_string(cameras.size()) + " cameras (" +
+                          std::to_string(cameras.size() - mjcf_count) +
+                          " from the world file, stereo pairs counting twice, " +
+                          std::to_string(mjcf_count) + " MJCF cameras); expected at most " +
+                          std::to_string(kMaxCameras) +
+                          " (mjcf_cameras: {enabled: false} leaves the MJCF cameras out)");
   std::set<std::string> names;
   for (const CameraSpec& c : cameras)
     if (!names.insert(c.name).second)

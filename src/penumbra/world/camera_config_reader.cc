@@ -7,6 +7,7 @@
 
 #include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -81,8 +82,12 @@ void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
     d.ExpectMap({"k1", "k2", "p1", "p2", "k3"});
     double* field[] = {&c->k1, &c->k2, &c->p1, &c->p2, &c->k3};
     const char* name[] = {"k1", "k2", "p1", "p2", "k3"};
+    // radial k1 k2 k3, tangential p1 p2 (scene/scene_limits.h)
+    const double bound[] = {kMaxRadialDistortion, kMaxRadialDistortion, kMaxTangentialDistortion,
+                            kMaxTangentialDistortion, kMaxRadialDistortion};
     for (int i = 0; i < 5; ++i)
-      if (d.Has(name[i])) *field[i] = d.Child(name[i]).Double();
+      if (const auto found = d.Find(name[i]))
+        *field[i] = Within(*found, *c, -bound[i], bound[i], false, "distortion coefficient");
     // an MJCF camera override without fovy_deg / intrinsics keeps the MJCF fovy, known only
     // after compilation: scene assembly checks it then (world/camera_specs.h)
     const bool optics_known = c->fovy_deg || c->intrinsics;

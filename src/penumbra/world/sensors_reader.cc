@@ -109,7 +109,7 @@ SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, Se
       c.Fail(sensor + "got " + FormatNumber(*s.rate_hz) + "; expected a rate > 0 (Hz)");
   }
   const WorldSensorParamReader reader(r, robot);
-  if (r.Has("latency_sec")) s.latency_sec = reader.NonNegative("latency_sec", "s");
+  if (r.Has("latency_sec")) s.latency_sec = reader.NonNegative("latency_sec", "s", 3600);
   if (r.Has("body")) s.body = Prefixed(robot, r.Child("body").String());
   if (r.Has("site")) s.site = Prefixed(robot, r.Child("site").String());
   if (!s.body.empty() && !s.site.empty())
@@ -132,7 +132,14 @@ SensorConfig ReadSensorFields(const ParamReader& r, const std::string& robot, Se
                FormatNumber(s.xyz.z()) + "]; expected each of the 3 numbers in [" +
                FormatNumber(-kMaxPositionM) + ", " + FormatNumber(kMaxPositionM) + "] (m)");
     }
-    if (const auto found = p.Find("rpy_deg")) s.rpy_deg = found->Vector3();
+    if (const auto found = p.Find("rpy_deg")) {
+      s.rpy_deg = found->Vector3();
+      // one turn holds every rotation, as for the world file's poses
+      if (!(s.rpy_deg.cwiseAbs().maxCoeff() <= 360))
+        found->Fail(sensor + "got [" + FormatNumber(s.rpy_deg.x()) + ", " +
+                    FormatNumber(s.rpy_deg.y()) + ", " + FormatNumber(s.rpy_deg.z()) +
+                    "]; expected each of the 3 numbers in [-360, 360] (deg)");
+    }
   }
   std::visit([&](auto& p) { p.Read(reader); }, s.params);
   return s;

@@ -13,6 +13,7 @@
 #include "penumbra/core/input_file.h"
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
@@ -100,7 +101,12 @@ class WorldParser {
       for (const ParamReader& l : r.Child("lights").List()) w.lights.push_back(ReadLight(l));
     }
     if (r.Has("cameras")) {
-      for (const ParamReader& c : r.Child("cameras").List()) w.cameras.push_back(ReadCamera(c));
+      const ParamReader cameras = r.Child("cameras");
+      // counted before any is read (scene/scene_limits.h)
+      if (cameras.node().IsSequence() && cameras.size() > static_cast<size_t>(kMaxCameras))
+        cameras.Fail(std::to_string(cameras.size()) + " cameras; expected at most " +
+                     std::to_string(kMaxCameras) + " (world-file and MJCF cameras together)");
+      for (const ParamReader& c : cameras.List()) w.cameras.push_back(ReadCamera(c));
     }
     if (const auto found = r.Find("mjcf_cameras")) ReadMjcfCameras(*found, &w.mjcf_cameras);
     if (r.Has("materials")) {
@@ -409,7 +415,11 @@ class WorldParser {
     if (const auto found = r.Find("rate_hz")) m->rate_hz = found->Double();
     if (const auto found = r.Find("outputs")) m->outputs = ReadOutputs(*found);
     if (!r.Has("overrides")) return;
-    for (auto& [name, o] : r.Child("overrides").Entries()) {
+    const ParamReader overrides = r.Child("overrides");
+    if (overrides.node().IsMap() && overrides.size() > static_cast<size_t>(kMaxCameras))
+      overrides.Fail(std::to_string(overrides.size()) + " camera overrides; expected at most " +
+                     std::to_string(kMaxCameras) + " (the most cameras a world may have)");
+    for (auto& [name, o] : overrides.Entries()) {
       std::vector<std::string_view> keys = {"width",    "height",     "rate_hz", "outputs",
                                             "fovy_deg", "intrinsics", "near_m"};
       keys.insert(keys.end(), CameraSensorKeys().begin(), CameraSensorKeys().end());

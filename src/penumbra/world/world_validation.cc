@@ -313,7 +313,8 @@ class Validator {
       }
     }
     if (l.type != Light::Type::kPoint) {
-      Check3(path + ".direction", l.direction, Range::Finite());
+      Check3(path + ".direction", l.direction,
+             Range::Closed(-kMaxDirectionComponent, kMaxDirectionComponent));
       if (l.direction.norm() == 0)
         Fail(path + ".direction", "zero vector; expected a non-zero direction");
     }

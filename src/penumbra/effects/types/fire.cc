@@ -3,6 +3,7 @@
 #include "penumbra/effects/blackbody.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/grid_fluid.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -100,7 +101,7 @@ void FireParams::Validate(const EffectConfig& e, EffectChecker* c) const {
   c->In("absorption_per_m", absorption_per_m, R::OpenClosed(0, 1e3));
   c->In3("albedo", albedo, R::Closed(0, 1));
   c->In("min_emission_temperature_k", min_emission_temperature_k, R::Closed(300, 4000));
-  c->In("glow_light_radius_m", glow_light_radius_m, R::AtLeast(0));
+  c->In("glow_light_radius_m", glow_light_radius_m, R::Closed(0, kMaxLightRadiusM));
 }
 
 std::unique_ptr<EffectInstance> FireParams::Bind(const EffectConfig& e,

@@ -2,6 +2,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/effects/effect_config.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -102,25 +103,26 @@ void FlashlightParams::Validate(const EffectConfig&, EffectChecker* c) const {
     }
     for (size_t i = 0; i < waypoints.size(); ++i) {
       const std::string k = "waypoints[" + std::to_string(i) + "]";
-      c->In(k + ".t_sec", waypoints[i].t_sec, R::AtLeast(0));
+      c->In(k + ".t_sec", waypoints[i].t_sec, R::Closed(0, kMaxDurationSec));
       if (c->ok() && i > 0 && !(waypoints[i].t_sec > waypoints[i - 1].t_sec)) {
         c->Fail(k + ".t_sec", N::Num(waypoints[i].t_sec) +
                                   " is out of range; expected t_sec increasing along the list");
       }
-      c->In3(k + ".position", waypoints[i].position_W, R::Finite());
-      c->In3(k + ".direction", waypoints[i].direction_W, R::Finite());
+      c->In3(k + ".position", waypoints[i].position_W, R::Closed(-kMaxPositionM, kMaxPositionM));
+      c->In3(k + ".direction", waypoints[i].direction_W,
+             R::Closed(-kMaxDirectionComponent, kMaxDirectionComponent));
       if (c->ok() && waypoints[i].direction_W.norm() < 1e-9) {
         c->Fail(k + ".direction", "zero vector; expected a non-zero direction");
       }
     }
   } else {
-    c->In3("position", position_B, R::Finite());
-    c->In3("direction", direction_B, R::Finite());
+    c->In3("position", position_B, R::Closed(-kMaxPositionM, kMaxPositionM));
+    c->In3("direction", direction_B, R::Closed(-kMaxDirectionComponent, kMaxDirectionComponent));
     if (c->ok() && direction_B.norm() < 1e-9) {
       c->Fail("direction", "zero vector; expected a non-zero direction");
     }
   }
-  c->In("intensity_cd", intensity_cd, R::Above(0));
+  c->In("intensity_cd", intensity_cd, R::OpenClosed(0, kMaxIntensityCd));
   c->In("inner_angle_deg", inner_angle_deg, R::Open(0, 90));
   c->In("outer_angle_deg", outer_angle_deg, R::Open(0, 90));
   if (c->ok() && inner_angle_deg > outer_angle_deg) {
@@ -132,7 +134,7 @@ void FlashlightParams::Validate(const EffectConfig&, EffectChecker* c) const {
   if (c->ok() && color.maxCoeff() <= 0) {
     c->Fail("color", "black; expected a colour with a component > 0");
   }
-  c->In("radius_m", radius_m, R::AtLeast(0));
+  c->In("radius_m", radius_m, R::Closed(0, kMaxLightRadiusM));
 }
 
 std::unique_ptr<EffectInstance> FlashlightParams::Bind(const EffectConfig& e,

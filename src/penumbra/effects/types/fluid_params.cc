@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "penumbra/scene/scene_limits.h"
+
 namespace penumbra {
 
 std::vector<std::string_view> FluidParams::Keys() {
@@ -41,10 +43,12 @@ void FluidParams::Validate(const std::optional<BoxRegion>& region, EffectChecker
   c->In("resolution", resolution, R::Closed(8, 128));
   c->In("dt_sec", dt_sec, R::Closed(kMinDtSec, kMaxDtSec));
   c->In("jacobi_iterations", jacobi_iterations, R::Closed(1, 200));
-  c->In("buoyancy_m_s2", buoyancy_m_s2, R::AtLeast(0));
-  c->In("weight_m_s2", weight_m_s2, R::AtLeast(0));
-  c->In("dissipation_per_s", dissipation_per_s, R::AtLeast(0));
-  c->In("cooling_per_s", cooling_per_s, R::AtLeast(0));
+  // accelerations up to 100 g and rates up to 1000 per second: beyond them one step of the
+  // grid already overflows the 32-bit floats the renderer reads (1e308 made the grid NaN)
+  c->In("buoyancy_m_s2", buoyancy_m_s2, R::Closed(0, kMaxFluidAccelerationM_S2));
+  c->In("weight_m_s2", weight_m_s2, R::Closed(0, kMaxFluidAccelerationM_S2));
+  c->In("dissipation_per_s", dissipation_per_s, R::Closed(0, kMaxFluidRatePerS));
+  c->In("cooling_per_s", cooling_per_s, R::Closed(0, kMaxFluidRatePerS));
   c->In("ambient_temperature_k", ambient_temperature_k, R::Closed(200, 400));
   c->In("turbulence_m_s", turbulence_m_s, R::Closed(0, 20));
   if (emitters.empty()) {
@@ -53,9 +57,9 @@ void FluidParams::Validate(const std::optional<BoxRegion>& region, EffectChecker
   for (size_t i = 0; i < emitters.size(); ++i) {
     const PlumeEmitter& e = emitters[i];
     const std::string k = "emitters[" + std::to_string(i) + "]";
-    c->In3(k + ".position", e.position_W, R::Finite());
-    c->In(k + ".radius_m", e.radius_m, R::Above(0));
-    c->In(k + ".rate", e.rate, R::AtLeast(0));
+    c->In3(k + ".position", e.position_W, R::Closed(-kMaxPositionM, kMaxPositionM));
+    c->In(k + ".radius_m", e.radius_m, R::OpenClosed(0, kMaxGeomSizeM));
+    c->In(k + ".rate", e.rate, R::Closed(0, kMaxFluidRatePerS));
     c->In(k + ".temperature_k", e.temperature_k, R::Closed(300, 4000));
     if (c->ok() && region) {
       const Eigen::Vector3d& p0 = e.position_W;

@@ -15,8 +15,9 @@ namespace penumbra {
 /// one smoke / fire source of the grid fluid.
 struct PlumeEmitter {
   Eigen::Vector3d position_W{0, 0, 0};  ///< centre, world frame, must lie inside the region
-  double radius_m = 0.2;  ///< > 0; voxels whose centres are within it receive the source
-  /// mass injected per second (density x m^3 per s), >= 0. density 1 = sigma_t of density_scale.
+  double radius_m = 0.2;  ///< (0, 1e5]; voxels whose centres are within it receive the source
+  /// mass injected per second (density x m^3 per s), [0, 1000]. density 1 = sigma_t of
+  /// density_scale.
   double rate = 0.5;
   /// temperature of the injected gas, K, [300, 4000] (fire: drives emission and buoyancy).
   double temperature_k = 600;
@@ -32,12 +33,16 @@ struct FluidParams {
   /// lower end caps the work at 1000 steps per simulated second (cost per step in
   /// docs/effects.md) instead of letting a tiny step hang the run.
   static constexpr double kMinDtSec = 1e-3, kMaxDtSec = 0.1;
-  double dt_sec = 1.0 / 30.0;             ///< fixed internal step, [kMinDtSec, kMaxDtSec]
-  int jacobi_iterations = 20;             ///< pressure iterations per step, [1, 200]
-  double buoyancy_m_s2 = 9.81;            ///< >= 0, thermal buoyancy scale
-  double weight_m_s2 = 0.0;               ///< >= 0, downward pull per unit density
-  double dissipation_per_s = 0.1;         ///< density decay rate k (d rho/dt = -k rho), >= 0
-  double cooling_per_s = 1.5;             ///< temperature excess decay rate, >= 0
+  double dt_sec = 1.0 / 30.0;  ///< fixed internal step, [kMinDtSec, kMaxDtSec]
+  int jacobi_iterations = 20;  ///< pressure iterations per step, [1, 200]
+  /// largest buoyancy_m_s2 / weight_m_s2 (100 g) and largest rate of an emitter, of
+  /// dissipation and of cooling (per s).
+  static constexpr double kMaxFluidAccelerationM_S2 = 1000;
+  static constexpr double kMaxFluidRatePerS = 1000;
+  double buoyancy_m_s2 = 9.81;            ///< [0, 1000], thermal buoyancy scale
+  double weight_m_s2 = 0.0;               ///< [0, 1000], downward pull per unit density
+  double dissipation_per_s = 0.1;         ///< density decay rate k (d rho/dt = -k rho), [0, 1000]
+  double cooling_per_s = 1.5;             ///< temperature excess decay rate, [0, 1000]
   double ambient_temperature_k = 293.15;  ///< [200, 400]
   /// random horizontal velocity kick per step at each emitter, uniform in [-t, t] m/s per
   /// axis from the seed (breaks the symmetry, makes flames flicker), [0, 20].

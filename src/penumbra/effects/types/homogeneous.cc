@@ -5,6 +5,7 @@
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/types/dust.h"
 #include "penumbra/effects/types/fog.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 
@@ -29,7 +30,7 @@ void CheckExtinction(const ExtinctionSpec& e, EffectChecker* c) {
   } else if (e.sigma_t_per_m) {
     c->In("sigma_t_per_m", *e.sigma_t_per_m, EffectRange::OpenClosed(0, 1e3));
   } else {
-    c->In("mor_m", *e.mor_m, EffectRange::AtLeast(1e-3));
+    c->In("mor_m", *e.mor_m, EffectRange::Closed(1e-3, kMaxPositionM));
   }
 }
 
@@ -97,9 +98,10 @@ void HomogeneousMediumType<P>::Validate(const EffectConfig&, EffectChecker* c) c
   CheckExtinction(p.extinction, c);
   c->In3(std::string(P::kAlbedoKey), p.*P::kAlbedo, EffectRange::Closed(0, 1));
   c->Phase("g", p.g);
-  c->In("height_falloff_per_m", p.height_falloff_per_m, EffectRange::AtLeast(0));
-  c->In("base_height_m", p.base_height_m, EffectRange::Finite());
-  if (p.layer_top_m) c->In("layer_top_m", *p.layer_top_m, EffectRange::Finite());
+  c->In("height_falloff_per_m", p.height_falloff_per_m, EffectRange::Closed(0, 1e3));
+  c->In("base_height_m", p.base_height_m, EffectRange::Closed(-kMaxPositionM, kMaxPositionM));
+  if (p.layer_top_m)
+    c->In("layer_top_m", *p.layer_top_m, EffectRange::Closed(-kMaxPositionM, kMaxPositionM));
 }
 
 template <typename P>

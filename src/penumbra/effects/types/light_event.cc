@@ -3,6 +3,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/light_events.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -58,7 +59,7 @@ void LightEventParams::Validate(const EffectConfig&, EffectChecker* c) const {
   c->In("duty_cycle", duty_cycle, R::Open(0, 1));
   c->In("failure_probability", failure_probability, R::Closed(0, 1));
   c->In("min_scale", min_scale, R::ClosedOpen(0, 1));
-  c->In("recovery_sec", recovery_sec, R::AtLeast(0));
+  c->In("recovery_sec", recovery_sec, R::Closed(0, kMaxDurationSec));
 }
 
 std::unique_ptr<EffectInstance> LightEventParams::Bind(const EffectConfig& e,

@@ -8,6 +8,7 @@
 #include "penumbra/effects/effect_config.h"
 #include "penumbra/effects/grid_fluid.h"
 #include "penumbra/effects/value_noise.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -125,10 +126,10 @@ void SmokeParams::Validate(const EffectConfig& e, EffectChecker* c) const {
   c->In3("wind_m_s", wind_m_s, R::Closed(-100, 100));
   if (mode == Mode::kNoise) {
     c->In("noise_resolution", noise_resolution, R::Closed(8, 256));
-    c->In("noise_scale_m", noise_scale_m, R::Above(0));
+    c->In("noise_scale_m", noise_scale_m, R::OpenClosed(0, kMaxGeomSizeM));
     c->In("octaves", octaves, R::Closed(1, 8));
     c->In("coverage", coverage, R::Closed(0, 1));
-    c->In("evolution_per_s", evolution_per_s, R::AtLeast(0));
+    c->In("evolution_per_s", evolution_per_s, R::Closed(0, FluidParams::kMaxFluidRatePerS));
   } else {
     fluid.Validate(e.region, c);
   }

@@ -6,6 +6,7 @@
 #include "penumbra/core/rng.h"
 #include "penumbra/effects/blackbody.h"
 #include "penumbra/effects/effect_config.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -82,7 +83,7 @@ void SparksParams::Read(const EffectParamReader& r) {
 
 void SparksParams::Validate(const EffectConfig&, EffectChecker* c) const {
   using R = EffectRange;
-  c->In3("position", position_W, R::Finite());
+  c->In3("position", position_W, R::Closed(-kMaxPositionM, kMaxPositionM));
   c->In("rate_per_s", rate_per_s, R::OpenClosed(0, 1e5));
   c->In("speed_m_s", speed_m_s, R::Closed(0, 100));
   c->In("spread_deg", spread_deg, R::Closed(0, 90));
@@ -90,7 +91,7 @@ void SparksParams::Validate(const EffectConfig&, EffectChecker* c) const {
   c->In("gravity_m_s2", gravity_m_s2, R::Closed(-100, 100));
   c->In("radius_m", radius_m, R::OpenClosed(0, 0.1));
   c->In("temperature_k", temperature_k, R::Closed(800, 4000));
-  c->In("luminance_cd_m2", luminance_cd_m2, R::AtLeast(0));
+  c->In("luminance_cd_m2", luminance_cd_m2, R::Closed(0, kMaxLuminanceCdM2));
   if (c->ok() && rate_per_s * lifetime_sec > 1e6) {
     c->Fail("rate_per_s", EffectChecker::Num(rate_per_s) + " x lifetime_sec " +
                               EffectChecker::Num(lifetime_sec) +

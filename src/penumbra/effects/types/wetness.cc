@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "penumbra/effects/effect_config.h"
+#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -48,8 +49,8 @@ void WetnessParams::Read(const EffectParamReader& r) {
 
 void WetnessParams::Validate(const EffectConfig&, EffectChecker* c) const {
   using R = EffectRange;
-  c->In("wetting_time_sec", wetting_time_sec, R::Above(0));
-  c->In("drying_time_sec", drying_time_sec, R::Above(0));
+  c->In("wetting_time_sec", wetting_time_sec, R::OpenClosed(0, kMaxDurationSec));
+  c->In("drying_time_sec", drying_time_sec, R::OpenClosed(0, kMaxDurationSec));
   c->In("max_wetness", max_wetness, R::Closed(0, 1));
 }
 

@@ -30,10 +30,11 @@ void LidarSensorParams::Read(const SensorParamReader& r) {
                             std::to_string(kMaxLidarBeamsPerScan) + " beams per scan)");
     columns = v;
   }
-  if (r.Has("min_range_m")) min_range_m = r.NonNegative("min_range_m", "m");
-  if (r.Has("max_range_m")) max_range_m = r.NonNegative("max_range_m", "m");
+  // ranges within the world's extent (scene/scene_limits.h); a divergence of at most 1 rad
+  if (r.Has("min_range_m")) min_range_m = r.NonNegative("min_range_m", "m", kMaxPositionM);
+  if (r.Has("max_range_m")) max_range_m = r.NonNegative("max_range_m", "m", kMaxPositionM);
   if (r.Has("beam_divergence_mrad"))
-    beam_divergence_mrad = r.NonNegative("beam_divergence_mrad", "mrad");
+    beam_divergence_mrad = r.NonNegative("beam_divergence_mrad", "mrad", 1000);
   if (r.Has("reference_reflectivity")) {
     const double v = r.Double("reference_reflectivity");
     if (!(v > 0 && v <= 1))
