@@ -319,6 +319,38 @@ def rollout_seeds():
                                                          cap=2 ** 64 - 1))
 
 
+# ---- ONNX policies and the policy's per-step checks --------------------------------------------
+def onnx_seeds():
+    """fuzz/onnx_fuzz.cc's layout: two bytes (observation and action sizes - 1, mod 64), then
+    the file: the crafted models of tests/control/make_crafted_onnx.py and two fixtures."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "tests", "control"))
+    from make_crafted_onnx import crafted
+    for name, data in sorted(crafted().items()):
+        write("onnx", name, b"\x03\x01" + data)
+    for name, n_in, n_out in (("mlp_48x12.onnx", 48, 12), ("gemm_15x12.onnx", 15, 12)):
+        with open(os.path.join(ROOT, "tests", "control", "fixtures", name), "rb") as f:
+            write("onnx", name, bytes([n_in - 1, n_out - 1]) + f.read())
+
+
+def policy_seed(clip, step, terms, outputs):
+    """fuzz/policy_fuzz.cc's layout: output count, clip choice, int64 step, term count, 3 bytes
+    per term (kind, size, history - 1), float32 outputs."""
+    return (struct.pack("<BBqB", len(outputs), clip, step, len(terms))
+            + b"".join(bytes(t) for t in terms) + struct.pack("<%df" % len(outputs), *outputs))
+
+
+def policy_seeds():
+    nan, inf = float("nan"), float("inf")
+    terms = [(0, 3, 0), (4, 12, 2), (6, 12, 0)]
+    write("policy", "finite.bin", policy_seed(0, 4, terms, [0.1 * i for i in range(12)]))
+    write("policy", "clip_100.bin", policy_seed(1, 8, terms, [250.0, -250.0, 1.0]))
+    write("policy", "huge_3e38.bin", policy_seed(0, 12, terms, [0.0, 3e38, 0.0]))
+    write("policy", "neg_inf.bin", policy_seed(2, 16, terms, [-inf, 0.0]))
+    write("policy", "nan.bin", policy_seed(3, -1, [], [nan] * 4))
+    write("policy", "max_step.bin", policy_seed(1, 2 ** 63 - 1, terms * 5, [1e6, -1e6]))
+
+
 if __name__ == "__main__":
     runlog_seeds()
     tum_seeds()
@@ -327,6 +359,8 @@ if __name__ == "__main__":
     viewer_seeds()
     rollout_seeds()
     template_seeds()
+    onnx_seeds()
+    policy_seeds()
     for t in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, t))
         size = sum(os.path.getsize(os.path.join(CORPUS, t, f)) for f in files)

@@ -16,6 +16,7 @@
 #include "penumbra/core/text_match.h"
 #include "penumbra/replay/world_override.h"
 #include "penumbra/run/runner.h"
+#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
@@ -123,7 +124,14 @@ class RunCommand : public Command {
     viewer_flag_.Apply(*verb_, &options_);
     const StopSignals stop_signals;
     options_.stop_request = args.stop_signal;
-    const RunSummary s = RunWorld(world, options_);
+    RunSummary s;
+    try {
+      s = RunWorld(world, options_);
+    } catch (const SetupInterrupted& e) {
+      // a signal during the set-up (a long composition): nothing was written
+      spdlog::warn("{}; no outputs written", e.what());
+      return 128 + e.signal();
+    }
     int64_t frames = 0;
     for (const auto& [name, n] : s.frames_per_camera) frames += n;
     spdlog::info(

@@ -139,6 +139,8 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   session_options.composed_xml_path = (out / "composed.xml").string();
   session_options.check_run_budget = true;
   session_options.reserve_live_npcs = !options.bridges.empty();
+  // a SIGINT / SIGTERM during the set-up ends it (SetupInterrupted)
+  session_options.stop_request = options.stop_request;
   Session session(world, session_options);
   // a crowd's walkable map goes with the run (npc_map.png, docs/npcs.md)
   if (const std::shared_ptr<const NpcMap> npc_map = session.effects().npc_map()) {

@@ -22,11 +22,13 @@
 // owns everything it built and is neither copied nor moved (what it hands out by reference
 // stays valid for its lifetime).
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "penumbra/control/terrain_ray_caster.h"
+#include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/render/renderer.h"
 #include "penumbra/scene/scene_description.h"
@@ -61,6 +63,23 @@ struct SessionOptions {
   /// settings); off for physics- or sensor-only work and for callers with their own render
   /// settings.
   bool build_renderer = true;
+  /// a stop request (0, or the number of the signal that asked to stop; app/stop_signals.h),
+  /// polled between the set-up steps (compose, compile, scene, renderer): once it is set,
+  /// the constructor throws SetupInterrupted instead of finishing the set-up. null = never.
+  const std::atomic<int>* stop_request = nullptr;
+};
+
+/// what a Session's constructor throws when its SessionOptions::stop_request was set while it
+/// set the world up (a SIGTERM during a long composition): nothing is left half-built.
+class SetupInterrupted : public Error {
+ public:
+  /// `signal` is the stop request's value (SIGINT, SIGTERM); `step` names the set-up step it
+  /// ended ("composing the models").
+  SetupInterrupted(int signal, const std::string& step);
+  int signal() const { return signal_; }
+
+ private:
+  int signal_ = 0;
 };
 
 /// wall-clock seconds of the set-up steps (run.json timings_sec: compose_sec, load_sec,
