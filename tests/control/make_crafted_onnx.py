@@ -11,10 +11,14 @@ Every file is for a policy of 4 observations and 2 actions (input "obs" [1, 4], 
                           OpenCV's InnerProductLayer::create).
   dims_2p20x48_raw4.onnx  dims [2^20, 48] with 4 raw bytes (was SIGSEGV in cv::Mat::copyTo).
   float_data3_2p22.onnx   dims [2^22] with 3 float_data values (was SIGSEGV).
-  raw_short.onnx          dims [2, 4] (32 bytes) with 4 raw bytes.
+  raw_short.onnx          dims [2, 4] (32 bytes) with 4 raw bytes (the old loader accepted it,
+                          reading 28 bytes past the data).
   negative_dim.onnx       dims [-1, 4].
   expand_bomb.onnx        a 0.3 KB graph whose Expand makes a [65536, 65536, 4] tensor (the
                           4.2 GB RSS model's kind: a tiny file, a huge activation).
+  constant_of_shape_bomb.onnx  278 bytes whose ConstantOfShape fills [16384, 16384, 4]: OpenCV
+                          folds it at import into a 4.3 GB tensor (the 4.2 GB RSS model; a
+                          [8192, 8192, 4] variant measured 1.06 GB RSS under the old loader).
   broadcast_bomb.onnx     Add of initializers [4096, 1] and [1, 4096]: 16.7 M elements from
                           supported operators (over the activation cap).
   gather_oob.onnx         Gather of index 1000 from obs (the out-of-bounds read behind
@@ -137,6 +141,11 @@ def crafted():
     f["expand_bomb.onnx"] = model(
         [node("Expand", ["obs", "shape"], ["big"], "expand"),
          node("ReduceSum", ["big"], ["actions"], "sum")], [shape])
+    big = tensor("shape", [3], [16384, 16384, 4], dtype=INT64)
+    f["constant_of_shape_bomb.onnx"] = model(
+        [node("ConstantOfShape", ["shape"], ["big"], "fill"),
+         node("Gemm", ["obs", "w", "b"], ["actions"], "fc", [attr_int("transB", 1)])],
+        [big, tensor("w", [2, 4], W), tensor("b", [2], [0.0, 0.0])])
     f["broadcast_bomb.onnx"] = model(
         [node("Add", ["a", "b"], ["big"], "add"),
          node("Gemm", ["obs", "w", "bias"], ["actions"], "fc", [attr_int("transB", 1)])],

@@ -99,7 +99,10 @@ TEST_F(OnnxModelCheckTest, DataShorterThanTheDimsIsRefused) {
 }
 
 TEST_F(OnnxModelCheckTest, TinyFilesWithHugeActivationsAreRefused) {
-  // the 4.2 GB RSS kind: a 0.2 KB graph expanding to 2^34 values
+  // the 4.2 GB RSS model: 278 bytes whose ConstantOfShape OpenCV folds into 2^32 floats
+  EXPECT_HAS(LoadError("constant_of_shape_bomb.onnx"),
+             "node 0 'fill' (ConstantOfShape): operator 'ConstantOfShape' is not supported");
+  // a 0.2 KB graph expanding to 2^34 values
   EXPECT_HAS(LoadError("expand_bomb.onnx"), "operator 'Expand' is not supported; expected one of");
   const std::string e = LoadError("broadcast_bomb.onnx");
   EXPECT_HAS(e, "node 0 'add' (Add)");
