@@ -5,10 +5,12 @@
 #include "penumbra/control/policy_controller.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "common/temp_dir.h"
 #include "control/policy_fake.h"
 #include "penumbra/config/yaml_document.h"
 #include "penumbra/control/policy_preset.h"
@@ -207,22 +209,53 @@ TEST(PolicyControllerTest, RefusesAnActionScaleOutOfBoundsWithItsLine) {
   });
   EXPECT_NE(clip.find("action.clip"), std::string::npos) << clip;
   EXPECT_NE(clip.find("expected a number in (0, 1e6]"), std::string::npos) << clip;
+  // the observation terms' scale, clip and noise likewise
+  const std::string obs = PolicyErrorOf([] {
+    MakePolicy(std::string(kReversedJoints) +
+               "model: gemm_15x12.onnx\n"
+               "observations: [{term: velocity_command}, {term: joint_pos, scale: 1e308}]\n"
+               "action: {kp: 20, kd: 0.5}\n");
+  });
+  EXPECT_NE(obs.find("world.yaml:"), std::string::npos) << obs;
+  EXPECT_NE(obs.find("observations[1].scale"), std::string::npos) << obs;
+  EXPECT_NE(obs.find("|scale| <= 1e4"), std::string::npos) << obs;
+  const std::string noise = PolicyErrorOf([] {
+    MakePolicy(std::string(kReversedJoints) +
+               "model: gemm_15x12.onnx\n"
+               "observations: [{term: velocity_command}, {term: joint_pos, noise: 1e300}]\n"
+               "action: {kp: 20, kd: 0.5}\n");
+  });
+  EXPECT_NE(noise.find("observations[1].noise"), std::string::npos) << noise;
+}
+
+TEST(PolicyControllerTest, APolicyFileThatIsNotARegularFileIsRefusedAsSuch) {
+  // a FIFO was reported as "no such file"; it must not block either
+  testing::TempDir dir;
+  const std::string fifo = (dir.path() / "policy.onnx").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string e = PolicyErrorOf([&] {
+    MakePolicy(std::string(kReversedJoints) + "model: " + fifo +
+               "\nobservations: [{term: joint_pos}]\n");
+  });
+  EXPECT_NE(e.find("robots[q].controller.model"), std::string::npos) << e;
+  EXPECT_NE(e.find("is not a regular file; expected an ONNX policy file"), std::string::npos) << e;
 }
 
 TEST(PolicyControllerTest, ANonFiniteObservationStopsTheRunNamingStepAndTerm) {
-  // joint_pos scaled by 1e300 overflows float32: the run stops before the network runs
+  // a joint position of 1e36 rad scaled by 1e4 overflows float32: the run stops before the
+  // network runs
   const ModelInfo m = QuadModel();
   auto c = MakePolicy(std::string(kReversedJoints) +
                       "model: gemm_15x12.onnx\n"
                       "decimation: 2\n"
-                      "observations: [{term: velocity_command}, {term: joint_pos, scale: 1e300}]\n"
+                      "observations: [{term: velocity_command}, {term: joint_pos, scale: 1e4}]\n"
                       "action: {kp: 20, kd: 0.5}\n");
   c->Initialize(m);
   QuadInput in(m);
   std::vector<double> ctrl(m.nu, 0.0);
   c->Compute(in, ctrl);  // q = default: joint_pos 0
   c->Compute(in, ctrl);
-  in.q_[7 + 11] = 0.5;  // model joint j11 = policy joint 0
+  in.q_[7 + 11] = 1e36;  // model joint j11 = policy joint 0
   const std::string e = PolicyErrorOf([&] { c->Compute(in, ctrl); });
   EXPECT_NE(e.find("policy step 2"), std::string::npos) << e;
   EXPECT_NE(e.find("observation 3, observations[1] (joint_pos) element 0, history frame 0 of 1"),

@@ -30,9 +30,14 @@ PolicyParams PolicyParams::Parse(ControllerParams& p, const std::string& prefix)
     path = std::filesystem::path(p.context().file).parent_path() / path;
   g.model_path = path.lexically_normal().string();
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(g.model_path, ec))
+  const std::filesystem::file_status st = std::filesystem::status(g.model_path, ec);
+  if (!std::filesystem::exists(st))
     p.Fail("model", "no such file '" + g.model_path +
                         "'; expected an ONNX policy (path relative to the world file)");
+  if (!std::filesystem::is_regular_file(st))
+    p.Fail("model", "'" + g.model_path + "' is " +
+                        (std::filesystem::is_directory(st) ? "a directory" : "not a regular file") +
+                        "; expected an ONNX policy file");
 
   // preset first: the keys below override it
   bool have_preset = false;

@@ -113,16 +113,17 @@ ObservationTermConfig ObservationTermConfig::Parse(ControllerParams& p, const Co
   }
 
   if (n["scale"])
-    t.scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a finite number",
-                             [](double) { return true; });
+    t.scale = ParamNumbersAt(p, n["scale"], key + ".scale", "a number with |scale| <= 1e4",
+                             [](double v) { return std::abs(v) <= kObservationMaxScale; });
   if (n["clip"]) {
-    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number > 0");
-    if (!(c > 0)) p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number > 0");
+    const double c = ParamNumberAt(p, n["clip"], key + ".clip", "a number in (0, 1e6]");
+    if (!(c > 0) || c > 1e6)
+      p.Fail(key + ".clip", "got " + n["clip"].Scalar() + "; expected a number in (0, 1e6]");
     t.clip = c;
   }
   if (n["noise"])
-    t.noise = ParamNumbersAt(p, n["noise"], key + ".noise", "a half-width >= 0",
-                             [](double v) { return v >= 0; });
+    t.noise = ParamNumbersAt(p, n["noise"], key + ".noise", "a half-width in [0, 1e6]",
+                             [](double v) { return v >= 0 && v <= 1e6; });
   if (n["history"]) {
     const double h = ParamNumberAt(p, n["history"], key + ".history", "an integer >= 1");
     if (!(h >= 1 && h <= 1000 && h == std::floor(h)))

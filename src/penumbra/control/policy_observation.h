@@ -71,6 +71,9 @@ enum class ObservationTermKind {
   kSensor,
 };
 
+/// the largest |scale| of an observation term, checked at load (clip and noise: at most 1e6).
+inline constexpr double kObservationMaxScale = 1e4;
+
 /// the world-file name of a term kind, e.g. "base_lin_vel".
 const char* ObservationTermName(ObservationTermKind kind);
 /// the kind named `name`, or nullopt.
