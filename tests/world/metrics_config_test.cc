@@ -131,7 +131,7 @@ TEST_F(MetricsConfigTest, ErrorsNameFileLineAndKey) {
       << rate;
   const std::string force =
       Error("metrics:\n  series:\n    - {name: c, type: contacts, min_force_N: -1}\n");
-  EXPECT_NE(force.find("metrics.series[0].min_force_N: got -1; expected a number >= 0"),
+  EXPECT_NE(force.find("metrics.series[0].min_force_N: got -1; expected a number in [0, 1e+09]"),
             std::string::npos)
       << force;
   const std::string dup = Error(

@@ -142,6 +142,12 @@ INSTANTIATE_TEST_SUITE_P(
                  "expected a height in [-100000, 100000] m"},
         BadValue{kBadAgentBase + "    speed_m_s: 1e300\n", 4, "agents[0].speed_m_s",
                  "expected (0, 20] m/s"},
+        // metrics: a point 1e300 m away, a debounce longer than any run
+        BadValue{"metrics:\n  series:\n    - {name: g, type: distance, body: r/b, "
+                 "to_point: [1e300, 0, 0]}\n",
+                 3, "metrics.series[0].to_point", "each in [-1e+05, 1e+05]"},
+        BadValue{"metrics:\n  series:\n    - {name: c, type: contacts, debounce_sec: 1e300}\n", 3,
+                 "metrics.series[0].debounce_sec", "expected a number in [0, 1e+06] (s)"},
         // sensors: latency, rotation; LiDAR ranges (a rate above the physics rate samples every
         // step)
         BadValue{kBadSensorBase + "    latency_sec: 1e300\n", 5, "sensors[0].latency_sec",

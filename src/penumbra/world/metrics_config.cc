@@ -7,6 +7,7 @@
 #include "penumbra/config/param_reader.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
+#include "penumbra/scene/scene_limits.h"
 #include "penumbra/world/world_validation.h"
 
 namespace penumbra {
@@ -180,19 +181,21 @@ void MetricsConfig::ValidateOrThrow() const {
         if (m.body.empty()) Fail(key + ".body", "required; expected a body name");
         if (m.to_body.empty() == !m.to_point_m.has_value())
           Fail(key, "a distance metric needs exactly one of to_body and to_point");
-        if (m.to_point_m && !m.to_point_m->allFinite())
-          Fail(key + ".to_point", "expected 3 finite numbers (m)");
+        if (m.to_point_m &&
+            !(m.to_point_m->allFinite() && m.to_point_m->cwiseAbs().maxCoeff() <= kMaxPositionM))
+          Fail(key + ".to_point", "expected 3 numbers, each in [-1e+05, 1e+05] (m)");
         break;
       case MetricKind::kTrackingError:
         if (m.robot.empty()) Fail(key + ".robot", "required; expected a robot's name");
         break;
       case MetricKind::kContacts:
-        if (!std::isfinite(m.min_force_N) || m.min_force_N < 0)
+        // a force no contact reaches, or a debounce longer than any run, counts nothing
+        if (!(m.min_force_N >= 0 && m.min_force_N <= 1e9))
           Fail(key + ".min_force_N",
-               "got " + FormatNumber(m.min_force_N) + "; expected a number >= 0 (N)");
-        if (!std::isfinite(m.debounce_sec) || m.debounce_sec < 0)
+               "got " + FormatNumber(m.min_force_N) + "; expected a number in [0, 1e+09] (N)");
+        if (!(m.debounce_sec >= 0 && m.debounce_sec <= kMaxDurationSec))
           Fail(key + ".debounce_sec",
-               "got " + FormatNumber(m.debounce_sec) + "; expected a number >= 0 (s)");
+               "got " + FormatNumber(m.debounce_sec) + "; expected a number in [0, 1e+06] (s)");
         if (!std::isfinite(m.detect_hz) || m.detect_hz < 0 || m.detect_hz > 100000)
           Fail(key + ".detect_hz", "got " + FormatNumber(m.detect_hz) +
                                        "; expected [0, 100000] Hz (0 = every physics step)");
