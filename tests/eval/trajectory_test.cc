@@ -3,8 +3,10 @@
 #include "penumbra/eval/trajectory.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "common/temp_dir.h"
+#include "common/within_seconds.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -117,7 +119,7 @@ TEST(TumTrajectory, FileErrorsNameThePath) {
     FAIL();
   } catch (const ConfigError& e) {
     EXPECT_EQ(e.file(), missing);
-    EXPECT_NE(std::string(e.what()).find("cannot be read (No such file or directory)"),
+    EXPECT_NE(std::string(e.what()).find("TUM trajectory file not found: " + missing),
               std::string::npos)
         << e.what();
   }
@@ -125,8 +127,24 @@ TEST(TumTrajectory, FileErrorsNameThePath) {
     ReadTumTrajectory(tmp.path());
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("is a folder"), std::string::npos) << e.what();
+    EXPECT_EQ(e.problem(), "TUM trajectory file is a directory; expected a regular file");
   }
+  // a FIFO is refused at once: open() without a writer blocked for ever
+  const std::string fifo = (tmp.path() / "gt.txt").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const testing::WithinResult r = testing::RunWithin(10, [&] {
+    try {
+      ReadTumTrajectory(fifo);
+    } catch (const ConfigError& e) {
+      return e.problem() ==
+                     "TUM trajectory file is not a regular file (a FIFO); expected a regular file"
+                 ? 0
+                 : 1;
+    }
+    return 2;
+  });
+  EXPECT_TRUE(r.finished) << "ReadTumTrajectory of a FIFO blocked";
+  EXPECT_EQ(r.exit_status, 0);
   // binary garbage: an error, escaped in the message
   const std::string garbage =
       tmp.Write("g.bin", std::string("\x01\x02\xff\x00 1 2 3 4 5 6 7\n", 19));

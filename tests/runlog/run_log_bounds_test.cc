@@ -270,5 +270,33 @@ TEST(RunLogBoundsTest, ALayoutOutOfRangeIsRefusedByReaderAndWriter) {
   EXPECT_THROW(o.ValidateOrThrow(), ConfigError);
 }
 
+// a header claiming a timestep of 0 s (or NaN, negative, above 0.1 s) is refused by the one
+// header check: by the writer, and by the reader whatever reads the log (replay, --resimulate,
+// export); --resimulate of such a log said "bit-exact"
+TEST(RunLogBoundsTest, ATimestepOutsideTheWorldFilesRangeIsRefusedByReaderAndWriter) {
+  testing::TempDir tmp;
+  for (double dt : {0.0, -0.002, 0.5, std::nan("")}) {
+    RunLogHeader h = BoundsHeader();
+    h.timestep_sec = dt;
+    EXPECT_NE(bounds_codec::CheckHeader(h).find("expected a physics timestep in [1e-06, 0.1] s"),
+              std::string::npos)
+        << dt;
+    EXPECT_THROW(RunLogWriter((tmp.path() / "a.plog").string(), h), RunLogError) << dt;
+  }
+  RunLogHeader h = BoundsHeader();
+  h.timestep_sec = 0;
+  EXPECT_EQ(bounds_codec::CheckHeader(h),
+            "timestep_sec is 0 s; expected a physics timestep in [1e-06, 0.1] s");
+  try {
+    bounds_codec::HeaderFromJson(bounds_codec::HeaderToJson(h));
+    ADD_FAILURE() << "a timestep of 0 s was read";
+  } catch (const RunLogError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "header chunk: timestep_sec is 0 s; expected a physics timestep in [1e-06, 0.1] s");
+  }
+  h.timestep_sec = 0.002;
+  EXPECT_EQ(bounds_codec::CheckHeader(h), "");
+}
+
 }  // namespace
 }  // namespace penumbra

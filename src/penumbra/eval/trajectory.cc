@@ -1,16 +1,17 @@
 #include "penumbra/eval/trajectory.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <optional>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/text_match.h"
 
 namespace penumbra {
@@ -141,25 +142,23 @@ Trajectory ParseTumTrajectory(std::string_view text, const std::string& source) 
 }
 
 Trajectory ReadTumTrajectory(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ConfigError(
-        path.string(), 0, "",
-        "is a folder; expected a TUM trajectory file (timestamp tx ty tz qx qy qz qw)");
-  std::ifstream f(path, std::ios::binary);
-  if (!f)
-    throw ConfigError(
-        path.string(), 0, "",
-        fmt::format("cannot be read ({}); expected a TUM trajectory file", std::strerror(errno)));
+  // a regular file only: a FIFO blocked in open() for ever, a folder or device is refused
+  // naming what it is
+  const InputFile file = OpenInputFile(path, "TUM trajectory file");
   // read in blocks, each checked as it arrives: a device, pipe or huge binary file is refused
   // at its first bad byte or line, before more than a block past the limit is held
   std::string text;
   std::array<char, 1 << 16> block;
   int line = 1;
   size_t line_start = 0;
-  while (f) {
-    f.read(block.data(), block.size());
-    const size_t n = static_cast<size_t>(f.gcount());
+  while (true) {
+    const ssize_t got = ::read(file.fd.get(), block.data(), block.size());
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0)
+      throw ConfigError(
+          path.string(), 0, "",
+          fmt::format("read failed ({}); expected a TUM trajectory file", std::strerror(errno)));
+    const size_t n = static_cast<size_t>(got);
     if (n == 0) break;
     if (text.size() + n > kTumMaxFileBytes)
       throw ConfigError(path.string(), line, "",
@@ -183,8 +182,6 @@ Trajectory ReadTumTrajectory(const std::filesystem::path& path) {
         !bad.empty())
       throw ConfigError(path.string(), line, "", bad);
   }
-  if (f.bad())
-    throw ConfigError(path.string(), 0, "", "read failed; expected a TUM trajectory file");
   return ParseTumTrajectory(text, path.string());
 }
 

@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "penumbra/scene/scene_limits.h"
+
 namespace penumbra::runlog_codec {
 namespace {
 
@@ -265,6 +267,14 @@ std::string CheckLayout(const RunLogLayout& l) {
   return "";
 }
 
+std::string CheckHeader(const RunLogHeader& h) {
+  // also false for NaN
+  if (!(h.timestep_sec >= kMinTimestepSec && h.timestep_sec <= kMaxTimestepSec))
+    return fmt::format("timestep_sec is {} s; expected a physics timestep in [{}, {}] s",
+                       h.timestep_sec, kMinTimestepSec, kMaxTimestepSec);
+  return CheckLayout(h.layout);
+}
+
 void EncodeEvent(const EventRecord& e, std::string* body) {
   PutI64(body, e.step);
   PutF64(body, e.time_sec);
@@ -428,7 +438,7 @@ RunLogHeader HeaderFromJson(std::string_view text) {
     get(jj, "qvel_width", &x.qvel_width, wj);
     l.joints.push_back(std::move(x));
   }
-  if (const std::string bad = CheckLayout(l); !bad.empty())
+  if (const std::string bad = CheckHeader(h); !bad.empty())
     throw RunLogError("header chunk: " + bad);
   return h;
 }

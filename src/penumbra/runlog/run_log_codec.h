@@ -65,6 +65,13 @@ uint64_t StepRecordMemoryBytes(const RunLogLayout& layout);
 /// [0, kMaxLayoutEntries], every joint's qpos and qvel span inside nq and nv. returns "" or
 /// the problem ("layout.nq is -3; expected 0 to 4194304").
 std::string CheckLayout(const RunLogLayout& layout);
+/// checks a header read from a log or given to the writer, the one validation of its values
+/// that every reader (replay, replay --resimulate, export) relies on: timestep_sec within
+/// [kMinTimestepSec, kMaxTimestepSec] (scene/scene_limits.h, the range of a world file's
+/// physics.timestep_sec), then the layout (CheckLayout). returns "" or the problem naming the
+/// field and the expected range ("timestep_sec is 0 s; expected a physics timestep in
+/// [1e-06, 0.1] s").
+std::string CheckHeader(const RunLogHeader& header);
 
 /// a chunk header as stored (RunLogChunkInfo less the file offset, plus the codec).
 struct ChunkHeader {

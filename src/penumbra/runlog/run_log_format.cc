@@ -2,9 +2,14 @@
 
 #include <fmt/format.h>
 #include <openssl/evp.h>
+#include <unistd.h>
 
 #include <array>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
+
+#include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -70,20 +75,31 @@ std::string Sha256Hex(std::string_view bytes) {
 }
 
 std::string Sha256OfFile(const std::string& path, uint64_t* size_bytes) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw RunLogError(fmt::format("{}: cannot be read for its content hash", path));
+  // a regular file only (a log names its assets' paths: a FIFO there blocked, /dev/zero never
+  // ended)
+  InputFile file;
+  try {
+    file = OpenInputFile(path, "asset file");
+  } catch (const ConfigError& e) {
+    throw RunLogError(
+        fmt::format("{}: cannot be read for its content hash: {}", path, e.problem()));
+  }
   uint64_t total = 0;
+  int read_error = 0;
   std::string hex = Sha256With([&](auto&& update) {
     std::array<char, 1 << 16> buf;
-    while (in) {
-      in.read(buf.data(), buf.size());
-      const std::streamsize n = in.gcount();
+    while (true) {
+      const ssize_t n = ::read(file.fd.get(), buf.data(), buf.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) read_error = errno;
       if (n <= 0) break;
       update(buf.data(), static_cast<size_t>(n));
       total += static_cast<uint64_t>(n);
     }
   });
-  if (in.bad()) throw RunLogError(fmt::format("{}: read error while hashing", path));
+  if (read_error != 0)
+    throw RunLogError(
+        fmt::format("{}: read error while hashing: {}", path, std::strerror(read_error)));
   if (size_bytes) *size_bytes = total;
   return hex;
 }

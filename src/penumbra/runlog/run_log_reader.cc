@@ -1,12 +1,15 @@
 #include "penumbra/runlog/run_log_reader.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
-#include <fstream>
 
 #include "penumbra/core/build_info.h"
+#include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/runlog/run_log_codec.h"
 
 namespace penumbra {
@@ -32,7 +35,7 @@ std::string StepsOf(const ChunkHeader& h) {
 struct RunLogReader::Impl {
   std::string path;
   RunLogReadMode mode = RunLogReadMode::kStrict;
-  std::ifstream file;
+  InputFile file;  // a regular file (core/input_file.h)
   uint64_t file_size = 0;
   RunLogHeader header;
   std::vector<RunLogChunkInfo> chunks;
@@ -57,10 +60,17 @@ struct RunLogReader::Impl {
   bool ReadAt(uint64_t offset, uint64_t n, std::string* out) {
     if (offset > file_size || n > file_size - offset) return false;
     out->resize(n);
-    file.clear();
-    file.seekg(static_cast<std::streamoff>(offset));
-    file.read(out->data(), static_cast<std::streamsize>(n));
-    return static_cast<uint64_t>(file.gcount()) == n;
+    uint64_t done = 0;
+    while (done < n) {
+      const ssize_t got =
+          ::pread(file.fd.get(), out->data() + done, n - done, static_cast<off_t>(offset + done));
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0)
+        throw RunLogError(fmt::format("{}: cannot be read: {}", path, std::strerror(errno)));
+      if (got == 0) return false;  // the file shrank since it was opened
+      done += static_cast<uint64_t>(got);
+    }
+    return true;
   }
 
   std::string ChunkName(const RunLogChunkInfo& c) const {
@@ -343,11 +353,14 @@ RunLogReader RunLogReader::Open(const std::string& path, RunLogReadMode mode) {
   auto m = std::make_unique<Impl>();
   m->path = path;
   m->mode = mode;
-  m->file.open(path, std::ios::binary);
-  if (!m->file)
-    throw RunLogError(fmt::format("{}: cannot be opened: {}", path, std::strerror(errno)));
-  m->file.seekg(0, std::ios::end);
-  m->file_size = static_cast<uint64_t>(m->file.tellg());
+  // a regular file only: a folder or /dev/zero read as an "empty file" and a FIFO blocked
+  // in open() for ever
+  try {
+    m->file = OpenInputFile(path, "run log");
+  } catch (const ConfigError& e) {
+    throw RunLogError(fmt::format("{}: {} (a penumbra run log, .plog)", path, e.problem()));
+  }
+  m->file_size = m->file.size;
   m->ReadPreambleAndHeader();
   m->ScanChunks();
   return RunLogReader(std::move(m));

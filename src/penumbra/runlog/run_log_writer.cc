@@ -188,7 +188,7 @@ namespace {
 // the writer never writes what the reader refuses (docs/run-log.md "Limits"): checked before the
 // file is opened or written
 void ThrowIfUnreadable(const std::string& path, const RunLogHeader& header) {
-  std::string bad = CheckLayout(header.layout);
+  std::string bad = CheckHeader(header);
   if (bad.empty() && StepRecordMemoryBytes(header.layout) > kMaxChunkDecodedBytes / 2)
     bad = fmt::format(
         "one step of this model takes {} bytes, more than a run log chunk may hold "
