@@ -5,7 +5,13 @@
 
 #include "penumbra/dataset/dataset_export.h"
 
+#include <fcntl.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <fstream>
@@ -403,6 +409,71 @@ TEST(DatasetExportOptions, ValidateOrThrow) {
   EXPECT_THROW(o.ValidateOrThrow(), ConfigError);
   EXPECT_THROW(ParseDatasetFormat("rosbag"), ConfigError);
   EXPECT_EQ(ParseDatasetFormat("euroc"), DatasetFormat::kEuroc);
+}
+
+// a PID that no process has now: a child that has exited and been waited for
+int64_t DeadPid() {
+  const pid_t pid = fork();
+  if (pid == 0) _exit(0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return pid;
+}
+
+// SIGKILL of an export left its "<out>.export-tmp-*" folder (or bag file) for ever: the next
+// export into the same parent removes those whose process is gone, never one a live export holds
+TEST_F(DatasetExportTest, AnExportRemovesTempsOfKilledExportsAndNoneALiveOneHolds) {
+  testing::WriteFakeRun(run_);
+  const int64_t dead = DeadPid();
+  ASSERT_NE(kill(static_cast<pid_t>(dead), 0), 0);
+  const fs::path parent = tmp_.path();
+  const fs::path stale_dir = parent / fmt::format("old.export-tmp-{}-0123456789ab", dead);
+  const fs::path stale_replay = parent / fmt::format("old.replay-tmp-{}-0123456789ac", dead);
+  const fs::path stale_bag = parent / fmt::format("x.bag.export-tmp-{}-aaaaaaaaaaaa", dead);
+  const fs::path live_dir = parent / fmt::format("live.export-tmp-{}-0123456789ab", getpid());
+  const fs::path held_dir = parent / fmt::format("held.export-tmp-{}-bbbbbbbbbbbb", dead);
+  const fs::path not_temp = parent / "notes.export-tmp-mine";
+  for (const fs::path& d : {stale_dir, stale_replay, live_dir, held_dir, not_temp}) {
+    fs::create_directories(d / "rgb");
+    std::ofstream(d / "rgb" / "0.png") << "x";
+  }
+  std::ofstream(stale_bag) << "half a bag";
+  // a live export's lock (its PID reused, or in another PID namespace): never removed
+  const int held = open(held_dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  ASSERT_GE(held, 0);
+  ASSERT_EQ(flock(held, LOCK_EX | LOCK_NB), 0);
+
+  Export(DatasetFormat::kTum);
+  EXPECT_TRUE(fs::is_regular_file(out() / "rgb.txt"));
+  EXPECT_FALSE(fs::exists(stale_dir));
+  EXPECT_FALSE(fs::exists(stale_replay));
+  EXPECT_FALSE(fs::exists(stale_bag));
+  EXPECT_TRUE(fs::exists(live_dir / "rgb" / "0.png"));
+  EXPECT_TRUE(fs::exists(held_dir / "rgb" / "0.png"));
+  EXPECT_TRUE(fs::exists(not_temp / "rgb" / "0.png"));
+  close(held);
+  // released: removed by the next call
+  EXPECT_EQ(RemoveStaleExportTemps(out()), std::vector<fs::path>{held_dir});
+  EXPECT_TRUE(fs::exists(live_dir));
+}
+
+TEST(DatasetExportTemp, TempNamesCarryThePidAndTheCreatorHoldsALock) {
+  TempDir tmp;
+  UniqueFd lock;
+  const fs::path d = MakeSiblingTempFolder(tmp.path() / "out", ".export-tmp", &lock);
+  EXPECT_EQ(ExportTempOwner(d.filename().string()), getpid()) << d;
+  EXPECT_EQ(d.filename().string().rfind(fmt::format("out.export-tmp-{}-", getpid()), 0), 0u);
+  const int other = open(d.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  EXPECT_NE(flock(other, LOCK_EX | LOCK_NB), 0);  // held by `lock`
+  close(other);
+  UniqueFd file_lock;
+  const fs::path f = MakeSiblingTempFile(tmp.path() / "a.bag", ".export-tmp", &file_lock);
+  EXPECT_EQ(ExportTempOwner(f.filename().string()), getpid()) << f;
+  EXPECT_TRUE(fs::is_regular_file(f));
+  EXPECT_EQ(ExportTempOwner("a.export-tmp-12-0123456789abc"), 0);  // 13 hex digits
+  EXPECT_EQ(ExportTempOwner("a.export-tmp-0123456789ab"), 0);      // no PID (older names)
+  EXPECT_EQ(ExportTempOwner("a.export-tmp--0123456789ab"), 0);
+  EXPECT_EQ(ExportTempOwner("a.replay-tmp-42-0123456789ab"), 42);
 }
 
 }  // namespace

@@ -1,13 +1,19 @@
 #include "penumbra/dataset/dataset_export.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <random>
 #include <system_error>
@@ -23,6 +29,28 @@ namespace penumbra {
 namespace {
 
 namespace fs = std::filesystem;
+
+// the suffixes of temporary export outputs (dataset_export.h)
+constexpr std::string_view kExportTempSuffixes[] = {".export-tmp", ".replay-tmp"};
+
+std::mt19937_64 SeededRng() {
+  std::random_device seed;
+  return std::mt19937_64((static_cast<uint64_t>(seed()) << 32) ^ seed());
+}
+
+// "<name><suffix>-<pid>-<12 random hex digits>"
+std::string TempName(const std::string& name, const std::string& suffix, std::mt19937_64& rng) {
+  return fmt::format("{}{}-{}-{:012x}", name, suffix, static_cast<int64_t>(::getpid()),
+                     rng() & 0xffffffffffffULL);
+}
+
+// a descriptor of the new temporary `p` (opened with `flags`) holding an exclusive flock
+UniqueFd LockTemp(const fs::path& p, int flags, mode_t mode) {
+  UniqueFd fd(::open(p.c_str(), flags, mode));
+  if (fd.get() < 0 || ::flock(fd.get(), LOCK_EX | LOCK_NB) != 0)
+    throw Error("cannot lock the temporary folder " + p.string() + ": " + std::strerror(errno));
+  return fd;
+}
 
 // the named sensor, or the only one when none is named
 std::string Pick(const std::string& named, const std::vector<std::string>& names,
@@ -117,23 +145,108 @@ void CheckExportFolder(const fs::path& out) {
                       "'" + out.string() + "' is not empty; expected a new or empty folder");
 }
 
-fs::path MakeSiblingTempFolder(const fs::path& out, const std::string& suffix) {
+fs::path MakeSiblingTempFolder(const fs::path& out, const std::string& suffix, UniqueFd* lock) {
   fs::path target = fs::absolute(out).lexically_normal();
   if (target.filename().empty()) target = target.parent_path();  // "DIR/"
   const fs::path parent = target.parent_path();
   std::error_code ec;
   fs::create_directories(parent, ec);
   if (ec) throw Error("cannot create the folder " + parent.string() + ": " + ec.message());
-  std::random_device seed;
-  std::mt19937_64 rng((static_cast<uint64_t>(seed()) << 32) ^ seed());
+  std::mt19937_64 rng = SeededRng();
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const fs::path p = parent / fmt::format("{}{}-{:012x}", target.filename().string(), suffix,
-                                            rng() & 0xffffffffffffULL);
-    if (::mkdir(p.c_str(), 0777) == 0) return p;
+    const fs::path p = parent / TempName(target.filename().string(), suffix, rng);
+    if (::mkdir(p.c_str(), 0777) == 0) {
+      if (lock) {
+        try {
+          *lock = LockTemp(p, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC, 0);
+        } catch (const Error&) {
+          ::rmdir(p.c_str());
+          throw;
+        }
+      }
+      return p;
+    }
     if (errno != EEXIST)
       throw Error("cannot create the folder " + p.string() + ": " + std::strerror(errno));
   }
   throw Error("cannot create a temporary folder beside " + target.string());
+}
+
+fs::path MakeSiblingTempFile(const fs::path& out, const std::string& suffix, UniqueFd* lock) {
+  const fs::path target = fs::absolute(out).lexically_normal();
+  std::mt19937_64 rng = SeededRng();
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const fs::path p = target.parent_path() / TempName(target.filename().string(), suffix, rng);
+    UniqueFd fd(::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666));
+    if (fd.get() >= 0) {
+      if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
+        const int err = errno;
+        ::unlink(p.c_str());
+        throw Error("cannot lock " + p.string() + ": " + std::strerror(err));
+      }
+      *lock = std::move(fd);
+      return p;
+    }
+    if (errno != EEXIST)
+      throw Error("cannot create " + p.string() + " beside " + out.string() + ": " +
+                  std::strerror(errno));
+  }
+  throw Error("cannot create a temporary file beside " + out.string());
+}
+
+int64_t ExportTempOwner(std::string_view name) {
+  for (std::string_view suffix : kExportTempSuffixes) {
+    const std::string marker = std::string(suffix) + "-";
+    const size_t at = name.rfind(marker);
+    if (at == std::string_view::npos || at == 0) continue;
+    const std::string_view rest = name.substr(at + marker.size());
+    const size_t dash = rest.find('-');
+    if (dash == std::string_view::npos || dash == 0 || dash > 10) continue;
+    const std::string_view hex = rest.substr(dash + 1);
+    if (hex.size() != 12 || hex.find_first_not_of("0123456789abcdef") != std::string_view::npos)
+      continue;
+    int64_t pid = 0;
+    const std::string_view digits = rest.substr(0, dash);
+    const auto [end, err] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+    if (err != std::errc() || end != digits.data() + digits.size() || pid <= 0 ||
+        pid > std::numeric_limits<pid_t>::max())
+      continue;
+    return pid;
+  }
+  return 0;
+}
+
+std::vector<fs::path> RemoveStaleExportTemps(const fs::path& out) {
+  fs::path target = fs::absolute(out).lexically_normal();
+  if (target.filename().empty()) target = target.parent_path();
+  const fs::path parent = target.parent_path();
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  fs::directory_iterator it(parent, ec);
+  if (ec) return removed;
+  for (; it != fs::directory_iterator(); it.increment(ec)) {
+    if (ec) break;
+    const fs::path p = it->path();
+    const int64_t pid = ExportTempOwner(p.filename().string());
+    if (pid == 0) continue;
+    // the creator still runs (or another user's process has its PID): in use, or not ours
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    // O_NONBLOCK: nothing of that name blocks the open; O_NOFOLLOW: a link is left alone
+    const UniqueFd fd(::open(p.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC));
+    if (fd.get() < 0) continue;
+    struct stat st {};
+    if (::fstat(fd.get(), &st) != 0 || st.st_uid != ::geteuid()) continue;
+    if (!S_ISDIR(st.st_mode) && !S_ISREG(st.st_mode)) continue;
+    // an flock held by a live export (a reused PID, another PID namespace): in use
+    if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) continue;
+    std::error_code rm;
+    if (S_ISDIR(st.st_mode))
+      fs::remove_all(p, rm);  // links inside are removed, not followed
+    else
+      fs::remove(p, rm);
+    if (!rm) removed.push_back(p);
+  }
+  return removed;
 }
 
 std::string ExportMetadataYaml(const DatasetExportOptions& options, const std::string& source,
@@ -183,9 +296,12 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
                                  : options.source_label;
   CheckExportFolder(options.out_dir);
   CheckExportStop(options.stop_request);
+  // what killed exports left beside out_dir (their process gone, no lock held on them)
+  RemoveStaleExportTemps(options.out_dir);
   std::optional<fs::path> temp;
+  UniqueFd temp_lock;  // held while the export works: no other export removes the folder
   auto prepare = [&] {
-    temp = MakeSiblingTempFolder(options.out_dir, ".export-tmp");
+    temp = MakeSiblingTempFolder(options.out_dir, ".export-tmp", &temp_lock);
     return *temp;
   };
   try {

@@ -5,16 +5,20 @@
 // timestamps and how Penumbra's map to them.
 //
 // the dataset is written into a new folder beside the output folder,
-// "<out>.export-tmp-<random>", and renamed to the output folder only when it is complete: the
+// "<out>.export-tmp-<pid>-<random>", and renamed to the output folder only when it is complete: the
 // output folder never holds a partial dataset (no images without their index files), and an
 // export that fails or is stopped (DatasetExportOptions::stop_request) removes the temporary
-// folder, leaving the output folder as it was.
+// folder, leaving the output folder as it was. one that a killed export left behind is removed
+// by the next export into the same parent folder (RemoveStaleExportTemps).
 
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/dataset/run_folder.h"
 
 namespace penumbra {
@@ -72,12 +76,37 @@ struct DatasetExportSummary {
 ///         empty.
 void CheckExportFolder(const std::filesystem::path& out);
 
-/// a new, empty folder beside `out` (same parent, created if missing): "<out's name>" +
-/// `suffix` + "-" + 12 random hex digits, made with mkdir (never an existing one; permissions
-/// from the umask).
-/// @throws Error naming the folder if it cannot be created.
+/// temporary outputs of an export live beside their destination until they are complete:
+/// "<out's name>" + suffix + "-" + the creating process's PID + "-" + 12 random hex digits
+/// (suffix ".export-tmp" for datasets and bags, ".replay-tmp" for the run folder a run log is
+/// replayed into). the creator holds an flock on it while it works (where `lock` is given), so
+/// that one left behind by a killed export (SIGKILL leaves it) can be told from one in use:
+/// RemoveStaleExportTemps removes the former and never the latter.
+
+/// a new, empty folder beside `out` (same parent, created if missing), named as above, made
+/// with mkdir (never an existing one; permissions from the umask). with `lock`, *lock receives
+/// a descriptor of the folder holding an exclusive flock, kept until the caller closes it.
+/// @throws Error naming the folder if it cannot be created or locked.
 std::filesystem::path MakeSiblingTempFolder(const std::filesystem::path& out,
-                                            const std::string& suffix);
+                                            const std::string& suffix, UniqueFd* lock = nullptr);
+
+/// a new, empty file beside `out` (same parent, which must exist), named as above, created with
+/// O_EXCL | O_NOFOLLOW (never an existing file or a link; permissions 0666 less the umask);
+/// *lock receives its descriptor (O_WRONLY) holding an exclusive flock.
+/// @throws Error naming `out` if it cannot be created or locked.
+std::filesystem::path MakeSiblingTempFile(const std::filesystem::path& out,
+                                          const std::string& suffix, UniqueFd* lock);
+
+/// the PID in the name of a temporary export output (see above), or 0 when `name` is not one.
+int64_t ExportTempOwner(std::string_view name);
+
+/// removes what killed exports left beside `out`: every folder or regular file in out's parent
+/// folder (not a link; owned by this user) named as a temporary export output whose process is
+/// gone (kill(pid, 0) fails with ESRCH) and on which no process holds an flock (one a live
+/// export holds is never touched, even if its PID was reused or belongs to another PID
+/// namespace). errors while listing or removing are ignored (best effort).
+/// @returns the paths removed.
+std::vector<std::filesystem::path> RemoveStaleExportTemps(const std::filesystem::path& out);
 
 /// the text of the dataset's penumbra_export.yaml: source, format, cameras and (TUM) the
 /// depth block of `options` (docs/datasets.md "penumbra_export.yaml").
