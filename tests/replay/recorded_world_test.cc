@@ -4,8 +4,10 @@
 #include "penumbra/replay/recorded_world.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "common/temp_dir.h"
+#include "common/within_seconds.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
@@ -93,6 +95,33 @@ TEST(ChangedAssets, NamesAssetsWhoseContentChangedOrIsGone) {
             std::string::npos)
       << w[0];
   EXPECT_NE(w[1].find("mesh " + dir.str() + "/gone.stl cannot be read"), std::string::npos) << w[1];
+}
+
+// a log names its assets' paths: a FIFO there blocked replay and --resimulate in open() for
+// ever, /dev/zero was hashed for ever; both are named as what they are
+TEST(ChangedAssets, AFifoOrADeviceAsAnAssetIsReportedAtOnce) {
+  testing::TempDir dir;
+  const std::string fifo = (dir.path() / "robot.xml").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  RunLogHeader h;
+  h.assets = {{"model", fifo, Sha256Hex("<mujoco/>"), 9},
+              {"mesh", "/dev/zero", Sha256Hex("solid"), 5}};
+  const testing::WithinResult r = testing::RunWithin(10, [&] {
+    const std::vector<std::string> w = ChangedAssets(h);
+    return w.size() == 2 && w[0].find("a FIFO") != std::string::npos &&
+                   w[1].find("a character device") != std::string::npos
+               ? 0
+               : 1;
+  });
+  EXPECT_TRUE(r.finished) << "ChangedAssets blocked on a FIFO or /dev/zero";
+  EXPECT_EQ(r.exit_status, 0);
+  const std::vector<std::string> w = ChangedAssets(h);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_EQ(w[0], "model " + fifo + " cannot be read any more (" + fifo +
+                      ": cannot be read for its content hash: asset file is not a regular file "
+                      "(a FIFO); expected a regular file)");
+  EXPECT_NE(w[1].find("asset file is not a regular file (a character device)"), std::string::npos)
+      << w[1];
 }
 
 }  // namespace

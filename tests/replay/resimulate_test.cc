@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 
 #include "common/run_loop.h"
 #include "common/temp_dir.h"
@@ -143,6 +145,68 @@ TEST_F(ResimulateStateCommandTest, ACommandThatSetsTheStateIsRefusedInBothModesN
                                          "first, 'set_mocap', at step 10)"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// `log` with its header's timestep_sec set to `timestep_sec`, the header chunk stored
+// uncompressed and every CRC valid again: a crafted log, not a damaged one
+void SetLoggedTimestep(const std::string& log, double timestep_sec) {
+  namespace codec = runlog_codec;
+  std::string bytes;
+  {
+    std::ifstream in(log, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  codec::ChunkHeader h;
+  ASSERT_EQ(codec::DecodeChunkHeader(
+                reinterpret_cast<const uint8_t*>(bytes.data() + codec::kPreambleBytes), &h),
+            "");
+  const size_t body_at = codec::kPreambleBytes + codec::kChunkHeaderBytes;
+  const std::string stored = bytes.substr(body_at, h.stored_size);
+  const std::string text =
+      h.codec == codec::kCodecZstd ? codec::ZstdDecompress(stored, h.raw_size) : stored;
+  nlohmann::json j = nlohmann::json::parse(text);
+  j["timestep_sec"] = timestep_sec;
+  const std::string body = j.dump();
+  codec::ChunkHeader nh = h;
+  nh.codec = codec::kCodecNone;
+  nh.raw_size = nh.stored_size = body.size();
+  std::string chunk = codec::EncodeChunkHeader(nh) + body;
+  codec::PutU32(&chunk, codec::Crc32(body.data(), body.size()));
+  bytes = bytes.substr(0, codec::kPreambleBytes) + chunk +
+          bytes.substr(body_at + h.stored_size + codec::kChunkTrailerBytes);
+  std::ofstream(log, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST_F(ResimulateTest, AHeaderTimestepOfZeroIsRefusedAsReplayRefusesItNeverBitExact) {
+  SetLoggedTimestep(log_, 0.0);
+  for (ResimulateMode mode : {ResimulateMode::kControllers, ResimulateMode::kCtrl}) {
+    ResimulateOptions o;
+    o.log_path = log_;
+    o.mode = mode;
+    try {
+      const ResimulateReport r = ResimulateLog(o);
+      ADD_FAILURE() << "a timestep of 0 s was resimulated: " << r.Describe();
+    } catch (const RunLogError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                log_ +
+                    ": damaged run log header: header chunk: timestep_sec is 0 s; expected a "
+                    "physics timestep in [1e-06, 0.1] s");
+    }
+  }
+}
+
+TEST_F(ResimulateTest, AHeaderTimestepOtherThanTheModelsIsRefusedNamingBoth) {
+  SetLoggedTimestep(log_, 0.001);
+  ResimulateOptions o;
+  o.log_path = log_;
+  try {
+    const ResimulateReport r = ResimulateLog(o);
+    ADD_FAILURE() << "a log recorded at another timestep was resimulated: " << r.Describe();
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.problem(),
+              "the replay model's timestep is 0.002 s; the log was recorded at 0.001 s; expected "
+              "the recorded physics unchanged");
   }
 }
 

@@ -8,17 +8,21 @@
 
 namespace penumbra {
 
+void CheckLoggedTimestep(const RunLogHeader& header, const Simulation& sim,
+                         const std::string& log_path) {
+  if (header.timestep_sec != sim.timestep())
+    throw ConfigError(log_path, 0, "",
+                      fmt::format("the replay model's timestep is {:.17g} s; the log was recorded "
+                                  "at {:.17g} s; expected the recorded physics unchanged",
+                                  sim.timestep(), header.timestep_sec));
+}
+
 LogSource::LogSource(RunLogReader* reader, Simulation* sim, LogSourceOptions options)
     : reader_(reader),
       sim_(sim),
       map_(reader->header().layout, RunLogLayoutOf(*sim), reader->path()),
       state_(sim->GetState()) {
-  const double logged_dt = reader_->header().timestep_sec;
-  if (logged_dt != sim_->timestep())
-    throw ConfigError(reader_->path(), 0, "",
-                      fmt::format("the replay model's timestep is {:.17g} s; the log was recorded "
-                                  "at {:.17g} s; expected the recorded physics unchanged",
-                                  sim_->timestep(), logged_dt));
+  CheckLoggedTimestep(reader_->header(), *sim_, reader_->path());
   if (!reader_->SeekStep(options.first_step) || !reader_->NextStep(&current_))
     throw RunLogError(fmt::format("{}: no step at or after step {} (the log's steps are {} to {})",
                                   reader_->path(), options.first_step, reader_->first_step(),

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/source.h"
@@ -21,6 +22,14 @@
 #include "penumbra/runlog/run_log_reader.h"
 
 namespace penumbra {
+
+/// refuses to replay a log with a model whose physics timestep differs from the timestep the
+/// log's header records: the one check that kinematic replays (LogSource) and
+/// `replay --resimulate` (ResimulateLog) both make, after the reader has checked the header's
+/// own values (runlog_codec::CheckHeader).
+/// @throws ConfigError naming `log_path`, both timesteps (s) and what was expected.
+void CheckLoggedTimestep(const RunLogHeader& header, const Simulation& sim,
+                         const std::string& log_path);
 
 /// settings of a LogSource.
 struct LogSourceOptions {

@@ -23,6 +23,7 @@
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
+#include "penumbra/replay/log_source.h"
 #include "penumbra/replay/recorded_world.h"
 #include "penumbra/replay/state_map.h"
 #include "penumbra/runlog/run_log_reader.h"
@@ -269,12 +270,13 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
   namespace fs = std::filesystem;
   const bool write = !options.out_dir.empty();
   const fs::path out = options.out_dir;
+  OutputLock out_lock;  // held for the whole resimulation (output/output_lock.h)
   std::optional<SetupRollback> rollback;
   if (write) {
     RefuseOutputFolderHoldingLog(options.out_dir, options.log_path);
     std::error_code exists_ec;
     const bool out_existed = fs::exists(fs::symlink_status(out, exists_ec));
-    PrepareOutputFolder(out, options.force, "--out");
+    out_lock = PrepareOutputFolder(out, options.force, "--out");
     rollback.emplace(out, !out_existed);
   }
 
@@ -295,6 +297,7 @@ ResimulateReport ResimulateLog(const ResimulateOptions& options) {
     throw LocateInWorld(world, e);  // the recorded world's `metrics:` line
   }
   Simulation& sim = session.sim();
+  CheckLoggedTimestep(header, sim, options.log_path);
   const RunLogLayout& layout = header.layout;
   const StateMap map(layout, RunLogLayoutOf(sim), options.log_path);
   if (!map.identity())
