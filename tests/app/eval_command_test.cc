@@ -152,7 +152,7 @@ TEST_F(EvalCommandTest, BadInputExits2WithTheMessageOnStderr) {
   const std::vector<Case> cases = {
       {{"eval"}, "A subcommand is required"},
       {{"eval", "ate", gt_}, "estimate is required"},
-      {{"eval", "ate", gt_, missing}, missing + ": cannot be read (No such file or directory)"},
+      {{"eval", "ate", gt_, missing}, missing + ": TUM trajectory file not found: " + missing},
       {{"eval", "ate", gt_, bad}, bad + ":3: 7 fields; expected 8 numbers"},
       {{"eval", "ate", gt_, late}, late + ": 0 poses associated with the ground truth " + gt_},
       {{"eval", "ate", gt_, est_, "--max-dt", "0"}, "--max-dt: '0' is out of range"},

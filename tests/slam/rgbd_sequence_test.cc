@@ -1,8 +1,10 @@
 #include "penumbra/slam/rgbd_sequence.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "common/temp_dir.h"
+#include "common/within_seconds.h"
 #include "penumbra/core/error.h"
 #include "penumbra/slam/rgbd_odometry.h"
 
@@ -38,6 +40,31 @@ TEST(RgbdSequence, BadLinesNameFileAndLine) {
   dir.Write("associations.txt", "# nothing\n");
   EXPECT_THROW(ReadTumRgbdSequence(dir.path()), ConfigError);
   EXPECT_THROW(ReadTumRgbdSequence(dir.path() / "missing"), ConfigError);
+}
+
+// a FIFO as associations.txt or camera_info.json blocked in open() for ever
+TEST(RgbdSequence, AFifoAsTheListOrCameraInfoIsRefusedAtOnce) {
+  TempDir dir;
+  const std::string list = (dir.path() / "associations.txt").string();
+  const std::string info = (dir.path() / "camera_info.json").string();
+  ASSERT_EQ(mkfifo(list.c_str(), 0600), 0);
+  ASSERT_EQ(mkfifo(info.c_str(), 0600), 0);
+  const testing::WithinResult r = testing::RunWithin(10, [&] {
+    int refused = 0;
+    try {
+      ReadTumRgbdSequence(dir.path());
+    } catch (const ConfigError& e) {
+      refused += e.problem().find("is not a regular file (a FIFO)") != std::string::npos;
+    }
+    try {
+      ReadCameraInfoIntrinsics(info, "");
+    } catch (const ConfigError& e) {
+      refused += e.problem().find("is not a regular file (a FIFO)") != std::string::npos;
+    }
+    return refused == 2 ? 0 : 1;
+  });
+  EXPECT_TRUE(r.finished) << "a FIFO blocked the TUM RGB-D reader";
+  EXPECT_EQ(r.exit_status, 0);
 }
 
 TEST(RgbdSequence, IntrinsicsFromCameraInfo) {

@@ -1,11 +1,14 @@
 #include "penumbra/core/image_file_limits.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <array>
-#include <fstream>
+#include <cerrno>
+#include <filesystem>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -76,11 +79,19 @@ void CheckImageBytesSize(std::string_view bytes, const std::string& what) {
 }
 
 void CheckImageFileSize(const std::filesystem::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return;
+  // a regular file only: a FIFO blocked in open() for ever, a device never ends
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return;  // left to the decoder, which names it
+  const InputFile f = OpenInputFile(path, "image file");
   std::string head(1 << 16, '\0');
-  f.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(f.gcount()));
+  size_t have = 0;
+  while (have < head.size()) {
+    const ssize_t n = ::read(f.fd.get(), head.data() + have, head.size() - have);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    have += static_cast<size_t>(n);
+  }
+  head.resize(have);
   CheckImageBytesSize(head, path.string());
 }
 

@@ -43,8 +43,10 @@ std::string ImageFileSizeProblem(const ImageFileSize& size, std::string_view for
 void CheckImageBytesSize(std::string_view bytes, const std::string& what);
 
 /// the same for a file: reads its first 64 KiB (a JPEG's frame header may follow its EXIF data).
-/// a file that cannot be opened is left to the decoder (which names it).
-/// @throws ConfigError(path, 0, "", problem) when the declared size is above a cap.
+/// a missing file is left to the decoder (which names it); anything but a regular file (a
+/// FIFO, which blocked open() for ever, a folder, a device) is refused (core/input_file.h).
+/// @throws ConfigError(path, 0, "", problem) when the declared size is above a cap, or the
+///         problem of OpenInputFile ("image file is not a regular file (a FIFO); ...").
 void CheckImageFileSize(const std::filesystem::path& path);
 
 }  // namespace penumbra

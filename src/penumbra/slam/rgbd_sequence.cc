@@ -1,11 +1,11 @@
 #include "penumbra/slam/rgbd_sequence.h"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/core/text_match.h"
 
 namespace penumbra {
@@ -19,11 +19,8 @@ void PinholeIntrinsics::ValidateOrThrow() const {
 
 std::vector<RgbdFrameFiles> ReadTumRgbdSequence(const std::filesystem::path& folder) {
   const std::filesystem::path list = folder / "associations.txt";
-  std::ifstream in(list);
-  if (!in)
-    throw ConfigError(list.string(), 0, "",
-                      "cannot read; expected a TUM RGB-D folder with associations.txt "
-                      "(penumbra export --format tum)");
+  // a regular file only (core/input_file.h): a FIFO there blocked in open() for ever
+  std::istringstream in(ReadInputFile(list, "association list of a TUM RGB-D folder"));
   std::vector<RgbdFrameFiles> frames;
   std::string line;
   int line_no = 0;
@@ -52,11 +49,10 @@ std::vector<RgbdFrameFiles> ReadTumRgbdSequence(const std::filesystem::path& fol
 PinholeIntrinsics ReadCameraInfoIntrinsics(const std::filesystem::path& camera_info_json,
                                            const std::string& camera) {
   const std::string file = camera_info_json.string();
-  std::ifstream in(camera_info_json);
-  if (!in) throw ConfigError(file, 0, "", "cannot read; expected a run's camera_info.json");
+  const std::string text = ReadInputFile(camera_info_json, "camera_info.json");
   nlohmann::json doc;
   try {
-    doc = nlohmann::json::parse(in);
+    doc = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw ConfigError(file, 0, "", std::string("not valid JSON: ") + e.what());
   }
