@@ -1,8 +1,15 @@
 #include "penumbra/app/npc_map_command.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <memory>
 
+#include "penumbra/core/error.h"
+#include "penumbra/core/output_file.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/session/npc_map.h"
@@ -10,8 +17,47 @@
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
+namespace {
+
+namespace fs = std::filesystem;
+
+ConfigError OutExists(const std::string& out) {
+  return ConfigError("", 0, "--out",
+                     "'" + out +
+                         "' exists; expected a new file (never overwritten; --force replaces "
+                         "it)");
+}
+
+// refuses an existing `out` (a link counts, followed or not) unless `force`
+void CheckNewOut(const std::string& out, bool force) {
+  std::error_code ec;
+  if (!force && fs::exists(fs::symlink_status(out, ec))) throw OutExists(out);
+}
+
+// writes `bytes` to `out`: whole under a temporary sibling name, then given its name with
+// link(2), which fails on an existing name (a file or a link made meanwhile is never
+// replaced), or with --force renamed over it
+void WriteNewFile(const std::string& out, const std::string& bytes, bool force) {
+  if (force) {
+    WriteFileAtomic(out, bytes);
+    return;
+  }
+  const fs::path path = fs::absolute(out);
+  const fs::path temp = path.parent_path() / ("." + path.filename().string() + ".npc-map-" +
+                                              std::to_string(static_cast<long long>(::getpid())));
+  WriteFileAtomic(temp, bytes);
+  const int linked = ::link(temp.c_str(), path.c_str());
+  const int err = errno;
+  ::unlink(temp.c_str());
+  if (linked == 0) return;
+  if (err == EEXIST) throw OutExists(out);
+  throw Error("cannot write " + out + ": " + std::strerror(err));
+}
+
+}  // namespace
 
 int WriteNpcMap(const NpcMapOptions& options) {
+  CheckNewOut(options.out, options.force);
   const WorldConfig world = LoadWorldFile(options.world_file);
   SessionOptions session_options;
   session_options.build_renderer = false;
@@ -47,7 +93,8 @@ int WriteNpcMap(const NpcMapOptions& options) {
         sim.scene(), X_WB, NpcFloorHeight(sim.scene(), X_WB, starts), centre, seeds, vehicle_seeds);
   }
   const ImageU8 image = map->Draw(effects.sites(), robots, agents, options.pixels_per_cell);
-  WritePngRgb8(options.out, image);
+  const std::vector<uint8_t> png = EncodePngRgb8(image);
+  WriteNewFile(options.out, std::string(png.begin(), png.end()), options.force);
   std::printf(
       "npc map of %s: %d x %d cells of %.2f m, walkable by people %.1f m^2, by vehicles %.1f "
       "m^2; %zu areas, %zu lanes, %zu crowd agents -> %s (%d x %d px)\n",

@@ -89,6 +89,7 @@ class NpcMapCommand : public Command {
   void AddOptions(CLI::App* verb) override {
     verb->add_option("world", options_.world_file, "world file")->required();
     verb->add_option("--out,-o", options_.out, "output PNG (default npc_map.png)");
+    verb->add_flag("--force", options_.force, "replace --out if it exists");
     verb->add_option("--adversity", options_.adversity,
                      "adversity preset whose crowd to place (default: the world's own)");
     AddInteger(verb, "--pixels", &options_.pixels_per_cell, 1, 16,

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <stdio.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -13,11 +14,11 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <random>
 #include <sstream>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/image.h"
+#include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/image_convert.h"
 #include "penumbra/dataset/run_file.h"
@@ -106,33 +107,32 @@ WorldConfig RunWorld(const fs::path& run_dir, std::string* world_file) {
     throw ConfigError(manifest.string(), 0, "world_file",
                       "missing; expected the world file of the run");
   *world_file = j["world_file"].get<std::string>();
-  std::error_code ec;
-  if (!fs::is_regular_file(*world_file, ec))
-    throw ConfigError(manifest.string(), 0, "world_file",
-                      "the run's world file '" + *world_file +
-                          "' is gone; the export names topics and frames from it");
+  // run.json may come from someone else: only a world file is read (by its ending, a regular
+  // file, not through a link at its name), and no error quotes its content
+  const std::string shown = SanitizeForMessage(*world_file, 300);
+  auto refuse = [&](const std::string& why) {
+    return ConfigError(manifest.string(), 0, "world_file", "the run's world file '" + shown +
+                                                               "' " + why +
+                                                               "; the export names topics and "
+                                                               "frames from it");
+  };
   const std::string ext = fs::path(*world_file).extension().string();
+  if (ext != ".yaml" && ext != ".yml" && ext != ".xml" && ext != ".urdf")
+    throw refuse("is not a world file (.yaml, .yml, .xml or .urdf) and is not read");
+  struct stat st {};
+  if (::lstat(world_file->c_str(), &st) != 0) throw refuse("is gone");
+  if (S_ISLNK(st.st_mode)) throw refuse("is a symbolic link (not followed)");
+  if (!S_ISREG(st.st_mode)) throw refuse("is not a regular file");
   if (ext == ".xml" || ext == ".urdf") return WorldForBareModel(*world_file);
-  return LoadWorldFile(*world_file);
-}
-
-// a new empty file beside `bag` for the bag to be written under: "<bag>.export-tmp-<random>",
-// created with O_EXCL | O_NOFOLLOW (never an existing file or a link)
-fs::path MakeTempBag(const fs::path& bag) {
-  std::random_device seed;
-  std::mt19937_64 rng((static_cast<uint64_t>(seed()) << 32) ^ seed());
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    const fs::path p =
-        fs::path(bag.string() + fmt::format(".export-tmp-{:012x}", rng() & 0xffffffffffffULL));
-    const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      ::close(fd);
-      return p;
-    }
-    if (errno != EEXIST)
-      throw Error("cannot create the bag " + bag.string() + ": " + std::strerror(errno));
+  try {
+    return LoadWorldFile(*world_file);
+  } catch (const Error& e) {
+    const auto* c = dynamic_cast<const ConfigError*>(&e);
+    throw refuse(std::string("does not load as a world") +
+                 (c && c->line() > 0 ? " (line " + std::to_string(c->line()) + ")" : "") +
+                 " (its error is not shown: run.json may come from someone else; run `penumbra "
+                 "run` on it to see why)");
   }
-  throw Error("cannot create a temporary file beside " + bag.string());
 }
 
 // gives the complete bag `from` its name `to`, never replacing a file there
@@ -229,7 +229,13 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
 
   CheckExportStop(stop_request);
   fs::create_directories(fs::absolute(bag_path).parent_path(), ec);
-  const fs::path temp_bag = MakeTempBag(bag_path);
+  // what killed exports left beside the bag (their process gone, no lock held on them); the
+  // bag is written under "<bag>.export-tmp-<pid>-<random>" (O_EXCL | O_NOFOLLOW), locked while
+  // this export works
+  for (const fs::path& stale : RemoveStaleExportTemps(bag_path))
+    spdlog::info("removed {}, left by an export that was killed", stale.string());
+  UniqueFd temp_lock;
+  const fs::path temp_bag = MakeSiblingTempFile(bag_path, ".export-tmp", &temp_lock);
   bool done = false;
   struct RemoveUnlessDone {
     const fs::path& path;
