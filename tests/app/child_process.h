@@ -54,6 +54,8 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
 
   void Signal(int sig) const { kill(pid_, sig); }
+  /// the child's process id (-1 once waited for).
+  pid_t pid() const { return pid_; }
 
   /// waits for the exit; returns the exit code, or 128 + signal if a signal killed it.
   int Wait() {

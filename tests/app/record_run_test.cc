@@ -234,5 +234,75 @@ TEST_F(RecordRunTest, BadRecordSettingsAreRefusedNamingTheirSource) {
   EXPECT_NE(c.err.find("--record-sensors"), std::string::npos) << c.err;
 }
 
+// a world file may come from anyone: its record.file is a new file inside the output folder,
+// never an absolute path or one that leaves it (which overwrote another run log)
+TEST_F(RecordRunTest, AWorldFilesRecordFileStaysInsideTheOutputFolder) {
+  tmp_.Write("victim.plog", "keep");
+  for (const std::string& f :
+       {std::string("../victim.plog"), (tmp_.path() / "victim.plog").string(),
+        std::string("../new.plog"), std::string("a/../../new.plog")}) {
+    const std::string w = World("record: {file: '" + f + "'}\n");
+    auto r = RunPenumbra({"run", w, "--out", (tmp_.path() / "out").string(), "-q"}, tmp_.path());
+    EXPECT_EQ(r.exit_code, 2) << f << ": " << r.err;
+    EXPECT_NE(r.err.find("w.yaml:7: record.file"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("inside it"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(ReadAll(tmp_.path() / "victim.plog"), "keep");
+  EXPECT_FALSE(fs::exists(tmp_.path() / "new.plog"));
+}
+
+// --record never overwrites an existing log unless the user passes --force
+TEST_F(RecordRunTest, AnExistingLogIsReplacedOnlyWithForce) {
+  const std::string log = tmp_.Write("old.plog", "keep");
+  auto a = RunPenumbra(
+      {"run", World(), "--out", (tmp_.path() / "o1").string(), "-q", "--record", log}, tmp_.path());
+  EXPECT_EQ(a.exit_code, 2) << a.err;
+  EXPECT_NE(a.err.find("--record: run log '" + log + "' exists"), std::string::npos) << a.err;
+  EXPECT_EQ(ReadAll(log), "keep");
+  EXPECT_FALSE(fs::exists(tmp_.path() / "o1" / "run.json"));
+  auto b = RunPenumbra(
+      {"run", World(), "--out", (tmp_.path() / "o2").string(), "-q", "--record", log, "--force"},
+      tmp_.path());
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_TRUE(RunLogReader::Open(log).complete());
+}
+
+// a live run owns its output folder and its log: a second run into either, --force or not,
+// fails at start naming the first run's PID, and the first run ends with all its outputs
+// (two runs into one log both exited 0 and left a corrupt log; --force into a live run's folder
+// removed its outputs and made it fail)
+TEST_F(RecordRunTest, ASecondRunIntoALiveRunsFolderOrLogFailsNamingItsPid) {
+  const std::string world = World("", 60);
+  const fs::path out = tmp_.path() / "out";
+  const std::string log = (tmp_.path() / "live.plog").string();
+  ChildProcess a({"run", world, "--out", out.string(), "-q", "--realtime", "--record", log},
+                 tmp_.path());
+  ASSERT_TRUE(WaitForStep(log, 255)) << a.err();
+  const std::string pid = "(PID " + std::to_string(a.pid()) + ")";
+  const fs::path cap = tmp_.path() / "second";
+  fs::create_directories(cap);
+  for (const bool force : {false, true}) {
+    std::vector<std::string> args = {"run", world,      "--out", (tmp_.path() / "o2").string(),
+                                     "-q",  "--record", log};
+    if (force) args.push_back("--force");
+    auto same_log = RunPenumbra(args, cap);
+    EXPECT_EQ(same_log.exit_code, 2) << same_log.err;
+    EXPECT_NE(same_log.err.find("is being written by another run " + pid), std::string::npos)
+        << same_log.err;
+    args = {"run", world, "--out", out.string(), "-q"};
+    if (force) args.push_back("--force");
+    auto same_out = RunPenumbra(args, cap);
+    EXPECT_EQ(same_out.exit_code, 2) << same_out.err;
+    EXPECT_NE(same_out.err.find("is in use by another run " + pid), std::string::npos)
+        << same_out.err;
+  }
+  EXPECT_FALSE(fs::exists(tmp_.path() / "o2"));
+  a.Signal(SIGINT);
+  EXPECT_EQ(a.Wait(), 130) << a.err();
+  EXPECT_TRUE(RunLogReader::Open(log).complete());
+  EXPECT_TRUE(fs::exists(out / "run.json"));
+  EXPECT_TRUE(fs::exists(out / "cam" / "rgb" / "000000.png"));
+}
+
 }  // namespace
 }  // namespace penumbra

@@ -2,20 +2,24 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 
 #include "penumbra/command/bridge_set.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
+#include "penumbra/core/output_path_policy.h"
 #include "penumbra/live/live_control.h"
 #include "penumbra/live/run_log_header.h"
 #include "penumbra/output/manifest_sink.h"
 #include "penumbra/output/output_folder.h"
+#include "penumbra/output/output_lock.h"
 #include "penumbra/output/png_io.h"
 #include "penumbra/output/recorder_sink.h"
 #include "penumbra/output/run_manifest.h"
@@ -102,15 +106,20 @@ WorldConfig WithRunOptions(const WorldConfig& world_in, const RunOptions& option
   return world;
 }
 
-// where the run log goes: --record is relative to the current folder, the world file's
-// record.file to the output folder
-std::string RecordPath(const WorldConfig& world, const RunOptions& options) {
-  if (world.record.file.empty()) return "";
-  std::filesystem::path p(world.record.file);
-  if (options.record_file.empty() && p.is_relative())
-    p = std::filesystem::path(world.output_dir) / p;
-  return p.lexically_normal().string();
-}
+// a run log this run created, removed should the run fail before its first step
+class NewLogRollback {
+ public:
+  explicit NewLogRollback(std::string path) : path_(std::move(path)) {}
+  NewLogRollback(const NewLogRollback&) = delete;
+  NewLogRollback& operator=(const NewLogRollback&) = delete;
+  ~NewLogRollback() {
+    if (!path_.empty()) ::unlink(path_.c_str());
+  }
+  void Dismiss() { path_.clear(); }
+
+ private:
+  std::string path_;
+};
 
 std::string JoinArgs(const std::vector<std::string>& args) {
   std::string s;
@@ -127,8 +136,34 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   // empty or new, or (--force) holding only an earlier run's outputs (output/output_folder.h)
   std::error_code exists_ec;
   const bool out_existed = fs::exists(fs::symlink_status(out, exists_ec));
-  PrepareOutputFolder(out, options.force, options.out_dir.empty() ? "output.dir" : "--out");
+  // locked for the whole run: a second run into it fails here naming this one's PID
+  const OutputLock out_lock =
+      PrepareOutputFolder(out, options.force, options.out_dir.empty() ? "output.dir" : "--out");
   SetupRollback rollback(out, !out_existed);
+  // the run log, opened now so that a second run into the same log fails at start (its header
+  // is written once the session is set up): --record is the user's, relative to the current
+  // folder, locked, replacing an existing log only with --force; the world file's record.file
+  // is a new file inside the output folder (core/output_path_policy.h: no absolute path, "..",
+  // symbolic link or existing file)
+  UniqueFd record_fd;
+  std::string record_path, record_created;
+  if (!options.record_file.empty()) {
+    LockedRunLogFile f = OpenRunLogFile(options.record_file, options.force, "--record");
+    record_path = fs::path(f.path).lexically_normal().string();
+    record_fd = std::move(f.fd);
+    if (f.created) record_created = f.path;
+  } else if (!world.record.file.empty()) {
+    try {
+      NewOutputFile f = OpenNewFileInside(out, world.record.file, ".plog");
+      record_fd = std::move(f.fd);
+      record_path = (out / f.relative).lexically_normal().string();
+    } catch (const OutputPathError& e) {
+      throw ConfigError("", 0, "record.file",
+                        "'" + SanitizeForMessage(world.record.file, 300) + "' " + e.rule() +
+                            "; expected a new file ending in .plog inside the output folder");
+    }
+  }
+  NewLogRollback log_rollback(record_created);
 
   std::map<std::string, double> timings;
 
@@ -213,14 +248,14 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   SimLoop loop(&physics, loop_options);
   RunSummary summary;
   // the run log (--record): every step's state from the loop thread, closed (complete) at the
-  // end of the run, also after Ctrl-C or an error; opened last so that a setup error leaves none
+  // end of the run, also after Ctrl-C or an error; the file was opened (and locked) at the start,
+  // its header is written now that the session is set up (a setup error removed a new file)
   std::unique_ptr<RecorderSink> recorder;
-  const std::string record_path = RecordPath(world, options);
-  if (!record_path.empty()) {
+  if (record_fd.get() >= 0) {
     RunLogHeader header =
         MakeRunLogHeader(session, PENUMBRA_VERSION, JoinArgs(options.command_line));
     header.has_sensor_records = world.record.sensors;
-    recorder = std::make_unique<RecorderSink>(record_path, header);
+    recorder = std::make_unique<RecorderSink>(std::move(record_fd), record_path, header);
     if (world.record.sensors) sensor_log = &recorder->writer();
     live.RecordChangesTo(&recorder->writer());
     // the crowd's decisions (goals, plans, pauses) as "npc" events (docs/npcs.md)
@@ -281,6 +316,7 @@ RunSummary RunWorldUnlocated(const WorldConfig& world_in, const RunOptions& opti
   if (bridges) bridges->AddTo(&loop);
   loop.AddSink(&manifest);
   rollback.Dismiss();
+  log_rollback.Dismiss();
   if (options.on_live) options.on_live(live);
   const LoopFinish finish = loop.Run();
   if (finish.error) std::rethrow_exception(finish.error);

@@ -126,7 +126,8 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   const fs::path out = options.out_dir;
   std::error_code exists_ec;
   const bool out_existed = fs::exists(fs::symlink_status(out, exists_ec));
-  PrepareOutputFolder(out, options.force, "--out");
+  // locked for the whole replay (output/output_lock.h)
+  const OutputLock out_lock = PrepareOutputFolder(out, options.force, "--out");
   SetupRollback rollback(out, !out_existed);
 
   // the recorded world set up as `run` does, without controllers: nothing is simulated
