@@ -758,7 +758,52 @@ def test_bridge_log(binary, source):
         assert r.stdout.startswith("bit-exact ("), r.stdout
 
 
-TESTS = {"lockstep": test_lockstep, "errors": test_errors, "stop": test_stop,
+def test_stop_two_sockets(binary, source):
+    """a start_recording sent from a second socket just after another socket's `stop`: refused
+    with `stopping`, no log left. ZeroMQ takes waiting peers in turn, so the second socket's
+    request could be carried out before the stop that was sent first (it left a 2-step log)."""
+    pack = lambda d: msgpack.packb(d, use_bin_type=True)  # noqa: E731
+    with tempfile.TemporaryDirectory() as tmp:
+        world = write_world(tmp, source)
+        out = os.path.join(tmp, "out")
+        server = Server(binary, world, out, ["--lockstep"])
+        try:
+            c = Client(server, topics=())
+            c.ok("step", n=5)
+            a = c.ctx.socket(zmq.DEALER)
+            b = c.ctx.socket(zmq.DEALER)
+            for s in (a, b):
+                s.setsockopt(zmq.LINGER, 0)
+                s.setsockopt(zmq.RCVTIMEO, TIMEOUT_MS)
+                s.connect(server.endpoint)
+            # both connected (a reply each) before the race
+            for s in (a, b):
+                s.send_multipart([b"", pack({"cmd": "hello", "protocol": 1})])
+                assert msgpack.unpackb(s.recv_multipart()[-1], raw=False)["ok"]
+            # a backlog on the first socket, its stop, then the second socket's start_recording
+            for i in range(40):
+                a.send_multipart([b"", pack({"cmd": "get_state", "id": i})])
+            a.send_multipart([b"", pack({"cmd": "stop", "id": "stop"})])
+            b.send_multipart([b"", pack({"cmd": "start_recording", "id": "rec",
+                                         "path": "late.plog"})])
+            r = msgpack.unpackb(b.recv_multipart()[-1], raw=False)
+            assert not r["ok"] and r["error"]["code"] == "stopping", r
+            replies = {}
+            while "stop" not in replies:
+                m = msgpack.unpackb(a.recv_multipart()[-1], raw=False)
+                replies[m.get("id")] = m
+            assert replies["stop"]["ok"], replies["stop"]
+            a.close()
+            b.close()
+            c.close()
+            assert server.wait() == 0
+            assert not os.path.exists(os.path.join(out, "late.plog")), \
+                "a start_recording sent after a stop left a log"
+        finally:
+            server.kill()
+
+
+TESTS = {"lockstep": test_lockstep, "stop_two_sockets": test_stop_two_sockets, "errors": test_errors, "stop": test_stop,
          "free": test_free, "live": test_live, "shutdown": test_shutdown,
          "subscriptions": test_subscriptions, "unsubscribe": test_unsubscribe,
          "subscription_memory": test_subscription_memory, "bridge_log": test_bridge_log}

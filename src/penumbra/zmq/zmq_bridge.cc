@@ -103,6 +103,8 @@ class ZmqBridge final : public RunBridge {
   void CommandLoop();
   void PublishLoop();
   void HandleRequest(std::vector<zmq::message_t>& frames, size_t total_frames);
+  // whether a received request is a `stop` that will be carried out (cmd and id only)
+  bool IsStopRequest(const std::vector<zmq::message_t>& frames, size_t total_frames) const;
   void HandleSubscription(const zmq::message_t& m);
   // queues a reply; `after_publications`: not sent before every publication queued so far
   // (a `step` reply follows the messages of its steps)
@@ -346,6 +348,25 @@ void ZmqBridge::SendReply(const std::vector<std::string>& envelope, json reply,
   Wake(cmd_wake_fd_);
 }
 
+bool ZmqBridge::IsStopRequest(const std::vector<zmq::message_t>& frames,
+                              size_t total_frames) const {
+  size_t body = 1;
+  if (body < frames.size() && frames[body].size() == 0) ++body;
+  if (total_frames != body + 1 || body >= frames.size()) return false;
+  const zmq::message_t& m = frames[body];
+  if (static_cast<int64_t>(m.size()) > options_.max_request_bytes) return false;
+  try {
+    const json request = DecodeMsgpack(m.data(), m.size());
+    if (!request.is_object() || request.value("cmd", json()) != "stop") return false;
+    // a stop that will be carried out: no field but cmd and id
+    for (const auto& [key, value] : request.items())
+      if (key != "cmd" && key != "id") return false;
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 void ZmqBridge::HandleRequest(std::vector<zmq::message_t>& frames, size_t total_frames) {
   if (frames.empty()) return;
   std::vector<std::string> envelope{frames[0].to_string()};
@@ -474,7 +495,8 @@ void ZmqBridge::CommandLoop() {
         const ssize_t r = read(cmd_wake_fd_, &n, sizeof(n));
         (void)r;
       }
-      // requests: one message at a time, at most kMaxRequestFrames frames kept
+      // requests: the messages waiting now (at most 64), at most kMaxRequestFrames frames kept
+      std::vector<std::pair<std::vector<zmq::message_t>, size_t>> batch;
       for (int budget = 0; budget < 64; ++budget) {
         zmq::message_t part;
         if (!router_.recv(part, zmq::recv_flags::dontwait)) break;
@@ -488,8 +510,14 @@ void ZmqBridge::CommandLoop() {
           ++total;
           if (frames.size() < kMaxRequestFrames) frames.push_back(std::move(more));
         }
-        HandleRequest(frames, total);
+        batch.emplace_back(std::move(frames), total);
       }
+      // a `stop` among them (from any peer) counts from now: a start_recording that arrived
+      // with it is refused, not left with a step or two (ZeroMQ takes the peers in turn, so a
+      // second socket's request sent just after the stop can come first)
+      for (const auto& [frames, total] : batch)
+        if (IsStopRequest(frames, total)) control_.NoteStopQueued();
+      for (auto& [frames, total] : batch) HandleRequest(frames, total);
     } catch (const zmq::error_t& e) {
       if (e.num() == ETERM) return;
       spdlog::warn("ZeroMQ: {}", e.what());
