@@ -294,6 +294,30 @@ TEST_F(ExportSafetyTest, APathtracedReplayStopsWithinOnePassOnSigint) {
 }
 
 // a bag on a full disk: a 2 MiB tmpfs (needs the right to mount; skipped where it is missing)
+// run.json's world_file is the one path of a run folder that leads outside it: only a world
+// file is read there (by its ending, a regular file, no link at its name), and no error quotes
+// a line of it (a world_file of /etc/shadow printed that file's first line)
+TEST_F(ExportSafetyTest, RunJsonsWorldFileIsReadOnlyAsAWorldAndNeverQuoted) {
+  const fs::path run = CopyOfRun("run_world");
+  const nlohmann::json manifest = nlohmann::json::parse(ReadAll(run / "run.json"));
+  const std::string shadow = tmp_.Write("shadow", "root:$6$SECRETHASH:19000:0:99999:7:::\n");
+  const std::string notes = tmp_.Write("notes.yaml", "SECRETKEY: SECRETVALUE\n");
+  const fs::path link = tmp_.path() / "link.yaml";
+  fs::create_symlink(notes, link);
+  for (const std::string& f : {shadow, notes, link.string()}) {
+    nlohmann::json j = manifest;
+    j["world_file"] = f;
+    std::ofstream(run / "run.json", std::ios::trunc) << j.dump();
+    const testing::ProcessResult r = Export(run, "rosbag", tmp_.path() / "x.bag");
+    if (r.exit_code != 0 && r.err.find("needs ROS 1") != std::string::npos)
+      GTEST_SKIP() << "this penumbra was built without ROS 1: " << r.err;
+    EXPECT_EQ(r.exit_code, 2) << f << ": " << r.err;
+    EXPECT_NE(r.err.find("world_file"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("SECRET"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp_.path() / "x.bag"));
+  }
+}
+
 TEST_F(ExportSafetyTest, ARosbagToAFullDiskExitsOneWithAMessage) {
   const fs::path run = BigRun("run_bag", 1500);
   // the same export to a roomy folder works (and tells whether this build has ROS 1)
