@@ -82,12 +82,14 @@ class RunCommand : public Command {
         "default 1, 0 = every pass)");
     run->add_flag("--force", options_.force,
                   "the output folder may hold an earlier run's outputs: remove them first "
-                  "(anything else there is refused)");
+                  "(anything else there, and a folder a running run holds, is refused); "
+                  "--record may replace an existing log");
     run->add_option("--outputs", outputs_,
                     "images of every camera, comma-separated: rgb, depth, segmentation, range, "
                     "normals, instance_segmentation, semantic_segmentation (overrides the world)");
     run->add_option("--record", options_.record_file,
-                    "write a run log of every physics step to FILE.plog (docs/run-log.md)");
+                    "write a run log of every physics step to FILE.plog, a new file unless "
+                    "--force (docs/run-log.md)");
     run->add_flag("--record-sensors", options_.record_sensors,
                   "the run log also holds every camera image and sensor output");
     bridge_flags_.Add(run);
