@@ -10,6 +10,7 @@
 #include "penumbra/app/backend_flag.h"
 #include "penumbra/app/stop_signals.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 #include "penumbra/dataset/dataset_export.h"
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/run_folder.h"
@@ -32,6 +33,15 @@ struct ExportCommand::State {
 };
 
 namespace {
+
+// a run log named as the export's input: missing, or not a regular file (a FIFO, which the
+// replay's open() would wait on, a folder, a device), refused naming what it is
+void CheckRunLogInput(const std::filesystem::path& input) {
+  std::error_code ec;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(input, ec)))
+    throw ConfigError(input.string(), 0, "", "no such run log; expected a .plog file");
+  OpenInputFile(input, "run log");
+}
 
 // a temporary folder that is removed with everything in it when it goes out of scope
 class TempFolder {
@@ -119,8 +129,7 @@ int ExportCommand::Run(const CommandArgs& args) {
   std::optional<TempFolder> replayed;
   fs::path run_dir = input;
   if (input.extension() == ".plog") {
-    if (!fs::is_regular_file(input))
-      throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
+    CheckRunLogInput(input);
     CheckExportFolder(options.out_dir);
     // the replay renders the depth with the benchmarks' sensor model (a camera's own
     // depth_noise first) or exact (--depth ground-truth)
@@ -208,8 +217,7 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   std::optional<TempFolder> replayed;
   fs::path run_dir = input;
   if (input.extension() == ".plog") {
-    if (!fs::is_regular_file(input))
-      throw ConfigError(s.input, 0, "", "no such run log; expected a .plog file");
+    CheckRunLogInput(input);
     if (bag.extension() != ".bag")
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "'; expected a bag file name ending in .bag");
