@@ -1,6 +1,7 @@
 #include "penumbra/output/output_lock.h"
 
 #include <fcntl.h>
+#include <spdlog/spdlog.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -21,6 +22,17 @@ namespace {
 std::string Holder(int fd) {
   const int pid = LockHolderPid(fd);
   return pid > 0 ? "another run (PID " + std::to_string(pid) + ")" : "another run (PID unknown)";
+}
+
+// a file system without flock(2) (some FUSE and network mounts): the run goes on unlocked,
+// with a warning, rather than not at all
+bool LocksUnsupported(int err) {
+  return err == ENOLCK || err == EOPNOTSUPP || err == ENOSYS || err == EINVAL;
+}
+
+void WarnUnlocked(const std::string& what, int err) {
+  spdlog::warn("{} cannot be locked ({}): another run could write into it at the same time", what,
+               std::strerror(err));
 }
 
 bool SameFile(const struct stat& a, const struct stat& b) {
@@ -62,11 +74,13 @@ OutputLock LockOutputFolder(const std::filesystem::path& dir, const std::string&
   UniqueFd fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (fd.get() < 0) throw fail(std::string("cannot be opened: ") + std::strerror(errno));
   if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
-    if (errno == EWOULDBLOCK)
+    const int err = errno;
+    if (err == EWOULDBLOCK)
       throw fail("is in use by " + Holder(fd.get()) +
                  "; wait for it to end or choose another folder (--force never removes the "
                  "outputs of a running run)");
-    throw fail(std::string("cannot be locked: ") + std::strerror(errno));
+    if (!LocksUnsupported(err)) throw fail(std::string("cannot be locked: ") + std::strerror(err));
+    WarnUnlocked("output folder '" + dir.string() + "'", err);
   }
   // the name still leads to the folder locked (not removed and made anew meanwhile)
   struct stat held {
@@ -90,7 +104,11 @@ LockedRunLogFile OpenRunLogFile(const std::string& path, bool replace, const std
   f.fd = UniqueFd(::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (f.fd.get() >= 0) {
     // another run that replaces it (--force) may have taken it in between
-    if (::flock(f.fd.get(), LOCK_EX | LOCK_NB) != 0) throw in_use(f.fd.get());
+    if (::flock(f.fd.get(), LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      if (!LocksUnsupported(err)) throw in_use(f.fd.get());
+      WarnUnlocked("run log '" + path + "'", err);
+    }
     f.created = true;
     return f;
   }
@@ -108,8 +126,10 @@ LockedRunLogFile OpenRunLogFile(const std::string& path, bool replace, const std
   if (!S_ISREG(held.st_mode) || !SameFile(held, named))
     throw fail("was replaced while it was being opened; run again");
   if (::flock(f.fd.get(), LOCK_EX | LOCK_NB) != 0) {
-    if (errno == EWOULDBLOCK) throw in_use(f.fd.get());
-    throw fail(std::string("cannot be locked: ") + std::strerror(errno));
+    const int err = errno;
+    if (err == EWOULDBLOCK) throw in_use(f.fd.get());
+    if (!LocksUnsupported(err)) throw fail(std::string("cannot be locked: ") + std::strerror(err));
+    WarnUnlocked("run log '" + path + "'", err);
   }
   if (!replace)
     throw fail(

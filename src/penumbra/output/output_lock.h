@@ -4,7 +4,8 @@
 // into the same folder or log fails at start naming the other run's PID (read from /proc/locks),
 // and --force never removes or truncates what a live run holds: the lock is taken before
 // anything is removed. the locks go with the open descriptors: a killed run leaves none behind,
-// and nothing is added to the folder.
+// and nothing is added to the folder. on a file system without flock(2) (ENOLCK, EOPNOTSUPP,
+// ENOSYS, EINVAL: some FUSE and network mounts) the run goes on unlocked with a warning.
 
 #include <filesystem>
 #include <string>
