@@ -166,7 +166,7 @@ TEST(ControllerFactory, BadValuesNameKeyAndExpectation) {
       {"waypoints: [[1.0, 0.0], [1.0, 1.0]]", "waypoints: [[1.0, 0.0], [1.0]]", "waypoints[1]",
        "[x, y]"},
       {"waypoints: [[1.0, 0.0], [1.0, 1.0]]", "waypoints: [[1.0, 0.0], [1.0, y]]", "waypoints[1]",
-       "finite number"},
+       "a number (m) in [-100000, 100000]"},
       {"waypoints: [[1.0, 0.0], [1.0, 1.0]]", "waypoints: 3", "waypoints", "list"},
       {"base_body: chassis", "base_body: [a, b]", "base_body", "name"},
       {"right_actuator: right_wheel", "right_actuator: left_wheel", "right_actuator", "different"},

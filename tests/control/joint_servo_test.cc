@@ -194,7 +194,7 @@ TEST(JointPd, ConfigErrors) {
     return "";
   };
   EXPECT_NE(error("kp: [1, 2]\n")
-                .find("kp: got a list of 2 items; expected a number >= 0 or a "
+                .find("kp: got a list of 2 items; expected a number >= 0 and <= 1e+06 or a "
                       "list of 7 such numbers (one per joint)"),
             std::string::npos);
   EXPECT_NE(error("output: effort\n").find("output: got 'effort'; expected torque or position"),

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "penumbra/config/config_value.h"
+#include "penumbra/control/param_limits.h"
 
 namespace penumbra {
 namespace command_script_detail {
@@ -21,7 +22,7 @@ std::vector<std::pair<double, ParamNode>> ReadTimedItems(ControllerParams& param
     ParamNode item((*list)[i], path, params.context());
     if (!(*list)[i].IsMap())
       item.FailHere("expected a mapping with `t` (s) and the command's keys");
-    const double t = item.Number("t", std::nullopt, 0, std::numeric_limits<double>::infinity());
+    const double t = item.Number("t", std::nullopt, 0, kMaxParamTimeSec);
     if (i > 0 && t < last_t) {
       std::ostringstream s;
       s << "got " << t << " s after " << last_t << " s at " << key << "[" << i - 1

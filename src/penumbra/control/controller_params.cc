@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "penumbra/config/config_value.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
@@ -64,8 +65,10 @@ bool ControllerParams::Bool(const std::string& key, bool fallback) {
 
 std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, size_t min_count) {
   const ConfigValue* n = Get(key);
+  const std::string bound = param::FormatNumber(kMaxParamPositionM);
   const std::string expected = "expected a list of at least " + std::to_string(min_count) +
-                               " [x, y] pairs of numbers (m), e.g. [[1.0, 0.0], [1.0, 1.0]]";
+                               " [x, y] pairs of numbers (m) in [-" + bound + ", " + bound +
+                               "], e.g. [[1.0, 0.0], [1.0, 1.0]]";
   if (!n) Fail(key, "missing; " + expected);
   if (!n->IsSequence()) Fail(key, "got " + Repr(*n) + "; " + expected);
   std::vector<Eigen::Vector2d> pts;
@@ -75,9 +78,9 @@ std::vector<Eigen::Vector2d> ControllerParams::Points2(const std::string& key, s
     if (!p.IsSequence() || p.size() != 2) Fail(item_key, "got " + Repr(p) + "; expected [x, y]");
     Eigen::Vector2d v;
     for (int k = 0; k < 2; ++k) {
-      if (!param::ToNumber(p[k], &v[k]))
+      if (!param::ToNumber(p[k], &v[k]) || std::abs(v[k]) > kMaxParamPositionM)
         Fail(item_key, "got " + Repr(p[k]) + " as coordinate " + std::to_string(k) +
-                           "; expected a finite number (m)");
+                           "; expected a number (m) in [-" + bound + ", " + bound + "]");
     }
     pts.push_back(v);
   }
@@ -103,6 +106,16 @@ double ParamNumberAt(ControllerParams& p, const ConfigValue& n, const std::strin
   const bool ok = n.ToDoubleLoose(&v);
   if (!ok || !std::isfinite(v))
     p.Fail(key, "got " + DescribeParamNode(n) + "; expected " + expected);
+  return v;
+}
+
+double ParamNumberAt(ControllerParams& p, const ConfigValue& n, const std::string& key, double min,
+                     double max, const std::string& unit) {
+  const std::string range = "in [" + param::FormatNumber(min) + ", " + param::FormatNumber(max) +
+                            "]" + (unit.empty() ? "" : " (" + unit + ")");
+  const double v = ParamNumberAt(p, n, key, "a number " + range);
+  if (v < min || v > max)
+    p.Fail(key, "got " + param::FormatNumber(v) + "; expected a number " + range);
   return v;
 }
 

@@ -68,6 +68,12 @@ std::string DescribeParamNode(const ConfigValue& node);
 double ParamNumberAt(ControllerParams& p, const ConfigValue& node, const std::string& key,
                      const std::string& expected);
 
+/// a finite number in [min, max] from `node`; `unit` (may be empty) names the unit in messages.
+/// @throws ConfigError through p.Fail naming the range, e.g. "got 1e+300; expected a number in
+/// [-100, 100] (m/s)".
+double ParamNumberAt(ControllerParams& p, const ConfigValue& node, const std::string& key,
+                     double min, double max, const std::string& unit);
+
 /// a number or a list of numbers (at least one) from `node`, each finite and accepted by `ok`;
 /// list elements are reported as key[i]. @throws ConfigError through p.Fail.
 std::vector<double> ParamNumbersAt(ControllerParams& p, const ConfigValue& node,

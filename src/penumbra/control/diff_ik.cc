@@ -7,12 +7,12 @@
 
 #include "penumbra/config/config_value.h"
 #include "penumbra/control/param_check.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDegToRad = M_PI / 180.0;
 
 // xyz (required unless `xyz_optional`) and rpy_deg (optional) of a pose mapping.
@@ -20,7 +20,7 @@ Pose ReadPose(ParamNode& n, bool xyz_optional, bool* has_xyz, bool* has_rpy) {
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
   *has_xyz = n.Has("xyz") || !xyz_optional;
   if (*has_xyz) {
-    const std::vector<double> v = n.Numbers("xyz", 3, -kInf, kInf, "m");
+    const std::vector<double> v = n.Numbers("xyz", 3, -kMaxParamPositionM, kMaxParamPositionM, "m");
     xyz = Eigen::Vector3d(v[0], v[1], v[2]);
   } else {
     n.Raw("xyz");
@@ -43,10 +43,10 @@ ArmCommand ReadGripper(const ConfigValue& node, const std::function<void(std::st
     if (s == "close" || s == "closed")
       return ArmCommand::Gripper(ArmCommand::GripperAction::kClose);
     double v = 0;
-    if (node.ToDoubleLoose(&v) && std::isfinite(v))
+    if (node.ToDoubleLoose(&v) && std::isfinite(v) && std::abs(v) <= kMaxParamEffort)
       return ArmCommand::Gripper(ArmCommand::GripperAction::kValue, v);
   }
-  fail("expected open, close or a ctrl value (a number)");
+  fail("expected open, close or a ctrl value (a number in [-1e+09, 1e+09])");
   return {};
 }
 
@@ -111,26 +111,31 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
   } else {
     p.Raw("base_body");
   }
-  d.position_gain = p.Number("position_gain", 10, 0, kInf, true);
-  d.orientation_gain = p.Number("orientation_gain", 10, 0, kInf, true);
-  d.damping = p.Number("damping", 0.01, 0, kInf);
-  d.damping_max = p.Number("damping_max", std::max(0.1, d.damping), d.damping, kInf);
-  d.manipulability_threshold = p.Number("manipulability_threshold", 0.005, 0, kInf, true);
-  d.max_linear_speed_m_s = p.Number("max_linear_speed_m_s", 1.0, 0, kInf, true);
-  d.max_angular_speed_rad_s = p.Number("max_angular_speed_deg_s", 180, 0, kInf, true) * kDegToRad;
-  d.speed_m_s = p.Number("speed_m_s", 0.25, 0, kInf, true);
-  d.angular_speed_rad_s = p.Number("angular_speed_deg_s", 90, 0, kInf, true) * kDegToRad;
-  d.posture = ReadOptionalNumbers(p, "posture", n, -kInf, kInf, "rad or m, one per joint");
-  d.posture_gain = p.Number("posture_gain", 0.3, 0, kInf);
-  d.limit_zone = p.Number("limit_zone", 0.2, 0, kInf, true);
-  d.limit_gain = p.Number("limit_gain", 5.0, 0, kInf);
-  d.max_tracking_error = p.Number("max_tracking_error", 0.2, 0, kInf, true);
-  d.limit_velocity_gain = p.Number("limit_velocity_gain", 5, 0, kInf, true);
+  d.position_gain = p.Number("position_gain", 10, 0, kMaxParamGain, true);
+  d.orientation_gain = p.Number("orientation_gain", 10, 0, kMaxParamGain, true);
+  d.damping = p.Number("damping", 0.01, 0, kMaxParamGain);
+  d.damping_max = p.Number("damping_max", std::max(0.1, d.damping), d.damping, kMaxParamGain);
+  d.manipulability_threshold = p.Number("manipulability_threshold", 0.005, 0, kMaxParamGain, true);
+  d.max_linear_speed_m_s = p.Number("max_linear_speed_m_s", 1.0, 0, kMaxParamSpeedMS, true);
+  d.max_angular_speed_rad_s =
+      p.Number("max_angular_speed_deg_s", 180, 0, kMaxParamAngularSpeedDegS, true) * kDegToRad;
+  d.speed_m_s = p.Number("speed_m_s", 0.25, 0, kMaxParamSpeedMS, true);
+  d.angular_speed_rad_s =
+      p.Number("angular_speed_deg_s", 90, 0, kMaxParamAngularSpeedDegS, true) * kDegToRad;
+  d.posture = ReadOptionalNumbers(p, "posture", n, -kMaxParamJointValue, kMaxParamJointValue,
+                                  "rad or m, one per joint");
+  d.posture_gain = p.Number("posture_gain", 0.3, 0, kMaxParamGain);
+  d.limit_zone = p.Number("limit_zone", 0.2, 0, kMaxParamJointValue, true);
+  d.limit_gain = p.Number("limit_gain", 5.0, 0, kMaxParamGain);
+  d.max_tracking_error = p.Number("max_tracking_error", 0.2, 0, kMaxParamPositionM, true);
+  d.limit_velocity_gain = p.Number("limit_velocity_gain", 5, 0, kMaxParamGain, true);
   if (p.Has("gripper_actuator")) {
     d.gripper_actuator = prefix + p.String("gripper_actuator");
-    if (p.Has("gripper_open")) d.gripper_open = p.Number("gripper_open", std::nullopt, -kInf, kInf);
+    if (p.Has("gripper_open"))
+      d.gripper_open = p.Number("gripper_open", std::nullopt, -kMaxParamEffort, kMaxParamEffort);
     if (p.Has("gripper_closed"))
-      d.gripper_closed = p.Number("gripper_closed", std::nullopt, -kInf, kInf);
+      d.gripper_closed =
+          p.Number("gripper_closed", std::nullopt, -kMaxParamEffort, kMaxParamEffort);
     if (const ConfigValue* g = p.Raw("gripper_initial"))
       d.gripper_initial = ReadGripper(*g, [&](const std::string& e) {
         p.Fail("gripper_initial", "got '" + (g->IsScalar() ? g->Scalar() : "?") + "'; " + e);
@@ -170,13 +175,14 @@ DiffIkParams DiffIkParams::Parse(ControllerParams& p, const std::string& prefix)
     const Pose X = ReadPose(pose, by, &has_xyz, &has_rpy);
     if (by && !has_xyz && !has_rpy) pose.FailHere("empty; expected xyz (m) and/or rpy_deg (deg)");
     pose.CheckNoUnknownKeys();
-    const double speed = item.Number("speed_m_s", 0, 0, kInf);
-    const double ang = item.Number("angular_speed_deg_s", 0, 0, kInf) * kDegToRad;
+    const double speed = item.Number("speed_m_s", 0, 0, kMaxParamSpeedMS);
+    const double ang =
+        item.Number("angular_speed_deg_s", 0, 0, kMaxParamAngularSpeedDegS) * kDegToRad;
     c = by ? ArmCommand::MoveBy(X, speed, ang) : ArmCommand::MoveTo(X, speed, ang);
     c.has_orientation = by || has_rpy;
     return c;
   });
-  d.rate_hz = p.Number("rate_hz", 0, 0, kInf);
+  d.rate_hz = p.Number("rate_hz", 0, 0, kMaxParamRateHz);
   p.CheckNoUnknownKeys();
   return d;
 }

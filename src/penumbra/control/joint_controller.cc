@@ -4,12 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "penumbra/control/param_limits.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
-
-constexpr double kJointInf = std::numeric_limits<double>::infinity();
 
 const char* ModeKey(JointCommand::Mode m) {
   switch (m) {
@@ -29,7 +28,8 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
   JointPdParams j;
   j.servo = JointServoParams::Parse(p, prefix, 400, 40, 2.0, 10.0);
   const size_t n = j.servo.joints.size();
-  j.target = ReadOptionalNumbers(p, "target", n, -kJointInf, kJointInf, "rad or m, one per joint");
+  j.target = ReadOptionalNumbers(p, "target", n, -kMaxParamJointValue, kMaxParamJointValue,
+                                 "rad or m, one per joint");
   j.commands = ParseCommandScript<JointCommand>(p, "commands", [n](ParamNode& item) {
     JointCommand c;
     int found = 0;
@@ -38,7 +38,10 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
       if (!item.Has(ModeKey(mode))) continue;
       ++found;
       c.mode = mode;
-      c.values = item.Numbers(ModeKey(mode), n, -kJointInf, kJointInf, "one per joint");
+      const double bound = mode == JointCommand::Mode::kPosition   ? kMaxParamJointValue
+                           : mode == JointCommand::Mode::kVelocity ? kMaxParamJointVelocity
+                                                                   : kMaxParamEffort;
+      c.values = item.Numbers(ModeKey(mode), n, -bound, bound, "one per joint");
     }
     if (found != 1)
       item.FailHere(std::string(found ? "got more than one of" : "missing") +
@@ -46,7 +49,7 @@ JointPdParams JointPdParams::Parse(ControllerParams& p, const std::string& prefi
                     "or tau (effort)");
     return c;
   });
-  j.rate_hz = p.Number("rate_hz", 0, 0, kJointInf);
+  j.rate_hz = p.Number("rate_hz", 0, 0, kMaxParamRateHz);
   p.CheckNoUnknownKeys();
   return j;
 }

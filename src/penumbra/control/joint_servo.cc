@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/param_node.h"
 #include "penumbra/core/error.h"
 
@@ -49,16 +50,17 @@ JointServoParams JointServoParams::Parse(ControllerParams& p, const std::string&
   };
   const bool torque = s.output == ServoOutput::kTorque;
   s.kp = ReadPerJoint(p, "kp", n, torque ? fallback(default_kp) : std::vector<double>(n, 0), 0,
-                      kServoInf);
+                      kMaxParamGain);
   s.kd = ReadPerJoint(p, "kd", n, torque ? fallback(default_kd) : std::vector<double>(n, 0), 0,
-                      kServoInf);
+                      kMaxParamGain);
   s.gravity_compensation = p.Bool("gravity_compensation", true);
-  s.max_velocity =
-      ReadPerJoint(p, "max_velocity", n, fallback(default_max_velocity), 0, kServoInf, true);
+  s.max_velocity = ReadPerJoint(p, "max_velocity", n, fallback(default_max_velocity), 0,
+                                kMaxParamJointVelocity, true);
   s.max_acceleration = ReadPerJoint(p, "max_acceleration", n, fallback(default_max_acceleration), 0,
-                                    kServoInf, true);
-  if (p.Has("max_effort")) s.max_effort = ReadPerJoint(p, "max_effort", n, {}, 0, kServoInf, true);
-  s.limit_margin = p.Number("limit_margin", 0.01, 0, kServoInf);
+                                    kMaxParamJointAcceleration, true);
+  if (p.Has("max_effort"))
+    s.max_effort = ReadPerJoint(p, "max_effort", n, {}, 0, kMaxParamEffort, true);
+  s.limit_margin = p.Number("limit_margin", 0.01, 0, kMaxParamJointValue);
   return s;
 }
 

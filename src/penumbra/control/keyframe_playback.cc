@@ -9,13 +9,13 @@
 
 #include "penumbra/config/config_value.h"
 #include "penumbra/control/command_script.h"
+#include "penumbra/control/param_limits.h"
+#include "penumbra/control/param_mapping.h"
 #include "penumbra/control/param_node.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
-
-constexpr double kKeyframeInf = std::numeric_limits<double>::infinity();
 
 std::string Trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r");
@@ -116,8 +116,17 @@ std::vector<PlaybackFrame> ReadJointCsv(const std::string& path,
     }
     PlaybackFrame f;
     f.time_sec = v[0];
-    if (f.time_sec < 0)
-      throw ConfigError(path, line_no, "", "time_sec is negative; expected a time >= 0 (s)");
+    if (f.time_sec < 0 || f.time_sec > kMaxParamTimeSec)
+      throw ConfigError(path, line_no, "",
+                        "time_sec " + cells[0] + " is out of range; expected a time in [0, " +
+                            param::FormatNumber(kMaxParamTimeSec) + "] (s)");
+    for (size_t c = 1; c < v.size(); ++c)
+      if (std::abs(v[c]) > kMaxParamJointValue)
+        throw ConfigError(path, line_no, "",
+                          "column '" + header[c] + "': got " + cells[c] +
+                              "; expected a joint value in [-" +
+                              param::FormatNumber(kMaxParamJointValue) + ", " +
+                              param::FormatNumber(kMaxParamJointValue) + "] (rad or m)");
     if (!frames.empty() && f.time_sec <= frames.back().time_sec)
       throw ConfigError(path, line_no, "",
                         "time_sec does not increase; expected strictly increasing times");
@@ -171,12 +180,13 @@ KeyframePlaybackParams KeyframePlaybackParams::Parse(ControllerParams& p,
         f.key = prefix + item.String("key");
         item.Raw("q");
       } else {
-        f.q = item.Numbers("q", n, -kKeyframeInf, kKeyframeInf, "rad or m, one per joint");
+        f.q = item.Numbers("q", n, -kMaxParamJointValue, kMaxParamJointValue,
+                           "rad or m, one per joint");
         item.Raw("key");
       }
       if (item.Has("gripper")) {
         if (!gripper) item.Fail("gripper", "given without gripper_actuator/gripper_joint");
-        f.gripper = item.Number("gripper", std::nullopt, -kKeyframeInf, kKeyframeInf);
+        f.gripper = item.Number("gripper", std::nullopt, -kMaxParamJointValue, kMaxParamJointValue);
       } else if (gripper && f.key.empty()) {
         item.Fail("gripper",
                   "missing; expected the gripper_joint value (m or rad) for a q frame "
@@ -196,7 +206,7 @@ KeyframePlaybackParams KeyframePlaybackParams::Parse(ControllerParams& p,
     }
   }
   k.loop = p.Bool("loop", false);
-  k.rate_hz = p.Number("rate_hz", 0, 0, kKeyframeInf);
+  k.rate_hz = p.Number("rate_hz", 0, 0, kMaxParamRateHz);
   p.CheckNoUnknownKeys();
   return k;
 }

@@ -6,13 +6,13 @@
 #include <sstream>
 
 #include "penumbra/config/config_value.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
 namespace {
 
-constexpr double kPidInf = std::numeric_limits<double>::infinity();
 constexpr double kPidDegToRad = M_PI / 180.0;
 // velocity integrator: input clipped to this error (m/s), and frozen while the thrust axis is
 // more than this far from its setpoint (rad), so an upset or a large step does not wind it up
@@ -51,11 +51,11 @@ double NodeNumber(const ControllerParams& p, const ConfigValue& n, const std::st
 }
 
 Eigen::Vector3d NodeVec3(const ControllerParams& p, const ConfigValue& n, const std::string& key,
-                         const char* what) {
+                         const char* what, double bound) {
   if (!n.IsSequence() || n.size() != 3) p.Fail(key, "got " + Repr(n) + "; expected " + what);
   Eigen::Vector3d v;
   for (int k = 0; k < 3; ++k)
-    v[k] = NodeNumber(p, n[k], key + "[" + std::to_string(k) + "]", -kPidInf, kPidInf);
+    v[k] = NodeNumber(p, n[k], key + "[" + std::to_string(k) + "]", -bound, bound);
   return v;
 }
 
@@ -99,7 +99,7 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const ConfigValue
   TimedMultirotorCommand tc;
   MultirotorCommand& c = tc.command;
   if (!n["t"]) p.Fail(key + ".t", "missing; expected the start time in s (sim time, >= 0)");
-  tc.t_sec = NodeNumber(p, n["t"], key + ".t", 0, kPidInf);
+  tc.t_sec = NodeNumber(p, n["t"], key + ".t", 0, kMaxParamTimeSec);
   if (!n["mode"])
     p.Fail(key + ".mode",
            "missing; expected one of idle, takeoff, hover, waypoints, velocity, land");
@@ -125,8 +125,11 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const ConfigValue
   }
 
   const std::string speed_key = key + ".speed_m_s";
-  if (n["speed_m_s"]) c.speed_m_s = NodeNumber(p, n["speed_m_s"], speed_key, 0, kPidInf, true);
-  if (n["yaw_deg"]) c.yaw_deg = NodeNumber(p, n["yaw_deg"], key + ".yaw_deg", -kPidInf, kPidInf);
+  if (n["speed_m_s"])
+    c.speed_m_s = NodeNumber(p, n["speed_m_s"], speed_key, 0, kMaxParamSpeedMS, true);
+  if (n["yaw_deg"])
+    c.yaw_deg =
+        NodeNumber(p, n["yaw_deg"], key + ".yaw_deg", -kMaxParamAngleDeg, kMaxParamAngleDeg);
   switch (c.mode) {
     case M::kIdle:
     case M::kLand:
@@ -134,11 +137,13 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const ConfigValue
     case M::kTakeoff:
       if (!n["altitude_m"])
         p.Fail(key + ".altitude_m", "missing; expected the target altitude (world z, m)");
-      c.altitude_m = NodeNumber(p, n["altitude_m"], key + ".altitude_m", -kPidInf, kPidInf);
+      c.altitude_m = NodeNumber(p, n["altitude_m"], key + ".altitude_m", -kMaxParamPositionM,
+                                kMaxParamPositionM);
       break;
     case M::kHover:
       if (n["position"])
-        c.position = NodeVec3(p, n["position"], key + ".position", "[x, y, z] (world, m)");
+        c.position = NodeVec3(p, n["position"], key + ".position", "[x, y, z] (world, m)",
+                              kMaxParamPositionM);
       break;
     case M::kWaypoints: {
       const ConfigValue w = n["waypoints"];
@@ -148,17 +153,17 @@ TimedMultirotorCommand ParseCommand(const ControllerParams& p, const ConfigValue
         p.Fail(key + ".waypoints", "got " + Repr(w) + "; expected " + expected);
       for (size_t i = 0; i < w.size(); ++i)
         c.waypoints.push_back(NodeVec3(p, w[i], key + ".waypoints[" + std::to_string(i) + "]",
-                                       "[x, y, z] (world, m)"));
+                                       "[x, y, z] (world, m)", kMaxParamPositionM));
       if (n["face_path"]) c.face_path = NodeBool(p, n["face_path"], key + ".face_path");
       break;
     }
     case M::kVelocity:
       if (n["velocity_m_s"])
-        c.velocity_m_s =
-            NodeVec3(p, n["velocity_m_s"], key + ".velocity_m_s", "[vx, vy, vz] (m/s)");
+        c.velocity_m_s = NodeVec3(p, n["velocity_m_s"], key + ".velocity_m_s", "[vx, vy, vz] (m/s)",
+                                  kMaxParamSpeedMS);
       if (n["yaw_rate_deg_s"])
-        c.yaw_rate_deg_s =
-            NodeNumber(p, n["yaw_rate_deg_s"], key + ".yaw_rate_deg_s", -kPidInf, kPidInf);
+        c.yaw_rate_deg_s = NodeNumber(p, n["yaw_rate_deg_s"], key + ".yaw_rate_deg_s",
+                                      -kMaxParamAngularSpeedDegS, kMaxParamAngularSpeedDegS);
       if (n["frame"]) {
         const std::string f = NodeName(p, n["frame"], key + ".frame");
         if (f == "world") {
@@ -243,25 +248,26 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
                                   " rotors; expected at most " +
                                   std::to_string(MultirotorMixer::kMaxRotors));
 
-  auto pos = [&](const char* key, double fallback) {
-    return p.Number(key, fallback, 0, kPidInf, true);
+  auto pos = [&](const char* key, double fallback, double max = kMaxParamGain) {
+    return p.Number(key, fallback, 0, max, true);
   };
-  auto nonneg = [&](const char* key, double fallback) {
-    return p.Number(key, fallback, 0, kPidInf);
+  auto nonneg = [&](const char* key, double fallback, double max = kMaxParamGain) {
+    return p.Number(key, fallback, 0, max);
   };
-  m.rate_hz = pos("rate_hz", m.rate_hz);
-  m.gravity_m_s2 = pos("gravity_m_s2", m.gravity_m_s2);
-  m.max_speed_xy_m_s = pos("max_speed_xy_m_s", m.max_speed_xy_m_s);
-  m.max_climb_m_s = pos("max_climb_m_s", m.max_climb_m_s);
-  m.max_descent_m_s = pos("max_descent_m_s", m.max_descent_m_s);
-  m.max_accel_m_s2 = pos("max_accel_m_s2", m.max_accel_m_s2);
-  m.max_jerk_m_s3 = pos("max_jerk_m_s3", m.max_jerk_m_s3);
+  m.rate_hz = pos("rate_hz", m.rate_hz, kMaxParamRateHz);
+  m.gravity_m_s2 = pos("gravity_m_s2", m.gravity_m_s2, kMaxParamAccelerationMS2);
+  m.max_speed_xy_m_s = pos("max_speed_xy_m_s", m.max_speed_xy_m_s, kMaxParamSpeedMS);
+  m.max_climb_m_s = pos("max_climb_m_s", m.max_climb_m_s, kMaxParamSpeedMS);
+  m.max_descent_m_s = pos("max_descent_m_s", m.max_descent_m_s, kMaxParamSpeedMS);
+  m.max_accel_m_s2 = pos("max_accel_m_s2", m.max_accel_m_s2, kMaxParamAccelerationMS2);
+  m.max_jerk_m_s3 = pos("max_jerk_m_s3", m.max_jerk_m_s3, kMaxParamJerkMS3);
   m.max_tilt_deg = p.Number("max_tilt_deg", m.max_tilt_deg, 0, 80, true);
-  m.max_roll_pitch_rate_deg_s = pos("max_roll_pitch_rate_deg_s", m.max_roll_pitch_rate_deg_s);
-  m.max_yaw_rate_deg_s = pos("max_yaw_rate_deg_s", m.max_yaw_rate_deg_s);
-  m.yaw_speed_deg_s = pos("yaw_speed_deg_s", m.yaw_speed_deg_s);
-  m.leash_m = pos("leash_m", m.leash_m);
-  m.land_speed_m_s = pos("land_speed_m_s", m.land_speed_m_s);
+  m.max_roll_pitch_rate_deg_s =
+      pos("max_roll_pitch_rate_deg_s", m.max_roll_pitch_rate_deg_s, kMaxParamAngularSpeedDegS);
+  m.max_yaw_rate_deg_s = pos("max_yaw_rate_deg_s", m.max_yaw_rate_deg_s, kMaxParamAngularSpeedDegS);
+  m.yaw_speed_deg_s = pos("yaw_speed_deg_s", m.yaw_speed_deg_s, kMaxParamAngularSpeedDegS);
+  m.leash_m = pos("leash_m", m.leash_m, kMaxParamPositionM);
+  m.land_speed_m_s = pos("land_speed_m_s", m.land_speed_m_s, kMaxParamSpeedMS);
   m.position_p_xy = pos("position_p_xy", m.position_p_xy);
   m.position_p_z = pos("position_p_z", m.position_p_z);
   m.velocity_p_xy = pos("velocity_p_xy", m.velocity_p_xy);
@@ -270,7 +276,8 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
   m.velocity_p_z = pos("velocity_p_z", m.velocity_p_z);
   m.velocity_i_z = nonneg("velocity_i_z", m.velocity_i_z);
   m.velocity_d_z = nonneg("velocity_d_z", m.velocity_d_z);
-  m.velocity_i_limit_m_s2 = nonneg("velocity_i_limit_m_s2", m.velocity_i_limit_m_s2);
+  m.velocity_i_limit_m_s2 =
+      nonneg("velocity_i_limit_m_s2", m.velocity_i_limit_m_s2, kMaxParamAccelerationMS2);
   m.attitude_p_roll_pitch = pos("attitude_p_roll_pitch", m.attitude_p_roll_pitch);
   m.attitude_p_yaw = pos("attitude_p_yaw", m.attitude_p_yaw);
   m.rate_p_roll_pitch = pos("rate_p_roll_pitch", m.rate_p_roll_pitch);
@@ -279,8 +286,9 @@ MultirotorPidParams MultirotorPidParams::Parse(ControllerParams& p,
   m.rate_p_yaw = pos("rate_p_yaw", m.rate_p_yaw);
   m.rate_i_yaw = nonneg("rate_i_yaw", m.rate_i_yaw);
   m.rate_d_yaw = nonneg("rate_d_yaw", m.rate_d_yaw);
-  m.rate_i_limit_rad_s2 = nonneg("rate_i_limit_rad_s2", m.rate_i_limit_rad_s2);
-  m.derivative_cutoff_hz = pos("derivative_cutoff_hz", m.derivative_cutoff_hz);
+  m.rate_i_limit_rad_s2 =
+      nonneg("rate_i_limit_rad_s2", m.rate_i_limit_rad_s2, kMaxParamAngularAccelerationRadS2);
+  m.derivative_cutoff_hz = pos("derivative_cutoff_hz", m.derivative_cutoff_hz, kMaxParamRateHz);
 
   if (const ConfigValue* cmds = p.Raw("commands")) {
     if (!cmds->IsSequence())

@@ -11,6 +11,7 @@
 #include "penumbra/config/config_value.h"
 #include "penumbra/control/actuator_drive.h"
 #include "penumbra/control/param_check.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/pure_pursuit.h"
 #include "penumbra/control/quadruped_swing_trajectory.h"
 #include "penumbra/core/error.h"
@@ -116,7 +117,7 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
         p.Fail(key + ".offsets_rad", "got " + DescribeParamNode(o) + "; expected 3 angles (rad)");
       for (int k = 0; k < 3; ++k)
         leg.offsets_rad[k] = ParamNumberAt(p, o[k], key + ".offsets_rad[" + std::to_string(k) + "]",
-                                           "a finite angle (rad)");
+                                           -kMaxParamJointValue, kMaxParamJointValue, "rad");
     }
   }
 
@@ -133,33 +134,35 @@ TrotGaitParams TrotGaitParams::Parse(ControllerParams& p, const std::string& pre
   g.duty = p.Number("duty", 0.5, 0.3, 0.8);
   g.swing_height_m = p.Number("swing_height_m", 0.08, 0, 1);
   if (p.Has("body_height_m"))
-    g.body_height_m = p.Number("body_height_m", std::nullopt, 0, kGaitInf, true);
+    g.body_height_m = p.Number("body_height_m", std::nullopt, 0, kMaxParamPositionM, true);
   if (p.Has("raibert_gain")) g.raibert_gain = p.Number("raibert_gain", std::nullopt, 0, 10);
-  if (p.Has("max_step_m")) g.max_step_m = p.Number("max_step_m", std::nullopt, 0, kGaitInf, true);
-  g.max_accel_m_s2 = p.Number("max_accel_m_s2", 1.5, 0, kGaitInf, true);
-  g.max_yaw_accel_rad_s2 = p.Number("max_yaw_accel_rad_s2", 3, 0, kGaitInf, true);
-  g.kp_xy = p.Number("kp_xy", 25, 0, kGaitInf);
-  g.kd_xy = p.Number("kd_xy", 8, 0, kGaitInf);
-  g.kp_z = p.Number("kp_z", 400, 0, kGaitInf);
-  g.kd_z = p.Number("kd_z", 40, 0, kGaitInf);
-  g.kp_tilt = p.Number("kp_tilt", 400, 0, kGaitInf);
-  g.kd_tilt = p.Number("kd_tilt", 40, 0, kGaitInf);
-  g.kp_yaw = p.Number("kp_yaw", 150, 0, kGaitInf);
-  g.kd_yaw = p.Number("kd_yaw", 25, 0, kGaitInf);
-  g.swing_kp = p.Number("swing_kp", 60, 0, kGaitInf);
-  g.swing_kd = p.Number("swing_kd", 1.5, 0, kGaitInf);
-  g.stance_kd = p.Number("stance_kd", 0.5, 0, kGaitInf);
+  if (p.Has("max_step_m"))
+    g.max_step_m = p.Number("max_step_m", std::nullopt, 0, kMaxParamPositionM, true);
+  g.max_accel_m_s2 = p.Number("max_accel_m_s2", 1.5, 0, kMaxParamAccelerationMS2, true);
+  g.max_yaw_accel_rad_s2 =
+      p.Number("max_yaw_accel_rad_s2", 3, 0, kMaxParamAngularAccelerationRadS2, true);
+  g.kp_xy = p.Number("kp_xy", 25, 0, kMaxParamGain);
+  g.kd_xy = p.Number("kd_xy", 8, 0, kMaxParamGain);
+  g.kp_z = p.Number("kp_z", 400, 0, kMaxParamGain);
+  g.kd_z = p.Number("kd_z", 40, 0, kMaxParamGain);
+  g.kp_tilt = p.Number("kp_tilt", 400, 0, kMaxParamGain);
+  g.kd_tilt = p.Number("kd_tilt", 40, 0, kMaxParamGain);
+  g.kp_yaw = p.Number("kp_yaw", 150, 0, kMaxParamGain);
+  g.kd_yaw = p.Number("kd_yaw", 25, 0, kMaxParamGain);
+  g.swing_kp = p.Number("swing_kp", 60, 0, kMaxParamGain);
+  g.swing_kd = p.Number("swing_kd", 1.5, 0, kMaxParamGain);
+  g.stance_kd = p.Number("stance_kd", 0.5, 0, kMaxParamGain);
   g.friction = p.Number("friction", 0.6, 0, 5, true);
   if (const ConfigValue* hold = p.Raw("hold")) {
     if (!hold->IsMap())
       p.Fail("hold", "got " + DescribeParamNode(*hold) + "; expected a mapping {actuator: ctrl}");
     for (const auto& kv : (*hold).pairs()) {
       const std::string k = kv.first.Scalar();
-      g.hold.emplace_back(prefix + k,
-                          ParamNumberAt(p, kv.second, "hold." + k, "a finite ctrl value"));
+      g.hold.emplace_back(prefix + k, ParamNumberAt(p, kv.second, "hold." + k, -kMaxParamEffort,
+                                                    kMaxParamEffort, "ctrl value"));
     }
   }
-  g.rate_hz = p.Number("rate_hz", 250, 0, kGaitInf, true);
+  g.rate_hz = p.Number("rate_hz", 250, 0, kMaxParamRateHz, true);
   p.CheckNoUnknownKeys();
   return g;
 }

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "penumbra/config/config_value.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/pure_pursuit.h"
 #include "penumbra/core/error.h"
 
@@ -11,7 +12,6 @@ namespace penumbra {
 namespace {}  // namespace
 
 TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   TwistScriptParams s;
   // commands: a list of {t, vx, vy, yaw_rate}, t strictly increasing
   if (const ConfigValue* cmds = p.Raw("commands")) {
@@ -30,14 +30,19 @@ TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
       }
       if (!c["t"]) p.Fail(key + ".t", "missing; expected a time >= 0 (s)");
       TimedTrotCommand tc;
-      tc.t_sec = ParamNumberAt(p, c["t"], key + ".t", "a time >= 0 (s)");
-      if (tc.t_sec < 0) p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time >= 0 (s)");
+      tc.t_sec = ParamNumberAt(p, c["t"], key + ".t", 0, kMaxParamTimeSec, "s");
       if (!s.commands.empty() && tc.t_sec <= s.commands.back().t_sec)
         p.Fail(key + ".t", "got " + c["t"].Scalar() + "; expected a time > the previous entry's");
-      if (c["vx"]) tc.command.vx = ParamNumberAt(p, c["vx"], key + ".vx", "a speed (m/s)");
-      if (c["vy"]) tc.command.vy = ParamNumberAt(p, c["vy"], key + ".vy", "a speed (m/s)");
+      if (c["vx"])
+        tc.command.vx =
+            ParamNumberAt(p, c["vx"], key + ".vx", -kMaxParamSpeedMS, kMaxParamSpeedMS, "m/s");
+      if (c["vy"])
+        tc.command.vy =
+            ParamNumberAt(p, c["vy"], key + ".vy", -kMaxParamSpeedMS, kMaxParamSpeedMS, "m/s");
       if (c["yaw_rate"])
-        tc.command.yaw_rate = ParamNumberAt(p, c["yaw_rate"], key + ".yaw_rate", "a rate (rad/s)");
+        tc.command.yaw_rate =
+            ParamNumberAt(p, c["yaw_rate"], key + ".yaw_rate", -kMaxParamAngularSpeedRadS,
+                          kMaxParamAngularSpeedRadS, "rad/s");
       s.commands.push_back(tc);
     }
   }
@@ -45,9 +50,9 @@ TwistScriptParams TwistScriptParams::Parse(ControllerParams& p) {
   if (p.Has("waypoints")) {
     s.waypoints = p.Points2("waypoints", 1);
     s.loop = p.Bool("loop", true);
-    s.speed_m_s = p.Number("speed_m_s", 0.5, 0, kInf, true);
-    s.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 60, 0, kInf, true);
-    s.tolerance_m = p.Number("tolerance_m", 0.15, 0, kInf, true);
+    s.speed_m_s = p.Number("speed_m_s", 0.5, 0, kMaxParamSpeedMS, true);
+    s.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 60, 0, kMaxParamAngularSpeedDegS, true);
+    s.tolerance_m = p.Number("tolerance_m", 0.15, 0, kMaxParamPositionM, true);
   } else {
     for (const char* k : {"loop", "speed_m_s", "max_yaw_rate_deg_s", "tolerance_m"})
       if (p.Has(k))

@@ -1,33 +1,28 @@
-#include "penumbra/control/param_check.h"
 #include "penumbra/control/waypoint_follower.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "penumbra/control/param_check.h"
+#include "penumbra/control/param_limits.h"
 #include "penumbra/control/pure_pursuit.h"
 #include "penumbra/core/error.h"
 
 namespace penumbra {
-namespace {
-
-constexpr double kWaypointInf = std::numeric_limits<double>::infinity();
-
-}  // namespace
-
 WaypointFollowerParams WaypointFollowerParams::Parse(ControllerParams& p,
                                                      const std::string& name_prefix) {
   WaypointFollowerParams w;
   w.base_body = name_prefix + p.String("base_body");
   w.left_actuator = name_prefix + p.String("left_actuator");
   w.right_actuator = name_prefix + p.String("right_actuator");
-  w.wheel_radius_m = p.Number("wheel_radius_m", std::nullopt, 0, kWaypointInf, true);
-  w.track_width_m = p.Number("track_width_m", std::nullopt, 0, kWaypointInf, true);
-  w.speed_m_s = p.Number("speed_m_s", 0.5, 0, kWaypointInf, true);
-  w.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 90, 0, kWaypointInf, true);
+  w.wheel_radius_m = p.Number("wheel_radius_m", std::nullopt, 0, kMaxParamPositionM, true);
+  w.track_width_m = p.Number("track_width_m", std::nullopt, 0, kMaxParamPositionM, true);
+  w.speed_m_s = p.Number("speed_m_s", 0.5, 0, kMaxParamSpeedMS, true);
+  w.max_yaw_rate_deg_s = p.Number("max_yaw_rate_deg_s", 90, 0, kMaxParamAngularSpeedDegS, true);
   w.waypoints = p.Points2("waypoints", 1);
   w.loop = p.Bool("loop", true);
-  w.tolerance_m = p.Number("tolerance_m", 0.15, 0, kWaypointInf, true);
-  w.rate_hz = p.Number("rate_hz", 50, 0, kWaypointInf, true);
+  w.tolerance_m = p.Number("tolerance_m", 0.15, 0, kMaxParamPositionM, true);
+  w.rate_hz = p.Number("rate_hz", 50, 0, kMaxParamRateHz, true);
   p.CheckNoUnknownKeys();
   if (w.left_actuator == w.right_actuator)
     p.Fail("right_actuator", "same actuator as left_actuator ('" + w.left_actuator +
@@ -41,7 +36,8 @@ void WaypointFollowerParams::ValidateOrThrow(const ControllerContext& c) const {
   if (left_actuator.empty()) check.Fail("left_actuator", "missing; expected an actuator name");
   if (right_actuator.empty()) check.Fail("right_actuator", "missing; expected an actuator name");
   if (left_actuator == right_actuator)
-    check.Fail("right_actuator", "same actuator as left_actuator; expected two different actuators");
+    check.Fail("right_actuator",
+               "same actuator as left_actuator; expected two different actuators");
   check.Positive("wheel_radius_m", wheel_radius_m);
   check.Positive("track_width_m", track_width_m);
   check.Positive("speed_m_s", speed_m_s);
@@ -50,7 +46,8 @@ void WaypointFollowerParams::ValidateOrThrow(const ControllerContext& c) const {
   check.Positive("rate_hz", rate_hz);
   if (waypoints.empty()) check.Fail("waypoints", "empty; expected at least 1 [x, y] point");
   for (const auto& w : waypoints)
-    if (!w.allFinite()) check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
+    if (!w.allFinite())
+      check.Fail("waypoints", "non-finite coordinate; expected finite numbers (m)");
 }
 
 WaypointFollower::WaypointFollower(WaypointFollowerParams params, ControllerContext context)
