@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/temp_dir.h"
@@ -102,11 +103,54 @@ TEST(BenchmarkInjection, ShellTextInPathsReachesTheMethodAsOneLiteralArgument) {
   EXPECT_EQ(InjectedFiles(dir.path(), "INJ"), std::vector<std::string>{});
 }
 
+// the templates that pasted values into code a shell then parsed: refused before anything runs,
+// so an --out holding $(touch ...) creates nothing; the same values given to a shell as its
+// positional arguments stay text
+TEST(BenchmarkInjection, TemplatesPastingValuesIntoShellCodeAreRefusedAndRunNothing) {
+  TempDir dir;
+  const fs::path out = dir.path() / "o $(touch INJ1) `touch INJ2`";
+  const std::vector<std::pair<std::string, int>> methods = {
+      {"  - {name: viash, command: \"sh -c -- 'true {output}'\"}\n", 10},
+      {"  - name: timeit\n    command: 'python3 -m timeit -s ''import os; "
+       "os.system(\"true {dataset} > {output}\")'' pass'\n",
+       11}};
+  for (const auto& [method, line] : methods) {
+    const std::string spec = dir.Write("spec.yaml", InjectionSpec(method));
+    std::string err;
+    EXPECT_EQ(
+        InjectionRun({"benchmark", spec, "--out", out.string(), "--quiet"}, dir.path(), 600, &err),
+        2)
+        << err;
+    EXPECT_NE(err.find(spec + ":" + std::to_string(line) + ": methods[0].command: column "),
+              std::string::npos)
+        << err;
+    EXPECT_NE(err.find("program text"), std::string::npos) << err;
+    EXPECT_EQ(InjectedFiles(dir.path(), "INJ"), std::vector<std::string>{});
+    EXPECT_EQ(InjectedFiles(fs::current_path(), "INJ"), std::vector<std::string>{});
+  }
+  // the shell a method asked for, the values as "$1" and "$2"
+  const std::string spec = dir.Write(
+      "spec.yaml", InjectionSpec("  - {name: argv, command: \"sh -c -- 'printf \\\"%s\\\\n\\\" "
+                                 "\\\"$1\\\" \\\"$2\\\"' sh {dataset} {output}\"}\n"));
+  std::string err;
+  ASSERT_EQ(
+      InjectionRun({"benchmark", spec, "--out", out.string(), "--quiet"}, dir.path(), 600, &err), 0)
+      << err;
+  const fs::path job = out / "jobs" / "room__none__t1";
+  EXPECT_EQ(
+      ReadAll(job / "argv" / "stdout.log"),
+      (job / "dataset_tum").string() + "\n" + (job / "argv" / "trajectory.txt").string() + "\n")
+      << ReadAll(job / "argv" / "stderr.log");
+  EXPECT_EQ(InjectedFiles(dir.path(), "INJ"), std::vector<std::string>{});
+}
+
 TEST(BenchmarkInjection, SlurmRefusesControlCharactersInOutBeforeWritingAnything) {
   TempDir dir;
   const std::string spec =
       dir.Write("spec.yaml", InjectionSpec("  - {name: rgbd, bundled: opencv_rgbd}\n"));
-  for (const std::string name : {"a\nexec touch PWNED\n#", "a\rb", "a\x01" "b"}) {
+  for (const std::string name : {"a\nexec touch PWNED\n#", "a\rb",
+                                 "a\x01"
+                                 "b"}) {
     const fs::path out = dir.path() / name;
     std::string err;
     EXPECT_EQ(InjectionRun({"benchmark", spec, "--out", out.string(), "--slurm", "--quiet"},
@@ -144,6 +188,25 @@ TEST(BenchmarkInjection, SlurmScriptQuotesEveryValueAndRunsTheWorkerLiterally) {
   ASSERT_TRUE(got) << script;
   EXPECT_EQ(*got, "benchmark " + spec.file + " --out " + out + " --job 2 --quiet\n");
   EXPECT_EQ(InjectedFiles(dir.path(), "SINJ"), std::vector<std::string>{});
+  // an --out with command substitutions (no blank: #SBATCH --output could not carry one)
+  // reaches the worker as one literal argument: placeholders are filled there, without a shell
+  const std::string odd_out = (dir.path() / "o$(touch${IFS}SINJ4)`touch${IFS}SINJ5`;x").string();
+  const std::string odd = dir.Write(
+      "odd.sbatch", "cd " + dir.str() + "\n" + SlurmBatchScript(spec, odd_out, "/bin/echo", {1}));
+  setenv("SLURM_ARRAY_TASK_ID", "1", 1);
+  const std::optional<std::string> odd_got = CaptureCommand({"/bin/bash", odd});
+  unsetenv("SLURM_ARRAY_TASK_ID");
+  ASSERT_TRUE(odd_got);
+  EXPECT_EQ(*odd_got, "benchmark " + spec.file + " --out " + odd_out + " --job 1 --quiet\n");
+  EXPECT_EQ(InjectedFiles(dir.path(), "SINJ"), std::vector<std::string>{});
+  // a spec without `name:` is named after its file: sbatch would read blanks on the #SBATCH
+  // line as the start of more options, so only name characters reach it
+  BenchmarkSpec stem = spec;
+  stem.name = "a b --chdir=/ x$(y)";
+  const std::string stem_script = SlurmBatchScript(stem, out, "/bin/echo", {0});
+  EXPECT_NE(stem_script.find("\n#SBATCH --job-name=penumbra-a_b_--chdir___x__y_\n"),
+            std::string::npos)
+      << stem_script;
 
   // control characters anywhere, and what an #SBATCH --output line cannot carry, are refused
   for (const std::string bad : {"\n", "\r", "\x01", "\x7f", " ", "#", "%", "\"", "'", "\\"}) {

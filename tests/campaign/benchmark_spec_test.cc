@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "common/temp_dir.h"
 #include "penumbra/campaign/benchmark_report.h"
 #include "penumbra/campaign/command_template.h"
@@ -130,6 +132,62 @@ TEST(BenchmarkSpec, CommandsAreSplitAtLoadAndShellSyntaxIsRefusedWithFileLineAnd
   e = ErrorOf(Spec("slurm: {sbatch: [\"#SBATCH --time=1\\r\"]}\n"));
   EXPECT_NE(e.find("slurm.sbatch[0]"), std::string::npos) << e;
   EXPECT_NE(e.find("without control characters"), std::string::npos) << e;
+}
+
+// a template that would paste a value into a shell's or an interpreter's code is refused at
+// load, with the spec file, the line, the field, the method and why (slam and nav alike)
+TEST(BenchmarkSpec, TemplatesPastingValuesIntoCodeAreRefusedAtLoadNamingTheMethod) {
+  std::string e = ErrorOf(Spec("", "  - {name: viash, command: \"sh -c -- 'true {output}'\"}\n"));
+  EXPECT_NE(e.find("spec.yaml:10: methods[0].command: column 10: word 4 'true {output}': a "
+                   "placeholder inside the inline program of 'sh -c'"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("(method 'viash')"), std::string::npos) << e;
+  // YAML single quotes: '' is one quote
+  e = ErrorOf(Spec("",
+                   "  - {name: rgbd, bundled: opencv_rgbd}\n"
+                   "  - name: timeit\n"
+                   "    command: 'python3 -m timeit -s ''import os; "
+                   "os.system(\"cat {dataset} > {output}\")'''\n"));
+  EXPECT_NE(e.find("spec.yaml:12: methods[1].command: column 22: word 5"), std::string::npos) << e;
+  EXPECT_NE(e.find("'python3 -m timeit' runs its arguments as code"), std::string::npos) << e;
+  EXPECT_NE(e.find("(method 'timeit')"), std::string::npos) << e;
+  TempDir dir;
+  const std::string nav =
+      std::string("kind: nav\nname: n\nworlds:\n  - name: pen\n    file: ") + PENUMBRA_SOURCE_DIR +
+      "/tests/campaign/data/nav_wall.yaml\n    robot: quadruped\n    episodes:\n"
+      "      - {name: a, goal: [1, 0], radius: 0.3, timeout_sec: 8}\n"
+      "conditions: [none]\ntrials: 1\nmethods:\n"
+      "  - {name: drive, command: \"/usr/bin/env X=1 bash -c 'nav {endpoint}'\"}\n";
+  try {
+    LoadBenchmarkSpec(dir.Write("nav.yaml", nav));
+    ADD_FAILURE() << "accepted a nav template with a placeholder in bash -c";
+  } catch (const ConfigError& err) {
+    const std::string what = err.what();
+    EXPECT_NE(what.find("nav.yaml:12: methods[0].command:"), std::string::npos) << what;
+    EXPECT_NE(what.find("inside the inline program of 'bash -c'"), std::string::npos) << what;
+    EXPECT_NE(what.find("(method 'drive')"), std::string::npos) << what;
+  }
+}
+
+// every spec under benchmarks/ still loads, and its methods' templates split
+TEST(BenchmarkSpec, BundledSpecsLoad) {
+  int loaded = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(PENUMBRA_SOURCE_DIR) + "/benchmarks")) {
+    if (entry.path().extension() != ".yaml") continue;
+    // presets files (nav_presets.yaml) are not specs: a spec has methods
+    if (testing::ReadAll(entry.path()).find("\nmethods:") == std::string::npos) continue;
+    try {
+      const BenchmarkSpec s = LoadBenchmarkSpec(entry.path().string());
+      ASSERT_FALSE(s.methods.empty()) << entry.path();
+      for (const BenchmarkMethod& m : s.methods) EXPECT_FALSE(m.command_words.empty()) << m.name;
+      ++loaded;
+    } catch (const Error& err) {
+      ADD_FAILURE() << entry.path() << ": " << err.what();
+    }
+  }
+  EXPECT_GE(loaded, 3);  // slam.yaml, nav.yaml, calibration.yaml
 }
 
 TEST(BenchmarkReport, SummaryIsMeanAndSampleStdOverOkTrials) {

@@ -138,6 +138,117 @@ TEST(CommandTemplate, RefusesWhatOnlyAShellWouldDo) {
   EXPECT_EQ(TemplateRefusal("'FOO=1' x=2 {penumbra}"), "");
 }
 
+// a shell or an interpreter reads its options and its program as code: no placeholder there,
+// whatever stands before it and however its options are written; values reach it only as the
+// program's arguments
+TEST(CommandTemplate, NoPlaceholderReachesTheCodeOfAShellOrAnInterpreter) {
+  struct Case {
+    const char* text;
+    const char* reason;
+  };
+  for (const Case& c : std::vector<Case>{
+           // the two templates: `--` ended the old option scan, -m stopped it
+           {"sh -c -- 'true {output}'",
+            "word 4 'true {output}': a placeholder inside the inline "
+            "program of 'sh -c'"},
+           {"python3 -m timeit -s 'os.system(\"cat {dataset} > {output}\")'",
+            "'python3 -m timeit' runs its arguments as code"},
+           {"python3 -m timeit -s {output}", "'python3 -m timeit' runs its arguments as code"},
+           {"/usr/bin/python3 -mtimeit {dataset}", "runs its arguments as code"},
+           {"python3 -m pdb script.py {output}", "runs its arguments as code"},
+           // the script itself a value, with and without -c
+           {"sh -c {output}", "inside the inline program of 'sh -c'"},
+           {"bash -e -- {output}", "as the program 'bash' runs"},
+           {"sh {output}", "as the program 'sh' runs"},
+           {"sh +s {output}", "as the program 'sh' runs"},
+           {"perl {dataset}", "as the program 'perl' runs"},
+           {"awk {output}", "as the program 'awk' runs"},
+           // behind wrappers, wherever the shell stands
+           {"env -i sh -c -- 'x {seed}'", "inside the inline program of 'sh -c'"},
+           {"/usr/bin/env A=1 dash -c 'x {seed}'", "inside the inline program of 'dash -c'"},
+           {"nice -n 5 timeout 60 stdbuf -oL zsh -c 'x {seed}'", "inside the inline program"},
+           {"xargs sh -c {output}", "inside the inline program of 'sh -c'"},
+           {"find . -exec bash -c 'x {output}' bash \\;", "inside the inline program of 'bash -c'"},
+           {"sh -c 'exec \"$@\"' sh sh -c {output}", "inside the inline program of 'sh -c'"},
+           // option clusters and attached code
+           {"bash -o pipefail -ec 'a {output}'", "inside the inline program of 'bash -c'"},
+           {"python3 -uc 'open(\"{output}\")'", "inside the inline program of 'python3 -uc'"},
+           {"python3 -c{output}", "inside the inline program of 'python3 -c'"},
+           {"python3 -W {output} script.py", "in an option of 'python3'"},
+           {"perl -lne {output}", "inside the inline program of 'perl -lne'"},
+           {"ruby -e {output}", "inside the inline program of 'ruby -e'"},
+           {"node --eval={output}", "inside the inline program of 'node --eval'"},
+           {"node -p {output}", "inside the inline program of 'node -p'"},
+           {"php -r {output}", "inside the inline program of 'php -r'"},
+           {"sed -e {output} f", "inside the inline program of 'sed -e'"},
+           {"env -S{output} x", "inside the inline program of 'env -S'"},
+           // programs that hand their arguments to a shell as text
+           {"ssh host slam {output}", "'ssh' hands its arguments to a shell"},
+           {"watch -n 1 slam {output}", "'watch' hands its arguments to a shell"},
+           {"make -C src OUT={output}", "'make' hands its arguments to a shell"},
+       }) {
+    const std::string e = TemplateRefusal(c.text);
+    EXPECT_NE(e, "") << "accepted: " << c.text;
+    EXPECT_NE(e.find(c.reason), std::string::npos) << c.text << ": " << e;
+    EXPECT_NE(e.find("column "), std::string::npos) << c.text << ": " << e;
+  }
+  EXPECT_NE(TemplateRefusal("sh -c -- 'true {output}'").find("column 10: word 4"),
+            std::string::npos)
+      << TemplateRefusal("sh -c -- 'true {output}'");
+  // values after the program are its arguments: "$1", sys.argv, @ARGV, process.argv
+  for (const char* t :
+       {"sh -c 'slam \"$1\" > \"$2\"' sh {dataset} {output}", "sh -c -- 'slam \"$1\"' sh {dataset}",
+        "/usr/bin/env A=1 nice -n 5 bash -ec 'x \"$1\"' bash {seed}", "sh -o pipefail -s {output}",
+        "sh script.sh {output}",
+        "python3 -c 'import sys; print(sys.argv[1])' {dataset} --out={output}",
+        "python3 -W ignore -u script.py {dataset}", "/usr/bin/python3 -m penumbra_nav --c {seed}",
+        "perl -0777 -ne 'print' {dataset}/x.txt", "perl -e 'print $ARGV[0]' {seed}",
+        "ruby -e 'p ARGV' {seed}", "node --eval 'x' {output}", "awk -f prog.awk {dataset}/a.txt",
+        "awk '{{print $1}}' {dataset}/a.txt", "sed s/a/b/ {dataset}/x",
+        "env -u HOME PYTHONPATH={workdir} prog {output}"})
+    EXPECT_EQ(TemplateRefusal(t), "") << t;
+}
+
+// a placeholder is a whole argument or has a fixed plain prefix or suffix: never part of a
+// longer text a program parses, and two values never run together
+TEST(CommandTemplate, APlaceholderIsAWholeWordOrHasAPlainPrefixOrSuffix) {
+  for (const char* t :
+       {"run '{dataset}/my file'", "run --json '{{\"seed\": {seed}}}'", "run 'x;{seed}'",
+        "run \"a {output}\"", "tool -e 'print({seed})'", "run '$({output})'"}) {
+    const std::string e = TemplateRefusal(t);
+    EXPECT_NE(e.find("holds a placeholder beside"), std::string::npos) << t << ": " << e;
+  }
+  EXPECT_NE(TemplateRefusal("run {dataset}{output}").find("two placeholders with nothing between"),
+            std::string::npos);
+  EXPECT_NE(TemplateRefusal("run {dataset").find("unmatched '{'"), std::string::npos);
+  EXPECT_NE(TemplateRefusal("run x}").find("unmatched '}'"), std::string::npos);
+  for (const char* t :
+       {"run {output}", "run --out={output}", "run {dataset}/rgb.txt", "run {fx},{fy},{cx},{cy}",
+        "run x{seed}y", "run -o:{output}@2%", "run '{{literal}}' 'a b' {output}"})
+    EXPECT_EQ(TemplateRefusal(t), "") << t;
+}
+
+// the templates of the docs (benchmarks.md) and the bundled methods still split, as before
+TEST(CommandTemplate, DocumentedAndBundledTemplatesAreAccepted) {
+  for (const char* t :
+       {"my_slam --images {dataset} --out {output} --fx {fx} --fy {fy} --cx {cx} --cy {cy}",
+        "/opt/slam/run --images {dataset}/rgb 'two words' --fx={fx} \"{output}\"",
+        "sh -c 'my_slam --images \"$1\" | tee slam.log > \"$2\"' sh {dataset} {output}",
+        "/usr/bin/env OMP_NUM_THREADS=1 /opt/slam/run {dataset} {output}",
+        "/opt/ORB_SLAM2/Examples/RGB-D/rgbd_tum /opt/ORB_SLAM2/Vocabulary/ORBvoc.txt "
+        "/opt/settings/penumbra_rgbd.yaml {dataset} {dataset}/associations.txt",
+        "/opt/ORB_SLAM3/Examples/Monocular/mono_tum /opt/ORB_SLAM3/Vocabulary/ORBvoc.txt "
+        "/opt/settings/penumbra_mono3.yaml {dataset}",
+        "my_nav --connect {endpoint} --goal {goal_x} {goal_y} --log {out_dir}/log.txt",
+        "{penumbra} slam opencv_rgbd {dataset} {output} --intrinsics {fx},{fy},{cx},{cy}",
+        "/usr/bin/env PYTHONPATH={pythonpath} /usr/bin/python3 -m penumbra_nav --endpoint "
+        "{endpoint} --goal {goal_x} {goal_y} --radius {radius} --timeout {timeout_sec} --robot "
+        "{robot} --robot-name {robot_name} --out {out_dir}/episode.json"})
+    EXPECT_EQ(TemplateRefusal(t), "") << t;
+  EXPECT_EQ(SplitCommandTemplate("sh -c -- 'slam \"$1\"' sh {dataset}"),
+            (Words{"sh", "-c", "--", "slam \"$1\"", "sh", "{dataset}"}));
+}
+
 TEST(CommandTemplate, ValuesBecomeOneLiteralArgumentEach) {
   const Words words =
       SplitCommandTemplate("prog {dataset} \"{dataset}\" '{output}' x{seed}y {{z}}");

@@ -271,11 +271,18 @@ std::string SlurmBatchScript(const BenchmarkSpec& spec, const std::string& out_d
       throw ConfigError(spec.file, 0, "slurm.sbatch",
                         "'" + SanitizeForMessage(l, 200) +
                             "'; expected one '#SBATCH ...' line without control characters");
+  // the name is the spec file's stem when it has no `name:`: only name characters reach the
+  // #SBATCH line (sbatch splits it at blanks into options)
+  std::string job_name = spec.name;
+  for (char& c : job_name)
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+          c == '-'))
+      c = '_';
   std::string s = fmt::format(
       "#!/bin/bash\n#SBATCH --job-name=penumbra-{}\n#SBATCH --array={}\n#SBATCH "
       "--output={}/slurm/%A_%a.out\n"
       "#SBATCH --cpus-per-task={}\n",
-      spec.name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
+      job_name, array, out, spec.render_threads > 0 ? spec.render_threads : 1);
   for (const std::string& l : spec.sbatch_lines) s += fmt::format("{}\n", l);
   s += "# one benchmark job (world x condition x trial) per array task; docs/benchmarks.md\n";
   s += fmt::format("exec {} benchmark {} --out {} --job \"$SLURM_ARRAY_TASK_ID\" --quiet{}\n",

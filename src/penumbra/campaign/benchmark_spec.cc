@@ -81,12 +81,14 @@ void CheckTemplate(const YamlReader& r, const std::string& text,
   }
 }
 
-// the template split into words (campaign/command_template.h); a refusal names the field
-std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text) {
+// the template split into words (campaign/command_template.h); a refusal names the field and
+// the method
+std::vector<std::string> SplitAt(const YamlReader& r, const std::string& text,
+                                 const std::string& method) {
   try {
     return SplitCommandTemplate(text);
   } catch (const ConfigError& e) {
-    r.Fail(e.problem());
+    r.Fail(e.problem() + " (method '" + method + "')");
   }
 }
 
@@ -96,7 +98,7 @@ void ReadCommand(const YamlReader& c, const std::vector<std::string>& known, Ben
   if (m->command.find_first_not_of(" \t") == std::string::npos)
     c.Fail("empty; expected a command line");
   CheckTemplate(c, m->command, known);
-  m->command_words = SplitAt(c, m->command);
+  m->command_words = SplitAt(c, m->command, m->name);
 }
 
 // a world's `file`: relative to the spec's folder `dir`, canonical; fails at the field when
