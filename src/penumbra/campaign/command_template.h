@@ -35,7 +35,8 @@
 //     code, runpy, doctest, ...) no word holds a placeholder;
 //   - after a program that hands its arguments to a shell as text (ssh, watch, su, runuser,
 //     sudo, doas, script, flock, tmux, screen, make, parallel, pwsh, expect, gdb) no word holds
-//     a placeholder.
+//     a placeholder. these names are matched on every word (a value such as `--lang python`
+//     is read as the program: write `--lang=python`).
 //   a method that needs a shell writes `sh -c 'SCRIPT' sh {dataset} {output}` and reads the
 //   values as "$1", "$2", ...; python3 -c 'CODE' {dataset} reads sys.argv[1].
 // {name} placeholders and the {{ }} brace escapes are left in the words and filled per job.
