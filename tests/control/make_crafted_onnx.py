@@ -42,31 +42,12 @@ import struct
 import sys
 
 
-def varint(n):
-    out = bytearray()
-    n &= (1 << 64) - 1
-    while True:
-        b = n & 0x7F
-        n >>= 7
-        if n:
-            out.append(b | 0x80)
-        else:
-            out.append(b)
-            return bytes(out)
-
-
-def fv(num, value):
-    return varint(num << 3) + varint(value)
-
-
-def fb(num, data):
-    if isinstance(data, str):
-        data = data.encode()
-    return varint((num << 3) | 2) + varint(len(data)) + data
-
-
-def ff(num, value):
-    return varint((num << 3) | 5) + struct.pack("<f", value)
+# the protobuf wire helpers are the policy fixtures' (one writer of onnx.proto's encoding)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "fixtures"))
+from make_policy_fixtures import field_bytes as fb  # noqa: E402
+from make_policy_fixtures import field_float as ff  # noqa: E402
+from make_policy_fixtures import field_varint as fv  # noqa: E402
+from make_policy_fixtures import varint  # noqa: E402,F401
 
 
 FLOAT, INT64 = 1, 7

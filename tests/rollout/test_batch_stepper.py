@@ -307,9 +307,9 @@ class HostileArgumentsTest(unittest.TestCase):
                 attempt("dev", lambda: BatchStepper("/dev/zero", 1))
                 """, timeout=30)
         self.assertIn(f"fifo ValueError {fifo}: model_path: model file is not a regular file "
-                      "(a FIFO); expected a regular MJCF file", out)
-        self.assertIn(f"dir ValueError {tmp}: model_path: model file is not a regular file "
-                      "(a directory)", out)
+                      "(a FIFO); expected a regular file", out)
+        self.assertIn(f"dir ValueError {tmp}: model_path: model file is a directory; expected a "
+                      "regular file", out)
         self.assertIn("dev ValueError /dev/zero: model_path: model file is not a regular file "
                       "(a character device)", out)
         # open() would stop at the NUL and load train/go1_flat.xml

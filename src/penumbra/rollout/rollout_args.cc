@@ -1,18 +1,15 @@
 #include "penumbra/rollout/rollout_args.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <sys/resource.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <thread>
 
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -22,30 +19,6 @@ std::string FormatDouble(double v) {
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   return std::to_string(v);
 }
-
-std::string KindOf(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "an unknown kind of file";
-}
-
-// closes a file descriptor when it goes out of scope
-class Fd {
- public:
-  explicit Fd(int fd) : fd_(fd) {}
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  int get() const { return fd_; }
-
- private:
-  int fd_;
-};
 
 }  // namespace
 
@@ -121,43 +94,15 @@ void CheckFiniteValues(const double* values, size_t count, size_t cols, const st
 }
 
 std::string ReadRolloutModelFile(const std::string& path, size_t max_bytes) {
-  auto fail = [&](const std::string& problem) {
-    throw ConfigError(path, 0, "model_path", problem);
-  };
   // open() would stop at a NUL and open another file
   if (path.empty() || path.find('\0') != std::string::npos)
-    fail("model path is empty or holds a NUL byte; expected a file name");
-  Fd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
-  if (fd.get() < 0) {
-    const int err = errno;
-    if (err == ENOENT) fail("model file not found; expected an MJCF file");
-    fail(std::string("cannot read the model file: ") + std::strerror(err));
+    throw ConfigError(path, 0, "model_path",
+                      "model path is empty or holds a NUL byte; expected a file name");
+  try {
+    return ReadInputFile(path, "model file", max_bytes);
+  } catch (const ConfigError& e) {
+    throw ConfigError(path, 0, "model_path", e.problem());
   }
-  struct stat st {};
-  if (::fstat(fd.get(), &st) != 0)
-    fail(std::string("cannot read the model file: ") + std::strerror(errno));
-  if (!S_ISREG(st.st_mode))
-    fail("model file is not a regular file (" + KindOf(st.st_mode) +
-         "); expected a regular MJCF file");
-  const auto size = static_cast<uint64_t>(st.st_size);
-  if (size > max_bytes) {
-    fail("model file is " + std::to_string(size) + " bytes; expected at most " +
-         std::to_string(max_bytes) + " bytes");
-  }
-  std::string bytes(static_cast<size_t>(size) + 1, '\0');
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::read(fd.get(), bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      fail(std::string("cannot read the model file: ") + std::strerror(errno));
-    }
-    if (n == 0) break;
-    done += static_cast<size_t>(n);
-  }
-  if (done > size) fail("model file grew while it was read; expected a file that does not change");
-  bytes.resize(done);
-  return bytes;
 }
 
 }  // namespace penumbra

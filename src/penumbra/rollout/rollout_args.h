@@ -51,15 +51,15 @@ void CheckRolloutMemory(int64_t num_copies, size_t bytes_per_copy,
 /// @throws ConfigError("", 0, "name[row, col]", "got nan; expected a finite number").
 void CheckFiniteValues(const double* values, size_t count, size_t cols, const std::string& name);
 
-/// the whole of the model file `path`: opened read-only with O_NONBLOCK (a FIFO opens at once
-/// instead of waiting for a writer), checked with fstat on the open descriptor to be a regular
-/// file of at most max_bytes, then read.
-/// @throws ConfigError(path, 0, "model_path", problem) with problem "model file not found;
-///         expected an MJCF file", "model file is not a regular file (a FIFO); expected a
-///         regular MJCF file" (likewise a directory, a character or block device, a socket),
-///         "model path is empty or holds a NUL byte; expected a file name",
-///         "model file is N bytes; expected at most M bytes" or "cannot read the model file:
-///         <reason>".
+/// the whole of the model file `path`, read by core/input_file.h's ReadInputFile (opened with
+/// O_NONBLOCK, so a FIFO opens at once instead of waiting for a writer; checked with fstat on
+/// the open descriptor to be a regular file of at most max_bytes).
+/// @throws ConfigError(path, 0, "model_path", problem) with problem "model path is empty or
+///         holds a NUL byte; expected a file name" or ReadInputFile's: "model file not found:
+///         <absolute path>; expected an existing file", "model file is a directory; expected a
+///         regular file", "model file is not a regular file (a FIFO); expected a regular file"
+///         (likewise a character or block device, a socket), "model file is N bytes; expected
+///         at most M bytes" or "cannot read the model file: <reason>; expected a readable file".
 std::string ReadRolloutModelFile(const std::string& path,
                                  size_t max_bytes = kMaxRolloutModelFileBytes);
 
