@@ -29,6 +29,8 @@ Every file is for a policy of 4 observations and 2 actions (input "obs" [1, 4], 
   external_data.onnx      an initializer whose data lives in an external file.
   input_5.onnx            the valid graph declaring input [1, 5] (mismatched observation size).
   output_3.onnx           a graph computing [1, 3] actions (mismatched action size).
+  gemm_omitted_b.onnx     a Gemm whose required input B is the empty name (an omitted input;
+                          found by fuzzing the checker).
   truncated.onnx          valid.onnx cut in the middle of a field.
   huge_action.onnx        accepted by the checker; returns 3e38 for every output on obs = 1.
   inf_action.onnx         accepted by the checker; returns -inf for output 0 on obs = 1.
@@ -152,6 +154,10 @@ def crafted():
     f["input_5.onnx"] = gemm_model([0.0] * 10, w_dims=(2, 5),
                                    inputs=[value_info("obs", [1, 5])])
     f["output_3.onnx"] = gemm_model([0.0] * 12, w_dims=(3, 4), n_out=3)
+    # a Gemm whose required B input is omitted ("": found by fuzzing, a null dereference)
+    f["gemm_omitted_b.onnx"] = model(
+        [node("Gemm", ["obs", "", "b"], ["actions"], "fc", [attr_int("transB", 1)])],
+        [tensor("b", [2], [0.0, 0.0])])
     f["truncated.onnx"] = f["valid.onnx"][: len(f["valid.onnx"]) // 2 + 3]
     f["huge_action.onnx"] = gemm_model([3e38 / 4] * 8)
     f["inf_action.onnx"] = gemm_model([float("-inf")] * 4 + [0.0] * 4)

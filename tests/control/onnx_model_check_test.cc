@@ -117,6 +117,8 @@ TEST_F(OnnxModelCheckTest, OperatorsOpsetsAndControlFlowOutsideTheSupportedSetAr
   EXPECT_HAS(LoadError("graph_attr.onnx"), "attribute 'body' holds a graph (control flow");
   EXPECT_HAS(LoadError("external_data.onnx"), "uses external data");
   EXPECT_HAS(LoadError("truncated.onnx"), "not a valid ONNX (protobuf) file");
+  EXPECT_HAS(LoadError("gemm_omitted_b.onnx"),
+             "node 0 'fc' (Gemm) omits its required input 1; expected a tensor name");
 }
 
 TEST_F(OnnxModelCheckTest, InputAndOutputShapesMustMatchTheConfiguredSizes) {

@@ -586,10 +586,15 @@ class Checker {
              "topological order");
       in.push_back(&it->second);
     }
+    // the first `lo` inputs are required: none of them may be omitted ("")
     auto need = [&](size_t lo, size_t hi) {
-      if (in.size() < lo || in.size() > hi || (lo > 0 && !in[0]))
+      if (in.size() < lo || in.size() > hi)
         Fail(label + " has " + std::to_string(in.size()) + " inputs; expected " +
              std::to_string(lo) + (hi != lo ? " .. " + std::to_string(hi) : ""));
+      for (size_t i = 0; i < lo; ++i)
+        if (!in[i])
+          Fail(label + " omits its required input " + std::to_string(i) +
+               "; expected a tensor name");
     };
     auto need_float = [&](size_t i) {
       if (i < in.size() && in[i] && in[i]->dtype != kFloat)
