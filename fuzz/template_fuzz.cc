@@ -109,8 +109,12 @@ void CheckProgram(const std::vector<std::string>& words) {
       if (!attached) ++j;
       continue;
     }
-    if (w[0] == '-' && w[1] != '-' && w.find('s') != std::string::npos) stdin_script = true;
-    if (w == "-o" || w == "+o" || w == "-O" || w == "+O") {
+    // a cluster's flags up to its first o / O, which takes the rest of the cluster or, at its
+    // end, the next word as its argument (sh -so NAME: NAME is -o's, then operands follow)
+    const size_t o = w[1] == '-' ? std::string::npos : w.find_first_of("oO", 1);
+    const std::string flags = w.substr(1, o == std::string::npos ? std::string::npos : o - 1);
+    if (w[0] == '-' && w[1] != '-' && flags.find('s') != std::string::npos) stdin_script = true;
+    if (o != std::string::npos && o + 1 == w.size()) {
       if (j + 1 < words.size() && HasPlaceholder(words[j + 1])) __builtin_trap();
       ++j;
     }
