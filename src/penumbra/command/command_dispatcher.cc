@@ -19,8 +19,8 @@
 #include "penumbra/control/controller_capabilities.h"
 #include "penumbra/core/build_info.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/magnitude_limits.h"
 #include "penumbra/core/output_path_policy.h"
-#include "penumbra/scene/scene_limits.h"
 
 namespace penumbra {
 namespace {
@@ -352,7 +352,7 @@ void CommandDispatcher::Waypoints(const CommandInfo& info, RequestReader& rd, co
     if (!pts[i].is_array() || pts[i].size() != 2)
       throw CommandError(command_code::kBadField, f,
                          fmt::format("'{}' is not [x, y]; expected two numbers (m)", f));
-    // inside the scene's bounds (scene/scene_limits.h): 1e300 used to be accepted
+    // inside the scene's bounds (core/magnitude_limits.h): 1e300 used to be accepted
     Eigen::Vector2d p;
     for (int a = 0; a < 2; ++a) {
       const std::string fa = fmt::format("{}[{}]", f, a);

@@ -7,17 +7,18 @@
 //
 // why these values: they sit far above anything a real robot does (so no valid world is
 // refused) and far below where products of them overflow or lose all precision. the position
-// and time bounds equal scene/scene_limits.h's kMaxPositionM and kMaxDurationSec, the rate bound
-// is 1 / kMinTimestepSec (control cannot run faster than physics); control/ does not include
-// scene/, so the values are repeated here.
+// and time bounds are core/magnitude_limits.h's kMaxPositionM and kMaxDurationSec, the rate
+// bound is 1 / kMinTimestepSec (control cannot run faster than physics).
 
 #include <numbers>
+
+#include "penumbra/core/magnitude_limits.h"
 
 namespace penumbra {
 
 /// largest |coordinate| (m) of a target, waypoint or altitude, and largest length parameter
 /// (wheel radius, track width, tolerance, leash, step length, ...), as kMaxPositionM.
-inline constexpr double kMaxParamPositionM = 1e5;
+inline constexpr double kMaxParamPositionM = kMaxPositionM;
 /// largest linear speed (m/s): speeds, speed limits and velocity commands.
 inline constexpr double kMaxParamSpeedMS = 100;
 /// largest angular speed, in deg/s (100 turns per second) and in rad/s.
@@ -35,9 +36,9 @@ inline constexpr double kMaxParamAngularAccelerationRadS2 = 1e6;
 /// servo, IK damping).
 inline constexpr double kMaxParamGain = 1e6;
 /// largest rate (Hz) of a controller or filter: 1 / kMinTimestepSec.
-inline constexpr double kMaxParamRateHz = 1e6;
+inline constexpr double kMaxParamRateHz = 1 / kMinTimestepSec;
 /// largest time (s) of a scripted command or keyframe, as kMaxDurationSec.
-inline constexpr double kMaxParamTimeSec = 1e6;
+inline constexpr double kMaxParamTimeSec = kMaxDurationSec;
 /// largest |joint value| (rad or m): joint targets, postures, keyframes, gripper values,
 /// joint-space margins and zones.
 inline constexpr double kMaxParamJointValue = 1e5;

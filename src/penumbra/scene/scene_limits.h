@@ -15,14 +15,13 @@
 #include <optional>
 #include <string>
 
+#include "penumbra/core/magnitude_limits.h"
 #include "penumbra/scene/scene_description.h"
 #include "penumbra/scene/world_snapshot.h"
 
 namespace penumbra {
 
-/// largest |coordinate| (m) of a position given at load: world-file poses and light positions,
-/// sensor mounts, and the centres of MJCF geoms, cameras and lights at qpos0.
-inline constexpr double kMaxPositionM = 1e5;
+// kMaxPositionM, kMinTimestepSec, kMaxTimestepSec and kMaxDurationSec: core/magnitude_limits.h
 /// range (m) of a primitive geom's size parameters (sphere radius, box half-sizes, ...), of
 /// |mesh vertex coordinates| and of height-field sizes. planes may also have size 0 (infinite).
 inline constexpr double kMinGeomSizeM = 1e-6;
@@ -68,12 +67,6 @@ inline constexpr int kMaxCameras = 256;
 /// (200 people overflow it at load, "Stack overflow"), and beyond 46,341 bodies the count
 /// overflows an int (10,000 agents ran 339 s and 1 GB before "broadphase buffer full").
 inline constexpr int kMaxAgents = 150;
-/// physics timestep range (s), for physics.timestep_sec and the MJCF <option timestep>.
-/// the lower end keeps 1 s of simulated time at <= 1e6 steps.
-inline constexpr double kMinTimestepSec = 1e-6;
-inline constexpr double kMaxTimestepSec = 0.1;
-/// largest run duration (s of simulated time): duration_sec and --duration (11.6 days).
-inline constexpr double kMaxDurationSec = 1e6;
 /// most LiDAR beams per scan (rings x columns; livox_mid40: points per scan): 128 rings x
 /// 32768 columns. a scan's buffers take about 100 bytes per beam (docs/sensors.md).
 inline constexpr int kMaxLidarBeamsPerScan = 1 << 22;
