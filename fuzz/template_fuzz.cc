@@ -99,6 +99,14 @@ void CheckProgram(const std::vector<std::string>& words) {
     if (w.size() < 2 || (w[0] != '-' && !(shell && w[0] == '+'))) break;
     if (HasPlaceholder(w)) __builtin_trap();
     if (python) {
+      // long options take no argument but --check-hash-based-pycs MODE
+      if (w[1] == '-') {
+        if (w == "--check-hash-based-pycs") {
+          if (j + 1 < words.size() && HasPlaceholder(words[j + 1])) __builtin_trap();
+          ++j;
+        }
+        continue;
+      }
       // -c CODE / -m MODULE / -W ARG / -X ARG, the argument attached or the next word; the
       // code and the module hold no placeholder either, and -c / -m end the options
       const size_t f = w.find_first_of("cmWX");
