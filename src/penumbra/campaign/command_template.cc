@@ -142,12 +142,12 @@ void CheckPlaceholderWords(const std::vector<std::string>& words, const std::vec
 
 // how a shell or interpreter takes its program, for the words after its name
 struct Syntax {
-  std::string_view code;           // short flags whose argument is program text
-  std::string_view file;           // short flags whose argument is the program's file
-  std::string_view takes_arg;      // short flags with an argument (attached or the next word)
-  std::string_view attached_only;  // short flags whose argument is the rest of the cluster
-  std::string_view no_program;     // short flags after which no operand is the program
-  std::vector<std::string_view> long_code, long_file, long_arg;
+  std::string_view code{};           // short flags whose argument is program text
+  std::string_view file{};           // short flags whose argument is the program's file
+  std::string_view takes_arg{};      // short flags with an argument (attached or the next word)
+  std::string_view attached_only{};  // short flags whose argument is the rest of the cluster
+  std::string_view no_program{};     // short flags after which no operand is the program
+  std::vector<std::string_view> long_code{}, long_file{}, long_arg{};
   bool plus_options = false;       // +o style options (shells)
   bool code_ends_options = false;  // the words after the code are its arguments (python -c)
   bool operand_is_program = true;  // without a code or file flag, the first operand is one
