@@ -3,6 +3,7 @@
 // (tests/control/arm_control_fake.h).
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -287,7 +288,21 @@ TEST_F(JointCsv, ErrorsNameTheFileAndLine) {
   EXPECT_NE(Error("time_sec,j1,j2,finger\n").find("no data rows"), std::string::npos);
   EXPECT_NE(ErrorOf([&] {
               ReadJointCsv((dir_ / "none.csv").string(), {"j1"}, "");
-            }).find("cannot open the CSV file"),
+            }).find("CSV file not found"),
+            std::string::npos);
+}
+
+// a FIFO named as the CSV blocked open() for ever; it is refused at once naming what it is
+TEST_F(JointCsv, AFifoOrAFolderIsRefusedWithoutBlocking) {
+  const std::string fifo = (dir_ / "fifo.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(ErrorOf([&] {
+              ReadJointCsv(fifo, {"j1"}, "");
+            }).find("CSV file is not a regular file (a FIFO); expected a regular file"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] {
+              ReadJointCsv(dir_.string(), {"j1"}, "");
+            }).find("CSV file is a directory; expected a regular file"),
             std::string::npos);
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -13,6 +12,7 @@
 #include "penumbra/control/param_mapping.h"
 #include "penumbra/control/param_node.h"
 #include "penumbra/core/error.h"
+#include "penumbra/core/input_file.h"
 
 namespace penumbra {
 namespace {
@@ -42,8 +42,8 @@ std::string LocalName(const std::string& full, const std::string& prefix) {
 std::vector<PlaybackFrame> ReadJointCsv(const std::string& path,
                                         const std::vector<std::string>& columns,
                                         const std::string& gripper_column) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, 0, "", "cannot open the CSV file; expected a readable file");
+  // read whole as a regular file: a FIFO named in a world file would block open() for ever
+  std::istringstream in(ReadInputFile(path, "CSV file"));
   std::string line;
   int line_no = 0;
   std::vector<std::string> header;

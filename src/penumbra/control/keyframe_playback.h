@@ -76,7 +76,10 @@ struct KeyframePlaybackParams {
 /// reads a CSV of joint targets (format in the file comment). `columns` are the expected
 /// joint column names (robot-local) in controller order; returns frames with q in that
 /// order and, when `gripper_column` is not empty, its values as PlaybackFrame::gripper.
-/// @throws ConfigError(csv_path, line, "", ...) for a missing file, bad header or rows.
+/// the file is read whole by core/input_file.h's ReadInputFile: a regular file only (a FIFO,
+/// folder or device is refused naming what it is, without blocking), at most 256 MiB.
+/// @throws ConfigError(csv_path, line, "", ...) for a missing or non-regular file, bad header
+///         or rows.
 std::vector<PlaybackFrame> ReadJointCsv(const std::string& csv_path,
                                         const std::vector<std::string>& columns,
                                         const std::string& gripper_column);
