@@ -388,7 +388,13 @@ int RunBenchmark(const BenchmarkOptions& o) {
     spdlog::info("recording the route of world '{}' ({})", w.name, w.file);
     const std::string tmp = plog.substr(0, plog.size() - 5) + ".partial.plog";
     fs::remove(tmp, ec);
-    o.record(w, tmp, o.stop_request);
+    try {
+      o.record(w, tmp, o.stop_request);
+    } catch (const Error&) {
+      // a stop during the recording's set-up ends it with an error (the session's
+      // SetupInterrupted): then the stop is what happened, reported below
+      if (!StopSignal(o.stop_request)) throw;
+    }
     if (const int sig = StopSignal(o.stop_request)) {
       fs::remove(tmp, ec);
       spdlog::warn(
