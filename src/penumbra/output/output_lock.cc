@@ -30,9 +30,15 @@ bool LocksUnsupported(int err) {
   return err == ENOLCK || err == EOPNOTSUPP || err == ENOSYS || err == EINVAL;
 }
 
-void WarnUnlocked(const std::string& what, int err) {
+// an exclusive flock on `fd` without waiting. 0: locked, or the file system has no flock
+// (warned, the run goes on unlocked); else the errno (EWOULDBLOCK: another holds it)
+int LockOrWarn(int fd, const std::string& what) {
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return 0;
+  const int err = errno;
+  if (!LocksUnsupported(err)) return err;
   spdlog::warn("{} cannot be locked ({}): another run could write into it at the same time", what,
                std::strerror(err));
+  return 0;
 }
 
 bool SameFile(const struct stat& a, const struct stat& b) {
@@ -73,14 +79,12 @@ OutputLock LockOutputFolder(const std::filesystem::path& dir, const std::string&
   };
   UniqueFd fd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (fd.get() < 0) throw fail(std::string("cannot be opened: ") + std::strerror(errno));
-  if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
+  if (const int err = LockOrWarn(fd.get(), "output folder '" + dir.string() + "'")) {
     if (err == EWOULDBLOCK)
       throw fail("is in use by " + Holder(fd.get()) +
                  "; wait for it to end or choose another folder (--force never removes the "
                  "outputs of a running run)");
-    if (!LocksUnsupported(err)) throw fail(std::string("cannot be locked: ") + std::strerror(err));
-    WarnUnlocked("output folder '" + dir.string() + "'", err);
+    throw fail(std::string("cannot be locked: ") + std::strerror(err));
   }
   // the name still leads to the folder locked (not removed and made anew meanwhile)
   struct stat held {
@@ -104,11 +108,7 @@ LockedRunLogFile OpenRunLogFile(const std::string& path, bool replace, const std
   f.fd = UniqueFd(::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644));
   if (f.fd.get() >= 0) {
     // another run that replaces it (--force) may have taken it in between
-    if (::flock(f.fd.get(), LOCK_EX | LOCK_NB) != 0) {
-      const int err = errno;
-      if (!LocksUnsupported(err)) throw in_use(f.fd.get());
-      WarnUnlocked("run log '" + path + "'", err);
-    }
+    if (LockOrWarn(f.fd.get(), "run log '" + path + "'") != 0) throw in_use(f.fd.get());
     f.created = true;
     return f;
   }
@@ -125,11 +125,9 @@ LockedRunLogFile OpenRunLogFile(const std::string& path, bool replace, const std
     throw fail(std::string("cannot be opened: ") + std::strerror(errno));
   if (!S_ISREG(held.st_mode) || !SameFile(held, named))
     throw fail("was replaced while it was being opened; run again");
-  if (::flock(f.fd.get(), LOCK_EX | LOCK_NB) != 0) {
-    const int err = errno;
+  if (const int err = LockOrWarn(f.fd.get(), "run log '" + path + "'")) {
     if (err == EWOULDBLOCK) throw in_use(f.fd.get());
-    if (!LocksUnsupported(err)) throw fail(std::string("cannot be locked: ") + std::strerror(err));
-    WarnUnlocked("run log '" + path + "'", err);
+    throw fail(std::string("cannot be locked: ") + std::strerror(err));
   }
   if (!replace)
     throw fail(
