@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# installs every Debian 12 package that penumbra's build, tests and benchmarks need.
+# installs every Debian 12 package that penumbra's build, tests and benchmarks need, and the
+# project venv (.venv, or $PENUMBRA_VENV) with the pinned PyPI packages of scripts/requirements.txt.
 # idempotent: re-running it only installs what is missing.
 set -euo pipefail
 pkgs=(
@@ -31,6 +32,8 @@ pkgs=(
   python3-torch python3-matplotlib python3-opencv  # train/ (PPO, curves) and the policy walking test
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for bench/fuzz/run.sh (docs/fuzzing.md)
   libglfw3-dev xvfb xauth  # scripts/compare_with_mujoco.py: MuJoCo's own renderer (tools/mujoco_offscreen.cc) under Xvfb
+  cyclonedds-dev cyclonedds-tools  # ROS 2 bridge and rosbag2 export: Cyclone DDS's C library and idlc
+  python3-venv  # the project venv below
 )
 missing=()
 for p in "${pkgs[@]}"; do
@@ -38,11 +41,23 @@ for p in "${pkgs[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#pkgs[@]} packages present"
-  exit 0
+else
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  echo "install-deps: installed ${missing[*]}"
 fi
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-echo "install-deps: installed ${missing[*]}"
+
+# the project venv: PyPI packages Debian does not package (rosbags, mcap, mcap-ros2-support,
+# cyclonedds), pinned. made with Debian's python; pip installs only what is missing or pinned
+# otherwise. configure with -DPENUMBRA_VENV=DIR when PENUMBRA_VENV names another folder
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+venv="${PENUMBRA_VENV:-$root/.venv}"
+if [ ! -x "$venv/bin/python" ]; then
+  /usr/bin/python3 -m venv "$venv"
+  echo "install-deps: made the venv $venv"
+fi
+"$venv/bin/python" -m pip install --disable-pip-version-check -q -r "$root/scripts/requirements.txt"
+echo "install-deps: venv $venv has the packages of scripts/requirements.txt"
