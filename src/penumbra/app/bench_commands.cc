@@ -9,6 +9,7 @@
 #include "penumbra/bench/bench.h"
 #include "penumbra/bench/net/bench_bridge.h"
 #include "penumbra/bench/net/bench_ros.h"
+#include "penumbra/bench/net/bench_ros2.h"
 #include "penumbra/bench/record/bench_record.h"
 #include "penumbra/bench/sensors/sensor_bench.h"
 #include "penumbra/core/error.h"
@@ -183,6 +184,36 @@ class BenchRosCommand : public Command {
   RosBenchOptions options_;
 };
 
+class BenchRos2Command : public Command {
+ public:
+  std::string name() const override { return "bench ros2"; }
+  std::string summary() const override {
+    return "ROS 2 transport (Cyclone DDS) of 640x480 images, Imu, /tf: latency, losses, "
+           "lockstep round trip";
+  }
+
+  void AddOptions(CLI::App* verb) override {
+    verb->add_option("--seconds", options_.seconds, "wall seconds of the streaming phase")
+        ->check(CLI::Range(0.5, 600.0));
+    verb->add_option("--trips", options_.trips, "lockstep round trips timed")
+        ->check(CLI::Range(10, 100000));
+    verb->add_option("--ros-domain", options_.domain,
+                     "ROS domain id (default: one at random in 100..232)")
+        ->check(CLI::Range(0, 232));
+    verb->add_option("--ros-interface", options_.interface,
+                     "IPv4 address of the one interface DDS uses (default 127.0.0.1)");
+    verb->add_option("--receive-buffer", options_.receive_buffer,
+                     "UDP receive buffer in bytes (Cyclone SocketReceiveBufferSize; default: the "
+                     "system's, capped by net.core.rmem_max)")
+        ->check(CLI::Range(int64_t{0}, int64_t{1} << 31));
+  }
+
+  int Run(const CommandArgs&) override { return BenchRos2(options_); }
+
+ private:
+  Ros2BenchOptions options_;
+};
+
 class BenchSensorsCommand : public Command {
  public:
   std::string name() const override { return "bench sensors"; }
@@ -213,6 +244,7 @@ std::unique_ptr<Command> MakeBenchPhysicsCommand() {
 std::unique_ptr<Command> MakeBenchRecordCommand() { return std::make_unique<BenchRecordCommand>(); }
 std::unique_ptr<Command> MakeBenchBridgeCommand() { return std::make_unique<BenchBridgeCommand>(); }
 std::unique_ptr<Command> MakeBenchRosCommand() { return std::make_unique<BenchRosCommand>(); }
+std::unique_ptr<Command> MakeBenchRos2Command() { return std::make_unique<BenchRos2Command>(); }
 std::unique_ptr<Command> MakeBenchSensorsCommand() {
   return std::make_unique<BenchSensorsCommand>();
 }

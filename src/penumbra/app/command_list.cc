@@ -31,6 +31,7 @@ std::vector<std::unique_ptr<Command>> CommandList() {
   list.push_back(MakeBenchRecordCommand());
   list.push_back(MakeBenchBridgeCommand());
   list.push_back(MakeBenchRosCommand());
+  list.push_back(MakeBenchRos2Command());
   list.push_back(MakeDecomposeCommand());
   list.push_back(MakeBenchDecomposeCommand());
   list.push_back(MakeBenchViewerCommand());
