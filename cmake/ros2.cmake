@@ -8,8 +8,8 @@
 #     scripts/install-deps.sh) with the rosbags package, whose ROS 2 Jazzy message definitions
 #     scripts/ros2_idl.py turns into ros2_msgs.idl and the type table ros2_types.inc.
 # sets PENUMBRA_ROS2_FOUND and, when found, the library penumbra_ros2_msgs (idlc's C types of
-# ros2_msgs.idl, linked to CycloneDDS::ddsc) and penumbra_use_ros2(target), which links a target
-# to it privately (the generated headers are in its include path).
+# ros2_msgs.idl, linked to CycloneDDS::ddsc) and penumbra_use_ros2(target folder), which links a
+# target to it privately (the generated headers are in its include path).
 set(PENUMBRA_ROS2_FOUND OFF)
 if(NOT PENUMBRA_WITH_ROS2 STREQUAL "OFF")
   find_package(CycloneDDS CONFIG QUIET)
@@ -67,6 +67,10 @@ if(NOT PENUMBRA_WITH_ROS2 STREQUAL "OFF")
   endif()
 endif()
 
-function(penumbra_use_ros2 target)
+# the folder's .cc files are compiled one by one, outside the target's unity batches: Cyclone
+# DDS's C headers (macros, short names) stay out of the other files
+function(penumbra_use_ros2 target folder)
+  file(GLOB ros2_srcs CONFIGURE_DEPENDS ${folder}/*.cc)
+  set_source_files_properties(${ros2_srcs} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
   target_link_libraries(${target} PRIVATE penumbra_ros2_msgs)
 endfunction()
