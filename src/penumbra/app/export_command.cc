@@ -15,6 +15,7 @@
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/replay/kinematic/replay_runner.h"
+#include "penumbra/ros/rosbag2_writer.h"
 #include "penumbra/ros/rosbag_export.h"
 
 namespace penumbra {
@@ -109,7 +110,7 @@ std::string ExportCommand::name() const { return "export"; }
 
 std::string ExportCommand::summary() const {
   return "write a run's output folder as a TUM RGB-D, EuRoC/ASL or KITTI odometry dataset, or as "
-         "a ROS 1 bag";
+         "a ROS 1 or ROS 2 (MCAP) bag";
 }
 
 int ExportCommand::Run(const CommandArgs& args) {
@@ -118,7 +119,7 @@ int ExportCommand::Run(const CommandArgs& args) {
   const State& s = *state_;
   namespace fs = std::filesystem;
   const fs::path input(s.input);
-  if (s.format == "rosbag") return RunRosbag(stop_request);
+  if (s.format == "rosbag" || s.format == "rosbag2") return RunRosbag(stop_request);
   const std::optional<RenderSettings::Backend> backend = s.backend.Resolve();
   DatasetExportOptions options = s.options;
   options.format = ParseDatasetFormat(s.format);
@@ -201,6 +202,7 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   namespace fs = std::filesystem;
   const fs::path input(s.input);
   const fs::path bag(s.out);
+  const bool ros2 = s.format == "rosbag2";
   const std::optional<RenderSettings::Backend> backend = s.backend.Resolve();
   if (!s.options.camera.empty() || !s.options.camera2.empty() || !s.options.imu.empty())
     throw ConfigError("", 0,
@@ -208,22 +210,27 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
                           ? "--camera"
                           : (!s.options.camera2.empty() ? "--camera2" : "--imu"),
                       "a rosbag holds every camera, LiDAR and IMU of the run; expected no sensor "
-                      "selection with --format rosbag");
+                      "selection with --format " +
+                          s.format);
   if (s.depth_option && s.depth_option->count() > 0)
     throw ConfigError("", 0, "--depth",
-                      "not for --format rosbag, whose depth images are the run's as recorded; "
-                      "expected --format tum");
+                      "not for --format " + s.format +
+                          ", whose depth images are the run's as recorded; expected --format tum");
+  // a build without ROS 2 says so before a run log is replayed
+  if (ros2) RequireRosbag2();
   // a run log is replayed into a temporary run folder beside the bag first
   std::optional<TempFolder> replayed;
   fs::path run_dir = input;
   if (input.extension() == ".plog") {
     CheckRunLogInput(input);
-    if (bag.extension() != ".bag")
+    if (!ros2 && bag.extension() != ".bag")
       throw ConfigError("", 0, "--out",
                         "'" + bag.string() + "'; expected a bag file name ending in .bag");
-    if (fs::exists(bag))
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(bag, ec)))
       throw ConfigError("", 0, "--out",
-                        "'" + bag.string() + "' exists; expected a new file (never overwritten)");
+                        "'" + bag.string() + "' exists; expected a new " +
+                            (ros2 ? "folder" : "file") + " (never overwritten)");
     try {
       run_dir = ReplayLogBeside(s.input, s.replay_world, s.replay_adversity, backend,
                                 ReplayDepth::kAsRecorded, bag, stop_request, &replayed);
@@ -238,7 +245,8 @@ int ExportCommand::RunRosbag(const std::atomic<int>* stop_request) const {
   }
   RosbagExportSummary summary;
   try {
-    summary = ExportRosbag(run_dir, bag, stop_request);
+    summary =
+        ros2 ? ExportRosbag2(run_dir, bag, stop_request) : ExportRosbag(run_dir, bag, stop_request);
   } catch (const ExportStopped& e) {
     return Stopped(e, s.out);
   }
@@ -262,8 +270,11 @@ void ExportCommand::AddOptions(CLI::App* command) {
   s.backend.Add(s.command, "the recorded render.backend (for a .plog input)");
   s.command->add_option("--format,-f", s.format, "dataset layout")
       ->required()
-      ->check(CLI::IsMember({"tum", "euroc", "kitti", "rosbag"}));
-  s.command->add_option("--out,-o", s.out, "output folder (new or empty); rosbag: a new FILE.bag")
+      ->check(CLI::IsMember({"tum", "euroc", "kitti", "rosbag", "rosbag2"}));
+  s.command
+      ->add_option("--out,-o", s.out,
+                   "output folder (new or empty); rosbag: a new FILE.bag; rosbag2: a new "
+                   "folder (ROS 2 bag: metadata.yaml + MCAP)")
       ->required();
   s.command->add_option("--camera", s.options.camera,
                         "camera to export (default: the run's only camera)");

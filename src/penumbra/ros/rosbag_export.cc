@@ -27,6 +27,7 @@
 #include "penumbra/physics/simulation.h"
 #include "penumbra/ros/ros_convert.h"
 #include "penumbra/ros/ros_graph.h"
+#include "penumbra/ros/rosbag2_writer.h"
 #include "penumbra/ros/rosbag_writer.h"
 #include "penumbra/scene/sim_time.h"
 #include "penumbra/world/ros_config.h"
@@ -111,10 +112,10 @@ WorldConfig RunWorld(const fs::path& run_dir, std::string* world_file) {
   // file, not through a link at its name), and no error quotes its content
   const std::string shown = SanitizeForMessage(*world_file, 300);
   auto refuse = [&](const std::string& why) {
-    return ConfigError(manifest.string(), 0, "world_file", "the run's world file '" + shown +
-                                                               "' " + why +
-                                                               "; the export names topics and "
-                                                               "frames from it");
+    return ConfigError(manifest.string(), 0, "world_file",
+                       "the run's world file '" + shown + "' " + why +
+                           "; the export names topics and "
+                           "frames from it");
   };
   const std::string ext = fs::path(*world_file).extension().string();
   if (ext != ".yaml" && ext != ".yml" && ext != ".xml" && ext != ".urdf")
@@ -157,6 +158,110 @@ void RenameNoReplace(const fs::path& from, const fs::path& to) {
   ::unlink(from.c_str());
 }
 
+// gives the complete bag folder `from` its name `to`, never replacing anything there
+void RenameFolderNoReplace(const fs::path& from, const fs::path& to) {
+  auto exists = [&] {
+    return ConfigError("", 0, "--out",
+                       "'" + to.string() +
+                           "' was created during the export; expected a new folder (never "
+                           "overwritten)");
+  };
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return;
+  if (errno == EEXIST || errno == ENOTEMPTY) throw exists();
+  if (errno != EINVAL && errno != ENOSYS)
+    throw Error("cannot rename " + from.string() + " to " + to.string() + ": " +
+                std::strerror(errno));
+  // a file system without RENAME_NOREPLACE: rename(2) would replace an empty folder there
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(to, ec))) throw exists();
+  if (::rename(from.c_str(), to.c_str()) != 0)
+    throw Error("cannot rename " + from.string() + " to " + to.string() + ": " +
+                std::strerror(errno));
+}
+
+// the ROS 1 bag being written: "<bag>.export-tmp-<pid>-<random>" beside it (O_EXCL |
+// O_NOFOLLOW), locked while this export works, removed unless the export completes
+struct Ros1Target {
+  fs::path final_path;
+  UniqueFd lock;
+  fs::path temp;
+  bool done = false;
+  std::unique_ptr<RosbagWriter> bag;
+
+  explicit Ros1Target(const fs::path& path) : final_path(path) {
+    temp = MakeSiblingTempFile(path, ".export-tmp", &lock);
+    try {
+      bag = std::make_unique<RosbagWriter>(temp.string(), path.string());
+    } catch (...) {
+      Remove();
+      throw;
+    }
+  }
+  ~Ros1Target() {
+    bag.reset();
+    if (!done) Remove();
+  }
+  void Remove() {
+    std::error_code e;
+    fs::remove(temp, e);
+  }
+  void Finish() {
+    bag->Close();
+    RenameNoReplace(temp, final_path);
+    done = true;
+  }
+};
+
+// the ROS 2 bag being written: the folder "<dir>.export-tmp-<pid>-<random>" beside it (mkdir),
+// locked while this export works, removed with its files unless the export completes
+struct Ros2Target {
+  fs::path final_path;
+  UniqueFd lock;
+  fs::path temp;
+  bool done = false;
+  std::unique_ptr<Rosbag2Writer> bag;
+
+  explicit Ros2Target(const fs::path& path) : final_path(path) {
+    temp = MakeSiblingTempFolder(path, ".export-tmp", &lock);
+    try {
+      bag = std::make_unique<Rosbag2Writer>(temp, path.filename().string(), path.string());
+    } catch (...) {
+      Remove();
+      throw;
+    }
+  }
+  ~Ros2Target() {
+    bag.reset();
+    if (!done) Remove();
+  }
+  void Remove() {
+    std::error_code e;
+    fs::remove_all(temp, e);
+  }
+  void Finish() {
+    bag->Close();
+    RenameFolderNoReplace(temp, final_path);
+    done = true;
+  }
+};
+
+// the bag folder named by --out `out` ("DIR/" is "DIR")
+fs::path Rosbag2Folder(const fs::path& out) {
+  fs::path p = out.lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  const std::string name = p.filename().string();
+  if (p.empty() || name == "." || name == "..")
+    throw ConfigError("", 0, "--out",
+                      "'" + out.string() + "'; expected the path of a new ROS 2 bag folder");
+  return p;
+}
+
+// writes the run's messages (the header comment) into a bag made by Target(bag_path) (above),
+// finished and renamed to bag_path when complete
+template <typename Target>
+RosbagExportSummary ExportRun(const fs::path& run_dir, const fs::path& bag_path,
+                              const std::atomic<int>* stop_request);
+
 }  // namespace
 
 RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_path,
@@ -169,6 +274,27 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     throw ConfigError(
         "", 0, "--out",
         "'" + bag_path.string() + "' exists; expected a new file (never overwritten)");
+  return ExportRun<Ros1Target>(run_dir, bag_path, stop_request);
+}
+
+RosbagExportSummary ExportRosbag2(const fs::path& run_dir, const fs::path& bag_dir,
+                                  const std::atomic<int>* stop_request) {
+  RequireRosbag2();
+  const fs::path dir = Rosbag2Folder(bag_dir);
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(dir, ec)))
+    throw ConfigError("", 0, "--out",
+                      "'" + bag_dir.string() +
+                          "' exists; expected a new folder for the ROS 2 bag (never overwritten)");
+  return ExportRun<Ros2Target>(run_dir, dir, stop_request);
+}
+
+namespace {
+
+template <typename Target>
+RosbagExportSummary ExportRun(const fs::path& run_dir, const fs::path& bag_path,
+                              const std::atomic<int>* stop_request) {
+  std::error_code ec;
   const RunFolder run(run_dir);
   RosbagExportSummary summary;
   const WorldConfig world = RunWorld(run_dir, &summary.world_file);
@@ -234,19 +360,8 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
   // this export works
   for (const fs::path& stale : RemoveStaleExportTemps(bag_path))
     spdlog::info("removed {}, left by an export that was killed", stale.string());
-  UniqueFd temp_lock;
-  const fs::path temp_bag = MakeSiblingTempFile(bag_path, ".export-tmp", &temp_lock);
-  bool done = false;
-  struct RemoveUnlessDone {
-    const fs::path& path;
-    const bool& done;
-    ~RemoveUnlessDone() {
-      if (done) return;
-      std::error_code e;
-      fs::remove(path, e);
-    }
-  } cleanup{temp_bag, done};
-  RosbagWriter bag(temp_bag.string(), bag_path.string());
+  Target target(bag_path);
+  auto& bag = *target.bag;
   auto count = [&](const std::string& topic) { ++summary.counts[topic]; };
 
   // cameras
@@ -398,11 +513,11 @@ RosbagExportSummary ExportRosbag(const fs::path& run_dir, const fs::path& bag_pa
     }
   }
   CheckExportStop(stop_request);
-  bag.Close();
-  RenameNoReplace(temp_bag, bag_path);
-  done = true;
+  target.Finish();
   for (const auto& [topic, n] : summary.counts) summary.messages += n;
   return summary;
 }
+
+}  // namespace
 
 }  // namespace penumbra
