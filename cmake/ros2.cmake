@@ -65,6 +65,8 @@ if(NOT PENUMBRA_WITH_ROS2 STREQUAL "OFF")
     target_include_directories(penumbra_ros2_msgs SYSTEM PUBLIC ${_ros2_gen})
     target_link_libraries(penumbra_ros2_msgs PUBLIC CycloneDDS::ddsc)
   endif()
+else()
+  message(STATUS "ROS 2 off (PENUMBRA_WITH_ROS2=OFF): the ROS 2 bridge and rosbag2 export are off")
 endif()
 
 # the folder's .cc files are compiled one by one, outside the target's unity batches: Cyclone
