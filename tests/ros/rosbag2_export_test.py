@@ -11,7 +11,7 @@ the run folder as a ROS 2 bag and checks it with
     joint names, point fields, /tf_static frames;
 and that the message count equals the ROS 1 export's (when this build has ROS 1), that an
 existing --out is refused, and that neither a completed nor a failed export (a write past a file
-size limit) leaves a temporary folder beside the bag.
+size limit; a full 2 MiB tmpfs where one can be mounted) leaves a temporary folder beside the bag.
 
 usage: rosbag2_export_test.py PENUMBRA_BINARY SOURCE_DIR WORK_DIR   (the project venv's python)
 exits 77 (skipped, saying why) in a build without ROS 2 or without the venv's packages.
@@ -307,6 +307,22 @@ class Rosbag2ExportTest(unittest.TestCase):
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertIn("File too large", r.stderr)
         self.assertEqual(os.listdir(os.path.dirname(out)), [])
+
+    def test_a_full_disk_exits_one_with_the_reason_and_leaves_nothing(self):
+        mnt = os.path.join(WORK, "full_disk")
+        os.makedirs(mnt)
+        m = run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", mnt])
+        if m.returncode != 0:
+            self.skipTest("cannot mount a 2 MiB tmpfs here: " + m.stderr.strip())
+        try:
+            out = os.path.join(mnt, "bag")
+            r = run([BINARY, "export", self.run_dir, "--format", "rosbag2", "--out", out])
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertIn("No space left on device", r.stderr)
+            self.assertIn(out, r.stderr)
+            self.assertEqual(os.listdir(mnt), [])
+        finally:
+            run(["umount", "-l", mnt])
 
     def test_an_existing_folder_is_refused(self):
         before = sorted(os.listdir(self.bag))
