@@ -9,8 +9,8 @@ made from and the type table (DDS name, RIHS01 hash, ros2msg definition) to WORK
 with the project venv's PyPI packages:
   - every RIHS01 hash against rosbags' Typestore.hash_rihs01 and against published values
     (std_msgs/msg/String's in the ROS 2 design docs; std_srvs/srv/Trigger_Request and
-    _Response and the message types below as ROS 2 Jazzy's generated code has them, quoted by
-    public projects that list them), where a type is not in the table (String, Time, Header)
+    _Response and the message types below as ROS 2 Jazzy's generated code and `ros2 topic info
+    -v` have them, quoted by public projects; all table types but ParticipantEntitiesInfo), where a type is not in the table (String, Time, Header)
     as scripts/ros2_idl.py's implementation computes it;
   - every definition parsed by rosbags (get_types_from_msg) against rosbags' own Jazzy types;
   - every sample decoded by rosbags' deserialize_cdr and by mcap_ros2's decoder built from our
@@ -45,6 +45,12 @@ PUBLISHED = {
     "sensor_msgs/msg/Imu": "RIHS01_7d9a00ff131080897a5ec7e26e315954b8eae3353c3f995c55faf71574000b5b",
     "nav_msgs/msg/Odometry": "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0",
     "rosgraph_msgs/msg/Clock": "RIHS01_692f7a66e93a3c83e71765d033b60349ba68023a8c689a79e48078bcb5c58564",
+    # as `ros2 topic info -v` prints them on Jazzy
+    "sensor_msgs/msg/Image": "RIHS01_d31d41a9a4c4bc8eae9be757b0beed306564f7526c88ea6a4588fb9582527d47",
+    "sensor_msgs/msg/CameraInfo": "RIHS01_b3dfd68ff46c9d56c80fd3bd4ed22c7a4ddce8c8348f2f59c299e73118e7e275",
+    "sensor_msgs/msg/PointCloud2": "RIHS01_9198cabf7da3796ae6fe19c4cb3bdd3525492988c70522628af5daa124bae2b5",
+    "sensor_msgs/msg/JointState": "RIHS01_a13ee3a330e346c9d87b5aa18d24e11690752bd33a0350f11c5882bc9179260e",
+    "tf2_msgs/msg/TFMessage": "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
 }
 
 TRIGGER_HEADER = struct.Struct("<Qq")  # rmw_cyclonedds's request header, after the 4-byte CDR header
