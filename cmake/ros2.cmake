@@ -44,11 +44,14 @@ if(NOT PENUMBRA_WITH_ROS2 STREQUAL "OFF")
                    "and rosbag2 export")
     enable_language(C)
     set(_ros2_gen "${CMAKE_BINARY_DIR}/generated/ros2")
+    # regenerated when the script or rosbags' Jazzy store changes (a pip upgrade of rosbags)
+    file(GLOB _ros2_store CONFIGURE_DEPENDS
+         "${PENUMBRA_VENV}/lib/python3*/site-packages/rosbags/typesys/stores/ros2_jazzy.py")
     add_custom_command(
       OUTPUT ${_ros2_gen}/ros2_msgs.idl ${_ros2_gen}/ros2_types.inc
       COMMAND "${_ros2_python}" ${CMAKE_SOURCE_DIR}/scripts/ros2_idl.py
               --idl ${_ros2_gen}/ros2_msgs.idl --inc ${_ros2_gen}/ros2_types.inc
-      DEPENDS ${CMAKE_SOURCE_DIR}/scripts/ros2_idl.py ${PENUMBRA_VENV}/pyvenv.cfg
+      DEPENDS ${CMAKE_SOURCE_DIR}/scripts/ros2_idl.py ${PENUMBRA_VENV}/pyvenv.cfg ${_ros2_store}
       COMMENT "ROS 2 message types from rosbags' Jazzy definitions (scripts/ros2_idl.py)"
       VERBATIM)
     # -Wno-implicit-extensibility: ROS 2's types are final (rmw_cyclonedds's are), idlc's default
