@@ -11,7 +11,8 @@ the run folder as a ROS 2 bag and checks it with
     joint names, point fields, /tf_static frames;
 and that the message count equals the ROS 1 export's (when this build has ROS 1), that an
 existing --out is refused, and that neither a completed nor a failed export (a write past a file
-size limit; a full 2 MiB tmpfs where one can be mounted) leaves a temporary folder beside the bag.
+size limit; a full 2 MiB tmpfs where one can be mounted; SIGINT) leaves a temporary folder beside
+the bag.
 
 usage: rosbag2_export_test.py PENUMBRA_BINARY SOURCE_DIR WORK_DIR   (the project venv's python)
 exits 77 (skipped, saying why) in a build without ROS 2 or without the venv's packages.
@@ -323,6 +324,35 @@ class Rosbag2ExportTest(unittest.TestCase):
             self.assertEqual(os.listdir(mnt), [])
         finally:
             run(["umount", "-l", mnt])
+
+    def test_an_interrupted_export_leaves_nothing(self):
+        # SIGINT at several points of the export: each ends as exit 130 with nothing at or
+        # beside --out (killed by it before the handler is set: nothing either), or (too late to
+        # stop) as a complete bag
+        import time
+
+        stopped = 0
+        for i in range(40):
+            if stopped >= 2:
+                break
+            delay = 0.01 * (i + 1)
+            parent = os.path.join(WORK, "stop%d" % i)
+            os.makedirs(parent)
+            out = os.path.join(parent, "bag")
+            p = subprocess.Popen([BINARY, "export", self.run_dir, "--format", "rosbag2", "--out",
+                                  out], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                 text=True)
+            time.sleep(delay)
+            p.send_signal(signal.SIGINT)
+            _, err = p.communicate(timeout=60)
+            if p.returncode in (130, -signal.SIGINT):  # stopped, or before it set its handler
+                stopped += p.returncode == 130
+                self.assertEqual(os.listdir(parent), [], err)
+            else:
+                self.assertEqual(p.returncode, 0, err)
+                self.assertEqual(os.listdir(parent), ["bag"])
+                self.assertEqual(sorted(os.listdir(out)), ["bag_0.mcap", "metadata.yaml"])
+        self.assertGreater(stopped, 0)
 
     def test_an_existing_folder_is_refused(self):
         before = sorted(os.listdir(self.bag))
