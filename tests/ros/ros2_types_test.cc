@@ -221,6 +221,10 @@ TEST(Ros2Types, MalformedCdrIsRefusedBeforeAllocating) {
   auto none = [](const void*) { FAIL() << "a malformed sample was read"; };
   // too short for the header, a foreign encapsulation, truncated data
   EXPECT_THROW(WithCdrSample(Ros2Type::kJointState, std::vector<uint8_t>{0, 1}, none), Error);
+  EXPECT_NE(ErrorOf([&] {
+              WithCdrSample(Ros2Type::kClock, std::vector<uint8_t>{0, 1, 0, 0}, none);
+            }).find("no data after its 4-byte header"),
+            std::string::npos);
   auto pl = good;
   pl[1] = 0x03;  // PL_CDR_LE
   EXPECT_NE(ErrorOf([&] {

@@ -338,8 +338,9 @@ void WithCdrSample(Ros2Type type, std::span<const uint8_t> cdr,
   auto bad = [&](const std::string& why) {
     return Error(std::string("ROS 2: the CDR of a ") + info.ros_name + " " + why);
   };
-  if (cdr.size() < 4)
-    throw bad("has " + std::to_string(cdr.size()) + " bytes, less than its header");
+  if (cdr.size() <= 4) {
+    throw bad("has " + std::to_string(cdr.size()) + " bytes, no data after its 4-byte header");
+  }
   if (cdr[0] != 0x00 || (cdr[1] != 0x00 && cdr[1] != 0x01)) {
     throw bad("starts with " + std::to_string(cdr[0]) + ", " + std::to_string(cdr[1]) +
               ", expected the encapsulation of plain CDR (0, 0 big or 0, 1 little endian)");
