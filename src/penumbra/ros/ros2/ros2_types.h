@@ -69,8 +69,8 @@ struct Ros2TypeInfo {
 /// the table entry of `type`. throws Error for a value outside the enum.
 const Ros2TypeInfo& Ros2TypeOf(Ros2Type type);
 
-/// the largest sequences accepted from a sample (joints of a JointState, nodes of a
-/// ParticipantEntitiesInfo) and strings (names, frame ids): larger ones are refused with an Error.
+/// the most joints a received JointState may name, and the longest string (joint name, frame id,
+/// Trigger message) read from a received sample, in bytes: larger ones are refused with an Error.
 inline constexpr uint32_t kRos2MaxJoints = 1024;
 inline constexpr uint32_t kRos2MaxNameBytes = 1024;
 
