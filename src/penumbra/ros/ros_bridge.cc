@@ -13,8 +13,10 @@
 #include "penumbra/control/controller_capabilities.h"
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros1_node.h"
+#include "penumbra/ros/ros2/ros2_node.h"
 #include "penumbra/ros/ros_convert.h"
 #include "penumbra/ros/ros_graph.h"
+#include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/ros_config.h"
 
 namespace penumbra {
@@ -29,6 +31,21 @@ constexpr int kSensorQueue = 100;
 constexpr int kStateQueue = 20;
 // /clock at most once per this much sim time
 constexpr double kClockPeriodSec = 1e-3;
+constexpr const char* kStepsPerTrigger = "/penumbra/steps_per_trigger";
+
+std::unique_ptr<RosNode> MakeNode(const RosBridgeOptions& options) {
+  if (options.transport == RosTransport::kRos2) {
+    Ros2Node::Options o;
+    o.name = options.node_name;
+    o.domain_id = options.ros2_domain;
+    o.interface_address = options.ros2_interface;
+    return std::make_unique<Ros2Node>(o);
+  }
+  Ros1Node::Options o;
+  o.name = options.node_name;
+  o.master_uri = options.master_uri;
+  return std::make_unique<Ros1Node>(o);
+}
 
 struct CameraTopics {
   const RosSensorGraph* graph = nullptr;
@@ -38,15 +55,19 @@ struct CameraTopics {
 class RosBridge : public RunBridge {
  public:
   RosBridge(const RunBridgeContext& context, const RosBridgeOptions& options)
-      : context_(context), model_(context.session.sim().model_info()) {
+      : context_(context),
+        model_(context.session.sim().model_info()),
+        options_(options),
+        tag_(options.transport == RosTransport::kRos2 ? "ROS 2 bridge" : "ROS bridge") {
     Simulation& sim = context.session.sim();
     graph_ = BuildRosGraph(context.world, LoadRosConfig(context.world), model_,
                            SensorMountsOf(context.world, model_, context.session.scene()),
                            sim.MocapBodyNames());
-    Ros1Node::Options node_options;
-    node_options.name = options.node_name;
-    node_options.master_uri = options.master_uri;
-    node_ = std::make_unique<Ros1Node>(node_options);
+    if (options.steps_per_trigger < 1)
+      throw ConfigError("", 0, "--ros-steps-per-trigger",
+                        fmt::format("{} is not a step count; expected an integer >= 1",
+                                    options.steps_per_trigger));
+    node_ = MakeNode(options);
     clock_ = node_->Advertise("/clock", RosTopicType::kClock, 10);
     tf_ = node_->Advertise("/tf", RosTopicType::kTf, kStateQueue);
     tf_static_ = node_->Advertise("/tf_static", RosTopicType::kTfStatic, 1);
@@ -86,8 +107,8 @@ class RosBridge : public RunBridge {
     // callbacks run from now on: a lockstep run waits for its first request in the
     // RunControl's OnStart, which may come before this bridge's OnStart
     node_->Start();
-    spdlog::info("ROS bridge: node /{} at {}, {} topics (e.g. {})", options.node_name,
-                 node_->master_uri(), graph_.PublishedTopics().size(),
+    spdlog::info("{}: node /{} {}, {} topics (e.g. {})", tag_, options.node_name, node_->where(),
+                 graph_.PublishedTopics().size(),
                  graph_.sensors.empty() ? std::string("/clock") : graph_.sensors.front().topic);
   }
 
@@ -166,9 +187,9 @@ class RosBridge : public RunBridge {
   // sends a request; a failure is logged (topics have no reply channel)
   void Send(json request) {
     const std::string what = request.dump();
-    context_.dispatcher.Dispatch(request, [what](json reply) {
+    context_.dispatcher.Dispatch(request, [what, tag = tag_](json reply) {
       if (!reply.value("ok", false))
-        spdlog::warn("ROS bridge: {} was refused: {}", what, reply.dump());
+        spdlog::warn("{}: {} was refused: {}", tag, what, reply.dump());
     });
   }
 
@@ -212,7 +233,7 @@ class RosBridge : public RunBridge {
         std::vector<double> values = v;
         if (!m.name.empty() && !joints.empty()) {
           if (m.name.size() != v.size()) {
-            spdlog::warn("ROS bridge: joint command for '{}' with {} names and {} values", robot,
+            spdlog::warn("{}: joint command for '{}' with {} names and {} values", tag_, robot,
                          m.name.size(), v.size());
             return;
           }
@@ -223,18 +244,16 @@ class RosBridge : public RunBridge {
             });
             if (it == joints.end()) {
               spdlog::warn(
-                  "ROS bridge: joint command for '{}' names joint '{}', which its "
-                  "controller does not drive",
-                  robot, m.name[i]);
+                  "{}: joint command for '{}' names joint '{}', which its controller does not "
+                  "drive",
+                  tag_, robot, m.name[i]);
               return;
             }
             values[it - joints.begin()] = v[i];
           }
           if (std::any_of(values.begin(), values.end(), [](double x) { return std::isnan(x); })) {
-            spdlog::warn(
-                "ROS bridge: joint command for '{}' does not name every joint of its "
-                "controller",
-                robot);
+            spdlog::warn("{}: joint command for '{}' does not name every joint of its controller",
+                         tag_, robot);
             return;
           }
         }
@@ -250,21 +269,30 @@ class RosBridge : public RunBridge {
               {"qwxyz", {p.orientation[3], p.orientation[0], p.orientation[1], p.orientation[2]}}});
       });
     }
-    node_->SetParam("/penumbra/steps_per_trigger",
-                    node_->IntParam("/penumbra/steps_per_trigger", 1));
+    // ROS 1 keeps a value already on the parameter server; ROS 2 has no parameter server
+    if (options_.transport == RosTransport::kRos2)
+      node_->SetParam(kStepsPerTrigger, options_.steps_per_trigger);
+    else
+      node_->SetParam(kStepsPerTrigger, node_->IntParam(kStepsPerTrigger, 1));
     node_->AdvertiseTrigger("/penumbra/step", [this] {
-      const int64_t n = node_->IntParam("/penumbra/steps_per_trigger", 1);
+      const int64_t n = node_->IntParam(kStepsPerTrigger, 1);
       return Call({{"cmd", "step"}, {"n", n}});
     });
     node_->AdvertiseTrigger("/penumbra/pause", [this] { return Call({{"cmd", "pause"}}); });
     node_->AdvertiseTrigger("/penumbra/resume", [this] { return Call({{"cmd", "resume"}}); });
     node_->AdvertiseTrigger("/penumbra/reset", [this] { return Call({{"cmd", "reset"}}); });
+    for (const std::string& preset : BundledAdversityPresetNames())
+      node_->AdvertiseTrigger("/penumbra/adversity/" + preset, [this, preset] {
+        return Call({{"cmd", "set_adversity"}, {"preset", preset}});
+      });
   }
 
   RunBridgeContext context_;
   const ModelInfo& model_;
+  RosBridgeOptions options_;
+  std::string tag_;  // "ROS bridge" / "ROS 2 bridge", for the log
   RosGraph graph_;
-  std::unique_ptr<Ros1Node> node_;
+  std::unique_ptr<RosNode> node_;
   int clock_ = -1, tf_ = -1, tf_static_ = -1;
   std::vector<int> odom_, joint_states_;
   std::map<std::string, CameraTopics> cameras_;

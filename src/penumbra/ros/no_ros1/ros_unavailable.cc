@@ -56,5 +56,6 @@ int64_t Ros1Node::IntParam(const std::string&, int64_t fallback) const { return 
 void Ros1Node::SetParam(const std::string&, int64_t) {}
 void Ros1Node::Start() {}
 std::string Ros1Node::master_uri() const { return ""; }
+std::string Ros1Node::where() const { return ""; }
 
 }  // namespace penumbra

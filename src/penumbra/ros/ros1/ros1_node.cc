@@ -187,4 +187,6 @@ void Ros1Node::Start() {
 
 std::string Ros1Node::master_uri() const { return ros::master::getURI(); }
 
+std::string Ros1Node::where() const { return "at " + master_uri(); }
+
 }  // namespace penumbra

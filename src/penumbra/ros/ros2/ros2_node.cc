@@ -1,0 +1,431 @@
+#include "penumbra/ros/ros2/ros2_node.h"
+
+#include <dds/dds.h>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <tuple>
+
+#include "penumbra/core/error.h"
+#include "penumbra/ros/ros2/ros2_types.h"
+#include "penumbra/ros/ros2_names.h"
+
+namespace penumbra {
+
+namespace {
+
+// samples taken from a reader at once
+constexpr uint32_t kTakeBatch = 16;
+// how long a service waits for its reply writer to match the caller's reply reader
+constexpr auto kReplyMatchWait = std::chrono::milliseconds(500);
+
+std::string DdsError(dds_return_t rc) { return dds_strretcode(rc); }
+
+// a DDS entity, or Error naming what failed and Cyclone's reason
+dds_entity_t Check(dds_entity_t e, const std::string& what) {
+  if (e < 0) throw Error(fmt::format("cannot create {}: {}", what, DdsError(e)));
+  return e;
+}
+
+struct QosDeleter {
+  void operator()(dds_qos_t* q) const { dds_delete_qos(q); }
+};
+using QosPtr = std::unique_ptr<dds_qos_t, QosDeleter>;
+
+// a ROS 2 QoS profile and REP-2011's type hash user data
+QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* type_hash) {
+  QosPtr q(dds_create_qos());
+  dds_qset_reliability(q.get(), reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+                       DDS_INFINITY);
+  dds_qset_durability(q.get(),
+                      transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+  // rmw_cyclonedds: samples of a deleted writer are not disposed (ROS 2 has no instances)
+  dds_qset_writer_data_lifecycle(q.get(), false);
+  const std::string user_data = fmt::format("typehash={};", type_hash);
+  dds_qset_userdata(q.get(), user_data.data(), user_data.size());
+  return q;
+}
+
+Ros2Type Ros2TypeOfTopic(RosTopicType t) {
+  switch (t) {
+    case RosTopicType::kImage:
+      return Ros2Type::kImage;
+    case RosTopicType::kCameraInfo:
+      return Ros2Type::kCameraInfo;
+    case RosTopicType::kPointCloud2:
+      return Ros2Type::kPointCloud2;
+    case RosTopicType::kImu:
+      return Ros2Type::kImu;
+    case RosTopicType::kJointState:
+      return Ros2Type::kJointState;
+    case RosTopicType::kOdometry:
+      return Ros2Type::kOdometry;
+    case RosTopicType::kTf:
+    case RosTopicType::kTfStatic:
+      return Ros2Type::kTfMessage;
+    case RosTopicType::kClock:
+      return Ros2Type::kClock;
+  }
+  throw Error("unknown ROS topic type");
+}
+
+// the writer QoS of a topic type (ros/ros2/ros2_node.h)
+QosPtr WriterQos(RosTopicType t, const char* type_hash) {
+  switch (t) {
+    case RosTopicType::kImage:
+    case RosTopicType::kCameraInfo:
+    case RosTopicType::kPointCloud2:
+    case RosTopicType::kImu:
+      return MakeQos(false, false, 5, type_hash);
+    case RosTopicType::kJointState:
+    case RosTopicType::kOdometry:
+      return MakeQos(true, false, 10, type_hash);
+    case RosTopicType::kTf:
+      return MakeQos(true, false, 100, type_hash);
+    case RosTopicType::kTfStatic:
+      return MakeQos(true, true, 1, type_hash);
+    case RosTopicType::kClock:
+      return MakeQos(true, false, 1, type_hash);
+  }
+  throw Error("unknown ROS topic type");
+}
+
+}  // namespace
+
+struct Ros2Node::Impl {
+  Options options;
+  dds_entity_t domain = 0, participant = 0;
+  dds_entity_t topic_waitset = 0, service_waitset = 0;
+  dds_entity_t topic_stop = 0, service_stop = 0;
+  std::map<std::string, dds_entity_t> topics;  // DDS topic name -> topic
+
+  struct Publisher {
+    std::string name;
+    RosTopicType type;
+    dds_entity_t writer;
+  };
+  std::vector<Publisher> publishers;  // fixed before Start (Advertise is a set-up call)
+  mutable std::mutex mutex;           // guards publishers and params
+
+  struct Reader {
+    std::string topic;  // ROS name, for the log
+    dds_entity_t reader;
+    std::function<void(const void*)> on_sample;
+  };
+  std::vector<Reader> readers;
+
+  struct Service {
+    std::string name;
+    dds_entity_t request_reader, reply_writer;
+    std::function<std::pair<bool, std::string>()> callback;
+  };
+  std::vector<Service> services;
+
+  std::map<std::string, int64_t> params;
+  std::thread topic_thread, service_thread;
+  bool started = false;
+
+  dds_entity_t Topic(const std::string& dds_name, Ros2Type type) {
+    auto it = topics.find(dds_name);
+    if (it != topics.end()) return it->second;
+    const Ros2TypeInfo& info = Ros2TypeOf(type);
+    const dds_entity_t t =
+        Check(dds_create_topic(participant, info.descriptor, dds_name.c_str(), nullptr, nullptr),
+              fmt::format("the DDS topic {} ({})", dds_name, info.dds_name));
+    topics[dds_name] = t;
+    return t;
+  }
+
+  dds_entity_t Writer(int id, RosTopicType type) const {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (id < 0 || id >= static_cast<int>(publishers.size()))
+      throw Error(fmt::format("no ROS 2 publisher {}", id));
+    const Publisher& p = publishers[id];
+    if (p.type != type && !(type == RosTopicType::kTf && p.type == RosTopicType::kTfStatic))
+      throw Error("ROS 2 publisher " + p.name + " has another message type");
+    return p.writer;
+  }
+
+  void Write(dds_entity_t writer, const void* sample, const std::string& what) {
+    const dds_return_t rc = dds_write(writer, sample);
+    if (rc < 0) spdlog::warn("ROS 2 bridge: cannot publish on {}: {}", what, DdsError(rc));
+  }
+
+  // takes every sample of `r` and hands each valid one to its callback
+  void TakeAll(const Reader& r) {
+    void* samples[kTakeBatch] = {};
+    dds_sample_info_t infos[kTakeBatch];
+    for (;;) {
+      const dds_return_t n = dds_take(r.reader, samples, infos, kTakeBatch, kTakeBatch);
+      if (n <= 0) return;
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        try {
+          r.on_sample(samples[i]);
+        } catch (const std::exception& e) {
+          spdlog::warn("ROS 2 bridge: a message on {} was dropped: {}", r.topic, e.what());
+        }
+      }
+      dds_return_loan(r.reader, samples, n);
+    }
+  }
+
+  void Serve(const Service& s) {
+    void* samples[kTakeBatch] = {};
+    dds_sample_info_t infos[kTakeBatch];
+    for (;;) {
+      const dds_return_t n = dds_take(s.request_reader, samples, infos, kTakeBatch, kTakeBatch);
+      if (n <= 0) return;
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        Ros2TriggerResponse reply;
+        try {
+          reply.header = TriggerRequestFromSample(samples[i]);
+        } catch (const std::exception& e) {
+          spdlog::warn("ROS 2 bridge: a request to {} was dropped: {}", s.name, e.what());
+          continue;
+        }
+        try {
+          std::tie(reply.success, reply.message) = s.callback();
+        } catch (const std::exception& e) {
+          reply.success = false;
+          reply.message = e.what();
+        }
+        // the caller made its reply reader before it sent the request; a reply written before
+        // the two have matched would be lost (volatile), so wait for a match (bounded)
+        const auto deadline = std::chrono::steady_clock::now() + kReplyMatchWait;
+        dds_publication_matched_status_t st{};
+        while (dds_get_publication_matched_status(s.reply_writer, &st) == DDS_RETCODE_OK &&
+               st.current_count == 0 && std::chrono::steady_clock::now() < deadline)
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        WithSample(reply, [&](const void* sample) {
+          Write(s.reply_writer, sample, Ros2ReplyTopic(s.name));
+        });
+      }
+      dds_return_loan(s.request_reader, samples, n);
+    }
+  }
+
+  // waits on `waitset` until its guard condition (attached as `count`) triggers;
+  // `on_trigger(index)` for each triggered reader (attached as its index)
+  static void Loop(dds_entity_t waitset, const std::function<void(size_t)>& on_trigger,
+                   size_t count) {
+    std::vector<dds_attach_t> triggered(count + 1);
+    for (;;) {
+      const dds_return_t n =
+          dds_waitset_wait(waitset, triggered.data(), triggered.size(), DDS_INFINITY);
+      if (n < 0) {
+        spdlog::error("ROS 2 bridge: waiting for DDS samples failed: {}", DdsError(n));
+        return;
+      }
+      for (dds_return_t i = 0; i < n; ++i) {
+        const auto a = static_cast<size_t>(triggered[i]);
+        if (a == count) return;
+        if (a < count) on_trigger(a);
+      }
+    }
+  }
+};
+
+Ros2Node::Ros2Node(const Options& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.options = options;
+  if (options.domain_id < 0 || options.domain_id > kRos2MaxDomainId)
+    throw ConfigError("", 0, "--ros-domain",
+                      fmt::format("{} is not a ROS 2 domain id; expected an integer in [0, {}]",
+                                  options.domain_id, kRos2MaxDomainId));
+  const std::string xml = CycloneConfigXml(options.interface_address);
+  const auto domain_id = static_cast<dds_domainid_t>(options.domain_id);
+  m.domain = dds_create_domain(domain_id, xml.c_str());
+  if (m.domain < 0)
+    throw Error(fmt::format("cannot create ROS 2 domain {} on {}: {}{}", options.domain_id,
+                            options.interface_address, DdsError(m.domain),
+                            m.domain == DDS_RETCODE_PRECONDITION_NOT_MET
+                                ? " (a ROS 2 node of this process already uses the domain)"
+                                : " (is the address one of this machine's network interfaces?)"));
+  QosPtr pq(dds_create_qos());
+  // rmw_cyclonedds: the participant's security enclave, "/" without ROS 2 security
+  const std::string enclave = "enclave=/;";
+  dds_qset_userdata(pq.get(), enclave.data(), enclave.size());
+  m.participant = dds_create_participant(domain_id, pq.get(), nullptr);
+  if (m.participant < 0) {
+    const dds_return_t rc = m.participant;
+    dds_delete(m.domain);
+    throw Error(fmt::format("cannot create the ROS 2 participant in domain {} on {}: {}",
+                            options.domain_id, options.interface_address, DdsError(rc)));
+  }
+}
+
+Ros2Node::~Ros2Node() {
+  Impl& m = *impl_;
+  if (m.topic_stop > 0) dds_set_guardcondition(m.topic_stop, true);
+  if (m.service_stop > 0) dds_set_guardcondition(m.service_stop, true);
+  if (m.topic_thread.joinable()) m.topic_thread.join();
+  if (m.service_thread.joinable()) m.service_thread.join();
+  // deleting the domain deletes the participant and everything in it
+  dds_delete(m.domain);
+}
+
+int Ros2Node::Advertise(const std::string& topic, RosTopicType type, int) {
+  Impl& m = *impl_;
+  const Ros2Type t = Ros2TypeOfTopic(type);
+  const std::string dds_name = Ros2TopicName(topic);
+  const QosPtr q = WriterQos(type, Ros2TypeOf(t).type_hash);
+  const dds_entity_t w =
+      Check(dds_create_writer(m.participant, m.Topic(dds_name, t), q.get(), nullptr),
+            "the ROS 2 publisher " + topic);
+  std::lock_guard<std::mutex> lock(m.mutex);
+  m.publishers.push_back({topic, type, w});
+  return static_cast<int>(m.publishers.size()) - 1;
+}
+
+int Ros2Node::Subscribers(int id) const {
+  dds_entity_t w = 0;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    if (id < 0 || id >= static_cast<int>(impl_->publishers.size())) return 0;
+    w = impl_->publishers[id].writer;
+  }
+  dds_publication_matched_status_t st{};
+  if (dds_get_publication_matched_status(w, &st) != DDS_RETCODE_OK) return 0;
+  return static_cast<int>(st.current_count);
+}
+
+void Ros2Node::Publish(int id, RosImage&& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kImage);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "an image topic"); });
+}
+void Ros2Node::Publish(int id, const RosCameraInfo& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kCameraInfo);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "a camera_info topic"); });
+}
+void Ros2Node::Publish(int id, RosPointCloud2&& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kPointCloud2);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "a points topic"); });
+}
+void Ros2Node::Publish(int id, const RosImu& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kImu);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "an imu topic"); });
+}
+void Ros2Node::Publish(int id, const RosJointState& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kJointState);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "a joint_states topic"); });
+}
+void Ros2Node::Publish(int id, const RosOdometry& m) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kOdometry);
+  WithSample(m, [&](const void* s) { impl_->Write(w, s, "an odom topic"); });
+}
+void Ros2Node::Publish(int id, const std::vector<RosTransform>& transforms) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kTf);
+  WithSample(transforms, [&](const void* s) { impl_->Write(w, s, "/tf"); });
+}
+void Ros2Node::PublishClock(int id, int64_t stamp_ns) {
+  const dds_entity_t w = impl_->Writer(id, RosTopicType::kClock);
+  WithClockSample(stamp_ns, [&](const void* s) { impl_->Write(w, s, "/clock"); });
+}
+
+namespace {
+// a reader with the subscription QoS (RELIABLE KEEP_LAST 10 VOLATILE)
+dds_entity_t MakeReader(dds_entity_t participant, dds_entity_t topic, Ros2Type type,
+                        const std::string& what) {
+  const QosPtr q = MakeQos(true, false, 10, Ros2TypeOf(type).type_hash);
+  return Check(dds_create_reader(participant, topic, q.get(), nullptr), what);
+}
+}  // namespace
+
+void Ros2Node::SubscribeTwist(const std::string& topic,
+                              std::function<void(const RosTwist&)> callback) {
+  Impl& m = *impl_;
+  const dds_entity_t r = MakeReader(m.participant, m.Topic(Ros2TopicName(topic), Ros2Type::kTwist),
+                                    Ros2Type::kTwist, "the ROS 2 subscription " + topic);
+  m.readers.push_back({topic, r, [callback](const void* s) { callback(TwistFromSample(s)); }});
+}
+
+void Ros2Node::SubscribeJointState(const std::string& topic,
+                                   std::function<void(const RosJointState&)> callback) {
+  Impl& m = *impl_;
+  const dds_entity_t r =
+      MakeReader(m.participant, m.Topic(Ros2TopicName(topic), Ros2Type::kJointState),
+                 Ros2Type::kJointState, "the ROS 2 subscription " + topic);
+  m.readers.push_back({topic, r, [callback](const void* s) { callback(JointStateFromSample(s)); }});
+}
+
+void Ros2Node::SubscribePose(const std::string& topic,
+                             std::function<void(const RosPoseStamped&)> callback) {
+  Impl& m = *impl_;
+  const dds_entity_t r =
+      MakeReader(m.participant, m.Topic(Ros2TopicName(topic), Ros2Type::kPoseStamped),
+                 Ros2Type::kPoseStamped, "the ROS 2 subscription " + topic);
+  m.readers.push_back(
+      {topic, r, [callback](const void* s) { callback(PoseStampedFromSample(s)); }});
+}
+
+void Ros2Node::AdvertiseTrigger(const std::string& service,
+                                std::function<std::pair<bool, std::string>()> callback) {
+  Impl& m = *impl_;
+  const std::string what = "the ROS 2 service " + service;
+  const dds_entity_t r =
+      MakeReader(m.participant, m.Topic(Ros2RequestTopic(service), Ros2Type::kTriggerRequest),
+                 Ros2Type::kTriggerRequest, what);
+  const QosPtr wq = MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerResponse).type_hash);
+  const dds_entity_t w = Check(
+      dds_create_writer(m.participant, m.Topic(Ros2ReplyTopic(service), Ros2Type::kTriggerResponse),
+                        wq.get(), nullptr),
+      what);
+  m.services.push_back({service, r, w, std::move(callback)});
+}
+
+int64_t Ros2Node::IntParam(const std::string& name, int64_t fallback) const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  const auto it = impl_->params.find(name);
+  return it == impl_->params.end() ? fallback : it->second;
+}
+
+void Ros2Node::SetParam(const std::string& name, int64_t value) {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->params[name] = value;
+}
+
+void Ros2Node::Start() {
+  Impl& m = *impl_;
+  if (m.started) return;
+  m.started = true;
+  m.topic_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
+  m.service_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
+  m.topic_stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");
+  m.service_stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");
+  dds_waitset_attach(m.topic_waitset, m.topic_stop, m.readers.size());
+  dds_waitset_attach(m.service_waitset, m.service_stop, m.services.size());
+  for (size_t i = 0; i < m.readers.size(); ++i) {
+    const dds_entity_t c =
+        Check(dds_create_readcondition(m.readers[i].reader, DDS_ANY_STATE), "a DDS read condition");
+    dds_waitset_attach(m.topic_waitset, c, static_cast<dds_attach_t>(i));
+  }
+  for (size_t i = 0; i < m.services.size(); ++i) {
+    const dds_entity_t c =
+        Check(dds_create_readcondition(m.services[i].request_reader, DDS_ANY_STATE),
+              "a DDS read condition");
+    dds_waitset_attach(m.service_waitset, c, static_cast<dds_attach_t>(i));
+  }
+  m.topic_thread = std::thread([&m] {
+    Impl::Loop(
+        m.topic_waitset, [&m](size_t i) { m.TakeAll(m.readers[i]); }, m.readers.size());
+  });
+  m.service_thread = std::thread([&m] {
+    Impl::Loop(
+        m.service_waitset, [&m](size_t i) { m.Serve(m.services[i]); }, m.services.size());
+  });
+}
+
+std::string Ros2Node::where() const {
+  return fmt::format("in ROS 2 domain {} on {}", impl_->options.domain_id,
+                     impl_->options.interface_address);
+}
+
+}  // namespace penumbra

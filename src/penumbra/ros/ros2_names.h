@@ -1,0 +1,57 @@
+#pragma once
+// the names and settings of the ROS 2 bridge's DDS side that need no DDS library
+// (ros/ros2/ros2_node.h uses them; tests check them in-process): how rmw_cyclonedds_cpp maps ROS 2
+// names to DDS topic names, the ROS 2 domain id, and the Cyclone DDS configuration that keeps the
+// node on one network interface.
+//
+// name mapping (rmw_cyclonedds_cpp, the ROS 2 design article "Topic and Service name mapping to
+// DDS"): topic "/a/b" -> DDS topic "rt/a/b"; service "/a/b" -> request topic "rq/a/bRequest" and
+// reply topic "rr/a/bReply".
+
+#include <string>
+
+namespace penumbra {
+
+/// the largest ROS 2 domain id: DDS-RTPS maps a domain to UDP ports 7400 + 250 * id + ...,
+/// which stay below 65536 up to 232 (ROS 2's "The ROS_DOMAIN_ID" article).
+inline constexpr int kRos2MaxDomainId = 232;
+
+/// the DDS topic of the ROS 2 topic `ros_name` ("/a/b" -> "rt/a/b").
+/// @throws Error when `ros_name` is not absolute (does not start with '/') or is "/".
+std::string Ros2TopicName(const std::string& ros_name);
+/// the DDS topic of the requests of service `service` ("/a/b" -> "rq/a/bRequest").
+/// @throws Error as Ros2TopicName.
+std::string Ros2RequestTopic(const std::string& service);
+/// the DDS topic of the replies of service `service` ("/a/b" -> "rr/a/bReply").
+/// @throws Error as Ros2TopicName.
+std::string Ros2ReplyTopic(const std::string& service);
+
+/// the ROS 2 domain id: `option` (the text of --ros-domain) when not empty, else `env` (the
+/// value of $ROS_DOMAIN_ID; null or empty = unset), else 0.
+/// @throws ConfigError (key "--ros-domain" or "ROS_DOMAIN_ID") for anything but an integer in
+///         [0, kRos2MaxDomainId].
+int Ros2DomainId(const std::string& option, const char* env);
+
+/// `address` when it is a numeric IPv4 or IPv6 address of this machine's kind (inet_pton),
+/// else throws ConfigError (key "--ros-interface") naming what is expected. no name is
+/// resolved.
+std::string CheckInterfaceAddress(const std::string& address);
+
+/// whether `address` (numeric) is a loopback address (127.0.0.0/8 or ::1).
+bool IsLoopbackAddress(const std::string& address);
+
+/// the Cyclone DDS configuration (XML, for dds_create_domain) of a node on the network
+/// interface with the numeric address `address` (checked by CheckInterfaceAddress):
+///   <CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="ADDR"/>
+///   </Interfaces>...</General>...</Domain></CycloneDDS>
+/// (the interface as rmw_cyclonedds_cpp pins it for ROS_LOCALHOST_ONLY=1); for a loopback
+/// address, which has no multicast, also what rmw_cyclonedds_cpp (Jazzy) adds for
+/// ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST: <AllowMulticast>false</AllowMulticast> in General and
+/// <Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32
+/// </MaxAutoParticipantIndex><Peers><Peer address="ADDR"/></Peers></Discovery>. Cyclone then
+/// sends from and advertises that address only; it still binds its receive sockets to the
+/// wildcard address (docs/ros.md).
+/// @throws ConfigError as CheckInterfaceAddress.
+std::string CycloneConfigXml(const std::string& address);
+
+}  // namespace penumbra
