@@ -49,8 +49,8 @@ bool IsLoopbackAddress(const std::string& address);
 /// ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST: <AllowMulticast>false</AllowMulticast> in General and
 /// <Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32
 /// </MaxAutoParticipantIndex><Peers><Peer address="ADDR"/></Peers></Discovery>. Cyclone then
-/// sends from and advertises that address only; it still binds its receive sockets to the
-/// wildcard address (docs/ros.md).
+/// sends from and advertises that address only; its receive sockets it binds to the wildcard
+/// address, which Ros2Node pins to ADDR (ros/ros2/udp_bind_pin.h).
 /// @throws ConfigError as CheckInterfaceAddress.
 std::string CycloneConfigXml(const std::string& address);
 

@@ -13,6 +13,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros2/ros2_types.h"
+#include "penumbra/ros/ros2/udp_bind_pin.h"
 #include "penumbra/ros/ros2_names.h"
 
 namespace penumbra {
@@ -242,6 +243,9 @@ Ros2Node::Ros2Node(const Options& options) : impl_(std::make_unique<Impl>()) {
                                   options.domain_id, kRos2MaxDomainId));
   const std::string xml = CycloneConfigXml(options.interface_address);
   const auto domain_id = static_cast<dds_domainid_t>(options.domain_id);
+  // Cyclone creates its sockets in these calls; its receive sockets would otherwise listen on
+  // every interface (ros/ros2/udp_bind_pin.h)
+  const ScopedUdpBindPin pin(options.interface_address);
   m.domain = dds_create_domain(domain_id, xml.c_str());
   if (m.domain < 0)
     throw Error(fmt::format("cannot create ROS 2 domain {} on {}: {}{}", options.domain_id,

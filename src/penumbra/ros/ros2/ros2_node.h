@@ -19,12 +19,18 @@
 //             reply echoes so that the calling client takes it as its answer.
 //   domain    Options::domain_id (ros/ros2_names.h Ros2DomainId), created with dds_create_domain
 //             from CycloneConfigXml(Options::interface_address): CYCLONEDDS_URI does not apply.
+//   sockets   all on Options::interface_address: Cyclone binds its transmit socket there and its
+//             unicast receive sockets (ports 7400 + 250 domain + 10 + 2 i and + 11 + 2 i) to the
+//             wildcard address, which the node pins to the interface (ros/ros2/udp_bind_pin.h).
+//             a multicast receive socket (only on a non-loopback interface) stays on the
+//             wildcard: Linux delivers multicast only to sockets bound to it or to the group.
 //   params    ROS 2 has no parameter server: IntParam / SetParam are values of this node.
 //
 // callbacks of subscriptions run on one thread of the node, services on another (a blocking
-// service, e.g. a lockstep step, never holds cmd_vel back), both started by Start(). a sample
-// whose sequences are longer than the bounds of ros/ros2/ros2_types.h is refused by Cyclone's
-// deserializer; a subscription's conversion is logged and dropped when it throws.
+// service, e.g. a lockstep step, never holds cmd_vel back), both started by Start().
+// Cyclone checks every length of a received sample against its size before it allocates; the
+// conversion (ros/ros2/ros2_types.h) bounds names and joint counts further, and a sample it
+// refuses is logged and dropped.
 //
 // this header includes no DDS header; in a build without ROS 2 the constructor throws Error.
 
