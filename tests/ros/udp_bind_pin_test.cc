@@ -1,7 +1,7 @@
-// ScopedUdpBindPin (ros/ros2/udp_bind_pin.h): wildcard UDP binds of the pinning thread go to the
+// ScopedUdpBindPin (ros/udp_bind_pin.h): wildcard UDP binds of the pinning thread go to the
 // pinned address, every other bind is left alone; and a ROS 2 node's Cyclone DDS sockets listen
 // on its interface only (checked in /proc/net/udp, as `ss -uan` shows them).
-#include "penumbra/ros/ros2/udp_bind_pin.h"
+#include "penumbra/ros/udp_bind_pin.h"
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>

@@ -50,7 +50,7 @@ bool IsLoopbackAddress(const std::string& address);
 /// <Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32
 /// </MaxAutoParticipantIndex><Peers><Peer address="ADDR"/></Peers></Discovery>. Cyclone then
 /// sends from and advertises that address only; its receive sockets it binds to the wildcard
-/// address, which Ros2Node pins to ADDR (ros/ros2/udp_bind_pin.h).
+/// address, which Ros2Node pins to ADDR (ros/udp_bind_pin.h).
 /// @throws ConfigError as CheckInterfaceAddress.
 std::string CycloneConfigXml(const std::string& address);
 

@@ -13,7 +13,7 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros2/ros2_types.h"
-#include "penumbra/ros/ros2/udp_bind_pin.h"
+#include "penumbra/ros/udp_bind_pin.h"
 #include "penumbra/ros/ros2_names.h"
 
 namespace penumbra {
@@ -244,7 +244,7 @@ Ros2Node::Ros2Node(const Options& options) : impl_(std::make_unique<Impl>()) {
   const std::string xml = CycloneConfigXml(options.interface_address);
   const auto domain_id = static_cast<dds_domainid_t>(options.domain_id);
   // Cyclone creates its sockets in these calls; its receive sockets would otherwise listen on
-  // every interface (ros/ros2/udp_bind_pin.h)
+  // every interface (ros/udp_bind_pin.h)
   const ScopedUdpBindPin pin(options.interface_address);
   m.domain = dds_create_domain(domain_id, xml.c_str());
   if (m.domain < 0)

@@ -21,7 +21,7 @@
 //             from CycloneConfigXml(Options::interface_address): CYCLONEDDS_URI does not apply.
 //   sockets   all on Options::interface_address: Cyclone binds its transmit socket there and its
 //             unicast receive sockets (ports 7400 + 250 domain + 10 + 2 i and + 11 + 2 i) to the
-//             wildcard address, which the node pins to the interface (ros/ros2/udp_bind_pin.h).
+//             wildcard address, which the node pins to the interface (ros/udp_bind_pin.h).
 //             a multicast receive socket (only on a non-loopback interface) stays on the
 //             wildcard: Linux delivers multicast only to sockets bound to it or to the group.
 //   params    ROS 2 has no parameter server: IntParam / SetParam are values of this node.

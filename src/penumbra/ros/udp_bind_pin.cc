@@ -1,4 +1,4 @@
-#include "penumbra/ros/ros2/udp_bind_pin.h"
+#include "penumbra/ros/udp_bind_pin.h"
 
 #include <arpa/inet.h>
 #include <dlfcn.h>
