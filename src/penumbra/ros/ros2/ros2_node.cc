@@ -13,8 +13,8 @@
 
 #include "penumbra/core/error.h"
 #include "penumbra/ros/ros2/ros2_types.h"
-#include "penumbra/ros/udp_bind_pin.h"
 #include "penumbra/ros/ros2_names.h"
+#include "penumbra/ros/udp_bind_pin.h"
 
 namespace penumbra {
 
@@ -132,12 +132,40 @@ struct Ros2Node::Impl {
   std::thread topic_thread, service_thread;
   bool started = false;
 
+  // idlc's descriptors without their XTypes type information, one per type used
+  std::map<Ros2Type, std::unique_ptr<dds_topic_descriptor_t>> descriptors;
+
+  // the descriptor of `type` without XTypes type information: rmw_cyclonedds's topics carry
+  // none either (ROS 2 matches on the type name), and with it Cyclone 0.10 asks a peer whose
+  // type ids differ (e.g. a Cyclone 0.11 peer that types uint8 as TK_UINT8, not octet) for its
+  // type objects and crashes on the answer: a network peer could end the run
+  const dds_topic_descriptor_t* Descriptor(Ros2Type type) {
+    auto& d = descriptors[type];
+    if (!d) {
+      const dds_topic_descriptor_t& s = *Ros2TypeOf(type).descriptor;
+      d.reset(new dds_topic_descriptor_t{
+          s.m_size,
+          s.m_align,
+          s.m_flagset & ~static_cast<uint32_t>(DDS_TOPIC_XTYPES_METADATA),
+          s.m_nkeys,
+          s.m_typename,
+          s.m_keys,
+          s.m_nops,
+          s.m_ops,
+          s.m_meta,
+          {nullptr, 0},
+          {nullptr, 0},
+          s.restrict_data_representation});
+    }
+    return d.get();
+  }
+
   dds_entity_t Topic(const std::string& dds_name, Ros2Type type) {
     auto it = topics.find(dds_name);
     if (it != topics.end()) return it->second;
     const Ros2TypeInfo& info = Ros2TypeOf(type);
     const dds_entity_t t =
-        Check(dds_create_topic(participant, info.descriptor, dds_name.c_str(), nullptr, nullptr),
+        Check(dds_create_topic(participant, Descriptor(type), dds_name.c_str(), nullptr, nullptr),
               fmt::format("the DDS topic {} ({})", dds_name, info.dds_name));
     topics[dds_name] = t;
     return t;
