@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -129,6 +131,7 @@ struct Ros2Node::Impl {
   std::vector<Service> services;
 
   std::map<std::string, int64_t> params;
+  dds_entity_t discovery_writer = 0;  // ros_discovery_info
   std::thread topic_thread, service_thread;
   bool started = false;
 
@@ -424,10 +427,45 @@ void Ros2Node::SetParam(const std::string& name, int64_t value) {
   impl_->params[name] = value;
 }
 
+namespace {
+// the GID of a DDS entity as rmw_cyclonedds makes it: the 16-byte GUID
+Ros2ParticipantEntities::Gid GidOf(dds_entity_t e) {
+  dds_guid_t guid;
+  Ros2ParticipantEntities::Gid gid{};
+  if (dds_get_guid(e, &guid) == DDS_RETCODE_OK)
+    std::copy(std::begin(guid.v), std::end(guid.v), gid.begin());
+  return gid;
+}
+}  // namespace
+
 void Ros2Node::Start() {
   Impl& m = *impl_;
   if (m.started) return;
   m.started = true;
+  // ros_discovery_info: ROS 2's graph (`ros2 node list`, rmw_dds_common) learns which node owns
+  // which readers and writers from it; RELIABLE TRANSIENT_LOCAL KEEP_LAST 1, no "rt/" prefix
+  {
+    Ros2ParticipantEntities info;
+    info.gid = GidOf(m.participant);
+    Ros2ParticipantEntities::Node node;
+    node.node_namespace = "/";
+    node.node_name = m.options.name;
+    for (const Impl::Publisher& p : m.publishers) node.writers.push_back(GidOf(p.writer));
+    for (const Impl::Reader& r : m.readers) node.readers.push_back(GidOf(r.reader));
+    for (const Impl::Service& sv : m.services) {
+      node.readers.push_back(GidOf(sv.request_reader));
+      node.writers.push_back(GidOf(sv.reply_writer));
+    }
+    info.nodes.push_back(std::move(node));
+    const QosPtr q =
+        MakeQos(true, true, 1, Ros2TypeOf(Ros2Type::kParticipantEntitiesInfo).type_hash);
+    m.discovery_writer =
+        Check(dds_create_writer(m.participant,
+                                m.Topic("ros_discovery_info", Ros2Type::kParticipantEntitiesInfo),
+                                q.get(), nullptr),
+              "the ros_discovery_info writer");
+    WithSample(info, [&](const void* s) { m.Write(m.discovery_writer, s, "ros_discovery_info"); });
+  }
   m.topic_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
   m.service_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
   m.topic_stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");

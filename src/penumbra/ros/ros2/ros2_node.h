@@ -25,6 +25,10 @@
 //             a multicast receive socket (only on a non-loopback interface) stays on the
 //             wildcard: Linux delivers multicast only to sockets bound to it or to the group.
 //   params    ROS 2 has no parameter server: IntParam / SetParam are values of this node.
+//   graph     Start() publishes rmw_dds_common/msg/ParticipantEntitiesInfo on the DDS topic
+//             "ros_discovery_info" (RELIABLE TRANSIENT_LOCAL KEEP_LAST 1; Jazzy's 16-byte GIDs:
+//             the DDS GUIDs): the node /<name> with every reader and writer made before, so that
+//             `ros2 node list` and `ros2 node info` show it.
 //
 // callbacks of subscriptions run on one thread of the node, services on another (a blocking
 // service, e.g. a lockstep step, never holds cmd_vel back), both started by Start().
@@ -98,6 +102,7 @@ class Ros2Node : public RosNode {
   int64_t IntParam(const std::string& name, int64_t fallback) const override;
   void SetParam(const std::string& name, int64_t value) override;
 
+  /// publishes ros_discovery_info (see the file header), then starts the callback threads.
   void Start() override;
   /// "in ROS 2 domain <id> on <address>".
   std::string where() const override;
