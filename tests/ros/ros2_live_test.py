@@ -421,6 +421,19 @@ class Ros2Live(unittest.TestCase):
                     "std_srvs/srv/Trigger_Request")).encode())
                 self.assertEqual(userdata(rr.qos), ("typehash=%s;" % TS.hash_rihs01(
                     "std_srvs/srv/Trigger_Response")).encode())
+        # `ros2 node list` and `ros2 topic info -v` read ros_discovery_info (rmw_dds_common):
+        # the node /penumbra with the GUIDs of its readers and writers
+        disc = DataReader(node.dp, node.topic("ros_discovery_info",
+                                              "rmw_dds_common/msg/ParticipantEntitiesInfo", True),
+                          ros_qos((True, True, 10)))
+        msgs = take(disc, 1, 20, "rmw_dds_common/msg/ParticipantEntitiesInfo")
+        nodes = {(n.node_namespace, n.node_name): n for m in msgs
+                 for n in m.node_entities_info_seq}
+        self.assertIn(("/", "penumbra"), nodes)
+        writers = {bytes(g.data) for g in nodes[("/", "penumbra")].writer_gid_seq}
+        readers = {bytes(g.data) for g in nodes[("/", "penumbra")].reader_gid_seq}
+        self.assertIn(node.seen_pub["rt/clock"].key.bytes, writers)
+        self.assertIn(node.seen_sub["rt" + ROBOT + "/cmd_vel"].key.bytes, readers)
         # the published std_msgs/String hash pins rosbags' implementation of REP-2011
         self.assertEqual(TS.hash_rihs01("std_msgs/msg/String"),
                          "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18")
