@@ -34,6 +34,7 @@ pkgs=(
   libglfw3-dev xvfb xauth  # scripts/compare_with_mujoco.py: MuJoCo's own renderer (tools/mujoco_offscreen.cc) under Xvfb
   cyclonedds-dev cyclonedds-tools  # ROS 2 bridge and rosbag2 export: Cyclone DDS's C library and idlc
   python3-venv  # the project venv below
+  iproute2  # tests/ros/ros2_remote_test.py: a second host as a network namespace
 )
 missing=()
 for p in "${pkgs[@]}"; do
