@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <iterator>
@@ -41,7 +42,10 @@ struct QosDeleter {
 using QosPtr = std::unique_ptr<dds_qos_t, QosDeleter>;
 
 // a ROS 2 QoS profile and REP-2011's type hash user data
-QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* type_hash) {
+// (`user_data_prefix`: more "key=value;" pairs before the type hash, as rmw_cyclonedds's
+// serviceid)
+QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* type_hash,
+               const std::string& user_data_prefix = "") {
   QosPtr q(dds_create_qos());
   dds_qset_reliability(q.get(), reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_INFINITY);
@@ -50,7 +54,7 @@ QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* t
   dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
   // rmw_cyclonedds: samples of a deleted writer are not disposed (ROS 2 has no instances)
   dds_qset_writer_data_lifecycle(q.get(), false);
-  const std::string user_data = fmt::format("typehash={};", type_hash);
+  const std::string user_data = fmt::format("{}typehash={};", user_data_prefix, type_hash);
   dds_qset_userdata(q.get(), user_data.data(), user_data.size());
   return q;
 }
@@ -405,10 +409,27 @@ void Ros2Node::AdvertiseTrigger(const std::string& service,
                                 std::function<std::pair<bool, std::string>()> callback) {
   Impl& m = *impl_;
   const std::string what = "the ROS 2 service " + service;
+  // rmw_cyclonedds pairs a service's request reader and reply writer by the "serviceid=" of
+  // their USER_DATA (a client waits for both halves of one service): 16 bytes, the
+  // participant's GUID prefix and a counter, as hex bytes joined by '.'
+  dds_guid_t guid;
+  std::array<uint8_t, 16> id{};
+  if (dds_get_guid(m.participant, &guid) == DDS_RETCODE_OK)
+    std::copy(guid.v, guid.v + 12, id.begin());
+  const auto n = static_cast<uint32_t>(m.services.size() + 1);
+  for (int i = 0; i < 4; ++i) id[12 + i] = static_cast<uint8_t>(n >> (24 - 8 * i));
+  std::string service_id = "serviceid=";
+  for (size_t i = 0; i < id.size(); ++i) service_id += fmt::format("{}{:x}", i ? "." : "", id[i]);
+  service_id += ";";
+  const QosPtr rq =
+      MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerRequest).type_hash, service_id);
   const dds_entity_t r =
-      MakeReader(m.participant, m.Topic(Ros2RequestTopic(service), Ros2Type::kTriggerRequest),
-                 Ros2Type::kTriggerRequest, what);
-  const QosPtr wq = MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerResponse).type_hash);
+      Check(dds_create_reader(m.participant,
+                              m.Topic(Ros2RequestTopic(service), Ros2Type::kTriggerRequest),
+                              rq.get(), nullptr),
+            what);
+  const QosPtr wq =
+      MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerResponse).type_hash, service_id);
   const dds_entity_t w = Check(
       dds_create_writer(m.participant, m.Topic(Ros2ReplyTopic(service), Ros2Type::kTriggerResponse),
                         wq.get(), nullptr),

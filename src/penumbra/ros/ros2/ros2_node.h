@@ -16,7 +16,9 @@
 //   services  std_srvs/srv/Trigger: requests on "rq/<name>Request", replies on
 //             "rr/<name>Reply"; every sample starts with rmw_cyclonedds's request header
 //             {uint64 guid; int64 seq} (cdds_request_header_t of its serdata.hpp), which the
-//             reply echoes so that the calling client takes it as its answer.
+//             reply echoes so that the calling client takes it as its answer. the request
+//             reader and reply writer carry USER_DATA "serviceid=<id>;typehash=...;" (the same
+//             id on both: rmw_cyclonedds's clients find a service's two halves by it).
 //   domain    Options::domain_id (ros/ros2_names.h Ros2DomainId), created with dds_create_domain
 //             from CycloneConfigXml(Options::interface_address): CYCLONEDDS_URI does not apply.
 //   sockets   all on Options::interface_address: Cyclone binds its transmit socket there and its
