@@ -22,13 +22,13 @@
 //               `penumbra run --ros --lockstep` / `--ros2 --lockstep`).
 //
 // the same topics, types and services on both transports (ros/ros_node.h). a ROS 1 node sets
-// /use_sim_time to true on the parameter server (nodes started afterwards use /clock); ROS 2
-// nodes are started with use_sim_time:=true. a message is converted only when its topic has
-// subscribers, so an idle bridge costs the run next to nothing; roscpp keeps a queue per
-// subscriber and drops the oldest message of a slow one (queue sizes in the docs), a ROS 2 writer
-// keeps the depth of its QoS profile (ros/ros2/ros2_node.h), so no subscriber can stall the
-// simulation. a command the run refuses (a NaN twist, joints the controller does not drive, a
-// wrong count) is logged as a warning naming the reason.
+// /use_sim_time to true on the parameter server (nodes started afterwards use /clock); ROS 2 has
+// no global parameters: ROS 2 nodes take /clock when started with use_sim_time:=true. a message is
+// converted only when its topic has subscribers, so an idle bridge costs the run next to nothing;
+// roscpp keeps a queue per subscriber and drops the oldest message of a slow one (queue sizes in
+// the docs), a ROS 2 writer keeps the depth of its QoS profile (ros/ros2/ros2_node.h), so no
+// subscriber can stall the simulation. a command the run refuses (a NaN twist, joints the
+// controller does not drive, a wrong count) is logged as a warning naming the reason.
 
 #include <cstdint>
 #include <string>

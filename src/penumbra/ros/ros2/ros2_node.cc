@@ -47,8 +47,10 @@ using QosPtr = std::unique_ptr<dds_qos_t, QosDeleter>;
 QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* type_hash,
                const std::string& user_data_prefix = "") {
   QosPtr q(dds_create_qos());
+  // a KEEP_LAST writer drops its oldest sample instead of waiting for a slow reader; should
+  // Cyclone still throttle it, a write gives up after max_blocking_time (the DDS default)
   dds_qset_reliability(q.get(), reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
-                       DDS_INFINITY);
+                       DDS_MSECS(100));
   dds_qset_durability(q.get(),
                       transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
