@@ -8,29 +8,39 @@ which bundles its own Cyclone C library) as a ROS 2 node would, and checks:
   - every topic of docs/ros.md's table is offered (DCPSPublication builtin topic) under its
     DDS topic name (rt/...) and type name (pkg::msg::dds_::T_), with the QoS of ROS 2's
     profiles (reliability, durability, history depth) and the USER_DATA "typehash=RIHS01_...;"
-    equal to rosbags' Typestore.hash_rihs01 of the type; the subscriptions and service
-    endpoints likewise (DCPSSubscription);
+    equal to rosbags' Typestore.hash_rihs01 of the type, without XTypes type information (as
+    rmw_cyclonedds); the subscriptions and service endpoints likewise (DCPSSubscription; a
+    service's two halves share one "serviceid="); the participant's USER_DATA "enclave=/;";
+    ros_discovery_info lists the node /penumbra with its readers' and writers' GUIDs;
+  - a reader whose Image type differs in XTypes terms only (uint8 as TK_UINT8, which crashed
+    Cyclone 0.10 when it asked for the type) is served and the run goes on;
   - samples decoded with rosbags' ROS 2 CDR: Image (rgb8 160x120 step 480, 32FC1 depth),
     CameraInfo K against the world's fovy, Imu at rest (specific force magnitude = g within
     noise), PointCloud2 (fields and layout), TFMessage (REP-105 odom -> base_link on /tf),
     /tf_static received by a reader created late (transient local), /clock monotonic;
-  - bad commands (a NaN twist, unknown joint names) are refused: the run logs the reason and
-    the robot's command is unchanged (it keeps standing), while a valid twist moves it;
+  - NaN and Inf twists are refused: the run logs the reason and the robot keeps standing,
+    while a valid twist moves it;
   - the bridge's UDP sockets are bound to 127.0.0.1 only (/proc/PID/fd against /proc/net/udp*);
-  - in a second run with --lockstep --ros-steps-per-trigger 50, /penumbra/step called as
-    rmw_cyclonedds calls a service (request header {client guid, sequence number} before the
-    request, on rq/penumbra/stepRequest): the reply on rr/penumbra/stepReply echoes the header,
-    sim time advances by 50 steps per call and not at all between calls.
+    with --ros-interface set to another address of this machine, it is discovered there and
+    every socket but the two multicast receive sockets is bound to it;
+  - in a lockstep run (tests/ros/ros2_lockstep_world.yaml, a joint_pd arm, --lockstep
+    --ros-steps-per-trigger 50), /penumbra/step called as rmw_cyclonedds calls a service
+    (request header {client guid, sequence number} before the request, on
+    rq/penumbra/stepRequest): the reply on rr/penumbra/stepReply echoes the header, sim time
+    (/clock) advances by 50 steps per call and not at all between calls; joint commands with an
+    unknown joint name or more values than names are refused (logged, the arm stays), a valid
+    one by name moves the arm (joint_states).
 
 How samples are decoded, independently of the bridge's IDL: the Python DDS types are built at
 run time from rosbags' ROS 2 Jazzy message definitions (field names and types of the .msg files,
-named as rmw_cyclonedds names them), so the reader matches the bridge's writers only when the
-type names agree and Cyclone finds the two XTypes descriptions assignable. Their deserialize is
-replaced so that the reader hands back the sample's serialized bytes as received (with the
-4-byte encapsulation header), which rosbags' typestore.deserialize_cdr decodes: the bytes on
-the wire are judged by rosbags' CDR, not by Cyclone's Python deserializer nor by our generated
-code. (Dynamic type discovery from the writers' type information was the alternative; it would
-build the reader's types from our own IDL, so a wrong field would go unnoticed until decoding.)
+named as rmw_cyclonedds names them); the bridge advertises no XTypes type information (as
+rmw_cyclonedds), so readers match it by type name. Their deserialize is replaced so that the
+reader hands back the sample's serialized bytes as received (with the 4-byte encapsulation
+header), which rosbags' typestore.deserialize_cdr decodes: the bytes on the wire are judged by
+rosbags' CDR, not by Cyclone's Python deserializer nor by our generated code. (Cyclone's dynamic
+type discovery, the alternative, needs the writers' type information, and would build the
+reader's types from our own IDL.) Commands and service requests are written with the same
+rosbags-derived types, serialized by Cyclone's Python binding.
 
 exit status 77 (ctest SKIP_RETURN_CODE) when this build has no ROS 2 or the venv lacks the
 Python packages, saying why. every process it starts is killed at the end, also on failure.
@@ -52,8 +62,8 @@ import unittest
 try:
     import cyclonedds.idl as idl
     import cyclonedds.idl.types as T
-    from cyclonedds.builtin import (BuiltinDataReader, BuiltinTopicDcpsPublication,
-                                    BuiltinTopicDcpsSubscription)
+    from cyclonedds.builtin import (BuiltinDataReader, BuiltinTopicDcpsParticipant,
+                                    BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription)
     from cyclonedds.core import Policy, Qos
     from cyclonedds.domain import Domain, DomainParticipant
     from cyclonedds.pub import DataWriter
@@ -267,10 +277,15 @@ def qos_triplet(qos):
 
 
 def userdata(qos):
+    """the USER_DATA of an endpoint as rmw_cyclonedds writes it, "key=value;..." -> dict."""
     for p in qos:
         if repr(p).startswith("Policy.Userdata"):
-            return bytes(p.data)
-    return b""
+            text = bytes(p.data).decode()
+            pairs = [kv.split("=", 1) for kv in text.split(";") if kv]
+            if not text.endswith(";") or any(len(kv) != 2 for kv in pairs):
+                raise AssertionError("USER_DATA %r is not key=value;..." % text)
+            return dict(pairs)
+    return {}
 
 
 # --- processes ----------------------------------------------------------------------------------
@@ -396,8 +411,7 @@ class Ros2Live(unittest.TestCase):
                 self.assertEqual(ep.type_name, dds_type_name(ros))
                 self.assertIsNone(ep.type_id, "XTypes type information (rmw_cyclonedds: none)")
                 self.assertEqual(qos_triplet(ep.qos), profile)
-                self.assertEqual(userdata(ep.qos),
-                                 ("typehash=%s;" % TS.hash_rihs01(ros)).encode())
+                self.assertEqual(userdata(ep.qos), {"typehash": TS.hash_rihs01(ros)})
         for topic, (ros, profile) in SUBSCRIBED.items():
             with self.subTest(topic=topic):
                 ep = node.seen_sub.get("rt" + topic)
@@ -405,8 +419,8 @@ class Ros2Live(unittest.TestCase):
                 self.assertEqual(ep.type_name, dds_type_name(ros))
                 self.assertIsNone(ep.type_id)
                 self.assertEqual(qos_triplet(ep.qos)[:2], profile[:2])
-                self.assertEqual(userdata(ep.qos),
-                                 ("typehash=%s;" % TS.hash_rihs01(ros)).encode())
+                self.assertEqual(userdata(ep.qos), {"typehash": TS.hash_rihs01(ros)})
+        service_ids = set()
         for service in SERVICES:
             with self.subTest(service=service):
                 rq = node.seen_sub.get("rq%sRequest" % service)
@@ -417,10 +431,27 @@ class Ros2Live(unittest.TestCase):
                 self.assertEqual(rr.type_name, "std_srvs::srv::dds_::Trigger_Response_")
                 self.assertEqual(qos_triplet(rr.qos), DEFAULT)
                 self.assertEqual(qos_triplet(rq.qos)[:2], DEFAULT[:2])
-                self.assertEqual(userdata(rq.qos), ("typehash=%s;" % TS.hash_rihs01(
-                    "std_srvs/srv/Trigger_Request")).encode())
-                self.assertEqual(userdata(rr.qos), ("typehash=%s;" % TS.hash_rihs01(
-                    "std_srvs/srv/Trigger_Response")).encode())
+                # the type hash of each half, and one service id pairing the two halves
+                # (rmw_cyclonedds: "serviceid=<16 bytes>;typehash=...;")
+                rq_ud, rr_ud = userdata(rq.qos), userdata(rr.qos)
+                self.assertEqual(rq_ud.get("typehash"),
+                                 TS.hash_rihs01("std_srvs/srv/Trigger_Request"))
+                self.assertEqual(rr_ud.get("typehash"),
+                                 TS.hash_rihs01("std_srvs/srv/Trigger_Response"))
+                self.assertRegex(rq_ud.get("serviceid", ""), r"^[0-9a-f]{1,2}(\.[0-9a-f]{1,2}){15}$")
+                self.assertEqual(rq_ud.get("serviceid"), rr_ud.get("serviceid"))
+                service_ids.add(rq_ud.get("serviceid"))
+        self.assertEqual(len(service_ids), len(SERVICES), "services share a service id")
+        # the participant of a ROS 2 node carries its security enclave (rmw_cyclonedds)
+        participants = BuiltinDataReader(node.dp, BuiltinTopicDcpsParticipant)
+        bridge = node.seen_pub["rt/clock"].participant_key
+        found = {}
+        end = time.time() + 10
+        while bridge not in found and time.time() < end:
+            found.update({p.key: p for p in participants.read(100) if hasattr(p, "qos")})
+            time.sleep(0.1)
+        self.assertIn(bridge, found)
+        self.assertEqual(userdata(found[bridge].qos), {"enclave": "/"})
         # `ros2 node list` and `ros2 topic info -v` read ros_discovery_info (rmw_dds_common):
         # the node /penumbra with the GUIDs of its readers and writers
         disc = DataReader(node.dp, node.topic("ros_discovery_info",
