@@ -199,9 +199,11 @@ class RosBridge : public RunBridge {
     const bool ok = reply.value("ok", false);
     if (!ok) return {false, reply.dump()};
     std::string msg = reply.value("cmd", "");
-    if (reply.contains("step"))
+    if (reply.contains("step") && reply.contains("time_sec"))
       msg += fmt::format(": step {}, t = {:.6f} s", reply["step"].get<int64_t>(),
-                         reply.value("time_sec", 0.0));
+                         reply["time_sec"].get<double>());
+    else if (reply.contains("step"))
+      msg += fmt::format(": step {}", reply["step"].get<int64_t>());
     return {true, msg};
   }
 

@@ -110,8 +110,7 @@ QosPtr WriterQos(RosTopicType t, const char* type_hash) {
 struct Ros2Node::Impl {
   Options options;
   dds_entity_t domain = 0, participant = 0;
-  dds_entity_t topic_waitset = 0, service_waitset = 0;
-  dds_entity_t topic_stop = 0, service_stop = 0;
+  dds_entity_t stop = 0;                       // guard condition that ends every callback thread
   std::map<std::string, dds_entity_t> topics;  // DDS topic name -> topic
 
   struct Publisher {
@@ -138,7 +137,7 @@ struct Ros2Node::Impl {
 
   std::map<std::string, int64_t> params;
   dds_entity_t discovery_writer = 0;  // ros_discovery_info
-  std::thread topic_thread, service_thread;
+  std::vector<std::thread> threads;   // subscriptions, then one per service
   bool started = false;
 
   // idlc's descriptors without their XTypes type information, one per type used
@@ -305,10 +304,8 @@ Ros2Node::Ros2Node(const Options& options) : impl_(std::make_unique<Impl>()) {
 
 Ros2Node::~Ros2Node() {
   Impl& m = *impl_;
-  if (m.topic_stop > 0) dds_set_guardcondition(m.topic_stop, true);
-  if (m.service_stop > 0) dds_set_guardcondition(m.service_stop, true);
-  if (m.topic_thread.joinable()) m.topic_thread.join();
-  if (m.service_thread.joinable()) m.service_thread.join();
+  if (m.stop > 0) dds_set_guardcondition(m.stop, true);
+  for (std::thread& t : m.threads) t.join();
   // deleting the domain deletes the participant and everything in it
   dds_delete(m.domain);
 }
@@ -489,31 +486,34 @@ void Ros2Node::Start() {
               "the ros_discovery_info writer");
     WithSample(info, [&](const void* s) { m.Write(m.discovery_writer, s, "ros_discovery_info"); });
   }
-  m.topic_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
-  m.service_waitset = Check(dds_create_waitset(m.participant), "a DDS waitset");
-  m.topic_stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");
-  m.service_stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");
-  dds_waitset_attach(m.topic_waitset, m.topic_stop, m.readers.size());
-  dds_waitset_attach(m.service_waitset, m.service_stop, m.services.size());
+  // one thread for every subscription; one per service, so that a long call (a step of many
+  // physics steps) does not hold back another (pause)
+  m.stop = Check(dds_create_guardcondition(m.participant), "a DDS guard condition");
+  const dds_entity_t topics = Check(dds_create_waitset(m.participant), "a DDS waitset");
+  dds_waitset_attach(topics, m.stop, static_cast<dds_attach_t>(m.readers.size()));
   for (size_t i = 0; i < m.readers.size(); ++i) {
     const dds_entity_t c =
         Check(dds_create_readcondition(m.readers[i].reader, DDS_ANY_STATE), "a DDS read condition");
-    dds_waitset_attach(m.topic_waitset, c, static_cast<dds_attach_t>(i));
+    dds_waitset_attach(topics, c, static_cast<dds_attach_t>(i));
   }
-  for (size_t i = 0; i < m.services.size(); ++i) {
+  std::vector<dds_entity_t> service_waitsets;
+  for (const Impl::Service& sv : m.services) {
+    const dds_entity_t ws = Check(dds_create_waitset(m.participant), "a DDS waitset");
+    dds_waitset_attach(ws, m.stop, 1);
     const dds_entity_t c =
-        Check(dds_create_readcondition(m.services[i].request_reader, DDS_ANY_STATE),
-              "a DDS read condition");
-    dds_waitset_attach(m.service_waitset, c, static_cast<dds_attach_t>(i));
+        Check(dds_create_readcondition(sv.request_reader, DDS_ANY_STATE), "a DDS read condition");
+    dds_waitset_attach(ws, c, 0);
+    service_waitsets.push_back(ws);
   }
-  m.topic_thread = std::thread([&m] {
+  m.threads.emplace_back([&m, topics] {
     Impl::Loop(
-        m.topic_waitset, [&m](size_t i) { m.TakeAll(m.readers[i]); }, m.readers.size());
+        topics, [&m](size_t i) { m.TakeAll(m.readers[i]); }, m.readers.size());
   });
-  m.service_thread = std::thread([&m] {
-    Impl::Loop(
-        m.service_waitset, [&m](size_t i) { m.Serve(m.services[i]); }, m.services.size());
-  });
+  for (size_t i = 0; i < m.services.size(); ++i)
+    m.threads.emplace_back([&m, i, ws = service_waitsets[i]] {
+      Impl::Loop(
+          ws, [&m, i](size_t) { m.Serve(m.services[i]); }, 1);
+    });
 }
 
 std::string Ros2Node::where() const {

@@ -32,8 +32,9 @@
 //             the DDS GUIDs): the node /<name> with every reader and writer made before, so that
 //             `ros2 node list` and `ros2 node info` show it.
 //
-// callbacks of subscriptions run on one thread of the node, services on another (a blocking
-// service, e.g. a lockstep step, never holds cmd_vel back), both started by Start().
+// callbacks of subscriptions run on one thread of the node, each service on a thread of its own
+// (a blocking call, e.g. a step of many physics steps, holds back neither cmd_vel nor pause), all
+// started by Start().
 // Cyclone checks every length of a received sample against its size before it allocates; the
 // conversion (ros/ros2/ros2_types.h) bounds names and joint counts further, and a sample it
 // refuses is logged and dropped.
