@@ -202,6 +202,9 @@ class BenchRos2Command : public Command {
         ->check(CLI::Range(0, 232));
     verb->add_option("--ros-interface", options_.interface,
                      "IPv4 address of the one interface DDS uses (default 127.0.0.1)");
+    verb->add_flag_callback(
+        "--no-depth", [this] { options_.depth = false; },
+        "rgb only: no depth image written beside each rgb image");
     verb->add_option("--receive-buffer", options_.receive_buffer,
                      "UDP receive buffer in bytes (Cyclone SocketReceiveBufferSize; default: the "
                      "system's, capped by net.core.rmem_max)")

@@ -15,14 +15,16 @@ int BenchRos2(const Ros2BenchOptions& o) {
                           o.receive_buffer > 0 ? fmt::format("{} bytes", o.receive_buffer)
                                                : std::string("the system's default"))
                   .c_str());
-  std::printf("%s", fmt::format("  {:.1f} s of {}x{} rgb8 + 32FC1 at {:g} Hz, Imu at {:g} Hz, /tf "
-                                "at {:g} Hz; latency = publish -> taken by the subscriber\n",
-                                o.seconds, o.width, o.height, o.camera_hz, o.imu_hz, o.tf_hz)
+  std::printf("%s", fmt::format("  {:.1f} s of {}x{} rgb8{} at {:g} Hz, Imu at {:g} Hz, /tf at "
+                                "{:g} Hz; latency = publish -> taken by the subscriber\n",
+                                o.seconds, o.width, o.height, o.depth ? " + 32FC1" : "",
+                                o.camera_hz, o.imu_hz, o.tf_hz)
                         .c_str());
   std::printf("  %-24s %-24s %8s %8s %6s %10s %10s %10s\n", "topic", "QoS", "sent", "received",
               "lost", "median ms", "p99 ms", "max ms");
   bool lost = false, slow = false;
   for (const Ros2TopicStats& t : r.topics) {
+    if (t.sent == 0) continue;
     std::printf(
         "%s",
         fmt::format("  {:<24} {:<24} {:>8} {:>8} {:>6} {:>10.3f} {:>10.3f} {:>10.3f}\n", t.topic,

@@ -456,6 +456,7 @@ Ros2BenchResult RunRos2Bench(const Ros2BenchOptions& o) {
   std::array<int64_t, kTopics> next{};
   const int64_t start = NowNs(), end = start + static_cast<int64_t>(o.seconds * 1e9);
   for (int i = 0; i < kTopics; ++i) next[i] = start;
+  if (!o.depth) next[1] = end;  // never sent
   std::array<int64_t, kTopics> sent{};
   for (;;) {
     const int i = static_cast<int>(std::min_element(next.begin(), next.end()) - next.begin());

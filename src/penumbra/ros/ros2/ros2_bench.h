@@ -28,8 +28,10 @@ struct Ros2BenchOptions {
   std::string interface = "127.0.0.1";  ///< the one interface both participants use
   int width = 640, height = 480;        ///< image size (pixels)
   double seconds = 5.0;                 ///< wall seconds of the streaming phase
-  double camera_hz = 30, imu_hz = 400, tf_hz = 500;  ///< messages per wall second
-  int trips = 200;                                   ///< lockstep round trips timed
+  /// messages per wall second
+  double camera_hz = 30, imu_hz = 400, tf_hz = 500;
+  bool depth = true;  ///< false: rgb only (no depth image written beside each rgb one)
+  int trips = 200;    ///< lockstep round trips timed
   /// UDP receive buffer of both participants (bytes, Cyclone's Internal/SocketReceiveBufferSize
   /// min); 0 = Cyclone's default, the system's net.core.rmem_default, as a ROS 2 node without a
   /// CYCLONEDDS_URI has. Linux caps it at net.core.rmem_max.
