@@ -196,9 +196,11 @@ struct Ros2Node::Impl {
 
   // takes every sample of `r` and hands each valid one to its callback
   void TakeAll(const Reader& r) {
-    void* samples[kTakeBatch] = {};
+    void* samples[kTakeBatch];
     dds_sample_info_t infos[kTakeBatch];
     for (;;) {
+      // a null first pointer asks Cyclone to lend its samples (returned below)
+      std::fill(std::begin(samples), std::end(samples), nullptr);
       const dds_return_t n = dds_take(r.reader, samples, infos, kTakeBatch, kTakeBatch);
       if (n <= 0) return;
       for (dds_return_t i = 0; i < n; ++i) {
@@ -214,9 +216,11 @@ struct Ros2Node::Impl {
   }
 
   void Serve(const Service& s) {
-    void* samples[kTakeBatch] = {};
+    void* samples[kTakeBatch];
     dds_sample_info_t infos[kTakeBatch];
     for (;;) {
+      // a null first pointer asks Cyclone to lend its samples (returned below)
+      std::fill(std::begin(samples), std::end(samples), nullptr);
       const dds_return_t n = dds_take(s.request_reader, samples, infos, kTakeBatch, kTakeBatch);
       if (n <= 0) return;
       for (dds_return_t i = 0; i < n; ++i) {
