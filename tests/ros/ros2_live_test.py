@@ -364,8 +364,9 @@ def no_ros2_reason():
     r = subprocess.run([BINARY, "run", WORLD, "--ros2", "--ros-domain", "0", "--duration",
                         "0.002", "--out", os.path.join(WORK, "probe")],
                        capture_output=True, text=True, timeout=120)
-    if "has no ROS 2" in r.stdout + r.stderr:
-        return "this build has no ROS 2 (Cyclone DDS): " + (r.stdout + r.stderr).strip()[-300:]
+    out = r.stdout + r.stderr
+    if r.returncode != 0 and "built without" in out and "ROS 2" in out:
+        return "this build has no ROS 2 (Cyclone DDS): " + out.strip()[-300:]
     return None
 
 
