@@ -29,7 +29,8 @@ which bundles its own Cyclone C library) as a ROS 2 node would, and checks:
     rq/penumbra/stepRequest): the reply on rr/penumbra/stepReply echoes the header, sim time
     (/clock) advances by 50 steps per call and not at all between calls; joint commands with an
     unknown joint name or more values than names are refused (logged, the arm stays), a valid
-    one by name moves the arm (joint_states).
+    one by name moves the arm (joint_states); reset, adversity/minor, pause and resume answer as
+    the ZeroMQ bridge's commands do.
 
 How samples are decoded, independently of the bridge's IDL: the Python DDS types are built at
 run time from rosbags' ROS 2 Jazzy message definitions (field names and types of the .msg files,
@@ -639,13 +640,28 @@ class Ros2Lockstep(unittest.TestCase):
     def tearDownClass(cls):
         cls.sim.stop()
 
-    def call(self, guid, seq, timeout=30):
-        """one /penumbra/step call as rmw_cyclonedds makes it; the decoded reply."""
-        self.req.write(dds_struct("std_srvs/srv/Trigger_Request")(
+    def service(self, name):
+        """the request writer and reply reader of the service /penumbra/<name>, matched."""
+        req = DataWriter(self.node.dp, self.node.topic("rq/penumbra/%sRequest" % name,
+                                                       "std_srvs/srv/Trigger_Request", False),
+                         ros_qos(DEFAULT, ("typehash=%s;" % TS.hash_rihs01(
+                             "std_srvs/srv/Trigger_Request")).encode()))
+        rep = DataReader(self.node.dp, self.node.topic("rr/penumbra/%sReply" % name,
+                                                       "std_srvs/srv/Trigger_Response", True),
+                         ros_qos((True, False, 100)))
+        wait_for(lambda: (req.get_matched_subscriptions() and rep.get_matched_publications())
+                 or not self.sim.alive(), 60, "the service /penumbra/" + name)
+        return req, rep
+
+    def call(self, guid, seq, timeout=30, service=None):
+        """one service call as rmw_cyclonedds makes it (default /penumbra/step); the decoded
+        reply."""
+        req, rep = service or (self.req, self.rep)
+        req.write(dds_struct("std_srvs/srv/Trigger_Request")(
             client_guid=guid, sequence_number=seq, structure_needs_at_least_one_member=0))
         end = time.time() + timeout
         while time.time() < end:
-            for s in self.rep.take(10):
+            for s in rep.take(10):
                 if not isinstance(s, RawSample):
                     continue
                 got_guid, got_seq = struct.unpack_from("<Qq", s.raw, 4)
@@ -672,13 +688,7 @@ class Ros2Lockstep(unittest.TestCase):
 
     def test_step_service_clock_and_joint_commands(self):
         node = self.node
-        self.req = DataWriter(node.dp, node.topic("rq/penumbra/stepRequest",
-                                                  "std_srvs/srv/Trigger_Request", False),
-                              ros_qos(DEFAULT, ("typehash=%s;" % TS.hash_rihs01(
-                                  "std_srvs/srv/Trigger_Request")).encode()))
-        self.rep = DataReader(node.dp, node.topic("rr/penumbra/stepReply",
-                                                  "std_srvs/srv/Trigger_Response", True),
-                              ros_qos((True, False, 100)))
+        self.req, self.rep = self.service("step")
         self.clock = node.reader("/clock", "rosgraph_msgs/msg/Clock", CLOCK, depth=1000)
         self.joints = node.reader("/arm/joint_states", "sensor_msgs/msg/JointState", DEFAULT,
                                   depth=100)
@@ -737,6 +747,14 @@ class Ros2Lockstep(unittest.TestCase):
         # a request from another client (other guid) gets its own reply
         other = self.call(guid ^ 0xFFFF, 7)
         self.assertIn("step %d," % (21 * self.STEPS), other.message)
+        # the other services, as the ZeroMQ bridge's commands: reset restores the state (time
+        # goes on), an adversity preset is applied, pause and resume answer
+        for name, expected in (("reset", "reset: step %d," % (21 * self.STEPS)),
+                               ("adversity/minor", "set_adversity: step %d" % (21 * self.STEPS)),
+                               ("pause", "pause: step"), ("resume", "resume: step")):
+            r = self.call(guid, 100, service=self.service(name))
+            self.assertTrue(r.success, r.message)
+            self.assertTrue(r.message.startswith(expected), r.message)
         self.assertEqual(self.sim.stop(signal.SIGINT), 130, self.sim.log()[-3000:])
 
 
