@@ -29,8 +29,9 @@ which bundles its own Cyclone C library) as a ROS 2 node would, and checks:
     rq/penumbra/stepRequest): the reply on rr/penumbra/stepReply echoes the header, sim time
     (/clock) advances by 50 steps per call and not at all between calls; joint commands with an
     unknown joint name or more values than names are refused (logged, the arm stays), a valid
-    one by name moves the arm (joint_states); reset, adversity/minor, pause and resume answer as
-    the ZeroMQ bridge's commands do.
+    one by name moves the arm (joint_states), a target beyond the joint's range is clamped to it
+    (as over ZeroMQ); a writer of another type on a command topic is never matched; reset,
+    adversity/minor, pause and resume answer as the ZeroMQ bridge's commands do.
 
 How samples are decoded, independently of the bridge's IDL: the Python DDS types are built at
 run time from rosbags' ROS 2 Jazzy message definitions (field names and types of the .msg files,
@@ -738,12 +739,29 @@ class Ros2Lockstep(unittest.TestCase):
         for n in range(3, 9):
             self.call(guid, n)
         self.assertLess(abs(self.hinge()), 0.05, "a refused joint command moved the arm")
+        # a target beyond the joint's range (-1..1 rad) is clamped to it, as over ZeroMQ
+        joint_command(["arm/hinge"], [5.0])
+        time.sleep(0.5)
+        for n in range(9, 15):
+            self.call(guid, n)
+        self.assertGreater(self.hinge(), 0.8, "a joint command by composed name was not obeyed")
+        self.assertLess(self.hinge(), 1.05, "a target beyond the range was not clamped")
         # a valid one by the joint's model-local name: obeyed at the next steps
         joint_command(["hinge"], [0.5])
         time.sleep(0.5)
-        for n in range(9, 21):
+        for n in range(15, 21):
             self.call(guid, n)
-        self.assertGreater(self.hinge(), 0.35, "a valid joint command did not move the arm")
+        self.assertAlmostEqual(self.hinge(), 0.5, delta=0.15,
+                               msg="a valid joint command was not obeyed")
+        # a writer of another type on a command topic is never matched (DDS compares the type
+        # names), so nothing of it reaches the run
+        node.discover(10, want_sub=["rt/arm/cmd_vel"])
+        self.assertIn("rt/arm/cmd_vel", node.seen_sub)
+        wrong = DataWriter(node.dp, node.topic("rt/arm/cmd_vel", "std_msgs/msg/String", False),
+                           ros_qos(DEFAULT))
+        time.sleep(2)
+        self.assertEqual(wrong.get_matched_subscriptions(), [])
+        wrong.write(dds_struct("std_msgs/msg/String")(data="not a twist"))
         # a request from another client (other guid) gets its own reply
         other = self.call(guid ^ 0xFFFF, 7)
         self.assertIn("step %d," % (21 * self.STEPS), other.message)
