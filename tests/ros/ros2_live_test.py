@@ -744,8 +744,9 @@ class Ros2Lockstep(unittest.TestCase):
         time.sleep(0.5)
         for n in range(9, 15):
             self.call(guid, n)
-        self.assertGreater(self.hinge(), 0.8, "a joint command by composed name was not obeyed")
-        self.assertLess(self.hinge(), 1.05, "a target beyond the range was not clamped")
+        angle = self.hinge()
+        self.assertGreater(angle, 0.8, "a joint command by composed name was not obeyed")
+        self.assertLess(angle, 1.05, "a target beyond the range was not clamped")
         # a valid one by the joint's model-local name: obeyed at the next steps
         joint_command(["hinge"], [0.5])
         time.sleep(0.5)
