@@ -15,7 +15,8 @@ which bundles its own Cyclone C library) as a ROS 2 node would, and checks:
   - a reader whose Image type differs in XTypes terms only (uint8 as TK_UINT8, which crashed
     Cyclone 0.10 when it asked for the type) is served and the run goes on;
   - samples decoded with rosbags' ROS 2 CDR: Image (rgb8 160x120 step 480, 32FC1 depth; 10
-    frames per wall second with --realtime, stamps 0.1 s apart),
+    frames per wall second with --realtime, stamps 0.1 s apart; after the run, the bytes of the
+    run's own PNGs of that frame),
     CameraInfo K against the world's fovy, Imu (about g on z, and after the run every sample
     equal to the run's own imu CSV), PointCloud2 (fields and layout), TFMessage (REP-105 odom -> base_link on /tf),
     /tf_static received by a reader created late (transient local), /clock monotonic;
@@ -79,6 +80,8 @@ except ImportError as e:  # pragma: no cover
     print("SKIP: the project venv lacks %s (scripts/install-deps.sh installs cyclonedds and "
           "rosbags)" % e.name)
     sys.exit(77)
+
+from run_png import read_png  # noqa: E402 (tests/ros/, beside this file)
 
 BINARY, SOURCE, WORK = sys.argv[1:4]
 WORLD = os.path.join(SOURCE, "tests/ros/ros2_live_world.yaml")
@@ -485,7 +488,9 @@ class Ros2Live(unittest.TestCase):
         self.assertEqual(len(im.data), 480 * 120)
         self.assertEqual(im.header.frame_id, "front/optical")
         self.assertGreater(int(im.data.max()) - int(im.data.min()), 20, "a flat image")
+        Ros2Live.frames = [im]
         d = take(depth, 2, 30, "sensor_msgs/msg/Image")[-1]
+        Ros2Live.frames.append(d)
         self.assertEqual((d.encoding, d.width, d.height, d.step), ("32FC1", 160, 120, 640))
         self.assertEqual(len(d.data), 640 * 120)
         metres = struct.unpack("<%df" % (160 * 120), d.data.tobytes())
@@ -637,6 +642,28 @@ class Ros2Live(unittest.TestCase):
 
     def test_8_clean_shutdown(self):
         self.assertEqual(self.sim.stop(signal.SIGINT), 130, self.sim.log()[-3000:])
+        # the images received over DDS are the run's own (front/rgb and front/depth PNGs, the
+        # depth in millimetres up to 65535; a pixel without return is 0 there, +Inf on ROS)
+        with open(os.path.join(self.sim.out, "front", "frames.csv")) as f:
+            index = {round(float(r["time_sec"]) * 1e9): int(r["frame"]) for r in csv.DictReader(f)}
+        for image in getattr(Ros2Live, "frames", []):
+            frame = index.get(image.header.stamp.sec * 1000000000 + image.header.stamp.nanosec)
+            self.assertIsNotNone(frame, "no frame at %s" % stamp_sec(image.header.stamp))
+            kind = "rgb" if image.encoding == "rgb8" else "depth"
+            w, h, _, _, png = read_png(os.path.join(self.sim.out, "front", kind,
+                                                    "%06d.png" % frame))
+            self.assertEqual((w, h), (image.width, image.height))
+            if kind == "rgb":
+                self.assertEqual(image.data.tobytes(), bytes(png))
+            else:
+                metres = struct.unpack("<%df" % (w * h), image.data.tobytes())
+                for z, mm in zip(metres, png):
+                    if mm == 0:
+                        self.assertEqual(z, math.inf)
+                    elif mm == 65535:  # the PNG's largest value: 65.535 m or farther
+                        self.assertGreaterEqual(z, 65.5345)
+                    else:
+                        self.assertAlmostEqual(z, mm / 1000, delta=0.0005)
         # the IMU samples received over DDS are the run's own (imu/trunk_imu.csv, 9 digits)
         samples = getattr(Ros2Live, "imu_samples", None)
         if not samples:
