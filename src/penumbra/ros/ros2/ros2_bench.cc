@@ -1,6 +1,5 @@
 #include "penumbra/ros/ros2/ros2_bench.h"
 
-#include <arpa/inet.h>
 #include <dds/dds.h>
 #include <poll.h>
 #include <signal.h>
@@ -19,6 +18,8 @@
 #include <vector>
 
 #include "penumbra/core/error.h"
+#include "penumbra/ros/ros2_names.h"
+#include "penumbra/ros/udp_bind_pin.h"
 #include "ros2_msgs.h"
 
 namespace penumbra {
@@ -73,25 +74,22 @@ void Percentiles(std::vector<double> v, double* median, double* p99, double* max
   if (max) *max = v.back();
 }
 
+// the bridge's configuration for the interface (ros/ros2_names.h), with the UDP receive buffer as
+// asked (Cyclone's default: the system's, net.core.rmem_default)
 std::string Config(const std::string& address, int64_t receive_buffer) {
-  // one interface, no multicast, unicast discovery through the participant index ports; the
-  // UDP receive buffer as asked (Cyclone's default: the system's, net.core.rmem_default)
-  std::string internal;
+  std::string xml = CycloneConfigXml(address);
   if (receive_buffer > 0)
-    internal = "<Internal><SocketReceiveBufferSize min=\"" + std::to_string(receive_buffer) +
-               "B\"/></Internal>";
-  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface address=\"" +
-         address +
-         "\"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32"
-         "</MaxAutoParticipantIndex><Peers><Peer address=\"" +
-         address + "\"/></Peers></Discovery>" + internal + "</Domain></CycloneDDS>";
+    xml.insert(xml.rfind("</Domain>"), "<Internal><SocketReceiveBufferSize min=\"" +
+                                           std::to_string(receive_buffer) + "B\"/></Internal>");
+  return xml;
 }
 
 // a DDS participant on its own domain entity; everything is deleted with it
 struct Participant {
   dds_entity_t domain = 0, pp = 0;
   Participant(int id, const std::string& address, int64_t receive_buffer) {
+    // as the bridge: Cyclone's receive sockets pinned to the interface (ros/udp_bind_pin.h)
+    const ScopedUdpBindPin pin(address);
     domain =
         dds_create_domain(static_cast<dds_domainid_t>(id), Config(address, receive_buffer).c_str());
     if (domain < 0)
@@ -347,10 +345,7 @@ void Check(const Ros2BenchOptions& o) {
   if (o.domain < -1 || o.domain > 232)
     throw Error("bench ros2: --ros-domain " + std::to_string(o.domain) +
                 ": expected 0..232 (ROS 2's domain ids)");
-  in_addr a{};
-  if (inet_pton(AF_INET, o.interface.c_str(), &a) != 1)
-    throw Error("bench ros2: --ros-interface '" + o.interface +
-                "': expected an IPv4 address of this machine, e.g. 127.0.0.1");
+  CheckInterfaceAddress(o.interface);
   if (o.width < 1 || o.width > 8192 || o.height < 1 || o.height > 8192)
     throw Error("bench ros2: image size: expected 1..8192 x 1..8192 pixels");
   auto rate = [](double hz, const char* what) {

@@ -25,7 +25,7 @@ namespace penumbra {
 /// settings of the ROS 2 transport benchmark.
 struct Ros2BenchOptions {
   int domain = -1;                      ///< ROS domain id 0..232; -1 = one at random in 100..232
-  std::string interface = "127.0.0.1";  ///< the one interface both participants use
+  std::string interface = "127.0.0.1";  ///< numeric address of the one interface both use
   int width = 640, height = 480;        ///< image size (pixels)
   double seconds = 5.0;                 ///< wall seconds of the streaming phase
   /// messages per wall second
@@ -57,7 +57,7 @@ struct Ros2BenchResult {
 };
 
 /// runs the benchmark. it forks: call it before anything else in the process starts DDS.
-/// @throws Error on a bad option (domain out of 0..232, interface not an IPv4 address, a size
+/// @throws Error on a bad option (domain out of 0..232, interface not a numeric address, a size
 ///         or rate out of range), when DDS cannot start on the interface, when the subscriber
 ///         does not match within 20 s or does not report, or when this build has no ROS 2.
 Ros2BenchResult RunRos2Bench(const Ros2BenchOptions& options);
