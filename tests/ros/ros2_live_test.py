@@ -103,7 +103,7 @@ SENSOR_DATA = (False, False, 5)       # rmw_qos_profile_sensor_data
 DEFAULT = (True, False, 10)           # rmw_qos_profile_default (also services)
 TF = (True, False, 100)               # tf2_ros::DynamicBroadcasterQoS
 TF_STATIC = (True, True, 1)           # tf2_ros::StaticBroadcasterQoS
-CLOCK = (True, False, 1)              # the plan's /clock writer (matches rclcpp's ClockQoS)
+CLOCK = (True, False, 1)              # the bridge's /clock writer (rclcpp's ClockQoS reader matches)
 
 PUBLISHED = {  # ROS topic -> (ROS type, QoS)
     CAMERA + "/image_raw": ("sensor_msgs/msg/Image", SENSOR_DATA),
