@@ -811,6 +811,24 @@ class Ros2Lockstep(unittest.TestCase):
             self.call(guid, n)
         self.assertAlmostEqual(self.hinge(), 0.5, delta=0.15,
                                msg="a valid joint command was not obeyed")
+        # a NaN target by name: refused by the dispatcher for what it is (not finite), not taken
+        # for a joint left unnamed; the arm keeps its target
+        log0 = joint_command(["hinge"], [float("nan")])
+        wait_for(lambda: "refused" in self.sim.log()[log0:], 10, "the refusal of a NaN target")
+        refusal = self.sim.log()[log0:]
+        self.assertIn("finite", refusal)
+        self.assertNotIn("does not name every joint", refusal)
+        for n in range(21, 27):
+            self.call(guid, n)
+        self.assertAlmostEqual(self.hinge(), 0.5, delta=0.15, msg="a NaN target moved the arm")
+        # no names: the values are in the controller's joint order (as the ROS 1 bridge takes them)
+        joint_command([], [-0.4])
+        time.sleep(0.5)
+        for n in range(27, 33):
+            self.call(guid, n)
+        self.assertAlmostEqual(self.hinge(), -0.4, delta=0.15,
+                               msg="a joint command in the controller's order was not obeyed")
+        calls = 33
         # a writer of another type on a command topic is never matched (DDS compares the type
         # names), so nothing of it reaches the run
         node.discover(10, want_sub=["rt/arm/cmd_vel"])
@@ -822,11 +840,11 @@ class Ros2Lockstep(unittest.TestCase):
         wrong.write(dds_struct("std_msgs/msg/String")(data="not a twist"))
         # a request from another client (other guid) gets its own reply
         other = self.call(guid ^ 0xFFFF, 7)
-        self.assertIn("step %d," % (21 * self.STEPS), other.message)
+        self.assertIn("step %d," % (calls * self.STEPS), other.message)
         # the other services, as the ZeroMQ bridge's commands: reset restores the state (time
         # goes on), an adversity preset is applied, pause and resume answer
-        for name, expected in (("reset", "reset: step %d," % (21 * self.STEPS)),
-                               ("adversity/minor", "set_adversity: step %d" % (21 * self.STEPS)),
+        for name, expected in (("reset", "reset: step %d," % (calls * self.STEPS)),
+                               ("adversity/minor", "set_adversity: step %d" % (calls * self.STEPS)),
                                ("pause", "pause: step"), ("resume", "resume: step")):
             r = self.call(guid, 100, service=self.service(name))
             self.assertTrue(r.success, r.message)

@@ -202,6 +202,14 @@ TEST(Ros2Types, ReceivedSamplesAreBounded) {
                             [](const void* s) { JointStateFromSample(s); });
             }).find("JointState.position has 1 values for 2 names"),
             std::string::npos);
+  // no names: the values are in the controller's joint order, any count up to the bound
+  RosJointState ordered;
+  ordered.position = {0.1, 0.2, 0.3};
+  RosJointState back;
+  WithCdrSample(Ros2Type::kJointState, Cdr(Ros2Type::kJointState, ordered),
+                [&](const void* s) { back = JointStateFromSample(s); });
+  EXPECT_TRUE(back.name.empty());
+  EXPECT_EQ(back.position, ordered.position);
   RosPoseStamped p;
   p.header.frame_id = std::string(kRos2MaxNameBytes + 1, 'f');
   EXPECT_NE(ErrorOf([&] {

@@ -239,7 +239,9 @@ class RosBridge : public RunBridge {
                          m.name.size(), v.size());
             return;
           }
-          values.assign(joints.size(), std::nan(""));
+          // which joints were named: a NaN value goes on to the dispatcher, which refuses it
+          std::vector<bool> named(joints.size(), false);
+          values.assign(joints.size(), 0.0);
           for (size_t i = 0; i < m.name.size(); ++i) {
             auto it = std::find_if(joints.begin(), joints.end(), [&](const std::string& j) {
               return j == m.name[i] || j == robot + "/" + m.name[i];
@@ -252,8 +254,9 @@ class RosBridge : public RunBridge {
               return;
             }
             values[it - joints.begin()] = v[i];
+            named[it - joints.begin()] = true;
           }
-          if (std::any_of(values.begin(), values.end(), [](double x) { return std::isnan(x); })) {
+          if (std::find(named.begin(), named.end(), false) != named.end()) {
             spdlog::warn("{}: joint command for '{}' does not name every joint of its controller",
                          tag_, robot);
             return;

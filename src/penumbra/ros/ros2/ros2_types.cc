@@ -402,7 +402,8 @@ RosJointState JointStateFromSample(const void* sample) {
   for (uint32_t i = 0; i < n; ++i) j.name.push_back(Name(s.name._buffer[i], "JointState.name[]"));
   auto values = [&](const dds_sequence_double& v, const char* field, std::vector<double>& out) {
     const uint32_t m = Bounded(v, kRos2MaxJoints, field);
-    if (m != 0 && m != n) {
+    // without names the values are in the controller's joint order (the bridge checks the count)
+    if (n != 0 && m != 0 && m != n) {
       throw Error(std::string("ROS 2: ") + field + " has " + std::to_string(m) + " values for " +
                   std::to_string(n) + " names (expected as many, or none)");
     }

@@ -150,13 +150,15 @@ void WithCdrSample(Ros2Type type, std::span<const uint8_t> cdr,
 
 // samples received (the generated C structs) as plain messages. strings and sequences over the
 // bounds above, a nanosec of 1e9 or more, and joint arrays whose non-empty lengths differ from
-// name's throw Error naming the field.
+// a non-empty name's throw Error naming the field (with no names, the arrays are in the
+// controller's joint order, as the ROS 1 bridge takes them).
 
 /// geometry_msgs/msg/Twist. the values are not checked (the dispatcher refuses NaN commands).
 RosTwist TwistFromSample(const void* sample);
 /// geometry_msgs/msg/PoseStamped.
 RosPoseStamped PoseStampedFromSample(const void* sample);
-/// sensor_msgs/msg/JointState (position, velocity, effort may each be empty).
+/// sensor_msgs/msg/JointState (position, velocity, effort may each be empty; name may be empty,
+/// the values then being in the controller's joint order).
 RosJointState JointStateFromSample(const void* sample);
 /// the request header of a std_srvs/srv/Trigger_Request.
 Ros2RequestHeader TriggerRequestFromSample(const void* sample);
