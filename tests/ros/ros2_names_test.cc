@@ -81,6 +81,7 @@ TEST(Ros2Names, CycloneConfigOfLoopbackIsRmwCycloneddsLocalhost) {
   EXPECT_EQ(CycloneConfigXml("127.0.0.1"),
             "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface "
             "address=\"127.0.0.1\"/></Interfaces><AllowMulticast>false</AllowMulticast>"
+            "<MaxMessageSize>65500B</MaxMessageSize><FragmentSize>60000B</FragmentSize>"
             "</General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
             "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex><Peers><Peer "
             "address=\"127.0.0.1\"/></Peers></Discovery></Domain></CycloneDDS>");

@@ -48,7 +48,9 @@ bool IsLoopbackAddress(const std::string& address);
 /// address, which has no multicast, also what rmw_cyclonedds_cpp (Jazzy) adds for
 /// ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST: <AllowMulticast>false</AllowMulticast> in General and
 /// <Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32
-/// </MaxAutoParticipantIndex><Peers><Peer address="ADDR"/></Peers></Discovery>. Cyclone then
+/// </MaxAutoParticipantIndex><Peers><Peer address="ADDR"/></Peers></Discovery>, and, as
+/// loopback's MTU is 64 KiB, <MaxMessageSize>65500B</MaxMessageSize><FragmentSize>60000B
+/// </FragmentSize> (fewer, larger UDP datagrams for images; any DDS reassembles them). Cyclone then
 /// sends from and advertises that address only; its receive sockets it binds to the wildcard
 /// address, which Ros2Node pins to ADDR (ros/udp_bind_pin.h).
 /// @throws ConfigError as CheckInterfaceAddress.
