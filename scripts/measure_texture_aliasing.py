@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Measures texture aliasing on a far checker floor (docs/rendering.md, "Textures").
 
-Pure Python (zlib + struct). Writes a world into OUT_DIR: MuJoCo's standard Menagerie ground
+Uses Pillow. Writes a world into OUT_DIR: MuJoCo's standard Menagerie ground
 plane (a 300 x 300 checker with mark="edge", texrepeat 5 5, texuniform) and one 640 x 480
 camera 1.2 m above it, fovy 20 deg, pitched 2 deg down, looking along it; runs
 
@@ -34,7 +34,8 @@ import os
 import struct
 import subprocess
 import sys
-import zlib
+
+from PIL import Image
 
 FLOOR_XML = """<mujoco model="floor">
   <asset>
@@ -72,47 +73,21 @@ mjcf_cameras: {enabled: false}
 
 
 def read_png(path):
-    """(width, height, channels, bit depth, rows of samples) of an 8/16-bit grey or RGB PNG."""
-    with open(path, "rb") as f:
-        data = f.read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
-    pos, idat = 8, b""
-    while pos < len(data):
-        n, tag = struct.unpack(">I4s", data[pos:pos + 8])
-        body = data[pos + 8:pos + 8 + n]
-        if tag == b"IHDR":
-            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
-        elif tag == b"IDAT":
-            idat += body
-        pos += 12 + n
-    ch = {0: 1, 2: 3}[ctype]
-    bpp = ch * depth // 8
-    raw = zlib.decompress(idat)
-    stride = w * bpp
-    rows, prev = [], bytearray(stride)
-    for y in range(h):
-        ft = raw[y * (stride + 1)]
-        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - bpp] if i >= bpp else 0
-            b = prev[i]
-            c = prev[i - bpp] if i >= bpp else 0
-            if ft == 1:
-                line[i] = (line[i] + a) & 0xFF
-            elif ft == 2:
-                line[i] = (line[i] + b) & 0xFF
-            elif ft == 3:
-                line[i] = (line[i] + (a + b) // 2) & 0xFF
-            elif ft == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 0xFF
-        prev = line
-        if depth == 16:
-            rows.append([(line[2 * i] << 8) | line[2 * i + 1] for i in range(w * ch)])
+    """(width, height, channels, rows of samples) of an 8/16-bit grey or RGB PNG (Pillow,
+    Debian's python3-pil)."""
+    with Image.open(path) as im:
+        w, h = im.size
+        if im.mode in ("L", "RGB"):
+            ch = len(im.mode)
+            flat = im.tobytes()
+        elif im.mode in ("I;16", "I"):  # 16-bit grey (Pillow >= 10: I;16, older: I)
+            ch = 1
+            fmt = "<%dH" if im.mode == "I;16" else "=%di"
+            flat = struct.unpack(fmt % (w * h), im.tobytes())
         else:
-            rows.append(list(line))
-    return w, h, ch, rows
+            raise ValueError("%s: unexpected PNG mode %s" % (path, im.mode))
+    stride = w * ch
+    return w, h, ch, [list(flat[y * stride:(y + 1) * stride]) for y in range(h)]
 
 
 def residual_std(lum, mask, w, h, r=4):

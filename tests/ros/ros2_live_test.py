@@ -81,7 +81,7 @@ except ImportError as e:  # pragma: no cover
           "rosbags)" % e.name)
     sys.exit(77)
 
-from run_png import read_png  # noqa: E402 (tests/ros/, beside this file)
+from run_folder import read_png  # noqa: E402 (tests/ros/, beside this file)
 
 BINARY, SOURCE, WORK = sys.argv[1:4]
 WORLD = os.path.join(SOURCE, "tests/ros/ros2_live_world.yaml")

@@ -17,7 +17,6 @@ the bag.
 usage: rosbag2_export_test.py PENUMBRA_BINARY SOURCE_DIR WORK_DIR   (the project venv's python)
 exits 77 (skipped, saying why) in a build without ROS 2 or without the venv's packages.
 """
-import csv
 import glob
 import json
 import math
@@ -43,7 +42,7 @@ except ImportError as e:
     sys.exit(77)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_png import read_png  # noqa: E402
+from run_folder import csv_rows, read_png, state_samples  # noqa: E402
 
 BINARY, SOURCE, WORK = sys.argv[1:4]
 DURATION = 0.6
@@ -97,20 +96,10 @@ class Rosbag2ExportTest(unittest.TestCase):
                 cls.messages.setdefault(c.topic, []).append((t, msg))
 
     def rows(self, path):
-        with open(os.path.join(self.run_dir, path)) as f:
-            return list(csv.DictReader(f))
+        return csv_rows(self.run_dir, path)
 
     def expected_state_samples(self, rate_hz=50.0):
-        # the first trajectory row at or after each k / rate
-        n, k = 0, 0
-        for row in self.rows("trajectory.csv"):
-            t = float(row["time_sec"])
-            if t < k / rate_hz:
-                continue
-            while k / rate_hz <= t:
-                k += 1
-            n += 1
-        return n
+        return state_samples(self.run_dir, rate_hz)
 
     def expected_topics(self):
         frames = len(self.rows("front/frames.csv"))

@@ -14,7 +14,6 @@ the run folder as a bag, and checks:
 
 usage: rosbag_export_test.py PENUMBRA_BINARY SOURCE_DIR WORK_DIR
 """
-import csv
 import json
 import math
 import os
@@ -27,7 +26,7 @@ import unittest
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from run_png import read_png  # noqa: E402
+from run_folder import csv_rows, read_png, state_samples  # noqa: E402
 
 BINARY, SOURCE, WORK = sys.argv[1:4]
 DURATION = 0.6
@@ -57,20 +56,10 @@ class RosbagExportTest(unittest.TestCase):
         cls.info = yaml.safe_load(info.stdout)
 
     def rows(self, path):
-        with open(os.path.join(self.run_dir, path)) as f:
-            return list(csv.DictReader(f))
+        return csv_rows(self.run_dir, path)
 
     def expected_state_samples(self, rate_hz=50.0):
-        # the first trajectory row at or after each k / rate
-        n, k = 0, 0
-        for row in self.rows("trajectory.csv"):
-            t = float(row["time_sec"])
-            if t < k / rate_hz:
-                continue
-            while k / rate_hz <= t:
-                k += 1
-            n += 1
-        return n
+        return state_samples(self.run_dir, rate_hz)
 
     def test_rosbag_info_lists_topics_and_counts(self):
         topics = {t["topic"]: t for t in self.info["topics"]}
