@@ -351,6 +351,107 @@ def policy_seeds():
     write("policy", "max_step.bin", policy_seed(1, 2 ** 63 - 1, terms * 5, [1e6, -1e6]))
 
 
+# ---- ROS 2 samples -----------------------------------------------------------------------------
+# fuzz/ros2_sample_fuzz.cc's layout: one byte, the Ros2Type (ros/ros2/ros2_types.h's order), then
+# the CDR as a DDS sample carries it: the encapsulation header (0, 1: little endian; 0, 0: big),
+# two option bytes whose last is the count of padding bytes at the end, then XCDR1 data: each
+# primitive aligned to its size from the first byte after the header, strings and sequences a
+# uint32 length first (a string's counts its terminating NUL). written here by hand, not by the
+# serializer under test.
+ROS2_TYPE = {"Image": 0, "JointState": 4, "TFMessage": 6, "Clock": 7, "Twist": 8,
+             "PoseStamped": 9, "TriggerRequest": 10, "TriggerResponse": 11}
+
+
+class Cdr:
+    def __init__(self, little=True):
+        self.e = "<" if little else ">"
+        self.b = bytearray()
+
+    def put(self, fmt, *v):
+        size = struct.calcsize(fmt)
+        self.b += bytes(-len(self.b) % size)
+        self.b += struct.pack(self.e + fmt * len(v), *v)
+        return self
+
+    def string(self, s, nul=True):
+        s = s.encode() if isinstance(s, str) else s
+        self.put("I", len(s) + (1 if nul else 0))
+        self.b += s + (b"\0" if nul else b"")
+        return self
+
+    def doubles(self, v):
+        self.put("I", len(v))
+        if v:
+            self.put("d", *v)
+        return self
+
+    def header(self, sec, nanosec, frame):
+        return self.put("i", sec).put("I", nanosec).string(frame)
+
+    def sample(self, type_name, pad=True):
+        n = -len(self.b) % 4 if pad else 0
+        head = (b"\x00\x01" if self.e == "<" else b"\x00\x00") + bytes([0, n])
+        return bytes([ROS2_TYPE[type_name]]) + head + bytes(self.b) + bytes(n)
+
+
+def joint_state(names, pos, vel=(), eff=(), frame="", little=True, sec=12, nanosec=5):
+    c = Cdr(little).header(sec, nanosec, frame).put("I", len(names))
+    for n in names:
+        c.string(n)
+    return c.doubles(list(pos)).doubles(list(vel)).doubles(list(eff)).sample("JointState")
+
+
+def ros2_seeds():
+    nan, inf = float("nan"), float("inf")
+    t = "ros2_sample"
+    write(t, "twist.bin", Cdr().put("d", 0.5, 0, 0, 0, 0, -0.25).sample("Twist"))
+    write(t, "twist_big_endian.bin", Cdr(False).put("d", 0.5, 0, 0, 0, 0, 1).sample("Twist"))
+    write(t, "twist_nan_inf.bin", Cdr().put("d", nan, inf, -inf, -0.0, 1e308, 5e-324)
+          .sample("Twist"))
+    write(t, "twist_short.bin", Cdr().put("d", 1, 2, 3, 4, 5).sample("Twist"))
+    write(t, "pose_stamped.bin", Cdr().header(3, 250000000, "world").put(
+        "d", 1, 2, 3, 0, 0, 0, 1).sample("PoseStamped"))
+    write(t, "pose_stamped_negative_stamp.bin", Cdr().header(-2, 999999999, "map").put(
+        "d", 0, 0, 0, 0, 0, 0, 1).sample("PoseStamped"))
+    write(t, "pose_stamped_nanosec_1e9.bin", Cdr().header(0, 1000000000, "world").put(
+        "d", 0, 0, 0, 0, 0, 0, 1).sample("PoseStamped"))
+    write(t, "pose_stamped_frame_no_nul.bin", Cdr().put("i", 0).put("I", 0).string(
+        "world", nul=False).put("d", 0, 0, 0, 0, 0, 0, 1).sample("PoseStamped"))
+    write(t, "pose_stamped_frame_1025.bin", Cdr().header(0, 0, "f" * 1025).put(
+        "d", 0, 0, 0, 0, 0, 0, 1).sample("PoseStamped"))
+    write(t, "joint_state.bin", joint_state(["shoulder", "elbow"], [0.1, -0.2], [0, 0],
+                                            frame="base_link"))
+    write(t, "joint_state_big_endian.bin", joint_state(["a"], [1.0], little=False))
+    write(t, "joint_state_unnamed.bin", joint_state([], [0.5, 0.25, 0.125]))
+    write(t, "joint_state_count_mismatch.bin", joint_state(["a", "b"], [1.0]))
+    write(t, "joint_state_1024.bin", joint_state(["j%d" % i for i in range(1024)], [0.0] * 1024))
+    write(t, "joint_state_1025.bin", joint_state(["j%d" % i for i in range(1025)], []))
+    write(t, "joint_state_1025_unnamed.bin", joint_state([], [0.0] * 1025))
+    write(t, "joint_state_4g_names.bin",
+          Cdr().header(0, 0, "").put("I", 0xFFFFFFFF).string("a").sample("JointState"))
+    write(t, "joint_state_4g_positions.bin",
+          Cdr().header(0, 0, "").put("I", 0).put("I", 0x20000000).put("d", 1.0)
+          .sample("JointState"))
+    write(t, "joint_state_name_4g.bin",
+          Cdr().header(0, 0, "").put("I", 1).put("I", 0xFFFFFFFF).sample("JointState"))
+    write(t, "trigger_request.bin",
+          Cdr().put("Q", 0x0110f00dcafe0001).put("q", 7).put("B", 0).sample("TriggerRequest"))
+    write(t, "trigger_request_short.bin", Cdr().put("Q", 1).sample("TriggerRequest"))
+    write(t, "trigger_response.bin", Cdr().put("Q", 9).put("q", 3).put("B", 1)
+          .string("step: step 1, t = 0.002 s").sample("TriggerResponse"))
+    write(t, "trigger_response_bool_2.bin", Cdr().put("Q", 9).put("q", 3).put("B", 2)
+          .string("").sample("TriggerResponse"))
+    write(t, "clock.bin", Cdr().put("i", 100).put("I", 2000000).sample("Clock"))
+    write(t, "clock_min.bin", Cdr().put("i", -2 ** 31).put("I", 999999999).sample("Clock"))
+    image = Cdr().header(1, 2, "camera").put("I", 2, 2).string("rgb8").put("B", 0).put("I", 6)
+    image.put("I", 12).b += bytes(range(12))
+    write(t, "image.bin", image.sample("Image"))
+    tf = Cdr().put("I", 1).header(0, 1, "world").string("base").put("d", 1, 2, 3, 0, 0, 0, 1)
+    write(t, "tf_message.bin", tf.sample("TFMessage"))
+    write(t, "bad_encapsulation.bin", b"\x08\x00\x07\x00\x00" + bytes(48))
+    write(t, "header_only.bin", b"\x08\x00\x01\x00\x00")
+
+
 if __name__ == "__main__":
     runlog_seeds()
     tum_seeds()
@@ -361,6 +462,7 @@ if __name__ == "__main__":
     template_seeds()
     onnx_seeds()
     policy_seeds()
+    ros2_seeds()
     for t in sorted(os.listdir(CORPUS)):
         files = os.listdir(os.path.join(CORPUS, t))
         size = sum(os.path.getsize(os.path.join(CORPUS, t, f)) for f in files)
