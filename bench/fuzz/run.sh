@@ -16,7 +16,7 @@ set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 seconds=1800
-targets="runlog world tum request viewer_messages rollout onnx policy template"
+targets="runlog world tum request viewer_messages rollout onnx policy template ros2_sample"
 build="$root/build-fuzz"
 jobs=2
 parallel=0
@@ -37,7 +37,7 @@ case "$seconds" in
 esac
 for t in $targets; do
   if [ ! -f "$root/fuzz/${t}_fuzz.cc" ]; then
-    echo "run.sh: no target '$t' (fuzz/${t}_fuzz.cc); expected one of runlog world tum request viewer_messages rollout onnx policy template" >&2
+    echo "run.sh: no target '$t' (fuzz/${t}_fuzz.cc); expected one of runlog world tum request viewer_messages rollout onnx policy template ros2_sample" >&2
     exit 2
   fi
 done
