@@ -18,12 +18,13 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 seconds=1800
 targets="runlog world tum request viewer_messages rollout onnx policy template ros2_sample"
 build="$root/build-fuzz"
+targets_given=0
 jobs=2
 parallel=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
-    --targets) targets="$2"; shift 2 ;;
+    --targets) targets="$2"; targets_given=1; shift 2 ;;
     --build) build="$(realpath -m "$2")"; shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --parallel) parallel=1; shift ;;
@@ -50,6 +51,15 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
   -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" >"$build/configure.log" 2>&1 \
   || { cat "$build/configure.log" >&2; exit 1; }
+# ros2_sample exists only in a build with ROS 2 (cmake/ros2.cmake: Cyclone DDS, idlc, the venv's
+# rosbags): left out of the default list without it, an error when asked for by name
+if ! ninja -C "$build" -t targets all | grep '^fuzz_ros2_sample:' >/dev/null; then
+  if [ "$targets_given" = 1 ] && [[ " $targets " == *" ros2_sample "* ]]; then
+    echo "run.sh: ros2_sample needs ROS 2 in the fuzz build; see $build/configure.log" >&2
+    exit 2
+  fi
+  targets="$(echo $targets | sed 's/\bros2_sample\b//')"
+fi
 bins=()
 for t in $targets; do bins+=("fuzz_$t"); done
 nice -n 19 cmake --build "$build" -j "$jobs" --target "${bins[@]}"
