@@ -213,6 +213,22 @@ TEST_F(ExportCommandTest, TumDepthIs5000PerMetreAtAKnownWallDistance) {
       const double v = depth.at<uint16_t>(depth.rows / 2, depth.cols / 2);
       EXPECT_NEAR(v, 5000 * d, 1.0) << camera << " " << file;
     }
+    // camera.txt: "fx fy cx cy d0 .. d4" of the run's camera_info.json
+    const auto cam = Lines(o / "camera.txt");
+    ASSERT_EQ(cam.size(), 4u);
+    EXPECT_EQ(cam[0].rfind("# camera intrinsics: 32 x 24 pixels", 0), 0u) << cam[0];
+    std::istringstream row(cam[3]);
+    std::vector<double> v;
+    for (double x = 0; row >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 9u) << cam[3];
+    const nlohmann::json info = nlohmann::json::parse(ReadAll(run() / "camera_info.json"));
+    const std::vector<double> K = info[camera]["K"];
+    EXPECT_NEAR(v[0], K[0], 1e-9);
+    EXPECT_NEAR(v[1], K[4], 1e-9);
+    EXPECT_NEAR(v[2], K[2], 1e-9);
+    EXPECT_NEAR(v[3], K[5], 1e-9);
+    EXPECT_NEAR(v[1], 12 / std::tan(M_PI / 6), 1e-6);  // fovy 60 deg over 24 pixels
+    for (int i = 4; i < 9; ++i) EXPECT_EQ(v[i], 0) << i;
   }
 }
 

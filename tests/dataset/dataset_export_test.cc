@@ -166,6 +166,25 @@ TEST_F(DatasetExportTest, TumListsImagesDepthScaleAndGroundTruth) {
   }
 }
 
+// camera.txt: "fx fy cx cy d0 d1 d2 d3 d4" as the benchmark's "File Formats" page lists its
+// Kinects' intrinsics, from camera_info.json (K row-major, D = k1 k2 p1 p2 k3)
+TEST_F(DatasetExportTest, TumCameraTxtCarriesTheIntrinsicsAndDistortion) {
+  testing::WriteFakeRun(run_);
+  std::ofstream(run_ / "camera_info.json")
+      << R"({"cam": {"frame_id": "cam/optical", "width": 8, "height": 6,)"
+      << R"( "distortion_model": "plumb_bob", "D": [0.125, -0.25, 0.001, -0.002, 0.5],)"
+      << R"( "K": [10.5, 0, 4.25, 0, 11.75, 3.5, 0, 0, 1]}})";
+  Export(DatasetFormat::kTum);
+  const auto rows = TumRows(out() / "camera.txt", 3);
+  ASSERT_EQ(rows.size(), 1u);
+  const std::vector<double> expected = {10.5, 11.75, 4.25, 3.5, 0.125, -0.25, 0.001, -0.002, 0.5};
+  ASSERT_EQ(rows[0].size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(std::stod(rows[0][i]), expected[i]) << i;
+  const std::vector<std::string> lines = Lines(out() / "camera.txt");
+  EXPECT_EQ(lines[0].rfind("# camera intrinsics: 8 x 6 pixels", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[2], "# fx fy cx cy d0 d1 d2 d3 d4");
+}
+
 TEST_F(DatasetExportTest, TumRefusesACameraWithoutDepthAndLeavesNoOutput) {
   testing::FakeRunSpec spec;
   spec.depth = false;

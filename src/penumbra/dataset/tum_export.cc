@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <array>
 
 #include "penumbra/core/error.h"
 #include "penumbra/core/output_file.h"
@@ -14,6 +15,18 @@ namespace penumbra {
 namespace fs = std::filesystem;
 
 std::string TumTimestamp(double time_sec) { return fmt::format("{:.6f}", time_sec); }
+
+std::string TumCameraText(const RunCamera& cam, const std::string& source) {
+  const std::array<double, 5>& d = cam.distortion;
+  // "+ 0.0": a -0 prints as 0
+  return fmt::format(
+      "# camera intrinsics: {} x {} pixels; d0 .. d4 = OpenCV k1 k2 p1 p2 k3\n"
+      "# file: '{}'\n"
+      "# fx fy cx cy d0 d1 d2 d3 d4\n"
+      "{} {} {} {} {} {} {} {} {}\n",
+      cam.width, cam.height, source, cam.fx, cam.fy, cam.cx, cam.cy, d[0] + 0.0, d[1] + 0.0,
+      d[2] + 0.0, d[3] + 0.0, d[4] + 0.0);
+}
 
 TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const fs::path& out,
                           const std::atomic<int>* stop_request) {
@@ -59,6 +72,7 @@ TumExportResult ExportTum(const RunCamera& cam, const std::string& source, const
   WriteFileAtomic(out / "depth.txt", depth);
   WriteFileAtomic(out / "groundtruth.txt", truth);
   WriteFileAtomic(out / "associations.txt", assoc);
+  WriteFileAtomic(out / "camera.txt", TumCameraText(cam, source));
   return result;
 }
 

@@ -11,6 +11,10 @@
 //                           y down, z forward) in the world (Penumbra's REP-103 world, z up)
 //   OUT/associations.txt    "rgb_timestamp rgb/<t>.png depth_timestamp depth/<t>.png", as
 //                           TUM's associate.py prints it (no header)
+//   OUT/camera.txt          '#' header lines, then "fx fy cx cy d0 d1 d2 d3 d4": the camera's
+//                           intrinsics as the benchmark's "File Formats" page lists those of
+//                           its Kinects (pixels; d0 .. d4 = OpenCV's k1 k2 p1 p2 k3), from the
+//                           run's camera_info.json; the image size is in the first header line
 //
 // <t> and every timestamp: the frame's sim time in seconds with 6 decimals (the benchmark
 // counts from the Unix epoch; Penumbra's sim time starts at 0). colour and depth come from the
@@ -35,8 +39,11 @@ struct TumExportResult {
 /// the TUM timestamp of a sim time: 6 decimals, as the benchmark prints them.
 std::string TumTimestamp(double time_sec);
 
+/// the text of camera.txt (see above); `source` as in ExportTum.
+std::string TumCameraText(const RunCamera& cam, const std::string& source);
+
 /// writes camera `cam`'s frames to `out` (an existing, empty folder) in the TUM layout.
-/// `source` names the run in the lists' "# file:" header line.
+/// `source` names the run in the lists' and camera.txt's "# file:" header line.
 /// @throws ConfigError if the camera has no rgb or no depth images (naming the camera and the
 ///         world-file key that adds them), a frame's image is missing, or two frames share a
 ///         6-decimal timestamp, or an image that fails the checks of dataset/image_convert.h;
