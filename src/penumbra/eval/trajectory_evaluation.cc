@@ -13,6 +13,10 @@ namespace penumbra {
 void EvaluationOptions::ValidateOrThrow() const {
   association.ValidateOrThrow();
   rpe_delta.ValidateOrThrow();
+  if (frame_period_sec && !(std::isfinite(*frame_period_sec) && *frame_period_sec > 0))
+    throw ConfigError(
+        "", 0, "frame_period_sec",
+        fmt::format("{} is out of range; expected a finite number > 0 (s)", *frame_period_sec));
   if (max_gap_sec && !(std::isfinite(*max_gap_sec) && *max_gap_sec > 0))
     throw ConfigError(
         "", 0, "max_gap_sec",
@@ -123,10 +127,16 @@ TrajectoryEvaluation EvaluateTrajectory(const Trajectory& ground_truth, const Tr
   const double nan = std::numeric_limits<double>::quiet_NaN();
   r.coverage = r.estimate_path_m > 0 ? r.ground_truth_path_m / r.estimate_path_m : nan;
   r.scaled_ate_m = r.coverage > 0 ? r.ate_m.rmse / r.coverage : nan;
-  const double max_gap_sec = options.max_gap_sec.value_or(
-      3.0 * std::max(MedianPeriod(ground_truth.time_sec), MedianPeriod(estimate.time_sec)));
+  // the gap limit from the ground truth's sampling: the estimate's own median spacing would
+  // make a mostly lost estimate's gaps the norm (3 poses of 41 frames read 0.95 tracked)
+  r.frame_period_sec = options.frame_period_sec.value_or(MedianPeriod(ground_truth.time_sec));
+  const double max_gap_sec = options.max_gap_sec.value_or(kTrackedGapPeriods * r.frame_period_sec);
   r.tracked = ComputeTrackedTime(r.pair_time_sec, r.ground_truth_start_sec, r.ground_truth_end_sec,
                                  max_gap_sec);
+  const double span_periods = r.frame_period_sec > 0 ? r.tracked.total_sec / r.frame_period_sec : 0;
+  // capped: a tiny frame period over a long span must not overflow the count
+  r.expected_poses = static_cast<size_t>(std::min(std::round(span_periods), 1e15)) + 1;
+  r.pose_fraction = std::min(1.0, static_cast<double>(n) / static_cast<double>(r.expected_poses));
 
   // 4. the ground-truth path the tracked intervals cover: the pairs are in ground-truth
   // order, so the ground-truth poses between pair k-1 and pair k are indices a_k-1 .. a_k

@@ -8,7 +8,9 @@
 //   3. ATE, RPE (trajectory_metrics.h) and the benchmark figures of the URLab paper:
 //      coverage = ground-truth path length / aligned estimated path length, both over the
 //      associated poses in ground-truth time order; scaled ATE = ATE RMSE / coverage;
-//      fraction of ground-truth time tracked (ComputeTrackedTime);
+//      fraction of ground-truth time tracked (ComputeTrackedTime), with the gap limit taken
+//      from the ground truth's sampling (or the caller's frame period), never from the
+//      estimate's own spacing: a mostly lost estimate's spacing is itself a gap;
 //   4. beside the paper's coverage, which rewards an estimate that barely moves (its path is
 //      short, so coverage > 1 and the scaled ATE shrinks): the tracked path coverage = the
 //      ground-truth path length over the tracked intervals (between consecutive associated
@@ -31,12 +33,16 @@ struct EvaluationOptions {
   AssociationOptions association;
   AlignmentModel alignment = AlignmentModel::kSe3;
   RpeDelta rpe_delta;
+  /// the sample period the estimate should have (its camera's frame period), s; unset: the
+  /// ground truth's median sample period (MedianPeriod). set it when the ground truth is
+  /// sampled faster than the estimator's input (e.g. 100 Hz motion capture, a 30 Hz camera).
+  std::optional<double> frame_period_sec;
   /// the longest interval between consecutive associated poses that counts as tracked, s;
-  /// unset: 3 x the larger of the two files' median sample periods (MedianPeriod)
+  /// unset: kTrackedGapPeriods x the frame period above
   std::optional<double> max_gap_sec;
 
   /// @throws ConfigError naming the key (max_dt_sec, offset_sec, delta, delta_sec,
-  ///         max_gap_sec) of a value out of range.
+  ///         frame_period_sec, max_gap_sec) of a value out of range.
   void ValidateOrThrow() const;
 };
 
@@ -71,6 +77,15 @@ struct TrajectoryEvaluation {
   double coverage = 0;
   double scaled_ate_m = 0;  ///< ate_m.rmse / coverage; NaN when coverage is NaN or 0
   TrackedTime tracked;
+  /// the frame period the gap limit and expected_poses come from: options.frame_period_sec,
+  /// else the ground truth's median sample period, s (0 for a single ground-truth pose)
+  double frame_period_sec = 0;
+  /// the poses an estimate at frame_period_sec has over the ground truth's span:
+  /// round(total_sec / frame_period_sec) + 1 (the ground truth's pose count by default)
+  size_t expected_poses = 0;
+  /// the associated poses the ATE rests on / expected_poses, in [0, 1]: 3 poses of 41 frames
+  /// read 0.073 whatever their errors
+  double pose_fraction = 0;
 
   /// the whole ground truth's path (every pose, associated or not), m
   double ground_truth_full_path_m = 0;

@@ -77,6 +77,12 @@ std::vector<RelativePoseError> RelativePoseErrors(const std::vector<double>& tim
 /// 1e-15 relative) and far below a real extra frame (1/3 relative). docs/evaluation.md.
 inline constexpr double kTrackedGapRelTolerance = 1e-9;
 
+/// the default gap limit in frame periods: an interval of up to 3 periods (at most two lost
+/// frames, or a pose that association jitter moved by up to a period) counts as tracked. the
+/// period is the ground truth's (or the caller's frame period), never the estimate's own
+/// spacing, which for a mostly lost estimate is itself a gap (docs/evaluation.md).
+inline constexpr double kTrackedGapPeriods = 3.0;
+
 /// true when an interval of `gap_sec` between consecutive associated poses counts as tracked
 /// under the limit `max_gap_sec`: gap_sec <= max_gap_sec * (1 + kTrackedGapRelTolerance).
 bool GapIsTracked(double gap_sec, double max_gap_sec);
