@@ -215,7 +215,7 @@ TEST(BenchmarkReport, SummaryIsMeanAndSampleStdOverOkTrials) {
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "world,condition,method,trial,seed,status,frames,poses,ate_rmse_m,ate_mean_m,ate_max_m,"
             "rpe_trans_rmse_m,rpe_rot_rmse_deg,coverage,scaled_ate_m,tracked_fraction,"
-            "tracked_path_coverage,tracked_scaled_ate_m,scale,replay_sec,"
+            "tracked_path_coverage,tracked_scaled_ate_m,pose_fraction,scale,replay_sec,"
             "export_sec,method_sec,eval_sec,detail");
   EXPECT_NE(csv.find("room,none,rgbd,3,0,failed,0,0,,,,"), std::string::npos) << csv;
 }

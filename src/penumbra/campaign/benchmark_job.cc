@@ -54,6 +54,7 @@ nlohmann::json RowJson(const BenchmarkRow& r) {
           {"tracked_fraction", Num(r.tracked_fraction)},
           {"tracked_path_coverage", Num(r.tracked_path_coverage)},
           {"tracked_scaled_ate_m", Num(r.tracked_scaled_ate_m)},
+          {"pose_fraction", Num(r.pose_fraction)},
           {"scale", Num(r.scale)},
           {"replay_sec", r.replay_sec},
           {"export_sec", r.export_sec},
@@ -98,6 +99,7 @@ void Evaluate(const Trajectory& gt, const Trajectory& est, const BenchmarkSpec& 
   row.tracked_fraction = e.tracked.fraction;
   row.tracked_path_coverage = e.tracked_path_coverage;
   row.tracked_scaled_ate_m = e.tracked_scaled_ate_m;
+  row.pose_fraction = e.pose_fraction;
   row.scale = e.alignment.scale;
 }
 
@@ -299,6 +301,7 @@ std::vector<BenchmarkRow> ReadJobResult(const std::string& path) {
       // absent from job results written before these figures existed
       r.tracked_path_coverage = NumOf(e.value("tracked_path_coverage", nlohmann::json()));
       r.tracked_scaled_ate_m = NumOf(e.value("tracked_scaled_ate_m", nlohmann::json()));
+      r.pose_fraction = NumOf(e.value("pose_fraction", nlohmann::json()));
       r.scale = NumOf(e.at("scale"));
       r.replay_sec = e.at("replay_sec");
       r.export_sec = e.at("export_sec");

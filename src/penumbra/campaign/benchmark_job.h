@@ -52,6 +52,9 @@ struct BenchmarkRow {
   /// beside the paper's coverage: the ground-truth path the tracked intervals cover / the whole
   /// ground-truth path, and ATE RMSE / that coverage (eval/trajectory_evaluation.h)
   double tracked_path_coverage = NAN, tracked_scaled_ate_m = NAN;
+  /// the poses the ATE rests on: associated poses / the frames of the ground truth's span
+  /// (eval/trajectory_evaluation.h pose_fraction), in [0, 1]
+  double pose_fraction = NAN;
   double scale = NAN;  ///< the alignment's scale (1 for se3)
   /// wall times, s: replay (rendering) and export are per job (the same in each of its rows)
   double replay_sec = 0, export_sec = 0, method_sec = 0, eval_sec = 0;

@@ -21,6 +21,11 @@ namespace {
 
 using namespace benchmark_text;  // NOLINT: module-internal helpers
 
+// `v` with `digits` decimals, "-" for NaN
+std::string FixedOrDash(double v, int digits) {
+  return std::isfinite(v) ? fmt::format("{:.{}f}", v, digits) : "-";
+}
+
 // a line plot: x = the conditions in spec order, one line per method with error bars (std),
 // the y axis up to a round number above the largest mean + std, ticks at 1, 2 or 5 x 10^k
 void PlotMetric(const BenchmarkSpec& spec, const std::vector<SummaryLine>& lines,
@@ -68,6 +73,7 @@ const std::vector<std::string>& BenchmarkCsvColumns() {
                                                     "tracked_fraction",
                                                     "tracked_path_coverage",
                                                     "tracked_scaled_ate_m",
+                                                    "pose_fraction",
                                                     "scale",
                                                     "replay_sec",
                                                     "export_sec",
@@ -86,7 +92,7 @@ std::string BenchmarkCsv(const std::vector<BenchmarkRow>& rows) {
                        r.status, r.frames, r.poses);
     for (double v : {r.ate_rmse_m, r.ate_mean_m, r.ate_max_m, r.rpe_trans_rmse_m,
                      r.rpe_rot_rmse_deg, r.coverage, r.scaled_ate_m, r.tracked_fraction,
-                     r.tracked_path_coverage, r.tracked_scaled_ate_m, r.scale})
+                     r.tracked_path_coverage, r.tracked_scaled_ate_m, r.pose_fraction, r.scale})
       out += Field(v) + ",";
     out += fmt::format("{:.3f},{:.3f},{:.3f},{:.3f},", r.replay_sec, r.export_sec, r.method_sec,
                        r.eval_sec);
@@ -105,14 +111,16 @@ std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
         l.world = w.name;
         l.condition = c.name;
         l.method = m.name;
-        std::vector<double> ate, sate, cov, rpet, rper, tracked, tcov, tsate;
+        std::vector<double> ate, sate, cov, rpet, rper, tracked, poses, tcov, tsate;
         for (const BenchmarkRow& r : rows) {
           if (r.world != w.name || r.condition != c.name || r.method != m.name) continue;
           ++l.trials;
           const bool ok = r.status == "ok";
           l.ok += ok ? 1 : 0;
           tracked.push_back(ok && std::isfinite(r.tracked_fraction) ? r.tracked_fraction : 0.0);
+          poses.push_back(ok && std::isfinite(r.pose_fraction) ? r.pose_fraction : 0.0);
           if (!ok) continue;
+          if (r.tracked_fraction >= kTrackedFractionThreshold) ++l.tracked;
           if (std::isfinite(r.ate_rmse_m)) ate.push_back(r.ate_rmse_m);
           if (std::isfinite(r.scaled_ate_m)) sate.push_back(r.scaled_ate_m);
           if (std::isfinite(r.coverage)) cov.push_back(r.coverage);
@@ -129,6 +137,7 @@ std::vector<SummaryLine> Summarize(const BenchmarkSpec& spec,
         l.rpe_trans_rmse_m = Cell(rpet);
         l.rpe_rot_rmse_deg = Cell(rper);
         l.tracked_fraction = Cell(tracked);
+        l.pose_fraction = Cell(poses);
         lines.push_back(l);
       }
   return lines;
@@ -139,24 +148,73 @@ std::string SummaryMarkdown(const BenchmarkSpec& spec, const std::vector<Summary
   for (const BenchmarkWorld& w : spec.worlds) {
     out += fmt::format(
         "**{}** (mean ± std over the trials that tracked; `ok` = trials with a trajectory "
-        "that matches the ground truth; tracked fraction counts failed trials as 0; RPE over {} "
-        "s)\n\n",
-        w.name, FormatNumber(spec.metrics.rpe_delta_sec));
+        "that matches the ground truth; `tracked` = ok trials that tracked at least {} of the "
+        "ground truth's time; tracked fraction and pose fraction (associated poses / frames) "
+        "count failed trials as 0; † = the ATE figures include trials below that, resting on "
+        "part of the ground truth; RPE over {} s)\n\n",
+        w.name, FormatNumber(kTrackedFractionThreshold), FormatNumber(spec.metrics.rpe_delta_sec));
     out +=
-        "| condition | method | ok | ATE RMSE (m) | scaled ATE (m) | coverage | tracked path "
-        "coverage | tracked-path scaled ATE (m) | tracked fraction | RPE (m) | RPE (deg) |\n";
-    out += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "| condition | method | ok | tracked | ATE RMSE (m) | scaled ATE (m) | coverage | tracked "
+        "path coverage | tracked-path scaled ATE (m) | tracked fraction | pose fraction | RPE (m) "
+        "| RPE (deg) |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const SummaryLine& l : lines) {
       if (l.world != w.name) continue;
-      out += fmt::format("| {} | {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
-                         l.condition, l.method, l.ok, l.trials, Pm(l.ate_rmse_m, 4),
-                         Pm(l.scaled_ate_m, 4), Pm(l.coverage, 3), Pm(l.tracked_path_coverage, 3),
-                         Pm(l.tracked_scaled_ate_m, 4), Pm(l.tracked_fraction, 3),
-                         Pm(l.rpe_trans_rmse_m, 4), Pm(l.rpe_rot_rmse_deg, 2));
+      const std::string mark = l.tracked < l.ok ? " †" : "";
+      out += fmt::format(
+          "| {} | {} | {}/{} | {}/{} | {}{} | {}{} | {} | {} | {}{} | {} | {} | {} | {} |\n",
+          l.condition, l.method, l.ok, l.trials, l.tracked, l.trials, Pm(l.ate_rmse_m, 4), mark,
+          Pm(l.scaled_ate_m, 4), mark, Pm(l.coverage, 3), Pm(l.tracked_path_coverage, 3),
+          Pm(l.tracked_scaled_ate_m, 4), mark, Pm(l.tracked_fraction, 3), Pm(l.pose_fraction, 3),
+          Pm(l.rpe_trans_rmse_m, 4), Pm(l.rpe_rot_rmse_deg, 2));
     }
     out += "\n";
   }
   return out;
+}
+
+std::string TrackingSummaryMarkdown(const std::vector<BenchmarkRow>& rows) {
+  const std::string threshold = FormatNumber(kTrackedFractionThreshold);
+  std::vector<const BenchmarkRow*> short_rows, failed_rows;
+  for (const BenchmarkRow& r : rows) {
+    if (r.status != "ok")
+      failed_rows.push_back(&r);
+    else if (!(r.tracked_fraction >= kTrackedFractionThreshold))
+      short_rows.push_back(&r);
+  }
+  if (short_rows.empty() && failed_rows.empty())
+    return fmt::format(
+        "Every method tracked at least {} of the ground truth's time in every trial ({} "
+        "row{}).\n",
+        threshold, rows.size(), rows.size() == 1 ? "" : "s");
+  const size_t tracked = rows.size() - short_rows.size() - failed_rows.size();
+  std::string md = fmt::format(
+      "{} of {} rows tracked at least {} of the ground truth's time; {} ran but tracked less "
+      "and {} failed.\n\n",
+      tracked, rows.size(), threshold, short_rows.size(), failed_rows.size());
+  if (!short_rows.empty()) {
+    md += "Tracked less than " + threshold +
+          " of the time (their ATE rests on the poses they kept, not comparable with a full "
+          "trajectory's):\n\n| world | condition | method | trial | tracked fraction | poses / "
+          "frames "
+          "| pose fraction | ATE RMSE (m) | scaled ATE (m) "
+          "|\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const BenchmarkRow* r : short_rows)
+      md += fmt::format("| {} | {} | {} | {} | {} | {} / {} | {} | {} | {} |\n", r->world,
+                        r->condition, r->method, r->trial, FixedOrDash(r->tracked_fraction, 3),
+                        r->poses, r->frames, FixedOrDash(r->pose_fraction, 3),
+                        FixedOrDash(r->ate_rmse_m, 4), FixedOrDash(r->scaled_ate_m, 4));
+    md += "\n";
+  }
+  if (!failed_rows.empty()) {
+    md +=
+        "Failed:\n\n| world | condition | method | trial | status | detail "
+        "|\n|---|---|---|---|---|---|\n";
+    for (const BenchmarkRow* r : failed_rows)
+      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r->world, r->condition, r->method,
+                        r->trial, r->status, r->detail.substr(0, 200));
+  }
+  return md;
 }
 
 void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
@@ -171,16 +229,18 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
       "ate_m_std,"
       "coverage_mean,coverage_std,tracked_fraction_mean,tracked_fraction_std,rpe_trans_rmse_m_mean,"
       "rpe_trans_rmse_m_std,tracked_path_coverage_mean,tracked_path_coverage_std,"
-      "tracked_scaled_ate_m_mean,tracked_scaled_ate_m_std\n";
+      "tracked_scaled_ate_m_mean,tracked_scaled_ate_m_std,tracked,pose_fraction_mean,"
+      "pose_fraction_std\n";
   for (const SummaryLine& l : lines)
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", l.world,
-                       l.condition, l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean),
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                       l.world, l.condition, l.method, l.trials, l.ok, Field(l.ate_rmse_m.mean),
                        Field(l.ate_rmse_m.std), Field(l.scaled_ate_m.mean),
                        Field(l.scaled_ate_m.std), Field(l.coverage.mean), Field(l.coverage.std),
                        Field(l.tracked_fraction.mean), Field(l.tracked_fraction.std),
                        Field(l.rpe_trans_rmse_m.mean), Field(l.rpe_trans_rmse_m.std),
                        Field(l.tracked_path_coverage.mean), Field(l.tracked_path_coverage.std),
-                       Field(l.tracked_scaled_ate_m.mean), Field(l.tracked_scaled_ate_m.std));
+                       Field(l.tracked_scaled_ate_m.mean), Field(l.tracked_scaled_ate_m.std),
+                       l.tracked, Field(l.pose_fraction.mean), Field(l.pose_fraction.std));
   WriteText(out / "summary.csv", csv);
 
   fs::create_directories(out / "plots");
@@ -244,16 +304,7 @@ void WriteBenchmarkReport(const BenchmarkSpec& spec, const std::string& out_dir,
   md +=
       "## Rows\n\nEvery (world, condition, method, trial): [results.csv](results.csv) (columns in "
       "docs/benchmarks.md).\n\n";
-  int failed = 0;
-  for (const BenchmarkRow& r : rows)
-    if (r.status != "ok") {
-      if (failed++ == 0)
-        md +=
-            "| world | condition | method | trial | status | detail |\n|---|---|---|---|---|---|\n";
-      md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", r.world, r.condition, r.method,
-                        r.trial, r.status, r.detail.substr(0, 200));
-    }
-  if (failed == 0) md += "Every method tracked in every trial.\n";
+  md += TrackingSummaryMarkdown(rows);
   WriteText(out / "report.md", md);
 }
 
