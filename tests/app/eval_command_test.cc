@@ -1,5 +1,6 @@
 // `penumbra eval ate|rpe` end to end on the real binary: reports (text and JSON, checked
 // against hand-computed values), the plot file, exit codes and error messages.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -84,6 +85,42 @@ TEST_F(EvalCommandTest, AteJsonOnStdoutAndInAFile) {
   EXPECT_DOUBLE_EQ(j["tracked_path"]["scaled_ate_m"].get<double>(), 0.5590169943749475);
   EXPECT_DOUBLE_EQ(j["tracked_path"]["ground_truth_path_m"].get<double>(), 3.0);
   EXPECT_FALSE(j.contains("rpe"));
+}
+
+TEST_F(EvalCommandTest, ASparseEstimateReportsItsLostTimeAndPoses) {
+  // ground truth at 10 Hz over 0 .. 4 s (41 frames); the estimate kept frames 0, 20, 40. the
+  // gap limit is 3 x the ground truth's 0.1 s period: nothing tracked, 3 of 41 poses. with
+  // --frame-period 2 (an estimator meant to run at 0.5 Hz) the 2 s intervals count
+  std::string gt, est;
+  for (int k = 0; k <= 40; ++k) {
+    const std::string line = fmt::format("{:.1f} {} 0 0 0 0 0 1\n", 0.1 * k, 0.25 * k);
+    gt += line;
+    if (k % 20 == 0) est += line;
+  }
+  const std::string gt_file = tmp_.Write("gt41.txt", gt), est_file = tmp_.Write("est3.txt", est);
+  const ProcessResult r = Run({"eval", "ate", gt_file, est_file, "--format", "json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j["time_tracked"]["fraction"].get<double>(), 0.0);
+  EXPECT_NEAR(j["time_tracked"]["max_gap_sec"].get<double>(), 0.3, 1e-12);
+  EXPECT_NEAR(j["time_tracked"]["frame_period_sec"].get<double>(), 0.1, 1e-12);
+  EXPECT_EQ(j["time_tracked"]["associated_poses"], 3);
+  EXPECT_EQ(j["time_tracked"]["expected_poses"], 41);
+  EXPECT_NEAR(j["time_tracked"]["pose_fraction"].get<double>(), 3.0 / 41.0, 1e-12);
+  const ProcessResult text = Run({"eval", "ate", gt_file, est_file});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("time tracked  0 (0 s of 4 s; intervals > 0.3 s"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("poses         3 associated of 41 expected at 0.1 s per frame "
+                          "(0.0731707)"),
+            std::string::npos)
+      << text.out;
+  const ProcessResult slow = Run({"eval", "ate", gt_file, est_file, "--frame-period", "2"});
+  ASSERT_EQ(slow.exit_code, 0) << slow.err;
+  EXPECT_NE(slow.out.find("time tracked  1 (4 s of 4 s; intervals > 6 s"), std::string::npos)
+      << slow.out;
+  EXPECT_NE(slow.out.find("3 associated of 3 expected at 2 s per frame (1)"), std::string::npos)
+      << slow.out;
 }
 
 TEST_F(EvalCommandTest, RpeJsonWithDeltaInFramesAndSeconds) {

@@ -78,7 +78,7 @@ struct EvalCommand::State {
   std::string align = "se3";
   std::string format = "text";
   std::string json_path, plot_path;
-  std::optional<double> max_dt_sec, offset_sec, max_gap_sec, delta_sec;
+  std::optional<double> max_dt_sec, offset_sec, frame_period_sec, max_gap_sec, delta_sec;
   int64_t delta_frames = 1;
 
   Json ToJson(bool ate_verb, const TrajectoryEvaluation& r) const;
@@ -115,9 +115,12 @@ void EvalCommand::AddOptions(CLI::App* eval) {
               "largest |dt| of an associated pose pair, s (default 0.02)");
     AddNumber(verb, "--offset", &s.offset_sec, false,
               "added to the estimate's timestamps before association, s (default 0)");
+    AddNumber(verb, "--frame-period", &s.frame_period_sec, true,
+              "the sample period the estimate should have (its camera's frame period), s "
+              "(default the ground truth's median sample period)");
     AddNumber(verb, "--max-gap", &s.max_gap_sec, true,
               "longest interval between associated poses that counts as tracked, s (default 3 x "
-              "the larger median sample period of the two files)");
+              "the frame period)");
     verb->add_option("--json", s.json_path, "also write the report as JSON to this file");
     verb->add_option("--plot", s.plot_path,
                      "write a PNG: top view of both trajectories and the error over time");
@@ -172,10 +175,11 @@ Json EvalCommand::State::ToJson(bool ate_verb, const TrajectoryEvaluation& r) co
     j["estimate_path_m"] = r.estimate_path_m;
     j["coverage"] = Number(r.coverage);
     j["scaled_ate_m"] = Number(r.scaled_ate_m);
-    j["time_tracked"] = {{"fraction", Number(r.tracked.fraction)},
-                         {"tracked_sec", r.tracked.tracked_sec},
-                         {"total_sec", r.tracked.total_sec},
-                         {"max_gap_sec", r.tracked.max_gap_sec}};
+    j["time_tracked"] = {
+        {"fraction", Number(r.tracked.fraction)}, {"tracked_sec", r.tracked.tracked_sec},
+        {"total_sec", r.tracked.total_sec},       {"max_gap_sec", r.tracked.max_gap_sec},
+        {"frame_period_sec", r.frame_period_sec}, {"associated_poses", r.association.pairs.size()},
+        {"expected_poses", r.expected_poses},     {"pose_fraction", Number(r.pose_fraction)}};
     // beside the paper's coverage: the ground-truth path the tracked intervals cover
     j["tracked_path"] = {{"coverage", Number(r.tracked_path_coverage)},
                          {"scaled_ate_m", Number(r.tracked_scaled_ate_m)},
@@ -224,6 +228,10 @@ std::string EvalCommand::State::ToText(bool ate_verb, const TrajectoryEvaluation
         "time tracked  {:.6g} ({:.6g} s of {:.6g} s; intervals > {:.6g} s between "
         "associated poses not counted)\n",
         r.tracked.fraction, r.tracked.tracked_sec, r.tracked.total_sec, r.tracked.max_gap_sec);
+    t += fmt::format(
+        "poses         {} associated of {} expected at {:.6g} s per frame ({:.6g}); the ATE rests "
+        "on these\n",
+        r.association.pairs.size(), r.expected_poses, r.frame_period_sec, r.pose_fraction);
     if (std::isfinite(r.tracked_path_coverage))
       t += fmt::format(
           "tracked path  coverage {:.6g} (ground-truth path over tracked intervals {:.6g} m / "
@@ -252,6 +260,7 @@ int EvalCommand::Run(const CommandArgs&) {
                                           : AlignmentModel::kSe3;
   options.rpe_delta.frames = s.delta_frames;
   options.rpe_delta.seconds = s.delta_sec;
+  options.frame_period_sec = s.frame_period_sec;
   options.max_gap_sec = s.max_gap_sec;
 
   const Trajectory ground_truth = ReadTumTrajectory(s.ground_truth_path);
