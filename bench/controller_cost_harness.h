@@ -58,6 +58,7 @@ class ReplayController final : public Controller {
   std::string type() const override { return "replay"; }
   double rate_hz() const override { return 0; }
   std::vector<NameRequirement> RequiredNames() const override { return {}; }
+  void Reset() override { k_ = 0; }
   void Compute(const ControlInput&, std::span<double> ctrl) override {
     std::copy(log_->begin() + k_ * nu_, log_->begin() + (k_ + 1) * nu_, ctrl.begin());
     ++k_;

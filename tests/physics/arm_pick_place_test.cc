@@ -47,6 +47,7 @@ class TouchProbe final : public Controller {
     return {{ModelObject::kSensor, "left_pad_touch", ""},
             {ModelObject::kSensor, "right_pad_touch", ""}};
   }
+  void Reset() override {}  // no memory: reads the current sensors
   void Compute(const ControlInput& input, std::span<double>) override {
     left_ = input.sensordata()[left_adr_];
     right_ = input.sensordata()[right_adr_];

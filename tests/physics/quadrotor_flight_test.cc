@@ -339,6 +339,7 @@ class RotorGlitch final : public Controller {
       r.push_back({ModelObject::kActuator, n, ""});
     return r;
   }
+  void Reset() override {}  // no memory
   void Compute(const ControlInput& input, std::span<double> ctrl) override {
     if (input.time_sec() < t0_ || input.time_sec() >= t1_) return;
     for (size_t i = 0; i < ids_.size(); ++i) ctrl[ids_[i]] = i == 0 ? 7.0 : 0.0;

@@ -67,6 +67,7 @@ class Probe final : public Controller {
   std::vector<NameRequirement> RequiredNames() const override {
     return {{ModelObject::kSensor, "trunk_touch", ""}, {ModelObject::kBody, "trunk", ""}};
   }
+  void Reset() override {}  // records over the whole run
   void Compute(const ControlInput& in, std::span<double>) override {
     const double touch = in.sensordata()[touch_adr_];
     max_trunk_touch_n = std::max(max_trunk_touch_n, touch);
@@ -106,6 +107,7 @@ class LegModelCheck final : public Controller {
         r.push_back({ModelObject::kJoint, std::string(leg) + j, ""});
     return r;
   }
+  void Reset() override {}  // records over the whole run
   void Compute(const ControlInput& in, std::span<double>) override {
     const Pose X_WT = in.X_WB(trunk_);
     for (int i = 0; i < 4; ++i) {

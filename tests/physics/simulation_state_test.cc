@@ -35,6 +35,7 @@ class StatelessPd final : public Controller {
   std::string type() const override { return "stateless_pd"; }
   double rate_hz() const override { return 100; }  // every 5th step at 2 ms
   std::vector<NameRequirement> RequiredNames() const override { return {}; }
+  void Reset() override {}  // no memory
   void Compute(const ControlInput& in, std::span<double> ctrl) override {
     const ModelInfo& info = in.model();
     for (size_t a = 0; a < info.actuators.size(); ++a) {

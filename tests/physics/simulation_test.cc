@@ -58,6 +58,7 @@ class LambdaController final : public Controller {
   std::string type() const override { return "lambda"; }
   double rate_hz() const override { return rate_; }
   std::vector<NameRequirement> RequiredNames() const override { return names_; }
+  void Reset() override {}  // records over the whole run
   void Compute(const ControlInput& in, std::span<double> ctrl) override {
     times.push_back(in.time_sec());
     if (fn_) fn_(in, ctrl);

@@ -441,10 +441,8 @@ void CommandDispatcher::Reset(const CommandInfo& info, RequestReader& rd, const 
           std::vector<int> ids(nmocap);
           for (int i = 0; i < nmocap; ++i) ids[i] = i;
           sim.ApplyMocapDrivers(ids);
-          for (int i = 0; i < sim.num_controllers(); ++i) {
-            if (TwistTarget* target = AsTwistTarget(sim.mutable_controller(i)))
-              target->ClearTwist();
-          }
+          // every controller back to its just-initialized state, on a clock that restarts at 0
+          sim.ResetControllers();
           return StepTime(sim);
         });
 }

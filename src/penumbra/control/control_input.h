@@ -23,7 +23,8 @@ class ControlInput {
  public:
   virtual ~ControlInput() = default;
 
-  /// simulation time (s).
+  /// the controllers' clock (s): simulation time since the last Simulation::ResetControllers
+  /// (the `reset` command), i.e. simulation time in a run without one.
   virtual double time_sec() const = 0;
   /// the model the state belongs to.
   virtual const ModelInfo& model() const = 0;

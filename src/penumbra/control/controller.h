@@ -10,6 +10,8 @@
 //      RequiredNames() is resolved; if any is missing, ONE ConfigError lists all of
 //      them, so a bad world file fails before the first step, not at run time.
 //   3. Compute(input, ctrl) at each control update.
+//   4. Reset(), called by Simulation::ResetControllers (the `reset` command): back to the
+//      state right after Initialize, so the next episode runs as the first one did.
 
 #include <span>
 #include <string>
@@ -60,6 +62,13 @@ class Controller {
   /// ((nu) MuJoCo ctrl vector; entries of other actuators must be left alone).
   /// must write finite values (the simulation throws PhysicsError otherwise).
   virtual void Compute(const ControlInput& input, std::span<double> ctrl) = 0;
+
+  /// returns the controller to its state right after Initialize: everything it learned or
+  /// integrated at its updates (gait phase origin, references, integrators, filters, histories,
+  /// last action, start pose, script position) and every programmatic command (twists,
+  /// waypoints, queued commands) is forgotten; configuration and resolved model ids stay.
+  /// called by Simulation::ResetControllers from the thread that steps the simulation.
+  virtual void Reset() = 0;
 
   /// names of the values AppendTrackingError reports, each ending in its unit (e.g.
   /// "cross_track_m", "vx_error_m_s"), for the world file's `tracking_error` metric

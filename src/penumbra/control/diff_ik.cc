@@ -281,6 +281,31 @@ void DiffIkController::OnInitialize(const ModelInfo& model, const std::vector<in
   commands_.Rewind();
 }
 
+void DiffIkController::Reset() {
+  commands_.ClearQueue();
+  commands_.Rewind();
+  const int n = servo_.size();
+  q_.setZero(n);
+  qd_.setZero(n);
+  q_ref_.setZero(n);
+  qdot_.setZero(n);
+  z_.setZero(n);
+  dq_fixed_.setZero(n);
+  tmp_n_.setZero(n);
+  clamped_.assign(n, 0);
+  posture_.setZero(n);
+  xdot_.setZero();
+  gripper_ctrl_ = 0;
+  started_ = false;
+  last_time_ = 0;
+  moving_ = false;
+  X_BS0_ = X_BG_ = X_BT_ = Pose::Identity();
+  axis_S_ = Eigen::Vector3d::UnitX();
+  angle_ = t0_ = duration_ = 0;
+  twist_ff_B_.setZero();
+  position_error_ = orientation_error_ = manipulability_ = lambda_ = 0;
+}
+
 void DiffIkController::CheckCommand(const ArmCommand& c) const {
   if (c.kind == ArmCommand::Kind::kGripper) {
     if (params_.gripper_actuator.empty())

@@ -165,6 +165,9 @@ class DiffIkController final : public Controller {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the queued commands, the move in progress, the target and the posture
+  /// (the next update takes the start pose again); the script starts over.
+  void Reset() override;
 
   /// queues `command` for the update at or after `at_time_sec` (default: the next one).
   /// thread-safe. @throws Error for a gripper command without gripper_actuator, or

@@ -127,6 +127,18 @@ void JointPdController::Apply(const JointCommand& c, const Eigen::VectorXd& q) {
   if (c.mode == JointCommand::Mode::kPosition) target_ = servo_.ClampPosition(values_);
 }
 
+void JointPdController::Reset() {
+  commands_.ClearQueue();
+  commands_.Rewind();
+  active_ = JointCommand{};
+  started_ = false;
+  last_time_ = 0;
+  q_ref_.resize(0);
+  qd_ref_.resize(0);
+  target_.resize(0);
+  values_.resize(0);
+}
+
 void JointPdController::Compute(const ControlInput& input, std::span<double> ctrl) {
   const double t = input.time_sec();
   servo_.ReadState(input, &q_, &qd_);

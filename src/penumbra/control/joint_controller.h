@@ -70,6 +70,9 @@ class JointPdController final : public Controller, public JointTarget {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the queued commands, the command in force and the reference (the next update
+  /// holds the start pose or `target` again); the script starts over.
+  void Reset() override;
 
   /// queues `command` for the update at or after `at_time_sec` (default: the next one).
   /// thread-safe. @throws Error if its size is not the number of joints, a value is not

@@ -256,6 +256,17 @@ std::vector<NameRequirement> KeyframePlayback::RequiredNames() const {
   return reqs;
 }
 
+void KeyframePlayback::Reset() {
+  const int n = servo_.size();
+  started_ = finished_ = false;
+  start_time_ = last_time_ = gripper_start_ = 0;
+  q_start_.setZero(n);
+  target_.setZero(n);
+  target_velocity_.setZero(n);
+  q_ref_.setZero(n);
+  qd_ref_.setZero(n);
+}
+
 void KeyframePlayback::OnInitialize(const ModelInfo& model, const std::vector<int>& ids) {
   const int n = servo_.size();
   servo_.Bind(model, std::span<const int>(ids.data(), 2 * n), context());

@@ -94,6 +94,8 @@ class KeyframePlayback final : public Controller {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// restarts the playback: the next update takes the start pose again.
+  void Reset() override;
 
   const KeyframePlaybackParams& params() const { return params_; }
   const JointServo& servo() const { return servo_; }

@@ -423,6 +423,36 @@ void MultirotorPid::SetCommand(const MultirotorCommand& command) {
   has_pending_.store(true, std::memory_order_release);
 }
 
+void MultirotorPid::Reset() {
+  {
+    std::lock_guard<std::mutex> lock(pending_mutex_);
+    has_pending_.store(false, std::memory_order_release);
+    pending_ = MultirotorCommand{};
+  }
+  next_scripted_ = 0;
+  mode_ = MultirotorCommand::Mode::kIdle;
+  path_ = MultirotorPath();
+  path_time_ = 0;
+  face_path_ = false;
+  v_cmd_.setZero();
+  yaw_rate_cmd_ = 0;
+  touchdown_sec_ = 0;
+  frame_ = MultirotorCommand::Frame::kWorld;
+  p_ref_.setZero();
+  yaw_ref_ = yaw_target_ = 0;
+  started_ = false;
+  t_prev_ = 0;
+  v_prev_.setZero();
+  w_prev_.setZero();
+  alpha_dt_ = -1;
+  alpha_ = 0;
+  heading_yaw_ = std::numeric_limits<double>::quiet_NaN();
+  heading_ = Eigen::Vector3d::UnitX();
+  last_collective_request_ = 0;
+  thrust_.assign(rotors_.size(), 0.0);
+  ResetState();
+}
+
 void MultirotorPid::ResetState() {
   vel_int_.setZero();
   rate_int_.setZero();

@@ -176,6 +176,10 @@ class MultirotorPid final : public Controller {
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the command being flown, a pending SetCommand, the script position, the
+  /// references, integrators and derivative filters: idle until the script or a command
+  /// says otherwise.
+  void Reset() override;
 
   /// replaces the current command at the next control update (programmatic command source,
   /// e.g. middleware). thread-safe.

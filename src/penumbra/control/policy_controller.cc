@@ -299,6 +299,20 @@ void PolicyController::OnInitialize(const ModelInfo& model, const std::vector<in
   tracking_ = {NAN, NAN, NAN};
 }
 
+void PolicyController::Reset() {
+  observation_.Reset();
+  source_ = TwistCommandSource(source_.params());
+  std::fill(obs_.begin(), obs_.end(), 0.0f);
+  std::fill(out_.begin(), out_.end(), 0.0f);
+  std::fill(action_.begin(), action_.end(), 0.0);
+  const int n = static_cast<int>(qpos_.size());
+  target_ = params_.action.kind == PolicyActionKind::kJointPosition ? default_q_
+                                                                    : Eigen::VectorXd::Zero(n);
+  command_ = TrotCommand{};
+  step_ = 0;
+  tracking_ = {NAN, NAN, NAN};
+}
+
 void PolicyController::SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) {
   source_.SetWaypoints(std::move(waypoints), loop, label());
 }

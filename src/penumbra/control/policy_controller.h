@@ -106,6 +106,10 @@ class PolicyController final : public Controller,
   double rate_hz() const override { return 0; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the observation histories (their noise streams restart from the seed), the last
+  /// action and target, the decimation count, the twist override and SetWaypoints (the
+  /// configured route restarts).
+  void Reset() override;
   /// command tracking at the last policy update: the command minus the base's velocity in
   /// its heading frame (m/s) and its yaw rate (rad/s).
   std::vector<std::string> tracking_error_labels() const override {

@@ -461,6 +461,30 @@ void TrotGait::FirstUpdate(const ControlInput& in, const Eigen::Vector3d& com,
   started_ = true;
 }
 
+void TrotGait::Reset() {
+  override_.reset();
+  route_.reset();
+  if (!params_.waypoints.empty())
+    route_.emplace(params_.waypoints, params_.loop, params_.tolerance_m);
+  command_ = TrotCommand{};
+  reference_ = TrotCommand{};
+  started_ = false;
+  last_t_ = 0;
+  h_ref_ = 0;
+  k_raibert_ = 0;
+  psi_ref_ = 0;
+  p_ref_.setZero();
+  plane_.setZero();
+  stance_ = {true, true, true, true};
+  for (auto& f : forces_) f.setZero();
+  tracking_ = {NAN, NAN, NAN};
+  for (Leg& leg : legs_) {
+    leg.p_lift.setZero();
+    leg.p_ground.setZero();
+    leg.in_swing = false;
+  }
+}
+
 void TrotGait::SetWaypoints(std::vector<Eigen::Vector2d> waypoints, bool loop) {
   if (waypoints.empty()) throw Error(label() + ": empty waypoint list; expected at least 1");
   for (const auto& w : waypoints)

@@ -184,6 +184,9 @@ class TrotGait final : public Controller, public TwistTarget, public WaypointTar
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the start pose, references, ground plane, stance and swing state and the
+  /// commands set since (twist override, SetWaypoints: the configured route restarts).
+  void Reset() override;
   /// twist tracking at the last update: the slew-limited reference() minus the measured
   /// velocity of the centre of mass (heading frame: x forward, y left, m/s) and the trunk's yaw
   /// rate (rad/s): "vx_error_m_s", "vy_error_m_s", "yaw_rate_error_rad_s".

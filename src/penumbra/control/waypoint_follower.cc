@@ -80,6 +80,14 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
   route_.Reset();
 }
 
+void WaypointFollower::Reset() {
+  route_ = WaypointRoute(params_.waypoints, params_.loop, params_.tolerance_m);
+  v_ = omega_ = 0;
+  start_.reset();
+  twist_.reset();
+  tracking_ = {NAN, NAN};
+}
+
 void WaypointFollower::SetTwist(const TrotCommand& command) {
   const double v_m_s = command.vx, yaw_rate = command.yaw_rate;
   if (!std::isfinite(v_m_s) || !std::isfinite(yaw_rate))

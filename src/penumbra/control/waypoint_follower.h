@@ -83,6 +83,9 @@ class WaypointFollower final : public Controller, public TwistTarget, public Way
   double rate_hz() const override { return params_.rate_hz; }
   std::vector<NameRequirement> RequiredNames() const override;
   void Compute(const ControlInput& input, std::span<double> ctrl) override;
+  /// forgets the start point, the twist override and SetWaypoints: the configured route
+  /// restarts.
+  void Reset() override;
   /// "cross_track_m": distance of the base body's origin (world xy) from the path segment
   /// being followed (the previous waypoint, or the start position before the first one is
   /// reached, to the current goal); "goal_distance_m": its distance to the current goal.

@@ -27,10 +27,10 @@ constexpr int kMaxMessagesPerWarning = 20;
 class MujocoControlInput final : public ControlInput {
  public:
   MujocoControlInput(const mjModel* m, mjData* d, const ModelInfo* info, std::vector<double>* jacp,
-                     std::vector<double>* jacr)
-      : m_(m), d_(d), info_(info), jacp_(jacp), jacr_(jacr) {}
+                     std::vector<double>* jacr, double time_sec)
+      : m_(m), d_(d), info_(info), jacp_(jacp), jacr_(jacr), time_sec_(time_sec) {}
 
-  double time_sec() const override { return d_->time; }
+  double time_sec() const override { return time_sec_; }
   const ModelInfo& model() const override { return *info_; }
   std::span<const double> qpos() const override { return {d_->qpos, static_cast<size_t>(m_->nq)}; }
   std::span<const double> qvel() const override { return {d_->qvel, static_cast<size_t>(m_->nv)}; }
@@ -77,6 +77,7 @@ class MujocoControlInput final : public ControlInput {
   const ModelInfo* info_;
   std::vector<double>* jacp_;
   std::vector<double>* jacr_;
+  double time_sec_;  // the controllers' clock (Simulation::ResetControllers)
 };
 
 JointInfo::Type JointType(int t) {
@@ -265,6 +266,8 @@ struct Simulation::Impl {
   // (RunDueControllers); -1 = none
   int64_t controllers_ran_at = -1;
   int64_t steps = 0;
+  // the step of the last ResetControllers: the controllers' clock starts there
+  int64_t episode_start = 0;
   int seen_warnings[mjNWARNING] = {};
   int warning_messages[mjNWARNING] = {};
   int64_t dropped_warnings = 0;
@@ -326,7 +329,10 @@ struct Simulation::Impl {
     throw PhysicsError(failure);
   }
 
-  // sets due[i] for the controllers due at time t; true if any is
+  // the controllers' clock at the current step (s)
+  double ControlTime() const { return SimTimeOfStep(steps - episode_start, m->opt.timestep); }
+
+  // sets due[i] for the controllers due at controllers' clock time t; true if any is
   bool MarkDue(double t) {
     const double tol = 1e-6 * m->opt.timestep;
     bool any = false;
@@ -338,8 +344,9 @@ struct Simulation::Impl {
     return any;
   }
 
-  void RunControllers(double t, int64_t step) {
-    MujocoControlInput input(m, d, &info, &jacp, &jacr);
+  // runs the due controllers at controllers' clock time tc (sim time t, for messages)
+  void RunControllers(double tc, double t, int64_t step) {
+    MujocoControlInput input(m, d, &info, &jacp, &jacr, tc);
     std::span<double> ctrl(d->ctrl, static_cast<size_t>(m->nu));
     const double tol = 1e-6 * m->opt.timestep;
     for (size_t i = 0; i < controllers.size(); ++i) {
@@ -360,7 +367,7 @@ struct Simulation::Impl {
                      ")");
       }
       Schedule& s = schedule[i];
-      if (s.rate_hz > 0) s.next = static_cast<int64_t>(std::floor((t + tol) * s.rate_hz)) + 1;
+      if (s.rate_hz > 0) s.next = static_cast<int64_t>(std::floor((tc + tol) * s.rate_hz)) + 1;
     }
   }
 
@@ -521,7 +528,7 @@ void Simulation::AddController(std::unique_ptr<Controller> controller) {
   // the first update runs at the first step at or after the current time
   if (rate > 0) {
     const double tol = 1e-6 * impl_->m->opt.timestep;
-    s.next = static_cast<int64_t>(std::ceil((impl_->d->time - tol) * rate));
+    s.next = static_cast<int64_t>(std::ceil((impl_->ControlTime() - tol) * rate));
   }
   impl_->controllers.push_back(std::move(controller));
   impl_->schedule.push_back(s);
@@ -555,13 +562,14 @@ void Simulation::Step() {
   const double t = d->time;
   const int64_t step = s.steps + 1;
   // controllers run ahead of the step (RunDueControllers) are not run again
-  const bool any_due = s.controllers_ran_at != s.steps && s.MarkDue(t);
+  const double tc = s.ControlTime();
+  const bool any_due = s.controllers_ran_at != s.steps && s.MarkDue(tc);
   s.controllers_ran_at = -1;
   try {
     if (any_due) {
       // position and velocity stages first, so controllers see a consistent state
       mj_step1(m, d);
-      s.RunControllers(t, step);
+      s.RunControllers(tc, t, step);
       if (m->opt.integrator == mjINT_RK4) {
         mj_step(m, d);
       } else {
@@ -669,6 +677,7 @@ void Simulation::SetState(const SimState& s) {
       },
       s);
   impl.steps = s.step;
+  if (impl.steps < impl.episode_start) impl.episode_start = 0;
   impl.controllers_ran_at = -1;
   impl.failed = false;
   impl.failure.clear();
@@ -748,10 +757,11 @@ void Simulation::RunDueControllers() {
   if (s.controllers_ran_at == s.steps) return;
   const double t = s.d->time;
   const int64_t step = s.steps + 1;
-  if (!s.MarkDue(t)) return;
+  const double tc = s.ControlTime();
+  if (!s.MarkDue(tc)) return;
   try {
     mj_step1(s.m, s.d);
-    s.RunControllers(t, step);
+    s.RunControllers(tc, t, step);
   } catch (const MujocoError& e) {
     s.Fail(t, step, std::string("MuJoCo error: ") + e.what());
   } catch (const std::exception&) {
@@ -761,6 +771,19 @@ void Simulation::RunDueControllers() {
   }
   s.controllers_ran_at = s.steps;
 }
+
+void Simulation::ResetControllers() {
+  Impl& s = *impl_;
+  for (const auto& c : s.controllers) {
+    c->Reset();
+    for (std::string& w : c->TakeWarnings()) s.warnings.push_back(c->label() + ": " + w);
+  }
+  s.episode_start = s.steps;
+  for (Impl::Schedule& sc : s.schedule) sc.next = 0;
+  s.controllers_ran_at = -1;
+}
+
+int64_t Simulation::controller_episode_start() const { return impl_->episode_start; }
 
 double Simulation::time() const { return impl_->d->time; }
 int64_t Simulation::step_count() const { return impl_->steps; }

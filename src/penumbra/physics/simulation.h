@@ -95,14 +95,28 @@ class Simulation {
   /// @throws PhysicsError as Step() does for a controller writing a non-finite ctrl.
   void RunDueControllers();
 
+  /// starts a new controller episode at the current step: every controller's Reset() (back
+  /// to its state right after Initialize), and the controllers' clock restarts at 0, so
+  /// controllers see ControlInput::time_sec() = SimTimeOfStep(step_count() - episode start,
+  /// timestep()) and update on that clock (update k at the first step whose clock time is at
+  /// least k / rate_hz; every controller is due at the next step). with the same physics state
+  /// and the same commands, the steps that follow are bit-identical to those after any other
+  /// call at any other step. sim time() and step_count() go on. the `reset` command calls it
+  /// after restoring the physics state. from the thread that steps the simulation.
+  void ResetControllers();
+  /// the step of the last ResetControllers (0 when there was none): the controllers' clock
+  /// is the sim time since it.
+  int64_t controller_episode_start() const;
+
   /// the current state (SimState: physics, step count, controller schedule).
   SimState GetState() const;
   /// as GetState(), into `out`, reusing its vectors' storage.
   void GetState(SimState* out) const;
   /// restores a state taken with GetState from a Simulation of the same model with the same
   /// number of controllers: the following steps are bit-identical to those that followed
-  /// GetState (with stateless controllers; see SimState). also clears a PhysicsError, so a
-  /// simulation can be restarted from a state before it failed.
+  /// GetState (with stateless controllers and the same controller episode start; see SimState).
+  /// a state before the episode start (ResetControllers) sets the episode start back to 0. also
+  /// clears a PhysicsError, so a simulation can be restarted from a state before it failed.
   /// @throws Error naming the first field whose size does not match this model, or when
   ///         time_sec is not SimTimeOfStep(step, timestep()); the state is unchanged then.
   void SetState(const SimState& state);

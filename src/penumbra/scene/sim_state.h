@@ -27,9 +27,11 @@ namespace penumbra {
 /// other mjData field is recomputed from them by the next step's mj_forward. qacc_warmstart is
 /// the constraint solver's starting point: without it the next contact solve starts elsewhere
 /// and the trajectory differs in the last bits. plus penumbra's own: the step count (time is
-/// SimTimeOfStep(step, timestep)) and each controller's next update (its schedule on sim time).
+/// SimTimeOfStep(step, timestep)) and each controller's next update (its schedule on the
+/// controllers' clock, Simulation::ResetControllers).
 ///
-/// NOT included: the controllers' own memory (waypoint index, gait phase, integrators, ...).
+/// NOT included: the controllers' own memory (waypoint index, gait phase, integrators, ...),
+/// which Simulation::ResetControllers returns to its start, and the controllers' episode start.
 /// SetState restores physics and the controllers' schedule only; a restart is bit-exact for a
 /// simulation whose controllers keep no state between updates, or that has none. mocap
 /// drivers (Simulation::AddMocapDriver) are pure functions of time and need nothing.
