@@ -326,6 +326,61 @@ TEST_F(ExportCommandTest, BadInputExitsTwoWithAMessage) {
   EXPECT_NE(r.err.find("only for a run log"), std::string::npos) << r.err;
 }
 
+// EuRoC of a world without an IMU says so, naming what is missing, before a run log is replayed
+// (no replay line, no replay folder) and before anything of a run folder is written
+TEST_F(ExportCommandTest, EurocWithoutAnImuIsRefusedBeforeTheReplay) {
+  std::string text = kWorld;
+  text.erase(text.find("sensors:"));
+  testing::TempDir world_dir;
+  world_dir.Write("walls.xml", kMjcf);
+  const std::string world = world_dir.Write("no_imu.yaml", text);
+  const fs::path log = world_dir.path() / "no_imu.plog";
+  testing::ProcessResult r =
+      RunPenumbra({"run", world, "--duration", "0.2", "--out", (world_dir.path() / "run").string(),
+                   "--record", log.string(), "--quiet"},
+                  world_dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto no_replay = [&](const testing::ProcessResult& p) {
+    EXPECT_EQ(p.out.find("replaying"), std::string::npos) << p.out;
+    EXPECT_EQ(p.err.find("replaying"), std::string::npos) << p.err;
+    for (const auto& e : fs::directory_iterator(out_.path()))
+      ADD_FAILURE() << "left behind: " << e.path();
+  };
+  const fs::path out = out_.path() / "euroc";
+  r = RunPenumbra(
+      {"export", log.string(), "--format", "euroc", "--camera", "front", "--out", out.string()},
+      world_dir.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("EuRoC needs an IMU (imu0) and the run log's world"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("no_imu.yaml) has none"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("type: imu"), std::string::npos) << r.err;
+  no_replay(r);
+  // the run folder of the same world
+  r = RunPenumbra({"export", (world_dir.path() / "run").string(), "--format", "euroc", "--camera",
+                   "front", "--out", out.string()},
+                  world_dir.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the run has no IMU; EuRoC needs one (imu0)"), std::string::npos) << r.err;
+  no_replay(r);
+  // a log with two IMUs: an --imu it does not have, and none named, before the replay too
+  const fs::path two = dir_->path() / "run.plog";
+  r = RunPenumbra({"export", two.string(), "--format", "euroc", "--camera", "front", "--imu",
+                   "nope", "--out", out.string()},
+                  world_dir.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("'nope' is not an IMU of the run log's world"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("expected one of: imu, spin"), std::string::npos) << r.err;
+  no_replay(r);
+  r = RunPenumbra(
+      {"export", two.string(), "--format", "euroc", "--camera", "front", "--out", out.string()},
+      world_dir.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("has 2 IMUs; expected one named with --imu (imu, spin)"), std::string::npos)
+      << r.err;
+  no_replay(r);
+}
+
 // a run log is replayed with the recorded conditions and exported with --depth ground-truth:
 // the dataset is the one the run's own folder gives (the run's camera has no depth_noise),
 // file for file, and the temporary replay folder is gone

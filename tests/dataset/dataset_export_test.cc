@@ -324,6 +324,27 @@ TEST_F(DatasetExportTest, EurocRefusesACameraMovingRelativeToTheImu) {
   EXPECT_FALSE(fs::exists(out()));
 }
 
+// a run without an IMU: EuRoC says what is missing and how to get it, and writes nothing
+TEST_F(DatasetExportTest, EurocOfARunWithoutAnImuSaysWhatIsMissing) {
+  testing::WriteFakeRun(run_);
+  std::ofstream(run_ / "rig.json")
+      << R"({"cameras": {"cam": {"body": "robot/head", "X_BS": )"
+      << testing::PoseJson(testing::FakeCameraMount())
+      << R"(, "rigid_body": "robot/base", "X_RS": )"
+      << testing::PoseJson(testing::FakeCameraMount()) << R"(}}, "imus": {}, "lidars": {}})";
+  try {
+    Export(DatasetFormat::kEuroc);
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(e.key(), "imus");
+    EXPECT_NE(e.file().find("rig.json"), std::string::npos) << e.what();
+    EXPECT_NE(e.problem().find("the run has no IMU; EuRoC needs one (imu0)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(e.problem().find("`type: imu`"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(out()));
+}
+
 TEST_F(DatasetExportTest, EurocRefusesK3Distortion) {
   testing::FakeRunSpec spec;
   spec.k3 = 0.01;

@@ -4,8 +4,11 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "penumbra/app/backend_flag.h"
 #include "penumbra/app/stop_signals.h"
@@ -15,8 +18,12 @@
 #include "penumbra/dataset/export_stop.h"
 #include "penumbra/dataset/run_folder.h"
 #include "penumbra/replay/kinematic/replay_runner.h"
+#include "penumbra/replay/recorded_world.h"
+#include "penumbra/replay/world_override.h"
 #include "penumbra/ros/rosbag2_writer.h"
 #include "penumbra/ros/rosbag_export.h"
+#include "penumbra/runlog/run_log_reader.h"
+#include "penumbra/world/world_config.h"
 
 namespace penumbra {
 
@@ -87,6 +94,38 @@ std::filesystem::path ReplayLogBeside(
   return (*replayed)->path();
 }
 
+// EuRoC's imu0 from a run log: the world the replay sets up (the recorded world, with --world's
+// keys replaced) must have the IMU named by --imu, or exactly one when none is named. checked
+// before the replay renders anything.
+void CheckEurocImuOfLog(const std::string& log_path, const std::string& world_override,
+                        const std::string& imu) {
+  const RunLogReader reader = RunLogReader::Open(log_path, RunLogReadMode::kRecover);
+  WorldConfig world = RecordedWorld(reader.header());
+  if (!world_override.empty()) world = ApplyWorldOverride(world, world_override);
+  std::vector<std::string> names;
+  std::string list;
+  for (const SensorConfig& c : world.sensors)
+    if (c.kind() == SensorKind::kImu) {
+      names.push_back(c.name);
+      list += (list.empty() ? "" : ", ") + c.name;
+    }
+  const std::string world_name = "the run log's world (" + world.file + ")";
+  if (names.empty())
+    throw ConfigError(log_path, 0, "--format",
+                      "EuRoC needs an IMU (imu0) and " + world_name +
+                          " has none; expected a world with an IMU (`type: imu` in its "
+                          "`sensors:`, docs/world-file.md), recorded again, or --format tum or "
+                          "kitti, which need cameras only");
+  if (!imu.empty() && std::find(names.begin(), names.end(), imu) == names.end())
+    throw ConfigError(
+        log_path, 0, "--imu",
+        "'" + imu + "' is not an IMU of " + world_name + "; expected one of: " + list);
+  if (imu.empty() && names.size() > 1)
+    throw ConfigError(log_path, 0, "--imu",
+                      world_name + " has " + std::to_string(names.size()) +
+                          " IMUs; expected one named with --imu (" + list + ")");
+}
+
 // --backend with a run folder: nothing is rendered
 ConfigError BackendNotForRunFolder() {
   return ConfigError("", 0, "--backend",
@@ -132,6 +171,10 @@ int ExportCommand::Run(const CommandArgs& args) {
   if (input.extension() == ".plog") {
     CheckRunLogInput(input);
     CheckExportFolder(options.out_dir);
+    // what can be told from the options and the log is checked before the replay renders
+    options.ValidateOrThrow();
+    if (options.format == DatasetFormat::kEuroc)
+      CheckEurocImuOfLog(s.input, s.replay_world, options.imu);
     // the replay renders the depth with the benchmarks' sensor model (a camera's own
     // depth_noise first) or exact (--depth ground-truth)
     const bool truth = s.depth == "ground-truth";

@@ -5,7 +5,9 @@
 // bag of every sensor and robot state (ros/rosbag_export.h, docs/ros.md). RUN may also be a run log
 // (.plog): it is first replayed (replay/kinematic/replay_runner.h; --world and --adversity as
 // `penumbra replay`'s) into a temporary folder beside --out ("<out>.replay-tmp-<random>"), removed
-// afterwards.
+// afterwards. what the options and the log tell is checked before the replay: the options
+// (DatasetExportOptions::ValidateOrThrow) and, for EuRoC, the IMU (the replayed world must have
+// the --imu named, or exactly one).
 //
 // SIGINT / SIGTERM (the stop request): the replay stops at its next step, the export between
 // frames; the partial dataset or bag and the replay folder are removed, --out is left as it was,

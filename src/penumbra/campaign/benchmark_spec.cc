@@ -199,6 +199,27 @@ BenchmarkMethod ReadMethod(const YamlReader& r, const BenchmarkMetrics& metrics)
   return m;
 }
 
+// a method reading EuRoC gets imu0 from each world's only IMU (a benchmark names none): every
+// world must have exactly one, told at the method's `dataset` before anything runs
+void CheckEurocImus(const YamlReader& dataset, const std::vector<BenchmarkWorld>& worlds) {
+  for (const BenchmarkWorld& w : worlds) {
+    std::vector<std::string> imus;
+    for (const SensorConfig& c : LoadWorldFile(w.file).sensors)
+      if (c.kind() == SensorKind::kImu) imus.push_back(c.name);
+    const std::string world = "world '" + w.name + "' (" + w.file + ")";
+    if (imus.empty())
+      dataset.Fail("EuRoC needs an IMU (imu0) and " + world +
+                   " has none; expected an IMU in every world of the benchmark (`type: imu` in "
+                   "its `sensors:`, docs/world-file.md), or dataset: tum");
+    if (imus.size() > 1) {
+      std::string list;
+      for (const std::string& n : imus) list += (list.empty() ? "" : ", ") + n;
+      dataset.Fail(world + " has " + std::to_string(imus.size()) + " IMUs (" + list +
+                   "); the EuRoC export takes a world's only IMU, expected one");
+    }
+  }
+}
+
 // a ConfigError of a Validate call (key = the field) re-raised at the field's line
 template <typename F>
 void AtLine(const YamlReader& r, F&& f) {
@@ -397,6 +418,7 @@ BenchmarkSpec LoadBenchmarkSpec(const std::string& path) {
     const YamlReader methods = r.Child("methods");
     for (const YamlReader& m : methods.List()) {
       s.methods.push_back(nav ? ReadNavMethod(m) : ReadMethod(m, s.metrics));
+      if (!nav && s.methods.back().dataset == "euroc") CheckEurocImus(m.Child("dataset"), s.worlds);
       if (!names.insert(s.methods.back().name).second)
         m.Child("name").Fail("method name appears twice; expected unique names");
     }

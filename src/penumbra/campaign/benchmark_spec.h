@@ -116,8 +116,9 @@ struct BenchmarkSpec {
 /// loads and checks a spec file.
 /// @throws ConfigError(file, line, key, problem) for unreadable files, YAML syntax errors,
 ///         unknown keys, wrong types, out-of-range values, duplicate or malformed names,
-///         missing worlds / conditions / methods, unknown presets, unknown placeholders and
-///         world files that do not exist.
+///         missing worlds / conditions / methods, unknown presets, unknown placeholders,
+///         world files that do not exist, and a method with `dataset: euroc` when a world has
+///         no IMU or several (at the method's `dataset`).
 BenchmarkSpec LoadBenchmarkSpec(const std::string& path);
 
 /// the placeholders a command template may use, in the order of the file header.

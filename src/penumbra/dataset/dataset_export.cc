@@ -83,7 +83,13 @@ void Export(const RunFolder& run, const DatasetExportOptions& options, const Run
     summary->frames = ExportKitti(cam0, cam1 ? &*cam1 : nullptr, options.sequence, dir, stop);
     return;
   }
-  summary->imu = Pick(options.imu, run.ImuNames(), "--imu", "IMU");
+  const std::vector<std::string> imus = run.ImuNames();
+  if (imus.empty())
+    throw ConfigError((run.dir() / "rig.json").string(), 0, "imus",
+                      "the run has no IMU; EuRoC needs one (imu0): expected a run of a world "
+                      "with an IMU (`type: imu` in its `sensors:`, docs/world-file.md), or "
+                      "--format tum or kitti, which need cameras only");
+  summary->imu = Pick(options.imu, imus, "--imu", "IMU");
   const RunImu imu = run.ReadImu(summary->imu);
   auto mounted = [&](const RunCamera& c) {
     const std::optional<RunMount> m = run.CameraMount(c.name);
