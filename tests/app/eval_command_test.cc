@@ -115,8 +115,14 @@ TEST_F(EvalCommandTest, ASparseEstimateReportsItsLostTimeAndPoses) {
                           "(0.0731707)"),
             std::string::npos)
       << text.out;
+  // the estimate is 20 times sparser than the ground truth: the warning names --frame-period
+  EXPECT_NE(text.err.find("is 20 times the ground truth's sample period (0.1 s)"),
+            std::string::npos)
+      << text.err;
+  EXPECT_NE(text.err.find("--frame-period"), std::string::npos) << text.err;
   const ProcessResult slow = Run({"eval", "ate", gt_file, est_file, "--frame-period", "2"});
   ASSERT_EQ(slow.exit_code, 0) << slow.err;
+  EXPECT_EQ(slow.err.find("--frame-period"), std::string::npos) << slow.err;
   EXPECT_NE(slow.out.find("time tracked  1 (4 s of 4 s; intervals > 6 s"), std::string::npos)
       << slow.out;
   EXPECT_NE(slow.out.find("3 associated of 3 expected at 2 s per frame (1)"), std::string::npos)

@@ -274,6 +274,17 @@ int EvalCommand::Run(const CommandArgs&) {
                                   DeltaText(r.rpe_delta), r.association.pairs.size(),
                                   r.pair_time_sec.front(), r.pair_time_sec.back()));
 
+  // a ground truth sampled faster than the camera (motion capture at 100 Hz, images at 30 Hz)
+  // makes every frame interval a gap under the default limit: say so, and what to give
+  const double estimate_period_sec = MedianPeriod(estimate.time_sec);
+  if (!s.frame_period_sec && !s.max_gap_sec && estimate_period_sec > 2 * r.frame_period_sec)
+    spdlog::warn(
+        "the estimate's median pose spacing ({:.6g} s) is {:.3g} times the ground truth's sample "
+        "period ({:.6g} s), which the tracked time's gap limit comes from: an estimate that lost "
+        "frames reads as such; if the camera ran slower than the ground truth was sampled (e.g. "
+        "motion capture), give its frame period with --frame-period",
+        estimate_period_sec, estimate_period_sec / r.frame_period_sec, r.frame_period_sec);
+
   const Json json = s.ToJson(ate_verb, r);
   if (!s.json_path.empty()) {
     WriteFileAtomic(s.json_path, json.dump(2) + "\n");
