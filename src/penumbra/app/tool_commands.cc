@@ -1,5 +1,7 @@
 #include "penumbra/app/tool_commands.h"
 
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
@@ -121,7 +123,7 @@ class MakeVdbCommand : public Command {
 
   int Run(const CommandArgs&) override {
     if (seed_) options_.seed = *seed_;
-    MakeSmokeVdb(path_, options_);
+    spdlog::info("{}", DescribeSmokeVdb(MakeSmokeVdb(path_, options_)));
     return 0;
   }
 

@@ -1,9 +1,11 @@
 #include "penumbra/app/vdb_tool.h"
 
+#include <fmt/format.h>
 #include <openvdb/openvdb.h>
 
 #include <Eigen/Core>
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 #include "penumbra/core/error.h"
@@ -11,7 +13,19 @@
 
 namespace penumbra {
 
-void MakeSmokeVdb(const std::string& path, const SmokeVdbOptions& o) {
+std::string DescribeSmokeVdb(const SmokeVdbSummary& s) {
+  auto m = [&](int i) { return i * s.voxel_m + 0.0; };
+  return fmt::format(
+      "wrote {} ({:.1f} KiB): float grid '{}' (fog volume), {} active voxels of {} m, "
+      "density up to {}, voxels [{}, {}, {}] .. [{}, {}, {}] = x [{:.3g}, {:.3g}] m, "
+      "y [{:.3g}, {:.3g}] m, z [{:.3g}, {:.3g}] m",
+      s.path, s.file_bytes / 1024.0, s.grid, s.active_voxels, s.voxel_m, s.max_density,
+      s.index_min[0], s.index_min[1], s.index_min[2], s.index_max[0], s.index_max[1],
+      s.index_max[2], m(s.index_min[0]), m(s.index_max[0]), m(s.index_min[1]), m(s.index_max[1]),
+      m(s.index_min[2]), m(s.index_max[2]));
+}
+
+SmokeVdbSummary MakeSmokeVdb(const std::string& path, const SmokeVdbOptions& o) {
   if (!(o.voxel_m > 0.005 && o.voxel_m <= 1))
     throw ConfigError("", 0, "--voxel",
                       "got " + std::to_string(o.voxel_m) + "; expected (0.005, 1] m");
@@ -63,6 +77,22 @@ void MakeSmokeVdb(const std::string& path, const SmokeVdbOptions& o) {
   } catch (const openvdb::Exception& e) {
     throw ConfigError(path, 0, "", std::string("cannot write the VDB file: ") + e.what());
   }
+  SmokeVdbSummary s;
+  s.path = path;
+  std::error_code ec;
+  s.file_bytes = std::filesystem::file_size(path, ec);
+  s.grid = grid->getName();
+  s.active_voxels = static_cast<int64_t>(grid->activeVoxelCount());
+  s.voxel_m = o.voxel_m;
+  const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+  for (int a = 0; a < 3; ++a) {
+    s.index_min[a] = box.min()[a];
+    s.index_max[a] = box.max()[a];
+  }
+  float lo = 0, hi = 0;
+  grid->evalMinMax(lo, hi);
+  s.max_density = hi;
+  return s;
 }
 
 }  // namespace penumbra
