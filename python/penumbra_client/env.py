@@ -45,8 +45,10 @@ class PenumbraEnv:
     every step sees a new image), i.e. :attr:`steps_per_action` physics steps.
 
     **Episodes**: ``reset`` restores the run's step-0 state (``options={"keyframe": NAME}``
-    applies an MJCF keyframe), then steps with a zero action until every image output has a
-    frame; sim time keeps increasing across episodes. ``reward_fn(obs, info)`` and
+    applies an MJCF keyframe) and the controllers' (gait phase, references, integrators,
+    histories), then steps with a zero action until every image output has a frame: the
+    same actions give the same qpos and qvel, bit for bit. Sim time keeps increasing across
+    episodes; image noise is not repeated. ``reward_fn(obs, info)`` and
     ``terminate_fn(obs, info)`` (defaults: 0.0 and False) define the task; ``truncated`` is
     True after ``max_episode_steps`` steps or when the run reaches its end time. ``info`` has
     ``step`` and ``time_sec`` (the run's physics step count and sim time) and
