@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .client import DEFAULT_ENDPOINT, Client
+from .protocol import RunEndedError
 from .spaces import Box, Dict
 
 # output -> (dtype, channels, low, high) of its observation
@@ -126,6 +127,7 @@ class PenumbraEnv:
             self.client.subscribe(list(self._topics))
         self._latest = {}
         self._episode_steps = 0
+        self._closed = False
 
     def _apply(self, action):
         a = np.clip(np.asarray(action, dtype=np.float64).reshape(self.action_space.shape),
@@ -181,7 +183,23 @@ class PenumbraEnv:
         """The newest ``rgb`` image (uint8 (H, W, 3)), or None when ``rgb`` is not observed."""
         return self._latest.get("rgb")
 
-    def close(self):
-        """Closes the connection if this environment opened it (the run goes on)."""
-        if self._own_client:
-            self.client.close()
+    def close(self, stop_server=True):
+        """Ends the environment and, by default, the run: sends ``stop`` (as Ctrl-C: the run
+        finishes its outputs, writes run.json with ``"interrupted": true`` and the server
+        process exits). ``stop_server=False`` leaves the run going for another client. The
+        connection is closed if this environment opened it. A second call does nothing.
+
+        :raises PenumbraTimeoutError: the server did not answer ``stop`` within the client's
+            timeout (a run that has already ended is not an error).
+        """
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            if stop_server:
+                self.client.stop()
+        except RunEndedError:
+            pass  # the run ended before: nothing to stop
+        finally:
+            if self._own_client:
+                self.client.close()

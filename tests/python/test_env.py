@@ -1,7 +1,9 @@
 """PenumbraEnv (Gymnasium-style reset/step) over a real lockstep `penumbra run --zmq`."""
 
+import json
 import os
 import sys
+import time
 import unittest
 
 import numpy as np
@@ -81,6 +83,33 @@ class PenumbraEnvTest(unittest.TestCase):
                              "first differing step: %d" %
                              int(np.argmax(np.any(first != second, axis=1))))
             env.close()
+            client.close()
+
+    def test_close_stops_the_server(self):
+        # an environment that opened its own connection: close() ends the run, whose server
+        # process exits with its outputs finished
+        with PenumbraServer("worlds/quadruped_target.yaml", lockstep=True) as server:
+            server.connect(timeout_sec=60).close()  # up and answering
+            env = pc.PenumbraEnv(server.endpoint, timeout_sec=60)
+            env.reset()
+            env.step([0.5, 0.0, 0.0])
+            env.close()
+            env.close()  # a second close does nothing
+            self.assertEqual(server.wait(60), 0, "the server exited after env.close()")
+            with open(os.path.join(server.out_dir, "run.json")) as f:
+                self.assertTrue(json.load(f)["interrupted"])
+
+    def test_close_can_leave_the_run_going(self):
+        with PenumbraServer("worlds/quadruped_target.yaml", lockstep=True) as server:
+            client = server.connect(timeout_sec=60)
+            env = pc.PenumbraEnv(client=client)
+            env.reset()
+            env.close(stop_server=False)
+            time.sleep(1.0)
+            self.assertIsNone(server.proc.poll(), "the server still runs")
+            step = client.get_state().step
+            client.step(5)  # and still answers
+            self.assertEqual(client.get_state().step, step + 5)
             client.close()
 
 
