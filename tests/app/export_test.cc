@@ -391,22 +391,33 @@ TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
        (out_.path() / "from_log").string(), "--camera", "front", "--depth", "ground-truth"},
       dir_->path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string log_from_dataset =
+      fs::relative(dir_->path() / "run.plog", out_.path() / "from_log").string();
   std::vector<std::string> names;
   for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_run")) {
     if (!e.is_regular_file()) continue;
     const fs::path rel = fs::relative(e.path(), out_.path() / "from_run");
     names.push_back(rel.string());
     if (rel == "penumbra_export.yaml") continue;  // names the source and the depth: below
-    // the lists name their source: the run folder, or the log
+    // the lists name their source relative to the dataset: the run folder, or the log
     std::string a = ReadAll(e.path()), b = ReadAll(out_.path() / "from_log" / rel);
-    const std::string run_line = "# file: '" + run().string() + "'\n";
-    const std::string log_line = "# file: '" + (dir_->path() / "run.plog").string() + "'\n";
+    const std::string run_line =
+        "# file: '" + fs::relative(run(), out_.path() / "from_run").string() + "'\n";
+    const std::string log_line = "# file: '" + log_from_dataset + "'\n";
     if (const size_t at = a.find(run_line); at != std::string::npos) {
       a.replace(at, run_line.size(), log_line);
     }
     EXPECT_EQ(a, b) << rel;
   }
   EXPECT_GT(names.size(), 10u);  // 6 rgb + 6 depth + 4 lists
+  // no absolute path in any of the dataset's text files
+  for (const char* d : {"from_run", "from_log"})
+    for (const auto& e : fs::recursive_directory_iterator(out_.path() / d))
+      if (e.is_regular_file() && e.path().extension() != ".png") {
+        const std::string text = ReadAll(e.path());
+        EXPECT_EQ(text.find(dir_->path().string()), std::string::npos) << e.path();
+        EXPECT_EQ(text.find(out_.path().string()), std::string::npos) << e.path();
+      }
   size_t log_files = 0;
   for (const auto& e : fs::recursive_directory_iterator(out_.path() / "from_log"))
     log_files += e.is_regular_file();
@@ -416,9 +427,8 @@ TEST_F(ExportCommandTest, ARunLogExportsTheSameDatasetAsItsRunFolder) {
   const std::string meta_log = ReadAll(out_.path() / "from_log" / "penumbra_export.yaml");
   EXPECT_NE(meta_run.find("depth:\n  source: as_recorded\n"), std::string::npos) << meta_run;
   EXPECT_NE(meta_log.find("depth:\n  source: ground_truth\n"), std::string::npos) << meta_log;
-  EXPECT_NE(meta_log.find("source: '" + (dir_->path() / "run.plog").string() + "'"),
-            std::string::npos)
-      << meta_log;
+  EXPECT_NE(meta_log.find("source: '" + log_from_dataset + "'"), std::string::npos) << meta_log;
+  EXPECT_TRUE(fs::is_regular_file(out_.path() / "from_log" / log_from_dataset));
 }
 
 // the README's replay -> export path: by default the replay renders the depth through the

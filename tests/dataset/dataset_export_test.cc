@@ -185,6 +185,25 @@ TEST_F(DatasetExportTest, TumCameraTxtCarriesTheIntrinsicsAndDistortion) {
   EXPECT_EQ(lines[2], "# fx fy cx cy d0 d1 d2 d3 d4");
 }
 
+// no absolute path is written into a dataset: its files name the run folder relative to the
+// dataset's own folder, a path that still leads there
+TEST_F(DatasetExportTest, TheDatasetNamesItsSourceRelativeToItself) {
+  testing::WriteFakeRun(run_);
+  Export(DatasetFormat::kTum);
+  EXPECT_EQ(Lines(out() / "rgb.txt")[1], "# file: '../run'");
+  EXPECT_EQ(Lines(out() / "camera.txt")[1], "# file: '../run'");
+  EXPECT_NE(ReadAll(out() / "penumbra_export.yaml").find("\nsource: '../run'\n"),
+            std::string::npos);
+  EXPECT_TRUE(fs::is_regular_file(out() / "../run" / "camera_info.json"));
+  for (const auto& e : fs::recursive_directory_iterator(out())) {
+    if (!e.is_regular_file() || e.path().extension() == ".png") continue;
+    EXPECT_EQ(ReadAll(e.path()).find(tmp_.path().string()), std::string::npos) << e.path();
+  }
+  EXPECT_EQ(PathRelativeTo("/a/b/run", "/a/c/out"), "../../b/run");
+  EXPECT_EQ(PathRelativeTo("/a/b/run", "/a/b/run/x"), "..");
+  EXPECT_EQ(PathRelativeTo("/a/b/run.plog", "/a/b/run"), "../run.plog");
+}
+
 TEST_F(DatasetExportTest, TumRefusesACameraWithoutDepthAndLeavesNoOutput) {
   testing::FakeRunSpec spec;
   spec.depth = false;

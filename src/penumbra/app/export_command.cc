@@ -186,7 +186,7 @@ int ExportCommand::Run(const CommandArgs& args) {
     } catch (const ExportStopped& e) {
       return Stopped(e, s.out);
     }
-    options.source_label = fs::absolute(input).lexically_normal().string();
+    options.source_label = PathRelativeTo(input, options.out_dir);
     const RunFolder replayed_run(run_dir);
     const std::vector<std::string> names = replayed_run.CameraNames();
     const std::string camera =

@@ -255,6 +255,16 @@ std::vector<fs::path> RemoveStaleExportTemps(const fs::path& out) {
   return removed;
 }
 
+std::string PathRelativeTo(const fs::path& target, const fs::path& from) {
+  std::error_code ec;
+  fs::path t = fs::weakly_canonical(fs::absolute(target), ec);
+  if (ec) t = fs::absolute(target).lexically_normal();
+  fs::path f = fs::weakly_canonical(fs::absolute(from), ec);
+  if (ec) f = fs::absolute(from).lexically_normal();
+  const fs::path rel = t.lexically_relative(f);
+  return rel.empty() ? t.string() : rel.string();
+}
+
 std::string ExportMetadataYaml(const DatasetExportOptions& options, const std::string& source,
                                const DatasetExportSummary& summary) {
   // YAML single-quoted scalars: a quote is written twice
@@ -298,7 +308,7 @@ DatasetExportSummary ExportDataset(const RunFolder& run, const DatasetExportOpti
   // beside out_dir, renamed to it when complete (rename(2) replaces an empty folder), removed
   // when the export fails or is stopped
   const std::string source = options.source_label.empty()
-                                 ? fs::absolute(run.dir()).lexically_normal().string()
+                                 ? PathRelativeTo(run.dir(), options.out_dir)
                                  : options.source_label;
   CheckExportFolder(options.out_dir);
   CheckExportStop(options.stop_request);

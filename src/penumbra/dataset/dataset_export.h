@@ -42,8 +42,9 @@ struct DatasetExportOptions {
   std::string imu;
   /// KITTI sequence name: two digits.
   std::string sequence = "00";
-  /// what the TUM lists' "# file:" line names as the source; "" = the run folder (absolute).
-  /// (a run log exported through a temporary replay folder names the log.)
+  /// what the TUM lists' "# file:" line and penumbra_export.yaml name as the source; "" = the
+  /// run folder, relative to out_dir (PathRelativeTo). (a run log exported through a temporary
+  /// replay folder names the log.)
   std::string source_label;
   /// what the run's depth images are, for the dataset's penumbra_export.yaml (TUM):
   /// `depth_source` "sensor_model" (with `depth_model`, a sensors/depth_noise.h preset),
@@ -107,6 +108,12 @@ int64_t ExportTempOwner(std::string_view name);
 /// namespace). errors while listing or removing are ignored (best effort).
 /// @returns the paths removed.
 std::vector<std::filesystem::path> RemoveStaleExportTemps(const std::filesystem::path& out);
+
+/// `target` as a path relative to the folder `from`, for the files of a dataset to name their
+/// source without an absolute path (it still leads there from the dataset's folder): both made
+/// absolute, with symbolic links of their existing parts resolved (std::filesystem::
+/// weakly_canonical); `target` absolute, normalised, when the two have no common root.
+std::string PathRelativeTo(const std::filesystem::path& target, const std::filesystem::path& from);
 
 /// the text of the dataset's penumbra_export.yaml: source, format, cameras and (TUM) the
 /// depth block of `options` (docs/datasets.md "penumbra_export.yaml").
