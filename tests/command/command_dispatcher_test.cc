@@ -8,17 +8,15 @@
 #include <memory>
 #include <string>
 
+#include "command/live_loop.h"
 #include "common/temp_dir.h"
-#include "penumbra/command/run_control.h"
-#include "penumbra/command/run_description.h"
-#include "penumbra/physics/physics_source.h"
 #include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace {
 
 using json = nlohmann::json;
+using penumbra::testing::LiveLoop;
 
 std::string Pendulum() {
   return "<mujoco>\n"
@@ -33,47 +31,6 @@ std::string Pendulum() {
          "</keyframe>\n"
          "</mujoco>\n";
 }
-
-// a paused (lockstep) live loop over the pendulum world, driven by a dispatcher
-class LiveLoop {
- public:
-  explicit LiveLoop(const std::string& world_file) {
-    SessionOptions so;
-    so.build_renderer = false;
-    session_ = std::make_unique<Session>(LoadWorldFile(world_file), so);
-    RunControlOptions co;
-    co.start_paused = true;
-    control_ = std::make_unique<RunControl>(&session_->sim(), co);
-    dispatcher_ =
-        std::make_unique<CommandDispatcher>(*session_, session_->world(), control_.get(),
-                                            DescribeRun(*session_, session_->world()), true);
-    PhysicsSourceOptions po;
-    po.before_step = [this](Simulation& sim) { return control_->BeforeStep(sim); };
-    source_ = std::make_unique<PhysicsSource>(&session_->sim(), po);
-    SimLoopOptions lo;
-    lo.end_time_sec = 1.0;
-    lo.stop_request = control_->stop_flag();
-    loop_ = std::make_unique<SimLoop>(source_.get(), lo);
-    loop_->AddSink(control_.get());
-    loop_->Start();
-  }
-  ~LiveLoop() {
-    control_->RequestStop();
-    loop_->Wait();
-  }
-  json Call(const json& request) { return dispatcher_->Call(request); }
-  LoopFinish Stop() {
-    Call({{"cmd", "stop"}});
-    return loop_->Wait();
-  }
-
- private:
-  std::unique_ptr<Session> session_;
-  std::unique_ptr<RunControl> control_;
-  std::unique_ptr<CommandDispatcher> dispatcher_;
-  std::unique_ptr<PhysicsSource> source_;
-  std::unique_ptr<SimLoop> loop_;
-};
 
 class CommandDispatcherTest : public ::testing::Test {
  protected:
@@ -96,7 +53,7 @@ void ExpectError(LiveLoop& live, const json& request, const std::string& code, c
 }
 
 TEST_F(CommandDispatcherTest, BadRequestsGetErrorsNamingTheField) {
-  LiveLoop live(world_);
+  LiveLoop live(world_, 1.0);
   ExpectError(live, json::array({1, 2}), "malformed", nullptr);
   ExpectError(live, {{"n", 1}}, "malformed", "cmd");
   ExpectError(live, {{"cmd", 5}}, "malformed", "cmd");
@@ -133,7 +90,7 @@ TEST_F(CommandDispatcherTest, BadRequestsGetErrorsNamingTheField) {
 
 // the same requests give the same trajectory, bit for bit
 json Drive(const std::string& world) {
-  LiveLoop live(world);
+  LiveLoop live(world, 1.0);
   EXPECT_TRUE(live.Call({{"cmd", "set_ctrl"}, {"ctrl", {0.3}}}).at("ok").get<bool>());
   json r = live.Call({{"cmd", "step"}, {"n", 17}});
   EXPECT_EQ(r.at("step"), 17) << r.dump();
@@ -159,7 +116,7 @@ TEST_F(CommandDispatcherTest, SameRequestsGiveTheSameTrajectory) {
 }
 
 TEST_F(CommandDispatcherTest, ResetRestoresTheStartOrAKeyframe) {
-  LiveLoop live(world_);
+  LiveLoop live(world_, 1.0);
   const json s0 = live.Call({{"cmd", "get_state"}});
   live.Call({{"cmd", "set_ctrl"}, {"ctrl", {1.0}}});
   live.Call({{"cmd", "step"}, {"n", 50}});
@@ -178,7 +135,7 @@ TEST_F(CommandDispatcherTest, ResetRestoresTheStartOrAKeyframe) {
 }
 
 TEST_F(CommandDispatcherTest, StepNeedsAPausedRunAndEndsWithTheRun) {
-  LiveLoop live(world_);
+  LiveLoop live(world_, 1.0);
   // running free at 1 % of real time: 0.2 s of wall time per 2 ms step
   EXPECT_EQ(live.Call({{"cmd", "set_realtime_factor"}, {"factor", 0.01}}).at("factor"), 0.01);
   EXPECT_EQ(live.Call({{"cmd", "resume"}}).at("paused"), false);
@@ -196,7 +153,7 @@ TEST_F(CommandDispatcherTest, StepNeedsAPausedRunAndEndsWithTheRun) {
 // issue 33: once a `stop` is queued, a start_recording would get no step; it is refused with
 // `stopping` (before anything else is checked), also when it arrives while the run finishes
 TEST_F(CommandDispatcherTest, StartRecordingAfterAStopIsRefusedWithStopping) {
-  LiveLoop live(world_);
+  LiveLoop live(world_, 1.0);
   EXPECT_TRUE(live.Call({{"cmd", "step"}, {"n", 2}}).at("ok").get<bool>());
   EXPECT_TRUE(live.Call({{"cmd", "stop"}}).at("ok").get<bool>());
   const json r = live.Call({{"cmd", "start_recording"}, {"path", "late.plog"}, {"id", 9}});
@@ -223,7 +180,7 @@ TEST_F(CommandDispatcherTest, WaypointsOutsideTheSceneAreRefusedNamingThePoint) 
                                                          "      track_width_m: 0.3\n"
                                                          "      speed_m_s: 0.5\n"
                                                          "      waypoints: [[3.0, 0.0]]\n");
-  LiveLoop live(world);
+  LiveLoop live(world, 1.0);
   const json far = {{"cmd", "waypoints"}, {"points", json::array({{1.0, 2.0}, {1e300, 0.0}})}};
   const json r = live.Call(far);
   ASSERT_FALSE(r.at("ok").get<bool>()) << r.dump();

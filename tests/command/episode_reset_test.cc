@@ -11,60 +11,23 @@
 #include <string>
 #include <vector>
 
+#include "command/live_loop.h"
 #include "common/temp_dir.h"
 #include "penumbra/command/command_dispatcher.h"
-#include "penumbra/command/run_control.h"
-#include "penumbra/command/run_description.h"
-#include "penumbra/physics/physics_source.h"
-#include "penumbra/pipeline/sim_loop.h"
-#include "penumbra/session/session.h"
 
 namespace penumbra {
 namespace episode_reset_test {
 namespace {
 
 using json = nlohmann::json;
+using penumbra::testing::LiveLoop;
 
-// a paused (lockstep) live loop over a world file, driven by a dispatcher
-class LiveLoop {
- public:
-  explicit LiveLoop(const std::string& world_file) {
-    SessionOptions so;
-    so.build_renderer = false;
-    session_ = std::make_unique<Session>(LoadWorldFile(world_file), so);
-    RunControlOptions co;
-    co.start_paused = true;
-    control_ = std::make_unique<RunControl>(&session_->sim(), co);
-    dispatcher_ =
-        std::make_unique<CommandDispatcher>(*session_, session_->world(), control_.get(),
-                                            DescribeRun(*session_, session_->world()), true);
-    PhysicsSourceOptions po;
-    po.before_step = [this](Simulation& sim) { return control_->BeforeStep(sim); };
-    source_ = std::make_unique<PhysicsSource>(&session_->sim(), po);
-    SimLoopOptions lo;
-    lo.end_time_sec = 1000.0;
-    lo.stop_request = control_->stop_flag();
-    loop_ = std::make_unique<SimLoop>(source_.get(), lo);
-    loop_->AddSink(control_.get());
-    loop_->Start();
-  }
-  ~LiveLoop() {
-    control_->RequestStop();
-    loop_->Wait();
-  }
-  json Call(const json& request) {
-    json r = dispatcher_->Call(request);
-    EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
-    return r;
-  }
-
- private:
-  std::unique_ptr<Session> session_;
-  std::unique_ptr<RunControl> control_;
-  std::unique_ptr<CommandDispatcher> dispatcher_;
-  std::unique_ptr<PhysicsSource> source_;
-  std::unique_ptr<SimLoop> loop_;
-};
+// the reply to a request that must succeed
+json CallOk(LiveLoop& live, const json& request) {
+  json r = live.Call(request);
+  EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
+  return r;
+}
 
 // what an episode sends besides `step`
 enum class Action { kNone, kTwist, kJointTargets };
@@ -91,14 +54,14 @@ Trajectory Episode(LiveLoop& live, const Case& c, int steps, int variant = 0) {
     if (k == steps / 3 || k == 2 * steps / 3) {
       const double sign = (k == steps / 3 ? 1.0 : -1.0) * (variant == 0 ? 1.0 : -0.5);
       if (c.action == Action::kTwist) {
-        live.Call({{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
+        CallOk(live, {{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
       } else if (c.action == Action::kJointTargets) {
-        live.Call(
-            {{"cmd", "joint_targets"}, {"values", {0.2 * sign, 0.1, 0, -2.0, 0, 1.9, 0.785}}});
+        CallOk(live,
+               {{"cmd", "joint_targets"}, {"values", {0.2 * sign, 0.1, 0, -2.0, 0, 1.9, 0.785}}});
       }
     }
-    live.Call({{"cmd", "step"}, {"n", 1}});
-    const json s = live.Call({{"cmd", "get_state"}});
+    CallOk(live, {{"cmd", "step"}, {"n", 1}});
+    const json s = CallOk(live, {{"cmd", "get_state"}});
     std::vector<double> row = s.at("qpos").get<std::vector<double>>();
     const std::vector<double> qvel = s.at("qvel").get<std::vector<double>>();
     row.insert(row.end(), qvel.begin(), qvel.end());
@@ -125,7 +88,7 @@ TEST_P(EpisodeResetTest, SameActionsAfterResetGiveTheFirstEpisodeBitForBit) {
   penumbra::testing::TempDir dir;
   const std::string world = c.world.empty() ? std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + c.file
                                             : dir.Write("world.yaml", c.world);
-  LiveLoop live(world);
+  LiveLoop live(world, 1000.0);
   const Trajectory first = Episode(live, c, c.steps);
   // the robot moved: the comparison below is not between two standing-still runs
   EXPECT_NE(first.front(), first.back());
@@ -133,7 +96,7 @@ TEST_P(EpisodeResetTest, SameActionsAfterResetGiveTheFirstEpisodeBitForBit) {
   // step off the controllers' update grid
   for (int before : {37, 61}) {
     Episode(live, c, before, 1);
-    const json r = live.Call({{"cmd", "reset"}});
+    const json r = CallOk(live, {{"cmd", "reset"}});
     EXPECT_GT(r.at("step").get<int64_t>(), 0);  // sim time goes on
     const Trajectory again = Episode(live, c, c.steps);
     EXPECT_EQ(FirstDifference(first, again), -1) << c.name << ": the episode after a reset at step "

@@ -267,20 +267,10 @@ void DiffIkController::OnInitialize(const ModelInfo& model, const std::vector<in
   J_full_.setZero(6, model.nv);
   J_.setZero(6, n);
   Ja_.setZero(6, n);
-  q_.setZero(n);
-  qd_.setZero(n);
-  q_ref_.setZero(n);
-  qdot_.setZero(n);
-  z_.setZero(n);
-  dq_fixed_.setZero(n);
-  tmp_n_.setZero(n);
-  clamped_.assign(n, 0);
-  posture_.setZero(n);
-  started_ = false;
-  moving_ = false;
-  commands_.Rewind();
+  Reset();
 }
 
+// the state of a controller just initialized: OnInitialize ends with it
 void DiffIkController::Reset() {
   commands_.ClearQueue();
   commands_.Rewind();
