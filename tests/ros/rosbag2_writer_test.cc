@@ -81,20 +81,20 @@ TEST(Rosbag2Writer, BadNamesAreRefused) {
 }
 
 TEST(Rosbag2Writer, QosIsTheLiveBridges) {
-  const std::string image = Rosbag2Writer::QosYaml("/cam/image_raw", "sensor_msgs/msg/Image");
+  const std::string image = Rosbag2Writer::QosYaml(Ros2WriterQos(RosTopicType::kImage));
   EXPECT_HAS(image, "- history: keep_last\n  depth: 5\n  reliability: best_effort\n");
   EXPECT_HAS(image, "  durability: volatile\n");
   EXPECT_HAS(image, "  deadline:\n    sec: 9223372036\n    nsec: 854775807\n");
   EXPECT_HAS(image, "  liveliness: automatic\n");
   EXPECT_HAS(image, "  avoid_ros_namespace_conventions: false\n");
-  const std::string odom = Rosbag2Writer::QosYaml("/r/odom", "nav_msgs/msg/Odometry");
+  const std::string odom = Rosbag2Writer::QosYaml(Ros2WriterQos(RosTopicType::kOdometry));
   EXPECT_HAS(odom, "  depth: 10\n  reliability: reliable\n  durability: volatile\n");
-  EXPECT_HAS(Rosbag2Writer::QosYaml("/tf", "tf2_msgs/msg/TFMessage"),
+  EXPECT_HAS(Rosbag2Writer::QosYaml(Ros2WriterQos(RosTopicType::kTf)),
              "  depth: 100\n  reliability: reliable\n  durability: volatile\n");
-  EXPECT_HAS(Rosbag2Writer::QosYaml("/tf_static", "tf2_msgs/msg/TFMessage"),
+  EXPECT_HAS(Rosbag2Writer::QosYaml(Ros2WriterQos(RosTopicType::kTfStatic)),
              "  depth: 1\n  reliability: reliable\n  durability: transient_local\n");
   // indented for metadata.yaml: every line
-  const std::string indented = Rosbag2Writer::QosYaml("/tf", "tf2_msgs/msg/TFMessage", "    ");
+  const std::string indented = Rosbag2Writer::QosYaml(Ros2WriterQos(RosTopicType::kTf), "    ");
   EXPECT_EQ(indented.rfind("    - history: keep_last\n", 0), 0u);
   EXPECT_EQ(indented.find("\n  d"), std::string::npos);
 }

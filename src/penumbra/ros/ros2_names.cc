@@ -91,4 +91,24 @@ std::string CycloneConfigXml(const std::string& address) {
          a + "\"/></Peers></Discovery></Domain></CycloneDDS>";
 }
 
+Ros2QosProfile Ros2WriterQos(RosTopicType t) {
+  switch (t) {
+    case RosTopicType::kImage:
+    case RosTopicType::kCameraInfo:
+    case RosTopicType::kPointCloud2:
+    case RosTopicType::kImu:
+      return kRos2SensorDataQos;
+    case RosTopicType::kJointState:
+    case RosTopicType::kOdometry:
+      return kRos2DefaultQos;
+    case RosTopicType::kTf:
+      return kRos2TfQos;
+    case RosTopicType::kTfStatic:
+      return kRos2TfStaticQos;
+    case RosTopicType::kClock:
+      return kRos2ClockQos;
+  }
+  throw Error("unknown ROS topic type");
+}
+
 }  // namespace penumbra

@@ -1,14 +1,18 @@
 #pragma once
 // the names and settings of the ROS 2 bridge's DDS side that need no DDS library
 // (ros/ros2/ros2_node.h uses them; tests check them in-process): how rmw_cyclonedds_cpp maps ROS 2
-// names to DDS topic names, the ROS 2 domain id, and the Cyclone DDS configuration that keeps the
-// node on one network interface.
+// names to DDS topic names, the ROS 2 domain id, the QoS of each topic (also what the rosbag2
+// export records as offered_qos_profiles, and what `bench ros2` measures), and the Cyclone DDS
+// configuration that keeps the node on one network interface.
 //
 // name mapping (rmw_cyclonedds_cpp, the ROS 2 design article "Topic and Service name mapping to
 // DDS"): topic "/a/b" -> DDS topic "rt/a/b"; service "/a/b" -> request topic "rq/a/bRequest" and
 // reply topic "rr/a/bReply".
 
+#include <cstdint>
 #include <string>
+
+#include "penumbra/ros/ros_node.h"
 
 namespace penumbra {
 
@@ -55,5 +59,25 @@ bool IsLoopbackAddress(const std::string& address);
 /// address, which Ros2Node pins to ADDR (ros/udp_bind_pin.h).
 /// @throws ConfigError as CheckInterfaceAddress.
 std::string CycloneConfigXml(const std::string& address);
+
+/// the QoS Penumbra sets on a ROS 2 endpoint: history KEEP_LAST `depth`, reliability and
+/// durability; every other policy is the DDS default, as in ROS 2's profiles.
+struct Ros2QosProfile {
+  bool reliable = true;
+  bool transient_local = false;
+  int32_t depth = 10;
+};
+
+/// ROS 2's profiles (rmw/qos_profiles.h, tf2_ros/qos.hpp, rclcpp's ClockQoS).
+inline constexpr Ros2QosProfile kRos2SensorDataQos{false, false, 5};  ///< sensor data
+inline constexpr Ros2QosProfile kRos2DefaultQos{true, false, 10};     ///< default; services
+inline constexpr Ros2QosProfile kRos2TfQos{true, false, 100};         ///< DynamicBroadcasterQoS
+inline constexpr Ros2QosProfile kRos2TfStaticQos{true, true, 1};      ///< StaticBroadcasterQoS
+/// /clock: reliable depth 1, which rclcpp's best-effort ClockQoS readers match too
+inline constexpr Ros2QosProfile kRos2ClockQos{true, false, 1};
+
+/// the writer QoS of the bridge's topics of type `t` (docs/ros.md's topic table): sensor data
+/// for images, camera info, point clouds and IMU samples; default for odometry and joint states.
+Ros2QosProfile Ros2WriterQos(RosTopicType t);
 
 }  // namespace penumbra

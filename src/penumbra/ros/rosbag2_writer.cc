@@ -48,26 +48,12 @@ void RequireRosbag2() {
   if (!Ros2Available()) Ros2TypeOf(Ros2Type::kImage);
 }
 
-std::string Rosbag2Writer::QosYaml(const std::string& topic, const std::string& ros_type,
-                                   const std::string& indent) {
-  // the live bridge's writer QoS (ros/ros2/ros2_node.cc, docs/ros.md)
-  bool reliable = true, transient_local = false;
-  int depth = 10;
-  if (ros_type == "sensor_msgs/msg/Image" || ros_type == "sensor_msgs/msg/CameraInfo" ||
-      ros_type == "sensor_msgs/msg/PointCloud2" || ros_type == "sensor_msgs/msg/Imu") {
-    reliable = false;
-    depth = 5;
-  } else if (ros_type == "tf2_msgs/msg/TFMessage") {
-    transient_local = topic == "/tf_static";
-    depth = transient_local ? 1 : 100;
-  } else if (ros_type == "rosgraph_msgs/msg/Clock") {
-    depth = 1;
-  }
+std::string Rosbag2Writer::QosYaml(const Ros2QosProfile& q, const std::string& indent) {
   // rmw's infinite duration (RMW_DURATION_INFINITE) as rosbag2 writes it
   const std::string infinite = indent + "    sec: 9223372036\n" + indent + "    nsec: 854775807\n";
-  return indent + "- history: keep_last\n" + indent + "  depth: " + std::to_string(depth) + "\n" +
-         indent + "  reliability: " + (reliable ? "reliable" : "best_effort") + "\n" + indent +
-         "  durability: " + (transient_local ? "transient_local" : "volatile") + "\n" + indent +
+  return indent + "- history: keep_last\n" + indent + "  depth: " + std::to_string(q.depth) + "\n" +
+         indent + "  reliability: " + (q.reliable ? "reliable" : "best_effort") + "\n" + indent +
+         "  durability: " + (q.transient_local ? "transient_local" : "volatile") + "\n" + indent +
          "  deadline:\n" + infinite + indent + "  lifespan:\n" + infinite + indent +
          "  liveliness: automatic\n" + indent + "  liveliness_lease_duration:\n" + infinite +
          indent + "  avoid_ros_namespace_conventions: false\n";
@@ -79,6 +65,7 @@ struct Rosbag2Writer::Impl {
   std::string file_name;  // "<name>_0.mcap"
   std::unique_ptr<McapWriter> mcap;
   struct Topic {
+    RosTopicType topic_type;  // its writer QoS in the live bridge (ros/ros2_names.h)
     Ros2Type type;
     uint16_t channel = 0;
   };
@@ -88,7 +75,8 @@ struct Rosbag2Writer::Impl {
   bool open = false;
   bool abandoned = false;
 
-  uint16_t ChannelOf(const std::string& topic, Ros2Type type) {
+  uint16_t ChannelOf(const std::string& topic, RosTopicType topic_type) {
+    const Ros2Type type = Ros2TypeOfTopic(topic_type);
     const auto it = topics.find(topic);
     if (it != topics.end()) return it->second.channel;
     const Ros2TypeInfo& info = Ros2TypeOf(type);
@@ -98,15 +86,16 @@ struct Rosbag2Writer::Impl {
           schemas.emplace(type, mcap->AddSchema(info.ros_name, "ros2msg", info.definition)).first;
     const uint16_t channel =
         mcap->AddChannel(schema->second, topic, "cdr",
-                         {{"offered_qos_profiles", QosYaml(topic, info.ros_name)},
+                         {{"offered_qos_profiles", QosYaml(Ros2WriterQos(topic_type))},
                           {"topic_type_hash", info.type_hash}});
-    topics.emplace(topic, Topic{type, channel});
+    topics.emplace(topic, Topic{topic_type, type, channel});
     topic_order.push_back(topic);
     return channel;
   }
 
   template <typename M>
-  void Write(const std::string& topic, int64_t time_ns, Ros2Type type, const M& m) {
+  void Write(const std::string& topic, int64_t time_ns, RosTopicType topic_type, const M& m) {
+    const Ros2Type type = Ros2TypeOfTopic(topic_type);
     if (!open)
       throw Error("cannot write topic " + topic + " to the ROS 2 bag " + shown +
                   (abandoned ? ": an earlier write failed" : ": it is closed"));
@@ -117,7 +106,7 @@ struct Rosbag2Writer::Impl {
     std::vector<uint8_t> cdr;
     WithSample(m, [&](const void* sample) { cdr = SerializeCdr(type, sample); });
     try {
-      const uint16_t channel = ChannelOf(topic, type);
+      const uint16_t channel = ChannelOf(topic, topic_type);
       const auto t = static_cast<uint64_t>(std::max<int64_t>(time_ns, 0));
       mcap->WriteMessage(channel, t, t, cdr);
     } catch (const Error& e) {
@@ -157,7 +146,7 @@ struct Rosbag2Writer::Impl {
       line("      type: " + Quote(info.ros_name));
       line("      serialization_format: cdr");
       line("      offered_qos_profiles:");
-      y += QosYaml(name, info.ros_name, indent + "        ");
+      y += QosYaml(Ros2WriterQos(t.topic_type), indent + "        ");
       line("      type_description_hash: " + Quote(info.type_hash));
       line("    message_count: " + std::to_string(mcap->messages(t.channel)));
     }
@@ -206,31 +195,32 @@ Rosbag2Writer::~Rosbag2Writer() {
 }
 
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosImage& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kImage, m);
+  impl_->Write(topic, time_ns, RosTopicType::kImage, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosCameraInfo& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kCameraInfo, m);
+  impl_->Write(topic, time_ns, RosTopicType::kCameraInfo, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosPointCloud2& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kPointCloud2, m);
+  impl_->Write(topic, time_ns, RosTopicType::kPointCloud2, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosImu& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kImu, m);
+  impl_->Write(topic, time_ns, RosTopicType::kImu, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosJointState& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kJointState, m);
+  impl_->Write(topic, time_ns, RosTopicType::kJointState, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosOdometry& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kOdometry, m);
+  impl_->Write(topic, time_ns, RosTopicType::kOdometry, m);
   ++messages_;
 }
 void Rosbag2Writer::Write(const std::string& topic, int64_t time_ns, const RosTransform& m) {
-  impl_->Write(topic, time_ns, Ros2Type::kTfMessage, std::vector<RosTransform>{m});
+  impl_->Write(topic, time_ns, topic == "/tf_static" ? RosTopicType::kTfStatic : RosTopicType::kTf,
+               std::vector<RosTransform>{m});
   ++messages_;
 }
 

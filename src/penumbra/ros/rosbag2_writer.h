@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "penumbra/ros/ros2_names.h"
 #include "penumbra/ros/ros_messages.h"
 
 namespace penumbra {
@@ -74,10 +75,9 @@ class Rosbag2Writer {
   void Close();
 
   /// the offered_qos_profiles YAML (rosbag2's, Jazzy: a list of one profile with the policy
-  /// names in lower case) of `topic` of ROS 2 type `ros_type` (e.g. "sensor_msgs/msg/Image"),
-  /// each line prefixed with `indent`. public for the tests.
-  static std::string QosYaml(const std::string& topic, const std::string& ros_type,
-                             const std::string& indent = "");
+  /// names in lower case) of the QoS `q` (a topic's: Ros2WriterQos, ros/ros2_names.h), each line
+  /// prefixed with `indent`. public for the tests.
+  static std::string QosYaml(const Ros2QosProfile& q, const std::string& indent = "");
 
  private:
   struct Impl;

@@ -113,14 +113,15 @@ struct Participant {
   }
 };
 
-// ROS 2's profiles: sensor data (BEST_EFFORT, KEEP_LAST 5), /tf (RELIABLE, KEEP_LAST 100),
-// services (RELIABLE, KEEP_LAST 10); all VOLATILE, XCDR1 as rmw_cyclonedds
-dds_qos_t* Qos(bool reliable, int depth) {
+// a ROS 2 profile of the bridge (ros/ros2_names.h: sensor data, /tf, services), XCDR1 as
+// rmw_cyclonedds
+dds_qos_t* Qos(const Ros2QosProfile& profile) {
   dds_qos_t* q = dds_create_qos();
-  dds_qset_reliability(q, reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+  dds_qset_reliability(q, profile.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_MSECS(100));
-  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
-  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, profile.depth);
+  dds_qset_durability(
+      q, profile.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
   dds_qset_data_representation(q, 1, &xcdr1);
   return q;
@@ -128,22 +129,21 @@ dds_qos_t* Qos(bool reliable, int depth) {
 
 struct TopicSpec {
   const dds_topic_descriptor_t* desc;
-  bool reliable;
-  int depth;
+  Ros2QosProfile qos;  // the bridge's writer QoS of such a topic
 };
 const std::array<TopicSpec, kTopics>& Specs() {
   static const std::array<TopicSpec, kTopics> specs = {{
-      {&sensor_msgs_msg_dds__Image__desc, false, 5},
-      {&sensor_msgs_msg_dds__Image__desc, false, 5},
-      {&sensor_msgs_msg_dds__Imu__desc, false, 5},
-      {&tf2_msgs_msg_dds__TFMessage__desc, true, 100},
+      {&sensor_msgs_msg_dds__Image__desc, Ros2WriterQos(RosTopicType::kImage)},
+      {&sensor_msgs_msg_dds__Image__desc, Ros2WriterQos(RosTopicType::kImage)},
+      {&sensor_msgs_msg_dds__Imu__desc, Ros2WriterQos(RosTopicType::kImu)},
+      {&tf2_msgs_msg_dds__TFMessage__desc, Ros2WriterQos(RosTopicType::kTf)},
   }};
   return specs;
 }
 
 dds_entity_t MakeEndpoint(const Participant& p, const dds_topic_descriptor_t* desc,
-                          const std::string& dds_name, bool reliable, int depth, bool writer) {
-  dds_qos_t* q = Qos(reliable, depth);
+                          const std::string& dds_name, const Ros2QosProfile& qos, bool writer) {
+  dds_qos_t* q = Qos(qos);
   const dds_entity_t topic = p.Topic(desc, dds_name);
   const dds_entity_t e = writer ? dds_create_writer(p.pp, topic, q, nullptr)
                                 : dds_create_reader(p.pp, topic, q, nullptr);
@@ -222,13 +222,13 @@ bool WaitMatched(const std::vector<dds_entity_t>& writers, const std::vector<dds
     for (int i = 0; i < kTopics; ++i) {
       // subscribers ask for what ROS 2 subscribers ask for: the same profiles
       readers[i] = MakeEndpoint(p, Specs()[i].desc, std::string("rt") + kTopicNames[i],
-                                Specs()[i].reliable, Specs()[i].depth, false);
+                                Specs()[i].qos, false);
       dds_waitset_attach(ws, dds_create_readcondition(readers[i], DDS_ANY_STATE), i);
     }
     const dds_entity_t request =
-        MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Request__desc, kRequest, true, 10, true);
+        MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Request__desc, kRequest, kRos2DefaultQos, true);
     const dds_entity_t reply =
-        MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Response__desc, kReply, true, 10, false);
+        MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Response__desc, kReply, kRos2DefaultQos, false);
     const dds_entity_t reply_cond = dds_create_readcondition(reply, DDS_ANY_STATE);
     dds_waitset_attach(ws, reply_cond, kTopics);
 
@@ -401,12 +401,12 @@ Ros2BenchResult RunRos2Bench(const Ros2BenchOptions& o) {
   Participant p(r.domain, o.interface, o.receive_buffer);
   std::array<dds_entity_t, kTopics> writers{};
   for (int i = 0; i < kTopics; ++i)
-    writers[i] = MakeEndpoint(p, Specs()[i].desc, std::string("rt") + kTopicNames[i],
-                              Specs()[i].reliable, Specs()[i].depth, true);
+    writers[i] =
+        MakeEndpoint(p, Specs()[i].desc, std::string("rt") + kTopicNames[i], Specs()[i].qos, true);
   const dds_entity_t request =
-      MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Request__desc, kRequest, true, 10, false);
+      MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Request__desc, kRequest, kRos2DefaultQos, false);
   const dds_entity_t reply =
-      MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Response__desc, kReply, true, 10, true);
+      MakeEndpoint(p, &std_srvs_srv_dds__Trigger_Response__desc, kReply, kRos2DefaultQos, true);
   if (!WaitMatched({writers[0], writers[1], writers[2], writers[3], reply}, {request}, 20))
     throw Error("bench ros2: the subscriber process did not match within 20 s (domain " +
                 std::to_string(r.domain) + " on " + o.interface + ")");
@@ -488,15 +488,15 @@ Ros2BenchResult RunRos2Bench(const Ros2BenchOptions& o) {
   if (!ReadAll(reap.from_child, &stream, sizeof stream, 60000))
     throw Error("bench ros2: the subscriber process ended without a report");
   if (stream.error[0]) throw Error(std::string("bench ros2: subscriber: ") + stream.error);
-  const char* qos_names[kTopics] = {"BEST_EFFORT KEEP_LAST 5", "BEST_EFFORT KEEP_LAST 5",
-                                    "BEST_EFFORT KEEP_LAST 5", "RELIABLE KEEP_LAST 100"};
   const int64_t sizes[kTopics] = {
       static_cast<int64_t>(rgb.size()), static_cast<int64_t>(depth.size() * sizeof(float)),
       static_cast<int64_t>(sizeof imu), static_cast<int64_t>(sizeof pose)};
   for (int i = 0; i < kTopics; ++i) {
     Ros2TopicStats s;
     s.topic = kTopicNames[i];
-    s.qos = qos_names[i];
+    const Ros2QosProfile& q = Specs()[i].qos;
+    s.qos = std::string(q.reliable ? "RELIABLE" : "BEST_EFFORT") + " KEEP_LAST " +
+            std::to_string(q.depth);
     s.sent = sent[i];
     s.received = stream.topics[i].received;
     s.median_ms = stream.topics[i].median_ms;

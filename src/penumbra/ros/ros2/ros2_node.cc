@@ -41,68 +41,28 @@ struct QosDeleter {
 };
 using QosPtr = std::unique_ptr<dds_qos_t, QosDeleter>;
 
+// ros_discovery_info's QoS (rmw_dds_common): a late reader gets the last graph update
+constexpr Ros2QosProfile kDiscoveryInfoQos{true, true, 1};
+
 // a ROS 2 QoS profile and REP-2011's type hash user data
 // (`user_data_prefix`: more "key=value;" pairs before the type hash, as rmw_cyclonedds's
 // serviceid)
-QosPtr MakeQos(bool reliable, bool transient_local, int32_t depth, const char* type_hash,
+QosPtr MakeQos(const Ros2QosProfile& profile, const char* type_hash,
                const std::string& user_data_prefix = "") {
   QosPtr q(dds_create_qos());
   // a KEEP_LAST writer drops its oldest sample instead of waiting for a slow reader; should
   // Cyclone still throttle it, a write gives up after max_blocking_time (the DDS default)
-  dds_qset_reliability(q.get(), reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+  dds_qset_reliability(q.get(),
+                       profile.reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
                        DDS_MSECS(100));
-  dds_qset_durability(q.get(),
-                      transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
-  dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+  dds_qset_durability(
+      q.get(), profile.transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
+  dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, profile.depth);
   // rmw_cyclonedds: samples of a deleted writer are not disposed (ROS 2 has no instances)
   dds_qset_writer_data_lifecycle(q.get(), false);
   const std::string user_data = fmt::format("{}typehash={};", user_data_prefix, type_hash);
   dds_qset_userdata(q.get(), user_data.data(), user_data.size());
   return q;
-}
-
-Ros2Type Ros2TypeOfTopic(RosTopicType t) {
-  switch (t) {
-    case RosTopicType::kImage:
-      return Ros2Type::kImage;
-    case RosTopicType::kCameraInfo:
-      return Ros2Type::kCameraInfo;
-    case RosTopicType::kPointCloud2:
-      return Ros2Type::kPointCloud2;
-    case RosTopicType::kImu:
-      return Ros2Type::kImu;
-    case RosTopicType::kJointState:
-      return Ros2Type::kJointState;
-    case RosTopicType::kOdometry:
-      return Ros2Type::kOdometry;
-    case RosTopicType::kTf:
-    case RosTopicType::kTfStatic:
-      return Ros2Type::kTfMessage;
-    case RosTopicType::kClock:
-      return Ros2Type::kClock;
-  }
-  throw Error("unknown ROS topic type");
-}
-
-// the writer QoS of a topic type (ros/ros2/ros2_node.h)
-QosPtr WriterQos(RosTopicType t, const char* type_hash) {
-  switch (t) {
-    case RosTopicType::kImage:
-    case RosTopicType::kCameraInfo:
-    case RosTopicType::kPointCloud2:
-    case RosTopicType::kImu:
-      return MakeQos(false, false, 5, type_hash);
-    case RosTopicType::kJointState:
-    case RosTopicType::kOdometry:
-      return MakeQos(true, false, 10, type_hash);
-    case RosTopicType::kTf:
-      return MakeQos(true, false, 100, type_hash);
-    case RosTopicType::kTfStatic:
-      return MakeQos(true, true, 1, type_hash);
-    case RosTopicType::kClock:
-      return MakeQos(true, false, 1, type_hash);
-  }
-  throw Error("unknown ROS topic type");
 }
 
 }  // namespace
@@ -194,63 +154,59 @@ struct Ros2Node::Impl {
     if (rc < 0) spdlog::warn("ROS 2 bridge: cannot publish on {}: {}", what, DdsError(rc));
   }
 
-  // takes every sample of `r` and hands each valid one to its callback
-  void TakeAll(const Reader& r) {
+  // takes every sample `reader` holds, in batches, and hands each valid one to `f`; Cyclone
+  // lends the samples for the call
+  static void TakeEach(dds_entity_t reader, const std::function<void(const void*)>& f) {
     void* samples[kTakeBatch];
     dds_sample_info_t infos[kTakeBatch];
     for (;;) {
       // a null first pointer asks Cyclone to lend its samples (returned below)
       std::fill(std::begin(samples), std::end(samples), nullptr);
-      const dds_return_t n = dds_take(r.reader, samples, infos, kTakeBatch, kTakeBatch);
+      const dds_return_t n = dds_take(reader, samples, infos, kTakeBatch, kTakeBatch);
       if (n <= 0) return;
-      for (dds_return_t i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        try {
-          r.on_sample(samples[i]);
-        } catch (const std::exception& e) {
-          spdlog::warn("ROS 2 bridge: a message on {} was dropped: {}", r.topic, e.what());
-        }
-      }
-      dds_return_loan(r.reader, samples, n);
+      for (dds_return_t i = 0; i < n; ++i)
+        if (infos[i].valid_data) f(samples[i]);
+      dds_return_loan(reader, samples, n);
     }
   }
 
-  void Serve(const Service& s) {
-    void* samples[kTakeBatch];
-    dds_sample_info_t infos[kTakeBatch];
-    for (;;) {
-      // a null first pointer asks Cyclone to lend its samples (returned below)
-      std::fill(std::begin(samples), std::end(samples), nullptr);
-      const dds_return_t n = dds_take(s.request_reader, samples, infos, kTakeBatch, kTakeBatch);
-      if (n <= 0) return;
-      for (dds_return_t i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        Ros2TriggerResponse reply;
-        try {
-          reply.header = TriggerRequestFromSample(samples[i]);
-        } catch (const std::exception& e) {
-          spdlog::warn("ROS 2 bridge: a request to {} was dropped: {}", s.name, e.what());
-          continue;
-        }
-        try {
-          std::tie(reply.success, reply.message) = s.callback();
-        } catch (const std::exception& e) {
-          reply.success = false;
-          reply.message = e.what();
-        }
-        // the caller made its reply reader before it sent the request; a reply written before
-        // the two have matched would be lost (volatile), so wait for a match (bounded)
-        const auto deadline = std::chrono::steady_clock::now() + kReplyMatchWait;
-        dds_publication_matched_status_t st{};
-        while (dds_get_publication_matched_status(s.reply_writer, &st) == DDS_RETCODE_OK &&
-               st.current_count == 0 && std::chrono::steady_clock::now() < deadline)
-          std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        WithSample(reply, [&](const void* sample) {
-          Write(s.reply_writer, sample, Ros2ReplyTopic(s.name));
-        });
+  // takes every sample of `r` and hands each valid one to its callback
+  void TakeAll(const Reader& r) {
+    TakeEach(r.reader, [&](const void* sample) {
+      try {
+        r.on_sample(sample);
+      } catch (const std::exception& e) {
+        spdlog::warn("ROS 2 bridge: a message on {} was dropped: {}", r.topic, e.what());
       }
-      dds_return_loan(s.request_reader, samples, n);
-    }
+    });
+  }
+
+  void Serve(const Service& s) {
+    TakeEach(s.request_reader, [&](const void* request) {
+      Ros2TriggerResponse reply;
+      try {
+        reply.header = TriggerRequestFromSample(request);
+      } catch (const std::exception& e) {
+        spdlog::warn("ROS 2 bridge: a request to {} was dropped: {}", s.name, e.what());
+        return;
+      }
+      try {
+        std::tie(reply.success, reply.message) = s.callback();
+      } catch (const std::exception& e) {
+        reply.success = false;
+        reply.message = e.what();
+      }
+      // the caller made its reply reader before it sent the request; a reply written before
+      // the two have matched would be lost (volatile), so wait for a match (bounded)
+      const auto deadline = std::chrono::steady_clock::now() + kReplyMatchWait;
+      dds_publication_matched_status_t st{};
+      while (dds_get_publication_matched_status(s.reply_writer, &st) == DDS_RETCODE_OK &&
+             st.current_count == 0 && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      WithSample(reply, [&](const void* sample) {
+        Write(s.reply_writer, sample, Ros2ReplyTopic(s.name));
+      });
+    });
   }
 
   // waits on `waitset` until its guard condition (attached as `count`) triggers;
@@ -318,7 +274,7 @@ int Ros2Node::Advertise(const std::string& topic, RosTopicType type, int) {
   Impl& m = *impl_;
   const Ros2Type t = Ros2TypeOfTopic(type);
   const std::string dds_name = Ros2TopicName(topic);
-  const QosPtr q = WriterQos(type, Ros2TypeOf(t).type_hash);
+  const QosPtr q = MakeQos(Ros2WriterQos(type), Ros2TypeOf(t).type_hash);
   const dds_entity_t w =
       Check(dds_create_writer(m.participant, m.Topic(dds_name, t), q.get(), nullptr),
             "the ROS 2 publisher " + topic);
@@ -376,7 +332,7 @@ namespace {
 // a reader with the subscription QoS (RELIABLE KEEP_LAST 10 VOLATILE)
 dds_entity_t MakeReader(dds_entity_t participant, dds_entity_t topic, Ros2Type type,
                         const std::string& what) {
-  const QosPtr q = MakeQos(true, false, 10, Ros2TypeOf(type).type_hash);
+  const QosPtr q = MakeQos(kRos2DefaultQos, Ros2TypeOf(type).type_hash);
   return Check(dds_create_reader(participant, topic, q.get(), nullptr), what);
 }
 }  // namespace
@@ -425,14 +381,14 @@ void Ros2Node::AdvertiseTrigger(const std::string& service,
   for (size_t i = 0; i < id.size(); ++i) service_id += fmt::format("{}{:x}", i ? "." : "", id[i]);
   service_id += ";";
   const QosPtr rq =
-      MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerRequest).type_hash, service_id);
+      MakeQos(kRos2DefaultQos, Ros2TypeOf(Ros2Type::kTriggerRequest).type_hash, service_id);
   const dds_entity_t r =
       Check(dds_create_reader(m.participant,
                               m.Topic(Ros2RequestTopic(service), Ros2Type::kTriggerRequest),
                               rq.get(), nullptr),
             what);
   const QosPtr wq =
-      MakeQos(true, false, 10, Ros2TypeOf(Ros2Type::kTriggerResponse).type_hash, service_id);
+      MakeQos(kRos2DefaultQos, Ros2TypeOf(Ros2Type::kTriggerResponse).type_hash, service_id);
   const dds_entity_t w = Check(
       dds_create_writer(m.participant, m.Topic(Ros2ReplyTopic(service), Ros2Type::kTriggerResponse),
                         wq.get(), nullptr),
@@ -482,7 +438,7 @@ void Ros2Node::Start() {
     }
     info.nodes.push_back(std::move(node));
     const QosPtr q =
-        MakeQos(true, true, 1, Ros2TypeOf(Ros2Type::kParticipantEntitiesInfo).type_hash);
+        MakeQos(kDiscoveryInfoQos, Ros2TypeOf(Ros2Type::kParticipantEntitiesInfo).type_hash);
     m.discovery_writer =
         Check(dds_create_writer(m.participant,
                                 m.Topic("ros_discovery_info", Ros2Type::kParticipantEntitiesInfo),

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "penumbra/ros/ros_messages.h"
+#include "penumbra/ros/ros_node.h"
 
 struct dds_topic_descriptor;
 typedef struct dds_topic_descriptor dds_topic_descriptor_t;
@@ -68,6 +69,30 @@ struct Ros2TypeInfo {
 
 /// the table entry of `type`. throws Error for a value outside the enum.
 const Ros2TypeInfo& Ros2TypeOf(Ros2Type type);
+
+/// the ROS 2 message type of the bridge's topics of type `t` (/tf and /tf_static: TFMessage).
+constexpr Ros2Type Ros2TypeOfTopic(RosTopicType t) {
+  switch (t) {
+    case RosTopicType::kImage:
+      return Ros2Type::kImage;
+    case RosTopicType::kCameraInfo:
+      return Ros2Type::kCameraInfo;
+    case RosTopicType::kPointCloud2:
+      return Ros2Type::kPointCloud2;
+    case RosTopicType::kImu:
+      return Ros2Type::kImu;
+    case RosTopicType::kJointState:
+      return Ros2Type::kJointState;
+    case RosTopicType::kOdometry:
+      return Ros2Type::kOdometry;
+    case RosTopicType::kTf:
+    case RosTopicType::kTfStatic:
+      return Ros2Type::kTfMessage;
+    case RosTopicType::kClock:
+      return Ros2Type::kClock;
+  }
+  return Ros2Type::kClock;  // not reached: every enumerator is handled above
+}
 
 /// the most joints a received JointState may name, and the longest string (joint name, frame id,
 /// Trigger message) read from a received sample, in bytes: larger ones are refused with an Error.
