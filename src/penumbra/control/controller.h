@@ -11,7 +11,8 @@
 //      them, so a bad world file fails before the first step, not at run time.
 //   3. Compute(input, ctrl) at each control update.
 //   4. Reset(), called by Simulation::ResetControllers (the `reset` command): back to the
-//      state right after Initialize, so the next episode runs as the first one did.
+//      state right after Initialize, so the next episode runs as the first one did. the
+//      controllers' OnInitialize end with their Reset(): the initial state is written once.
 
 #include <span>
 #include <string>

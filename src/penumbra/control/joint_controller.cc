@@ -93,8 +93,7 @@ std::vector<NameRequirement> JointPdController::RequiredNames() const {
 
 void JointPdController::OnInitialize(const ModelInfo& model, const std::vector<int>& ids) {
   servo_.Bind(model, ids, context());
-  started_ = false;
-  commands_.Rewind();
+  Reset();
 }
 
 void JointPdController::CheckCommand(const JointCommand& c) const {

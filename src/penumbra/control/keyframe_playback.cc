@@ -307,10 +307,7 @@ void KeyframePlayback::OnInitialize(const ModelInfo& model, const std::vector<in
     qs_.push_back(q);
     grippers_.push_back(g);
   }
-  started_ = finished_ = false;
-  target_.setZero(n);
-  q_ref_.setZero(n);
-  qd_ref_.setZero(n);
+  Reset();
 }
 
 void KeyframePlayback::Evaluate(double t_rel, const Eigen::VectorXd& q_start, double gripper_start,

@@ -409,11 +409,7 @@ void MultirotorPid::OnInitialize(const ModelInfo& model, const std::vector<int>&
         c.file, c.line, c.key.empty() ? "rotor_actuators" : c.key + ".rotor_actuators",
         std::string(e.what()) + "; expected rotors that can lift and steer the airframe");
   }
-  thrust_.assign(rotors_.size(), 0.0);
-  next_scripted_ = 0;
-  mode_ = MultirotorCommand::Mode::kIdle;
-  started_ = false;
-  ResetState();
+  Reset();
 }
 
 void MultirotorPid::SetCommand(const MultirotorCommand& command) {

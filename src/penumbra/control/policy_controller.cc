@@ -293,10 +293,7 @@ void PolicyController::OnInitialize(const ModelInfo& model, const std::vector<in
   obs_.assign(observation_.size(), 0.0f);
   out_.assign(n, 0.0f);
   action_.assign(n, 0.0);
-  target_ = a.kind == PolicyActionKind::kJointPosition ? default_q_ : Eigen::VectorXd::Zero(n);
-  step_ = 0;
-  source_.Reset();
-  tracking_ = {NAN, NAN, NAN};
+  Reset();
 }
 
 void PolicyController::Reset() {

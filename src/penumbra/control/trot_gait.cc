@@ -404,10 +404,7 @@ void TrotGait::OnInitialize(const ModelInfo& model, const std::vector<int>& ids)
   limits_.mu = params_.friction;
   limits_.min_normal_n = 0.01 * mass_ * kGravity;
   limits_.max_normal_n = 2.0 * mass_ * kGravity;
-  started_ = false;
-  h_ref_ = 0;
-  k_raibert_ = 0;
-  if (route_) route_->Reset();
+  Reset();
 }
 
 TrotCommand TrotGait::ScriptedCommand(double t) const {

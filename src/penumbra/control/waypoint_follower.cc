@@ -77,7 +77,7 @@ void WaypointFollower::OnInitialize(const ModelInfo& model, const std::vector<in
                             "' does not drive a hinge joint; expected a velocity actuator on a "
                             "wheel's hinge joint");
   }
-  route_.Reset();
+  Reset();
 }
 
 void WaypointFollower::Reset() {
