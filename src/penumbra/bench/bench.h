@@ -68,13 +68,16 @@ inline constexpr double kRenderTargetFps = 30.0;
 /// the adversity preset `major`'s target of the same measurement, frames/s.
 inline constexpr double kMajorPresetTargetFps = 10.0;
 
-/// "met" when `measured` >= `target`, else "NOT met": the verdict the bench commands print
-/// after each target line (a higher-is-better figure).
+/// "met" when `measured` >= `target`, else "NOT met": the verdict of a ratio target (two
+/// measurements on the same machine, e.g. steps/s with and without a sink), which holds on any
+/// machine. absolute targets (frames/s, ms) use BenchTargetVerdict (core/bench_machine.h).
 const char* TargetVerdict(double measured, double target);
 
-/// prints the realtime frame-rate target line of a render bench: "target (2-core CI machine):
-/// <subject>>= T frames/s at 640x480 realtime: met|NOT met (F frames/s here)", or "not
-/// applicable (tier X)" when `tier` is not "realtime". `subject` is "" or e.g. "major ".
+/// prints the realtime frame-rate target line of a render bench: "target on <machine>:
+/// <subject>>= T frames/s at 640x480 realtime: <verdict> (F frames/s here)" with the machine the
+/// target was set on and BenchTargetVerdict's verdict (met / NOT met there, "not judged" naming
+/// both machines elsewhere), or "not applicable (tier X)" when `tier` is not "realtime".
+/// `subject` is "" or e.g. "major ".
 void PrintRealtimeFpsTarget(const std::string& subject, double target_fps, double measured_fps,
                             const std::string& tier);
 

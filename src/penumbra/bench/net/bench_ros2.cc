@@ -4,6 +4,8 @@
 
 #include <cstdio>
 
+#include "penumbra/core/bench_machine.h"
+
 namespace penumbra {
 
 int BenchRos2(const Ros2BenchOptions& o) {
@@ -33,15 +35,16 @@ int BenchRos2(const Ros2BenchOptions& o) {
     if (t.received < t.sent) lost = true;
     if (t.median_ms >= 1.0) slow = true;
   }
-  std::printf("%s",
-              fmt::format("  targets: added latency < 1 ms (median): {}; no message lost: {}\n",
-                          slow ? "NOT met" : "met", lost ? "NOT met" : "met")
-                  .c_str());
+  std::printf("%s", fmt::format("  {}: added latency < 1 ms (median): {}; no message lost: {}\n",
+                                BenchTargetLabel(), BenchTargetVerdict(!slow, ThisMachine()),
+                                lost ? "NOT met" : "met")
+                        .c_str());
   std::printf("%s", fmt::format("  lockstep round trip (Trigger request -> {}x{} rgb8 frame and "
                                 "reply), {} trips: median {:.3f} ms, p99 {:.3f} ms, {} requests "
-                                "sent again   target < 2 ms: {}\n",
+                                "sent again   {}: < 2 ms: {}\n",
                                 o.width, o.height, r.trips, r.trip_median_ms, r.trip_p99_ms,
-                                r.trips_resent, r.trip_median_ms < 2.0 ? "met" : "NOT met")
+                                r.trips_resent, BenchTargetLabel(),
+                                BenchTargetVerdict(r.trip_median_ms < 2.0, ThisMachine()))
                         .c_str());
   return 0;
 }

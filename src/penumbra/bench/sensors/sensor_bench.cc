@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "penumbra/core/bench_machine.h"
 #include "penumbra/physics/physics_source.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/pipeline/sim_loop.h"
@@ -111,9 +112,9 @@ int BenchSensors(const SensorBenchOptions& options) {
   RayQuery& rs = *query;
   fmt::print(
       "\nLiDAR (single thread, Embree packets of 16, motion-interpolated pose, scene posed per "
-      "scan, {} scans each after one untimed warm-up scan; target: OS1-64 < 10 ms/scan = 10 % of "
+      "scan, {} scans each after one untimed warm-up scan; {}: OS1-64 < 10 ms/scan = 10 % of "
       "one core at 10 Hz)\n",
-      options.scans);
+      options.scans, BenchTargetLabel());
   fmt::print("{:<16} {:>7} {:>12} {:>10} {:>8} {:>8} {:>12} {:>8}\n", "preset", "rays",
              "wall mean ms", "median ms", "max ms", "cpu ms", "cpu Mrays/s", "points");
   // homogeneous fog of meteorological optical range 30 m (sigma_t = ln 20 / MOR)
