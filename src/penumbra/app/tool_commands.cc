@@ -27,7 +27,14 @@ class HeightfieldCommand : public Command {
   void AddOptions(CLI::App* verb) override {
     verb->add_option("world", options_.world_file, "world file")->required();
     verb->add_option("--model", options_.model,
-                     "sample only this model's geoms (default: every static geom)");
+                     "sample only this model's static geoms (default: the ground)");
+    verb->add_option("--geoms", options_.geoms,
+                     "sample only static geoms whose name (model/geom) matches one of these "
+                     "globs (default: the ground: planes, height fields, geoms named *floor*, "
+                     "*ground*, *terrain*)")
+        ->delimiter(',');
+    verb->add_flag("--all", options_.all,
+                   "sample every static geom (trees, rocks, furniture and walls included)");
     AddDecimal(
         verb, "--cell", [this](double v) { options_.cell_m = v; }, 0, true,
         "sample spacing, m (default 0.1)");
