@@ -120,9 +120,14 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   const int truth_k = n / 2;
 
   CameraOutputs internal = spec_.outputs;
+  // a correlation matcher (stereo, structured light) reads the scene's light: the radiance of
+  // the ground-truth sub-frame
+  const bool depth_reads_light =
+      depth_model_ && depth_model_->kind != DepthNoiseModel::Kind::kTimeOfFlight;
   if (depth_model_) {
     for (ImageKind k : {ImageKind::kDepth, ImageKind::kNormals, ImageKind::kSegmentation})
       internal[k] = true;
+    if (depth_reads_light) internal[ImageKind::kRgb] = true;
   }
   const bool want_rgb = spec_.outputs[ImageKind::kRgb];
   if (want_rgb && n > 1) {
@@ -153,7 +158,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;
     view.white_balance_gains = wb_before;
-    view.want_radiance = want_rgb && need_radiance;
+    view.want_radiance = (want_rgb && need_radiance) || (k == truth_k && depth_reads_light);
     view.outputs = internal;
     if (k != truth_k) {
       view.outputs = CameraOutputs::None();
@@ -300,6 +305,15 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
           DepthTransmittance(out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *effects,
                              HashKeys(settings_.seed, camera_index_, frame_index, 4), pool_.get());
       in.transmittance = &transmittance;
+    }
+    ImageF ambient;  // the scene's luminance (cd/m^2), the matcher's texture and ambient light
+    if (depth_reads_light && !out->truth.radiance.empty()) {
+      ambient = ImageF(W, H, 1);
+      const ImageF& rad = out->truth.radiance;
+      for (size_t i = 0; i < ambient.data.size(); ++i)
+        ambient.data[i] = 0.2126f * rad.data[3 * i] + 0.7152f * rad.data[3 * i + 1] +
+                          0.0722f * rad.data[3 * i + 2];
+      in.ambient_cd_m2 = &ambient;
     }
     ApplyDepthNoise(out->truth.depth_m, in, *depth_model_,
                     HashKeys(settings_.seed, camera_index_, frame_index, 2), &out->depth_m,
