@@ -55,7 +55,7 @@ duration_sec: 0.5
 models:
   - {name: scene, file: walls.xml, initial_keyframe: spin}
 lights:
-  - {name: sun, type: sun, direction: [0.3, 0.4, -1], illuminance_lux: 20000}
+  - {name: sun, type: sun, direction: [0.3, 0.4, -1], illuminance_lux: 400}
 mjcf_cameras: {enabled: false}
 cameras:
   - name: front
@@ -453,13 +453,16 @@ TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
             std::string::npos)
       << meta;
   // the wall is fronto-parallel at 1.5 m: every pixel's z is 1.5 m (7500 in TUM units); the
-  // 32 x 24 camera with fovy 60 deg has fx = fy = 12 / tan(30 deg) = 20.78 px
+  // 32 x 24 camera with fovy 60 deg has fx = fy = 12 / tan(30 deg) = 20.78 px. the plain wall
+  // in soft light (a 400 lux sun plus the sky) is textured by the D435's projector (a brighter
+  // sun washes the dots out: holes); column 0 is the stereo model's left invalid band (fx b / z =
+  // 0.69 px)
   const double fx = 12.0 / std::tan(30.0 * M_PI / 180.0);
   const double sigma_m = 1.5 * 1.5 * 0.08 / (fx * 0.05);  // 0.1732 m
   const auto lines = Lines(out_.path() / "truth" / "depth.txt");
   ASSERT_GE(lines.size(), 3u + 5u);
   double sum = 0, sum2 = 0;
-  int64_t n = 0, holes = 0;
+  int64_t n = 0, holes = 0, band = 0, band_holes = 0;
   for (size_t i = 3; i < lines.size(); ++i) {
     const std::string file = lines[i].substr(lines[i].find(' ') + 1);
     const cv::Mat truth = cv::imread((out_.path() / "truth" / file).string(), cv::IMREAD_UNCHANGED);
@@ -473,6 +476,11 @@ TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
       for (int u = 0; u < truth.cols; ++u) {
         const double t = truth.at<uint16_t>(v, u), z = noisy.at<uint16_t>(v, u);
         EXPECT_NEAR(t, 7500, 1.0);  // ground truth: exact
+        if (u == 0) {
+          ++band;
+          band_holes += z == 0;
+          continue;
+        }
         if (z == 0) {
           ++holes;
           continue;
@@ -485,6 +493,7 @@ TEST_F(ExportCommandTest, ARunLogExportsDepthThroughTheBenchmarksSensorModel) {
   }
   ASSERT_GT(n, 2000);
   EXPECT_LT(holes, n / 100);
+  EXPECT_GT(band_holes, band / 2);  // lateral jitter reads some from column 1
   const double mean = sum / n, std = std::sqrt(sum2 / n - mean * mean);
   // the model's axial sigma within 10 % (n > 2000 samples: the estimate's own spread is ~2 %);
   // the mean within 4 standard errors of 0

@@ -586,6 +586,109 @@ TEST(DepthNoiseTest, MismatchedInputSizeIsAnError) {
   EXPECT_THROW(ApplyDepthNoise(depth, in, Preset("realsense_d435"), 1, &out), Error);
 }
 
+// a rendered room for the D435 model: a white textureless back wall at 4.2 m whose left part
+// carries a printed checker poster, a grey box at 1.5 m, office light (a 400 lux directional
+// light from behind the camera). captured clear and in fog (sigma_t 0.12 / m). writes the
+// picture of docs/sensors.md (rgb | depth clear | depth fog) when PENUMBRA_DOC_IMAGES names a
+// folder:
+//   PENUMBRA_DOC_IMAGES=docs build/sensors_tests --gtest_filter=DepthNoiseTest.RenderedRoom*
+TEST(DepthNoiseTest, RenderedRoomTexturedFillsTexturelessBreaksFogLoses) {
+  SceneDescription scene = BlackScene();
+  const int white = AddMaterial(&scene, Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+  const int dark = AddMaterial(&scene, Eigen::Vector3f(0.08f, 0.08f, 0.08f));
+  const int grey = AddMaterial(&scene, Eigen::Vector3f(0.5f, 0.45f, 0.4f));
+  const double wall = 4.2;
+  AddGeom(&scene, GeomShape::kBox, Eigen::Vector3d(0.01, 6, 6), Eigen::Vector3d(wall + 0.01, 0, 0),
+          white);
+  // poster: 0.1 m squares, world y in [0.4, 2.0] (image left), z in [-0.9, 0.9]
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 18; ++j)
+      if ((i + j) % 2)
+        AddGeom(&scene, GeomShape::kBox, Eigen::Vector3d(0.005, 0.05, 0.05),
+                Eigen::Vector3d(wall - 0.005, 0.45 + 0.1 * i, -0.85 + 0.1 * j), dark);
+  AddGeom(&scene, GeomShape::kBox, Eigen::Vector3d(0.2, 0.25, 0.25),
+          Eigen::Vector3d(1.5, -0.6, -0.2), grey);
+  Light sun;
+  sun.type = Light::Type::kDirectional;
+  sun.direction_B = Eigen::Vector3d(1, 0, 0);
+  sun.intensity = 400;
+  sun.cast_shadow = false;
+  scene.lights.push_back(sun);
+  RenderSettings rs;
+  rs.tier = RenderSettings::Tier::kRealtime;
+  auto renderer = MakeRenderer(scene, rs);
+  CameraSpec spec;
+  spec.name = "d435";
+  spec.intrinsics = CameraIntrinsics::FromFovy(320, 240, 58);
+  spec.outputs = CameraOutputs{ImageKind::kRgb, ImageKind::kDepth};
+  CameraSensorConfig cfg;
+  cfg.depth_noise.preset = "realsense_d435";
+  CameraImager imager(spec, cfg, rs, 0, scene);
+  CameraSensorConfig exact_cfg;
+  CameraImager exact(spec, exact_cfg, rs, 0, scene);
+  const WorldSnapshot snap = testing::Snapshot(scene, 0);
+  const Pose X_WO = testing::LookingAlongX(Eigen::Vector3d::Zero());
+  EffectsFrame fog;
+  HomogeneousMedium m;
+  m.sigma_t_per_m = Eigen::Vector3f(0.12f, 0.12f, 0.12f);
+  m.albedo = Eigen::Vector3f(0.9f, 0.9f, 0.9f);
+  fog.homogeneous_media.push_back(m);
+  CameraImages clear, foggy, truth;
+  imager.Capture(renderer.get(), snap, nullptr, X_WO, nullptr, Pose::Identity(), 0, &clear);
+  imager.Capture(renderer.get(), snap, &fog, X_WO, nullptr, Pose::Identity(), 1, &foggy);
+  exact.Capture(renderer.get(), snap, nullptr, X_WO, nullptr, Pose::Identity(), 0, &truth);
+  // the ground truth stays exact
+  EXPECT_EQ(clear.truth.depth_m.data, truth.depth_m.data);
+  EXPECT_EQ(truth.depth_m.data, truth.truth.depth_m.data);
+  // fill of the poster (image left of centre) and of the plain wall right of the box
+  const CameraIntrinsics& k = spec.intrinsics;
+  auto fill = [&](const ImageF& d, double y0, double y1) {
+    int valid = 0, n = 0;
+    for (int v = 0; v < k.height; ++v)
+      for (int u = 0; u < k.width; ++u) {
+        const double y = -(u - k.cx) / k.fx * wall, z = -(v - k.cy) / k.fy * wall;
+        if (y < y0 || y > y1 || std::abs(z) > 0.8 ||
+            std::abs(truth.depth_m.at(u, v)[0] - wall) > 0.05)
+          continue;
+        ++n;
+        valid += d.at(u, v)[0] > 0;
+      }
+    return static_cast<double>(valid) / std::max(1, n);
+  };
+  const double poster = fill(clear.depth_m, 0.5, 1.9), plain = fill(clear.depth_m, -2.0, -1.2);
+  const double poster_fog = fill(foggy.depth_m, 0.5, 1.9);
+  std::printf("rendered room: fill poster %.3f, plain wall %.3f, poster in fog %.3f\n", poster,
+              plain, poster_fog);
+  EXPECT_GT(poster, 0.98);
+  EXPECT_LT(plain, poster - 0.2);
+  EXPECT_LT(poster_fog, poster - 0.2);
+  if (const char* dir = std::getenv("PENUMBRA_DOC_IMAGES")) {
+    const int W = k.width, H = k.height;
+    cv::Mat panel(H, 3 * W, CV_8UC3);
+    for (int v = 0; v < H; ++v)
+      for (int u = 0; u < W; ++u) {
+        const uint8_t* c = clear.rgb.at(u, v);
+        panel.at<cv::Vec3b>(v, u) = cv::Vec3b(c[2], c[1], c[0]);
+      }
+    for (int p = 0; p < 2; ++p) {
+      const ImageF& d = p == 0 ? clear.depth_m : foggy.depth_m;
+      cv::Mat g(H, W, CV_8U), colour;
+      for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u)
+          g.at<uint8_t>(v, u) =
+              static_cast<uint8_t>(std::clamp(d.at(u, v)[0] / 5.0 * 255.0, 0.0, 255.0));
+      cv::applyColorMap(g, colour, cv::COLORMAP_TURBO);
+      for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u)
+          panel.at<cv::Vec3b>(v, (p + 1) * W + u) =
+              d.at(u, v)[0] > 0 ? colour.at<cv::Vec3b>(v, u) : cv::Vec3b(0, 0, 0);
+    }
+    const std::string path = (std::filesystem::path(dir) / "depth_d435.png").string();
+    ASSERT_TRUE(cv::imwrite(path, panel)) << path;
+    std::printf("wrote %s\n", path.c_str());
+  }
+}
+
 TEST(DepthNoiseTest, SmokeGridTransmittanceByRatioTracking) {
   // a 1 m smoke box of density 1, sigma_t 0.5 / m across the rays: mean T = exp(-0.5)
   EffectsFrame fx;

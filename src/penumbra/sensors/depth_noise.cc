@@ -131,7 +131,7 @@ std::vector<uint8_t> MatcherValid(const ImageF& depth_z, const DepthNoiseInputs&
                                   ThreadPool* pool) {
   const int W = depth_z.width, H = depth_z.height;
   const int w = std::max(1, model.window_px | 1);
-  cv::Mat A(H, W, CV_64F), S(H, W, CV_64F), V(H, W, CV_64F), noise(H, W, CV_64F);
+  cv::Mat A(H, W, CV_64F), S(H, W, CV_64F), V(H, W, CV_64F);
   const bool have_ambient = in.ambient_cd_m2 && !in.ambient_cd_m2->empty();
   ParallelForOrSerial(pool, H, [&](int v) {
     for (int u = 0; u < W; ++u) {
@@ -146,7 +146,15 @@ std::vector<uint8_t> MatcherValid(const ImageF& depth_z, const DepthNoiseInputs&
       A.at<double>(v, u) = model.ambient_fraction * lum / model.projector_luminance_1m;
       S.at<double>(v, u) = hit ? rho * px.cos_theta[i] * t2 / (z * z) : 0.0;
       V.at<double>(v, u) = hit ? model.backscatter * (1.0 - t2) : 0.0;
-      Rng rng(HashKeys(key, i, 7));
+    }
+  });
+  // white noise on the image padded by the window's half width, so that every window below
+  // averages w^2 independent samples (mirrored borders would repeat some)
+  const int r = w / 2, PW = W + 2 * r, PH = H + 2 * r;
+  cv::Mat noise(PH, PW, CV_64F);
+  ParallelForOrSerial(pool, PH, [&](int v) {
+    for (int u = 0; u < PW; ++u) {
+      Rng rng(HashKeys(key, static_cast<uint64_t>(v) * static_cast<uint64_t>(PW) + u, 7));
       noise.at<double>(v, u) = SampleStandardNormal(&rng);
     }
   });
@@ -162,7 +170,7 @@ std::vector<uint8_t> MatcherValid(const ImageF& depth_z, const DepthNoiseInputs&
                 mV = BoxMean(V, w);
   // the window score's fluctuation: white noise averaged over the window, rescaled to unit
   // variance (a box mean of w^2 unit normals has standard deviation 1 / w)
-  const cv::Mat jitter = BoxMean(noise, w) * static_cast<double>(w);
+  const cv::Mat jitter = BoxMean(noise, w)(cv::Rect(r, r, W, H)) * static_cast<double>(w);
   cv::Mat matched(H, W, CV_64F);
   const double read2 = model.read_noise_e * model.read_noise_e;
   ParallelForOrSerial(pool, H, [&](int v) {
