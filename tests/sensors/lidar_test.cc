@@ -80,12 +80,81 @@ double AnalyticRange(const Eigen::Vector3d& o, const Eigen::Vector3d& d, bool gr
   return best;
 }
 
+// a fan of beams (el 0, azimuth -50..50 mrad in 0.1 mrad steps, divergence 3 mrad) at the wall
+// x = 10 with a box whose front face is at x = `front` covering y < 0 (its edge on the beam at
+// azimuth 0).
+LidarScan FanAtEdge(double front, int footprint_rays) {
+  SceneDescription scene = AnalyticScene(false, true, false);
+  Geom box;
+  box.id = 7;
+  box.shape = GeomShape::kBox;
+  box.size = {0.05, 2.5, 2.0};
+  box.material = 0;
+  box.X_BG = PoseFromXyzRpyDeg({front + 0.05, -2.5, 0}, {0, 0, 0});
+  scene.geoms.push_back(box);
+  RayScene rs(scene);
+  rs.Update(StaticSnapshot());
+  LidarConfig cfg;
+  cfg.pattern.name = "fan";
+  cfg.pattern.rings = 1;
+  cfg.pattern.beam_divergence_rad = 0.003;
+  for (int i = -500; i <= 500; ++i) {
+    LidarBeam b;
+    b.azimuth_rad = static_cast<float>(i * 1e-4);
+    b.column = i + 500;
+    cfg.pattern.beams.push_back(b);
+  }
+  cfg.footprint_rays = footprint_rays;
+  LidarScanner lidar(cfg, 1);
+  LidarScan scan;
+  lidar.Scan(
+      rs, nullptr, [](double) { return Pose::Identity(); }, 0, &scan);
+  return scan;
+}
+
+// mixed returns: a beam whose footprint straddles an edge less than a pulse length (3 m for
+// 20 ns) in front of its background reports one point between the two surfaces; only beams
+// within the footprint's reach of the edge do; the axis alone (footprint_rays 0) never does;
+// an edge 6 m in front of the wall gives separate pulses, the stronger wins, no point between.
+TEST(LidarTest, MixedReturnsBetweenSurfacesOnlyAtEdges) {
+  auto between = [](const LidarScan& scan, double near, double far, double* max_abs_az) {
+    int n = 0;
+    *max_abs_az = 0;
+    for (const LidarPoint& p : scan.points) {
+      const double r = std::hypot(p.x, p.y, p.z);
+      if (r > near + 0.02 && r < far - 0.02) {
+        ++n;
+        *max_abs_az = std::max(*max_abs_az, std::abs(std::atan2(static_cast<double>(p.y), p.x)));
+      }
+    }
+    return n;
+  };
+  double reach = 0;
+  const LidarScan mixed = FanAtEdge(9.0, 4);
+  EXPECT_EQ(mixed.points.size(), 1001u);
+  const int n_mixed = between(mixed, 9.0, 10.0, &reach);
+  std::printf("edge 1 m before the wall: %d mixed points, out to %.2f mrad\n", n_mixed,
+              1e3 * reach);
+  EXPECT_GE(n_mixed, 5);
+  EXPECT_LE(reach, 0.7 * 0.0015 + 2e-4);  // the footprint ring's radius
+  // off the edge the points are the surfaces' own (within the ring's range spread)
+  for (const LidarPoint& p : mixed.points) {
+    const double az = std::atan2(static_cast<double>(p.y), p.x), r = std::hypot(p.x, p.y, p.z);
+    if (std::abs(az) < 2e-3) continue;
+    const double expected = (az < 0 ? 9.0 : 10.0) / std::cos(az);
+    EXPECT_NEAR(r, expected, 1e-3) << az;
+  }
+  EXPECT_EQ(between(FanAtEdge(9.0, 0), 9.0, 10.0, &reach), 0);
+  EXPECT_EQ(between(FanAtEdge(4.0, 4), 4.0, 10.0, &reach), 0);
+}
+
 TEST(LidarTest, NoiseFreeRangesMatchAnalyticSceneAndDetectionThreshold) {
   const SceneDescription scene = AnalyticScene(true, true, true);
   RayScene rs(scene);
   rs.Update(StaticSnapshot());
   LidarConfig cfg;
   cfg.pattern = MakeLidarPattern("velodyne_vlp16");
+  cfg.footprint_rays = 0;  // the beam's axis: the analytic range (mixed returns: below)
   LidarScanner lidar(cfg, 1);
   const Pose X_WS = PoseFromXyzRpyDeg({0, 0, 1}, {0, 0, 0});
   LidarScan scan;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "penumbra/core/error.h"
@@ -159,6 +160,8 @@ void LidarConfig::ValidateOrThrow() const {
     bad("pulse_half_power_width_ns", pulse_half_power_width_ns, "> 0");
   if (!(overlap_start_m >= 0 && overlap_full_m > overlap_start_m))
     bad("overlap_full_m", overlap_full_m, "> overlap_start_m >= 0");
+  if (footprint_rays < 0 || footprint_rays > kMaxFootprintRays)
+    bad("footprint_rays", footprint_rays, "[0, " + std::to_string(kMaxFootprintRays) + "]");
 }
 
 Pose InterpolatePose(const Pose& a, const Pose& b, double s) {
@@ -308,6 +311,13 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
   std::vector<Ray> rays(kChunk);
   std::vector<SurfaceHit> hits(kChunk);
   bool did_hit[kChunk];
+  // the beam's footprint: K more rays on a ring of 0.7 half-divergences around the axis (the
+  // rms radius of a uniform disc), traced per chunk
+  const int K = pat.beam_divergence_rad > 0 ? config_.footprint_rays : 0;
+  const double ring = 0.7 * tan_half_div;
+  std::vector<Ray> fp_rays(static_cast<size_t>(kChunk) * K);
+  std::vector<SurfaceHit> fp_hits(fp_rays.size());
+  std::unique_ptr<bool[]> fp_did_hit(new bool[std::max<size_t>(1, fp_rays.size())]);
   float last_time = -1;
   Pose X = Pose::Identity();
   for (int start = 0; start < n; start += kChunk) {
@@ -326,6 +336,23 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
     }
     scene.Intersect(std::span<const Ray>(rays.data(), m), std::span<SurfaceHit>(hits.data(), m),
                     std::span<bool>(did_hit, m));
+    if (K > 0) {
+      for (int j = 0; j < m; ++j) {
+        const Eigen::Vector3f d = rays[j].d;
+        const Eigen::Vector3f e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+        for (int k = 0; k < K; ++k) {
+          const float phi = static_cast<float>(2 * kScanPi * (k + 0.5) / K);
+          Ray& r = fp_rays[static_cast<size_t>(j) * K + k];
+          r = rays[j];
+          r.d = (d + static_cast<float>(ring) * (std::cos(phi) * e1 + std::sin(phi) * e2))
+                    .normalized();
+        }
+      }
+      const size_t mk = static_cast<size_t>(m) * K;
+      scene.Intersect(std::span<const Ray>(fp_rays.data(), mk),
+                      std::span<SurfaceHit>(fp_hits.data(), mk),
+                      std::span<bool>(fp_did_hit.get(), mk));
+    }
     for (int j = 0; j < m; ++j) {
       const int i = start + j;
       const LidarBeam& beam = pat.beams[i];
@@ -388,28 +415,77 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
           }
         }
       }
-      if (did_hit[j]) {
-        const SurfaceHit& h = hits[j];
+      // hard target: the power of one ray's surface hit (LiDAR equation, media T^2)
+      auto hard_power = [&](const SurfaceHit& h, const Ray& ry, bool main_ray) {
         const double r = h.t;
         const float rho = h.material >= 0 && h.material < static_cast<int>(desc.materials.size())
                               ? Luminance(desc.materials[h.material].base_color)
                               : 0.8f;
-        const double cos_t = std::abs(static_cast<double>(h.ng_W.dot(ray.d)));
+        const double cos_t = std::abs(static_cast<double>(h.ng_W.dot(ry.d)));
         double p = rho * cos_t / kScanPi / (r * r);
         if (has_media) {
           // zero if the soft-target march already showed it undetectable; else T^2 from the
           // march's optical depth (exact for uniform media: the initial segment is exact and
           // the midpoint sum of a constant is exact; 48 midpoint samples for height fog and
           // grids), or from OpticalDepth when the march did not run
-          if (r_stop < r_end && p * std::exp(-2 * tau_stop) < floor_power)
+          if (main_ray && r_stop < r_end && p * std::exp(-2 * tau_stop) < floor_power)
             p = 0;
+          else if (main_ray && tau_end >= 0)
+            p *= std::exp(-2 * tau_end);
           else
-            p *= std::exp(-2 * (tau_end >= 0 ? tau_end : media.OpticalDepth(o, d, r)));
+            p *= std::exp(-2 * media.OpticalDepth(ry.o.cast<double>(), ry.d.cast<double>(), r));
         }
-        p += sigma_n * n_hard;
-        if (r >= pat.min_range_m && p > best_p) {
+        return p;
+      };
+      double hard_p = 0, hard_r = 0;
+      bool hard = false;
+      if (K == 0) {
+        if (did_hit[j]) {
+          hard = true;
+          hard_r = hits[j].t;
+          hard_p = hard_power(hits[j], ray, true);
+        }
+      } else {
+        // the footprint's returns (equal weights, axis and ring) overlap in time when their
+        // ranges differ by less than the pulse length and the receiver sees one pulse: the
+        // strongest such group is the return, at its power-weighted mean range (a mixed
+        // return between foreground and background on an edge); farther apart they are
+        // separate pulses and the stronger group wins
+        double ps[kMaxFootprintRays + 1], rs[kMaxFootprintRays + 1];
+        int ns = 0;
+        if (did_hit[j]) {
+          rs[ns] = hits[j].t;
+          ps[ns++] = hard_power(hits[j], ray, true);
+        }
+        for (int k = 0; k < K; ++k) {
+          const size_t f = static_cast<size_t>(j) * K + k;
+          if (!fp_did_hit[f]) continue;
+          rs[ns] = fp_hits[f].t;
+          ps[ns++] = hard_power(fp_hits[f], fp_rays[f], false);
+        }
+        double best_group = 0;
+        for (int a = 0; a < ns; ++a) {
+          double sp = 0, spr = 0;
+          for (int b = 0; b < ns; ++b) {
+            if (std::abs(rs[b] - rs[a]) >= pulse_len) continue;
+            sp += ps[b];
+            spr += ps[b] * rs[b];
+          }
+          if (sp > best_group) {
+            best_group = sp;
+            hard_r = spr / sp;
+          }
+        }
+        if (best_group > 0) {
+          hard = true;
+          hard_p = best_group / (K + 1);
+        }
+      }
+      if (hard) {
+        const double p = hard_p + sigma_n * n_hard;
+        if (hard_r >= pat.min_range_m && p > best_p) {
           best_p = p;
-          best_r = r;
+          best_r = hard_r;
           best_kind = LidarReturnKind::kSurface;
         }
       }

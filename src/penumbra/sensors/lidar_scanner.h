@@ -37,6 +37,20 @@
 //    returns P_p = (rho_p / pi) min(1, (r_p / r_beam)^2) T^2 / R^2, r_beam = R tan(div / 2);
 //    rho_p = 0.02 for rain (Fresnel reflectance of water at normal incidence), the colour's
 //    luminance for snow and sparks.
+//  - mixed returns: a beam is traced along its axis and along footprint_rays more rays on a
+//    ring of 0.7 half-divergences (the rms radius of a uniform disc), each sampling the hard
+//    target with equal weight. returns whose ranges differ by less than the pulse length
+//    L = c tau_H / 2 arrive as one pulse: the strongest such group is the hard-target
+//    candidate, with the group's mean power over the footprint and its power-weighted mean
+//    range. on a depth edge closer than L to its background the point lands between the two
+//    surfaces (a mixed or "flying" point); farther apart the two are separate pulses and the
+//    stronger wins (single strongest return). on a continuous surface the range is the
+//    axis's to within the footprint's spread.
+//  - multipath is not modelled: with a narrow receiver field that sees only the laser spot,
+//    light that reaches the spot from a second diffuse surface scales with the spot's area
+//    over the squared distance (well below 1e-3 in a room corner), so Lambertian corners
+//    give no measurable bias; ghost points behind mirrors and glass (specular multipath)
+//    are not traced.
 // detection: the strongest candidate plus receiver noise N(0, (receiver_noise P_th)^2) must
 // reach P_th = (reference_reflectivity / pi) / max_range^2, the power of a reference target
 // at maximum range; a beam is also dropped with dropout_probability, and when its
@@ -80,6 +94,9 @@ struct LidarScan {
   int64_t particle_returns = 0;    ///< returns from rain / snow / sparks
 };
 
+/// the most footprint rays a beam may trace besides its axis (LidarConfig::footprint_rays).
+inline constexpr int kMaxFootprintRays = 16;
+
 /// LiDAR model parameters beyond the scan pattern.
 struct LidarConfig {
   LidarPattern pattern;
@@ -93,6 +110,9 @@ struct LidarConfig {
   double pulse_half_power_width_ns = 20.0;  ///< tau_H (Hahner et al.: 20 ns), > 0
   double overlap_start_m = 1.0;             ///< R_1 of xi(R)
   double overlap_full_m = 5.0;              ///< R_2 of xi(R) (> R_1)
+  /// rays on the beam's footprint besides its axis (mixed returns at edges; 0 = the axis
+  /// alone), in [0, kMaxFootprintRays]
+  int footprint_rays = 4;
 
   /// @throws Error naming the parameter and its valid range.
   void ValidateOrThrow() const;
