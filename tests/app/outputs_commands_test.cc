@@ -13,6 +13,7 @@
 
 #include "app/child_process.h"
 #include "common/temp_dir.h"
+#include "penumbra/core/bench_machine.h"
 
 namespace penumbra {
 namespace {
@@ -104,7 +105,7 @@ TEST(PathtracedProgress, EverySamplePassOfEveryFrameGetsALineWithAnEta) {
   }
 }
 
-TEST(BenchRender, TheTargetLineSaysWhetherItWasMet) {
+TEST(BenchRender, TheTargetLineNamesItsMachineAndJudgesOnlyThere) {
   testing::TempDir dir;
   dir.Write("box.xml", kOcBoxMjcf);
   std::string text = kOcBoxWorld;
@@ -119,12 +120,19 @@ TEST(BenchRender, TheTargetLineSaysWhetherItWasMet) {
       << r.out;
   ASSERT_TRUE(std::regex_search(
       r.out, target,
-      std::regex("\ntarget \\(2-core CI machine\\): >= 30 frames/s at 640x480 realtime: (met|NOT "
-                 "met) \\(([0-9]+\\.[0-9]) frames/s here\\)\n")))
+      std::regex("\ntarget on 2 cores, AMD EPYC, no GPU: >= 30 frames/s at 640x480 realtime: "
+                 "(.*) \\(([0-9]+\\.[0-9]) frames/s here\\)\n")))
       << r.out;
-  // the verdict is the measured rate against 30 (whatever this machine measures)
+  // on the machine the target was set on, the measured rate against 30; on any other, no
+  // verdict, both machines named
   EXPECT_EQ(target[2].str(), fps[1].str());
-  EXPECT_EQ(target[1].str(), std::stod(fps[1].str()) >= 30 ? "met" : "NOT met");
+  const bool met = std::stod(fps[1].str()) >= 30;
+  if (SameMachine(ThisMachine(), BenchTargetMachine())) {
+    EXPECT_EQ(target[1].str(), met ? "met" : "NOT met");
+  } else {
+    EXPECT_EQ(target[1].str(), "not judged (set on 2 cores, AMD EPYC, no GPU; this machine: " +
+                                   ThisMachine().Describe() + ")");
+  }
 }
 
 TEST(BenchRender, PresetTimesOnlyTheNamedPresetsLines) {
