@@ -52,10 +52,122 @@ void RoundTripJpeg(int quality, ImageU8* rgb) {
   cv::cvtColor(dec, img, cv::COLOR_BGR2RGB);  // writes into rgb's buffer (same size and type)
 }
 
+bool HasOptics(const OpticsConfig& o) {
+  return o.vignetting_exponent > 0 || o.psf_sigma_px > 0 || o.lateral_ca_px > 0;
+}
+
+// bilinear sample of channel ch of `img` at (x, y) px (pixel centres at integers), clamped to
+// the image.
+float Bilinear(const ImageF& img, float x, float y, int ch) {
+  x = std::clamp(x, 0.0f, static_cast<float>(img.width - 1));
+  y = std::clamp(y, 0.0f, static_cast<float>(img.height - 1));
+  const int x0 = std::min(static_cast<int>(x), img.width - 2 < 0 ? 0 : img.width - 2);
+  const int y0 = std::min(static_cast<int>(y), img.height - 2 < 0 ? 0 : img.height - 2);
+  const int x1 = std::min(x0 + 1, img.width - 1), y1 = std::min(y0 + 1, img.height - 1);
+  const float fx = x - x0, fy = y - y0;
+  const float a = img.at(x0, y0)[ch], b = img.at(x1, y0)[ch];
+  const float c = img.at(x0, y1)[ch], d = img.at(x1, y1)[ch];
+  return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
+}
+
+// the optics of `o` on `in` ((H x W x 3) radiance) into `out`: vignetting, lateral chromatic
+// aberration, then the Gaussian PSF (separable, edges clamped). `tmp` is scratch.
+void ApplyOptics(const OpticsConfig& o, const CameraIntrinsics& k, const ImageF& in, ImageF* out,
+                 ImageF* tmp, ThreadPool* pool) {
+  const int W = in.width, H = in.height;
+  if (out->width != W || out->height != H || out->channels != 3) *out = ImageF(W, H, 3);
+  if (tmp->width != W || tmp->height != H || tmp->channels != 3) *tmp = ImageF(W, H, 3);
+  const double scale = o.reference_width > 0 ? static_cast<double>(W) / o.reference_width : 1.0;
+  // lateral CA: relative magnification of red (1 + m) and blue (1 - m) from the corner shift
+  const double corner = std::hypot(std::max(k.cx, W - 1 - k.cx), std::max(k.cy, H - 1 - k.cy));
+  const float m = corner > 0 ? static_cast<float>(o.lateral_ca_px * scale / corner) : 0.0f;
+  const float half_n = static_cast<float>(0.5 * o.vignetting_exponent);
+  ParallelForOrSerial(pool, H, [&](int v) {
+    const float b = static_cast<float>((v - k.cy) / k.fy);
+    float* dst = tmp->at(0, v);
+    for (int u = 0; u < W; ++u) {
+      const float a = static_cast<float>((u - k.cx) / k.fx);
+      const float ri = half_n > 0 ? std::pow(1.0f + a * a + b * b, -half_n) : 1.0f;
+      const float* src = in.at(u, v);
+      float r = src[0], g = src[1], bl = src[2];
+      if (m > 0) {
+        const float du = u - static_cast<float>(k.cx), dv = v - static_cast<float>(k.cy);
+        r = Bilinear(in, static_cast<float>(k.cx) + du / (1 + m),
+                     static_cast<float>(k.cy) + dv / (1 + m), 0);
+        bl = Bilinear(in, static_cast<float>(k.cx) + du / (1 - m),
+                      static_cast<float>(k.cy) + dv / (1 - m), 2);
+      }
+      dst[3 * u] = r * ri;
+      dst[3 * u + 1] = g * ri;
+      dst[3 * u + 2] = bl * ri;
+    }
+  });
+  const double sigma = o.psf_sigma_px * scale;
+  if (!(sigma >= 0.05)) {
+    std::swap(*out, *tmp);
+    return;
+  }
+  const int radius = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
+  std::vector<float> w(2 * radius + 1);
+  float sum = 0;
+  for (int i = -radius; i <= radius; ++i)
+    sum += w[i + radius] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+  for (float& x : w) x /= sum;
+  // rows (tmp -> out), then columns (out -> tmp), then swap
+  ParallelForOrSerial(pool, H, [&](int v) {
+    for (int u = 0; u < W; ++u)
+      for (int ch = 0; ch < 3; ++ch) {
+        float acc = 0;
+        for (int i = -radius; i <= radius; ++i)
+          acc += w[i + radius] * tmp->at(std::clamp(u + i, 0, W - 1), v)[ch];
+        out->at(u, v)[ch] = acc;
+      }
+  });
+  ParallelForOrSerial(pool, H, [&](int v) {
+    for (int u = 0; u < W; ++u)
+      for (int ch = 0; ch < 3; ++ch) {
+        float acc = 0;
+        for (int i = -radius; i <= radius; ++i)
+          acc += w[i + radius] * out->at(u, std::clamp(v + i, 0, H - 1))[ch];
+        tmp->at(u, v)[ch] = acc;
+      }
+  });
+  std::swap(*out, *tmp);
+}
+
+// the radiance (cd/m^2) of the largest white-balanced channel that a fraction `fraction` of the
+// pixels of `img` exceed; 0 for an empty image.
+double BrightQuantile(const ImageF& img, const Eigen::Vector3f& wb, double fraction) {
+  const size_t n = static_cast<size_t>(img.width) * img.height;
+  if (n == 0) return 0;
+  std::vector<float> m(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = &img.data[3 * i];
+    const float v = std::max({p[0] * wb[0], p[1] * wb[1], p[2] * wb[2]});
+    m[i] = std::isfinite(v) ? v : 0.0f;
+  }
+  const size_t k = std::min(n - 1, static_cast<size_t>(std::floor((1.0 - fraction) * n)));
+  std::nth_element(m.begin(), m.begin() + k, m.end());
+  return m[k];
+}
+
 }  // namespace
 
+double FilmicWhite() {
+  // AcesFilmic(x) = 1: 0.08 x^2 - 0.56 x - 0.14 = 0
+  return (0.56 + std::sqrt(0.56 * 0.56 + 4 * 0.08 * 0.14)) / (2 * 0.08);
+}
+
+double RowTimeSec(const CameraSensorConfig& c, int height) {
+  if (c.rolling_shutter_line_time_sec > 0 || height <= 0) return c.rolling_shutter_line_time_sec;
+  return c.rolling_shutter_readout_sec / height;
+}
+
 double FrameSpanSec(const CameraSensorConfig& c, int height) {
-  return c.exposure_time_sec + std::max(0, height - 1) * c.rolling_shutter_line_time_sec;
+  const double T = c.auto_exposure.enabled
+                       ? std::max(c.exposure_time_sec, c.auto_exposure.max_exposure_time_sec)
+                       : c.exposure_time_sec;
+  return T + std::max(0, height - 1) * RowTimeSec(c, height);
 }
 
 void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string& key_prefix) {
@@ -84,6 +196,35 @@ void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string&
     fail("white_balance", "expected a colour temperature in [1667, 25000] K");
   if (c.stereo_baseline_m && (!(*c.stereo_baseline_m > 0) || !std::isfinite(*c.stereo_baseline_m)))
     fail("stereo.baseline_m", "expected a finite baseline > 0 (m)");
+  if (!(c.rolling_shutter_readout_sec >= 0 && c.rolling_shutter_readout_sec <= 10))
+    fail("rolling_shutter_readout_sec", "expected a number in [0, 10] (seconds)");
+  const OpticsConfig& o = c.optics;
+  if (!(o.vignetting_exponent >= 0 && o.vignetting_exponent <= 8))
+    fail("optics.vignetting_exponent", "expected a number in [0, 8]");
+  if (!(o.psf_sigma_px >= 0 && o.psf_sigma_px <= 20))
+    fail("optics.psf_sigma_px", "expected a number in [0, 20] (px)");
+  if (!(o.lateral_ca_px >= 0 && o.lateral_ca_px <= 20))
+    fail("optics.lateral_ca_px", "expected a number in [0, 20] (px)");
+  if (o.reference_width < 0 || o.reference_width > 100000)
+    fail("optics.reference_width", "expected an integer in [0, 100000] (px)");
+  const AutoExposureConfig& a = c.auto_exposure;
+  if (a.enabled) {
+    if (!(a.f_number > 0 && a.f_number <= 1000))
+      fail("auto_exposure.f_number", "expected a number in (0, 1000]");
+    if (!(a.min_exposure_time_sec > 0 && a.min_exposure_time_sec <= 60))
+      fail("auto_exposure.min_exposure_time_sec", "expected a number in (0, 60] (seconds)");
+    if (!(a.max_exposure_time_sec >= a.min_exposure_time_sec && a.max_exposure_time_sec <= 60))
+      fail("auto_exposure.max_exposure_time_sec",
+           "expected a number in [min_exposure_time_sec, 60] (seconds)");
+    if (!(a.max_gain >= 1 && a.max_gain <= 1e6))
+      fail("auto_exposure.max_gain", "expected a number in [1, 1e6]");
+    if (!(a.saturated_fraction >= 0 && a.saturated_fraction <= 1))
+      fail("auto_exposure.saturated_fraction", "expected a number in [0, 1]");
+    if (!(a.max_highlight_reduction_ev >= 0 && a.max_highlight_reduction_ev <= 10))
+      fail("auto_exposure.max_highlight_reduction_ev", "expected a number in [0, 10] (EV)");
+    if (!(a.motion_blur_step_sec >= 0 && a.motion_blur_step_sec <= 60))
+      fail("auto_exposure.motion_blur_step_sec", "expected a number in [0, 60] (seconds)");
+  }
   ValidateImageNoiseOrThrow(c.noise, key_prefix + ".noise");
   if (!c.depth_noise.preset.empty()) DepthNoisePreset(c.depth_noise, key_prefix + ".depth_noise");
 }
@@ -101,7 +242,8 @@ CameraImager::CameraImager(const CameraSpec& spec, const CameraSensorConfig& con
   ValidateCameraSensorOrThrow(config, key);
   if (!config.depth_noise.preset.empty())
     depth_model_ = DepthNoisePreset(config.depth_noise, key + ".depth_noise");
-  if (config.noise.enabled || depth_model_ || config.motion_blur_samples > 1)
+  if (config.noise.enabled || depth_model_ || config.motion_blur_samples > 1 ||
+      HasOptics(config.optics) || config.auto_exposure.enabled)
     pool_ = std::make_unique<ThreadPool>(render_settings.threads);
   if (config.white_balance.mode == WhiteBalance::Mode::kDaylight)
     daylight_white_ = DaylightWhite(scene);
@@ -113,11 +255,21 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
                            CameraImages* out) {
   const CameraSensorConfig& c = config_;
   const int W = spec_.intrinsics.width, H = spec_.intrinsics.height;
-  const double T = c.exposure_time_sec;
+  const AutoExposureConfig& ae_cfg = c.auto_exposure;
+  const bool ae = ae_cfg.enabled;
+  // with auto exposure the shutter time metered on the last frame (frame 0: exposure_time_sec)
+  const double T = ae && ae_time_ ? *ae_time_ : c.exposure_time_sec;
+  const double row_time = RowTimeSec(c, H);
   const bool moving = end != nullptr && end->time_sec > start.time_sec;
   const double span = moving ? end->time_sec - start.time_sec : 0.0;
-  const int n = moving ? c.motion_blur_samples : 1;
+  int n = moving ? c.motion_blur_samples : 1;
+  if (moving && ae && ae_cfg.motion_blur_step_sec > 0)
+    n = std::clamp(static_cast<int>(std::ceil(T / ae_cfg.motion_blur_step_sec)), 1,
+                   c.motion_blur_samples);
+  // renderer frame indices: sub-frames of different frames never share one
+  const int64_t stride = ae ? c.motion_blur_samples : n;
   const int truth_k = n / 2;
+  const bool optics = HasOptics(c.optics);
 
   CameraOutputs internal = spec_.outputs;
   // a correlation matcher (stereo, structured light) reads the scene's light: the radiance of
@@ -144,7 +296,8 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
                                         : GainsForFrame(c.white_balance, daylight_white_, ImageF());
   // the camera model reads the radiance for sub-frames, noise, gray world and adaptation;
   // otherwise the renderer's developed rgb is the camera's (set_keep_radiance)
-  const bool need_radiance = keep_radiance_ || n > 1 || c.noise.enabled || gray_world || adapts;
+  const bool need_radiance =
+      keep_radiance_ || n > 1 || c.noise.enabled || gray_world || adapts || optics || ae;
   truth_view_.reset();
   truth_moving_ = moving;
   RenderedFrame sub;
@@ -154,7 +307,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.X_WO = X_WO_start;
     view.intrinsics = spec_.intrinsics;
     view.near_m = spec_.near_m;
-    view.frame_index = frame_index * n + k;
+    view.frame_index = frame_index * stride + k;
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;
     view.white_balance_gains = wb_before;
@@ -168,7 +321,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       view.motion.X_WO_end = X_WO_end;
       view.motion.end_sec = span;
       view.motion.time_sec = s;
-      view.motion.line_time_sec = c.rolling_shutter_line_time_sec;
+      view.motion.line_time_sec = row_time;
     }
     // (interp_ keeps the last sub-frame's snapshot: the ground truth's when n = 1, the only
     // case BrightestRadiance renders again)
@@ -207,15 +360,21 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       out->radiance = ImageF();
     }
     const ImageF& radiance = out->radiance;
+    // the light on the sensor: the radiance through the optics
+    const ImageF* sensor_in = &radiance;
+    if (optics) {
+      ApplyOptics(c.optics, spec_.intrinsics, radiance, &optic_, &optic_tmp_, pool_.get());
+      sensor_in = &optic_;
+    }
     // exposure with adaptation over sim time; one frame's metering is the renderer's (Film::Ev100
     // of this very radiance)
-    const bool developed = n == 1 && !out->truth.rgb.empty();
+    const bool developed = n == 1 && !out->truth.rgb.empty() && !optics;
     if (!developed && radiance.empty())
       throw Error(fmt::format(
           "camera '{}': frame {}: the renderer gave neither rgb nor radiance; expected the rgb "
           "it was asked for (CameraOutputs rgb)",
           spec_.name, frame_index));
-    double ev = developed ? out->truth.ev100 : film_.Ev100(radiance, pool_.get());
+    double ev = developed ? out->truth.ev100 : film_.Ev100(*sensor_in, pool_.get());
     if (adapts && last_ev_) {
       const double dt = std::max(0.0, start.time_sec - *last_time_);
       ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
@@ -226,20 +385,61 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     // gray world needs this frame's radiance; the other modes' gains were known before it
     const Eigen::Vector3f wb_gains =
         gray_world ? GainsForFrame(c.white_balance, daylight_white_, radiance) : wb_before;
-    if (c.noise.enabled) {
+    out->exposure_time_sec = T;
+    out->analog_gain = 1;
+    const uint64_t noise_key = HashKeys(settings_.seed, camera_index_, frame_index, 1);
+    const uint64_t pattern_key = HashKeys(settings_.seed, camera_index_, 5);
+    if ((ae || c.noise.enabled) &&
+        (exposed_.width != W || exposed_.height != H || exposed_.channels != 3))
+      exposed_ = ImageF(W, H, 3);
+    if (ae) {
+      // exposure per cd/m^2 of shutter time t and gain g: H = t g / k (saturation-based ISO)
+      const double k = 100.0 * 1.2 * ae_cfg.f_number * ae_cfg.f_number / c.noise.base_iso;
+      const double white = film_.filmic() ? FilmicWhite() : 1.0;
+      // the target exposure, raw full scale at the curve's white; highlights protected
+      double h = ExposureFromEv100(ev) / white;
+      if (settings_.auto_exposure && ae_cfg.saturated_fraction < 1) {
+        const double bright = BrightQuantile(*sensor_in, wb_gains, ae_cfg.saturated_fraction);
+        // the brightest pixels at 80 % of full scale: their noise stays below saturation
+        constexpr double kHighlightLevel = 0.8;
+        if (bright * h > kHighlightLevel)
+          h = std::max(kHighlightLevel / bright, h * std::exp2(-ae_cfg.max_highlight_reduction_ev));
+      }
+      const double tg = h * k;
+      const double next_t =
+          std::clamp(tg, ae_cfg.min_exposure_time_sec, ae_cfg.max_exposure_time_sec);
+      const double next_g = std::clamp(tg / next_t, 1.0, ae_cfg.max_gain);
+      if (!ae_time_) {  // frame 0 meters itself
+        ae_time_ = next_t;
+        ae_gain_ = next_g;
+      }
+      const double t = *ae_time_, g = *ae_gain_;
+      ae_time_ = next_t;
+      ae_gain_ = next_g;
+      const double h_used = t * g / k;
+      out->exposure_time_sec = t;
+      out->analog_gain = g;
+      out->ev100 = -std::log2(1.2 * h_used * white);
+      const float hf = static_cast<float>(h_used);
+      for (size_t i = 0; i < sensor_in->data.size(); ++i)
+        exposed_.data[i] = sensor_in->data[i] * hf;
+      ImageNoiseConfig sensor = c.noise;
+      sensor.iso = sensor.base_iso * g;
+      ApplyImageNoise(exposed_, sensor, noise_key, &dn_, pool_.get(), t, pattern_key);
+      const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
+      for (float& v : dn_.data) v *= inv_max;
+      film_.Develop(dn_, -std::log2(1.2 * white), pool_.get(), &out->rgb, wb_gains);
+    } else if (c.noise.enabled) {
       const float h = static_cast<float>(ExposureFromEv100(ev));
-      if (exposed_.width != W || exposed_.height != H || exposed_.channels != 3)
-        exposed_ = ImageF(W, H, 3);
-      for (size_t i = 0; i < radiance.data.size(); ++i) exposed_.data[i] = radiance.data[i] * h;
-      ApplyImageNoise(exposed_, c.noise, HashKeys(settings_.seed, camera_index_, frame_index, 1),
-                      &dn_, pool_.get());
+      for (size_t i = 0; i < sensor_in->data.size(); ++i) exposed_.data[i] = sensor_in->data[i] * h;
+      ApplyImageNoise(exposed_, c.noise, noise_key, &dn_, pool_.get(), T, pattern_key);
       const float inv_max = static_cast<float>(1.0 / (std::ldexp(1.0, c.noise.adc_bits) - 1.0));
       for (float& v : dn_.data) v *= inv_max;
       film_.Develop(dn_, -std::log2(1.2), pool_.get(), &out->rgb, wb_gains);  // exposure H = 1
     } else if (developed && ev == out->truth.ev100 && wb_gains == wb_before) {
       out->rgb = out->truth.rgb;  // the renderer developed this very radiance at this EV and gains
     } else {
-      film_.Develop(radiance, ev, pool_.get(), &out->rgb, wb_gains);
+      film_.Develop(*sensor_in, ev, pool_.get(), &out->rgb, wb_gains);
     }
     if (c.lens_droplets) {
       // drops land only while the camera is under open sky in the rain (the shelter map of
@@ -299,7 +499,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
         m.X_WO_end = X_WO_end;
         m.end_sec = span;
         m.time_sec = (truth_k + 0.5) * T / n;
-        m.line_time_sec = c.rolling_shutter_line_time_sec;
+        m.line_time_sec = row_time;
       }
       transmittance =
           DepthTransmittance(out->truth.depth_m, Camera(X_WO_start, spec_.intrinsics, m), *effects,

@@ -16,11 +16,21 @@
 // particle streaks (rain, snow, sparks) are drawn by the renderer over the exposure of each
 // sub-frame from the effects given to Capture (those of the capture instant).
 //
+// optics (OpticsConfig): the averaged radiance is vignetted (cos^n of each pixel's field
+// angle), its red and blue images magnified against green (lateral chromatic aberration) and
+// blurred by a Gaussian PSF, in that order, before anything is metered or exposed.
+//
 // exposure: the renderer's auto or manual EV100 (render/film.h) of the averaged radiance is the
 // target; with auto_exposure_time_constant_sec = tau > 0 the EV used adapts as
 // EV_k = EV_target + (EV_{k-1} - EV_target) exp(-(t_k - t_{k-1}) / tau) (state per camera; the
 // first frame uses its target). the exposed values x = radiance * H(EV) go through the sensor
 // model (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB.
+// with auto_exposure enabled (a camera profile, sensors/camera_profile.h) the target is met by
+// a shutter time and an analog gain within the camera's limits (AutoExposureConfig), metered
+// on the previous frame: the sub-frames span that shutter time (frame 0: exposure_time_sec,
+// then metered on itself), the gain raises the ISO of the sensor model, and the raw values
+// (DN / full scale) are developed with raw full scale at the filmic curve's white
+// (kFilmicWhite), the highlight roll-off.
 
 #include <cstdint>
 #include <memory>
@@ -46,7 +56,10 @@ struct CameraImages {
   ImageU8 rgb;          ///< (H x W x 3) uint8 sRGB after exposure, noise, droplets and JPEG
   ImageF depth_m;       ///< (H x W x 1) z-depth in m after depth noise (= truth.depth_m without)
   double ev100 = 0;     ///< exposure value used
-  double time_sec = 0;  ///< capture time t0 (exposure starts)
+  /// with auto_exposure: the shutter time (s) and analog gain (>= 1) of this frame; else
+  /// exposure_time_sec and 1.
+  double exposure_time_sec = 0, analog_gain = 1;
+  double time_sec = 0;               ///< capture time t0 (exposure starts)
   double mid_exposure_time_sec = 0;  ///< time of the ground-truth images, t0 + s_{n/2}
   Pose X_WO = Pose::Identity();      ///< optical frame at mid_exposure_time_sec (row 0)
   /// the renderer's stop request ended a render of this frame (RenderedFrame::stopped): the
@@ -58,8 +71,17 @@ struct CameraImages {
 /// @throws ConfigError with key `key_prefix`.<field> naming the bad value and the valid range.
 void ValidateCameraSensorOrThrow(const CameraSensorConfig& c, const std::string& key_prefix);
 
-/// the span D = T + (H - 1) l of a frame: the end snapshot must be at least this late.
+/// the span D = T + (H - 1) l of a frame: the end snapshot must be at least this late (T the
+/// longest shutter time the camera may use, l = RowTimeSec).
 double FrameSpanSec(const CameraSensorConfig& c, int height);
+
+/// the rolling shutter's time between rows, s: rolling_shutter_line_time_sec, or when it is 0
+/// the readout time / height.
+double RowTimeSec(const CameraSensorConfig& c, int height);
+
+/// the exposed value at which the filmic tone curve (render/film_math.h AcesFilmic) reaches
+/// display white: with auto_exposure the raw full scale is developed at this value.
+double FilmicWhite();
 
 /// stateful image formation of one camera (auto-exposure state). not thread-safe.
 class CameraImager {
@@ -120,6 +142,9 @@ class CameraImager {
   std::unique_ptr<ShelterMap> shelter_;
   std::optional<double> last_wet_time_;
   std::optional<double> last_ev_, last_time_;
+  // auto_exposure: the shutter time and gain metered on the last frame, for the next one
+  std::optional<double> ae_time_, ae_gain_;
+  ImageF optic_, optic_tmp_;          // the radiance after the optics
   std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;
   double renderer_sec_ = 0;

@@ -58,6 +58,15 @@ void ValidateImageNoiseOrThrow(const ImageNoiseConfig& c, const std::string& key
   if (!(c.read_noise_e >= 0) || !std::isfinite(c.read_noise_e))
     throw ConfigError("", 0, key_prefix + ".read_noise_e",
                       "got " + std::to_string(c.read_noise_e) + "; expected a finite number >= 0");
+  auto at_least_zero = [&](double v, const char* name, double hi) {
+    if (!(v >= 0 && v <= hi))
+      throw ConfigError(
+          "", 0, key_prefix + "." + name,
+          "got " + std::to_string(v) + "; expected a number in [0, " + std::to_string(hi) + "]");
+  };
+  at_least_zero(c.dark_current_e_per_s, "dark_current_e_per_s", 1e9);
+  at_least_zero(c.dsnu_e, "dsnu_e", 1e6);
+  at_least_zero(c.prnu, "prnu", 0.5);
   if (c.adc_bits < 1 || c.adc_bits > 16)
     throw ConfigError("", 0, key_prefix + ".adc_bits",
                       "got " + std::to_string(c.adc_bits) + "; expected an integer in [1, 16]");
@@ -68,7 +77,7 @@ double GainDnPerElectron(const ImageNoiseConfig& c) {
 }
 
 void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t key, ImageF* dn,
-                     ThreadPool* pool) {
+                     ThreadPool* pool, double exposure_time_sec, uint64_t fixed_pattern_key) {
   if (dn->width != exposed.width || dn->height != exposed.height ||
       dn->channels != exposed.channels)
     *dn = ImageF(exposed.width, exposed.height, exposed.channels);
@@ -76,14 +85,22 @@ void ApplyImageNoise(const ImageF& exposed, const ImageNoiseConfig& c, uint64_t 
   const double max_dn = std::ldexp(1.0, c.adc_bits) - 1.0;
   const double e_per_x = c.full_well_e * c.base_iso / c.iso;
   const size_t row = static_cast<size_t>(exposed.width) * exposed.channels;
+  const double dark_e = c.dark_current_e_per_s * std::max(0.0, exposure_time_sec);
+  const bool fixed_pattern = c.dsnu_e > 0 || c.prnu > 0;
   auto do_row = [&](int64_t v) {
     for (size_t i = v * row; i < (v + 1) * row; ++i) {
       const double x = std::max(0.0f, exposed.data[i]);
       double e = std::isfinite(x) ? x * e_per_x : c.full_well_e;
       if (c.enabled) {
+        double offset = 0;
+        if (fixed_pattern) {
+          Rng fp(HashKeys(fixed_pattern_key, static_cast<uint64_t>(i)));
+          e *= std::max(0.0, 1.0 + c.prnu * SampleStandardNormal(&fp));
+          offset = c.dsnu_e * SampleStandardNormal(&fp);
+        }
         Rng rng(HashKeys(key, static_cast<uint64_t>(i)));
-        e = static_cast<double>(SamplePoisson(std::min(e, 4.0 * c.full_well_e), &rng));
-        e += c.read_noise_e * SampleStandardNormal(&rng);
+        e = static_cast<double>(SamplePoisson(std::min(e + dark_e, 4.0 * c.full_well_e), &rng));
+        e += offset + c.read_noise_e * SampleStandardNormal(&rng);
       }
       e = std::clamp(e, 0.0, c.full_well_e);
       dn->data[i] = static_cast<float>(std::min(max_dn, std::round(e * gain)));

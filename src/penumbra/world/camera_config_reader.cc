@@ -8,6 +8,7 @@
 #include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
 #include "penumbra/scene/scene_limits.h"
+#include "penumbra/sensors/camera_profile.h"
 
 namespace penumbra {
 namespace {
@@ -61,12 +62,15 @@ CameraIntrinsics IntrinsicsOf(const CameraConfig& c) {
 }  // namespace
 
 const std::vector<std::string_view>& CameraSensorKeys() {
-  static const std::vector<std::string_view> keys = {"distortion",
+  static const std::vector<std::string_view> keys = {"profile",
+                                                     "distortion",
                                                      "exposure_time_sec",
                                                      "motion_blur_samples",
                                                      "rolling_shutter_line_time_sec",
                                                      "auto_exposure_time_constant_sec",
                                                      "noise",
+                                                     "optics",
+                                                     "auto_exposure",
                                                      "jpeg_quality",
                                                      "lens_droplets",
                                                      "white_balance",
@@ -75,8 +79,19 @@ const std::vector<std::string_view>& CameraSensorKeys() {
   return keys;
 }
 
+CameraProfile ReadCameraProfile(const ParamReader& r, const std::string& who) {
+  const std::string name = r.String();
+  const std::optional<CameraProfile> p = FindCameraProfile(name);
+  if (!p)
+    r.Fail(who + "unknown camera profile '" + name + "'; expected one of: " + CameraProfileNames());
+  return *p;
+}
+
 void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
   CameraSensorConfig& s = c->sensor;
+  // the profile first: the keys below override its values
+  if (const auto found = r.Find("profile"))
+    s = CameraProfileConfig(ReadCameraProfile(*found, Who(*c)));
   if (r.Has("distortion")) {
     const ParamReader d = r.Child("distortion");
     d.ExpectMap({"k1", "k2", "p1", "p2", "k3"});
@@ -103,15 +118,18 @@ void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
     s.exposure_time_sec = Within(r.Child("exposure_time_sec"), *c, 0, 60, false, "seconds");
   if (r.Has("motion_blur_samples"))
     s.motion_blur_samples = IntIn(r.Child("motion_blur_samples"), *c, 1, 64);
-  if (r.Has("rolling_shutter_line_time_sec"))
+  if (r.Has("rolling_shutter_line_time_sec")) {
     s.rolling_shutter_line_time_sec =
         Within(r.Child("rolling_shutter_line_time_sec"), *c, 0, 0.01, false, "seconds per row");
+    s.rolling_shutter_readout_sec = 0;  // the explicit line time replaces the profile's readout
+  }
   if (r.Has("auto_exposure_time_constant_sec"))
     s.auto_exposure_time_constant_sec =
         Within(r.Child("auto_exposure_time_constant_sec"), *c, 0, 3600, false, "seconds");
   if (r.Has("noise")) {
     const ParamReader n = r.Child("noise");
-    n.ExpectMap({"enabled", "full_well_e", "read_noise_e", "iso", "base_iso", "adc_bits"});
+    n.ExpectMap({"enabled", "full_well_e", "read_noise_e", "iso", "base_iso", "adc_bits",
+                 "dark_current_e_per_s", "dsnu_e", "prnu"});
     s.noise.enabled = n.Has("enabled") ? n.Child("enabled").Bool() : true;
     if (n.Has("full_well_e"))
       s.noise.full_well_e = Within(n.Child("full_well_e"), *c, 1, 1e9, false, "electrons");
@@ -121,6 +139,46 @@ void ReadCameraSensorKeys(const ParamReader& r, CameraConfig* c) {
     if (const auto found = n.Find("base_iso"))
       s.noise.base_iso = Within(*found, *c, 0, 1e7, true, "ISO");
     if (const auto found = n.Find("adc_bits")) s.noise.adc_bits = IntIn(*found, *c, 1, 16);
+    if (const auto found = n.Find("dark_current_e_per_s"))
+      s.noise.dark_current_e_per_s = Within(*found, *c, 0, 1e9, false, "electrons per second");
+    if (const auto found = n.Find("dsnu_e"))
+      s.noise.dsnu_e = Within(*found, *c, 0, 1e6, false, "electrons");
+    if (const auto found = n.Find("prnu"))
+      s.noise.prnu = Within(*found, *c, 0, 0.5, false, "fraction of the signal");
+  }
+  if (r.Has("optics")) {
+    const ParamReader o = r.Child("optics");
+    o.ExpectMap({"vignetting_exponent", "psf_sigma_px", "lateral_ca_px", "reference_width"});
+    if (const auto found = o.Find("vignetting_exponent"))
+      s.optics.vignetting_exponent = Within(*found, *c, 0, 8, false, "cos^n exponent");
+    if (const auto found = o.Find("psf_sigma_px"))
+      s.optics.psf_sigma_px = Within(*found, *c, 0, 20, false, "px");
+    if (const auto found = o.Find("lateral_ca_px"))
+      s.optics.lateral_ca_px = Within(*found, *c, 0, 20, false, "px");
+    if (const auto found = o.Find("reference_width"))
+      s.optics.reference_width = IntIn(*found, *c, 0, 100000);
+  }
+  if (r.Has("auto_exposure")) {
+    const ParamReader a = r.Child("auto_exposure");
+    a.ExpectMap({"enabled", "f_number", "min_exposure_time_sec", "max_exposure_time_sec",
+                 "max_gain", "saturated_fraction", "max_highlight_reduction_ev",
+                 "motion_blur_step_sec"});
+    AutoExposureConfig& ae = s.auto_exposure;
+    ae.enabled = a.Has("enabled") ? a.Child("enabled").Bool() : true;
+    if (const auto found = a.Find("f_number")) ae.f_number = Within(*found, *c, 0, 1000, true, "");
+    if (const auto found = a.Find("min_exposure_time_sec"))
+      ae.min_exposure_time_sec = Within(*found, *c, 0, 60, true, "seconds");
+    if (const auto found = a.Find("max_exposure_time_sec"))
+      ae.max_exposure_time_sec = Within(*found, *c, 0, 60, true, "seconds");
+    if (ae.max_exposure_time_sec < ae.min_exposure_time_sec)
+      a.Fail(Who(*c) + "expected max_exposure_time_sec >= min_exposure_time_sec");
+    if (const auto found = a.Find("max_gain")) ae.max_gain = Within(*found, *c, 1, 1e6, false, "x");
+    if (const auto found = a.Find("saturated_fraction"))
+      ae.saturated_fraction = Within(*found, *c, 0, 1, false, "fraction of the pixels");
+    if (const auto found = a.Find("max_highlight_reduction_ev"))
+      ae.max_highlight_reduction_ev = Within(*found, *c, 0, 10, false, "EV");
+    if (const auto found = a.Find("motion_blur_step_sec"))
+      ae.motion_blur_step_sec = Within(*found, *c, 0, 60, false, "seconds");
   }
   if (const auto found = r.Find("jpeg_quality")) s.jpeg_quality = IntIn(*found, *c, 0, 100);
   if (r.Has("lens_droplets")) {

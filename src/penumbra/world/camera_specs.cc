@@ -3,6 +3,7 @@
 #include "penumbra/core/error.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/render/camera_distortion.h"
+#include "penumbra/sensors/camera_profile.h"
 
 namespace penumbra {
 
@@ -42,7 +43,9 @@ std::vector<CameraSensorConfig> SensorConfigsFor(const SceneDescription& scene,
                                                  const WorldConfig& world) {
   std::vector<CameraSensorConfig> out;
   for (const CameraSpec& spec : scene.cameras) {
-    CameraSensorConfig cfg;
+    // an MJCF camera without an override: the mjcf_cameras profile
+    CameraSensorConfig cfg = spec.mjcf_camera >= 0 ? CameraProfileConfig(world.mjcf_cameras.profile)
+                                                   : CameraSensorConfig();
     cfg.exposure_time_sec = spec.exposure_time_sec;
     for (const CameraConfig& c : world.mjcf_cameras.overrides) {
       if (spec.mjcf_camera >= 0 && spec.name == c.name) cfg = c.sensor;

@@ -14,6 +14,7 @@
 #include "penumbra/core/output_path_policy.h"
 #include "penumbra/core/text_match.h"
 #include "penumbra/scene/scene_limits.h"
+#include "penumbra/sensors/camera_profile.h"
 #include "penumbra/world/adversity_preset.h"
 #include "penumbra/world/agents_reader.h"
 #include "penumbra/world/camera_config_reader.h"
@@ -408,8 +409,9 @@ class WorldParser {
   }
 
   static void ReadMjcfCameras(const ParamReader& r, MjcfCameraDefaults* m) {
-    r.ExpectMap({"enabled", "width", "height", "rate_hz", "outputs", "overrides"});
+    r.ExpectMap({"enabled", "width", "height", "rate_hz", "outputs", "profile", "overrides"});
     if (const auto found = r.Find("enabled")) m->enabled = found->Bool();
+    if (const auto found = r.Find("profile")) m->profile = ReadCameraProfile(*found, "");
     if (const auto found = r.Find("width")) m->width = found->Int();
     if (const auto found = r.Find("height")) m->height = found->Int();
     if (const auto found = r.Find("rate_hz")) m->rate_hz = found->Double();
@@ -432,6 +434,7 @@ class WorldParser {
       c.height = m->height;
       c.rate_hz = m->rate_hz;
       c.outputs = m->outputs;
+      c.sensor = CameraProfileConfig(m->profile);
       ReadCameraOptics(o, &c);
       ReadCameraSensorKeys(o, &c);
       m->overrides.push_back(c);

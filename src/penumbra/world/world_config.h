@@ -48,7 +48,7 @@ struct ModelConfig {
   std::string
       file;  ///< absolute path after loading (relative paths resolve against the world file)
   PoseConfig pose;
-  bool is_robot = false;  ///< listed under `robots:` (may carry a controller)
+  bool is_robot = false;          ///< listed under `robots:` (may carry a controller)
   ControllerConfig controller;    ///< control/controller_config.h; type "" = none
   std::vector<SiteConfig> sites;  ///< `sites:` added to the model when composing
   /// `initial_keyframe:` a <key> of the model (its local name) the run starts from ("" =
@@ -147,6 +147,8 @@ struct MjcfCameraDefaults {
   int width = 640, height = 480;
   double rate_hz = 10;
   CameraOutputs outputs;
+  /// `mjcf_cameras.profile`: the camera profile of every MJCF camera (overrides start from it).
+  CameraProfile profile = CameraProfile::kIdeal;
   /// `mjcf_cameras.overrides`: per MJCF camera (prefixed name) width/height/fovy/
   /// intrinsics/rate/outputs; entries have is_mjcf_override = true.
   std::vector<CameraConfig> overrides;
