@@ -68,7 +68,8 @@ DepthNoiseModel DepthNoisePreset(const DepthNoiseConfig& config, const std::stri
     m.window_px = 9;
     m.passive_texture = false;
     m.invalid_band = false;
-    m.ambient_fraction = 0.05;
+    m.ambient_fraction = 0.04;
+    m.projector_luminance_1m = 80;
   } else if (config.preset == "kinect_v2") {
     m.kind = DepthNoiseModel::Kind::kTimeOfFlight;
     m.axial = DepthNoiseModel::Axial::kKinectV2;

@@ -61,27 +61,32 @@
 //
 // presets (DepthNoisePreset):
 //   realsense_d435  active stereo, baseline 50 mm (datasheet), subpixel 0.08 (Tuning white
-//                   paper), range 0.2-10 m; projector: ~5000 dots, 360 mW average optical
-//                   power over 86 x 57 deg (Intel, "Projectors for D400 Series Depth Cameras",
-//                   Grunnet-Jepsen et al., rev. 1.0; D435 datasheet): dot_fill 0.1 (each dot
-//                   ~3 x 3 px at 848 x 480) and projector_luminance_1m = 150 cd/m^2 (the dots'
-//                   irradiance at 1 m, ~2.4 W/m^2, expressed as the luminance of a white wall
-//                   under equal visible light; our estimate: the D435 imagers have no IR-cut
-//                   filter and see visible and near-infrared light alike, ambient_fraction 1).
-//                   matcher: window 7 px, target_electrons 2000, read noise 5 e-,
-//                   min_snr 1, snr_jitter 0.35, backscatter 0.5, min_frame_signal 0.05 (our
-//                   choices). validated (tests/sensors/depth_noise_test.cc) against the
-//                   datasheet's active-stereo depth quality (textureless white wall, 80 % ROI,
-//                   office light: fill rate >= 99 %, RMS error <= 2 % at 2 m), its "ideal range
-//                   0.3-3 m", and the Projectors paper (passive texture works outdoors, sunlight
-//                   washes the projector out of a textureless wall).
+//                   paper), range 0.2-10 m; projector: ~5000 dots over 86 x 57 deg (Intel,
+//                   "Projectors for D400 Series Depth Cameras", Grunnet-Jepsen et al., rev.
+//                   1.0), 360 mW average and 4.25 W peak optical power, pulsed with the
+//                   exposure (D435 module manual): dot_fill 0.1 (each dot ~3 x 3 px at
+//                   848 x 480) and projector_luminance_1m = 1800 cd/m^2: 4.25 W over 1.33 sr
+//                   is 3.2 W/m^2 at 1 m, 32 W/m^2 inside the dots, ~19 W/m^2 after silicon's
+//                   lower quantum efficiency at 850 nm (0.6 of visible), the irradiance of
+//                   ~5800 lux of white light, whose luminance on a white wall is 1800 cd/m^2
+//                   (our estimate; the D435 imagers have no IR-cut filter and see visible and
+//                   near-infrared light alike: ambient_fraction 1). matcher: window 7 px,
+//                   target_electrons 2000, read noise 5 e-, min_snr 1, snr_jitter 0.35,
+//                   backscatter 0.5, min_frame_signal 0.05 (our choices). validated
+//                   (tests/sensors/depth_noise_test.cc) against the datasheet's active-stereo
+//                   depth quality (textureless white wall, 80 % ROI: fill rate >= 99 %, RMS
+//                   error <= 2 % at 2 m), the Tuning paper's RMS error, and the Projectors
+//                   paper (passive texture works outdoors, sunlight washes the projector out of
+//                   a textureless wall).
 //   kinect_v1       structured light; Nguyen, Izadi, Lovell, "Modeling Kinect sensor noise for
 //                   improved 3D reconstruction and tracking", 3DIMPVT 2012, eqs. (1)-(3):
 //                   sigma_z = 0.0012 + 0.0019 (z - 0.4)^2 + 0.0001 / sqrt(z) theta^2 / (pi/2 -
 //                   theta)^2 m, sigma_L = 0.8 + 0.035 theta / (pi/2 - theta) px; range 0.5-4.0
-//                   m; projector-camera baseline 75 mm; 830 nm band-pass: ambient_fraction 0.05,
-//                   no passive texture, no invalid band (the projector's field covers the
-//                   camera's), window 9 px (our choices).
+//                   m; projector-camera baseline 75 mm; continuous 830 nm projector behind a
+//                   band-pass filter: projector_luminance_1m 80 cd/m^2 and ambient_fraction
+//                   0.04 (sunlight's share in a 20 nm band; our estimates), no passive
+//                   texture, no invalid band (the projector's field covers the camera's),
+//                   window 9 px (our choice).
 //   kinect_v2       time of flight; Fankhauser et al., "Kinect v2 for mobile robot navigation:
 //                   evaluation and modeling", ICAR 2015: sigma_z = 1.5 - 0.5 z + 0.3 z^2 +
 //                   0.1 z^1.5 theta^2 / (pi/2 - theta)^2 mm, lateral sigma_L = 1.6 px; range
@@ -124,19 +129,19 @@ struct DepthNoiseModel {
   double min_round_trip_transmittance = 0.05;  ///< below: no return in smoke / fog
 
   // correlation matchers (kActiveStereo, kStructuredLight)
-  int window_px = 7;                    ///< matching window side, px (odd)
-  double projector_luminance_1m = 150;  ///< dot irradiance on a white wall at 1 m, cd/m^2 equiv.
-  double dot_fill = 0.1;                ///< fraction of the image the dots cover
-  double ambient_fraction = 1.0;        ///< share of the scene luminance the imagers see
-  bool passive_texture = true;          ///< the scene's own texture helps the matcher
-  bool invalid_band = true;             ///< left band outside the second view (stereo)
-  double target_electrons = 2000;       ///< auto exposure's mean signal, e-
-  double read_noise_e = 5;              ///< imager read noise, e-
-  double min_frame_signal = 0.05;       ///< exposure limit: darker frames get no more gain
-  double min_snr = 1.0;                 ///< window SNR below this: no match
-  double snr_jitter = 0.35;             ///< log-normal spread of the window score
-  double backscatter = 0.5;             ///< veil per unit (1 - T^2), projector units
-  double default_ambient_cd_m2 = 30;    ///< scene luminance of a white surface w/o image
+  int window_px = 7;                     ///< matching window side, px (odd)
+  double projector_luminance_1m = 1800;  ///< dot irradiance on a white wall at 1 m, cd/m^2 equiv.
+  double dot_fill = 0.1;                 ///< fraction of the image the dots cover
+  double ambient_fraction = 1.0;         ///< share of the scene luminance the imagers see
+  bool passive_texture = true;           ///< the scene's own texture helps the matcher
+  bool invalid_band = true;              ///< left band outside the second view (stereo)
+  double target_electrons = 2000;        ///< auto exposure's mean signal, e-
+  double read_noise_e = 5;               ///< imager read noise, e-
+  double min_frame_signal = 0.05;        ///< exposure limit: darker frames get no more gain
+  double min_snr = 1.0;                  ///< window SNR below this: no match
+  double snr_jitter = 0.35;              ///< log-normal spread of the window score
+  double backscatter = 0.5;              ///< veil per unit (1 - T^2), projector units
+  double default_ambient_cd_m2 = 30;     ///< scene luminance of a white surface w/o image
 
   // time of flight (kTimeOfFlight)
   double tof_psf_sigma_px = 0.5;  ///< pixel footprint (Gaussian sigma), px
