@@ -3,6 +3,7 @@
 // tests run requests against (Session -> RunControl -> PhysicsSource -> SimLoop, as
 // `penumbra run --lockstep` without sinks).
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -19,8 +20,10 @@ namespace penumbra::testing {
 class LiveLoop {
  public:
   /// loads `world_file` (no renderer) and starts the loop paused; it ends at `end_time_sec` of
-  /// sim time or on `stop`.
-  LiveLoop(const std::string& world_file, double end_time_sec) {
+  /// sim time or on `stop`. `add_sinks` (optional) adds sinks to the loop before it starts;
+  /// they must outlive the LiveLoop.
+  LiveLoop(const std::string& world_file, double end_time_sec,
+           const std::function<void(Session&, SimLoop&)>& add_sinks = {}) {
     SessionOptions so;
     so.build_renderer = false;
     session_ = std::make_unique<Session>(LoadWorldFile(world_file), so);
@@ -38,6 +41,7 @@ class LiveLoop {
     lo.stop_request = control_->stop_flag();
     loop_ = std::make_unique<SimLoop>(source_.get(), lo);
     loop_->AddSink(control_.get());
+    if (add_sinks) add_sinks(*session_, *loop_);
     loop_->Start();
   }
   ~LiveLoop() {

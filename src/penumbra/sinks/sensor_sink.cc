@@ -15,6 +15,7 @@
 #include "penumbra/output/sensor_writers.h"
 #include "penumbra/pipeline/sink_worker.h"
 #include "penumbra/render/backends/renderer_factory.h"
+#include "penumbra/scene/sim_time.h"
 #include "penumbra/sensors/imu_model.h"
 #include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sensors/mujoco_sensors.h"
@@ -134,6 +135,7 @@ struct SensorSink::Impl {
     LidarScanWriter out;
     bool pending = false;
     SensorFiring start_firing;
+    int64_t start_noise_index = 0;  // the scan's index within its episode (noise key)
     std::shared_ptr<const WorldSnapshot> start;
     std::shared_ptr<const EffectsFrame> start_effects;  // seen at the scan's start
     int64_t written = 0;
@@ -141,6 +143,11 @@ struct SensorSink::Impl {
   struct Imu {
     const SensorConfig* cfg = nullptr;
     std::unique_ptr<ImuNoiseModel> noise;
+    ImuNoiseConfig noise_config;
+    double period_sec = 0;
+    uint64_t stream = 0;
+    int episode = 0;     // the episode `noise` belongs to
+    int64_t next_k = 0;  // the next sample index within it (from episode 1 on)
     SensorDescription accel, gyro;
     Mount mount;
     ImuCsvWriter out;
@@ -168,13 +175,22 @@ struct SensorSink::Impl {
   struct Entry {
     SensorKind kind = SensorKind::kLidar;
     int index = 0;
+    double rate_hz = 0, latency_sec = 0;  // as given to the schedule
+    int64_t next_output = 0;              // the output index of its next sample
+    int64_t base = 0;  // output index = base + index within the episode; -1 = not set yet
   };
 
   std::vector<SensorConfig> configs;
   const SceneDescription* scene = nullptr;
   SensorEffectsAt effects_at;
+  // the schedule of the current episode, on its clock (steps since the episode start)
   std::optional<SensorSchedule> schedule;
   std::vector<Entry> entries;
+  const Simulation* sim = nullptr;
+  double timestep_sec = 0;
+  // the episode (Simulation::controller_episode_start: the last `reset`), counted from 0
+  int episode = 0;
+  int64_t episode_start = 0;
   std::vector<Lidar> lidars;
   std::vector<Imu> imus;
   std::vector<Mujoco> mujocos;
@@ -184,7 +200,8 @@ struct SensorSink::Impl {
   SensorOutputCallback on_output;
   SensorSampleCallback on_sample;
   // loop thread
-  std::vector<SensorFiring> due;
+  std::vector<SensorFiring> due;   // output indices and sim times
+  std::vector<int64_t> due_noise;  // per entry of `due`: its index within the episode
   int64_t due_step = -1;
   double effects_sec = 0;
   // sink thread
@@ -200,8 +217,22 @@ struct SensorSink::Impl {
   // the sensors `due` read `snap`; on the sink thread, in step order. `scan_effects`: per
   // entry of `due`, the effects a LiDAR starting a scan sees (null otherwise).
   void Process(const std::shared_ptr<const WorldSnapshot>& snap,
-               const std::vector<SensorFiring>& due,
+               const std::vector<SensorFiring>& due, const std::vector<int64_t>& due_noise,
+               int due_episode,
                const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects);
+
+  // a new episode starts at step `start` and the loop is at `step`: every schedule restarts
+  // on the episode's clock (the samples due before `step` pass), output indices go on
+  void StartEpisode(int64_t start, int64_t step) {
+    ++episode;
+    episode_start = start;
+    schedule.emplace(timestep_sec);
+    for (size_t i = 0; i < entries.size(); ++i) {
+      schedule->Add(configs[i].name, entries[i].rate_hz, entries[i].latency_sec);
+      entries[i].base = -1;
+    }
+    schedule->StartAt(step - start);
+  }
 
   void TraceScan(Lidar& l, const WorldSnapshot& end) {
     const auto t0 = Clock::now();
@@ -215,7 +246,7 @@ struct SensorSink::Impl {
     };
     auto scan_ptr = std::make_shared<LidarScan>();
     LidarScan& scan = *scan_ptr;
-    l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_firing.index, &scan);
+    l.scanner->Scan(*ray_scene, l.start_effects.get(), pose, l.start_noise_index, &scan);
     std::string pcd = l.out.Write(l.start_firing, scan);
     if (on_output) on_output(l.cfg->name, "points.pcd", start.step, start.time_sec, std::move(pcd));
     if (on_sample) {
@@ -238,6 +269,8 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
   s.configs = world.sensors;
   s.scene = &scene;
   s.effects_at = std::move(effects_at);
+  s.sim = &sim;
+  s.timestep_sec = sim.timestep();
   const ModelInfo& info = sim.model_info();
   s.body_names = info.body_names;
   const fs::path out(out_dir);
@@ -301,6 +334,9 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
       m.gyro = sim.sensor_info()[ig];
       const ImuNoiseConfig nc = p->MakeNoise();
       m.noise = std::make_unique<ImuNoiseModel>(nc, 1.0 / rate, stream);
+      m.noise_config = nc;
+      m.period_sec = 1.0 / rate;
+      m.stream = stream;
       m.mount = ResolveMount(c, info);
       m.out = ImuCsvWriter(out, c.name);
       m.truth_out = ImuTruthCsvWriter(out, c.name);
@@ -352,6 +388,8 @@ SensorSink::SensorSink(const WorldConfig& world, const Simulation& sim,
     } catch (const Error& e) {
       throw SensorError(c, "rate_hz", e.what());
     }
+    s.entries.back().rate_hz = rate;
+    s.entries.back().latency_sec = c.latency_sec;
   }
   if (!s.lidars.empty()) s.ray_scene = MakeRayQuery(scene, world.render.backend);
   WriteFileAtomic(out / "rig.json", rig.dump(2) + "\n");
@@ -379,7 +417,23 @@ void SensorSink::OnStart(const LoopStart& start) {
 SnapshotContent SensorSink::Wants(int64_t step, double) {
   Impl& s = *impl_;
   s.due.clear();
-  s.schedule->Due(step, &s.due);
+  s.due_noise.clear();
+  const int64_t start = s.sim->controller_episode_start();
+  if (start != s.episode_start) s.StartEpisode(start, step);
+  s.schedule->Due(step - s.episode_start, &s.due);
+  for (SensorFiring& f : s.due) {
+    Impl::Entry& e = s.entries[f.sensor];
+    s.due_noise.push_back(f.index);
+    if (s.episode > 0) {
+      // sample k of the episode: noise keyed by k, the output index and times of the run
+      if (e.base < 0) e.base = e.next_output - f.index;
+      f.index += e.base;
+      f.nominal_time_sec += SimTimeOfStep(s.episode_start, s.timestep_sec);
+      f.capture_time_sec = SimTimeOfStep(step, s.timestep_sec);
+      f.delivery_time_sec = f.capture_time_sec + e.latency_sec;
+    }
+    e.next_output = f.index + 1;
+  }
   s.due_step = s.due.empty() ? -1 : step;
   return s.due.empty() ? SnapshotContent::kNone : SnapshotContent::kFull;
 }
@@ -400,13 +454,15 @@ void SensorSink::OnSnapshot(const std::shared_ptr<const WorldSnapshot>& snapshot
     }
     s.effects_sec += std::chrono::duration<double>(Clock::now() - t0).count();
   }
-  s.worker.Post([&s, snapshot, due = s.due, scan_effects = std::move(scan_effects)] {
-    s.Process(snapshot, due, scan_effects);
+  s.worker.Post([&s, snapshot, due = s.due, due_noise = s.due_noise, episode = s.episode,
+                 scan_effects = std::move(scan_effects)] {
+    s.Process(snapshot, due, due_noise, episode, scan_effects);
   });
 }
 
 void SensorSink::Impl::Process(
     const std::shared_ptr<const WorldSnapshot>& snap_ptr, const std::vector<SensorFiring>& due,
+    const std::vector<int64_t>& due_noise, int due_episode,
     const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
   Impl& s = *this;
   const WorldSnapshot& snap = *snap_ptr;
@@ -419,12 +475,24 @@ void SensorSink::Impl::Process(
       if (l.pending) s.TraceScan(l, snap);
       l.pending = true;
       l.start_firing = f;
+      l.start_noise_index = due_noise[i];
       l.start = snap_ptr;
       l.start_effects = scan_effects[i];
       continue;
     }
     if (e.kind == SensorKind::kImu) {
       Impl::Imu& m = s.imus[e.index];
+      const int64_t k = due_noise[i];
+      if (m.episode != due_episode) {
+        // a new episode: the bias from the start of the stream, as in the first episode
+        m.noise = std::make_unique<ImuNoiseModel>(m.noise_config, m.period_sec, m.stream);
+        m.episode = due_episode;
+        m.next_k = 0;
+      }
+      // the samples of the episode that passed before its first step still move the bias
+      if (m.episode > 0)
+        for (; m.next_k < k; ++m.next_k) m.noise->Apply(m.next_k, ImuSample{});
+      m.next_k = k + 1;
       const auto a = MujocoSensorValues(snap, m.accel);
       const auto w = MujocoSensorValues(snap, m.gyro);
       ImuSample truth;
@@ -441,7 +509,7 @@ void SensorSink::Impl::Process(
       state.v_WS = V.tail<3>() + V.head<3>().cross(p_BS_W);
       state.gyro_bias = m.noise->gyro_bias();
       state.accel_bias = m.noise->accel_bias();
-      const ImuSample measured = m.noise->Apply(f.index, truth);
+      const ImuSample measured = m.noise->Apply(k, truth);
       std::string row = m.out.Write(f, measured);
       m.truth_out.Write(f, state);
       if (s.on_sample) {
@@ -459,7 +527,7 @@ void SensorSink::Impl::Process(
       Impl::Mujoco& m = s.mujocos[e.index];
       m.values.clear();
       m.set->Read(snap, &m.values);
-      Rng rng(HashKeys(m.stream, static_cast<uint64_t>(f.index)));
+      Rng rng(HashKeys(m.stream, static_cast<uint64_t>(due_noise[i])));
       if (m.stddev > 0)
         for (double& v : m.values) v += m.stddev * StandardNormal(&rng);
       std::string row = m.out.Write(f, m.values);

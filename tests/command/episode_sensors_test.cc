@@ -1,0 +1,164 @@
+// `reset` restarts the sensors with the episode: their schedules on the episode's clock and
+// their noise streams keyed by the sample index within the episode (the IMU's bias from the
+// start of its stream), so the same actions after a reset give the first episode's IMU and
+// MuJoCo sensor samples bit for bit, while the written sample indices go on increasing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "command/live_loop.h"
+#include "common/temp_dir.h"
+#include "penumbra/sinks/sensor_sink.h"
+
+namespace penumbra {
+namespace episode_sensors_test {
+namespace {
+
+using json = nlohmann::json;
+using penumbra::testing::LiveLoop;
+
+json CallOk(LiveLoop& live, const json& request) {
+  json r = live.Call(request);
+  EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
+  return r;
+}
+
+struct Case {
+  std::string name;
+  std::string file;   // bundled world, relative to worlds/
+  std::string robot;  // its robot's name
+};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+// the bundled world with model paths made absolute, plus a noisy IMU and noisy MuJoCo sensors
+std::string WorldWithSensors(const Case& c) {
+  std::ifstream in(std::string(PENUMBRA_SOURCE_DIR) + "/worlds/" + c.file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const std::string models = std::string(PENUMBRA_SOURCE_DIR) + "/worlds/models/";
+  for (const std::string key : {"file: models/", "model: models/"}) {
+    for (size_t at = text.find(key); at != std::string::npos; at = text.find(key, at + 1))
+      text.replace(at + key.size() - 7, 7, models);
+  }
+  return text +
+         "\nsensors:\n"
+         "  - {name: imu, type: imu, body: " +
+         c.robot +
+         "/trunk, preset: consumer_mems, rate_hz: 200}\n"
+         "  - {name: joints, type: mujoco, rate_hz: 100, noise: {stddev: 0.01}}\n";
+}
+
+// a sample as kept by the test: values as raw doubles
+struct Kept {
+  int64_t index = 0, step = 0;
+  std::vector<double> values;
+};
+
+// `steps` single steps with a twist at a third and two thirds
+void Episode(LiveLoop& live, int steps, int variant = 0) {
+  for (int k = 0; k < steps; ++k) {
+    if (k == steps / 3 || k == 2 * steps / 3) {
+      const double sign = (k == steps / 3 ? 1.0 : -1.0) * (variant == 0 ? 1.0 : -0.5);
+      CallOk(live, {{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
+    }
+    CallOk(live, {{"cmd", "step"}, {"n", 1}});
+  }
+}
+
+// the samples of `sensor` with steps in (start, start + steps] (from step 0 for the first
+// episode), keyed by the step within the episode
+std::map<int64_t, Kept> EpisodeSamples(const std::vector<std::pair<std::string, Kept>>& all,
+                                       const std::string& sensor, int64_t start, int steps) {
+  std::map<int64_t, Kept> out;
+  for (const auto& [name, k] : all)
+    if (name == sensor && k.step >= start && (start == 0 || k.step > start) &&
+        k.step <= start + steps)
+      out[k.step - start] = k;
+  return out;
+}
+
+class EpisodeSensorsTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(EpisodeSensorsTest, SameActionsAfterResetGiveTheFirstEpisodesSamplesBitForBit) {
+  const Case& c = GetParam();
+  penumbra::testing::TempDir dir;
+  const std::string world = dir.Write("world.yaml", WorldWithSensors(c));
+  std::mutex mu;
+  std::vector<std::pair<std::string, Kept>> samples;
+  std::unique_ptr<SensorSink> sensors;
+  const int steps = 120;
+  std::vector<int64_t> starts = {0};
+  {
+    LiveLoop live(world, 1000.0, [&](Session& session, SimLoop& loop) {
+      sensors = std::make_unique<SensorSink>(session.world(), session.sim(), session.scene(),
+                                             dir.path().string());
+      sensors->set_on_sample([&](const SensorSample& s) {
+        std::lock_guard<std::mutex> lock(mu);
+        samples.push_back({s.sensor, Kept{s.index, s.step, s.values}});
+      });
+      loop.AddSink(sensors.get());
+    });
+    Episode(live, steps);
+    for (int before : {37, 61}) {
+      Episode(live, before, 1);
+      const json r = CallOk(live, {{"cmd", "reset"}});
+      starts.push_back(r.at("step").get<int64_t>());
+      Episode(live, steps);
+    }
+    live.Stop();
+  }
+  for (const std::string sensor : {"imu", "joints"}) {
+    // written indices increase over the whole run, episodes and resets included
+    int64_t last = -1;
+    int n = 0;
+    for (const auto& [name, k] : samples) {
+      if (name != sensor) continue;
+      EXPECT_GT(k.index, last) << sensor << " at step " << k.step;
+      last = k.index;
+      ++n;
+    }
+    EXPECT_GT(n, 3 * steps / 5) << sensor;
+    const std::map<int64_t, Kept> first = EpisodeSamples(samples, sensor, 0, steps);
+    for (size_t e = 1; e < starts.size(); ++e) {
+      const std::map<int64_t, Kept> again = EpisodeSamples(samples, sensor, starts[e], steps);
+      // the step of the reset shows the state before it: an episode after a reset samples
+      // from its first step on
+      EXPECT_EQ(again.size() + 1, first.size()) << sensor << " episode " << e;
+      int compared = 0;
+      for (const auto& [j, k] : again) {
+        ASSERT_TRUE(first.count(j)) << sensor << ": episode " << e << " sampled at its step " << j
+                                    << ", the first episode did not";
+        const Kept& f = first.at(j);
+        ASSERT_EQ(k.values.size(), f.values.size());
+        EXPECT_EQ(std::memcmp(k.values.data(), f.values.data(), k.values.size() * sizeof(double)),
+                  0)
+            << sensor << ": episode " << e << " (reset at step " << starts[e]
+            << ") differs from the first at its step " << j;
+        ++compared;
+      }
+      EXPECT_GE(compared, steps / 6);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Controllers, EpisodeSensorsTest,
+                         ::testing::Values(Case{"trot_gait", "quadruped.yaml", "quadruped"},
+                                           Case{"policy", "quadruped_policy.yaml", "go1"}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return info.param.name;
+                         });
+
+}  // namespace
+}  // namespace episode_sensors_test
+}  // namespace penumbra
