@@ -158,7 +158,8 @@ class CameraImager {
 
 /// frames per second of CameraImager::Capture for a small scene (a box room, 320 x 240, realtime
 /// tier) with each noise option in turn: "none", "shot_read", "motion_blur_4", "rolling_shutter",
-/// "jpeg_q80", "lens_droplets", "depth_realsense_d435", "all". for `penumbra bench sensors`.
+/// "jpeg_q80", "lens_droplets", "depth_realsense_d435", "all", then each camera profile as
+/// "profile_<name>" (sensors/camera_profile.h). for `penumbra bench sensors`.
 /// returns (option name, frames per second) in that order; `frames` frames each.
 std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames = 20);
 

@@ -1,8 +1,10 @@
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
 #include "penumbra/render/backends/renderer_factory.h"
 #include "penumbra/sensors/camera_imager.h"
+#include "penumbra/sensors/camera_profile.h"
 
 namespace penumbra {
 
@@ -84,16 +86,22 @@ std::vector<std::pair<std::string, double>> CameraNoiseBench(int frames) {
   c.rolling_shutter_line_time_sec = 3e-5;
   c.jpeg_quality = 80;
   options.emplace_back("all", c);
+  // the named camera profiles (moving, so their shutter and readout act), then every option
+  for (CameraProfile p : {CameraProfile::kRealsenseD435Rgb, CameraProfile::kBlackflySImx250})
+    options.emplace_back("profile_" + std::string(CameraProfileName(p)), CameraProfileConfig(p));
 
   std::vector<std::pair<std::string, double>> out;
   for (auto& [name, cfg] : options) {
     CameraImager imager(spec, cfg, rs, 0, scene);
     const EffectsFrame* fx = name == "lens_droplets" || name == "all" ? wet.get() : nullptr;
-    const bool moving = cfg.motion_blur_samples > 1 || cfg.rolling_shutter_line_time_sec > 0;
+    const bool moving = cfg.motion_blur_samples > 1 || RowTimeSec(cfg, spec.intrinsics.height) > 0;
+    // the end snapshot no earlier than the frame's span (a profile's longest shutter + readout)
+    WorldSnapshot end = b;
+    end.time_sec = std::max(b.time_sec, FrameSpanSec(cfg, spec.intrinsics.height));
     CameraImages img;
     const auto t0 = std::chrono::steady_clock::now();
     for (int f = 0; f < frames; ++f)
-      imager.Capture(renderer.get(), a, fx, X0, moving ? &b : nullptr, X1, f, &img);
+      imager.Capture(renderer.get(), a, fx, X0, moving ? &end : nullptr, X1, f, &img);
     const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     out.emplace_back(name, frames / std::max(sec, 1e-9));
   }
