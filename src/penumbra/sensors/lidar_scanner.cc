@@ -17,6 +17,8 @@ constexpr double kScanPi = 3.14159265358979323846;
 constexpr double kBinDeg = 0.5;  // angular bins of beams for the particle lookup
 constexpr int kChunk = 256;
 constexpr int kSoftSamples = 48;
+// beams closer than 2.5 deg are neighbours for the edge test of the mixed returns
+const float kCosNeighbour = static_cast<float>(std::cos(2.5 * 3.14159265358979323846 / 180));
 constexpr double kSpeedOfLight = 299792458.0;
 // Hahner et al. 2021: beta = 0.046 / MOR, sigma_t = ln(20) / MOR
 const double kBetaPerSigma = 0.046 / std::log(20.0);
@@ -318,6 +320,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
   std::vector<Ray> fp_rays(static_cast<size_t>(kChunk) * K);
   std::vector<SurfaceHit> fp_hits(fp_rays.size());
   std::unique_ptr<bool[]> fp_did_hit(new bool[std::max<size_t>(1, fp_rays.size())]);
+  std::vector<int> fp_first(kChunk, -1);  // first footprint ray of each beam, -1 = none
   float last_time = -1;
   Pose X = Pose::Identity();
   for (int start = 0; start < n; start += kChunk) {
@@ -336,22 +339,48 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
     }
     scene.Intersect(std::span<const Ray>(rays.data(), m), std::span<SurfaceHit>(hits.data(), m),
                     std::span<bool>(did_hit, m));
+    int n_fp = 0;
     if (K > 0) {
+      // only beams that may straddle an edge trace their footprint: a neighbour (the next beam
+      // either way, and the neighbouring column of a spinning sensor, within 2.5 deg) hits and
+      // this one does
+      // not or the other way round, or its hit lies off this hit's tangent plane by more than
+      // 5 cm + 2 % of the range (a plane seen at any angle keeps its neighbours on it)
+      const int col = pat.spinning && pat.rings > 0 ? pat.rings : 0;
       for (int j = 0; j < m; ++j) {
+        bool edge = false;
+        for (const int nb : {j - 1, j + 1, j - col, j + col}) {
+          if (nb == j || nb < 0 || nb >= m) continue;
+          // a neighbour in the firing order that is not one in angle (a new column) is skipped
+          if (dir_S_[start + nb].dot(dir_S_[start + j]) < kCosNeighbour) continue;
+          if (did_hit[nb] != did_hit[j]) {
+            edge = true;
+            break;
+          }
+          if (!did_hit[j]) continue;
+          const double off = std::abs(hits[j].ng_W.dot(hits[nb].p_W - hits[j].p_W));
+          if (off > 0.05 + 0.02 * hits[j].t) {
+            edge = true;
+            break;
+          }
+        }
+        fp_first[j] = -1;
+        if (!edge) continue;
+        fp_first[j] = n_fp;
         const Eigen::Vector3f d = rays[j].d;
         const Eigen::Vector3f e1 = d.unitOrthogonal(), e2 = d.cross(e1);
         for (int k = 0; k < K; ++k) {
           const float phi = static_cast<float>(2 * kScanPi * (k + 0.5) / K);
-          Ray& r = fp_rays[static_cast<size_t>(j) * K + k];
+          Ray& r = fp_rays[n_fp++];
           r = rays[j];
           r.d = (d + static_cast<float>(ring) * (std::cos(phi) * e1 + std::sin(phi) * e2))
                     .normalized();
         }
       }
-      const size_t mk = static_cast<size_t>(m) * K;
-      scene.Intersect(std::span<const Ray>(fp_rays.data(), mk),
-                      std::span<SurfaceHit>(fp_hits.data(), mk),
-                      std::span<bool>(fp_did_hit.get(), mk));
+      if (n_fp > 0)
+        scene.Intersect(std::span<const Ray>(fp_rays.data(), n_fp),
+                        std::span<SurfaceHit>(fp_hits.data(), n_fp),
+                        std::span<bool>(fp_did_hit.get(), n_fp));
     }
     for (int j = 0; j < m; ++j) {
       const int i = start + j;
@@ -439,7 +468,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
       };
       double hard_p = 0, hard_r = 0;
       bool hard = false;
-      if (K == 0) {
+      if (K == 0 || fp_first[j] < 0) {
         if (did_hit[j]) {
           hard = true;
           hard_r = hits[j].t;
@@ -458,7 +487,7 @@ void LidarScanner::Scan(const RayQuery& scene, const EffectsFrame* effects,
           ps[ns++] = hard_power(hits[j], ray, true);
         }
         for (int k = 0; k < K; ++k) {
-          const size_t f = static_cast<size_t>(j) * K + k;
+          const size_t f = static_cast<size_t>(fp_first[j]) + k;
           if (!fp_did_hit[f]) continue;
           rs[ns] = fp_hits[f].t;
           ps[ns++] = hard_power(fp_hits[f], fp_rays[f], false);

@@ -37,15 +37,19 @@
 //    returns P_p = (rho_p / pi) min(1, (r_p / r_beam)^2) T^2 / R^2, r_beam = R tan(div / 2);
 //    rho_p = 0.02 for rain (Fresnel reflectance of water at normal incidence), the colour's
 //    luminance for snow and sparks.
-//  - mixed returns: a beam is traced along its axis and along footprint_rays more rays on a
-//    ring of 0.7 half-divergences (the rms radius of a uniform disc), each sampling the hard
-//    target with equal weight. returns whose ranges differ by less than the pulse length
-//    L = c tau_H / 2 arrive as one pulse: the strongest such group is the hard-target
-//    candidate, with the group's mean power over the footprint and its power-weighted mean
-//    range. on a depth edge closer than L to its background the point lands between the two
-//    surfaces (a mixed or "flying" point); farther apart the two are separate pulses and the
-//    stronger wins (single strongest return). on a continuous surface the range is the
-//    axis's to within the footprint's spread.
+//  - mixed returns: a beam near an edge is traced along its axis and along footprint_rays
+//    more rays on a ring of 0.7 half-divergences (the rms radius of a uniform disc), each
+//    sampling the hard target with equal weight. near an edge: a neighbouring beam (the next
+//    one either way, the neighbouring column of a spinning sensor, within 2.5 deg and a batch
+//    of 256 beams)
+//    hits where it misses or the other way round, or hits off its tangent plane by more than
+//    5 cm + 2 % of the range; other beams (continuous surfaces) trace their axis alone. returns
+//    whose ranges differ by less than the pulse length L = c tau_H / 2 arrive as one pulse: the
+//    strongest such group is the hard-target candidate, with the group's mean power over the
+//    footprint and its power-weighted mean range. on a depth edge closer than L to its background
+//    the point lands between the two surfaces (a mixed or "flying" point); farther apart the two
+//    are separate pulses and the stronger wins (single strongest return). on a continuous surface
+//    the range is the axis's to within the footprint's spread.
 //  - multipath is not modelled: with a narrow receiver field that sees only the laser spot,
 //    light that reaches the spot from a second diffuse surface scales with the spot's area
 //    over the squared distance (well below 1e-3 in a room corner), so Lambertian corners
