@@ -366,6 +366,22 @@ TEST(DepthNoiseTest, D435MatchesPublishedCharacterisation) {
   EXPECT_GT(FillRate(Apply(Frame(424, 240, f / 2, 3.0, 0.8, 0.0), m), 0.8, 30), 0.99);
 }
 
+// structured light (kinect_v1): its own pattern behind a band-pass filter; a textureless wall
+// fills in office light to its 4 m range, sunlight (in band) washes the pattern out and the
+// scene's own texture does not help (it fails outdoors); no left invalid band.
+TEST(DepthNoiseTest, KinectV1SeesItsPatternIndoorsNotInSunlight) {
+  const DepthNoiseModel m = Preset("kinect_v1");
+  EXPECT_EQ(m.InvalidBandPx(2.0, 300), 0.0);
+  for (const double z : {1.0, 2.0, 3.5}) {
+    const ImageF out = Apply(Frame(320, 240, 300, z, 0.8, kOfficeLux), m);
+    EXPECT_GE(FillRate(out, 1.0), 0.99) << z;
+  }
+  EXPECT_LT(FillRate(Apply(Frame(320, 240, 300, 1.5, 0.8, kSunlightLux), m), 0.8), 0.05);
+  Frame textured(320, 240, 300, 1.5, 0.8, kSunlightLux);
+  textured.Checker(0, 320, 0, 240, 6, kSunlightLux);
+  EXPECT_LT(FillRate(Apply(textured, m), 0.8), 0.05);
+}
+
 TEST(DepthNoiseTest, DarkAndSpecularSurfacesDropReturns) {
   // stereo: a dark patch and a mirror in a white textureless wall at 2 m in a bright room
   Frame fr(320, 240, 300, 2.0, 0.8, kBrightLux);

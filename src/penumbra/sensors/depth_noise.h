@@ -6,7 +6,8 @@
 // projector is the second "view"). depth exists only where a block matcher finds its match, and
 // that is decided per matching window, never per pixel, so holes are contiguous:
 //   1. geometry: z outside [min_range_m, max_range_m], incidence above max_incidence_deg,
-//      mirror-like surfaces (reflectance < 0) -> no return.
+//      mirror-like surfaces (reflectance < 0), round-trip transmittance T^2 below
+//      min_round_trip_transmittance -> no return.
 //   2. the left invalid band (stereo only): the left imager is the reference; a point at depth z
 //      seen at column u lands at u - d in the right imager, d = fx b / z (disparity). columns
 //      with u - d < 0 are outside the right imager: the band is fx b / z pixels wide (Intel
@@ -20,8 +21,8 @@
 //        S = rho cos(theta) T^2 / z^2  (projector dots: inverse-square, reflectance, incidence,
 //                                       round-trip transmittance T^2 through fog or smoke),
 //        A = L / projector_luminance_1m (ambient: the scene's luminance L in cd/m^2 from the
-//            rendered image, times ambient_fraction; sunlight makes A large and washes the
-//            dots out),
+//            rendered image, times ambient_fraction; without an image default_ambient_cd_m2
+//            rho T; sunlight makes A large and washes the dots out),
 //        V = backscatter (1 - T^2)      (projector light scattered back by the medium: a veil
 //                                       that adds shot noise and no texture).
 //      over the matching window (window_px square) the texture is the standard deviation
