@@ -56,6 +56,9 @@ struct SmallCameraWorld {
     c.width = 32;
     c.height = 24;
     c.rate_hz = 20;
+    // the ideal camera: one render per frame (a real profile's motion-blur sub-frames would
+    // multiply the renderer calls these tests count)
+    c.sensor = CameraSensorConfig();
     c.outputs = CameraOutputs{ImageKind::kRgb, ImageKind::kDepth, ImageKind::kSegmentation};
     c.outputs[ImageKind::kRange] = c.outputs[ImageKind::kNormals] = true;
     c.outputs[ImageKind::kInstanceSegmentation] = c.outputs[ImageKind::kSemanticSegmentation] =
