@@ -7,11 +7,11 @@
 
 #include "common/temp_dir.h"
 #include "penumbra/app/cli.h"
-#include "penumbra/run/runner.h"
 #include "penumbra/compose/scene_composer.h"
 #include "penumbra/core/error.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/physics/urdf_converter.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/session/floor_map.h"
 
 namespace penumbra {
@@ -47,8 +47,13 @@ TEST(AdversityPlan, NoneAddsNothingMinorAndMajorAddTheirParts) {
   EXPECT_EQ(Names(minor), (std::vector<std::string>{"adversity_fog", "adversity_smoke",
                                                     "adversity_rain", "adversity_dim"}));
   const Planned major = Plan("major", 7);
-  EXPECT_EQ(major.agents.size(), 5u);
-  EXPECT_EQ(major.agents.back().kind, AgentKind::kForklift);
+  // four people; the forklift is left out: the room is no place for a vehicle (the default
+  // world marks nothing drivable)
+  EXPECT_EQ(major.agents.size(), 4u);
+  for (const AgentConfig& a : major.agents) {
+    EXPECT_EQ(a.kind, AgentKind::kPerson) << a.name;
+    EXPECT_FALSE(a.robot_contact) << a.name;
+  }
   // fog extinction from the MOR of the preset: 2.996 / 12 m
   EXPECT_NEAR(major.effects[0].Get<FogParams>().extinction.SigmaT(), -std::log(0.05) / 12.0, 1e-9);
   // smoke box inside the room (x in [-4, 4], y in [-3, 3] plus walls), floor to 2.5 m
@@ -126,7 +131,8 @@ TEST(AdversityPlan, CliRunWithAnUnknownPresetExitsWith2AndAKnownOneRecordsIt) {
   RunWorld(world, options);
   const std::string text = testing::ReadAll(std::filesystem::path(out) / "run.json");
   EXPECT_NE(text.find("\"adversity\": \"major ("), std::string::npos) << text;
-  EXPECT_NE(text.find("\"adversity_forklift0: forklift\""), std::string::npos);
+  EXPECT_NE(text.find("\"adversity_person0: person\""), std::string::npos);
+  EXPECT_EQ(text.find("forklift"), std::string::npos);
   EXPECT_NE(text.find("\"adversity_smoke: smoke\""), std::string::npos);
 }
 

@@ -156,16 +156,149 @@ TEST(CrowdSimTest, AvoidAgentsKeepTheirClearanceFromAStandingRobot) {
       least_gap = std::min(least_gap, (s.position_W - robot.position_W).norm() - 0.4 - 0.25);
   }
   EXPECT_GE(least_gap, 0.6 - 0.01);
-  // `ignore` walkers go straight through the robot's disc
+  // `ignore` walkers do not plan or steer round the robot, but never walk into its contact
+  // disc (robot radius + their reach 0.3 m + 0.02 m)
   for (AgentConfig& a : agents) a.behaviour = AgentBehaviour::kIgnore;
   CrowdSim careless(agents, RoomsFor(0.3), RoomsFor(0.7), 3);
   least_gap = 1e9;
   for (int k = 0; k < 400; ++k) {
     careless.Step({robot});
     for (const CrowdAgentState& s : careless.states())
+      least_gap = std::min(least_gap, (s.position_W - robot.position_W).norm() - 0.4 - 0.3);
+  }
+  EXPECT_GE(least_gap, 0.02 - 1e-9);
+  // with robot_contact (a preset's npcs.contact: true) they go straight through it
+  for (AgentConfig& a : agents) a.robot_contact = true;
+  CrowdSim pushing(agents, RoomsFor(0.3), RoomsFor(0.7), 3);
+  least_gap = 1e9;
+  for (int k = 0; k < 400; ++k) {
+    pushing.Step({robot});
+    for (const CrowdAgentState& s : pushing.states())
       least_gap = std::min(least_gap, (s.position_W - robot.position_W).norm() - 0.4 - 0.25);
   }
   EXPECT_LT(least_gap, 0.0);
+}
+
+TEST(CrowdSimTest, AgentsYieldToARobotThatWalksIntoThem) {
+  // a walker paused at its waypoint in the middle of the right room, and a robot (0.4 m disc)
+  // walking straight at it at 0.5 m/s: the walker steps away (a "yield" decision) and the
+  // robot's disc never reaches the walker's reach by more than the robot's own step
+  // (an `ignore` walker: an `avoid` one steps aside before, by ORCA; and a robot whose motion
+  // the crowd does not see coming, velocity 0: else the walker gives way before, below)
+  AgentConfig a = Walker("idle", {{3, 2}, {3.5, 2}});
+  a.behaviour = AgentBehaviour::kIgnore;
+  a.pause_sec = 60;  // stands at its goal
+  a.route = AgentRoute::kOnce;
+  for (const bool contact : {false, true}) {
+    a.robot_contact = contact;
+    CrowdSim sim({a}, RoomsFor(0.3), RoomsFor(0.7), 3);
+    for (int k = 0; k < 40; ++k) sim.Step({});  // reaches (3.5, 2) and pauses there
+    CrowdRobot robot;
+    robot.radius_m = 0.4;
+    double least = 1e9;
+    bool yielded = false;
+    const double t0 = sim.time_sec();
+    for (int k = 0; k < 100; ++k) {  // 5 s: the robot walks from x = 1.2 to 3.7
+      robot.position_W = {1.2 + 0.5 * (sim.time_sec() - t0), 2.0};
+      sim.Step({robot});
+      least = std::min(least, (sim.states()[0].position_W - robot.position_W).norm());
+      for (const CrowdDecision& d : sim.TakeDecisions()) yielded = yielded || d.what == "yield";
+    }
+    if (!contact) {
+      EXPECT_TRUE(yielded);
+      EXPECT_GE(least, 0.4 + 0.3 + 0.02 - 0.5 * sim.dt() - 1e-9);
+    } else {
+      // agents that may push stay where they are: the robot walks into (through) them
+      EXPECT_FALSE(yielded);
+      EXPECT_LT(least, 0.4 + 0.25);
+    }
+  }
+}
+
+TEST(CrowdSimTest, APersonInARobotsWayWalksOutOfItBeforeTheRobotArrives) {
+  // a walker standing in the right room on the line a robot drives (east along y = 2 through
+  // the door at 0.5 m/s): it gives way (leaves the robot's swept corridor) before the robot
+  // reaches it, instead of yielding ahead of it; with robot_contact it stays
+  AgentConfig a = Walker("idle", {{2.5, 2.0}, {2.0, 2.0}});
+  a.behaviour = AgentBehaviour::kIgnore;
+  a.route = AgentRoute::kOnce;
+  a.pause_sec = 60;
+  for (const bool contact : {false, true}) {
+    a.robot_contact = contact;
+    CrowdSim sim({a}, RoomsFor(0.3), RoomsFor(0.7), 3);
+    for (int k = 0; k < 40; ++k) sim.Step({});  // at (2, 2), paused
+    sim.TakeDecisions();
+    CrowdRobot robot;
+    robot.radius_m = 0.4;
+    robot.velocity_W = {0.5, 0};
+    bool gave_way = false;
+    double least = 1e9, lateral_at_pass = 0;
+    const double t0 = sim.time_sec();
+    for (int k = 0; k < 240; ++k) {  // 12 s: from x = -3 to x = 3
+      robot.position_W = {-3.0 + 0.5 * (sim.time_sec() - t0), 2.0};
+      sim.Step({robot});
+      const Eigen::Vector2d p = sim.states()[0].position_W;
+      least = std::min(least, (p - robot.position_W).norm());
+      if (std::abs(robot.position_W.x() - p.x()) < 0.05) lateral_at_pass = std::abs(p.y() - 2.0);
+      for (const CrowdDecision& d : sim.TakeDecisions())
+        gave_way = gave_way || d.what == "give_way";
+    }
+    if (!contact) {
+      EXPECT_TRUE(gave_way);
+      EXPECT_GE(least, 0.4 + 0.3 + 0.02);            // never in its contact disc
+      EXPECT_GE(lateral_at_pass, 0.4 + 0.3 + 0.02);  // beside the robot as it passed
+    } else {
+      EXPECT_FALSE(gave_way);
+      EXPECT_LT(least, 0.4);
+    }
+  }
+}
+
+OccupancyGrid OpenHallGrid();
+
+TEST(CrowdSimTest, AForkliftStopsWithItsForksClearOfARobotInItsLane) {
+  // a forklift driving east along y = 0 in an open hall towards a robot standing in its lane:
+  // it stops before its reach (1.95 m: the fork tips) meets the robot's disc; with
+  // robot_contact it brakes at its own rate (ORCA on its 1.2 m disc) and gets closer
+  const auto hall =
+      std::make_shared<const WalkableGrid>(OpenHallGrid(), 0.7, Eigen::Vector2d(0, 0));
+  AgentConfig f;
+  f.name = "lift";
+  f.kind = AgentKind::kForklift;
+  f.motion = AgentMotion::kCrowd;
+  f.waypoints = {{-6, 0}, {6, 0}};
+  f.route = AgentRoute::kOnce;
+  f.speed_m_s = 2.0;
+  CrowdRobot robot;
+  robot.position_W = {2, 0};
+  robot.radius_m = 0.45;
+  double gap[2] = {0, 0};
+  for (const bool contact : {false, true}) {
+    f.robot_contact = contact;
+    CrowdSim sim({f}, hall, hall, 1);
+    double least = 1e9;
+    for (int k = 0; k < 400; ++k) {  // 20 s
+      sim.Step({robot});
+      least = std::min(least, (sim.states()[0].position_W - robot.position_W).norm());
+    }
+    gap[contact] = least - 0.45 - 1.95;
+  }
+  EXPECT_GE(gap[0], 0.0);
+  EXPECT_LT(gap[1], gap[0] - 0.3);
+}
+
+TEST(CrowdSimTest, CrowdSitesSayWhereVehiclesMayDrive) {
+  CrowdSites sites;
+  sites.areas.push_back({"room", {0, 0}, {4, 3}, false});
+  EXPECT_FALSE(sites.any_drivable());
+  EXPECT_FALSE(sites.Drivable({1, 1}));
+  sites.areas.push_back({"zone", {10, 0}, {20, 5}, true});
+  sites.lanes.push_back({"aisle", {{0, 10}, {10, 10}}, true});
+  EXPECT_TRUE(sites.any_drivable());
+  EXPECT_FALSE(sites.Drivable({1, 1}));
+  EXPECT_TRUE(sites.Drivable({15, 2.5}));
+  EXPECT_TRUE(sites.Drivable({5, 10.8}, 1.0));
+  EXPECT_FALSE(sites.Drivable({5, 11.2}, 1.0));
 }
 
 TEST(CrowdSimTest, BlockAgentsStepIntoTheRobotsPath) {

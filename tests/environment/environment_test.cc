@@ -164,6 +164,21 @@ TEST(EnvironmentGenerator, EveryCollidingGeomKeepsClearOfTheWalkway) {
   }
 }
 
+TEST(EnvironmentGenerator, OnlyTheWarehouseSaysWhereVehiclesMayDrive) {
+  // vehicles belong in the warehouse's zones and aisle; no room of the house, no outdoor trail
+  for (const std::string type : {"house", "outdoor"})
+    EXPECT_TRUE(GenerateEnvironment(Config(type, 1)).drivable.empty()) << type;
+  const GeneratedEnvironment w = GenerateEnvironment(Config("warehouse", 1));
+  EXPECT_FALSE(w.drivable.empty());
+  for (const std::string& name : w.drivable) {
+    const bool room =
+        std::any_of(w.rooms.begin(), w.rooms.end(), [&](const auto& r) { return r.first == name; });
+    const bool walkway = std::any_of(w.walkways.begin(), w.walkways.end(),
+                                     [&](const Walkway& k) { return k.name == name; });
+    EXPECT_TRUE(room || walkway) << name << " is neither a zone nor a walkway";
+  }
+}
+
 TEST(EnvironmentGenerator, ItLoadsInMujocoWithItsMaterials) {
   for (const std::string type : {"house", "warehouse"}) {
     SCOPED_TRACE(type);

@@ -49,6 +49,35 @@ TEST(WorldAgents, ParsesEveryKey) {
   EXPECT_EQ(w.agents[1].kind, AgentKind::kForklift);
   EXPECT_EQ(w.agents[1].start_delay_sec, 3);
   EXPECT_EQ(w.agents[1].route, AgentRoute::kLoop);
+  // agents never push robots unless asked to (`contact: true`)
+  EXPECT_FALSE(w.agents[0].robot_contact);
+  const WorldConfig pushing =
+      ParseWorld("agents:\n  - {name: a, waypoints: [[0, 0], [1, 0]], contact: true}\n", "w.yaml");
+  EXPECT_TRUE(pushing.agents[0].robot_contact);
+  EXPECT_NE(ErrorOf("agents:\n  - {name: a, waypoints: [[0, 0], [1, 0]], contact: 3}\n")
+                .find("agents[0].contact"),
+            std::string::npos);
+}
+
+TEST(AdversityPresets, NpcsContactKeyReadsAndRoundTrips) {
+  const auto dir = std::filesystem::path(penumbra::testing::ProcessTempDir());
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "push.yaml") << "presets:\n  push:\n    npcs: {people: 2, contact: true}\n";
+  const AdversityPreset p = LoadAdversityPreset((dir / "push.yaml").string());
+  EXPECT_TRUE(p.npc_contact);
+  EXPECT_FALSE(LoadAdversityPreset("major").npc_contact);  // bundled presets never push
+  EXPECT_FALSE(LoadAdversityPreset("minor").npc_contact);
+  const std::vector<AdversityPreset> back =
+      ParseAdversityPresets(AdversityPresetFileText(p), "again.yaml");
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_TRUE(back[0].npc_contact);
+  std::ofstream(dir / "bad.yaml") << "presets:\n  bad:\n    npcs: {contact: maybe}\n";
+  try {
+    LoadAdversityPreset((dir / "bad.yaml").string());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("npcs.contact"), std::string::npos) << e.what();
+  }
 }
 
 TEST(WorldAgents, BadInputNamesFileLineKeyAndRange) {
@@ -91,6 +120,30 @@ TEST(AdversityPresets, BundledNoneMinorMajorWithIncreasingSeverity) {
   EXPECT_GT(*major.rain_rate_mm_h, *minor.rain_rate_mm_h);
   EXPECT_LT(major.light_scale, minor.light_scale);
   EXPECT_GT(major.npc_people + major.npc_vehicles, minor.npc_people + minor.npc_vehicles);
+}
+
+TEST(AdversityPresets, EveryBundledPresetStatesWhatItDoesToEachSensor) {
+  for (const std::string& name : {"minor", "major"}) {
+    const AdversityPreset p = LoadAdversityPreset(name);
+    std::vector<std::string> sensors;
+    for (const auto& [sensor, text] : p.sensor_effects) {
+      sensors.push_back(sensor);
+      EXPECT_GT(text.size(), 20u) << name << " " << sensor;
+    }
+    EXPECT_EQ(sensors, AdversitySensorNames()) << name;
+    // a preset written back (penumbra benchmark's per-episode files) keeps them
+    const std::vector<AdversityPreset> back =
+        ParseAdversityPresets(AdversityPresetFileText(p), "again.yaml");
+    ASSERT_EQ(back.size(), 1u);
+    EXPECT_EQ(back[0].sensor_effects, p.sensor_effects) << name;
+  }
+  try {
+    ParseAdversityPresets("presets:\n  p:\n    sensors: {sonar: loud}\n", "p.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("sensors.sonar: unknown key"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(AdversityPresets, TheExampleUserFileLoads) {

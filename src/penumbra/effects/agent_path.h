@@ -84,7 +84,13 @@ struct AgentConfig {
   AgentBehaviour behaviour = AgentBehaviour::kAvoid;  ///< crowd motion only
   AgentGoals goals = AgentGoals::kPatrol;             ///< crowd motion only
   double clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m (crowd only)
-  int line = 0;              ///< line of the entry in the world file (0 = unknown)
+  /// crowd only: false (the default) = the agent never moves into a robot's disc and, when a
+  /// robot comes into its own, steps away (yields; a `block` agent holds still instead), so an
+  /// agent never pins or knocks a robot; true = no such rule (an `ignore` agent walks through
+  /// a robot, a vehicle brakes at its own rate), what a world asks for with `contact: true`
+  /// and a preset with npcs.contact (effects/crowd_sim.h "contact")
+  bool robot_contact = false;
+  int line = 0;  ///< line of the entry in the world file (0 = unknown)
 
   /// checks names, ranges and the path (>= 2 waypoints, consecutive waypoints >= 1 cm
   /// apart, every value finite).

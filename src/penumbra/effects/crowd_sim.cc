@@ -11,18 +11,21 @@ namespace {
 
 // key of the crowd's random goal draws (core/rng.h streams)
 constexpr uint64_t kCrowdStream = 0xC20D5E1D0ULL;
-constexpr double kTau = 2.0;              // ORCA time horizon, s
-constexpr double kNeighbourM = 8.0;       // neighbours farther than this are not considered, m
-constexpr double kReachedM = 0.2;         // a goal within this is reached (people), m
-constexpr double kVehicleReachedM = 0.6;  // ... by a vehicle (its turns are limited), m
-constexpr double kWaypointM = 0.3;        // a plan point within this is passed, m
-constexpr double kTurnRate = 6.0;         // people's heading rate limit, rad/s
-constexpr double kLookAheadM = 1.5;       // pure pursuit look-ahead, m
-constexpr double kVehicleAccel = 1.5;     // vehicles' speed change limit, m/s^2
-constexpr double kSafetyM = 0.02;         // added to every combined radius, m
-constexpr double kBlockReplanSec = 1.0;   // a `block` agent's new block point, s
-constexpr double kBlockAheadM = 0.5;      // block point: this far beyond the discs' contact, m
-constexpr double kBlockHoldM = 0.5;       // holds while no farther than the block point + this, m
+constexpr double kTau = 2.0;                // ORCA time horizon, s
+constexpr double kNeighbourM = 8.0;         // neighbours farther than this are not considered, m
+constexpr double kReachedM = 0.2;           // a goal within this is reached (people), m
+constexpr double kVehicleReachedM = 0.6;    // ... by a vehicle (its turns are limited), m
+constexpr double kWaypointM = 0.3;          // a plan point within this is passed, m
+constexpr double kTurnRate = 6.0;           // people's heading rate limit, rad/s
+constexpr double kLookAheadM = 1.5;         // pure pursuit look-ahead, m
+constexpr double kVehicleAccel = 1.5;       // vehicles' speed change limit, m/s^2
+constexpr double kSafetyM = 0.02;           // added to every combined radius, m
+constexpr double kBlockReplanSec = 1.0;     // a `block` agent's new block point, s
+constexpr double kBlockAheadM = 0.5;        // block point: this far beyond the discs' contact, m
+constexpr double kBlockHoldM = 0.5;         // holds while no farther than the block point + this, m
+constexpr double kVehicleYieldSpeed = 0.5;  // a vehicle backs away from a robot at most this, m/s
+constexpr double kGiveWaySec = 4.0;  // a person keeps out of where a robot goes this far ahead, s
+constexpr double kGiveWayMarginM = 0.3;  // ... and this much beside its contact disc, m
 
 // the direction a robot is going: its velocity when moving, else its yaw
 Eigen::Vector2d RobotHeading(const CrowdRobot& robot) {
@@ -39,15 +42,18 @@ AgentKindModel KindModel(AgentKind kind) {
   switch (kind) {
     case AgentKind::kPerson:
       m.disc_radius_m = 0.25;
+      m.reach_m = 0.3;
       m.walkable = {0.3, 0.1, 2.0, 0.0};
       break;
     case AgentKind::kForklift:
       m.disc_radius_m = 1.2;
+      m.reach_m = 1.95;  // fork tips at x = 1.9 m, y = +-0.3 m
       m.walkable = {0.7, 0.05, 2.3, 2.0};
       m.wheelbase_m = AgentWheelbase(kind);
       break;
     case AgentKind::kCart:
       m.disc_radius_m = 0.6;
+      m.reach_m = 0.6;
       m.walkable = {0.45, 0.05, 1.2, 0.8};
       m.wheelbase_m = AgentWheelbase(kind);
       break;
@@ -56,6 +62,29 @@ AgentKindModel KindModel(AgentKind kind) {
 }
 
 bool IsVehicle(AgentKind kind) { return kind != AgentKind::kPerson; }
+
+bool CrowdSites::any_drivable() const {
+  return std::any_of(areas.begin(), areas.end(), [](const Area& a) { return a.drivable; }) ||
+         std::any_of(lanes.begin(), lanes.end(), [](const Lane& l) { return l.drivable; });
+}
+
+bool CrowdSites::Drivable(const Eigen::Vector2d& p_W, double lane_half_width_m) const {
+  for (const Area& a : areas)
+    if (a.drivable && (p_W.array() >= a.min_W.array()).all() &&
+        (p_W.array() <= a.max_W.array()).all())
+      return true;
+  for (const Lane& l : lanes) {
+    if (!l.drivable) continue;
+    for (size_t k = 0; k + 1 < l.points_W.size(); ++k) {
+      const Eigen::Vector2d d = l.points_W[k + 1] - l.points_W[k];
+      const double t = d.squaredNorm() > 0
+                           ? std::clamp((p_W - l.points_W[k]).dot(d) / d.squaredNorm(), 0.0, 1.0)
+                           : 0.0;
+      if ((p_W - (l.points_W[k] + t * d)).norm() <= lane_half_width_m) return true;
+    }
+  }
+  return false;
+}
 
 CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
                    std::shared_ptr<const WalkableGrid> person_region,
@@ -78,6 +107,8 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   speed_.assign(n, 0);
   slow_since_.assign(n, 0);
   active_.assign(n, 1);
+  yielding_.assign(n, 0);
+  giving_way_.assign(n, 0);
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     rngs_.emplace_back(HashKeys(seed, kCrowdStream, i));
@@ -202,11 +233,100 @@ Eigen::Vector2d CrowdSim::Preferred(size_t i) {
   return to / dist * speed;
 }
 
+const CrowdRobot* CrowdSim::Touching(size_t i, const Eigen::Vector2d& p,
+                                     const std::vector<CrowdRobot>& robots) const {
+  if (agents_[i].robot_contact) return nullptr;
+  const double reach = KindModel(agents_[i].kind).reach_m + kSafetyM;
+  const CrowdRobot* deepest = nullptr;
+  double depth = 0;
+  for (const CrowdRobot& r : robots) {
+    const double d = r.radius_m + reach - (p - r.position_W).norm();
+    if (d > depth) {
+      depth = d;
+      deepest = &r;
+    }
+  }
+  return deepest;
+}
+
+bool CrowdSim::InRobotsWay(size_t i, const Eigen::Vector2d& p, const CrowdRobot& robot) const {
+  const double speed = robot.velocity_W.norm();
+  if (speed < 0.05) return false;
+  const Eigen::Vector2d h = robot.velocity_W / speed;
+  const Eigen::Vector2d rel = p - robot.position_W;
+  const double contact = robot.radius_m + KindModel(agents_[i].kind).reach_m + kSafetyM;
+  const double along = rel.dot(h);
+  const double lateral = std::abs(h.x() * rel.y() - h.y() * rel.x());
+  return along > -contact && along < speed * kGiveWaySec + contact &&
+         lateral < contact + kGiveWayMarginM;
+}
+
+bool CrowdSim::GiveWay(size_t i, const std::vector<CrowdRobot>& robots) {
+  const Eigen::Vector2d p = states_[i].position_W;
+  const double reach = KindModel(agents_[i].kind).reach_m + kSafetyM;
+  // beside or behind every moving robot's path (not further ahead on it, where the robot
+  // still comes) and away from every robot's contact disc
+  const auto clear = [&](const Eigen::Vector2d& q) {
+    for (const CrowdRobot& r : robots) {
+      const double contact = r.radius_m + reach;
+      if ((q - r.position_W).norm() < contact + kGiveWayMarginM) return false;
+      const double speed = r.velocity_W.norm();
+      if (speed < 0.05) continue;
+      const Eigen::Vector2d h = r.velocity_W / speed, rel = q - r.position_W;
+      const double lateral = std::abs(h.x() * rel.y() - h.y() * rel.x());
+      if (lateral < contact + kGiveWayMarginM && rel.dot(h) > -contact) return false;
+    }
+    return true;
+  };
+  // walkable points out of every robot's way, nearest first (rings of 16, a fixed order)
+  std::vector<Eigen::Vector2d> refuges;
+  for (const double d : {0.5, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0})
+    for (int k = 0; k < 16; ++k) {
+      const Eigen::Vector2d q =
+          p + d * Eigen::Vector2d(std::cos(k * M_PI / 8), std::sin(k * M_PI / 8));
+      if (region(i).Walkable(q) && clear(q)) refuges.push_back(q);
+    }
+  std::vector<std::pair<Eigen::Vector2d, double>> keep_out;
+  for (const CrowdRobot& r : robots) keep_out.emplace_back(r.position_W, r.radius_m + reach);
+  int tried = 0;
+  for (const Eigen::Vector2d& q : refuges) {
+    if (++tried > 12) break;
+    const auto path = region(i).Plan(p, q, keep_out);
+    if (!path || (path->back() - q).norm() > 0.2) continue;
+    double length = 0;
+    for (size_t k = 1; k < path->size(); ++k) length += ((*path)[k] - (*path)[k - 1]).norm();
+    if (length > 2.5 * (q - p).norm() + 0.5) continue;
+    Plan& plan = plans_[i];
+    plan.points = *path;
+    plan.next = plan.points.size() > 1 ? 1 : 0;
+    plan.goal = plan.points.back();
+    plan.active = true;
+    slow_since_[i] = time_;
+    Decide(i, "give_way", plan.goal, static_cast<int>(plan.points.size()));
+    return true;
+  }
+  return false;
+}
+
+bool CrowdSim::EntersRobot(size_t i, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+                           const std::vector<CrowdRobot>& robots) const {
+  if (agents_[i].robot_contact) return false;
+  const double reach = KindModel(agents_[i].kind).reach_m + kSafetyM;
+  for (const CrowdRobot& r : robots) {
+    const double d = (to - r.position_W).norm();
+    if (d < r.radius_m + reach && d < (from - r.position_W).norm()) return true;
+  }
+  return false;
+}
+
 void CrowdSim::AddRobotLines(size_t i, const std::vector<CrowdRobot>& robots, double own_radius,
                              const Eigen::Vector2d& v_a, std::vector<OrcaLine>* lines) const {
   const AgentConfig& a = agents_[i];
   if (a.behaviour == AgentBehaviour::kIgnore) return;
   const double extra = a.behaviour == AgentBehaviour::kAvoid ? a.clearance_m : 0.0;
+  // a vehicle keeps its whole body (its reach: the forks) from a robot, not its disc
+  if (!a.robot_contact && IsVehicle(a.kind))
+    own_radius = std::max(own_radius, KindModel(a.kind).reach_m);
   for (const CrowdRobot& r : robots) {
     const Eigen::Vector2d rel = r.position_W - states_[i].position_W;
     if (rel.norm() > kNeighbourM + extra) continue;
@@ -249,7 +369,24 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     }
     if (!plan.active && time_ >= pause_until_[i] && a.behaviour != AgentBehaviour::kBlock)
       ChooseGoal(i, robots);
+    // a person in the way of a moving robot walks out of it first (it would else be cornered
+    // where the robot goes: a door, a corner)
+    if (!a.robot_contact && a.behaviour != AgentBehaviour::kBlock && !IsVehicle(a.kind)) {
+      bool in_way = false;
+      for (const CrowdRobot& r : robots)
+        in_way = in_way || InRobotsWay(i, states_[i].position_W, r);
+      if (in_way && !giving_way_[i])
+        giving_way_[i] = GiveWay(i, robots) ? 1 : 0;
+      else if (!in_way)
+        giving_way_[i] = 0;
+    }
     preferred[i] = Preferred(i);
+    // a robot came into the agent's contact disc: it steps away (a blocker holds still)
+    const bool yield = a.behaviour != AgentBehaviour::kBlock &&
+                       Touching(i, states_[i].position_W, robots) != nullptr;
+    if (yield && !yielding_[i])
+      Decide(i, "yield", Touching(i, states_[i].position_W, robots)->position_W);
+    yielding_[i] = yield ? 1 : 0;
   }
   // new velocities from the states at the start of the step (a synchronous update)
   std::vector<Eigen::Vector2d> velocity(n, Eigen::Vector2d::Zero());
@@ -275,6 +412,20 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
                                     kTau, dt_, responsibility));
     }
     AddRobotLines(i, robots, own, s.velocity_W, &lines);
+    if (yielding_[i]) {
+      // straight away from the robot (a vehicle: along its axis, below)
+      const Eigen::Vector2d away = s.position_W - Touching(i, s.position_W, robots)->position_W;
+      const Eigen::Vector2d dir =
+          away.norm() > 1e-9 ? Eigen::Vector2d(away.normalized()) : Eigen::Vector2d(1, 0);
+      if (!vehicle) {
+        velocity[i] = dir * a.speed_m_s;
+        continue;
+      }
+      const Eigen::Vector2d axis(std::cos(s.yaw), std::sin(s.yaw));
+      velocity[i] =
+          (axis.dot(dir) >= 0 ? 1.0 : -1.0) * std::min(a.speed_m_s, kVehicleYieldSpeed) * axis;
+      continue;
+    }
     if (!vehicle) {
       velocity[i] = SolveOrcaVelocity(lines, a.speed_m_s, preferred[i]);
       continue;
@@ -303,7 +454,9 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
         hi = std::min(hi, b / k);
       }
     }
-    double v = lo <= hi ? std::clamp(want, lo, hi) : 0.0;
+    // no speed meets every half-plane: stop, unless only lower bounds conflict (it is inside
+    // a neighbour's horizon and driving away from it), then drive away as fast as it may
+    double v = lo <= hi ? std::clamp(want, lo, hi) : hi >= a.speed_m_s ? a.speed_m_s : 0.0;
     const double prev = std::abs(speed_[i]);
     v = std::clamp(v, prev - kVehicleAccel * dt_, prev + kVehicleAccel * dt_);
     new_speed[i] = std::max(0.0, v);
@@ -326,14 +479,22 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
     CrowdAgentState& s = states_[i];
     const WalkableGrid& reg = region(i);
     const Eigen::Vector2d old = s.position_W;
-    if (!IsVehicle(a.kind)) {
+    const auto allowed = [&](const Eigen::Vector2d& c) {
+      return reg.Walkable(c) && !crowds(i, old, c) && !EntersRobot(i, old, c, robots);
+    };
+    if (IsVehicle(a.kind) && yielding_[i]) {
+      // backing away from a robot along its axis, heading unchanged
+      const Eigen::Vector2d next = old + velocity[i] * dt_;
+      if (allowed(next)) s.position_W = next;
+      speed_[i] = 0;
+    } else if (!IsVehicle(a.kind)) {
       const Eigen::Vector2d step = velocity[i] * dt_;
       // the whole step, along x or y alone, half of it, or none
       Eigen::Vector2d next = old;
       for (const Eigen::Vector2d& c :
            {Eigen::Vector2d(old + step), Eigen::Vector2d(old.x() + step.x(), old.y()),
             Eigen::Vector2d(old.x(), old.y() + step.y()), Eigen::Vector2d(old + 0.5 * step)})
-        if (reg.Walkable(c) && !crowds(i, old, c)) {
+        if (allowed(c)) {
           next = c;
           break;
         }
@@ -365,7 +526,7 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
       const double new_drive_yaw = drive_yaw + yaw_rate * dt_;
       const double mid = drive_yaw + 0.5 * yaw_rate * dt_;
       const Eigen::Vector2d next = old + v * dt_ * Eigen::Vector2d(std::cos(mid), std::sin(mid));
-      if (reg.Walkable(next) && !crowds(i, old, next)) {
+      if (allowed(next)) {
         s.position_W = next;
         s.yaw = WrapAngle(gear_[i] > 0 ? new_drive_yaw : new_drive_yaw - M_PI);
         speed_[i] = v;

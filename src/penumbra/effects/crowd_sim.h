@@ -30,12 +30,29 @@
 //             (look-ahead 1.5 m; Coulter, "Implementation of the Pure Pursuit Path Tracking
 //             Algorithm", CMU-RI-TR-92-01, 1992). speed: the largest v <= speed_m_s whose
 //             velocity along the heading satisfies the ORCA half-planes of the others and the
-//             robots (responsibility 1), else 0 (it stops). a pingpong lane is driven back in
+//             robots (responsibility 1), else 0 (it stops; but speed_m_s when only the lower
+//             bounds conflict: inside a neighbour's horizon, heading away). a pingpong lane is
+//             driven back in
 //             reverse (forklifts do), steering as a rear-steered bicycle.
 //   walkable  a centre may only move to a walkable point of its kind's region and never deeper
 //             into another agent's disc (agents already moved this step where they are now):
 //             the step is taken whole, else along x or y alone, else half, else not at all
 //             (a vehicle: whole or not at all).
+//   contact   an agent without robot_contact (the default; effects/agent_path.h) never moves
+//             deeper into a robot's contact disc (robot radius + the agent's reach, the disc
+//             that holds its whole body: a forklift's forks too, + 0.02 m), whatever its
+//             behaviour, and ORCA keeps a vehicle's reach (not its disc) from the robots. when
+//             a robot comes into an avoid or ignore agent's contact disc the agent yields: a
+//             person walks straight away from the robot at its speed, a vehicle drives along
+//             its axis away from it at up to 0.5 m/s (a "yield" decision; a `block` agent holds
+//             still instead: the robot walked into it). so an agent never pins or knocks a
+//             robot; with robot_contact (a preset's npcs.contact: true) none of this applies.
+//             before that, a person (avoid or ignore, without robot_contact) standing where a
+//             moving robot goes within 4 s (its swept corridor: its contact disc + 0.3 m
+//             either side of its velocity) walks out of its way: to the nearest walkable point
+//             beside or behind every moving robot's path and off every contact disc (+ 0.3 m)
+//             (rings of 16 points 0.5-4 m away, the first 12 tried by A* round the robots'
+//             contact discs; a "give_way" decision), then goes on.
 
 #include <Eigen/Core>
 #include <memory>
@@ -54,13 +71,16 @@ struct AgentKindModel {
   double disc_radius_m = 0.25;  ///< the agent's body as a disc about its origin, m
   WalkableProfile walkable;     ///< what its walkable region is built from
   double wheelbase_m = 0;       ///< vehicles: L of the bicycle model (0 for people)
+  /// the disc about the origin that holds the whole body (a forklift's fork tips, a walker's
+  /// swinging arms), m: what is kept from a robot (see the file header's "contact")
+  double reach_m = 0.3;
 };
 
-/// person: disc 0.25 m, walkable radius 0.3 m, steps 0.1 m (a 0.144 m pallet is an obstacle),
-/// passes under 2.0 m.
-/// forklift: disc 1.2 m (its chassis and counterweight about the origin, not the fork tips),
-/// walkable radius 0.7 m (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes
-/// under 2.3 m, turning radius 2.0 m. cart: disc 0.6 m, walkable 0.45 m, turning radius 0.8 m.
+/// person: disc 0.25 m, reach 0.3 m, walkable radius 0.3 m, steps 0.1 m (a 0.144 m pallet is an
+/// obstacle), passes under 2.0 m. forklift: disc 1.2 m (its chassis and counterweight about the
+/// origin, not the fork tips; reach 1.95 m with the forks, compose/agent_bodies.cc), walkable
+/// radius 0.7 m (half width + 0.15 m: it drives along lanes), steps 0.05 m, passes under 2.3 m,
+/// turning radius 2.0 m. cart: disc 0.6 m, reach 0.6 m, walkable 0.45 m, turning radius 0.8 m.
 /// wheelbase: the body's axle spacing, AgentWheelbase (effects/agent_animation.h): forklift
 /// 1.1 m, cart 0.8 m.
 AgentKindModel KindModel(AgentKind kind);
@@ -68,20 +88,29 @@ AgentKindModel KindModel(AgentKind kind);
 bool IsVehicle(AgentKind kind);
 
 /// where a world's crowds go: its rooms or zones and its lanes (walkways, aisles, trails), in
-/// the world frame. generated environments provide them (environment/environment_generator.h
-/// GeneratedEnvironment::rooms and walkways; environment/model_sources.h).
+/// the world frame, and which of them vehicles may drive. generated environments provide them
+/// (environment/environment_generator.h GeneratedEnvironment::rooms, walkways and drivable;
+/// environment/model_sources.h): a warehouse's zones and aisle are drivable, a house's rooms
+/// and hallway are not.
 struct CrowdSites {
   struct Area {
     std::string name;
     Eigen::Vector2d min_W{0, 0}, max_W{0, 0};  ///< plan bounding box, m
+    bool drivable = false;                     ///< vehicles may drive here
   };
   struct Lane {
     std::string name;
     std::vector<Eigen::Vector2d> points_W;  ///< polyline, m
+    bool drivable = false;                  ///< vehicles may drive along it
   };
   std::vector<Area> areas;
   std::vector<Lane> lanes;
   bool empty() const { return areas.empty() && lanes.empty(); }
+  /// true when some area or lane is drivable.
+  bool any_drivable() const;
+  /// true when `p_W` lies in a drivable area's box or within `lane_half_width_m` of a drivable
+  /// lane.
+  bool Drivable(const Eigen::Vector2d& p_W, double lane_half_width_m = 1.0) const;
 };
 
 /// a robot as the crowd sees it: a disc in the plan.
@@ -97,7 +126,9 @@ struct CrowdDecision {
   double time_sec = 0;
   int agent = 0;  ///< index into the agents
   ///< "goal", "block" (a new block point), "hold" (a `block` agent stands its ground in a
-  ///< robot's path), "pause", "stuck", "blocked" (no plan to the goal)
+  ///< robot's path), "pause", "stuck", "blocked" (no plan to the goal), "give_way" (out of a
+  ///< moving robot's way, to goal_W), "yield" (a robot
+  ///< came into the agent's contact disc: it steps away; goal_W is the robot's position)
   std::string what;
   Eigen::Vector2d goal_W{0, 0};
   int plan_points = 0;  ///< points of the plan made (0 = none)
@@ -161,6 +192,21 @@ class CrowdSim {
   /// corridor (robot radius + agent radius either side of its heading), no farther than its
   /// block point plus kBlockHoldM.
   bool InRobotsPath(size_t i, const std::vector<CrowdRobot>& robots) const;
+  /// the robot whose contact disc (robot radius + agent i's reach) agent i's centre at `p` is
+  /// inside, deepest first; null when none or when agent i has robot_contact.
+  const CrowdRobot* Touching(size_t i, const Eigen::Vector2d& p,
+                             const std::vector<CrowdRobot>& robots) const;
+  /// true when moving agent i's centre from `from` to `to` goes deeper into a robot's contact
+  /// disc (never for robot_contact agents).
+  bool EntersRobot(size_t i, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+                   const std::vector<CrowdRobot>& robots) const;
+  /// true when agent i's centre at `p` lies where a moving robot goes within 4 s: in
+  /// its swept corridor (its contact disc + kGiveWayMarginM either side of its velocity),
+  /// from its contact disc behind it to its contact disc ahead of where it will be.
+  bool InRobotsWay(size_t i, const Eigen::Vector2d& p, const CrowdRobot& robot) const;
+  /// plans agent i to the nearest walkable point out of every robot's way (a "give_way"
+  /// decision); false when none is found.
+  bool GiveWay(size_t i, const std::vector<CrowdRobot>& robots);
 
   std::vector<AgentConfig> agents_;
   std::shared_ptr<const WalkableGrid> person_region_, vehicle_region_;
@@ -172,12 +218,14 @@ class CrowdSim {
   std::vector<int> goal_index_;  // patrol: the waypoint headed for; random: the last drawn
   std::vector<int> patrol_dir_;  // pingpong: +1 / -1
   std::vector<double> pause_until_;
-  std::vector<double> replan_at_;  // block: the time of the next replan
-  std::vector<uint8_t> holding_;   // block: standing its ground in a robot's path
-  std::vector<int> gear_;          // vehicles: +1 forward, -1 reverse
-  std::vector<double> speed_;      // vehicles: signed speed along the heading, m/s
-  std::vector<double> slow_since_;
-  std::vector<uint8_t> active_;  // start of the agent's current spell below 0.1 m/s
+  std::vector<double> replan_at_;   // block: the time of the next replan
+  std::vector<uint8_t> holding_;    // block: standing its ground in a robot's path
+  std::vector<int> gear_;           // vehicles: +1 forward, -1 reverse
+  std::vector<double> speed_;       // vehicles: signed speed along the heading, m/s
+  std::vector<double> slow_since_;  // start of the agent's current spell below 0.1 m/s
+  std::vector<uint8_t> active_;
+  std::vector<uint8_t> yielding_;    // stepping away from a robot that came into it
+  std::vector<uint8_t> giving_way_;  // walking out of a moving robot's way
   std::vector<CrowdDecision> decisions_;
 };
 

@@ -53,6 +53,10 @@ struct GeneratedEnvironment {
   std::vector<Walkway> walkways;
   /// the rooms (house) or zones (warehouse) by name, for docs and tests.
   std::vector<std::pair<std::string, PlanRect>> rooms;
+  /// the rooms and walkways (by name) where vehicles may drive: an adversity preset's
+  /// forklifts go only there (session/effects_stage.h "npcs"; CrowdSites::Area::drivable).
+  /// the warehouse: its zones and its aisle walkway; the house and the outdoor terrain: none.
+  std::vector<std::string> drivable;
   int geoms = 0, colliding_geoms = 0;
   int furniture = 0;  ///< furniture items, racks, pallets placed
 };

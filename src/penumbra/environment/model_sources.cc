@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <utility>
 
 #include "penumbra/assets/mjcf_mesh_conversion.h"
@@ -49,6 +50,8 @@ CrowdSites ModelSources::crowd_sites(const std::vector<ModelConfig>& world_model
     for (const auto& [name, r] : g.environment.rooms) {
       CrowdSites::Area a;
       a.name = g.model + "/" + name;
+      a.drivable = std::find(g.environment.drivable.begin(), g.environment.drivable.end(), name) !=
+                   g.environment.drivable.end();
       a.min_W = Eigen::Vector2d(1e300, 1e300);
       a.max_W = -a.min_W;
       for (const Eigen::Vector2d& c : {Eigen::Vector2d(r.x0, r.y0), Eigen::Vector2d(r.x1, r.y0),
@@ -62,6 +65,8 @@ CrowdSites ModelSources::crowd_sites(const std::vector<ModelConfig>& world_model
     for (const Walkway& w : g.environment.walkways) {
       CrowdSites::Lane l;
       l.name = g.model + "/" + w.name;
+      l.drivable = std::find(g.environment.drivable.begin(), g.environment.drivable.end(),
+                             w.name) != g.environment.drivable.end();
       for (const Eigen::Vector2d& p : w.points)
         l.points_W.push_back((X_WM * Eigen::Vector3d(p.x(), p.y(), 0)).head<2>());
       sites.lanes.push_back(std::move(l));

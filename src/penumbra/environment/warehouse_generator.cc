@@ -131,6 +131,8 @@ class Warehouse : public EnvironmentBuilder {
         {"hall", {-kWarehouseHalfX, -kWarehouseHalfY, kWarehouseHalfX, kWarehouseHalfY}});
     out_.rooms.push_back({"staging", {-kWarehouseHalfX, -kWarehouseHalfY, kWarehouseHalfX, -6.0}});
     out_.rooms.push_back({"east_floor", {8.6, -6.0, kWarehouseHalfX, kWarehouseHalfY}});
+    // a warehouse's floor and aisles are where forklifts work
+    out_.drivable = {"hall", "staging", "east_floor", "tour"};
   }
 
   void Lamps() {

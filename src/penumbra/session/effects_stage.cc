@@ -188,6 +188,7 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
     a.behaviour = preset.npc_behaviour;
     a.clearance_m = preset.npc_clearance_m;
     a.pause_sec = preset.npc_pause_sec;
+    a.robot_contact = preset.npc_contact;
     a.floor_z = map.floor_z();
     return a;
   };
@@ -276,8 +277,18 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
   std::vector<AgentConfig> vehicle_agents;
   std::vector<std::vector<Eigen::Vector2d>> drive_lanes;
   for (const CrowdSites::Lane& l : sites.lanes) {
+    if (!l.drivable) continue;
     std::vector<Eigen::Vector2d> pts = DrivableStretch(vehicles, l.points_W);
     if (!pts.empty()) drive_lanes.push_back(std::move(pts));
+  }
+  // vehicles drive only where the world says they may (a room is no place for a forklift)
+  if (preset.npc_vehicles > 0 && !sites.any_drivable()) {
+    spdlog::info(
+        "adversity preset '{}': {} vehicle(s) left out: the world has no drivable area "
+        "(vehicles drive only in a generated environment's drivable zones and lanes, "
+        "docs/npcs.md)",
+        preset.name, preset.npc_vehicles);
+    return;
   }
   for (int j = 0; j < preset.npc_vehicles; ++j) {
     const std::string name = "adversity_forklift" + std::to_string(j);
@@ -309,8 +320,9 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
         }
       }
       lane = found;
-    } else if (sites.lanes.empty()) {
-      // no lanes in the world: a straight drivable lane drawn from the seed
+    } else {
+      // no drivable lane a forklift fits: a straight lane drawn from the seed inside the
+      // drivable areas (checked every 0.25 m)
       Rng rng(HashKeys(seed, kNpcStream, 1, j));
       std::vector<Eigen::Vector2d> fallback;
       for (int k = 0; k < 200 && lane.empty(); ++k) {
@@ -320,6 +332,10 @@ void PlanPresetNpcs(const AdversityPreset& preset, const NpcMap& map, const Crow
         if (len < 3.0 || len > 12.0 || !away(*p, 2.5) || !away(*q, 2.5) ||
             !vehicles.SegmentWalkable(*p, *q))
           continue;
+        bool drivable = true;
+        for (double t = 0; t <= len && drivable; t += 0.25)
+          drivable = sites.Drivable(*p + (*q - *p) * (t / len), 0.0);
+        if (!drivable || !sites.Drivable(*q, 0.0)) continue;
         if (free_start(*p, vehicle_r, 2.5))
           lane = {*p, *q};
         else if (free_start(*q, vehicle_r, 2.5))
@@ -526,6 +542,21 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
 
 EffectsStage::~EffectsStage() = default;
 
+bool AgentMayTouchRobot(const AgentConfig& agent) {
+  return agent.motion == AgentMotion::kScripted || agent.robot_contact ||
+         agent.behaviour == AgentBehaviour::kBlock;
+}
+
+std::vector<AgentConfig> TouchingAgentsWithout(const std::vector<AgentConfig>& agents,
+                                               const std::vector<std::string>& mocap_bodies) {
+  std::vector<AgentConfig> out;
+  for (const AgentConfig& a : agents)
+    if (AgentMayTouchRobot(a) && std::find(mocap_bodies.begin(), mocap_bodies.end(),
+                                           AgentBodyName(a.name)) == mocap_bodies.end())
+      out.push_back(a);
+  return out;
+}
+
 WalkerAppearance AgentAppearance(const AgentConfig& agent, uint64_t seed) {
   return WalkerAppearanceOf(seed, agent.name, agent.height_given ? agent.height_m : 0.0);
 }
@@ -699,7 +730,8 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
     const auto same = [](const AgentConfig& x, const AgentConfig& y) {
       return x.kind == y.kind && x.waypoints == y.waypoints && x.speed_m_s == y.speed_m_s &&
              x.pause_sec == y.pause_sec && x.route == y.route && x.goals == y.goals &&
-             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m && x.floor_z == y.floor_z;
+             x.behaviour == y.behaviour && x.clearance_m == y.clearance_m &&
+             x.floor_z == y.floor_z && x.robot_contact == y.robot_contact;
     };
     const auto it = std::find_if(agents.begin(), agents.end(),
                                  [&](const AgentConfig& a) { return a.name == name; });

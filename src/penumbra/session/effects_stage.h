@@ -45,10 +45,14 @@
 //              route to it instead: the A* path on the people's walkable cells (else the
 //              straight segment), at an arc length drawn in [min(2, L), min(6, L)] m (L the
 //              route's length), up to 1 m to its side; failing that, by the heading rule. vehicles
-//              (forklifts at 1.5x speed) drive a lane (its longest drivable stretch, >= 3 m) there
-//              and back; without lanes in the world, a straight drivable lane of 3-12 m drawn from
-//              the seed; a world whose lanes no forklift fits (the house) gets none (logged).
-//              behaviour and clearance from the preset.
+//              (forklifts at 1.5x speed) drive a drivable lane (its longest stretch they fit,
+//              >= 3 m) there and back; without one, a straight lane of 3-12 m drawn from the
+//              seed inside the world's drivable areas. vehicles go only where the world says
+//              they may drive (CrowdSites' drivable areas and lanes: a generated warehouse's
+//              zones and aisle; never a house, a hand-built room or the outdoor terrain): a
+//              world without a drivable area gets none (one log line), nor one whose drivable
+//              lanes and areas no forklift fits (logged). behaviour, clearance and contact
+//              (AgentConfig::robot_contact: whether they may push a robot) from the preset.
 // preset effects and agents are named "adversity_<what>" and follow the world's own.
 
 #include <Eigen/Core>
@@ -213,6 +217,18 @@ void PlanAdversityPreset(const AdversityPreset& preset, const SceneDescription& 
                          const std::vector<double>& robot_yaws, uint64_t seed,
                          std::vector<EffectConfig>* effects, std::vector<AgentConfig>* agents,
                          const CrowdSites& sites = {});
+
+/// true when `agent` may touch a robot: a scripted agent follows its path whatever it
+/// touches, a crowd agent with robot_contact may push, a `block` one stands in the robot's way
+/// (effects/crowd_sim.h "contact"); other crowd agents keep clear of robots and yield.
+bool AgentMayTouchRobot(const AgentConfig& agent);
+
+/// the agents of `agents` that may touch a robot (AgentMayTouchRobot) and whose root body is
+/// not one of `mocap_bodies` (e.g. the mocap bodies a run log holds), in order: agents a
+/// kinematic replay would add, moving on their own while the robot moves as logged, which
+/// cannot show the contact.
+std::vector<AgentConfig> TouchingAgentsWithout(const std::vector<AgentConfig>& agents,
+                                               const std::vector<std::string>& mocap_bodies);
 
 /// what agent `agent` looks like in a run of world seed `seed`: WalkerAppearanceOf(seed, its
 /// name, its height_m when height_given, else 0: drawn from the seed).

@@ -49,11 +49,17 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
   if (auto problem = NameLengthProblem(name)) r.Fail("preset " + *problem);
   if (!std::regex_match(name, kName))
     r.Fail("preset name '" + name + "' is not valid; expected letters, digits, '_' and '-'");
-  r.ExpectMap({"description", "fog", "dust", "smoke", "rain", "snow", "lights", "npcs"});
+  r.ExpectMap({"description", "sensors", "fog", "dust", "smoke", "rain", "snow", "lights", "npcs"});
   AdversityPreset p;
   p.name = name;
   p.file = file;
   if (const auto found = r.Find("description")) p.description = found->String();
+  if (r.Has("sensors")) {
+    const ParamReader s = r.Child("sensors");
+    s.ExpectMap({"rgb", "depth", "lidar", "imu"});  // AdversitySensorNames
+    for (const std::string& sensor : AdversitySensorNames())
+      if (const auto found = s.Find(sensor)) p.sensor_effects.emplace_back(sensor, found->String());
+  }
   if (r.Has("fog")) {
     const ParamReader f = r.Child("fog");
     f.ExpectMap({"mor_m", "height_falloff_per_m"});
@@ -95,8 +101,8 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
   }
   if (r.Has("npcs")) {
     const ParamReader s = r.Child("npcs");
-    s.ExpectMap(
-        {"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m", "block_goal"});
+    s.ExpectMap({"people", "vehicles", "speed_m_s", "pause_sec", "behaviour", "clearance_m",
+                 "block_goal", "contact"});
     if (const auto found = s.Find("people")) p.npc_people = RangedInt(*found, 0, 100);
     if (const auto found = s.Find("vehicles")) p.npc_vehicles = RangedInt(*found, 0, 20);
     if (const auto found = s.Find("speed_m_s")) p.npc_speed_m_s = Ranged(*found, 0, 5, true, "m/s");
@@ -107,6 +113,7 @@ AdversityPreset ReadPreset(const std::string& name, const ParamReader& r, const 
                         : b == "ignore" ? AgentBehaviour::kIgnore
                                         : AgentBehaviour::kBlock;
     }
+    if (const auto found = s.Find("contact")) p.npc_contact = found->Bool();
     if (const auto found = s.Find("clearance_m"))
       p.npc_clearance_m = Ranged(*found, 0, 10, false, "m");
     if (const auto found = s.Find("block_goal")) {
@@ -165,7 +172,8 @@ ConfigValue PresetNode(const AdversityPreset& p) {
                    {"speed_m_s", PresetNumber(p.npc_speed_m_s)},
                    {"pause_sec", PresetNumber(p.npc_pause_sec)},
                    {"behaviour", ConfigValue::Scalar(AgentBehaviourName(p.npc_behaviour))},
-                   {"clearance_m", PresetNumber(p.npc_clearance_m)}}));
+                   {"clearance_m", PresetNumber(p.npc_clearance_m)},
+                   {"contact", ConfigValue::Scalar(p.npc_contact ? "true" : "false")}}));
   if (p.npc_block_goal) {
     const std::string goal = "[" + FormatNumber(p.npc_block_goal->x()) + ", " +
                              FormatNumber(p.npc_block_goal->y()) + "]";
@@ -219,7 +227,18 @@ std::string AdversityPresetFileText(const AdversityPreset& preset) {
   ConfigValue node = PresetNode(preset);
   if (!preset.description.empty())
     node = WithEntry(node, "description", ConfigValue::Scalar(preset.description));
+  if (!preset.sensor_effects.empty()) {
+    ConfigValue sensors = ConfigValue::Map();
+    for (const auto& [sensor, text] : preset.sensor_effects)
+      sensors = WithEntry(sensors, sensor, ConfigValue::Scalar(text));
+    node = WithEntry(node, "sensors", sensors);
+  }
   return "presets:\n  " + preset.name + ": " + EmitYamlFlow(node) + "\n";
+}
+
+const std::vector<std::string>& AdversitySensorNames() {
+  static const std::vector<std::string> kSensors = {"rgb", "depth", "lidar", "imu"};
+  return kSensors;
 }
 
 std::vector<std::string> BundledAdversityPresetNames() {

@@ -10,6 +10,7 @@
 //   presets:
 //     <name>:                          # [A-Za-z0-9_-]+
 //       description: <text>
+//       sensors: {rgb: <text>, depth: <text>, lidar: <text>, imu: <text>}  # what it does to each
 //       fog:    {mor_m: M, height_falloff_per_m: H}     # homogeneous fog everywhere
 //       dust:   {mor_m: M}                              # brown absorbing haze everywhere
 //       smoke:  {sigma_t_per_m: S, coverage: C, extent_fraction: F, height_m: Z}
@@ -18,7 +19,8 @@
 //       lights: {scale: K, flicker_depth: D, flicker_hz: F}
 //       npcs:   {people: N, vehicles: V, speed_m_s: S, pause_sec: P,
 //                behaviour: avoid | ignore | block, clearance_m: C,
-//                block_goal: [X, Y]}                # block only: the robots' goal
+//                block_goal: [X, Y],                # block only: the robots' goal
+//                contact: true | false}             # default false: NPCs never push a robot
 // every block is optional; MOR is the meteorological optical range (WMO No. 8, 2018;
 // sigma_t = 2.996 / MOR, Koschmieder), rain and snow rates are water-equivalent mm/h.
 //
@@ -37,6 +39,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "penumbra/effects/agent_path.h"
@@ -48,6 +51,10 @@ struct AdversityPreset {
   std::string name;
   std::string description;
   std::string file;  ///< the file it came from
+  /// what the preset does to each kind of sensor, as its file states it (`sensors:`): pairs of
+  /// sensor (AdversitySensorNames order: rgb, depth, lidar, imu) and text; documentation only,
+  /// nothing reads it to simulate.
+  std::vector<std::pair<std::string, std::string>> sensor_effects;
 
   std::optional<double> fog_mor_m;            ///< fog MOR, (0, 1e5] m
   double fog_height_falloff_per_m = 0;        ///< [0, 10] 1/m; 0 = uniform
@@ -69,6 +76,9 @@ struct AdversityPreset {
   /// what the NPCs do about the robots (effects/agent_path.h AgentBehaviour)
   AgentBehaviour npc_behaviour = AgentBehaviour::kAvoid;
   double npc_clearance_m = 0.5;  ///< avoid: kept from a robot's disc, [0, 10] m
+  /// NPCs may push the robots (`npcs.contact: true`; AgentConfig::robot_contact). false (the
+  /// default): they never move into a robot and yield when one comes into them.
+  bool npc_contact = false;
   /// block: where the robots are going (world x, y in m, |x|, |y| <= 1e5; `npcs.block_goal`,
   /// only with behaviour block). block people then start near each robot's route to it
   /// instead of ahead of its start heading (session/effects_stage.h "npcs").
@@ -97,6 +107,9 @@ std::vector<AdversityPreset> ParseAdversityPresets(const std::string& text,
 /// writes to run a preset with a changed field (e.g. `penumbra benchmark` adds the episode's
 /// goal as npcs.block_goal, campaign/nav_job.h).
 std::string AdversityPresetFileText(const AdversityPreset& preset);
+
+/// the sensors a preset's `sensors:` block may describe: "rgb", "depth", "lidar", "imu".
+const std::vector<std::string>& AdversitySensorNames();
 
 /// the names of the bundled presets ("none", "minor", "major").
 std::vector<std::string> BundledAdversityPresetNames();

@@ -33,7 +33,7 @@ std::vector<AgentConfig> ReadAgents(const ParamReader& list, const std::string& 
   for (const ParamReader& r : list.List()) {
     note(r);
     r.ExpectMap({"name", "type", "waypoints", "speed_m_s", "pause_sec", "start_delay_sec", "route",
-                 "floor_z", "height_m", "motion", "behaviour", "goals", "clearance_m"});
+                 "floor_z", "height_m", "motion", "behaviour", "goals", "clearance_m", "contact"});
     AgentConfig a;
     a.line = r.line();
     a.name = note(r.Child("name")).String();
@@ -73,6 +73,7 @@ std::vector<AgentConfig> ReadAgents(const ParamReader& list, const std::string& 
       a.goals = note(r.Child("goals")).Enum({"patrol", "random"}) == "random" ? AgentGoals::kRandom
                                                                               : AgentGoals::kPatrol;
     if (const auto found = r.Find("clearance_m")) a.clearance_m = note(*found).Double();
+    if (const auto found = r.Find("contact")) a.robot_contact = note(*found).Bool();
     a.ValidateOrThrow(file, r.path(), [&](const std::string& key) {
       auto it = lines.find(key);
       return it == lines.end() ? 0 : it->second;

@@ -5,7 +5,8 @@
 //   waypoints (required, >= 2 [x, y] in m), speed_m_s (0, 20], pause_sec [0, 3600],
 //   start_delay_sec [0, 3600], route (loop | pingpong | once), floor_z (m),
 //   height_m [0.5, 2.5] (person), motion (scripted | crowd), behaviour (avoid | ignore |
-//   block), goals (patrol | random), clearance_m [0, 10] (docs/npcs.md).
+//   block), goals (patrol | random), clearance_m [0, 10], contact (bool, default false: a
+//   crowd agent never moves into a robot and yields to it) (docs/npcs.md).
 
 #include <vector>
 
