@@ -76,7 +76,8 @@ void ReplayCommand::AddOptions(CLI::App* r) {
               "the output folder may hold an earlier run's outputs: remove them first");
   r->add_option("--adversity", o.adversity,
                 "adversity preset: none, minor, major, FILE.yaml or FILE.yaml#NAME (default: as "
-                "recorded); its NPCs are seen but push nothing");
+                "recorded); its NPCs keep clear of the logged robot (NPCs that may touch it "
+                "are refused)");
   r->add_option("--world", o.world_override,
                 "world-file fragment replacing visual keys of the recorded world (cameras, "
                 "lights, sky, materials, render, effects, ...; docs/replay.md)");

@@ -16,8 +16,9 @@
 // a replaced key replaces the recorded key entirely (a `cameras` list replaces the recorded
 // list: repeat a recorded camera to keep it); keys the override does not name stay as recorded.
 // agents named as in the log follow the log whatever their new path (only their look changes);
-// new agents move on their own paths and, like an adversity preset's NPCs added by a replay,
-// are seen but push nothing. `seed` changes noise, effects and a preset's NPC paths.
+// new agents move on their own and, like an adversity preset's NPCs added by a replay, keep
+// clear of the logged robot (crowd agents); a kinematic replay refuses new agents that may touch
+// it (replay/kinematic/replay_runner.h). `seed` changes noise, effects and a preset's NPC paths.
 //
 // the fragment is read as a world file at its own path: its relative paths resolve against its
 // folder and its errors name its lines; names it uses (camera attach bodies, material names)

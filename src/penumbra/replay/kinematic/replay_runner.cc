@@ -138,6 +138,25 @@ ReplaySummary ReplayLocated(const ReplayOptions& options, const WorldConfig& rec
   session_options.check_run_budget = true;
   session_options.reserve_live_npcs = ParseRecordedRunFlags(header.command_line).live;
   Session session(world, session_options);
+  // agents the log does not hold move on their own while the robot moves as logged: a crowd
+  // agent keeps clear of the logged robot as it would have in a run (effects/crowd_sim.h
+  // "contact"); one that may touch it (scripted, contact: true, behaviour block) would pass
+  // through it or be passed through where the run would have had a contact: refused
+  for (const AgentConfig& a :
+       TouchingAgentsWithout(session.effects().agents(), header.layout.mocap_body_names)) {
+    const bool preset = a.name.rfind("adversity_", 0) == 0;
+    const std::string why =
+        a.robot_contact ? (preset ? "the preset's npcs.contact: true" : "contact: true")
+        : a.behaviour == AgentBehaviour::kBlock && a.motion == AgentMotion::kCrowd
+            ? "behaviour: block stands in the robot's way"
+            : "motion: scripted follows its path whatever it touches";
+    throw ConfigError(
+        "", 0, preset ? (options.adversity.empty() ? "adversity" : "--adversity") : "agents",
+        "agent '" + a.name + "' is not in the log and may touch the robot (" + why +
+            "); a replay moves the robot as logged and cannot show the contact; expected "
+            "agents that keep clear of the robot (motion: crowd, behaviour avoid or ignore, "
+            "without contact), or a run recorded with this agent (penumbra run --record)");
+  }
   // a stop (SIGINT / SIGTERM) also ends a pathtraced frame between samples
   if (Renderer* renderer = session.renderer()) renderer->set_stop_request(options.stop_request);
   Simulation& sim = session.sim();

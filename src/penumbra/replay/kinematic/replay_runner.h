@@ -10,6 +10,12 @@
 // with the recorded conditions the frames are those of the run, byte for byte (same steps,
 // same snapshots, same sinks); --from / --to render the frames of that window only, with the
 // indices (file names) of the run's.
+//
+// agents: the log's own follow the log (agents that pushed the robot push it again). agents
+// the replay adds (--adversity NPCs, an override's `agents:`) move on their own while the robot
+// moves as logged: crowd agents read its logged pose and keep clear of it as in a run; one
+// that may touch it (session/effects_stage.h AgentMayTouchRobot: scripted, contact, block)
+// is refused before any frame, since the replay cannot show the contact.
 
 #include <atomic>
 #include <cstdint>
@@ -92,8 +98,9 @@ int64_t FirstStepAtOrAfter(double time_sec, double timestep_sec);
 ///         outside the log, unknown camera names, an override key that changes physics, an
 ///         output folder that is not empty without force) or a replay model that does not
 ///         match the log (a joint missing or changed), naming the file, line and key where one
-///         applies; Error for a write failure (after what was rendered is flushed and run.json
-///         written, as in `run`).
+///         applies; ConfigError("", 0, "--adversity" / "adversity" / "agents", ...) naming an
+///         added agent that may touch the robot and why; Error for a write failure (after what was
+///         rendered is flushed and run.json written, as in `run`).
 ReplaySummary ReplayLog(const ReplayOptions& options);
 
 }  // namespace penumbra
