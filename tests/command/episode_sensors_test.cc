@@ -17,6 +17,7 @@
 
 #include "command/live_loop.h"
 #include "common/temp_dir.h"
+#include "penumbra/sinks/camera_sink.h"
 #include "penumbra/sinks/sensor_sink.h"
 
 namespace penumbra {
@@ -148,6 +149,96 @@ TEST_P(EpisodeSensorsTest, SameActionsAfterResetGiveTheFirstEpisodesSamplesBitFo
         ++compared;
       }
       EXPECT_GE(compared, steps / 6);
+    }
+  }
+}
+
+// the cameras of worlds/quadruped.yaml (a RealSense D435 colour imager on the robot, a Blackfly
+// S on the world: profile noise, fixed pattern and auto exposure) at a quarter of their size.
+// two episodes that start with a reset give the same images; the run's first episode differs
+// from them, since its frame at step 0 (which an episode after a reset does not render) is
+// what auto exposure meters its second frame on
+TEST(EpisodeCamerasTest, SameActionsAfterResetsGiveTheSameImagesBitForBit) {
+  const Case c{"trot_gait", "quadruped.yaml", "quadruped"};
+  std::string text = WorldWithSensors(c);
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"width: 640\n    height: 480",
+                                                                     "width: 160\n    height: 120"},
+                                 {"width: 800\n    height: 450", "width: 200\n    height: 113"}}) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  }
+  penumbra::testing::TempDir dir;
+  const std::string world = dir.Write("world.yaml", text);
+  struct Frame {
+    std::string camera;
+    int64_t index = 0, step = 0;
+    std::vector<uint8_t> rgb;
+  };
+  std::mutex mu;
+  std::vector<Frame> frames;
+  std::unique_ptr<CameraSink> cameras;
+  const int steps = 120;  // 0.24 s: frames at 0, 0.1 and 0.2 s of each episode
+  std::vector<int64_t> starts = {0};
+  {
+    LiveLoop live(
+        world, 1000.0,
+        [&](Session& session, SimLoop& loop) {
+          CameraSinkOptions options;
+          options.episode_start = [&sim = session.sim()] { return sim.controller_episode_start(); };
+          options.on_frame = [&](const std::shared_ptr<const CameraFrame>& f) {
+            std::lock_guard<std::mutex> lock(mu);
+            frames.push_back({f->camera, f->index, f->step, f->rgb.data});
+          };
+          cameras = std::make_unique<CameraSink>(session.scene(), session.world(),
+                                                 session.sim().timestep(), session.renderer(),
+                                                 (dir.path() / "out").string(), nullptr, options);
+          loop.AddSink(cameras.get());
+        },
+        true);
+    Episode(live, steps);
+    for (int before : {37, 61}) {
+      Episode(live, before, 1);
+      const json r = CallOk(live, {{"cmd", "reset"}});
+      starts.push_back(r.at("step").get<int64_t>());
+      Episode(live, steps);
+    }
+    // steps beyond the last episode: its last exposure ends before the run does
+    Episode(live, 40, 1);
+    live.Stop();
+  }
+  for (const std::string camera : {"front", "side"}) {
+    std::map<int64_t, const Frame*> first;
+    int64_t last = -1;
+    for (const Frame& f : frames) {
+      if (f.camera != camera) continue;
+      EXPECT_GT(f.index, last) << camera << " at step " << f.step;  // indices go on
+      last = f.index;
+      if (f.step <= steps) first[f.step] = &f;
+    }
+    ASSERT_EQ(first.size(), 3u) << camera;
+    // the noise is on: two frames of the static side camera differ
+    if (camera == "side") EXPECT_NE(first.begin()->second->rgb, first.rbegin()->second->rgb);
+    // the episode after the first reset is the reference of the one after the second
+    first.clear();
+    for (const Frame& f : frames)
+      if (f.camera == camera && f.step > starts[1] && f.step <= starts[1] + steps)
+        first[f.step - starts[1]] = &f;
+    for (size_t e = 2; e < starts.size(); ++e) {
+      int compared = 0;
+      for (const Frame& f : frames) {
+        if (f.camera != camera || f.step <= starts[e] || f.step > starts[e] + steps) continue;
+        const int64_t j = f.step - starts[e];
+        ASSERT_TRUE(first.count(j)) << camera << ": episode " << e << " rendered at its step " << j
+                                    << ", the first episode did not";
+        EXPECT_TRUE(f.rgb == first.at(j)->rgb)
+            << camera << ": episode " << e << " (reset at step " << starts[e]
+            << ") differs from episode 1 at its step " << j;
+        ++compared;
+      }
+      // the frame at the episode's step 0 is not rendered (the reset step shows the episode
+      // before it): 0.1 and 0.2 s are
+      EXPECT_EQ(compared, 2) << camera << " episode " << e;
     }
   }
 }

@@ -21,11 +21,13 @@ class LiveLoop {
  public:
   /// loads `world_file` (no renderer) and starts the loop paused; it ends at `end_time_sec` of
   /// sim time or on `stop`. `add_sinks` (optional) adds sinks to the loop before it starts;
-  /// they must outlive the LiveLoop.
+  /// they must outlive the LiveLoop. `build_renderer`: the session builds its renderer (for
+  /// camera sinks).
   LiveLoop(const std::string& world_file, double end_time_sec,
-           const std::function<void(Session&, SimLoop&)>& add_sinks = {}) {
+           const std::function<void(Session&, SimLoop&)>& add_sinks = {},
+           bool build_renderer = false) {
     SessionOptions so;
-    so.build_renderer = false;
+    so.build_renderer = build_renderer;
     session_ = std::make_unique<Session>(LoadWorldFile(world_file), so);
     RunControlOptions co;
     co.start_paused = true;

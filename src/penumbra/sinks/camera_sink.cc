@@ -123,6 +123,7 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
                 return w;
               }()),
       schedule_(timestep_sec),
+      timestep_sec_(timestep_sec),
       shutters_(scene, world),
       worker_(static_cast<size_t>(std::max(1, options_.render_queue))) {
   selected_.assign(scene.cameras.size(), options_.cameras.empty() ? 1 : 0);
@@ -146,6 +147,9 @@ CameraSink::CameraSink(const SceneDescription& scene, const WorldConfig& world, 
     selected.push_back(scene.cameras[i]);
   }
   const std::vector<CameraSensorConfig> cfg = SensorConfigsFor(scene, world);
+  imager_configs_ = cfg;
+  next_frame_.assign(scene.cameras.size(), 0);
+  frame_base_.assign(scene.cameras.size(), 0);
   imagers_.reserve(scene.cameras.size());
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     imagers_.emplace_back(scene.cameras[i], cfg[i], world.render, static_cast<int>(i), scene);
@@ -179,15 +183,50 @@ void CameraSink::OnStart(const LoopStart& start) {
   worker_.Start(start.report_error);
 }
 
+void CameraSink::StartEpisode(int64_t start, int64_t step) {
+  episode_start_ = start;
+  later_episode_ = true;
+  schedule_ = SensorSchedule(timestep_sec_);
+  for (size_t i = 0; i < scene_.cameras.size(); ++i) {
+    schedule_.Add(scene_.cameras[i].name, scene_.cameras[i].rate_hz);
+    frame_base_[i] = -1;
+  }
+  schedule_.StartAt(step - start);
+  // on the render thread, in order: the open exposures end at the episode's last snapshot,
+  // then every imager starts over
+  worker_.Post([this] {
+    CompletePending(true);
+    for (const CameraImager& imager : imagers_) renderer_sec_before_ += imager.renderer_sec();
+    imagers_.clear();
+    for (size_t i = 0; i < scene_.cameras.size(); ++i) {
+      imagers_.emplace_back(scene_.cameras[i], imager_configs_[i], render_, static_cast<int>(i),
+                            scene_);
+      imagers_.back().set_keep_radiance(false);
+    }
+  });
+}
+
 SnapshotContent CameraSink::Wants(int64_t step, double time_sec) {
   Capture c;
   c.step = step;
   due_.clear();
-  schedule_.Due(step, &due_);
+  if (options_.episode_start) {
+    const int64_t start = options_.episode_start();
+    if (start != episode_start_) StartEpisode(start, step);
+  }
+  schedule_.Due(step - episode_start_, &due_);
   for (const SensorFiring& f : due_) {
+    // frame k of the episode: noise keyed by k, the written index goes on
+    int64_t frame = f.index;
+    if (later_episode_) {
+      if (frame_base_[f.sensor] < 0) frame_base_[f.sensor] = next_frame_[f.sensor] - f.index;
+      frame += frame_base_[f.sensor];
+    }
+    next_frame_[f.sensor] = frame + 1;
     if (!selected_[f.sensor]) continue;
     c.cameras.push_back(f.sensor);
-    c.frames.push_back(f.index);
+    c.frames.push_back(frame);
+    c.noise_frames.push_back(f.index);
   }
   const bool shutter_due = shutters_.Due(time_sec);
   if (!shutter_due && c.cameras.empty()) {
@@ -221,7 +260,7 @@ void CameraSink::OnFinish(const LoopFinish& finish) {
 }
 
 double CameraSink::renderer_sec() const {
-  double sec = 0;
+  double sec = renderer_sec_before_;
   for (const CameraImager& imager : imagers_) sec += imager.renderer_sec();
   return sec;
 }
@@ -235,7 +274,11 @@ void CameraSink::Render(const std::shared_ptr<const WorldSnapshot>& snapshot,
   }
   for (size_t i = 0; i < capture.cameras.size(); ++i) {
     const int c = capture.cameras[i];
-    Pending p{c, capture.frames[i], snapshot, i < effects.size() ? effects[i] : nullptr,
+    Pending p{c,
+              capture.frames[i],
+              capture.noise_frames[i],
+              snapshot,
+              i < effects.size() ? effects[i] : nullptr,
               snapshot->time_sec + span_[c]};
     if (span_[c] > 0) {
       pending_.push_back(std::move(p));
@@ -262,7 +305,8 @@ void CameraSink::Complete(const Pending& p, const WorldSnapshot* end) {
   MoveUnwrittenImages(&scratch_[p.camera], &img);
   buffers_.Take(spec.name, &img);
   const auto t0 = std::chrono::steady_clock::now();
-  imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.frame, &img);
+  imagers_[p.camera].Capture(renderer_, *p.start, p.effects.get(), X0, end, X1, p.noise_frame,
+                             &img);
   const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   render_sec_ += sec;
   if (!rendered_once_[p.camera]) {

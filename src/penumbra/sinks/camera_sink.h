@@ -97,6 +97,12 @@ struct CameraSinkOptions {
   /// to the writer (e.g. a bridge publishing images; command/run_bridge.h). may be empty;
   /// when set, each frame is copied once into the shared object.
   std::function<void(const std::shared_ptr<const CameraFrame>& frame)> on_frame;
+  /// the step the current episode started at (Simulation::controller_episode_start: the last
+  /// `reset`), read on the loop thread at every step; empty = one episode. when it changes,
+  /// the exposures open end at the last snapshot, every camera's schedule restarts on the
+  /// episode's clock and its imager starts over (noise keyed by the frame's index within the
+  /// episode, auto exposure from its start); written frame indices go on increasing.
+  std::function<int64_t()> episode_start;
 };
 
 /// every camera of `scene`. the render thread is the only user of `renderer`.
@@ -153,6 +159,7 @@ class CameraSink : public Sink {
   struct Pending {
     int camera;
     int64_t frame;
+    int64_t noise_frame;  // the frame's index within its episode
     std::shared_ptr<const WorldSnapshot> start;
     std::shared_ptr<const EffectsFrame> effects;
     double end_time;
@@ -161,7 +168,10 @@ class CameraSink : public Sink {
     int64_t step = -1;
     std::vector<int> cameras;
     std::vector<int64_t> frames;
+    std::vector<int64_t> noise_frames;  // per camera: the frame's index within the episode
   };
+  // loop thread: a new episode starts at step `start`; the loop is at `step`
+  void StartEpisode(int64_t start, int64_t step);
   // render thread
   void Render(const std::shared_ptr<const WorldSnapshot>& snapshot, const Capture& capture,
               const std::vector<std::shared_ptr<const EffectsFrame>>& effects);
@@ -179,13 +189,21 @@ class CameraSink : public Sink {
   FrameBufferPool buffers_;
   AsyncFrameWriter writer_;
   // loop thread
-  SensorSchedule schedule_;
+  SensorSchedule schedule_;  // on the current episode's clock
+  double timestep_sec_;
+  int64_t episode_start_ = 0;
+  bool later_episode_ = false;       // a reset started an episode
+  std::vector<int64_t> next_frame_;  // per scene camera: the index of its next frame
+  std::vector<int64_t> frame_base_;  // per scene camera: frame = base + index in episode
   ShutterSchedule shutters_;
   std::vector<SensorFiring> due_;
   std::vector<char> selected_;  // per scene camera: rendered (CameraSinkOptions::cameras)
   std::optional<Capture> capture_;
   // render thread
   std::vector<CameraImager> imagers_;
+  // what the imagers are made of (a new episode makes them anew)
+  std::vector<CameraSensorConfig> imager_configs_;
+  double renderer_sec_before_ = 0;  // renderer time of the imagers of earlier episodes
   // per scene camera: the last frame's images that are not handed to the writer (the renderer's
   // radiance, rgb and depth, the imager's radiance), reused by the camera's next frame
   std::vector<CameraImages> scratch_;

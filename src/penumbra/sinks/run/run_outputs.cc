@@ -25,6 +25,9 @@ RunOutputs::RunOutputs(Session& session, const WorldConfig& world,
   camera_options.cameras = std::move(options.cameras);
   camera_options.render_queue = options.render_queue;
   camera_options.writer.on_image = std::move(options.on_image);
+  // a `reset` (Simulation::ResetControllers) restarts the cameras with the episode, as the
+  // sensors (SensorSink follows the same simulation)
+  camera_options.episode_start = [&sim] { return sim.controller_episode_start(); };
   cameras_ =
       std::make_unique<CameraSink>(session.scene(), world, sim.timestep(), session.renderer(),
                                    out_dir.string(), viewer_effects, camera_options);
