@@ -17,7 +17,7 @@
 
 #include "command/live_loop.h"
 #include "common/temp_dir.h"
-#include "penumbra/sinks/camera_sink.h"
+#include "penumbra/sinks/run/run_outputs.h"
 #include "penumbra/sinks/sensor_sink.h"
 
 namespace penumbra {
@@ -177,23 +177,21 @@ TEST(EpisodeCamerasTest, SameActionsAfterResetsGiveTheSameImagesBitForBit) {
   };
   std::mutex mu;
   std::vector<Frame> frames;
-  std::unique_ptr<CameraSink> cameras;
+  std::unique_ptr<RunOutputs> outputs;
   const int steps = 120;  // 0.24 s: frames at 0, 0.1 and 0.2 s of each episode
   std::vector<int64_t> starts = {0};
   {
     LiveLoop live(
         world, 1000.0,
         [&](Session& session, SimLoop& loop) {
-          CameraSinkOptions options;
-          options.episode_start = [&sim = session.sim()] { return sim.controller_episode_start(); };
-          options.on_frame = [&](const std::shared_ptr<const CameraFrame>& f) {
+          // the outputs of `penumbra run` (their cameras follow the simulation's episodes)
+          outputs = std::make_unique<RunOutputs>(session, session.world(), dir.path() / "out",
+                                                 RunOutputsOptions{});
+          outputs->cameras().set_on_frame([&](const std::shared_ptr<const CameraFrame>& f) {
             std::lock_guard<std::mutex> lock(mu);
             frames.push_back({f->camera, f->index, f->step, f->rgb.data});
-          };
-          cameras = std::make_unique<CameraSink>(session.scene(), session.world(),
-                                                 session.sim().timestep(), session.renderer(),
-                                                 (dir.path() / "out").string(), nullptr, options);
-          loop.AddSink(cameras.get());
+          });
+          outputs->AddTo(&loop);
         },
         true);
     Episode(live, steps);
