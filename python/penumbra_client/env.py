@@ -47,9 +47,10 @@ class PenumbraEnv:
 
     **Episodes**: ``reset`` restores the run's step-0 state (``options={"keyframe": NAME}``
     applies an MJCF keyframe) and the controllers' (gait phase, references, integrators,
-    histories), then steps with a zero action until every image output has a frame: the
-    same actions give the same qpos and qvel, bit for bit. Sim time keeps increasing across
-    episodes; image noise is not repeated. ``reward_fn(obs, info)`` and
+    histories) and the cameras' frame schedules and noise, then steps with a zero action until
+    every image output has a frame captured in the new episode: the same actions give the
+    same qpos, qvel and images, bit for bit. Sim time keeps increasing across episodes.
+    ``reward_fn(obs, info)`` and
     ``terminate_fn(obs, info)`` (defaults: 0.0 and False) define the task; ``truncated`` is
     True after ``max_episode_steps`` steps or when the run reaches its end time. ``info`` has
     ``step`` and ``time_sec`` (the run's physics step count and sim time) and
@@ -127,6 +128,10 @@ class PenumbraEnv:
             self.client.subscribe(list(self._topics))
         self._latest = {}
         self._episode_steps = 0
+        # the step the run's current episode started at (the run's start, then each reset)
+        # and the newest step whose frames belong to an earlier episode
+        self._episode_start = 0
+        self._stale_until = -1
         self._closed = False
 
     def _apply(self, action):
@@ -141,7 +146,8 @@ class PenumbraEnv:
         r = self.client.step(self.steps_per_action, state=True)
         for msg in r.messages:
             out = self._topics.get(msg.topic)
-            if out is not None:
+            # an exposure open at the reset ends after it: that frame shows the last episode
+            if out is not None and msg.sim_step > self._stale_until:
                 self._latest[out] = msg.image()
         obs = {out: self._latest.get(out) for out in self.outputs}
         obs["qpos"] = r.state.qpos
@@ -156,7 +162,13 @@ class PenumbraEnv:
         if seed is not None and seed != self.model.seed:
             raise ValueError(f"seed: {seed}; this run's world seed is {self.model.seed} "
                              "(start a new run with --seed for another)")
-        self.client.reset(keyframe=options.get("keyframe"))
+        if self.client.get_state().step == self._episode_start:
+            # nothing stepped since the episode began (the run's start): the cameras and
+            # sensors see a reset as a new episode only after a step, so take one, so that
+            # this episode starts as every later one does (no frame at its step 0)
+            self.client.step(1)
+        r = self.client.reset(keyframe=options.get("keyframe"))
+        self._episode_start = self._stale_until = r["step"]
         self._latest = {}
         self._episode_steps = 0
         self._apply(np.zeros(self.action_space.shape) if self.action == "twist" else

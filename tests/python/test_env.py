@@ -58,30 +58,36 @@ class PenumbraEnvTest(unittest.TestCase):
             client.close()
 
     def test_same_actions_give_the_same_episode(self):
-        # reset restores the controllers (gait phase, references) and restarts their clock: the
-        # same actions after a reset give the first episode's qpos and qvel bit for bit, also
-        # after an episode of other actions
+        # reset restores the controllers (gait phase, references) and restarts their clock and
+        # the cameras' schedules and noise: the same actions after a reset give the first
+        # episode's qpos and qvel and its images (the D435 profile's noise and auto exposure)
+        # bit for bit, also after an episode of other actions
         actions = [[0.5, 0.0, 0.0]] * 10 + [[0.3, 0.2, 1.0]] * 10 + [[0.0, 0.0, -1.5]] * 10
 
         def episode(env, acts):
             obs, _ = env.reset()
             rows = [np.concatenate([obs["qpos"], obs["qvel"]])]
+            images = [obs["rgb"].tobytes()]
             for a in acts:
                 obs, _, _, _, _ = env.step(a)
                 rows.append(np.concatenate([obs["qpos"], obs["qvel"]]))
-            return np.array(rows)
+                images.append(obs["rgb"].tobytes())
+            return np.array(rows), images
 
         with PenumbraServer("worlds/quadruped_target.yaml", lockstep=True) as server:
             client = server.connect(timeout_sec=60)
             env = pc.PenumbraEnv(client=client)
-            first = episode(env, actions)
+            first, first_images = episode(env, actions)
             self.assertGreater(first[-1, 0] - first[0, 0], 0.3)  # it walked
             episode(env, [[1.0, -0.5, 2.0]] * 7)
-            second = episode(env, actions)
+            second, second_images = episode(env, actions)
             self.assertEqual(first.shape, second.shape)
             self.assertEqual(first.tobytes(), second.tobytes(),
                              "first differing step: %d" %
                              int(np.argmax(np.any(first != second, axis=1))))
+            self.assertEqual(len(set(first_images)), len(first_images))  # it saw new frames
+            differ = [k for k, (a, b) in enumerate(zip(first_images, second_images)) if a != b]
+            self.assertEqual(differ, [], "the images of these steps differ")
             env.close()
             client.close()
 
