@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include "penumbra/core/error.h"
 #include "penumbra/live/run_log_header.h"
 #include "penumbra/physics/physics_source.h"
@@ -27,15 +29,24 @@ LogSource::LogSource(RunLogReader* reader, Simulation* sim, LogSourceOptions opt
     throw RunLogError(fmt::format("{}: no step at or after step {} (the log's steps are {} to {})",
                                   reader_->path(), options.first_step, reader_->first_step(),
                                   reader_->last_step()));
+  for (const EventRecord& e : reader_->Events(options.first_step)) {
+    if (e.kind != "command") continue;
+    const nlohmann::json payload = nlohmann::json::parse(e.payload, nullptr, false);
+    if (payload.is_object() && payload.value("cmd", nlohmann::json()) == "reset")
+      reset_steps_.insert(e.step);
+  }
+}
+
+void LogSource::ApplyCurrent() {
+  if (applied_step_ == current_.step) return;
+  map_.Apply(current_, &state_);
+  sim_->SetState(state_);
+  sim_->ApplyMocapDrivers(map_.unlogged_mocap());
+  applied_step_ = current_.step;
 }
 
 std::shared_ptr<const WorldSnapshot> LogSource::Snapshot(SnapshotContent content) {
-  if (applied_step_ != current_.step) {
-    map_.Apply(current_, &state_);
-    sim_->SetState(state_);
-    sim_->ApplyMocapDrivers(map_.unlogged_mocap());
-    applied_step_ = current_.step;
-  }
+  ApplyCurrent();
   const std::shared_ptr<WorldSnapshot> s = TakeSnapshot(*sim_, content);
   // the controllers' schedule as logged (the replay runs none)
   s->controller_next_update = current_.controller_next_update;
@@ -43,6 +54,11 @@ std::shared_ptr<const WorldSnapshot> LogSource::Snapshot(SnapshotContent content
 }
 
 bool LogSource::Advance() {
+  // a reset at the boundary after this step: the episode starts here, as in the run
+  if (reset_steps_.count(current_.step)) {
+    ApplyCurrent();
+    sim_->ResetControllers();
+  }
   if (!reader_->NextStep(&next_)) return false;
   std::swap(current_, next_);
   return true;

@@ -11,9 +11,16 @@
 // with the model and state of the recorded run, a snapshot equals bit for bit the one live
 // physics took at that step (the same mjData inputs into the same MuJoCo functions), so the
 // sinks write the same files.
+//
+// the log's `reset` commands ("command" events, docs/run-log.md) start an episode in the replay
+// model at their step as they did in the run (Simulation::ResetControllers after the state of
+// that step is set), so that the sensors and cameras, which restart their schedules and noise
+// streams with each episode (sinks/sensor_sink.h, sinks/camera_sink.h), sample as in the run.
+// a replay that starts (LogSourceOptions::first_step) after a reset samples as from episode 0.
 
 #include <cstdint>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "penumbra/physics/simulation.h"
@@ -56,8 +63,9 @@ class LogSource : public Source {
   /// of the replay model at that state, with the same state fields.
   /// @throws Error from Simulation::SetState; PhysicsError from Simulation::Snapshot.
   std::shared_ptr<const WorldSnapshot> Snapshot(SnapshotContent content) override;
-  /// moves to the next logged step; false at the end of the log (of its usable chunks).
-  /// @throws RunLogError when a chunk cannot be read.
+  /// moves to the next logged step; false at the end of the log (of its usable chunks). at a
+  /// step the log holds a `reset` command at, the replay model's episode starts there first.
+  /// @throws RunLogError when a chunk cannot be read; Error from Simulation::SetState.
   bool Advance() override;
 
   /// the name mapping used.
@@ -68,8 +76,11 @@ class LogSource : public Source {
   Simulation* sim_;
   StateMap map_;
   StepRecord current_, next_;
-  SimState state_;             // the replay model's state, reused
-  int64_t applied_step_ = -1;  // step whose state is set in sim_
+  SimState state_;                 // the replay model's state, reused
+  int64_t applied_step_ = -1;      // step whose state is set in sim_
+  std::set<int64_t> reset_steps_;  // steps of the log's `reset` commands
+  // sets the logged state of the current step into sim_ (once per step)
+  void ApplyCurrent();
 };
 
 }  // namespace penumbra
