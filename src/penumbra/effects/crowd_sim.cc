@@ -109,6 +109,7 @@ CrowdSim::CrowdSim(std::vector<AgentConfig> agents,
   active_.assign(n, 1);
   yielding_.assign(n, 0);
   giving_way_.assign(n, 0);
+  give_way_retry_.assign(n, 0.0);
   for (size_t i = 0; i < n; ++i) {
     const AgentConfig& a = agents_[i];
     rngs_.emplace_back(HashKeys(seed, kCrowdStream, i));
@@ -375,9 +376,11 @@ void CrowdSim::Step(const std::vector<CrowdRobot>& robots) {
       bool in_way = false;
       for (const CrowdRobot& r : robots)
         in_way = in_way || InRobotsWay(i, states_[i].position_W, r);
-      if (in_way && !giving_way_[i])
+      if (in_way && !giving_way_[i] && time_ >= give_way_retry_[i]) {
         giving_way_[i] = GiveWay(i, robots) ? 1 : 0;
-      else if (!in_way)
+        // no refuge found: look again in a second (each look runs up to 12 A* searches)
+        if (!giving_way_[i]) give_way_retry_[i] = time_ + 1.0;
+      } else if (!in_way)
         giving_way_[i] = 0;
     }
     preferred[i] = Preferred(i);

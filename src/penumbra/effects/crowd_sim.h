@@ -52,7 +52,8 @@
 //             either side of its velocity) walks out of its way: to the nearest walkable point
 //             beside or behind every moving robot's path and off every contact disc (+ 0.3 m)
 //             (rings of 16 points 0.5-4 m away, the first 12 tried by A* round the robots'
-//             contact discs; a "give_way" decision), then goes on.
+//             contact discs; a "give_way" decision; none found: it looks again after 1 s),
+//             then goes on.
 
 #include <Eigen/Core>
 #include <memory>
@@ -224,8 +225,9 @@ class CrowdSim {
   std::vector<double> speed_;       // vehicles: signed speed along the heading, m/s
   std::vector<double> slow_since_;  // start of the agent's current spell below 0.1 m/s
   std::vector<uint8_t> active_;
-  std::vector<uint8_t> yielding_;    // stepping away from a robot that came into it
-  std::vector<uint8_t> giving_way_;  // walking out of a moving robot's way
+  std::vector<uint8_t> yielding_;       // stepping away from a robot that came into it
+  std::vector<uint8_t> giving_way_;     // walking out of a moving robot's way
+  std::vector<double> give_way_retry_;  // no refuge found: the time of the next look
   std::vector<CrowdDecision> decisions_;
 };
 
