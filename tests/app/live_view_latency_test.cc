@@ -16,9 +16,9 @@
 #include <set>
 
 #include "common/temp_dir.h"
-#include "penumbra/run/runner.h"
 #include "penumbra/command/command_dispatcher.h"
 #include "penumbra/command/run_bridge.h"
+#include "penumbra/run/runner.h"
 #include "penumbra/world/world_config.h"
 
 namespace penumbra {
@@ -96,6 +96,9 @@ TEST(LiveViewLatencyTest, ATeleopCommandShowsOnTheNextRenderedFrameAndFilesKeepE
   world.cameras[0].width = 160;
   world.cameras[0].height = 120;
   world.cameras[0].outputs = CameraOutputs{};
+  // the ideal camera: a frame is due at its capture step (a real profile's exposure and readout
+  // would hold each frame back until its span ended)
+  world.cameras[0].sensor = CameraSensorConfig();
   ASSERT_EQ(world.timestep_sec.value_or(0), 0.002);
   world.cameras[0].rate_hz = 500;
   world.sensors.clear();

@@ -135,6 +135,20 @@ void ApplyOptics(const OpticsConfig& o, const CameraIntrinsics& k, const ImageF&
   std::swap(*out, *tmp);
 }
 
+// `k` at a quarter of its size (at least 1 x 1), the same field of view.
+CameraIntrinsics QuarterIntrinsics(const CameraIntrinsics& k) {
+  CameraIntrinsics q = k;
+  q.width = std::max(1, k.width / 4);
+  q.height = std::max(1, k.height / 4);
+  const double sx = static_cast<double>(q.width) / k.width;
+  const double sy = static_cast<double>(q.height) / k.height;
+  q.fx = k.fx * sx;
+  q.fy = k.fy * sy;
+  q.cx = (k.cx + 0.5) * sx - 0.5;
+  q.cy = (k.cy + 0.5) * sy - 0.5;
+  return q;
+}
+
 // the radiance (cd/m^2) of the largest white-balanced channel that a fraction `fraction` of the
 // pixels of `img` exceed; 0 for an empty image.
 double BrightQuantile(const ImageF& img, const Eigen::Vector3f& wb, double fraction) {
@@ -257,8 +271,60 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   const int W = spec_.intrinsics.width, H = spec_.intrinsics.height;
   const AutoExposureConfig& ae_cfg = c.auto_exposure;
   const bool ae = ae_cfg.enabled;
-  // with auto exposure the shutter time metered on the last frame (frame 0: exposure_time_sec)
-  const double T = ae && ae_time_ ? *ae_time_ : c.exposure_time_sec;
+  const bool want_rgb_frame = spec_.outputs[ImageKind::kRgb];
+  const bool optics = HasOptics(c.optics);
+  // renderer frame indices: sub-frames (and the metering view) of different frames never share
+  // one
+  const int64_t stride = ae ? c.motion_blur_samples + 1 : 0;
+  // auto exposure: this frame's shutter time and gain, metered on a quarter-size view of the
+  // capture instant (as a camera's statistics grid), so they depend on this frame alone
+  double ae_t = c.exposure_time_sec, ae_g = 1, ae_ev = 0;
+  if (ae && want_rgb_frame) {
+    CameraView mv;
+    mv.X_WO = X_WO_start;
+    mv.intrinsics = QuarterIntrinsics(spec_.intrinsics);
+    mv.near_m = spec_.near_m;
+    mv.frame_index = frame_index * stride + c.motion_blur_samples;
+    mv.camera_index = camera_index_;
+    mv.exposure_time_sec = c.exposure_time_sec;
+    mv.want_radiance = true;
+    mv.outputs = CameraOutputs::None();
+    mv.outputs[ImageKind::kRgb] = true;
+    RenderedFrame meter;
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer->Render(start, effects, mv, &meter);
+    renderer_sec_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    out->stopped = meter.stopped;
+    if (out->stopped) return;
+    const ImageF* m = &meter.radiance;
+    if (optics) {
+      ApplyOptics(c.optics, mv.intrinsics, meter.radiance, &meter_optic_, &meter_tmp_, pool_.get());
+      m = &meter_optic_;
+    }
+    ae_ev = film_.Ev100(*m, pool_.get());
+    if (settings_.auto_exposure && c.auto_exposure_time_constant_sec > 0 && last_ev_) {
+      const double dt = std::max(0.0, start.time_sec - *last_time_);
+      ae_ev = ae_ev + (*last_ev_ - ae_ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
+    }
+    last_ev_ = ae_ev;
+    last_time_ = start.time_sec;
+    const Eigen::Vector3f wb = GainsForFrame(c.white_balance, daylight_white_, *m);
+    const double k = 100.0 * 1.2 * ae_cfg.f_number * ae_cfg.f_number / c.noise.base_iso;
+    const double white = film_.filmic() ? FilmicWhite() : 1.0;
+    // the target exposure, raw full scale at the curve's white; highlights protected
+    double h = ExposureFromEv100(ae_ev) / white;
+    if (settings_.auto_exposure && ae_cfg.saturated_fraction < 1) {
+      const double bright = BrightQuantile(*m, wb, ae_cfg.saturated_fraction);
+      // the brightest pixels at 80 % of full scale: their noise stays below saturation
+      constexpr double kHighlightLevel = 0.8;
+      if (bright * h > kHighlightLevel)
+        h = std::max(kHighlightLevel / bright, h * std::exp2(-ae_cfg.max_highlight_reduction_ev));
+    }
+    const double tg = h * k;
+    ae_t = std::clamp(tg, ae_cfg.min_exposure_time_sec, ae_cfg.max_exposure_time_sec);
+    ae_g = std::clamp(tg / ae_t, 1.0, ae_cfg.max_gain);
+  }
+  const double T = ae ? ae_t : c.exposure_time_sec;
   const double row_time = RowTimeSec(c, H);
   const bool moving = end != nullptr && end->time_sec > start.time_sec;
   const double span = moving ? end->time_sec - start.time_sec : 0.0;
@@ -266,10 +332,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
   if (moving && ae && ae_cfg.motion_blur_step_sec > 0)
     n = std::clamp(static_cast<int>(std::ceil(T / ae_cfg.motion_blur_step_sec)), 1,
                    c.motion_blur_samples);
-  // renderer frame indices: sub-frames of different frames never share one
-  const int64_t stride = ae ? c.motion_blur_samples : n;
   const int truth_k = n / 2;
-  const bool optics = HasOptics(c.optics);
 
   CameraOutputs internal = spec_.outputs;
   // a correlation matcher (stereo, structured light) reads the scene's light: the radiance of
@@ -307,7 +370,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
     view.X_WO = X_WO_start;
     view.intrinsics = spec_.intrinsics;
     view.near_m = spec_.near_m;
-    view.frame_index = frame_index * stride + k;
+    view.frame_index = frame_index * (ae ? stride : n) + k;
     view.camera_index = camera_index_;
     view.exposure_time_sec = T;
     view.white_balance_gains = wb_before;
@@ -374,13 +437,16 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
           "camera '{}': frame {}: the renderer gave neither rgb nor radiance; expected the rgb "
           "it was asked for (CameraOutputs rgb)",
           spec_.name, frame_index));
-    double ev = developed ? out->truth.ev100 : film_.Ev100(*sensor_in, pool_.get());
-    if (adapts && last_ev_) {
-      const double dt = std::max(0.0, start.time_sec - *last_time_);
-      ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
+    double ev = ae_ev;
+    if (!ae) {
+      ev = developed ? out->truth.ev100 : film_.Ev100(*sensor_in, pool_.get());
+      if (adapts && last_ev_) {
+        const double dt = std::max(0.0, start.time_sec - *last_time_);
+        ev = ev + (*last_ev_ - ev) * std::exp(-dt / c.auto_exposure_time_constant_sec);
+      }
+      last_ev_ = ev;
+      last_time_ = start.time_sec;
     }
-    last_ev_ = ev;
-    last_time_ = start.time_sec;
     out->ev100 = ev;
     // gray world needs this frame's radiance; the other modes' gains were known before it
     const Eigen::Vector3f wb_gains =
@@ -396,26 +462,7 @@ void CameraImager::Capture(Renderer* renderer, const WorldSnapshot& start,
       // exposure per cd/m^2 of shutter time t and gain g: H = t g / k (saturation-based ISO)
       const double k = 100.0 * 1.2 * ae_cfg.f_number * ae_cfg.f_number / c.noise.base_iso;
       const double white = film_.filmic() ? FilmicWhite() : 1.0;
-      // the target exposure, raw full scale at the curve's white; highlights protected
-      double h = ExposureFromEv100(ev) / white;
-      if (settings_.auto_exposure && ae_cfg.saturated_fraction < 1) {
-        const double bright = BrightQuantile(*sensor_in, wb_gains, ae_cfg.saturated_fraction);
-        // the brightest pixels at 80 % of full scale: their noise stays below saturation
-        constexpr double kHighlightLevel = 0.8;
-        if (bright * h > kHighlightLevel)
-          h = std::max(kHighlightLevel / bright, h * std::exp2(-ae_cfg.max_highlight_reduction_ev));
-      }
-      const double tg = h * k;
-      const double next_t =
-          std::clamp(tg, ae_cfg.min_exposure_time_sec, ae_cfg.max_exposure_time_sec);
-      const double next_g = std::clamp(tg / next_t, 1.0, ae_cfg.max_gain);
-      if (!ae_time_) {  // frame 0 meters itself
-        ae_time_ = next_t;
-        ae_gain_ = next_g;
-      }
-      const double t = *ae_time_, g = *ae_gain_;
-      ae_time_ = next_t;
-      ae_gain_ = next_g;
+      const double t = ae_t, g = ae_g;
       const double h_used = t * g / k;
       out->exposure_time_sec = t;
       out->analog_gain = g;

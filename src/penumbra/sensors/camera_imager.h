@@ -27,8 +27,10 @@
 // model (sensors/image_noise.h) when noise is enabled, then the film's tone curve and sRGB.
 // with auto_exposure enabled (a camera profile, sensors/camera_profile.h) the target is met by
 // a shutter time and an analog gain within the camera's limits (AutoExposureConfig), metered
-// on the previous frame: the sub-frames span that shutter time (frame 0: exposure_time_sec,
-// then metered on itself), the gain raises the ISO of the sensor model, and the raw values
+// on a quarter-size render of the capture instant (one more render per frame, 1/16 of the
+// pixels: a camera's statistics grid), so a frame's exposure depends on that frame alone (a
+// replay from any frame reproduces it): the sub-frames span that shutter time, the gain
+// raises the ISO of the sensor model, and the raw values
 // (DN / full scale) are developed with raw full scale at the filmic curve's white
 // (kFilmicWhite), the highlight roll-off.
 
@@ -142,9 +144,8 @@ class CameraImager {
   std::unique_ptr<ShelterMap> shelter_;
   std::optional<double> last_wet_time_;
   std::optional<double> last_ev_, last_time_;
-  // auto_exposure: the shutter time and gain metered on the last frame, for the next one
-  std::optional<double> ae_time_, ae_gain_;
   ImageF optic_, optic_tmp_;          // the radiance after the optics
+  ImageF meter_optic_, meter_tmp_;    // auto exposure's metering view after the optics
   std::unique_ptr<ThreadPool> pool_;  // for the per-pixel passes (null when there are none)
   ImageF accum_, exposed_, dn_;
   double renderer_sec_ = 0;

@@ -69,8 +69,8 @@ struct OpticsConfig {
 /// the limits the image is darker than the target. the film's tone curve is then a highlight
 /// roll-off over the sensor's range: the raw full scale (full well or the ADC's top code) maps
 /// to display white, so highlights compress towards it instead of clipping early, and only
-/// pixels whose raw value saturates reach 255. the exposure of frame k is the one metered on
-/// frame k - 1 (frame 0 meters itself), as a camera's control loop does.
+/// pixels whose raw value saturates reach 255. each frame is metered on a quarter-size view of
+/// its own capture instant (sensors/camera_imager.h).
 struct AutoExposureConfig {
   bool enabled = false;
   double f_number = 2.0;                 ///< lens aperture N, > 0
@@ -103,7 +103,8 @@ struct CameraSensorConfig {
   /// the named profile these values started from (sensors/camera_profile.h; explicit world-file
   /// keys override its values): for messages only, every behaviour comes from the fields below.
   CameraProfile profile = CameraProfile::kIdeal;
-  /// shutter open time T, >= 0 (with auto_exposure enabled: the first frame's, then metered)
+  /// shutter open time T, >= 0 (with auto_exposure enabled: the metering view's, for particle
+  /// streaks; the frame's own is metered)
   double exposure_time_sec = 0.01;
   /// motion blur: sub-frames rendered at times (k + 0.5) T / n, k < n, and averaged; 1 = none.
   int motion_blur_samples = 1;
