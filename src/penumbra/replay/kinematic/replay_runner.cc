@@ -19,6 +19,7 @@
 #include "penumbra/replay/world_override.h"
 #include "penumbra/runlog/run_log_reader.h"
 #include "penumbra/scene/sim_time.h"
+#include "penumbra/session/effects_stage.h"
 #include "penumbra/session/session.h"
 #include "penumbra/sinks/run/run_outputs.h"
 
