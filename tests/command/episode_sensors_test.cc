@@ -1,7 +1,8 @@
 // `reset` restarts the sensors with the episode: their schedules on the episode's clock and
 // their noise streams keyed by the sample index within the episode (the IMU's bias from the
-// start of its stream), so the same actions after a reset give the first episode's IMU and
-// MuJoCo sensor samples bit for bit, while the written sample indices go on increasing.
+// start of its stream), so the same actions after a reset give the first episode's IMU,
+// MuJoCo sensor and LiDAR samples bit for bit, while the written sample indices go on
+// increasing; and the cameras the same images in every episode after a reset.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,6 +18,7 @@
 
 #include "command/live_loop.h"
 #include "common/temp_dir.h"
+#include "penumbra/sensors/lidar_scanner.h"
 #include "penumbra/sinks/run/run_outputs.h"
 #include "penumbra/sinks/sensor_sink.h"
 
@@ -57,7 +59,11 @@ std::string WorldWithSensors(const Case& c) {
          "  - {name: imu, type: imu, body: " +
          c.robot +
          "/trunk, preset: consumer_mems, rate_hz: 200}\n"
-         "  - {name: joints, type: mujoco, rate_hz: 100, noise: {stddev: 0.01}}\n";
+         "  - {name: joints, type: mujoco, rate_hz: 100, noise: {stddev: 0.01}}\n"
+         "  - {name: top, type: lidar, preset: velodyne_vlp16, columns: 90, body: " +
+         c.robot +
+         "/trunk, pose: {xyz: [0.1, 0, 0.15], rpy_deg: [0, 0, 0]},\n"
+         "     noise: {range_stddev_m: 0.01, dropout_probability: 0.05}}\n";
 }
 
 // a sample as kept by the test: values as raw doubles
@@ -106,7 +112,13 @@ TEST_P(EpisodeSensorsTest, SameActionsAfterResetGiveTheFirstEpisodesSamplesBitFo
                                              dir.path().string());
       sensors->set_on_sample([&](const SensorSample& s) {
         std::lock_guard<std::mutex> lock(mu);
-        samples.push_back({s.sensor, Kept{s.index, s.step, s.values}});
+        Kept k{s.index, s.step, s.values};
+        // a scan as its points' values (x, y, z, intensity, time, beam)
+        if (s.scan)
+          for (const LidarPoint& p : s.scan->points)
+            k.values.insert(k.values.end(),
+                            {p.x, p.y, p.z, p.intensity, p.time, static_cast<double>(p.beam)});
+        samples.push_back({s.sensor, std::move(k)});
       });
       loop.AddSink(sensors.get());
     });
@@ -150,6 +162,31 @@ TEST_P(EpisodeSensorsTest, SameActionsAfterResetGiveTheFirstEpisodesSamplesBitFo
       }
       EXPECT_GE(compared, steps / 6);
     }
+  }
+  // a scan covers the time to the next one (traced with the robot's motion up to it): the
+  // scans that end inside an episode are the same in every episode (noise and dropouts keyed
+  // by the scan's index within it); the one open at a reset is not written
+  const int scan_steps = 50;  // 10 Hz at 2 ms steps
+  const std::map<int64_t, Kept> first = EpisodeSamples(samples, "top", 0, steps);
+  ASSERT_TRUE(first.count(scan_steps));
+  EXPECT_GT(first.at(scan_steps).values.size(), 100u);
+  int64_t last = -1;
+  for (const auto& [name, k] : samples) {
+    if (name != "top") continue;
+    EXPECT_GT(k.index, last) << "scan at step " << k.step;
+    last = k.index;
+  }
+  for (size_t e = 1; e < starts.size(); ++e) {
+    const std::map<int64_t, Kept> again = EpisodeSamples(samples, "top", starts[e], steps);
+    int compared = 0;
+    for (const auto& [j, k] : again) {
+      if (j + scan_steps > steps) continue;
+      ASSERT_TRUE(first.count(j)) << "episode " << e << " scanned at its step " << j;
+      EXPECT_TRUE(k.values == first.at(j).values)
+          << "the scan of episode " << e << " at its step " << j << " differs from the first's";
+      ++compared;
+    }
+    EXPECT_EQ(compared, 1) << "episode " << e;
   }
 }
 

@@ -205,6 +205,7 @@ struct SensorSink::Impl {
   int64_t due_step = -1;
   double effects_sec = 0;
   // sink thread
+  int processed_episode = 0;  // the episode of the last snapshot processed
   std::map<std::string, double> busy;
   // busy seconds of a sensor type (its name), or of a part of it ("<name>_<part>")
   double& Busy(SensorKind kind, std::string_view part = {}) {
@@ -466,6 +467,15 @@ void SensorSink::Impl::Process(
     const std::vector<std::shared_ptr<const EffectsFrame>>& scan_effects) {
   Impl& s = *this;
   const WorldSnapshot& snap = *snap_ptr;
+  if (due_episode != s.processed_episode) {
+    // a scan still open when its episode ends is not written (as at the end of a run)
+    for (Lidar& l : s.lidars) {
+      l.pending = false;
+      l.start.reset();
+      l.start_effects.reset();
+    }
+    s.processed_episode = due_episode;
+  }
   for (size_t i = 0; i < due.size(); ++i) {
     const SensorFiring& f = due[i];
     const Impl::Entry e = s.entries[f.sensor];

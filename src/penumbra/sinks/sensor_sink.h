@@ -24,6 +24,14 @@
 // arrives, with the sensor pose interpolated between the two snapshots (motion distortion);
 // the scan still open when the run ends is not written.
 //
+// episodes: the sink follows the simulation's controller episode start (a `reset`:
+// Simulation::ResetControllers). at a new episode every schedule restarts on the episode's
+// clock (steps since the episode start; the samples due before the loop's step pass), noise
+// is keyed by the sample's index k within the episode (an IMU's bias walks from its stream's
+// start), and the scan open at the reset is not written. written indices go on (index = the
+// next one of the run + k - the episode's first k) and stamps are in run time. the first
+// episode (no reset) samples and writes as before episodes existed.
+//
 // threading and determinism: the loop thread only decides which steps need a snapshot and
 // evaluates the effects a LiDAR sees at the start of each scan (in step order, as the effects
 // engine wants); the sensor models, the LiDAR ray tracing and every file write run on the
