@@ -6,15 +6,18 @@ robot sections and world-file reference never drift from docs/.
   <!-- begin world-file -->    docs/world-file.md
 each block ends at the matching <!-- end ... --> marker."""
 import pathlib
+import posixpath
 import re
 
 root = pathlib.Path(__file__).resolve().parent.parent
 readme = root / "README.md"
 
 
-def readme_links(text):
-    """links between docs (`](effects.md)`) point into docs/ from the README."""
-    return re.sub(r"\]\((?![a-z]+:|/|#|docs/)([^)]+\.(?:md|png))", r"](docs/\1", text)
+def readme_links(text, base="docs"):
+    """links between docs (`](effects.md)`, `](../policies.md)` in docs/robots/) point from the
+    README to the file they name, relative to `base`, the folder of the doc they are in."""
+    return re.sub(r"\]\((?![a-z]+:|/|#|docs/)([^)#]+\.(?:md|png))",
+                  lambda m: "](" + posixpath.normpath(posixpath.join(base, m.group(1))), text)
 
 
 def demote(text):
@@ -26,7 +29,7 @@ parts = []
 for name in robots:
     p = root / "docs" / "robots" / f"{name}.md"
     if p.exists():
-        parts.append(readme_links(demote(p.read_text().strip())))
+        parts.append(readme_links(demote(p.read_text().strip()), "docs/robots"))
 blocks = {
     "robots": "## Robots\n\nEach bundled robot has a model in `worlds/models/`, an example world in "
     "`worlds/`, and a controller configured in that world.\n\n" + "\n\n".join(parts),
