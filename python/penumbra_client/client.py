@@ -224,9 +224,9 @@ class Client:
         as at step 0 (gait phase, references, integrators, histories; programmatic commands
         are dropped), on a controller clock that restarts at 0: the same requests then give
         the same qpos and qvel. The world-file sensors and the cameras restart their
-        schedules and noise streams with the episode. Sim time and the step count keep
-        increasing; agents on paths and effects are not rewound (docs/zmq-protocol.md
-        ``reset``).
+        schedules and noise streams with the episode, and the agents (paths, crowds) and
+        effects start again on the episode's clock. Sim time and the step count keep
+        increasing (docs/zmq-protocol.md ``reset``).
 
         :param seed: must be None or the world's seed (a new seed needs a new run).
         :returns: the reply (``step``, ``time_sec`` of the boundary).

@@ -438,11 +438,12 @@ void CommandDispatcher::Reset(const CommandInfo& info, RequestReader& rd, const 
           s.controller_next_update = now.controller_next_update;
           sim.SetState(s);
           if (!keyframe.empty()) sim.ApplyKeyframe(keyframe, "", "keyframe");
+          // every controller back to its just-initialized state, on a clock that restarts at 0
+          sim.ResetControllers();
+          // agents at the new episode's time 0 (their drivers restart them with the episode)
           std::vector<int> ids(nmocap);
           for (int i = 0; i < nmocap; ++i) ids[i] = i;
           sim.ApplyMocapDrivers(ids);
-          // every controller back to its just-initialized state, on a clock that restarts at 0
-          sim.ResetControllers();
           return StepTime(sim);
         });
 }

@@ -371,7 +371,7 @@ struct Simulation::Impl {
     }
   }
 
-  // poses every driven mocap body for sim time t
+  // poses every driven mocap body for episode time t (ControlTime)
   void ApplyMocapDrivers(double t) {
     for (const MocapDriver& md : mocap_drivers) ApplyMocapDriver(md, t);
   }
@@ -551,7 +551,7 @@ void Simulation::AddMocapDriver(const std::string& body_name,
                           "mocap=\"true\"");
   if (!X_WB) throw Error("Simulation::AddMocapDriver: empty pose function for '" + body_name + "'");
   impl_->mocap_drivers.push_back({mocap, std::move(X_WB)});
-  impl_->ApplyMocapDrivers(impl_->d->time);
+  impl_->ApplyMocapDrivers(impl_->ControlTime());
 }
 
 void Simulation::Step() {
@@ -591,7 +591,7 @@ void Simulation::Step() {
   // time from the step count, not summed (SimTimeOfStep)
   s.steps = step;
   d->time = SimTimeOfStep(step, m->opt.timestep);
-  if (!s.mocap_drivers.empty()) s.ApplyMocapDrivers(d->time);
+  if (!s.mocap_drivers.empty()) s.ApplyMocapDrivers(s.ControlTime());
 }
 
 SimState Simulation::GetState() const {
@@ -652,7 +652,10 @@ void Simulation::SetMocapPose(int mocap_id, const Pose& X_WB) {
   d->mocap_quat[4 * mocap_id + 3] = q.z();
 }
 
-void Simulation::SnapshotState(WorldSnapshot* out) const { GetState(out); }
+void Simulation::SnapshotState(WorldSnapshot* out) const {
+  GetState(out);
+  out->episode_start_step = impl_->episode_start;
+}
 
 void Simulation::SetState(const SimState& s) {
   Impl& impl = *impl_;
@@ -685,7 +688,7 @@ void Simulation::SetState(const SimState& s) {
 
 void Simulation::ApplyMocapDrivers(std::span<const int> mocap_ids) {
   Impl& impl = *impl_;
-  const double t = impl.d->time;
+  const double t = impl.ControlTime();
   for (const int id : mocap_ids) {
     if (id < 0 || id >= impl.m->nmocap)
       throw Error(impl.source + ": ApplyMocapDrivers: mocap id " + std::to_string(id) +
@@ -815,6 +818,7 @@ void Simulation::Snapshot(WorldSnapshot* out, SnapshotContent content) const {
   }
   out->time_sec = live->time;
   out->step = impl_->steps;
+  out->episode_start_step = impl_->episode_start;
   out->X_WB.resize(m->nbody);
   for (int b = 0; b < m->nbody; ++b)
     out->X_WB[b] = PoseFromPosQuat(d->xpos + 3 * b, d->xquat + 4 * b);

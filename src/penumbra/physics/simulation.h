@@ -66,9 +66,12 @@ class Simulation {
   void AddController(std::unique_ptr<Controller> controller);
 
   /// drives the mocap body `body_name` kinematically (NPC agents, effects/agent_path.h):
-  /// its mocap_pos / mocap_quat are set to X_WB(t) now (t = time()) and after every
-  /// Step() for the new time, so the body's pose always matches the sim time, for the
-  /// controllers, the contacts of the next step and Snapshot(). coupling is one-way:
+  /// its mocap_pos / mocap_quat are set to X_WB(t) now and after every Step() for the new
+  /// time, so the body's pose always matches the time, for the controllers, the contacts of
+  /// the next step and Snapshot(). t is the episode's time, the controllers' clock
+  /// (SimTimeOfStep(step_count() - controller_episode_start(), timestep()): time() until the
+  /// first ResetControllers, then from 0 again at each), so an agent's path restarts with the
+  /// episode. coupling is one-way:
   /// other bodies collide with it and are pushed; it ignores contact. X_WB must be a pure
   /// function of t (determinism). drivers apply in the order they were added.
   /// @throws ConfigError("", 0, "mocap driver", ...) naming the body if no body has that
@@ -122,7 +125,7 @@ class Simulation {
   void SetState(const SimState& state);
 
   /// poses the mocap bodies among `mocap_ids` (mocap ids, see MocapBodyNames) that have a
-  /// driver (AddMocapDriver) for the current time(), as Step() does for all of them; ids
+  /// driver (AddMocapDriver) for the current episode time, as Step() does for all of them; ids
   /// without a driver are left alone. a kinematic replay uses it after SetState of a recorded
   /// state to move the driven bodies the recording does not hold.
   /// @throws Error for an id outside [0, number of mocap bodies).
@@ -163,8 +166,9 @@ class Simulation {
     kFull,
   };
 
-  /// copies the current state into `out`'s SimState part (GetState(out)), reusing its
-  /// storage; the other fields are left as they are. Snapshot() does this too.
+  /// copies the current state into `out`'s SimState part (GetState(out)) and its
+  /// episode_start_step, reusing its storage; the other fields are left as they are.
+  /// Snapshot() does this too.
   void SnapshotState(WorldSnapshot* out) const;
 
   /// the world at the current time (see SnapshotContent).

@@ -21,6 +21,11 @@ namespace penumbra {
 /// source does not have them) and what is derived from it for renderers, sensors and metrics.
 /// the SimState part is a SimState: `SimState s = snapshot;` copies exactly the state.
 struct WorldSnapshot : SimState {
+  /// the step the snapshot's episode started at (Simulation::controller_episode_start: the
+  /// last `reset`; 0 in the first episode and for a snapshot not made by a Simulation). time
+  /// in the episode is SimTimeOfStep(step - episode_start_step, timestep); effects and agents
+  /// follow it (session/effects_stage.h).
+  int64_t episode_start_step = 0;
   /// X_WB for every body of SceneDescription::bodies (index 0 = world = identity).
   std::vector<Pose> X_WB;
   /// X_W_mjcam: pose of every MJCF camera in MuJoCo's camera convention (x right,
@@ -47,8 +52,8 @@ struct WorldSnapshot : SimState {
   std::vector<Eigen::Matrix<double, 6, 1>> V_WB;
   /// one active contact (MuJoCo d->contact and mj_contactForce).
   struct Contact {
-    int geom1 = -1, geom2 = -1;  ///< MuJoCo geom ids
-    int body1 = -1, body2 = -1;  ///< body indices
+    int geom1 = -1, geom2 = -1;         ///< MuJoCo geom ids
+    int body1 = -1, body2 = -1;         ///< body indices
     Eigen::Vector3d p_W{0, 0, 0};       ///< contact point, m
     Eigen::Vector3d normal_W{0, 0, 1};  ///< unit normal, from geom1 towards geom2
     double distance_m = 0;              ///< signed distance (< 0 = penetration)

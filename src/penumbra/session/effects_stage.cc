@@ -11,6 +11,7 @@
 #include "penumbra/effects/agent_animation.h"
 #include "penumbra/physics/simulation.h"
 #include "penumbra/scene/scene_limits.h"
+#include "penumbra/scene/sim_time.h"
 #include "penumbra/session/floor_map.h"
 #include "penumbra/world/yaml_reader.h"
 
@@ -624,6 +625,7 @@ void EffectsStage::Attach(Simulation* sim) {
   // over the root's pose: its crowd's (motion: crowd, session/crowd_runner.h), its path's, or
   // parked; a live change gives an agent whose motion changed a fresh animator
   sim_ = sim;
+  episode_start_ = sim->controller_episode_start();
   crowd_ = MakeCrowd(agents_, 0.0);
   size_t crowd_index = 0;
   const auto attach = [&](const AgentConfig& a, bool parked_reserve) {
@@ -639,12 +641,17 @@ void EffectsStage::Attach(Simulation* sim) {
       path = std::make_shared<const AgentPath>(a);
     }
     slot->Follow(std::move(path));
-    sim->AddMocapDriver(AgentBodyName(a.name),
-                        [slot](double t) { return slot->animator->Poses(t)[0]; });
+    // t is the episode's time (Simulation::AddMocapDriver); a new episode restarts the agents
+    sim->AddMocapDriver(AgentBodyName(a.name), [this, slot](double t) {
+      FollowEpisode();
+      return slot->animator->Poses(t)[0];
+    });
     const std::vector<std::string> parts = AgentPartNames(a.kind);
     for (size_t j = 0; j < parts.size(); ++j)
-      sim->AddMocapDriver(AgentPartBodyName(a.name, parts[j]),
-                          [slot, j](double t) { return slot->animator->Poses(t)[j + 1]; });
+      sim->AddMocapDriver(AgentPartBodyName(a.name, parts[j]), [this, slot, j](double t) {
+        FollowEpisode();
+        return slot->animator->Poses(t)[j + 1];
+      });
     body_names_.push_back(a.name);
     slots_.push_back(std::move(slot));
   };
@@ -665,7 +672,8 @@ void EffectsStage::AgentSlot::Follow(std::shared_ptr<const AgentPath> new_path) 
 }
 
 std::shared_ptr<CrowdRunner> EffectsStage::MakeCrowd(const std::vector<AgentConfig>& agents,
-                                                     double start_sec) {
+                                                     double start_sec,
+                                                     std::shared_ptr<const NpcMap> map) {
   std::vector<AgentConfig> crowd;
   for (const AgentConfig& a : agents)
     if (a.motion == AgentMotion::kCrowd) crowd.push_back(a);
@@ -684,20 +692,58 @@ std::shared_ptr<CrowdRunner> EffectsStage::MakeCrowd(const std::vector<AgentConf
     seeds.insert(seeds.end(), a.waypoints.begin(), a.waypoints.end());
   }
   const double floor_z = crowd.front().floor_z;
-  npc_map_ = std::make_shared<const NpcMap>(
-      sim_->scene(), sim_->Snapshot(Simulation::SnapshotContent::kPoses).X_WB, floor_z, centre,
-      person_seeds, vehicle_seeds);
+  npc_map_ = map ? std::move(map)
+                 : std::make_shared<const NpcMap>(
+                       sim_->scene(), sim_->Snapshot(Simulation::SnapshotContent::kPoses).X_WB,
+                       floor_z, centre, person_seeds, vehicle_seeds);
   auto sim =
       std::make_unique<CrowdSim>(std::move(crowd), npc_map_->person(), npc_map_->vehicle(), seed_);
   auto runner = std::make_shared<CrowdRunner>(std::move(sim), sim_, CrowdRobotsOf(robots_, *sim_),
                                               floor_z, start_sec);
-  if (decision_sink_) runner->set_decision_sink(decision_sink_);
+  if (decision_sink_) runner->set_decision_sink(EpisodeDecisionSink());
   return runner;
+}
+
+std::function<void(double, const std::string&)> EffectsStage::EpisodeDecisionSink() {
+  // the crowd runs on the episode's time; its decisions are logged at sim time
+  return [this](double t, const std::string& payload) {
+    if (decision_sink_) decision_sink_(episode_start_sec_ + t, payload);
+  };
 }
 
 void EffectsStage::set_crowd_decision_sink(std::function<void(double, const std::string&)> sink) {
   decision_sink_ = std::move(sink);
-  if (crowd_) crowd_->set_decision_sink(decision_sink_);
+  if (crowd_) crowd_->set_decision_sink(EpisodeDecisionSink());
+}
+
+void EffectsStage::FollowEpisode() {
+  if (!sim_ || sim_->controller_episode_start() == episode_start_) return;
+  episode_start_ = sim_->controller_episode_start();
+  episode_start_sec_ = SimTimeOfStep(episode_start_, sim_->timestep());
+  // every agent back to its start: the crowd as just constructed (its map kept: it depends on
+  // the static scene and the agents alone), paths from their time 0, fresh animators
+  std::vector<std::shared_ptr<const AgentPath>> paths(slots_.size());
+  std::vector<size_t> crowd_slot;
+  for (const AgentConfig& a : agents_) {
+    const auto it = std::find(body_names_.begin(), body_names_.end(), a.name);
+    if (it == body_names_.end()) continue;
+    if (a.motion == AgentMotion::kCrowd)
+      crowd_slot.push_back(it - body_names_.begin());
+    else
+      paths[it - body_names_.begin()] = std::make_shared<const AgentPath>(a);
+  }
+  crowd_ = MakeCrowd(agents_, 0.0, npc_map_);
+  for (size_t i = 0; i < slots_.size(); ++i) {
+    AgentSlot& s = *slots_[i];
+    s.crowd = nullptr;
+    s.crowd_index = 0;
+    for (size_t k = 0; k < crowd_slot.size(); ++k)
+      if (crowd_slot[k] == i && crowd_) {
+        s.crowd = crowd_;
+        s.crowd_index = k;
+      }
+    s.Follow(s.crowd ? nullptr : paths[i]);
+  }
 }
 
 void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
@@ -745,7 +791,7 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
       crowd->SetActive(
           m, std::find(index_in_crowd.begin(), index_in_crowd.end(), m) != index_in_crowd.end());
   } else {
-    crowd = MakeCrowd(agents, sim_ ? sim_->time() : 0.0);
+    crowd = MakeCrowd(agents, sim_ ? sim_->time() - episode_start_sec_ : 0.0);
     index_in_crowd.clear();
     for (size_t k = 0; k < crowd_slot.size(); ++k) index_in_crowd.push_back(k);
   }
@@ -787,7 +833,12 @@ SceneDescription EffectsStage::Bind(SceneDescription scene) {
 std::shared_ptr<const EffectsFrame> EffectsStage::Evaluate(const WorldSnapshot& snapshot,
                                                            const Eigen::Vector3d& viewer_W) {
   if (!engine_) return nullptr;
-  return engine_->Evaluate(snapshot.time_sec, viewer_W, &snapshot.X_WB);
+  // the episode's time (WorldSnapshot::episode_start_step): effects restart with the episode
+  const double t =
+      snapshot.episode_start_step > 0 && sim_
+          ? SimTimeOfStep(snapshot.step - snapshot.episode_start_step, sim_->timestep())
+          : snapshot.time_sec;
+  return engine_->Evaluate(t, viewer_W, &snapshot.X_WB);
 }
 
 std::vector<std::string> EffectsStage::EffectLabels() const {

@@ -100,7 +100,12 @@ class EffectsStage {
 
   /// checks the world's agents against `sim`'s static geometry, then drives every agent's
   /// mocap body from its path (Simulation::AddMocapDriver). `sim` is the composed model
-  /// loaded, before its first step.
+  /// loaded, before its first step; this stage outlives its stepping. agents follow the
+  /// episode's time (the drivers' t): at a new episode (Simulation::ResetControllers, as
+  /// `reset` and a kinematic replay of a run with resets call it) every agent starts again
+  /// as at the run's start: paths from their time 0, fresh animators, the crowd as just
+  /// constructed (the same seed, the same walkable map), so two episodes of the same actions
+  /// move the agents alike. the restart happens at the drivers' next call.
   /// @throws ConfigError for a waypoint of a world agent outside the world (the static
   ///         geometry's plan-view box + 1 m), naming agents[i].waypoints[j].
   void Attach(Simulation* sim);
@@ -111,8 +116,9 @@ class EffectsStage {
   /// @throws ConfigError from the EffectsEngine (unknown light or body names, bad .vdb).
   SceneDescription Bind(SceneDescription scene);
 
-  /// the effects at the snapshot's time for a viewer at viewer_W; null when the run has
-  /// no effects (clear conditions). deterministic.
+  /// the effects at the snapshot's episode time (SimTimeOfStep(step - episode_start_step):
+  /// the run's time in the first episode, from 0 again after each `reset`) for a viewer at
+  /// viewer_W; null when the run has no effects (clear conditions). deterministic.
   std::shared_ptr<const EffectsFrame> Evaluate(const WorldSnapshot& snapshot,
                                                const Eigen::Vector3d& viewer_W);
 
@@ -176,8 +182,15 @@ class EffectsStage {
     void Follow(std::shared_ptr<const AgentPath> new_path);
   };
   // a crowd runner for the crowd agents of `agents` (null if none), with its time 0 at
-  // start_sec; sets npc_map_
-  std::shared_ptr<CrowdRunner> MakeCrowd(const std::vector<AgentConfig>& agents, double start_sec);
+  // start_sec (episode time); sets npc_map_ (`map` when given, else built)
+  std::shared_ptr<CrowdRunner> MakeCrowd(const std::vector<AgentConfig>& agents, double start_sec,
+                                         std::shared_ptr<const NpcMap> map = nullptr);
+  // restarts every agent when the simulation's episode start moved (Attach); physics thread
+  void FollowEpisode();
+  // decision_sink_ at sim time for a crowd on the episode's time
+  std::function<void(double, const std::string&)> EpisodeDecisionSink();
+  int64_t episode_start_ = 0;       // the episode start step the agents follow
+  double episode_start_sec_ = 0.0;  // its sim time
   CrowdSites sites_;
   std::vector<ModelConfig> robots_;
   Simulation* sim_ = nullptr;
