@@ -1,7 +1,7 @@
 #pragma once
 // NPC agents: people and vehicles that walk or drive a waypoint path in the
 // world. an agent is a kinematic (mocap) body in the composed MJCF
-// (compose/agent_bodies.h), posed every physics step from AgentPath::X_WA(sim time)
+// (compose/agent_bodies.h), posed every physics step from AgentPath::X_WA(the episode's time)
 // (physics Simulation::AddMocapDriver). coupling is one-way: robots and free bodies
 // collide with agents and are pushed by them; agents follow their path whatever they touch.
 //

@@ -92,7 +92,8 @@ struct ParticleSet {
 
 /// everything the effects stage adds to one frame. empty by default = clear conditions.
 struct EffectsFrame {
-  double time_sec = 0;  ///< sim time it was evaluated at
+  /// the time it was evaluated at, s (in a run the episode's time: session/effects_stage.h)
+  double time_sec = 0;
   std::vector<HomogeneousMedium> homogeneous_media;
   std::vector<GridMedium> grid_media;
   std::vector<ParticleSet> particles;
