@@ -77,6 +77,17 @@ Eigen::Quaterniond TwistAboutZ(const Eigen::Quaterniond& q) {
   return t.normalized();
 }
 
+// the fields a settle changes: the physics state proper (positions, velocities, activations
+// and the constraint solver's warm start); controls, applied forces, mocap poses and the
+// controllers' schedule stay the start's
+void CopySettledFields(const SimState& from, SimState* to) {
+  for (const StateFieldInfo& f : kStateFields) {
+    const bool settled = f.field == StateField::kQpos || f.field == StateField::kQvel ||
+                         f.field == StateField::kAct || f.field == StateField::kQaccWarmstart;
+    if (settled) to->*f.f64 = from.*f.f64;
+  }
+}
+
 // how long robots settle before t = 0 (SettledState), s
 constexpr double kSettleSec = 0.2;
 // how far a settling base may sink before it counts as in the air (it then keeps its start), m:
@@ -178,10 +189,7 @@ SimState SettledState(const WorldConfig& world, const std::string& composed_xml,
   // controller keeps the slow motion it settled into, and zeroing it would drop the damping
   // that balances it), the start's controls, applied forces and mocap poses
   SimState out = s0;
-  out.qpos = s.qpos;
-  out.act = s.act;
-  out.qacc_warmstart = s.qacc_warmstart;
-  out.qvel = s.qvel;
+  CopySettledFields(s, &out);
   out.controller_next_update.clear();
   return out;
 }
@@ -326,10 +334,7 @@ Session::Session(const WorldConfig& world, const SessionOptions& options) : worl
       return terrain_.get();
     });
     SimState now = sim_->GetState();
-    now.qpos = settled.qpos;
-    now.qvel = settled.qvel;
-    now.act = settled.act;
-    now.qacc_warmstart = settled.qacc_warmstart;
+    CopySettledFields(settled, &now);
     sim_->SetState(now);
     poll("settling the robots");
   }
