@@ -27,12 +27,6 @@ namespace {
 using json = nlohmann::json;
 using penumbra::testing::LiveLoop;
 
-json CallOk(LiveLoop& live, const json& request) {
-  json r = live.Call(request);
-  EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
-  return r;
-}
-
 // the room of worlds/effects/crowd.yaml with its rover, one scripted walker, one crowd person
 // with random goals, a flickering lamp and rain
 std::string World() {
@@ -156,13 +150,13 @@ TEST(EpisodeAgentsTest, SameActionsAfterResetGiveTheFirstEpisodesAgentsAndEffect
       recorder = std::make_unique<Recorder>(&session.effects(), agents);
       loop.AddSink(recorder.get());
     });
-    CallOk(live, {{"cmd", "step"}, {"n", steps}});
+    live.CallOk({{"cmd", "step"}, {"n", steps}});
     // episodes of other lengths before each reset: an odd step, one off every grid
     for (int before : {37, 161}) {
-      CallOk(live, {{"cmd", "step"}, {"n", before}});
-      const json r = CallOk(live, {{"cmd", "reset"}});
+      live.CallOk({{"cmd", "step"}, {"n", before}});
+      const json r = live.CallOk({{"cmd", "reset"}});
       starts.push_back(r.at("step").get<int64_t>());
-      CallOk(live, {{"cmd", "step"}, {"n", steps}});
+      live.CallOk({{"cmd", "step"}, {"n", steps}});
     }
     live.Stop();
   }

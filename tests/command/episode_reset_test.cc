@@ -22,13 +22,6 @@ namespace {
 using json = nlohmann::json;
 using penumbra::testing::LiveLoop;
 
-// the reply to a request that must succeed
-json CallOk(LiveLoop& live, const json& request) {
-  json r = live.Call(request);
-  EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
-  return r;
-}
-
 // what an episode sends besides `step`
 enum class Action { kNone, kTwist, kJointTargets };
 
@@ -54,14 +47,14 @@ Trajectory Episode(LiveLoop& live, const Case& c, int steps, int variant = 0) {
     if (k == steps / 3 || k == 2 * steps / 3) {
       const double sign = (k == steps / 3 ? 1.0 : -1.0) * (variant == 0 ? 1.0 : -0.5);
       if (c.action == Action::kTwist) {
-        CallOk(live, {{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
+        live.CallOk({{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
       } else if (c.action == Action::kJointTargets) {
-        CallOk(live,
-               {{"cmd", "joint_targets"}, {"values", {0.2 * sign, 0.1, 0, -2.0, 0, 1.9, 0.785}}});
+        live.CallOk(
+            {{"cmd", "joint_targets"}, {"values", {0.2 * sign, 0.1, 0, -2.0, 0, 1.9, 0.785}}});
       }
     }
-    CallOk(live, {{"cmd", "step"}, {"n", 1}});
-    const json s = CallOk(live, {{"cmd", "get_state"}});
+    live.CallOk({{"cmd", "step"}, {"n", 1}});
+    const json s = live.CallOk({{"cmd", "get_state"}});
     std::vector<double> row = s.at("qpos").get<std::vector<double>>();
     const std::vector<double> qvel = s.at("qvel").get<std::vector<double>>();
     row.insert(row.end(), qvel.begin(), qvel.end());
@@ -96,7 +89,7 @@ TEST_P(EpisodeResetTest, SameActionsAfterResetGiveTheFirstEpisodeBitForBit) {
   // step off the controllers' update grid
   for (int before : {37, 61}) {
     Episode(live, c, before, 1);
-    const json r = CallOk(live, {{"cmd", "reset"}});
+    const json r = live.CallOk({{"cmd", "reset"}});
     EXPECT_GT(r.at("step").get<int64_t>(), 0);  // sim time goes on
     const Trajectory again = Episode(live, c, c.steps);
     EXPECT_EQ(FirstDifference(first, again), -1) << c.name << ": the episode after a reset at step "

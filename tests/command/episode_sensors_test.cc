@@ -29,12 +29,6 @@ namespace {
 using json = nlohmann::json;
 using penumbra::testing::LiveLoop;
 
-json CallOk(LiveLoop& live, const json& request) {
-  json r = live.Call(request);
-  EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
-  return r;
-}
-
 struct Case {
   std::string name;
   std::string file;   // bundled world, relative to worlds/
@@ -77,9 +71,9 @@ void Episode(LiveLoop& live, int steps, int variant = 0) {
   for (int k = 0; k < steps; ++k) {
     if (k == steps / 3 || k == 2 * steps / 3) {
       const double sign = (k == steps / 3 ? 1.0 : -1.0) * (variant == 0 ? 1.0 : -0.5);
-      CallOk(live, {{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
+      live.CallOk({{"cmd", "twist"}, {"vx", 0.3 * std::abs(sign)}, {"yaw_rate", 0.4 * sign}});
     }
-    CallOk(live, {{"cmd", "step"}, {"n", 1}});
+    live.CallOk({{"cmd", "step"}, {"n", 1}});
   }
 }
 
@@ -125,7 +119,7 @@ TEST_P(EpisodeSensorsTest, SameActionsAfterResetGiveTheFirstEpisodesSamplesBitFo
     Episode(live, steps);
     for (int before : {37, 61}) {
       Episode(live, before, 1);
-      const json r = CallOk(live, {{"cmd", "reset"}});
+      const json r = live.CallOk({{"cmd", "reset"}});
       starts.push_back(r.at("step").get<int64_t>());
       Episode(live, steps);
     }
@@ -231,7 +225,7 @@ TEST(EpisodeCamerasTest, SameActionsAfterResetGiveTheFirstEpisodesImagesBitForBi
     Episode(live, steps);
     for (int before : {37, 61}) {
       Episode(live, before, 1);
-      const json r = CallOk(live, {{"cmd", "reset"}});
+      const json r = live.CallOk({{"cmd", "reset"}});
       starts.push_back(r.at("step").get<int64_t>());
       Episode(live, steps);
     }

@@ -3,6 +3,8 @@
 // tests run requests against (Session -> RunControl -> PhysicsSource -> SimLoop, as
 // `penumbra run --lockstep` without sinks).
 
+#include <gtest/gtest.h>
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -55,6 +57,13 @@ class LiveLoop {
 
   /// the dispatcher's reply to `request` (JSON form of docs/zmq-protocol.md), waiting for it.
   nlohmann::json Call(const nlohmann::json& request) { return dispatcher_->Call(request); }
+  /// Call for a request that must succeed: a reply without `ok` true fails the test (gtest
+  /// EXPECT, naming the request and the reply); returns the reply.
+  nlohmann::json CallOk(const nlohmann::json& request) {
+    nlohmann::json r = Call(request);
+    EXPECT_TRUE(r.at("ok").get<bool>()) << request.dump() << " -> " << r.dump();
+    return r;
+  }
   /// sends `stop` and waits for the loop's end.
   LoopFinish Stop() {
     Call({{"cmd", "stop"}});
