@@ -2,7 +2,7 @@
 """Side by side with MuJoCo's own renderer (issue 36, item 6).
 
 Renders bare models with Penumbra (`penumbra run MODEL.xml`: the auto-framed `default` camera,
-the bare-model daylight) and with MuJoCo 2.2.2's OpenGL renderer (tools/mujoco_offscreen.cc,
+the bare-model daylight) and with MuJoCo 4's OpenGL renderer (tools/mujoco_offscreen.cc,
 under Xvfb) from the same camera (the pose of frame 0 in <out>/default/frames.csv, the vertical
 field of view of camera_info.json), at the model's initial state, and reports per model:
 
@@ -45,9 +45,9 @@ from PIL import Image
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
+GYM_ASSETS = os.path.join(ROOT, ".venv/lib/python3.11/site-packages/gymnasium/envs/mujoco/assets")
 DEFAULT_MODELS = [
-    "/usr/share/mujoco/model/humanoid/humanoid.xml",
-    "/usr/share/mujoco/model/tendon_arm/arm26.xml",
+    os.path.join(GYM_ASSETS, "humanoid.xml"),  # MuJoCo's classic humanoid, gymnasium's copy
     os.path.join(ROOT, "worlds/models/quadruped.xml"),
     os.path.join(ROOT, "worlds/models/arm.xml"),
 ]

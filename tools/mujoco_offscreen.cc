@@ -1,4 +1,4 @@
-// mujoco_offscreen: renders an MJCF model with MuJoCo's own OpenGL renderer (MuJoCo 2.2.2,
+// mujoco_offscreen: renders an MJCF model with MuJoCo's own OpenGL renderer (MuJoCo 4,
 // mjr_render into the offscreen buffer of a hidden GLFW window; run it under Xvfb on a machine
 // without a display) from a given camera, for scripts/compare_with_mujoco.py.
 //

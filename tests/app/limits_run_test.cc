@@ -137,9 +137,15 @@ TEST(LimitsRun, HugeMjcfGeomsAndBodiesExit2) {
 
 TEST(LimitsRun, MjcfCameraFovyIsCheckedLikeWorldCameras) {
   penumbra::testing::TempDir dir;
-  const std::string wide = dir.Write("wide.xml", Ball("0.005", "0.2", "0 0 1", "180"));
+  // MuJoCo 4 refuses 180 deg itself; 179.5 and 0.05 compile and are Penumbra's to refuse
+  const std::string wide = dir.Write("wide.xml", Ball("0.005", "0.2", "0 0 1", "179.5"));
   ExpectExit2(RunChild(dir, wide),
-              "MJCF camera 'wide/eye': fovy is 180 deg; expected [0.1, 179) deg");
+              "MJCF camera 'wide/eye': fovy is 179.5 deg; expected [0.1, 179) deg");
+  const std::string narrow = dir.Write("narrow.xml", Ball("0.005", "0.2", "0 0 1", "0.05"));
+  ExpectExit2(RunChild(dir, narrow),
+              "MJCF camera 'narrow/eye': fovy is 0.05 deg; expected [0.1, 179) deg");
+  const std::string flat = dir.Write("flat.xml", Ball("0.005", "0.2", "0 0 1", "180"));
+  ExpectExit2(RunChild(dir, flat), "fovy too large in camera 'flat/eye'");
 }
 
 TEST(LimitsRun, DegenerateTimestepsAndDurationsExit2InsteadOfHanging) {

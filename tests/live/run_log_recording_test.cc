@@ -92,7 +92,7 @@ TEST(RunLogRecordingTest, TheHeaderMapsTheStateByNameAndHashesTheFilesRead) {
   Session session(world, PhysicsOnly());
   const RunLogHeader h = MakeRunLogHeader(session, "1.2.3", "penumbra run crowd.yaml");
   EXPECT_EQ(h.penumbra_version, "1.2.3");
-  EXPECT_EQ(h.mujoco_version, "2.2.2");
+  EXPECT_EQ(h.mujoco_version, "4.0.0");  // the pinned wheel (scripts/requirements.txt)
   EXPECT_EQ(h.world_file, std::filesystem::path(world.file).lexically_normal().string());
   EXPECT_NE(h.world_text.find("name: rover"), std::string::npos);
   EXPECT_EQ(h.composed_mjcf, session.composed_xml());

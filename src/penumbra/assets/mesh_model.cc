@@ -120,8 +120,8 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
   std::string x = fmt::format("<mujoco model=\"{}\">\n  <asset>\n",
                               XmlEscape(fs::path(asset.file).stem().string()));
   for (size_t i = 0; i < asset.meshes.size(); ++i)
-    x += fmt::format("    <mesh name=\"{}\" file=\"{}\"/>\n", XmlEscape(asset.meshes[i].mesh.name),
-                     XmlEscape(msh_files.at(i)));
+    x += fmt::format("    <mesh name=\"{}\" file=\"{}\" inertia=\"shell\"/>\n",
+                     XmlEscape(asset.meshes[i].mesh.name), XmlEscape(msh_files.at(i)));
   for (const ImportedMaterial& m : asset.materials) {
     const Eigen::Vector3f& c = m.factors.base_color;
     x += fmt::format("    <material name=\"{}\" rgba=\"{:.6g} {:.6g} {:.6g} 1\"/>\n",
@@ -132,7 +132,9 @@ std::string MeshModelMjcf(const ImportedAsset& asset, const std::vector<std::str
   if (collision.hfield)
     x += fmt::format("    <hfield name=\"collision_heightfield\" file=\"{}\" size=\"{}\"/>\n",
                      XmlEscape(collision.hfield_file), HfieldSizeAttribute(*collision.hfield, 0.1));
-  // geoms of the world body: MuJoCo computes no inertia for them, so open and flat meshes load
+  // geoms of the world body: their inertia is never used, but MuJoCo computes every mesh's at
+  // compile time and refuses a volume of zero; inertia="shell" (by area) lets open and flat
+  // meshes load
   x += "  </asset>\n  <worldbody>\n";
   for (const ImportedMesh& m : asset.meshes)
     x += fmt::format("    <geom name=\"{0}\" type=\"mesh\" mesh=\"{0}\" material=\"{1}\"{2}/>\n",

@@ -80,13 +80,12 @@ mjModel* LoadMujocoXmlLocked(const std::string& path, const std::string* content
     for (size_t i = 0; i < files.size(); ++i) {
       const std::string& name = files[i].first;
       const std::string& bytes = i == 0 ? *contents : files[i].second;
-      if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(bytes.size())) != 0) {
+      if (mj_addBufferVFS(vfs.get(), name.c_str(), bytes.data(), static_cast<int>(bytes.size())) !=
+          0) {
         mj_deleteVFS(vfs.get());
         throw ConfigError(display_name, 0, "",
                           "could not create the in-memory file '" + name + "' for MuJoCo");
       }
-      const int idx = mj_findFileVFS(vfs.get(), name.c_str());
-      std::memcpy(vfs->filedata[idx], bytes.data(), bytes.size());
     }
   }
   char error[2048] = "";

@@ -45,6 +45,13 @@ GeomShape ShapeFromMujoco(int type) {
   }
 }
 
+// the material's base-colour texture: MJCF's `texture=` sets the rgb role, glTF-style
+// materials the rgba one
+int BaseColorTexture(const mjModel* m, int mat) {
+  const int* ids = m->mat_texid + mjNTEXROLE * mat;
+  return ids[mjTEXROLE_RGB] >= 0 ? ids[mjTEXROLE_RGB] : ids[mjTEXROLE_RGBA];
+}
+
 bool IsDefaultRgba(const float* rgba) {
   return rgba[0] == 0.5f && rgba[1] == 0.5f && rgba[2] == 0.5f && rgba[3] == 1.0f;
 }
@@ -64,7 +71,7 @@ Light LightFromMjcf(const mjModel* m, const mjData* d, int i) {
                      : Eigen::Vector3f(1, 1, 1);
   l.cast_shadow = m->light_castshadow[i] != 0;
   l.active = m->light_active[i] != 0;
-  if (m->light_directional[i]) {
+  if (m->light_type[i] == mjLIGHT_DIRECTIONAL) {
     l.type = Light::Type::kDirectional;
     l.intensity = static_cast<float>(kMjcfDirectionalLux * peak);
     return l;
@@ -76,7 +83,7 @@ Light LightFromMjcf(const mjModel* m, const mjData* d, int i) {
   const double r = std::max((p_W - c_W).norm(), kMjcfLampMinDistance);
   l.intensity = static_cast<float>(kMjcfDirectionalLux * peak * r * r);
   const double cutoff = m->light_cutoff[i];
-  if (!(cutoff < 90.0)) {
+  if (m->light_type[i] != mjLIGHT_SPOT || !(cutoff < 90.0)) {
     l.type = Light::Type::kPoint;
     return l;
   }
@@ -134,26 +141,34 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
   for (int i = 0; i < m->nmesh; ++i) {
     TriangleMesh& mesh = s.meshes[i];
     mesh.name = Name(m, mjOBJ_MESH, i);
-    const int v0 = m->mesh_vertadr[i], nv = m->mesh_vertnum[i];
-    mesh.vertices.reserve(nv);
-    mesh.normals.reserve(nv);
-    for (int v = v0; v < v0 + nv; ++v) {
-      mesh.vertices.emplace_back(m->mesh_vert[3 * v], m->mesh_vert[3 * v + 1],
-                                 m->mesh_vert[3 * v + 2]);
-      mesh.normals.emplace_back(m->mesh_normal[3 * v], m->mesh_normal[3 * v + 1],
-                                m->mesh_normal[3 * v + 2]);
-    }
-    const int t0 = m->mesh_texcoordadr[i];
-    if (t0 >= 0 && t0 + nv <= m->nmeshtexvert) {
-      mesh.texcoords.reserve(nv);
-      for (int t = t0; t < t0 + nv; ++t)
-        mesh.texcoords.emplace_back(m->mesh_texcoord[2 * t], m->mesh_texcoord[2 * t + 1]);
-    }
+    // MuJoCo indexes positions, normals and texcoords separately per face corner; the renderer
+    // takes one index per corner, so each distinct (position, normal, texcoord) becomes a vertex
+    const int v0 = m->mesh_vertadr[i], n0 = m->mesh_normaladr[i], t0 = m->mesh_texcoordadr[i];
+    const bool textured = t0 >= 0 && m->mesh_texcoordnum[i] > 0;
     const int f0 = m->mesh_faceadr[i], nf = m->mesh_facenum[i];
+    std::map<std::tuple<int, int, int>, int> corner_vertex;
     mesh.faces.reserve(nf);
-    for (int f = f0; f < f0 + nf; ++f)
-      mesh.faces.emplace_back(m->mesh_face[3 * f], m->mesh_face[3 * f + 1],
-                              m->mesh_face[3 * f + 2]);
+    for (int f = f0; f < f0 + nf; ++f) {
+      int corner[3];
+      for (int k = 0; k < 3; ++k) {
+        const int v = m->mesh_face[3 * f + k], n = m->mesh_facenormal[3 * f + k];
+        const int t = textured ? m->mesh_facetexcoord[3 * f + k] : -1;
+        auto [it, added] =
+            corner_vertex.emplace(std::make_tuple(v, n, t), static_cast<int>(mesh.vertices.size()));
+        if (added) {
+          const float* p = m->mesh_vert + 3 * (v0 + v);
+          const float* nn = m->mesh_normal + 3 * (n0 + n);
+          mesh.vertices.emplace_back(p[0], p[1], p[2]);
+          mesh.normals.emplace_back(nn[0], nn[1], nn[2]);
+          if (textured) {
+            const float* uv = m->mesh_texcoord + 2 * (t0 + t);
+            mesh.texcoords.emplace_back(uv[0], uv[1]);
+          }
+        }
+        corner[k] = it->second;
+      }
+      mesh.faces.emplace_back(corner[0], corner[1], corner[2]);
+    }
   }
 
   // height fields
@@ -174,6 +189,7 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
   // textures: one shared image (with mip levels) per distinct set of pixels
   s.textures.resize(m->ntex);
   std::vector<TextureSource> sources(m->ntex);
+  std::vector<std::vector<uint8_t>> rgb(m->ntex);  // 1- and 4-channel textures as RGB
   for (int i = 0; i < m->ntex; ++i) {
     Texture& t = s.textures[i];
     t.name = Name(m, mjOBJ_TEXTURE, i);
@@ -184,8 +200,18 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
     src.width = m->tex_width[i];
     src.height = m->tex_height[i];
     src.faces = t.kind == Texture::Kind::k2D ? 1 : 6;
-    src.rgb_srgb = reinterpret_cast<const uint8_t*>(m->tex_rgb + m->tex_adr[i]);
     src.size = static_cast<size_t>(src.width) * src.height * 3;
+    const int channels = m->tex_nchannel[i];
+    const uint8_t* data = m->tex_data + m->tex_adr[i];
+    if (channels == 3) {
+      src.rgb_srgb = data;
+    } else {
+      rgb[i].resize(src.size);
+      for (size_t p = 0; p < src.size / 3; ++p)
+        for (int c = 0; c < 3; ++c)
+          rgb[i][3 * p + c] = data[p * channels + std::min(c, channels - 1)];
+      src.rgb_srgb = rgb[i].data();
+    }
   }
   TextureStore store;
   const std::vector<std::shared_ptr<const TextureImage>> images = store.AddAll(sources);
@@ -194,10 +220,10 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
   // MJCF materials keep their ids
   s.materials.reserve(m->nmat);
   for (int i = 0; i < m->nmat; ++i) {
-    s.materials.push_back(
-        MaterialFromMjcf(Name(m, mjOBJ_MATERIAL, i), m->mat_rgba + 4 * i, m->mat_emission[i],
-                         m->mat_specular[i], m->mat_shininess[i], m->mat_reflectance[i],
-                         m->mat_texid[i], m->mat_texrepeat + 2 * i, m->mat_texuniform[i] != 0));
+    s.materials.push_back(MaterialFromMjcf(
+        Name(m, mjOBJ_MATERIAL, i), m->mat_rgba + 4 * i, m->mat_emission[i], m->mat_specular[i],
+        m->mat_shininess[i], m->mat_reflectance[i], BaseColorTexture(m, i),
+        m->mat_texrepeat + 2 * i, m->mat_texuniform[i] != 0));
   }
 
   // geoms (and tendons), with generated materials deduplicated by (material id, rgba)
@@ -211,7 +237,7 @@ SceneDescription ExtractScene(const mjModel* m, const mjData* d) {
       if (mat >= 0) {
         made = MaterialFromMjcf(s.materials[mat].name + "#" + RgbaLabel(rgba), rgba,
                                 m->mat_emission[mat], m->mat_specular[mat], m->mat_shininess[mat],
-                                m->mat_reflectance[mat], m->mat_texid[mat],
+                                m->mat_reflectance[mat], BaseColorTexture(m, mat),
                                 m->mat_texrepeat + 2 * mat, m->mat_texuniform[mat] != 0);
       } else {
         // MuJoCo's material defaults: emission 0, specular 0.5, shininess 0.5, reflectance 0

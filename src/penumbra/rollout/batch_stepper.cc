@@ -52,12 +52,11 @@ mjModel* LoadModel(const std::string& name, const std::string& xml) {
   mj_defaultVFS(vfs.get());
   const std::string file = std::filesystem::path(name).filename().string();
   if (file.empty() ||
-      mj_makeEmptyFileVFS(vfs.get(), file.c_str(), static_cast<int>(xml.size())) != 0) {
+      mj_addBufferVFS(vfs.get(), file.c_str(), xml.data(), static_cast<int>(xml.size())) != 0) {
     mj_deleteVFS(vfs.get());
     throw ConfigError(name, 0, "model_path",
                       "cannot hand the model to MuJoCo; expected an MJCF file name");
   }
-  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), file.c_str())], xml.data(), xml.size());
   char error[1024] = "";
   mjModel* m = nullptr;
   try {
@@ -132,7 +131,7 @@ void BatchStepper::Init(const std::string& mjcf_path, const std::string& xml) {
       }
     }
     // the first copy's size bounds the others before they are allocated
-    CheckRolloutMemory(1, sizeof(mjData) + sizeof(mjtNum) * static_cast<size_t>(model_->nstack));
+    CheckRolloutMemory(1, sizeof(mjData) + static_cast<size_t>(model_->narena));
     datas_.reserve(config_.num_copies);
     for (int i = 0; i < config_.num_copies; ++i) {
       mjData* d = mj_makeData(model_);
@@ -140,8 +139,8 @@ void BatchStepper::Init(const std::string& mjcf_path, const std::string& xml) {
         throw Error(mjcf_path + ": MuJoCo could not allocate data for copy " + std::to_string(i));
       datas_.push_back(d);
       if (i == 0) {
-        copy_bytes_ = sizeof(mjData) + static_cast<size_t>(d->nbuffer) +
-                      sizeof(mjtNum) * static_cast<size_t>(d->nstack);
+        copy_bytes_ =
+            sizeof(mjData) + static_cast<size_t>(d->nbuffer) + static_cast<size_t>(d->narena);
         CheckRolloutMemory(config_.num_copies, copy_bytes_);
       }
       mj_forward(model_, d);
