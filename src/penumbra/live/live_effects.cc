@@ -115,7 +115,7 @@ LiveEffects::Change LiveEffects::Plan(const State& s) const {
       throw ConfigError("", 0, "npcs",
                         "NPC '" + a.name +
                             "' has no body in this run: a run keeps the NPC bodies of the preset "
-                            "it started with (MuJoCo 2.2.2 cannot add bodies to a loaded model); "
+                            "it started with (a run cannot add bodies to its loaded model); "
                             "expected at most those (" +
                             std::to_string(bodies.size() - session_.world().agents.size()) +
                             " NPCs)");

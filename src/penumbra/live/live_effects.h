@@ -18,8 +18,8 @@
 // of a run; the agents are the world's, then the preset's NPCs. every random stream is keyed by
 // the effect's name and type (effects/effects_engine.h), so a change leaves the other effects'
 // particles and noise where they were; stateful fluids (plume smoke, fire) are re-stepped from
-// t = 0 with their new parameters. NPCs: MuJoCo 2.2.2 cannot add bodies to a loaded model, so
-// a run has the NPC bodies of the preset it started with, plus, in a live run, parked bodies
+// t = 0 with their new parameters. NPCs: a run cannot add bodies to its loaded model (the
+// physics state and every index would change mid-run), so a run has the NPC bodies of the preset it started with, plus, in a live run, parked bodies
 // for the NPCs of the bundled presets (SessionOptions::reserve_live_npcs); a change may move
 // them onto other paths or park them (100 m below the floor) but not add more.
 //

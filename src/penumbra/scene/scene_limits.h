@@ -62,10 +62,11 @@ inline constexpr double kMaxDirectionComponent = 1e5;
 inline constexpr int kMaxCameras = 256;
 /// most NPC agents of a run: the world file's `agents`, an adversity preset's people and
 /// vehicles and a live run's parked reserve together. each is a MuJoCo mocap body per part (a
-/// person 9, a vehicle 5), and MuJoCo 2.2.2's collision detection takes nbody (nbody - 1) / 2
-/// doubles of its stack every step: its automatic stack holds that up to about 1,650 bodies
-/// (200 people overflow it at load, "Stack overflow"), and beyond 46,341 bodies the count
-/// overflows an int (10,000 agents ran 339 s and 1 GB before "broadphase buffer full").
+/// person 9, a vehicle 5), and MuJoCo's collision detection takes nbody (nbody - 1) / 2 ints
+/// of its arena every step: MuJoCo 4.0's automatic arena (15-20 MB for such models) holds that
+/// up to about 2,800 bodies and 5,000 overflow it ("mj_stackAlloc: out of memory" at
+/// mj_collision); MuJoCo 2.2.2's stack held about 1,650 (200 people). the bound keeps a run
+/// well inside either.
 inline constexpr int kMaxAgents = 150;
 /// most LiDAR beams per scan (rings x columns; livox_mid40: points per scan): 128 rings x
 /// 32768 columns. a scan's buffers take about 100 bytes per beam (docs/sensors.md).

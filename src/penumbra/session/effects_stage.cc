@@ -492,7 +492,7 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
   if (!spec.empty()) preset_ = LoadAdversityPreset(spec, spec_file, spec_line);
 
   // the preset's regions and NPC paths need the static scene at the start, before the NPCs'
-  // bodies exist: MuJoCo 2.2.2 cannot add bodies to a compiled model, so a world with a
+  // bodies exist, and Penumbra adds no bodies to a compiled model, so a world with a
   // preset compiles its composed document twice, here (a probe, without agents) and for the
   // run. without a preset it compiles once; the world's own agents are checked against
   // the run's model in Attach.
@@ -536,7 +536,8 @@ EffectsStage::EffectsStage(const WorldConfig& world, ComposedScene* composed,
             " in the world file, " + std::to_string(added - reserved_.size()) +
             " from the adversity preset, " + std::to_string(reserved_.size()) +
             " reserved for live presets); expected at most " + std::to_string(kMaxAgents) +
-            " (MuJoCo 2.2.2's collision detection runs out of its stack beyond that)");
+            " (MuJoCo's collision detection needs memory that grows with the square of the bodies; "
+            "each agent is several)");
   }
   AddAgentBodies(bodies, world.file, composed);
 }
@@ -756,8 +757,8 @@ void EffectsStage::Replace(std::vector<EffectConfig> effects, std::vector<AgentC
     if (it == body_names_.end())
       throw ConfigError("", 0, "npcs",
                         "agent '" + a.name +
-                            "' has no body in this run (MuJoCo 2.2.2 cannot add bodies to a "
-                            "loaded model); expected at most the NPCs the run started with");
+                            "' has no body in this run (bodies are not added to a loaded model); "
+                            "expected at most the NPCs the run started with");
     if (a.motion == AgentMotion::kCrowd)
       crowd_slot.push_back(it - body_names_.begin());
     else

@@ -90,7 +90,7 @@ class EffectsStage {
   ///        for the world's own `adversity` key
   /// @param reserve_live_npcs also add parked bodies for the NPCs the bundled presets can ask
   ///        for (LiveNpcReserve), so that a live change to a bundled preset can bring them in
-  ///        (live/live_effects.h; MuJoCo 2.2.2 cannot add bodies to a loaded model)
+  ///        (live/live_effects.h; bodies are not added to a loaded model)
   /// @throws ConfigError for an unknown preset, invalid agents or invalid effects.
   /// @param sites the world's areas and lanes for placing crowds (CrowdSites; empty = none)
   EffectsStage(const WorldConfig& world, ComposedScene* composed,
@@ -129,7 +129,7 @@ class EffectsStage {
   /// at the driver's next call (Simulation::ApplyMocapDrivers or the next step). call on the
   /// loop thread at a step boundary (Evaluate and the mocap drivers run there).
   /// @throws ConfigError("", 0, "npcs", ...) naming an agent without a body, before anything
-  ///         changes (MuJoCo 2.2.2 cannot add bodies to a loaded model).
+  ///         changes (bodies are not added to a loaded model).
   void Replace(std::vector<EffectConfig> effects, std::vector<AgentConfig> agents,
                std::optional<AdversityPreset> preset, std::unique_ptr<EffectsEngine> engine);
   /// names of the agents whose bodies the model has (the agents at Attach), in order.

@@ -355,7 +355,7 @@ class ViewerBridge : public RunBridge {
     s.push_back(slider("rain", "rate_mm_h", "rain rate", "mm/h", 0, 50, 0.5, 0));
     s.push_back(slider("snow", "rate_mm_h", "snow rate", "mm/h", 0, 20, 0.5, 0));
     s.push_back(slider("lights", "scale", "light scale", "", 0, 1, 0.01, 1));
-    // MuJoCo cannot add bodies to a loaded model: the run has the NPC bodies it started with
+    // a run cannot add bodies to its loaded model: the run has the NPC bodies it started with
     // (a live run also parks bodies for the bundled presets' NPCs: live/live_effects.h)
     const int npc_bodies = std::max(
         0, static_cast<int>(session_.effects().agent_bodies().size() - world_.agents.size()));

@@ -18,12 +18,12 @@ Eigen::Vector2d ReadPoint(const ParamReader& r) {
 }  // namespace
 
 std::vector<AgentConfig> ReadAgents(const ParamReader& list, const std::string& file) {
-  // counted before any is read (scene/scene_limits.h: what MuJoCo 2.2.2 can collide)
+  // counted before any is read (scene/scene_limits.h: what MuJoCo's collision detection holds)
   if (list.node().IsSequence() && list.size() > static_cast<size_t>(kMaxAgents))
     list.Fail(std::to_string(list.size()) + " agents; expected at most " +
               std::to_string(kMaxAgents) +
-              " (with an adversity preset's NPCs; MuJoCo 2.2.2's collision detection runs out "
-              "of its stack beyond that)");
+              " (with an adversity preset's NPCs; MuJoCo's collision detection needs memory "
+              "that grows with the square of the bodies)");
   std::vector<AgentConfig> agents;
   std::map<std::string, int> lines;  // key path -> line, for validation messages
   const auto note = [&](const ParamReader& r) {
