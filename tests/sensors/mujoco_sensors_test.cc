@@ -134,5 +134,148 @@ TEST(MujocoSensorsTest, EverySensorReadableByNameWithDimensionUnitAndValue) {
   EXPECT_EQ(UnitSuffix("rad/s^2"), "rad_s2");
 }
 
+// the sensor types MuJoCo added after 2.2.2: an 8 kg box resting on the floor inside a zone
+// site, a 0.1 m ball resting 1 m away along +x, a camera 2 m behind them.
+constexpr const char* kNewTypesModel = R"(
+<mujoco>
+  <option timestep="0.002"/>
+  <asset><mesh name="plate" builtin="plate" params="3 3" scale="0.04 0.04 0.005"/></asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="5 5 0.1"/>
+    <site name="zone" type="box" size="0.5 0.5 0.5" pos="0 0 0.5"/>
+    <camera name="cam" pos="0 -2 0.1" xyaxes="1 0 0 0 0 1" resolution="64 48"/>
+    <body name="box" pos="0 0 0.1">
+      <freejoint/>
+      <geom name="box_geom" type="box" size="0.1 0.1 0.1" mass="8"/>
+      <geom name="skin" type="mesh" mesh="plate" contype="0" conaffinity="0" mass="0"
+            pos="0 0 0.1"/>
+      <site name="center" zaxis="0 0 -1"/>
+    </body>
+    <body name="ball" pos="1 0 0.1">
+      <freejoint/>
+      <geom name="ball_geom" type="sphere" size="0.1" mass="1"/>
+    </body>
+  </worldbody>
+  <sensor>
+    <contact name="feet" geom1="box_geom" geom2="floor" num="2" data="found force dist"
+             reduce="mindist"/>
+    <contact name="net" body1="box" reduce="netforce" data="force pos"/>
+    <insidesite name="inside" objtype="body" objname="box" site="zone"/>
+    <insidesite name="outside" objtype="body" objname="ball" site="zone"/>
+    <distance name="gap" geom1="box_geom" geom2="ball_geom" cutoff="2"/>
+    <normal name="gap_dir" geom1="box_geom" geom2="ball_geom" cutoff="2"/>
+    <fromto name="gap_seg" geom1="box_geom" geom2="ball_geom" cutoff="2"/>
+    <camprojection name="pixel" site="center" camera="cam"/>
+    <rangefinder name="ray" site="center" data="dist point normal"/>
+    <e_potential name="potential"/>
+    <e_kinetic name="kinetic"/>
+    <tactile name="taxels" geom="skin" mesh="plate"/>
+  </sensor>
+</mujoco>)";
+
+TEST(MujocoSensorsTest, SensorTypesNewerThanMujoco2ReadWithTheirLayoutAndUnits) {
+  Simulation sim = Simulation::LoadFromString(kNewTypesModel);
+  for (int i = 0; i < 500; ++i) sim.Step();  // 1 s: both at rest on the floor
+  const WorldSnapshot snap = sim.Snapshot();
+  const std::vector<SensorDescription>& info = sim.sensor_info();
+  ASSERT_EQ(info.size(), 12u);
+  struct Expect {
+    const char* name;
+    const char* type;
+    int dim;
+    const char* unit;
+  };
+  const Expect expect[] = {{"feet", "contact", 2 * 5, ""},   {"net", "contact", 6, ""},
+                           {"inside", "insidesite", 1, "1"}, {"outside", "insidesite", 1, "1"},
+                           {"gap", "distance", 1, "m"},      {"gap_dir", "normal", 3, "1"},
+                           {"gap_seg", "fromto", 6, "m"},    {"pixel", "camprojection", 2, "px"},
+                           {"ray", "rangefinder", 7, ""},    {"potential", "e_potential", 1, "J"},
+                           {"kinetic", "e_kinetic", 1, "J"}, {"taxels", "tactile", 27, ""}};
+  for (const Expect& e : expect) {
+    const int i = FindSensor(info, e.name);
+    ASSERT_GE(i, 0) << e.name;
+    EXPECT_EQ(info[i].type, e.type) << e.name;
+    EXPECT_EQ(info[i].dim, e.dim) << e.name;
+    EXPECT_EQ(info[i].unit, e.unit) << e.name;
+    EXPECT_EQ(static_cast<int>(info[i].components.size()), e.dim) << e.name;
+  }
+  const auto v = [&](const char* name) {
+    return MujocoSensorValues(snap, info[FindSensor(info, name)]);
+  };
+  const double g = 9.81;
+  // contact slots: found = number of box-floor contacts (4 corners), each carrying a quarter
+  // of the weight along its normal (the contact frame's x)
+  EXPECT_EQ(v("feet")[0], 4.0);
+  EXPECT_EQ(v("feet")[5], 4.0);
+  EXPECT_NEAR(v("feet")[1], 8 * g / 4, 0.5);
+  EXPECT_NEAR(v("feet")[4], 0.0, 1e-3);  // penetration of a resting contact, m
+  // the net contact wrench on the box carries its weight; its point lies under the box
+  EXPECT_NEAR(Eigen::Vector3d(v("net")[0], v("net")[1], v("net")[2]).norm(), 8 * g, 0.1);
+  EXPECT_NEAR(v("net")[5], 0.0, 1e-3);
+  EXPECT_EQ(v("inside")[0], 1.0);
+  EXPECT_EQ(v("outside")[0], 0.0);
+  // box face at x = 0.1, ball surface at x = 0.9
+  EXPECT_NEAR(v("gap")[0], 0.8, 1e-3);
+  EXPECT_NEAR(v("gap_dir")[0], 1.0, 1e-6);
+  EXPECT_NEAR(v("gap_seg")[0], 0.1, 1e-3);
+  EXPECT_NEAR(v("gap_seg")[3], 0.9, 1e-3);
+  // the box's centre seen by a camera level with it straight ahead: the image centre
+  EXPECT_NEAR(v("pixel")[0], 32.0, 0.05);
+  EXPECT_NEAR(v("pixel")[1], 24.0, 0.05);
+  // a ray from the box's centre down to the floor (its own geoms excluded)
+  EXPECT_NEAR(v("ray")[0], 0.1, 1e-3);
+  EXPECT_NEAR(v("ray")[3], 0.0, 1e-3);
+  EXPECT_NEAR(v("ray")[6], 1.0, 1e-9);
+  EXPECT_NEAR(v("potential")[0], 9 * g * 0.1, 0.02);
+  EXPECT_NEAR(v("kinetic")[0], 0.0, 1e-3);
+
+  // labels carry the units of values with several
+  const SensorDescription& feet = info[FindSensor(info, "feet")];
+  EXPECT_EQ(feet.components[0], "0_found");
+  EXPECT_EQ(feet.components[1], "0_force_x_N");
+  EXPECT_EQ(feet.components[4], "0_dist_m");
+  EXPECT_EQ(feet.components[5], "1_found");
+  const SensorDescription& ray = info[FindSensor(info, "ray")];
+  EXPECT_EQ(ray.components[0], "dist_m");
+  EXPECT_EQ(ray.components[1], "point_x_m");
+  EXPECT_EQ(ray.components[6], "normal_z");
+  const SensorDescription& taxels = info[FindSensor(info, "taxels")];
+  EXPECT_EQ(taxels.components[0], "depth_0_m");
+  EXPECT_EQ(taxels.components[9], "slip1_0_m_s");
+  EXPECT_EQ(taxels.components[26], "slip2_8_m_s");
+  MujocoSensorSet set(info, {"net", "pixel"});
+  const std::vector<std::string> cols = set.ColumnNames();
+  ASSERT_EQ(cols.size(), 8u);
+  EXPECT_EQ(cols[0], "net_0_force_x_N");
+  EXPECT_EQ(cols[3], "net_0_pos_x_m");
+  EXPECT_EQ(cols[6], "pixel_u_px");
+}
+
+// a MuJoCo-delayed sensor reads in snapshots what the undelayed one read `delay` earlier:
+// its history buffer is part of the state the snapshot copies
+TEST(MujocoSensorsTest, DelayedSensorReadsItsValueOfDelayEarlier) {
+  const std::string model = R"(
+<mujoco>
+  <option timestep="0.002"/>
+  <worldbody><body name="b" pos="0 0 10"><freejoint/><geom size="0.1"/></body></worldbody>
+  <sensor>
+    <framepos name="now" objtype="body" objname="b"/>
+    <framepos name="late" objtype="body" objname="b" nsample="3" delay="0.004"/>
+  </sensor>
+</mujoco>)";
+  Simulation sim = Simulation::LoadFromString(model);
+  const std::vector<SensorDescription>& info = sim.sensor_info();
+  std::vector<double> now;
+  for (int k = 0; k < 10; ++k) {
+    sim.Step();
+    const WorldSnapshot snap = sim.Snapshot();
+    now.push_back(MujocoSensorValues(snap, info[FindSensor(info, "now")])[2]);
+    const double late = MujocoSensorValues(snap, info[FindSensor(info, "late")])[2];
+    // two steps of 2 ms behind (falling: each step's height differs)
+    if (k >= 2) EXPECT_EQ(late, now[k - 2]) << "step " << k;
+  }
+  EXPECT_LT(now.back(), now.front());
+}
+
 }  // namespace
 }  // namespace penumbra
