@@ -1,13 +1,14 @@
 #pragma once
-// a mesh file placed by a world-file `models:` entry becomes an MJCF model that MuJoCo 2.2.2
+// a mesh file placed by a world-file `models:` entry becomes an MJCF model that MuJoCo
 // compiles, plus the imported materials that the renderer's scene gets after extraction
 // (docs/assets.md).
 //
 // the generated MJCF (written next to the meshes, "<stem>-<hash>.xml"): one mesh geom of the
 // world body per imported mesh ("<i>_<mesh name>", MuJoCo binary .msh files with positions,
 // normals and texcoords in metres, z up), each with the material "<material name>" (rgba =
-// the base colour factor, sRGB): static geometry, for which MuJoCo 2.2.2 computes no inertia,
-// so open and flat meshes load (it refuses "mesh volume is too small" in a body). the geoms
+// the base colour factor, sRGB): static geometry whose meshes say inertia="shell", so that
+// MuJoCo's compile-time inertia of every mesh accepts open and flat ones (it refuses "mesh
+// volume is too small" otherwise). the geoms
 // collide with MuJoCo's default (the convex hull of each mesh) and are in group 0. as every
 // model, the composer prefixes the names with "<model>/" and places the geoms at the model pose.
 // ApplyImportedMaterials then gives the scene's "<model>/<material name>" materials the
