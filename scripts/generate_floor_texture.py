@@ -6,8 +6,9 @@ Run from the repository root:  python3 scripts/generate_floor_texture.py
 
 The texture is 512 x 512 sRGB and tiles seamlessly. It shows 8 planks side by side along
 u (columns), each 64 px wide, with grain running along v (rows), staggered end joints, a
-per-plank tone and dark seams. With texuniform and texrepeat 0.8 per metre in room.xml one
-tile covers 1.25 m, so a plank is about 0.16 m wide.
+per-plank tone and dark seams. With texuniform and texrepeat 1.6 in room.xml (MuJoCo repeats a
+texuniform texture texrepeat / 2 times per metre) one tile covers 1.25 m, so a plank is about
+0.16 m wide.
 """
 
 import math

@@ -143,7 +143,7 @@ TEST(ProceduralMaterial, ApplyNamesMissingMaterials) {
   EXPECT_EQ(scene.textures[1].name, "room/floor/metallic_roughness");
   EXPECT_EQ(scene.textures[2].name, "room/floor/normal");
   EXPECT_TRUE(m.texuniform);
-  EXPECT_NEAR(m.texrepeat.x(), 1 / 1.2, 1e-6);
+  EXPECT_NEAR(m.texrepeat.x(), 2 / 1.2, 1e-6);  // MuJoCo: texrepeat / 2 images per metre
   o.material = "room/wall";
   o.line = 12;
   try {

@@ -94,15 +94,23 @@ TEST(MaterialEvalTest, PlaneTexrepeatAndTexuniform) {
                 1e-6);  // black
   }
   s.materials[0].texuniform = true;
-  s.materials[0].texrepeat = {2, 2};  // two repeats per metre: 0.5 m per image
+  s.materials[0].texrepeat = {4, 4};  // MuJoCo: texrepeat / 2 images per metre, 0.5 m per image
   {
     const MaterialEvaluator me(s);
-    const Eigen::Vector3f a = me.Evaluate(HitAt({0.375f, -0.125f, 0}, {0, 0, 1})).pbr.base_color;
-    const Eigen::Vector3f b = me.Evaluate(HitAt({0.875f, 0.375f, 0}, {0, 0, 1})).pbr.base_color;
-    EXPECT_NEAR((a - b).norm(), 0.0, 1e-6);  // one period (0.5 m) apart in x and y
-    // (0.375, -0.125): s = 0.75, t = 0.25 -> texel (1, 0) = white.
+    // s = 2 x - 0.5, t = -2 y - 0.5 (MuJoCo's texture generation); (0.625, -0.375): s = 0.75,
+    // t = 0.25 -> texel (1, 0) = white; one period (0.5 m) further in x and y the same.
+    const Eigen::Vector3f a = me.Evaluate(HitAt({0.625f, -0.375f, 0}, {0, 0, 1})).pbr.base_color;
+    const Eigen::Vector3f b = me.Evaluate(HitAt({1.125f, 0.125f, 0}, {0, 0, 1})).pbr.base_color;
+    EXPECT_NEAR((a - b).norm(), 0.0, 1e-6);
     EXPECT_NEAR(a.x(), 1.0, 1e-6);
     EXPECT_NEAR(a.z(), 1.0, 1e-6);
+    // (0.375, -0.375): s = t = 0.25 -> texel (0, 0) = black; (0.375, -0.125): s = 0.25, t = 0.75
+    // -> texel (0, 1) = red.
+    EXPECT_NEAR(me.Evaluate(HitAt({0.375f, -0.375f, 0}, {0, 0, 1})).pbr.base_color.norm(), 0.0,
+                1e-6);
+    const Eigen::Vector3f red = me.Evaluate(HitAt({0.375f, -0.125f, 0}, {0, 0, 1})).pbr.base_color;
+    EXPECT_NEAR(red.x(), 1.0, 1e-6);
+    EXPECT_NEAR(red.y(), 0.0, 1e-6);
   }
 }
 

@@ -49,8 +49,8 @@ std::shared_ptr<const TextureImage> MenagerieChecker() {
   return std::make_shared<const TextureImage>(n, n, 1, std::move(rgb));
 }
 
-// the infinite ground plane with that texture (texuniform, texrepeat 5 5: 0.1 m checks, edge
-// marks every 0.2 m), a sun and a uniform sky.
+// the infinite ground plane with that texture (texuniform, texrepeat 5 5: MuJoCo draws 0.4 m per
+// image, 0.2 m checks, edge marks on the lines x, y = 0.2 m + k 0.4 m), a sun and a uniform sky.
 SceneDescription CheckerFloor() {
   SceneDescription s = EmptyScene();
   s.sky.radiance = {0.3f, 0.3f, 0.3f};
@@ -71,10 +71,10 @@ SceneDescription CheckerFloor() {
   return s;
 }
 
-// 320 x 240, fovy 20 deg, 1.2 m above the floor, looking along it pitched 2 deg down: the floor
-// 15-60 m away fills about 40 rows below the horizon.
+// 320 x 240, fovy 20 deg, 1.2 m above the floor over the edge-mark line y = 0.2 m, looking along
+// it pitched 2 deg down: the floor 15-60 m away fills about 40 rows below the horizon.
 CameraView FarView() {
-  Pose X_WO = CameraLookingAlongX(Eigen::Vector3d(0, 0, 1.2));
+  Pose X_WO = CameraLookingAlongX(Eigen::Vector3d(0, 0.2, 1.2));
   X_WO.linear() =
       Eigen::AngleAxisd(2 * kDeg, Eigen::Vector3d::UnitY()).toRotationMatrix() * X_WO.linear();
   CameraView view = MakeView(X_WO, 320, 240, 20, true, false, false);
@@ -171,7 +171,7 @@ TEST(TextureFilteringTest, FarFloorKeepsTheTextureMean) {
   EXPECT_NEAR(textured / untextured, 1.0, 0.03);
 }
 
-// a near checker keeps its contrast: seen from 1 m above (a pixel covers ~6 mm, a check 0.1 m)
+// a near checker keeps its contrast: seen from 1 m above (a pixel covers ~6 mm, a check 0.2 m)
 // the bright and dark checks keep the texture's luminance ratio.
 TEST(TextureFilteringTest, NearCheckerStaysSharp) {
   const SceneDescription s = CheckerFloor();
@@ -194,10 +194,11 @@ TEST(TextureFilteringTest, NearCheckerStaysSharp) {
   }
 }
 
-// the contrast of the checker's edge-mark line y = 0 (it runs along the view direction, so it
-// projects to the middle column) on the floor 10-15 m away: per image row there, the brightest
-// of the 5 columns around the middle over the median of the 13 around it (the next lines,
-// y = +-0.2 m, are >= 9 columns away), minus 1, averaged over the rows.
+// the contrast of the checker's edge-mark line y = 0.2 m (it runs along the view direction under
+// the camera, so it projects to the middle column) on the floor 10-15 m away: per image row
+// there, the brightest of the 5 columns around the middle over the median of the 13 around it
+// (the next lines, 0.4 m to either side, are >= 18 columns away), minus 1, averaged over the
+// rows.
 double RunAwayLineContrast(const RenderedFrame& f, int* rows) {
   const int cu = f.radiance.width / 2;
   double sum = 0;

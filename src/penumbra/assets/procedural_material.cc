@@ -462,7 +462,7 @@ void ApplyProceduralMaterials(const std::vector<ProceduralMaterialEntry>& entrie
     m.roughness = 1;
     m.metallic = 1;
     m.texuniform = true;
-    const float r = static_cast<float>(1.0 / maps.size_m);
+    const float r = static_cast<float>(2.0 / maps.size_m);  // MuJoCo: texrepeat / 2 per metre
     m.texrepeat = {r, r};
   }
 }

@@ -68,8 +68,9 @@ ProceduralMaps CachedProceduralMaterial(const ProceduralMaterialConfig& config,
 /// makes them the scene material's: texture (albedo, "<material>/albedo"), and the maps
 /// "<material>/metallic_roughness" and "<material>/normal" (render/material_eval.h, "PBR
 /// maps"), added to scene->textures; base_color 1, roughness and metallic
-/// factors 1 (the maps hold them), texuniform on with texrepeat 1 / size_m (one image per
-/// size_m metres on planes and boxes). the entry's own base_color / roughness / ... (applied
+/// factors 1 (the maps hold them), texuniform on with texrepeat 2 / size_m (one image per
+/// size_m metres on planes and boxes: MuJoCo repeats a texuniform texture texrepeat / 2 times
+/// per metre). the entry's own base_color / roughness / ... (applied
 /// after this by the scene assembly) then scale the maps.
 /// @throws ConfigError(world_file, entry line, "materials.<name>", ...) when the scene has no
 ///         material of that name.

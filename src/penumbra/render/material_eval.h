@@ -9,9 +9,11 @@
 //    wrapped (repeat).
 //  - 2d texture elsewhere: planar projection of the hit point in the geom frame onto the
 //    plane of the dominant axis of the geom-frame normal (for planes and box faces: the face
-//    plane). with texuniform the texture repeats texrepeat times per metre; without, texrepeat
-//    times across the geom's extent along that axis (2 x half-size; an infinite plane counts
-//    as uniform). wrapped (repeat), image rows running along -y of the face.
+//    plane), by MuJoCo's OpenGL texture generation (texture_math.h, PlanarMap): with
+//    texuniform the texture repeats texrepeat / 2 times per metre (MuJoCo's unit-size geom is
+//    2 m across); without, texrepeat times across the geom's extent along that axis
+//    (2 x half-size; an infinite plane counts as uniform). s = 0.5 texrepeat.x x - 0.5 in those
+//    units, wrapped (repeat), image rows running along -y of the face.
 //  - cube texture: looked up by the direction q = p_G / h (h = half extents of the geom's
 //    local bounding box; for a box each face shows a whole cube face, for a sphere q is the
 //    normal), with the face orientation of OpenGL cube maps (OpenGL 4.6 core spec, table 8.19)
@@ -26,7 +28,7 @@
 // with rho the texels per metre of surface of the mapping at the hit and n . v the cosine
 // between the ray and the geometric normal (the paper's isotropic level, its equation for
 // lambda with Delta_0 = log2 rho). rho: planar mapping, sqrt(rho_s rho_t) with rho_s =
-// texrepeat.x w (uniform) or texrepeat.x w / (2 h_a0) (per face), rho_t likewise with the
+// texrepeat.x w / 2 (uniform) or texrepeat.x w / (2 h_a0) (per face), rho_t likewise with the
 // height; mesh texcoords, SurfaceHit::uv_per_m sqrt(w h) (the triangle's texcoord-to-surface
 // area ratio, the paper's t_a / p_a); cube textures, w / (2 max(h)). the colour is a trilinear
 // lookup: bilinear in levels floor(lambda) and floor(lambda) + 1, mixed by the fraction

@@ -237,6 +237,11 @@ PB_HOST_DEVICE inline float CubeRho(float w, float h_max) {
 /// a planar texture mapping at a point (render/material_eval.h, "texture mapping"): texture
 /// coordinates (s, t) in images, their derivatives ds / dp_a0 and dt / dp_a1 along the face
 /// axes a0, a1 (the only non-zero entries of the mapping's gradient), and its texels per metre.
+/// the formulas are MuJoCo's OpenGL texture generation for 2d textures (render_gl3.c,
+/// settexture: s = 0.5 scl_x x - 0.5, t = -0.5 scl_y y - 0.5 in the geom's unit-size object
+/// coordinates): per face, texrepeat images across the face (2 h); texuniform, texrepeat / 2
+/// images per metre (Menagerie's floor, texrepeat 5 with a 2 x 2 checker: 0.4 m per image,
+/// 0.2 m checks).
 struct PlanarMap {
   float s = 0, t = 0;
   float j0 = 0, j1 = 0;
@@ -246,21 +251,21 @@ struct PlanarMap {
 
   /// texels per metre of surface for a w x th image (the isotropic lookup's rho).
   PB_HOST_DEVICE float rho(float w, float th) const {
-    if (uniform) return sqrtf(fabsf(rx) * w * fabsf(ry) * th);
+    if (uniform) return sqrtf(0.5f * fabsf(rx) * w * 0.5f * fabsf(ry) * th);
     return sqrtf(fabsf(rx) * w / (2 * h0) * fabsf(ry) * th / (2 * h1));
   }
 };
 
-/// texuniform mapping: texrepeat (rx, ry) times per metre of the face coordinates p_a0, p_a1,
-/// image rows along -a1.
+/// texuniform mapping: texrepeat (rx, ry) images per 2 m of the face coordinates p_a0, p_a1
+/// (MuJoCo's convention), image rows along -a1.
 PB_HOST_DEVICE inline PlanarMap PlanarMapUniform(float p_a0, float p_a1, float rx, float ry) {
   PlanarMap m;
   m.uniform = true;
   m.rx = rx, m.ry = ry;
-  m.s = p_a0 * rx;
-  m.t = -p_a1 * ry;
-  m.j0 = rx;
-  m.j1 = -ry;
+  m.s = 0.5f * rx * p_a0 - 0.5f;
+  m.t = -0.5f * ry * p_a1 - 0.5f;
+  m.j0 = 0.5f * rx;
+  m.j1 = -0.5f * ry;
   return m;
 }
 
@@ -271,8 +276,8 @@ PB_HOST_DEVICE inline PlanarMap PlanarMapPerFace(float p_a0, float p_a1, float h
   m.uniform = false;
   m.rx = rx, m.ry = ry;
   m.h0 = h0, m.h1 = h1;
-  m.s = (0.5f * p_a0 / h0 + 0.5f) * rx;
-  m.t = (0.5f - 0.5f * p_a1 / h1) * ry;
+  m.s = 0.5f * rx * p_a0 / h0 - 0.5f;
+  m.t = -0.5f * ry * p_a1 / h1 - 0.5f;
   m.j0 = 0.5f * rx / h0;
   m.j1 = -0.5f * ry / h1;
   return m;
