@@ -366,6 +366,39 @@ TEST(Simulation, NonFatalWarningsAreCollectedWithTime) {
   EXPECT_TRUE(sim.TakeWarnings().empty());
 }
 
+TEST(Simulation, KeyframeReachesUnnamedFreeJointsAndActuatorsOfItsModel) {
+  // two composed models: "a/" with Menagerie's unnamed <freejoint/> and an unnamed actuator
+  // with activation dynamics, placed before a stateless one; "b/" named, left alone
+  const char* xml = R"(
+<mujoco>
+  <worldbody>
+    <body name="a/trunk" pos="0 0 0.5"><freejoint/><geom type="box" size=".1 .1 .1"/>
+      <body name="a/leg"><joint name="a/hip" type="hinge"/><geom type="capsule" size=".02 .1"/></body>
+    </body>
+    <body name="b/trunk" pos="1 0 0.5"><freejoint name="b/root"/><geom type="box" size=".1 .1 .1"/></body>
+  </worldbody>
+  <actuator>
+    <general joint="a/hip" dyntype="filter" dynprm="0.1"/>
+    <motor name="b/none" joint="b/root" gear="0 0 1 0 0 0"/>
+  </actuator>
+  <keyframe>
+    <key name="a/home" qpos="0.1 0 0.27 1 0 0 0 0.3 1 0 0.5 1 0 0 0" ctrl="0.7 0" act="0.4"/>
+  </keyframe>
+</mujoco>)";
+  Simulation sim = Simulation::LoadFromString(xml);
+  sim.ApplyKeyframe("a/home", "a/", "models[a].initial_keyframe");
+  const SimState s = sim.GetState();
+  ASSERT_EQ(s.qpos.size(), 15u);
+  EXPECT_EQ(s.qpos[0], 0.1);
+  EXPECT_EQ(s.qpos[2], 0.27) << "the unnamed free joint of a/trunk takes the key's height";
+  EXPECT_EQ(s.qpos[7], 0.3);
+  EXPECT_EQ(s.qpos[8], 1.0) << "b/'s free joint keeps its reference position";
+  EXPECT_EQ(s.qpos[10], 0.5);
+  EXPECT_EQ(s.ctrl[0], 0.7);
+  ASSERT_EQ(s.act.size(), 1u);
+  EXPECT_EQ(s.act[0], 0.4) << "the activation of a/'s unnamed filter actuator";
+}
+
 TEST(Simulation, ControllersRunAtTheirRateOnSimTime) {
   Simulation sim = Simulation::LoadFromString(kArmXml, 0.003);
   auto c30 = std::make_unique<LambdaController>(30, std::vector<NameRequirement>{}, nullptr);

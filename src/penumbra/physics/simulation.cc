@@ -610,8 +610,7 @@ void Simulation::GetState(SimState* out) const {
       [&](const StateFieldInfo& f, auto& v) {
         v.resize(StateFieldSize(f, dims));
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::vector<double>>) {
-          const mjtNum* src = MujocoStatePtr(d, f.field);
-          std::copy(src, src + v.size(), v.begin());
+          ReadMujocoState(d, f.field, v);
         } else {
           for (size_t i = 0; i < v.size(); ++i) v[i] = impl_->schedule[i].next;
         }
@@ -662,7 +661,7 @@ void Simulation::SetState(const SimState& s) {
   const mjModel* m = impl.m;
   mjData* d = impl.d;
   const std::string bad =
-      StateSizeMismatch(s, MujocoStateDims(m, static_cast<int64_t>(impl.schedule.size())));
+      StateMismatch(s, MujocoStateDims(m, static_cast<int64_t>(impl.schedule.size())));
   if (!bad.empty()) throw Error(impl.source + ": SetState: " + bad + " for this model");
   if (s.step < 0 || s.time_sec != SimTimeOfStep(s.step, m->opt.timestep))
     throw Error(impl.source + ": SetState: time_sec " + FormatG(s.time_sec) +
@@ -672,8 +671,7 @@ void Simulation::SetState(const SimState& s) {
   ForEachStateField(
       [&](const StateFieldInfo& f, const auto& v) {
         if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::vector<double>>) {
-          if (!v.empty())
-            std::memcpy(MujocoStatePtr(d, f.field), v.data(), sizeof(mjtNum) * v.size());
+          WriteMujocoState(d, f.field, v);
         } else {
           for (size_t i = 0; i < v.size(); ++i) impl.schedule[i].next = v[i];
         }
@@ -716,12 +714,44 @@ void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix
             prefix.substr(0, prefix.size() - 1) +
             "'; expected one of its <key> names: " + (keys.empty() ? "(it has none)" : keys));
   }
-  const auto mine = [&](mjtObj type, int id) {
+  // an element is the model's when its name carries the prefix; an unnamed one (Menagerie's
+  // `<freejoint/>`, an unnamed actuator) when what it belongs to is: a body by its nearest named
+  // ancestor, a joint by its body, an actuator by its transmission's target
+  const auto named = [&](mjtObj type, int id) -> std::optional<bool> {
     const char* name = mj_id2name(m, type, id);
-    return name != nullptr && std::string(name).rfind(prefix, 0) == 0;
+    if (name == nullptr || *name == '\0') return std::nullopt;
+    return std::string(name).rfind(prefix, 0) == 0;
+  };
+  const auto body_mine = [&](int b) {
+    for (; b > 0; b = m->body_parentid[b])
+      if (const auto own = named(mjOBJ_BODY, b)) return *own;
+    return false;
+  };
+  const auto joint_mine = [&](int j) {
+    const auto own = named(mjOBJ_JOINT, j);
+    return own ? *own : body_mine(m->jnt_bodyid[j]);
+  };
+  const auto mine = [&](mjtObj type, int id) {
+    if (const auto own = named(type, id)) return *own;
+    if (type == mjOBJ_BODY) return body_mine(id);
+    if (type != mjOBJ_ACTUATOR) return false;
+    const int target = m->actuator_trnid[2 * id];
+    switch (m->actuator_trntype[id]) {
+      case mjTRN_JOINT:
+      case mjTRN_JOINTINPARENT:
+        return joint_mine(target);
+      case mjTRN_SITE:
+        return body_mine(m->site_bodyid[target]);
+      case mjTRN_BODY:
+        return body_mine(target);
+      case mjTRN_TENDON:
+        return named(mjOBJ_TENDON, target).value_or(false);
+      default:
+        return false;
+    }
   };
   for (int j = 0; j < m->njnt; ++j) {
-    if (!mine(mjOBJ_JOINT, j)) continue;
+    if (!joint_mine(j)) continue;
     const int type = m->jnt_type[j];
     const int nq = type == mjJNT_FREE ? 7 : type == mjJNT_BALL ? 4 : 1;
     const int nv = type == mjJNT_FREE ? 6 : type == mjJNT_BALL ? 3 : 1;
@@ -734,12 +764,13 @@ void Simulation::ApplyKeyframe(const std::string& key, const std::string& prefix
       d->qvel[a] = m->key_qvel[static_cast<size_t>(k) * m->nv + a];
     }
   }
-  // stateful actuators come last (MuJoCo 2.2.2), act[i] belongs to actuator nu - na + i
   for (int a = 0; a < m->nu; ++a) {
     if (!mine(mjOBJ_ACTUATOR, a)) continue;
     d->ctrl[a] = m->key_ctrl[static_cast<size_t>(k) * m->nu + a];
-    const int act = a - (m->nu - m->na);
-    if (act >= 0) d->act[act] = m->key_act[static_cast<size_t>(k) * m->na + act];
+    for (int i = 0; i < m->actuator_actnum[a]; ++i) {
+      const int act = m->actuator_actadr[a] + i;
+      d->act[act] = m->key_act[static_cast<size_t>(k) * m->na + act];
+    }
   }
   for (int b = 0; b < m->nbody; ++b) {
     const int mocap = m->body_mocapid[b];

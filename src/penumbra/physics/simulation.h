@@ -120,8 +120,9 @@ class Simulation {
   /// GetState (with stateless controllers and the same controller episode start; see SimState).
   /// a state before the episode start (ResetControllers) sets the episode start back to 0. also
   /// clears a PhysicsError, so a simulation can be restarted from a state before it failed.
-  /// @throws Error naming the first field whose size does not match this model, or when
-  ///         time_sec is not SimTimeOfStep(step, timestep()); the state is unchanged then.
+  /// @throws Error naming the first field whose size does not match this model or a flag
+  ///         (eq_active) that is not 0 or 1 (StateMismatch), or when time_sec is not
+  ///         SimTimeOfStep(step, timestep()); the state is unchanged then.
   void SetState(const SimState& state);
 
   /// poses the mocap bodies among `mocap_ids` (mocap ids, see MocapBodyNames) that have a
@@ -134,7 +135,9 @@ class Simulation {
   /// sets the state of one composed model from one of its keyframes: for the MJCF key named
   /// `key` (e.g. "go1/home"), the qpos and qvel of every joint, the ctrl (and act) of every
   /// actuator and the mocap pose of every mocap body whose name starts with `prefix` (e.g.
-  /// "go1/") are copied from the key; everything else is left as it is. then the derived
+  /// "go1/") are copied from the key; an unnamed element counts by what it belongs to (a joint
+  /// by its body, a body by its nearest named ancestor, an actuator by its transmission's
+  /// joint, site, body or tendon); everything else is left as it is. then the derived
   /// quantities are recomputed (mj_forward). call before the first Step(), e.g. for the world
   /// file's `initial_keyframe`.
   /// @throws ConfigError("", 0, `error_key`, ...) when the model has no key `key`, naming the
